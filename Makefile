@@ -1,0 +1,41 @@
+# tiledtex - make / make demo / make test / make bench / make fuzz
+CC      ?= cc
+CFLAGS  ?= -O2 -g
+WARN    := -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes
+STB_INC := $(shell pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
+TOOL_SRC := $(wildcard examples/*.c)
+TOOL_HDR := $(wildcard examples/*.h) tiledtex.h
+
+.PHONY: all demo test bench fuzz clean deps
+
+all: build/tiledtex
+
+build/tiledtex: $(TOOL_SRC) $(TOOL_HDR) | build
+	$(CC) $(CFLAGS) $(WARN) -I. $(STB_INC) $(TOOL_SRC) -o $@ -lm
+
+build:
+	mkdir -p build
+
+# Installs libstb-dev when it is missing and we may (root with apt-get),
+# otherwise says the one command to run.
+deps:
+	@bash tests/ensure_stb.sh
+
+demo: deps build/tiledtex
+	@bash examples/demo.sh
+
+test: deps
+	@bash tests/run.sh
+
+build/bench: bench/bench.c tiledtex.h | build
+	$(CC) -O2 -g $(WARN) -I. bench/bench.c -o $@ -lm
+
+bench: build/bench
+	@./build/bench
+
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	@bash tests/fuzz/run.sh $(FUZZ_SECONDS)
+
+clean:
+	rm -rf build

@@ -1,0 +1,2363 @@
+/* tiledtex.h - v0.1.0 - texture any mesh from one example image, with no seams,
+   no singularities and no visible repetition.   MIT license: see end of file.
+
+   Do this in *one* C or C++ file before including this file:
+
+       #define TILEDTEX_IMPLEMENTATION
+       #include "tiledtex.h"
+
+   Other files just #include "tiledtex.h". Define TILEDTEX_STATIC as well to make
+   every function static to that one file.
+
+   Optional overrides (define before the implementation; all or none):
+       TT_MALLOC(size, user_data)   default malloc(size)
+       TT_FREE(ptr, user_data)      default free(ptr)
+   and TT_ASSERT(x) (default assert). Every allocation also honours the
+   tt_allocator you may pass in an options struct, so nothing here is global.
+
+   QUICK START: tile a quad mesh from a photo (Akleman et al.'s tiled textures)
+
+       tt_mesh_desc desc = {0};
+       desc.positions = xyz; desc.nverts = nverts;          // float[3*nverts]
+       desc.indices = quads; desc.nfaces = nquads; desc.fixed_face_size = 4;
+       tt_mesh *mesh; tt_error err;
+       if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) { puts(err.message); return 1; }
+       tt_tile_layout layout = {0};                          // n=1, 128-texel tiles, gutter 4
+       uint8_t *types = malloc(mesh->ncorners);  float *uv = malloc(8 * mesh->ncorners);
+       tt_assign_boundaries(mesh, &layout, 42, types);       // seeded: same seed, same result
+       tt_assign_uvs(mesh, &layout, types, uv);              // uv[2*c] lines up with indices[c]
+       tt_synth_options opt = {0};  tt_tileset *tiles;       // opt.layout = layout
+       tt_synthesize_tiles(&photo, &opt, &tiles, &err);      // tiles->levels[0] is the atlas
+
+   Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first.
+
+   CONVENTIONS
+     - Half-edges are corners: the half-edges of face f are stored contiguously in
+       the order of your index buffer, so half-edge id == corner id == position in
+       your `indices` array. Every per-corner output (boundary types, UVs) lines up
+       with your own index buffer: no remapping.
+     - Half-edge c runs from corner c to the next corner of the same face. Faces are
+       counter-clockwise seen from outside.
+     - UV origin is the bottom-left of the image (OBJ / OpenGL). Images are stored
+       with row 0 at the top (as image files are), so v = 1 - y / height.
+     - Images are float RGBA, nominally in [0,1]; the library does no colour-space
+       conversion, it blends the values you give it.
+     - Every fallible function returns tt_result (TT_OK == 0, errors negative). Pass
+       a tt_error* (may be NULL) to learn where: face, corner, vertex, and a sentence.
+     - No global or static mutable state: every function is reentrant, and safe to
+       call from several threads on distinct objects.
+
+   SECTIONS (each uses only the ones above it; read top to bottom)
+     1. Common  - results and errors, allocator hooks, seeded RNG
+     2. Mesh    - half-edge builder with validation, queries, quadrangulation
+     3. Image   - float RGBA images, bilinear sampling, 90-degree rotations,
+                  premultiplied `over`, box downsampling, minimum-error cut
+     5. Raster  - 2D triangle rasterisation with barycentrics
+     6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
+                  Textures: A Simple and Practical Technique for Seamless Texturing")
+                - boundary assignment, UV formula, tile-set synthesis, quality report
+*/
+#ifndef TILEDTEX_H
+#define TILEDTEX_H
+
+#define TILEDTEX_VERSION_MAJOR 0
+#define TILEDTEX_VERSION_MINOR 1
+#define TILEDTEX_VERSION_PATCH 0
+#define TILEDTEX_VERSION_STRING "0.1.0"
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifndef TTDEF
+#ifdef TILEDTEX_STATIC
+#define TTDEF static
+#else
+#define TTDEF extern
+#endif
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ======================================================================== */
+/* 1. Common                                                                */
+/* ======================================================================== */
+
+typedef enum tt_result {
+    TT_OK = 0,
+    TT_CANCELLED = -1,                      /* a progress callback asked to stop */
+    TT_ERROR_INVALID_ARGUMENT = -2,         /* NULL pointer, count or option out of range */
+    TT_ERROR_OUT_OF_MEMORY = -3,
+    TT_ERROR_TOO_LARGE = -4,                /* a size would overflow or exceed a documented limit */
+    TT_ERROR_EMPTY_MESH = -5,               /* no faces */
+    TT_ERROR_INDEX_OUT_OF_RANGE = -6,       /* a corner names a vertex that does not exist */
+    TT_ERROR_FACE_TOO_SMALL = -7,           /* a face with fewer than 3 corners */
+    TT_ERROR_REPEATED_VERTEX = -8,          /* a face uses one vertex twice */
+    TT_ERROR_NON_FINITE = -9,               /* NaN or infinite coordinate */
+    TT_ERROR_ZERO_AREA_FACE = -10,          /* a face whose corners are collinear or coincide */
+    TT_ERROR_NON_MANIFOLD_EDGE = -11,       /* an edge shared by more than two faces */
+    TT_ERROR_INCONSISTENT_ORIENTATION = -12,/* two faces use an edge in the same direction */
+    TT_ERROR_NON_MANIFOLD_VERTEX = -13,     /* the faces around a vertex form more than one fan */
+    TT_ERROR_NOT_QUAD_MESH = -14,           /* this step needs quads; quadrangulate first */
+    TT_ERROR_IMAGE_TOO_SMALL = -15,         /* the image cannot hold the requested windows */
+    TT_RESULT_MAX_ENUM = 0x7fffffff
+} tt_result;
+
+/* A sentence describing a result code (static storage, never NULL). */
+TTDEF const char *tt_result_string(tt_result result);
+
+/* Where an error happened. Fields that do not apply are -1. `message` is a
+   complete sentence such as "face 12 (corners 48..51) uses vertex 1033, but the
+   mesh has 1000 vertices". */
+typedef struct tt_error {
+    tt_result result;
+    int face;
+    int corner;
+    int vertex;
+    int other_vertex;   /* the second end of an edge, for edge errors */
+    char message[224];
+} tt_error;
+
+/* Allocation hooks. Leave zeroed to use TT_MALLOC / TT_FREE. `alloc` returns
+   memory suitably aligned for any type, or NULL. */
+typedef struct tt_allocator {
+    void *(*alloc)(size_t size, void *user_data);
+    void (*free)(void *ptr, void *user_data);
+    void *user_data;
+} tt_allocator;
+
+/* Progress callback for long operations: `fraction` runs from 0 to 1. Return
+   non-zero to cancel; the operation then cleans up and returns TT_CANCELLED. */
+typedef int (*tt_progress_fn)(float fraction, void *user_data);
+
+/* Seeded random numbers (PCG32). Integer arithmetic only, so the same seed gives
+   the same sequence on every machine and compiler. Not for cryptography. */
+typedef struct tt_rng {
+    uint64_t state;
+    uint64_t increment;
+} tt_rng;
+
+/* Start a sequence. Different `stream` values give independent sequences for
+   the same seed. */
+TTDEF void tt_rng_seed(tt_rng *rng, uint64_t seed, uint64_t stream);
+TTDEF uint32_t tt_rng_next(tt_rng *rng);                    /* uniform 32 bits */
+TTDEF uint32_t tt_rng_below(tt_rng *rng, uint32_t bound);   /* uniform in [0, bound); 0 if bound==0 */
+TTDEF float tt_rng_float(tt_rng *rng);                      /* uniform in [0, 1), 24-bit grid */
+
+/* ======================================================================== */
+/* 2. Mesh                                                                  */
+/* ======================================================================== */
+
+enum {
+    /* Accept real-world assets: edges shared by more than two faces, edges two
+       faces use in the same direction, and degenerate edges (a face repeating a
+       vertex) become boundary edges instead of errors; non-manifold vertices and
+       zero-area faces are accepted. tt_mesh::repaired_edges counts the edges cut. */
+    TT_MESH_PERMISSIVE = 1u << 0,
+    /* Do not copy positions: the mesh points at desc->positions, which must
+       outlive the mesh and not change while it is in use. */
+    TT_MESH_BORROW_POSITIONS = 1u << 1
+};
+
+typedef struct tt_mesh_desc {
+    const float *positions;     /* 3 * nverts floats: x, y, z */
+    int nverts;
+    const int *indices;         /* corner vertex indices, 0-based, faces one after another */
+    const int *face_sizes;      /* nfaces corner counts, or NULL: every face has fixed_face_size */
+    int nfaces;
+    int fixed_face_size;        /* used when face_sizes is NULL; 0 means 3 */
+    unsigned flags;             /* TT_MESH_* */
+    tt_allocator allocator;     /* zeroed: TT_MALLOC / TT_FREE */
+} tt_mesh_desc;
+
+/* A polygon mesh as half-edges. Read the arrays freely; do not modify them.
+   Corner c of face f is in [face_start[f], face_start[f+1]); the next corner of
+   the same face is implicit (wrapping), so half-edge c runs from corner_vert[c]
+   to corner_vert[next]. */
+typedef struct tt_mesh {
+    int nverts, nfaces, ncorners;
+    const float *pos;           /* 3 * nverts; owned unless TT_MESH_BORROW_POSITIONS */
+    int *face_start;            /* nfaces + 1 */
+    int *corner_vert;           /* ncorners: vertex at corner c = origin of half-edge c */
+    int *corner_face;           /* ncorners: face of corner c */
+    int *twin;                  /* ncorners: opposite half-edge, -1 on a boundary */
+    int *vert_corner;           /* nverts: one outgoing half-edge (a boundary one if any), -1 if unused */
+    int min_face_size, max_face_size;
+    int repaired_edges;         /* TT_MESH_PERMISSIVE only: edges turned into boundaries */
+    unsigned flags;
+    tt_allocator allocator;
+} tt_mesh;
+
+/* Build a half-edge mesh and validate it. On failure *out_mesh is NULL and the
+   error names the first problem in index-buffer order: empty mesh, index out of
+   range, face with fewer than 3 corners or a repeated vertex, non-finite
+   coordinate, zero-area face, an edge shared by more than two faces, two faces
+   using an edge in the same direction, a vertex whose faces form several fans.
+   Twin pairing is O(corners log valence). Free the mesh with tt_mesh_free. */
+TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_error *error);
+TTDEF void tt_mesh_free(tt_mesh *mesh);
+
+/* Index of the corner after / before c in its face. */
+TTDEF int tt_mesh_next(const tt_mesh *mesh, int corner);
+TTDEF int tt_mesh_prev(const tt_mesh *mesh, int corner);
+
+typedef struct tt_mesh_stats {
+    int used_vertices;          /* vertices referenced by at least one face */
+    int edges;                  /* undirected edges (a repaired edge counts once per side) */
+    int boundary_edges;
+    int boundary_loops;
+    int components;             /* connected through shared edges */
+    int euler_characteristic;   /* used_vertices - edges + faces */
+    int genus;                  /* sum over components of (2 - chi - loops) / 2 */
+    int min_valence, max_valence;   /* edges per used vertex */
+    int nonmanifold_vertices;   /* only possible with TT_MESH_PERMISSIVE */
+} tt_mesh_stats;
+
+/* Topology summary. Allocates temporary memory through the mesh's allocator. */
+TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, tt_mesh_stats *stats);
+
+/* Number of edges at vertex v (0 for an unused vertex). */
+TTDEF int tt_mesh_valence(const tt_mesh *mesh, int vertex);
+
+/* histogram[k] = number of used vertices of valence k for k < nbins-1; the last
+   bin counts every valence >= nbins-1. */
+TTDEF tt_result tt_mesh_valence_histogram(const tt_mesh *mesh, int *histogram, int nbins);
+
+/* face_component[f] = component id (0..n-1, numbered in order of first face). */
+TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, int *face_component, int *ncomponents);
+
+/* corner_loop[c] = boundary loop id of boundary half-edge c, -1 for interior ones. */
+TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, int *nloops);
+
+typedef enum tt_subdivision {
+    TT_SUBDIVIDE_LINEAR = 0,        /* new points on the old faces: the shape is kept */
+    TT_SUBDIVIDE_CATMULL_CLARK = 1  /* Catmull-Clark positions: smoother, shrinks a little */
+} tt_subdivision;
+
+/* One step that turns every n-gon into n quads: a point per face and per edge;
+   quad i of face f is (corner i's vertex, edge point of half-edge i, face point,
+   edge point of half-edge i-1). New vertex order: old vertices, then edge points
+   (edges in order of their first half-edge), then face points. Repeat it to make
+   the faces smaller (it is how you choose the texture's scale on the surface).
+   The result inherits the input's flags (without BORROW_POSITIONS). */
+TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme,
+                                      tt_mesh **out_mesh, tt_error *error);
+
+/* ======================================================================== */
+/* 3. Image                                                                 */
+/* ======================================================================== */
+
+/* Width or height above this is refused with TT_ERROR_TOO_LARGE. */
+#define TT_MAX_IMAGE_SIZE 32768
+
+/* Float RGBA, row-major, row 0 at the top. Colours may be straight or
+   premultiplied by alpha: each function says which it expects. */
+typedef struct tt_image {
+    int width, height;
+    float *pixels;              /* 4 * width * height */
+    tt_allocator allocator;
+} tt_image;
+
+/* Allocate a zero-filled image (transparent black). */
+TTDEF tt_result tt_image_create(tt_image *image, int width, int height, const tt_allocator *allocator);
+TTDEF void tt_image_free(tt_image *image);
+
+/* From 8-bit pixels with 1 (grey), 2 (grey+alpha), 3 (RGB) or 4 (RGBA) channels,
+   `stride` bytes per row (0 = width*channels). Values become v/255. */
+TTDEF tt_result tt_image_from_bytes(tt_image *image, const unsigned char *data, int width, int height,
+                                    int channels, int stride, const tt_allocator *allocator);
+/* To 8-bit RGBA, width*height*4 bytes, rounded and clamped; exact inverse of
+   tt_image_from_bytes for values that came from bytes. */
+TTDEF void tt_image_to_rgba8(const tt_image *image, unsigned char *out);
+
+/* Bilinear sample at continuous pixel coordinates: texel (i, j) covers
+   [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5). Clamps to the edge. */
+TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4]);
+
+/* Where pixel (x, y) of a width x height image lands after `quarter_turns`
+   counter-clockwise quarter turns (as the picture is seen, row 0 on top).
+   Works for coordinates outside the image too (it is an affine map). */
+TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y);
+
+/* dst = src turned counter-clockwise by quarter_turns * 90 degrees (any integer,
+   negative = clockwise). dst is created (sizes swap for odd turns); it must not
+   already hold an image. */
+TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, tt_image *dst, const tt_allocator *allocator);
+
+/* Porter-Duff `over` on premultiplied RGBA: dst = src + (1 - src.a) * dst.
+   alpha 1 gives src exactly and alpha 0 leaves dst exactly. Same sizes. */
+TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src);
+TTDEF void tt_rgba_over(float dst[4], const float src_premultiplied[4]);
+
+/* dst = src halved by 2x2 box filter (width and height must be even). */
+TTDEF tt_result tt_image_downsample2(const tt_image *src, tt_image *dst, const tt_allocator *allocator);
+
+/* Minimum-error cut (as in image quilting): in a width x height cost map, find
+   the path path[x] (one row per column) with path[x] in [lo[x], hi[x]] and
+   |path[x] - path[x-1]| <= 1 that minimises the sum of cost[path[x]*width + x].
+   Ties go to the smaller row. Needs lo[x] <= hi[x] and consecutive ranges
+   that a path can follow; returns TT_ERROR_INVALID_ARGUMENT otherwise. */
+TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
+                                 int *path, const tt_allocator *allocator);
+
+/* ======================================================================== */
+/* 5. Raster                                                                */
+/* ======================================================================== */
+
+/* Called once per covered pixel; barycentric[i] is the weight of vertex i at the
+   pixel centre (x + 0.5, y + 0.5), and the three sum to 1. */
+typedef void (*tt_raster_fn)(int x, int y, const float barycentric[3], void *user_data);
+
+/* Visit the pixels of a width x height grid whose centres lie inside the 2D
+   triangle xy = {x0,y0, x1,y1, x2,y2} (either winding). A centre exactly on an
+   edge belongs to the triangle only if that edge is a top or left edge, so
+   triangles sharing an edge never both draw a pixel and leave no gap. */
+TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raster_fn fn, void *user_data);
+
+/* ======================================================================== */
+/* 6. Tiled textures                                                        */
+/* ======================================================================== */
+
+#define TT_MAX_COLORS 128           /* boundary conditions n; types 0..2n-1 fit a byte */
+#define TT_DEFAULT_TILE_SIZE 128
+#define TT_DEFAULT_GUTTER 4
+#define TT_NO_GUTTER (-1)
+
+/* How tiles sit in the atlas. The UVs depend on this and nothing else, so UVs
+   made with one layout fit every atlas synthesised with it.
+   T = (2n)^2 tiles per side, cell C = S + 2g, atlas side W = T * C. */
+typedef struct tt_tile_layout {
+    int colors;       /* n, distinct edge conditions (1..TT_MAX_COLORS); 0 = 1 */
+    int tile_size;    /* S, texels per tile side; 0 = TT_DEFAULT_TILE_SIZE */
+    int gutter;       /* g, texels around each tile; 0 = TT_DEFAULT_GUTTER, TT_NO_GUTTER = none */
+} tt_tile_layout;
+
+/* Replace zeros by defaults and check ranges (the atlas side must stay within
+   TT_MAX_IMAGE_SIZE). */
+TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error);
+/* For a resolved layout: tiles per atlas side T, atlas side W, total tiles (2n)^4. */
+TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout);
+TTDEF int tt_tile_layout_atlas_size(const tt_tile_layout *layout);
+TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout);
+
+/* Akleman et al. Sec. 3 / 6, AssignBoundaries: every edge gets a condition k in
+   [0, n) and a side i in {0, 1} from the seeded RNG; one half-edge gets type
+   2k+i, its twin 2k+1-i. Boundary half-edges get a type too. Works on any mesh.
+   corner_type has mesh->ncorners entries, aligned with the index buffer. */
+TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
+                                     uint8_t *corner_type);
+
+/* Tile of a quad whose half-edges have types e0..e3 (bottom, right, top, left):
+   column = 2n*e0 + e1, row = 2n*e2 + e3 (row 0 at the bottom of the atlas);
+   returns row * T + column. */
+TTDEF int tt_tile_index(const tt_tile_layout *layout, const uint8_t types[4]);
+
+/* UV of corner i (0..3) of the tile with types e0..e3 (Akleman Sec. 3 with n
+   conditions and gutters): j = ((i+1) mod 4) / 2,
+       u = (column*C + g + j*S) / W,   v = (row*C + g + (i/2)*S) / W. */
+TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4], int corner, float uv[2]);
+
+/* AssignTextureCoordinates: corner_uv gets 2 * mesh->ncorners floats. Every face
+   must be a quad (TT_ERROR_NOT_QUAD_MESH names the first that is not). The
+   layout is resolved internally (zeros mean defaults). */
+TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
+                              float *corner_uv, tt_error *error);
+
+typedef struct tt_rect {
+    int x, y, w, h;         /* pixels; (x, y) is the top-left corner, row 0 at the top */
+} tt_rect;
+
+typedef struct tt_synth_options {
+    tt_tile_layout layout;
+    uint64_t seed;
+    /* Edge condition k is a window of two S x S squares stacked vertically: the
+       line between them is the condition; the upper square lines edges of type
+       2k, the lower one (turned 180 degrees) edges of type 2k+1. NULL: chosen
+       from the seed. Otherwise `colors` rects; only x and y are read. */
+    const tt_rect *edge_windows;
+    /* Region from which each tile's S x S background window is drawn; all zero =
+       the whole image. */
+    tt_rect background;
+    int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16) */
+    tt_progress_fn progress;
+    void *progress_user_data;
+    tt_allocator allocator;
+} tt_synth_options;
+
+#define TT_MAX_MIP_LEVELS 16
+
+typedef struct tt_tileset {
+    tt_tile_layout layout;          /* resolved */
+    /* levels[0] is the atlas (W x W, opaque, straight alpha = 1); level L is built
+       per tile by halving each cell, for as long as the cell size stays even.
+       Levels 0..seamless_levels-1 (up to log2(g)) keep every edge seamless under
+       bilinear filtering. */
+    int nlevels;
+    int seamless_levels;
+    tt_image levels[TT_MAX_MIP_LEVELS];
+    tt_rect *edge_windows;          /* colors rects actually used (w = S, h = 2S) */
+    tt_rect *background_windows;    /* one per tile, indexed like tt_tile_index */
+    tt_allocator allocator;
+} tt_tileset;
+
+/* Akleman Sec. 4, tile-set synthesis: every tile ABCD = AXXX over XBXX over XXCX
+   over XXXD over XXXX (Sec. 4). The band along each side is the edge sample for
+   its type, turned to that side; it is cut against what lies beneath where the
+   two agree (minimum-error cut) and feathered, and every texel of a tile's edge
+   rows except the two corner texels is the edge sample alone, exactly. Gutters
+   hold what lies across each edge on the surface. Needs a source of at least
+   S x 2S texels. Free with tt_tileset_free. */
+TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
+                                    tt_tileset **out_tileset, tt_error *error);
+TTDEF void tt_tileset_free(tt_tileset *tileset);
+
+/* Seam measure across every interior edge (the project's acceptance measure):
+   at points along the edge, sample the atlas just inside each of the two faces,
+   half a texel from the edge; compare with two samples the same distance apart
+   inside one face, and with samples from two unrelated edges. Differences are
+   mean absolute RGB differences of bilinear samples.
+   score = (seam - same_face) / (unrelated - same_face): about 0 when an edge
+   looks like any other place in the image, about 1 when tiles do not match. */
+typedef struct tt_seam_report {
+    double seam;
+    double same_face;
+    double unrelated;
+    double score;
+    int edges_measured;
+} tt_seam_report;
+
+/* Works on any mesh with per-corner UVs (2 * ncorners floats) and any atlas;
+   `seed` picks the sample positions and unrelated pairs. */
+TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
+                                 uint64_t seed, tt_seam_report *report);
+
+/* counts[t] = number of quads using tile t (tt_tile_layout_tile_count entries). */
+TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
+                                  int *counts);
+
+/* stretch[f] = ratio of the larger to the smaller singular value of face f's
+   surface -> texture map (1 = no stretch), taken at the face's centre; faces
+   with a degenerate map get INFINITY. nfaces floats. */
+TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TILEDTEX_H */
+
+/* ======================================================================== */
+/* ======================================================================== */
+/*                           IMPLEMENTATION                                 */
+/* ======================================================================== */
+/* ======================================================================== */
+
+#ifdef TILEDTEX_IMPLEMENTATION
+#ifndef TILEDTEX_IMPLEMENTATION_INCLUDED
+#define TILEDTEX_IMPLEMENTATION_INCLUDED
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#if defined(TT_MALLOC) && defined(TT_FREE)
+#elif !defined(TT_MALLOC) && !defined(TT_FREE)
+#include <stdlib.h>
+#define TT_MALLOC(size, user_data) ((void)(user_data), malloc(size))
+#define TT_FREE(ptr, user_data) ((void)(user_data), free(ptr))
+#else
+#error "tiledtex.h: define both TT_MALLOC and TT_FREE, or neither"
+#endif
+
+#ifndef TT_ASSERT
+#include <assert.h>
+#define TT_ASSERT(x) assert(x)
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------ */
+/* 1. Common                                                                */
+/* ------------------------------------------------------------------------ */
+
+TTDEF const char *tt_result_string(tt_result result)
+{
+    switch (result) {
+    case TT_OK: return "success";
+    case TT_CANCELLED: return "cancelled by the progress callback";
+    case TT_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case TT_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case TT_ERROR_TOO_LARGE: return "size too large";
+    case TT_ERROR_EMPTY_MESH: return "the mesh has no faces";
+    case TT_ERROR_INDEX_OUT_OF_RANGE: return "a face refers to a vertex that does not exist";
+    case TT_ERROR_FACE_TOO_SMALL: return "a face has fewer than 3 corners";
+    case TT_ERROR_REPEATED_VERTEX: return "a face uses the same vertex twice";
+    case TT_ERROR_NON_FINITE: return "a coordinate is NaN or infinite";
+    case TT_ERROR_ZERO_AREA_FACE: return "a face has zero area";
+    case TT_ERROR_NON_MANIFOLD_EDGE: return "an edge is shared by more than two faces";
+    case TT_ERROR_INCONSISTENT_ORIENTATION: return "two neighbouring faces are oriented inconsistently";
+    case TT_ERROR_NON_MANIFOLD_VERTEX: return "the faces around a vertex form more than one fan";
+    case TT_ERROR_NOT_QUAD_MESH: return "this step needs a mesh of quads";
+    case TT_ERROR_IMAGE_TOO_SMALL: return "the image is too small for the requested tiles";
+    default: return "unknown tiledtex result";
+    }
+}
+
+/* Fill *error (if given) and return `result`. Every error path goes through
+   here, so every error carries a sentence and the place it refers to. */
+static tt_result tt__fail(tt_error *error, tt_result result, int face, int corner, int vertex,
+                          int other_vertex, const char *format, ...)
+{
+    if (error) {
+        va_list args;
+        error->result = result;
+        error->face = face;
+        error->corner = corner;
+        error->vertex = vertex;
+        error->other_vertex = other_vertex;
+        va_start(args, format);
+        vsnprintf(error->message, sizeof error->message, format, args);
+        va_end(args);
+    }
+    return result;
+}
+
+static tt_result tt__ok(tt_error *error)
+{
+    if (error) {
+        error->result = TT_OK;
+        error->face = error->corner = error->vertex = error->other_vertex = -1;
+        error->message[0] = '\0';
+    }
+    return TT_OK;
+}
+
+static void *tt__alloc(const tt_allocator *allocator, size_t size)
+{
+    if (size == 0) size = 1;
+    if (allocator && allocator->alloc) return allocator->alloc(size, allocator->user_data);
+    return TT_MALLOC(size, allocator ? allocator->user_data : NULL);
+}
+
+static void tt__free(const tt_allocator *allocator, void *ptr)
+{
+    if (!ptr) return;
+    if (allocator && allocator->alloc) {
+        if (allocator->free) allocator->free(ptr, allocator->user_data);
+        return;
+    }
+    TT_FREE(ptr, allocator ? allocator->user_data : NULL);
+}
+
+/* count * element_size bytes, or NULL when that overflows size_t. */
+static void *tt__alloc_array(const tt_allocator *allocator, size_t count, size_t element_size)
+{
+    if (element_size != 0 && count > (size_t)-1 / element_size) return NULL;
+    return tt__alloc(allocator, count * element_size);
+}
+
+#define TT__ALLOC(allocator, type, count) ((type *)tt__alloc_array((allocator), (size_t)(count), sizeof(type)))
+
+static int tt__min_i(int a, int b) { return a < b ? a : b; }
+static int tt__max_i(int a, int b) { return a > b ? a : b; }
+static int tt__clamp_i(int x, int lo, int hi) { return x < lo ? lo : (x > hi ? hi : x); }
+static float tt__clamp_f(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }
+
+/* NaN and infinity have an all-ones exponent. Tested on the bits so that the
+   answer does not depend on compiler flags such as -ffast-math. */
+static int tt__is_finite(float x)
+{
+    uint32_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (bits & 0x7f800000u) != 0x7f800000u;
+}
+
+static float tt__infinity(void)
+{
+    uint32_t bits = 0x7f800000u;
+    float x;
+    memcpy(&x, &bits, sizeof x);
+    return x;
+}
+
+/* PCG32 (O'Neill 2014): a 64-bit LCG whose output is a permuted 32-bit word. */
+TTDEF uint32_t tt_rng_next(tt_rng *rng)
+{
+    uint64_t old = rng->state;
+    uint32_t xorshifted, rotation;
+    rng->state = old * 6364136223846793005ull + rng->increment;
+    xorshifted = (uint32_t)(((old >> 18) ^ old) >> 27);
+    rotation = (uint32_t)(old >> 59);
+    return (xorshifted >> rotation) | (xorshifted << ((32u - rotation) & 31u));
+}
+
+TTDEF void tt_rng_seed(tt_rng *rng, uint64_t seed, uint64_t stream)
+{
+    rng->state = 0;
+    rng->increment = (stream << 1) | 1u;
+    tt_rng_next(rng);
+    rng->state += seed;
+    tt_rng_next(rng);
+}
+
+TTDEF uint32_t tt_rng_below(tt_rng *rng, uint32_t bound)
+{
+    /* Reject the few values that would make `% bound` favour small results. */
+    uint32_t threshold, r;
+    if (bound == 0) return 0;
+    threshold = (0u - bound) % bound;
+    do {
+        r = tt_rng_next(rng);
+    } while (r < threshold);
+    return r % bound;
+}
+
+TTDEF float tt_rng_float(tt_rng *rng)
+{
+    return (float)(tt_rng_next(rng) >> 8) * (1.0f / 16777216.0f);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 2. Mesh                                                                  */
+/* ------------------------------------------------------------------------ */
+
+TTDEF int tt_mesh_next(const tt_mesh *mesh, int corner)
+{
+    int face = mesh->corner_face[corner];
+    return corner + 1 < mesh->face_start[face + 1] ? corner + 1 : mesh->face_start[face];
+}
+
+TTDEF int tt_mesh_prev(const tt_mesh *mesh, int corner)
+{
+    int face = mesh->corner_face[corner];
+    return corner > mesh->face_start[face] ? corner - 1 : mesh->face_start[face + 1] - 1;
+}
+
+TTDEF void tt_mesh_free(tt_mesh *mesh)
+{
+    tt_allocator allocator;
+    if (!mesh) return;
+    allocator = mesh->allocator;
+    if (!(mesh->flags & TT_MESH_BORROW_POSITIONS)) tt__free(&allocator, (void *)mesh->pos);
+    tt__free(&allocator, mesh->face_start);
+    tt__free(&allocator, mesh->corner_vert);
+    tt__free(&allocator, mesh->corner_face);
+    tt__free(&allocator, mesh->twin);
+    tt__free(&allocator, mesh->vert_corner);
+    tt__free(&allocator, mesh);
+}
+
+/* One outgoing half-edge in a vertex's bucket, sorted by destination so that
+   the half-edges of one undirected edge are found by binary search. */
+typedef struct tt__out_edge {
+    int dest;
+    int corner;
+} tt__out_edge;
+
+static int tt__out_edge_less(const tt__out_edge *a, const tt__out_edge *b)
+{
+    return a->dest < b->dest || (a->dest == b->dest && a->corner < b->corner);
+}
+
+static void tt__sift_down(tt__out_edge *items, int root, int count)
+{
+    for (;;) {
+        int child = 2 * root + 1;
+        tt__out_edge tmp;
+        if (child >= count) return;
+        if (child + 1 < count && tt__out_edge_less(&items[child], &items[child + 1])) child++;
+        if (!tt__out_edge_less(&items[root], &items[child])) return;
+        tmp = items[root]; items[root] = items[child]; items[child] = tmp;
+        root = child;
+    }
+}
+
+/* Buckets hold a vertex's valence worth of entries: insertion sort for the
+   usual handful, heapsort so that a pathological fan of a million faces around
+   one vertex is still O(n log n) rather than quadratic. */
+static void tt__sort_out_edges(tt__out_edge *items, int count)
+{
+    int i;
+    if (count <= 24) {
+        for (i = 1; i < count; i++) {
+            tt__out_edge key = items[i];
+            int j = i - 1;
+            while (j >= 0 && tt__out_edge_less(&key, &items[j])) { items[j + 1] = items[j]; j--; }
+            items[j + 1] = key;
+        }
+        return;
+    }
+    for (i = count / 2 - 1; i >= 0; i--) tt__sift_down(items, i, count);
+    for (i = count - 1; i > 0; i--) {
+        tt__out_edge tmp = items[0]; items[0] = items[i]; items[i] = tmp;
+        tt__sift_down(items, 0, i);
+    }
+}
+
+/* First index in items[0..count) whose dest is >= dest. */
+static int tt__lower_bound(const tt__out_edge *items, int count, int dest)
+{
+    int lo = 0, hi = count;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (items[mid].dest < dest) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+}
+
+/* Twice the vector area of a polygon (Newell's method, relative to its first
+   corner so that faces far from the origin lose no precision), compared with
+   its longest edge: "zero area" means numerically zero, not merely thin. */
+static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
+{
+    double n[3] = {0, 0, 0}, longest2 = 0.0, area2;
+    const float *o = pos + 3 * (size_t)verts[0];
+    int i;
+    for (i = 0; i < count; i++) {
+        const float *p = pos + 3 * (size_t)verts[i];
+        const float *q = pos + 3 * (size_t)verts[(i + 1) % count];
+        double a[3], b[3], e2;
+        a[0] = (double)p[0] - o[0]; a[1] = (double)p[1] - o[1]; a[2] = (double)p[2] - o[2];
+        b[0] = (double)q[0] - o[0]; b[1] = (double)q[1] - o[1]; b[2] = (double)q[2] - o[2];
+        n[0] += a[1] * b[2] - a[2] * b[1];
+        n[1] += a[2] * b[0] - a[0] * b[2];
+        n[2] += a[0] * b[1] - a[1] * b[0];
+        e2 = (b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]);
+        if (e2 > longest2) longest2 = e2;
+    }
+    area2 = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return area2 <= 1e-12 * longest2;
+}
+
+/* A problem found while pairing twins; the one with the smallest corner is
+   reported, so the error names the first problem in index-buffer order. */
+typedef struct tt__edge_problem {
+    int corner;              /* -1: none */
+    tt_result result;
+    int a, b;                /* the edge, as vertices */
+    int faces[3];
+    int nfaces;
+} tt__edge_problem;
+
+static tt_result tt__report_edge_problem(const tt__edge_problem *p, tt_error *error)
+{
+    if (p->result == TT_ERROR_INCONSISTENT_ORIENTATION)
+        return tt__fail(error, p->result, p->faces[0], p->corner, p->a, p->b,
+                        "faces %d and %d both run along the edge from vertex %d to vertex %d in the same "
+                        "direction: one of them is flipped (fix its winding, or build with TT_MESH_PERMISSIVE)",
+                        p->faces[0], p->faces[1], p->a, p->b);
+    return tt__fail(error, p->result, p->faces[0], p->corner, p->a, p->b,
+                    "the edge between vertices %d and %d is shared by %d faces (%d, %d, %d%s): a surface edge "
+                    "can border at most two (build with TT_MESH_PERMISSIVE to cut it open)",
+                    p->a, p->b, p->nfaces, p->faces[0], p->faces[1], p->faces[2], p->nfaces > 3 ? ", ..." : "");
+}
+
+/* Number of outgoing half-edges met turning around v from vert_corner[v] (a
+   boundary half-edge when v has one) by h -> twin(prev(h)). A vertex is
+   manifold exactly when this reaches all of its outgoing half-edges. */
+static int tt__fan_size(const tt_mesh *mesh, int v)
+{
+    int start = mesh->vert_corner[v], h = start, visited = 1;
+    if (start < 0) return 0;
+    while (visited <= mesh->ncorners) {
+        int next = mesh->twin[tt_mesh_prev(mesh, h)];
+        if (next < 0 || next == start) break;
+        h = next;
+        visited++;
+    }
+    return visited;
+}
+
+TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_error *error)
+{
+    const tt_allocator *allocator;
+    tt_mesh *mesh = NULL;
+    int *bucket_start = NULL;
+    tt__out_edge *buckets = NULL;
+    int *stamp = NULL;
+    tt__edge_problem problem;
+    tt_result result = TT_OK;
+    int permissive, fixed_size, nverts, nfaces, ncorners, f, c, v;
+    long long total_corners;
+
+    tt__ok(error);
+    if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
+    *out_mesh = NULL;
+    if (!desc) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "desc is NULL");
+    allocator = &desc->allocator;
+    permissive = (desc->flags & TT_MESH_PERMISSIVE) != 0;
+    nverts = desc->nverts;
+    nfaces = desc->nfaces;
+    if (nverts < 0 || nfaces < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "negative count: nverts = %d, nfaces = %d", nverts, nfaces);
+    if (nfaces == 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    if (!desc->indices || (nverts > 0 && !desc->positions))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "desc->indices or desc->positions is NULL");
+
+    /* Face sizes first: they decide how many corners there are. */
+    fixed_size = desc->face_sizes ? 0 : (desc->fixed_face_size ? desc->fixed_face_size : 3);
+    if (desc->face_sizes) {
+        total_corners = 0;
+        for (f = 0; f < nfaces; f++) {
+            int size = desc->face_sizes[f];
+            if (size < 3)
+                return tt__fail(error, TT_ERROR_FACE_TOO_SMALL, f, (int)total_corners, -1, -1,
+                                "face %d has %d corners; a face needs at least 3", f, size);
+            total_corners += size;
+            if (total_corners > 0x3fffffff)
+                return tt__fail(error, TT_ERROR_TOO_LARGE, f, -1, -1, -1,
+                                "the faces have more than %d corners in all", 0x3fffffff);
+        }
+    } else {
+        if (fixed_size < 3)
+            return tt__fail(error, TT_ERROR_FACE_TOO_SMALL, 0, 0, -1, -1,
+                            "fixed_face_size is %d; a face needs at least 3 corners", fixed_size);
+        total_corners = (long long)nfaces * fixed_size;
+        if (total_corners > 0x3fffffff)
+            return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                            "%d faces of %d corners are more than %d corners", nfaces, fixed_size, 0x3fffffff);
+    }
+    ncorners = (int)total_corners;
+
+    mesh = TT__ALLOC(allocator, tt_mesh, 1);
+    if (!mesh) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for the mesh");
+    memset(mesh, 0, sizeof *mesh);
+    mesh->allocator = *allocator;
+    mesh->flags = desc->flags;
+    mesh->nverts = nverts;
+    mesh->nfaces = nfaces;
+    mesh->ncorners = ncorners;
+    mesh->face_start = TT__ALLOC(allocator, int, (size_t)nfaces + 1);
+    mesh->corner_vert = TT__ALLOC(allocator, int, ncorners);
+    mesh->corner_face = TT__ALLOC(allocator, int, ncorners);
+    mesh->twin = TT__ALLOC(allocator, int, ncorners);
+    mesh->vert_corner = TT__ALLOC(allocator, int, nverts);
+    bucket_start = TT__ALLOC(allocator, int, (size_t)nverts + 1);
+    buckets = TT__ALLOC(allocator, tt__out_edge, ncorners);
+    if (desc->flags & TT_MESH_BORROW_POSITIONS) {
+        mesh->pos = desc->positions;
+    } else {
+        float *copy = TT__ALLOC(allocator, float, (size_t)nverts * 3);
+        if (copy && nverts > 0) memcpy(copy, desc->positions, (size_t)nverts * 3 * sizeof(float));
+        mesh->pos = copy;
+    }
+    if (!mesh->face_start || !mesh->corner_vert || !mesh->corner_face || !mesh->twin || !mesh->vert_corner ||
+        !bucket_start || !buckets || !mesh->pos) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                          "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
+        goto cleanup;
+    }
+
+    /* Coordinates must be finite: everything downstream measures lengths. */
+    for (v = 0; v < nverts; v++) {
+        const float *p = desc->positions + 3 * (size_t)v;
+        if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2])) {
+            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, v, -1,
+                              "vertex %d has a coordinate that is NaN or infinite (%g, %g, %g)", v, p[0], p[1],
+                              p[2]);
+            goto cleanup;
+        }
+    }
+
+    /* Corners: copy, range-check, and count each vertex's outgoing half-edges. */
+    memset(bucket_start, 0, ((size_t)nverts + 1) * sizeof(int));
+    c = 0;
+    for (f = 0; f < nfaces; f++) {
+        int size = fixed_size ? fixed_size : desc->face_sizes[f];
+        int first = c, i;
+        mesh->face_start[f] = first;
+        if (size > mesh->max_face_size) mesh->max_face_size = size;
+        if (f == 0 || size < mesh->min_face_size) mesh->min_face_size = size;
+        for (i = 0; i < size; i++, c++) {
+            int vert = desc->indices[c];
+            if (vert < 0 || vert >= nverts) {
+                result = tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, f, c, vert, -1,
+                                  "face %d (corner %d) refers to vertex %d, but the mesh has %d vertices (0..%d)",
+                                  f, c, vert, nverts, nverts - 1);
+                goto cleanup;
+            }
+            mesh->corner_vert[c] = vert;
+            mesh->corner_face[c] = f;
+            bucket_start[vert + 1]++;
+        }
+        /* A repeated vertex makes a degenerate edge or pinches the face. Small
+           faces compare pairs; large ones stamp vertices to stay linear. */
+        if (!permissive) {
+            int repeated = -1, j;
+            if (size <= 16) {
+                for (i = 1; i < size && repeated < 0; i++)
+                    for (j = 0; j < i; j++)
+                        if (mesh->corner_vert[first + i] == mesh->corner_vert[first + j]) { repeated = first + i; break; }
+            } else {
+                if (!stamp) {
+                    stamp = TT__ALLOC(allocator, int, nverts);
+                    if (!stamp) {
+                        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+                        goto cleanup;
+                    }
+                    for (j = 0; j < nverts; j++) stamp[j] = -1;
+                }
+                for (i = 0; i < size; i++) {
+                    int vert = mesh->corner_vert[first + i];
+                    if (stamp[vert] == f) { repeated = first + i; break; }
+                    stamp[vert] = f;
+                }
+            }
+            if (repeated >= 0) {
+                result = tt__fail(error, TT_ERROR_REPEATED_VERTEX, f, repeated, mesh->corner_vert[repeated], -1,
+                                  "face %d uses vertex %d more than once (corner %d)", f,
+                                  mesh->corner_vert[repeated], repeated);
+                goto cleanup;
+            }
+            if (tt__face_has_zero_area(desc->positions, mesh->corner_vert + first, size)) {
+                result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, first, mesh->corner_vert[first], -1,
+                                  "face %d has zero area: its %d corners coincide or lie on one line", f, size);
+                goto cleanup;
+            }
+        }
+    }
+    mesh->face_start[nfaces] = ncorners;
+
+    /* Bucket half-edges by origin vertex (a counting sort), each entry knowing
+       its destination, then sort every bucket by destination. */
+    for (v = 0; v < nverts; v++) bucket_start[v + 1] += bucket_start[v];
+    for (f = 0; f < nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+        for (c = first; c < end; c++) {
+            int origin = mesh->corner_vert[c];
+            int slot = bucket_start[origin]++;
+            buckets[slot].dest = mesh->corner_vert[c + 1 < end ? c + 1 : first];
+            buckets[slot].corner = c;
+        }
+    }
+    for (v = nverts; v > 0; v--) bucket_start[v] = bucket_start[v - 1];
+    bucket_start[0] = 0;
+    for (v = 0; v < nverts; v++)
+        tt__sort_out_edges(buckets + bucket_start[v], bucket_start[v + 1] - bucket_start[v]);
+
+    /* Pair twins, one run of equal destinations at a time: p half-edges a->b
+       here, q half-edges b->a in b's bucket. p = q = 1 is an interior edge,
+       p = 1, q = 0 a boundary; anything else is non-manifold or flipped. */
+    for (c = 0; c < ncorners; c++) mesh->twin[c] = -2;
+    problem.corner = -1;
+    for (v = 0; v < nverts; v++) {
+        int start = bucket_start[v], end = bucket_start[v + 1], i = start;
+        while (i < end) {
+            int dest = buckets[i].dest, run_end = i + 1, p, q = 0, other_start, j, k;
+            while (run_end < end && buckets[run_end].dest == dest) run_end++;
+            p = run_end - i;
+            if (mesh->twin[buckets[i].corner] != -2) { i = run_end; continue; }
+            other_start = bucket_start[dest];
+            if (dest != v) {
+                const tt__out_edge *other = buckets + other_start;
+                int count = bucket_start[dest + 1] - other_start;
+                j = tt__lower_bound(other, count, v);
+                other_start += j;
+                while (j < count && other[j].dest == v) { q++; j++; }
+            }
+            if (dest != v && p == 1 && q <= 1) {
+                int a = buckets[i].corner;
+                if (q == 1) {
+                    int b = buckets[other_start].corner;
+                    mesh->twin[a] = b;
+                    mesh->twin[b] = a;
+                } else {
+                    mesh->twin[a] = -1;
+                }
+            } else {
+                /* Cut every half-edge of this edge loose; remember the problem. */
+                int lowest = buckets[i].corner;
+                for (k = i; k < run_end; k++) mesh->twin[buckets[k].corner] = -1;
+                if (dest != v)
+                    for (k = 0; k < q; k++) {
+                        int b = buckets[other_start + k].corner;
+                        mesh->twin[b] = -1;
+                        if (b < lowest) lowest = b;
+                    }
+                mesh->repaired_edges++;
+                if (!permissive && (problem.corner < 0 || lowest < problem.corner)) {
+                    int nf = 0;
+                    problem.corner = lowest;
+                    problem.a = v;
+                    problem.b = dest;
+                    problem.result = (p + q > 2) ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
+                    for (k = i; k < run_end && nf < 3; k++) problem.faces[nf++] = mesh->corner_face[buckets[k].corner];
+                    for (k = 0; k < q && nf < 3; k++) problem.faces[nf++] = mesh->corner_face[buckets[other_start + k].corner];
+                    while (nf < 3) problem.faces[nf++] = -1;
+                    problem.nfaces = p + q;
+                }
+            }
+            i = run_end;
+        }
+    }
+    if (problem.corner >= 0) {
+        result = tt__report_edge_problem(&problem, error);
+        goto cleanup;
+    }
+    if (!permissive) mesh->repaired_edges = 0;
+
+    /* Each vertex: one outgoing half-edge, a boundary one if there is one. In
+       strict mode also check that its faces form one fan. */
+    for (v = 0; v < nverts; v++) {
+        int start = bucket_start[v], end = bucket_start[v + 1], i, boundary = -1;
+        if (start == end) { mesh->vert_corner[v] = -1; continue; }
+        for (i = start; i < end && boundary < 0; i++)
+            if (mesh->twin[buckets[i].corner] < 0) boundary = buckets[i].corner;
+        mesh->vert_corner[v] = boundary >= 0 ? boundary : buckets[start].corner;
+        if (!permissive && tt__fan_size(mesh, v) != end - start) {
+            result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, mesh->corner_face[mesh->vert_corner[v]],
+                              mesh->vert_corner[v], v, -1,
+                              "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
+                              "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
+                              v, end - start);
+            goto cleanup;
+        }
+    }
+
+cleanup:
+    tt__free(allocator, bucket_start);
+    tt__free(allocator, buckets);
+    tt__free(allocator, stamp);
+    if (result != TT_OK) {
+        tt_mesh_free(mesh);
+        return result;
+    }
+    *out_mesh = mesh;
+    return TT_OK;
+}
+
+TTDEF int tt_mesh_valence(const tt_mesh *mesh, int vertex)
+{
+    /* Turn around the vertex: edges = outgoing half-edges, plus one for the
+       incoming boundary half-edge that closes an open fan. */
+    int start, h, count = 0, guard;
+    if (!mesh || vertex < 0 || vertex >= mesh->nverts || mesh->vert_corner[vertex] < 0) return 0;
+    start = h = mesh->vert_corner[vertex];
+    for (guard = 0; guard <= mesh->ncorners; guard++) {
+        int prev = tt_mesh_prev(mesh, h);
+        count++;
+        if (mesh->twin[prev] < 0) return count + 1;
+        h = mesh->twin[prev];
+        if (h == start) return count;
+    }
+    return count;
+}
+
+/* valence[v] for every vertex in O(corners), counting edges rather than walking
+   fans so that it is right for non-manifold vertices too. */
+static void tt__valences(const tt_mesh *mesh, int *valence)
+{
+    int c;
+    memset(valence, 0, (size_t)mesh->nverts * sizeof(int));
+    for (c = 0; c < mesh->ncorners; c++) {
+        valence[mesh->corner_vert[c]]++;
+        if (mesh->twin[c] < 0) valence[mesh->corner_vert[tt_mesh_next(mesh, c)]]++;
+    }
+}
+
+TTDEF tt_result tt_mesh_valence_histogram(const tt_mesh *mesh, int *histogram, int nbins)
+{
+    int *valence, v;
+    if (!mesh || !histogram || nbins < 1) return TT_ERROR_INVALID_ARGUMENT;
+    valence = TT__ALLOC(&mesh->allocator, int, mesh->nverts);
+    if (!valence) return TT_ERROR_OUT_OF_MEMORY;
+    tt__valences(mesh, valence);
+    memset(histogram, 0, (size_t)nbins * sizeof(int));
+    for (v = 0; v < mesh->nverts; v++)
+        if (mesh->vert_corner[v] >= 0) histogram[tt__min_i(valence[v], nbins - 1)]++;
+    tt__free(&mesh->allocator, valence);
+    return TT_OK;
+}
+
+TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, int *face_component, int *ncomponents)
+{
+    int *queue, f, count = 0;
+    if (!mesh || !face_component || !ncomponents) return TT_ERROR_INVALID_ARGUMENT;
+    queue = TT__ALLOC(&mesh->allocator, int, mesh->nfaces);
+    if (!queue) return TT_ERROR_OUT_OF_MEMORY;
+    for (f = 0; f < mesh->nfaces; f++) face_component[f] = -1;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int head = 0, tail = 0;
+        if (face_component[f] >= 0) continue;
+        face_component[f] = count;
+        queue[tail++] = f;
+        while (head < tail) {
+            int g = queue[head++], c;
+            for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
+                int t = mesh->twin[c];
+                if (t >= 0 && face_component[mesh->corner_face[t]] < 0) {
+                    face_component[mesh->corner_face[t]] = count;
+                    queue[tail++] = mesh->corner_face[t];
+                }
+            }
+        }
+        count++;
+    }
+    *ncomponents = count;
+    tt__free(&mesh->allocator, queue);
+    return TT_OK;
+}
+
+TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, int *nloops)
+{
+    int c, count = 0;
+    if (!mesh || !corner_loop || !nloops) return TT_ERROR_INVALID_ARGUMENT;
+    for (c = 0; c < mesh->ncorners; c++) corner_loop[c] = mesh->twin[c] < 0 ? -2 : -1;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int h = c, steps;
+        if (corner_loop[c] != -2) continue;
+        /* Follow the boundary: from the end of h, turn around its end vertex
+           across interior edges until the outgoing boundary half-edge. */
+        for (steps = 0; steps <= mesh->ncorners && corner_loop[h] == -2; steps++) {
+            int x = tt_mesh_next(mesh, h), guard;
+            corner_loop[h] = count;
+            for (guard = 0; guard <= mesh->ncorners && mesh->twin[x] >= 0; guard++)
+                x = tt_mesh_next(mesh, mesh->twin[x]);
+            if (mesh->twin[x] >= 0) break;
+            h = x;
+        }
+        count++;
+    }
+    *nloops = count;
+    return TT_OK;
+}
+
+TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, tt_mesh_stats *stats)
+{
+    const tt_allocator *allocator;
+    int *valence = NULL, *face_component = NULL, *corner_loop = NULL, *twice_genus = NULL;
+    int *loop_component = NULL, *faces_by_component = NULL, *component_start = NULL;
+    int ncomponents = 0, nloops = 0, v, c, f, k;
+    long long genus_sum = 0;
+    tt_result result = TT_OK;
+    if (!mesh || !stats) return TT_ERROR_INVALID_ARGUMENT;
+    allocator = &mesh->allocator;
+    memset(stats, 0, sizeof *stats);
+    valence = TT__ALLOC(allocator, int, mesh->nverts);
+    face_component = TT__ALLOC(allocator, int, mesh->nfaces);
+    corner_loop = TT__ALLOC(allocator, int, mesh->ncorners);
+    faces_by_component = TT__ALLOC(allocator, int, mesh->nfaces);
+    if (!valence || !face_component || !corner_loop || !faces_by_component) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
+
+    tt__valences(mesh, valence);
+    for (v = 0; v < mesh->nverts; v++) {
+        if (mesh->vert_corner[v] < 0) continue;
+        if (stats->used_vertices == 0 || valence[v] < stats->min_valence) stats->min_valence = valence[v];
+        if (valence[v] > stats->max_valence) stats->max_valence = valence[v];
+        stats->used_vertices++;
+    }
+    for (c = 0; c < mesh->ncorners; c++) {
+        if (mesh->twin[c] < 0) stats->boundary_edges++;
+        if (mesh->twin[c] < c) stats->edges++;   /* boundary, or the later half of a pair */
+    }
+    /* Non-manifold vertices: the fan from vert_corner misses some corners. */
+    memset(valence, 0, (size_t)mesh->nverts * sizeof(int));
+    for (c = 0; c < mesh->ncorners; c++) valence[mesh->corner_vert[c]]++;
+    for (v = 0; v < mesh->nverts; v++)
+        if (mesh->vert_corner[v] >= 0 && tt__fan_size(mesh, v) != valence[v]) stats->nonmanifold_vertices++;
+
+    if ((result = tt_mesh_components(mesh, face_component, &ncomponents)) != TT_OK) goto done;
+    if ((result = tt_mesh_boundary_loops(mesh, corner_loop, &nloops)) != TT_OK) goto done;
+    stats->components = ncomponents;
+    stats->boundary_loops = nloops;
+    stats->euler_characteristic = stats->used_vertices - stats->edges + mesh->nfaces;
+
+    /* genus_c = (2 - chi_c - b_c) / 2 with chi_c = V_c - E_c + F_c; twice_genus
+       starts at 2 per component and takes each term as it is counted. */
+    twice_genus = TT__ALLOC(allocator, int, ncomponents);
+    loop_component = TT__ALLOC(allocator, int, nloops);
+    component_start = TT__ALLOC(allocator, int, (size_t)ncomponents + 1);
+    if (!twice_genus || !loop_component || !component_start) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
+    for (k = 0; k < ncomponents; k++) twice_genus[k] = 2;
+    for (f = 0; f < mesh->nfaces; f++) twice_genus[face_component[f]] -= 1;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] < c) twice_genus[face_component[mesh->corner_face[c]]] += 1;
+    for (k = 0; k < nloops; k++) loop_component[k] = -1;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (corner_loop[c] >= 0 && loop_component[corner_loop[c]] < 0)
+            loop_component[corner_loop[c]] = face_component[mesh->corner_face[c]];
+    for (k = 0; k < nloops; k++) twice_genus[loop_component[k]] -= 1;
+    /* A vertex counts once in every component that uses it (more than one only
+       for a non-manifold vertex): visit faces grouped by component. */
+    memset(component_start, 0, ((size_t)ncomponents + 1) * sizeof(int));
+    for (f = 0; f < mesh->nfaces; f++) component_start[face_component[f] + 1]++;
+    for (k = 0; k < ncomponents; k++) component_start[k + 1] += component_start[k];
+    for (f = 0; f < mesh->nfaces; f++) faces_by_component[component_start[face_component[f]]++] = f;
+    for (v = 0; v < mesh->nverts; v++) valence[v] = -1;   /* now: last component that counted v */
+    for (k = 0; k < mesh->nfaces; k++) {
+        int face = faces_by_component[k], comp = face_component[face];
+        for (c = mesh->face_start[face]; c < mesh->face_start[face + 1]; c++) {
+            int vert = mesh->corner_vert[c];
+            if (valence[vert] != comp) { valence[vert] = comp; twice_genus[comp] -= 1; }
+        }
+    }
+    for (k = 0; k < ncomponents; k++) genus_sum += twice_genus[k];
+    stats->genus = (int)(genus_sum / 2);
+done:
+    tt__free(allocator, valence);
+    tt__free(allocator, face_component);
+    tt__free(allocator, corner_loop);
+    tt__free(allocator, faces_by_component);
+    tt__free(allocator, twice_genus);
+    tt__free(allocator, loop_component);
+    tt__free(allocator, component_start);
+    return result;
+}
+
+/* Quadrangulation: one Catmull-Clark step's topology. Based on: Catmull and
+   Clark 1978 (the paper's reference [3]); Akleman Sec. 6 uses it to turn any
+   mesh into quads. Edge ids follow the first half-edge of each edge. */
+TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, tt_mesh **out_mesh,
+                                      tt_error *error)
+{
+    const tt_allocator *allocator;
+    int *edge_of = NULL, *quads = NULL, nedges = 0, c, f, v;
+    double *sum = NULL;       /* CC vertex rule accumulators: 3 face sums, 3 edge-midpoint sums */
+    int *count = NULL;        /* per vertex: faces, edges, boundary edges */
+    float *pos = NULL;
+    long long nverts_new, ncorners_new;
+    tt_mesh_desc desc;
+    tt_result result;
+
+    tt__ok(error);
+    if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
+    *out_mesh = NULL;
+    if (!mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "mesh is NULL");
+    if (scheme != TT_SUBDIVIDE_LINEAR && scheme != TT_SUBDIVIDE_CATMULL_CLARK)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "unknown subdivision scheme %d",
+                        (int)scheme);
+    allocator = &mesh->allocator;
+    edge_of = TT__ALLOC(allocator, int, mesh->ncorners);
+    if (!edge_of) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c];
+        edge_of[c] = (t < 0 || c < t) ? nedges++ : edge_of[t];
+    }
+    nverts_new = (long long)mesh->nverts + nedges + mesh->nfaces;
+    ncorners_new = 4LL * mesh->ncorners;
+    if (nverts_new > 0x3fffffff || ncorners_new > 0x3fffffff) {
+        tt__free(allocator, edge_of);
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "quadrangulating %d corners would make %lld corners, more than %d", mesh->ncorners,
+                        ncorners_new, 0x3fffffff);
+    }
+    pos = TT__ALLOC(allocator, float, (size_t)nverts_new * 3);
+    quads = TT__ALLOC(allocator, int, (size_t)ncorners_new);
+    if (!pos || !quads) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+        goto done;
+    }
+
+    /* Quad i of face f: (v_i, edge point of half-edge i, face point, edge point
+       of half-edge i-1) keeps the face's counter-clockwise order. */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+        int face_point = mesh->nverts + nedges + f;
+        for (c = first; c < end; c++) {
+            int prev = c > first ? c - 1 : end - 1;
+            int *q = quads + 4 * (size_t)c;
+            q[0] = mesh->corner_vert[c];
+            q[1] = mesh->nverts + edge_of[c];
+            q[2] = face_point;
+            q[3] = mesh->nverts + edge_of[prev];
+        }
+    }
+
+    /* Face points: centroids. Edge points: midpoints (linear, and CC on a
+       boundary) or the average of the two ends and the two face points (CC). */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1], k;
+        double centre[3] = {0, 0, 0};
+        float *out = pos + 3 * ((size_t)mesh->nverts + nedges + f);
+        for (c = first; c < end; c++)
+            for (k = 0; k < 3; k++) centre[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
+        for (k = 0; k < 3; k++) out[k] = (float)(centre[k] / (end - first));
+    }
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], k;
+        const float *a, *b;
+        float *out;
+        if (!(t < 0 || c < t)) continue;
+        a = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+        b = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
+        out = pos + 3 * ((size_t)mesh->nverts + edge_of[c]);
+        if (scheme == TT_SUBDIVIDE_CATMULL_CLARK && t >= 0) {
+            const float *f0 = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[c]);
+            const float *f1 = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[t]);
+            for (k = 0; k < 3; k++) out[k] = (float)(((double)a[k] + b[k] + f0[k] + f1[k]) * 0.25);
+        } else {
+            for (k = 0; k < 3; k++) out[k] = (float)(((double)a[k] + b[k]) * 0.5);
+        }
+    }
+
+    /* Old vertices: kept (linear), or moved by the Catmull-Clark rules:
+       interior  (Q + 2R + (n-3) S) / n  with Q the average face point, R the
+       average edge midpoint, n the number of faces; boundary  3/4 S + 1/8 of
+       each boundary neighbour; a boundary vertex with other than two boundary
+       edges (a corner of a permissive mesh) stays. */
+    if (mesh->nverts > 0) memcpy(pos, mesh->pos, (size_t)mesh->nverts * 3 * sizeof(float));
+    if (scheme == TT_SUBDIVIDE_CATMULL_CLARK && mesh->nverts > 0) {
+        sum = TT__ALLOC(allocator, double, (size_t)mesh->nverts * 9);
+        count = TT__ALLOC(allocator, int, (size_t)mesh->nverts * 3);
+        if (!sum || !count) {
+            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+            goto done;
+        }
+        memset(sum, 0, (size_t)mesh->nverts * 9 * sizeof(double));
+        memset(count, 0, (size_t)mesh->nverts * 3 * sizeof(int));
+        for (c = 0; c < mesh->ncorners; c++) {
+            int a = mesh->corner_vert[c], b = mesh->corner_vert[tt_mesh_next(mesh, c)], t = mesh->twin[c], k;
+            const float *fp = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[c]);
+            for (k = 0; k < 3; k++) sum[9 * (size_t)a + k] += fp[k];
+            count[3 * (size_t)a]++;
+            if (t < 0 || c < t) {
+                for (k = 0; k < 3; k++) {
+                    double mid = 0.5 * ((double)mesh->pos[3 * (size_t)a + k] + mesh->pos[3 * (size_t)b + k]);
+                    sum[9 * (size_t)a + 3 + k] += mid;
+                    sum[9 * (size_t)b + 3 + k] += mid;
+                }
+                count[3 * (size_t)a + 1]++;
+                count[3 * (size_t)b + 1]++;
+            }
+            if (t < 0) {
+                /* Boundary neighbours of a and b: the other end of this edge. */
+                for (k = 0; k < 3; k++) {
+                    sum[9 * (size_t)a + 6 + k] += mesh->pos[3 * (size_t)b + k];
+                    sum[9 * (size_t)b + 6 + k] += mesh->pos[3 * (size_t)a + k];
+                }
+                count[3 * (size_t)a + 2]++;
+                count[3 * (size_t)b + 2]++;
+            }
+        }
+        for (v = 0; v < mesh->nverts; v++) {
+            const double *s = sum + 9 * (size_t)v;
+            const int *n = count + 3 * (size_t)v;
+            const float *old = mesh->pos + 3 * (size_t)v;
+            float *out = pos + 3 * (size_t)v;
+            int k;
+            if (n[0] == 0) continue;
+            if (n[2] == 2) {
+                for (k = 0; k < 3; k++) out[k] = (float)(0.75 * old[k] + 0.125 * s[6 + k]);
+            } else if (n[2] == 0) {
+                double faces = n[0];
+                for (k = 0; k < 3; k++)
+                    out[k] = (float)((s[k] / faces + 2.0 * s[3 + k] / n[1] + (faces - 3.0) * old[k]) / faces);
+            }
+        }
+    }
+
+    memset(&desc, 0, sizeof desc);
+    desc.positions = pos;
+    desc.nverts = (int)nverts_new;
+    desc.indices = quads;
+    desc.nfaces = mesh->ncorners;
+    desc.fixed_face_size = 4;
+    desc.flags = mesh->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS;
+    desc.allocator = mesh->allocator;
+    result = tt_mesh_build(&desc, out_mesh, error);
+done:
+    tt__free(allocator, edge_of);
+    tt__free(allocator, quads);
+    tt__free(allocator, pos);
+    tt__free(allocator, sum);
+    tt__free(allocator, count);
+    return result;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 3. Image                                                                 */
+/* ------------------------------------------------------------------------ */
+
+TTDEF tt_result tt_image_create(tt_image *image, int width, int height, const tt_allocator *allocator)
+{
+    size_t count;
+    if (!image) return TT_ERROR_INVALID_ARGUMENT;
+    memset(image, 0, sizeof *image);
+    if (width <= 0 || height <= 0) return TT_ERROR_INVALID_ARGUMENT;
+    if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) return TT_ERROR_TOO_LARGE;
+    if (allocator) image->allocator = *allocator;
+    count = (size_t)width * (size_t)height;   /* <= 2^30: fits any size_t of 32 bits or more */
+    image->pixels = TT__ALLOC(&image->allocator, float, count * 4);
+    if (!image->pixels) return TT_ERROR_OUT_OF_MEMORY;
+    memset(image->pixels, 0, count * 4 * sizeof(float));
+    image->width = width;
+    image->height = height;
+    return TT_OK;
+}
+
+TTDEF void tt_image_free(tt_image *image)
+{
+    if (!image) return;
+    tt__free(&image->allocator, image->pixels);
+    image->pixels = NULL;
+    image->width = image->height = 0;
+}
+
+TTDEF tt_result tt_image_from_bytes(tt_image *image, const unsigned char *data, int width, int height,
+                                    int channels, int stride, const tt_allocator *allocator)
+{
+    tt_result result;
+    int x, y;
+    if (!image) return TT_ERROR_INVALID_ARGUMENT;
+    memset(image, 0, sizeof *image);
+    if (!data || channels < 1 || channels > 4 || stride < 0) return TT_ERROR_INVALID_ARGUMENT;
+    if (stride == 0) stride = width * channels;
+    else if (stride < width * channels) return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt_image_create(image, width, height, allocator)) != TT_OK) return result;
+    for (y = 0; y < height; y++) {
+        const unsigned char *row = data + (size_t)y * (size_t)stride;
+        float *out = image->pixels + (size_t)y * width * 4;
+        for (x = 0; x < width; x++, out += 4) {
+            const unsigned char *p = row + (size_t)x * channels;
+            float grey = p[0] / 255.0f;
+            switch (channels) {
+            case 1: out[0] = out[1] = out[2] = grey; out[3] = 1.0f; break;
+            case 2: out[0] = out[1] = out[2] = grey; out[3] = p[1] / 255.0f; break;
+            case 3: out[0] = grey; out[1] = p[1] / 255.0f; out[2] = p[2] / 255.0f; out[3] = 1.0f; break;
+            default: out[0] = grey; out[1] = p[1] / 255.0f; out[2] = p[2] / 255.0f; out[3] = p[3] / 255.0f; break;
+            }
+        }
+    }
+    return TT_OK;
+}
+
+TTDEF void tt_image_to_rgba8(const tt_image *image, unsigned char *out)
+{
+    size_t i, n;
+    if (!image || !image->pixels || !out) return;
+    n = (size_t)image->width * image->height * 4;
+    for (i = 0; i < n; i++) {
+        float value = image->pixels[i];
+        value = value != value ? 0.0f : tt__clamp_f(value, 0.0f, 1.0f);
+        out[i] = (unsigned char)(value * 255.0f + 0.5f);
+    }
+}
+
+TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4])
+{
+    float fx = x - 0.5f, fy = y - 0.5f, tx, ty;
+    int x0, y0, x1, y1, k;
+    const float *p00, *p10, *p01, *p11;
+    if (!(fx > -1e9f && fx < 1e9f)) fx = 0.0f;   /* NaN or absurd: clamp somewhere sane */
+    if (!(fy > -1e9f && fy < 1e9f)) fy = 0.0f;
+    x0 = (int)floorf(fx);
+    y0 = (int)floorf(fy);
+    tx = fx - (float)x0;
+    ty = fy - (float)y0;
+    x1 = tt__clamp_i(x0 + 1, 0, image->width - 1);
+    y1 = tt__clamp_i(y0 + 1, 0, image->height - 1);
+    x0 = tt__clamp_i(x0, 0, image->width - 1);
+    y0 = tt__clamp_i(y0, 0, image->height - 1);
+    p00 = image->pixels + ((size_t)y0 * image->width + x0) * 4;
+    p10 = image->pixels + ((size_t)y0 * image->width + x1) * 4;
+    p01 = image->pixels + ((size_t)y1 * image->width + x0) * 4;
+    p11 = image->pixels + ((size_t)y1 * image->width + x1) * 4;
+    for (k = 0; k < 4; k++) {
+        float top = p00[k] + (p10[k] - p00[k]) * tx;
+        float bottom = p01[k] + (p11[k] - p01[k]) * tx;
+        rgba[k] = top + (bottom - top) * ty;
+    }
+}
+
+TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y)
+{
+    /* One counter-clockwise quarter turn of a W x H picture (row 0 on top)
+       sends the top-left corner to the bottom-left: (x, y) -> (y, W-1-x). */
+    switch (((quarter_turns % 4) + 4) % 4) {
+    case 0: *out_x = x; *out_y = y; break;
+    case 1: *out_x = y; *out_y = width - 1 - x; break;
+    case 2: *out_x = width - 1 - x; *out_y = height - 1 - y; break;
+    default: *out_x = height - 1 - y; *out_y = x; break;
+    }
+}
+
+TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, tt_image *dst, const tt_allocator *allocator)
+{
+    int odd, x, y;
+    tt_result result;
+    if (!src || !dst || !src->pixels || src == dst) return TT_ERROR_INVALID_ARGUMENT;
+    odd = (((quarter_turns % 4) + 4) % 4) & 1;
+    result = tt_image_create(dst, odd ? src->height : src->width, odd ? src->width : src->height, allocator);
+    if (result != TT_OK) return result;
+    for (y = 0; y < src->height; y++)
+        for (x = 0; x < src->width; x++) {
+            int rx, ry;
+            tt_rotate_coords(quarter_turns, src->width, src->height, x, y, &rx, &ry);
+            memcpy(dst->pixels + ((size_t)ry * dst->width + rx) * 4, src->pixels + ((size_t)y * src->width + x) * 4,
+                   4 * sizeof(float));
+        }
+    return TT_OK;
+}
+
+TTDEF void tt_rgba_over(float dst[4], const float src[4])
+{
+    float keep = 1.0f - src[3];
+    dst[0] = src[0] + keep * dst[0];
+    dst[1] = src[1] + keep * dst[1];
+    dst[2] = src[2] + keep * dst[2];
+    dst[3] = src[3] + keep * dst[3];
+}
+
+TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src)
+{
+    size_t i, n;
+    if (!dst || !src || !dst->pixels || !src->pixels) return TT_ERROR_INVALID_ARGUMENT;
+    if (dst->width != src->width || dst->height != src->height) return TT_ERROR_INVALID_ARGUMENT;
+    n = (size_t)dst->width * dst->height;
+    for (i = 0; i < n; i++) tt_rgba_over(dst->pixels + 4 * i, src->pixels + 4 * i);
+    return TT_OK;
+}
+
+TTDEF tt_result tt_image_downsample2(const tt_image *src, tt_image *dst, const tt_allocator *allocator)
+{
+    int x, y, k, w, h;
+    tt_result result;
+    if (!src || !dst || !src->pixels || src == dst) return TT_ERROR_INVALID_ARGUMENT;
+    if (src->width % 2 || src->height % 2) return TT_ERROR_INVALID_ARGUMENT;
+    w = src->width / 2;
+    h = src->height / 2;
+    if ((result = tt_image_create(dst, w, h, allocator)) != TT_OK) return result;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            const float *a = src->pixels + ((size_t)(2 * y) * src->width + 2 * x) * 4;
+            const float *b = a + (size_t)src->width * 4;
+            float *out = dst->pixels + ((size_t)y * w + x) * 4;
+            for (k = 0; k < 4; k++) out[k] = 0.25f * (a[k] + a[4 + k] + b[k] + b[4 + k]);
+        }
+    return TT_OK;
+}
+
+TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
+                                 int *path, const tt_allocator *allocator)
+{
+    /* Dynamic programming over columns (Efros and Freeman 2001, the paper's
+       reference [2]): total[x][y] = cost[y][x] + min over y-1..y+1 of
+       total[x-1][.], restricted to each column's allowed rows. */
+    double *total;
+    signed char *step;
+    int x, y, best = -1;
+    const double unreachable = 1e300;
+    if (!cost || !lo || !hi || !path || width <= 0 || height <= 0) return TT_ERROR_INVALID_ARGUMENT;
+    for (x = 0; x < width; x++)
+        if (lo[x] < 0 || hi[x] >= height || lo[x] > hi[x]) return TT_ERROR_INVALID_ARGUMENT;
+    if ((size_t)width * (size_t)height > ((size_t)1 << 28)) return TT_ERROR_TOO_LARGE;
+    total = TT__ALLOC(allocator, double, (size_t)width * height);
+    step = TT__ALLOC(allocator, signed char, (size_t)width * height);
+    if (!total || !step) {
+        tt__free(allocator, total);
+        tt__free(allocator, step);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    for (x = 0; x < width; x++) {
+        for (y = 0; y < height; y++) {
+            size_t i = (size_t)x * height + y;
+            double from = 0.0;
+            int d, choice = 0;
+            total[i] = unreachable;
+            step[i] = 0;
+            if (y < lo[x] || y > hi[x]) continue;
+            if (x > 0) {
+                from = unreachable;
+                for (d = -1; d <= 1; d++) {
+                    int py = y + d;
+                    if (py < 0 || py >= height) continue;
+                    if (total[(size_t)(x - 1) * height + py] < from) {
+                        from = total[(size_t)(x - 1) * height + py];
+                        choice = d;
+                    }
+                }
+                if (from >= unreachable) continue;
+            }
+            total[i] = from + cost[(size_t)y * width + x];
+            step[i] = (signed char)choice;
+        }
+    }
+    for (y = 0; y < height; y++)
+        if (total[(size_t)(width - 1) * height + y] < unreachable &&
+            (best < 0 || total[(size_t)(width - 1) * height + y] < total[(size_t)(width - 1) * height + best]))
+            best = y;
+    if (best < 0) {
+        tt__free(allocator, total);
+        tt__free(allocator, step);
+        return TT_ERROR_INVALID_ARGUMENT;
+    }
+    for (x = width - 1; x >= 0; x--) {
+        path[x] = best;
+        best += step[(size_t)x * height + best];
+    }
+    tt__free(allocator, total);
+    tt__free(allocator, step);
+    return TT_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 5. Raster                                                                */
+/* ------------------------------------------------------------------------ */
+
+/* Vertices are snapped to 1/256 pixel and edge functions evaluated in 64-bit
+   integers, as GPUs do: two triangles sharing an edge then compute exactly
+   opposite edge values, so the top-left rule can give every pixel centre on
+   the shared edge to exactly one of them. */
+#define TT__SUBPIXEL 256
+#define TT__RASTER_LIMIT 2097152.0   /* |coordinate| in pixels; keeps products within 63 bits */
+
+TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raster_fn fn, void *user_data)
+{
+    long long px[3], py[3], area, bias[3], step_x[3], step_y[3], row[3];
+    float min_x, max_x, min_y, max_y, inverse_area;
+    int i, x0, x1, y0, y1, x, y, swapped = 0;
+    if (!xy || !fn || width <= 0 || height <= 0) return;
+    for (i = 0; i < 6; i++)
+        if (!(xy[i] > -TT__RASTER_LIMIT && xy[i] < TT__RASTER_LIMIT)) return;
+    for (i = 0; i < 3; i++) {
+        px[i] = (long long)floor((double)xy[2 * i] * TT__SUBPIXEL + 0.5);
+        py[i] = (long long)floor((double)xy[2 * i + 1] * TT__SUBPIXEL + 0.5);
+    }
+    area = (px[1] - px[0]) * (py[2] - py[0]) - (px[2] - px[0]) * (py[1] - py[0]);
+    if (area == 0) return;
+    if (area < 0) {   /* make the winding positive; remember to swap weights back */
+        long long t;
+        t = px[1]; px[1] = px[2]; px[2] = t;
+        t = py[1]; py[1] = py[2]; py[2] = t;
+        area = -area;
+        swapped = 1;
+    }
+    min_x = max_x = xy[0];
+    min_y = max_y = xy[1];
+    for (i = 1; i < 3; i++) {
+        if (xy[2 * i] < min_x) min_x = xy[2 * i];
+        if (xy[2 * i] > max_x) max_x = xy[2 * i];
+        if (xy[2 * i + 1] < min_y) min_y = xy[2 * i + 1];
+        if (xy[2 * i + 1] > max_y) max_y = xy[2 * i + 1];
+    }
+    x0 = tt__max_i((int)floorf(min_x - 0.5f), 0);
+    y0 = tt__max_i((int)floorf(min_y - 0.5f), 0);
+    x1 = tt__min_i((int)ceilf(max_x - 0.5f), width - 1);
+    y1 = tt__min_i((int)ceilf(max_y - 0.5f), height - 1);
+    if (x0 > x1 || y0 > y1) return;
+    inverse_area = 1.0f / (float)area;
+
+    /* Edge i is opposite vertex i, from vertex i+1 to i+2; its function is
+       positive inside. With y pointing down, a top edge is horizontal with
+       the inside below (dy == 0, dx > 0) and a left edge has dy < 0; on other
+       edges a centre exactly on the line is outside (bias -1). */
+    for (i = 0; i < 3; i++) {
+        int a = (i + 1) % 3, b = (i + 2) % 3;
+        long long dx = px[b] - px[a], dy = py[b] - py[a];
+        long long cx = (long long)x0 * TT__SUBPIXEL + TT__SUBPIXEL / 2;
+        long long cy = (long long)y0 * TT__SUBPIXEL + TT__SUBPIXEL / 2;
+        int top_left = (dy == 0 && dx > 0) || dy < 0;
+        bias[i] = top_left ? 0 : -1;
+        row[i] = dx * (cy - py[a]) - dy * (cx - px[a]);
+        step_x[i] = -dy * TT__SUBPIXEL;
+        step_y[i] = dx * TT__SUBPIXEL;
+    }
+    for (y = y0; y <= y1; y++) {
+        long long e0 = row[0], e1 = row[1], e2 = row[2];
+        for (x = x0; x <= x1; x++) {
+            if (e0 + bias[0] >= 0 && e1 + bias[1] >= 0 && e2 + bias[2] >= 0) {
+                float weight[3];
+                weight[0] = (float)e0 * inverse_area;
+                weight[1] = (float)e1 * inverse_area;
+                weight[2] = 1.0f - weight[0] - weight[1];
+                if (swapped) { float t = weight[1]; weight[1] = weight[2]; weight[2] = t; }
+                fn(x, y, weight, user_data);
+            }
+            e0 += step_x[0]; e1 += step_x[1]; e2 += step_x[2];
+        }
+        row[0] += step_y[0]; row[1] += step_y[1]; row[2] += step_y[2];
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* 6. Tiled textures                                                        */
+/* ------------------------------------------------------------------------ */
+/* Based on: E. Akleman, J. Chen, V. Meenakshisundaram, V. Srinivasan, "Tiled
+   Textures: A Simple and Practical Technique for Seamless Texturing".
+     Sec. 2   tiles named by their four boundary types, placed by their name
+     Sec. 3   AssignBoundaries + AssignTextureCoordinates   -> tt_assign_boundaries,
+                                                               tt_assign_uvs
+     Sec. 4   tile synthesis by compositing                 -> tt_synthesize_tiles
+     Sec. 6   n conditions: types 2k, 2k+1; (2n)^4 tiles
+   Beyond the paper: gutters around tiles and a per-tile mip chain, so that
+   bilinear filtering and mip-mapping do not bleed across tiles; a measured
+   seam score (tt_measure_seams).
+
+   A quad's corners 0..3 are counter-clockwise; half-edge i runs from corner i
+   to corner i+1, so e0 is the tile's bottom, e1 its right, e2 its top, e3 its
+   left side. */
+
+TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error)
+{
+    tt_tile_layout layout;
+    long long tiles_per_side, atlas;
+    tt__ok(error);
+    if (!in || !out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "layout is NULL");
+    layout = *in;
+    if (layout.colors == 0) layout.colors = 1;
+    if (layout.tile_size == 0) layout.tile_size = TT_DEFAULT_TILE_SIZE;
+    if (layout.gutter == 0) layout.gutter = TT_DEFAULT_GUTTER;
+    else if (layout.gutter == TT_NO_GUTTER) layout.gutter = 0;
+    if (layout.colors < 1 || layout.colors > TT_MAX_COLORS)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "colors (boundary conditions) must be 1..%d, got %d", TT_MAX_COLORS, in->colors);
+    if (layout.tile_size < 4 || layout.tile_size > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, layout.tile_size > 0 ? TT_ERROR_TOO_LARGE : TT_ERROR_INVALID_ARGUMENT,
+                        -1, -1, -1, -1, "tile size must be 4..%d texels, got %d", TT_MAX_IMAGE_SIZE, in->tile_size);
+    if (layout.gutter < 0 || layout.gutter > layout.tile_size)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "gutter must be 0..%d texels (at most the tile size), got %d", layout.tile_size,
+                        in->gutter);
+    tiles_per_side = 4LL * layout.colors * layout.colors;
+    atlas = tiles_per_side * (layout.tile_size + 2LL * layout.gutter);
+    if (atlas > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "%d colors of %d-texel tiles with a %d-texel gutter need an atlas %lld texels wide; "
+                        "the limit is %d (use fewer colors or smaller tiles)",
+                        layout.colors, layout.tile_size, layout.gutter, atlas, TT_MAX_IMAGE_SIZE);
+    *out = layout;
+    return TT_OK;
+}
+
+TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout)
+{
+    return 4 * layout->colors * layout->colors;
+}
+
+TTDEF int tt_tile_layout_atlas_size(const tt_tile_layout *layout)
+{
+    return tt_tile_layout_tiles_per_side(layout) * (layout->tile_size + 2 * layout->gutter);
+}
+
+TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout)
+{
+    int side = tt_tile_layout_tiles_per_side(layout);
+    return side * side;
+}
+
+TTDEF int tt_tile_index(const tt_tile_layout *layout, const uint8_t types[4])
+{
+    int base = 2 * layout->colors;
+    int column = base * types[0] + types[1];
+    int row = base * types[2] + types[3];
+    return row * base * base + column;
+}
+
+TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4], int corner, float uv[2])
+{
+    /* The paper prints floor(j/2) in the u equation (Figure 6); with
+       j = floor(((i+1) mod 4)/2) already 0 or 1 that would pin u to the
+       tile's left side. j itself is the corner's column within the tile. */
+    int base = 2 * layout->colors, tiles = base * base;
+    int cell = layout->tile_size + 2 * layout->gutter;
+    double atlas = (double)tiles * cell;
+    int column = base * types[0] + types[1], row = base * types[2] + types[3];
+    int j = ((corner + 1) & 3) >> 1, k = (corner & 3) >> 1;
+    uv[0] = (float)(((double)column * cell + layout->gutter + (double)j * layout->tile_size) / atlas);
+    uv[1] = (float)(((double)row * cell + layout->gutter + (double)k * layout->tile_size) / atlas);
+}
+
+TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
+                                     uint8_t *corner_type)
+{
+    tt_rng rng;
+    int n, c;
+    if (!mesh || !corner_type) return TT_ERROR_INVALID_ARGUMENT;
+    n = layout && layout->colors ? layout->colors : 1;
+    if (n < 1 || n > TT_MAX_COLORS) return TT_ERROR_INVALID_ARGUMENT;
+    tt_rng_seed(&rng, seed, 0x6564676573ull /* "edges" */);
+    /* Edges are visited in order of their first half-edge, so the result
+       depends only on the mesh and the seed. */
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c];
+        uint32_t k, side;
+        if (t >= 0 && t < c) continue;
+        k = n > 1 ? tt_rng_below(&rng, (uint32_t)n) : 0u;
+        side = tt_rng_next(&rng) >> 31;
+        corner_type[c] = (uint8_t)(2u * k + side);
+        if (t >= 0) corner_type[t] = (uint8_t)(2u * k + 1u - side);
+    }
+    return TT_OK;
+}
+
+TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
+                              float *corner_uv, tt_error *error)
+{
+    tt_tile_layout resolved;
+    tt_result result;
+    float *table;   /* table[2*value + j]: the u (or v) of tile column (row) `value`, side j */
+    int f, base, tiles, value, c;
+    tt__ok(error);
+    if (!mesh || !layout || !corner_type || !corner_uv)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "NULL argument to tt_assign_uvs");
+    if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
+    base = 2 * resolved.colors;
+    tiles = base * base;
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4)
+            return tt__fail(error, TT_ERROR_NOT_QUAD_MESH, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners; tiled textures need quads (quadrangulate the mesh first)",
+                            f, mesh->face_start[f + 1] - mesh->face_start[f]);
+    for (c = 0; c < mesh->ncorners; c++)
+        if (corner_type[c] >= base)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                            "corner %d has boundary type %d, but %d colors allow 0..%d", c, corner_type[c],
+                            resolved.colors, base - 1);
+    table = TT__ALLOC(&mesh->allocator, float, 2 * (size_t)tiles);
+    if (!table) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    for (value = 0; value < tiles; value++) {
+        uint8_t types[4];
+        float uv[2];
+        types[0] = types[2] = (uint8_t)(value / base);
+        types[1] = types[3] = (uint8_t)(value % base);
+        tt_tile_corner_uv(&resolved, types, 0, uv);
+        table[2 * value] = uv[0];
+        tt_tile_corner_uv(&resolved, types, 2, uv);
+        table[2 * value + 1] = uv[0];
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        const uint8_t *e = corner_type + 4 * (size_t)f;
+        float *uv = corner_uv + 8 * (size_t)f;
+        int column = base * e[0] + e[1], row = base * e[2] + e[3];
+        float u0 = table[2 * column], u1 = table[2 * column + 1];
+        float v0 = table[2 * row], v1 = table[2 * row + 1];
+        uv[0] = u0; uv[1] = v0;   /* corner 0: bottom-left  */
+        uv[2] = u1; uv[3] = v0;   /* corner 1: bottom-right */
+        uv[4] = u1; uv[5] = v1;   /* corner 2: top-right    */
+        uv[6] = u0; uv[7] = v1;   /* corner 3: top-left     */
+    }
+    tt__free(&mesh->allocator, table);
+    return TT_OK;
+}
+
+/* --- tile-set synthesis (Akleman Sec. 4) --------------------------------- */
+
+/* Everything one synthesis run shares. Tiles are composed in a "side frame"
+   per side s: x runs along the side in the direction of its half-edge, d is
+   the distance from the side into the tile (d = 0 is the side's edge row,
+   d < 0 lies in the gutter, across the edge). The side frame is the tile's
+   bottom side turned by s quarter turns, so it maps to tile texels through
+   tt_rotate_coords(s, S, S, x, S-1-d). */
+typedef struct tt__synth {
+    const tt_image *source;
+    const tt_rect *windows;   /* per condition: S x 2S, top-left (x, y) */
+    int n, size, gutter, feather, min_depth, max_depth;
+    float *tile;              /* S x S RGBA, premultiplied (opaque) */
+    float *cost;              /* S x (max_depth + 1) */
+    int *lo, *hi, *cut;       /* S each */
+} tt__synth;
+
+/* The edge sample for a side of type t at side-frame (x, d). Condition k's
+   window holds two squares, upper U and lower L, meeting at the line between
+   rows S-1 and S. Type 2k lines the side with U as it is, so d counts rows up
+   from that line; type 2k+1 lines it with L turned 180 degrees. For d < 0 both
+   continue across the line, which is exactly what the neighbour across the
+   edge (with the other type) shows: this is why tiles meet seamlessly. */
+static const float *tt__edge_sample(const tt__synth *s, int type, int x, int d)
+{
+    const tt_rect *w = &s->windows[type >> 1];
+    int sx, sy;
+    if ((type & 1) == 0) { sx = w->x + x; sy = w->y + s->size - 1 - d; }
+    else { sx = w->x + s->size - 1 - x; sy = w->y + s->size + d; }
+    return s->source->pixels + ((size_t)sy * s->source->width + sx) * 4;
+}
+
+static void tt__side_to_tile(const tt__synth *s, int side, int x, int d, int *tx, int *ty)
+{
+    tt_rotate_coords(side, s->size, s->size, x, s->size - 1 - d, tx, ty);
+}
+
+/* Lay the band of side `side` (type `type`) over the tile composed so far:
+   AXXX over (what is there). The band's depth follows a minimum-error cut
+   against what lies beneath (the paper's f4: "once colour values of two image
+   layers become similar, the foreground becomes transparent"), kept inside the
+   side's wedge (the triangle between the tile's diagonals, the paper's f1..f3
+   keeping it off the other sides) and feathered across the cut. */
+static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocator *allocator)
+{
+    const int S = s->size, rows = s->max_depth + 1;
+    const float feather = (float)s->feather;
+    int x, d, k;
+    tt_result result;
+    for (d = 0; d < rows; d++)
+        for (x = 0; x < S; x++) {
+            int tx, ty;
+            const float *band = tt__edge_sample(s, type, x, d);
+            const float *below;
+            float err = 0.0f;
+            tt__side_to_tile(s, side, x, d, &tx, &ty);
+            below = s->tile + ((size_t)ty * S + tx) * 4;
+            for (k = 0; k < 3; k++) err += (band[k] - below[k]) * (band[k] - below[k]);
+            s->cost[(size_t)d * S + x] = err;
+        }
+    for (x = 0; x < S; x++) {
+        int wedge = tt__min_i(x, S - 1 - x);   /* rows strictly inside this side's wedge */
+        s->hi[x] = tt__min_i(wedge, s->max_depth);
+        s->lo[x] = tt__min_i(s->min_depth, s->hi[x]);
+    }
+    result = tt_min_error_cut(s->cost, S, rows, s->lo, s->hi, s->cut, allocator);
+    if (result != TT_OK) return result;
+    for (x = 0; x < S; x++) {
+        int wedge = tt__min_i(x, S - 1 - x);
+        int last = tt__min_i(s->cut[x] + s->feather, S - 1);
+        for (d = 0; d <= last; d++) {
+            float alpha, premultiplied[4];
+            const float *band;
+            int tx, ty;
+            if (x == 0 || x == S - 1) break;    /* corner columns belong to the neighbouring sides */
+            if (d == 0) {
+                alpha = 1.0f;                  /* the edge row is the edge sample, exactly */
+            } else {
+                float a_cut = tt__clamp_f(((float)s->cut[x] - (float)d - 0.5f) / feather + 0.5f, 0.0f, 1.0f);
+                float a_wedge = tt__clamp_f(((float)wedge - (float)d - 0.5f) / feather + 0.5f, 0.0f, 1.0f);
+                alpha = a_cut * a_wedge;
+            }
+            if (alpha <= 0.0f) continue;
+            band = tt__edge_sample(s, type, x, d);
+            for (k = 0; k < 3; k++) premultiplied[k] = band[k] * alpha;
+            premultiplied[3] = alpha;
+            tt__side_to_tile(s, side, x, d, &tx, &ty);
+            tt_rgba_over(s->tile + ((size_t)ty * S + tx) * 4, premultiplied);
+        }
+    }
+    return TT_OK;
+}
+
+/* Copy a composed tile and its gutter into its atlas cell. The gutter strip
+   outside each side holds the edge sample continued across the edge (d < 0),
+   i.e. the first rows of whichever tile lies across that edge on the surface;
+   the g x g corner squares repeat the nearest tile texel. */
+static void tt__write_cell(const tt__synth *s, const uint8_t types[4], tt_image *atlas, int cell_x, int cell_y)
+{
+    const int S = s->size, g = s->gutter, C = S + 2 * g;
+    int x, y, side, d;
+    for (y = 0; y < C; y++)
+        for (x = 0; x < C; x++) {
+            int tx = tt__clamp_i(x - g, 0, S - 1), ty = tt__clamp_i(y - g, 0, S - 1);
+            float *out = atlas->pixels + ((size_t)(cell_y + y) * atlas->width + cell_x + x) * 4;
+            memcpy(out, s->tile + ((size_t)ty * S + tx) * 4, 4 * sizeof(float));
+        }
+    for (side = 0; side < 4; side++)
+        for (d = -g; d < 0; d++)
+            for (x = 0; x < S; x++) {
+                int tx, ty;
+                float *out;
+                tt__side_to_tile(s, side, x, d, &tx, &ty);
+                out = atlas->pixels + ((size_t)(cell_y + g + ty) * atlas->width + cell_x + g + tx) * 4;
+                memcpy(out, tt__edge_sample(s, types[side], x, d), 3 * sizeof(float));
+                out[3] = 1.0f;
+            }
+}
+
+TTDEF void tt_tileset_free(tt_tileset *tileset)
+{
+    tt_allocator allocator;
+    int i;
+    if (!tileset) return;
+    allocator = tileset->allocator;
+    for (i = 0; i < tileset->nlevels; i++) tt_image_free(&tileset->levels[i]);
+    tt__free(&allocator, tileset->edge_windows);
+    tt__free(&allocator, tileset->background_windows);
+    tt__free(&allocator, tileset);
+}
+
+/* Condition windows from the seed: each of 16 candidates is scored by its
+   distance to the windows already chosen, so several conditions use different
+   parts of the image. */
+static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int size, int n, tt_rect *windows)
+{
+    int k, trial;
+    for (k = 0; k < n; k++) {
+        long long best_score = -1;
+        for (trial = 0; trial < 16; trial++) {
+            tt_rect r;
+            long long score = 0;
+            int j;
+            r.x = (int)tt_rng_below(rng, (uint32_t)(source->width - size + 1));
+            r.y = (int)tt_rng_below(rng, (uint32_t)(source->height - 2 * size + 1));
+            r.w = size;
+            r.h = 2 * size;
+            if (k > 0) {
+                score = 0x7fffffffffffffffLL;
+                for (j = 0; j < k; j++) {
+                    long long dx = r.x - windows[j].x, dy = r.y - windows[j].y, dist = dx * dx + dy * dy;
+                    if (dist < score) score = dist;
+                }
+            }
+            if (score > best_score) { best_score = score; windows[k] = r; }
+            if (k == 0) break;
+        }
+    }
+}
+
+TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
+                                    tt_tileset **out_tileset, tt_error *error)
+{
+    tt_synth_options defaults;
+    const tt_synth_options *opt = options;
+    const tt_allocator *allocator;
+    tt_tileset *set = NULL;
+    tt__synth s;
+    tt_tile_layout layout;
+    tt_rect region;
+    tt_rng rng;
+    tt_result result;
+    int S, g, C, T, W, ntiles, t, k, side;
+
+    tt__ok(error);
+    if (!out_tileset) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_tileset is NULL");
+    *out_tileset = NULL;
+    if (!opt) {
+        memset(&defaults, 0, sizeof defaults);
+        opt = &defaults;
+    }
+    allocator = &opt->allocator;
+    if (!source || !source->pixels || source->width <= 0 || source->height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is empty");
+    if ((result = tt_tile_layout_resolve(&opt->layout, &layout, error)) != TT_OK) return result;
+    S = layout.tile_size;
+    g = layout.gutter;
+    C = S + 2 * g;
+    T = tt_tile_layout_tiles_per_side(&layout);
+    W = T * C;
+    ntiles = T * T;
+    if (source->width < S || source->height < 2 * S)
+        return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                        "the source image is %dx%d, but %d-texel tiles need an edge window of %dx%d "
+                        "(use a tile size of at most %d)",
+                        source->width, source->height, S, S, 2 * S,
+                        tt__min_i(source->width, source->height / 2));
+
+    memset(&s, 0, sizeof s);
+    s.source = source;
+    s.n = layout.colors;
+    s.size = S;
+    s.gutter = g;
+    s.feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
+    if (s.feather > S / 4 + 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "feather %d is too wide for %d-texel tiles (at most %d)", s.feather, S, S / 4 + 1);
+    /* Bands reach at most 3/8 of the tile in, so the background always shows
+       in the middle, and at least past the gutter's depth plus half the
+       feather, so the rows a neighbour's gutter copies are the sample alone. */
+    s.max_depth = tt__max_i(1, 3 * S / 8);
+    s.min_depth = tt__min_i(tt__max_i(S / 8, g + s.feather / 2 + 1), s.max_depth);
+
+    region = opt->background;
+    if (region.x == 0 && region.y == 0 && region.w == 0 && region.h == 0) {
+        region.w = source->width;
+        region.h = source->height;
+    }
+    if (region.x < 0 || region.y < 0 || region.w < S || region.h < S ||
+        region.x > source->width - region.w || region.y > source->height - region.h)
+        return tt__fail(error, region.w < S || region.h < S ? TT_ERROR_IMAGE_TOO_SMALL : TT_ERROR_INVALID_ARGUMENT,
+                        -1, -1, -1, -1,
+                        "the background region %d,%d %dx%d must lie inside the %dx%d image and hold a %dx%d tile",
+                        region.x, region.y, region.w, region.h, source->width, source->height, S, S);
+
+    set = TT__ALLOC(allocator, tt_tileset, 1);
+    if (!set) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    memset(set, 0, sizeof *set);
+    set->allocator = *allocator;
+    set->layout = layout;
+    set->edge_windows = TT__ALLOC(allocator, tt_rect, s.n);
+    set->background_windows = TT__ALLOC(allocator, tt_rect, ntiles);
+    s.tile = TT__ALLOC(allocator, float, (size_t)S * S * 4);
+    s.cost = TT__ALLOC(allocator, float, (size_t)S * (s.max_depth + 1));
+    s.lo = TT__ALLOC(allocator, int, S);
+    s.hi = TT__ALLOC(allocator, int, S);
+    s.cut = TT__ALLOC(allocator, int, S);
+    if (!set->edge_windows || !set->background_windows || !s.tile || !s.cost || !s.lo || !s.hi || !s.cut) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+        goto done;
+    }
+    result = tt_image_create(&set->levels[0], W, W, allocator);
+    if (result != TT_OK) {
+        tt__fail(error, result, -1, -1, -1, -1, "cannot allocate a %dx%d atlas", W, W);
+        goto done;
+    }
+    set->nlevels = 1;
+
+    tt_rng_seed(&rng, opt->seed, 0x74696c6573ull /* "tiles" */);
+    if (opt->edge_windows) {
+        for (k = 0; k < s.n; k++) {
+            tt_rect r = opt->edge_windows[k];
+            if (r.x < 0 || r.y < 0 || r.x > source->width - S || r.y > source->height - 2 * S) {
+                result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                                  "edge window %d at %d,%d does not fit: it needs %dx%d texels inside the %dx%d "
+                                  "image", k, r.x, r.y, S, 2 * S, source->width, source->height);
+                goto done;
+            }
+            r.w = S;
+            r.h = 2 * S;
+            set->edge_windows[k] = r;
+        }
+    } else {
+        tt__choose_edge_windows(&rng, source, S, s.n, set->edge_windows);
+    }
+    s.windows = set->edge_windows;
+
+    for (t = 0; t < ntiles; t++) {
+        int column = t % T, row = t / T, base = 2 * s.n, x, y;
+        uint8_t types[4];
+        tt_rect *bg = &set->background_windows[t];
+        types[0] = (uint8_t)(column / base);
+        types[1] = (uint8_t)(column % base);
+        types[2] = (uint8_t)(row / base);
+        types[3] = (uint8_t)(row % base);
+
+        /* XXXX: a fresh background window per tile gives the aperiodicity. */
+        bg->x = region.x + (int)tt_rng_below(&rng, (uint32_t)(region.w - S + 1));
+        bg->y = region.y + (int)tt_rng_below(&rng, (uint32_t)(region.h - S + 1));
+        bg->w = bg->h = S;
+        for (y = 0; y < S; y++)
+            for (x = 0; x < S; x++) {
+                const float *p = source->pixels + ((size_t)(bg->y + y) * source->width + bg->x + x) * 4;
+                float *q = s.tile + ((size_t)y * S + x) * 4;
+                q[0] = p[0]; q[1] = p[1]; q[2] = p[2]; q[3] = 1.0f;
+            }
+        /* ABCD = AXXX over XBXX over XXCX over XXXD over XXXX: lay D first. */
+        for (side = 3; side >= 0; side--)
+            if ((result = tt__lay_band(&s, side, types[side], allocator)) != TT_OK) {
+                tt__fail(error, result, -1, -1, -1, -1, "out of memory while cutting tile %d", t);
+                goto done;
+            }
+        /* Tile row 0 of the formula is at the bottom of the atlas image. */
+        tt__write_cell(&s, types, &set->levels[0], column * C, (T - 1 - row) * C);
+        if (opt->progress && opt->progress((float)(t + 1) / (float)ntiles, opt->progress_user_data)) {
+            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "tile synthesis was cancelled");
+            goto done;
+        }
+    }
+
+    /* Mip levels: while the cell size stays even, 2x2 blocks never straddle
+       two cells, so halving the whole atlas halves every tile on its own. A
+       level is seamless while its gutter is still at least a texel wide. */
+    while (set->nlevels < TT_MAX_MIP_LEVELS && ((C >> (set->nlevels - 1)) % 2) == 0) {
+        result = tt_image_downsample2(&set->levels[set->nlevels - 1], &set->levels[set->nlevels], allocator);
+        if (result != TT_OK) {
+            tt__fail(error, result, -1, -1, -1, -1, "out of memory for mip level %d", set->nlevels);
+            goto done;
+        }
+        set->nlevels++;
+    }
+    set->seamless_levels = 0;
+    while (set->seamless_levels < set->nlevels && (g >> set->seamless_levels) >= 1) set->seamless_levels++;
+    result = TT_OK;
+
+done:
+    tt__free(allocator, s.tile);
+    tt__free(allocator, s.cost);
+    tt__free(allocator, s.lo);
+    tt__free(allocator, s.hi);
+    tt__free(allocator, s.cut);
+    if (result != TT_OK) {
+        tt_tileset_free(set);
+        return result;
+    }
+    *out_tileset = set;
+    return TT_OK;
+}
+
+/* --- quality report ------------------------------------------------------ */
+
+typedef struct tt__edge_point {
+    float px, py;     /* on the edge, atlas pixel coordinates */
+    float nx, ny;     /* unit normal into the face, in pixels */
+} tt__edge_point;
+
+/* The point at parameter t along half-edge c, in atlas pixels, with the unit
+   normal pointing into c's face (toward the face's UV centroid, so the answer
+   does not depend on the face's winding in UV space). */
+static int tt__edge_point_at(const tt_mesh *mesh, const float *uv, const tt_image *atlas, int c, float t,
+                             tt__edge_point *out)
+{
+    int next = tt_mesh_next(mesh, c), face = mesh->corner_face[c], k, count = 0;
+    float ax = uv[2 * c] * atlas->width, ay = (1.0f - uv[2 * c + 1]) * atlas->height;
+    float bx = uv[2 * next] * atlas->width, by = (1.0f - uv[2 * next + 1]) * atlas->height;
+    float cx = 0.0f, cy = 0.0f, ex = bx - ax, ey = by - ay, len = sqrtf(ex * ex + ey * ey);
+    if (!(len > 1e-6f)) return 0;
+    for (k = mesh->face_start[face]; k < mesh->face_start[face + 1]; k++, count++) {
+        cx += uv[2 * k] * atlas->width;
+        cy += (1.0f - uv[2 * k + 1]) * atlas->height;
+    }
+    cx /= (float)count;
+    cy /= (float)count;
+    out->px = ax + ex * t;
+    out->py = ay + ey * t;
+    out->nx = -ey / len;
+    out->ny = ex / len;
+    if (out->nx * (cx - out->px) + out->ny * (cy - out->py) < 0.0f) { out->nx = -out->nx; out->ny = -out->ny; }
+    return 1;
+}
+
+static void tt__sample_inside(const tt_image *atlas, const tt__edge_point *p, float depth, float rgba[4])
+{
+    tt_image_sample_bilinear(atlas, p->px + p->nx * depth, p->py + p->ny * depth, rgba);
+}
+
+static double tt__rgb_difference(const float a[4], const float b[4])
+{
+    return (fabs((double)a[0] - b[0]) + fabs((double)a[1] - b[1]) + fabs((double)a[2] - b[2])) / 3.0;
+}
+
+TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
+                                 uint64_t seed, tt_seam_report *report)
+{
+    enum { POINTS_PER_EDGE = 4 };
+    int *interior, ninterior = 0, c, i, j;
+    double seam = 0.0, same = 0.0, unrelated = 0.0;
+    long long samples = 0;
+    tt_rng rng;
+    if (!mesh || !corner_uv || !atlas || !atlas->pixels || !report) return TT_ERROR_INVALID_ARGUMENT;
+    memset(report, 0, sizeof *report);
+    interior = TT__ALLOC(&mesh->allocator, int, mesh->ncorners);
+    if (!interior) return TT_ERROR_OUT_OF_MEMORY;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] > c) interior[ninterior++] = c;
+    tt_rng_seed(&rng, seed, 0x7365616d73ull /* "seams" */);
+    for (i = 0; i < ninterior && ninterior > 1; i++) {
+        int a = interior[i], b = mesh->twin[a];
+        for (j = 0; j < POINTS_PER_EDGE; j++) {
+            /* Stratified along the edge; the twin runs the other way. */
+            float t = ((float)j + tt_rng_float(&rng)) / (float)POINTS_PER_EDGE;
+            int other = interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(ninterior - 1))) % ninterior];
+            float t_other = tt_rng_float(&rng);
+            tt__edge_point pa, pb, po;
+            float sa[4], sa_deeper[4], sb[4], so[4];
+            if (!tt__edge_point_at(mesh, corner_uv, atlas, a, t, &pa) ||
+                !tt__edge_point_at(mesh, corner_uv, atlas, b, 1.0f - t, &pb) ||
+                !tt__edge_point_at(mesh, corner_uv, atlas, other, t_other, &po))
+                continue;
+            tt__sample_inside(atlas, &pa, 0.5f, sa);
+            tt__sample_inside(atlas, &pa, 1.5f, sa_deeper);
+            tt__sample_inside(atlas, &pb, 0.5f, sb);
+            tt__sample_inside(atlas, &po, 0.5f, so);
+            seam += tt__rgb_difference(sa, sb);
+            same += tt__rgb_difference(sa, sa_deeper);
+            unrelated += tt__rgb_difference(sa, so);
+            samples++;
+        }
+    }
+    tt__free(&mesh->allocator, interior);
+    report->edges_measured = ninterior > 1 ? ninterior : 0;
+    if (samples > 0) {
+        report->seam = seam / (double)samples;
+        report->same_face = same / (double)samples;
+        report->unrelated = unrelated / (double)samples;
+        if (report->unrelated - report->same_face > 1e-9)
+            report->score = (report->seam - report->same_face) / (report->unrelated - report->same_face);
+    }
+    return TT_OK;
+}
+
+TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
+                                  int *counts)
+{
+    tt_tile_layout resolved;
+    int f, c, base;
+    if (!mesh || !layout || !corner_type || !counts) return TT_ERROR_INVALID_ARGUMENT;
+    if (tt_tile_layout_resolve(layout, &resolved, NULL) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    base = 2 * resolved.colors;
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4) return TT_ERROR_NOT_QUAD_MESH;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (corner_type[c] >= base) return TT_ERROR_INVALID_ARGUMENT;
+    memset(counts, 0, (size_t)tt_tile_layout_tile_count(&resolved) * sizeof(int));
+    for (f = 0; f < mesh->nfaces; f++) counts[tt_tile_index(&resolved, corner_type + 4 * (size_t)f)]++;
+    return TT_OK;
+}
+
+TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch)
+{
+    int f;
+    if (!mesh || !corner_uv || !stretch) return TT_ERROR_INVALID_ARGUMENT;
+    for (f = 0; f < mesh->nfaces; f++) {
+        /* Tangents of the face's own parametrisation s,t at its centre: for a
+           quad the bilinear patch's derivatives, otherwise the first triangle.
+           A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2); texture -> surface is
+           M = A B^-1, and the ratio of M's singular values is the stretch. */
+        int first = mesh->face_start[f], size = mesh->face_start[f + 1] - first, k;
+        const float *p[4], *q[4];
+        double a[2][3], b[2][2], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc, big, small;
+        for (k = 0; k < 4; k++) {
+            int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
+            p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
+            q[k] = corner_uv + 2 * (size_t)corner;
+        }
+        for (k = 0; k < 3; k++) {
+            if (size == 4) {
+                a[0][k] = 0.5 * (((double)p[1][k] - p[0][k]) + ((double)p[2][k] - p[3][k]));
+                a[1][k] = 0.5 * (((double)p[3][k] - p[0][k]) + ((double)p[2][k] - p[1][k]));
+            } else {
+                a[0][k] = (double)p[1][k] - p[0][k];
+                a[1][k] = (double)p[2][k] - p[0][k];
+            }
+        }
+        for (k = 0; k < 2; k++) {
+            if (size == 4) {
+                b[0][k] = 0.5 * (((double)q[1][k] - q[0][k]) + ((double)q[2][k] - q[3][k]));
+                b[1][k] = 0.5 * (((double)q[3][k] - q[0][k]) + ((double)q[2][k] - q[1][k]));
+            } else {
+                b[0][k] = (double)q[1][k] - q[0][k];
+                b[1][k] = (double)q[2][k] - q[0][k];
+            }
+        }
+        /* b[i] is d(u,v)/d(param i); rows of A likewise. Solve M B = A for the
+           two texture axes: M's column for u and v. */
+        det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
+        if (fabs(det) < 1e-30) { stretch[f] = tt__infinity(); continue; }
+        for (k = 0; k < 3; k++) {
+            m[0][k] = (a[0][k] * b[1][1] - a[1][k] * b[0][1]) / det;   /* dP/du */
+            m[1][k] = (a[1][k] * b[0][0] - a[0][k] * b[1][0]) / det;   /* dP/dv */
+            g11 += m[0][k] * m[0][k];
+            g12 += m[0][k] * m[1][k];
+            g22 += m[1][k] * m[1][k];
+        }
+        tr = g11 + g22;
+        disc = sqrt((g11 - g22) * (g11 - g22) + 4.0 * g12 * g12);
+        big = 0.5 * (tr + disc);
+        small = 0.5 * (tr - disc);
+        stretch[f] = small > 1e-30 * (big > 0 ? big : 1) ? (float)sqrt(big / small) : tt__infinity();
+    }
+    return TT_OK;
+}
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TILEDTEX_IMPLEMENTATION_INCLUDED */
+#endif /* TILEDTEX_IMPLEMENTATION */
+
+/*
+------------------------------------------------------------------------------
+MIT License
+
+Copyright (c) 2026 the tiledtex authors
+
+Permission is hereby granted, free of charge, to any person obtaining a copy of
+this software and associated documentation files (the "Software"), to deal in
+the Software without restriction, including without limitation the rights to
+use, copy, modify, merge, publish, distribute, sublicense, and/or sell copies
+of the Software, and to permit persons to whom the Software is furnished to do
+so, subject to the following conditions:
+
+The above copyright notice and this permission notice shall be included in all
+copies or substantial portions of the Software.
+
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS OR COPYRIGHT HOLDERS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER
+LIABILITY, WHETHER IN AN ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM,
+OUT OF OR IN CONNECTION WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE
+SOFTWARE.
+------------------------------------------------------------------------------
+*/
