@@ -564,6 +564,7 @@ static void *tt__alloc_array(const tt_allocator *allocator, size_t count, size_t
 
 static int tt__min_i(int a, int b) { return a < b ? a : b; }
 static int tt__max_i(int a, int b) { return a > b ? a : b; }
+static int tt__abs_i(int x) { return x < 0 ? -x : x; }
 static int tt__clamp_i(int x, int lo, int hi) { return x < lo ? lo : (x > hi ? hi : x); }
 static float tt__clamp_f(float x, float lo, float hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
@@ -1882,7 +1883,9 @@ static void tt__side_to_tile(const tt__synth *s, int side, int x, int d, int *tx
 static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocator *allocator)
 {
     const int S = s->size, rows = s->max_depth + 1;
-    const float feather = (float)s->feather;
+    /* Near the corners two bands meet along the diagonal; a short blend there
+       keeps both bands' rows next to their edges intact. */
+    const float feather = (float)s->feather, wedge_feather = 2.0f;
     int x, d, k;
     tt_result result;
     for (d = 0; d < rows; d++)
@@ -1915,7 +1918,7 @@ static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocat
                 alpha = 1.0f;                  /* the edge row is the edge sample, exactly */
             } else {
                 float a_cut = tt__clamp_f(((float)s->cut[x] - (float)d - 0.5f) / feather + 0.5f, 0.0f, 1.0f);
-                float a_wedge = tt__clamp_f(((float)wedge - (float)d - 0.5f) / feather + 0.5f, 0.0f, 1.0f);
+                float a_wedge = tt__clamp_f(((float)wedge - (float)d - 0.5f) / wedge_feather + 0.5f, 0.0f, 1.0f);
                 alpha = a_cut * a_wedge;
             }
             if (alpha <= 0.0f) continue;
@@ -1967,31 +1970,60 @@ TTDEF void tt_tileset_free(tt_tileset *tileset)
     tt__free(&allocator, tileset);
 }
 
-/* Condition windows from the seed: each of 16 candidates is scored by its
-   distance to the windows already chosen, so several conditions use different
-   parts of the image. */
+/* How conspicuous condition window (x, y) would be. Every edge of the mesh
+   shows the rows next to the window's middle line, so structure running along
+   that line (a mortar joint, a plank border) would draw the mesh's edges as a
+   grid, and an unusually bright or dark strip would too. The score is the
+   variance of the row means over the S/4 rows on each side of the line plus
+   the squared difference between their mean and the image's mean (luminance). */
+static double tt__edge_window_score(const tt_image *source, int x, int y, int size, double image_mean)
+{
+    int half = tt__max_i(1, size / 4), r, i;
+    double sum = 0.0, sum2 = 0.0;
+    for (r = y + size - half; r < y + size + half; r++) {
+        const float *p = source->pixels + ((size_t)r * source->width + x) * 4;
+        double row = 0.0;
+        for (i = 0; i < size; i++, p += 4) row += (double)p[0] + p[1] + p[2];
+        row /= 3.0 * size;
+        sum += row;
+        sum2 += row * row;
+    }
+    sum /= 2 * half;
+    return (sum2 / (2 * half) - sum * sum) + (sum - image_mean) * (sum - image_mean);
+}
+
+/* Condition windows from the seed: the least conspicuous of 48 random
+   candidates, among those at least S away from the windows already chosen
+   (so several conditions use different parts of the image) when there are
+   any. */
 static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int size, int n, tt_rect *windows)
 {
+    const int candidates = 48;
+    double image_mean = 0.0;
+    size_t i, count = (size_t)source->width * source->height;
     int k, trial;
+    for (i = 0; i < count; i++)
+        image_mean += (double)source->pixels[4 * i] + source->pixels[4 * i + 1] + source->pixels[4 * i + 2];
+    image_mean /= 3.0 * (double)count;
     for (k = 0; k < n; k++) {
-        long long best_score = -1;
-        for (trial = 0; trial < 16; trial++) {
+        double best_score = 0.0;
+        int best_far = -1;
+        for (trial = 0; trial < candidates; trial++) {
             tt_rect r;
-            long long score = 0;
-            int j;
+            double score;
+            int j, far = 1;
             r.x = (int)tt_rng_below(rng, (uint32_t)(source->width - size + 1));
             r.y = (int)tt_rng_below(rng, (uint32_t)(source->height - 2 * size + 1));
             r.w = size;
             r.h = 2 * size;
-            if (k > 0) {
-                score = 0x7fffffffffffffffLL;
-                for (j = 0; j < k; j++) {
-                    long long dx = r.x - windows[j].x, dy = r.y - windows[j].y, dist = dx * dx + dy * dy;
-                    if (dist < score) score = dist;
-                }
+            for (j = 0; j < k; j++)
+                if (tt__abs_i(r.x - windows[j].x) < size && tt__abs_i(r.y - windows[j].y) < size) far = 0;
+            score = tt__edge_window_score(source, r.x, r.y, size, image_mean);
+            if (far > best_far || (far == best_far && score < best_score)) {
+                best_far = far;
+                best_score = score;
+                windows[k] = r;
             }
-            if (score > best_score) { best_score = score; windows[k] = r; }
-            if (k == 0) break;
         }
     }
 }
@@ -2043,11 +2075,13 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
     if (s.feather > S / 4 + 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "feather %d is too wide for %d-texel tiles (at most %d)", s.feather, S, S / 4 + 1);
-    /* Bands reach at most 3/8 of the tile in, so the background always shows
-       in the middle, and at least past the gutter's depth plus half the
-       feather, so the rows a neighbour's gutter copies are the sample alone. */
-    s.max_depth = tt__max_i(1, 3 * S / 8);
-    s.min_depth = tt__min_i(tt__max_i(S / 8, g + s.feather / 2 + 1), s.max_depth);
+    /* Every edge of a type shows the same band, so a deep band repeats
+       visibly across the surface: bands go no deeper than the cut needs. At
+       least past the gutter's depth plus half the feather (so the rows a
+       neighbour's gutter copies are the sample alone), at most S/4 (so most
+       of each tile is its own background). */
+    s.max_depth = tt__max_i(1, S / 4);
+    s.min_depth = tt__min_i(tt__max_i(2, g + s.feather / 2 + 1), s.max_depth);
 
     region = opt->background;
     if (region.x == 0 && region.y == 0 && region.w == 0 && region.h == 0) {
