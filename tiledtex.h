@@ -699,10 +699,15 @@ static void tt__sort_out_edges(tt__out_edge *items, int count)
     }
 }
 
-/* First index in items[0..count) whose dest is >= dest. */
+/* First index in items[0..count) whose dest is >= dest. Buckets hold a
+   vertex's valence worth of entries; a scan beats halving for the usual few. */
 static int tt__lower_bound(const tt__out_edge *items, int count, int dest)
 {
     int lo = 0, hi = count;
+    if (count <= 8) {
+        while (lo < count && items[lo].dest < dest) lo++;
+        return lo;
+    }
     while (lo < hi) {
         int mid = lo + (hi - lo) / 2;
         if (items[mid].dest < dest) lo = mid + 1; else hi = mid;
@@ -710,28 +715,32 @@ static int tt__lower_bound(const tt__out_edge *items, int count, int dest)
     return lo;
 }
 
-/* Twice the vector area of a polygon (Newell's method, relative to its first
-   corner so that faces far from the origin lose no precision), compared with
-   its longest edge: "zero area" means numerically zero, not merely thin. */
+/* Twice the vector area of a polygon by Newell's method taken relative to
+   its first corner (the terms with that corner vanish, and faces far from the
+   origin lose no precision): n = sum over i of (p_i - p_0) x (p_(i+1) - p_0).
+   "Zero area" means numerically zero against the face's own size (the sum of
+   squared distances from p_0), not merely thin. Squares are compared. */
 static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
 {
-    double n[3] = {0, 0, 0}, longest2 = 0.0, area2;
     const float *o = pos + 3 * (size_t)verts[0];
+    const float *p = pos + 3 * (size_t)verts[1];
+    float a[3], n[3] = {0, 0, 0}, scale;
+    double area2_squared;
     int i;
-    for (i = 0; i < count; i++) {
-        const float *p = pos + 3 * (size_t)verts[i];
-        const float *q = pos + 3 * (size_t)verts[(i + 1) % count];
-        double a[3], b[3], e2;
-        a[0] = (double)p[0] - o[0]; a[1] = (double)p[1] - o[1]; a[2] = (double)p[2] - o[2];
-        b[0] = (double)q[0] - o[0]; b[1] = (double)q[1] - o[1]; b[2] = (double)q[2] - o[2];
+    a[0] = p[0] - o[0]; a[1] = p[1] - o[1]; a[2] = p[2] - o[2];
+    scale = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    for (i = 2; i < count; i++) {
+        const float *q = pos + 3 * (size_t)verts[i];
+        float b[3];
+        b[0] = q[0] - o[0]; b[1] = q[1] - o[1]; b[2] = q[2] - o[2];
         n[0] += a[1] * b[2] - a[2] * b[1];
         n[1] += a[2] * b[0] - a[0] * b[2];
         n[2] += a[0] * b[1] - a[1] * b[0];
-        e2 = (b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]);
-        if (e2 > longest2) longest2 = e2;
+        scale += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+        a[0] = b[0]; a[1] = b[1]; a[2] = b[2];
     }
-    area2 = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    return area2 <= 1e-12 * longest2;
+    area2_squared = (double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2];
+    return area2_squared <= 1e-24 * (double)scale * (double)scale;
 }
 
 /* A problem found while pairing twins; the one with the smallest corner is
@@ -762,10 +771,16 @@ static tt_result tt__report_edge_problem(const tt__edge_problem *p, tt_error *er
    manifold exactly when this reaches all of its outgoing half-edges. */
 static int tt__fan_size(const tt_mesh *mesh, int v)
 {
+    /* All triangles or all quads (the usual meshes): prev is arithmetic with
+       a constant divisor, no face lookups. */
     int start = mesh->vert_corner[v], h = start, visited = 1;
+    int k = mesh->min_face_size == mesh->max_face_size ? mesh->min_face_size : 0;
     if (start < 0) return 0;
     while (visited <= mesh->ncorners) {
-        int next = mesh->twin[tt_mesh_prev(mesh, h)];
+        int prev = k == 4 ? ((h & 3) == 0 ? h + 3 : h - 1)
+                 : k == 3 ? (h % 3 == 0 ? h + 2 : h - 1)
+                 : tt_mesh_prev(mesh, h);
+        int next = mesh->twin[prev];
         if (next < 0 || next == start) break;
         h = next;
         visited++;
@@ -885,6 +900,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
             }
             mesh->corner_vert[c] = vert;
             mesh->corner_face[c] = f;
+            mesh->twin[c] = -2;   /* not paired yet */
             bucket_start[vert + 1]++;
         }
         /* A repeated vertex makes a degenerate edge or pinches the face. Small
@@ -945,7 +961,6 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     /* Pair twins, one run of equal destinations at a time: p half-edges a->b
        here, q half-edges b->a in b's bucket. p = q = 1 is an interior edge,
        p = 1, q = 0 a boundary; anything else is non-manifold or flipped. */
-    for (c = 0; c < ncorners; c++) mesh->twin[c] = -2;
     problem.corner = -1;
     for (v = 0; v < nverts; v++) {
         int start = bucket_start[v], end = bucket_start[v + 1], i = start;
