@@ -1,0 +1,308 @@
+/* map.c - `tiledtex map`: give a mesh tiled-texture UVs.
+
+   This is Akleman et al.'s mapping algorithm (Sec. 3) as a library user calls it:
+
+     tt_mesh_build          validate the OBJ's faces into a half-edge mesh
+     tt_mesh_quadrangulate  only when there are triangles or n-gons: each
+                            n-gon becomes n quads (and again per --subdivide)
+     tt_assign_boundaries   a random boundary type per half-edge, twins
+                            complementary (seeded: same seed, same result)
+     tt_assign_uvs          one UV per corner: the tile named by its four
+                            boundary types, at its place in the atlas
+
+   The UVs depend only on --colors, --tile and --gutter, never on an image:
+   any atlas `tiledtex synth` makes with the same three fits them.
+*/
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tiled.h"
+
+static void print_help(void)
+{
+    printf("usage: tiledtex map MESH.obj OUT.obj [options]\n"
+           "\n"
+           "Give every face of MESH.obj a tile of a tiled texture: writes OUT.obj with one\n"
+           "texture coordinate per face corner. Triangles and n-gons are quadrangulated\n"
+           "first (each n-gon into n quads). The UVs fit any atlas that `tiledtex synth`\n"
+           "makes with the same --colors, --tile and --gutter.\n"
+           "\n"
+           "options:\n"
+           "  --colors N       edge conditions n; the atlas holds (2n)^4 tiles (default 1)\n"
+           "  --tile S         tile size in texels (default %d)\n"
+           "  --gutter G       texels of gutter around each tile, 0 for none (default %d)\n"
+           "  --seed K         random seed for the boundary types (default 0)\n"
+           "  --subdivide L    quadrangulate L more times: smaller faces, smaller texture\n"
+           "  --smooth         use Catmull-Clark positions when subdividing (default: keep the shape)\n"
+           "  --atlas A.png    also write OUT.mtl naming A.png, and report the seam score\n"
+           "  --permissive     accept non-manifold or mis-oriented edges (they become boundaries)\n",
+           TT_DEFAULT_TILE_SIZE, TT_DEFAULT_GUTTER);
+}
+
+int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled_options *options)
+{
+    const char *value;
+    int number;
+    if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--colors", &value)) {
+        if (parse_int("--colors", value, 1, 8, &options->layout.colors) != 0) return -1;
+    } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--tile", &value)) {
+        if (parse_int("--tile", value, 4, TT_MAX_IMAGE_SIZE, &options->layout.tile_size) != 0) return -1;
+        options->tile_size_given = 1;
+    } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--gutter", &value)) {
+        if (parse_int("--gutter", value, 0, TT_MAX_IMAGE_SIZE, &number) != 0) return -1;
+        options->layout.gutter = number == 0 ? TT_NO_GUTTER : number;
+    } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--seed", &value)) {
+        if (parse_u64("--seed", value, &options->seed) != 0) return -1;
+    } else if ((accept & TILED_MESH_OPTIONS) && tool_option(argc, argv, index, "--subdivide", &value)) {
+        if (parse_int("--subdivide", value, 0, 8, &options->subdivide) != 0) return -1;
+    } else if ((accept & TILED_MESH_OPTIONS) && strcmp(argv[*index], "--smooth") == 0) {
+        options->smooth = 1;
+    } else if ((accept & TILED_MESH_OPTIONS) && strcmp(argv[*index], "--permissive") == 0) {
+        options->permissive = 1;
+    } else if ((accept & TILED_SYNTH_OPTIONS) && tool_option(argc, argv, index, "--edge", &value)) {
+        int xy[2];
+        if (parse_int_list("--edge", value, 2, xy) != 0) return -1;
+        if (options->nedges >= TT_MAX_COLORS) { tool_usage("too many --edge options"); return -1; }
+        options->edges[options->nedges].x = xy[0];
+        options->edges[options->nedges].y = xy[1];
+        options->nedges++;
+    } else if ((accept & TILED_SYNTH_OPTIONS) && tool_option(argc, argv, index, "--background", &value)) {
+        int r[4];
+        if (parse_int_list("--background", value, 4, r) != 0) return -1;
+        if (r[2] <= 0 || r[3] <= 0) { tool_usage("--background wants X,Y,W,H with W and H above 0"); return -1; }
+        options->background.x = r[0];
+        options->background.y = r[1];
+        options->background.w = r[2];
+        options->background.h = r[3];
+    } else if ((accept & TILED_SYNTH_OPTIONS) && strcmp(argv[*index], "--mips") == 0) {
+        options->mips = 1;
+    } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
+        if (!value) { tool_usage("--atlas needs a value"); return -1; }
+        options->atlas_path = value;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+void tiled_mesh_free(tiled_mesh *mesh)
+{
+    tt_mesh_free(mesh->mesh);
+    free(mesh->corner_type);
+    free(mesh->corner_uv);
+    memset(mesh, 0, sizeof *mesh);
+}
+
+/* Replace *mesh by one quadrangulation step of it. */
+static int quadrangulate(tt_mesh **mesh, tt_subdivision scheme, const char *obj_path)
+{
+    tt_mesh *quads;
+    tt_error error;
+    if (tt_mesh_quadrangulate(*mesh, scheme, &quads, &error) != TT_OK)
+        return tool_fail("%s: cannot quadrangulate: %s", obj_path, error.message);
+    tt_mesh_free(*mesh);
+    *mesh = quads;
+    return 0;
+}
+
+int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out)
+{
+    obj_mesh obj;
+    tt_mesh_desc desc;
+    tt_error error;
+    char message[TOOL_ERROR_SIZE];
+    int status, step;
+
+    memset(out, 0, sizeof *out);
+    if (tt_tile_layout_resolve(&options->layout, &out->layout, &error) != TT_OK)
+        return tool_fail("%s", error.message);
+    if (obj_read(obj_path, &obj, message, sizeof message) != 0) return tool_fail("%s", message);
+
+    /* The OBJ's arrays go straight in: corners are faces one after another,
+       exactly the index-buffer layout the library expects. */
+    memset(&desc, 0, sizeof desc);
+    desc.positions = obj.pos;
+    desc.nverts = obj.nverts;
+    desc.indices = obj.corner_vert;
+    desc.face_sizes = obj.face_size;
+    desc.nfaces = obj.nfaces;
+    desc.flags = options->permissive ? TT_MESH_PERMISSIVE : 0;
+    out->input_faces = obj.nfaces;
+    if (tt_mesh_build(&desc, &out->mesh, &error) != TT_OK) {
+        obj_free(&obj);
+        if (error.result == TT_ERROR_NON_MANIFOLD_EDGE || error.result == TT_ERROR_INCONSISTENT_ORIENTATION ||
+            error.result == TT_ERROR_NON_MANIFOLD_VERTEX)
+            return tool_fail("%s: %s (or use --permissive)", obj_path, error.message);
+        return tool_fail("%s: %s", obj_path, error.message);
+    }
+    obj_free(&obj);
+    if (out->mesh->repaired_edges > 0)
+        fprintf(stderr, "tiledtex: %s: --permissive cut %d non-manifold or mis-oriented edges open\n", obj_path,
+                out->mesh->repaired_edges);
+
+    /* Tiles are square: every face must be a quad. */
+    if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
+        int smallest = out->mesh->min_face_size, largest = out->mesh->max_face_size;
+        out->quadrangulated = 1;
+        if ((status = quadrangulate(&out->mesh, TT_SUBDIVIDE_LINEAR, obj_path)) != 0) goto fail;
+        fprintf(stderr, "tiledtex: %s has faces of %d to %d corners: quadrangulated its %d faces into %d quads\n",
+                obj_path, smallest, largest, out->input_faces, out->mesh->nfaces);
+    }
+    for (step = 0; step < options->subdivide; step++)
+        if ((status = quadrangulate(&out->mesh, options->smooth ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR,
+                                    obj_path)) != 0)
+            goto fail;
+
+    out->corner_type = (uint8_t *)malloc((size_t)out->mesh->ncorners);
+    out->corner_uv = (float *)malloc((size_t)out->mesh->ncorners * 2 * sizeof(float));
+    if (!out->corner_type || !out->corner_uv) {
+        status = tool_fail("out of memory for %d corners", out->mesh->ncorners);
+        goto fail;
+    }
+    tt_assign_boundaries(out->mesh, &out->layout, options->seed, out->corner_type);
+    if (tt_assign_uvs(out->mesh, &out->layout, out->corner_type, out->corner_uv, &error) != TT_OK) {
+        status = tool_fail("%s: %s", obj_path, error.message);
+        goto fail;
+    }
+    if (tt_mesh_compute_stats(out->mesh, &out->stats) != TT_OK) {
+        status = tool_fail("out of memory while measuring %s", obj_path);
+        goto fail;
+    }
+    return 0;
+fail:
+    tiled_mesh_free(out);
+    return status;
+}
+
+int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name)
+{
+    tool_buffer text;
+    obj_write_desc desc;
+    char comment[256];
+    memset(&text, 0, sizeof text);
+    memset(&desc, 0, sizeof desc);
+    snprintf(comment, sizeof comment,
+             "tiled texture by tiledtex %s: %d quads, %d colors, %d-texel tiles, gutter %d",
+             TILEDTEX_VERSION_STRING, mesh->mesh->nfaces, mesh->layout.colors, mesh->layout.tile_size,
+             mesh->layout.gutter);
+    desc.comment = comment;
+    desc.nverts = mesh->mesh->nverts;
+    desc.pos = mesh->mesh->pos;
+    desc.nfaces = mesh->mesh->nfaces;
+    desc.fixed_face_size = 4;
+    desc.corner_vert = mesh->mesh->corner_vert;
+    desc.corner_uv = mesh->corner_uv;
+    desc.mtllib = mtl_name;
+    desc.material = mtl_name ? "tiled" : NULL;
+    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, obj_path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", obj_path);
+    }
+    return 0;
+}
+
+int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name)
+{
+    tool_buffer text;
+    memset(&text, 0, sizeof text);
+    mtl_add_material(&text, "tiled", texture_name);
+    if (output_add_buffer(output, mtl_path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", mtl_path);
+    }
+    return 0;
+}
+
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams)
+{
+    const tt_mesh_stats *s = &mesh->stats;
+    printf("%s: %d quads, %d vertices, genus %d, %d component%s, %d boundary loop%s, valence %d..%d, "
+           "%d tiles (n=%d, %d texels, gutter %d)",
+           obj_path, mesh->mesh->nfaces, s->used_vertices, s->genus, s->components, s->components == 1 ? "" : "s",
+           s->boundary_loops, s->boundary_loops == 1 ? "" : "s", s->min_valence, s->max_valence,
+           tt_tile_layout_tile_count(&mesh->layout), mesh->layout.colors, mesh->layout.tile_size,
+           mesh->layout.gutter);
+    if (seams) printf(", seam score %.3f (seam %.4f, same-face %.4f, unrelated %.4f)", seams->score, seams->seam,
+                      seams->same_face, seams->unrelated);
+    printf("\n");
+}
+
+/* With --atlas: the atlas must have the layout's size. When --tile was not
+   given, the tile size is read off the atlas instead (W = T * (S + 2g)). */
+static int load_atlas_for_layout(const char *path, tiled_options *options, tt_image *atlas)
+{
+    char message[TOOL_ERROR_SIZE];
+    tt_tile_layout layout;
+    tt_error error;
+    int tiles_per_side;
+    if (image_load(path, atlas, message, sizeof message) != 0) return tool_fail("%s", message);
+    if (tt_tile_layout_resolve(&options->layout, &layout, &error) != TT_OK) {
+        tt_image_free(atlas);
+        return tool_fail("%s", error.message);
+    }
+    tiles_per_side = tt_tile_layout_tiles_per_side(&layout);
+    if (!options->tile_size_given && atlas->width == atlas->height && atlas->width % tiles_per_side == 0 &&
+        atlas->width / tiles_per_side - 2 * layout.gutter >= 4)
+        options->layout.tile_size = layout.tile_size = atlas->width / tiles_per_side - 2 * layout.gutter;
+    if (atlas->width != tt_tile_layout_atlas_size(&layout) || atlas->height != atlas->width) {
+        int expected = tt_tile_layout_atlas_size(&layout), width = atlas->width, height = atlas->height;
+        tt_image_free(atlas);
+        return tool_fail("%s is %dx%d, but --colors %d --tile %d --gutter %d make %dx%d atlases", path, width,
+                         height, layout.colors, layout.tile_size, layout.gutter, expected, expected);
+    }
+    return 0;
+}
+
+int cmd_map(int argc, char **argv)
+{
+    const char *positional[2];
+    int npositional = 0, i, status;
+    tiled_options options;
+    tiled_mesh mesh;
+    tt_image atlas;
+    tt_seam_report seams;
+    tool_output output;
+    char message[TOOL_ERROR_SIZE], mtl_path[4096];
+
+    memset(&options, 0, sizeof options);
+    memset(&output, 0, sizeof output);
+    memset(&atlas, 0, sizeof atlas);
+    for (i = 1; i < argc; i++) {
+        int taken;
+        if (tool_is_help(argv[i])) { print_help(); return 0; }
+        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION,
+                                   &options);
+        if (taken < 0) return TOOL_EXIT_USAGE;
+        if (taken) continue;
+        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
+        if (npositional == 2) return tool_usage("too many arguments (see 'tiledtex map --help')");
+        positional[npositional++] = argv[i];
+    }
+    if (npositional != 2) return tool_usage("needs MESH.obj and OUT.obj (see 'tiledtex map --help')");
+
+    if (options.atlas_path && (status = load_atlas_for_layout(options.atlas_path, &options, &atlas)) != 0)
+        return status;
+    if ((status = tiled_map_mesh(positional[0], &options, &mesh)) != 0) {
+        tt_image_free(&atlas);
+        return status;
+    }
+    if (options.atlas_path) {
+        tt_measure_seams(mesh.mesh, mesh.corner_uv, &atlas, options.seed, &seams);
+        /* The MTL sits beside the OBJ and names the atlas as given. */
+        snprintf(mtl_path, sizeof mtl_path, "%.*s.mtl",
+                 (int)(strlen(positional[1]) > 4 && strcmp(positional[1] + strlen(positional[1]) - 4, ".obj") == 0
+                           ? strlen(positional[1]) - 4 : strlen(positional[1])),
+                 positional[1]);
+        status = tiled_add_mtl(&output, mtl_path, options.atlas_path);
+        if (status == 0) status = tiled_add_obj(&output, positional[1], &mesh, tool_basename(mtl_path));
+    } else {
+        status = tiled_add_obj(&output, positional[1], &mesh, NULL);
+    }
+    if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
+    if (status == 0) tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL);
+    output_free(&output);
+    tiled_mesh_free(&mesh);
+    tt_image_free(&atlas);
+    return status;
+}

@@ -1,0 +1,738 @@
+/* render.c - `tiledtex render`: look at a textured mesh without any other program.
+
+   A small software renderer, written to be read. The steps:
+
+     1. Read the OBJ (positions, per-corner vt) and the texture; build the
+        texture's mip chain (each level half the size of the one before).
+     2. Split every polygon into a fan of triangles; give every face corner a
+        smooth normal (faces meeting at a sharp crease keep their own).
+     3. Put a perspective camera on a sphere around the model: it looks at the
+        centre of the model's bounding sphere from far enough away that the whole
+        sphere fits the picture; --yaw and --pitch move it around, --up says
+        which axis of the model points up.
+     4. Visibility pass: every triangle is rasterised with tt_raster_triangle
+        into a z-buffer twice as wide and tall as the picture (2x2 supersampling
+        for anti-aliasing). Each sample keeps the nearest triangle's id.
+     5. Shading pass: each sample's triangle is shaded once (so hidden surfaces
+        cost nothing): perspective-correct UVs, trilinear mip-mapped texture
+        lookup with the level chosen from how fast the UVs change across the
+        screen, and simple two-sided lighting.
+     6. Resolve: average each 2x2 block of samples into one pixel; save the PNG.
+
+   Pasting meshes (lapped textures: many groups of faces, each an alpha-textured
+   patch drawn over the ones before) fit in between steps 5 and 6: rasterise the
+   patches in file order against the finished z-buffer and blend them `over` the
+   colour buffer. The pieces are ready for it: scene.triangle_face leads to each
+   triangle's OBJ group (obj_mesh.face_group), which is where a per-group
+   texture would be chosen, and shade_sample already returns straight-alpha
+   RGBA for any triangle at any sample position. */
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tool.h"
+
+#define RENDER_DEFAULT_WIDTH 800
+#define RENDER_DEFAULT_HEIGHT 600
+#define RENDER_MAX_SIZE 4096
+#define SUPERSAMPLING 2                 /* samples per pixel along each axis */
+#define FIELD_OF_VIEW_DEGREES 35.0f     /* along the picture's shorter side */
+#define FRAME_MARGIN 1.1f               /* a little room around the model's bounding sphere */
+#define CREASE_ANGLE_DEGREES 50.0f      /* faces meeting at a sharper angle are not smoothed together */
+#define UNTEXTURED_GREY 0.75f
+
+static const float PI = 3.14159265358979f;
+
+/* ======================================================================== */
+/* A few vector helpers                                                     */
+/* ======================================================================== */
+
+typedef struct vec3 {
+    float x, y, z;
+} vec3;
+
+static vec3 vec3_make(float x, float y, float z) { vec3 v; v.x = x; v.y = y; v.z = z; return v; }
+static vec3 vec3_add(vec3 a, vec3 b) { return vec3_make(a.x + b.x, a.y + b.y, a.z + b.z); }
+static vec3 vec3_sub(vec3 a, vec3 b) { return vec3_make(a.x - b.x, a.y - b.y, a.z - b.z); }
+static vec3 vec3_scale(vec3 a, float s) { return vec3_make(a.x * s, a.y * s, a.z * s); }
+static float vec3_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static float vec3_length(vec3 a) { return sqrtf(vec3_dot(a, a)); }
+static vec3 vec3_cross(vec3 a, vec3 b)
+{
+    return vec3_make(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static vec3 vec3_normalize(vec3 a)
+{
+    float length = vec3_length(a);
+    return length > 0.0f ? vec3_scale(a, 1.0f / length) : a;
+}
+static vec3 vertex_position(const obj_mesh *mesh, int v)
+{
+    return vec3_make(mesh->pos[3 * v], mesh->pos[3 * v + 1], mesh->pos[3 * v + 2]);
+}
+
+/* ======================================================================== */
+/* Texture: mip chain and filtered lookups                                  */
+/* ======================================================================== */
+
+/* levels[0] is the image; level k + 1 is level k halved with a 2x2 box filter
+   (tt_image_downsample2), for as long as both sides are even. Coarser detail
+   than the last level can hold is simply sampled from the last level. */
+typedef struct mip_texture {
+    int nlevels;
+    tt_image levels[TT_MAX_MIP_LEVELS];
+} mip_texture;
+
+static void texture_free(mip_texture *texture)
+{
+    int i;
+    for (i = 0; i < texture->nlevels; i++) tt_image_free(&texture->levels[i]);
+    texture->nlevels = 0;
+}
+
+/* Takes ownership of `image`. */
+static int texture_build(mip_texture *texture, tt_image *image)
+{
+    memset(texture, 0, sizeof *texture);
+    texture->levels[0] = *image;
+    memset(image, 0, sizeof *image);
+    texture->nlevels = 1;
+    while (texture->nlevels < TT_MAX_MIP_LEVELS) {
+        const tt_image *last = &texture->levels[texture->nlevels - 1];
+        if (last->width % 2 != 0 || last->height % 2 != 0) break;
+        if (tt_image_downsample2(last, &texture->levels[texture->nlevels], NULL) != TT_OK) {
+            texture_free(texture);
+            return -1;
+        }
+        texture->nlevels++;
+    }
+    return 0;
+}
+
+/* Bilinear lookup at texture coordinates (u, v) that wrap around: the texture
+   repeats outside [0,1]. v = 0 is the bottom of the image (OBJ convention)
+   while row 0 is its top, hence y = (1 - v) * height. */
+static void sample_bilinear_wrapped(const tt_image *image, float u, float v, float rgba[4])
+{
+    int w = image->width, h = image->height, x0, y0, x1, y1, i;
+    float x, y, fx, fy;
+    const float *p00, *p10, *p01, *p11;
+    u -= floorf(u);                      /* into [0, 1): the repeat */
+    v -= floorf(v);
+    x = u * (float)w - 0.5f;             /* texel centres sit at half-integers */
+    y = (1.0f - v) * (float)h - 0.5f;
+    x0 = (int)floorf(x);
+    y0 = (int)floorf(y);
+    fx = x - (float)x0;
+    fy = y - (float)y0;
+    /* Neighbours across the image's border come from the opposite side. */
+    x0 = (x0 % w + w) % w;
+    y0 = (y0 % h + h) % h;
+    x1 = x0 + 1 == w ? 0 : x0 + 1;
+    y1 = y0 + 1 == h ? 0 : y0 + 1;
+    p00 = image->pixels + 4 * ((size_t)y0 * (size_t)w + (size_t)x0);
+    p10 = image->pixels + 4 * ((size_t)y0 * (size_t)w + (size_t)x1);
+    p01 = image->pixels + 4 * ((size_t)y1 * (size_t)w + (size_t)x0);
+    p11 = image->pixels + 4 * ((size_t)y1 * (size_t)w + (size_t)x1);
+    for (i = 0; i < 4; i++) {
+        float top = p00[i] + (p10[i] - p00[i]) * fx;
+        float bottom = p01[i] + (p11[i] - p01[i]) * fx;
+        rgba[i] = top + (bottom - top) * fy;
+    }
+}
+
+/* Trilinear lookup: `texels_per_pixel` says how many level-0 texels one screen
+   sample spans; its log2 is the mip level (fractional: blend two levels). */
+static void sample_trilinear(const mip_texture *texture, float u, float v, float texels_per_pixel, float rgba[4])
+{
+    float lod = texels_per_pixel > 1.0f ? log2f(texels_per_pixel) : 0.0f;
+    float coarse[4], t;
+    int level, i;
+    if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
+    if (!(lod < (float)(texture->nlevels - 1))) {   /* also catches NaN */
+        sample_bilinear_wrapped(&texture->levels[texture->nlevels - 1], u, v, rgba);
+        return;
+    }
+    level = (int)lod;
+    t = lod - (float)level;
+    sample_bilinear_wrapped(&texture->levels[level], u, v, rgba);
+    if (t <= 0.0f) return;
+    sample_bilinear_wrapped(&texture->levels[level + 1], u, v, coarse);
+    for (i = 0; i < 4; i++) rgba[i] += (coarse[i] - rgba[i]) * t;
+}
+
+/* ======================================================================== */
+/* Camera                                                                   */
+/* ======================================================================== */
+
+typedef struct camera {
+    vec3 eye;
+    vec3 right, up, forward;    /* orthonormal; the camera looks along `forward` */
+    float focal;                /* in samples: screen x = centre_x + focal * x / z */
+    float centre_x, centre_y;
+} camera;
+
+/* Which way is up in the model: most OBJ files use +y, CAD parts and scans
+   often +z. `side` and `front` complete a right-handed frame with it, so that
+   yaw 0 looks at the model's front. */
+typedef struct up_axis {
+    vec3 up, side, front;
+} up_axis;
+
+static int parse_up_axis(const char *text, up_axis *axis)
+{
+    static const char *const names[] = {"y", "z", "x", "-y", "-z", "-x"};
+    int i;
+    if (!text) return -1;
+    for (i = 0; i < 6; i++) {
+        if (strcmp(text, names[i]) == 0) break;
+    }
+    if (i == 6) return -1;
+    switch (i % 3) {
+    case 0: /* y up, looking from +z */
+        axis->up = vec3_make(0, 1, 0); axis->side = vec3_make(1, 0, 0); axis->front = vec3_make(0, 0, 1); break;
+    case 1: /* z up, looking from -y */
+        axis->up = vec3_make(0, 0, 1); axis->side = vec3_make(1, 0, 0); axis->front = vec3_make(0, -1, 0); break;
+    default: /* x up, looking from +z */
+        axis->up = vec3_make(1, 0, 0); axis->side = vec3_make(0, -1, 0); axis->front = vec3_make(0, 0, 1); break;
+    }
+    if (i >= 3) {   /* upside down: turn the frame half a turn about `front` */
+        axis->up = vec3_scale(axis->up, -1.0f);
+        axis->side = vec3_scale(axis->side, -1.0f);
+    }
+    return 0;
+}
+
+/* Orbit: yaw turns the camera around the up axis, pitch raises it above the
+   model. yaw 0, pitch 0 looks at the model's front. The distance is chosen so
+   that the bounding sphere fits the field of view with a small margin, which also puts every
+   vertex in front of the camera: no clipping is ever needed. */
+static void camera_orbit(camera *cam, vec3 centre, float radius, const up_axis *axis, float yaw_degrees,
+                         float pitch_degrees, int width, int height)
+{
+    float yaw = yaw_degrees * PI / 180.0f, pitch = pitch_degrees * PI / 180.0f;
+    float half_fov = 0.5f * FIELD_OF_VIEW_DEGREES * PI / 180.0f;
+    float distance = FRAME_MARGIN * radius / sinf(half_fov);
+    vec3 toward_eye = vec3_add(vec3_add(vec3_scale(axis->side, cosf(pitch) * sinf(yaw)),
+                                        vec3_scale(axis->up, sinf(pitch))),
+                               vec3_scale(axis->front, cosf(pitch) * cosf(yaw)));
+    cam->eye = vec3_add(centre, vec3_scale(toward_eye, distance));
+    cam->forward = vec3_scale(toward_eye, -1.0f);
+    cam->right = vec3_normalize(vec3_cross(cam->forward, axis->up));
+    cam->up = vec3_cross(cam->right, cam->forward);
+    cam->focal = 0.5f * (float)(width < height ? width : height) / tanf(half_fov);
+    cam->centre_x = 0.5f * (float)width;
+    cam->centre_y = 0.5f * (float)height;
+}
+
+/* ======================================================================== */
+/* Scene: the mesh as triangles, ready to draw                              */
+/* ======================================================================== */
+
+typedef struct scene {
+    const obj_mesh *mesh;
+    int ntriangles;
+    int *triangle_corners;      /* 3 per triangle: corners of the OBJ (index into corner_vert / corner_uv) */
+    int *triangle_face;         /* the OBJ face each triangle comes from */
+    signed char *triangle_facing; /* +1: the camera sees the side the winding calls "outside", -1: the inside */
+    float *corner_normal;       /* 3 per OBJ corner, unit length */
+    float *screen;              /* 3 per vertex: x and y in samples, then q = 1 / depth */
+    const mip_texture *texture; /* NULL: draw grey */
+    vec3 light_key, light_fill; /* unit vectors towards the two lights */
+    int width, height;          /* of the sample grid */
+} scene;
+
+static void scene_free(scene *s)
+{
+    free(s->triangle_corners);
+    free(s->triangle_face);
+    free(s->triangle_facing);
+    free(s->corner_normal);
+    free(s->screen);
+    memset(s, 0, sizeof *s);
+}
+
+/* Fan triangulation: face (c0, c1, ..., cn-1) becomes (c0, ci, ci+1). Exact for
+   triangles and convex polygons, which is what meshes are made of. */
+static int scene_triangulate(scene *s)
+{
+    const obj_mesh *mesh = s->mesh;
+    int f, first = 0, t = 0, total = 0;
+    for (f = 0; f < mesh->nfaces; f++) total += mesh->face_size[f] - 2;   /* < ncorners: no overflow */
+    s->triangle_corners = (int *)malloc((size_t)total * 3 * sizeof(int));
+    s->triangle_face = (int *)malloc((size_t)total * sizeof(int));
+    s->triangle_facing = (signed char *)malloc((size_t)total);
+    if (!s->triangle_corners || !s->triangle_face || !s->triangle_facing) return -1;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int i;
+        for (i = 1; i + 1 < mesh->face_size[f]; i++, t++) {
+            s->triangle_corners[3 * t] = first;
+            s->triangle_corners[3 * t + 1] = first + i;
+            s->triangle_corners[3 * t + 2] = first + i + 1;
+            s->triangle_face[t] = f;
+        }
+        first += mesh->face_size[f];
+    }
+    s->ntriangles = total;
+    return 0;
+}
+
+/* Normal of a polygon by Newell's method: for a planar polygon it is the normal
+   with length twice the area, and for a bent one a sensible average. */
+static vec3 polygon_normal(const obj_mesh *mesh, int first_corner, int size)
+{
+    vec3 n = vec3_make(0.0f, 0.0f, 0.0f);
+    int i;
+    for (i = 0; i < size; i++) {
+        vec3 a = vertex_position(mesh, mesh->corner_vert[first_corner + i]);
+        vec3 b = vertex_position(mesh, mesh->corner_vert[first_corner + (i + 1) % size]);
+        n.x += (a.y - b.y) * (a.z + b.z);
+        n.y += (a.z - b.z) * (a.x + b.x);
+        n.z += (a.x - b.x) * (a.y + b.y);
+    }
+    return n;
+}
+
+/* Smooth normals per corner: the area-weighted average of the normals of the
+   faces around the corner's vertex - but only of those within the crease angle
+   of the corner's own face, so a cube keeps its edges and faces wound the
+   other way (a badly oriented neighbour) do not cancel out. */
+static int scene_compute_normals(scene *s)
+{
+    const obj_mesh *mesh = s->mesh;
+    int nv = mesh->nverts, nc = mesh->ncorners, nf = mesh->nfaces, f, c, v, ok = 0;
+    float cos_crease = cosf(CREASE_ANGLE_DEGREES * PI / 180.0f);
+    vec3 *face_normal = (vec3 *)malloc((size_t)nf * sizeof(vec3));
+    int *corner_face = (int *)malloc((size_t)nc * sizeof(int));
+    int *vertex_start = (int *)calloc((size_t)nv + 1, sizeof(int));    /* corners around each vertex, */
+    int *vertex_corners = (int *)malloc((size_t)nc * sizeof(int));     /* as compressed rows */
+    s->corner_normal = (float *)malloc((size_t)nc * 3 * sizeof(float));
+    if (!face_normal || !corner_face || !vertex_start || !vertex_corners || !s->corner_normal) goto done;
+
+    for (f = 0, c = 0; f < nf; f++) {
+        int i;
+        face_normal[f] = polygon_normal(mesh, c, mesh->face_size[f]);
+        for (i = 0; i < mesh->face_size[f]; i++) corner_face[c++] = f;
+    }
+    for (c = 0; c < nc; c++) vertex_start[mesh->corner_vert[c] + 1]++;
+    for (v = 0; v < nv; v++) vertex_start[v + 1] += vertex_start[v];
+    for (c = 0; c < nc; c++) vertex_corners[vertex_start[mesh->corner_vert[c]]++] = c;
+    for (v = nv; v > 0; v--) vertex_start[v] = vertex_start[v - 1];   /* undo the shift the fill made */
+    vertex_start[0] = 0;
+
+    for (c = 0; c < nc; c++) {
+        int vertex = mesh->corner_vert[c], k;
+        vec3 own = vec3_normalize(face_normal[corner_face[c]]);
+        vec3 sum = vec3_make(0.0f, 0.0f, 0.0f);
+        for (k = vertex_start[vertex]; k < vertex_start[vertex + 1]; k++) {
+            vec3 other = face_normal[corner_face[vertex_corners[k]]];
+            if (vec3_dot(own, vec3_normalize(other)) >= cos_crease) sum = vec3_add(sum, other);
+        }
+        sum = vec3_normalize(sum);
+        if (vec3_dot(sum, sum) == 0.0f) sum = own;     /* a degenerate face: whatever we have */
+        s->corner_normal[3 * c] = sum.x;
+        s->corner_normal[3 * c + 1] = sum.y;
+        s->corner_normal[3 * c + 2] = sum.z;
+    }
+    ok = 1;
+done:
+    free(face_normal);
+    free(corner_face);
+    free(vertex_start);
+    free(vertex_corners);
+    return ok ? 0 : -1;
+}
+
+/* Bounding sphere of the vertices faces use: centre of the bounding box, radius
+   to the farthest vertex. Fails on a non-finite coordinate. */
+static int mesh_bounding_sphere(const obj_mesh *mesh, vec3 *centre, float *radius, int *bad_vertex)
+{
+    vec3 lo = vec3_make(INFINITY, INFINITY, INFINITY), hi = vec3_scale(lo, -1.0f);
+    float r2 = 0.0f;
+    int c;
+    for (c = 0; c < mesh->ncorners; c++) {
+        vec3 p = vertex_position(mesh, mesh->corner_vert[c]);
+        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z)) {
+            *bad_vertex = mesh->corner_vert[c];
+            return -1;
+        }
+        lo = vec3_make(fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z));
+        hi = vec3_make(fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z));
+    }
+    *centre = vec3_add(vec3_scale(lo, 0.5f), vec3_scale(hi, 0.5f));   /* halves first: no overflow */
+    for (c = 0; c < mesh->ncorners; c++) {
+        vec3 d = vec3_sub(vertex_position(mesh, mesh->corner_vert[c]), *centre);
+        float d2 = vec3_dot(d, d);
+        if (d2 > r2) r2 = d2;
+    }
+    *radius = sqrtf(r2);
+    /* A mesh squeezed into a point (or too large for floats) still gets a view. */
+    if (!(*radius > 1e-30f) || !isfinite(*radius * 4.0f)) *radius = 1.0f;
+    return 0;
+}
+
+/* Project every vertex: x, y on the sample grid (y down) and q = 1 / depth.
+   q is what varies linearly across a triangle on screen, so it is what the
+   z-buffer stores (larger q = nearer). */
+static int scene_project(scene *s, const camera *cam)
+{
+    const obj_mesh *mesh = s->mesh;
+    int v, t;
+    s->screen = (float *)malloc((size_t)mesh->nverts * 3 * sizeof(float));
+    if (!s->screen) return -1;
+    for (v = 0; v < mesh->nverts; v++) {
+        vec3 d = vec3_sub(vertex_position(mesh, v), cam->eye);
+        float depth = vec3_dot(d, cam->forward);
+        float q = depth > 0.0f ? 1.0f / depth : 0.0f;
+        float x = cam->centre_x + cam->focal * vec3_dot(d, cam->right) * q;
+        float y = cam->centre_y - cam->focal * vec3_dot(d, cam->up) * q;
+        /* A vertex that lands nowhere (float overflow in an absurd mesh) gets
+           q = 0, which makes the visibility pass skip its triangles. */
+        if (!isfinite(x) || !isfinite(y) || !isfinite(q)) x = y = q = 0.0f;
+        s->screen[3 * v] = x;
+        s->screen[3 * v + 1] = y;
+        s->screen[3 * v + 2] = q;
+    }
+    /* Which side of each triangle faces the camera: lighting is two-sided, so
+       a mesh wound inwards (or an open surface seen from behind) still gets
+       its normals turned towards the viewer. */
+    for (t = 0; t < s->ntriangles; t++) {
+        const int *corner = s->triangle_corners + 3 * t;
+        vec3 p0 = vertex_position(mesh, mesh->corner_vert[corner[0]]);
+        vec3 p1 = vertex_position(mesh, mesh->corner_vert[corner[1]]);
+        vec3 p2 = vertex_position(mesh, mesh->corner_vert[corner[2]]);
+        vec3 normal = vec3_cross(vec3_sub(p1, p0), vec3_sub(p2, p0));
+        s->triangle_facing[t] = vec3_dot(normal, vec3_sub(cam->eye, p0)) >= 0.0f ? 1 : -1;
+    }
+    return 0;
+}
+
+/* ======================================================================== */
+/* Sample buffers                                                           */
+/* ======================================================================== */
+
+typedef struct sample_buffer {
+    int width, height;          /* SUPERSAMPLING times the picture's */
+    float *depth;               /* q = 1 / depth of the nearest surface; 0 = nothing */
+    int *triangle;              /* the nearest triangle, -1 = background */
+    float *color;               /* 3 per sample, RGB */
+} sample_buffer;
+
+static int samples_create(sample_buffer *b, int width, int height)
+{
+    size_t n = (size_t)width * (size_t)height, i;
+    b->width = width;
+    b->height = height;
+    b->depth = (float *)calloc(n, sizeof(float));
+    b->triangle = (int *)malloc(n * sizeof(int));
+    b->color = (float *)malloc(n * 3 * sizeof(float));
+    if (!b->depth || !b->triangle || !b->color) return -1;
+    for (i = 0; i < n; i++) b->triangle[i] = -1;
+    return 0;
+}
+
+static void samples_free(sample_buffer *b)
+{
+    free(b->depth);
+    free(b->triangle);
+    free(b->color);
+    memset(b, 0, sizeof *b);
+}
+
+/* ======================================================================== */
+/* Pass 1: visibility                                                       */
+/* ======================================================================== */
+
+typedef struct visibility_job {
+    sample_buffer *samples;
+    int triangle;
+    float q[3];                 /* 1 / depth at the three corners */
+} visibility_job;
+
+/* Called by tt_raster_triangle for every sample the triangle covers. */
+static void visibility_sample(int x, int y, const float barycentric[3], void *user_data)
+{
+    visibility_job *job = (visibility_job *)user_data;
+    size_t i = (size_t)y * (size_t)job->samples->width + (size_t)x;
+    float q = barycentric[0] * job->q[0] + barycentric[1] * job->q[1] + barycentric[2] * job->q[2];
+    if (q > job->samples->depth[i]) {       /* nearer than what is there */
+        job->samples->depth[i] = q;
+        job->samples->triangle[i] = job->triangle;
+    }
+}
+
+static void draw_visibility(const scene *s, sample_buffer *samples)
+{
+    visibility_job job;
+    int t, k;
+    job.samples = samples;
+    for (t = 0; t < s->ntriangles; t++) {
+        float xy[6];
+        int usable = 1;
+        for (k = 0; k < 3; k++) {
+            const float *p = s->screen + 3 * s->mesh->corner_vert[s->triangle_corners[3 * t + k]];
+            xy[2 * k] = p[0];
+            xy[2 * k + 1] = p[1];
+            job.q[k] = p[2];
+            if (!(p[2] > 0.0f)) usable = 0;     /* behind the camera: cannot happen with the orbit camera */
+        }
+        if (!usable) continue;
+        job.triangle = t;
+        tt_raster_triangle(xy, samples->width, samples->height, visibility_sample, &job);
+    }
+}
+
+/* ======================================================================== */
+/* Pass 2: shading                                                          */
+/* ======================================================================== */
+
+/* The colour of triangle t at sample position (px, py), straight alpha. */
+static void shade_sample(const scene *s, int t, float px, float py, float rgba[4])
+{
+    const obj_mesh *mesh = s->mesh;
+    const int *corner = s->triangle_corners + 3 * t;
+    const float *p0 = s->screen + 3 * mesh->corner_vert[corner[0]];
+    const float *p1 = s->screen + 3 * mesh->corner_vert[corner[1]];
+    const float *p2 = s->screen + 3 * mesh->corner_vert[corner[2]];
+    float b[3], dbdx[3], dbdy[3], w[3], q, qx, qy, area, light;
+    vec3 normal = vec3_make(0.0f, 0.0f, 0.0f);
+    int k;
+
+    /* Screen-space barycentrics of the sample and how they change per sample
+       step in x and y (constant over the triangle). */
+    area = (p1[1] - p2[1]) * (p0[0] - p2[0]) + (p2[0] - p1[0]) * (p0[1] - p2[1]);
+    if (area == 0.0f) area = 1e-20f;
+    dbdx[0] = (p1[1] - p2[1]) / area;  dbdy[0] = (p2[0] - p1[0]) / area;
+    dbdx[1] = (p2[1] - p0[1]) / area;  dbdy[1] = (p0[0] - p2[0]) / area;
+    dbdx[2] = -dbdx[0] - dbdx[1];      dbdy[2] = -dbdy[0] - dbdy[1];
+    b[0] = dbdx[0] * (px - p2[0]) + dbdy[0] * (py - p2[1]);
+    b[1] = dbdx[1] * (px - p2[0]) + dbdy[1] * (py - p2[1]);
+    b[2] = 1.0f - b[0] - b[1];
+
+    /* Perspective correction: attributes divided by depth (times q) are linear
+       on screen, so interpolate a*q and q, then divide. w[k] are the true
+       weights of the corners at this point of the surface. */
+    q = b[0] * p0[2] + b[1] * p1[2] + b[2] * p2[2];
+    qx = dbdx[0] * p0[2] + dbdx[1] * p1[2] + dbdx[2] * p2[2];
+    qy = dbdy[0] * p0[2] + dbdy[1] * p1[2] + dbdy[2] * p2[2];
+    if (!(q > 0.0f)) q = 1e-20f;
+    w[0] = b[0] * p0[2] / q;
+    w[1] = b[1] * p1[2] / q;
+    w[2] = b[2] * p2[2] / q;
+
+    /* Colour: the texture, or grey when a corner has no UV. */
+    rgba[0] = rgba[1] = rgba[2] = UNTEXTURED_GREY;
+    rgba[3] = 1.0f;
+    if (s->texture && mesh->corner_uv && mesh->corner_uv[corner[0]] >= 0 && mesh->corner_uv[corner[1]] >= 0 &&
+        mesh->corner_uv[corner[2]] >= 0) {
+        const float *uv0 = mesh->uv + 2 * mesh->corner_uv[corner[0]];
+        const float *uv1 = mesh->uv + 2 * mesh->corner_uv[corner[1]];
+        const float *uv2 = mesh->uv + 2 * mesh->corner_uv[corner[2]];
+        float u = w[0] * uv0[0] + w[1] * uv1[0] + w[2] * uv2[0];
+        float v = w[0] * uv0[1] + w[1] * uv1[1] + w[2] * uv2[1];
+        /* d(u)/dx = (d(u q)/dx - u dq/dx) / q, the quotient rule on u = (u q) / q. */
+        float uqx = dbdx[0] * uv0[0] * p0[2] + dbdx[1] * uv1[0] * p1[2] + dbdx[2] * uv2[0] * p2[2];
+        float uqy = dbdy[0] * uv0[0] * p0[2] + dbdy[1] * uv1[0] * p1[2] + dbdy[2] * uv2[0] * p2[2];
+        float vqx = dbdx[0] * uv0[1] * p0[2] + dbdx[1] * uv1[1] * p1[2] + dbdx[2] * uv2[1] * p2[2];
+        float vqy = dbdy[0] * uv0[1] * p0[2] + dbdy[1] * uv1[1] * p1[2] + dbdy[2] * uv2[1] * p2[2];
+        const tt_image *base = &s->texture->levels[0];
+        float dudx = (uqx - u * qx) / q * (float)base->width, dvdx = (vqx - v * qx) / q * (float)base->height;
+        float dudy = (uqy - u * qy) / q * (float)base->width, dvdy = (vqy - v * qy) / q * (float)base->height;
+        /* The footprint of one sample in texels: the longer of its two sides. */
+        float footprint = sqrtf(fmaxf(dudx * dudx + dvdx * dvdx, dudy * dudy + dvdy * dvdy));
+        sample_trilinear(s->texture, u, v, footprint, rgba);
+    }
+
+    /* Lighting: ambient plus two directional lights fixed to the camera,
+       with the normal turned towards the viewer (two-sided). */
+    for (k = 0; k < 3; k++) {
+        const float *n = s->corner_normal + 3 * corner[k];
+        normal = vec3_add(normal, vec3_scale(vec3_make(n[0], n[1], n[2]), w[k]));
+    }
+    normal = vec3_scale(vec3_normalize(normal), (float)s->triangle_facing[t]);
+    light = 0.32f + 0.72f * fmaxf(0.0f, vec3_dot(normal, s->light_key)) +
+            0.22f * fmaxf(0.0f, vec3_dot(normal, s->light_fill));
+    for (k = 0; k < 3; k++) rgba[k] *= light;
+}
+
+/* A quiet vertical gradient, so both dark and light models stand out. */
+static void background_color(float y_fraction, float rgb[3])
+{
+    float grey = 0.86f - 0.16f * y_fraction;
+    rgb[0] = grey;
+    rgb[1] = grey;
+    rgb[2] = grey + 0.015f;
+}
+
+static void shade_samples(const scene *s, sample_buffer *samples)
+{
+    int x, y;
+    for (y = 0; y < samples->height; y++) {
+        float background[3];
+        background_color((float)y / (float)samples->height, background);
+        for (x = 0; x < samples->width; x++) {
+            size_t i = (size_t)y * (size_t)samples->width + (size_t)x;
+            float *out = samples->color + 3 * i, rgba[4];
+            int t = samples->triangle[i], k;
+            if (t < 0) {
+                memcpy(out, background, sizeof background);
+                continue;
+            }
+            shade_sample(s, t, (float)x + 0.5f, (float)y + 0.5f, rgba);
+            /* Opaque surfaces: alpha is ignored here; a pasting pass would blend. */
+            for (k = 0; k < 3; k++) out[k] = rgba[k];
+        }
+    }
+}
+
+/* ======================================================================== */
+/* Resolve: average the samples of each pixel                               */
+/* ======================================================================== */
+
+static int resolve(const sample_buffer *samples, tt_image *picture)
+{
+    int width = samples->width / SUPERSAMPLING, height = samples->height / SUPERSAMPLING, x, y;
+    const float weight = 1.0f / (float)(SUPERSAMPLING * SUPERSAMPLING);
+    if (tt_image_create(picture, width, height, NULL) != TT_OK) return -1;
+    for (y = 0; y < height; y++) {
+        for (x = 0; x < width; x++) {
+            float *pixel = picture->pixels + 4 * ((size_t)y * (size_t)width + (size_t)x);
+            int sx, sy, k;
+            for (sy = 0; sy < SUPERSAMPLING; sy++) {
+                for (sx = 0; sx < SUPERSAMPLING; sx++) {
+                    size_t i = (size_t)(y * SUPERSAMPLING + sy) * (size_t)samples->width +
+                               (size_t)(x * SUPERSAMPLING + sx);
+                    for (k = 0; k < 3; k++) pixel[k] += samples->color[3 * i + k] * weight;
+                }
+            }
+            pixel[3] = 1.0f;
+        }
+    }
+    return 0;
+}
+
+/* ======================================================================== */
+/* The command                                                              */
+/* ======================================================================== */
+
+static void print_render_help(void)
+{
+    printf("usage: tiledtex render MESH.obj TEXTURE OUT.png [--size WxH] [--yaw DEG] [--pitch DEG] [--up AXIS]\n"
+           "\n"
+           "Draw MESH with TEXTURE (PNG, JPEG, TGA, BMP, ...) applied through the mesh's per-corner\n"
+           "texture coordinates (vt) and save the picture as OUT.png. Faces without texture\n"
+           "coordinates are drawn in grey. The camera looks at the whole model; texture\n"
+           "coordinates outside [0,1] repeat the texture.\n"
+           "\n"
+           "  --size WxH    picture size in pixels, each side up to %d (default %dx%d)\n"
+           "  --yaw DEG     turn the camera around the model's up axis (default 30)\n"
+           "  --pitch DEG   raise the camera above the model, -89 to 89 (default 20)\n"
+           "  --up AXIS     the model's up axis: y (default, usual for OBJ), z (usual for CAD\n"
+           "                and scans), x, -y, -z or -x\n",
+           RENDER_MAX_SIZE, RENDER_DEFAULT_WIDTH, RENDER_DEFAULT_HEIGHT);
+}
+
+int cmd_render(int argc, char **argv)
+{
+    const char *positional[3];
+    int npositional = 0, width = RENDER_DEFAULT_WIDTH, height = RENDER_DEFAULT_HEIGHT, i, status = TOOL_EXIT_FAILURE;
+    double yaw = 30.0, pitch = 20.0;
+    char err[TOOL_ERROR_SIZE];
+    obj_mesh mesh;
+    tt_image image, picture;
+    mip_texture texture;
+    scene s;
+    camera cam;
+    sample_buffer samples;
+    tool_output output = {0};
+    vec3 centre;
+    float radius;
+    int bad_vertex = -1;
+    up_axis axis;
+
+    parse_up_axis("y", &axis);
+
+    for (i = 1; i < argc; i++) {
+        const char *value;
+        if (tool_is_help(argv[i])) {
+            print_render_help();
+            return 0;
+        } else if (tool_option(argc, argv, &i, "--size", &value)) {
+            if (parse_size("--size", value, 8, RENDER_MAX_SIZE, &width, &height) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--yaw", &value)) {
+            if (parse_float("--yaw", value, -3600.0, 3600.0, &yaw) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--pitch", &value)) {
+            if (parse_float("--pitch", value, -89.0, 89.0, &pitch) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--up", &value)) {
+            if (parse_up_axis(value, &axis) != 0)
+                return value ? tool_usage("--up wants x, y, z, -x, -y or -z, got '%s'", value)
+                             : tool_usage("--up needs a value");
+        } else if (tool_is_option(argv[i])) {
+            return tool_unknown_option(argv[i]);
+        } else if (npositional < 3) {
+            positional[npositional++] = argv[i];
+        } else {
+            return tool_usage("too many arguments: '%s' (usage: tiledtex render MESH.obj TEXTURE OUT.png)", argv[i]);
+        }
+    }
+    if (npositional < 3)
+        return tool_usage("needs MESH.obj TEXTURE OUT.png (see 'tiledtex render --help')");
+
+    memset(&texture, 0, sizeof texture);
+    memset(&s, 0, sizeof s);
+    memset(&samples, 0, sizeof samples);
+    memset(&picture, 0, sizeof picture);
+    if (obj_read(positional[0], &mesh, err, sizeof err) != 0) return tool_fail("%s", err);
+    if (image_load(positional[1], &image, err, sizeof err) != 0) {
+        obj_free(&mesh);
+        return tool_fail("%s", err);
+    }
+    if (texture_build(&texture, &image) != 0) {
+        tool_fail("out of memory while preparing the texture");
+        goto done;
+    }
+    if (mesh_bounding_sphere(&mesh, &centre, &radius, &bad_vertex) != 0) {
+        tool_fail("%s: vertex %d has a coordinate that is not a finite number", positional[0], bad_vertex + 1);
+        goto done;
+    }
+
+    s.mesh = &mesh;
+    s.texture = &texture;
+    s.width = width * SUPERSAMPLING;
+    s.height = height * SUPERSAMPLING;
+    camera_orbit(&cam, centre, radius, &axis, (float)yaw, (float)pitch, s.width, s.height);
+    /* Key light from the upper left behind the viewer, a weaker fill from the right. */
+    s.light_key = vec3_normalize(vec3_add(vec3_add(vec3_scale(cam.right, -0.45f), vec3_scale(cam.up, 0.6f)),
+                                          vec3_scale(cam.forward, -0.75f)));
+    s.light_fill = vec3_normalize(vec3_add(vec3_scale(cam.right, 0.8f), vec3_scale(cam.forward, -0.4f)));
+    if (scene_triangulate(&s) != 0 || scene_compute_normals(&s) != 0 || scene_project(&s, &cam) != 0 ||
+        samples_create(&samples, s.width, s.height) != 0) {
+        tool_fail("out of memory while rendering %s", positional[0]);
+        goto done;
+    }
+
+    draw_visibility(&s, &samples);
+    shade_samples(&s, &samples);
+    if (resolve(&samples, &picture) != 0) {
+        tool_fail("out of memory while rendering %s", positional[0]);
+        goto done;
+    }
+    if (output_add_png(&output, positional[2], &picture, err, sizeof err) != 0 ||
+        output_commit(&output, err, sizeof err) != 0) {
+        tool_fail("%s", err);
+        goto done;
+    }
+    printf("wrote %s (%dx%d, %d triangles)\n", positional[2], width, height, s.ntriangles);
+    status = 0;
+
+done:
+    output_free(&output);
+    tt_image_free(&picture);
+    samples_free(&samples);
+    scene_free(&s);
+    texture_free(&texture);
+    obj_free(&mesh);
+    return status;
+}

@@ -1,0 +1,127 @@
+/* synth.c - `tiledtex synth`: make a tiled-texture atlas from one image.
+
+   Akleman et al. Sec. 4 as a library user calls it: load the photo into a
+   tt_image, fill a tt_synth_options, call tt_synthesize_tiles. The atlas holds
+   all (2n)^4 tiles, each placed where its name puts it (Sec. 2), so the UVs of
+   `tiledtex map` with the same --colors/--tile/--gutter find them.
+
+   Every tile ABCD = AXXX over XBXX over XXCX over XXXD over XXXX: a band per
+   side taken from that side's edge window, over a background window of its
+   own. Edge windows are S wide and 2S tall: the line between their upper and
+   lower squares is what two tiles meeting across an edge continue.
+*/
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tiled.h"
+
+static void print_help(void)
+{
+    printf("usage: tiledtex synth IMAGE ATLAS.png [options]\n"
+           "\n"
+           "Make a tiled-texture atlas of (2n)^4 tiles from IMAGE (PNG, JPEG, TGA, BMP, ...).\n"
+           "Tiles meet seamlessly in any arrangement `tiledtex map` gives them.\n"
+           "\n"
+           "options:\n"
+           "  --colors N             edge conditions n (default 1: 16 tiles; 2: 256 tiles)\n"
+           "  --tile S               tile size in texels (default %d); IMAGE needs S x 2S at least\n"
+           "  --gutter G             texels of gutter around each tile, 0 for none (default %d)\n"
+           "  --seed K               random seed for the windows (default 0)\n"
+           "  --edge X,Y             top-left of condition k's S x 2S edge window; give it once\n"
+           "                         per condition (default: chosen from the seed)\n"
+           "  --background X,Y,W,H   region the per-tile background windows come from\n"
+           "                         (default: the whole image)\n"
+           "  --mips                 also write the per-tile mip levels as ATLAS_mipL.png\n",
+           TT_DEFAULT_TILE_SIZE, TT_DEFAULT_GUTTER);
+}
+
+int tiled_fit_tile_size(int width, int height)
+{
+    int fit = width < height / 2 ? width : height / 2;
+    if (fit > TT_DEFAULT_TILE_SIZE) fit = TT_DEFAULT_TILE_SIZE;
+    fit -= fit % 8;
+    return fit >= 8 ? fit : 0;
+}
+
+int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options, tt_tileset **out)
+{
+    tt_synth_options synth;
+    tt_error error;
+    memset(&synth, 0, sizeof synth);
+    synth.layout = options->layout;
+    synth.seed = options->seed;
+    synth.background = options->background;
+    if (options->nedges > 0) {
+        int colors = options->layout.colors ? options->layout.colors : 1;
+        if (options->nedges != colors)
+            return tool_usage("--edge was given %d times, but there are %d colors: give it once per color",
+                              options->nedges, colors);
+        synth.edge_windows = options->edges;
+    }
+    if (tt_synthesize_tiles(image, &synth, out, &error) != TT_OK) {
+        if (error.result == TT_ERROR_IMAGE_TOO_SMALL || error.result == TT_ERROR_INVALID_ARGUMENT)
+            return tool_fail("%s: %s", image_path, error.message);
+        return tool_fail("%s", error.message);
+    }
+    return 0;
+}
+
+int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips)
+{
+    char message[TOOL_ERROR_SIZE], path[4096];
+    int level;
+    size_t stem = strlen(png_path);
+    if (output_add_png(output, png_path, &tiles->levels[0], message, sizeof message) != 0)
+        return tool_fail("%s", message);
+    if (stem > 4 && strcmp(png_path + stem - 4, ".png") == 0) stem -= 4;
+    for (level = 1; mips && level < tiles->nlevels; level++) {
+        snprintf(path, sizeof path, "%.*s_mip%d.png", (int)stem, png_path, level);
+        if (output_add_png(output, path, &tiles->levels[level], message, sizeof message) != 0)
+            return tool_fail("%s", message);
+    }
+    return 0;
+}
+
+int cmd_synth(int argc, char **argv)
+{
+    const char *positional[2];
+    int npositional = 0, i, k, status;
+    tiled_options options;
+    tt_image image;
+    tt_tileset *tiles = NULL;
+    tool_output output;
+    char message[TOOL_ERROR_SIZE];
+
+    memset(&options, 0, sizeof options);
+    memset(&output, 0, sizeof output);
+    for (i = 1; i < argc; i++) {
+        int taken;
+        if (tool_is_help(argv[i])) { print_help(); return 0; }
+        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_SYNTH_OPTIONS, &options);
+        if (taken < 0) return TOOL_EXIT_USAGE;
+        if (taken) continue;
+        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
+        if (npositional == 2) return tool_usage("too many arguments (see 'tiledtex synth --help')");
+        positional[npositional++] = argv[i];
+    }
+    if (npositional != 2) return tool_usage("needs IMAGE and ATLAS.png (see 'tiledtex synth --help')");
+
+    if (image_load(positional[0], &image, message, sizeof message) != 0) return tool_fail("%s", message);
+    status = tiled_synthesize(&image, positional[0], &options, &tiles);
+    if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips);
+    if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
+    if (status == 0) {
+        printf("%s: %dx%d atlas of %d tiles (n=%d, %d texels, gutter %d) from %s; edge windows",
+               positional[1], tiles->levels[0].width, tiles->levels[0].height,
+               tt_tile_layout_tile_count(&tiles->layout), tiles->layout.colors, tiles->layout.tile_size,
+               tiles->layout.gutter, positional[0]);
+        for (k = 0; k < tiles->layout.colors; k++)
+            printf(" %d,%d", tiles->edge_windows[k].x, tiles->edge_windows[k].y);
+        printf("; seamless mip levels: %d\n", tiles->seamless_levels);
+    }
+    output_free(&output);
+    tt_tileset_free(tiles);
+    tt_image_free(&image);
+    return status;
+}

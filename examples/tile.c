@@ -1,0 +1,104 @@
+/* tile.c - `tiledtex tile`: the whole tiled-texture job in one step.
+
+   MESH.obj + IMAGE -> OUT_PREFIX.obj (one UV per corner), OUT_PREFIX.mtl and
+   OUT_PREFIX.png (the atlas): `tiledtex map` and `tiledtex synth` together,
+   with the seam score measured on the result. Open the OBJ in Blender, or
+   look at it with `tiledtex render OUT_PREFIX.obj OUT_PREFIX.png view.png`.
+*/
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tiled.h"
+
+static void print_help(void)
+{
+    printf("usage: tiledtex tile MESH.obj IMAGE OUT_PREFIX [options]\n"
+           "\n"
+           "Texture MESH.obj from IMAGE with no seams: writes OUT_PREFIX.obj, OUT_PREFIX.mtl\n"
+           "and OUT_PREFIX.png (the tile atlas). Triangles and n-gons are quadrangulated\n"
+           "first; each quad shows one tile, so --subdivide makes the texture smaller on the\n"
+           "surface.\n"
+           "\n"
+           "options:\n"
+           "  --colors N             edge conditions n; (2n)^4 tiles (default 1)\n"
+           "  --tile S               tile size in texels (default: %d, or what IMAGE can feed)\n"
+           "  --gutter G             texels of gutter around each tile, 0 for none (default %d)\n"
+           "  --seed K               random seed (default 0)\n"
+           "  --subdivide L          quadrangulate L more times (smaller texture on the surface)\n"
+           "  --smooth               Catmull-Clark positions when subdividing\n"
+           "  --permissive           accept non-manifold or mis-oriented edges\n"
+           "  --edge X,Y             condition k's S x 2S edge window, once per condition\n"
+           "  --background X,Y,W,H   region the background windows come from\n"
+           "  --mips                 also write the per-tile mip levels\n",
+           TT_DEFAULT_TILE_SIZE, TT_DEFAULT_GUTTER);
+}
+
+int cmd_tile(int argc, char **argv)
+{
+    const char *positional[3];
+    int npositional = 0, i, status;
+    tiled_options options;
+    tiled_mesh mesh;
+    tt_image image;
+    tt_tileset *tiles = NULL;
+    tt_seam_report seams;
+    tool_output output;
+    char message[TOOL_ERROR_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
+
+    memset(&options, 0, sizeof options);
+    memset(&output, 0, sizeof output);
+    memset(&mesh, 0, sizeof mesh);
+    for (i = 1; i < argc; i++) {
+        int taken;
+        if (tool_is_help(argv[i])) { print_help(); return 0; }
+        taken = tiled_parse_option(argc, argv, &i,
+                                   TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS, &options);
+        if (taken < 0) return TOOL_EXIT_USAGE;
+        if (taken) continue;
+        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
+        if (npositional == 3) return tool_usage("too many arguments (see 'tiledtex tile --help')");
+        positional[npositional++] = argv[i];
+    }
+    if (npositional != 3) return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see 'tiledtex tile --help')");
+    if (strlen(positional[2]) + 8 > sizeof obj_path) return tool_usage("OUT_PREFIX is too long");
+    snprintf(obj_path, sizeof obj_path, "%s.obj", positional[2]);
+    snprintf(mtl_path, sizeof mtl_path, "%s.mtl", positional[2]);
+    snprintf(png_path, sizeof png_path, "%s.png", positional[2]);
+
+    if (image_load(positional[1], &image, message, sizeof message) != 0) return tool_fail("%s", message);
+    /* Without --tile, take the default tile size or the largest this image
+       can feed; say so when it is smaller. */
+    if (!options.tile_size_given) {
+        int fit = tiled_fit_tile_size(image.width, image.height);
+        if (fit == 0) {
+            tt_image_free(&image);
+            return tool_fail("%s is %dx%d: too small to cut tiles from (at least 8x16 texels)", positional[1],
+                             image.width, image.height);
+        }
+        if (fit < TT_DEFAULT_TILE_SIZE)
+            fprintf(stderr, "tiledtex: %s is %dx%d: using %d-texel tiles (--tile to choose)\n", positional[1],
+                    image.width, image.height, fit);
+        options.layout.tile_size = fit;
+    }
+
+    status = tiled_map_mesh(positional[0], &options, &mesh);
+    if (status == 0) status = tiled_synthesize(&image, positional[1], &options, &tiles);
+    if (status == 0) {
+        tt_measure_seams(mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, &seams);
+        status = tiled_add_atlas(&output, png_path, tiles, options.mips);
+    }
+    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
+    if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));
+    if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
+    if (status == 0) {
+        tiled_print_summary(positional[0], &mesh, &seams);
+        printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
+               tiles->levels[0].height);
+    }
+    output_free(&output);
+    tiled_mesh_free(&mesh);
+    tt_tileset_free(tiles);
+    tt_image_free(&image);
+    return status;
+}

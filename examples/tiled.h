@@ -1,0 +1,77 @@
+/* tiled.h - the tiled-texture steps shared by `tiledtex synth`, `map` and `tile`.
+
+   map.c   turns an OBJ into a quad mesh with tiled-texture UVs (tiled_map_mesh)
+   synth.c turns a photo into an atlas of (2n)^4 tiles     (tiled_synthesize)
+   tile.c  does both in one go.
+   The options they share are parsed in one place (tiled_parse_option).
+*/
+#ifndef TILEDTEX_TILED_H
+#define TILEDTEX_TILED_H
+
+#include "tool.h"
+
+/* Which options a command accepts (tiled_parse_option's `accept`). */
+enum {
+    TILED_LAYOUT_OPTIONS = 1 << 0,   /* --colors --tile --gutter --seed */
+    TILED_MESH_OPTIONS = 1 << 1,     /* --subdivide --smooth --permissive */
+    TILED_SYNTH_OPTIONS = 1 << 2,    /* --edge --background --mips */
+    TILED_ATLAS_OPTION = 1 << 3      /* --atlas */
+};
+
+typedef struct tiled_options {
+    tt_tile_layout layout;       /* zeros = the library's defaults */
+    int tile_size_given;
+    uint64_t seed;
+    int subdivide;               /* extra quadrangulation steps */
+    int smooth;                  /* Catmull-Clark positions for those steps */
+    int permissive;
+    int nedges;                  /* --edge X,Y given this many times */
+    tt_rect edges[TT_MAX_COLORS];
+    tt_rect background;          /* all zero = whole image */
+    int mips;                    /* also write the per-tile mip levels */
+    const char *atlas_path;      /* --atlas */
+} tiled_options;
+
+/* If argv[*index] is one of the accepted options, consume it (and its value)
+   and return 1; return 0 for anything else; on a bad value print one line
+   and return -1. */
+int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled_options *options);
+
+/* A quad mesh with its tiled-texture UVs, ready to write. */
+typedef struct tiled_mesh {
+    tt_mesh *mesh;
+    uint8_t *corner_type;        /* ncorners boundary types */
+    float *corner_uv;            /* 2 * ncorners */
+    tt_tile_layout layout;       /* resolved */
+    tt_mesh_stats stats;
+    int input_faces;             /* faces in the OBJ */
+    int quadrangulated;          /* 1 when the OBJ had triangles or n-gons */
+} tiled_mesh;
+
+/* Read an OBJ, build and validate it, quadrangulate when it is not all quads
+   (said on stderr), subdivide, assign boundaries and UVs. Prints the error and
+   returns an exit status on failure, 0 on success. */
+int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out);
+void tiled_mesh_free(tiled_mesh *mesh);
+
+/* Add OBJ_PATH (positions + one vt per corner, using MATERIAL from MTL_NAME
+   when mtl_name is not NULL) to the output batch. */
+int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name);
+/* Add an MTL file with one material, "tiled", whose texture is TEXTURE_NAME. */
+int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name);
+
+/* The largest tile size up to TT_DEFAULT_TILE_SIZE, a multiple of 8, that an
+   image of width x height can feed (an edge window is S x 2S); 0 if none. */
+int tiled_fit_tile_size(int width, int height);
+
+/* Synthesise the atlas from an image already loaded. Prints the error and
+   returns an exit status on failure. */
+int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options,
+                     tt_tileset **out);
+/* Add the atlas (and with --mips its levels as PREFIX_mipL.png) to the batch. */
+int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips);
+
+/* The one-line summary map and tile print; seams may be NULL. */
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams);
+
+#endif /* TILEDTEX_TILED_H */

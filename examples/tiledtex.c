@@ -1,0 +1,85 @@
+/* tiledtex.c - the `tiledtex` command-line tool: main() and the list of
+   subcommands. Each subcommand lives in its own file (synth.c, map.c, tile.c,
+   render.c, generate.c) as `int cmd_NAME(int argc, char **argv)`.
+
+   This is the one translation unit that compiles the library itself: */
+#define TILEDTEX_IMPLEMENTATION
+#include "tiledtex.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "tool.h"
+
+typedef struct subcommand {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} subcommand;
+
+static const subcommand subcommands[] = {
+    {"tile", cmd_tile, "texture a mesh with Akleman et al.'s tiled textures: OBJ + MTL + atlas PNG"},
+    {"synth", cmd_synth, "synthesise a tile set (the atlas) from an example image"},
+    {"map", cmd_map, "give a mesh tiled-texture UVs for a given tile layout"},
+    {"render", cmd_render, "draw a textured OBJ to a PNG with the built-in software renderer"},
+    {"generate", cmd_generate, "make a procedural example texture or test mesh"},
+};
+#define SUBCOMMAND_COUNT ((int)(sizeof subcommands / sizeof subcommands[0]))
+
+static const subcommand *find_subcommand(const char *name)
+{
+    int i;
+    for (i = 0; i < SUBCOMMAND_COUNT; i++)
+        if (strcmp(subcommands[i].name, name) == 0) return &subcommands[i];
+    return NULL;
+}
+
+static void print_help(void)
+{
+    int i;
+    printf("tiledtex %s - texture any mesh from one example image, without seams or visible repetition\n\n",
+           TILEDTEX_VERSION_STRING);
+    printf("usage: tiledtex COMMAND [ARGUMENTS]\n\ncommands:\n");
+    for (i = 0; i < SUBCOMMAND_COUNT; i++) printf("  %-9s %s\n", subcommands[i].name, subcommands[i].summary);
+    printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
+           "Try it: tiledtex generate mesh torus.obj --shape torus\n"
+           "        tiledtex generate texture stones.png\n"
+           "        tiledtex tile torus.obj stones.png torus_tiled\n"
+           "        tiledtex render torus_tiled.obj torus_tiled.png view.png\n");
+}
+
+int main(int argc, char **argv)
+{
+    const subcommand *command;
+    if (argc < 2 || tool_is_help(argv[1])) {
+        print_help();
+        return argc < 2 ? TOOL_EXIT_USAGE : 0;
+    }
+    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
+        printf("tiledtex %s\n", TILEDTEX_VERSION_STRING);
+        return 0;
+    }
+    if (strcmp(argv[1], "help") == 0) {
+        /* "tiledtex help render" is "tiledtex render --help". */
+        char help_flag[] = "--help";
+        char *help_argv[3];
+        if (argc < 3) {
+            print_help();
+            return 0;
+        }
+        command = find_subcommand(argv[2]);
+        if (!command) return tool_fail("no command called '%s' (try 'tiledtex --help')", argv[2]);
+        help_argv[0] = argv[2];
+        help_argv[1] = help_flag;
+        help_argv[2] = NULL;
+        tool_set_command(command->name);
+        return command->run(2, help_argv);
+    }
+    command = find_subcommand(argv[1]);
+    if (!command) {
+        if (tool_is_option(argv[1])) return tool_usage("unknown option '%s' (try 'tiledtex --help')", argv[1]);
+        return tool_usage("unknown command '%s' (try 'tiledtex --help')", argv[1]);
+    }
+    tool_set_command(command->name);
+    return command->run(argc - 1, argv + 1);
+}

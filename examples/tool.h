@@ -1,0 +1,258 @@
+/* tool.h - shared pieces of the `tiledtex` command-line tool (not the library).
+
+   The tool is a set of subcommands, one file each (synth.c, map.c, tile.c,
+   render.c, generate.c), dispatched by tiledtex.c. They share what is declared
+   here and implemented in tool_io.c:
+
+     - one-line error reporting          tool_fail, tool_usage
+     - command-line helpers              tool_option, parse_int, parse_size, ...
+     - OBJ reading and writing           obj_parse, obj_read, obj_write
+     - MTL writing                       mtl_add_material
+     - images                            image_load, png_encode
+     - atomic output                     tool_output: build every file in
+                                         memory, then commit them all or none
+
+   Conventions every command follows:
+     - Errors are one line on stderr, "tiledtex: <message>" (or
+       "tiledtex CMD: <message>" for a bad command line), and a non-zero exit
+       status: TOOL_EXIT_FAILURE for a failure, TOOL_EXIT_USAGE for a bad
+       command line.
+     - A command never leaves a half-written output: it adds every file it
+       makes to a tool_output and commits them together at the end.
+*/
+#ifndef TILEDTEX_TOOL_H
+#define TILEDTEX_TOOL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "tiledtex.h"
+
+#define TOOL_NAME "tiledtex"
+#define TOOL_EXIT_FAILURE 1
+#define TOOL_EXIT_USAGE 2
+
+/* A good size for the `err` buffers the functions below fill. */
+#define TOOL_ERROR_SIZE 512
+
+/* ---------------------------------------------------------------------- */
+/* Subcommands: argv[0] is the subcommand's name ("render"), options follow. */
+/* Each returns the process exit status.                                     */
+/* ---------------------------------------------------------------------- */
+
+int cmd_synth(int argc, char **argv);
+int cmd_map(int argc, char **argv);
+int cmd_tile(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_generate(int argc, char **argv);
+
+/* ---------------------------------------------------------------------- */
+/* Errors                                                                   */
+/* ---------------------------------------------------------------------- */
+
+/* The subcommand being run ("render"); the dispatcher sets it so that
+   command-line errors can say which command they are about. NULL = none. */
+void tool_set_command(const char *name);
+
+/* Print "tiledtex: <message>" on stderr and return TOOL_EXIT_FAILURE, so a
+   command can write `return tool_fail("cannot ...");`. */
+int tool_fail(const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+
+/* Print "tiledtex CMD: <message>" on stderr and return TOOL_EXIT_USAGE: for a
+   bad command line. */
+int tool_usage(const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+
+/* ---------------------------------------------------------------------- */
+/* Command-line helpers                                                     */
+/*                                                                          */
+/* A command walks its arguments like this:                                 */
+/*                                                                          */
+/*     for (i = 1; i < argc; i++) {                                         */
+/*         const char *value;                                               */
+/*         if (tool_is_help(argv[i])) { print_help(); return 0; }           */
+/*         else if (tool_option(argc, argv, &i, "--size", &value)) {        */
+/*             if (parse_size("--size", value, 1, 4096, &w, &h) != 0)       */
+/*                 return TOOL_EXIT_USAGE;                                  */
+/*         } else if (tool_is_option(argv[i]))                              */
+/*             return tool_unknown_option(argv[i]);                         */
+/*         else positional[npositional++] = argv[i];                        */
+/*     }                                                                    */
+/*                                                                          */
+/* The parse_* functions print the error themselves (one line, naming the   */
+/* option and the text they were given) and return -1; 0 means success.    */
+/* ---------------------------------------------------------------------- */
+
+/* "-h" or "--help". */
+int tool_is_help(const char *arg);
+/* Looks like an option: starts with '-' and is not just "-" or a number. */
+int tool_is_option(const char *arg);
+/* Report "unknown option '--foo' (see 'tiledtex CMD --help')"; returns TOOL_EXIT_USAGE. */
+int tool_unknown_option(const char *arg);
+
+/* If argv[*index] is `name` ("--size"), consume its value - the next argument,
+   or the text after '=' in "--size=800x600" - into *value, advance *index past
+   it, and return 1. A missing value gives *value = NULL, which every parse_*
+   function below reports as "--size needs a value". Returns 0 when argv[*index]
+   is some other argument. */
+int tool_option(int argc, char **argv, int *index, const char *name, const char **value);
+
+/* An integer in [min, max]: "tiledtex CMD: --seed wants an integer from 0 to 9, got 'x'". */
+int parse_int(const char *option, const char *text, int min, int max, int *out);
+/* An unsigned 64-bit integer (seeds), decimal or 0x hexadecimal. */
+int parse_u64(const char *option, const char *text, uint64_t *out);
+/* A finite number in [min, max]. */
+int parse_float(const char *option, const char *text, double min, double max, double *out);
+/* "WxH" such as "800x600", each side in [min, max]:
+   "tiledtex render: --size wants WxH, got '12'". */
+int parse_size(const char *option, const char *text, int min, int max, int *width, int *height);
+/* Exactly `count` comma-separated numbers, such as "X,Y" or "X,Y,W,H". */
+int parse_float_list(const char *option, const char *text, int count, double *out);
+int parse_int_list(const char *option, const char *text, int count, int *out);
+
+/* ---------------------------------------------------------------------- */
+/* Files and growing byte buffers                                           */
+/* ---------------------------------------------------------------------- */
+
+/* Read a whole file (or "-" for standard input) into a malloc'ed buffer with a
+   terminating NUL byte after the `*size` bytes of content. On failure returns
+   -1 and says why in err ("cannot open 'x.obj': No such file or directory"). */
+int tool_read_file(const char *path, unsigned char **data, size_t *size, char *err, size_t err_size);
+
+/* A byte buffer that grows as text is appended. A failed allocation sets
+   `failed` and makes every later append a no-op, so a writer can append
+   freely and check once at the end. Zero-initialise it before use. */
+typedef struct tool_buffer {
+    char *data;
+    size_t size;
+    size_t capacity;
+    int failed;
+} tool_buffer;
+
+void buffer_append(tool_buffer *buffer, const void *bytes, size_t count);
+void buffer_printf(tool_buffer *buffer, const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+void buffer_free(tool_buffer *buffer);
+
+/* ---------------------------------------------------------------------- */
+/* Atomic output: build every file in memory, then write them all or none  */
+/* ---------------------------------------------------------------------- */
+
+typedef struct tool_output_file {
+    char *path;
+    unsigned char *data;
+    size_t size;
+} tool_output_file;
+
+/* Zero-initialise (tool_output out = {0};). */
+typedef struct tool_output {
+    tool_output_file *files;
+    int count;
+    int capacity;
+} tool_output;
+
+/* Add a file. The batch takes ownership of `data` (malloc'ed, may be NULL when
+   size is 0) whether or not the call succeeds. Adding a path that is already
+   in the batch replaces its contents. Returns 0, or -1 when out of memory. */
+int output_add(tool_output *output, const char *path, void *data, size_t size);
+/* Add the contents of a tool_buffer (which is emptied). Fails when the
+   buffer's `failed` flag is set. */
+int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer);
+/* Encode `image` as PNG and add it. */
+int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size);
+
+/* Write every file to a temporary file beside it ("PATH.tiledtex-tmp"), and
+   only when all of them were written completely rename each onto its real
+   name. On any failure every temporary is removed, as is every file already
+   renamed in this commit, so the command leaves no output at all. Returns 0
+   or -1 with the reason in err. The batch stays valid; free it with
+   output_free. */
+int output_commit(tool_output *output, char *err, size_t err_size);
+void output_free(tool_output *output);
+
+/* ---------------------------------------------------------------------- */
+/* Images                                                                   */
+/* ---------------------------------------------------------------------- */
+
+/* Load a PNG / JPEG / TGA / BMP / PSD / GIF / HDR / PIC / PNM file as a float
+   RGBA tt_image (grey and grey+alpha become RGB(A); no alpha means alpha 1).
+   Errors: the file is missing or unreadable, is not an image stb_image can
+   decode, or is wider or taller than TT_MAX_IMAGE_SIZE. */
+int image_load(const char *path, tt_image *image, char *err, size_t err_size);
+
+/* Encode an image as an 8-bit RGBA PNG in memory (malloc'ed; free it). */
+int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, char *err, size_t err_size);
+
+/* ---------------------------------------------------------------------- */
+/* Wavefront OBJ                                                            */
+/* ---------------------------------------------------------------------- */
+
+typedef struct obj_mesh {
+    int nverts;  float *pos;          /* 3 * nverts */
+    int nfaces;  int *face_size;      /* corners per face */
+    int ncorners; int *corner_vert;   /* 0-based vertex per corner, faces one after another */
+    int nuvs;    float *uv;           /* 2 * nuvs, from vt lines */
+    int *corner_uv;                   /* ncorners entries (0-based vt index) or NULL when no face has vt; -1 for a corner without one */
+    int *face_group;                  /* nfaces: index into group_names of the `g`/`o`/`usemtl` group the face is in (0 = before any) */
+    int ngroups; char **group_names;  /* group_names[0] = "" */
+    char *mtllib;                     /* first mtllib name or NULL */
+} obj_mesh;
+
+/* Parse OBJ text (`length` bytes, need not end in NUL; any bytes are safe).
+   Reads v, vt, f (corners v, v/vt, v//vn, v/vt/vn; negative indices count
+   back from the latest vertex), g / o / usemtl (which group each face is in;
+   the latest of these statements names it), and the first mtllib. Everything
+   else (vn values, s, l, p, comments, unknown statements) is skipped. A line
+   ending in '\' continues on the next. Returns 0, or -1 with a message naming
+   the line in err ("line 12: face with fewer than 3 corners") and *out zeroed. */
+int obj_parse(const char *text, size_t length, obj_mesh *out, char *err, size_t err_size);
+/* Read and parse a file; messages start with the path ("mesh.obj:12: ..."). */
+int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
+void obj_free(obj_mesh *mesh);
+
+/* What obj_write writes. Only positions and faces are required. */
+typedef struct obj_write_desc {
+    const char *comment;            /* "# ..." header lines (may contain '\n'), or NULL */
+    int nverts;
+    const float *pos;               /* 3 * nverts */
+    int nfaces;
+    const int *face_size;           /* nfaces corner counts, or NULL: all fixed_face_size */
+    int fixed_face_size;
+    const int *corner_vert;         /* 0-based, faces one after another */
+    const float *corner_uv;         /* 2 floats per corner, or NULL: no vt, faces are "f v v v" */
+    const char *mtllib;             /* "mtllib NAME" line, or NULL */
+    const char *material;           /* "usemtl NAME" before the faces, or NULL */
+    /* Optional groups: face_group[f] indexes group_names (and group_materials,
+       when given); "g NAME" (and "usemtl MATERIAL") is written before every
+       run of faces whose group differs from the previous face's. */
+    const int *face_group;          /* nfaces, or NULL */
+    int ngroups;
+    const char *const *group_names;
+    const char *const *group_materials;   /* or NULL: use `material` for all */
+} obj_write_desc;
+
+/* Append the OBJ text to `out`: "v x y z", then one "vt u v" per face corner
+   (when corner_uv is given), then "f v/vt ..." with 1-based indices. Numbers
+   use 9 significant digits, so floats read back exactly. Returns 0, or -1 on
+   an invalid description or when the buffer ran out of memory. */
+int obj_write(tool_buffer *out, const obj_write_desc *desc);
+
+/* Append one MTL material: "newmtl NAME", white diffuse colour, and
+   "map_Kd TEXTURE" when texture is not NULL. */
+void mtl_add_material(tool_buffer *out, const char *name, const char *texture);
+
+/* The file name part of a path ("out/a.png" -> "a.png"), for mtllib / map_Kd
+   lines that must be relative to the OBJ / MTL file. */
+const char *tool_basename(const char *path);
+
+#endif /* TILEDTEX_TOOL_H */
