@@ -2177,6 +2177,18 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
                 tt__fail(error, result, -1, -1, -1, -1, "out of memory while cutting tile %d", t);
                 goto done;
             }
+        /* A corner texel lies on two sides' edge rows, and whatever meets it
+           around a mesh vertex differs from tile to tile: the mean of the two
+           edge samples there matches each neighbour across an edge halfway. */
+        for (side = 0; side < 4; side++) {
+            const float *a = tt__edge_sample(&s, types[side], 0, 0);
+            const float *b = tt__edge_sample(&s, types[(side + 3) % 4], S - 1, 0);
+            int tx, ty;
+            float *corner;
+            tt__side_to_tile(&s, side, 0, 0, &tx, &ty);
+            corner = s.tile + ((size_t)ty * S + tx) * 4;
+            for (k = 0; k < 3; k++) corner[k] = 0.5f * (a[k] + b[k]);
+        }
         /* Tile row 0 of the formula is at the bottom of the atlas image. */
         tt__write_cell(&s, types, &set->levels[0], column * C, (T - 1 - row) * C);
         if (opt->progress && opt->progress((float)(t + 1) / (float)ntiles, opt->progress_user_data)) {
