@@ -116,6 +116,7 @@ typedef struct tt_error {
     int corner;
     int vertex;
     int other_vertex;   /* the second end of an edge, for edge errors */
+    int other_face;     /* a second face on that edge, for edge errors */
     char message[224];
 } tt_error;
 
@@ -519,6 +520,7 @@ static tt_result tt__fail(tt_error *error, tt_result result, int face, int corne
         error->corner = corner;
         error->vertex = vertex;
         error->other_vertex = other_vertex;
+        error->other_face = -1;
         va_start(args, format);
         vsnprintf(error->message, sizeof error->message, format, args);
         va_end(args);
@@ -530,7 +532,7 @@ static tt_result tt__ok(tt_error *error)
 {
     if (error) {
         error->result = TT_OK;
-        error->face = error->corner = error->vertex = error->other_vertex = -1;
+        error->face = error->corner = error->vertex = error->other_vertex = error->other_face = -1;
         error->message[0] = '\0';
     }
     return TT_OK;
@@ -756,14 +758,17 @@ typedef struct tt__edge_problem {
 static tt_result tt__report_edge_problem(const tt__edge_problem *p, tt_error *error)
 {
     if (p->result == TT_ERROR_INCONSISTENT_ORIENTATION)
-        return tt__fail(error, p->result, p->faces[0], p->corner, p->a, p->b,
-                        "faces %d and %d both run along the edge from vertex %d to vertex %d in the same "
-                        "direction: one of them is flipped (fix its winding, or build with TT_MESH_PERMISSIVE)",
-                        p->faces[0], p->faces[1], p->a, p->b);
-    return tt__fail(error, p->result, p->faces[0], p->corner, p->a, p->b,
-                    "the edge between vertices %d and %d is shared by %d faces (%d, %d, %d%s): a surface edge "
-                    "can border at most two (build with TT_MESH_PERMISSIVE to cut it open)",
-                    p->a, p->b, p->nfaces, p->faces[0], p->faces[1], p->faces[2], p->nfaces > 3 ? ", ..." : "");
+        tt__fail(error, p->result, p->faces[0], p->corner, p->a, p->b,
+                 "faces %d and %d both run along the edge from vertex %d to vertex %d in the same direction: one "
+                 "of them is flipped (fix its winding, or build with TT_MESH_PERMISSIVE)",
+                 p->faces[0], p->faces[1], p->a, p->b);
+    else
+        tt__fail(error, p->result, p->faces[0], p->corner, p->a, p->b,
+                 "the edge between vertices %d and %d is shared by %d faces (%d, %d, %d%s): a surface edge can "
+                 "border at most two (build with TT_MESH_PERMISSIVE to cut it open)",
+                 p->a, p->b, p->nfaces, p->faces[0], p->faces[1], p->faces[2], p->nfaces > 3 ? ", ..." : "");
+    if (error) error->other_face = p->faces[1];
+    return p->result;
 }
 
 /* Number of outgoing half-edges met turning around v from vert_corner[v] (a

@@ -206,6 +206,8 @@ typedef struct obj_mesh {
     int *face_group;                  /* nfaces: index into group_names of the `g`/`o`/`usemtl` group the face is in (0 = before any) */
     int ngroups; char **group_names;  /* group_names[0] = "" */
     char *mtllib;                     /* first mtllib name or NULL */
+    int *vert_line;                   /* nverts: the file line of each `v`, for messages */
+    int *face_line;                   /* nfaces: the file line of each `f` */
 } obj_mesh;
 
 /* Parse OBJ text (`length` bytes, need not end in NUL; any bytes are safe).

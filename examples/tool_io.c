@@ -658,7 +658,7 @@ typedef struct obj_parser {
     char *err;
     size_t err_size;
     obj_mesh *mesh;
-    int pos_capacity, uv_capacity, face_capacity, corner_capacity, group_capacity;
+    int pos_capacity, vert_line_capacity, uv_capacity, face_capacity, corner_capacity, group_capacity;
     int nnormals;
     int current_group;
     int *group_table;           /* open-addressing hash: group index + 1, 0 = empty */
@@ -846,9 +846,11 @@ static int parse_vertex(obj_parser *P)
     }
     /* A 4th number (w) or vertex colours may follow; they are not needed. */
     if (mesh->nverts >= OBJ_MAX_COUNT) return obj_error(P, "too many vertices (at most %d)", OBJ_MAX_COUNT);
-    if (grow_array((void **)&mesh->pos, &P->pos_capacity, (mesh->nverts + 1) * 3, sizeof(float)) != 0)
+    if (grow_array((void **)&mesh->pos, &P->pos_capacity, (mesh->nverts + 1) * 3, sizeof(float)) != 0 ||
+        grow_array((void **)&mesh->vert_line, &P->vert_line_capacity, mesh->nverts + 1, sizeof(int)) != 0)
         return out_of_memory(P);
     memcpy(mesh->pos + 3 * (size_t)mesh->nverts, xyz, sizeof xyz);
+    mesh->vert_line[mesh->nverts] = P->statement_line;
     mesh->nverts++;
     return 0;
 }
@@ -982,16 +984,18 @@ static int parse_face(obj_parser *P)
     if (corners < 3) return obj_error(P, "face with fewer than 3 corners");
     if (mesh->nfaces >= OBJ_MAX_COUNT) return obj_error(P, "too many faces (at most %d)", OBJ_MAX_COUNT);
     if (mesh->nfaces == P->face_capacity) {
-        /* face_size and face_group share one capacity. */
+        /* face_size, face_group and face_line share one capacity. */
         int capacity;
         if (grown_capacity(P->face_capacity, mesh->nfaces + 1, sizeof(int), &capacity) != 0 ||
             resize_array((void **)&mesh->face_size, capacity, sizeof(int)) != 0 ||
-            resize_array((void **)&mesh->face_group, capacity, sizeof(int)) != 0)
+            resize_array((void **)&mesh->face_group, capacity, sizeof(int)) != 0 ||
+            resize_array((void **)&mesh->face_line, capacity, sizeof(int)) != 0)
             return out_of_memory(P);
         P->face_capacity = capacity;
     }
     mesh->face_size[mesh->nfaces] = corners;
     mesh->face_group[mesh->nfaces] = P->current_group;
+    mesh->face_line[mesh->nfaces] = P->statement_line;
     mesh->nfaces++;
     return 0;
 }
@@ -1154,6 +1158,8 @@ void obj_free(obj_mesh *mesh)
     free(mesh->uv);
     free(mesh->corner_uv);
     free(mesh->face_group);
+    free(mesh->face_line);
+    free(mesh->vert_line);
     for (g = 0; g < mesh->ngroups; g++) free(mesh->group_names[g]);
     free(mesh->group_names);
     free(mesh->mtllib);
