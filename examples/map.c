@@ -15,6 +15,7 @@
 */
 #include <stdio.h>
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 
 #include "tiled.h"
@@ -171,16 +172,25 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
     }
     obj_free(&obj);
     if (out->mesh->repaired_edges > 0)
-        fprintf(stderr, "tiledtex: %s: --permissive cut %d non-manifold or mis-oriented edges open\n", obj_path,
-                out->mesh->repaired_edges);
+        fprintf(stderr, "tiledtex: %s: --permissive cut %d non-manifold or mis-oriented edge%s open\n", obj_path,
+                out->mesh->repaired_edges, out->mesh->repaired_edges == 1 ? "" : "s");
 
     /* Tiles are square: every face must be a quad. */
     if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
         int smallest = out->mesh->min_face_size, largest = out->mesh->max_face_size;
         out->quadrangulated = 1;
         if ((status = quadrangulate(&out->mesh, TT_SUBDIVIDE_LINEAR, obj_path)) != 0) goto fail;
-        fprintf(stderr, "tiledtex: %s has faces of %d to %d corners: quadrangulated its %d faces into %d quads\n",
-                obj_path, smallest, largest, out->input_faces, out->mesh->nfaces);
+        fprintf(stderr, "tiledtex: %s has faces of %d to %d corners: quadrangulated %d face%s into %d quads\n",
+                obj_path, smallest, largest, out->input_faces, out->input_faces == 1 ? "" : "s", out->mesh->nfaces);
+    }
+    /* Each step makes four times the quads: refuse what would not fit in
+       memory long before it is tried. */
+    if (options->subdivide > 0 &&
+        (double)out->mesh->nfaces * pow(4.0, options->subdivide) > (double)TILED_MAX_QUADS) {
+        status = tool_fail("%s: --subdivide %d would make %.0f quads; the limit is %d (use a smaller level)",
+                           obj_path, options->subdivide, (double)out->mesh->nfaces * pow(4.0, options->subdivide),
+                           TILED_MAX_QUADS);
+        goto fail;
     }
     for (step = 0; step < options->subdivide; step++)
         if ((status = quadrangulate(&out->mesh, options->smooth ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR,

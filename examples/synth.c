@@ -55,8 +55,9 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     if (options->nedges > 0) {
         int colors = options->layout.colors ? options->layout.colors : 1;
         if (options->nedges != colors)
-            return tool_usage("--edge was given %d times, but there are %d colors: give it once per color",
-                              options->nedges, colors);
+            return tool_usage("--edge was given %d time%s, but there %s %d color%s: give it once per color",
+                              options->nedges, options->nedges == 1 ? "" : "s", colors == 1 ? "is" : "are", colors,
+                              colors == 1 ? "" : "s");
         synth.edge_windows = options->edges;
     }
     if (tt_synthesize_tiles(image, &synth, out, &error) != TT_OK) {

@@ -18,6 +18,10 @@ enum {
     TILED_ATLAS_OPTION = 1 << 3      /* --atlas */
 };
 
+/* Subdividing past this many quads is refused (an OBJ of 16M quads is already
+   about 1.5 GB of text). */
+#define TILED_MAX_QUADS (1 << 24)
+
 typedef struct tiled_options {
     tt_tile_layout layout;       /* zeros = the library's defaults */
     int tile_size_given;

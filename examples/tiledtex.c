@@ -51,9 +51,11 @@ static void print_help(void)
 int main(int argc, char **argv)
 {
     const subcommand *command;
-    if (argc < 2 || tool_is_help(argv[1])) {
+    if (argc < 2)
+        return tool_usage("needs a command: tile, synth, map, render or generate (see 'tiledtex --help')");
+    if (tool_is_help(argv[1])) {
         print_help();
-        return argc < 2 ? TOOL_EXIT_USAGE : 0;
+        return 0;
     }
     if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
         printf("tiledtex %s\n", TILEDTEX_VERSION_STRING);

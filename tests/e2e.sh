@@ -1,0 +1,645 @@
+#!/usr/bin/env bash
+# tests/e2e.sh - end-to-end tests of the `tiledtex` command-line tool.
+#
+#   bash tests/e2e.sh TOOL        (e.g. build/asan/tiledtex)
+#
+# Runs the tool on generated and hand-written inputs in a temporary directory
+# (removed at the end). Prints one line per failed check and, as its last
+# line, "N passed, M failed"; exits non-zero when M > 0. Any AddressSanitizer /
+# UndefinedBehaviorSanitizer report on stderr is a failure.
+set -u
+
+if [ $# -ne 1 ] || [ -z "$1" ]; then
+    echo "usage: bash tests/e2e.sh TOOL" >&2
+    echo "0 passed, 1 failed"
+    exit 2
+fi
+TOOL=$1
+case $TOOL in
+    */*) TOOL=$(cd "$(dirname "$TOOL")" 2>/dev/null && pwd)/$(basename "$TOOL") ;;
+    *) TOOL=$(command -v "$TOOL" || echo "$TOOL") ;;
+esac
+if [ ! -x "$TOOL" ]; then
+    echo "FAIL tool | cmd: test -x $1 | expected: an executable | got: not found / not executable"
+    echo "0 passed, 1 failed"
+    exit 1
+fi
+
+W=$(mktemp -d "${TMPDIR:-/tmp}/tiledtex-e2e.XXXXXX") || exit 1
+trap 'cd /; rm -rf "$W"' EXIT
+export LC_ALL=C
+# Make sure a sanitizer finding is printed (the caller may add more options).
+export UBSAN_OPTIONS="print_stacktrace=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
+
+PASS=0
+FAIL=0
+RUNS=0
+SANITIZER_REPORTS=0
+
+# One line: newlines shown as '\n', cut to a readable length.
+oneline() {
+    local s
+    s=$(printf '%s' "$1" | tr -d '\r' | awk 'BEGIN{ORS="\\n"} {print}' | sed 's/\\n$//')
+    if [ ${#s} -gt 400 ]; then s="${s:0:400}..."; fi
+    printf '%s' "$s"
+}
+
+pass() { PASS=$((PASS + 1)); }
+# fail WHAT COMMAND EXPECTED GOT
+fail() {
+    FAIL=$((FAIL + 1))
+    printf 'FAIL %s | cmd: %s | expected: %s | got: %s\n' "$1" "$2" "$3" "$(oneline "$4")"
+}
+# check WHAT EXPECTED GOT CONDITION-STATUS (0 = ok); command is $CMD
+check() {
+    if [ "$4" = 0 ]; then pass; else fail "$1" "$CMD" "$2" "$3"; fi
+}
+
+# run ARGS... : runs the tool in the current directory with stdout/stderr in
+# $W/out and $W/err; sets RC, CMD, OUT, ERR. A sanitizer report is a failure.
+run() {
+    CMD="tiledtex $*"
+    RUNS=$((RUNS + 1))
+    timeout 60 "$TOOL" "$@" >"$W/out" 2>"$W/err" </dev/null
+    RC=$?
+    OUT=$(cat "$W/out")
+    ERR=$(cat "$W/err")
+    if grep -qE 'ERROR: (AddressSanitizer|LeakSanitizer)|runtime error:|SUMMARY: [A-Za-z]*Sanitizer' "$W/err"; then
+        SANITIZER_REPORTS=$((SANITIZER_REPORTS + 1))
+        fail "sanitizer report" "$CMD (in $(basename "$PWD"))" "no ASan/UBSan report" \
+            "$(grep -m3 -E 'ERROR: |runtime error:|SUMMARY:|#[0-3] ' "$W/err")"
+    fi
+    if [ $RC -eq 124 ]; then
+        fail "timeout" "$CMD" "finishes within 60 s" "killed after 60 s"
+    fi
+}
+
+# expect_ok WHAT ARGS... : exit status 0 (one counted check)
+expect_ok() {
+    local what=$1
+    shift
+    run "$@"
+    check "$what: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
+}
+
+# A fresh, empty directory under $W; cd's into it. Inputs are in ../in.
+NEWDIR_N=0
+newdir() {
+    NEWDIR_N=$((NEWDIR_N + 1))
+    mkdir -p "$W/d$NEWDIR_N" && cd "$W/d$NEWDIR_N" || exit 1
+}
+
+# expect_error WHAT ARGS... : in a fresh empty directory, the tool must fail
+# with a non-zero status, exactly one stderr line starting with "tiledtex",
+# and leave no file behind. Three counted checks. $ERR holds the message.
+expect_error() {
+    local what=$1 left
+    shift
+    newdir
+    run "$@"
+    check "$what: exit status" "non-zero (not a crash)" "exit $RC" \
+        "$([ $RC -ne 0 ] && [ $RC -lt 124 ]; echo $?)"
+    check "$what: stderr" "exactly one line starting with 'tiledtex'" \
+        "$(wc -l <"$W/err") line(s): $ERR" \
+        "$([ "$(wc -l <"$W/err")" -eq 1 ] && head -c 8 "$W/err" | grep -qx 'tiledtex'; echo $?)"
+    left=$(ls -A)
+    check "$what: no output left" "empty directory" "files: $left" "$([ -z "$left" ]; echo $?)"
+    cd "$W" || exit 1
+}
+
+# stderr of the last run contains a pattern (extended regex, case-insensitive)
+err_mentions() {
+    check "$1" "stderr matching /$2/" "$ERR" "$(printf '%s' "$ERR" | grep -qiE "$2"; echo $?)"
+}
+
+# png_size FILE -> "W H" (from the IHDR chunk, bytes 16-23)
+png_size() {
+    od -An -tu1 -j16 -N8 "$1" 2>/dev/null |
+        awk 'NF == 8 { printf "%d %d", (($1*256+$2)*256+$3)*256+$4, (($5*256+$6)*256+$7)*256+$8 }'
+}
+is_png() {
+    [ "$(od -An -tx1 -N8 "$1" 2>/dev/null | tr -d ' \n')" = "89504e470d0a1a0a" ]
+}
+
+# obj_report FILE -> "corners vts nonquads badcorners baduv faces"
+#   corners: corners on f lines; vts: vt lines; nonquads: f lines without 4
+#   corners; badcorners: corners whose vertex or vt index is missing or out of
+#   range; baduv: vt values that are not numbers in [0,1].
+obj_report() {
+    awk '
+        function isnum(s) { return s ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?$/ }
+        $1 == "v"  { nv++ }
+        $1 == "vt" { nvt++
+                     for (i = 2; i <= 3; i++)
+                         if (!isnum($i) || $i + 0 < 0 || $i + 0 > 1) baduv++ }
+        $1 == "f"  { nf++
+                     if (NF - 1 != 4) nonquad++
+                     for (i = 2; i <= NF; i++) { corners++; c[corners] = $i } }
+        END {
+            for (k = 1; k <= corners; k++) {
+                n = split(c[k], p, "/")
+                if (n < 2 || p[1] !~ /^[0-9]+$/ || p[2] !~ /^[0-9]+$/ ||
+                    p[1] + 0 < 1 || p[1] + 0 > nv || p[2] + 0 < 1 || p[2] + 0 > nvt) badc++
+            }
+            printf "%d %d %d %d %d %d\n", corners, nvt, nonquad, badc, baduv, nf
+        }' "$1" 2>/dev/null
+}
+
+# check_obj WHAT FILE : one vt per corner, all quads, UVs in [0,1] (4 checks)
+check_obj() {
+    local r corners nvt nonquad badc baduv nf
+    r=$(obj_report "$2")
+    read -r corners nvt nonquad badc baduv nf <<<"$r"
+    check "$1: OBJ has faces" "> 0 f lines" "$nf" "$([ "${nf:-0}" -gt 0 ]; echo $?)"
+    check "$1: one vt per face corner" "vt lines = corners" "$nvt vt lines, $corners corners" \
+        "$([ "${nvt:-x}" = "${corners:-y}" ] && [ "${badc:-1}" -eq 0 ]; echo $?)"
+    [ "${badc:-0}" -eq 0 ] || fail "$1: corner indices" "$CMD" "every corner v/vt with indices in range" "$badc bad corners"
+    check "$1: all faces quads" "0 non-quad f lines" "$nonquad" "$([ "${nonquad:-1}" -eq 0 ]; echo $?)"
+    check "$1: UVs in [0,1]" "0 bad vt values" "$baduv" "$([ "${baduv:-1}" -eq 0 ]; echo $?)"
+}
+
+# numbers from the summary line(s) on stdout ($OUT)
+summary_genus() { printf '%s\n' "$OUT" | grep -oE 'genus -?[0-9]+' | head -1 | awk '{print $2}'; }
+summary_seam() { printf '%s\n' "$OUT" | grep -oE 'seam score -?[0-9.]+([eE][-+]?[0-9]+)?' | head -1 | awk '{print $3}'; }
+
+nonempty() { [ -s "$1" ]; }
+
+# ======================================================================
+# Inputs
+# ======================================================================
+mkdir -p "$W/in"
+cd "$W/in" || exit 1
+
+# --help everywhere
+for sub in synth map tile render generate; do
+    run $sub --help
+    check "$sub --help" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes, stderr: $ERR" \
+        "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
+done
+run --help
+check "--help" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes" "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
+run help tile
+check "help tile" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes" "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
+
+expect_ok "generate texture" generate texture tex.png --size 256 --seed 3
+check "generate texture: 256x256 PNG" "256 256" "$(png_size tex.png)" "$([ "$(png_size tex.png)" = "256 256" ]; echo $?)"
+expect_ok "generate small texture" generate texture small.png --size 64
+for shape in double-torus torus sphere grid pair genus3; do
+    expect_ok "generate mesh $shape" generate mesh $shape.obj --shape $shape
+    check "generate mesh $shape: non-empty" "non-empty $shape.obj" "$(ls -l $shape.obj 2>&1)" "$(nonempty $shape.obj; echo $?)"
+done
+expect_ok "generate mesh sphere --triangles" generate mesh spheretri.obj --shape sphere --triangles
+check "generate --triangles: all triangles" "only 3-corner faces" \
+    "$(awk '$1=="f"{n[NF-1]++} END{for(k in n) printf "%d-gons:%d ", k, n[k]}' spheretri.obj 2>/dev/null)" \
+    "$(awk '$1=="f"{f++; if (NF!=4) bad++} END{exit !(f>0 && bad==0)}' spheretri.obj 2>/dev/null; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
+# Happy paths: tile on generated meshes
+# ======================================================================
+# tile_case NAME MESH GENUS EXTRA-ARGS...
+tile_case() {
+    local name=$1 mesh=$2 genus=$3 g
+    shift 3
+    newdir
+    run tile "../in/$mesh" ../in/tex.png out "$@"
+    check "tile $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
+    check "tile $name: outputs non-empty" "out.obj out.mtl out.png non-empty" "$(ls -l 2>&1)" \
+        "$(nonempty out.obj && nonempty out.mtl && nonempty out.png; echo $?)"
+    check "tile $name: atlas is a PNG" "PNG signature" "$(od -An -tx1 -N8 out.png 2>&1)" "$(is_png out.png; echo $?)"
+    check "tile $name: mtl names the atlas" "map_Kd out.png in out.mtl, mtllib out.mtl in out.obj" \
+        "$(grep -h -E 'map_Kd|mtllib' out.mtl out.obj 2>&1)" \
+        "$(grep -qE '^map_Kd +out\.png' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl' out.obj 2>/dev/null; echo $?)"
+    check "tile $name: exactly out.obj, out.mtl, out.png written (no temporaries)" "out.mtl out.obj out.png" \
+        "$(ls -A | tr '\n' ' ')" "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out.png " ]; echo $?)"
+    [ -f out.obj ] && check_obj "tile $name" out.obj
+    if [ "$genus" != - ]; then
+        g=$(summary_genus)
+        check "tile $name: summary genus" "genus $genus" "$OUT" "$([ "$g" = "$genus" ]; echo $?)"
+    fi
+    cd "$W" || exit 1
+}
+
+tile_case double-torus double-torus.obj 2
+tile_case sphere-triangles spheretri.obj 0
+check "tile sphere-triangles: says it quadrangulated" "stderr mentions quadrangulat" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -qi quadrangulat; echo $?)"
+tile_case grid grid.obj -
+check "tile grid: one boundary loop" "'1 boundary loop' in summary" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])1 boundary loop'; echo $?)"
+tile_case pair pair.obj -
+check "tile pair: two components" "'2 components' in summary" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])2 components'; echo $?)"
+tile_case genus3 genus3.obj 3
+tile_case torus-n1 torus.obj 1
+s=$(summary_seam)
+check "tile torus n=1: seam score <= 0.05" "seam score <= 0.05" "$OUT" \
+    "$(awk -v s="${s:-x}" 'BEGIN{exit !(s ~ /^-?[0-9.]+/ && s + 0 <= 0.05)}'; echo $?)"
+check "tile torus n=1: atlas size" "544 544 (4 x (128+2*4))" "$(png_size "$W/d$NEWDIR_N/out.png")" \
+    "$([ "$(png_size "$W/d$NEWDIR_N/out.png")" = "544 544" ]; echo $?)"
+tile_case torus-n2 torus.obj 1 --colors 2 --tile 32
+s=$(summary_seam)
+check "tile torus --colors 2 --tile 32: seam score <= 0.05" "seam score <= 0.05" "$OUT" \
+    "$(awk -v s="${s:-x}" 'BEGIN{exit !(s ~ /^-?[0-9.]+/ && s + 0 <= 0.05)}'; echo $?)"
+check "tile torus n=2: atlas size" "640 640 (16 x (32+2*4))" "$(png_size "$W/d$NEWDIR_N/out.png")" \
+    "$([ "$(png_size "$W/d$NEWDIR_N/out.png")" = "640 640" ]; echo $?)"
+
+# ----------------------------------------------------------------------
+# Determinism and seeds
+# ----------------------------------------------------------------------
+TARGS=(--colors 2 --tile 32 --gutter 2 --seed 7)
+mkdir -p "$W/det1" "$W/det2" "$W/det3"
+cd "$W/det1" && expect_ok "tile seed 7 (1st)" tile ../in/double-torus.obj ../in/tex.png out "${TARGS[@]}"
+cd "$W/det2" && expect_ok "tile seed 7 (2nd)" tile ../in/double-torus.obj ../in/tex.png out "${TARGS[@]}"
+CMD="tiledtex tile ../in/double-torus.obj ../in/tex.png out ${TARGS[*]} (twice)"
+check "same seed twice: identical .obj" "cmp equal" "$(cmp "$W/det1/out.obj" "$W/det2/out.obj" 2>&1)" \
+    "$(cmp -s "$W/det1/out.obj" "$W/det2/out.obj"; echo $?)"
+check "same seed twice: identical .png" "cmp equal" "$(cmp "$W/det1/out.png" "$W/det2/out.png" 2>&1)" \
+    "$(cmp -s "$W/det1/out.png" "$W/det2/out.png"; echo $?)"
+cd "$W/det3" && expect_ok "tile seed 8" tile ../in/double-torus.obj ../in/tex.png out --colors 2 --tile 32 --gutter 2 --seed 8
+CMD="tiledtex tile ../in/double-torus.obj ../in/tex.png out --colors 2 --tile 32 --gutter 2 --seed 7 / --seed 8"
+check "different seed: different .obj" "files differ" "identical" \
+    "$(! cmp -s "$W/det1/out.obj" "$W/det3/out.obj"; echo $?)"
+check "different seed: different .png" "files differ" "identical" \
+    "$(! cmp -s "$W/det1/out.png" "$W/det3/out.png"; echo $?)"
+
+# map + synth separately == tile (same --colors/--tile/--gutter/--seed)
+cd "$W/det1" || exit 1
+expect_ok "map seed 7" map ../in/double-torus.obj m.obj "${TARGS[@]}"
+check "map: one-line summary on stdout" "1 line with quads, genus, valence" "$OUT" \
+    "$([ "$(printf '%s\n' "$OUT" | wc -l)" -eq 1 ] && printf '%s' "$OUT" | grep -q 'quads.*genus.*valence'; echo $?)"
+check "map without --atlas: no seam score, no .mtl" "no 'seam score', no m.mtl" "$OUT / $(ls)" \
+    "$([ -z "$(summary_seam)" ] && [ ! -e m.mtl ]; echo $?)"
+expect_ok "synth seed 7" synth ../in/tex.png a.png "${TARGS[@]}"
+CMD="tiledtex map ../in/double-torus.obj m.obj ${TARGS[*]} vs tile ... ${TARGS[*]}"
+check "map's vt lines = tile's vt lines" "identical vt lines" \
+    "$(diff <(grep '^vt' m.obj 2>&1) <(grep '^vt' out.obj 2>/dev/null) 2>&1 | head -4)" \
+    "$([ -s m.obj ] && diff -q <(grep '^vt' m.obj 2>/dev/null) <(grep '^vt' out.obj 2>/dev/null) >/dev/null; echo $?)"
+check "map's f lines = tile's f lines" "identical f lines" \
+    "$(diff <(grep '^f' m.obj 2>&1) <(grep '^f' out.obj 2>/dev/null) 2>&1 | head -4)" \
+    "$([ -s m.obj ] && diff -q <(grep '^f' m.obj 2>/dev/null) <(grep '^f' out.obj 2>/dev/null) >/dev/null; echo $?)"
+CMD="tiledtex synth ../in/tex.png a.png ${TARGS[*]} vs tile ... ${TARGS[*]}"
+check "synth's atlas = tile's atlas" "cmp equal" "$(cmp a.png out.png 2>&1)" "$(cmp -s a.png out.png; echo $?)"
+
+# map --atlas: seam score + .mtl
+expect_ok "map --atlas" map ../in/double-torus.obj ma.obj "${TARGS[@]}" --atlas a.png
+check "map --atlas: seam score printed" "'seam score X' on stdout" "$OUT" \
+    "$([ -n "$(summary_seam)" ]; echo $?)"
+check "map --atlas: writes ma.mtl naming a.png" "ma.mtl with map_Kd a.png; mtllib ma.mtl in ma.obj" \
+    "$(cat ma.mtl 2>&1; grep mtllib ma.obj 2>&1)" \
+    "$(grep -qE '^map_Kd +a\.png' ma.mtl 2>/dev/null && grep -qE '^mtllib +ma\.mtl' ma.obj 2>/dev/null; echo $?)"
+s=$(summary_seam)
+check "map --atlas: seam score <= 0.05 with matching atlas" "seam score <= 0.05" "$OUT" \
+    "$(awk -v s="${s:-x}" 'BEGIN{exit !(s ~ /^-?[0-9.]+/ && s + 0 <= 0.05)}'; echo $?)"
+check "map --atlas: same UVs as tile" "identical vt lines" "differ" \
+    "$([ -s ma.obj ] && diff -q <(grep '^vt' ma.obj 2>/dev/null) <(grep '^vt' out.obj 2>/dev/null) >/dev/null; echo $?)"
+# no --tile: the tile size is read off the atlas (640 = 16 x (32 + 2*4))
+newdir
+expect_ok "map --atlas without --tile" map ../in/torus.obj m.obj --colors 2 --atlas ../det1/a.png --gutter 2 --seed 7
+check "map --atlas without --tile: tile size from atlas" "summary says 32 texels" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])32 texels'; echo $?)"
+cd "$W" || exit 1
+# wrong-size atlas with an explicit --tile fails cleanly
+expect_error "map --atlas wrong size" map ../in/torus.obj m.obj --colors 2 --tile 64 --gutter 2 --atlas ../det1/a.png
+err_mentions "map --atlas wrong size: message names the size" '[0-9]+ ?x ?[0-9]+|size'
+
+# more options that must work
+newdir
+expect_ok "synth --colors 2 with two --edge" synth ../in/tex.png a.png --colors 2 --tile 32 --edge 0,0 --edge 100,120
+check "synth two --edge: atlas 640x640" "640 640" "$(png_size a.png)" "$([ "$(png_size a.png)" = "640 640" ]; echo $?)"
+expect_ok "synth --background" synth ../in/tex.png b.png --tile 32 --background 10,10,100,100 --gutter 0
+check "synth --gutter 0: atlas 128x128" "128 128" "$(png_size b.png)" "$([ "$(png_size b.png)" = "128 128" ]; echo $?)"
+expect_ok "synth --seed=5 (--opt=value form)" synth ../in/tex.png c.png --tile=32 --seed=5
+expect_ok "map --subdivide 1" map ../in/torus.obj s.obj --subdivide 1
+check "map --subdivide 1: 4x the quads" "2048 quads (512 x 4)" "$OUT" "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])2048 quads'; echo $?)"
+[ -s s.obj ] && check_obj "map --subdivide 1" s.obj
+cd "$W" || exit 1
+
+# ----------------------------------------------------------------------
+# synth --mips, render --size
+# ----------------------------------------------------------------------
+newdir
+expect_ok "synth --mips" synth ../in/tex.png at.png --tile 32 --mips
+check "synth --mips: at_mip1.png, at_mip2.png written" "at.png at_mip1.png at_mip2.png ..." "$(ls)" \
+    "$([ -s at_mip1.png ] && [ -s at_mip2.png ] && is_png at_mip1.png; echo $?)"
+check "synth --mips: only at*.png files, no temporaries" "at.png at_mipL.png ..." "$(ls -A | tr '\n' ' ')" \
+    "$(! ls -A | grep -qvE '^at(_mip[0-9]+)?\.png$'; echo $?)"
+check "synth --mips: at_mip1.png is half the atlas" "80 80 (atlas 160 160)" \
+    "atlas $(png_size at.png), mip1 $(png_size at_mip1.png)" \
+    "$([ "$(png_size at.png)" = "160 160" ] && [ "$(png_size at_mip1.png)" = "80 80" ]; echo $?)"
+expect_ok "tile for render" tile ../in/torus.obj ../in/tex.png t --tile 32
+expect_ok "render --size=123x77" render t.obj t.png r.png --size=123x77 --yaw 40 --pitch -10
+check "render --size 123x77: PNG of that size" "123 77" "$(png_size r.png)" \
+    "$(is_png r.png && [ "$(png_size r.png)" = "123 77" ]; echo $?)"
+expect_ok "render default size" render t.obj t.png r2.png
+check "render default size: 800x600" "800 600" "$(png_size r2.png)" "$([ "$(png_size r2.png)" = "800 600" ]; echo $?)"
+expect_ok "render an untextured mesh" render ../in/torus.obj t.png r3.png --size 64x64
+check "render untextured: 64x64" "64 64" "$(png_size r3.png)" "$([ "$(png_size r3.png)" = "64 64" ]; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
+# Hand-written OBJs
+# ======================================================================
+cd "$W/in" || exit 1
+CUBE_V='v -1 -1 -1
+v 1 -1 -1
+v 1 1 -1
+v -1 1 -1
+v -1 -1 1
+v 1 -1 1
+v 1 1 1
+v -1 1 1
+'
+CUBE_F='f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+'
+printf '%s%s' "$CUBE_V" "$CUBE_F" >cube.obj
+# the same cube with relative (negative) indices, vertices interleaved with faces
+{
+    printf 'v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n'
+    printf 'f -4 -1 -2 -3\n'                   # = f 1 4 3 2
+    printf 'v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n'
+    printf 'f -4 -3 -2 -1\nf -8 -7 -3 -4\nf -7 -6 -2 -3\nf -6 -5 -1 -2\nf -5 -8 -4 -1\n'
+} >cube_neg.obj
+# the same cube with v/vt/vn, v//vn and v/vt corners
+{
+    printf '%s' "$CUBE_V"
+    printf 'vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n'
+    printf 'f 1/1/1 4/2/1 3/3/1 2/4/1\nf 5/1/1 6/2/1 7/3/1 8/4/1\nf 1//1 2//1 6//1 5//1\n'
+    printf 'f 2/1 3/2 7/3 6/4\nf 3/1/1 4/2/1 8/3/1 7/4/1\nf 4/4/1 1/3/1 5/2/1 8/1/1\n'
+} >cube_forms.obj
+# one face flipped (f 5 6 7 8 -> f 8 7 6 5): mis-oriented edges
+printf '%s%s' "$CUBE_V" "$(printf '%s' "$CUBE_F" | sed 's/^f 5 6 7 8$/f 8 7 6 5/')" >cube_flipped.obj
+printf '\n' >>cube_flipped.obj
+# three triangles sharing the edge 1-2
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n' >nonmanifold.obj
+printf '%sf 1 2 3 9\n' "$CUBE_V" >out_of_range.obj
+printf '%sf -9 -5 -6 -7\n' "$CUBE_V" >bad_negative.obj
+printf '%sf 0 1 2 3\n' "$CUBE_V" >zero_index.obj
+printf 'v nan 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n' >nan.obj
+printf 'v inf 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n' >inf.obj
+printf '# no faces\nv 0 0 0\nv 1 0 0\nv 0 1 0\n' >noface.obj
+: >empty.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n' >two_corners.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 1 2 3\n' >repeated_vertex.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3x\n' >bad_corner.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/5 3/1\n' >bad_vt.obj
+head -c 2000 /dev/urandom >garbage.obj
+awk 'BEGIN { srand(12345); for (i = 0; i < 2000; i++) printf "%c", int(rand() * 256) }' >garbage_fixed.obj
+# OBJ-shaped random text: random vertices, then faces of 3-5 distinct random
+# vertices (absolute or relative indices, some with /vt): a random soup of
+# non-manifold and mis-oriented edges, which --permissive must cope with.
+for k in 1 2 3 4 5 6; do
+    awk -v seed=$k 'BEGIN {
+        srand(seed); nv = 10 + 3 * seed
+        for (i = 0; i < nv; i++) printf "v %f %f %f\n", rand() * 2 - 1, rand() * 2 - 1, (seed == 6 ? 0 : rand())
+        printf "vt 0 0\nvt 1 1\n"
+        for (i = 0; i < 20 + 10 * seed; i++) {
+            n = 3 + int(rand() * 3); printf "f"; split("", used)
+            for (j = 0; j < n; j++) {
+                do x = 1 + int(rand() * nv); while (x in used)
+                used[x] = 1
+                printf " %d%s", (rand() < 0.3 ? x - nv - 1 : x), (rand() < 0.2 ? "/2" : "")
+            }
+            printf "\n"
+        }
+    }' >random$k.obj
+done
+# truncated mid-line: torus.obj cut in the middle of its 100th face line ("f 1"),
+# and in the middle of a vertex line
+off=$(awk '/^f /{n++; if (n == 100) {print b; exit}} {b += length($0) + 1}' torus.obj 2>/dev/null)
+head -c $((${off:-100} + 3)) torus.obj >truncated_face.obj 2>/dev/null
+off=$(awk '/^v /{n++; if (n == 50) {print b; exit}} {b += length($0) + 1}' torus.obj 2>/dev/null)
+head -c $((${off:-100} + 4)) torus.obj >truncated_vertex.obj 2>/dev/null
+cd "$W" || exit 1
+
+# cube of quads: genus 0, valence 3..3, tile works
+tile_case cube cube.obj 0 --tile 32
+check "tile cube: valence 3..3" "'valence 3..3' in summary" "$OUT" "$(printf '%s' "$OUT" | grep -q 'valence 3\.\.3'; echo $?)"
+check "tile cube: 6 quads" "'6 quads' in summary" "$OUT" "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])6 quads'; echo $?)"
+CUBE_OUT=$W/d$NEWDIR_N/out.obj
+tile_case cube-negative-indices cube_neg.obj 0 --tile 32
+check "tile cube with negative indices: same v/vt/f as the plain cube" "identical v/vt/f lines" \
+    "$(diff <(grep -E '^(v|vt|f) ' "$CUBE_OUT" 2>/dev/null) <(grep -E '^(v|vt|f) ' out.obj 2>/dev/null) 2>&1 | head -3)" \
+    "$(cd "$W/d$NEWDIR_N" && diff -q <(grep -E '^(v|vt|f) ' "$CUBE_OUT" 2>/dev/null) <(grep -E '^(v|vt|f) ' out.obj 2>/dev/null) >/dev/null; echo $?)"
+tile_case cube-v/vt/vn-forms cube_forms.obj 0 --tile 32
+check "tile cube with v/vt/vn corners: same v/vt/f as the plain cube" "identical v/vt/f lines" \
+    "$(diff <(grep -E '^(v|vt|f) ' "$CUBE_OUT" 2>/dev/null) <(grep -E '^(v|vt|f) ' out.obj 2>/dev/null) 2>&1 | head -3)" \
+    "$(cd "$W/d$NEWDIR_N" && diff -q <(grep -E '^(v|vt|f) ' "$CUBE_OUT" 2>/dev/null) <(grep -E '^(v|vt|f) ' out.obj 2>/dev/null) >/dev/null; echo $?)"
+
+newdir
+expect_ok "map --subdivide 1 --smooth" map ../in/cube.obj sm.obj --subdivide 1 --smooth
+check "map --subdivide 1 --smooth: cube -> 24 quads" "24 quads" "$OUT" "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])24 quads'; echo $?)"
+check "--smooth moves the cube's corners inward" "no vertex at |x|=|y|=|z|=1" "$(grep -c '^v -\?1 -\?1 -\?1$' sm.obj 2>/dev/null) such vertices" \
+    "$([ -s sm.obj ] && ! grep -qE '^v -?1 -?1 -?1$' sm.obj; echo $?)"
+expect_ok "map --subdivide 1 (no --smooth)" map ../in/cube.obj sf.obj --subdivide 1
+check "--subdivide without --smooth keeps the cube's corners" "8 vertices at |x|=|y|=|z|=1" "$(grep -cE '^v -?1 -?1 -?1$' sf.obj 2>/dev/null) such vertices" \
+    "$([ "$(grep -cE '^v -?1 -?1 -?1$' sf.obj 2>/dev/null)" = 8 ]; echo $?)"
+cd "$W" || exit 1
+
+expect_error "tile non-manifold edge" tile ../in/nonmanifold.obj ../in/tex.png out --tile 32
+err_mentions "non-manifold: message names the edge or face" 'edge|face'
+newdir
+expect_ok "tile non-manifold --permissive" tile ../in/nonmanifold.obj ../in/tex.png out --tile 32 --permissive
+[ -s out.obj ] && check_obj "tile non-manifold --permissive" out.obj
+expect_ok "map non-manifold --permissive" map ../in/nonmanifold.obj m.obj --permissive
+cd "$W" || exit 1
+
+expect_error "tile flipped face" tile ../in/cube_flipped.obj ../in/tex.png out --tile 32
+err_mentions "flipped face: message names the edge or face" 'edge|face'
+newdir
+expect_ok "tile flipped face --permissive" tile ../in/cube_flipped.obj ../in/tex.png out --tile 32 --permissive
+[ -s out.obj ] && check_obj "tile flipped face --permissive" out.obj
+cd "$W" || exit 1
+
+# OBJ numbers vertices and faces from 1 (the tool says so itself), so an error
+# about a mesh must never name vertex 0 or face 0.
+no_zero_index() {
+    check "$1: names vertices/faces the OBJ way (from 1)" "no 'vertex 0', 'vertices 0', 'face 0', 'faces 0', '(0,'" "$ERR" \
+        "$(! printf '%s' "$ERR" | grep -qE '(vertex|vertices|face|faces) 0([^0-9.]|$)|\(0,'; echo $?)"
+}
+expect_error "map NaN in vertex 1" map ../in/nan.obj m.obj
+no_zero_index "map NaN in vertex 1"
+expect_error "map non-manifold edge 1-2" map ../in/nonmanifold.obj m.obj
+err_mentions "map non-manifold: message names the edge or face" 'edge|face'
+no_zero_index "map non-manifold edge 1-2"
+expect_error "map face 1 repeats vertex 1" map ../in/repeated_vertex.obj m.obj
+no_zero_index "map face 1 repeats vertex 1"
+expect_error "map flipped face 2" map ../in/cube_flipped.obj m.obj
+check "map flipped face 2: names OBJ face 2 or vertices 8/7" "'face 2' / 'faces 2 and 5' or 'vertex 8 ... vertex 7'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -qE 'faces? 2([^0-9]|$)|vertex 8.*vertex 7|vertex 7.*vertex 8|vertices (7 and 8|8 and 7)'; echo $?)"
+
+expect_error "index out of range" tile ../in/out_of_range.obj ../in/tex.png out --tile 32
+err_mentions "index out of range: message names line 9 or vertex 9" 'vertex 9|line 9|:9:'
+expect_error "negative index out of range" tile ../in/bad_negative.obj ../in/tex.png out --tile 32
+expect_error "index 0" tile ../in/zero_index.obj ../in/tex.png out --tile 32
+expect_error "NaN coordinate" tile ../in/nan.obj ../in/tex.png out --tile 32
+err_mentions "NaN coordinate: message says NaN" 'nan'
+expect_error "infinite coordinate" map ../in/inf.obj m.obj
+expect_error "OBJ without faces" tile ../in/noface.obj ../in/tex.png out --tile 32
+expect_error "empty OBJ" tile ../in/empty.obj ../in/tex.png out --tile 32
+expect_error "face with 2 corners" tile ../in/two_corners.obj ../in/tex.png out --tile 32
+expect_error "face repeating a vertex" map ../in/repeated_vertex.obj m.obj
+expect_error "unreadable face corner" map ../in/bad_corner.obj m.obj
+expect_error "vt index out of range" map ../in/bad_vt.obj m.obj
+expect_error "binary garbage OBJ" tile ../in/garbage.obj ../in/tex.png out --tile 32
+expect_error "binary garbage OBJ (fixed)" map ../in/garbage_fixed.obj m.obj
+# random OBJ-shaped input: either a clean error or a valid result, never a crash
+for k in 1 2 3 4 5 6; do
+    newdir
+    run tile ../in/random$k.obj ../in/tex.png out --tile 32 --permissive
+    if [ $RC -eq 0 ]; then
+        pass
+        check_obj "random OBJ $k" out.obj
+        expect_ok "render random OBJ $k" render out.obj out.png r.png --size 64x48
+        check "render random OBJ $k: 64x48" "64 48" "$(png_size r.png)" "$([ "$(png_size r.png)" = "64 48" ]; echo $?)"
+    else
+        check "random OBJ $k: clean failure" "exit 1 or 2, one 'tiledtex' stderr line, no files" \
+            "exit $RC, stderr: $ERR, files: $(ls -A | tr '\n' ' ')" \
+            "$([ $RC -lt 124 ] && [ "$(wc -l <"$W/err")" -eq 1 ] && head -c 8 "$W/err" | grep -qx tiledtex && [ -z "$(ls -A)" ]; echo $?)"
+    fi
+    cd "$W" || exit 1
+done
+expect_error "OBJ truncated mid face line" tile ../in/truncated_face.obj ../in/tex.png out --tile 32
+expect_error "OBJ truncated mid vertex line" map ../in/truncated_vertex.obj m.obj
+
+# ======================================================================
+# Bad files, images and options
+# ======================================================================
+expect_error "missing mesh file" tile ../in/nope.obj ../in/tex.png out
+err_mentions "missing mesh: message names the file" 'nope\.obj'
+expect_error "missing image file" tile ../in/torus.obj ../in/nope.png out
+err_mentions "missing image: message names the file" 'nope\.png'
+expect_error "missing image file (synth)" synth ../in/nope.png a.png
+expect_error "non-image file as IMAGE" tile ../in/torus.obj ../in/torus.obj out
+expect_error "garbage as IMAGE (synth)" synth ../in/garbage.obj a.png
+expect_error "non-image TEXTURE (render)" render ../in/torus.obj ../in/torus.obj r.png
+expect_error "missing mesh (render)" render ../in/nope.obj ../in/tex.png r.png
+expect_error "NaN mesh (render)" render ../in/nan.obj ../in/tex.png r.png
+expect_error "garbage mesh (render)" render ../in/garbage.obj ../in/tex.png r.png
+expect_error "image smaller than the tiles" synth ../in/small.png a.png --tile 128
+err_mentions "image smaller than the tiles: message mentions the size" '64 ?x ?64'
+newdir
+expect_ok "tile with a small image and no --tile picks a smaller tile" tile ../in/torus.obj ../in/small.png out
+check "tile small image: atlas 160x160 (32-texel tiles)" "160 160" "$(png_size out.png)" \
+    "$([ "$(png_size out.png)" = "160 160" ]; echo $?)"
+cd "$W" || exit 1
+expect_error "--tile 100000 (synth)" synth ../in/tex.png a.png --tile 100000
+expect_error "--tile 100000 (tile)" tile ../in/torus.obj ../in/tex.png out --tile 100000
+expect_error "--tile 100000 (map)" map ../in/torus.obj m.obj --tile 100000
+expect_error "--colors 0 (synth)" synth ../in/tex.png a.png --colors 0
+expect_error "--colors 99 (synth)" synth ../in/tex.png a.png --colors 99
+expect_error "--colors 0 (map)" map ../in/torus.obj m.obj --colors 0
+expect_error "--colors 99 (tile)" tile ../in/torus.obj ../in/tex.png out --colors 99
+expect_error "--gutter -1" synth ../in/tex.png a.png --gutter -1
+expect_error "--subdivide 99" map ../in/torus.obj m.obj --subdivide 99
+expect_error "--size 0x0 (render)" render ../in/torus.obj ../in/tex.png r.png --size 0x0
+expect_error "--size 100000x100000 (render)" render ../in/torus.obj ../in/tex.png r.png --size 100000x100000
+expect_error "--size 12 (render)" render ../in/torus.obj ../in/tex.png r.png --size 12
+expect_error "--pitch 90 (render)" render ../in/torus.obj ../in/tex.png r.png --pitch 90
+expect_error "--yaw nan (render)" render ../in/torus.obj ../in/tex.png r.png --yaw nan
+expect_error "--size 0 (generate texture)" generate texture t.png --size 0
+expect_error "--size 100000 (generate texture)" generate texture t.png --size 100000
+expect_error "--seed abc (synth)" synth ../in/tex.png a.png --seed abc
+expect_error "--seed abc (map)" map ../in/torus.obj m.obj --seed abc
+expect_error "--seed abc (tile)" tile ../in/torus.obj ../in/tex.png out --seed abc
+expect_error "--seed abc (generate)" generate texture t.png --seed abc
+expect_error "--seed without a value" synth ../in/tex.png a.png --seed
+for sub in synth map tile render generate; do
+    case $sub in
+        synth) args="../in/tex.png a.png" ;;
+        map) args="../in/torus.obj m.obj" ;;
+        tile) args="../in/torus.obj ../in/tex.png out" ;;
+        render) args="../in/torus.obj ../in/tex.png r.png" ;;
+        generate) args="mesh g.obj --shape torus" ;;
+    esac
+    # shellcheck disable=SC2086
+    expect_error "unknown option ($sub)" $sub $args --frobnicate
+    err_mentions "unknown option ($sub): message names it" 'frobnicate'
+done
+expect_error "unknown command" frobnicate
+expect_error "missing positional args (synth)" synth ../in/tex.png
+expect_error "missing positional args (map)" map ../in/torus.obj
+expect_error "missing positional args (tile)" tile ../in/torus.obj ../in/tex.png
+expect_error "missing positional args (tile, none)" tile
+expect_error "missing positional args (render)" render ../in/torus.obj ../in/tex.png
+expect_error "missing positional args (generate)" generate
+expect_error "missing positional args (generate mesh)" generate mesh
+expect_error "generate mesh without --shape" generate mesh g.obj
+expect_error "generate mesh unknown shape" generate mesh g.obj --shape blob
+expect_error "too many positional args (synth)" synth ../in/tex.png a.png extra.png
+expect_error "--edge outside the image" synth ../in/tex.png a.png --edge 1000,1000
+expect_error "--edge negative" synth ../in/tex.png a.png --tile 32 --edge -1,0
+expect_error "--edge once with --colors 2" synth ../in/tex.png a.png --colors 2 --tile 32 --edge 0,0
+expect_error "--edge once with --colors 2 (tile)" tile ../in/torus.obj ../in/tex.png out --colors 2 --tile 32 --edge 0,0
+expect_error "--edge not X,Y" synth ../in/tex.png a.png --edge 5
+expect_error "--background outside the image" synth ../in/tex.png a.png --tile 32 --background 200,200,100,100
+expect_error "map --atlas missing" map ../in/torus.obj m.obj --atlas ../in/nope.png
+expect_error "map --atlas not an image" map ../in/torus.obj m.obj --atlas ../in/torus.obj
+expect_error "output directory missing" tile ../in/torus.obj ../in/tex.png nodir/out --tile 32
+
+# more geometry errors (and their --permissive twins)
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 1 0\nv 2 2 0\nv 1 2 0\nf 1 2 3 4\nf 3 5 6 7\n' >"$W/in/bowtie.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3 4\n' >"$W/in/duplicate_face.obj"
+printf 'v 0 0 0\nv 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3 4\n' >"$W/in/zero_area.obj"
+expect_error "two quads touching at one vertex" map ../in/bowtie.obj m.obj
+no_zero_index "two quads touching at one vertex"
+newdir
+expect_ok "two quads touching at one vertex --permissive" map ../in/bowtie.obj m.obj --permissive
+cd "$W" || exit 1
+expect_error "the same face twice" map ../in/duplicate_face.obj m.obj
+no_zero_index "the same face twice"
+expect_error "zero-area face" tile ../in/zero_area.obj ../in/tex.png out --tile 32
+no_zero_index "zero-area face"
+# the messages above suggest --permissive: it must then work
+newdir
+expect_ok "face repeating a vertex --permissive" map ../in/repeated_vertex.obj m1.obj --permissive
+expect_ok "the same face twice --permissive" map ../in/duplicate_face.obj m2.obj --permissive
+expect_ok "zero-area face --permissive" tile ../in/zero_area.obj ../in/tex.png out --tile 32 --permissive
+cd "$W" || exit 1
+
+# bare `tiledtex`: either help (exit 0) or an error with its one stderr line
+newdir
+run
+check "tiledtex with no arguments" "exit 0 with help, or non-zero with one 'tiledtex...' line on stderr" \
+    "exit $RC, $(wc -l <"$W/err") stderr line(s), stdout ${#OUT} bytes" \
+    "$({ [ $RC -eq 0 ] && [ -n "$OUT" ]; } || { [ $RC -ne 0 ] && [ "$(wc -l <"$W/err")" -eq 1 ] && head -c 8 "$W/err" | grep -qx tiledtex; }; echo $?)"
+cd "$W" || exit 1
+
+# all-or-nothing output: one output path is a directory -> nothing else written
+for blocked in obj mtl png; do
+    newdir
+    mkdir out.$blocked
+    run tile ../in/torus.obj ../in/tex.png out --tile 32
+    check "tile with out.$blocked a directory: fails" "non-zero exit, one stderr line" "exit $RC, stderr: $ERR" \
+        "$([ $RC -ne 0 ] && [ $RC -lt 124 ] && [ "$(wc -l <"$W/err")" -eq 1 ]; echo $?)"
+    check "tile with out.$blocked a directory: no other output" "only out.$blocked" "$(ls -A)" \
+        "$([ "$(ls -A)" = "out.$blocked" ]; echo $?)"
+    cd "$W" || exit 1
+done
+newdir
+echo old >out.obj
+mkdir out.png
+run tile ../in/torus.obj ../in/tex.png out --tile 32
+check "failed tile keeps an existing out.obj" "out.obj still 'old', no other files" "$(ls -A | tr '\n' ' ') / $(head -c 40 out.obj 2>/dev/null)" \
+    "$([ $RC -ne 0 ] && [ "$(cat out.obj 2>/dev/null)" = old ] && [ "$(ls -A | tr '\n' ' ')" = "out.obj out.png " ]; echo $?)"
+cd "$W" || exit 1
+newdir
+mkdir a_mip2.png
+run synth ../in/tex.png a.png --tile 32 --mips
+check "synth --mips with a_mip2.png a directory: nothing written" "non-zero exit, only a_mip2.png" \
+    "exit $RC, files: $(ls -A | tr '\n' ' ')" "$([ $RC -ne 0 ] && [ "$(ls -A)" = a_mip2.png ]; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
+# Sanitizers
+# ======================================================================
+CMD="all $RUNS runs"
+[ $SANITIZER_REPORTS -eq 0 ] && pass   # each report was already counted as a failure
+
+echo "$PASS passed, $FAIL failed"
+[ "$FAIL" -eq 0 ]
