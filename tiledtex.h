@@ -22,7 +22,7 @@
        desc.indices = quads; desc.nfaces = nquads; desc.fixed_face_size = 4;
        tt_mesh *mesh; tt_error err;
        if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) { puts(err.message); return 1; }
-       tt_tile_layout layout = {0};                          // n=1, 128-texel tiles, gutter 4
+       tt_tile_layout layout = {1, 128, TT_RECOMMENDED_GUTTER}; // n, tile size, gutter
        uint8_t *types = malloc(mesh->ncorners);  float *uv = malloc(8 * mesh->ncorners);
        tt_assign_boundaries(mesh, &layout, 42, types);       // seeded: same seed, same result
        tt_assign_uvs(mesh, &layout, types, uv);              // uv[2*c] lines up with indices[c]
@@ -70,7 +70,11 @@
 
 #ifndef TTDEF
 #ifdef TILEDTEX_STATIC
+#if defined(__GNUC__) || defined(__clang__)
+#define TTDEF static __attribute__((unused))   /* a file may use only some functions */
+#else
 #define TTDEF static
+#endif
 #else
 #define TTDEF extern
 #endif
@@ -322,8 +326,8 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
 
 #define TT_MAX_COLORS 128           /* boundary conditions n; types 0..2n-1 fit a byte */
 #define TT_DEFAULT_TILE_SIZE 128
-#define TT_DEFAULT_GUTTER 4
-#define TT_NO_GUTTER (-1)
+#define TT_NO_GUTTER 0
+#define TT_RECOMMENDED_GUTTER 4      /* what the tiledtex tool uses: mip levels 0..2 stay seamless */
 
 /* How tiles sit in the atlas. The UVs depend on this and nothing else, so UVs
    made with one layout fit every atlas synthesised with it.
@@ -331,11 +335,11 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
 typedef struct tt_tile_layout {
     int colors;       /* n, distinct edge conditions (1..TT_MAX_COLORS); 0 = 1 */
     int tile_size;    /* S, texels per tile side; 0 = TT_DEFAULT_TILE_SIZE */
-    int gutter;       /* g, texels around each tile; 0 = TT_DEFAULT_GUTTER, TT_NO_GUTTER = none */
+    int gutter;       /* g, texels around each tile, 0 = none; TT_RECOMMENDED_GUTTER for mip-mapping */
 } tt_tile_layout;
 
 /* Replace zeros by defaults and check ranges (the atlas side must stay within
-   TT_MAX_IMAGE_SIZE). */
+   TT_MAX_IMAGE_SIZE). Resolving a resolved layout changes nothing. */
 TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error);
 /* For a resolved layout: tiles per atlas side T, atlas side W, total tiles (2n)^4. */
 TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout);
@@ -1003,14 +1007,26 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
                     }
                 mesh->repaired_edges++;
                 if (!permissive && (problem.corner < 0 || lowest < problem.corner)) {
-                    int nf = 0;
+                    /* Name the faces in corner order, the lowest corner's first. */
+                    int nf, previous = -1;
                     problem.corner = lowest;
                     problem.a = v;
                     problem.b = dest;
                     problem.result = (p + q > 2) ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
-                    for (k = i; k < run_end && nf < 3; k++) problem.faces[nf++] = mesh->corner_face[buckets[k].corner];
-                    for (k = 0; k < q && nf < 3; k++) problem.faces[nf++] = mesh->corner_face[buckets[other_start + k].corner];
-                    while (nf < 3) problem.faces[nf++] = -1;
+                    for (nf = 0; nf < 3; nf++) {
+                        int next = -1;
+                        for (k = i; k < run_end; k++)
+                            if (buckets[k].corner > previous && (next < 0 || buckets[k].corner < next))
+                                next = buckets[k].corner;
+                        for (k = 0; k < q; k++)
+                            if (buckets[other_start + k].corner > previous &&
+                                (next < 0 || buckets[other_start + k].corner < next))
+                                next = buckets[other_start + k].corner;
+                        if (next < 0) break;
+                        problem.faces[nf] = mesh->corner_face[next];
+                        previous = next;
+                    }
+                    for (; nf < 3; nf++) problem.faces[nf] = -1;
                     problem.nfaces = p + q;
                 }
             }
@@ -1465,8 +1481,10 @@ TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, flo
     float fx = x - 0.5f, fy = y - 0.5f, tx, ty;
     int x0, y0, x1, y1, k;
     const float *p00, *p10, *p01, *p11;
-    if (!(fx > -1e9f && fx < 1e9f)) fx = 0.0f;   /* NaN or absurd: clamp somewhere sane */
-    if (!(fy > -1e9f && fy < 1e9f)) fy = 0.0f;
+    /* Far outside is the same as just outside (clamping), and it keeps the
+       conversion to int defined; NaN samples the first texel. */
+    fx = fx != fx ? 0.0f : tt__clamp_f(fx, -1.0f, (float)image->width);
+    fy = fy != fy ? 0.0f : tt__clamp_f(fy, -1.0f, (float)image->height);
     x0 = (int)floorf(fx);
     y0 = (int)floorf(fy);
     tx = fx - (float)x0;
@@ -1714,22 +1732,27 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
    to corner i+1, so e0 is the tile's bottom, e1 its right, e2 its top, e3 its
    left side. */
 
+/* Defaults filled in without validation, for the small pure functions. */
+static tt_tile_layout tt__layout_with_defaults(const tt_tile_layout *layout)
+{
+    tt_tile_layout out = *layout;
+    if (out.colors == 0) out.colors = 1;
+    if (out.tile_size == 0) out.tile_size = TT_DEFAULT_TILE_SIZE;
+    return out;
+}
+
 TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error)
 {
     tt_tile_layout layout;
     long long tiles_per_side, atlas;
     tt__ok(error);
     if (!in || !out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "layout is NULL");
-    layout = *in;
-    if (layout.colors == 0) layout.colors = 1;
-    if (layout.tile_size == 0) layout.tile_size = TT_DEFAULT_TILE_SIZE;
-    if (layout.gutter == 0) layout.gutter = TT_DEFAULT_GUTTER;
-    else if (layout.gutter == TT_NO_GUTTER) layout.gutter = 0;
+    layout = tt__layout_with_defaults(in);
     if (layout.colors < 1 || layout.colors > TT_MAX_COLORS)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "colors (boundary conditions) must be 1..%d, got %d", TT_MAX_COLORS, in->colors);
     if (layout.tile_size < 4 || layout.tile_size > TT_MAX_IMAGE_SIZE)
-        return tt__fail(error, layout.tile_size > 0 ? TT_ERROR_TOO_LARGE : TT_ERROR_INVALID_ARGUMENT,
+        return tt__fail(error, layout.tile_size > TT_MAX_IMAGE_SIZE ? TT_ERROR_TOO_LARGE : TT_ERROR_INVALID_ARGUMENT,
                         -1, -1, -1, -1, "tile size must be 4..%d texels, got %d", TT_MAX_IMAGE_SIZE, in->tile_size);
     if (layout.gutter < 0 || layout.gutter > layout.tile_size)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -1764,7 +1787,7 @@ TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout)
 
 TTDEF int tt_tile_index(const tt_tile_layout *layout, const uint8_t types[4])
 {
-    int base = 2 * layout->colors;
+    int base = 2 * (layout->colors ? layout->colors : 1);
     int column = base * types[0] + types[1];
     int row = base * types[2] + types[3];
     return row * base * base + column;
@@ -1775,13 +1798,14 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
     /* The paper prints floor(j/2) in the u equation (Figure 6); with
        j = floor(((i+1) mod 4)/2) already 0 or 1 that would pin u to the
        tile's left side. j itself is the corner's column within the tile. */
-    int base = 2 * layout->colors, tiles = base * base;
-    int cell = layout->tile_size + 2 * layout->gutter;
+    tt_tile_layout L = tt__layout_with_defaults(layout);
+    int base = 2 * L.colors, tiles = base * base;
+    int cell = L.tile_size + 2 * L.gutter;
     double atlas = (double)tiles * cell;
     int column = base * types[0] + types[1], row = base * types[2] + types[3];
     int j = ((corner + 1) & 3) >> 1, k = (corner & 3) >> 1;
-    uv[0] = (float)(((double)column * cell + layout->gutter + (double)j * layout->tile_size) / atlas);
-    uv[1] = (float)(((double)row * cell + layout->gutter + (double)k * layout->tile_size) / atlas);
+    uv[0] = (float)(((double)column * cell + L.gutter + (double)j * L.tile_size) / atlas);
+    uv[1] = (float)(((double)row * cell + L.gutter + (double)k * L.tile_size) / atlas);
 }
 
 TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,

@@ -38,7 +38,13 @@ static void print_help(void)
            "  --smooth         use Catmull-Clark positions when subdividing (default: keep the shape)\n"
            "  --atlas A.png    also write OUT.mtl naming A.png, and report the seam score\n"
            "  --permissive     accept non-manifold or mis-oriented edges (they become boundaries)\n",
-           TT_DEFAULT_TILE_SIZE, TT_DEFAULT_GUTTER);
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
+}
+
+void tiled_default_options(tiled_options *options)
+{
+    memset(options, 0, sizeof *options);
+    options->layout.gutter = TT_RECOMMENDED_GUTTER;
 }
 
 int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled_options *options)
@@ -52,7 +58,7 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         options->tile_size_given = 1;
     } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--gutter", &value)) {
         if (parse_int("--gutter", value, 0, TT_MAX_IMAGE_SIZE, &number) != 0) return -1;
-        options->layout.gutter = number == 0 ? TT_NO_GUTTER : number;
+        options->layout.gutter = number;
     } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--seed", &value)) {
         if (parse_u64("--seed", value, &options->seed) != 0) return -1;
     } else if ((accept & TILED_MESH_OPTIONS) && tool_option(argc, argv, index, "--subdivide", &value)) {
@@ -308,7 +314,7 @@ int cmd_map(int argc, char **argv)
     tool_output output;
     char message[TOOL_ERROR_SIZE], mtl_path[4096];
 
-    memset(&options, 0, sizeof options);
+    tiled_default_options(&options);
     memset(&output, 0, sizeof output);
     memset(&atlas, 0, sizeof atlas);
     for (i = 1; i < argc; i++) {

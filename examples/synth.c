@@ -33,7 +33,7 @@ static void print_help(void)
            "  --background X,Y,W,H   region the per-tile background windows come from\n"
            "                         (default: the whole image)\n"
            "  --mips                 also write the per-tile mip levels as ATLAS_mipL.png\n",
-           TT_DEFAULT_TILE_SIZE, TT_DEFAULT_GUTTER);
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
 
 int tiled_fit_tile_size(int width, int height)
@@ -94,7 +94,7 @@ int cmd_synth(int argc, char **argv)
     tool_output output;
     char message[TOOL_ERROR_SIZE];
 
-    memset(&options, 0, sizeof options);
+    tiled_default_options(&options);
     memset(&output, 0, sizeof output);
     for (i = 1; i < argc; i++) {
         int taken;

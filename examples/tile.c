@@ -31,7 +31,7 @@ static void print_help(void)
            "  --edge X,Y             condition k's S x 2S edge window, once per condition\n"
            "  --background X,Y,W,H   region the background windows come from\n"
            "  --mips                 also write the per-tile mip levels\n",
-           TT_DEFAULT_TILE_SIZE, TT_DEFAULT_GUTTER);
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
 
 int cmd_tile(int argc, char **argv)
@@ -46,7 +46,7 @@ int cmd_tile(int argc, char **argv)
     tool_output output;
     char message[TOOL_ERROR_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
 
-    memset(&options, 0, sizeof options);
+    tiled_default_options(&options);
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
     for (i = 1; i < argc; i++) {

@@ -36,6 +36,10 @@ typedef struct tiled_options {
     const char *atlas_path;      /* --atlas */
 } tiled_options;
 
+/* The tool's defaults: the library's, with a gutter of TT_RECOMMENDED_GUTTER
+   so that mip-mapped rendering stays seamless. */
+void tiled_default_options(tiled_options *options);
+
 /* If argv[*index] is one of the accepted options, consume it (and its value)
    and return 1; return 0 for anything else; on a bad value print one line
    and return -1. */

@@ -1,0 +1,153 @@
+/* Compile check for tiledtex.h, built by tests/run.sh with several compilers
+   and options and -Werror (C99, C++, clang, tcc, TILEDTEX_STATIC, user
+   TT_MALLOC/TT_FREE). Calls every public function once, so that a static
+   build has no unused function, and exits 0 when a tiny smoke run works.
+   Valid C99 and C++98. Define COMPILE_CHECK_USER_ALLOC to route the default
+   allocator through counting TT_MALLOC / TT_FREE macros. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef COMPILE_CHECK_USER_ALLOC
+static long user_allocs, user_frees;
+#define TT_MALLOC(size, user_data) ((void)(user_data), user_allocs++, malloc(size))
+#define TT_FREE(ptr, user_data) ((void)(user_data), user_frees++, free(ptr))
+#endif
+
+#define TILEDTEX_IMPLEMENTATION
+#include "tiledtex.h"
+/* A second inclusion must be harmless. */
+#include "tiledtex.h"
+
+static int raster_count;
+static void on_pixel(int x, int y, const float barycentric[3], void *user_data)
+{
+    (void)x;
+    (void)y;
+    (void)barycentric;
+    (void)user_data;
+    raster_count++;
+}
+
+static int progress(float fraction, void *user_data)
+{
+    (void)fraction;
+    (void)user_data;
+    return 0;
+}
+
+#define EXPECT(cond)                                                   \
+    do {                                                               \
+        if (!(cond)) {                                                 \
+            printf("compile_check: %s:%d: %s\n", __FILE__, __LINE__, #cond); \
+            failures++;                                                \
+        }                                                              \
+    } while (0)
+
+int main(void)
+{
+    static const float cube_pos[8 * 3] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+    static const int cube_idx[6 * 4] = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7};
+    int failures = 0, hist[8], comp[64], loops[64], nc = 0, nl = 0, lo[4] = {0, 0, 0, 0}, hi[4] = {1, 1, 1, 1};
+    int path[4], rx = 0, ry = 0;
+    float cost[8] = {1, 1, 1, 1, 0, 0, 0, 0}, rgba[4], tri[6] = {0, 0, 4, 0, 0, 4}, uvc[2], over_dst[4] = {0, 0, 0, 0};
+    float over_src[4] = {1, 1, 1, 1}, stretch[64], *uv;
+    unsigned char bytes[16 * 32 * 3], out8[4 * 4 * 4];
+    uint8_t *types;
+    tt_rng rng;
+    tt_mesh_desc desc;
+    tt_mesh *mesh = NULL, *quads = NULL;
+    tt_error err;
+    tt_mesh_stats stats;
+    tt_image image, rotated, half, atlas_copy;
+    tt_tile_layout layout, resolved;
+    tt_synth_options options;
+    tt_tileset *tiles = NULL;
+    tt_seam_report report;
+    int counts[16], i;
+
+    EXPECT(strlen(tt_result_string(TT_ERROR_OUT_OF_MEMORY)) > 0);
+    tt_rng_seed(&rng, 42, 54);
+    EXPECT(tt_rng_next(&rng) == 0xa15c02b7u);
+    EXPECT(tt_rng_below(&rng, 10) < 10);
+    EXPECT(tt_rng_float(&rng) < 1.0f);
+
+    memset(&desc, 0, sizeof desc);
+    desc.positions = cube_pos;
+    desc.nverts = 8;
+    desc.indices = cube_idx;
+    desc.nfaces = 6;
+    desc.fixed_face_size = 4;
+    EXPECT(tt_mesh_build(&desc, &mesh, &err) == TT_OK);
+    if (!mesh) return 1;
+    EXPECT(tt_mesh_next(mesh, 0) == 1 && tt_mesh_prev(mesh, 0) == 3);
+    EXPECT(tt_mesh_compute_stats(mesh, &stats) == TT_OK && stats.genus == 0);
+    EXPECT(tt_mesh_valence(mesh, 0) == 3);
+    EXPECT(tt_mesh_valence_histogram(mesh, hist, 8) == TT_OK && hist[3] == 8);
+    EXPECT(tt_mesh_components(mesh, comp, &nc) == TT_OK && nc == 1);
+    EXPECT(tt_mesh_boundary_loops(mesh, loops, &nl) == TT_OK && nl == 0);
+    EXPECT(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &quads, &err) == TT_OK);
+    if (!quads) return 1;
+
+    for (i = 0; i < (int)sizeof bytes; i++) bytes[i] = (unsigned char)(i * 7);
+    EXPECT(tt_image_from_bytes(&image, bytes, 16, 32, 3, 0, NULL) == TT_OK);
+    tt_image_sample_bilinear(&image, 1.5f, 1.5f, rgba);
+    tt_rotate_coords(1, 16, 32, 0, 0, &rx, &ry);
+    EXPECT(rx == 0 && ry == 15);
+    EXPECT(tt_image_rotate90(&image, 1, &rotated, NULL) == TT_OK && rotated.width == 32);
+    EXPECT(tt_image_downsample2(&image, &half, NULL) == TT_OK && half.width == 8);
+    EXPECT(tt_image_create(&atlas_copy, 8, 16, NULL) == TT_OK);
+    EXPECT(tt_image_over(&atlas_copy, &half) == TT_OK);
+    tt_rgba_over(over_dst, over_src);
+    EXPECT(over_dst[3] == 1.0f);
+    {
+        tt_image small;
+        EXPECT(tt_image_create(&small, 2, 2, NULL) == TT_OK);
+        tt_image_to_rgba8(&small, out8);
+        tt_image_free(&small);
+    }
+    EXPECT(tt_min_error_cut(cost, 4, 2, lo, hi, path, NULL) == TT_OK && path[0] == 1);
+    tt_raster_triangle(tri, 8, 8, on_pixel, NULL);
+    EXPECT(raster_count > 0);
+
+    memset(&layout, 0, sizeof layout);
+    layout.tile_size = 8;
+    layout.gutter = 2;
+    EXPECT(tt_tile_layout_resolve(&layout, &resolved, &err) == TT_OK);
+    EXPECT(tt_tile_layout_tiles_per_side(&resolved) == 4 && tt_tile_layout_tile_count(&resolved) == 16 &&
+           tt_tile_layout_atlas_size(&resolved) == 48);
+    types = (uint8_t *)malloc((size_t)quads->ncorners);
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)quads->ncorners);
+    if (!types || !uv) return 1;
+    EXPECT(tt_assign_boundaries(quads, &layout, 1, types) == TT_OK);
+    EXPECT(tt_tile_index(&resolved, types) >= 0);
+    tt_tile_corner_uv(&resolved, types, 2, uvc);
+    EXPECT(tt_assign_uvs(quads, &layout, types, uv, &err) == TT_OK);
+    EXPECT(tt_tile_histogram(quads, &layout, types, counts) == TT_OK);
+    EXPECT(tt_face_stretch(quads, uv, stretch) == TT_OK);
+
+    memset(&options, 0, sizeof options);
+    options.layout = layout;
+    options.progress = progress;
+    EXPECT(tt_synthesize_tiles(&image, &options, &tiles, &err) == TT_OK);
+    if (tiles) {
+        EXPECT(tt_measure_seams(quads, uv, &tiles->levels[0], 1, &report) == TT_OK);
+        tt_tileset_free(tiles);
+    }
+
+    free(types);
+    free(uv);
+    tt_image_free(&image);
+    tt_image_free(&rotated);
+    tt_image_free(&half);
+    tt_image_free(&atlas_copy);
+    tt_mesh_free(quads);
+    tt_mesh_free(mesh);
+#ifdef COMPILE_CHECK_USER_ALLOC
+    EXPECT(user_allocs > 0);
+    EXPECT(user_allocs == user_frees);
+    if (user_allocs != user_frees) printf("compile_check: TT_MALLOC %ld, TT_FREE %ld\n", user_allocs, user_frees);
+#endif
+    if (failures == 0) printf("compile_check: ok\n");
+    return failures ? 1 : 0;
+}

@@ -1,0 +1,155 @@
+#!/usr/bin/env bash
+# tests/run.sh - the test runner behind `make test`.
+#
+#   1. compile checks of tiledtex.h (each counts as one test): gcc C99 with
+#      strict warnings, g++ as C++, clang, tcc, TILEDTEX_STATIC (every function
+#      used, and only one used), user-defined TT_MALLOC/TT_FREE, and no raw
+#      malloc/free/realloc/calloc outside the TT_MALLOC/TT_FREE defaults;
+#   2. the unit tests, tests/test_tiledtex.c, with ASan + UBSan;
+#   3. if tests/e2e.sh exists: a sanitizer build of the tool and the
+#      end-to-end tests.
+# The last line is "N passed, M failed" over everything; the exit status is
+# non-zero when M > 0.
+set -u
+cd "$(dirname "$0")/.." || { echo "0 passed, 1 failed"; exit 1; }
+
+PASSED=0
+FAILED=0
+START=$(date +%s)
+OUT=build/tests
+mkdir -p "$OUT" || { echo "0 passed, 1 failed"; exit 1; }
+CC=${CC:-cc}
+# Sanitizer reports must stop the program and say where.
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
+
+pass() { PASSED=$((PASSED + 1)); echo "ok   $1"; }
+fail() {
+    FAILED=$((FAILED + 1))
+    echo "FAIL $1"
+    if [ -n "${2:-}" ]; then printf '%s\n' "$2" | head -n 25 | sed 's/^/     | /'; fi
+}
+
+# Compile tests/compile_check.c (which calls every public function) with a
+# compiler command and -Werror, link, and run it: one test.
+compile_check() {
+    local name=$1 exe=$OUT/compile_$2 log
+    shift 2
+    if ! command -v "$1" >/dev/null 2>&1; then
+        fail "compile: $name ($1 not installed: apt-get install $1)"
+        return
+    fi
+    if ! log=$("$@" -I. tests/compile_check.c -o "$exe" -lm 2>&1); then
+        fail "compile: $name: $*" "$log"
+        return
+    fi
+    if [ -n "$log" ]; then
+        fail "compile: $name printed diagnostics: $*" "$log"
+        return
+    fi
+    if ! log=$("$exe" 2>&1); then
+        fail "compile: $name: the smoke run failed" "$log"
+        return
+    fi
+    pass "compile: $name"
+}
+
+echo "== compile checks"
+compile_check "gcc -std=c99 strict" gcc_c99 \
+    gcc -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror
+compile_check "g++ as C++" gxx \
+    g++ -x c++ -Wall -Wextra -pedantic -Werror
+compile_check "clang -std=c99" clang \
+    clang -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror
+if command -v tcc >/dev/null 2>&1; then
+    compile_check "tcc" tcc tcc -Wall -Werror
+else
+    fail "compile: tcc not installed: apt-get install tcc"
+fi
+compile_check "TILEDTEX_STATIC (every function used)" static \
+    gcc -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror -DTILEDTEX_STATIC
+compile_check "user-defined TT_MALLOC/TT_FREE" user_alloc \
+    gcc -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror -DCOMPILE_CHECK_USER_ALLOC
+
+# TILEDTEX_STATIC in a file that uses one function, as a user would: the
+# functions it does not call must not warn (-Wunused-function) under -Wall.
+{
+    src=$OUT/static_one.c
+    printf '%s\n' '#define TILEDTEX_STATIC' '#define TILEDTEX_IMPLEMENTATION' '#include "tiledtex.h"' \
+        'int main(void) { tt_rng r; tt_rng_seed(&r, 1, 2); return (int)(tt_rng_next(&r) & 0u); }' >"$src"
+    if log=$(gcc -std=c99 -Wall -Wextra -pedantic -Werror -I. -c "$src" -o "$OUT/static_one.o" 2>&1) &&
+        log2=$(clang -std=c99 -Wall -Wextra -pedantic -Werror -I. -c "$src" -o "$OUT/static_one.o" 2>&1); then
+        pass "compile: TILEDTEX_STATIC with one function used (gcc, clang -Wall -Werror)"
+    else
+        fail "compile: TILEDTEX_STATIC with one function used warns about the unused ones (gcc/clang -Wall -Werror)" \
+            "$(printf '%s\n%s' "$log" "${log2:-}" | grep -E 'error|warning' | head -n 6)"
+    fi
+}
+
+# No raw allocation calls: comments stripped by the preprocessor (directives
+# kept), then any malloc( free( realloc( calloc( that is not a member call
+# (allocator->free) or part of a longer name, outside the two default macros.
+{
+    if stripped=$(gcc -fpreprocessed -dD -E -P -x c tiledtex.h 2>/dev/null); then
+        raw=$(printf '%s\n' "$stripped" |
+            grep -nE '(^|[^A-Za-z0-9_>.])(malloc|free|realloc|calloc)[[:space:]]*\(' |
+            grep -vE '^[0-9]+:[[:space:]]*#[[:space:]]*define[[:space:]]+TT_(MALLOC|FREE)[[:space:]]*\(')
+        if [ -z "$raw" ]; then
+            pass "source: no raw malloc/free/realloc/calloc outside the TT_MALLOC/TT_FREE defaults"
+        else
+            fail "source: raw allocation calls in tiledtex.h (line numbers after comment stripping)" "$raw"
+        fi
+    else
+        fail "source: could not strip comments from tiledtex.h with gcc -fpreprocessed"
+    fi
+}
+
+# Run a test program that ends with "N passed, M failed" and add its counts.
+# A sanitizer report printed after that line (LeakSanitizer runs at exit) is
+# one more failure; a missing line (a crash, a sanitizer abort) is one failure.
+run_counted() {
+    local name=$1 status summary p m
+    shift
+    "$@" 2>&1 | tee "$OUT/$name.log"
+    status=${PIPESTATUS[0]}
+    summary=$(grep -E '^[0-9]+ passed, [0-9]+ failed$' "$OUT/$name.log" | tail -n 1)
+    if [[ $summary =~ ^([0-9]+)\ passed,\ ([0-9]+)\ failed$ ]]; then
+        p=${BASH_REMATCH[1]}
+        m=${BASH_REMATCH[2]}
+        PASSED=$((PASSED + p))
+        FAILED=$((FAILED + m))
+        if [ "$(tail -n 1 "$OUT/$name.log")" != "$summary" ]; then
+            fail "$name: output after its summary line (sanitizer report at exit?), exit status $status"
+        elif [ "$m" -eq 0 ] && [ "$status" -ne 0 ]; then
+            fail "$name: reported no failures but exited with status $status"
+        fi
+    else
+        fail "$name: exited with status $status without its 'N passed, M failed' line (crash or sanitizer report?)"
+    fi
+}
+
+echo "== unit tests (tests/test_tiledtex.c, ASan + UBSan)"
+if log=$($CC -std=c99 -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -Wall -Wextra -pedantic -I. \
+    tests/test_tiledtex.c -o "$OUT/test_tiledtex" -lm 2>&1); then
+    [ -n "$log" ] && printf '%s\n' "$log"
+    run_counted test_tiledtex "$OUT/test_tiledtex"
+else
+    fail "unit tests: tests/test_tiledtex.c does not build" "$log"
+fi
+
+if [ -f tests/e2e.sh ]; then
+    echo "== end-to-end tests (tests/e2e.sh, tool built with ASan + UBSan)"
+    mkdir -p build/asan
+    STB_INC=$(pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
+    # shellcheck disable=SC2086  # STB_INC is a list of flags
+    if log=$($CC -std=c99 -g -O1 -fsanitize=address,undefined -I. $STB_INC examples/*.c -o build/asan/tiledtex \
+        -lm 2>&1); then
+        run_counted e2e bash tests/e2e.sh build/asan/tiledtex
+    else
+        fail "e2e: the tool does not build with sanitizers" "$log"
+    fi
+fi
+
+echo "== done in $(($(date +%s) - START)) s"
+echo "$PASSED passed, $FAILED failed"
+[ "$FAILED" -eq 0 ]

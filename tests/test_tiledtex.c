@@ -1,0 +1,3222 @@
+/* Unit tests for tiledtex.h. Plain C99, no framework, deterministic.
+   Built and run by tests/run.sh (with ASan + UBSan). Prints one line per
+   failed check and, last, "N passed, M failed". Does not read any file. */
+#define TILEDTEX_IMPLEMENTATION
+#include "tiledtex.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------ */
+/* Framework                                                                */
+/* ------------------------------------------------------------------------ */
+
+static int g_passed, g_failed;
+static const char *g_test = "";
+
+static void check_report(int ok, const char *file, int line, const char *what, const char *fmt, ...)
+{
+    va_list args;
+    if (ok) { g_passed++; return; }
+    g_failed++;
+    printf("%s:%d: FAIL in %s: %s: ", file, line, g_test, what);
+    va_start(args, fmt);
+    vprintf(fmt, args);
+    va_end(args);
+    printf("\n");
+    fflush(stdout);
+}
+
+/* CHECK(cond, fmt, ...): fmt says what was expected and what came out. */
+#define CHECK(cond, ...) check_report((cond) ? 1 : 0, __FILE__, __LINE__, #cond, __VA_ARGS__)
+/* DETAIL(fmt, ...): the first offending case of a loop whose CHECK counts
+   the offenders; printed, not counted. */
+#define DETAIL(...) check_detail(__FILE__, __LINE__, __VA_ARGS__)
+#define RUN(fn) do { g_test = #fn; fn(); } while (0)
+
+static void check_detail(const char *file, int line, const char *fmt, ...)
+{
+    va_list args;
+    printf("%s:%d: detail in %s: ", file, line, g_test);
+    va_start(args, fmt);
+    vprintf(fmt, args);
+    va_end(args);
+    printf("\n");
+}
+
+/* ------------------------------------------------------------------------ */
+/* Counting and failing allocators                                          */
+/* ------------------------------------------------------------------------ */
+
+typedef union header {
+    size_t size;
+    long double ld;
+    void *p;
+    long long ll;
+    double d;
+} header;
+
+typedef struct counter {
+    long live;          /* allocations not yet freed */
+    long calls;         /* alloc calls so far */
+    long fail_at;       /* fail the alloc call with this index (0-based); -1 = never */
+    long failures;      /* how many calls were failed */
+    long bad_frees;     /* frees of pointers we did not hand out */
+    size_t live_bytes;
+} counter;
+
+#define MAGIC 0x7474u
+
+static void *counting_alloc(size_t size, void *user_data)
+{
+    counter *c = (counter *)user_data;
+    header *h;
+    long call = c->calls++;
+    if (c->fail_at >= 0 && call == c->fail_at) { c->failures++; return NULL; }
+    h = (header *)malloc(sizeof(header) * 2 + size);
+    if (!h) return NULL;
+    h[0].size = size;
+    h[1].size = MAGIC;
+    c->live++;
+    c->live_bytes += size;
+    return h + 2;
+}
+
+static void counting_free(void *ptr, void *user_data)
+{
+    counter *c = (counter *)user_data;
+    header *h;
+    if (!ptr) return;
+    h = (header *)ptr - 2;
+    if (h[1].size != MAGIC) { c->bad_frees++; return; }
+    h[1].size = 0;
+    c->live--;
+    c->live_bytes -= h[0].size;
+    free(h);
+}
+
+static tt_allocator make_allocator(counter *c, long fail_at)
+{
+    tt_allocator a;
+    memset(c, 0, sizeof *c);
+    c->fail_at = fail_at;
+    a.alloc = counting_alloc;
+    a.free = counting_free;
+    a.user_data = c;
+    return a;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Small helpers                                                            */
+/* ------------------------------------------------------------------------ */
+
+static int near(double a, double b, double tol) { return fabs(a - b) <= tol; }
+
+static unsigned long long g_lcg = 1;
+static void lcg_seed(unsigned long long s) { g_lcg = s * 2862933555777941757ull + 3037000493ull; }
+static unsigned lcg_next(void)
+{
+    g_lcg = g_lcg * 6364136223846793005ull + 1442695040888963407ull;
+    return (unsigned)(g_lcg >> 33);
+}
+static int lcg_below(int n) { return (int)(lcg_next() % (unsigned)n); }
+static double lcg_unit(void) { return (double)lcg_next() / 2147483648.0; }
+
+/* ------------------------------------------------------------------------ */
+/* 1. RNG                                                                   */
+/* ------------------------------------------------------------------------ */
+
+static void test_rng(void)
+{
+    /* The reference PCG32 demo (pcg32_srandom_r(&rng, 42u, 54u)) prints these. */
+    static const uint32_t golden[6] = {0xa15c02b7u, 0x7b47f409u, 0xba1d3330u, 0x83d2f293u, 0xbfa4784bu, 0xcbed606eu};
+    tt_rng a, b, c;
+    int i, same = 1, differ = 0, below_bad = 0, float_bad = 0;
+    uint32_t got;
+    tt_rng_seed(&a, 42, 54);
+    for (i = 0; i < 6; i++) {
+        got = tt_rng_next(&a);
+        CHECK(got == golden[i], "value %d of seed 42 stream 54: expected 0x%08x, got 0x%08x", i,
+              (unsigned)golden[i], (unsigned)got);
+    }
+    tt_rng_seed(&a, 12345, 7);
+    tt_rng_seed(&b, 12345, 7);
+    tt_rng_seed(&c, 12345, 8);
+    for (i = 0; i < 1000; i++) {
+        uint32_t x = tt_rng_next(&a), y = tt_rng_next(&b), z = tt_rng_next(&c);
+        if (x != y) same = 0;
+        if (x != z) differ++;
+    }
+    CHECK(same, "same seed and stream should give the same sequence");
+    CHECK(differ > 990, "streams 7 and 8 should differ almost everywhere, %d of 1000 differ", differ);
+    tt_rng_seed(&a, 1, 7);
+    tt_rng_seed(&b, 2, 7);
+    differ = 0;
+    for (i = 0; i < 1000; i++) differ += tt_rng_next(&a) != tt_rng_next(&b);
+    CHECK(differ > 990, "seeds 1 and 2 should differ almost everywhere, %d of 1000 differ", differ);
+
+    /* tt_rng_below: range, and chi-square for a few bounds. */
+    {
+        static const uint32_t bounds[] = {1, 2, 3, 7, 10, 100, 1000};
+        int bi;
+        for (bi = 0; bi < (int)(sizeof bounds / sizeof bounds[0]); bi++) {
+            uint32_t bound = bounds[bi];
+            long counts[1000];
+            long n = 200 * (long)bound;
+            double chi2 = 0.0, expected = 200.0, limit;
+            long k;
+            memset(counts, 0, sizeof counts);
+            tt_rng_seed(&a, 99 + bi, 3);
+            for (k = 0; k < n; k++) {
+                uint32_t r = tt_rng_below(&a, bound);
+                if (r >= bound) below_bad++;
+                else counts[r]++;
+            }
+            for (k = 0; k < (long)bound; k++) chi2 += (counts[k] - expected) * (counts[k] - expected) / expected;
+            /* dof = bound-1; mean dof, sd sqrt(2 dof): allow mean + 6 sd + 10. */
+            limit = (bound - 1) + 6.0 * sqrt(2.0 * (bound - 1)) + 10.0;
+            CHECK(chi2 <= limit, "tt_rng_below(%u): chi-square %.1f exceeds %.1f", (unsigned)bound, chi2, limit);
+        }
+        CHECK(below_bad == 0, "tt_rng_below returned a value >= bound %d times", below_bad);
+        CHECK(tt_rng_below(&a, 0) == 0, "tt_rng_below(0) should be 0");
+        /* A bound near 2^32 still in range. */
+        below_bad = 0;
+        for (i = 0; i < 1000; i++) if (tt_rng_below(&a, 0xfffffff0u) >= 0xfffffff0u) below_bad++;
+        CHECK(below_bad == 0, "tt_rng_below(0xfffffff0) out of range %d times", below_bad);
+    }
+    /* tt_rng_float in [0,1), mean about 1/2, buckets roughly even. */
+    {
+        double sum = 0.0, chi2 = 0.0;
+        long buckets[16];
+        int n = 64000;
+        memset(buckets, 0, sizeof buckets);
+        tt_rng_seed(&a, 5, 5);
+        for (i = 0; i < n; i++) {
+            float f = tt_rng_float(&a);
+            if (!(f >= 0.0f && f < 1.0f)) float_bad++;
+            else buckets[(int)(f * 16.0f)]++;
+            sum += f;
+        }
+        for (i = 0; i < 16; i++) chi2 += (buckets[i] - n / 16.0) * (buckets[i] - n / 16.0) / (n / 16.0);
+        CHECK(float_bad == 0, "tt_rng_float outside [0,1) %d times", float_bad);
+        CHECK(near(sum / n, 0.5, 0.01), "tt_rng_float mean: expected 0.5, got %f", sum / n);
+        CHECK(chi2 < 60.0, "tt_rng_float buckets: chi-square %.1f for 15 dof", chi2);
+        /* The largest output is below 1 (24-bit grid). */
+        a.state = 0; a.increment = 1;
+        {
+            float f = tt_rng_float(&a);   /* any value: only its range matters */
+            CHECK(f >= 0.0f && f < 1.0f, "tt_rng_float out of range: %f", f);
+        }
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Hand-made meshes                                                         */
+/* ------------------------------------------------------------------------ */
+
+typedef struct tmesh {
+    float *pos;
+    int nv, cap_v;
+    int *idx;
+    int nc, cap_c;
+    int *sizes;
+    int nf, cap_f;
+} tmesh;
+
+static void tm_free(tmesh *m)
+{
+    free(m->pos);
+    free(m->idx);
+    free(m->sizes);
+    memset(m, 0, sizeof *m);
+}
+
+static int tm_vert(tmesh *m, double x, double y, double z)
+{
+    if (m->nv == m->cap_v) {
+        m->cap_v = m->cap_v ? 2 * m->cap_v : 16;
+        m->pos = (float *)realloc(m->pos, sizeof(float) * 3 * (size_t)m->cap_v);
+    }
+    m->pos[3 * m->nv] = (float)x;
+    m->pos[3 * m->nv + 1] = (float)y;
+    m->pos[3 * m->nv + 2] = (float)z;
+    return m->nv++;
+}
+
+static void tm_face(tmesh *m, int n, const int *v)
+{
+    int i;
+    if (m->nf == m->cap_f) {
+        m->cap_f = m->cap_f ? 2 * m->cap_f : 16;
+        m->sizes = (int *)realloc(m->sizes, sizeof(int) * (size_t)m->cap_f);
+    }
+    while (m->nc + n > m->cap_c) {
+        m->cap_c = m->cap_c ? 2 * m->cap_c : 64;
+        m->idx = (int *)realloc(m->idx, sizeof(int) * (size_t)m->cap_c);
+    }
+    for (i = 0; i < n; i++) m->idx[m->nc + i] = v[i];
+    m->nc += n;
+    m->sizes[m->nf++] = n;
+}
+
+static void tm_tri(tmesh *m, int a, int b, int c) { int v[3]; v[0] = a; v[1] = b; v[2] = c; tm_face(m, 3, v); }
+static void tm_quad(tmesh *m, int a, int b, int c, int d)
+{
+    int v[4];
+    v[0] = a; v[1] = b; v[2] = c; v[3] = d;
+    tm_face(m, 4, v);
+}
+
+static tt_mesh_desc tm_desc(const tmesh *m)
+{
+    tt_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    d.positions = m->pos;
+    d.nverts = m->nv;
+    d.indices = m->idx;
+    d.face_sizes = m->sizes;
+    d.nfaces = m->nf;
+    return d;
+}
+
+/* Regular tetrahedron-ish: 4 vertices, 4 triangles, outward CCW. */
+static void make_tetra(tmesh *m, double ox)
+{
+    int a = tm_vert(m, ox + 0, 0, 0), b = tm_vert(m, ox + 1, 0, 0), c = tm_vert(m, ox + 0, 1, 0),
+        d = tm_vert(m, ox + 0, 0, 1);
+    tm_tri(m, a, c, b);
+    tm_tri(m, a, b, d);
+    tm_tri(m, a, d, c);
+    tm_tri(m, b, c, d);
+}
+
+/* Boundary quads of a set of unit voxels (filled[x + nx*(y + ny*z)]), on
+   the lattice (nx+1)(ny+1)(nz+1); outward CCW. Used lattice points only. */
+static void make_voxels(tmesh *m, int nx, int ny, int nz, const unsigned char *filled, double ox)
+{
+    int *lat = (int *)malloc(sizeof(int) * (size_t)(nx + 1) * (ny + 1) * (nz + 1));
+    int x, y, z, i, dir;
+    /* corner offsets per direction: +x, -x, +y, -y, +z, -z */
+    static const int off[6][4][3] = {
+        {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}},
+        {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}},
+        {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},
+        {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}},
+        {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
+        {{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}};
+    static const int nb[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (i = 0; i < (nx + 1) * (ny + 1) * (nz + 1); i++) lat[i] = -1;
+    for (z = 0; z < nz; z++)
+        for (y = 0; y < ny; y++)
+            for (x = 0; x < nx; x++) {
+                if (!filled[x + nx * (y + ny * z)]) continue;
+                for (dir = 0; dir < 6; dir++) {
+                    int X = x + nb[dir][0], Y = y + nb[dir][1], Z = z + nb[dir][2], v[4];
+                    if (X >= 0 && Y >= 0 && Z >= 0 && X < nx && Y < ny && Z < nz && filled[X + nx * (Y + ny * Z)])
+                        continue;
+                    for (i = 0; i < 4; i++) {
+                        int px = x + off[dir][i][0], py = y + off[dir][i][1], pz = z + off[dir][i][2];
+                        int li = px + (nx + 1) * (py + (ny + 1) * pz);
+                        if (lat[li] < 0) lat[li] = tm_vert(m, ox + px, py, pz);
+                        v[i] = lat[li];
+                    }
+                    tm_face(m, 4, v);
+                }
+            }
+    free(lat);
+}
+
+static void make_cube(tmesh *m, double ox)
+{
+    unsigned char one = 1;
+    make_voxels(m, 1, 1, 1, &one, ox);
+}
+
+/* 3 x 5 x 1 slab with holes at (1,1) and (1,3): a genus-2 polycube. */
+static void make_genus2(tmesh *m)
+{
+    unsigned char f[15];
+    int i;
+    for (i = 0; i < 15; i++) f[i] = 1;
+    f[1 + 3 * 1] = 0;
+    f[1 + 3 * 3] = 0;
+    make_voxels(m, 3, 5, 1, f, 0.0);
+}
+
+/* nu x nv quads on a torus (nu, nv >= 3). Quad (i,j) is face j*nu + i. */
+static void make_torus(tmesh *m, int nu, int nv, double R, double r)
+{
+    int i, j, base = m->nv;
+    const double pi = 3.14159265358979323846;
+    for (j = 0; j < nv; j++)
+        for (i = 0; i < nu; i++) {
+            double a = 2 * pi * i / nu, b = 2 * pi * j / nv;
+            tm_vert(m, (R + r * cos(b)) * cos(a), (R + r * cos(b)) * sin(a), r * sin(b));
+        }
+    for (j = 0; j < nv; j++)
+        for (i = 0; i < nu; i++) {
+            int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
+            tm_quad(m, base + j * nu + i, base + j * nu + i1, base + j1 * nu + i1, base + j1 * nu + i);
+        }
+}
+
+/* Open nx x ny grid of unit quads in the plane z = 0. */
+static void make_grid(tmesh *m, int nx, int ny)
+{
+    int i, j, base = m->nv;
+    for (j = 0; j <= ny; j++)
+        for (i = 0; i <= nx; i++) tm_vert(m, i, j, 0);
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++)
+            tm_quad(m, base + j * (nx + 1) + i, base + j * (nx + 1) + i + 1, base + (j + 1) * (nx + 1) + i + 1,
+                    base + (j + 1) * (nx + 1) + i);
+}
+
+/* A closed mesh of mixed polygon sizes: a pentagonal prism (2 pentagons,
+   5 quads) and, beside it, a square pyramid (1 quad, 4 triangles). */
+static void make_mixed(tmesh *m)
+{
+    const double pi = 3.14159265358979323846;
+    int bot[5], top[5], i, v[5], p[5];
+    for (i = 0; i < 5; i++) {
+        double a = 2 * pi * i / 5;
+        bot[i] = tm_vert(m, cos(a), sin(a), 0);
+        top[i] = tm_vert(m, cos(a), sin(a), 1);
+    }
+    for (i = 0; i < 5; i++) v[i] = top[i];
+    tm_face(m, 5, v);                                     /* top, CCW from +z */
+    for (i = 0; i < 5; i++) v[i] = bot[4 - i];
+    tm_face(m, 5, v);                                     /* bottom, CCW from -z */
+    for (i = 0; i < 5; i++) tm_quad(m, bot[i], bot[(i + 1) % 5], top[(i + 1) % 5], top[i]);
+    p[0] = tm_vert(m, 5, 0, 0);
+    p[1] = tm_vert(m, 6, 0, 0);
+    p[2] = tm_vert(m, 6, 1, 0);
+    p[3] = tm_vert(m, 5, 1, 0);
+    p[4] = tm_vert(m, 5.5, 0.5, 1);
+    tm_quad(m, p[0], p[3], p[2], p[1]);                   /* base, seen from below */
+    for (i = 0; i < 4; i++) tm_tri(m, p[i], p[(i + 1) % 4], p[4]);
+}
+
+/* Build with an optional counting allocator; returns the result. */
+static tt_result build(const tmesh *m, unsigned flags, tt_mesh **out, tt_error *err)
+{
+    tt_mesh_desc d = tm_desc(m);
+    d.flags = flags;
+    return tt_mesh_build(&d, out, err);
+}
+
+/* Half-edges without a reversed partner anywhere (a naive O(n^2) count). */
+static int count_boundary_naive(const tmesh *m)
+{
+    int f, c, g, c2, start = 0, n = 0, s2;
+    for (f = 0; f < m->nf; f++) {
+        for (c = start; c < start + m->sizes[f]; c++) {
+            int a = m->idx[c], b = m->idx[c + 1 < start + m->sizes[f] ? c + 1 : start], found = 0;
+            for (g = 0, s2 = 0; g < m->nf && !found; s2 += m->sizes[g], g++)
+                for (c2 = s2; c2 < s2 + m->sizes[g]; c2++) {
+                    int a2 = m->idx[c2], b2 = m->idx[c2 + 1 < s2 + m->sizes[g] ? c2 + 1 : s2];
+                    if (a2 == b && b2 == a) { found = 1; break; }
+                }
+            n += !found;
+        }
+        start += m->sizes[f];
+    }
+    return n;
+}
+
+/* Structural invariants of a built mesh against its description (each kind
+   of violation is one check). */
+static void check_structure(const tt_mesh *mesh, const tmesh *m, const char *name)
+{
+    int c, f, v, bad_twin = 0, bad_rev = 0, bad_face = 0, bad_vc = 0, bad_vb = 0, bad_cv = 0, nboundary = 0;
+    CHECK(mesh->nverts == m->nv && mesh->nfaces == m->nf && mesh->ncorners == m->nc,
+          "%s: counts: expected %d/%d/%d, got %d/%d/%d", name, m->nv, m->nf, m->nc, mesh->nverts, mesh->nfaces,
+          mesh->ncorners);
+    for (f = 0, c = 0; f < m->nf; f++) {
+        if (mesh->face_start[f] != c) bad_face++;
+        c += m->sizes[f];
+    }
+    if (mesh->face_start[m->nf] != m->nc) bad_face++;
+    for (f = 0; f < m->nf; f++)
+        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++)
+            if (mesh->corner_face[c] != f) bad_face++;
+    for (c = 0; c < m->nc; c++) {
+        int t = mesh->twin[c];
+        if (mesh->corner_vert[c] != m->idx[c]) bad_cv++;
+        if (t < 0) { nboundary++; continue; }
+        if (t >= m->nc || mesh->twin[t] != c || t == c) { bad_twin++; continue; }
+        /* reversed: twin's origin is my destination and vice versa */
+        if (mesh->corner_vert[t] != mesh->corner_vert[tt_mesh_next(mesh, c)] ||
+            mesh->corner_vert[tt_mesh_next(mesh, t)] != mesh->corner_vert[c])
+            bad_rev++;
+    }
+    for (v = 0; v < m->nv; v++) {
+        int vc = mesh->vert_corner[v], has_boundary = 0, used = 0;
+        for (c = 0; c < m->nc; c++)
+            if (m->idx[c] == v) {
+                used = 1;
+                if (mesh->twin[c] < 0) has_boundary = 1;
+            }
+        if (!used) { if (vc != -1) bad_vc++; continue; }
+        if (vc < 0 || vc >= m->nc || mesh->corner_vert[vc] != v) { bad_vc++; continue; }
+        if (has_boundary && mesh->twin[vc] >= 0) bad_vb++;
+    }
+    /* next/prev are inverse and stay in the face */
+    for (c = 0; c < m->nc; c++) {
+        int n = tt_mesh_next(mesh, c);
+        if (tt_mesh_prev(mesh, n) != c || mesh->corner_face[n] != mesh->corner_face[c]) bad_face++;
+    }
+    CHECK(bad_face == 0, "%s: face_start/corner_face/next/prev inconsistent in %d places", name, bad_face);
+    CHECK(bad_cv == 0, "%s: corner_vert differs from the index buffer in %d corners", name, bad_cv);
+    CHECK(bad_twin == 0, "%s: %d twins not mutual", name, bad_twin);
+    CHECK(bad_rev == 0, "%s: %d twins not reversed", name, bad_rev);
+    CHECK(bad_vc == 0, "%s: %d vert_corner entries not an outgoing half-edge of their vertex", name, bad_vc);
+    CHECK(bad_vb == 0, "%s: %d boundary vertices whose vert_corner is not a boundary half-edge", name, bad_vb);
+    if (mesh->repaired_edges == 0)   /* repairs cut edges open on purpose */
+        CHECK(nboundary == count_boundary_naive(m), "%s: %d boundary half-edges, the naive count is %d", name,
+              nboundary, count_boundary_naive(m));
+}
+
+static int count_boundary(const tt_mesh *mesh)
+{
+    int c, n = 0;
+    for (c = 0; c < mesh->ncorners; c++) n += mesh->twin[c] < 0;
+    return n;
+}
+
+static void test_builder_valid(void)
+{
+    tmesh m;
+    tt_mesh *mesh;
+    tt_error err;
+    tt_result r;
+    counter cnt;
+    tt_mesh_desc d;
+
+    memset(&m, 0, sizeof m);
+    make_tetra(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "tetrahedron: expected TT_OK, got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "tetrahedron");
+        CHECK(count_boundary(mesh) == 0, "tetrahedron is closed, got %d boundary half-edges", count_boundary(mesh));
+        CHECK(mesh->min_face_size == 3 && mesh->max_face_size == 3, "tetrahedron face sizes %d..%d",
+              mesh->min_face_size, mesh->max_face_size);
+        CHECK(mesh->repaired_edges == 0, "strict build repaired %d edges", mesh->repaired_edges);
+        CHECK(mesh->pos != m.pos, "positions should be copied without TT_MESH_BORROW_POSITIONS");
+        CHECK(err.result == TT_OK && err.face == -1 && err.vertex == -1, "error cleared on success");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    make_cube(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "cube: expected TT_OK, got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "cube");
+        CHECK(count_boundary(mesh) == 0, "cube is closed, got %d boundary half-edges", count_boundary(mesh));
+        tt_mesh_free(mesh);
+    }
+    /* The same cube through fixed_face_size = 4 and a counting allocator. */
+    {
+        tt_allocator al = make_allocator(&cnt, -1);
+        d = tm_desc(&m);
+        d.face_sizes = NULL;
+        d.fixed_face_size = 4;
+        d.allocator = al;
+        r = tt_mesh_build(&d, &mesh, &err);
+        CHECK(r == TT_OK, "cube (fixed size 4): got %d", r);
+        if (r == TT_OK) {
+            check_structure(mesh, &m, "cube fixed");
+            CHECK(cnt.live > 0, "the mesh should be allocated through the given allocator");
+            tt_mesh_free(mesh);
+        }
+        CHECK(cnt.live == 0 && cnt.bad_frees == 0, "cube: %ld allocations leaked, %ld bad frees", cnt.live,
+              cnt.bad_frees);
+    }
+    /* TT_MESH_BORROW_POSITIONS */
+    r = build(&m, TT_MESH_BORROW_POSITIONS, &mesh, &err);
+    CHECK(r == TT_OK, "cube borrowed: got %d", r);
+    if (r == TT_OK) {
+        CHECK(mesh->pos == m.pos, "TT_MESH_BORROW_POSITIONS: mesh->pos should be desc.positions");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* Open square of two triangles */
+    tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 1, 1, 0); tm_vert(&m, 0, 1, 0);
+    tm_tri(&m, 0, 1, 2);
+    tm_tri(&m, 0, 2, 3);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "open square: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "open square");
+        CHECK(count_boundary(mesh) == 4, "open square: expected 4 boundary half-edges, got %d", count_boundary(mesh));
+        CHECK(mesh->twin[2] == 3 && mesh->twin[3] == 2, "open square: diagonal 2-0 / 0-2 should pair corners 2,3; got %d %d",
+              mesh->twin[2], mesh->twin[3]);
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    make_mixed(&m);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "mixed: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "mixed");
+        CHECK(count_boundary(mesh) == 0, "mixed is closed, got %d boundary half-edges", count_boundary(mesh));
+        CHECK(mesh->min_face_size == 3 && mesh->max_face_size == 5, "mixed face sizes: expected 3..5, got %d..%d",
+              mesh->min_face_size, mesh->max_face_size);
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* An unused vertex is allowed and gets vert_corner -1; a grid with
+       boundary and the genus-2 polycube pass the invariants too. */
+    make_grid(&m, 3, 2);
+    tm_vert(&m, 9, 9, 9);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "grid + unused vertex: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "grid");
+        CHECK(mesh->vert_corner[m.nv - 1] == -1, "unused vertex: vert_corner should be -1, got %d",
+              mesh->vert_corner[m.nv - 1]);
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+    make_genus2(&m);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "genus-2 polycube: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "genus2");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* A large polygon (> 16 corners takes the stamping path). */
+    {
+        int i, v[40];
+        for (i = 0; i < 40; i++) v[i] = tm_vert(&m, cos(i * 0.15707963), sin(i * 0.15707963), 0);
+        tm_face(&m, 40, v);
+        r = build(&m, 0, &mesh, &err);
+        CHECK(r == TT_OK, "40-gon: got %d (%s)", r, err.message);
+        if (r == TT_OK) {
+            check_structure(mesh, &m, "40-gon");
+            tt_mesh_free(mesh);
+        }
+        tm_free(&m);
+    }
+}
+
+/* Does `msg` contain the decimal number n as a whole token? */
+static int msg_has_number(const char *msg, int n)
+{
+    char buf[32];
+    const char *p = msg;
+    size_t len;
+    sprintf(buf, "%d", n);
+    len = strlen(buf);
+    while ((p = strstr(p, buf)) != NULL) {
+        int before_ok = p == msg || !(p[-1] >= '0' && p[-1] <= '9') || n < 0;
+        int after_ok = !(p[len] >= '0' && p[len] <= '9');
+        if (before_ok && after_ok) return 1;
+        p++;
+    }
+    return 0;
+}
+
+/* Naive reference for edge problems: the smallest corner of any edge used
+   twice in one direction; sets *code. Returns -1 when there is none. */
+static int naive_first_edge_problem(const tmesh *m, tt_result *code, int *va, int *vb)
+{
+    int *start = (int *)malloc(sizeof(int) * (size_t)(m->nf + 1));
+    int f, c, c2, best = -1;
+    start[0] = 0;
+    for (f = 0; f < m->nf; f++) start[f + 1] = start[f] + m->sizes[f];
+    for (f = 0; f < m->nf; f++)
+        for (c = start[f]; c < start[f + 1]; c++) {
+            int a = m->idx[c], b = m->idx[c + 1 < start[f + 1] ? c + 1 : start[f]], p = 0, q = 0, g, lowest = m->nc;
+            for (g = 0; g < m->nf; g++)
+                for (c2 = start[g]; c2 < start[g + 1]; c2++) {
+                    int a2 = m->idx[c2], b2 = m->idx[c2 + 1 < start[g + 1] ? c2 + 1 : start[g]];
+                    if (a2 == a && b2 == b) { p++; if (c2 < lowest) lowest = c2; }
+                    if (a2 == b && b2 == a) { q++; if (c2 < lowest) lowest = c2; }
+                }
+            if ((p > 1 || q > 1) && (best < 0 || lowest < best)) {
+                best = lowest;
+                *code = p + q > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
+                *va = a;
+                *vb = b;
+            }
+        }
+    free(start);
+    return best;
+}
+
+static int face_of_corner(const tmesh *m, int corner)
+{
+    int f, c = 0;
+    for (f = 0; f < m->nf; f++) {
+        if (corner < c + m->sizes[f]) return f;
+        c += m->sizes[f];
+    }
+    return -1;
+}
+
+/* Build m strictly and expect `code` with the given fields (-2 = don't care). */
+static void expect_build_error(const tmesh *m, tt_result code, int face, int corner, int vertex, const char *what)
+{
+    tt_mesh *mesh = (tt_mesh *)&mesh;   /* must become NULL */
+    tt_error err;
+    counter cnt;
+    tt_mesh_desc d = tm_desc(m);
+    tt_result r;
+    memset(&err, 0x55, sizeof err);
+    d.allocator = make_allocator(&cnt, -1);
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == code, "%s: expected result %d, got %d (%s)", what, code, r, err.message);
+    CHECK(mesh == NULL, "%s: *out_mesh should be NULL on failure", what);
+    CHECK(err.result == code, "%s: err.result expected %d, got %d", what, code, err.result);
+    if (face != -2) CHECK(err.face == face, "%s: err.face expected %d, got %d", what, face, err.face);
+    if (corner != -2) CHECK(err.corner == corner, "%s: err.corner expected %d, got %d", what, corner, err.corner);
+    if (vertex != -2) CHECK(err.vertex == vertex, "%s: err.vertex expected %d, got %d", what, vertex, err.vertex);
+    CHECK(err.message[0] != '\0' && memchr(err.message, '\0', sizeof err.message) != NULL,
+          "%s: the message should be a non-empty string", what);
+    if (face >= 0 || vertex >= 0)
+        CHECK((face >= 0 && msg_has_number(err.message, face)) || (vertex >= 0 && msg_has_number(err.message, vertex)),
+              "%s: message should name face %d or vertex %d: \"%s\"", what, face, vertex, err.message);
+    CHECK(cnt.live == 0 && cnt.bad_frees == 0, "%s: %ld allocations leaked on the error path", what, cnt.live);
+    if (r == TT_OK) tt_mesh_free(mesh);
+    /* The NULL error pointer is accepted too. */
+    mesh = (tt_mesh *)&mesh;
+    r = tt_mesh_build(&d, &mesh, NULL);
+    CHECK(r == code && mesh == NULL, "%s with error == NULL: expected %d, got %d", what, code, r);
+    if (r == TT_OK && mesh) tt_mesh_free(mesh);
+    CHECK(cnt.live == 0, "%s (error NULL): %ld allocations leaked", what, cnt.live);
+}
+
+/* Build permissively: expect success, repaired_edges in [min_repaired, ...]. */
+static void expect_permissive(const tmesh *m, int min_repaired, const char *what)
+{
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    counter cnt;
+    tt_mesh_desc d = tm_desc(m);
+    tt_result r;
+    d.flags = TT_MESH_PERMISSIVE;
+    d.allocator = make_allocator(&cnt, -1);
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_OK, "%s (permissive): expected TT_OK, got %d (%s)", what, r, err.message);
+    if (r == TT_OK) {
+        tt_mesh_stats st;
+        CHECK(mesh->repaired_edges >= min_repaired, "%s (permissive): repaired_edges expected >= %d, got %d", what,
+              min_repaired, mesh->repaired_edges);
+        CHECK((mesh->flags & TT_MESH_PERMISSIVE) != 0, "%s: mesh->flags should keep TT_MESH_PERMISSIVE", what);
+        check_structure(mesh, m, what);
+        CHECK(tt_mesh_compute_stats(mesh, &st) == TT_OK, "%s: stats on a permissive mesh", what);
+        tt_mesh_free(mesh);
+    }
+    CHECK(cnt.live == 0, "%s (permissive): %ld allocations leaked", what, cnt.live);
+}
+
+static void test_builder_errors(void)
+{
+    tmesh m;
+    tt_mesh *mesh;
+    tt_error err;
+    tt_result r;
+    tt_mesh_desc d;
+    memset(&m, 0, sizeof m);
+
+    /* NULLs and bad counts */
+    make_tetra(&m, 0);
+    d = tm_desc(&m);
+    r = tt_mesh_build(&d, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "out_mesh NULL: expected %d, got %d", TT_ERROR_INVALID_ARGUMENT, r);
+    mesh = (tt_mesh *)&mesh;
+    r = tt_mesh_build(NULL, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "desc NULL: expected %d, got %d", TT_ERROR_INVALID_ARGUMENT, r);
+    d.indices = NULL;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "indices NULL: got %d", r);
+    d = tm_desc(&m);
+    d.positions = NULL;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "positions NULL: got %d", r);
+    d = tm_desc(&m);
+    d.nverts = -1;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "nverts -1: got %d", r);
+    d = tm_desc(&m);
+    d.nfaces = -3;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "nfaces -3: got %d", r);
+    d = tm_desc(&m);
+    d.face_sizes = NULL;
+    d.fixed_face_size = 2;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_FACE_TOO_SMALL && mesh == NULL, "fixed_face_size 2: expected %d, got %d",
+          TT_ERROR_FACE_TOO_SMALL, r);
+    /* fixed_face_size 0 means triangles */
+    d = tm_desc(&m);
+    d.face_sizes = NULL;
+    d.fixed_face_size = 0;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_OK, "fixed_face_size 0 (= 3) on a tetrahedron: got %d (%s)", r, err.message);
+    if (r == TT_OK) tt_mesh_free(mesh);
+
+    /* empty mesh */
+    {
+        tmesh e = m;
+        e.nf = 0;
+        expect_build_error(&e, TT_ERROR_EMPTY_MESH, -1, -1, -1, "empty mesh");
+    }
+    /* index out of range: negative, and too big */
+    m.idx[5] = -1;
+    expect_build_error(&m, TT_ERROR_INDEX_OUT_OF_RANGE, 1, 5, -1, "negative index");
+    m.idx[5] = 3;
+    m.idx[7] = 4;
+    expect_build_error(&m, TT_ERROR_INDEX_OUT_OF_RANGE, 2, 7, 4, "index too big");
+    m.idx[7] = 3;
+    /* face with 2 corners */
+    m.sizes[1] = 2;
+    expect_build_error(&m, TT_ERROR_FACE_TOO_SMALL, 1, 3, -2, "face_sizes entry 2");
+    m.sizes[1] = 3;
+    /* repeated vertex: face 2 = (a, d, a) */
+    {
+        int keep = m.idx[8];
+        m.idx[8] = m.idx[6];
+        expect_build_error(&m, TT_ERROR_REPEATED_VERTEX, 2, 8, m.idx[6], "repeated vertex");
+        m.idx[8] = keep;
+    }
+    /* NaN and infinite coordinates */
+    {
+        float keep = m.pos[3 * 2 + 1];
+        m.pos[3 * 2 + 1] = (float)NAN;
+        expect_build_error(&m, TT_ERROR_NON_FINITE, -1, -2, 2, "NaN coordinate");
+        m.pos[3 * 2 + 1] = keep;
+        keep = m.pos[3 * 3 + 2];
+        m.pos[3 * 3 + 2] = -(float)INFINITY;
+        expect_build_error(&m, TT_ERROR_NON_FINITE, -1, -2, 3, "-inf coordinate");
+        m.pos[3 * 3 + 2] = (float)INFINITY;
+        expect_build_error(&m, TT_ERROR_NON_FINITE, -1, -2, 3, "+inf coordinate");
+        m.pos[3 * 3 + 2] = keep;
+    }
+    /* The untouched tetrahedron still builds (the edits were undone). */
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "restored tetrahedron: got %d (%s)", r, err.message);
+    if (r == TT_OK) tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* zero-area face: 3 collinear points (an open mesh of one good and one flat face) */
+    tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 0, 1, 0);
+    tm_vert(&m, 2, 0, 0); tm_vert(&m, 3, 0, 0);
+    tm_tri(&m, 0, 1, 2);
+    tm_tri(&m, 1, 3, 4);
+    expect_build_error(&m, TT_ERROR_ZERO_AREA_FACE, 1, 3, -2, "zero-area face");
+    expect_permissive(&m, 0, "zero-area face");
+    tm_free(&m);
+
+    /* non-manifold edge: 3 triangles on edge 0-1 */
+    {
+        int va = -1, vb = -1, first;
+        tt_result code = TT_OK;
+        tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 0.5, 1, 0);
+        tm_vert(&m, 0.5, -1, 0); tm_vert(&m, 0.5, 0, 1);
+        tm_tri(&m, 0, 1, 2);
+        tm_tri(&m, 1, 0, 3);
+        tm_tri(&m, 0, 1, 4);
+        first = naive_first_edge_problem(&m, &code, &va, &vb);
+        CHECK(first == 0 && code == TT_ERROR_NON_MANIFOLD_EDGE, "naive reference: corner %d code %d", first, code);
+        expect_build_error(&m, TT_ERROR_NON_MANIFOLD_EDGE, 0, 0, -2, "non-manifold edge");
+        r = build(&m, 0, &mesh, &err);
+        if (r == TT_OK) tt_mesh_free(mesh);
+        CHECK((err.vertex == 0 && err.other_vertex == 1) || (err.vertex == 1 && err.other_vertex == 0),
+              "non-manifold edge: vertices expected 0 and 1, got %d and %d", err.vertex, err.other_vertex);
+        expect_permissive(&m, 1, "non-manifold edge");
+        tm_free(&m);
+
+        /* The same three triangles with the lone reverse half-edge first:
+           the first problem in index-buffer order is corner 0 of face 0. */
+        tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 0.5, 1, 0);
+        tm_vert(&m, 0.5, -1, 0); tm_vert(&m, 0.5, 0, 1);
+        tm_tri(&m, 1, 0, 3);
+        tm_tri(&m, 0, 1, 2);
+        tm_tri(&m, 0, 1, 4);
+        first = naive_first_edge_problem(&m, &code, &va, &vb);
+        expect_build_error(&m, TT_ERROR_NON_MANIFOLD_EDGE, face_of_corner(&m, first), first, -2,
+                           "non-manifold edge (reverse half-edge first)");
+        tm_free(&m);
+    }
+
+    /* inconsistent orientation: one face of a cube flipped */
+    {
+        int f, flip = 3, va = -1, vb = -1, first;
+        tt_result code = TT_OK;
+        for (f = 0; f < 6; f++) {
+            int i, *q;
+            make_cube(&m, 0);
+            flip = f;
+            q = m.idx + 4 * flip;
+            for (i = 0; i < 2; i++) { int t = q[i]; q[i] = q[3 - i]; q[3 - i] = t; }
+            first = naive_first_edge_problem(&m, &code, &va, &vb);
+            CHECK(code == TT_ERROR_INCONSISTENT_ORIENTATION, "naive reference code %d", code);
+            expect_build_error(&m, TT_ERROR_INCONSISTENT_ORIENTATION, face_of_corner(&m, first), first, -2,
+                               "cube with a flipped face");
+            r = build(&m, 0, &mesh, &err);
+            if (r == TT_OK) tt_mesh_free(mesh);
+            CHECK((err.vertex == va && err.other_vertex == vb) || (err.vertex == vb && err.other_vertex == va),
+                  "flipped face %d: edge expected %d-%d, got %d-%d", f, va, vb, err.vertex, err.other_vertex);
+            CHECK(msg_has_number(err.message, face_of_corner(&m, first)),
+                  "flipped face %d: message should name face %d: \"%s\"", f, face_of_corner(&m, first), err.message);
+            if (f == 0) expect_permissive(&m, 4, "cube with a flipped face");
+            tm_free(&m);
+        }
+    }
+
+    /* non-manifold vertex: two tetrahedra sharing only vertex 0 */
+    {
+        int ok_corner;
+        make_tetra(&m, 0);
+        tm_vert(&m, -1, 0, 0); tm_vert(&m, 0, -1, 0); tm_vert(&m, 0, 0, -1);
+        tm_tri(&m, 0, 4, 5);
+        tm_tri(&m, 0, 6, 4);
+        tm_tri(&m, 0, 5, 6);
+        tm_tri(&m, 4, 6, 5);
+        r = build(&m, 0, &mesh, &err);
+        if (r == TT_OK) tt_mesh_free(mesh);
+        CHECK(r == TT_ERROR_NON_MANIFOLD_VERTEX, "two tetrahedra at a vertex: expected %d, got %d (%s)",
+              TT_ERROR_NON_MANIFOLD_VERTEX, r, err.message);
+        CHECK(err.vertex == 0, "non-manifold vertex: expected vertex 0, got %d", err.vertex);
+        ok_corner = err.corner >= 0 && err.corner < m.nc && m.idx[err.corner] == 0 &&
+                    face_of_corner(&m, err.corner) == err.face;
+        CHECK(ok_corner, "non-manifold vertex: corner %d / face %d should be a corner of vertex 0 in that face",
+              err.corner, err.face);
+        expect_build_error(&m, TT_ERROR_NON_MANIFOLD_VERTEX, -2, -2, 0, "non-manifold vertex");
+        expect_permissive(&m, 0, "non-manifold vertex");
+        r = build(&m, TT_MESH_PERMISSIVE, &mesh, &err);
+        if (r == TT_OK) {
+            tt_mesh_stats st;
+            tt_mesh_compute_stats(mesh, &st);
+            CHECK(st.nonmanifold_vertices == 1, "permissive: nonmanifold_vertices expected 1, got %d",
+                  st.nonmanifold_vertices);
+            CHECK(st.components == 2, "two tetrahedra at a vertex: components expected 2, got %d", st.components);
+            CHECK(st.genus == 0, "two tetrahedra at a vertex: genus expected 0, got %d", st.genus);
+            tt_mesh_free(mesh);
+        }
+        tm_free(&m);
+    }
+
+    /* permissive repeated vertex: a degenerate edge becomes a boundary */
+    {
+        make_tetra(&m, 0);
+        tm_vert(&m, 3, 3, 3);
+        tm_vert(&m, 4, 3, 3);
+        tm_tri(&m, 4, 5, 4);
+        expect_build_error(&m, TT_ERROR_REPEATED_VERTEX, 4, 14, 4, "repeated vertex (extra face)");
+        expect_permissive(&m, 1, "repeated vertex");
+        tm_free(&m);
+    }
+    /* repeated vertex in a large face (stamping path, > 16 corners) */
+    {
+        int i, v[20];
+        for (i = 0; i < 20; i++) v[i] = tm_vert(&m, cos(i * 0.314159), sin(i * 0.314159), 0);
+        v[17] = v[3];
+        tm_face(&m, 20, v);
+        expect_build_error(&m, TT_ERROR_REPEATED_VERTEX, 0, 17, 3, "repeated vertex in a 20-gon");
+        tm_free(&m);
+    }
+}
+
+/* Run `call` with allocation k failing for k = 0, 1, ... until it succeeds:
+   every run must give TT_OK or TT_ERROR_OUT_OF_MEMORY and leak nothing. */
+typedef tt_result (*oom_call)(void *ctx, const tt_allocator *allocator);
+
+/* The allocator and counter every OOM sweep uses. Objects built through it
+   before a sweep (meshes whose own allocator is this one) stay live: a run
+   must leave `live` where it found it. */
+static counter g_oom_counter;
+static tt_allocator g_oom_allocator;
+
+static void oom_reset(void) { g_oom_allocator = make_allocator(&g_oom_counter, -1); }
+
+static void oom_sweep(const char *what, oom_call call, void *ctx, tt_result expected_final)
+{
+    int k, bad_result = 0, leaks = 0, bad_frees = 0, nsteps = 0;
+    tt_result r = TT_ERROR_OUT_OF_MEMORY, first_bad = TT_OK;
+    counter *cnt = &g_oom_counter;
+    for (k = 0; k < 100000; k++) {
+        long live0 = cnt->live, bad0 = cnt->bad_frees;
+        cnt->calls = 0;
+        cnt->failures = 0;
+        cnt->fail_at = k;
+        r = call(ctx, &g_oom_allocator);
+        nsteps++;
+        if (cnt->live != live0) leaks++;
+        if (cnt->bad_frees != bad0) bad_frees++;
+        if (cnt->failures == 0) break;   /* allocation k was never reached: the run is complete */
+        if (r != TT_ERROR_OUT_OF_MEMORY) { if (!bad_result) first_bad = r; bad_result++; }
+    }
+    cnt->fail_at = -1;
+    CHECK(r == expected_final, "%s: after %d allocation-failure runs, expected final result %d, got %d", what, nsteps,
+          expected_final, r);
+    CHECK(bad_result == 0, "%s: %d runs with a failed allocation did not return TT_ERROR_OUT_OF_MEMORY (first: %d)",
+          what, bad_result, first_bad);
+    CHECK(leaks == 0 && bad_frees == 0, "%s: %d runs leaked, %d freed foreign pointers", what, leaks, bad_frees);
+    CHECK(nsteps > 1, "%s: expected at least one allocation, got %d runs", what, nsteps);
+}
+
+typedef struct build_ctx {
+    const tmesh *m;
+    unsigned flags;
+} build_ctx;
+
+static tt_result oom_build(void *ctx, const tt_allocator *al)
+{
+    build_ctx *b = (build_ctx *)ctx;
+    tt_mesh_desc d = tm_desc(b->m);
+    tt_mesh *mesh = (tt_mesh *)&mesh;
+    tt_error err;
+    tt_result r;
+    d.flags = b->flags;
+    d.allocator = *al;
+    r = tt_mesh_build(&d, &mesh, &err);
+    if (r == TT_OK) tt_mesh_free(mesh);
+    else if (mesh != NULL) return TT_RESULT_MAX_ENUM;   /* must be NULL on failure */
+    if (r != TT_OK && err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_builder_oom(void)
+{
+    tmesh m;
+    build_ctx b;
+    memset(&m, 0, sizeof m);
+    oom_reset();
+    b.m = &m;
+    b.flags = 0;
+    make_tetra(&m, 0);
+    oom_sweep("tt_mesh_build(tetrahedron)", oom_build, &b, TT_OK);
+    tm_free(&m);
+    make_mixed(&m);
+    oom_sweep("tt_mesh_build(mixed)", oom_build, &b, TT_OK);
+    b.flags = TT_MESH_BORROW_POSITIONS;
+    oom_sweep("tt_mesh_build(mixed, borrowed)", oom_build, &b, TT_OK);
+    b.flags = 0;
+    tm_free(&m);
+    {
+        int i, v[40];
+        for (i = 0; i < 40; i++) v[i] = tm_vert(&m, cos(i * 0.15707963), sin(i * 0.15707963), 0);
+        tm_face(&m, 40, v);
+        oom_sweep("tt_mesh_build(40-gon)", oom_build, &b, TT_OK);
+        tm_free(&m);
+    }
+    /* An invalid mesh: every run is OOM or the validation error, never a leak. */
+    make_cube(&m, 0);
+    { int t = m.idx[0]; m.idx[0] = m.idx[2]; m.idx[2] = t; }
+    oom_sweep("tt_mesh_build(flipped cube)", oom_build, &b, TT_ERROR_INCONSISTENT_ORIENTATION);
+    b.flags = TT_MESH_PERMISSIVE;
+    oom_sweep("tt_mesh_build(flipped cube, permissive)", oom_build, &b, TT_OK);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 2b. Mesh queries                                                         */
+/* ------------------------------------------------------------------------ */
+
+/* Naive valence: distinct neighbours over all faces. */
+static int naive_valence(const tt_mesh *mesh, int v, int *scratch)
+{
+    int c, n = 0, i;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int a = mesh->corner_vert[c], b = mesh->corner_vert[tt_mesh_next(mesh, c)], other = -1, dup = 0;
+        if (a == v) other = b;
+        else if (b == v) other = a;
+        if (other < 0) continue;
+        for (i = 0; i < n; i++) if (scratch[i] == other) dup = 1;
+        if (!dup) scratch[n++] = other;
+    }
+    return n;
+}
+
+static int uf_find(int *parent, int x)
+{
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+}
+
+typedef struct expect_stats {
+    int used, edges, boundary_edges, loops, components, chi, genus, min_val, max_val;
+} expect_stats;
+
+static void check_queries(const tmesh *m, const expect_stats *e, const char *name)
+{
+    tt_mesh *mesh;
+    tt_error err;
+    tt_mesh_stats st;
+    tt_result r;
+    counter cnt;
+    tt_mesh_desc d = tm_desc(m);
+    d.allocator = make_allocator(&cnt, -1);
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_OK, "%s: build failed: %d (%s)", name, r, err.message);
+    if (r != TT_OK) return;
+    r = tt_mesh_compute_stats(mesh, &st);
+    CHECK(r == TT_OK, "%s: compute_stats returned %d", name, r);
+    CHECK(st.used_vertices == e->used, "%s: used_vertices expected %d, got %d", name, e->used, st.used_vertices);
+    CHECK(st.edges == e->edges, "%s: edges expected %d, got %d", name, e->edges, st.edges);
+    CHECK(st.boundary_edges == e->boundary_edges, "%s: boundary_edges expected %d, got %d", name, e->boundary_edges,
+          st.boundary_edges);
+    CHECK(st.boundary_loops == e->loops, "%s: boundary_loops expected %d, got %d", name, e->loops, st.boundary_loops);
+    CHECK(st.components == e->components, "%s: components expected %d, got %d", name, e->components, st.components);
+    CHECK(st.euler_characteristic == e->chi, "%s: chi expected %d, got %d", name, e->chi, st.euler_characteristic);
+    CHECK(st.genus == e->genus, "%s: genus expected %d, got %d", name, e->genus, st.genus);
+    CHECK(st.min_valence == e->min_val && st.max_valence == e->max_val, "%s: valence expected %d..%d, got %d..%d",
+          name, e->min_val, e->max_val, st.min_valence, st.max_valence);
+    CHECK(st.nonmanifold_vertices == 0, "%s: nonmanifold_vertices expected 0, got %d", name, st.nonmanifold_vertices);
+
+    /* valence against the naive count; histogram against naive valences */
+    {
+        int *scratch = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners * 2 + 8);
+        int *naive = (int *)calloc((size_t)mesh->nverts + 1, sizeof(int));
+        int hist[64], nhist[64], v, bad = 0, total = 0, nb;
+        for (v = 0; v < mesh->nverts; v++) {
+            naive[v] = naive_valence(mesh, v, scratch);
+            if (tt_mesh_valence(mesh, v) != naive[v]) {
+                if (!bad) DETAIL("%s: tt_mesh_valence(%d) expected %d, got %d", name, v, naive[v],
+                                tt_mesh_valence(mesh, v));
+                bad++;
+            }
+        }
+        CHECK(bad == 0, "%s: %d vertices with a wrong valence", name, bad);
+        CHECK(tt_mesh_valence(mesh, -1) == 0 && tt_mesh_valence(mesh, mesh->nverts) == 0,
+              "%s: valence of an out-of-range vertex should be 0", name);
+        for (nb = 1; nb <= 64; nb = nb < 8 ? nb + 1 : nb * 2) {
+            int k;
+            memset(nhist, 0, sizeof nhist);
+            for (v = 0; v < mesh->nverts; v++)
+                if (mesh->vert_corner[v] >= 0) nhist[naive[v] < nb - 1 ? naive[v] : nb - 1]++;
+            for (k = 0; k < 64; k++) hist[k] = -7;
+            r = tt_mesh_valence_histogram(mesh, hist, nb);
+            bad = 0;
+            total = 0;
+            for (k = 0; k < nb; k++) { bad += hist[k] != nhist[k]; total += hist[k]; }
+            for (k = nb; k < 64; k++) bad += hist[k] != -7;   /* no write past nbins */
+            CHECK(r == TT_OK && bad == 0 && total == st.used_vertices,
+                  "%s: valence histogram with %d bins: %d bins differ from the naive one (total %d, used %d)", name, nb,
+                  bad, total, st.used_vertices);
+        }
+        CHECK(tt_mesh_valence_histogram(mesh, hist, 0) == TT_ERROR_INVALID_ARGUMENT,
+              "%s: histogram with 0 bins should be rejected", name);
+        CHECK(tt_mesh_valence_histogram(NULL, hist, 4) == TT_ERROR_INVALID_ARGUMENT &&
+                  tt_mesh_valence_histogram(mesh, NULL, 4) == TT_ERROR_INVALID_ARGUMENT,
+              "%s: histogram with NULL should be rejected", name);
+        free(scratch);
+        free(naive);
+    }
+
+    /* components: naive union-find over shared edges, numbered by first face */
+    {
+        int *comp = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+        int *parent = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+        int *label = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+        int n = -1, f, c, c2, next = 0, bad = 0;
+        for (f = 0; f < mesh->nfaces; f++) { parent[f] = f; label[f] = -1; }
+        for (c = 0; c < mesh->ncorners; c++)
+            for (c2 = c + 1; c2 < mesh->ncorners; c2++) {
+                int a = mesh->corner_vert[c], b = mesh->corner_vert[tt_mesh_next(mesh, c)];
+                int a2 = mesh->corner_vert[c2], b2 = mesh->corner_vert[tt_mesh_next(mesh, c2)];
+                if (a == b2 && b == a2) {
+                    int x = uf_find(parent, mesh->corner_face[c]), y = uf_find(parent, mesh->corner_face[c2]);
+                    if (x != y) parent[x] = y;
+                }
+            }
+        r = tt_mesh_components(mesh, comp, &n);
+        CHECK(r == TT_OK && n == e->components, "%s: tt_mesh_components: expected %d, got %d (result %d)", name,
+              e->components, n, r);
+        for (f = 0; f < mesh->nfaces; f++) {
+            int root = uf_find(parent, f);
+            if (label[root] < 0) label[root] = next++;
+            if (comp[f] != label[root]) bad++;
+        }
+        CHECK(bad == 0 && next == n, "%s: %d faces with a component id other than the naive one", name, bad);
+        CHECK(tt_mesh_components(mesh, NULL, &n) == TT_ERROR_INVALID_ARGUMENT, "%s: components(NULL)", name);
+        free(comp);
+        free(parent);
+        free(label);
+    }
+
+    /* boundary loops: ids, count, and each boundary half-edge's successor
+       (the boundary half-edge leaving its end vertex) is in the same loop */
+    {
+        int *loop = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners);
+        int n = -1, c, c2, bad = 0, nb = 0, *seen;
+        r = tt_mesh_boundary_loops(mesh, loop, &n);
+        CHECK(r == TT_OK && n == e->loops, "%s: tt_mesh_boundary_loops: expected %d loops, got %d (result %d)", name,
+              e->loops, n, r);
+        seen = (int *)calloc((size_t)(n > 0 ? n : 1), sizeof(int));
+        for (c = 0; c < mesh->ncorners; c++) {
+            if (mesh->twin[c] >= 0) { bad += loop[c] != -1; continue; }
+            nb++;
+            if (loop[c] < 0 || loop[c] >= n) { bad++; continue; }
+            seen[loop[c]] = 1;
+            for (c2 = 0; c2 < mesh->ncorners; c2++)
+                if (mesh->twin[c2] < 0 && mesh->corner_vert[c2] == mesh->corner_vert[tt_mesh_next(mesh, c)] &&
+                    loop[c2] != loop[c])
+                    bad++;
+        }
+        for (c = 0; c < n; c++) bad += !seen[c];
+        CHECK(bad == 0, "%s: %d inconsistencies in the boundary loop ids", name, bad);
+        CHECK(nb == st.boundary_edges, "%s: boundary half-edges %d vs stats %d", name, nb, st.boundary_edges);
+        free(loop);
+        free(seen);
+    }
+    CHECK(tt_mesh_compute_stats(NULL, &st) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_mesh_compute_stats(mesh, NULL) == TT_ERROR_INVALID_ARGUMENT,
+          "%s: compute_stats with NULL should be rejected", name);
+    tt_mesh_free(mesh);
+    CHECK(cnt.live == 0, "%s: %ld allocations leaked by the queries", name, cnt.live);
+}
+
+static void test_queries(void)
+{
+    tmesh m;
+    expect_stats e;
+    memset(&m, 0, sizeof m);
+
+    make_tetra(&m, 0);
+    e.used = 4; e.edges = 6; e.boundary_edges = 0; e.loops = 0; e.components = 1; e.chi = 2; e.genus = 0;
+    e.min_val = 3; e.max_val = 3;
+    check_queries(&m, &e, "tetrahedron");
+    tm_free(&m);
+
+    make_torus(&m, 8, 6, 3.0, 1.0);
+    e.used = 48; e.edges = 96; e.boundary_edges = 0; e.loops = 0; e.components = 1; e.chi = 0; e.genus = 1;
+    e.min_val = 4; e.max_val = 4;
+    check_queries(&m, &e, "torus 8x6");
+    tm_free(&m);
+
+    /* genus 2: 3x5 slab of voxels with two holes. 13 voxels; lattice 4x6x2
+       all used = 48 vertices; F = 2*13 top/bottom + side walls. */
+    make_genus2(&m);
+    e.used = 48; e.boundary_edges = 0; e.loops = 0; e.components = 1; e.chi = -2; e.genus = 2;
+    e.edges = 48 + m.nf + 2;   /* V - E + F = -2 */
+    e.min_val = 3; e.max_val = 5;
+    check_queries(&m, &e, "genus-2 polycube");
+    tm_free(&m);
+
+    make_grid(&m, 4, 3);
+    e.used = 20; e.edges = 31; e.boundary_edges = 14; e.loops = 1; e.components = 1; e.chi = 1; e.genus = 0;
+    e.min_val = 2; e.max_val = 4;
+    check_queries(&m, &e, "open grid 4x3");
+    tm_free(&m);
+
+    /* annulus: 5x5 grid without its centre quad: 2 loops, chi 0, genus 0 */
+    {
+        tmesh g;
+        int f;
+        memset(&g, 0, sizeof g);
+        make_grid(&g, 5, 5);
+        for (f = 0; f < 36; f++) tm_vert(&m, g.pos[3 * f], g.pos[3 * f + 1], g.pos[3 * f + 2]);
+        for (f = 0; f < g.nf; f++)
+            if (f != 12) tm_face(&m, 4, g.idx + 4 * f);
+        tm_free(&g);
+        e.used = 36; e.edges = 60 - 0; e.boundary_edges = 24; e.loops = 2; e.components = 1; e.chi = 0; e.genus = 0;
+        e.min_val = 2; e.max_val = 4;
+        check_queries(&m, &e, "annulus");
+        tm_free(&m);
+    }
+
+    make_cube(&m, 0);
+    make_cube(&m, 3);
+    e.used = 16; e.edges = 24; e.boundary_edges = 0; e.loops = 0; e.components = 2; e.chi = 4; e.genus = 0;
+    e.min_val = 3; e.max_val = 3;
+    check_queries(&m, &e, "two cubes");
+    tm_free(&m);
+
+    make_mixed(&m);
+    e.used = 15; e.edges = 23; e.boundary_edges = 0; e.loops = 0; e.components = 2; e.chi = 4; e.genus = 0;
+    e.min_val = 3; e.max_val = 4;
+    check_queries(&m, &e, "prism + pyramid");
+    tm_free(&m);
+
+    /* two tori and a grid: genus 2, 3 components, 1 loop */
+    make_torus(&m, 5, 4, 3.0, 1.0);
+    make_torus(&m, 3, 3, 3.0, 1.0);
+    make_grid(&m, 1, 1);
+    e.used = 20 + 9 + 4; e.edges = 40 + 18 + 4; e.boundary_edges = 4; e.loops = 1; e.components = 3;
+    e.chi = 0 + 0 + 1; e.genus = 2; e.min_val = 2; e.max_val = 4;
+    check_queries(&m, &e, "two tori and a quad");
+    tm_free(&m);
+}
+
+typedef struct mesh_ctx {
+    tt_mesh *mesh;
+    tt_subdivision scheme;
+} mesh_ctx;
+
+static tt_result oom_stats(void *ctx, const tt_allocator *al)
+{
+    tt_mesh_stats st;
+    (void)al;   /* the mesh was built with it */
+    return tt_mesh_compute_stats(((mesh_ctx *)ctx)->mesh, &st);
+}
+
+static tt_result oom_quad(void *ctx, const tt_allocator *al)
+{
+    mesh_ctx *q = (mesh_ctx *)ctx;
+    tt_mesh *out = (tt_mesh *)&out;
+    tt_error err;
+    tt_result r = tt_mesh_quadrangulate(q->mesh, q->scheme, &out, &err);
+    (void)al;
+    if (r == TT_OK) tt_mesh_free(out);
+    else if (out != NULL) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_queries_oom(void)
+{
+    tmesh m;
+    tt_mesh_desc d;
+    mesh_ctx q;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    oom_reset();
+    make_grid(&m, 3, 2);
+    make_torus(&m, 4, 3, 3.0, 1.0);
+    tm_tri(&m, 0, 1, 5);   /* the grid's first row gets a triangle below: mixed sizes */
+    {
+        /* fix the triangle's orientation: grid face 0 is 0,1,5,4 so edge 0->1
+           is used; a face below must use 1->0 */
+        int *t = m.idx + m.nc - 3;
+        t[0] = 1; t[1] = 0; t[2] = tm_vert(&m, 0.5, -1, 0);
+    }
+    d = tm_desc(&m);
+    d.allocator = g_oom_allocator;
+    r = tt_mesh_build(&d, &q.mesh, NULL);
+    CHECK(r == TT_OK, "oom mesh: build got %d", r);
+    if (r != TT_OK) { tm_free(&m); return; }
+    oom_sweep("tt_mesh_compute_stats", oom_stats, &q, TT_OK);
+    q.scheme = TT_SUBDIVIDE_LINEAR;
+    oom_sweep("tt_mesh_quadrangulate(linear)", oom_quad, &q, TT_OK);
+    q.scheme = TT_SUBDIVIDE_CATMULL_CLARK;
+    oom_sweep("tt_mesh_quadrangulate(Catmull-Clark)", oom_quad, &q, TT_OK);
+    tt_mesh_free(q.mesh);
+    CHECK(g_oom_counter.live == 0, "oom mesh: %ld allocations leaked", g_oom_counter.live);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 2c. Quadrangulation                                                      */
+/* ------------------------------------------------------------------------ */
+
+static int count_edges(const tt_mesh *mesh)
+{
+    int c, n = 0;
+    for (c = 0; c < mesh->ncorners; c++) n += mesh->twin[c] < 0 || c < mesh->twin[c];
+    return n;
+}
+
+static int vec_near(const float *a, const double *b, double tol)
+{
+    return near(a[0], b[0], tol) && near(a[1], b[1], tol) && near(a[2], b[2], tol);
+}
+
+/* One linear step on `mesh`: counts, layout, positions; returns the result. */
+static tt_mesh *check_quad_step(const tt_mesh *mesh, tt_subdivision scheme, const char *name)
+{
+    tt_mesh *out = NULL;
+    tt_error err;
+    tt_result r = tt_mesh_quadrangulate(mesh, scheme, &out, &err);
+    int E = count_edges(mesh), c, f, bad_quad = 0, bad_v0 = 0, bad_pos = 0, bad_face = 0, bad_edge = 0;
+    CHECK(r == TT_OK, "%s: quadrangulate returned %d (%s)", name, r, err.message);
+    if (r != TT_OK) return NULL;
+    CHECK(out->nverts == mesh->nverts + E + mesh->nfaces, "%s: V' expected V+E+F = %d+%d+%d, got %d", name,
+          mesh->nverts, E, mesh->nfaces, out->nverts);
+    CHECK(out->nfaces == mesh->ncorners, "%s: F' expected %d (one quad per corner), got %d", name, mesh->ncorners,
+          out->nfaces);
+    CHECK(out->ncorners == 4 * mesh->ncorners, "%s: corners expected %d, got %d", name, 4 * mesh->ncorners,
+          out->ncorners);
+    CHECK(out->min_face_size == 4 && out->max_face_size == 4, "%s: face sizes %d..%d, expected quads", name,
+          out->min_face_size, out->max_face_size);
+    CHECK(out->flags == (mesh->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS), "%s: flags expected 0x%x, got 0x%x",
+          name, mesh->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS, out->flags);
+    for (f = 0; f < out->nfaces; f++) bad_quad += out->face_start[f + 1] - out->face_start[f] != 4;
+    /* quad c (c = old corner i of face f): corner 0 = old vertex of c; corner 1
+       = point of the edge of half-edge c; corner 2 = face point; corner 3 =
+       point of the edge of the previous half-edge. */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1], n = end - first, k;
+        double centroid[3] = {0, 0, 0};
+        for (c = first; c < end; c++)
+            for (k = 0; k < 3; k++) centroid[k] += mesh->pos[3 * mesh->corner_vert[c] + k] / n;
+        for (c = first; c < end; c++) {
+            const int *q = out->corner_vert + 4 * c;
+            int prev = tt_mesh_prev(mesh, c), next = tt_mesh_next(mesh, c);
+            const float *a = mesh->pos + 3 * mesh->corner_vert[c], *b = mesh->pos + 3 * mesh->corner_vert[next];
+            const float *p0 = mesh->pos + 3 * mesh->corner_vert[prev];
+            double mid[3], midp[3];
+            for (k = 0; k < 3; k++) {
+                mid[k] = 0.5 * ((double)a[k] + b[k]);
+                midp[k] = 0.5 * ((double)p0[k] + a[k]);
+            }
+            if (q[0] != mesh->corner_vert[c]) bad_v0++;
+            if (q[2] != mesh->nverts + E + f) bad_face++;
+            if (q[1] < mesh->nverts || q[1] >= mesh->nverts + E || q[3] < mesh->nverts || q[3] >= mesh->nverts + E)
+                bad_edge++;
+            if (scheme == TT_SUBDIVIDE_LINEAR) {
+                double old[3];
+                for (k = 0; k < 3; k++) old[k] = a[k];
+                if (!vec_near(out->pos + 3 * q[0], old, 0.0)) bad_pos++;
+                if (!vec_near(out->pos + 3 * q[1], mid, 1e-6)) bad_pos++;
+                if (!vec_near(out->pos + 3 * q[3], midp, 1e-6)) bad_pos++;
+            }
+            if (!vec_near(out->pos + 3 * q[2], centroid, 1e-5)) bad_pos++;
+        }
+    }
+    /* edge points are numbered in order of their first half-edge */
+    {
+        int next_id = 0, bad_order = 0;
+        for (c = 0; c < mesh->ncorners; c++) {
+            int t = mesh->twin[c];
+            if (t >= 0 && t < c) {
+                if (out->corner_vert[4 * c + 1] != out->corner_vert[4 * t + 1]) bad_order++;
+                continue;
+            }
+            if (out->corner_vert[4 * c + 1] != mesh->nverts + next_id++) bad_order++;
+        }
+        CHECK(bad_order == 0, "%s: %d edge points not numbered by first half-edge", name, bad_order);
+    }
+    CHECK(bad_quad == 0, "%s: %d faces are not quads", name, bad_quad);
+    CHECK(bad_v0 == 0, "%s: %d quads whose corner 0 is not the old vertex", name, bad_v0);
+    CHECK(bad_face == 0, "%s: %d quads whose corner 2 is not their face point", name, bad_face);
+    CHECK(bad_edge == 0, "%s: %d quads whose corners 1/3 are not edge points", name, bad_edge);
+    CHECK(bad_pos == 0, "%s: %d new positions differ from midpoints / centroids / old positions", name, bad_pos);
+    return out;
+}
+
+static void check_topology_kept(const tt_mesh *a, const tt_mesh *b, const char *name)
+{
+    tt_mesh_stats sa, sb;
+    CHECK(tt_mesh_compute_stats(a, &sa) == TT_OK && tt_mesh_compute_stats(b, &sb) == TT_OK, "%s: stats", name);
+    CHECK(sa.euler_characteristic == sb.euler_characteristic && sa.genus == sb.genus &&
+              sa.components == sb.components && sa.boundary_loops == sb.boundary_loops &&
+              2 * sa.boundary_edges == sb.boundary_edges,
+          "%s: chi/genus/components/loops/boundary: %d/%d/%d/%d/%d before, %d/%d/%d/%d/%d after", name,
+          sa.euler_characteristic, sa.genus, sa.components, sa.boundary_loops, sa.boundary_edges,
+          sb.euler_characteristic, sb.genus, sb.components, sb.boundary_loops, sb.boundary_edges);
+}
+
+static void test_quadrangulate(void)
+{
+    tmesh m;
+    tt_mesh *mesh, *q1, *q2;
+    tt_error err;
+    tt_result r;
+    int which;
+    memset(&m, 0, sizeof m);
+    for (which = 0; which < 5; which++) {
+        const char *name = which == 0 ? "tetrahedron" : which == 1 ? "mixed" : which == 2 ? "open grid"
+                         : which == 3 ? "genus-2" : "torus";
+        int s;
+        if (which == 0) make_tetra(&m, 0);
+        if (which == 1) make_mixed(&m);
+        if (which == 2) { make_grid(&m, 3, 2); tm_tri(&m, 1, 0, tm_vert(&m, 0.5, -1, 0)); }
+        if (which == 3) make_genus2(&m);
+        if (which == 4) make_torus(&m, 5, 4, 3.0, 1.0);
+        r = build(&m, 0, &mesh, &err);
+        CHECK(r == TT_OK, "%s: build %d", name, r);
+        if (r != TT_OK) { tm_free(&m); continue; }
+        for (s = 0; s < 2; s++) {
+            tt_subdivision scheme = s ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR;
+            q1 = check_quad_step(mesh, scheme, name);
+            if (!q1) continue;
+            q2 = check_quad_step(q1, scheme, name);   /* twice */
+            check_topology_kept(mesh, q1, name);
+            if (q2) {
+                check_topology_kept(q1, q2, name);
+                tt_mesh_free(q2);
+            }
+            tt_mesh_free(q1);
+        }
+        tt_mesh_free(mesh);
+        tm_free(&m);
+    }
+
+    /* Catmull-Clark on a unit cube, by hand: the corner vertex at the origin
+       has n = 3 faces with centroids (.5,.5,0), (.5,0,.5), (0,.5,.5), so
+       Q = (1/3,1/3,1/3); its 3 edge midpoints average R = (1/6,1/6,1/6); S is
+       the origin: (Q + 2R + (n-3)S)/n = (2/9, 2/9, 2/9). The edge point of
+       (0,0,0)-(1,0,0) averages its ends and the centroids of faces z=0 and y=0:
+       (0.5, 0.125, 0.125). The face point of z = 0 is (0.5, 0.5, 0). */
+    make_cube(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "cube build %d", r);
+    if (r == TT_OK) {
+        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q1, &err);
+        CHECK(r == TT_OK, "cube: Catmull-Clark returned %d", r);
+        if (r == TT_OK) {
+            int v, c, bad = 0, found_edge = 0;
+            double expect_corner = 2.0 / 9.0;
+            for (v = 0; v < mesh->nverts; v++) {
+                double e[3];
+                int k;
+                for (k = 0; k < 3; k++)
+                    e[k] = mesh->pos[3 * v + k] == 0.0f ? expect_corner : 1.0 - expect_corner;
+                if (!vec_near(q1->pos + 3 * v, e, 1e-6)) {
+                    if (!bad)
+                        DETAIL("cube vertex %d (%g,%g,%g): expected (%g,%g,%g), got (%g,%g,%g)", v, mesh->pos[3 * v],
+                              mesh->pos[3 * v + 1], mesh->pos[3 * v + 2], e[0], e[1], e[2], q1->pos[3 * v],
+                              q1->pos[3 * v + 1], q1->pos[3 * v + 2]);
+                    bad++;
+                }
+            }
+            CHECK(bad == 0, "Catmull-Clark cube: %d of 8 corners not at 2/9 (or 7/9)", bad);
+            for (c = 0; c < mesh->ncorners; c++) {
+                const float *a = mesh->pos + 3 * mesh->corner_vert[c];
+                const float *b = mesh->pos + 3 * mesh->corner_vert[tt_mesh_next(mesh, c)];
+                if (a[0] == 0 && a[1] == 0 && a[2] == 0 && b[0] == 1 && b[1] == 0 && b[2] == 0) {
+                    double e[3] = {0.5, 0.125, 0.125};
+                    found_edge = 1;
+                    CHECK(vec_near(q1->pos + 3 * q1->corner_vert[4 * c + 1], e, 1e-6),
+                          "Catmull-Clark edge point of (0,0,0)-(1,0,0): expected (0.5,0.125,0.125), got (%g,%g,%g)",
+                          q1->pos[3 * q1->corner_vert[4 * c + 1]], q1->pos[3 * q1->corner_vert[4 * c + 1] + 1],
+                          q1->pos[3 * q1->corner_vert[4 * c + 1] + 2]);
+                }
+            }
+            CHECK(found_edge, "the cube should have a half-edge (0,0,0)->(1,0,0)");
+            tt_mesh_free(q1);
+        }
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* Catmull-Clark on an open grid: an interior vertex of a flat grid stays
+       put, a boundary vertex with two boundary edges goes to 3/4 S + 1/8 of
+       its boundary neighbours (= stays on a straight boundary), and edge
+       points on the boundary are midpoints. */
+    make_grid(&m, 3, 3);
+    m.pos[3 * 1 + 1] = 0.5f;   /* lift boundary vertex (1,0) to y = .5: 3/4*.5 = .375 */
+    r = build(&m, 0, &mesh, &err);
+    if (r == TT_OK) {
+        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q1, &err);
+        CHECK(r == TT_OK, "grid CC %d", r);
+        if (r == TT_OK) {
+            double e5[3] = {1, 1, 0}, e1[3] = {1, 0.375, 0}, e0[3] = {0.125, 0.1875, 0};
+            /* vertex 5 = (1,1): interior, flat, regular, but its neighbour (1,0)
+               moved: Q and R change. Check only the boundary rules here. */
+            (void)e5;
+            CHECK(vec_near(q1->pos + 3, e1, 1e-6), "CC boundary vertex (1,.5): expected (1,.375,0), got (%g,%g,%g)",
+                  q1->pos[3], q1->pos[4], q1->pos[5]);
+            /* the grid corner (0,0) has 2 boundary edges, to (1,.5) and (0,1):
+               3/4 (0,0) + 1/8 (1,.5) + 1/8 (0,1) = (.125, .1875) */
+            CHECK(vec_near(q1->pos, e0, 1e-6), "CC grid corner: expected (0.125,0.1875,0), got (%g,%g,%g)",
+                  q1->pos[0], q1->pos[1], q1->pos[2]);
+            tt_mesh_free(q1);
+        }
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* bad arguments */
+    make_tetra(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    if (r == TT_OK) {
+        q1 = (tt_mesh *)&q1;
+        CHECK(tt_mesh_quadrangulate(mesh, (tt_subdivision)7, &q1, &err) == TT_ERROR_INVALID_ARGUMENT && q1 == NULL,
+              "unknown scheme should be rejected with *out NULL");
+        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+              "out_mesh NULL should be rejected");
+        CHECK(tt_mesh_quadrangulate(NULL, TT_SUBDIVIDE_LINEAR, &q1, &err) == TT_ERROR_INVALID_ARGUMENT && q1 == NULL,
+              "mesh NULL should be rejected");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+    tt_mesh_free(NULL);   /* allowed */
+}
+
+/* ------------------------------------------------------------------------ */
+/* 3. Image                                                                 */
+/* ------------------------------------------------------------------------ */
+
+static float *px(const tt_image *im, int x, int y) { return im->pixels + ((size_t)y * im->width + x) * 4; }
+
+static void fill_random(tt_image *im, unsigned seed)
+{
+    size_t i, n = (size_t)im->width * im->height * 4;
+    lcg_seed(seed);
+    for (i = 0; i < n; i++) im->pixels[i] = (float)lcg_unit();
+}
+
+static void test_image_basics(void)
+{
+    tt_image im;
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    int ch, x, y, k, bad;
+    unsigned char data[7 * 5 * 4 + 64], back[7 * 5 * 4];
+
+    /* create: sizes */
+    CHECK(tt_image_create(&im, 0, 5, NULL) == TT_ERROR_INVALID_ARGUMENT && im.pixels == NULL, "width 0 rejected");
+    CHECK(tt_image_create(&im, 5, 0, NULL) == TT_ERROR_INVALID_ARGUMENT && im.pixels == NULL, "height 0 rejected");
+    CHECK(tt_image_create(&im, -3, 5, NULL) == TT_ERROR_INVALID_ARGUMENT && im.pixels == NULL, "width -3 rejected");
+    CHECK(tt_image_create(&im, 5, -1, NULL) == TT_ERROR_INVALID_ARGUMENT && im.pixels == NULL, "height -1 rejected");
+    CHECK(tt_image_create(&im, TT_MAX_IMAGE_SIZE + 1, 1, NULL) == TT_ERROR_TOO_LARGE && im.pixels == NULL,
+          "width TT_MAX_IMAGE_SIZE+1 should be TT_ERROR_TOO_LARGE");
+    CHECK(tt_image_create(&im, 1, TT_MAX_IMAGE_SIZE + 1, NULL) == TT_ERROR_TOO_LARGE && im.pixels == NULL,
+          "height TT_MAX_IMAGE_SIZE+1 should be TT_ERROR_TOO_LARGE");
+    CHECK(tt_image_create(NULL, 4, 4, NULL) == TT_ERROR_INVALID_ARGUMENT, "image NULL rejected");
+    CHECK(tt_image_create(&im, TT_MAX_IMAGE_SIZE, 1, &al) == TT_OK && im.width == TT_MAX_IMAGE_SIZE,
+          "TT_MAX_IMAGE_SIZE x 1 is allowed");
+    tt_image_free(&im);
+    {
+        counter fc;
+        tt_allocator fail = make_allocator(&fc, 0);
+        CHECK(tt_image_create(&im, 4, 4, &fail) == TT_ERROR_OUT_OF_MEMORY && im.pixels == NULL && fc.live == 0,
+              "tt_image_create with a failing allocator: clean TT_ERROR_OUT_OF_MEMORY");
+    }
+    CHECK(tt_image_create(&im, 3, 2, &al) == TT_OK, "create 3x2");
+    bad = 0;
+    for (k = 0; k < 3 * 2 * 4; k++) bad += im.pixels[k] != 0.0f;
+    CHECK(bad == 0 && im.width == 3 && im.height == 2, "a new image is zero-filled, %d non-zero values", bad);
+    tt_image_free(&im);
+    CHECK(im.pixels == NULL && im.width == 0, "tt_image_free resets the image");
+    tt_image_free(&im);   /* twice is harmless */
+    tt_image_free(NULL);
+
+    /* from_bytes / to_rgba8 round trip, 1..4 channels, tight and padded stride */
+    for (ch = 1; ch <= 4; ch++) {
+        int stride_pad;
+        for (stride_pad = 0; stride_pad <= 5; stride_pad += 5) {
+            int stride = stride_pad ? 7 * ch + stride_pad : 0, rs = 7 * ch + stride_pad;
+            lcg_seed(ch * 10 + stride_pad);
+            for (k = 0; k < (int)sizeof data; k++) data[k] = (unsigned char)lcg_below(256);
+            data[0] = 0;
+            data[1] = 255;
+            CHECK(tt_image_from_bytes(&im, data, 7, 5, ch, stride, &al) == TT_OK, "from_bytes ch %d", ch);
+            memset(back, 0x11, sizeof back);
+            tt_image_to_rgba8(&im, back);
+            bad = 0;
+            for (y = 0; y < 5; y++)
+                for (x = 0; x < 7; x++) {
+                    const unsigned char *p = data + y * rs + x * ch, *q = back + (y * 7 + x) * 4;
+                    const float *f = px(&im, x, y);
+                    unsigned char e[4];
+                    if (ch <= 2) { e[0] = e[1] = e[2] = p[0]; e[3] = ch == 2 ? p[1] : 255; }
+                    else { e[0] = p[0]; e[1] = p[1]; e[2] = p[2]; e[3] = ch == 4 ? p[3] : 255; }
+                    for (k = 0; k < 4; k++) {
+                        if (q[k] != e[k]) bad++;
+                        if (!near(f[k], e[k] / 255.0, 1e-7)) bad++;
+                    }
+                }
+            CHECK(bad == 0, "round trip with %d channels, stride %d: %d values differ", ch, stride, bad);
+            tt_image_free(&im);
+        }
+    }
+    CHECK(tt_image_from_bytes(&im, data, 7, 5, 0, 0, &al) == TT_ERROR_INVALID_ARGUMENT, "0 channels rejected");
+    CHECK(tt_image_from_bytes(&im, data, 7, 5, 5, 0, &al) == TT_ERROR_INVALID_ARGUMENT, "5 channels rejected");
+    CHECK(tt_image_from_bytes(&im, data, 7, 5, 3, 20, &al) == TT_ERROR_INVALID_ARGUMENT,
+          "stride smaller than width*channels rejected");
+    CHECK(tt_image_from_bytes(&im, NULL, 7, 5, 3, 0, &al) == TT_ERROR_INVALID_ARGUMENT, "data NULL rejected");
+    CHECK(tt_image_from_bytes(&im, data, 0, 5, 3, 0, &al) == TT_ERROR_INVALID_ARGUMENT, "width 0 rejected");
+    /* to_rgba8 rounds and clamps */
+    CHECK(tt_image_create(&im, 2, 1, &al) == TT_OK, "create 2x1");
+    im.pixels[0] = -0.5f; im.pixels[1] = 1.5f; im.pixels[2] = 0.5f; im.pixels[3] = (float)NAN;
+    im.pixels[4] = 0.2f / 255.0f; im.pixels[5] = 0.6f / 255.0f; im.pixels[6] = 254.6f / 255.0f; im.pixels[7] = 1.0f;
+    tt_image_to_rgba8(&im, back);
+    CHECK(back[0] == 0 && back[1] == 255 && back[2] == 128 && back[3] == 0 && back[4] == 0 && back[5] == 1 &&
+              back[6] == 255 && back[7] == 255,
+          "to_rgba8 clamp/round: got %d %d %d %d %d %d %d %d", back[0], back[1], back[2], back[3], back[4], back[5],
+          back[6], back[7]);
+    tt_image_free(&im);
+
+    /* bilinear */
+    CHECK(tt_image_create(&im, 5, 4, &al) == TT_OK, "create 5x4");
+    fill_random(&im, 77);
+    {
+        int bad_centre = 0, bad_half = 0, bad_clamp = 0;
+        float s[4];
+        for (y = 0; y < 4; y++)
+            for (x = 0; x < 5; x++) {
+                tt_image_sample_bilinear(&im, x + 0.5f, y + 0.5f, s);
+                if (memcmp(s, px(&im, x, y), sizeof s) != 0) bad_centre++;
+                if (x + 1 < 5) {
+                    tt_image_sample_bilinear(&im, x + 1.0f, y + 0.5f, s);
+                    for (k = 0; k < 4; k++)
+                        if (!near(s[k], 0.5 * (px(&im, x, y)[k] + px(&im, x + 1, y)[k]), 1e-6)) bad_half++;
+                }
+                if (y + 1 < 4) {
+                    tt_image_sample_bilinear(&im, x + 0.5f, y + 1.0f, s);
+                    for (k = 0; k < 4; k++)
+                        if (!near(s[k], 0.5 * (px(&im, x, y)[k] + px(&im, x, y + 1)[k]), 1e-6)) bad_half++;
+                }
+                if (x + 1 < 5 && y + 1 < 4) {
+                    tt_image_sample_bilinear(&im, x + 1.0f, y + 1.0f, s);
+                    for (k = 0; k < 4; k++)
+                        if (!near(s[k], 0.25 * (px(&im, x, y)[k] + px(&im, x + 1, y)[k] + px(&im, x, y + 1)[k] +
+                                                px(&im, x + 1, y + 1)[k]), 1e-6))
+                            bad_half++;
+                }
+            }
+        CHECK(bad_centre == 0, "bilinear at texel centres: %d texels differ", bad_centre);
+        CHECK(bad_half == 0, "bilinear halfway: %d values differ from the average", bad_half);
+        tt_image_sample_bilinear(&im, -10.0f, -3.0f, s);
+        bad_clamp += memcmp(s, px(&im, 0, 0), sizeof s) != 0;
+        tt_image_sample_bilinear(&im, 100.0f, 50.0f, s);
+        bad_clamp += memcmp(s, px(&im, 4, 3), sizeof s) != 0;
+        tt_image_sample_bilinear(&im, 0.1f, 2.5f, s);   /* left of the first centre: clamps in x */
+        bad_clamp += memcmp(s, px(&im, 0, 2), sizeof s) != 0;
+        tt_image_sample_bilinear(&im, 3.5f, 3.9f, s);   /* below the last centre */
+        bad_clamp += memcmp(s, px(&im, 3, 3), sizeof s) != 0;
+        CHECK(bad_clamp == 0, "bilinear clamps outside the image: %d cases wrong", bad_clamp);
+        /* far outside: still the nearest edge texel */
+        tt_image_sample_bilinear(&im, -1e30f, 1e30f, s);
+        CHECK(memcmp(s, px(&im, 0, 3), sizeof s) == 0,
+              "bilinear at (-1e30, 1e30) should clamp to the bottom-left texel (0,3): got %g, texel (0,3) %g, (0,0) %g",
+              s[0], px(&im, 0, 3)[0], px(&im, 0, 0)[0]);
+        tt_image_sample_bilinear(&im, 3e9f, 2.5f, s);
+        CHECK(memcmp(s, px(&im, 4, 2), sizeof s) == 0,
+              "bilinear at (3e9, 2.5) should clamp to the right texel (4,2): got %g, texel (4,2) %g, (0,2) %g", s[0],
+              px(&im, 4, 2)[0], px(&im, 0, 2)[0]);
+        tt_image_sample_bilinear(&im, (float)NAN, 1.0f, s);   /* must not crash */
+        CHECK(s[0] == s[0], "bilinear at NaN should return a number");
+    }
+    tt_image_free(&im);
+    CHECK(cnt.live == 0, "image basics: %ld allocations leaked", cnt.live);
+}
+
+/* Naive one-step counter-clockwise turn: (x, y) of a W x H image goes to
+   (y, W-1-x) of an H x W image. */
+static void naive_rotate(int turns, int w, int h, int x, int y, int *ox, int *oy)
+{
+    int t = ((turns % 4) + 4) % 4, i;
+    for (i = 0; i < t; i++) {
+        int nx = y, ny = w - 1 - x, tmp = w;
+        x = nx;
+        y = ny;
+        w = h;
+        h = tmp;
+    }
+    *ox = x;
+    *oy = y;
+}
+
+static void test_rotate(void)
+{
+    tt_image src, dst;
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    int turns, x, y, W = 7, H = 4;
+    CHECK(tt_image_create(&src, W, H, &al) == TT_OK, "create");
+    fill_random(&src, 3);
+    for (turns = -5; turns <= 7; turns++) {
+        int bad_coords = 0, bad_pixels = 0, odd = (((turns % 4) + 4) % 4) & 1;
+        tt_result r;
+        for (y = -2; y < H + 2; y++)
+            for (x = -2; x < W + 2; x++) {
+                int ax, ay, bx, by;
+                tt_rotate_coords(turns, W, H, x, y, &ax, &ay);
+                naive_rotate(turns, W, H, x, y, &bx, &by);
+                if (ax != bx || ay != by) bad_coords++;
+            }
+        CHECK(bad_coords == 0, "tt_rotate_coords(%d) differs from the naive rotation at %d points", turns, bad_coords);
+        r = tt_image_rotate90(&src, turns, &dst, &al);
+        CHECK(r == TT_OK, "rotate90(%d) returned %d", turns, r);
+        if (r != TT_OK) continue;
+        CHECK(dst.width == (odd ? H : W) && dst.height == (odd ? W : H), "rotate90(%d): size %dx%d", turns, dst.width,
+              dst.height);
+        for (y = 0; y < H; y++)
+            for (x = 0; x < W; x++) {
+                int bx, by;
+                naive_rotate(turns, W, H, x, y, &bx, &by);
+                if (memcmp(px(&dst, bx, by), px(&src, x, y), 4 * sizeof(float)) != 0) bad_pixels++;
+            }
+        CHECK(bad_pixels == 0, "tt_image_rotate90(%d): %d pixels differ from the naive rotation", turns, bad_pixels);
+        if (turns == 1) {
+            /* one CCW turn: top-left goes to bottom-left; top-right to top-left */
+            CHECK(memcmp(px(&dst, 0, dst.height - 1), px(&src, 0, 0), 16) == 0,
+                  "one CCW turn should send the top-left pixel to the bottom-left");
+            CHECK(memcmp(px(&dst, 0, 0), px(&src, W - 1, 0), 16) == 0,
+                  "one CCW turn should send the top-right pixel to the top-left");
+        }
+        if (turns % 4 == 0)
+            CHECK(memcmp(dst.pixels, src.pixels, sizeof(float) * 4 * W * H) == 0, "rotate90(%d) is the identity",
+                  turns);
+        tt_image_free(&dst);
+    }
+    /* composition: 1 turn then 3 turns = identity */
+    {
+        tt_image a, b;
+        if (tt_image_rotate90(&src, 1, &a, &al) == TT_OK) {
+            if (tt_image_rotate90(&a, 3, &b, &al) == TT_OK) {
+                CHECK(b.width == W && memcmp(b.pixels, src.pixels, sizeof(float) * 4 * W * H) == 0,
+                      "1 + 3 quarter turns should be the identity");
+                tt_image_free(&b);
+            }
+            tt_image_free(&a);
+        }
+    }
+    CHECK(tt_image_rotate90(&src, 1, &src, &al) == TT_ERROR_INVALID_ARGUMENT, "rotating in place is rejected");
+    CHECK(tt_image_rotate90(NULL, 1, &dst, &al) == TT_ERROR_INVALID_ARGUMENT, "src NULL rejected");
+    tt_image_free(&src);
+    CHECK(cnt.live == 0, "rotate: %ld allocations leaked", cnt.live);
+}
+
+static void test_over_downsample(void)
+{
+    tt_image a, b, c, d;
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    int x, y, k, bad;
+    float dst[4] = {0.3f, 0.6f, 0.9f, 0.8f}, keep[4], src[4];
+
+    memcpy(keep, dst, sizeof dst);
+    src[0] = src[1] = src[2] = src[3] = 0.0f;
+    tt_rgba_over(dst, src);
+    CHECK(memcmp(dst, keep, sizeof dst) == 0, "over with alpha 0 leaves dst exactly");
+    src[0] = 0.123f; src[1] = 0.456f; src[2] = 0.789f; src[3] = 1.0f;
+    tt_rgba_over(dst, src);
+    CHECK(memcmp(dst, src, sizeof dst) == 0, "over with alpha 1 gives src exactly: got %g %g %g %g", dst[0], dst[1],
+          dst[2], dst[3]);
+    memcpy(dst, keep, sizeof dst);
+    src[0] = 0.1f; src[1] = 0.2f; src[2] = 0.3f; src[3] = 0.5f;
+    tt_rgba_over(dst, src);
+    bad = 0;
+    for (k = 0; k < 4; k++) bad += !near(dst[k], src[k] + 0.5 * keep[k], 1e-6);
+    CHECK(bad == 0, "over with alpha .5: expected src + .5 dst, %d channels differ", bad);
+
+    CHECK(tt_image_create(&a, 6, 4, &al) == TT_OK && tt_image_create(&b, 6, 4, &al) == TT_OK, "create");
+    fill_random(&a, 11);
+    fill_random(&b, 12);
+    for (y = 0; y < 4; y++)
+        for (x = 0; x < 6; x++) {
+            float *p = px(&b, x, y);
+            int kind = (x + y) % 3;
+            p[3] = kind == 0 ? 0.0f : kind == 1 ? 1.0f : 0.5f;
+            if (kind == 0) p[0] = p[1] = p[2] = 0.0f;
+            for (k = 0; k < 3; k++) p[k] *= p[3];   /* premultiplied */
+        }
+    CHECK(tt_image_create(&c, 6, 4, &al) == TT_OK, "create");
+    memcpy(c.pixels, a.pixels, sizeof(float) * 4 * 24);
+    CHECK(tt_image_over(&a, &b) == TT_OK, "tt_image_over");
+    bad = 0;
+    for (y = 0; y < 4; y++)
+        for (x = 0; x < 6; x++) {
+            const float *s = px(&b, x, y), *o = px(&c, x, y), *r = px(&a, x, y);
+            for (k = 0; k < 4; k++) {
+                if (s[3] == 0.0f) bad += r[k] != o[k];
+                else if (s[3] == 1.0f) bad += r[k] != s[k];
+                else bad += !near(r[k], s[k] + (1.0 - s[3]) * o[k], 1e-6);
+            }
+        }
+    CHECK(bad == 0, "tt_image_over: %d values differ from the formula", bad);
+    tt_image_free(&c);
+    CHECK(tt_image_create(&c, 5, 4, &al) == TT_OK, "create");
+    CHECK(tt_image_over(&a, &c) == TT_ERROR_INVALID_ARGUMENT, "over with different sizes rejected");
+    CHECK(tt_image_over(NULL, &c) == TT_ERROR_INVALID_ARGUMENT, "over NULL rejected");
+    tt_image_free(&c);
+
+    /* downsample against a naive box */
+    CHECK(tt_image_downsample2(&a, &d, &al) == TT_OK, "downsample 6x4");
+    CHECK(d.width == 3 && d.height == 2, "downsample size %dx%d", d.width, d.height);
+    bad = 0;
+    for (y = 0; y < 2; y++)
+        for (x = 0; x < 3; x++)
+            for (k = 0; k < 4; k++) {
+                double e = (px(&a, 2 * x, 2 * y)[k] + px(&a, 2 * x + 1, 2 * y)[k] + px(&a, 2 * x, 2 * y + 1)[k] +
+                            px(&a, 2 * x + 1, 2 * y + 1)[k]) / 4.0;
+                bad += !near(px(&d, x, y)[k], e, 1e-6);
+            }
+    CHECK(bad == 0, "downsample2: %d values differ from the naive box", bad);
+    tt_image_free(&d);
+    CHECK(tt_image_create(&c, 5, 4, &al) == TT_OK, "create");
+    CHECK(tt_image_downsample2(&c, &d, &al) == TT_ERROR_INVALID_ARGUMENT && d.pixels == NULL, "odd width rejected");
+    tt_image_free(&c);
+    CHECK(tt_image_create(&c, 4, 3, &al) == TT_OK, "create");
+    CHECK(tt_image_downsample2(&c, &d, &al) == TT_ERROR_INVALID_ARGUMENT && d.pixels == NULL, "odd height rejected");
+    tt_image_free(&c);
+    CHECK(tt_image_create(&c, 2, 2, &al) == TT_OK, "create");
+    CHECK(tt_image_downsample2(&c, &d, &al) == TT_OK && d.width == 1 && d.height == 1, "2x2 -> 1x1");
+    tt_image_free(&d);
+    CHECK(tt_image_downsample2(&c, &c, &al) == TT_ERROR_INVALID_ARGUMENT, "in place rejected");
+    tt_image_free(&c);
+    tt_image_free(&a);
+    tt_image_free(&b);
+    CHECK(cnt.live == 0, "over/downsample: %ld allocations leaked", cnt.live);
+}
+
+/* Brute force over all paths; ties: smallest last row, then smallest row
+   one column earlier, and so on (what "ties go to the smaller row" gives
+   when each step prefers the smaller row). */
+static int brute_cut(const float *cost, int w, int h, const int *lo, const int *hi, int *best_path, double *best_cost)
+{
+    int path[8], x, found = 0;
+    for (x = 0; x < w; x++) path[x] = 0;
+    for (;;) {
+        int ok = 1;
+        double sum = 0.0;
+        for (x = 0; x < w && ok; x++) {
+            if (path[x] < lo[x] || path[x] > hi[x]) ok = 0;
+            if (x > 0 && abs(path[x] - path[x - 1]) > 1) ok = 0;
+        }
+        if (ok) {
+            for (x = 0; x < w; x++) sum += cost[path[x] * w + x];
+            if (!found || sum < *best_cost) {
+                found = 1;
+                *best_cost = sum;
+                memcpy(best_path, path, sizeof(int) * (size_t)w);
+            } else if (sum == *best_cost) {
+                /* compare from the last column */
+                for (x = w - 1; x >= 0; x--) {
+                    if (path[x] != best_path[x]) {
+                        if (path[x] < best_path[x]) memcpy(best_path, path, sizeof(int) * (size_t)w);
+                        break;
+                    }
+                }
+            }
+        }
+        for (x = 0; x < w; x++) {
+            if (++path[x] < h) break;
+            path[x] = 0;
+        }
+        if (x == w) break;
+    }
+    return found;
+}
+
+static void test_min_error_cut(void)
+{
+    int trial, bad_cost = 0, bad_path = 0, bad_valid = 0, bad_result = 0, nvalid = 0, ninvalid = 0;
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    lcg_seed(2024);
+    for (trial = 0; trial < 3000; trial++) {
+        int w = 1 + lcg_below(6), h = 1 + lcg_below(5), x, lo[8], hi[8], path[8], best[8], found;
+        float cost[64];
+        double best_cost = 0.0, got = 0.0;
+        tt_result r;
+        int integer = trial % 2;   /* integer costs: many ties */
+        for (x = 0; x < w * h; x++) cost[x] = integer ? (float)lcg_below(3) : (float)lcg_unit();
+        for (x = 0; x < w; x++) {
+            int a = lcg_below(h), b = lcg_below(h);
+            if (trial % 3 == 0) { a = 0; b = h - 1; }
+            lo[x] = a < b ? a : b;
+            hi[x] = a < b ? b : a;
+        }
+        found = brute_cut(cost, w, h, lo, hi, best, &best_cost);
+        for (x = 0; x < 8; x++) path[x] = -99;
+        r = tt_min_error_cut(cost, w, h, lo, hi, path, &al);
+        if (!found) {
+            ninvalid++;
+            if (r != TT_ERROR_INVALID_ARGUMENT) bad_result++;
+            continue;
+        }
+        nvalid++;
+        if (r != TT_OK) { bad_result++; continue; }
+        for (x = 0; x < w; x++) {
+            if (path[x] < lo[x] || path[x] > hi[x] || (x > 0 && abs(path[x] - path[x - 1]) > 1)) { bad_valid++; break; }
+            got += cost[path[x] * w + x];
+        }
+        if (got != best_cost) bad_cost++;
+        else if (memcmp(path, best, sizeof(int) * (size_t)w) != 0) bad_path++;
+    }
+    CHECK(bad_result == 0, "min_error_cut: %d results differ (expected OK when a path exists, INVALID_ARGUMENT otherwise)",
+          bad_result);
+    CHECK(bad_valid == 0, "min_error_cut: %d paths leave their range or jump more than one row", bad_valid);
+    CHECK(bad_cost == 0, "min_error_cut: %d paths are not of minimal cost", bad_cost);
+    CHECK(bad_path == 0, "min_error_cut: %d tied paths differ from the smaller-row choice", bad_path);
+    CHECK(nvalid > 1000 && ninvalid > 100, "min_error_cut sampling: %d valid, %d invalid cases", nvalid, ninvalid);
+    {
+        float cost[4] = {1, 2, 3, 4};
+        int lo[2] = {0, 0}, hi[2] = {1, 1}, path[2], badlo[2] = {1, 0}, badhi[2] = {0, 5}, hi01[2] = {0, 1};
+        CHECK(tt_min_error_cut(cost, 2, 2, badlo, hi01, path, &al) == TT_ERROR_INVALID_ARGUMENT, "lo > hi rejected");
+        CHECK(tt_min_error_cut(cost, 2, 2, lo, badhi, path, &al) == TT_ERROR_INVALID_ARGUMENT, "hi >= height rejected");
+        CHECK(tt_min_error_cut(NULL, 2, 2, lo, hi, path, &al) == TT_ERROR_INVALID_ARGUMENT, "cost NULL rejected");
+        CHECK(tt_min_error_cut(cost, 0, 2, lo, hi, path, &al) == TT_ERROR_INVALID_ARGUMENT, "width 0 rejected");
+        CHECK(tt_min_error_cut(cost, 2, 2, lo, hi, path, NULL) == TT_OK && path[0] == 0 && path[1] == 0,
+              "default allocator: path %d %d", path[0], path[1]);
+        {
+            counter fc;
+            tt_allocator fail;
+            int k;
+            for (k = 0; k < 2; k++) {
+                fail = make_allocator(&fc, k);
+                CHECK(tt_min_error_cut(cost, 2, 2, lo, hi, path, &fail) == TT_ERROR_OUT_OF_MEMORY && fc.live == 0,
+                      "min_error_cut with allocation %d failing: clean TT_ERROR_OUT_OF_MEMORY", k);
+            }
+        }
+    }
+    CHECK(cnt.live == 0, "min_error_cut: %ld allocations leaked", cnt.live);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 5. Raster                                                                */
+/* ------------------------------------------------------------------------ */
+
+#define RW 48
+#define RH 36
+
+typedef struct raster_rec {
+    int hits[RH][RW];
+    float bary[RH][RW][3];
+    int out_of_grid;
+    int bad_sum;
+} raster_rec;
+
+static void raster_cb(int x, int y, const float b[3], void *user)
+{
+    raster_rec *r = (raster_rec *)user;
+    if (x < 0 || y < 0 || x >= RW || y >= RH) { r->out_of_grid++; return; }
+    r->hits[y][x]++;
+    memcpy(r->bary[y][x], b, sizeof(float) * 3);
+    if (!near((double)b[0] + b[1] + b[2], 1.0, 1e-5)) r->bad_sum++;
+}
+
+/* Naive: signed distances of (px,py) to the 3 edges, positive inside for
+   either winding; returns the smallest; +inside / -outside. */
+static double naive_inside(const float *t, double px_, double py_)
+{
+    double area = ((double)t[2] - t[0]) * ((double)t[5] - t[1]) - ((double)t[4] - t[0]) * ((double)t[3] - t[1]);
+    double sgn = area > 0 ? 1.0 : -1.0, best = 1e300;
+    int i;
+    for (i = 0; i < 3; i++) {
+        double ax = t[2 * i], ay = t[2 * i + 1], bx = t[2 * ((i + 1) % 3)], by = t[2 * ((i + 1) % 3) + 1];
+        double len = sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay));
+        double e = ((bx - ax) * (py_ - ay) - (by - ay) * (px_ - ax)) * sgn / (len > 0 ? len : 1);
+        if (e < best) best = e;
+    }
+    return best;
+}
+
+static void raster_compare(const float *t, double margin, int *bad_cover, int *bad_bary, int *bad_other)
+{
+    static raster_rec rec;
+    int x, y;
+    memset(&rec, 0, sizeof rec);
+    tt_raster_triangle(t, RW, RH, raster_cb, &rec);
+    *bad_other += rec.out_of_grid + rec.bad_sum;
+    for (y = 0; y < RH; y++)
+        for (x = 0; x < RW; x++) {
+            double d = naive_inside(t, x + 0.5, y + 0.5);
+            if (rec.hits[y][x] > 1) (*bad_other)++;
+            if (fabs(d) > margin && (d > 0) != (rec.hits[y][x] == 1)) (*bad_cover)++;
+            if (rec.hits[y][x]) {
+                const float *b = rec.bary[y][x];
+                double qx = b[0] * t[0] + b[1] * t[2] + b[2] * t[4], qy = b[0] * t[1] + b[1] * t[3] + b[2] * t[5];
+                if (!near(qx, x + 0.5, 2e-3) || !near(qy, y + 0.5, 2e-3)) (*bad_bary)++;
+                if (b[0] < -1e-3 || b[1] < -1e-3 || b[2] < -1e-3) (*bad_bary)++;
+            }
+        }
+}
+
+static void test_raster_random(void)
+{
+    int trial, bad_cover = 0, bad_bary = 0, bad_other = 0, bad_wind = 0;
+    static raster_rec r1, r2;
+    lcg_seed(555);
+    for (trial = 0; trial < 600; trial++) {
+        float t[6], u[6];
+        int i, x, y;
+        for (i = 0; i < 6; i++) {
+            double lo = -6.0, hi = (i % 2 ? RH : RW) + 6.0, v = lo + (hi - lo) * lcg_unit();
+            /* half the triangles on the 1/256 grid, where the rasteriser's
+               snapping changes nothing (margin 1e-3 px); half arbitrary, where
+               snapping moves an edge by up to ~0.003 px (margin 6e-3 px) */
+            t[i] = trial % 2 ? (float)(floor(v * 256.0) / 256.0) : (float)v;
+        }
+        raster_compare(t, trial % 2 ? 1e-3 : 6e-3, &bad_cover, &bad_bary, &bad_other);
+        /* the other winding: same pixels, weights follow their vertices */
+        u[0] = t[0]; u[1] = t[1]; u[2] = t[4]; u[3] = t[5]; u[4] = t[2]; u[5] = t[3];
+        memset(&r1, 0, sizeof r1);
+        memset(&r2, 0, sizeof r2);
+        tt_raster_triangle(t, RW, RH, raster_cb, &r1);
+        tt_raster_triangle(u, RW, RH, raster_cb, &r2);
+        for (y = 0; y < RH; y++)
+            for (x = 0; x < RW; x++) {
+                if (r1.hits[y][x] != r2.hits[y][x]) bad_wind++;
+                else if (r1.hits[y][x] &&
+                         (!near(r1.bary[y][x][0], r2.bary[y][x][0], 1e-5) ||
+                          !near(r1.bary[y][x][1], r2.bary[y][x][2], 1e-5) ||
+                          !near(r1.bary[y][x][2], r2.bary[y][x][1], 1e-5)))
+                    bad_wind++;
+            }
+    }
+    CHECK(bad_cover == 0, "raster: %d pixel centres differ from the naive point-in-triangle test", bad_cover);
+    CHECK(bad_bary == 0, "raster: %d barycentrics do not reproduce the pixel centre", bad_bary);
+    CHECK(bad_other == 0, "raster: %d pixels outside the grid, hit twice, or weights not summing to 1", bad_other);
+    CHECK(bad_wind == 0, "raster: %d pixels differ between the two windings", bad_wind);
+    {
+        /* degenerate and NULL inputs draw nothing and do not crash */
+        float flat[6] = {1, 1, 5, 5, 9, 9}, nan_t[6] = {1, 1, 5, 1, 1, 5};
+        static raster_rec rr;
+        memset(&rr, 0, sizeof rr);
+        tt_raster_triangle(flat, RW, RH, raster_cb, &rr);
+        nan_t[3] = (float)NAN;
+        tt_raster_triangle(nan_t, RW, RH, raster_cb, &rr);
+        tt_raster_triangle(NULL, RW, RH, raster_cb, &rr);
+        tt_raster_triangle(flat, 0, RH, raster_cb, &rr);
+        {
+            int x, y, n = 0;
+            for (y = 0; y < RH; y++) for (x = 0; x < RW; x++) n += rr.hits[y][x];
+            CHECK(n == 0, "degenerate / NaN triangles should draw nothing, drew %d", n);
+        }
+    }
+}
+
+/* Rasterise a set of triangles; every pixel whose centre is inside the union
+   (by `inside`) must be hit exactly once, no pixel twice. */
+static void raster_cover(const float *tris, int ntris, int (*inside)(double, double, const void *), const void *ctx,
+                         const char *what)
+{
+    static raster_rec rec;
+    int i, x, y, twice = 0, gaps = 0, extra = 0;
+    memset(&rec, 0, sizeof rec);
+    for (i = 0; i < ntris; i++) tt_raster_triangle(tris + 6 * i, RW, RH, raster_cb, &rec);
+    for (y = 0; y < RH; y++)
+        for (x = 0; x < RW; x++) {
+            int in = inside(x + 0.5, y + 0.5, ctx);
+            if (rec.hits[y][x] > 1) twice++;
+            if (in == 1 && rec.hits[y][x] == 0) gaps++;
+            if (in == 0 && rec.hits[y][x] != 0) extra++;
+        }
+    CHECK(twice == 0 && gaps == 0 && extra == 0 && rec.out_of_grid == 0,
+          "%s: %d pixels hit twice, %d gaps, %d outside hits, %d off-grid", what, twice, gaps, extra, rec.out_of_grid);
+}
+
+static int inside_everything(double x, double y, const void *ctx) { (void)x; (void)y; (void)ctx; return 1; }
+
+typedef struct poly_ctx {
+    const float *pts;
+    int n;
+} poly_ctx;
+
+/* 1 inside the convex polygon, 0 outside, 2 within 1e-3 of its boundary. */
+static int inside_convex(double x, double y, const void *ctx)
+{
+    const poly_ctx *p = (const poly_ctx *)ctx;
+    int i;
+    double best = 1e300;
+    for (i = 0; i < p->n; i++) {
+        double ax = p->pts[2 * i], ay = p->pts[2 * i + 1];
+        double bx = p->pts[2 * ((i + 1) % p->n)], by = p->pts[2 * ((i + 1) % p->n) + 1];
+        double len = sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay));
+        double e = ((bx - ax) * (y - ay) - (by - ay) * (x - ax)) / len;
+        if (e < best) best = e;
+    }
+    if (fabs(best) < 1e-3) return 2;
+    return best > 0 ? 1 : 0;
+}
+
+static void test_raster_cover(void)
+{
+    static float tris[6 * 4096];
+    int n, i, j, k, variant;
+    const double pi = 3.14159265358979323846;
+    /* fans around a point: centre at a pixel centre, at a pixel corner, and
+       at an arbitrary place; rim points at pixel centres / corners / anywhere */
+    for (variant = 0; variant < 6; variant++) {
+        float pts[2 * 64];
+        int npts = variant < 3 ? 12 : 7;
+        double cx = variant % 3 == 0 ? 20.5 : variant % 3 == 1 ? 20.0 : 20.3137, cy = variant % 3 == 0 ? 17.5
+                                                                                   : variant % 3 == 1 ? 18.0 : 16.871;
+        poly_ctx pc;
+        char what[96];
+        for (i = 0; i < npts; i++) {
+            double a = 2 * pi * i / npts + 0.01 * variant, rx = cx + 14 * cos(a), ry = cy + 14 * sin(a);
+            if (variant % 3 == 0) { rx = floor(rx) + 0.5; ry = floor(ry) + 0.5; }
+            if (variant % 3 == 1) { rx = floor(rx + 0.5); ry = floor(ry + 0.5); }
+            pts[2 * i] = (float)rx;
+            pts[2 * i + 1] = (float)ry;
+        }
+        /* pts go counter-clockwise in a y-up frame = clockwise on screen; the
+           convex test needs consistent winding: reverse when negative. */
+        {
+            double area = 0;
+            for (i = 0; i < npts; i++)
+                area += pts[2 * i] * pts[2 * ((i + 1) % npts) + 1] - pts[2 * ((i + 1) % npts)] * pts[2 * i + 1];
+            if (area < 0)
+                for (i = 0; i < npts / 2; i++)
+                    for (k = 0; k < 2; k++) {
+                        float t = pts[2 * i + k];
+                        pts[2 * i + k] = pts[2 * (npts - 1 - i) + k];
+                        pts[2 * (npts - 1 - i) + k] = t;
+                    }
+        }
+        n = 0;
+        for (i = 0; i < npts; i++) {
+            float *t = tris + 6 * n++;
+            t[0] = (float)cx; t[1] = (float)cy;
+            /* alternate windings inside the fan */
+            if (i % 2) { t[2] = pts[2 * i]; t[3] = pts[2 * i + 1]; t[4] = pts[2 * ((i + 1) % npts)]; t[5] = pts[2 * ((i + 1) % npts) + 1]; }
+            else { t[4] = pts[2 * i]; t[5] = pts[2 * i + 1]; t[2] = pts[2 * ((i + 1) % npts)]; t[3] = pts[2 * ((i + 1) % npts) + 1]; }
+        }
+        pc.pts = pts;
+        pc.n = npts;
+        sprintf(what, "fan variant %d (centre %.4g,%.4g)", variant, cx, cy);
+        raster_cover(tris, n, inside_convex, &pc, what);
+    }
+    /* grids of quads split in two, covering [0,RW] x [0,RH] exactly: lines at
+       pixel corners (spacing 4), at pixel centres (spacing 3, offset .5),
+       at half pixels (spacing 2.5), and jittered interior vertices */
+    for (variant = 0; variant < 8; variant++) {
+        float gx[64], gy[64];
+        int nx, ny, diag = variant & 1;
+        int kind = variant / 2;
+        char what[96];
+        lcg_seed(100 + variant);
+        if (kind == 0) { nx = RW / 4; ny = RH / 4; for (i = 0; i <= nx; i++) gx[i] = 4.0f * i; for (j = 0; j <= ny; j++) gy[j] = 4.0f * j; }
+        else if (kind == 1) {
+            nx = 0; gx[nx++] = 0; for (i = 0; 0.5 + 3 * i < RW; i++) gx[nx++] = 0.5f + 3.0f * i; gx[nx] = RW;
+            ny = 0; gy[ny++] = 0; for (j = 0; 0.5 + 3 * j < RH; j++) gy[ny++] = 0.5f + 3.0f * j; gy[ny] = RH;
+        } else if (kind == 2) {
+            nx = 0; for (i = 0; 2.5 * i < RW; i++) gx[nx++] = 2.5f * i; gx[nx] = RW;
+            ny = 0; for (j = 0; 2.5 * j < RH; j++) gy[ny++] = 2.5f * j; gy[ny] = RH;
+        } else { nx = 9; ny = 7; for (i = 0; i <= nx; i++) gx[i] = (float)RW * i / nx; for (j = 0; j <= ny; j++) gy[j] = (float)RH * j / ny; }
+        n = 0;
+        {
+            /* vertex positions, jittered inside for kind 3 */
+            static float vx[64][64], vy[64][64];
+            for (j = 0; j <= ny; j++)
+                for (i = 0; i <= nx; i++) {
+                    vx[j][i] = gx[i];
+                    vy[j][i] = gy[j];
+                    if (kind == 3 && i > 0 && i < nx && j > 0 && j < ny) {
+                        vx[j][i] += (float)((lcg_unit() - 0.5) * 2.0);
+                        vy[j][i] += (float)((lcg_unit() - 0.5) * 2.0);
+                    }
+                }
+            for (j = 0; j < ny; j++)
+                for (i = 0; i < nx; i++) {
+                    float a[2], b[2], c[2], d[2], *t;
+                    a[0] = vx[j][i]; a[1] = vy[j][i];
+                    b[0] = vx[j][i + 1]; b[1] = vy[j][i + 1];
+                    c[0] = vx[j + 1][i + 1]; c[1] = vy[j + 1][i + 1];
+                    d[0] = vx[j + 1][i]; d[1] = vy[j + 1][i];
+                    t = tris + 6 * n++;
+                    if (!diag) { t[0] = a[0]; t[1] = a[1]; t[2] = b[0]; t[3] = b[1]; t[4] = c[0]; t[5] = c[1]; }
+                    else { t[0] = a[0]; t[1] = a[1]; t[2] = b[0]; t[3] = b[1]; t[4] = d[0]; t[5] = d[1]; }
+                    t = tris + 6 * n++;
+                    if (!diag) { t[0] = a[0]; t[1] = a[1]; t[2] = d[0]; t[3] = d[1]; t[4] = c[0]; t[5] = c[1]; }
+                    else { t[0] = b[0]; t[1] = b[1]; t[2] = d[0]; t[3] = d[1]; t[4] = c[0]; t[5] = c[1]; }
+                }
+        }
+        sprintf(what, "grid kind %d diagonal %d (%dx%d quads)", kind, diag, nx, ny);
+        raster_cover(tris, n, inside_everything, NULL, what);
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* 6. Tiled textures: layout, boundaries, UVs                               */
+/* ------------------------------------------------------------------------ */
+
+static tt_tile_layout make_layout(int colors, int size, int gutter)
+{
+    tt_tile_layout l;
+    l.colors = colors;
+    l.tile_size = size;
+    l.gutter = gutter;
+    return l;
+}
+
+static void test_layout(void)
+{
+    tt_tile_layout in, out;
+    tt_error err;
+    tt_result r;
+    in = make_layout(0, 0, 0);
+    r = tt_tile_layout_resolve(&in, &out, &err);
+    CHECK(r == TT_OK && out.colors == 1 && out.tile_size == TT_DEFAULT_TILE_SIZE && out.gutter == 0,
+          "zeros resolve to defaults: got %d colors, %d size, %d gutter (result %d)", out.colors, out.tile_size,
+          out.gutter, r);
+    CHECK(tt_tile_layout_tiles_per_side(&out) == 4 && tt_tile_layout_tile_count(&out) == 16 &&
+              tt_tile_layout_atlas_size(&out) == 4 * 128,
+          "default layout: T %d, count %d, W %d", tt_tile_layout_tiles_per_side(&out), tt_tile_layout_tile_count(&out),
+          tt_tile_layout_atlas_size(&out));
+    /* Resolving is idempotent: a resolved layout passed back in stays as it is
+       (a gutter of 0 means none, never "the default"). */
+    {
+        tt_tile_layout again;
+        in = make_layout(2, 32, TT_RECOMMENDED_GUTTER);
+        r = tt_tile_layout_resolve(&in, &out, &err);
+        CHECK(r == TT_OK && tt_tile_layout_resolve(&out, &again, &err) == TT_OK && again.colors == out.colors &&
+                  again.tile_size == out.tile_size && again.gutter == out.gutter,
+              "resolve(resolve(L)) == resolve(L): got %d/%d/%d vs %d/%d/%d", again.colors, again.tile_size,
+              again.gutter, out.colors, out.tile_size, out.gutter);
+        in = make_layout(1, 32, 0);
+        r = tt_tile_layout_resolve(&in, &out, &err);
+        CHECK(r == TT_OK && tt_tile_layout_resolve(&out, &again, &err) == TT_OK && again.gutter == 0,
+              "no gutter stays no gutter: %d", again.gutter);
+    }
+    in = make_layout(2, 32, TT_NO_GUTTER);
+    r = tt_tile_layout_resolve(&in, &out, &err);
+    CHECK(r == TT_OK && out.gutter == 0 && tt_tile_layout_tiles_per_side(&out) == 16 &&
+              tt_tile_layout_atlas_size(&out) == 512 && tt_tile_layout_tile_count(&out) == 256,
+          "n=2, S=32, no gutter: gutter %d, T %d, W %d", out.gutter, tt_tile_layout_tiles_per_side(&out),
+          tt_tile_layout_atlas_size(&out));
+    in = make_layout(-1, 32, 4);
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_INVALID_ARGUMENT && err.message[0],
+          "colors -1 rejected with a message");
+    in = make_layout(TT_MAX_COLORS + 1, 32, 4);
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "colors TT_MAX_COLORS+1 rejected");
+    in = make_layout(TT_MAX_COLORS, 4, TT_NO_GUTTER);
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_TOO_LARGE, "TT_MAX_COLORS colors: atlas too large");
+    in = make_layout(1, 3, 4);
+    r = tt_tile_layout_resolve(&in, &out, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "tile size 3 (below the minimum 4) should be TT_ERROR_INVALID_ARGUMENT "
+          "(%d), got %d (%s)", TT_ERROR_INVALID_ARGUMENT, r, err.message);
+    in = make_layout(1, -5, 4);
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "tile size -5 rejected");
+    in = make_layout(1, 40000, 4);
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_TOO_LARGE, "tile size 40000: TT_ERROR_TOO_LARGE");
+    in = make_layout(2, 2048, 4);   /* 16 * 2056 = 32896 > 32768 */
+    r = tt_tile_layout_resolve(&in, &out, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE, "n=2, S=2048: atlas 32896 > TT_MAX_IMAGE_SIZE: expected %d, got %d",
+          TT_ERROR_TOO_LARGE, r);
+    in = make_layout(2, 2040, 4);   /* 16 * 2048 = 32768: allowed */
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_OK, "n=2, S=2040, g=4: atlas exactly TT_MAX_IMAGE_SIZE");
+    in = make_layout(1, 32, 33);
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "gutter > tile size rejected");
+    in = make_layout(1, 32, -2);
+    CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "gutter -2 rejected");
+    CHECK(tt_tile_layout_resolve(NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL layout rejected");
+}
+
+static void test_tile_uv_index(void)
+{
+    /* Hand-computed for n = 1, S = 32: no gutter (C = 32, W = 128) and gutter
+       4 (C = 40, W = 160). {e0,e1,e2,e3, corner, u*W, v*W} */
+    static const int table_g0[][7] = {
+        {0, 0, 0, 0, 0, 0, 0},    {0, 0, 0, 0, 1, 32, 0},   {0, 0, 0, 0, 2, 32, 32},  {0, 0, 0, 0, 3, 0, 32},
+        {1, 0, 1, 1, 0, 64, 96},  {1, 0, 1, 1, 1, 96, 96},  {1, 0, 1, 1, 2, 96, 128}, {1, 0, 1, 1, 3, 64, 128},
+        {0, 1, 1, 0, 0, 32, 64},  {0, 1, 1, 0, 2, 64, 96},  {1, 1, 1, 1, 2, 128, 128}, {1, 1, 0, 1, 3, 96, 64}};
+    static const int table_g4[][7] = {
+        {0, 0, 0, 0, 0, 4, 4},    {0, 0, 0, 0, 1, 36, 4},   {0, 0, 0, 0, 2, 36, 36},  {0, 0, 0, 0, 3, 4, 36},
+        {1, 0, 1, 1, 0, 84, 124}, {1, 0, 1, 1, 1, 116, 124}, {1, 0, 1, 1, 2, 116, 156}, {1, 0, 1, 1, 3, 84, 156},
+        {0, 1, 1, 0, 0, 44, 84},  {0, 1, 1, 0, 2, 76, 116}, {1, 1, 1, 1, 2, 156, 156}, {1, 1, 0, 1, 3, 124, 76}};
+    int g, i, n;
+    for (g = 0; g < 2; g++) {
+        tt_tile_layout in = make_layout(1, 32, g ? 4 : TT_NO_GUTTER), l;
+        const int(*table)[7] = g ? table_g4 : table_g0;
+        double W = g ? 160.0 : 128.0;
+        int bad = 0;
+        tt_tile_layout_resolve(&in, &l, NULL);
+        for (i = 0; i < 12; i++) {
+            uint8_t t[4];
+            float uv[2];
+            t[0] = (uint8_t)table[i][0]; t[1] = (uint8_t)table[i][1]; t[2] = (uint8_t)table[i][2]; t[3] = (uint8_t)table[i][3];
+            tt_tile_corner_uv(&l, t, table[i][4], uv);
+            if (uv[0] != (float)(table[i][5] / W) || uv[1] != (float)(table[i][6] / W)) {
+                if (!bad)
+                    DETAIL("corner uv (gutter %d) types %d%d%d%d corner %d: expected (%g,%g), got (%g,%g)", l.gutter,
+                          t[0], t[1], t[2], t[3], table[i][4], table[i][5] / W, table[i][6] / W, uv[0] * W, uv[1] * W);
+                bad++;
+            }
+        }
+        CHECK(bad == 0, "tt_tile_corner_uv (gutter %d): %d entries differ from the hand table", l.gutter, bad);
+        /* The same layout as the user writes it (TT_NO_GUTTER, not resolved):
+           tt_assign_uvs resolves it, so tt_tile_corner_uv should agree. */
+        bad = 0;
+        for (i = 0; i < 12; i++) {
+            uint8_t t[4];
+            float uv[2];
+            t[0] = (uint8_t)table[i][0]; t[1] = (uint8_t)table[i][1]; t[2] = (uint8_t)table[i][2]; t[3] = (uint8_t)table[i][3];
+            tt_tile_corner_uv(&in, t, table[i][4], uv);
+            if (uv[0] != (float)(table[i][5] / W) || uv[1] != (float)(table[i][6] / W)) {
+                if (!bad)
+                    DETAIL("corner uv, unresolved layout {1, 32, %d}: types %d%d%d%d corner %d: expected (%g,%g)/W, "
+                          "got (%g,%g)/W", in.gutter, t[0], t[1], t[2], t[3], table[i][4], (double)table[i][5],
+                          (double)table[i][6], uv[0] * W, uv[1] * W);
+                bad++;
+            }
+        }
+        CHECK(bad == 0, "tt_tile_corner_uv with the unresolved layout (gutter %d): %d entries differ", in.gutter, bad);
+    }
+    {
+        /* tt_tile_index with colors 0 (= 1 everywhere else) */
+        tt_tile_layout in = make_layout(0, 0, 0);
+        uint8_t t[4] = {1, 0, 1, 1};
+        CHECK(tt_tile_index(&in, t) == 3 * 4 + 2, "tt_tile_index with colors 0 (= 1): types 1011: expected 14, got %d",
+              tt_tile_index(&in, t));
+    }
+    {
+        static const tt_result codes[] = {TT_OK, TT_CANCELLED, TT_ERROR_INVALID_ARGUMENT, TT_ERROR_OUT_OF_MEMORY,
+                                          TT_ERROR_TOO_LARGE, TT_ERROR_EMPTY_MESH, TT_ERROR_INDEX_OUT_OF_RANGE,
+                                          TT_ERROR_FACE_TOO_SMALL, TT_ERROR_REPEATED_VERTEX, TT_ERROR_NON_FINITE,
+                                          TT_ERROR_ZERO_AREA_FACE, TT_ERROR_NON_MANIFOLD_EDGE,
+                                          TT_ERROR_INCONSISTENT_ORIENTATION, TT_ERROR_NON_MANIFOLD_VERTEX,
+                                          TT_ERROR_NOT_QUAD_MESH, TT_ERROR_IMAGE_TOO_SMALL};
+        int a, b, bad = 0, n = (int)(sizeof codes / sizeof codes[0]);
+        const char *unknown = tt_result_string((tt_result)-99);
+        for (a = 0; a < n; a++) {
+            const char *sa = tt_result_string(codes[a]);
+            if (!sa || !sa[0] || strcmp(sa, unknown) == 0) bad++;
+            for (b = 0; b < a; b++) if (strcmp(sa, tt_result_string(codes[b])) == 0) bad++;
+        }
+        CHECK(bad == 0 && unknown && unknown[0], "tt_result_string: %d codes without a distinct sentence", bad);
+    }
+    /* the formula, n = 1..3, all type combinations; tile index bijective */
+    for (n = 1; n <= 3; n++) {
+        int gi;
+        for (gi = 0; gi < 2; gi++) {
+            tt_tile_layout in = make_layout(n, 16, gi ? 3 : TT_NO_GUTTER), l;
+            int base = 2 * n, T = base * base, S = 16, gg, C, bad_uv = 0, bad_idx = 0, e0, e1, e2, e3, k;
+            double W;
+            char *seen = (char *)calloc((size_t)T * T, 1);
+            tt_tile_layout_resolve(&in, &l, NULL);
+            gg = l.gutter;
+            C = S + 2 * gg;
+            W = (double)T * C;
+            for (e0 = 0; e0 < base; e0++)
+                for (e1 = 0; e1 < base; e1++)
+                    for (e2 = 0; e2 < base; e2++)
+                        for (e3 = 0; e3 < base; e3++) {
+                            uint8_t t[4];
+                            int col = base * e0 + e1, row = base * e2 + e3, idx;
+                            t[0] = (uint8_t)e0; t[1] = (uint8_t)e1; t[2] = (uint8_t)e2; t[3] = (uint8_t)e3;
+                            idx = tt_tile_index(&l, t);
+                            if (idx != row * T + col || idx < 0 || idx >= T * T || seen[idx]) bad_idx++;
+                            else seen[idx] = 1;
+                            for (k = 0; k < 4; k++) {
+                                float uv[2];
+                                int j = ((k + 1) % 4) / 2;
+                                double u = (col * C + gg + j * S) / W, v = (row * C + gg + (k / 2) * S) / W;
+                                tt_tile_corner_uv(&l, t, k, uv);
+                                if (!near(uv[0], u, 1e-7) || !near(uv[1], v, 1e-7)) bad_uv++;
+                            }
+                        }
+            CHECK(bad_idx == 0, "tt_tile_index n=%d: %d wrong or repeated indices", n, bad_idx);
+            CHECK(bad_uv == 0, "tt_tile_corner_uv n=%d gutter %d: %d corners differ from the formula", n, gg, bad_uv);
+            free(seen);
+        }
+    }
+}
+
+static void check_boundaries(const tt_mesh *mesh, int n, const char *name)
+{
+    uint8_t *a = (uint8_t *)malloc((size_t)mesh->ncorners), *b = (uint8_t *)malloc((size_t)mesh->ncorners);
+    tt_tile_layout l = make_layout(n, 32, 4);
+    int c, bad_pair = 0, bad_range = 0, differ = 0, *used = (int *)calloc((size_t)2 * n, sizeof(int));
+    tt_result r;
+    memset(a, 0xee, (size_t)mesh->ncorners);
+    r = tt_assign_boundaries(mesh, &l, 1234, a);
+    CHECK(r == TT_OK, "%s n=%d: assign_boundaries returned %d", name, n, r);
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c];
+        if (a[c] >= 2 * n) { bad_range++; continue; }
+        used[a[c]]++;
+        if (t >= 0 && (a[t] != (a[c] ^ 1))) bad_pair++;
+    }
+    CHECK(bad_range == 0, "%s n=%d: %d types outside 0..2n-1", name, n, bad_range);
+    CHECK(bad_pair == 0, "%s n=%d: %d twin pairs whose types are not t and t^1", name, n, bad_pair);
+    if (mesh->ncorners >= 200 * n) {
+        int k, unused = 0;
+        for (k = 0; k < 2 * n; k++) unused += used[k] == 0;
+        CHECK(unused == 0, "%s n=%d: %d of %d types never used", name, n, unused, 2 * n);
+    }
+    tt_assign_boundaries(mesh, &l, 1234, b);
+    CHECK(memcmp(a, b, (size_t)mesh->ncorners) == 0, "%s n=%d: same seed should give the same types", name, n);
+    tt_assign_boundaries(mesh, &l, 1235, b);
+    for (c = 0; c < mesh->ncorners; c++) differ += a[c] != b[c];
+    CHECK(differ > 0, "%s n=%d: seeds 1234 and 1235 gave identical types", name, n);
+    free(a);
+    free(b);
+    free(used);
+}
+
+static void test_boundaries_uvs(void)
+{
+    tmesh m;
+    tt_mesh *torus = NULL, *grid = NULL, *tet = NULL, *mixed = NULL;
+    tt_error err;
+    int n;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 24, 16, 3, 1);
+    CHECK(build(&m, 0, &torus, &err) == TT_OK, "torus build");
+    tm_free(&m);
+    make_grid(&m, 6, 5);
+    CHECK(build(&m, 0, &grid, &err) == TT_OK, "grid build");
+    tm_free(&m);
+    make_tetra(&m, 0);
+    CHECK(build(&m, 0, &tet, &err) == TT_OK, "tetra build");
+    tm_free(&m);
+    make_grid(&m, 3, 2);
+    tm_tri(&m, 1, 0, tm_vert(&m, 0.5, -1, 0));   /* face 6 is a triangle */
+    CHECK(build(&m, 0, &mixed, &err) == TT_OK, "grid+triangle build");
+    tm_free(&m);
+    if (!torus || !grid || !tet || !mixed) return;
+
+    for (n = 1; n <= 4; n++) {
+        check_boundaries(torus, n, "torus");
+        check_boundaries(grid, n, "open grid");
+        check_boundaries(tet, n, "tetrahedron");
+    }
+    {
+        uint8_t types[64];
+        tt_tile_layout l = make_layout(0, 0, 0);
+        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_OK, "colors 0 (= 1) accepted");
+        CHECK(tt_assign_boundaries(tet, NULL, 1, types) == TT_OK, "layout NULL (= 1 color) accepted");
+        l.colors = -1;
+        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_ERROR_INVALID_ARGUMENT, "colors -1 rejected");
+        l.colors = TT_MAX_COLORS + 1;
+        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_ERROR_INVALID_ARGUMENT, "colors TT_MAX_COLORS+1 rejected");
+        l.colors = TT_MAX_COLORS;
+        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_OK, "colors TT_MAX_COLORS accepted by assign_boundaries");
+        CHECK(tt_assign_boundaries(NULL, &l, 1, types) == TT_ERROR_INVALID_ARGUMENT, "mesh NULL rejected");
+        CHECK(tt_assign_boundaries(tet, &l, 1, NULL) == TT_ERROR_INVALID_ARGUMENT, "types NULL rejected");
+    }
+
+    /* assign_uvs: not quads */
+    {
+        uint8_t types[64];
+        float uv[128];
+        tt_tile_layout l = make_layout(1, 32, 4);
+        tt_result r;
+        tt_assign_boundaries(tet, &l, 1, types);
+        r = tt_assign_uvs(tet, &l, types, uv, &err);
+        CHECK(r == TT_ERROR_NOT_QUAD_MESH && err.face == 0 && msg_has_number(err.message, 0),
+              "tetrahedron: expected TT_ERROR_NOT_QUAD_MESH naming face 0, got %d face %d \"%s\"", r, err.face,
+              err.message);
+        tt_assign_boundaries(mixed, &l, 1, types);
+        r = tt_assign_uvs(mixed, &l, types, uv, &err);
+        CHECK(r == TT_ERROR_NOT_QUAD_MESH && err.face == 6 && err.corner == 24 && msg_has_number(err.message, 6),
+              "grid + triangle: expected TT_ERROR_NOT_QUAD_MESH naming face 6 (corner 24), got %d face %d corner %d \"%s\"",
+              r, err.face, err.corner, err.message);
+        {
+            int counts[16];
+            CHECK(tt_tile_histogram(mixed, &l, types, counts) == TT_ERROR_NOT_QUAD_MESH,
+                  "tile histogram on a mesh with a triangle: TT_ERROR_NOT_QUAD_MESH");
+        }
+        CHECK(tt_assign_uvs(NULL, &l, types, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "assign_uvs mesh NULL");
+        CHECK(tt_assign_uvs(grid, NULL, types, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "assign_uvs layout NULL");
+        CHECK(tt_assign_uvs(grid, &l, NULL, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "assign_uvs types NULL");
+        CHECK(tt_assign_uvs(grid, &l, types, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "assign_uvs uv NULL");
+    }
+    /* assign_uvs output = tt_tile_corner_uv per corner, n = 1..3, gutter or not */
+    for (n = 1; n <= 3; n++) {
+        int gi;
+        for (gi = 0; gi < 2; gi++) {
+            tt_tile_layout l = make_layout(n, 16, gi ? 2 : TT_NO_GUTTER), res;
+            uint8_t *types = (uint8_t *)malloc((size_t)torus->ncorners);
+            float *uv = (float *)malloc(sizeof(float) * 2 * (size_t)torus->ncorners);
+            int f, i, bad = 0;
+            tt_result r;
+            tt_tile_layout_resolve(&l, &res, NULL);
+            tt_assign_boundaries(torus, &l, 77 + (uint64_t)n, types);
+            r = tt_assign_uvs(torus, &l, types, uv, &err);
+            CHECK(r == TT_OK, "assign_uvs n=%d: %d (%s)", n, r, err.message);
+            for (f = 0; f < torus->nfaces && r == TT_OK; f++)
+                for (i = 0; i < 4; i++) {
+                    float e[2];
+                    tt_tile_corner_uv(&res, types + 4 * f, i, e);
+                    if (uv[8 * f + 2 * i] != e[0] || uv[8 * f + 2 * i + 1] != e[1]) bad++;
+                }
+            CHECK(bad == 0, "assign_uvs n=%d gutter %d: %d corners differ from tt_tile_corner_uv", n, res.gutter, bad);
+            /* a type out of range is rejected and named */
+            types[13] = (uint8_t)(2 * n);
+            r = tt_assign_uvs(torus, &l, types, uv, &err);
+            CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.corner == 13 && err.face == 3,
+                  "type %d at corner 13 (n=%d): expected TT_ERROR_INVALID_ARGUMENT at corner 13 face 3, got %d %d %d",
+                  2 * n, n, r, err.corner, err.face);
+            free(types);
+            free(uv);
+        }
+    }
+    tt_mesh_free(torus);
+    tt_mesh_free(grid);
+    tt_mesh_free(tet);
+    tt_mesh_free(mixed);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 6b. Tile-set synthesis                                                   */
+/* ------------------------------------------------------------------------ */
+
+/* Random-noise RGB source, opaque. */
+static void make_noise(tt_image *im, int w, int h, unsigned seed)
+{
+    int i;
+    tt_image_create(im, w, h, NULL);
+    lcg_seed(seed);
+    for (i = 0; i < w * h; i++) {
+        im->pixels[4 * i] = (float)lcg_unit();
+        im->pixels[4 * i + 1] = (float)lcg_unit();
+        im->pixels[4 * i + 2] = (float)lcg_unit();
+        im->pixels[4 * i + 3] = 1.0f;
+    }
+}
+
+/* Smooth waves plus a little noise: a texture with structure at every scale. */
+static void make_procedural(tt_image *im, int w, int h, unsigned seed)
+{
+    int x, y, k;
+    tt_image_create(im, w, h, NULL);
+    lcg_seed(seed);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = px(im, x, y);
+            double a = sin(x * 0.11 + 0.7 * sin(y * 0.05)) * 0.25 + sin(y * 0.13 + x * 0.03) * 0.2;
+            for (k = 0; k < 3; k++) p[k] = (float)(0.5 + a * (1.0 - 0.3 * k) + (lcg_unit() - 0.5) * 0.08 + 0.05 * k);
+            p[3] = 1.0f;
+        }
+}
+
+typedef struct synth_view {
+    const tt_tileset *set;
+    const tt_image *src;
+    int n, S, g, C, T;
+} synth_view;
+
+/* Atlas texel of tile t at tile coordinates (tx, ty) (may reach into the gutter). */
+static const float *tile_texel(const synth_view *v, int t, int tx, int ty)
+{
+    int col = t % v->T, row = t / v->T;
+    return px(&v->set->levels[0], col * v->C + v->g + tx, (v->T - 1 - row) * v->C + v->g + ty);
+}
+
+/* Side frame (x, d) of side `side` -> tile texel. */
+static const float *side_texel(const synth_view *v, int t, int side, int x, int d)
+{
+    int tx, ty;
+    tt_rotate_coords(side, v->S, v->S, x, v->S - 1 - d, &tx, &ty);
+    return tile_texel(v, t, tx, ty);
+}
+
+/* The edge sample of type `type` at side frame (x, d), from the source. */
+static const float *edge_sample(const synth_view *v, int type, int x, int d)
+{
+    const tt_rect *w = &v->set->edge_windows[type >> 1];
+    if ((type & 1) == 0) return px(v->src, w->x + x, w->y + v->S - 1 - d);
+    return px(v->src, w->x + v->S - 1 - x, w->y + v->S + d);
+}
+
+static int rgb_equal(const float *a, const float *b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+
+static void tile_types(const synth_view *v, int t, int types[4])
+{
+    int base = 2 * v->n, col = t % v->T, row = t / v->T;
+    types[0] = col / base;
+    types[1] = col % base;
+    types[2] = row / base;
+    types[3] = row % base;
+}
+
+static void check_tileset(const tt_tileset *set, const tt_image *src, int feather, const char *name)
+{
+    synth_view v;
+    int t, side, x, d, k, bad_edge = 0, bad_gutter = 0, bad_cont = 0, bad_alpha = 0, bad_bg = 0,
+        bad_win = 0, ncont = 0, L;
+    v.set = set;
+    v.src = src;
+    v.n = set->layout.colors;
+    v.S = set->layout.tile_size;
+    v.g = set->layout.gutter;
+    v.C = v.S + 2 * v.g;
+    v.T = 4 * v.n * v.n;
+    CHECK(set->levels[0].width == v.T * v.C && set->levels[0].height == v.T * v.C, "%s: atlas %dx%d, expected %d",
+          name, set->levels[0].width, set->levels[0].height, v.T * v.C);
+    if (set->levels[0].width != v.T * v.C) return;
+    for (k = 0; k < v.n; k++) {
+        const tt_rect *w = &set->edge_windows[k];
+        if (w->w != v.S || w->h != 2 * v.S || w->x < 0 || w->y < 0 || w->x + v.S > src->width ||
+            w->y + 2 * v.S > src->height)
+            bad_win++;
+    }
+    CHECK(bad_win == 0, "%s: %d edge windows not S x 2S inside the source", name, bad_win);
+    if (bad_win) return;
+    lcg_seed(31337);
+    for (t = 0; t < v.T * v.T; t++) {
+        int types[4];
+        const tt_rect *bg = &set->background_windows[t];
+        tile_types(&v, t, types);
+        /* every atlas texel of the cell is opaque */
+        for (d = -v.g; d < v.S + v.g; d++)
+            for (x = -v.g; x < v.S + v.g; x++) bad_alpha += tile_texel(&v, t, x, d)[3] != 1.0f;
+        for (side = 0; side < 4; side++) {
+            int tb, sb, typesb[4];
+            /* the edge row: all texels but the two corners are the sample */
+            for (x = 1; x < v.S - 1; x++)
+                if (!rgb_equal(side_texel(&v, t, side, x, 0), edge_sample(&v, types[side], x, 0))) bad_edge++;
+            /* the gutter rows continue it across the edge */
+            for (d = -v.g; d < 0; d++)
+                for (x = 0; x < v.S; x++)
+                    if (!rgb_equal(side_texel(&v, t, side, x, d), edge_sample(&v, types[side], x, d))) bad_gutter++;
+            /* a tile with the complementary type on some side: A's gutter at
+               d = -1-k is B's row k, with x' = S-1-x, wherever B's row is
+               the sample alone (row 0 but its corners; deeper rows away from
+               the corners by more than the feather) */
+            do {
+                tb = lcg_below(v.T * v.T);
+                sb = lcg_below(4);
+                tile_types(&v, tb, typesb);
+            } while (typesb[sb] != (types[side] ^ 1));
+            for (k = 0; k < (v.g > 0 ? v.g : 1); k++)
+                for (x = 0; x < v.S; x++) {
+                    int xb = v.S - 1 - x, wedge = xb < v.S - 1 - xb ? xb : v.S - 1 - xb;
+                    const float *a, *b;
+                    if (k == 0 ? (xb == 0 || xb == v.S - 1) : wedge < k + feather) continue;
+                    a = v.g > 0 ? side_texel(&v, t, side, x, -1 - k) : edge_sample(&v, types[side], x, -1 - k);
+                    b = side_texel(&v, tb, sb, xb, k);
+                    ncont++;
+                    if (!rgb_equal(a, b)) bad_cont++;
+                }
+        }
+        /* the middle of the tile is its background window */
+        if (bg->w != v.S || bg->h != v.S || bg->x < 0 || bg->y < 0 || bg->x + v.S > src->width ||
+            bg->y + v.S > src->height)
+            bad_bg++;
+        else if (!rgb_equal(tile_texel(&v, t, v.S / 2, v.S / 2), px(src, bg->x + v.S / 2, bg->y + v.S / 2)))
+            bad_bg++;
+    }
+    CHECK(bad_edge == 0, "%s: %d edge-row texels differ from the edge sample", name, bad_edge);
+    CHECK(bad_gutter == 0, "%s: %d gutter texels do not continue the edge sample", name, bad_gutter);
+    CHECK(bad_cont == 0 && ncont > 0, "%s: %d of %d texels discontinuous across complementary edges", name, bad_cont,
+          ncont);
+    CHECK(bad_alpha == 0, "%s: %d atlas texels not opaque", name, bad_alpha);
+    CHECK(bad_bg == 0, "%s: %d tiles whose centre is not their background window", name, bad_bg);
+
+    /* mip levels: count, seamless count, each the box-downsample of the last */
+    {
+        int expect_levels = 1, expect_seamless = 0, bad_mip = 0;
+        while (expect_levels < TT_MAX_MIP_LEVELS && (v.C >> (expect_levels - 1)) % 2 == 0) expect_levels++;
+        while (expect_seamless < expect_levels && (v.g >> expect_seamless) >= 1) expect_seamless++;
+        CHECK(set->nlevels == expect_levels, "%s: nlevels expected %d (cell %d), got %d", name, expect_levels, v.C,
+              set->nlevels);
+        CHECK(set->seamless_levels == expect_seamless, "%s: seamless_levels expected %d (gutter %d), got %d", name,
+              expect_seamless, v.g, set->seamless_levels);
+        for (L = 1; L < set->nlevels; L++) {
+            const tt_image *a = &set->levels[L - 1], *b = &set->levels[L];
+            int y;
+            if (b->width * 2 != a->width || b->height * 2 != a->height) { bad_mip++; continue; }
+            for (y = 0; y < b->height; y++)
+                for (x = 0; x < b->width; x++)
+                    for (k = 0; k < 4; k++) {
+                        double e = (px(a, 2 * x, 2 * y)[k] + px(a, 2 * x + 1, 2 * y)[k] + px(a, 2 * x, 2 * y + 1)[k] +
+                                    px(a, 2 * x + 1, 2 * y + 1)[k]) / 4.0;
+                        if (!near(px(b, x, y)[k], e, 1e-6)) bad_mip++;
+                    }
+        }
+        CHECK(bad_mip == 0, "%s: %d mip texels differ from the box-downsample of the previous level", name, bad_mip);
+    }
+}
+
+static void test_synthesis(void)
+{
+    tt_image src;
+    int n, gi;
+    make_noise(&src, 96, 192, 42);
+    for (n = 1; n <= 2; n++)
+        for (gi = 0; gi < 2; gi++) {
+            tt_synth_options opt;
+            tt_tileset *set = NULL, *again = NULL, *other = NULL;
+            tt_error err;
+            tt_result r;
+            counter cnt;
+            char name[64];
+            memset(&opt, 0, sizeof opt);
+            opt.layout = make_layout(n, 32, gi ? 4 : TT_NO_GUTTER);
+            opt.seed = 7;
+            opt.allocator = make_allocator(&cnt, -1);
+            sprintf(name, "noise n=%d gutter %d", n, gi ? 4 : 0);
+            r = tt_synthesize_tiles(&src, &opt, &set, &err);
+            CHECK(r == TT_OK, "%s: synthesize returned %d (%s)", name, r, err.message);
+            if (r != TT_OK) continue;
+            check_tileset(set, &src, 2, name);
+            r = tt_synthesize_tiles(&src, &opt, &again, &err);
+            CHECK(r == TT_OK && again->levels[0].width == set->levels[0].width &&
+                      memcmp(again->levels[0].pixels, set->levels[0].pixels,
+                             sizeof(float) * 4 * (size_t)set->levels[0].width * set->levels[0].height) == 0,
+                  "%s: same seed should give a byte-identical atlas", name);
+            opt.seed = 8;
+            r = tt_synthesize_tiles(&src, &opt, &other, &err);
+            CHECK(r == TT_OK && other->levels[0].width == set->levels[0].width &&
+                      memcmp(other->levels[0].pixels, set->levels[0].pixels,
+                             sizeof(float) * 4 * (size_t)set->levels[0].width * set->levels[0].height) != 0,
+                  "%s: seeds 7 and 8 should give different atlases", name);
+            tt_tileset_free(set);
+            tt_tileset_free(again);
+            tt_tileset_free(other);
+            CHECK(cnt.live == 0 && cnt.bad_frees == 0, "%s: %ld allocations leaked", name, cnt.live);
+        }
+    /* Given edge windows, a background region, a larger feather, S = 64 */
+    {
+        tt_synth_options opt;
+        tt_tileset *set = NULL;
+        tt_error err;
+        tt_rect windows[2];
+        tt_result r;
+        memset(&opt, 0, sizeof opt);
+        opt.layout = make_layout(2, 24, 3);
+        windows[0].x = 5; windows[0].y = 9; windows[0].w = windows[0].h = 0;
+        windows[1].x = 96 - 24; windows[1].y = 192 - 48; windows[1].w = windows[1].h = 0;
+        opt.edge_windows = windows;
+        opt.background.x = 10; opt.background.y = 20; opt.background.w = 40; opt.background.h = 50;
+        opt.feather = 4;
+        opt.seed = 3;
+        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        CHECK(r == TT_OK, "given windows: synthesize returned %d (%s)", r, err.message);
+        if (r == TT_OK) {
+            int t, bad = 0;
+            CHECK(set->edge_windows[0].x == 5 && set->edge_windows[0].y == 9 && set->edge_windows[1].x == 72 &&
+                      set->edge_windows[1].y == 144 && set->edge_windows[0].w == 24 && set->edge_windows[1].h == 48,
+                  "the given edge windows should be used as they are");
+            for (t = 0; t < tt_tile_layout_tile_count(&set->layout); t++) {
+                const tt_rect *b = &set->background_windows[t];
+                if (b->x < 10 || b->y < 20 || b->x + 24 > 50 || b->y + 24 > 70) bad++;
+            }
+            CHECK(bad == 0, "%d background windows outside the background region", bad);
+            check_tileset(set, &src, 4, "given windows, feather 4, n=2, S=24, g=3");
+            tt_tileset_free(set);
+        }
+        memset(&opt, 0, sizeof opt);
+        opt.layout = make_layout(1, 64, 8);
+        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        CHECK(r == TT_OK, "S=64: %d (%s)", r, err.message);
+        if (r == TT_OK) {
+            check_tileset(set, &src, 4, "n=1, S=64, g=8");
+            tt_tileset_free(set);
+        }
+    }
+    tt_image_free(&src);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 6c. Quality measures                                                     */
+/* ------------------------------------------------------------------------ */
+
+static void check_histogram(int grid, int n, double tolerance)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_tile_layout l = make_layout(n, 16, 2);
+    uint8_t *types;
+    int *counts, ntiles = (2 * n) * (2 * n) * (2 * n) * (2 * n), t, lo = 1 << 30, hi = 0, sum = 0, unused = 0;
+    double expected;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, grid, grid, 10.0, 3.0);
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "histogram torus build %d", r);
+    if (r != TT_OK) return;
+    types = (uint8_t *)malloc((size_t)mesh->ncorners);
+    counts = (int *)malloc(sizeof(int) * (size_t)ntiles);
+    tt_assign_boundaries(mesh, &l, 2025, types);
+    r = tt_tile_histogram(mesh, &l, types, counts);
+    CHECK(r == TT_OK, "tt_tile_histogram returned %d", r);
+    expected = (double)mesh->nfaces / ntiles;
+    for (t = 0; t < ntiles; t++) {
+        if (counts[t] < lo) lo = counts[t];
+        if (counts[t] > hi) hi = counts[t];
+        unused += counts[t] == 0;
+        sum += counts[t];
+    }
+    CHECK(sum == mesh->nfaces, "histogram n=%d: counts sum to %d, expected %d faces", n, sum, mesh->nfaces);
+    CHECK(unused == 0, "histogram n=%d on %dx%d: %d of %d tiles unused", n, grid, grid, unused, ntiles);
+    CHECK(lo >= expected * (1 - tolerance) && hi <= expected * (1 + tolerance),
+          "histogram n=%d on %dx%d: counts %d..%d, expected %.0f +- %.0f%%", n, grid, grid, lo, hi, expected,
+          100 * tolerance);
+    /* against a naive count by tt_tile_index */
+    {
+        int *naive = (int *)calloc((size_t)ntiles, sizeof(int)), f, bad = 0;
+        tt_tile_layout res;
+        tt_tile_layout_resolve(&l, &res, NULL);
+        for (f = 0; f < mesh->nfaces; f++) naive[tt_tile_index(&res, types + 4 * f)]++;
+        for (t = 0; t < ntiles; t++) bad += naive[t] != counts[t];
+        CHECK(bad == 0, "histogram n=%d: %d bins differ from the naive count", n, bad);
+        free(naive);
+    }
+    types[5] = (uint8_t)(2 * n);
+    CHECK(tt_tile_histogram(mesh, &l, types, counts) == TT_ERROR_INVALID_ARGUMENT, "histogram: type out of range");
+    CHECK(tt_tile_histogram(NULL, &l, types, counts) == TT_ERROR_INVALID_ARGUMENT, "histogram: mesh NULL");
+    free(types);
+    free(counts);
+    tt_mesh_free(mesh);
+}
+
+static void test_histogram(void)
+{
+    check_histogram(200, 1, 0.20);
+    check_histogram(400, 2, 0.25);
+}
+
+static void test_seams(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_image src;
+    tt_synth_options opt;
+    tt_tileset *set = NULL;
+    uint8_t *types;
+    float *uv, *shuffled;
+    tt_seam_report rep, rep2;
+    tt_result r;
+    int f, n;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 32, 24, 3.0, 1.0);
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "seam torus build %d", r);
+    if (r != TT_OK) return;
+    make_procedural(&src, 160, 256, 9);
+    types = (uint8_t *)malloc((size_t)mesh->ncorners);
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    shuffled = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    for (n = 1; n <= 2; n++) {
+        memset(&opt, 0, sizeof opt);
+        opt.layout = make_layout(n, 32, 4);
+        opt.seed = 11;
+        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        CHECK(r == TT_OK, "seams n=%d: synthesize %d (%s)", n, r, err.message);
+        if (r != TT_OK) continue;
+        tt_assign_boundaries(mesh, &opt.layout, 5, types);
+        r = tt_assign_uvs(mesh, &opt.layout, types, uv, &err);
+        CHECK(r == TT_OK, "seams: assign_uvs %d", r);
+        r = tt_measure_seams(mesh, uv, &set->levels[0], 99, &rep);
+        CHECK(r == TT_OK, "tt_measure_seams returned %d", r);
+        CHECK(rep.edges_measured == 2 * mesh->nfaces, "seams: edges_measured expected %d, got %d", 2 * mesh->nfaces,
+              rep.edges_measured);
+        CHECK(rep.score <= 0.05, "seams n=%d: score %.4f > 0.05 (seam %.4f, same face %.4f, unrelated %.4f)", n,
+              rep.score, rep.seam, rep.same_face, rep.unrelated);
+        /* same seed, same report */
+        tt_measure_seams(mesh, uv, &set->levels[0], 99, &rep2);
+        CHECK(rep.score == rep2.score && rep.seam == rep2.seam, "seams: the same seed should give the same report");
+        /* shuffle the faces' tiles: permute the 8-float UV blocks */
+        {
+            int *perm = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+            lcg_seed(77);
+            for (f = 0; f < mesh->nfaces; f++) perm[f] = f;
+            for (f = mesh->nfaces - 1; f > 0; f--) {
+                int j = lcg_below(f + 1), t = perm[f];
+                perm[f] = perm[j];
+                perm[j] = t;
+            }
+            for (f = 0; f < mesh->nfaces; f++) memcpy(shuffled + 8 * f, uv + 8 * perm[f], 8 * sizeof(float));
+            free(perm);
+        }
+        r = tt_measure_seams(mesh, shuffled, &set->levels[0], 99, &rep2);
+        /* With n = 2 a shuffled edge keeps complementary types (and so stays
+           seamless) with probability 1/4 and otherwise mostly shows two
+           different windows: the score must rise to >= 0.6. With n = 1 half
+           the shuffled edges still match by type, and a mismatched one shows
+           the same window row twice, mirrored (x against S-1-x: close
+           together near the middle of the edge, so similar in a smooth
+           texture), so the ceiling is lower: require a clear rise only. */
+        if (n == 2)
+            CHECK(r == TT_OK && rep2.score >= 0.6,
+                  "seams n=%d shuffled: score %.4f < 0.6 (seam %.4f, same face %.4f, unrelated %.4f): the measure "
+                  "should see mismatched tiles", n, rep2.score, rep2.seam, rep2.same_face, rep2.unrelated);
+        else
+            CHECK(r == TT_OK && rep2.score >= 0.15 && rep2.score >= rep.score + 0.2,
+                  "seams n=%d shuffled: score %.4f (unshuffled %.4f; seam %.4f, same face %.4f, unrelated %.4f): "
+                  "expected >= 0.15 and >= unshuffled + 0.2", n, rep2.score, rep.score, rep2.seam, rep2.same_face,
+                  rep2.unrelated);
+        tt_tileset_free(set);
+        set = NULL;
+    }
+    CHECK(tt_measure_seams(NULL, uv, &src, 1, &rep) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_seams(mesh, NULL, &src, 1, &rep) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_seams(mesh, uv, NULL, 1, &rep) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_seams(mesh, uv, &src, 1, NULL) == TT_ERROR_INVALID_ARGUMENT,
+          "tt_measure_seams with NULL arguments should be rejected");
+    free(types);
+    free(uv);
+    free(shuffled);
+    tt_image_free(&src);
+    tt_mesh_free(mesh);
+}
+
+static void test_stretch(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_tile_layout l = make_layout(1, 32, 4);
+    uint8_t types[64];
+    float uv[128], st[16];
+    tt_result r;
+    int f, bad = 0;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 3, 2);
+    r = build(&m, 0, &mesh, &err);
+    if (r == TT_OK) {
+        tt_assign_boundaries(mesh, &l, 1, types);
+        tt_assign_uvs(mesh, &l, types, uv, &err);
+        CHECK(tt_face_stretch(mesh, uv, st) == TT_OK, "face_stretch");
+        for (f = 0; f < mesh->nfaces; f++) bad += !near(st[f], 1.0, 1e-5);
+        CHECK(bad == 0, "unit squares on square tiles: %d faces with stretch != 1 (face 0: %g)", bad, st[0]);
+        tt_mesh_free(mesh);
+    }
+    /* 2:1 rectangles */
+    for (f = 0; f < m.nv; f++) m.pos[3 * f] *= 2.0f;
+    r = build(&m, 0, &mesh, &err);
+    if (r == TT_OK) {
+        tt_assign_boundaries(mesh, &l, 1, types);
+        tt_assign_uvs(mesh, &l, types, uv, &err);
+        CHECK(tt_face_stretch(mesh, uv, st) == TT_OK, "face_stretch");
+        bad = 0;
+        for (f = 0; f < mesh->nfaces; f++) bad += !near(st[f], 2.0, 1e-5);
+        CHECK(bad == 0, "2:1 rectangles on square tiles: %d faces with stretch != 2 (face 0: %g)", bad, st[0]);
+        /* a face whose UVs collapse is infinitely stretched */
+        for (f = 0; f < 4; f++) { uv[2 * f] = 0.5f; uv[2 * f + 1] = 0.5f; }
+        tt_face_stretch(mesh, uv, st);
+        CHECK(isinf(st[0]) && st[0] > 0, "collapsed UVs: stretch expected +inf, got %g", st[0]);
+        CHECK(tt_face_stretch(NULL, uv, st) == TT_ERROR_INVALID_ARGUMENT, "face_stretch mesh NULL");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+    /* a right triangle with legs 1 and 3 mapped to legs of equal length: 3 */
+    tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 0, 3, 0);
+    tm_tri(&m, 0, 1, 2);
+    r = build(&m, 0, &mesh, &err);
+    if (r == TT_OK) {
+        float tuv[6] = {0, 0, 0.1f, 0, 0, 0.1f};
+        tt_face_stretch(mesh, tuv, st);
+        CHECK(near(st[0], 3.0, 1e-4), "triangle 1 x 3 on a 1 x 1 UV triangle: stretch expected 3, got %g", st[0]);
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+}
+
+static int g_progress_calls;
+static float g_progress_last;
+static int g_progress_monotone;
+static int cancel_at_3(float fraction, void *user)
+{
+    (void)user;
+    if (fraction < g_progress_last || fraction < 0.0f || fraction > 1.0f) g_progress_monotone = 0;
+    g_progress_last = fraction;
+    return ++g_progress_calls >= 3;
+}
+static int never_cancel(float fraction, void *user)
+{
+    (void)user;
+    if (fraction < g_progress_last || fraction < 0.0f || fraction > 1.0f) g_progress_monotone = 0;
+    g_progress_last = fraction;
+    g_progress_calls++;
+    return 0;
+}
+
+static void expect_synth_error(const tt_image *src, const tt_synth_options *opt, tt_result code, const char *what)
+{
+    tt_synth_options o = *opt;
+    tt_tileset *set = (tt_tileset *)&set;
+    tt_error err;
+    counter cnt;
+    tt_result r;
+    o.allocator = make_allocator(&cnt, -1);
+    err.message[0] = '\0';
+    r = tt_synthesize_tiles(src, &o, &set, &err);
+    CHECK(r == code && set == NULL && err.result == code && err.message[0] != '\0',
+          "%s: expected %d with *out NULL and a message, got %d (%s)", what, code, r, err.message);
+    if (r == TT_OK && set) tt_tileset_free(set);
+    CHECK(cnt.live == 0, "%s: %ld allocations leaked", what, cnt.live);
+}
+
+static void test_synth_errors(void)
+{
+    tt_image src, small;
+    tt_synth_options opt;
+    tt_tileset *set = NULL;
+    tt_error err;
+    tt_result r;
+    tt_rect win;
+    make_noise(&src, 64, 128, 5);
+    memset(&opt, 0, sizeof opt);
+    opt.layout = make_layout(1, 16, 2);
+
+    r = tt_synthesize_tiles(&src, &opt, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "out NULL: got %d", r);
+    expect_synth_error(NULL, &opt, TT_ERROR_INVALID_ARGUMENT, "source NULL");
+    {
+        tt_image empty;
+        memset(&empty, 0, sizeof empty);
+        expect_synth_error(&empty, &opt, TT_ERROR_INVALID_ARGUMENT, "empty source");
+    }
+    opt.layout.colors = -1;
+    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "colors -1");
+    opt.layout.colors = TT_MAX_COLORS + 1;
+    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "colors TT_MAX_COLORS+1");
+    opt.layout.colors = 0;
+    {
+        counter cnt;
+        opt.allocator = make_allocator(&cnt, -1);
+        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        CHECK(r == TT_OK && set->layout.colors == 1 && set->layout.tile_size == 16 && set->layout.gutter == 2,
+              "colors 0 means 1: got %d, colors %d", r, r == TT_OK ? set->layout.colors : -1);
+        if (r == TT_OK) tt_tileset_free(set);
+        CHECK(cnt.live == 0, "colors 0: leak");
+        memset(&opt.allocator, 0, sizeof opt.allocator);
+    }
+    opt.layout.colors = 1;
+    opt.layout.tile_size = 3;
+    {
+        counter cnt;
+        tt_synth_options o = opt;
+        o.allocator = make_allocator(&cnt, -1);
+        set = (tt_tileset *)&set;
+        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        if (r == TT_OK) tt_tileset_free(set);
+        CHECK((r == TT_ERROR_INVALID_ARGUMENT || r == TT_ERROR_TOO_LARGE) && set == NULL && cnt.live == 0,
+              "tile size 3 rejected, got %d", r);
+    }
+    opt.layout.tile_size = 40000;
+    expect_synth_error(&src, &opt, TT_ERROR_TOO_LARGE, "tile size 40000");
+    opt.layout = make_layout(2, 2048, 4);
+    expect_synth_error(&src, &opt, TT_ERROR_TOO_LARGE, "n=2, S=2048: atlas over TT_MAX_IMAGE_SIZE");
+    opt.layout = make_layout(1, 65, 2);
+    expect_synth_error(&src, &opt, TT_ERROR_IMAGE_TOO_SMALL, "S=65 on a 64x128 image (too narrow)");
+    make_noise(&small, 64, 95, 1);
+    opt.layout = make_layout(1, 48, 2);
+    expect_synth_error(&small, &opt, TT_ERROR_IMAGE_TOO_SMALL, "S=48 on a 64x95 image: fits S x S but not S x 2S");
+    tt_image_free(&small);
+    make_noise(&small, 16, 31, 1);
+    opt.layout = make_layout(1, 16, 2);
+    expect_synth_error(&small, &opt, TT_ERROR_IMAGE_TOO_SMALL, "16x31 image for S=16");
+    tt_image_free(&small);
+    make_noise(&small, 16, 32, 1);
+    {
+        counter cnt;
+        tt_synth_options o = opt;
+        o.allocator = make_allocator(&cnt, -1);
+        r = tt_synthesize_tiles(&small, &o, &set, &err);
+        CHECK(r == TT_OK, "16x32 image for S=16 (exactly S x 2S) should work, got %d (%s)", r, err.message);
+        if (r == TT_OK) tt_tileset_free(set);
+        CHECK(cnt.live == 0, "16x32: leak");
+    }
+    tt_image_free(&small);
+
+    /* edge windows outside the image */
+    opt.layout = make_layout(1, 16, 2);
+    opt.edge_windows = &win;
+    win.w = win.h = 0;
+    win.x = 64 - 16 + 1; win.y = 0;
+    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window one texel too far right");
+    win.x = 0; win.y = 128 - 32 + 1;
+    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window one texel too low");
+    win.x = -1; win.y = 0;
+    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window at x = -1");
+    win.x = 64 - 16; win.y = 128 - 32;
+    {
+        counter cnt;
+        tt_synth_options o = opt;
+        o.allocator = make_allocator(&cnt, -1);
+        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        CHECK(r == TT_OK, "edge window at the bottom-right limit should fit, got %d (%s)", r, err.message);
+        if (r == TT_OK) tt_tileset_free(set);
+    }
+    opt.edge_windows = NULL;
+    /* background region */
+    opt.background.x = 60; opt.background.y = 0; opt.background.w = 16; opt.background.h = 16;
+    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "background region outside the image");
+    opt.background.x = 0; opt.background.w = 15;
+    expect_synth_error(&src, &opt, TT_ERROR_IMAGE_TOO_SMALL, "background region narrower than a tile");
+    memset(&opt.background, 0, sizeof opt.background);
+    /* feather too wide */
+    opt.feather = 16 / 4 + 2;
+    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "feather wider than S/4+1");
+    opt.feather = 0;
+
+    /* progress: monotone in (0,1], ends at 1; cancelling cleans up */
+    {
+        counter cnt;
+        tt_synth_options o = opt;
+        o.allocator = make_allocator(&cnt, -1);
+        o.progress = never_cancel;
+        g_progress_calls = 0;
+        g_progress_last = 0.0f;
+        g_progress_monotone = 1;
+        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        CHECK(r == TT_OK && g_progress_calls > 0 && g_progress_monotone && g_progress_last == 1.0f,
+              "progress: %d calls, monotone %d, last %g", g_progress_calls, g_progress_monotone, g_progress_last);
+        if (r == TT_OK) tt_tileset_free(set);
+        o.progress = cancel_at_3;
+        g_progress_calls = 0;
+        g_progress_last = 0.0f;
+        set = (tt_tileset *)&set;
+        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        if (r == TT_OK) tt_tileset_free(set);
+        CHECK(r == TT_CANCELLED && set == NULL && err.result == TT_CANCELLED && g_progress_calls == 3,
+              "cancel at the 3rd progress call: expected TT_CANCELLED after 3 calls, got %d after %d", r,
+              g_progress_calls);
+        CHECK(cnt.live == 0 && cnt.bad_frees == 0, "cancelled synthesis leaked %ld allocations", cnt.live);
+    }
+    /* NULL options: defaults (n = 1, S = 128) need a 128 x 256 source */
+    set = (tt_tileset *)&set;
+    r = tt_synthesize_tiles(&src, NULL, &set, &err);
+    if (r == TT_OK) tt_tileset_free(set);
+    CHECK(r == TT_ERROR_IMAGE_TOO_SMALL && set == NULL, "NULL options on a 64x128 image: expected %d, got %d",
+          TT_ERROR_IMAGE_TOO_SMALL, r);
+    tt_tileset_free(NULL);
+    tt_image_free(&src);
+}
+
+typedef struct synth_ctx {
+    const tt_image *src;
+    tt_synth_options opt;
+} synth_ctx;
+
+static tt_result oom_synth(void *ctx, const tt_allocator *al)
+{
+    synth_ctx *s = (synth_ctx *)ctx;
+    tt_synth_options o = s->opt;
+    tt_tileset *set = (tt_tileset *)&set;
+    tt_error err;
+    tt_result r;
+    o.allocator = *al;
+    r = tt_synthesize_tiles(s->src, &o, &set, &err);
+    if (r == TT_OK) tt_tileset_free(set);
+    else if (set != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_synth_oom(void)
+{
+    tt_image src;
+    synth_ctx s;
+    make_noise(&src, 24, 48, 8);
+    oom_reset();
+    memset(&s, 0, sizeof s);
+    s.src = &src;
+    s.opt.layout = make_layout(1, 8, 2);
+    oom_sweep("tt_synthesize_tiles(n=1, S=8)", oom_synth, &s, TT_OK);
+    s.opt.layout = make_layout(2, 4, TT_NO_GUTTER);
+    s.opt.seed = 3;
+    oom_sweep("tt_synthesize_tiles(n=2, S=4)", oom_synth, &s, TT_OK);
+    tt_image_free(&src);
+}
+
+/* ------------------------------------------------------------------------ */
+/* main                                                                     */
+/* ------------------------------------------------------------------------ */
+
+int main(void)
+{
+    RUN(test_rng);
+    RUN(test_builder_valid);
+    RUN(test_builder_errors);
+    RUN(test_builder_oom);
+    RUN(test_queries);
+    RUN(test_queries_oom);
+    RUN(test_quadrangulate);
+    RUN(test_image_basics);
+    RUN(test_rotate);
+    RUN(test_over_downsample);
+    RUN(test_min_error_cut);
+    RUN(test_raster_random);
+    RUN(test_raster_cover);
+    RUN(test_layout);
+    RUN(test_tile_uv_index);
+    RUN(test_boundaries_uvs);
+    RUN(test_synthesis);
+    RUN(test_histogram);
+    RUN(test_seams);
+    RUN(test_stretch);
+    RUN(test_synth_errors);
+    RUN(test_synth_oom);
+    printf("%d passed, %d failed\n", g_passed, g_failed);
+    return g_failed ? 1 : 0;
+}
