@@ -658,67 +658,75 @@ TTDEF void tt_mesh_free(tt_mesh *mesh)
     tt__free(&allocator, mesh);
 }
 
-/* One outgoing half-edge in a vertex's bucket, sorted by destination so that
-   the half-edges of one undirected edge are found by binary search. */
-typedef struct tt__out_edge {
-    int dest;
-    int corner;
-} tt__out_edge;
+/* A half-edge in the bucket of its edge's smaller vertex: `other` is the
+   larger vertex, corner_dir = 2 * corner + 1 when the half-edge runs from the
+   larger vertex to the smaller. Both halves of an edge share one bucket, so
+   pairing never has to look into another vertex's bucket. */
+typedef struct tt__edge_entry {
+    int other;
+    int corner_dir;
+} tt__edge_entry;
 
-static int tt__out_edge_less(const tt__out_edge *a, const tt__out_edge *b)
+static int tt__edge_entry_less(const tt__edge_entry *a, const tt__edge_entry *b)
 {
-    return a->dest < b->dest || (a->dest == b->dest && a->corner < b->corner);
+    return a->other < b->other || (a->other == b->other && a->corner_dir < b->corner_dir);
 }
 
-static void tt__sift_down(tt__out_edge *items, int root, int count)
+static void tt__sift_down(tt__edge_entry *items, int root, int count)
 {
     for (;;) {
         int child = 2 * root + 1;
-        tt__out_edge tmp;
+        tt__edge_entry tmp;
         if (child >= count) return;
-        if (child + 1 < count && tt__out_edge_less(&items[child], &items[child + 1])) child++;
-        if (!tt__out_edge_less(&items[root], &items[child])) return;
+        if (child + 1 < count && tt__edge_entry_less(&items[child], &items[child + 1])) child++;
+        if (!tt__edge_entry_less(&items[root], &items[child])) return;
         tmp = items[root]; items[root] = items[child]; items[child] = tmp;
         root = child;
     }
 }
 
-/* Buckets hold a vertex's valence worth of entries: insertion sort for the
-   usual handful, heapsort so that a pathological fan of a million faces around
-   one vertex is still O(n log n) rather than quadratic. */
-static void tt__sort_out_edges(tt__out_edge *items, int count)
+/* Buckets hold about half a vertex's valence worth of edges: insertion sort
+   for the usual handful, heapsort so that a pathological fan of a million
+   faces around one vertex is still O(n log n) rather than quadratic. */
+static void tt__sort_edge_entries(tt__edge_entry *items, int count)
 {
     int i;
     if (count <= 24) {
         for (i = 1; i < count; i++) {
-            tt__out_edge key = items[i];
+            tt__edge_entry key = items[i];
             int j = i - 1;
-            while (j >= 0 && tt__out_edge_less(&key, &items[j])) { items[j + 1] = items[j]; j--; }
+            while (j >= 0 && tt__edge_entry_less(&key, &items[j])) { items[j + 1] = items[j]; j--; }
             items[j + 1] = key;
         }
         return;
     }
     for (i = count / 2 - 1; i >= 0; i--) tt__sift_down(items, i, count);
     for (i = count - 1; i > 0; i--) {
-        tt__out_edge tmp = items[0]; items[0] = items[i]; items[i] = tmp;
+        tt__edge_entry tmp = items[0]; items[0] = items[i]; items[i] = tmp;
         tt__sift_down(items, 0, i);
     }
 }
 
-/* First index in items[0..count) whose dest is >= dest. Buckets hold a
-   vertex's valence worth of entries; a scan beats halving for the usual few. */
-static int tt__lower_bound(const tt__out_edge *items, int count, int dest)
+/* The corner of the first repeated vertex in a face, or -1. Triangles and
+   quads, nearly every face there is, compare their few pairs directly; large
+   faces stamp vertices (stamp[v] == face) to stay linear. */
+static int tt__repeated_corner(const int *v, int count, int face, int *stamp)
 {
-    int lo = 0, hi = count;
-    if (count <= 8) {
-        while (lo < count && items[lo].dest < dest) lo++;
-        return lo;
+    int i, j;
+    if (count == 3) return v[1] == v[0] ? 1 : (v[2] == v[0] || v[2] == v[1]) ? 2 : -1;
+    if (count == 4)
+        return v[1] == v[0] ? 1 : (v[2] == v[0] || v[2] == v[1]) ? 2 : (v[3] == v[0] || v[3] == v[1] || v[3] == v[2]) ? 3 : -1;
+    if (!stamp) {
+        for (i = 1; i < count; i++)
+            for (j = 0; j < i; j++)
+                if (v[i] == v[j]) return i;
+        return -1;
     }
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        if (items[mid].dest < dest) lo = mid + 1; else hi = mid;
+    for (i = 0; i < count; i++) {
+        if (stamp[v[i]] == face) return i;
+        stamp[v[i]] = face;
     }
-    return lo;
+    return -1;
 }
 
 /* Twice the vector area of a polygon by Newell's method taken relative to
@@ -733,6 +741,19 @@ static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
     float a[3], n[3] = {0, 0, 0}, scale;
     double area2_squared;
     int i;
+    if (count == 4) {
+        /* For a quad the sum is the cross product of its diagonals. */
+        const float *q = pos + 3 * (size_t)verts[2], *r = pos + 3 * (size_t)verts[3];
+        float d[3], e[3];
+        d[0] = q[0] - o[0]; d[1] = q[1] - o[1]; d[2] = q[2] - o[2];
+        e[0] = r[0] - p[0]; e[1] = r[1] - p[1]; e[2] = r[2] - p[2];
+        n[0] = d[1] * e[2] - d[2] * e[1];
+        n[1] = d[2] * e[0] - d[0] * e[2];
+        n[2] = d[0] * e[1] - d[1] * e[0];
+        scale = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        area2_squared = (double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2];
+        return area2_squared <= 1e-24 * (double)scale * (double)scale;
+    }
     a[0] = p[0] - o[0]; a[1] = p[1] - o[1]; a[2] = p[2] - o[2];
     scale = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     for (i = 2; i < count; i++) {
@@ -801,9 +822,8 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
 {
     const tt_allocator *allocator;
     tt_mesh *mesh = NULL;
-    int *bucket_start = NULL;
-    tt__out_edge *buckets = NULL;
-    int *stamp = NULL;
+    int *bucket_start = NULL, *out_count = NULL, *stamp = NULL;
+    tt__edge_entry *buckets = NULL;
     tt__edge_problem problem;
     tt_result result = TT_OK;
     int permissive, fixed_size, nverts, nfaces, ncorners, f, c, v;
@@ -864,7 +884,8 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     mesh->twin = TT__ALLOC(allocator, int, ncorners);
     mesh->vert_corner = TT__ALLOC(allocator, int, nverts);
     bucket_start = TT__ALLOC(allocator, int, (size_t)nverts + 1);
-    buckets = TT__ALLOC(allocator, tt__out_edge, ncorners);
+    out_count = TT__ALLOC(allocator, int, nverts);
+    buckets = TT__ALLOC(allocator, tt__edge_entry, ncorners);
     if (desc->flags & TT_MESH_BORROW_POSITIONS) {
         mesh->pos = desc->positions;
     } else {
@@ -873,7 +894,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
         mesh->pos = copy;
     }
     if (!mesh->face_start || !mesh->corner_vert || !mesh->corner_face || !mesh->twin || !mesh->vert_corner ||
-        !bucket_start || !buckets || !mesh->pos) {
+        !bucket_start || !out_count || !buckets || !mesh->pos) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                           "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
         goto cleanup;
@@ -890,12 +911,17 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
         }
     }
 
-    /* Corners: copy, range-check, and count each vertex's outgoing half-edges. */
+    /* Corners: copy and range-check them; count each vertex's outgoing
+       half-edges (for the fan check) and each edge's bucket, the bucket of its
+       smaller vertex. vert_corner starts as any outgoing half-edge. */
     memset(bucket_start, 0, ((size_t)nverts + 1) * sizeof(int));
+    memset(out_count, 0, (size_t)nverts * sizeof(int));
+    memset(mesh->vert_corner, 0xff, (size_t)nverts * sizeof(int));
     c = 0;
     for (f = 0; f < nfaces; f++) {
         int size = fixed_size ? fixed_size : desc->face_sizes[f];
         int first = c, i;
+        const int *verts = mesh->corner_vert + first;
         mesh->face_start[f] = first;
         if (size > mesh->max_face_size) mesh->max_face_size = size;
         if (f == 0 || size < mesh->min_face_size) mesh->min_face_size = size;
@@ -909,40 +935,33 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
             }
             mesh->corner_vert[c] = vert;
             mesh->corner_face[c] = f;
-            mesh->twin[c] = -2;   /* not paired yet */
-            bucket_start[vert + 1]++;
+            mesh->vert_corner[vert] = c;
+            out_count[vert]++;
         }
-        /* A repeated vertex makes a degenerate edge or pinches the face. Small
-           faces compare pairs; large ones stamp vertices to stay linear. */
+        for (i = 0; i < size; i++) {
+            int a = verts[i], b = verts[i + 1 < size ? i + 1 : 0];
+            bucket_start[(a < b ? a : b) + 1]++;
+        }
         if (!permissive) {
-            int repeated = -1, j;
-            if (size <= 16) {
-                for (i = 1; i < size && repeated < 0; i++)
-                    for (j = 0; j < i; j++)
-                        if (mesh->corner_vert[first + i] == mesh->corner_vert[first + j]) { repeated = first + i; break; }
-            } else {
+            /* A repeated vertex makes a degenerate edge or pinches the face. */
+            int repeated;
+            if (size > 16 && !stamp) {
+                stamp = TT__ALLOC(allocator, int, nverts);
                 if (!stamp) {
-                    stamp = TT__ALLOC(allocator, int, nverts);
-                    if (!stamp) {
-                        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
-                        goto cleanup;
-                    }
-                    for (j = 0; j < nverts; j++) stamp[j] = -1;
+                    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+                    goto cleanup;
                 }
-                for (i = 0; i < size; i++) {
-                    int vert = mesh->corner_vert[first + i];
-                    if (stamp[vert] == f) { repeated = first + i; break; }
-                    stamp[vert] = f;
-                }
+                memset(stamp, 0xff, (size_t)nverts * sizeof(int));
             }
+            repeated = tt__repeated_corner(verts, size, f, size > 16 ? stamp : NULL);
             if (repeated >= 0) {
-                result = tt__fail(error, TT_ERROR_REPEATED_VERTEX, f, repeated, mesh->corner_vert[repeated], -1,
-                                  "face %d uses vertex %d more than once (corner %d)", f,
-                                  mesh->corner_vert[repeated], repeated);
+                result = tt__fail(error, TT_ERROR_REPEATED_VERTEX, f, first + repeated, verts[repeated], -1,
+                                  "face %d uses vertex %d more than once (corner %d)", f, verts[repeated],
+                                  first + repeated);
                 goto cleanup;
             }
-            if (tt__face_has_zero_area(desc->positions, mesh->corner_vert + first, size)) {
-                result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, first, mesh->corner_vert[first], -1,
+            if (tt__face_has_zero_area(desc->positions, verts, size)) {
+                result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, first, verts[0], -1,
                                   "face %d has zero area: its %d corners coincide or lie on one line", f, size);
                 goto cleanup;
             }
@@ -950,84 +969,59 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     }
     mesh->face_start[nfaces] = ncorners;
 
-    /* Bucket half-edges by origin vertex (a counting sort), each entry knowing
-       its destination, then sort every bucket by destination. */
+    /* Counting sort of the half-edges into their buckets, then each bucket
+       sorted by (other vertex, corner): the halves of an edge end up side by
+       side, in corner order. */
     for (v = 0; v < nverts; v++) bucket_start[v + 1] += bucket_start[v];
     for (f = 0; f < nfaces; f++) {
         int first = mesh->face_start[f], end = mesh->face_start[f + 1];
         for (c = first; c < end; c++) {
-            int origin = mesh->corner_vert[c];
-            int slot = bucket_start[origin]++;
-            buckets[slot].dest = mesh->corner_vert[c + 1 < end ? c + 1 : first];
-            buckets[slot].corner = c;
+            int a = mesh->corner_vert[c], b = mesh->corner_vert[c + 1 < end ? c + 1 : first];
+            int slot = bucket_start[a < b ? a : b]++;
+            buckets[slot].other = a < b ? b : a;
+            buckets[slot].corner_dir = 2 * c + (a > b);
         }
     }
     for (v = nverts; v > 0; v--) bucket_start[v] = bucket_start[v - 1];
     bucket_start[0] = 0;
-    for (v = 0; v < nverts; v++)
-        tt__sort_out_edges(buckets + bucket_start[v], bucket_start[v + 1] - bucket_start[v]);
 
-    /* Pair twins, one run of equal destinations at a time: p half-edges a->b
-       here, q half-edges b->a in b's bucket. p = q = 1 is an interior edge,
-       p = 1, q = 0 a boundary; anything else is non-manifold or flipped. */
+    /* Pair twins one edge (one run of equal `other`) at a time: one half-edge
+       each way is an interior edge, a single one a boundary; anything else is
+       non-manifold (three or more) or flipped (two the same way). Those are
+       cut loose into boundaries; the problem with the smallest corner is the
+       one reported, so errors come in index-buffer order. */
     problem.corner = -1;
     for (v = 0; v < nverts; v++) {
-        int start = bucket_start[v], end = bucket_start[v + 1], i = start;
-        while (i < end) {
-            int dest = buckets[i].dest, run_end = i + 1, p, q = 0, other_start, j, k;
-            while (run_end < end && buckets[run_end].dest == dest) run_end++;
-            p = run_end - i;
-            if (mesh->twin[buckets[i].corner] != -2) { i = run_end; continue; }
-            other_start = bucket_start[dest];
-            if (dest != v) {
-                const tt__out_edge *other = buckets + other_start;
-                int count = bucket_start[dest + 1] - other_start;
-                j = tt__lower_bound(other, count, v);
-                other_start += j;
-                while (j < count && other[j].dest == v) { q++; j++; }
-            }
-            if (dest != v && p == 1 && q <= 1) {
-                int a = buckets[i].corner;
-                if (q == 1) {
-                    int b = buckets[other_start].corner;
-                    mesh->twin[a] = b;
-                    mesh->twin[b] = a;
-                } else {
-                    mesh->twin[a] = -1;
-                }
+        tt__edge_entry *e = buckets + bucket_start[v];
+        int count = bucket_start[v + 1] - bucket_start[v], i = 0;
+        tt__sort_edge_entries(e, count);
+        while (i < count) {
+            int other = e[i].other, run_end = i + 1, backward = e[i].corner_dir & 1, k;
+            while (run_end < count && e[run_end].other == other) backward += e[run_end++].corner_dir & 1;
+            if (other != v && run_end - i == 2 && backward == 1) {
+                int a = e[i].corner_dir >> 1, b = e[i + 1].corner_dir >> 1;
+                mesh->twin[a] = b;
+                mesh->twin[b] = a;
+            } else if (other != v && run_end - i == 1) {
+                int a = e[i].corner_dir >> 1;
+                mesh->twin[a] = -1;
+                mesh->vert_corner[mesh->corner_vert[a]] = a;   /* prefer a boundary half-edge */
             } else {
-                /* Cut every half-edge of this edge loose; remember the problem. */
-                int lowest = buckets[i].corner;
-                for (k = i; k < run_end; k++) mesh->twin[buckets[k].corner] = -1;
-                if (dest != v)
-                    for (k = 0; k < q; k++) {
-                        int b = buckets[other_start + k].corner;
-                        mesh->twin[b] = -1;
-                        if (b < lowest) lowest = b;
-                    }
+                for (k = i; k < run_end; k++) {
+                    int h = e[k].corner_dir >> 1;
+                    mesh->twin[h] = -1;
+                    mesh->vert_corner[mesh->corner_vert[h]] = h;
+                }
                 mesh->repaired_edges++;
-                if (!permissive && (problem.corner < 0 || lowest < problem.corner)) {
-                    /* Name the faces in corner order, the lowest corner's first. */
-                    int nf, previous = -1;
+                if (!permissive && other != v && (problem.corner < 0 || (e[i].corner_dir >> 1) < problem.corner)) {
+                    int lowest = e[i].corner_dir >> 1;
                     problem.corner = lowest;
-                    problem.a = v;
-                    problem.b = dest;
-                    problem.result = (p + q > 2) ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
-                    for (nf = 0; nf < 3; nf++) {
-                        int next = -1;
-                        for (k = i; k < run_end; k++)
-                            if (buckets[k].corner > previous && (next < 0 || buckets[k].corner < next))
-                                next = buckets[k].corner;
-                        for (k = 0; k < q; k++)
-                            if (buckets[other_start + k].corner > previous &&
-                                (next < 0 || buckets[other_start + k].corner < next))
-                                next = buckets[other_start + k].corner;
-                        if (next < 0) break;
-                        problem.faces[nf] = mesh->corner_face[next];
-                        previous = next;
-                    }
-                    for (; nf < 3; nf++) problem.faces[nf] = -1;
-                    problem.nfaces = p + q;
+                    problem.a = mesh->corner_vert[lowest];
+                    problem.b = mesh->corner_vert[tt_mesh_next(mesh, lowest)];
+                    problem.result = run_end - i > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
+                    problem.nfaces = run_end - i;
+                    for (k = 0; k < 3; k++)
+                        problem.faces[k] = i + k < run_end ? mesh->corner_face[e[i + k].corner_dir >> 1] : -1;
                 }
             }
             i = run_end;
@@ -1039,26 +1033,21 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     }
     if (!permissive) mesh->repaired_edges = 0;
 
-    /* Each vertex: one outgoing half-edge, a boundary one if there is one. In
-       strict mode also check that its faces form one fan. */
-    for (v = 0; v < nverts; v++) {
-        int start = bucket_start[v], end = bucket_start[v + 1], i, boundary = -1;
-        if (start == end) { mesh->vert_corner[v] = -1; continue; }
-        for (i = start; i < end && boundary < 0; i++)
-            if (mesh->twin[buckets[i].corner] < 0) boundary = buckets[i].corner;
-        mesh->vert_corner[v] = boundary >= 0 ? boundary : buckets[start].corner;
-        if (!permissive && tt__fan_size(mesh, v) != end - start) {
-            result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, mesh->corner_face[mesh->vert_corner[v]],
-                              mesh->vert_corner[v], v, -1,
-                              "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
-                              "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
-                              v, end - start);
-            goto cleanup;
-        }
-    }
+    /* In strict mode every vertex's faces must form one fan. */
+    if (!permissive)
+        for (v = 0; v < nverts; v++)
+            if (out_count[v] > 0 && tt__fan_size(mesh, v) != out_count[v]) {
+                result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, mesh->corner_face[mesh->vert_corner[v]],
+                                  mesh->vert_corner[v], v, -1,
+                                  "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
+                                  "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
+                                  v, out_count[v]);
+                goto cleanup;
+            }
 
 cleanup:
     tt__free(allocator, bucket_start);
+    tt__free(allocator, out_count);
     tt__free(allocator, buckets);
     tt__free(allocator, stamp);
     if (result != TT_OK) {
