@@ -4,7 +4,7 @@
 #   1. a procedural stone texture           build/demo/texture.png
 #   2. a smooth double torus (genus 2)      build/demo/double_torus_mesh.obj
 #   3. tiled textures (Akleman et al.):     build/demo/double_torus.obj/.mtl/.png
-#   4. two pictures of the result           build/demo/double_torus_front.png, _side.png
+#   4. pictures of the result               build/demo/double_torus_front.png, _side.png, _closeup.png
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,6 +21,8 @@ mkdir -p "$out"
 "$tool" tile "$out/double_torus_mesh.obj" "$out/texture.png" "$out/double_torus"
 "$tool" render "$out/double_torus.obj" "$out/double_torus.png" "$out/double_torus_front.png" --yaw 20 --pitch 15
 "$tool" render "$out/double_torus.obj" "$out/double_torus.png" "$out/double_torus_side.png" --yaw -40 --pitch 55
+"$tool" render "$out/double_torus.obj" "$out/double_torus.png" "$out/double_torus_closeup.png" \
+    --yaw 10 --pitch 30 --zoom 3 --size 900x600 --wireframe
 
 echo
 echo "pictures:"
@@ -28,3 +30,4 @@ echo "  $out/texture.png               the example image"
 echo "  $out/double_torus.png          the tile atlas made from it"
 echo "  $out/double_torus_front.png    the textured double torus"
 echo "  $out/double_torus_side.png     the same from another side"
+echo "  $out/double_torus_closeup.png  close up, with the quads drawn: the stones run across every edge"

@@ -210,7 +210,7 @@ static int parse_up_axis(const char *text, up_axis *axis)
    that the bounding sphere fits the field of view with a small margin, which also puts every
    vertex in front of the camera: no clipping is ever needed. */
 static void camera_orbit(camera *cam, vec3 centre, float radius, const up_axis *axis, float yaw_degrees,
-                         float pitch_degrees, int width, int height)
+                         float pitch_degrees, float zoom, int width, int height)
 {
     float yaw = yaw_degrees * PI / 180.0f, pitch = pitch_degrees * PI / 180.0f;
     float half_fov = 0.5f * FIELD_OF_VIEW_DEGREES * PI / 180.0f;
@@ -222,7 +222,9 @@ static void camera_orbit(camera *cam, vec3 centre, float radius, const up_axis *
     cam->forward = vec3_scale(toward_eye, -1.0f);
     cam->right = vec3_normalize(vec3_cross(cam->forward, axis->up));
     cam->up = vec3_cross(cam->right, cam->forward);
-    cam->focal = 0.5f * (float)(width < height ? width : height) / tanf(half_fov);
+    /* Zooming narrows the view instead of moving closer: nothing can come to
+       lie behind the camera. */
+    cam->focal = zoom * 0.5f * (float)(width < height ? width : height) / tanf(half_fov);
     cam->centre_x = 0.5f * (float)width;
     cam->centre_y = 0.5f * (float)height;
 }
@@ -236,10 +238,12 @@ typedef struct scene {
     int ntriangles;
     int *triangle_corners;      /* 3 per triangle: corners of the OBJ (index into corner_vert / corner_uv) */
     int *triangle_face;         /* the OBJ face each triangle comes from */
+    unsigned char *triangle_edges; /* bit k: the edge opposite corner k is an edge of the OBJ face */
     signed char *triangle_facing; /* +1: the camera sees the side the winding calls "outside", -1: the inside */
     float *corner_normal;       /* 3 per OBJ corner, unit length */
     float *screen;              /* 3 per vertex: x and y in samples, then q = 1 / depth */
     const mip_texture *texture; /* NULL: draw grey */
+    int wireframe;              /* draw the OBJ faces' edges over the surface */
     vec3 light_key, light_fill; /* unit vectors towards the two lights */
     int width, height;          /* of the sample grid */
 } scene;
@@ -248,6 +252,7 @@ static void scene_free(scene *s)
 {
     free(s->triangle_corners);
     free(s->triangle_face);
+    free(s->triangle_edges);
     free(s->triangle_facing);
     free(s->corner_normal);
     free(s->screen);
@@ -264,7 +269,8 @@ static int scene_triangulate(scene *s)
     s->triangle_corners = (int *)malloc((size_t)total * 3 * sizeof(int));
     s->triangle_face = (int *)malloc((size_t)total * sizeof(int));
     s->triangle_facing = (signed char *)malloc((size_t)total);
-    if (!s->triangle_corners || !s->triangle_face || !s->triangle_facing) return -1;
+    s->triangle_edges = (unsigned char *)malloc((size_t)total);
+    if (!s->triangle_corners || !s->triangle_face || !s->triangle_facing || !s->triangle_edges) return -1;
     for (f = 0; f < mesh->nfaces; f++) {
         int i;
         for (i = 1; i + 1 < mesh->face_size[f]; i++, t++) {
@@ -272,6 +278,9 @@ static int scene_triangulate(scene *s)
             s->triangle_corners[3 * t + 1] = first + i;
             s->triangle_corners[3 * t + 2] = first + i + 1;
             s->triangle_face[t] = f;
+            /* (ci, ci+1) is always a side of the face; (ci+1, c0) and (c0, ci)
+               only for the last and the first triangle of the fan. */
+            s->triangle_edges[t] = (unsigned char)(1u | (i + 2 == mesh->face_size[f] ? 2u : 0u) | (i == 1 ? 4u : 0u));
         }
         first += mesh->face_size[f];
     }
@@ -555,6 +564,18 @@ static void shade_sample(const scene *s, int t, float px, float py, float rgba[4
     light = 0.32f + 0.72f * fmaxf(0.0f, vec3_dot(normal, s->light_key)) +
             0.22f * fmaxf(0.0f, vec3_dot(normal, s->light_fill));
     for (k = 0; k < 3; k++) rgba[k] *= light;
+
+    /* Wireframe: b[k] / |grad b[k]| is the distance in samples to the edge
+       opposite corner k; darken within a line's width of a face's edge. */
+    if (s->wireframe) {
+        float ink = 0.0f;
+        for (k = 0; k < 3; k++) {
+            float gradient = sqrtf(dbdx[k] * dbdx[k] + dbdy[k] * dbdy[k]);
+            if ((s->triangle_edges[t] >> k) & 1u && gradient > 0.0f)
+                ink = fmaxf(ink, 1.0f - fminf(1.0f, fmaxf(0.0f, b[k] / gradient - 0.6f) / 0.8f));
+        }
+        for (k = 0; k < 3; k++) rgba[k] = rgba[k] * (1.0f - 0.85f * ink) + 0.05f * ink;
+    }
 }
 
 /* A quiet vertical gradient, so both dark and light models stand out. */
@@ -620,6 +641,7 @@ static int resolve(const sample_buffer *samples, tt_image *picture)
 static void print_render_help(void)
 {
     printf("usage: tiledtex render MESH.obj TEXTURE OUT.png [--size WxH] [--yaw DEG] [--pitch DEG] [--up AXIS]\n"
+           "                       [--zoom F] [--wireframe]\n"
            "\n"
            "Draw MESH with TEXTURE (PNG, JPEG, TGA, BMP, ...) applied through the mesh's per-corner\n"
            "texture coordinates (vt) and save the picture as OUT.png. Faces without texture\n"
@@ -630,7 +652,9 @@ static void print_render_help(void)
            "  --yaw DEG     turn the camera around the model's up axis (default 30)\n"
            "  --pitch DEG   raise the camera above the model, -89 to 89 (default 20)\n"
            "  --up AXIS     the model's up axis: y (default, usual for OBJ), z (usual for CAD\n"
-           "                and scans), x, -y, -z or -x\n",
+           "                and scans), x, -y, -z or -x\n"
+           "  --zoom F      magnify the view F times, 0.1 to 100 (default 1: the whole model)\n"
+           "  --wireframe   draw the edges of the mesh's faces over the surface\n",
            RENDER_MAX_SIZE, RENDER_DEFAULT_WIDTH, RENDER_DEFAULT_HEIGHT);
 }
 
@@ -638,7 +662,8 @@ int cmd_render(int argc, char **argv)
 {
     const char *positional[3];
     int npositional = 0, width = RENDER_DEFAULT_WIDTH, height = RENDER_DEFAULT_HEIGHT, i, status = TOOL_EXIT_FAILURE;
-    double yaw = 30.0, pitch = 20.0;
+    double yaw = 30.0, pitch = 20.0, zoom = 1.0;
+    int wireframe = 0;
     char err[TOOL_ERROR_SIZE];
     obj_mesh mesh;
     tt_image image, picture;
@@ -665,6 +690,10 @@ int cmd_render(int argc, char **argv)
             if (parse_float("--yaw", value, -3600.0, 3600.0, &yaw) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--pitch", &value)) {
             if (parse_float("--pitch", value, -89.0, 89.0, &pitch) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--zoom", &value)) {
+            if (parse_float("--zoom", value, 0.1, 100.0, &zoom) != 0) return TOOL_EXIT_USAGE;
+        } else if (strcmp(argv[i], "--wireframe") == 0) {
+            wireframe = 1;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
             if (parse_up_axis(value, &axis) != 0)
                 return value ? tool_usage("--up wants x, y, z, -x, -y or -z, got '%s'", value)
@@ -702,7 +731,8 @@ int cmd_render(int argc, char **argv)
     s.texture = &texture;
     s.width = width * SUPERSAMPLING;
     s.height = height * SUPERSAMPLING;
-    camera_orbit(&cam, centre, radius, &axis, (float)yaw, (float)pitch, s.width, s.height);
+    s.wireframe = wireframe;
+    camera_orbit(&cam, centre, radius, &axis, (float)yaw, (float)pitch, (float)zoom, s.width, s.height);
     /* Key light from the upper left behind the viewer, a weaker fill from the right. */
     s.light_key = vec3_normalize(vec3_add(vec3_add(vec3_scale(cam.right, -0.45f), vec3_scale(cam.up, 0.6f)),
                                           vec3_scale(cam.forward, -0.75f)));
