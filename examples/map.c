@@ -263,6 +263,45 @@ int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture
     return 0;
 }
 
+static int compare_floats(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The rest of the quality report: how evenly the tiles are used (every tile
+   equally often is what keeps repetition invisible) and how much each face
+   stretches its tile (the ratio of the singular values of its map). */
+static void print_quality(const tiled_mesh *mesh)
+{
+    int ntiles = tt_tile_layout_tile_count(&mesh->layout), nfaces = mesh->mesh->nfaces, used = 0, least = -1,
+        most = 0, t, f, degenerate = 0;
+    int *counts = (int *)malloc((size_t)ntiles * sizeof(int));
+    float *stretch = (float *)malloc((size_t)nfaces * sizeof(float));
+    if (!counts || !stretch || tt_tile_histogram(mesh->mesh, &mesh->layout, mesh->corner_type, counts) != TT_OK ||
+        tt_face_stretch(mesh->mesh, mesh->corner_uv, stretch) != TT_OK) {
+        free(counts);
+        free(stretch);
+        return;
+    }
+    for (t = 0; t < ntiles; t++) {
+        if (counts[t] > 0) used++;
+        if (least < 0 || counts[t] < least) least = counts[t];
+        if (counts[t] > most) most = counts[t];
+    }
+    qsort(stretch, (size_t)nfaces, sizeof(float), compare_floats);
+    for (f = nfaces; f > 0 && !(stretch[f - 1] < 1e30f); f--) degenerate++;
+    printf("quality: %d of %d tiles used (%d to %d faces each, %.1f on average)", used, ntiles, least, most,
+           (double)nfaces / ntiles);
+    if (nfaces > degenerate)
+        printf("; stretch median %.2f, 95th percentile %.2f, max %.2f", stretch[(nfaces - degenerate) / 2],
+               stretch[(int)(0.95 * (nfaces - degenerate - 1))], stretch[nfaces - degenerate - 1]);
+    if (degenerate > 0) printf("; %d degenerate face%s", degenerate, degenerate == 1 ? "" : "s");
+    printf("\n");
+    free(counts);
+    free(stretch);
+}
+
 void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams)
 {
     const tt_mesh_stats *s = &mesh->stats;
@@ -275,6 +314,7 @@ void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_
     if (seams) printf(", seam score %.3f (seam %.4f, same-face %.4f, unrelated %.4f)", seams->score, seams->seam,
                       seams->same_face, seams->unrelated);
     printf("\n");
+    print_quality(mesh);
 }
 
 /* With --atlas: the atlas must have the layout's size. When --tile was not
