@@ -37,7 +37,8 @@ static void print_help(void)
            "  --subdivide L    quadrangulate L more times: smaller faces, smaller texture\n"
            "  --smooth         use Catmull-Clark positions when subdividing (default: keep the shape)\n"
            "  --atlas A.png    also write OUT.mtl naming A.png, and report the seam score\n"
-           "  --permissive     accept non-manifold or mis-oriented edges (they become boundaries)\n",
+           "  --permissive     accept non-manifold or mis-oriented edges (they become boundaries)\n"
+           "  --report         also print tile usage and face stretch\n",
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
 
@@ -84,6 +85,8 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         options->background.h = r[3];
     } else if ((accept & TILED_SYNTH_OPTIONS) && strcmp(argv[*index], "--mips") == 0) {
         options->mips = 1;
+    } else if ((accept & TILED_REPORT_OPTION) && strcmp(argv[*index], "--report") == 0) {
+        options->report = 1;
     } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
         if (!value) { tool_usage("--atlas needs a value"); return -1; }
         options->atlas_path = value;
@@ -302,7 +305,7 @@ static void print_quality(const tiled_mesh *mesh)
     free(stretch);
 }
 
-void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams)
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams, int report)
 {
     const tt_mesh_stats *s = &mesh->stats;
     printf("%s: %d quads, %d vertices, genus %d, %d component%s, %d boundary loop%s, valence %d..%d, "
@@ -314,7 +317,7 @@ void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_
     if (seams) printf(", seam score %.3f (seam %.4f, same-face %.4f, unrelated %.4f)", seams->score, seams->seam,
                       seams->same_face, seams->unrelated);
     printf("\n");
-    print_quality(mesh);
+    if (report) print_quality(mesh);
 }
 
 /* With --atlas: the atlas must have the layout's size. When --tile was not
@@ -360,7 +363,7 @@ int cmd_map(int argc, char **argv)
     for (i = 1; i < argc; i++) {
         int taken;
         if (tool_is_help(argv[i])) { print_help(); return 0; }
-        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION,
+        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION,
                                    &options);
         if (taken < 0) return TOOL_EXIT_USAGE;
         if (taken) continue;
@@ -389,7 +392,7 @@ int cmd_map(int argc, char **argv)
         status = tiled_add_obj(&output, positional[1], &mesh, NULL);
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
-    if (status == 0) tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL);
+    if (status == 0) tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL, options.report);
     output_free(&output);
     tiled_mesh_free(&mesh);
     tt_image_free(&atlas);

@@ -30,7 +30,8 @@ static void print_help(void)
            "  --permissive           accept non-manifold or mis-oriented edges\n"
            "  --edge X,Y             condition k's S x 2S edge window, once per condition\n"
            "  --background X,Y,W,H   region the background windows come from\n"
-           "  --mips                 also write the per-tile mip levels\n",
+           "  --mips                 also write the per-tile mip levels\n"
+           "  --report               also print tile usage and face stretch\n",
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
 
@@ -53,7 +54,8 @@ int cmd_tile(int argc, char **argv)
         int taken;
         if (tool_is_help(argv[i])) { print_help(); return 0; }
         taken = tiled_parse_option(argc, argv, &i,
-                                   TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS, &options);
+                                   TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS |
+                                       TILED_REPORT_OPTION, &options);
         if (taken < 0) return TOOL_EXIT_USAGE;
         if (taken) continue;
         if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
@@ -92,7 +94,7 @@ int cmd_tile(int argc, char **argv)
     if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
-        tiled_print_summary(positional[0], &mesh, &seams);
+        tiled_print_summary(positional[0], &mesh, &seams, options.report);
         printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
                tiles->levels[0].height);
     }

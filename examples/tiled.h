@@ -15,7 +15,8 @@ enum {
     TILED_LAYOUT_OPTIONS = 1 << 0,   /* --colors --tile --gutter --seed */
     TILED_MESH_OPTIONS = 1 << 1,     /* --subdivide --smooth --permissive */
     TILED_SYNTH_OPTIONS = 1 << 2,    /* --edge --background --mips */
-    TILED_ATLAS_OPTION = 1 << 3      /* --atlas */
+    TILED_ATLAS_OPTION = 1 << 3,     /* --atlas */
+    TILED_REPORT_OPTION = 1 << 4     /* --report */
 };
 
 /* Subdividing past this many quads is refused (an OBJ of 16M quads is already
@@ -34,6 +35,7 @@ typedef struct tiled_options {
     tt_rect background;          /* all zero = whole image */
     int mips;                    /* also write the per-tile mip levels */
     const char *atlas_path;      /* --atlas */
+    int report;                  /* --report: tile usage and stretch under the summary */
 } tiled_options;
 
 /* The tool's defaults: the library's, with a gutter of TT_RECOMMENDED_GUTTER
@@ -79,7 +81,8 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
 /* Add the atlas (and with --mips its levels as PREFIX_mipL.png) to the batch. */
 int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips);
 
-/* The one-line summary map and tile print; seams may be NULL. */
-void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams);
+/* The one-line summary map and tile print; seams may be NULL. With `report`
+   a second line gives tile usage and face stretch. */
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams, int report);
 
 #endif /* TILEDTEX_TILED_H */
