@@ -1,0 +1,530 @@
+/* bench.c - throughput figures for tiledtex.h (`make bench`).
+
+   Prints one line per figure, `name value unit`, nothing else on stdout
+   (problems go to stderr and make the exit status non-zero). Every timed
+   figure is the median of several runs after one warm-up run, measured with
+   the monotonic clock.
+
+       build/bench            all figures (about half a minute)
+       build/bench build      only the figures whose name contains "build"
+                              (handy under `perf record` or valgrind)
+
+   The meshes are 1000 x 1000 torus grids: 1M vertices, 1M quads, 4M
+   half-edges, closed (genus 1), so every half-edge has a twin. The second copy
+   has its vertex ids randomly permuted (faces in the same order): it shows
+   how much of the builder's time is memory locality rather than arithmetic.
+
+   `memcpy_1M_quads` is the floor any builder must pay: allocate fresh buffers
+   for the index and position arrays and copy them. `build_assign_uv_over_memcpy`
+   is the end-to-end path (build, allocate the per-corner outputs, assign
+   boundaries and UVs) divided by that floor.
+
+   Memory state matters as much as the code: the first touch of a freshly
+   mapped page costs about as much as copying it several times over, and glibc
+   decides per call whether a big block comes fresh from the kernel or is
+   recycled, depending on what was freed before. So the allocator is pinned:
+     - the plain figures are "cold": every big block is a fresh mapping, page
+       faults included for the library and for memcpy alike (a one-shot
+       importer, a command-line tool);
+     - the `_warm` figures recycle memory freed by the previous run, so no page
+       faults (an engine that rebuilds meshes all the time).
+   On a C library other than glibc the allocator is left alone and both kinds
+   are whatever it does.
+
+   Peers: the CGAL Surface_mesh figure (about 32 ns per half-edge for the same
+   kind of build) is quoted from elsewhere; this program does not link CGAL. */
+#define _POSIX_C_SOURCE 199309L
+#define TILEDTEX_IMPLEMENTATION
+#include "tiledtex.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
+#define GRID 1000           /* torus grid side: GRID * GRID quads */
+#define RUNS_FAST 5         /* runs of the sub-second figures */
+#define RUNS_SLOW 3         /* runs of the multi-second ones */
+#define SLOW_MS 2500.0      /* a warm-up slower than this gets a single timed run */
+
+static int bench_failed = 0;
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static void *xmalloc(size_t size)
+{
+    void *p = malloc(size ? size : 1);
+    if (!p) {
+        fprintf(stderr, "bench: out of memory (%lu bytes)\n", (unsigned long)size);
+        exit(1);
+    }
+    return p;
+}
+
+static void fail(const char *what, tt_result r, const tt_error *err)
+{
+    fprintf(stderr, "bench: %s failed: %s%s%s\n", what, tt_result_string(r),
+            err ? " - " : "", err ? err->message : "");
+    exit(1);
+}
+
+static void report(const char *name, double value, const char *unit)
+{
+    printf("%s %.*f %s\n", name, value < 10.0 ? 2 : 1, value, unit);
+    fflush(stdout);
+}
+
+/* Cold: big blocks are mapped fresh and unmapped on free. Warm: they come
+   from the heap and stay there after free (up to glibc's 32 MB mmap maximum). */
+static void malloc_cold(void)
+{
+#ifdef __GLIBC__
+    malloc_trim(0);
+    mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+    mallopt(M_TRIM_THRESHOLD, 128 * 1024);
+    malloc_trim(0);
+#endif
+}
+
+static void malloc_warm(void)
+{
+#ifdef __GLIBC__
+    mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
+}
+
+/* ---- selection on the command line ---------------------------------------- */
+
+static int g_argc;
+static char **g_argv;
+
+static int wanted(const char *name)
+{
+    int i;
+    if (g_argc <= 1) return 1;
+    for (i = 1; i < g_argc; ++i)
+        if (strstr(name, g_argv[i])) return 1;
+    return 0;
+}
+
+/* ---- timing harness --------------------------------------------------------- */
+
+/* One run: do untimed setup, time the work, do untimed teardown; return ms. */
+typedef double (*run_fn)(void *ctx);
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median_ms(run_fn fn, void *ctx, int runs)
+{
+    double t[16];
+    int i;
+    double warm = fn(ctx);
+    if (warm > SLOW_MS) runs = 1;
+    if (runs > 16) runs = 16;
+    for (i = 0; i < runs; ++i) t[i] = fn(ctx);
+    qsort(t, (size_t)runs, sizeof t[0], cmp_double);
+    return t[runs / 2];
+}
+
+/* ---- test data ---------------------------------------------------------------- */
+
+static uint64_t splitmix64(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+typedef struct grid_mesh {
+    int nverts, nfaces;
+    float *pos;     /* 3 * nverts */
+    int *idx;       /* 4 * nfaces */
+} grid_mesh;
+
+/* Torus, u around the main axis (i), v around the tube (j); quad (i, j) is
+   (i,j) (i+1,j) (i+1,j+1) (i,j+1), which is counter-clockwise seen from
+   outside because dP/du x dP/dv points outwards. */
+static void make_torus(grid_mesh *m, int n)
+{
+    const double R = 1.0, r = 0.35, two_pi = 6.283185307179586;
+    int i, j;
+    m->nverts = n * n;
+    m->nfaces = n * n;
+    m->pos = (float *)xmalloc(sizeof(float) * 3 * (size_t)m->nverts);
+    m->idx = (int *)xmalloc(sizeof(int) * 4 * (size_t)m->nfaces);
+    for (i = 0; i < n; ++i) {
+        double u = two_pi * i / n, cu = cos(u), su = sin(u);
+        for (j = 0; j < n; ++j) {
+            double v = two_pi * j / n, ring = R + r * cos(v);
+            float *p = m->pos + 3 * ((size_t)i * n + j);
+            p[0] = (float)(ring * cu);
+            p[1] = (float)(ring * su);
+            p[2] = (float)(r * sin(v));
+        }
+    }
+    for (i = 0; i < n; ++i) {
+        int i1 = (i + 1) % n;
+        for (j = 0; j < n; ++j) {
+            int j1 = (j + 1) % n;
+            int *q = m->idx + 4 * ((size_t)i * n + j);
+            q[0] = i * n + j;
+            q[1] = i1 * n + j;
+            q[2] = i1 * n + j1;
+            q[3] = i * n + j1;
+        }
+    }
+}
+
+/* Same mesh with vertex ids renamed by a random permutation. */
+static void make_shuffled(const grid_mesh *src, grid_mesh *dst, uint64_t seed)
+{
+    int *perm = (int *)xmalloc(sizeof(int) * (size_t)src->nverts);
+    int v, c, ncorners = 4 * src->nfaces;
+    for (v = 0; v < src->nverts; ++v) perm[v] = v;
+    for (v = src->nverts - 1; v > 0; --v) {
+        int k = (int)(splitmix64(&seed) % (uint64_t)(v + 1)), t = perm[v];
+        perm[v] = perm[k];
+        perm[k] = t;
+    }
+    dst->nverts = src->nverts;
+    dst->nfaces = src->nfaces;
+    dst->pos = (float *)xmalloc(sizeof(float) * 3 * (size_t)src->nverts);
+    dst->idx = (int *)xmalloc(sizeof(int) * (size_t)ncorners);
+    for (v = 0; v < src->nverts; ++v)
+        memcpy(dst->pos + 3 * (size_t)perm[v], src->pos + 3 * (size_t)v, 3 * sizeof(float));
+    for (c = 0; c < ncorners; ++c) dst->idx[c] = perm[src->idx[c]];
+    free(perm);
+}
+
+static void free_grid(grid_mesh *m)
+{
+    free(m->pos);
+    free(m->idx);
+}
+
+static tt_mesh_desc grid_desc(const grid_mesh *m)
+{
+    tt_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    d.positions = m->pos;
+    d.nverts = m->nverts;
+    d.indices = m->idx;
+    d.nfaces = m->nfaces;
+    d.fixed_face_size = 4;
+    d.flags = 0;            /* positions copied, strict validation */
+    return d;
+}
+
+/* Value noise on an integer lattice, smoothly interpolated. */
+static double lattice(int x, int y, int channel)
+{
+    uint64_t s = ((uint64_t)(uint32_t)x << 32) ^ (uint64_t)(uint32_t)y ^ ((uint64_t)channel << 58);
+    return (double)(splitmix64(&s) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static double value_noise(double x, double y, int channel)
+{
+    int x0 = (int)floor(x), y0 = (int)floor(y);
+    double fx = x - x0, fy = y - y0;
+    double sx = fx * fx * (3 - 2 * fx), sy = fy * fy * (3 - 2 * fy);
+    double a = lattice(x0, y0, channel), b = lattice(x0 + 1, y0, channel);
+    double c = lattice(x0, y0 + 1, channel), d = lattice(x0 + 1, y0 + 1, channel);
+    return (a + (b - a) * sx) * (1 - sy) + (c + (d - c) * sx) * sy;
+}
+
+/* A 512 x 512 "stone" texture: four octaves of noise per channel plus dark
+   cracks where a coarse noise crosses one half. */
+static void make_source(tt_image *img, int size)
+{
+    int x, y, ch;
+    tt_result r = tt_image_create(img, size, size, NULL);
+    if (r != TT_OK) fail("tt_image_create", r, NULL);
+    for (y = 0; y < size; ++y)
+        for (x = 0; x < size; ++x) {
+            float *p = img->pixels + 4 * ((size_t)y * size + x);
+            double crack = fabs(value_noise(x / 24.0, y / 24.0, 7) - 0.5);
+            double dark = crack < 0.03 ? 0.45 : 1.0;
+            for (ch = 0; ch < 3; ++ch) {
+                double v = 0, amp = 0.5, freq = 1.0 / 32.0;
+                int o;
+                for (o = 0; o < 4; ++o, amp *= 0.5, freq *= 2.0)
+                    v += amp * value_noise(x * freq, y * freq, ch * 4 + o);
+                v = (0.35 + 0.2 * ch) * 0.5 + 0.55 * v;
+                p[ch] = (float)(v * dark);
+            }
+            p[3] = 1.0f;
+        }
+}
+
+/* ---- the figures ---------------------------------------------------------------- */
+
+typedef struct build_ctx {
+    const grid_mesh *grid;
+} build_ctx;
+
+static double run_build(void *p)
+{
+    build_ctx *ctx = (build_ctx *)p;
+    tt_mesh_desc d = grid_desc(ctx->grid);
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    double t0 = now_ms(), t1;
+    tt_result r = tt_mesh_build(&d, &mesh, &err);
+    t1 = now_ms();
+    if (r != TT_OK) fail("tt_mesh_build", r, &err);
+    tt_mesh_free(mesh);
+    return t1 - t0;
+}
+
+typedef struct assign_ctx {
+    const tt_mesh *mesh;
+    uint8_t *types;
+    float *uv;
+    uint64_t seed;
+} assign_ctx;
+
+static double run_assign(void *p)
+{
+    assign_ctx *ctx = (assign_ctx *)p;
+    tt_tile_layout layout;
+    tt_error err;
+    tt_result r;
+    double t0, t1;
+    memset(&layout, 0, sizeof layout);
+    t0 = now_ms();
+    r = tt_assign_boundaries(ctx->mesh, &layout, ctx->seed++, ctx->types);
+    if (r == TT_OK) r = tt_assign_uvs(ctx->mesh, &layout, ctx->types, ctx->uv, &err);
+    t1 = now_ms();
+    if (r != TT_OK) fail("tt_assign_boundaries / tt_assign_uvs", r, NULL);
+    return t1 - t0;
+}
+
+static double run_build_assign(void *p)
+{
+    build_ctx *ctx = (build_ctx *)p;
+    tt_mesh_desc d = grid_desc(ctx->grid);
+    tt_mesh *mesh = NULL;
+    tt_tile_layout layout;
+    uint8_t *types;
+    float *uv;
+    tt_error err;
+    tt_result r;
+    double t0, t1;
+    memset(&layout, 0, sizeof layout);
+    t0 = now_ms();
+    r = tt_mesh_build(&d, &mesh, &err);
+    if (r != TT_OK) fail("tt_mesh_build", r, &err);
+    types = (uint8_t *)xmalloc((size_t)mesh->ncorners);
+    uv = (float *)xmalloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    r = tt_assign_boundaries(mesh, &layout, 42, types);
+    if (r == TT_OK) r = tt_assign_uvs(mesh, &layout, types, uv, &err);
+    t1 = now_ms();
+    if (r != TT_OK) fail("tt_assign_boundaries / tt_assign_uvs", r, NULL);
+    free(uv);
+    free(types);
+    tt_mesh_free(mesh);
+    return t1 - t0;
+}
+
+static double run_memcpy(void *p)
+{
+    build_ctx *ctx = (build_ctx *)p;
+    size_t ibytes = sizeof(int) * 4 * (size_t)ctx->grid->nfaces;
+    size_t pbytes = sizeof(float) * 3 * (size_t)ctx->grid->nverts;
+    int *idx;
+    float *pos;
+    double t0 = now_ms(), t1;
+    idx = (int *)xmalloc(ibytes);
+    pos = (float *)xmalloc(pbytes);
+    memcpy(idx, ctx->grid->idx, ibytes);
+    memcpy(pos, ctx->grid->pos, pbytes);
+    t1 = now_ms();
+    /* keep the copy observable so it cannot be optimised away */
+    if (idx[ctx->grid->nfaces] != ctx->grid->idx[ctx->grid->nfaces] || pos[1] != ctx->grid->pos[1])
+        fail("memcpy check", TT_OK, NULL);
+    free(idx);
+    free(pos);
+    return t1 - t0;
+}
+
+typedef struct quad_ctx {
+    const tt_mesh *mesh;
+} quad_ctx;
+
+static double run_quadrangulate(void *p)
+{
+    quad_ctx *ctx = (quad_ctx *)p;
+    tt_mesh *out = NULL;
+    tt_error err;
+    double t0 = now_ms(), t1;
+    tt_result r = tt_mesh_quadrangulate(ctx->mesh, TT_SUBDIVIDE_LINEAR, &out, &err);
+    t1 = now_ms();
+    if (r != TT_OK) fail("tt_mesh_quadrangulate", r, &err);
+    tt_mesh_free(out);
+    return t1 - t0;
+}
+
+typedef struct synth_ctx {
+    const tt_image *source;
+    int colors, tile_size;
+    uint64_t seed;
+} synth_ctx;
+
+static double run_synth(void *p)
+{
+    synth_ctx *ctx = (synth_ctx *)p;
+    tt_synth_options opt;
+    tt_tileset *tiles = NULL;
+    tt_error err;
+    tt_result r;
+    double t0, t1;
+    memset(&opt, 0, sizeof opt);
+    opt.layout.colors = ctx->colors;
+    opt.layout.tile_size = ctx->tile_size;
+    opt.seed = ctx->seed++;
+    t0 = now_ms();
+    r = tt_synthesize_tiles(ctx->source, &opt, &tiles, &err);
+    t1 = now_ms();
+    if (r != TT_OK) fail("tt_synthesize_tiles", r, &err);
+    tt_tileset_free(tiles);
+    return t1 - t0;
+}
+
+/* Untimed: the meshes really are what the figures claim (closed torus). */
+static void check_mesh(const tt_mesh *mesh, const char *what)
+{
+    tt_mesh_stats st;
+    tt_result r = tt_mesh_compute_stats(mesh, &st);
+    if (r != TT_OK) fail("tt_mesh_compute_stats", r, NULL);
+    if (mesh->ncorners != 4 * GRID * GRID || st.boundary_edges != 0 || st.genus != 1 ||
+        st.edges != 2 * GRID * GRID || st.min_valence != 4 || st.max_valence != 4) {
+        fprintf(stderr, "bench: %s: unexpected topology (corners %d, edges %d, boundary %d, genus %d, valence %d..%d)\n",
+                what, mesh->ncorners, st.edges, st.boundary_edges, st.genus, st.min_valence, st.max_valence);
+        bench_failed = 1;
+    }
+}
+
+int main(int argc, char **argv)
+{
+    grid_mesh grid, shuffled;
+    build_ctx bc, bcs;
+    double build_ms = -1, e2e_ms = -1, memcpy_ms = -1;
+    int halfedges = 4 * GRID * GRID;
+
+    g_argc = argc;
+    g_argv = argv;
+    malloc_cold();
+    make_torus(&grid, GRID);
+    bc.grid = &grid;
+
+    if (wanted("build_1M_quads") || wanted("build_1M_quads_per_halfedge")) {
+        build_ms = median_ms(run_build, &bc, RUNS_FAST);
+        report("build_1M_quads", build_ms, "ms");
+        report("build_1M_quads_per_halfedge", build_ms * 1e6 / halfedges, "ns");
+    }
+    if (wanted("build_1M_quads_shuffled")) {
+        double ms;
+        make_shuffled(&grid, &shuffled, 12345);
+        bcs.grid = &shuffled;
+        ms = median_ms(run_build, &bcs, RUNS_FAST);
+        report("build_1M_quads_shuffled", ms, "ms");
+        report("build_1M_quads_shuffled_per_halfedge", ms * 1e6 / halfedges, "ns");
+        {
+            tt_mesh_desc d = grid_desc(&shuffled);
+            tt_mesh *mesh;
+            tt_error err;
+            tt_result r = tt_mesh_build(&d, &mesh, &err);
+            if (r != TT_OK) fail("tt_mesh_build (shuffled)", r, &err);
+            check_mesh(mesh, "shuffled torus");
+            tt_mesh_free(mesh);
+        }
+        free_grid(&shuffled);
+    }
+    if (wanted("assign_uv_1M_quads") || wanted("quadrangulate_1M_quads")) {
+        tt_mesh_desc d = grid_desc(&grid);
+        tt_mesh *mesh;
+        tt_error err;
+        tt_result r = tt_mesh_build(&d, &mesh, &err);
+        if (r != TT_OK) fail("tt_mesh_build", r, &err);
+        check_mesh(mesh, "torus");
+        if (wanted("assign_uv_1M_quads")) {
+            assign_ctx ac;
+            ac.mesh = mesh;
+            ac.seed = 1;
+            ac.types = (uint8_t *)xmalloc((size_t)mesh->ncorners);
+            ac.uv = (float *)xmalloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+            report("assign_uv_1M_quads", median_ms(run_assign, &ac, RUNS_FAST), "ms");
+            free(ac.types);
+            free(ac.uv);
+        }
+        if (wanted("quadrangulate_1M_quads")) {
+            quad_ctx qc;
+            qc.mesh = mesh;
+            report("quadrangulate_1M_quads", median_ms(run_quadrangulate, &qc, RUNS_SLOW), "ms");
+        }
+        tt_mesh_free(mesh);
+    }
+    if (wanted("build_assign_uv_1M_quads") || wanted("build_assign_uv_over_memcpy")) {
+        e2e_ms = median_ms(run_build_assign, &bc, RUNS_FAST);
+        report("build_assign_uv_1M_quads", e2e_ms, "ms");
+    }
+    if (wanted("memcpy_1M_quads") || wanted("build_assign_uv_over_memcpy")) {
+        memcpy_ms = median_ms(run_memcpy, &bc, RUNS_FAST);
+        report("memcpy_1M_quads", memcpy_ms, "ms");
+    }
+    if (e2e_ms >= 0 && memcpy_ms > 0) report("build_assign_uv_over_memcpy", e2e_ms / memcpy_ms, "x");
+
+    malloc_warm();
+    if (wanted("build_1M_quads_warm")) {
+        build_ms = median_ms(run_build, &bc, RUNS_FAST);
+        report("build_1M_quads_warm", build_ms, "ms");
+        report("build_1M_quads_warm_per_halfedge", build_ms * 1e6 / halfedges, "ns");
+    }
+    e2e_ms = memcpy_ms = -1;
+    if (wanted("build_assign_uv_1M_quads_warm") || wanted("build_assign_uv_over_memcpy_warm")) {
+        e2e_ms = median_ms(run_build_assign, &bc, RUNS_FAST);
+        report("build_assign_uv_1M_quads_warm", e2e_ms, "ms");
+    }
+    if (wanted("memcpy_1M_quads_warm") || wanted("build_assign_uv_over_memcpy_warm")) {
+        memcpy_ms = median_ms(run_memcpy, &bc, RUNS_FAST);
+        report("memcpy_1M_quads_warm", memcpy_ms, "ms");
+    }
+    if (e2e_ms >= 0 && memcpy_ms > 0) report("build_assign_uv_over_memcpy_warm", e2e_ms / memcpy_ms, "x");
+    malloc_cold();
+    free_grid(&grid);
+
+    if (wanted("synth_n1_tile256") || wanted("synth_n2_tile64")) {
+        tt_image source;
+        synth_ctx sc;
+        make_source(&source, 512);
+        sc.source = &source;
+        sc.seed = 7;
+        if (wanted("synth_n1_tile256")) {
+            sc.colors = 1;
+            sc.tile_size = 256;
+            report("synth_n1_tile256", median_ms(run_synth, &sc, RUNS_SLOW), "ms");
+        }
+        if (wanted("synth_n2_tile64")) {
+            sc.colors = 2;
+            sc.tile_size = 64;
+            report("synth_n2_tile64", median_ms(run_synth, &sc, RUNS_SLOW), "ms");
+        }
+        tt_image_free(&source);
+    }
+    return bench_failed;
+}

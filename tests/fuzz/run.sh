@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# tests/fuzz/run.sh [SECONDS] - build the libFuzzer targets into build/fuzz/ and run
+# each for SECONDS (default 60), side by side. Exits non-zero if a target crashed,
+# leaked, hit undefined behaviour or broke a contract check; the input that did it
+# is saved as build/fuzz/<target>-crash-* (or -leak-, -timeout-, -oom-).
+#
+# The seed corpora in tests/fuzz/corpus_* are copied into build/fuzz/corpus_*
+# (which keeps growing from run to run until `make clean`), so the repository's
+# seeds are never modified. Needs clang with libFuzzer (FUZZ_CC overrides).
+#
+# Reproduce a saved input:  build/fuzz/fuzz_obj build/fuzz/fuzz_obj-crash-<sha1>
+set -u
+secs=${1:-60}
+root=$(cd "$(dirname "$0")/../.." && pwd)
+cd "$root" || exit 2
+out=build/fuzz
+mkdir -p "$out"
+
+cc=${FUZZ_CC:-clang}
+if ! command -v "$cc" >/dev/null 2>&1; then
+  echo "fuzz: $cc not found (libFuzzer needs clang; set FUZZ_CC)" >&2
+  exit 2
+fi
+flags="-std=c99 -g -O1 -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
+warn="-Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes"
+# stb as a system header: its own warnings are not ours to fix
+stb=$(pkg-config --cflags-only-I stb 2>/dev/null | sed "s/-I/-isystem /g")
+[ -n "$stb" ] || stb="-isystem /usr/include/stb"
+
+targets=()
+echo "fuzz: building into $out/"
+if $cc $flags $warn -I. tests/fuzz/fuzz_mesh_build.c -o "$out/fuzz_mesh_build" -lm; then
+  targets+=(mesh_build)
+else
+  echo "fuzz: fuzz_mesh_build does not build" >&2
+  exit 2
+fi
+if [ -f examples/tool_io.c ] && [ -f examples/tool.h ]; then
+  # tool_io.c is compiled as it is; fuzz_obj.c is the one TU that defines
+  # TILEDTEX_IMPLEMENTATION.
+  if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_obj.c examples/tool_io.c -o "$out/fuzz_obj" -lm; then
+    targets+=(obj)
+  else
+    echo "fuzz: fuzz_obj does not build" >&2
+    exit 2
+  fi
+else
+  echo "fuzz: SKIPPED fuzz_obj: examples/tool_io.c or examples/tool.h is missing" >&2
+fi
+
+declare -A pid
+for t in "${targets[@]}"; do
+  corpus="$out/corpus_$t"
+  mkdir -p "$corpus"
+  cp -n tests/fuzz/corpus_"$t"/* "$corpus"/ 2>/dev/null
+  extra=()
+  [ -f tests/fuzz/"$t".dict ] && extra+=("-dict=tests/fuzz/$t.dict")
+  "$out/fuzz_$t" -max_total_time="$secs" -max_len=4096 -timeout=20 -rss_limit_mb=2048 \
+    -print_final_stats=1 -artifact_prefix="$out/fuzz_$t-" "${extra[@]}" "$corpus" \
+    >"$out/fuzz_$t.log" 2>&1 &
+  pid[$t]=$!
+done
+
+status=0
+for t in "${targets[@]}"; do
+  wait "${pid[$t]}"
+  rc=$?
+  log="$out/fuzz_$t.log"
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  cov=$(grep -o 'cov: [0-9]* ft: [0-9]* corp: [0-9]*/[^ ]*' "$log" | tail -1)
+  if [ "$rc" = 0 ]; then
+    echo "fuzz_$t: ok, ${execs:-?} execs in ${secs}s, $cov"
+  else
+    status=1
+    echo "fuzz_$t: FAILED (exit $rc) after ${execs:-?} execs; log: $log"
+    grep -m1 -E 'ERROR: |contract broken|runtime error|deadly signal' "$log" | sed 's/^/    /'
+    grep -E '^(artifact_prefix|Test unit written)' "$log" | sed 's/^/    /'
+  fi
+done
+exit $status
