@@ -818,6 +818,29 @@ static int tt__fan_size(const tt_mesh *mesh, int v)
     return visited;
 }
 
+/* A mesh with its arrays allocated (positions excepted), or NULL. */
+static tt_mesh *tt__mesh_alloc(const tt_allocator *allocator, int nverts, int nfaces, int ncorners, unsigned flags)
+{
+    tt_mesh *mesh = TT__ALLOC(allocator, tt_mesh, 1);
+    if (!mesh) return NULL;
+    memset(mesh, 0, sizeof *mesh);
+    mesh->allocator = *allocator;
+    mesh->flags = flags;
+    mesh->nverts = nverts;
+    mesh->nfaces = nfaces;
+    mesh->ncorners = ncorners;
+    mesh->face_start = TT__ALLOC(allocator, int, (size_t)nfaces + 1);
+    mesh->corner_vert = TT__ALLOC(allocator, int, ncorners);
+    mesh->corner_face = TT__ALLOC(allocator, int, ncorners);
+    mesh->twin = TT__ALLOC(allocator, int, ncorners);
+    mesh->vert_corner = TT__ALLOC(allocator, int, nverts);
+    if (!mesh->face_start || !mesh->corner_vert || !mesh->corner_face || !mesh->twin || !mesh->vert_corner) {
+        tt_mesh_free(mesh);
+        return NULL;
+    }
+    return mesh;
+}
+
 TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_error *error)
 {
     const tt_allocator *allocator;
@@ -852,7 +875,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
         for (f = 0; f < nfaces; f++) {
             int size = desc->face_sizes[f];
             if (size < 3)
-                return tt__fail(error, TT_ERROR_FACE_TOO_SMALL, f, (int)total_corners, -1, -1,
+                return tt__fail(error, TT_ERROR_FACE_TOO_SMALL, f, size > 0 ? (int)total_corners : -1, -1, -1,
                                 "face %d has %d corners; a face needs at least 3", f, size);
             total_corners += size;
             if (total_corners > 0x3fffffff)
@@ -870,31 +893,22 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     }
     ncorners = (int)total_corners;
 
-    mesh = TT__ALLOC(allocator, tt_mesh, 1);
-    if (!mesh) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for the mesh");
-    memset(mesh, 0, sizeof *mesh);
-    mesh->allocator = *allocator;
-    mesh->flags = desc->flags;
-    mesh->nverts = nverts;
-    mesh->nfaces = nfaces;
-    mesh->ncorners = ncorners;
-    mesh->face_start = TT__ALLOC(allocator, int, (size_t)nfaces + 1);
-    mesh->corner_vert = TT__ALLOC(allocator, int, ncorners);
-    mesh->corner_face = TT__ALLOC(allocator, int, ncorners);
-    mesh->twin = TT__ALLOC(allocator, int, ncorners);
-    mesh->vert_corner = TT__ALLOC(allocator, int, nverts);
+    mesh = tt__mesh_alloc(allocator, nverts, nfaces, ncorners, desc->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS);
+    if (!mesh)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                        "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
     bucket_start = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     out_count = TT__ALLOC(allocator, int, nverts);
     buckets = TT__ALLOC(allocator, tt__edge_entry, ncorners);
     if (desc->flags & TT_MESH_BORROW_POSITIONS) {
+        mesh->flags = desc->flags;
         mesh->pos = desc->positions;
     } else {
         float *copy = TT__ALLOC(allocator, float, (size_t)nverts * 3);
         if (copy && nverts > 0) memcpy(copy, desc->positions, (size_t)nverts * 3 * sizeof(float));
         mesh->pos = copy;
     }
-    if (!mesh->face_start || !mesh->corner_vert || !mesh->corner_face || !mesh->twin || !mesh->vert_corner ||
-        !bucket_start || !out_count || !buckets || !mesh->pos) {
+    if (!bucket_start || !out_count || !buckets || !mesh->pos) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                           "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
         goto cleanup;
@@ -1243,13 +1257,13 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
                                       tt_error *error)
 {
     const tt_allocator *allocator;
-    int *edge_of = NULL, *quads = NULL, nedges = 0, c, f, v;
-    double *sum = NULL;       /* CC vertex rule accumulators: 3 face sums, 3 edge-midpoint sums */
+    int *edge_of = NULL, nedges = 0, c, f, v, nverts_new;
+    double *sum = NULL;       /* CC vertex rule accumulators: 3 face sums, 3 edge-midpoint sums, 3 boundary sums */
     int *count = NULL;        /* per vertex: faces, edges, boundary edges */
     float *pos = NULL;
-    long long nverts_new, ncorners_new;
-    tt_mesh_desc desc;
-    tt_result result;
+    tt_mesh *quads = NULL;
+    long long nverts_wanted, ncorners_new;
+    tt_result result = TT_OK;
 
     tt__ok(error);
     if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
@@ -1265,35 +1279,60 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
         int t = mesh->twin[c];
         edge_of[c] = (t < 0 || c < t) ? nedges++ : edge_of[t];
     }
-    nverts_new = (long long)mesh->nverts + nedges + mesh->nfaces;
+    nverts_wanted = (long long)mesh->nverts + nedges + mesh->nfaces;
     ncorners_new = 4LL * mesh->ncorners;
-    if (nverts_new > 0x3fffffff || ncorners_new > 0x3fffffff) {
+    if (nverts_wanted > 0x3fffffff || ncorners_new > 0x3fffffff) {
         tt__free(allocator, edge_of);
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "quadrangulating %d corners would make %lld corners, more than %d", mesh->ncorners,
                         ncorners_new, 0x3fffffff);
     }
+    nverts_new = (int)nverts_wanted;
     pos = TT__ALLOC(allocator, float, (size_t)nverts_new * 3);
-    quads = TT__ALLOC(allocator, int, (size_t)ncorners_new);
+    quads = tt__mesh_alloc(allocator, nverts_new, mesh->ncorners, (int)ncorners_new,
+                           mesh->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS);
     if (!pos || !quads) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
         goto done;
     }
 
-    /* Quad i of face f: (v_i, edge point of half-edge i, face point, edge point
-       of half-edge i-1) keeps the face's counter-clockwise order. */
+    /* Topology, straight from the input's: no search, and a valid mesh gives
+       a valid result. Quad c (one per input corner c of face f, with next n,
+       previous p) is (v_c, E(c), F(f), E(p)); its half-edges are
+         4c   v_c -> E(c)   first half of old c:  twin is the second half of
+                            twin(c), i.e. half-edge 4 next(twin c) + 3
+         4c+1 E(c) -> F     inside f:             twin 4n + 2
+         4c+2 F -> E(p)     inside f:             twin 4p + 1
+         4c+3 E(p) -> v_c   second half of old p: twin 4 twin(p) */
     for (f = 0; f < mesh->nfaces; f++) {
         int first = mesh->face_start[f], end = mesh->face_start[f + 1];
         int face_point = mesh->nverts + nedges + f;
         for (c = first; c < end; c++) {
-            int prev = c > first ? c - 1 : end - 1;
-            int *q = quads + 4 * (size_t)c;
+            int n = c + 1 < end ? c + 1 : first, p = c > first ? c - 1 : end - 1, t = mesh->twin[c], k;
+            int *q = quads->corner_vert + 4 * (size_t)c, *tw = quads->twin + 4 * (size_t)c;
             q[0] = mesh->corner_vert[c];
             q[1] = mesh->nverts + edge_of[c];
             q[2] = face_point;
-            q[3] = mesh->nverts + edge_of[prev];
+            q[3] = mesh->nverts + edge_of[p];
+            tw[0] = t >= 0 ? 4 * tt_mesh_next(mesh, t) + 3 : -1;
+            tw[1] = 4 * n + 2;
+            tw[2] = 4 * p + 1;
+            tw[3] = mesh->twin[p] >= 0 ? 4 * mesh->twin[p] : -1;
+            quads->face_start[c] = 4 * c;
+            for (k = 0; k < 4; k++) quads->corner_face[4 * c + k] = c;
         }
+        quads->vert_corner[face_point] = 4 * first + 2;
     }
+    quads->face_start[mesh->ncorners] = 4 * mesh->ncorners;
+    /* Outgoing half-edges, a boundary one where there is one: an old vertex
+       keeps its own (first half of it); an edge point takes the second half of
+       its edge (a boundary exactly when the edge is). */
+    for (v = 0; v < mesh->nverts; v++) quads->vert_corner[v] = mesh->vert_corner[v] >= 0 ? 4 * mesh->vert_corner[v] : -1;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] < 0 || c < mesh->twin[c])
+            quads->vert_corner[mesh->nverts + edge_of[c]] = 4 * tt_mesh_next(mesh, c) + 3;
+    quads->min_face_size = quads->max_face_size = 4;
+    quads->repaired_edges = 2 * mesh->repaired_edges;   /* each cut edge is now two */
 
     /* Face points: centroids. Edge points: midpoints (linear, and CC on a
        boundary) or the average of the two ends and the two face points (CC). */
@@ -1362,37 +1401,40 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
             }
         }
         for (v = 0; v < mesh->nverts; v++) {
-            const double *s = sum + 9 * (size_t)v;
+            const double *sv = sum + 9 * (size_t)v;
             const int *n = count + 3 * (size_t)v;
             const float *old = mesh->pos + 3 * (size_t)v;
             float *out = pos + 3 * (size_t)v;
             int k;
             if (n[0] == 0) continue;
             if (n[2] == 2) {
-                for (k = 0; k < 3; k++) out[k] = (float)(0.75 * old[k] + 0.125 * s[6 + k]);
+                for (k = 0; k < 3; k++) out[k] = (float)(0.75 * old[k] + 0.125 * sv[6 + k]);
             } else if (n[2] == 0) {
                 double faces = n[0];
                 for (k = 0; k < 3; k++)
-                    out[k] = (float)((s[k] / faces + 2.0 * s[3 + k] / n[1] + (faces - 3.0) * old[k]) / faces);
+                    out[k] = (float)((sv[k] / faces + 2.0 * sv[3 + k] / n[1] + (faces - 3.0) * old[k]) / faces);
             }
         }
     }
-
-    memset(&desc, 0, sizeof desc);
-    desc.positions = pos;
-    desc.nverts = (int)nverts_new;
-    desc.indices = quads;
-    desc.nfaces = mesh->ncorners;
-    desc.fixed_face_size = 4;
-    desc.flags = mesh->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS;
-    desc.allocator = mesh->allocator;
-    result = tt_mesh_build(&desc, out_mesh, error);
+    /* Averages of finite numbers can still overflow float. */
+    for (v = 0; v < nverts_new; v++)
+        if (!tt__is_finite(pos[3 * (size_t)v]) || !tt__is_finite(pos[3 * (size_t)v + 1]) ||
+            !tt__is_finite(pos[3 * (size_t)v + 2])) {
+            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, v, -1,
+                              "quadrangulation overflowed: new vertex %d is not finite (coordinates near the "
+                              "float limit)", v);
+            goto done;
+        }
+    quads->pos = pos;
+    pos = NULL;
+    *out_mesh = quads;
+    quads = NULL;
 done:
     tt__free(allocator, edge_of);
-    tt__free(allocator, quads);
     tt__free(allocator, pos);
     tt__free(allocator, sum);
     tt__free(allocator, count);
+    tt_mesh_free(quads);
     return result;
 }
 

@@ -1011,8 +1011,8 @@ static size_t read_name(obj_parser *P, char *name, size_t name_size)
         if (length == 0 || token[0] == '#') break;
         if (n > 0 && n + 1 < name_size) name[n++] = ' ';
         if (length > name_size - 1 - n) length = name_size - 1 - n;
-        memcpy(name + n, token, length);
-        n += length;
+        /* Control bytes (a NUL would end the C string early) become '_'. */
+        for (; length > 0; length--, token++) name[n++] = (unsigned char)*token < 0x20 ? '_' : *token;
     }
     name[n] = '\0';
     return n;
@@ -1170,6 +1170,14 @@ void obj_free(obj_mesh *mesh)
 /* OBJ and MTL writing                                                      */
 /* ======================================================================== */
 
+/* "KEYWORD NAME" and a newline. A name ending in '\\' gets a blank after it,
+   or the reader would take the backslash for a line continuation. */
+static void write_name_line(tool_buffer *out, const char *keyword, const char *name)
+{
+    size_t length = strlen(name);
+    buffer_printf(out, "%s %s%s\n", keyword, name, length > 0 && name[length - 1] == '\\' ? " " : "");
+}
+
 int obj_write(tool_buffer *out, const obj_write_desc *desc)
 {
     int v, f, c = 0, previous_group = -1;
@@ -1187,7 +1195,7 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
             line += length + (newline ? 1 : 0);
         }
     }
-    if (desc->mtllib) buffer_printf(out, "mtllib %s\n", desc->mtllib);
+    if (desc->mtllib) write_name_line(out, "mtllib", desc->mtllib);
 
     /* %.9g: nine significant digits are enough for any float to read back
        exactly, so writing a mesh and reading it again changes nothing. */
@@ -1203,7 +1211,7 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         c = 0;
     }
 
-    if (desc->material && !(desc->face_group && desc->group_materials)) buffer_printf(out, "usemtl %s\n", desc->material);
+    if (desc->material && !(desc->face_group && desc->group_materials)) write_name_line(out, "usemtl", desc->material);
     for (f = 0; f < desc->nfaces; f++) {
         int size = desc->face_size ? desc->face_size[f] : desc->fixed_face_size, i;
         if (size < 3) return -1;
@@ -1211,9 +1219,9 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
             int group = desc->face_group[f];
             if (group < 0 || group >= desc->ngroups) return -1;
             if (group != previous_group) {
-                buffer_printf(out, "g %s\n", desc->group_names[group]);
+                write_name_line(out, "g", desc->group_names[group]);
                 if (desc->group_materials && desc->group_materials[group])
-                    buffer_printf(out, "usemtl %s\n", desc->group_materials[group]);
+                    write_name_line(out, "usemtl", desc->group_materials[group]);
                 previous_group = group;
             }
         }
@@ -1231,8 +1239,8 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
 
 void mtl_add_material(tool_buffer *out, const char *name, const char *texture)
 {
-    buffer_printf(out, "newmtl %s\n", name);
+    write_name_line(out, "newmtl", name);
     buffer_printf(out, "Ka 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\n");
-    if (texture) buffer_printf(out, "map_Kd %s\n", texture);
+    if (texture) write_name_line(out, "map_Kd", texture);
     buffer_printf(out, "\n");
 }

@@ -1409,6 +1409,107 @@ static void check_topology_kept(const tt_mesh *a, const tt_mesh *b, const char *
           sb.euler_characteristic, sb.genus, sb.components, sb.boundary_loops, sb.boundary_edges);
 }
 
+/* Quadrangulation builds its output's topology directly from the input's.
+   Rebuild the same index buffer with the validating builder (a permissive one
+   for a permissive input) and demand the same twins, and vert_corner entries
+   that leave the right vertex and are boundaries exactly where one exists. */
+static void check_direct_topology(const tt_mesh *q, const char *name)
+{
+    tt_mesh_desc d;
+    tt_mesh *rebuilt = NULL;
+    tt_error err;
+    int c, v, bad_twin = 0, bad_vc = 0;
+    memset(&d, 0, sizeof d);
+    d.positions = q->pos;
+    d.nverts = q->nverts;
+    d.indices = q->corner_vert;
+    d.nfaces = q->nfaces;
+    d.fixed_face_size = 4;
+    d.flags = TT_MESH_PERMISSIVE;   /* zero-area quads are possible in the output */
+    if (tt_mesh_build(&d, &rebuilt, &err) != TT_OK) {
+        CHECK(0, "%s: rebuilding the quadrangulation failed: %s", name, err.message);
+        return;
+    }
+    for (c = 0; c < q->ncorners; c++) {
+        if (q->twin[c] != rebuilt->twin[c]) bad_twin++;
+        if (q->corner_face[c] != c / 4) bad_twin++;
+    }
+    for (v = 0; v < q->nverts; v++) {
+        int h = q->vert_corner[v], want_boundary = rebuilt->vert_corner[v] >= 0 && rebuilt->twin[rebuilt->vert_corner[v]] < 0;
+        if (h < 0 || q->corner_vert[h] != v || ((q->twin[h] < 0) != want_boundary)) bad_vc++;
+    }
+    CHECK(bad_twin == 0, "%s: %d twins / corner faces differ from a validated rebuild", name, bad_twin);
+    CHECK(bad_vc == 0, "%s: %d vert_corner entries wrong", name, bad_vc);
+    tt_mesh_free(rebuilt);
+}
+
+static void test_quadrangulate_direct(void)
+{
+    tmesh m;
+    tt_mesh *mesh, *q;
+    tt_error err;
+    int which;
+    memset(&m, 0, sizeof m);
+    for (which = 0; which < 4; which++) {
+        const char *name = which == 0 ? "mixed" : which == 1 ? "open grid" : which == 2 ? "genus-2" : "torus";
+        if (which == 0) make_mixed(&m);
+        if (which == 1) make_grid(&m, 4, 3);
+        if (which == 2) make_genus2(&m);
+        if (which == 3) make_torus(&m, 6, 5, 3.0, 1.0);
+        if (build(&m, 0, &mesh, &err) == TT_OK) {
+            if (tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q, &err) == TT_OK) {
+                check_direct_topology(q, name);
+                tt_mesh_free(q);
+            } else {
+                CHECK(0, "%s: quadrangulate failed: %s", name, err.message);
+            }
+            tt_mesh_free(mesh);
+        } else {
+            CHECK(0, "%s: build failed: %s", name, err.message);
+        }
+        tm_free(&m);
+    }
+    /* A permissive mesh: three triangles on one edge (cut open) still
+       quadrangulates into a consistent mesh. */
+    tm_tri(&m, tm_vert(&m, 0, 0, 0), tm_vert(&m, 1, 0, 0), tm_vert(&m, 0, 1, 0));
+    tm_tri(&m, 1, 0, tm_vert(&m, 0, -1, 0));
+    tm_tri(&m, 0, 1, tm_vert(&m, 0, 0, 1));
+    if (build(&m, TT_MESH_PERMISSIVE, &mesh, &err) == TT_OK) {
+        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, &q, &err) == TT_OK, "permissive: %s", err.message);
+        if (q) { check_direct_topology(q, "permissive"); tt_mesh_free(q); }
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+    /* A valid hexagon whose last four corners are distinct vertices at one
+       point: its quads there have zero area, and quadrangulating must still
+       succeed (it validated the input, not its own output). */
+    {
+        float p[18] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0};
+        int idx[6] = {0, 1, 2, 3, 4, 5};
+        tt_mesh_desc d;
+        memset(&d, 0, sizeof d);
+        d.positions = p; d.nverts = 6; d.indices = idx; d.nfaces = 1; d.fixed_face_size = 6;
+        if (tt_mesh_build(&d, &mesh, &err) == TT_OK) {
+            tt_result r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, &q, &err);
+            CHECK(r == TT_OK && q && q->nfaces == 6, "hexagon with coincident corners: result %d (%s)", r, err.message);
+            tt_mesh_free(q);
+            tt_mesh_free(mesh);
+        } else {
+            CHECK(0, "hexagon with coincident corners should build: %s", err.message);
+        }
+    }
+    /* An empty face names no corner (there is none). */
+    {
+        float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        int idx[3] = {0, 1, 2}, sizes[2] = {3, 0};
+        tt_mesh_desc d;
+        memset(&d, 0, sizeof d);
+        d.positions = p; d.nverts = 3; d.indices = idx; d.face_sizes = sizes; d.nfaces = 2;
+        CHECK(tt_mesh_build(&d, &mesh, &err) == TT_ERROR_FACE_TOO_SMALL && err.face == 1 && err.corner == -1,
+              "empty face: face %d corner %d", err.face, err.corner);
+    }
+}
+
 static void test_quadrangulate(void)
 {
     tmesh m;
@@ -3202,6 +3303,7 @@ int main(void)
     RUN(test_queries);
     RUN(test_queries_oom);
     RUN(test_quadrangulate);
+    RUN(test_quadrangulate_direct);
     RUN(test_image_basics);
     RUN(test_rotate);
     RUN(test_over_downsample);

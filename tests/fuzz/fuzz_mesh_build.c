@@ -35,8 +35,7 @@
    when one exists, stats that disagree with the arrays, boundary types whose twins
    are not complementary (2k+i vs 2k+1-i), UVs outside [0,1], a quadrangulation
    with the wrong counts, an allocation not given back, an error without a place or
-   a sentence, or TT_ERROR_OUT_OF_MEMORY when no allocation failed. Two known
-   issues are tolerated and marked KNOWN below until tiledtex.h changes. */
+   a sentence, or TT_ERROR_OUT_OF_MEMORY when no allocation failed. */
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 
@@ -132,11 +131,8 @@ static void check_error(tt_result r, const tt_error *err, int nfaces, int ncorne
     CHECK(len > 0 && len < sizeof err->message, "message length %lu", (unsigned long)len);
     CHECK(err->face >= -1 && err->face < (nfaces > 0 ? nfaces : 1), "face %d of %d: %s", err->face, nfaces,
           err->message);
-    /* KNOWN: an empty last face is reported at corner == ncorners (one past the
-       index buffer); tolerated here until tiledtex.h reports -1. */
-    CHECK((err->corner >= -1 && err->corner < (ncorners > 0 ? ncorners : 1)) ||
-              (r == TT_ERROR_FACE_TOO_SMALL && err->corner == ncorners),
-          "corner %d of %d: %s", err->corner, ncorners, err->message);
+    CHECK(err->corner >= -1 && err->corner < (ncorners > 0 ? ncorners : 1), "corner %d of %d: %s", err->corner,
+          ncorners, err->message);
     CHECK(r != TT_ERROR_OUT_OF_MEMORY || a->failed, "out of memory with no failed allocation: %s", err->message);
 }
 
@@ -320,10 +316,8 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
                 /* the error names a face / corner of the new mesh */
                 check_error(r, &err, m->ncorners, 4 * m->ncorners, a);
                 /* A valid mesh must quadrangulate, except that new points may
-                   overflow to infinity, and (KNOWN, tolerated) a strict mesh whose
-                   face has coincident vertices yields zero-area quads. */
-                CHECK(r == TT_ERROR_OUT_OF_MEMORY || r == TT_ERROR_NON_FINITE ||
-                          (strict && r == TT_ERROR_ZERO_AREA_FACE),
+                   overflow to infinity. */
+                CHECK(r == TT_ERROR_OUT_OF_MEMORY || r == TT_ERROR_NON_FINITE,
                       "quadrangulating a valid mesh failed: %s", err.message);
                 continue;
             }

@@ -44,11 +44,9 @@ static int same_float(float a, float b)
 }
 
 /* Names that are not expected to survive a round trip, so the round trip
-   leaves groups and mtllib out when there is one: control characters, blanks
-   at either end (a NUL byte inside a name line cuts the stored C string short:
-   "mtllib a\r\0 b" gives "a ", "mtllib \0" gives ""), and a trailing
-   backslash, which obj_write turns into a line continuation (KNOWN: reported;
-   the face line after "g name\" is swallowed). */
+   leaves groups and mtllib out when there is one: control characters (the
+   reader turns them into '_') and blanks at either end. A trailing backslash
+   does survive: obj_write puts a blank after it. */
 static int plain_name(const char *s)
 {
     size_t n;
@@ -56,7 +54,7 @@ static int plain_name(const char *s)
     n = strlen(s);
     if (n > 0 && (s[0] == ' ' || s[n - 1] == ' ')) return 0;
     for (; *s; ++s)
-        if ((unsigned char)*s < 0x20 || *s == 0x7f || *s == '\\') return 0;
+        if ((unsigned char)*s < 0x20 || *s == 0x7f) return 0;
     return 1;
 }
 
