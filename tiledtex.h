@@ -2395,6 +2395,23 @@ TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *lay
     return TT_OK;
 }
 
+/* The two tangents of a face's own parametrisation (s, t) at its centre, for
+   points of `dims` coordinates: a quad's bilinear patch derivatives, or the
+   edges of the first triangle for any other face. */
+static void tt__face_tangents(const float *const point[4], int dims, int size, double tangent[2][3])
+{
+    int k;
+    for (k = 0; k < dims; k++) {
+        if (size == 4) {
+            tangent[0][k] = 0.5 * (((double)point[1][k] - point[0][k]) + ((double)point[2][k] - point[3][k]));
+            tangent[1][k] = 0.5 * (((double)point[3][k] - point[0][k]) + ((double)point[2][k] - point[1][k]));
+        } else {
+            tangent[0][k] = (double)point[1][k] - point[0][k];
+            tangent[1][k] = (double)point[2][k] - point[0][k];
+        }
+    }
+}
+
 TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch)
 {
     int f;
@@ -2406,30 +2423,14 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
            M = A B^-1, and the ratio of M's singular values is the stretch. */
         int first = mesh->face_start[f], size = mesh->face_start[f + 1] - first, k;
         const float *p[4], *q[4];
-        double a[2][3], b[2][2], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc, big, small;
+        double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc, big, small;
         for (k = 0; k < 4; k++) {
             int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
             p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
             q[k] = corner_uv + 2 * (size_t)corner;
         }
-        for (k = 0; k < 3; k++) {
-            if (size == 4) {
-                a[0][k] = 0.5 * (((double)p[1][k] - p[0][k]) + ((double)p[2][k] - p[3][k]));
-                a[1][k] = 0.5 * (((double)p[3][k] - p[0][k]) + ((double)p[2][k] - p[1][k]));
-            } else {
-                a[0][k] = (double)p[1][k] - p[0][k];
-                a[1][k] = (double)p[2][k] - p[0][k];
-            }
-        }
-        for (k = 0; k < 2; k++) {
-            if (size == 4) {
-                b[0][k] = 0.5 * (((double)q[1][k] - q[0][k]) + ((double)q[2][k] - q[3][k]));
-                b[1][k] = 0.5 * (((double)q[3][k] - q[0][k]) + ((double)q[2][k] - q[1][k]));
-            } else {
-                b[0][k] = (double)q[1][k] - q[0][k];
-                b[1][k] = (double)q[2][k] - q[0][k];
-            }
-        }
+        tt__face_tangents(p, 3, size, a);
+        tt__face_tangents(q, 2, size, b);
         /* b[i] is d(u,v)/d(param i); rows of A likewise. Solve M B = A for the
            two texture axes: M's column for u and v. */
         det = b[0][0] * b[1][1] - b[0][1] * b[1][0];

@@ -835,22 +835,27 @@ static int smooth_twice(poly_mesh *m, char *err, size_t err_size)
     return m->failed ? -1 : 0;
 }
 
-static int make_double_torus(poly_mesh *m, char *err, size_t err_size)
+/* A thick plate with `holes` holes in a row, smoothed: a surface of genus
+   `holes`. Holes are wider than the arms around them so they stay open after
+   smoothing. With mix_polygons some cells become triangles, pentagons and a
+   hexagon first, so the smoothed quads meet at vertices of valence 3 to 6. */
+static int make_holed_plate(poly_mesh *m, int holes, int mix_polygons, char *err, size_t err_size)
 {
-    /* Five by three cells; the holes are wider than the arms around them so
-       they stay open after smoothing. */
-    static const float xs[] = {0.0f, 1.0f, 2.4f, 3.4f, 4.8f, 5.8f}, ys[] = {0.0f, 1.0f, 2.4f, 3.4f};
+    static const float xs[] = {0.0f, 1.0f, 2.4f, 3.4f, 4.8f, 5.8f, 7.2f, 8.2f}, ys[] = {0.0f, 1.0f, 2.4f, 3.4f};
+    static const char *const middle_rows[] = {"", "#.#", "#.#.#", "#.#.#.#"};
+    char holes_text[3 * 8];
     plate p;
     face_list list;
-    p.nx = 5;
+    p.nx = 2 * holes + 1;
     p.ny = 3;
     p.xs = xs;
     p.ys = ys;
-    p.holes = "#####"
-              "#.#.#"
-              "#####";
+    memset(holes_text, '#', (size_t)(3 * p.nx));
+    memcpy(holes_text + p.nx, middle_rows[holes], (size_t)p.nx);
+    holes_text[3 * p.nx] = '\0';
+    p.holes = holes_text;
     plate_faces(&p, &list);
-    if (plate_mix_polygons(&p, &list) != 0) {
+    if (mix_polygons && plate_mix_polygons(&p, &list) != 0) {
         snprintf(err, err_size, "internal error: could not mix polygons into the plate");
         return -1;
     }
@@ -858,21 +863,14 @@ static int make_double_torus(poly_mesh *m, char *err, size_t err_size)
     return smooth_twice(m, err, err_size);
 }
 
+static int make_double_torus(poly_mesh *m, char *err, size_t err_size)
+{
+    return make_holed_plate(m, 2, 1, err, err_size);
+}
+
 static int make_genus3(poly_mesh *m, char *err, size_t err_size)
 {
-    static const float xs[] = {0.0f, 1.0f, 2.4f, 3.4f, 4.8f, 5.8f, 7.2f, 8.2f}, ys[] = {0.0f, 1.0f, 2.4f, 3.4f};
-    plate p;
-    face_list list;
-    p.nx = 7;
-    p.ny = 3;
-    p.xs = xs;
-    p.ys = ys;
-    p.holes = "#######"
-              "#.#.#.#"
-              "#######";
-    plate_faces(&p, &list);
-    plate_to_poly(&p, &list, m);
-    return smooth_twice(m, err, err_size);
+    return make_holed_plate(m, 3, 0, err, err_size);
 }
 
 /* ---- the command --------------------------------------------------------- */
