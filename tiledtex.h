@@ -2045,41 +2045,109 @@ TTDEF void tt_tileset_free(tt_tileset *tileset)
     tt__free(&allocator, tileset);
 }
 
-/* How conspicuous condition window (x, y) would be. Every edge of the mesh
-   shows the rows next to the window's middle line, so structure running along
-   that line (a mortar joint, a plank border) would draw the mesh's edges as a
-   grid, and an unusually bright or dark strip would too. The score is the
-   variance of the row means over the S/4 rows on each side of the line plus
-   the squared difference between their mean and the image's mean (luminance). */
-static double tt__edge_window_score(const tt_image *source, int x, int y, int size, double image_mean)
+/* Mean absolute RGB difference of two texels, the seam measure's unit. */
+static double tt__texel_difference(const float *a, const float *b)
 {
-    int half = tt__max_i(1, size / 4), r, i;
-    double sum = 0.0, sum2 = 0.0;
+    return (fabs((double)a[0] - b[0]) + fabs((double)a[1] - b[1]) + fabs((double)a[2] - b[2])) / 3.0;
+}
+
+/* What a typical place of the image looks like, for choosing edge windows:
+   its mean brightness and the mean difference between vertically adjacent
+   texels (the difference a seam should show, since every edge shows two rows
+   of a window that were neighbours in the image). */
+typedef struct tt__image_statistics {
+    double mean;
+    double variance;          /* of a texel's mean of R, G, B */
+    double row_difference;
+} tt__image_statistics;
+
+static tt__image_statistics tt__measure_image(const tt_image *image)
+{
+    tt__image_statistics st;
+    size_t x, y, w = (size_t)image->width, h = (size_t)image->height;
+    double sum = 0.0, sum2 = 0.0, difference = 0.0;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            const float *p = image->pixels + (y * w + x) * 4;
+            double grey = ((double)p[0] + p[1] + p[2]) / 3.0;
+            sum += grey;
+            sum2 += grey * grey;
+            if (y + 1 < h) difference += tt__texel_difference(p, p + 4 * w);
+        }
+    st.mean = sum / (double)(w * h);
+    st.variance = sum2 / (double)(w * h) - st.mean * st.mean;
+    st.row_difference = h > 1 ? difference / (double)(w * (h - 1)) : 0.0;
+    return st;
+}
+
+/* How conspicuous condition window (x, y) would be. Every edge of the mesh
+   shows the rows next to the window's middle line, so
+   - structure running along that line (a mortar joint, a plank border) would
+     draw the mesh's edges as a grid: the variance of the row means over the
+     S/4 rows on each side of the line;
+   - an unusually bright or dark strip would too: their mean against the
+     image's;
+   - anything distinctive in it (a joint crossing the line, a knot) repeats
+     at the same place along every edge: their contrast (texel variance)
+     against the image's, so the blandest typical strip wins;
+   - the two rows that meet across every edge, and the rows next to them
+     inside each square, should differ like any two neighbouring rows of the
+     image, or every edge looks unlike the rest: their mean differences
+     against the image's.
+   Each term is relative to the image's own (texel variance, neighbour
+   difference), so one scale fits any image. Most of all, the pair that meets
+   across every edge must not differ more than the pairs beside it inside the
+   squares: then no edge can stand out from the texture next to it. */
+static double tt__edge_window_score(const tt_image *source, int x, int y, int size, const tt__image_statistics *st)
+{
+    int half = tt__max_i(2, size / 4), r, i;
+    double sum = 0.0, sum2 = 0.0, texel_sum2 = 0.0, across = 0.0, upper = 0.0, lower = 0.0;
+    const float *line = source->pixels + ((size_t)(y + size) * source->width + x) * 4;   /* first row of L */
+    const size_t stride = (size_t)source->width * 4;
     for (r = y + size - half; r < y + size + half; r++) {
         const float *p = source->pixels + ((size_t)r * source->width + x) * 4;
         double row = 0.0;
-        for (i = 0; i < size; i++, p += 4) row += (double)p[0] + p[1] + p[2];
-        row /= 3.0 * size;
+        for (i = 0; i < size; i++, p += 4) {
+            double grey = ((double)p[0] + p[1] + p[2]) / 3.0;
+            row += grey;
+            texel_sum2 += grey * grey;
+        }
+        row /= size;
         sum += row;
         sum2 += row * row;
     }
     sum /= 2 * half;
-    return (sum2 / (2 * half) - sum * sum) + (sum - image_mean) * (sum - image_mean);
+    for (i = 0; i < size; i++) {
+        const float *p = line + 4 * (size_t)i;
+        across += tt__texel_difference(p - stride, p);
+        upper += tt__texel_difference(p - 2 * stride, p - stride);
+        lower += tt__texel_difference(p, p + stride);
+    }
+    {
+        double variance = st->variance > 1e-12 ? st->variance : 1e-12;
+        double difference = st->row_difference > 1e-6 ? st->row_difference : 1e-6;
+        double excess;
+        across = across / size / difference;
+        upper = upper / size / difference;
+        lower = lower / size / difference;
+        excess = across - 0.5 * (upper + lower);
+        excess = excess > 0.0 ? excess : 0.0;
+        double contrast = texel_sum2 / (2.0 * half * size) - sum * sum;
+        return ((sum2 / (2 * half) - sum * sum) + (sum - st->mean) * (sum - st->mean) + contrast) / variance +
+               16.0 * excess * excess + (across - 1.0) * (across - 1.0) + (upper - 1.0) * (upper - 1.0) +
+               (lower - 1.0) * (lower - 1.0);
+    }
 }
 
-/* Condition windows from the seed: the least conspicuous of 48 random
+/* Condition windows from the seed: the least conspicuous of 128 random
    candidates, among those at least S away from the windows already chosen
    (so several conditions use different parts of the image) when there are
    any. */
 static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int size, int n, tt_rect *windows)
 {
-    const int candidates = 48;
-    double image_mean = 0.0;
-    size_t i, count = (size_t)source->width * source->height;
+    const int candidates = 128;
+    tt__image_statistics st = tt__measure_image(source);
     int k, trial;
-    for (i = 0; i < count; i++)
-        image_mean += (double)source->pixels[4 * i] + source->pixels[4 * i + 1] + source->pixels[4 * i + 2];
-    image_mean /= 3.0 * (double)count;
     for (k = 0; k < n; k++) {
         double best_score = 0.0;
         int best_far = -1;
@@ -2093,7 +2161,7 @@ static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int siz
             r.h = 2 * size;
             for (j = 0; j < k; j++)
                 if (tt__abs_i(r.x - windows[j].x) < size && tt__abs_i(r.y - windows[j].y) < size) far = 0;
-            score = tt__edge_window_score(source, r.x, r.y, size, image_mean);
+            score = tt__edge_window_score(source, r.x, r.y, size, &st);
             if (far > best_far || (far == best_far && score < best_score)) {
                 best_far = far;
                 best_score = score;
@@ -2323,11 +2391,6 @@ static void tt__sample_inside(const tt_image *atlas, const tt__edge_point *p, fl
     tt_image_sample_bilinear(atlas, p->px + p->nx * depth, p->py + p->ny * depth, rgba);
 }
 
-static double tt__rgb_difference(const float a[4], const float b[4])
-{
-    return (fabs((double)a[0] - b[0]) + fabs((double)a[1] - b[1]) + fabs((double)a[2] - b[2])) / 3.0;
-}
-
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  uint64_t seed, tt_seam_report *report)
 {
@@ -2360,9 +2423,9 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
             tt__sample_inside(atlas, &pa, 1.5f, sa_deeper);
             tt__sample_inside(atlas, &pb, 0.5f, sb);
             tt__sample_inside(atlas, &po, 0.5f, so);
-            seam += tt__rgb_difference(sa, sb);
-            same += tt__rgb_difference(sa, sa_deeper);
-            unrelated += tt__rgb_difference(sa, so);
+            seam += tt__texel_difference(sa, sb);
+            same += tt__texel_difference(sa, sa_deeper);
+            unrelated += tt__texel_difference(sa, so);
             samples++;
         }
     }

@@ -38,10 +38,15 @@ static void print_help(void)
 
 int tiled_fit_tile_size(int width, int height)
 {
-    int fit = width < height / 2 ? width : height / 2;
+    /* An edge window is S x 2S; at 2/5 of the smaller side it still has room
+       to move, so synthesis can choose an inconspicuous line for the edges
+       (with h = 2S exactly there is only one) and varied backgrounds. */
+    int side = width < height ? width : height;
+    int fit = 2 * side / 5;
     if (fit > TT_DEFAULT_TILE_SIZE) fit = TT_DEFAULT_TILE_SIZE;
     fit -= fit % 8;
-    return fit >= 8 ? fit : 0;
+    if (fit < 8) fit = width >= 8 && height >= 16 ? 8 : 0;
+    return fit;
 }
 
 int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options, tt_tileset **out)

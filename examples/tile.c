@@ -78,9 +78,6 @@ int cmd_tile(int argc, char **argv)
             return tool_fail("%s is %dx%d: too small to cut tiles from (at least 8x16 texels)", positional[1],
                              image.width, image.height);
         }
-        if (fit < TT_DEFAULT_TILE_SIZE)
-            fprintf(stderr, "tiledtex: %s is %dx%d: using %d-texel tiles (--tile to choose)\n", positional[1],
-                    image.width, image.height, fit);
         options.layout.tile_size = fit;
     }
 
@@ -94,6 +91,10 @@ int cmd_tile(int argc, char **argv)
     if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
+        /* Said only on success: a failing command prints its one error line. */
+        if (!options.tile_size_given && options.layout.tile_size < TT_DEFAULT_TILE_SIZE)
+            fprintf(stderr, "tiledtex: %s is %dx%d: used %d-texel tiles (--tile to choose)\n", positional[1],
+                    image.width, image.height, options.layout.tile_size);
         tiled_print_summary(positional[0], &mesh, &seams, options.report);
         printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
                tiles->levels[0].height);

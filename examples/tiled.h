@@ -70,8 +70,9 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
 /* Add an MTL file with one material, "tiled", whose texture is TEXTURE_NAME. */
 int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name);
 
-/* The largest tile size up to TT_DEFAULT_TILE_SIZE, a multiple of 8, that an
-   image of width x height can feed (an edge window is S x 2S); 0 if none. */
+/* The tile size `tile` picks when none is given: TT_DEFAULT_TILE_SIZE, or for
+   a small image a multiple of 8 up to 2/5 of its smaller side; 0 when even
+   8-texel tiles (an 8 x 16 edge window) do not fit. */
 int tiled_fit_tile_size(int width, int height);
 
 /* Synthesise the atlas from an image already loaded. Prints the error and

@@ -235,8 +235,9 @@ tile_case torus-n1 torus.obj 1
 s=$(summary_seam)
 check "tile torus n=1: seam score <= 0.05" "seam score <= 0.05" "$OUT" \
     "$(awk -v s="${s:-x}" 'BEGIN{exit !(s ~ /^-?[0-9.]+/ && s + 0 <= 0.05)}'; echo $?)"
-check "tile torus n=1: atlas size" "544 544 (4 x (128+2*4))" "$(png_size "$W/d$NEWDIR_N/out.png")" \
-    "$([ "$(png_size "$W/d$NEWDIR_N/out.png")" = "544 544" ]; echo $?)"
+# tex.png is 256x256: without --tile, tile picks 96-texel tiles (2/5 of 256, a multiple of 8)
+check "tile torus n=1: atlas size" "416 416 (4 x (96+2*4))" "$(png_size "$W/d$NEWDIR_N/out.png")" \
+    "$([ "$(png_size "$W/d$NEWDIR_N/out.png")" = "416 416" ]; echo $?)"
 tile_case torus-n2 torus.obj 1 --colors 2 --tile 32
 s=$(summary_seam)
 check "tile torus --colors 2 --tile 32: seam score <= 0.05" "seam score <= 0.05" "$OUT" \
@@ -525,8 +526,8 @@ expect_error "image smaller than the tiles" synth ../in/small.png a.png --tile 1
 err_mentions "image smaller than the tiles: message mentions the size" '64 ?x ?64'
 newdir
 expect_ok "tile with a small image and no --tile picks a smaller tile" tile ../in/torus.obj ../in/small.png out
-check "tile small image: atlas 160x160 (32-texel tiles)" "160 160" "$(png_size out.png)" \
-    "$([ "$(png_size out.png)" = "160 160" ]; echo $?)"
+check "tile small image: atlas 128x128 (24-texel tiles: 2/5 of 64)" "128 128" "$(png_size out.png)" \
+    "$([ "$(png_size out.png)" = "128 128" ]; echo $?)"
 cd "$W" || exit 1
 expect_error "--tile 100000 (synth)" synth ../in/tex.png a.png --tile 100000
 expect_error "--tile 100000 (tile)" tile ../in/torus.obj ../in/tex.png out --tile 100000
