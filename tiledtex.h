@@ -18,16 +18,16 @@
    QUICK START: tile a quad mesh from a photo (Akleman et al.'s tiled textures)
 
        tt_mesh_desc desc = {0};
-       desc.positions = xyz; desc.nverts = nverts;          // float[3*nverts]
+       desc.positions = xyz; desc.nverts = nverts;              // float[3 * nverts]
        desc.indices = quads; desc.nfaces = nquads; desc.fixed_face_size = 4;
        tt_mesh *mesh; tt_error err;
        if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) { puts(err.message); return 1; }
-       tt_tile_layout layout = {1, 128, TT_RECOMMENDED_GUTTER}; // n, tile size, gutter
+       tt_tile_layout layout = {1, 128, TT_RECOMMENDED_GUTTER};  // n, tile size, gutter
        uint8_t *types = malloc(mesh->ncorners);  float *uv = malloc(8 * mesh->ncorners);
-       tt_assign_boundaries(mesh, &layout, 42, types);       // seeded: same seed, same result
-       tt_assign_uvs(mesh, &layout, types, uv);              // uv[2*c] lines up with indices[c]
-       tt_synth_options opt = {0};  tt_tileset *tiles;       // opt.layout = layout
-       tt_synthesize_tiles(&photo, &opt, &tiles, &err);      // tiles->levels[0] is the atlas
+       tt_assign_boundaries(mesh, &layout, 42, types);           // same seed, same result
+       tt_assign_uvs(mesh, &layout, types, uv, &err);            // uv[2c..2c+1]: corner c
+       tt_synth_options opt = {0};  opt.layout = layout;  tt_tileset *tiles;
+       tt_synthesize_tiles(&photo, &opt, &tiles, &err);          // tiles->levels[0]: atlas
 
    Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first.
 
@@ -52,6 +52,7 @@
      2. Mesh    - half-edge builder with validation, queries, quadrangulation
      3. Image   - float RGBA images, bilinear sampling, 90-degree rotations,
                   premultiplied `over`, box downsampling, minimum-error cut
+     4. Numerics - (comes with the lapped-texture pipeline)
      5. Raster  - 2D triangle rasterisation with barycentrics
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")

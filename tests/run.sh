@@ -86,6 +86,32 @@ compile_check "user-defined TT_MALLOC/TT_FREE" user_alloc \
     fi
 }
 
+# The QUICK START block at the top of tiledtex.h, exactly as printed there,
+# inside a program that gives it a mesh (a 2x2 grid of quads) and a photo:
+# documentation that compiles, runs and makes an atlas.
+{
+    src=$OUT/quickstart.c
+    {
+        printf '%s\n' '#include <stdio.h>' '#include <stdlib.h>' '#define TILEDTEX_IMPLEMENTATION' \
+            '#include "tiledtex.h"' 'int main(void) {' \
+            'static const float xyz[27] = {0,0,0, 1,0,0, 2,0,0, 0,1,0, 1,1,0, 2,1,0, 0,2,0, 1,2,0, 2,2,0};' \
+            'static const int quads[16] = {0,1,4,3, 1,2,5,4, 3,4,7,6, 4,5,8,7};' \
+            'int nverts = 9, nquads = 4, x; tt_image photo; tt_image_create(&photo, 128, 256, NULL);' \
+            'for (x = 0; x < 128 * 256 * 4; x++) photo.pixels[x] = (float)((x * 37) % 101) / 100.0f;' \
+            '{'
+        sed -n '/QUICK START/,/Triangles or n-gons?/p' tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
+        printf '%s\n' 'if (!tiles || tiles->levels[0].width != 4 * (128 + 8)) return 2;' \
+            'tt_tileset_free(tiles); free(types); free(uv); tt_mesh_free(mesh); }' \
+            'tt_image_free(&photo); return 0; }'
+    } >"$src"
+    if log=$(gcc -std=c99 -Wall -Wextra -pedantic -Werror -Wno-declaration-after-statement -I. -g \
+            -fsanitize=address,undefined "$src" -o "$OUT/quickstart" -lm 2>&1) && log=$("$OUT/quickstart" 2>&1); then
+        pass "docs: the QUICK START in tiledtex.h compiles, runs and makes a 544x544 atlas"
+    else
+        fail "docs: the QUICK START in tiledtex.h does not compile or run" "$log"
+    fi
+}
+
 # No raw allocation calls: comments stripped by the preprocessor (directives
 # kept), then any malloc( free( realloc( calloc( that is not a member call
 # (allocator->free) or part of a longer name, outside the two default macros.
