@@ -30,8 +30,19 @@ test: deps
 build/bench: bench/bench.c tiledtex.h | build
 	$(CC) -O2 -g $(WARN) -I. bench/bench.c -o $@ -lm
 
-bench: build/bench
+build/bench_cg: bench/bench_cg.c bench/bench_cg_problem.h tiledtex.h | build
+	$(CC) -O2 -g $(WARN) -I. bench/bench_cg.c -o $@ -lm
+
+# The optional peer: the same CG system solved by Eigen, when Debian's
+# libeigen3-dev is installed (the target is ours within 1.1x of it).
+EIGEN_INC := $(wildcard /usr/include/eigen3)
+build/bench_cg_eigen: bench/bench_cg_eigen.cpp bench/bench_cg_problem.h | build
+	$(CXX) -O2 -DNDEBUG -I$(EIGEN_INC) -Ibench bench/bench_cg_eigen.cpp -o $@
+
+bench: build/bench build/bench_cg $(if $(EIGEN_INC),build/bench_cg_eigen)
 	@./build/bench
+	@./build/bench_cg
+	@$(if $(EIGEN_INC),./build/bench_cg_eigen,echo "(no Eigen peer: apt-get install libeigen3-dev)" >&2)
 
 FUZZ_SECONDS ?= 60
 fuzz: deps

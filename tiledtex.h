@@ -53,6 +53,8 @@
      3. Image   - float RGBA images, bilinear sampling, 90-degree rotations,
                   premultiplied `over`, box downsampling, minimum-error cut
      4. Numerics - (comes with the lapped-texture pipeline)
+     4. Numerics - triplets to CSR sparse matrices, Jacobi-preconditioned
+                  conjugate gradients (symmetric positive definite systems)
      5. Raster  - 2D triangle rasterisation with barycentrics
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
@@ -106,6 +108,8 @@ typedef enum tt_result {
     TT_ERROR_NON_MANIFOLD_VERTEX = -13,     /* the faces around a vertex form more than one fan */
     TT_ERROR_NOT_QUAD_MESH = -14,           /* this step needs quads; quadrangulate first */
     TT_ERROR_IMAGE_TOO_SMALL = -15,         /* the image cannot hold the requested windows */
+    TT_ERROR_NOT_CONVERGED = -16,          /* an iterative solver hit its iteration cap first */
+    TT_ERROR_NOT_POSITIVE_DEFINITE = -17,  /* a matrix that must be positive definite is not */
     TT_RESULT_MAX_ENUM = 0x7fffffff
 } tt_result;
 
@@ -306,6 +310,142 @@ TTDEF tt_result tt_image_downsample2(const tt_image *src, tt_image *dst, const t
    that a path can follow; returns TT_ERROR_INVALID_ARGUMENT otherwise. */
 TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
                                  int *path, const tt_allocator *allocator);
+
+/* ======================================================================== */
+/* 4. Numerics                                                              */
+/* ======================================================================== */
+
+/* Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
+   Sec. 3.4: a patch's parametrization is the least-squares solution of a
+   sparse linear system, solved by conjugate gradients from the patch's
+   initial parametrization. The solver here is the Jacobi (diagonal)
+   preconditioned conjugate gradient method for symmetric positive definite
+   systems, with the formulas of Shewchuk, "An Introduction to the Conjugate
+   Gradient Method Without the Agonizing Pain" (edition 1 1/4, 1994), Sec. 12
+   and the preconditioned algorithm of its Appendix B3 (M = diag(A)):
+
+       r0 = b - A x0,   z0 = M^-1 r0,   p0 = z0
+       alpha_k = (r_k . z_k) / (p_k . A p_k)
+       x_k+1 = x_k + alpha_k p_k,   r_k+1 = r_k - alpha_k A p_k
+       z_k+1 = M^-1 r_k+1
+       beta_k = (r_k+1 . z_k+1) / (r_k . z_k),   p_k+1 = z_k+1 + beta_k p_k
+
+   stopping when |r| <= tolerance * |b| (Euclidean norms), and confirming it
+   with a freshly computed b - A x (Shewchuk Sec. 11) before reporting success.
+
+   Errors about a matrix entry put its row in tt_error::vertex and its column in
+   tt_error::other_vertex (the mesh systems have one unknown per vertex); the
+   message names them as row and column. Other tt_error fields are -1. */
+
+/* One entry of a sparse matrix being assembled: A[row][col] += value. */
+typedef struct tt_triplet {
+    int row, col;
+    double value;
+} tt_triplet;
+
+/* Compressed sparse rows (CSR). The entries of row i are k in
+   [row_start[i], row_start[i+1]): A[i][col[k]] = value[k]. Matrices made by
+   tt_sparse_from_triplets have strictly increasing columns within each row.
+   You may change value[] in place (same pattern, new numbers); do not change
+   the other fields. You may also fill this struct yourself from your own CSR
+   arrays to call tt_sparse_multiply or tt_cg_solve (then do not call
+   tt_sparse_free on it); such arrays may have unsorted or repeated columns
+   (repeats add up). */
+typedef struct tt_sparse_matrix {
+    int rows, cols;
+    int nnz;                    /* stored entries = row_start[rows] */
+    int *row_start;             /* rows + 1, row_start[0] == 0 */
+    int *col;                   /* nnz column indices, 0-based */
+    double *value;              /* nnz values */
+    tt_allocator allocator;     /* the one the arrays came from */
+} tt_sparse_matrix;
+
+/* Build an rows x cols CSR matrix from `ntriplets` triplets in any order.
+   Triplets naming the same entry are summed, in the order given (so the result
+   is the same on every run); entries that sum to zero are kept (the pattern is
+   what the triplets name). Rows without triplets are empty. Fails, with
+   *matrix zeroed and nothing left allocated, on:
+     TT_ERROR_INDEX_OUT_OF_RANGE  a triplet outside the matrix (message names
+                                  the triplet, its row and column),
+     TT_ERROR_NON_FINITE          a NaN or infinite value,
+     TT_ERROR_INVALID_ARGUMENT    NULL matrix, negative sizes, triplets NULL
+                                  while ntriplets > 0,
+     TT_ERROR_TOO_LARGE           byte counts that overflow size_t,
+     TT_ERROR_OUT_OF_MEMORY.
+   Time O(ntriplets + rows + cols) (two stable bucket passes); memory: the
+   result (12 bytes per entry + 4 per row) plus 8 bytes per triplet and 4 per
+   row or column of temporary space. The arrays come from `allocator` (NULL or
+   zeroed: TT_MALLOC / TT_FREE); free them with tt_sparse_free. Thread-safe:
+   reads only the triplets. */
+TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int cols, const tt_triplet *triplets,
+                                        int ntriplets, const tt_allocator *allocator, tt_error *error);
+
+/* Release a matrix made by tt_sparse_from_triplets and zero the struct.
+   NULL and zeroed matrices are fine. */
+TTDEF void tt_sparse_free(tt_sparse_matrix *matrix);
+
+/* y = A x: x has A->cols entries, y gets A->rows. x and y must not overlap
+   (x == y is refused with TT_ERROR_INVALID_ARGUMENT). The CSR arrays are
+   trusted (tt_cg_solve checks them, this does not). Does not allocate;
+   thread-safe for distinct y. */
+TTDEF tt_result tt_sparse_multiply(const tt_sparse_matrix *A, const double *x, double *y);
+
+typedef struct tt_cg_options {
+    int max_iterations;         /* cap on CG steps; 0 = max(2 * n, 100) for an n x n system */
+    /* Stop at |b - A x| <= tolerance * |b|; 0 = 1e-8. Success is confirmed on
+       a recomputed b - A x, so a tolerance below what double precision can
+       reach for this A (roughly 1e-16 times its condition number) ends in
+       TT_ERROR_NOT_CONVERGED at the cap rather than in a false success. */
+    double tolerance;
+    /* Called before every step with a fraction in [0, 1] that never
+       decreases: the larger of steps / max_iterations and
+       log(residual) / log(tolerance). Non-zero return cancels. May be NULL. */
+    tt_progress_fn progress;
+    void *progress_user_data;
+    tt_allocator allocator;     /* for the scratch vectors; zeroed: TT_MALLOC / TT_FREE */
+} tt_cg_options;
+
+typedef struct tt_cg_report {
+    int iterations;             /* CG steps taken (0 when x0 already solved the system) */
+    double residual;            /* |b - A x| / |b| for the x returned, recomputed from A, x, b; 0 when b = 0 */
+    int converged;              /* 1 when residual <= tolerance */
+} tt_cg_report;
+
+/* Solve A x = b for a symmetric positive definite n x n A by Jacobi
+   preconditioned conjugate gradients (see the section comment).
+     b   n values, read only; must not overlap x.
+     x   n values: in, the initial guess (warm start; zeros if you have none),
+         out, the solution. It must be finite.
+     options, report, error may be NULL (defaults; no report; no details).
+     report is filled on every return; before any step it reads
+     {0, 0.0, 0} (converged = 1 for b = 0 or an x0 that already solves).
+   Returns
+     TT_OK                          converged: report->residual <= tolerance;
+     TT_ERROR_NOT_CONVERGED         max_iterations steps did not get there: x is
+                                    the last iterate, report says how close;
+     TT_ERROR_NOT_POSITIVE_DEFINITE a diagonal entry <= 0 or missing (names the
+                                    row: before any work, x untouched), or the
+                                    iteration broke down with p . A p <= 0
+                                    (x is the last iterate);
+     TT_ERROR_NON_FINITE            NaN or infinity in A, b or x (names the
+                                    row), or an overflow during the iteration;
+     TT_ERROR_INVALID_ARGUMENT      NULL pointers, b == x, A not square or its
+                                    row_start array inconsistent, negative
+                                    max_iterations or tolerance;
+     TT_ERROR_INDEX_OUT_OF_RANGE    a column index outside the matrix (only
+                                    possible in a CSR you filled yourself);
+     TT_CANCELLED                   the progress callback asked to stop (x is
+                                    the last iterate);
+     TT_ERROR_OUT_OF_MEMORY.
+   b = 0 gives x = 0 at once. Symmetry is assumed, not checked (checking
+   costs more than several steps): a non-symmetric A may stall or break down.
+   Memory: one scratch block of 4 n doubles for the whole solve, nothing per
+   step. A step costs one product with A (with p . A p in the same pass) and
+   two fused passes over the vectors; one more product confirms the result.
+   Thread-safe: several threads may solve with the same A and b into
+   distinct x. */
+TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, double *x, const tt_cg_options *options,
+                            tt_cg_report *report, tt_error *error);
 
 /* ======================================================================== */
 /* 5. Raster                                                                */
@@ -509,6 +649,8 @@ TTDEF const char *tt_result_string(tt_result result)
     case TT_ERROR_NON_MANIFOLD_VERTEX: return "the faces around a vertex form more than one fan";
     case TT_ERROR_NOT_QUAD_MESH: return "this step needs a mesh of quads";
     case TT_ERROR_IMAGE_TOO_SMALL: return "the image is too small for the requested tiles";
+    case TT_ERROR_NOT_CONVERGED: return "the solver did not converge within its iteration limit";
+    case TT_ERROR_NOT_POSITIVE_DEFINITE: return "the matrix is not symmetric positive definite";
     default: return "unknown tiledtex result";
     }
 }
@@ -1665,6 +1807,448 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
     tt__free(allocator, total);
     tt__free(allocator, step);
     return TT_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 4. Numerics                                                              */
+/* ------------------------------------------------------------------------ */
+
+/* `restrict` tells the compiler that the vectors of one loop do not overlap,
+   which lets it keep values in registers and vectorise. It is C99 only; C++
+   compilers spell it __restrict, others get nothing (correct, maybe slower). */
+#ifndef TT__RESTRICT
+#if defined(__cplusplus)
+#if defined(__GNUC__) || defined(__clang__) || defined(_MSC_VER)
+#define TT__RESTRICT __restrict
+#else
+#define TT__RESTRICT
+#endif
+#elif defined(__STDC_VERSION__) && __STDC_VERSION__ >= 199901L
+#define TT__RESTRICT restrict
+#else
+#define TT__RESTRICT
+#endif
+#endif
+
+/* Double version of tt__is_finite: tested on the bits, like it. */
+static int tt__is_finite_d(double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
+}
+
+/* count elements of element_size bytes fit in a size_t byte count. */
+static int tt__size_fits(size_t count, size_t element_size)
+{
+    return element_size == 0 || count <= (size_t)-1 / element_size;
+}
+
+TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int cols, const tt_triplet *triplets,
+                                        int ntriplets, const tt_allocator *allocator, tt_error *error)
+{
+    /* Two stable bucket passes (a radix sort with the column as the low digit
+       and the row as the high digit) put the triplets in row order with
+       increasing columns inside each row; duplicates then sit next to each
+       other, in their input order, and are summed in one walk. */
+    size_t nt, nbuckets, k;
+    int *work, *bucket, *by_col, *by_row;
+    int r, nnz, pos, begin;
+    if (!matrix)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "no matrix to fill: `matrix` is NULL");
+    memset(matrix, 0, sizeof *matrix);
+    if (rows < 0 || cols < 0 || ntriplets < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "a %d x %d matrix from %d triplets: sizes and counts must not be negative", rows, cols,
+                        ntriplets);
+    if (!triplets && ntriplets > 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "%d triplets announced but `triplets` is NULL", ntriplets);
+    for (k = 0; k < (size_t)ntriplets; k++) {
+        const tt_triplet *t = triplets + k;
+        if (t->row < 0 || t->row >= rows || t->col < 0 || t->col >= cols)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, t->row, t->col,
+                            "triplet %d is at row %d, column %d, outside the %d x %d matrix", (int)k, t->row, t->col,
+                            rows, cols);
+        if (!tt__is_finite_d(t->value))
+            return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, t->row, t->col,
+                            "triplet %d (row %d, column %d) has the value %g", (int)k, t->row, t->col, t->value);
+    }
+
+    nt = (size_t)ntriplets;
+    nbuckets = (size_t)(rows > cols ? rows : cols) + 1;
+    if (nt > ((size_t)-1 / sizeof(int) - nbuckets) / 2 || !tt__size_fits(nt, sizeof(double)) ||
+        !tt__size_fits((size_t)rows + 1, sizeof(int)))
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "a %d x %d matrix from %d triplets needs more bytes than size_t can count", rows, cols,
+                        ntriplets);
+    if (allocator) matrix->allocator = *allocator;
+    work = TT__ALLOC(&matrix->allocator, int, nbuckets + 2 * nt);
+    if (!work) goto out_of_memory;
+    bucket = work;
+    by_col = work + nbuckets;
+    by_row = by_col + nt;
+
+    /* Pass 1, by column: bucket[c] = first slot of column c, then scatter. */
+    memset(bucket, 0, ((size_t)cols + 1) * sizeof(int));
+    for (k = 0; k < nt; k++) bucket[triplets[k].col + 1]++;
+    for (r = 0; r < cols; r++) bucket[r + 1] += bucket[r];
+    for (k = 0; k < nt; k++) by_col[bucket[triplets[k].col]++] = (int)k;
+    /* Pass 2, by row, reading in column order (stable): afterwards
+       bucket[r] = one past the last slot of row r. */
+    memset(bucket, 0, ((size_t)rows + 1) * sizeof(int));
+    for (k = 0; k < nt; k++) bucket[triplets[k].row + 1]++;
+    for (r = 0; r < rows; r++) bucket[r + 1] += bucket[r];
+    for (k = 0; k < nt; k++) {
+        int t = by_col[k];
+        by_row[bucket[triplets[t].row]++] = t;
+    }
+
+    /* Distinct (row, column) pairs. */
+    nnz = 0;
+    for (r = 0, begin = 0; r < rows; begin = bucket[r], r++) {
+        int i, last = -1;
+        for (i = begin; i < bucket[r]; i++)
+            if (triplets[by_row[i]].col != last) {
+                last = triplets[by_row[i]].col;
+                nnz++;
+            }
+    }
+
+    matrix->row_start = TT__ALLOC(&matrix->allocator, int, (size_t)rows + 1);
+    matrix->col = TT__ALLOC(&matrix->allocator, int, nnz);
+    matrix->value = TT__ALLOC(&matrix->allocator, double, nnz);
+    if (!matrix->row_start || !matrix->col || !matrix->value) {
+        tt__free(&matrix->allocator, work);
+        goto out_of_memory;
+    }
+    matrix->rows = rows;
+    matrix->cols = cols;
+    matrix->nnz = nnz;
+    matrix->row_start[0] = 0;
+    for (r = 0, begin = 0, pos = 0; r < rows; begin = bucket[r], r++) {
+        int i, last = -1;
+        for (i = begin; i < bucket[r]; i++) {
+            const tt_triplet *t = triplets + by_row[i];
+            if (t->col != last) {
+                last = t->col;
+                matrix->col[pos] = t->col;
+                matrix->value[pos] = t->value;
+                pos++;
+            } else {
+                matrix->value[pos - 1] += t->value;
+            }
+        }
+        matrix->row_start[r + 1] = pos;
+    }
+    tt__free(&matrix->allocator, work);
+    return tt__ok(error);
+
+out_of_memory:
+    tt_sparse_free(matrix);
+    return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                    "out of memory building a %d x %d matrix from %d triplets", rows, cols, ntriplets);
+}
+
+TTDEF void tt_sparse_free(tt_sparse_matrix *matrix)
+{
+    if (!matrix) return;
+    tt__free(&matrix->allocator, matrix->row_start);
+    tt__free(&matrix->allocator, matrix->col);
+    tt__free(&matrix->allocator, matrix->value);
+    memset(matrix, 0, sizeof *matrix);
+}
+
+/* y = A x for rows [0, n). */
+static void tt__spmv(int n, const int *TT__RESTRICT row_start, const int *TT__RESTRICT col,
+                     const double *TT__RESTRICT value, const double *TT__RESTRICT x, double *TT__RESTRICT y)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        int k, end = row_start[i + 1];
+        double sum = 0.0;
+        for (k = row_start[i]; k < end; k++) sum += value[k] * x[col[k]];
+        y[i] = sum;
+    }
+}
+
+TTDEF tt_result tt_sparse_multiply(const tt_sparse_matrix *A, const double *x, double *y)
+{
+    if (!A || !x || !y || x == y || A->rows < 0 || (A->rows > 0 && !A->row_start)) return TT_ERROR_INVALID_ARGUMENT;
+    tt__spmv(A->rows, A->row_start, A->col, A->value, x, y);
+    return TT_OK;
+}
+
+/* The CG step's product: Ap = A p, returning p . Ap (the alpha denominator)
+   from the same pass, while p[i] is still in a register. */
+static double tt__spmv_dot(int n, const int *TT__RESTRICT row_start, const int *TT__RESTRICT col,
+                           const double *TT__RESTRICT value, const double *TT__RESTRICT p, double *TT__RESTRICT Ap)
+{
+    double dot = 0.0;
+    int i;
+    for (i = 0; i < n; i++) {
+        int k, end = row_start[i + 1];
+        double sum = 0.0;
+        for (k = row_start[i]; k < end; k++) sum += value[k] * p[col[k]];
+        Ap[i] = sum;
+        dot += sum * p[i];
+    }
+    return dot;
+}
+
+/* r = b - A x; returns r . r. */
+static double tt__cg_residual(const tt_sparse_matrix *A, const double *TT__RESTRICT b, const double *TT__RESTRICT x,
+                              double *TT__RESTRICT r)
+{
+    double rr = 0.0;
+    int i;
+    tt__spmv(A->rows, A->row_start, A->col, A->value, x, r);
+    for (i = 0; i < A->rows; i++) {
+        r[i] = b[i] - r[i];
+        rr += r[i] * r[i];
+    }
+    return rr;
+}
+
+/* p = z = M^-1 r (a fresh start of the directions); returns r . z. */
+static double tt__cg_restart(int n, const double *TT__RESTRICT r, const double *TT__RESTRICT inv_diag,
+                             double *TT__RESTRICT p)
+{
+    double rz = 0.0;
+    int i;
+    for (i = 0; i < n; i++) {
+        p[i] = r[i] * inv_diag[i];
+        rz += r[i] * p[i];
+    }
+    return rz;
+}
+
+/* r -= alpha Ap and the two new dot products in one pass: returns r . z with
+   z = M^-1 r (z itself is never stored), *rr_out = r . r. Four partial sums
+   (lanes i mod 4) break the chain of dependent additions, so the loop runs at
+   the speed of memory rather than of the adder's latency. */
+static double tt__cg_update(int n, double alpha, double *TT__RESTRICT r, const double *TT__RESTRICT Ap,
+                            const double *TT__RESTRICT inv_diag, double *rr_out)
+{
+    double rz[4] = {0.0, 0.0, 0.0, 0.0}, rr[4] = {0.0, 0.0, 0.0, 0.0};
+    int i, lane;
+    for (i = 0; i + 3 < n; i += 4)
+        for (lane = 0; lane < 4; lane++) {
+            double ri = r[i + lane] - alpha * Ap[i + lane];
+            r[i + lane] = ri;
+            rr[lane] += ri * ri;
+            rz[lane] += ri * ri * inv_diag[i + lane];
+        }
+    for (; i < n; i++) {
+        double ri = r[i] - alpha * Ap[i];
+        r[i] = ri;
+        rr[0] += ri * ri;
+        rz[0] += ri * ri * inv_diag[i];
+    }
+    *rr_out = (rr[0] + rr[1]) + (rr[2] + rr[3]);
+    return (rz[0] + rz[1]) + (rz[2] + rz[3]);
+}
+
+/* x += alpha p with the old direction, then p = M^-1 r + beta p: x is updated
+   here rather than with r, so that p is read once per step, not twice. */
+static void tt__cg_direction(int n, double alpha, double beta, const double *TT__RESTRICT r,
+                             const double *TT__RESTRICT inv_diag, double *TT__RESTRICT p, double *TT__RESTRICT x)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        double pi = p[i];
+        x[i] += alpha * pi;
+        p[i] = r[i] * inv_diag[i] + beta * pi;
+    }
+}
+
+/* x += alpha p: the last step's update of x when no new direction follows. */
+static void tt__cg_axpy(int n, double alpha, const double *TT__RESTRICT p, double *TT__RESTRICT x)
+{
+    int i;
+    for (i = 0; i < n; i++) x[i] += alpha * p[i];
+}
+
+/* One pass over A for tt_cg_solve: consistent row_start, columns in range,
+   finite values, a positive diagonal (repeated diagonal entries add up);
+   inv_diag[i] = 1 / A[i][i]. */
+static tt_result tt__cg_check_matrix(const tt_sparse_matrix *A, double *inv_diag, tt_error *error)
+{
+    int i, k, n = A->rows;
+    if (n > 0 && !A->row_start)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the matrix has %d rows but no row_start", n);
+    if (n > 0 && (A->row_start[0] != 0 || A->row_start[n] != A->nnz))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the matrix's row_start runs from %d to %d; it must run from 0 to nnz = %d", A->row_start[0],
+                        A->row_start[n], A->nnz);
+    if (A->nnz > 0 && (!A->col || !A->value))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the matrix has %d entries but no col or value array", A->nnz);
+    for (i = 0; i < n; i++) {
+        int begin = A->row_start[i], end = A->row_start[i + 1];
+        double diagonal = 0.0;
+        if (end < begin)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, i, -1,
+                            "the matrix's row_start decreases at row %d (%d, then %d)", i, begin, end);
+        for (k = begin; k < end; k++) {
+            int c = A->col[k];
+            double v = A->value[k];
+            if (c < 0 || c >= n)
+                return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, i, c,
+                                "entry %d of the matrix is at row %d, column %d, outside the %d x %d matrix", k, i,
+                                c, n, n);
+            if (!tt__is_finite_d(v))
+                return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, i, c,
+                                "the matrix entry at row %d, column %d is %g", i, c, v);
+            if (c == i) diagonal += v;
+        }
+        if (!(diagonal > 0.0))
+            return tt__fail(error, TT_ERROR_NOT_POSITIVE_DEFINITE, -1, -1, i, i,
+                            "row %d has diagonal entry %g%s: a symmetric positive definite matrix has a positive "
+                            "diagonal", i, diagonal, begin == end ? " (the row is empty)" : "");
+        inv_diag[i] = 1.0 / diagonal;
+    }
+    return TT_OK;
+}
+
+TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, double *x, const tt_cg_options *options,
+                            tt_cg_report *report, tt_error *error)
+{
+    tt_cg_options opt;
+    tt_cg_report rep;
+    tt_result result = TT_OK;
+    double *block, *r, *p, *Ap, *inv_diag;
+    double bb = 0.0, norm_b, limit, rr, rz, shown = 0.0;
+    int i, n, max_iterations, r_is_true;
+
+    memset(&rep, 0, sizeof rep);
+    if (report) *report = rep;
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    if (!A || !b || !x)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_cg_solve needs a matrix, a right-hand side and a solution vector; one is NULL");
+    if (b == x)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the right-hand side b and the solution x must be different arrays");
+    if (opt.max_iterations < 0 || !(opt.tolerance >= 0.0) || !tt__is_finite_d(opt.tolerance))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "max_iterations %d and tolerance %g: neither may be negative (0 = default)", opt.max_iterations,
+                        opt.tolerance);
+    if (A->rows != A->cols || A->rows < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the matrix is %d x %d; conjugate gradients need a square matrix", A->rows, A->cols);
+    n = A->rows;
+    if (opt.tolerance == 0.0) opt.tolerance = 1e-8;
+    max_iterations = opt.max_iterations;
+    if (max_iterations == 0) max_iterations = n > 0x3fffffff ? 0x7fffffff : (2 * n > 100 ? 2 * n : 100);
+
+    /* One block for the whole solve: r, p, Ap and the inverse diagonal. */
+    if (!tt__size_fits((size_t)n, 4 * sizeof(double)))
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "%d unknowns need more bytes than size_t can count",
+                        n);
+    block = TT__ALLOC(&opt.allocator, double, (size_t)n * 4);
+    if (!block)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for %d unknowns", n);
+    r = block;
+    p = r + n;
+    Ap = p + n;
+    inv_diag = Ap + n;
+
+    if ((result = tt__cg_check_matrix(A, inv_diag, error)) != TT_OK) goto done;
+    for (i = 0; i < n; i++) {
+        if (!tt__is_finite_d(b[i])) {
+            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, i, -1, "the right-hand side b[%d] is %g", i, b[i]);
+            goto done;
+        }
+        if (!tt__is_finite_d(x[i])) {
+            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, i, -1, "the initial guess x[%d] is %g", i, x[i]);
+            goto done;
+        }
+        bb += b[i] * b[i];
+    }
+    if (bb == 0.0) {
+        /* A x = 0 with A positive definite: x = 0 exactly. */
+        for (i = 0; i < n; i++) x[i] = 0.0;
+        rep.converged = 1;
+        result = tt__ok(error);
+        goto done;
+    }
+    norm_b = sqrt(bb);
+    limit = opt.tolerance * norm_b;
+
+    rr = tt__cg_residual(A, b, x, r);
+    r_is_true = 1;
+    rz = tt__cg_restart(n, r, inv_diag, p);
+    for (;;) {
+        double pAp, alpha, rz_next;
+        if (sqrt(rr) <= limit) {
+            /* The updated r drifts from b - A x by rounding: success is only
+               claimed for a freshly computed residual. If that one is still too
+               big, start the directions afresh from it (Shewchuk Sec. 11). */
+            if (!r_is_true) {
+                rr = tt__cg_residual(A, b, x, r);
+                r_is_true = 1;
+            }
+            if (sqrt(rr) <= limit) {
+                rep.converged = 1;
+                break;
+            }
+            rz = tt__cg_restart(n, r, inv_diag, p);
+        }
+        if (rep.iterations >= max_iterations) {
+            result = TT_ERROR_NOT_CONVERGED;   /* the message, with the final residual, below */
+            break;
+        }
+        if (opt.progress) {
+            double rel = sqrt(rr) / norm_b, fraction = (double)rep.iterations / max_iterations;
+            if (opt.tolerance < 1.0 && rel < 1.0 && log(rel) / log(opt.tolerance) > fraction)
+                fraction = log(rel) / log(opt.tolerance);
+            if (fraction > 1.0) fraction = 1.0;
+            if (fraction > shown) shown = fraction;
+            if (opt.progress((float)shown, opt.progress_user_data)) {
+                result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1,
+                                  "cancelled by the progress callback after %d conjugate gradient steps",
+                                  rep.iterations);
+                break;
+            }
+        }
+        pAp = tt__spmv_dot(n, A->row_start, A->col, A->value, p, Ap);
+        if (!tt__is_finite_d(pAp)) {
+            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                              "conjugate gradients overflowed at step %d (p . A p = %g): scale the system",
+                              rep.iterations, pAp);
+            break;
+        }
+        if (pAp <= 0.0) {
+            result = tt__fail(error, TT_ERROR_NOT_POSITIVE_DEFINITE, -1, -1, -1, -1,
+                              "conjugate gradients broke down at step %d: p . A p = %g <= 0, so the matrix is not "
+                              "positive definite", rep.iterations, pAp);
+            break;
+        }
+        alpha = rz / pAp;
+        rz_next = tt__cg_update(n, alpha, r, Ap, inv_diag, &rr);
+        rep.iterations++;
+        r_is_true = 0;
+        if (sqrt(rr) <= limit) {
+            tt__cg_axpy(n, alpha, p, x);
+            continue;   /* confirmed (or restarted) at the top */
+        }
+        tt__cg_direction(n, alpha, rz_next / rz, r, inv_diag, p, x);
+        rz = rz_next;
+    }
+    if (!r_is_true) rr = tt__cg_residual(A, b, x, r);
+    rep.residual = sqrt(rr) / norm_b;
+    if (result == TT_ERROR_NOT_CONVERGED)
+        tt__fail(error, result, -1, -1, -1, -1,
+                 "conjugate gradients stopped after %d steps (max_iterations) at relative residual %.3g, above the "
+                 "tolerance %.3g", rep.iterations, rep.residual, opt.tolerance);
+    if (result == TT_OK) result = tt__ok(error);
+
+done:
+    tt__free(&opt.allocator, block);
+    if (report) *report = rep;
+    return result;
 }
 
 /* ------------------------------------------------------------------------ */

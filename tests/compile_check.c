@@ -143,6 +143,21 @@ int main(void)
     tt_image_free(&atlas_copy);
     tt_mesh_free(quads);
     tt_mesh_free(mesh);
+    {
+        /* 4. Numerics: every public function once. */
+        static const tt_triplet trip[4] = {{0, 0, 2.0}, {1, 1, 2.0}, {0, 1, 0.5}, {1, 0, 0.5}};
+        tt_sparse_matrix sm;
+        double rhs[2] = {1.0, 1.0}, sol[2] = {0.0, 0.0}, prod[2];
+        tt_cg_options cgo;
+        tt_cg_report cgr;
+        memset(&cgo, 0, sizeof cgo);
+        cgo.progress = progress;
+        EXPECT(tt_sparse_from_triplets(&sm, 2, 2, trip, 4, NULL, &err) == TT_OK);
+        EXPECT(tt_sparse_multiply(&sm, rhs, prod) == TT_OK && prod[0] == 2.5);
+        EXPECT(tt_cg_solve(&sm, rhs, sol, &cgo, &cgr, &err) == TT_OK && cgr.converged && sol[0] > 0.39 && sol[0] < 0.41);
+        EXPECT(tt_result_string(TT_ERROR_NOT_CONVERGED)[0] && tt_result_string(TT_ERROR_NOT_POSITIVE_DEFINITE)[0]);
+        tt_sparse_free(&sm);
+    }
 #ifdef COMPILE_CHECK_USER_ALLOC
     EXPECT(user_allocs > 0);
     EXPECT(user_allocs == user_frees);
