@@ -961,6 +961,18 @@ static int tt__fan_size(const tt_mesh *mesh, int v)
     return visited;
 }
 
+/* The face of corner c from face_start alone (binary search): for the build's
+   error path, while corner_face still holds the pairing buckets. */
+static int tt__face_of_corner(const tt_mesh *mesh, int corner)
+{
+    int lo = 0, hi = mesh->nfaces - 1;
+    while (lo < hi) {
+        int mid = lo + (hi - lo + 1) / 2;
+        if (mesh->face_start[mid] <= corner) lo = mid; else hi = mid - 1;
+    }
+    return lo;
+}
+
 /* A mesh with its arrays allocated (positions excepted), or NULL. */
 static tt_mesh *tt__mesh_alloc(const tt_allocator *allocator, int nverts, int nfaces, int ncorners, unsigned flags)
 {
@@ -988,8 +1000,8 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
 {
     const tt_allocator *allocator;
     tt_mesh *mesh = NULL;
-    int *bucket_start = NULL, *out_count = NULL, *stamp = NULL;
-    tt__edge_entry *buckets = NULL;
+    int *bucket_start = NULL, *out_count = NULL, *stamp = NULL, *entries, largest_bucket = 0;
+    tt__edge_entry *local = NULL;
     tt__edge_problem problem;
     tt_result result = TT_OK;
     int permissive, fixed_size, nverts, nfaces, ncorners, f, c, v;
@@ -1042,7 +1054,6 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
                         "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
     bucket_start = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     out_count = TT__ALLOC(allocator, int, nverts);
-    buckets = TT__ALLOC(allocator, tt__edge_entry, ncorners);
     if (desc->flags & TT_MESH_BORROW_POSITIONS) {
         mesh->flags = desc->flags;
         mesh->pos = desc->positions;
@@ -1051,7 +1062,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
         if (copy && nverts > 0) memcpy(copy, desc->positions, (size_t)nverts * 3 * sizeof(float));
         mesh->pos = copy;
     }
-    if (!bucket_start || !out_count || !buckets || !mesh->pos) {
+    if (!bucket_start || !out_count || !mesh->pos) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                           "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
         goto cleanup;
@@ -1070,7 +1081,8 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
 
     /* Corners: copy and range-check them; count each vertex's outgoing
        half-edges (for the fan check) and each edge's bucket, the bucket of its
-       smaller vertex. vert_corner starts as any outgoing half-edge. */
+       smaller vertex. vert_corner starts as any outgoing half-edge. Until
+       pairing overwrites it, twin[c] holds half-edge c's destination. */
     memset(bucket_start, 0, ((size_t)nverts + 1) * sizeof(int));
     memset(out_count, 0, (size_t)nverts * sizeof(int));
     memset(mesh->vert_corner, 0xff, (size_t)nverts * sizeof(int));
@@ -1091,12 +1103,12 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
                 goto cleanup;
             }
             mesh->corner_vert[c] = vert;
-            mesh->corner_face[c] = f;
             mesh->vert_corner[vert] = c;
             out_count[vert]++;
         }
         for (i = 0; i < size; i++) {
             int a = verts[i], b = verts[i + 1 < size ? i + 1 : 0];
+            mesh->twin[first + i] = b;
             bucket_start[(a < b ? a : b) + 1]++;
         }
         if (!permissive) {
@@ -1126,34 +1138,48 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     }
     mesh->face_start[nfaces] = ncorners;
 
-    /* Counting sort of the half-edges into their buckets, then each bucket
-       sorted by (other vertex, corner): the halves of an edge end up side by
-       side, in corner order. */
-    for (v = 0; v < nverts; v++) bucket_start[v + 1] += bucket_start[v];
-    for (f = 0; f < nfaces; f++) {
-        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
-        for (c = first; c < end; c++) {
-            int a = mesh->corner_vert[c], b = mesh->corner_vert[c + 1 < end ? c + 1 : first];
-            int slot = bucket_start[a < b ? a : b]++;
-            buckets[slot].other = a < b ? b : a;
-            buckets[slot].corner_dir = 2 * c + (a > b);
-        }
+    /* Counting sort of the half-edges into their buckets: 2 * corner + 1 when
+       the half-edge runs from the larger vertex to the smaller. The entries
+       live in corner_face, which is only filled at the end: no extra memory
+       for the largest array of the build. */
+    entries = mesh->corner_face;
+    for (v = 0; v < nverts; v++) {
+        if (bucket_start[v + 1] > largest_bucket) largest_bucket = bucket_start[v + 1];
+        bucket_start[v + 1] += bucket_start[v];
+    }
+    for (c = 0; c < ncorners; c++) {
+        int a = mesh->corner_vert[c], b = mesh->twin[c];
+        entries[bucket_start[a < b ? a : b]++] = 2 * c + (a > b);
     }
     for (v = nverts; v > 0; v--) bucket_start[v] = bucket_start[v - 1];
     bucket_start[0] = 0;
+    local = TT__ALLOC(allocator, tt__edge_entry, largest_bucket);
+    if (!local) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+        goto cleanup;
+    }
 
-    /* Pair twins one edge (one run of equal `other`) at a time: one half-edge
-       each way is an interior edge, a single one a boundary; anything else is
-       non-manifold (three or more) or flipped (two the same way). Those are
-       cut loose into boundaries; the problem with the smallest corner is the
-       one reported, so errors come in index-buffer order. */
+    /* Pair twins bucket by bucket: the bucket's entries, keyed by the other
+       vertex, sorted by (other vertex, corner) so the halves of an edge sit
+       side by side in corner order; then one run of equal `other` is one
+       edge. One half-edge each way is an interior edge, a single one a
+       boundary; anything else is non-manifold (three or more) or flipped (two
+       the same way). Those are cut loose into boundaries; the problem with the
+       smallest corner is the one reported, so errors come in index-buffer
+       order. A corner is in one bucket only, so overwriting its destination
+       (twin) here cannot disturb another bucket. */
     problem.corner = -1;
     for (v = 0; v < nverts; v++) {
-        tt__edge_entry *e = buckets + bucket_start[v];
-        int count = bucket_start[v + 1] - bucket_start[v], i = 0;
+        tt__edge_entry *e = local;
+        int count = bucket_start[v + 1] - bucket_start[v], i = 0, k;
+        for (k = 0; k < count; k++) {
+            int corner_dir = entries[bucket_start[v] + k], h = corner_dir >> 1;
+            e[k].other = mesh->corner_vert[h] + mesh->twin[h] - v;   /* the larger of the two ends */
+            e[k].corner_dir = corner_dir;
+        }
         tt__sort_edge_entries(e, count);
         while (i < count) {
-            int other = e[i].other, run_end = i + 1, backward = e[i].corner_dir & 1, k;
+            int other = e[i].other, run_end = i + 1, backward = e[i].corner_dir & 1;
             while (run_end < count && e[run_end].other == other) backward += e[run_end++].corner_dir & 1;
             if (other != v && run_end - i == 2 && backward == 1) {
                 int a = e[i].corner_dir >> 1, b = e[i + 1].corner_dir >> 1;
@@ -1164,26 +1190,28 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
                 mesh->twin[a] = -1;
                 mesh->vert_corner[mesh->corner_vert[a]] = a;   /* prefer a boundary half-edge */
             } else {
+                if (!permissive && other != v && (problem.corner < 0 || (e[i].corner_dir >> 1) < problem.corner)) {
+                    int lowest = e[i].corner_dir >> 1;
+                    problem.corner = lowest;
+                    problem.a = mesh->corner_vert[lowest];
+                    problem.b = problem.a == v ? other : v;
+                    problem.result = run_end - i > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
+                    problem.nfaces = run_end - i;
+                    for (k = 0; k < 3; k++)
+                        problem.faces[k] = i + k < run_end ? tt__face_of_corner(mesh, e[i + k].corner_dir >> 1) : -1;
+                }
                 for (k = i; k < run_end; k++) {
                     int h = e[k].corner_dir >> 1;
                     mesh->twin[h] = -1;
                     mesh->vert_corner[mesh->corner_vert[h]] = h;
                 }
                 mesh->repaired_edges++;
-                if (!permissive && other != v && (problem.corner < 0 || (e[i].corner_dir >> 1) < problem.corner)) {
-                    int lowest = e[i].corner_dir >> 1;
-                    problem.corner = lowest;
-                    problem.a = mesh->corner_vert[lowest];
-                    problem.b = mesh->corner_vert[tt_mesh_next(mesh, lowest)];
-                    problem.result = run_end - i > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
-                    problem.nfaces = run_end - i;
-                    for (k = 0; k < 3; k++)
-                        problem.faces[k] = i + k < run_end ? mesh->corner_face[e[i + k].corner_dir >> 1] : -1;
-                }
             }
             i = run_end;
         }
     }
+    for (f = 0; f < nfaces; f++)
+        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++) mesh->corner_face[c] = f;
     if (problem.corner >= 0) {
         result = tt__report_edge_problem(&problem, error);
         goto cleanup;
@@ -1205,7 +1233,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
 cleanup:
     tt__free(allocator, bucket_start);
     tt__free(allocator, out_count);
-    tt__free(allocator, buckets);
+    tt__free(allocator, local);
     tt__free(allocator, stamp);
     if (result != TT_OK) {
         tt_mesh_free(mesh);
