@@ -17,17 +17,17 @@
 
    QUICK START: tile a quad mesh from a photo (Akleman et al.'s tiled textures)
 
-       tt_mesh_desc desc = {0};
-       desc.positions = xyz; desc.nverts = nverts;              // float[3 * nverts]
-       desc.indices = quads; desc.nfaces = nquads; desc.fixed_face_size = 4;
+       tt_mesh_desc desc = {0};                                 // your arrays:
+       desc.positions = xyz; desc.nverts = nverts;              //   float xyz[3 * nverts]
+       desc.indices = quads; desc.nfaces = nquads;              //   int quads[4 * nquads]
+       desc.fixed_face_size = 4;
        tt_mesh *mesh; tt_error err;
        if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) { puts(err.message); return 1; }
        tt_tile_layout layout = {1, 128, TT_RECOMMENDED_GUTTER};  // n, tile size, gutter
-       uint8_t *types = malloc(mesh->ncorners);  float *uv = malloc(8 * mesh->ncorners);
-       tt_assign_boundaries(mesh, &layout, 42, types);           // same seed, same result
-       tt_assign_uvs(mesh, &layout, types, uv, &err);            // uv[2c..2c+1]: corner c
+       tt_assign_boundaries(mesh, &layout, 42, types);           // uint8_t types[4 * nquads]
+       tt_assign_uvs(mesh, &layout, types, uv, &err);            // float uv[8 * nquads]: 2 per corner
        tt_synth_options opt = {0};  opt.layout = layout;  tt_tileset *tiles;
-       tt_synthesize_tiles(&photo, &opt, &tiles, &err);          // tiles->levels[0]: atlas
+       tt_synthesize_tiles(&photo, &opt, &tiles, &err);          // tiles->levels[0]: the atlas
 
    Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first.
 
@@ -696,7 +696,8 @@ static void tt__free(const tt_allocator *allocator, void *ptr)
 {
     if (!ptr) return;
     if (allocator && allocator->alloc) {
-        if (allocator->free) allocator->free(ptr, allocator->user_data);
+        void (*release)(void *, void *) = allocator->free;
+        if (release) release(ptr, allocator->user_data);
         return;
     }
     TT_FREE(ptr, allocator ? allocator->user_data : NULL);

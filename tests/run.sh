@@ -96,12 +96,13 @@ compile_check "user-defined TT_MALLOC/TT_FREE" user_alloc \
             '#include "tiledtex.h"' 'int main(void) {' \
             'static const float xyz[27] = {0,0,0, 1,0,0, 2,0,0, 0,1,0, 1,1,0, 2,1,0, 0,2,0, 1,2,0, 2,2,0};' \
             'static const int quads[16] = {0,1,4,3, 1,2,5,4, 3,4,7,6, 4,5,8,7};' \
-            'int nverts = 9, nquads = 4, x; tt_image photo; tt_image_create(&photo, 128, 256, NULL);' \
+            'int nverts = 9, nquads = 4, x; uint8_t types[16]; float uv[32];' \
+            'tt_image photo; tt_image_create(&photo, 128, 256, NULL);' \
             'for (x = 0; x < 128 * 256 * 4; x++) photo.pixels[x] = (float)((x * 37) % 101) / 100.0f;' \
             '{'
         sed -n '/QUICK START/,/Triangles or n-gons?/p' tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
         printf '%s\n' 'if (!tiles || tiles->levels[0].width != 4 * (128 + 8)) return 2;' \
-            'tt_tileset_free(tiles); free(types); free(uv); tt_mesh_free(mesh); }' \
+            'tt_tileset_free(tiles); tt_mesh_free(mesh); }' \
             'tt_image_free(&photo); return 0; }'
     } >"$src"
     if log=$(gcc -std=c99 -Wall -Wextra -pedantic -Werror -Wno-declaration-after-statement -I. -g \
