@@ -12,7 +12,7 @@
    Optional overrides (define before the implementation; all or none):
        TT_MALLOC(size, user_data)   default malloc(size)
        TT_FREE(ptr, user_data)      default free(ptr)
-   and TT_ASSERT(x) (default assert). Every allocation also honours the
+   Every allocation also honours the
    tt_allocator you may pass in an options struct, so nothing here is global.
 
    QUICK START: tile a quad mesh from a photo (Akleman et al.'s tiled textures)
@@ -29,7 +29,9 @@
        tt_synth_options opt = {0};  opt.layout = layout;  tt_tileset *tiles;
        tt_synthesize_tiles(&photo, &opt, &tiles, &err);          // tiles->levels[0]: the atlas
 
-   Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first.
+   Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first
+   (the per-corner outputs then line up with the quadrangulated mesh's corners:
+   mesh->corner_vert is its index buffer).
 
    CONVENTIONS
      - Half-edges are corners: the half-edges of face f are stored contiguously in
@@ -52,7 +54,6 @@
      2. Mesh    - half-edge builder with validation, queries, quadrangulation
      3. Image   - float RGBA images, bilinear sampling, 90-degree rotations,
                   premultiplied `over`, box downsampling, minimum-error cut
-     4. Numerics - (comes with the lapped-texture pipeline)
      4. Numerics - triplets to CSR sparse matrices, Jacobi-preconditioned
                   conjugate gradients (symmetric positive definite systems)
      5. Raster  - 2D triangle rasterisation with barycentrics
@@ -200,10 +201,12 @@ typedef struct tt_mesh {
 } tt_mesh;
 
 /* Build a half-edge mesh and validate it. On failure *out_mesh is NULL and the
-   error names the first problem in index-buffer order: empty mesh, index out of
-   range, face with fewer than 3 corners or a repeated vertex, non-finite
-   coordinate, zero-area face, an edge shared by more than two faces, two faces
-   using an edge in the same direction, a vertex whose faces form several fans.
+   error names the first problem found, checking in this order: counts (empty
+   mesh, a face with fewer than 3 corners, sizes that overflow), coordinates
+   (every vertex, used or not: NaN or infinite), then face by face in index
+   order (index out of range, repeated vertex, zero area), then edges, the one
+   with the smallest corner first (shared by more than two faces, or used twice
+   in the same direction), then vertices (faces forming several fans).
    Twin pairing is O(corners log valence). Free the mesh with tt_mesh_free. */
 TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_error *error);
 TTDEF void tt_mesh_free(tt_mesh *mesh);
@@ -474,13 +477,17 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
    made with one layout fit every atlas synthesised with it.
    T = (2n)^2 tiles per side, cell C = S + 2g, atlas side W = T * C. */
 typedef struct tt_tile_layout {
-    int colors;       /* n, distinct edge conditions (1..TT_MAX_COLORS); 0 = 1 */
+    int colors;       /* n, distinct edge conditions; 0 = 1. Up to TT_MAX_COLORS for boundary
+                         assignment; an atlas of (2n)^2 tiles a side must fit TT_MAX_IMAGE_SIZE,
+                         so n <= 7 with 128-texel tiles and gutter 4, n <= 45 at most */
     int tile_size;    /* S, texels per tile side; 0 = TT_DEFAULT_TILE_SIZE */
     int gutter;       /* g, texels around each tile, 0 = none; TT_RECOMMENDED_GUTTER for mip-mapping */
 } tt_tile_layout;
 
-/* Replace zeros by defaults and check ranges (the atlas side must stay within
-   TT_MAX_IMAGE_SIZE). Resolving a resolved layout changes nothing. */
+/* Replace zeros by defaults and check ranges: colors 1..TT_MAX_COLORS, tile
+   size 4..TT_MAX_IMAGE_SIZE, gutter 0..tile size, and an atlas side within
+   TT_MAX_IMAGE_SIZE (TT_ERROR_TOO_LARGE otherwise; TT_ERROR_INVALID_ARGUMENT
+   for the others). Resolving a resolved layout changes nothing. */
 TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error);
 /* For a resolved layout: tiles per atlas side T, atlas side W, total tiles (2n)^4. */
 TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout);
@@ -490,7 +497,9 @@ TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout);
 /* Akleman et al. Sec. 3 / 6, AssignBoundaries: every edge gets a condition k in
    [0, n) and a side i in {0, 1} from the seeded RNG; one half-edge gets type
    2k+i, its twin 2k+1-i. Boundary half-edges get a type too. Works on any mesh.
-   corner_type has mesh->ncorners entries, aligned with the index buffer. */
+   corner_type has mesh->ncorners entries, aligned with the index buffer. Only
+   layout->colors is read (0 = 1). Returns TT_ERROR_INVALID_ARGUMENT for NULL
+   mesh or corner_type, or colors outside 1..TT_MAX_COLORS; TT_OK otherwise. */
 TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
                                      uint8_t *corner_type);
 
@@ -553,7 +562,8 @@ typedef struct tt_tileset {
    two agree (minimum-error cut) and feathered, and every texel of a tile's edge
    rows except the two corner texels is the edge sample alone, exactly. Gutters
    hold what lies across each edge on the surface. Needs a source of at least
-   S x 2S texels. Free with tt_tileset_free. */
+   S x 2S texels. A feather wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT.
+   Free with tt_tileset_free. */
 TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
                                     tt_tileset **out_tileset, tt_error *error);
 TTDEF void tt_tileset_free(tt_tileset *tileset);
@@ -564,7 +574,9 @@ TTDEF void tt_tileset_free(tt_tileset *tileset);
    inside one face, and with samples from two unrelated edges. Differences are
    mean absolute RGB differences of bilinear samples.
    score = (seam - same_face) / (unrelated - same_face): about 0 when an edge
-   looks like any other place in the image, about 1 when tiles do not match. */
+   looks like any other place in the image, about 1 when tiles do not match.
+   When unrelated places differ no more than neighbours do (pure noise at the
+   texel scale) the score means nothing and is NaN; read seam - same_face. */
 typedef struct tt_seam_report {
     double seam;
     double same_face;
@@ -615,11 +627,6 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
 #define TT_FREE(ptr, user_data) ((void)(user_data), free(ptr))
 #else
 #error "tiledtex.h: define both TT_MALLOC and TT_FREE, or neither"
-#endif
-
-#ifndef TT_ASSERT
-#include <assert.h>
-#define TT_ASSERT(x) assert(x)
 #endif
 
 #ifdef __cplusplus
@@ -725,6 +732,14 @@ static int tt__is_finite(float x)
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
     return (bits & 0x7f800000u) != 0x7f800000u;
+}
+
+static double tt__not_a_number(void)
+{
+    uint64_t bits = 0x7ff8000000000000ull;
+    double x;
+    memcpy(&x, &bits, sizeof x);
+    return x;
 }
 
 static float tt__infinity(void)
@@ -3049,8 +3064,9 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         report->seam = seam / (double)samples;
         report->same_face = same / (double)samples;
         report->unrelated = unrelated / (double)samples;
-        if (report->unrelated - report->same_face > 1e-9)
-            report->score = (report->seam - report->same_face) / (report->unrelated - report->same_face);
+        report->score = report->unrelated - report->same_face > 1e-9
+                            ? (report->seam - report->same_face) / (report->unrelated - report->same_face)
+                            : tt__not_a_number();
     }
     return TT_OK;
 }

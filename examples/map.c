@@ -31,7 +31,7 @@ static void print_help(void)
            "\n"
            "options:\n"
            "  --colors N       edge conditions n; the atlas holds (2n)^4 tiles (default 1)\n"
-           "  --tile S         tile size in texels (default %d)\n"
+           "  --tile S         tile size in texels (default %d, or read off --atlas)\n"
            "  --gutter G       texels of gutter around each tile, 0 for none (default %d)\n"
            "  --seed K         random seed for the boundary types (default 0)\n"
            "  --subdivide L    quadrangulate L more times: smaller faces, smaller texture\n"
@@ -180,17 +180,14 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         return status;
     }
     obj_free(&obj);
-    if (out->mesh->repaired_edges > 0)
-        fprintf(stderr, "tiledtex: %s: --permissive cut %d non-manifold or mis-oriented edge%s open\n", obj_path,
-                out->mesh->repaired_edges, out->mesh->repaired_edges == 1 ? "" : "s");
+    out->repaired_edges = out->mesh->repaired_edges;
+    out->input_min_face_size = out->mesh->min_face_size;
+    out->input_max_face_size = out->mesh->max_face_size;
 
     /* Tiles are square: every face must be a quad. */
     if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
-        int smallest = out->mesh->min_face_size, largest = out->mesh->max_face_size;
-        out->quadrangulated = 1;
         if ((status = quadrangulate(&out->mesh, TT_SUBDIVIDE_LINEAR, obj_path)) != 0) goto fail;
-        fprintf(stderr, "tiledtex: %s has faces of %d to %d corners: quadrangulated %d face%s into %d quads\n",
-                obj_path, smallest, largest, out->input_faces, out->input_faces == 1 ? "" : "s", out->mesh->nfaces);
+        out->quadrangulated = out->mesh->nfaces;
     }
     /* Each step makes four times the quads: refuse what would not fit in
        memory long before it is tried. */
@@ -305,6 +302,35 @@ static void print_quality(const tiled_mesh *mesh)
     free(stretch);
 }
 
+int tiled_check_atlas_size(const tiled_options *options)
+{
+    tt_tile_layout layout;
+    tt_error error;
+    int atlas;
+    if (tt_tile_layout_resolve(&options->layout, &layout, &error) != TT_OK) return tool_fail("%s", error.message);
+    atlas = tt_tile_layout_atlas_size(&layout);
+    if (atlas > TILED_MAX_ATLAS)
+        return tool_fail("--colors %d with %d-texel tiles and gutter %d makes a %dx%d atlas; the tool writes at most "
+                         "%dx%d (use fewer --colors or a smaller --tile)",
+                         layout.colors, layout.tile_size, layout.gutter, atlas, atlas, TILED_MAX_ATLAS, TILED_MAX_ATLAS);
+    return 0;
+}
+
+void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
+{
+    if (mesh->repaired_edges > 0)
+        fprintf(stderr, "tiledtex: %s: --permissive cut %d non-manifold or mis-oriented edge%s open\n", obj_path,
+                mesh->repaired_edges, mesh->repaired_edges == 1 ? "" : "s");
+    if (mesh->quadrangulated) {
+        char sizes[64];
+        if (mesh->input_max_face_size == 3) snprintf(sizes, sizeof sizes, "triangles");
+        else snprintf(sizes, sizeof sizes, "faces of %d to %d corners", mesh->input_min_face_size,
+                      mesh->input_max_face_size);
+        fprintf(stderr, "tiledtex: %s has %s: quadrangulated %d face%s into %d quads\n", obj_path, sizes,
+                mesh->input_faces, mesh->input_faces == 1 ? "" : "s", mesh->quadrangulated);
+    }
+}
+
 void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams, int report)
 {
     const tt_mesh_stats *s = &mesh->stats;
@@ -314,8 +340,12 @@ void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_
            s->boundary_loops, s->boundary_loops == 1 ? "" : "s", s->min_valence, s->max_valence,
            tt_tile_layout_tile_count(&mesh->layout), mesh->layout.colors, mesh->layout.tile_size,
            mesh->layout.gutter);
-    if (seams) printf(", seam score %.3f (seam %.4f, same-face %.4f, unrelated %.4f)", seams->score, seams->seam,
-                      seams->same_face, seams->unrelated);
+    if (seams && seams->score == seams->score)
+        printf(", seam score %.3f (seam %.4f, same-face %.4f, unrelated %.4f)", seams->score, seams->seam,
+               seams->same_face, seams->unrelated);
+    else if (seams)
+        printf(", seam score n/a: unrelated places differ no more than neighbours (seam %.4f, same-face %.4f, "
+               "unrelated %.4f)", seams->seam, seams->same_face, seams->unrelated);
     printf("\n");
     if (report) print_quality(mesh);
 }
@@ -375,24 +405,34 @@ int cmd_map(int argc, char **argv)
 
     if (options.atlas_path && (status = load_atlas_for_layout(options.atlas_path, &options, &atlas)) != 0)
         return status;
-    if ((status = tiled_map_mesh(positional[0], &options, &mesh)) != 0) {
+    if ((status = tiled_check_atlas_size(&options)) != 0 ||
+        (status = tiled_map_mesh(positional[0], &options, &mesh)) != 0) {
         tt_image_free(&atlas);
         return status;
     }
     if (options.atlas_path) {
-        tt_measure_seams(mesh.mesh, mesh.corner_uv, &atlas, options.seed, &seams);
-        /* The MTL sits beside the OBJ and names the atlas as given. */
+        char texture[4096];
+        if (tt_measure_seams(mesh.mesh, mesh.corner_uv, &atlas, options.seed, &seams) != TT_OK) {
+            status = tool_fail("out of memory while measuring the seams of %s", positional[0]);
+            goto done;
+        }
+        /* The MTL sits beside the OBJ, and names the atlas relative to itself. */
         snprintf(mtl_path, sizeof mtl_path, "%.*s.mtl",
                  (int)(strlen(positional[1]) > 4 && strcmp(positional[1] + strlen(positional[1]) - 4, ".obj") == 0
                            ? strlen(positional[1]) - 4 : strlen(positional[1])),
                  positional[1]);
-        status = tiled_add_mtl(&output, mtl_path, options.atlas_path);
+        tool_relative_path(options.atlas_path, mtl_path, texture, sizeof texture);
+        status = tiled_add_mtl(&output, mtl_path, texture);
         if (status == 0) status = tiled_add_obj(&output, positional[1], &mesh, tool_basename(mtl_path));
     } else {
         status = tiled_add_obj(&output, positional[1], &mesh, NULL);
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
-    if (status == 0) tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL, options.report);
+    if (status == 0) {
+        tiled_print_notes(positional[0], &mesh);
+        tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL, options.report);
+    }
+done:
     output_free(&output);
     tiled_mesh_free(&mesh);
     tt_image_free(&atlas);

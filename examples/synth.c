@@ -36,17 +36,20 @@ static void print_help(void)
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
 
-int tiled_fit_tile_size(int width, int height)
+int tiled_fit_tile_size(int width, int height, int colors, int gutter)
 {
     /* An edge window is S x 2S; at 2/5 of the smaller side it still has room
        to move, so synthesis can choose an inconspicuous line for the edges
-       (with h = 2S exactly there is only one) and varied backgrounds. */
-    int side = width < height ? width : height;
-    int fit = 2 * side / 5;
+       (with h = 2S exactly there is only one) and varied backgrounds. With
+       more colors the atlas, (2n)^2 tiles a side, must stay within
+       TILED_MAX_ATLAS. Multiples of 8 keep mip levels per tile. */
+    int side = width < height ? width : height, n = colors > 0 ? colors : 1;
+    int fit = 2 * side / 5, fits_atlas = TILED_MAX_ATLAS / (4 * n * n) - 2 * gutter;
     if (fit > TT_DEFAULT_TILE_SIZE) fit = TT_DEFAULT_TILE_SIZE;
-    fit -= fit % 8;
-    if (fit < 8) fit = width >= 8 && height >= 16 ? 8 : 0;
-    return fit;
+    if (fit > fits_atlas) fit = fits_atlas;
+    if (fit >= 8) return fit - fit % 8;
+    if (fits_atlas >= 4 && width >= 4 && height >= 8) return 4;
+    return 0;
 }
 
 int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options, tt_tileset **out)
@@ -113,6 +116,7 @@ int cmd_synth(int argc, char **argv)
     }
     if (npositional != 2) return tool_usage("needs IMAGE and ATLAS.png (see 'tiledtex synth --help')");
 
+    if ((status = tiled_check_atlas_size(&options)) != 0) return status;
     if (image_load(positional[0], &image, message, sizeof message) != 0) return tool_fail("%s", message);
     status = tiled_synthesize(&image, positional[0], &options, &tiles);
     if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips);

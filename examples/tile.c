@@ -30,7 +30,7 @@ static void print_help(void)
            "  --permissive           accept non-manifold or mis-oriented edges\n"
            "  --edge X,Y             condition k's S x 2S edge window, once per condition\n"
            "  --background X,Y,W,H   region the background windows come from\n"
-           "  --mips                 also write the per-tile mip levels\n"
+           "  --mips                 also write the per-tile mip levels, OUT_PREFIX_mip1.png ...\n"
            "  --report               also print tile usage and face stretch\n",
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
@@ -64,6 +64,9 @@ int cmd_tile(int argc, char **argv)
     }
     if (npositional != 3) return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see 'tiledtex tile --help')");
     if (strlen(positional[2]) + 8 > sizeof obj_path) return tool_usage("OUT_PREFIX is too long");
+    if (tool_basename(positional[2])[0] == '\0')
+        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",
+                          positional[2], positional[2]);
     snprintf(obj_path, sizeof obj_path, "%s.obj", positional[2]);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", positional[2]);
     snprintf(png_path, sizeof png_path, "%s.png", positional[2]);
@@ -72,21 +75,22 @@ int cmd_tile(int argc, char **argv)
     /* Without --tile, take the default tile size or the largest this image
        can feed; say so when it is smaller. */
     if (!options.tile_size_given) {
-        int fit = tiled_fit_tile_size(image.width, image.height);
+        int fit = tiled_fit_tile_size(image.width, image.height, options.layout.colors, options.layout.gutter);
         if (fit == 0) {
+            status = tool_fail("%s is %dx%d: too small to cut tiles from (it needs at least 4x8 texels)",
+                               positional[1], image.width, image.height);
             tt_image_free(&image);
-            return tool_fail("%s is %dx%d: too small to cut tiles from (at least 8x16 texels)", positional[1],
-                             image.width, image.height);
+            return status;
         }
         options.layout.tile_size = fit;
     }
 
-    status = tiled_map_mesh(positional[0], &options, &mesh);
+    status = tiled_check_atlas_size(&options);
+    if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
     if (status == 0) status = tiled_synthesize(&image, positional[1], &options, &tiles);
-    if (status == 0) {
-        tt_measure_seams(mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, &seams);
-        status = tiled_add_atlas(&output, png_path, tiles, options.mips);
-    }
+    if (status == 0 && tt_measure_seams(mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, &seams) != TT_OK)
+        status = tool_fail("out of memory while measuring the seams of %s", positional[0]);
+    if (status == 0) status = tiled_add_atlas(&output, png_path, tiles, options.mips);
     if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
     if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
@@ -95,6 +99,7 @@ int cmd_tile(int argc, char **argv)
         if (!options.tile_size_given && options.layout.tile_size < TT_DEFAULT_TILE_SIZE)
             fprintf(stderr, "tiledtex: %s is %dx%d: used %d-texel tiles (--tile to choose)\n", positional[1],
                     image.width, image.height, options.layout.tile_size);
+        tiled_print_notes(positional[0], &mesh);
         tiled_print_summary(positional[0], &mesh, &seams, options.report);
         printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
                tiles->levels[0].height);

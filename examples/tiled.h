@@ -23,6 +23,11 @@ enum {
    about 1.5 GB of text). */
 #define TILED_MAX_QUADS (1 << 24)
 
+/* The tool refuses atlases wider than this: an 8192^2 PNG is already about
+   200 MB in memory while it is written, and few renderers take larger
+   textures. (The library's own limit is TT_MAX_IMAGE_SIZE.) */
+#define TILED_MAX_ATLAS 8192
+
 typedef struct tiled_options {
     tt_tile_layout layout;       /* zeros = the library's defaults */
     int tile_size_given;
@@ -55,7 +60,9 @@ typedef struct tiled_mesh {
     tt_tile_layout layout;       /* resolved */
     tt_mesh_stats stats;
     int input_faces;             /* faces in the OBJ */
-    int quadrangulated;          /* 1 when the OBJ had triangles or n-gons */
+    int quadrangulated;          /* quads made from the OBJ's triangles or n-gons; 0 if all quads */
+    int input_min_face_size, input_max_face_size;
+    int repaired_edges;          /* edges --permissive cut open */
 } tiled_mesh;
 
 /* Read an OBJ, build and validate it, quadrangulate when it is not all quads
@@ -71,9 +78,10 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
 int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name);
 
 /* The tile size `tile` picks when none is given: TT_DEFAULT_TILE_SIZE, or for
-   a small image a multiple of 8 up to 2/5 of its smaller side; 0 when even
-   8-texel tiles (an 8 x 16 edge window) do not fit. */
-int tiled_fit_tile_size(int width, int height);
+   a small image a multiple of 8 up to 2/5 of its smaller side, or less so the
+   atlas of `colors` fits TILED_MAX_ATLAS; 4 for a tiny image; 0 when even a
+   4 x 8 edge window does not fit. */
+int tiled_fit_tile_size(int width, int height, int colors, int gutter);
 
 /* Synthesise the atlas from an image already loaded. Prints the error and
    returns an exit status on failure. */
@@ -81,6 +89,13 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
                      tt_tileset **out);
 /* Add the atlas (and with --mips its levels as PREFIX_mipL.png) to the batch. */
 int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips);
+
+/* Check a layout against the tool's atlas limit; prints the error. */
+int tiled_check_atlas_size(const tiled_options *options);
+
+/* The notes a successful map or tile gives on stderr (quadrangulated, edges
+   cut open): said only on success, so a failing command prints one line. */
+void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh);
 
 /* The one-line summary map and tile print; seams may be NULL. With `report`
    a second line gives tile usage and face stretch. */

@@ -257,4 +257,11 @@ void mtl_add_material(tool_buffer *out, const char *name, const char *texture);
    lines that must be relative to the OBJ / MTL file. */
 const char *tool_basename(const char *path);
 
+/* `target` (a path from the current directory) as seen from the directory of
+   `from_file`: what an MTL beside from_file should write to name target
+   ("out/a.mtl", "out/tex.png" -> "tex.png"; "out/a.mtl", "tex.png" ->
+   "../tex.png"). Absolute targets are kept; so is target when from_file's
+   directory climbs with "..". */
+void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size);
+
 #endif /* TILEDTEX_TOOL_H */

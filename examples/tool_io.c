@@ -400,6 +400,51 @@ int tool_read_file(const char *path, unsigned char **data, size_t *size, char *e
     return 0;
 }
 
+void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size)
+{
+    /* Directory parts of both, as text ranges; "." parts are skipped. */
+    const char *from_end = tool_basename(from_file), *target_name = tool_basename(target);
+    const char *f = from_file, *t = target;
+    size_t used = 0;
+    int ups = 0;
+    if (target[0] == '/') {
+        snprintf(out, out_size, "%s", target);
+        return;
+    }
+    /* Skip the directories both paths share, one part at a time. */
+    for (;;) {
+        const char *fe, *te;
+        while (f < from_end && (*f == '/' || (f[0] == '.' && (f[1] == '/')))) f += (*f == '/') ? 1 : 2;
+        while (t < target_name && (*t == '/' || (t[0] == '.' && (t[1] == '/')))) t += (*t == '/') ? 1 : 2;
+        fe = f;
+        te = t;
+        while (fe < from_end && *fe != '/') fe++;
+        while (te < target_name && *te != '/') te++;
+        if (f == from_end || t == target_name || fe - f != te - t || strncmp(f, t, (size_t)(fe - f)) != 0) break;
+        f = fe;
+        t = te;
+    }
+    /* Every directory left on the file's side is one step up, unless it is a
+       step up itself: then the way back cannot be named, so keep the path. */
+    while (f < from_end) {
+        const char *fe = f;
+        while (fe < from_end && *fe != '/') fe++;
+        if (fe - f == 2 && f[0] == '.' && f[1] == '.') {
+            snprintf(out, out_size, "%s", target);
+            return;
+        }
+        if (fe > f && !(fe - f == 1 && f[0] == '.')) ups++;
+        f = fe;
+        while (f < from_end && *f == '/') f++;
+    }
+    out[0] = '\0';
+    while (ups-- > 0 && used + 3 < out_size) {
+        memcpy(out + used, "../", 3);
+        used += 3;
+    }
+    snprintf(out + used, out_size - used, "%s", t);
+}
+
 const char *tool_basename(const char *path)
 {
     const char *base = path, *p;
@@ -510,6 +555,12 @@ int output_commit(tool_output *output, char *err, size_t err_size)
        directory, so the rename below cannot cross file systems). */
     for (i = 0; i < output->count && !failed; i++) {
         const tool_output_file *file = &output->files[i];
+        size_t length = strlen(file->path);
+        if (length == 0 || file->path[length - 1] == '/') {
+            set_error(err, err_size, "'%s' names a directory: give a file name", file->path);
+            failed = 1;
+            break;
+        }
         temporaries[i] = temporary_name(file->path);
         if (!temporaries[i]) {
             set_error(err, err_size, "out of memory while writing '%s'", file->path);
