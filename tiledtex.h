@@ -3023,8 +3023,7 @@ static void tt__sample_inside(const tt_image *atlas, const tt__edge_point *p, fl
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  uint64_t seed, tt_seam_report *report)
 {
-    enum { POINTS_PER_EDGE = 4 };
-    int *interior, ninterior = 0, c, i, j;
+    int *interior, ninterior = 0, c, i, j, points_per_edge;
     double seam = 0.0, same = 0.0, unrelated = 0.0;
     long long samples = 0;
     tt_rng rng;
@@ -3035,11 +3034,14 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
     for (c = 0; c < mesh->ncorners; c++)
         if (mesh->twin[c] > c) interior[ninterior++] = c;
     tt_rng_seed(&rng, seed, 0x7365616d73ull /* "seams" */);
+    /* Four points an edge, more on small meshes so that every measure rests
+       on a few thousand samples. */
+    points_per_edge = ninterior > 0 ? tt__clamp_i(4096 / ninterior, 4, 64) : 4;
     for (i = 0; i < ninterior && ninterior > 1; i++) {
         int a = interior[i], b = mesh->twin[a];
-        for (j = 0; j < POINTS_PER_EDGE; j++) {
+        for (j = 0; j < points_per_edge; j++) {
             /* Stratified along the edge; the twin runs the other way. */
-            float t = ((float)j + tt_rng_float(&rng)) / (float)POINTS_PER_EDGE;
+            float t = ((float)j + tt_rng_float(&rng)) / (float)points_per_edge;
             int other = interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(ninterior - 1))) % ninterior];
             float t_other = tt_rng_float(&rng);
             tt__edge_point pa, pb, po;
