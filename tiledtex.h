@@ -60,6 +60,8 @@
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
                 - boundary assignment, UV formula, tile-set synthesis, quality report
+     7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures", Sec. 3.2)
+                - tangent field: texture up and scale per face
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
@@ -598,6 +600,105 @@ TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *lay
    surface -> texture map (1 = no stretch), taken at the face's centre; faces
    with a degenerate map get INFINITY. nfaces floats. */
 TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch);
+
+/* ======================================================================== */
+/* 7. Lapped textures                                                       */
+/* ======================================================================== */
+
+/* Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
+   Sec. 3.2 (establishing local orientation and scale: the tangent field).
+
+   Each face f gets a vector T_f in its plane: its direction is the texture's
+   "up", its length the texture's local scale (the side of a texture patch in
+   mesh units). The "right" direction is S = T x N (Sec. 3.2). Isotropic
+   textures need no direction: the patch-growing step picks one per patch
+   (Sec. 3.2, last paragraph); give it this field's length only. */
+
+/* Below this, |up projected on a face's plane| (with |up| = 1) counts as
+   perpendicular and the face takes its direction from its neighbours. */
+#define TT_FIELD_PERPENDICULAR 0.2f
+/* options->scale = 0: this fraction of the mesh's bounding-box diagonal. */
+#define TT_DEFAULT_FIELD_SCALE 0.1f
+/* options->sigma = 0: this fraction of the mesh's bounding-box diagonal. */
+#define TT_DEFAULT_FIELD_SIGMA 0.25f
+
+/* The user says "at this face, up is this way and this long" (Sec. 3.2). */
+typedef struct tt_field_constraint {
+    int face;           /* 0 .. nfaces-1 */
+    float vector[3];    /* finite, non-zero; projected on the face's plane, where it must not vanish;
+                           its length is the scale there (mesh units) */
+    float sigma;        /* extent of this basis function (mesh units); 0 = options->sigma */
+    float weight;       /* relative weight of this basis function; 0 = 1 */
+} tt_field_constraint;
+
+typedef struct tt_field_options {
+    float up[3];        /* global up for the default field; 0,0,0 = (0,1,0); only its direction counts */
+    float scale;        /* length of the default field's vectors (mesh units);
+                           0 = TT_DEFAULT_FIELD_SCALE * bounding-box diagonal */
+    const tt_field_constraint *constraints;     /* nconstraints entries, or NULL when 0 */
+    int nconstraints;
+    float sigma;        /* default Gaussian extent (mesh units); 0 = TT_DEFAULT_FIELD_SIGMA * diagonal */
+    tt_allocator allocator;     /* zeroed: the mesh's allocator */
+} tt_field_options;
+
+/* Unit normal of face f by Newell's method (the normal of the best-fit plane,
+   so non-planar polygons are fine), CCW seen from outside. A face of
+   numerically zero area (as tt_mesh_build judges it) gets (0,0,0). */
+TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3]);
+
+/* The tangent field of Sec. 3.2. face_vectors gets 3 * mesh->nfaces floats,
+   T_f = face_vectors[3f .. 3f+2], in the plane of face f (|T.N| ~ 1e-7 |T|).
+   options may be NULL (all defaults).
+
+   Without constraints (the default field, Sec. 3.2 "project the global up
+   direction onto the surface, and then normalize"): T_f = scale * P_f(up) /
+   |P_f(up)|, with P_f(u) = u - (u.N_f) N_f and |up| = 1. Where |P_f(up)| <
+   TT_FIELD_PERPENDICULAR the face is nearly perpendicular to up and takes its
+   direction from its neighbours instead: breadth-first over faces through
+   shared edges, in layers from the faces already assigned, each face of a
+   layer gets the normalised sum of its assigned neighbours' vectors from
+   earlier layers, each rotated about the shared edge into the face's plane
+   (parallel transport). A connected component with no assigned face at all
+   (say a flat patch facing up) starts from its lowest-numbered face, whose
+   direction is its first edge (corner 0 to corner 1).
+
+   With constraints (Sec. 3.2 "Gaussian radial basis functions, where radius
+   is defined as distance over the mesh, as computed using Dijkstra's
+   algorithm"): d_i(f) is the shortest path from constraint i's face to f over
+   the dual graph, each step centroid -> shared edge's midpoint -> centroid;
+   w_i(f) = weight_i * exp(-d_i(f)^2 / (2 sigma_i^2)). c_i is carried to f by
+   parallel transport along the Dijkstra tree (rotation about each shared
+   edge, so it stays tangent and keeps its length), giving t_i(f). Then
+       T_f = (sum_i w_i |c_i| / sum_i w_i) * normalize(sum_i w_i t_i(f)),
+   the normalised average direction with the averaged length. Weights are
+   normalised, so far from every constraint the nearest one decides (no
+   underflow: the sums are kept relative to the largest weight). A face that
+   carries constraints gets exactly the average of its own (projected)
+   constraint vectors. Faces no constraint reaches (other components) follow
+   the default rule with `scale`. If the directions cancel exactly, the
+   constraint of largest weight (first on ties) gives the direction.
+   Transport along each constraint's own shortest-path tree is exact on
+   developable pieces, but on curved closed surfaces paths that go round a
+   handle or a bump different ways meet with different holonomy: the field
+   can turn sharply along that cut locus, far from the constraint (Sec. 3.3
+   calls such places discontinuities of the direction field; add a
+   constraint there, or lower sigma, to move them).
+
+   One Dijkstra pass (binary heap) per constraint: O(K F log F) for K
+   constraints, O(F) without. Faces of zero area (TT_MESH_PERMISSIVE meshes
+   only) get (0,0,0) and nothing is transported through them.
+   Errors: NULL mesh or face_vectors, a zero or non-finite up, negative or
+   non-finite scale or sigma, nconstraints < 0 or constraints NULL with
+   nconstraints > 0: TT_ERROR_INVALID_ARGUMENT. A constraint on a face out of
+   range: TT_ERROR_INDEX_OUT_OF_RANGE (error->face = that index); a zero,
+   perpendicular (projects to under 1e-3 of its length) vector or a negative
+   sigma or weight: TT_ERROR_INVALID_ARGUMENT; a non-finite one:
+   TT_ERROR_NON_FINITE; a constraint on a zero-area face:
+   TT_ERROR_ZERO_AREA_FACE. The message names the constraint. Temporary
+   memory goes through the allocator and is freed on every path.
+   Deterministic; reentrant and thread-safe on distinct outputs. */
+TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options, float *face_vectors,
+                                 tt_error *error);
 
 #ifdef __cplusplus
 }
@@ -3144,6 +3245,493 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
         stretch[f] = small > 1e-30 * (big > 0 ? big : 1) ? (float)sqrt(big / small) : tt__infinity();
     }
     return TT_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 7. Lapped textures                                                       */
+/* ------------------------------------------------------------------------ */
+
+/* Newell: n = sum over i of (p_i - p_0) x (p_(i+1) - p_0), in double. Zero area
+   is judged as tt__face_has_zero_area does: |n|^2 <= 1e-24 * (sum |p_i - p_0|^2)^2. */
+static int tt__face_normal_d(const tt_mesh *mesh, int face, double normal[3])
+{
+    int begin = mesh->face_start[face], end = mesh->face_start[face + 1], c;
+    const float *o = mesh->pos + 3 * (size_t)mesh->corner_vert[begin];
+    double a[3], n[3] = {0.0, 0.0, 0.0}, size = 0.0, len2;
+    a[0] = a[1] = a[2] = 0.0;
+    for (c = begin + 1; c < end; c++) {
+        const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+        double b[3];
+        b[0] = (double)q[0] - o[0]; b[1] = (double)q[1] - o[1]; b[2] = (double)q[2] - o[2];
+        n[0] += a[1] * b[2] - a[2] * b[1];
+        n[1] += a[2] * b[0] - a[0] * b[2];
+        n[2] += a[0] * b[1] - a[1] * b[0];
+        size += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+        a[0] = b[0]; a[1] = b[1]; a[2] = b[2];
+    }
+    len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (!(len2 > 1e-24 * size * size) || len2 <= 0.0) {
+        normal[0] = normal[1] = normal[2] = 0.0;
+        return 0;
+    }
+    len2 = 1.0 / sqrt(len2);
+    normal[0] = n[0] * len2; normal[1] = n[1] * len2; normal[2] = n[2] * len2;
+    return 1;
+}
+
+TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
+{
+    double n[3];
+    tt__face_normal_d(mesh, face, n);
+    normal[0] = (float)n[0]; normal[1] = (float)n[1]; normal[2] = (float)n[2];
+}
+
+static double tt__dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void tt__cross3(const double *a, const double *b, double *out)
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Scale v to unit length; returns the old length (v untouched when it is 0). */
+static double tt__normalize3(double *v)
+{
+    double len = sqrt(tt__dot3(v, v));
+    if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
+    return len;
+}
+
+/* v minus its component along the unit normal n. */
+static void tt__project3(const double *v, const double *n, double *out)
+{
+    double d = tt__dot3(v, n);
+    out[0] = v[0] - d * n[0]; out[1] = v[1] - d * n[1]; out[2] = v[2] - d * n[2];
+}
+
+/* Parallel transport across half-edge c (of the source face, normal ns) into
+   the face across it (normal nt): with e the unit edge direction and
+   b = n x e, v = (v.e) e + (v.b_s) b_s  ->  (v.e) e + (v.b_s) b_t, i.e. the
+   rotation about the edge taking ns to nt. The result is projected on the
+   target plane (non-planar polygons) and given v's tangential length back. */
+static void tt__field_transport(const tt_mesh *mesh, int c, const double *ns, const double *nt, const double *v,
+                                double *out)
+{
+    const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+    const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
+    double e[3], bs[3], bt[3], r[3], ve, vb, len;
+    e[0] = (double)q[0] - p[0]; e[1] = (double)q[1] - p[1]; e[2] = (double)q[2] - p[2];
+    len = sqrt(tt__dot3(v, v));
+    if (tt__normalize3(e) <= 0.0) { tt__project3(v, nt, out); return; }
+    tt__cross3(ns, e, bs);
+    tt__cross3(nt, e, bt);
+    tt__normalize3(bs);
+    tt__normalize3(bt);
+    ve = tt__dot3(v, e);
+    vb = tt__dot3(v, bs);
+    r[0] = ve * e[0] + vb * bt[0]; r[1] = ve * e[1] + vb * bt[1]; r[2] = ve * e[2] + vb * bt[2];
+    tt__project3(r, nt, out);
+    if (tt__normalize3(out) > 0.0) { out[0] *= len; out[1] *= len; out[2] *= len; }
+}
+
+/* Binary min-heap of (distance, face), ties broken by face: deterministic. */
+typedef struct tt__heap_item {
+    double key;
+    int face;
+} tt__heap_item;
+
+static int tt__heap_less(const tt__heap_item *a, const tt__heap_item *b)
+{
+    return a->key < b->key || (a->key == b->key && a->face < b->face);
+}
+
+static void tt__heap_push(tt__heap_item *heap, int *count, double key, int face)
+{
+    int i = (*count)++;
+    tt__heap_item item;
+    item.key = key;
+    item.face = face;
+    while (i > 0) {
+        int parent = (i - 1) / 2;
+        if (!tt__heap_less(&item, &heap[parent])) break;
+        heap[i] = heap[parent];
+        i = parent;
+    }
+    heap[i] = item;
+}
+
+static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
+{
+    tt__heap_item top = heap[0], last = heap[--(*count)];
+    int i = 0, n = *count;
+    for (;;) {
+        int child = 2 * i + 1;
+        if (child >= n) break;
+        if (child + 1 < n && tt__heap_less(&heap[child + 1], &heap[child])) child++;
+        if (!tt__heap_less(&heap[child], &last)) break;
+        heap[i] = heap[child];
+        i = child;
+    }
+    if (n > 0) heap[i] = last;
+    return top;
+}
+
+/* Distance of one dual step from face a across half-edge c (of a) to face b:
+   centroid(a) -> midpoint of the edge -> centroid(b). */
+static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a, int c, int b)
+{
+    const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+    const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
+    double m[3], da[3], db[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        m[k] = 0.5 * ((double)p[k] + q[k]);
+        da[k] = m[k] - centroid[3 * (size_t)a + k];
+        db[k] = m[k] - centroid[3 * (size_t)b + k];
+    }
+    return sqrt(tt__dot3(da, da)) + sqrt(tt__dot3(db, db));
+}
+
+TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options, float *face_vectors,
+                                 tt_error *error)
+{
+    tt_field_options opt;
+    const tt_allocator *al;
+    double up[3], diag, scale, sigma, lo[3], hi[3];
+    double *normal = NULL, *vec = NULL, *centroid = NULL, *dist = NULL, *trans = NULL, *sum = NULL,
+           *wsum = NULL, *lsum = NULL, *wlog = NULL, *best = NULL;
+    int *state = NULL, *parent = NULL, *queue = NULL;
+    tt__heap_item *heap = NULL;
+    tt_result result = TT_OK;
+    int nf, f, c, i, k, next_seed;
+
+    if (!mesh || !face_vectors)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_tangent_field needs a mesh and an output array (got NULL)");
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    al = opt.allocator.alloc ? &opt.allocator : &mesh->allocator;
+    nf = mesh->nfaces;
+
+    /* Options. */
+    for (k = 0; k < 3; k++)
+        if (!tt__is_finite(opt.up[k]))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "the up vector (%g, %g, %g) is not finite", opt.up[0], opt.up[1], opt.up[2]);
+    if (opt.up[0] == 0.0f && opt.up[1] == 0.0f && opt.up[2] == 0.0f) opt.up[1] = 1.0f;
+    for (k = 0; k < 3; k++) up[k] = opt.up[k];
+    if (!(tt__normalize3(up) > 0.0))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the up vector (%g, %g, %g) has no usable length", opt.up[0], opt.up[1], opt.up[2]);
+    if (!tt__is_finite(opt.scale) || opt.scale < 0.0f)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "scale %g must be finite and >= 0 (0 = default)", opt.scale);
+    if (!tt__is_finite(opt.sigma) || opt.sigma < 0.0f)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "sigma %g must be finite and >= 0 (0 = default)", opt.sigma);
+    if (opt.nconstraints < 0 || (opt.nconstraints > 0 && !opt.constraints))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "nconstraints is %d with constraints %s", opt.nconstraints,
+                        opt.constraints ? "given" : "NULL");
+    if (nf <= 0) return tt__ok(error);
+
+    /* Bounding-box diagonal of the vertices the faces use. */
+    for (k = 0; k < 3; k++) { lo[k] = 1e300; hi[k] = -1e300; }
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+        for (k = 0; k < 3; k++) {
+            if (p[k] < lo[k]) lo[k] = p[k];
+            if (p[k] > hi[k]) hi[k] = p[k];
+        }
+    }
+    for (k = 0; k < 3; k++) lo[k] = hi[k] - lo[k];
+    diag = sqrt(tt__dot3(lo, lo));
+    if (!(diag > 0.0)) diag = 1.0;
+    scale = opt.scale > 0.0f ? (double)opt.scale : TT_DEFAULT_FIELD_SCALE * diag;
+    sigma = opt.sigma > 0.0f ? (double)opt.sigma : TT_DEFAULT_FIELD_SIGMA * diag;
+
+    normal = TT__ALLOC(al, double, 3 * (size_t)nf);
+    vec = TT__ALLOC(al, double, 3 * (size_t)nf);
+    state = TT__ALLOC(al, int, nf);
+    queue = TT__ALLOC(al, int, nf);
+    if (!normal || !vec || !state || !queue) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
+    /* state: -1 = zero-area face (never assigned), 0 = unassigned,
+       1 + layer = assigned in that breadth-first layer (constraints and up: 0). */
+    for (f = 0; f < nf; f++) {
+        state[f] = tt__face_normal_d(mesh, f, normal + 3 * (size_t)f) ? 0 : -1;
+        vec[3 * (size_t)f] = vec[3 * (size_t)f + 1] = vec[3 * (size_t)f + 2] = 0.0;
+    }
+
+    /* Constraints: check them all before any work. */
+    for (i = 0; i < opt.nconstraints; i++) {
+        const tt_field_constraint *con = &opt.constraints[i];
+        double v[3], p[3], len, plen;
+        if (con->face < 0 || con->face >= nf) {
+            result = tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, con->face, -1, -1, -1,
+                              "constraint %d names face %d, but the mesh has %d faces", i, con->face, nf);
+            goto done;
+        }
+        if (!tt__is_finite(con->vector[0]) || !tt__is_finite(con->vector[1]) || !tt__is_finite(con->vector[2]) ||
+            !tt__is_finite(con->sigma) || !tt__is_finite(con->weight)) {
+            result = tt__fail(error, TT_ERROR_NON_FINITE, con->face, -1, -1, -1,
+                              "constraint %d (face %d) has a NaN or infinite vector, sigma or weight", i, con->face);
+            goto done;
+        }
+        if (con->sigma < 0.0f || con->weight < 0.0f) {
+            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
+                              "constraint %d (face %d) has sigma %g and weight %g; neither may be negative", i,
+                              con->face, con->sigma, con->weight);
+            goto done;
+        }
+        if (state[con->face] < 0) {
+            result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, con->face, -1, -1, -1,
+                              "constraint %d is on face %d, which has zero area and no plane", i, con->face);
+            goto done;
+        }
+        for (k = 0; k < 3; k++) v[k] = con->vector[k];
+        len = sqrt(tt__dot3(v, v));
+        tt__project3(v, normal + 3 * (size_t)con->face, p);
+        plen = sqrt(tt__dot3(p, p));
+        if (!(len > 0.0) || !(plen > 1e-3 * len)) {
+            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
+                              "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
+                              con->vector[0], con->vector[1], con->vector[2],
+                              len > 0.0 ? "perpendicular to the face" : "zero");
+            goto done;
+        }
+    }
+
+    if (opt.nconstraints > 0) {
+        /* Gaussian RBFs over Dijkstra distances, one pass per constraint. */
+        centroid = TT__ALLOC(al, double, 3 * (size_t)nf);
+        dist = TT__ALLOC(al, double, nf);
+        trans = TT__ALLOC(al, double, 3 * (size_t)nf);
+        sum = TT__ALLOC(al, double, 3 * (size_t)nf);
+        wsum = TT__ALLOC(al, double, nf);
+        lsum = TT__ALLOC(al, double, nf);
+        wlog = TT__ALLOC(al, double, nf);
+        best = TT__ALLOC(al, double, 4 * (size_t)nf);
+        parent = TT__ALLOC(al, int, nf);
+        heap = TT__ALLOC(al, tt__heap_item, (size_t)mesh->ncorners + 1);
+        if (!centroid || !dist || !trans || !sum || !wsum || !lsum || !wlog || !best || !parent || !heap) {
+            result = TT_ERROR_OUT_OF_MEMORY;
+            goto done;
+        }
+        for (f = 0; f < nf; f++) {
+            int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
+            double *ce = centroid + 3 * (size_t)f;
+            ce[0] = ce[1] = ce[2] = 0.0;
+            for (c = begin; c < end; c++)
+                for (k = 0; k < 3; k++) ce[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
+            for (k = 0; k < 3; k++) ce[k] /= (double)(end - begin);
+            sum[3 * (size_t)f] = sum[3 * (size_t)f + 1] = sum[3 * (size_t)f + 2] = 0.0;
+            wsum[f] = lsum[f] = 0.0;
+            wlog[f] = -1e300;
+            best[4 * (size_t)f] = -1e300;   /* best log weight, then that constraint's t_i(f) */
+        }
+        for (i = 0; i < opt.nconstraints; i++) {
+            const tt_field_constraint *con = &opt.constraints[i];
+            double s = con->sigma > 0.0f ? (double)con->sigma : sigma;
+            double wt = con->weight > 0.0f ? (double)con->weight : 1.0, len, v[3];
+            int nheap = 0;
+            for (k = 0; k < 3; k++) v[k] = con->vector[k];
+            len = sqrt(tt__dot3(v, v));
+            for (f = 0; f < nf; f++) { dist[f] = -1.0; parent[f] = -2; }   /* -2 unreached, -1 source */
+            dist[con->face] = 0.0;
+            parent[con->face] = -1;
+            tt__heap_push(heap, &nheap, 0.0, con->face);
+            while (nheap > 0) {
+                tt__heap_item top = tt__heap_pop(heap, &nheap);
+                int g = top.face, begin, end;
+                double *t = trans + 3 * (size_t)g, lw, scl;
+                if (top.key > dist[g]) continue;   /* stale entry */
+                if (parent[g] == -1) {
+                    tt__project3(v, normal + 3 * (size_t)g, t);
+                    tt__normalize3(t);
+                    t[0] *= len; t[1] *= len; t[2] *= len;
+                } else {
+                    int from = mesh->corner_face[parent[g]];
+                    tt__field_transport(mesh, parent[g], normal + 3 * (size_t)from, normal + 3 * (size_t)g,
+                                        trans + 3 * (size_t)from, t);
+                }
+                parent[g] = -3;   /* settled */
+                /* Accumulate w = wt exp(-d^2 / 2s^2) relative to the largest log weight so far. */
+                lw = log(wt) - top.key * top.key / (2.0 * s * s);
+                if (lw > wlog[g]) {
+                    scl = wsum[g] > 0.0 ? exp(wlog[g] - lw) : 0.0;
+                    for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] *= scl;
+                    wsum[g] *= scl;
+                    lsum[g] *= scl;
+                    wlog[g] = lw;
+                }
+                scl = exp(lw - wlog[g]);
+                for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] += scl * t[k];
+                wsum[g] += scl;
+                lsum[g] += scl * len;
+                if (lw > best[4 * (size_t)g]) {
+                    best[4 * (size_t)g] = lw;
+                    for (k = 0; k < 3; k++) best[4 * (size_t)g + 1 + k] = t[k];
+                }
+                begin = mesh->face_start[g];
+                end = mesh->face_start[g + 1];
+                for (c = begin; c < end; c++) {
+                    int tw = mesh->twin[c], h;
+                    double d;
+                    if (tw < 0) continue;
+                    h = mesh->corner_face[tw];
+                    if (state[h] < 0 || parent[h] == -3 || parent[h] == -1) continue;
+                    d = top.key + tt__field_step(mesh, centroid, g, c, h);
+                    if (dist[h] < 0.0 || d < dist[h]) {
+                        dist[h] = d;
+                        parent[h] = c;
+                        tt__heap_push(heap, &nheap, d, h);
+                    }
+                }
+            }
+        }
+        for (f = 0; f < nf; f++) {
+            double *o = vec + 3 * (size_t)f, dir[3];
+            if (state[f] < 0 || !(wsum[f] > 0.0)) continue;
+            for (k = 0; k < 3; k++) dir[k] = sum[3 * (size_t)f + k];
+            tt__project3(dir, normal + 3 * (size_t)f, dir);
+            if (!(tt__normalize3(dir) > 1e-9 * (lsum[f] / wsum[f]))) {
+                for (k = 0; k < 3; k++) dir[k] = best[4 * (size_t)f + 1 + k];
+                tt__normalize3(dir);
+            }
+            for (k = 0; k < 3; k++) o[k] = dir[k] * (lsum[f] / wsum[f]);
+            state[f] = 1;
+        }
+        /* A constrained face gets exactly the average of its own constraints. */
+        for (f = 0; f < nf; f++) wsum[f] = 0.0;
+        for (i = 0; i < opt.nconstraints; i++) {
+            const tt_field_constraint *con = &opt.constraints[i];
+            double *o = sum + 3 * (size_t)con->face;
+            if (wsum[con->face] == 0.0) o[0] = o[1] = o[2] = 0.0;
+            for (k = 0; k < 3; k++) o[k] += con->vector[k];
+            wsum[con->face] += 1.0;
+        }
+        for (i = 0; i < opt.nconstraints; i++) {
+            int g = opt.constraints[i].face;
+            double p[3], *o = vec + 3 * (size_t)g;
+            if (wsum[g] == 0.0) continue;
+            for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] /= wsum[g];
+            tt__project3(sum + 3 * (size_t)g, normal + 3 * (size_t)g, p);
+            if (tt__normalize3(p) > 0.0) {   /* opposite constraints on one face keep the blended one */
+                double l = 0.0;
+                int j;
+                for (j = 0; j < opt.nconstraints; j++)
+                    if (opt.constraints[j].face == g) {
+                        const float *cv = opt.constraints[j].vector;
+                        l += sqrt((double)cv[0] * cv[0] + (double)cv[1] * cv[1] + (double)cv[2] * cv[2]);
+                    }
+                l /= wsum[g];
+                for (k = 0; k < 3; k++) o[k] = p[k] * l;
+            }
+            wsum[g] = 0.0;
+        }
+    }
+
+    /* Default rule for every face no constraint reached: projected up. */
+    for (f = 0; f < nf; f++) {
+        double p[3], *o = vec + 3 * (size_t)f;
+        if (state[f] != 0) continue;
+        tt__project3(up, normal + 3 * (size_t)f, p);
+        if (tt__normalize3(p) >= TT_FIELD_PERPENDICULAR) {
+            for (k = 0; k < 3; k++) o[k] = p[k] * scale;
+            state[f] = 1;
+        }
+    }
+
+    /* Breadth-first propagation in layers; then one seed per untouched
+       component. state = 1 + layer, layers numbered on across components, so
+       "from an earlier layer" is state <= the current one. O(F) in all. */
+    {
+        int head = 0, tail = 0, layer = 1;
+        for (f = 0; f < nf; f++)
+            if (state[f] == 1) queue[tail++] = f;
+        next_seed = 0;
+        for (;;) {
+            if (head == tail) {
+                /* Nothing left to grow from: seed the lowest unassigned face
+                   with its first edge. */
+                int a;
+                const float *p, *q;
+                double e[3], *o;
+                while (next_seed < nf && state[next_seed] != 0) next_seed++;
+                if (next_seed >= nf) break;
+                a = mesh->face_start[next_seed];
+                p = mesh->pos + 3 * (size_t)mesh->corner_vert[a];
+                q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, a)];
+                o = vec + 3 * (size_t)next_seed;
+                for (k = 0; k < 3; k++) e[k] = (double)q[k] - p[k];
+                tt__project3(e, normal + 3 * (size_t)next_seed, e);
+                if (!(tt__normalize3(e) > 0.0)) { e[0] = 1.0; e[1] = e[2] = 0.0; }   /* not reached: area > 0 */
+                for (k = 0; k < 3; k++) o[k] = e[k] * scale;
+                layer++;
+                state[next_seed] = layer;
+                queue[tail++] = next_seed;
+            }
+            /* Faces of state <= layer are assigned; the unassigned neighbours of
+               the current layer form the next, and each of them averages the
+               transported directions of its neighbours from earlier layers. */
+            {
+                int start = tail, layer_end = tail;
+                for (; head < layer_end; head++) {
+                    int g = queue[head];
+                    for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
+                        int tw = mesh->twin[c], h;
+                        if (tw < 0) continue;
+                        h = mesh->corner_face[tw];
+                        if (state[h] != 0) continue;
+                        state[h] = layer + 1;
+                        queue[tail++] = h;
+                    }
+                }
+                for (i = start; i < tail; i++) {
+                    int h = queue[i], first = 1;
+                    double acc[3] = {0.0, 0.0, 0.0}, firstv[3] = {0.0, 0.0, 0.0}, *o = vec + 3 * (size_t)h;
+                    for (c = mesh->face_start[h]; c < mesh->face_start[h + 1]; c++) {
+                        int tw = mesh->twin[c], g;
+                        double t[3];
+                        if (tw < 0) continue;
+                        g = mesh->corner_face[tw];
+                        if (state[g] <= 0 || state[g] > layer) continue;
+                        tt__field_transport(mesh, tw, normal + 3 * (size_t)g, normal + 3 * (size_t)h,
+                                            vec + 3 * (size_t)g, t);
+                        tt__normalize3(t);
+                        if (first) { firstv[0] = t[0]; firstv[1] = t[1]; firstv[2] = t[2]; first = 0; }
+                        for (k = 0; k < 3; k++) acc[k] += t[k];
+                    }
+                    if (!(tt__normalize3(acc) > 1e-6)) { acc[0] = firstv[0]; acc[1] = firstv[1]; acc[2] = firstv[2]; }
+                    for (k = 0; k < 3; k++) o[k] = acc[k] * scale;
+                }
+                if (tail > start) layer++;
+            }
+        }
+    }
+
+    for (f = 0; f < 3 * nf; f++) face_vectors[f] = (float)vec[f];
+    result = tt__ok(error);
+
+done:
+    if (result == TT_ERROR_OUT_OF_MEMORY)
+        tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory building the tangent field");
+    tt__free(al, normal);
+    tt__free(al, vec);
+    tt__free(al, state);
+    tt__free(al, queue);
+    tt__free(al, centroid);
+    tt__free(al, dist);
+    tt__free(al, trans);
+    tt__free(al, sum);
+    tt__free(al, wsum);
+    tt__free(al, lsum);
+    tt__free(al, wlog);
+    tt__free(al, best);
+    tt__free(al, parent);
+    tt__free(al, heap);
+    return result;
 }
 
 #ifdef __cplusplus

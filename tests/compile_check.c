@@ -141,6 +141,14 @@ int main(void)
     tt_image_free(&rotated);
     tt_image_free(&half);
     tt_image_free(&atlas_copy);
+    if (mesh) {
+        /* 7. Lapped textures: the tangent field. */
+        float normal[3], *field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+        tt_face_normal(mesh, 0, normal);
+        EXPECT(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2] > 0.99f);
+        EXPECT(field && tt_tangent_field(mesh, NULL, field, &err) == TT_OK);
+        free(field);
+    }
     tt_mesh_free(quads);
     tt_mesh_free(mesh);
     {

@@ -4129,6 +4129,597 @@ static void test_cg_oom(void)
 }
 
 /* ------------------------------------------------------------------------ */
+/* 7. Lapped textures: the tangent field                                    */
+/* ------------------------------------------------------------------------ */
+
+/* ------------------------------------------------------------------------ */
+/* 7. Lapped textures: tangent field                                        */
+/* ------------------------------------------------------------------------ */
+
+/* Latitude-longitude sphere, poles on the z axis: triangles at the poles,
+   quads between; outward CCW. */
+static void make_field_sphere(tmesh *m, int nlat, int nlon, double radius)
+{
+    const double pi = 3.14159265358979323846;
+    int i, j, north, south, base;
+    north = tm_vert(m, 0, 0, radius);
+    base = m->nv;
+    for (j = 1; j < nlat; j++)
+        for (i = 0; i < nlon; i++) {
+            double t = pi * j / nlat, p = 2 * pi * i / nlon;
+            tm_vert(m, radius * sin(t) * cos(p), radius * sin(t) * sin(p), radius * cos(t));
+        }
+    south = tm_vert(m, 0, 0, -radius);
+    for (i = 0; i < nlon; i++) tm_tri(m, north, base + i, base + (i + 1) % nlon);
+    for (j = 0; j + 1 < nlat - 1; j++)
+        for (i = 0; i < nlon; i++) {
+            int i1 = (i + 1) % nlon;
+            tm_quad(m, base + j * nlon + i, base + (j + 1) * nlon + i, base + (j + 1) * nlon + i1, base + j * nlon + i1);
+        }
+    for (i = 0; i < nlon; i++)
+        tm_tri(m, base + (nlat - 2) * nlon + i, south, base + (nlat - 2) * nlon + (i + 1) % nlon);
+}
+
+static double fv_dot(const float *a, const float *b) { return (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2]; }
+static double fv_len(const float *a) { return sqrt(fv_dot(a, a)); }
+
+/* Angle between a and b (radians); pi/2 if either is zero. */
+static double fv_angle(const double *a, const double *b)
+{
+    double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    double c;
+    if (la == 0.0 || lb == 0.0) return 1.5707963267948966;
+    c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
+    return acos(c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c));
+}
+
+/* Largest angle between the vectors of two faces sharing an edge, the
+   neighbour's projected on the face's plane. */
+static double field_max_neighbour_angle(const tt_mesh *mesh, const float *v)
+{
+    double worst = 0.0;
+    int c;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int f = mesh->corner_face[c], g, k;
+        float n[3];
+        double a[3], b[3], d, ang;
+        if (mesh->twin[c] < 0) continue;
+        g = mesh->corner_face[mesh->twin[c]];
+        tt_face_normal(mesh, f, n);
+        d = fv_dot(v + 3 * g, n);
+        for (k = 0; k < 3; k++) { a[k] = v[3 * f + k]; b[k] = v[3 * g + k] - d * n[k]; }
+        ang = fv_angle(a, b);
+        if (ang > worst) worst = ang;
+    }
+    return worst;
+}
+
+/* Half-edges across which the field turns by more than `limit` radians. */
+static int field_rough_edges(const tt_mesh *mesh, const float *v, double limit)
+{
+    int c, count = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int f = mesh->corner_face[c], g, k;
+        float n[3];
+        double a[3], b[3], d;
+        if (mesh->twin[c] < 0) continue;
+        g = mesh->corner_face[mesh->twin[c]];
+        tt_face_normal(mesh, f, n);
+        d = fv_dot(v + 3 * g, n);
+        for (k = 0; k < 3; k++) { a[k] = v[3 * f + k]; b[k] = v[3 * g + k] - d * n[k]; }
+        if (fv_angle(a, b) > limit) count++;
+    }
+    return count;
+}
+
+/* Every vector in its face's plane with length `len` (relative tolerances);
+   counts offenders and reports the first. */
+static void check_field_plane_length(const tt_mesh *mesh, const float *v, double len, const char *what)
+{
+    int f, off_plane = 0, bad_len = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        float n[3];
+        double l = fv_len(v + 3 * f), d;
+        tt_face_normal(mesh, f, n);
+        d = fv_dot(v + 3 * f, n);
+        if (!(fabs(d) <= 1e-5 * (len >= 0 ? len : l))) {
+            if (!off_plane) DETAIL("%s: face %d: |v.n| = %g for |v| = %g", what, f, fabs(d), l);
+            off_plane++;
+        }
+        if (len >= 0 && !near(l, len, 1e-5 * len)) {
+            if (!bad_len) DETAIL("%s: face %d: length %.9g, expected %.9g", what, f, l, len);
+            bad_len++;
+        }
+    }
+    CHECK(off_plane == 0, "%s: %d of %d vectors leave their face's plane", what, off_plane, mesh->nfaces);
+    CHECK(bad_len == 0, "%s: %d of %d vectors do not have length %g", what, bad_len, mesh->nfaces, len);
+}
+
+/* Faces not perpendicular to `up` must point along up projected on the face.
+   Returns how many faces were perpendicular (left to propagation). */
+static int check_field_up(const tt_mesh *mesh, int first_face, const float *v, const float up_in[3], const char *what)
+{
+    double up[3], lu;
+    int f, k, bad = 0, perpendicular = 0;
+    for (k = 0; k < 3; k++) up[k] = up_in[k];
+    lu = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+    for (k = 0; k < 3; k++) up[k] /= lu;
+    for (f = first_face; f < mesh->nfaces; f++) {
+        float n[3];
+        double p[3], d, a[3], ang;
+        tt_face_normal(mesh, f, n);
+        d = up[0] * n[0] + up[1] * n[1] + up[2] * n[2];
+        for (k = 0; k < 3; k++) { p[k] = up[k] - d * n[k]; a[k] = v[3 * f + k]; }
+        if (sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) < TT_FIELD_PERPENDICULAR + 1e-4) { perpendicular++; continue; }
+        ang = fv_angle(a, p);
+        if (!(ang < 1e-4)) {
+            if (!bad) DETAIL("%s: face %d is %g rad from projected up", what, f, ang);
+            bad++;
+        }
+    }
+    CHECK(bad == 0, "%s: %d faces do not point along the projected up vector", what, bad);
+    return perpendicular;
+}
+
+static void test_field_default(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options opt;
+    tt_error err;
+    float *v;
+    int perpendicular, f;
+    double diag;
+
+    /* Sphere, up = +y (default): the caps around +-y are perpendicular. */
+    memset(&m, 0, sizeof m);
+    make_field_sphere(&m, 24, 32, 2.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.scale = 0.5f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "sphere field: %s", err.message);
+    CHECK(err.result == TT_OK && err.face == -1, "success clears the error (result %d face %d)", err.result, err.face);
+    check_field_plane_length(mesh, v, 0.5, "sphere, up = default");
+    {
+        const float up[3] = {0, 1, 0};
+        perpendicular = check_field_up(mesh, 0, v, up, "sphere, up = default");
+    }
+    CHECK(perpendicular > 0, "sphere: expected some faces perpendicular to +y, got %d", perpendicular);
+    /* Default scale: 0.1 of the bounding-box diagonal (4 sqrt 3 for r = 2: the poles and equator reach +-2). */
+    {
+        float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+        int i, k;
+        for (i = 0; i < m.nv; i++)
+            for (k = 0; k < 3; k++) {
+                if (m.pos[3 * i + k] < lo[k]) lo[k] = m.pos[3 * i + k];
+                if (m.pos[3 * i + k] > hi[k]) hi[k] = m.pos[3 * i + k];
+            }
+        diag = sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) + (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                    (double)(hi[2] - lo[2]) * (hi[2] - lo[2]));
+    }
+    CHECK(tt_tangent_field(mesh, NULL, v, &err) == TT_OK, "NULL options: %s", err.message);
+    check_field_plane_length(mesh, v, TT_DEFAULT_FIELD_SCALE * diag, "sphere, NULL options (default scale)");
+    /* A tilted up vector, not unit length: only its direction counts. */
+    opt.up[0] = 0.6f; opt.up[1] = 2.0f; opt.up[2] = -0.9f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "tilted up: %s", err.message);
+    check_field_plane_length(mesh, v, 0.5, "sphere, tilted up");
+    perpendicular = check_field_up(mesh, 0, v, opt.up, "sphere, tilted up");
+    CHECK(perpendicular > 0, "sphere, tilted up: expected perpendicular faces, got %d", perpendicular);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Torus around z with up = +z: the top and bottom bands are perpendicular. */
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 32, 16, 3.0, 1.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.up[2] = 1.0f;
+    opt.scale = 0.25f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "torus field: %s", err.message);
+    check_field_plane_length(mesh, v, 0.25, "torus, up = +z");
+    perpendicular = check_field_up(mesh, 0, v, opt.up, "torus, up = +z");
+    CHECK(perpendicular > 0, "torus: expected perpendicular faces, got %d", perpendicular);
+    /* Projected up flips across the top and bottom rings (both sides point
+       at the ring), so only most edges are smooth; the flips are the field's. */
+    CHECK(field_rough_edges(mesh, v, 0.5) <= 2 * 2 * 32, "torus: %d half-edges turn by more than 0.5 rad",
+          field_rough_edges(mesh, v, 0.5));
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Open grid in z = 0, up = +y: every face points exactly along +y. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 6, 4);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.scale = 2.0f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid field: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++)
+        if (v[3 * f] != 0.0f || v[3 * f + 1] != 2.0f || v[3 * f + 2] != 0.0f) break;
+    CHECK(f == mesh->nfaces, "grid, up = +y: face %d is (%g, %g, %g), expected (0, 2, 0)", f,
+          f < mesh->nfaces ? v[3 * f] : 0.0, f < mesh->nfaces ? v[3 * f + 1] : 0.0, f < mesh->nfaces ? v[3 * f + 2] : 0.0);
+    {
+        float n[3];
+        tt_face_normal(mesh, 0, n);
+        CHECK(n[0] == 0.0f && n[1] == 0.0f && n[2] == 1.0f, "tt_face_normal of the grid: (%g, %g, %g)", n[0], n[1], n[2]);
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* Surfaces facing up: no face has a usable projection, so everything comes
+   from the seed face's first edge, carried breadth-first. */
+static void test_field_fallback(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options opt;
+    tt_error err;
+    float *v, *w;
+    int f, i, j, bad = 0;
+
+    /* Flat grid facing up: every face gets face 0's first edge, +x. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 7, 5);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.up[2] = 1.0f;
+    opt.scale = 1.0f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "flat grid facing up: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++)
+        if (!near(v[3 * f], 1.0, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
+    CHECK(bad == 0, "flat grid facing up: %d faces not (1, 0, 0) (face 0's first edge)", bad);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* A gentle dome facing up (normals within ~8 degrees of +z, under the 11.5 of TT_FIELD_PERPENDICULAR): propagation
+       must stay tangent, keep the scale and vary slowly. */
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= 12; j++)
+        for (i = 0; i <= 12; i++) {
+            double x = (i - 6) / 6.0, y = (j - 6) / 6.0;
+            tm_vert(&m, x, y, -0.05 * (x * x + y * y));
+        }
+    for (j = 0; j < 12; j++)
+        for (i = 0; i < 12; i++) {
+            int a = j * 13 + i;
+            if ((i + j) % 2) tm_quad(&m, a, a + 1, a + 14, a + 13);
+            else { tm_tri(&m, a, a + 1, a + 14); tm_tri(&m, a, a + 14, a + 13); }
+        }
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "dome builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    w = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "dome facing up: %s", err.message);
+    check_field_plane_length(mesh, v, 1.0, "dome facing up");
+    CHECK(field_max_neighbour_angle(mesh, v) < 0.05, "dome facing up: neighbouring vectors differ by %g rad",
+          field_max_neighbour_angle(mesh, v));
+    /* Determinism: the same call gives the same bits. */
+    CHECK(tt_tangent_field(mesh, &opt, w, &err) == TT_OK, "dome again: %s", err.message);
+    CHECK(memcmp(v, w, sizeof(float) * 3 * (size_t)mesh->nfaces) == 0, "two identical calls differ");
+    free(v);
+    free(w);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Two components: a grid facing up (fallback) and a torus (up works),
+       plus a zero-area triangle in a permissive mesh: it gets (0, 0, 0). */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 3, 3);
+    make_torus(&m, 12, 8, 3.0, 1.0);
+    {
+        int a = tm_vert(&m, 10, 0, 0), b = tm_vert(&m, 11, 0, 0), c = tm_vert(&m, 12, 0, 0);
+        tm_tri(&m, a, b, c);
+    }
+    CHECK(build(&m, TT_MESH_PERMISSIVE, &mesh, &err) == TT_OK, "grid + torus + sliver builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid + torus + sliver: %s", err.message);
+    f = mesh->nfaces - 1;
+    CHECK(v[3 * f] == 0.0f && v[3 * f + 1] == 0.0f && v[3 * f + 2] == 0.0f, "zero-area face: (%g, %g, %g)", v[3 * f],
+          v[3 * f + 1], v[3 * f + 2]);
+    {
+        float n[3];
+        tt_face_normal(mesh, f, n);
+        CHECK(n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f, "tt_face_normal of a zero-area face: (%g, %g, %g)", n[0],
+              n[1], n[2]);
+    }
+    bad = 0;
+    for (f = 0; f < 9; f++)
+        if (!near(v[3 * f], 1.0, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
+    CHECK(bad == 0, "grid beside a torus: %d faces not (1, 0, 0)", bad);
+    bad = 0;
+    for (f = 9; f < mesh->nfaces - 1; f++)
+        if (!near(fv_len(v + 3 * f), 1.0, 1e-5)) bad++;
+    CHECK(bad == 0, "torus beside a grid: %d faces without unit length", bad);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+static void test_field_constraints(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options opt;
+    tt_field_constraint con[3];
+    tt_error err;
+    float *v;
+    int f, k, bad = 0;
+    double lmin = 1e30, lmax = 0.0;
+
+    /* One constraint on a flat grid: parallel transport is the identity, so
+       every face gets the constraint's vector. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 8, 8);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    memset(con, 0, sizeof con);
+    con[0].face = 27;
+    con[0].vector[0] = 0.3f; con[0].vector[1] = 0.4f; con[0].vector[2] = 5.0f;   /* z is projected away */
+    opt.constraints = con;
+    opt.nconstraints = 1;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid, one constraint: %s", err.message);
+    {
+        /* Direction from the projection (0.6, 0.8, 0), length |vector| (the scale). */
+        double l = sqrt(0.3 * 0.3 + 0.4 * 0.4 + 5.0 * 5.0);
+        for (f = 0; f < mesh->nfaces; f++)
+            if (!near(v[3 * f], 0.6 * l, 1e-5) || !near(v[3 * f + 1], 0.8 * l, 1e-5) || !near(v[3 * f + 2], 0.0, 1e-6))
+                bad++;
+        CHECK(bad == 0, "grid, one constraint: %d faces differ from (0.6, 0.8, 0) * %g", bad, l);
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Torus: three constraints of different directions and lengths. */
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 16, 3.0, 1.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(con, 0, sizeof con);
+    con[0].face = 0;                       /* outer equator at angle 0: tangent plane y, z */
+    con[0].vector[2] = 0.2f;
+    con[1].face = 16;                      /* a third of the way round */
+    con[1].vector[0] = -0.866f * 0.4f; con[1].vector[1] = 0.5f * 0.4f;   /* along the ring */
+    con[2].face = 32 + 8 * 48;             /* inner side, two thirds round */
+    con[2].vector[2] = -0.3f;
+    con[2].sigma = 1.0f;
+    con[2].weight = 2.0f;
+    opt.constraints = con;
+    opt.nconstraints = 3;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "torus, constraints: %s", err.message);
+    check_field_plane_length(mesh, v, -1.0, "torus, constraints (plane only)");
+    for (k = 0; k < 3; k++) {
+        float n[3];
+        double c[3], d, a[3];
+        int g = con[k].face, j;
+        tt_face_normal(mesh, g, n);
+        d = fv_dot(con[k].vector, n);
+        for (j = 0; j < 3; j++) { c[j] = con[k].vector[j] - d * n[j]; a[j] = v[3 * g + j]; }
+        CHECK(fv_angle(a, c) < 1e-5 && near(fv_len(v + 3 * g), fv_len(con[k].vector), 1e-6),
+              "constraint %d on face %d: got (%g, %g, %g), expected (%g, %g, %g) projected", k, g, v[3 * g],
+              v[3 * g + 1], v[3 * g + 2], con[k].vector[0], con[k].vector[1], con[k].vector[2]);
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        double l = fv_len(v + 3 * f);
+        if (l < lmin) lmin = l;
+        if (l > lmax) lmax = l;
+    }
+    CHECK(lmin >= 0.2 - 1e-6 && lmax <= 0.4 + 1e-6 && lmax - lmin > 0.1,
+          "torus, constraints: lengths in [%g, %g], expected within [0.2, 0.4] and varying", lmin, lmax);
+    /* Transport along each constraint's Dijkstra tree has a cut locus where paths round
+       a handle meet with different holonomy: a few rough edges there, smooth elsewhere. */
+    CHECK(field_rough_edges(mesh, v, 0.5) < mesh->ncorners / 10, "torus, constraints: %d of %d half-edges turn by more than 0.5 rad",
+          field_rough_edges(mesh, v, 0.5), mesh->ncorners);
+    /* Faces next to a constrained face stay close to it (smooth interpolation). */
+    {
+        int g = con[1].face, c;
+        double worst = 0.0;
+        for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
+            int h = mesh->corner_face[mesh->twin[c]], j;
+            double a[3], b[3];
+            for (j = 0; j < 3; j++) { a[j] = v[3 * g + j]; b[j] = v[3 * h + j]; }
+            if (fv_angle(a, b) > worst) worst = fv_angle(a, b);
+        }
+        CHECK(worst < 0.3, "neighbours of constraint 1 turn by %g rad", worst);
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Two components: the constraint's component follows it, the other one
+       (unreachable) falls back to the default rule. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 3, 3);
+    make_torus(&m, 12, 8, 3.0, 1.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid + torus builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(con, 0, sizeof con);
+    con[0].face = 4;
+    con[0].vector[0] = 0.5f;
+    opt.constraints = con;
+    opt.nconstraints = 1;
+    opt.scale = 0.7f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid + torus, constraint: %s", err.message);
+    bad = 0;
+    for (f = 0; f < 9; f++)
+        if (!near(v[3 * f], 0.5, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
+    CHECK(bad == 0, "constrained grid: %d faces differ from (0.5, 0, 0)", bad);
+    {
+        int perpendicular;
+        const float up[3] = {0, 1, 0};
+        bad = 0;
+        for (f = 9; f < mesh->nfaces; f++)
+            if (!near(fv_len(v + 3 * f), 0.7, 1e-5)) bad++;
+        CHECK(bad == 0, "unconstrained torus: %d faces without the scale 0.7", bad);
+        perpendicular = check_field_up(mesh, 9, v, up, "grid + torus, torus part");
+        (void)perpendicular;
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+static void test_field_errors(void)
+{
+    tmesh m, md;
+    tt_mesh *mesh = NULL, *dmesh = NULL;
+    tt_field_options opt;
+    tt_field_constraint con[2];
+    tt_error err;
+    float v[3 * 64];
+    float nan_f;
+    {
+        uint32_t bits = 0x7fc00000u;   /* a quiet NaN, whatever the compiler flags */
+        memcpy(&nan_f, &bits, sizeof nan_f);
+    }
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 4, 4);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+
+#define FIELD_EXPECT(call, code, face_expected, what)                                                           \
+    do {                                                                                                        \
+        tt_result r_ = (call);                                                                                  \
+        CHECK(r_ == (code) && err.result == (code) && (face_expected == -2 || err.face == face_expected) &&    \
+                  err.message[0] != '\0',                                                                       \
+              "%s: expected %d (face %d), got %d (face %d): %s", what, (int)(code), face_expected, (int)r_,   \
+              err.face, err.message);                                                                          \
+    } while (0)
+
+    memset(&opt, 0, sizeof opt);
+    FIELD_EXPECT(tt_tangent_field(NULL, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL mesh");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL output");
+    CHECK(tt_tangent_field(NULL, &opt, v, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL error pointer is allowed");
+    opt.up[0] = nan_f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN up");
+    opt.up[0] = 1e-45f;   /* denormal: non-zero, still a direction */
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "tiny up is a direction: %s", err.message);
+    opt.up[0] = 0.0f;
+    opt.scale = -1.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative scale");
+    opt.scale = 1.0f / 0.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "infinite scale");
+    opt.scale = 0.0f;
+    opt.sigma = nan_f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN sigma");
+    opt.sigma = 0.0f;
+    opt.nconstraints = -1;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative nconstraints");
+    opt.nconstraints = 1;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL constraints");
+
+    memset(con, 0, sizeof con);
+    con[0].face = 3; con[0].vector[0] = 1.0f;
+    con[1].face = 16; con[1].vector[1] = 1.0f;
+    opt.constraints = con;
+    opt.nconstraints = 2;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 16, "face == nfaces");
+    CHECK(msg_has_number(err.message, 16) && msg_has_number(err.message, 1) && strstr(err.message, "constraint"),
+          "the message names constraint 1 and face 16: %s", err.message);
+    con[1].face = -1;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, -1, "face -1");
+    con[1].face = 5;
+    con[1].vector[1] = 0.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "zero vector");
+    CHECK(strstr(err.message, "constraint 1") != NULL, "the message names constraint 1: %s", err.message);
+    con[1].vector[2] = 1.0f;   /* along the grid's normal */
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "perpendicular vector");
+    con[1].vector[2] = 0.0f;
+    con[1].vector[1] = nan_f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_NON_FINITE, 5, "NaN vector");
+    con[1].vector[1] = 1.0f / 0.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_NON_FINITE, 5, "infinite vector");
+    con[1].vector[1] = 1.0f;
+    con[1].weight = -1.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative weight");
+    con[1].weight = 0.0f;
+    con[1].sigma = -2.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative sigma");
+    con[1].sigma = 0.0f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "valid constraints: %s", err.message);
+
+    /* A constraint on a zero-area face (permissive mesh). */
+    memset(&md, 0, sizeof md);
+    make_grid(&md, 2, 1);
+    {
+        int a = tm_vert(&md, 5, 0, 0), b = tm_vert(&md, 6, 0, 0), c = tm_vert(&md, 7, 0, 0);
+        tm_tri(&md, a, b, c);
+    }
+    CHECK(build(&md, TT_MESH_PERMISSIVE, &dmesh, &err) == TT_OK, "sliver mesh builds: %s", err.message);
+    con[0].face = 2;
+    opt.nconstraints = 1;
+    FIELD_EXPECT(tt_tangent_field(dmesh, &opt, v, &err), TT_ERROR_ZERO_AREA_FACE, 2, "constraint on a zero-area face");
+#undef FIELD_EXPECT
+    tt_mesh_free(dmesh);
+    tm_free(&md);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+typedef struct field_oom_ctx {
+    const tt_mesh *mesh;
+    const tt_field_constraint *constraints;
+    int nconstraints;
+    float up[3];
+    float *out;
+} field_oom_ctx;
+
+static tt_result field_oom_call(void *ctx, const tt_allocator *al)
+{
+    field_oom_ctx *c = (field_oom_ctx *)ctx;
+    tt_field_options opt;
+    tt_error err;
+    tt_result r;
+    memset(&opt, 0, sizeof opt);
+    memcpy(opt.up, c->up, sizeof opt.up);
+    opt.constraints = c->constraints;
+    opt.nconstraints = c->nconstraints;
+    opt.allocator = *al;
+    r = tt_tangent_field(c->mesh, &opt, c->out, &err);
+    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_field_oom(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    field_oom_ctx c;
+    tt_field_constraint con[2];
+    float *v;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 10, 6, 3.0, 1.0);
+    make_grid(&m, 3, 2);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus + grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(con, 0, sizeof con);
+    con[0].face = 0; con[0].vector[2] = 1.0f;
+    con[1].face = 30; con[1].vector[2] = -1.0f;
+    oom_reset();
+    memset(&c, 0, sizeof c);
+    c.mesh = mesh;
+    c.out = v;
+    c.up[2] = 1.0f;
+    oom_sweep("tt_tangent_field(default, up = +z)", field_oom_call, &c, TT_OK);
+    c.constraints = con;
+    c.nconstraints = 2;
+    oom_sweep("tt_tangent_field(2 constraints)", field_oom_call, &c, TT_OK);
+    con[1].face = 1000;
+    oom_sweep("tt_tangent_field(bad constraint)", field_oom_call, &c, TT_ERROR_INDEX_OUT_OF_RANGE);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
 /* main                                                                     */
 /* ------------------------------------------------------------------------ */
 
@@ -4154,6 +4745,11 @@ int main(void)
     RUN(test_cg_progress);
     RUN(test_cg_errors);
     RUN(test_cg_oom);
+    RUN(test_field_default);
+    RUN(test_field_fallback);
+    RUN(test_field_constraints);
+    RUN(test_field_errors);
+    RUN(test_field_oom);
     RUN(test_raster_random);
     RUN(test_raster_cover);
     RUN(test_layout);
