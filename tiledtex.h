@@ -991,43 +991,54 @@ static int tt__repeated_corner(const int *v, int count, int face, int *stamp)
 
 /* Twice the vector area of a polygon by Newell's method taken relative to
    its first corner (the terms with that corner vanish, and faces far from the
-   origin lose no precision): n = sum over i of (p_i - p_0) x (p_(i+1) - p_0).
-   "Zero area" means numerically zero against the face's own size (the sum of
-   squared distances from p_0), not merely thin. Squares are compared. */
-static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
+   origin lose no precision): n = sum over i of (p_i - p_0) x (p_(i+1) - p_0),
+   with the face's own size, scale = sum of |p_i - p_0|^2. */
+static void tt__polygon_newell(const float *pos, const int *verts, int count, double n[3], double *scale)
 {
     const float *o = pos + 3 * (size_t)verts[0];
-    const float *p = pos + 3 * (size_t)verts[1];
-    float a[3], n[3] = {0, 0, 0}, scale;
-    double area2_squared;
+    double a[3] = {0.0, 0.0, 0.0};
     int i;
+    n[0] = n[1] = n[2] = 0.0;
+    *scale = 0.0;
+    for (i = 1; i < count; i++) {
+        const float *q = pos + 3 * (size_t)verts[i];
+        double b[3];
+        b[0] = (double)q[0] - o[0]; b[1] = (double)q[1] - o[1]; b[2] = (double)q[2] - o[2];
+        n[0] += a[1] * b[2] - a[2] * b[1];
+        n[1] += a[2] * b[0] - a[0] * b[2];
+        n[2] += a[0] * b[1] - a[1] * b[0];
+        *scale += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+        a[0] = b[0]; a[1] = b[1]; a[2] = b[2];
+    }
+}
+
+/* "Zero area" means numerically zero against the face's own size, not
+   merely thin. Squares are compared: no square root per face. */
+static int tt__newell_is_zero(const double n[3], double scale)
+{
+    return n[0] * n[0] + n[1] * n[1] + n[2] * n[2] <= 1e-24 * scale * scale;
+}
+
+static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
+{
+    double n[3], scale;
     if (count == 4) {
-        /* For a quad the sum is the cross product of its diagonals. */
+        /* The builder's hot path: for a quad, Newell's vector is the cross
+           product of its diagonals, and their squared lengths a fair size. */
+        const float *o = pos + 3 * (size_t)verts[0], *p = pos + 3 * (size_t)verts[1];
         const float *q = pos + 3 * (size_t)verts[2], *r = pos + 3 * (size_t)verts[3];
         float d[3], e[3];
         d[0] = q[0] - o[0]; d[1] = q[1] - o[1]; d[2] = q[2] - o[2];
         e[0] = r[0] - p[0]; e[1] = r[1] - p[1]; e[2] = r[2] - p[2];
-        n[0] = d[1] * e[2] - d[2] * e[1];
-        n[1] = d[2] * e[0] - d[0] * e[2];
-        n[2] = d[0] * e[1] - d[1] * e[0];
-        scale = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-        area2_squared = (double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2];
-        return area2_squared <= 1e-24 * (double)scale * (double)scale;
+        n[0] = (double)d[1] * e[2] - (double)d[2] * e[1];
+        n[1] = (double)d[2] * e[0] - (double)d[0] * e[2];
+        n[2] = (double)d[0] * e[1] - (double)d[1] * e[0];
+        scale = (double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2] + (double)e[0] * e[0] +
+                (double)e[1] * e[1] + (double)e[2] * e[2];
+        return tt__newell_is_zero(n, scale);
     }
-    a[0] = p[0] - o[0]; a[1] = p[1] - o[1]; a[2] = p[2] - o[2];
-    scale = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    for (i = 2; i < count; i++) {
-        const float *q = pos + 3 * (size_t)verts[i];
-        float b[3];
-        b[0] = q[0] - o[0]; b[1] = q[1] - o[1]; b[2] = q[2] - o[2];
-        n[0] += a[1] * b[2] - a[2] * b[1];
-        n[1] += a[2] * b[0] - a[0] * b[2];
-        n[2] += a[0] * b[1] - a[1] * b[0];
-        scale += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-        a[0] = b[0]; a[1] = b[1]; a[2] = b[2];
-    }
-    area2_squared = (double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2];
-    return area2_squared <= 1e-24 * (double)scale * (double)scale;
+    tt__polygon_newell(pos, verts, count, n, &scale);
+    return tt__newell_is_zero(n, scale);
 }
 
 /* A problem found while pairing twins; the one with the smallest corner is
@@ -3251,31 +3262,19 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
 /* 7. Lapped textures                                                       */
 /* ------------------------------------------------------------------------ */
 
-/* Newell: n = sum over i of (p_i - p_0) x (p_(i+1) - p_0), in double. Zero area
-   is judged as tt__face_has_zero_area does: |n|^2 <= 1e-24 * (sum |p_i - p_0|^2)^2. */
+/* The unit normal, or zero for a face of numerically zero area (judged as
+   tt_mesh_build judges it, through tt__polygon_newell). */
 static int tt__face_normal_d(const tt_mesh *mesh, int face, double normal[3])
 {
-    int begin = mesh->face_start[face], end = mesh->face_start[face + 1], c;
-    const float *o = mesh->pos + 3 * (size_t)mesh->corner_vert[begin];
-    double a[3], n[3] = {0.0, 0.0, 0.0}, size = 0.0, len2;
-    a[0] = a[1] = a[2] = 0.0;
-    for (c = begin + 1; c < end; c++) {
-        const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
-        double b[3];
-        b[0] = (double)q[0] - o[0]; b[1] = (double)q[1] - o[1]; b[2] = (double)q[2] - o[2];
-        n[0] += a[1] * b[2] - a[2] * b[1];
-        n[1] += a[2] * b[0] - a[0] * b[2];
-        n[2] += a[0] * b[1] - a[1] * b[0];
-        size += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-        a[0] = b[0]; a[1] = b[1]; a[2] = b[2];
-    }
-    len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    if (!(len2 > 1e-24 * size * size) || len2 <= 0.0) {
+    int begin = mesh->face_start[face];
+    double n[3], scale, inverse;
+    tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, mesh->face_start[face + 1] - begin, n, &scale);
+    if (tt__newell_is_zero(n, scale)) {
         normal[0] = normal[1] = normal[2] = 0.0;
         return 0;
     }
-    len2 = 1.0 / sqrt(len2);
-    normal[0] = n[0] * len2; normal[1] = n[1] * len2; normal[2] = n[2] * len2;
+    inverse = 1.0 / sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    normal[0] = n[0] * inverse; normal[1] = n[1] * inverse; normal[2] = n[2] * inverse;
     return 1;
 }
 
