@@ -17,10 +17,23 @@ out=build/fuzz
 mkdir -p "$out"
 
 cc=${FUZZ_CC:-clang}
-if ! command -v "$cc" >/dev/null 2>&1; then
-  echo "fuzz: $cc not found (libFuzzer needs clang; set FUZZ_CC)" >&2
-  exit 2
+# libFuzzer needs clang and its runtime (Debian: clang, libclang-rt-14-dev);
+# install them when we may (root with apt-get), as make demo does for stb.
+probe=$(mktemp -d)
+printf 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n) { (void)d; (void)n; return 0; }\n' >"$probe/p.c"
+if ! "$cc" -fsanitize=fuzzer "$probe/p.c" -o "$probe/p" >/dev/null 2>&1; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && [ -z "${FUZZ_CC:-}" ]; then
+    echo "fuzz: installing clang and libclang-rt-14-dev (libFuzzer) ..." >&2
+    apt-get install -y -qq clang libclang-rt-14-dev >/dev/null 2>&1 ||
+      { apt-get update -qq >/dev/null 2>&1 && apt-get install -y -qq clang libclang-rt-14-dev >/dev/null 2>&1; }
+  fi
+  if ! "$cc" -fsanitize=fuzzer "$probe/p.c" -o "$probe/p" >/dev/null 2>&1; then
+    rm -rf "$probe"
+    echo "fuzz: $cc cannot build libFuzzer targets: run  sudo apt-get install clang libclang-rt-14-dev  (or set FUZZ_CC)" >&2
+    exit 2
+  fi
 fi
+rm -rf "$probe"
 flags="-std=c99 -g -O1 -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
 warn="-Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes"
 # stb as a system header: its own warnings are not ours to fix
