@@ -60,8 +60,9 @@
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
                 - boundary assignment, UV formula, tile-set synthesis, quality report
-     7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures", Sec. 3.2)
-                - tangent field: texture up and scale per face
+     7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures")
+                - tangent field: texture up and scale per face (Sec. 3.2)
+                - texture patches with soft splotch masks (Sec. 3.1)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
@@ -699,6 +700,69 @@ TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3]);
    Deterministic; reentrant and thread-safe on distinct outputs. */
 TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options, float *face_vectors,
                                  tt_error *error);
+
+/* Texture patches.
+   Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
+   Sec. 3.1 (creating the texture patches: "the texture patch is assigned an
+   alpha mask that falls off near the patch boundary (e.g. over a distance of
+   3 pixels)"; for homogeneous textures a predefined irregular "splotch"). */
+
+/* options->falloff = 0: this many texels of soft edge (the paper's value). */
+#define TT_DEFAULT_PATCH_FALLOFF 3.0f
+/* options->roughness = 0: the splotch radius varies by up to this fraction. */
+#define TT_DEFAULT_PATCH_ROUGHNESS 0.25f
+/* The splotch covers about this fraction of the image (as a binary shape, before
+   the soft edge), when the image is large next to the falloff. */
+#define TT_PATCH_SPLOTCH_COVERAGE 0.70f
+
+typedef struct tt_patch_options {
+    uint64_t seed;          /* picks the splotch's shape; unused when a mask is given */
+    float falloff;          /* texels of soft edge; 0 = TT_DEFAULT_PATCH_FALLOFF */
+    float roughness;        /* how irregular the splotch boundary is, in [0, 1);
+                               0 = TT_DEFAULT_PATCH_ROUGHNESS */
+    tt_allocator allocator; /* for the patch and scratch; zeroed: TT_MALLOC / TT_FREE */
+} tt_patch_options;
+
+/* Cut a texture patch from `source` (straight, un-premultiplied RGBA): patch
+   is created (it must not already hold an image) with the source's size and
+   holds premultiplied RGBA, rgb = source.rgb * alpha, with a soft alpha.
+
+   The shape, a binary mask (a texel is inside when its value >= 0.5), is the
+   first that applies of:
+     1. the source's own alpha, when some source alpha is below 1;
+     2. `mask` (same size as the source): its alpha channel, or, when every
+        mask alpha is 1, its grey value (r + g + b) / 3;
+     3. a seeded splotch: a blob centred in the image whose radius, on a
+        rounded-square base shape (|x|^4 + |y|^4 = 1), varies with the angle
+        theta by 1 + roughness * sum_k c_k cos(k theta + phi_k), k = 2..5,
+        with seeded weights c_k (sum 1) and phases; it stays `falloff` texels
+        (at least 1) inside the image, and its size is chosen so that it
+        covers TT_PATCH_SPLOTCH_COVERAGE of the image (less when the margin
+        leaves no room).
+   Soft falloff: with d the exact Euclidean distance (separable distance
+   transform, Felzenszwalb-Huttenlocher, O(pixels)) from a texel's centre to
+   the nearest texel centre outside the shape (everything beyond the image
+   counts as outside), alpha = clamp((d - 0.5) / falloff, 0, 1): 0 outside,
+   rising over `falloff` texels from the shape's edge (which lies half a texel
+   beyond the last inside centre) to 1. So a shape that reaches the image
+   border still fades out there.
+
+   Errors (the patch is left empty, memory freed on every path):
+     TT_ERROR_INVALID_ARGUMENT  NULL or empty source or patch; a mask of
+                                another size (the message gives both sizes);
+                                "the mask has no opaque pixel" (no texel >=
+                                0.5); a negative falloff, a roughness outside
+                                [0, 1), or a falloff so large that no texel
+                                gets alpha 1 (the message says how deep the
+                                shape is);
+     TT_ERROR_NON_FINITE        a NaN or infinite option, source value or
+                                mask value (the message names the texel);
+     TT_ERROR_TOO_LARGE         a source above TT_MAX_IMAGE_SIZE;
+     TT_ERROR_OUT_OF_MEMORY.
+   options may be NULL (all defaults, seed 0). Deterministic for a given seed
+   on a given platform (the splotch uses cosf/atan2f). */
+TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
+                                      tt_image *patch, tt_error *error);
 
 #ifdef __cplusplus
 }
@@ -3730,6 +3794,247 @@ done:
     tt__free(al, best);
     tt__free(al, parent);
     tt__free(al, heap);
+    return result;
+}
+
+/* ---- Texture patches (Praun et al. Sec. 3.1) ---------------------------- */
+
+/* Exact 1D squared distance transform of f[0..n-1] (Felzenszwalb and
+   Huttenlocher, "Distance Transforms of Sampled Functions"): d[q] = min_p
+   (q - p)^2 + f[p]. v gets n ints, z n + 1 floats of scratch. */
+static void tt__edt_1d(const float *f, int n, float *d, int *v, float *z, float big)
+{
+    int k = 0, q;
+    v[0] = 0;
+    z[0] = -big;
+    z[1] = big;
+    for (q = 1; q < n; q++) {
+        float s;
+        for (;;) {
+            int p = v[k];
+            s = ((f[q] + (float)q * (float)q) - (f[p] + (float)p * (float)p)) / (2.0f * (float)(q - p));
+            if (s <= z[k] && k > 0) { k--; continue; }
+            break;
+        }
+        if (s <= z[k]) {   /* k == 0 and the new parabola is lower everywhere */
+            v[0] = q;
+            z[0] = -big;
+            z[1] = big;
+            continue;
+        }
+        k++;
+        v[k] = q;
+        z[k] = s;
+        z[k + 1] = big;
+    }
+    k = 0;
+    for (q = 0; q < n; q++) {
+        float dq;
+        while (z[k + 1] < (float)q) k++;
+        dq = (float)(q - v[k]);
+        d[q] = dq * dq + f[v[k]];
+    }
+}
+
+TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
+                                      tt_image *patch, tt_error *error)
+{
+    const float big = 1e30f;
+    tt_patch_options opt;
+    const tt_allocator *al;
+    tt_result result = TT_OK;
+    float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL, *q = NULL;
+    int *v = NULL;
+    int w, h, gw, gh, x, y, n, inside = 0, source_alpha = 0, mask_alpha = 0;
+    size_t count, i;
+    float falloff, roughness, deepest = 0.0f;
+
+    if (patch) memset(patch, 0, sizeof *patch);
+    if (!patch) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "patch is NULL");
+    if (!source || !source->pixels || source->width <= 0 || source->height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
+    w = source->width;
+    h = source->height;
+    if (w > TT_MAX_IMAGE_SIZE || h > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "the source is %d x %d texels, above %d", w, h,
+                        TT_MAX_IMAGE_SIZE);
+    if (mask && (!mask->pixels || mask->width != w || mask->height != h))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the mask is %d x %d texels but the source is %d x %d", mask->pixels ? mask->width : 0,
+                        mask->pixels ? mask->height : 0, w, h);
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    if (!tt__is_finite(opt.falloff) || !tt__is_finite(opt.roughness))
+        return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1, "options: falloff %g or roughness %g is not finite",
+                        (double)opt.falloff, (double)opt.roughness);
+    if (opt.falloff < 0.0f)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "options: falloff %g is negative",
+                        (double)opt.falloff);
+    if (opt.roughness < 0.0f || opt.roughness >= 1.0f)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "options: roughness %g is outside [0, 1)",
+                        (double)opt.roughness);
+    falloff = opt.falloff > 0.0f ? opt.falloff : TT_DEFAULT_PATCH_FALLOFF;
+    roughness = opt.roughness > 0.0f ? opt.roughness : TT_DEFAULT_PATCH_ROUGHNESS;
+    count = (size_t)w * (size_t)h;
+
+    /* Which shape: source alpha, mask alpha, mask grey, or the splotch. */
+    for (i = 0; i < count * 4; i++) {
+        if (!tt__is_finite(source->pixels[i]))
+            return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1, "source texel (%d, %d) is not finite",
+                            (int)((i / 4) % (size_t)w), (int)((i / 4) / (size_t)w));
+        if ((i & 3) == 3 && source->pixels[i] < 1.0f) source_alpha = 1;
+    }
+    if (!source_alpha && mask) {
+        for (i = 0; i < count * 4; i++) {
+            if (!tt__is_finite(mask->pixels[i]))
+                return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1, "mask texel (%d, %d) is not finite",
+                                (int)((i / 4) % (size_t)w), (int)((i / 4) / (size_t)w));
+            if ((i & 3) == 3 && mask->pixels[i] < 1.0f) mask_alpha = 1;
+        }
+    }
+    if (!source_alpha && !mask) {
+        /* The splotch needs a margin of max(falloff, 1) texels on every side. */
+        float margin = falloff > 1.0f ? falloff : 1.0f;
+        if (2.0f * margin + 2.0f >= (float)(w < h ? w : h))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "falloff %g leaves no room for a splotch in a %d x %d image", (double)falloff, w, h);
+    }
+
+    al = &opt.allocator;
+    gw = w + 2;
+    gh = h + 2;
+    n = (gw > gh ? gw : gh);
+    grid = TT__ALLOC(al, float, (size_t)gw * (size_t)gh);
+    line = TT__ALLOC(al, float, n);
+    dline = TT__ALLOC(al, float, n);
+    z = TT__ALLOC(al, float, n + 1);
+    v = TT__ALLOC(al, int, n);
+    if (!grid || !line || !dline || !z || !v) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory making a %d x %d texture patch",
+                          w, h);
+        goto done;
+    }
+
+    /* grid: 0 outside the shape (and on the one-texel frame around the image), big inside. */
+    for (i = 0; i < (size_t)gw * (size_t)gh; i++) grid[i] = 0.0f;
+    if (source_alpha || mask) {
+        const float *src = source_alpha ? source->pixels : mask->pixels;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                const float *p = src + 4 * ((size_t)y * (size_t)w + (size_t)x);
+                float value = (source_alpha || mask_alpha) ? p[3] : (p[0] + p[1] + p[2]) * (1.0f / 3.0f);
+                if (value >= 0.5f) {
+                    grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
+                    inside++;
+                }
+            }
+        if (inside == 0) {
+            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                              "the mask has no opaque pixel (no %s value >= 0.5)",
+                              source_alpha ? "source alpha" : (mask_alpha ? "mask alpha" : "mask grey"));
+            goto done;
+        }
+    } else {
+        /* Splotch: q = rho / (1 + g(theta)) where rho <= 1 (inside the base
+           shape shrunk by the margin), else infinite; inside <=> q <= s, with
+           s found by bisection so that the shape covers the target fraction. */
+        tt_rng rng;
+        float c[4], phi[4], csum = 0.0f, lo, hi, ax, ay, margin = falloff > 1.0f ? falloff : 1.0f;
+        long target = (long)((double)TT_PATCH_SPLOTCH_COVERAGE * (double)count + 0.5);
+        int k, it;
+        q = TT__ALLOC(al, float, count);
+        if (!q) {
+            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                              "out of memory making a %d x %d splotch", w, h);
+            goto done;
+        }
+        tt_rng_seed(&rng, opt.seed, 0x7061746368ull);   /* "patch" */
+        for (k = 0; k < 4; k++) {
+            c[k] = (0.5f + 0.5f * tt_rng_float(&rng)) / (float)(k + 2);
+            phi[k] = 6.28318531f * tt_rng_float(&rng);
+            csum += c[k];
+        }
+        for (k = 0; k < 4; k++) c[k] *= roughness / csum;
+        ax = 0.5f * (float)w - margin;
+        ay = 0.5f * (float)h - margin;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float dx = ((float)x + 0.5f - 0.5f * (float)w) / ax, dy = ((float)y + 0.5f - 0.5f * (float)h) / ay;
+                float dx2 = dx * dx, dy2 = dy * dy, rho = sqrtf(sqrtf(dx2 * dx2 + dy2 * dy2));
+                float theta = atan2f(dy, dx), g = 1.0f;
+                for (k = 0; k < 4; k++) g += c[k] * cosf((float)(k + 2) * theta + phi[k]);
+                q[(size_t)y * (size_t)w + (size_t)x] = rho <= 1.0f ? rho / g : big;
+            }
+        lo = 0.0f;
+        hi = 1.0f / (1.0f - roughness) + 1.0f;
+        for (it = 0; it < 40; it++) {
+            float mid = 0.5f * (lo + hi);
+            long covered = 0;
+            for (i = 0; i < count; i++) covered += q[i] <= mid;
+            if (covered < target) lo = mid;
+            else hi = mid;
+        }
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++)
+                if (q[(size_t)y * (size_t)w + (size_t)x] <= hi) {
+                    grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
+                    inside++;
+                }
+        if (inside == 0) {   /* not reachable with the margin check above; kept for safety */
+            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the mask has no opaque pixel");
+            goto done;
+        }
+    }
+
+    /* Separable exact EDT: columns, then rows (squared distances). */
+    for (x = 0; x < gw; x++) {
+        for (y = 0; y < gh; y++) line[y] = grid[(size_t)y * (size_t)gw + (size_t)x];
+        tt__edt_1d(line, gh, dline, v, z, big);
+        for (y = 0; y < gh; y++) grid[(size_t)y * (size_t)gw + (size_t)x] = dline[y];
+    }
+    for (y = 0; y < gh; y++) {
+        float *row = grid + (size_t)y * (size_t)gw;
+        memcpy(line, row, sizeof(float) * (size_t)gw);
+        tt__edt_1d(line, gw, row, v, z, big);
+    }
+    for (y = 1; y <= h; y++)
+        for (x = 1; x <= w; x++) {
+            float d = sqrtf(grid[(size_t)y * (size_t)gw + (size_t)x]) - 0.5f;
+            grid[(size_t)y * (size_t)gw + (size_t)x] = d;
+            if (d > deepest) deepest = d;
+        }
+    if (deepest < falloff) {
+        result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                          "falloff %g leaves no opaque texel: the shape is at most %g texels deep", (double)falloff,
+                          (double)deepest);
+        goto done;
+    }
+
+    result = tt_image_create(patch, w, h, al);
+    if (result != TT_OK) {
+        result = tt__fail(error, result, -1, -1, -1, -1, "could not allocate the %d x %d patch", w, h);
+        goto done;
+    }
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            size_t at = (size_t)y * (size_t)w + (size_t)x;
+            float a = tt__clamp_f(grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] / falloff, 0.0f, 1.0f);
+            const float *s = source->pixels + 4 * at;
+            float *o = patch->pixels + 4 * at;
+            o[0] = s[0] * a;
+            o[1] = s[1] * a;
+            o[2] = s[2] * a;
+            o[3] = a;
+        }
+    result = tt__ok(error);
+
+done:
+    tt__free(al, grid);
+    tt__free(al, line);
+    tt__free(al, dline);
+    tt__free(al, z);
+    tt__free(al, v);
+    tt__free(al, q);
     return result;
 }
 

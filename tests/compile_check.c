@@ -149,6 +149,16 @@ int main(void)
         EXPECT(field && tt_tangent_field(mesh, NULL, field, &err) == TT_OK);
         free(field);
     }
+    {
+        /* 7. Lapped textures: a texture patch with a splotch mask. */
+        tt_image source, patch;
+        int k;
+        EXPECT(tt_image_create(&source, 32, 32, NULL) == TT_OK);
+        for (k = 0; k < 32 * 32 * 4; k++) source.pixels[k] = 1.0f;
+        EXPECT(tt_make_texture_patch(&source, NULL, NULL, &patch, &err) == TT_OK && patch.width == 32);
+        tt_image_free(&patch);
+        tt_image_free(&source);
+    }
     tt_mesh_free(quads);
     tt_mesh_free(mesh);
     {

@@ -4720,6 +4720,342 @@ static void test_field_oom(void)
 }
 
 /* ------------------------------------------------------------------------ */
+/* 7. Lapped textures: texture patches                                      */
+/* ------------------------------------------------------------------------ */
+
+/* ------------------------------------------------------------------------ */
+/* 7b. Texture patches                                                      */
+/* ------------------------------------------------------------------------ */
+
+/* A smooth, opaque RGB test source. */
+static void patch_source(tt_image *img, int w, int h)
+{
+    int x, y;
+    tt_image_create(img, w, h, NULL);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = img->pixels + 4 * (y * w + x);
+            p[0] = 0.2f + 0.6f * (float)x / (float)w;
+            p[1] = 0.3f + 0.5f * (float)y / (float)h;
+            p[2] = 0.7f;
+            p[3] = 1.0f;
+        }
+}
+
+/* Brute force: distance from texel (x, y)'s centre to the nearest texel centre
+   outside the binary shape (alpha >= 0.5 of in), the image's surroundings
+   counting as outside; 0 for texels outside. */
+static double patch_brute_depth(const unsigned char *in, int w, int h, int x, int y)
+{
+    int i, j;
+    double best;
+    if (!in[y * w + x]) return 0.0;
+    best = x + 1;
+    if (w - x < best) best = w - x;
+    if (y + 1 < best) best = y + 1;
+    if (h - y < best) best = h - y;
+    for (j = 0; j < h; j++)
+        for (i = 0; i < w; i++)
+            if (!in[j * w + i]) {
+                double d = sqrt((double)((i - x) * (i - x) + (j - y) * (j - y)));
+                if (d < best) best = d;
+            }
+    return best;
+}
+
+/* Checks alpha against the brute-force distance transform of `in`. */
+static void patch_check_ramp(const tt_image *patch, const unsigned char *in, float falloff, const char *what)
+{
+    int x, y, bad = 0, w = patch->width, h = patch->height;
+    double worst = 0.0;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            double d = patch_brute_depth(in, w, h, x, y);
+            double want = d > 0.0 ? (d - 0.5) / falloff : 0.0;
+            double got = patch->pixels[4 * (y * w + x) + 3];
+            if (want > 1.0) want = 1.0;
+            if (want < 0.0) want = 0.0;
+            if (fabs(got - want) > 1e-4) {
+                if (!bad) DETAIL("%s: texel (%d, %d): alpha %g, want %g (depth %g)", what, x, y, got, want, d);
+                bad++;
+            }
+            if (fabs(got - want) > worst) worst = fabs(got - want);
+        }
+    CHECK(bad == 0, "%s: alpha = clamp((depth - 0.5) / falloff) everywhere: %d texels off (worst %g)", what, bad,
+          worst);
+}
+
+static void test_patch_splotch(void)
+{
+    tt_image src, patch;
+    tt_patch_options opt;
+    tt_error err;
+    int w = 96, h = 80, x, y, inside = 0, half = 0, border_bad = 0, deep_bad = 0, pm_bad = 0, contour_bad = 0;
+    unsigned char *in = (unsigned char *)malloc((size_t)(w * h));
+    patch_source(&src, w, h);
+    memset(&opt, 0, sizeof opt);
+    opt.seed = 7;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_OK, "splotch: ok (%s)", err.message);
+    CHECK(patch.width == w && patch.height == h && patch.pixels, "splotch: %d x %d patch", patch.width, patch.height);
+    if (patch.pixels) {
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                const float *p = patch.pixels + 4 * (y * w + x), *s = src.pixels + 4 * (y * w + x);
+                in[y * w + x] = (unsigned char)(p[3] > 0.0f);
+                inside += p[3] > 0.0f;
+                half += p[3] >= 0.5f;
+                if ((x == 0 || y == 0 || x == w - 1 || y == h - 1) && p[3] != 0.0f) border_bad++;
+                if (p[0] != s[0] * p[3] || p[1] != s[1] * p[3] || p[2] != s[2] * p[3]) pm_bad++;
+            }
+        /* The inside of the binary shape is exactly where alpha > 0 (depth >= 1). */
+        CHECK(inside >= 0.60 * w * h && inside <= 0.75 * w * h, "splotch covers 60-75%% of the image: %.1f%%",
+              100.0 * inside / (w * h));
+        CHECK(half >= 0.55 * w * h && half <= 0.75 * w * h, "alpha >= 0.5 on 55-75%% of the image: %.1f%%",
+              100.0 * half / (w * h));
+        CHECK(border_bad == 0, "alpha is 0 on the image border: %d texels are not", border_bad);
+        CHECK(pm_bad == 0, "premultiplied exactly: %d texels differ", pm_bad);
+        /* Deep inside (the centre region) alpha is 1. */
+        for (y = h / 2 - 10; y < h / 2 + 10; y++)
+            for (x = w / 2 - 10; x < w / 2 + 10; x++) deep_bad += patch.pixels[4 * (y * w + x) + 3] != 1.0f;
+        CHECK(deep_bad == 0, "alpha is 1 in the centre: %d texels are not", deep_bad);
+        /* The 0.5 contour lies falloff/2 texels inside the shape's edge: every
+           texel with alpha >= 0.5 is at least 2 texels from an outside centre,
+           every one with 0 < alpha < 0.5 at most 2 (falloff 3: depth 0.5 + 1.5). */
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float a = patch.pixels[4 * (y * w + x) + 3];
+                double d = patch_brute_depth(in, w, h, x, y);
+                if (a >= 0.5f && d < 2.0 - 1e-6) contour_bad++;
+                if (a > 0.0f && a < 0.5f && d > 2.0 + 1e-6) contour_bad++;
+            }
+        CHECK(contour_bad == 0, "the 0.5 contour is falloff/2 = 1.5 texels inside the edge: %d texels off",
+              contour_bad);
+        patch_check_ramp(&patch, in, 3.0f, "splotch, falloff 3");
+    }
+    tt_image_free(&patch);
+    /* A wider falloff is honoured too. */
+    opt.falloff = 6.5f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_OK, "falloff 6.5: ok (%s)", err.message);
+    if (patch.pixels) {
+        int ramp = 0;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float a = patch.pixels[4 * (y * w + x) + 3];
+                in[y * w + x] = (unsigned char)(a > 0.0f);
+                if ((x < 6 || y < 6 || x >= w - 6 || y >= h - 6) && a != 0.0f) border_bad++;
+                ramp += a > 0.0f && a < 1.0f;
+            }
+        CHECK(border_bad == 0, "falloff 6.5: margin of 6.5 texels is transparent: %d texels are not", border_bad);
+        CHECK(ramp > 6 * 150, "falloff 6.5: a wide ramp (%d texels between 0 and 1)", ramp);
+        patch_check_ramp(&patch, in, 6.5f, "splotch, falloff 6.5");
+    }
+    tt_image_free(&patch);
+    tt_image_free(&src);
+    free(in);
+}
+
+static void test_patch_seeds(void)
+{
+    tt_image src, a, b, c;
+    tt_patch_options opt;
+    int w = 64, h = 64, seed, differ = 0, min_cov = w * h, max_cov = 0;
+    size_t i;
+    patch_source(&src, w, h);
+    memset(&opt, 0, sizeof opt);
+    opt.seed = 123;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &a, NULL) == TT_OK, "seed 123: ok");
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &b, NULL) == TT_OK, "seed 123 again: ok");
+    opt.seed = 124;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &c, NULL) == TT_OK, "seed 124: ok");
+    if (a.pixels && b.pixels && c.pixels) {
+        CHECK(memcmp(a.pixels, b.pixels, sizeof(float) * 4 * (size_t)(w * h)) == 0, "same seed, same patch");
+        for (i = 0; i < (size_t)(w * h); i++) differ += (a.pixels[4 * i + 3] > 0.0f) != (c.pixels[4 * i + 3] > 0.0f);
+        CHECK(differ > 20, "seeds 123 and 124 give different shapes: %d texels differ", differ);
+    }
+    tt_image_free(&a);
+    tt_image_free(&b);
+    tt_image_free(&c);
+    /* Coverage holds over many seeds, and at the roughest setting. */
+    for (seed = 0; seed < 40; seed++) {
+        int cov = 0;
+        opt.seed = (uint64_t)seed * 0x9e3779b97f4a7c15ull;
+        opt.roughness = seed < 20 ? 0.0f : 0.6f;
+        if (tt_make_texture_patch(&src, NULL, &opt, &a, NULL) != TT_OK) { cov = -1; }
+        else {
+            for (i = 0; i < (size_t)(w * h); i++) cov += a.pixels[4 * i + 3] > 0.0f;
+            tt_image_free(&a);
+        }
+        if (cov < min_cov) min_cov = cov;
+        if (cov > max_cov) max_cov = cov;
+    }
+    CHECK(min_cov >= 0.60 * w * h && max_cov <= 0.75 * w * h, "40 seeds: coverage %.1f%% .. %.1f%%",
+          100.0 * min_cov / (w * h), 100.0 * max_cov / (w * h));
+    tt_image_free(&src);
+}
+
+static void test_patch_masks(void)
+{
+    tt_image src, mask, patch;
+    tt_error err;
+    int w = 40, h = 30, x, y, bad = 0;
+    unsigned char *in = (unsigned char *)malloc((size_t)(w * h));
+    patch_source(&src, w, h);
+    tt_image_create(&mask, w, h, NULL);
+    /* Grey mask (opaque): a rectangle of grey 0.6 plus a stray 0.4 texel (outside). */
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = mask.pixels + 4 * (y * w + x);
+            float g = (x >= 5 && x < 35 && y >= 4 && y < 26) ? 0.6f : 0.0f;
+            if (x == 1 && y == 1) g = 0.4f;
+            p[0] = p[1] = p[2] = g;
+            p[3] = 1.0f;
+            in[y * w + x] = (unsigned char)(g >= 0.5f);
+        }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "grey mask: ok (%s)", err.message);
+    if (patch.pixels) {
+        patch_check_ramp(&patch, in, 3.0f, "grey mask");
+        CHECK(patch.pixels[4 * (15 * w + 20) + 3] == 1.0f, "grey mask: centre alpha 1, got %g",
+              patch.pixels[4 * (15 * w + 20) + 3]);
+        CHECK(patch.pixels[4 * (4 * w + 20) + 3] > 0.16f && patch.pixels[4 * (4 * w + 20) + 3] < 0.17f,
+              "grey mask: edge texel alpha 0.5/3, got %g", patch.pixels[4 * (4 * w + 20) + 3]);
+    }
+    tt_image_free(&patch);
+    /* Mask alpha (not all 1): alpha is used, the grey ignored. */
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = mask.pixels + 4 * (y * w + x);
+            int inside = (x - 20) * (x - 20) + (y - 15) * (y - 15) <= 100;
+            p[0] = p[1] = p[2] = 1.0f - (float)inside;   /* grey says the opposite */
+            p[3] = inside ? 0.75f : 0.25f;
+            in[y * w + x] = (unsigned char)inside;
+        }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "alpha mask: ok (%s)", err.message);
+    if (patch.pixels) patch_check_ramp(&patch, in, 3.0f, "alpha mask");
+    tt_image_free(&patch);
+    /* Source alpha takes precedence over the mask: a band x in [10, 30). */
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            src.pixels[4 * (y * w + x) + 3] = (x >= 10 && x < 30) ? 1.0f : 0.0f;
+            in[y * w + x] = (unsigned char)(x >= 10 && x < 30);
+        }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "source alpha: ok (%s)", err.message);
+    if (patch.pixels) {
+        patch_check_ramp(&patch, in, 3.0f, "source alpha over mask");
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                const float *p = patch.pixels + 4 * (y * w + x), *s = src.pixels + 4 * (y * w + x);
+                if (p[0] != s[0] * p[3] || p[1] != s[1] * p[3] || p[2] != s[2] * p[3]) bad++;
+            }
+        CHECK(bad == 0, "source alpha: premultiplied exactly, %d texels differ", bad);
+    }
+    tt_image_free(&patch);
+    /* A fully opaque grey mask still fades out at the image border. */
+    for (y = 0; y < h * w * 4; y++) mask.pixels[y] = 1.0f;
+    for (y = 0; y < h * w; y++) { src.pixels[4 * y + 3] = 1.0f; in[y] = 1; }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "full mask: ok (%s)", err.message);
+    if (patch.pixels) patch_check_ramp(&patch, in, 3.0f, "full mask");
+    tt_image_free(&patch);
+    tt_image_free(&mask);
+    tt_image_free(&src);
+    free(in);
+}
+
+static void test_patch_errors(void)
+{
+    tt_image src, mask, patch, empty;
+    tt_patch_options opt;
+    tt_error err;
+    float nan_value = (float)tt__not_a_number();
+    patch_source(&src, 32, 32);
+    memset(&empty, 0, sizeof empty);
+    memset(&opt, 0, sizeof opt);
+    CHECK(tt_make_texture_patch(NULL, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL source");
+    CHECK(tt_make_texture_patch(&empty, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty source");
+    CHECK(tt_make_texture_patch(&src, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL patch");
+    tt_image_create(&mask, 31, 32, NULL);
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "mask size");
+    CHECK(strstr(err.message, "31 x 32") && strstr(err.message, "32 x 32"), "size message: %s", err.message);
+    CHECK(patch.pixels == NULL && patch.width == 0, "patch left empty on error");
+    tt_image_free(&mask);
+    tt_image_create(&mask, 32, 32, NULL);   /* all zero: transparent black */
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty mask");
+    CHECK(strstr(err.message, "the mask has no opaque pixel") != NULL, "empty mask message: %s", err.message);
+    CHECK(err.result == TT_ERROR_INVALID_ARGUMENT, "err.result set: %d", err.result);
+    mask.pixels[3] = nan_value;
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "NaN mask: %s", err.message);
+    tt_image_free(&mask);
+    opt.falloff = -1.0f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "negative falloff");
+    CHECK(strstr(err.message, "negative") != NULL, "negative falloff message: %s", err.message);
+    opt.falloff = 15.0f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 15 on 32: %s",
+          err.message);
+    opt.falloff = 10.0f;   /* room for a splotch, but it is not 10 texels deep */
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 10 on 32: %s",
+          err.message);
+    CHECK(strstr(err.message, "no opaque texel") != NULL, "falloff 10 message: %s", err.message);
+    opt.falloff = tt__infinity();
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "infinite falloff");
+    opt.falloff = nan_value;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN falloff");
+    opt.falloff = 0.0f;
+    opt.roughness = nan_value;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN roughness");
+    opt.roughness = 1.0f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness 1");
+    opt.roughness = -0.5f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness -0.5");
+    opt.roughness = 0.0f;
+    src.pixels[4 * 33 + 1] = nan_value;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN source");
+    CHECK(strstr(err.message, "(1, 1)") != NULL, "NaN source names the texel: %s", err.message);
+    CHECK(patch.pixels == NULL, "patch left empty on error");
+    tt_image_free(&src);
+}
+
+typedef struct patch_oom_ctx {
+    const tt_image *source, *mask;
+    uint64_t seed;
+} patch_oom_ctx;
+
+static tt_result patch_oom_call(void *ctx, const tt_allocator *al)
+{
+    patch_oom_ctx *c = (patch_oom_ctx *)ctx;
+    tt_patch_options opt;
+    tt_image patch;
+    tt_error err;
+    tt_result r;
+    memset(&opt, 0, sizeof opt);
+    opt.seed = c->seed;
+    opt.allocator = *al;
+    r = tt_make_texture_patch(c->source, c->mask, &opt, &patch, &err);
+    if (r != TT_OK && (patch.pixels != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
+    tt_image_free(&patch);
+    return r;
+}
+
+static void test_patch_oom(void)
+{
+    tt_image src, mask;
+    patch_oom_ctx c;
+    int i;
+    patch_source(&src, 24, 20);
+    tt_image_create(&mask, 24, 20, NULL);
+    for (i = 0; i < 24 * 20; i++) mask.pixels[4 * i + 3] = (i % 24 > 4 && i % 24 < 20) ? 1.0f : 0.0f;
+    oom_reset();
+    c.source = &src;
+    c.mask = NULL;
+    c.seed = 3;
+    oom_sweep("tt_make_texture_patch(splotch)", patch_oom_call, &c, TT_OK);
+    c.mask = &mask;
+    oom_sweep("tt_make_texture_patch(mask)", patch_oom_call, &c, TT_OK);
+    memset(mask.pixels, 0, sizeof(float) * 4 * 24 * 20);
+    oom_sweep("tt_make_texture_patch(empty mask)", patch_oom_call, &c, TT_ERROR_INVALID_ARGUMENT);
+    tt_image_free(&mask);
+    tt_image_free(&src);
+}
+
+/* ------------------------------------------------------------------------ */
 /* main                                                                     */
 /* ------------------------------------------------------------------------ */
 
@@ -4750,6 +5086,11 @@ int main(void)
     RUN(test_field_constraints);
     RUN(test_field_errors);
     RUN(test_field_oom);
+    RUN(test_patch_splotch);
+    RUN(test_patch_seeds);
+    RUN(test_patch_masks);
+    RUN(test_patch_errors);
+    RUN(test_patch_oom);
     RUN(test_raster_random);
     RUN(test_raster_cover);
     RUN(test_layout);
