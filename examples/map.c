@@ -96,6 +96,28 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
     return 1;
 }
 
+int tiled_parse_command_line(int argc, char **argv, unsigned accept, tiled_options *options,
+                             const char **positional, int count, const char *names, void (*help)(void))
+{
+    int npositional = 0, i;
+    tiled_default_options(options);
+    for (i = 1; i < argc; i++) {
+        int taken;
+        if (tool_is_help(argv[i])) {
+            help();
+            return 0;
+        }
+        taken = tiled_parse_option(argc, argv, &i, accept, options);
+        if (taken < 0) return TOOL_EXIT_USAGE;
+        if (taken) continue;
+        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
+        if (npositional == count) return tool_usage("too many arguments (see 'tiledtex %s --help')", argv[0]);
+        positional[npositional++] = argv[i];
+    }
+    if (npositional != count) return tool_usage("needs %s (see 'tiledtex %s --help')", names, argv[0]);
+    return -1;
+}
+
 void tiled_mesh_free(tiled_mesh *mesh)
 {
     tt_mesh_free(mesh->mesh);
@@ -164,15 +186,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         return tool_fail("%s", error.message);
     if (obj_read(obj_path, &obj, message, sizeof message) != 0) return tool_fail("%s", message);
 
-    /* The OBJ's arrays go straight in: corners are faces one after another,
-       exactly the index-buffer layout the library expects. */
-    memset(&desc, 0, sizeof desc);
-    desc.positions = obj.pos;
-    desc.nverts = obj.nverts;
-    desc.indices = obj.corner_vert;
-    desc.face_sizes = obj.face_size;
-    desc.nfaces = obj.nfaces;
-    desc.flags = options->permissive ? TT_MESH_PERMISSIVE : 0;
+    desc = obj_mesh_desc(&obj, options->permissive ? TT_MESH_PERMISSIVE : 0);
     out->input_faces = obj.nfaces;
     if (tt_mesh_build(&desc, &out->mesh, &error) != TT_OK) {
         status = report_mesh_error(obj_path, &obj, &error);
@@ -379,7 +393,7 @@ static int load_atlas_for_layout(const char *path, tiled_options *options, tt_im
 int cmd_map(int argc, char **argv)
 {
     const char *positional[2];
-    int npositional = 0, i, status;
+    int status;
     tiled_options options;
     tiled_mesh mesh;
     tt_image atlas;
@@ -387,21 +401,12 @@ int cmd_map(int argc, char **argv)
     tool_output output;
     char message[TOOL_ERROR_SIZE], mtl_path[4096];
 
-    tiled_default_options(&options);
     memset(&output, 0, sizeof output);
     memset(&atlas, 0, sizeof atlas);
-    for (i = 1; i < argc; i++) {
-        int taken;
-        if (tool_is_help(argv[i])) { print_help(); return 0; }
-        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION,
-                                   &options);
-        if (taken < 0) return TOOL_EXIT_USAGE;
-        if (taken) continue;
-        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
-        if (npositional == 2) return tool_usage("too many arguments (see 'tiledtex map --help')");
-        positional[npositional++] = argv[i];
-    }
-    if (npositional != 2) return tool_usage("needs MESH.obj and OUT.obj (see 'tiledtex map --help')");
+    status = tiled_parse_command_line(argc, argv,
+                                      TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION,
+                                      &options, positional, 2, "MESH.obj and OUT.obj", print_help);
+    if (status >= 0) return status;
 
     if (options.atlas_path && (status = load_atlas_for_layout(options.atlas_path, &options, &atlas)) != 0)
         return status;

@@ -95,26 +95,17 @@ int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset 
 int cmd_synth(int argc, char **argv)
 {
     const char *positional[2];
-    int npositional = 0, i, k, status;
+    int k, status;
     tiled_options options;
     tt_image image;
     tt_tileset *tiles = NULL;
     tool_output output;
     char message[TOOL_ERROR_SIZE];
 
-    tiled_default_options(&options);
     memset(&output, 0, sizeof output);
-    for (i = 1; i < argc; i++) {
-        int taken;
-        if (tool_is_help(argv[i])) { print_help(); return 0; }
-        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_SYNTH_OPTIONS, &options);
-        if (taken < 0) return TOOL_EXIT_USAGE;
-        if (taken) continue;
-        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
-        if (npositional == 2) return tool_usage("too many arguments (see 'tiledtex synth --help')");
-        positional[npositional++] = argv[i];
-    }
-    if (npositional != 2) return tool_usage("needs IMAGE and ATLAS.png (see 'tiledtex synth --help')");
+    status = tiled_parse_command_line(argc, argv, TILED_LAYOUT_OPTIONS | TILED_SYNTH_OPTIONS, &options, positional, 2,
+                                      "IMAGE and ATLAS.png", print_help);
+    if (status >= 0) return status;
 
     if ((status = tiled_check_atlas_size(&options)) != 0) return status;
     if (image_load(positional[0], &image, message, sizeof message) != 0) return tool_fail("%s", message);

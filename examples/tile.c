@@ -38,7 +38,7 @@ static void print_help(void)
 int cmd_tile(int argc, char **argv)
 {
     const char *positional[3];
-    int npositional = 0, i, status;
+    int status;
     tiled_options options;
     tiled_mesh mesh;
     tt_image image;
@@ -47,22 +47,12 @@ int cmd_tile(int argc, char **argv)
     tool_output output;
     char message[TOOL_ERROR_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
 
-    tiled_default_options(&options);
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
-    for (i = 1; i < argc; i++) {
-        int taken;
-        if (tool_is_help(argv[i])) { print_help(); return 0; }
-        taken = tiled_parse_option(argc, argv, &i,
-                                   TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS |
-                                       TILED_REPORT_OPTION, &options);
-        if (taken < 0) return TOOL_EXIT_USAGE;
-        if (taken) continue;
-        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
-        if (npositional == 3) return tool_usage("too many arguments (see 'tiledtex tile --help')");
-        positional[npositional++] = argv[i];
-    }
-    if (npositional != 3) return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see 'tiledtex tile --help')");
+    status = tiled_parse_command_line(argc, argv,
+                                      TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS | TILED_REPORT_OPTION,
+                                      &options, positional, 3, "MESH.obj, IMAGE and OUT_PREFIX", print_help);
+    if (status >= 0) return status;
     if (strlen(positional[2]) + 8 > sizeof obj_path) return tool_usage("OUT_PREFIX is too long");
     if (tool_basename(positional[2])[0] == '\0')
         return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",

@@ -52,6 +52,13 @@ void tiled_default_options(tiled_options *options);
    and return -1. */
 int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled_options *options);
 
+/* The whole command line of synth, map or tile: the tool's defaults, then
+   --help (prints `help` and asks to exit 0), the accepted options, and
+   exactly `count` positional arguments described by `names` ("MESH.obj and
+   OUT.obj"). Returns -1 to go on, or the exit status to return now. */
+int tiled_parse_command_line(int argc, char **argv, unsigned accept, tiled_options *options,
+                             const char **positional, int count, const char *names, void (*help)(void));
+
 /* A quad mesh with its tiled-texture UVs, ready to write. */
 typedef struct tiled_mesh {
     tt_mesh *mesh;

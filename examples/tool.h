@@ -218,6 +218,10 @@ typedef struct obj_mesh {
    ending in '\' continues on the next. Returns 0, or -1 with a message naming
    the line in err ("line 12: face with fewer than 3 corners") and *out zeroed. */
 int obj_parse(const char *text, size_t length, obj_mesh *out, char *err, size_t err_size);
+/* The description that hands an OBJ's arrays to tt_mesh_build as they are:
+   corners are faces one after another, the library's index-buffer layout. */
+tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
+
 /* Read and parse a file; messages start with the path ("mesh.obj:12: ..."). */
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);

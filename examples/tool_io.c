@@ -1199,6 +1199,19 @@ int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size)
     return result;
 }
 
+tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags)
+{
+    tt_mesh_desc desc;
+    memset(&desc, 0, sizeof desc);
+    desc.positions = mesh->pos;
+    desc.nverts = mesh->nverts;
+    desc.indices = mesh->corner_vert;
+    desc.face_sizes = mesh->face_size;
+    desc.nfaces = mesh->nfaces;
+    desc.flags = flags;
+    return desc;
+}
+
 void obj_free(obj_mesh *mesh)
 {
     int g;

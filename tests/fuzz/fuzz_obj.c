@@ -115,13 +115,7 @@ static void feed_library(const obj_mesh *m)
     tt_mesh *mesh = NULL;
     tt_error err;
     tt_result r;
-    memset(&desc, 0, sizeof desc);
-    desc.positions = m->pos;
-    desc.nverts = m->nverts;
-    desc.indices = m->corner_vert;
-    desc.face_sizes = m->face_size;
-    desc.nfaces = m->nfaces;
-    desc.flags = TT_MESH_PERMISSIVE;
+    desc = obj_mesh_desc(m, TT_MESH_PERMISSIVE);
     r = tt_mesh_build(&desc, &mesh, &err);
     if (r != TT_OK) {
         CHECK(mesh == NULL, "build failed but returned a mesh");
