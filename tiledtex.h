@@ -1437,19 +1437,11 @@ cleanup:
 
 TTDEF int tt_mesh_valence(const tt_mesh *mesh, int vertex)
 {
-    /* Turn around the vertex: edges = outgoing half-edges, plus one for the
-       incoming boundary half-edge that closes an open fan. */
-    int start, h, count = 0, guard;
+    /* Edges at a vertex: one per outgoing half-edge of its fan, plus the
+       incoming boundary edge that closes an open fan (vert_corner is a
+       boundary half-edge exactly when the fan is open). */
     if (!mesh || vertex < 0 || vertex >= mesh->nverts || mesh->vert_corner[vertex] < 0) return 0;
-    start = h = mesh->vert_corner[vertex];
-    for (guard = 0; guard <= mesh->ncorners; guard++) {
-        int prev = tt_mesh_prev(mesh, h);
-        count++;
-        if (mesh->twin[prev] < 0) return count + 1;
-        h = mesh->twin[prev];
-        if (h == start) return count;
-    }
-    return count;
+    return tt__fan_size(mesh, vertex) + (mesh->twin[mesh->vert_corner[vertex]] < 0 ? 1 : 0);
 }
 
 /* valence[v] for every vertex in O(corners), counting edges rather than walking
