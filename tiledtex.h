@@ -764,6 +764,190 @@ typedef struct tt_patch_options {
 TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
                                       tt_image *patch, tt_error *error);
 
+/* The paste loop.
+   Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
+   Sec. 3 (overview), 3.3 (growing the surface patch), 3.4 (optimizing its
+   parametrization), 3.5 (recording the paste), 3.6 (face coverage) and 4
+   (runtime pasting: faces hidden by later pastes are dropped).
+
+   Texture space: each paste maps its faces into the unit square of one texture
+   patch, (0,0) bottom-left, (1,1) top-right (OBJ / OpenGL convention), the
+   patch's image being 1 x 1. The face vector T_f (from tt_tangent_field) should
+   map to the patch's up axis (0,1) and S_f = T_f x N_f to its right axis (1,0):
+   |T_f| mesh units at face f are one patch side. Coordinates outside [0,1] are
+   meant to be clamped (the patches are transparent at their border).
+
+   The loop, until every face is covered:
+     1. pick a face not yet covered at random (seeded) and a point of it not
+        yet covered; pick a texture patch at random;
+     2. map the seed face so that point lands on the patch's anchor (its
+        deepest opaque texel, the "center" for any mask shape) with (S, T)
+        along the axes;
+     3. grow the surface patch one face at a time, nearest (in texture space)
+        first, across an edge only when (a) the face keeps the patch a disc,
+        (b) the edge's image meets the patch's conservative polygonal hull
+        (Sec. 3.3, Fig. 4), (c) the face's predicted map is not too distorted
+        (TT_LAPPED_MAX_DISTORTION); each new vertex is placed by similar-
+        triangle prediction from every patch face containing it and a mapped
+        edge, taking the centroid (Sec. 3.3, after Maillot et al.);
+     4. solve the least-squares alignment of Sec. 3.4, sum over the patch's
+        faces of |phi(S_f) - (1,0)|^2 + |phi(T_f) - (0,1)|^2, with the seed point
+        held on the anchor, by tt_cg_solve warm-started from the prediction
+        (s and t decouple: one matrix, two right-hand sides); if the new map
+        moved an edge of the patch back over the hull, grow and solve again;
+     5. mark coverage (Sec. 3.6): each face carries a fixed set of sample
+        points (its own barycentric raster: tt_raster_triangle on a right
+        triangle, about 64 points per patch side, at least 4 and at most 256
+        a side); a sample is covered when a paste puts it so deep inside the
+        patch's opaque part (alpha >= TT_LAPPED_OPAQUE) that every point of
+        the face near it, and every texel a bilinear lookup there reads, is
+        opaque too - so the gaps between samples are covered as well.
+   Then, walking the pastes from last to first, a face whose samples are all
+   covered by later pastes is removed from the earlier paste (Sec. 4).
+
+   Isotropic mode (Sec. 3.2, last paragraph): the seed face's direction is
+   random, and each face added gets the average direction of its neighbours
+   already in the patch, projected on its plane; only |T_f| is used.
+
+   Hard edges: where growth stops (a disc would close, or distortion), the
+   paste ends at a mesh edge without its soft falloff; later pastes usually
+   cover such places (Sec. 3.3 finds them "less objectionable than distorted
+   texture"). A patch may fold over itself in texture space (allowed by the
+   paper); coverage is still counted per face, correctly. */
+
+/* Growth does not cross into a face whose predicted map turns T_f by more than
+   this many degrees, or scales it by more than 1 + this / 90 or less than
+   1 / (1 + this / 90) (a "hard edge", Sec. 3.3). */
+#define TT_LAPPED_MAX_DISTORTION 40.0f
+/* A sample counts as covered under an alpha of at least this. */
+#define TT_LAPPED_OPAQUE 0.99f
+/* The loop refuses meshes whose estimated number of pastes (area over patch
+   area) exceeds this; options->max_pastes = 0 uses it as the cap. */
+#define TT_LAPPED_MAX_PASTES 1000000
+
+typedef struct tt_lapped_options {
+    uint64_t seed;              /* random seed: same seed, same result */
+    int isotropic;              /* 1: orientation by propagation per paste (only |T_f| counts) */
+    int max_pastes;             /* cap on pastes; 0 = TT_LAPPED_MAX_PASTES */
+    /* Called after every paste with the fraction of sample points covered
+       (never decreasing); non-zero return cancels with TT_CANCELLED. */
+    tt_progress_fn progress;
+    void *progress_user_data;
+    tt_allocator allocator;     /* for the result and scratch; zeroed: the mesh's allocator */
+} tt_lapped_options;
+
+/* One paste operation (Sec. 3.5 / 4): texture patch `patch` over faces
+   lapped->faces[first .. first + nfaces - 1]. */
+typedef struct tt_paste {
+    int patch;                  /* index into the patches given to tt_lapped_paste */
+    int first;                  /* first entry of this paste in lapped->faces / lapped->uv */
+    int nfaces;                 /* entries (after hidden faces were removed) */
+} tt_paste;
+
+/* Result of tt_lapped_paste, in paste order: draw the pastes in order with
+   alpha blending ("over") and the surface is covered. */
+typedef struct tt_lapped {
+    int npastes;
+    tt_paste *pastes;           /* npastes */
+    int nentries;               /* face entries over all pastes */
+    int *faces;                 /* nentries face indices */
+    float *uv;                  /* 6 * nentries: entry e's corners 0, 1, 2 (the face's own corner
+                                   order) at uv[6e .. 6e+5], in its patch's texture space */
+    /* Statistics (also available from tt_lapped_measure for any UVs). */
+    double coverage;            /* fraction of faces whose samples are all covered: 1 on success */
+    double mean_overdraw;       /* nentries / faces: how often a face is drawn */
+    int removed_entries;        /* face entries dropped because later pastes hide them */
+    double mean_angle_error;    /* degrees, mean over entries of the angle between phi(T_f) and (0,1)
+                                   (isotropic: against each paste's propagated direction) */
+    double median_scale_error;  /* median over entries of | |phi(T_f)| - 1 | */
+    tt_allocator allocator;
+} tt_lapped;
+
+/* Cover `mesh` (triangles only) with pastes of the `npatches` texture patches
+   (premultiplied RGBA with alpha, e.g. from tt_make_texture_patch; each needs
+   at least one texel with alpha >= TT_LAPPED_OPAQUE). face_vectors: 3 per
+   face, from tt_tangent_field or your own (in each face's plane; only their
+   lengths count when isotropic). options may be NULL (defaults, seed 0).
+   *result must be zeroed or freed; on failure it is left zeroed.
+   Errors:
+     TT_ERROR_INVALID_ARGUMENT  NULL pointers, npatches < 1, a face that is not
+                                a triangle (error->face), an empty patch or one
+                                with no opaque texel ("texture patch 2 has no
+                                opaque texel"), a zero field vector or one
+                                perpendicular to its face (error->face), a
+                                patch larger than the mesh (|T_f| above the
+                                mesh's bounding-box diagonal), a face so many
+                                patch sides long that no paste could cover it
+                                (error->face; subdivide), max_pastes < 0;
+     TT_ERROR_NON_FINITE        a NaN or infinite field vector (error->face)
+                                or patch texel;
+     TT_ERROR_ZERO_AREA_FACE    a face of zero area (permissive meshes);
+     TT_ERROR_TOO_LARGE         the patches are so small next to the mesh that
+                                more than max_pastes would be needed (the
+                                message gives the estimate);
+     TT_ERROR_NOT_CONVERGED     max_pastes pastes did not cover the mesh;
+     TT_CANCELLED, TT_ERROR_OUT_OF_MEMORY.
+   Deterministic for a seed; time about O(faces * overdraw * CG steps). */
+TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, const tt_image *patches,
+                                int npatches, const tt_lapped_options *options, tt_lapped *result,
+                                tt_error *error);
+TTDEF void tt_lapped_free(tt_lapped *lapped);
+
+typedef struct tt_lapped_report {
+    double mean_angle_error;    /* degrees: mean over entries of angle(phi(T_f), (0,1)) */
+    double median_scale_error;  /* median over entries of | |phi(T_f)| - 1 | */
+    double mean_overdraw;       /* nentries / nfaces */
+    int uncovered_faces;        /* faces in no paste */
+} tt_lapped_report;
+
+/* Measure alignment from the UVs alone: phi(T_f) is T_f pushed through each
+   entry's linear map (the UVs of its three corners). An independent check of
+   the statistics tt_lapped_paste reports (anisotropic mode), or of UVs from
+   anywhere. phi(T_f) = 0 (a degenerate face or UV triangle) counts as the
+   worst case, 180 degrees and scale error 1; no entries give 0 errors.
+   Errors: NULL pointers or a mesh of non-triangles:
+   TT_ERROR_INVALID_ARGUMENT; an entry's face out of range:
+   TT_ERROR_INDEX_OUT_OF_RANGE; a non-finite UV or field vector of an entry:
+   TT_ERROR_NON_FINITE; TT_ERROR_OUT_OF_MEMORY (the mesh's allocator). */
+TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
+                                  tt_lapped_report *report);
+
+/* A simple atlas for meshes without UVs (Sec. 4 "rendering with a texture
+   atlas"; the paper's charts were arranged by hand, this is automatic):
+   triangles in pairs, each pair in one square cell of a grid over a size x
+   size texture, one triangle in each half of the cell, `gutter` texels apart
+   from each other and from the cell border. corner_uv gets 2 floats per
+   corner (origin bottom-left). The corner with the largest angle takes the
+   right angle and the winding is kept (nothing is mirrored). Errors:
+   non-triangles, size outside [1, TT_MAX_IMAGE_SIZE] or gutter < 0
+   (TT_ERROR_INVALID_ARGUMENT); cells smaller than ceil((2 + sqrt 2) *
+   gutter) + 4 texels, the least that keeps both triangles' gutters apart
+   (TT_ERROR_IMAGE_TOO_SMALL; the message gives the smallest size that
+   works). */
+TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, float *corner_uv, tt_error *error);
+
+/* Bake the pastes into `atlas` (created by the caller: its size is the
+   resolution) over the texture coordinates corner_uv (2 floats per corner,
+   origin bottom-left: the mesh's own, or from tt_atlas_pack_pairs). Every
+   texel whose centre lies in a triangle's image (tt_raster_triangle) gets the
+   pastes of that face composited in paste order ("over" of the premultiplied
+   patches, each sampled bilinearly with clamping at the UVs interpolated
+   from the entry's corners). Texels within `gutter` texels outside a
+   triangle get the same composite extrapolated across its edges (the
+   face's maps extended linearly), and every texel still empty is then
+   filled from the nearest filled texel, so bilinear filtering and mipmaps
+   near chart borders read chart colours, not background. The atlas holds
+   straight (un-premultiplied) RGBA, alpha the composited coverage (1 where
+   the pastes cover the face). Where two triangles' images overlap, the later
+   face wins. Errors: NULL pointers, an empty atlas, non-triangles, npatches
+   < 1, an entry naming a patch or face out of range
+   (TT_ERROR_INDEX_OUT_OF_RANGE), non-finite corner_uv (TT_ERROR_NON_FINITE),
+   gutter < 0; TT_ERROR_OUT_OF_MEMORY (scratch comes from the mesh's
+   allocator, all of it before the atlas is touched). */
+TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, const tt_image *patches,
+                               int npatches, const float *corner_uv, int gutter, tt_image *atlas,
+                               tt_error *error);
+
 #ifdef __cplusplus
 }
 #endif
@@ -780,6 +964,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
 #ifndef TILEDTEX_IMPLEMENTATION_INCLUDED
 #define TILEDTEX_IMPLEMENTATION_INCLUDED
 
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -3828,6 +4013,27 @@ static void tt__edt_1d(const float *f, int n, float *d, int *v, float *z, float 
     }
 }
 
+/* Exact squared Euclidean distance transform of a gw x gh grid, in place:
+   cells holding 0 are the sites, cells holding `big` get the squared distance
+   (in cells) to the nearest site. Separable: columns, then rows. Scratch:
+   line and dline of max(gw, gh) floats, v of as many ints, z of one more
+   float. */
+static void tt__distance_transform(float *grid, int gw, int gh, float *line, float *dline, int *v, float *z,
+                                   float big)
+{
+    int x, y;
+    for (x = 0; x < gw; x++) {
+        for (y = 0; y < gh; y++) line[y] = grid[(size_t)y * (size_t)gw + (size_t)x];
+        tt__edt_1d(line, gh, dline, v, z, big);
+        for (y = 0; y < gh; y++) grid[(size_t)y * (size_t)gw + (size_t)x] = dline[y];
+    }
+    for (y = 0; y < gh; y++) {
+        float *row = grid + (size_t)y * (size_t)gw;
+        memcpy(line, row, sizeof(float) * (size_t)gw);
+        tt__edt_1d(line, gw, row, v, z, big);
+    }
+}
+
 TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
                                       tt_image *patch, tt_error *error)
 {
@@ -3978,17 +4184,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         }
     }
 
-    /* Separable exact EDT: columns, then rows (squared distances). */
-    for (x = 0; x < gw; x++) {
-        for (y = 0; y < gh; y++) line[y] = grid[(size_t)y * (size_t)gw + (size_t)x];
-        tt__edt_1d(line, gh, dline, v, z, big);
-        for (y = 0; y < gh; y++) grid[(size_t)y * (size_t)gw + (size_t)x] = dline[y];
-    }
-    for (y = 0; y < gh; y++) {
-        float *row = grid + (size_t)y * (size_t)gw;
-        memcpy(line, row, sizeof(float) * (size_t)gw);
-        tt__edt_1d(line, gw, row, v, z, big);
-    }
+    tt__distance_transform(grid, gw, gh, line, dline, v, z, big);
     for (y = 1; y <= h; y++)
         for (x = 1; x <= w; x++) {
             float d = sqrtf(grid[(size_t)y * (size_t)gw + (size_t)x]) - 0.5f;
@@ -4027,6 +4223,2245 @@ done:
     tt__free(al, z);
     tt__free(al, v);
     tt__free(al, q);
+    return result;
+}
+
+/* Conservative polygonal hull of a texture patch (Sec. 3.3, Fig. 4).
+
+   Growth (Sec. 3.3) crosses a mesh edge only while the edge's image still
+   meets the texture patch; the paper answers that with a polygon that
+   contains the patch. Choice made here:
+     1. the outer contour of the union of the texel squares with alpha > 0.
+        Holes are filled (conservative), and where two texels touch only at a
+        corner with outside on both other sides (a "pinch", which would make
+        the contour touch itself) one of the two outside texels is filled too,
+        so the contour is a simple polygon through texel corners;
+     2. that polygon simplified by the 2D progressive-hull operations of
+        Fig. 4 (Sander et al.'s conservative edge collapses): removing a
+        reflex or straight vertex (its triangle is outside the polygon), or
+        collapsing an edge between two convex vertices into the intersection
+        of the lines of its two neighbouring edges. Each only adds area, the
+        smallest addition first, and one that would bring a new edge within
+        a small clearance of another edge is refused, so the polygon stays
+        simple even after rounding to float;
+     3. if the filled mask still has several components, or the operations
+        cannot get down to max_vertices, the convex hull of all nonzero texel
+        corners simplified the same way (for a convex polygon only the edge
+        collapse applies); if even that stalls (a parallelogram cannot lose a
+        vertex that way), the bounding rectangle, or a triangle around it.
+   Coordinates inside are texel units of the image padded by one transparent
+   texel on every side, y up: texel (i, j) is the square [i+1, i+2] x
+   [h-j, h-j+1], so the unit-square point is ((x - 1) / w, (y - 1) / h). */
+
+enum { TT__HULL_DEAD = 0, TT__HULL_LIVE = 1, TT__HULL_BLOCKED = 2 };
+enum { TT__HULL_REMOVE = 1, TT__HULL_COLLAPSE = 2 };
+enum { TT__CELL_EMPTY = 0, TT__CELL_FULL = 1, TT__CELL_OUTSIDE = 2 };
+
+/* Filling a pinch can close a new hole or make a new pinch; this many rounds
+   of (flood the outside, fill pinches) settle every shape met in practice,
+   and a shape that does not settle gets the convex hull instead. */
+#define TT__HULL_PINCH_ROUNDS 16
+/* A refused operation can become possible after operations elsewhere moved
+   the edge in its way; the queue is rebuilt at most this many times. */
+#define TT__HULL_ROUNDS 8
+
+/* One entry of the grid of edges that makes the simplicity test local. */
+typedef struct tt__hull_node {
+    int vertex;     /* the edge from this vertex to its successor */
+    int stamp;      /* that vertex's edge stamp when the entry was made */
+    int next;       /* next entry in the same cell, -1 at the end */
+} tt__hull_node;
+
+typedef struct tt__hull {
+    const tt_allocator *allocator;
+    int n;                  /* vertex slots */
+    int count;              /* live vertices */
+    double *x, *y;
+    int *next, *prev;
+    int *stamp;             /* changes whenever the edge leaving the vertex changes */
+    double *key;            /* area of the operation last queued for the vertex */
+    unsigned char *state;   /* TT__HULL_DEAD / LIVE / BLOCKED */
+    tt__heap_item *heap;
+    int heap_count, heap_cap;
+    int gx, gy;             /* grid of edges: gx * gy cells of side 1 / inv_cell */
+    double inv_cell;
+    int *cell_head;
+    tt__hull_node *nodes;
+    int node_count, node_cap, node_free;
+    double eps;             /* clearance kept between edges that do not share a vertex */
+    double lo[2], hi[2];    /* box in which a new vertex may be placed */
+} tt__hull;
+
+typedef struct tt__hull_op {
+    int kind;               /* TT__HULL_REMOVE or TT__HULL_COLLAPSE */
+    double area;            /* area it adds to the polygon */
+    double vx, vy;          /* collapse: the new vertex */
+} tt__hull_op;
+
+/* Twice the signed area of triangle a, b, c: positive when it turns left. */
+static double tt__orient2(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+static double tt__point_segment_distance(double px, double py, double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay, len2 = dx * dx + dy * dy, t = 0.0, ex, ey;
+    if (len2 > 0.0) {
+        t = ((px - ax) * dx + (py - ay) * dy) / len2;
+        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    }
+    ex = ax + t * dx - px;
+    ey = ay + t * dy - py;
+    return sqrt(ex * ex + ey * ey);
+}
+
+/* 1 when segments a-b and c-d come closer than eps (crossing counts). */
+static int tt__segments_near(double ax, double ay, double bx, double by, double cx, double cy, double dx,
+                             double dy, double eps)
+{
+    double o1 = tt__orient2(ax, ay, bx, by, cx, cy), o2 = tt__orient2(ax, ay, bx, by, dx, dy);
+    double o3 = tt__orient2(cx, cy, dx, dy, ax, ay), o4 = tt__orient2(cx, cy, dx, dy, bx, by);
+    if (((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0)))
+        return 1;
+    return tt__point_segment_distance(cx, cy, ax, ay, bx, by) < eps ||
+           tt__point_segment_distance(dx, dy, ax, ay, bx, by) < eps ||
+           tt__point_segment_distance(ax, ay, cx, cy, dx, dy) < eps ||
+           tt__point_segment_distance(bx, by, cx, cy, dx, dy) < eps;
+}
+
+static void tt__hull_free(tt__hull *h)
+{
+    tt__free(h->allocator, h->x);
+    tt__free(h->allocator, h->y);
+    tt__free(h->allocator, h->next);
+    tt__free(h->allocator, h->prev);
+    tt__free(h->allocator, h->stamp);
+    tt__free(h->allocator, h->key);
+    tt__free(h->allocator, h->state);
+    tt__free(h->allocator, h->heap);
+    tt__free(h->allocator, h->cell_head);
+    tt__free(h->allocator, h->nodes);
+    memset(h, 0, sizeof *h);
+}
+
+/* Cells overlapped by the box [x0, x1] x [y0, y1]; outside the grid clamps
+   to its border cells, which is still a superset. */
+static void tt__hull_cells(const tt__hull *h, double x0, double y0, double x1, double y1, int range[4])
+{
+    double bound = (double)(h->gx > h->gy ? h->gx : h->gy) + 1.0;
+    double c[4];
+    int k;
+    c[0] = floor(x0 * h->inv_cell); c[1] = floor(y0 * h->inv_cell);
+    c[2] = floor(x1 * h->inv_cell); c[3] = floor(y1 * h->inv_cell);
+    for (k = 0; k < 4; k++) {
+        double v = c[k] < -1.0 ? -1.0 : (c[k] > bound ? bound : c[k]);
+        range[k] = tt__clamp_i((int)v, 0, (k & 1) ? h->gy - 1 : h->gx - 1);
+    }
+}
+
+/* Record the edge leaving u in every cell its box overlaps; older entries
+   for u go stale through the stamp and are dropped when next met. */
+static tt_result tt__hull_insert_edge(tt__hull *h, int u)
+{
+    int w = h->next[u], range[4], cx, cy;
+    h->stamp[u]++;
+    tt__hull_cells(h, h->x[u] < h->x[w] ? h->x[u] : h->x[w], h->y[u] < h->y[w] ? h->y[u] : h->y[w],
+                   h->x[u] > h->x[w] ? h->x[u] : h->x[w], h->y[u] > h->y[w] ? h->y[u] : h->y[w], range);
+    for (cy = range[1]; cy <= range[3]; cy++) {
+        for (cx = range[0]; cx <= range[2]; cx++) {
+            int cell = cy * h->gx + cx, k;
+            if (h->node_free >= 0) {
+                k = h->node_free;
+                h->node_free = h->nodes[k].next;
+            } else {
+                if (h->node_count == h->node_cap) {
+                    tt__hull_node *grown;
+                    if (h->node_cap > 0x3fffffff) return TT_ERROR_OUT_OF_MEMORY;
+                    grown = TT__ALLOC(h->allocator, tt__hull_node, 2 * h->node_cap);
+                    if (!grown) return TT_ERROR_OUT_OF_MEMORY;
+                    memcpy(grown, h->nodes, (size_t)h->node_count * sizeof *grown);
+                    tt__free(h->allocator, h->nodes);
+                    h->nodes = grown;
+                    h->node_cap *= 2;
+                }
+                k = h->node_count++;
+            }
+            h->nodes[k].vertex = u;
+            h->nodes[k].stamp = h->stamp[u];
+            h->nodes[k].next = h->cell_head[cell];
+            h->cell_head[cell] = k;
+        }
+    }
+    return TT_OK;
+}
+
+/* The n-gon (xs, ys), counter-clockwise and simple, ready to simplify;
+   width x height is the padded image in texel units (grid and box). */
+static tt_result tt__hull_init(tt__hull *h, const double *xs, const double *ys, int n, int width, int height,
+                               const tt_allocator *allocator)
+{
+    double side = (double)tt__max_i(width, height), cell;
+    int v, c;
+    tt_result result;
+    memset(h, 0, sizeof *h);
+    h->allocator = allocator;
+    h->n = h->count = n;
+    /* Cells about as many as vertices, so a short new edge meets O(1) others. */
+    cell = sqrt((double)width * (double)height / (double)n);
+    if (cell < 1.0) cell = 1.0;
+    h->gx = tt__clamp_i((int)((double)width / cell) + 1, 1, 1024);
+    h->gy = tt__clamp_i((int)((double)height / cell) + 1, 1, 1024);
+    h->inv_cell = 1.0 / cell;
+    h->heap_cap = 7 * n + 8;
+    h->node_cap = 4 * n + 64;
+    h->node_free = -1;
+    h->x = TT__ALLOC(allocator, double, n);
+    h->y = TT__ALLOC(allocator, double, n);
+    h->next = TT__ALLOC(allocator, int, n);
+    h->prev = TT__ALLOC(allocator, int, n);
+    h->stamp = TT__ALLOC(allocator, int, n);
+    h->key = TT__ALLOC(allocator, double, n);
+    h->state = TT__ALLOC(allocator, unsigned char, n);
+    h->heap = TT__ALLOC(allocator, tt__heap_item, h->heap_cap);
+    h->cell_head = TT__ALLOC(allocator, int, h->gx * h->gy);
+    h->nodes = TT__ALLOC(allocator, tt__hull_node, h->node_cap);
+    if (!h->x || !h->y || !h->next || !h->prev || !h->stamp || !h->key || !h->state || !h->heap || !h->cell_head ||
+        !h->nodes) {
+        tt__hull_free(h);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    /* 1e-5 of the patch side: far above float rounding of unit-square
+       coordinates, far below a texel for any allowed image size. */
+    h->eps = 1e-5 * side;
+    h->lo[0] = -side; h->lo[1] = -side;
+    h->hi[0] = (double)width + side; h->hi[1] = (double)height + side;
+    for (c = 0; c < h->gx * h->gy; c++) h->cell_head[c] = -1;
+    for (v = 0; v < n; v++) {
+        h->x[v] = xs[v];
+        h->y[v] = ys[v];
+        h->next[v] = v + 1 < n ? v + 1 : 0;
+        h->prev[v] = v > 0 ? v - 1 : n - 1;
+        h->stamp[v] = 0;
+        h->key[v] = 0.0;
+        h->state[v] = TT__HULL_LIVE;
+    }
+    for (v = 0; v < n; v++) {
+        if ((result = tt__hull_insert_edge(h, v)) != TT_OK) {
+            tt__hull_free(h);
+            return result;
+        }
+    }
+    return TT_OK;
+}
+
+/* The cheapest conservative operation owned by vertex v (Fig. 4): removing v
+   when it is reflex or straight (the triangle prev-v-next lies outside), or,
+   when v and its successor q are both convex, moving v to where the lines of
+   the edges before v and after q meet and dropping q. */
+static int tt__hull_candidate(const tt__hull *h, int v, tt__hull_op *op)
+{
+    int p = h->prev[v], q = h->next[v], r = h->next[q];
+    double turn_v = tt__orient2(h->x[p], h->y[p], h->x[v], h->y[v], h->x[q], h->y[q]);
+    double d1x, d1y, d2x, d2y, ex, ey, den, t, s, vx, vy;
+    if (h->count <= 3) return 0;
+    if (turn_v <= 0.0) {
+        op->kind = TT__HULL_REMOVE;
+        op->area = -0.5 * turn_v;
+        op->vx = op->vy = 0.0;
+        return 1;
+    }
+    if (tt__orient2(h->x[v], h->y[v], h->x[q], h->y[q], h->x[r], h->y[r]) <= 0.0) return 0;
+    d1x = h->x[v] - h->x[p]; d1y = h->y[v] - h->y[p];
+    d2x = h->x[q] - h->x[r]; d2y = h->y[q] - h->y[r];
+    ex = h->x[q] - h->x[v]; ey = h->y[q] - h->y[v];
+    den = d1x * d2y - d1y * d2x;
+    if (den == 0.0) return 0;
+    t = (ex * d2y - ey * d2x) / den;
+    s = (ex * d1y - ey * d1x) / den;
+    if (!(t > 0.0) || !(s > 0.0)) return 0;
+    vx = h->x[v] + t * d1x;
+    vy = h->y[v] + t * d1y;
+    /* Nearly parallel lines meet far away: such a vertex would add more area
+       than any useful operation, and would cost precision. */
+    if (!(vx >= h->lo[0] && vx <= h->hi[0] && vy >= h->lo[1] && vy <= h->hi[1])) return 0;
+    /* The new vertex must lie right of v-q, outside the polygon. */
+    if (!(tt__orient2(h->x[v], h->y[v], h->x[q], h->y[q], vx, vy) < 0.0)) return 0;
+    op->kind = TT__HULL_COLLAPSE;
+    op->area = -0.5 * tt__orient2(h->x[v], h->y[v], h->x[q], h->y[q], vx, vy);
+    op->vx = vx;
+    op->vy = vy;
+    return 1;
+}
+
+/* 1 when the new edge a-b (between vertices ia and ib) keeps the clearance
+   from every edge not leaving a vertex in skip; edges sharing ia or ib must
+   merely not fold back onto it. Stale grid entries are unlinked on the way. */
+static int tt__hull_clear(tt__hull *h, double ax, double ay, double bx, double by, int ia, int ib, const int *skip,
+                          int nskip)
+{
+    int range[4], cx, cy;
+    tt__hull_cells(h, (ax < bx ? ax : bx) - h->eps, (ay < by ? ay : by) - h->eps, (ax > bx ? ax : bx) + h->eps,
+                   (ay > by ? ay : by) + h->eps, range);
+    for (cy = range[1]; cy <= range[3]; cy++) {
+        for (cx = range[0]; cx <= range[2]; cx++) {
+            int *link = &h->cell_head[cy * h->gx + cx];
+            while (*link >= 0) {
+                int k = *link, u = h->nodes[k].vertex, w, s, skipped = 0;
+                if (h->state[u] == TT__HULL_DEAD || h->nodes[k].stamp != h->stamp[u]) {
+                    *link = h->nodes[k].next;
+                    h->nodes[k].next = h->node_free;
+                    h->node_free = k;
+                    continue;
+                }
+                link = &h->nodes[k].next;
+                for (s = 0; s < nskip; s++) skipped |= skip[s] == u;
+                if (skipped) continue;
+                w = h->next[u];
+                if (u == ia || w == ia || u == ib || w == ib) {
+                    int shared_a = u == ia || w == ia, e = (u == ia || u == ib) ? w : u;
+                    double ox = shared_a ? bx : ax, oy = shared_a ? by : ay;
+                    double sx = shared_a ? ax : bx, sy = shared_a ? ay : by;
+                    if (tt__point_segment_distance(h->x[e], h->y[e], ax, ay, bx, by) < h->eps ||
+                        tt__point_segment_distance(ox, oy, sx, sy, h->x[e], h->y[e]) < h->eps)
+                        return 0;
+                } else if (tt__segments_near(ax, ay, bx, by, h->x[u], h->y[u], h->x[w], h->y[w], h->eps)) {
+                    return 0;
+                }
+            }
+        }
+    }
+    return 1;
+}
+
+/* Simplicity (Sec. 3.3: "operations that would give rise to
+   self-intersections are disallowed"): only the new edges need testing. */
+static int tt__hull_valid(tt__hull *h, int v, const tt__hull_op *op)
+{
+    int p = h->prev[v], q = h->next[v], skip[3];
+    skip[0] = p;
+    skip[1] = v;
+    skip[2] = q;
+    if (op->kind == TT__HULL_REMOVE) return tt__hull_clear(h, h->x[p], h->y[p], h->x[q], h->y[q], p, q, skip, 2);
+    return tt__hull_clear(h, h->x[p], h->y[p], op->vx, op->vy, p, v, skip, 3) &&
+           tt__hull_clear(h, op->vx, op->vy, h->x[h->next[q]], h->y[h->next[q]], v, h->next[q], skip, 3);
+}
+
+static void tt__hull_evaluate(tt__hull *h, int v)
+{
+    tt__hull_op op;
+    h->state[v] = TT__HULL_LIVE;
+    if (h->heap_count < h->heap_cap && tt__hull_candidate(h, v, &op)) {
+        h->key[v] = op.area;
+        tt__heap_push(h->heap, &h->heap_count, op.area, v);
+    }
+}
+
+static tt_result tt__hull_apply(tt__hull *h, int v, const tt__hull_op *op)
+{
+    int p = h->prev[v], q = h->next[v], touched[6], k;
+    tt_result result;
+    if (op->kind == TT__HULL_REMOVE) {
+        h->next[p] = q;
+        h->prev[q] = p;
+        h->state[v] = TT__HULL_DEAD;
+        h->count--;
+        if ((result = tt__hull_insert_edge(h, p)) != TT_OK) return result;
+        touched[2] = p;
+        touched[3] = q;
+    } else {
+        int r = h->next[q];
+        h->x[v] = op->vx;
+        h->y[v] = op->vy;
+        h->next[v] = r;
+        h->prev[r] = v;
+        h->state[q] = TT__HULL_DEAD;
+        h->count--;
+        if ((result = tt__hull_insert_edge(h, p)) != TT_OK) return result;
+        if ((result = tt__hull_insert_edge(h, v)) != TT_OK) return result;
+        touched[2] = p;
+        touched[3] = v;
+    }
+    /* Every vertex whose operation reads a moved vertex or a changed edge. */
+    touched[1] = h->prev[touched[2]];
+    touched[0] = h->prev[touched[1]];
+    touched[4] = h->next[touched[3]];
+    touched[5] = h->next[touched[4]];
+    for (k = 0; k < 6; k++) tt__hull_evaluate(h, touched[k]);
+    return TT_OK;
+}
+
+/* Smallest added area first (Sec. 3.3), until max_vertices remain or no
+   operation is allowed. Each round queues at most n + 6 * (operations done)
+   entries, within heap_cap. */
+static tt_result tt__hull_simplify(tt__hull *h, int max_vertices)
+{
+    int round, v;
+    for (round = 0; round < TT__HULL_ROUNDS && h->count > max_vertices; round++) {
+        int done = 0;
+        h->heap_count = 0;
+        for (v = 0; v < h->n; v++)
+            if (h->state[v] != TT__HULL_DEAD) tt__hull_evaluate(h, v);
+        while (h->count > max_vertices && h->heap_count > 0) {
+            tt__heap_item item = tt__heap_pop(h->heap, &h->heap_count);
+            tt__hull_op op;
+            tt_result result;
+            v = item.face;
+            if (h->state[v] != TT__HULL_LIVE || h->key[v] != item.key || !tt__hull_candidate(h, v, &op)) continue;
+            if (!tt__hull_valid(h, v, &op)) {
+                h->state[v] = TT__HULL_BLOCKED;
+                continue;
+            }
+            if ((result = tt__hull_apply(h, v, &op)) != TT_OK) return result;
+            done++;
+        }
+        if (!done) break;
+    }
+    return TT_OK;
+}
+
+/* n points (texel units, padded) to the caller's unit-square floats, in
+   index order, or along `next` from `start` when next is not NULL. */
+static tt_result tt__hull_emit(const double *xs, const double *ys, const int *next, int start, int n, int w, int h,
+                               const tt_allocator *allocator, float **out_xy, int *out_count)
+{
+    float *xy = TT__ALLOC(allocator, float, 2 * n);
+    int k, v = start;
+    if (!xy) return TT_ERROR_OUT_OF_MEMORY;
+    for (k = 0; k < n; k++) {
+        if (!next) v = k;
+        xy[2 * k] = (float)((xs[v] - 1.0) / (double)w);
+        xy[2 * k + 1] = (float)((ys[v] - 1.0) / (double)h);
+        if (next) v = next[v];
+    }
+    *out_xy = xy;
+    *out_count = n;
+    return TT_OK;
+}
+
+/* Simplify the n-gon and, when at most max_vertices remain, emit it;
+   otherwise leave *out_xy NULL. */
+static tt_result tt__hull_reduce(const double *xs, const double *ys, int n, int w, int h, int max_vertices,
+                                 const tt_allocator *allocator, float **out_xy, int *out_count)
+{
+    tt__hull hull;
+    tt_result result = tt__hull_init(&hull, xs, ys, n, w + 2, h + 2, allocator);
+    if (result != TT_OK) return result;
+    result = tt__hull_simplify(&hull, max_vertices);
+    if (result == TT_OK && hull.count <= max_vertices) {
+        int start = 0;
+        while (hull.state[start] == TT__HULL_DEAD) start++;
+        result = tt__hull_emit(hull.x, hull.y, hull.next, start, hull.count, w, h, allocator, out_xy, out_count);
+    }
+    tt__hull_free(&hull);
+    return result;
+}
+
+static int tt__hull_in(const unsigned char *cells, int width, int x, int y)
+{
+    return cells[(size_t)y * (size_t)width + (size_t)x] != TT__CELL_OUTSIDE;
+}
+
+/* Mark as outside every non-full cell 4-connected to the padding. */
+static void tt__hull_flood(unsigned char *cells, int *stack, int width, int height)
+{
+    size_t total = (size_t)width * (size_t)height, k;
+    int top = 0;
+    for (k = 0; k < total; k++)
+        if (cells[k] == TT__CELL_OUTSIDE) cells[k] = TT__CELL_EMPTY;
+    cells[0] = TT__CELL_OUTSIDE;
+    stack[top++] = 0;
+    while (top > 0) {
+        int c = stack[--top], x = c % width, y = c / width, d;
+        for (d = 0; d < 4; d++) {
+            int nx = x + (d == 0) - (d == 1), ny = y + (d == 2) - (d == 3), nc;
+            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+            nc = ny * width + nx;
+            if (cells[nc] != TT__CELL_EMPTY) continue;
+            cells[nc] = TT__CELL_OUTSIDE;
+            stack[top++] = nc;
+        }
+    }
+}
+
+/* Fill one outside cell of every pinch (two diagonal inside cells, the other
+   two outside); returns how many were filled. */
+static int tt__hull_fill_pinches(unsigned char *cells, int width, int height)
+{
+    int x, y, filled = 0;
+    for (y = 0; y + 1 < height; y++) {
+        for (x = 0; x + 1 < width; x++) {
+            int a = tt__hull_in(cells, width, x, y), b = tt__hull_in(cells, width, x + 1, y);
+            int c = tt__hull_in(cells, width, x, y + 1), d = tt__hull_in(cells, width, x + 1, y + 1);
+            if (a && d && !b && !c) {
+                cells[(size_t)(y * width + x + 1)] = TT__CELL_FULL;
+                filled++;
+            } else if (b && c && !a && !d) {
+                cells[(size_t)(y * width + x)] = TT__CELL_FULL;
+                filled++;
+            }
+        }
+    }
+    return filled;
+}
+
+/* Step 1: the outer contour, counter-clockwise, one vertex per turn. *n = 0
+   (and TT_OK) when the shape needs the convex-hull fallback instead. */
+static tt_result tt__hull_outer_contour(const tt_image *patch, const tt_allocator *allocator, double **out_x,
+                                        double **out_y, int *out_n)
+{
+    int w = patch->width, h = patch->height, width = w + 2, height = h + 2;
+    int i, j, round, x, y, dir, sx = -1, sy = -1, n = 0, closed = 0;
+    size_t total = (size_t)width * (size_t)height, boundary = 0, steps = 0, k;
+    unsigned char *cells = TT__ALLOC(allocator, unsigned char, total);
+    int *stack = TT__ALLOC(allocator, int, total);
+    double *xs = NULL, *ys = NULL;
+    *out_x = *out_y = NULL;
+    *out_n = 0;
+    if (!cells || !stack) {
+        tt__free(allocator, cells);
+        tt__free(allocator, stack);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    memset(cells, TT__CELL_EMPTY, total);
+    for (j = 0; j < h; j++)
+        for (i = 0; i < w; i++)
+            if (patch->pixels[4 * ((size_t)j * (size_t)w + (size_t)i) + 3] > 0.0f)
+                cells[(size_t)(h - j) * (size_t)width + (size_t)(i + 1)] = TT__CELL_FULL;
+    for (round = 0;; round++) {
+        tt__hull_flood(cells, stack, width, height);
+        if (!tt__hull_fill_pinches(cells, width, height)) break;
+        if (round + 1 == TT__HULL_PINCH_ROUNDS) goto fallback;
+    }
+    for (y = 1; y + 1 < height; y++) {
+        for (x = 1; x + 1 < width; x++) {
+            if (!tt__hull_in(cells, width, x, y)) continue;
+            if (sx < 0) { sx = x; sy = y; }
+            boundary += (size_t)!tt__hull_in(cells, width, x - 1, y) + (size_t)!tt__hull_in(cells, width, x + 1, y) +
+                        (size_t)!tt__hull_in(cells, width, x, y - 1) + (size_t)!tt__hull_in(cells, width, x, y + 1);
+        }
+    }
+    /* Keeps 7 * n + 8 (the queue) within int. */
+    if (boundary > 0x7fffffffu / 8u) goto fallback;
+    xs = TT__ALLOC(allocator, double, boundary);
+    ys = TT__ALLOC(allocator, double, boundary);
+    if (!xs || !ys) {
+        tt__free(allocator, xs);
+        tt__free(allocator, ys);
+        tt__free(allocator, cells);
+        tt__free(allocator, stack);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    /* Square tracing along texel edges with the inside on the left, from the
+       bottom-left corner of the lowest, leftmost inside cell heading east.
+       Directions 0..3: east, north, west, south. */
+    x = sx;
+    y = sy;
+    dir = 0;
+    for (k = 0; k < boundary; k++) {
+        int ahead_left, ahead_right, turn;
+        x += dir == 0 ? 1 : (dir == 2 ? -1 : 0);
+        y += dir == 1 ? 1 : (dir == 3 ? -1 : 0);
+        steps++;
+        switch (dir) {
+        case 0: ahead_left = tt__hull_in(cells, width, x, y); ahead_right = tt__hull_in(cells, width, x, y - 1); break;
+        case 1: ahead_left = tt__hull_in(cells, width, x - 1, y); ahead_right = tt__hull_in(cells, width, x, y); break;
+        case 2: ahead_left = tt__hull_in(cells, width, x - 1, y - 1); ahead_right = tt__hull_in(cells, width, x - 1, y); break;
+        default: ahead_left = tt__hull_in(cells, width, x, y - 1); ahead_right = tt__hull_in(cells, width, x - 1, y - 1); break;
+        }
+        turn = !ahead_left ? 1 : (ahead_right ? 3 : 0);
+        if (turn) {
+            xs[n] = (double)x;
+            ys[n] = (double)y;
+            n++;
+            dir = (dir + turn) & 3;
+        }
+        if (x == sx && y == sy && dir == 0) {
+            closed = 1;
+            break;
+        }
+    }
+    tt__free(allocator, cells);
+    tt__free(allocator, stack);
+    /* Another component has edges of its own: the traced loop missed them. */
+    if (!closed || steps != boundary || n < 4) {
+        tt__free(allocator, xs);
+        tt__free(allocator, ys);
+        return TT_OK;
+    }
+    *out_x = xs;
+    *out_y = ys;
+    *out_n = n;
+    return TT_OK;
+
+fallback:
+    tt__free(allocator, cells);
+    tt__free(allocator, stack);
+    return TT_OK;
+}
+
+/* Step 3: convex hull of the nonzero texels' corners (Andrew's monotone
+   chain over the extreme corners of each row). */
+static tt_result tt__hull_convex(const tt_image *patch, const tt_allocator *allocator, double **out_x, double **out_y,
+                                 int *out_n)
+{
+    int w = patch->width, h = patch->height, lines = h + 3, npoints = 0, k = 0, i, j, t;
+    int *lo = TT__ALLOC(allocator, int, 2 * lines);
+    double *px = TT__ALLOC(allocator, double, 2 * lines), *py = TT__ALLOC(allocator, double, 2 * lines);
+    double *hx = TT__ALLOC(allocator, double, 4 * lines + 2), *hy = TT__ALLOC(allocator, double, 4 * lines + 2);
+    double area = 0.0;
+    *out_x = *out_y = NULL;
+    *out_n = 0;
+    if (!lo || !px || !py || !hx || !hy) {
+        tt__free(allocator, lo);
+        tt__free(allocator, px);
+        tt__free(allocator, py);
+        tt__free(allocator, hx);
+        tt__free(allocator, hy);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    for (t = 0; t < lines; t++) {
+        lo[2 * t] = w + 3;
+        lo[2 * t + 1] = -1;
+    }
+    for (j = 0; j < h; j++) {
+        int first = -1, last = -1, row = h - j;
+        for (i = 0; i < w; i++) {
+            if (patch->pixels[4 * ((size_t)j * (size_t)w + (size_t)i) + 3] > 0.0f) {
+                if (first < 0) first = i;
+                last = i;
+            }
+        }
+        if (first < 0) continue;
+        for (t = row; t <= row + 1; t++) {
+            lo[2 * t] = tt__min_i(lo[2 * t], first + 1);
+            lo[2 * t + 1] = tt__max_i(lo[2 * t + 1], last + 2);
+        }
+    }
+    /* Sorted by (y, x): the chain's order need not be by x. */
+    for (t = 0; t < lines; t++) {
+        if (lo[2 * t + 1] < 0) continue;
+        px[npoints] = (double)lo[2 * t]; py[npoints] = (double)t; npoints++;
+        px[npoints] = (double)lo[2 * t + 1]; py[npoints] = (double)t; npoints++;
+    }
+    for (i = 0; i < npoints; i++) {
+        while (k >= 2 && tt__orient2(hx[k - 2], hy[k - 2], hx[k - 1], hy[k - 1], px[i], py[i]) <= 0.0) k--;
+        hx[k] = px[i]; hy[k] = py[i]; k++;
+    }
+    for (i = npoints - 2, t = k + 1; i >= 0; i--) {
+        while (k >= t && tt__orient2(hx[k - 2], hy[k - 2], hx[k - 1], hy[k - 1], px[i], py[i]) <= 0.0) k--;
+        hx[k] = px[i]; hy[k] = py[i]; k++;
+    }
+    k--;
+    for (i = 0; i < k; i++) area += hx[i] * hy[(i + 1) % k] - hx[(i + 1) % k] * hy[i];
+    if (area < 0.0) {
+        for (i = 0; i < k / 2; i++) {
+            double sx = hx[i], sy = hy[i];
+            hx[i] = hx[k - 1 - i]; hy[i] = hy[k - 1 - i];
+            hx[k - 1 - i] = sx; hy[k - 1 - i] = sy;
+        }
+    }
+    tt__free(allocator, lo);
+    tt__free(allocator, px);
+    tt__free(allocator, py);
+    *out_x = hx;
+    *out_y = hy;
+    *out_n = k;
+    return TT_OK;
+}
+
+static tt_result tt__patch_hull(const tt_image *patch, int max_vertices, const tt_allocator *allocator,
+                                float **out_xy, int *out_count)
+{
+    double *xs, *ys, bx[4], by[4], x0, y0, x1, y1;
+    int n, k, any = 0;
+    size_t texels, t;
+    tt_result result;
+    if (out_xy) *out_xy = NULL;
+    if (out_count) *out_count = 0;
+    if (!patch || !patch->pixels || !out_xy || !out_count || max_vertices < 3 || patch->width < 1 ||
+        patch->height < 1 || patch->width > TT_MAX_IMAGE_SIZE || patch->height > TT_MAX_IMAGE_SIZE)
+        return TT_ERROR_INVALID_ARGUMENT;
+    texels = (size_t)patch->width * (size_t)patch->height;
+    for (t = 0; t < texels && !any; t++) any = patch->pixels[4 * t + 3] > 0.0f;
+    if (!any) return TT_ERROR_INVALID_ARGUMENT;
+
+    if ((result = tt__hull_outer_contour(patch, allocator, &xs, &ys, &n)) != TT_OK) return result;
+    if (n > 0) {
+        result = tt__hull_reduce(xs, ys, n, patch->width, patch->height, max_vertices, allocator, out_xy, out_count);
+        tt__free(allocator, xs);
+        tt__free(allocator, ys);
+        if (result != TT_OK || *out_xy) return result;
+    }
+
+    if ((result = tt__hull_convex(patch, allocator, &xs, &ys, &n)) != TT_OK) return result;
+    result = tt__hull_reduce(xs, ys, n, patch->width, patch->height, max_vertices, allocator, out_xy, out_count);
+    x0 = x1 = xs[0];
+    y0 = y1 = ys[0];
+    for (k = 1; k < n; k++) {
+        x0 = xs[k] < x0 ? xs[k] : x0; x1 = xs[k] > x1 ? xs[k] : x1;
+        y0 = ys[k] < y0 ? ys[k] : y0; y1 = ys[k] > y1 ? ys[k] : y1;
+    }
+    tt__free(allocator, xs);
+    tt__free(allocator, ys);
+    if (result != TT_OK || *out_xy) return result;
+
+    /* Last resort: the bounding box, or for a triangle the one with legs
+       along its bottom and left sides, twice as long (its hypotenuse passes
+       through the box's top-right corner). */
+    bx[0] = x0; by[0] = y0;
+    if (max_vertices >= 4) {
+        bx[1] = x1; by[1] = y0;
+        bx[2] = x1; by[2] = y1;
+        bx[3] = x0; by[3] = y1;
+        return tt__hull_emit(bx, by, NULL, 0, 4, patch->width, patch->height, allocator, out_xy, out_count);
+    }
+    bx[1] = x0 + 2.0 * (x1 - x0); by[1] = y0;
+    bx[2] = x0; by[2] = y0 + 2.0 * (y1 - y0);
+    return tt__hull_emit(bx, by, NULL, 0, 3, patch->width, patch->height, allocator, out_xy, out_count);
+}
+
+static int tt__point_on_segment(double px, double py, double ax, double ay, double bx, double by)
+{
+    return tt__orient2(ax, ay, bx, by, px, py) == 0.0 && px >= (ax < bx ? ax : bx) && px <= (ax > bx ? ax : bx) &&
+           py >= (ay < by ? ay : by) && py <= (ay > by ? ay : by);
+}
+
+/* Inside or on the boundary, by the winding number. */
+static int tt__point_in_polygon(double px, double py, const float *xy, int count)
+{
+    int k, winding = 0;
+    for (k = 0; k < count; k++) {
+        const float *a = xy + 2 * k, *b = xy + 2 * ((k + 1) % count);
+        double o = tt__orient2(a[0], a[1], b[0], b[1], px, py);
+        if (tt__point_on_segment(px, py, a[0], a[1], b[0], b[1])) return 1;
+        if (a[1] <= py && b[1] > py && o > 0.0) winding++;
+        else if (a[1] > py && b[1] <= py && o < 0.0) winding--;
+    }
+    return winding != 0;
+}
+
+/* Growth test of Sec. 3.3. If the segment meets the polygon without
+   crossing or touching its boundary, it lies inside, and so do its ends. */
+static int tt__segment_meets_polygon(const float a[2], const float b[2], const float *xy, int count)
+{
+    int k;
+    if (!xy || count < 1) return 0;
+    if (count >= 3 && (tt__point_in_polygon(a[0], a[1], xy, count) || tt__point_in_polygon(b[0], b[1], xy, count)))
+        return 1;
+    for (k = 0; k < count; k++) {
+        const float *c = xy + 2 * k, *d = xy + 2 * ((k + 1) % count);
+        double o1 = tt__orient2(a[0], a[1], b[0], b[1], c[0], c[1]), o2 = tt__orient2(a[0], a[1], b[0], b[1], d[0], d[1]);
+        double o3 = tt__orient2(c[0], c[1], d[0], d[1], a[0], a[1]), o4 = tt__orient2(c[0], c[1], d[0], d[1], b[0], b[1]);
+        if (((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0)))
+            return 1;
+        if (tt__point_on_segment(c[0], c[1], a[0], a[1], b[0], b[1]) ||
+            tt__point_on_segment(d[0], d[1], a[0], a[1], b[0], b[1]) ||
+            tt__point_on_segment(a[0], a[1], c[0], c[1], d[0], d[1]) ||
+            tt__point_on_segment(b[0], b[1], c[0], c[1], d[0], d[1]))
+            return 1;
+    }
+    return 0;
+}
+
+/* ---- The paste loop (Praun et al. Sec. 3, 3.3-3.6, 4) ---- */
+
+/* Coverage samples per patch side: a face's sample points lie about
+   1/TT__LAPPED_SAMPLES_PER_SIDE of a patch side apart (Sec. 3.6). */
+#define TT__LAPPED_SAMPLES_PER_SIDE 64
+/* Sample raster resolutions range over [TT__LAPPED_MIN_SAMPLE_RES, this] (a
+   face then carries about R^2 / 2 samples); faces larger than the spacing
+   allows are sampled more coarsely, and covered more conservatively. */
+#define TT__LAPPED_MIN_SAMPLE_RES 4
+#define TT__LAPPED_MAX_SAMPLE_RES 256
+/* Every point of a face's canonical raster triangle lies within this many
+   raster cells of one of its sample points (1.58 at the acute corners). */
+#define TT__LAPPED_SAMPLE_REACH 1.6
+/* A sample's nearest texel, and the 2 x 2 texels a bilinear lookup reads
+   within reach of it, lie within this many texels of the sample. */
+#define TT__LAPPED_TEXEL_REACH 2.2
+/* Vertices of a patch's conservative hull (Sec. 3.3, Fig. 4). */
+#define TT__LAPPED_HULL_VERTICES 32
+/* Grow-and-solve rounds per paste (Sec. 3.3: "when this occurs, we further
+   grow the patch and optimize again"). */
+#define TT__LAPPED_GROW_ROUNDS 3
+/* Consecutive pastes that cover no new sample before the loop gives up. */
+#define TT__LAPPED_STALL_LIMIT 64
+
+/* One face of one paste (Sec. 3.5), with its alignment error (Sec. 3.4). */
+typedef struct tt__entry {
+    int face, paste;
+    float uv[6];
+    float angle_error, scale_error;
+} tt__entry;
+
+typedef struct tt__lapper {
+    const tt_mesh *mesh;
+    const tt_image *patches;
+    int npatches;
+    const float *field;
+    int isotropic;
+    const tt_allocator *al;
+    tt_rng rng;
+    /* per texture patch */
+    float **hull;               /* conservative hull, texture space, CCW */
+    int *hull_count;
+    float **depth;              /* per texel: distance (texels) to the nearest texel not opaque */
+    float *anchor;              /* 2 per patch: where a paste's seed point lands */
+    /* per face */
+    double *normal;             /* 3 per face */
+    double *tangent;            /* 3 per face: T of the current paste (isotropic: propagated) */
+    int *sample_res;            /* R of the face's sample raster */
+    int *sample_start;          /* nfaces + 1: its samples in covered[] */
+    unsigned char *covered;     /* one byte per sample */
+    int *covered_count;
+    int *uncovered, *uncovered_pos, nuncovered;
+    long long total_samples, covered_samples;
+    /* barycentric sample tables, one per raster resolution R in use */
+    float *table[TT__LAPPED_MAX_SAMPLE_RES + 1];    /* 2 per sample: weights of corners 1 and 2 */
+    int table_count[TT__LAPPED_MAX_SAMPLE_RES + 1];
+    /* per paste (stamped with the paste number, so nothing is cleared) */
+    int *face_stamp, *vert_stamp, *edge_stamp, *vert_local;
+    int round_stamp;
+    double *vert_uv;            /* 2 per vertex */
+    int *patch_faces, npatch_faces;
+    int *patch_verts, npatch_verts;
+    tt__heap_item *heap;        /* half-edges to grow across; `face` holds the half-edge */
+    int heap_count;
+    tt_triplet *triplets;
+    double *solve;              /* 4 per patch vertex: b_s, b_t, x_s, x_t */
+    /* recorded pastes (Sec. 3.5) */
+    int *paste_patch, npastes, paste_capacity;
+    tt__entry *entries;
+    int nentries, entry_capacity;
+} tt__lapper;
+
+/* `array` (holding *capacity elements of `size` bytes) grown to hold at
+   least `need`, doubling; NULL when out of memory, the old array then still
+   the caller's. */
+static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int need, size_t size)
+{
+    int cap = *capacity;
+    void *bigger;
+    if (need <= cap) return array;
+    while (cap < need) {
+        if (cap > INT_MAX / 2) return NULL;
+        cap = cap ? 2 * cap : 64;
+    }
+    if (!tt__size_fits((size_t)cap, size)) return NULL;
+    bigger = tt__alloc(al, (size_t)cap * size);
+    if (!bigger) return NULL;
+    if (array) memcpy(bigger, array, (size_t)*capacity * size);
+    tt__free(al, array);
+    *capacity = cap;
+    return bigger;
+}
+
+/* Sec. 3.6 counts a face point as covered where a paste is opaque. Here a
+   sample point counts only when every texel a bilinear lookup could read
+   anywhere within reach of it (rho texels) is opaque, so that the points
+   between samples are covered too: depth[t] is the distance from texel t's
+   centre to the nearest centre of a texel with alpha < TT_LAPPED_OPAQUE
+   (outside the image counts as such: clamped lookups beyond the border are
+   not relied on). The anchor, where a paste's seed point lands, is the
+   deepest texel - the patch's "center" (Sec. 3.3) for any mask shape.
+   Returns the depth of the anchor (0: nothing opaque), or -1 when out of
+   memory. */
+static float tt__patch_depth(tt__lapper *L, int index)
+{
+    const tt_image *patch = &L->patches[index];
+    const float big = 1e30f;
+    int w = patch->width, h = patch->height, gw = w + 2, gh = h + 2, n = gw > gh ? gw : gh, x, y;
+    float *grid = TT__ALLOC(L->al, float, (size_t)gw * gh), *line = TT__ALLOC(L->al, float, n);
+    float *dline = TT__ALLOC(L->al, float, n), *z = TT__ALLOC(L->al, float, (size_t)n + 1), deepest = 0.0f;
+    int *v = TT__ALLOC(L->al, int, n), ok;
+    float *depth = TT__ALLOC(L->al, float, (size_t)w * h);
+    L->depth[index] = depth;
+    ok = grid && line && dline && z && v && depth;
+    if (ok) {
+        for (y = 0; y < gh; y++)
+            for (x = 0; x < gw; x++) {
+                int inside = x > 0 && y > 0 && x <= w && y <= h &&
+                             patch->pixels[4 * ((size_t)(y - 1) * w + (x - 1)) + 3] >= TT_LAPPED_OPAQUE;
+                grid[(size_t)y * gw + x] = inside ? big : 0.0f;
+            }
+        tt__distance_transform(grid, gw, gh, line, dline, v, z, big);
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float d = sqrtf(grid[(size_t)(y + 1) * gw + (x + 1)]);
+                depth[(size_t)y * w + x] = d;
+                if (d > deepest) {
+                    deepest = d;
+                    L->anchor[2 * (size_t)index] = (float)((x + 0.5) / w);
+                    L->anchor[2 * (size_t)index + 1] = (float)(1.0 - (y + 0.5) / h);
+                }
+            }
+    }
+    tt__free(L->al, grid);
+    tt__free(L->al, line);
+    tt__free(L->al, dline);
+    tt__free(L->al, z);
+    tt__free(L->al, v);
+    return ok ? deepest : -1.0f;
+}
+
+typedef struct tt__table_fill {
+    float *table;
+    int count;
+} tt__table_fill;
+
+static void tt__table_add(int x, int y, const float barycentric[3], void *user_data)
+{
+    tt__table_fill *fill = (tt__table_fill *)user_data;
+    (void)x; (void)y;
+    if (fill->table) {
+        fill->table[2 * fill->count] = barycentric[1];
+        fill->table[2 * fill->count + 1] = barycentric[2];
+    }
+    fill->count++;
+}
+
+/* Sample points of a face (Sec. 3.6, "render all the patch faces ... and
+   count covered pixels"): the pixel centres of an R x R raster that fall in
+   the right triangle (0,0), (R,0), (0,R) by tt_raster_triangle, as
+   barycentric weights of the face's corners - the same set for every face of
+   resolution R, so coverage is counted on points fixed to the surface,
+   whichever paste maps them. Built once per R in use. */
+static int tt__sample_table(tt__lapper *L, int r)
+{
+    float xy[6];
+    tt__table_fill fill;
+    if (L->table[r]) return 1;
+    xy[0] = 0.0f; xy[1] = 0.0f; xy[2] = (float)r; xy[3] = 0.0f; xy[4] = 0.0f; xy[5] = (float)r;
+    fill.table = NULL;
+    fill.count = 0;
+    tt_raster_triangle(xy, r, r, tt__table_add, &fill);
+    L->table[r] = TT__ALLOC(L->al, float, 2 * (size_t)fill.count);
+    if (!L->table[r]) return 0;
+    L->table_count[r] = fill.count;
+    fill.table = L->table[r];
+    fill.count = 0;
+    tt_raster_triangle(xy, r, r, tt__table_add, &fill);
+    return 1;
+}
+
+static const float *tt__corner_pos(const tt_mesh *mesh, int corner)
+{
+    return mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
+}
+
+/* The weights (w0, w1, w2), summing to 0, with which a vector t in the plane
+   of triangle f is a combination of its corners: t = sum w_i P_i (Sec. 3.4,
+   footnote 1). Then phi(t) = sum w_i phi(P_i) for the linear map phi. */
+static void tt__face_vector_weights(const tt_mesh *mesh, int f, const double *t, double w[3])
+{
+    const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
+    const float *c = tt__corner_pos(mesh, 3 * f + 2);
+    double e1[3], e2[3], g11, g12, g22, r1, r2, det;
+    int k;
+    for (k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
+    g11 = tt__dot3(e1, e1); g12 = tt__dot3(e1, e2); g22 = tt__dot3(e2, e2);
+    r1 = tt__dot3(e1, t); r2 = tt__dot3(e2, t);
+    det = g11 * g22 - g12 * g12;   /* g11 g22 sin^2 of the angle at corner 0 */
+    if (!(det > 1e-14 * g11 * g22)) { w[0] = w[1] = w[2] = 0.0; return; }
+    w[1] = (g22 * r1 - g12 * r2) / det;
+    w[2] = (g11 * r2 - g12 * r1) / det;
+    w[0] = -w[1] - w[2];
+}
+
+/* phi(T_f) and phi(S_f) of face f under the current vertex UVs. */
+static void tt__face_axes_image(const tt__lapper *L, int f, double image_t[2], double image_s[2])
+{
+    const tt_mesh *mesh = L->mesh;
+    const double *t = L->tangent + 3 * (size_t)f;
+    double s[3], wt[3], ws[3];
+    int k;
+    tt__cross3(t, L->normal + 3 * (size_t)f, s);
+    tt__face_vector_weights(mesh, f, t, wt);
+    tt__face_vector_weights(mesh, f, s, ws);
+    image_t[0] = image_t[1] = image_s[0] = image_s[1] = 0.0;
+    for (k = 0; k < 3; k++) {
+        const double *uv = L->vert_uv + 2 * (size_t)mesh->corner_vert[3 * f + k];
+        image_t[0] += wt[k] * uv[0]; image_t[1] += wt[k] * uv[1];
+        image_s[0] += ws[k] * uv[0]; image_s[1] += ws[k] * uv[1];
+    }
+}
+
+/* Angle (degrees) between phi(T) and the texture's up axis, and phi(T)'s length. */
+static void tt__alignment_error(const double image_t[2], double *angle, double *scale)
+{
+    *scale = sqrt(image_t[0] * image_t[0] + image_t[1] * image_t[1]);
+    *angle = *scale > 0.0 ? fabs(atan2(image_t[0], image_t[1])) * (180.0 / 3.14159265358979323846) : 180.0;
+}
+
+static int tt__lapped_too_distorted(const tt__lapper *L, int f)
+{
+    double image_t[2], image_s[2], angle, scale, limit = 1.0 + TT_LAPPED_MAX_DISTORTION / 90.0;
+    tt__face_axes_image(L, f, image_t, image_s);
+    tt__alignment_error(image_t, &angle, &scale);
+    return !(angle <= TT_LAPPED_MAX_DISTORTION && scale <= limit && scale * limit >= 1.0);
+}
+
+static void tt__map_vertex(tt__lapper *L, int v, int paste)
+{
+    L->vert_stamp[v] = paste;
+    L->vert_local[v] = L->npatch_verts;
+    L->patch_verts[L->npatch_verts++] = v;
+}
+
+/* Queue the half-edges of patch face f whose far side is not in the patch
+   and whose image still meets the hull of texture patch `patch` (Sec. 3.3:
+   "the patch is only grown over an edge if the edge is still partially
+   inside the texture patch"), keyed by the distance of the edge's image
+   from the anchor, so that the patch grows nearest first. */
+static void tt__queue_edges(tt__lapper *L, int f, int paste, int patch)
+{
+    const tt_mesh *mesh = L->mesh;
+    const float *anchor = L->anchor + 2 * (size_t)patch;
+    int k;
+    for (k = 0; k < 3; k++) {
+        int c = 3 * f + k, t = mesh->twin[c];
+        const double *p, *q;
+        float a[2], b[2];
+        double mx, my;
+        if (t < 0 || L->face_stamp[t / 3] == paste || L->edge_stamp[c] == L->round_stamp) continue;
+        p = L->vert_uv + 2 * (size_t)mesh->corner_vert[c];
+        q = L->vert_uv + 2 * (size_t)mesh->corner_vert[3 * f + (k + 1) % 3];
+        a[0] = (float)p[0]; a[1] = (float)p[1]; b[0] = (float)q[0]; b[1] = (float)q[1];
+        if (!tt__segment_meets_polygon(a, b, L->hull[patch], L->hull_count[patch])) continue;
+        L->edge_stamp[c] = L->round_stamp;
+        mx = 0.5 * (p[0] + q[0]) - anchor[0];
+        my = 0.5 * (p[1] + q[1]) - anchor[1];
+        tt__heap_push(L->heap, &L->heap_count, mx * mx + my * my, c);
+    }
+}
+
+/* Isotropic mode (Sec. 3.2, last paragraph): "the direction of each
+   subsequently added face is computed by projecting onto its face plane the
+   average direction of neighboring faces already in the patch"; the length
+   stays the field's. `from` is the half-edge of the patch face g was reached
+   across, the fallback when the average cancels. */
+static void tt__propagate_direction(tt__lapper *L, int g, int from, int paste)
+{
+    const tt_mesh *mesh = L->mesh;
+    double sum[3] = {0.0, 0.0, 0.0}, d[3], *out = L->tangent + 3 * (size_t)g;
+    const float *field = L->field + 3 * (size_t)g;
+    double length = sqrt((double)field[0] * field[0] + (double)field[1] * field[1] + (double)field[2] * field[2]);
+    int k;
+    for (k = 0; k < 3; k++) {
+        int t = mesh->twin[3 * g + k], h;
+        if (t < 0 || L->face_stamp[h = t / 3] != paste) continue;
+        d[0] = L->tangent[3 * (size_t)h]; d[1] = L->tangent[3 * (size_t)h + 1]; d[2] = L->tangent[3 * (size_t)h + 2];
+        tt__normalize3(d);
+        sum[0] += d[0]; sum[1] += d[1]; sum[2] += d[2];
+    }
+    tt__project3(sum, L->normal + 3 * (size_t)g, out);
+    if (tt__normalize3(out) <= 1e-6) {
+        int h = from / 3;
+        tt__field_transport(mesh, from, L->normal + 3 * (size_t)h, L->normal + 3 * (size_t)g,
+                            L->tangent + 3 * (size_t)h, out);
+        tt__normalize3(out);
+    }
+    out[0] *= length; out[1] *= length; out[2] *= length;
+}
+
+/* Similar-triangle prediction (Sec. 3.3, after Maillot et al.): for every
+   face around vertex v whose other two corners x, y are mapped, place v so
+   the UV triangle is similar to the 3D one; v gets the centroid of the
+   predictions. The fan walk starts at vert_corner, the outgoing boundary
+   half-edge when v is on a boundary, so one sweep sees every face. Returns 0
+   when no face predicts v. */
+static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2])
+{
+    const tt_mesh *mesh = L->mesh;
+    const float *pv = mesh->pos + 3 * (size_t)v;
+    int start = mesh->vert_corner[v], c = start, count = 0, guard = 0;
+    uv[0] = uv[1] = 0.0;
+    while (c >= 0 && guard++ < mesh->ncorners) {
+        int f = c / 3, k = c % 3;
+        int x = mesh->corner_vert[3 * f + (k + 1) % 3], y = mesh->corner_vert[3 * f + (k + 2) % 3];
+        if (L->vert_stamp[x] == paste && L->vert_stamp[y] == paste) {
+            const float *px = mesh->pos + 3 * (size_t)x, *py = mesh->pos + 3 * (size_t)y;
+            const double *ux = L->vert_uv + 2 * (size_t)x, *uy = L->vert_uv + 2 * (size_t)y;
+            double e[3], q[3], n[3], ee, along, across;
+            int j;
+            for (j = 0; j < 3; j++) { e[j] = (double)py[j] - px[j]; q[j] = (double)pv[j] - px[j]; }
+            ee = tt__dot3(e, e);
+            if (ee > 0.0) {
+                /* The face (v, x, y) is counter-clockwise, so v lies left of
+                   x -> y: the perpendicular offset turns x -> y by +90 deg. */
+                tt__cross3(e, q, n);
+                along = tt__dot3(q, e) / ee;
+                across = sqrt(tt__dot3(n, n)) / ee;
+                uv[0] += ux[0] + along * (uy[0] - ux[0]) - across * (uy[1] - ux[1]);
+                uv[1] += ux[1] + along * (uy[1] - ux[1]) + across * (uy[0] - ux[0]);
+                count++;
+            }
+        }
+        c = mesh->twin[3 * f + (k + 2) % 3];
+        if (c == start) break;
+    }
+    if (count == 0) return 0;
+    uv[0] /= count;
+    uv[1] /= count;
+    return 1;
+}
+
+/* Add the face across half-edge c (of a patch face) if the three rules of
+   Sec. 3.3 allow it: the patch stays a disc (the face meets the patch along
+   one edge with a new vertex, or along two edges), and the face's predicted
+   map is not too distorted ("patch growth is stopped when distortion
+   becomes excessive"). Returns 1 when it was added. */
+static int tt__try_add_face(tt__lapper *L, int c, int paste)
+{
+    const tt_mesh *mesh = L->mesh;
+    int t = mesh->twin[c], g = t / 3, v = mesh->corner_vert[3 * g + (t % 3 + 2) % 3], shared = 0, k, mapped;
+    double uv[2];
+    if (L->face_stamp[g] == paste) return 0;
+    for (k = 0; k < 3; k++) {
+        int u = mesh->twin[3 * g + k];
+        if (u >= 0 && L->face_stamp[u / 3] == paste) shared++;
+    }
+    mapped = L->vert_stamp[v] == paste;
+    if (mapped ? shared != 2 : shared != 1) return 0;
+    if (L->isotropic) tt__propagate_direction(L, g, c, paste);
+    if (!mapped) {
+        if (!tt__predict_vertex(L, v, paste, uv)) return 0;
+        L->vert_uv[2 * (size_t)v] = uv[0];        /* provisional until v is stamped */
+        L->vert_uv[2 * (size_t)v + 1] = uv[1];
+    }
+    if (tt__lapped_too_distorted(L, g)) return 0;
+    L->face_stamp[g] = paste;
+    L->patch_faces[L->npatch_faces++] = g;
+    if (!mapped) tt__map_vertex(L, v, paste);
+    return 1;
+}
+
+static void tt__grow_patch(tt__lapper *L, int paste, int patch)
+{
+    int i, count = L->npatch_faces;
+    L->round_stamp++;
+    L->heap_count = 0;
+    for (i = 0; i < count; i++) tt__queue_edges(L, L->patch_faces[i], paste, patch);
+    while (L->heap_count > 0) {
+        int c = tt__heap_pop(L->heap, &L->heap_count).face;
+        if (tt__try_add_face(L, c, paste))
+            tt__queue_edges(L, L->patch_faces[L->npatch_faces - 1], paste, patch);
+    }
+}
+
+/* Sec. 3.4: minimise sum_f |phi(S_f) - (1,0)|^2 + |phi(T_f) - (0,1)|^2 over
+   the patch's vertex UVs. With phi(T_f) = sum_i wt_i uv_i (and ws for S), the
+   s and t coordinates decouple into one normal matrix
+       A = sum_f (wt wt^T + ws ws^T),   A s = sum_f ws,   A t = sum_f wt.
+   The minimum is unique up to a translation; a penalty holding the seed
+   point on the anchor removes it (at the optimum the penalty is zero, so its
+   weight only affects conditioning), and a final exact translation puts the
+   seed on the anchor. Solved by tt_cg_solve from the current map. A solve
+   that fails for a numerical reason keeps the predicted map. */
+static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double seed_weight[3], const float anchor[2])
+{
+    const tt_mesh *mesh = L->mesh;
+    int n = L->npatch_verts, nt = 0, i, j, k, f;
+    double trace = 0.0, penalty, seed_uv[2] = {0.0, 0.0};
+    double *b_s, *b_t, *x_s, *x_t;
+    tt_sparse_matrix A;
+    tt_cg_options cg;
+    tt_result r;
+    memset(&A, 0, sizeof A);
+    b_s = L->solve; b_t = b_s + n; x_s = b_t + n; x_t = x_s + n;
+    for (i = 0; i < 4 * n; i++) L->solve[i] = 0.0;
+    for (i = 0; i < n; i++) {
+        x_s[i] = L->vert_uv[2 * (size_t)L->patch_verts[i]];
+        x_t[i] = L->vert_uv[2 * (size_t)L->patch_verts[i] + 1];
+    }
+    for (f = 0; f < L->npatch_faces; f++) {
+        int face = L->patch_faces[f], local[3];
+        double s[3], wt[3], ws[3];
+        const double *t = L->tangent + 3 * (size_t)face;
+        tt__cross3(t, L->normal + 3 * (size_t)face, s);
+        tt__face_vector_weights(mesh, face, t, wt);
+        tt__face_vector_weights(mesh, face, s, ws);
+        for (k = 0; k < 3; k++) local[k] = L->vert_local[mesh->corner_vert[3 * face + k]];
+        for (k = 0; k < 3; k++) {
+            b_s[local[k]] += ws[k];
+            b_t[local[k]] += wt[k];
+            trace += wt[k] * wt[k] + ws[k] * ws[k];
+            for (j = 0; j < 3; j++) {
+                L->triplets[nt].row = local[k];
+                L->triplets[nt].col = local[j];
+                L->triplets[nt].value = wt[k] * wt[j] + ws[k] * ws[j];
+                nt++;
+            }
+        }
+    }
+    penalty = trace / n;
+    for (k = 0; k < 3; k++) {
+        int row = L->vert_local[mesh->corner_vert[3 * seed_face + k]];
+        b_s[row] += penalty * seed_weight[k] * anchor[0];
+        b_t[row] += penalty * seed_weight[k] * anchor[1];
+        for (j = 0; j < 3; j++) {
+            L->triplets[nt].row = row;
+            L->triplets[nt].col = L->vert_local[mesh->corner_vert[3 * seed_face + j]];
+            L->triplets[nt].value = penalty * seed_weight[k] * seed_weight[j];
+            nt++;
+        }
+    }
+    r = tt_sparse_from_triplets(&A, n, n, L->triplets, nt, L->al, NULL);
+    if (r != TT_OK) return r == TT_ERROR_OUT_OF_MEMORY ? r : TT_OK;
+    memset(&cg, 0, sizeof cg);
+    cg.tolerance = 1e-7;
+    cg.allocator = *L->al;
+    r = tt_cg_solve(&A, b_s, x_s, &cg, NULL, NULL);
+    if (r == TT_OK || r == TT_ERROR_NOT_CONVERGED) r = tt_cg_solve(&A, b_t, x_t, &cg, NULL, NULL);
+    tt_sparse_free(&A);
+    if (r == TT_ERROR_OUT_OF_MEMORY) return r;
+    if (r != TT_OK && r != TT_ERROR_NOT_CONVERGED) return TT_OK;
+    for (k = 0; k < 3; k++) {
+        int local = L->vert_local[mesh->corner_vert[3 * seed_face + k]];
+        seed_uv[0] += seed_weight[k] * x_s[local];
+        seed_uv[1] += seed_weight[k] * x_t[local];
+    }
+    for (i = 0; i < n; i++) {
+        L->vert_uv[2 * (size_t)L->patch_verts[i]] = x_s[i] + (anchor[0] - seed_uv[0]);
+        L->vert_uv[2 * (size_t)L->patch_verts[i] + 1] = x_t[i] + (anchor[1] - seed_uv[1]);
+    }
+    return TT_OK;
+}
+
+/* The face's sample points that an entry's map (corner UVs uv[6]) puts
+   safely inside the opaque part of texture patch `patch` (see
+   tt__patch_depth): marks them in marks[] (the face's slice of a per-sample
+   array) and returns how many it newly marked. Any point of the face lies
+   within TT__LAPPED_SAMPLE_REACH raster cells of a sample; the face's map
+   stretches a cell to at most rho texels. */
+static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, int patch, unsigned char *marks)
+{
+    const tt_image *image = &L->patches[patch];
+    const float *depth = L->depth[patch];
+    int r = L->sample_res[f], count = L->sample_start[f + 1] - L->sample_start[f], s, added = 0;
+    int w = image->width, h = image->height;
+    const float *table = L->table[r];
+    double e1u = (uv[2] - uv[0]) * w, e1v = (uv[3] - uv[1]) * h, e2u = (uv[4] - uv[0]) * w, e2v = (uv[5] - uv[1]) * h;
+    double rho = TT__LAPPED_SAMPLE_REACH * sqrt(e1u * e1u + e1v * e1v + e2u * e2u + e2v * e2v) / r;
+    float need = (float)(rho + TT__LAPPED_TEXEL_REACH);
+    for (s = 0; s < count; s++) {
+        double w1 = table[2 * s], w2 = table[2 * s + 1], w0 = 1.0 - w1 - w2, x, y;
+        if (marks[s]) continue;
+        x = (w0 * uv[0] + w1 * uv[2] + w2 * uv[4]) * w;
+        y = (1.0 - (w0 * uv[1] + w1 * uv[3] + w2 * uv[5])) * h;
+        if (!(x >= 0.0 && y >= 0.0 && x < w && y < h)) continue;
+        if (depth[(size_t)(int)y * w + (int)x] > need) {
+            marks[s] = 1;
+            added++;
+        }
+    }
+    return added;
+}
+
+/* Sec. 3.5 and 3.6: record the paste (one entry per patch face, with its
+   corner UVs and its alignment error) and update the coverage. Returns the
+   number of samples newly covered, or -1 when out of memory. */
+static long long tt__record_paste(tt__lapper *L, int patch)
+{
+    const tt_mesh *mesh = L->mesh;
+    long long added = 0;
+    int i, k, paste = L->npastes;
+    void *grown = tt__grow(L->al, L->paste_patch, &L->paste_capacity, paste + 1, sizeof(int));
+    if (!grown) return -1;
+    L->paste_patch = (int *)grown;
+    L->paste_patch[L->npastes++] = patch;
+    grown = tt__grow(L->al, L->entries, &L->entry_capacity, L->nentries + L->npatch_faces, sizeof(tt__entry));
+    if (!grown) return -1;
+    L->entries = (tt__entry *)grown;
+    for (i = 0; i < L->npatch_faces; i++) {
+        int f = L->patch_faces[i], got;
+        tt__entry *entry = &L->entries[L->nentries++];
+        double image_t[2], image_s[2], angle, scale;
+        for (k = 0; k < 3; k++) {
+            const double *p = L->vert_uv + 2 * (size_t)mesh->corner_vert[3 * f + k];
+            entry->uv[2 * k] = (float)p[0];
+            entry->uv[2 * k + 1] = (float)p[1];
+        }
+        tt__face_axes_image(L, f, image_t, image_s);
+        tt__alignment_error(image_t, &angle, &scale);
+        entry->face = f;
+        entry->paste = paste;
+        entry->angle_error = (float)angle;
+        entry->scale_error = (float)fabs(scale - 1.0);
+        if (L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) continue;
+        got = tt__mark_opaque_samples(L, f, entry->uv, patch, L->covered + L->sample_start[f]);
+        L->covered_count[f] += got;
+        added += got;
+        if (L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) {
+            int at = L->uncovered_pos[f], last = L->uncovered[--L->nuncovered];
+            L->uncovered[at] = last;
+            L->uncovered_pos[last] = at;
+            L->uncovered_pos[f] = -1;
+        }
+    }
+    L->covered_samples += added;
+    return added;
+}
+
+static void tt__lapper_free(tt__lapper *L)
+{
+    int i;
+    for (i = 0; i < L->npatches; i++) {
+        if (L->hull) tt__free(L->al, L->hull[i]);
+        if (L->depth) tt__free(L->al, L->depth[i]);
+    }
+    for (i = 0; i <= TT__LAPPED_MAX_SAMPLE_RES; i++) tt__free(L->al, L->table[i]);
+    tt__free(L->al, L->hull);
+    tt__free(L->al, L->depth);
+    tt__free(L->al, L->hull_count);
+    tt__free(L->al, L->anchor);
+    tt__free(L->al, L->normal);
+    tt__free(L->al, L->tangent);
+    tt__free(L->al, L->sample_res);
+    tt__free(L->al, L->sample_start);
+    tt__free(L->al, L->covered);
+    tt__free(L->al, L->covered_count);
+    tt__free(L->al, L->uncovered);
+    tt__free(L->al, L->uncovered_pos);
+    tt__free(L->al, L->face_stamp);
+    tt__free(L->al, L->vert_stamp);
+    tt__free(L->al, L->edge_stamp);
+    tt__free(L->al, L->vert_local);
+    tt__free(L->al, L->vert_uv);
+    tt__free(L->al, L->patch_faces);
+    tt__free(L->al, L->patch_verts);
+    tt__free(L->al, L->heap);
+    tt__free(L->al, L->triplets);
+    tt__free(L->al, L->solve);
+    tt__free(L->al, L->paste_patch);
+    tt__free(L->al, L->entries);
+}
+
+/* Check the inputs and prepare the per-face and per-patch data. */
+static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error)
+{
+    const tt_mesh *mesh = L->mesh;
+    int nf = mesh->nfaces, nv = mesh->nverts, f, i, k;
+    double lo[3], hi[3], diagonal, estimate = 0.0, opaque_fraction = 0.0;
+    float shallowest = 0.0f;
+    int widest = 1;
+    long long total = 0;
+    if (mesh->min_face_size != 3 || mesh->max_face_size != 3) {
+        for (f = 0; f < nf && mesh->face_start[f + 1] - mesh->face_start[f] == 3; f++) {}
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                        "lapped textures need a triangle mesh: face %d has %d corners (split it into triangles)", f,
+                        mesh->face_start[f + 1] - mesh->face_start[f]);
+    }
+    for (i = 0; i < L->npatches; i++) {
+        const tt_image *p = &L->patches[i];
+        size_t n, j;
+        if (p->width <= 0 || p->height <= 0 || !p->pixels)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "texture patch %d is empty", i);
+        n = (size_t)p->width * p->height * 4;
+        for (j = 0; j < n; j++)
+            if (!tt__is_finite(p->pixels[j]))
+                return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                                "texture patch %d has a NaN or infinite value at texel (%d, %d)", i,
+                                (int)(j / 4 % (size_t)p->width), (int)(j / 4 / (size_t)p->width));
+    }
+    L->hull = TT__ALLOC(L->al, float *, L->npatches);
+    L->depth = TT__ALLOC(L->al, float *, L->npatches);
+    for (i = 0; i < L->npatches; i++) {
+        if (L->hull) L->hull[i] = NULL;
+        if (L->depth) L->depth[i] = NULL;
+    }
+    L->hull_count = TT__ALLOC(L->al, int, L->npatches);
+    L->anchor = TT__ALLOC(L->al, float, 2 * (size_t)L->npatches);
+    L->normal = TT__ALLOC(L->al, double, 3 * (size_t)nf);
+    L->tangent = TT__ALLOC(L->al, double, 3 * (size_t)nf);
+    L->sample_res = TT__ALLOC(L->al, int, nf);
+    L->sample_start = TT__ALLOC(L->al, int, (size_t)nf + 1);
+    L->covered_count = TT__ALLOC(L->al, int, nf);
+    L->uncovered = TT__ALLOC(L->al, int, nf);
+    L->uncovered_pos = TT__ALLOC(L->al, int, nf);
+    L->face_stamp = TT__ALLOC(L->al, int, nf);
+    L->vert_stamp = TT__ALLOC(L->al, int, nv);
+    L->edge_stamp = TT__ALLOC(L->al, int, mesh->ncorners);
+    L->vert_local = TT__ALLOC(L->al, int, nv);
+    L->vert_uv = TT__ALLOC(L->al, double, 2 * (size_t)nv);
+    L->patch_faces = TT__ALLOC(L->al, int, nf);
+    L->patch_verts = TT__ALLOC(L->al, int, nv);
+    L->heap = TT__ALLOC(L->al, tt__heap_item, mesh->ncorners);
+    L->triplets = TT__ALLOC(L->al, tt_triplet, 9 * ((size_t)nf + 1));
+    L->solve = TT__ALLOC(L->al, double, 4 * (size_t)nv);
+    if (!L->hull || !L->hull_count || !L->anchor || !L->normal || !L->tangent || !L->sample_res ||
+        !L->sample_start || !L->covered_count || !L->uncovered || !L->uncovered_pos || !L->face_stamp ||
+        !L->vert_stamp || !L->edge_stamp || !L->vert_local || !L->vert_uv || !L->patch_faces ||
+        !L->patch_verts || !L->heap || !L->triplets || !L->solve || !L->depth)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    for (i = 0; i < L->npatches; i++) {
+        const tt_image *p = &L->patches[i];
+        size_t j, n = (size_t)p->width * p->height, opaque = 0;
+        float deepest = tt__patch_depth(L, i);
+        tt_result r;
+        if (deepest < 0.0f) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+        if (deepest == 0.0f)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "texture patch %d has no opaque texel (alpha >= %.2f)", i, TT_LAPPED_OPAQUE);
+        if (i == 0 || deepest < shallowest) shallowest = deepest;
+        r = tt__patch_hull(p, TT__LAPPED_HULL_VERTICES, L->al, &L->hull[i], &L->hull_count[i]);
+        if (r != TT_OK)
+            return tt__fail(error, r, -1, -1, -1, -1, "texture patch %d: %s", i, tt_result_string(r));
+        for (j = 0; j < n; j++) opaque += p->pixels[4 * j + 3] >= TT_LAPPED_OPAQUE;
+        if (p->width > widest) widest = p->width;
+        if (p->height > widest) widest = p->height;
+        opaque_fraction += (double)opaque / (double)n / L->npatches;
+    }
+
+    for (k = 0; k < 3; k++) lo[k] = hi[k] = mesh->pos[k];
+    for (i = 0; i < nv; i++)
+        for (k = 0; k < 3; k++) {
+            double x = mesh->pos[3 * (size_t)i + k];
+            if (x < lo[k]) lo[k] = x;
+            if (x > hi[k]) hi[k] = x;
+        }
+    diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                    (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    for (f = 0; f < nf; f++) {
+        const float *fv = L->field + 3 * (size_t)f;
+        double *n = L->normal + 3 * (size_t)f, *t = L->tangent + 3 * (size_t)f, v[3], length, projected;
+        if (!tt__face_normal_d(mesh, f, n))
+            return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, -1, -1, -1, "face %d has zero area", f);
+        if (!tt__is_finite(fv[0]) || !tt__is_finite(fv[1]) || !tt__is_finite(fv[2]))
+            return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
+                            "the field vector of face %d is NaN or infinite", f);
+        v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
+        length = sqrt(tt__dot3(v, v));
+        tt__project3(v, n, t);
+        projected = sqrt(tt__dot3(t, t));
+        if (!(length > 0.0) || projected < 1e-3 * length)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            length > 0.0 ? "the field vector of face %d is perpendicular to the face"
+                                         : "the field vector of face %d has zero length", f);
+        if (projected > diagonal)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "the texture patch (%g mesh units at face %d) is larger than the mesh "
+                            "(bounding-box diagonal %g): use a smaller scale", projected, f, diagonal);
+        /* A paste covers at most about the patch's opaque area, |T|^2 times
+           its opaque fraction, so this many pastes at least. */
+        {
+            const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
+            const float *c = tt__corner_pos(mesh, 3 * f + 2);
+            double e1[3], e2[3], cr[3];
+            for (k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
+            tt__cross3(e1, e2, cr);
+            estimate += 0.5 * sqrt(tt__dot3(cr, cr)) / (projected * projected * opaque_fraction);
+        }
+    }
+    if (estimate > max_pastes)
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "the texture patches are too small for this mesh: covering it would take at least "
+                        "%.0f pastes, more than the limit of %d (use a larger scale)", estimate, max_pastes);
+    for (f = 0; f < nf; f++) {
+        const double *t = L->tangent + 3 * (size_t)f;
+        double projected = sqrt(tt__dot3(t, t)), longest = 0.0;
+        for (k = 0; k < 3; k++) {
+            const float *a = tt__corner_pos(mesh, 3 * f + k), *b = tt__corner_pos(mesh, 3 * f + (k + 1) % 3);
+            double e[3];
+            e[0] = (double)b[0] - a[0]; e[1] = (double)b[1] - a[1]; e[2] = (double)b[2] - a[2];
+            if (sqrt(tt__dot3(e, e)) > longest) longest = sqrt(tt__dot3(e, e));
+        }
+        {
+            /* Faces so large next to the patch that even its deepest point
+               cannot cover a sample's reach would never be covered. */
+            double r = ceil(longest / projected * TT__LAPPED_SAMPLES_PER_SIDE), reach;
+            L->sample_res[f] = r < TT__LAPPED_MIN_SAMPLE_RES ? TT__LAPPED_MIN_SAMPLE_RES
+                             : r > TT__LAPPED_MAX_SAMPLE_RES ? TT__LAPPED_MAX_SAMPLE_RES : (int)r;
+            reach = TT__LAPPED_SAMPLE_REACH * 1.5 * longest / projected * widest / L->sample_res[f] +
+                    TT__LAPPED_TEXEL_REACH;
+            if (reach >= shallowest)
+                return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                                "face %d is %.1f texture patches long, too coarse for a patch whose opaque part is "
+                                "%.1f texels deep: subdivide the mesh, or use a larger scale or a larger image",
+                                f, longest / projected, (double)shallowest);
+        }
+        if (!tt__sample_table(L, L->sample_res[f]))
+            return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+        L->sample_start[f] = (int)total;
+        total += L->table_count[L->sample_res[f]];
+        if (total > INT_MAX)
+            return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                            "too many faces: the coverage samples do not fit an int");
+    }
+    L->sample_start[nf] = (int)total;
+    L->total_samples = total;
+    L->covered = TT__ALLOC(L->al, unsigned char, (size_t)total);
+    if (!L->covered) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    memset(L->covered, 0, (size_t)total);
+    for (f = 0; f < nf; f++) {
+        L->covered_count[f] = 0;
+        L->uncovered[f] = f;
+        L->uncovered_pos[f] = f;
+        L->face_stamp[f] = -1;
+    }
+    L->nuncovered = nf;
+    for (i = 0; i < nv; i++) L->vert_stamp[i] = -1;
+    for (i = 0; i < mesh->ncorners; i++) L->edge_stamp[i] = -1;
+    L->round_stamp = 0;
+    return TT_OK;
+}
+
+/* Start paste number `paste` (Sec. 3.3): a random face not yet covered, a
+   random uncovered sample point of it, and a random texture patch; the face
+   is mapped so that the point lands on the patch's anchor with (S, T) along
+   the texture axes. Returns the patch; fills the seed point's weights. */
+static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_weight[3])
+{
+    const tt_mesh *mesh = L->mesh;
+    int f = L->uncovered[tt_rng_below(&L->rng, (uint32_t)L->nuncovered)];
+    int r = L->sample_res[f], count = L->sample_start[f + 1] - L->sample_start[f];
+    int pick = (int)tt_rng_below(&L->rng, (uint32_t)(count - L->covered_count[f])), s, k;
+    int patch = (int)tt_rng_below(&L->rng, (uint32_t)L->npatches);
+    const unsigned char *marks = L->covered + L->sample_start[f];
+    const float *w = L->table[r], *anchor = L->anchor + 2 * (size_t)patch;
+    double *t = L->tangent + 3 * (size_t)f, s_axis[3], point[3] = {0.0, 0.0, 0.0}, tt_, ss;
+    for (s = 0; s < count; s++)
+        if (!marks[s] && pick-- == 0) break;
+    seed_weight[1] = w[2 * s];
+    seed_weight[2] = w[2 * s + 1];
+    seed_weight[0] = 1.0 - seed_weight[1] - seed_weight[2];
+    if (L->isotropic) {
+        /* "the center face of the patch is assigned an arbitrary tangent
+           direction" (Sec. 3.2): the field's direction turned at random. */
+        const float *fv = L->field + 3 * (size_t)f;
+        double v[3], across[3], angle = 6.283185307179586 * tt_rng_float(&L->rng), length;
+        v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
+        length = sqrt(tt__dot3(v, v));
+        tt__project3(v, L->normal + 3 * (size_t)f, t);
+        tt__normalize3(t);
+        tt__cross3(L->normal + 3 * (size_t)f, t, across);
+        for (k = 0; k < 3; k++) t[k] = length * (cos(angle) * t[k] + sin(angle) * across[k]);
+    }
+    tt__cross3(t, L->normal + 3 * (size_t)f, s_axis);
+    tt_ = tt__dot3(t, t);
+    ss = tt__dot3(s_axis, s_axis);
+    for (k = 0; k < 3; k++) {
+        const float *p = tt__corner_pos(mesh, 3 * f + k);
+        point[0] += seed_weight[k] * p[0]; point[1] += seed_weight[k] * p[1]; point[2] += seed_weight[k] * p[2];
+    }
+    L->npatch_faces = 0;
+    L->npatch_verts = 0;
+    L->face_stamp[f] = paste;
+    L->patch_faces[L->npatch_faces++] = f;
+    for (k = 0; k < 3; k++) {
+        int v = mesh->corner_vert[3 * f + k];
+        const float *p = mesh->pos + 3 * (size_t)v;
+        double d[3];
+        d[0] = p[0] - point[0]; d[1] = p[1] - point[1]; d[2] = p[2] - point[2];
+        L->vert_uv[2 * (size_t)v] = anchor[0] + tt__dot3(d, s_axis) / ss;
+        L->vert_uv[2 * (size_t)v + 1] = anchor[1] + tt__dot3(d, t) / tt_;
+        tt__map_vertex(L, v, paste);
+    }
+    *seed_face = f;
+    return patch;
+}
+
+/* Sec. 4: "we remove for a given paste operation any faces that are
+   completely occluded by subsequent paste operations". Walking the entries
+   from the last paste to the first, an entry whose face's samples are all
+   opaque under later pastes is dropped (face = -1). Returns how many. */
+static int tt__remove_hidden(tt__lapper *L)
+{
+    int e, removed = 0, f;
+    memset(L->covered, 0, (size_t)L->total_samples);
+    for (f = 0; f < L->mesh->nfaces; f++) L->covered_count[f] = 0;
+    for (e = L->nentries - 1; e >= 0; e--) {
+        tt__entry *entry = &L->entries[e];
+        int face = entry->face;
+        if (L->covered_count[face] == L->sample_start[face + 1] - L->sample_start[face]) {
+            entry->face = -1;
+            removed++;
+            continue;
+        }
+        L->covered_count[face] += tt__mark_opaque_samples(L, face, entry->uv, L->paste_patch[entry->paste],
+                                                          L->covered + L->sample_start[face]);
+    }
+    return removed;
+}
+
+/* Heapsort: O(n log n) whatever the input, so the exact median of a million
+   entries never degrades to the quadratic worst case of a quickselect. */
+static void tt__sift_doubles(double *v, int root, int count)
+{
+    for (;;) {
+        int child = 2 * root + 1;
+        double tmp;
+        if (child >= count) return;
+        if (child + 1 < count && v[child] < v[child + 1]) child++;
+        if (!(v[root] < v[child])) return;
+        tmp = v[root]; v[root] = v[child]; v[child] = tmp;
+        root = child;
+    }
+}
+
+static void tt__sort_doubles(double *v, int n)
+{
+    int i;
+    for (i = n / 2 - 1; i >= 0; i--) tt__sift_doubles(v, i, n);
+    for (i = n - 1; i > 0; i--) {
+        double tmp = v[0]; v[0] = v[i]; v[i] = tmp;
+        tt__sift_doubles(v, 0, i);
+    }
+}
+
+/* The median of values[0 .. count-1] (sorts them); 0 for none. */
+static double tt__median(double *values, int count)
+{
+    if (count <= 0) return 0.0;
+    tt__sort_doubles(values, count);
+    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+/* Move the surviving entries into the result, pastes that lost every face
+   dropped. */
+static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
+{
+    int kept = L->nentries - removed, e, n = 0, p = -1, last_paste = -1, i;
+    double angle_sum = 0.0;
+    double *scales;
+    out->allocator = *L->al;
+    out->faces = TT__ALLOC(L->al, int, kept > 0 ? kept : 1);
+    out->uv = TT__ALLOC(L->al, float, 6 * (size_t)(kept > 0 ? kept : 1));
+    out->pastes = TT__ALLOC(L->al, tt_paste, L->npastes > 0 ? L->npastes : 1);
+    scales = TT__ALLOC(L->al, double, kept > 0 ? kept : 1);
+    if (!out->faces || !out->uv || !out->pastes || !scales) {
+        tt__free(L->al, scales);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    for (e = 0; e < L->nentries; e++) {
+        const tt__entry *entry = &L->entries[e];
+        if (entry->face < 0) continue;
+        if (entry->paste != last_paste) {
+            last_paste = entry->paste;
+            p++;
+            out->pastes[p].patch = L->paste_patch[entry->paste];
+            out->pastes[p].first = n;
+            out->pastes[p].nfaces = 0;
+        }
+        out->faces[n] = entry->face;
+        for (i = 0; i < 6; i++) out->uv[6 * (size_t)n + i] = entry->uv[i];
+        angle_sum += entry->angle_error;
+        scales[n] = entry->scale_error;
+        out->pastes[p].nfaces++;
+        n++;
+    }
+    out->npastes = p + 1;
+    out->nentries = n;
+    out->removed_entries = removed;
+    out->coverage = 1.0;
+    out->mean_overdraw = (double)n / L->mesh->nfaces;
+    out->mean_angle_error = n > 0 ? angle_sum / n : 0.0;
+    out->median_scale_error = tt__median(scales, n);
+    tt__free(L->al, scales);
+    return TT_OK;
+}
+
+TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, const tt_image *patches,
+                                int npatches, const tt_lapped_options *options, tt_lapped *result,
+                                tt_error *error)
+{
+    tt__lapper L;
+    tt_lapped_options opts;
+    tt_result r;
+    int max_pastes, stall = 0;
+    if (result) memset(result, 0, sizeof *result);
+    if (!mesh || !face_vectors || !patches || !result)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_lapped_paste: mesh, face_vectors, patches and result must not be NULL");
+    if (npatches < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_lapped_paste: npatches is %d, it must be at least 1", npatches);
+    if (options) opts = *options;
+    else memset(&opts, 0, sizeof opts);
+    if (opts.max_pastes < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_lapped_paste: max_pastes is %d, it must be 0 (default) or more", opts.max_pastes);
+    max_pastes = opts.max_pastes ? opts.max_pastes : TT_LAPPED_MAX_PASTES;
+    memset(&L, 0, sizeof L);
+    L.mesh = mesh;
+    L.patches = patches;
+    L.npatches = npatches;
+    L.field = face_vectors;
+    L.isotropic = opts.isotropic != 0;
+    L.al = opts.allocator.alloc ? &opts.allocator : &mesh->allocator;
+    tt_rng_seed(&L.rng, opts.seed, 0x1a99ed);
+    r = tt__lapper_setup(&L, max_pastes, error);
+    while (r == TT_OK && L.nuncovered > 0) {
+        int seed_face, patch, round;
+        double seed_weight[3];
+        long long added;
+        if (L.npastes >= max_pastes) {
+            r = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
+                         "%d pastes left %d faces uncovered (max_pastes)", L.npastes, L.nuncovered);
+            break;
+        }
+        patch = tt__seed_paste(&L, L.npastes, &seed_face, seed_weight);
+        tt__grow_patch(&L, L.npastes, patch);
+        for (round = 0;; round++) {
+            int before;
+            r = tt__optimize_patch(&L, seed_face, seed_weight, L.anchor + 2 * (size_t)patch);
+            if (r != TT_OK || round + 1 == TT__LAPPED_GROW_ROUNDS) break;
+            before = L.npatch_faces;
+            tt__grow_patch(&L, L.npastes, patch);
+            if (L.npatch_faces == before) break;
+        }
+        if (r != TT_OK) {
+            r = tt__fail(error, r, -1, -1, -1, -1, "out of memory");
+            break;
+        }
+        added = tt__record_paste(&L, patch);
+        if (added < 0) {
+            r = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+            break;
+        }
+        stall = added > 0 ? 0 : stall + 1;
+        if (stall >= TT__LAPPED_STALL_LIMIT) {
+            r = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
+                         "%d pastes in a row covered nothing new; %d faces are left uncovered",
+                         stall, L.nuncovered);
+            break;
+        }
+        if (opts.progress && opts.progress((float)((double)L.covered_samples / (double)L.total_samples),
+                                           opts.progress_user_data)) {
+            r = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled");
+            break;
+        }
+    }
+    if (r == TT_OK) {
+        int removed = tt__remove_hidden(&L);
+        r = tt__lapped_output(&L, removed, result);
+        if (r != TT_OK) {
+            tt_lapped_free(result);
+            r = tt__fail(error, r, -1, -1, -1, -1, "out of memory");
+        }
+    }
+    tt__lapper_free(&L);
+    return r == TT_OK ? tt__ok(error) : r;
+}
+
+TTDEF void tt_lapped_free(tt_lapped *lapped)
+{
+    if (!lapped) return;
+    tt__free(&lapped->allocator, lapped->pastes);
+    tt__free(&lapped->allocator, lapped->faces);
+    tt__free(&lapped->allocator, lapped->uv);
+    memset(lapped, 0, sizeof *lapped);
+}
+
+/* ---- Measuring, packing and baking (Praun et al. Sec. 4) ---------------- */
+
+/* phi(v) for one entry: the combination of the face's corners that gives v
+   (tt__face_vector_weights, exact for v in the face's plane, its
+   least-squares projection otherwise) applied to the entry's corner UVs. A
+   face without a map (edges parallel to float precision) gives 0, which the
+   caller reports as the worst alignment. */
+static void tt__entry_map_vector(const tt_mesh *mesh, int face, const float *uv, const float *vector,
+                                 double out[2])
+{
+    double v[3], w[3];
+    v[0] = vector[0]; v[1] = vector[1]; v[2] = vector[2];
+    tt__face_vector_weights(mesh, face, v, w);
+    out[0] = w[0] * uv[0] + w[1] * uv[2] + w[2] * uv[4];
+    out[1] = w[0] * uv[1] + w[1] * uv[3] + w[2] * uv[5];
+}
+
+/* Alignment of every entry's map with the field (Sec. 3.4's objective, read
+   back from the UVs). phi(T_f) = 0 (a zero field vector, a degenerate face or
+   degenerate UVs) counts as the worst case: angle 180 degrees, scale error 1.
+   With no entries both errors are 0. Non-finite UVs or field vectors of an
+   entry give TT_ERROR_NON_FINITE rather than NaN statistics. */
+TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
+                                  tt_lapped_report *report)
+{
+    const tt_allocator *al;
+    double *scale_error = NULL, angle_sum = 0.0;
+    unsigned char *covered = NULL;
+    int n, e, f, k;
+
+    if (report) memset(report, 0, sizeof *report);
+    if (!mesh || !face_vectors || !lapped || !report) return TT_ERROR_INVALID_ARGUMENT;
+    if (mesh->min_face_size != 3 || mesh->max_face_size != 3) return TT_ERROR_INVALID_ARGUMENT;
+    n = lapped->nentries;
+    if (n < 0 || (n > 0 && (!lapped->faces || !lapped->uv))) return TT_ERROR_INVALID_ARGUMENT;
+    for (e = 0; e < n; e++) {
+        f = lapped->faces[e];
+        if (f < 0 || f >= mesh->nfaces) return TT_ERROR_INDEX_OUT_OF_RANGE;
+        for (k = 0; k < 6; k++)
+            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k])) return TT_ERROR_NON_FINITE;
+        for (k = 0; k < 3; k++)
+            if (!tt__is_finite(face_vectors[3 * (size_t)f + k])) return TT_ERROR_NON_FINITE;
+    }
+
+    al = &mesh->allocator;
+    scale_error = TT__ALLOC(al, double, n);
+    covered = TT__ALLOC(al, unsigned char, mesh->nfaces);
+    if (!scale_error || !covered) {
+        tt__free(al, scale_error);
+        tt__free(al, covered);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    memset(covered, 0, (size_t)mesh->nfaces);
+
+    for (e = 0; e < n; e++) {
+        double image[2], angle, length;
+        f = lapped->faces[e];
+        covered[f] = 1;
+        tt__entry_map_vector(mesh, f, lapped->uv + 6 * (size_t)e, face_vectors + 3 * (size_t)f, image);
+        tt__alignment_error(image, &angle, &length);
+        angle_sum += angle;
+        scale_error[e] = fabs(length - 1.0);
+    }
+    if (n > 0) {
+        report->mean_angle_error = angle_sum / n;
+        report->median_scale_error = tt__median(scale_error, n);
+    }
+    report->mean_overdraw = mesh->nfaces > 0 ? (double)n / mesh->nfaces : 0.0;
+    for (f = 0; f < mesh->nfaces; f++) report->uncovered_faces += !covered[f];
+
+    tt__free(al, scale_error);
+    tt__free(al, covered);
+    return TT_OK;
+}
+
+/* The corner opposite a triangle's longest edge: its largest angle, which
+   becomes the right angle of the atlas image (the least change of shape a
+   right isosceles image can give). The first such corner on ties. */
+static int tt__pack_right_corner(const tt_mesh *mesh, int first)
+{
+    int best = 0, i, k;
+    double best_length = -1.0;
+    for (i = 0; i < 3; i++) {
+        const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[first + (i + 1) % 3];
+        const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[first + (i + 2) % 3];
+        double length = 0.0;
+        for (k = 0; k < 3; k++) length += ((double)q[k] - p[k]) * ((double)q[k] - p[k]);
+        if (length > best_length) {
+            best_length = length;
+            best = i;
+        }
+    }
+    return best;
+}
+
+/* Sec. 4 "rendering with a texture atlas" leaves chart layout to the user;
+   this is the automatic fallback. In cell-local texel coordinates (s right,
+   t up, 0..c) the first triangle of a pair is {s >= m, t >= m, s + t <= c - h}
+   and the second its point reflection through the cell centre, with m = g and
+   h = sqrt(2) g + 1/2. Offsetting each edge outward by g (tt_lapped_bake's
+   gutter) gives s >= 0, t >= 0, s + t <= c - 1/2 and its reflection: gutters
+   stay inside the cell and the two halves stay apart by a band that holds
+   the texel centres with s + t = c, so no texel centre belongs to two
+   gutters. The legs are c - (2 + sqrt 2) g - 1/2 texels; cells below
+   (2 + sqrt 2) g + 4 texels (legs under 3.5 texels) are refused. */
+TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, float *corner_uv, tt_error *error)
+{
+    const double root2 = 1.4142135623730951;
+    int f, npairs, per_side, cell;
+    double need, m, h, leg;
+
+    if (!mesh || !corner_uv)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_atlas_pack_pairs needs a mesh and an output array (got NULL)");
+    if (size < 1 || size > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "atlas size %d is outside 1..%d", size,
+                        TT_MAX_IMAGE_SIZE);
+    if (gutter < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
+    for (f = 0; f < mesh->nfaces; f++) {
+        int count = mesh->face_start[f + 1] - mesh->face_start[f];
+        if (count != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners: the atlas packs triangles only", f, count);
+    }
+
+    npairs = mesh->nfaces / 2 + mesh->nfaces % 2;
+    per_side = (int)ceil(sqrt((double)npairs));
+    while ((double)per_side * per_side < (double)npairs) per_side++;
+    while (per_side > 1 && (double)(per_side - 1) * (per_side - 1) >= (double)npairs) per_side--;
+    cell = size / per_side;
+    need = ceil((2.0 + root2) * gutter + 4.0);
+    if ((double)cell < need) {
+        double smallest = need * per_side;
+        if (smallest <= TT_MAX_IMAGE_SIZE)
+            return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                            "%d triangles need %d x %d cells of at least %.0f texels for gutter %d: size %d "
+                            "gives %d, the smallest size that works is %.0f",
+                            mesh->nfaces, per_side, per_side, need, gutter, size, cell, smallest);
+        return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                        "%d triangles need %d x %d cells of at least %.0f texels for gutter %d: that is %.0f "
+                        "texels, above the limit of %d; lower the gutter",
+                        mesh->nfaces, per_side, per_side, need, gutter, smallest, TT_MAX_IMAGE_SIZE);
+    }
+
+    m = gutter;
+    h = root2 * gutter + 0.5;
+    leg = cell - 2.0 * m - h;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int pair = f / 2, first = mesh->face_start[f], right = tt__pack_right_corner(mesh, first), k;
+        double x0 = (double)(pair % per_side) * cell, y0 = (double)(pair / per_side) * cell;
+        double s[3], t[3];
+        /* Corners right, right+1, right+2 counter-clockwise, as on the surface. */
+        if (f % 2 == 0) {
+            s[0] = m; t[0] = m;
+            s[1] = m + leg; t[1] = m;
+            s[2] = m; t[2] = m + leg;
+        } else {
+            s[0] = cell - m; t[0] = cell - m;
+            s[1] = cell - m - leg; t[1] = cell - m;
+            s[2] = cell - m; t[2] = cell - m - leg;
+        }
+        for (k = 0; k < 3; k++) {
+            int corner = first + (right + k) % 3;
+            /* Cells fill the image from its top-left (row 0 on top); v = 1 - y / size. */
+            corner_uv[2 * (size_t)corner] = (float)((x0 + s[k]) / size);
+            corner_uv[2 * (size_t)corner + 1] = (float)(1.0 - (y0 + cell - t[k]) / size);
+        }
+    }
+    return tt__ok(error);
+}
+
+/* State of one face's bake, shared by its raster callbacks. */
+typedef struct tt__bake {
+    const tt_lapped *lapped;
+    const tt_image *patches;
+    const int *items;           /* pairs (entry, patch) of this face, in paste order */
+    int nitems;
+    double x[3], y[3];          /* the face's atlas triangle, pixels */
+    double inverse_area2;       /* 1 / twice its signed area */
+    double gutter;              /* texels */
+    int inside;                 /* 1: rasterising the triangle itself, 0: its gutter */
+    float *state;               /* per texel: -1 inside a triangle, else distance of the gutter
+                                   that wrote it, +infinity for empty */
+    tt_image *atlas;
+} tt__bake;
+
+/* Distance from (px, py) to the segment from vertex i to vertex j. */
+static double tt__bake_segment_distance(const tt__bake *b, int i, int j, double px, double py)
+{
+    double dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
+    double wx = px - b->x[i], wy = py - b->y[i], length2 = dx * dx + dy * dy, t = 0.0;
+    if (length2 > 0.0) {
+        t = (wx * dx + wy * dy) / length2;
+        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    }
+    wx -= t * dx;
+    wy -= t * dy;
+    return sqrt(wx * wx + wy * wy);
+}
+
+/* Composite the face's pastes at barycentric weights w (Sec. 4: the pastes
+   drawn in order with "over"), premultiplied. Weights outside [0, 1] extend
+   each paste's linear map across the face's edges. */
+static void tt__bake_composite(const tt__bake *b, const double w[3], float out[4])
+{
+    int k, i;
+    out[0] = out[1] = out[2] = out[3] = 0.0f;
+    for (k = 0; k < b->nitems; k++) {
+        const float *uv = b->lapped->uv + 6 * (size_t)b->items[2 * k];
+        const tt_image *patch = b->patches + b->items[2 * k + 1];
+        double u = 0.0, v = 0.0, px, py;
+        float sample[4];
+        for (i = 0; i < 3; i++) {
+            u += w[i] * uv[2 * i];
+            v += w[i] * uv[2 * i + 1];
+        }
+        /* The sampler clamps; clamping here first keeps the float conversion
+           defined for far extrapolations. */
+        px = u * patch->width;
+        py = (1.0 - v) * patch->height;
+        px = px < -1.0 ? -1.0 : (px > patch->width + 1.0 ? patch->width + 1.0 : px);
+        py = py < -1.0 ? -1.0 : (py > patch->height + 1.0 ? patch->height + 1.0 : py);
+        tt_image_sample_bilinear(patch, (float)px, (float)py, sample);
+        tt_rgba_over(out, sample);
+    }
+}
+
+static void tt__bake_texel(int x, int y, const float barycentric[3], void *user_data)
+{
+    tt__bake *b = (tt__bake *)user_data;
+    size_t texel = (size_t)y * (size_t)b->atlas->width + (size_t)x;
+    double px = x + 0.5, py = y + 0.5, w[3];
+    float distance = -1.0f;
+    (void)barycentric;   /* those of the fan triangle in the gutter pass: recomputed for the face */
+    /* Texels inside any triangle keep its colour. */
+    if (!b->inside && b->state[texel] < 0.0f) return;
+    w[0] = ((b->x[1] - px) * (b->y[2] - py) - (b->x[2] - px) * (b->y[1] - py)) * b->inverse_area2;
+    w[1] = ((b->x[2] - px) * (b->y[0] - py) - (b->x[0] - px) * (b->y[2] - py)) * b->inverse_area2;
+    w[2] = 1.0 - w[0] - w[1];
+    if (!b->inside) {
+        /* Between gutters the nearer triangle wins, the later face on ties. */
+        double d = 0.0;
+        if (w[0] < 0.0 || w[1] < 0.0 || w[2] < 0.0) {
+            double d1 = tt__bake_segment_distance(b, 0, 1, px, py);
+            double d2 = tt__bake_segment_distance(b, 1, 2, px, py);
+            double d3 = tt__bake_segment_distance(b, 2, 0, px, py);
+            d = d1 < d2 ? d1 : d2;
+            d = d < d3 ? d : d3;
+        }
+        if (d > b->gutter || (float)d > b->state[texel]) return;
+        distance = (float)d;
+    }
+    b->state[texel] = distance;
+    tt__bake_composite(b, w, b->atlas->pixels + 4 * texel);
+}
+
+/* Keep the part of the convex polygon p (n vertices) where
+   nx * x + ny * y <= limit; returns the new count (at most n + 1). */
+static int tt__bake_clip(const double *p, int n, double nx, double ny, double limit, double *out)
+{
+    int i, count = 0;
+    for (i = 0; i < n; i++) {
+        const double *a = p + 2 * i, *c = p + 2 * ((i + 1) % n);
+        double da = nx * a[0] + ny * a[1] - limit, dc = nx * c[0] + ny * c[1] - limit;
+        if (da <= 0.0) {
+            out[2 * count] = a[0];
+            out[2 * count + 1] = a[1];
+            count++;
+        }
+        if ((da < 0.0 && dc > 0.0) || (da > 0.0 && dc < 0.0)) {
+            double t = da / (da - dc);
+            out[2 * count] = a[0] + t * (c[0] - a[0]);
+            out[2 * count + 1] = a[1] + t * (c[1] - a[1]);
+            count++;
+        }
+    }
+    return count;
+}
+
+/* The texels of one face's gutter: its triangle with every edge moved out by
+   g, intersected with its bounding box grown by g (which cuts off the long
+   mitre spikes of thin triangles) and with the image, rasterised as a fan;
+   the callback keeps texels within g of the triangle. */
+static void tt__bake_gutter(tt__bake *b)
+{
+    double poly[2 * 8], tmp[2 * 8], lo_x, hi_x, lo_y, hi_y, g = b->gutter;
+    int n = 4, i, k;
+    lo_x = hi_x = b->x[0];
+    lo_y = hi_y = b->y[0];
+    for (i = 1; i < 3; i++) {
+        if (b->x[i] < lo_x) lo_x = b->x[i];
+        if (b->x[i] > hi_x) hi_x = b->x[i];
+        if (b->y[i] < lo_y) lo_y = b->y[i];
+        if (b->y[i] > hi_y) hi_y = b->y[i];
+    }
+    lo_x = lo_x - g > 0.0 ? lo_x - g : 0.0;
+    lo_y = lo_y - g > 0.0 ? lo_y - g : 0.0;
+    hi_x = hi_x + g < b->atlas->width ? hi_x + g : (double)b->atlas->width;
+    hi_y = hi_y + g < b->atlas->height ? hi_y + g : (double)b->atlas->height;
+    if (!(lo_x < hi_x && lo_y < hi_y)) return;
+    poly[0] = lo_x; poly[1] = lo_y;
+    poly[2] = hi_x; poly[3] = lo_y;
+    poly[4] = hi_x; poly[5] = hi_y;
+    poly[6] = lo_x; poly[7] = hi_y;
+    for (i = 0; i < 3 && n >= 3; i++) {
+        int j = (i + 1) % 3, o = (i + 2) % 3;
+        double nx = b->y[j] - b->y[i], ny = b->x[i] - b->x[j], length = sqrt(nx * nx + ny * ny);
+        nx /= length;
+        ny /= length;
+        if (nx * (b->x[o] - b->x[i]) + ny * (b->y[o] - b->y[i]) > 0.0) { nx = -nx; ny = -ny; }
+        n = tt__bake_clip(poly, n, nx, ny, nx * b->x[i] + ny * b->y[i] + g, tmp);
+        memcpy(poly, tmp, (size_t)n * 2 * sizeof(double));
+    }
+    for (k = 1; k + 1 < n; k++) {
+        float xy[6];
+        xy[0] = (float)poly[0]; xy[1] = (float)poly[1];
+        xy[2] = (float)poly[2 * k]; xy[3] = (float)poly[2 * k + 1];
+        xy[4] = (float)poly[2 * k + 2]; xy[5] = (float)poly[2 * k + 3];
+        tt_raster_triangle(xy, b->atlas->width, b->atlas->height, tt__bake_texel, b);
+    }
+}
+
+/* A face whose atlas triangle is thinner than this (texels) gets no gutter of
+   its own: extrapolating g texels across it would multiply its barycentrics,
+   and their rounding, by g / height. The final fill covers its surroundings. */
+#define TT__BAKE_MIN_HEIGHT (1.0 / 16.0)
+
+/* Sec. 4 "rendering with a texture atlas": "the texture paste operations are
+   composited into the atlas charts". Per face, its entries in paste order
+   (a CSR list built once), composited at every texel of its atlas triangle
+   and, extrapolated, of its gutter; then un-premultiplied, and every texel
+   still empty takes the colour of the nearest written one (breadth-first over
+   4-neighbours from all written texels at once, O(texels)) so that bilinear
+   filtering and mipmaps at chart borders read chart colours (the sampling
+   problems Sec. 4 lists for atlases). Temporary memory comes from the mesh's
+   allocator, all of it before the atlas is touched. */
+TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, const tt_image *patches,
+                               int npatches, const float *corner_uv, int gutter, tt_image *atlas,
+                               tt_error *error)
+{
+    const tt_allocator *al;
+    tt_result result;
+    tt__bake bake;
+    int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL;
+    float *state = NULL;
+    size_t texels, t, total = 0, head = 0, tail = 0;
+    float empty = tt__infinity();
+    int f, p, e, k, c, width, height;
+
+    if (!mesh || !lapped || !patches || !corner_uv || !atlas)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_lapped_bake needs a mesh, pastes, patches, UVs and an atlas (got NULL)");
+    if (!atlas->pixels || atlas->width <= 0 || atlas->height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the atlas is empty: create it with tt_image_create first");
+    if (atlas->width > TT_MAX_IMAGE_SIZE || atlas->height > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "the atlas is %d x %d texels, above %d",
+                        atlas->width, atlas->height, TT_MAX_IMAGE_SIZE);
+    if (gutter < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
+    if (npatches < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "npatches is %d: need at least 1",
+                        npatches);
+    for (p = 0; p < npatches; p++)
+        if (!patches[p].pixels || patches[p].width <= 0 || patches[p].height <= 0)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "patch %d is empty", p);
+    for (f = 0; f < mesh->nfaces; f++) {
+        int count = mesh->face_start[f + 1] - mesh->face_start[f];
+        if (count != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners: baking needs triangles", f, count);
+    }
+    for (c = 0; c < 2 * mesh->ncorners; c++)
+        if (!tt__is_finite(corner_uv[c]))
+            return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
+                            "corner %d (face %d) has a non-finite atlas UV", c / 2, mesh->corner_face[c / 2]);
+    if (lapped->npastes < 0 || lapped->nentries < 0 || (lapped->npastes > 0 && !lapped->pastes) ||
+        (lapped->nentries > 0 && (!lapped->faces || !lapped->uv)))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the pastes are inconsistent: %d pastes, %d entries, some arrays NULL or counts negative",
+                        lapped->npastes, lapped->nentries);
+    for (e = 0; e < lapped->nentries; e++) {
+        f = lapped->faces[e];
+        if (f < 0 || f >= mesh->nfaces)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, f, -1, -1, -1,
+                            "entry %d names face %d, but the mesh has %d faces", e, f, mesh->nfaces);
+        for (k = 0; k < 6; k++)
+            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k]))
+                return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
+                                "entry %d (face %d) has a non-finite paste UV", e, f);
+    }
+    for (p = 0; p < lapped->npastes; p++) {
+        const tt_paste *paste = lapped->pastes + p;
+        if (paste->patch < 0 || paste->patch >= npatches)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
+                            "paste %d uses patch %d, but there are %d patches", p, paste->patch, npatches);
+        if (paste->first < 0 || paste->nfaces < 0 || paste->first > lapped->nentries - paste->nfaces)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
+                            "paste %d has entries %d..%d, but there are %d entries", p, paste->first,
+                            paste->first + paste->nfaces - 1, lapped->nentries);
+        total += (size_t)paste->nfaces;
+        if (total > 0x3fffffff)
+            return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                            "the pastes draw more than %d face entries", 0x3fffffff);
+    }
+
+    width = atlas->width;
+    height = atlas->height;
+    texels = (size_t)width * (size_t)height;   /* <= 2^30 */
+    al = &mesh->allocator;
+    start = TT__ALLOC(al, int, (size_t)mesh->nfaces + 1);
+    fill = TT__ALLOC(al, int, mesh->nfaces);
+    items = TT__ALLOC(al, int, 2 * total);
+    state = TT__ALLOC(al, float, texels);
+    queue = TT__ALLOC(al, int, texels);
+    if (!start || !fill || !items || !state || !queue) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                          "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
+        goto done;
+    }
+
+    /* Entries by face, in paste order (bucket by face, stable). */
+    memset(start, 0, ((size_t)mesh->nfaces + 1) * sizeof(int));
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++)
+            start[lapped->faces[e] + 1]++;
+    for (f = 0; f < mesh->nfaces; f++) {
+        start[f + 1] += start[f];
+        fill[f] = start[f];
+    }
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) {
+            int slot = fill[lapped->faces[e]]++;
+            items[2 * slot] = e;
+            items[2 * slot + 1] = lapped->pastes[p].patch;
+        }
+
+    for (t = 0; t < texels; t++) state[t] = empty;
+    memset(&bake, 0, sizeof bake);
+    bake.lapped = lapped;
+    bake.patches = patches;
+    bake.state = state;
+    bake.atlas = atlas;
+    /* A gutter wider than the image reaches every texel anyway. */
+    bake.gutter = gutter < width + height ? (double)gutter : (double)(width + height);
+
+    for (f = 0; f < mesh->nfaces; f++) {
+        float xy[6];
+        double area2, longest = 0.0;
+        for (k = 0; k < 3; k++) {
+            int corner = mesh->face_start[f] + k;
+            xy[2 * k] = corner_uv[2 * (size_t)corner] * (float)width;
+            xy[2 * k + 1] = (1.0f - corner_uv[2 * (size_t)corner + 1]) * (float)height;
+            bake.x[k] = xy[2 * k];
+            bake.y[k] = xy[2 * k + 1];
+        }
+        area2 = (bake.x[1] - bake.x[0]) * (bake.y[2] - bake.y[0]) - (bake.x[2] - bake.x[0]) * (bake.y[1] - bake.y[0]);
+        if (!(fabs(area2) > 0.0) || !tt__is_finite_d(area2)) continue;   /* no image: the fill covers it */
+        bake.inverse_area2 = 1.0 / area2;
+        bake.items = items + 2 * (size_t)start[f];
+        bake.nitems = start[f + 1] - start[f];
+        bake.inside = 1;
+        tt_raster_triangle(xy, width, height, tt__bake_texel, &bake);
+        if (bake.gutter <= 0.0) continue;
+        for (k = 0; k < 3; k++) {
+            double dx = bake.x[(k + 1) % 3] - bake.x[k], dy = bake.y[(k + 1) % 3] - bake.y[k];
+            double length = sqrt(dx * dx + dy * dy);
+            if (length > longest) longest = length;
+        }
+        if (fabs(area2) / longest < TT__BAKE_MIN_HEIGHT) continue;
+        bake.inside = 0;
+        tt__bake_gutter(&bake);
+    }
+
+    /* Straight alpha for the written texels; they seed the fill. */
+    for (t = 0; t < texels; t++) {
+        float *px = atlas->pixels + 4 * t;
+        if (!(state[t] < empty)) continue;
+        if (px[3] > 0.0f) {
+            float inverse = 1.0f / px[3];
+            px[0] *= inverse;
+            px[1] *= inverse;
+            px[2] *= inverse;
+        }
+        queue[tail++] = (int)t;
+    }
+    if (tail == 0) memset(atlas->pixels, 0, texels * 4 * sizeof(float));
+    while (head < tail) {
+        int from = queue[head++], x = from % width, y = from / width, side;
+        for (side = 0; side < 4; side++) {
+            int nx = x + (side == 0) - (side == 1), ny = y + (side == 2) - (side == 3), to;
+            if (nx < 0 || nx >= width || ny < 0 || ny >= height) continue;
+            to = ny * width + nx;
+            if (state[to] < empty) continue;
+            state[to] = -1.0f;
+            memcpy(atlas->pixels + 4 * (size_t)to, atlas->pixels + 4 * (size_t)from, 4 * sizeof(float));
+            queue[tail++] = to;
+        }
+    }
+    result = tt__ok(error);
+
+done:
+    tt__free(al, start);
+    tt__free(al, fill);
+    tt__free(al, items);
+    tt__free(al, state);
+    tt__free(al, queue);
     return result;
 }
 

@@ -156,6 +156,39 @@ int main(void)
         EXPECT(tt_image_create(&source, 32, 32, NULL) == TT_OK);
         for (k = 0; k < 32 * 32 * 4; k++) source.pixels[k] = 1.0f;
         EXPECT(tt_make_texture_patch(&source, NULL, NULL, &patch, &err) == TT_OK && patch.width == 32);
+        {
+            /* 7. Lapped textures: paste, measure, pack and bake on the cube
+               split into triangles. */
+            int tri_idx[36], f, c;
+            tt_mesh *tris = NULL;
+            for (f = 0; f < 6; f++)
+                for (c = 0; c < 3; c++) {
+                    tri_idx[6 * f + c] = cube_idx[4 * f + c];
+                    tri_idx[6 * f + 3 + c] = cube_idx[4 * f + (c + 2) % 4];
+                }
+            desc.indices = tri_idx;
+            desc.nfaces = 12;
+            desc.fixed_face_size = 3;
+            EXPECT(tt_mesh_build(&desc, &tris, &err) == TT_OK);
+            if (tris) {
+                float field[36], corner_uv[72];
+                tt_field_options fo;
+                tt_lapped lapped;
+                tt_lapped_report lr;
+                tt_image baked;
+                memset(&fo, 0, sizeof fo);
+                fo.scale = 0.6f;
+                EXPECT(tt_tangent_field(tris, &fo, field, &err) == TT_OK);
+                EXPECT(tt_lapped_paste(tris, field, &patch, 1, NULL, &lapped, &err) == TT_OK);
+                EXPECT(tt_lapped_measure(tris, field, &lapped, &lr) == TT_OK && lr.uncovered_faces == 0);
+                EXPECT(tt_atlas_pack_pairs(tris, 64, 2, corner_uv, &err) == TT_OK);
+                EXPECT(tt_image_create(&baked, 64, 64, NULL) == TT_OK);
+                EXPECT(tt_lapped_bake(tris, &lapped, &patch, 1, corner_uv, 2, &baked, &err) == TT_OK);
+                tt_image_free(&baked);
+                tt_lapped_free(&lapped);
+                tt_mesh_free(tris);
+            }
+        }
         tt_image_free(&patch);
         tt_image_free(&source);
     }
