@@ -4985,6 +4985,11 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 /* Grow-and-solve rounds per paste (Sec. 3.3: "when this occurs, we further
    grow the patch and optimize again"). */
 #define TT__LAPPED_GROW_ROUNDS 3
+/* After regrowing, the patch is solved again only when it grew by more than
+   1/this of its faces. */
+#define TT__LAPPED_RESOLVE_FRACTION 10
+/* Relative residual of the alignment solve: UVs to well under a texel. */
+#define TT__LAPPED_CG_TOLERANCE 1e-5
 /* Consecutive pastes that cover no new sample before the loop gives up. */
 #define TT__LAPPED_STALL_LIMIT 64
 
@@ -5410,7 +5415,7 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
     r = tt_sparse_from_triplets(&A, n, n, L->triplets, nt, L->al, NULL);
     if (r != TT_OK) return r == TT_ERROR_OUT_OF_MEMORY ? r : TT_OK;
     memset(&cg, 0, sizeof cg);
-    cg.tolerance = 1e-7;
+    cg.tolerance = TT__LAPPED_CG_TOLERANCE;
     cg.allocator = *L->al;
     r = tt_cg_solve(&A, b_s, x_s, &cg, NULL, NULL);
     if (r == TT_OK || r == TT_ERROR_NOT_CONVERGED) r = tt_cg_solve(&A, b_t, x_t, &cg, NULL, NULL);
@@ -5909,7 +5914,9 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
             if (r != TT_OK || round + 1 == TT__LAPPED_GROW_ROUNDS) break;
             before = L.npatch_faces;
             tt__grow_patch(&L, L.npastes, patch);
-            if (L.npatch_faces == before) break;
+            /* A few faces more keep their predicted map: a new solve would
+               hardly move the rest, and it is most of the cost. */
+            if (L.npatch_faces - before <= before / TT__LAPPED_RESOLVE_FRACTION) break;
         }
         if (r != TT_OK) {
             r = tt__fail(error, r, -1, -1, -1, -1, "out of memory");

@@ -5,7 +5,7 @@
    figure is the median of several runs after one warm-up run, measured with
    the monotonic clock.
 
-       build/bench            all figures (about half a minute)
+       build/bench            all figures (about a minute)
        build/bench build      only the figures whose name contains "build"
                               (handy under `perf record` or valgrind)
 
@@ -406,6 +406,87 @@ static double run_synth(void *p)
 }
 
 /* Untimed: the meshes really are what the figures claim (closed torus). */
+/* Lapped textures (Praun et al.) end to end on a triangulated torus: the
+   default tangent field and one 256 x 256 splotch patch at the default scale
+   (a tenth of the bounding-box diagonal), field + paste loop timed. */
+typedef struct lapped_ctx {
+    tt_mesh *mesh;
+    const tt_image *patch;
+    float *field;
+    int pastes;
+    double angle, scale, overdraw;
+} lapped_ctx;
+
+static double run_lapped(void *p)
+{
+    lapped_ctx *c = (lapped_ctx *)p;
+    tt_lapped lapped;
+    tt_lapped_options options;
+    tt_error err;
+    tt_result r;
+    double t0 = now_ms(), t1;
+    r = tt_tangent_field(c->mesh, NULL, c->field, &err);
+    if (r != TT_OK) fail("tt_tangent_field", r, &err);
+    memset(&options, 0, sizeof options);
+    options.seed = 1;
+    r = tt_lapped_paste(c->mesh, c->field, c->patch, 1, &options, &lapped, &err);
+    t1 = now_ms();
+    if (r != TT_OK) fail("tt_lapped_paste", r, &err);
+    c->pastes = lapped.npastes;
+    c->angle = lapped.mean_angle_error;
+    c->scale = lapped.median_scale_error;
+    c->overdraw = lapped.mean_overdraw;
+    tt_lapped_free(&lapped);
+    return t1 - t0;
+}
+
+/* The n x n torus grid with every quad split into two triangles. */
+static tt_mesh *make_triangle_torus(int n)
+{
+    grid_mesh quads;
+    tt_mesh_desc d;
+    tt_mesh *mesh;
+    tt_error err;
+    tt_result r;
+    int *tri, f, k;
+    make_torus(&quads, n);
+    tri = (int *)xmalloc(sizeof(int) * 6 * (size_t)quads.nfaces);
+    for (f = 0; f < quads.nfaces; ++f)
+        for (k = 0; k < 3; ++k) {
+            tri[6 * (size_t)f + k] = quads.idx[4 * (size_t)f + k];
+            tri[6 * (size_t)f + 3 + k] = quads.idx[4 * (size_t)f + (k + 2) % 4];
+        }
+    d = grid_desc(&quads);
+    d.indices = tri;
+    d.nfaces = 2 * quads.nfaces;
+    d.fixed_face_size = 3;
+    r = tt_mesh_build(&d, &mesh, &err);
+    if (r != TT_OK) fail("tt_mesh_build (triangle torus)", r, &err);
+    free(tri);
+    free_grid(&quads);
+    return mesh;
+}
+
+static void bench_lapped(const char *name, int n, const tt_image *patch)
+{
+    lapped_ctx lc;
+    char label[64];
+    lc.mesh = make_triangle_torus(n);
+    lc.patch = patch;
+    lc.field = (float *)xmalloc(sizeof(float) * 3 * (size_t)lc.mesh->nfaces);
+    report(name, median_ms(run_lapped, &lc, RUNS_SLOW), "ms");
+    snprintf(label, sizeof label, "%s_pastes", name);
+    report(label, lc.pastes, "pastes");
+    snprintf(label, sizeof label, "%s_overdraw", name);
+    report(label, lc.overdraw, "x");
+    snprintf(label, sizeof label, "%s_angle_error", name);
+    report(label, lc.angle, "deg");
+    snprintf(label, sizeof label, "%s_scale_error", name);
+    report(label, 100.0 * lc.scale, "%");
+    free(lc.field);
+    tt_mesh_free(lc.mesh);
+}
+
 static void check_mesh(const tt_mesh *mesh, const char *what)
 {
     tt_mesh_stats st;
@@ -524,6 +605,18 @@ int main(int argc, char **argv)
             sc.tile_size = 64;
             report("synth_n2_tile64", median_ms(run_synth, &sc, RUNS_SLOW), "ms");
         }
+        tt_image_free(&source);
+    }
+    if (wanted("lapped_20k_faces") || wanted("lapped_100k_faces")) {
+        tt_image source, patch;
+        tt_error err;
+        tt_result r;
+        make_source(&source, 256);
+        r = tt_make_texture_patch(&source, NULL, NULL, &patch, &err);
+        if (r != TT_OK) fail("tt_make_texture_patch", r, &err);
+        if (wanted("lapped_20k_faces")) bench_lapped("lapped_20k_faces", 100, &patch);      /* 20000 triangles */
+        if (wanted("lapped_100k_faces")) bench_lapped("lapped_100k_faces", 224, &patch);    /* 100352 triangles */
+        tt_image_free(&patch);
         tt_image_free(&source);
     }
     return bench_failed;
