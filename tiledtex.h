@@ -5028,6 +5028,7 @@ typedef struct tt__lapper {
     /* per paste (stamped with the paste number, so nothing is cleared) */
     int *face_stamp, *vert_stamp, *edge_stamp, *vert_local;
     int round_stamp;
+    int seed_face, seed_sample;  /* the current paste's seed point */
     double *vert_uv;            /* 2 per vertex */
     int *patch_faces, npatch_faces;
     int *patch_verts, npatch_verts;
@@ -5464,6 +5465,20 @@ static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, 
     return added;
 }
 
+/* Face f got `count` more covered samples; a face now fully covered leaves
+   the list seed points are drawn from. Returns count. */
+static int tt__count_covered(tt__lapper *L, int f, int count)
+{
+    L->covered_count[f] += count;
+    if (count > 0 && L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) {
+        int at = L->uncovered_pos[f], last = L->uncovered[--L->nuncovered];
+        L->uncovered[at] = last;
+        L->uncovered_pos[last] = at;
+        L->uncovered_pos[f] = -1;
+    }
+    return count;
+}
+
 /* Sec. 3.5 and 3.6: record the paste (one entry per patch face, with its
    corner UVs and its alignment error) and update the coverage. Returns the
    number of samples newly covered, or -1 when out of memory. */
@@ -5496,14 +5511,14 @@ static long long tt__record_paste(tt__lapper *L, int patch)
         entry->scale_error = (float)fabs(scale - 1.0);
         if (L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) continue;
         got = tt__mark_opaque_samples(L, f, entry->uv, patch, L->covered + L->sample_start[f]);
-        L->covered_count[f] += got;
-        added += got;
-        if (L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) {
-            int at = L->uncovered_pos[f], last = L->uncovered[--L->nuncovered];
-            L->uncovered[at] = last;
-            L->uncovered_pos[last] = at;
-            L->uncovered_pos[f] = -1;
-        }
+        added += tt__count_covered(L, f, got);
+    }
+    /* The seed point sits on the patch's deepest texel, so it is covered
+       even where the face's map is too stretched for the test above to
+       vouch for the points around it: every paste makes progress. */
+    if (!L->covered[L->sample_start[L->seed_face] + L->seed_sample]) {
+        L->covered[L->sample_start[L->seed_face] + L->seed_sample] = 1;
+        added += tt__count_covered(L, L->seed_face, 1);
     }
     L->covered_samples += added;
     return added;
@@ -5764,6 +5779,8 @@ static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_
         tt__map_vertex(L, v, paste);
     }
     *seed_face = f;
+    L->seed_face = f;
+    L->seed_sample = s;
     return patch;
 }
 
