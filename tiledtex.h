@@ -795,6 +795,8 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         held on the anchor, by tt_cg_solve warm-started from the prediction
         (s and t decouple: one matrix, two right-hand sides); if the new map
         moved an edge of the patch back over the hull, grow and solve again;
+        faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
+        are dropped from the paste, except the seed face;
      5. mark coverage (Sec. 3.6): each face carries a fixed set of sample
         points (its own barycentric raster: tt_raster_triangle on a right
         triangle, about 64 points per patch side, at least 4 and at most 256
@@ -815,10 +817,12 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    texture"). A patch may fold over itself in texture space (allowed by the
    paper); coverage is still counted per face, correctly. */
 
-/* Growth does not cross into a face whose predicted map turns T_f by more than
-   this many degrees, or scales it by more than 1 + this / 90 or less than
-   1 / (1 + this / 90) (a "hard edge", Sec. 3.3). */
-#define TT_LAPPED_MAX_DISTORTION 40.0f
+/* Growth does not cross into a face whose predicted map turns T_f by more
+   than this many degrees, or scales it by more than 1 + this / 90 or less
+   than 1 / (1 + this / 90) (a "hard edge", Sec. 3.3); faces the optimized
+   map leaves that far off are left out of the paste as well. Lower values
+   align better and leave more hard edges. */
+#define TT_LAPPED_MAX_DISTORTION 20.0f
 /* A sample counts as covered under an alpha of at least this. */
 #define TT_LAPPED_OPAQUE 0.99f
 /* The loop refuses meshes whose estimated number of pastes (area over patch
@@ -5496,8 +5500,14 @@ static long long tt__record_paste(tt__lapper *L, int patch)
     L->entries = (tt__entry *)grown;
     for (i = 0; i < L->npatch_faces; i++) {
         int f = L->patch_faces[i], got;
-        tt__entry *entry = &L->entries[L->nentries++];
+        tt__entry *entry;
         double image_t[2], image_s[2], angle, scale;
+        /* Sec. 3.3 stops growth where distortion becomes excessive; the
+           optimization can still leave faces far off the field (near its
+           singularities), and they are left out of the paste too: a hard
+           edge there, and another paste covers them. The seed face stays. */
+        if (f != L->seed_face && tt__lapped_too_distorted(L, f)) continue;
+        entry = &L->entries[L->nentries++];
         for (k = 0; k < 3; k++) {
             const double *p = L->vert_uv + 2 * (size_t)mesh->corner_vert[3 * f + k];
             entry->uv[2 * k] = (float)p[0];
