@@ -29,6 +29,18 @@
        tt_synth_options opt = {0};  opt.layout = layout;  tt_tileset *tiles;
        tt_synthesize_tiles(&photo, &opt, &tiles, &err);          // tiles->levels[0]: the atlas
 
+   QUICK START: lapped textures on a triangle mesh (Praun et al.)
+
+       float *field = malloc(sizeof(float) * 3 * mesh->nfaces);
+       tt_tangent_field(mesh, NULL, field, &err);               // up = +Y, scale 0.1 * diagonal
+       tt_image patch; tt_make_texture_patch(&photo, NULL, NULL, &patch, &err);
+       tt_lapped pastes = {0};
+       tt_lapped_paste(mesh, field, &patch, 1, NULL, &pastes, &err);
+       // draw pastes.pastes[p] in order, alpha-blended: faces pastes.faces[first..],
+       // corner UVs pastes.uv[6 * entry ..] into the patch; or bake them:
+       tt_atlas_pack_pairs(mesh, 2048, 2, corner_uv, &err);      // float corner_uv[6 * ntris]
+       tt_lapped_bake(mesh, &pastes, &patch, 1, corner_uv, 2, &atlas, &err);
+
    Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first
    (the per-corner outputs then line up with the quadrangulated mesh's corners:
    mesh->corner_vert is its index buffer).
@@ -63,6 +75,9 @@
      7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures")
                 - tangent field: texture up and scale per face (Sec. 3.2)
                 - texture patches with soft splotch masks (Sec. 3.1)
+                - the paste loop: surface patches grown over the mesh, aligned
+                  with the field by least squares, until covered (Sec. 3.3-3.6)
+                - runtime pasting lists, alignment measure, atlas and baking (Sec. 4)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H

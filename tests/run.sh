@@ -100,7 +100,7 @@ compile_check "user-defined TT_MALLOC/TT_FREE" user_alloc \
             'tt_image photo; tt_image_create(&photo, 128, 256, NULL);' \
             'for (x = 0; x < 128 * 256 * 4; x++) photo.pixels[x] = (float)((x * 37) % 101) / 100.0f;' \
             '{'
-        sed -n '/QUICK START/,/Triangles or n-gons?/p' tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
+        sed -n '/QUICK START: tile/,/QUICK START: lapped/p' tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
         printf '%s\n' 'if (!tiles || tiles->levels[0].width != 4 * (128 + 8)) return 2;' \
             'tt_tileset_free(tiles); tt_mesh_free(mesh); }' \
             'tt_image_free(&photo); return 0; }'
@@ -110,6 +110,37 @@ compile_check "user-defined TT_MALLOC/TT_FREE" user_alloc \
         pass "docs: the QUICK START in tiledtex.h compiles, runs and makes a 544x544 atlas"
     else
         fail "docs: the QUICK START in tiledtex.h does not compile or run" "$log"
+    fi
+}
+
+# The lapped-textures QUICK START, in a program that gives it a triangle mesh
+# (a 4x4 grid of squares split in two), a photo, UV storage and an atlas.
+{
+    src=$OUT/quickstart_lapped.c
+    {
+        printf '%s\n' '#include <stdio.h>' '#include <stdlib.h>' '#define TILEDTEX_IMPLEMENTATION' \
+            '#include "tiledtex.h"' 'int main(void) {' \
+            'float xyz[75]; int tris[96], i, j, n = 0; float corner_uv[192];' \
+            'tt_mesh_desc desc = {0}; tt_mesh *mesh; tt_error err; tt_image photo, atlas;' \
+            'for (j = 0; j < 5; j++) for (i = 0; i < 5; i++) { xyz[3*(5*j+i)] = (float)i; xyz[3*(5*j+i)+1] = (float)j; xyz[3*(5*j+i)+2] = 0; }' \
+            'for (j = 0; j < 4; j++) for (i = 0; i < 4; i++) { int a = 5*j+i; tris[n++] = a; tris[n++] = a+1; tris[n++] = a+6; tris[n++] = a; tris[n++] = a+6; tris[n++] = a+5; }' \
+            'desc.positions = xyz; desc.nverts = 25; desc.indices = tris; desc.nfaces = 32; desc.fixed_face_size = 3;' \
+            'if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) return 3;' \
+            'tt_image_create(&photo, 64, 64, NULL); tt_image_create(&atlas, 256, 256, NULL);' \
+            'for (i = 0; i < 64 * 64 * 4; i++) photo.pixels[i] = (float)((i * 37) % 101) / 100.0f;' \
+            'for (i = 0; i < 64 * 64; i++) photo.pixels[4 * i + 3] = 1.0f;' \
+            '{'
+        sed -n '/QUICK START: lapped/,/Triangles or n-gons?/p' tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
+        printf '%s\n' 'if (pastes.npastes < 1 || pastes.coverage != 1.0 || atlas.pixels[4 * 300 + 3] != 1.0f) return 2;' \
+            'tt_lapped_free(&pastes); tt_image_free(&patch); free(field); }' \
+            'tt_mesh_free(mesh); tt_image_free(&atlas); tt_image_free(&photo); return 0; }'
+    } >"$src"
+    if log=$(gcc -std=c99 -Wall -Wextra -pedantic -Werror -Wno-declaration-after-statement -I. -g \
+            -fsanitize=address,undefined "$src" -o "$OUT/quickstart_lapped" -lm 2>&1) &&
+        log=$("$OUT/quickstart_lapped" 2>&1); then
+        pass "docs: the lapped-textures QUICK START in tiledtex.h compiles, runs, covers and bakes"
+    else
+        fail "docs: the lapped-textures QUICK START in tiledtex.h does not compile or run" "$log"
     fi
 }
 
