@@ -840,9 +840,14 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
 #define TT_LAPPED_MAX_DISTORTION 20.0f
 /* A sample counts as covered under an alpha of at least this. */
 #define TT_LAPPED_OPAQUE 0.99f
-/* The loop refuses meshes whose estimated number of pastes (area over patch
-   area) exceeds this; options->max_pastes = 0 uses it as the cap. */
-#define TT_LAPPED_MAX_PASTES 1000000
+/* options->max_pastes = 0: this cap (a few minutes of work). */
+#define TT_LAPPED_MAX_PASTES 200000
+/* Pastes take about this many times the surface area over the patch's
+   opaque area (they overlap, and their hulls reach past the opaque part):
+   3 to 5 on every mesh tried. tt_lapped_paste refuses up front when the
+   estimate exceeds max_pastes, and gives up when the loop runs past four
+   times the estimate. */
+#define TT_LAPPED_PASTES_PER_AREA 4.0
 
 typedef struct tt_lapped_options {
     uint64_t seed;              /* random seed: same seed, same result */
@@ -903,8 +908,10 @@ typedef struct tt_lapped {
      TT_ERROR_ZERO_AREA_FACE    a face of zero area (permissive meshes);
      TT_ERROR_TOO_LARGE         the patches are so small next to the mesh that
                                 more than max_pastes would be needed (the
-                                message gives the estimate);
-     TT_ERROR_NOT_CONVERGED     max_pastes pastes did not cover the mesh;
+                                message gives the estimate, see
+                                TT_LAPPED_PASTES_PER_AREA);
+     TT_ERROR_NOT_CONVERGED     max_pastes pastes, or four times the estimate,
+                                did not cover the mesh;
      TT_CANCELLED, TT_ERROR_OUT_OF_MEMORY.
    Deterministic for a seed; time about O(faces * overdraw * CG steps). */
 TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, const tt_image *patches,
@@ -5048,6 +5055,7 @@ typedef struct tt__lapper {
     int *face_stamp, *vert_stamp, *edge_stamp, *vert_local;
     int round_stamp;
     int seed_face, seed_sample;  /* the current paste's seed point */
+    double expected_pastes;     /* TT_LAPPED_PASTES_PER_AREA estimate */
     double *vert_uv;            /* 2 per vertex */
     int *patch_faces, npatch_faces;
     int *patch_verts, npatch_verts;
@@ -5688,20 +5696,22 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
                             "the texture patch (%g mesh units at face %d) is larger than the mesh "
                             "(bounding-box diagonal %g): use a smaller scale", projected, f, diagonal);
-        /* A paste covers at most about the patch's opaque area, |T|^2 times
-           its opaque fraction, so this many pastes at least. */
+        /* Pastes needed: the area over the patch's opaque area, |T|^2
+           times its opaque fraction, times TT_LAPPED_PASTES_PER_AREA. */
         {
             const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
             const float *c = tt__corner_pos(mesh, 3 * f + 2);
             double e1[3], e2[3], cr[3];
             for (k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
             tt__cross3(e1, e2, cr);
-            estimate += 0.5 * sqrt(tt__dot3(cr, cr)) / (projected * projected * opaque_fraction);
+            estimate += TT_LAPPED_PASTES_PER_AREA * 0.5 * sqrt(tt__dot3(cr, cr)) /
+                        (projected * projected * opaque_fraction);
         }
     }
+    L->expected_pastes = estimate;
     if (estimate > max_pastes)
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                        "the texture patches are too small for this mesh: covering it would take at least "
+                        "the texture patches are too small for this mesh: covering it would take about "
                         "%.0f pastes, more than the limit of %d (use a larger scale)", estimate, max_pastes);
     for (f = 0; f < nf; f++) {
         const double *t = L->tangent + 3 * (size_t)f;
@@ -5715,12 +5725,14 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         {
             /* Faces so large next to the patch that even its deepest point
                cannot cover a sample's reach would never be covered. */
-            double r = ceil(longest / projected * TT__LAPPED_SAMPLES_PER_SIDE), reach;
+            double r = ceil(longest / projected * TT__LAPPED_SAMPLES_PER_SIDE), rho;
             L->sample_res[f] = r < TT__LAPPED_MIN_SAMPLE_RES ? TT__LAPPED_MIN_SAMPLE_RES
                              : r > TT__LAPPED_MAX_SAMPLE_RES ? TT__LAPPED_MAX_SAMPLE_RES : (int)r;
-            reach = TT__LAPPED_SAMPLE_REACH * 1.5 * longest / projected * widest / L->sample_res[f] +
-                    TT__LAPPED_TEXEL_REACH;
-            if (reach >= shallowest)
+            rho = TT__LAPPED_SAMPLE_REACH * 1.5 * longest / projected * widest / L->sample_res[f];
+            /* A paste should cover a good disc around its centre, not just
+               its deepest texel: the samples' reach may use a quarter of the
+               depth. */
+            if (rho > 0.25 * shallowest || rho + TT__LAPPED_TEXEL_REACH >= shallowest)
                 return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
                                 "face %d is %.1f texture patches long, too coarse for a patch whose opaque part is "
                                 "%.1f texels deep: subdivide the mesh, or use a larger scale or a larger image",
@@ -5943,9 +5955,11 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
         int seed_face, patch, round;
         double seed_weight[3];
         long long added;
-        if (L.npastes >= max_pastes) {
+        if (L.npastes >= max_pastes || L.npastes > 4.0 * L.expected_pastes + 100.0) {
             r = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
-                         "%d pastes left %d faces uncovered (max_pastes)", L.npastes, L.nuncovered);
+                         "%d pastes (about %.0f expected) left %d faces uncovered: the pastes cover too little "
+                         "of each face (use a larger scale, or subdivide the mesh)",
+                         L.npastes, L.expected_pastes, L.nuncovered);
             break;
         }
         patch = tt__seed_paste(&L, L.npastes, &seed_face, seed_weight);
