@@ -226,6 +226,13 @@ tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
 
+/* Print a tt_mesh_build error about `obj` the OBJ file's way - faces and
+   vertices counted from 1, "mesh.obj:12: face 3 has zero area ..." - and
+   return TOOL_EXIT_FAILURE. The error's face and vertex indices must be the
+   OBJ's. offer_permissive: the command has --permissive, so say when it
+   would accept the mesh. */
+int obj_report_mesh_error(const char *obj_path, const obj_mesh *obj, const tt_error *error, int offer_permissive);
+
 /* What obj_write writes. Only positions and faces are required. */
 typedef struct obj_write_desc {
     const char *comment;            /* "# ..." header lines (may contain '\n'), or NULL */
@@ -254,8 +261,9 @@ typedef struct obj_write_desc {
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
 
 /* Append one MTL material: "newmtl NAME", white diffuse colour, and
-   "map_Kd TEXTURE" when texture is not NULL. */
-void mtl_add_material(tool_buffer *out, const char *name, const char *texture);
+   "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
+   "map_d TEXTURE": the texture's alpha channel is the material's opacity. */
+void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha);
 
 /* The file name part of a path ("out/a.png" -> "a.png"), for mtllib / map_Kd
    lines that must be relative to the OBJ / MTL file. */
