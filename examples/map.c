@@ -288,10 +288,10 @@ int tiled_check_atlas_size(const tiled_options *options)
     int atlas;
     if (tt_tile_layout_resolve(&options->layout, &layout, &error) != TT_OK) return tool_fail("%s", error.message);
     atlas = tt_tile_layout_atlas_size(&layout);
-    if (atlas > TILED_MAX_ATLAS)
+    if (atlas > TOOL_MAX_ATLAS)
         return tool_fail("--colors %d with %d-texel tiles and gutter %d makes a %dx%d atlas; the tool writes at most "
                          "%dx%d (use fewer --colors or a smaller --tile)",
-                         layout.colors, layout.tile_size, layout.gutter, atlas, atlas, TILED_MAX_ATLAS, TILED_MAX_ATLAS);
+                         layout.colors, layout.tile_size, layout.gutter, atlas, atlas, TOOL_MAX_ATLAS, TOOL_MAX_ATLAS);
     return 0;
 }
 

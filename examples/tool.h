@@ -35,6 +35,12 @@
 /* A good size for the `err` buffers the functions below fill. */
 #define TOOL_ERROR_SIZE 512
 
+/* The tool refuses to write textures (atlases, baked textures) wider than
+   this: an 8192^2 PNG is already about 200 MB in memory while it is written,
+   and few renderers take larger textures. (The library's own limit is
+   TT_MAX_IMAGE_SIZE.) */
+#define TOOL_MAX_ATLAS 8192
+
 /* ---------------------------------------------------------------------- */
 /* Subcommands: argv[0] is the subcommand's name ("render"), options follow. */
 /* Each returns the process exit status.                                     */
@@ -113,6 +119,11 @@ int parse_float(const char *option, const char *text, double min, double max, do
 /* "WxH" such as "800x600", each side in [min, max]:
    "tiledtex render: --size wants WxH, got '12'". */
 int parse_size(const char *option, const char *text, int min, int max, int *width, int *height);
+/* Quiet versions for numbers read from files, whose errors name FILE:LINE:
+   a whole string (blanks around allowed) as a long / a finite double;
+   0 on success, -1 without a message otherwise. */
+int parse_whole_long(const char *text, long *out);
+int parse_whole_double(const char *text, double *out);
 /* Exactly `count` comma-separated numbers, such as "X,Y" or "X,Y,W,H". */
 int parse_float_list(const char *option, const char *text, int count, double *out);
 int parse_int_list(const char *option, const char *text, int count, int *out);

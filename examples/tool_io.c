@@ -146,8 +146,7 @@ static int missing_value(const char *option)
     return -1;
 }
 
-/* Parse a whole string as a long integer; 0 on success. */
-static int parse_whole_long(const char *text, long *out)
+int parse_whole_long(const char *text, long *out)
 {
     char *end;
     long value;
@@ -162,7 +161,7 @@ static int parse_whole_long(const char *text, long *out)
     return 0;
 }
 
-static int parse_whole_double(const char *text, double *out)
+int parse_whole_double(const char *text, double *out)
 {
     char *end;
     double value;
