@@ -1,7 +1,7 @@
 /* tool.h - shared pieces of the `tiledtex` command-line tool (not the library).
 
    The tool is a set of subcommands, one file each (synth.c, map.c, tile.c,
-   render.c, generate.c), dispatched by tiledtex.c. They share what is declared
+   lapped.c, render.c, generate.c), dispatched by tiledtex.c. They share what is declared
    here and implemented in tool_io.c:
 
      - one-line error reporting          tool_fail, tool_usage
@@ -49,6 +49,7 @@
 int cmd_synth(int argc, char **argv);
 int cmd_map(int argc, char **argv);
 int cmd_tile(int argc, char **argv);
+int cmd_lapped(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 
