@@ -173,38 +173,26 @@ static void triangle_mesh_free(triangle_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
-/* Read the OBJ and split face (c0, c1, ..., cn-1) into the fan (c0, ci, ci+1),
-   keeping the corners' order, so the triangles face the way the face does. */
+/* Read the OBJ, split its faces into triangle fans and build those. */
 static int triangle_mesh_read(const char *path, triangle_mesh *m)
 {
     char message[TOOL_ERROR_SIZE];
     tt_mesh_desc desc;
     tt_error error;
-    int f, c = 0, t = 0, total = 0;
+    int c, t, total;
     memset(m, 0, sizeof *m);
     if (obj_read(path, &m->obj, message, sizeof message) != 0) return tool_fail("%s", message);
-    for (f = 0; f < m->obj.nfaces; f++) total += m->obj.face_size[f] - 2;     /* < ncorners: no overflow */
-    m->corner = (int *)malloc((size_t)total * 3 * sizeof(int));
-    m->vert = (int *)malloc((size_t)total * 3 * sizeof(int));
-    m->face = (int *)malloc((size_t)total * sizeof(int));
-    m->first_triangle = (int *)malloc((size_t)m->obj.nfaces * sizeof(int));
-    if (!m->corner || !m->vert || !m->face || !m->first_triangle) {
+    total = m->ntriangles = obj_triangle_fans(&m->obj, &m->corner, &m->face);
+    if (total >= 0) {
+        m->vert = (int *)malloc((size_t)total * 3 * sizeof(int));
+        m->first_triangle = (int *)malloc((size_t)m->obj.nfaces * sizeof(int));
+    }
+    if (!m->vert || !m->first_triangle) {
         triangle_mesh_free(m);
-        return tool_fail("out of memory for the %d triangles of %s", total, path);
+        return tool_fail("out of memory for the triangles of %s", path);
     }
-    for (f = 0; f < m->obj.nfaces; f++) {
-        int i, k;
-        m->first_triangle[f] = t;
-        for (i = 1; i + 1 < m->obj.face_size[f]; i++, t++) {
-            m->corner[3 * t] = c;
-            m->corner[3 * t + 1] = c + i;
-            m->corner[3 * t + 2] = c + i + 1;
-            for (k = 0; k < 3; k++) m->vert[3 * t + k] = m->obj.corner_vert[m->corner[3 * t + k]];
-            m->face[t] = f;
-        }
-        c += m->obj.face_size[f];
-    }
-    m->ntriangles = total;
+    for (c = 0; c < 3 * total; c++) m->vert[c] = m->obj.corner_vert[m->corner[c]];
+    for (t = total - 1; t >= 0; t--) m->first_triangle[m->face[t]] = t;
 
     memset(&desc, 0, sizeof desc);
     desc.positions = m->obj.pos;

@@ -301,28 +301,19 @@ static void scene_free(scene *s)
    triangles and convex polygons, which is what meshes are made of. */
 static int scene_triangulate(scene *s)
 {
-    const obj_mesh *mesh = s->mesh;
-    int f, first = 0, t = 0, total = 0;
-    for (f = 0; f < mesh->nfaces; f++) total += mesh->face_size[f] - 2;   /* < ncorners: no overflow */
-    s->triangle_corners = (int *)malloc((size_t)total * 3 * sizeof(int));
-    s->triangle_face = (int *)malloc((size_t)total * sizeof(int));
+    int t, total = obj_triangle_fans(s->mesh, &s->triangle_corners, &s->triangle_face);
+    if (total < 0) return -1;
+    s->ntriangles = total;
     s->triangle_facing = (signed char *)malloc((size_t)total);
     s->triangle_edges = (unsigned char *)malloc((size_t)total);
-    if (!s->triangle_corners || !s->triangle_face || !s->triangle_facing || !s->triangle_edges) return -1;
-    for (f = 0; f < mesh->nfaces; f++) {
-        int i;
-        for (i = 1; i + 1 < mesh->face_size[f]; i++, t++) {
-            s->triangle_corners[3 * t] = first;
-            s->triangle_corners[3 * t + 1] = first + i;
-            s->triangle_corners[3 * t + 2] = first + i + 1;
-            s->triangle_face[t] = f;
-            /* (ci, ci+1) is always a side of the face; (ci+1, c0) and (c0, ci)
-               only for the last and the first triangle of the fan. */
-            s->triangle_edges[t] = (unsigned char)(1u | (i + 2 == mesh->face_size[f] ? 2u : 0u) | (i == 1 ? 4u : 0u));
-        }
-        first += mesh->face_size[f];
+    if (!s->triangle_facing || !s->triangle_edges) return -1;
+    for (t = 0; t < total; t++) {
+        /* Triangle (c0, ci, ci+1): (ci, ci+1) is always a side of the face;
+           (ci+1, c0) and (c0, ci) only for the last and the first of the fan. */
+        const int *corner = s->triangle_corners + 3 * t;
+        int i = corner[1] - corner[0], size = s->mesh->face_size[s->triangle_face[t]];
+        s->triangle_edges[t] = (unsigned char)(1u | (i + 2 == size ? 2u : 0u) | (i == 1 ? 4u : 0u));
     }
-    s->ntriangles = total;
     return 0;
 }
 

@@ -238,6 +238,14 @@ tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
 
+/* Split every face (c0, c1, ..., cn-1) into the fan of triangles (c0, ci,
+   ci+1), in face order: exact for triangles and convex polygons, which is
+   what meshes are made of, and each triangle keeps its face's winding.
+   *corners gets 3 OBJ corners per triangle (indices into corner_vert and
+   corner_uv), *faces the OBJ face of each (both malloc'ed). Returns the
+   number of triangles, or -1 when out of memory. */
+int obj_triangle_fans(const obj_mesh *mesh, int **corners, int **faces);
+
 /* Print a tt_mesh_build error about `obj` the OBJ file's way - faces and
    vertices counted from 1, "mesh.obj:12: face 3 has zero area ..." - and
    return TOOL_EXIT_FAILURE. The error's face and vertex indices must be the

@@ -1211,6 +1211,31 @@ tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags)
     return desc;
 }
 
+int obj_triangle_fans(const obj_mesh *mesh, int **corners, int **faces)
+{
+    int f, first = 0, t = 0, total = 0;
+    for (f = 0; f < mesh->nfaces; f++) total += mesh->face_size[f] - 2;   /* < ncorners: no overflow */
+    *corners = (int *)malloc((size_t)total * 3 * sizeof(int));
+    *faces = (int *)malloc((size_t)total * sizeof(int));
+    if (!*corners || !*faces) {
+        free(*corners);
+        free(*faces);
+        *corners = *faces = NULL;
+        return -1;
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        int i;
+        for (i = 1; i + 1 < mesh->face_size[f]; i++, t++) {
+            (*corners)[3 * t] = first;
+            (*corners)[3 * t + 1] = first + i;
+            (*corners)[3 * t + 2] = first + i + 1;
+            (*faces)[t] = f;
+        }
+        first += mesh->face_size[f];
+    }
+    return total;
+}
+
 /* The library counts faces and vertices from 0, as C arrays do; an OBJ file
    counts them from 1 and a user finds them by line. Say it the file's way,
    from the error's fields. */
