@@ -22,6 +22,7 @@
 */
 #define _POSIX_C_SOURCE 200112L     /* clock_gettime, isatty */
 
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -212,6 +213,28 @@ static int triangle_mesh_read(const char *path, triangle_mesh *m)
     return 0;
 }
 
+/* Report a library error. The library counts faces from 0 and means the
+   triangles; an error about one is said the OBJ's way, at the line of its
+   face and with the face counted from 1. */
+static int report_error(const char *path, const triangle_mesh *m, const tt_error *error)
+{
+    char message[sizeof error->message + 32], pattern[32];
+    const char *at;
+    size_t length;
+    int face;
+    if (error->face < 0 || error->face >= m->ntriangles) return tool_fail("%s: %s", path, error->message);
+    face = m->face[error->face];
+    length = (size_t)snprintf(pattern, sizeof pattern, "face %d", error->face);
+    for (at = strstr(error->message, pattern); at && isdigit((unsigned char)at[length]); at = strstr(at + 1, pattern))
+        continue;
+    if (at)
+        snprintf(message, sizeof message, "%.*sface %d%s", (int)(at - error->message), error->message, face + 1,
+                 at + length);
+    else
+        snprintf(message, sizeof message, "%s", error->message);
+    return tool_fail("%s:%d: %s", path, m->obj.face_line[face], message);
+}
+
 /* ======================================================================== */
 /* The tangent field and its constraints file                               */
 /* ======================================================================== */
@@ -325,7 +348,7 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
             status = tool_fail("%s:%d: the vector is perpendicular to face %d: it must point along the face",
                                options->constraints_path, constraints.line[i], m->face[error.face] + 1);
         else
-            status = tool_fail("%s: %s", options->mesh_path, error.message);
+            status = report_error(options->mesh_path, m, &error);
     }
     constraint_list_free(&constraints);
     return status;
@@ -533,7 +556,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
         goto done;
     }
     if (tt_lapped_bake(m->mesh, lapped, patch, 1, corner_uv, LAPPED_BAKE_GUTTER, &atlas, &error) != TT_OK) {
-        status = tool_fail("%s: %s", *own_uvs ? options->mesh_path : png_path, error.message);
+        status = report_error(options->mesh_path, m, &error);
         goto done;
     }
 
@@ -583,10 +606,7 @@ static int paste(const lapped_options *options, const triangle_mesh *m, const fl
     paste_options.progress_user_data = &progress;
     result = tt_lapped_paste(m->mesh, field, patch, 1, &paste_options, lapped, &error);
     end_progress(&progress);
-    if (result == TT_OK) return 0;
-    if (result == TT_ERROR_TOO_LARGE)
-        return tool_fail("%s: %s (use a larger --scale)", options->mesh_path, error.message);
-    return tool_fail("%s: %s", options->mesh_path, error.message);
+    return result == TT_OK ? 0 : report_error(options->mesh_path, m, &error);
 }
 
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
