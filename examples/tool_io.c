@@ -1000,7 +1000,7 @@ static int parse_face(obj_parser *P)
         if (resolve_index(P, v_index, mesh->nverts, "vertex", token, v_length, &vertex) != 0)
             return -1;
         if (vt_valid) {
-            const char *vt_text = memchr(token, '/', length);
+            const char *vt_text = (const char *)memchr(token, '/', length);
             size_t vt_length = 0;
             vt_text++;
             while (vt_text + vt_length < token_end && vt_text[vt_length] != '/') vt_length++;
