@@ -258,14 +258,14 @@ static void constraint_list_free(constraint_list *list)
    Returns 0, or the exit status after printing "FILE:LINE: ...". */
 static int parse_constraint(char *text, const char *where, const triangle_mesh *m, tt_field_constraint *out)
 {
-    char *token[7];
+    char *token[6];
     double value[6];
     long face;
     int ntokens = 0, k;
-    char *p = strtok(text, " \t\r\v\f");
-    while (p && ntokens < 7) {
-        token[ntokens++] = p;
-        p = strtok(NULL, " \t\r\v\f");
+    char *p;
+    for (p = strtok(text, " \t\r\v\f"); p; p = strtok(NULL, " \t\r\v\f")) {
+        if (ntokens < 6) token[ntokens] = p;
+        ntokens++;
     }
     if (ntokens < 4 || ntokens > 6)
         return tool_fail("%s: wants FACE X Y Z [SIGMA [WEIGHT]], got %d value%s", where, ntokens,
