@@ -519,6 +519,8 @@ printf '# FACE X Y Z [SIGMA [WEIGHT]], faces counted from 1\n\n1 0 1 0\n300 1 0 
 printf '1 0 1 0\n513 0 1 0\n' >constraints_range.txt
 printf '1 0 0 0\n' >constraints_zero.txt
 printf '1 0 1\n' >constraints_short.txt
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' >square.obj
+printf '1 0 0 1\n' >constraints_normal.txt     # along the square's normal
 # a quad whose fan has a zero-area triangle (corners 1, 2, 3 on one line)
 printf 'v 0 0 0\nv 1 0 0\nv 2 0 0\nv 1 1 0\nf 1 2 3 4\n' >lapped_degenerate.obj
 cd "$W" || exit 1
@@ -667,6 +669,9 @@ err_mentions "lapped constraint zero vector: FILE:LINE" 'constraints_zero\.txt:1
 expect_error "lapped --constraints malformed line" lapped ../in/torus.obj ../in/lap.png out \
     --constraints ../in/constraints_short.txt
 err_mentions "lapped constraint malformed: FILE:LINE" 'constraints_short\.txt:1:'
+expect_error "lapped --constraints along the face's normal" lapped ../in/square.obj ../in/lap.png out \
+    --constraints ../in/constraints_normal.txt
+err_mentions "lapped constraint along the normal: FILE:LINE, perpendicular" 'constraints_normal\.txt:1:.*perpendicular'
 expect_error "lapped --constraints missing file" lapped ../in/torus.obj ../in/lap.png out --constraints ../in/nope.txt
 expect_error "lapped --bake 0" lapped ../in/torus.obj ../in/lap.png out --bake 0
 expect_error "lapped --bake 100000" lapped ../in/torus.obj ../in/lap.png out --bake 100000
