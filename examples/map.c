@@ -126,41 +126,6 @@ void tiled_mesh_free(tiled_mesh *mesh)
     memset(mesh, 0, sizeof *mesh);
 }
 
-/* The library counts faces and vertices from 0, as C arrays do; an OBJ file
-   counts them from 1 and a user finds them by line. Say it the file's way,
-   from the error's fields. */
-static int report_mesh_error(const char *obj_path, const obj_mesh *obj, const tt_error *error)
-{
-    int face = error->face, vertex = error->vertex, other = error->other_vertex;
-    int line = face >= 0 && face < obj->nfaces ? obj->face_line[face]
-             : vertex >= 0 && vertex < obj->nverts ? obj->vert_line[vertex] : 0;
-    char where[4096];
-    if (line > 0) snprintf(where, sizeof where, "%s:%d", obj_path, line);
-    else snprintf(where, sizeof where, "%s", obj_path);
-    switch (error->result) {
-    case TT_ERROR_NON_FINITE:
-        return tool_fail("%s: vertex %d has a coordinate that is NaN or infinite", where, vertex + 1);
-    case TT_ERROR_REPEATED_VERTEX:
-        return tool_fail("%s: face %d uses vertex %d twice (or use --permissive)", where, face + 1, vertex + 1);
-    case TT_ERROR_ZERO_AREA_FACE:
-        return tool_fail("%s: face %d has zero area: its corners coincide or lie on one line (or use --permissive)",
-                         where, face + 1);
-    case TT_ERROR_NON_MANIFOLD_EDGE:
-        return tool_fail("%s: the edge between vertices %d and %d is shared by more than two faces (face %d and "
-                         "face %d among them); --permissive cuts it open",
-                         where, vertex + 1, other + 1, face + 1, error->other_face + 1);
-    case TT_ERROR_INCONSISTENT_ORIENTATION:
-        return tool_fail("%s: faces %d and %d both run from vertex %d to vertex %d: one of them is flipped "
-                         "(fix its winding, or use --permissive)",
-                         where, face + 1, error->other_face + 1, vertex + 1, other + 1);
-    case TT_ERROR_NON_MANIFOLD_VERTEX:
-        return tool_fail("%s: vertex %d is non-manifold: surfaces touch at that one point (or use --permissive)",
-                         vertex >= 0 && vertex < obj->nverts ? where : obj_path, vertex + 1);
-    default:
-        return tool_fail("%s: %s", obj_path, error->message);
-    }
-}
-
 /* Replace *mesh by one quadrangulation step of it. */
 static int quadrangulate(tt_mesh **mesh, tt_subdivision scheme, const char *obj_path)
 {
@@ -189,7 +154,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
     desc = obj_mesh_desc(&obj, options->permissive ? TT_MESH_PERMISSIVE : 0);
     out->input_faces = obj.nfaces;
     if (tt_mesh_build(&desc, &out->mesh, &error) != TT_OK) {
-        status = report_mesh_error(obj_path, &obj, &error);
+        status = obj_report_mesh_error(obj_path, &obj, &error, 1);
         obj_free(&obj);
         return status;
     }
@@ -269,7 +234,7 @@ int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture
 {
     tool_buffer text;
     memset(&text, 0, sizeof text);
-    mtl_add_material(&text, "tiled", texture_name);
+    mtl_add_material(&text, "tiled", texture_name, 0);
     if (output_add_buffer(output, mtl_path, &text) != 0) {
         buffer_free(&text);
         return tool_fail("out of memory while writing %s", mtl_path);
@@ -323,10 +288,10 @@ int tiled_check_atlas_size(const tiled_options *options)
     int atlas;
     if (tt_tile_layout_resolve(&options->layout, &layout, &error) != TT_OK) return tool_fail("%s", error.message);
     atlas = tt_tile_layout_atlas_size(&layout);
-    if (atlas > TILED_MAX_ATLAS)
+    if (atlas > TOOL_MAX_ATLAS)
         return tool_fail("--colors %d with %d-texel tiles and gutter %d makes a %dx%d atlas; the tool writes at most "
                          "%dx%d (use fewer --colors or a smaller --tile)",
-                         layout.colors, layout.tile_size, layout.gutter, atlas, atlas, TILED_MAX_ATLAS, TILED_MAX_ATLAS);
+                         layout.colors, layout.tile_size, layout.gutter, atlas, atlas, TOOL_MAX_ATLAS, TOOL_MAX_ATLAS);
     return 0;
 }
 

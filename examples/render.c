@@ -19,13 +19,19 @@
         screen, and simple two-sided lighting.
      6. Resolve: average each 2x2 block of samples into one pixel; save the PNG.
 
-   Pasting meshes (lapped textures: many groups of faces, each an alpha-textured
-   patch drawn over the ones before) fit in between steps 5 and 6: rasterise the
-   patches in file order against the finished z-buffer and blend them `over` the
-   colour buffer. The pieces are ready for it: scene.triangle_face leads to each
-   triangle's OBJ group (obj_mesh.face_group), which is where a per-group
-   texture would be chosen, and shade_sample already returns straight-alpha
-   RGBA for any triangle at any sample position. */
+   Pasting meshes (lapped textures, Praun et al. Sec. 4, as `tiledtex lapped`
+   writes them) draw the same triangle several times, once per paste, each
+   time with the texture patch at other coordinates; drawn in file order
+   with alpha blending, the pastes cover the surface. A mesh is drawn that way
+   when some triangle occurs more than once (the same three vertices). Then
+   the texture is premultiplied by its own alpha (the lapped MTL names the
+   same PNG as map_d) before its mip chain is built, its coordinates are clamped instead
+   of repeated (outside [0,1] is transparent), and between steps 4 and 5 a
+   pasting pass rasterises every triangle again in file order: at each sample
+   whose nearest triangle has the same three vertices, it composites its
+   texture colour `over` an opaque grey base. Step 5 then lights that colour.
+   Only the nearest surface is blended, so a gap between pastes shows grey,
+   never the surface behind. Other meshes are drawn exactly as before. */
 
 #include <math.h>
 #include <stdio.h>
@@ -92,6 +98,18 @@ static void texture_free(mip_texture *texture)
     texture->nlevels = 0;
 }
 
+/* rgb *= alpha, in place: straight colours to premultiplied ones. */
+static void premultiply_alpha(tt_image *image)
+{
+    size_t i, n = (size_t)image->width * (size_t)image->height;
+    for (i = 0; i < n; i++) {
+        float *p = image->pixels + 4 * i;
+        p[0] *= p[3];
+        p[1] *= p[3];
+        p[2] *= p[3];
+    }
+}
+
 /* Takes ownership of `image`. */
 static int texture_build(mip_texture *texture, tt_image *image)
 {
@@ -111,27 +129,43 @@ static int texture_build(mip_texture *texture, tt_image *image)
     return 0;
 }
 
-/* Bilinear lookup at texture coordinates (u, v) that wrap around: the texture
-   repeats outside [0,1]. v = 0 is the bottom of the image (OBJ convention)
-   while row 0 is its top, hence y = (1 - v) * height. */
-static void sample_bilinear_wrapped(const tt_image *image, float u, float v, float rgba[4])
+/* Bilinear lookup at texture coordinates (u, v). v = 0 is the bottom of the
+   image (OBJ convention) while row 0 is its top, hence y = (1 - v) * height.
+   repeat: the texture repeats outside [0,1], as for an ordinary textured
+   mesh. Otherwise it is a texture patch of a pasting mesh, whose coordinates
+   run far outside [0,1] and must be clamped (Praun et al. Sec. 4): outside
+   is transparent, and texels are not blended across the image's border. */
+static void sample_bilinear(const tt_image *image, float u, float v, int repeat, float rgba[4])
 {
     int w = image->width, h = image->height, x0, y0, x1, y1, i;
     float x, y, fx, fy;
     const float *p00, *p10, *p01, *p11;
-    u -= floorf(u);                      /* into [0, 1): the repeat */
-    v -= floorf(v);
+    if (repeat) {
+        u -= floorf(u);                  /* into [0, 1): the repeat */
+        v -= floorf(v);
+    } else if (!(u >= 0.0f && u <= 1.0f && v >= 0.0f && v <= 1.0f)) {
+        rgba[0] = rgba[1] = rgba[2] = rgba[3] = 0.0f;
+        return;
+    }
     x = u * (float)w - 0.5f;             /* texel centres sit at half-integers */
     y = (1.0f - v) * (float)h - 0.5f;
     x0 = (int)floorf(x);
     y0 = (int)floorf(y);
     fx = x - (float)x0;
     fy = y - (float)y0;
-    /* Neighbours across the image's border come from the opposite side. */
-    x0 = (x0 % w + w) % w;
-    y0 = (y0 % h + h) % h;
-    x1 = x0 + 1 == w ? 0 : x0 + 1;
-    y1 = y0 + 1 == h ? 0 : y0 + 1;
+    if (repeat) {
+        /* Neighbours across the image's border come from the opposite side. */
+        x0 = (x0 % w + w) % w;
+        y0 = (y0 % h + h) % h;
+        x1 = x0 + 1 == w ? 0 : x0 + 1;
+        y1 = y0 + 1 == h ? 0 : y0 + 1;
+    } else {
+        /* u, v in [0, 1] put x0, y0 in [-1, w - 1], [-1, h - 1]. */
+        x1 = x0 + 1 < w ? x0 + 1 : w - 1;
+        y1 = y0 + 1 < h ? y0 + 1 : h - 1;
+        x0 = x0 < 0 ? 0 : x0;
+        y0 = y0 < 0 ? 0 : y0;
+    }
     p00 = image->pixels + 4 * ((size_t)y0 * (size_t)w + (size_t)x0);
     p10 = image->pixels + 4 * ((size_t)y0 * (size_t)w + (size_t)x1);
     p01 = image->pixels + 4 * ((size_t)y1 * (size_t)w + (size_t)x0);
@@ -145,21 +179,22 @@ static void sample_bilinear_wrapped(const tt_image *image, float u, float v, flo
 
 /* Trilinear lookup: `texels_per_pixel` says how many level-0 texels one screen
    sample spans; its log2 is the mip level (fractional: blend two levels). */
-static void sample_trilinear(const mip_texture *texture, float u, float v, float texels_per_pixel, float rgba[4])
+static void sample_trilinear(const mip_texture *texture, float u, float v, float texels_per_pixel, int repeat,
+                             float rgba[4])
 {
     float lod = texels_per_pixel > 1.0f ? log2f(texels_per_pixel) : 0.0f;
     float coarse[4], t;
     int level, i;
     if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
     if (!(lod < (float)(texture->nlevels - 1))) {   /* also catches NaN */
-        sample_bilinear_wrapped(&texture->levels[texture->nlevels - 1], u, v, rgba);
+        sample_bilinear(&texture->levels[texture->nlevels - 1], u, v, repeat, rgba);
         return;
     }
     level = (int)lod;
     t = lod - (float)level;
-    sample_bilinear_wrapped(&texture->levels[level], u, v, rgba);
+    sample_bilinear(&texture->levels[level], u, v, repeat, rgba);
     if (t <= 0.0f) return;
-    sample_bilinear_wrapped(&texture->levels[level + 1], u, v, coarse);
+    sample_bilinear(&texture->levels[level + 1], u, v, repeat, coarse);
     for (i = 0; i < 4; i++) rgba[i] += (coarse[i] - rgba[i]) * t;
 }
 
@@ -239,6 +274,8 @@ typedef struct scene {
     int *triangle_corners;      /* 3 per triangle: corners of the OBJ (index into corner_vert / corner_uv) */
     int *triangle_face;         /* the OBJ face each triangle comes from */
     unsigned char *triangle_edges; /* bit k: the edge opposite corner k is an edge of the OBJ face */
+    int *triangle_shape;        /* the first triangle with the same three vertices (often itself) */
+    int pasting;                /* some triangle is drawn more than once: a pasting mesh */
     signed char *triangle_facing; /* +1: the camera sees the side the winding calls "outside", -1: the inside */
     float *corner_normal;       /* 3 per OBJ corner, unit length */
     float *screen;              /* 3 per vertex: x and y in samples, then q = 1 / depth */
@@ -253,6 +290,7 @@ static void scene_free(scene *s)
     free(s->triangle_corners);
     free(s->triangle_face);
     free(s->triangle_edges);
+    free(s->triangle_shape);
     free(s->triangle_facing);
     free(s->corner_normal);
     free(s->screen);
@@ -263,28 +301,67 @@ static void scene_free(scene *s)
    triangles and convex polygons, which is what meshes are made of. */
 static int scene_triangulate(scene *s)
 {
-    const obj_mesh *mesh = s->mesh;
-    int f, first = 0, t = 0, total = 0;
-    for (f = 0; f < mesh->nfaces; f++) total += mesh->face_size[f] - 2;   /* < ncorners: no overflow */
-    s->triangle_corners = (int *)malloc((size_t)total * 3 * sizeof(int));
-    s->triangle_face = (int *)malloc((size_t)total * sizeof(int));
+    int t, total = obj_triangle_fans(s->mesh, &s->triangle_corners, &s->triangle_face);
+    if (total < 0) return -1;
+    s->ntriangles = total;
     s->triangle_facing = (signed char *)malloc((size_t)total);
     s->triangle_edges = (unsigned char *)malloc((size_t)total);
-    if (!s->triangle_corners || !s->triangle_face || !s->triangle_facing || !s->triangle_edges) return -1;
-    for (f = 0; f < mesh->nfaces; f++) {
-        int i;
-        for (i = 1; i + 1 < mesh->face_size[f]; i++, t++) {
-            s->triangle_corners[3 * t] = first;
-            s->triangle_corners[3 * t + 1] = first + i;
-            s->triangle_corners[3 * t + 2] = first + i + 1;
-            s->triangle_face[t] = f;
-            /* (ci, ci+1) is always a side of the face; (ci+1, c0) and (c0, ci)
-               only for the last and the first triangle of the fan. */
-            s->triangle_edges[t] = (unsigned char)(1u | (i + 2 == mesh->face_size[f] ? 2u : 0u) | (i == 1 ? 4u : 0u));
-        }
-        first += mesh->face_size[f];
+    if (!s->triangle_facing || !s->triangle_edges) return -1;
+    for (t = 0; t < total; t++) {
+        /* Triangle (c0, ci, ci+1): (ci, ci+1) is always a side of the face;
+           (ci+1, c0) and (c0, ci) only for the last and the first of the fan. */
+        const int *corner = s->triangle_corners + 3 * t;
+        int i = corner[1] - corner[0], size = s->mesh->face_size[s->triangle_face[t]];
+        s->triangle_edges[t] = (unsigned char)(1u | (i + 2 == size ? 2u : 0u) | (i == 1 ? 4u : 0u));
     }
-    s->ntriangles = total;
+    return 0;
+}
+
+/* Triangles named by their vertices, sorted so that copies lie together. */
+typedef struct triangle_key {
+    int vertex[3];              /* ascending */
+    int triangle;
+} triangle_key;
+
+static int compare_triangle_keys(const void *a, const void *b)
+{
+    const triangle_key *x = (const triangle_key *)a, *y = (const triangle_key *)b;
+    int k;
+    for (k = 0; k < 3; k++)
+        if (x->vertex[k] != y->vertex[k]) return x->vertex[k] < y->vertex[k] ? -1 : 1;
+    return (x->triangle > y->triangle) - (x->triangle < y->triangle);
+}
+
+/* A pasting mesh (lapped textures, Praun et al. Sec. 4) draws the same
+   triangle once per paste that covers it, each time with other texture
+   coordinates. Give every triangle the first triangle of the same three
+   vertices, whatever their order; there is pasting when one is not itself. */
+static int scene_find_pastes(scene *s)
+{
+    const obj_mesh *mesh = s->mesh;
+    triangle_key *keys = (triangle_key *)malloc((size_t)s->ntriangles * sizeof(triangle_key));
+    int t, first = 0;
+    s->triangle_shape = (int *)malloc((size_t)s->ntriangles * sizeof(int));
+    if (!keys || !s->triangle_shape) {
+        free(keys);
+        return -1;
+    }
+    for (t = 0; t < s->ntriangles; t++) {
+        int *v = keys[t].vertex, k, swap;
+        for (k = 0; k < 3; k++) v[k] = mesh->corner_vert[s->triangle_corners[3 * t + k]];
+        if (v[0] > v[1]) { swap = v[0]; v[0] = v[1]; v[1] = swap; }
+        if (v[1] > v[2]) { swap = v[1]; v[1] = v[2]; v[2] = swap; }
+        if (v[0] > v[1]) { swap = v[0]; v[0] = v[1]; v[1] = swap; }
+        keys[t].triangle = t;
+    }
+    qsort(keys, (size_t)s->ntriangles, sizeof(triangle_key), compare_triangle_keys);
+    s->pasting = 0;
+    for (t = 0; t < s->ntriangles; t++) {
+        if (t > 0 && memcmp(keys[t].vertex, keys[first].vertex, sizeof keys[t].vertex) != 0) first = t;
+        s->triangle_shape[keys[t].triangle] = keys[first].triangle;
+        if (t != first) s->pasting = 1;
+    }
+    free(keys);
     return 0;
 }
 
@@ -427,9 +504,10 @@ typedef struct sample_buffer {
     float *depth;               /* q = 1 / depth of the nearest surface; 0 = nothing */
     int *triangle;              /* the nearest triangle, -1 = background */
     float *color;               /* 3 per sample, RGB */
+    float *paste;               /* pasting meshes only: 4 per sample, the pastes composited, premultiplied */
 } sample_buffer;
 
-static int samples_create(sample_buffer *b, int width, int height)
+static int samples_create(sample_buffer *b, int width, int height, int pasting)
 {
     size_t n = (size_t)width * (size_t)height, i;
     b->width = width;
@@ -437,7 +515,8 @@ static int samples_create(sample_buffer *b, int width, int height)
     b->depth = (float *)calloc(n, sizeof(float));
     b->triangle = (int *)malloc(n * sizeof(int));
     b->color = (float *)malloc(n * 3 * sizeof(float));
-    if (!b->depth || !b->triangle || !b->color) return -1;
+    b->paste = pasting ? (float *)malloc(n * 4 * sizeof(float)) : NULL;
+    if (!b->depth || !b->triangle || !b->color || (pasting && !b->paste)) return -1;
     for (i = 0; i < n; i++) b->triangle[i] = -1;
     return 0;
 }
@@ -447,6 +526,7 @@ static void samples_free(sample_buffer *b)
     free(b->depth);
     free(b->triangle);
     free(b->color);
+    free(b->paste);
     memset(b, 0, sizeof *b);
 }
 
@@ -472,22 +552,30 @@ static void visibility_sample(int x, int y, const float barycentric[3], void *us
     }
 }
 
+/* Triangle t's corners on the sample grid (xy) and their q = 1 / depth.
+   Returns 0 when a corner lies behind the camera, which cannot happen with
+   the orbit camera but would make the triangle meaningless. */
+static int triangle_on_screen(const scene *s, int t, float xy[6], float q[3])
+{
+    int k, usable = 1;
+    for (k = 0; k < 3; k++) {
+        const float *p = s->screen + 3 * s->mesh->corner_vert[s->triangle_corners[3 * t + k]];
+        xy[2 * k] = p[0];
+        xy[2 * k + 1] = p[1];
+        q[k] = p[2];
+        if (!(p[2] > 0.0f)) usable = 0;
+    }
+    return usable;
+}
+
 static void draw_visibility(const scene *s, sample_buffer *samples)
 {
     visibility_job job;
-    int t, k;
+    int t;
     job.samples = samples;
     for (t = 0; t < s->ntriangles; t++) {
         float xy[6];
-        int usable = 1;
-        for (k = 0; k < 3; k++) {
-            const float *p = s->screen + 3 * s->mesh->corner_vert[s->triangle_corners[3 * t + k]];
-            xy[2 * k] = p[0];
-            xy[2 * k + 1] = p[1];
-            job.q[k] = p[2];
-            if (!(p[2] > 0.0f)) usable = 0;     /* behind the camera: cannot happen with the orbit camera */
-        }
-        if (!usable) continue;
+        if (!triangle_on_screen(s, t, xy, job.q)) continue;
         job.triangle = t;
         tt_raster_triangle(xy, samples->width, samples->height, visibility_sample, &job);
     }
@@ -497,20 +585,27 @@ static void draw_visibility(const scene *s, sample_buffer *samples)
 /* Pass 2: shading                                                          */
 /* ======================================================================== */
 
-/* The colour of triangle t at sample position (px, py), straight alpha. */
-static void shade_sample(const scene *s, int t, float px, float py, float rgba[4])
-{
-    const obj_mesh *mesh = s->mesh;
-    const int *corner = s->triangle_corners + 3 * t;
-    const float *p0 = s->screen + 3 * mesh->corner_vert[corner[0]];
-    const float *p1 = s->screen + 3 * mesh->corner_vert[corner[1]];
-    const float *p2 = s->screen + 3 * mesh->corner_vert[corner[2]];
-    float b[3], dbdx[3], dbdy[3], w[3], q, qx, qy, area, light;
-    vec3 normal = vec3_make(0.0f, 0.0f, 0.0f);
-    int k;
+/* Where a sample lies on a triangle: its screen-space barycentrics b, how
+   they change per sample step in x and y (constant over the triangle), and
+   w, the true (perspective-correct) weights of the corners there. */
+typedef struct surface_point {
+    const float *corner[3];     /* the corners' screen x, y, q */
+    float b[3], dbdx[3], dbdy[3];
+    float q, qx, qy;            /* 1 / depth and its steps in x and y */
+    float w[3];
+} surface_point;
 
-    /* Screen-space barycentrics of the sample and how they change per sample
-       step in x and y (constant over the triangle). */
+static void locate_sample(const scene *s, int t, float px, float py, surface_point *point)
+{
+    const int *corner = s->triangle_corners + 3 * t;
+    const float *p0 = s->screen + 3 * s->mesh->corner_vert[corner[0]];
+    const float *p1 = s->screen + 3 * s->mesh->corner_vert[corner[1]];
+    const float *p2 = s->screen + 3 * s->mesh->corner_vert[corner[2]];
+    float *b = point->b, *dbdx = point->dbdx, *dbdy = point->dbdy, area, q;
+
+    point->corner[0] = p0;
+    point->corner[1] = p1;
+    point->corner[2] = p2;
     area = (p1[1] - p2[1]) * (p0[0] - p2[0]) + (p2[0] - p1[0]) * (p0[1] - p2[1]);
     if (area == 0.0f) area = 1e-20f;
     dbdx[0] = (p1[1] - p2[1]) / area;  dbdy[0] = (p2[0] - p1[0]) / area;
@@ -521,17 +616,24 @@ static void shade_sample(const scene *s, int t, float px, float py, float rgba[4
     b[2] = 1.0f - b[0] - b[1];
 
     /* Perspective correction: attributes divided by depth (times q) are linear
-       on screen, so interpolate a*q and q, then divide. w[k] are the true
-       weights of the corners at this point of the surface. */
+       on screen, so interpolate a*q and q, then divide. */
     q = b[0] * p0[2] + b[1] * p1[2] + b[2] * p2[2];
-    qx = dbdx[0] * p0[2] + dbdx[1] * p1[2] + dbdx[2] * p2[2];
-    qy = dbdy[0] * p0[2] + dbdy[1] * p1[2] + dbdy[2] * p2[2];
+    point->qx = dbdx[0] * p0[2] + dbdx[1] * p1[2] + dbdx[2] * p2[2];
+    point->qy = dbdy[0] * p0[2] + dbdy[1] * p1[2] + dbdy[2] * p2[2];
     if (!(q > 0.0f)) q = 1e-20f;
-    w[0] = b[0] * p0[2] / q;
-    w[1] = b[1] * p1[2] / q;
-    w[2] = b[2] * p2[2] / q;
+    point->q = q;
+    point->w[0] = b[0] * p0[2] / q;
+    point->w[1] = b[1] * p1[2] / q;
+    point->w[2] = b[2] * p2[2] / q;
+}
 
-    /* Colour: the texture, or grey when a corner has no UV. */
+/* Triangle t's texture colour at a point: the texture (straight alpha, or
+   premultiplied for a pasting mesh, whose texture is premultiplied), or
+   opaque grey when a corner has no UV. */
+static void texture_color(const scene *s, int t, const surface_point *point, float rgba[4])
+{
+    const obj_mesh *mesh = s->mesh;
+    const int *corner = s->triangle_corners + 3 * t;
     rgba[0] = rgba[1] = rgba[2] = UNTEXTURED_GREY;
     rgba[3] = 1.0f;
     if (s->texture && mesh->corner_uv && mesh->corner_uv[corner[0]] >= 0 && mesh->corner_uv[corner[1]] >= 0 &&
@@ -539,6 +641,9 @@ static void shade_sample(const scene *s, int t, float px, float py, float rgba[4
         const float *uv0 = mesh->uv + 2 * mesh->corner_uv[corner[0]];
         const float *uv1 = mesh->uv + 2 * mesh->corner_uv[corner[1]];
         const float *uv2 = mesh->uv + 2 * mesh->corner_uv[corner[2]];
+        const float *w = point->w, *dbdx = point->dbdx, *dbdy = point->dbdy;
+        const float *p0 = point->corner[0], *p1 = point->corner[1], *p2 = point->corner[2];
+        float q = point->q, qx = point->qx, qy = point->qy;
         float u = w[0] * uv0[0] + w[1] * uv1[0] + w[2] * uv2[0];
         float v = w[0] * uv0[1] + w[1] * uv1[1] + w[2] * uv2[1];
         /* d(u)/dx = (d(u q)/dx - u dq/dx) / q, the quotient rule on u = (u q) / q. */
@@ -551,30 +656,84 @@ static void shade_sample(const scene *s, int t, float px, float py, float rgba[4
         float dudy = (uqy - u * qy) / q * (float)base->width, dvdy = (vqy - v * qy) / q * (float)base->height;
         /* The footprint of one sample in texels: the longer of its two sides. */
         float footprint = sqrtf(fmaxf(dudx * dudx + dvdx * dvdx, dudy * dudy + dvdy * dvdy));
-        sample_trilinear(s->texture, u, v, footprint, rgba);
+        sample_trilinear(s->texture, u, v, footprint, !s->pasting, rgba);
     }
+}
 
-    /* Lighting: ambient plus two directional lights fixed to the camera,
-       with the normal turned towards the viewer (two-sided). */
+/* Light an RGB colour on triangle t at a point, and draw the wireframe. */
+static void light_sample(const scene *s, int t, const surface_point *point, float rgb[3])
+{
+    const int *corner = s->triangle_corners + 3 * t;
+    vec3 normal = vec3_make(0.0f, 0.0f, 0.0f);
+    float light;
+    int k;
+
+    /* Ambient plus two directional lights fixed to the camera, with the
+       normal turned towards the viewer (two-sided). */
     for (k = 0; k < 3; k++) {
         const float *n = s->corner_normal + 3 * corner[k];
-        normal = vec3_add(normal, vec3_scale(vec3_make(n[0], n[1], n[2]), w[k]));
+        normal = vec3_add(normal, vec3_scale(vec3_make(n[0], n[1], n[2]), point->w[k]));
     }
     normal = vec3_scale(vec3_normalize(normal), (float)s->triangle_facing[t]);
     light = 0.32f + 0.72f * fmaxf(0.0f, vec3_dot(normal, s->light_key)) +
             0.22f * fmaxf(0.0f, vec3_dot(normal, s->light_fill));
-    for (k = 0; k < 3; k++) rgba[k] *= light;
+    for (k = 0; k < 3; k++) rgb[k] *= light;
 
     /* Wireframe: b[k] / |grad b[k]| is the distance in samples to the edge
        opposite corner k; darken within a line's width of a face's edge. */
     if (s->wireframe) {
         float ink = 0.0f;
         for (k = 0; k < 3; k++) {
-            float gradient = sqrtf(dbdx[k] * dbdx[k] + dbdy[k] * dbdy[k]);
+            float gradient = sqrtf(point->dbdx[k] * point->dbdx[k] + point->dbdy[k] * point->dbdy[k]);
             if ((s->triangle_edges[t] >> k) & 1u && gradient > 0.0f)
-                ink = fmaxf(ink, 1.0f - fminf(1.0f, fmaxf(0.0f, b[k] / gradient - 0.6f) / 0.8f));
+                ink = fmaxf(ink, 1.0f - fminf(1.0f, fmaxf(0.0f, point->b[k] / gradient - 0.6f) / 0.8f));
         }
-        for (k = 0; k < 3; k++) rgba[k] = rgba[k] * (1.0f - 0.85f * ink) + 0.05f * ink;
+        for (k = 0; k < 3; k++) rgb[k] = rgb[k] * (1.0f - 0.85f * ink) + 0.05f * ink;
+    }
+}
+
+/* Pasting meshes: every triangle again, in file order. Where the nearest
+   surface at a sample is this very triangle (this copy or another paste of
+   it), its texture colour goes `over` what the earlier pastes left there. */
+typedef struct paste_job {
+    const scene *s;
+    sample_buffer *samples;
+    int triangle;
+} paste_job;
+
+static void paste_sample(int x, int y, const float barycentric[3], void *user_data)
+{
+    paste_job *job = (paste_job *)user_data;
+    size_t i = (size_t)y * (size_t)job->samples->width + (size_t)x;
+    int nearest = job->samples->triangle[i];
+    surface_point point;
+    float rgba[4];
+    (void)barycentric;
+    if (nearest < 0 || job->s->triangle_shape[nearest] != job->s->triangle_shape[job->triangle]) return;
+    locate_sample(job->s, job->triangle, (float)x + 0.5f, (float)y + 0.5f, &point);
+    texture_color(job->s, job->triangle, &point, rgba);
+    tt_rgba_over(job->samples->paste + 4 * i, rgba);
+}
+
+static void draw_pastes(const scene *s, sample_buffer *samples)
+{
+    paste_job job;
+    size_t i, n = (size_t)samples->width * (size_t)samples->height;
+    int t;
+    /* An opaque grey base: where the pastes leave a gap, the surface shows
+       as an untextured one would. */
+    for (i = 0; i < n; i++) {
+        float *base = samples->paste + 4 * i;
+        base[0] = base[1] = base[2] = UNTEXTURED_GREY;
+        base[3] = 1.0f;
+    }
+    job.s = s;
+    job.samples = samples;
+    for (t = 0; t < s->ntriangles; t++) {
+        float xy[6], q[3];
+        if (!triangle_on_screen(s, t, xy, q)) continue;
+        job.triangle = t;
+        tt_raster_triangle(xy, samples->width, samples->height, paste_sample, &job);
     }
 }
 
@@ -597,12 +756,15 @@ static void shade_samples(const scene *s, sample_buffer *samples)
             size_t i = (size_t)y * (size_t)samples->width + (size_t)x;
             float *out = samples->color + 3 * i, rgba[4];
             int t = samples->triangle[i], k;
+            surface_point point;
             if (t < 0) {
                 memcpy(out, background, sizeof background);
                 continue;
             }
-            shade_sample(s, t, (float)x + 0.5f, (float)y + 0.5f, rgba);
-            /* Opaque surfaces: alpha is ignored here; a pasting pass would blend. */
+            locate_sample(s, t, (float)x + 0.5f, (float)y + 0.5f, &point);
+            if (samples->paste) memcpy(rgba, samples->paste + 4 * i, sizeof rgba);   /* opaque: over grey */
+            else texture_color(s, t, &point, rgba);     /* opaque surfaces: alpha is ignored */
+            light_sample(s, t, &point, rgba);
             for (k = 0; k < 3; k++) out[k] = rgba[k];
         }
     }
@@ -647,6 +809,11 @@ static void print_render_help(void)
            "texture coordinates (vt) and save the picture as OUT.png. Faces without texture\n"
            "coordinates are drawn in grey. The camera looks at the whole model; texture\n"
            "coordinates outside [0,1] repeat the texture.\n"
+           "\n"
+           "Pasting meshes (from 'tiledtex lapped'), where the same triangle occurs several times,\n"
+           "are drawn as the paper draws them: each occurrence in file order, blended over the\n"
+           "ones before through TEXTURE's alpha, which is the texture patch; its coordinates\n"
+           "are clamped, not repeated.\n"
            "\n"
            "  --size WxH    picture size in pixels, each side up to %d (default %dx%d)\n"
            "  --yaw DEG     turn the camera around the model's up axis (default 30)\n"
@@ -715,11 +882,7 @@ int cmd_render(int argc, char **argv)
     memset(&picture, 0, sizeof picture);
     if (obj_read(positional[0], &mesh, err, sizeof err) != 0) return tool_fail("%s", err);
     if (image_load(positional[1], &image, err, sizeof err) != 0) {
-        obj_free(&mesh);
-        return tool_fail("%s", err);
-    }
-    if (texture_build(&texture, &image) != 0) {
-        tool_fail("out of memory while preparing the texture");
+        tool_fail("%s", err);
         goto done;
     }
     if (mesh_bounding_sphere(&mesh, &centre, &radius, &bad_vertex) != 0) {
@@ -728,6 +891,17 @@ int cmd_render(int argc, char **argv)
     }
 
     s.mesh = &mesh;
+    if (scene_triangulate(&s) != 0 || scene_find_pastes(&s) != 0) {
+        tool_fail("out of memory while rendering %s", positional[0]);
+        goto done;
+    }
+    /* A pasting mesh blends its texture, and blending, like mip-mapping,
+       needs premultiplied colours (or transparent texels bleed their colour). */
+    if (s.pasting) premultiply_alpha(&image);
+    if (texture_build(&texture, &image) != 0) {
+        tool_fail("out of memory while preparing the texture");
+        goto done;
+    }
     s.texture = &texture;
     s.width = width * SUPERSAMPLING;
     s.height = height * SUPERSAMPLING;
@@ -737,13 +911,14 @@ int cmd_render(int argc, char **argv)
     s.light_key = vec3_normalize(vec3_add(vec3_add(vec3_scale(cam.right, -0.45f), vec3_scale(cam.up, 0.6f)),
                                           vec3_scale(cam.forward, -0.75f)));
     s.light_fill = vec3_normalize(vec3_add(vec3_scale(cam.right, 0.8f), vec3_scale(cam.forward, -0.4f)));
-    if (scene_triangulate(&s) != 0 || scene_compute_normals(&s) != 0 || scene_project(&s, &cam) != 0 ||
-        samples_create(&samples, s.width, s.height) != 0) {
+    if (scene_compute_normals(&s) != 0 || scene_project(&s, &cam) != 0 ||
+        samples_create(&samples, s.width, s.height, s.pasting) != 0) {
         tool_fail("out of memory while rendering %s", positional[0]);
         goto done;
     }
 
     draw_visibility(&s, &samples);
+    if (s.pasting) draw_pastes(&s, &samples);
     shade_samples(&s, &samples);
     if (resolve(&samples, &picture) != 0) {
         tool_fail("out of memory while rendering %s", positional[0]);
@@ -763,6 +938,7 @@ done:
     samples_free(&samples);
     scene_free(&s);
     texture_free(&texture);
+    tt_image_free(&image);
     obj_free(&mesh);
     return status;
 }

@@ -42,9 +42,9 @@ int tiled_fit_tile_size(int width, int height, int colors, int gutter)
        to move, so synthesis can choose an inconspicuous line for the edges
        (with h = 2S exactly there is only one) and varied backgrounds. With
        more colors the atlas, (2n)^2 tiles a side, must stay within
-       TILED_MAX_ATLAS. Multiples of 8 keep mip levels per tile. */
+       TOOL_MAX_ATLAS. Multiples of 8 keep mip levels per tile. */
     int side = width < height ? width : height, n = colors > 0 ? colors : 1;
-    int fit = 2 * side / 5, fits_atlas = TILED_MAX_ATLAS / (4 * n * n) - 2 * gutter;
+    int fit = 2 * side / 5, fits_atlas = TOOL_MAX_ATLAS / (4 * n * n) - 2 * gutter;
     if (fit > TT_DEFAULT_TILE_SIZE) fit = TT_DEFAULT_TILE_SIZE;
     if (fit > fits_atlas) fit = fits_atlas;
     if (fit >= 8) return fit - fit % 8;

@@ -23,11 +23,6 @@ enum {
    about 1.5 GB of text). */
 #define TILED_MAX_QUADS (1 << 24)
 
-/* The tool refuses atlases wider than this: an 8192^2 PNG is already about
-   200 MB in memory while it is written, and few renderers take larger
-   textures. (The library's own limit is TT_MAX_IMAGE_SIZE.) */
-#define TILED_MAX_ATLAS 8192
-
 typedef struct tiled_options {
     tt_tile_layout layout;       /* zeros = the library's defaults */
     int tile_size_given;
@@ -86,7 +81,7 @@ int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture
 
 /* The tile size `tile` picks when none is given: TT_DEFAULT_TILE_SIZE, or for
    a small image a multiple of 8 up to 2/5 of its smaller side, or less so the
-   atlas of `colors` fits TILED_MAX_ATLAS; 4 for a tiny image; 0 when even a
+   atlas of `colors` fits TOOL_MAX_ATLAS; 4 for a tiny image; 0 when even a
    4 x 8 edge window does not fit. */
 int tiled_fit_tile_size(int width, int height, int colors, int gutter);
 

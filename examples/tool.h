@@ -1,7 +1,7 @@
 /* tool.h - shared pieces of the `tiledtex` command-line tool (not the library).
 
    The tool is a set of subcommands, one file each (synth.c, map.c, tile.c,
-   render.c, generate.c), dispatched by tiledtex.c. They share what is declared
+   lapped.c, render.c, generate.c), dispatched by tiledtex.c. They share what is declared
    here and implemented in tool_io.c:
 
      - one-line error reporting          tool_fail, tool_usage
@@ -35,6 +35,12 @@
 /* A good size for the `err` buffers the functions below fill. */
 #define TOOL_ERROR_SIZE 512
 
+/* The tool refuses to write textures (atlases, baked textures) wider than
+   this: an 8192^2 PNG is already about 200 MB in memory while it is written,
+   and few renderers take larger textures. (The library's own limit is
+   TT_MAX_IMAGE_SIZE.) */
+#define TOOL_MAX_ATLAS 8192
+
 /* ---------------------------------------------------------------------- */
 /* Subcommands: argv[0] is the subcommand's name ("render"), options follow. */
 /* Each returns the process exit status.                                     */
@@ -43,6 +49,7 @@
 int cmd_synth(int argc, char **argv);
 int cmd_map(int argc, char **argv);
 int cmd_tile(int argc, char **argv);
+int cmd_lapped(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 
@@ -113,6 +120,11 @@ int parse_float(const char *option, const char *text, double min, double max, do
 /* "WxH" such as "800x600", each side in [min, max]:
    "tiledtex render: --size wants WxH, got '12'". */
 int parse_size(const char *option, const char *text, int min, int max, int *width, int *height);
+/* Quiet versions for numbers read from files, whose errors name FILE:LINE:
+   a whole string (blanks around allowed) as a long / a finite double;
+   0 on success, -1 without a message otherwise. */
+int parse_whole_long(const char *text, long *out);
+int parse_whole_double(const char *text, double *out);
 /* Exactly `count` comma-separated numbers, such as "X,Y" or "X,Y,W,H". */
 int parse_float_list(const char *option, const char *text, int count, double *out);
 int parse_int_list(const char *option, const char *text, int count, int *out);
@@ -226,6 +238,21 @@ tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
 
+/* Split every face (c0, c1, ..., cn-1) into the fan of triangles (c0, ci,
+   ci+1), in face order: exact for triangles and convex polygons, which is
+   what meshes are made of, and each triangle keeps its face's winding.
+   *corners gets 3 OBJ corners per triangle (indices into corner_vert and
+   corner_uv), *faces the OBJ face of each (both malloc'ed). Returns the
+   number of triangles, or -1 when out of memory. */
+int obj_triangle_fans(const obj_mesh *mesh, int **corners, int **faces);
+
+/* Print a tt_mesh_build error about `obj` the OBJ file's way - faces and
+   vertices counted from 1, "mesh.obj:12: face 3 has zero area ..." - and
+   return TOOL_EXIT_FAILURE. The error's face and vertex indices must be the
+   OBJ's. offer_permissive: the command has --permissive, so say when it
+   would accept the mesh. */
+int obj_report_mesh_error(const char *obj_path, const obj_mesh *obj, const tt_error *error, int offer_permissive);
+
 /* What obj_write writes. Only positions and faces are required. */
 typedef struct obj_write_desc {
     const char *comment;            /* "# ..." header lines (may contain '\n'), or NULL */
@@ -254,8 +281,9 @@ typedef struct obj_write_desc {
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
 
 /* Append one MTL material: "newmtl NAME", white diffuse colour, and
-   "map_Kd TEXTURE" when texture is not NULL. */
-void mtl_add_material(tool_buffer *out, const char *name, const char *texture);
+   "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
+   "map_d TEXTURE": the texture's alpha channel is the material's opacity. */
+void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha);
 
 /* The file name part of a path ("out/a.png" -> "a.png"), for mtllib / map_Kd
    lines that must be relative to the OBJ / MTL file. */

@@ -146,8 +146,7 @@ static int missing_value(const char *option)
     return -1;
 }
 
-/* Parse a whole string as a long integer; 0 on success. */
-static int parse_whole_long(const char *text, long *out)
+int parse_whole_long(const char *text, long *out)
 {
     char *end;
     long value;
@@ -162,7 +161,7 @@ static int parse_whole_long(const char *text, long *out)
     return 0;
 }
 
-static int parse_whole_double(const char *text, double *out)
+int parse_whole_double(const char *text, double *out)
 {
     char *end;
     double value;
@@ -1001,7 +1000,7 @@ static int parse_face(obj_parser *P)
         if (resolve_index(P, v_index, mesh->nverts, "vertex", token, v_length, &vertex) != 0)
             return -1;
         if (vt_valid) {
-            const char *vt_text = memchr(token, '/', length);
+            const char *vt_text = (const char *)memchr(token, '/', length);
             size_t vt_length = 0;
             vt_text++;
             while (vt_text + vt_length < token_end && vt_text[vt_length] != '/') vt_length++;
@@ -1212,6 +1211,69 @@ tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags)
     return desc;
 }
 
+int obj_triangle_fans(const obj_mesh *mesh, int **corners, int **faces)
+{
+    int f, first = 0, t = 0, total = 0;
+    for (f = 0; f < mesh->nfaces; f++) total += mesh->face_size[f] - 2;   /* < ncorners: no overflow */
+    *corners = (int *)malloc((size_t)total * 3 * sizeof(int));
+    *faces = (int *)malloc((size_t)total * sizeof(int));
+    if (!*corners || !*faces) {
+        free(*corners);
+        free(*faces);
+        *corners = *faces = NULL;
+        return -1;
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        int i;
+        for (i = 1; i + 1 < mesh->face_size[f]; i++, t++) {
+            (*corners)[3 * t] = first;
+            (*corners)[3 * t + 1] = first + i;
+            (*corners)[3 * t + 2] = first + i + 1;
+            (*faces)[t] = f;
+        }
+        first += mesh->face_size[f];
+    }
+    return total;
+}
+
+/* The library counts faces and vertices from 0, as C arrays do; an OBJ file
+   counts them from 1 and a user finds them by line. Say it the file's way,
+   from the error's fields. */
+int obj_report_mesh_error(const char *obj_path, const obj_mesh *obj, const tt_error *error, int offer_permissive)
+{
+    int face = error->face, vertex = error->vertex, other = error->other_vertex;
+    int line = face >= 0 && face < obj->nfaces ? obj->face_line[face]
+             : vertex >= 0 && vertex < obj->nverts ? obj->vert_line[vertex] : 0;
+    const char *or_permissive = offer_permissive ? " (or use --permissive)" : "";
+    char where[4096];
+    if (line > 0) snprintf(where, sizeof where, "%s:%d", obj_path, line);
+    else snprintf(where, sizeof where, "%s", obj_path);
+    switch (error->result) {
+    case TT_ERROR_NON_FINITE:
+        return tool_fail("%s: vertex %d has a coordinate that is NaN or infinite", where, vertex + 1);
+    case TT_ERROR_REPEATED_VERTEX:
+        return tool_fail("%s: face %d uses vertex %d twice%s", where, face + 1, vertex + 1, or_permissive);
+    case TT_ERROR_ZERO_AREA_FACE:
+        return tool_fail("%s: face %d has zero area: its corners coincide or lie on one line%s", where, face + 1,
+                         or_permissive);
+    case TT_ERROR_NON_MANIFOLD_EDGE:
+        return tool_fail("%s: the edge between vertices %d and %d is shared by more than two faces (face %d and "
+                         "face %d among them)%s",
+                         where, vertex + 1, other + 1, face + 1, error->other_face + 1,
+                         offer_permissive ? "; --permissive cuts it open" : "");
+    case TT_ERROR_INCONSISTENT_ORIENTATION:
+        return tool_fail("%s: faces %d and %d both run from vertex %d to vertex %d: one of them is flipped "
+                         "(fix its winding%s)",
+                         where, face + 1, error->other_face + 1, vertex + 1, other + 1,
+                         offer_permissive ? ", or use --permissive" : "");
+    case TT_ERROR_NON_MANIFOLD_VERTEX:
+        return tool_fail("%s: vertex %d is non-manifold: surfaces touch at that one point%s",
+                         vertex >= 0 && vertex < obj->nverts ? where : obj_path, vertex + 1, or_permissive);
+    default:
+        return tool_fail("%s: %s", obj_path, error->message);
+    }
+}
+
 void obj_free(obj_mesh *mesh)
 {
     int g;
@@ -1301,10 +1363,11 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     return out->failed ? -1 : 0;
 }
 
-void mtl_add_material(tool_buffer *out, const char *name, const char *texture)
+void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha)
 {
     write_name_line(out, "newmtl", name);
     buffer_printf(out, "Ka 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\n");
     if (texture) write_name_line(out, "map_Kd", texture);
+    if (texture && texture_alpha) write_name_line(out, "map_d", texture);
     buffer_printf(out, "\n");
 }

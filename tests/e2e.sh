@@ -171,7 +171,7 @@ mkdir -p "$W/in"
 cd "$W/in" || exit 1
 
 # --help everywhere
-for sub in synth map tile render generate; do
+for sub in synth map tile lapped render generate; do
     run $sub --help
     check "$sub --help" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes, stderr: $ERR" \
         "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
@@ -509,6 +509,181 @@ expect_error "OBJ truncated mid face line" tile ../in/truncated_face.obj ../in/t
 expect_error "OBJ truncated mid vertex line" map ../in/truncated_vertex.obj m.obj
 
 # ======================================================================
+# Lapped textures
+# ======================================================================
+cd "$W/in" || exit 1
+expect_ok "generate 64x64 texture for lapped" generate texture lap.png --size 64
+# a black 64x64 mask (binary PGM): no pixel is inside the patch
+{ printf 'P5\n64 64\n255\n'; head -c 4096 /dev/zero; } >black_mask.pgm
+printf '# FACE X Y Z [SIGMA [WEIGHT]], faces counted from 1\n\n1 0 1 0\n300 1 0 0 0.5 2   # another\n' >constraints.txt
+printf '1 0 1 0\n513 0 1 0\n' >constraints_range.txt
+printf '1 0 0 0\n' >constraints_zero.txt
+printf '1 0 1\n' >constraints_short.txt
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' >square.obj
+printf '1 0 0 1\n' >constraints_normal.txt     # along the square's normal
+# a quad whose fan has a zero-area triangle (corners 1, 2, 3 on one line)
+printf 'v 0 0 0\nv 1 0 0\nv 2 0 0\nv 1 1 0\nf 1 2 3 4\n' >lapped_degenerate.obj
+cd "$W" || exit 1
+
+# lapped_coverage MESH OUT -> "triangles missing foreign": the MESH's faces as
+# triangle fans; how many of them no face of OUT draws; how many faces of OUT
+# are not one of them (triangles compared by their vertex sets).
+lapped_coverage() {
+    awk '
+        function key(a, b, c,   t) {
+            if (a > b) { t = a; a = b; b = t }
+            if (b > c) { t = b; b = c; c = t }
+            if (a > b) { t = a; a = b; b = t }
+            return a " " b " " c
+        }
+        FNR == 1 { file++ }
+        $1 == "f" {
+            n = 0
+            for (i = 2; i <= NF; i++) { split($i, p, "/"); v[++n] = p[1] + 0 }
+            if (file == 1) {
+                for (i = 2; i < n; i++) { k = key(v[1], v[i], v[i + 1]); if (!(k in want)) total++; want[k] = 1 }
+            } else {
+                k = key(v[1], v[2], v[3])
+                if (n != 3 || !(k in want)) foreign++
+                got[k] = 1
+            }
+        }
+        END { for (k in want) if (!(k in got)) missing++; printf "%d %d %d\n", total, missing, foreign }
+    ' "$1" "$2" 2>/dev/null
+}
+# lapped_groups OUT -> "groups bad": groups named paste_N with N increasing,
+# each holding faces, and no face outside a group
+lapped_groups() {
+    awk '
+        $1 == "g" {
+            if (groups > 0 && faces == 0) bad++
+            if ($2 !~ /^paste_[0-9]+$/ || substr($2, 7) + 0 <= last) bad++
+            last = substr($2, 7) + 0; groups++; faces = 0
+        }
+        $1 == "f" { if (groups == 0) bad++; faces++ }
+        END { if (groups > 0 && faces == 0) bad++; printf "%d %d\n", groups, bad }
+    ' "$1" 2>/dev/null
+}
+summary_pastes() { printf '%s\n' "$OUT" | grep -oE '[0-9]+ pastes' | head -1 | awk '{print $1}'; }
+
+# lapped_case NAME MESH ARGS... : in a fresh directory, lapped writes out.obj,
+# out.mtl and out_patch.png; every triangle of MESH is in a paste, the
+# groups are the pastes in order, coverage 100.0%.
+lapped_case() {
+    local name=$1 mesh=$2 r total missing foreign groups bad pastes
+    shift 2
+    newdir
+    run lapped "../in/$mesh" ../in/lap.png out "$@"
+    check "lapped $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
+    check "lapped $name: exactly out.mtl, out.obj, out_patch.png" "out.mtl out.obj out_patch.png" \
+        "$(ls -A | tr '\n' ' ')" "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_patch.png " ]; echo $?)"
+    check "lapped $name: patch is a PNG" "PNG signature" "$(od -An -tx1 -N8 out_patch.png 2>&1)" \
+        "$(is_png out_patch.png; echo $?)"
+    check "lapped $name: mtl names the patch as colour and alpha" "map_Kd and map_d out_patch.png, mtllib out.mtl" \
+        "$(grep -h -E 'map_|mtllib' out.mtl out.obj 2>&1)" \
+        "$(grep -qE '^map_Kd +out_patch\.png' out.mtl 2>/dev/null && grep -qE '^map_d +out_patch\.png' out.mtl 2>/dev/null &&
+            grep -qE '^mtllib +out\.mtl' out.obj 2>/dev/null; echo $?)"
+    r=$(lapped_coverage "$W/in/$mesh" out.obj)
+    read -r total missing foreign <<<"$r"
+    check "lapped $name: every triangle of the mesh is in a paste" "0 missing, 0 foreign of > 0" \
+        "$total triangles, $missing missing, $foreign foreign" \
+        "$([ "${total:-0}" -gt 0 ] && [ "${missing:-1}" -eq 0 ] && [ "${foreign:-1}" -eq 0 ]; echo $?)"
+    read -r groups bad <<<"$(lapped_groups out.obj)"
+    pastes=$(summary_pastes)
+    check "lapped $name: groups paste_N in order, one per non-empty paste" \
+        "> 1 groups, at most the $pastes pastes printed, in order" "$groups groups, $bad out of order or empty" \
+        "$([ "${groups:-0}" -gt 1 ] && [ "${groups:-0}" -le "${pastes:-0}" ] && [ "${bad:-1}" -eq 0 ]; echo $?)"
+    check "lapped $name: coverage 100.0%" "'coverage 100.0%' on stdout" "$OUT" \
+        "$(printf '%s' "$OUT" | grep -q 'coverage 100\.0%'; echo $?)"
+    cd "$W" || exit 1
+}
+
+lapped_case torus torus.obj --scale 1.5 --seed 3
+LAPPED_TORUS=$W/d$NEWDIR_N
+check "lapped torus: says it split the quads into triangles" "'1024 triangles (fans of 512 faces)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '1024 triangles (fans of 512 faces)'; echo $?)"
+check "lapped torus: reports alignment" "'mean angle error X degrees, median scale error Y%'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE 'mean angle error [0-9.]+ degrees, median scale error [0-9.]+%'; echo $?)"
+lapped_case sphere-triangles spheretri.obj --scale 0.9 --isotropic
+lapped_case "grid (open)" grid.obj --scale 2 --up 0,0,1
+lapped_case "pair (two components)" pair.obj --scale 1.5 --constraints ../in/constraints.txt
+
+# the same seed twice: the same files; another seed: another result
+newdir
+expect_ok "lapped seed 3 again" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3
+CMD="tiledtex lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3 (twice)"
+check "lapped same seed twice: identical .obj" "cmp equal" "$(cmp out.obj "$LAPPED_TORUS/out.obj" 2>&1)" \
+    "$(cmp -s out.obj "$LAPPED_TORUS/out.obj"; echo $?)"
+check "lapped same seed twice: identical patch" "cmp equal" "$(cmp out_patch.png "$LAPPED_TORUS/out_patch.png" 2>&1)" \
+    "$(cmp -s out_patch.png "$LAPPED_TORUS/out_patch.png"; echo $?)"
+expect_ok "lapped seed 4" lapped ../in/torus.obj ../in/lap.png other --scale 1.5 --seed 4
+CMD="tiledtex lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3 / --seed 4"
+check "lapped different seed: different .obj" "files differ" "identical" "$(! cmp -s out.obj other.obj; echo $?)"
+
+# the pasting OBJ renders (blended pastes)
+expect_ok "render a pasting OBJ" render out.obj out_patch.png view.png --size 160x120
+check "render pasting OBJ: 160x120 PNG" "160 120" "$(png_size view.png)" \
+    "$(is_png view.png && [ "$(png_size view.png)" = "160 120" ]; echo $?)"
+cd "$W" || exit 1
+
+# --bake: over an atlas of triangle pairs (no vt in the OBJ) ...
+newdir
+expect_ok "lapped --bake 256" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --bake 256
+check "lapped --bake: writes out_baked.obj/.mtl/.png too" "6 files" "$(ls -A | tr '\n' ' ')" \
+    "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_baked.mtl out_baked.obj out_baked.png out_patch.png " ]; echo $?)"
+check "lapped --bake: 256x256 texture" "256 256" "$(png_size out_baked.png)" \
+    "$(is_png out_baked.png && [ "$(png_size out_baked.png)" = "256 256" ]; echo $?)"
+r=$(obj_report out_baked.obj)
+read -r corners nvt nonquad badc baduv nf <<<"$r"
+check "lapped --bake: baked OBJ has one vt in [0,1] per corner of 1024 triangles" "3072 3072 0 0" \
+    "$corners corners, $nvt vt, $badc bad corners, $baduv bad vt" \
+    "$([ "${corners:-0}" = 3072 ] && [ "${nvt:-0}" = 3072 ] && [ "${badc:-1}" = 0 ] && [ "${baduv:-1}" = 0 ]; echo $?)"
+check "lapped --bake: mtl names the baked texture" "map_Kd out_baked.png" "$(cat out_baked.mtl 2>&1)" \
+    "$(grep -qE '^map_Kd +out_baked\.png' out_baked.mtl 2>/dev/null && grep -qE '^mtllib +out_baked\.mtl' out_baked.obj; echo $?)"
+expect_ok "render the baked OBJ" render out_baked.obj out_baked.png view.png --size 64x48
+# ... and over the OBJ's own texture coordinates (a tiled-texture OBJ has one per corner)
+expect_ok "tile for lapped --bake" tile ../in/torus.obj ../in/lap.png t --tile 16
+expect_ok "lapped --bake over the OBJ's own vt" lapped t.obj ../in/lap.png own --scale 1.5 --bake 128
+check "lapped --bake over own vt: says so" "'over the OBJ's texture coordinates'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q "over the OBJ's texture coordinates"; echo $?)"
+check "lapped --bake over own vt: same vt values as the OBJ" "identical sorted vt lines" "differ" \
+    "$(diff -q <(grep '^vt' t.obj | sort -u) <(grep '^vt' own_baked.obj | sort -u) >/dev/null; echo $?)"
+cd "$W" || exit 1
+
+# bad inputs: one line, non-zero exit, no files
+expect_error "lapped missing mesh" lapped ../in/nope.obj ../in/lap.png out
+err_mentions "lapped missing mesh: names the file" 'nope\.obj'
+expect_error "lapped image not an image" lapped ../in/torus.obj ../in/torus.obj out
+expect_error "lapped mask with no opaque pixel" lapped ../in/torus.obj ../in/lap.png out --mask ../in/black_mask.pgm
+err_mentions "lapped empty mask: says so" 'opaque'
+expect_error "lapped --scale 0" lapped ../in/torus.obj ../in/lap.png out --scale 0
+expect_error "lapped --scale -1" lapped ../in/torus.obj ../in/lap.png out --scale -1
+expect_error "lapped --scale nan" lapped ../in/torus.obj ../in/lap.png out --scale nan
+expect_error "lapped --scale larger than the mesh" lapped ../in/torus.obj ../in/lap.png out --scale 1000
+expect_error "lapped --constraints face out of range" lapped ../in/torus.obj ../in/lap.png out \
+    --constraints ../in/constraints_range.txt
+err_mentions "lapped constraint out of range: FILE:LINE" 'constraints_range\.txt:2:'
+expect_error "lapped --constraints zero vector" lapped ../in/torus.obj ../in/lap.png out \
+    --constraints ../in/constraints_zero.txt
+err_mentions "lapped constraint zero vector: FILE:LINE" 'constraints_zero\.txt:1:'
+expect_error "lapped --constraints malformed line" lapped ../in/torus.obj ../in/lap.png out \
+    --constraints ../in/constraints_short.txt
+err_mentions "lapped constraint malformed: FILE:LINE" 'constraints_short\.txt:1:'
+expect_error "lapped --constraints along the face's normal" lapped ../in/square.obj ../in/lap.png out \
+    --constraints ../in/constraints_normal.txt
+err_mentions "lapped constraint along the normal: FILE:LINE, perpendicular" 'constraints_normal\.txt:1:.*perpendicular'
+expect_error "lapped --constraints missing file" lapped ../in/torus.obj ../in/lap.png out --constraints ../in/nope.txt
+expect_error "lapped --bake 0" lapped ../in/torus.obj ../in/lap.png out --bake 0
+expect_error "lapped --bake 100000" lapped ../in/torus.obj ../in/lap.png out --bake 100000
+expect_error "lapped --bake too small for the atlas" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --bake 16
+expect_error "lapped --up 0,0,0" lapped ../in/torus.obj ../in/lap.png out --up 0,0,0
+expect_error "lapped zero-area face" lapped ../in/lapped_degenerate.obj ../in/lap.png out
+err_mentions "lapped zero-area face: FILE:LINE and face 1" 'lapped_degenerate\.obj:5: face 1 '
+expect_error "lapped non-manifold edge" lapped ../in/nonmanifold.obj ../in/lap.png out
+check "lapped non-manifold edge: no --permissive hint (lapped has none)" "no '--permissive'" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q -- '--permissive'; echo $?)"
+
+# ======================================================================
 # Bad files, images and options
 # ======================================================================
 expect_error "missing mesh file" tile ../in/nope.obj ../in/tex.png out
@@ -550,11 +725,12 @@ expect_error "--seed abc (map)" map ../in/torus.obj m.obj --seed abc
 expect_error "--seed abc (tile)" tile ../in/torus.obj ../in/tex.png out --seed abc
 expect_error "--seed abc (generate)" generate texture t.png --seed abc
 expect_error "--seed without a value" synth ../in/tex.png a.png --seed
-for sub in synth map tile render generate; do
+for sub in synth map tile lapped render generate; do
     case $sub in
         synth) args="../in/tex.png a.png" ;;
         map) args="../in/torus.obj m.obj" ;;
         tile) args="../in/torus.obj ../in/tex.png out" ;;
+        lapped) args="../in/torus.obj ../in/tex.png out" ;;
         render) args="../in/torus.obj ../in/tex.png r.png" ;;
         generate) args="mesh g.obj --shape torus" ;;
     esac
@@ -567,6 +743,7 @@ expect_error "missing positional args (synth)" synth ../in/tex.png
 expect_error "missing positional args (map)" map ../in/torus.obj
 expect_error "missing positional args (tile)" tile ../in/torus.obj ../in/tex.png
 expect_error "missing positional args (tile, none)" tile
+expect_error "missing positional args (lapped)" lapped ../in/torus.obj ../in/tex.png
 expect_error "missing positional args (render)" render ../in/torus.obj ../in/tex.png
 expect_error "missing positional args (generate)" generate
 expect_error "missing positional args (generate mesh)" generate mesh

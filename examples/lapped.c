@@ -1,0 +1,689 @@
+/* lapped.c - `tiledtex lapped`: texture a mesh with Praun et al.'s lapped textures.
+
+   MESH.obj + IMAGE -> OUT_PREFIX.obj, whose faces are the pastes in order
+   (group paste_N: the triangles paste N covers, with that paste's texture
+   coordinates), OUT_PREFIX.mtl and OUT_PREFIX_patch.png, the texture patch
+   (straight alpha). Drawn in file order with alpha blending, the pastes cover
+   the surface (Praun et al. Sec. 4, "runtime pasting"); `tiledtex render`
+   draws such a file that way. --bake also writes an ordinary textured mesh
+   (Sec. 4, "rendering with a texture atlas").
+
+   The library calls, as a user of tiledtex.h makes them:
+
+     tt_mesh_build          validate the OBJ's faces, split into triangle
+                            fans here first: lapped textures work on triangles
+     tt_tangent_field       each face's texture "up" and scale (Sec. 3.2):
+                            --up, --scale, --constraints
+     tt_make_texture_patch  the image with a soft splotch (or --mask) alpha (Sec. 3.1)
+     tt_lapped_paste        the paste loop (Sec. 3.3 - 3.6, 4)
+     tt_lapped_measure      alignment measured from the written UVs alone
+     tt_atlas_pack_pairs,   --bake: an atlas (unless the OBJ has UVs) and the
+     tt_lapped_bake         pastes composited into it
+*/
+#define _POSIX_C_SOURCE 200112L     /* clock_gettime, isatty */
+
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "tool.h"
+
+/* Texels between charts of a packed atlas, and of extrapolated colour around
+   each chart: enough for bilinear filtering and the first mip level. */
+#define LAPPED_BAKE_GUTTER 2
+
+static void print_help(void)
+{
+    printf("usage: tiledtex lapped MESH.obj IMAGE OUT_PREFIX [options]\n"
+           "\n"
+           "Cover MESH.obj with overlapping pastes of one texture patch cut from IMAGE (Praun et\n"
+           "al., Lapped Textures): no seams show, because every paste fades out over the ones\n"
+           "beneath it. Writes OUT_PREFIX.obj (group paste_N holds the triangles of paste N with\n"
+           "its texture coordinates; draw the groups in order with alpha blending and clamped\n"
+           "texture coordinates), OUT_PREFIX.mtl and OUT_PREFIX_patch.png (the patch, straight\n"
+           "alpha; the MTL names it as map_Kd and map_d). Look at it with\n"
+           "'tiledtex render OUT_PREFIX.obj OUT_PREFIX_patch.png view.png'.\n"
+           "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
+           "triangle fans first. The mesh must be manifold and consistently oriented.\n"
+           "\n"
+           "options:\n"
+           "  --scale X            side of one texture patch on the surface, in mesh units\n"
+           "                       (default: %g of the mesh's bounding-box diagonal)\n"
+           "  --seed K             random seed: patch shape, paste order (default 0)\n"
+           "  --up X,Y,Z           the texture's up direction, projected on each face\n"
+           "                       (default 0,1,0)\n"
+           "  --constraints FILE   the texture's direction and scale at chosen faces, one per line:\n"
+           "                       FACE X Y Z [SIGMA [WEIGHT]]; FACE counts the OBJ's faces from 1,\n"
+           "                       X Y Z points up along the face and its length is the scale there,\n"
+           "                       SIGMA (mesh units, default %g of the diagonal) is how far it\n"
+           "                       reaches, WEIGHT its weight (default 1); '#' starts a comment.\n"
+           "                       Directions elsewhere blend the constraints; --up is unused\n"
+           "  --isotropic          the texture has no direction: each paste takes a random one\n"
+           "  --mask MASK.png      the patch's shape: MASK's alpha, or its grey when opaque\n"
+           "                       (white = inside); same size as IMAGE (default: a random splotch,\n"
+           "                       or IMAGE's own alpha when it has one)\n"
+           "  --bake SIZE          also write OUT_PREFIX_baked.obj/.mtl/.png: the pastes baked into a\n"
+           "                       SIZE x SIZE texture (16 to %d) over the OBJ's own texture\n"
+           "                       coordinates when every corner has one, else over an atlas of\n"
+           "                       triangle pairs\n"
+           "\n"
+           "Prints the number of pastes, the coverage, how often a face is drawn (overdraw), how\n"
+           "well the texture follows the field (angle and scale error) and how many face entries\n"
+           "hidden by later pastes were dropped.\n"
+           "\n"
+           "example: tiledtex generate mesh torus.obj --shape torus\n"
+           "         tiledtex generate texture stones.png --size 128\n"
+           "         tiledtex lapped torus.obj stones.png torus_lapped --scale 1.5\n"
+           "         tiledtex render torus_lapped.obj torus_lapped_patch.png view.png\n",
+           TT_DEFAULT_FIELD_SCALE, TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS);
+}
+
+typedef struct lapped_options {
+    const char *mesh_path, *image_path, *prefix;
+    float scale;                    /* 0 = the library's default */
+    uint64_t seed;
+    float up[3];
+    const char *constraints_path;   /* or NULL */
+    int isotropic;
+    const char *mask_path;          /* or NULL */
+    int bake_size;                  /* 0 = no --bake */
+} lapped_options;
+
+/* Returns -1 to go on, or the exit status to return now. */
+static int parse_command_line(int argc, char **argv, lapped_options *options)
+{
+    const char *positional[3];
+    int npositional = 0, i;
+    memset(options, 0, sizeof *options);
+    options->up[1] = 1.0f;
+    for (i = 1; i < argc; i++) {
+        const char *value;
+        double number, xyz[3];
+        if (tool_is_help(argv[i])) {
+            print_help();
+            return 0;
+        } else if (tool_option(argc, argv, &i, "--scale", &value)) {
+            if (!value) return tool_usage("--scale needs a value");
+            if (parse_whole_double(value, &number) != 0 || !(number > 0.0) || number > 1e30)
+                return tool_usage("--scale wants a patch size above 0 (in mesh units), got '%s'", value);
+            options->scale = (float)number;
+        } else if (tool_option(argc, argv, &i, "--seed", &value)) {
+            if (parse_u64("--seed", value, &options->seed) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--up", &value)) {
+            if (parse_float_list("--up", value, 3, xyz) != 0) return TOOL_EXIT_USAGE;
+            if (xyz[0] == 0.0 && xyz[1] == 0.0 && xyz[2] == 0.0)
+                return tool_usage("--up wants a direction, got the zero vector '%s'", value);
+            options->up[0] = (float)xyz[0];
+            options->up[1] = (float)xyz[1];
+            options->up[2] = (float)xyz[2];
+        } else if (tool_option(argc, argv, &i, "--constraints", &value)) {
+            if (!value) return tool_usage("--constraints needs a value");
+            options->constraints_path = value;
+        } else if (tool_option(argc, argv, &i, "--mask", &value)) {
+            if (!value) return tool_usage("--mask needs a value");
+            options->mask_path = value;
+        } else if (tool_option(argc, argv, &i, "--bake", &value)) {
+            if (parse_int("--bake", value, 16, TOOL_MAX_ATLAS, &options->bake_size) != 0) return TOOL_EXIT_USAGE;
+        } else if (strcmp(argv[i], "--isotropic") == 0) {
+            options->isotropic = 1;
+        } else if (tool_is_option(argv[i])) {
+            return tool_unknown_option(argv[i]);
+        } else if (npositional == 3) {
+            return tool_usage("too many arguments (see 'tiledtex lapped --help')");
+        } else {
+            positional[npositional++] = argv[i];
+        }
+    }
+    if (npositional != 3) return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see 'tiledtex lapped --help')");
+    options->mesh_path = positional[0];
+    options->image_path = positional[1];
+    options->prefix = positional[2];
+    if (strlen(options->prefix) + 16 > 4096) return tool_usage("OUT_PREFIX is too long");
+    if (tool_basename(options->prefix)[0] == '\0')
+        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",
+                          options->prefix, options->prefix);
+    return -1;
+}
+
+/* ======================================================================== */
+/* The mesh: the OBJ split into triangles                                   */
+/* ======================================================================== */
+
+typedef struct triangle_mesh {
+    obj_mesh obj;
+    int ntriangles;
+    int *corner;            /* 3 per triangle: its OBJ corners (index into obj.corner_vert, obj.corner_uv) */
+    int *vert;              /* 3 per triangle: their vertices */
+    int *face;              /* per triangle: its OBJ face */
+    int *first_triangle;    /* per OBJ face: the first triangle of its fan */
+    tt_mesh *mesh;          /* the triangles, validated */
+} triangle_mesh;
+
+static void triangle_mesh_free(triangle_mesh *m)
+{
+    obj_free(&m->obj);
+    free(m->corner);
+    free(m->vert);
+    free(m->face);
+    free(m->first_triangle);
+    tt_mesh_free(m->mesh);
+    memset(m, 0, sizeof *m);
+}
+
+/* Read the OBJ, split its faces into triangle fans and build those. */
+static int triangle_mesh_read(const char *path, triangle_mesh *m)
+{
+    char message[TOOL_ERROR_SIZE];
+    tt_mesh_desc desc;
+    tt_error error;
+    int c, t, total;
+    memset(m, 0, sizeof *m);
+    if (obj_read(path, &m->obj, message, sizeof message) != 0) return tool_fail("%s", message);
+    total = m->ntriangles = obj_triangle_fans(&m->obj, &m->corner, &m->face);
+    if (total >= 0) {
+        m->vert = (int *)malloc((size_t)total * 3 * sizeof(int));
+        m->first_triangle = (int *)malloc((size_t)m->obj.nfaces * sizeof(int));
+    }
+    if (!m->vert || !m->first_triangle) {
+        triangle_mesh_free(m);
+        return tool_fail("out of memory for the triangles of %s", path);
+    }
+    for (c = 0; c < 3 * total; c++) m->vert[c] = m->obj.corner_vert[m->corner[c]];
+    for (t = total - 1; t >= 0; t--) m->first_triangle[m->face[t]] = t;
+
+    memset(&desc, 0, sizeof desc);
+    desc.positions = m->obj.pos;
+    desc.nverts = m->obj.nverts;
+    desc.indices = m->vert;
+    desc.nfaces = total;
+    desc.fixed_face_size = 3;
+    if (tt_mesh_build(&desc, &m->mesh, &error) != TT_OK) {
+        int status;
+        /* Say it about the OBJ's faces, which the user can find. */
+        if (error.face >= 0 && error.face < total) error.face = m->face[error.face];
+        if (error.other_face >= 0 && error.other_face < total) error.other_face = m->face[error.other_face];
+        status = obj_report_mesh_error(path, &m->obj, &error, 0);
+        triangle_mesh_free(m);
+        return status;
+    }
+    return 0;
+}
+
+/* Report a library error. The library counts faces from 0 and means the
+   triangles; an error about one is said the OBJ's way, at the line of its
+   face and with the face counted from 1. */
+static int report_error(const char *path, const triangle_mesh *m, const tt_error *error)
+{
+    char message[sizeof error->message + 32], pattern[32];
+    const char *at;
+    size_t length;
+    int face;
+    if (error->face < 0 || error->face >= m->ntriangles) return tool_fail("%s: %s", path, error->message);
+    face = m->face[error->face];
+    length = (size_t)snprintf(pattern, sizeof pattern, "face %d", error->face);
+    for (at = strstr(error->message, pattern); at && isdigit((unsigned char)at[length]); at = strstr(at + 1, pattern))
+        continue;
+    if (at)
+        snprintf(message, sizeof message, "%.*sface %d%s", (int)(at - error->message), error->message, face + 1,
+                 at + length);
+    else
+        snprintf(message, sizeof message, "%s", error->message);
+    return tool_fail("%s:%d: %s", path, m->obj.face_line[face], message);
+}
+
+/* ======================================================================== */
+/* The tangent field and its constraints file                               */
+/* ======================================================================== */
+
+typedef struct constraint_list {
+    tt_field_constraint *items;
+    int *line;              /* the file line of each */
+    int count;
+} constraint_list;
+
+static void constraint_list_free(constraint_list *list)
+{
+    free(list->items);
+    free(list->line);
+    memset(list, 0, sizeof *list);
+}
+
+/* One line "FACE X Y Z [SIGMA [WEIGHT]]" ('#' comments and blank lines are
+   skipped by the caller). FACE counts the OBJ's faces from 1; a polygon's
+   constraint goes on the first triangle of its fan (they share its plane).
+   Returns 0, or the exit status after printing "FILE:LINE: ...". */
+static int parse_constraint(char *text, const char *where, const triangle_mesh *m, tt_field_constraint *out)
+{
+    char *token[6];
+    double value[6];
+    long face;
+    int ntokens = 0, k;
+    char *p;
+    for (p = strtok(text, " \t\r\v\f"); p; p = strtok(NULL, " \t\r\v\f")) {
+        if (ntokens < 6) token[ntokens] = p;
+        ntokens++;
+    }
+    if (ntokens < 4 || ntokens > 6)
+        return tool_fail("%s: wants FACE X Y Z [SIGMA [WEIGHT]], got %d value%s", where, ntokens,
+                         ntokens == 1 ? "" : "s");
+    if (parse_whole_long(token[0], &face) != 0)
+        return tool_fail("%s: FACE wants a face number, got '%s'", where, token[0]);
+    if (face < 1 || face > m->obj.nfaces)
+        return tool_fail("%s: face %s is out of range: the mesh has faces 1 to %d", where, token[0], m->obj.nfaces);
+    for (k = 1; k < ntokens; k++)
+        if (parse_whole_double(token[k], &value[k]) != 0)
+            return tool_fail("%s: '%s' is not a finite number", where, token[k]);
+    if (value[1] == 0.0 && value[2] == 0.0 && value[3] == 0.0)
+        return tool_fail("%s: the vector 0 0 0 has no direction", where);
+    if ((ntokens > 4 && !(value[4] > 0.0)) || (ntokens > 5 && !(value[5] > 0.0)))
+        return tool_fail("%s: SIGMA and WEIGHT must be above 0", where);
+    memset(out, 0, sizeof *out);
+    out->face = m->first_triangle[face - 1];
+    for (k = 0; k < 3; k++) out->vector[k] = (float)value[k + 1];
+    out->sigma = ntokens > 4 ? (float)value[4] : 0.0f;
+    out->weight = ntokens > 5 ? (float)value[5] : 0.0f;
+    return 0;
+}
+
+static int read_constraints(const char *path, const triangle_mesh *m, constraint_list *list)
+{
+    unsigned char *data;
+    size_t size;
+    char message[TOOL_ERROR_SIZE], where[4096], *line, *next;
+    int capacity = 0, number = 0, status = 0;
+    memset(list, 0, sizeof *list);
+    if (tool_read_file(path, &data, &size, message, sizeof message) != 0) return tool_fail("%s", message);
+    for (line = (char *)data; line && status == 0; line = next) {
+        char *comment;
+        number++;
+        next = strchr(line, '\n');
+        if (next) *next++ = '\0';
+        if ((comment = strchr(line, '#')) != NULL) *comment = '\0';
+        if (strspn(line, " \t\r\v\f") == strlen(line)) continue;
+        if (list->count == capacity) {
+            int grown = capacity ? 2 * capacity : 16;
+            tt_field_constraint *items = (tt_field_constraint *)realloc(list->items, (size_t)grown * sizeof *items);
+            int *lines = items ? (int *)realloc(list->line, (size_t)grown * sizeof(int)) : NULL;
+            if (items) list->items = items;
+            if (lines) list->line = lines;
+            if (!items || !lines) {
+                status = tool_fail("out of memory reading %s", path);
+                break;
+            }
+            capacity = grown;
+        }
+        snprintf(where, sizeof where, "%s:%d", path, number);
+        status = parse_constraint(line, where, m, &list->items[list->count]);
+        list->line[list->count++] = number;
+    }
+    free(data);
+    if (status != 0) constraint_list_free(list);
+    return status;
+}
+
+/* face_vectors gets 3 floats per triangle. */
+static int make_field(const lapped_options *options, const triangle_mesh *m, float *face_vectors)
+{
+    constraint_list constraints;
+    tt_field_options field;
+    tt_error error;
+    int status = 0, i;
+    memset(&constraints, 0, sizeof constraints);
+    if (options->constraints_path && (status = read_constraints(options->constraints_path, m, &constraints)) != 0)
+        return status;
+    memset(&field, 0, sizeof field);
+    memcpy(field.up, options->up, sizeof field.up);
+    field.scale = options->scale;
+    field.constraints = constraints.items;
+    field.nconstraints = constraints.count;
+    if (tt_tangent_field(m->mesh, &field, face_vectors, &error) != TT_OK) {
+        /* What reading the file could not see: a vector that the face's plane
+           reduces to nothing. Name the first line on that face. */
+        for (i = 0; i < constraints.count && constraints.items[i].face != error.face; i++) continue;
+        if (error.face >= 0 && i < constraints.count && error.result == TT_ERROR_INVALID_ARGUMENT)
+            status = tool_fail("%s:%d: the vector is perpendicular to face %d: it must point along the face",
+                               options->constraints_path, constraints.line[i], m->face[error.face] + 1);
+        else
+            status = report_error(options->mesh_path, m, &error);
+    }
+    constraint_list_free(&constraints);
+    return status;
+}
+
+/* ======================================================================== */
+/* The texture patch                                                        */
+/* ======================================================================== */
+
+static int make_patch(const lapped_options *options, const tt_image *image, tt_image *patch)
+{
+    char message[TOOL_ERROR_SIZE];
+    tt_image mask;
+    tt_patch_options patch_options;
+    tt_error error;
+    int status = 0;
+    memset(&mask, 0, sizeof mask);
+    if (options->mask_path && image_load(options->mask_path, &mask, message, sizeof message) != 0)
+        return tool_fail("%s", message);
+    memset(&patch_options, 0, sizeof patch_options);
+    patch_options.seed = options->seed;
+    memset(patch, 0, sizeof *patch);
+    if (tt_make_texture_patch(image, options->mask_path ? &mask : NULL, &patch_options, patch, &error) != TT_OK)
+        status = tool_fail("%s: %s", options->mask_path ? options->mask_path : options->image_path, error.message);
+    tt_image_free(&mask);
+    return status;
+}
+
+/* The patch as a PNG wants straight alpha. Where alpha > 0 that is the
+   premultiplied patch divided by its alpha, which is the image's own colour;
+   taking the image's colour everywhere also keeps real colours under alpha 0,
+   so a viewer that filters straight-alpha textures shows no dark fringes. */
+static int straight_patch(const tt_image *image, const tt_image *patch, tt_image *out)
+{
+    size_t i, n = (size_t)image->width * (size_t)image->height;
+    if (tt_image_create(out, image->width, image->height, NULL) != TT_OK) return -1;
+    for (i = 0; i < n; i++) {
+        memcpy(out->pixels + 4 * i, image->pixels + 4 * i, 3 * sizeof(float));
+        out->pixels[4 * i + 3] = patch->pixels[4 * i + 3];
+    }
+    return 0;
+}
+
+/* ======================================================================== */
+/* Progress on a terminal                                                   */
+/* ======================================================================== */
+
+typedef struct progress_state {
+    double start, last;     /* seconds */
+    int terminal;           /* stderr is a terminal: a "\r" line can be redrawn */
+    int shown;
+} progress_state;
+
+static double seconds_now(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+}
+
+/* A tt_progress_fn. Quiet for the first second (most runs are shorter) and
+   when stderr is not a terminal (a log would fill with "\r" lines). */
+static int show_progress(float fraction, void *user_data)
+{
+    progress_state *progress = (progress_state *)user_data;
+    double now = seconds_now();
+    if (!progress->terminal || now - progress->start < 1.0 || (progress->shown && now - progress->last < 0.1))
+        return 0;
+    fprintf(stderr, "\rtiledtex: pasting: %5.1f%% of the surface covered", 100.0 * (double)fraction);
+    fflush(stderr);
+    progress->shown = 1;
+    progress->last = now;
+    return 0;
+}
+
+static void end_progress(progress_state *progress)
+{
+    if (progress->shown) fputc('\n', stderr);
+    progress->shown = 0;
+}
+
+/* ======================================================================== */
+/* Output files                                                             */
+/* ======================================================================== */
+
+/* OUT_PREFIX.obj: the vertices, then paste after paste a group "paste_N"
+   (N counts the pastes from 1) with its triangles and their texture
+   coordinates in the patch. A paste whose faces were all hidden has none. */
+static int add_pasting_obj(tool_output *output, const char *path, const char *mtl_name, const triangle_mesh *m,
+                           const tt_lapped *lapped)
+{
+    const tt_mesh *mesh = m->mesh;
+    int *corner_vert = (int *)malloc((size_t)lapped->nentries * 3 * sizeof(int));
+    float *corner_uv = (float *)malloc((size_t)lapped->nentries * 6 * sizeof(float));
+    int *face_group = (int *)malloc((size_t)lapped->nentries * sizeof(int));
+    char **names = (char **)calloc((size_t)lapped->npastes + 1, sizeof(char *));
+    char comment[512];
+    tool_buffer text;
+    obj_write_desc desc;
+    int p, n = 0, status = 0;
+
+    memset(&text, 0, sizeof text);
+    if (!corner_vert || !corner_uv || !face_group || !names) goto out_of_memory;
+    for (p = 0; p < lapped->npastes; p++) {
+        const tt_paste *paste = &lapped->pastes[p];
+        int e, k;
+        names[p] = (char *)malloc(24);
+        if (!names[p]) goto out_of_memory;
+        snprintf(names[p], 24, "paste_%d", p + 1);
+        for (e = paste->first; e < paste->first + paste->nfaces; e++, n++) {
+            int face = lapped->faces[e];
+            for (k = 0; k < 3; k++) corner_vert[3 * n + k] = mesh->corner_vert[mesh->face_start[face] + k];
+            memcpy(corner_uv + 6 * n, lapped->uv + 6 * (size_t)e, 6 * sizeof(float));
+            face_group[n] = p;
+        }
+    }
+    snprintf(comment, sizeof comment,
+             "lapped texture by tiledtex %s (Praun et al.): %d pastes over %d triangles\n"
+             "draw the groups in order, each blended over the ones before through the patch's alpha,\n"
+             "with texture coordinates clamped (outside [0,1] is transparent)",
+             TILEDTEX_VERSION_STRING, lapped->npastes, mesh->nfaces);
+    memset(&desc, 0, sizeof desc);
+    desc.comment = comment;
+    desc.nverts = mesh->nverts;
+    desc.pos = mesh->pos;
+    desc.nfaces = n;
+    desc.fixed_face_size = 3;
+    desc.corner_vert = corner_vert;
+    desc.corner_uv = corner_uv;
+    desc.mtllib = mtl_name;
+    desc.material = "lapped";
+    desc.face_group = face_group;
+    desc.ngroups = lapped->npastes;
+    desc.group_names = (const char *const *)names;
+    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, path, &text) != 0) goto out_of_memory;
+    goto done;
+out_of_memory:
+    status = tool_fail("out of memory while writing %s", path);
+done:
+    buffer_free(&text);
+    if (names)
+        for (p = 0; p < lapped->npastes; p++) free(names[p]);
+    free(names);
+    free(corner_vert);
+    free(corner_uv);
+    free(face_group);
+    return status;
+}
+
+static int add_mtl(tool_output *output, const char *path, const char *material, const char *texture_path,
+                   int texture_alpha)
+{
+    tool_buffer text;
+    char texture[4096];
+    memset(&text, 0, sizeof text);
+    tool_relative_path(texture_path, path, texture, sizeof texture);
+    mtl_add_material(&text, material, texture, texture_alpha);
+    if (output_add_buffer(output, path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", path);
+    }
+    return 0;
+}
+
+static int add_png(tool_output *output, const char *path, const tt_image *image)
+{
+    char message[TOOL_ERROR_SIZE];
+    if (output_add_png(output, path, image, message, sizeof message) != 0) return tool_fail("%s", message);
+    return 0;
+}
+
+/* --bake: texture coordinates per triangle corner, the OBJ's own when every
+   corner has one, else an atlas of triangle pairs; the pastes composited
+   into a size x size texture over them; an ordinary OBJ + MTL + PNG. */
+static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
+                     const tt_lapped *lapped, const tt_image *patch, int *own_uvs)
+{
+    char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
+    size_t ncorners = 3 * (size_t)m->ntriangles, c;
+    float *corner_uv = (float *)malloc(ncorners * 2 * sizeof(float));
+    tt_image atlas;
+    tt_error error;
+    tool_buffer text;
+    obj_write_desc desc;
+    int status = 0;
+
+    memset(&atlas, 0, sizeof atlas);
+    memset(&text, 0, sizeof text);
+    snprintf(obj_path, sizeof obj_path, "%s_baked.obj", options->prefix);
+    snprintf(mtl_path, sizeof mtl_path, "%s_baked.mtl", options->prefix);
+    snprintf(png_path, sizeof png_path, "%s_baked.png", options->prefix);
+    if (!corner_uv) return tool_fail("out of memory for the texture coordinates of %s", obj_path);
+
+    *own_uvs = m->obj.corner_uv != NULL;
+    for (c = 0; c < ncorners && *own_uvs; c++) *own_uvs = m->obj.corner_uv[m->corner[c]] >= 0;
+    if (*own_uvs) {
+        for (c = 0; c < ncorners; c++) memcpy(corner_uv + 2 * c, m->obj.uv + 2 * m->obj.corner_uv[m->corner[c]],
+                                              2 * sizeof(float));
+    } else if (tt_atlas_pack_pairs(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, corner_uv, &error) != TT_OK) {
+        status = tool_fail("--bake %d: %s", options->bake_size, error.message);
+        goto done;
+    }
+    if (tt_image_create(&atlas, options->bake_size, options->bake_size, NULL) != TT_OK) {
+        status = tool_fail("out of memory for a %dx%d texture", options->bake_size, options->bake_size);
+        goto done;
+    }
+    if (tt_lapped_bake(m->mesh, lapped, patch, 1, corner_uv, LAPPED_BAKE_GUTTER, &atlas, &error) != TT_OK) {
+        status = report_error(options->mesh_path, m, &error);
+        goto done;
+    }
+
+    snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
+             tool_basename(png_path));
+    memset(&desc, 0, sizeof desc);
+    desc.comment = comment;
+    desc.nverts = m->mesh->nverts;
+    desc.pos = m->mesh->pos;
+    desc.nfaces = m->ntriangles;
+    desc.fixed_face_size = 3;
+    desc.corner_vert = m->vert;
+    desc.corner_uv = corner_uv;
+    desc.mtllib = tool_basename(mtl_path);
+    desc.material = "lapped_baked";
+    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, obj_path, &text) != 0) {
+        status = tool_fail("out of memory while writing %s", obj_path);
+        goto done;
+    }
+    status = add_mtl(output, mtl_path, "lapped_baked", png_path, 0);
+    if (status == 0) status = add_png(output, png_path, &atlas);
+done:
+    buffer_free(&text);
+    tt_image_free(&atlas);
+    free(corner_uv);
+    return status;
+}
+
+/* ======================================================================== */
+/* The command                                                              */
+/* ======================================================================== */
+
+static int paste(const lapped_options *options, const triangle_mesh *m, const float *field, const tt_image *patch,
+                 tt_lapped *lapped)
+{
+    tt_lapped_options paste_options;
+    progress_state progress;
+    tt_error error;
+    tt_result result;
+    memset(&progress, 0, sizeof progress);
+    progress.start = seconds_now();
+    progress.terminal = isatty(STDERR_FILENO);
+    memset(&paste_options, 0, sizeof paste_options);
+    paste_options.seed = options->seed;
+    paste_options.isotropic = options->isotropic;
+    paste_options.progress = show_progress;
+    paste_options.progress_user_data = &progress;
+    result = tt_lapped_paste(m->mesh, field, patch, 1, &paste_options, lapped, &error);
+    end_progress(&progress);
+    return result == TT_OK ? 0 : report_error(options->mesh_path, m, &error);
+}
+
+static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
+                          const tt_lapped *lapped, double seconds)
+{
+    tt_lapped_report report;
+    double angle = lapped->mean_angle_error, scale = lapped->median_scale_error;
+    /* Anisotropic: measured again from the UVs that were written, an
+       independent check of what the paste loop believes. Isotropic pastes
+       choose their own directions, which only the loop knows. */
+    if (!options->isotropic && tt_lapped_measure(m->mesh, field, lapped, &report) == TT_OK) {
+        angle = report.mean_angle_error;
+        scale = report.median_scale_error;
+    }
+    printf("%s: %d triangles", options->mesh_path, m->ntriangles);
+    if (m->ntriangles != m->obj.nfaces) printf(" (fans of %d faces)", m->obj.nfaces);
+    printf(", %d pastes, coverage %.1f%%, mean overdraw %.2f\n", lapped->npastes, 100.0 * lapped->coverage,
+           lapped->mean_overdraw);
+    printf("alignment: mean angle error %.1f degrees, median scale error %.1f%%%s\n", angle, 100.0 * scale,
+           options->isotropic ? " (isotropic: against each paste's own direction)" : "");
+    printf("removed %d hidden face entries; %.1f s\n", lapped->removed_entries, seconds);
+}
+
+int cmd_lapped(int argc, char **argv)
+{
+    lapped_options options;
+    triangle_mesh mesh;
+    tt_image image, patch, straight;
+    tt_lapped lapped;
+    tool_output output;
+    float *field = NULL;
+    char obj_path[4096], mtl_path[4096], png_path[4096], message[TOOL_ERROR_SIZE];
+    double start = seconds_now();
+    int status, own_uvs = 0;
+
+    status = parse_command_line(argc, argv, &options);
+    if (status >= 0) return status;
+    snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
+    snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
+    snprintf(png_path, sizeof png_path, "%s_patch.png", options.prefix);
+    memset(&image, 0, sizeof image);
+    memset(&patch, 0, sizeof patch);
+    memset(&straight, 0, sizeof straight);
+    memset(&lapped, 0, sizeof lapped);
+    memset(&output, 0, sizeof output);
+
+    if ((status = triangle_mesh_read(options.mesh_path, &mesh)) != 0) return status;
+    field = (float *)malloc((size_t)mesh.ntriangles * 3 * sizeof(float));
+    if (!field) status = tool_fail("out of memory for the field of %s", options.mesh_path);
+    if (status == 0) status = make_field(&options, &mesh, field);
+    if (status == 0 && image_load(options.image_path, &image, message, sizeof message) != 0)
+        status = tool_fail("%s", message);
+    if (status == 0) status = make_patch(&options, &image, &patch);
+    if (status == 0) status = paste(&options, &mesh, field, &patch, &lapped);
+
+    if (status == 0 && straight_patch(&image, &patch, &straight) != 0)
+        status = tool_fail("out of memory for the patch image");
+    if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, &lapped);
+    if (status == 0) status = add_mtl(&output, mtl_path, "lapped", png_path, 1);
+    if (status == 0) status = add_png(&output, png_path, &straight);
+    if (status == 0 && options.bake_size > 0) status = add_baked(&output, &options, &mesh, &lapped, &patch, &own_uvs);
+    if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
+
+    if (status == 0) {
+        print_summary(&options, &mesh, field, &lapped, seconds_now() - start);
+        printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
+        if (options.bake_size > 0)
+            printf("; %s_baked.obj/.mtl/.png (%dx%d, over %s)", options.prefix, options.bake_size,
+                   options.bake_size, own_uvs ? "the OBJ's texture coordinates" : "an atlas of triangle pairs");
+        printf("\n");
+    }
+    output_free(&output);
+    tt_lapped_free(&lapped);
+    tt_image_free(&straight);
+    tt_image_free(&patch);
+    tt_image_free(&image);
+    free(field);
+    triangle_mesh_free(&mesh);
+    return status;
+}
