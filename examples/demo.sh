@@ -5,6 +5,9 @@
 #   2. a smooth double torus (genus 2)      build/demo/double_torus_mesh.obj
 #   3. tiled textures (Akleman et al.):     build/demo/double_torus.obj/.mtl/.png
 #   4. pictures of the result               build/demo/double_torus_front.png, _side.png, _closeup.png
+#   5. lapped textures (Praun et al.) on the same surface, runtime pasting and baked:
+#                                           build/demo/lapped.obj/.mtl, lapped_patch.png, lapped_baked.*,
+#                                           pictures build/demo/lapped_front.png, lapped_baked_front.png
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,6 +26,9 @@ mkdir -p "$out"
 "$tool" render "$out/double_torus.obj" "$out/double_torus.png" "$out/double_torus_side.png" --yaw -40 --pitch 55
 "$tool" render "$out/double_torus.obj" "$out/double_torus.png" "$out/double_torus_closeup.png" \
     --yaw 10 --pitch 30 --zoom 3 --size 900x600 --wireframe
+"$tool" lapped "$out/double_torus_mesh.obj" "$out/texture.png" "$out/lapped" --scale 1.2 --seed 1 --bake 2048
+"$tool" render "$out/lapped.obj" "$out/lapped_patch.png" "$out/lapped_front.png" --yaw 20 --pitch 15
+"$tool" render "$out/lapped_baked.obj" "$out/lapped_baked.png" "$out/lapped_baked_front.png" --yaw 20 --pitch 15
 
 echo
 echo "pictures:"
@@ -31,3 +37,5 @@ echo "  $out/double_torus.png          the tile atlas made from it"
 echo "  $out/double_torus_front.png    the textured double torus"
 echo "  $out/double_torus_side.png     the same from another side"
 echo "  $out/double_torus_closeup.png  close up, with the quads drawn: the stones run across every edge"
+echo "  $out/lapped_front.png          lapped textures: overlapping pastes of one patch, drawn in order"
+echo "  $out/lapped_baked_front.png    the same pastes baked into one texture over an atlas of triangle pairs"
