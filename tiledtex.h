@@ -818,7 +818,9 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         a side); a sample is covered when a paste puts it so deep inside the
         patch's opaque part (alpha >= TT_LAPPED_OPAQUE) that every point of
         the face near it, and every texel a bilinear lookup there reads, is
-        opaque too - so the gaps between samples are covered as well.
+        opaque too - so the gaps between samples are covered as well. The
+        seed point itself always counts (it sits on the deepest texel), so
+        every paste makes progress.
    Then, walking the pastes from last to first, a face whose samples are all
    covered by later pastes is removed from the earlier paste (Sec. 4).
 
