@@ -5018,6 +5018,8 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 #define TT__LAPPED_RESOLVE_FRACTION 10
 /* Relative residual of the alignment solve: UVs to well under a texel. */
 #define TT__LAPPED_CG_TOLERANCE 1e-5
+/* Early seed faces: the most difficult of this many random draws. */
+#define TT__LAPPED_PRIORITY_DRAWS 8
 /* Consecutive pastes that cover no new sample before the loop gives up. */
 #define TT__LAPPED_STALL_LIMIT 64
 
@@ -5044,6 +5046,7 @@ typedef struct tt__lapper {
     /* per face */
     double *normal;             /* 3 per face */
     double *tangent;            /* 3 per face: T of the current paste (isotropic: propagated) */
+    float *difficulty;          /* tt__face_difficulty, for the seed priority */
     int *sample_res;            /* R of the face's sample raster */
     int *sample_start;          /* nfaces + 1: its samples in covered[] */
     unsigned char *covered;     /* one byte per sample */
@@ -5559,6 +5562,49 @@ static long long tt__record_paste(tt__lapper *L, int patch)
     return added;
 }
 
+/* Sec. 3.3: "Early in the process we give higher priority both to areas of
+   high curvature and to discontinuities in the direction field - where the
+   parametrization is difficult - with the hope that any distorted regions
+   will be covered over later." Until half the samples are covered, the seed
+   face is the most difficult of TT__LAPPED_PRIORITY_DRAWS random uncovered
+   faces; then any uncovered face, uniformly. */
+static int tt__pick_seed_face(tt__lapper *L)
+{
+    int f = L->uncovered[tt_rng_below(&L->rng, (uint32_t)L->nuncovered)], k;
+    if (2 * L->covered_samples >= L->total_samples) return f;
+    for (k = 1; k < TT__LAPPED_PRIORITY_DRAWS; k++) {
+        int g = L->uncovered[tt_rng_below(&L->rng, (uint32_t)L->nuncovered)];
+        if (L->difficulty[g] > L->difficulty[f]) f = g;
+    }
+    return f;
+}
+
+/* How hard face f is to parametrize: the largest bend to a neighbour (angle
+   between normals) plus the largest turn of the field across an edge (the
+   neighbour's vector carried over by parallel transport), in radians. The
+   field does not count in isotropic mode. */
+static float tt__face_difficulty(const tt__lapper *L, int f)
+{
+    const tt_mesh *mesh = L->mesh;
+    const double *n = L->normal + 3 * (size_t)f, *t = L->tangent + 3 * (size_t)f;
+    double worst = 0.0;
+    int k;
+    for (k = 0; k < 3; k++) {
+        int c = mesh->twin[3 * f + k], g;
+        double bend, turn = 0.0, carried[3], tn;
+        if (c < 0) continue;
+        g = c / 3;
+        bend = acos(tt__clamp_f((float)tt__dot3(n, L->normal + 3 * (size_t)g), -1.0f, 1.0f));
+        if (!L->isotropic) {
+            tt__field_transport(mesh, c, L->normal + 3 * (size_t)g, n, L->tangent + 3 * (size_t)g, carried);
+            tn = sqrt(tt__dot3(t, t) * tt__dot3(carried, carried));
+            if (tn > 0.0) turn = acos(tt__clamp_f((float)(tt__dot3(t, carried) / tn), -1.0f, 1.0f));
+        }
+        if (bend + turn > worst) worst = bend + turn;
+    }
+    return (float)worst;
+}
+
 static void tt__lapper_free(tt__lapper *L)
 {
     int i;
@@ -5573,6 +5619,7 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->anchor);
     tt__free(L->al, L->normal);
     tt__free(L->al, L->tangent);
+    tt__free(L->al, L->difficulty);
     tt__free(L->al, L->sample_res);
     tt__free(L->al, L->sample_start);
     tt__free(L->al, L->covered);
@@ -5630,6 +5677,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->anchor = TT__ALLOC(L->al, float, 2 * (size_t)L->npatches);
     L->normal = TT__ALLOC(L->al, double, 3 * (size_t)nf);
     L->tangent = TT__ALLOC(L->al, double, 3 * (size_t)nf);
+    L->difficulty = TT__ALLOC(L->al, float, nf);
     L->sample_res = TT__ALLOC(L->al, int, nf);
     L->sample_start = TT__ALLOC(L->al, int, (size_t)nf + 1);
     L->covered_count = TT__ALLOC(L->al, int, nf);
@@ -5645,7 +5693,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->heap = TT__ALLOC(L->al, tt__heap_item, mesh->ncorners);
     L->triplets = TT__ALLOC(L->al, tt_triplet, 9 * ((size_t)nf + 1));
     L->solve = TT__ALLOC(L->al, double, 4 * (size_t)nv);
-    if (!L->hull || !L->hull_count || !L->anchor || !L->normal || !L->tangent || !L->sample_res ||
+    if (!L->hull || !L->hull_count || !L->anchor || !L->normal || !L->tangent || !L->difficulty || !L->sample_res ||
         !L->sample_start || !L->covered_count || !L->uncovered || !L->uncovered_pos || !L->face_stamp ||
         !L->vert_stamp || !L->edge_stamp || !L->vert_local || !L->vert_uv || !L->patch_faces ||
         !L->patch_verts || !L->heap || !L->triplets || !L->solve || !L->depth)
@@ -5760,6 +5808,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         L->face_stamp[f] = -1;
     }
     L->nuncovered = nf;
+    for (f = 0; f < nf; f++) L->difficulty[f] = tt__face_difficulty(L, f);
     for (i = 0; i < nv; i++) L->vert_stamp[i] = -1;
     for (i = 0; i < mesh->ncorners; i++) L->edge_stamp[i] = -1;
     L->round_stamp = 0;
@@ -5773,7 +5822,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
 static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_weight[3])
 {
     const tt_mesh *mesh = L->mesh;
-    int f = L->uncovered[tt_rng_below(&L->rng, (uint32_t)L->nuncovered)];
+    int f = tt__pick_seed_face(L);
     int r = L->sample_res[f], count = L->sample_start[f + 1] - L->sample_start[f];
     int pick = (int)tt_rng_below(&L->rng, (uint32_t)(count - L->covered_count[f])), s, k;
     int patch = (int)tt_rng_below(&L->rng, (uint32_t)L->npatches);
