@@ -48,6 +48,12 @@ else
   echo "fuzz: fuzz_mesh_build does not build" >&2
   exit 2
 fi
+if $cc $flags $warn -I. tests/fuzz/fuzz_lapped.c -o "$out/fuzz_lapped" -lm; then
+  targets+=(lapped)
+else
+  echo "fuzz: fuzz_lapped does not build" >&2
+  exit 2
+fi
 if [ -f examples/tool_io.c ] && [ -f examples/tool.h ]; then
   # tool_io.c is compiled as it is; fuzz_obj.c is the one TU that defines
   # TILEDTEX_IMPLEMENTATION.
