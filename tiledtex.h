@@ -5020,8 +5020,6 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 #define TT__LAPPED_CG_TOLERANCE 1e-5
 /* Early seed faces: the most difficult of this many random draws. */
 #define TT__LAPPED_PRIORITY_DRAWS 8
-/* Consecutive pastes that cover no new sample before the loop gives up. */
-#define TT__LAPPED_STALL_LIMIT 64
 
 /* One face of one paste (Sec. 3.5), with its alignment error (Sec. 3.4). */
 typedef struct tt__entry {
@@ -5979,7 +5977,7 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
     tt__lapper L;
     tt_lapped_options opts;
     tt_result r;
-    int max_pastes, stall = 0;
+    int max_pastes;
     if (result) memset(result, 0, sizeof *result);
     if (!mesh || !face_vectors || !patches || !result)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -6032,13 +6030,6 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
         added = tt__record_paste(&L, patch);
         if (added < 0) {
             r = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
-            break;
-        }
-        stall = added > 0 ? 0 : stall + 1;
-        if (stall >= TT__LAPPED_STALL_LIMIT) {
-            r = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
-                         "%d pastes in a row covered nothing new; %d faces are left uncovered",
-                         stall, L.nuncovered);
             break;
         }
         if (opts.progress && opts.progress((float)((double)L.covered_samples / (double)L.total_samples),
