@@ -5324,6 +5324,51 @@ static void test_lapped_determinism(void)
     tt_image_free(&patch);
 }
 
+/* Several texture patches: each paste picks one at random, all get used,
+   and the mesh is covered with the right patch's alpha. */
+static void test_lapped_patches(void)
+{
+    tmesh m;
+    tt_mesh *mesh;
+    tt_mesh_desc d;
+    tt_field_options fo;
+    tt_lapped_options lo;
+    tt_lapped out;
+    tt_error err;
+    tt_image patches[3];
+    float *field;
+    int used[3] = {0, 0, 0}, p, f, bad = 0;
+    tt_result r;
+    make_lapped_shape(&m, 0);
+    d = tm_desc(&m);
+    tt_mesh_build(&d, &mesh, &err);
+    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&fo, 0, sizeof fo);
+    tt_tangent_field(mesh, &fo, field, &err);
+    lapped_patch(&patches[0], 48, 1);
+    lapped_patch(&patches[1], 64, 2);
+    lapped_patch(&patches[2], 40, 3);
+    memset(&lo, 0, sizeof lo);
+    lo.seed = 5;
+    r = tt_lapped_paste(mesh, field, patches, 3, &lo, &out, &err);
+    CHECK(r == TT_OK, "three patches: %d %s", r, err.message);
+    for (p = 0; p < out.npastes; p++)
+        if (out.pastes[p].patch >= 0 && out.pastes[p].patch < 3) used[out.pastes[p].patch]++;
+        else bad++;
+    CHECK(bad == 0 && used[0] > 0 && used[1] > 0 && used[2] > 0, "patches used %d %d %d, %d out of range", used[0],
+          used[1], used[2], bad);
+    for (f = 0; f < mesh->nfaces; f++) {
+        double w[3] = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
+        if (lapped_alpha_at(&out, patches, f, w) < 0.98) bad++;
+    }
+    CHECK(bad == 0, "three patches: %d face centres not opaque", bad);
+    tt_lapped_free(&out);
+    for (p = 0; p < 3; p++) tt_image_free(&patches[p]);
+    tt_mesh_free(mesh);
+    free(field);
+    tm_free(&m);
+}
+
 typedef struct lapped_progress {
     int calls, cancel_at;
     float last;
@@ -7099,6 +7144,7 @@ int main(void)
     RUN(test_lapped_plane);
     RUN(test_lapped_cover);
     RUN(test_lapped_determinism);
+    RUN(test_lapped_patches);
     RUN(test_lapped_errors);
     RUN(test_lapped_oom);
     RUN(test_hull_shapes);
