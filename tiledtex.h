@@ -10,8 +10,8 @@
    every function static to that one file.
 
    Optional overrides (define before the implementation; all or none):
-       TT_MALLOC(size, user_data)   default malloc(size)
-       TT_FREE(ptr, user_data)      default free(ptr)
+       TT_MALLOC(size, user_data)   default: the C library's malloc
+       TT_FREE(ptr, user_data)      default: the C library's free
    Every allocation also honours the
    tt_allocator you may pass in an options struct, so nothing here is global.
 
@@ -31,8 +31,8 @@
 
    QUICK START: lapped textures on a triangle mesh (Praun et al.)
 
-       float *field = malloc(sizeof(float) * 3 * mesh->nfaces);
-       tt_tangent_field(mesh, NULL, field, &err);               // up = +Y, scale 0.1 * diagonal
+       tt_tangent_field(mesh, NULL, field, &err);               // float field[3 * ntris]: up = +Y,
+                                                                //   length 0.1 * bbox diagonal
        tt_image patch; tt_make_texture_patch(&photo, NULL, NULL, &patch, &err);
        tt_lapped pastes = {0};
        tt_lapped_paste(mesh, field, &patch, 1, NULL, &pastes, &err);
