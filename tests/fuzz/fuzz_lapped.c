@@ -54,6 +54,8 @@
    value; TT_ERROR_OUT_OF_MEMORY when no allocation failed. */
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
+#define FUZZ_NAME "fuzz_lapped"
+#include "fuzz_common.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -64,57 +66,6 @@
 #define MAX_TRIS 40
 #define MAX_PASTES 100
 #define ATLAS_SIZE 128
-
-/* ---- counting allocator that can fail once ---------------------------------- */
-
-typedef struct fz_alloc {
-    long count;         /* allocations asked for */
-    long live;          /* allocations not yet freed */
-    long fail_at;       /* 1-based allocation number that returns NULL, 0 = none */
-    int failed;         /* an allocation did fail */
-} fz_alloc;
-
-static void *fz_malloc(size_t size, void *user)
-{
-    fz_alloc *a = (fz_alloc *)user;
-    void *p;
-    a->count++;
-    if (a->fail_at && a->count == a->fail_at) {
-        a->failed = 1;
-        return NULL;
-    }
-    p = malloc(size ? size : 1);
-    if (p) a->live++;
-    return p;
-}
-
-static void fz_free(void *p, void *user)
-{
-    fz_alloc *a = (fz_alloc *)user;
-    if (p) {
-        a->live--;
-        free(p);
-    }
-}
-
-#define CHECK(cond, ...)                                                  \
-    do {                                                                  \
-        if (!(cond)) {                                                    \
-            fprintf(stderr, "fuzz_lapped: contract broken: %s: ", #cond); \
-            fprintf(stderr, __VA_ARGS__);                                 \
-            fprintf(stderr, "\n");                                        \
-            abort();                                                      \
-        }                                                                 \
-    } while (0)
-
-/* ---- input reader --------------------------------------------------------------- */
-
-typedef struct reader {
-    const uint8_t *p;
-    size_t n, at;
-} reader;
-
-static uint8_t rd_u8(reader *r) { return r->at < r->n ? r->p[r->at++] : 0; }
 
 /* ---- the fixed texture patch ------------------------------------------------------ */
 

@@ -38,6 +38,8 @@
    a sentence, or TT_ERROR_OUT_OF_MEMORY when no allocation failed. */
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
+#define FUZZ_NAME "fuzz_mesh_build"
+#include "fuzz_common.h"
 
 #include <float.h>
 #include <limits.h>
@@ -45,57 +47,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* ---- counting allocator that can fail once ---------------------------------- */
-
-typedef struct fz_alloc {
-    long count;         /* allocations asked for */
-    long live;          /* allocations not yet freed */
-    long fail_at;       /* 1-based allocation number that returns NULL, 0 = none */
-    int failed;         /* an allocation did fail */
-} fz_alloc;
-
-static void *fz_malloc(size_t size, void *user)
-{
-    fz_alloc *a = (fz_alloc *)user;
-    void *p;
-    a->count++;
-    if (a->fail_at && a->count == a->fail_at) {
-        a->failed = 1;
-        return NULL;
-    }
-    p = malloc(size ? size : 1);
-    if (p) a->live++;
-    return p;
-}
-
-static void fz_free(void *p, void *user)
-{
-    fz_alloc *a = (fz_alloc *)user;
-    if (p) {
-        a->live--;
-        free(p);
-    }
-}
-
-#define CHECK(cond, ...)                                                  \
-    do {                                                                  \
-        if (!(cond)) {                                                    \
-            fprintf(stderr, "fuzz_mesh_build: contract broken: %s: ", #cond); \
-            fprintf(stderr, __VA_ARGS__);                                 \
-            fprintf(stderr, "\n");                                        \
-            abort();                                                      \
-        }                                                                 \
-    } while (0)
-
-/* ---- input reader --------------------------------------------------------------- */
-
-typedef struct reader {
-    const uint8_t *p;
-    size_t n, at;
-} reader;
-
-static uint8_t rd_u8(reader *r) { return r->at < r->n ? r->p[r->at++] : 0; }
 
 static float coord_from_byte(uint8_t b)
 {

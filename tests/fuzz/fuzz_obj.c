@@ -22,21 +22,13 @@
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #include "tool.h"
+#define FUZZ_NAME "fuzz_obj"
+#include "fuzz_common.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define CHECK(cond, ...)                                                  \
-    do {                                                                  \
-        if (!(cond)) {                                                    \
-            fprintf(stderr, "fuzz_obj: contract broken: %s: ", #cond);    \
-            fprintf(stderr, __VA_ARGS__);                                 \
-            fprintf(stderr, "\n");                                        \
-            abort();                                                      \
-        }                                                                 \
-    } while (0)
 
 static int same_float(float a, float b)
 {
