@@ -86,63 +86,54 @@ compile_check "user-defined TT_MALLOC/TT_FREE" user_alloc \
     fi
 }
 
-# The QUICK START block at the top of tiledtex.h, exactly as printed there,
-# inside a program that gives it a mesh (a 2x2 grid of quads) and a photo:
-# documentation that compiles, runs and makes an atlas.
-{
-    src=$OUT/quickstart.c
+# A QUICK START block of tiledtex.h, exactly as printed there (from the line
+# after its heading up to the line before `end`, comments dropped), inside a
+# program that gives it its inputs and checks its result: documentation that
+# compiles and runs. Arguments: name, heading pattern, end pattern, what it
+# does (for the report), the C lines before the block and after it (each one
+# string of newline-separated lines).
+quickstart_check() {
+    local name=$1 heading=$2 end=$3 what=$4 before=$5 after=$6 src=$OUT/$1.c log
     {
         printf '%s\n' '#include <stdio.h>' '#include <stdlib.h>' '#define TILEDTEX_IMPLEMENTATION' \
-            '#include "tiledtex.h"' 'int main(void) {' \
-            'static const float xyz[27] = {0,0,0, 1,0,0, 2,0,0, 0,1,0, 1,1,0, 2,1,0, 0,2,0, 1,2,0, 2,2,0};' \
-            'static const int quads[16] = {0,1,4,3, 1,2,5,4, 3,4,7,6, 4,5,8,7};' \
-            'int nverts = 9, nquads = 4, x; uint8_t types[16]; float uv[32];' \
-            'tt_image photo; tt_image_create(&photo, 128, 256, NULL);' \
-            'for (x = 0; x < 128 * 256 * 4; x++) photo.pixels[x] = (float)((x * 37) % 101) / 100.0f;' \
-            '{'
-        sed -n '/QUICK START: tile/,/QUICK START: lapped/p' tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
-        printf '%s\n' 'if (!tiles || tiles->levels[0].width != 4 * (128 + 8)) return 2;' \
-            'tt_tileset_free(tiles); tt_mesh_free(mesh); }' \
-            'tt_image_free(&photo); return 0; }'
+            '#include "tiledtex.h"' 'int main(void) {' "$before" '{'
+        sed -n "/$heading/,/$end/p" tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
+        printf '%s\n' "$after"
     } >"$src"
     if log=$(gcc -std=c99 -Wall -Wextra -pedantic -Werror -Wno-declaration-after-statement -I. -g \
-            -fsanitize=address,undefined "$src" -o "$OUT/quickstart" -lm 2>&1) && log=$("$OUT/quickstart" 2>&1); then
-        pass "docs: the QUICK START in tiledtex.h compiles, runs and makes a 544x544 atlas"
+            -fsanitize=address,undefined "$src" -o "$OUT/$name" -lm 2>&1) && log=$("$OUT/$name" 2>&1); then
+        pass "docs: the $heading in tiledtex.h compiles, runs and $what"
     else
-        fail "docs: the QUICK START in tiledtex.h does not compile or run" "$log"
+        fail "docs: the $heading in tiledtex.h does not compile or run" "$log"
     fi
 }
 
-# The lapped-textures QUICK START, in a program that gives it a triangle mesh
-# (a 4x4 grid of squares split in two), a photo, UV storage and an atlas.
-{
-    src=$OUT/quickstart_lapped.c
-    {
-        printf '%s\n' '#include <stdio.h>' '#include <stdlib.h>' '#define TILEDTEX_IMPLEMENTATION' \
-            '#include "tiledtex.h"' 'int main(void) {' \
-            'float xyz[75], field[96], corner_uv[192]; int tris[96], i, j, n = 0;' \
-            'tt_mesh_desc desc = {0}; tt_mesh *mesh; tt_error err; tt_image photo, atlas;' \
-            'for (j = 0; j < 5; j++) for (i = 0; i < 5; i++) { xyz[3*(5*j+i)] = (float)i; xyz[3*(5*j+i)+1] = (float)j; xyz[3*(5*j+i)+2] = 0; }' \
-            'for (j = 0; j < 4; j++) for (i = 0; i < 4; i++) { int a = 5*j+i; tris[n++] = a; tris[n++] = a+1; tris[n++] = a+6; tris[n++] = a; tris[n++] = a+6; tris[n++] = a+5; }' \
-            'desc.positions = xyz; desc.nverts = 25; desc.indices = tris; desc.nfaces = 32; desc.fixed_face_size = 3;' \
-            'if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) return 3;' \
-            'tt_image_create(&photo, 64, 64, NULL); tt_image_create(&atlas, 256, 256, NULL);' \
-            'for (i = 0; i < 64 * 64 * 4; i++) photo.pixels[i] = (float)((i * 37) % 101) / 100.0f;' \
-            'for (i = 0; i < 64 * 64; i++) photo.pixels[4 * i + 3] = 1.0f;' \
-            '{'
-        sed -n '/QUICK START: lapped/,/Triangles or n-gons?/p' tiledtex.h | sed '1d;$d' | sed 's|//.*$||'
-        printf '%s\n' 'if (pastes.npastes < 1 || pastes.coverage != 1.0 || atlas.pixels[4 * 300 + 3] != 1.0f) return 2;' \
-            'tt_lapped_free(&pastes); tt_image_free(&patch); }' \
-            'tt_mesh_free(mesh); tt_image_free(&atlas); tt_image_free(&photo); return 0; }'
-    } >"$src"
-    if log=$(gcc -std=c99 -Wall -Wextra -pedantic -Werror -Wno-declaration-after-statement -I. -g \
-            -fsanitize=address,undefined "$src" -o "$OUT/quickstart_lapped" -lm 2>&1) &&
-        log=$("$OUT/quickstart_lapped" 2>&1); then
-        pass "docs: the lapped-textures QUICK START in tiledtex.h compiles, runs, covers and bakes"
-    else
-        fail "docs: the lapped-textures QUICK START in tiledtex.h does not compile or run" "$log"
-    fi
-}
+# Tiled textures: a 2x2 grid of quads and a photo; it must make the atlas.
+quickstart_check quickstart "QUICK START: tile" "QUICK START: lapped" "makes a 544x544 atlas" \
+    'static const float xyz[27] = {0,0,0, 1,0,0, 2,0,0, 0,1,0, 1,1,0, 2,1,0, 0,2,0, 1,2,0, 2,2,0};
+static const int quads[16] = {0,1,4,3, 1,2,5,4, 3,4,7,6, 4,5,8,7};
+int nverts = 9, nquads = 4, x; uint8_t types[16]; float uv[32];
+tt_image photo; tt_image_create(&photo, 128, 256, NULL);
+for (x = 0; x < 128 * 256 * 4; x++) photo.pixels[x] = (float)((x * 37) % 101) / 100.0f;' \
+    'if (!tiles || tiles->levels[0].width != 4 * (128 + 8)) return 2;
+tt_tileset_free(tiles); tt_mesh_free(mesh); }
+tt_image_free(&photo); return 0; }'
+
+# Lapped textures: a 4x4 grid of squares split in two, a photo, field and UV
+# storage and an atlas; it must cover the mesh and fill the atlas.
+quickstart_check quickstart_lapped "QUICK START: lapped" "Triangles or n-gons?" "covers and bakes" \
+    'float xyz[75], field[96], corner_uv[192]; int tris[96], i, j, n = 0;
+tt_mesh_desc desc = {0}; tt_mesh *mesh; tt_error err; tt_image photo, atlas;
+for (j = 0; j < 5; j++) for (i = 0; i < 5; i++) { xyz[3*(5*j+i)] = (float)i; xyz[3*(5*j+i)+1] = (float)j; xyz[3*(5*j+i)+2] = 0; }
+for (j = 0; j < 4; j++) for (i = 0; i < 4; i++) { int a = 5*j+i; tris[n++] = a; tris[n++] = a+1; tris[n++] = a+6; tris[n++] = a; tris[n++] = a+6; tris[n++] = a+5; }
+desc.positions = xyz; desc.nverts = 25; desc.indices = tris; desc.nfaces = 32; desc.fixed_face_size = 3;
+if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) return 3;
+tt_image_create(&photo, 64, 64, NULL); tt_image_create(&atlas, 256, 256, NULL);
+for (i = 0; i < 64 * 64 * 4; i++) photo.pixels[i] = (float)((i * 37) % 101) / 100.0f;
+for (i = 0; i < 64 * 64; i++) photo.pixels[4 * i + 3] = 1.0f;' \
+    'if (pastes.npastes < 1 || pastes.coverage != 1.0 || atlas.pixels[4 * 300 + 3] != 1.0f) return 2;
+tt_lapped_free(&pastes); tt_image_free(&patch); }
+tt_mesh_free(mesh); tt_image_free(&atlas); tt_image_free(&photo); return 0; }'
 
 # No raw allocation calls, in the code or in the documentation's examples
 # (which users copy): any malloc( free( realloc( calloc( that is not a member
