@@ -5205,21 +5205,19 @@ static void tt__face_vector_weights(const tt_mesh *mesh, int f, const double *t,
     w[0] = -w[1] - w[2];
 }
 
-/* phi(T_f) and phi(S_f) of face f under the current vertex UVs. */
-static void tt__face_axes_image(const tt__lapper *L, int f, double image_t[2], double image_s[2])
+/* phi(T_f) of face f under the current vertex UVs: what the alignment error
+   is read from. */
+static void tt__face_up_image(const tt__lapper *L, int f, double image_t[2])
 {
     const tt_mesh *mesh = L->mesh;
-    const double *t = L->tangent + 3 * (size_t)f;
-    double s[3], wt[3], ws[3];
+    double wt[3];
     int k;
-    tt__cross3(t, L->normal + 3 * (size_t)f, s);
-    tt__face_vector_weights(mesh, f, t, wt);
-    tt__face_vector_weights(mesh, f, s, ws);
-    image_t[0] = image_t[1] = image_s[0] = image_s[1] = 0.0;
+    tt__face_vector_weights(mesh, f, L->tangent + 3 * (size_t)f, wt);
+    image_t[0] = image_t[1] = 0.0;
     for (k = 0; k < 3; k++) {
         const double *uv = L->vert_uv + 2 * (size_t)mesh->corner_vert[3 * f + k];
-        image_t[0] += wt[k] * uv[0]; image_t[1] += wt[k] * uv[1];
-        image_s[0] += ws[k] * uv[0]; image_s[1] += ws[k] * uv[1];
+        image_t[0] += wt[k] * uv[0];
+        image_t[1] += wt[k] * uv[1];
     }
 }
 
@@ -5232,8 +5230,8 @@ static void tt__alignment_error(const double image_t[2], double *angle, double *
 
 static int tt__lapped_too_distorted(const tt__lapper *L, int f)
 {
-    double image_t[2], image_s[2], angle, scale, limit = 1.0 + TT_LAPPED_MAX_DISTORTION / 90.0;
-    tt__face_axes_image(L, f, image_t, image_s);
+    double image_t[2], angle, scale, limit = 1.0 + TT_LAPPED_MAX_DISTORTION / 90.0;
+    tt__face_up_image(L, f, image_t);
     tt__alignment_error(image_t, &angle, &scale);
     return !(angle <= TT_LAPPED_MAX_DISTORTION && scale <= limit && scale * limit >= 1.0);
 }
@@ -5527,7 +5525,7 @@ static long long tt__record_paste(tt__lapper *L, int patch)
     for (i = 0; i < L->npatch_faces; i++) {
         int f = L->patch_faces[i], got;
         tt__entry *entry;
-        double image_t[2], image_s[2], angle, scale;
+        double image_t[2], angle, scale;
         /* Sec. 3.3 stops growth where distortion becomes excessive; the
            optimization can still leave faces far off the field (near its
            singularities), and they are left out of the paste too: a hard
@@ -5539,7 +5537,7 @@ static long long tt__record_paste(tt__lapper *L, int patch)
             entry->uv[2 * k] = (float)p[0];
             entry->uv[2 * k + 1] = (float)p[1];
         }
-        tt__face_axes_image(L, f, image_t, image_s);
+        tt__face_up_image(L, f, image_t);
         tt__alignment_error(image_t, &angle, &scale);
         entry->face = f;
         entry->paste = paste;
