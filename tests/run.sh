@@ -5,7 +5,8 @@
 #      strict warnings, g++ as C++, clang, tcc, TILEDTEX_STATIC (every function
 #      used, and only one used), user-defined TT_MALLOC/TT_FREE, and no raw
 #      malloc/free/realloc/calloc outside the TT_MALLOC/TT_FREE defaults;
-#   2. the unit tests, tests/test_tiledtex.c, with ASan + UBSan;
+#   2. the unit tests, tests/test_*.c (test_common.c and one file per section
+#      of the header, built into one program), with ASan + UBSan;
 #   3. if tests/e2e.sh exists: a sanitizer build of the tool and the
 #      end-to-end tests.
 # The last line is "N passed, M failed" over everything; the exit status is
@@ -173,13 +174,13 @@ run_counted() {
     fi
 }
 
-echo "== unit tests (tests/test_tiledtex.c, ASan + UBSan)"
+echo "== unit tests (tests/test_*.c, ASan + UBSan)"
 if log=$($CC -std=c99 -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -Wall -Wextra -pedantic -I. \
-    tests/test_tiledtex.c -o "$OUT/test_tiledtex" -lm 2>&1); then
+    tests/test_*.c -o "$OUT/unit" -lm 2>&1); then
     [ -n "$log" ] && printf '%s\n' "$log"
-    run_counted test_tiledtex "$OUT/test_tiledtex"
+    run_counted unit "$OUT/unit"
 else
-    fail "unit tests: tests/test_tiledtex.c does not build" "$log"
+    fail "unit tests: tests/test_*.c do not build" "$log"
 fi
 
 if [ -f tests/e2e.sh ]; then

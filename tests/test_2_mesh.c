@@ -1,0 +1,1277 @@
+/* tests/test_2_mesh.c - unit tests for section 2 of tiledtex.h: the mesh
+   builder, queries and quadrangulation. Run by run_mesh_tests()
+   (tests/test_common.c calls it). */
+#include "test_common.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------ */
+/* 2. Mesh: the builder                                                     */
+/* ------------------------------------------------------------------------ */
+
+/* Boundary quads of a set of unit voxels (filled[x + nx*(y + ny*z)]), on
+   the lattice (nx+1)(ny+1)(nz+1); outward CCW. Used lattice points only. */
+static void make_voxels(tmesh *m, int nx, int ny, int nz, const unsigned char *filled, double ox)
+{
+    int *lat = (int *)malloc(sizeof(int) * (size_t)(nx + 1) * (ny + 1) * (nz + 1));
+    int x, y, z, i, dir;
+    /* corner offsets per direction: +x, -x, +y, -y, +z, -z */
+    static const int off[6][4][3] = {
+        {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}},
+        {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}},
+        {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},
+        {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}},
+        {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
+        {{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}};
+    static const int nb[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (i = 0; i < (nx + 1) * (ny + 1) * (nz + 1); i++) lat[i] = -1;
+    for (z = 0; z < nz; z++)
+        for (y = 0; y < ny; y++)
+            for (x = 0; x < nx; x++) {
+                if (!filled[x + nx * (y + ny * z)]) continue;
+                for (dir = 0; dir < 6; dir++) {
+                    int X = x + nb[dir][0], Y = y + nb[dir][1], Z = z + nb[dir][2], v[4];
+                    if (X >= 0 && Y >= 0 && Z >= 0 && X < nx && Y < ny && Z < nz && filled[X + nx * (Y + ny * Z)])
+                        continue;
+                    for (i = 0; i < 4; i++) {
+                        int px = x + off[dir][i][0], py = y + off[dir][i][1], pz = z + off[dir][i][2];
+                        int li = px + (nx + 1) * (py + (ny + 1) * pz);
+                        if (lat[li] < 0) lat[li] = tm_vert(m, ox + px, py, pz);
+                        v[i] = lat[li];
+                    }
+                    tm_face(m, 4, v);
+                }
+            }
+    free(lat);
+}
+
+static void make_cube(tmesh *m, double ox)
+{
+    unsigned char one = 1;
+    make_voxels(m, 1, 1, 1, &one, ox);
+}
+
+/* 3 x 5 x 1 slab with holes at (1,1) and (1,3): a genus-2 polycube. */
+static void make_genus2(tmesh *m)
+{
+    unsigned char f[15];
+    int i;
+    for (i = 0; i < 15; i++) f[i] = 1;
+    f[1 + 3 * 1] = 0;
+    f[1 + 3 * 3] = 0;
+    make_voxels(m, 3, 5, 1, f, 0.0);
+}
+
+/* A closed mesh of mixed polygon sizes: a pentagonal prism (2 pentagons,
+   5 quads) and, beside it, a square pyramid (1 quad, 4 triangles). */
+static void make_mixed(tmesh *m)
+{
+    const double pi = 3.14159265358979323846;
+    int bot[5], top[5], i, v[5], p[5];
+    for (i = 0; i < 5; i++) {
+        double a = 2 * pi * i / 5;
+        bot[i] = tm_vert(m, cos(a), sin(a), 0);
+        top[i] = tm_vert(m, cos(a), sin(a), 1);
+    }
+    for (i = 0; i < 5; i++) v[i] = top[i];
+    tm_face(m, 5, v);                                     /* top, CCW from +z */
+    for (i = 0; i < 5; i++) v[i] = bot[4 - i];
+    tm_face(m, 5, v);                                     /* bottom, CCW from -z */
+    for (i = 0; i < 5; i++) tm_quad(m, bot[i], bot[(i + 1) % 5], top[(i + 1) % 5], top[i]);
+    p[0] = tm_vert(m, 5, 0, 0);
+    p[1] = tm_vert(m, 6, 0, 0);
+    p[2] = tm_vert(m, 6, 1, 0);
+    p[3] = tm_vert(m, 5, 1, 0);
+    p[4] = tm_vert(m, 5.5, 0.5, 1);
+    tm_quad(m, p[0], p[3], p[2], p[1]);                   /* base, seen from below */
+    for (i = 0; i < 4; i++) tm_tri(m, p[i], p[(i + 1) % 4], p[4]);
+}
+
+/* Half-edges without a reversed partner anywhere (a naive O(n^2) count). */
+static int count_boundary_naive(const tmesh *m)
+{
+    int f, c, g, c2, start = 0, n = 0, s2;
+    for (f = 0; f < m->nf; f++) {
+        for (c = start; c < start + m->sizes[f]; c++) {
+            int a = m->idx[c], b = m->idx[c + 1 < start + m->sizes[f] ? c + 1 : start], found = 0;
+            for (g = 0, s2 = 0; g < m->nf && !found; s2 += m->sizes[g], g++)
+                for (c2 = s2; c2 < s2 + m->sizes[g]; c2++) {
+                    int a2 = m->idx[c2], b2 = m->idx[c2 + 1 < s2 + m->sizes[g] ? c2 + 1 : s2];
+                    if (a2 == b && b2 == a) { found = 1; break; }
+                }
+            n += !found;
+        }
+        start += m->sizes[f];
+    }
+    return n;
+}
+
+/* Structural invariants of a built mesh against its description (each kind
+   of violation is one check). */
+static void check_structure(const tt_mesh *mesh, const tmesh *m, const char *name)
+{
+    int c, f, v, bad_twin = 0, bad_rev = 0, bad_face = 0, bad_vc = 0, bad_vb = 0, bad_cv = 0, nboundary = 0;
+    CHECK(mesh->nverts == m->nv && mesh->nfaces == m->nf && mesh->ncorners == m->nc,
+          "%s: counts: expected %d/%d/%d, got %d/%d/%d", name, m->nv, m->nf, m->nc, mesh->nverts, mesh->nfaces,
+          mesh->ncorners);
+    for (f = 0, c = 0; f < m->nf; f++) {
+        if (mesh->face_start[f] != c) bad_face++;
+        c += m->sizes[f];
+    }
+    if (mesh->face_start[m->nf] != m->nc) bad_face++;
+    for (f = 0; f < m->nf; f++)
+        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++)
+            if (mesh->corner_face[c] != f) bad_face++;
+    for (c = 0; c < m->nc; c++) {
+        int t = mesh->twin[c];
+        if (mesh->corner_vert[c] != m->idx[c]) bad_cv++;
+        if (t < 0) { nboundary++; continue; }
+        if (t >= m->nc || mesh->twin[t] != c || t == c) { bad_twin++; continue; }
+        /* reversed: twin's origin is my destination and vice versa */
+        if (mesh->corner_vert[t] != mesh->corner_vert[tt_mesh_next(mesh, c)] ||
+            mesh->corner_vert[tt_mesh_next(mesh, t)] != mesh->corner_vert[c])
+            bad_rev++;
+    }
+    for (v = 0; v < m->nv; v++) {
+        int vc = mesh->vert_corner[v], has_boundary = 0, used = 0;
+        for (c = 0; c < m->nc; c++)
+            if (m->idx[c] == v) {
+                used = 1;
+                if (mesh->twin[c] < 0) has_boundary = 1;
+            }
+        if (!used) { if (vc != -1) bad_vc++; continue; }
+        if (vc < 0 || vc >= m->nc || mesh->corner_vert[vc] != v) { bad_vc++; continue; }
+        if (has_boundary && mesh->twin[vc] >= 0) bad_vb++;
+    }
+    /* next/prev are inverse and stay in the face */
+    for (c = 0; c < m->nc; c++) {
+        int n = tt_mesh_next(mesh, c);
+        if (tt_mesh_prev(mesh, n) != c || mesh->corner_face[n] != mesh->corner_face[c]) bad_face++;
+    }
+    CHECK(bad_face == 0, "%s: face_start/corner_face/next/prev inconsistent in %d places", name, bad_face);
+    CHECK(bad_cv == 0, "%s: corner_vert differs from the index buffer in %d corners", name, bad_cv);
+    CHECK(bad_twin == 0, "%s: %d twins not mutual", name, bad_twin);
+    CHECK(bad_rev == 0, "%s: %d twins not reversed", name, bad_rev);
+    CHECK(bad_vc == 0, "%s: %d vert_corner entries not an outgoing half-edge of their vertex", name, bad_vc);
+    CHECK(bad_vb == 0, "%s: %d boundary vertices whose vert_corner is not a boundary half-edge", name, bad_vb);
+    if (mesh->repaired_edges == 0)   /* repairs cut edges open on purpose */
+        CHECK(nboundary == count_boundary_naive(m), "%s: %d boundary half-edges, the naive count is %d", name,
+              nboundary, count_boundary_naive(m));
+}
+
+static int count_boundary(const tt_mesh *mesh)
+{
+    int c, n = 0;
+    for (c = 0; c < mesh->ncorners; c++) n += mesh->twin[c] < 0;
+    return n;
+}
+
+static void test_builder_valid(void)
+{
+    tmesh m;
+    tt_mesh *mesh;
+    tt_error err;
+    tt_result r;
+    counter cnt;
+    tt_mesh_desc d;
+
+    memset(&m, 0, sizeof m);
+    make_tetra(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "tetrahedron: expected TT_OK, got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "tetrahedron");
+        CHECK(count_boundary(mesh) == 0, "tetrahedron is closed, got %d boundary half-edges", count_boundary(mesh));
+        CHECK(mesh->min_face_size == 3 && mesh->max_face_size == 3, "tetrahedron face sizes %d..%d",
+              mesh->min_face_size, mesh->max_face_size);
+        CHECK(mesh->repaired_edges == 0, "strict build repaired %d edges", mesh->repaired_edges);
+        CHECK(mesh->pos != m.pos, "positions should be copied without TT_MESH_BORROW_POSITIONS");
+        CHECK(err.result == TT_OK && err.face == -1 && err.vertex == -1, "error cleared on success");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    make_cube(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "cube: expected TT_OK, got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "cube");
+        CHECK(count_boundary(mesh) == 0, "cube is closed, got %d boundary half-edges", count_boundary(mesh));
+        tt_mesh_free(mesh);
+    }
+    /* The same cube through fixed_face_size = 4 and a counting allocator. */
+    {
+        tt_allocator al = make_allocator(&cnt, -1);
+        d = tm_desc(&m);
+        d.face_sizes = NULL;
+        d.fixed_face_size = 4;
+        d.allocator = al;
+        r = tt_mesh_build(&d, &mesh, &err);
+        CHECK(r == TT_OK, "cube (fixed size 4): got %d", r);
+        if (r == TT_OK) {
+            check_structure(mesh, &m, "cube fixed");
+            CHECK(cnt.live > 0, "the mesh should be allocated through the given allocator");
+            tt_mesh_free(mesh);
+        }
+        CHECK(cnt.live == 0 && cnt.bad_frees == 0, "cube: %ld allocations leaked, %ld bad frees", cnt.live,
+              cnt.bad_frees);
+    }
+    /* TT_MESH_BORROW_POSITIONS */
+    r = build(&m, TT_MESH_BORROW_POSITIONS, &mesh, &err);
+    CHECK(r == TT_OK, "cube borrowed: got %d", r);
+    if (r == TT_OK) {
+        CHECK(mesh->pos == m.pos, "TT_MESH_BORROW_POSITIONS: mesh->pos should be desc.positions");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* Open square of two triangles */
+    tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 1, 1, 0); tm_vert(&m, 0, 1, 0);
+    tm_tri(&m, 0, 1, 2);
+    tm_tri(&m, 0, 2, 3);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "open square: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "open square");
+        CHECK(count_boundary(mesh) == 4, "open square: expected 4 boundary half-edges, got %d", count_boundary(mesh));
+        CHECK(mesh->twin[2] == 3 && mesh->twin[3] == 2, "open square: diagonal 2-0 / 0-2 should pair corners 2,3; got %d %d",
+              mesh->twin[2], mesh->twin[3]);
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    make_mixed(&m);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "mixed: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "mixed");
+        CHECK(count_boundary(mesh) == 0, "mixed is closed, got %d boundary half-edges", count_boundary(mesh));
+        CHECK(mesh->min_face_size == 3 && mesh->max_face_size == 5, "mixed face sizes: expected 3..5, got %d..%d",
+              mesh->min_face_size, mesh->max_face_size);
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* An unused vertex is allowed and gets vert_corner -1; a grid with
+       boundary and the genus-2 polycube pass the invariants too. */
+    make_grid(&m, 3, 2);
+    tm_vert(&m, 9, 9, 9);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "grid + unused vertex: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "grid");
+        CHECK(mesh->vert_corner[m.nv - 1] == -1, "unused vertex: vert_corner should be -1, got %d",
+              mesh->vert_corner[m.nv - 1]);
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+    make_genus2(&m);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "genus-2 polycube: got %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        check_structure(mesh, &m, "genus2");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* A large polygon (> 16 corners takes the stamping path). */
+    {
+        int i, v[40];
+        for (i = 0; i < 40; i++) v[i] = tm_vert(&m, cos(i * 0.15707963), sin(i * 0.15707963), 0);
+        tm_face(&m, 40, v);
+        r = build(&m, 0, &mesh, &err);
+        CHECK(r == TT_OK, "40-gon: got %d (%s)", r, err.message);
+        if (r == TT_OK) {
+            check_structure(mesh, &m, "40-gon");
+            tt_mesh_free(mesh);
+        }
+        tm_free(&m);
+    }
+}
+
+/* Naive reference for edge problems: the smallest corner of any edge used
+   twice in one direction; sets *code. Returns -1 when there is none. */
+static int naive_first_edge_problem(const tmesh *m, tt_result *code, int *va, int *vb)
+{
+    int *start = (int *)malloc(sizeof(int) * (size_t)(m->nf + 1));
+    int f, c, c2, best = -1;
+    start[0] = 0;
+    for (f = 0; f < m->nf; f++) start[f + 1] = start[f] + m->sizes[f];
+    for (f = 0; f < m->nf; f++)
+        for (c = start[f]; c < start[f + 1]; c++) {
+            int a = m->idx[c], b = m->idx[c + 1 < start[f + 1] ? c + 1 : start[f]], p = 0, q = 0, g, lowest = m->nc;
+            for (g = 0; g < m->nf; g++)
+                for (c2 = start[g]; c2 < start[g + 1]; c2++) {
+                    int a2 = m->idx[c2], b2 = m->idx[c2 + 1 < start[g + 1] ? c2 + 1 : start[g]];
+                    if (a2 == a && b2 == b) { p++; if (c2 < lowest) lowest = c2; }
+                    if (a2 == b && b2 == a) { q++; if (c2 < lowest) lowest = c2; }
+                }
+            if ((p > 1 || q > 1) && (best < 0 || lowest < best)) {
+                best = lowest;
+                *code = p + q > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
+                *va = a;
+                *vb = b;
+            }
+        }
+    free(start);
+    return best;
+}
+
+static int face_of_corner(const tmesh *m, int corner)
+{
+    int f, c = 0;
+    for (f = 0; f < m->nf; f++) {
+        if (corner < c + m->sizes[f]) return f;
+        c += m->sizes[f];
+    }
+    return -1;
+}
+
+/* Build m strictly and expect `code` with the given fields (-2 = don't care). */
+static void expect_build_error(const tmesh *m, tt_result code, int face, int corner, int vertex, const char *what)
+{
+    tt_mesh *mesh = (tt_mesh *)&mesh;   /* must become NULL */
+    tt_error err;
+    counter cnt;
+    tt_mesh_desc d = tm_desc(m);
+    tt_result r;
+    memset(&err, 0x55, sizeof err);
+    d.allocator = make_allocator(&cnt, -1);
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == code, "%s: expected result %d, got %d (%s)", what, code, r, err.message);
+    CHECK(mesh == NULL, "%s: *out_mesh should be NULL on failure", what);
+    CHECK(err.result == code, "%s: err.result expected %d, got %d", what, code, err.result);
+    if (face != -2) CHECK(err.face == face, "%s: err.face expected %d, got %d", what, face, err.face);
+    if (corner != -2) CHECK(err.corner == corner, "%s: err.corner expected %d, got %d", what, corner, err.corner);
+    if (vertex != -2) CHECK(err.vertex == vertex, "%s: err.vertex expected %d, got %d", what, vertex, err.vertex);
+    CHECK(err.message[0] != '\0' && memchr(err.message, '\0', sizeof err.message) != NULL,
+          "%s: the message should be a non-empty string", what);
+    if (face >= 0 || vertex >= 0)
+        CHECK((face >= 0 && msg_has_number(err.message, face)) || (vertex >= 0 && msg_has_number(err.message, vertex)),
+              "%s: message should name face %d or vertex %d: \"%s\"", what, face, vertex, err.message);
+    CHECK(cnt.live == 0 && cnt.bad_frees == 0, "%s: %ld allocations leaked on the error path", what, cnt.live);
+    if (r == TT_OK) tt_mesh_free(mesh);
+    /* The NULL error pointer is accepted too. */
+    mesh = (tt_mesh *)&mesh;
+    r = tt_mesh_build(&d, &mesh, NULL);
+    CHECK(r == code && mesh == NULL, "%s with error == NULL: expected %d, got %d", what, code, r);
+    if (r == TT_OK && mesh) tt_mesh_free(mesh);
+    CHECK(cnt.live == 0, "%s (error NULL): %ld allocations leaked", what, cnt.live);
+}
+
+/* Build permissively: expect success, repaired_edges in [min_repaired, ...]. */
+static void expect_permissive(const tmesh *m, int min_repaired, const char *what)
+{
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    counter cnt;
+    tt_mesh_desc d = tm_desc(m);
+    tt_result r;
+    d.flags = TT_MESH_PERMISSIVE;
+    d.allocator = make_allocator(&cnt, -1);
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_OK, "%s (permissive): expected TT_OK, got %d (%s)", what, r, err.message);
+    if (r == TT_OK) {
+        tt_mesh_stats st;
+        CHECK(mesh->repaired_edges >= min_repaired, "%s (permissive): repaired_edges expected >= %d, got %d", what,
+              min_repaired, mesh->repaired_edges);
+        CHECK((mesh->flags & TT_MESH_PERMISSIVE) != 0, "%s: mesh->flags should keep TT_MESH_PERMISSIVE", what);
+        check_structure(mesh, m, what);
+        CHECK(tt_mesh_compute_stats(mesh, &st) == TT_OK, "%s: stats on a permissive mesh", what);
+        tt_mesh_free(mesh);
+    }
+    CHECK(cnt.live == 0, "%s (permissive): %ld allocations leaked", what, cnt.live);
+}
+
+static void test_builder_errors(void)
+{
+    tmesh m;
+    tt_mesh *mesh;
+    tt_error err;
+    tt_result r;
+    tt_mesh_desc d;
+    memset(&m, 0, sizeof m);
+
+    /* NULLs and bad counts */
+    make_tetra(&m, 0);
+    d = tm_desc(&m);
+    r = tt_mesh_build(&d, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "out_mesh NULL: expected %d, got %d", TT_ERROR_INVALID_ARGUMENT, r);
+    mesh = (tt_mesh *)&mesh;
+    r = tt_mesh_build(NULL, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "desc NULL: expected %d, got %d", TT_ERROR_INVALID_ARGUMENT, r);
+    d.indices = NULL;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "indices NULL: got %d", r);
+    d = tm_desc(&m);
+    d.positions = NULL;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "positions NULL: got %d", r);
+    d = tm_desc(&m);
+    d.nverts = -1;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "nverts -1: got %d", r);
+    d = tm_desc(&m);
+    d.nfaces = -3;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "nfaces -3: got %d", r);
+    d = tm_desc(&m);
+    d.face_sizes = NULL;
+    d.fixed_face_size = 2;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_ERROR_FACE_TOO_SMALL && mesh == NULL, "fixed_face_size 2: expected %d, got %d",
+          TT_ERROR_FACE_TOO_SMALL, r);
+    /* fixed_face_size 0 means triangles */
+    d = tm_desc(&m);
+    d.face_sizes = NULL;
+    d.fixed_face_size = 0;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_OK, "fixed_face_size 0 (= 3) on a tetrahedron: got %d (%s)", r, err.message);
+    if (r == TT_OK) tt_mesh_free(mesh);
+
+    /* empty mesh */
+    {
+        tmesh e = m;
+        e.nf = 0;
+        expect_build_error(&e, TT_ERROR_EMPTY_MESH, -1, -1, -1, "empty mesh");
+    }
+    /* index out of range: negative, and too big */
+    m.idx[5] = -1;
+    expect_build_error(&m, TT_ERROR_INDEX_OUT_OF_RANGE, 1, 5, -1, "negative index");
+    m.idx[5] = 3;
+    m.idx[7] = 4;
+    expect_build_error(&m, TT_ERROR_INDEX_OUT_OF_RANGE, 2, 7, 4, "index too big");
+    m.idx[7] = 3;
+    /* face with 2 corners */
+    m.sizes[1] = 2;
+    expect_build_error(&m, TT_ERROR_FACE_TOO_SMALL, 1, 3, -2, "face_sizes entry 2");
+    m.sizes[1] = 3;
+    /* repeated vertex: face 2 = (a, d, a) */
+    {
+        int keep = m.idx[8];
+        m.idx[8] = m.idx[6];
+        expect_build_error(&m, TT_ERROR_REPEATED_VERTEX, 2, 8, m.idx[6], "repeated vertex");
+        m.idx[8] = keep;
+    }
+    /* NaN and infinite coordinates */
+    {
+        float keep = m.pos[3 * 2 + 1];
+        m.pos[3 * 2 + 1] = (float)NAN;
+        expect_build_error(&m, TT_ERROR_NON_FINITE, -1, -2, 2, "NaN coordinate");
+        m.pos[3 * 2 + 1] = keep;
+        keep = m.pos[3 * 3 + 2];
+        m.pos[3 * 3 + 2] = -(float)INFINITY;
+        expect_build_error(&m, TT_ERROR_NON_FINITE, -1, -2, 3, "-inf coordinate");
+        m.pos[3 * 3 + 2] = (float)INFINITY;
+        expect_build_error(&m, TT_ERROR_NON_FINITE, -1, -2, 3, "+inf coordinate");
+        m.pos[3 * 3 + 2] = keep;
+    }
+    /* The untouched tetrahedron still builds (the edits were undone). */
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "restored tetrahedron: got %d (%s)", r, err.message);
+    if (r == TT_OK) tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* zero-area face: 3 collinear points (an open mesh of one good and one flat face) */
+    tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 0, 1, 0);
+    tm_vert(&m, 2, 0, 0); tm_vert(&m, 3, 0, 0);
+    tm_tri(&m, 0, 1, 2);
+    tm_tri(&m, 1, 3, 4);
+    expect_build_error(&m, TT_ERROR_ZERO_AREA_FACE, 1, 3, -2, "zero-area face");
+    expect_permissive(&m, 0, "zero-area face");
+    tm_free(&m);
+
+    /* non-manifold edge: 3 triangles on edge 0-1 */
+    {
+        int va = -1, vb = -1, first;
+        tt_result code = TT_OK;
+        tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 0.5, 1, 0);
+        tm_vert(&m, 0.5, -1, 0); tm_vert(&m, 0.5, 0, 1);
+        tm_tri(&m, 0, 1, 2);
+        tm_tri(&m, 1, 0, 3);
+        tm_tri(&m, 0, 1, 4);
+        first = naive_first_edge_problem(&m, &code, &va, &vb);
+        CHECK(first == 0 && code == TT_ERROR_NON_MANIFOLD_EDGE, "naive reference: corner %d code %d", first, code);
+        expect_build_error(&m, TT_ERROR_NON_MANIFOLD_EDGE, 0, 0, -2, "non-manifold edge");
+        r = build(&m, 0, &mesh, &err);
+        if (r == TT_OK) tt_mesh_free(mesh);
+        CHECK((err.vertex == 0 && err.other_vertex == 1) || (err.vertex == 1 && err.other_vertex == 0),
+              "non-manifold edge: vertices expected 0 and 1, got %d and %d", err.vertex, err.other_vertex);
+        expect_permissive(&m, 1, "non-manifold edge");
+        tm_free(&m);
+
+        /* The same three triangles with the lone reverse half-edge first:
+           the first problem in index-buffer order is corner 0 of face 0. */
+        tm_vert(&m, 0, 0, 0); tm_vert(&m, 1, 0, 0); tm_vert(&m, 0.5, 1, 0);
+        tm_vert(&m, 0.5, -1, 0); tm_vert(&m, 0.5, 0, 1);
+        tm_tri(&m, 1, 0, 3);
+        tm_tri(&m, 0, 1, 2);
+        tm_tri(&m, 0, 1, 4);
+        first = naive_first_edge_problem(&m, &code, &va, &vb);
+        expect_build_error(&m, TT_ERROR_NON_MANIFOLD_EDGE, face_of_corner(&m, first), first, -2,
+                           "non-manifold edge (reverse half-edge first)");
+        tm_free(&m);
+    }
+
+    /* inconsistent orientation: one face of a cube flipped */
+    {
+        int f, flip = 3, va = -1, vb = -1, first;
+        tt_result code = TT_OK;
+        for (f = 0; f < 6; f++) {
+            int i, *q;
+            make_cube(&m, 0);
+            flip = f;
+            q = m.idx + 4 * flip;
+            for (i = 0; i < 2; i++) { int t = q[i]; q[i] = q[3 - i]; q[3 - i] = t; }
+            first = naive_first_edge_problem(&m, &code, &va, &vb);
+            CHECK(code == TT_ERROR_INCONSISTENT_ORIENTATION, "naive reference code %d", code);
+            expect_build_error(&m, TT_ERROR_INCONSISTENT_ORIENTATION, face_of_corner(&m, first), first, -2,
+                               "cube with a flipped face");
+            r = build(&m, 0, &mesh, &err);
+            if (r == TT_OK) tt_mesh_free(mesh);
+            CHECK((err.vertex == va && err.other_vertex == vb) || (err.vertex == vb && err.other_vertex == va),
+                  "flipped face %d: edge expected %d-%d, got %d-%d", f, va, vb, err.vertex, err.other_vertex);
+            CHECK(msg_has_number(err.message, face_of_corner(&m, first)),
+                  "flipped face %d: message should name face %d: \"%s\"", f, face_of_corner(&m, first), err.message);
+            if (f == 0) expect_permissive(&m, 4, "cube with a flipped face");
+            tm_free(&m);
+        }
+    }
+
+    /* non-manifold vertex: two tetrahedra sharing only vertex 0 */
+    {
+        int ok_corner;
+        make_tetra(&m, 0);
+        tm_vert(&m, -1, 0, 0); tm_vert(&m, 0, -1, 0); tm_vert(&m, 0, 0, -1);
+        tm_tri(&m, 0, 4, 5);
+        tm_tri(&m, 0, 6, 4);
+        tm_tri(&m, 0, 5, 6);
+        tm_tri(&m, 4, 6, 5);
+        r = build(&m, 0, &mesh, &err);
+        if (r == TT_OK) tt_mesh_free(mesh);
+        CHECK(r == TT_ERROR_NON_MANIFOLD_VERTEX, "two tetrahedra at a vertex: expected %d, got %d (%s)",
+              TT_ERROR_NON_MANIFOLD_VERTEX, r, err.message);
+        CHECK(err.vertex == 0, "non-manifold vertex: expected vertex 0, got %d", err.vertex);
+        ok_corner = err.corner >= 0 && err.corner < m.nc && m.idx[err.corner] == 0 &&
+                    face_of_corner(&m, err.corner) == err.face;
+        CHECK(ok_corner, "non-manifold vertex: corner %d / face %d should be a corner of vertex 0 in that face",
+              err.corner, err.face);
+        expect_build_error(&m, TT_ERROR_NON_MANIFOLD_VERTEX, -2, -2, 0, "non-manifold vertex");
+        expect_permissive(&m, 0, "non-manifold vertex");
+        r = build(&m, TT_MESH_PERMISSIVE, &mesh, &err);
+        if (r == TT_OK) {
+            tt_mesh_stats st;
+            tt_mesh_compute_stats(mesh, &st);
+            CHECK(st.nonmanifold_vertices == 1, "permissive: nonmanifold_vertices expected 1, got %d",
+                  st.nonmanifold_vertices);
+            CHECK(st.components == 2, "two tetrahedra at a vertex: components expected 2, got %d", st.components);
+            CHECK(st.genus == 0, "two tetrahedra at a vertex: genus expected 0, got %d", st.genus);
+            tt_mesh_free(mesh);
+        }
+        tm_free(&m);
+    }
+
+    /* permissive repeated vertex: a degenerate edge becomes a boundary */
+    {
+        make_tetra(&m, 0);
+        tm_vert(&m, 3, 3, 3);
+        tm_vert(&m, 4, 3, 3);
+        tm_tri(&m, 4, 5, 4);
+        expect_build_error(&m, TT_ERROR_REPEATED_VERTEX, 4, 14, 4, "repeated vertex (extra face)");
+        expect_permissive(&m, 1, "repeated vertex");
+        tm_free(&m);
+    }
+    /* repeated vertex in a large face (stamping path, > 16 corners) */
+    {
+        int i, v[20];
+        for (i = 0; i < 20; i++) v[i] = tm_vert(&m, cos(i * 0.314159), sin(i * 0.314159), 0);
+        v[17] = v[3];
+        tm_face(&m, 20, v);
+        expect_build_error(&m, TT_ERROR_REPEATED_VERTEX, 0, 17, 3, "repeated vertex in a 20-gon");
+        tm_free(&m);
+    }
+}
+
+typedef struct build_ctx {
+    const tmesh *m;
+    unsigned flags;
+} build_ctx;
+
+static tt_result oom_build(void *ctx, const tt_allocator *al)
+{
+    build_ctx *b = (build_ctx *)ctx;
+    tt_mesh_desc d = tm_desc(b->m);
+    tt_mesh *mesh = (tt_mesh *)&mesh;
+    tt_error err;
+    tt_result r;
+    d.flags = b->flags;
+    d.allocator = *al;
+    r = tt_mesh_build(&d, &mesh, &err);
+    if (r == TT_OK) tt_mesh_free(mesh);
+    else if (mesh != NULL) return TT_RESULT_MAX_ENUM;   /* must be NULL on failure */
+    if (r != TT_OK && err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_builder_oom(void)
+{
+    tmesh m;
+    build_ctx b;
+    memset(&m, 0, sizeof m);
+    oom_reset();
+    b.m = &m;
+    b.flags = 0;
+    make_tetra(&m, 0);
+    oom_sweep("tt_mesh_build(tetrahedron)", oom_build, &b, TT_OK);
+    tm_free(&m);
+    make_mixed(&m);
+    oom_sweep("tt_mesh_build(mixed)", oom_build, &b, TT_OK);
+    b.flags = TT_MESH_BORROW_POSITIONS;
+    oom_sweep("tt_mesh_build(mixed, borrowed)", oom_build, &b, TT_OK);
+    b.flags = 0;
+    tm_free(&m);
+    {
+        int i, v[40];
+        for (i = 0; i < 40; i++) v[i] = tm_vert(&m, cos(i * 0.15707963), sin(i * 0.15707963), 0);
+        tm_face(&m, 40, v);
+        oom_sweep("tt_mesh_build(40-gon)", oom_build, &b, TT_OK);
+        tm_free(&m);
+    }
+    /* An invalid mesh: every run is OOM or the validation error, never a leak. */
+    make_cube(&m, 0);
+    { int t = m.idx[0]; m.idx[0] = m.idx[2]; m.idx[2] = t; }
+    oom_sweep("tt_mesh_build(flipped cube)", oom_build, &b, TT_ERROR_INCONSISTENT_ORIENTATION);
+    b.flags = TT_MESH_PERMISSIVE;
+    oom_sweep("tt_mesh_build(flipped cube, permissive)", oom_build, &b, TT_OK);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 2b. Mesh queries                                                         */
+/* ------------------------------------------------------------------------ */
+
+/* Naive valence: distinct neighbours over all faces. */
+static int naive_valence(const tt_mesh *mesh, int v, int *scratch)
+{
+    int c, n = 0, i;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int a = mesh->corner_vert[c], b = mesh->corner_vert[tt_mesh_next(mesh, c)], other = -1, dup = 0;
+        if (a == v) other = b;
+        else if (b == v) other = a;
+        if (other < 0) continue;
+        for (i = 0; i < n; i++) if (scratch[i] == other) dup = 1;
+        if (!dup) scratch[n++] = other;
+    }
+    return n;
+}
+
+static int uf_find(int *parent, int x)
+{
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+}
+
+typedef struct expect_stats {
+    int used, edges, boundary_edges, loops, components, chi, genus, min_val, max_val;
+} expect_stats;
+
+static void check_queries(const tmesh *m, const expect_stats *e, const char *name)
+{
+    tt_mesh *mesh;
+    tt_error err;
+    tt_mesh_stats st;
+    tt_result r;
+    counter cnt;
+    tt_mesh_desc d = tm_desc(m);
+    d.allocator = make_allocator(&cnt, -1);
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_OK, "%s: build failed: %d (%s)", name, r, err.message);
+    if (r != TT_OK) return;
+    r = tt_mesh_compute_stats(mesh, &st);
+    CHECK(r == TT_OK, "%s: compute_stats returned %d", name, r);
+    CHECK(st.used_vertices == e->used, "%s: used_vertices expected %d, got %d", name, e->used, st.used_vertices);
+    CHECK(st.edges == e->edges, "%s: edges expected %d, got %d", name, e->edges, st.edges);
+    CHECK(st.boundary_edges == e->boundary_edges, "%s: boundary_edges expected %d, got %d", name, e->boundary_edges,
+          st.boundary_edges);
+    CHECK(st.boundary_loops == e->loops, "%s: boundary_loops expected %d, got %d", name, e->loops, st.boundary_loops);
+    CHECK(st.components == e->components, "%s: components expected %d, got %d", name, e->components, st.components);
+    CHECK(st.euler_characteristic == e->chi, "%s: chi expected %d, got %d", name, e->chi, st.euler_characteristic);
+    CHECK(st.genus == e->genus, "%s: genus expected %d, got %d", name, e->genus, st.genus);
+    CHECK(st.min_valence == e->min_val && st.max_valence == e->max_val, "%s: valence expected %d..%d, got %d..%d",
+          name, e->min_val, e->max_val, st.min_valence, st.max_valence);
+    CHECK(st.nonmanifold_vertices == 0, "%s: nonmanifold_vertices expected 0, got %d", name, st.nonmanifold_vertices);
+
+    /* valence against the naive count; histogram against naive valences */
+    {
+        int *scratch = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners * 2 + 8);
+        int *naive = (int *)calloc((size_t)mesh->nverts + 1, sizeof(int));
+        int hist[64], nhist[64], v, bad = 0, total = 0, nb;
+        for (v = 0; v < mesh->nverts; v++) {
+            naive[v] = naive_valence(mesh, v, scratch);
+            if (tt_mesh_valence(mesh, v) != naive[v]) {
+                if (!bad) DETAIL("%s: tt_mesh_valence(%d) expected %d, got %d", name, v, naive[v],
+                                tt_mesh_valence(mesh, v));
+                bad++;
+            }
+        }
+        CHECK(bad == 0, "%s: %d vertices with a wrong valence", name, bad);
+        CHECK(tt_mesh_valence(mesh, -1) == 0 && tt_mesh_valence(mesh, mesh->nverts) == 0,
+              "%s: valence of an out-of-range vertex should be 0", name);
+        for (nb = 1; nb <= 64; nb = nb < 8 ? nb + 1 : nb * 2) {
+            int k;
+            memset(nhist, 0, sizeof nhist);
+            for (v = 0; v < mesh->nverts; v++)
+                if (mesh->vert_corner[v] >= 0) nhist[naive[v] < nb - 1 ? naive[v] : nb - 1]++;
+            for (k = 0; k < 64; k++) hist[k] = -7;
+            r = tt_mesh_valence_histogram(mesh, hist, nb);
+            bad = 0;
+            total = 0;
+            for (k = 0; k < nb; k++) { bad += hist[k] != nhist[k]; total += hist[k]; }
+            for (k = nb; k < 64; k++) bad += hist[k] != -7;   /* no write past nbins */
+            CHECK(r == TT_OK && bad == 0 && total == st.used_vertices,
+                  "%s: valence histogram with %d bins: %d bins differ from the naive one (total %d, used %d)", name, nb,
+                  bad, total, st.used_vertices);
+        }
+        CHECK(tt_mesh_valence_histogram(mesh, hist, 0) == TT_ERROR_INVALID_ARGUMENT,
+              "%s: histogram with 0 bins should be rejected", name);
+        CHECK(tt_mesh_valence_histogram(NULL, hist, 4) == TT_ERROR_INVALID_ARGUMENT &&
+                  tt_mesh_valence_histogram(mesh, NULL, 4) == TT_ERROR_INVALID_ARGUMENT,
+              "%s: histogram with NULL should be rejected", name);
+        free(scratch);
+        free(naive);
+    }
+
+    /* components: naive union-find over shared edges, numbered by first face */
+    {
+        int *comp = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+        int *parent = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+        int *label = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+        int n = -1, f, c, c2, next = 0, bad = 0;
+        for (f = 0; f < mesh->nfaces; f++) { parent[f] = f; label[f] = -1; }
+        for (c = 0; c < mesh->ncorners; c++)
+            for (c2 = c + 1; c2 < mesh->ncorners; c2++) {
+                int a = mesh->corner_vert[c], b = mesh->corner_vert[tt_mesh_next(mesh, c)];
+                int a2 = mesh->corner_vert[c2], b2 = mesh->corner_vert[tt_mesh_next(mesh, c2)];
+                if (a == b2 && b == a2) {
+                    int x = uf_find(parent, mesh->corner_face[c]), y = uf_find(parent, mesh->corner_face[c2]);
+                    if (x != y) parent[x] = y;
+                }
+            }
+        r = tt_mesh_components(mesh, comp, &n);
+        CHECK(r == TT_OK && n == e->components, "%s: tt_mesh_components: expected %d, got %d (result %d)", name,
+              e->components, n, r);
+        for (f = 0; f < mesh->nfaces; f++) {
+            int root = uf_find(parent, f);
+            if (label[root] < 0) label[root] = next++;
+            if (comp[f] != label[root]) bad++;
+        }
+        CHECK(bad == 0 && next == n, "%s: %d faces with a component id other than the naive one", name, bad);
+        CHECK(tt_mesh_components(mesh, NULL, &n) == TT_ERROR_INVALID_ARGUMENT, "%s: components(NULL)", name);
+        free(comp);
+        free(parent);
+        free(label);
+    }
+
+    /* boundary loops: ids, count, and each boundary half-edge's successor
+       (the boundary half-edge leaving its end vertex) is in the same loop */
+    {
+        int *loop = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners);
+        int n = -1, c, c2, bad = 0, nb = 0, *seen;
+        r = tt_mesh_boundary_loops(mesh, loop, &n);
+        CHECK(r == TT_OK && n == e->loops, "%s: tt_mesh_boundary_loops: expected %d loops, got %d (result %d)", name,
+              e->loops, n, r);
+        seen = (int *)calloc((size_t)(n > 0 ? n : 1), sizeof(int));
+        for (c = 0; c < mesh->ncorners; c++) {
+            if (mesh->twin[c] >= 0) { bad += loop[c] != -1; continue; }
+            nb++;
+            if (loop[c] < 0 || loop[c] >= n) { bad++; continue; }
+            seen[loop[c]] = 1;
+            for (c2 = 0; c2 < mesh->ncorners; c2++)
+                if (mesh->twin[c2] < 0 && mesh->corner_vert[c2] == mesh->corner_vert[tt_mesh_next(mesh, c)] &&
+                    loop[c2] != loop[c])
+                    bad++;
+        }
+        for (c = 0; c < n; c++) bad += !seen[c];
+        CHECK(bad == 0, "%s: %d inconsistencies in the boundary loop ids", name, bad);
+        CHECK(nb == st.boundary_edges, "%s: boundary half-edges %d vs stats %d", name, nb, st.boundary_edges);
+        free(loop);
+        free(seen);
+    }
+    CHECK(tt_mesh_compute_stats(NULL, &st) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_mesh_compute_stats(mesh, NULL) == TT_ERROR_INVALID_ARGUMENT,
+          "%s: compute_stats with NULL should be rejected", name);
+    tt_mesh_free(mesh);
+    CHECK(cnt.live == 0, "%s: %ld allocations leaked by the queries", name, cnt.live);
+}
+
+static void test_queries(void)
+{
+    tmesh m;
+    expect_stats e;
+    memset(&m, 0, sizeof m);
+
+    make_tetra(&m, 0);
+    e.used = 4; e.edges = 6; e.boundary_edges = 0; e.loops = 0; e.components = 1; e.chi = 2; e.genus = 0;
+    e.min_val = 3; e.max_val = 3;
+    check_queries(&m, &e, "tetrahedron");
+    tm_free(&m);
+
+    make_torus(&m, 8, 6, 3.0, 1.0);
+    e.used = 48; e.edges = 96; e.boundary_edges = 0; e.loops = 0; e.components = 1; e.chi = 0; e.genus = 1;
+    e.min_val = 4; e.max_val = 4;
+    check_queries(&m, &e, "torus 8x6");
+    tm_free(&m);
+
+    /* genus 2: 3x5 slab of voxels with two holes. 13 voxels; lattice 4x6x2
+       all used = 48 vertices; F = 2*13 top/bottom + side walls. */
+    make_genus2(&m);
+    e.used = 48; e.boundary_edges = 0; e.loops = 0; e.components = 1; e.chi = -2; e.genus = 2;
+    e.edges = 48 + m.nf + 2;   /* V - E + F = -2 */
+    e.min_val = 3; e.max_val = 5;
+    check_queries(&m, &e, "genus-2 polycube");
+    tm_free(&m);
+
+    make_grid(&m, 4, 3);
+    e.used = 20; e.edges = 31; e.boundary_edges = 14; e.loops = 1; e.components = 1; e.chi = 1; e.genus = 0;
+    e.min_val = 2; e.max_val = 4;
+    check_queries(&m, &e, "open grid 4x3");
+    tm_free(&m);
+
+    /* annulus: 5x5 grid without its centre quad: 2 loops, chi 0, genus 0 */
+    {
+        tmesh g;
+        int f;
+        memset(&g, 0, sizeof g);
+        make_grid(&g, 5, 5);
+        for (f = 0; f < 36; f++) tm_vert(&m, g.pos[3 * f], g.pos[3 * f + 1], g.pos[3 * f + 2]);
+        for (f = 0; f < g.nf; f++)
+            if (f != 12) tm_face(&m, 4, g.idx + 4 * f);
+        tm_free(&g);
+        e.used = 36; e.edges = 60 - 0; e.boundary_edges = 24; e.loops = 2; e.components = 1; e.chi = 0; e.genus = 0;
+        e.min_val = 2; e.max_val = 4;
+        check_queries(&m, &e, "annulus");
+        tm_free(&m);
+    }
+
+    make_cube(&m, 0);
+    make_cube(&m, 3);
+    e.used = 16; e.edges = 24; e.boundary_edges = 0; e.loops = 0; e.components = 2; e.chi = 4; e.genus = 0;
+    e.min_val = 3; e.max_val = 3;
+    check_queries(&m, &e, "two cubes");
+    tm_free(&m);
+
+    make_mixed(&m);
+    e.used = 15; e.edges = 23; e.boundary_edges = 0; e.loops = 0; e.components = 2; e.chi = 4; e.genus = 0;
+    e.min_val = 3; e.max_val = 4;
+    check_queries(&m, &e, "prism + pyramid");
+    tm_free(&m);
+
+    /* two tori and a grid: genus 2, 3 components, 1 loop */
+    make_torus(&m, 5, 4, 3.0, 1.0);
+    make_torus(&m, 3, 3, 3.0, 1.0);
+    make_grid(&m, 1, 1);
+    e.used = 20 + 9 + 4; e.edges = 40 + 18 + 4; e.boundary_edges = 4; e.loops = 1; e.components = 3;
+    e.chi = 0 + 0 + 1; e.genus = 2; e.min_val = 2; e.max_val = 4;
+    check_queries(&m, &e, "two tori and a quad");
+    tm_free(&m);
+}
+
+typedef struct mesh_ctx {
+    tt_mesh *mesh;
+    tt_subdivision scheme;
+} mesh_ctx;
+
+static tt_result oom_stats(void *ctx, const tt_allocator *al)
+{
+    tt_mesh_stats st;
+    (void)al;   /* the mesh was built with it */
+    return tt_mesh_compute_stats(((mesh_ctx *)ctx)->mesh, &st);
+}
+
+static tt_result oom_quad(void *ctx, const tt_allocator *al)
+{
+    mesh_ctx *q = (mesh_ctx *)ctx;
+    tt_mesh *out = (tt_mesh *)&out;
+    tt_error err;
+    tt_result r = tt_mesh_quadrangulate(q->mesh, q->scheme, &out, &err);
+    (void)al;
+    if (r == TT_OK) tt_mesh_free(out);
+    else if (out != NULL) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_queries_oom(void)
+{
+    tmesh m;
+    tt_mesh_desc d;
+    mesh_ctx q;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    oom_reset();
+    make_grid(&m, 3, 2);
+    make_torus(&m, 4, 3, 3.0, 1.0);
+    tm_tri(&m, 0, 1, 5);   /* the grid's first row gets a triangle below: mixed sizes */
+    {
+        /* fix the triangle's orientation: grid face 0 is 0,1,5,4 so edge 0->1
+           is used; a face below must use 1->0 */
+        int *t = m.idx + m.nc - 3;
+        t[0] = 1; t[1] = 0; t[2] = tm_vert(&m, 0.5, -1, 0);
+    }
+    d = tm_desc(&m);
+    d.allocator = g_oom_allocator;
+    r = tt_mesh_build(&d, &q.mesh, NULL);
+    CHECK(r == TT_OK, "oom mesh: build got %d", r);
+    if (r != TT_OK) { tm_free(&m); return; }
+    oom_sweep("tt_mesh_compute_stats", oom_stats, &q, TT_OK);
+    q.scheme = TT_SUBDIVIDE_LINEAR;
+    oom_sweep("tt_mesh_quadrangulate(linear)", oom_quad, &q, TT_OK);
+    q.scheme = TT_SUBDIVIDE_CATMULL_CLARK;
+    oom_sweep("tt_mesh_quadrangulate(Catmull-Clark)", oom_quad, &q, TT_OK);
+    tt_mesh_free(q.mesh);
+    CHECK(g_oom_counter.live == 0, "oom mesh: %ld allocations leaked", g_oom_counter.live);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 2c. Quadrangulation                                                      */
+/* ------------------------------------------------------------------------ */
+
+static int count_edges(const tt_mesh *mesh)
+{
+    int c, n = 0;
+    for (c = 0; c < mesh->ncorners; c++) n += mesh->twin[c] < 0 || c < mesh->twin[c];
+    return n;
+}
+
+static int vec_near(const float *a, const double *b, double tol)
+{
+    return near(a[0], b[0], tol) && near(a[1], b[1], tol) && near(a[2], b[2], tol);
+}
+
+/* One linear step on `mesh`: counts, layout, positions; returns the result. */
+static tt_mesh *check_quad_step(const tt_mesh *mesh, tt_subdivision scheme, const char *name)
+{
+    tt_mesh *out = NULL;
+    tt_error err;
+    tt_result r = tt_mesh_quadrangulate(mesh, scheme, &out, &err);
+    int E = count_edges(mesh), c, f, bad_quad = 0, bad_v0 = 0, bad_pos = 0, bad_face = 0, bad_edge = 0;
+    CHECK(r == TT_OK, "%s: quadrangulate returned %d (%s)", name, r, err.message);
+    if (r != TT_OK) return NULL;
+    CHECK(out->nverts == mesh->nverts + E + mesh->nfaces, "%s: V' expected V+E+F = %d+%d+%d, got %d", name,
+          mesh->nverts, E, mesh->nfaces, out->nverts);
+    CHECK(out->nfaces == mesh->ncorners, "%s: F' expected %d (one quad per corner), got %d", name, mesh->ncorners,
+          out->nfaces);
+    CHECK(out->ncorners == 4 * mesh->ncorners, "%s: corners expected %d, got %d", name, 4 * mesh->ncorners,
+          out->ncorners);
+    CHECK(out->min_face_size == 4 && out->max_face_size == 4, "%s: face sizes %d..%d, expected quads", name,
+          out->min_face_size, out->max_face_size);
+    CHECK(out->flags == (mesh->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS), "%s: flags expected 0x%x, got 0x%x",
+          name, mesh->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS, out->flags);
+    for (f = 0; f < out->nfaces; f++) bad_quad += out->face_start[f + 1] - out->face_start[f] != 4;
+    /* quad c (c = old corner i of face f): corner 0 = old vertex of c; corner 1
+       = point of the edge of half-edge c; corner 2 = face point; corner 3 =
+       point of the edge of the previous half-edge. */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1], n = end - first, k;
+        double centroid[3] = {0, 0, 0};
+        for (c = first; c < end; c++)
+            for (k = 0; k < 3; k++) centroid[k] += mesh->pos[3 * mesh->corner_vert[c] + k] / n;
+        for (c = first; c < end; c++) {
+            const int *q = out->corner_vert + 4 * c;
+            int prev = tt_mesh_prev(mesh, c), next = tt_mesh_next(mesh, c);
+            const float *a = mesh->pos + 3 * mesh->corner_vert[c], *b = mesh->pos + 3 * mesh->corner_vert[next];
+            const float *p0 = mesh->pos + 3 * mesh->corner_vert[prev];
+            double mid[3], midp[3];
+            for (k = 0; k < 3; k++) {
+                mid[k] = 0.5 * ((double)a[k] + b[k]);
+                midp[k] = 0.5 * ((double)p0[k] + a[k]);
+            }
+            if (q[0] != mesh->corner_vert[c]) bad_v0++;
+            if (q[2] != mesh->nverts + E + f) bad_face++;
+            if (q[1] < mesh->nverts || q[1] >= mesh->nverts + E || q[3] < mesh->nverts || q[3] >= mesh->nverts + E)
+                bad_edge++;
+            if (scheme == TT_SUBDIVIDE_LINEAR) {
+                double old[3];
+                for (k = 0; k < 3; k++) old[k] = a[k];
+                if (!vec_near(out->pos + 3 * q[0], old, 0.0)) bad_pos++;
+                if (!vec_near(out->pos + 3 * q[1], mid, 1e-6)) bad_pos++;
+                if (!vec_near(out->pos + 3 * q[3], midp, 1e-6)) bad_pos++;
+            }
+            if (!vec_near(out->pos + 3 * q[2], centroid, 1e-5)) bad_pos++;
+        }
+    }
+    /* edge points are numbered in order of their first half-edge */
+    {
+        int next_id = 0, bad_order = 0;
+        for (c = 0; c < mesh->ncorners; c++) {
+            int t = mesh->twin[c];
+            if (t >= 0 && t < c) {
+                if (out->corner_vert[4 * c + 1] != out->corner_vert[4 * t + 1]) bad_order++;
+                continue;
+            }
+            if (out->corner_vert[4 * c + 1] != mesh->nverts + next_id++) bad_order++;
+        }
+        CHECK(bad_order == 0, "%s: %d edge points not numbered by first half-edge", name, bad_order);
+    }
+    CHECK(bad_quad == 0, "%s: %d faces are not quads", name, bad_quad);
+    CHECK(bad_v0 == 0, "%s: %d quads whose corner 0 is not the old vertex", name, bad_v0);
+    CHECK(bad_face == 0, "%s: %d quads whose corner 2 is not their face point", name, bad_face);
+    CHECK(bad_edge == 0, "%s: %d quads whose corners 1/3 are not edge points", name, bad_edge);
+    CHECK(bad_pos == 0, "%s: %d new positions differ from midpoints / centroids / old positions", name, bad_pos);
+    return out;
+}
+
+static void check_topology_kept(const tt_mesh *a, const tt_mesh *b, const char *name)
+{
+    tt_mesh_stats sa, sb;
+    CHECK(tt_mesh_compute_stats(a, &sa) == TT_OK && tt_mesh_compute_stats(b, &sb) == TT_OK, "%s: stats", name);
+    CHECK(sa.euler_characteristic == sb.euler_characteristic && sa.genus == sb.genus &&
+              sa.components == sb.components && sa.boundary_loops == sb.boundary_loops &&
+              2 * sa.boundary_edges == sb.boundary_edges,
+          "%s: chi/genus/components/loops/boundary: %d/%d/%d/%d/%d before, %d/%d/%d/%d/%d after", name,
+          sa.euler_characteristic, sa.genus, sa.components, sa.boundary_loops, sa.boundary_edges,
+          sb.euler_characteristic, sb.genus, sb.components, sb.boundary_loops, sb.boundary_edges);
+}
+
+/* Quadrangulation builds its output's topology directly from the input's.
+   Rebuild the same index buffer with the validating builder (a permissive one
+   for a permissive input) and demand the same twins, and vert_corner entries
+   that leave the right vertex and are boundaries exactly where one exists. */
+static void check_direct_topology(const tt_mesh *q, const char *name)
+{
+    tt_mesh_desc d;
+    tt_mesh *rebuilt = NULL;
+    tt_error err;
+    int c, v, bad_twin = 0, bad_vc = 0;
+    memset(&d, 0, sizeof d);
+    d.positions = q->pos;
+    d.nverts = q->nverts;
+    d.indices = q->corner_vert;
+    d.nfaces = q->nfaces;
+    d.fixed_face_size = 4;
+    d.flags = TT_MESH_PERMISSIVE;   /* zero-area quads are possible in the output */
+    if (tt_mesh_build(&d, &rebuilt, &err) != TT_OK) {
+        CHECK(0, "%s: rebuilding the quadrangulation failed: %s", name, err.message);
+        return;
+    }
+    for (c = 0; c < q->ncorners; c++) {
+        if (q->twin[c] != rebuilt->twin[c]) bad_twin++;
+        if (q->corner_face[c] != c / 4) bad_twin++;
+    }
+    for (v = 0; v < q->nverts; v++) {
+        int h = q->vert_corner[v], want_boundary = rebuilt->vert_corner[v] >= 0 && rebuilt->twin[rebuilt->vert_corner[v]] < 0;
+        if (h < 0 || q->corner_vert[h] != v || ((q->twin[h] < 0) != want_boundary)) bad_vc++;
+    }
+    CHECK(bad_twin == 0, "%s: %d twins / corner faces differ from a validated rebuild", name, bad_twin);
+    CHECK(bad_vc == 0, "%s: %d vert_corner entries wrong", name, bad_vc);
+    tt_mesh_free(rebuilt);
+}
+
+static void test_quadrangulate_direct(void)
+{
+    tmesh m;
+    tt_mesh *mesh, *q;
+    tt_error err;
+    int which;
+    memset(&m, 0, sizeof m);
+    for (which = 0; which < 4; which++) {
+        const char *name = which == 0 ? "mixed" : which == 1 ? "open grid" : which == 2 ? "genus-2" : "torus";
+        if (which == 0) make_mixed(&m);
+        if (which == 1) make_grid(&m, 4, 3);
+        if (which == 2) make_genus2(&m);
+        if (which == 3) make_torus(&m, 6, 5, 3.0, 1.0);
+        if (build(&m, 0, &mesh, &err) == TT_OK) {
+            if (tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q, &err) == TT_OK) {
+                check_direct_topology(q, name);
+                tt_mesh_free(q);
+            } else {
+                CHECK(0, "%s: quadrangulate failed: %s", name, err.message);
+            }
+            tt_mesh_free(mesh);
+        } else {
+            CHECK(0, "%s: build failed: %s", name, err.message);
+        }
+        tm_free(&m);
+    }
+    /* A permissive mesh: three triangles on one edge (cut open) still
+       quadrangulates into a consistent mesh. */
+    tm_tri(&m, tm_vert(&m, 0, 0, 0), tm_vert(&m, 1, 0, 0), tm_vert(&m, 0, 1, 0));
+    tm_tri(&m, 1, 0, tm_vert(&m, 0, -1, 0));
+    tm_tri(&m, 0, 1, tm_vert(&m, 0, 0, 1));
+    if (build(&m, TT_MESH_PERMISSIVE, &mesh, &err) == TT_OK) {
+        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, &q, &err) == TT_OK, "permissive: %s", err.message);
+        if (q) { check_direct_topology(q, "permissive"); tt_mesh_free(q); }
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+    /* A valid hexagon whose last four corners are distinct vertices at one
+       point: its quads there have zero area, and quadrangulating must still
+       succeed (it validated the input, not its own output). */
+    {
+        float p[18] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0};
+        int idx[6] = {0, 1, 2, 3, 4, 5};
+        tt_mesh_desc d;
+        memset(&d, 0, sizeof d);
+        d.positions = p; d.nverts = 6; d.indices = idx; d.nfaces = 1; d.fixed_face_size = 6;
+        if (tt_mesh_build(&d, &mesh, &err) == TT_OK) {
+            tt_result r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, &q, &err);
+            CHECK(r == TT_OK && q && q->nfaces == 6, "hexagon with coincident corners: result %d (%s)", r, err.message);
+            tt_mesh_free(q);
+            tt_mesh_free(mesh);
+        } else {
+            CHECK(0, "hexagon with coincident corners should build: %s", err.message);
+        }
+    }
+    /* An empty face names no corner (there is none). */
+    {
+        float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        int idx[3] = {0, 1, 2}, sizes[2] = {3, 0};
+        tt_mesh_desc d;
+        memset(&d, 0, sizeof d);
+        d.positions = p; d.nverts = 3; d.indices = idx; d.face_sizes = sizes; d.nfaces = 2;
+        CHECK(tt_mesh_build(&d, &mesh, &err) == TT_ERROR_FACE_TOO_SMALL && err.face == 1 && err.corner == -1,
+              "empty face: face %d corner %d", err.face, err.corner);
+    }
+}
+
+static void test_quadrangulate(void)
+{
+    tmesh m;
+    tt_mesh *mesh, *q1, *q2;
+    tt_error err;
+    tt_result r;
+    int which;
+    memset(&m, 0, sizeof m);
+    for (which = 0; which < 5; which++) {
+        const char *name = which == 0 ? "tetrahedron" : which == 1 ? "mixed" : which == 2 ? "open grid"
+                         : which == 3 ? "genus-2" : "torus";
+        int s;
+        if (which == 0) make_tetra(&m, 0);
+        if (which == 1) make_mixed(&m);
+        if (which == 2) { make_grid(&m, 3, 2); tm_tri(&m, 1, 0, tm_vert(&m, 0.5, -1, 0)); }
+        if (which == 3) make_genus2(&m);
+        if (which == 4) make_torus(&m, 5, 4, 3.0, 1.0);
+        r = build(&m, 0, &mesh, &err);
+        CHECK(r == TT_OK, "%s: build %d", name, r);
+        if (r != TT_OK) { tm_free(&m); continue; }
+        for (s = 0; s < 2; s++) {
+            tt_subdivision scheme = s ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR;
+            q1 = check_quad_step(mesh, scheme, name);
+            if (!q1) continue;
+            q2 = check_quad_step(q1, scheme, name);   /* twice */
+            check_topology_kept(mesh, q1, name);
+            if (q2) {
+                check_topology_kept(q1, q2, name);
+                tt_mesh_free(q2);
+            }
+            tt_mesh_free(q1);
+        }
+        tt_mesh_free(mesh);
+        tm_free(&m);
+    }
+
+    /* Catmull-Clark on a unit cube, by hand: the corner vertex at the origin
+       has n = 3 faces with centroids (.5,.5,0), (.5,0,.5), (0,.5,.5), so
+       Q = (1/3,1/3,1/3); its 3 edge midpoints average R = (1/6,1/6,1/6); S is
+       the origin: (Q + 2R + (n-3)S)/n = (2/9, 2/9, 2/9). The edge point of
+       (0,0,0)-(1,0,0) averages its ends and the centroids of faces z=0 and y=0:
+       (0.5, 0.125, 0.125). The face point of z = 0 is (0.5, 0.5, 0). */
+    make_cube(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    CHECK(r == TT_OK, "cube build %d", r);
+    if (r == TT_OK) {
+        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q1, &err);
+        CHECK(r == TT_OK, "cube: Catmull-Clark returned %d", r);
+        if (r == TT_OK) {
+            int v, c, bad = 0, found_edge = 0;
+            double expect_corner = 2.0 / 9.0;
+            for (v = 0; v < mesh->nverts; v++) {
+                double e[3];
+                int k;
+                for (k = 0; k < 3; k++)
+                    e[k] = mesh->pos[3 * v + k] == 0.0f ? expect_corner : 1.0 - expect_corner;
+                if (!vec_near(q1->pos + 3 * v, e, 1e-6)) {
+                    if (!bad)
+                        DETAIL("cube vertex %d (%g,%g,%g): expected (%g,%g,%g), got (%g,%g,%g)", v, mesh->pos[3 * v],
+                              mesh->pos[3 * v + 1], mesh->pos[3 * v + 2], e[0], e[1], e[2], q1->pos[3 * v],
+                              q1->pos[3 * v + 1], q1->pos[3 * v + 2]);
+                    bad++;
+                }
+            }
+            CHECK(bad == 0, "Catmull-Clark cube: %d of 8 corners not at 2/9 (or 7/9)", bad);
+            for (c = 0; c < mesh->ncorners; c++) {
+                const float *a = mesh->pos + 3 * mesh->corner_vert[c];
+                const float *b = mesh->pos + 3 * mesh->corner_vert[tt_mesh_next(mesh, c)];
+                if (a[0] == 0 && a[1] == 0 && a[2] == 0 && b[0] == 1 && b[1] == 0 && b[2] == 0) {
+                    double e[3] = {0.5, 0.125, 0.125};
+                    found_edge = 1;
+                    CHECK(vec_near(q1->pos + 3 * q1->corner_vert[4 * c + 1], e, 1e-6),
+                          "Catmull-Clark edge point of (0,0,0)-(1,0,0): expected (0.5,0.125,0.125), got (%g,%g,%g)",
+                          q1->pos[3 * q1->corner_vert[4 * c + 1]], q1->pos[3 * q1->corner_vert[4 * c + 1] + 1],
+                          q1->pos[3 * q1->corner_vert[4 * c + 1] + 2]);
+                }
+            }
+            CHECK(found_edge, "the cube should have a half-edge (0,0,0)->(1,0,0)");
+            tt_mesh_free(q1);
+        }
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* Catmull-Clark on an open grid: an interior vertex of a flat grid stays
+       put, a boundary vertex with two boundary edges goes to 3/4 S + 1/8 of
+       its boundary neighbours (= stays on a straight boundary), and edge
+       points on the boundary are midpoints. */
+    make_grid(&m, 3, 3);
+    m.pos[3 * 1 + 1] = 0.5f;   /* lift boundary vertex (1,0) to y = .5: 3/4*.5 = .375 */
+    r = build(&m, 0, &mesh, &err);
+    if (r == TT_OK) {
+        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q1, &err);
+        CHECK(r == TT_OK, "grid CC %d", r);
+        if (r == TT_OK) {
+            double e5[3] = {1, 1, 0}, e1[3] = {1, 0.375, 0}, e0[3] = {0.125, 0.1875, 0};
+            /* vertex 5 = (1,1): interior, flat, regular, but its neighbour (1,0)
+               moved: Q and R change. Check only the boundary rules here. */
+            (void)e5;
+            CHECK(vec_near(q1->pos + 3, e1, 1e-6), "CC boundary vertex (1,.5): expected (1,.375,0), got (%g,%g,%g)",
+                  q1->pos[3], q1->pos[4], q1->pos[5]);
+            /* the grid corner (0,0) has 2 boundary edges, to (1,.5) and (0,1):
+               3/4 (0,0) + 1/8 (1,.5) + 1/8 (0,1) = (.125, .1875) */
+            CHECK(vec_near(q1->pos, e0, 1e-6), "CC grid corner: expected (0.125,0.1875,0), got (%g,%g,%g)",
+                  q1->pos[0], q1->pos[1], q1->pos[2]);
+            tt_mesh_free(q1);
+        }
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+
+    /* bad arguments */
+    make_tetra(&m, 0);
+    r = build(&m, 0, &mesh, &err);
+    if (r == TT_OK) {
+        q1 = (tt_mesh *)&q1;
+        CHECK(tt_mesh_quadrangulate(mesh, (tt_subdivision)7, &q1, &err) == TT_ERROR_INVALID_ARGUMENT && q1 == NULL,
+              "unknown scheme should be rejected with *out NULL");
+        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+              "out_mesh NULL should be rejected");
+        CHECK(tt_mesh_quadrangulate(NULL, TT_SUBDIVIDE_LINEAR, &q1, &err) == TT_ERROR_INVALID_ARGUMENT && q1 == NULL,
+              "mesh NULL should be rejected");
+        tt_mesh_free(mesh);
+    }
+    tm_free(&m);
+    tt_mesh_free(NULL);   /* allowed */
+}
+
+void run_mesh_tests(void)
+{
+    RUN(test_builder_valid);
+    RUN(test_builder_errors);
+    RUN(test_builder_oom);
+    RUN(test_queries);
+    RUN(test_queries_oom);
+    RUN(test_quadrangulate);
+    RUN(test_quadrangulate_direct);
+}

@@ -1,0 +1,836 @@
+/* tests/test_4_numerics.c - unit tests for section 4 of tiledtex.h: sparse
+   matrices and conjugate gradients. Run by run_numerics_tests()
+   (tests/test_common.c calls it). */
+#include "test_common.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------ */
+/* 4. Numerics (sparse matrices, conjugate gradients)                       */
+/* ------------------------------------------------------------------------ */
+
+/* Random triplets in a rows x cols matrix: unsorted, with duplicates (about a
+   third repeat an earlier position), and some rows left empty. */
+static tt_triplet *cg_random_triplets(int rows, int cols, int count)
+{
+    tt_triplet *t = (tt_triplet *)malloc(sizeof(tt_triplet) * (size_t)(count > 0 ? count : 1));
+    int k, skip = rows > 2 ? lcg_below(rows) : -1;   /* one row stays empty */
+    for (k = 0; k < count; k++) {
+        if (k > 0 && lcg_below(3) == 0) {
+            t[k] = t[lcg_below(k)];
+        } else {
+            do t[k].row = lcg_below(rows);
+            while (t[k].row == skip);
+            t[k].col = lcg_below(cols);
+        }
+        t[k].value = lcg_unit() * 4.0 - 2.0;
+    }
+    return t;
+}
+
+/* The matrix as dense rows x cols, adding the triplets in input order. */
+static double *cg_dense_from_triplets(int rows, int cols, const tt_triplet *t, int count, char *used)
+{
+    double *d = (double *)calloc((size_t)rows * cols + 1, sizeof(double));
+    int k;
+    for (k = 0; k < count; k++) {
+        d[(size_t)t[k].row * cols + t[k].col] += t[k].value;
+        if (used) used[(size_t)t[k].row * cols + t[k].col] = 1;
+    }
+    return d;
+}
+
+/* Every stored entry matches the dense matrix bit for bit, the pattern is
+   exactly the named positions, columns strictly increase in a row. */
+static int cg_matches_dense(const tt_sparse_matrix *m, const double *d, const char *used, int rows, int cols)
+{
+    int i, k, bad = 0, named = 0;
+    if (m->rows != rows || m->cols != cols || m->row_start[0] != 0 || m->row_start[rows] != m->nnz) return -1;
+    for (i = 0; i < rows * cols; i++) named += used[i];
+    if (named != m->nnz) bad++;
+    for (i = 0; i < rows; i++) {
+        if (m->row_start[i + 1] < m->row_start[i]) bad++;
+        for (k = m->row_start[i]; k < m->row_start[i + 1]; k++) {
+            int c = m->col[k];
+            if (c < 0 || c >= cols || (k > m->row_start[i] && c <= m->col[k - 1])) { bad++; continue; }
+            if (!used[(size_t)i * cols + c] || m->value[k] != d[(size_t)i * cols + c]) bad++;
+        }
+    }
+    return bad;
+}
+
+static void test_cg_triplets(void)
+{
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    int trial, bad_trials = 0;
+    lcg_seed(401);
+    for (trial = 0; trial < 300; trial++) {
+        int rows = 1 + lcg_below(trial < 100 ? 6 : 40), cols = 1 + lcg_below(trial < 100 ? 6 : 40);
+        int count = lcg_below(3 * rows * cols / 2 + 2), bad;
+        tt_triplet *t = cg_random_triplets(rows, cols, count);
+        char *used = (char *)calloc((size_t)rows * cols, 1);
+        double *d = cg_dense_from_triplets(rows, cols, t, count, used);
+        tt_sparse_matrix m;
+        tt_error err;
+        tt_result r = tt_sparse_from_triplets(&m, rows, cols, t, count, &al, &err);
+        if (r != TT_OK) bad = 1000;
+        else {
+            bad = cg_matches_dense(&m, d, used, rows, cols);
+            if (cnt.live != 3) bad++;
+        }
+        if (bad && !bad_trials)
+            DETAIL("trial %d: %d x %d from %d triplets: result %d, %d bad entries (%s)", trial, rows, cols, count, r,
+                   bad, err.message);
+        if (bad) bad_trials++;
+        if (r == TT_OK) tt_sparse_free(&m);
+        CHECK(m.row_start == NULL && m.col == NULL && m.value == NULL && m.nnz == 0,
+              "tt_sparse_free zeroes the struct");
+        free(t);
+        free(used);
+        free(d);
+    }
+    CHECK(bad_trials == 0, "CSR from random triplets differs from the dense sum in %d of 300 trials", bad_trials);
+    CHECK(cnt.live == 0 && cnt.bad_frees == 0, "triplets: %ld allocations leaked, %ld bad frees", cnt.live,
+          cnt.bad_frees);
+    {
+        /* A hand-checked case: unsorted input, a duplicate, an empty row 1, a
+           zero sum that stays in the pattern. */
+        static const tt_triplet t[] = {{2, 3, 1.0}, {0, 2, 5.0}, {2, 0, 2.0}, {0, 0, 1.5}, {2, 3, 0.25},
+                                       {0, 1, 4.0}, {0, 1, -4.0}};
+        static const int rs[] = {0, 3, 3, 5}, cl[] = {0, 1, 2, 0, 3};
+        static const double vl[] = {1.5, 0.0, 5.0, 2.0, 1.25};
+        tt_sparse_matrix m;
+        int k, same = 1;
+        tt_result r = tt_sparse_from_triplets(&m, 3, 4, t, 7, NULL, NULL);
+        CHECK(r == TT_OK && m.rows == 3 && m.cols == 4 && m.nnz == 5, "3x4 example: result %d, %d x %d, nnz %d", r,
+              m.rows, m.cols, m.nnz);
+        if (r == TT_OK && m.nnz == 5) {
+            for (k = 0; k < 4; k++) same &= m.row_start[k] == rs[k];
+            for (k = 0; k < 5; k++) same &= m.col[k] == cl[k] && m.value[k] == vl[k];
+            CHECK(same, "3x4 example: row_start/col/value differ from the hand-made CSR");
+        }
+        tt_sparse_free(&m);
+        tt_sparse_free(&m);   /* twice is harmless */
+        tt_sparse_free(NULL);
+    }
+    {
+        /* No triplets; a 0 x 0 matrix; NULL triplets with count 0. */
+        tt_sparse_matrix m;
+        tt_result r = tt_sparse_from_triplets(&m, 4, 2, NULL, 0, &al, NULL);
+        CHECK(r == TT_OK && m.nnz == 0 && m.rows == 4 && m.row_start && m.row_start[4] == 0,
+              "4x2 from no triplets: result %d, nnz %d", r, m.nnz);
+        tt_sparse_free(&m);
+        r = tt_sparse_from_triplets(&m, 0, 0, NULL, 0, &al, NULL);
+        CHECK(r == TT_OK && m.nnz == 0 && m.rows == 0 && m.row_start && m.row_start[0] == 0,
+              "0x0 matrix: result %d", r);
+        tt_sparse_free(&m);
+        CHECK(cnt.live == 0, "empty matrices: %ld allocations leaked", cnt.live);
+    }
+}
+
+static void cg_expect_triplet_error(int rows, int cols, const tt_triplet *t, int count, tt_result code, int row,
+                                    int col, int index, const char *what)
+{
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    tt_sparse_matrix m;
+    tt_error err;
+    tt_result r;
+    memset(&m, 0x5a, sizeof m);
+    r = tt_sparse_from_triplets(&m, rows, cols, t, count, &al, &err);
+    CHECK(r == code && err.result == code, "%s: expected %d, got %d (err.result %d)", what, code, r, err.result);
+    CHECK(m.row_start == NULL && m.col == NULL && m.value == NULL && m.rows == 0 && m.nnz == 0,
+          "%s: the matrix should be zeroed on failure", what);
+    CHECK(cnt.calls == 0 && cnt.live == 0, "%s: %ld allocations made, %ld live; none expected", what, cnt.calls,
+          cnt.live);
+    CHECK(err.message[0] != '\0', "%s: empty message", what);
+    if (row != -2) CHECK(err.vertex == row && err.other_vertex == col, "%s: row/col expected %d/%d, got %d/%d", what,
+                         row, col, err.vertex, err.other_vertex);
+    if (index >= 0) CHECK(msg_has_number(err.message, index), "%s: message should name triplet %d: %s", what, index,
+                          err.message);
+    r = tt_sparse_from_triplets(&m, rows, cols, t, count, &al, NULL);
+    CHECK(r == code, "%s with error == NULL: expected %d, got %d", what, code, r);
+}
+
+static void test_cg_triplet_errors(void)
+{
+    tt_triplet t[4] = {{0, 0, 1.0}, {1, 1, 2.0}, {2, 2, 3.0}, {1, 0, 0.5}};
+    t[2].row = 3;
+    cg_expect_triplet_error(3, 3, t, 4, TT_ERROR_INDEX_OUT_OF_RANGE, 3, 2, 2, "row == rows");
+    t[2].row = -1;
+    cg_expect_triplet_error(3, 3, t, 4, TT_ERROR_INDEX_OUT_OF_RANGE, -1, 2, 2, "row -1");
+    t[2].row = 2;
+    t[3].col = 7;
+    cg_expect_triplet_error(3, 3, t, 4, TT_ERROR_INDEX_OUT_OF_RANGE, 1, 7, 3, "column 7 of 3");
+    t[3].col = 0;
+    t[1].value = NAN;
+    cg_expect_triplet_error(3, 3, t, 4, TT_ERROR_NON_FINITE, 1, 1, 1, "NaN value");
+    t[1].value = -INFINITY;
+    cg_expect_triplet_error(3, 3, t, 4, TT_ERROR_NON_FINITE, 1, 1, 1, "-inf value");
+    t[1].value = 2.0;
+    cg_expect_triplet_error(-1, 3, t, 4, TT_ERROR_INVALID_ARGUMENT, -2, -2, -1, "rows -1");
+    cg_expect_triplet_error(3, 3, t, -4, TT_ERROR_INVALID_ARGUMENT, -2, -2, -1, "ntriplets -4");
+    cg_expect_triplet_error(3, 3, NULL, 4, TT_ERROR_INVALID_ARGUMENT, -2, -2, -1, "triplets NULL");
+    CHECK(tt_sparse_from_triplets(NULL, 3, 3, t, 4, NULL, NULL) == TT_ERROR_INVALID_ARGUMENT, "matrix NULL");
+}
+
+static void test_cg_multiply(void)
+{
+    int trial, bad = 0;
+    lcg_seed(402);
+    for (trial = 0; trial < 200; trial++) {
+        int rows = 1 + lcg_below(30), cols = 1 + lcg_below(30), count = lcg_below(rows * cols + 1), i, j;
+        tt_triplet *t = cg_random_triplets(rows, cols, count);
+        double *d = cg_dense_from_triplets(rows, cols, t, count, NULL);
+        double *x = (double *)malloc(sizeof(double) * (size_t)cols);
+        double *y = (double *)malloc(sizeof(double) * (size_t)rows);
+        tt_sparse_matrix m;
+        for (j = 0; j < cols; j++) x[j] = lcg_unit() * 2.0 - 1.0;
+        if (tt_sparse_from_triplets(&m, rows, cols, t, count, NULL, NULL) != TT_OK ||
+            tt_sparse_multiply(&m, x, y) != TT_OK) {
+            bad++;
+        } else {
+            for (i = 0; i < rows; i++) {
+                double want = 0.0, scale = 0.0;
+                for (j = 0; j < cols; j++) {
+                    want += d[(size_t)i * cols + j] * x[j];
+                    scale += fabs(d[(size_t)i * cols + j] * x[j]);
+                }
+                if (!near(y[i], want, 1e-14 * (scale + 1e-300) * cols)) {
+                    if (!bad) DETAIL("trial %d row %d: y %.17g, dense %.17g", trial, i, y[i], want);
+                    bad++;
+                }
+            }
+        }
+        tt_sparse_free(&m);
+        free(t);
+        free(d);
+        free(x);
+        free(y);
+    }
+    CHECK(bad == 0, "tt_sparse_multiply differs from the dense product in %d rows", bad);
+    {
+        /* A CSR filled by hand, unsorted with a repeated column (they add up). */
+        int rs[3] = {0, 3, 4}, cl[4] = {2, 0, 2, 1};
+        double vl[4] = {1.0, 2.0, 10.0, -1.0}, x[3] = {1.0, 2.0, 3.0}, y[2] = {0, 0};
+        tt_sparse_matrix m;
+        memset(&m, 0, sizeof m);
+        m.rows = 2;
+        m.cols = 3;
+        m.nnz = 4;
+        m.row_start = rs;
+        m.col = cl;
+        m.value = vl;
+        CHECK(tt_sparse_multiply(&m, x, y) == TT_OK && y[0] == 35.0 && y[1] == -2.0,
+              "hand-made CSR: expected 35, -2, got %g, %g", y[0], y[1]);
+        CHECK(tt_sparse_multiply(&m, x, x) == TT_ERROR_INVALID_ARGUMENT, "x == y must be refused");
+        CHECK(tt_sparse_multiply(NULL, x, y) == TT_ERROR_INVALID_ARGUMENT, "A NULL must be refused");
+        CHECK(tt_sparse_multiply(&m, NULL, y) == TT_ERROR_INVALID_ARGUMENT, "x NULL must be refused");
+    }
+}
+
+/* Dense Cholesky solve of the n x n SPD matrix a (overwritten by its factor):
+   x = a^-1 b. Returns 0 when a is not positive definite. */
+static int cg_dense_cholesky_solve(double *a, int n, const double *b, double *x)
+{
+    int i, j, k;
+    for (j = 0; j < n; j++) {
+        double s = a[(size_t)j * n + j];
+        for (k = 0; k < j; k++) s -= a[(size_t)j * n + k] * a[(size_t)j * n + k];
+        if (!(s > 0.0)) return 0;
+        a[(size_t)j * n + j] = sqrt(s);
+        for (i = j + 1; i < n; i++) {
+            double t = a[(size_t)i * n + j];
+            for (k = 0; k < j; k++) t -= a[(size_t)i * n + k] * a[(size_t)j * n + k];
+            a[(size_t)i * n + j] = t / a[(size_t)j * n + j];
+        }
+    }
+    for (i = 0; i < n; i++) {   /* L y = b */
+        double s = b[i];
+        for (k = 0; k < i; k++) s -= a[(size_t)i * n + k] * x[k];
+        x[i] = s / a[(size_t)i * n + i];
+    }
+    for (i = n - 1; i >= 0; i--) {   /* L^T x = y */
+        double s = x[i];
+        for (k = i + 1; k < n; k++) s -= a[(size_t)k * n + i] * x[k];
+        x[i] = s / a[(size_t)i * n + i];
+    }
+    return 1;
+}
+
+/* A sparse SPD matrix as triplets: a weighted graph Laplacian (a random tree
+   plus n random edges, weights 0.1..10) + a positive diagonal, + two sparse
+   rank-one terms v v^T with mixed signs, all scaled as D A D with D spread
+   over 1e-2..1e2 (so the Jacobi preconditioner has something to undo).
+   Triplets repeat positions (duplicates are summed). Returns the count. */
+static int cg_random_spd(int n, tt_triplet *t, int capacity)
+{
+    double *scale = (double *)malloc(sizeof(double) * (size_t)n);
+    int count = 0, i, e, k;
+#define CG_ADD(i_, j_, v_)                                          \
+    do {                                                            \
+        if (count < capacity) {                                     \
+            t[count].row = (i_);                                    \
+            t[count].col = (j_);                                    \
+            t[count].value = (v_) * scale[i_] * scale[j_];          \
+            count++;                                                \
+        }                                                           \
+    } while (0)
+    for (i = 0; i < n; i++) scale[i] = pow(10.0, lcg_unit() * 4.0 - 2.0);
+    for (i = 0; i < n; i++) CG_ADD(i, i, 0.01 + lcg_unit());
+    for (e = 0; e < 2 * n - 1; e++) {
+        int a = e < n - 1 ? e + 1 : lcg_below(n), b = e < n - 1 ? lcg_below(e + 1) : lcg_below(n);
+        double w = 0.1 + 9.9 * lcg_unit();
+        if (a == b) continue;
+        CG_ADD(a, a, w);
+        CG_ADD(b, b, w);
+        CG_ADD(a, b, -w);
+        CG_ADD(b, a, -w);
+    }
+    for (k = 0; k < 2 && n >= 3; k++) {
+        int idx[3];
+        double v[3];
+        int p, q;
+        idx[0] = lcg_below(n);
+        do idx[1] = lcg_below(n);
+        while (idx[1] == idx[0]);
+        do idx[2] = lcg_below(n);
+        while (idx[2] == idx[0] || idx[2] == idx[1]);
+        for (p = 0; p < 3; p++) v[p] = lcg_unit() * 4.0 - 2.0;
+        for (p = 0; p < 3; p++)
+            for (q = 0; q < 3; q++) CG_ADD(idx[p], idx[q], v[p] * v[q]);
+    }
+#undef CG_ADD
+    free(scale);
+    return count;
+}
+
+/* |b - A x| / |b| in long double from a dense matrix. */
+static double cg_dense_relres(const double *d, int n, const double *b, const double *x)
+{
+    long double rr = 0.0L, bb = 0.0L;
+    int i, j;
+    for (i = 0; i < n; i++) {
+        long double s = b[i];
+        for (j = 0; j < n; j++) s -= (long double)d[(size_t)i * n + j] * x[j];
+        rr += s * s;
+        bb += (long double)b[i] * b[i];
+    }
+    return bb > 0.0L ? (double)sqrtl(rr / bb) : (double)sqrtl(rr);
+}
+
+static void test_cg_random_spd(void)
+{
+    int n, bad_result = 0, bad_x = 0, bad_res = 0, bad_report = 0;
+    double worst_err = 0.0;
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    lcg_seed(403);
+    for (n = 1; n <= 200; n++) {
+        int cap = 30 * n + 20, count, i;
+        tt_triplet *t = (tt_triplet *)malloc(sizeof(tt_triplet) * (size_t)cap);
+        double *d, *chol, *b = (double *)malloc(sizeof(double) * (size_t)n);
+        double *x = (double *)calloc((size_t)n, sizeof(double)), *xr = (double *)malloc(sizeof(double) * (size_t)n);
+        double err_num = 0.0, err_den = 0.0, relres;
+        tt_sparse_matrix m;
+        tt_cg_options opt;
+        tt_cg_report rep;
+        tt_error err;
+        tt_result r;
+        count = cg_random_spd(n, t, cap);
+        d = cg_dense_from_triplets(n, n, t, count, NULL);
+        chol = (double *)malloc(sizeof(double) * (size_t)n * n);
+        memcpy(chol, d, sizeof(double) * (size_t)n * n);
+        for (i = 0; i < n; i++) b[i] = lcg_unit() * 2.0 - 1.0;
+        if (!cg_dense_cholesky_solve(chol, n, b, xr)) {
+            DETAIL("n = %d: the test matrix is not SPD (generator bug)", n);
+            bad_result++;
+        } else if (tt_sparse_from_triplets(&m, n, n, t, count, &al, NULL) != TT_OK) {
+            bad_result++;
+        } else {
+            memset(&opt, 0, sizeof opt);
+            /* 1e-12 is near what double arithmetic can confirm for these
+               matrices: without the final check against a recomputed b - A x,
+               the drift of the updated residual shows here. */
+            opt.tolerance = 1e-12;
+            opt.max_iterations = 20 * n + 100;
+            opt.allocator = al;
+            r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+            relres = cg_dense_relres(d, n, b, x);
+            for (i = 0; i < n; i++) {
+                err_num = fmax(err_num, fabs(x[i] - xr[i]));
+                err_den = fmax(err_den, fabs(xr[i]));
+            }
+            if (r != TT_OK || !rep.converged) {
+                if (!bad_result) DETAIL("n = %d: result %d after %d steps, residual %g: %s", n, r, rep.iterations,
+                                        rep.residual, err.message);
+                bad_result++;
+            }
+            if (relres > 2e-12) {
+                if (!bad_res) DETAIL("n = %d: true relative residual %g > 2e-12", n, relres);
+                bad_res++;
+            }
+            /* the report's residual is computed in double: rounding ~1e-13 here */
+            if (!(rep.residual <= 1e-12) || fabs(rep.residual - relres) > 1e-12) {
+                if (!bad_report) DETAIL("n = %d: report residual %g, recomputed %g", n, rep.residual, relres);
+                bad_report++;
+            }
+            if (err_num > 1e-7 * err_den) {
+                if (!bad_x) DETAIL("n = %d: |x - x_cholesky|_inf = %g, |x|_inf = %g", n, err_num, err_den);
+                bad_x++;
+            }
+            if (err_num / err_den > worst_err) worst_err = err_num / err_den;
+            tt_sparse_free(&m);
+        }
+        free(t);
+        free(d);
+        free(chol);
+        free(b);
+        free(x);
+        free(xr);
+    }
+    CHECK(bad_result == 0, "CG on random SPD matrices n = 1..200: %d did not converge", bad_result);
+    CHECK(bad_res == 0, "CG on random SPD matrices: %d true residuals above twice the tolerance 1e-12", bad_res);
+    CHECK(bad_report == 0, "CG: %d reports whose residual is not the recomputed one", bad_report);
+    CHECK(bad_x == 0, "CG vs dense Cholesky: %d solutions off by more than 1e-7 relative (worst %g)", bad_x,
+          worst_err);
+    CHECK(cnt.live == 0 && cnt.bad_frees == 0, "random SPD: %ld allocations leaked", cnt.live);
+}
+
+/* The 5-point Laplacian of a w x h grid (Neumann: interior and boundary rows
+   alike sum to zero) plus `shift` on the diagonal, as triplets. */
+static tt_sparse_matrix cg_grid_matrix(int w, int h, double shift)
+{
+    tt_triplet *t = (tt_triplet *)malloc(sizeof(tt_triplet) * (size_t)w * h * 9);
+    int x, y, count = 0;
+    tt_sparse_matrix m;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            int v = y * w + x, k;
+            static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+            t[count].row = v;
+            t[count].col = v;
+            t[count].value = shift;
+            count++;
+            for (k = 0; k < 4; k++) {
+                int nx = x + dx[k], ny = y + dy[k];
+                if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                t[count].row = v;
+                t[count].col = v;
+                t[count].value = 1.0;
+                count++;
+                t[count].row = v;
+                t[count].col = ny * w + nx;
+                t[count].value = -1.0;
+                count++;
+            }
+        }
+    if (tt_sparse_from_triplets(&m, w * h, w * h, t, count, NULL, NULL) != TT_OK) memset(&m, 0, sizeof m);
+    free(t);
+    return m;
+}
+
+/* |b - A x| / |b| through tt_sparse_multiply. */
+static double cg_relres(const tt_sparse_matrix *m, const double *b, const double *x)
+{
+    double *ax = (double *)malloc(sizeof(double) * (size_t)m->rows + 1), rr = 0.0, bb = 0.0;
+    int i;
+    tt_sparse_multiply(m, x, ax);
+    for (i = 0; i < m->rows; i++) {
+        rr += (b[i] - ax[i]) * (b[i] - ax[i]);
+        bb += b[i] * b[i];
+    }
+    free(ax);
+    return sqrt(rr / bb);
+}
+
+static void test_cg_grid(void)
+{
+    const int w = 40, h = 30, n = w * h;
+    tt_sparse_matrix m = cg_grid_matrix(w, h, 1.0);
+    double *xs = (double *)malloc(sizeof(double) * n), *b = (double *)malloc(sizeof(double) * n);
+    double *x = (double *)calloc((size_t)n, sizeof(double)), maxerr = 0.0;
+    tt_cg_report rep;
+    tt_error err;
+    tt_result r;
+    int i, iterations;
+    counter cnt;
+    tt_cg_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.allocator = make_allocator(&cnt, -1);
+    CHECK(m.rows == n && m.nnz == n + 2 * ((w - 1) * h + w * (h - 1)), "grid matrix: %d rows, %d entries", m.rows,
+          m.nnz);
+    lcg_seed(404);
+    for (i = 0; i < n; i++) xs[i] = sin(0.1 * (i % w)) * cos(0.13 * (i / w)) + 0.1 * lcg_unit();
+    tt_sparse_multiply(&m, xs, b);
+
+    /* Laplacian + identity: condition number < 9, default options. */
+    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    for (i = 0; i < n; i++) maxerr = fmax(maxerr, fabs(x[i] - xs[i]));
+    CHECK(r == TT_OK && rep.converged && err.result == TT_OK, "grid: expected TT_OK, got %d (%s)", r, err.message);
+    CHECK(rep.residual <= 1e-8 && near(rep.residual, cg_relres(&m, b, x), 1e-12),
+          "grid: report residual %g, recomputed %g (tolerance 1e-8)", rep.residual, cg_relres(&m, b, x));
+    CHECK(rep.iterations > 5 && rep.iterations < 60, "grid: %d steps for a condition number below 9", rep.iterations);
+    CHECK(maxerr < 1e-7, "grid: |x - x*|_inf = %g", maxerr);
+    CHECK(cnt.live == 0 && cnt.calls == 1, "grid: %ld allocation calls (1 expected), %ld live", cnt.calls, cnt.live);
+    iterations = rep.iterations;
+
+    /* Warm start from the solution just found: done in 0 or 1 step. */
+    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    CHECK(r == TT_OK && rep.iterations <= 1 && rep.converged, "warm start from the solution: %d, %d steps", r,
+          rep.iterations);
+    /* Warm start from the exact x*: b = A x* up to rounding, so 0 steps. */
+    memcpy(x, xs, sizeof(double) * n);
+    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    CHECK(r == TT_OK && rep.iterations <= 1 && rep.converged, "warm start from x*: %d, %d steps", r, rep.iterations);
+
+    /* A tighter tolerance takes more steps and gets closer. */
+    memset(x, 0, sizeof(double) * n);
+    opt.tolerance = 1e-13;
+    r = tt_cg_solve(&m, b, x, &opt, &rep, NULL);
+    CHECK(r == TT_OK && rep.iterations > iterations && rep.residual <= 1e-13,
+          "tolerance 1e-13: result %d, %d steps (1e-8 took %d), residual %g", r, rep.iterations, iterations,
+          rep.residual);
+
+    /* The iteration cap. */
+    memset(x, 0, sizeof(double) * n);
+    opt.tolerance = 0.0;
+    opt.max_iterations = 3;
+    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    CHECK(r == TT_ERROR_NOT_CONVERGED && err.result == r, "cap of 3 steps: expected %d, got %d",
+          TT_ERROR_NOT_CONVERGED, r);
+    CHECK(rep.iterations == 3 && !rep.converged && rep.residual > 1e-8 && rep.residual < 1.0 &&
+              near(rep.residual, cg_relres(&m, b, x), 1e-12),
+          "cap of 3 steps: report {%d, %g, %d}, recomputed residual %g", rep.iterations, rep.residual, rep.converged,
+          cg_relres(&m, b, x));
+    CHECK(msg_has_number(err.message, 3), "cap message should say 3 steps: %s", err.message);
+    CHECK(strcmp(tt_result_string(TT_ERROR_NOT_CONVERGED), tt_result_string((tt_result)-99)) != 0 &&
+              strcmp(tt_result_string(TT_ERROR_NOT_POSITIVE_DEFINITE), tt_result_string((tt_result)-99)) != 0 &&
+              strcmp(tt_result_string(TT_ERROR_NOT_CONVERGED),
+                     tt_result_string(TT_ERROR_NOT_POSITIVE_DEFINITE)) != 0,
+          "the two numerics codes need their own sentences");
+    CHECK(cnt.live == 0, "grid: %ld allocations leaked", cnt.live);
+
+    /* b = 0: x = 0 at once, whatever x was. */
+    for (i = 0; i < n; i++) {
+        x[i] = 5.0;
+        b[i] = 0.0;
+    }
+    opt.max_iterations = 0;
+    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    for (i = 0; i < n && x[i] == 0.0; i++) continue;
+    CHECK(r == TT_OK && i == n && rep.iterations == 0 && rep.converged && rep.residual == 0.0,
+          "b = 0: result %d, %d of %d zeros, %d steps", r, i, n, rep.iterations);
+
+    /* A pure Laplacian (no shift) plus one pinned row is still SPD but badly
+       conditioned: the default cap (2n) is enough with Jacobi. */
+    tt_sparse_free(&m);
+    m = cg_grid_matrix(w, h, 0.0);
+    m.value[0] += 1.0;   /* A[0][0] is the first entry of row 0: pin vertex 0 */
+    tt_sparse_multiply(&m, xs, b);
+    memset(x, 0, sizeof(double) * n);
+    r = tt_cg_solve(&m, b, x, NULL, &rep, &err);
+    maxerr = 0.0;
+    for (i = 0; i < n; i++) maxerr = fmax(maxerr, fabs(x[i] - xs[i]));
+    CHECK(r == TT_OK && rep.residual <= 1e-8 && maxerr < 1e-3,
+          "pinned Laplacian: result %d, %d steps, residual %g, |x - x*| %g (%s)", r, rep.iterations, rep.residual,
+          maxerr, err.message);
+    tt_sparse_free(&m);
+    free(xs);
+    free(b);
+    free(x);
+}
+
+typedef struct cg_progress_log {
+    int calls, cancel_at, decreasing, out_of_range;
+    float last;
+} cg_progress_log;
+
+static int cg_progress(float fraction, void *user_data)
+{
+    cg_progress_log *log = (cg_progress_log *)user_data;
+    if (fraction < log->last) log->decreasing++;
+    if (!(fraction >= 0.0f && fraction <= 1.0f)) log->out_of_range++;
+    log->last = fraction;
+    log->calls++;
+    return log->cancel_at > 0 && log->calls >= log->cancel_at;
+}
+
+static void test_cg_progress(void)
+{
+    const int w = 20, h = 20, n = w * h;
+    tt_sparse_matrix m = cg_grid_matrix(w, h, 0.01);
+    double *b = (double *)malloc(sizeof(double) * n), *x = (double *)calloc((size_t)n, sizeof(double));
+    cg_progress_log log;
+    tt_cg_options opt;
+    tt_cg_report rep;
+    tt_error err;
+    tt_result r;
+    counter cnt;
+    int i;
+    for (i = 0; i < n; i++) b[i] = (double)(i % 7) - 3.0;
+    memset(&opt, 0, sizeof opt);
+    memset(&log, 0, sizeof log);
+    opt.progress = cg_progress;
+    opt.progress_user_data = &log;
+    opt.allocator = make_allocator(&cnt, -1);
+    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    CHECK(r == TT_OK && log.calls == rep.iterations, "progress: result %d, %d calls for %d steps", r, log.calls,
+          rep.iterations);
+    CHECK(log.decreasing == 0 && log.out_of_range == 0 && log.last > 0.5f,
+          "progress: %d decreases, %d outside [0,1], last %g", log.decreasing, log.out_of_range, log.last);
+    memset(&log, 0, sizeof log);
+    memset(x, 0, sizeof(double) * n);
+    log.cancel_at = 5;
+    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    CHECK(r == TT_CANCELLED && err.result == TT_CANCELLED && rep.iterations == 4 && !rep.converged &&
+              rep.residual > 0.0 && rep.residual < 1.0,
+          "cancel at the 5th call: result %d, %d steps, residual %g", r, rep.iterations, rep.residual);
+    CHECK(cnt.live == 0, "cancel: %ld allocations leaked", cnt.live);
+    tt_sparse_free(&m);
+    free(b);
+    free(x);
+}
+
+/* tt_cg_solve must fail with `code`, name `row` (-2: do not check), leave x
+   alone when `untouched`, and leak nothing. */
+static void cg_expect_solve_error(const tt_sparse_matrix *m, const double *b, double *x, const tt_cg_options *o,
+                                  tt_result code, int row, int untouched, const char *what)
+{
+    counter cnt;
+    tt_cg_options opt;
+    tt_cg_report rep;
+    tt_error err;
+    tt_result r;
+    double keep[8];
+    int n = m && m->rows > 0 && m->rows <= 8 ? m->rows : 0, i, same = 1;
+    if (o) opt = *o;
+    else memset(&opt, 0, sizeof opt);
+    opt.allocator = make_allocator(&cnt, -1);
+    if (x && n) memcpy(keep, x, sizeof(double) * n);
+    memset(&rep, 0x5a, sizeof rep);
+    r = tt_cg_solve(m, b, x, &opt, &rep, &err);
+    CHECK(r == code && err.result == code, "%s: expected %d, got %d (%s)", what, code, r, err.message);
+    CHECK(err.message[0] != '\0', "%s: empty message", what);
+    if (row != -2) CHECK(err.vertex == row && msg_has_number(err.message, row), "%s: should name row %d: vertex %d, %s",
+                         what, row, err.vertex, err.message);
+    if (untouched && x && n) {
+        for (i = 0; i < n; i++) same &= x[i] == keep[i];
+        CHECK(same, "%s: x should be left as it was", what);
+    }
+    CHECK(!rep.converged && rep.iterations >= 0 && rep.iterations < 100, "%s: report {%d, %g, %d}", what,
+          rep.iterations, rep.residual, rep.converged);
+    CHECK(cnt.live == 0 && cnt.bad_frees == 0, "%s: %ld allocations leaked", what, cnt.live);
+    r = tt_cg_solve(m, b, x, &opt, NULL, NULL);
+    CHECK(r == code, "%s with report and error NULL: expected %d, got %d", what, code, r);
+    if (x && n) memcpy(x, keep, sizeof(double) * n);
+}
+
+static tt_sparse_matrix cg_small(int rows, int cols, const double *dense)
+{
+    tt_triplet t[64];
+    int i, j, count = 0;
+    tt_sparse_matrix m;
+    for (i = 0; i < rows; i++)
+        for (j = 0; j < cols; j++)
+            if (dense[i * cols + j] != 0.0) {
+                t[count].row = i;
+                t[count].col = j;
+                t[count].value = dense[i * cols + j];
+                count++;
+            }
+    if (tt_sparse_from_triplets(&m, rows, cols, t, count, NULL, NULL) != TT_OK) memset(&m, 0, sizeof m);
+    return m;
+}
+
+static void test_cg_errors(void)
+{
+    static const double spd[9] = {4, 1, 0, 1, 3, 1, 0, 1, 2};
+    static const double rect[12] = {4, 1, 0, 0, 1, 3, 1, 0, 0, 1, 2, 0};
+    static const double zero_diag[9] = {4, 1, 0, 1, 0, 1, 0, 1, 2};
+    static const double neg_diag[9] = {4, 1, 0, 1, 3, 1, 0, 1, -2};
+    static const double empty_row[9] = {4, 0, 0, 0, 3, 0, 0, 0, 0};
+    static const double indefinite[4] = {1, 2, 2, 1};
+    double b[3] = {1, 2, 3}, x[3] = {0.5, 0.25, 0.125};
+    tt_sparse_matrix m = cg_small(3, 3, spd), bad;
+    tt_cg_options opt;
+    memset(&opt, 0, sizeof opt);
+
+    cg_expect_solve_error(NULL, b, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "A NULL");
+    cg_expect_solve_error(&m, NULL, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "b NULL");
+    cg_expect_solve_error(&m, b, NULL, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "x NULL");
+    cg_expect_solve_error(&m, b, b, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "b == x");
+    opt.tolerance = -1.0;
+    cg_expect_solve_error(&m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "tolerance -1");
+    opt.tolerance = NAN;
+    cg_expect_solve_error(&m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "tolerance NaN");
+    opt.tolerance = 0.0;
+    opt.max_iterations = -1;
+    cg_expect_solve_error(&m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "max_iterations -1");
+
+    bad = cg_small(3, 4, rect);
+    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "3 x 4 matrix");
+    tt_sparse_free(&bad);
+    bad = cg_small(3, 3, zero_diag);
+    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 1, 1, "zero (missing) diagonal in row 1");
+    tt_sparse_free(&bad);
+    bad = cg_small(3, 3, neg_diag);
+    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 2, 1, "negative diagonal in row 2");
+    tt_sparse_free(&bad);
+    bad = cg_small(3, 3, empty_row);
+    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 2, 1, "empty row 2");
+    tt_sparse_free(&bad);
+    {
+        /* An explicit zero on the diagonal (kept in the pattern). */
+        tt_triplet t[4] = {{0, 0, 1.0}, {1, 1, 1.0}, {1, 1, -1.0}, {2, 2, 1.0}};
+        tt_sparse_from_triplets(&bad, 3, 3, t, 4, NULL, NULL);
+        cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 1, 1, "diagonal summing to 0");
+        tt_sparse_free(&bad);
+    }
+
+    /* NaN or infinity in A (changed in place), b, x. */
+    m.value[3] = NAN;   /* row 1: entries (1,0) (1,1) (1,2) start at 2 */
+    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 1, 1, "NaN in A");
+    m.value[3] = 3.0;
+    b[2] = NAN;
+    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 2, 1, "NaN in b");
+    b[2] = INFINITY;
+    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 2, 1, "inf in b");
+    b[2] = 3.0;
+    x[1] = -INFINITY;
+    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 1, 1, "-inf in the initial guess");
+    x[1] = 0.25;
+
+    {
+        /* Hand-made CSR with a column out of range, and a broken row_start. */
+        int rs[4] = {0, 1, 2, 3}, cl[3] = {0, 3, 2};
+        double vl[3] = {1, 1, 1};
+        tt_sparse_matrix h;
+        memset(&h, 0, sizeof h);
+        h.rows = h.cols = 3;
+        h.nnz = 3;
+        h.row_start = rs;
+        h.col = cl;
+        h.value = vl;
+        cg_expect_solve_error(&h, b, x, NULL, TT_ERROR_INDEX_OUT_OF_RANGE, 1, 1, "column 3 in a 3 x 3 CSR");
+        cl[1] = 1;
+        rs[1] = 2;
+        rs[2] = 1;
+        cg_expect_solve_error(&h, b, x, NULL, TT_ERROR_INVALID_ARGUMENT, 1, 1, "row_start decreasing");
+        rs[1] = 1;
+        rs[2] = 2;
+        h.nnz = 2;
+        cg_expect_solve_error(&h, b, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "nnz != row_start[rows]");
+        h.nnz = 3;
+        {
+            /* unsorted and repeated columns are fine: diagonal 3 + (-1) = 2 */
+            int rs2[3] = {0, 3, 5}, cl2[5] = {1, 0, 0, 1, 0};
+            double vl2[5] = {1.0, 3.0, -1.0, 3.0, 1.0}, b2[2] = {3.0, 4.0}, x2[2] = {0, 0};
+            tt_cg_report rep;
+            memset(&rep, 0, sizeof rep);
+            h.rows = h.cols = 2;
+            h.nnz = 5;
+            h.row_start = rs2;
+            h.col = cl2;
+            h.value = vl2;
+            /* [[2,1],[1,3]] x = [3,4]  ->  x = [1, 1] */
+            CHECK(tt_cg_solve(&h, b2, x2, NULL, &rep, NULL) == TT_OK && near(x2[0], 1.0, 1e-9) &&
+                      near(x2[1], 1.0, 1e-9) && rep.iterations <= 2,
+                  "unsorted CSR with repeated columns: x = %g %g in %d steps", x2[0], x2[1], rep.iterations);
+        }
+    }
+
+    /* Positive diagonal but indefinite: breakdown at step 1 (p . A p = -12). */
+    bad = cg_small(2, 2, indefinite);
+    b[1] = 0.0;
+    x[0] = x[1] = 0.0;
+    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, -2, 0, "indefinite 2 x 2");
+    tt_sparse_free(&bad);
+    b[1] = 2.0;
+
+    {
+        /* 0 x 0 and 1 x 1 systems. */
+        tt_sparse_matrix e;
+        tt_cg_report rep;
+        double one = 4.0, sol = 0.0;
+        tt_sparse_from_triplets(&e, 0, 0, NULL, 0, NULL, NULL);
+        CHECK(tt_cg_solve(&e, b, x, NULL, &rep, NULL) == TT_OK && rep.converged && rep.iterations == 0,
+              "0 x 0 system: should succeed at once");
+        tt_sparse_free(&e);
+        e = cg_small(1, 1, &one);
+        CHECK(tt_cg_solve(&e, b, &sol, NULL, &rep, NULL) == TT_OK && near(sol, 0.25, 1e-15) && rep.iterations == 1,
+              "1 x 1: 4 x = 1 gave %g in %d steps", sol, rep.iterations);
+        tt_sparse_free(&e);
+    }
+    tt_sparse_free(&m);
+}
+
+typedef struct cg_oom_ctx {
+    const tt_triplet *t;
+    int n, count;
+    const double *b;
+} cg_oom_ctx;
+
+static tt_result cg_oom_triplets(void *ctx, const tt_allocator *al)
+{
+    cg_oom_ctx *c = (cg_oom_ctx *)ctx;
+    tt_sparse_matrix m;
+    tt_error err;
+    tt_result r = tt_sparse_from_triplets(&m, c->n, c->n, c->t, c->count, al, &err);
+    if (r == TT_OK) tt_sparse_free(&m);
+    else if (m.row_start || m.col || m.value || err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static tt_result cg_oom_solve(void *ctx, const tt_allocator *al)
+{
+    cg_oom_ctx *c = (cg_oom_ctx *)ctx;
+    tt_sparse_matrix m;
+    tt_cg_options opt;
+    tt_error err;
+    tt_result r;
+    double x[64];
+    memset(x, 0, sizeof x);
+    if (tt_sparse_from_triplets(&m, c->n, c->n, c->t, c->count, NULL, NULL) != TT_OK) return TT_RESULT_MAX_ENUM;
+    memset(&opt, 0, sizeof opt);
+    opt.allocator = *al;
+    r = tt_cg_solve(&m, c->b, x, &opt, NULL, &err);
+    if (r != TT_OK && err.result != r) r = TT_RESULT_MAX_ENUM;
+    tt_sparse_free(&m);
+    return r;
+}
+
+static void test_cg_oom(void)
+{
+    tt_triplet t[2000];
+    double b[64];
+    cg_oom_ctx c;
+    int i;
+    lcg_seed(405);
+    c.n = 40;
+    c.count = cg_random_spd(c.n, t, 2000);
+    c.t = t;
+    for (i = 0; i < 64; i++) b[i] = lcg_unit();
+    c.b = b;
+    oom_reset();
+    oom_sweep("tt_sparse_from_triplets(40 x 40)", cg_oom_triplets, &c, TT_OK);
+    oom_sweep("tt_cg_solve(40 x 40)", cg_oom_solve, &c, TT_OK);
+    for (i = 0; i < 64; i++) b[i] = 0.0;
+    oom_sweep("tt_cg_solve(b = 0)", cg_oom_solve, &c, TT_OK);
+}
+
+void run_numerics_tests(void)
+{
+    RUN(test_cg_triplets);
+    RUN(test_cg_triplet_errors);
+    RUN(test_cg_multiply);
+    RUN(test_cg_random_spd);
+    RUN(test_cg_grid);
+    RUN(test_cg_progress);
+    RUN(test_cg_errors);
+    RUN(test_cg_oom);
+}

@@ -1,0 +1,3018 @@
+/* tests/test_7_lapped.c - unit tests for section 7 of tiledtex.h: the
+   tangent field, texture patches, the paste loop, patch hulls, measuring, atlas
+   packing and baking. Run by run_lapped_tests() (tests/test_common.c calls it).
+   */
+#include "test_common.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------ */
+/* 7. Lapped textures: the tangent field                                    */
+/* ------------------------------------------------------------------------ */
+
+/* Latitude-longitude sphere, poles on the z axis: triangles at the poles,
+   quads between; outward CCW. */
+static void make_field_sphere(tmesh *m, int nlat, int nlon, double radius)
+{
+    const double pi = 3.14159265358979323846;
+    int i, j, north, south, base;
+    north = tm_vert(m, 0, 0, radius);
+    base = m->nv;
+    for (j = 1; j < nlat; j++)
+        for (i = 0; i < nlon; i++) {
+            double t = pi * j / nlat, p = 2 * pi * i / nlon;
+            tm_vert(m, radius * sin(t) * cos(p), radius * sin(t) * sin(p), radius * cos(t));
+        }
+    south = tm_vert(m, 0, 0, -radius);
+    for (i = 0; i < nlon; i++) tm_tri(m, north, base + i, base + (i + 1) % nlon);
+    for (j = 0; j + 1 < nlat - 1; j++)
+        for (i = 0; i < nlon; i++) {
+            int i1 = (i + 1) % nlon;
+            tm_quad(m, base + j * nlon + i, base + (j + 1) * nlon + i, base + (j + 1) * nlon + i1, base + j * nlon + i1);
+        }
+    for (i = 0; i < nlon; i++)
+        tm_tri(m, base + (nlat - 2) * nlon + i, south, base + (nlat - 2) * nlon + (i + 1) % nlon);
+}
+
+static double fv_dot(const float *a, const float *b) { return (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2]; }
+static double fv_len(const float *a) { return sqrt(fv_dot(a, a)); }
+
+/* Angle between a and b (radians); pi/2 if either is zero. */
+static double fv_angle(const double *a, const double *b)
+{
+    double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    double c;
+    if (la == 0.0 || lb == 0.0) return 1.5707963267948966;
+    c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
+    return acos(c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c));
+}
+
+/* Largest angle between the vectors of two faces sharing an edge, the
+   neighbour's projected on the face's plane. */
+static double field_max_neighbour_angle(const tt_mesh *mesh, const float *v)
+{
+    double worst = 0.0;
+    int c;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int f = mesh->corner_face[c], g, k;
+        float n[3];
+        double a[3], b[3], d, ang;
+        if (mesh->twin[c] < 0) continue;
+        g = mesh->corner_face[mesh->twin[c]];
+        tt_face_normal(mesh, f, n);
+        d = fv_dot(v + 3 * g, n);
+        for (k = 0; k < 3; k++) { a[k] = v[3 * f + k]; b[k] = v[3 * g + k] - d * n[k]; }
+        ang = fv_angle(a, b);
+        if (ang > worst) worst = ang;
+    }
+    return worst;
+}
+
+/* Half-edges across which the field turns by more than `limit` radians. */
+static int field_rough_edges(const tt_mesh *mesh, const float *v, double limit)
+{
+    int c, count = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int f = mesh->corner_face[c], g, k;
+        float n[3];
+        double a[3], b[3], d;
+        if (mesh->twin[c] < 0) continue;
+        g = mesh->corner_face[mesh->twin[c]];
+        tt_face_normal(mesh, f, n);
+        d = fv_dot(v + 3 * g, n);
+        for (k = 0; k < 3; k++) { a[k] = v[3 * f + k]; b[k] = v[3 * g + k] - d * n[k]; }
+        if (fv_angle(a, b) > limit) count++;
+    }
+    return count;
+}
+
+/* Every vector in its face's plane with length `len` (relative tolerances);
+   counts offenders and reports the first. */
+static void check_field_plane_length(const tt_mesh *mesh, const float *v, double len, const char *what)
+{
+    int f, off_plane = 0, bad_len = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        float n[3];
+        double l = fv_len(v + 3 * f), d;
+        tt_face_normal(mesh, f, n);
+        d = fv_dot(v + 3 * f, n);
+        if (!(fabs(d) <= 1e-5 * (len >= 0 ? len : l))) {
+            if (!off_plane) DETAIL("%s: face %d: |v.n| = %g for |v| = %g", what, f, fabs(d), l);
+            off_plane++;
+        }
+        if (len >= 0 && !near(l, len, 1e-5 * len)) {
+            if (!bad_len) DETAIL("%s: face %d: length %.9g, expected %.9g", what, f, l, len);
+            bad_len++;
+        }
+    }
+    CHECK(off_plane == 0, "%s: %d of %d vectors leave their face's plane", what, off_plane, mesh->nfaces);
+    CHECK(bad_len == 0, "%s: %d of %d vectors do not have length %g", what, bad_len, mesh->nfaces, len);
+}
+
+/* Faces not perpendicular to `up` must point along up projected on the face.
+   Returns how many faces were perpendicular (left to propagation). */
+static int check_field_up(const tt_mesh *mesh, int first_face, const float *v, const float up_in[3], const char *what)
+{
+    double up[3], lu;
+    int f, k, bad = 0, perpendicular = 0;
+    for (k = 0; k < 3; k++) up[k] = up_in[k];
+    lu = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+    for (k = 0; k < 3; k++) up[k] /= lu;
+    for (f = first_face; f < mesh->nfaces; f++) {
+        float n[3];
+        double p[3], d, a[3], ang;
+        tt_face_normal(mesh, f, n);
+        d = up[0] * n[0] + up[1] * n[1] + up[2] * n[2];
+        for (k = 0; k < 3; k++) { p[k] = up[k] - d * n[k]; a[k] = v[3 * f + k]; }
+        if (sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) < TT_FIELD_PERPENDICULAR + 1e-4) { perpendicular++; continue; }
+        ang = fv_angle(a, p);
+        if (!(ang < 1e-4)) {
+            if (!bad) DETAIL("%s: face %d is %g rad from projected up", what, f, ang);
+            bad++;
+        }
+    }
+    CHECK(bad == 0, "%s: %d faces do not point along the projected up vector", what, bad);
+    return perpendicular;
+}
+
+static void test_field_default(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options opt;
+    tt_error err;
+    float *v;
+    int perpendicular, f;
+    double diag;
+
+    /* Sphere, up = +y (default): the caps around +-y are perpendicular. */
+    memset(&m, 0, sizeof m);
+    make_field_sphere(&m, 24, 32, 2.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.scale = 0.5f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "sphere field: %s", err.message);
+    CHECK(err.result == TT_OK && err.face == -1, "success clears the error (result %d face %d)", err.result, err.face);
+    check_field_plane_length(mesh, v, 0.5, "sphere, up = default");
+    {
+        const float up[3] = {0, 1, 0};
+        perpendicular = check_field_up(mesh, 0, v, up, "sphere, up = default");
+    }
+    CHECK(perpendicular > 0, "sphere: expected some faces perpendicular to +y, got %d", perpendicular);
+    /* Default scale: 0.1 of the bounding-box diagonal (4 sqrt 3 for r = 2: the poles and equator reach +-2). */
+    {
+        float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+        int i, k;
+        for (i = 0; i < m.nv; i++)
+            for (k = 0; k < 3; k++) {
+                if (m.pos[3 * i + k] < lo[k]) lo[k] = m.pos[3 * i + k];
+                if (m.pos[3 * i + k] > hi[k]) hi[k] = m.pos[3 * i + k];
+            }
+        diag = sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) + (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                    (double)(hi[2] - lo[2]) * (hi[2] - lo[2]));
+    }
+    CHECK(tt_tangent_field(mesh, NULL, v, &err) == TT_OK, "NULL options: %s", err.message);
+    check_field_plane_length(mesh, v, TT_DEFAULT_FIELD_SCALE * diag, "sphere, NULL options (default scale)");
+    /* A tilted up vector, not unit length: only its direction counts. */
+    opt.up[0] = 0.6f; opt.up[1] = 2.0f; opt.up[2] = -0.9f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "tilted up: %s", err.message);
+    check_field_plane_length(mesh, v, 0.5, "sphere, tilted up");
+    perpendicular = check_field_up(mesh, 0, v, opt.up, "sphere, tilted up");
+    CHECK(perpendicular > 0, "sphere, tilted up: expected perpendicular faces, got %d", perpendicular);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Torus around z with up = +z: the top and bottom bands are perpendicular. */
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 32, 16, 3.0, 1.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.up[2] = 1.0f;
+    opt.scale = 0.25f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "torus field: %s", err.message);
+    check_field_plane_length(mesh, v, 0.25, "torus, up = +z");
+    perpendicular = check_field_up(mesh, 0, v, opt.up, "torus, up = +z");
+    CHECK(perpendicular > 0, "torus: expected perpendicular faces, got %d", perpendicular);
+    /* Projected up flips across the top and bottom rings (both sides point
+       at the ring), so only most edges are smooth; the flips are the field's. */
+    CHECK(field_rough_edges(mesh, v, 0.5) <= 2 * 2 * 32, "torus: %d half-edges turn by more than 0.5 rad",
+          field_rough_edges(mesh, v, 0.5));
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Open grid in z = 0, up = +y: every face points exactly along +y. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 6, 4);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.scale = 2.0f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid field: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++)
+        if (v[3 * f] != 0.0f || v[3 * f + 1] != 2.0f || v[3 * f + 2] != 0.0f) break;
+    CHECK(f == mesh->nfaces, "grid, up = +y: face %d is (%g, %g, %g), expected (0, 2, 0)", f,
+          f < mesh->nfaces ? v[3 * f] : 0.0, f < mesh->nfaces ? v[3 * f + 1] : 0.0, f < mesh->nfaces ? v[3 * f + 2] : 0.0);
+    {
+        float n[3];
+        tt_face_normal(mesh, 0, n);
+        CHECK(n[0] == 0.0f && n[1] == 0.0f && n[2] == 1.0f, "tt_face_normal of the grid: (%g, %g, %g)", n[0], n[1], n[2]);
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* Surfaces facing up: no face has a usable projection, so everything comes
+   from the seed face's first edge, carried breadth-first. */
+static void test_field_fallback(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options opt;
+    tt_error err;
+    float *v, *w;
+    int f, i, j, bad = 0;
+
+    /* Flat grid facing up: every face gets face 0's first edge, +x. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 7, 5);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    opt.up[2] = 1.0f;
+    opt.scale = 1.0f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "flat grid facing up: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++)
+        if (!near(v[3 * f], 1.0, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
+    CHECK(bad == 0, "flat grid facing up: %d faces not (1, 0, 0) (face 0's first edge)", bad);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* A gentle dome facing up (normals within ~8 degrees of +z, under the 11.5 of TT_FIELD_PERPENDICULAR): propagation
+       must stay tangent, keep the scale and vary slowly. */
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= 12; j++)
+        for (i = 0; i <= 12; i++) {
+            double x = (i - 6) / 6.0, y = (j - 6) / 6.0;
+            tm_vert(&m, x, y, -0.05 * (x * x + y * y));
+        }
+    for (j = 0; j < 12; j++)
+        for (i = 0; i < 12; i++) {
+            int a = j * 13 + i;
+            if ((i + j) % 2) tm_quad(&m, a, a + 1, a + 14, a + 13);
+            else { tm_tri(&m, a, a + 1, a + 14); tm_tri(&m, a, a + 14, a + 13); }
+        }
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "dome builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    w = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "dome facing up: %s", err.message);
+    check_field_plane_length(mesh, v, 1.0, "dome facing up");
+    CHECK(field_max_neighbour_angle(mesh, v) < 0.05, "dome facing up: neighbouring vectors differ by %g rad",
+          field_max_neighbour_angle(mesh, v));
+    /* Determinism: the same call gives the same bits. */
+    CHECK(tt_tangent_field(mesh, &opt, w, &err) == TT_OK, "dome again: %s", err.message);
+    CHECK(memcmp(v, w, sizeof(float) * 3 * (size_t)mesh->nfaces) == 0, "two identical calls differ");
+    free(v);
+    free(w);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Two components: a grid facing up (fallback) and a torus (up works),
+       plus a zero-area triangle in a permissive mesh: it gets (0, 0, 0). */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 3, 3);
+    make_torus(&m, 12, 8, 3.0, 1.0);
+    {
+        int a = tm_vert(&m, 10, 0, 0), b = tm_vert(&m, 11, 0, 0), c = tm_vert(&m, 12, 0, 0);
+        tm_tri(&m, a, b, c);
+    }
+    CHECK(build(&m, TT_MESH_PERMISSIVE, &mesh, &err) == TT_OK, "grid + torus + sliver builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid + torus + sliver: %s", err.message);
+    f = mesh->nfaces - 1;
+    CHECK(v[3 * f] == 0.0f && v[3 * f + 1] == 0.0f && v[3 * f + 2] == 0.0f, "zero-area face: (%g, %g, %g)", v[3 * f],
+          v[3 * f + 1], v[3 * f + 2]);
+    {
+        float n[3];
+        tt_face_normal(mesh, f, n);
+        CHECK(n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f, "tt_face_normal of a zero-area face: (%g, %g, %g)", n[0],
+              n[1], n[2]);
+    }
+    bad = 0;
+    for (f = 0; f < 9; f++)
+        if (!near(v[3 * f], 1.0, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
+    CHECK(bad == 0, "grid beside a torus: %d faces not (1, 0, 0)", bad);
+    bad = 0;
+    for (f = 9; f < mesh->nfaces - 1; f++)
+        if (!near(fv_len(v + 3 * f), 1.0, 1e-5)) bad++;
+    CHECK(bad == 0, "torus beside a grid: %d faces without unit length", bad);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+static void test_field_constraints(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options opt;
+    tt_field_constraint con[3];
+    tt_error err;
+    float *v;
+    int f, k, bad = 0;
+    double lmin = 1e30, lmax = 0.0;
+
+    /* One constraint on a flat grid: parallel transport is the identity, so
+       every face gets the constraint's vector. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 8, 8);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    memset(con, 0, sizeof con);
+    con[0].face = 27;
+    con[0].vector[0] = 0.3f; con[0].vector[1] = 0.4f; con[0].vector[2] = 5.0f;   /* z is projected away */
+    opt.constraints = con;
+    opt.nconstraints = 1;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid, one constraint: %s", err.message);
+    {
+        /* Direction from the projection (0.6, 0.8, 0), length |vector| (the scale). */
+        double l = sqrt(0.3 * 0.3 + 0.4 * 0.4 + 5.0 * 5.0);
+        for (f = 0; f < mesh->nfaces; f++)
+            if (!near(v[3 * f], 0.6 * l, 1e-5) || !near(v[3 * f + 1], 0.8 * l, 1e-5) || !near(v[3 * f + 2], 0.0, 1e-6))
+                bad++;
+        CHECK(bad == 0, "grid, one constraint: %d faces differ from (0.6, 0.8, 0) * %g", bad, l);
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Torus: three constraints of different directions and lengths. */
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 16, 3.0, 1.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(con, 0, sizeof con);
+    con[0].face = 0;                       /* outer equator at angle 0: tangent plane y, z */
+    con[0].vector[2] = 0.2f;
+    con[1].face = 16;                      /* a third of the way round */
+    con[1].vector[0] = -0.866f * 0.4f; con[1].vector[1] = 0.5f * 0.4f;   /* along the ring */
+    con[2].face = 32 + 8 * 48;             /* inner side, two thirds round */
+    con[2].vector[2] = -0.3f;
+    con[2].sigma = 1.0f;
+    con[2].weight = 2.0f;
+    opt.constraints = con;
+    opt.nconstraints = 3;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "torus, constraints: %s", err.message);
+    check_field_plane_length(mesh, v, -1.0, "torus, constraints (plane only)");
+    for (k = 0; k < 3; k++) {
+        float n[3];
+        double c[3], d, a[3];
+        int g = con[k].face, j;
+        tt_face_normal(mesh, g, n);
+        d = fv_dot(con[k].vector, n);
+        for (j = 0; j < 3; j++) { c[j] = con[k].vector[j] - d * n[j]; a[j] = v[3 * g + j]; }
+        CHECK(fv_angle(a, c) < 1e-5 && near(fv_len(v + 3 * g), fv_len(con[k].vector), 1e-6),
+              "constraint %d on face %d: got (%g, %g, %g), expected (%g, %g, %g) projected", k, g, v[3 * g],
+              v[3 * g + 1], v[3 * g + 2], con[k].vector[0], con[k].vector[1], con[k].vector[2]);
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        double l = fv_len(v + 3 * f);
+        if (l < lmin) lmin = l;
+        if (l > lmax) lmax = l;
+    }
+    CHECK(lmin >= 0.2 - 1e-6 && lmax <= 0.4 + 1e-6 && lmax - lmin > 0.1,
+          "torus, constraints: lengths in [%g, %g], expected within [0.2, 0.4] and varying", lmin, lmax);
+    /* Transport along each constraint's Dijkstra tree has a cut locus where paths round
+       a handle meet with different holonomy: a few rough edges there, smooth elsewhere. */
+    CHECK(field_rough_edges(mesh, v, 0.5) < mesh->ncorners / 10, "torus, constraints: %d of %d half-edges turn by more than 0.5 rad",
+          field_rough_edges(mesh, v, 0.5), mesh->ncorners);
+    /* Faces next to a constrained face stay close to it (smooth interpolation). */
+    {
+        int g = con[1].face, c;
+        double worst = 0.0;
+        for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
+            int h = mesh->corner_face[mesh->twin[c]], j;
+            double a[3], b[3];
+            for (j = 0; j < 3; j++) { a[j] = v[3 * g + j]; b[j] = v[3 * h + j]; }
+            if (fv_angle(a, b) > worst) worst = fv_angle(a, b);
+        }
+        CHECK(worst < 0.3, "neighbours of constraint 1 turn by %g rad", worst);
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* Two components: the constraint's component follows it, the other one
+       (unreachable) falls back to the default rule. */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 3, 3);
+    make_torus(&m, 12, 8, 3.0, 1.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid + torus builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(con, 0, sizeof con);
+    con[0].face = 4;
+    con[0].vector[0] = 0.5f;
+    opt.constraints = con;
+    opt.nconstraints = 1;
+    opt.scale = 0.7f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid + torus, constraint: %s", err.message);
+    bad = 0;
+    for (f = 0; f < 9; f++)
+        if (!near(v[3 * f], 0.5, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
+    CHECK(bad == 0, "constrained grid: %d faces differ from (0.5, 0, 0)", bad);
+    {
+        int perpendicular;
+        const float up[3] = {0, 1, 0};
+        bad = 0;
+        for (f = 9; f < mesh->nfaces; f++)
+            if (!near(fv_len(v + 3 * f), 0.7, 1e-5)) bad++;
+        CHECK(bad == 0, "unconstrained torus: %d faces without the scale 0.7", bad);
+        perpendicular = check_field_up(mesh, 9, v, up, "grid + torus, torus part");
+        (void)perpendicular;
+    }
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+static void test_field_errors(void)
+{
+    tmesh m, md;
+    tt_mesh *mesh = NULL, *dmesh = NULL;
+    tt_field_options opt;
+    tt_field_constraint con[2];
+    tt_error err;
+    float v[3 * 64];
+    float nan_f;
+    {
+        uint32_t bits = 0x7fc00000u;   /* a quiet NaN, whatever the compiler flags */
+        memcpy(&nan_f, &bits, sizeof nan_f);
+    }
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 4, 4);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+
+#define FIELD_EXPECT(call, code, face_expected, what)                                                           \
+    do {                                                                                                        \
+        tt_result r_ = (call);                                                                                  \
+        CHECK(r_ == (code) && err.result == (code) && (face_expected == -2 || err.face == face_expected) &&    \
+                  err.message[0] != '\0',                                                                       \
+              "%s: expected %d (face %d), got %d (face %d): %s", what, (int)(code), face_expected, (int)r_,   \
+              err.face, err.message);                                                                          \
+    } while (0)
+
+    memset(&opt, 0, sizeof opt);
+    FIELD_EXPECT(tt_tangent_field(NULL, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL mesh");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL output");
+    CHECK(tt_tangent_field(NULL, &opt, v, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL error pointer is allowed");
+    opt.up[0] = nan_f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN up");
+    opt.up[0] = 1e-45f;   /* denormal: non-zero, still a direction */
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "tiny up is a direction: %s", err.message);
+    opt.up[0] = 0.0f;
+    opt.scale = -1.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative scale");
+    opt.scale = 1.0f / 0.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "infinite scale");
+    opt.scale = 0.0f;
+    opt.sigma = nan_f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN sigma");
+    opt.sigma = 0.0f;
+    opt.nconstraints = -1;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative nconstraints");
+    opt.nconstraints = 1;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL constraints");
+
+    memset(con, 0, sizeof con);
+    con[0].face = 3; con[0].vector[0] = 1.0f;
+    con[1].face = 16; con[1].vector[1] = 1.0f;
+    opt.constraints = con;
+    opt.nconstraints = 2;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 16, "face == nfaces");
+    CHECK(msg_has_number(err.message, 16) && msg_has_number(err.message, 1) && strstr(err.message, "constraint"),
+          "the message names constraint 1 and face 16: %s", err.message);
+    con[1].face = -1;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, -1, "face -1");
+    con[1].face = 5;
+    con[1].vector[1] = 0.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "zero vector");
+    CHECK(strstr(err.message, "constraint 1") != NULL, "the message names constraint 1: %s", err.message);
+    con[1].vector[2] = 1.0f;   /* along the grid's normal */
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "perpendicular vector");
+    con[1].vector[2] = 0.0f;
+    con[1].vector[1] = nan_f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_NON_FINITE, 5, "NaN vector");
+    con[1].vector[1] = 1.0f / 0.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_NON_FINITE, 5, "infinite vector");
+    con[1].vector[1] = 1.0f;
+    con[1].weight = -1.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative weight");
+    con[1].weight = 0.0f;
+    con[1].sigma = -2.0f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative sigma");
+    con[1].sigma = 0.0f;
+    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "valid constraints: %s", err.message);
+
+    /* A constraint on a zero-area face (permissive mesh). */
+    memset(&md, 0, sizeof md);
+    make_grid(&md, 2, 1);
+    {
+        int a = tm_vert(&md, 5, 0, 0), b = tm_vert(&md, 6, 0, 0), c = tm_vert(&md, 7, 0, 0);
+        tm_tri(&md, a, b, c);
+    }
+    CHECK(build(&md, TT_MESH_PERMISSIVE, &dmesh, &err) == TT_OK, "sliver mesh builds: %s", err.message);
+    con[0].face = 2;
+    opt.nconstraints = 1;
+    FIELD_EXPECT(tt_tangent_field(dmesh, &opt, v, &err), TT_ERROR_ZERO_AREA_FACE, 2, "constraint on a zero-area face");
+#undef FIELD_EXPECT
+    tt_mesh_free(dmesh);
+    tm_free(&md);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+typedef struct field_oom_ctx {
+    const tt_mesh *mesh;
+    const tt_field_constraint *constraints;
+    int nconstraints;
+    float up[3];
+    float *out;
+} field_oom_ctx;
+
+static tt_result field_oom_call(void *ctx, const tt_allocator *al)
+{
+    field_oom_ctx *c = (field_oom_ctx *)ctx;
+    tt_field_options opt;
+    tt_error err;
+    tt_result r;
+    memset(&opt, 0, sizeof opt);
+    memcpy(opt.up, c->up, sizeof opt.up);
+    opt.constraints = c->constraints;
+    opt.nconstraints = c->nconstraints;
+    opt.allocator = *al;
+    r = tt_tangent_field(c->mesh, &opt, c->out, &err);
+    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_field_oom(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    field_oom_ctx c;
+    tt_field_constraint con[2];
+    float *v;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 10, 6, 3.0, 1.0);
+    make_grid(&m, 3, 2);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus + grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(con, 0, sizeof con);
+    con[0].face = 0; con[0].vector[2] = 1.0f;
+    con[1].face = 30; con[1].vector[2] = -1.0f;
+    oom_reset();
+    memset(&c, 0, sizeof c);
+    c.mesh = mesh;
+    c.out = v;
+    c.up[2] = 1.0f;
+    oom_sweep("tt_tangent_field(default, up = +z)", field_oom_call, &c, TT_OK);
+    c.constraints = con;
+    c.nconstraints = 2;
+    oom_sweep("tt_tangent_field(2 constraints)", field_oom_call, &c, TT_OK);
+    con[1].face = 1000;
+    oom_sweep("tt_tangent_field(bad constraint)", field_oom_call, &c, TT_ERROR_INDEX_OUT_OF_RANGE);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 7b. Texture patches                                                      */
+/* ------------------------------------------------------------------------ */
+
+/* A smooth, opaque RGB test source. */
+static void patch_source(tt_image *img, int w, int h)
+{
+    int x, y;
+    tt_image_create(img, w, h, NULL);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = img->pixels + 4 * (y * w + x);
+            p[0] = 0.2f + 0.6f * (float)x / (float)w;
+            p[1] = 0.3f + 0.5f * (float)y / (float)h;
+            p[2] = 0.7f;
+            p[3] = 1.0f;
+        }
+}
+
+/* Brute force: distance from texel (x, y)'s centre to the nearest texel centre
+   outside the binary shape (alpha >= 0.5 of in), the image's surroundings
+   counting as outside; 0 for texels outside. */
+static double patch_brute_depth(const unsigned char *in, int w, int h, int x, int y)
+{
+    int i, j;
+    double best;
+    if (!in[y * w + x]) return 0.0;
+    best = x + 1;
+    if (w - x < best) best = w - x;
+    if (y + 1 < best) best = y + 1;
+    if (h - y < best) best = h - y;
+    for (j = 0; j < h; j++)
+        for (i = 0; i < w; i++)
+            if (!in[j * w + i]) {
+                double d = sqrt((double)((i - x) * (i - x) + (j - y) * (j - y)));
+                if (d < best) best = d;
+            }
+    return best;
+}
+
+/* Checks alpha against the brute-force distance transform of `in`. */
+static void patch_check_ramp(const tt_image *patch, const unsigned char *in, float falloff, const char *what)
+{
+    int x, y, bad = 0, w = patch->width, h = patch->height;
+    double worst = 0.0;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            double d = patch_brute_depth(in, w, h, x, y);
+            double want = d > 0.0 ? (d - 0.5) / falloff : 0.0;
+            double got = patch->pixels[4 * (y * w + x) + 3];
+            if (want > 1.0) want = 1.0;
+            if (want < 0.0) want = 0.0;
+            if (fabs(got - want) > 1e-4) {
+                if (!bad) DETAIL("%s: texel (%d, %d): alpha %g, want %g (depth %g)", what, x, y, got, want, d);
+                bad++;
+            }
+            if (fabs(got - want) > worst) worst = fabs(got - want);
+        }
+    CHECK(bad == 0, "%s: alpha = clamp((depth - 0.5) / falloff) everywhere: %d texels off (worst %g)", what, bad,
+          worst);
+}
+
+static void test_patch_splotch(void)
+{
+    tt_image src, patch;
+    tt_patch_options opt;
+    tt_error err;
+    int w = 96, h = 80, x, y, inside = 0, half = 0, border_bad = 0, deep_bad = 0, pm_bad = 0, contour_bad = 0;
+    unsigned char *in = (unsigned char *)malloc((size_t)(w * h));
+    patch_source(&src, w, h);
+    memset(&opt, 0, sizeof opt);
+    opt.seed = 7;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_OK, "splotch: ok (%s)", err.message);
+    CHECK(patch.width == w && patch.height == h && patch.pixels, "splotch: %d x %d patch", patch.width, patch.height);
+    if (patch.pixels) {
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                const float *p = patch.pixels + 4 * (y * w + x), *s = src.pixels + 4 * (y * w + x);
+                in[y * w + x] = (unsigned char)(p[3] > 0.0f);
+                inside += p[3] > 0.0f;
+                half += p[3] >= 0.5f;
+                if ((x == 0 || y == 0 || x == w - 1 || y == h - 1) && p[3] != 0.0f) border_bad++;
+                if (p[0] != s[0] * p[3] || p[1] != s[1] * p[3] || p[2] != s[2] * p[3]) pm_bad++;
+            }
+        /* The inside of the binary shape is exactly where alpha > 0 (depth >= 1). */
+        CHECK(inside >= 0.60 * w * h && inside <= 0.75 * w * h, "splotch covers 60-75%% of the image: %.1f%%",
+              100.0 * inside / (w * h));
+        CHECK(half >= 0.55 * w * h && half <= 0.75 * w * h, "alpha >= 0.5 on 55-75%% of the image: %.1f%%",
+              100.0 * half / (w * h));
+        CHECK(border_bad == 0, "alpha is 0 on the image border: %d texels are not", border_bad);
+        CHECK(pm_bad == 0, "premultiplied exactly: %d texels differ", pm_bad);
+        /* Deep inside (the centre region) alpha is 1. */
+        for (y = h / 2 - 10; y < h / 2 + 10; y++)
+            for (x = w / 2 - 10; x < w / 2 + 10; x++) deep_bad += patch.pixels[4 * (y * w + x) + 3] != 1.0f;
+        CHECK(deep_bad == 0, "alpha is 1 in the centre: %d texels are not", deep_bad);
+        /* The 0.5 contour lies falloff/2 texels inside the shape's edge: every
+           texel with alpha >= 0.5 is at least 2 texels from an outside centre,
+           every one with 0 < alpha < 0.5 at most 2 (falloff 3: depth 0.5 + 1.5). */
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float a = patch.pixels[4 * (y * w + x) + 3];
+                double d = patch_brute_depth(in, w, h, x, y);
+                if (a >= 0.5f && d < 2.0 - 1e-6) contour_bad++;
+                if (a > 0.0f && a < 0.5f && d > 2.0 + 1e-6) contour_bad++;
+            }
+        CHECK(contour_bad == 0, "the 0.5 contour is falloff/2 = 1.5 texels inside the edge: %d texels off",
+              contour_bad);
+        patch_check_ramp(&patch, in, 3.0f, "splotch, falloff 3");
+    }
+    tt_image_free(&patch);
+    /* A wider falloff is honoured too. */
+    opt.falloff = 6.5f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_OK, "falloff 6.5: ok (%s)", err.message);
+    if (patch.pixels) {
+        int ramp = 0;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float a = patch.pixels[4 * (y * w + x) + 3];
+                in[y * w + x] = (unsigned char)(a > 0.0f);
+                if ((x < 6 || y < 6 || x >= w - 6 || y >= h - 6) && a != 0.0f) border_bad++;
+                ramp += a > 0.0f && a < 1.0f;
+            }
+        CHECK(border_bad == 0, "falloff 6.5: margin of 6.5 texels is transparent: %d texels are not", border_bad);
+        CHECK(ramp > 6 * 150, "falloff 6.5: a wide ramp (%d texels between 0 and 1)", ramp);
+        patch_check_ramp(&patch, in, 6.5f, "splotch, falloff 6.5");
+    }
+    tt_image_free(&patch);
+    tt_image_free(&src);
+    free(in);
+}
+
+static void test_patch_seeds(void)
+{
+    tt_image src, a, b, c;
+    tt_patch_options opt;
+    int w = 64, h = 64, seed, differ = 0, min_cov = w * h, max_cov = 0;
+    size_t i;
+    patch_source(&src, w, h);
+    memset(&opt, 0, sizeof opt);
+    opt.seed = 123;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &a, NULL) == TT_OK, "seed 123: ok");
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &b, NULL) == TT_OK, "seed 123 again: ok");
+    opt.seed = 124;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &c, NULL) == TT_OK, "seed 124: ok");
+    if (a.pixels && b.pixels && c.pixels) {
+        CHECK(memcmp(a.pixels, b.pixels, sizeof(float) * 4 * (size_t)(w * h)) == 0, "same seed, same patch");
+        for (i = 0; i < (size_t)(w * h); i++) differ += (a.pixels[4 * i + 3] > 0.0f) != (c.pixels[4 * i + 3] > 0.0f);
+        CHECK(differ > 20, "seeds 123 and 124 give different shapes: %d texels differ", differ);
+    }
+    tt_image_free(&a);
+    tt_image_free(&b);
+    tt_image_free(&c);
+    /* Coverage holds over many seeds, and at the roughest setting. */
+    for (seed = 0; seed < 40; seed++) {
+        int cov = 0;
+        opt.seed = (uint64_t)seed * 0x9e3779b97f4a7c15ull;
+        opt.roughness = seed < 20 ? 0.0f : 0.6f;
+        if (tt_make_texture_patch(&src, NULL, &opt, &a, NULL) != TT_OK) { cov = -1; }
+        else {
+            for (i = 0; i < (size_t)(w * h); i++) cov += a.pixels[4 * i + 3] > 0.0f;
+            tt_image_free(&a);
+        }
+        if (cov < min_cov) min_cov = cov;
+        if (cov > max_cov) max_cov = cov;
+    }
+    CHECK(min_cov >= 0.60 * w * h && max_cov <= 0.75 * w * h, "40 seeds: coverage %.1f%% .. %.1f%%",
+          100.0 * min_cov / (w * h), 100.0 * max_cov / (w * h));
+    tt_image_free(&src);
+}
+
+static void test_patch_masks(void)
+{
+    tt_image src, mask, patch;
+    tt_error err;
+    int w = 40, h = 30, x, y, bad = 0;
+    unsigned char *in = (unsigned char *)malloc((size_t)(w * h));
+    patch_source(&src, w, h);
+    tt_image_create(&mask, w, h, NULL);
+    /* Grey mask (opaque): a rectangle of grey 0.6 plus a stray 0.4 texel (outside). */
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = mask.pixels + 4 * (y * w + x);
+            float g = (x >= 5 && x < 35 && y >= 4 && y < 26) ? 0.6f : 0.0f;
+            if (x == 1 && y == 1) g = 0.4f;
+            p[0] = p[1] = p[2] = g;
+            p[3] = 1.0f;
+            in[y * w + x] = (unsigned char)(g >= 0.5f);
+        }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "grey mask: ok (%s)", err.message);
+    if (patch.pixels) {
+        patch_check_ramp(&patch, in, 3.0f, "grey mask");
+        CHECK(patch.pixels[4 * (15 * w + 20) + 3] == 1.0f, "grey mask: centre alpha 1, got %g",
+              patch.pixels[4 * (15 * w + 20) + 3]);
+        CHECK(patch.pixels[4 * (4 * w + 20) + 3] > 0.16f && patch.pixels[4 * (4 * w + 20) + 3] < 0.17f,
+              "grey mask: edge texel alpha 0.5/3, got %g", patch.pixels[4 * (4 * w + 20) + 3]);
+    }
+    tt_image_free(&patch);
+    /* Mask alpha (not all 1): alpha is used, the grey ignored. */
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = mask.pixels + 4 * (y * w + x);
+            int inside = (x - 20) * (x - 20) + (y - 15) * (y - 15) <= 100;
+            p[0] = p[1] = p[2] = 1.0f - (float)inside;   /* grey says the opposite */
+            p[3] = inside ? 0.75f : 0.25f;
+            in[y * w + x] = (unsigned char)inside;
+        }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "alpha mask: ok (%s)", err.message);
+    if (patch.pixels) patch_check_ramp(&patch, in, 3.0f, "alpha mask");
+    tt_image_free(&patch);
+    /* Source alpha takes precedence over the mask: a band x in [10, 30). */
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            src.pixels[4 * (y * w + x) + 3] = (x >= 10 && x < 30) ? 1.0f : 0.0f;
+            in[y * w + x] = (unsigned char)(x >= 10 && x < 30);
+        }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "source alpha: ok (%s)", err.message);
+    if (patch.pixels) {
+        patch_check_ramp(&patch, in, 3.0f, "source alpha over mask");
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                const float *p = patch.pixels + 4 * (y * w + x), *s = src.pixels + 4 * (y * w + x);
+                if (p[0] != s[0] * p[3] || p[1] != s[1] * p[3] || p[2] != s[2] * p[3]) bad++;
+            }
+        CHECK(bad == 0, "source alpha: premultiplied exactly, %d texels differ", bad);
+    }
+    tt_image_free(&patch);
+    /* A fully opaque grey mask still fades out at the image border. */
+    for (y = 0; y < h * w * 4; y++) mask.pixels[y] = 1.0f;
+    for (y = 0; y < h * w; y++) { src.pixels[4 * y + 3] = 1.0f; in[y] = 1; }
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "full mask: ok (%s)", err.message);
+    if (patch.pixels) patch_check_ramp(&patch, in, 3.0f, "full mask");
+    tt_image_free(&patch);
+    tt_image_free(&mask);
+    tt_image_free(&src);
+    free(in);
+}
+
+static void test_patch_errors(void)
+{
+    tt_image src, mask, patch, empty;
+    tt_patch_options opt;
+    tt_error err;
+    float nan_value = (float)internal_not_a_number();
+    patch_source(&src, 32, 32);
+    memset(&empty, 0, sizeof empty);
+    memset(&opt, 0, sizeof opt);
+    CHECK(tt_make_texture_patch(NULL, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL source");
+    CHECK(tt_make_texture_patch(&empty, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty source");
+    CHECK(tt_make_texture_patch(&src, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL patch");
+    tt_image_create(&mask, 31, 32, NULL);
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "mask size");
+    CHECK(strstr(err.message, "31 x 32") && strstr(err.message, "32 x 32"), "size message: %s", err.message);
+    CHECK(patch.pixels == NULL && patch.width == 0, "patch left empty on error");
+    tt_image_free(&mask);
+    tt_image_create(&mask, 32, 32, NULL);   /* all zero: transparent black */
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty mask");
+    CHECK(strstr(err.message, "the mask has no opaque pixel") != NULL, "empty mask message: %s", err.message);
+    CHECK(err.result == TT_ERROR_INVALID_ARGUMENT, "err.result set: %d", err.result);
+    mask.pixels[3] = nan_value;
+    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "NaN mask: %s", err.message);
+    tt_image_free(&mask);
+    opt.falloff = -1.0f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "negative falloff");
+    CHECK(strstr(err.message, "negative") != NULL, "negative falloff message: %s", err.message);
+    opt.falloff = 15.0f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 15 on 32: %s",
+          err.message);
+    opt.falloff = 10.0f;   /* room for a splotch, but it is not 10 texels deep */
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 10 on 32: %s",
+          err.message);
+    CHECK(strstr(err.message, "no opaque texel") != NULL, "falloff 10 message: %s", err.message);
+    opt.falloff = internal_infinity();
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "infinite falloff");
+    opt.falloff = nan_value;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN falloff");
+    opt.falloff = 0.0f;
+    opt.roughness = nan_value;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN roughness");
+    opt.roughness = 1.0f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness 1");
+    opt.roughness = -0.5f;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness -0.5");
+    opt.roughness = 0.0f;
+    src.pixels[4 * 33 + 1] = nan_value;
+    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN source");
+    CHECK(strstr(err.message, "(1, 1)") != NULL, "NaN source names the texel: %s", err.message);
+    CHECK(patch.pixels == NULL, "patch left empty on error");
+    tt_image_free(&src);
+}
+
+typedef struct patch_oom_ctx {
+    const tt_image *source, *mask;
+    uint64_t seed;
+} patch_oom_ctx;
+
+static tt_result patch_oom_call(void *ctx, const tt_allocator *al)
+{
+    patch_oom_ctx *c = (patch_oom_ctx *)ctx;
+    tt_patch_options opt;
+    tt_image patch;
+    tt_error err;
+    tt_result r;
+    memset(&opt, 0, sizeof opt);
+    opt.seed = c->seed;
+    opt.allocator = *al;
+    r = tt_make_texture_patch(c->source, c->mask, &opt, &patch, &err);
+    if (r != TT_OK && (patch.pixels != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
+    tt_image_free(&patch);
+    return r;
+}
+
+static void test_patch_oom(void)
+{
+    tt_image src, mask;
+    patch_oom_ctx c;
+    int i;
+    patch_source(&src, 24, 20);
+    tt_image_create(&mask, 24, 20, NULL);
+    for (i = 0; i < 24 * 20; i++) mask.pixels[4 * i + 3] = (i % 24 > 4 && i % 24 < 20) ? 1.0f : 0.0f;
+    oom_reset();
+    c.source = &src;
+    c.mask = NULL;
+    c.seed = 3;
+    oom_sweep("tt_make_texture_patch(splotch)", patch_oom_call, &c, TT_OK);
+    c.mask = &mask;
+    oom_sweep("tt_make_texture_patch(mask)", patch_oom_call, &c, TT_OK);
+    memset(mask.pixels, 0, sizeof(float) * 4 * 24 * 20);
+    oom_sweep("tt_make_texture_patch(empty mask)", patch_oom_call, &c, TT_ERROR_INVALID_ARGUMENT);
+    tt_image_free(&mask);
+    tt_image_free(&src);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 7c. The paste loop                                                       */
+/* ------------------------------------------------------------------------ */
+
+/* The mesh with every polygon split into a fan of triangles. */
+static void tm_triangulate(const tmesh *in, tmesh *out)
+{
+    int f, c = 0, i;
+    memset(out, 0, sizeof *out);
+    for (i = 0; i < in->nv; i++) tm_vert(out, in->pos[3 * i], in->pos[3 * i + 1], in->pos[3 * i + 2]);
+    for (f = 0; f < in->nf; f++) {
+        for (i = 1; i + 1 < in->sizes[f]; i++) tm_tri(out, in->idx[c], in->idx[c + i], in->idx[c + i + 1]);
+        c += in->sizes[f];
+    }
+}
+
+/* The test shapes of the lapped tests, all triangles: a sphere (closed), a
+   wavy open sheet, two spheres (two components), a torus (genus 1). */
+static void make_lapped_shape(tmesh *out, int which)
+{
+    tmesh m;
+    int i;
+    memset(&m, 0, sizeof m);
+    if (which == 0) make_field_sphere(&m, 12, 16, 1.0);
+    else if (which == 1) {
+        make_grid(&m, 16, 12);
+        for (i = 0; i < m.nv; i++) m.pos[3 * i + 2] = (float)(0.8 * sin(0.35 * m.pos[3 * i]));
+    } else if (which == 2) {
+        make_field_sphere(&m, 8, 10, 1.0);
+        make_field_sphere(&m, 8, 10, 0.5);
+        for (i = m.nv / 2; i < m.nv; i++) m.pos[3 * i] += 3.0f;
+    } else make_torus(&m, 24, 10, 2.0, 0.7);
+    tm_triangulate(&m, out);
+    tm_free(&m);
+}
+
+static const char *const LAPPED_SHAPE_NAMES[4] = {"sphere", "open sheet", "two spheres", "torus"};
+
+/* A texture patch from value noise with a seeded splotch. */
+static void lapped_patch(tt_image *patch, int size, unsigned seed)
+{
+    tt_image src;
+    tt_patch_options po;
+    tt_error err;
+    make_value_noise(&src, size, size, seed);
+    memset(&po, 0, sizeof po);
+    po.seed = seed;
+    memset(patch, 0, sizeof *patch);
+    tt_make_texture_patch(&src, NULL, &po, patch, &err);
+    tt_image_free(&src);
+}
+
+/* Composite alpha of every entry of face f at barycentric point w, the
+   pastes drawn in order with "over", recomputed from the output alone. */
+static double lapped_alpha_at(const tt_lapped *lapped, const tt_image *patches, int f, const double w[3])
+{
+    double alpha = 0.0;
+    int p, e;
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) {
+            const float *uv = lapped->uv + 6 * (size_t)e;
+            const tt_image *im = &patches[lapped->pastes[p].patch];
+            float rgba[4];
+            double u, v;
+            if (lapped->faces[e] != f) continue;
+            u = w[0] * uv[0] + w[1] * uv[2] + w[2] * uv[4];
+            v = w[0] * uv[1] + w[1] * uv[3] + w[2] * uv[5];
+            tt_image_sample_bilinear(im, (float)(u * im->width), (float)((1.0 - v) * im->height), rgba);
+            alpha = rgba[3] + alpha * (1.0 - rgba[3]);
+        }
+    return alpha;
+}
+
+/* Angle error (degrees) of entry e: T_f pushed through the entry's UV map,
+   against (0, 1); and the length of the image. Independent of the library. */
+static void lapped_entry_error(const tt_mesh *mesh, const float *field, const tt_lapped *lapped, int e,
+                               double *angle, double *length)
+{
+    int f = lapped->faces[e], k;
+    const float *p0 = mesh->pos + 3 * mesh->corner_vert[3 * f], *p1 = mesh->pos + 3 * mesh->corner_vert[3 * f + 1];
+    const float *p2 = mesh->pos + 3 * mesh->corner_vert[3 * f + 2], *uv = lapped->uv + 6 * (size_t)e;
+    double e1[3], e2[3], t[3], g11 = 0, g12 = 0, g22 = 0, r1 = 0, r2 = 0, det, a, b, pu, pv;
+    for (k = 0; k < 3; k++) {
+        e1[k] = (double)p1[k] - p0[k];
+        e2[k] = (double)p2[k] - p0[k];
+        t[k] = field[3 * f + k];
+        g11 += e1[k] * e1[k]; g12 += e1[k] * e2[k]; g22 += e2[k] * e2[k];
+        r1 += e1[k] * t[k]; r2 += e2[k] * t[k];
+    }
+    det = g11 * g22 - g12 * g12;
+    a = (g22 * r1 - g12 * r2) / det;
+    b = (g11 * r2 - g12 * r1) / det;
+    pu = a * (uv[2] - uv[0]) + b * (uv[4] - uv[0]);
+    pv = a * (uv[3] - uv[1]) + b * (uv[5] - uv[1]);
+    *length = sqrt(pu * pu + pv * pv);
+    *angle = fabs(atan2(pu, pv)) * 180.0 / 3.14159265358979323846;
+}
+
+static int lapped_run(const tmesh *m, int isotropic, uint64_t seed, float scale, tt_mesh **mesh, float **field,
+                      tt_image *patch, tt_lapped *out)
+{
+    tt_mesh_desc d = tm_desc(m);
+    tt_field_options fo;
+    tt_lapped_options lo;
+    tt_error err;
+    tt_result r;
+    *mesh = NULL;
+    *field = NULL;
+    memset(out, 0, sizeof *out);
+    if (tt_mesh_build(&d, mesh, &err) != TT_OK) return -1;
+    *field = (float *)malloc(sizeof(float) * 3 * (size_t)(*mesh)->nfaces);
+    memset(&fo, 0, sizeof fo);
+    fo.scale = scale;
+    if (tt_tangent_field(*mesh, &fo, *field, &err) != TT_OK) return -1;
+    memset(&lo, 0, sizeof lo);
+    lo.seed = seed;
+    lo.isotropic = isotropic;
+    r = tt_lapped_paste(*mesh, *field, patch, 1, &lo, out, &err);
+    CHECK(r == TT_OK, "tt_lapped_paste: %d %s", r, err.message);
+    return r == TT_OK ? 0 : -1;
+}
+
+static void test_lapped_cover(void)
+{
+    tt_image patch;
+    int shape, iso;
+    lapped_patch(&patch, 64, 5);
+    for (shape = 0; shape < 4; shape++)
+        for (iso = 0; iso < 2; iso++) {
+            tmesh m;
+            tt_mesh *mesh;
+            float *field;
+            tt_lapped lapped;
+            double angle_sum = 0.0, worst_alpha = 1.0;
+            int f, e, p, missing = 0, bad_points = 0, points = 0, bad_entries = 0, order_ok = 1;
+            char *seen;
+            make_lapped_shape(&m, shape);
+            if (lapped_run(&m, iso, 11, 0.0f, &mesh, &field, &patch, &lapped) != 0) {
+                tt_mesh_free(mesh);
+                free(field);
+                tm_free(&m);
+                continue;
+            }
+            seen = (char *)calloc((size_t)mesh->nfaces, 1);
+            for (p = 0; p < lapped.npastes; p++) {
+                order_ok &= lapped.pastes[p].first == (p ? lapped.pastes[p - 1].first + lapped.pastes[p - 1].nfaces : 0);
+                order_ok &= lapped.pastes[p].nfaces > 0 && lapped.pastes[p].patch == 0;
+            }
+            CHECK(order_ok && lapped.npastes > 0, "%s: pastes are not consecutive runs of entries",
+                  LAPPED_SHAPE_NAMES[shape]);
+            CHECK(lapped.npastes == 0 ||
+                      lapped.pastes[lapped.npastes - 1].first + lapped.pastes[lapped.npastes - 1].nfaces ==
+                          lapped.nentries,
+                  "%s: the pastes do not account for every entry", LAPPED_SHAPE_NAMES[shape]);
+            for (e = 0; e < lapped.nentries; e++) {
+                double angle, length;
+                int k;
+                if (lapped.faces[e] < 0 || lapped.faces[e] >= mesh->nfaces) { bad_entries++; continue; }
+                seen[lapped.faces[e]] = 1;
+                for (k = 0; k < 6; k++) bad_entries += !isfinite(lapped.uv[6 * e + k]);
+                lapped_entry_error(mesh, field, &lapped, e, &angle, &length);
+                angle_sum += angle;
+            }
+            for (f = 0; f < mesh->nfaces; f++) missing += !seen[f];
+            CHECK(bad_entries == 0, "%s: %d entries with a bad face or UV", LAPPED_SHAPE_NAMES[shape], bad_entries);
+            CHECK(missing == 0, "%s (isotropic %d): %d faces in no paste", LAPPED_SHAPE_NAMES[shape], iso, missing);
+            CHECK(lapped.coverage == 1.0, "%s: coverage %g", LAPPED_SHAPE_NAMES[shape], lapped.coverage);
+            CHECK(near(lapped.mean_overdraw, (double)lapped.nentries / mesh->nfaces, 1e-12),
+                  "%s: mean overdraw %g != entries / faces", LAPPED_SHAPE_NAMES[shape], lapped.mean_overdraw);
+            CHECK(lapped.mean_overdraw >= 1.0 && lapped.mean_overdraw < 12.0, "%s: overdraw %g",
+                  LAPPED_SHAPE_NAMES[shape], lapped.mean_overdraw);
+            /* Coverage seen from the output alone: random points of every
+               face, every paste composited in order, are opaque. */
+            lcg_seed(77);
+            for (f = 0; f < mesh->nfaces; f++) {
+                int s;
+                for (s = 0; s < 12; s++) {
+                    double w[3], a = lcg_unit(), b = lcg_unit(), alpha;
+                    if (a + b > 1.0) { a = 1.0 - a; b = 1.0 - b; }
+                    w[0] = 1.0 - a - b; w[1] = a; w[2] = b;
+                    alpha = lapped_alpha_at(&lapped, &patch, f, w);
+                    points++;
+                    if (alpha < 0.98) bad_points++;
+                    if (alpha < worst_alpha) worst_alpha = alpha;
+                }
+            }
+            CHECK(bad_points <= points / 500, "%s (isotropic %d): %d of %d random points are not opaque (worst alpha %g)",
+                  LAPPED_SHAPE_NAMES[shape], iso, bad_points, points, worst_alpha);
+            if (!iso && lapped.nentries > 0) {
+                CHECK(near(angle_sum / lapped.nentries, lapped.mean_angle_error, 1e-3),
+                      "%s: reported mean angle %g, measured from the UVs %g", LAPPED_SHAPE_NAMES[shape],
+                      lapped.mean_angle_error, angle_sum / lapped.nentries);
+                CHECK(lapped.mean_angle_error <= 8.0, "%s: mean angle error %g deg", LAPPED_SHAPE_NAMES[shape],
+                      lapped.mean_angle_error);
+            }
+            CHECK(lapped.median_scale_error <= 0.1, "%s (isotropic %d): median scale error %g",
+                  LAPPED_SHAPE_NAMES[shape], iso, lapped.median_scale_error);
+            free(seen);
+            tt_lapped_free(&lapped);
+            tt_mesh_free(mesh);
+            free(field);
+            tm_free(&m);
+        }
+    tt_image_free(&patch);
+}
+
+/* A flat sheet with a constant field: the optimum maps every face exactly
+   (phi(S) = (1,0), phi(T) = (0,1)), so the error is 0 up to rounding. */
+static void test_lapped_plane(void)
+{
+    tmesh g, m;
+    tt_mesh *mesh;
+    float *field;
+    tt_image patch;
+    tt_lapped lapped;
+    int e;
+    double worst = 0.0, worst_len = 0.0;
+    memset(&g, 0, sizeof g);
+    make_grid(&g, 20, 20);
+    tm_triangulate(&g, &m);
+    lapped_patch(&patch, 48, 9);
+    if (lapped_run(&m, 0, 3, 4.0f, &mesh, &field, &patch, &lapped) == 0) {
+        for (e = 0; e < lapped.nentries; e++) {
+            double angle, length;
+            lapped_entry_error(mesh, field, &lapped, e, &angle, &length);
+            if (angle > worst) worst = angle;
+            if (fabs(length - 1.0) > worst_len) worst_len = fabs(length - 1.0);
+        }
+        CHECK(worst < 1e-3 && worst_len < 1e-4, "plane: worst angle %g deg, worst scale error %g", worst, worst_len);
+        CHECK(lapped.mean_angle_error < 1e-3 && lapped.median_scale_error < 1e-4, "plane: reported %g deg, %g",
+              lapped.mean_angle_error, lapped.median_scale_error);
+        /* a 20 x 20 sheet with 4-unit patches needs a few dozen pastes */
+        CHECK(lapped.npastes >= 20 && lapped.npastes <= 400, "plane: %d pastes", lapped.npastes);
+    }
+    tt_lapped_free(&lapped);
+    tt_mesh_free(mesh);
+    free(field);
+    tm_free(&m);
+    tm_free(&g);
+    tt_image_free(&patch);
+}
+
+static void test_lapped_determinism(void)
+{
+    tmesh m;
+    tt_mesh *mesh[3];
+    float *field[3];
+    tt_image patch;
+    tt_lapped out[3];
+    int i, same, differ;
+    make_lapped_shape(&m, 3);
+    lapped_patch(&patch, 48, 2);
+    for (i = 0; i < 3; i++) lapped_run(&m, 0, i == 2 ? 8 : 7, 0.0f, &mesh[i], &field[i], &patch, &out[i]);
+    same = out[0].nentries == out[1].nentries && out[0].npastes == out[1].npastes &&
+           memcmp(out[0].faces, out[1].faces, sizeof(int) * (size_t)out[0].nentries) == 0 &&
+           memcmp(out[0].uv, out[1].uv, sizeof(float) * 6 * (size_t)out[0].nentries) == 0;
+    differ = out[0].nentries != out[2].nentries ||
+             memcmp(out[0].uv, out[2].uv, sizeof(float) * 6 * (size_t)(out[0].nentries < out[2].nentries ? out[0].nentries : out[2].nentries)) != 0;
+    CHECK(same, "the same seed gave different pastes");
+    CHECK(differ, "different seeds gave the same pastes");
+    for (i = 0; i < 3; i++) {
+        tt_lapped_free(&out[i]);
+        tt_mesh_free(mesh[i]);
+        free(field[i]);
+    }
+    tm_free(&m);
+    tt_image_free(&patch);
+}
+
+/* Several texture patches: each paste picks one at random, all get used,
+   and the mesh is covered with the right patch's alpha. */
+static void test_lapped_patches(void)
+{
+    tmesh m;
+    tt_mesh *mesh;
+    tt_mesh_desc d;
+    tt_field_options fo;
+    tt_lapped_options lo;
+    tt_lapped out;
+    tt_error err;
+    tt_image patches[3];
+    float *field;
+    int used[3] = {0, 0, 0}, p, f, bad = 0;
+    tt_result r;
+    make_lapped_shape(&m, 0);
+    d = tm_desc(&m);
+    tt_mesh_build(&d, &mesh, &err);
+    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&fo, 0, sizeof fo);
+    tt_tangent_field(mesh, &fo, field, &err);
+    lapped_patch(&patches[0], 48, 1);
+    lapped_patch(&patches[1], 64, 2);
+    lapped_patch(&patches[2], 40, 3);
+    memset(&lo, 0, sizeof lo);
+    lo.seed = 5;
+    r = tt_lapped_paste(mesh, field, patches, 3, &lo, &out, &err);
+    CHECK(r == TT_OK, "three patches: %d %s", r, err.message);
+    for (p = 0; p < out.npastes; p++)
+        if (out.pastes[p].patch >= 0 && out.pastes[p].patch < 3) used[out.pastes[p].patch]++;
+        else bad++;
+    CHECK(bad == 0 && used[0] > 0 && used[1] > 0 && used[2] > 0, "patches used %d %d %d, %d out of range", used[0],
+          used[1], used[2], bad);
+    for (f = 0; f < mesh->nfaces; f++) {
+        double w[3] = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
+        if (lapped_alpha_at(&out, patches, f, w) < 0.98) bad++;
+    }
+    CHECK(bad == 0, "three patches: %d face centres not opaque", bad);
+    tt_lapped_free(&out);
+    for (p = 0; p < 3; p++) tt_image_free(&patches[p]);
+    tt_mesh_free(mesh);
+    free(field);
+    tm_free(&m);
+}
+
+typedef struct lapped_progress {
+    int calls, cancel_at;
+    float last;
+    int decreasing;
+} lapped_progress;
+
+static int lapped_progress_fn(float fraction, void *user_data)
+{
+    lapped_progress *p = (lapped_progress *)user_data;
+    if (fraction < p->last || fraction > 1.0f) p->decreasing = 1;
+    p->last = fraction;
+    return ++p->calls == p->cancel_at;
+}
+
+static void test_lapped_errors(void)
+{
+    tmesh m, q;
+    tt_mesh *mesh = NULL, *quads = NULL;
+    tt_mesh_desc d;
+    float *field;
+    tt_image patch, empty, clear;
+    tt_lapped out;
+    tt_lapped_options lo;
+    tt_field_options fo;
+    tt_error err;
+    tt_result r;
+    lapped_progress prog;
+    make_lapped_shape(&m, 0);
+    d = tm_desc(&m);
+    tt_mesh_build(&d, &mesh, &err);
+    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&fo, 0, sizeof fo);
+    tt_tangent_field(mesh, &fo, field, &err);
+    lapped_patch(&patch, 32, 1);
+    memset(&empty, 0, sizeof empty);
+    tt_image_create(&clear, 16, 16, NULL);
+    memset(&lo, 0, sizeof lo);
+
+    CHECK(tt_lapped_paste(NULL, field, &patch, 1, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh");
+    CHECK(tt_lapped_paste(mesh, NULL, &patch, 1, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL field");
+    CHECK(tt_lapped_paste(mesh, field, &patch, 0, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "no patches");
+    CHECK(tt_lapped_paste(mesh, field, &empty, 1, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              out.pastes == NULL, "empty patch");
+    r = tt_lapped_paste(mesh, field, &clear, 1, NULL, &out, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "no opaque") != NULL,
+          "transparent patch: %d %s", r, err.message);
+    lo.max_pastes = -1;
+    CHECK(tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "max_pastes < 0");
+
+    /* field vectors: zero, NaN, perpendicular to the face */
+    {
+        float saved[3];
+        memcpy(saved, field + 3 * 5, sizeof saved);
+        field[15] = field[16] = field[17] = 0.0f;
+        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, &out, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face == 5 && strstr(err.message, "zero length"),
+              "zero field vector: %d %d %s", r, err.face, err.message);
+        field[16] = NAN;
+        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, &out, &err);
+        CHECK(r == TT_ERROR_NON_FINITE && err.face == 5, "NaN field vector: %d %s", r, err.message);
+        tt_face_normal(mesh, 5, field + 15);
+        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, &out, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face == 5 && strstr(err.message, "perpendicular"),
+              "normal as field vector: %d %s", r, err.message);
+        memcpy(field + 15, saved, sizeof saved);
+    }
+    /* a patch larger than the mesh, and one so small it would take forever */
+    {
+        float *big = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+        fo.scale = 5.0f;
+        tt_tangent_field(mesh, &fo, big, &err);
+        r = tt_lapped_paste(mesh, big, &patch, 1, NULL, &out, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "larger than the mesh"),
+              "patch larger than the mesh: %d %s", r, err.message);
+        fo.scale = 1e-4f;
+        tt_tangent_field(mesh, &fo, big, &err);
+        r = tt_lapped_paste(mesh, big, &patch, 1, NULL, &out, &err);
+        CHECK(r == TT_ERROR_TOO_LARGE && strstr(err.message, "pastes"), "tiny patches: %d %s", r, err.message);
+        free(big);
+    }
+    /* progress after every paste, never decreasing, ending at 1 */
+    lo.max_pastes = 0;
+    memset(&prog, 0, sizeof prog);
+    prog.cancel_at = -1;
+    lo.progress = lapped_progress_fn;
+    lo.progress_user_data = &prog;
+    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err);
+    CHECK(r == TT_OK && prog.calls >= out.npastes && !prog.decreasing && prog.last == 1.0f,
+          "progress: %d calls for %d pastes, last %g, decreasing %d", prog.calls, out.npastes, prog.last,
+          prog.decreasing);
+    tt_lapped_free(&out);
+    /* one paste short of what it takes */
+    lo.max_pastes = prog.calls - 1;
+    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err);
+    CHECK(r == TT_ERROR_NOT_CONVERGED && out.pastes == NULL && strstr(err.message, "uncovered"),
+          "max_pastes %d: %d %s", lo.max_pastes, r, err.message);
+    lo.max_pastes = 0;
+    memset(&prog, 0, sizeof prog);
+    prog.cancel_at = 3;
+    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err);
+    CHECK(r == TT_CANCELLED && prog.calls == 3 && out.pastes == NULL, "cancel: %d after %d calls", r, prog.calls);
+
+    /* not triangles */
+    memset(&q, 0, sizeof q);
+    make_grid(&q, 3, 3);
+    d = tm_desc(&q);
+    tt_mesh_build(&d, &quads, &err);
+    {
+        float *qf = (float *)malloc(sizeof(float) * 3 * (size_t)quads->nfaces);
+        tt_tangent_field(quads, &fo, qf, &err);
+        r = tt_lapped_paste(quads, qf, &patch, 1, NULL, &out, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face == 0 && strstr(err.message, "triangle"),
+              "quads: %d %s", r, err.message);
+        free(qf);
+    }
+    tt_mesh_free(quads);
+    tm_free(&q);
+
+    /* a zero-area face (permissive mesh) */
+    {
+        tmesh z;
+        tt_mesh *zm = NULL;
+        float zf[9] = {0, 1, 0, 0, 1, 0, 0, 1, 0};
+        memset(&z, 0, sizeof z);
+        tm_vert(&z, 0, 0, 0); tm_vert(&z, 1, 0, 0); tm_vert(&z, 0, 1, 0); tm_vert(&z, 2, 0, 0);
+        tm_tri(&z, 0, 1, 2);
+        tm_tri(&z, 1, 0, 3);
+        d = tm_desc(&z);
+        d.nfaces = 2;
+        d.flags = TT_MESH_PERMISSIVE;
+        if (tt_mesh_build(&d, &zm, &err) == TT_OK) {
+            r = tt_lapped_paste(zm, zf, &patch, 1, NULL, &out, &err);
+            CHECK(r == TT_ERROR_ZERO_AREA_FACE && err.face == 1, "zero-area face: %d %s", r, err.message);
+        }
+        tt_mesh_free(zm);
+        tm_free(&z);
+    }
+    tt_image_free(&clear);
+    tt_image_free(&patch);
+    tt_mesh_free(mesh);
+    free(field);
+    tm_free(&m);
+}
+
+typedef struct lapped_oom_ctx {
+    const tt_mesh *mesh;
+    const float *field;
+    const tt_image *patch;
+    int isotropic;
+} lapped_oom_ctx;
+
+static tt_result lapped_oom_call(void *ctx, const tt_allocator *al)
+{
+    lapped_oom_ctx *c = (lapped_oom_ctx *)ctx;
+    tt_lapped_options lo;
+    tt_lapped out;
+    tt_error err;
+    tt_result r;
+    memset(&lo, 0, sizeof lo);
+    lo.allocator = *al;
+    lo.isotropic = c->isotropic;
+    r = tt_lapped_paste(c->mesh, c->field, c->patch, 1, &lo, &out, &err);
+    if (r != TT_OK && (out.pastes != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
+    tt_lapped_free(&out);
+    return r;
+}
+
+static void test_lapped_oom(void)
+{
+    tmesh m;
+    tt_mesh *mesh;
+    tt_mesh_desc d;
+    tt_field_options fo;
+    tt_error err;
+    float *field;
+    tt_image patch;
+    lapped_oom_ctx c;
+    memset(&m, 0, sizeof m);
+    make_field_sphere(&m, 5, 6, 1.0);
+    {
+        tmesh t;
+        tm_triangulate(&m, &t);
+        tm_free(&m);
+        m = t;
+    }
+    d = tm_desc(&m);
+    tt_mesh_build(&d, &mesh, &err);
+    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&fo, 0, sizeof fo);
+    fo.scale = 2.0f;
+    tt_tangent_field(mesh, &fo, field, &err);
+    lapped_patch(&patch, 32, 4);
+    oom_reset();
+    c.mesh = mesh;
+    c.field = field;
+    c.patch = &patch;
+    c.isotropic = 0;
+    oom_sweep("tt_lapped_paste", lapped_oom_call, &c, TT_OK);
+    c.isotropic = 1;
+    oom_sweep("tt_lapped_paste(isotropic)", lapped_oom_call, &c, TT_OK);
+    tt_image_free(&patch);
+    tt_mesh_free(mesh);
+    free(field);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 7d. Patch hulls (Sec. 3.3, Fig. 4)                                       */
+/* ------------------------------------------------------------------------ */
+
+/* A transparent w x h image. */
+static tt_image hull_image(int w, int h)
+{
+    tt_image img;
+    tt_result r = tt_image_create(&img, w, h, NULL);
+    CHECK(r == TT_OK, "tt_image_create(%d, %d): %d", w, h, (int)r);
+    return img;
+}
+
+static void hull_set_alpha(tt_image *img, int i, int j, float a)
+{
+    if (i < 0 || j < 0 || i >= img->width || j >= img->height) return;
+    img->pixels[4 * (j * img->width + i) + 3] = a;
+}
+
+static float hull_alpha(const tt_image *img, int i, int j) { return img->pixels[4 * (j * img->width + i) + 3]; }
+
+static void hull_disc(tt_image *img, double cx, double cy, double r, float a)
+{
+    int i, j;
+    for (j = 0; j < img->height; j++)
+        for (i = 0; i < img->width; i++) {
+            double dx = i + 0.5 - cx, dy = j + 0.5 - cy;
+            if (dx * dx + dy * dy <= r * r) hull_set_alpha(img, i, j, a);
+        }
+}
+
+static void hull_rect(tt_image *img, int i0, int j0, int i1, int j1)
+{
+    int i, j;
+    for (j = j0; j < j1; j++)
+        for (i = i0; i < i1; i++) hull_set_alpha(img, i, j, 1.0f);
+}
+
+/* 4-connected random growth from the centre: one irregular component. */
+static void hull_blob(tt_image *img, int cells)
+{
+    int n = 1, k;
+    int *list = (int *)malloc(sizeof(int) * (size_t)(cells + 1));
+    list[0] = (img->height / 2) * img->width + img->width / 2;
+    hull_set_alpha(img, img->width / 2, img->height / 2, 1.0f);
+    for (k = 0; k < cells * 20 && n < cells; k++) {
+        int c = list[lcg_below(n)], d = lcg_below(4);
+        int i = c % img->width + (d == 0) - (d == 1), j = c / img->width + (d == 2) - (d == 3);
+        if (i < 0 || j < 0 || i >= img->width || j >= img->height || hull_alpha(img, i, j) > 0.0f) continue;
+        hull_set_alpha(img, i, j, 0.5f);
+        list[n++] = j * img->width + i;
+    }
+    free(list);
+}
+
+/* Keep only the texels 8-connected to the centre (the splotch itself, not
+   the specks its ragged rim throws off). */
+static void hull_keep_centre(tt_image *img)
+{
+    int w = img->width, h = img->height, top = 0, k;
+    unsigned char *seen = (unsigned char *)calloc((size_t)(w * h), 1);
+    int *stack = (int *)malloc(sizeof(int) * (size_t)(w * h));
+    stack[top++] = (h / 2) * w + w / 2;
+    seen[stack[0]] = 1;
+    while (top > 0) {
+        int c = stack[--top], i = c % w, j = c / w, di, dj;
+        for (dj = -1; dj <= 1; dj++)
+            for (di = -1; di <= 1; di++) {
+                int ni = i + di, nj = j + dj;
+                if (ni < 0 || nj < 0 || ni >= w || nj >= h || seen[nj * w + ni] || !(hull_alpha(img, ni, nj) > 0.0f))
+                    continue;
+                seen[nj * w + ni] = 1;
+                stack[top++] = nj * w + ni;
+            }
+    }
+    for (k = 0; k < w * h; k++)
+        if (!seen[k]) img->pixels[4 * k + 3] = 0.0f;
+    free(seen);
+    free(stack);
+}
+
+/* A splotch: radius varying with angle plus a ragged rim; speckled keeps
+   the specks the rim throws off (several components). */
+static void hull_splotch(tt_image *img, double rough, int speckled)
+{
+    int i, j;
+    double cx = img->width * 0.5, cy = img->height * 0.5, base = 0.38 * img->width;
+    double ph1 = 6.283 * lcg_unit(), ph2 = 6.283 * lcg_unit(), ph3 = 6.283 * lcg_unit();
+    for (j = 0; j < img->height; j++)
+        for (i = 0; i < img->width; i++) {
+            double dx = i + 0.5 - cx, dy = j + 0.5 - cy, t = atan2(dy, dx);
+            double r = base * (1.0 + 0.12 * sin(3 * t + ph1) + 0.06 * sin(7 * t + ph2) + 0.03 * sin(17 * t + ph3));
+            r += rough * (lcg_unit() - 0.5);
+            if (dx * dx + dy * dy <= r * r)
+                hull_set_alpha(img, i, j, 1.0f - (float)sqrt(dx * dx + dy * dy) / (float)(r + 1));
+        }
+    if (!speckled) hull_keep_centre(img);
+}
+
+static double hull_polygon_area(const float *xy, int n)
+{
+    double a = 0.0;
+    int k;
+    for (k = 0; k < n; k++) {
+        const float *p = xy + 2 * k, *q = xy + 2 * ((k + 1) % n);
+        a += (double)p[0] * q[1] - (double)q[0] * p[1];
+    }
+    return 0.5 * a;
+}
+
+/* Closed segments ab and cd share a point. */
+static int hull_segments_meet(const double *a, const double *b, const double *c, const double *d)
+{
+    double o1 = internal_orient2(a[0], a[1], b[0], b[1], c[0], c[1]), o2 = internal_orient2(a[0], a[1], b[0], b[1], d[0], d[1]);
+    double o3 = internal_orient2(c[0], c[1], d[0], d[1], a[0], a[1]), o4 = internal_orient2(c[0], c[1], d[0], d[1], b[0], b[1]);
+    if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return 1;
+    return internal_point_on_segment(c[0], c[1], a[0], a[1], b[0], b[1]) ||
+           internal_point_on_segment(d[0], d[1], a[0], a[1], b[0], b[1]) ||
+           internal_point_on_segment(a[0], a[1], c[0], c[1], d[0], d[1]) ||
+           internal_point_on_segment(b[0], b[1], c[0], c[1], d[0], d[1]);
+}
+
+/* Simple: no two non-adjacent edges meet, adjacent ones share only their
+   common vertex, no repeated consecutive vertex. */
+static int hull_is_simple(const float *xy, int n)
+{
+    int i, j;
+    for (i = 0; i < n; i++) {
+        double a[2], b[2];
+        a[0] = xy[2 * i]; a[1] = xy[2 * i + 1];
+        b[0] = xy[2 * ((i + 1) % n)]; b[1] = xy[2 * ((i + 1) % n) + 1];
+        if (a[0] == b[0] && a[1] == b[1]) return 0;
+        for (j = i + 1; j < n; j++) {
+            double c[2], d[2];
+            c[0] = xy[2 * j]; c[1] = xy[2 * j + 1];
+            d[0] = xy[2 * ((j + 1) % n)]; d[1] = xy[2 * ((j + 1) % n) + 1];
+            if (j == i + 1) {
+                /* shares b == c: the far ends must not lie on the other edge */
+                if (internal_point_on_segment(d[0], d[1], a[0], a[1], b[0], b[1]) ||
+                    internal_point_on_segment(a[0], a[1], c[0], c[1], d[0], d[1]))
+                    return 0;
+            } else if ((j + 1) % n == i) {
+                if (internal_point_on_segment(c[0], c[1], a[0], a[1], b[0], b[1]) ||
+                    internal_point_on_segment(b[0], b[1], c[0], c[1], d[0], d[1]))
+                    return 0;
+            } else if (hull_segments_meet(a, b, c, d)) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+/* Inside the polygon (winding number) or within eps of its boundary. */
+static int hull_inside_or_near(double x, double y, const float *xy, int n, double eps)
+{
+    int k, winding = 0;
+    for (k = 0; k < n; k++) {
+        const float *a = xy + 2 * k, *b = xy + 2 * ((k + 1) % n);
+        double o = internal_orient2(a[0], a[1], b[0], b[1], x, y);
+        if (internal_point_segment_distance(x, y, a[0], a[1], b[0], b[1]) <= eps) return 1;
+        if (a[1] <= y && b[1] > y && o > 0.0) winding++;
+        else if (a[1] > y && b[1] <= y && o < 0.0) winding--;
+    }
+    return winding != 0;
+}
+
+/* Area of the convex hull of the nonzero texel squares (unit square). */
+static double hull_convex_area(const tt_image *img)
+{
+    double *xs, *ys, area = 0.0;
+    int n, k;
+    if (internal_hull_convex(img, NULL, &xs, &ys, &n) != TT_OK) return -1.0;
+    for (k = 0; k < n; k++) area += xs[k] * ys[(k + 1) % n] - xs[(k + 1) % n] * ys[k];
+    free(xs);
+    free(ys);
+    return 0.5 * area / ((double)img->width * img->height);
+}
+
+static double hull_mask_area(const tt_image *img)
+{
+    int i, j, c = 0;
+    for (j = 0; j < img->height; j++)
+        for (i = 0; i < img->width; i++) c += hull_alpha(img, i, j) > 0.0f;
+    return (double)c / ((double)img->width * img->height);
+}
+
+/* tt__patch_hull of img with a vertex budget: OK, 3..max vertices, simple,
+   counter-clockwise and containing every texel with alpha > 0 (all four
+   corners of its square, in the unit square with v up). Returns the area. */
+static double hull_check(const tt_image *img, int max_vertices, const char *name)
+{
+    float *xy = NULL;
+    int n = 0, i, j, covered = 1, bad_i = -1, bad_j = -1;
+    double area;
+    tt_result r = internal_patch_hull(img, max_vertices, NULL, &xy, &n);
+    CHECK(r == TT_OK, "%s, max %d vertices: result %d", name, max_vertices, (int)r);
+    if (r != TT_OK) return 0.0;
+    CHECK(n >= 3 && n <= max_vertices, "%s: %d vertices for max %d", name, n, max_vertices);
+    CHECK(hull_is_simple(xy, n), "%s, max %d: polygon not simple", name, max_vertices);
+    area = hull_polygon_area(xy, n);
+    CHECK(area > 0.0, "%s, max %d: counter-clockwise (positive signed area), got %g", name, max_vertices, area);
+    for (j = 0; j < img->height && covered; j++)
+        for (i = 0; i < img->width && covered; i++) {
+            double x0 = (double)i / img->width, x1 = (double)(i + 1) / img->width;
+            double y0 = 1.0 - (double)(j + 1) / img->height, y1 = 1.0 - (double)j / img->height;
+            if (!(hull_alpha(img, i, j) > 0.0f)) continue;
+            if (!hull_inside_or_near(x0, y0, xy, n, 1e-6) || !hull_inside_or_near(x1, y0, xy, n, 1e-6) ||
+                !hull_inside_or_near(x0, y1, xy, n, 1e-6) || !hull_inside_or_near(x1, y1, xy, n, 1e-6)) {
+                covered = 0;
+                bad_i = i;
+                bad_j = j;
+            }
+        }
+    CHECK(covered, "%s, max %d: texel (%d, %d) not inside the hull", name, max_vertices, bad_i, bad_j);
+    free(xy);
+    return area;
+}
+
+static void hull_check_budgets(const tt_image *img, const char *name)
+{
+    static const int budgets[4] = {3, 4, 8, 32};
+    int b;
+    for (b = 0; b < 4; b++) hull_check(img, budgets[b], name);
+}
+
+static void test_hull_shapes(void)
+{
+    char name[64];
+    int s;
+    tt_image img;
+    lcg_seed(1234);
+
+    img = hull_image(64, 64); hull_disc(&img, 32, 32, 25, 1.0f); hull_check_budgets(&img, "disc"); tt_image_free(&img);
+    img = hull_image(40, 30); hull_rect(&img, 5, 5, 15, 25); hull_rect(&img, 5, 18, 35, 25);
+    hull_check_budgets(&img, "L"); tt_image_free(&img);
+    img = hull_image(50, 50); hull_disc(&img, 25, 25, 20, 1.0f); hull_disc(&img, 25, 25, 10, 0.0f);
+    hull_check_budgets(&img, "ring"); tt_image_free(&img);
+    img = hull_image(50, 50); hull_disc(&img, 25, 25, 20, 1.0f); hull_disc(&img, 25, 25, 10, 0.0f);
+    hull_disc(&img, 25, 25, 4, 1.0f); hull_check_budgets(&img, "ring with island"); tt_image_free(&img);
+    img = hull_image(60, 40); hull_disc(&img, 12, 12, 8, 1.0f); hull_disc(&img, 45, 28, 9, 1.0f);
+    hull_check_budgets(&img, "two blobs"); tt_image_free(&img);
+    img = hull_image(32, 32); hull_rect(&img, 0, 0, 32, 32); hull_check_budgets(&img, "full square"); tt_image_free(&img);
+    img = hull_image(1, 1); hull_set_alpha(&img, 0, 0, 1.0f); hull_check_budgets(&img, "1x1"); tt_image_free(&img);
+    img = hull_image(9, 7); hull_set_alpha(&img, 4, 2, 0.1f); hull_check_budgets(&img, "single texel");
+    tt_image_free(&img);
+    img = hull_image(40, 40);
+    for (s = 3; s < 37; s++) hull_set_alpha(&img, s, s, 1.0f);
+    hull_check_budgets(&img, "diagonal"); tt_image_free(&img);
+    img = hull_image(40, 40);
+    for (s = 3; s < 37; s++) hull_set_alpha(&img, s, 39 - s, 1.0f);
+    hull_check_budgets(&img, "anti-diagonal"); tt_image_free(&img);
+    img = hull_image(40, 40);
+    for (s = 0; s < 40; s++) hull_set_alpha(&img, s, (s * 7) % 40 < 20 ? s / 2 : 39 - s / 3, 1.0f);
+    hull_check_budgets(&img, "scattered line"); tt_image_free(&img);
+    img = hull_image(1, 37); hull_rect(&img, 0, 3, 1, 30); hull_check_budgets(&img, "1xN"); tt_image_free(&img);
+    img = hull_image(37, 1); hull_rect(&img, 3, 0, 30, 1); hull_check_budgets(&img, "Nx1"); tt_image_free(&img);
+    img = hull_image(1, 37); hull_rect(&img, 0, 3, 1, 10); hull_rect(&img, 0, 20, 1, 30);
+    hull_check_budgets(&img, "1xN split"); tt_image_free(&img);
+    img = hull_image(16, 16);
+    for (s = 0; s < 256; s++)
+        if (((s % 16) + (s / 16)) % 2 == 0) hull_set_alpha(&img, s % 16, s / 16, 1.0f);
+    hull_check_budgets(&img, "checkerboard"); tt_image_free(&img);
+    img = hull_image(60, 40); /* comb: deep narrow slots */
+    hull_rect(&img, 2, 30, 58, 36);
+    for (s = 2; s < 58; s += 4) hull_rect(&img, s, 3, s + 2, 30);
+    hull_check_budgets(&img, "comb"); tt_image_free(&img);
+    img = hull_image(64, 64); /* square spiral, one texel wide with one-texel gaps */
+    {
+        int x = 31, y = 31, len = 1, d = 0, k, step;
+        for (k = 0; k < 58; k++) {
+            for (step = 0; step < len; step++) {
+                hull_set_alpha(&img, x, y, 1.0f);
+                x += d == 0 ? 1 : (d == 2 ? -1 : 0);
+                y += d == 1 ? 1 : (d == 3 ? -1 : 0);
+            }
+            d = (d + 1) & 3;
+            if (k % 2 == 1) len += 2;
+        }
+    }
+    hull_check_budgets(&img, "spiral"); tt_image_free(&img);
+
+    for (s = 0; s < 40; s++) {
+        int w = 8 + lcg_below(90), h = 8 + lcg_below(90);
+        img = hull_image(w, h);
+        hull_blob(&img, 1 + lcg_below(w * h / 3));
+        sprintf(name, "blob %d (%dx%d)", s, w, h);
+        hull_check_budgets(&img, name);
+        tt_image_free(&img);
+    }
+    for (s = 0; s < 10; s++) {
+        int k;
+        img = hull_image(30, 30);
+        for (k = 0; k < 900; k++)
+            if (lcg_unit() < 0.3) hull_set_alpha(&img, k % 30, k / 30, 1.0f);
+        sprintf(name, "noise %d", s);
+        hull_check_budgets(&img, name);
+        tt_image_free(&img);
+    }
+    for (s = 0; s < 6; s++) {
+        img = hull_image(128, 128);
+        hull_splotch(&img, s * 3.0, 0);
+        sprintf(name, "splotch %d", s);
+        hull_check_budgets(&img, name);
+        tt_image_free(&img);
+        img = hull_image(128, 128);
+        hull_splotch(&img, s * 3.0, 1);
+        sprintf(name, "speckled splotch %d", s);
+        hull_check_budgets(&img, name);
+        tt_image_free(&img);
+    }
+}
+
+/* Large splotches (smooth, ragged, speckled) at 32 vertices. */
+static void test_hull_large(void)
+{
+    static const char *const names[3] = {"smooth 512 splotch", "ragged 512 splotch", "speckled 512 splotch"};
+    int kind;
+    lcg_seed(77);
+    for (kind = 0; kind < 3; kind++) {
+        tt_image img = hull_image(512, 512);
+        hull_splotch(&img, kind ? 24.0 : 0.0, kind == 2);
+        hull_check(&img, 32, names[kind]);
+        tt_image_free(&img);
+    }
+}
+
+static void test_hull_area(void)
+{
+    tt_image img = hull_image(256, 256);
+    double disc, convex, a32, a8;
+    hull_disc(&img, 128, 128, 100, 1.0f);
+    disc = 3.14159265358979 * 100.0 * 100.0 / (256.0 * 256.0);
+    convex = hull_convex_area(&img);
+    CHECK(convex > disc, "convex hull of the disc: area %g above the disc's %g", convex, disc);
+    a32 = hull_check(&img, 32, "disc r=100");
+    a8 = hull_check(&img, 8, "disc r=100");
+    CHECK(a32 <= 1.3 * disc, "32-gon area %g within 1.3 x the disc's %g", a32, disc);
+    CHECK(a32 <= 1.1 * convex, "32-gon area %g within 1.1 x the convex hull's %g", a32, convex);
+    CHECK(a8 <= 1.3 * convex, "8-gon area %g within 1.3 x the convex hull's %g", a8, convex);
+    tt_image_free(&img);
+
+    img = hull_image(32, 32);
+    hull_rect(&img, 4, 6, 20, 30);
+    a32 = hull_check(&img, 4, "rectangle");
+    CHECK(fabs(a32 - hull_mask_area(&img)) < 1e-6, "rectangle: hull is the rectangle, area %g vs %g", a32,
+          hull_mask_area(&img));
+    tt_image_free(&img);
+
+    img = hull_image(64, 64);
+    hull_rect(&img, 4, 4, 20, 60); hull_rect(&img, 4, 44, 60, 60);
+    a32 = hull_check(&img, 32, "L exact");
+    CHECK(a32 < 1.01 * hull_mask_area(&img), "L: hull area %g vs mask %g (should stay non-convex)", a32,
+          hull_mask_area(&img));
+    tt_image_free(&img);
+}
+
+/* Distance between segment ab and the polygon's boundary (0 if they meet). */
+static double hull_segment_distance(const double *a, const double *b, const float *xy, int n)
+{
+    double best = 1e300;
+    int k;
+    for (k = 0; k < n; k++) {
+        const float *c = xy + 2 * k, *d = xy + 2 * ((k + 1) % n);
+        double dist[4];
+        int i;
+        if (internal_segments_near(a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1], 0.0)) return 0.0;
+        dist[0] = internal_point_segment_distance(c[0], c[1], a[0], a[1], b[0], b[1]);
+        dist[1] = internal_point_segment_distance(d[0], d[1], a[0], a[1], b[0], b[1]);
+        dist[2] = internal_point_segment_distance(a[0], a[1], c[0], c[1], d[0], d[1]);
+        dist[3] = internal_point_segment_distance(b[0], b[1], c[0], c[1], d[0], d[1]);
+        for (i = 0; i < 4; i++)
+            if (dist[i] < best) best = dist[i];
+    }
+    return best;
+}
+
+/* tt__segment_meets_polygon against dense sampling of the segment: every
+   sampled hit must be reported; a reported hit the sampling missed must be a
+   grazing one (the segment within one sample spacing of the boundary). */
+static void test_hull_segment(void)
+{
+    int shape, trial, mismatches = 0, ntests = 0;
+    lcg_seed(99);
+    for (shape = 0; shape < 12; shape++) {
+        tt_image img = hull_image(48, 48);
+        float *xy;
+        int n;
+        if (shape % 3 == 0) hull_disc(&img, 24, 24, 18, 1.0f);
+        else if (shape % 3 == 1) { hull_rect(&img, 4, 4, 14, 44); hull_rect(&img, 4, 34, 44, 44); }
+        else hull_blob(&img, 600);
+        if (internal_patch_hull(&img, shape < 6 ? 32 : 8, NULL, &xy, &n) != TT_OK) {
+            CHECK(0, "shape %d: hull for the segment test", shape);
+            tt_image_free(&img);
+            continue;
+        }
+        for (trial = 0; trial < 250; trial++) {
+            float a[2], b[2];
+            double da[2], db[2];
+            int got, ref = 0, s, samples = 2000;
+            if (trial % 10 == 0) { /* from a hull vertex */
+                int v = lcg_below(n);
+                a[0] = xy[2 * v]; a[1] = xy[2 * v + 1];
+            } else {
+                a[0] = (float)(-0.2 + 1.4 * lcg_unit()); a[1] = (float)(-0.2 + 1.4 * lcg_unit());
+            }
+            if (trial % 4 == 0) { /* short */
+                b[0] = a[0] + (float)(0.1 * (lcg_unit() - 0.5)); b[1] = a[1] + (float)(0.1 * (lcg_unit() - 0.5));
+            } else {
+                b[0] = (float)(-0.2 + 1.4 * lcg_unit()); b[1] = (float)(-0.2 + 1.4 * lcg_unit());
+            }
+            da[0] = a[0]; da[1] = a[1]; db[0] = b[0]; db[1] = b[1];
+            got = internal_segment_meets_polygon(a, b, xy, n);
+            for (s = 0; s <= samples && !ref; s++) {
+                double t = (double)s / samples;
+                ref = hull_inside_or_near(da[0] + t * (db[0] - da[0]), da[1] + t * (db[1] - da[1]), xy, n, 0.0);
+            }
+            ntests++;
+            if (ref && !got) {
+                if (!mismatches) DETAIL("shape %d: (%g, %g)-(%g, %g) meets the hull, not reported", shape, da[0],
+                                        da[1], db[0], db[1]);
+                mismatches++;
+            }
+            if (!ref && got) {
+                double len = sqrt((db[0] - da[0]) * (db[0] - da[0]) + (db[1] - da[1]) * (db[1] - da[1]));
+                if (hull_segment_distance(da, db, xy, n) > len / samples + 1e-9) {
+                    if (!mismatches) DETAIL("shape %d: (%g, %g)-(%g, %g) reported, but misses the hull", shape,
+                                            da[0], da[1], db[0], db[1]);
+                    mismatches++;
+                }
+            }
+        }
+        free(xy);
+        tt_image_free(&img);
+    }
+    CHECK(mismatches == 0 && ntests == 3000, "%d of %d random segments disagree with sampling", mismatches, ntests);
+
+    {
+        /* unit square, hand-made cases */
+        const float sq[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+        float a[2], b[2];
+        a[0] = 0.2f; a[1] = 0.2f; b[0] = 0.4f; b[1] = 0.6f;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 1, "segment inside");
+        a[0] = -1; a[1] = 0.5f; b[0] = 2; b[1] = 0.5f;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 1, "segment through");
+        a[0] = -1; a[1] = 2; b[0] = 2; b[1] = 2;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 0, "segment above");
+        a[0] = -1; a[1] = 1; b[0] = 2; b[1] = 1;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 1, "segment along the top edge");
+        a[0] = 1; a[1] = 2; b[0] = 2; b[1] = 1;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 0, "segment near the corner");
+        a[0] = 0; a[1] = 2; b[0] = 2; b[1] = 0;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 1, "segment touching the corner");
+        a[0] = 1; a[1] = 1; b[0] = 1; b[1] = 1;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 1, "a point on the corner");
+        a[0] = 1.5f; a[1] = 0.5f; b[0] = 1.5f; b[1] = 0.5f;
+        CHECK(internal_segment_meets_polygon(a, b, sq, 4) == 0, "a point outside");
+    }
+}
+
+static void test_hull_errors(void)
+{
+    tt_image img = hull_image(8, 8);
+    float *xy = (float *)&img; /* must be reset to NULL on failure */
+    int n = 5;
+    CHECK(internal_patch_hull(&img, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "transparent patch refused");
+    CHECK(xy == NULL && n == 0, "outputs reset on failure: %p, %d", (void *)xy, n);
+    hull_set_alpha(&img, 3, 3, 1.0f);
+    CHECK(internal_patch_hull(&img, 2, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "max_vertices 2 refused");
+    CHECK(internal_patch_hull(NULL, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "NULL patch refused");
+    CHECK(internal_patch_hull(&img, 32, NULL, NULL, &n) == TT_ERROR_INVALID_ARGUMENT, "NULL out refused");
+    hull_set_alpha(&img, 3, 3, -1.0f);
+    CHECK(internal_patch_hull(&img, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "negative alpha only refused");
+    tt_image_free(&img);
+}
+
+typedef struct hull_oom_ctx {
+    const tt_image *img;
+    int max_vertices;
+} hull_oom_ctx;
+
+static tt_result hull_oom_call(void *ctx, const tt_allocator *al)
+{
+    hull_oom_ctx *c = (hull_oom_ctx *)ctx;
+    float *xy = (float *)ctx;
+    int n = -1;
+    tt_result r = internal_patch_hull(c->img, c->max_vertices, al, &xy, &n);
+    if (r != TT_OK) return xy == NULL && n == 0 ? r : TT_RESULT_MAX_ENUM;   /* outputs reset on failure */
+    if (!xy || n < 3 || n > c->max_vertices) r = TT_RESULT_MAX_ENUM;
+    internal_free(al, xy);
+    return r;
+}
+
+static void test_hull_oom(void)
+{
+    tt_image img;
+    hull_oom_ctx c;
+    int s;
+    oom_reset();
+    lcg_seed(5);
+    img = hull_image(64, 64);
+    hull_blob(&img, 900);
+    c.img = &img;
+    c.max_vertices = 32;
+    oom_sweep("tt__patch_hull(blob, contour)", hull_oom_call, &c, TT_OK);
+    tt_image_free(&img);
+
+    img = hull_image(40, 40);
+    hull_disc(&img, 10, 10, 6, 1.0f); hull_disc(&img, 30, 28, 7, 1.0f);
+    c.img = &img;
+    c.max_vertices = 8;
+    oom_sweep("tt__patch_hull(two blobs, convex)", hull_oom_call, &c, TT_OK);
+    tt_image_free(&img);
+
+    img = hull_image(16, 16);
+    hull_rect(&img, 2, 2, 14, 14);
+    c.img = &img;
+    c.max_vertices = 3;
+    oom_sweep("tt__patch_hull(square to triangle, bounding)", hull_oom_call, &c, TT_OK);
+    tt_image_free(&img);
+
+    img = hull_image(200, 200); /* long straight sides plus fine detail: the edge grid grows */
+    hull_rect(&img, 10, 10, 190, 190);
+    for (s = 12; s < 188; s += 3) hull_set_alpha(&img, s, 9, 1.0f);
+    for (s = 12; s < 188; s += 5) hull_set_alpha(&img, 190, s, 1.0f);
+    c.img = &img;
+    c.max_vertices = 4;
+    oom_sweep("tt__patch_hull(square with teeth)", hull_oom_call, &c, TT_OK);
+    tt_image_free(&img);
+
+    img = hull_image(60, 40); /* comb: the edge grid's node pool grows */
+    hull_rect(&img, 2, 30, 58, 36);
+    for (s = 2; s < 58; s += 4) hull_rect(&img, s, 3, s + 2, 30);
+    c.img = &img;
+    c.max_vertices = 8;
+    oom_sweep("tt__patch_hull(comb)", hull_oom_call, &c, TT_OK);
+    tt_image_free(&img);
+
+    img = hull_image(8, 8);   /* transparent: refused before any allocation */
+    c.img = &img;
+    c.max_vertices = 8;
+    CHECK(hull_oom_call(&c, &g_oom_allocator) == TT_ERROR_INVALID_ARGUMENT && g_oom_counter.live == 0,
+          "transparent patch refused, nothing allocated");
+    tt_image_free(&img);
+    CHECK(g_oom_counter.live == 0 && g_oom_counter.bad_frees == 0, "hull sweeps: %ld blocks live, %ld bad frees",
+          g_oom_counter.live, g_oom_counter.bad_frees);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 7e. Measuring, atlas packing, baking (Sec. 4)                            */
+/* ------------------------------------------------------------------------ */
+
+/* Build a tmesh (optionally with an allocator). */
+static tt_mesh *bake_build(const tmesh *m, const tt_allocator *al)
+{
+    tt_mesh_desc d = tm_desc(m);
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_result r;
+    if (al) d.allocator = *al;
+    r = tt_mesh_build(&d, &mesh, &err);
+    CHECK(r == TT_OK, "test mesh builds: %s", err.message);
+    return mesh;
+}
+
+/* An nx x ny grid of unit squares over [0, nx] x [0, ny] in z = 0, each
+   split into the CCW triangles (a, b, c), (a, c, d) (faces 2q, 2q + 1 of
+   square q); `jitter` moves interior vertices by up to jitter / 2. */
+static tt_mesh *bake_grid(int nx, int ny, double jitter, const tt_allocator *al)
+{
+    tmesh q, t;
+    tt_mesh *mesh;
+    int i, j;
+    memset(&q, 0, sizeof q);
+    make_grid(&q, nx, ny);
+    for (j = 1; j < ny; j++)
+        for (i = 1; i < nx; i++) {
+            float *p = q.pos + 3 * (j * (nx + 1) + i);
+            p[0] = (float)(i + jitter * (lcg_unit() - 0.5));
+            p[1] = (float)(j + jitter * (lcg_unit() - 0.5));
+        }
+    tm_triangulate(&q, &t);
+    mesh = bake_build(&t, al);
+    tm_free(&q);
+    tm_free(&t);
+    return mesh;
+}
+
+/* One quad: every function here wants triangles. */
+static tt_mesh *bake_quad(void)
+{
+    tmesh q;
+    tt_mesh *mesh;
+    memset(&q, 0, sizeof q);
+    make_grid(&q, 1, 1);
+    mesh = bake_build(&q, NULL);
+    tm_free(&q);
+    return mesh;
+}
+
+/* Triangles (0,1,2), (1,3,2), (1,4,3) over (0,0) (1,0) (0,1) (1,1) (2,0)
+   and, with six vertices, (2,1); the first `nfaces` of them. */
+static tt_mesh *bake_three(int nverts, int nfaces)
+{
+    static const float p[18] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0, 2, 1, 0};
+    tmesh m;
+    tt_mesh *mesh;
+    int i;
+    memset(&m, 0, sizeof m);
+    for (i = 0; i < nverts; i++) tm_vert(&m, p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+    tm_tri(&m, 0, 1, 2);
+    if (nfaces > 1) tm_tri(&m, 1, 3, 2);
+    if (nfaces > 2) tm_tri(&m, 1, 4, 3);
+    mesh = bake_build(&m, NULL);
+    tm_free(&m);
+    return mesh;
+}
+
+/* A tt_lapped over arrays from malloc, grown one paste / entry at a time. */
+typedef struct lb_builder {
+    tt_lapped l;
+    int cap_pastes, cap_entries;
+} lb_builder;
+
+static void lb_init(lb_builder *b) { memset(b, 0, sizeof *b); }
+
+static void lb_free(lb_builder *b)
+{
+    free(b->l.pastes);
+    free(b->l.faces);
+    free(b->l.uv);
+    memset(b, 0, sizeof *b);
+}
+
+static void lb_begin(lb_builder *b, int patch)
+{
+    if (b->l.npastes == b->cap_pastes) {
+        b->cap_pastes = b->cap_pastes ? 2 * b->cap_pastes : 8;
+        b->l.pastes = (tt_paste *)realloc(b->l.pastes, sizeof(tt_paste) * (size_t)b->cap_pastes);
+    }
+    b->l.pastes[b->l.npastes].patch = patch;
+    b->l.pastes[b->l.npastes].first = b->l.nentries;
+    b->l.pastes[b->l.npastes].nfaces = 0;
+    b->l.npastes++;
+}
+
+static void lb_add(lb_builder *b, int face, const float uv[6])
+{
+    if (b->l.nentries == b->cap_entries) {
+        b->cap_entries = b->cap_entries ? 2 * b->cap_entries : 64;
+        b->l.faces = (int *)realloc(b->l.faces, sizeof(int) * (size_t)b->cap_entries);
+        b->l.uv = (float *)realloc(b->l.uv, sizeof(float) * 6 * (size_t)b->cap_entries);
+    }
+    b->l.faces[b->l.nentries] = face;
+    memcpy(b->l.uv + 6 * (size_t)b->l.nentries, uv, 6 * sizeof(float));
+    b->l.nentries++;
+    b->l.pastes[b->l.npastes - 1].nfaces++;
+}
+
+/* Paste UVs of face f by an affine map of its positions: uv = M (x, y) + o. */
+static void bake_affine_uv(const tt_mesh *mesh, int f, const double m[4], const double o[2], float uv[6])
+{
+    int k;
+    for (k = 0; k < 3; k++) {
+        const float *p = mesh->pos + 3 * mesh->corner_vert[mesh->face_start[f] + k];
+        uv[2 * k] = (float)(m[0] * p[0] + m[1] * p[1] + o[0]);
+        uv[2 * k + 1] = (float)(m[2] * p[0] + m[3] * p[1] + o[1]);
+    }
+}
+
+/* A new paste of every face with the map uv = m (x, y) + o. */
+static void lb_paste_all(lb_builder *b, const tt_mesh *mesh, int patch, const double m[4], const double o[2])
+{
+    int f;
+    float uv[6];
+    lb_begin(b, patch);
+    for (f = 0; f < mesh->nfaces; f++) {
+        bake_affine_uv(mesh, f, m, o, uv);
+        lb_add(b, f, uv);
+    }
+}
+
+/* A constant image, premultiplied colour (r, g, b) * a. */
+static tt_image bake_constant(int w, int h, float r, float g, float b, float a)
+{
+    tt_image img;
+    int i;
+    tt_image_create(&img, w, h, NULL);
+    for (i = 0; i < w * h; i++) {
+        img.pixels[4 * i] = r * a;
+        img.pixels[4 * i + 1] = g * a;
+        img.pixels[4 * i + 2] = b * a;
+        img.pixels[4 * i + 3] = a;
+    }
+    return img;
+}
+
+/* The same vector (x, y, 0) on every face (malloc). */
+static float *bake_face_vectors(const tt_mesh *mesh, float x, float y)
+{
+    float *v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    int f;
+    for (f = 0; f < mesh->nfaces; f++) {
+        v[3 * f] = x;
+        v[3 * f + 1] = y;
+        v[3 * f + 2] = 0.0f;
+    }
+    return v;
+}
+
+/* ---- tt_lapped_measure ---- */
+
+static void test_lapped_measure(void)
+{
+    tt_mesh *mesh;
+    float *fv, uv[6];
+    lb_builder b;
+    tt_lapped_report rep;
+    double pi = 3.14159265358979323846, a = 10.0 * pi / 180.0, s = 1.2;
+    double rot[4], id[4] = {1, 0, 0, 1}, o[2] = {0.3, -0.2};
+    int f;
+    lcg_seed(11);
+    mesh = bake_grid(4, 3, 0.4, NULL);
+    fv = bake_face_vectors(mesh, 0.0f, 1.0f);
+    rot[0] = s * cos(a); rot[1] = -s * sin(a); rot[2] = s * sin(a); rot[3] = s * cos(a);
+
+    /* Rotation by 10 degrees and scale 1.2 on every face. */
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, rot, o);
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "rotated paste: ok");
+    CHECK(fabs(rep.mean_angle_error - 10.0) < 1e-4, "rotated paste: angle 10, got %.8f", rep.mean_angle_error);
+    CHECK(fabs(rep.median_scale_error - 0.2) < 1e-4, "rotated paste: scale error 0.2, got %.8f",
+          rep.median_scale_error);
+    CHECK(fabs(rep.mean_overdraw - 1.0) < 1e-12, "rotated paste: overdraw 1, got %g", rep.mean_overdraw);
+    CHECK(rep.uncovered_faces == 0, "rotated paste: no uncovered faces, got %d", rep.uncovered_faces);
+
+    /* A face vector of length 2 along x maps to rotated (2.4, ...): 80 degrees off up. */
+    {
+        float *fx = bake_face_vectors(mesh, 2.0f, 0.0f);
+        CHECK(tt_lapped_measure(mesh, fx, &b.l, &rep) == TT_OK, "x field: ok");
+        CHECK(fabs(rep.mean_angle_error - 80.0) < 1e-4, "x field: angle 80, got %.8f", rep.mean_angle_error);
+        CHECK(fabs(rep.median_scale_error - 1.4) < 1e-4, "x field: scale error 1.4, got %.8f",
+              rep.median_scale_error);
+        free(fx);
+    }
+    lb_free(&b);
+
+    /* Identity, over only some faces, one face twice: overdraw and uncovered. */
+    lb_init(&b);
+    lb_begin(&b, 0);
+    for (f = 0; f < mesh->nfaces - 5; f++) {
+        bake_affine_uv(mesh, f, id, o, uv);
+        lb_add(&b, f, uv);
+    }
+    bake_affine_uv(mesh, 0, id, o, uv);
+    lb_add(&b, 0, uv);
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "partial paste: ok");
+    CHECK(fabs(rep.mean_angle_error) < 1e-4, "partial paste: angle 0, got %g", rep.mean_angle_error);
+    CHECK(fabs(rep.median_scale_error) < 1e-5, "partial paste: scale error 0, got %g", rep.median_scale_error);
+    CHECK(rep.uncovered_faces == 5, "partial paste: 5 uncovered, got %d", rep.uncovered_faces);
+    CHECK(fabs(rep.mean_overdraw - (double)(mesh->nfaces - 4) / mesh->nfaces) < 1e-12,
+          "partial paste: overdraw %d / %d, got %g", mesh->nfaces - 4, mesh->nfaces, rep.mean_overdraw);
+    lb_free(&b);
+
+    /* Exact median of an even count: scales 2.0, 1.1, 1.6, 1.3 -> errors
+       1 .1 .6 .3, median (0.3 + 0.6) / 2; then odd counts. */
+    {
+        double scales[4] = {2.0, 1.1, 1.6, 1.3}, m[4];
+        int i;
+        lb_init(&b);
+        lb_begin(&b, 0);
+        for (i = 0; i < 4; i++) {
+            m[0] = scales[i]; m[1] = 0; m[2] = 0; m[3] = scales[i];
+            bake_affine_uv(mesh, i, m, o, uv);
+            lb_add(&b, i, uv);
+        }
+        CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "4 scales: ok");
+        CHECK(fabs(rep.median_scale_error - 0.45) < 1e-5, "4 scales: median 0.45, got %.8f", rep.median_scale_error);
+        /* Odd count: add scale 1 (error 0): sorted 0 .1 .3 .6 1 -> 0.3. */
+        bake_affine_uv(mesh, 4, id, o, uv);
+        lb_add(&b, 4, uv);
+        CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "5 scales: ok");
+        CHECK(fabs(rep.median_scale_error - 0.3) < 1e-5, "5 scales: median 0.3, got %.8f", rep.median_scale_error);
+        /* Degenerate UVs (all corners one point): phi(T) = 0 counts 180
+           degrees and scale error 1. */
+        for (i = 0; i < 6; i++) uv[i] = 0.5f;
+        lb_add(&b, 5, uv);
+        CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "degenerate entry: ok");
+        CHECK(fabs(rep.mean_angle_error - 30.0) < 1e-4, "degenerate entry: angle (5 * 0 + 180) / 6 = 30, got %g",
+              rep.mean_angle_error);
+        CHECK(fabs(rep.median_scale_error - 0.45) < 1e-5,
+              "degenerate entry: errors 0 .1 .3 .6 1 1, median 0.45, got %g", rep.median_scale_error);
+        lb_free(&b);
+    }
+
+    /* No entries: errors 0, every face uncovered. */
+    lb_init(&b);
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "no entries: ok");
+    CHECK(rep.mean_angle_error == 0.0 && rep.median_scale_error == 0.0 && rep.mean_overdraw == 0.0 &&
+              rep.uncovered_faces == mesh->nfaces,
+          "no entries: zeros and %d uncovered, got %g %g %g %d", mesh->nfaces, rep.mean_angle_error,
+          rep.median_scale_error, rep.mean_overdraw, rep.uncovered_faces);
+    free(fv);
+    tt_mesh_free(mesh);
+}
+
+static void test_lapped_measure_errors(void)
+{
+    tt_mesh *mesh, *qm;
+    float *fv, uv[6], qv[3] = {0, 1, 0};
+    lb_builder b;
+    tt_lapped_report rep;
+    double id[4] = {1, 0, 0, 1}, o[2] = {0, 0};
+    int i;
+    lcg_seed(12);
+    mesh = bake_grid(4, 3, 0.4, NULL);
+    fv = bake_face_vectors(mesh, 0.0f, 1.0f);
+    lb_init(&b);
+    lb_begin(&b, 0);
+    for (i = 0; i < 4; i++) {
+        bake_affine_uv(mesh, i, id, o, uv);
+        lb_add(&b, i, uv);
+    }
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "valid input: ok");
+    CHECK(tt_lapped_measure(NULL, fv, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh refused");
+    CHECK(tt_lapped_measure(mesh, NULL, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "NULL vectors refused");
+    CHECK(tt_lapped_measure(mesh, fv, NULL, &rep) == TT_ERROR_INVALID_ARGUMENT, "NULL lapped refused");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL report refused");
+    b.l.faces[2] = mesh->nfaces;
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_INDEX_OUT_OF_RANGE, "face nfaces out of range");
+    b.l.faces[2] = -1;
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_INDEX_OUT_OF_RANGE, "face -1 out of range");
+    b.l.faces[2] = 2;
+    b.l.uv[7] = (float)internal_not_a_number();
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_NON_FINITE, "NaN paste uv refused");
+    b.l.uv[7] = 0.0f;
+    fv[3 * 3 + 1] = internal_infinity();
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_NON_FINITE, "infinite face vector refused");
+    fv[3 * 3 + 1] = 1.0f;
+    b.l.nentries = -1;
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "nentries -1 refused");
+    b.l.nentries = 4;
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "restored input: ok");
+    lb_free(&b);
+
+    qm = bake_quad();
+    lb_init(&b);
+    CHECK(tt_lapped_measure(qm, qv, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "quad mesh refused");
+    tt_mesh_free(qm);
+    free(fv);
+    tt_mesh_free(mesh);
+}
+
+typedef struct measure_oom_ctx {
+    const tt_mesh *mesh;      /* built with the sweep's allocator */
+    const float *fv;
+    const tt_lapped *lapped;
+} measure_oom_ctx;
+
+static tt_result measure_oom_call(void *ctx, const tt_allocator *al)
+{
+    measure_oom_ctx *c = (measure_oom_ctx *)ctx;
+    tt_lapped_report rep;
+    (void)al;   /* tt_lapped_measure allocates from the mesh's allocator: the same one */
+    return tt_lapped_measure(c->mesh, c->fv, c->lapped, &rep);
+}
+
+static void test_lapped_measure_oom(void)
+{
+    tt_mesh *mesh;
+    float *fv;
+    lb_builder b;
+    measure_oom_ctx c;
+    double id[4] = {1, 0, 0, 1}, o[2] = {0.3, -0.2};
+    oom_reset();
+    mesh = bake_grid(3, 3, 0.0, &g_oom_allocator);
+    if (!mesh) return;
+    fv = bake_face_vectors(mesh, 0.0f, 1.0f);
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, id, o);
+    c.mesh = mesh;
+    c.fv = fv;
+    c.lapped = &b.l;
+    oom_sweep("tt_lapped_measure", measure_oom_call, &c, TT_OK);
+    CHECK(g_oom_counter.calls == 2, "tt_lapped_measure: 2 allocations, got %ld", g_oom_counter.calls);
+    tt_mesh_free(mesh);
+    CHECK(g_oom_counter.live == 0 && g_oom_counter.bad_frees == 0, "all freed (%ld live, %ld bad frees)",
+          g_oom_counter.live, g_oom_counter.bad_frees);
+    lb_free(&b);
+    free(fv);
+}
+
+/* ---- tt_atlas_pack_pairs ---- */
+
+typedef struct bake_count {
+    int *count;
+    int width;
+    int overlaps;
+} bake_count;
+
+static void bake_count_texel(int x, int y, const float bary[3], void *user)
+{
+    bake_count *cb = (bake_count *)user;
+    (void)bary;
+    if (++cb->count[y * cb->width + x] > 1) cb->overlaps++;
+}
+
+/* Distance (texels) from (qx, qy) to the triangle x, y (0 inside). */
+static double bake_triangle_distance(const double *x, const double *y, double qx, double qy)
+{
+    double area2 = internal_orient2(x[0], y[0], x[1], y[1], x[2], y[2]), best = 1e300;
+    int i, inside = 1;
+    for (i = 0; i < 3; i++) {
+        int j = (i + 1) % 3;
+        double d = internal_point_segment_distance(qx, qy, x[i], y[i], x[j], y[j]);
+        if (internal_orient2(x[i], y[i], x[j], y[j], qx, qy) * area2 < 0) inside = 0;
+        if (d < best) best = d;
+    }
+    return inside ? 0.0 : best;
+}
+
+/* Texel centres within `gutter` of each atlas triangle, counted per
+   triangle: the number of texels counted more than once. */
+static int bake_gutter_overlaps(const tt_mesh *mesh, const float *uv, int size, int gutter)
+{
+    int *count = (int *)calloc((size_t)size * size, sizeof(int));
+    int f, over = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        double x[3], y[3], lo_x = 1e30, hi_x = -1e30, lo_y = 1e30, hi_y = -1e30;
+        int k, i, j;
+        for (k = 0; k < 3; k++) {
+            int c = mesh->face_start[f] + k;
+            x[k] = uv[2 * c] * (double)size;
+            y[k] = (1.0 - uv[2 * c + 1]) * (double)size;
+            lo_x = fmin(lo_x, x[k]); hi_x = fmax(hi_x, x[k]);
+            lo_y = fmin(lo_y, y[k]); hi_y = fmax(hi_y, y[k]);
+        }
+        for (j = (int)floor(lo_y - gutter - 1); j <= (int)ceil(hi_y + gutter + 1); j++)
+            for (i = (int)floor(lo_x - gutter - 1); i <= (int)ceil(hi_x + gutter + 1); i++) {
+                if (i < 0 || j < 0 || i >= size || j >= size) continue;
+                if (bake_triangle_distance(x, y, i + 0.5, j + 0.5) <= gutter + 1e-3)
+                    if (++count[j * size + i] > 1) over++;
+            }
+    }
+    free(count);
+    return over;
+}
+
+/* UVs outside [0, 1] (or NaN) among the first n floats. */
+static int bake_uv_outside(const float *uv, int n)
+{
+    int c, bad = 0;
+    for (c = 0; c < n; c++) bad += !(uv[c] >= 0.0f && uv[c] <= 1.0f);
+    return bad;
+}
+
+/* Jittered grids: the size the TOO_SMALL message suggests is the smallest
+   that works; at it and above, UVs in [0, 1], gutters disjoint, orientation
+   kept, rasters disjoint. */
+static void test_atlas_pack_pairs(void)
+{
+    static const int sizes[3][3] = {{5, 2, 4}, {7, 3, 0}, {33, 4, 4}};   /* grid nx, ny, gutter */
+    const char *key = "smallest size that works is ";
+    int t;
+    tt_error err;
+    lcg_seed(21);
+    for (t = 0; t < 3; t++) {
+        tt_mesh *mesh = bake_grid(sizes[t][0], sizes[t][1], 0.5, NULL);
+        int gutter = sizes[t][2], size = 0, bad = 0, f, s2;
+        float *uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+        tt_result r = tt_atlas_pack_pairs(mesh, 8, gutter, uv, &err);
+        const char *hint;
+        CHECK(r == TT_ERROR_IMAGE_TOO_SMALL, "grid %d: 8 texels too small, got %d", t, (int)r);
+        hint = strstr(err.message, key);
+        CHECK(hint != NULL, "grid %d: message suggests a size: %s", t, err.message);
+        if (hint) size = atoi(hint + strlen(key));
+        CHECK(tt_atlas_pack_pairs(mesh, size, gutter, uv, &err) == TT_OK,
+              "grid %d: suggested size %d works: %s", t, size, err.message);
+        CHECK(tt_atlas_pack_pairs(mesh, size - 1, gutter, uv, &err) == TT_ERROR_IMAGE_TOO_SMALL,
+              "grid %d: size %d - 1 does not", t, size);
+        CHECK(tt_atlas_pack_pairs(mesh, size, gutter, uv, &err) == TT_OK, "grid %d: size %d again", t, size);
+        bad = bake_uv_outside(uv, 2 * mesh->ncorners);
+        CHECK(bad == 0, "grid %d: %d UVs outside [0,1]", t, bad);
+        bad = bake_gutter_overlaps(mesh, uv, size, gutter);
+        CHECK(bad == 0, "grid %d: gutters disjoint at the smallest size, %d texels shared", t, bad);
+        /* Orientation kept (CCW in UV, v up) and area positive. */
+        bad = 0;
+        for (f = 0; f < mesh->nfaces; f++) {
+            const float *a = uv + 6 * f;
+            double area = ((double)a[2] - a[0]) * ((double)a[5] - a[1]) - ((double)a[4] - a[0]) * ((double)a[3] - a[1]);
+            if (!(area > 0)) bad++;
+        }
+        CHECK(bad == 0, "grid %d: %d faces flipped or empty", t, bad);
+        /* A larger size too, and the rasters of the triangles are disjoint. */
+        s2 = size * 2 + 3;
+        CHECK(tt_atlas_pack_pairs(mesh, s2, gutter, uv, &err) == TT_OK, "grid %d: size %d", t, s2);
+        bad = bake_gutter_overlaps(mesh, uv, s2, gutter);
+        CHECK(bad == 0, "grid %d: gutters disjoint at size %d, %d texels shared", t, s2, bad);
+        {
+            bake_count cb;
+            cb.width = s2;
+            cb.overlaps = 0;
+            cb.count = (int *)calloc((size_t)s2 * s2, sizeof(int));
+            for (f = 0; f < mesh->nfaces; f++) {
+                float xy[6];
+                int k;
+                for (k = 0; k < 3; k++) {
+                    xy[2 * k] = uv[6 * f + 2 * k] * (float)s2;
+                    xy[2 * k + 1] = (1.0f - uv[6 * f + 2 * k + 1]) * (float)s2;
+                }
+                tt_raster_triangle(xy, s2, s2, bake_count_texel, &cb);
+            }
+            CHECK(cb.overlaps == 0, "grid %d: raster overlaps %d", t, cb.overlaps);
+            free(cb.count);
+        }
+        free(uv);
+        tt_mesh_free(mesh);
+    }
+}
+
+/* Odd triangle counts: three, and one. */
+static void test_atlas_pack_odd(void)
+{
+    tt_mesh *m3 = bake_three(5, 3);
+    float uv[18];
+    tt_error err;
+    int bad;
+    CHECK(tt_atlas_pack_pairs(m3, 64, 2, uv, &err) == TT_OK, "3 triangles: %s", err.message);
+    bad = bake_uv_outside(uv, 18);
+    CHECK(bad == 0, "3 triangles: %d UVs outside [0,1]", bad);
+    bad = bake_gutter_overlaps(m3, uv, 64, 2);
+    CHECK(bad == 0, "3 triangles: gutters disjoint, %d texels shared", bad);
+    /* The largest angle becomes the right angle: face 0's corner 0 (the right
+       angle at (0,0)) sits at its cell's lower-left, (2, 30) texels. */
+    CHECK(fabs(uv[0] * 64 - 2.0) < 1e-4 && fabs((1 - uv[1]) * 64 - 30.0) < 1e-4,
+          "corner 0 at (2, 30) texels, got (%g, %g)", uv[0] * 64, (1 - uv[1]) * 64);
+    tt_mesh_free(m3);
+    m3 = bake_three(5, 1);
+    CHECK(tt_atlas_pack_pairs(m3, 4, 0, uv, &err) == TT_OK, "one triangle in 4 texels: %s", err.message);
+    CHECK(tt_atlas_pack_pairs(m3, 3, 0, uv, &err) == TT_ERROR_IMAGE_TOO_SMALL, "one triangle: 3 texels too small");
+    tt_mesh_free(m3);
+}
+
+static void test_atlas_pack_errors(void)
+{
+    tt_mesh *mesh = bake_grid(2, 2, 0.0, NULL), *qm;
+    float uv[48];
+    tt_error err;
+    CHECK(tt_atlas_pack_pairs(NULL, 64, 1, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh refused");
+    CHECK(tt_atlas_pack_pairs(mesh, 64, 1, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL uv refused");
+    CHECK(tt_atlas_pack_pairs(mesh, 0, 1, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "size 0 refused");
+    CHECK(tt_atlas_pack_pairs(mesh, TT_MAX_IMAGE_SIZE + 1, 1, uv, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "size above TT_MAX_IMAGE_SIZE refused");
+    CHECK(tt_atlas_pack_pairs(mesh, 64, -1, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "negative gutter refused");
+    CHECK(tt_atlas_pack_pairs(mesh, 64, 20000, uv, &err) == TT_ERROR_IMAGE_TOO_SMALL && strstr(err.message, "above"),
+          "huge gutter: too small, above the limit: %s", err.message);
+    tt_mesh_free(mesh);
+    qm = bake_quad();
+    CHECK(tt_atlas_pack_pairs(qm, 64, 1, uv, &err) == TT_ERROR_INVALID_ARGUMENT && err.face == 0,
+          "quads refused, face 0 named: %s", err.message);
+    tt_mesh_free(qm);
+}
+
+/* ---- tt_lapped_bake ---- */
+
+/* Atlas UVs of a mesh in [0,1]^2 (the unit square grid cell) scaled into [lo, hi]^2. */
+static void bake_square_uvs(const tt_mesh *mesh, double lo, double hi, float *uv)
+{
+    int c;
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *p = mesh->pos + 3 * mesh->corner_vert[c];
+        uv[2 * c] = (float)(lo + (hi - lo) * p[0]);
+        uv[2 * c + 1] = (float)(lo + (hi - lo) * p[1]);
+    }
+}
+
+typedef struct bake_mask {
+    unsigned char *mask;
+    int width;
+} bake_mask;
+
+static void bake_mark_texel(int x, int y, const float bary[3], void *user)
+{
+    bake_mask *m = (bake_mask *)user;
+    (void)bary;
+    m->mask[y * m->width + x] = 1;
+}
+
+/* 1 for the texels tt_raster_triangle gives the atlas triangles (calloc). */
+static unsigned char *bake_raster_mask(const tt_mesh *mesh, const float *uv, int w, int h)
+{
+    bake_mask m;
+    int f, k;
+    m.mask = (unsigned char *)calloc((size_t)w * h, 1);
+    m.width = w;
+    for (f = 0; f < mesh->nfaces; f++) {
+        float xy[6];
+        for (k = 0; k < 3; k++) {
+            int c = mesh->face_start[f] + k;
+            xy[2 * k] = uv[2 * c] * (float)w;
+            xy[2 * k + 1] = (1.0f - uv[2 * c + 1]) * (float)h;
+        }
+        tt_raster_triangle(xy, w, h, bake_mark_texel, &m);
+    }
+    return m.mask;
+}
+
+/* Texels of the atlas not within 1e-6 of straight colour (r, g, b, a);
+   a negative component is not compared. */
+static int bake_count_off(const tt_image *atlas, const unsigned char *only, double r, double g, double b, double a)
+{
+    const double want[4] = {r, g, b, a};
+    int i, k, bad = 0;
+    for (i = 0; i < atlas->width * atlas->height; i++) {
+        const float *p = atlas->pixels + 4 * i;
+        int off = 0;
+        if (only && !only[i]) continue;
+        for (k = 0; k < 4; k++) off |= want[k] >= 0.0 && !(fabs(p[k] - want[k]) < 1e-6);
+        bad += off;
+    }
+    return bad;
+}
+
+static void test_lapped_bake_constant(void)
+{
+    tt_mesh *mesh = bake_grid(1, 1, 0.0, NULL);
+    float uv[12];
+    double id[4] = {1, 0, 0, 1}, zero[2] = {0, 0};
+    tt_image patches[2], atlas;
+    lb_builder b;
+    tt_error err;
+    unsigned char *inside;
+    int i, bad, ninside = 0;
+    patches[0] = bake_constant(16, 16, 1, 0, 0, 1);
+    patches[1] = bake_constant(8, 8, 0, 0, 1, 0.5f);
+    bake_square_uvs(mesh, 0.25, 0.75, uv);
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, id, zero);
+    tt_image_create(&atlas, 40, 32, NULL);
+    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 2, &atlas, &err) == TT_OK, "red: %s", err.message);
+    inside = bake_raster_mask(mesh, uv, 40, 32);
+    for (i = 0; i < 40 * 32; i++) ninside += inside[i];
+    CHECK(ninside > 200, "triangles cover %d texels", ninside);
+    bad = bake_count_off(&atlas, inside, 1, 0, 0, 1);
+    CHECK(bad == 0, "red: %d texels inside the triangles not opaque red", bad);
+    bad = bake_count_off(&atlas, NULL, 1, 0, 0, 1);
+    CHECK(bad == 0, "red: %d texels anywhere not red after the fill", bad);
+
+    /* A second paste, half-transparent blue over red: straight colour is the
+       premultiplied "over" divided by alpha: (0.5, 0, 0.5), alpha 1. */
+    lb_paste_all(&b, mesh, 1, id, zero);
+    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 2, &atlas, &err) == TT_OK, "blue over red: %s", err.message);
+    bad = bake_count_off(&atlas, NULL, 0.5, 0, 0.5, 1);
+    CHECK(bad == 0, "%d texels differ from blue (alpha 0.5) over red", bad);
+
+    /* Only the blue paste: alpha 0.5, straight colour pure blue. */
+    b.l.pastes[0].nfaces = 0;
+    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 0, &atlas, &err) == TT_OK, "blue only: %s", err.message);
+    bad = bake_count_off(&atlas, NULL, 0, -1, 1, 0.5);
+    CHECK(bad == 0, "%d texels not straight blue with alpha 0.5", bad);
+
+    /* No pastes at all: transparent black everywhere, still OK. */
+    b.l.npastes = 0;
+    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 1, &atlas, &err) == TT_OK, "no pastes: %s", err.message);
+    bad = bake_count_off(&atlas, NULL, 0, 0, 0, 0);
+    CHECK(bad == 0, "no pastes: %d texels not transparent black", bad);
+    free(inside);
+    lb_free(&b);
+    tt_image_free(&atlas);
+    tt_image_free(&patches[0]);
+    tt_image_free(&patches[1]);
+    tt_mesh_free(mesh);
+}
+
+/* A smooth colour ramp patch: r = x / w, g = y / h, b = 0.5, opaque. */
+static tt_image bake_ramp(int w, int h)
+{
+    tt_image img;
+    int x, y;
+    tt_image_create(&img, w, h, NULL);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = img.pixels + 4 * (y * w + x);
+            p[0] = (x + 0.5f) / w;
+            p[1] = (y + 0.5f) / h;
+            p[2] = 0.5f;
+            p[3] = 1.0f;
+        }
+    return img;
+}
+
+/* One triangle pasted into the middle of a ramp patch: texels of the
+   triangle and of its gutter hold the (extrapolated) composite, not a copy
+   of the nearest inside texel; texels beyond the gutter are filled opaque. */
+static void test_lapped_bake_gutter(void)
+{
+    float uv[6] = {0.3f, 0.3f, 0.7f, 0.35f, 0.32f, 0.72f};
+    float puv[6] = {0.3f, 0.3f, 0.6f, 0.3f, 0.3f, 0.6f};
+    tt_mesh *mesh = bake_three(3, 1);
+    tt_image ramp = bake_ramp(64, 64), atlas;
+    lb_builder b;
+    tt_error err;
+    unsigned char *inside;
+    int W = 50, H = 60, x, y, k, ngutter = 0, bad = 0, gutter = 3, nfar = 0, badfar = 0;
+    double maxdiff = 0, X[3], Y[3], area2;
+    lb_init(&b);
+    lb_begin(&b, 0);
+    lb_add(&b, 0, puv);
+    tt_image_create(&atlas, W, H, NULL);
+    CHECK(tt_lapped_bake(mesh, &b.l, &ramp, 1, uv, gutter, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    inside = bake_raster_mask(mesh, uv, W, H);
+    for (k = 0; k < 3; k++) { X[k] = uv[2 * k] * W; Y[k] = (1.0 - uv[2 * k + 1]) * H; }
+    area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]);
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            double qx = x + 0.5, qy = y + 0.5, w0, w1, w2, u, v, d = bake_triangle_distance(X, Y, qx, qy);
+            float want[4];
+            const float *got = atlas.pixels + 4 * (y * W + x);
+            w0 = ((X[1] - qx) * (Y[2] - qy) - (X[2] - qx) * (Y[1] - qy)) / area2;
+            w1 = ((X[2] - qx) * (Y[0] - qy) - (X[0] - qx) * (Y[2] - qy)) / area2;
+            w2 = 1 - w0 - w1;
+            u = w0 * puv[0] + w1 * puv[2] + w2 * puv[4];
+            v = w0 * puv[1] + w1 * puv[3] + w2 * puv[5];
+            tt_image_sample_bilinear(&ramp, (float)(u * 64), (float)((1 - v) * 64), want);
+            if (inside[y * W + x] || d <= gutter - 1e-3) {
+                double diff = 0;
+                for (k = 0; k < 4; k++) diff = fmax(diff, fabs(got[k] - want[k]));
+                if (!inside[y * W + x] && d > 0.5) ngutter++;
+                if (diff > 1e-5) bad++;
+                if (diff > maxdiff) maxdiff = diff;
+            } else if (d > gutter + 1.5) {
+                /* Beyond the gutter: a copy of a written texel. */
+                nfar++;
+                badfar += got[3] != 1.0f;
+            }
+        }
+    CHECK(ngutter > 50, "gutter texels tested: %d", ngutter);
+    CHECK(bad == 0, "%d texels in the triangle or its gutter differ from the extrapolated composite, max %g", bad,
+          maxdiff);
+    CHECK(nfar > 100 && badfar == 0, "texels beyond the gutter filled opaque (%d of %d bad)", badfar, nfar);
+    free(inside);
+    lb_free(&b);
+    tt_image_free(&atlas);
+    tt_image_free(&ramp);
+    tt_mesh_free(mesh);
+}
+
+static tt_image bake_checker(int w, int h, int square)
+{
+    tt_image img;
+    int x, y;
+    tt_image_create(&img, w, h, NULL);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = img.pixels + 4 * (y * w + x);
+            int on = ((x / square) + (y / square)) & 1;
+            p[0] = on ? 0.9f : 0.1f;
+            p[1] = on ? 0.2f : 0.7f;
+            p[2] = (float)x / (float)w;
+            p[3] = 1.0f;
+        }
+    return img;
+}
+
+/* Mean RGB difference between the atlas (through the atlas UVs) and the
+   patch (through face f's paste UVs, entry f) at barycentric point w. */
+static double bake_seam_diff(const tt_mesh *mesh, const tt_lapped *l, const float *uv, const tt_image *atlas,
+                             const tt_image *patch, int f, const double w[3])
+{
+    double au = 0, av = 0, pu = 0, pv = 0, diff = 0;
+    float a[4], p[4];
+    int k;
+    for (k = 0; k < 3; k++) {
+        int c = mesh->face_start[f] + k;
+        au += w[k] * uv[2 * c];
+        av += w[k] * uv[2 * c + 1];
+        pu += w[k] * l->uv[6 * f + 2 * k];
+        pv += w[k] * l->uv[6 * f + 2 * k + 1];
+    }
+    tt_image_sample_bilinear(atlas, (float)(au * atlas->width), (float)((1 - av) * atlas->height), a);
+    tt_image_sample_bilinear(patch, (float)(pu * patch->width), (float)((1 - pv) * patch->height), p);
+    for (k = 0; k < 3; k++) diff += fabs(a[k] - p[k]) / 3;
+    return diff;
+}
+
+/* "No chart seams": the baked atlas read through the atlas UVs matches the
+   patch read through the paste UVs, everywhere and right at the edges; the
+   gutter does better at the edges than no gutter. */
+static void test_lapped_bake_seams(void)
+{
+    tt_mesh *mesh;
+    float *uv;
+    tt_image checker = bake_checker(64, 64, 8), atlas;
+    lb_builder b;
+    tt_error err;
+    double m[4] = {1.0 / 8, 0, 0, 1.0 / 8}, o[2] = {0, 0}, sum_all = 0, sum_edge = 0, sum_nogutter = 0;
+    int size = 512, n_all = 0, n_edge = 0, ne = 0, i;
+    lcg_seed(7);
+    mesh = bake_grid(8, 8, 0.6, NULL);
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_atlas_pack_pairs(mesh, size, 2, uv, &err) == TT_OK, "pack: %s", err.message);
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, m, o);
+    tt_image_create(&atlas, size, size, NULL);
+    CHECK(tt_lapped_bake(mesh, &b.l, &checker, 1, uv, 2, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    for (i = 0; i < 20000; i++) {
+        int f = lcg_below(mesh->nfaces);
+        double r1 = lcg_unit(), r2 = lcg_unit(), w[3], diff;
+        if (r1 + r2 > 1) { r1 = 1 - r1; r2 = 1 - r2; }
+        w[0] = 1 - r1 - r2; w[1] = r1; w[2] = r2;
+        /* Half of the points hug an edge: push one weight to almost 0. */
+        if (i & 1) {
+            double s;
+            w[i % 3] = 0.002 * lcg_unit();
+            s = w[0] + w[1] + w[2];
+            w[0] /= s; w[1] /= s; w[2] /= s;
+        }
+        diff = bake_seam_diff(mesh, &b.l, uv, &atlas, &checker, f, w);
+        sum_all += diff;
+        n_all++;
+        if (fmin(w[0], fmin(w[1], w[2])) < 0.01) { sum_edge += diff; n_edge++; }
+    }
+    CHECK(sum_all / n_all < 0.02, "mean abs difference %g", sum_all / n_all);
+    CHECK(n_edge > 5000 && sum_edge / n_edge < 0.02, "near edges: mean abs difference %g over %d",
+          n_edge ? sum_edge / n_edge : -1.0, n_edge);
+    /* Without gutters the same edge samples read the fill's copies: the
+       gutter must do better than that. */
+    CHECK(tt_lapped_bake(mesh, &b.l, &checker, 1, uv, 0, &atlas, &err) == TT_OK, "bake without gutter: %s",
+          err.message);
+    lcg_seed(99);
+    for (i = 0; i < 10000; i++) {
+        int f = lcg_below(mesh->nfaces);
+        double w[3], r;
+        w[0] = 0.002 * lcg_unit();
+        r = lcg_unit();
+        w[1] = (1 - w[0]) * r;
+        w[2] = 1 - w[0] - w[1];
+        sum_nogutter += bake_seam_diff(mesh, &b.l, uv, &atlas, &checker, f, w);
+        ne++;
+    }
+    sum_nogutter /= ne;
+    CHECK(n_edge > 0 && sum_nogutter >= sum_edge / n_edge, "gutter helps at edges: %g with, %g without",
+          n_edge ? sum_edge / n_edge : -1.0, sum_nogutter);
+    free(uv);
+    lb_free(&b);
+    tt_image_free(&atlas);
+    tt_image_free(&checker);
+    tt_mesh_free(mesh);
+}
+
+/* Two faces with the same atlas triangle: the later face's pastes win. */
+static void test_lapped_bake_order(void)
+{
+    float uv[12] = {0.1f, 0.1f, 0.9f, 0.1f, 0.9f, 0.9f, 0.1f, 0.1f, 0.9f, 0.1f, 0.9f, 0.9f};
+    float puv[6] = {0, 0, 1, 0, 1, 1};
+    tt_mesh *mesh = bake_grid(1, 1, 0.0, NULL);
+    tt_image patches[2], atlas;
+    lb_builder b;
+    tt_error err;
+    const float *p;
+    patches[0] = bake_constant(4, 4, 1, 0, 0, 1);
+    patches[1] = bake_constant(4, 4, 0, 1, 0, 1);
+    lb_init(&b);
+    lb_begin(&b, 1);
+    lb_add(&b, 1, puv);     /* green on face 1 */
+    lb_begin(&b, 0);
+    lb_add(&b, 0, puv);     /* red on face 0, pasted later, but face 1 is drawn later */
+    tt_image_create(&atlas, 20, 20, NULL);
+    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 1, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    p = atlas.pixels + 4 * (12 * 20 + 14);
+    CHECK(p[1] == 1.0f && p[0] == 0.0f, "face 1 (green) wins, got %g %g %g", p[0], p[1], p[2]);
+    lb_free(&b);
+    tt_image_free(&atlas);
+    tt_image_free(&patches[0]);
+    tt_image_free(&patches[1]);
+    tt_mesh_free(mesh);
+}
+
+static void test_lapped_bake_errors(void)
+{
+    tt_mesh *mesh = bake_grid(1, 1, 0.0, NULL), *qm;
+    float uv[12], quv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    double id[4] = {1, 0, 0, 1}, zero[2] = {0, 0};
+    tt_image red = bake_constant(4, 4, 1, 0, 0, 1), atlas, empty;
+    lb_builder b;
+    tt_error err;
+    bake_square_uvs(mesh, 0.1, 0.9, uv);
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, id, zero);
+    tt_image_create(&atlas, 16, 16, NULL);
+    memset(&empty, 0, sizeof empty);
+
+    CHECK(tt_lapped_bake(NULL, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh");
+    CHECK(tt_lapped_bake(mesh, NULL, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL lapped");
+    CHECK(tt_lapped_bake(mesh, &b.l, NULL, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL patches");
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, NULL, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL uv");
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL atlas");
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &empty, &err) == TT_ERROR_INVALID_ARGUMENT, "empty atlas");
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 0, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "npatches 0");
+    CHECK(tt_lapped_bake(mesh, &b.l, &empty, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "empty patch");
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, -1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "gutter -1");
+
+    b.l.pastes[0].patch = 1;
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE,
+          "patch out of range: %s", err.message);
+    b.l.pastes[0].patch = -1;
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE, "patch -1");
+    b.l.pastes[0].patch = 0;
+    b.l.pastes[0].nfaces = 3;
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE,
+          "entries out of range: %s", err.message);
+    b.l.pastes[0].nfaces = 2;
+    b.l.faces[1] = 2;
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE && err.face == 2,
+          "face out of range, named: %s", err.message);
+    b.l.faces[1] = 1;
+    b.l.uv[3] = (float)internal_not_a_number();
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_NON_FINITE && err.face == 0,
+          "NaN paste uv, face named: %s", err.message);
+    b.l.uv[3] = 0.0f;
+    uv[7] = internal_infinity();
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_NON_FINITE && err.corner == 3,
+          "infinite atlas uv, corner named: %s", err.message);
+    bake_square_uvs(mesh, 0.1, 0.9, uv);
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_OK, "fixed: %s", err.message);
+    b.l.nentries = -1;
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "nentries -1");
+    b.l.nentries = 2;
+    lb_free(&b);
+
+    qm = bake_quad();
+    lb_init(&b);
+    CHECK(tt_lapped_bake(qm, &b.l, &red, 1, quv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT && err.face == 0,
+          "quads refused, face 0 named: %s", err.message);
+    tt_mesh_free(qm);
+    tt_image_free(&atlas);
+    tt_image_free(&red);
+    tt_mesh_free(mesh);
+}
+
+typedef struct bake_oom_ctx {
+    const tt_mesh *mesh;      /* built with the sweep's allocator */
+    const tt_lapped *lapped;
+    const tt_image *patch;
+    const float *uv;
+    tt_image *atlas;
+} bake_oom_ctx;
+
+static tt_result bake_oom_call(void *ctx, const tt_allocator *al)
+{
+    bake_oom_ctx *c = (bake_oom_ctx *)ctx;
+    tt_error err;
+    tt_result r;
+    int i, n = 4 * c->atlas->width * c->atlas->height;
+    (void)al;   /* tt_lapped_bake allocates from the mesh's allocator: the same one */
+    for (i = 0; i < n; i++) c->atlas->pixels[i] = 0.25f;
+    r = tt_lapped_bake(c->mesh, c->lapped, c->patch, 1, c->uv, 1, c->atlas, &err);
+    if (r != TT_OK) {
+        if (err.result != r) return TT_RESULT_MAX_ENUM;
+        for (i = 0; i < n; i++)   /* all memory is taken before the atlas is touched */
+            if (c->atlas->pixels[i] != 0.25f) return TT_RESULT_MAX_ENUM;
+    }
+    return r;
+}
+
+static void test_lapped_bake_oom(void)
+{
+    tt_mesh *mesh;
+    float uv[2 * 3 * 32];
+    double m[4] = {0.25, 0, 0, 0.25}, zero[2] = {0, 0};
+    tt_image red = bake_constant(4, 4, 1, 0, 0, 1), atlas;
+    lb_builder b;
+    bake_oom_ctx c;
+    tt_error err;
+    lcg_seed(31);
+    oom_reset();
+    mesh = bake_grid(4, 4, 0.3, &g_oom_allocator);
+    if (!mesh) return;
+    CHECK(tt_atlas_pack_pairs(mesh, 64, 1, uv, &err) == TT_OK, "pack: %s", err.message);
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, m, zero);
+    tt_image_create(&atlas, 64, 64, NULL);
+    c.mesh = mesh;
+    c.lapped = &b.l;
+    c.patch = &red;
+    c.uv = uv;
+    c.atlas = &atlas;
+    oom_sweep("tt_lapped_bake", bake_oom_call, &c, TT_OK);
+    CHECK(g_oom_counter.calls == 5, "tt_lapped_bake: 5 allocations, got %ld", g_oom_counter.calls);
+    tt_mesh_free(mesh);
+    CHECK(g_oom_counter.live == 0 && g_oom_counter.bad_frees == 0, "all freed (%ld live, %ld bad frees)",
+          g_oom_counter.live, g_oom_counter.bad_frees);
+    lb_free(&b);
+    tt_image_free(&atlas);
+    tt_image_free(&red);
+}
+
+/* A sliver far thinner than a texel, a degenerate triangle and one with UVs
+   far outside the atlas: no crash; without pastes the big one leaves the
+   atlas transparent, with one it is red everywhere. */
+static void test_lapped_bake_thin(void)
+{
+    float uv[18] = {0.1f, 0.1f, 0.9f, 0.9f, 0.1f, 0.1000001f,
+                    0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f,
+                    -3000.0f, -3000.0f, 3000.0f, -3000.0f, 0.0f, 3000.0f};
+    float puv[6] = {0, 0, 1, 0, 0, 1};
+    tt_mesh *mesh = bake_three(6, 3);
+    tt_image red = bake_constant(4, 4, 1, 0, 0, 1), atlas;
+    lb_builder b;
+    tt_error err;
+    int i, bad = 0;
+    lb_init(&b);
+    lb_begin(&b, 0);
+    lb_add(&b, 0, puv);
+    lb_add(&b, 1, puv);
+    tt_image_create(&atlas, 32, 32, NULL);
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 4, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    for (i = 0; i < 32 * 32 * 4; i++) bad += atlas.pixels[i] != 0.0f;
+    CHECK(bad == 0, "face 2 without pastes covers the atlas: transparent (%d values off)", bad);
+    lb_add(&b, 2, puv);
+    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 4, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    bad = 0;
+    for (i = 0; i < 32 * 32; i++) bad += atlas.pixels[4 * i] != 1.0f || atlas.pixels[4 * i + 3] != 1.0f;
+    CHECK(bad == 0, "face 2 pasted red: all red (%d texels off)", bad);
+    lb_free(&b);
+    tt_image_free(&atlas);
+    tt_image_free(&red);
+    tt_mesh_free(mesh);
+}
+
+void run_lapped_tests(void)
+{
+    RUN(test_field_default);
+    RUN(test_field_fallback);
+    RUN(test_field_constraints);
+    RUN(test_field_errors);
+    RUN(test_field_oom);
+    RUN(test_patch_splotch);
+    RUN(test_patch_seeds);
+    RUN(test_patch_masks);
+    RUN(test_patch_errors);
+    RUN(test_patch_oom);
+    RUN(test_lapped_plane);
+    RUN(test_lapped_cover);
+    RUN(test_lapped_determinism);
+    RUN(test_lapped_patches);
+    RUN(test_lapped_errors);
+    RUN(test_lapped_oom);
+    RUN(test_hull_shapes);
+    RUN(test_hull_large);
+    RUN(test_hull_area);
+    RUN(test_hull_segment);
+    RUN(test_hull_errors);
+    RUN(test_hull_oom);
+    RUN(test_lapped_measure);
+    RUN(test_lapped_measure_errors);
+    RUN(test_lapped_measure_oom);
+    RUN(test_atlas_pack_pairs);
+    RUN(test_atlas_pack_odd);
+    RUN(test_atlas_pack_errors);
+    RUN(test_lapped_bake_constant);
+    RUN(test_lapped_bake_gutter);
+    RUN(test_lapped_bake_seams);
+    RUN(test_lapped_bake_order);
+    RUN(test_lapped_bake_errors);
+    RUN(test_lapped_bake_oom);
+    RUN(test_lapped_bake_thin);
+}

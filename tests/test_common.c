@@ -1,0 +1,361 @@
+/* tests/test_common.c - the shared part of the unit tests of tiledtex.h
+   (declared in tests/test_common.h), the one file that compiles the
+   implementation, and main(). Built with tests/test_[1-7]_*.c into one
+   program by tests/run.sh (with ASan + UBSan). Prints one line per failed
+   check and, last, "N passed, M failed". Does not read any file. */
+#define TILEDTEX_IMPLEMENTATION
+#include "tiledtex.h"
+
+#include "test_common.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------ */
+/* Framework                                                                */
+/* ------------------------------------------------------------------------ */
+
+int g_passed, g_failed;
+const char *g_test = "";
+
+void check_report(int ok, const char *file, int line, const char *what, const char *fmt, ...)
+{
+    va_list args;
+    if (ok) { g_passed++; return; }
+    g_failed++;
+    printf("%s:%d: FAIL in %s: %s: ", file, line, g_test, what);
+    va_start(args, fmt);
+    vprintf(fmt, args);
+    va_end(args);
+    printf("\n");
+    fflush(stdout);
+}
+
+void check_detail(const char *file, int line, const char *fmt, ...)
+{
+    va_list args;
+    printf("%s:%d: detail in %s: ", file, line, g_test);
+    va_start(args, fmt);
+    vprintf(fmt, args);
+    va_end(args);
+    printf("\n");
+}
+
+/* ------------------------------------------------------------------------ */
+/* Counting and failing allocators                                          */
+/* ------------------------------------------------------------------------ */
+
+typedef union header {
+    size_t size;
+    long double ld;
+    void *p;
+    long long ll;
+    double d;
+} header;
+
+#define MAGIC 0x7474u
+
+static void *counting_alloc(size_t size, void *user_data)
+{
+    counter *c = (counter *)user_data;
+    header *h;
+    long call = c->calls++;
+    if (c->fail_at >= 0 && call == c->fail_at) { c->failures++; return NULL; }
+    h = (header *)malloc(sizeof(header) * 2 + size);
+    if (!h) return NULL;
+    h[0].size = size;
+    h[1].size = MAGIC;
+    c->live++;
+    c->live_bytes += size;
+    return h + 2;
+}
+
+static void counting_free(void *ptr, void *user_data)
+{
+    counter *c = (counter *)user_data;
+    header *h;
+    if (!ptr) return;
+    h = (header *)ptr - 2;
+    if (h[1].size != MAGIC) { c->bad_frees++; return; }
+    h[1].size = 0;
+    c->live--;
+    c->live_bytes -= h[0].size;
+    free(h);
+}
+
+tt_allocator make_allocator(counter *c, long fail_at)
+{
+    tt_allocator a;
+    memset(c, 0, sizeof *c);
+    c->fail_at = fail_at;
+    a.alloc = counting_alloc;
+    a.free = counting_free;
+    a.user_data = c;
+    return a;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Allocation-failure sweep                                                 */
+/* ------------------------------------------------------------------------ */
+
+counter g_oom_counter;
+tt_allocator g_oom_allocator;
+
+void oom_reset(void) { g_oom_allocator = make_allocator(&g_oom_counter, -1); }
+
+void oom_sweep(const char *what, oom_call call, void *ctx, tt_result expected_final)
+{
+    int k, bad_result = 0, leaks = 0, bad_frees = 0, nsteps = 0;
+    tt_result r = TT_ERROR_OUT_OF_MEMORY, first_bad = TT_OK;
+    counter *cnt = &g_oom_counter;
+    for (k = 0; k < 100000; k++) {
+        long live0 = cnt->live, bad0 = cnt->bad_frees;
+        cnt->calls = 0;
+        cnt->failures = 0;
+        cnt->fail_at = k;
+        r = call(ctx, &g_oom_allocator);
+        nsteps++;
+        if (cnt->live != live0) leaks++;
+        if (cnt->bad_frees != bad0) bad_frees++;
+        if (cnt->failures == 0) break;   /* allocation k was never reached: the run is complete */
+        if (r != TT_ERROR_OUT_OF_MEMORY) { if (!bad_result) first_bad = r; bad_result++; }
+    }
+    cnt->fail_at = -1;
+    CHECK(r == expected_final, "%s: after %d allocation-failure runs, expected final result %d, got %d", what, nsteps,
+          expected_final, r);
+    CHECK(bad_result == 0, "%s: %d runs with a failed allocation did not return TT_ERROR_OUT_OF_MEMORY (first: %d)",
+          what, bad_result, first_bad);
+    CHECK(leaks == 0 && bad_frees == 0, "%s: %d runs leaked, %d freed foreign pointers", what, leaks, bad_frees);
+    CHECK(nsteps > 1, "%s: expected at least one allocation, got %d runs", what, nsteps);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Small helpers                                                            */
+/* ------------------------------------------------------------------------ */
+
+int near(double a, double b, double tol) { return fabs(a - b) <= tol; }
+
+static unsigned long long g_lcg = 1;
+
+void lcg_seed(unsigned long long s) { g_lcg = s * 2862933555777941757ull + 3037000493ull; }
+unsigned lcg_next(void)
+{
+    g_lcg = g_lcg * 6364136223846793005ull + 1442695040888963407ull;
+    return (unsigned)(g_lcg >> 33);
+}
+int lcg_below(int n) { return (int)(lcg_next() % (unsigned)n); }
+double lcg_unit(void) { return (double)lcg_next() / 2147483648.0; }
+
+int msg_has_number(const char *msg, int n)
+{
+    char buf[32];
+    const char *p = msg;
+    size_t len;
+    sprintf(buf, "%d", n);
+    len = strlen(buf);
+    while ((p = strstr(p, buf)) != NULL) {
+        int before_ok = p == msg || !(p[-1] >= '0' && p[-1] <= '9') || n < 0;
+        int after_ok = !(p[len] >= '0' && p[len] <= '9');
+        if (before_ok && after_ok) return 1;
+        p++;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Hand-made meshes                                                         */
+/* ------------------------------------------------------------------------ */
+
+void tm_free(tmesh *m)
+{
+    free(m->pos);
+    free(m->idx);
+    free(m->sizes);
+    memset(m, 0, sizeof *m);
+}
+
+int tm_vert(tmesh *m, double x, double y, double z)
+{
+    if (m->nv == m->cap_v) {
+        m->cap_v = m->cap_v ? 2 * m->cap_v : 16;
+        m->pos = (float *)realloc(m->pos, sizeof(float) * 3 * (size_t)m->cap_v);
+    }
+    m->pos[3 * m->nv] = (float)x;
+    m->pos[3 * m->nv + 1] = (float)y;
+    m->pos[3 * m->nv + 2] = (float)z;
+    return m->nv++;
+}
+
+void tm_face(tmesh *m, int n, const int *v)
+{
+    int i;
+    if (m->nf == m->cap_f) {
+        m->cap_f = m->cap_f ? 2 * m->cap_f : 16;
+        m->sizes = (int *)realloc(m->sizes, sizeof(int) * (size_t)m->cap_f);
+    }
+    while (m->nc + n > m->cap_c) {
+        m->cap_c = m->cap_c ? 2 * m->cap_c : 64;
+        m->idx = (int *)realloc(m->idx, sizeof(int) * (size_t)m->cap_c);
+    }
+    for (i = 0; i < n; i++) m->idx[m->nc + i] = v[i];
+    m->nc += n;
+    m->sizes[m->nf++] = n;
+}
+
+void tm_tri(tmesh *m, int a, int b, int c) { int v[3]; v[0] = a; v[1] = b; v[2] = c; tm_face(m, 3, v); }
+void tm_quad(tmesh *m, int a, int b, int c, int d)
+{
+    int v[4];
+    v[0] = a; v[1] = b; v[2] = c; v[3] = d;
+    tm_face(m, 4, v);
+}
+
+tt_mesh_desc tm_desc(const tmesh *m)
+{
+    tt_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    d.positions = m->pos;
+    d.nverts = m->nv;
+    d.indices = m->idx;
+    d.face_sizes = m->sizes;
+    d.nfaces = m->nf;
+    return d;
+}
+
+void make_tetra(tmesh *m, double ox)
+{
+    int a = tm_vert(m, ox + 0, 0, 0), b = tm_vert(m, ox + 1, 0, 0), c = tm_vert(m, ox + 0, 1, 0),
+        d = tm_vert(m, ox + 0, 0, 1);
+    tm_tri(m, a, c, b);
+    tm_tri(m, a, b, d);
+    tm_tri(m, a, d, c);
+    tm_tri(m, b, c, d);
+}
+
+void make_torus(tmesh *m, int nu, int nv, double R, double r)
+{
+    int i, j, base = m->nv;
+    const double pi = 3.14159265358979323846;
+    for (j = 0; j < nv; j++)
+        for (i = 0; i < nu; i++) {
+            double a = 2 * pi * i / nu, b = 2 * pi * j / nv;
+            tm_vert(m, (R + r * cos(b)) * cos(a), (R + r * cos(b)) * sin(a), r * sin(b));
+        }
+    for (j = 0; j < nv; j++)
+        for (i = 0; i < nu; i++) {
+            int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
+            tm_quad(m, base + j * nu + i, base + j * nu + i1, base + j1 * nu + i1, base + j1 * nu + i);
+        }
+}
+
+/* Open nx x ny grid of unit quads in the plane z = 0. */
+void make_grid(tmesh *m, int nx, int ny)
+{
+    int i, j, base = m->nv;
+    for (j = 0; j <= ny; j++)
+        for (i = 0; i <= nx; i++) tm_vert(m, i, j, 0);
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++)
+            tm_quad(m, base + j * (nx + 1) + i, base + j * (nx + 1) + i + 1, base + (j + 1) * (nx + 1) + i + 1,
+                    base + (j + 1) * (nx + 1) + i);
+}
+
+tt_result build(const tmesh *m, unsigned flags, tt_mesh **out, tt_error *err)
+{
+    tt_mesh_desc d = tm_desc(m);
+    d.flags = flags;
+    return tt_mesh_build(&d, out, err);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Images                                                                   */
+/* ------------------------------------------------------------------------ */
+
+float *px(const tt_image *im, int x, int y) { return im->pixels + ((size_t)y * im->width + x) * 4; }
+
+void make_value_noise(tt_image *im, int w, int h, unsigned seed)
+{
+    static const int scales[3] = {6, 13, 29};
+    static const double weights[3] = {0.12, 0.16, 0.2};
+    float lattice[3][64][64];
+    int x, y, k, s;
+    tt_image_create(im, w, h, NULL);
+    lcg_seed(seed);
+    for (s = 0; s < 3; s++)
+        for (y = 0; y < 64; y++)
+            for (x = 0; x < 64; x++) lattice[s][y][x] = (float)lcg_unit() - 0.5f;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = px(im, x, y);
+            double a = 0.0;
+            for (s = 0; s < 3; s++) {
+                double fx = (double)x / scales[s], fy = (double)y / scales[s];
+                int ix = (int)fx, iy = (int)fy;
+                double tx = fx - ix, ty = fy - iy;
+                double top = lattice[s][iy % 64][ix % 64] * (1 - tx) + lattice[s][iy % 64][(ix + 1) % 64] * tx;
+                double bottom = lattice[s][(iy + 1) % 64][ix % 64] * (1 - tx) + lattice[s][(iy + 1) % 64][(ix + 1) % 64] * tx;
+                a += weights[s] * (top * (1 - ty) + bottom * ty);
+            }
+            for (k = 0; k < 3; k++) p[k] = (float)(0.5 + a * (1.0 - 0.25 * k) + (lcg_unit() - 0.5) * 0.03);
+            p[3] = 1.0f;
+        }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Internal functions of the implementation the tests call                  */
+/* ------------------------------------------------------------------------ */
+
+void internal_free(const tt_allocator *allocator, void *ptr) { tt__free(allocator, ptr); }
+float internal_infinity(void) { return tt__infinity(); }
+double internal_not_a_number(void) { return tt__not_a_number(); }
+double internal_orient2(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    return tt__orient2(ax, ay, bx, by, cx, cy);
+}
+double internal_point_segment_distance(double px_, double py_, double ax, double ay, double bx, double by)
+{
+    return tt__point_segment_distance(px_, py_, ax, ay, bx, by);
+}
+int internal_point_on_segment(double px_, double py_, double ax, double ay, double bx, double by)
+{
+    return tt__point_on_segment(px_, py_, ax, ay, bx, by);
+}
+int internal_segments_near(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy,
+                           double eps)
+{
+    return tt__segments_near(ax, ay, bx, by, cx, cy, dx, dy, eps);
+}
+int internal_segment_meets_polygon(const float a[2], const float b[2], const float *xy, int count)
+{
+    return tt__segment_meets_polygon(a, b, xy, count);
+}
+tt_result internal_hull_convex(const tt_image *patch, const tt_allocator *allocator, double **out_x, double **out_y,
+                               int *out_n)
+{
+    return tt__hull_convex(patch, allocator, out_x, out_y, out_n);
+}
+tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_allocator *allocator, float **out_xy,
+                              int *out_count)
+{
+    return tt__patch_hull(patch, max_vertices, allocator, out_xy, out_count);
+}
+
+/* ------------------------------------------------------------------------ */
+/* main                                                                     */
+/* ------------------------------------------------------------------------ */
+
+int main(void)
+{
+    run_common_tests();
+    run_mesh_tests();
+    run_image_tests();
+    run_numerics_tests();
+    run_raster_tests();
+    run_tiled_tests();
+    run_lapped_tests();
+    printf("%d passed, %d failed\n", g_passed, g_failed);
+    return g_failed ? 1 : 0;
+}

@@ -1,0 +1,160 @@
+/* tests/test_common.h - what the unit tests of tiledtex.h share: the check
+   framework, the counting and failing allocators, the allocation-failure
+   sweep, small helpers and the hand-made meshes and images that more than
+   one section file uses. Defined in tests/test_common.c, which is also the
+   one file that compiles the implementation (TILEDTEX_IMPLEMENTATION) and
+   holds main(). Plain C99, deterministic, reads no file. */
+#ifndef TEST_COMMON_H
+#define TEST_COMMON_H
+
+#include <stddef.h>
+
+#include "tiledtex.h"
+
+/* ------------------------------------------------------------------------ */
+/* Framework                                                                */
+/* ------------------------------------------------------------------------ */
+
+extern int g_passed, g_failed;
+extern const char *g_test;   /* the test RUN is running, for the reports */
+
+void check_report(int ok, const char *file, int line, const char *what, const char *fmt, ...);
+void check_detail(const char *file, int line, const char *fmt, ...);
+
+/* CHECK(cond, fmt, ...): fmt says what was expected and what came out. */
+#define CHECK(cond, ...) check_report((cond) ? 1 : 0, __FILE__, __LINE__, #cond, __VA_ARGS__)
+/* DETAIL(fmt, ...): the first offending case of a loop whose CHECK counts
+   the offenders; printed, not counted. */
+#define DETAIL(...) check_detail(__FILE__, __LINE__, __VA_ARGS__)
+#define RUN(fn) do { g_test = #fn; fn(); } while (0)
+
+/* One function per section file, RUNning its tests in the header's order;
+   main calls them in section order. */
+void run_common_tests(void);     /* tests/test_1_common.c */
+void run_mesh_tests(void);       /* tests/test_2_mesh.c */
+void run_image_tests(void);      /* tests/test_3_image.c */
+void run_numerics_tests(void);   /* tests/test_4_numerics.c */
+void run_raster_tests(void);     /* tests/test_5_raster.c */
+void run_tiled_tests(void);      /* tests/test_6_tiled.c */
+void run_lapped_tests(void);     /* tests/test_7_lapped.c */
+
+/* ------------------------------------------------------------------------ */
+/* Counting and failing allocators                                          */
+/* ------------------------------------------------------------------------ */
+
+typedef struct counter {
+    long live;          /* allocations not yet freed */
+    long calls;         /* alloc calls so far */
+    long fail_at;       /* fail the alloc call with this index (0-based); -1 = never */
+    long failures;      /* how many calls were failed */
+    long bad_frees;     /* frees of pointers we did not hand out */
+    size_t live_bytes;
+} counter;
+
+/* Resets *c and returns an allocator counting into it that fails its
+   allocation number fail_at (0-based; -1: never). */
+tt_allocator make_allocator(counter *c, long fail_at);
+
+/* ------------------------------------------------------------------------ */
+/* Allocation-failure sweep                                                 */
+/* ------------------------------------------------------------------------ */
+
+/* The call a sweep repeats: run the function under test with `allocator`,
+   free whatever it made, and return its result (or TT_RESULT_MAX_ENUM when
+   it broke its contract, e.g. an output not reset on failure). */
+typedef tt_result (*oom_call)(void *ctx, const tt_allocator *allocator);
+
+/* The allocator and counter every OOM sweep uses. Objects built through it
+   before a sweep (meshes whose own allocator is this one) stay live: a run
+   must leave `live` where it found it. oom_reset() zeroes the counter. */
+extern counter g_oom_counter;
+extern tt_allocator g_oom_allocator;
+void oom_reset(void);
+
+/* Run `call` with allocation k failing for k = 0, 1, ... until a run no
+   longer reaches allocation k. Four CHECKs: the last result is
+   expected_final, every run with a failed allocation returned
+   TT_ERROR_OUT_OF_MEMORY, no run leaked or freed a foreign pointer, and
+   there was at least one allocation. */
+void oom_sweep(const char *what, oom_call call, void *ctx, tt_result expected_final);
+
+/* ------------------------------------------------------------------------ */
+/* Small helpers                                                            */
+/* ------------------------------------------------------------------------ */
+
+int near(double a, double b, double tol);   /* |a - b| <= tol */
+
+/* A deterministic LCG for test data (one global state). */
+void lcg_seed(unsigned long long s);
+unsigned lcg_next(void);
+int lcg_below(int n);     /* in [0, n) */
+double lcg_unit(void);    /* in [0, 1) */
+
+/* Does `msg` contain the decimal number n as a whole token? */
+int msg_has_number(const char *msg, int n);
+
+/* ------------------------------------------------------------------------ */
+/* Hand-made meshes                                                         */
+/* ------------------------------------------------------------------------ */
+
+/* A growable polygon soup (malloc); zero-initialise, free with tm_free. */
+typedef struct tmesh {
+    float *pos;
+    int nv, cap_v;
+    int *idx;
+    int nc, cap_c;
+    int *sizes;
+    int nf, cap_f;
+} tmesh;
+
+void tm_free(tmesh *m);
+int tm_vert(tmesh *m, double x, double y, double z);   /* returns the new vertex */
+void tm_face(tmesh *m, int n, const int *v);
+void tm_tri(tmesh *m, int a, int b, int c);
+void tm_quad(tmesh *m, int a, int b, int c, int d);
+tt_mesh_desc tm_desc(const tmesh *m);   /* borrows m's arrays; flags 0, default allocator */
+
+/* Regular tetrahedron-ish: 4 vertices, 4 triangles, outward CCW. */
+void make_tetra(tmesh *m, double ox);
+/* nu x nv quads on a torus (nu, nv >= 3). Quad (i,j) is face j*nu + i. */
+void make_torus(tmesh *m, int nu, int nv, double R, double r);
+/* Open nx x ny grid of unit quads in the plane z = 0. */
+void make_grid(tmesh *m, int nx, int ny);
+
+/* tt_mesh_build of m with `flags` and the default allocator. */
+tt_result build(const tmesh *m, unsigned flags, tt_mesh **out, tt_error *err);
+
+/* ------------------------------------------------------------------------ */
+/* Images                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/* The RGBA texel (x, y) of im. */
+float *px(const tt_image *im, int x, int y);
+
+/* Photograph-like: value noise at 6, 13 and 29 texel scales plus grain. A row
+   of it looks different from its own mirror image, as rows of real textures
+   do, so tiles that do not belong together show (the seam test shuffles).
+   Creates im (w x h, opaque) with the default allocator; reseeds the LCG. */
+void make_value_noise(tt_image *im, int w, int h, unsigned seed);
+
+/* ------------------------------------------------------------------------ */
+/* Internal functions of the implementation the tests call                  */
+/* ------------------------------------------------------------------------ */
+
+/* The implementation's static tt__<name> functions, reachable only from the
+   file that compiles it; internal_<name> forwards to tt__<name>. */
+void internal_free(const tt_allocator *allocator, void *ptr);
+float internal_infinity(void);
+double internal_not_a_number(void);
+double internal_orient2(double ax, double ay, double bx, double by, double cx, double cy);
+double internal_point_segment_distance(double px_, double py_, double ax, double ay, double bx, double by);
+int internal_point_on_segment(double px_, double py_, double ax, double ay, double bx, double by);
+int internal_segments_near(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy,
+                           double eps);
+int internal_segment_meets_polygon(const float a[2], const float b[2], const float *xy, int count);
+tt_result internal_hull_convex(const tt_image *patch, const tt_allocator *allocator, double **out_x, double **out_y,
+                               int *out_n);
+tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_allocator *allocator, float **out_xy,
+                              int *out_count);
+
+#endif /* TEST_COMMON_H */
