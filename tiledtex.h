@@ -1,4 +1,4 @@
-/* tiledtex.h - v0.1.0 - texture any mesh from one example image, with no seams,
+/* tiledtex.h - v0.2.0 - texture any mesh from one example image, with no seams,
    no singularities and no visible repetition.   MIT license: see end of file.
 
    Do this in *one* C or C++ file before including this file:
@@ -9,11 +9,41 @@
    Other files just #include "tiledtex.h". Define TILEDTEX_STATIC as well to make
    every function static to that one file.
 
-   Optional overrides (define before the implementation; all or none):
-       TT_MALLOC(size, user_data)   default: the C library's malloc
-       TT_FREE(ptr, user_data)      default: the C library's free
-   Every allocation also honours the
-   tt_allocator you may pass in an options struct, so nothing here is global.
+   Optional overrides (define before the implementation):
+       TT_MALLOC(size, user_data)   default: the C library's malloc  } both
+       TT_FREE(ptr, user_data)      default: the C library's free    } or neither
+       TT_ASSERT(condition)         default: assert() from <assert.h>, so it is
+                                    off under NDEBUG; checks the preconditions
+                                    of the helpers that return no tt_result
+
+   THE API CONTRACT (true of every public function)
+     - Errors. A function that can fail returns tt_result (TT_OK == 0, errors
+       negative, tt_result_string() gives a sentence) and takes, as its last
+       parameter, an optional `tt_error *error` (NULL: no details). On failure
+       the error names the place it refers to (face, corner, vertex, matrix row
+       and column or texel, input item) and holds one sentence. Bad input of any
+       kind - NULL, out of range, NaN, infinity, sizes that overflow - gets a
+       specific result, never a crash and never TT_OK with a wrong answer.
+     - Helpers that cannot fail (tt_mesh_next, tt_face_normal, tt_tile_index,
+       tt_image_sample_bilinear, ...) return their answer directly; each states
+       its preconditions, and TT_ASSERT checks them.
+     - Memory. A function that allocates takes `const tt_allocator *allocator`
+       as the parameter before its outputs: NULL means TT_MALLOC / TT_FREE, and
+       an allocator must set both alloc and free (one without the other is
+       TT_ERROR_INVALID_ARGUMENT). Every allocation, temporary or returned, goes
+       through it and is freed on every error path. An object it returns
+       remembers its allocator.
+     - Ownership. Where the size of an output is known up front (per-corner UVs,
+       per-face vectors, a bake target) you pass the buffer; its size is stated
+       (a count such as mesh->ncorners, or a *_bound function). Where the
+       library must allocate, it returns one object through `T **out`, NULL on
+       failure, released by its one tt_T_free (NULL is fine to free).
+     - Options structs zero-initialised mean defaults; each default is written
+       next to its field. Long operations take a progress callback that can
+       cancel (TT_CANCELLED).
+     - No global or static mutable state: every function is reentrant and safe
+       to call from several threads on distinct outputs.
+     - The library never touches files.
 
    QUICK START: tile a quad mesh from a photo (Akleman et al.'s tiled textures)
 
@@ -21,25 +51,30 @@
        desc.positions = xyz; desc.nverts = nverts;              //   float xyz[3 * nverts]
        desc.indices = quads; desc.nfaces = nquads;              //   int quads[4 * nquads]
        desc.fixed_face_size = 4;
-       tt_mesh *mesh; tt_error err;
-       if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) { puts(err.message); return 1; }
+       tt_mesh *mesh; tt_image *photo; tt_tileset *tiles; tt_error err;
+       if (tt_mesh_build(&desc, NULL, &mesh, &err) != TT_OK) { puts(err.message); return 1; }
+       // 8-bit pixels from your image loader (stbi_load, say), sRGB-encoded:
+       tt_image_from_bytes(bytes, w, h, channels, 0, TT_COLOR_SRGB, NULL, &photo, &err);
        tt_tile_layout layout = {1, 128, TT_RECOMMENDED_GUTTER};  // n, tile size, gutter
-       tt_assign_boundaries(mesh, &layout, 42, types);           // uint8_t types[4 * nquads]
+       tt_assign_boundaries(mesh, &layout, 42, NULL, types, &err); // uint8_t types[4 * nquads]
        tt_assign_uvs(mesh, &layout, types, uv, &err);            // float uv[8 * nquads]: 2 per corner
-       tt_synth_options opt = {0};  opt.layout = layout;  tt_tileset *tiles;
-       tt_synthesize_tiles(&photo, &opt, &tiles, &err);          // tiles->levels[0]: the atlas
+       tt_synth_options opt = {0};  opt.layout = layout;
+       if (tt_synthesize_tiles(photo, &opt, NULL, &tiles, &err) != TT_OK) { puts(err.message); return 1; }
+       tt_image_to_rgba8(&tiles->levels[0], TT_COLOR_SRGB, rgba); // the atlas, W * W * 4 bytes
+       tt_tileset_free(tiles); tt_image_free(photo); tt_mesh_free(mesh);
 
    QUICK START: lapped textures on a triangle mesh (Praun et al.)
 
-       tt_tangent_field(mesh, NULL, field, &err);               // float field[3 * ntris]: up = +Y,
+       tt_tangent_field(mesh, NULL, NULL, field, &err);         // float field[3 * ntris]: up = +Y,
                                                                 //   length 0.1 * bbox diagonal
-       tt_image patch; tt_make_texture_patch(&photo, NULL, NULL, &patch, &err);
-       tt_lapped pastes = {0};
-       tt_lapped_paste(mesh, field, &patch, 1, NULL, &pastes, &err);
-       // draw pastes.pastes[p] in order, alpha-blended: faces pastes.faces[first..],
-       // corner UVs pastes.uv[6 * entry ..] into the patch; or bake them:
+       tt_image *patch; tt_lapped *pastes;
+       tt_make_texture_patch(photo, NULL, NULL, NULL, &patch, &err);
+       tt_lapped_paste(mesh, field, &patch, 1, NULL, NULL, &pastes, &err);
+       // draw pastes->pastes[p] in order, alpha-blended: faces pastes->faces[first..],
+       // corner UVs pastes->uv[6 * entry ..] into the patch; or bake them:
        tt_atlas_pack_pairs(mesh, 2048, 2, corner_uv, &err);      // float corner_uv[6 * ntris]
-       tt_lapped_bake(mesh, &pastes, &patch, 1, corner_uv, 2, &atlas, &err);
+       tt_lapped_bake(mesh, pastes, &patch, 1, corner_uv, NULL, NULL, atlas, &err);
+       tt_lapped_free(pastes); tt_image_free(patch);             // atlas: your 2048 x 2048 tt_image
 
    Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first
    (the per-corner outputs then line up with the quadrangulated mesh's corners:
@@ -54,24 +89,28 @@
        counter-clockwise seen from outside.
      - UV origin is the bottom-left of the image (OBJ / OpenGL). Images are stored
        with row 0 at the top (as image files are), so v = 1 - y / height.
-     - Images are float RGBA, nominally in [0,1]; the library does no colour-space
-       conversion, it blends the values you give it.
-     - Every fallible function returns tt_result (TT_OK == 0, errors negative). Pass
-       a tt_error* (may be NULL) to learn where: face, corner, vertex, and a sentence.
-     - No global or static mutable state: every function is reentrant, and safe to
-       call from several threads on distinct objects.
+     - tt_image holds linear-light RGBA floats, nominally in [0, 1]: blending,
+       feathering, filtering and mip averaging are done in linear light. Colour
+       photos arrive sRGB-encoded: convert them with tt_image_from_bytes(...,
+       TT_COLOR_SRGB, ...) and back with tt_image_to_rgba8. Data maps (normals,
+       roughness, height) are TT_COLOR_LINEAR and never converted.
 
    SECTIONS (each uses only the ones above it; read top to bottom)
-     1. Common  - results and errors, allocator hooks, seeded RNG
-     2. Mesh    - half-edge builder with validation, queries, quadrangulation
-     3. Image   - float RGBA images, bilinear sampling, 90-degree rotations,
-                  premultiplied `over`, box downsampling, minimum-error cut
+     1. Common  - results and errors, allocator hooks, asserts, seeded RNG,
+                  version, and the small tools every section shares
+     2. Mesh    - half-edge builder with validation, queries, quadrangulation,
+                  face normals
+     3. Image   - float RGBA images, colour spaces, bilinear sampling, 90-degree
+                  rotations, premultiplied `over`, box downsampling,
+                  minimum-error cut
      4. Numerics - triplets to CSR sparse matrices, Jacobi-preconditioned
                   conjugate gradients (symmetric positive definite systems)
      5. Raster  - 2D triangle rasterisation with barycentrics
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
-                - boundary assignment, UV formula, tile-set synthesis, quality report
+                - boundary assignment (random or prescribed), UV formula,
+                  tile-set synthesis as a plan applied to one or more images,
+                  quality report
      7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures")
                 - tangent field: texture up and scale per face (Sec. 3.2)
                 - texture patches with soft splotch masks (Sec. 3.1)
@@ -83,9 +122,9 @@
 #define TILEDTEX_H
 
 #define TILEDTEX_VERSION_MAJOR 0
-#define TILEDTEX_VERSION_MINOR 1
+#define TILEDTEX_VERSION_MINOR 2
 #define TILEDTEX_VERSION_PATCH 0
-#define TILEDTEX_VERSION_STRING "0.1.0"
+#define TILEDTEX_VERSION_STRING "0.2.0"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -117,27 +156,29 @@ typedef enum tt_result {
     TT_ERROR_OUT_OF_MEMORY = -3,
     TT_ERROR_TOO_LARGE = -4,                /* a size would overflow or exceed a documented limit */
     TT_ERROR_EMPTY_MESH = -5,               /* no faces */
-    TT_ERROR_INDEX_OUT_OF_RANGE = -6,       /* a corner names a vertex that does not exist */
+    TT_ERROR_INDEX_OUT_OF_RANGE = -6,       /* an index names something that does not exist */
     TT_ERROR_FACE_TOO_SMALL = -7,           /* a face with fewer than 3 corners */
     TT_ERROR_REPEATED_VERTEX = -8,          /* a face uses one vertex twice */
-    TT_ERROR_NON_FINITE = -9,               /* NaN or infinite coordinate */
+    TT_ERROR_NON_FINITE = -9,               /* a NaN or infinite input value, or an overflow */
     TT_ERROR_ZERO_AREA_FACE = -10,          /* a face whose corners are collinear or coincide */
     TT_ERROR_NON_MANIFOLD_EDGE = -11,       /* an edge shared by more than two faces */
     TT_ERROR_INCONSISTENT_ORIENTATION = -12,/* two faces use an edge in the same direction */
     TT_ERROR_NON_MANIFOLD_VERTEX = -13,     /* the faces around a vertex form more than one fan */
     TT_ERROR_NOT_QUAD_MESH = -14,           /* this step needs quads; quadrangulate first */
     TT_ERROR_IMAGE_TOO_SMALL = -15,         /* the image cannot hold the requested windows */
-    TT_ERROR_NOT_CONVERGED = -16,          /* an iterative solver hit its iteration cap first */
-    TT_ERROR_NOT_POSITIVE_DEFINITE = -17,  /* a matrix that must be positive definite is not */
+    TT_ERROR_NOT_CONVERGED = -16,           /* an iterative method hit its limit first */
+    TT_ERROR_NOT_POSITIVE_DEFINITE = -17,   /* a matrix that must be positive definite is not */
+    TT_ERROR_NOT_MEASURED = -18,            /* a measure found nothing it could measure */
     TT_RESULT_MAX_ENUM = 0x7fffffff
 } tt_result;
 
-/* A sentence describing a result code (static storage, never NULL). */
+/* A sentence describing a result code (static storage, never NULL). It fits
+   every function that returns the code; tt_error::message says more. */
 TTDEF const char *tt_result_string(tt_result result);
 
-/* Where an error happened. Fields that do not apply are -1. `message` is a
-   complete sentence such as "face 12 (corners 48..51) uses vertex 1033, but the
-   mesh has 1000 vertices". */
+/* Where an error happened. Fields that do not apply are -1. `message` is one
+   complete sentence such as "face 12 (corners 48..51) uses vertex 1033, but
+   the mesh has 1000 vertices"; numbers in it are printed compactly. */
 typedef struct tt_error {
     tt_result result;
     int face;
@@ -145,20 +186,31 @@ typedef struct tt_error {
     int vertex;
     int other_vertex;   /* the second end of an edge, for edge errors */
     int other_face;     /* a second face on that edge, for edge errors */
+    int row, column;    /* a matrix entry, a row of a linear system, or an image texel (row y, column x) */
+    int item;           /* the offending element of an input array that is not a face, corner or
+                           vertex: a triplet, a constraint, a paste entry, a texture patch */
     char message[224];
 } tt_error;
 
-/* Allocation hooks. Leave zeroed to use TT_MALLOC / TT_FREE. `alloc` returns
-   memory suitably aligned for any type, or NULL. */
+/* Allocation hooks (see THE API CONTRACT): both alloc and free, or pass NULL
+   for TT_MALLOC / TT_FREE. `alloc` returns memory suitably aligned for any
+   type, or NULL. */
 typedef struct tt_allocator {
     void *(*alloc)(size_t size, void *user_data);
     void (*free)(void *ptr, void *user_data);
     void *user_data;
 } tt_allocator;
 
-/* Progress callback for long operations: `fraction` runs from 0 to 1. Return
-   non-zero to cancel; the operation then cleans up and returns TT_CANCELLED. */
+/* Progress callback for long operations: `fraction` runs from 0 to 1 and
+   never decreases. Return non-zero to cancel; the operation then cleans up
+   and returns TT_CANCELLED. */
 typedef int (*tt_progress_fn)(float fraction, void *user_data);
+
+/* The library's version at run time, which may differ from the
+   TILEDTEX_VERSION_* macros your code was compiled with when the
+   implementation lives in another file: the string, and the numbers through
+   the pointers that are not NULL. */
+TTDEF const char *tt_version(int *major, int *minor, int *patch);
 
 /* Seeded random numbers (PCG32). Integer arithmetic only, so the same seed gives
    the same sequence on every machine and compiler. Not for cryptography. */
@@ -197,7 +249,6 @@ typedef struct tt_mesh_desc {
     int nfaces;
     int fixed_face_size;        /* used when face_sizes is NULL; 0 means 3 */
     unsigned flags;             /* TT_MESH_* */
-    tt_allocator allocator;     /* zeroed: TT_MALLOC / TT_FREE */
 } tt_mesh_desc;
 
 /* A polygon mesh as half-edges. Read the arrays freely; do not modify them.
@@ -215,7 +266,7 @@ typedef struct tt_mesh {
     int min_face_size, max_face_size;
     int repaired_edges;         /* TT_MESH_PERMISSIVE only: edges turned into boundaries */
     unsigned flags;
-    tt_allocator allocator;
+    tt_allocator allocator;     /* the one it was built with */
 } tt_mesh;
 
 /* Build a half-edge mesh and validate it. On failure *out_mesh is NULL and the
@@ -226,10 +277,12 @@ typedef struct tt_mesh {
    with the smallest corner first (shared by more than two faces, or used twice
    in the same direction), then vertices (faces forming several fans).
    Twin pairing is O(corners log valence). Free the mesh with tt_mesh_free. */
-TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_error *error);
+TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allocator, tt_mesh **out_mesh,
+                              tt_error *error);
 TTDEF void tt_mesh_free(tt_mesh *mesh);
 
-/* Index of the corner after / before c in its face. */
+/* Index of the corner after / before c in its face.
+   Preconditions (TT_ASSERT): mesh is not NULL, 0 <= corner < mesh->ncorners. */
 TTDEF int tt_mesh_next(const tt_mesh *mesh, int corner);
 TTDEF int tt_mesh_prev(const tt_mesh *mesh, int corner);
 
@@ -245,21 +298,28 @@ typedef struct tt_mesh_stats {
     int nonmanifold_vertices;   /* only possible with TT_MESH_PERMISSIVE */
 } tt_mesh_stats;
 
-/* Topology summary. Allocates temporary memory through the mesh's allocator. */
-TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, tt_mesh_stats *stats);
+/* Topology summary (temporary memory only). Errors: NULL mesh or stats, a bad
+   allocator (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY. */
+TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, const tt_allocator *allocator, tt_mesh_stats *stats,
+                                      tt_error *error);
 
-/* Number of edges at vertex v (0 for an unused vertex). */
+/* Number of edges at vertex v (0 for an unused vertex).
+   Preconditions (TT_ASSERT): mesh is not NULL, 0 <= vertex < mesh->nverts. */
 TTDEF int tt_mesh_valence(const tt_mesh *mesh, int vertex);
 
 /* histogram[k] = number of used vertices of valence k for k < nbins-1; the last
-   bin counts every valence >= nbins-1. */
-TTDEF tt_result tt_mesh_valence_histogram(const tt_mesh *mesh, int *histogram, int nbins);
+   bin counts every valence >= nbins-1. nbins >= 1. */
+TTDEF tt_result tt_mesh_valence_histogram(const tt_mesh *mesh, const tt_allocator *allocator, int *histogram,
+                                          int nbins, tt_error *error);
 
-/* face_component[f] = component id (0..n-1, numbered in order of first face). */
-TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, int *face_component, int *ncomponents);
+/* face_component[f] = component id (0..n-1, numbered in order of first face);
+   face_component has mesh->nfaces entries. */
+TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, const tt_allocator *allocator, int *face_component,
+                                   int *ncomponents, tt_error *error);
 
-/* corner_loop[c] = boundary loop id of boundary half-edge c, -1 for interior ones. */
-TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, int *nloops);
+/* corner_loop[c] = boundary loop id of boundary half-edge c, -1 for interior
+   ones; corner_loop has mesh->ncorners entries. Allocates nothing. */
+TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, int *nloops, tt_error *error);
 
 typedef enum tt_subdivision {
     TT_SUBDIVIDE_LINEAR = 0,        /* new points on the old faces: the shape is kept */
@@ -272,8 +332,15 @@ typedef enum tt_subdivision {
    (edges in order of their first half-edge), then face points. Repeat it to make
    the faces smaller (it is how you choose the texture's scale on the surface).
    The result inherits the input's flags (without BORROW_POSITIONS). */
-TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme,
+TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error);
+
+/* Unit normal of face f by Newell's method (the normal of the best-fit plane,
+   so non-planar polygons are fine), CCW seen from outside. A face of
+   numerically zero area (as tt_mesh_build judges it) gets (0,0,0).
+   Preconditions (TT_ASSERT): mesh and normal are not NULL,
+   0 <= face < mesh->nfaces. */
+TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3]);
 
 /* ======================================================================== */
 /* 3. Image                                                                 */
@@ -282,68 +349,103 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
 /* Width or height above this is refused with TT_ERROR_TOO_LARGE. */
 #define TT_MAX_IMAGE_SIZE 32768
 
-/* Float RGBA, row-major, row 0 at the top. Colours may be straight or
-   premultiplied by alpha: each function says which it expects. */
+/* Float RGBA, row-major, row 0 at the top, in linear light (see CONVENTIONS).
+   Colours may be straight or premultiplied by alpha: each function says which
+   it expects. Images the library creates come from tt_image_create and its
+   kin and are freed with tt_image_free. You may also fill this struct
+   yourself to hand the library your own pixels (a view): leave `allocator`
+   zeroed and never pass a view to tt_image_free. */
 typedef struct tt_image {
     int width, height;
     float *pixels;              /* 4 * width * height */
-    tt_allocator allocator;
+    tt_allocator allocator;     /* the one it was created with */
 } tt_image;
 
-/* Allocate a zero-filled image (transparent black). */
-TTDEF tt_result tt_image_create(tt_image *image, int width, int height, const tt_allocator *allocator);
+/* How 8-bit values encode colour. */
+typedef enum tt_color_space {
+    TT_COLOR_SRGB = 0,          /* colour photos and albedo maps: sRGB transfer curve on r, g, b
+                                   (IEC 61966-2-1); alpha is always linear */
+    TT_COLOR_LINEAR = 1         /* data maps (normals, roughness, height, masks): v / 255 as is */
+} tt_color_space;
+
+/* The sRGB transfer curve and its inverse, on values in [0, 1] (clamped). */
+TTDEF float tt_srgb_to_linear(float encoded);
+TTDEF float tt_linear_to_srgb(float linear);
+
+/* A zero-filled image (transparent black). Errors: sizes below 1
+   (TT_ERROR_INVALID_ARGUMENT) or above TT_MAX_IMAGE_SIZE (TT_ERROR_TOO_LARGE),
+   a bad allocator, TT_ERROR_OUT_OF_MEMORY. One allocation holds the struct and
+   its pixels. */
+TTDEF tt_result tt_image_create(int width, int height, const tt_allocator *allocator, tt_image **out_image,
+                                tt_error *error);
+/* Free an image the library created (NULL is fine). */
 TTDEF void tt_image_free(tt_image *image);
 
-/* From 8-bit pixels with 1 (grey), 2 (grey+alpha), 3 (RGB) or 4 (RGBA) channels,
-   `stride` bytes per row (0 = width*channels). Values become v/255. */
-TTDEF tt_result tt_image_from_bytes(tt_image *image, const unsigned char *data, int width, int height,
-                                    int channels, int stride, const tt_allocator *allocator);
-/* To 8-bit RGBA, width*height*4 bytes, rounded and clamped; exact inverse of
-   tt_image_from_bytes for values that came from bytes. */
-TTDEF void tt_image_to_rgba8(const tt_image *image, unsigned char *out);
+/* From 8-bit pixels with 1 (grey), 2 (grey+alpha), 3 (RGB) or 4 (RGBA)
+   channels, `stride` bytes per row (0 = width * channels; otherwise at least
+   that). r, g, b are decoded from `space` into linear light (alpha: v / 255).
+   Bytes -> linear -> bytes (tt_image_to_rgba8, same space) is exact. */
+TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int height, int channels, int stride,
+                                    tt_color_space space, const tt_allocator *allocator, tt_image **out_image,
+                                    tt_error *error);
+/* To 8-bit RGBA, width * height * 4 bytes: r, g, b encoded into `space`
+   (straight alpha: pass an un-premultiplied image), everything rounded to
+   the nearest byte and clamped to [0, 255]; NaN becomes 0.
+   Preconditions (TT_ASSERT): image, its pixels and out are not NULL. */
+TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out);
 
 /* Bilinear sample at continuous pixel coordinates: texel (i, j) covers
-   [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5). Clamps to the edge. */
+   [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5). Clamps to the edge.
+   Preconditions (TT_ASSERT): image has pixels and a size of at least 1 x 1. */
 TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4]);
 
 /* Where pixel (x, y) of a width x height image lands after `quarter_turns`
    counter-clockwise quarter turns (as the picture is seen, row 0 on top).
-   Works for coordinates outside the image too (it is an affine map). */
+   Works for coordinates outside the image too (it is an affine map).
+   Preconditions (TT_ASSERT): out_x and out_y are not NULL, and the result
+   fits an int (|x|, |y|, width, height below 2^30 always do). */
 TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y);
 
-/* dst = src turned counter-clockwise by quarter_turns * 90 degrees (any integer,
-   negative = clockwise). dst is created (sizes swap for odd turns); it must not
-   already hold an image. */
-TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, tt_image *dst, const tt_allocator *allocator);
+/* *dst = src turned counter-clockwise by quarter_turns * 90 degrees (any
+   integer, negative = clockwise); sizes swap for odd turns. */
+TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const tt_allocator *allocator,
+                                  tt_image **out_image, tt_error *error);
 
 /* Porter-Duff `over` on premultiplied RGBA: dst = src + (1 - src.a) * dst.
-   alpha 1 gives src exactly and alpha 0 leaves dst exactly. Same sizes. */
-TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src);
+   alpha 1 gives src exactly and alpha 0 leaves dst exactly. Same sizes
+   (TT_ERROR_INVALID_ARGUMENT otherwise). */
+TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *error);
+/* The same on one pixel. Preconditions (TT_ASSERT): neither is NULL. */
 TTDEF void tt_rgba_over(float dst[4], const float src_premultiplied[4]);
 
-/* dst = src halved by 2x2 box filter (width and height must be even). */
-TTDEF tt_result tt_image_downsample2(const tt_image *src, tt_image *dst, const tt_allocator *allocator);
+/* *dst = src halved by a 2x2 box filter (width and height must be even; in
+   linear light, so a black and white checkerboard becomes sRGB 188, not 128). */
+TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *allocator, tt_image **out_image,
+                                     tt_error *error);
 
 /* Minimum-error cut (as in image quilting): in a width x height cost map, find
    the path path[x] (one row per column) with path[x] in [lo[x], hi[x]] and
    |path[x] - path[x-1]| <= 1 that minimises the sum of cost[path[x]*width + x].
    Ties go to the smaller row. Needs lo[x] <= hi[x] and consecutive ranges
-   that a path can follow; returns TT_ERROR_INVALID_ARGUMENT otherwise. */
+   that a path can follow (TT_ERROR_INVALID_ARGUMENT otherwise, naming the
+   column); a NaN cost is TT_ERROR_NON_FINITE. path has width entries. */
 TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
-                                 int *path, const tt_allocator *allocator);
+                                 const tt_allocator *allocator, int *path, tt_error *error);
 
 /* ======================================================================== */
 /* 4. Numerics                                                              */
 /* ======================================================================== */
 
-/* Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
-   Sec. 3.4: a patch's parametrization is the least-squares solution of a
-   sparse linear system, solved by conjugate gradients from the patch's
-   initial parametrization. The solver here is the Jacobi (diagonal)
-   preconditioned conjugate gradient method for symmetric positive definite
-   systems, with the formulas of Shewchuk, "An Introduction to the Conjugate
-   Gradient Method Without the Agonizing Pain" (edition 1 1/4, 1994), Sec. 12
-   and the preconditioned algorithm of its Appendix B3 (M = diag(A)):
+/* Sparse linear systems. The pipelines that flatten a piece of surface into
+   the plane solve least-squares problems whose normal equations are sparse,
+   symmetric and positive definite: lapped textures align each paste with the
+   tangent field (Praun et al. Sec. 3.4), hierarchical pattern mapping
+   flattens each face cluster (Soler et al. Sec. 3.2). Such a system is
+   assembled as triplets, compressed into rows (CSR) and solved by the Jacobi
+   (diagonal) preconditioned conjugate gradient method, with the formulas of
+   Shewchuk, "An Introduction to the Conjugate Gradient Method Without the
+   Agonizing Pain" (edition 1 1/4, 1994), Sec. 12 and the preconditioned
+   algorithm of its Appendix B3 (M = diag(A)):
 
        r0 = b - A x0,   z0 = M^-1 r0,   p0 = z0
        alpha_k = (r_k . z_k) / (p_k . A p_k)
@@ -351,12 +453,15 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
        z_k+1 = M^-1 r_k+1
        beta_k = (r_k+1 . z_k+1) / (r_k . z_k),   p_k+1 = z_k+1 + beta_k p_k
 
-   stopping when |r| <= tolerance * |b| (Euclidean norms), and confirming it
-   with a freshly computed b - A x (Shewchuk Sec. 11) before reporting success.
+   stopping when |r| <= tolerance * |b| (Euclidean norms, computed with a
+   scale so that no |b_i| of any finite size overflows or underflows them),
+   and confirming it with a freshly computed b - A x (Shewchuk Sec. 11)
+   before reporting success.
 
-   Errors about a matrix entry put its row in tt_error::vertex and its column in
-   tt_error::other_vertex (the mesh systems have one unknown per vertex); the
-   message names them as row and column. Other tt_error fields are -1. */
+   Errors about a matrix entry give its row and column in tt_error::row and
+   tt_error::column, errors about a triplet its position in tt_error::item,
+   errors about an unknown or a right-hand side value its index in
+   tt_error::row. */
 
 /* One entry of a sparse matrix being assembled: A[row][col] += value. */
 typedef struct tt_triplet {
@@ -385,31 +490,33 @@ typedef struct tt_sparse_matrix {
    Triplets naming the same entry are summed, in the order given (so the result
    is the same on every run); entries that sum to zero are kept (the pattern is
    what the triplets name). Rows without triplets are empty. Fails, with
-   *matrix zeroed and nothing left allocated, on:
-     TT_ERROR_INDEX_OUT_OF_RANGE  a triplet outside the matrix (message names
-                                  the triplet, its row and column),
-     TT_ERROR_NON_FINITE          a NaN or infinite value,
-     TT_ERROR_INVALID_ARGUMENT    NULL matrix, negative sizes, triplets NULL
-                                  while ntriplets > 0,
+   *out_matrix NULL and nothing left allocated, on:
+     TT_ERROR_INDEX_OUT_OF_RANGE  a triplet outside the matrix (error->item,
+                                  row and column name it),
+     TT_ERROR_NON_FINITE          a NaN or infinite value, or triplets of one
+                                  entry whose sum overflows to infinity
+                                  (error->row, column),
+     TT_ERROR_INVALID_ARGUMENT    NULL out_matrix, negative sizes, triplets
+                                  NULL while ntriplets > 0, a bad allocator,
      TT_ERROR_TOO_LARGE           byte counts that overflow size_t,
      TT_ERROR_OUT_OF_MEMORY.
    Time O(ntriplets + rows + cols) (two stable bucket passes); memory: the
    result (12 bytes per entry + 4 per row) plus 8 bytes per triplet and 4 per
-   row or column of temporary space. The arrays come from `allocator` (NULL or
-   zeroed: TT_MALLOC / TT_FREE); free them with tt_sparse_free. Thread-safe:
-   reads only the triplets. */
-TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int cols, const tt_triplet *triplets,
-                                        int ntriplets, const tt_allocator *allocator, tt_error *error);
+   row or column of temporary space. Free the matrix with tt_sparse_free.
+   Thread-safe: reads only the triplets. */
+TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,
+                                        const tt_allocator *allocator, tt_sparse_matrix **out_matrix,
+                                        tt_error *error);
 
-/* Release a matrix made by tt_sparse_from_triplets and zero the struct.
-   NULL and zeroed matrices are fine. */
+/* Release a matrix made by tt_sparse_from_triplets (NULL is fine; never a
+   struct you filled yourself). */
 TTDEF void tt_sparse_free(tt_sparse_matrix *matrix);
 
 /* y = A x: x has A->cols entries, y gets A->rows. x and y must not overlap
    (x == y is refused with TT_ERROR_INVALID_ARGUMENT). The CSR arrays are
    trusted (tt_cg_solve checks them, this does not). Does not allocate;
    thread-safe for distinct y. */
-TTDEF tt_result tt_sparse_multiply(const tt_sparse_matrix *A, const double *x, double *y);
+TTDEF tt_result tt_sparse_multiply(const tt_sparse_matrix *A, const double *x, double *y, tt_error *error);
 
 typedef struct tt_cg_options {
     int max_iterations;         /* cap on CG steps; 0 = max(2 * n, 100) for an n x n system */
@@ -423,7 +530,6 @@ typedef struct tt_cg_options {
        log(residual) / log(tolerance). Non-zero return cancels. May be NULL. */
     tt_progress_fn progress;
     void *progress_user_data;
-    tt_allocator allocator;     /* for the scratch vectors; zeroed: TT_MALLOC / TT_FREE */
 } tt_cg_options;
 
 typedef struct tt_cg_report {
@@ -434,10 +540,13 @@ typedef struct tt_cg_report {
 
 /* Solve A x = b for a symmetric positive definite n x n A by Jacobi
    preconditioned conjugate gradients (see the section comment).
-     b   n values, read only; must not overlap x.
+     b   n values, read only; must not overlap x. Any finite values: the
+         norms are scaled, so b = (1e155, 1) or entries of 1e-200 are solved
+         like any other.
      x   n values: in, the initial guess (warm start; zeros if you have none),
          out, the solution. It must be finite.
-     options, report, error may be NULL (defaults; no report; no details).
+     options, allocator (for 4 n scratch doubles), report, error may be NULL
+     (defaults; TT_MALLOC; no report; no details).
      report is filled on every return; before any step it reads
      {0, 0.0, 0} (converged = 1 for b = 0 or an x0 that already solves).
    Returns
@@ -448,8 +557,9 @@ typedef struct tt_cg_report {
                                     row: before any work, x untouched), or the
                                     iteration broke down with p . A p <= 0
                                     (x is the last iterate);
-     TT_ERROR_NON_FINITE            NaN or infinity in A, b or x (names the
-                                    row), or an overflow during the iteration;
+     TT_ERROR_NON_FINITE            NaN or infinity in A, b or x (error->row
+                                    names it), or an overflow during the
+                                    iteration;
      TT_ERROR_INVALID_ARGUMENT      NULL pointers, b == x, A not square or its
                                     row_start array inconsistent, negative
                                     max_iterations or tolerance;
@@ -465,8 +575,8 @@ typedef struct tt_cg_report {
    two fused passes over the vectors; one more product confirms the result.
    Thread-safe: several threads may solve with the same A and b into
    distinct x. */
-TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, double *x, const tt_cg_options *options,
-                            tt_cg_report *report, tt_error *error);
+TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, const tt_cg_options *options,
+                            const tt_allocator *allocator, double *x, tt_cg_report *report, tt_error *error);
 
 /* ======================================================================== */
 /* 5. Raster                                                                */
@@ -479,7 +589,10 @@ typedef void (*tt_raster_fn)(int x, int y, const float barycentric[3], void *use
 /* Visit the pixels of a width x height grid whose centres lie inside the 2D
    triangle xy = {x0,y0, x1,y1, x2,y2} (either winding). A centre exactly on an
    edge belongs to the triangle only if that edge is a top or left edge, so
-   triangles sharing an edge never both draw a pixel and leave no gap. */
+   triangles sharing an edge never both draw a pixel and leave no gap. An empty
+   grid, a degenerate triangle or a non-finite or huge coordinate (beyond
+   2^21 pixels) visits nothing. Preconditions (TT_ASSERT): xy and fn are not
+   NULL. */
 TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raster_fn fn, void *user_data);
 
 /* ======================================================================== */
@@ -507,28 +620,42 @@ typedef struct tt_tile_layout {
    TT_MAX_IMAGE_SIZE (TT_ERROR_TOO_LARGE otherwise; TT_ERROR_INVALID_ARGUMENT
    for the others). Resolving a resolved layout changes nothing. */
 TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error);
-/* For a resolved layout: tiles per atlas side T, atlas side W, total tiles (2n)^4. */
+/* For a resolved layout: tiles per atlas side T, atlas side W, total tiles
+   (2n)^4. A layout that tt_tile_layout_resolve would refuse gives 0 (and
+   fails TT_ASSERT); zeros in it mean defaults, as everywhere. */
 TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout);
 TTDEF int tt_tile_layout_atlas_size(const tt_tile_layout *layout);
 TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout);
 
 /* Akleman et al. Sec. 3 / 6, AssignBoundaries: every edge gets a condition k in
-   [0, n) and a side i in {0, 1} from the seeded RNG; one half-edge gets type
-   2k+i, its twin 2k+1-i. Boundary half-edges get a type too. Works on any mesh.
-   corner_type has mesh->ncorners entries, aligned with the index buffer. Only
-   layout->colors is read (0 = 1). Returns TT_ERROR_INVALID_ARGUMENT for NULL
-   mesh or corner_type, or colors outside 1..TT_MAX_COLORS; TT_OK otherwise. */
+   [0, n) and a side i in {0, 1}; one half-edge gets type 2k+i, its twin
+   2k+1-i. Boundary half-edges get a type too. Works on any mesh.
+     edge_colors  NULL: every k from the seeded RNG. Otherwise mesh->ncorners
+                  entries: the condition k of the edge of half-edge c, or -1
+                  to draw it at random; both half-edges of an edge must say
+                  the same (a polycube's per-axis palettes, say). The side i
+                  always comes from the RNG.
+     corner_type  mesh->ncorners entries out, aligned with the index buffer.
+   Only layout->colors is read (0 = 1). Same seed and inputs, same result.
+   Errors: NULL mesh, layout or corner_type, colors outside 1..TT_MAX_COLORS
+   (TT_ERROR_INVALID_ARGUMENT); a prescribed colour outside -1..n-1
+   (TT_ERROR_INDEX_OUT_OF_RANGE) or twins that disagree
+   (TT_ERROR_INVALID_ARGUMENT), naming the corner. */
 TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
-                                     uint8_t *corner_type);
+                                     const int *edge_colors, uint8_t *corner_type, tt_error *error);
 
 /* Tile of a quad whose half-edges have types e0..e3 (bottom, right, top, left):
    column = 2n*e0 + e1, row = 2n*e2 + e3 (row 0 at the bottom of the atlas);
-   returns row * T + column. */
+   returns row * T + column.
+   Preconditions (TT_ASSERT): layout and types are not NULL, layout->colors
+   in 0..TT_MAX_COLORS (0 = 1), every type below 2n. */
 TTDEF int tt_tile_index(const tt_tile_layout *layout, const uint8_t types[4]);
 
 /* UV of corner i (0..3) of the tile with types e0..e3 (Akleman Sec. 3 with n
    conditions and gutters): j = ((i+1) mod 4) / 2,
-       u = (column*C + g + j*S) / W,   v = (row*C + g + (i/2)*S) / W. */
+       u = (column*C + g + j*S) / W,   v = (row*C + g + (i/2)*S) / W.
+   Preconditions (TT_ASSERT): as tt_tile_index, a layout that resolves, and
+   0 <= corner < 4. */
 TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4], int corner, float uv[2]);
 
 /* AssignTextureCoordinates: corner_uv gets 2 * mesh->ncorners floats. Every face
@@ -555,7 +682,6 @@ typedef struct tt_synth_options {
     int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16) */
     tt_progress_fn progress;
     void *progress_user_data;
-    tt_allocator allocator;
 } tt_synth_options;
 
 #define TT_MAX_MIP_LEVELS 16
@@ -571,7 +697,7 @@ typedef struct tt_tileset {
     tt_image levels[TT_MAX_MIP_LEVELS];
     tt_rect *edge_windows;          /* colors rects actually used (w = S, h = 2S) */
     tt_rect *background_windows;    /* one per tile, indexed like tt_tile_index */
-    tt_allocator allocator;
+    tt_allocator allocator;         /* the one it was made with */
 } tt_tileset;
 
 /* Akleman Sec. 4, tile-set synthesis: every tile ABCD = AXXX over XBXX over XXCX
@@ -580,42 +706,66 @@ typedef struct tt_tileset {
    two agree (minimum-error cut) and feathered, and every texel of a tile's edge
    rows except the two corner texels is the edge sample alone, exactly. Gutters
    hold what lies across each edge on the surface. Needs a source of at least
-   S x 2S texels. A feather wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT.
-   Free with tt_tileset_free. */
+   S x 2S texels (TT_ERROR_IMAGE_TOO_SMALL) and finite texels
+   (TT_ERROR_NON_FINITE names the first other one by row and column). A
+   feather wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT. Free with
+   tt_tileset_free. */
 TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
-                                    tt_tileset **out_tileset, tt_error *error);
+                                    const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error);
 TTDEF void tt_tileset_free(tt_tileset *tileset);
 
 /* Seam measure across every interior edge (the project's acceptance measure):
    at points along the edge, sample the atlas just inside each of the two faces,
    half a texel from the edge; compare with two samples the same distance apart
    inside one face, and with samples from two unrelated edges. Differences are
-   mean absolute RGB differences of bilinear samples.
+   mean absolute differences of bilinear samples of r, g, b as displayed
+   (sRGB-encoded, in [0, 1]), so the thresholds mean what the eye sees.
    score = (seam - same_face) / (unrelated - same_face): about 0 when an edge
    looks like any other place in the image, about 1 when tiles do not match.
    When unrelated places differ no more than neighbours do (pure noise at the
    texel scale) the score means nothing and is NaN; read seam - same_face. */
+typedef struct tt_seam_options {
+    uint64_t seed;          /* picks the sample positions, unrelated pairs and sampled edges */
+    /* 0: every interior edge (the acceptance measure). Otherwise at most this
+       many edges, drawn at random without replacement: an estimate for quick
+       reports (with 20000 edges it stays within about 0.01 of the full score). */
+    int max_edges;
+} tt_seam_options;
+
 typedef struct tt_seam_report {
-    double seam;
-    double same_face;
-    double unrelated;
-    double score;
-    int edges_measured;
+    double seam;            /* mean difference across edges */
+    double same_face;       /* the same distance apart inside one face */
+    double unrelated;       /* between unrelated edges */
+    double score;           /* NaN when unrelated - same_face <= 1e-9 (see above) */
+    int edges_measured;     /* interior edges that gave at least one sample */
+    long long samples;
 } tt_seam_report;
 
-/* Works on any mesh with per-corner UVs (2 * ncorners floats) and any atlas;
-   `seed` picks the sample positions and unrelated pairs. */
+/* Works on any mesh with per-corner UVs (2 * ncorners floats) and any atlas.
+   options may be NULL (every edge, seed 0). Not measured reads as not
+   measured: when no sample could be taken (no interior edge, fewer than two,
+   or every edge of zero length or non-finite UVs) the result is
+   TT_ERROR_NOT_MEASURED and the report is zero with score NaN. Other errors:
+   NULL pointers or an empty atlas (TT_ERROR_INVALID_ARGUMENT), a negative
+   max_edges, TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
-                                 uint64_t seed, tt_seam_report *report);
+                                 const tt_seam_options *options, const tt_allocator *allocator,
+                                 tt_seam_report *report, tt_error *error);
 
-/* counts[t] = number of quads using tile t (tt_tile_layout_tile_count entries). */
+/* counts[t] = number of quads using tile t (tt_tile_layout_tile_count entries).
+   Errors: NULL pointers, a layout that does not resolve
+   (TT_ERROR_INVALID_ARGUMENT), a face that is not a quad
+   (TT_ERROR_NOT_QUAD_MESH, naming it), a type of 2n or more
+   (TT_ERROR_INDEX_OUT_OF_RANGE, naming the corner). */
 TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
-                                  int *counts);
+                                  int *counts, tt_error *error);
 
 /* stretch[f] = ratio of the larger to the smaller singular value of face f's
    surface -> texture map (1 = no stretch), taken at the face's centre; faces
-   with a degenerate map get INFINITY. nfaces floats. */
-TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch);
+   with a degenerate map get INFINITY. nfaces floats. Errors: NULL pointers
+   (TT_ERROR_INVALID_ARGUMENT), a non-finite UV (TT_ERROR_NON_FINITE, naming
+   the corner). */
+TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch, tt_error *error);
 
 /* ======================================================================== */
 /* 7. Lapped textures                                                       */
@@ -654,13 +804,7 @@ typedef struct tt_field_options {
     const tt_field_constraint *constraints;     /* nconstraints entries, or NULL when 0 */
     int nconstraints;
     float sigma;        /* default Gaussian extent (mesh units); 0 = TT_DEFAULT_FIELD_SIGMA * diagonal */
-    tt_allocator allocator;     /* zeroed: the mesh's allocator */
 } tt_field_options;
-
-/* Unit normal of face f by Newell's method (the normal of the best-fit plane,
-   so non-planar polygons are fine), CCW seen from outside. A face of
-   numerically zero area (as tt_mesh_build judges it) gets (0,0,0). */
-TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3]);
 
 /* The tangent field of Sec. 3.2. face_vectors gets 3 * mesh->nfaces floats,
    T_f = face_vectors[3f .. 3f+2], in the plane of face f (|T.N| ~ 1e-7 |T|).
@@ -710,11 +854,11 @@ TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3]);
    perpendicular (projects to under 1e-3 of its length) vector or a negative
    sigma or weight: TT_ERROR_INVALID_ARGUMENT; a non-finite one:
    TT_ERROR_NON_FINITE; a constraint on a zero-area face:
-   TT_ERROR_ZERO_AREA_FACE. The message names the constraint. Temporary
-   memory goes through the allocator and is freed on every path.
+   TT_ERROR_ZERO_AREA_FACE. Every constraint error names the constraint in
+   error->item (and its face in error->face). Temporary memory only.
    Deterministic; reentrant and thread-safe on distinct outputs. */
-TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options, float *face_vectors,
-                                 tt_error *error);
+TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
+                                 const tt_allocator *allocator, float *face_vectors, tt_error *error);
 
 /* Texture patches.
    Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
@@ -735,12 +879,11 @@ typedef struct tt_patch_options {
     float falloff;          /* texels of soft edge; 0 = TT_DEFAULT_PATCH_FALLOFF */
     float roughness;        /* how irregular the splotch boundary is, in [0, 1);
                                0 = TT_DEFAULT_PATCH_ROUGHNESS */
-    tt_allocator allocator; /* for the patch and scratch; zeroed: TT_MALLOC / TT_FREE */
 } tt_patch_options;
 
-/* Cut a texture patch from `source` (straight, un-premultiplied RGBA): patch
-   is created (it must not already hold an image) with the source's size and
-   holds premultiplied RGBA, rgb = source.rgb * alpha, with a soft alpha.
+/* Cut a texture patch from `source` (straight, un-premultiplied RGBA): *patch
+   is created with the source's size and holds premultiplied RGBA,
+   rgb = source.rgb * alpha, with a soft alpha (free it with tt_image_free).
 
    The shape, a binary mask (a texel is inside when its value >= 0.5), is the
    first that applies of:
@@ -762,7 +905,7 @@ typedef struct tt_patch_options {
    beyond the last inside centre) to 1. So a shape that reaches the image
    border still fades out there.
 
-   Errors (the patch is left empty, memory freed on every path):
+   Errors (*patch is NULL, memory freed on every path):
      TT_ERROR_INVALID_ARGUMENT  NULL or empty source or patch; a mask of
                                 another size (the message gives both sizes);
                                 "the mask has no opaque pixel" (no texel >=
@@ -777,7 +920,7 @@ typedef struct tt_patch_options {
    options may be NULL (all defaults, seed 0). Deterministic for a given seed
    on a given platform (the splotch uses cosf/atan2f). */
 TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
-                                      tt_image *patch, tt_error *error);
+                                      const tt_allocator *allocator, tt_image **patch, tt_error *error);
 
 /* The paste loop.
    Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
@@ -859,7 +1002,6 @@ typedef struct tt_lapped_options {
        (never decreasing); non-zero return cancels with TT_CANCELLED. */
     tt_progress_fn progress;
     void *progress_user_data;
-    tt_allocator allocator;     /* for the result and scratch; zeroed: the mesh's allocator */
 } tt_lapped_options;
 
 /* One paste operation (Sec. 3.5 / 4): texture patch `patch` over faces
@@ -886,7 +1028,7 @@ typedef struct tt_lapped {
     double mean_angle_error;    /* degrees, mean over entries of the angle between phi(T_f) and (0,1)
                                    (isotropic: against each paste's propagated direction) */
     double median_scale_error;  /* median over entries of | |phi(T_f)| - 1 | */
-    tt_allocator allocator;
+    tt_allocator allocator;     /* the one it was made with */
 } tt_lapped;
 
 /* Cover `mesh` (triangles only) with pastes of the `npatches` texture patches
@@ -894,12 +1036,13 @@ typedef struct tt_lapped {
    at least one texel with alpha >= TT_LAPPED_OPAQUE). face_vectors: 3 per
    face, from tt_tangent_field or your own (in each face's plane; only their
    lengths count when isotropic). options may be NULL (defaults, seed 0).
-   *result must be zeroed or freed; on failure it is left zeroed.
+   *out_lapped gets the result (free it with tt_lapped_free), NULL on failure.
    Errors:
      TT_ERROR_INVALID_ARGUMENT  NULL pointers, npatches < 1, a face that is not
                                 a triangle (error->face), an empty patch or one
                                 with no opaque texel ("texture patch 2 has no
-                                opaque texel"), a zero field vector or one
+                                opaque texel", error->item = 2), a zero
+                                field vector or one
                                 perpendicular to its face (error->face), a
                                 patch larger than the mesh (|T_f| above the
                                 mesh's bounding-box diagonal), a face so many
@@ -916,9 +1059,9 @@ typedef struct tt_lapped {
                                 did not cover the mesh;
      TT_CANCELLED, TT_ERROR_OUT_OF_MEMORY.
    Deterministic for a seed; time about O(faces * overdraw * CG steps). */
-TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, const tt_image *patches,
-                                int npatches, const tt_lapped_options *options, tt_lapped *result,
-                                tt_error *error);
+TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, tt_image *const *patches,
+                                int npatches, const tt_lapped_options *options, const tt_allocator *allocator,
+                                tt_lapped **out_lapped, tt_error *error);
 TTDEF void tt_lapped_free(tt_lapped *lapped);
 
 typedef struct tt_lapped_report {
@@ -933,12 +1076,13 @@ typedef struct tt_lapped_report {
    the statistics tt_lapped_paste reports (anisotropic mode), or of UVs from
    anywhere. phi(T_f) = 0 (a degenerate face or UV triangle) counts as the
    worst case, 180 degrees and scale error 1; no entries give 0 errors.
-   Errors: NULL pointers or a mesh of non-triangles:
-   TT_ERROR_INVALID_ARGUMENT; an entry's face out of range:
-   TT_ERROR_INDEX_OUT_OF_RANGE; a non-finite UV or field vector of an entry:
-   TT_ERROR_NON_FINITE; TT_ERROR_OUT_OF_MEMORY (the mesh's allocator). */
+   Errors: NULL pointers, a mesh of non-triangles (error->face) or
+   inconsistent counts: TT_ERROR_INVALID_ARGUMENT; an entry's face out of
+   range: TT_ERROR_INDEX_OUT_OF_RANGE; a non-finite UV or field vector of an
+   entry: TT_ERROR_NON_FINITE; each naming the entry in error->item and its
+   face; TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
-                                  tt_lapped_report *report);
+                                  const tt_allocator *allocator, tt_lapped_report *report, tt_error *error);
 
 /* A simple atlas for meshes without UVs (Sec. 4 "rendering with a texture
    atlas"; the paper's charts were arranged by hand, this is automatic):
@@ -954,27 +1098,40 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
    works). */
 TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, float *corner_uv, tt_error *error);
 
-/* Bake the pastes into `atlas` (created by the caller: its size is the
-   resolution) over the texture coordinates corner_uv (2 floats per corner,
-   origin bottom-left: the mesh's own, or from tt_atlas_pack_pairs). Every
-   texel whose centre lies in a triangle's image (tt_raster_triangle) gets the
-   pastes of that face composited in paste order ("over" of the premultiplied
-   patches, each sampled bilinearly with clamping at the UVs interpolated
-   from the entry's corners). Texels within `gutter` texels outside a
-   triangle get the same composite extrapolated across its edges (the
-   face's maps extended linearly), and every texel still empty is then
+typedef struct tt_bake_options {
+    int gutter;             /* texels past each triangle's image filled by extrapolating its
+                               composite across its edges; 0 = none (the nearest-texel fill
+                               still covers the rest); the tool uses 2 */
+    /* Called as faces are baked with the fraction of faces done (never
+       decreasing); non-zero return cancels with TT_CANCELLED. */
+    tt_progress_fn progress;
+    void *progress_user_data;
+} tt_bake_options;
+
+/* Bake the pastes into `atlas` (yours: its size is the resolution; a view is
+   fine) over the texture coordinates corner_uv (2 floats per corner, origin
+   bottom-left: the mesh's own, or from tt_atlas_pack_pairs). Every texel
+   whose centre lies in a triangle's image (tt_raster_triangle) gets the
+   pastes of that face composited in paste order ("over" of the
+   premultiplied patches, each sampled bilinearly with clamping at the UVs
+   interpolated from the entry's corners). Texels within `gutter` texels
+   outside a triangle get the same composite extrapolated across its edges
+   (the face's maps extended linearly), and every texel still empty is then
    filled from the nearest filled texel, so bilinear filtering and mipmaps
    near chart borders read chart colours, not background. The atlas holds
    straight (un-premultiplied) RGBA, alpha the composited coverage (1 where
-   the pastes cover the face). Where two triangles' images overlap, the later
-   face wins. Errors: NULL pointers, an empty atlas, non-triangles, npatches
-   < 1, an entry naming a patch or face out of range
-   (TT_ERROR_INDEX_OUT_OF_RANGE), non-finite corner_uv (TT_ERROR_NON_FINITE),
-   gutter < 0; TT_ERROR_OUT_OF_MEMORY (scratch comes from the mesh's
-   allocator, all of it before the atlas is touched). */
-TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, const tt_image *patches,
-                               int npatches, const float *corner_uv, int gutter, tt_image *atlas,
-                               tt_error *error);
+   the pastes cover the face). Where two triangles' images overlap, the
+   later face wins. Work: proportional to the texels the triangles and
+   their gutters cover plus one pass over the atlas. options may be NULL
+   (no gutter). Errors: NULL pointers, an empty atlas, non-triangles,
+   npatches < 1, a negative gutter (TT_ERROR_INVALID_ARGUMENT); an entry
+   naming a patch or face out of range (TT_ERROR_INDEX_OUT_OF_RANGE,
+   error->item names the paste or entry); non-finite corner_uv
+   (TT_ERROR_NON_FINITE); TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch
+   is allocated before the atlas is touched). */
+TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
+                               int npatches, const float *corner_uv, const tt_bake_options *options,
+                               const tt_allocator *allocator, tt_image *atlas, tt_error *error);
 
 #ifdef __cplusplus
 }
@@ -1007,6 +1164,11 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, con
 #error "tiledtex.h: define both TT_MALLOC and TT_FREE, or neither"
 #endif
 
+#ifndef TT_ASSERT
+#include <assert.h>
+#define TT_ASSERT(condition) assert(condition)
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -1022,37 +1184,73 @@ TTDEF const char *tt_result_string(tt_result result)
     case TT_CANCELLED: return "cancelled by the progress callback";
     case TT_ERROR_INVALID_ARGUMENT: return "invalid argument";
     case TT_ERROR_OUT_OF_MEMORY: return "out of memory";
-    case TT_ERROR_TOO_LARGE: return "size too large";
+    case TT_ERROR_TOO_LARGE: return "a size is too large";
     case TT_ERROR_EMPTY_MESH: return "the mesh has no faces";
-    case TT_ERROR_INDEX_OUT_OF_RANGE: return "a face refers to a vertex that does not exist";
+    case TT_ERROR_INDEX_OUT_OF_RANGE: return "an index is out of range";
     case TT_ERROR_FACE_TOO_SMALL: return "a face has fewer than 3 corners";
     case TT_ERROR_REPEATED_VERTEX: return "a face uses the same vertex twice";
-    case TT_ERROR_NON_FINITE: return "a coordinate is NaN or infinite";
+    case TT_ERROR_NON_FINITE: return "a value is NaN or infinite";
     case TT_ERROR_ZERO_AREA_FACE: return "a face has zero area";
     case TT_ERROR_NON_MANIFOLD_EDGE: return "an edge is shared by more than two faces";
     case TT_ERROR_INCONSISTENT_ORIENTATION: return "two neighbouring faces are oriented inconsistently";
     case TT_ERROR_NON_MANIFOLD_VERTEX: return "the faces around a vertex form more than one fan";
     case TT_ERROR_NOT_QUAD_MESH: return "this step needs a mesh of quads";
-    case TT_ERROR_IMAGE_TOO_SMALL: return "the image is too small for the requested tiles";
-    case TT_ERROR_NOT_CONVERGED: return "the solver did not converge within its iteration limit";
+    case TT_ERROR_IMAGE_TOO_SMALL: return "an image is too small for what was asked";
+    case TT_ERROR_NOT_CONVERGED: return "an iterative method did not finish within its limit";
     case TT_ERROR_NOT_POSITIVE_DEFINITE: return "the matrix is not symmetric positive definite";
+    case TT_ERROR_NOT_MEASURED: return "nothing could be measured";
     default: return "unknown tiledtex result";
     }
 }
 
+TTDEF const char *tt_version(int *major, int *minor, int *patch)
+{
+    if (major) *major = TILEDTEX_VERSION_MAJOR;
+    if (minor) *minor = TILEDTEX_VERSION_MINOR;
+    if (patch) *patch = TILEDTEX_VERSION_PATCH;
+    return TILEDTEX_VERSION_STRING;
+}
+
+static void tt__clear_places(tt_error *error)
+{
+    error->face = error->corner = error->vertex = error->other_vertex = error->other_face = -1;
+    error->row = error->column = error->item = -1;
+}
+
 /* Fill *error (if given) and return `result`. Every error path goes through
-   here, so every error carries a sentence and the place it refers to. */
+   here, so every error carries a sentence and the place it refers to; places
+   other than a face, corner or vertex are set after it (tt__fail_at). Numbers
+   in messages use %g-style formats, never %f, so a huge value cannot push
+   the sentence past the buffer. */
 static tt_result tt__fail(tt_error *error, tt_result result, int face, int corner, int vertex,
                           int other_vertex, const char *format, ...)
 {
     if (error) {
         va_list args;
+        tt__clear_places(error);
         error->result = result;
         error->face = face;
         error->corner = corner;
         error->vertex = vertex;
         error->other_vertex = other_vertex;
-        error->other_face = -1;
+        va_start(args, format);
+        vsnprintf(error->message, sizeof error->message, format, args);
+        va_end(args);
+    }
+    return result;
+}
+
+/* The same for errors about an input item, a matrix entry or a texel. */
+static tt_result tt__fail_at(tt_error *error, tt_result result, int item, int row, int column, const char *format,
+                             ...)
+{
+    if (error) {
+        va_list args;
+        tt__clear_places(error);
+        error->result = result;
+        error->item = item;
+        error->row = row;
+        error->column = column;
         va_start(args, format);
         vsnprintf(error->message, sizeof error->message, format, args);
         va_end(args);
@@ -1063,11 +1261,32 @@ static tt_result tt__fail(tt_error *error, tt_result result, int face, int corne
 static tt_result tt__ok(tt_error *error)
 {
     if (error) {
+        tt__clear_places(error);
         error->result = TT_OK;
-        error->face = error->corner = error->vertex = error->other_vertex = error->other_face = -1;
         error->message[0] = '\0';
     }
     return TT_OK;
+}
+
+/* THE API CONTRACT's allocator rule: NULL means TT_MALLOC / TT_FREE; a given
+   allocator sets both functions (or neither, to pass user_data to the
+   TT_MALLOC / TT_FREE macros). */
+static tt_result tt__check_allocator(const tt_allocator *allocator, tt_error *error)
+{
+    if (allocator && (allocator->alloc == NULL) != (allocator->free == NULL))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the allocator sets %s but not %s: set both, or pass NULL for TT_MALLOC / TT_FREE",
+                        allocator->alloc ? "alloc" : "free", allocator->alloc ? "free" : "alloc");
+    return TT_OK;
+}
+
+/* The allocator an object remembers: a copy, zeroed for NULL. */
+static tt_allocator tt__allocator_copy(const tt_allocator *allocator)
+{
+    tt_allocator copy;
+    if (allocator) return *allocator;
+    memset(&copy, 0, sizeof copy);
+    return copy;
 }
 
 static void *tt__alloc(const tt_allocator *allocator, size_t size)
@@ -1081,8 +1300,7 @@ static void tt__free(const tt_allocator *allocator, void *ptr)
 {
     if (!ptr) return;
     if (allocator && allocator->alloc) {
-        void (*release)(void *, void *) = allocator->free;
-        if (release) release(ptr, allocator->user_data);
+        allocator->free(ptr, allocator->user_data);
         return;
     }
     TT_FREE(ptr, allocator ? allocator->user_data : NULL);
@@ -1171,13 +1389,17 @@ TTDEF float tt_rng_float(tt_rng *rng)
 
 TTDEF int tt_mesh_next(const tt_mesh *mesh, int corner)
 {
-    int face = mesh->corner_face[corner];
+    int face;
+    TT_ASSERT(mesh && corner >= 0 && corner < mesh->ncorners);
+    face = mesh->corner_face[corner];
     return corner + 1 < mesh->face_start[face + 1] ? corner + 1 : mesh->face_start[face];
 }
 
 TTDEF int tt_mesh_prev(const tt_mesh *mesh, int corner)
 {
-    int face = mesh->corner_face[corner];
+    int face;
+    TT_ASSERT(mesh && corner >= 0 && corner < mesh->ncorners);
+    face = mesh->corner_face[corner];
     return corner > mesh->face_start[face] ? corner - 1 : mesh->face_start[face + 1] - 1;
 }
 
@@ -1384,7 +1606,7 @@ static tt_mesh *tt__mesh_alloc(const tt_allocator *allocator, int nverts, int nf
     tt_mesh *mesh = TT__ALLOC(allocator, tt_mesh, 1);
     if (!mesh) return NULL;
     memset(mesh, 0, sizeof *mesh);
-    mesh->allocator = *allocator;
+    mesh->allocator = tt__allocator_copy(allocator);
     mesh->flags = flags;
     mesh->nverts = nverts;
     mesh->nfaces = nfaces;
@@ -1401,9 +1623,9 @@ static tt_mesh *tt__mesh_alloc(const tt_allocator *allocator, int nverts, int nf
     return mesh;
 }
 
-TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_error *error)
+TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allocator, tt_mesh **out_mesh,
+                              tt_error *error)
 {
-    const tt_allocator *allocator;
     tt_mesh *mesh = NULL;
     int *bucket_start = NULL, *out_count = NULL, *stamp = NULL, *entries, largest_bucket = 0;
     tt__edge_entry *local = NULL;
@@ -1416,7 +1638,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
     *out_mesh = NULL;
     if (!desc) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "desc is NULL");
-    allocator = &desc->allocator;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     permissive = (desc->flags & TT_MESH_PERMISSIVE) != 0;
     nverts = desc->nverts;
     nfaces = desc->nfaces;
@@ -1653,6 +1875,7 @@ TTDEF int tt_mesh_valence(const tt_mesh *mesh, int vertex)
     /* Edges at a vertex: one per outgoing half-edge of its fan, plus the
        incoming boundary edge that closes an open fan (vert_corner is a
        boundary half-edge exactly when the fan is open). */
+    TT_ASSERT(mesh && vertex >= 0 && vertex < mesh->nverts);
     if (!mesh || vertex < 0 || vertex >= mesh->nverts || mesh->vert_corner[vertex] < 0) return 0;
     return tt__fan_size(mesh, vertex) + (mesh->twin[mesh->vert_corner[vertex]] < 0 ? 1 : 0);
 }
@@ -1669,26 +1892,39 @@ static void tt__valences(const tt_mesh *mesh, int *valence)
     }
 }
 
-TTDEF tt_result tt_mesh_valence_histogram(const tt_mesh *mesh, int *histogram, int nbins)
+TTDEF tt_result tt_mesh_valence_histogram(const tt_mesh *mesh, const tt_allocator *allocator, int *histogram,
+                                          int nbins, tt_error *error)
 {
     int *valence, v;
-    if (!mesh || !histogram || nbins < 1) return TT_ERROR_INVALID_ARGUMENT;
-    valence = TT__ALLOC(&mesh->allocator, int, mesh->nverts);
-    if (!valence) return TT_ERROR_OUT_OF_MEMORY;
+    tt__ok(error);
+    if (!mesh || !histogram)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the mesh or the histogram is NULL");
+    if (nbins < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "nbins is %d: need at least 1", nbins);
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    valence = TT__ALLOC(allocator, int, mesh->nverts);
+    if (!valence)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory counting valences");
     tt__valences(mesh, valence);
     memset(histogram, 0, (size_t)nbins * sizeof(int));
     for (v = 0; v < mesh->nverts; v++)
         if (mesh->vert_corner[v] >= 0) histogram[tt__min_i(valence[v], nbins - 1)]++;
-    tt__free(&mesh->allocator, valence);
+    tt__free(allocator, valence);
     return TT_OK;
 }
 
-TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, int *face_component, int *ncomponents)
+TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, const tt_allocator *allocator, int *face_component,
+                                   int *ncomponents, tt_error *error)
 {
     int *queue, f, count = 0;
-    if (!mesh || !face_component || !ncomponents) return TT_ERROR_INVALID_ARGUMENT;
-    queue = TT__ALLOC(&mesh->allocator, int, mesh->nfaces);
-    if (!queue) return TT_ERROR_OUT_OF_MEMORY;
+    tt__ok(error);
+    if (!mesh || !face_component || !ncomponents)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_mesh_components needs a mesh and both outputs (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    queue = TT__ALLOC(allocator, int, mesh->nfaces);
+    if (!queue)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory finding components");
     for (f = 0; f < mesh->nfaces; f++) face_component[f] = -1;
     for (f = 0; f < mesh->nfaces; f++) {
         int head = 0, tail = 0;
@@ -1708,14 +1944,17 @@ TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, int *face_component, int
         count++;
     }
     *ncomponents = count;
-    tt__free(&mesh->allocator, queue);
+    tt__free(allocator, queue);
     return TT_OK;
 }
 
-TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, int *nloops)
+TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, int *nloops, tt_error *error)
 {
     int c, count = 0;
-    if (!mesh || !corner_loop || !nloops) return TT_ERROR_INVALID_ARGUMENT;
+    tt__ok(error);
+    if (!mesh || !corner_loop || !nloops)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_mesh_boundary_loops needs a mesh and both outputs (got NULL)");
     for (c = 0; c < mesh->ncorners; c++) corner_loop[c] = mesh->twin[c] < 0 ? -2 : -1;
     for (c = 0; c < mesh->ncorners; c++) {
         int h = c, steps;
@@ -1736,22 +1975,23 @@ TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, in
     return TT_OK;
 }
 
-TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, tt_mesh_stats *stats)
+TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, const tt_allocator *allocator, tt_mesh_stats *stats,
+                                      tt_error *error)
 {
-    const tt_allocator *allocator;
     int *valence = NULL, *face_component = NULL, *corner_loop = NULL, *twice_genus = NULL;
     int *loop_component = NULL, *faces_by_component = NULL, *component_start = NULL;
     int ncomponents = 0, nloops = 0, v, c, f, k;
     long long genus_sum = 0;
-    tt_result result = TT_OK;
-    if (!mesh || !stats) return TT_ERROR_INVALID_ARGUMENT;
-    allocator = &mesh->allocator;
+    tt_result result = tt__ok(error);
+    if (!mesh || !stats)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the mesh or the stats is NULL");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     memset(stats, 0, sizeof *stats);
     valence = TT__ALLOC(allocator, int, mesh->nverts);
     face_component = TT__ALLOC(allocator, int, mesh->nfaces);
     corner_loop = TT__ALLOC(allocator, int, mesh->ncorners);
     faces_by_component = TT__ALLOC(allocator, int, mesh->nfaces);
-    if (!valence || !face_component || !corner_loop || !faces_by_component) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
+    if (!valence || !face_component || !corner_loop || !faces_by_component) goto out_of_memory;
 
     tt__valences(mesh, valence);
     for (v = 0; v < mesh->nverts; v++) {
@@ -1770,8 +2010,8 @@ TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, tt_mesh_stats *stats)
     for (v = 0; v < mesh->nverts; v++)
         if (mesh->vert_corner[v] >= 0 && tt__fan_size(mesh, v) != valence[v]) stats->nonmanifold_vertices++;
 
-    if ((result = tt_mesh_components(mesh, face_component, &ncomponents)) != TT_OK) goto done;
-    if ((result = tt_mesh_boundary_loops(mesh, corner_loop, &nloops)) != TT_OK) goto done;
+    if ((result = tt_mesh_components(mesh, allocator, face_component, &ncomponents, error)) != TT_OK) goto done;
+    if ((result = tt_mesh_boundary_loops(mesh, corner_loop, &nloops, error)) != TT_OK) goto done;
     stats->components = ncomponents;
     stats->boundary_loops = nloops;
     stats->euler_characteristic = stats->used_vertices - stats->edges + mesh->nfaces;
@@ -1781,7 +2021,7 @@ TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, tt_mesh_stats *stats)
     twice_genus = TT__ALLOC(allocator, int, ncomponents);
     loop_component = TT__ALLOC(allocator, int, nloops);
     component_start = TT__ALLOC(allocator, int, (size_t)ncomponents + 1);
-    if (!twice_genus || !loop_component || !component_start) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
+    if (!twice_genus || !loop_component || !component_start) goto out_of_memory;
     for (k = 0; k < ncomponents; k++) twice_genus[k] = 2;
     for (f = 0; f < mesh->nfaces; f++) twice_genus[face_component[f]] -= 1;
     for (c = 0; c < mesh->ncorners; c++)
@@ -1807,6 +2047,9 @@ TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, tt_mesh_stats *stats)
     }
     for (k = 0; k < ncomponents; k++) genus_sum += twice_genus[k];
     stats->genus = (int)(genus_sum / 2);
+    goto done;
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory computing mesh statistics");
 done:
     tt__free(allocator, valence);
     tt__free(allocator, face_component);
@@ -1821,10 +2064,9 @@ done:
 /* Quadrangulation: one Catmull-Clark step's topology. Based on: Catmull and
    Clark 1978 (the paper's reference [3]); Akleman Sec. 6 uses it to turn any
    mesh into quads. Edge ids follow the first half-edge of each edge. */
-TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, tt_mesh **out_mesh,
-                                      tt_error *error)
+TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
+                                      tt_mesh **out_mesh, tt_error *error)
 {
-    const tt_allocator *allocator;
     int *edge_of = NULL, nedges = 0, c, f, v, nverts_new;
     double *sum = NULL;       /* CC vertex rule accumulators: 3 face sums, 3 edge-midpoint sums, 3 boundary sums */
     int *count = NULL;        /* per vertex: faces, edges, boundary edges */
@@ -1840,7 +2082,7 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
     if (scheme != TT_SUBDIVIDE_LINEAR && scheme != TT_SUBDIVIDE_CATMULL_CLARK)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "unknown subdivision scheme %d",
                         (int)scheme);
-    allocator = &mesh->allocator;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     edge_of = TT__ALLOC(allocator, int, mesh->ncorners);
     if (!edge_of) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     for (c = 0; c < mesh->ncorners; c++) {
@@ -2010,68 +2252,199 @@ done:
 /* 3. Image                                                                 */
 /* ------------------------------------------------------------------------ */
 
-TTDEF tt_result tt_image_create(tt_image *image, int width, int height, const tt_allocator *allocator)
+/* Size checks shared by every image the library makes. */
+static tt_result tt__check_image_size(int width, int height, tt_error *error)
+{
+    if (width <= 0 || height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "an image of %d x %d texels is empty",
+                        width, height);
+    if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "an image of %d x %d texels is above the limit of %d a side", width, height,
+                        TT_MAX_IMAGE_SIZE);
+    return TT_OK;
+}
+
+/* Pixels for an image held by value inside a larger object (a tileset's mip
+   levels); released with tt__image_release. */
+static tt_result tt__image_init(tt_image *image, int width, int height, const tt_allocator *allocator,
+                                tt_error *error)
 {
     size_t count;
-    if (!image) return TT_ERROR_INVALID_ARGUMENT;
+    tt_result result;
     memset(image, 0, sizeof *image);
-    if (width <= 0 || height <= 0) return TT_ERROR_INVALID_ARGUMENT;
-    if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) return TT_ERROR_TOO_LARGE;
-    if (allocator) image->allocator = *allocator;
+    if ((result = tt__check_image_size(width, height, error)) != TT_OK) return result;
     count = (size_t)width * (size_t)height;   /* <= 2^30: fits any size_t of 32 bits or more */
-    image->pixels = TT__ALLOC(&image->allocator, float, count * 4);
-    if (!image->pixels) return TT_ERROR_OUT_OF_MEMORY;
+    image->allocator = tt__allocator_copy(allocator);
+    image->pixels = TT__ALLOC(allocator, float, count * 4);
+    if (!image->pixels)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for a %d x %d image", width,
+                        height);
     memset(image->pixels, 0, count * 4 * sizeof(float));
     image->width = width;
     image->height = height;
     return TT_OK;
 }
 
-TTDEF void tt_image_free(tt_image *image)
+static void tt__image_release(tt_image *image)
 {
-    if (!image) return;
     tt__free(&image->allocator, image->pixels);
-    image->pixels = NULL;
-    image->width = image->height = 0;
+    memset(image, 0, sizeof *image);
 }
 
-TTDEF tt_result tt_image_from_bytes(tt_image *image, const unsigned char *data, int width, int height,
-                                    int channels, int stride, const tt_allocator *allocator)
+/* TT_ERROR_NON_FINITE naming the first NaN or infinite texel, by row and
+   column: one bad texel would otherwise spread through every blend. */
+static tt_result tt__check_finite_texels(const tt_image *image, const char *what, tt_error *error)
 {
+    size_t i, n = (size_t)image->width * (size_t)image->height * 4;
+    for (i = 0; i < n; i++)
+        if (!tt__is_finite(image->pixels[i])) {
+            int texel = (int)(i / 4), x = texel % image->width, y = texel / image->width;
+            return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, y, x, "the %s has a non-finite value at texel %d, %d",
+                               what, x, y);
+        }
+    return TT_OK;
+}
+
+/* The struct and its pixels share one block; the header is padded to 64
+   bytes so the pixels keep the allocator's alignment. */
+#define TT__IMAGE_HEADER 64
+
+TTDEF tt_result tt_image_create(int width, int height, const tt_allocator *allocator, tt_image **out_image,
+                                tt_error *error)
+{
+    size_t count;
+    tt_image *image;
     tt_result result;
-    int x, y;
-    if (!image) return TT_ERROR_INVALID_ARGUMENT;
-    memset(image, 0, sizeof *image);
-    if (!data || channels < 1 || channels > 4 || stride < 0) return TT_ERROR_INVALID_ARGUMENT;
-    if (stride == 0) stride = width * channels;
-    else if (stride < width * channels) return TT_ERROR_INVALID_ARGUMENT;
-    if ((result = tt_image_create(image, width, height, allocator)) != TT_OK) return result;
+    tt__ok(error);
+    if (!out_image) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_image is NULL");
+    *out_image = NULL;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__check_image_size(width, height, error)) != TT_OK) return result;
+    count = (size_t)width * (size_t)height;
+    image = (tt_image *)tt__alloc(allocator, TT__IMAGE_HEADER + count * 4 * sizeof(float));
+    if (!image)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for a %d x %d image", width,
+                        height);
+    memset(image, 0, TT__IMAGE_HEADER + count * 4 * sizeof(float));
+    image->width = width;
+    image->height = height;
+    image->pixels = (float *)(void *)((unsigned char *)image + TT__IMAGE_HEADER);
+    image->allocator = tt__allocator_copy(allocator);
+    *out_image = image;
+    return TT_OK;
+}
+
+TTDEF void tt_image_free(tt_image *image)
+{
+    tt_allocator allocator;
+    if (!image) return;
+    allocator = image->allocator;
+    tt__free(&allocator, image);
+}
+
+/* IEC 61966-2-1: linear segment near black, a 2.4 power above it. */
+TTDEF float tt_srgb_to_linear(float encoded)
+{
+    float v = encoded != encoded ? 0.0f : tt__clamp_f(encoded, 0.0f, 1.0f);
+    return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+}
+
+TTDEF float tt_linear_to_srgb(float linear)
+{
+    float v = linear != linear ? 0.0f : tt__clamp_f(linear, 0.0f, 1.0f);
+    return v <= 0.0031308f ? v * 12.92f : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+}
+
+/* decode[b]: the linear value of byte b. bound[b], b = 0..254: the linear
+   value halfway (in the encoded scale) between bytes b and b + 1, so that
+   encoding rounds to the nearest byte by a search among the bounds, with no
+   power function per texel, and decode then encode gives back every byte. */
+static void tt__byte_tables(tt_color_space space, float decode[256], float bound[255])
+{
+    int b;
+    for (b = 0; b < 256; b++)
+        decode[b] = space == TT_COLOR_SRGB ? tt_srgb_to_linear((float)b / 255.0f) : (float)b / 255.0f;
+    for (b = 0; b < 255; b++)
+        bound[b] = space == TT_COLOR_SRGB ? tt_srgb_to_linear(((float)b + 0.5f) / 255.0f)
+                                          : ((float)b + 0.5f) / 255.0f;
+}
+
+static unsigned char tt__encode_byte(const float bound[255], float value)
+{
+    int lo = 0, hi = 255;   /* the answer is the number of bounds <= value */
+    if (!(value >= bound[0])) return 0;   /* NaN too */
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (value >= bound[mid - 1]) lo = mid; else hi = mid;
+    }
+    return (unsigned char)(value >= bound[lo] ? lo + 1 : lo);
+}
+
+TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int height, int channels, int stride,
+                                    tt_color_space space, const tt_allocator *allocator, tt_image **out_image,
+                                    tt_error *error)
+{
+    float decode[256], bound[255], alpha[256];
+    tt_image *image;
+    tt_result result;
+    long long row_bytes;
+    int x, y, b;
+    tt__ok(error);
+    if (!out_image) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_image is NULL");
+    *out_image = NULL;
+    if (!data) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the pixel data is NULL");
+    if (channels < 1 || channels > 4)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "%d channels: need 1, 2, 3 or 4",
+                        channels);
+    if (space != TT_COLOR_SRGB && space != TT_COLOR_LINEAR)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "unknown colour space %d", (int)space);
+    if ((result = tt__check_image_size(width, height, error)) != TT_OK) return result;
+    row_bytes = (long long)width * channels;   /* width <= 32768: no overflow */
+    if (stride < 0 || (stride > 0 && stride < row_bytes))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "a stride of %d bytes is less than a row of %d pixels of %d channels", stride, width,
+                        channels);
+    if (stride == 0) stride = (int)row_bytes;
+    if ((result = tt_image_create(width, height, allocator, &image, error)) != TT_OK) return result;
+    tt__byte_tables(space, decode, bound);
+    for (b = 0; b < 256; b++) alpha[b] = (float)b / 255.0f;
     for (y = 0; y < height; y++) {
         const unsigned char *row = data + (size_t)y * (size_t)stride;
         float *out = image->pixels + (size_t)y * width * 4;
         for (x = 0; x < width; x++, out += 4) {
             const unsigned char *p = row + (size_t)x * channels;
-            float grey = p[0] / 255.0f;
             switch (channels) {
-            case 1: out[0] = out[1] = out[2] = grey; out[3] = 1.0f; break;
-            case 2: out[0] = out[1] = out[2] = grey; out[3] = p[1] / 255.0f; break;
-            case 3: out[0] = grey; out[1] = p[1] / 255.0f; out[2] = p[2] / 255.0f; out[3] = 1.0f; break;
-            default: out[0] = grey; out[1] = p[1] / 255.0f; out[2] = p[2] / 255.0f; out[3] = p[3] / 255.0f; break;
+            case 1: out[0] = out[1] = out[2] = decode[p[0]]; out[3] = 1.0f; break;
+            case 2: out[0] = out[1] = out[2] = decode[p[0]]; out[3] = alpha[p[1]]; break;
+            case 3: out[0] = decode[p[0]]; out[1] = decode[p[1]]; out[2] = decode[p[2]]; out[3] = 1.0f; break;
+            default:
+                out[0] = decode[p[0]]; out[1] = decode[p[1]]; out[2] = decode[p[2]]; out[3] = alpha[p[3]];
+                break;
             }
         }
     }
+    (void)bound;
+    *out_image = image;
     return TT_OK;
 }
 
-TTDEF void tt_image_to_rgba8(const tt_image *image, unsigned char *out)
+TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out)
 {
+    float decode[256], bound[255], alpha_bound[255];
     size_t i, n;
+    int b;
+    TT_ASSERT(image && image->pixels && out);
     if (!image || !image->pixels || !out) return;
-    n = (size_t)image->width * image->height * 4;
+    tt__byte_tables(space, decode, bound);
+    for (b = 0; b < 255; b++) alpha_bound[b] = ((float)b + 0.5f) / 255.0f;
+    n = (size_t)image->width * image->height;
     for (i = 0; i < n; i++) {
-        float value = image->pixels[i];
-        value = value != value ? 0.0f : tt__clamp_f(value, 0.0f, 1.0f);
-        out[i] = (unsigned char)(value * 255.0f + 0.5f);
+        const float *p = image->pixels + 4 * i;
+        out[4 * i] = tt__encode_byte(bound, p[0]);
+        out[4 * i + 1] = tt__encode_byte(bound, p[1]);
+        out[4 * i + 2] = tt__encode_byte(bound, p[2]);
+        out[4 * i + 3] = tt__encode_byte(alpha_bound, p[3]);
     }
 }
 
@@ -2080,6 +2453,7 @@ TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, flo
     float fx = x - 0.5f, fy = y - 0.5f, tx, ty;
     int x0, y0, x1, y1, k;
     const float *p00, *p10, *p01, *p11;
+    TT_ASSERT(image && image->pixels && image->width > 0 && image->height > 0 && rgba);
     /* Far outside is the same as just outside (clamping), and it keeps the
        conversion to int defined; NaN samples the first texel. */
     fx = fx != fx ? 0.0f : tt__clamp_f(fx, -1.0f, (float)image->width);
@@ -2106,22 +2480,35 @@ TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, flo
 TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y)
 {
     /* One counter-clockwise quarter turn of a W x H picture (row 0 on top)
-       sends the top-left corner to the bottom-left: (x, y) -> (y, W-1-x). */
+       sends the top-left corner to the bottom-left: (x, y) -> (y, W-1-x).
+       Computed in 64 bits: a result that does not fit an int is a broken
+       precondition, caught by TT_ASSERT and never undefined behaviour. */
+    long long rx, ry, w = width, h = height;
+    TT_ASSERT(out_x && out_y);
     switch (((quarter_turns % 4) + 4) % 4) {
-    case 0: *out_x = x; *out_y = y; break;
-    case 1: *out_x = y; *out_y = width - 1 - x; break;
-    case 2: *out_x = width - 1 - x; *out_y = height - 1 - y; break;
-    default: *out_x = height - 1 - y; *out_y = x; break;
+    case 0: rx = x; ry = y; break;
+    case 1: rx = y; ry = w - 1 - x; break;
+    case 2: rx = w - 1 - x; ry = h - 1 - y; break;
+    default: rx = h - 1 - y; ry = x; break;
     }
+    TT_ASSERT(rx >= INT_MIN && rx <= INT_MAX && ry >= INT_MIN && ry <= INT_MAX);
+    *out_x = (int)rx;
+    *out_y = (int)ry;
 }
 
-TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, tt_image *dst, const tt_allocator *allocator)
+TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const tt_allocator *allocator,
+                                  tt_image **out_image, tt_error *error)
 {
     int odd, x, y;
+    tt_image *dst;
     tt_result result;
-    if (!src || !dst || !src->pixels || src == dst) return TT_ERROR_INVALID_ARGUMENT;
+    tt__ok(error);
+    if (!out_image) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_image is NULL");
+    *out_image = NULL;
+    if (!src || !src->pixels)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
     odd = (((quarter_turns % 4) + 4) % 4) & 1;
-    result = tt_image_create(dst, odd ? src->height : src->width, odd ? src->width : src->height, allocator);
+    result = tt_image_create(odd ? src->height : src->width, odd ? src->width : src->height, allocator, &dst, error);
     if (result != TT_OK) return result;
     for (y = 0; y < src->height; y++)
         for (x = 0; x < src->width; x++) {
@@ -2130,37 +2517,40 @@ TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, tt_ima
             memcpy(dst->pixels + ((size_t)ry * dst->width + rx) * 4, src->pixels + ((size_t)y * src->width + x) * 4,
                    4 * sizeof(float));
         }
+    *out_image = dst;
     return TT_OK;
 }
 
 TTDEF void tt_rgba_over(float dst[4], const float src[4])
 {
-    float keep = 1.0f - src[3];
+    float keep;
+    TT_ASSERT(dst && src);
+    keep = 1.0f - src[3];
     dst[0] = src[0] + keep * dst[0];
     dst[1] = src[1] + keep * dst[1];
     dst[2] = src[2] + keep * dst[2];
     dst[3] = src[3] + keep * dst[3];
 }
 
-TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src)
+TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *error)
 {
     size_t i, n;
-    if (!dst || !src || !dst->pixels || !src->pixels) return TT_ERROR_INVALID_ARGUMENT;
-    if (dst->width != src->width || dst->height != src->height) return TT_ERROR_INVALID_ARGUMENT;
+    tt__ok(error);
+    if (!dst || !src || !dst->pixels || !src->pixels)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "an image is NULL or empty");
+    if (dst->width != src->width || dst->height != src->height)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the images differ in size: %d x %d over %d x %d", src->width, src->height, dst->width,
+                        dst->height);
     n = (size_t)dst->width * dst->height;
     for (i = 0; i < n; i++) tt_rgba_over(dst->pixels + 4 * i, src->pixels + 4 * i);
     return TT_OK;
 }
 
-TTDEF tt_result tt_image_downsample2(const tt_image *src, tt_image *dst, const tt_allocator *allocator)
+/* dst (allocated, half the size of src) = src halved by a 2x2 box. */
+static void tt__downsample_into(const tt_image *src, tt_image *dst)
 {
-    int x, y, k, w, h;
-    tt_result result;
-    if (!src || !dst || !src->pixels || src == dst) return TT_ERROR_INVALID_ARGUMENT;
-    if (src->width % 2 || src->height % 2) return TT_ERROR_INVALID_ARGUMENT;
-    w = src->width / 2;
-    h = src->height / 2;
-    if ((result = tt_image_create(dst, w, h, allocator)) != TT_OK) return result;
+    int x, y, k, w = dst->width, h = dst->height;
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
             const float *a = src->pixels + ((size_t)(2 * y) * src->width + 2 * x) * 4;
@@ -2168,11 +2558,28 @@ TTDEF tt_result tt_image_downsample2(const tt_image *src, tt_image *dst, const t
             float *out = dst->pixels + ((size_t)y * w + x) * 4;
             for (k = 0; k < 4; k++) out[k] = 0.25f * (a[k] + a[4 + k] + b[k] + b[4 + k]);
         }
+}
+
+TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *allocator, tt_image **out_image,
+                                     tt_error *error)
+{
+    tt_result result;
+    tt__ok(error);
+    if (!out_image) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_image is NULL");
+    *out_image = NULL;
+    if (!src || !src->pixels)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
+    if (src->width % 2 || src->height % 2)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "a %d x %d image cannot be halved: both sides must be even", src->width, src->height);
+    if ((result = tt_image_create(src->width / 2, src->height / 2, allocator, out_image, error)) != TT_OK)
+        return result;
+    tt__downsample_into(src, *out_image);
     return TT_OK;
 }
 
 TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
-                                 int *path, const tt_allocator *allocator)
+                                 const tt_allocator *allocator, int *path, tt_error *error)
 {
     /* Dynamic programming over columns (Efros and Freeman 2001, the paper's
        reference [2]): total[x][y] = cost[y][x] + min over y-1..y+1 of
@@ -2181,16 +2588,33 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
     signed char *step;
     int x, y, best = -1;
     const double unreachable = 1e300;
-    if (!cost || !lo || !hi || !path || width <= 0 || height <= 0) return TT_ERROR_INVALID_ARGUMENT;
+    tt__ok(error);
+    if (!cost || !lo || !hi || !path)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_min_error_cut needs the cost, lo, hi and path arrays (got NULL)");
+    if (width <= 0 || height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "a %d x %d cost map is empty", width,
+                        height);
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     for (x = 0; x < width; x++)
-        if (lo[x] < 0 || hi[x] >= height || lo[x] > hi[x]) return TT_ERROR_INVALID_ARGUMENT;
-    if ((size_t)width * (size_t)height > ((size_t)1 << 28)) return TT_ERROR_TOO_LARGE;
+        if (lo[x] < 0 || hi[x] >= height || lo[x] > hi[x])
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, x,
+                               "column %d allows rows %d..%d of a cost map %d rows high", x, lo[x], hi[x], height);
+    if ((size_t)width * (size_t)height > ((size_t)1 << 28))
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "a %d x %d cost map is above 2^28 entries",
+                        width, height);
+    for (y = 0; y < height; y++)
+        for (x = 0; x < width; x++)
+            if (!tt__is_finite(cost[(size_t)y * width + x]))
+                return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, y, x, "the cost at row %d, column %d is %g", y,
+                                   x, (double)cost[(size_t)y * width + x]);
     total = TT__ALLOC(allocator, double, (size_t)width * height);
     step = TT__ALLOC(allocator, signed char, (size_t)width * height);
     if (!total || !step) {
         tt__free(allocator, total);
         tt__free(allocator, step);
-        return TT_ERROR_OUT_OF_MEMORY;
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for a %d x %d cut", width,
+                        height);
     }
     for (x = 0; x < width; x++) {
         for (y = 0; y < height; y++) {
@@ -2223,7 +2647,8 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
     if (best < 0) {
         tt__free(allocator, total);
         tt__free(allocator, step);
-        return TT_ERROR_INVALID_ARGUMENT;
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "no path can follow the allowed rows from column to column (steps of at most one row)");
     }
     for (x = width - 1; x >= 0; x--) {
         path[x] = best;
@@ -2269,8 +2694,9 @@ static int tt__size_fits(size_t count, size_t element_size)
     return element_size == 0 || count <= (size_t)-1 / element_size;
 }
 
-TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int cols, const tt_triplet *triplets,
-                                        int ntriplets, const tt_allocator *allocator, tt_error *error)
+TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,
+                                        const tt_allocator *allocator, tt_sparse_matrix **out_matrix,
+                                        tt_error *error)
 {
     /* Two stable bucket passes (a radix sort with the column as the low digit
        and the row as the high digit) put the triplets in row order with
@@ -2279,9 +2705,12 @@ TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int 
     size_t nt, nbuckets, k;
     int *work, *bucket, *by_col, *by_row;
     int r, nnz, pos, begin;
-    if (!matrix)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "no matrix to fill: `matrix` is NULL");
-    memset(matrix, 0, sizeof *matrix);
+    tt_sparse_matrix *matrix;
+    tt__ok(error);
+    if (!out_matrix)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_matrix is NULL");
+    *out_matrix = NULL;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (rows < 0 || cols < 0 || ntriplets < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "a %d x %d matrix from %d triplets: sizes and counts must not be negative", rows, cols,
@@ -2292,12 +2721,12 @@ TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int 
     for (k = 0; k < (size_t)ntriplets; k++) {
         const tt_triplet *t = triplets + k;
         if (t->row < 0 || t->row >= rows || t->col < 0 || t->col >= cols)
-            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, t->row, t->col,
-                            "triplet %d is at row %d, column %d, outside the %d x %d matrix", (int)k, t->row, t->col,
-                            rows, cols);
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, (int)k, t->row, t->col,
+                               "triplet %d is at row %d, column %d, outside the %d x %d matrix", (int)k, t->row,
+                               t->col, rows, cols);
         if (!tt__is_finite_d(t->value))
-            return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, t->row, t->col,
-                            "triplet %d (row %d, column %d) has the value %g", (int)k, t->row, t->col, t->value);
+            return tt__fail_at(error, TT_ERROR_NON_FINITE, (int)k, t->row, t->col,
+                               "triplet %d (row %d, column %d) has the value %g", (int)k, t->row, t->col, t->value);
     }
 
     nt = (size_t)ntriplets;
@@ -2307,7 +2736,12 @@ TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int 
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "a %d x %d matrix from %d triplets needs more bytes than size_t can count", rows, cols,
                         ntriplets);
-    if (allocator) matrix->allocator = *allocator;
+    matrix = TT__ALLOC(allocator, tt_sparse_matrix, 1);
+    if (!matrix)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for a %d x %d matrix", rows,
+                        cols);
+    memset(matrix, 0, sizeof *matrix);
+    matrix->allocator = tt__allocator_copy(allocator);
     work = TT__ALLOC(&matrix->allocator, int, nbuckets + 2 * nt);
     if (!work) goto out_of_memory;
     bucket = work;
@@ -2361,13 +2795,23 @@ TTDEF tt_result tt_sparse_from_triplets(tt_sparse_matrix *matrix, int rows, int 
                 matrix->value[pos] = t->value;
                 pos++;
             } else {
+                /* Finite triplets can still sum to infinity: that entry is
+                   not a number the solver can use. */
                 matrix->value[pos - 1] += t->value;
+                if (!tt__is_finite_d(matrix->value[pos - 1])) {
+                    tt__free(&matrix->allocator, work);
+                    tt_sparse_free(matrix);
+                    return tt__fail_at(error, TT_ERROR_NON_FINITE, by_row[i], r, t->col,
+                                       "the triplets of row %d, column %d sum to infinity (triplet %d overflows)",
+                                       r, t->col, by_row[i]);
+                }
             }
         }
         matrix->row_start[r + 1] = pos;
     }
     tt__free(&matrix->allocator, work);
-    return tt__ok(error);
+    *out_matrix = matrix;
+    return TT_OK;
 
 out_of_memory:
     tt_sparse_free(matrix);
@@ -2377,11 +2821,13 @@ out_of_memory:
 
 TTDEF void tt_sparse_free(tt_sparse_matrix *matrix)
 {
+    tt_allocator allocator;
     if (!matrix) return;
-    tt__free(&matrix->allocator, matrix->row_start);
-    tt__free(&matrix->allocator, matrix->col);
-    tt__free(&matrix->allocator, matrix->value);
-    memset(matrix, 0, sizeof *matrix);
+    allocator = matrix->allocator;
+    tt__free(&allocator, matrix->row_start);
+    tt__free(&allocator, matrix->col);
+    tt__free(&allocator, matrix->value);
+    tt__free(&allocator, matrix);
 }
 
 /* y = A x for rows [0, n). */
@@ -2397,9 +2843,14 @@ static void tt__spmv(int n, const int *TT__RESTRICT row_start, const int *TT__RE
     }
 }
 
-TTDEF tt_result tt_sparse_multiply(const tt_sparse_matrix *A, const double *x, double *y)
+TTDEF tt_result tt_sparse_multiply(const tt_sparse_matrix *A, const double *x, double *y, tt_error *error)
 {
-    if (!A || !x || !y || x == y || A->rows < 0 || (A->rows > 0 && !A->row_start)) return TT_ERROR_INVALID_ARGUMENT;
+    tt__ok(error);
+    if (!A || !x || !y || A->rows < 0 || (A->rows > 0 && !A->row_start))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_sparse_multiply needs a matrix with rows, x and y (got NULL or a negative size)");
+    if (x == y)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "x and y must not overlap");
     tt__spmv(A->rows, A->row_start, A->col, A->value, x, y);
     return TT_OK;
 }
@@ -2513,47 +2964,49 @@ static tt_result tt__cg_check_matrix(const tt_sparse_matrix *A, double *inv_diag
         int begin = A->row_start[i], end = A->row_start[i + 1];
         double diagonal = 0.0;
         if (end < begin)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, i, -1,
-                            "the matrix's row_start decreases at row %d (%d, then %d)", i, begin, end);
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, i, -1,
+                               "the matrix's row_start decreases at row %d (%d, then %d)", i, begin, end);
         for (k = begin; k < end; k++) {
             int c = A->col[k];
             double v = A->value[k];
             if (c < 0 || c >= n)
-                return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, i, c,
-                                "entry %d of the matrix is at row %d, column %d, outside the %d x %d matrix", k, i,
-                                c, n, n);
+                return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, i, c,
+                                   "entry %d of the matrix is at row %d, column %d, outside the %d x %d matrix", k,
+                                   i, c, n, n);
             if (!tt__is_finite_d(v))
-                return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, i, c,
-                                "the matrix entry at row %d, column %d is %g", i, c, v);
+                return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, i, c,
+                                   "the matrix entry at row %d, column %d is %g", i, c, v);
             if (c == i) diagonal += v;
         }
         if (!(diagonal > 0.0))
-            return tt__fail(error, TT_ERROR_NOT_POSITIVE_DEFINITE, -1, -1, i, i,
-                            "row %d has diagonal entry %g%s: a symmetric positive definite matrix has a positive "
-                            "diagonal", i, diagonal, begin == end ? " (the row is empty)" : "");
+            return tt__fail_at(error, TT_ERROR_NOT_POSITIVE_DEFINITE, -1, i, i,
+                               "row %d has diagonal entry %g%s: a symmetric positive definite matrix has a positive "
+                               "diagonal", i, diagonal, begin == end ? " (the row is empty)" : "");
         inv_diag[i] = 1.0 / diagonal;
     }
     return TT_OK;
 }
 
-TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, double *x, const tt_cg_options *options,
-                            tt_cg_report *report, tt_error *error)
+TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const tt_cg_options *options,
+                            const tt_allocator *allocator, double *x, tt_cg_report *report, tt_error *error)
 {
     tt_cg_options opt;
     tt_cg_report rep;
     tt_result result = TT_OK;
-    double *block, *r, *p, *Ap, *inv_diag;
-    double bb = 0.0, norm_b, limit, rr, rz, shown = 0.0;
-    int i, n, max_iterations, r_is_true;
+    double *block, *r, *p, *Ap, *inv_diag, *b;
+    double bb = 0.0, b_max = 0.0, norm_b, limit, rr, rz, shown = 0.0;
+    int i, n, max_iterations, r_is_true, b_exponent = 0;
 
     memset(&rep, 0, sizeof rep);
     if (report) *report = rep;
+    tt__ok(error);
     if (options) opt = *options;
     else memset(&opt, 0, sizeof opt);
-    if (!A || !b || !x)
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (!A || !b_in || !x)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_cg_solve needs a matrix, a right-hand side and a solution vector; one is NULL");
-    if (b == x)
+    if (b_in == x)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the right-hand side b and the solution x must be different arrays");
     if (opt.max_iterations < 0 || !(opt.tolerance >= 0.0) || !tt__is_finite_d(opt.tolerance))
@@ -2568,36 +3021,47 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, double *
     max_iterations = opt.max_iterations;
     if (max_iterations == 0) max_iterations = n > 0x3fffffff ? 0x7fffffff : (2 * n > 100 ? 2 * n : 100);
 
-    /* One block for the whole solve: r, p, Ap and the inverse diagonal. */
-    if (!tt__size_fits((size_t)n, 4 * sizeof(double)))
+    /* One block for the whole solve: r, p, Ap, the inverse diagonal and b
+       scaled (below). */
+    if (!tt__size_fits((size_t)n, 5 * sizeof(double)))
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "%d unknowns need more bytes than size_t can count",
                         n);
-    block = TT__ALLOC(&opt.allocator, double, (size_t)n * 4);
+    block = TT__ALLOC(allocator, double, (size_t)n * 5);
     if (!block)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for %d unknowns", n);
     r = block;
     p = r + n;
     Ap = p + n;
     inv_diag = Ap + n;
+    b = inv_diag + n;
 
     if ((result = tt__cg_check_matrix(A, inv_diag, error)) != TT_OK) goto done;
     for (i = 0; i < n; i++) {
-        if (!tt__is_finite_d(b[i])) {
-            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, i, -1, "the right-hand side b[%d] is %g", i, b[i]);
+        if (!tt__is_finite_d(b_in[i])) {
+            result = tt__fail_at(error, TT_ERROR_NON_FINITE, -1, i, -1, "the right-hand side b[%d] is %g", i, b_in[i]);
             goto done;
         }
         if (!tt__is_finite_d(x[i])) {
-            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, i, -1, "the initial guess x[%d] is %g", i, x[i]);
+            result = tt__fail_at(error, TT_ERROR_NON_FINITE, -1, i, -1, "the initial guess x[%d] is %g", i, x[i]);
             goto done;
         }
-        bb += b[i] * b[i];
+        if (fabs(b_in[i]) > b_max) b_max = fabs(b_in[i]);
     }
-    if (bb == 0.0) {
+    if (b_max == 0.0) {
         /* A x = 0 with A positive definite: x = 0 exactly. */
         for (i = 0; i < n; i++) x[i] = 0.0;
         rep.converged = 1;
-        result = tt__ok(error);
         goto done;
+    }
+    /* The system is solved for b / 2^e and x / 2^e with max |b_i| / 2^e in
+       [0.5, 1): powers of two scale exactly, and the sums of squares can then
+       neither overflow (|b_i| above 1e154) nor underflow to zero (all |b_i|
+       below 1e-162), which would make any x look converged. */
+    frexp(b_max, &b_exponent);
+    for (i = 0; i < n; i++) {
+        b[i] = ldexp(b_in[i], -b_exponent);
+        x[i] = ldexp(x[i], -b_exponent);
+        bb += b[i] * b[i];
     }
     norm_b = sqrt(bb);
     limit = opt.tolerance * norm_b;
@@ -2664,14 +3128,18 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, double *
     }
     if (!r_is_true) rr = tt__cg_residual(A, b, x, r);
     rep.residual = sqrt(rr) / norm_b;
+    for (i = 0; i < n; i++) x[i] = ldexp(x[i], b_exponent);
+    for (i = 0; i < n && result == TT_OK; i++)
+        if (!tt__is_finite_d(x[i]))
+            result = tt__fail_at(error, TT_ERROR_NON_FINITE, -1, i, -1,
+                                 "the solution overflows at x[%d]: scale the system", i);
     if (result == TT_ERROR_NOT_CONVERGED)
         tt__fail(error, result, -1, -1, -1, -1,
                  "conjugate gradients stopped after %d steps (max_iterations) at relative residual %.3g, above the "
                  "tolerance %.3g", rep.iterations, rep.residual, opt.tolerance);
-    if (result == TT_OK) result = tt__ok(error);
 
 done:
-    tt__free(&opt.allocator, block);
+    tt__free(allocator, block);
     if (report) *report = rep;
     return result;
 }
@@ -2692,6 +3160,7 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
     long long px[3], py[3], area, bias[3], step_x[3], step_y[3], row[3];
     float min_x, max_x, min_y, max_y, inverse_area;
     int i, x0, x1, y0, y1, x, y, swapped = 0;
+    TT_ASSERT(xy && fn);
     if (!xy || !fn || width <= 0 || height <= 0) return;
     for (i = 0; i < 6; i++)
         if (!(xy[i] > -TT__RASTER_LIMIT && xy[i] < TT__RASTER_LIMIT)) return;
@@ -2810,27 +3279,35 @@ TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout 
     return TT_OK;
 }
 
-TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout)
+/* The three layout figures, or 0 for a layout that does not resolve: all
+   computed from a resolved copy, so no product can overflow. */
+static int tt__layout_figure(const tt_tile_layout *layout, int which)
 {
-    return 4 * layout->colors * layout->colors;
+    tt_tile_layout resolved;
+    int side;
+    TT_ASSERT(layout);
+    if (!layout || tt_tile_layout_resolve(layout, &resolved, NULL) != TT_OK) {
+        TT_ASSERT(!"the layout does not resolve (see tt_tile_layout_resolve)");
+        return 0;
+    }
+    side = 4 * resolved.colors * resolved.colors;   /* <= TT_MAX_IMAGE_SIZE / 4 once resolved */
+    if (which == 0) return side;
+    if (which == 1) return side * (resolved.tile_size + 2 * resolved.gutter);
+    return side <= 46340 ? side * side : 0;   /* 46340^2 < 2^31 */
 }
 
-TTDEF int tt_tile_layout_atlas_size(const tt_tile_layout *layout)
-{
-    return tt_tile_layout_tiles_per_side(layout) * (layout->tile_size + 2 * layout->gutter);
-}
-
-TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout)
-{
-    int side = tt_tile_layout_tiles_per_side(layout);
-    return side * side;
-}
+TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout) { return tt__layout_figure(layout, 0); }
+TTDEF int tt_tile_layout_atlas_size(const tt_tile_layout *layout) { return tt__layout_figure(layout, 1); }
+TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout) { return tt__layout_figure(layout, 2); }
 
 TTDEF int tt_tile_index(const tt_tile_layout *layout, const uint8_t types[4])
 {
-    int base = 2 * (layout->colors ? layout->colors : 1);
-    int column = base * types[0] + types[1];
-    int row = base * types[2] + types[3];
+    int base, column, row;
+    TT_ASSERT(layout && types && layout->colors >= 0 && layout->colors <= TT_MAX_COLORS);
+    base = 2 * (layout->colors ? layout->colors : 1);
+    TT_ASSERT(types[0] < base && types[1] < base && types[2] < base && types[3] < base);
+    column = base * types[0] + types[1];
+    row = base * types[2] + types[3];
     return row * base * base + column;
 }
 
@@ -2839,32 +3316,59 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
     /* The paper prints floor(j/2) in the u equation (Figure 6); with
        j = floor(((i+1) mod 4)/2) already 0 or 1 that would pin u to the
        tile's left side. j itself is the corner's column within the tile. */
-    tt_tile_layout L = tt__layout_with_defaults(layout);
-    int base = 2 * L.colors, tiles = base * base;
-    int cell = L.tile_size + 2 * L.gutter;
-    double atlas = (double)tiles * cell;
-    int column = base * types[0] + types[1], row = base * types[2] + types[3];
-    int j = ((corner + 1) & 3) >> 1, k = (corner & 3) >> 1;
+    tt_tile_layout L;
+    int base, tiles, cell, column, row, j, k;
+    double atlas;
+    TT_ASSERT(layout && types && uv && corner >= 0 && corner < 4);
+    L = tt__layout_with_defaults(layout);
+    TT_ASSERT(L.colors >= 1 && L.colors <= TT_MAX_COLORS && L.tile_size >= 1 && L.gutter >= 0);
+    base = 2 * L.colors;
+    tiles = base * base;
+    cell = L.tile_size + 2 * L.gutter;
+    atlas = (double)tiles * cell;
+    column = base * types[0] + types[1];
+    row = base * types[2] + types[3];
+    j = ((corner + 1) & 3) >> 1;
+    k = (corner & 3) >> 1;
     uv[0] = (float)(((double)column * cell + L.gutter + (double)j * L.tile_size) / atlas);
     uv[1] = (float)(((double)row * cell + L.gutter + (double)k * L.tile_size) / atlas);
 }
 
 TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
-                                     uint8_t *corner_type)
+                                     const int *edge_colors, uint8_t *corner_type, tt_error *error)
 {
     tt_rng rng;
     int n, c;
-    if (!mesh || !corner_type) return TT_ERROR_INVALID_ARGUMENT;
-    n = layout && layout->colors ? layout->colors : 1;
-    if (n < 1 || n > TT_MAX_COLORS) return TT_ERROR_INVALID_ARGUMENT;
+    tt__ok(error);
+    if (!mesh || !layout || !corner_type)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_assign_boundaries needs a mesh, a layout and corner_type (got NULL)");
+    n = layout->colors ? layout->colors : 1;
+    if (n < 1 || n > TT_MAX_COLORS)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "colors (boundary conditions) must be 1..%d, got %d", TT_MAX_COLORS, layout->colors);
+    if (edge_colors)
+        for (c = 0; c < mesh->ncorners; c++) {
+            int t = mesh->twin[c];
+            if (edge_colors[c] < -1 || edge_colors[c] >= n)
+                return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, mesh->corner_face[c], c, -1, -1,
+                                "corner %d prescribes colour %d, but %d colors allow 0..%d (or -1: random)", c,
+                                edge_colors[c], n, n - 1);
+            if (t >= 0 && edge_colors[t] != edge_colors[c])
+                return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                                "corners %d and %d are the two sides of one edge but prescribe colours %d and %d",
+                                c, t, edge_colors[c], edge_colors[t]);
+        }
     tt_rng_seed(&rng, seed, 0x6564676573ull /* "edges" */);
     /* Edges are visited in order of their first half-edge, so the result
-       depends only on the mesh and the seed. */
+       depends only on the mesh and the seed. A prescribed colour draws no
+       number for k, so the other edges' draws do not depend on it. */
     for (c = 0; c < mesh->ncorners; c++) {
         int t = mesh->twin[c];
         uint32_t k, side;
         if (t >= 0 && t < c) continue;
-        k = n > 1 ? tt_rng_below(&rng, (uint32_t)n) : 0u;
+        if (edge_colors && edge_colors[c] >= 0) k = (uint32_t)edge_colors[c];
+        else k = n > 1 ? tt_rng_below(&rng, (uint32_t)n) : 0u;
         side = tt_rng_next(&rng) >> 31;
         corner_type[c] = (uint8_t)(2u * k + side);
         if (t >= 0) corner_type[t] = (uint8_t)(2u * k + 1u - side);
@@ -2877,14 +3381,15 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
 {
     tt_tile_layout resolved;
     tt_result result;
-    float *table;   /* table[2*value + j]: the u (or v) of tile column (row) `value`, side j */
-    int f, base, tiles, value, c;
+    double cell, atlas;
+    int f, base, c;
     tt__ok(error);
     if (!mesh || !layout || !corner_type || !corner_uv)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "NULL argument to tt_assign_uvs");
     if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
     base = 2 * resolved.colors;
-    tiles = base * base;
+    cell = resolved.tile_size + 2.0 * resolved.gutter;
+    atlas = (double)base * base * cell;
     for (f = 0; f < mesh->nfaces; f++)
         if (mesh->face_start[f + 1] - mesh->face_start[f] != 4)
             return tt__fail(error, TT_ERROR_NOT_QUAD_MESH, f, mesh->face_start[f], -1, -1,
@@ -2892,33 +3397,24 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
                             f, mesh->face_start[f + 1] - mesh->face_start[f]);
     for (c = 0; c < mesh->ncorners; c++)
         if (corner_type[c] >= base)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, mesh->corner_face[c], c, -1, -1,
                             "corner %d has boundary type %d, but %d colors allow 0..%d", c, corner_type[c],
                             resolved.colors, base - 1);
-    table = TT__ALLOC(&mesh->allocator, float, 2 * (size_t)tiles);
-    if (!table) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
-    for (value = 0; value < tiles; value++) {
-        uint8_t types[4];
-        float uv[2];
-        types[0] = types[2] = (uint8_t)(value / base);
-        types[1] = types[3] = (uint8_t)(value % base);
-        tt_tile_corner_uv(&resolved, types, 0, uv);
-        table[2 * value] = uv[0];
-        tt_tile_corner_uv(&resolved, types, 2, uv);
-        table[2 * value + 1] = uv[0];
-    }
     for (f = 0; f < mesh->nfaces; f++) {
+        /* tt_tile_corner_uv's formula, term for term, so the two agree to
+           the bit. */
         const uint8_t *e = corner_type + 4 * (size_t)f;
         float *uv = corner_uv + 8 * (size_t)f;
         int column = base * e[0] + e[1], row = base * e[2] + e[3];
-        float u0 = table[2 * column], u1 = table[2 * column + 1];
-        float v0 = table[2 * row], v1 = table[2 * row + 1];
+        float u0 = (float)(((double)column * cell + resolved.gutter) / atlas);
+        float u1 = (float)(((double)column * cell + resolved.gutter + (double)resolved.tile_size) / atlas);
+        float v0 = (float)(((double)row * cell + resolved.gutter) / atlas);
+        float v1 = (float)(((double)row * cell + resolved.gutter + (double)resolved.tile_size) / atlas);
         uv[0] = u0; uv[1] = v0;   /* corner 0: bottom-left  */
         uv[2] = u1; uv[3] = v0;   /* corner 1: bottom-right */
         uv[4] = u1; uv[5] = v1;   /* corner 2: top-right    */
         uv[6] = u0; uv[7] = v1;   /* corner 3: top-left     */
     }
-    tt__free(&mesh->allocator, table);
     return TT_OK;
 }
 
@@ -2965,7 +3461,7 @@ static void tt__side_to_tile(const tt__synth *s, int side, int x, int d, int *tx
    layers become similar, the foreground becomes transparent"), kept inside the
    side's wedge (the triangle between the tile's diagonals, the paper's f1..f3
    keeping it off the other sides) and feathered across the cut. */
-static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocator *allocator)
+static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocator *allocator, tt_error *error)
 {
     const int S = s->size, rows = s->max_depth + 1;
     /* Near the corners two bands meet along the diagonal; a short blend there
@@ -2989,7 +3485,7 @@ static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocat
         s->hi[x] = tt__min_i(wedge, s->max_depth);
         s->lo[x] = tt__min_i(s->min_depth, s->hi[x]);
     }
-    result = tt_min_error_cut(s->cost, S, rows, s->lo, s->hi, s->cut, allocator);
+    result = tt_min_error_cut(s->cost, S, rows, s->lo, s->hi, allocator, s->cut, error);
     if (result != TT_OK) return result;
     for (x = 0; x < S; x++) {
         int wedge = tt__min_i(x, S - 1 - x);
@@ -3049,7 +3545,7 @@ TTDEF void tt_tileset_free(tt_tileset *tileset)
     int i;
     if (!tileset) return;
     allocator = tileset->allocator;
-    for (i = 0; i < tileset->nlevels; i++) tt_image_free(&tileset->levels[i]);
+    for (i = 0; i < tileset->nlevels; i++) tt__image_release(&tileset->levels[i]);
     tt__free(&allocator, tileset->edge_windows);
     tt__free(&allocator, tileset->background_windows);
     tt__free(&allocator, tileset);
@@ -3182,11 +3678,10 @@ static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int siz
 }
 
 TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
-                                    tt_tileset **out_tileset, tt_error *error)
+                                    const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error)
 {
     tt_synth_options defaults;
     const tt_synth_options *opt = options;
-    const tt_allocator *allocator;
     tt_tileset *set = NULL;
     tt__synth s;
     tt_tile_layout layout;
@@ -3202,9 +3697,10 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
         memset(&defaults, 0, sizeof defaults);
         opt = &defaults;
     }
-    allocator = &opt->allocator;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (!source || !source->pixels || source->width <= 0 || source->height <= 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is empty");
+    if ((result = tt__check_finite_texels(source, "source image", error)) != TT_OK) return result;
     if ((result = tt_tile_layout_resolve(&opt->layout, &layout, error)) != TT_OK) return result;
     S = layout.tile_size;
     g = layout.gutter;
@@ -3251,7 +3747,7 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
     set = TT__ALLOC(allocator, tt_tileset, 1);
     if (!set) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     memset(set, 0, sizeof *set);
-    set->allocator = *allocator;
+    set->allocator = tt__allocator_copy(allocator);
     set->layout = layout;
     set->edge_windows = TT__ALLOC(allocator, tt_rect, s.n);
     set->background_windows = TT__ALLOC(allocator, tt_rect, ntiles);
@@ -3264,11 +3760,7 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
         goto done;
     }
-    result = tt_image_create(&set->levels[0], W, W, allocator);
-    if (result != TT_OK) {
-        tt__fail(error, result, -1, -1, -1, -1, "cannot allocate a %dx%d atlas", W, W);
-        goto done;
-    }
+    if ((result = tt__image_init(&set->levels[0], W, W, allocator, error)) != TT_OK) goto done;
     set->nlevels = 1;
 
     tt_rng_seed(&rng, opt->seed, 0x74696c6573ull /* "tiles" */);
@@ -3311,10 +3803,7 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
             }
         /* ABCD = AXXX over XBXX over XXCX over XXXD over XXXX: lay D first. */
         for (side = 3; side >= 0; side--)
-            if ((result = tt__lay_band(&s, side, types[side], allocator)) != TT_OK) {
-                tt__fail(error, result, -1, -1, -1, -1, "out of memory while cutting tile %d", t);
-                goto done;
-            }
+            if ((result = tt__lay_band(&s, side, types[side], allocator, error)) != TT_OK) goto done;
         /* A corner texel lies on two sides' edge rows, and whatever meets it
            around a mesh vertex differs from tile to tile: the mean of the two
            edge samples there matches each neighbour across an edge halfway. */
@@ -3339,11 +3828,10 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
        two cells, so halving the whole atlas halves every tile on its own. A
        level is seamless while its gutter is still at least a texel wide. */
     while (set->nlevels < TT_MAX_MIP_LEVELS && ((C >> (set->nlevels - 1)) % 2) == 0) {
-        result = tt_image_downsample2(&set->levels[set->nlevels - 1], &set->levels[set->nlevels], allocator);
-        if (result != TT_OK) {
-            tt__fail(error, result, -1, -1, -1, -1, "out of memory for mip level %d", set->nlevels);
-            goto done;
-        }
+        const tt_image *above = &set->levels[set->nlevels - 1];
+        result = tt__image_init(&set->levels[set->nlevels], above->width / 2, above->height / 2, allocator, error);
+        if (result != TT_OK) goto done;
+        tt__downsample_into(above, &set->levels[set->nlevels]);
         set->nlevels++;
     }
     set->seamless_levels = 0;
@@ -3401,71 +3889,129 @@ static void tt__sample_inside(const tt_image *atlas, const tt__edge_point *p, fl
     tt_image_sample_bilinear(atlas, p->px + p->nx * depth, p->py + p->ny * depth, rgba);
 }
 
-TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
-                                 uint64_t seed, tt_seam_report *report)
+/* A colour as displayed: the seam measure's thresholds are about what the
+   eye sees, and they were set when images held sRGB-encoded values. */
+static void tt__displayed(const tt_image *atlas, const tt__edge_point *p, float depth, float rgb[3])
 {
-    int *interior, ninterior = 0, c, i, j, points_per_edge;
+    float rgba[4];
+    tt__sample_inside(atlas, p, depth, rgba);
+    rgb[0] = tt_linear_to_srgb(rgba[0]);
+    rgb[1] = tt_linear_to_srgb(rgba[1]);
+    rgb[2] = tt_linear_to_srgb(rgba[2]);
+}
+
+TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
+                                 const tt_seam_options *options, const tt_allocator *allocator,
+                                 tt_seam_report *report, tt_error *error)
+{
+    int *interior, ninterior = 0, nmeasured, c, i, j, points_per_edge;
     double seam = 0.0, same = 0.0, unrelated = 0.0;
     long long samples = 0;
+    tt_seam_options opt;
     tt_rng rng;
-    if (!mesh || !corner_uv || !atlas || !atlas->pixels || !report) return TT_ERROR_INVALID_ARGUMENT;
-    memset(report, 0, sizeof *report);
-    interior = TT__ALLOC(&mesh->allocator, int, mesh->ncorners);
-    if (!interior) return TT_ERROR_OUT_OF_MEMORY;
+    tt__ok(error);
+    if (report) {
+        memset(report, 0, sizeof *report);
+        report->score = tt__not_a_number();
+    }
+    if (!mesh || !corner_uv || !atlas || !report)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_measure_seams needs a mesh, UVs, an atlas and a report (got NULL)");
+    if (!atlas->pixels || atlas->width <= 0 || atlas->height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the atlas is empty");
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    if (opt.max_edges < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_edges is %d: 0 (all) or more",
+                        opt.max_edges);
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    interior = TT__ALLOC(allocator, int, mesh->ncorners);
+    if (!interior)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d corners",
+                        mesh->ncorners);
     for (c = 0; c < mesh->ncorners; c++)
         if (mesh->twin[c] > c) interior[ninterior++] = c;
-    tt_rng_seed(&rng, seed, 0x7365616d73ull /* "seams" */);
+    tt_rng_seed(&rng, opt.seed, 0x7365616d73ull /* "seams" */);
+    /* A quick estimate measures a random subset: the first max_edges of a
+       partial Fisher-Yates shuffle. Unrelated pairs are still drawn from
+       every interior edge. */
+    nmeasured = ninterior;
+    if (opt.max_edges > 0 && opt.max_edges < ninterior) {
+        nmeasured = opt.max_edges;
+        for (i = 0; i < nmeasured; i++) {
+            int pick = i + (int)tt_rng_below(&rng, (uint32_t)(ninterior - i)), swap = interior[i];
+            interior[i] = interior[pick];
+            interior[pick] = swap;
+        }
+    }
     /* Four points an edge, more on small meshes so that every measure rests
        on a few thousand samples. */
-    points_per_edge = ninterior > 0 ? tt__clamp_i(4096 / ninterior, 4, 64) : 4;
-    for (i = 0; i < ninterior && ninterior > 1; i++) {
-        int a = interior[i], b = mesh->twin[a];
+    points_per_edge = nmeasured > 0 ? tt__clamp_i(4096 / nmeasured, 4, 64) : 4;
+    for (i = 0; i < nmeasured && ninterior > 1; i++) {
+        int a = interior[i], b = mesh->twin[a], edge_samples = 0;
         for (j = 0; j < points_per_edge; j++) {
             /* Stratified along the edge; the twin runs the other way. */
             float t = ((float)j + tt_rng_float(&rng)) / (float)points_per_edge;
             int other = interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(ninterior - 1))) % ninterior];
             float t_other = tt_rng_float(&rng);
             tt__edge_point pa, pb, po;
-            float sa[4], sa_deeper[4], sb[4], so[4];
+            float sa[3], sa_deeper[3], sb[3], so[3];
             if (!tt__edge_point_at(mesh, corner_uv, atlas, a, t, &pa) ||
                 !tt__edge_point_at(mesh, corner_uv, atlas, b, 1.0f - t, &pb) ||
                 !tt__edge_point_at(mesh, corner_uv, atlas, other, t_other, &po))
                 continue;
-            tt__sample_inside(atlas, &pa, 0.5f, sa);
-            tt__sample_inside(atlas, &pa, 1.5f, sa_deeper);
-            tt__sample_inside(atlas, &pb, 0.5f, sb);
-            tt__sample_inside(atlas, &po, 0.5f, so);
+            tt__displayed(atlas, &pa, 0.5f, sa);
+            tt__displayed(atlas, &pa, 1.5f, sa_deeper);
+            tt__displayed(atlas, &pb, 0.5f, sb);
+            tt__displayed(atlas, &po, 0.5f, so);
             seam += tt__texel_difference(sa, sb);
             same += tt__texel_difference(sa, sa_deeper);
             unrelated += tt__texel_difference(sa, so);
             samples++;
+            edge_samples++;
         }
+        if (edge_samples > 0) report->edges_measured++;
     }
-    tt__free(&mesh->allocator, interior);
-    report->edges_measured = ninterior > 1 ? ninterior : 0;
-    if (samples > 0) {
-        report->seam = seam / (double)samples;
-        report->same_face = same / (double)samples;
-        report->unrelated = unrelated / (double)samples;
-        report->score = report->unrelated - report->same_face > 1e-9
-                            ? (report->seam - report->same_face) / (report->unrelated - report->same_face)
-                            : tt__not_a_number();
+    tt__free(allocator, interior);
+    if (samples == 0) {
+        report->edges_measured = 0;
+        return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                        ninterior < 2 ? "the mesh has %d interior edges: the seam measure needs at least two"
+                                      : "none of the %d interior edges could be sampled (zero length or non-finite "
+                                        "UVs)",
+                        ninterior);
     }
+    report->samples = samples;
+    report->seam = seam / (double)samples;
+    report->same_face = same / (double)samples;
+    report->unrelated = unrelated / (double)samples;
+    if (report->unrelated - report->same_face > 1e-9)
+        report->score = (report->seam - report->same_face) / (report->unrelated - report->same_face);
     return TT_OK;
 }
 
 TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
-                                  int *counts)
+                                  int *counts, tt_error *error)
 {
     tt_tile_layout resolved;
+    tt_result result;
     int f, c, base;
-    if (!mesh || !layout || !corner_type || !counts) return TT_ERROR_INVALID_ARGUMENT;
-    if (tt_tile_layout_resolve(layout, &resolved, NULL) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    tt__ok(error);
+    if (!mesh || !layout || !corner_type || !counts)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_tile_histogram needs a mesh, a layout, corner types and counts (got NULL)");
+    if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
     base = 2 * resolved.colors;
     for (f = 0; f < mesh->nfaces; f++)
-        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4) return TT_ERROR_NOT_QUAD_MESH;
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4)
+            return tt__fail(error, TT_ERROR_NOT_QUAD_MESH, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners; tiles belong to quads", f,
+                            mesh->face_start[f + 1] - mesh->face_start[f]);
     for (c = 0; c < mesh->ncorners; c++)
-        if (corner_type[c] >= base) return TT_ERROR_INVALID_ARGUMENT;
+        if (corner_type[c] >= base)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, mesh->corner_face[c], c, -1, -1,
+                            "corner %d has boundary type %d, but %d colors allow 0..%d", c, corner_type[c],
+                            resolved.colors, base - 1);
     memset(counts, 0, (size_t)tt_tile_layout_tile_count(&resolved) * sizeof(int));
     for (f = 0; f < mesh->nfaces; f++) counts[tt_tile_index(&resolved, corner_type + 4 * (size_t)f)]++;
     return TT_OK;
@@ -3488,10 +4034,17 @@ static void tt__face_tangents(const float *const point[4], int dims, int size, d
     }
 }
 
-TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch)
+TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch, tt_error *error)
 {
-    int f;
-    if (!mesh || !corner_uv || !stretch) return TT_ERROR_INVALID_ARGUMENT;
+    int f, c;
+    tt__ok(error);
+    if (!mesh || !corner_uv || !stretch)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_face_stretch needs a mesh, UVs and the stretch array (got NULL)");
+    for (c = 0; c < 2 * mesh->ncorners; c++)
+        if (!tt__is_finite(corner_uv[c]))
+            return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
+                            "corner %d (face %d) has a non-finite UV", c / 2, mesh->corner_face[c / 2]);
     for (f = 0; f < mesh->nfaces; f++) {
         /* Tangents of the face's own parametrisation s,t at its centre: for a
            quad the bilinear patch's derivatives, otherwise the first triangle.
@@ -3550,6 +4103,7 @@ static int tt__face_normal_d(const tt_mesh *mesh, int face, double normal[3])
 TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
 {
     double n[3];
+    TT_ASSERT(mesh && normal && face >= 0 && face < mesh->nfaces);
     tt__face_normal_d(mesh, face, n);
     normal[0] = (float)n[0]; normal[1] = (float)n[1]; normal[2] = (float)n[2];
 }
@@ -3661,11 +4215,11 @@ static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a,
     return sqrt(tt__dot3(da, da)) + sqrt(tt__dot3(db, db));
 }
 
-TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options, float *face_vectors,
-                                 tt_error *error)
+TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
+                                 const tt_allocator *allocator, float *face_vectors, tt_error *error)
 {
     tt_field_options opt;
-    const tt_allocator *al;
+    const tt_allocator *al = allocator;
     double up[3], diag, scale, sigma, lo[3], hi[3];
     double *normal = NULL, *vec = NULL, *centroid = NULL, *dist = NULL, *trans = NULL, *sum = NULL,
            *wsum = NULL, *lsum = NULL, *wlog = NULL, *best = NULL;
@@ -3679,7 +4233,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
                         "tt_tangent_field needs a mesh and an output array (got NULL)");
     if (options) opt = *options;
     else memset(&opt, 0, sizeof opt);
-    al = opt.allocator.alloc ? &opt.allocator : &mesh->allocator;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     nf = mesh->nfaces;
 
     /* Options. */
@@ -3738,23 +4292,27 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
         if (con->face < 0 || con->face >= nf) {
             result = tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, con->face, -1, -1, -1,
                               "constraint %d names face %d, but the mesh has %d faces", i, con->face, nf);
+            if (error) error->item = i;
             goto done;
         }
         if (!tt__is_finite(con->vector[0]) || !tt__is_finite(con->vector[1]) || !tt__is_finite(con->vector[2]) ||
             !tt__is_finite(con->sigma) || !tt__is_finite(con->weight)) {
             result = tt__fail(error, TT_ERROR_NON_FINITE, con->face, -1, -1, -1,
                               "constraint %d (face %d) has a NaN or infinite vector, sigma or weight", i, con->face);
+            if (error) error->item = i;
             goto done;
         }
         if (con->sigma < 0.0f || con->weight < 0.0f) {
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
                               "constraint %d (face %d) has sigma %g and weight %g; neither may be negative", i,
                               con->face, con->sigma, con->weight);
+            if (error) error->item = i;
             goto done;
         }
         if (state[con->face] < 0) {
             result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, con->face, -1, -1, -1,
                               "constraint %d is on face %d, which has zero area and no plane", i, con->face);
+            if (error) error->item = i;
             goto done;
         }
         for (k = 0; k < 3; k++) v[k] = con->vector[k];
@@ -3766,6 +4324,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
                               "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
                               con->vector[0], con->vector[1], con->vector[2],
                               len > 0.0 ? "perpendicular to the face" : "zero");
+            if (error) error->item = i;
             goto done;
         }
     }
@@ -4063,11 +4622,12 @@ static void tt__distance_transform(float *grid, int gw, int gh, float *line, flo
 }
 
 TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
-                                      tt_image *patch, tt_error *error)
+                                      const tt_allocator *allocator, tt_image **out_patch, tt_error *error)
 {
     const float big = 1e30f;
     tt_patch_options opt;
-    const tt_allocator *al;
+    const tt_allocator *al = allocator;
+    tt_image *patch = NULL;
     tt_result result = TT_OK;
     float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL, *q = NULL;
     int *v = NULL;
@@ -4075,8 +4635,10 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     size_t count, i;
     float falloff, roughness, deepest = 0.0f;
 
-    if (patch) memset(patch, 0, sizeof *patch);
-    if (!patch) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "patch is NULL");
+    tt__ok(error);
+    if (!out_patch) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_patch is NULL");
+    *out_patch = NULL;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (!source || !source->pixels || source->width <= 0 || source->height <= 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
     w = source->width;
@@ -4106,15 +4668,17 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     /* Which shape: source alpha, mask alpha, mask grey, or the splotch. */
     for (i = 0; i < count * 4; i++) {
         if (!tt__is_finite(source->pixels[i]))
-            return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1, "source texel (%d, %d) is not finite",
-                            (int)((i / 4) % (size_t)w), (int)((i / 4) / (size_t)w));
+            return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, (int)((i / 4) / (size_t)w), (int)((i / 4) % (size_t)w),
+                               "source texel (%d, %d) is not finite", (int)((i / 4) % (size_t)w),
+                               (int)((i / 4) / (size_t)w));
         if ((i & 3) == 3 && source->pixels[i] < 1.0f) source_alpha = 1;
     }
     if (!source_alpha && mask) {
         for (i = 0; i < count * 4; i++) {
             if (!tt__is_finite(mask->pixels[i]))
-                return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1, "mask texel (%d, %d) is not finite",
-                                (int)((i / 4) % (size_t)w), (int)((i / 4) / (size_t)w));
+                return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, (int)((i / 4) / (size_t)w),
+                                   (int)((i / 4) % (size_t)w), "mask texel (%d, %d) is not finite",
+                                   (int)((i / 4) % (size_t)w), (int)((i / 4) / (size_t)w));
             if ((i & 3) == 3 && mask->pixels[i] < 1.0f) mask_alpha = 1;
         }
     }
@@ -4126,7 +4690,6 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
                             "falloff %g leaves no room for a splotch in a %d x %d image", (double)falloff, w, h);
     }
 
-    al = &opt.allocator;
     gw = w + 2;
     gh = h + 2;
     n = (gw > gh ? gw : gh);
@@ -4226,11 +4789,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         goto done;
     }
 
-    result = tt_image_create(patch, w, h, al);
-    if (result != TT_OK) {
-        result = tt__fail(error, result, -1, -1, -1, -1, "could not allocate the %d x %d patch", w, h);
-        goto done;
-    }
+    if ((result = tt_image_create(w, h, al, &patch, error)) != TT_OK) goto done;
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
             size_t at = (size_t)y * (size_t)w + (size_t)x;
@@ -4242,6 +4801,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
             o[2] = s[2] * a;
             o[3] = a;
         }
+    *out_patch = patch;
     result = tt__ok(error);
 
 done:
@@ -5030,7 +5590,7 @@ typedef struct tt__entry {
 
 typedef struct tt__lapper {
     const tt_mesh *mesh;
-    const tt_image *patches;
+    tt_image *const *patches;
     int npatches;
     const float *field;
     int isotropic;
@@ -5105,7 +5665,7 @@ static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int ne
    memory. */
 static float tt__patch_depth(tt__lapper *L, int index)
 {
-    const tt_image *patch = &L->patches[index];
+    const tt_image *patch = L->patches[index];
     const float big = 1e30f;
     int w = patch->width, h = patch->height, gw = w + 2, gh = h + 2, n = gw > gh ? gw : gh, x, y;
     float *grid = TT__ALLOC(L->al, float, (size_t)gw * gh), *line = TT__ALLOC(L->al, float, n);
@@ -5399,7 +5959,7 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
     int n = L->npatch_verts, nt = 0, i, j, k, f;
     double trace = 0.0, penalty, seed_uv[2] = {0.0, 0.0};
     double *b_s, *b_t, *x_s, *x_t;
-    tt_sparse_matrix A;
+    tt_sparse_matrix *A;
     tt_cg_options cg;
     tt_result r;
     memset(&A, 0, sizeof A);
@@ -5441,14 +6001,13 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
             nt++;
         }
     }
-    r = tt_sparse_from_triplets(&A, n, n, L->triplets, nt, L->al, NULL);
+    r = tt_sparse_from_triplets(n, n, L->triplets, nt, L->al, &A, NULL);
     if (r != TT_OK) return r == TT_ERROR_OUT_OF_MEMORY ? r : TT_OK;
     memset(&cg, 0, sizeof cg);
     cg.tolerance = TT__LAPPED_CG_TOLERANCE;
-    cg.allocator = *L->al;
-    r = tt_cg_solve(&A, b_s, x_s, &cg, NULL, NULL);
-    if (r == TT_OK || r == TT_ERROR_NOT_CONVERGED) r = tt_cg_solve(&A, b_t, x_t, &cg, NULL, NULL);
-    tt_sparse_free(&A);
+    r = tt_cg_solve(A, b_s, &cg, L->al, x_s, NULL, NULL);
+    if (r == TT_OK || r == TT_ERROR_NOT_CONVERGED) r = tt_cg_solve(A, b_t, &cg, L->al, x_t, NULL, NULL);
+    tt_sparse_free(A);
     if (r == TT_ERROR_OUT_OF_MEMORY) return r;
     if (r != TT_OK && r != TT_ERROR_NOT_CONVERGED) return TT_OK;
     for (k = 0; k < 3; k++) {
@@ -5471,7 +6030,7 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
    stretches a cell to at most rho texels. */
 static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, int patch, unsigned char *marks)
 {
-    const tt_image *image = &L->patches[patch];
+    const tt_image *image = L->patches[patch];
     const float *depth = L->depth[patch];
     int r = L->sample_res[f], count = L->sample_start[f + 1] - L->sample_start[f], s, added = 0;
     int w = image->width, h = image->height;
@@ -5652,16 +6211,17 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
                         mesh->face_start[f + 1] - mesh->face_start[f]);
     }
     for (i = 0; i < L->npatches; i++) {
-        const tt_image *p = &L->patches[i];
+        const tt_image *p = L->patches[i];
         size_t n, j;
-        if (p->width <= 0 || p->height <= 0 || !p->pixels)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "texture patch %d is empty", i);
+        if (!p || p->width <= 0 || p->height <= 0 || !p->pixels)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1, "texture patch %d is NULL or empty", i);
         n = (size_t)p->width * p->height * 4;
         for (j = 0; j < n; j++)
             if (!tt__is_finite(p->pixels[j]))
-                return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
-                                "texture patch %d has a NaN or infinite value at texel (%d, %d)", i,
-                                (int)(j / 4 % (size_t)p->width), (int)(j / 4 / (size_t)p->width));
+                return tt__fail_at(error, TT_ERROR_NON_FINITE, i, (int)(j / 4 / (size_t)p->width),
+                                   (int)(j / 4 % (size_t)p->width),
+                                   "texture patch %d has a NaN or infinite value at texel (%d, %d)", i,
+                                   (int)(j / 4 % (size_t)p->width), (int)(j / 4 / (size_t)p->width));
     }
     L->hull = TT__ALLOC(L->al, float *, L->npatches);
     L->depth = TT__ALLOC(L->al, float *, L->npatches);
@@ -5695,7 +6255,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         !L->patch_verts || !L->heap || !L->triplets || !L->solve || !L->depth)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     for (i = 0; i < L->npatches; i++) {
-        const tt_image *p = &L->patches[i];
+        const tt_image *p = L->patches[i];
         size_t j, n = (size_t)p->width * p->height, opaque = 0;
         float deepest = tt__patch_depth(L, i);
         tt_result r;
@@ -5931,7 +6491,7 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
     int kept = L->nentries - removed, e, n = 0, p = -1, last_paste = -1, i;
     double angle_sum = 0.0;
     double *scales;
-    out->allocator = *L->al;
+    out->allocator = tt__allocator_copy(L->al);
     out->faces = TT__ALLOC(L->al, int, kept > 0 ? kept : 1);
     out->uv = TT__ALLOC(L->al, float, 6 * (size_t)(kept > 0 ? kept : 1));
     out->pastes = TT__ALLOC(L->al, tt_paste, L->npastes > 0 ? L->npastes : 1);
@@ -5968,18 +6528,21 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
     return TT_OK;
 }
 
-TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, const tt_image *patches,
-                                int npatches, const tt_lapped_options *options, tt_lapped *result,
-                                tt_error *error)
+TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, tt_image *const *patches,
+                                int npatches, const tt_lapped_options *options, const tt_allocator *allocator,
+                                tt_lapped **out_lapped, tt_error *error)
 {
     tt__lapper L;
     tt_lapped_options opts;
+    tt_lapped *result;
     tt_result r;
     int max_pastes;
-    if (result) memset(result, 0, sizeof *result);
-    if (!mesh || !face_vectors || !patches || !result)
+    tt__ok(error);
+    if (out_lapped) *out_lapped = NULL;
+    if (!mesh || !face_vectors || !patches || !out_lapped)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_lapped_paste: mesh, face_vectors, patches and result must not be NULL");
+                        "tt_lapped_paste: mesh, face_vectors, patches and out_lapped must not be NULL");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (npatches < 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_lapped_paste: npatches is %d, it must be at least 1", npatches);
@@ -5995,7 +6558,7 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
     L.npatches = npatches;
     L.field = face_vectors;
     L.isotropic = opts.isotropic != 0;
-    L.al = opts.allocator.alloc ? &opts.allocator : &mesh->allocator;
+    L.al = allocator;
     tt_rng_seed(&L.rng, opts.seed, 0x1a99ed);
     r = tt__lapper_setup(&L, max_pastes, error);
     while (r == TT_OK && L.nuncovered > 0) {
@@ -6038,11 +6601,17 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
     }
     if (r == TT_OK) {
         int removed = tt__remove_hidden(&L);
-        r = tt__lapped_output(&L, removed, result);
-        if (r != TT_OK) {
-            tt_lapped_free(result);
-            r = tt__fail(error, r, -1, -1, -1, -1, "out of memory");
+        result = TT__ALLOC(L.al, tt_lapped, 1);
+        if (result) {
+            memset(result, 0, sizeof *result);
+            r = tt__lapped_output(&L, removed, result);
         }
+        if (!result || r != TT_OK) {
+            tt_lapped_free(result);
+            result = NULL;
+            r = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for the paste list");
+        }
+        *out_lapped = result;
     }
     tt__lapper_free(&L);
     return r == TT_OK ? tt__ok(error) : r;
@@ -6050,11 +6619,13 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
 
 TTDEF void tt_lapped_free(tt_lapped *lapped)
 {
+    tt_allocator allocator;
     if (!lapped) return;
-    tt__free(&lapped->allocator, lapped->pastes);
-    tt__free(&lapped->allocator, lapped->faces);
-    tt__free(&lapped->allocator, lapped->uv);
-    memset(lapped, 0, sizeof *lapped);
+    allocator = lapped->allocator;
+    tt__free(&allocator, lapped->pastes);
+    tt__free(&allocator, lapped->faces);
+    tt__free(&allocator, lapped->uv);
+    tt__free(&allocator, lapped);
 }
 
 /* ---- Measuring, packing and baking (Praun et al. Sec. 4) ---------------- */
@@ -6080,34 +6651,55 @@ static void tt__entry_map_vector(const tt_mesh *mesh, int face, const float *uv,
    With no entries both errors are 0. Non-finite UVs or field vectors of an
    entry give TT_ERROR_NON_FINITE rather than NaN statistics. */
 TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
-                                  tt_lapped_report *report)
+                                  const tt_allocator *allocator, tt_lapped_report *report, tt_error *error)
 {
-    const tt_allocator *al;
+    const tt_allocator *al = allocator;
     double *scale_error = NULL, angle_sum = 0.0;
     unsigned char *covered = NULL;
     int n, e, f, k;
 
+    tt__ok(error);
     if (report) memset(report, 0, sizeof *report);
-    if (!mesh || !face_vectors || !lapped || !report) return TT_ERROR_INVALID_ARGUMENT;
-    if (mesh->min_face_size != 3 || mesh->max_face_size != 3) return TT_ERROR_INVALID_ARGUMENT;
+    if (!mesh || !face_vectors || !lapped || !report)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_lapped_measure needs a mesh, face vectors, pastes and a report (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (mesh->min_face_size != 3 || mesh->max_face_size != 3) {
+        for (f = 0; f < mesh->nfaces && mesh->face_start[f + 1] - mesh->face_start[f] == 3; f++) {}
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                        "face %d has %d corners: the alignment measure needs triangles", f,
+                        mesh->face_start[f + 1] - mesh->face_start[f]);
+    }
     n = lapped->nentries;
-    if (n < 0 || (n > 0 && (!lapped->faces || !lapped->uv))) return TT_ERROR_INVALID_ARGUMENT;
+    if (n < 0 || (n > 0 && (!lapped->faces || !lapped->uv)))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the pastes are inconsistent: %d entries with faces or uv NULL", n);
     for (e = 0; e < n; e++) {
         f = lapped->faces[e];
-        if (f < 0 || f >= mesh->nfaces) return TT_ERROR_INDEX_OUT_OF_RANGE;
+        if (f < 0 || f >= mesh->nfaces)
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, e, -1, -1,
+                               "entry %d names face %d, but the mesh has %d faces", e, f, mesh->nfaces);
         for (k = 0; k < 6; k++)
-            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k])) return TT_ERROR_NON_FINITE;
+            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k])) {
+                tt__fail_at(error, TT_ERROR_NON_FINITE, e, -1, -1, "entry %d (face %d) has a non-finite UV", e, f);
+                if (error) error->face = f;
+                return TT_ERROR_NON_FINITE;
+            }
         for (k = 0; k < 3; k++)
-            if (!tt__is_finite(face_vectors[3 * (size_t)f + k])) return TT_ERROR_NON_FINITE;
+            if (!tt__is_finite(face_vectors[3 * (size_t)f + k])) {
+                tt__fail_at(error, TT_ERROR_NON_FINITE, e, -1, -1,
+                            "the field vector of face %d (entry %d) is not finite", f, e);
+                if (error) error->face = f;
+                return TT_ERROR_NON_FINITE;
+            }
     }
 
-    al = &mesh->allocator;
     scale_error = TT__ALLOC(al, double, n);
     covered = TT__ALLOC(al, unsigned char, mesh->nfaces);
     if (!scale_error || !covered) {
         tt__free(al, scale_error);
         tt__free(al, covered);
-        return TT_ERROR_OUT_OF_MEMORY;
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d entries", n);
     }
     memset(covered, 0, (size_t)mesh->nfaces);
 
@@ -6232,7 +6824,7 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
 /* State of one face's bake, shared by its raster callbacks. */
 typedef struct tt__bake {
     const tt_lapped *lapped;
-    const tt_image *patches;
+    tt_image *const *patches;
     const int *items;           /* pairs (entry, patch) of this face, in paste order */
     int nitems;
     double x[3], y[3];          /* the face's atlas triangle, pixels */
@@ -6267,7 +6859,7 @@ static void tt__bake_composite(const tt__bake *b, const double w[3], float out[4
     out[0] = out[1] = out[2] = out[3] = 0.0f;
     for (k = 0; k < b->nitems; k++) {
         const float *uv = b->lapped->uv + 6 * (size_t)b->items[2 * k];
-        const tt_image *patch = b->patches + b->items[2 * k + 1];
+        const tt_image *patch = b->patches[b->items[2 * k + 1]];
         double u = 0.0, v = 0.0, px, py;
         float sample[4];
         for (i = 0; i < 3; i++) {
@@ -6394,11 +6986,13 @@ static void tt__bake_gutter(tt__bake *b)
    filtering and mipmaps at chart borders read chart colours (the sampling
    problems Sec. 4 lists for atlases). Temporary memory comes from the mesh's
    allocator, all of it before the atlas is touched. */
-TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, const tt_image *patches,
-                               int npatches, const float *corner_uv, int gutter, tt_image *atlas,
-                               tt_error *error)
+TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
+                               int npatches, const float *corner_uv, const tt_bake_options *options,
+                               const tt_allocator *allocator, tt_image *atlas, tt_error *error)
 {
-    const tt_allocator *al;
+    const tt_allocator *al = allocator;
+    tt_bake_options opt;
+    int gutter;
     tt_result result;
     tt__bake bake;
     int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL;
@@ -6407,9 +7001,14 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, con
     float empty = tt__infinity();
     int f, p, e, k, c, width, height;
 
+    tt__ok(error);
     if (!mesh || !lapped || !patches || !corner_uv || !atlas)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_lapped_bake needs a mesh, pastes, patches, UVs and an atlas (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    gutter = opt.gutter;
     if (!atlas->pixels || atlas->width <= 0 || atlas->height <= 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the atlas is empty: create it with tt_image_create first");
@@ -6422,8 +7021,8 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, con
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "npatches is %d: need at least 1",
                         npatches);
     for (p = 0; p < npatches; p++)
-        if (!patches[p].pixels || patches[p].width <= 0 || patches[p].height <= 0)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "patch %d is empty", p);
+        if (!patches[p] || !patches[p]->pixels || patches[p]->width <= 0 || patches[p]->height <= 0)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1, "patch %d is NULL or empty", p);
     for (f = 0; f < mesh->nfaces; f++) {
         int count = mesh->face_start[f + 1] - mesh->face_start[f];
         if (count != 3)
@@ -6442,22 +7041,25 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, con
     for (e = 0; e < lapped->nentries; e++) {
         f = lapped->faces[e];
         if (f < 0 || f >= mesh->nfaces)
-            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, f, -1, -1, -1,
-                            "entry %d names face %d, but the mesh has %d faces", e, f, mesh->nfaces);
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, e, -1, -1,
+                               "entry %d names face %d, but the mesh has %d faces", e, f, mesh->nfaces);
         for (k = 0; k < 6; k++)
-            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k]))
-                return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
-                                "entry %d (face %d) has a non-finite paste UV", e, f);
+            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k])) {
+                tt__fail_at(error, TT_ERROR_NON_FINITE, e, -1, -1, "entry %d (face %d) has a non-finite paste UV", e,
+                            f);
+                if (error) error->face = f;
+                return TT_ERROR_NON_FINITE;
+            }
     }
     for (p = 0; p < lapped->npastes; p++) {
         const tt_paste *paste = lapped->pastes + p;
         if (paste->patch < 0 || paste->patch >= npatches)
-            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
-                            "paste %d uses patch %d, but there are %d patches", p, paste->patch, npatches);
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, p, -1, -1,
+                               "paste %d uses patch %d, but there are %d patches", p, paste->patch, npatches);
         if (paste->first < 0 || paste->nfaces < 0 || paste->first > lapped->nentries - paste->nfaces)
-            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
-                            "paste %d has entries %d..%d, but there are %d entries", p, paste->first,
-                            paste->first + paste->nfaces - 1, lapped->nentries);
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, p, -1, -1,
+                               "paste %d has entries %d..%lld, but there are %d entries", p, paste->first,
+                               (long long)paste->first + paste->nfaces - 1, lapped->nentries);
         total += (size_t)paste->nfaces;
         if (total > 0x3fffffff)
             return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
@@ -6467,7 +7069,6 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, con
     width = atlas->width;
     height = atlas->height;
     texels = (size_t)width * (size_t)height;   /* <= 2^30 */
-    al = &mesh->allocator;
     start = TT__ALLOC(al, int, (size_t)mesh->nfaces + 1);
     fill = TT__ALLOC(al, int, mesh->nfaces);
     items = TT__ALLOC(al, int, 2 * total);
@@ -6507,6 +7108,14 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, con
     for (f = 0; f < mesh->nfaces; f++) {
         float xy[6];
         double area2, longest = 0.0;
+        if (opt.progress && opt.progress((float)f / (float)mesh->nfaces, opt.progress_user_data)) {
+            /* The atlas is half-written: clear it, so no caller mistakes it
+               for a result. */
+            memset(atlas->pixels, 0, texels * 4 * sizeof(float));
+            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at face %d of %d", f,
+                              mesh->nfaces);
+            goto done;
+        }
         for (k = 0; k < 3; k++) {
             int corner = mesh->face_start[f] + k;
             xy[2 * k] = corner_uv[2 * (size_t)corner] * (float)width;
