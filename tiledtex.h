@@ -6261,8 +6261,8 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         tt_result r;
         if (deepest < 0.0f) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
         if (deepest == 0.0f)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                            "texture patch %d has no opaque texel (alpha >= %.2f)", i, TT_LAPPED_OPAQUE);
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
+                               "texture patch %d has no opaque texel (alpha >= %g)", i, TT_LAPPED_OPAQUE);
         if (i == 0 || deepest < shallowest) shallowest = deepest;
         r = tt__patch_hull(p, TT__LAPPED_HULL_VERTICES, L->al, &L->hull[i], &L->hull_count[i]);
         if (r != TT_OK)
@@ -6318,7 +6318,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     if (estimate > max_pastes)
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "the texture patches are too small for this mesh: covering it would take about "
-                        "%.0f pastes, more than the limit of %d (use a larger scale)", estimate, max_pastes);
+                        "%.3g pastes, more than the limit of %d (use a larger scale)", estimate, max_pastes);
     for (f = 0; f < nf; f++) {
         const double *t = L->tangent + 3 * (size_t)f;
         double projected = sqrt(tt__dot3(t, t)), longest = 0.0;
@@ -6340,8 +6340,8 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
                depth. */
             if (rho > 0.25 * shallowest || rho + TT__LAPPED_TEXEL_REACH >= shallowest)
                 return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
-                                "face %d is %.1f texture patches long, too coarse for a patch whose opaque part is "
-                                "%.1f texels deep: subdivide the mesh, or use a larger scale or a larger image",
+                                "face %d is %.3g texture patches long, too coarse for a patch whose opaque part is "
+                                "%.3g texels deep: subdivide the mesh, or use a larger scale or a larger image",
                                 f, longest / projected, (double)shallowest);
         }
         if (!tt__sample_table(L, L->sample_res[f]))
@@ -6567,7 +6567,7 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
         long long added;
         if (L.npastes >= max_pastes || L.npastes > 4.0 * L.expected_pastes + 100.0) {
             r = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
-                         "%d pastes (about %.0f expected) left %d faces uncovered: the pastes cover too little "
+                         "%d pastes (about %.3g expected) left %d faces uncovered: the pastes cover too little "
                          "of each face (use a larger scale, or subdivide the mesh)",
                          L.npastes, L.expected_pastes, L.nuncovered);
             break;
@@ -6785,11 +6785,11 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
         double smallest = need * per_side;
         if (smallest <= TT_MAX_IMAGE_SIZE)
             return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
-                            "%d triangles need %d x %d cells of at least %.0f texels for gutter %d: size %d "
-                            "gives %d, the smallest size that works is %.0f",
+                            "%d triangles need %d x %d cells of at least %.6g texels for gutter %d: size %d "
+                            "gives %d, the smallest size that works is %.6g",
                             mesh->nfaces, per_side, per_side, need, gutter, size, cell, smallest);
         return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
-                        "%d triangles need %d x %d cells of at least %.0f texels for gutter %d: that is %.0f "
+                        "%d triangles need %d x %d cells of at least %.6g texels for gutter %d: that is %.6g "
                         "texels, above the limit of %d; lower the gutter",
                         mesh->nfaces, per_side, per_side, need, gutter, smallest, TT_MAX_IMAGE_SIZE);
     }

@@ -49,7 +49,7 @@ int main(void)
     static const float cube_pos[8 * 3] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
     static const int cube_idx[6 * 4] = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7};
     int failures = 0, hist[8], comp[64], loops[64], nc = 0, nl = 0, lo[4] = {0, 0, 0, 0}, hi[4] = {1, 1, 1, 1};
-    int path[4], rx = 0, ry = 0;
+    int path[4], rx = 0, ry = 0, major = 0;
     float cost[8] = {1, 1, 1, 1, 0, 0, 0, 0}, rgba[4], tri[6] = {0, 0, 4, 0, 0, 4}, uvc[2], over_dst[4] = {0, 0, 0, 0};
     float over_src[4] = {1, 1, 1, 1}, stretch[64], *uv;
     unsigned char bytes[16 * 32 * 3], out8[4 * 4 * 4];
@@ -59,7 +59,7 @@ int main(void)
     tt_mesh *mesh = NULL, *quads = NULL;
     tt_error err;
     tt_mesh_stats stats;
-    tt_image image, rotated, half, atlas_copy;
+    tt_image *image = NULL, *rotated = NULL, *half = NULL, *atlas_copy = NULL;
     tt_tile_layout layout, resolved;
     tt_synth_options options;
     tt_tileset *tiles = NULL;
@@ -67,6 +67,8 @@ int main(void)
     int counts[16], i;
 
     EXPECT(strlen(tt_result_string(TT_ERROR_OUT_OF_MEMORY)) > 0);
+    EXPECT(strcmp(tt_version(&major, NULL, NULL), TILEDTEX_VERSION_STRING) == 0 &&
+           major == TILEDTEX_VERSION_MAJOR);
     tt_rng_seed(&rng, 42, 54);
     EXPECT(tt_rng_next(&rng) == 0xa15c02b7u);
     EXPECT(tt_rng_below(&rng, 10) < 10);
@@ -78,35 +80,38 @@ int main(void)
     desc.indices = cube_idx;
     desc.nfaces = 6;
     desc.fixed_face_size = 4;
-    EXPECT(tt_mesh_build(&desc, &mesh, &err) == TT_OK);
+    EXPECT(tt_mesh_build(&desc, NULL, &mesh, &err) == TT_OK);
     if (!mesh) return 1;
     EXPECT(tt_mesh_next(mesh, 0) == 1 && tt_mesh_prev(mesh, 0) == 3);
-    EXPECT(tt_mesh_compute_stats(mesh, &stats) == TT_OK && stats.genus == 0);
+    EXPECT(tt_mesh_compute_stats(mesh, NULL, &stats, &err) == TT_OK && stats.genus == 0);
     EXPECT(tt_mesh_valence(mesh, 0) == 3);
-    EXPECT(tt_mesh_valence_histogram(mesh, hist, 8) == TT_OK && hist[3] == 8);
-    EXPECT(tt_mesh_components(mesh, comp, &nc) == TT_OK && nc == 1);
-    EXPECT(tt_mesh_boundary_loops(mesh, loops, &nl) == TT_OK && nl == 0);
-    EXPECT(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &quads, &err) == TT_OK);
+    EXPECT(tt_mesh_valence_histogram(mesh, NULL, hist, 8, &err) == TT_OK && hist[3] == 8);
+    EXPECT(tt_mesh_components(mesh, NULL, comp, &nc, &err) == TT_OK && nc == 1);
+    EXPECT(tt_mesh_boundary_loops(mesh, loops, &nl, &err) == TT_OK && nl == 0);
+    EXPECT(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &quads, &err) == TT_OK);
     if (!quads) return 1;
 
     for (i = 0; i < (int)sizeof bytes; i++) bytes[i] = (unsigned char)(i * 7);
-    EXPECT(tt_image_from_bytes(&image, bytes, 16, 32, 3, 0, NULL) == TT_OK);
-    tt_image_sample_bilinear(&image, 1.5f, 1.5f, rgba);
+    EXPECT(tt_image_from_bytes(bytes, 16, 32, 3, 0, TT_COLOR_SRGB, NULL, &image, &err) == TT_OK);
+    if (!image) return 1;
+    EXPECT(tt_srgb_to_linear(tt_linear_to_srgb(0.25f)) > 0.2499f);
+    tt_image_sample_bilinear(image, 1.5f, 1.5f, rgba);
     tt_rotate_coords(1, 16, 32, 0, 0, &rx, &ry);
     EXPECT(rx == 0 && ry == 15);
-    EXPECT(tt_image_rotate90(&image, 1, &rotated, NULL) == TT_OK && rotated.width == 32);
-    EXPECT(tt_image_downsample2(&image, &half, NULL) == TT_OK && half.width == 8);
-    EXPECT(tt_image_create(&atlas_copy, 8, 16, NULL) == TT_OK);
-    EXPECT(tt_image_over(&atlas_copy, &half) == TT_OK);
+    EXPECT(tt_image_rotate90(image, 1, NULL, &rotated, &err) == TT_OK && rotated->width == 32);
+    EXPECT(tt_image_downsample2(image, NULL, &half, &err) == TT_OK && half->width == 8);
+    EXPECT(tt_image_create(8, 16, NULL, &atlas_copy, &err) == TT_OK);
+    if (!rotated || !half || !atlas_copy) return 1;
+    EXPECT(tt_image_over(atlas_copy, half, &err) == TT_OK);
     tt_rgba_over(over_dst, over_src);
     EXPECT(over_dst[3] == 1.0f);
     {
-        tt_image small;
-        EXPECT(tt_image_create(&small, 2, 2, NULL) == TT_OK);
-        tt_image_to_rgba8(&small, out8);
-        tt_image_free(&small);
+        tt_image *small = NULL;
+        EXPECT(tt_image_create(2, 2, NULL, &small, &err) == TT_OK);
+        if (small) tt_image_to_rgba8(small, TT_COLOR_LINEAR, out8);
+        tt_image_free(small);
     }
-    EXPECT(tt_min_error_cut(cost, 4, 2, lo, hi, path, NULL) == TT_OK && path[0] == 1);
+    EXPECT(tt_min_error_cut(cost, 4, 2, lo, hi, NULL, path, &err) == TT_OK && path[0] == 1);
     tt_raster_triangle(tri, 8, 8, on_pixel, NULL);
     EXPECT(raster_count > 0);
 
@@ -119,44 +124,45 @@ int main(void)
     types = (uint8_t *)malloc((size_t)quads->ncorners);
     uv = (float *)malloc(sizeof(float) * 2 * (size_t)quads->ncorners);
     if (!types || !uv) return 1;
-    EXPECT(tt_assign_boundaries(quads, &layout, 1, types) == TT_OK);
+    EXPECT(tt_assign_boundaries(quads, &layout, 1, NULL, types, &err) == TT_OK);
     EXPECT(tt_tile_index(&resolved, types) >= 0);
     tt_tile_corner_uv(&resolved, types, 2, uvc);
     EXPECT(tt_assign_uvs(quads, &layout, types, uv, &err) == TT_OK);
-    EXPECT(tt_tile_histogram(quads, &layout, types, counts) == TT_OK);
-    EXPECT(tt_face_stretch(quads, uv, stretch) == TT_OK);
+    EXPECT(tt_tile_histogram(quads, &layout, types, counts, &err) == TT_OK);
+    EXPECT(tt_face_stretch(quads, uv, stretch, &err) == TT_OK);
 
     memset(&options, 0, sizeof options);
     options.layout = layout;
     options.progress = progress;
-    EXPECT(tt_synthesize_tiles(&image, &options, &tiles, &err) == TT_OK);
+    EXPECT(tt_synthesize_tiles(image, &options, NULL, &tiles, &err) == TT_OK);
     if (tiles) {
-        EXPECT(tt_measure_seams(quads, uv, &tiles->levels[0], 1, &report) == TT_OK);
+        EXPECT(tt_measure_seams(quads, uv, &tiles->levels[0], NULL, NULL, &report, &err) == TT_OK);
         tt_tileset_free(tiles);
     }
 
     free(types);
     free(uv);
-    tt_image_free(&image);
-    tt_image_free(&rotated);
-    tt_image_free(&half);
-    tt_image_free(&atlas_copy);
+    tt_image_free(image);
+    tt_image_free(rotated);
+    tt_image_free(half);
+    tt_image_free(atlas_copy);
     if (mesh) {
         /* 7. Lapped textures: the tangent field. */
         float normal[3], *field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
         tt_face_normal(mesh, 0, normal);
         EXPECT(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2] > 0.99f);
-        EXPECT(field && tt_tangent_field(mesh, NULL, field, &err) == TT_OK);
+        EXPECT(field && tt_tangent_field(mesh, NULL, NULL, field, &err) == TT_OK);
         free(field);
     }
     {
         /* 7. Lapped textures: a texture patch with a splotch mask. */
-        tt_image source, patch;
+        tt_image *source = NULL, *patch = NULL;
         int k;
-        EXPECT(tt_image_create(&source, 32, 32, NULL) == TT_OK);
-        for (k = 0; k < 32 * 32 * 4; k++) source.pixels[k] = 1.0f;
-        EXPECT(tt_make_texture_patch(&source, NULL, NULL, &patch, &err) == TT_OK && patch.width == 32);
-        {
+        EXPECT(tt_image_create(32, 32, NULL, &source, &err) == TT_OK);
+        if (!source) return 1;
+        for (k = 0; k < 32 * 32 * 4; k++) source->pixels[k] = 1.0f;
+        EXPECT(tt_make_texture_patch(source, NULL, NULL, NULL, &patch, &err) == TT_OK && patch && patch->width == 32);
+        if (patch) {
             /* 7. Lapped textures: paste, measure, pack and bake on the cube
                split into triangles. */
             int tri_idx[36], f, c;
@@ -169,45 +175,54 @@ int main(void)
             desc.indices = tri_idx;
             desc.nfaces = 12;
             desc.fixed_face_size = 3;
-            EXPECT(tt_mesh_build(&desc, &tris, &err) == TT_OK);
+            EXPECT(tt_mesh_build(&desc, NULL, &tris, &err) == TT_OK);
             if (tris) {
                 float field[36], corner_uv[72];
                 tt_field_options fo;
-                tt_lapped lapped;
+                tt_lapped *lapped = NULL;
                 tt_lapped_report lr;
-                tt_image baked;
+                tt_image *baked = NULL;
+                tt_bake_options bo;
                 memset(&fo, 0, sizeof fo);
+                memset(&bo, 0, sizeof bo);
+                bo.gutter = 2;
                 fo.scale = 0.6f;
-                EXPECT(tt_tangent_field(tris, &fo, field, &err) == TT_OK);
-                EXPECT(tt_lapped_paste(tris, field, &patch, 1, NULL, &lapped, &err) == TT_OK);
-                EXPECT(tt_lapped_measure(tris, field, &lapped, &lr) == TT_OK && lr.uncovered_faces == 0);
-                EXPECT(tt_atlas_pack_pairs(tris, 64, 2, corner_uv, &err) == TT_OK);
-                EXPECT(tt_image_create(&baked, 64, 64, NULL) == TT_OK);
-                EXPECT(tt_lapped_bake(tris, &lapped, &patch, 1, corner_uv, 2, &baked, &err) == TT_OK);
-                tt_image_free(&baked);
-                tt_lapped_free(&lapped);
+                EXPECT(tt_tangent_field(tris, &fo, NULL, field, &err) == TT_OK);
+                EXPECT(tt_lapped_paste(tris, field, &patch, 1, NULL, NULL, &lapped, &err) == TT_OK && lapped);
+                if (lapped) {
+                    EXPECT(tt_lapped_measure(tris, field, lapped, NULL, &lr, &err) == TT_OK &&
+                           lr.uncovered_faces == 0);
+                    EXPECT(tt_atlas_pack_pairs(tris, 64, 2, corner_uv, &err) == TT_OK);
+                    EXPECT(tt_image_create(64, 64, NULL, &baked, &err) == TT_OK);
+                    if (baked)
+                        EXPECT(tt_lapped_bake(tris, lapped, &patch, 1, corner_uv, &bo, NULL, baked, &err) == TT_OK);
+                    tt_image_free(baked);
+                    tt_lapped_free(lapped);
+                }
                 tt_mesh_free(tris);
             }
         }
-        tt_image_free(&patch);
-        tt_image_free(&source);
+        tt_image_free(patch);
+        tt_image_free(source);
     }
     tt_mesh_free(quads);
     tt_mesh_free(mesh);
     {
         /* 4. Numerics: every public function once. */
         static const tt_triplet trip[4] = {{0, 0, 2.0}, {1, 1, 2.0}, {0, 1, 0.5}, {1, 0, 0.5}};
-        tt_sparse_matrix sm;
+        tt_sparse_matrix *sm = NULL;
         double rhs[2] = {1.0, 1.0}, sol[2] = {0.0, 0.0}, prod[2];
         tt_cg_options cgo;
         tt_cg_report cgr;
         memset(&cgo, 0, sizeof cgo);
         cgo.progress = progress;
-        EXPECT(tt_sparse_from_triplets(&sm, 2, 2, trip, 4, NULL, &err) == TT_OK);
-        EXPECT(tt_sparse_multiply(&sm, rhs, prod) == TT_OK && prod[0] == 2.5);
-        EXPECT(tt_cg_solve(&sm, rhs, sol, &cgo, &cgr, &err) == TT_OK && cgr.converged && sol[0] > 0.39 && sol[0] < 0.41);
+        EXPECT(tt_sparse_from_triplets(2, 2, trip, 4, NULL, &sm, &err) == TT_OK);
+        if (!sm) return 1;
+        EXPECT(tt_sparse_multiply(sm, rhs, prod, &err) == TT_OK && prod[0] == 2.5);
+        EXPECT(tt_cg_solve(sm, rhs, &cgo, NULL, sol, &cgr, &err) == TT_OK && cgr.converged && sol[0] > 0.39 &&
+               sol[0] < 0.41);
         EXPECT(tt_result_string(TT_ERROR_NOT_CONVERGED)[0] && tt_result_string(TT_ERROR_NOT_POSITIVE_DEFINITE)[0]);
-        tt_sparse_free(&sm);
+        tt_sparse_free(sm);
     }
 #ifdef COMPILE_CHECK_USER_ALLOC
     EXPECT(user_allocs > 0);
