@@ -6,7 +6,7 @@ STB_INC := $(shell pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/st
 TOOL_SRC := $(wildcard examples/*.c)
 TOOL_HDR := $(wildcard examples/*.h) tiledtex.h
 
-.PHONY: all demo test bench fuzz clean deps
+.PHONY: all demo test bench fuzz clean deps test-deps
 
 all: build/tiledtex
 
@@ -16,15 +16,18 @@ build/tiledtex: $(TOOL_SRC) $(TOOL_HDR) | build
 build:
 	mkdir -p build
 
-# Installs libstb-dev when it is missing and we may (root with apt-get),
-# otherwise says the one command to run.
+# Install what is missing when we may (root with apt-get), otherwise say the
+# one command to run: libstb-dev for the tool; clang and tcc for the tests.
 deps:
-	@bash tests/ensure_stb.sh
+	@bash tests/ensure_deps.sh demo
+
+test-deps:
+	@bash tests/ensure_deps.sh test
 
 demo: deps build/tiledtex
 	@bash examples/demo.sh
 
-test: deps
+test: test-deps
 	@bash tests/run.sh
 
 build/bench: bench/bench.c tiledtex.h | build

