@@ -475,7 +475,7 @@ typedef struct tt_triplet {
    You may change value[] in place (same pattern, new numbers); do not change
    the other fields. You may also fill this struct yourself from your own CSR
    arrays to call tt_sparse_multiply or tt_cg_solve (then do not call
-   tt_sparse_free on it); such arrays may have unsorted or repeated columns
+   tt_sparse_matrix_free on it); such arrays may have unsorted or repeated columns
    (repeats add up). */
 typedef struct tt_sparse_matrix {
     int rows, cols;
@@ -502,7 +502,7 @@ typedef struct tt_sparse_matrix {
      TT_ERROR_OUT_OF_MEMORY.
    Time O(ntriplets + rows + cols) (two stable bucket passes); memory: the
    result (12 bytes per entry + 4 per row) plus 8 bytes per triplet and 4 per
-   row or column of temporary space. Free the matrix with tt_sparse_free.
+   row or column of temporary space. Free the matrix with tt_sparse_matrix_free.
    Thread-safe: reads only the triplets. */
 TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,
                                         const tt_allocator *allocator, tt_sparse_matrix **out_matrix,
@@ -510,7 +510,7 @@ TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *tr
 
 /* Release a matrix made by tt_sparse_from_triplets (NULL is fine; never a
    struct you filled yourself). */
-TTDEF void tt_sparse_free(tt_sparse_matrix *matrix);
+TTDEF void tt_sparse_matrix_free(tt_sparse_matrix *matrix);
 
 /* y = A x: x has A->cols entries, y gets A->rows. x and y must not overlap
    (x == y is refused with TT_ERROR_INVALID_ARGUMENT). The CSR arrays are
@@ -620,9 +620,10 @@ typedef struct tt_tile_layout {
    TT_MAX_IMAGE_SIZE (TT_ERROR_TOO_LARGE otherwise; TT_ERROR_INVALID_ARGUMENT
    for the others). Resolving a resolved layout changes nothing. */
 TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error);
-/* For a resolved layout: tiles per atlas side T, atlas side W, total tiles
-   (2n)^4. A layout that tt_tile_layout_resolve would refuse gives 0 (and
-   fails TT_ASSERT); zeros in it mean defaults, as everywhere. */
+/* Tiles per atlas side T, atlas side W, total tiles (2n)^4; zeros in the
+   layout mean defaults, as everywhere.
+   Preconditions (TT_ASSERT): a layout that tt_tile_layout_resolve accepts;
+   any other gives 0, never an overflow. */
 TTDEF int tt_tile_layout_tiles_per_side(const tt_tile_layout *layout);
 TTDEF int tt_tile_layout_atlas_size(const tt_tile_layout *layout);
 TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout);
@@ -920,7 +921,7 @@ typedef struct tt_patch_options {
    options may be NULL (all defaults, seed 0). Deterministic for a given seed
    on a given platform (the splotch uses cosf/atan2f). */
 TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
-                                      const tt_allocator *allocator, tt_image **patch, tt_error *error);
+                                      const tt_allocator *allocator, tt_image **out_patch, tt_error *error);
 
 /* The paste loop.
    Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
@@ -2800,7 +2801,7 @@ TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *tr
                 matrix->value[pos - 1] += t->value;
                 if (!tt__is_finite_d(matrix->value[pos - 1])) {
                     tt__free(&matrix->allocator, work);
-                    tt_sparse_free(matrix);
+                    tt_sparse_matrix_free(matrix);
                     return tt__fail_at(error, TT_ERROR_NON_FINITE, by_row[i], r, t->col,
                                        "the triplets of row %d, column %d sum to infinity (triplet %d overflows)",
                                        r, t->col, by_row[i]);
@@ -2814,12 +2815,12 @@ TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *tr
     return TT_OK;
 
 out_of_memory:
-    tt_sparse_free(matrix);
+    tt_sparse_matrix_free(matrix);
     return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                     "out of memory building a %d x %d matrix from %d triplets", rows, cols, ntriplets);
 }
 
-TTDEF void tt_sparse_free(tt_sparse_matrix *matrix)
+TTDEF void tt_sparse_matrix_free(tt_sparse_matrix *matrix)
 {
     tt_allocator allocator;
     if (!matrix) return;
@@ -6007,7 +6008,7 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
     cg.tolerance = TT__LAPPED_CG_TOLERANCE;
     r = tt_cg_solve(A, b_s, &cg, L->al, x_s, NULL, NULL);
     if (r == TT_OK || r == TT_ERROR_NOT_CONVERGED) r = tt_cg_solve(A, b_t, &cg, L->al, x_t, NULL, NULL);
-    tt_sparse_free(A);
+    tt_sparse_matrix_free(A);
     if (r == TT_ERROR_OUT_OF_MEMORY) return r;
     if (r != TT_OK && r != TT_ERROR_NOT_CONVERGED) return TT_OK;
     for (k = 0; k < 3; k++) {

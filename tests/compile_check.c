@@ -222,7 +222,7 @@ int main(void)
         EXPECT(tt_cg_solve(sm, rhs, &cgo, NULL, sol, &cgr, &err) == TT_OK && cgr.converged && sol[0] > 0.39 &&
                sol[0] < 0.41);
         EXPECT(tt_result_string(TT_ERROR_NOT_CONVERGED)[0] && tt_result_string(TT_ERROR_NOT_POSITIVE_DEFINITE)[0]);
-        tt_sparse_free(sm);
+        tt_sparse_matrix_free(sm);
     }
 #ifdef COMPILE_CHECK_USER_ALLOC
     EXPECT(user_allocs > 0);

@@ -139,6 +139,15 @@ for (i = 0; i < 64 * 64; i++) photo->pixels[4 * i + 3] = 1.0f;' \
 }
 tt_mesh_free(mesh); tt_image_free(atlas); tt_image_free(photo); return 0; }'
 
+# THE API CONTRACT at the top of tiledtex.h, checked on every public
+# declaration (tests/check_api.sh enumerates them): one line each.
+while IFS= read -r line; do
+    case "$line" in
+    "ok   "*) pass "${line#ok   }" ;;
+    "FAIL "*) fail "${line#FAIL }" ;;
+    esac
+done < <(bash tests/check_api.sh tiledtex.h)
+
 # No raw allocation calls, in the code or in the documentation's examples
 # (which users copy): any malloc( free( realloc( calloc( that is not a member
 # call (allocator->free) or part of a longer name, outside the two default
