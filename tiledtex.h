@@ -6851,29 +6851,54 @@ static double tt__bake_segment_distance(const tt__bake *b, int i, int j, double 
     return sqrt(wx * wx + wy * wy);
 }
 
+/* Paste item k of the face sampled at barycentric weights w (weights outside
+   [0, 1] extend the paste's linear map across the face's edges). */
+static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float sample[4])
+{
+    const float *uv = b->lapped->uv + 6 * (size_t)b->items[2 * k];
+    const tt_image *patch = b->patches[b->items[2 * k + 1]];
+    double u = 0.0, v = 0.0, px, py;
+    int i;
+    for (i = 0; i < 3; i++) {
+        u += w[i] * uv[2 * i];
+        v += w[i] * uv[2 * i + 1];
+    }
+    /* The sampler clamps; clamping here first keeps the float conversion
+       defined for far extrapolations. */
+    px = u * patch->width;
+    py = (1.0 - v) * patch->height;
+    px = px < -1.0 ? -1.0 : (px > patch->width + 1.0 ? patch->width + 1.0 : px);
+    py = py < -1.0 ? -1.0 : (py > patch->height + 1.0 ? patch->height + 1.0 : py);
+    tt_image_sample_bilinear(patch, (float)px, (float)py, sample);
+}
+
+/* Pastes sampled from the top down before compositing, at most. */
+#define TT__BAKE_CACHE 32
+
 /* Composite the face's pastes at barycentric weights w (Sec. 4: the pastes
-   drawn in order with "over"), premultiplied. Weights outside [0, 1] extend
-   each paste's linear map across the face's edges. */
+   drawn in order with "over"), premultiplied. A paste that is opaque here
+   (alpha exactly 1) hides everything beneath it - "over" then gives the
+   paste itself, exactly - so the walk goes down from the topmost paste and
+   composites upward from the first opaque one: the same bits as drawing
+   every paste, at the cost of the one or two on top instead of the face's
+   whole overdraw. */
 static void tt__bake_composite(const tt__bake *b, const double w[3], float out[4])
 {
-    int k, i;
+    float cache[TT__BAKE_CACHE][4];
+    int n = b->nitems, k, cached = 0, opaque = 0;
     out[0] = out[1] = out[2] = out[3] = 0.0f;
-    for (k = 0; k < b->nitems; k++) {
-        const float *uv = b->lapped->uv + 6 * (size_t)b->items[2 * k];
-        const tt_image *patch = b->patches[b->items[2 * k + 1]];
-        double u = 0.0, v = 0.0, px, py;
+    for (k = n - 1; k >= 0 && cached < TT__BAKE_CACHE && !opaque; k--) {
+        tt__bake_sample(b, k, w, cache[cached]);
+        opaque = cache[cached][3] == 1.0f;
+        cached++;
+    }
+    if (opaque || cached == n) {
+        while (cached > 0) tt_rgba_over(out, cache[--cached]);
+        return;
+    }
+    for (k = 0; k < n; k++) {
         float sample[4];
-        for (i = 0; i < 3; i++) {
-            u += w[i] * uv[2 * i];
-            v += w[i] * uv[2 * i + 1];
-        }
-        /* The sampler clamps; clamping here first keeps the float conversion
-           defined for far extrapolations. */
-        px = u * patch->width;
-        py = (1.0 - v) * patch->height;
-        px = px < -1.0 ? -1.0 : (px > patch->width + 1.0 ? patch->width + 1.0 : px);
-        py = py < -1.0 ? -1.0 : (py > patch->height + 1.0 ? patch->height + 1.0 : py);
-        tt_image_sample_bilinear(patch, (float)px, (float)py, sample);
+        tt__bake_sample(b, k, w, sample);
         tt_rgba_over(out, sample);
     }
 }
