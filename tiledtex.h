@@ -1420,7 +1420,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     tt__edge_entry *local = NULL;
     tt__edge_problem problem;
     tt_result result = TT_OK;
-    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, f, c, v;
+    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, boundary = 0, f, c, v;
     long long total_corners;
 
     tt__ok(error);
@@ -1667,6 +1667,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
         int x = entries[c];
         if (x < 0) {
             mesh->twin[~x] = -1;
+            boundary = 1;
         } else {
             int a = x >> 1, b = entries[++c] >> 1;
             mesh->twin[a] = b;
@@ -1684,7 +1685,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     /* vert_corner prefers a boundary half-edge: of a vertex's boundary
        half-edges, the one to the largest vertex id (then the largest corner),
        whatever order they were paired in. */
-    for (c = 0; c < ncorners; c++)
+    for (c = 0; boundary && c < ncorners; c++)
         if (mesh->twin[c] < 0) {
             int u = mesh->corner_vert[c], w = mesh->corner_vert[tt_mesh_next(mesh, c)], cur = mesh->vert_corner[u];
             int cur_w = mesh->corner_vert[tt_mesh_next(mesh, cur)];
@@ -1695,11 +1696,22 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
        vertex id that does not is reported. */
     if (!permissive) {
         int bad = -1, bad_local = -1;
-        for (v = 0; v < nused; v++)
-            if (tt__fan_size(mesh, inverse[v]) != out_count[v] && (bad < 0 || inverse[v] < bad)) {
+        for (v = 0; v < nused; v++) {
+            /* tt__fan_size, with the usual all-quad and all-triangle meshes'
+               prev inlined: this loop is a chain of dependent loads. */
+            int start = mesh->vert_corner[inverse[v]], h = start, fan = 1, next;
+            if (fixed_size == 4) {
+                while ((next = mesh->twin[(h & 3) ? h - 1 : h + 3]) >= 0 && next != start) h = next, fan++;
+            } else if (fixed_size == 3) {
+                while ((next = mesh->twin[h % 3 ? h - 1 : h + 2]) >= 0 && next != start) h = next, fan++;
+            } else {
+                fan = tt__fan_size(mesh, inverse[v]);
+            }
+            if (fan != out_count[v] && (bad < 0 || inverse[v] < bad)) {
                 bad = inverse[v];
                 bad_local = v;
             }
+        }
         if (bad >= 0) {
             result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, mesh->corner_face[mesh->vert_corner[bad]],
                               mesh->vert_corner[bad], bad, -1,
