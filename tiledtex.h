@@ -1674,8 +1674,6 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
             mesh->twin[b] = a;
         }
     }
-    for (f = 0; f < nfaces; f++)
-        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++) mesh->corner_face[c] = f;
     if (problem.corner >= 0) {
         result = tt__report_edge_problem(&problem, error);
         goto cleanup;
@@ -1685,42 +1683,50 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, tt_mesh **out_mesh, tt_e
     /* vert_corner prefers a boundary half-edge: of a vertex's boundary
        half-edges, the one to the largest vertex id (then the largest corner),
        whatever order they were paired in. */
-    for (c = 0; boundary && c < ncorners; c++)
-        if (mesh->twin[c] < 0) {
-            int u = mesh->corner_vert[c], w = mesh->corner_vert[tt_mesh_next(mesh, c)], cur = mesh->vert_corner[u];
-            int cur_w = mesh->corner_vert[tt_mesh_next(mesh, cur)];
-            if (mesh->twin[cur] >= 0 || cur_w < w || (cur_w == w && cur < c)) mesh->vert_corner[u] = c;
-        }
-
-    /* In strict mode every vertex's faces must form one fan; the smallest
-       vertex id that does not is reported. */
-    if (!permissive) {
-        int bad = -1, bad_local = -1;
-        for (v = 0; v < nused; v++) {
-            /* tt__fan_size, with the usual all-quad and all-triangle meshes'
-               prev inlined: this loop is a chain of dependent loads. */
-            int start = mesh->vert_corner[inverse[v]], h = start, fan = 1, next;
-            if (fixed_size == 4) {
-                while ((next = mesh->twin[(h & 3) ? h - 1 : h + 3]) >= 0 && next != start) h = next, fan++;
-            } else if (fixed_size == 3) {
-                while ((next = mesh->twin[h % 3 ? h - 1 : h + 2]) >= 0 && next != start) h = next, fan++;
-            } else {
-                fan = tt__fan_size(mesh, inverse[v]);
+    for (f = 0; boundary && f < nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+        for (c = first; c < end; c++)
+            if (mesh->twin[c] < 0) {
+                int u = mesh->corner_vert[c], w = mesh->corner_vert[c + 1 < end ? c + 1 : first];
+                int cur = mesh->vert_corner[u], cur_face = tt__face_of_corner(mesh, cur), cur_w;
+                cur_w = mesh->corner_vert[cur + 1 < mesh->face_start[cur_face + 1] ? cur + 1
+                                                                                    : mesh->face_start[cur_face]];
+                if (mesh->twin[cur] >= 0 || cur_w < w || (cur_w == w && cur < c)) mesh->vert_corner[u] = c;
             }
+    }
+
+    /* In strict mode every vertex's faces must form one fan (tt__fan_size's
+       walk); the smallest vertex id that does not is reported. The walk is a
+       chain of dependent loads, so each step is made one load: corner_face
+       first holds fan_next[h] = twin[prev(h)]. */
+    if (!permissive) {
+        int bad = -1, bad_local = -1, *fan_next = mesh->corner_face;
+        for (f = 0; f < nfaces; f++) {
+            int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+            fan_next[first] = mesh->twin[end - 1];
+            for (c = first + 1; c < end; c++) fan_next[c] = mesh->twin[c - 1];
+        }
+        for (v = 0; v < nused; v++) {
+            int start = mesh->vert_corner[inverse[v]], h = start, fan = 1, next;
+            while ((next = fan_next[h]) >= 0 && next != start) h = next, fan++;
             if (fan != out_count[v] && (bad < 0 || inverse[v] < bad)) {
                 bad = inverse[v];
                 bad_local = v;
             }
         }
         if (bad >= 0) {
-            result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, mesh->corner_face[mesh->vert_corner[bad]],
-                              mesh->vert_corner[bad], bad, -1,
+            int bad_corner = mesh->vert_corner[bad];
+            result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, tt__face_of_corner(mesh, bad_corner), bad_corner,
+                              bad, -1,
                               "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
                               "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
                               bad, out_count[bad_local]);
             goto cleanup;
         }
     }
+    for (f = 0; f < nfaces; f++)
+        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++) mesh->corner_face[c] = f;
+
 cleanup:
     tt__free(allocator, bucket_start);
     tt__free(allocator, out_count);
