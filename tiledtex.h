@@ -1601,6 +1601,17 @@ static int tt__face_of_corner(const tt_mesh *mesh, int corner)
     return lo;
 }
 
+/* A hint that memory is about to be read; it does nothing where the
+   compiler has no prefetch builtin. */
+#if defined(__GNUC__) || defined(__clang__)
+#define TT__PREFETCH(address) __builtin_prefetch(address)
+#else
+#define TT__PREFETCH(address) ((void)0)
+#endif
+
+/* How many corners ahead the builder prefetches a vertex's id and position. */
+#define TT__BUILD_PREFETCH 48
+
 /* A mesh with its arrays allocated (positions excepted), or NULL. */
 static tt_mesh *tt__mesh_alloc(const tt_allocator *allocator, int nverts, int nfaces, int ncorners, unsigned flags)
 {
@@ -1628,11 +1639,11 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                               tt_error *error)
 {
     tt_mesh *mesh = NULL;
-    int *bucket_start = NULL, *out_count = NULL, *stamp = NULL, *entries, largest_bucket = 0;
+    int *bucket_start = NULL, *out_count = NULL, *inverse = NULL, *stamp = NULL, *entries, largest_bucket = 0;
     tt__edge_entry *local = NULL;
     tt__edge_problem problem;
     tt_result result = TT_OK;
-    int permissive, fixed_size, nverts, nfaces, ncorners, f, c, v;
+    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, boundary = 0, f, c, v;
     long long total_corners;
 
     tt__ok(error);
@@ -1680,8 +1691,11 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
     if (!mesh)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                         "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
-    bucket_start = TT__ALLOC(allocator, int, (size_t)nverts + 1);
-    out_count = TT__ALLOC(allocator, int, nverts);
+    /* Per used vertex: there are at most ncorners of them. */
+    nlocal = nverts < ncorners ? nverts : ncorners;
+    bucket_start = TT__ALLOC(allocator, int, (size_t)nlocal + 1);
+    out_count = TT__ALLOC(allocator, int, nlocal);
+    inverse = TT__ALLOC(allocator, int, nlocal);
     if (desc->flags & TT_MESH_BORROW_POSITIONS) {
         mesh->flags = desc->flags;
         mesh->pos = desc->positions;
@@ -1690,7 +1704,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
         if (copy && nverts > 0) memcpy(copy, desc->positions, (size_t)nverts * 3 * sizeof(float));
         mesh->pos = copy;
     }
-    if (!bucket_start || !out_count || !mesh->pos) {
+    if (!bucket_start || !out_count || !inverse || !mesh->pos) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                           "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
         goto cleanup;
@@ -1707,13 +1721,19 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
         }
     }
 
-    /* Corners: copy and range-check them; count each vertex's outgoing
-       half-edges (for the fan check) and each edge's bucket, the bucket of its
-       smaller vertex. vert_corner starts as any outgoing half-edge. Until
-       pairing overwrites it, twin[c] holds half-edge c's destination. */
-    memset(bucket_start, 0, ((size_t)nverts + 1) * sizeof(int));
-    memset(out_count, 0, (size_t)nverts * sizeof(int));
+    /* Corners: copy and range-check them, and give the used vertices local
+       ids in order of first use (the index buffer's order). Everything the
+       pairing touches afterwards is indexed by corner or by local id, so it
+       runs through memory in index-buffer order whatever the numbering of the
+       vertices: a mesh with shuffled vertex ids costs about what a grid-ordered
+       one does. While the loop runs, vert_corner[v] is v's local id (-1:
+       unseen), inverse[l] the vertex of local id l, corner_face[l] its last
+       corner so far, out_count[l] its outgoing half-edges (for the fan check),
+       and twin[c] = 2 * (local id of corner c's vertex) + (c is the last corner
+       of its face). bucket_start counts each edge in the bucket of its end
+       with the smaller local id. */
     memset(mesh->vert_corner, 0xff, (size_t)nverts * sizeof(int));
+    bucket_start[0] = 0;
     c = 0;
     for (f = 0; f < nfaces; f++) {
         int size = fixed_size ? fixed_size : desc->face_sizes[f];
@@ -1723,7 +1743,16 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
         if (size > mesh->max_face_size) mesh->max_face_size = size;
         if (f == 0 || size < mesh->min_face_size) mesh->min_face_size = size;
         for (i = 0; i < size; i++, c++) {
-            int vert = desc->indices[c];
+            int vert = desc->indices[c], l;
+            if (c + TT__BUILD_PREFETCH < ncorners) {
+                /* With scattered vertex ids these two reads are the build's
+                   cache misses: start them early. */
+                unsigned ahead = (unsigned)desc->indices[c + TT__BUILD_PREFETCH];
+                if (ahead < (unsigned)nverts) {
+                    TT__PREFETCH(mesh->vert_corner + ahead);
+                    if (!permissive) TT__PREFETCH(desc->positions + 3 * (size_t)ahead);
+                }
+            }
             if (vert < 0 || vert >= nverts) {
                 result = tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, f, c, vert, -1,
                                   "face %d (corner %d) refers to vertex %d, but the mesh has %d vertices (0..%d)",
@@ -1731,12 +1760,21 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                 goto cleanup;
             }
             mesh->corner_vert[c] = vert;
-            mesh->vert_corner[vert] = c;
-            out_count[vert]++;
+            l = mesh->vert_corner[vert];
+            if (l < 0) {
+                l = nused++;
+                mesh->vert_corner[vert] = l;
+                inverse[l] = vert;
+                out_count[l] = 0;
+                bucket_start[l + 1] = 0;
+            }
+            out_count[l]++;
+            mesh->corner_face[l] = c;
+            mesh->twin[c] = 2 * l;
         }
+        mesh->twin[c - 1] |= 1;
         for (i = 0; i < size; i++) {
-            int a = verts[i], b = verts[i + 1 < size ? i + 1 : 0];
-            mesh->twin[first + i] = b;
+            int a = mesh->twin[first + i] >> 1, b = mesh->twin[first + (i + 1 < size ? i + 1 : 0)] >> 1;
             bucket_start[(a < b ? a : b) + 1]++;
         }
         if (!permissive) {
@@ -1765,21 +1803,26 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
         }
     }
     mesh->face_start[nfaces] = ncorners;
+    /* vert_corner starts as the vertex's last corner (any outgoing half-edge). */
+    for (v = 0; v < nused; v++) mesh->vert_corner[inverse[v]] = mesh->corner_face[v];
 
     /* Counting sort of the half-edges into their buckets: 2 * corner + 1 when
-       the half-edge runs from the larger vertex to the smaller. The entries
+       the half-edge runs from the larger local id to the smaller. The entries
        live in corner_face, which is only filled at the end: no extra memory
        for the largest array of the build. */
     entries = mesh->corner_face;
-    for (v = 0; v < nverts; v++) {
+    for (v = 0; v < nused; v++) {
         if (bucket_start[v + 1] > largest_bucket) largest_bucket = bucket_start[v + 1];
         bucket_start[v + 1] += bucket_start[v];
     }
-    for (c = 0; c < ncorners; c++) {
-        int a = mesh->corner_vert[c], b = mesh->twin[c];
-        entries[bucket_start[a < b ? a : b]++] = 2 * c + (a > b);
+    for (f = 0; f < nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1], a = mesh->twin[first] >> 1, b;
+        for (c = first; c < end; c++, a = b) {
+            b = mesh->twin[c + 1 < end ? c + 1 : first] >> 1;
+            entries[bucket_start[a < b ? a : b]++] = 2 * c + (a > b);
+        }
     }
-    for (v = nverts; v > 0; v--) bucket_start[v] = bucket_start[v - 1];
+    for (v = nused; v > 0; v--) bucket_start[v] = bucket_start[v - 1];
     bucket_start[0] = 0;
     local = TT__ALLOC(allocator, tt__edge_entry, largest_bucket);
     if (!local) {
@@ -1788,21 +1831,33 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
     }
 
     /* Pair twins bucket by bucket: the bucket's entries, keyed by the other
-       vertex, sorted by (other vertex, corner) so the halves of an edge sit
-       side by side in corner order; then one run of equal `other` is one
+       end's local id, sorted by (other end, corner) so the halves of an edge
+       sit side by side in corner order; then one run of equal `other` is one
        edge. One half-edge each way is an interior edge, a single one a
        boundary; anything else is non-manifold (three or more) or flipped (two
        the same way). Those are cut loose into boundaries; the problem with the
        smallest corner is the one reported, so errors come in index-buffer
-       order. A corner is in one bucket only, so overwriting its destination
-       (twin) here cannot disturb another bucket. */
+       order. twin still holds the local ids here (a half-edge's far end is the
+       next corner's), so the outcome goes back into the bucket in place: a
+       pair as 2 * a + 1 followed by 2 * b, a boundary half-edge h as ~h. */
+    memset(&problem, 0, sizeof problem);
     problem.corner = -1;
-    for (v = 0; v < nverts; v++) {
+    for (v = 0; v < nused; v++) {
         tt__edge_entry *e = local;
+        int *bucket = entries + bucket_start[v];
         int count = bucket_start[v + 1] - bucket_start[v], i = 0, k;
         for (k = 0; k < count; k++) {
-            int corner_dir = entries[bucket_start[v] + k], h = corner_dir >> 1;
-            e[k].other = mesh->corner_vert[h] + mesh->twin[h] - v;   /* the larger of the two ends */
+            int corner_dir = bucket[k], h = corner_dir >> 1, far;
+            if (corner_dir & 1) {
+                far = h;                                    /* runs from the other end to v */
+            } else if (!(mesh->twin[h] & 1)) {
+                far = h + 1;
+            } else if (fixed_size) {
+                far = h - fixed_size + 1;
+            } else {
+                for (far = h; far > 0 && !(mesh->twin[far - 1] & 1); far--) {}
+            }
+            e[k].other = mesh->twin[far] >> 1;
             e[k].corner_dir = corner_dir;
         }
         tt__sort_edge_entries(e, count);
@@ -1810,57 +1865,95 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
             int other = e[i].other, run_end = i + 1, backward = e[i].corner_dir & 1;
             while (run_end < count && e[run_end].other == other) backward += e[run_end++].corner_dir & 1;
             if (other != v && run_end - i == 2 && backward == 1) {
-                int a = e[i].corner_dir >> 1, b = e[i + 1].corner_dir >> 1;
-                mesh->twin[a] = b;
-                mesh->twin[b] = a;
+                bucket[i] = (e[i].corner_dir | 1);
+                bucket[i + 1] = (e[i + 1].corner_dir & ~1);
             } else if (other != v && run_end - i == 1) {
-                int a = e[i].corner_dir >> 1;
-                mesh->twin[a] = -1;
-                mesh->vert_corner[mesh->corner_vert[a]] = a;   /* prefer a boundary half-edge */
+                bucket[i] = ~(e[i].corner_dir >> 1);
             } else {
                 if (!permissive && other != v && (problem.corner < 0 || (e[i].corner_dir >> 1) < problem.corner)) {
                     int lowest = e[i].corner_dir >> 1;
                     problem.corner = lowest;
                     problem.a = mesh->corner_vert[lowest];
-                    problem.b = problem.a == v ? other : v;
+                    problem.b = problem.a == inverse[v] ? inverse[other] : inverse[v];
                     problem.result = run_end - i > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
                     problem.nfaces = run_end - i;
                     for (k = 0; k < 3; k++)
                         problem.faces[k] = i + k < run_end ? tt__face_of_corner(mesh, e[i + k].corner_dir >> 1) : -1;
                 }
-                for (k = i; k < run_end; k++) {
-                    int h = e[k].corner_dir >> 1;
-                    mesh->twin[h] = -1;
-                    mesh->vert_corner[mesh->corner_vert[h]] = h;
-                }
+                for (k = i; k < run_end; k++) bucket[k] = ~(e[k].corner_dir >> 1);
                 mesh->repaired_edges++;
             }
             i = run_end;
         }
     }
-    for (f = 0; f < nfaces; f++)
-        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++) mesh->corner_face[c] = f;
+    for (c = 0; c < ncorners; c++) {
+        int x = entries[c];
+        if (x < 0) {
+            mesh->twin[~x] = -1;
+            boundary = 1;
+        } else {
+            int a = x >> 1, b = entries[++c] >> 1;
+            mesh->twin[a] = b;
+            mesh->twin[b] = a;
+        }
+    }
     if (problem.corner >= 0) {
         result = tt__report_edge_problem(&problem, error);
         goto cleanup;
     }
     if (!permissive) mesh->repaired_edges = 0;
 
-    /* In strict mode every vertex's faces must form one fan. */
-    if (!permissive)
-        for (v = 0; v < nverts; v++)
-            if (out_count[v] > 0 && tt__fan_size(mesh, v) != out_count[v]) {
-                result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, mesh->corner_face[mesh->vert_corner[v]],
-                                  mesh->vert_corner[v], v, -1,
-                                  "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
-                                  "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
-                                  v, out_count[v]);
-                goto cleanup;
+    /* vert_corner prefers a boundary half-edge: of a vertex's boundary
+       half-edges, the one to the largest vertex id (then the largest corner),
+       whatever order they were paired in. */
+    for (f = 0; boundary && f < nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+        for (c = first; c < end; c++)
+            if (mesh->twin[c] < 0) {
+                int u = mesh->corner_vert[c], w = mesh->corner_vert[c + 1 < end ? c + 1 : first];
+                int cur = mesh->vert_corner[u], cur_face = tt__face_of_corner(mesh, cur), cur_w;
+                cur_w = mesh->corner_vert[cur + 1 < mesh->face_start[cur_face + 1] ? cur + 1
+                                                                                    : mesh->face_start[cur_face]];
+                if (mesh->twin[cur] >= 0 || cur_w < w || (cur_w == w && cur < c)) mesh->vert_corner[u] = c;
             }
+    }
+
+    /* In strict mode every vertex's faces must form one fan (tt__fan_size's
+       walk); the smallest vertex id that does not is reported. The walk is a
+       chain of dependent loads, so each step is made one load: corner_face
+       first holds fan_next[h] = twin[prev(h)]. */
+    if (!permissive) {
+        int bad = -1, bad_local = -1, *fan_next = mesh->corner_face;
+        for (f = 0; f < nfaces; f++) {
+            int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+            fan_next[first] = mesh->twin[end - 1];
+            for (c = first + 1; c < end; c++) fan_next[c] = mesh->twin[c - 1];
+        }
+        for (v = 0; v < nused; v++) {
+            int start = mesh->vert_corner[inverse[v]], h = start, fan = 1, next;
+            while ((next = fan_next[h]) >= 0 && next != start) h = next, fan++;
+            if (fan != out_count[v] && (bad < 0 || inverse[v] < bad)) {
+                bad = inverse[v];
+                bad_local = v;
+            }
+        }
+        if (bad >= 0) {
+            int bad_corner = mesh->vert_corner[bad];
+            result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, tt__face_of_corner(mesh, bad_corner), bad_corner,
+                              bad, -1,
+                              "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
+                              "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
+                              bad, out_count[bad_local]);
+            goto cleanup;
+        }
+    }
+    for (f = 0; f < nfaces; f++)
+        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++) mesh->corner_face[c] = f;
 
 cleanup:
     tt__free(allocator, bucket_start);
     tt__free(allocator, out_count);
+    tt__free(allocator, inverse);
     tt__free(allocator, local);
     tt__free(allocator, stamp);
     if (result != TT_OK) {

@@ -46,7 +46,7 @@ int main(void)
     tt_triplet *t;
     double *xs = (double *)malloc(sizeof(double) * (size_t)n), *b = (double *)malloc(sizeof(double) * (size_t)n);
     double *x = (double *)malloc(sizeof(double) * (size_t)n), ms[RUNS + 1], err = 0.0;
-    tt_sparse_matrix A;
+    tt_sparse_matrix *A = NULL;
     tt_cg_options opt;
     tt_cg_report rep;
     tt_error error;
@@ -65,7 +65,7 @@ int main(void)
         t[i].col = e[i].col;
         t[i].value = e[i].value;
     }
-    r = tt_sparse_from_triplets(&A, n, n, t, count, NULL, &error);
+    r = tt_sparse_from_triplets(n, n, t, count, NULL, &A, &error);
     if (r != TT_OK) {
         fprintf(stderr, "bench_cg: tt_sparse_from_triplets: %s\n", error.message);
         return 1;
@@ -77,7 +77,7 @@ int main(void)
         double start;
         memset(x, 0, sizeof(double) * (size_t)n);
         start = now_ms();
-        r = tt_cg_solve(&A, b, x, &opt, &rep, &error);
+        r = tt_cg_solve(A, b, &opt, NULL, x, &rep, &error);
         ms[run] = now_ms() - start;
         if (r != TT_OK) {
             fprintf(stderr, "bench_cg: tt_cg_solve: %s\n", error.message);
@@ -92,9 +92,9 @@ int main(void)
     printf("cg_laplacian_100k %.1f ms\n", ms[1 + RUNS / 2]);
     printf("cg_laplacian_100k %d iterations\n", iterations);
     fprintf(stderr, "bench_cg: %d unknowns, %d entries; runs %.1f..%.1f ms (warm-up %.1f); %.3f ms a step; "
-            "residual %.3g; |x - x*|_inf %.3g\n", n, A.nnz, ms[1], ms[RUNS], ms[0], ms[1 + RUNS / 2] / iterations,
+            "residual %.3g; |x - x*|_inf %.3g\n", n, A->nnz, ms[1], ms[RUNS], ms[0], ms[1 + RUNS / 2] / iterations,
             rep.residual, err);
-    tt_sparse_free(&A);
+    tt_sparse_matrix_free(A);
     free(e);
     free(t);
     free(xs);
