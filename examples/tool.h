@@ -1,16 +1,17 @@
 /* tool.h - shared pieces of the `tiledtex` command-line tool (not the library).
 
    The tool is a set of subcommands, one file each (synth.c, map.c, tile.c,
-   lapped.c, render.c, generate.c), dispatched by tiledtex.c. They share what is declared
-   here and implemented in tool_io.c:
+   lapped.c, render.c, generate.c), dispatched by tiledtex.c; synth, map and
+   tile also share tiled.c (see tiled.h). They share what is declared here:
 
-     - one-line error reporting          tool_fail, tool_usage
-     - command-line helpers              tool_option, parse_int, parse_size, ...
-     - OBJ reading and writing           obj_parse, obj_read, obj_write
-     - MTL writing                       mtl_add_material
-     - images                            image_load, png_encode
-     - atomic output                     tool_output: build every file in
+     tool_io.c   one-line errors         tool_fail, tool_usage
+                 files, byte buffers     tool_read_file, tool_buffer
+                 atomic output           tool_output: build every file in
                                          memory, then commit them all or none
+     cli.c       command-line helpers    tool_option, parse_int, parse_size, ...
+     image_io.c  images                  image_load, png_encode, output_add_png
+     obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
+                 MTL writing             mtl_add_material
 
    Conventions every command follows:
      - Errors are one line on stderr, "tiledtex: <message>" (or
@@ -54,12 +55,13 @@ int cmd_render(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 
 /* ---------------------------------------------------------------------- */
-/* Errors                                                                   */
+/* Errors (tool_io.c)                                                       */
 /* ---------------------------------------------------------------------- */
 
 /* The subcommand being run ("render"); the dispatcher sets it so that
    command-line errors can say which command they are about. NULL = none. */
 void tool_set_command(const char *name);
+const char *tool_command(void);
 
 /* Print "tiledtex: <message>" on stderr and return TOOL_EXIT_FAILURE, so a
    command can write `return tool_fail("cannot ...");`. */
@@ -77,8 +79,15 @@ int tool_usage(const char *format, ...)
 #endif
     ;
 
+/* Fill the `err` buffer a function was given (which may be NULL). */
+void tool_set_error(char *err, size_t err_size, const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 /* ---------------------------------------------------------------------- */
-/* Command-line helpers                                                     */
+/* Command-line helpers (cli.c)                                             */
 /*                                                                          */
 /* A command walks its arguments like this:                                 */
 /*                                                                          */
@@ -130,7 +139,7 @@ int parse_float_list(const char *option, const char *text, int count, double *ou
 int parse_int_list(const char *option, const char *text, int count, int *out);
 
 /* ---------------------------------------------------------------------- */
-/* Files and growing byte buffers                                           */
+/* Files and growing byte buffers (tool_io.c)                               */
 /* ---------------------------------------------------------------------- */
 
 /* Read a whole file (or "-" for standard input) into a malloc'ed buffer with a
@@ -148,6 +157,10 @@ typedef struct tool_buffer {
     int failed;
 } tool_buffer;
 
+/* An empty buffer, for initialising one (plain `= {0}` draws a warning from
+   C++ compilers with -Wextra). */
+#define TOOL_BUFFER_INIT {NULL, 0, 0, 0}
+
 void buffer_append(tool_buffer *buffer, const void *bytes, size_t count);
 void buffer_printf(tool_buffer *buffer, const char *format, ...)
 #if defined(__GNUC__) || defined(__clang__)
@@ -157,7 +170,8 @@ void buffer_printf(tool_buffer *buffer, const char *format, ...)
 void buffer_free(tool_buffer *buffer);
 
 /* ---------------------------------------------------------------------- */
-/* Atomic output: build every file in memory, then write them all or none  */
+/* Atomic output (tool_io.c): build every file in memory, then write them   */
+/* all or none                                                              */
 /* ---------------------------------------------------------------------- */
 
 typedef struct tool_output_file {
@@ -166,12 +180,13 @@ typedef struct tool_output_file {
     size_t size;
 } tool_output_file;
 
-/* Zero-initialise (tool_output out = {0};). */
+/* Zero-initialise (tool_output out = TOOL_OUTPUT_INIT;). */
 typedef struct tool_output {
     tool_output_file *files;
     int count;
     int capacity;
 } tool_output;
+#define TOOL_OUTPUT_INIT {NULL, 0, 0}
 
 /* Add a file. The batch takes ownership of `data` (malloc'ed, may be NULL when
    size is 0) whether or not the call succeeds. Adding a path that is already
@@ -180,8 +195,6 @@ int output_add(tool_output *output, const char *path, void *data, size_t size);
 /* Add the contents of a tool_buffer (which is emptied). Fails when the
    buffer's `failed` flag is set. */
 int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer);
-/* Encode `image` as PNG and add it. */
-int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size);
 
 /* Write every file to a temporary file beside it ("PATH.tiledtex-tmp"), and
    only when all of them were written completely rename each onto its real
@@ -193,7 +206,7 @@ int output_commit(tool_output *output, char *err, size_t err_size);
 void output_free(tool_output *output);
 
 /* ---------------------------------------------------------------------- */
-/* Images                                                                   */
+/* Images (image_io.c)                                                      */
 /* ---------------------------------------------------------------------- */
 
 /* Load a PNG / JPEG / TGA / BMP / PSD / GIF / HDR / PIC / PNM file as a float
@@ -204,9 +217,11 @@ int image_load(const char *path, tt_image *image, char *err, size_t err_size);
 
 /* Encode an image as an 8-bit RGBA PNG in memory (malloc'ed; free it). */
 int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, char *err, size_t err_size);
+/* Encode `image` as PNG and add it to an output batch. */
+int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size);
 
 /* ---------------------------------------------------------------------- */
-/* Wavefront OBJ                                                            */
+/* Wavefront OBJ (obj.c)                                                    */
 /* ---------------------------------------------------------------------- */
 
 typedef struct obj_mesh {
@@ -284,6 +299,14 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc);
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
    "map_d TEXTURE": the texture's alpha channel is the material's opacity. */
 void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha);
+
+/* ---------------------------------------------------------------------- */
+/* Paths and strings (tool_io.c)                                            */
+/* ---------------------------------------------------------------------- */
+
+/* A malloc'ed, NUL-terminated copy of `length` bytes of text; NULL when out
+   of memory. */
+char *tool_copy_string(const char *text, size_t length);
 
 /* The file name part of a path ("out/a.png" -> "a.png"), for mtllib / map_Kd
    lines that must be relative to the OBJ / MTL file. */
