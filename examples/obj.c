@@ -92,18 +92,27 @@ static int obj_error(obj_parser *P, const char *format, ...)
     return -1;
 }
 
+/* Lines end in "\n" (Unix), "\r\n" (Windows) or a lone "\r" (old Mac OS).
+   Returns how many bytes the line end at p takes, 0 when p is not at one. */
+static size_t line_end_length(const obj_parser *P, const char *p)
+{
+    if (p >= P->end) return 0;
+    if (*p == '\n') return 1;
+    if (*p == '\r') return (p + 1 < P->end && p[1] == '\n') ? 2 : 1;
+    return 0;
+}
+
 /* The current statement as printable text for messages: its first line, at
    most 60 bytes, with control bytes and non-ASCII shown as '?'. */
 static const char *quote_statement(const obj_parser *P, char *out, size_t out_size)
 {
     const char *p = P->statement;
     size_t n = 0;
-    while (p < P->end && *p != '\n' && n + 4 < out_size && n < 60) {
+    while (p < P->end && !line_end_length(P, p) && n + 4 < out_size && n < 60) {
         unsigned char c = (unsigned char)*p++;
-        if (c == '\r' && (p == P->end || *p == '\n')) break;
         out[n++] = (c >= 32 && c < 127) ? (char)c : '?';
     }
-    if (p < P->end && *p != '\n' && !(*p == '\r' && (p + 1 == P->end || p[1] == '\n'))) {
+    if (p < P->end && !line_end_length(P, p)) {
         out[n++] = '.'; out[n++] = '.'; out[n++] = '.';
     }
     out[n] = '\0';
@@ -115,19 +124,20 @@ static int out_of_memory(obj_parser *P)
     return obj_error(P, "out of memory");
 }
 
+/* Blanks between tokens ('\r' is a line end, see line_end_length). */
 static int is_blank(char c)
 {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+    return c == ' ' || c == '\t' || c == '\v' || c == '\f';
 }
 
 /* A '\' right before the end of a line joins the next line to this one.
    Returns how many bytes the continuation takes (0 if there is none here). */
 static size_t continuation_length(const obj_parser *P, const char *p)
 {
+    size_t newline;
     if (p >= P->end || *p != '\\') return 0;
-    if (p + 1 < P->end && p[1] == '\n') return 2;
-    if (p + 2 < P->end && p[1] == '\r' && p[2] == '\n') return 3;
-    return 0;
+    newline = line_end_length(P, p + 1);
+    return newline ? 1 + newline : 0;
 }
 
 static void count_line(obj_parser *P)
@@ -135,7 +145,7 @@ static void count_line(obj_parser *P)
     if (P->line < INT_MAX) P->line++;
 }
 
-/* Skip blanks and line continuations; stop at a newline, the end, or text. */
+/* Skip blanks and line continuations; stop at a line end, the end, or text. */
 static void skip_blanks(obj_parser *P)
 {
     for (;;) {
@@ -150,7 +160,7 @@ static void skip_blanks(obj_parser *P)
 
 static int at_statement_end(const obj_parser *P)
 {
-    return P->p >= P->end || *P->p == '\n';
+    return P->p >= P->end || line_end_length(P, P->p);
 }
 
 /* The next whitespace-separated token of the statement; length 0 at its end. */
@@ -159,20 +169,20 @@ static size_t next_token(obj_parser *P, const char **token)
     const char *start;
     skip_blanks(P);
     start = P->p;
-    while (P->p < P->end && *P->p != '\n' && !is_blank(*P->p) && !continuation_length(P, P->p)) P->p++;
+    while (P->p < P->end && !is_blank(*P->p) && !line_end_length(P, P->p) && !continuation_length(P, P->p)) P->p++;
     *token = start;
     return (size_t)(P->p - start);
 }
 
-/* Move past the rest of the statement and its newline. */
+/* Move past the rest of the statement and its line end. */
 static void finish_statement(obj_parser *P)
 {
-    while (P->p < P->end && *P->p != '\n') {
+    while (P->p < P->end && !line_end_length(P, P->p)) {
         size_t joined = continuation_length(P, P->p);
         if (joined) { P->p += joined; count_line(P); }
         else P->p++;
     }
-    if (P->p < P->end) { P->p++; count_line(P); }
+    if (P->p < P->end) { P->p += line_end_length(P, P->p); count_line(P); }
 }
 
 static int token_is(const char *token, size_t length, const char *word)
@@ -435,6 +445,19 @@ static int find_or_add_group(obj_parser *P, const char *name, size_t length)
     return mesh->ngroups++;
 }
 
+/* Statements that are valid OBJ but carry nothing this tool uses: normals
+   (recomputed when needed), smoothing groups, lines, points, parameter-space
+   vertices and display attributes. They are skipped without a word. */
+static int is_ignored_keyword(const char *keyword, size_t length)
+{
+    static const char *const ignored[] = {"vn", "vp", "s", "l", "p", "lod", "bevel", "c_interp", "d_interp",
+                                          "maplib", "usemap", "shadow_obj", "trace_obj"};
+    size_t i;
+    for (i = 0; i < sizeof ignored / sizeof ignored[0]; i++)
+        if (token_is(keyword, length, ignored[i])) return 1;
+    return 0;
+}
+
 static int parse_statement(obj_parser *P)
 {
     const char *keyword;
@@ -462,7 +485,19 @@ static int parse_statement(obj_parser *P)
         }
         return 0;
     }
-    return 0;   /* comments and everything else (vn, vp, s, l, p, curves, ...) are skipped */
+    if (length == 0 || keyword[0] == '#' || is_ignored_keyword(keyword, length)) return 0;
+    /* Anything else is not OBJ this reader knows: skip it, but count it, so
+       the tool can say so (a mangled "v" line would shift every index). */
+    if (P->mesh->unknown_statements++ == 0) {
+        size_t i, shown = length < sizeof P->mesh->first_unknown - 1 ? length : sizeof P->mesh->first_unknown - 1;
+        for (i = 0; i < shown; i++) {
+            unsigned char c = (unsigned char)keyword[i];
+            P->mesh->first_unknown[i] = (c >= 32 && c < 127) ? (char)c : '?';
+        }
+        P->mesh->first_unknown[shown] = '\0';
+        P->mesh->first_unknown_line = P->statement_line;
+    }
+    return 0;
 }
 
 static int obj_parse_named(const char *text, size_t length, const char *source, obj_mesh *out, char *err,
@@ -474,6 +509,9 @@ static int obj_parse_named(const char *text, size_t length, const char *source, 
     memset(P, 0, sizeof *P);
     P->p = text ? text : "";
     P->end = P->p + (text ? length : 0);
+    /* A UTF-8 byte-order mark, as some Windows editors write, is not part of
+       the first statement. */
+    if (P->end - P->p >= 3 && memcmp(P->p, "\xEF\xBB\xBF", 3) == 0) P->p += 3;
     P->line = 1;
     P->source = source;
     P->err = err;
@@ -521,6 +559,12 @@ int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size)
     if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
     result = obj_parse_named((const char *)data, size, path, out, err, err_size);
     free(data);
+    if (result == 0 && out->unknown_statements == 1)
+        tool_note("%s:%d: skipped a line with an unknown keyword, '%s'", path, out->first_unknown_line,
+                  out->first_unknown);
+    else if (result == 0 && out->unknown_statements > 1)
+        tool_note("%s:%d: skipped %d lines with unknown keywords, the first '%s'", path,
+                  out->first_unknown_line, out->unknown_statements, out->first_unknown);
     return result;
 }
 

@@ -54,6 +54,7 @@ static void print_help(void)
 int main(int argc, char **argv)
 {
     const subcommand *command;
+    int status;
     if (argc < 2)
         return tool_usage("needs a command: tile, lapped, synth, map, render or generate (see 'tiledtex --help')");
     if (tool_is_help(argv[1])) {
@@ -86,5 +87,7 @@ int main(int argc, char **argv)
         return tool_usage("unknown command '%s' (try 'tiledtex --help')", argv[1]);
     }
     tool_set_command(command->name);
-    return command->run(argc - 1, argv + 1);
+    status = command->run(argc - 1, argv + 1);
+    if (status == 0) tool_print_notes();
+    return status;
 }

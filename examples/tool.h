@@ -79,6 +79,17 @@ int tool_usage(const char *format, ...)
 #endif
     ;
 
+/* A warning for the user that is not an error ("mesh.obj:3: skipped ..."):
+   kept, and printed as "tiledtex: <message>" on stderr by tool_print_notes,
+   which main calls when the command succeeds, so that a failing command
+   still prints exactly one line. Notes past the first 16 are dropped. */
+void tool_note(const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+void tool_print_notes(void);
+
 /* Fill the `err` buffer a function was given (which may be NULL). */
 void tool_set_error(char *err, size_t err_size, const char *format, ...)
 #if defined(__GNUC__) || defined(__clang__)
@@ -235,21 +246,27 @@ typedef struct obj_mesh {
     char *mtllib;                     /* first mtllib name or NULL */
     int *vert_line;                   /* nverts: the file line of each `v`, for messages */
     int *face_line;                   /* nfaces: the file line of each `f` */
+    int unknown_statements;           /* statements with a keyword the reader does not know (skipped) */
+    int first_unknown_line;           /* the line of the first of them */
+    char first_unknown[32];           /* its keyword, cut short, unprintable bytes as '?' */
 } obj_mesh;
 
 /* Parse OBJ text (`length` bytes, need not end in NUL; any bytes are safe).
    Reads v, vt, f (corners v, v/vt, v//vn, v/vt/vn; negative indices count
    back from the latest vertex), g / o / usemtl (which group each face is in;
    the latest of these statements names it), and the first mtllib. Everything
-   else (vn values, s, l, p, comments, unknown statements) is skipped. A line
-   ending in '\' continues on the next. Returns 0, or -1 with a message naming
-   the line in err ("line 12: face with fewer than 3 corners") and *out zeroed. */
+   else (vn values, s, l, p, comments, unknown statements) is skipped; unknown
+   statements are counted in unknown_statements. Lines end in LF, CRLF or a
+   lone CR; a UTF-8 byte-order mark at the start is skipped. A line ending in
+   '\' continues on the next. Returns 0, or -1 with a message naming the line
+   in err ("line 12: face with fewer than 3 corners") and *out zeroed. */
 int obj_parse(const char *text, size_t length, obj_mesh *out, char *err, size_t err_size);
 /* The description that hands an OBJ's arrays to tt_mesh_build as they are:
    corners are faces one after another, the library's index-buffer layout. */
 tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
 
-/* Read and parse a file; messages start with the path ("mesh.obj:12: ..."). */
+/* Read and parse a file; messages start with the path ("mesh.obj:12: ...").
+   Unknown statements give one tool_note naming the first and the count. */
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
 

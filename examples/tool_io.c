@@ -55,6 +55,32 @@ int tool_usage(const char *format, ...)
     return TOOL_EXIT_USAGE;
 }
 
+#define MAX_NOTES 16
+static char tool_notes[MAX_NOTES][TOOL_ERROR_SIZE];
+static int tool_note_count = 0;
+
+void tool_note(const char *format, ...)
+{
+    va_list args;
+    if (tool_note_count == MAX_NOTES) return;
+    va_start(args, format);
+    vsnprintf(tool_notes[tool_note_count], sizeof tool_notes[0], format, args);
+    va_end(args);
+    tool_note_count++;
+}
+
+void tool_print_notes(void)
+{
+    int i;
+    for (i = 0; i < tool_note_count; i++) {
+        char *c;
+        for (c = tool_notes[i]; *c; c++)
+            if (*c == '\n' || *c == '\r') *c = ' ';
+        fprintf(stderr, "%s: %s\n", TOOL_NAME, tool_notes[i]);
+    }
+    tool_note_count = 0;
+}
+
 /* Fill a caller's error buffer (which may be NULL). */
 void tool_set_error(char *err, size_t err_size, const char *format, ...)
 {

@@ -814,6 +814,44 @@ check "synth --mips with a_mip2.png a directory: nothing written" "non-zero exit
 cd "$W" || exit 1
 
 # ======================================================================
+# OBJ reader: byte-order marks, line endings, unknown keywords
+# ======================================================================
+# Two quads; the BOM / CR / CRLF twins must give byte-identical outputs.
+OBJ_LINES='v 0 0 0|v 1 0 0|v 2 0 0|v 0 1 0|v 1 1 0|v 2 1 0.5|f 1 2 5 4|f 2 3 6 5|'
+printf '%s' "$OBJ_LINES" | tr '|' '\n' >"$W/in/two.obj"
+{ printf '\357\273\277'; cat "$W/in/two.obj"; } >"$W/in/two_bom.obj"
+tr '\n' '\r' <"$W/in/two.obj" >"$W/in/two_cr.obj"
+sed 's/$/\r/' "$W/in/two.obj" >"$W/in/two_crlf.obj"
+newdir
+expect_ok "map two quads (LF)" map ../in/two.obj lf.obj --seed 1
+for kind in bom cr crlf; do
+    expect_ok "map two quads ($kind)" map ../in/two_$kind.obj $kind.obj --seed 1
+    check "OBJ with $kind: same output as with LF" "cmp equal, nothing on stderr" "$(cmp lf.obj $kind.obj 2>&1) / $ERR" \
+        "$(cmp -s lf.obj $kind.obj && [ -z "$ERR" ]; echo $?)"
+done
+# a BOM must not drop the first vertex (the faces would silently shift)
+check "OBJ with a BOM: 6 vertices, first one kept" "6 v lines, the first 'v 0 0 0'" "$(grep -c '^v ' bom.obj) v lines" \
+    "$([ "$(grep -c '^v ' bom.obj)" = 6 ] && [ "$(grep -m1 '^v ' bom.obj)" = 'v 0 0 0' ]; echo $?)"
+# CR-only lines count as lines: an error names the right line
+printf 'v 0 0 0\rv 1 0 0\rv 1 1 0\rf 1 2 9\r' >"$W/in/cr_bad.obj"
+cd "$W" || exit 1
+expect_error "CR-only OBJ with a bad face" map ../in/cr_bad.obj m.obj
+err_mentions "CR-only OBJ with a bad face: names line 4" 'cr_bad\.obj:4: '
+# unknown keywords: one warning naming the first, its line and the count
+printf 'v 0 0 0\nv 1 0 0\nfoo 1 2\nv 1 1 0\nbar\nv 0 1 0\nV 3 3 3\nf 1 2 3 4\n' >"$W/in/unknown.obj"
+newdir
+expect_ok "OBJ with unknown keywords" map ../in/unknown.obj m.obj
+check "unknown keywords: exactly one warning line" "1 stderr line" "$ERR" \
+    "$([ "$(wc -l <"$W/err")" -eq 1 ]; echo $?)"
+err_mentions "unknown keywords: names the first, its line and the count" "unknown\.obj:3: .*3 lines.*'foo'"
+# known but unused statements stay silent
+printf 'mtllib x.mtl\no thing\ng part\nusemtl m\ns 1\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\nl 1 2\np 1\n# note\nf 1//1 2//1 3//1 4//1\n' \
+    >"$W/in/known.obj"
+expect_ok "OBJ with known unused statements" map ../in/known.obj k.obj
+check "known unused statements: no warning" "empty stderr" "$ERR" "$([ -z "$ERR" ]; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
 # Sanitizers
 # ======================================================================
 CMD="all $RUNS runs"
