@@ -89,5 +89,6 @@ int main(int argc, char **argv)
     tool_set_command(command->name);
     status = command->run(argc - 1, argv + 1);
     if (status == 0) tool_print_notes();
+    tool_forget_inputs();
     return status;
 }

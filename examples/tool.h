@@ -158,6 +158,18 @@ int parse_int_list(const char *option, const char *text, int count, int *out);
    -1 and says why in err ("cannot open 'x.obj': No such file or directory"). */
 int tool_read_file(const char *path, unsigned char **data, size_t *size, char *err, size_t err_size);
 
+/* tool_read_file remembers every regular file it read (device and inode,
+   which catches "./m.obj" for "m.obj" and hard links). An output path that
+   is a directory or is one of those inputs gives -1 and the reason in err;
+   a path that does not exist yet is fine. output_commit checks every
+   output; a command may check its outputs earlier, before a long
+   computation, with tool_refuse_input_overwrite (prints the error, returns
+   TOOL_EXIT_FAILURE, or 0 when the path is fine). */
+int tool_check_output_path(const char *path, char *err, size_t err_size);
+int tool_refuse_input_overwrite(const char *path);
+/* Forget the inputs remembered so far (frees their list). */
+void tool_forget_inputs(void);
+
 /* A byte buffer that grows as text is appended. A failed allocation sets
    `failed` and makes every later append a no-op, so a writer can append
    freely and check once at the end. Zero-initialise it before use. */
@@ -207,11 +219,14 @@ int output_add(tool_output *output, const char *path, void *data, size_t size);
    buffer's `failed` flag is set. */
 int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer);
 
-/* Write every file to a temporary file beside it ("PATH.tiledtex-tmp"), and
-   only when all of them were written completely rename each onto its real
-   name. On any failure every temporary is removed, as is every file already
-   renamed in this commit, so the command leaves no output at all. Returns 0
-   or -1 with the reason in err. The batch stays valid; free it with
+/* First refuse (writing nothing) when an output path names a directory or
+   the same file as an input (see tool_check_output_path). Then write every
+   file to a new temporary file beside it ("PATH.tiledtex-tmp", numbered when
+   that name is taken), and only when all of them were written completely
+   rename each onto its real name. On any failure the temporaries this commit
+   created are removed, as is every file already renamed in this commit, so
+   the command leaves no output at all; no other path is ever removed.
+   Returns 0 or -1 with the reason in err. The batch stays valid; free it with
    output_free. */
 int output_commit(tool_output *output, char *err, size_t err_size);
 void output_free(tool_output *output);

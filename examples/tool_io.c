@@ -3,11 +3,18 @@
    See tool.h for the interface. Command-line parsing is in cli.c, images in
    image_io.c, OBJ / MTL in obj.c. */
 
+#define _POSIX_C_SOURCE 200809L    /* open, fdopen, fileno, stat */
+
 #include <errno.h>
+#include <fcntl.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <unistd.h>
 
 #include "tool.h"
 
@@ -150,6 +157,76 @@ void buffer_free(tool_buffer *buffer)
     memset(buffer, 0, sizeof *buffer);
 }
 
+/* Every file read so far, by device and inode, so that no output can replace
+   one (output_commit checks). */
+typedef struct input_file {
+    dev_t device;
+    ino_t inode;
+    char *path;
+} input_file;
+static input_file *tool_inputs = NULL;
+static int tool_input_count = 0, tool_input_capacity = 0;
+
+static void remember_input(FILE *file, const char *path)
+{
+    struct stat info;
+    if (fstat(fileno(file), &info) != 0 || !S_ISREG(info.st_mode)) return;   /* pipes cannot be overwritten */
+    if (tool_input_count == tool_input_capacity) {
+        int capacity = tool_input_capacity ? 2 * tool_input_capacity : 8;
+        input_file *grown = (input_file *)realloc(tool_inputs, (size_t)capacity * sizeof *grown);
+        if (!grown) return;
+        tool_inputs = grown;
+        tool_input_capacity = capacity;
+    }
+    tool_inputs[tool_input_count].path = tool_copy_string(path, strlen(path));
+    if (!tool_inputs[tool_input_count].path) return;
+    tool_inputs[tool_input_count].device = info.st_dev;
+    tool_inputs[tool_input_count].inode = info.st_ino;
+    tool_input_count++;
+}
+
+int tool_check_output_path(const char *path, char *err, size_t err_size)
+{
+    struct stat info;
+    int i;
+    if (stat(path, &info) != 0) return 0;      /* does not exist (yet): cannot be an input */
+    if (S_ISDIR(info.st_mode)) {
+        tool_set_error(err, err_size, "cannot write '%s': it is a directory", path);
+        return -1;
+    }
+    for (i = 0; i < tool_input_count; i++) {
+        if (tool_inputs[i].device == info.st_dev && tool_inputs[i].inode == info.st_ino) {
+            if (strcmp(tool_inputs[i].path, "-") == 0)
+                tool_set_error(err, err_size, "will not overwrite '%s': it is the standard input; choose another "
+                               "output name", path);
+            else if (strcmp(tool_inputs[i].path, path) == 0)
+                tool_set_error(err, err_size, "will not overwrite the input '%s' with an output; choose another "
+                               "output name", path);
+            else
+                tool_set_error(err, err_size, "will not overwrite '%s': it is the input '%s'; choose another "
+                               "output name", path, tool_inputs[i].path);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int tool_refuse_input_overwrite(const char *path)
+{
+    char message[TOOL_ERROR_SIZE];
+    if (tool_check_output_path(path, message, sizeof message) != 0) return tool_fail("%s", message);
+    return 0;
+}
+
+void tool_forget_inputs(void)
+{
+    int i;
+    for (i = 0; i < tool_input_count; i++) free(tool_inputs[i].path);
+    free(tool_inputs);
+    tool_inputs = NULL;
+    tool_input_count = tool_input_capacity = 0;
+}
+
 int tool_read_file(const char *path, unsigned char **data, size_t *size, char *err, size_t err_size)
 {
     tool_buffer buffer = TOOL_BUFFER_INIT;
@@ -178,6 +255,7 @@ int tool_read_file(const char *path, unsigned char **data, size_t *size, char *e
         tool_set_error(err, err_size, "cannot read '%s': %s", path, strerror(errno));
         buffer.failed = 1;
     }
+    if (!buffer.failed) remember_input(file, path);
     if (!from_stdin) fclose(file);
     if (buffer.failed) {
         buffer_free(&buffer);
@@ -294,25 +372,44 @@ int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer
 }
 
 #define TEMPORARY_SUFFIX ".tiledtex-tmp"
+#define TEMPORARY_ATTEMPTS 100
 
-static char *temporary_name(const char *path)
+/* Create a new temporary file beside `path` ("PATH.tiledtex-tmp", or with a
+   number after it when that name is taken: an existing file or directory of
+   that name is never opened, let alone removed). On success *name is the
+   malloc'ed name of a file this call created, open in *file. */
+static int create_temporary(const char *path, char **name, FILE **file)
 {
-    size_t length = strlen(path);
-    char *name = (char *)malloc(length + sizeof TEMPORARY_SUFFIX);
-    if (!name) return NULL;
-    memcpy(name, path, length);
-    memcpy(name + length, TEMPORARY_SUFFIX, sizeof TEMPORARY_SUFFIX);
-    return name;
+    size_t length = strlen(path), size = length + sizeof TEMPORARY_SUFFIX + 8;
+    int attempt;
+    *name = (char *)malloc(size);
+    *file = NULL;
+    if (!*name) { errno = ENOMEM; return -1; }
+    for (attempt = 0; attempt < TEMPORARY_ATTEMPTS; attempt++) {
+        int fd;
+        if (attempt == 0) snprintf(*name, size, "%s%s", path, TEMPORARY_SUFFIX);
+        else snprintf(*name, size, "%s%s%d", path, TEMPORARY_SUFFIX, attempt);
+        fd = open(*name, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd >= 0) {
+            *file = fdopen(fd, "wb");
+            if (*file) return 0;
+            close(fd);
+            remove(*name);          /* ours: created just now */
+            break;
+        }
+        if (errno != EEXIST) break;
+    }
+    if (attempt == TEMPORARY_ATTEMPTS) errno = EEXIST;
+    free(*name);
+    *name = NULL;
+    return -1;
 }
 
 /* Write one file completely; any short write or failed close is an error
-   (a full disk often shows up only at fclose). */
-static int write_whole_file(const char *path, const unsigned char *data, size_t size)
+   (a full disk often shows up only at fclose). Closes the file. */
+static int write_whole_file(FILE *file, const unsigned char *data, size_t size)
 {
-    FILE *file = fopen(path, "wb");
-    int ok;
-    if (!file) return -1;
-    ok = (size == 0 || fwrite(data, 1, size, file) == size);
+    int ok = (size == 0 || fwrite(data, 1, size, file) == size);
     ok = (fflush(file) == 0) && ok;
     ok = (fclose(file) == 0) && ok;
     return ok ? 0 : -1;
@@ -320,48 +417,54 @@ static int write_whole_file(const char *path, const unsigned char *data, size_t 
 
 int output_commit(tool_output *output, char *err, size_t err_size)
 {
-    char **temporaries;
-    int written = 0, renamed = 0, i, failed = 0;
+    char **temporaries;     /* the temporaries this commit created (NULL: none for that file) */
+    int renamed = 0, i, failed = 0;
     if (output->count == 0) return 0;
+    /* Before anything is written: no output may name a directory, or the
+       same file as one of the command's inputs. */
+    for (i = 0; i < output->count; i++) {
+        const char *path = output->files[i].path;
+        size_t length = strlen(path);
+        if (length == 0 || path[length - 1] == '/') {
+            tool_set_error(err, err_size, "'%s' names a directory: give a file name", path);
+            return -1;
+        }
+        if (tool_check_output_path(path, err, err_size) != 0) return -1;
+    }
     temporaries = (char **)calloc((size_t)output->count, sizeof *temporaries);
     if (!temporaries) {
         tool_set_error(err, err_size, "out of memory while writing the output files");
         return -1;
     }
-    /* Phase 1: every file to its temporary name beside the real one (the same
+    /* Phase 1: every file to a temporary name beside the real one (the same
        directory, so the rename below cannot cross file systems). */
     for (i = 0; i < output->count && !failed; i++) {
         const tool_output_file *file = &output->files[i];
-        size_t length = strlen(file->path);
-        if (length == 0 || file->path[length - 1] == '/') {
-            tool_set_error(err, err_size, "'%s' names a directory: give a file name", file->path);
-            failed = 1;
-            break;
-        }
-        temporaries[i] = temporary_name(file->path);
-        if (!temporaries[i]) {
-            tool_set_error(err, err_size, "out of memory while writing '%s'", file->path);
-            failed = 1;
-        } else if (write_whole_file(temporaries[i], file->data, file->size) != 0) {
+        FILE *stream;
+        if (create_temporary(file->path, &temporaries[i], &stream) != 0) {
             tool_set_error(err, err_size, "cannot write '%s': %s", file->path, strerror(errno));
-            remove(temporaries[i]);     /* may exist half-written */
             failed = 1;
-        } else {
-            written = i + 1;
+        } else if (write_whole_file(stream, file->data, file->size) != 0) {
+            tool_set_error(err, err_size, "cannot write '%s': %s", file->path, strerror(errno));
+            failed = 1;
         }
     }
     /* Phase 2: only when all are complete, give them their real names. */
-    for (i = 0; i < written && !failed; i++) {
+    for (i = 0; i < output->count && !failed; i++) {
         if (rename(temporaries[i], output->files[i].path) != 0) {
             tool_set_error(err, err_size, "cannot write '%s': %s", output->files[i].path, strerror(errno));
             failed = 1;
         } else {
+            free(temporaries[i]);
+            temporaries[i] = NULL;
             renamed = i + 1;
         }
     }
     if (failed) {
-        /* Undo: no temporary stays behind, and no file of this batch either. */
-        for (i = renamed; i < written; i++) remove(temporaries[i]);
+        /* Undo: remove the temporaries this commit created, and the files it
+           already renamed into place; nothing else. */
+        for (i = 0; i < output->count; i++)
+            if (temporaries[i]) remove(temporaries[i]);
         for (i = 0; i < renamed; i++) remove(output->files[i].path);
     }
     for (i = 0; i < output->count; i++) free(temporaries[i]);

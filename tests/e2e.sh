@@ -852,6 +852,62 @@ check "known unused statements: no warning" "empty stderr" "$ERR" "$([ -z "$ERR"
 cd "$W" || exit 1
 
 # ======================================================================
+# Outputs never replace inputs; the rollback removes only its own files
+# ======================================================================
+# expect_refused WHAT ARGS... : run in the current directory, whose files are
+# the inputs: non-zero exit, one stderr line saying it will not overwrite,
+# and afterwards the same files with the same contents.
+expect_refused() {
+    local what=$1 before after
+    shift
+    before=$(ls -A | tr '\n' ' '; cat -- * 2>/dev/null | cksum)
+    run "$@"
+    after=$(ls -A | tr '\n' ' '; cat -- * 2>/dev/null | cksum)
+    check "$what: refused" "non-zero exit, one stderr line 'will not overwrite'" "exit $RC, stderr: $ERR" \
+        "$([ $RC -ne 0 ] && [ $RC -lt 124 ] && [ "$(wc -l <"$W/err")" -eq 1 ] && grep -q 'will not overwrite' "$W/err"; echo $?)"
+    check "$what: nothing written or changed" "files and contents as before" "before: $before, after: $after" \
+        "$([ "$before" = "$after" ]; echo $?)"
+}
+newdir
+cp ../in/torus.obj m.obj
+cp ../in/lap.png img.png
+expect_refused "tile MESH IMAGE with OUT_PREFIX naming the mesh" tile m.obj img.png m --tile 16
+expect_refused "tile ./m.obj ... m (same file, other spelling)" tile ./m.obj img.png m --tile 16
+expect_refused "tile with OUT_PREFIX naming the image" tile m.obj img.png img --tile 16
+ln m.obj link.obj
+expect_refused "map onto a hard link of the input" map m.obj link.obj
+expect_refused "map onto the input" map m.obj m.obj
+cp img.png x_patch.png
+expect_refused "lapped IMAGE that is OUT_PREFIX_patch.png" lapped m.obj x_patch.png x --scale 1.5
+cp img.png y_baked.png
+expect_refused "lapped --bake output that is the IMAGE" lapped m.obj y_baked.png y --scale 1.5 --bake 64
+expect_refused "synth onto its image" synth img.png img.png --tile 16
+expect_refused "synth onto its image (other spelling)" synth img.png ../$(basename "$PWD")/img.png --tile 16
+expect_refused "render onto its texture" render m.obj img.png img.png --size 32x32
+expect_refused "render onto its mesh" render m.obj img.png m.obj --size 32x32
+CMD="tiledtex map - m.obj < m.obj"
+"$TOOL" map - m.obj <m.obj >"$W/out" 2>"$W/err"
+RC=$?
+check "map from standard input onto the same file: refused" "non-zero exit, m.obj unchanged" "exit $RC, $(cat "$W/err")" \
+    "$([ $RC -ne 0 ] && cmp -s m.obj ../in/torus.obj; echo $?)"
+cd "$W" || exit 1
+
+# a directory named like a temporary is never opened nor removed
+newdir
+mkdir out.obj.tiledtex-tmp
+expect_ok "tile beside a directory named out.obj.tiledtex-tmp" tile ../in/torus.obj ../in/tex.png out --tile 16
+check "the directory named like a temporary is left alone" "out.obj.tiledtex-tmp still a directory, out.obj written" \
+    "$(ls -A | tr '\n' ' ')" "$([ -d out.obj.tiledtex-tmp ] && [ -s out.obj ]; echo $?)"
+cd "$W" || exit 1
+newdir
+mkdir out.obj.tiledtex-tmp out.png
+run tile ../in/torus.obj ../in/tex.png out --tile 16
+check "failed tile: rollback keeps a directory named like a temporary" "fails; only out.obj.tiledtex-tmp and out.png" \
+    "exit $RC, files: $(ls -A | tr '\n' ' ')" \
+    "$([ $RC -ne 0 ] && [ "$(ls -A | tr '\n' ' ')" = "out.obj.tiledtex-tmp out.png " ] && [ -d out.obj.tiledtex-tmp ]; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
 # Sanitizers
 # ======================================================================
 CMD="all $RUNS runs"
