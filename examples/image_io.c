@@ -42,6 +42,10 @@
 /* Images                                                                   */
 /* ======================================================================== */
 
+static uint64_t image_max_pixels = TOOL_DEFAULT_MAX_PIXELS;
+
+void image_set_max_pixels(uint64_t max_pixels) { image_max_pixels = max_pixels; }
+
 int image_load(const char *path, tt_image *image, char *err, size_t err_size)
 {
     unsigned char *file_data, *pixels;
@@ -65,6 +69,16 @@ int image_load(const char *path, tt_image *image, char *err, size_t err_size)
     if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) {
         tool_set_error(err, err_size, "'%s' is %dx%d; images up to %dx%d are supported", path, width, height,
                   TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
+        free(file_data);
+        return -1;
+    }
+    /* A small file can declare a huge image (a 62 KB PNG of 8000x8000 zeros
+       would take over 1 GB as floats): refuse it before decoding a pixel. */
+    if ((uint64_t)width * (uint64_t)height > image_max_pixels) {
+        tool_set_error(err, err_size,
+                       "'%s' is %dx%d = %llu pixels, over the limit of %llu (raise it with --max-pixels N)", path,
+                       width, height, (unsigned long long)width * (unsigned long long)height,
+                       (unsigned long long)image_max_pixels);
         free(file_data);
         return -1;
     }

@@ -235,10 +235,17 @@ void output_free(tool_output *output);
 /* Images (image_io.c)                                                      */
 /* ---------------------------------------------------------------------- */
 
+/* The pixel budget for the images the tool reads (the global option
+   --max-pixels): 4096 x 4096, which take 256 MB as float RGBA. */
+#define TOOL_DEFAULT_MAX_PIXELS 16777216
+void image_set_max_pixels(uint64_t max_pixels);
+
 /* Load a PNG / JPEG / TGA / BMP / PSD / GIF / HDR / PIC / PNM file as a float
    RGBA tt_image (grey and grey+alpha become RGB(A); no alpha means alpha 1).
    Errors: the file is missing or unreadable, is not an image stb_image can
-   decode, or is wider or taller than TT_MAX_IMAGE_SIZE. */
+   decode, is wider or taller than TT_MAX_IMAGE_SIZE, or has more pixels than
+   the budget (image_set_max_pixels). Sizes are read from the header before
+   any pixel is decoded. */
 int image_load(const char *path, tt_image *image, char *err, size_t err_size);
 
 /* Encode an image as an 8-bit RGBA PNG in memory (malloc'ed; free it). */

@@ -908,6 +908,60 @@ check "failed tile: rollback keeps a directory named like a temporary" "fails; o
 cd "$W" || exit 1
 
 # ======================================================================
+# Image size budget (--max-pixels): refused from the header, before decoding
+# ======================================================================
+HELPER_CC=${CC:-cc}
+STB_INC=$(pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
+# A valid 8000x8000 all-black PNG of well under 1 MB: 64 M pixels to decode.
+cat >"$W/bigpng.c" <<'EOF_C'
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include "stb_image_write.h"
+#include <stdlib.h>
+int main(int argc, char **argv)
+{
+    int width = 8000, height = 8000;
+    unsigned char *pixels = (unsigned char *)calloc((size_t)width * height, 1);
+    (void)argc;
+    return !(pixels && stbi_write_png(argv[1], width, height, 1, pixels, width));
+}
+EOF_C
+CMD="$HELPER_CC $STB_INC bigpng.c (test helper)"
+# shellcheck disable=SC2086
+if $HELPER_CC -O2 -w $STB_INC "$W/bigpng.c" -o "$W/bigpng" -lm 2>"$W/err" && "$W/bigpng" "$W/in/big.png"; then
+    pass
+    check "helper PNG: 8000x8000, under 1 MB" "8000 8000, < 1000000 bytes" "$(png_size "$W/in/big.png"), $(wc -c <"$W/in/big.png") bytes" \
+        "$([ "$(png_size "$W/in/big.png")" = "8000 8000" ] && [ "$(wc -c <"$W/in/big.png")" -lt 1000000 ]; echo $?)"
+    for sub in synth tile lapped render; do
+        case $sub in
+            synth) args="../in/big.png a.png" ;;
+            tile) args="../in/torus.obj ../in/big.png out" ;;
+            lapped) args="../in/torus.obj ../in/big.png out" ;;
+            render) args="../in/torus.obj ../in/big.png r.png" ;;
+        esac
+        # shellcheck disable=SC2086
+        expect_error "8000x8000 PNG ($sub)" $sub $args
+        err_mentions "8000x8000 PNG ($sub): names the size and --max-pixels" '8000x8000.*--max-pixels'
+    done
+    expect_error "8000x8000 PNG as map --atlas" map ../in/torus.obj m.obj --atlas ../in/big.png
+    err_mentions "8000x8000 PNG as map --atlas: names --max-pixels" 'with --max-pixels'
+else
+    fail "helper for the big PNG" "$CMD" "compiles and writes big.png" "$(head -c 300 "$W/err")"
+fi
+# the budget itself: tex.png is 256x256 = 65536 pixels
+expect_error "--max-pixels 65535 refuses a 256x256 image" synth ../in/tex.png a.png --tile 32 --max-pixels 65535
+err_mentions "--max-pixels 65535: names the size and the option" '256x256.*65535.*--max-pixels'
+newdir
+expect_ok "--max-pixels 65536 (before the command) takes a 256x256 image" --max-pixels 65536 synth ../in/tex.png a.png --tile 32
+expect_ok "--max-pixels=65536 (after the command)" synth ../in/tex.png b.png --tile 32 --max-pixels=65536
+cd "$W" || exit 1
+expect_error "--max-pixels 0" --max-pixels 0 synth ../in/tex.png a.png
+expect_error "--max-pixels abc" synth ../in/tex.png a.png --max-pixels abc
+expect_error "--max-pixels without a value" synth ../in/tex.png a.png --max-pixels
+run --help
+check "--help documents --max-pixels" "'--max-pixels' in the usage" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q -- '--max-pixels'; echo $?)"
+
+# ======================================================================
 # Sanitizers
 # ======================================================================
 CMD="all $RUNS runs"
