@@ -674,6 +674,21 @@ static void write_name_line(tool_buffer *out, const char *keyword, const char *n
     buffer_printf(out, "%s %s%s\n", keyword, name, length > 0 && name[length - 1] == '\\' ? " " : "");
 }
 
+/* "KEYWORD x y z" and a newline, built in one piece and appended once. */
+static void write_floats(tool_buffer *out, const char *keyword, const float *values, int count)
+{
+    char line[8 + 3 * (TOOL_NUMBER_TEXT_SIZE + 1)];
+    size_t length = strlen(keyword);
+    int i;
+    memcpy(line, keyword, length);
+    for (i = 0; i < count && i < 3; i++) {
+        line[length++] = ' ';
+        length += (size_t)tool_format_float(values[i], line + length);
+    }
+    line[length++] = '\n';
+    buffer_append(out, line, length);
+}
+
 int obj_write(tool_buffer *out, const obj_write_desc *desc)
 {
     int v, f, c = 0, previous_group = -1;
@@ -693,17 +708,17 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     }
     if (desc->mtllib) write_name_line(out, "mtllib", desc->mtllib);
 
-    /* %.9g: nine significant digits are enough for any float to read back
-       exactly, so writing a mesh and reading it again changes nothing. */
-    for (v = 0; v < desc->nverts; v++)
-        buffer_printf(out, "v %.9g %.9g %.9g\n", desc->pos[3 * v], desc->pos[3 * v + 1], desc->pos[3 * v + 2]);
+    /* Nine significant digits (tool_format_float) are enough for any float
+       to read back exactly, so writing a mesh and reading it again changes
+       nothing. */
+    for (v = 0; v < desc->nverts; v++) write_floats(out, "v", desc->pos + 3 * (size_t)v, 3);
 
     if (desc->corner_uv) {
         /* One vt per face corner, in corner order: corner c uses vt c + 1. */
         int ncorners = 0;
         for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
         for (c = 0; c < ncorners; c++)
-            buffer_printf(out, "vt %.9g %.9g\n", desc->corner_uv[2 * c], desc->corner_uv[2 * c + 1]);
+            write_floats(out, "vt", desc->corner_uv + 2 * (size_t)c, 2);
         c = 0;
     }
 
@@ -723,10 +738,16 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         }
         buffer_append(out, "f", 1);
         for (i = 0; i < size; i++, c++) {
-            int vertex = desc->corner_vert[c];
+            char text[2 * TOOL_NUMBER_TEXT_SIZE + 2];
+            int vertex = desc->corner_vert[c], length;
             if (vertex < 0 || vertex >= desc->nverts) return -1;
-            if (desc->corner_uv) buffer_printf(out, " %d/%d", vertex + 1, c + 1);
-            else buffer_printf(out, " %d", vertex + 1);
+            text[0] = ' ';
+            length = 1 + tool_format_int((long)vertex + 1, text + 1);
+            if (desc->corner_uv) {
+                text[length++] = '/';
+                length += tool_format_int((long)c + 1, text + length);
+            }
+            buffer_append(out, text, (size_t)length);
         }
         buffer_append(out, "\n", 1);
     }

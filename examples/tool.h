@@ -12,6 +12,7 @@
      image_io.c  images                  image_load, png_encode, output_add_png
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
                  MTL writing             mtl_add_material
+     format_number.c  numbers as text   tool_format_float, tool_format_int
 
    Conventions every command follows:
      - Errors are one line on stderr, "tiledtex: <message>" (or
@@ -330,7 +331,7 @@ typedef struct obj_write_desc {
 
 /* Append the OBJ text to `out`: "v x y z", then one "vt u v" per face corner
    (when corner_uv is given), then "f v/vt ..." with 1-based indices. Numbers
-   use 9 significant digits, so floats read back exactly. Returns 0, or -1 on
+   use 9 significant digits (tool_format_float), so floats read back exactly. Returns 0, or -1 on
    an invalid description or when the buffer ran out of memory. */
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
 
@@ -338,6 +339,22 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc);
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
    "map_d TEXTURE": the texture's alpha channel is the material's opacity. */
 void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha);
+
+/* ---------------------------------------------------------------------- */
+/* Numbers as text without printf (format_number.c)                        */
+/* ---------------------------------------------------------------------- */
+
+/* Room for any text below, with its NUL ("-1.23456789e-38"). */
+#define TOOL_NUMBER_TEXT_SIZE 24
+
+/* A float with 9 significant digits, the text printf("%.9g") gives (up to,
+   rarely, the last digit), which reads back as exactly the same float; NaN
+   and infinity go through snprintf. Writes a NUL-terminated string into out
+   (TOOL_NUMBER_TEXT_SIZE bytes) and returns its length. Several times faster
+   than printf. */
+int tool_format_float(float value, char *out);
+/* A decimal integer the same way. */
+int tool_format_int(long value, char *out);
 
 /* ---------------------------------------------------------------------- */
 /* Paths and strings (tool_io.c)                                            */
