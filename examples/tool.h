@@ -20,7 +20,10 @@
        status: TOOL_EXIT_FAILURE for a failure, TOOL_EXIT_USAGE for a bad
        command line.
      - A command never leaves a half-written output: it adds every file it
-       makes to a tool_output and commits them together at the end.
+       makes to a tool_output and commits them together at the end. The
+       commit refuses any output that is the same file as an input.
+     - Warnings that are not errors go through tool_note, printed only when
+       the command succeeds.
 */
 #ifndef TILEDTEX_TOOL_H
 #define TILEDTEX_TOOL_H
