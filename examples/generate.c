@@ -289,7 +289,7 @@ static int generate_texture(int argc, char **argv)
     int size = TEXTURE_DEFAULT_SIZE, i, status;
     uint64_t seed = 1;
     tt_image image;
-    tool_output output = {0};
+    tool_output output = TOOL_OUTPUT_INIT;
     char err[TOOL_ERROR_SIZE];
     for (i = 2; i < argc; i++) {
         const char *value;
@@ -952,8 +952,8 @@ static int generate_mesh(int argc, char **argv)
     char err[TOOL_ERROR_SIZE], comment[200], summary[400];
     poly_mesh m, split;
     obj_write_desc desc;
-    tool_buffer text = {0};
-    tool_output output = {0};
+    tool_buffer text = TOOL_BUFFER_INIT;
+    tool_output output = TOOL_OUTPUT_INIT;
     for (i = 2; i < argc; i++) {
         const char *value;
         if (tool_is_help(argv[i])) {

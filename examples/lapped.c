@@ -630,6 +630,23 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
     printf("removed %d hidden face entries; %.1f s\n", lapped->removed_entries, seconds);
 }
 
+/* Refuse, before the long part, outputs that would replace an input (the
+   commit checks again, but only after pasting). */
+static int refuse_overwriting_inputs(const lapped_options *options, const char *obj_path, const char *mtl_path,
+                                     const char *png_path)
+{
+    static const char *const baked[] = {"_baked.obj", "_baked.mtl", "_baked.png"};
+    char path[4096 + 16];
+    int status = tool_refuse_input_overwrite(obj_path), k;
+    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0) status = tool_refuse_input_overwrite(png_path);
+    for (k = 0; k < 3 && status == 0 && options->bake_size > 0; k++) {
+        snprintf(path, sizeof path, "%s%s", options->prefix, baked[k]);
+        status = tool_refuse_input_overwrite(path);
+    }
+    return status;
+}
+
 int cmd_lapped(int argc, char **argv)
 {
     lapped_options options;
@@ -660,6 +677,7 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && image_load(options.image_path, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
     if (status == 0) status = make_patch(&options, &image, &patch);
+    if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, png_path);
     if (status == 0) status = paste(&options, &mesh, field, &patch, &lapped);
 
     if (status == 0 && straight_patch(&image, &patch, &straight) != 0)

@@ -838,7 +838,7 @@ int cmd_render(int argc, char **argv)
     scene s;
     camera cam;
     sample_buffer samples;
-    tool_output output = {0};
+    tool_output output = TOOL_OUTPUT_INIT;
     vec3 centre;
     float radius;
     int bad_vertex = -1;

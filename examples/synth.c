@@ -36,61 +36,6 @@ static void print_help(void)
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
 
-int tiled_fit_tile_size(int width, int height, int colors, int gutter)
-{
-    /* An edge window is S x 2S; at 2/5 of the smaller side it still has room
-       to move, so synthesis can choose an inconspicuous line for the edges
-       (with h = 2S exactly there is only one) and varied backgrounds. With
-       more colors the atlas, (2n)^2 tiles a side, must stay within
-       TOOL_MAX_ATLAS. Multiples of 8 keep mip levels per tile. */
-    int side = width < height ? width : height, n = colors > 0 ? colors : 1;
-    int fit = 2 * side / 5, fits_atlas = TOOL_MAX_ATLAS / (4 * n * n) - 2 * gutter;
-    if (fit > TT_DEFAULT_TILE_SIZE) fit = TT_DEFAULT_TILE_SIZE;
-    if (fit > fits_atlas) fit = fits_atlas;
-    if (fit >= 8) return fit - fit % 8;
-    if (fits_atlas >= 4 && width >= 4 && height >= 8) return 4;
-    return 0;
-}
-
-int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options, tt_tileset **out)
-{
-    tt_synth_options synth;
-    tt_error error;
-    memset(&synth, 0, sizeof synth);
-    synth.layout = options->layout;
-    synth.seed = options->seed;
-    synth.background = options->background;
-    if (options->nedges > 0) {
-        int colors = options->layout.colors ? options->layout.colors : 1;
-        if (options->nedges != colors)
-            return tool_usage("--edge was given %d time%s, but there %s %d color%s: give it once per color",
-                              options->nedges, options->nedges == 1 ? "" : "s", colors == 1 ? "is" : "are", colors,
-                              colors == 1 ? "" : "s");
-        synth.edge_windows = options->edges;
-    }
-    if (tt_synthesize_tiles(image, &synth, out, &error) != TT_OK) {
-        if (error.result == TT_ERROR_IMAGE_TOO_SMALL || error.result == TT_ERROR_INVALID_ARGUMENT)
-            return tool_fail("%s: %s", image_path, error.message);
-        return tool_fail("%s", error.message);
-    }
-    return 0;
-}
-
-int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips)
-{
-    char message[TOOL_ERROR_SIZE], path[4096];
-    int level;
-    size_t stem = strlen(png_path);
-    if (output_add_png(output, png_path, &tiles->levels[0], message, sizeof message) != 0)
-        return tool_fail("%s", message);
-    if (stem > 4 && strcmp(png_path + stem - 4, ".png") == 0) stem -= 4;
-    for (level = 1; mips && level < tiles->nlevels; level++) {
-        snprintf(path, sizeof path, "%.*s_mip%d.png", (int)stem, png_path, level);
-        if (output_add_png(output, path, &tiles->levels[level], message, sizeof message) != 0)
-            return tool_fail("%s", message);
-    }
-    return 0;
-}
 
 int cmd_synth(int argc, char **argv)
 {

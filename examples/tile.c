@@ -77,6 +77,10 @@ int cmd_tile(int argc, char **argv)
 
     status = tiled_check_atlas_size(&options);
     if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
+    /* Before the synthesis: no output may replace an input (checked again at the commit). */
+    if (status == 0) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0) status = tool_refuse_input_overwrite(png_path);
     if (status == 0) status = tiled_synthesize(&image, positional[1], &options, &tiles);
     if (status == 0 && tt_measure_seams(mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, &seams) != TT_OK)
         status = tool_fail("out of memory while measuring the seams of %s", positional[0]);

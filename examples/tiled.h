@@ -1,9 +1,10 @@
-/* tiled.h - the tiled-texture steps shared by `tiledtex synth`, `map` and `tile`.
+/* tiled.h - the tiled-texture steps shared by `tiledtex synth`, `map` and
+   `tile`, implemented in tiled.c:
 
-   map.c   turns an OBJ into a quad mesh with tiled-texture UVs (tiled_map_mesh)
-   synth.c turns a photo into an atlas of (2n)^4 tiles     (tiled_synthesize)
-   tile.c  does both in one go.
-   The options they share are parsed in one place (tiled_parse_option).
+   tiled_map_mesh    turns an OBJ into a quad mesh with tiled-texture UVs (map)
+   tiled_synthesize  turns a photo into an atlas of (2n)^4 tiles      (synth)
+   tile.c does both in one go. The options they share are parsed in one place
+   (tiled_parse_option).
 */
 #ifndef TILEDTEX_TILED_H
 #define TILEDTEX_TILED_H

@@ -40,8 +40,12 @@ static void print_help(void)
     int i;
     printf("tiledtex %s - texture any mesh from one example image, without seams or visible repetition\n\n",
            TILEDTEX_VERSION_STRING);
-    printf("usage: tiledtex COMMAND [ARGUMENTS]\n\ncommands:\n");
+    printf("usage: tiledtex [--max-pixels N] COMMAND [ARGUMENTS]\n\ncommands:\n");
     for (i = 0; i < SUBCOMMAND_COUNT; i++) printf("  %-9s %s\n", subcommands[i].name, subcommands[i].summary);
+    printf("\nglobal option (before or after the command):\n"
+           "  --max-pixels N  refuse images of more than N pixels, checked before decoding them\n"
+           "                  (default %d = 4096x4096)\n",
+           TOOL_DEFAULT_MAX_PIXELS);
     printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
            "Try it: tiledtex generate mesh torus.obj --shape torus\n"
            "        tiledtex generate texture stones.png\n"
@@ -51,9 +55,39 @@ static void print_help(void)
            "        tiledtex render torus_lapped.obj torus_lapped_patch.png lapped.png\n");
 }
 
+/* The global options, accepted before or after the command name (the error
+   message about a large image suggests adding one to the same command line):
+   take them out of argv before the command sees it. Returns 0, or the exit
+   status for a bad value. */
+static int take_global_options(int *argc, char **argv)
+{
+    const char *max_pixels = NULL;
+    int i, kept = 1, given = 0;
+    for (i = 1; i < *argc; i++) {
+        const char *value;
+        if (tool_option(*argc, argv, &i, "--max-pixels", &value)) {
+            max_pixels = value;
+            given = 1;
+        } else {
+            argv[kept++] = argv[i];
+        }
+    }
+    *argc = kept;
+    argv[kept] = NULL;
+    if (given) {
+        uint64_t n;
+        if (parse_u64("--max-pixels", max_pixels, &n) != 0) return TOOL_EXIT_USAGE;
+        if (n == 0) return tool_usage("--max-pixels wants a number of pixels above 0, got '%s'", max_pixels);
+        image_set_max_pixels(n);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const subcommand *command;
+    int status;
+    if ((status = take_global_options(&argc, argv)) != 0) return status;
     if (argc < 2)
         return tool_usage("needs a command: tile, lapped, synth, map, render or generate (see 'tiledtex --help')");
     if (tool_is_help(argv[1])) {
@@ -86,5 +120,8 @@ int main(int argc, char **argv)
         return tool_usage("unknown command '%s' (try 'tiledtex --help')", argv[1]);
     }
     tool_set_command(command->name);
-    return command->run(argc - 1, argv + 1);
+    status = command->run(argc - 1, argv + 1);
+    if (status == 0) tool_print_notes();
+    tool_forget_inputs();
+    return status;
 }

@@ -1,16 +1,18 @@
 /* tool.h - shared pieces of the `tiledtex` command-line tool (not the library).
 
    The tool is a set of subcommands, one file each (synth.c, map.c, tile.c,
-   lapped.c, render.c, generate.c), dispatched by tiledtex.c. They share what is declared
-   here and implemented in tool_io.c:
+   lapped.c, render.c, generate.c), dispatched by tiledtex.c; synth, map and
+   tile also share tiled.c (see tiled.h). They share what is declared here:
 
-     - one-line error reporting          tool_fail, tool_usage
-     - command-line helpers              tool_option, parse_int, parse_size, ...
-     - OBJ reading and writing           obj_parse, obj_read, obj_write
-     - MTL writing                       mtl_add_material
-     - images                            image_load, png_encode
-     - atomic output                     tool_output: build every file in
+     tool_io.c   one-line errors         tool_fail, tool_usage
+                 files, byte buffers     tool_read_file, tool_buffer
+                 atomic output           tool_output: build every file in
                                          memory, then commit them all or none
+     cli.c       command-line helpers    tool_option, parse_int, parse_size, ...
+     image_io.c  images                  image_load, png_encode, output_add_png
+     obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
+                 MTL writing             mtl_add_material
+     format_number.c  numbers as text   tool_format_float, tool_format_int
 
    Conventions every command follows:
      - Errors are one line on stderr, "tiledtex: <message>" (or
@@ -18,7 +20,10 @@
        status: TOOL_EXIT_FAILURE for a failure, TOOL_EXIT_USAGE for a bad
        command line.
      - A command never leaves a half-written output: it adds every file it
-       makes to a tool_output and commits them together at the end.
+       makes to a tool_output and commits them together at the end. The
+       commit refuses any output that is the same file as an input.
+     - Warnings that are not errors go through tool_note, printed only when
+       the command succeeds.
 */
 #ifndef TILEDTEX_TOOL_H
 #define TILEDTEX_TOOL_H
@@ -54,12 +59,13 @@ int cmd_render(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 
 /* ---------------------------------------------------------------------- */
-/* Errors                                                                   */
+/* Errors (tool_io.c)                                                       */
 /* ---------------------------------------------------------------------- */
 
 /* The subcommand being run ("render"); the dispatcher sets it so that
    command-line errors can say which command they are about. NULL = none. */
 void tool_set_command(const char *name);
+const char *tool_command(void);
 
 /* Print "tiledtex: <message>" on stderr and return TOOL_EXIT_FAILURE, so a
    command can write `return tool_fail("cannot ...");`. */
@@ -77,8 +83,26 @@ int tool_usage(const char *format, ...)
 #endif
     ;
 
+/* A warning for the user that is not an error ("mesh.obj:3: skipped ..."):
+   kept, and printed as "tiledtex: <message>" on stderr by tool_print_notes,
+   which main calls when the command succeeds, so that a failing command
+   still prints exactly one line. Notes past the first 16 are dropped. */
+void tool_note(const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+void tool_print_notes(void);
+
+/* Fill the `err` buffer a function was given (which may be NULL). */
+void tool_set_error(char *err, size_t err_size, const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 /* ---------------------------------------------------------------------- */
-/* Command-line helpers                                                     */
+/* Command-line helpers (cli.c)                                             */
 /*                                                                          */
 /* A command walks its arguments like this:                                 */
 /*                                                                          */
@@ -130,13 +154,25 @@ int parse_float_list(const char *option, const char *text, int count, double *ou
 int parse_int_list(const char *option, const char *text, int count, int *out);
 
 /* ---------------------------------------------------------------------- */
-/* Files and growing byte buffers                                           */
+/* Files and growing byte buffers (tool_io.c)                               */
 /* ---------------------------------------------------------------------- */
 
 /* Read a whole file (or "-" for standard input) into a malloc'ed buffer with a
    terminating NUL byte after the `*size` bytes of content. On failure returns
    -1 and says why in err ("cannot open 'x.obj': No such file or directory"). */
 int tool_read_file(const char *path, unsigned char **data, size_t *size, char *err, size_t err_size);
+
+/* tool_read_file remembers every regular file it read (device and inode,
+   which catches "./m.obj" for "m.obj" and hard links). An output path that
+   is a directory or is one of those inputs gives -1 and the reason in err;
+   a path that does not exist yet is fine. output_commit checks every
+   output; a command may check its outputs earlier, before a long
+   computation, with tool_refuse_input_overwrite (prints the error, returns
+   TOOL_EXIT_FAILURE, or 0 when the path is fine). */
+int tool_check_output_path(const char *path, char *err, size_t err_size);
+int tool_refuse_input_overwrite(const char *path);
+/* Forget the inputs remembered so far (frees their list). */
+void tool_forget_inputs(void);
 
 /* A byte buffer that grows as text is appended. A failed allocation sets
    `failed` and makes every later append a no-op, so a writer can append
@@ -148,6 +184,10 @@ typedef struct tool_buffer {
     int failed;
 } tool_buffer;
 
+/* An empty buffer, for initialising one (plain `= {0}` draws a warning from
+   C++ compilers with -Wextra). */
+#define TOOL_BUFFER_INIT {NULL, 0, 0, 0}
+
 void buffer_append(tool_buffer *buffer, const void *bytes, size_t count);
 void buffer_printf(tool_buffer *buffer, const char *format, ...)
 #if defined(__GNUC__) || defined(__clang__)
@@ -157,7 +197,8 @@ void buffer_printf(tool_buffer *buffer, const char *format, ...)
 void buffer_free(tool_buffer *buffer);
 
 /* ---------------------------------------------------------------------- */
-/* Atomic output: build every file in memory, then write them all or none  */
+/* Atomic output (tool_io.c): build every file in memory, then write them   */
+/* all or none                                                              */
 /* ---------------------------------------------------------------------- */
 
 typedef struct tool_output_file {
@@ -166,12 +207,13 @@ typedef struct tool_output_file {
     size_t size;
 } tool_output_file;
 
-/* Zero-initialise (tool_output out = {0};). */
+/* Zero-initialise (tool_output out = TOOL_OUTPUT_INIT;). */
 typedef struct tool_output {
     tool_output_file *files;
     int count;
     int capacity;
 } tool_output;
+#define TOOL_OUTPUT_INIT {NULL, 0, 0}
 
 /* Add a file. The batch takes ownership of `data` (malloc'ed, may be NULL when
    size is 0) whether or not the call succeeds. Adding a path that is already
@@ -180,33 +222,43 @@ int output_add(tool_output *output, const char *path, void *data, size_t size);
 /* Add the contents of a tool_buffer (which is emptied). Fails when the
    buffer's `failed` flag is set. */
 int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer);
-/* Encode `image` as PNG and add it. */
-int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size);
 
-/* Write every file to a temporary file beside it ("PATH.tiledtex-tmp"), and
-   only when all of them were written completely rename each onto its real
-   name. On any failure every temporary is removed, as is every file already
-   renamed in this commit, so the command leaves no output at all. Returns 0
-   or -1 with the reason in err. The batch stays valid; free it with
+/* First refuse (writing nothing) when an output path names a directory or
+   the same file as an input (see tool_check_output_path). Then write every
+   file to a new temporary file beside it ("PATH.tiledtex-tmp", numbered when
+   that name is taken), and only when all of them were written completely
+   rename each onto its real name. On any failure the temporaries this commit
+   created are removed, as is every file already renamed in this commit, so
+   the command leaves no output at all; no other path is ever removed.
+   Returns 0 or -1 with the reason in err. The batch stays valid; free it with
    output_free. */
 int output_commit(tool_output *output, char *err, size_t err_size);
 void output_free(tool_output *output);
 
 /* ---------------------------------------------------------------------- */
-/* Images                                                                   */
+/* Images (image_io.c)                                                      */
 /* ---------------------------------------------------------------------- */
+
+/* The pixel budget for the images the tool reads (the global option
+   --max-pixels): 4096 x 4096, which take 256 MB as float RGBA. */
+#define TOOL_DEFAULT_MAX_PIXELS 16777216
+void image_set_max_pixels(uint64_t max_pixels);
 
 /* Load a PNG / JPEG / TGA / BMP / PSD / GIF / HDR / PIC / PNM file as a float
    RGBA tt_image (grey and grey+alpha become RGB(A); no alpha means alpha 1).
    Errors: the file is missing or unreadable, is not an image stb_image can
-   decode, or is wider or taller than TT_MAX_IMAGE_SIZE. */
+   decode, is wider or taller than TT_MAX_IMAGE_SIZE, or has more pixels than
+   the budget (image_set_max_pixels). Sizes are read from the header before
+   any pixel is decoded. */
 int image_load(const char *path, tt_image *image, char *err, size_t err_size);
 
 /* Encode an image as an 8-bit RGBA PNG in memory (malloc'ed; free it). */
 int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, char *err, size_t err_size);
+/* Encode `image` as PNG and add it to an output batch. */
+int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size);
 
 /* ---------------------------------------------------------------------- */
-/* Wavefront OBJ                                                            */
+/* Wavefront OBJ (obj.c)                                                    */
 /* ---------------------------------------------------------------------- */
 
 typedef struct obj_mesh {
@@ -220,21 +272,27 @@ typedef struct obj_mesh {
     char *mtllib;                     /* first mtllib name or NULL */
     int *vert_line;                   /* nverts: the file line of each `v`, for messages */
     int *face_line;                   /* nfaces: the file line of each `f` */
+    int unknown_statements;           /* statements with a keyword the reader does not know (skipped) */
+    int first_unknown_line;           /* the line of the first of them */
+    char first_unknown[32];           /* its keyword, cut short, unprintable bytes as '?' */
 } obj_mesh;
 
 /* Parse OBJ text (`length` bytes, need not end in NUL; any bytes are safe).
    Reads v, vt, f (corners v, v/vt, v//vn, v/vt/vn; negative indices count
    back from the latest vertex), g / o / usemtl (which group each face is in;
    the latest of these statements names it), and the first mtllib. Everything
-   else (vn values, s, l, p, comments, unknown statements) is skipped. A line
-   ending in '\' continues on the next. Returns 0, or -1 with a message naming
-   the line in err ("line 12: face with fewer than 3 corners") and *out zeroed. */
+   else (vn values, s, l, p, comments, unknown statements) is skipped; unknown
+   statements are counted in unknown_statements. Lines end in LF, CRLF or a
+   lone CR; a UTF-8 byte-order mark at the start is skipped. A line ending in
+   '\' continues on the next. Returns 0, or -1 with a message naming the line
+   in err ("line 12: face with fewer than 3 corners") and *out zeroed. */
 int obj_parse(const char *text, size_t length, obj_mesh *out, char *err, size_t err_size);
 /* The description that hands an OBJ's arrays to tt_mesh_build as they are:
    corners are faces one after another, the library's index-buffer layout. */
 tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
 
-/* Read and parse a file; messages start with the path ("mesh.obj:12: ..."). */
+/* Read and parse a file; messages start with the path ("mesh.obj:12: ...").
+   Unknown statements give one tool_note naming the first and the count. */
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
 
@@ -276,7 +334,7 @@ typedef struct obj_write_desc {
 
 /* Append the OBJ text to `out`: "v x y z", then one "vt u v" per face corner
    (when corner_uv is given), then "f v/vt ..." with 1-based indices. Numbers
-   use 9 significant digits, so floats read back exactly. Returns 0, or -1 on
+   use 9 significant digits (tool_format_float), so floats read back exactly. Returns 0, or -1 on
    an invalid description or when the buffer ran out of memory. */
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
 
@@ -284,6 +342,30 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc);
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
    "map_d TEXTURE": the texture's alpha channel is the material's opacity. */
 void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha);
+
+/* ---------------------------------------------------------------------- */
+/* Numbers as text without printf (format_number.c)                        */
+/* ---------------------------------------------------------------------- */
+
+/* Room for any text below, with its NUL ("-1.23456789e-38"). */
+#define TOOL_NUMBER_TEXT_SIZE 24
+
+/* A float with 9 significant digits, the text printf("%.9g") gives (up to,
+   rarely, the last digit), which reads back as exactly the same float; NaN
+   and infinity go through snprintf. Writes a NUL-terminated string into out
+   (TOOL_NUMBER_TEXT_SIZE bytes) and returns its length. Several times faster
+   than printf. */
+int tool_format_float(float value, char *out);
+/* A decimal integer the same way. */
+int tool_format_int(long value, char *out);
+
+/* ---------------------------------------------------------------------- */
+/* Paths and strings (tool_io.c)                                            */
+/* ---------------------------------------------------------------------- */
+
+/* A malloc'ed, NUL-terminated copy of `length` bytes of text; NULL when out
+   of memory. */
+char *tool_copy_string(const char *text, size_t length);
 
 /* The file name part of a path ("out/a.png" -> "a.png"), for mtllib / map_Kd
    lines that must be relative to the OBJ / MTL file. */

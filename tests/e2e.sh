@@ -15,6 +15,8 @@ if [ $# -ne 1 ] || [ -z "$1" ]; then
     exit 2
 fi
 TOOL=$1
+# the repository (test helpers compile examples/ sources)
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 case $TOOL in
     */*) TOOL=$(cd "$(dirname "$TOOL")" 2>/dev/null && pwd)/$(basename "$TOOL") ;;
     *) TOOL=$(command -v "$TOOL" || echo "$TOOL") ;;
@@ -811,6 +813,252 @@ mkdir a_mip2.png
 run synth ../in/tex.png a.png --tile 32 --mips
 check "synth --mips with a_mip2.png a directory: nothing written" "non-zero exit, only a_mip2.png" \
     "exit $RC, files: $(ls -A | tr '\n' ' ')" "$([ $RC -ne 0 ] && [ "$(ls -A)" = a_mip2.png ]; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
+# OBJ reader: byte-order marks, line endings, unknown keywords
+# ======================================================================
+# Two quads; the BOM / CR / CRLF twins must give byte-identical outputs.
+OBJ_LINES='v 0 0 0|v 1 0 0|v 2 0 0|v 0 1 0|v 1 1 0|v 2 1 0.5|f 1 2 5 4|f 2 3 6 5|'
+printf '%s' "$OBJ_LINES" | tr '|' '\n' >"$W/in/two.obj"
+{ printf '\357\273\277'; cat "$W/in/two.obj"; } >"$W/in/two_bom.obj"
+tr '\n' '\r' <"$W/in/two.obj" >"$W/in/two_cr.obj"
+sed 's/$/\r/' "$W/in/two.obj" >"$W/in/two_crlf.obj"
+newdir
+expect_ok "map two quads (LF)" map ../in/two.obj lf.obj --seed 1
+for kind in bom cr crlf; do
+    expect_ok "map two quads ($kind)" map ../in/two_$kind.obj $kind.obj --seed 1
+    check "OBJ with $kind: same output as with LF" "cmp equal, nothing on stderr" "$(cmp lf.obj $kind.obj 2>&1) / $ERR" \
+        "$(cmp -s lf.obj $kind.obj && [ -z "$ERR" ]; echo $?)"
+done
+# a BOM must not drop the first vertex (the faces would silently shift)
+check "OBJ with a BOM: 6 vertices, first one kept" "6 v lines, the first 'v 0 0 0'" "$(grep -c '^v ' bom.obj) v lines" \
+    "$([ "$(grep -c '^v ' bom.obj)" = 6 ] && [ "$(grep -m1 '^v ' bom.obj)" = 'v 0 0 0' ]; echo $?)"
+# CR-only lines count as lines: an error names the right line
+printf 'v 0 0 0\rv 1 0 0\rv 1 1 0\rf 1 2 9\r' >"$W/in/cr_bad.obj"
+cd "$W" || exit 1
+expect_error "CR-only OBJ with a bad face" map ../in/cr_bad.obj m.obj
+err_mentions "CR-only OBJ with a bad face: names line 4" 'cr_bad\.obj:4: '
+# unknown keywords: one warning naming the first, its line and the count
+printf 'v 0 0 0\nv 1 0 0\nfoo 1 2\nv 1 1 0\nbar\nv 0 1 0\nV 3 3 3\nf 1 2 3 4\n' >"$W/in/unknown.obj"
+newdir
+expect_ok "OBJ with unknown keywords" map ../in/unknown.obj m.obj
+check "unknown keywords: exactly one warning line" "1 stderr line" "$ERR" \
+    "$([ "$(wc -l <"$W/err")" -eq 1 ]; echo $?)"
+err_mentions "unknown keywords: names the first, its line and the count" "unknown\.obj:3: .*3 lines.*'foo'"
+# known but unused statements stay silent
+printf 'mtllib x.mtl\no thing\ng part\nusemtl m\ns 1\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\nl 1 2\np 1\n# note\nf 1//1 2//1 3//1 4//1\n' \
+    >"$W/in/known.obj"
+expect_ok "OBJ with known unused statements" map ../in/known.obj k.obj
+check "known unused statements: no warning" "empty stderr" "$ERR" "$([ -z "$ERR" ]; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
+# Outputs never replace inputs; the rollback removes only its own files
+# ======================================================================
+# expect_refused WHAT ARGS... : run in the current directory, whose files are
+# the inputs: non-zero exit, one stderr line saying it will not overwrite,
+# and afterwards the same files with the same contents.
+expect_refused() {
+    local what=$1 before after
+    shift
+    before=$(ls -A | tr '\n' ' '; cat -- * 2>/dev/null | cksum)
+    run "$@"
+    after=$(ls -A | tr '\n' ' '; cat -- * 2>/dev/null | cksum)
+    check "$what: refused" "non-zero exit, one stderr line 'will not overwrite'" "exit $RC, stderr: $ERR" \
+        "$([ $RC -ne 0 ] && [ $RC -lt 124 ] && [ "$(wc -l <"$W/err")" -eq 1 ] && grep -q 'will not overwrite' "$W/err"; echo $?)"
+    check "$what: nothing written or changed" "files and contents as before" "before: $before, after: $after" \
+        "$([ "$before" = "$after" ]; echo $?)"
+}
+newdir
+cp ../in/torus.obj m.obj
+cp ../in/lap.png img.png
+expect_refused "tile MESH IMAGE with OUT_PREFIX naming the mesh" tile m.obj img.png m --tile 16
+expect_refused "tile ./m.obj ... m (same file, other spelling)" tile ./m.obj img.png m --tile 16
+expect_refused "tile with OUT_PREFIX naming the image" tile m.obj img.png img --tile 16
+ln m.obj link.obj
+expect_refused "map onto a hard link of the input" map m.obj link.obj
+expect_refused "map onto the input" map m.obj m.obj
+cp img.png x_patch.png
+expect_refused "lapped IMAGE that is OUT_PREFIX_patch.png" lapped m.obj x_patch.png x --scale 1.5
+cp img.png y_baked.png
+expect_refused "lapped --bake output that is the IMAGE" lapped m.obj y_baked.png y --scale 1.5 --bake 64
+expect_refused "synth onto its image" synth img.png img.png --tile 16
+expect_refused "synth onto its image (other spelling)" synth img.png ../$(basename "$PWD")/img.png --tile 16
+expect_refused "render onto its texture" render m.obj img.png img.png --size 32x32
+expect_refused "render onto its mesh" render m.obj img.png m.obj --size 32x32
+CMD="tiledtex map - m.obj < m.obj"
+"$TOOL" map - m.obj <m.obj >"$W/out" 2>"$W/err"
+RC=$?
+check "map from standard input onto the same file: refused" "non-zero exit, m.obj unchanged" "exit $RC, $(cat "$W/err")" \
+    "$([ $RC -ne 0 ] && cmp -s m.obj ../in/torus.obj; echo $?)"
+cd "$W" || exit 1
+
+# a directory named like a temporary is never opened nor removed
+newdir
+mkdir out.obj.tiledtex-tmp
+expect_ok "tile beside a directory named out.obj.tiledtex-tmp" tile ../in/torus.obj ../in/tex.png out --tile 16
+check "the directory named like a temporary is left alone" "out.obj.tiledtex-tmp still a directory, out.obj written" \
+    "$(ls -A | tr '\n' ' ')" "$([ -d out.obj.tiledtex-tmp ] && [ -s out.obj ]; echo $?)"
+cd "$W" || exit 1
+newdir
+mkdir out.obj.tiledtex-tmp out.png
+run tile ../in/torus.obj ../in/tex.png out --tile 16
+check "failed tile: rollback keeps a directory named like a temporary" "fails; only out.obj.tiledtex-tmp and out.png" \
+    "exit $RC, files: $(ls -A | tr '\n' ' ')" \
+    "$([ $RC -ne 0 ] && [ "$(ls -A | tr '\n' ' ')" = "out.obj.tiledtex-tmp out.png " ] && [ -d out.obj.tiledtex-tmp ]; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
+# Image size budget (--max-pixels): refused from the header, before decoding
+# ======================================================================
+HELPER_CC=${CC:-cc}
+STB_INC=$(pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
+# A valid 8000x8000 all-black PNG of well under 1 MB: 64 M pixels to decode.
+cat >"$W/bigpng.c" <<'EOF_C'
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include "stb_image_write.h"
+#include <stdlib.h>
+int main(int argc, char **argv)
+{
+    int width = 8000, height = 8000;
+    unsigned char *pixels = (unsigned char *)calloc((size_t)width * height, 1);
+    (void)argc;
+    return !(pixels && stbi_write_png(argv[1], width, height, 1, pixels, width));
+}
+EOF_C
+CMD="$HELPER_CC $STB_INC bigpng.c (test helper)"
+# shellcheck disable=SC2086
+if $HELPER_CC -O2 -w $STB_INC "$W/bigpng.c" -o "$W/bigpng" -lm 2>"$W/err" && "$W/bigpng" "$W/in/big.png"; then
+    pass
+    check "helper PNG: 8000x8000, under 1 MB" "8000 8000, < 1000000 bytes" "$(png_size "$W/in/big.png"), $(wc -c <"$W/in/big.png") bytes" \
+        "$([ "$(png_size "$W/in/big.png")" = "8000 8000" ] && [ "$(wc -c <"$W/in/big.png")" -lt 1000000 ]; echo $?)"
+    for sub in synth tile lapped render; do
+        case $sub in
+            synth) args="../in/big.png a.png" ;;
+            tile) args="../in/torus.obj ../in/big.png out" ;;
+            lapped) args="../in/torus.obj ../in/big.png out" ;;
+            render) args="../in/torus.obj ../in/big.png r.png" ;;
+        esac
+        # shellcheck disable=SC2086
+        expect_error "8000x8000 PNG ($sub)" $sub $args
+        err_mentions "8000x8000 PNG ($sub): names the size and --max-pixels" '8000x8000.*--max-pixels'
+    done
+    expect_error "8000x8000 PNG as map --atlas" map ../in/torus.obj m.obj --atlas ../in/big.png
+    err_mentions "8000x8000 PNG as map --atlas: names --max-pixels" 'with --max-pixels'
+else
+    fail "helper for the big PNG" "$CMD" "compiles and writes big.png" "$(head -c 300 "$W/err")"
+fi
+# the budget itself: tex.png is 256x256 = 65536 pixels
+expect_error "--max-pixels 65535 refuses a 256x256 image" synth ../in/tex.png a.png --tile 32 --max-pixels 65535
+err_mentions "--max-pixels 65535: names the size and the option" '256x256.*65535.*--max-pixels'
+newdir
+expect_ok "--max-pixels 65536 (before the command) takes a 256x256 image" --max-pixels 65536 synth ../in/tex.png a.png --tile 32
+expect_ok "--max-pixels=65536 (after the command)" synth ../in/tex.png b.png --tile 32 --max-pixels=65536
+cd "$W" || exit 1
+expect_error "--max-pixels 0" --max-pixels 0 synth ../in/tex.png a.png
+expect_error "--max-pixels abc" synth ../in/tex.png a.png --max-pixels abc
+expect_error "--max-pixels without a value" synth ../in/tex.png a.png --max-pixels
+run --help
+check "--help documents --max-pixels" "'--max-pixels' in the usage" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q -- '--max-pixels'; echo $?)"
+
+# ======================================================================
+# Numbers in written OBJ files: tool_format_float reads back exactly
+# ======================================================================
+cat >"$W/fmt_check.c" <<'EOF_C'
+/* Round trip of tool_format_float on random floats, and its speed against printf. */
+#define _POSIX_C_SOURCE 200112L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <math.h>
+#include <stdint.h>
+#include "tool.h"
+
+static uint64_t state = 0x9E3779B97F4A7C15u;
+static uint32_t next_random(void)
+{
+    state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+    return (uint32_t)(state >> 16);
+}
+static float random_float(long i)
+{
+    uint32_t bits;
+    float f;
+    if (i % 4 == 0) {                     /* mesh-like values */
+        f = ((float)next_random() / 4294967296.0f - 0.5f) * 20.0f;
+        return f;
+    }
+    do {                                  /* any finite bit pattern */
+        bits = next_random();
+        memcpy(&f, &bits, sizeof f);
+    } while (!isfinite(f));
+    return f;
+}
+static double seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+int main(int argc, char **argv)
+{
+    long n = argc > 1 ? atol(argv[1]) : 1000000, i, bad = 0, differs = 0;
+    static const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.1f, 0.5f, 1e-4f, 9.99999975e-05f, 1e9f,
+                                    999999999.0f, 123456789.0f, 1e-45f, -1e-45f, 1.17549435e-38f, 3.40282347e38f,
+                                    -3.40282347e38f, 16777216.0f, 2097151.625f, 0.0001f, 100000000.0f};
+    char mine[TOOL_NUMBER_TEXT_SIZE], theirs[64];
+    double t0, t_mine, t_printf;
+    size_t sink = 0;
+    for (i = 0; i < n + (long)(sizeof special / sizeof special[0]); i++) {
+        float f = i < n ? random_float(i) : special[i - n], back, back_double;
+        tool_format_float(f, mine);
+        back = strtof(mine, NULL);
+        back_double = (float)strtod(mine, NULL);       /* how the tool's reader reads it */
+        if (memcmp(&back, &f, sizeof f) != 0 || memcmp(&back_double, &f, sizeof f) != 0) {
+            if (bad++ < 5) printf("no round trip: %.9g -> '%s'\n", f, mine);
+        }
+        snprintf(theirs, sizeof theirs, "%.9g", f);
+        if (strcmp(mine, theirs) != 0 && differs++ < 5) printf("differs from printf: '%s' vs '%s'\n", mine, theirs);
+    }
+    printf("%ld floats: %ld without an exact round trip, %ld differing from printf %%.9g\n", i, bad, differs);
+    if (argc > 2) {                               /* speed: the same 1M values both ways */
+        long m = 1000000, r, rounds = atol(argv[2]);
+        float *values = (float *)malloc((size_t)m * sizeof(float));
+        for (i = 0; i < m; i++) values[i] = ((float)next_random() / 4294967296.0f - 0.5f) * 20.0f;
+        t0 = seconds();
+        for (r = 0; r < rounds; r++)
+            for (i = 0; i < m; i++) sink += (size_t)tool_format_float(values[i], mine);
+        t_mine = (seconds() - t0) / ((double)m * rounds);
+        t0 = seconds();
+        for (r = 0; r < rounds; r++)
+            for (i = 0; i < m; i++) sink += (size_t)snprintf(theirs, sizeof theirs, "%.9g", values[i]);
+        t_printf = (seconds() - t0) / ((double)m * rounds);
+        printf("tool_format_float %.1f ns, snprintf %%.9g %.1f ns per float: %.1fx (%zu)\n", t_mine * 1e9,
+               t_printf * 1e9, t_printf / t_mine, sink % 10);
+        free(values);
+    }
+    return bad != 0;
+}
+EOF_C
+CMD="$HELPER_CC fmt_check.c examples/format_number.c (test helper)"
+if $HELPER_CC -std=c99 -O2 -I"$ROOT" -I"$ROOT/examples" "$W/fmt_check.c" "$ROOT/examples/format_number.c" \
+    -o "$W/fmt_check" -lm 2>"$W/err"; then
+    FMT=$("$W/fmt_check" 1000000 2>&1)
+    check "tool_format_float: 1M random floats read back exactly" "0 without an exact round trip" "$FMT" \
+        "$(printf '%s' "$FMT" | grep -q ' 0 without an exact round trip'; echo $?)"
+else
+    fail "helper for the float formatter" "$CMD" "compiles" "$(head -c 300 "$W/err")"
+fi
+# a written mesh reads back as the same numbers: map's OBJ through map again
+newdir
+expect_ok "map the double torus" map ../in/double-torus.obj a.obj --seed 2
+expect_ok "map its output again" map a.obj b.obj --seed 2
+check "positions survive writing and reading" "identical v lines" "differ" \
+    "$(cmp -s <(grep '^v ' a.obj) <(grep '^v ' b.obj); echo $?)"
 cd "$W" || exit 1
 
 # ======================================================================

@@ -54,17 +54,21 @@ else
   echo "fuzz: fuzz_lapped does not build" >&2
   exit 2
 fi
-if [ -f examples/tool_io.c ] && [ -f examples/tool.h ]; then
-  # tool_io.c is compiled as it is; fuzz_obj.c is the one TU that defines
+# The tool's OBJ reader (examples/obj.c) with what it uses: tool_io.c (errors,
+# files, buffers) and format_number.c (the writer's numbers).
+obj_sources="examples/obj.c examples/tool_io.c examples/format_number.c"
+if [ -f examples/obj.c ] && [ -f examples/tool_io.c ] && [ -f examples/format_number.c ] && [ -f examples/tool.h ]; then
+  # These are compiled as they are; fuzz_obj.c is the one TU that defines
   # TILEDTEX_IMPLEMENTATION.
-  if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_obj.c examples/tool_io.c -o "$out/fuzz_obj" -lm; then
+  # shellcheck disable=SC2086
+  if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_obj.c $obj_sources -o "$out/fuzz_obj" -lm; then
     targets+=(obj)
   else
     echo "fuzz: fuzz_obj does not build" >&2
     exit 2
   fi
 else
-  echo "fuzz: SKIPPED fuzz_obj: examples/tool_io.c or examples/tool.h is missing" >&2
+  echo "fuzz: SKIPPED fuzz_obj: one of $obj_sources examples/tool.h is missing" >&2
 fi
 
 declare -A pid

@@ -1,0 +1,214 @@
+/* cli.c - command-line helpers of the `tiledtex` tool: options and their
+   values, and numbers read from text. See tool.h for the interface. */
+
+#include <ctype.h>
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tool.h"
+
+/* ======================================================================== */
+/* Command-line helpers                                                     */
+/* ======================================================================== */
+
+int tool_is_help(const char *arg)
+{
+    return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
+}
+
+int tool_is_option(const char *arg)
+{
+    /* "-" alone often means standard input, and "-3" is a number. */
+    return arg[0] == '-' && arg[1] != '\0' && !isdigit((unsigned char)arg[1]) && arg[1] != '.';
+}
+
+int tool_unknown_option(const char *arg)
+{
+    if (tool_command())
+        return tool_usage("unknown option '%s' (see '%s %s --help')", arg, TOOL_NAME, tool_command());
+    return tool_usage("unknown option '%s' (see '%s --help')", arg, TOOL_NAME);
+}
+
+int tool_option(int argc, char **argv, int *index, const char *name, const char **value)
+{
+    const char *arg = argv[*index];
+    size_t name_length = strlen(name);
+    if (strncmp(arg, name, name_length) != 0) return 0;
+    if (arg[name_length] == '=') {              /* --size=800x600 */
+        *value = arg + name_length + 1;
+        return 1;
+    }
+    if (arg[name_length] != '\0') return 0;     /* --sizes is another option */
+    if (*index + 1 < argc) {
+        *index += 1;
+        *value = argv[*index];
+    } else {
+        *value = NULL;
+    }
+    return 1;
+}
+
+static int missing_value(const char *option)
+{
+    tool_usage("%s needs a value", option);
+    return -1;
+}
+
+int parse_whole_long(const char *text, long *out)
+{
+    char *end;
+    long value;
+    while (isspace((unsigned char)*text)) text++;
+    if (*text == '\0') return -1;
+    errno = 0;
+    value = strtol(text, &end, 10);
+    if (errno == ERANGE || end == text) return -1;
+    while (isspace((unsigned char)*end)) end++;
+    if (*end != '\0') return -1;
+    *out = value;
+    return 0;
+}
+
+int parse_whole_double(const char *text, double *out)
+{
+    char *end;
+    double value;
+    while (isspace((unsigned char)*text)) text++;
+    if (*text == '\0') return -1;
+    value = strtod(text, &end);
+    if (end == text) return -1;
+    while (isspace((unsigned char)*end)) end++;
+    if (*end != '\0' || !isfinite(value)) return -1;
+    *out = value;
+    return 0;
+}
+
+int parse_int(const char *option, const char *text, int min, int max, int *out)
+{
+    long value;
+    if (!text) return missing_value(option);
+    if (parse_whole_long(text, &value) != 0 || value < min || value > max) {
+        tool_usage("%s wants an integer from %d to %d, got '%s'", option, min, max, text);
+        return -1;
+    }
+    *out = (int)value;
+    return 0;
+}
+
+int parse_u64(const char *option, const char *text, uint64_t *out)
+{
+    const char *p = text;
+    uint64_t value = 0;
+    int base = 10, digits = 0;
+    if (!text) return missing_value(option);
+    if (p[0] == '0' && (p[1] == 'x' || p[1] == 'X')) { base = 16; p += 2; }
+    for (; *p; p++, digits++) {
+        int digit;
+        if (isdigit((unsigned char)*p)) digit = *p - '0';
+        else if (base == 16 && isxdigit((unsigned char)*p)) digit = tolower((unsigned char)*p) - 'a' + 10;
+        else break;
+        if (value > (UINT64_MAX - (uint64_t)digit) / (uint64_t)base) { digits = 0; break; }  /* overflow */
+        value = value * (uint64_t)base + (uint64_t)digit;
+    }
+    if (digits == 0 || *p != '\0') {
+        tool_usage("%s wants a non-negative integer below 2^64, got '%s'", option, text);
+        return -1;
+    }
+    *out = value;
+    return 0;
+}
+
+int parse_float(const char *option, const char *text, double min, double max, double *out)
+{
+    double value;
+    if (!text) return missing_value(option);
+    if (parse_whole_double(text, &value) != 0 || value < min || value > max) {
+        tool_usage("%s wants a number from %g to %g, got '%s'", option, min, max, text);
+        return -1;
+    }
+    *out = value;
+    return 0;
+}
+
+int parse_size(const char *option, const char *text, int min, int max, int *width, int *height)
+{
+    char first[32];
+    const char *x;
+    long w, h;
+    size_t first_length;
+    if (!text) return missing_value(option);
+    x = strpbrk(text, "xX");
+    first_length = x ? (size_t)(x - text) : 0;
+    if (!x || first_length >= sizeof first) {
+        tool_usage("%s wants WxH, got '%s'", option, text);
+        return -1;
+    }
+    memcpy(first, text, first_length);
+    first[first_length] = '\0';
+    if (parse_whole_long(first, &w) != 0 || parse_whole_long(x + 1, &h) != 0) {
+        tool_usage("%s wants WxH, got '%s'", option, text);
+        return -1;
+    }
+    if (w < min || w > max || h < min || h > max) {
+        tool_usage("%s wants WxH with each side from %d to %d, got '%s'", option, min, max, text);
+        return -1;
+    }
+    *width = (int)w;
+    *height = (int)h;
+    return 0;
+}
+
+/* Split "a,b,c" into exactly `count` pieces and hand each to `parse_one`. */
+static int parse_list(const char *option, const char *text, int count, void *out,
+                      int (*parse_one)(const char *piece, void *out, int i))
+{
+    const char *p = text;
+    int i;
+    if (!text) return missing_value(option);
+    for (i = 0; i < count; i++) {
+        char piece[64];
+        const char *comma = strchr(p, ',');
+        size_t length = comma ? (size_t)(comma - p) : strlen(p);
+        if ((comma != NULL) != (i + 1 < count) || length >= sizeof piece) break;
+        memcpy(piece, p, length);
+        piece[length] = '\0';
+        if (parse_one(piece, out, i) != 0) break;
+        p = comma ? comma + 1 : p + length;
+    }
+    if (i < count) {
+        static const char *const shapes[] = {"", "X", "X,Y", "X,Y,Z", "X,Y,W,H"};
+        if (count >= 1 && count <= 4)
+            tool_usage("%s wants %s, got '%s'", option, shapes[count], text);
+        else
+            tool_usage("%s wants %d comma-separated numbers, got '%s'", option, count, text);
+        return -1;
+    }
+    return 0;
+}
+
+static int parse_one_double(const char *piece, void *out, int i)
+{
+    return parse_whole_double(piece, (double *)out + i);
+}
+
+static int parse_one_int(const char *piece, void *out, int i)
+{
+    long value;
+    if (parse_whole_long(piece, &value) != 0 || value < INT_MIN || value > INT_MAX) return -1;
+    ((int *)out)[i] = (int)value;
+    return 0;
+}
+
+int parse_float_list(const char *option, const char *text, int count, double *out)
+{
+    return parse_list(option, text, count, out, parse_one_double);
+}
+
+int parse_int_list(const char *option, const char *text, int count, int *out)
+{
+    return parse_list(option, text, count, out, parse_one_int);
+}

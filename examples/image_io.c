@@ -1,0 +1,150 @@
+/* image_io.c - images for the `tiledtex` tool: loading any format stb_image
+   reads into a float RGBA tt_image (after checking its size), and encoding
+   PNG files. See tool.h for the interface. */
+
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tool.h"
+
+/* stb_image and stb_image_write (Debian package libstb-dev) are compiled in
+   this one file. They are not written for -Wextra -pedantic -Wshadow, so their
+   own warnings are switched off around them - and only around them. */
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic push
+#ifdef __clang__
+#pragma clang diagnostic ignored "-Wunknown-warning-option"
+#endif
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wunused-but-set-variable"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#ifndef __cplusplus
+#pragma GCC diagnostic ignored "-Wstrict-prototypes"
+#endif
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#endif
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_FAILURE_USERMSG        /* friendlier texts from stbi_failure_reason() */
+#include "stb_image.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include "stb_image_write.h"
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+/* ======================================================================== */
+/* Images                                                                   */
+/* ======================================================================== */
+
+static uint64_t image_max_pixels = TOOL_DEFAULT_MAX_PIXELS;
+
+void image_set_max_pixels(uint64_t max_pixels) { image_max_pixels = max_pixels; }
+
+int image_load(const char *path, tt_image *image, char *err, size_t err_size)
+{
+    unsigned char *file_data, *pixels;
+    size_t file_size;
+    int width, height, channels;
+    tt_result result;
+    memset(image, 0, sizeof *image);
+    if (tool_read_file(path, &file_data, &file_size, err, err_size) != 0) return -1;
+    if (file_size > INT_MAX) {
+        tool_set_error(err, err_size, "'%s' is too large to be an image this tool can read", path);
+        free(file_data);
+        return -1;
+    }
+    /* Look at the header first: a corrupt or hostile file can claim a huge
+       size, and we want to refuse it before anything is allocated for it. */
+    if (!stbi_info_from_memory(file_data, (int)file_size, &width, &height, &channels)) {
+        tool_set_error(err, err_size, "'%s' is not an image that can be read (%s)", path, stbi_failure_reason());
+        free(file_data);
+        return -1;
+    }
+    if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) {
+        tool_set_error(err, err_size, "'%s' is %dx%d; images up to %dx%d are supported", path, width, height,
+                  TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
+        free(file_data);
+        return -1;
+    }
+    /* A small file can declare a huge image (a 62 KB PNG of 8000x8000 zeros
+       would take over 1 GB as floats): refuse it before decoding a pixel. */
+    if ((uint64_t)width * (uint64_t)height > image_max_pixels) {
+        tool_set_error(err, err_size,
+                       "'%s' is %dx%d = %llu pixels, over the limit of %llu (raise it with --max-pixels N)", path,
+                       width, height, (unsigned long long)width * (unsigned long long)height,
+                       (unsigned long long)image_max_pixels);
+        free(file_data);
+        return -1;
+    }
+    pixels = stbi_load_from_memory(file_data, (int)file_size, &width, &height, &channels, 0);
+    free(file_data);
+    if (!pixels) {
+        tool_set_error(err, err_size, "cannot decode '%s' (%s)", path, stbi_failure_reason());
+        return -1;
+    }
+    result = tt_image_from_bytes(image, pixels, width, height, channels, 0, NULL);
+    stbi_image_free(pixels);
+    if (result != TT_OK) {
+        tool_set_error(err, err_size, "cannot use '%s': %s", path, tt_result_string(result));
+        memset(image, 0, sizeof *image);
+        return -1;
+    }
+    return 0;
+}
+
+/* stb_image_write hands the encoded PNG over in pieces; collect them. */
+static void collect_png_bytes(void *context, void *bytes, int count)
+{
+    if (count > 0) buffer_append((tool_buffer *)context, bytes, (size_t)count);
+}
+
+int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, char *err, size_t err_size)
+{
+    tool_buffer buffer = TOOL_BUFFER_INIT;
+    unsigned char *rgba;
+    size_t bytes;
+    int ok;
+    *png = NULL;
+    *png_size = 0;
+    if (!image || !image->pixels || image->width <= 0 || image->height <= 0 ||
+        image->width > TT_MAX_IMAGE_SIZE || image->height > TT_MAX_IMAGE_SIZE) {
+        tool_set_error(err, err_size, "cannot save an empty or oversized image");
+        return -1;
+    }
+    bytes = (size_t)image->width * (size_t)image->height * 4;
+    rgba = (unsigned char *)malloc(bytes);
+    if (!rgba) {
+        tool_set_error(err, err_size, "out of memory while encoding a %dx%d PNG", image->width, image->height);
+        return -1;
+    }
+    tt_image_to_rgba8(image, rgba);
+    ok = stbi_write_png_to_func(collect_png_bytes, &buffer, image->width, image->height, 4, rgba,
+                                image->width * 4);
+    free(rgba);
+    if (!ok || buffer.failed) {
+        tool_set_error(err, err_size, "could not encode a %dx%d PNG (out of memory?)", image->width, image->height);
+        buffer_free(&buffer);
+        return -1;
+    }
+    *png = (unsigned char *)buffer.data;
+    *png_size = buffer.size;
+    return 0;
+}
+
+int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size)
+{
+    unsigned char *png;
+    size_t png_size;
+    if (png_encode(image, &png, &png_size, err, err_size) != 0) return -1;
+    if (output_add(output, path, png, png_size) != 0) {
+        tool_set_error(err, err_size, "out of memory while preparing '%s'", path);
+        return -1;
+    }
+    return 0;
+}

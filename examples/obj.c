@@ -1,0 +1,764 @@
+/* obj.c - Wavefront OBJ reading and writing, and MTL writing, for the
+   `tiledtex` tool. See tool.h for the interface. */
+
+#include <ctype.h>
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tool.h"
+
+/* ======================================================================== */
+/* OBJ reading                                                              */
+/*                                                                          */
+/* One pass over the text with a cursor; no allocation per token. Arrays    */
+/* grow by doubling with overflow-checked sizes. Counts are capped well     */
+/* below INT_MAX so that 3 * nverts and 2 * ncorners still fit an int.      */
+/* ======================================================================== */
+
+#define OBJ_MAX_COUNT (1 << 28)
+#define OBJ_MAX_NUMBER_LENGTH 128   /* longer "numbers" are not numbers */
+#define OBJ_MAX_NAME_LENGTH 1024    /* group / material names are cut here */
+
+typedef struct obj_parser {
+    const char *p, *end;        /* cursor over the text */
+    int line;                   /* physical line of the cursor, 1-based */
+    int statement_line;         /* line the current statement starts on */
+    const char *statement;      /* its first byte, for quoting in messages */
+    const char *source;         /* file name for messages, or NULL */
+    char *err;
+    size_t err_size;
+    obj_mesh *mesh;
+    int pos_capacity, vert_line_capacity, uv_capacity, face_capacity, corner_capacity, group_capacity;
+    int nnormals;
+    int current_group;
+    int *group_table;           /* open-addressing hash: group index + 1, 0 = empty */
+    int group_table_size;       /* a power of two, kept at least twice ngroups */
+} obj_parser;
+
+/* The capacity to grow an array to so that `needed` elements fit: doubling,
+   so appending n elements costs O(n) in all; -1 if the bytes would overflow. */
+static int grown_capacity(int capacity, int needed, size_t element_size, int *out)
+{
+    size_t grown = capacity > 0 ? (size_t)capacity : 16;
+    while (grown < (size_t)needed) grown *= 2;
+    if (grown > INT_MAX) grown = (size_t)needed;
+    if (grown > SIZE_MAX / element_size) return -1;
+    *out = (int)grown;
+    return 0;
+}
+
+static int resize_array(void **array, int capacity, size_t element_size)
+{
+    void *resized = realloc(*array, (size_t)capacity * element_size);
+    if (!resized) return -1;
+    *array = resized;
+    return 0;
+}
+
+/* Grow *array (of element_size bytes each) so it holds at least `needed`. */
+static int grow_array(void **array, int *capacity, int needed, size_t element_size)
+{
+    int new_capacity;
+    if (needed <= *capacity) return 0;
+    if (grown_capacity(*capacity, needed, element_size, &new_capacity) != 0) return -1;
+    if (resize_array(array, new_capacity, element_size) != 0) return -1;
+    *capacity = new_capacity;
+    return 0;
+}
+
+/* Report an error on the current statement's line. Always returns -1. */
+static int obj_error(obj_parser *P, const char *format, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+static int obj_error(obj_parser *P, const char *format, ...)
+{
+    char message[400];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    if (P->source)
+        tool_set_error(P->err, P->err_size, "%s:%d: %s", P->source, P->statement_line, message);
+    else
+        tool_set_error(P->err, P->err_size, "line %d: %s", P->statement_line, message);
+    return -1;
+}
+
+/* Lines end in "\n" (Unix), "\r\n" (Windows) or a lone "\r" (old Mac OS).
+   Returns how many bytes the line end at p takes, 0 when p is not at one. */
+static size_t line_end_length(const obj_parser *P, const char *p)
+{
+    if (p >= P->end) return 0;
+    if (*p == '\n') return 1;
+    if (*p == '\r') return (p + 1 < P->end && p[1] == '\n') ? 2 : 1;
+    return 0;
+}
+
+/* The current statement as printable text for messages: its first line, at
+   most 60 bytes, with control bytes and non-ASCII shown as '?'. */
+static const char *quote_statement(const obj_parser *P, char *out, size_t out_size)
+{
+    const char *p = P->statement;
+    size_t n = 0;
+    while (p < P->end && !line_end_length(P, p) && n + 4 < out_size && n < 60) {
+        unsigned char c = (unsigned char)*p++;
+        out[n++] = (c >= 32 && c < 127) ? (char)c : '?';
+    }
+    if (p < P->end && !line_end_length(P, p)) {
+        out[n++] = '.'; out[n++] = '.'; out[n++] = '.';
+    }
+    out[n] = '\0';
+    return out;
+}
+
+static int out_of_memory(obj_parser *P)
+{
+    return obj_error(P, "out of memory");
+}
+
+/* Blanks between tokens ('\r' is a line end, see line_end_length). */
+static int is_blank(char c)
+{
+    return c == ' ' || c == '\t' || c == '\v' || c == '\f';
+}
+
+/* A '\' right before the end of a line joins the next line to this one.
+   Returns how many bytes the continuation takes (0 if there is none here). */
+static size_t continuation_length(const obj_parser *P, const char *p)
+{
+    size_t newline;
+    if (p >= P->end || *p != '\\') return 0;
+    newline = line_end_length(P, p + 1);
+    return newline ? 1 + newline : 0;
+}
+
+static void count_line(obj_parser *P)
+{
+    if (P->line < INT_MAX) P->line++;
+}
+
+/* Skip blanks and line continuations; stop at a line end, the end, or text. */
+static void skip_blanks(obj_parser *P)
+{
+    for (;;) {
+        size_t joined;
+        while (P->p < P->end && is_blank(*P->p)) P->p++;
+        joined = continuation_length(P, P->p);
+        if (!joined) return;
+        P->p += joined;
+        count_line(P);
+    }
+}
+
+static int at_statement_end(const obj_parser *P)
+{
+    return P->p >= P->end || line_end_length(P, P->p);
+}
+
+/* The next whitespace-separated token of the statement; length 0 at its end. */
+static size_t next_token(obj_parser *P, const char **token)
+{
+    const char *start;
+    skip_blanks(P);
+    start = P->p;
+    while (P->p < P->end && !is_blank(*P->p) && !line_end_length(P, P->p) && !continuation_length(P, P->p)) P->p++;
+    *token = start;
+    return (size_t)(P->p - start);
+}
+
+/* Move past the rest of the statement and its line end. */
+static void finish_statement(obj_parser *P)
+{
+    while (P->p < P->end && !line_end_length(P, P->p)) {
+        size_t joined = continuation_length(P, P->p);
+        if (joined) { P->p += joined; count_line(P); }
+        else P->p++;
+    }
+    if (P->p < P->end) { P->p += line_end_length(P, P->p); count_line(P); }
+}
+
+static int token_is(const char *token, size_t length, const char *word)
+{
+    return strlen(word) == length && memcmp(token, word, length) == 0;
+}
+
+/* Read the next token as a number. Returns 1 on success, 0 when the statement
+   has ended (or a comment starts), -1 when the token is not a number. */
+static int read_number(obj_parser *P, float *out)
+{
+    char text[OBJ_MAX_NUMBER_LENGTH];
+    const char *token;
+    char *end;
+    double value;
+    size_t length = next_token(P, &token);
+    if (length == 0 || token[0] == '#') return 0;
+    if (length >= sizeof text) return -1;
+    /* strtod needs a NUL-terminated string, and the input has no NUL after
+       the token, so copy it (at most 127 bytes, on the stack). */
+    memcpy(text, token, length);
+    text[length] = '\0';
+    value = strtod(text, &end);
+    if (end != text + length) return -1;
+    /* NaN and infinity are passed through (the library rejects them with a
+       message naming the vertex); a finite double beyond float range becomes
+       infinity explicitly, because converting it is undefined behaviour. */
+    if (value > FLT_MAX) *out = (float)INFINITY;
+    else if (value < -FLT_MAX) *out = (float)-INFINITY;
+    else *out = (float)value;
+    return 1;
+}
+
+static int parse_vertex(obj_parser *P)
+{
+    obj_mesh *mesh = P->mesh;
+    float xyz[3];
+    int i;
+    for (i = 0; i < 3; i++) {
+        int got = read_number(P, &xyz[i]);
+        if (got <= 0) {
+            char quoted[80];
+            return obj_error(P, got < 0 ? "cannot read a number in '%s'"
+                                        : "a vertex needs 3 coordinates: '%s'",
+                             quote_statement(P, quoted, sizeof quoted));
+        }
+    }
+    /* A 4th number (w) or vertex colours may follow; they are not needed. */
+    if (mesh->nverts >= OBJ_MAX_COUNT) return obj_error(P, "too many vertices (at most %d)", OBJ_MAX_COUNT);
+    if (grow_array((void **)&mesh->pos, &P->pos_capacity, (mesh->nverts + 1) * 3, sizeof(float)) != 0 ||
+        grow_array((void **)&mesh->vert_line, &P->vert_line_capacity, mesh->nverts + 1, sizeof(int)) != 0)
+        return out_of_memory(P);
+    memcpy(mesh->pos + 3 * (size_t)mesh->nverts, xyz, sizeof xyz);
+    mesh->vert_line[mesh->nverts] = P->statement_line;
+    mesh->nverts++;
+    return 0;
+}
+
+static int parse_texture_vertex(obj_parser *P)
+{
+    obj_mesh *mesh = P->mesh;
+    float uv[2] = {0.0f, 0.0f};     /* "vt u" alone means v = 0 */
+    int i;
+    for (i = 0; i < 2; i++) {
+        int got = read_number(P, &uv[i]);
+        if (got < 0 || (got == 0 && i == 0)) {
+            char quoted[80];
+            return obj_error(P, got < 0 ? "cannot read a number in '%s'"
+                                        : "a texture vertex needs a coordinate: '%s'",
+                             quote_statement(P, quoted, sizeof quoted));
+        }
+        if (got == 0) break;
+    }
+    if (mesh->nuvs >= OBJ_MAX_COUNT) return obj_error(P, "too many texture vertices (at most %d)", OBJ_MAX_COUNT);
+    if (grow_array((void **)&mesh->uv, &P->uv_capacity, (mesh->nuvs + 1) * 2, sizeof(float)) != 0)
+        return out_of_memory(P);
+    mesh->uv[2 * (size_t)mesh->nuvs] = uv[0];
+    mesh->uv[2 * (size_t)mesh->nuvs + 1] = uv[1];
+    mesh->nuvs++;
+    return 0;
+}
+
+/* One index field of a face corner ("12", "-3"). Returns the number of bytes
+   read (0 if the field is empty). *value saturates at +-(INT_MAX + 1), which is
+   out of range for every count, so overflow cannot slip through. */
+static size_t read_index(const char *p, const char *end, long long *value, int *valid)
+{
+    const char *start = p;
+    int negative = 0;
+    long long v = 0;
+    if (p < end && (*p == '-' || *p == '+')) { negative = (*p == '-'); p++; }
+    *valid = (p < end && isdigit((unsigned char)*p));
+    while (p < end && isdigit((unsigned char)*p)) {
+        if (v <= INT_MAX) v = v * 10 + (*p - '0');
+        p++;
+    }
+    *value = negative ? -v : v;
+    return (size_t)(p - start);
+}
+
+/* Turn a 1-based or negative (relative) OBJ index into a 0-based one. */
+static int resolve_index(obj_parser *P, long long index, int defined, const char *what,
+                         const char *text, size_t text_length, int *out)
+{
+    long long resolved = index > 0 ? index - 1 : (long long)defined + index;
+    if (index == 0)
+        return obj_error(P, "face refers to %s 0, but OBJ numbers them from 1", what);
+    if (resolved < 0 || resolved >= defined) {
+        /* Quote the index as written (it may be too long for an int). */
+        int shown = text_length > 24 ? 24 : (int)text_length;
+        return obj_error(P, "face refers to %s %.*s%s but only %d %s defined so far", what, shown, text,
+                         shown < (int)text_length ? "..." : "", defined, defined == 1 ? "is" : "are");
+    }
+    *out = (int)resolved;
+    return 0;
+}
+
+static int parse_face(obj_parser *P)
+{
+    obj_mesh *mesh = P->mesh;
+    int corners = 0;
+    for (;;) {
+        const char *token, *p, *token_end;
+        long long v_index, vt_index = 0, vn_index;
+        size_t v_length;
+        int v_valid, vt_valid = 0, vn_valid, vertex, uv = -1;
+        size_t length = next_token(P, &token);
+        char quoted[80];
+        if (length == 0 || token[0] == '#') break;
+        p = token;
+        token_end = token + length;
+        /* v, v/vt, v//vn or v/vt/vn */
+        v_length = read_index(p, token_end, &v_index, &v_valid);
+        p += v_length;
+        if (v_valid && p < token_end && *p == '/') {
+            p++;
+            p += read_index(p, token_end, &vt_index, &vt_valid);
+            if (p < token_end && *p == '/') {
+                const char *normal = ++p;
+                p += read_index(p, token_end, &vn_index, &vn_valid);
+                if (p == normal) vn_valid = 1;   /* "v/vt/" : tolerated, as many readers do */
+                (void)vn_index;                  /* normals are recomputed, not read */
+                if (!vn_valid) p = token;        /* force the error below */
+            }
+        }
+        if (!v_valid || p != token_end) {
+            int shown = length > 24 ? 24 : (int)length;
+            return obj_error(P, "cannot read the face corner '%.*s' in '%s'", shown, token,
+                             quote_statement(P, quoted, sizeof quoted));
+        }
+        if (resolve_index(P, v_index, mesh->nverts, "vertex", token, v_length, &vertex) != 0)
+            return -1;
+        if (vt_valid) {
+            const char *vt_text = (const char *)memchr(token, '/', length);
+            size_t vt_length = 0;
+            vt_text++;
+            while (vt_text + vt_length < token_end && vt_text[vt_length] != '/') vt_length++;
+            if (resolve_index(P, vt_index, mesh->nuvs, "texture vertex", vt_text, vt_length, &uv) != 0)
+                return -1;
+        }
+
+        if (mesh->ncorners >= OBJ_MAX_COUNT) return obj_error(P, "too many face corners (at most %d)", OBJ_MAX_COUNT);
+        if (mesh->ncorners == P->corner_capacity) {
+            /* corner_vert and corner_uv (once it exists) share one capacity. */
+            int capacity;
+            if (grown_capacity(P->corner_capacity, mesh->ncorners + 1, sizeof(int), &capacity) != 0 ||
+                resize_array((void **)&mesh->corner_vert, capacity, sizeof(int)) != 0 ||
+                (mesh->corner_uv && resize_array((void **)&mesh->corner_uv, capacity, sizeof(int)) != 0))
+                return out_of_memory(P);
+            P->corner_capacity = capacity;
+        }
+        if (uv >= 0 && !mesh->corner_uv) {
+            /* The first corner with a texture vertex: from now on every corner
+               records one, and the earlier corners had none. */
+            int c;
+            mesh->corner_uv = (int *)malloc((size_t)P->corner_capacity * sizeof(int));
+            if (!mesh->corner_uv) return out_of_memory(P);
+            for (c = 0; c < mesh->ncorners; c++) mesh->corner_uv[c] = -1;
+        }
+        mesh->corner_vert[mesh->ncorners] = vertex;
+        if (mesh->corner_uv) mesh->corner_uv[mesh->ncorners] = uv;
+        mesh->ncorners++;
+        corners++;
+    }
+    if (corners < 3) return obj_error(P, "face with fewer than 3 corners");
+    if (mesh->nfaces >= OBJ_MAX_COUNT) return obj_error(P, "too many faces (at most %d)", OBJ_MAX_COUNT);
+    if (mesh->nfaces == P->face_capacity) {
+        /* face_size, face_group and face_line share one capacity. */
+        int capacity;
+        if (grown_capacity(P->face_capacity, mesh->nfaces + 1, sizeof(int), &capacity) != 0 ||
+            resize_array((void **)&mesh->face_size, capacity, sizeof(int)) != 0 ||
+            resize_array((void **)&mesh->face_group, capacity, sizeof(int)) != 0 ||
+            resize_array((void **)&mesh->face_line, capacity, sizeof(int)) != 0)
+            return out_of_memory(P);
+        P->face_capacity = capacity;
+    }
+    mesh->face_size[mesh->nfaces] = corners;
+    mesh->face_group[mesh->nfaces] = P->current_group;
+    mesh->face_line[mesh->nfaces] = P->statement_line;
+    mesh->nfaces++;
+    return 0;
+}
+
+/* The rest of the statement as one name ("g left arm" -> "left arm"), with
+   runs of blanks turned into single spaces and a trailing comment dropped. */
+static size_t read_name(obj_parser *P, char *name, size_t name_size)
+{
+    size_t n = 0;
+    for (;;) {
+        const char *token;
+        size_t length = next_token(P, &token);
+        if (length == 0 || token[0] == '#') break;
+        if (n > 0 && n + 1 < name_size) name[n++] = ' ';
+        if (length > name_size - 1 - n) length = name_size - 1 - n;
+        /* Control bytes (a NUL would end the C string early) become '_'. */
+        for (; length > 0; length--, token++) name[n++] = (unsigned char)*token < 0x20 ? '_' : *token;
+    }
+    name[n] = '\0';
+    return n;
+}
+
+static uint32_t hash_name(const char *name)
+{
+    uint32_t h = 2166136261u;   /* FNV-1a */
+    while (*name) { h ^= (unsigned char)*name++; h *= 16777619u; }
+    return h;
+}
+
+/* Index of the group called `name`, adding it if it is new. Names are looked
+   up in a hash table, so a file with many groups (one per paste, say) stays
+   linear-time. */
+static int find_or_add_group(obj_parser *P, const char *name, size_t length)
+{
+    obj_mesh *mesh = P->mesh;
+    uint32_t mask, slot;
+    if (mesh->ngroups * 2 >= P->group_table_size) {
+        /* Rebuild the table twice as large. */
+        int size = P->group_table_size ? P->group_table_size * 2 : 64, g;
+        int *table;
+        if (size > OBJ_MAX_COUNT) return out_of_memory(P);
+        table = (int *)calloc((size_t)size, sizeof(int));
+        if (!table) return out_of_memory(P);
+        for (g = 0; g < mesh->ngroups; g++) {
+            uint32_t s = hash_name(mesh->group_names[g]) & (uint32_t)(size - 1);
+            while (table[s]) s = (s + 1) & (uint32_t)(size - 1);
+            table[s] = g + 1;
+        }
+        free(P->group_table);
+        P->group_table = table;
+        P->group_table_size = size;
+    }
+    mask = (uint32_t)P->group_table_size - 1;
+    for (slot = hash_name(name) & mask; P->group_table[slot]; slot = (slot + 1) & mask)
+        if (strcmp(mesh->group_names[P->group_table[slot] - 1], name) == 0) return P->group_table[slot] - 1;
+    if (grow_array((void **)&mesh->group_names, &P->group_capacity, mesh->ngroups + 1, sizeof(char *)) != 0)
+        return out_of_memory(P);
+    mesh->group_names[mesh->ngroups] = tool_copy_string(name, length);
+    if (!mesh->group_names[mesh->ngroups]) return out_of_memory(P);
+    P->group_table[slot] = mesh->ngroups + 1;
+    return mesh->ngroups++;
+}
+
+/* Statements that are valid OBJ but carry nothing this tool uses: normals
+   (recomputed when needed), smoothing groups, lines, points, parameter-space
+   vertices and display attributes. They are skipped without a word. */
+static int is_ignored_keyword(const char *keyword, size_t length)
+{
+    static const char *const ignored[] = {"vn", "vp", "s", "l", "p", "lod", "bevel", "c_interp", "d_interp",
+                                          "maplib", "usemap", "shadow_obj", "trace_obj"};
+    size_t i;
+    for (i = 0; i < sizeof ignored / sizeof ignored[0]; i++)
+        if (token_is(keyword, length, ignored[i])) return 1;
+    return 0;
+}
+
+static int parse_statement(obj_parser *P)
+{
+    const char *keyword;
+    size_t length = next_token(P, &keyword);
+    char name[OBJ_MAX_NAME_LENGTH];
+    if (token_is(keyword, length, "v")) return parse_vertex(P);
+    if (token_is(keyword, length, "vt")) return parse_texture_vertex(P);
+    if (token_is(keyword, length, "f")) return parse_face(P);
+    if (token_is(keyword, length, "vn")) {
+        P->nnormals++;      /* counted only; normals are recomputed by whoever needs them */
+        return 0;
+    }
+    if (token_is(keyword, length, "g") || token_is(keyword, length, "o") || token_is(keyword, length, "usemtl")) {
+        size_t name_length = read_name(P, name, sizeof name);
+        int group = find_or_add_group(P, name, name_length);
+        if (group < 0) return -1;
+        P->current_group = group;
+        return 0;
+    }
+    if (token_is(keyword, length, "mtllib")) {
+        size_t name_length = read_name(P, name, sizeof name);
+        if (!P->mesh->mtllib && name_length > 0) {
+            P->mesh->mtllib = tool_copy_string(name, name_length);
+            if (!P->mesh->mtllib) return out_of_memory(P);
+        }
+        return 0;
+    }
+    if (length == 0 || keyword[0] == '#' || is_ignored_keyword(keyword, length)) return 0;
+    /* Anything else is not OBJ this reader knows: skip it, but count it, so
+       the tool can say so (a mangled "v" line would shift every index). */
+    if (P->mesh->unknown_statements++ == 0) {
+        size_t i, shown = length < sizeof P->mesh->first_unknown - 1 ? length : sizeof P->mesh->first_unknown - 1;
+        for (i = 0; i < shown; i++) {
+            unsigned char c = (unsigned char)keyword[i];
+            P->mesh->first_unknown[i] = (c >= 32 && c < 127) ? (char)c : '?';
+        }
+        P->mesh->first_unknown[shown] = '\0';
+        P->mesh->first_unknown_line = P->statement_line;
+    }
+    return 0;
+}
+
+static int obj_parse_named(const char *text, size_t length, const char *source, obj_mesh *out, char *err,
+                           size_t err_size)
+{
+    obj_parser parser;
+    obj_parser *P = &parser;
+    memset(out, 0, sizeof *out);
+    memset(P, 0, sizeof *P);
+    P->p = text ? text : "";
+    P->end = P->p + (text ? length : 0);
+    /* A UTF-8 byte-order mark, as some Windows editors write, is not part of
+       the first statement. */
+    if (P->end - P->p >= 3 && memcmp(P->p, "\xEF\xBB\xBF", 3) == 0) P->p += 3;
+    P->line = 1;
+    P->source = source;
+    P->err = err;
+    P->err_size = err_size;
+    P->mesh = out;
+    tool_set_error(err, err_size, "no error");
+
+    if (find_or_add_group(P, "", 0) != 0) goto fail;    /* group 0: faces before any g / o / usemtl */
+    while (P->p < P->end) {
+        skip_blanks(P);
+        if (at_statement_end(P)) {      /* blank line */
+            finish_statement(P);
+            continue;
+        }
+        P->statement = P->p;
+        P->statement_line = P->line;
+        if (parse_statement(P) != 0) goto fail;
+        finish_statement(P);
+    }
+    if (out->nfaces == 0) {
+        if (source) tool_set_error(err, err_size, "%s: no faces", source);
+        else tool_set_error(err, err_size, "no faces");
+        goto fail;
+    }
+    free(P->group_table);
+    return 0;
+
+fail:
+    free(P->group_table);
+    obj_free(out);
+    return -1;
+}
+
+int obj_parse(const char *text, size_t length, obj_mesh *out, char *err, size_t err_size)
+{
+    return obj_parse_named(text, length, NULL, out, err, err_size);
+}
+
+int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size)
+{
+    unsigned char *data;
+    size_t size;
+    int result;
+    memset(out, 0, sizeof *out);
+    if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
+    result = obj_parse_named((const char *)data, size, path, out, err, err_size);
+    free(data);
+    if (result == 0 && out->unknown_statements == 1)
+        tool_note("%s:%d: skipped a line with an unknown keyword, '%s'", path, out->first_unknown_line,
+                  out->first_unknown);
+    else if (result == 0 && out->unknown_statements > 1)
+        tool_note("%s:%d: skipped %d lines with unknown keywords, the first '%s'", path,
+                  out->first_unknown_line, out->unknown_statements, out->first_unknown);
+    return result;
+}
+
+tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags)
+{
+    tt_mesh_desc desc;
+    memset(&desc, 0, sizeof desc);
+    desc.positions = mesh->pos;
+    desc.nverts = mesh->nverts;
+    desc.indices = mesh->corner_vert;
+    desc.face_sizes = mesh->face_size;
+    desc.nfaces = mesh->nfaces;
+    desc.flags = flags;
+    return desc;
+}
+
+int obj_triangle_fans(const obj_mesh *mesh, int **corners, int **faces)
+{
+    int f, first = 0, t = 0, total = 0;
+    for (f = 0; f < mesh->nfaces; f++) total += mesh->face_size[f] - 2;   /* < ncorners: no overflow */
+    *corners = (int *)malloc((size_t)total * 3 * sizeof(int));
+    *faces = (int *)malloc((size_t)total * sizeof(int));
+    if (!*corners || !*faces) {
+        free(*corners);
+        free(*faces);
+        *corners = *faces = NULL;
+        return -1;
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        int i;
+        for (i = 1; i + 1 < mesh->face_size[f]; i++, t++) {
+            (*corners)[3 * t] = first;
+            (*corners)[3 * t + 1] = first + i;
+            (*corners)[3 * t + 2] = first + i + 1;
+            (*faces)[t] = f;
+        }
+        first += mesh->face_size[f];
+    }
+    return total;
+}
+
+/* The library counts faces and vertices from 0, as C arrays do; an OBJ file
+   counts them from 1 and a user finds them by line. Say it the file's way,
+   from the error's fields. */
+int obj_report_mesh_error(const char *obj_path, const obj_mesh *obj, const tt_error *error, int offer_permissive)
+{
+    int face = error->face, vertex = error->vertex, other = error->other_vertex;
+    int line = face >= 0 && face < obj->nfaces ? obj->face_line[face]
+             : vertex >= 0 && vertex < obj->nverts ? obj->vert_line[vertex] : 0;
+    const char *or_permissive = offer_permissive ? " (or use --permissive)" : "";
+    char where[4096];
+    if (line > 0) snprintf(where, sizeof where, "%s:%d", obj_path, line);
+    else snprintf(where, sizeof where, "%s", obj_path);
+    switch (error->result) {
+    case TT_ERROR_NON_FINITE:
+        return tool_fail("%s: vertex %d has a coordinate that is NaN or infinite", where, vertex + 1);
+    case TT_ERROR_REPEATED_VERTEX:
+        return tool_fail("%s: face %d uses vertex %d twice%s", where, face + 1, vertex + 1, or_permissive);
+    case TT_ERROR_ZERO_AREA_FACE:
+        return tool_fail("%s: face %d has zero area: its corners coincide or lie on one line%s", where, face + 1,
+                         or_permissive);
+    case TT_ERROR_NON_MANIFOLD_EDGE:
+        return tool_fail("%s: the edge between vertices %d and %d is shared by more than two faces (face %d and "
+                         "face %d among them)%s",
+                         where, vertex + 1, other + 1, face + 1, error->other_face + 1,
+                         offer_permissive ? "; --permissive cuts it open" : "");
+    case TT_ERROR_INCONSISTENT_ORIENTATION:
+        return tool_fail("%s: faces %d and %d both run from vertex %d to vertex %d: one of them is flipped "
+                         "(fix its winding%s)",
+                         where, face + 1, error->other_face + 1, vertex + 1, other + 1,
+                         offer_permissive ? ", or use --permissive" : "");
+    case TT_ERROR_NON_MANIFOLD_VERTEX:
+        return tool_fail("%s: vertex %d is non-manifold: surfaces touch at that one point%s",
+                         vertex >= 0 && vertex < obj->nverts ? where : obj_path, vertex + 1, or_permissive);
+    default:
+        return tool_fail("%s: %s", obj_path, error->message);
+    }
+}
+
+void obj_free(obj_mesh *mesh)
+{
+    int g;
+    if (!mesh) return;
+    free(mesh->pos);
+    free(mesh->face_size);
+    free(mesh->corner_vert);
+    free(mesh->uv);
+    free(mesh->corner_uv);
+    free(mesh->face_group);
+    free(mesh->face_line);
+    free(mesh->vert_line);
+    for (g = 0; g < mesh->ngroups; g++) free(mesh->group_names[g]);
+    free(mesh->group_names);
+    free(mesh->mtllib);
+    memset(mesh, 0, sizeof *mesh);
+}
+
+/* ======================================================================== */
+/* OBJ and MTL writing                                                      */
+/* ======================================================================== */
+
+/* "KEYWORD NAME" and a newline. A name ending in '\\' gets a blank after it,
+   or the reader would take the backslash for a line continuation. */
+static void write_name_line(tool_buffer *out, const char *keyword, const char *name)
+{
+    size_t length = strlen(name);
+    buffer_printf(out, "%s %s%s\n", keyword, name, length > 0 && name[length - 1] == '\\' ? " " : "");
+}
+
+/* "KEYWORD x y z" and a newline, built in one piece and appended once. */
+static void write_floats(tool_buffer *out, const char *keyword, const float *values, int count)
+{
+    char line[8 + 3 * (TOOL_NUMBER_TEXT_SIZE + 1)];
+    size_t length = strlen(keyword);
+    int i;
+    memcpy(line, keyword, length);
+    for (i = 0; i < count && i < 3; i++) {
+        line[length++] = ' ';
+        length += (size_t)tool_format_float(values[i], line + length);
+    }
+    line[length++] = '\n';
+    buffer_append(out, line, length);
+}
+
+int obj_write(tool_buffer *out, const obj_write_desc *desc)
+{
+    int v, f, c = 0, previous_group = -1;
+    if (!desc || desc->nverts < 0 || desc->nfaces < 0 || (desc->nverts > 0 && !desc->pos) ||
+        (desc->nfaces > 0 && !desc->corner_vert) || (!desc->face_size && desc->fixed_face_size < 3 && desc->nfaces > 0))
+        return -1;
+    if (desc->face_group && (desc->ngroups <= 0 || !desc->group_names)) return -1;
+
+    if (desc->comment) {
+        const char *line = desc->comment;
+        while (*line) {
+            const char *newline = strchr(line, '\n');
+            size_t length = newline ? (size_t)(newline - line) : strlen(line);
+            buffer_printf(out, "# %.*s\n", (int)length, line);
+            line += length + (newline ? 1 : 0);
+        }
+    }
+    if (desc->mtllib) write_name_line(out, "mtllib", desc->mtllib);
+
+    /* Nine significant digits (tool_format_float) are enough for any float
+       to read back exactly, so writing a mesh and reading it again changes
+       nothing. */
+    for (v = 0; v < desc->nverts; v++) write_floats(out, "v", desc->pos + 3 * (size_t)v, 3);
+
+    if (desc->corner_uv) {
+        /* One vt per face corner, in corner order: corner c uses vt c + 1. */
+        int ncorners = 0;
+        for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
+        for (c = 0; c < ncorners; c++)
+            write_floats(out, "vt", desc->corner_uv + 2 * (size_t)c, 2);
+        c = 0;
+    }
+
+    if (desc->material && !(desc->face_group && desc->group_materials)) write_name_line(out, "usemtl", desc->material);
+    for (f = 0; f < desc->nfaces; f++) {
+        int size = desc->face_size ? desc->face_size[f] : desc->fixed_face_size, i;
+        if (size < 3) return -1;
+        if (desc->face_group) {
+            int group = desc->face_group[f];
+            if (group < 0 || group >= desc->ngroups) return -1;
+            if (group != previous_group) {
+                write_name_line(out, "g", desc->group_names[group]);
+                if (desc->group_materials && desc->group_materials[group])
+                    write_name_line(out, "usemtl", desc->group_materials[group]);
+                previous_group = group;
+            }
+        }
+        buffer_append(out, "f", 1);
+        for (i = 0; i < size; i++, c++) {
+            char text[2 * TOOL_NUMBER_TEXT_SIZE + 2];
+            int vertex = desc->corner_vert[c], length;
+            if (vertex < 0 || vertex >= desc->nverts) return -1;
+            text[0] = ' ';
+            length = 1 + tool_format_int((long)vertex + 1, text + 1);
+            if (desc->corner_uv) {
+                text[length++] = '/';
+                length += tool_format_int((long)c + 1, text + length);
+            }
+            buffer_append(out, text, (size_t)length);
+        }
+        buffer_append(out, "\n", 1);
+    }
+    return out->failed ? -1 : 0;
+}
+
+void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha)
+{
+    write_name_line(out, "newmtl", name);
+    buffer_printf(out, "Ka 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\n");
+    if (texture) write_name_line(out, "map_Kd", texture);
+    if (texture && texture_alpha) write_name_line(out, "map_d", texture);
+    buffer_printf(out, "\n");
+}

@@ -1,0 +1,363 @@
+/* tiled.c - the tiled-texture steps `tiledtex synth`, `map` and `tile` share
+   (see tiled.h): their options, mapping a mesh (Akleman et al.'s algorithm,
+   Sec. 3, as a library user calls it), synthesising the atlas, writing the
+   OBJ / MTL / PNG files, and the summary lines.
+
+   Mapping a mesh:
+     tt_mesh_build          validate the OBJ's faces into a half-edge mesh
+     tt_mesh_quadrangulate  only when there are triangles or n-gons: each
+                            n-gon becomes n quads (and again per --subdivide)
+     tt_assign_boundaries   a random boundary type per half-edge, twins
+                            complementary (seeded: same seed, same result)
+     tt_assign_uvs          one UV per corner: the tile named by its four
+                            boundary types, at its place in the atlas
+*/
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tiled.h"
+
+void tiled_default_options(tiled_options *options)
+{
+    memset(options, 0, sizeof *options);
+    options->layout.gutter = TT_RECOMMENDED_GUTTER;
+}
+
+int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled_options *options)
+{
+    const char *value;
+    int number;
+    if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--colors", &value)) {
+        if (parse_int("--colors", value, 1, 8, &options->layout.colors) != 0) return -1;
+    } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--tile", &value)) {
+        if (parse_int("--tile", value, 4, TT_MAX_IMAGE_SIZE, &options->layout.tile_size) != 0) return -1;
+        options->tile_size_given = 1;
+    } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--gutter", &value)) {
+        if (parse_int("--gutter", value, 0, TT_MAX_IMAGE_SIZE, &number) != 0) return -1;
+        options->layout.gutter = number;
+    } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--seed", &value)) {
+        if (parse_u64("--seed", value, &options->seed) != 0) return -1;
+    } else if ((accept & TILED_MESH_OPTIONS) && tool_option(argc, argv, index, "--subdivide", &value)) {
+        if (parse_int("--subdivide", value, 0, 8, &options->subdivide) != 0) return -1;
+    } else if ((accept & TILED_MESH_OPTIONS) && strcmp(argv[*index], "--smooth") == 0) {
+        options->smooth = 1;
+    } else if ((accept & TILED_MESH_OPTIONS) && strcmp(argv[*index], "--permissive") == 0) {
+        options->permissive = 1;
+    } else if ((accept & TILED_SYNTH_OPTIONS) && tool_option(argc, argv, index, "--edge", &value)) {
+        int xy[2];
+        if (parse_int_list("--edge", value, 2, xy) != 0) return -1;
+        if (options->nedges >= TT_MAX_COLORS) { tool_usage("too many --edge options"); return -1; }
+        options->edges[options->nedges].x = xy[0];
+        options->edges[options->nedges].y = xy[1];
+        options->nedges++;
+    } else if ((accept & TILED_SYNTH_OPTIONS) && tool_option(argc, argv, index, "--background", &value)) {
+        int r[4];
+        if (parse_int_list("--background", value, 4, r) != 0) return -1;
+        if (r[2] <= 0 || r[3] <= 0) { tool_usage("--background wants X,Y,W,H with W and H above 0"); return -1; }
+        options->background.x = r[0];
+        options->background.y = r[1];
+        options->background.w = r[2];
+        options->background.h = r[3];
+    } else if ((accept & TILED_SYNTH_OPTIONS) && strcmp(argv[*index], "--mips") == 0) {
+        options->mips = 1;
+    } else if ((accept & TILED_REPORT_OPTION) && strcmp(argv[*index], "--report") == 0) {
+        options->report = 1;
+    } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
+        if (!value) { tool_usage("--atlas needs a value"); return -1; }
+        options->atlas_path = value;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+int tiled_parse_command_line(int argc, char **argv, unsigned accept, tiled_options *options,
+                             const char **positional, int count, const char *names, void (*help)(void))
+{
+    int npositional = 0, i;
+    tiled_default_options(options);
+    for (i = 1; i < argc; i++) {
+        int taken;
+        if (tool_is_help(argv[i])) {
+            help();
+            return 0;
+        }
+        taken = tiled_parse_option(argc, argv, &i, accept, options);
+        if (taken < 0) return TOOL_EXIT_USAGE;
+        if (taken) continue;
+        if (tool_is_option(argv[i])) return tool_unknown_option(argv[i]);
+        if (npositional == count) return tool_usage("too many arguments (see 'tiledtex %s --help')", argv[0]);
+        positional[npositional++] = argv[i];
+    }
+    if (npositional != count) return tool_usage("needs %s (see 'tiledtex %s --help')", names, argv[0]);
+    return -1;
+}
+
+void tiled_mesh_free(tiled_mesh *mesh)
+{
+    tt_mesh_free(mesh->mesh);
+    free(mesh->corner_type);
+    free(mesh->corner_uv);
+    memset(mesh, 0, sizeof *mesh);
+}
+
+/* Replace *mesh by one quadrangulation step of it. */
+static int quadrangulate(tt_mesh **mesh, tt_subdivision scheme, const char *obj_path)
+{
+    tt_mesh *quads;
+    tt_error error;
+    if (tt_mesh_quadrangulate(*mesh, scheme, &quads, &error) != TT_OK)
+        return tool_fail("%s: cannot quadrangulate: %s", obj_path, error.message);
+    tt_mesh_free(*mesh);
+    *mesh = quads;
+    return 0;
+}
+
+int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out)
+{
+    obj_mesh obj;
+    tt_mesh_desc desc;
+    tt_error error;
+    char message[TOOL_ERROR_SIZE];
+    int status, step;
+
+    memset(out, 0, sizeof *out);
+    if (tt_tile_layout_resolve(&options->layout, &out->layout, &error) != TT_OK)
+        return tool_fail("%s", error.message);
+    if (obj_read(obj_path, &obj, message, sizeof message) != 0) return tool_fail("%s", message);
+
+    desc = obj_mesh_desc(&obj, options->permissive ? TT_MESH_PERMISSIVE : 0);
+    out->input_faces = obj.nfaces;
+    if (tt_mesh_build(&desc, &out->mesh, &error) != TT_OK) {
+        status = obj_report_mesh_error(obj_path, &obj, &error, 1);
+        obj_free(&obj);
+        return status;
+    }
+    obj_free(&obj);
+    out->repaired_edges = out->mesh->repaired_edges;
+    out->input_min_face_size = out->mesh->min_face_size;
+    out->input_max_face_size = out->mesh->max_face_size;
+
+    /* Tiles are square: every face must be a quad. */
+    if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
+        if ((status = quadrangulate(&out->mesh, TT_SUBDIVIDE_LINEAR, obj_path)) != 0) goto fail;
+        out->quadrangulated = out->mesh->nfaces;
+    }
+    /* Each step makes four times the quads: refuse what would not fit in
+       memory long before it is tried. */
+    if (options->subdivide > 0 &&
+        (double)out->mesh->nfaces * pow(4.0, options->subdivide) > (double)TILED_MAX_QUADS) {
+        status = tool_fail("%s: --subdivide %d would make %.0f quads; the limit is %d (use a smaller level)",
+                           obj_path, options->subdivide, (double)out->mesh->nfaces * pow(4.0, options->subdivide),
+                           TILED_MAX_QUADS);
+        goto fail;
+    }
+    for (step = 0; step < options->subdivide; step++)
+        if ((status = quadrangulate(&out->mesh, options->smooth ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR,
+                                    obj_path)) != 0)
+            goto fail;
+
+    out->corner_type = (uint8_t *)malloc((size_t)out->mesh->ncorners);
+    out->corner_uv = (float *)malloc((size_t)out->mesh->ncorners * 2 * sizeof(float));
+    if (!out->corner_type || !out->corner_uv) {
+        status = tool_fail("out of memory for %d corners", out->mesh->ncorners);
+        goto fail;
+    }
+    tt_assign_boundaries(out->mesh, &out->layout, options->seed, out->corner_type);
+    if (tt_assign_uvs(out->mesh, &out->layout, out->corner_type, out->corner_uv, &error) != TT_OK) {
+        status = tool_fail("%s: %s", obj_path, error.message);
+        goto fail;
+    }
+    if (tt_mesh_compute_stats(out->mesh, &out->stats) != TT_OK) {
+        status = tool_fail("out of memory while measuring %s", obj_path);
+        goto fail;
+    }
+    return 0;
+fail:
+    tiled_mesh_free(out);
+    return status;
+}
+
+int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name)
+{
+    tool_buffer text;
+    obj_write_desc desc;
+    char comment[256];
+    memset(&text, 0, sizeof text);
+    memset(&desc, 0, sizeof desc);
+    snprintf(comment, sizeof comment,
+             "tiled texture by tiledtex %s: %d quads, %d colors, %d-texel tiles, gutter %d",
+             TILEDTEX_VERSION_STRING, mesh->mesh->nfaces, mesh->layout.colors, mesh->layout.tile_size,
+             mesh->layout.gutter);
+    desc.comment = comment;
+    desc.nverts = mesh->mesh->nverts;
+    desc.pos = mesh->mesh->pos;
+    desc.nfaces = mesh->mesh->nfaces;
+    desc.fixed_face_size = 4;
+    desc.corner_vert = mesh->mesh->corner_vert;
+    desc.corner_uv = mesh->corner_uv;
+    desc.mtllib = mtl_name;
+    desc.material = mtl_name ? "tiled" : NULL;
+    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, obj_path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", obj_path);
+    }
+    return 0;
+}
+
+int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name)
+{
+    tool_buffer text;
+    memset(&text, 0, sizeof text);
+    mtl_add_material(&text, "tiled", texture_name, 0);
+    if (output_add_buffer(output, mtl_path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", mtl_path);
+    }
+    return 0;
+}
+
+static int compare_floats(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The rest of the quality report: how evenly the tiles are used (every tile
+   equally often is what keeps repetition invisible) and how much each face
+   stretches its tile (the ratio of the singular values of its map). */
+static void print_quality(const tiled_mesh *mesh)
+{
+    int ntiles = tt_tile_layout_tile_count(&mesh->layout), nfaces = mesh->mesh->nfaces, used = 0, least = -1,
+        most = 0, t, f, degenerate = 0;
+    int *counts = (int *)malloc((size_t)ntiles * sizeof(int));
+    float *stretch = (float *)malloc((size_t)nfaces * sizeof(float));
+    if (!counts || !stretch || tt_tile_histogram(mesh->mesh, &mesh->layout, mesh->corner_type, counts) != TT_OK ||
+        tt_face_stretch(mesh->mesh, mesh->corner_uv, stretch) != TT_OK) {
+        free(counts);
+        free(stretch);
+        return;
+    }
+    for (t = 0; t < ntiles; t++) {
+        if (counts[t] > 0) used++;
+        if (least < 0 || counts[t] < least) least = counts[t];
+        if (counts[t] > most) most = counts[t];
+    }
+    qsort(stretch, (size_t)nfaces, sizeof(float), compare_floats);
+    for (f = nfaces; f > 0 && !(stretch[f - 1] < 1e30f); f--) degenerate++;
+    printf("quality: %d of %d tiles used (%d to %d faces each, %.1f on average)", used, ntiles, least, most,
+           (double)nfaces / ntiles);
+    if (nfaces > degenerate)
+        printf("; stretch median %.2f, 95th percentile %.2f, max %.2f", stretch[(nfaces - degenerate) / 2],
+               stretch[(int)(0.95 * (nfaces - degenerate - 1))], stretch[nfaces - degenerate - 1]);
+    if (degenerate > 0) printf("; %d degenerate face%s", degenerate, degenerate == 1 ? "" : "s");
+    printf("\n");
+    free(counts);
+    free(stretch);
+}
+
+int tiled_check_atlas_size(const tiled_options *options)
+{
+    tt_tile_layout layout;
+    tt_error error;
+    int atlas;
+    if (tt_tile_layout_resolve(&options->layout, &layout, &error) != TT_OK) return tool_fail("%s", error.message);
+    atlas = tt_tile_layout_atlas_size(&layout);
+    if (atlas > TOOL_MAX_ATLAS)
+        return tool_fail("--colors %d with %d-texel tiles and gutter %d makes a %dx%d atlas; the tool writes at most "
+                         "%dx%d (use fewer --colors or a smaller --tile)",
+                         layout.colors, layout.tile_size, layout.gutter, atlas, atlas, TOOL_MAX_ATLAS, TOOL_MAX_ATLAS);
+    return 0;
+}
+
+void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
+{
+    if (mesh->repaired_edges > 0)
+        fprintf(stderr, "tiledtex: %s: --permissive cut %d non-manifold or mis-oriented edge%s open\n", obj_path,
+                mesh->repaired_edges, mesh->repaired_edges == 1 ? "" : "s");
+    if (mesh->quadrangulated) {
+        char sizes[64];
+        if (mesh->input_max_face_size == 3) snprintf(sizes, sizeof sizes, "triangles");
+        else snprintf(sizes, sizeof sizes, "faces of %d to %d corners", mesh->input_min_face_size,
+                      mesh->input_max_face_size);
+        fprintf(stderr, "tiledtex: %s has %s: quadrangulated %d face%s into %d quads\n", obj_path, sizes,
+                mesh->input_faces, mesh->input_faces == 1 ? "" : "s", mesh->quadrangulated);
+    }
+}
+
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams, int report)
+{
+    const tt_mesh_stats *s = &mesh->stats;
+    printf("%s: %d quads, %d vertices, genus %d, %d component%s, %d boundary loop%s, valence %d..%d, "
+           "%d tiles (n=%d, %d texels, gutter %d)",
+           obj_path, mesh->mesh->nfaces, s->used_vertices, s->genus, s->components, s->components == 1 ? "" : "s",
+           s->boundary_loops, s->boundary_loops == 1 ? "" : "s", s->min_valence, s->max_valence,
+           tt_tile_layout_tile_count(&mesh->layout), mesh->layout.colors, mesh->layout.tile_size,
+           mesh->layout.gutter);
+    if (seams && seams->score == seams->score)
+        printf(", seam score %.3f (seam %.4f, same-face %.4f, unrelated %.4f)", seams->score, seams->seam,
+               seams->same_face, seams->unrelated);
+    else if (seams)
+        printf(", seam score n/a: unrelated places differ no more than neighbours (seam %.4f, same-face %.4f, "
+               "unrelated %.4f)", seams->seam, seams->same_face, seams->unrelated);
+    printf("\n");
+    if (report) print_quality(mesh);
+}
+
+int tiled_fit_tile_size(int width, int height, int colors, int gutter)
+{
+    /* An edge window is S x 2S; at 2/5 of the smaller side it still has room
+       to move, so synthesis can choose an inconspicuous line for the edges
+       (with h = 2S exactly there is only one) and varied backgrounds. With
+       more colors the atlas, (2n)^2 tiles a side, must stay within
+       TOOL_MAX_ATLAS. Multiples of 8 keep mip levels per tile. */
+    int side = width < height ? width : height, n = colors > 0 ? colors : 1;
+    int fit = 2 * side / 5, fits_atlas = TOOL_MAX_ATLAS / (4 * n * n) - 2 * gutter;
+    if (fit > TT_DEFAULT_TILE_SIZE) fit = TT_DEFAULT_TILE_SIZE;
+    if (fit > fits_atlas) fit = fits_atlas;
+    if (fit >= 8) return fit - fit % 8;
+    if (fits_atlas >= 4 && width >= 4 && height >= 8) return 4;
+    return 0;
+}
+
+int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options, tt_tileset **out)
+{
+    tt_synth_options synth;
+    tt_error error;
+    memset(&synth, 0, sizeof synth);
+    synth.layout = options->layout;
+    synth.seed = options->seed;
+    synth.background = options->background;
+    if (options->nedges > 0) {
+        int colors = options->layout.colors ? options->layout.colors : 1;
+        if (options->nedges != colors)
+            return tool_usage("--edge was given %d time%s, but there %s %d color%s: give it once per color",
+                              options->nedges, options->nedges == 1 ? "" : "s", colors == 1 ? "is" : "are", colors,
+                              colors == 1 ? "" : "s");
+        synth.edge_windows = options->edges;
+    }
+    if (tt_synthesize_tiles(image, &synth, out, &error) != TT_OK) {
+        if (error.result == TT_ERROR_IMAGE_TOO_SMALL || error.result == TT_ERROR_INVALID_ARGUMENT)
+            return tool_fail("%s: %s", image_path, error.message);
+        return tool_fail("%s", error.message);
+    }
+    return 0;
+}
+
+int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips)
+{
+    char message[TOOL_ERROR_SIZE], path[4096];
+    int level;
+    size_t stem = strlen(png_path);
+    if (output_add_png(output, png_path, &tiles->levels[0], message, sizeof message) != 0)
+        return tool_fail("%s", message);
+    if (stem > 4 && strcmp(png_path + stem - 4, ".png") == 0) stem -= 4;
+    for (level = 1; mips && level < tiles->nlevels; level++) {
+        snprintf(path, sizeof path, "%.*s_mip%d.png", (int)stem, png_path, level);
+        if (output_add_png(output, path, &tiles->levels[level], message, sizeof message) != 0)
+            return tool_fail("%s", message);
+    }
+    return 0;
+}
