@@ -2799,11 +2799,12 @@ TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *tr
                    not a number the solver can use. */
                 matrix->value[pos - 1] += t->value;
                 if (!tt__is_finite_d(matrix->value[pos - 1])) {
+                    int item = by_row[i], column = t->col;   /* by_row lives in work, freed next */
                     tt__free(&matrix->allocator, work);
                     tt_sparse_free(matrix);
-                    return tt__fail_at(error, TT_ERROR_NON_FINITE, by_row[i], r, t->col,
+                    return tt__fail_at(error, TT_ERROR_NON_FINITE, item, r, column,
                                        "the triplets of row %d, column %d sum to infinity (triplet %d overflows)",
-                                       r, t->col, by_row[i]);
+                                       r, column, item);
                 }
             }
         }
