@@ -545,7 +545,7 @@ typedef struct tt_cg_report {
          like any other.
      x   n values: in, the initial guess (warm start; zeros if you have none),
          out, the solution. It must be finite.
-     options, allocator (for 4 n scratch doubles), report, error may be NULL
+     options, allocator (for 5 n scratch doubles), report, error may be NULL
      (defaults; TT_MALLOC; no report; no details).
      report is filled on every return; before any step it reads
      {0, 0.0, 0} (converged = 1 for b = 0 or an x0 that already solves).
@@ -570,7 +570,7 @@ typedef struct tt_cg_report {
      TT_ERROR_OUT_OF_MEMORY.
    b = 0 gives x = 0 at once. Symmetry is assumed, not checked (checking
    costs more than several steps): a non-symmetric A may stall or break down.
-   Memory: one scratch block of 4 n doubles for the whole solve, nothing per
+   Memory: one scratch block of 5 n doubles for the whole solve, nothing per
    step. A step costs one product with A (with p . A p in the same pass) and
    two fused passes over the vectors; one more product confirms the result.
    Thread-safe: several threads may solve with the same A and b into
@@ -2447,6 +2447,7 @@ TTDEF float tt_srgb_to_linear(float encoded)
 TTDEF float tt_linear_to_srgb(float linear)
 {
     float v = linear != linear ? 0.0f : tt__clamp_f(linear, 0.0f, 1.0f);
+    if (v >= 1.0f) return 1.0f;   /* the formula rounds to 0.99999994 there */
     return v <= 0.0031308f ? v * 12.92f : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
 }
 
@@ -2893,11 +2894,12 @@ TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *tr
                    not a number the solver can use. */
                 matrix->value[pos - 1] += t->value;
                 if (!tt__is_finite_d(matrix->value[pos - 1])) {
+                    int item = by_row[i], column = t->col;   /* by_row lives in work, freed next */
                     tt__free(&matrix->allocator, work);
                     tt_sparse_matrix_free(matrix);
-                    return tt__fail_at(error, TT_ERROR_NON_FINITE, by_row[i], r, t->col,
+                    return tt__fail_at(error, TT_ERROR_NON_FINITE, item, r, column,
                                        "the triplets of row %d, column %d sum to infinity (triplet %d overflows)",
-                                       r, t->col, by_row[i]);
+                                       r, column, item);
                 }
             }
         }

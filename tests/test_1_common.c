@@ -96,7 +96,167 @@ static void test_rng(void)
     }
 }
 
+static void test_version(void)
+{
+    int major = -1, minor = -1, patch = -1;
+    const char *v = tt_version(&major, &minor, &patch);
+    char expect[32];
+    CHECK(v != NULL && strcmp(v, TILEDTEX_VERSION_STRING) == 0, "tt_version: expected \"%s\", got \"%s\"",
+          TILEDTEX_VERSION_STRING, v ? v : "(null)");
+    CHECK(major == TILEDTEX_VERSION_MAJOR && minor == TILEDTEX_VERSION_MINOR && patch == TILEDTEX_VERSION_PATCH,
+          "tt_version numbers: expected %d.%d.%d, got %d.%d.%d", TILEDTEX_VERSION_MAJOR, TILEDTEX_VERSION_MINOR,
+          TILEDTEX_VERSION_PATCH, major, minor, patch);
+    sprintf(expect, "%d.%d.%d", TILEDTEX_VERSION_MAJOR, TILEDTEX_VERSION_MINOR, TILEDTEX_VERSION_PATCH);
+    CHECK(strcmp(expect, TILEDTEX_VERSION_STRING) == 0 && strcmp(TILEDTEX_VERSION_STRING, "0.2.0") == 0,
+          "TILEDTEX_VERSION_STRING \"%s\" should be the numbers \"%s\" (0.2.0)", TILEDTEX_VERSION_STRING, expect);
+    /* Each pointer may be NULL. */
+    major = -1;
+    CHECK(tt_version(NULL, NULL, NULL) == v && tt_version(&major, NULL, NULL) == v && major == TILEDTEX_VERSION_MAJOR,
+          "tt_version with NULL pointers");
+}
+
+static void test_result_strings(void)
+{
+    /* Every code from TT_OK down to the last one, TT_ERROR_NOT_MEASURED. */
+    const char *s[19];
+    const char *unknown = tt_result_string((tt_result)-99);
+    int i, j, empty = 0, same = 0, generic = 0;
+    CHECK(TT_ERROR_NOT_MEASURED == -18, "TT_ERROR_NOT_MEASURED is the last code, -18 (got %d)",
+          (int)TT_ERROR_NOT_MEASURED);
+    for (i = 0; i < 19; i++) {
+        s[i] = tt_result_string((tt_result)-i);
+        if (!s[i] || !s[i][0]) { empty++; continue; }
+        if (strcmp(s[i], unknown) == 0) {
+            if (!generic) DETAIL("result %d has the sentence for unknown codes: \"%s\"", -i, s[i]);
+            generic++;
+        }
+    }
+    CHECK(empty == 0, "%d result codes have an empty or NULL sentence", empty);
+    CHECK(generic == 0, "%d result codes have no sentence of their own", generic);
+    for (i = 0; i < 19; i++)
+        for (j = i + 1; j < 19; j++)
+            if (s[i] && s[j] && strcmp(s[i], s[j]) == 0) {
+                if (!same) DETAIL("results %d and %d share the sentence \"%s\"", -i, -j, s[i]);
+                same++;
+            }
+    CHECK(same == 0, "%d pairs of result codes share a sentence", same);
+    CHECK(s[18] && strcmp(s[18], tt_result_string(TT_ERROR_NOT_MEASURED)) == 0 && strlen(s[18]) > 5,
+          "TT_ERROR_NOT_MEASURED: \"%s\"", s[18] ? s[18] : "(null)");
+    CHECK(unknown && unknown[0] && tt_result_string(TT_RESULT_MAX_ENUM) && tt_result_string((tt_result)1),
+          "unknown codes still get a sentence");
+}
+
+/* An allocator with only one of its two functions is refused, with a
+   message, by every allocating function; a NULL allocator means malloc. */
+static void *only_alloc(size_t size, void *user_data)
+{
+    (void)user_data;
+    return malloc(size);
+}
+static void only_free(void *ptr, void *user_data)
+{
+    (void)user_data;
+    free(ptr);
+}
+
+static int bad_allocator_refused(tt_result r, const tt_error *err, const char *what, const char *which)
+{
+    int ok = r == TT_ERROR_INVALID_ARGUMENT && err->result == TT_ERROR_INVALID_ARGUMENT && err->message[0] != '\0';
+    CHECK(ok, "%s with an allocator that has only %s: expected %d with a message, got %d (\"%s\")", what, which,
+          TT_ERROR_INVALID_ARGUMENT, r, err->message);
+    return ok;
+}
+
+static void test_half_allocators(void)
+{
+    static const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    static const int idx[3] = {0, 1, 2};
+    static const tt_triplet t[3] = {{0, 0, 4.0}, {1, 1, 2.0}, {0, 1, 1.0}};
+    static const tt_triplet ts[4] = {{0, 0, 4.0}, {1, 1, 3.0}, {0, 1, 1.0}, {1, 0, 1.0}};
+    double b[2] = {1.0, 2.0}, x[2];
+    tt_allocator halves[2];
+    tt_mesh_desc d;
+    tt_error err;
+    int h;
+    memset(&d, 0, sizeof d);
+    d.positions = pos;
+    d.nverts = 3;
+    d.indices = idx;
+    d.nfaces = 1;
+    memset(halves, 0, sizeof halves);
+    halves[0].alloc = only_alloc;
+    halves[1].free = only_free;
+    for (h = 0; h < 2; h++) {
+        const char *which = h ? "free" : "alloc";
+        const tt_allocator *al = &halves[h];
+        tt_mesh *mesh = (tt_mesh *)&mesh;
+        tt_image *im = (tt_image *)&im;
+        tt_sparse_matrix *m = (tt_sparse_matrix *)&m;
+        tt_sparse_matrix *A = NULL;
+        tt_result r;
+        memset(&err, 0, sizeof err);
+        r = tt_mesh_build(&d, al, &mesh, &err);
+        if (bad_allocator_refused(r, &err, "tt_mesh_build", which))
+            CHECK(mesh == NULL, "tt_mesh_build with a half allocator: *out_mesh should be NULL");
+        if (r == TT_OK && mesh) tt_mesh_free(mesh);
+        memset(&err, 0, sizeof err);
+        r = tt_image_create(4, 4, al, &im, &err);
+        if (bad_allocator_refused(r, &err, "tt_image_create", which))
+            CHECK(im == NULL, "tt_image_create with a half allocator: *out_image should be NULL");
+        if (r == TT_OK && im) tt_image_free(im);
+        memset(&err, 0, sizeof err);
+        r = tt_sparse_from_triplets(2, 2, t, 3, al, &m, &err);
+        if (bad_allocator_refused(r, &err, "tt_sparse_from_triplets", which))
+            CHECK(m == NULL, "tt_sparse_from_triplets with a half allocator: *out_matrix should be NULL");
+        if (r == TT_OK && m) tt_sparse_matrix_free(m);
+        if (tt_sparse_from_triplets(2, 2, ts, 4, NULL, &A, NULL) == TT_OK) {
+            x[0] = x[1] = 0.25;
+            memset(&err, 0, sizeof err);
+            r = tt_cg_solve(A, b, NULL, al, x, NULL, &err);
+            if (bad_allocator_refused(r, &err, "tt_cg_solve", which))
+                CHECK(x[0] == 0.25 && x[1] == 0.25, "tt_cg_solve with a half allocator should leave x alone");
+            tt_sparse_matrix_free(A);
+        } else {
+            CHECK(0, "2 x 2 SPD matrix with the default allocator");
+        }
+    }
+    /* NULL: TT_MALLOC / TT_FREE. */
+    {
+        tt_mesh *mesh = NULL;
+        tt_image *im = NULL;
+        tt_sparse_matrix *A = NULL;
+        tt_cg_report rep;
+        tt_result r1 = tt_mesh_build(&d, NULL, &mesh, &err);
+        tt_result r2 = tt_image_create(4, 4, NULL, &im, &err);
+        tt_result r3 = tt_sparse_from_triplets(2, 2, ts, 4, NULL, &A, &err), r4 = TT_RESULT_MAX_ENUM;
+        x[0] = x[1] = 0.0;
+        if (A) r4 = tt_cg_solve(A, b, NULL, NULL, x, &rep, &err);
+        /* [[4,1],[1,3]] x = [1,2]: x = (1/11, 7/11) */
+        CHECK(r1 == TT_OK && mesh && r2 == TT_OK && im && r3 == TT_OK && A && r4 == TT_OK &&
+                  near(x[0], 1.0 / 11.0, 1e-9) && near(x[1], 7.0 / 11.0, 1e-9),
+              "NULL allocator: results %d %d %d %d, x = %g %g", r1, r2, r3, r4, x[0], x[1]);
+        CHECK(!im || (im->allocator.alloc == NULL && im->allocator.free == NULL),
+              "an image made with the NULL allocator remembers a zeroed allocator");
+        tt_mesh_free(mesh);
+        tt_image_free(im);
+        tt_sparse_matrix_free(A);
+    }
+    /* Both set, user_data passed through: the counting allocator. */
+    {
+        counter cnt;
+        tt_allocator al = make_allocator(&cnt, -1);
+        tt_image *im = NULL;
+        CHECK(tt_image_create(2, 2, &al, &im, NULL) == TT_OK && cnt.calls == 1 && cnt.live == 1,
+              "a full allocator is used: %ld calls", cnt.calls);
+        tt_image_free(im);
+        CHECK(cnt.live == 0 && cnt.bad_frees == 0, "and frees through it: %ld live", cnt.live);
+    }
+}
+
 void run_common_tests(void)
 {
     RUN(test_rng);
+    RUN(test_version);
+    RUN(test_result_strings);
+    RUN(test_half_allocators);
 }

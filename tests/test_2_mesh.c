@@ -208,8 +208,7 @@ static void test_builder_valid(void)
         d = tm_desc(&m);
         d.face_sizes = NULL;
         d.fixed_face_size = 4;
-        d.allocator = al;
-        r = tt_mesh_build(&d, &mesh, &err);
+        r = tt_mesh_build(&d, &al, &mesh, &err);
         CHECK(r == TT_OK, "cube (fixed size 4): got %d", r);
         if (r == TT_OK) {
             check_structure(mesh, &m, "cube fixed");
@@ -337,10 +336,10 @@ static void expect_build_error(const tmesh *m, tt_result code, int face, int cor
     tt_error err;
     counter cnt;
     tt_mesh_desc d = tm_desc(m);
+    tt_allocator al = make_allocator(&cnt, -1);
     tt_result r;
     memset(&err, 0x55, sizeof err);
-    d.allocator = make_allocator(&cnt, -1);
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, &al, &mesh, &err);
     CHECK(r == code, "%s: expected result %d, got %d (%s)", what, code, r, err.message);
     CHECK(mesh == NULL, "%s: *out_mesh should be NULL on failure", what);
     CHECK(err.result == code, "%s: err.result expected %d, got %d", what, code, err.result);
@@ -356,7 +355,7 @@ static void expect_build_error(const tmesh *m, tt_result code, int face, int cor
     if (r == TT_OK) tt_mesh_free(mesh);
     /* The NULL error pointer is accepted too. */
     mesh = (tt_mesh *)&mesh;
-    r = tt_mesh_build(&d, &mesh, NULL);
+    r = tt_mesh_build(&d, &al, &mesh, NULL);
     CHECK(r == code && mesh == NULL, "%s with error == NULL: expected %d, got %d", what, code, r);
     if (r == TT_OK && mesh) tt_mesh_free(mesh);
     CHECK(cnt.live == 0, "%s (error NULL): %ld allocations leaked", what, cnt.live);
@@ -369,10 +368,10 @@ static void expect_permissive(const tmesh *m, int min_repaired, const char *what
     tt_error err;
     counter cnt;
     tt_mesh_desc d = tm_desc(m);
+    tt_allocator al = make_allocator(&cnt, -1);
     tt_result r;
     d.flags = TT_MESH_PERMISSIVE;
-    d.allocator = make_allocator(&cnt, -1);
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, &al, &mesh, &err);
     CHECK(r == TT_OK, "%s (permissive): expected TT_OK, got %d (%s)", what, r, err.message);
     if (r == TT_OK) {
         tt_mesh_stats st;
@@ -380,7 +379,7 @@ static void expect_permissive(const tmesh *m, int min_repaired, const char *what
               min_repaired, mesh->repaired_edges);
         CHECK((mesh->flags & TT_MESH_PERMISSIVE) != 0, "%s: mesh->flags should keep TT_MESH_PERMISSIVE", what);
         check_structure(mesh, m, what);
-        CHECK(tt_mesh_compute_stats(mesh, &st) == TT_OK, "%s: stats on a permissive mesh", what);
+        CHECK(tt_mesh_compute_stats(mesh, &al, &st, NULL) == TT_OK, "%s: stats on a permissive mesh", what);
         tt_mesh_free(mesh);
     }
     CHECK(cnt.live == 0, "%s (permissive): %ld allocations leaked", what, cnt.live);
@@ -398,37 +397,37 @@ static void test_builder_errors(void)
     /* NULLs and bad counts */
     make_tetra(&m, 0);
     d = tm_desc(&m);
-    r = tt_mesh_build(&d, NULL, &err);
+    r = tt_mesh_build(&d, NULL, NULL, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT, "out_mesh NULL: expected %d, got %d", TT_ERROR_INVALID_ARGUMENT, r);
     mesh = (tt_mesh *)&mesh;
-    r = tt_mesh_build(NULL, &mesh, &err);
+    r = tt_mesh_build(NULL, NULL, &mesh, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "desc NULL: expected %d, got %d", TT_ERROR_INVALID_ARGUMENT, r);
     d.indices = NULL;
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "indices NULL: got %d", r);
     d = tm_desc(&m);
     d.positions = NULL;
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "positions NULL: got %d", r);
     d = tm_desc(&m);
     d.nverts = -1;
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "nverts -1: got %d", r);
     d = tm_desc(&m);
     d.nfaces = -3;
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "nfaces -3: got %d", r);
     d = tm_desc(&m);
     d.face_sizes = NULL;
     d.fixed_face_size = 2;
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
     CHECK(r == TT_ERROR_FACE_TOO_SMALL && mesh == NULL, "fixed_face_size 2: expected %d, got %d",
           TT_ERROR_FACE_TOO_SMALL, r);
     /* fixed_face_size 0 means triangles */
     d = tm_desc(&m);
     d.face_sizes = NULL;
     d.fixed_face_size = 0;
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
     CHECK(r == TT_OK, "fixed_face_size 0 (= 3) on a tetrahedron: got %d (%s)", r, err.message);
     if (r == TT_OK) tt_mesh_free(mesh);
 
@@ -564,7 +563,7 @@ static void test_builder_errors(void)
         r = build(&m, TT_MESH_PERMISSIVE, &mesh, &err);
         if (r == TT_OK) {
             tt_mesh_stats st;
-            tt_mesh_compute_stats(mesh, &st);
+            tt_mesh_compute_stats(mesh, NULL, &st, NULL);
             CHECK(st.nonmanifold_vertices == 1, "permissive: nonmanifold_vertices expected 1, got %d",
                   st.nonmanifold_vertices);
             CHECK(st.components == 2, "two tetrahedra at a vertex: components expected 2, got %d", st.components);
@@ -608,8 +607,7 @@ static tt_result oom_build(void *ctx, const tt_allocator *al)
     tt_error err;
     tt_result r;
     d.flags = b->flags;
-    d.allocator = *al;
-    r = tt_mesh_build(&d, &mesh, &err);
+    r = tt_mesh_build(&d, al, &mesh, &err);
     if (r == TT_OK) tt_mesh_free(mesh);
     else if (mesh != NULL) return TT_RESULT_MAX_ENUM;   /* must be NULL on failure */
     if (r != TT_OK && err.result != r) return TT_RESULT_MAX_ENUM;
@@ -686,11 +684,11 @@ static void check_queries(const tmesh *m, const expect_stats *e, const char *nam
     tt_result r;
     counter cnt;
     tt_mesh_desc d = tm_desc(m);
-    d.allocator = make_allocator(&cnt, -1);
-    r = tt_mesh_build(&d, &mesh, &err);
+    tt_allocator al = make_allocator(&cnt, -1);
+    r = tt_mesh_build(&d, &al, &mesh, &err);
     CHECK(r == TT_OK, "%s: build failed: %d (%s)", name, r, err.message);
     if (r != TT_OK) return;
-    r = tt_mesh_compute_stats(mesh, &st);
+    r = tt_mesh_compute_stats(mesh, &al, &st, &err);
     CHECK(r == TT_OK, "%s: compute_stats returned %d", name, r);
     CHECK(st.used_vertices == e->used, "%s: used_vertices expected %d, got %d", name, e->used, st.used_vertices);
     CHECK(st.edges == e->edges, "%s: edges expected %d, got %d", name, e->edges, st.edges);
@@ -718,15 +716,13 @@ static void check_queries(const tmesh *m, const expect_stats *e, const char *nam
             }
         }
         CHECK(bad == 0, "%s: %d vertices with a wrong valence", name, bad);
-        CHECK(tt_mesh_valence(mesh, -1) == 0 && tt_mesh_valence(mesh, mesh->nverts) == 0,
-              "%s: valence of an out-of-range vertex should be 0", name);
         for (nb = 1; nb <= 64; nb = nb < 8 ? nb + 1 : nb * 2) {
             int k;
             memset(nhist, 0, sizeof nhist);
             for (v = 0; v < mesh->nverts; v++)
                 if (mesh->vert_corner[v] >= 0) nhist[naive[v] < nb - 1 ? naive[v] : nb - 1]++;
             for (k = 0; k < 64; k++) hist[k] = -7;
-            r = tt_mesh_valence_histogram(mesh, hist, nb);
+            r = tt_mesh_valence_histogram(mesh, &al, hist, nb, NULL);
             bad = 0;
             total = 0;
             for (k = 0; k < nb; k++) { bad += hist[k] != nhist[k]; total += hist[k]; }
@@ -735,10 +731,10 @@ static void check_queries(const tmesh *m, const expect_stats *e, const char *nam
                   "%s: valence histogram with %d bins: %d bins differ from the naive one (total %d, used %d)", name, nb,
                   bad, total, st.used_vertices);
         }
-        CHECK(tt_mesh_valence_histogram(mesh, hist, 0) == TT_ERROR_INVALID_ARGUMENT,
+        CHECK(tt_mesh_valence_histogram(mesh, &al, hist, 0, NULL) == TT_ERROR_INVALID_ARGUMENT,
               "%s: histogram with 0 bins should be rejected", name);
-        CHECK(tt_mesh_valence_histogram(NULL, hist, 4) == TT_ERROR_INVALID_ARGUMENT &&
-                  tt_mesh_valence_histogram(mesh, NULL, 4) == TT_ERROR_INVALID_ARGUMENT,
+        CHECK(tt_mesh_valence_histogram(NULL, &al, hist, 4, NULL) == TT_ERROR_INVALID_ARGUMENT &&
+                  tt_mesh_valence_histogram(mesh, &al, NULL, 4, NULL) == TT_ERROR_INVALID_ARGUMENT,
               "%s: histogram with NULL should be rejected", name);
         free(scratch);
         free(naive);
@@ -760,7 +756,7 @@ static void check_queries(const tmesh *m, const expect_stats *e, const char *nam
                     if (x != y) parent[x] = y;
                 }
             }
-        r = tt_mesh_components(mesh, comp, &n);
+        r = tt_mesh_components(mesh, &al, comp, &n, NULL);
         CHECK(r == TT_OK && n == e->components, "%s: tt_mesh_components: expected %d, got %d (result %d)", name,
               e->components, n, r);
         for (f = 0; f < mesh->nfaces; f++) {
@@ -769,7 +765,8 @@ static void check_queries(const tmesh *m, const expect_stats *e, const char *nam
             if (comp[f] != label[root]) bad++;
         }
         CHECK(bad == 0 && next == n, "%s: %d faces with a component id other than the naive one", name, bad);
-        CHECK(tt_mesh_components(mesh, NULL, &n) == TT_ERROR_INVALID_ARGUMENT, "%s: components(NULL)", name);
+        CHECK(tt_mesh_components(mesh, &al, NULL, &n, NULL) == TT_ERROR_INVALID_ARGUMENT, "%s: components(NULL)",
+              name);
         free(comp);
         free(parent);
         free(label);
@@ -780,7 +777,7 @@ static void check_queries(const tmesh *m, const expect_stats *e, const char *nam
     {
         int *loop = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners);
         int n = -1, c, c2, bad = 0, nb = 0, *seen;
-        r = tt_mesh_boundary_loops(mesh, loop, &n);
+        r = tt_mesh_boundary_loops(mesh, loop, &n, NULL);
         CHECK(r == TT_OK && n == e->loops, "%s: tt_mesh_boundary_loops: expected %d loops, got %d (result %d)", name,
               e->loops, n, r);
         seen = (int *)calloc((size_t)(n > 0 ? n : 1), sizeof(int));
@@ -800,8 +797,8 @@ static void check_queries(const tmesh *m, const expect_stats *e, const char *nam
         free(loop);
         free(seen);
     }
-    CHECK(tt_mesh_compute_stats(NULL, &st) == TT_ERROR_INVALID_ARGUMENT &&
-              tt_mesh_compute_stats(mesh, NULL) == TT_ERROR_INVALID_ARGUMENT,
+    CHECK(tt_mesh_compute_stats(NULL, &al, &st, NULL) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_mesh_compute_stats(mesh, &al, NULL, NULL) == TT_ERROR_INVALID_ARGUMENT,
           "%s: compute_stats with NULL should be rejected", name);
     tt_mesh_free(mesh);
     CHECK(cnt.live == 0, "%s: %ld allocations leaked by the queries", name, cnt.live);
@@ -887,8 +884,23 @@ typedef struct mesh_ctx {
 static tt_result oom_stats(void *ctx, const tt_allocator *al)
 {
     tt_mesh_stats st;
-    (void)al;   /* the mesh was built with it */
-    return tt_mesh_compute_stats(((mesh_ctx *)ctx)->mesh, &st);
+    return tt_mesh_compute_stats(((mesh_ctx *)ctx)->mesh, al, &st, NULL);
+}
+
+static tt_result oom_histogram(void *ctx, const tt_allocator *al)
+{
+    int hist[6];
+    return tt_mesh_valence_histogram(((mesh_ctx *)ctx)->mesh, al, hist, 6, NULL);
+}
+
+static tt_result oom_components(void *ctx, const tt_allocator *al)
+{
+    mesh_ctx *q = (mesh_ctx *)ctx;
+    int *comp = (int *)malloc(sizeof(int) * (size_t)q->mesh->nfaces), n = -1;
+    tt_result r = tt_mesh_components(q->mesh, al, comp, &n, NULL);
+    free(comp);
+    if (r == TT_OK && n != 2) return TT_RESULT_MAX_ENUM;   /* the grid part and the torus */
+    return r;
 }
 
 static tt_result oom_quad(void *ctx, const tt_allocator *al)
@@ -896,8 +908,7 @@ static tt_result oom_quad(void *ctx, const tt_allocator *al)
     mesh_ctx *q = (mesh_ctx *)ctx;
     tt_mesh *out = (tt_mesh *)&out;
     tt_error err;
-    tt_result r = tt_mesh_quadrangulate(q->mesh, q->scheme, &out, &err);
-    (void)al;
+    tt_result r = tt_mesh_quadrangulate(q->mesh, q->scheme, al, &out, &err);
     if (r == TT_OK) tt_mesh_free(out);
     else if (out != NULL) return TT_RESULT_MAX_ENUM;
     return r;
@@ -921,11 +932,12 @@ static void test_queries_oom(void)
         t[0] = 1; t[1] = 0; t[2] = tm_vert(&m, 0.5, -1, 0);
     }
     d = tm_desc(&m);
-    d.allocator = g_oom_allocator;
-    r = tt_mesh_build(&d, &q.mesh, NULL);
+    r = tt_mesh_build(&d, NULL, &q.mesh, NULL);
     CHECK(r == TT_OK, "oom mesh: build got %d", r);
     if (r != TT_OK) { tm_free(&m); return; }
     oom_sweep("tt_mesh_compute_stats", oom_stats, &q, TT_OK);
+    oom_sweep("tt_mesh_valence_histogram", oom_histogram, &q, TT_OK);
+    oom_sweep("tt_mesh_components", oom_components, &q, TT_OK);
     q.scheme = TT_SUBDIVIDE_LINEAR;
     oom_sweep("tt_mesh_quadrangulate(linear)", oom_quad, &q, TT_OK);
     q.scheme = TT_SUBDIVIDE_CATMULL_CLARK;
@@ -956,7 +968,7 @@ static tt_mesh *check_quad_step(const tt_mesh *mesh, tt_subdivision scheme, cons
 {
     tt_mesh *out = NULL;
     tt_error err;
-    tt_result r = tt_mesh_quadrangulate(mesh, scheme, &out, &err);
+    tt_result r = tt_mesh_quadrangulate(mesh, scheme, NULL, &out, &err);
     int E = count_edges(mesh), c, f, bad_quad = 0, bad_v0 = 0, bad_pos = 0, bad_face = 0, bad_edge = 0;
     CHECK(r == TT_OK, "%s: quadrangulate returned %d (%s)", name, r, err.message);
     if (r != TT_OK) return NULL;
@@ -1027,7 +1039,8 @@ static tt_mesh *check_quad_step(const tt_mesh *mesh, tt_subdivision scheme, cons
 static void check_topology_kept(const tt_mesh *a, const tt_mesh *b, const char *name)
 {
     tt_mesh_stats sa, sb;
-    CHECK(tt_mesh_compute_stats(a, &sa) == TT_OK && tt_mesh_compute_stats(b, &sb) == TT_OK, "%s: stats", name);
+    CHECK(tt_mesh_compute_stats(a, NULL, &sa, NULL) == TT_OK && tt_mesh_compute_stats(b, NULL, &sb, NULL) == TT_OK,
+          "%s: stats", name);
     CHECK(sa.euler_characteristic == sb.euler_characteristic && sa.genus == sb.genus &&
               sa.components == sb.components && sa.boundary_loops == sb.boundary_loops &&
               2 * sa.boundary_edges == sb.boundary_edges,
@@ -1053,7 +1066,7 @@ static void check_direct_topology(const tt_mesh *q, const char *name)
     d.nfaces = q->nfaces;
     d.fixed_face_size = 4;
     d.flags = TT_MESH_PERMISSIVE;   /* zero-area quads are possible in the output */
-    if (tt_mesh_build(&d, &rebuilt, &err) != TT_OK) {
+    if (tt_mesh_build(&d, NULL, &rebuilt, &err) != TT_OK) {
         CHECK(0, "%s: rebuilding the quadrangulation failed: %s", name, err.message);
         return;
     }
@@ -1084,7 +1097,7 @@ static void test_quadrangulate_direct(void)
         if (which == 2) make_genus2(&m);
         if (which == 3) make_torus(&m, 6, 5, 3.0, 1.0);
         if (build(&m, 0, &mesh, &err) == TT_OK) {
-            if (tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q, &err) == TT_OK) {
+            if (tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &q, &err) == TT_OK) {
                 check_direct_topology(q, name);
                 tt_mesh_free(q);
             } else {
@@ -1102,7 +1115,8 @@ static void test_quadrangulate_direct(void)
     tm_tri(&m, 1, 0, tm_vert(&m, 0, -1, 0));
     tm_tri(&m, 0, 1, tm_vert(&m, 0, 0, 1));
     if (build(&m, TT_MESH_PERMISSIVE, &mesh, &err) == TT_OK) {
-        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, &q, &err) == TT_OK, "permissive: %s", err.message);
+        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &q, &err) == TT_OK, "permissive: %s",
+              err.message);
         if (q) { check_direct_topology(q, "permissive"); tt_mesh_free(q); }
         tt_mesh_free(mesh);
     }
@@ -1116,8 +1130,8 @@ static void test_quadrangulate_direct(void)
         tt_mesh_desc d;
         memset(&d, 0, sizeof d);
         d.positions = p; d.nverts = 6; d.indices = idx; d.nfaces = 1; d.fixed_face_size = 6;
-        if (tt_mesh_build(&d, &mesh, &err) == TT_OK) {
-            tt_result r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, &q, &err);
+        if (tt_mesh_build(&d, NULL, &mesh, &err) == TT_OK) {
+            tt_result r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &q, &err);
             CHECK(r == TT_OK && q && q->nfaces == 6, "hexagon with coincident corners: result %d (%s)", r, err.message);
             tt_mesh_free(q);
             tt_mesh_free(mesh);
@@ -1132,7 +1146,7 @@ static void test_quadrangulate_direct(void)
         tt_mesh_desc d;
         memset(&d, 0, sizeof d);
         d.positions = p; d.nverts = 3; d.indices = idx; d.face_sizes = sizes; d.nfaces = 2;
-        CHECK(tt_mesh_build(&d, &mesh, &err) == TT_ERROR_FACE_TOO_SMALL && err.face == 1 && err.corner == -1,
+        CHECK(tt_mesh_build(&d, NULL, &mesh, &err) == TT_ERROR_FACE_TOO_SMALL && err.face == 1 && err.corner == -1,
               "empty face: face %d corner %d", err.face, err.corner);
     }
 }
@@ -1183,7 +1197,7 @@ static void test_quadrangulate(void)
     r = build(&m, 0, &mesh, &err);
     CHECK(r == TT_OK, "cube build %d", r);
     if (r == TT_OK) {
-        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q1, &err);
+        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &q1, &err);
         CHECK(r == TT_OK, "cube: Catmull-Clark returned %d", r);
         if (r == TT_OK) {
             int v, c, bad = 0, found_edge = 0;
@@ -1229,7 +1243,7 @@ static void test_quadrangulate(void)
     m.pos[3 * 1 + 1] = 0.5f;   /* lift boundary vertex (1,0) to y = .5: 3/4*.5 = .375 */
     r = build(&m, 0, &mesh, &err);
     if (r == TT_OK) {
-        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &q1, &err);
+        r = tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &q1, &err);
         CHECK(r == TT_OK, "grid CC %d", r);
         if (r == TT_OK) {
             double e5[3] = {1, 1, 0}, e1[3] = {1, 0.375, 0}, e0[3] = {0.125, 0.1875, 0};
@@ -1253,16 +1267,182 @@ static void test_quadrangulate(void)
     r = build(&m, 0, &mesh, &err);
     if (r == TT_OK) {
         q1 = (tt_mesh *)&q1;
-        CHECK(tt_mesh_quadrangulate(mesh, (tt_subdivision)7, &q1, &err) == TT_ERROR_INVALID_ARGUMENT && q1 == NULL,
+        CHECK(tt_mesh_quadrangulate(mesh, (tt_subdivision)7, NULL, &q1, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  q1 == NULL,
               "unknown scheme should be rejected with *out NULL");
-        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+        CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
               "out_mesh NULL should be rejected");
-        CHECK(tt_mesh_quadrangulate(NULL, TT_SUBDIVIDE_LINEAR, &q1, &err) == TT_ERROR_INVALID_ARGUMENT && q1 == NULL,
+        CHECK(tt_mesh_quadrangulate(NULL, TT_SUBDIVIDE_LINEAR, NULL, &q1, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  q1 == NULL,
               "mesh NULL should be rejected");
         tt_mesh_free(mesh);
     }
     tm_free(&m);
     tt_mesh_free(NULL);   /* allowed */
+}
+
+/* ------------------------------------------------------------------------ */
+/* 2d. The new contract: errors on NULL, the allocator parameter            */
+/* ------------------------------------------------------------------------ */
+
+/* A result and the error it filled: the same code, a non-empty sentence. */
+static void expect_filled(tt_result r, const tt_error *err, tt_result code, const char *what)
+{
+    CHECK(r == code && err->result == code && err->message[0] != '\0' &&
+              memchr(err->message, '\0', sizeof err->message) != NULL,
+          "%s: expected %d with a message, got %d (err.result %d, \"%.60s\")", what, code, r, err->result,
+          err->message[0] == 0x55 ? "(not written)" : err->message);
+}
+
+static void fresh_error(tt_error *err)
+{
+    memset(err, 0x55, sizeof *err);
+    err->message[0] = '\0';
+}
+
+static void test_mesh_null_errors(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *out;
+    tt_mesh_desc d;
+    tt_mesh_stats st;
+    tt_error err;
+    int hist[8], comp[64], loops[64], n;
+    memset(&m, 0, sizeof m);
+    make_tetra(&m, 0);
+    d = tm_desc(&m);
+    if (tt_mesh_build(&d, NULL, &mesh, NULL) != TT_OK) { CHECK(0, "tetrahedron build"); tm_free(&m); return; }
+
+    fresh_error(&err);
+    expect_filled(tt_mesh_build(NULL, NULL, &out, &err), &err, TT_ERROR_INVALID_ARGUMENT, "tt_mesh_build(desc NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_build(&d, NULL, NULL, &err), &err, TT_ERROR_INVALID_ARGUMENT, "tt_mesh_build(out NULL)");
+
+    fresh_error(&err);
+    expect_filled(tt_mesh_compute_stats(NULL, NULL, &st, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_compute_stats(mesh NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_compute_stats(mesh, NULL, NULL, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_compute_stats(stats NULL)");
+
+    fresh_error(&err);
+    expect_filled(tt_mesh_valence_histogram(NULL, NULL, hist, 8, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_valence_histogram(mesh NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_valence_histogram(mesh, NULL, NULL, 8, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_valence_histogram(histogram NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_valence_histogram(mesh, NULL, hist, 0, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_valence_histogram(nbins 0)");
+
+    fresh_error(&err);
+    expect_filled(tt_mesh_components(NULL, NULL, comp, &n, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_components(mesh NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_components(mesh, NULL, NULL, &n, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_components(face_component NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_components(mesh, NULL, comp, NULL, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_components(ncomponents NULL)");
+
+    fresh_error(&err);
+    expect_filled(tt_mesh_boundary_loops(NULL, loops, &n, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_boundary_loops(mesh NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_boundary_loops(mesh, NULL, &n, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_boundary_loops(corner_loop NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_boundary_loops(mesh, loops, NULL, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_boundary_loops(nloops NULL)");
+
+    fresh_error(&err);
+    out = (tt_mesh *)&out;
+    expect_filled(tt_mesh_quadrangulate(NULL, TT_SUBDIVIDE_LINEAR, NULL, &out, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_quadrangulate(mesh NULL)");
+    CHECK(out == NULL, "tt_mesh_quadrangulate(mesh NULL): *out_mesh should be NULL");
+    fresh_error(&err);
+    expect_filled(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, NULL, &err), &err,
+                  TT_ERROR_INVALID_ARGUMENT, "tt_mesh_quadrangulate(out NULL)");
+    fresh_error(&err);
+    expect_filled(tt_mesh_quadrangulate(mesh, (tt_subdivision)9, NULL, &out, &err), &err, TT_ERROR_INVALID_ARGUMENT,
+                  "tt_mesh_quadrangulate(scheme 9)");
+
+    /* Success clears the error: result TT_OK, every place -1. */
+    fresh_error(&err);
+    CHECK(tt_mesh_compute_stats(mesh, NULL, &st, &err) == TT_OK && err.result == TT_OK && err.face == -1 &&
+              err.corner == -1 && err.vertex == -1 && err.row == -1 && err.column == -1 && err.item == -1,
+          "a successful call resets the error: result %d, face %d, row %d, item %d", err.result, err.face, err.row,
+          err.item);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* The queries take their temporary memory from the allocator they are
+   given, not from the one the mesh was built with, and give it all back. */
+static void test_mesh_query_allocators(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *q = NULL;
+    counter built, used;
+    tt_allocator build_al = make_allocator(&built, -1), al;
+    tt_mesh_desc d;
+    tt_mesh_stats st;
+    int hist[8], *comp, n = 0;
+    long built_calls;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 6, 5, 3.0, 1.0);
+    make_grid(&m, 2, 2);
+    d = tm_desc(&m);
+    if (tt_mesh_build(&d, &build_al, &mesh, NULL) != TT_OK) { CHECK(0, "build"); tm_free(&m); return; }
+    built_calls = built.calls;
+    comp = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+
+    al = make_allocator(&used, -1);
+    CHECK(tt_mesh_compute_stats(mesh, &al, &st, NULL) == TT_OK && st.components == 2, "stats: components %d",
+          st.components);
+    CHECK(used.calls > 0 && used.live == 0 && used.bad_frees == 0,
+          "tt_mesh_compute_stats: %ld calls to its allocator (> 0 expected), %ld live", used.calls, used.live);
+
+    al = make_allocator(&used, -1);
+    CHECK(tt_mesh_components(mesh, &al, comp, &n, NULL) == TT_OK && n == 2, "components: %d", n);
+    CHECK(used.calls > 0 && used.live == 0 && used.bad_frees == 0,
+          "tt_mesh_components: %ld calls to its allocator (> 0 expected), %ld live", used.calls, used.live);
+
+    al = make_allocator(&used, -1);
+    CHECK(tt_mesh_valence_histogram(mesh, &al, hist, 8, NULL) == TT_OK && hist[4] == 30 + 1,
+          "histogram: %d vertices of valence 4 (31 expected)", hist[4]);
+    CHECK(used.calls > 0 && used.live == 0 && used.bad_frees == 0,
+          "tt_mesh_valence_histogram: %ld calls to its allocator (> 0 expected), %ld live", used.calls, used.live);
+
+    /* quadrangulate: the new mesh comes from (and remembers) the allocator given */
+    al = make_allocator(&used, -1);
+    CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, &al, &q, NULL) == TT_OK && q, "quadrangulate");
+    CHECK(used.live > 0, "the quadrangulated mesh should live in the allocator given (%ld live)", used.live);
+    tt_mesh_free(q);
+    CHECK(used.live == 0 && used.bad_frees == 0, "tt_mesh_free(quadrangulated): %ld live, %ld bad frees", used.live,
+          used.bad_frees);
+    CHECK(built.calls == built_calls, "the queries used the mesh's own allocator %ld times (none expected)",
+          built.calls - built_calls);
+
+    /* a failing allocator: clean TT_ERROR_OUT_OF_MEMORY from each */
+    {
+        tt_error err;
+        tt_result r1, r2, r3;
+        al = make_allocator(&used, 0);   /* each call's first allocation fails */
+        r1 = tt_mesh_compute_stats(mesh, &al, &st, &err);
+        used.calls = 0;
+        r2 = tt_mesh_components(mesh, &al, comp, &n, NULL);
+        used.calls = 0;
+        r3 = tt_mesh_valence_histogram(mesh, &al, hist, 8, NULL);
+        CHECK(r1 == TT_ERROR_OUT_OF_MEMORY && r2 == TT_ERROR_OUT_OF_MEMORY && r3 == TT_ERROR_OUT_OF_MEMORY &&
+                  used.live == 0 && used.failures == 3,
+              "queries with a failing allocator: expected TT_ERROR_OUT_OF_MEMORY, got %d %d %d, %ld live", r1, r2, r3,
+              used.live);
+    }
+    free(comp);
+    tt_mesh_free(mesh);
+    CHECK(built.live == 0, "mesh: %ld allocations leaked", built.live);
+    tm_free(&m);
 }
 
 void run_mesh_tests(void)
@@ -1274,4 +1454,6 @@ void run_mesh_tests(void)
     RUN(test_queries_oom);
     RUN(test_quadrangulate);
     RUN(test_quadrangulate_direct);
+    RUN(test_mesh_null_errors);
+    RUN(test_mesh_query_allocators);
 }

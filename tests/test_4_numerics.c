@@ -66,7 +66,7 @@ static void test_cg_triplets(void)
 {
     counter cnt;
     tt_allocator al = make_allocator(&cnt, -1);
-    int trial, bad_trials = 0;
+    int trial, bad_trials = 0, bad_free = 0;
     lcg_seed(401);
     for (trial = 0; trial < 300; trial++) {
         int rows = 1 + lcg_below(trial < 100 ? 6 : 40), cols = 1 + lcg_below(trial < 100 ? 6 : 40);
@@ -74,26 +74,26 @@ static void test_cg_triplets(void)
         tt_triplet *t = cg_random_triplets(rows, cols, count);
         char *used = (char *)calloc((size_t)rows * cols, 1);
         double *d = cg_dense_from_triplets(rows, cols, t, count, used);
-        tt_sparse_matrix m;
+        tt_sparse_matrix *m = NULL;
         tt_error err;
-        tt_result r = tt_sparse_from_triplets(&m, rows, cols, t, count, &al, &err);
-        if (r != TT_OK) bad = 1000;
+        tt_result r = tt_sparse_from_triplets(rows, cols, t, count, &al, &m, &err);
+        if (r != TT_OK || !m) bad = 1000;
         else {
-            bad = cg_matches_dense(&m, d, used, rows, cols);
-            if (cnt.live != 3) bad++;
+            bad = cg_matches_dense(m, d, used, rows, cols);
+            if (cnt.live != 4) bad++;   /* the struct and its three arrays */
         }
         if (bad && !bad_trials)
-            DETAIL("trial %d: %d x %d from %d triplets: result %d, %d bad entries (%s)", trial, rows, cols, count, r,
-                   bad, err.message);
+            DETAIL("trial %d: %d x %d from %d triplets: result %d, %d bad entries, %ld live (%s)", trial, rows, cols,
+                   count, r, bad, cnt.live, err.message);
         if (bad) bad_trials++;
-        if (r == TT_OK) tt_sparse_free(&m);
-        CHECK(m.row_start == NULL && m.col == NULL && m.value == NULL && m.nnz == 0,
-              "tt_sparse_free zeroes the struct");
+        tt_sparse_matrix_free(m);
+        if (cnt.live != 0) bad_free++;
         free(t);
         free(used);
         free(d);
     }
     CHECK(bad_trials == 0, "CSR from random triplets differs from the dense sum in %d of 300 trials", bad_trials);
+    CHECK(bad_free == 0, "tt_sparse_matrix_free left allocations live in %d of 300 trials", bad_free);
     CHECK(cnt.live == 0 && cnt.bad_frees == 0, "triplets: %ld allocations leaked, %ld bad frees", cnt.live,
           cnt.bad_frees);
     {
@@ -103,31 +103,31 @@ static void test_cg_triplets(void)
                                        {0, 1, 4.0}, {0, 1, -4.0}};
         static const int rs[] = {0, 3, 3, 5}, cl[] = {0, 1, 2, 0, 3};
         static const double vl[] = {1.5, 0.0, 5.0, 2.0, 1.25};
-        tt_sparse_matrix m;
+        tt_sparse_matrix *m = NULL;
         int k, same = 1;
-        tt_result r = tt_sparse_from_triplets(&m, 3, 4, t, 7, NULL, NULL);
-        CHECK(r == TT_OK && m.rows == 3 && m.cols == 4 && m.nnz == 5, "3x4 example: result %d, %d x %d, nnz %d", r,
-              m.rows, m.cols, m.nnz);
-        if (r == TT_OK && m.nnz == 5) {
-            for (k = 0; k < 4; k++) same &= m.row_start[k] == rs[k];
-            for (k = 0; k < 5; k++) same &= m.col[k] == cl[k] && m.value[k] == vl[k];
+        tt_result r = tt_sparse_from_triplets(3, 4, t, 7, NULL, &m, NULL);
+        CHECK(r == TT_OK && m && m->rows == 3 && m->cols == 4 && m->nnz == 5, "3x4 example: result %d, nnz %d", r,
+              m ? m->nnz : -1);
+        if (r == TT_OK && m && m->nnz == 5) {
+            for (k = 0; k < 4; k++) same &= m->row_start[k] == rs[k];
+            for (k = 0; k < 5; k++) same &= m->col[k] == cl[k] && m->value[k] == vl[k];
             CHECK(same, "3x4 example: row_start/col/value differ from the hand-made CSR");
         }
-        tt_sparse_free(&m);
-        tt_sparse_free(&m);   /* twice is harmless */
-        tt_sparse_free(NULL);
+        tt_sparse_matrix_free(m);
+        tt_sparse_matrix_free(NULL);   /* allowed */
     }
     {
         /* No triplets; a 0 x 0 matrix; NULL triplets with count 0. */
-        tt_sparse_matrix m;
-        tt_result r = tt_sparse_from_triplets(&m, 4, 2, NULL, 0, &al, NULL);
-        CHECK(r == TT_OK && m.nnz == 0 && m.rows == 4 && m.row_start && m.row_start[4] == 0,
-              "4x2 from no triplets: result %d, nnz %d", r, m.nnz);
-        tt_sparse_free(&m);
-        r = tt_sparse_from_triplets(&m, 0, 0, NULL, 0, &al, NULL);
-        CHECK(r == TT_OK && m.nnz == 0 && m.rows == 0 && m.row_start && m.row_start[0] == 0,
+        tt_sparse_matrix *m = NULL;
+        tt_result r = tt_sparse_from_triplets(4, 2, NULL, 0, &al, &m, NULL);
+        CHECK(r == TT_OK && m && m->nnz == 0 && m->rows == 4 && m->row_start && m->row_start[4] == 0,
+              "4x2 from no triplets: result %d", r);
+        tt_sparse_matrix_free(m);
+        m = NULL;
+        r = tt_sparse_from_triplets(0, 0, NULL, 0, &al, &m, NULL);
+        CHECK(r == TT_OK && m && m->nnz == 0 && m->rows == 0 && m->row_start && m->row_start[0] == 0,
               "0x0 matrix: result %d", r);
-        tt_sparse_free(&m);
+        tt_sparse_matrix_free(m);
         CHECK(cnt.live == 0, "empty matrices: %ld allocations leaked", cnt.live);
     }
 }
@@ -137,23 +137,30 @@ static void cg_expect_triplet_error(int rows, int cols, const tt_triplet *t, int
 {
     counter cnt;
     tt_allocator al = make_allocator(&cnt, -1);
-    tt_sparse_matrix m;
+    tt_sparse_matrix *m = (tt_sparse_matrix *)&m;   /* must become NULL */
     tt_error err;
     tt_result r;
-    memset(&m, 0x5a, sizeof m);
-    r = tt_sparse_from_triplets(&m, rows, cols, t, count, &al, &err);
+    memset(&err, 0x5a, sizeof err);
+    r = tt_sparse_from_triplets(rows, cols, t, count, &al, &m, &err);
     CHECK(r == code && err.result == code, "%s: expected %d, got %d (err.result %d)", what, code, r, err.result);
-    CHECK(m.row_start == NULL && m.col == NULL && m.value == NULL && m.rows == 0 && m.nnz == 0,
-          "%s: the matrix should be zeroed on failure", what);
+    CHECK(m == NULL, "%s: *out_matrix should be NULL on failure", what);
+    if (r == TT_OK && m) tt_sparse_matrix_free(m);
     CHECK(cnt.calls == 0 && cnt.live == 0, "%s: %ld allocations made, %ld live; none expected", what, cnt.calls,
           cnt.live);
-    CHECK(err.message[0] != '\0', "%s: empty message", what);
-    if (row != -2) CHECK(err.vertex == row && err.other_vertex == col, "%s: row/col expected %d/%d, got %d/%d", what,
-                         row, col, err.vertex, err.other_vertex);
-    if (index >= 0) CHECK(msg_has_number(err.message, index), "%s: message should name triplet %d: %s", what, index,
-                          err.message);
-    r = tt_sparse_from_triplets(&m, rows, cols, t, count, &al, NULL);
-    CHECK(r == code, "%s with error == NULL: expected %d, got %d", what, code, r);
+    CHECK(err.message[0] != '\0' && memchr(err.message, '\0', sizeof err.message) != NULL, "%s: empty message",
+          what);
+    if (row != -2)
+        CHECK(err.row == row && err.column == col && err.vertex == -1 && err.other_vertex == -1,
+              "%s: row/column expected %d/%d, got %d/%d (vertex %d/%d should be -1)", what, row, col, err.row,
+              err.column, err.vertex, err.other_vertex);
+    if (index >= 0) {
+        CHECK(err.item == index, "%s: error->item expected triplet %d, got %d", what, index, err.item);
+        CHECK(msg_has_number(err.message, index), "%s: message should name triplet %d: %s", what, index,
+              err.message);
+    }
+    m = (tt_sparse_matrix *)&m;
+    r = tt_sparse_from_triplets(rows, cols, t, count, &al, &m, NULL);
+    CHECK(r == code && m == NULL, "%s with error == NULL: expected %d, got %d", what, code, r);
 }
 
 static void test_cg_triplet_errors(void)
@@ -175,7 +182,7 @@ static void test_cg_triplet_errors(void)
     cg_expect_triplet_error(-1, 3, t, 4, TT_ERROR_INVALID_ARGUMENT, -2, -2, -1, "rows -1");
     cg_expect_triplet_error(3, 3, t, -4, TT_ERROR_INVALID_ARGUMENT, -2, -2, -1, "ntriplets -4");
     cg_expect_triplet_error(3, 3, NULL, 4, TT_ERROR_INVALID_ARGUMENT, -2, -2, -1, "triplets NULL");
-    CHECK(tt_sparse_from_triplets(NULL, 3, 3, t, 4, NULL, NULL) == TT_ERROR_INVALID_ARGUMENT, "matrix NULL");
+    CHECK(tt_sparse_from_triplets(3, 3, t, 4, NULL, NULL, NULL) == TT_ERROR_INVALID_ARGUMENT, "matrix NULL");
 }
 
 static void test_cg_multiply(void)
@@ -188,10 +195,10 @@ static void test_cg_multiply(void)
         double *d = cg_dense_from_triplets(rows, cols, t, count, NULL);
         double *x = (double *)malloc(sizeof(double) * (size_t)cols);
         double *y = (double *)malloc(sizeof(double) * (size_t)rows);
-        tt_sparse_matrix m;
+        tt_sparse_matrix *m = NULL;
         for (j = 0; j < cols; j++) x[j] = lcg_unit() * 2.0 - 1.0;
-        if (tt_sparse_from_triplets(&m, rows, cols, t, count, NULL, NULL) != TT_OK ||
-            tt_sparse_multiply(&m, x, y) != TT_OK) {
+        if (tt_sparse_from_triplets(rows, cols, t, count, NULL, &m, NULL) != TT_OK ||
+            tt_sparse_multiply(m, x, y, NULL) != TT_OK) {
             bad++;
         } else {
             for (i = 0; i < rows; i++) {
@@ -206,7 +213,7 @@ static void test_cg_multiply(void)
                 }
             }
         }
-        tt_sparse_free(&m);
+        tt_sparse_matrix_free(m);
         free(t);
         free(d);
         free(x);
@@ -225,11 +232,11 @@ static void test_cg_multiply(void)
         m.row_start = rs;
         m.col = cl;
         m.value = vl;
-        CHECK(tt_sparse_multiply(&m, x, y) == TT_OK && y[0] == 35.0 && y[1] == -2.0,
+        CHECK(tt_sparse_multiply(&m, x, y, NULL) == TT_OK && y[0] == 35.0 && y[1] == -2.0,
               "hand-made CSR: expected 35, -2, got %g, %g", y[0], y[1]);
-        CHECK(tt_sparse_multiply(&m, x, x) == TT_ERROR_INVALID_ARGUMENT, "x == y must be refused");
-        CHECK(tt_sparse_multiply(NULL, x, y) == TT_ERROR_INVALID_ARGUMENT, "A NULL must be refused");
-        CHECK(tt_sparse_multiply(&m, NULL, y) == TT_ERROR_INVALID_ARGUMENT, "x NULL must be refused");
+        CHECK(tt_sparse_multiply(&m, x, x, NULL) == TT_ERROR_INVALID_ARGUMENT, "x == y must be refused");
+        CHECK(tt_sparse_multiply(NULL, x, y, NULL) == TT_ERROR_INVALID_ARGUMENT, "A NULL must be refused");
+        CHECK(tt_sparse_multiply(&m, NULL, y, NULL) == TT_ERROR_INVALID_ARGUMENT, "x NULL must be refused");
     }
 }
 
@@ -336,7 +343,7 @@ static void test_cg_random_spd(void)
         double *d, *chol, *b = (double *)malloc(sizeof(double) * (size_t)n);
         double *x = (double *)calloc((size_t)n, sizeof(double)), *xr = (double *)malloc(sizeof(double) * (size_t)n);
         double err_num = 0.0, err_den = 0.0, relres;
-        tt_sparse_matrix m;
+        tt_sparse_matrix *m = NULL;
         tt_cg_options opt;
         tt_cg_report rep;
         tt_error err;
@@ -349,7 +356,7 @@ static void test_cg_random_spd(void)
         if (!cg_dense_cholesky_solve(chol, n, b, xr)) {
             DETAIL("n = %d: the test matrix is not SPD (generator bug)", n);
             bad_result++;
-        } else if (tt_sparse_from_triplets(&m, n, n, t, count, &al, NULL) != TT_OK) {
+        } else if (tt_sparse_from_triplets(n, n, t, count, &al, &m, NULL) != TT_OK) {
             bad_result++;
         } else {
             memset(&opt, 0, sizeof opt);
@@ -358,8 +365,7 @@ static void test_cg_random_spd(void)
                the drift of the updated residual shows here. */
             opt.tolerance = 1e-12;
             opt.max_iterations = 20 * n + 100;
-            opt.allocator = al;
-            r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+            r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
             relres = cg_dense_relres(d, n, b, x);
             for (i = 0; i < n; i++) {
                 err_num = fmax(err_num, fabs(x[i] - xr[i]));
@@ -384,7 +390,7 @@ static void test_cg_random_spd(void)
                 bad_x++;
             }
             if (err_num / err_den > worst_err) worst_err = err_num / err_den;
-            tt_sparse_free(&m);
+            tt_sparse_matrix_free(m);
         }
         free(t);
         free(d);
@@ -403,11 +409,11 @@ static void test_cg_random_spd(void)
 
 /* The 5-point Laplacian of a w x h grid (Neumann: interior and boundary rows
    alike sum to zero) plus `shift` on the diagonal, as triplets. */
-static tt_sparse_matrix cg_grid_matrix(int w, int h, double shift)
+static tt_sparse_matrix *cg_grid_matrix(int w, int h, double shift)
 {
     tt_triplet *t = (tt_triplet *)malloc(sizeof(tt_triplet) * (size_t)w * h * 9);
     int x, y, count = 0;
-    tt_sparse_matrix m;
+    tt_sparse_matrix *m = NULL;
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
             int v = y * w + x, k;
@@ -429,7 +435,7 @@ static tt_sparse_matrix cg_grid_matrix(int w, int h, double shift)
                 count++;
             }
         }
-    if (tt_sparse_from_triplets(&m, w * h, w * h, t, count, NULL, NULL) != TT_OK) memset(&m, 0, sizeof m);
+    if (tt_sparse_from_triplets(w * h, w * h, t, count, NULL, &m, NULL) != TT_OK) m = NULL;
     free(t);
     return m;
 }
@@ -439,7 +445,7 @@ static double cg_relres(const tt_sparse_matrix *m, const double *b, const double
 {
     double *ax = (double *)malloc(sizeof(double) * (size_t)m->rows + 1), rr = 0.0, bb = 0.0;
     int i;
-    tt_sparse_multiply(m, x, ax);
+    tt_sparse_multiply(m, x, ax, NULL);
     for (i = 0; i < m->rows; i++) {
         rr += (b[i] - ax[i]) * (b[i] - ax[i]);
         bb += b[i] * b[i];
@@ -451,7 +457,7 @@ static double cg_relres(const tt_sparse_matrix *m, const double *b, const double
 static void test_cg_grid(void)
 {
     const int w = 40, h = 30, n = w * h;
-    tt_sparse_matrix m = cg_grid_matrix(w, h, 1.0);
+    tt_sparse_matrix *m = cg_grid_matrix(w, h, 1.0);
     double *xs = (double *)malloc(sizeof(double) * n), *b = (double *)malloc(sizeof(double) * n);
     double *x = (double *)calloc((size_t)n, sizeof(double)), maxerr = 0.0;
     tt_cg_report rep;
@@ -460,38 +466,39 @@ static void test_cg_grid(void)
     int i, iterations;
     counter cnt;
     tt_cg_options opt;
+    tt_allocator al = make_allocator(&cnt, -1);
     memset(&opt, 0, sizeof opt);
-    opt.allocator = make_allocator(&cnt, -1);
-    CHECK(m.rows == n && m.nnz == n + 2 * ((w - 1) * h + w * (h - 1)), "grid matrix: %d rows, %d entries", m.rows,
-          m.nnz);
+    if (!m) { CHECK(0, "grid matrix"); free(xs); free(b); free(x); return; }
+    CHECK(m->rows == n && m->nnz == n + 2 * ((w - 1) * h + w * (h - 1)), "grid matrix: %d rows, %d entries", m->rows,
+          m->nnz);
     lcg_seed(404);
     for (i = 0; i < n; i++) xs[i] = sin(0.1 * (i % w)) * cos(0.13 * (i / w)) + 0.1 * lcg_unit();
-    tt_sparse_multiply(&m, xs, b);
+    tt_sparse_multiply(m, xs, b, NULL);
 
     /* Laplacian + identity: condition number < 9, default options. */
-    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     for (i = 0; i < n; i++) maxerr = fmax(maxerr, fabs(x[i] - xs[i]));
     CHECK(r == TT_OK && rep.converged && err.result == TT_OK, "grid: expected TT_OK, got %d (%s)", r, err.message);
-    CHECK(rep.residual <= 1e-8 && near(rep.residual, cg_relres(&m, b, x), 1e-12),
-          "grid: report residual %g, recomputed %g (tolerance 1e-8)", rep.residual, cg_relres(&m, b, x));
+    CHECK(rep.residual <= 1e-8 && near(rep.residual, cg_relres(m, b, x), 1e-12),
+          "grid: report residual %g, recomputed %g (tolerance 1e-8)", rep.residual, cg_relres(m, b, x));
     CHECK(rep.iterations > 5 && rep.iterations < 60, "grid: %d steps for a condition number below 9", rep.iterations);
     CHECK(maxerr < 1e-7, "grid: |x - x*|_inf = %g", maxerr);
     CHECK(cnt.live == 0 && cnt.calls == 1, "grid: %ld allocation calls (1 expected), %ld live", cnt.calls, cnt.live);
     iterations = rep.iterations;
 
     /* Warm start from the solution just found: done in 0 or 1 step. */
-    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     CHECK(r == TT_OK && rep.iterations <= 1 && rep.converged, "warm start from the solution: %d, %d steps", r,
           rep.iterations);
     /* Warm start from the exact x*: b = A x* up to rounding, so 0 steps. */
     memcpy(x, xs, sizeof(double) * n);
-    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     CHECK(r == TT_OK && rep.iterations <= 1 && rep.converged, "warm start from x*: %d, %d steps", r, rep.iterations);
 
     /* A tighter tolerance takes more steps and gets closer. */
     memset(x, 0, sizeof(double) * n);
     opt.tolerance = 1e-13;
-    r = tt_cg_solve(&m, b, x, &opt, &rep, NULL);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, NULL);
     CHECK(r == TT_OK && rep.iterations > iterations && rep.residual <= 1e-13,
           "tolerance 1e-13: result %d, %d steps (1e-8 took %d), residual %g", r, rep.iterations, iterations,
           rep.residual);
@@ -500,13 +507,13 @@ static void test_cg_grid(void)
     memset(x, 0, sizeof(double) * n);
     opt.tolerance = 0.0;
     opt.max_iterations = 3;
-    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     CHECK(r == TT_ERROR_NOT_CONVERGED && err.result == r, "cap of 3 steps: expected %d, got %d",
           TT_ERROR_NOT_CONVERGED, r);
     CHECK(rep.iterations == 3 && !rep.converged && rep.residual > 1e-8 && rep.residual < 1.0 &&
-              near(rep.residual, cg_relres(&m, b, x), 1e-12),
+              near(rep.residual, cg_relres(m, b, x), 1e-12),
           "cap of 3 steps: report {%d, %g, %d}, recomputed residual %g", rep.iterations, rep.residual, rep.converged,
-          cg_relres(&m, b, x));
+          cg_relres(m, b, x));
     CHECK(msg_has_number(err.message, 3), "cap message should say 3 steps: %s", err.message);
     CHECK(strcmp(tt_result_string(TT_ERROR_NOT_CONVERGED), tt_result_string((tt_result)-99)) != 0 &&
               strcmp(tt_result_string(TT_ERROR_NOT_POSITIVE_DEFINITE), tt_result_string((tt_result)-99)) != 0 &&
@@ -521,25 +528,26 @@ static void test_cg_grid(void)
         b[i] = 0.0;
     }
     opt.max_iterations = 0;
-    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     for (i = 0; i < n && x[i] == 0.0; i++) continue;
     CHECK(r == TT_OK && i == n && rep.iterations == 0 && rep.converged && rep.residual == 0.0,
           "b = 0: result %d, %d of %d zeros, %d steps", r, i, n, rep.iterations);
 
     /* A pure Laplacian (no shift) plus one pinned row is still SPD but badly
        conditioned: the default cap (2n) is enough with Jacobi. */
-    tt_sparse_free(&m);
+    tt_sparse_matrix_free(m);
     m = cg_grid_matrix(w, h, 0.0);
-    m.value[0] += 1.0;   /* A[0][0] is the first entry of row 0: pin vertex 0 */
-    tt_sparse_multiply(&m, xs, b);
+    if (!m) { CHECK(0, "grid matrix"); free(xs); free(b); free(x); return; }
+    m->value[0] += 1.0;   /* A[0][0] is the first entry of row 0: pin vertex 0 */
+    tt_sparse_multiply(m, xs, b, NULL);
     memset(x, 0, sizeof(double) * n);
-    r = tt_cg_solve(&m, b, x, NULL, &rep, &err);
+    r = tt_cg_solve(m, b, NULL, NULL, x, &rep, &err);
     maxerr = 0.0;
     for (i = 0; i < n; i++) maxerr = fmax(maxerr, fabs(x[i] - xs[i]));
     CHECK(r == TT_OK && rep.residual <= 1e-8 && maxerr < 1e-3,
           "pinned Laplacian: result %d, %d steps, residual %g, |x - x*| %g (%s)", r, rep.iterations, rep.residual,
           maxerr, err.message);
-    tt_sparse_free(&m);
+    tt_sparse_matrix_free(m);
     free(xs);
     free(b);
     free(x);
@@ -563,7 +571,7 @@ static int cg_progress(float fraction, void *user_data)
 static void test_cg_progress(void)
 {
     const int w = 20, h = 20, n = w * h;
-    tt_sparse_matrix m = cg_grid_matrix(w, h, 0.01);
+    tt_sparse_matrix *m = cg_grid_matrix(w, h, 0.01);
     double *b = (double *)malloc(sizeof(double) * n), *x = (double *)calloc((size_t)n, sizeof(double));
     cg_progress_log log;
     tt_cg_options opt;
@@ -571,14 +579,15 @@ static void test_cg_progress(void)
     tt_error err;
     tt_result r;
     counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
     int i;
+    if (!m) { CHECK(0, "grid matrix"); free(b); free(x); return; }
     for (i = 0; i < n; i++) b[i] = (double)(i % 7) - 3.0;
     memset(&opt, 0, sizeof opt);
     memset(&log, 0, sizeof log);
     opt.progress = cg_progress;
     opt.progress_user_data = &log;
-    opt.allocator = make_allocator(&cnt, -1);
-    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     CHECK(r == TT_OK && log.calls == rep.iterations, "progress: result %d, %d calls for %d steps", r, log.calls,
           rep.iterations);
     CHECK(log.decreasing == 0 && log.out_of_range == 0 && log.last > 0.5f,
@@ -586,12 +595,12 @@ static void test_cg_progress(void)
     memset(&log, 0, sizeof log);
     memset(x, 0, sizeof(double) * n);
     log.cancel_at = 5;
-    r = tt_cg_solve(&m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     CHECK(r == TT_CANCELLED && err.result == TT_CANCELLED && rep.iterations == 4 && !rep.converged &&
               rep.residual > 0.0 && rep.residual < 1.0,
           "cancel at the 5th call: result %d, %d steps, residual %g", r, rep.iterations, rep.residual);
     CHECK(cnt.live == 0, "cancel: %ld allocations leaked", cnt.live);
-    tt_sparse_free(&m);
+    tt_sparse_matrix_free(m);
     free(b);
     free(x);
 }
@@ -602,6 +611,7 @@ static void cg_expect_solve_error(const tt_sparse_matrix *m, const double *b, do
                                   tt_result code, int row, int untouched, const char *what)
 {
     counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
     tt_cg_options opt;
     tt_cg_report rep;
     tt_error err;
@@ -610,14 +620,15 @@ static void cg_expect_solve_error(const tt_sparse_matrix *m, const double *b, do
     int n = m && m->rows > 0 && m->rows <= 8 ? m->rows : 0, i, same = 1;
     if (o) opt = *o;
     else memset(&opt, 0, sizeof opt);
-    opt.allocator = make_allocator(&cnt, -1);
     if (x && n) memcpy(keep, x, sizeof(double) * n);
     memset(&rep, 0x5a, sizeof rep);
-    r = tt_cg_solve(m, b, x, &opt, &rep, &err);
+    r = tt_cg_solve(m, b, &opt, &al, x, &rep, &err);
     CHECK(r == code && err.result == code, "%s: expected %d, got %d (%s)", what, code, r, err.message);
     CHECK(err.message[0] != '\0', "%s: empty message", what);
-    if (row != -2) CHECK(err.vertex == row && msg_has_number(err.message, row), "%s: should name row %d: vertex %d, %s",
-                         what, row, err.vertex, err.message);
+    if (row != -2)
+        CHECK(err.row == row && err.vertex == -1 && msg_has_number(err.message, row),
+              "%s: should name row %d in error->row (not vertex): row %d, vertex %d, %s", what, row, err.row,
+              err.vertex, err.message);
     if (untouched && x && n) {
         for (i = 0; i < n; i++) same &= x[i] == keep[i];
         CHECK(same, "%s: x should be left as it was", what);
@@ -625,16 +636,16 @@ static void cg_expect_solve_error(const tt_sparse_matrix *m, const double *b, do
     CHECK(!rep.converged && rep.iterations >= 0 && rep.iterations < 100, "%s: report {%d, %g, %d}", what,
           rep.iterations, rep.residual, rep.converged);
     CHECK(cnt.live == 0 && cnt.bad_frees == 0, "%s: %ld allocations leaked", what, cnt.live);
-    r = tt_cg_solve(m, b, x, &opt, NULL, NULL);
+    r = tt_cg_solve(m, b, &opt, &al, x, NULL, NULL);
     CHECK(r == code, "%s with report and error NULL: expected %d, got %d", what, code, r);
     if (x && n) memcpy(x, keep, sizeof(double) * n);
 }
 
-static tt_sparse_matrix cg_small(int rows, int cols, const double *dense)
+static tt_sparse_matrix *cg_small(int rows, int cols, const double *dense)
 {
     tt_triplet t[64];
     int i, j, count = 0;
-    tt_sparse_matrix m;
+    tt_sparse_matrix *m = NULL;
     for (i = 0; i < rows; i++)
         for (j = 0; j < cols; j++)
             if (dense[i * cols + j] != 0.0) {
@@ -643,7 +654,7 @@ static tt_sparse_matrix cg_small(int rows, int cols, const double *dense)
                 t[count].value = dense[i * cols + j];
                 count++;
             }
-    if (tt_sparse_from_triplets(&m, rows, cols, t, count, NULL, NULL) != TT_OK) memset(&m, 0, sizeof m);
+    if (tt_sparse_from_triplets(rows, cols, t, count, NULL, &m, NULL) != TT_OK) m = NULL;
     return m;
 }
 
@@ -656,53 +667,55 @@ static void test_cg_errors(void)
     static const double empty_row[9] = {4, 0, 0, 0, 3, 0, 0, 0, 0};
     static const double indefinite[4] = {1, 2, 2, 1};
     double b[3] = {1, 2, 3}, x[3] = {0.5, 0.25, 0.125};
-    tt_sparse_matrix m = cg_small(3, 3, spd), bad;
+    tt_sparse_matrix *m = cg_small(3, 3, spd), *bad;
     tt_cg_options opt;
     memset(&opt, 0, sizeof opt);
+    if (!m) { CHECK(0, "cg_small(spd)"); return; }
 
     cg_expect_solve_error(NULL, b, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "A NULL");
-    cg_expect_solve_error(&m, NULL, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "b NULL");
-    cg_expect_solve_error(&m, b, NULL, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "x NULL");
-    cg_expect_solve_error(&m, b, b, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "b == x");
+    cg_expect_solve_error(m, NULL, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "b NULL");
+    cg_expect_solve_error(m, b, NULL, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "x NULL");
+    cg_expect_solve_error(m, b, b, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "b == x");
     opt.tolerance = -1.0;
-    cg_expect_solve_error(&m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "tolerance -1");
+    cg_expect_solve_error(m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "tolerance -1");
     opt.tolerance = NAN;
-    cg_expect_solve_error(&m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "tolerance NaN");
+    cg_expect_solve_error(m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "tolerance NaN");
     opt.tolerance = 0.0;
     opt.max_iterations = -1;
-    cg_expect_solve_error(&m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "max_iterations -1");
+    cg_expect_solve_error(m, b, x, &opt, TT_ERROR_INVALID_ARGUMENT, -2, 1, "max_iterations -1");
 
     bad = cg_small(3, 4, rect);
-    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "3 x 4 matrix");
-    tt_sparse_free(&bad);
+    cg_expect_solve_error(bad, b, x, NULL, TT_ERROR_INVALID_ARGUMENT, -2, 1, "3 x 4 matrix");
+    tt_sparse_matrix_free(bad);
     bad = cg_small(3, 3, zero_diag);
-    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 1, 1, "zero (missing) diagonal in row 1");
-    tt_sparse_free(&bad);
+    cg_expect_solve_error(bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 1, 1, "zero (missing) diagonal in row 1");
+    tt_sparse_matrix_free(bad);
     bad = cg_small(3, 3, neg_diag);
-    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 2, 1, "negative diagonal in row 2");
-    tt_sparse_free(&bad);
+    cg_expect_solve_error(bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 2, 1, "negative diagonal in row 2");
+    tt_sparse_matrix_free(bad);
     bad = cg_small(3, 3, empty_row);
-    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 2, 1, "empty row 2");
-    tt_sparse_free(&bad);
+    cg_expect_solve_error(bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 2, 1, "empty row 2");
+    tt_sparse_matrix_free(bad);
     {
         /* An explicit zero on the diagonal (kept in the pattern). */
         tt_triplet t[4] = {{0, 0, 1.0}, {1, 1, 1.0}, {1, 1, -1.0}, {2, 2, 1.0}};
-        tt_sparse_from_triplets(&bad, 3, 3, t, 4, NULL, NULL);
-        cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 1, 1, "diagonal summing to 0");
-        tt_sparse_free(&bad);
+        bad = NULL;
+        tt_sparse_from_triplets(3, 3, t, 4, NULL, &bad, NULL);
+        cg_expect_solve_error(bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, 1, 1, "diagonal summing to 0");
+        tt_sparse_matrix_free(bad);
     }
 
     /* NaN or infinity in A (changed in place), b, x. */
-    m.value[3] = NAN;   /* row 1: entries (1,0) (1,1) (1,2) start at 2 */
-    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 1, 1, "NaN in A");
-    m.value[3] = 3.0;
+    m->value[3] = NAN;   /* row 1: entries (1,0) (1,1) (1,2) start at 2 */
+    cg_expect_solve_error(m, b, x, NULL, TT_ERROR_NON_FINITE, 1, 1, "NaN in A");
+    m->value[3] = 3.0;
     b[2] = NAN;
-    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 2, 1, "NaN in b");
+    cg_expect_solve_error(m, b, x, NULL, TT_ERROR_NON_FINITE, 2, 1, "NaN in b");
     b[2] = INFINITY;
-    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 2, 1, "inf in b");
+    cg_expect_solve_error(m, b, x, NULL, TT_ERROR_NON_FINITE, 2, 1, "inf in b");
     b[2] = 3.0;
     x[1] = -INFINITY;
-    cg_expect_solve_error(&m, b, x, NULL, TT_ERROR_NON_FINITE, 1, 1, "-inf in the initial guess");
+    cg_expect_solve_error(m, b, x, NULL, TT_ERROR_NON_FINITE, 1, 1, "-inf in the initial guess");
     x[1] = 0.25;
 
     {
@@ -738,7 +751,7 @@ static void test_cg_errors(void)
             h.col = cl2;
             h.value = vl2;
             /* [[2,1],[1,3]] x = [3,4]  ->  x = [1, 1] */
-            CHECK(tt_cg_solve(&h, b2, x2, NULL, &rep, NULL) == TT_OK && near(x2[0], 1.0, 1e-9) &&
+            CHECK(tt_cg_solve(&h, b2, NULL, NULL, x2, &rep, NULL) == TT_OK && near(x2[0], 1.0, 1e-9) &&
                       near(x2[1], 1.0, 1e-9) && rep.iterations <= 2,
                   "unsorted CSR with repeated columns: x = %g %g in %d steps", x2[0], x2[1], rep.iterations);
         }
@@ -748,25 +761,26 @@ static void test_cg_errors(void)
     bad = cg_small(2, 2, indefinite);
     b[1] = 0.0;
     x[0] = x[1] = 0.0;
-    cg_expect_solve_error(&bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, -2, 0, "indefinite 2 x 2");
-    tt_sparse_free(&bad);
+    cg_expect_solve_error(bad, b, x, NULL, TT_ERROR_NOT_POSITIVE_DEFINITE, -2, 0, "indefinite 2 x 2");
+    tt_sparse_matrix_free(bad);
     b[1] = 2.0;
 
     {
         /* 0 x 0 and 1 x 1 systems. */
-        tt_sparse_matrix e;
+        tt_sparse_matrix *e = NULL;
         tt_cg_report rep;
         double one = 4.0, sol = 0.0;
-        tt_sparse_from_triplets(&e, 0, 0, NULL, 0, NULL, NULL);
-        CHECK(tt_cg_solve(&e, b, x, NULL, &rep, NULL) == TT_OK && rep.converged && rep.iterations == 0,
+        tt_sparse_from_triplets(0, 0, NULL, 0, NULL, &e, NULL);
+        CHECK(e && tt_cg_solve(e, b, NULL, NULL, x, &rep, NULL) == TT_OK && rep.converged && rep.iterations == 0,
               "0 x 0 system: should succeed at once");
-        tt_sparse_free(&e);
+        tt_sparse_matrix_free(e);
         e = cg_small(1, 1, &one);
-        CHECK(tt_cg_solve(&e, b, &sol, NULL, &rep, NULL) == TT_OK && near(sol, 0.25, 1e-15) && rep.iterations == 1,
+        CHECK(e && tt_cg_solve(e, b, NULL, NULL, &sol, &rep, NULL) == TT_OK && near(sol, 0.25, 1e-15) &&
+                  rep.iterations == 1,
               "1 x 1: 4 x = 1 gave %g in %d steps", sol, rep.iterations);
-        tt_sparse_free(&e);
+        tt_sparse_matrix_free(e);
     }
-    tt_sparse_free(&m);
+    tt_sparse_matrix_free(m);
 }
 
 typedef struct cg_oom_ctx {
@@ -778,29 +792,26 @@ typedef struct cg_oom_ctx {
 static tt_result cg_oom_triplets(void *ctx, const tt_allocator *al)
 {
     cg_oom_ctx *c = (cg_oom_ctx *)ctx;
-    tt_sparse_matrix m;
+    tt_sparse_matrix *m = (tt_sparse_matrix *)&m;
     tt_error err;
-    tt_result r = tt_sparse_from_triplets(&m, c->n, c->n, c->t, c->count, al, &err);
-    if (r == TT_OK) tt_sparse_free(&m);
-    else if (m.row_start || m.col || m.value || err.result != r) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_sparse_from_triplets(c->n, c->n, c->t, c->count, al, &m, &err);
+    if (r == TT_OK) tt_sparse_matrix_free(m);
+    else if (m != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
 static tt_result cg_oom_solve(void *ctx, const tt_allocator *al)
 {
     cg_oom_ctx *c = (cg_oom_ctx *)ctx;
-    tt_sparse_matrix m;
-    tt_cg_options opt;
+    tt_sparse_matrix *m = NULL;
     tt_error err;
     tt_result r;
     double x[64];
     memset(x, 0, sizeof x);
-    if (tt_sparse_from_triplets(&m, c->n, c->n, c->t, c->count, NULL, NULL) != TT_OK) return TT_RESULT_MAX_ENUM;
-    memset(&opt, 0, sizeof opt);
-    opt.allocator = *al;
-    r = tt_cg_solve(&m, c->b, x, &opt, NULL, &err);
+    if (tt_sparse_from_triplets(c->n, c->n, c->t, c->count, NULL, &m, NULL) != TT_OK) return TT_RESULT_MAX_ENUM;
+    r = tt_cg_solve(m, c->b, NULL, al, x, NULL, &err);
     if (r != TT_OK && err.result != r) r = TT_RESULT_MAX_ENUM;
-    tt_sparse_free(&m);
+    tt_sparse_matrix_free(m);
     return r;
 }
 
@@ -823,6 +834,200 @@ static void test_cg_oom(void)
     oom_sweep("tt_cg_solve(b = 0)", cg_oom_solve, &c, TT_OK);
 }
 
+/* ------------------------------------------------------------------------ */
+/* Hostile right-hand sides and entries (the cases)                 */
+/* ------------------------------------------------------------------------ */
+
+/* Solve A x = b (A dense n x n, SPD) with tt_cg_solve from x = 0 and with
+   the dense Cholesky reference; returns max |x - x_ref| / max |x_ref| (or
+   -1 when the solve did not converge) and fills *rep. */
+static double cg_solve_vs_dense(const double *dense, int n, const double *b, double *x, tt_cg_report *rep,
+                                tt_result *result, double *ref)
+{
+    double *chol = (double *)malloc(sizeof(double) * (size_t)n * n), num = 0.0, den = 0.0;
+    tt_sparse_matrix *m = cg_small(n, n, dense);
+    int i;
+    memcpy(chol, dense, sizeof(double) * (size_t)n * n);
+    *result = TT_RESULT_MAX_ENUM;
+    memset(rep, 0, sizeof *rep);
+    if (!m || !cg_dense_cholesky_solve(chol, n, b, ref)) {
+        free(chol);
+        tt_sparse_matrix_free(m);
+        return -2.0;
+    }
+    memset(x, 0, sizeof(double) * (size_t)n);
+    *result = tt_cg_solve(m, b, NULL, NULL, x, rep, NULL);
+    for (i = 0; i < n; i++) {
+        num = fmax(num, fabs(x[i] - ref[i]));
+        den = fmax(den, fabs(ref[i]));
+    }
+    free(chol);
+    tt_sparse_matrix_free(m);
+    return den > 0.0 ? num / den : num;
+}
+
+static void test_cg_hostile_rhs(void)
+{
+    static const double a2[4] = {4, 1, 1, 3};
+    static const double a5[25] = {10, 1, 0, 2, 0,  1, 8, 1, 0, 0,  0, 1, 6, 1, 1,  2, 0, 1, 9, 3,  0, 0, 1, 3, 7};
+    double x[5], ref[5], b[5], rel;
+    tt_cg_report rep;
+    tt_result r;
+    int i, k;
+
+    /* b = (1e155, 1): |b|^2 overflows double without scaling. */
+    b[0] = 1e155;
+    b[1] = 1.0;
+    rel = cg_solve_vs_dense(a2, 2, b, x, &rep, &r, ref);
+    CHECK(r == TT_OK && rep.converged && rep.iterations > 0 && rel >= 0.0 && rel <= 1e-8 && x[0] != 0.0,
+          "b = (1e155, 1): result %d, %d steps, x = (%g, %g), reference (%g, %g), relative error %g", r,
+          rep.iterations, x[0], x[1], ref[0], ref[1], rel);
+    /* the same on 5 unknowns, mixed signs and sizes */
+    b[0] = 1e155; b[1] = 1.0; b[2] = -3e154; b[3] = 1e-10; b[4] = 7e153;
+    rel = cg_solve_vs_dense(a5, 5, b, x, &rep, &r, ref);
+    CHECK(r == TT_OK && rep.converged && rel >= 0.0 && rel <= 1e-7,
+          "b = (1e155, 1, -3e154, 1e-10, 7e153): result %d, %d steps, relative error %g", r, rep.iterations, rel);
+    /* near the top of the double range: b_i = 1e300 */
+    for (i = 0; i < 5; i++) b[i] = (i % 2 ? -1e300 : 1e300);
+    rel = cg_solve_vs_dense(a5, 5, b, x, &rep, &r, ref);
+    CHECK(r == TT_OK && rep.converged && rel >= 0.0 && rel <= 1e-7, "b = +-1e300: result %d, relative error %g", r,
+          rel);
+
+    /* All |b_i| below 1e-162: |b|^2 underflows to 0 without scaling, and
+       x = 0 would look converged. x must be the reference times 1e-200. */
+    for (k = 0; k < 2; k++) {
+        const double *a = k ? a5 : a2;
+        int n = k ? 5 : 2;
+        double normal[5] = {1.0, -2.0, 0.5, 3.0, -1.25}, xn[5], refn[5], worst = 0.0, top = 0.0;
+        tt_result rn;
+        tt_cg_report repn;
+        cg_solve_vs_dense(a, n, normal, xn, &repn, &rn, refn);
+        for (i = 0; i < n; i++) b[i] = normal[i] * 1e-200;
+        cg_solve_vs_dense(a, n, b, x, &rep, &r, ref);
+        for (i = 0; i < n; i++) {
+            worst = fmax(worst, fabs(x[i] - refn[i] * 1e-200));
+            top = fmax(top, fabs(refn[i] * 1e-200));
+        }
+        CHECK(rn == TT_OK && r == TT_OK && rep.converged && rep.iterations > 0 && top > 0.0 && worst <= 1e-6 * top,
+              "%d x %d, b = 1e-200 * normal b: result %d, %d steps, converged %d, x[0] = %g (expected %g), "
+              "max error %g of %g", n, n, r, rep.iterations, rep.converged, x[0], refn[0] * 1e-200, worst, top);
+    }
+    /* denormal b: 1e-310 */
+    b[0] = 1e-310;
+    b[1] = -4e-310;
+    rel = cg_solve_vs_dense(a2, 2, b, x, &rep, &r, ref);
+    CHECK(r == TT_OK && rep.converged && rep.iterations > 0 && x[0] != 0.0,
+          "subnormal b = (1e-310, -4e-310): result %d, %d steps, x = (%g, %g), reference (%g, %g)", r, rep.iterations,
+          x[0], x[1], ref[0], ref[1]);
+
+    /* b = 0: x = 0 exactly, at once, from any start. */
+    {
+        tt_sparse_matrix *m = cg_small(5, 5, a5);
+        double zero[5] = {0, 0, 0, 0, -0.0};
+        for (i = 0; i < 5; i++) x[i] = 1.0 + i;
+        r = m ? tt_cg_solve(m, zero, NULL, NULL, x, &rep, NULL) : TT_RESULT_MAX_ENUM;
+        for (i = 0; i < 5 && x[i] == 0.0; i++) continue;
+        CHECK(r == TT_OK && i == 5 && rep.converged && rep.iterations == 0 && rep.residual == 0.0,
+              "b = 0: result %d, %d of 5 zeros, %d steps", r, i, rep.iterations);
+        tt_sparse_matrix_free(m);
+    }
+}
+
+/* Finite triplets of one entry whose sum overflows: TT_ERROR_NON_FINITE
+   naming the entry (row, column) and the triplet (item), *out NULL, no leak. */
+static void test_cg_triplet_overflow(void)
+{
+    tt_triplet t[5] = {{0, 0, 1.0}, {1, 2, 1e308}, {2, 2, 5.0}, {1, 0, 2.0}, {1, 2, 1e308}};
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    tt_sparse_matrix *m = (tt_sparse_matrix *)&m;
+    tt_error err;
+    tt_result r;
+    int sign;
+    for (sign = 0; sign < 2; sign++) {
+        t[1].value = t[4].value = sign ? -1e308 : 1e308;
+        memset(&err, 0x5a, sizeof err);
+        m = (tt_sparse_matrix *)&m;
+        r = tt_sparse_from_triplets(3, 3, t, 5, &al, &m, &err);
+        CHECK(r == TT_ERROR_NON_FINITE && err.result == r && m == NULL,
+              "%s1e308 twice on entry (1, 2): expected TT_ERROR_NON_FINITE and *out NULL, got %d", sign ? "-" : "", r);
+        CHECK(err.row == 1 && err.column == 2 && err.vertex == -1 && err.other_vertex == -1,
+              "overflowing entry: row/column expected 1/2, got %d/%d (vertex %d, other_vertex %d)", err.row,
+              err.column, err.vertex, err.other_vertex);
+        CHECK(err.item == 4 || err.item == 1, "overflowing entry: item should name triplet 4 (or 1), got %d",
+              err.item);
+        CHECK(err.message[0] != '\0' && msg_has_number(err.message, 1) && msg_has_number(err.message, 2),
+              "overflowing entry: the message should name row 1 and column 2: %s", err.message);
+        CHECK(cnt.live == 0 && cnt.bad_frees == 0, "overflowing entry: %ld allocations leaked", cnt.live);
+    }
+    /* Large but finite sums are fine: 1e308 + (-1e308) = 0 stays in the pattern. */
+    t[1].value = 1e308;
+    t[4].value = -1e308;
+    m = NULL;
+    r = tt_sparse_from_triplets(3, 3, t, 5, &al, &m, &err);
+    CHECK(r == TT_OK && m && m->nnz == 4, "1e308 - 1e308: result %d, nnz %d", r, m ? m->nnz : -1);
+    tt_sparse_matrix_free(m);
+    CHECK(cnt.live == 0, "triplet overflow: %ld allocations leaked", cnt.live);
+}
+
+typedef struct overflow_ctx {
+    const tt_triplet *t;
+    int count;
+} overflow_ctx;
+
+static tt_result cg_oom_overflow(void *ctx, const tt_allocator *al)
+{
+    overflow_ctx *c = (overflow_ctx *)ctx;
+    tt_sparse_matrix *m = (tt_sparse_matrix *)&m;
+    tt_error err;
+    tt_result r = tt_sparse_from_triplets(3, 3, c->t, c->count, al, &m, &err);
+    if (r == TT_OK) tt_sparse_matrix_free(m);
+    else if (m != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+/* Errors about matrix entries come in error->row / column, not in vertex. */
+static void test_cg_entry_errors(void)
+{
+    static const double spd[9] = {4, 1, 0, 1, 3, 1, 0, 1, 2};
+    tt_sparse_matrix *m = cg_small(3, 3, spd);
+    double b[3] = {1, 2, 3}, x[3] = {0, 0, 0};
+    tt_error err;
+    if (!m) { CHECK(0, "cg_small"); return; }
+    m->value[4] = INFINITY;   /* row 1: (1,0) (1,1) (1,2) are entries 2, 3, 4 */
+    CHECK(tt_cg_solve(m, b, NULL, NULL, x, NULL, &err) == TT_ERROR_NON_FINITE && err.row == 1 && err.column == 2 &&
+              err.vertex == -1 && err.other_vertex == -1 && err.face == -1,
+          "inf at (1, 2): row %d, column %d, vertex %d, other_vertex %d", err.row, err.column, err.vertex,
+          err.other_vertex);
+    m->value[4] = 1.0;
+    m->value[6] = -2.0;   /* A[2][2]: row 2 is entries 5 (2,1) and 6 (2,2) */
+    CHECK(tt_cg_solve(m, b, NULL, NULL, x, NULL, &err) == TT_ERROR_NOT_POSITIVE_DEFINITE && err.row == 2 &&
+              err.vertex == -1,
+          "negative diagonal in row 2: row %d, column %d, vertex %d", err.row, err.column, err.vertex);
+    m->value[6] = 2.0;
+    b[1] = NAN;
+    CHECK(tt_cg_solve(m, b, NULL, NULL, x, NULL, &err) == TT_ERROR_NON_FINITE && err.row == 1 && err.vertex == -1,
+          "NaN in b[1]: row %d, vertex %d", err.row, err.vertex);
+    b[1] = 2.0;
+    {
+        tt_triplet t[2] = {{0, 0, 1.0}, {0, 3, 1.0}};
+        tt_sparse_matrix *out = (tt_sparse_matrix *)&out;
+        CHECK(tt_sparse_from_triplets(3, 3, t, 2, NULL, &out, &err) == TT_ERROR_INDEX_OUT_OF_RANGE && out == NULL &&
+                  err.row == 0 && err.column == 3 && err.item == 1 && err.vertex == -1 && err.other_vertex == -1,
+              "triplet 1 at (0, 3) of a 3 x 3: row %d, column %d, item %d, vertex %d", err.row, err.column, err.item,
+              err.vertex);
+    }
+    {
+        overflow_ctx c;
+        static const tt_triplet t[5] = {{0, 0, 1.0}, {1, 2, 1e308}, {2, 2, 5.0}, {1, 0, 2.0}, {1, 2, 1e308}};
+        c.t = t;
+        c.count = 5;
+        oom_reset();
+        oom_sweep("tt_sparse_from_triplets(overflowing entry)", cg_oom_overflow, &c, TT_ERROR_NON_FINITE);
+    }
+    tt_sparse_matrix_free(m);
+}
+
 void run_numerics_tests(void)
 {
     RUN(test_cg_triplets);
@@ -833,4 +1038,7 @@ void run_numerics_tests(void)
     RUN(test_cg_progress);
     RUN(test_cg_errors);
     RUN(test_cg_oom);
+    RUN(test_cg_hostile_rhs);
+    RUN(test_cg_triplet_overflow);
+    RUN(test_cg_entry_errors);
 }

@@ -267,7 +267,7 @@ tt_result build(const tmesh *m, unsigned flags, tt_mesh **out, tt_error *err)
 {
     tt_mesh_desc d = tm_desc(m);
     d.flags = flags;
-    return tt_mesh_build(&d, out, err);
+    return tt_mesh_build(&d, NULL, out, err);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -276,13 +276,19 @@ tt_result build(const tmesh *m, unsigned flags, tt_mesh **out, tt_error *err)
 
 float *px(const tt_image *im, int x, int y) { return im->pixels + ((size_t)y * im->width + x) * 4; }
 
-void make_value_noise(tt_image *im, int w, int h, unsigned seed)
+void make_value_noise(tt_image **out, int w, int h, unsigned seed)
 {
     static const int scales[3] = {6, 13, 29};
     static const double weights[3] = {0.12, 0.16, 0.2};
     float lattice[3][64][64];
     int x, y, k, s;
-    tt_image_create(im, w, h, NULL);
+    tt_image *im;
+    tt_result r = tt_image_create(w, h, NULL, out, NULL);
+    if (r != TT_OK) {
+        CHECK(0, "make_value_noise: tt_image_create(%d, %d) returned %d", w, h, r);
+        return;
+    }
+    im = *out;
     lcg_seed(seed);
     for (s = 0; s < 3; s++)
         for (y = 0; y < 64; y++)

@@ -64,9 +64,10 @@ tt_allocator make_allocator(counter *c, long fail_at);
    it broke its contract, e.g. an output not reset on failure). */
 typedef tt_result (*oom_call)(void *ctx, const tt_allocator *allocator);
 
-/* The allocator and counter every OOM sweep uses. Objects built through it
-   before a sweep (meshes whose own allocator is this one) stay live: a run
-   must leave `live` where it found it. oom_reset() zeroes the counter. */
+/* The allocator and counter every OOM sweep uses: the call passes it as the
+   allocator parameter of the function under test. Objects built through it
+   before a sweep stay live: a run must leave `live` where it found it.
+   oom_reset() zeroes the counter. */
 extern counter g_oom_counter;
 extern tt_allocator g_oom_allocator;
 void oom_reset(void);
@@ -112,7 +113,7 @@ int tm_vert(tmesh *m, double x, double y, double z);   /* returns the new vertex
 void tm_face(tmesh *m, int n, const int *v);
 void tm_tri(tmesh *m, int a, int b, int c);
 void tm_quad(tmesh *m, int a, int b, int c, int d);
-tt_mesh_desc tm_desc(const tmesh *m);   /* borrows m's arrays; flags 0, default allocator */
+tt_mesh_desc tm_desc(const tmesh *m);   /* borrows m's arrays; flags 0 */
 
 /* Regular tetrahedron-ish: 4 vertices, 4 triangles, outward CCW. */
 void make_tetra(tmesh *m, double ox);
@@ -121,7 +122,7 @@ void make_torus(tmesh *m, int nu, int nv, double R, double r);
 /* Open nx x ny grid of unit quads in the plane z = 0. */
 void make_grid(tmesh *m, int nx, int ny);
 
-/* tt_mesh_build of m with `flags` and the default allocator. */
+/* tt_mesh_build of m with `flags` and the default allocator (NULL). */
 tt_result build(const tmesh *m, unsigned flags, tt_mesh **out, tt_error *err);
 
 /* ------------------------------------------------------------------------ */
@@ -134,8 +135,10 @@ float *px(const tt_image *im, int x, int y);
 /* Photograph-like: value noise at 6, 13 and 29 texel scales plus grain. A row
    of it looks different from its own mirror image, as rows of real textures
    do, so tiles that do not belong together show (the seam test shuffles).
-   Creates im (w x h, opaque) with the default allocator; reseeds the LCG. */
-void make_value_noise(tt_image *im, int w, int h, unsigned seed);
+   Creates *im (w x h, opaque, linear values used as they are) with the
+   default allocator (free it with tt_image_free; *im is NULL, and a CHECK
+   fails, if it cannot be created); reseeds the LCG. */
+void make_value_noise(tt_image **im, int w, int h, unsigned seed);
 
 /* ------------------------------------------------------------------------ */
 /* Internal functions of the implementation the tests call                  */
