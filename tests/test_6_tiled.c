@@ -1092,7 +1092,7 @@ static void test_seams(void)
     tmesh m;
     tt_mesh *mesh = NULL;
     tt_error err;
-    tt_image *src;
+    tt_image *src = NULL;
     tt_synth_options opt;
     tt_tileset *set = NULL;
     uint8_t *types;
@@ -1107,7 +1107,7 @@ static void test_seams(void)
     tm_free(&m);
     CHECK(r == TT_OK, "seam torus build %d", r);
     if (r != TT_OK) return;
-    src = make_value_noise(160, 256, 9);
+    make_value_noise(&src, 160, 256, 9);
     CHECK(src != NULL, "make_value_noise");
     if (!src) { tt_mesh_free(mesh); return; }
     types = (uint8_t *)malloc((size_t)mesh->ncorners);
@@ -1207,7 +1207,7 @@ static void test_seams_control(void)
     tmesh m;
     tt_mesh *mesh = NULL;
     tt_error err;
-    tt_image *src;
+    tt_image *src = NULL;
     tt_synth_options opt;
     tt_tileset *set = NULL;
     uint8_t *types;
@@ -1221,7 +1221,7 @@ static void test_seams_control(void)
     tm_free(&m);
     CHECK(r == TT_OK, "control torus build %d", r);
     if (r != TT_OK) return;
-    src = make_value_noise(160, 256, 21);
+    make_value_noise(&src, 160, 256, 21);
     memset(&opt, 0, sizeof opt);
     opt.layout = make_layout(2, 32, 4);
     opt.seed = 4;
@@ -1322,10 +1322,11 @@ static void test_seams_not_measured(void)
 {
     tmesh m;
     tt_mesh *quad = NULL, *pair = NULL, *torus = NULL;
-    tt_image *atlas = make_value_noise(64, 64, 3);
+    tt_image *atlas = NULL;
     tt_error err;
     float *uv;
     int c;
+    make_value_noise(&atlas, 64, 64, 3);
     memset(&m, 0, sizeof m);
     make_grid(&m, 1, 1);
     CHECK(build(&m, 0, &quad, &err) == TT_OK, "one quad build");
@@ -1372,7 +1373,7 @@ static void test_seams_sampled(void)
     tmesh m;
     tt_mesh *mesh = NULL;
     tt_error err;
-    tt_image *src;
+    tt_image *src = NULL;
     tt_synth_options opt;
     tt_tileset *set = NULL;
     uint8_t *types;
@@ -1388,7 +1389,7 @@ static void test_seams_sampled(void)
     CHECK(r == TT_OK, "sampled torus build %d", r);
     if (r != TT_OK) return;
     interior = 2 * mesh->nfaces;
-    src = make_value_noise(128, 256, 17);
+    make_value_noise(&src, 128, 256, 17);
     memset(&opt, 0, sizeof opt);
     opt.layout = make_layout(1, 32, 4);
     opt.seed = 2;
@@ -1467,11 +1468,12 @@ static void test_seams_oom(void)
     tmesh m;
     tt_mesh *mesh = NULL;
     tt_error err;
-    tt_image *atlas = make_value_noise(64, 64, 4);
+    tt_image *atlas = NULL;
     tt_tile_layout l = make_layout(1, 12, 2);
     uint8_t types[4 * 48];
     float uv[8 * 48];
     seams_ctx s;
+    make_value_noise(&atlas, 64, 64, 4);
     memset(&m, 0, sizeof m);
     make_torus(&m, 8, 6, 3, 1);
     if (build(&m, 0, &mesh, &err) != TT_OK || !atlas) {
