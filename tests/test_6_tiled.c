@@ -83,6 +83,50 @@ static void test_layout(void)
     in = make_layout(1, 32, -2);
     CHECK(tt_tile_layout_resolve(&in, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "gutter -2 rejected");
     CHECK(tt_tile_layout_resolve(NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL layout rejected");
+    CHECK(tt_tile_layout_resolve(&in, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL output rejected");
+
+    /* Layouts whose figures would overflow an int are refused by resolve.
+       (tt_tile_layout_tiles_per_side / atlas_size / tile_count give 0 for
+       them but fail TT_ASSERT, which aborts this debug build, so they are
+       called here only on layouts that resolve.) */
+    {
+        static const struct { int colors, size, gutter; tt_result expect; } bad[] = {
+            {1000, 16, 2, TT_ERROR_INVALID_ARGUMENT},   {-5, 16, 2, TT_ERROR_INVALID_ARGUMENT},
+            {2147483647, 16, 2, TT_ERROR_INVALID_ARGUMENT}, {-2147483647 - 1, 16, 2, TT_ERROR_INVALID_ARGUMENT},
+            {1, 2147483647, 0, TT_ERROR_TOO_LARGE},     {1, -2147483647 - 1, 0, TT_ERROR_INVALID_ARGUMENT},
+            {1, 16, 2147483647, TT_ERROR_INVALID_ARGUMENT}, {1, 16, -2147483647 - 1, TT_ERROR_INVALID_ARGUMENT},
+            {TT_MAX_COLORS, 32768, 32768, TT_ERROR_TOO_LARGE}, {46, 4, 0, TT_ERROR_TOO_LARGE},
+            {1, 32768, 1, TT_ERROR_TOO_LARGE},          {8, 128, 4, TT_ERROR_TOO_LARGE}};
+        int i;
+        for (i = 0; i < (int)(sizeof bad / sizeof bad[0]); i++) {
+            tt_tile_layout o;
+            memset(&o, 0x5a, sizeof o);
+            in = make_layout(bad[i].colors, bad[i].size, bad[i].gutter);
+            memset(&err, 0, sizeof err);
+            r = tt_tile_layout_resolve(&in, &o, &err);
+            CHECK(r == bad[i].expect && err.result == r && err.message[0] && o.colors == 0x5a5a5a5a,
+                  "layout {%d, %d, %d}: expected %d with a message and the output untouched, got %d (%s)",
+                  bad[i].colors, bad[i].size, bad[i].gutter, bad[i].expect, r, err.message);
+        }
+    }
+    /* the largest layouts that resolve: n = 45 with 4-texel tiles (the bound
+       in tt_tile_layout's comment), n = 7 with 128-texel tiles and gutter 4 */
+    in = make_layout(45, 4, 0);
+    r = tt_tile_layout_resolve(&in, &out, &err);
+    CHECK(r == TT_OK && tt_tile_layout_tiles_per_side(&out) == 8100 && tt_tile_layout_atlas_size(&out) == 32400 &&
+              tt_tile_layout_tile_count(&out) == 8100 * 8100,
+          "n=45, S=4: %d, T %d, W %d, count %d", r, r == TT_OK ? tt_tile_layout_tiles_per_side(&out) : -1,
+          r == TT_OK ? tt_tile_layout_atlas_size(&out) : -1, r == TT_OK ? tt_tile_layout_tile_count(&out) : -1);
+    in = make_layout(7, 128, 4);
+    r = tt_tile_layout_resolve(&in, &out, &err);
+    CHECK(r == TT_OK && tt_tile_layout_atlas_size(&out) == 196 * 136,
+          "n=7, S=128, g=4: %d, W %d (want %d)", r, r == TT_OK ? tt_tile_layout_atlas_size(&out) : -1, 196 * 136);
+    /* the figures accept an unresolved layout (zeros mean defaults) */
+    in = make_layout(0, 0, 3);
+    CHECK(tt_tile_layout_tiles_per_side(&in) == 4 && tt_tile_layout_atlas_size(&in) == 4 * 134 &&
+              tt_tile_layout_tile_count(&in) == 16,
+          "layout {0, 0, 3}: T %d, W %d, count %d (want 4, 536, 16)", tt_tile_layout_tiles_per_side(&in),
+          tt_tile_layout_atlas_size(&in), tt_tile_layout_tile_count(&in));
 }
 
 static void check_boundaries(const tt_mesh *mesh, int n, const char *name)
@@ -91,8 +135,9 @@ static void check_boundaries(const tt_mesh *mesh, int n, const char *name)
     tt_tile_layout l = make_layout(n, 32, 4);
     int c, bad_pair = 0, bad_range = 0, differ = 0, *used = (int *)calloc((size_t)2 * n, sizeof(int));
     tt_result r;
+    tt_error err;
     memset(a, 0xee, (size_t)mesh->ncorners);
-    r = tt_assign_boundaries(mesh, &l, 1234, a);
+    r = tt_assign_boundaries(mesh, &l, 1234, NULL, a, &err);
     CHECK(r == TT_OK, "%s n=%d: assign_boundaries returned %d", name, n, r);
     for (c = 0; c < mesh->ncorners; c++) {
         int t = mesh->twin[c];
@@ -107,9 +152,9 @@ static void check_boundaries(const tt_mesh *mesh, int n, const char *name)
         for (k = 0; k < 2 * n; k++) unused += used[k] == 0;
         CHECK(unused == 0, "%s n=%d: %d of %d types never used", name, n, unused, 2 * n);
     }
-    tt_assign_boundaries(mesh, &l, 1234, b);
+    tt_assign_boundaries(mesh, &l, 1234, NULL, b, NULL);
     CHECK(memcmp(a, b, (size_t)mesh->ncorners) == 0, "%s n=%d: same seed should give the same types", name, n);
-    tt_assign_boundaries(mesh, &l, 1235, b);
+    tt_assign_boundaries(mesh, &l, 1235, NULL, b, NULL);
     for (c = 0; c < mesh->ncorners; c++) differ += a[c] != b[c];
     CHECK(differ > 0, "%s n=%d: seeds 1234 and 1235 gave identical types", name, n);
     free(a);
@@ -147,16 +192,24 @@ static void test_boundaries_uvs(void)
     {
         uint8_t types[64];
         tt_tile_layout l = make_layout(0, 0, 0);
-        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_OK, "colors 0 (= 1) accepted");
-        CHECK(tt_assign_boundaries(tet, NULL, 1, types) == TT_OK, "layout NULL (= 1 color) accepted");
+        tt_result r;
+        CHECK(tt_assign_boundaries(tet, &l, 1, NULL, types, &err) == TT_OK, "colors 0 (= 1) accepted");
+        /* the layout is no longer optional (THE API CONTRACT: NULL is bad input) */
+        r = tt_assign_boundaries(tet, NULL, 1, NULL, types, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0],
+              "layout NULL: expected TT_ERROR_INVALID_ARGUMENT with a message, got %d", r);
         l.colors = -1;
-        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_ERROR_INVALID_ARGUMENT, "colors -1 rejected");
+        CHECK(tt_assign_boundaries(tet, &l, 1, NULL, types, &err) == TT_ERROR_INVALID_ARGUMENT && err.message[0],
+              "colors -1 rejected");
         l.colors = TT_MAX_COLORS + 1;
-        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_ERROR_INVALID_ARGUMENT, "colors TT_MAX_COLORS+1 rejected");
+        CHECK(tt_assign_boundaries(tet, &l, 1, NULL, types, &err) == TT_ERROR_INVALID_ARGUMENT,
+              "colors TT_MAX_COLORS+1 rejected");
         l.colors = TT_MAX_COLORS;
-        CHECK(tt_assign_boundaries(tet, &l, 1, types) == TT_OK, "colors TT_MAX_COLORS accepted by assign_boundaries");
-        CHECK(tt_assign_boundaries(NULL, &l, 1, types) == TT_ERROR_INVALID_ARGUMENT, "mesh NULL rejected");
-        CHECK(tt_assign_boundaries(tet, &l, 1, NULL) == TT_ERROR_INVALID_ARGUMENT, "types NULL rejected");
+        CHECK(tt_assign_boundaries(tet, &l, 1, NULL, types, &err) == TT_OK,
+              "colors TT_MAX_COLORS accepted by assign_boundaries");
+        CHECK(tt_assign_boundaries(NULL, &l, 1, NULL, types, &err) == TT_ERROR_INVALID_ARGUMENT, "mesh NULL rejected");
+        CHECK(tt_assign_boundaries(tet, &l, 1, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "types NULL rejected");
+        CHECK(tt_assign_boundaries(tet, &l, 1, NULL, types, NULL) == TT_OK, "error NULL is fine");
     }
 
     /* assign_uvs: not quads */
@@ -165,20 +218,28 @@ static void test_boundaries_uvs(void)
         float uv[128];
         tt_tile_layout l = make_layout(1, 32, 4);
         tt_result r;
-        tt_assign_boundaries(tet, &l, 1, types);
+        tt_assign_boundaries(tet, &l, 1, NULL, types, NULL);
         r = tt_assign_uvs(tet, &l, types, uv, &err);
         CHECK(r == TT_ERROR_NOT_QUAD_MESH && err.face == 0 && msg_has_number(err.message, 0),
               "tetrahedron: expected TT_ERROR_NOT_QUAD_MESH naming face 0, got %d face %d \"%s\"", r, err.face,
               err.message);
-        tt_assign_boundaries(mixed, &l, 1, types);
+        tt_assign_boundaries(mixed, &l, 1, NULL, types, NULL);
         r = tt_assign_uvs(mixed, &l, types, uv, &err);
         CHECK(r == TT_ERROR_NOT_QUAD_MESH && err.face == 6 && err.corner == 24 && msg_has_number(err.message, 6),
               "grid + triangle: expected TT_ERROR_NOT_QUAD_MESH naming face 6 (corner 24), got %d face %d corner %d \"%s\"",
               r, err.face, err.corner, err.message);
         {
             int counts[16];
-            CHECK(tt_tile_histogram(mixed, &l, types, counts) == TT_ERROR_NOT_QUAD_MESH,
-                  "tile histogram on a mesh with a triangle: TT_ERROR_NOT_QUAD_MESH");
+            memset(&err, 0, sizeof err);
+            r = tt_tile_histogram(mixed, &l, types, counts, &err);
+            CHECK(r == TT_ERROR_NOT_QUAD_MESH && err.result == r && err.face == 6 && err.corner == 24 &&
+                      msg_has_number(err.message, 6),
+                  "tile histogram on a mesh with a triangle: expected TT_ERROR_NOT_QUAD_MESH naming face 6 "
+                  "(corner 24), got %d face %d corner %d \"%s\"", r, err.face, err.corner, err.message);
+            r = tt_tile_histogram(tet, &l, types, counts, &err);
+            CHECK(r == TT_ERROR_NOT_QUAD_MESH && err.face == 0 && err.corner == 0,
+                  "tile histogram on a tetrahedron: expected TT_ERROR_NOT_QUAD_MESH naming face 0, got %d face %d",
+                  r, err.face);
         }
         CHECK(tt_assign_uvs(NULL, &l, types, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "assign_uvs mesh NULL");
         CHECK(tt_assign_uvs(grid, NULL, types, uv, &err) == TT_ERROR_INVALID_ARGUMENT, "assign_uvs layout NULL");
@@ -195,7 +256,7 @@ static void test_boundaries_uvs(void)
             int f, i, bad = 0;
             tt_result r;
             tt_tile_layout_resolve(&l, &res, NULL);
-            tt_assign_boundaries(torus, &l, 77 + (uint64_t)n, types);
+            tt_assign_boundaries(torus, &l, 77 + (uint64_t)n, NULL, types, NULL);
             r = tt_assign_uvs(torus, &l, types, uv, &err);
             CHECK(r == TT_OK, "assign_uvs n=%d: %d (%s)", n, r, err.message);
             for (f = 0; f < torus->nfaces && r == TT_OK; f++)
@@ -208,9 +269,15 @@ static void test_boundaries_uvs(void)
             /* a type out of range is rejected and named */
             types[13] = (uint8_t)(2 * n);
             r = tt_assign_uvs(torus, &l, types, uv, &err);
-            CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.corner == 13 && err.face == 3,
-                  "type %d at corner 13 (n=%d): expected TT_ERROR_INVALID_ARGUMENT at corner 13 face 3, got %d %d %d",
-                  2 * n, n, r, err.corner, err.face);
+            CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.result == r && err.corner == 13 && err.face == 3 &&
+                      msg_has_number(err.message, 13),
+                  "type %d at corner 13 (n=%d): expected TT_ERROR_INDEX_OUT_OF_RANGE at corner 13 face 3, got %d "
+                  "%d %d \"%s\"", 2 * n, n, r, err.corner, err.face, err.message);
+            types[13] = 255;
+            r = tt_assign_uvs(torus, &l, types, uv, &err);
+            CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.corner == 13,
+                  "type 255 at corner 13 (n=%d): expected TT_ERROR_INDEX_OUT_OF_RANGE at corner 13, got %d %d", n, r,
+                  err.corner);
             free(types);
             free(uv);
         }
@@ -219,6 +286,163 @@ static void test_boundaries_uvs(void)
     tt_mesh_free(grid);
     tt_mesh_free(tet);
     tt_mesh_free(mixed);
+}
+
+/* Prescribed edge colours on one mesh: kept where given (the twin's type is
+   the complement), drawn where -1, all -1 equals NULL, deterministic. */
+static void check_prescribed(const tt_mesh *mesh, int n, const char *name)
+{
+    size_t nc = (size_t)mesh->ncorners;
+    uint8_t *a = (uint8_t *)malloc(nc), *b = (uint8_t *)malloc(nc);
+    int *colors = (int *)malloc(sizeof(int) * nc), *drawn = (int *)calloc((size_t)n, sizeof(int));
+    tt_tile_layout l = make_layout(n, 16, 2);
+    int c, bad_kept = 0, bad_pair = 0, bad_range = 0, nprescribed = 0, nrandom = 0, sides[2] = {0, 0}, unused = 0, k;
+    tt_error err;
+    tt_result r;
+    lcg_seed(1000 + (unsigned)n);
+    /* per edge: -1 (random) about half the time, otherwise a colour */
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c];
+        if (t >= 0 && t < c) { colors[c] = colors[t]; continue; }
+        colors[c] = lcg_below(2) ? -1 : lcg_below(n);
+    }
+    memset(a, 0xee, nc);
+    r = tt_assign_boundaries(mesh, &l, 31, colors, a, &err);
+    CHECK(r == TT_OK, "%s n=%d: prescribed colours: %d (%s)", name, n, r, err.message);
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c];
+        if (a[c] >= 2 * n) { bad_range++; continue; }
+        if (t >= 0 && a[t] != (a[c] ^ 1)) bad_pair++;
+        if (t >= 0 && t < c) continue;   /* one count per edge */
+        if (colors[c] >= 0) {
+            nprescribed++;
+            sides[a[c] & 1]++;
+            if (a[c] >> 1 != colors[c]) {
+                if (!bad_kept) DETAIL("%s n=%d: corner %d prescribes %d, got type %d", name, n, c, colors[c], a[c]);
+                bad_kept++;
+            }
+        } else {
+            nrandom++;
+            drawn[a[c] >> 1]++;
+        }
+    }
+    CHECK(bad_range == 0, "%s n=%d prescribed: %d types outside 0..2n-1", name, n, bad_range);
+    CHECK(bad_pair == 0, "%s n=%d prescribed: %d twin pairs whose types are not 2k+i and 2k+1-i", name, n, bad_pair);
+    CHECK(bad_kept == 0 && nprescribed > 0, "%s n=%d: %d of %d prescribed colours not kept", name, n, bad_kept,
+          nprescribed);
+    /* sides come from the RNG on prescribed edges too */
+    if (nprescribed >= 40)
+        CHECK(sides[0] > nprescribed / 5 && sides[1] > nprescribed / 5,
+              "%s n=%d: prescribed edges got side 0 %d times and side 1 %d times", name, n, sides[0], sides[1]);
+    /* -1 entries are drawn at random: every colour shows up */
+    if (nrandom >= 30 * n) {
+        for (k = 0; k < n; k++) unused += drawn[k] == 0;
+        CHECK(unused == 0, "%s n=%d: %d of %d colours never drawn on %d random edges", name, n, unused, n, nrandom);
+    }
+    /* determinism */
+    memset(b, 0xee, nc);
+    tt_assign_boundaries(mesh, &l, 31, colors, b, NULL);
+    CHECK(memcmp(a, b, nc) == 0, "%s n=%d: same seed and colours should give the same types", name, n);
+    /* all -1 is NULL */
+    for (c = 0; c < mesh->ncorners; c++) colors[c] = -1;
+    r = tt_assign_boundaries(mesh, &l, 31, colors, a, &err);
+    tt_assign_boundaries(mesh, &l, 31, NULL, b, NULL);
+    CHECK(r == TT_OK && memcmp(a, b, nc) == 0, "%s n=%d: all -1 should equal edge_colors NULL (result %d)", name, n,
+          r);
+    /* all prescribed: every type's k is the prescription */
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c];
+        colors[c] = t >= 0 && t < c ? colors[t] : (c * 7 + 3) % n;
+    }
+    r = tt_assign_boundaries(mesh, &l, 32, colors, a, &err);
+    bad_kept = 0;
+    for (c = 0; c < mesh->ncorners; c++) bad_kept += a[c] >> 1 != colors[c];
+    CHECK(r == TT_OK && bad_kept == 0, "%s n=%d, every edge prescribed: %d, %d corners not kept", name, n, r,
+          bad_kept);
+    free(a);
+    free(b);
+    free(colors);
+    free(drawn);
+}
+
+static void test_prescribed_colors(void)
+{
+    tmesh m;
+    tt_mesh *torus = NULL, *grid = NULL;
+    tt_error err;
+    int n;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 24, 16, 3, 1);
+    CHECK(build(&m, 0, &torus, &err) == TT_OK, "torus build");
+    tm_free(&m);
+    make_grid(&m, 6, 5);
+    CHECK(build(&m, 0, &grid, &err) == TT_OK, "grid build");
+    tm_free(&m);
+    if (!torus || !grid) { tt_mesh_free(torus); tt_mesh_free(grid); return; }
+    for (n = 1; n <= 4; n++) {
+        check_prescribed(torus, n, "torus");
+        check_prescribed(grid, n, "open grid");
+    }
+    {
+        /* bad prescriptions on the open grid: on its first boundary
+           half-edge and on the first interior edge past face 0 */
+        int nc = grid->ncorners, c, t = -1, boundary = -1, interior = -1;
+        int *colors = (int *)malloc(sizeof(int) * (size_t)nc);
+        uint8_t *types = (uint8_t *)malloc((size_t)nc);
+        tt_tile_layout l = make_layout(3, 16, 2);
+        tt_result r;
+        for (c = 0; c < nc && (boundary < 0 || interior < 0); c++) {
+            if (grid->twin[c] < 0 && boundary < 0) boundary = c;
+            if (grid->twin[c] > c && interior < 0 && c > 4) interior = c;
+        }
+        t = grid->twin[interior];
+        for (c = 0; c < nc; c++) colors[c] = -1;
+        /* twins that disagree */
+        colors[interior] = 1;
+        colors[t] = 2;
+        memset(&err, 0, sizeof err);
+        r = tt_assign_boundaries(grid, &l, 1, colors, types, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && (err.corner == interior || err.corner == t) &&
+                  err.corner >= 0 && err.face == grid->corner_face[err.corner] &&
+                  msg_has_number(err.message, err.corner),
+              "twins %d and %d prescribing 1 and 2: expected TT_ERROR_INVALID_ARGUMENT naming one of them and its "
+              "face, got %d corner %d face %d \"%s\"", interior, t, r, err.corner, err.face, err.message);
+        /* one side given, the other -1: they disagree too */
+        colors[t] = -1;
+        r = tt_assign_boundaries(grid, &l, 1, colors, types, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && (err.corner == interior || err.corner == t),
+              "twins prescribing 1 and -1: expected TT_ERROR_INVALID_ARGUMENT naming one of them, got %d corner %d",
+              r, err.corner);
+        colors[t] = 1;
+        r = tt_assign_boundaries(grid, &l, 1, colors, types, &err);
+        CHECK(r == TT_OK && types[interior] >> 1 == 1 && types[t] >> 1 == 1,
+              "twins agreeing on 1: %d, types %d %d", r, types[interior], types[t]);
+        /* colours outside -1..n-1 */
+        colors[boundary] = 3;
+        memset(&err, 0, sizeof err);
+        r = tt_assign_boundaries(grid, &l, 1, colors, types, &err);
+        CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.result == r && err.corner == boundary &&
+                  err.face == grid->corner_face[boundary] && msg_has_number(err.message, boundary),
+              "colour 3 of 3 at boundary corner %d: expected TT_ERROR_INDEX_OUT_OF_RANGE naming it, got %d corner %d "
+              "face %d \"%s\"", boundary, r, err.corner, err.face, err.message);
+        colors[boundary] = -2;
+        r = tt_assign_boundaries(grid, &l, 1, colors, types, &err);
+        CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.corner == boundary,
+              "colour -2 at corner %d: expected TT_ERROR_INDEX_OUT_OF_RANGE, got %d corner %d", boundary, r,
+              err.corner);
+        colors[boundary] = -1;
+        colors[interior] = colors[t] = 1000;
+        r = tt_assign_boundaries(grid, &l, 1, colors, types, &err);
+        CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && (err.corner == interior || err.corner == t),
+              "colour 1000 on both sides of edge %d/%d: expected TT_ERROR_INDEX_OUT_OF_RANGE, got %d corner %d",
+              interior, t, r, err.corner);
+        colors[interior] = colors[t] = 2;
+        CHECK(tt_assign_boundaries(grid, &l, 1, colors, types, &err) == TT_OK, "colour n-1 = 2 accepted");
+        free(colors);
+        free(types);
+    }
+    tt_mesh_free(torus);
+    tt_mesh_free(grid);
 }
 
 static void test_tile_uv_index(void)
@@ -285,7 +509,7 @@ static void test_tile_uv_index(void)
                                           TT_ERROR_ZERO_AREA_FACE, TT_ERROR_NON_MANIFOLD_EDGE,
                                           TT_ERROR_INCONSISTENT_ORIENTATION, TT_ERROR_NON_MANIFOLD_VERTEX,
                                           TT_ERROR_NOT_QUAD_MESH, TT_ERROR_IMAGE_TOO_SMALL, TT_ERROR_NOT_CONVERGED,
-                                          TT_ERROR_NOT_POSITIVE_DEFINITE};
+                                          TT_ERROR_NOT_POSITIVE_DEFINITE, TT_ERROR_NOT_MEASURED};
         int a, b, bad = 0, n = (int)(sizeof codes / sizeof codes[0]);
         const char *unknown = tt_result_string((tt_result)-99);
         for (a = 0; a < n; a++) {
@@ -336,11 +560,13 @@ static void test_tile_uv_index(void)
 /* 6b. Tile-set synthesis                                                   */
 /* ------------------------------------------------------------------------ */
 
-/* Random-noise RGB source, opaque. */
-static void make_noise(tt_image *im, int w, int h, unsigned seed)
+/* Random-noise RGB source, opaque, linear values uniform in [0, 1); free
+   with tt_image_free. */
+static tt_image *make_noise(int w, int h, unsigned seed)
 {
+    tt_image *im = NULL;
     int i;
-    tt_image_create(im, w, h, NULL);
+    if (tt_image_create(w, h, NULL, &im, NULL) != TT_OK) return NULL;
     lcg_seed(seed);
     for (i = 0; i < w * h; i++) {
         im->pixels[4 * i] = (float)lcg_unit();
@@ -348,6 +574,7 @@ static void make_noise(tt_image *im, int w, int h, unsigned seed)
         im->pixels[4 * i + 2] = (float)lcg_unit();
         im->pixels[4 * i + 3] = 1.0f;
     }
+    return im;
 }
 
 typedef struct synth_view {
@@ -491,9 +718,10 @@ static void check_tileset(const tt_tileset *set, const tt_image *src, int feathe
 
 static void test_synthesis(void)
 {
-    tt_image src;
+    tt_image *src = make_noise(96, 192, 42);
     int n, gi;
-    make_noise(&src, 96, 192, 42);
+    CHECK(src != NULL, "make_noise");
+    if (!src) return;
     for (n = 1; n <= 2; n++)
         for (gi = 0; gi < 2; gi++) {
             tt_synth_options opt;
@@ -501,23 +729,25 @@ static void test_synthesis(void)
             tt_error err;
             tt_result r;
             counter cnt;
+            tt_allocator al = make_allocator(&cnt, -1);
             char name[64];
             memset(&opt, 0, sizeof opt);
             opt.layout = make_layout(n, 32, gi ? 4 : TT_NO_GUTTER);
             opt.seed = 7;
-            opt.allocator = make_allocator(&cnt, -1);
             sprintf(name, "noise n=%d gutter %d", n, gi ? 4 : 0);
-            r = tt_synthesize_tiles(&src, &opt, &set, &err);
+            r = tt_synthesize_tiles(src, &opt, &al, &set, &err);
             CHECK(r == TT_OK, "%s: synthesize returned %d (%s)", name, r, err.message);
             if (r != TT_OK) continue;
-            check_tileset(set, &src, 2, name);
-            r = tt_synthesize_tiles(&src, &opt, &again, &err);
+            CHECK(set->allocator.alloc == al.alloc && set->allocator.user_data == &cnt,
+                  "%s: the tileset should remember its allocator", name);
+            check_tileset(set, src, 2, name);
+            r = tt_synthesize_tiles(src, &opt, &al, &again, &err);
             CHECK(r == TT_OK && again->levels[0].width == set->levels[0].width &&
                       memcmp(again->levels[0].pixels, set->levels[0].pixels,
                              sizeof(float) * 4 * (size_t)set->levels[0].width * set->levels[0].height) == 0,
                   "%s: same seed should give a byte-identical atlas", name);
             opt.seed = 8;
-            r = tt_synthesize_tiles(&src, &opt, &other, &err);
+            r = tt_synthesize_tiles(src, &opt, &al, &other, &err);
             CHECK(r == TT_OK && other->levels[0].width == set->levels[0].width &&
                       memcmp(other->levels[0].pixels, set->levels[0].pixels,
                              sizeof(float) * 4 * (size_t)set->levels[0].width * set->levels[0].height) != 0,
@@ -542,7 +772,7 @@ static void test_synthesis(void)
         opt.background.x = 10; opt.background.y = 20; opt.background.w = 40; opt.background.h = 50;
         opt.feather = 4;
         opt.seed = 3;
-        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        r = tt_synthesize_tiles(src, &opt, NULL, &set, &err);
         CHECK(r == TT_OK, "given windows: synthesize returned %d (%s)", r, err.message);
         if (r == TT_OK) {
             int t, bad = 0;
@@ -554,19 +784,19 @@ static void test_synthesis(void)
                 if (b->x < 10 || b->y < 20 || b->x + 24 > 50 || b->y + 24 > 70) bad++;
             }
             CHECK(bad == 0, "%d background windows outside the background region", bad);
-            check_tileset(set, &src, 4, "given windows, feather 4, n=2, S=24, g=3");
+            check_tileset(set, src, 4, "given windows, feather 4, n=2, S=24, g=3");
             tt_tileset_free(set);
         }
         memset(&opt, 0, sizeof opt);
         opt.layout = make_layout(1, 64, 8);
-        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        r = tt_synthesize_tiles(src, &opt, NULL, &set, &err);
         CHECK(r == TT_OK, "S=64: %d (%s)", r, err.message);
         if (r == TT_OK) {
-            check_tileset(set, &src, 4, "n=1, S=64, g=8");
+            check_tileset(set, src, 4, "n=1, S=64, g=8");
             tt_tileset_free(set);
         }
     }
-    tt_image_free(&src);
+    tt_image_free(src);
 }
 
 static int g_progress_calls;
@@ -590,14 +820,13 @@ static int never_cancel(float fraction, void *user)
 
 static void expect_synth_error(const tt_image *src, const tt_synth_options *opt, tt_result code, const char *what)
 {
-    tt_synth_options o = *opt;
     tt_tileset *set = (tt_tileset *)&set;
     tt_error err;
     counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
     tt_result r;
-    o.allocator = make_allocator(&cnt, -1);
     err.message[0] = '\0';
-    r = tt_synthesize_tiles(src, &o, &set, &err);
+    r = tt_synthesize_tiles(src, opt, &al, &set, &err);
     CHECK(r == code && set == NULL && err.result == code && err.message[0] != '\0',
           "%s: expected %d with *out NULL and a message, got %d (%s)", what, code, r, err.message);
     if (r == TT_OK && set) tt_tileset_free(set);
@@ -606,17 +835,18 @@ static void expect_synth_error(const tt_image *src, const tt_synth_options *opt,
 
 static void test_synth_errors(void)
 {
-    tt_image src, small;
+    tt_image *src = make_noise(64, 128, 5), *small;
     tt_synth_options opt;
     tt_tileset *set = NULL;
     tt_error err;
     tt_result r;
     tt_rect win;
-    make_noise(&src, 64, 128, 5);
+    CHECK(src != NULL, "make_noise");
+    if (!src) return;
     memset(&opt, 0, sizeof opt);
     opt.layout = make_layout(1, 16, 2);
 
-    r = tt_synthesize_tiles(&src, &opt, NULL, &err);
+    r = tt_synthesize_tiles(src, &opt, NULL, NULL, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT, "out NULL: got %d", r);
     expect_synth_error(NULL, &opt, TT_ERROR_INVALID_ARGUMENT, "source NULL");
     {
@@ -624,100 +854,109 @@ static void test_synth_errors(void)
         memset(&empty, 0, sizeof empty);
         expect_synth_error(&empty, &opt, TT_ERROR_INVALID_ARGUMENT, "empty source");
     }
+    {
+        /* an allocator with only one of its two functions */
+        counter cnt;
+        tt_allocator half = make_allocator(&cnt, -1);
+        half.free = NULL;
+        set = (tt_tileset *)&set;
+        r = tt_synthesize_tiles(src, &opt, &half, &set, &err);
+        if (r == TT_OK) tt_tileset_free(set);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && set == NULL && cnt.calls == 0,
+              "allocator without free: expected TT_ERROR_INVALID_ARGUMENT before any allocation, got %d (%ld calls)",
+              r, cnt.calls);
+    }
     opt.layout.colors = -1;
-    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "colors -1");
+    expect_synth_error(src, &opt, TT_ERROR_INVALID_ARGUMENT, "colors -1");
     opt.layout.colors = TT_MAX_COLORS + 1;
-    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "colors TT_MAX_COLORS+1");
+    expect_synth_error(src, &opt, TT_ERROR_INVALID_ARGUMENT, "colors TT_MAX_COLORS+1");
     opt.layout.colors = 0;
     {
         counter cnt;
-        opt.allocator = make_allocator(&cnt, -1);
-        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        tt_allocator al = make_allocator(&cnt, -1);
+        r = tt_synthesize_tiles(src, &opt, &al, &set, &err);
         CHECK(r == TT_OK && set->layout.colors == 1 && set->layout.tile_size == 16 && set->layout.gutter == 2,
               "colors 0 means 1: got %d, colors %d", r, r == TT_OK ? set->layout.colors : -1);
         if (r == TT_OK) tt_tileset_free(set);
         CHECK(cnt.live == 0, "colors 0: leak");
-        memset(&opt.allocator, 0, sizeof opt.allocator);
     }
     opt.layout.colors = 1;
     opt.layout.tile_size = 3;
     {
         counter cnt;
-        tt_synth_options o = opt;
-        o.allocator = make_allocator(&cnt, -1);
+        tt_allocator al = make_allocator(&cnt, -1);
         set = (tt_tileset *)&set;
-        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        r = tt_synthesize_tiles(src, &opt, &al, &set, &err);
         if (r == TT_OK) tt_tileset_free(set);
         CHECK((r == TT_ERROR_INVALID_ARGUMENT || r == TT_ERROR_TOO_LARGE) && set == NULL && cnt.live == 0,
               "tile size 3 rejected, got %d", r);
     }
     opt.layout.tile_size = 40000;
-    expect_synth_error(&src, &opt, TT_ERROR_TOO_LARGE, "tile size 40000");
+    expect_synth_error(src, &opt, TT_ERROR_TOO_LARGE, "tile size 40000");
     opt.layout = make_layout(2, 2048, 4);
-    expect_synth_error(&src, &opt, TT_ERROR_TOO_LARGE, "n=2, S=2048: atlas over TT_MAX_IMAGE_SIZE");
+    expect_synth_error(src, &opt, TT_ERROR_TOO_LARGE, "n=2, S=2048: atlas over TT_MAX_IMAGE_SIZE");
     opt.layout = make_layout(1, 65, 2);
-    expect_synth_error(&src, &opt, TT_ERROR_IMAGE_TOO_SMALL, "S=65 on a 64x128 image (too narrow)");
-    make_noise(&small, 64, 95, 1);
+    expect_synth_error(src, &opt, TT_ERROR_IMAGE_TOO_SMALL, "S=65 on a 64x128 image (too narrow)");
+    small = make_noise(64, 95, 1);
     opt.layout = make_layout(1, 48, 2);
-    expect_synth_error(&small, &opt, TT_ERROR_IMAGE_TOO_SMALL, "S=48 on a 64x95 image: fits S x S but not S x 2S");
-    tt_image_free(&small);
-    make_noise(&small, 16, 31, 1);
+    expect_synth_error(small, &opt, TT_ERROR_IMAGE_TOO_SMALL, "S=48 on a 64x95 image: fits S x S but not S x 2S");
+    tt_image_free(small);
+    small = make_noise(16, 31, 1);
     opt.layout = make_layout(1, 16, 2);
-    expect_synth_error(&small, &opt, TT_ERROR_IMAGE_TOO_SMALL, "16x31 image for S=16");
-    tt_image_free(&small);
-    make_noise(&small, 16, 32, 1);
+    expect_synth_error(small, &opt, TT_ERROR_IMAGE_TOO_SMALL, "16x31 image for S=16");
+    tt_image_free(small);
+    small = make_noise(16, 32, 1);
     {
         counter cnt;
-        tt_synth_options o = opt;
-        o.allocator = make_allocator(&cnt, -1);
-        r = tt_synthesize_tiles(&small, &o, &set, &err);
+        tt_allocator al = make_allocator(&cnt, -1);
+        r = tt_synthesize_tiles(small, &opt, &al, &set, &err);
         CHECK(r == TT_OK, "16x32 image for S=16 (exactly S x 2S) should work, got %d (%s)", r, err.message);
         if (r == TT_OK) tt_tileset_free(set);
         CHECK(cnt.live == 0, "16x32: leak");
     }
-    tt_image_free(&small);
+    tt_image_free(small);
 
     /* edge windows outside the image */
     opt.layout = make_layout(1, 16, 2);
     opt.edge_windows = &win;
     win.w = win.h = 0;
     win.x = 64 - 16 + 1; win.y = 0;
-    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window one texel too far right");
+    expect_synth_error(src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window one texel too far right");
     win.x = 0; win.y = 128 - 32 + 1;
-    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window one texel too low");
+    expect_synth_error(src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window one texel too low");
     win.x = -1; win.y = 0;
-    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window at x = -1");
+    expect_synth_error(src, &opt, TT_ERROR_INVALID_ARGUMENT, "edge window at x = -1");
     win.x = 64 - 16; win.y = 128 - 32;
     {
         counter cnt;
-        tt_synth_options o = opt;
-        o.allocator = make_allocator(&cnt, -1);
-        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        tt_allocator al = make_allocator(&cnt, -1);
+        r = tt_synthesize_tiles(src, &opt, &al, &set, &err);
         CHECK(r == TT_OK, "edge window at the bottom-right limit should fit, got %d (%s)", r, err.message);
         if (r == TT_OK) tt_tileset_free(set);
+        CHECK(cnt.live == 0, "edge window at the limit: leak");
     }
     opt.edge_windows = NULL;
     /* background region */
     opt.background.x = 60; opt.background.y = 0; opt.background.w = 16; opt.background.h = 16;
-    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "background region outside the image");
+    expect_synth_error(src, &opt, TT_ERROR_INVALID_ARGUMENT, "background region outside the image");
     opt.background.x = 0; opt.background.w = 15;
-    expect_synth_error(&src, &opt, TT_ERROR_IMAGE_TOO_SMALL, "background region narrower than a tile");
+    expect_synth_error(src, &opt, TT_ERROR_IMAGE_TOO_SMALL, "background region narrower than a tile");
     memset(&opt.background, 0, sizeof opt.background);
     /* feather too wide */
     opt.feather = 16 / 4 + 2;
-    expect_synth_error(&src, &opt, TT_ERROR_INVALID_ARGUMENT, "feather wider than S/4+1");
+    expect_synth_error(src, &opt, TT_ERROR_INVALID_ARGUMENT, "feather wider than S/4+1");
     opt.feather = 0;
 
     /* progress: monotone in (0,1], ends at 1; cancelling cleans up */
     {
         counter cnt;
+        tt_allocator al = make_allocator(&cnt, -1);
         tt_synth_options o = opt;
-        o.allocator = make_allocator(&cnt, -1);
         o.progress = never_cancel;
         g_progress_calls = 0;
         g_progress_last = 0.0f;
         g_progress_monotone = 1;
-        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        r = tt_synthesize_tiles(src, &o, &al, &set, &err);
         CHECK(r == TT_OK && g_progress_calls > 0 && g_progress_monotone && g_progress_last == 1.0f,
               "progress: %d calls, monotone %d, last %g", g_progress_calls, g_progress_monotone, g_progress_last);
         if (r == TT_OK) tt_tileset_free(set);
@@ -725,7 +964,7 @@ static void test_synth_errors(void)
         g_progress_calls = 0;
         g_progress_last = 0.0f;
         set = (tt_tileset *)&set;
-        r = tt_synthesize_tiles(&src, &o, &set, &err);
+        r = tt_synthesize_tiles(src, &o, &al, &set, &err);
         if (r == TT_OK) tt_tileset_free(set);
         CHECK(r == TT_CANCELLED && set == NULL && err.result == TT_CANCELLED && g_progress_calls == 3,
               "cancel at the 3rd progress call: expected TT_CANCELLED after 3 calls, got %d after %d", r,
@@ -734,12 +973,70 @@ static void test_synth_errors(void)
     }
     /* NULL options: defaults (n = 1, S = 128) need a 128 x 256 source */
     set = (tt_tileset *)&set;
-    r = tt_synthesize_tiles(&src, NULL, &set, &err);
+    r = tt_synthesize_tiles(src, NULL, NULL, &set, &err);
     if (r == TT_OK) tt_tileset_free(set);
     CHECK(r == TT_ERROR_IMAGE_TOO_SMALL && set == NULL, "NULL options on a 64x128 image: expected %d, got %d",
           TT_ERROR_IMAGE_TOO_SMALL, r);
     tt_tileset_free(NULL);
-    tt_image_free(&src);
+    tt_image_free(src);
+}
+
+/* A source with one NaN or infinite texel is refused, naming the texel by
+   row (y) and column (x), with *out NULL and nothing leaked; the same texel
+   finite again works. Each channel, including alpha, is checked. */
+static void test_synth_non_finite(void)
+{
+    static const struct { int x, y, channel, kind; } cases[] = {
+        {5, 7, 0, 0}, {63, 0, 1, 1}, {0, 127, 2, 2}, {30, 90, 3, 0}, {17, 33, 1, 2}};
+    tt_image *src = make_noise(64, 128, 12);
+    tt_synth_options opt;
+    int i;
+    CHECK(src != NULL, "make_noise");
+    if (!src) return;
+    memset(&opt, 0, sizeof opt);
+    opt.layout = make_layout(1, 16, 2);
+    for (i = 0; i < (int)(sizeof cases / sizeof cases[0]); i++) {
+        float *p = px(src, cases[i].x, cases[i].y), keep = p[cases[i].channel];
+        const char *kind = cases[i].kind == 0 ? "NaN" : cases[i].kind == 1 ? "+inf" : "-inf";
+        tt_tileset *set = (tt_tileset *)&set;
+        tt_error err;
+        counter cnt;
+        tt_allocator al = make_allocator(&cnt, -1);
+        tt_result r;
+        p[cases[i].channel] = cases[i].kind == 0 ? (float)internal_not_a_number()
+                              : cases[i].kind == 1 ? internal_infinity() : -internal_infinity();
+        memset(&err, 0, sizeof err);
+        r = tt_synthesize_tiles(src, &opt, &al, &set, &err);
+        if (r == TT_OK) tt_tileset_free(set);
+        CHECK(r == TT_ERROR_NON_FINITE && err.result == r && set == NULL && err.row == cases[i].y &&
+                  err.column == cases[i].x && msg_has_number(err.message, cases[i].x) &&
+                  msg_has_number(err.message, cases[i].y),
+              "%s in channel %d of texel (x %d, y %d): expected TT_ERROR_NON_FINITE with row %d, column %d and "
+              "*out NULL, got %d row %d column %d out %s \"%s\"", kind, cases[i].channel, cases[i].x, cases[i].y,
+              cases[i].y, cases[i].x, r, err.row, err.column, set ? "set" : "NULL", err.message);
+        CHECK(cnt.live == 0 && cnt.bad_frees == 0, "%s texel: %ld allocations leaked", kind, cnt.live);
+        p[cases[i].channel] = keep;
+    }
+    {
+        /* two bad texels: the first in row order is named */
+        tt_tileset *set = NULL;
+        tt_error err;
+        tt_result r;
+        float *a = px(src, 40, 50), *b = px(src, 3, 51), ka = a[1], kb = b[0];
+        a[1] = internal_infinity();
+        b[0] = (float)internal_not_a_number();
+        r = tt_synthesize_tiles(src, &opt, NULL, &set, &err);
+        if (r == TT_OK) tt_tileset_free(set);
+        CHECK(r == TT_ERROR_NON_FINITE && err.row == 50 && err.column == 40,
+              "two bad texels: expected the first (row 50, column 40), got %d row %d column %d", r, err.row,
+              err.column);
+        a[1] = ka;
+        b[0] = kb;
+        r = tt_synthesize_tiles(src, &opt, NULL, &set, &err);
+        CHECK(r == TT_OK, "all texels finite again: %d (%s)", r, err.message);
+        if (r == TT_OK) tt_tileset_free(set);
+    }
+    tt_image_free(src);
 }
 
 typedef struct synth_ctx {
@@ -750,12 +1047,10 @@ typedef struct synth_ctx {
 static tt_result oom_synth(void *ctx, const tt_allocator *al)
 {
     synth_ctx *s = (synth_ctx *)ctx;
-    tt_synth_options o = s->opt;
     tt_tileset *set = (tt_tileset *)&set;
     tt_error err;
     tt_result r;
-    o.allocator = *al;
-    r = tt_synthesize_tiles(s->src, &o, &set, &err);
+    r = tt_synthesize_tiles(s->src, &s->opt, al, &set, &err);
     if (r == TT_OK) tt_tileset_free(set);
     else if (set != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
     return r;
@@ -763,34 +1058,46 @@ static tt_result oom_synth(void *ctx, const tt_allocator *al)
 
 static void test_synth_oom(void)
 {
-    tt_image src;
     synth_ctx s;
-    make_noise(&src, 24, 48, 8);
+    tt_image *src = make_noise(24, 48, 8);
+    CHECK(src != NULL, "make_noise");
+    if (!src) return;
     oom_reset();
     memset(&s, 0, sizeof s);
-    s.src = &src;
+    s.src = src;
     s.opt.layout = make_layout(1, 8, 2);
     oom_sweep("tt_synthesize_tiles(n=1, S=8)", oom_synth, &s, TT_OK);
     s.opt.layout = make_layout(2, 4, TT_NO_GUTTER);
     s.opt.seed = 3;
     oom_sweep("tt_synthesize_tiles(n=2, S=4)", oom_synth, &s, TT_OK);
-    tt_image_free(&src);
+    tt_image_free(src);
 }
 
 /* ------------------------------------------------------------------------ */
 /* 6c. Quality measures                                                     */
 /* ------------------------------------------------------------------------ */
 
+/* UVs of one random tile per face: four types drawn independently, so the
+   two sides of an edge mostly do not agree (the control for the seam
+   measure). */
+static void random_face_types(const tt_mesh *mesh, int n, unsigned seed, uint8_t *types)
+{
+    int c;
+    lcg_seed(seed);
+    for (c = 0; c < mesh->ncorners; c++) types[c] = (uint8_t)lcg_below(2 * n);
+}
+
 static void test_seams(void)
 {
     tmesh m;
     tt_mesh *mesh = NULL;
     tt_error err;
-    tt_image src;
+    tt_image *src = NULL;
     tt_synth_options opt;
     tt_tileset *set = NULL;
     uint8_t *types;
     float *uv, *shuffled;
+    tt_seam_options so;
     tt_seam_report rep, rep2;
     tt_result r;
     int f, n;
@@ -801,28 +1108,37 @@ static void test_seams(void)
     CHECK(r == TT_OK, "seam torus build %d", r);
     if (r != TT_OK) return;
     make_value_noise(&src, 160, 256, 9);
+    CHECK(src != NULL, "make_value_noise");
+    if (!src) { tt_mesh_free(mesh); return; }
     types = (uint8_t *)malloc((size_t)mesh->ncorners);
     uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
     shuffled = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    memset(&so, 0, sizeof so);
+    so.seed = 99;
     for (n = 1; n <= 2; n++) {
         memset(&opt, 0, sizeof opt);
         opt.layout = make_layout(n, 32, 4);
         opt.seed = 11;
-        r = tt_synthesize_tiles(&src, &opt, &set, &err);
+        r = tt_synthesize_tiles(src, &opt, NULL, &set, &err);
         CHECK(r == TT_OK, "seams n=%d: synthesize %d (%s)", n, r, err.message);
         if (r != TT_OK) continue;
-        tt_assign_boundaries(mesh, &opt.layout, 5, types);
+        tt_assign_boundaries(mesh, &opt.layout, 5, NULL, types, NULL);
         r = tt_assign_uvs(mesh, &opt.layout, types, uv, &err);
         CHECK(r == TT_OK, "seams: assign_uvs %d", r);
-        r = tt_measure_seams(mesh, uv, &set->levels[0], 99, &rep);
-        CHECK(r == TT_OK, "tt_measure_seams returned %d", r);
+        r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &rep, &err);
+        CHECK(r == TT_OK, "tt_measure_seams returned %d (%s)", r, err.message);
         CHECK(rep.edges_measured == 2 * mesh->nfaces, "seams: edges_measured expected %d, got %d", 2 * mesh->nfaces,
               rep.edges_measured);
         CHECK(rep.score <= 0.05, "seams n=%d: score %.4f > 0.05 (seam %.4f, same face %.4f, unrelated %.4f)", n,
               rep.score, rep.seam, rep.same_face, rep.unrelated);
         /* same seed, same report */
-        tt_measure_seams(mesh, uv, &set->levels[0], 99, &rep2);
-        CHECK(rep.score == rep2.score && rep.seam == rep2.seam, "seams: the same seed should give the same report");
+        tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &rep2, NULL);
+        CHECK(rep.score == rep2.score && rep.seam == rep2.seam && rep.samples == rep2.samples,
+              "seams: the same seed should give the same report");
+        /* NULL options: every edge, seed 0 */
+        r = tt_measure_seams(mesh, uv, &set->levels[0], NULL, NULL, &rep2, &err);
+        CHECK(r == TT_OK && rep2.edges_measured == 2 * mesh->nfaces && rep2.score <= 0.05,
+              "seams n=%d, NULL options: %d, %d edges, score %.4f", n, r, rep2.edges_measured, rep2.score);
         /* shuffle the faces' tiles: permute the 8-float UV blocks */
         {
             int *perm = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
@@ -836,7 +1152,7 @@ static void test_seams(void)
             for (f = 0; f < mesh->nfaces; f++) memcpy(shuffled + 8 * f, uv + 8 * perm[f], 8 * sizeof(float));
             free(perm);
         }
-        r = tt_measure_seams(mesh, shuffled, &set->levels[0], 99, &rep2);
+        r = tt_measure_seams(mesh, shuffled, &set->levels[0], &so, NULL, &rep2, &err);
         /* With n = 2 a shuffled edge keeps complementary types (and so stays
            seamless) with probability 1/4 and otherwise mostly shows two
            different windows: the score must rise to >= 0.6. With n = 1 half
@@ -856,15 +1172,326 @@ static void test_seams(void)
         tt_tileset_free(set);
         set = NULL;
     }
-    CHECK(tt_measure_seams(NULL, uv, &src, 1, &rep) == TT_ERROR_INVALID_ARGUMENT &&
-              tt_measure_seams(mesh, NULL, &src, 1, &rep) == TT_ERROR_INVALID_ARGUMENT &&
-              tt_measure_seams(mesh, uv, NULL, 1, &rep) == TT_ERROR_INVALID_ARGUMENT &&
-              tt_measure_seams(mesh, uv, &src, 1, NULL) == TT_ERROR_INVALID_ARGUMENT,
+    CHECK(tt_measure_seams(NULL, uv, src, NULL, NULL, &rep, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_seams(mesh, NULL, src, NULL, NULL, &rep, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_seams(mesh, uv, NULL, NULL, NULL, &rep, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_seams(mesh, uv, src, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
           "tt_measure_seams with NULL arguments should be rejected");
+    {
+        tt_image empty;
+        memset(&empty, 0, sizeof empty);
+        r = tt_measure_seams(mesh, uv, &empty, NULL, NULL, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT, "tt_measure_seams on an empty atlas: expected %d, got %d",
+              TT_ERROR_INVALID_ARGUMENT, r);
+    }
+    {
+        counter cnt;
+        tt_allocator half = make_allocator(&cnt, -1);
+        half.alloc = NULL;
+        r = tt_measure_seams(mesh, uv, src, NULL, &half, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT, "tt_measure_seams with an allocator without alloc: expected %d, got %d",
+              TT_ERROR_INVALID_ARGUMENT, r);
+    }
     free(types);
     free(uv);
     free(shuffled);
-    tt_image_free(&src);
+    tt_image_free(src);
+    tt_mesh_free(mesh);
+}
+
+/* The control, on displayed colours: one random tile per face (corner types
+   that do not match across edges) scores badly where the real assignment
+   scores near 0, with the same atlas. */
+static void test_seams_control(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_image *src = NULL;
+    tt_synth_options opt;
+    tt_tileset *set = NULL;
+    uint8_t *types;
+    float *uv;
+    tt_seam_report real, random;
+    tt_result r;
+    int c, matching = 0, interior = 0;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 40, 24, 3.0, 1.0);
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "control torus build %d", r);
+    if (r != TT_OK) return;
+    make_value_noise(&src, 160, 256, 21);
+    memset(&opt, 0, sizeof opt);
+    opt.layout = make_layout(2, 32, 4);
+    opt.seed = 4;
+    r = src ? tt_synthesize_tiles(src, &opt, NULL, &set, &err) : TT_ERROR_OUT_OF_MEMORY;
+    CHECK(r == TT_OK, "control: synthesize %d (%s)", r, err.message);
+    if (r != TT_OK) { tt_image_free(src); tt_mesh_free(mesh); return; }
+    types = (uint8_t *)malloc((size_t)mesh->ncorners);
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    tt_assign_boundaries(mesh, &opt.layout, 8, NULL, types, NULL);
+    tt_assign_uvs(mesh, &opt.layout, types, uv, NULL);
+    r = tt_measure_seams(mesh, uv, &set->levels[0], NULL, NULL, &real, &err);
+    CHECK(r == TT_OK && real.score < 0.1, "control, real assignment: %d, score %.4f (want < 0.1)", r, real.score);
+    random_face_types(mesh, 2, 4242, types);
+    for (c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] > c) { interior++; matching += types[mesh->twin[c]] == (types[c] ^ 1); }
+    CHECK(matching < interior / 2, "control: %d of %d random edges match; the control is not random", matching,
+          interior);
+    r = tt_assign_uvs(mesh, &opt.layout, types, uv, &err);
+    CHECK(r == TT_OK, "control: assign_uvs of random types %d", r);
+    r = tt_measure_seams(mesh, uv, &set->levels[0], NULL, NULL, &random, &err);
+    CHECK(r == TT_OK && random.score > 0.3 && random.score > real.score + 0.25,
+          "control, random tiles per face: %d, score %.4f (want > 0.3; real %.4f; seam %.4f, same face %.4f, "
+          "unrelated %.4f)", r, random.score, real.score, random.seam, random.same_face, random.unrelated);
+    free(types);
+    free(uv);
+    tt_tileset_free(set);
+    tt_image_free(src);
+    tt_mesh_free(mesh);
+}
+
+/* The seam measure compares colours as displayed: three unit quads in a row,
+   each mapped onto its own flat 8 x 8 block of an atlas made from sRGB bytes
+   100, 200, 100. Both interior edges then differ by exactly 100/255 as
+   displayed (in linear light it would be 0.45), the same-face difference is
+   0, and the measure does not depend on the atlas's linear values. */
+static void test_seams_displayed(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_image *atlas = NULL;
+    tt_error err;
+    tt_seam_report rep;
+    unsigned char bytes[8 * 24];
+    float uv[24];
+    tt_result r;
+    int x, y, f;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 3, 1);
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "row of three quads: build %d", r);
+    if (r != TT_OK) return;
+    for (y = 0; y < 8; y++)
+        for (x = 0; x < 24; x++) bytes[y * 24 + x] = (unsigned char)(x / 8 == 1 ? 200 : 100);
+    r = tt_image_from_bytes(bytes, 24, 8, 1, 0, TT_COLOR_SRGB, NULL, &atlas, &err);
+    CHECK(r == TT_OK, "atlas from bytes: %d (%s)", r, err.message);
+    if (r != TT_OK) { tt_mesh_free(mesh); return; }
+    for (f = 0; f < 3; f++) {
+        /* corners (f,0) (f+1,0) (f+1,1) (f,1): block f of the atlas */
+        float u0 = (float)(8 * f) / 24.0f, u1 = (float)(8 * f + 8) / 24.0f;
+        uv[8 * f] = u0; uv[8 * f + 1] = 0.0f;
+        uv[8 * f + 2] = u1; uv[8 * f + 3] = 0.0f;
+        uv[8 * f + 4] = u1; uv[8 * f + 5] = 1.0f;
+        uv[8 * f + 6] = u0; uv[8 * f + 7] = 1.0f;
+    }
+    r = tt_measure_seams(mesh, uv, atlas, NULL, NULL, &rep, &err);
+    CHECK(r == TT_OK && rep.edges_measured == 2 && rep.samples > 0,
+          "row of three quads: expected TT_OK with 2 edges measured, got %d, %d edges (%s)", r, rep.edges_measured,
+          err.message);
+    CHECK(near(rep.seam, 100.0 / 255.0, 1e-4) && near(rep.same_face, 0.0, 1e-6),
+          "seam across sRGB 100 | 200: expected %.5f as displayed (linear light would give %.5f), got seam %.5f, "
+          "same face %.5f", 100.0 / 255.0, (double)(tt_srgb_to_linear(200.0f / 255.0f) - tt_srgb_to_linear(100.0f / 255.0f)),
+          rep.seam, rep.same_face);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
+static void expect_not_measured(const tt_mesh *mesh, const float *uv, const tt_image *atlas, const char *what)
+{
+    tt_seam_report rep;
+    tt_error err;
+    tt_result r;
+    memset(&rep, 0x55, sizeof rep);
+    memset(&err, 0, sizeof err);
+    r = tt_measure_seams(mesh, uv, atlas, NULL, NULL, &rep, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && err.result == r && err.message[0] && isnan(rep.score) &&
+              rep.edges_measured == 0 && rep.samples == 0 && rep.seam == 0.0 && rep.same_face == 0.0 &&
+              rep.unrelated == 0.0,
+          "%s: expected TT_ERROR_NOT_MEASURED (%d) with score NaN and an empty report, got %d, score %g, %d edges, "
+          "%lld samples, seam %g (\"%s\")", what, TT_ERROR_NOT_MEASURED, r, rep.score, rep.edges_measured,
+          rep.samples, rep.seam, err.message);
+}
+
+/* Not measured reads as not measured: nothing to sample gives
+   TT_ERROR_NOT_MEASURED and a NaN score, never a score of 0 (which would
+   read as "seamless"). */
+static void test_seams_not_measured(void)
+{
+    tmesh m;
+    tt_mesh *quad = NULL, *pair = NULL, *torus = NULL;
+    tt_image *atlas = NULL;
+    tt_error err;
+    float *uv;
+    int c;
+    make_value_noise(&atlas, 64, 64, 3);
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 1, 1);
+    CHECK(build(&m, 0, &quad, &err) == TT_OK, "one quad build");
+    tm_free(&m);
+    make_grid(&m, 2, 1);
+    CHECK(build(&m, 0, &pair, &err) == TT_OK, "two quads build");
+    tm_free(&m);
+    make_torus(&m, 8, 6, 3, 1);
+    CHECK(build(&m, 0, &torus, &err) == TT_OK, "torus build");
+    tm_free(&m);
+    if (!quad || !pair || !torus || !atlas) {
+        tt_mesh_free(quad); tt_mesh_free(pair); tt_mesh_free(torus); tt_image_free(atlas);
+        return;
+    }
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)torus->ncorners);
+    for (c = 0; c < 2 * torus->ncorners; c++) uv[c] = (float)lcg_unit();
+    expect_not_measured(quad, uv, atlas, "one quad (no interior edge)");
+    expect_not_measured(pair, uv, atlas, "two quads (one interior edge: no unrelated edge to compare with)");
+    for (c = 0; c < 2 * torus->ncorners; c++) uv[c] = (float)internal_not_a_number();
+    expect_not_measured(torus, uv, atlas, "torus with all-NaN UVs");
+    for (c = 0; c < 2 * torus->ncorners; c++) uv[c] = internal_infinity();
+    expect_not_measured(torus, uv, atlas, "torus with all-infinite UVs");
+    for (c = 0; c < 2 * torus->ncorners; c++) uv[c] = 0.25f;
+    expect_not_measured(torus, uv, atlas, "torus with every UV at one point (zero-length edges)");
+    {
+        /* the control: the same torus with real UVs is measured */
+        tt_seam_report rep;
+        tt_result r;
+        for (c = 0; c < 2 * torus->ncorners; c++) uv[c] = (float)lcg_unit();
+        r = tt_measure_seams(torus, uv, atlas, NULL, NULL, &rep, &err);
+        CHECK(r == TT_OK && rep.edges_measured > 0 && !isnan(rep.seam),
+              "torus with random finite UVs should be measured: %d, %d edges", r, rep.edges_measured);
+    }
+    free(uv);
+    tt_mesh_free(quad);
+    tt_mesh_free(pair);
+    tt_mesh_free(torus);
+    tt_image_free(atlas);
+}
+
+/* max_edges: a random subset of edges estimates the full score. */
+static void test_seams_sampled(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_image *src = NULL;
+    tt_synth_options opt;
+    tt_tileset *set = NULL;
+    uint8_t *types;
+    float *uv;
+    tt_seam_options so;
+    tt_seam_report full, part, again;
+    tt_result r;
+    int pass, interior;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 32, 3.0, 1.0);
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "sampled torus build %d", r);
+    if (r != TT_OK) return;
+    interior = 2 * mesh->nfaces;
+    make_value_noise(&src, 128, 256, 17);
+    memset(&opt, 0, sizeof opt);
+    opt.layout = make_layout(1, 32, 4);
+    opt.seed = 2;
+    r = src ? tt_synthesize_tiles(src, &opt, NULL, &set, &err) : TT_ERROR_OUT_OF_MEMORY;
+    CHECK(r == TT_OK, "sampled: synthesize %d (%s)", r, err.message);
+    if (r != TT_OK) { tt_image_free(src); tt_mesh_free(mesh); return; }
+    types = (uint8_t *)malloc((size_t)mesh->ncorners);
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    /* pass 0: the real assignment (score near 0), 200 edges; pass 1: random
+       tiles per face (a high score, and edges that differ a lot from each
+       other: half match by type, half do not), so a larger subset for the
+       same tolerance: 1000 edges. */
+    for (pass = 0; pass < 2; pass++) {
+        const char *what = pass ? "random tiles" : "real assignment";
+        const int subset = pass ? 1000 : 200;
+        const double tolerance = pass ? 0.06 : 0.05;
+        if (pass == 0) tt_assign_boundaries(mesh, &opt.layout, 6, NULL, types, NULL);
+        else random_face_types(mesh, 1, 99, types);
+        tt_assign_uvs(mesh, &opt.layout, types, uv, NULL);
+        memset(&so, 0, sizeof so);
+        so.seed = 5;
+        r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &full, &err);
+        CHECK(r == TT_OK && full.edges_measured == interior, "%s, all edges: %d, %d of %d edges", what, r,
+              full.edges_measured, interior);
+        so.max_edges = subset;
+        r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &part, &err);
+        CHECK(r == TT_OK && part.edges_measured == subset && part.samples < full.samples && part.samples > 0,
+              "%s, max_edges %d: %d, %d edges measured, %lld samples (full: %lld)", what, subset, r,
+              part.edges_measured, part.samples, full.samples);
+        CHECK(near(part.score, full.score, tolerance),
+              "%s: max_edges %d scores %.4f, all %d edges %.4f (want within %g)", what, subset, part.score, interior,
+              full.score, tolerance);
+        tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &again, NULL);
+        CHECK(again.score == part.score && again.samples == part.samples,
+              "%s, max_edges %d: the same seed should give the same estimate", what, subset);
+        if (pass == 1)
+            CHECK(full.score > 0.15 && part.score > 0.15,
+                  "random tiles (n = 1): full score %.4f and estimate %.4f should be clearly above 0", full.score,
+                  part.score);
+        /* max_edges at or above the number of edges measures them all */
+        so.max_edges = interior;
+        r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &part, &err);
+        CHECK(r == TT_OK && part.edges_measured == interior && part.samples == full.samples,
+              "%s, max_edges = all %d edges: %d, %d edges, %lld samples (full %lld)", what, interior, r,
+              part.edges_measured, part.samples, full.samples);
+    }
+    so.max_edges = -1;
+    r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &part, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0] && isnan(part.score),
+          "max_edges -1: expected TT_ERROR_INVALID_ARGUMENT (score NaN), got %d score %g", r, part.score);
+    free(types);
+    free(uv);
+    tt_tileset_free(set);
+    tt_image_free(src);
+    tt_mesh_free(mesh);
+}
+
+typedef struct seams_ctx {
+    const tt_mesh *mesh;
+    const float *uv;
+    const tt_image *atlas;
+} seams_ctx;
+
+static tt_result oom_seams(void *ctx, const tt_allocator *al)
+{
+    seams_ctx *s = (seams_ctx *)ctx;
+    tt_seam_report rep;
+    tt_error err;
+    tt_result r = tt_measure_seams(s->mesh, s->uv, s->atlas, NULL, al, &rep, &err);
+    if (r != TT_OK && (err.result != r || !isnan(rep.score))) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_seams_oom(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_image *atlas = NULL;
+    tt_tile_layout l = make_layout(1, 12, 2);
+    uint8_t types[4 * 48];
+    float uv[8 * 48];
+    seams_ctx s;
+    make_value_noise(&atlas, 64, 64, 4);
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 8, 6, 3, 1);
+    if (build(&m, 0, &mesh, &err) != TT_OK || !atlas) {
+        CHECK(0, "seams OOM setup");
+        tm_free(&m);
+        tt_image_free(atlas);
+        tt_mesh_free(mesh);
+        return;
+    }
+    tm_free(&m);
+    tt_assign_boundaries(mesh, &l, 1, NULL, types, NULL);
+    tt_assign_uvs(mesh, &l, types, uv, NULL);
+    s.mesh = mesh;
+    s.uv = uv;
+    s.atlas = atlas;
+    oom_reset();
+    oom_sweep("tt_measure_seams", oom_seams, &s, TT_OK);
+    tt_image_free(atlas);
     tt_mesh_free(mesh);
 }
 
@@ -886,8 +1513,9 @@ static void check_histogram(int grid, int n, double tolerance)
     if (r != TT_OK) return;
     types = (uint8_t *)malloc((size_t)mesh->ncorners);
     counts = (int *)malloc(sizeof(int) * (size_t)ntiles);
-    tt_assign_boundaries(mesh, &l, 2025, types);
-    r = tt_tile_histogram(mesh, &l, types, counts);
+    tt_assign_boundaries(mesh, &l, 2025, NULL, types, NULL);
+    for (t = 0; t < ntiles; t++) counts[t] = -7;   /* the histogram must overwrite, not add */
+    r = tt_tile_histogram(mesh, &l, types, counts, &err);
     CHECK(r == TT_OK, "tt_tile_histogram returned %d", r);
     expected = (double)mesh->nfaces / ntiles;
     for (t = 0; t < ntiles; t++) {
@@ -912,8 +1540,22 @@ static void check_histogram(int grid, int n, double tolerance)
         free(naive);
     }
     types[5] = (uint8_t)(2 * n);
-    CHECK(tt_tile_histogram(mesh, &l, types, counts) == TT_ERROR_INVALID_ARGUMENT, "histogram: type out of range");
-    CHECK(tt_tile_histogram(NULL, &l, types, counts) == TT_ERROR_INVALID_ARGUMENT, "histogram: mesh NULL");
+    memset(&err, 0, sizeof err);
+    r = tt_tile_histogram(mesh, &l, types, counts, &err);
+    CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.result == r && err.corner == 5 && err.face == 1 &&
+              msg_has_number(err.message, 5),
+          "histogram: type %d at corner 5: expected TT_ERROR_INDEX_OUT_OF_RANGE naming corner 5 (face 1), got %d "
+          "corner %d face %d \"%s\"", 2 * n, r, err.corner, err.face, err.message);
+    CHECK(tt_tile_histogram(NULL, &l, types, counts, &err) == TT_ERROR_INVALID_ARGUMENT, "histogram: mesh NULL");
+    CHECK(tt_tile_histogram(mesh, NULL, types, counts, &err) == TT_ERROR_INVALID_ARGUMENT, "histogram: layout NULL");
+    CHECK(tt_tile_histogram(mesh, &l, NULL, counts, &err) == TT_ERROR_INVALID_ARGUMENT, "histogram: types NULL");
+    CHECK(tt_tile_histogram(mesh, &l, types, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "histogram: counts NULL");
+    {
+        tt_tile_layout bad = make_layout(1000, 16, 2);
+        r = tt_tile_histogram(mesh, &bad, types, counts, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT, "histogram with 1000 colors: expected TT_ERROR_INVALID_ARGUMENT, got %d",
+              r);
+    }
     free(types);
     free(counts);
     tt_mesh_free(mesh);
@@ -939,9 +1581,9 @@ static void test_stretch(void)
     make_grid(&m, 3, 2);
     r = build(&m, 0, &mesh, &err);
     if (r == TT_OK) {
-        tt_assign_boundaries(mesh, &l, 1, types);
+        tt_assign_boundaries(mesh, &l, 1, NULL, types, NULL);
         tt_assign_uvs(mesh, &l, types, uv, &err);
-        CHECK(tt_face_stretch(mesh, uv, st) == TT_OK, "face_stretch");
+        CHECK(tt_face_stretch(mesh, uv, st, &err) == TT_OK, "face_stretch");
         for (f = 0; f < mesh->nfaces; f++) bad += !near(st[f], 1.0, 1e-5);
         CHECK(bad == 0, "unit squares on square tiles: %d faces with stretch != 1 (face 0: %g)", bad, st[0]);
         tt_mesh_free(mesh);
@@ -950,17 +1592,37 @@ static void test_stretch(void)
     for (f = 0; f < m.nv; f++) m.pos[3 * f] *= 2.0f;
     r = build(&m, 0, &mesh, &err);
     if (r == TT_OK) {
-        tt_assign_boundaries(mesh, &l, 1, types);
+        tt_assign_boundaries(mesh, &l, 1, NULL, types, NULL);
         tt_assign_uvs(mesh, &l, types, uv, &err);
-        CHECK(tt_face_stretch(mesh, uv, st) == TT_OK, "face_stretch");
+        CHECK(tt_face_stretch(mesh, uv, st, &err) == TT_OK, "face_stretch");
         bad = 0;
         for (f = 0; f < mesh->nfaces; f++) bad += !near(st[f], 2.0, 1e-5);
         CHECK(bad == 0, "2:1 rectangles on square tiles: %d faces with stretch != 2 (face 0: %g)", bad, st[0]);
+        /* a non-finite UV is refused, naming its corner and face */
+        {
+            static const int corners[3] = {9, 0, 23};
+            int i;
+            for (i = 0; i < 3; i++) {
+                int c = corners[i], k = i == 1 ? 0 : 1;
+                float keep = uv[2 * c + k];
+                uv[2 * c + k] = i == 2 ? -internal_infinity() : (float)internal_not_a_number();
+                memset(&err, 0, sizeof err);
+                r = tt_face_stretch(mesh, uv, st, &err);
+                CHECK(r == TT_ERROR_NON_FINITE && err.result == r && err.corner == c && err.face == c / 4 &&
+                          msg_has_number(err.message, c),
+                      "%s in the UV of corner %d: expected TT_ERROR_NON_FINITE naming corner %d (face %d), got %d "
+                      "corner %d face %d \"%s\"", i == 2 ? "-inf" : "NaN", c, c, c / 4, r, err.corner, err.face,
+                      err.message);
+                uv[2 * c + k] = keep;
+            }
+        }
         /* a face whose UVs collapse is infinitely stretched */
         for (f = 0; f < 4; f++) { uv[2 * f] = 0.5f; uv[2 * f + 1] = 0.5f; }
-        tt_face_stretch(mesh, uv, st);
+        tt_face_stretch(mesh, uv, st, NULL);
         CHECK(isinf(st[0]) && st[0] > 0, "collapsed UVs: stretch expected +inf, got %g", st[0]);
-        CHECK(tt_face_stretch(NULL, uv, st) == TT_ERROR_INVALID_ARGUMENT, "face_stretch mesh NULL");
+        CHECK(tt_face_stretch(NULL, uv, st, &err) == TT_ERROR_INVALID_ARGUMENT, "face_stretch mesh NULL");
+        CHECK(tt_face_stretch(mesh, NULL, st, &err) == TT_ERROR_INVALID_ARGUMENT, "face_stretch uv NULL");
+        CHECK(tt_face_stretch(mesh, uv, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "face_stretch stretch NULL");
         tt_mesh_free(mesh);
     }
     tm_free(&m);
@@ -970,7 +1632,7 @@ static void test_stretch(void)
     r = build(&m, 0, &mesh, &err);
     if (r == TT_OK) {
         float tuv[6] = {0, 0, 0.1f, 0, 0, 0.1f};
-        tt_face_stretch(mesh, tuv, st);
+        CHECK(tt_face_stretch(mesh, tuv, st, &err) == TT_OK, "face_stretch on a triangle");
         CHECK(near(st[0], 3.0, 1e-4), "triangle 1 x 3 on a 1 x 1 UV triangle: stretch expected 3, got %g", st[0]);
         tt_mesh_free(mesh);
     }
@@ -981,11 +1643,18 @@ void run_tiled_tests(void)
 {
     RUN(test_layout);
     RUN(test_boundaries_uvs);
+    RUN(test_prescribed_colors);
     RUN(test_tile_uv_index);
     RUN(test_synthesis);
     RUN(test_synth_errors);
+    RUN(test_synth_non_finite);
     RUN(test_synth_oom);
     RUN(test_seams);
+    RUN(test_seams_control);
+    RUN(test_seams_displayed);
+    RUN(test_seams_not_measured);
+    RUN(test_seams_sampled);
+    RUN(test_seams_oom);
     RUN(test_histogram);
     RUN(test_stretch);
 }
