@@ -1073,11 +1073,11 @@ static const char *const LAPPED_SHAPE_NAMES[4] = {"sphere", "open sheet", "two s
 /* A texture patch from value noise with a seeded splotch. */
 static tt_image *lapped_patch(int size, unsigned seed)
 {
-    tt_image *src, *patch = NULL;
+    tt_image *src = NULL, *patch = NULL;
     tt_patch_options po;
     tt_error err;
     tt_result r;
-    src = make_value_noise(size, size, seed);
+    make_value_noise(&src, size, size, seed);
     memset(&po, 0, sizeof po);
     po.seed = seed;
     r = tt_make_texture_patch(src, NULL, &po, NULL, &patch, &err);
