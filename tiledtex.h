@@ -1103,8 +1103,9 @@ typedef struct tt_bake_options {
     int gutter;             /* texels past each triangle's image filled by extrapolating its
                                composite across its edges; 0 = none (the nearest-texel fill
                                still covers the rest); the tool uses 2 */
-    /* Called as faces are baked with the fraction of faces done (never
-       decreasing); non-zero return cancels with TT_CANCELLED. */
+    /* Called before each face with the fraction of faces done (never
+       decreasing), and with 1 when all are baked; non-zero return cancels
+       with TT_CANCELLED. */
     tt_progress_fn progress;
     void *progress_user_data;
 } tt_bake_options;
@@ -7226,10 +7227,12 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     /* A gutter wider than the image reaches every texel anyway. */
     bake.gutter = gutter < width + height ? (double)gutter : (double)(width + height);
 
-    for (f = 0; f < mesh->nfaces; f++) {
+    /* Progress before each face, and 1 once every face is baked. */
+    for (f = 0; f <= mesh->nfaces; f++) {
         float xy[6];
         double area2, longest = 0.0;
-        if (opt.progress && opt.progress((float)f / (float)mesh->nfaces, opt.progress_user_data)) {
+        if (opt.progress && opt.progress(f < mesh->nfaces ? (float)f / (float)mesh->nfaces : 1.0f,
+                                         opt.progress_user_data)) {
             /* The atlas is half-written: clear it, so no caller mistakes it
                for a result. */
             memset(atlas->pixels, 0, texels * 4 * sizeof(float));
@@ -7237,6 +7240,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
                               mesh->nfaces);
             goto done;
         }
+        if (f == mesh->nfaces) break;
         for (k = 0; k < 3; k++) {
             int corner = mesh->face_start[f] + k;
             xy[2 * k] = corner_uv[2 * (size_t)corner] * (float)width;

@@ -9,6 +9,18 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The longest run of decimal digits in s: error messages print numbers
+   compactly (%g), so no run is longer than 12. */
+static int longest_digit_run(const char *s)
+{
+    int best = 0, run = 0;
+    for (; *s; s++) {
+        run = (*s >= '0' && *s <= '9') ? run + 1 : 0;
+        if (run > best) best = run;
+    }
+    return best;
+}
+
 /* ------------------------------------------------------------------------ */
 /* 7. Lapped textures: the tangent field                                    */
 /* ------------------------------------------------------------------------ */
@@ -155,7 +167,7 @@ static void test_field_default(void)
     v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
     memset(&opt, 0, sizeof opt);
     opt.scale = 0.5f;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "sphere field: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "sphere field: %s", err.message);
     CHECK(err.result == TT_OK && err.face == -1, "success clears the error (result %d face %d)", err.result, err.face);
     check_field_plane_length(mesh, v, 0.5, "sphere, up = default");
     {
@@ -175,11 +187,11 @@ static void test_field_default(void)
         diag = sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) + (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
                     (double)(hi[2] - lo[2]) * (hi[2] - lo[2]));
     }
-    CHECK(tt_tangent_field(mesh, NULL, v, &err) == TT_OK, "NULL options: %s", err.message);
+    CHECK(tt_tangent_field(mesh, NULL, NULL, v, &err) == TT_OK, "NULL options: %s", err.message);
     check_field_plane_length(mesh, v, TT_DEFAULT_FIELD_SCALE * diag, "sphere, NULL options (default scale)");
     /* A tilted up vector, not unit length: only its direction counts. */
     opt.up[0] = 0.6f; opt.up[1] = 2.0f; opt.up[2] = -0.9f;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "tilted up: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "tilted up: %s", err.message);
     check_field_plane_length(mesh, v, 0.5, "sphere, tilted up");
     perpendicular = check_field_up(mesh, 0, v, opt.up, "sphere, tilted up");
     CHECK(perpendicular > 0, "sphere, tilted up: expected perpendicular faces, got %d", perpendicular);
@@ -195,7 +207,7 @@ static void test_field_default(void)
     memset(&opt, 0, sizeof opt);
     opt.up[2] = 1.0f;
     opt.scale = 0.25f;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "torus field: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "torus field: %s", err.message);
     check_field_plane_length(mesh, v, 0.25, "torus, up = +z");
     perpendicular = check_field_up(mesh, 0, v, opt.up, "torus, up = +z");
     CHECK(perpendicular > 0, "torus: expected perpendicular faces, got %d", perpendicular);
@@ -214,7 +226,7 @@ static void test_field_default(void)
     v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
     memset(&opt, 0, sizeof opt);
     opt.scale = 2.0f;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid field: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "grid field: %s", err.message);
     for (f = 0; f < mesh->nfaces; f++)
         if (v[3 * f] != 0.0f || v[3 * f + 1] != 2.0f || v[3 * f + 2] != 0.0f) break;
     CHECK(f == mesh->nfaces, "grid, up = +y: face %d is (%g, %g, %g), expected (0, 2, 0)", f,
@@ -248,7 +260,7 @@ static void test_field_fallback(void)
     memset(&opt, 0, sizeof opt);
     opt.up[2] = 1.0f;
     opt.scale = 1.0f;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "flat grid facing up: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "flat grid facing up: %s", err.message);
     for (f = 0; f < mesh->nfaces; f++)
         if (!near(v[3 * f], 1.0, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
     CHECK(bad == 0, "flat grid facing up: %d faces not (1, 0, 0) (face 0's first edge)", bad);
@@ -273,12 +285,12 @@ static void test_field_fallback(void)
     CHECK(build(&m, 0, &mesh, &err) == TT_OK, "dome builds: %s", err.message);
     v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
     w = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "dome facing up: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "dome facing up: %s", err.message);
     check_field_plane_length(mesh, v, 1.0, "dome facing up");
     CHECK(field_max_neighbour_angle(mesh, v) < 0.05, "dome facing up: neighbouring vectors differ by %g rad",
           field_max_neighbour_angle(mesh, v));
     /* Determinism: the same call gives the same bits. */
-    CHECK(tt_tangent_field(mesh, &opt, w, &err) == TT_OK, "dome again: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, w, &err) == TT_OK, "dome again: %s", err.message);
     CHECK(memcmp(v, w, sizeof(float) * 3 * (size_t)mesh->nfaces) == 0, "two identical calls differ");
     free(v);
     free(w);
@@ -296,7 +308,7 @@ static void test_field_fallback(void)
     }
     CHECK(build(&m, TT_MESH_PERMISSIVE, &mesh, &err) == TT_OK, "grid + torus + sliver builds: %s", err.message);
     v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid + torus + sliver: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "grid + torus + sliver: %s", err.message);
     f = mesh->nfaces - 1;
     CHECK(v[3 * f] == 0.0f && v[3 * f + 1] == 0.0f && v[3 * f + 2] == 0.0f, "zero-area face: (%g, %g, %g)", v[3 * f],
           v[3 * f + 1], v[3 * f + 2]);
@@ -342,7 +354,7 @@ static void test_field_constraints(void)
     con[0].vector[0] = 0.3f; con[0].vector[1] = 0.4f; con[0].vector[2] = 5.0f;   /* z is projected away */
     opt.constraints = con;
     opt.nconstraints = 1;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid, one constraint: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "grid, one constraint: %s", err.message);
     {
         /* Direction from the projection (0.6, 0.8, 0), length |vector| (the scale). */
         double l = sqrt(0.3 * 0.3 + 0.4 * 0.4 + 5.0 * 5.0);
@@ -371,7 +383,7 @@ static void test_field_constraints(void)
     con[2].weight = 2.0f;
     opt.constraints = con;
     opt.nconstraints = 3;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "torus, constraints: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "torus, constraints: %s", err.message);
     check_field_plane_length(mesh, v, -1.0, "torus, constraints (plane only)");
     for (k = 0; k < 3; k++) {
         float n[3];
@@ -424,7 +436,7 @@ static void test_field_constraints(void)
     opt.constraints = con;
     opt.nconstraints = 1;
     opt.scale = 0.7f;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "grid + torus, constraint: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "grid + torus, constraint: %s", err.message);
     bad = 0;
     for (f = 0; f < 9; f++)
         if (!near(v[3 * f], 0.5, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
@@ -471,56 +483,56 @@ static void test_field_errors(void)
     } while (0)
 
     memset(&opt, 0, sizeof opt);
-    FIELD_EXPECT(tt_tangent_field(NULL, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL mesh");
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL output");
-    CHECK(tt_tangent_field(NULL, &opt, v, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL error pointer is allowed");
+    FIELD_EXPECT(tt_tangent_field(NULL, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL mesh");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, NULL, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL output");
+    CHECK(tt_tangent_field(NULL, &opt, NULL, v, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL error pointer is allowed");
     opt.up[0] = nan_f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN up");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN up");
     opt.up[0] = 1e-45f;   /* denormal: non-zero, still a direction */
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "tiny up is a direction: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "tiny up is a direction: %s", err.message);
     opt.up[0] = 0.0f;
     opt.scale = -1.0f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative scale");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative scale");
     opt.scale = 1.0f / 0.0f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "infinite scale");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "infinite scale");
     opt.scale = 0.0f;
     opt.sigma = nan_f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN sigma");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NaN sigma");
     opt.sigma = 0.0f;
     opt.nconstraints = -1;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative nconstraints");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "negative nconstraints");
     opt.nconstraints = 1;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL constraints");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, -1, "NULL constraints");
 
     memset(con, 0, sizeof con);
     con[0].face = 3; con[0].vector[0] = 1.0f;
     con[1].face = 16; con[1].vector[1] = 1.0f;
     opt.constraints = con;
     opt.nconstraints = 2;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 16, "face == nfaces");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 16, "face == nfaces");
     CHECK(msg_has_number(err.message, 16) && msg_has_number(err.message, 1) && strstr(err.message, "constraint"),
           "the message names constraint 1 and face 16: %s", err.message);
     con[1].face = -1;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, -1, "face -1");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INDEX_OUT_OF_RANGE, -1, "face -1");
     con[1].face = 5;
     con[1].vector[1] = 0.0f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "zero vector");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "zero vector");
     CHECK(strstr(err.message, "constraint 1") != NULL, "the message names constraint 1: %s", err.message);
     con[1].vector[2] = 1.0f;   /* along the grid's normal */
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "perpendicular vector");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "perpendicular vector");
     con[1].vector[2] = 0.0f;
     con[1].vector[1] = nan_f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_NON_FINITE, 5, "NaN vector");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_NON_FINITE, 5, "NaN vector");
     con[1].vector[1] = 1.0f / 0.0f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_NON_FINITE, 5, "infinite vector");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_NON_FINITE, 5, "infinite vector");
     con[1].vector[1] = 1.0f;
     con[1].weight = -1.0f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative weight");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative weight");
     con[1].weight = 0.0f;
     con[1].sigma = -2.0f;
-    FIELD_EXPECT(tt_tangent_field(mesh, &opt, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative sigma");
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative sigma");
     con[1].sigma = 0.0f;
-    CHECK(tt_tangent_field(mesh, &opt, v, &err) == TT_OK, "valid constraints: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "valid constraints: %s", err.message);
 
     /* A constraint on a zero-area face (permissive mesh). */
     memset(&md, 0, sizeof md);
@@ -532,10 +544,100 @@ static void test_field_errors(void)
     CHECK(build(&md, TT_MESH_PERMISSIVE, &dmesh, &err) == TT_OK, "sliver mesh builds: %s", err.message);
     con[0].face = 2;
     opt.nconstraints = 1;
-    FIELD_EXPECT(tt_tangent_field(dmesh, &opt, v, &err), TT_ERROR_ZERO_AREA_FACE, 2, "constraint on a zero-area face");
+    FIELD_EXPECT(tt_tangent_field(dmesh, &opt, NULL, v, &err), TT_ERROR_ZERO_AREA_FACE, 2, "constraint on a zero-area face");
 #undef FIELD_EXPECT
     tt_mesh_free(dmesh);
     tm_free(&md);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* Every constraint error names the constraint in error->item and its face
+   in error->face. The bad constraint sits at index 2, after two good ones,
+   so item cannot be confused with 0 or with the face. */
+static void test_field_constraint_items(void)
+{
+    tmesh m, md;
+    tt_mesh *mesh = NULL, *dmesh = NULL;
+    tt_field_options opt;
+    tt_field_constraint con[4];
+    tt_error err;
+    float *v;
+    float nan_f = (float)internal_not_a_number();
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 4, 4);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+
+#define ITEM_EXPECT(code, item_, face_, what)                                                                   \
+    do {                                                                                                        \
+        tt_result r_;                                                                                           \
+        memset(&err, 0x5a, sizeof err);                                                                         \
+        r_ = tt_tangent_field(mesh, &opt, NULL, v, &err);                                                       \
+        CHECK(r_ == (code) && err.result == (code) && err.item == (item_) && err.face == (face_) &&             \
+                  err.corner == -1 && err.vertex == -1 && err.row == -1 && err.column == -1 &&                  \
+                  err.message[0] != '\0' && strlen(err.message) < sizeof err.message &&                         \
+                  longest_digit_run(err.message) <= 12,                                                         \
+              "%s: expected %d (item %d, face %d), got %d (item %d, face %d, corner %d): %.100s", what,         \
+              (int)(code), item_, face_, (int)r_, err.item, err.face, err.corner, err.message);                 \
+        CHECK(strstr(err.message, "constraint 2") != NULL, "%s: the message names constraint 2: %.100s", what,  \
+              err.message);                                                                                     \
+    } while (0)
+
+    memset(&opt, 0, sizeof opt);
+    memset(con, 0, sizeof con);
+    con[0].face = 3; con[0].vector[0] = 1.0f;
+    con[1].face = 9; con[1].vector[1] = 0.5f;
+    con[2].face = 11; con[2].vector[0] = 0.7f; con[2].vector[1] = 0.7f;
+    con[3].face = 14; con[3].vector[1] = -1.0f;
+    opt.constraints = con;
+    opt.nconstraints = 4;
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK && err.item == -1,
+          "four valid constraints: %s (item %d)", err.message, err.item);
+
+    con[2].face = mesh->nfaces + 5;
+    ITEM_EXPECT(TT_ERROR_INDEX_OUT_OF_RANGE, 2, mesh->nfaces + 5, "constraint 2 on face nfaces + 5");
+    con[2].face = -3;
+    ITEM_EXPECT(TT_ERROR_INDEX_OUT_OF_RANGE, 2, -3, "constraint 2 on face -3");
+    con[2].face = 11;
+    con[2].vector[1] = nan_f;
+    ITEM_EXPECT(TT_ERROR_NON_FINITE, 2, 11, "constraint 2 with a NaN vector");
+    con[2].vector[1] = 0.7f;
+    con[2].sigma = -0.5f;
+    ITEM_EXPECT(TT_ERROR_INVALID_ARGUMENT, 2, 11, "constraint 2 with a negative sigma");
+    con[2].sigma = 0.0f;
+    con[2].vector[0] = con[2].vector[1] = con[2].vector[2] = 0.0f;
+    ITEM_EXPECT(TT_ERROR_INVALID_ARGUMENT, 2, 11, "constraint 2 with a zero vector");
+    con[2].vector[2] = 3.0f;   /* along the grid's normal */
+    ITEM_EXPECT(TT_ERROR_INVALID_ARGUMENT, 2, 11, "constraint 2 perpendicular to its face");
+    con[2].vector[0] = 0.001f;   /* projects to 1/3000 of its length: still perpendicular */
+    ITEM_EXPECT(TT_ERROR_INVALID_ARGUMENT, 2, 11, "constraint 2 nearly perpendicular to its face");
+    con[2].vector[0] = 0.7f;
+    con[2].vector[2] = 0.0f;
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "restored: %s", err.message);
+
+    /* A constraint on a zero-area face (permissive mesh): faces 0..7 are the
+       grid, face 8 the sliver. */
+    memset(&md, 0, sizeof md);
+    make_grid(&md, 4, 2);
+    {
+        int a = tm_vert(&md, 5, 0, 0), b = tm_vert(&md, 6, 0, 0), c = tm_vert(&md, 7, 0, 0);
+        tm_tri(&md, a, b, c);
+    }
+    CHECK(build(&md, TT_MESH_PERMISSIVE, &dmesh, &err) == TT_OK, "sliver mesh builds: %s", err.message);
+    if (dmesh) {
+        tt_mesh *grid = mesh;
+        mesh = dmesh;
+        con[1].face = 5;
+        con[2].face = 8;
+        con[3].face = 7;
+        ITEM_EXPECT(TT_ERROR_ZERO_AREA_FACE, 2, 8, "constraint 2 on the zero-area face 8");
+        mesh = grid;
+    }
+#undef ITEM_EXPECT
+    tt_mesh_free(dmesh);
+    tm_free(&md);
+    free(v);
     tt_mesh_free(mesh);
     tm_free(&m);
 }
@@ -558,8 +660,7 @@ static tt_result field_oom_call(void *ctx, const tt_allocator *al)
     memcpy(opt.up, c->up, sizeof opt.up);
     opt.constraints = c->constraints;
     opt.nconstraints = c->nconstraints;
-    opt.allocator = *al;
-    r = tt_tangent_field(c->mesh, &opt, c->out, &err);
+    r = tt_tangent_field(c->mesh, &opt, al, c->out, &err);
     if (err.result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
@@ -601,10 +702,13 @@ static void test_field_oom(void)
 /* ------------------------------------------------------------------------ */
 
 /* A smooth, opaque RGB test source. */
-static void patch_source(tt_image *img, int w, int h)
+static tt_image *patch_source(int w, int h)
 {
+    tt_image *img = NULL;
     int x, y;
-    tt_image_create(img, w, h, NULL);
+    tt_result r = tt_image_create(w, h, NULL, &img, NULL);
+    CHECK(r == TT_OK && img, "tt_image_create(%d, %d): %d", w, h, (int)r);
+    if (!img) return NULL;
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
             float *p = img->pixels + 4 * (y * w + x);
@@ -613,6 +717,7 @@ static void patch_source(tt_image *img, int w, int h)
             p[2] = 0.7f;
             p[3] = 1.0f;
         }
+    return img;
 }
 
 /* Brute force: distance from texel (x, y)'s centre to the nearest texel centre
@@ -660,20 +765,20 @@ static void patch_check_ramp(const tt_image *patch, const unsigned char *in, flo
 
 static void test_patch_splotch(void)
 {
-    tt_image src, patch;
+    tt_image *src, *patch = NULL;
     tt_patch_options opt;
     tt_error err;
     int w = 96, h = 80, x, y, inside = 0, half = 0, border_bad = 0, deep_bad = 0, pm_bad = 0, contour_bad = 0;
     unsigned char *in = (unsigned char *)malloc((size_t)(w * h));
-    patch_source(&src, w, h);
+    src = patch_source(w, h);
     memset(&opt, 0, sizeof opt);
     opt.seed = 7;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_OK, "splotch: ok (%s)", err.message);
-    CHECK(patch.width == w && patch.height == h && patch.pixels, "splotch: %d x %d patch", patch.width, patch.height);
-    if (patch.pixels) {
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_OK, "splotch: ok (%s)", err.message);
+    CHECK(patch->width == w && patch->height == h && patch->pixels, "splotch: %d x %d patch", patch->width, patch->height);
+    if (patch) {
         for (y = 0; y < h; y++)
             for (x = 0; x < w; x++) {
-                const float *p = patch.pixels + 4 * (y * w + x), *s = src.pixels + 4 * (y * w + x);
+                const float *p = patch->pixels + 4 * (y * w + x), *s = src->pixels + 4 * (y * w + x);
                 in[y * w + x] = (unsigned char)(p[3] > 0.0f);
                 inside += p[3] > 0.0f;
                 half += p[3] >= 0.5f;
@@ -689,201 +794,201 @@ static void test_patch_splotch(void)
         CHECK(pm_bad == 0, "premultiplied exactly: %d texels differ", pm_bad);
         /* Deep inside (the centre region) alpha is 1. */
         for (y = h / 2 - 10; y < h / 2 + 10; y++)
-            for (x = w / 2 - 10; x < w / 2 + 10; x++) deep_bad += patch.pixels[4 * (y * w + x) + 3] != 1.0f;
+            for (x = w / 2 - 10; x < w / 2 + 10; x++) deep_bad += patch->pixels[4 * (y * w + x) + 3] != 1.0f;
         CHECK(deep_bad == 0, "alpha is 1 in the centre: %d texels are not", deep_bad);
         /* The 0.5 contour lies falloff/2 texels inside the shape's edge: every
            texel with alpha >= 0.5 is at least 2 texels from an outside centre,
            every one with 0 < alpha < 0.5 at most 2 (falloff 3: depth 0.5 + 1.5). */
         for (y = 0; y < h; y++)
             for (x = 0; x < w; x++) {
-                float a = patch.pixels[4 * (y * w + x) + 3];
+                float a = patch->pixels[4 * (y * w + x) + 3];
                 double d = patch_brute_depth(in, w, h, x, y);
                 if (a >= 0.5f && d < 2.0 - 1e-6) contour_bad++;
                 if (a > 0.0f && a < 0.5f && d > 2.0 + 1e-6) contour_bad++;
             }
         CHECK(contour_bad == 0, "the 0.5 contour is falloff/2 = 1.5 texels inside the edge: %d texels off",
               contour_bad);
-        patch_check_ramp(&patch, in, 3.0f, "splotch, falloff 3");
+        patch_check_ramp(patch, in, 3.0f, "splotch, falloff 3");
     }
-    tt_image_free(&patch);
+    tt_image_free(patch);
     /* A wider falloff is honoured too. */
     opt.falloff = 6.5f;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_OK, "falloff 6.5: ok (%s)", err.message);
-    if (patch.pixels) {
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_OK, "falloff 6.5: ok (%s)", err.message);
+    if (patch) {
         int ramp = 0;
         for (y = 0; y < h; y++)
             for (x = 0; x < w; x++) {
-                float a = patch.pixels[4 * (y * w + x) + 3];
+                float a = patch->pixels[4 * (y * w + x) + 3];
                 in[y * w + x] = (unsigned char)(a > 0.0f);
                 if ((x < 6 || y < 6 || x >= w - 6 || y >= h - 6) && a != 0.0f) border_bad++;
                 ramp += a > 0.0f && a < 1.0f;
             }
         CHECK(border_bad == 0, "falloff 6.5: margin of 6.5 texels is transparent: %d texels are not", border_bad);
         CHECK(ramp > 6 * 150, "falloff 6.5: a wide ramp (%d texels between 0 and 1)", ramp);
-        patch_check_ramp(&patch, in, 6.5f, "splotch, falloff 6.5");
+        patch_check_ramp(patch, in, 6.5f, "splotch, falloff 6.5");
     }
-    tt_image_free(&patch);
-    tt_image_free(&src);
+    tt_image_free(patch);
+    tt_image_free(src);
     free(in);
 }
 
 static void test_patch_seeds(void)
 {
-    tt_image src, a, b, c;
+    tt_image *src, *a = NULL, *b = NULL, *c = NULL;
     tt_patch_options opt;
     int w = 64, h = 64, seed, differ = 0, min_cov = w * h, max_cov = 0;
     size_t i;
-    patch_source(&src, w, h);
+    src = patch_source(w, h);
     memset(&opt, 0, sizeof opt);
     opt.seed = 123;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &a, NULL) == TT_OK, "seed 123: ok");
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &b, NULL) == TT_OK, "seed 123 again: ok");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &a, NULL) == TT_OK, "seed 123: ok");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &b, NULL) == TT_OK, "seed 123 again: ok");
     opt.seed = 124;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &c, NULL) == TT_OK, "seed 124: ok");
-    if (a.pixels && b.pixels && c.pixels) {
-        CHECK(memcmp(a.pixels, b.pixels, sizeof(float) * 4 * (size_t)(w * h)) == 0, "same seed, same patch");
-        for (i = 0; i < (size_t)(w * h); i++) differ += (a.pixels[4 * i + 3] > 0.0f) != (c.pixels[4 * i + 3] > 0.0f);
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &c, NULL) == TT_OK, "seed 124: ok");
+    if (a && b && c) {
+        CHECK(memcmp(a->pixels, b->pixels, sizeof(float) * 4 * (size_t)(w * h)) == 0, "same seed, same patch");
+        for (i = 0; i < (size_t)(w * h); i++) differ += (a->pixels[4 * i + 3] > 0.0f) != (c->pixels[4 * i + 3] > 0.0f);
         CHECK(differ > 20, "seeds 123 and 124 give different shapes: %d texels differ", differ);
     }
-    tt_image_free(&a);
-    tt_image_free(&b);
-    tt_image_free(&c);
+    tt_image_free(a);
+    tt_image_free(b);
+    tt_image_free(c);
     /* Coverage holds over many seeds, and at the roughest setting. */
     for (seed = 0; seed < 40; seed++) {
         int cov = 0;
         opt.seed = (uint64_t)seed * 0x9e3779b97f4a7c15ull;
         opt.roughness = seed < 20 ? 0.0f : 0.6f;
-        if (tt_make_texture_patch(&src, NULL, &opt, &a, NULL) != TT_OK) { cov = -1; }
+        if (tt_make_texture_patch(src, NULL, &opt, NULL, &a, NULL) != TT_OK) { cov = -1; }
         else {
-            for (i = 0; i < (size_t)(w * h); i++) cov += a.pixels[4 * i + 3] > 0.0f;
-            tt_image_free(&a);
+            for (i = 0; i < (size_t)(w * h); i++) cov += a->pixels[4 * i + 3] > 0.0f;
+            tt_image_free(a);
         }
         if (cov < min_cov) min_cov = cov;
         if (cov > max_cov) max_cov = cov;
     }
     CHECK(min_cov >= 0.60 * w * h && max_cov <= 0.75 * w * h, "40 seeds: coverage %.1f%% .. %.1f%%",
           100.0 * min_cov / (w * h), 100.0 * max_cov / (w * h));
-    tt_image_free(&src);
+    tt_image_free(src);
 }
 
 static void test_patch_masks(void)
 {
-    tt_image src, mask, patch;
+    tt_image *src, *mask = NULL, *patch = NULL;
     tt_error err;
     int w = 40, h = 30, x, y, bad = 0;
     unsigned char *in = (unsigned char *)malloc((size_t)(w * h));
-    patch_source(&src, w, h);
-    tt_image_create(&mask, w, h, NULL);
+    src = patch_source(w, h);
+    tt_image_create(w, h, NULL, &mask, NULL);
     /* Grey mask (opaque): a rectangle of grey 0.6 plus a stray 0.4 texel (outside). */
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            float *p = mask.pixels + 4 * (y * w + x);
+            float *p = mask->pixels + 4 * (y * w + x);
             float g = (x >= 5 && x < 35 && y >= 4 && y < 26) ? 0.6f : 0.0f;
             if (x == 1 && y == 1) g = 0.4f;
             p[0] = p[1] = p[2] = g;
             p[3] = 1.0f;
             in[y * w + x] = (unsigned char)(g >= 0.5f);
         }
-    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "grey mask: ok (%s)", err.message);
-    if (patch.pixels) {
-        patch_check_ramp(&patch, in, 3.0f, "grey mask");
-        CHECK(patch.pixels[4 * (15 * w + 20) + 3] == 1.0f, "grey mask: centre alpha 1, got %g",
-              patch.pixels[4 * (15 * w + 20) + 3]);
-        CHECK(patch.pixels[4 * (4 * w + 20) + 3] > 0.16f && patch.pixels[4 * (4 * w + 20) + 3] < 0.17f,
-              "grey mask: edge texel alpha 0.5/3, got %g", patch.pixels[4 * (4 * w + 20) + 3]);
+    CHECK(tt_make_texture_patch(src, mask, NULL, NULL, &patch, &err) == TT_OK, "grey mask: ok (%s)", err.message);
+    if (patch) {
+        patch_check_ramp(patch, in, 3.0f, "grey mask");
+        CHECK(patch->pixels[4 * (15 * w + 20) + 3] == 1.0f, "grey mask: centre alpha 1, got %g",
+              patch->pixels[4 * (15 * w + 20) + 3]);
+        CHECK(patch->pixels[4 * (4 * w + 20) + 3] > 0.16f && patch->pixels[4 * (4 * w + 20) + 3] < 0.17f,
+              "grey mask: edge texel alpha 0.5/3, got %g", patch->pixels[4 * (4 * w + 20) + 3]);
     }
-    tt_image_free(&patch);
+    tt_image_free(patch);
     /* Mask alpha (not all 1): alpha is used, the grey ignored. */
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            float *p = mask.pixels + 4 * (y * w + x);
+            float *p = mask->pixels + 4 * (y * w + x);
             int inside = (x - 20) * (x - 20) + (y - 15) * (y - 15) <= 100;
             p[0] = p[1] = p[2] = 1.0f - (float)inside;   /* grey says the opposite */
             p[3] = inside ? 0.75f : 0.25f;
             in[y * w + x] = (unsigned char)inside;
         }
-    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "alpha mask: ok (%s)", err.message);
-    if (patch.pixels) patch_check_ramp(&patch, in, 3.0f, "alpha mask");
-    tt_image_free(&patch);
+    CHECK(tt_make_texture_patch(src, mask, NULL, NULL, &patch, &err) == TT_OK, "alpha mask: ok (%s)", err.message);
+    if (patch) patch_check_ramp(patch, in, 3.0f, "alpha mask");
+    tt_image_free(patch);
     /* Source alpha takes precedence over the mask: a band x in [10, 30). */
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            src.pixels[4 * (y * w + x) + 3] = (x >= 10 && x < 30) ? 1.0f : 0.0f;
+            src->pixels[4 * (y * w + x) + 3] = (x >= 10 && x < 30) ? 1.0f : 0.0f;
             in[y * w + x] = (unsigned char)(x >= 10 && x < 30);
         }
-    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "source alpha: ok (%s)", err.message);
-    if (patch.pixels) {
-        patch_check_ramp(&patch, in, 3.0f, "source alpha over mask");
+    CHECK(tt_make_texture_patch(src, mask, NULL, NULL, &patch, &err) == TT_OK, "source alpha: ok (%s)", err.message);
+    if (patch) {
+        patch_check_ramp(patch, in, 3.0f, "source alpha over mask");
         for (y = 0; y < h; y++)
             for (x = 0; x < w; x++) {
-                const float *p = patch.pixels + 4 * (y * w + x), *s = src.pixels + 4 * (y * w + x);
+                const float *p = patch->pixels + 4 * (y * w + x), *s = src->pixels + 4 * (y * w + x);
                 if (p[0] != s[0] * p[3] || p[1] != s[1] * p[3] || p[2] != s[2] * p[3]) bad++;
             }
         CHECK(bad == 0, "source alpha: premultiplied exactly, %d texels differ", bad);
     }
-    tt_image_free(&patch);
+    tt_image_free(patch);
     /* A fully opaque grey mask still fades out at the image border. */
-    for (y = 0; y < h * w * 4; y++) mask.pixels[y] = 1.0f;
-    for (y = 0; y < h * w; y++) { src.pixels[4 * y + 3] = 1.0f; in[y] = 1; }
-    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_OK, "full mask: ok (%s)", err.message);
-    if (patch.pixels) patch_check_ramp(&patch, in, 3.0f, "full mask");
-    tt_image_free(&patch);
-    tt_image_free(&mask);
-    tt_image_free(&src);
+    for (y = 0; y < h * w * 4; y++) mask->pixels[y] = 1.0f;
+    for (y = 0; y < h * w; y++) { src->pixels[4 * y + 3] = 1.0f; in[y] = 1; }
+    CHECK(tt_make_texture_patch(src, mask, NULL, NULL, &patch, &err) == TT_OK, "full mask: ok (%s)", err.message);
+    if (patch) patch_check_ramp(patch, in, 3.0f, "full mask");
+    tt_image_free(patch);
+    tt_image_free(mask);
+    tt_image_free(src);
     free(in);
 }
 
 static void test_patch_errors(void)
 {
-    tt_image src, mask, patch, empty;
+    tt_image *src, *mask = NULL, *patch = NULL, empty;
     tt_patch_options opt;
     tt_error err;
     float nan_value = (float)internal_not_a_number();
-    patch_source(&src, 32, 32);
+    src = patch_source(32, 32);
     memset(&empty, 0, sizeof empty);
     memset(&opt, 0, sizeof opt);
-    CHECK(tt_make_texture_patch(NULL, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL source");
-    CHECK(tt_make_texture_patch(&empty, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty source");
-    CHECK(tt_make_texture_patch(&src, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL patch");
-    tt_image_create(&mask, 31, 32, NULL);
-    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "mask size");
+    CHECK(tt_make_texture_patch(NULL, NULL, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL source");
+    CHECK(tt_make_texture_patch(&empty, NULL, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty source");
+    CHECK(tt_make_texture_patch(src, NULL, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL patch");
+    tt_image_create(31, 32, NULL, &mask, NULL);
+    CHECK(tt_make_texture_patch(src, mask, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "mask size");
     CHECK(strstr(err.message, "31 x 32") && strstr(err.message, "32 x 32"), "size message: %s", err.message);
-    CHECK(patch.pixels == NULL && patch.width == 0, "patch left empty on error");
-    tt_image_free(&mask);
-    tt_image_create(&mask, 32, 32, NULL);   /* all zero: transparent black */
-    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty mask");
+    CHECK(patch == NULL, "patch left NULL on error");
+    tt_image_free(mask);
+    tt_image_create(32, 32, NULL, &mask, NULL);   /* all zero: transparent black */
+    CHECK(tt_make_texture_patch(src, mask, NULL, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "empty mask");
     CHECK(strstr(err.message, "the mask has no opaque pixel") != NULL, "empty mask message: %s", err.message);
     CHECK(err.result == TT_ERROR_INVALID_ARGUMENT, "err.result set: %d", err.result);
-    mask.pixels[3] = nan_value;
-    CHECK(tt_make_texture_patch(&src, &mask, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "NaN mask: %s", err.message);
-    tt_image_free(&mask);
+    mask->pixels[3] = nan_value;
+    CHECK(tt_make_texture_patch(src, mask, NULL, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "NaN mask: %s", err.message);
+    tt_image_free(mask);
     opt.falloff = -1.0f;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "negative falloff");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "negative falloff");
     CHECK(strstr(err.message, "negative") != NULL, "negative falloff message: %s", err.message);
     opt.falloff = 15.0f;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 15 on 32: %s",
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 15 on 32: %s",
           err.message);
     opt.falloff = 10.0f;   /* room for a splotch, but it is not 10 texels deep */
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 10 on 32: %s",
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "falloff 10 on 32: %s",
           err.message);
     CHECK(strstr(err.message, "no opaque texel") != NULL, "falloff 10 message: %s", err.message);
     opt.falloff = internal_infinity();
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "infinite falloff");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "infinite falloff");
     opt.falloff = nan_value;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN falloff");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "NaN falloff");
     opt.falloff = 0.0f;
     opt.roughness = nan_value;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN roughness");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "NaN roughness");
     opt.roughness = 1.0f;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness 1");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness 1");
     opt.roughness = -0.5f;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness -0.5");
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_INVALID_ARGUMENT, "roughness -0.5");
     opt.roughness = 0.0f;
-    src.pixels[4 * 33 + 1] = nan_value;
-    CHECK(tt_make_texture_patch(&src, NULL, &opt, &patch, &err) == TT_ERROR_NON_FINITE, "NaN source");
+    src->pixels[4 * 33 + 1] = nan_value;
+    CHECK(tt_make_texture_patch(src, NULL, &opt, NULL, &patch, &err) == TT_ERROR_NON_FINITE, "NaN source");
     CHECK(strstr(err.message, "(1, 1)") != NULL, "NaN source names the texel: %s", err.message);
-    CHECK(patch.pixels == NULL, "patch left empty on error");
-    tt_image_free(&src);
+    CHECK(patch == NULL, "patch left NULL on error");
+    tt_image_free(src);
 }
 
 typedef struct patch_oom_ctx {
@@ -895,37 +1000,36 @@ static tt_result patch_oom_call(void *ctx, const tt_allocator *al)
 {
     patch_oom_ctx *c = (patch_oom_ctx *)ctx;
     tt_patch_options opt;
-    tt_image patch;
+    tt_image *patch = (tt_image *)ctx;   /* must be reset to NULL on failure */
     tt_error err;
     tt_result r;
     memset(&opt, 0, sizeof opt);
     opt.seed = c->seed;
-    opt.allocator = *al;
-    r = tt_make_texture_patch(c->source, c->mask, &opt, &patch, &err);
-    if (r != TT_OK && (patch.pixels != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
-    tt_image_free(&patch);
+    r = tt_make_texture_patch(c->source, c->mask, &opt, al, &patch, &err);
+    if (r != TT_OK && (patch != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
+    tt_image_free(patch);
     return r;
 }
 
 static void test_patch_oom(void)
 {
-    tt_image src, mask;
+    tt_image *src, *mask = NULL;
     patch_oom_ctx c;
     int i;
-    patch_source(&src, 24, 20);
-    tt_image_create(&mask, 24, 20, NULL);
-    for (i = 0; i < 24 * 20; i++) mask.pixels[4 * i + 3] = (i % 24 > 4 && i % 24 < 20) ? 1.0f : 0.0f;
+    src = patch_source(24, 20);
+    tt_image_create(24, 20, NULL, &mask, NULL);
+    for (i = 0; i < 24 * 20; i++) mask->pixels[4 * i + 3] = (i % 24 > 4 && i % 24 < 20) ? 1.0f : 0.0f;
     oom_reset();
-    c.source = &src;
+    c.source = src;
     c.mask = NULL;
     c.seed = 3;
     oom_sweep("tt_make_texture_patch(splotch)", patch_oom_call, &c, TT_OK);
-    c.mask = &mask;
+    c.mask = mask;
     oom_sweep("tt_make_texture_patch(mask)", patch_oom_call, &c, TT_OK);
-    memset(mask.pixels, 0, sizeof(float) * 4 * 24 * 20);
+    memset(mask->pixels, 0, sizeof(float) * 4 * 24 * 20);
     oom_sweep("tt_make_texture_patch(empty mask)", patch_oom_call, &c, TT_ERROR_INVALID_ARGUMENT);
-    tt_image_free(&mask);
-    tt_image_free(&src);
+    tt_image_free(mask);
+    tt_image_free(src);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -967,29 +1071,31 @@ static void make_lapped_shape(tmesh *out, int which)
 static const char *const LAPPED_SHAPE_NAMES[4] = {"sphere", "open sheet", "two spheres", "torus"};
 
 /* A texture patch from value noise with a seeded splotch. */
-static void lapped_patch(tt_image *patch, int size, unsigned seed)
+static tt_image *lapped_patch(int size, unsigned seed)
 {
-    tt_image src;
+    tt_image *src = NULL, *patch = NULL;
     tt_patch_options po;
     tt_error err;
+    tt_result r;
     make_value_noise(&src, size, size, seed);
     memset(&po, 0, sizeof po);
     po.seed = seed;
-    memset(patch, 0, sizeof *patch);
-    tt_make_texture_patch(&src, NULL, &po, patch, &err);
-    tt_image_free(&src);
+    r = tt_make_texture_patch(src, NULL, &po, NULL, &patch, &err);
+    CHECK(r == TT_OK && patch, "lapped_patch(%d, %u): %d %s", size, seed, (int)r, err.message);
+    tt_image_free(src);
+    return patch;
 }
 
 /* Composite alpha of every entry of face f at barycentric point w, the
    pastes drawn in order with "over", recomputed from the output alone. */
-static double lapped_alpha_at(const tt_lapped *lapped, const tt_image *patches, int f, const double w[3])
+static double lapped_alpha_at(const tt_lapped *lapped, tt_image *const *patches, int f, const double w[3])
 {
     double alpha = 0.0;
     int p, e;
     for (p = 0; p < lapped->npastes; p++)
         for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) {
             const float *uv = lapped->uv + 6 * (size_t)e;
-            const tt_image *im = &patches[lapped->pastes[p].patch];
+            const tt_image *im = patches[lapped->pastes[p].patch];
             float rgba[4];
             double u, v;
             if (lapped->faces[e] != f) continue;
@@ -1026,79 +1132,85 @@ static void lapped_entry_error(const tt_mesh *mesh, const float *field, const tt
     *angle = fabs(atan2(pu, pv)) * 180.0 / 3.14159265358979323846;
 }
 
+/* An address no tt_lapped_paste returns: outputs are preset to it, to see
+   that a failing call resets them to NULL. */
+static tt_lapped g_lapped_sentinel;
+
 static int lapped_run(const tmesh *m, int isotropic, uint64_t seed, float scale, tt_mesh **mesh, float **field,
-                      tt_image *patch, tt_lapped *out)
+                      tt_image *patch, tt_lapped **out)
 {
-    tt_mesh_desc d = tm_desc(m);
     tt_field_options fo;
     tt_lapped_options lo;
     tt_error err;
     tt_result r;
     *mesh = NULL;
     *field = NULL;
-    memset(out, 0, sizeof *out);
-    if (tt_mesh_build(&d, mesh, &err) != TT_OK) return -1;
+    *out = NULL;
+    if (build(m, 0, mesh, &err) != TT_OK) return -1;
     *field = (float *)malloc(sizeof(float) * 3 * (size_t)(*mesh)->nfaces);
     memset(&fo, 0, sizeof fo);
     fo.scale = scale;
-    if (tt_tangent_field(*mesh, &fo, *field, &err) != TT_OK) return -1;
+    if (tt_tangent_field(*mesh, &fo, NULL, *field, &err) != TT_OK) return -1;
     memset(&lo, 0, sizeof lo);
     lo.seed = seed;
     lo.isotropic = isotropic;
-    r = tt_lapped_paste(*mesh, *field, patch, 1, &lo, out, &err);
-    CHECK(r == TT_OK, "tt_lapped_paste: %d %s", r, err.message);
-    return r == TT_OK ? 0 : -1;
+    *out = &g_lapped_sentinel;   /* tt_lapped_paste must set it */
+    r = tt_lapped_paste(*mesh, *field, &patch, 1, &lo, NULL, out, &err);
+    CHECK(r == TT_OK && *out != NULL, "tt_lapped_paste: %d %s", r, err.message);
+    CHECK(r == TT_OK || *out == NULL, "tt_lapped_paste failed but left *out_lapped set");
+    if (r != TT_OK) *out = NULL;   /* never free the sentinel */
+    return r == TT_OK && *out ? 0 : -1;
 }
 
 static void test_lapped_cover(void)
 {
-    tt_image patch;
+    tt_image *patch;
     int shape, iso;
-    lapped_patch(&patch, 64, 5);
+    patch = lapped_patch(64, 5);
     for (shape = 0; shape < 4; shape++)
         for (iso = 0; iso < 2; iso++) {
             tmesh m;
             tt_mesh *mesh;
             float *field;
-            tt_lapped lapped;
+            tt_lapped *lapped = NULL;
             double angle_sum = 0.0, worst_alpha = 1.0;
             int f, e, p, missing = 0, bad_points = 0, points = 0, bad_entries = 0, order_ok = 1;
             char *seen;
             make_lapped_shape(&m, shape);
-            if (lapped_run(&m, iso, 11, 0.0f, &mesh, &field, &patch, &lapped) != 0) {
+            if (lapped_run(&m, iso, 11, 0.0f, &mesh, &field, patch, &lapped) != 0) {
                 tt_mesh_free(mesh);
                 free(field);
                 tm_free(&m);
                 continue;
             }
             seen = (char *)calloc((size_t)mesh->nfaces, 1);
-            for (p = 0; p < lapped.npastes; p++) {
-                order_ok &= lapped.pastes[p].first == (p ? lapped.pastes[p - 1].first + lapped.pastes[p - 1].nfaces : 0);
-                order_ok &= lapped.pastes[p].nfaces > 0 && lapped.pastes[p].patch == 0;
+            for (p = 0; p < lapped->npastes; p++) {
+                order_ok &= lapped->pastes[p].first == (p ? lapped->pastes[p - 1].first + lapped->pastes[p - 1].nfaces : 0);
+                order_ok &= lapped->pastes[p].nfaces > 0 && lapped->pastes[p].patch == 0;
             }
-            CHECK(order_ok && lapped.npastes > 0, "%s: pastes are not consecutive runs of entries",
+            CHECK(order_ok && lapped->npastes > 0, "%s: pastes are not consecutive runs of entries",
                   LAPPED_SHAPE_NAMES[shape]);
-            CHECK(lapped.npastes == 0 ||
-                      lapped.pastes[lapped.npastes - 1].first + lapped.pastes[lapped.npastes - 1].nfaces ==
-                          lapped.nentries,
+            CHECK(lapped->npastes == 0 ||
+                      lapped->pastes[lapped->npastes - 1].first + lapped->pastes[lapped->npastes - 1].nfaces ==
+                          lapped->nentries,
                   "%s: the pastes do not account for every entry", LAPPED_SHAPE_NAMES[shape]);
-            for (e = 0; e < lapped.nentries; e++) {
+            for (e = 0; e < lapped->nentries; e++) {
                 double angle, length;
                 int k;
-                if (lapped.faces[e] < 0 || lapped.faces[e] >= mesh->nfaces) { bad_entries++; continue; }
-                seen[lapped.faces[e]] = 1;
-                for (k = 0; k < 6; k++) bad_entries += !isfinite(lapped.uv[6 * e + k]);
-                lapped_entry_error(mesh, field, &lapped, e, &angle, &length);
+                if (lapped->faces[e] < 0 || lapped->faces[e] >= mesh->nfaces) { bad_entries++; continue; }
+                seen[lapped->faces[e]] = 1;
+                for (k = 0; k < 6; k++) bad_entries += !isfinite(lapped->uv[6 * e + k]);
+                lapped_entry_error(mesh, field, lapped, e, &angle, &length);
                 angle_sum += angle;
             }
             for (f = 0; f < mesh->nfaces; f++) missing += !seen[f];
             CHECK(bad_entries == 0, "%s: %d entries with a bad face or UV", LAPPED_SHAPE_NAMES[shape], bad_entries);
             CHECK(missing == 0, "%s (isotropic %d): %d faces in no paste", LAPPED_SHAPE_NAMES[shape], iso, missing);
-            CHECK(lapped.coverage == 1.0, "%s: coverage %g", LAPPED_SHAPE_NAMES[shape], lapped.coverage);
-            CHECK(near(lapped.mean_overdraw, (double)lapped.nentries / mesh->nfaces, 1e-12),
-                  "%s: mean overdraw %g != entries / faces", LAPPED_SHAPE_NAMES[shape], lapped.mean_overdraw);
-            CHECK(lapped.mean_overdraw >= 1.0 && lapped.mean_overdraw < 12.0, "%s: overdraw %g",
-                  LAPPED_SHAPE_NAMES[shape], lapped.mean_overdraw);
+            CHECK(lapped->coverage == 1.0, "%s: coverage %g", LAPPED_SHAPE_NAMES[shape], lapped->coverage);
+            CHECK(near(lapped->mean_overdraw, (double)lapped->nentries / mesh->nfaces, 1e-12),
+                  "%s: mean overdraw %g != entries / faces", LAPPED_SHAPE_NAMES[shape], lapped->mean_overdraw);
+            CHECK(lapped->mean_overdraw >= 1.0 && lapped->mean_overdraw < 12.0, "%s: overdraw %g",
+                  LAPPED_SHAPE_NAMES[shape], lapped->mean_overdraw);
             /* Coverage seen from the output alone: random points of every
                face, every paste composited in order, are opaque. */
             lcg_seed(77);
@@ -1108,7 +1220,7 @@ static void test_lapped_cover(void)
                     double w[3], a = lcg_unit(), b = lcg_unit(), alpha;
                     if (a + b > 1.0) { a = 1.0 - a; b = 1.0 - b; }
                     w[0] = 1.0 - a - b; w[1] = a; w[2] = b;
-                    alpha = lapped_alpha_at(&lapped, &patch, f, w);
+                    alpha = lapped_alpha_at(lapped, &patch, f, w);
                     points++;
                     if (alpha < 0.98) bad_points++;
                     if (alpha < worst_alpha) worst_alpha = alpha;
@@ -1116,22 +1228,22 @@ static void test_lapped_cover(void)
             }
             CHECK(bad_points <= points / 500, "%s (isotropic %d): %d of %d random points are not opaque (worst alpha %g)",
                   LAPPED_SHAPE_NAMES[shape], iso, bad_points, points, worst_alpha);
-            if (!iso && lapped.nentries > 0) {
-                CHECK(near(angle_sum / lapped.nentries, lapped.mean_angle_error, 1e-3),
+            if (!iso && lapped->nentries > 0) {
+                CHECK(near(angle_sum / lapped->nentries, lapped->mean_angle_error, 1e-3),
                       "%s: reported mean angle %g, measured from the UVs %g", LAPPED_SHAPE_NAMES[shape],
-                      lapped.mean_angle_error, angle_sum / lapped.nentries);
-                CHECK(lapped.mean_angle_error <= 8.0, "%s: mean angle error %g deg", LAPPED_SHAPE_NAMES[shape],
-                      lapped.mean_angle_error);
+                      lapped->mean_angle_error, angle_sum / lapped->nentries);
+                CHECK(lapped->mean_angle_error <= 8.0, "%s: mean angle error %g deg", LAPPED_SHAPE_NAMES[shape],
+                      lapped->mean_angle_error);
             }
-            CHECK(lapped.median_scale_error <= 0.1, "%s (isotropic %d): median scale error %g",
-                  LAPPED_SHAPE_NAMES[shape], iso, lapped.median_scale_error);
+            CHECK(lapped->median_scale_error <= 0.1, "%s (isotropic %d): median scale error %g",
+                  LAPPED_SHAPE_NAMES[shape], iso, lapped->median_scale_error);
             free(seen);
-            tt_lapped_free(&lapped);
+            tt_lapped_free(lapped);
             tt_mesh_free(mesh);
             free(field);
             tm_free(&m);
         }
-    tt_image_free(&patch);
+    tt_image_free(patch);
 }
 
 /* A flat sheet with a constant field: the optimum maps every face exactly
@@ -1141,33 +1253,33 @@ static void test_lapped_plane(void)
     tmesh g, m;
     tt_mesh *mesh;
     float *field;
-    tt_image patch;
-    tt_lapped lapped;
+    tt_image *patch;
+    tt_lapped *lapped = NULL;
     int e;
     double worst = 0.0, worst_len = 0.0;
     memset(&g, 0, sizeof g);
     make_grid(&g, 20, 20);
     tm_triangulate(&g, &m);
-    lapped_patch(&patch, 48, 9);
-    if (lapped_run(&m, 0, 3, 4.0f, &mesh, &field, &patch, &lapped) == 0) {
-        for (e = 0; e < lapped.nentries; e++) {
+    patch = lapped_patch(48, 9);
+    if (lapped_run(&m, 0, 3, 4.0f, &mesh, &field, patch, &lapped) == 0) {
+        for (e = 0; e < lapped->nentries; e++) {
             double angle, length;
-            lapped_entry_error(mesh, field, &lapped, e, &angle, &length);
+            lapped_entry_error(mesh, field, lapped, e, &angle, &length);
             if (angle > worst) worst = angle;
             if (fabs(length - 1.0) > worst_len) worst_len = fabs(length - 1.0);
         }
         CHECK(worst < 1e-3 && worst_len < 1e-4, "plane: worst angle %g deg, worst scale error %g", worst, worst_len);
-        CHECK(lapped.mean_angle_error < 1e-3 && lapped.median_scale_error < 1e-4, "plane: reported %g deg, %g",
-              lapped.mean_angle_error, lapped.median_scale_error);
+        CHECK(lapped->mean_angle_error < 1e-3 && lapped->median_scale_error < 1e-4, "plane: reported %g deg, %g",
+              lapped->mean_angle_error, lapped->median_scale_error);
         /* a 20 x 20 sheet with 4-unit patches needs a few dozen pastes */
-        CHECK(lapped.npastes >= 20 && lapped.npastes <= 400, "plane: %d pastes", lapped.npastes);
+        CHECK(lapped->npastes >= 20 && lapped->npastes <= 400, "plane: %d pastes", lapped->npastes);
     }
-    tt_lapped_free(&lapped);
+    tt_lapped_free(lapped);
     tt_mesh_free(mesh);
     free(field);
     tm_free(&m);
     tm_free(&g);
-    tt_image_free(&patch);
+    tt_image_free(patch);
 }
 
 static void test_lapped_determinism(void)
@@ -1175,26 +1287,31 @@ static void test_lapped_determinism(void)
     tmesh m;
     tt_mesh *mesh[3];
     float *field[3];
-    tt_image patch;
-    tt_lapped out[3];
+    tt_image *patch;
+    tt_lapped *out[3];
     int i, same, differ;
     make_lapped_shape(&m, 3);
-    lapped_patch(&patch, 48, 2);
-    for (i = 0; i < 3; i++) lapped_run(&m, 0, i == 2 ? 8 : 7, 0.0f, &mesh[i], &field[i], &patch, &out[i]);
-    same = out[0].nentries == out[1].nentries && out[0].npastes == out[1].npastes &&
-           memcmp(out[0].faces, out[1].faces, sizeof(int) * (size_t)out[0].nentries) == 0 &&
-           memcmp(out[0].uv, out[1].uv, sizeof(float) * 6 * (size_t)out[0].nentries) == 0;
-    differ = out[0].nentries != out[2].nentries ||
-             memcmp(out[0].uv, out[2].uv, sizeof(float) * 6 * (size_t)(out[0].nentries < out[2].nentries ? out[0].nentries : out[2].nentries)) != 0;
+    patch = lapped_patch(48, 2);
+    for (i = 0; i < 3; i++) lapped_run(&m, 0, i == 2 ? 8 : 7, 0.0f, &mesh[i], &field[i], patch, &out[i]);
+    same = differ = 0;
+    if (out[0] && out[1] && out[2]) {
+        same = out[0]->nentries == out[1]->nentries && out[0]->npastes == out[1]->npastes &&
+               memcmp(out[0]->faces, out[1]->faces, sizeof(int) * (size_t)out[0]->nentries) == 0 &&
+               memcmp(out[0]->uv, out[1]->uv, sizeof(float) * 6 * (size_t)out[0]->nentries) == 0;
+        differ = out[0]->nentries != out[2]->nentries ||
+                 memcmp(out[0]->uv, out[2]->uv,
+                        sizeof(float) * 6 *
+                            (size_t)(out[0]->nentries < out[2]->nentries ? out[0]->nentries : out[2]->nentries)) != 0;
+    }
     CHECK(same, "the same seed gave different pastes");
     CHECK(differ, "different seeds gave the same pastes");
     for (i = 0; i < 3; i++) {
-        tt_lapped_free(&out[i]);
+        tt_lapped_free(out[i]);
         tt_mesh_free(mesh[i]);
         free(field[i]);
     }
     tm_free(&m);
-    tt_image_free(&patch);
+    tt_image_free(patch);
 }
 
 /* Several texture patches: each paste picks one at random, all get used,
@@ -1202,41 +1319,41 @@ static void test_lapped_determinism(void)
 static void test_lapped_patches(void)
 {
     tmesh m;
-    tt_mesh *mesh;
-    tt_mesh_desc d;
+    tt_mesh *mesh = NULL;
     tt_field_options fo;
     tt_lapped_options lo;
-    tt_lapped out;
+    tt_lapped *out = NULL;
     tt_error err;
-    tt_image patches[3];
+    tt_image *patches[3];
     float *field;
     int used[3] = {0, 0, 0}, p, f, bad = 0;
     tt_result r;
     make_lapped_shape(&m, 0);
-    d = tm_desc(&m);
-    tt_mesh_build(&d, &mesh, &err);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
     field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
     memset(&fo, 0, sizeof fo);
-    tt_tangent_field(mesh, &fo, field, &err);
-    lapped_patch(&patches[0], 48, 1);
-    lapped_patch(&patches[1], 64, 2);
-    lapped_patch(&patches[2], 40, 3);
+    tt_tangent_field(mesh, &fo, NULL, field, &err);
+    patches[0] = lapped_patch(48, 1);
+    patches[1] = lapped_patch(64, 2);
+    patches[2] = lapped_patch(40, 3);
     memset(&lo, 0, sizeof lo);
     lo.seed = 5;
-    r = tt_lapped_paste(mesh, field, patches, 3, &lo, &out, &err);
-    CHECK(r == TT_OK, "three patches: %d %s", r, err.message);
-    for (p = 0; p < out.npastes; p++)
-        if (out.pastes[p].patch >= 0 && out.pastes[p].patch < 3) used[out.pastes[p].patch]++;
-        else bad++;
-    CHECK(bad == 0 && used[0] > 0 && used[1] > 0 && used[2] > 0, "patches used %d %d %d, %d out of range", used[0],
-          used[1], used[2], bad);
-    for (f = 0; f < mesh->nfaces; f++) {
-        double w[3] = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
-        if (lapped_alpha_at(&out, patches, f, w) < 0.98) bad++;
+    r = tt_lapped_paste(mesh, field, patches, 3, &lo, NULL, &out, &err);
+    CHECK(r == TT_OK && out, "three patches: %d %s", r, err.message);
+    if (out) {
+        for (p = 0; p < out->npastes; p++)
+            if (out->pastes[p].patch >= 0 && out->pastes[p].patch < 3) used[out->pastes[p].patch]++;
+            else bad++;
+        CHECK(bad == 0 && used[0] > 0 && used[1] > 0 && used[2] > 0, "patches used %d %d %d, %d out of range",
+              used[0], used[1], used[2], bad);
+        for (f = 0; f < mesh->nfaces; f++) {
+            double w[3] = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
+            if (lapped_alpha_at(out, patches, f, w) < 0.98) bad++;
+        }
+        CHECK(bad == 0, "three patches: %d face centres not opaque", bad);
     }
-    CHECK(bad == 0, "three patches: %d face centres not opaque", bad);
-    tt_lapped_free(&out);
-    for (p = 0; p < 3; p++) tt_image_free(&patches[p]);
+    tt_lapped_free(out);
+    for (p = 0; p < 3; p++) tt_image_free(patches[p]);
     tt_mesh_free(mesh);
     free(field);
     tm_free(&m);
@@ -1251,110 +1368,181 @@ typedef struct lapped_progress {
 static int lapped_progress_fn(float fraction, void *user_data)
 {
     lapped_progress *p = (lapped_progress *)user_data;
-    if (fraction < p->last || fraction > 1.0f) p->decreasing = 1;
+    if (fraction < p->last || fraction > 1.0f || !(fraction >= 0.0f)) p->decreasing = 1;
     p->last = fraction;
     return ++p->calls == p->cancel_at;
 }
+
+/* A lapped-function error: result, err.result, a message, no run of more
+   than 12 digits in it (numbers are printed compactly), *out reset. */
+#define LAPPED_EXPECT(r_, out_, code, what)                                                                      \
+    do {                                                                                                         \
+        CHECK((r_) == (code) && err.result == (code) && err.message[0] != '\0' &&                                \
+                  longest_digit_run(err.message) <= 12 && (out_) == NULL,                                        \
+              "%s: expected %d, got %d (err.result %d, out %p): %s", what, (int)(code), (int)(r_), (int)err.result, \
+              (void *)(out_), err.message);                                                                      \
+    } while (0)
 
 static void test_lapped_errors(void)
 {
     tmesh m, q;
     tt_mesh *mesh = NULL, *quads = NULL;
-    tt_mesh_desc d;
     float *field;
-    tt_image patch, empty, clear;
-    tt_lapped out;
+    tt_image *patch, empty, *clear = NULL, *two[2];
+    tt_lapped *out = NULL;
     tt_lapped_options lo;
     tt_field_options fo;
     tt_error err;
     tt_result r;
     lapped_progress prog;
+    tt_allocator half;
     make_lapped_shape(&m, 0);
-    d = tm_desc(&m);
-    tt_mesh_build(&d, &mesh, &err);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
     field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
     memset(&fo, 0, sizeof fo);
-    tt_tangent_field(mesh, &fo, field, &err);
-    lapped_patch(&patch, 32, 1);
+    tt_tangent_field(mesh, &fo, NULL, field, &err);
+    patch = lapped_patch(32, 1);
     memset(&empty, 0, sizeof empty);
-    tt_image_create(&clear, 16, 16, NULL);
+    tt_image_create(16, 16, NULL, &clear, NULL);
     memset(&lo, 0, sizeof lo);
 
-    CHECK(tt_lapped_paste(NULL, field, &patch, 1, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh");
-    CHECK(tt_lapped_paste(mesh, NULL, &patch, 1, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL field");
-    CHECK(tt_lapped_paste(mesh, field, &patch, 0, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "no patches");
-    CHECK(tt_lapped_paste(mesh, field, &empty, 1, NULL, &out, &err) == TT_ERROR_INVALID_ARGUMENT &&
-              out.pastes == NULL, "empty patch");
-    r = tt_lapped_paste(mesh, field, &clear, 1, NULL, &out, &err);
-    CHECK(r == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "no opaque") != NULL,
-          "transparent patch: %d %s", r, err.message);
+    out = &g_lapped_sentinel;
+    r = tt_lapped_paste(NULL, field, &patch, 1, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "NULL mesh");
+    out = &g_lapped_sentinel;
+    r = tt_lapped_paste(mesh, NULL, &patch, 1, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "NULL field");
+    r = tt_lapped_paste(mesh, field, NULL, 1, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "NULL patches");
+    CHECK(tt_lapped_paste(mesh, field, &patch, 1, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL out");
+    r = tt_lapped_paste(mesh, field, &patch, 0, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "no patches");
+    memset(&half, 0, sizeof half);
+    {
+        counter hc;
+        tt_allocator full = make_allocator(&hc, -1);
+        half.alloc = full.alloc;   /* alloc without free */
+        half.user_data = &hc;
+        out = &g_lapped_sentinel;
+        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, &half, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "allocator with alloc but no free");
+        CHECK(hc.calls == 0, "a refused allocator is not used: %ld calls", hc.calls);
+    }
+    out = &g_lapped_sentinel;
+    r = tt_lapped_paste(mesh, field, &clear, 1, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "transparent patch");
+    CHECK(strstr(err.message, "no opaque") != NULL && err.item == 0, "transparent patch: item %d, %s", err.item,
+          err.message);
     lo.max_pastes = -1;
-    CHECK(tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err) == TT_ERROR_INVALID_ARGUMENT, "max_pastes < 0");
+    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "max_pastes < 0");
+    lo.max_pastes = 0;
+
+    /* The patches array: a NULL entry, an empty image and one with no opaque
+       texel are named by their index in error->item. */
+    two[0] = patch;
+    two[1] = NULL;
+    out = &g_lapped_sentinel;
+    r = tt_lapped_paste(mesh, field, two, 2, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "NULL patches[1]");
+    CHECK(err.item == 1 && msg_has_number(err.message, 1), "NULL patches[1]: item %d (want 1): %s", err.item,
+          err.message);
+    two[1] = &empty;
+    r = tt_lapped_paste(mesh, field, two, 2, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "empty patches[1]");
+    CHECK(err.item == 1, "empty patches[1]: item %d (want 1): %s", err.item, err.message);
+    two[1] = clear;
+    r = tt_lapped_paste(mesh, field, two, 2, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "transparent patches[1]");
+    CHECK(err.item == 1 && strstr(err.message, "texture patch 1 has no opaque texel") != NULL,
+          "transparent patches[1]: item %d (want 1): %s", err.item, err.message);
+    two[0] = clear;
+    two[1] = patch;
+    r = tt_lapped_paste(mesh, field, two, 2, NULL, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "transparent patches[0]");
+    CHECK(err.item == 0 && strstr(err.message, "texture patch 0 has no opaque texel") != NULL,
+          "transparent patches[0]: item %d (want 0): %s", err.item, err.message);
 
     /* field vectors: zero, NaN, perpendicular to the face */
     {
         float saved[3];
         memcpy(saved, field + 3 * 5, sizeof saved);
         field[15] = field[16] = field[17] = 0.0f;
-        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, &out, &err);
-        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face == 5 && strstr(err.message, "zero length"),
-              "zero field vector: %d %d %s", r, err.face, err.message);
-        field[16] = NAN;
-        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, &out, &err);
-        CHECK(r == TT_ERROR_NON_FINITE && err.face == 5, "NaN field vector: %d %s", r, err.message);
+        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "zero field vector");
+        CHECK(err.face == 5 && strstr(err.message, "zero length"), "zero field vector: %d %d %s", r, err.face,
+              err.message);
+        field[16] = (float)internal_not_a_number();
+        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_NON_FINITE, "NaN field vector");
+        CHECK(err.face == 5, "NaN field vector: face %d: %s", err.face, err.message);
         tt_face_normal(mesh, 5, field + 15);
-        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, &out, &err);
-        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face == 5 && strstr(err.message, "perpendicular"),
-              "normal as field vector: %d %s", r, err.message);
+        r = tt_lapped_paste(mesh, field, &patch, 1, NULL, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "normal as field vector");
+        CHECK(err.face == 5 && strstr(err.message, "perpendicular"), "normal as field vector: %d %s", r,
+              err.message);
         memcpy(field + 15, saved, sizeof saved);
     }
-    /* a patch larger than the mesh, and one so small it would take forever */
+    /* a patch larger than the mesh, and ones so small it would take forever */
     {
         float *big = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
         fo.scale = 5.0f;
-        tt_tangent_field(mesh, &fo, big, &err);
-        r = tt_lapped_paste(mesh, big, &patch, 1, NULL, &out, &err);
-        CHECK(r == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "larger than the mesh"),
-              "patch larger than the mesh: %d %s", r, err.message);
+        tt_tangent_field(mesh, &fo, NULL, big, &err);
+        r = tt_lapped_paste(mesh, big, &patch, 1, NULL, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "patch larger than the mesh");
+        CHECK(strstr(err.message, "larger than the mesh") != NULL, "patch larger than the mesh: %s", err.message);
         fo.scale = 1e-4f;
-        tt_tangent_field(mesh, &fo, big, &err);
-        r = tt_lapped_paste(mesh, big, &patch, 1, NULL, &out, &err);
-        CHECK(r == TT_ERROR_TOO_LARGE && strstr(err.message, "pastes"), "tiny patches: %d %s", r, err.message);
+        tt_tangent_field(mesh, &fo, NULL, big, &err);
+        r = tt_lapped_paste(mesh, big, &patch, 1, NULL, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_TOO_LARGE, "tiny patches");
+        CHECK(strstr(err.message, "pastes") != NULL, "tiny patches: %s", err.message);
+        /* Astronomically many pastes (about 1e60): the message stays short
+           and gives the estimate in %g form, not 61 digits. */
+        fo.scale = 1e-30f;
+        CHECK(tt_tangent_field(mesh, &fo, NULL, big, &err) == TT_OK, "field of scale 1e-30: %s", err.message);
+        out = &g_lapped_sentinel;
+        r = tt_lapped_paste(mesh, big, &patch, 1, NULL, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_TOO_LARGE, "patches of 1e-30 mesh units");
+        CHECK(strstr(err.message, "e+") != NULL && strlen(err.message) < 200 &&
+                  longest_digit_run(err.message) <= 12,
+              "patches of 1e-30 mesh units: the estimate in %%g form, short: %s", err.message);
         free(big);
     }
     /* progress after every paste, never decreasing, ending at 1 */
-    lo.max_pastes = 0;
     memset(&prog, 0, sizeof prog);
     prog.cancel_at = -1;
     lo.progress = lapped_progress_fn;
     lo.progress_user_data = &prog;
-    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err);
-    CHECK(r == TT_OK && prog.calls >= out.npastes && !prog.decreasing && prog.last == 1.0f,
-          "progress: %d calls for %d pastes, last %g, decreasing %d", prog.calls, out.npastes, prog.last,
-          prog.decreasing);
-    tt_lapped_free(&out);
+    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, NULL, &out, &err);
+    CHECK(r == TT_OK && out && prog.calls >= out->npastes && !prog.decreasing && prog.last == 1.0f,
+          "progress: %d calls for %d pastes, last %g, decreasing %d", prog.calls, out ? out->npastes : -1,
+          prog.last, prog.decreasing);
+    tt_lapped_free(out);
+    out = NULL;
     /* one paste short of what it takes */
     lo.max_pastes = prog.calls - 1;
-    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err);
-    CHECK(r == TT_ERROR_NOT_CONVERGED && out.pastes == NULL && strstr(err.message, "uncovered"),
-          "max_pastes %d: %d %s", lo.max_pastes, r, err.message);
+    out = &g_lapped_sentinel;
+    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_ERROR_NOT_CONVERGED, "one paste short");
+    CHECK(strstr(err.message, "uncovered") != NULL, "max_pastes %d: %d %s", lo.max_pastes, r, err.message);
     lo.max_pastes = 0;
     memset(&prog, 0, sizeof prog);
     prog.cancel_at = 3;
-    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, &out, &err);
-    CHECK(r == TT_CANCELLED && prog.calls == 3 && out.pastes == NULL, "cancel: %d after %d calls", r, prog.calls);
+    out = &g_lapped_sentinel;
+    r = tt_lapped_paste(mesh, field, &patch, 1, &lo, NULL, &out, &err);
+    LAPPED_EXPECT(r, out, TT_CANCELLED, "cancel");
+    CHECK(prog.calls == 3, "cancel: %d after %d calls", r, prog.calls);
 
     /* not triangles */
     memset(&q, 0, sizeof q);
     make_grid(&q, 3, 3);
-    d = tm_desc(&q);
-    tt_mesh_build(&d, &quads, &err);
+    CHECK(build(&q, 0, &quads, &err) == TT_OK, "grid builds: %s", err.message);
     {
         float *qf = (float *)malloc(sizeof(float) * 3 * (size_t)quads->nfaces);
-        tt_tangent_field(quads, &fo, qf, &err);
-        r = tt_lapped_paste(quads, qf, &patch, 1, NULL, &out, &err);
-        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face == 0 && strstr(err.message, "triangle"),
-              "quads: %d %s", r, err.message);
+        tt_tangent_field(quads, &fo, NULL, qf, &err);
+        r = tt_lapped_paste(quads, qf, &patch, 1, NULL, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_INVALID_ARGUMENT, "quads");
+        CHECK(err.face == 0 && strstr(err.message, "triangle"), "quads: %d %s", r, err.message);
         free(qf);
     }
     tt_mesh_free(quads);
@@ -1369,18 +1557,17 @@ static void test_lapped_errors(void)
         tm_vert(&z, 0, 0, 0); tm_vert(&z, 1, 0, 0); tm_vert(&z, 0, 1, 0); tm_vert(&z, 2, 0, 0);
         tm_tri(&z, 0, 1, 2);
         tm_tri(&z, 1, 0, 3);
-        d = tm_desc(&z);
-        d.nfaces = 2;
-        d.flags = TT_MESH_PERMISSIVE;
-        if (tt_mesh_build(&d, &zm, &err) == TT_OK) {
-            r = tt_lapped_paste(zm, zf, &patch, 1, NULL, &out, &err);
-            CHECK(r == TT_ERROR_ZERO_AREA_FACE && err.face == 1, "zero-area face: %d %s", r, err.message);
+        CHECK(build(&z, TT_MESH_PERMISSIVE, &zm, &err) == TT_OK, "permissive sliver mesh builds: %s", err.message);
+        if (zm) {
+            r = tt_lapped_paste(zm, zf, &patch, 1, NULL, NULL, &out, &err);
+            LAPPED_EXPECT(r, out, TT_ERROR_ZERO_AREA_FACE, "zero-area face");
+            CHECK(err.face == 1, "zero-area face: face %d: %s", err.face, err.message);
         }
         tt_mesh_free(zm);
         tm_free(&z);
     }
-    tt_image_free(&clear);
-    tt_image_free(&patch);
+    tt_image_free(clear);
+    tt_image_free(patch);
     tt_mesh_free(mesh);
     free(field);
     tm_free(&m);
@@ -1389,7 +1576,7 @@ static void test_lapped_errors(void)
 typedef struct lapped_oom_ctx {
     const tt_mesh *mesh;
     const float *field;
-    const tt_image *patch;
+    tt_image *patch;
     int isotropic;
 } lapped_oom_ctx;
 
@@ -1397,27 +1584,26 @@ static tt_result lapped_oom_call(void *ctx, const tt_allocator *al)
 {
     lapped_oom_ctx *c = (lapped_oom_ctx *)ctx;
     tt_lapped_options lo;
-    tt_lapped out;
+    tt_lapped *out = &g_lapped_sentinel;   /* must be reset to NULL on failure */
     tt_error err;
     tt_result r;
     memset(&lo, 0, sizeof lo);
-    lo.allocator = *al;
     lo.isotropic = c->isotropic;
-    r = tt_lapped_paste(c->mesh, c->field, c->patch, 1, &lo, &out, &err);
-    if (r != TT_OK && (out.pastes != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
-    tt_lapped_free(&out);
+    r = tt_lapped_paste(c->mesh, c->field, &c->patch, 1, &lo, al, &out, &err);
+    if (r != TT_OK && (out != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
+    if (r == TT_OK && (!out || out->nentries <= 0)) return TT_RESULT_MAX_ENUM;
+    tt_lapped_free(out);
     return r;
 }
 
 static void test_lapped_oom(void)
 {
     tmesh m;
-    tt_mesh *mesh;
-    tt_mesh_desc d;
+    tt_mesh *mesh = NULL;
     tt_field_options fo;
     tt_error err;
     float *field;
-    tt_image patch;
+    tt_image *patch;
     lapped_oom_ctx c;
     memset(&m, 0, sizeof m);
     make_field_sphere(&m, 5, 6, 1.0);
@@ -1427,22 +1613,21 @@ static void test_lapped_oom(void)
         tm_free(&m);
         m = t;
     }
-    d = tm_desc(&m);
-    tt_mesh_build(&d, &mesh, &err);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "small sphere builds: %s", err.message);
     field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
     memset(&fo, 0, sizeof fo);
     fo.scale = 2.0f;
-    tt_tangent_field(mesh, &fo, field, &err);
-    lapped_patch(&patch, 32, 4);
+    tt_tangent_field(mesh, &fo, NULL, field, &err);
+    patch = lapped_patch(32, 4);
     oom_reset();
     c.mesh = mesh;
     c.field = field;
-    c.patch = &patch;
+    c.patch = patch;
     c.isotropic = 0;
     oom_sweep("tt_lapped_paste", lapped_oom_call, &c, TT_OK);
     c.isotropic = 1;
     oom_sweep("tt_lapped_paste(isotropic)", lapped_oom_call, &c, TT_OK);
-    tt_image_free(&patch);
+    tt_image_free(patch);
     tt_mesh_free(mesh);
     free(field);
     tm_free(&m);
@@ -1453,11 +1638,11 @@ static void test_lapped_oom(void)
 /* ------------------------------------------------------------------------ */
 
 /* A transparent w x h image. */
-static tt_image hull_image(int w, int h)
+static tt_image *hull_image(int w, int h)
 {
-    tt_image img;
-    tt_result r = tt_image_create(&img, w, h, NULL);
-    CHECK(r == TT_OK, "tt_image_create(%d, %d): %d", w, h, (int)r);
+    tt_image *img = NULL;
+    tt_result r = tt_image_create(w, h, NULL, &img, NULL);
+    CHECK(r == TT_OK && img, "tt_image_create(%d, %d): %d", w, h, (int)r);
     return img;
 }
 
@@ -1678,49 +1863,49 @@ static void test_hull_shapes(void)
 {
     char name[64];
     int s;
-    tt_image img;
+    tt_image *img;
     lcg_seed(1234);
 
-    img = hull_image(64, 64); hull_disc(&img, 32, 32, 25, 1.0f); hull_check_budgets(&img, "disc"); tt_image_free(&img);
-    img = hull_image(40, 30); hull_rect(&img, 5, 5, 15, 25); hull_rect(&img, 5, 18, 35, 25);
-    hull_check_budgets(&img, "L"); tt_image_free(&img);
-    img = hull_image(50, 50); hull_disc(&img, 25, 25, 20, 1.0f); hull_disc(&img, 25, 25, 10, 0.0f);
-    hull_check_budgets(&img, "ring"); tt_image_free(&img);
-    img = hull_image(50, 50); hull_disc(&img, 25, 25, 20, 1.0f); hull_disc(&img, 25, 25, 10, 0.0f);
-    hull_disc(&img, 25, 25, 4, 1.0f); hull_check_budgets(&img, "ring with island"); tt_image_free(&img);
-    img = hull_image(60, 40); hull_disc(&img, 12, 12, 8, 1.0f); hull_disc(&img, 45, 28, 9, 1.0f);
-    hull_check_budgets(&img, "two blobs"); tt_image_free(&img);
-    img = hull_image(32, 32); hull_rect(&img, 0, 0, 32, 32); hull_check_budgets(&img, "full square"); tt_image_free(&img);
-    img = hull_image(1, 1); hull_set_alpha(&img, 0, 0, 1.0f); hull_check_budgets(&img, "1x1"); tt_image_free(&img);
-    img = hull_image(9, 7); hull_set_alpha(&img, 4, 2, 0.1f); hull_check_budgets(&img, "single texel");
-    tt_image_free(&img);
+    img = hull_image(64, 64); hull_disc(img, 32, 32, 25, 1.0f); hull_check_budgets(img, "disc"); tt_image_free(img);
+    img = hull_image(40, 30); hull_rect(img, 5, 5, 15, 25); hull_rect(img, 5, 18, 35, 25);
+    hull_check_budgets(img, "L"); tt_image_free(img);
+    img = hull_image(50, 50); hull_disc(img, 25, 25, 20, 1.0f); hull_disc(img, 25, 25, 10, 0.0f);
+    hull_check_budgets(img, "ring"); tt_image_free(img);
+    img = hull_image(50, 50); hull_disc(img, 25, 25, 20, 1.0f); hull_disc(img, 25, 25, 10, 0.0f);
+    hull_disc(img, 25, 25, 4, 1.0f); hull_check_budgets(img, "ring with island"); tt_image_free(img);
+    img = hull_image(60, 40); hull_disc(img, 12, 12, 8, 1.0f); hull_disc(img, 45, 28, 9, 1.0f);
+    hull_check_budgets(img, "two blobs"); tt_image_free(img);
+    img = hull_image(32, 32); hull_rect(img, 0, 0, 32, 32); hull_check_budgets(img, "full square"); tt_image_free(img);
+    img = hull_image(1, 1); hull_set_alpha(img, 0, 0, 1.0f); hull_check_budgets(img, "1x1"); tt_image_free(img);
+    img = hull_image(9, 7); hull_set_alpha(img, 4, 2, 0.1f); hull_check_budgets(img, "single texel");
+    tt_image_free(img);
     img = hull_image(40, 40);
-    for (s = 3; s < 37; s++) hull_set_alpha(&img, s, s, 1.0f);
-    hull_check_budgets(&img, "diagonal"); tt_image_free(&img);
+    for (s = 3; s < 37; s++) hull_set_alpha(img, s, s, 1.0f);
+    hull_check_budgets(img, "diagonal"); tt_image_free(img);
     img = hull_image(40, 40);
-    for (s = 3; s < 37; s++) hull_set_alpha(&img, s, 39 - s, 1.0f);
-    hull_check_budgets(&img, "anti-diagonal"); tt_image_free(&img);
+    for (s = 3; s < 37; s++) hull_set_alpha(img, s, 39 - s, 1.0f);
+    hull_check_budgets(img, "anti-diagonal"); tt_image_free(img);
     img = hull_image(40, 40);
-    for (s = 0; s < 40; s++) hull_set_alpha(&img, s, (s * 7) % 40 < 20 ? s / 2 : 39 - s / 3, 1.0f);
-    hull_check_budgets(&img, "scattered line"); tt_image_free(&img);
-    img = hull_image(1, 37); hull_rect(&img, 0, 3, 1, 30); hull_check_budgets(&img, "1xN"); tt_image_free(&img);
-    img = hull_image(37, 1); hull_rect(&img, 3, 0, 30, 1); hull_check_budgets(&img, "Nx1"); tt_image_free(&img);
-    img = hull_image(1, 37); hull_rect(&img, 0, 3, 1, 10); hull_rect(&img, 0, 20, 1, 30);
-    hull_check_budgets(&img, "1xN split"); tt_image_free(&img);
+    for (s = 0; s < 40; s++) hull_set_alpha(img, s, (s * 7) % 40 < 20 ? s / 2 : 39 - s / 3, 1.0f);
+    hull_check_budgets(img, "scattered line"); tt_image_free(img);
+    img = hull_image(1, 37); hull_rect(img, 0, 3, 1, 30); hull_check_budgets(img, "1xN"); tt_image_free(img);
+    img = hull_image(37, 1); hull_rect(img, 3, 0, 30, 1); hull_check_budgets(img, "Nx1"); tt_image_free(img);
+    img = hull_image(1, 37); hull_rect(img, 0, 3, 1, 10); hull_rect(img, 0, 20, 1, 30);
+    hull_check_budgets(img, "1xN split"); tt_image_free(img);
     img = hull_image(16, 16);
     for (s = 0; s < 256; s++)
-        if (((s % 16) + (s / 16)) % 2 == 0) hull_set_alpha(&img, s % 16, s / 16, 1.0f);
-    hull_check_budgets(&img, "checkerboard"); tt_image_free(&img);
+        if (((s % 16) + (s / 16)) % 2 == 0) hull_set_alpha(img, s % 16, s / 16, 1.0f);
+    hull_check_budgets(img, "checkerboard"); tt_image_free(img);
     img = hull_image(60, 40); /* comb: deep narrow slots */
-    hull_rect(&img, 2, 30, 58, 36);
-    for (s = 2; s < 58; s += 4) hull_rect(&img, s, 3, s + 2, 30);
-    hull_check_budgets(&img, "comb"); tt_image_free(&img);
+    hull_rect(img, 2, 30, 58, 36);
+    for (s = 2; s < 58; s += 4) hull_rect(img, s, 3, s + 2, 30);
+    hull_check_budgets(img, "comb"); tt_image_free(img);
     img = hull_image(64, 64); /* square spiral, one texel wide with one-texel gaps */
     {
         int x = 31, y = 31, len = 1, d = 0, k, step;
         for (k = 0; k < 58; k++) {
             for (step = 0; step < len; step++) {
-                hull_set_alpha(&img, x, y, 1.0f);
+                hull_set_alpha(img, x, y, 1.0f);
                 x += d == 0 ? 1 : (d == 2 ? -1 : 0);
                 y += d == 1 ? 1 : (d == 3 ? -1 : 0);
             }
@@ -1728,36 +1913,36 @@ static void test_hull_shapes(void)
             if (k % 2 == 1) len += 2;
         }
     }
-    hull_check_budgets(&img, "spiral"); tt_image_free(&img);
+    hull_check_budgets(img, "spiral"); tt_image_free(img);
 
     for (s = 0; s < 40; s++) {
         int w = 8 + lcg_below(90), h = 8 + lcg_below(90);
         img = hull_image(w, h);
-        hull_blob(&img, 1 + lcg_below(w * h / 3));
+        hull_blob(img, 1 + lcg_below(w * h / 3));
         sprintf(name, "blob %d (%dx%d)", s, w, h);
-        hull_check_budgets(&img, name);
-        tt_image_free(&img);
+        hull_check_budgets(img, name);
+        tt_image_free(img);
     }
     for (s = 0; s < 10; s++) {
         int k;
         img = hull_image(30, 30);
         for (k = 0; k < 900; k++)
-            if (lcg_unit() < 0.3) hull_set_alpha(&img, k % 30, k / 30, 1.0f);
+            if (lcg_unit() < 0.3) hull_set_alpha(img, k % 30, k / 30, 1.0f);
         sprintf(name, "noise %d", s);
-        hull_check_budgets(&img, name);
-        tt_image_free(&img);
+        hull_check_budgets(img, name);
+        tt_image_free(img);
     }
     for (s = 0; s < 6; s++) {
         img = hull_image(128, 128);
-        hull_splotch(&img, s * 3.0, 0);
+        hull_splotch(img, s * 3.0, 0);
         sprintf(name, "splotch %d", s);
-        hull_check_budgets(&img, name);
-        tt_image_free(&img);
+        hull_check_budgets(img, name);
+        tt_image_free(img);
         img = hull_image(128, 128);
-        hull_splotch(&img, s * 3.0, 1);
+        hull_splotch(img, s * 3.0, 1);
         sprintf(name, "speckled splotch %d", s);
-        hull_check_budgets(&img, name);
-        tt_image_free(&img);
+        hull_check_budgets(img, name);
+        tt_image_free(img);
     }
 }
 
@@ -1768,41 +1953,41 @@ static void test_hull_large(void)
     int kind;
     lcg_seed(77);
     for (kind = 0; kind < 3; kind++) {
-        tt_image img = hull_image(512, 512);
-        hull_splotch(&img, kind ? 24.0 : 0.0, kind == 2);
-        hull_check(&img, 32, names[kind]);
-        tt_image_free(&img);
+        tt_image *img = hull_image(512, 512);
+        hull_splotch(img, kind ? 24.0 : 0.0, kind == 2);
+        hull_check(img, 32, names[kind]);
+        tt_image_free(img);
     }
 }
 
 static void test_hull_area(void)
 {
-    tt_image img = hull_image(256, 256);
+    tt_image *img = hull_image(256, 256);
     double disc, convex, a32, a8;
-    hull_disc(&img, 128, 128, 100, 1.0f);
+    hull_disc(img, 128, 128, 100, 1.0f);
     disc = 3.14159265358979 * 100.0 * 100.0 / (256.0 * 256.0);
-    convex = hull_convex_area(&img);
+    convex = hull_convex_area(img);
     CHECK(convex > disc, "convex hull of the disc: area %g above the disc's %g", convex, disc);
-    a32 = hull_check(&img, 32, "disc r=100");
-    a8 = hull_check(&img, 8, "disc r=100");
+    a32 = hull_check(img, 32, "disc r=100");
+    a8 = hull_check(img, 8, "disc r=100");
     CHECK(a32 <= 1.3 * disc, "32-gon area %g within 1.3 x the disc's %g", a32, disc);
     CHECK(a32 <= 1.1 * convex, "32-gon area %g within 1.1 x the convex hull's %g", a32, convex);
     CHECK(a8 <= 1.3 * convex, "8-gon area %g within 1.3 x the convex hull's %g", a8, convex);
-    tt_image_free(&img);
+    tt_image_free(img);
 
     img = hull_image(32, 32);
-    hull_rect(&img, 4, 6, 20, 30);
-    a32 = hull_check(&img, 4, "rectangle");
-    CHECK(fabs(a32 - hull_mask_area(&img)) < 1e-6, "rectangle: hull is the rectangle, area %g vs %g", a32,
-          hull_mask_area(&img));
-    tt_image_free(&img);
+    hull_rect(img, 4, 6, 20, 30);
+    a32 = hull_check(img, 4, "rectangle");
+    CHECK(fabs(a32 - hull_mask_area(img)) < 1e-6, "rectangle: hull is the rectangle, area %g vs %g", a32,
+          hull_mask_area(img));
+    tt_image_free(img);
 
     img = hull_image(64, 64);
-    hull_rect(&img, 4, 4, 20, 60); hull_rect(&img, 4, 44, 60, 60);
-    a32 = hull_check(&img, 32, "L exact");
-    CHECK(a32 < 1.01 * hull_mask_area(&img), "L: hull area %g vs mask %g (should stay non-convex)", a32,
-          hull_mask_area(&img));
-    tt_image_free(&img);
+    hull_rect(img, 4, 4, 20, 60); hull_rect(img, 4, 44, 60, 60);
+    a32 = hull_check(img, 32, "L exact");
+    CHECK(a32 < 1.01 * hull_mask_area(img), "L: hull area %g vs mask %g (should stay non-convex)", a32,
+          hull_mask_area(img));
+    tt_image_free(img);
 }
 
 /* Distance between segment ab and the polygon's boundary (0 if they meet). */
@@ -1833,15 +2018,15 @@ static void test_hull_segment(void)
     int shape, trial, mismatches = 0, ntests = 0;
     lcg_seed(99);
     for (shape = 0; shape < 12; shape++) {
-        tt_image img = hull_image(48, 48);
+        tt_image *img = hull_image(48, 48);
         float *xy;
         int n;
-        if (shape % 3 == 0) hull_disc(&img, 24, 24, 18, 1.0f);
-        else if (shape % 3 == 1) { hull_rect(&img, 4, 4, 14, 44); hull_rect(&img, 4, 34, 44, 44); }
-        else hull_blob(&img, 600);
-        if (internal_patch_hull(&img, shape < 6 ? 32 : 8, NULL, &xy, &n) != TT_OK) {
+        if (shape % 3 == 0) hull_disc(img, 24, 24, 18, 1.0f);
+        else if (shape % 3 == 1) { hull_rect(img, 4, 4, 14, 44); hull_rect(img, 4, 34, 44, 44); }
+        else hull_blob(img, 600);
+        if (internal_patch_hull(img, shape < 6 ? 32 : 8, NULL, &xy, &n) != TT_OK) {
             CHECK(0, "shape %d: hull for the segment test", shape);
-            tt_image_free(&img);
+            tt_image_free(img);
             continue;
         }
         for (trial = 0; trial < 250; trial++) {
@@ -1881,7 +2066,7 @@ static void test_hull_segment(void)
             }
         }
         free(xy);
-        tt_image_free(&img);
+        tt_image_free(img);
     }
     CHECK(mismatches == 0 && ntests == 3000, "%d of %d random segments disagree with sampling", mismatches, ntests);
 
@@ -1910,18 +2095,18 @@ static void test_hull_segment(void)
 
 static void test_hull_errors(void)
 {
-    tt_image img = hull_image(8, 8);
-    float *xy = (float *)&img; /* must be reset to NULL on failure */
+    tt_image *img = hull_image(8, 8);
+    float *xy = (float *)img; /* must be reset to NULL on failure */
     int n = 5;
-    CHECK(internal_patch_hull(&img, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "transparent patch refused");
+    CHECK(internal_patch_hull(img, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "transparent patch refused");
     CHECK(xy == NULL && n == 0, "outputs reset on failure: %p, %d", (void *)xy, n);
-    hull_set_alpha(&img, 3, 3, 1.0f);
-    CHECK(internal_patch_hull(&img, 2, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "max_vertices 2 refused");
+    hull_set_alpha(img, 3, 3, 1.0f);
+    CHECK(internal_patch_hull(img, 2, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "max_vertices 2 refused");
     CHECK(internal_patch_hull(NULL, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "NULL patch refused");
-    CHECK(internal_patch_hull(&img, 32, NULL, NULL, &n) == TT_ERROR_INVALID_ARGUMENT, "NULL out refused");
-    hull_set_alpha(&img, 3, 3, -1.0f);
-    CHECK(internal_patch_hull(&img, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "negative alpha only refused");
-    tt_image_free(&img);
+    CHECK(internal_patch_hull(img, 32, NULL, NULL, &n) == TT_ERROR_INVALID_ARGUMENT, "NULL out refused");
+    hull_set_alpha(img, 3, 3, -1.0f);
+    CHECK(internal_patch_hull(img, 32, NULL, &xy, &n) == TT_ERROR_INVALID_ARGUMENT, "negative alpha only refused");
+    tt_image_free(img);
 }
 
 typedef struct hull_oom_ctx {
@@ -1943,55 +2128,55 @@ static tt_result hull_oom_call(void *ctx, const tt_allocator *al)
 
 static void test_hull_oom(void)
 {
-    tt_image img;
+    tt_image *img;
     hull_oom_ctx c;
     int s;
     oom_reset();
     lcg_seed(5);
     img = hull_image(64, 64);
-    hull_blob(&img, 900);
-    c.img = &img;
+    hull_blob(img, 900);
+    c.img = img;
     c.max_vertices = 32;
     oom_sweep("tt__patch_hull(blob, contour)", hull_oom_call, &c, TT_OK);
-    tt_image_free(&img);
+    tt_image_free(img);
 
     img = hull_image(40, 40);
-    hull_disc(&img, 10, 10, 6, 1.0f); hull_disc(&img, 30, 28, 7, 1.0f);
-    c.img = &img;
+    hull_disc(img, 10, 10, 6, 1.0f); hull_disc(img, 30, 28, 7, 1.0f);
+    c.img = img;
     c.max_vertices = 8;
     oom_sweep("tt__patch_hull(two blobs, convex)", hull_oom_call, &c, TT_OK);
-    tt_image_free(&img);
+    tt_image_free(img);
 
     img = hull_image(16, 16);
-    hull_rect(&img, 2, 2, 14, 14);
-    c.img = &img;
+    hull_rect(img, 2, 2, 14, 14);
+    c.img = img;
     c.max_vertices = 3;
     oom_sweep("tt__patch_hull(square to triangle, bounding)", hull_oom_call, &c, TT_OK);
-    tt_image_free(&img);
+    tt_image_free(img);
 
     img = hull_image(200, 200); /* long straight sides plus fine detail: the edge grid grows */
-    hull_rect(&img, 10, 10, 190, 190);
-    for (s = 12; s < 188; s += 3) hull_set_alpha(&img, s, 9, 1.0f);
-    for (s = 12; s < 188; s += 5) hull_set_alpha(&img, 190, s, 1.0f);
-    c.img = &img;
+    hull_rect(img, 10, 10, 190, 190);
+    for (s = 12; s < 188; s += 3) hull_set_alpha(img, s, 9, 1.0f);
+    for (s = 12; s < 188; s += 5) hull_set_alpha(img, 190, s, 1.0f);
+    c.img = img;
     c.max_vertices = 4;
     oom_sweep("tt__patch_hull(square with teeth)", hull_oom_call, &c, TT_OK);
-    tt_image_free(&img);
+    tt_image_free(img);
 
     img = hull_image(60, 40); /* comb: the edge grid's node pool grows */
-    hull_rect(&img, 2, 30, 58, 36);
-    for (s = 2; s < 58; s += 4) hull_rect(&img, s, 3, s + 2, 30);
-    c.img = &img;
+    hull_rect(img, 2, 30, 58, 36);
+    for (s = 2; s < 58; s += 4) hull_rect(img, s, 3, s + 2, 30);
+    c.img = img;
     c.max_vertices = 8;
     oom_sweep("tt__patch_hull(comb)", hull_oom_call, &c, TT_OK);
-    tt_image_free(&img);
+    tt_image_free(img);
 
     img = hull_image(8, 8);   /* transparent: refused before any allocation */
-    c.img = &img;
+    c.img = img;
     c.max_vertices = 8;
     CHECK(hull_oom_call(&c, &g_oom_allocator) == TT_ERROR_INVALID_ARGUMENT && g_oom_counter.live == 0,
           "transparent patch refused, nothing allocated");
-    tt_image_free(&img);
+    tt_image_free(img);
     CHECK(g_oom_counter.live == 0 && g_oom_counter.bad_frees == 0, "hull sweeps: %ld blocks live, %ld bad frees",
           g_oom_counter.live, g_oom_counter.bad_frees);
 }
@@ -2006,9 +2191,7 @@ static tt_mesh *bake_build(const tmesh *m, const tt_allocator *al)
     tt_mesh_desc d = tm_desc(m);
     tt_mesh *mesh = NULL;
     tt_error err;
-    tt_result r;
-    if (al) d.allocator = *al;
-    r = tt_mesh_build(&d, &mesh, &err);
+    tt_result r = tt_mesh_build(&d, al, &mesh, &err);
     CHECK(r == TT_OK, "test mesh builds: %s", err.message);
     return mesh;
 }
@@ -2131,16 +2314,16 @@ static void lb_paste_all(lb_builder *b, const tt_mesh *mesh, int patch, const do
 }
 
 /* A constant image, premultiplied colour (r, g, b) * a. */
-static tt_image bake_constant(int w, int h, float r, float g, float b, float a)
+static tt_image *bake_constant(int w, int h, float r, float g, float b, float a)
 {
-    tt_image img;
+    tt_image *img = NULL;
     int i;
-    tt_image_create(&img, w, h, NULL);
+    if (tt_image_create(w, h, NULL, &img, NULL) != TT_OK) return NULL;
     for (i = 0; i < w * h; i++) {
-        img.pixels[4 * i] = r * a;
-        img.pixels[4 * i + 1] = g * a;
-        img.pixels[4 * i + 2] = b * a;
-        img.pixels[4 * i + 3] = a;
+        img->pixels[4 * i] = r * a;
+        img->pixels[4 * i + 1] = g * a;
+        img->pixels[4 * i + 2] = b * a;
+        img->pixels[4 * i + 3] = a;
     }
     return img;
 }
@@ -2169,6 +2352,7 @@ static void test_lapped_measure(void)
     double pi = 3.14159265358979323846, a = 10.0 * pi / 180.0, s = 1.2;
     double rot[4], id[4] = {1, 0, 0, 1}, o[2] = {0.3, -0.2};
     int f;
+    tt_error err;
     lcg_seed(11);
     mesh = bake_grid(4, 3, 0.4, NULL);
     fv = bake_face_vectors(mesh, 0.0f, 1.0f);
@@ -2177,7 +2361,7 @@ static void test_lapped_measure(void)
     /* Rotation by 10 degrees and scale 1.2 on every face. */
     lb_init(&b);
     lb_paste_all(&b, mesh, 0, rot, o);
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "rotated paste: ok");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "rotated paste: ok");
     CHECK(fabs(rep.mean_angle_error - 10.0) < 1e-4, "rotated paste: angle 10, got %.8f", rep.mean_angle_error);
     CHECK(fabs(rep.median_scale_error - 0.2) < 1e-4, "rotated paste: scale error 0.2, got %.8f",
           rep.median_scale_error);
@@ -2187,7 +2371,7 @@ static void test_lapped_measure(void)
     /* A face vector of length 2 along x maps to rotated (2.4, ...): 80 degrees off up. */
     {
         float *fx = bake_face_vectors(mesh, 2.0f, 0.0f);
-        CHECK(tt_lapped_measure(mesh, fx, &b.l, &rep) == TT_OK, "x field: ok");
+        CHECK(tt_lapped_measure(mesh, fx, &b.l, NULL, &rep, &err) == TT_OK, "x field: ok");
         CHECK(fabs(rep.mean_angle_error - 80.0) < 1e-4, "x field: angle 80, got %.8f", rep.mean_angle_error);
         CHECK(fabs(rep.median_scale_error - 1.4) < 1e-4, "x field: scale error 1.4, got %.8f",
               rep.median_scale_error);
@@ -2204,7 +2388,7 @@ static void test_lapped_measure(void)
     }
     bake_affine_uv(mesh, 0, id, o, uv);
     lb_add(&b, 0, uv);
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "partial paste: ok");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "partial paste: ok");
     CHECK(fabs(rep.mean_angle_error) < 1e-4, "partial paste: angle 0, got %g", rep.mean_angle_error);
     CHECK(fabs(rep.median_scale_error) < 1e-5, "partial paste: scale error 0, got %g", rep.median_scale_error);
     CHECK(rep.uncovered_faces == 5, "partial paste: 5 uncovered, got %d", rep.uncovered_faces);
@@ -2224,18 +2408,18 @@ static void test_lapped_measure(void)
             bake_affine_uv(mesh, i, m, o, uv);
             lb_add(&b, i, uv);
         }
-        CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "4 scales: ok");
+        CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "4 scales: ok");
         CHECK(fabs(rep.median_scale_error - 0.45) < 1e-5, "4 scales: median 0.45, got %.8f", rep.median_scale_error);
         /* Odd count: add scale 1 (error 0): sorted 0 .1 .3 .6 1 -> 0.3. */
         bake_affine_uv(mesh, 4, id, o, uv);
         lb_add(&b, 4, uv);
-        CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "5 scales: ok");
+        CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "5 scales: ok");
         CHECK(fabs(rep.median_scale_error - 0.3) < 1e-5, "5 scales: median 0.3, got %.8f", rep.median_scale_error);
         /* Degenerate UVs (all corners one point): phi(T) = 0 counts 180
            degrees and scale error 1. */
         for (i = 0; i < 6; i++) uv[i] = 0.5f;
         lb_add(&b, 5, uv);
-        CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "degenerate entry: ok");
+        CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "degenerate entry: ok");
         CHECK(fabs(rep.mean_angle_error - 30.0) < 1e-4, "degenerate entry: angle (5 * 0 + 180) / 6 = 30, got %g",
               rep.mean_angle_error);
         CHECK(fabs(rep.median_scale_error - 0.45) < 1e-5,
@@ -2245,7 +2429,7 @@ static void test_lapped_measure(void)
 
     /* No entries: errors 0, every face uncovered. */
     lb_init(&b);
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "no entries: ok");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "no entries: ok");
     CHECK(rep.mean_angle_error == 0.0 && rep.median_scale_error == 0.0 && rep.mean_overdraw == 0.0 &&
               rep.uncovered_faces == mesh->nfaces,
           "no entries: zeros and %d uncovered, got %g %g %g %d", mesh->nfaces, rep.mean_angle_error,
@@ -2254,12 +2438,29 @@ static void test_lapped_measure(void)
     tt_mesh_free(mesh);
 }
 
+/* A tt_lapped_measure error: the code, err.result, a message, the entry in
+   err.item and its face in err.face (-2: not compared), and a report of
+   zeros. */
+#define MEASURE_EXPECT(call, code, item_, face_, what)                                                          \
+    do {                                                                                                        \
+        tt_result r_;                                                                                           \
+        memset(&rep, 0x55, sizeof rep);                                                                         \
+        r_ = (call);                                                                                            \
+        CHECK(r_ == (code) && err.result == (code) && err.message[0] != '\0' &&                                 \
+                  longest_digit_run(err.message) <= 12 && (item_ == -2 || err.item == item_) &&                \
+                  (face_ == -2 || err.face == face_),                                                           \
+              "%s: expected %d (item %d, face %d), got %d (item %d, face %d): %s", what, (int)(code), item_,  \
+              face_, (int)r_, err.item, err.face, err.message);                                                \
+        CHECK(rep.uncovered_faces == 0 && rep.mean_overdraw == 0.0, "%s: report not zeroed on failure", what); \
+    } while (0)
+
 static void test_lapped_measure_errors(void)
 {
     tt_mesh *mesh, *qm;
     float *fv, uv[6], qv[3] = {0, 1, 0};
     lb_builder b;
     tt_lapped_report rep;
+    tt_error err;
     double id[4] = {1, 0, 0, 1}, o[2] = {0, 0};
     int i;
     lcg_seed(12);
@@ -2271,38 +2472,93 @@ static void test_lapped_measure_errors(void)
         bake_affine_uv(mesh, i, id, o, uv);
         lb_add(&b, i, uv);
     }
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "valid input: ok");
-    CHECK(tt_lapped_measure(NULL, fv, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh refused");
-    CHECK(tt_lapped_measure(mesh, NULL, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "NULL vectors refused");
-    CHECK(tt_lapped_measure(mesh, fv, NULL, &rep) == TT_ERROR_INVALID_ARGUMENT, "NULL lapped refused");
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL report refused");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK && err.result == TT_OK, "valid input: ok");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, NULL) == TT_OK, "valid input, no error struct: ok");
+    MEASURE_EXPECT(tt_lapped_measure(NULL, fv, &b.l, NULL, &rep, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1,
+                   "NULL mesh");
+    MEASURE_EXPECT(tt_lapped_measure(mesh, NULL, &b.l, NULL, &rep, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1,
+                   "NULL vectors");
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, NULL, NULL, &rep, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1,
+                   "NULL lapped");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL report refused");
+    {
+        counter hc;
+        tt_allocator half = make_allocator(&hc, -1);
+        half.free = NULL;   /* alloc without free */
+        MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, &half, &rep, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1,
+                       "allocator without free");
+        CHECK(hc.calls == 0, "a refused allocator is not used: %ld calls", hc.calls);
+    }
+    /* An entry naming a face out of range: the entry in item. */
     b.l.faces[2] = mesh->nfaces;
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_INDEX_OUT_OF_RANGE, "face nfaces out of range");
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 2, -2,
+                   "entry 2 names face nfaces");
+    CHECK(msg_has_number(err.message, 2) && msg_has_number(err.message, mesh->nfaces),
+          "the message names entry 2 and face %d: %s", mesh->nfaces, err.message);
     b.l.faces[2] = -1;
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_INDEX_OUT_OF_RANGE, "face -1 out of range");
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 2, -2,
+                   "entry 2 names face -1");
     b.l.faces[2] = 2;
+    b.l.faces[3] = 1 << 30;
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 3, -2,
+                   "entry 3 names face 2^30");
+    b.l.faces[3] = 3;
+    /* A non-finite UV: the entry in item, its face in face. */
     b.l.uv[7] = (float)internal_not_a_number();
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_NON_FINITE, "NaN paste uv refused");
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_NON_FINITE, 1, 1,
+                   "NaN paste uv of entry 1");
     b.l.uv[7] = 0.0f;
+    b.l.faces[3] = 7;   /* entry 3 now on face 7: item and face differ */
+    b.l.uv[6 * 3 + 4] = -internal_infinity();
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_NON_FINITE, 3, 7,
+                   "infinite paste uv of entry 3 (face 7)");
+    b.l.uv[6 * 3 + 4] = 0.0f;
+    b.l.faces[3] = 3;
     fv[3 * 3 + 1] = internal_infinity();
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_NON_FINITE, "infinite face vector refused");
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_NON_FINITE, 3, 3,
+                   "infinite face vector of face 3 (entry 3)");
     fv[3 * 3 + 1] = 1.0f;
     b.l.nentries = -1;
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "nentries -1 refused");
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_INVALID_ARGUMENT, -2, -2,
+                   "nentries -1");
     b.l.nentries = 4;
-    CHECK(tt_lapped_measure(mesh, fv, &b.l, &rep) == TT_OK, "restored input: ok");
+    CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "restored input: ok");
     lb_free(&b);
 
+    /* Not triangles: INVALID_ARGUMENT naming the first face that is not one. */
     qm = bake_quad();
     lb_init(&b);
-    CHECK(tt_lapped_measure(qm, qv, &b.l, &rep) == TT_ERROR_INVALID_ARGUMENT, "quad mesh refused");
+    MEASURE_EXPECT(tt_lapped_measure(qm, qv, &b.l, NULL, &rep, &err), TT_ERROR_INVALID_ARGUMENT, -2, 0,
+                   "quad mesh");
     tt_mesh_free(qm);
+    {
+        /* Two triangles, then a quad: face 2 is named. */
+        tmesh mix;
+        tt_mesh *mm = NULL;
+        float mv[9] = {0, 1, 0, 0, 1, 0, 0, 1, 0};
+        memset(&mix, 0, sizeof mix);
+        tm_vert(&mix, 0, 0, 0); tm_vert(&mix, 1, 0, 0); tm_vert(&mix, 0, 1, 0); tm_vert(&mix, 1, 1, 0);
+        tm_vert(&mix, 2, 0, 0); tm_vert(&mix, 2, 1, 0);
+        tm_tri(&mix, 0, 1, 2);
+        tm_tri(&mix, 1, 3, 2);
+        tm_quad(&mix, 1, 4, 5, 3);
+        CHECK(build(&mix, 0, &mm, &err) == TT_OK, "two triangles and a quad build: %s", err.message);
+        if (mm) {
+            MEASURE_EXPECT(tt_lapped_measure(mm, mv, &b.l, NULL, &rep, &err), TT_ERROR_INVALID_ARGUMENT, -2, 2,
+                           "face 2 is a quad");
+            CHECK(msg_has_number(err.message, 2) && msg_has_number(err.message, 4),
+                  "the message names face 2 and its 4 corners: %s", err.message);
+        }
+        tt_mesh_free(mm);
+        tm_free(&mix);
+    }
     free(fv);
     tt_mesh_free(mesh);
 }
+#undef MEASURE_EXPECT
 
 typedef struct measure_oom_ctx {
-    const tt_mesh *mesh;      /* built with the sweep's allocator */
+    const tt_mesh *mesh;
     const float *fv;
     const tt_lapped *lapped;
 } measure_oom_ctx;
@@ -2311,8 +2567,10 @@ static tt_result measure_oom_call(void *ctx, const tt_allocator *al)
 {
     measure_oom_ctx *c = (measure_oom_ctx *)ctx;
     tt_lapped_report rep;
-    (void)al;   /* tt_lapped_measure allocates from the mesh's allocator: the same one */
-    return tt_lapped_measure(c->mesh, c->fv, c->lapped, &rep);
+    tt_error err;
+    tt_result r = tt_lapped_measure(c->mesh, c->fv, c->lapped, al, &rep, &err);
+    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    return r;
 }
 
 static void test_lapped_measure_oom(void)
@@ -2322,9 +2580,9 @@ static void test_lapped_measure_oom(void)
     lb_builder b;
     measure_oom_ctx c;
     double id[4] = {1, 0, 0, 1}, o[2] = {0.3, -0.2};
-    oom_reset();
-    mesh = bake_grid(3, 3, 0.0, &g_oom_allocator);
+    mesh = bake_grid(3, 3, 0.0, NULL);   /* the mesh's own allocator is not used */
     if (!mesh) return;
+    oom_reset();
     fv = bake_face_vectors(mesh, 0.0f, 1.0f);
     lb_init(&b);
     lb_paste_all(&b, mesh, 0, id, o);
@@ -2513,6 +2771,16 @@ static void test_atlas_pack_errors(void)
 
 /* ---- tt_lapped_bake ---- */
 
+/* tt_lapped_bake with only a gutter set (default allocator). */
+static tt_result bake_gutter(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches, int npatches,
+                             const float *uv, int gutter, tt_image *atlas, tt_error *err)
+{
+    tt_bake_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.gutter = gutter;
+    return tt_lapped_bake(mesh, lapped, patches, npatches, uv, &opt, NULL, atlas, err);
+}
+
 /* Atlas UVs of a mesh in [0,1]^2 (the unit square grid cell) scaled into [lo, hi]^2. */
 static void bake_square_uvs(const tt_mesh *mesh, double lo, double hi, float *uv)
 {
@@ -2576,7 +2844,7 @@ static void test_lapped_bake_constant(void)
     tt_mesh *mesh = bake_grid(1, 1, 0.0, NULL);
     float uv[12];
     double id[4] = {1, 0, 0, 1}, zero[2] = {0, 0};
-    tt_image patches[2], atlas;
+    tt_image *patches[2], *atlas = NULL;
     lb_builder b;
     tt_error err;
     unsigned char *inside;
@@ -2586,51 +2854,51 @@ static void test_lapped_bake_constant(void)
     bake_square_uvs(mesh, 0.25, 0.75, uv);
     lb_init(&b);
     lb_paste_all(&b, mesh, 0, id, zero);
-    tt_image_create(&atlas, 40, 32, NULL);
-    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 2, &atlas, &err) == TT_OK, "red: %s", err.message);
+    tt_image_create(40, 32, NULL, &atlas, NULL);
+    CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 2, atlas, &err) == TT_OK, "red: %s", err.message);
     inside = bake_raster_mask(mesh, uv, 40, 32);
     for (i = 0; i < 40 * 32; i++) ninside += inside[i];
     CHECK(ninside > 200, "triangles cover %d texels", ninside);
-    bad = bake_count_off(&atlas, inside, 1, 0, 0, 1);
+    bad = bake_count_off(atlas, inside, 1, 0, 0, 1);
     CHECK(bad == 0, "red: %d texels inside the triangles not opaque red", bad);
-    bad = bake_count_off(&atlas, NULL, 1, 0, 0, 1);
+    bad = bake_count_off(atlas, NULL, 1, 0, 0, 1);
     CHECK(bad == 0, "red: %d texels anywhere not red after the fill", bad);
 
     /* A second paste, half-transparent blue over red: straight colour is the
        premultiplied "over" divided by alpha: (0.5, 0, 0.5), alpha 1. */
     lb_paste_all(&b, mesh, 1, id, zero);
-    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 2, &atlas, &err) == TT_OK, "blue over red: %s", err.message);
-    bad = bake_count_off(&atlas, NULL, 0.5, 0, 0.5, 1);
+    CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 2, atlas, &err) == TT_OK, "blue over red: %s", err.message);
+    bad = bake_count_off(atlas, NULL, 0.5, 0, 0.5, 1);
     CHECK(bad == 0, "%d texels differ from blue (alpha 0.5) over red", bad);
 
     /* Only the blue paste: alpha 0.5, straight colour pure blue. */
     b.l.pastes[0].nfaces = 0;
-    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 0, &atlas, &err) == TT_OK, "blue only: %s", err.message);
-    bad = bake_count_off(&atlas, NULL, 0, -1, 1, 0.5);
+    CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 0, atlas, &err) == TT_OK, "blue only: %s", err.message);
+    bad = bake_count_off(atlas, NULL, 0, -1, 1, 0.5);
     CHECK(bad == 0, "%d texels not straight blue with alpha 0.5", bad);
 
     /* No pastes at all: transparent black everywhere, still OK. */
     b.l.npastes = 0;
-    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 1, &atlas, &err) == TT_OK, "no pastes: %s", err.message);
-    bad = bake_count_off(&atlas, NULL, 0, 0, 0, 0);
+    CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 1, atlas, &err) == TT_OK, "no pastes: %s", err.message);
+    bad = bake_count_off(atlas, NULL, 0, 0, 0, 0);
     CHECK(bad == 0, "no pastes: %d texels not transparent black", bad);
     free(inside);
     lb_free(&b);
-    tt_image_free(&atlas);
-    tt_image_free(&patches[0]);
-    tt_image_free(&patches[1]);
+    tt_image_free(atlas);
+    tt_image_free(patches[0]);
+    tt_image_free(patches[1]);
     tt_mesh_free(mesh);
 }
 
 /* A smooth colour ramp patch: r = x / w, g = y / h, b = 0.5, opaque. */
-static tt_image bake_ramp(int w, int h)
+static tt_image *bake_ramp(int w, int h)
 {
-    tt_image img;
+    tt_image *img = NULL;
     int x, y;
-    tt_image_create(&img, w, h, NULL);
+    if (tt_image_create(w, h, NULL, &img, NULL) != TT_OK) return NULL;
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            float *p = img.pixels + 4 * (y * w + x);
+            float *p = img->pixels + 4 * (y * w + x);
             p[0] = (x + 0.5f) / w;
             p[1] = (y + 0.5f) / h;
             p[2] = 0.5f;
@@ -2647,7 +2915,7 @@ static void test_lapped_bake_gutter(void)
     float uv[6] = {0.3f, 0.3f, 0.7f, 0.35f, 0.32f, 0.72f};
     float puv[6] = {0.3f, 0.3f, 0.6f, 0.3f, 0.3f, 0.6f};
     tt_mesh *mesh = bake_three(3, 1);
-    tt_image ramp = bake_ramp(64, 64), atlas;
+    tt_image *ramp = bake_ramp(64, 64), *atlas = NULL;
     lb_builder b;
     tt_error err;
     unsigned char *inside;
@@ -2656,8 +2924,8 @@ static void test_lapped_bake_gutter(void)
     lb_init(&b);
     lb_begin(&b, 0);
     lb_add(&b, 0, puv);
-    tt_image_create(&atlas, W, H, NULL);
-    CHECK(tt_lapped_bake(mesh, &b.l, &ramp, 1, uv, gutter, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    tt_image_create(W, H, NULL, &atlas, NULL);
+    CHECK(bake_gutter(mesh, &b.l, &ramp, 1, uv, gutter, atlas, &err) == TT_OK, "bake: %s", err.message);
     inside = bake_raster_mask(mesh, uv, W, H);
     for (k = 0; k < 3; k++) { X[k] = uv[2 * k] * W; Y[k] = (1.0 - uv[2 * k + 1]) * H; }
     area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]);
@@ -2665,13 +2933,13 @@ static void test_lapped_bake_gutter(void)
         for (x = 0; x < W; x++) {
             double qx = x + 0.5, qy = y + 0.5, w0, w1, w2, u, v, d = bake_triangle_distance(X, Y, qx, qy);
             float want[4];
-            const float *got = atlas.pixels + 4 * (y * W + x);
+            const float *got = atlas->pixels + 4 * (y * W + x);
             w0 = ((X[1] - qx) * (Y[2] - qy) - (X[2] - qx) * (Y[1] - qy)) / area2;
             w1 = ((X[2] - qx) * (Y[0] - qy) - (X[0] - qx) * (Y[2] - qy)) / area2;
             w2 = 1 - w0 - w1;
             u = w0 * puv[0] + w1 * puv[2] + w2 * puv[4];
             v = w0 * puv[1] + w1 * puv[3] + w2 * puv[5];
-            tt_image_sample_bilinear(&ramp, (float)(u * 64), (float)((1 - v) * 64), want);
+            tt_image_sample_bilinear(ramp, (float)(u * 64), (float)((1 - v) * 64), want);
             if (inside[y * W + x] || d <= gutter - 1e-3) {
                 double diff = 0;
                 for (k = 0; k < 4; k++) diff = fmax(diff, fabs(got[k] - want[k]));
@@ -2690,19 +2958,19 @@ static void test_lapped_bake_gutter(void)
     CHECK(nfar > 100 && badfar == 0, "texels beyond the gutter filled opaque (%d of %d bad)", badfar, nfar);
     free(inside);
     lb_free(&b);
-    tt_image_free(&atlas);
-    tt_image_free(&ramp);
+    tt_image_free(atlas);
+    tt_image_free(ramp);
     tt_mesh_free(mesh);
 }
 
-static tt_image bake_checker(int w, int h, int square)
+static tt_image *bake_checker(int w, int h, int square)
 {
-    tt_image img;
+    tt_image *img = NULL;
     int x, y;
-    tt_image_create(&img, w, h, NULL);
+    if (tt_image_create(w, h, NULL, &img, NULL) != TT_OK) return NULL;
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            float *p = img.pixels + 4 * (y * w + x);
+            float *p = img->pixels + 4 * (y * w + x);
             int on = ((x / square) + (y / square)) & 1;
             p[0] = on ? 0.9f : 0.1f;
             p[1] = on ? 0.2f : 0.7f;
@@ -2740,7 +3008,7 @@ static void test_lapped_bake_seams(void)
 {
     tt_mesh *mesh;
     float *uv;
-    tt_image checker = bake_checker(64, 64, 8), atlas;
+    tt_image *checker = bake_checker(64, 64, 8), *atlas = NULL;
     lb_builder b;
     tt_error err;
     double m[4] = {1.0 / 8, 0, 0, 1.0 / 8}, o[2] = {0, 0}, sum_all = 0, sum_edge = 0, sum_nogutter = 0;
@@ -2751,8 +3019,8 @@ static void test_lapped_bake_seams(void)
     CHECK(tt_atlas_pack_pairs(mesh, size, 2, uv, &err) == TT_OK, "pack: %s", err.message);
     lb_init(&b);
     lb_paste_all(&b, mesh, 0, m, o);
-    tt_image_create(&atlas, size, size, NULL);
-    CHECK(tt_lapped_bake(mesh, &b.l, &checker, 1, uv, 2, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    tt_image_create(size, size, NULL, &atlas, NULL);
+    CHECK(bake_gutter(mesh, &b.l, &checker, 1, uv, 2, atlas, &err) == TT_OK, "bake: %s", err.message);
     for (i = 0; i < 20000; i++) {
         int f = lcg_below(mesh->nfaces);
         double r1 = lcg_unit(), r2 = lcg_unit(), w[3], diff;
@@ -2765,7 +3033,7 @@ static void test_lapped_bake_seams(void)
             s = w[0] + w[1] + w[2];
             w[0] /= s; w[1] /= s; w[2] /= s;
         }
-        diff = bake_seam_diff(mesh, &b.l, uv, &atlas, &checker, f, w);
+        diff = bake_seam_diff(mesh, &b.l, uv, atlas, checker, f, w);
         sum_all += diff;
         n_all++;
         if (fmin(w[0], fmin(w[1], w[2])) < 0.01) { sum_edge += diff; n_edge++; }
@@ -2775,7 +3043,7 @@ static void test_lapped_bake_seams(void)
           n_edge ? sum_edge / n_edge : -1.0, n_edge);
     /* Without gutters the same edge samples read the fill's copies: the
        gutter must do better than that. */
-    CHECK(tt_lapped_bake(mesh, &b.l, &checker, 1, uv, 0, &atlas, &err) == TT_OK, "bake without gutter: %s",
+    CHECK(bake_gutter(mesh, &b.l, &checker, 1, uv, 0, atlas, &err) == TT_OK, "bake without gutter: %s",
           err.message);
     lcg_seed(99);
     for (i = 0; i < 10000; i++) {
@@ -2785,7 +3053,7 @@ static void test_lapped_bake_seams(void)
         r = lcg_unit();
         w[1] = (1 - w[0]) * r;
         w[2] = 1 - w[0] - w[1];
-        sum_nogutter += bake_seam_diff(mesh, &b.l, uv, &atlas, &checker, f, w);
+        sum_nogutter += bake_seam_diff(mesh, &b.l, uv, atlas, checker, f, w);
         ne++;
     }
     sum_nogutter /= ne;
@@ -2793,8 +3061,8 @@ static void test_lapped_bake_seams(void)
           n_edge ? sum_edge / n_edge : -1.0, sum_nogutter);
     free(uv);
     lb_free(&b);
-    tt_image_free(&atlas);
-    tt_image_free(&checker);
+    tt_image_free(atlas);
+    tt_image_free(checker);
     tt_mesh_free(mesh);
 }
 
@@ -2804,7 +3072,7 @@ static void test_lapped_bake_order(void)
     float uv[12] = {0.1f, 0.1f, 0.9f, 0.1f, 0.9f, 0.9f, 0.1f, 0.1f, 0.9f, 0.1f, 0.9f, 0.9f};
     float puv[6] = {0, 0, 1, 0, 1, 1};
     tt_mesh *mesh = bake_grid(1, 1, 0.0, NULL);
-    tt_image patches[2], atlas;
+    tt_image *patches[2], *atlas = NULL;
     lb_builder b;
     tt_error err;
     const float *p;
@@ -2815,83 +3083,258 @@ static void test_lapped_bake_order(void)
     lb_add(&b, 1, puv);     /* green on face 1 */
     lb_begin(&b, 0);
     lb_add(&b, 0, puv);     /* red on face 0, pasted later, but face 1 is drawn later */
-    tt_image_create(&atlas, 20, 20, NULL);
-    CHECK(tt_lapped_bake(mesh, &b.l, patches, 2, uv, 1, &atlas, &err) == TT_OK, "bake: %s", err.message);
-    p = atlas.pixels + 4 * (12 * 20 + 14);
+    tt_image_create(20, 20, NULL, &atlas, NULL);
+    CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 1, atlas, &err) == TT_OK, "bake: %s", err.message);
+    p = atlas->pixels + 4 * (12 * 20 + 14);
     CHECK(p[1] == 1.0f && p[0] == 0.0f, "face 1 (green) wins, got %g %g %g", p[0], p[1], p[2]);
     lb_free(&b);
-    tt_image_free(&atlas);
-    tt_image_free(&patches[0]);
-    tt_image_free(&patches[1]);
+    tt_image_free(atlas);
+    tt_image_free(patches[0]);
+    tt_image_free(patches[1]);
     tt_mesh_free(mesh);
 }
+
+/* A tt_lapped_bake error: the code, err.result, a message without long
+   digit runs, the item (-2: not compared) and the face (-2: not compared). */
+#define BAKE_EXPECT(call, code, item_, face_, what)                                                             \
+    do {                                                                                                        \
+        tt_result r_ = (call);                                                                                  \
+        CHECK(r_ == (code) && err.result == (code) && err.message[0] != '\0' &&                                 \
+                  longest_digit_run(err.message) <= 12 && (item_ == -2 || err.item == item_) &&                \
+                  (face_ == -2 || err.face == face_),                                                           \
+              "%s: expected %d (item %d, face %d), got %d (item %d, face %d): %s", what, (int)(code), item_,  \
+              face_, (int)r_, err.item, err.face, err.message);                                                \
+    } while (0)
 
 static void test_lapped_bake_errors(void)
 {
     tt_mesh *mesh = bake_grid(1, 1, 0.0, NULL), *qm;
     float uv[12], quv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
     double id[4] = {1, 0, 0, 1}, zero[2] = {0, 0};
-    tt_image red = bake_constant(4, 4, 1, 0, 0, 1), atlas, empty;
+    tt_image *red = bake_constant(4, 4, 1, 0, 0, 1), *atlas = NULL, empty, *two[2];
     lb_builder b;
     tt_error err;
     bake_square_uvs(mesh, 0.1, 0.9, uv);
     lb_init(&b);
     lb_paste_all(&b, mesh, 0, id, zero);
-    tt_image_create(&atlas, 16, 16, NULL);
+    tt_image_create(16, 16, NULL, &atlas, NULL);
     memset(&empty, 0, sizeof empty);
 
-    CHECK(tt_lapped_bake(NULL, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh");
-    CHECK(tt_lapped_bake(mesh, NULL, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL lapped");
-    CHECK(tt_lapped_bake(mesh, &b.l, NULL, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL patches");
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, NULL, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL uv");
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL atlas");
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &empty, &err) == TT_ERROR_INVALID_ARGUMENT, "empty atlas");
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 0, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "npatches 0");
-    CHECK(tt_lapped_bake(mesh, &b.l, &empty, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "empty patch");
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, -1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "gutter -1");
+    BAKE_EXPECT(bake_gutter(NULL, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1, "NULL mesh");
+    BAKE_EXPECT(bake_gutter(mesh, NULL, &red, 1, uv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1,
+                "NULL lapped");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, NULL, 1, uv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1,
+                "NULL patches");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, NULL, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1, "NULL uv");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, NULL, &err), TT_ERROR_INVALID_ARGUMENT, -1, -1, "NULL atlas");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, &empty, &err), TT_ERROR_INVALID_ARGUMENT, -2, -2,
+                "empty atlas");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 0, uv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -2, -2,
+                "npatches 0");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, -1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -2, -2,
+                "gutter -1");
+    {
+        counter hc;
+        tt_allocator half = make_allocator(&hc, -1);
+        half.alloc = NULL;   /* free without alloc */
+        BAKE_EXPECT(tt_lapped_bake(mesh, &b.l, &red, 1, uv, NULL, &half, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -2,
+                    -2, "allocator without alloc");
+    }
+    /* The patches array: an empty image, a NULL pointer; the index in item. */
+    two[0] = red;
+    two[1] = &empty;
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, two, 2, uv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, 1, -2,
+                "empty patches[1]");
+    two[0] = NULL;
+    two[1] = red;
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, two, 2, uv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, 0, -2,
+                "NULL patches[0]");
 
-    b.l.pastes[0].patch = 1;
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE,
-          "patch out of range: %s", err.message);
+    /* Bad pastes and entries: the paste or entry in item. */
+    lb_begin(&b, 0);   /* paste 1: empty, then made bad */
+    b.l.pastes[1].patch = 1;
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 1, -2,
+                "paste 1 uses patch 1 of 1");
+    CHECK(msg_has_number(err.message, 1), "paste 1 named: %s", err.message);
+    b.l.pastes[1].patch = 0;
     b.l.pastes[0].patch = -1;
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE, "patch -1");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 0, -2,
+                "paste 0 uses patch -1");
     b.l.pastes[0].patch = 0;
+    b.l.pastes[1].first = 1;
+    b.l.pastes[1].nfaces = 2;   /* entries 1..2 of 2 */
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 1, -2,
+                "paste 1 runs past the entries");
+    b.l.pastes[1].first = -1;
+    b.l.pastes[1].nfaces = 1;
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 1, -2,
+                "paste 1 starts at entry -1");
+    b.l.pastes[1].first = 2;
+    b.l.pastes[1].nfaces = 0;
+    CHECK(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err) == TT_OK, "an empty paste is fine: %s", err.message);
     b.l.pastes[0].nfaces = 3;
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE,
-          "entries out of range: %s", err.message);
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 0, -2,
+                "paste 0 has 3 entries of 2");
     b.l.pastes[0].nfaces = 2;
     b.l.faces[1] = 2;
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INDEX_OUT_OF_RANGE && err.face == 2,
-          "face out of range, named: %s", err.message);
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 1, -2,
+                "entry 1 names face 2 of 2");
+    CHECK(msg_has_number(err.message, 2), "face 2 in the message: %s", err.message);
+    b.l.faces[1] = -7;
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 1, -2,
+                "entry 1 names face -7");
     b.l.faces[1] = 1;
     b.l.uv[3] = (float)internal_not_a_number();
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_NON_FINITE && err.face == 0,
-          "NaN paste uv, face named: %s", err.message);
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_NON_FINITE, 0, 0,
+                "NaN paste uv of entry 0");
     b.l.uv[3] = 0.0f;
+    b.l.uv[6 + 5] = internal_infinity();
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_NON_FINITE, 1, 1,
+                "infinite paste uv of entry 1");
+    b.l.uv[6 + 5] = 0.0f;
     uv[7] = internal_infinity();
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_NON_FINITE && err.corner == 3,
-          "infinite atlas uv, corner named: %s", err.message);
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_NON_FINITE, -2, 1,
+                "infinite atlas uv");
+    CHECK(err.corner == 3, "infinite atlas uv, corner named: %d %s", err.corner, err.message);
     bake_square_uvs(mesh, 0.1, 0.9, uv);
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_OK, "fixed: %s", err.message);
+    CHECK(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err) == TT_OK, "fixed: %s", err.message);
     b.l.nentries = -1;
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT, "nentries -1");
+    BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -2, -2,
+                "nentries -1");
     b.l.nentries = 2;
     lb_free(&b);
 
     qm = bake_quad();
     lb_init(&b);
-    CHECK(tt_lapped_bake(qm, &b.l, &red, 1, quv, 1, &atlas, &err) == TT_ERROR_INVALID_ARGUMENT && err.face == 0,
-          "quads refused, face 0 named: %s", err.message);
+    BAKE_EXPECT(bake_gutter(qm, &b.l, &red, 1, quv, 1, atlas, &err), TT_ERROR_INVALID_ARGUMENT, -2, 0,
+                "quads refused, face 0 named");
     tt_mesh_free(qm);
-    tt_image_free(&atlas);
-    tt_image_free(&red);
+    tt_image_free(atlas);
+    tt_image_free(red);
+    tt_mesh_free(mesh);
+}
+
+/* Progress and cancelling, options NULL (no gutter). */
+typedef struct bake_progress {
+    int calls, cancel_at, bad;
+    float last;
+} bake_progress;
+
+static int bake_progress_fn(float fraction, void *user_data)
+{
+    bake_progress *p = (bake_progress *)user_data;
+    if (!(fraction >= p->last) || !(fraction <= 1.0f)) p->bad++;
+    p->last = fraction;
+    return ++p->calls == p->cancel_at;
+}
+
+static void test_lapped_bake_progress(void)
+{
+    tt_mesh *mesh;
+    float *uv;
+    double m[4] = {0.25, 0, 0, 0.25}, zero[2] = {0, 0};
+    tt_image *checker = bake_checker(32, 32, 4), *atlas = NULL, *reference = NULL;
+    tt_bake_options opt;
+    bake_progress prog;
+    lb_builder b;
+    tt_error err;
+    tt_result r;
+    size_t i, n;
+    int nonzero, differ;
+    lcg_seed(41);
+    mesh = bake_grid(5, 4, 0.3, NULL);
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_atlas_pack_pairs(mesh, 128, 2, uv, &err) == TT_OK, "pack: %s", err.message);
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, m, zero);
+    tt_image_create(128, 128, NULL, &atlas, NULL);
+    tt_image_create(128, 128, NULL, &reference, NULL);
+    n = 4 * (size_t)128 * 128;
+
+    /* options NULL is no gutter: the same atlas as gutter 0. */
+    CHECK(tt_lapped_bake(mesh, &b.l, &checker, 1, uv, NULL, NULL, atlas, &err) == TT_OK && err.result == TT_OK,
+          "options NULL: %s", err.message);
+    CHECK(bake_gutter(mesh, &b.l, &checker, 1, uv, 0, reference, &err) == TT_OK, "gutter 0: %s", err.message);
+    CHECK(memcmp(atlas->pixels, reference->pixels, n * sizeof(float)) == 0, "options NULL bakes as gutter 0");
+    CHECK(bake_gutter(mesh, &b.l, &checker, 1, uv, 2, reference, &err) == TT_OK, "gutter 2: %s", err.message);
+    differ = memcmp(atlas->pixels, reference->pixels, n * sizeof(float)) != 0;
+    CHECK(differ, "a gutter of 2 changes the atlas (so the NULL-options check can fail)");
+
+    /* Progress: once per face, fractions in [0, 1], never decreasing. */
+    memset(&opt, 0, sizeof opt);
+    memset(&prog, 0, sizeof prog);
+    prog.cancel_at = -1;
+    prog.last = 0.0f;
+    opt.gutter = 2;
+    opt.progress = bake_progress_fn;
+    opt.progress_user_data = &prog;
+    r = tt_lapped_bake(mesh, &b.l, &checker, 1, uv, &opt, NULL, atlas, &err);
+    CHECK(r == TT_OK, "bake with progress: %d %s", (int)r, err.message);
+    CHECK(prog.calls == mesh->nfaces + 1 && prog.bad == 0 && prog.last == 1.0f,
+          "progress: %d calls for %d faces (one before each, one at the end), %d out of order, last %g (want 1)",
+          prog.calls, mesh->nfaces, prog.bad, prog.last);
+    CHECK(memcmp(atlas->pixels, reference->pixels, n * sizeof(float)) == 0,
+          "a progress callback that never cancels does not change the atlas");
+
+    /* Cancel half-way: TT_CANCELLED and an atlas of zeros, not half-written. */
+    memset(&prog, 0, sizeof prog);
+    prog.cancel_at = mesh->nfaces / 2;
+    for (i = 0; i < n; i++) atlas->pixels[i] = 0.25f;
+    r = tt_lapped_bake(mesh, &b.l, &checker, 1, uv, &opt, NULL, atlas, &err);
+    CHECK(r == TT_CANCELLED && err.result == TT_CANCELLED && err.message[0] != '\0',
+          "cancel at call %d: %d %s", prog.cancel_at, (int)r, err.message);
+    CHECK(prog.calls == prog.cancel_at, "no progress call after cancelling: %d calls, cancelled at %d", prog.calls,
+          prog.cancel_at);
+    nonzero = 0;
+    for (i = 0; i < n; i++) nonzero += atlas->pixels[i] != 0.0f;
+    CHECK(nonzero == 0, "cancelled: the atlas is cleared, %d values are not 0", nonzero);
+    /* Cancel at the last call (every face baked, the fill not yet run): cleared too. */
+    memset(&prog, 0, sizeof prog);
+    prog.cancel_at = mesh->nfaces + 1;
+    for (i = 0; i < n; i++) atlas->pixels[i] = 0.25f;
+    r = tt_lapped_bake(mesh, &b.l, &checker, 1, uv, &opt, NULL, atlas, &err);
+    nonzero = 0;
+    for (i = 0; i < n; i++) nonzero += atlas->pixels[i] != 0.0f;
+    CHECK(r == TT_CANCELLED && prog.last == 1.0f && nonzero == 0,
+          "cancel at the final call: %d, last %g, %d values not 0", (int)r, prog.last, nonzero);
+    /* Cancel at the first call: still cleared (the atlas held 0.25). */
+    memset(&prog, 0, sizeof prog);
+    prog.cancel_at = 1;
+    for (i = 0; i < n; i++) atlas->pixels[i] = 0.25f;
+    r = tt_lapped_bake(mesh, &b.l, &checker, 1, uv, &opt, NULL, atlas, &err);
+    nonzero = 0;
+    for (i = 0; i < n; i++) nonzero += atlas->pixels[i] != 0.0f;
+    CHECK(r == TT_CANCELLED && prog.calls == 1 && nonzero == 0, "cancel at once: %d, %d calls, %d values not 0",
+          (int)r, prog.calls, nonzero);
+    /* And through a view of someone else's pixels. */
+    {
+        tt_image view;
+        float *pixels = (float *)malloc(sizeof(float) * 4 * 40 * 30);
+        memset(&view, 0, sizeof view);
+        view.width = 40;
+        view.height = 30;
+        view.pixels = pixels;
+        for (i = 0; i < 4 * 40 * 30; i++) pixels[i] = 0.5f;
+        memset(&prog, 0, sizeof prog);
+        prog.cancel_at = 2;
+        r = tt_lapped_bake(mesh, &b.l, &checker, 1, uv, &opt, NULL, &view, &err);
+        nonzero = 0;
+        for (i = 0; i < 4 * 40 * 30; i++) nonzero += pixels[i] != 0.0f;
+        CHECK(r == TT_CANCELLED && nonzero == 0, "cancel into a view: %d, %d values not 0", (int)r, nonzero);
+        free(pixels);
+    }
+    free(uv);
+    lb_free(&b);
+    tt_image_free(atlas);
+    tt_image_free(reference);
+    tt_image_free(checker);
     tt_mesh_free(mesh);
 }
 
 typedef struct bake_oom_ctx {
-    const tt_mesh *mesh;      /* built with the sweep's allocator */
+    const tt_mesh *mesh;
     const tt_lapped *lapped;
-    const tt_image *patch;
+    tt_image *patch;
     const float *uv;
     tt_image *atlas;
 } bake_oom_ctx;
@@ -2899,14 +3342,16 @@ typedef struct bake_oom_ctx {
 static tt_result bake_oom_call(void *ctx, const tt_allocator *al)
 {
     bake_oom_ctx *c = (bake_oom_ctx *)ctx;
+    tt_bake_options opt;
     tt_error err;
     tt_result r;
     int i, n = 4 * c->atlas->width * c->atlas->height;
-    (void)al;   /* tt_lapped_bake allocates from the mesh's allocator: the same one */
+    memset(&opt, 0, sizeof opt);
+    opt.gutter = 1;
     for (i = 0; i < n; i++) c->atlas->pixels[i] = 0.25f;
-    r = tt_lapped_bake(c->mesh, c->lapped, c->patch, 1, c->uv, 1, c->atlas, &err);
+    r = tt_lapped_bake(c->mesh, c->lapped, &c->patch, 1, c->uv, &opt, al, c->atlas, &err);
+    if (err.result != r) return TT_RESULT_MAX_ENUM;
     if (r != TT_OK) {
-        if (err.result != r) return TT_RESULT_MAX_ENUM;
         for (i = 0; i < n; i++)   /* all memory is taken before the atlas is touched */
             if (c->atlas->pixels[i] != 0.25f) return TT_RESULT_MAX_ENUM;
     }
@@ -2918,31 +3363,31 @@ static void test_lapped_bake_oom(void)
     tt_mesh *mesh;
     float uv[2 * 3 * 32];
     double m[4] = {0.25, 0, 0, 0.25}, zero[2] = {0, 0};
-    tt_image red = bake_constant(4, 4, 1, 0, 0, 1), atlas;
+    tt_image *red = bake_constant(4, 4, 1, 0, 0, 1), *atlas = NULL;
     lb_builder b;
     bake_oom_ctx c;
     tt_error err;
     lcg_seed(31);
-    oom_reset();
-    mesh = bake_grid(4, 4, 0.3, &g_oom_allocator);
+    mesh = bake_grid(4, 4, 0.3, NULL);   /* the mesh's own allocator is not used */
     if (!mesh) return;
+    oom_reset();
     CHECK(tt_atlas_pack_pairs(mesh, 64, 1, uv, &err) == TT_OK, "pack: %s", err.message);
     lb_init(&b);
     lb_paste_all(&b, mesh, 0, m, zero);
-    tt_image_create(&atlas, 64, 64, NULL);
+    tt_image_create(64, 64, NULL, &atlas, NULL);
     c.mesh = mesh;
     c.lapped = &b.l;
-    c.patch = &red;
+    c.patch = red;
     c.uv = uv;
-    c.atlas = &atlas;
+    c.atlas = atlas;
     oom_sweep("tt_lapped_bake", bake_oom_call, &c, TT_OK);
     CHECK(g_oom_counter.calls == 5, "tt_lapped_bake: 5 allocations, got %ld", g_oom_counter.calls);
     tt_mesh_free(mesh);
     CHECK(g_oom_counter.live == 0 && g_oom_counter.bad_frees == 0, "all freed (%ld live, %ld bad frees)",
           g_oom_counter.live, g_oom_counter.bad_frees);
     lb_free(&b);
-    tt_image_free(&atlas);
-    tt_image_free(&red);
+    tt_image_free(atlas);
+    tt_image_free(red);
 }
 
 /* A sliver far thinner than a texel, a degenerate triangle and one with UVs
@@ -2955,7 +3400,7 @@ static void test_lapped_bake_thin(void)
                     -3000.0f, -3000.0f, 3000.0f, -3000.0f, 0.0f, 3000.0f};
     float puv[6] = {0, 0, 1, 0, 0, 1};
     tt_mesh *mesh = bake_three(6, 3);
-    tt_image red = bake_constant(4, 4, 1, 0, 0, 1), atlas;
+    tt_image *red = bake_constant(4, 4, 1, 0, 0, 1), *atlas = NULL;
     lb_builder b;
     tt_error err;
     int i, bad = 0;
@@ -2963,18 +3408,18 @@ static void test_lapped_bake_thin(void)
     lb_begin(&b, 0);
     lb_add(&b, 0, puv);
     lb_add(&b, 1, puv);
-    tt_image_create(&atlas, 32, 32, NULL);
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 4, &atlas, &err) == TT_OK, "bake: %s", err.message);
-    for (i = 0; i < 32 * 32 * 4; i++) bad += atlas.pixels[i] != 0.0f;
+    tt_image_create(32, 32, NULL, &atlas, NULL);
+    CHECK(bake_gutter(mesh, &b.l, &red, 1, uv, 4, atlas, &err) == TT_OK, "bake: %s", err.message);
+    for (i = 0; i < 32 * 32 * 4; i++) bad += atlas->pixels[i] != 0.0f;
     CHECK(bad == 0, "face 2 without pastes covers the atlas: transparent (%d values off)", bad);
     lb_add(&b, 2, puv);
-    CHECK(tt_lapped_bake(mesh, &b.l, &red, 1, uv, 4, &atlas, &err) == TT_OK, "bake: %s", err.message);
+    CHECK(bake_gutter(mesh, &b.l, &red, 1, uv, 4, atlas, &err) == TT_OK, "bake: %s", err.message);
     bad = 0;
-    for (i = 0; i < 32 * 32; i++) bad += atlas.pixels[4 * i] != 1.0f || atlas.pixels[4 * i + 3] != 1.0f;
+    for (i = 0; i < 32 * 32; i++) bad += atlas->pixels[4 * i] != 1.0f || atlas->pixels[4 * i + 3] != 1.0f;
     CHECK(bad == 0, "face 2 pasted red: all red (%d texels off)", bad);
     lb_free(&b);
-    tt_image_free(&atlas);
-    tt_image_free(&red);
+    tt_image_free(atlas);
+    tt_image_free(red);
     tt_mesh_free(mesh);
 }
 
@@ -2984,6 +3429,7 @@ void run_lapped_tests(void)
     RUN(test_field_fallback);
     RUN(test_field_constraints);
     RUN(test_field_errors);
+    RUN(test_field_constraint_items);
     RUN(test_field_oom);
     RUN(test_patch_splotch);
     RUN(test_patch_seeds);
@@ -3013,6 +3459,7 @@ void run_lapped_tests(void)
     RUN(test_lapped_bake_seams);
     RUN(test_lapped_bake_order);
     RUN(test_lapped_bake_errors);
+    RUN(test_lapped_bake_progress);
     RUN(test_lapped_bake_oom);
     RUN(test_lapped_bake_thin);
 }
