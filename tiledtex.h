@@ -28,9 +28,9 @@
        tt_image_sample_bilinear, ...) return their answer directly; each states
        its preconditions, and TT_ASSERT checks them.
      - Memory. A function that allocates takes `const tt_allocator *allocator`
-       as the parameter before its outputs: NULL means TT_MALLOC / TT_FREE, and
-       an allocator must set both alloc and free (one without the other is
-       TT_ERROR_INVALID_ARGUMENT). Every allocation, temporary or returned, goes
+       as the parameter before its outputs: NULL means TT_MALLOC / TT_FREE. An
+       allocator sets both of its functions, alloc and free: one without the
+       other is TT_ERROR_INVALID_ARGUMENT. Every allocation, temporary or returned, goes
        through it and is freed on every error path. An object it returns
        remembers its allocator.
      - Ownership. Where the size of an output is known up front (per-corner UVs,
