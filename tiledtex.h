@@ -1346,6 +1346,48 @@ static float tt__infinity(void)
     return x;
 }
 
+/* ---- Small 3D vector math (doubles) ---- */
+
+static double tt__dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static double tt__length3(const double *v) { return sqrt(tt__dot3(v, v)); }
+
+/* |v| of a float vector, in double. */
+static double tt__length3f(const float *v)
+{
+    double d[3];
+    d[0] = v[0]; d[1] = v[1]; d[2] = v[2];
+    return tt__length3(d);
+}
+
+/* out = a - b for float points, in double. */
+static void tt__sub3f(const float *a, const float *b, double *out)
+{
+    out[0] = (double)a[0] - b[0]; out[1] = (double)a[1] - b[1]; out[2] = (double)a[2] - b[2];
+}
+
+static void tt__cross3(const double *a, const double *b, double *out)
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Scale v to unit length; returns the old length (v untouched when it is 0). */
+static double tt__normalize3(double *v)
+{
+    double len = tt__length3(v);
+    if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
+    return len;
+}
+
+/* v minus its component along the unit normal n. */
+static void tt__project3(const double *v, const double *n, double *out)
+{
+    double d = tt__dot3(v, n);
+    out[0] = v[0] - d * n[0]; out[1] = v[1] - d * n[1]; out[2] = v[2] - d * n[2];
+}
+
 /* PCG32 (O'Neill 2014): a 64-bit LCG whose output is a permuted 32-bit word. */
 TTDEF uint32_t tt_rng_next(tt_rng *rng)
 {
@@ -1501,12 +1543,11 @@ static void tt__polygon_newell(const float *pos, const int *verts, int count, do
     *scale = 0.0;
     for (i = 1; i < count; i++) {
         const float *q = pos + 3 * (size_t)verts[i];
-        double b[3];
-        b[0] = (double)q[0] - o[0]; b[1] = (double)q[1] - o[1]; b[2] = (double)q[2] - o[2];
-        n[0] += a[1] * b[2] - a[2] * b[1];
-        n[1] += a[2] * b[0] - a[0] * b[2];
-        n[2] += a[0] * b[1] - a[1] * b[0];
-        *scale += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+        double b[3], ab[3];
+        tt__sub3f(q, o, b);
+        tt__cross3(a, b, ab);
+        n[0] += ab[0]; n[1] += ab[1]; n[2] += ab[2];
+        *scale += tt__dot3(b, b);
         a[0] = b[0]; a[1] = b[1]; a[2] = b[2];
     }
 }
@@ -1515,7 +1556,7 @@ static void tt__polygon_newell(const float *pos, const int *verts, int count, do
    merely thin. Squares are compared: no square root per face. */
 static int tt__newell_is_zero(const double n[3], double scale)
 {
-    return n[0] * n[0] + n[1] * n[1] + n[2] * n[2] <= 1e-24 * scale * scale;
+    return tt__dot3(n, n) <= 1e-24 * scale * scale;
 }
 
 static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
@@ -1538,6 +1579,30 @@ static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
     }
     tt__polygon_newell(pos, verts, count, n, &scale);
     return tt__newell_is_zero(n, scale);
+}
+
+/* The unit normal, or zero for a face of numerically zero area (judged as
+   tt_mesh_build judges it, through tt__polygon_newell). */
+static int tt__face_normal_d(const tt_mesh *mesh, int face, double normal[3])
+{
+    int begin = mesh->face_start[face];
+    double n[3], scale, inverse;
+    tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, mesh->face_start[face + 1] - begin, n, &scale);
+    if (tt__newell_is_zero(n, scale)) {
+        normal[0] = normal[1] = normal[2] = 0.0;
+        return 0;
+    }
+    inverse = 1.0 / tt__length3(n);
+    normal[0] = n[0] * inverse; normal[1] = n[1] * inverse; normal[2] = n[2] * inverse;
+    return 1;
+}
+
+TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
+{
+    double n[3];
+    TT_ASSERT(mesh && normal && face >= 0 && face < mesh->nfaces);
+    tt__face_normal_d(mesh, face, n);
+    normal[0] = (float)n[0]; normal[1] = (float)n[1]; normal[2] = (float)n[2];
 }
 
 /* A problem found while pairing twins; the one with the smallest corner is
@@ -4084,54 +4149,6 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
 /* 7. Lapped textures                                                       */
 /* ------------------------------------------------------------------------ */
 
-/* The unit normal, or zero for a face of numerically zero area (judged as
-   tt_mesh_build judges it, through tt__polygon_newell). */
-static int tt__face_normal_d(const tt_mesh *mesh, int face, double normal[3])
-{
-    int begin = mesh->face_start[face];
-    double n[3], scale, inverse;
-    tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, mesh->face_start[face + 1] - begin, n, &scale);
-    if (tt__newell_is_zero(n, scale)) {
-        normal[0] = normal[1] = normal[2] = 0.0;
-        return 0;
-    }
-    inverse = 1.0 / sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    normal[0] = n[0] * inverse; normal[1] = n[1] * inverse; normal[2] = n[2] * inverse;
-    return 1;
-}
-
-TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
-{
-    double n[3];
-    TT_ASSERT(mesh && normal && face >= 0 && face < mesh->nfaces);
-    tt__face_normal_d(mesh, face, n);
-    normal[0] = (float)n[0]; normal[1] = (float)n[1]; normal[2] = (float)n[2];
-}
-
-static double tt__dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void tt__cross3(const double *a, const double *b, double *out)
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-/* Scale v to unit length; returns the old length (v untouched when it is 0). */
-static double tt__normalize3(double *v)
-{
-    double len = sqrt(tt__dot3(v, v));
-    if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
-    return len;
-}
-
-/* v minus its component along the unit normal n. */
-static void tt__project3(const double *v, const double *n, double *out)
-{
-    double d = tt__dot3(v, n);
-    out[0] = v[0] - d * n[0]; out[1] = v[1] - d * n[1]; out[2] = v[2] - d * n[2];
-}
-
 /* Parallel transport across half-edge c (of the source face, normal ns) into
    the face across it (normal nt): with e the unit edge direction and
    b = n x e, v = (v.e) e + (v.b_s) b_s  ->  (v.e) e + (v.b_s) b_t, i.e. the
@@ -4143,8 +4160,8 @@ static void tt__field_transport(const tt_mesh *mesh, int c, const double *ns, co
     const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
     const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
     double e[3], bs[3], bt[3], r[3], ve, vb, len;
-    e[0] = (double)q[0] - p[0]; e[1] = (double)q[1] - p[1]; e[2] = (double)q[2] - p[2];
-    len = sqrt(tt__dot3(v, v));
+    tt__sub3f(q, p, e);
+    len = tt__length3(v);
     if (tt__normalize3(e) <= 0.0) { tt__project3(v, nt, out); return; }
     tt__cross3(ns, e, bs);
     tt__cross3(nt, e, bt);
@@ -4212,7 +4229,7 @@ static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a,
         da[k] = m[k] - centroid[3 * (size_t)a + k];
         db[k] = m[k] - centroid[3 * (size_t)b + k];
     }
-    return sqrt(tt__dot3(da, da)) + sqrt(tt__dot3(db, db));
+    return tt__length3(da) + tt__length3(db);
 }
 
 TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
@@ -4268,7 +4285,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
         }
     }
     for (k = 0; k < 3; k++) lo[k] = hi[k] - lo[k];
-    diag = sqrt(tt__dot3(lo, lo));
+    diag = tt__length3(lo);
     if (!(diag > 0.0)) diag = 1.0;
     scale = opt.scale > 0.0f ? (double)opt.scale : TT_DEFAULT_FIELD_SCALE * diag;
     sigma = opt.sigma > 0.0f ? (double)opt.sigma : TT_DEFAULT_FIELD_SIGMA * diag;
@@ -4316,9 +4333,9 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
             goto done;
         }
         for (k = 0; k < 3; k++) v[k] = con->vector[k];
-        len = sqrt(tt__dot3(v, v));
+        len = tt__length3(v);
         tt__project3(v, normal + 3 * (size_t)con->face, p);
-        plen = sqrt(tt__dot3(p, p));
+        plen = tt__length3(p);
         if (!(len > 0.0) || !(plen > 1e-3 * len)) {
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
                               "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
@@ -4363,7 +4380,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
             double wt = con->weight > 0.0f ? (double)con->weight : 1.0, len, v[3];
             int nheap = 0;
             for (k = 0; k < 3; k++) v[k] = con->vector[k];
-            len = sqrt(tt__dot3(v, v));
+            len = tt__length3(v);
             for (f = 0; f < nf; f++) { dist[f] = -1.0; parent[f] = -2; }   /* -2 unreached, -1 source */
             dist[con->face] = 0.0;
             parent[con->face] = -1;
@@ -4450,7 +4467,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
                 for (j = 0; j < opt.nconstraints; j++)
                     if (opt.constraints[j].face == g) {
                         const float *cv = opt.constraints[j].vector;
-                        l += sqrt((double)cv[0] * cv[0] + (double)cv[1] * cv[1] + (double)cv[2] * cv[2]);
+                        l += tt__length3f(cv);
                     }
                 l /= wsum[g];
                 for (k = 0; k < 3; k++) o[k] = p[k] * l;
@@ -4491,7 +4508,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
                 p = mesh->pos + 3 * (size_t)mesh->corner_vert[a];
                 q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, a)];
                 o = vec + 3 * (size_t)next_seed;
-                for (k = 0; k < 3; k++) e[k] = (double)q[k] - p[k];
+                tt__sub3f(q, p, e);
                 tt__project3(e, normal + 3 * (size_t)next_seed, e);
                 if (!(tt__normalize3(e) > 0.0)) { e[0] = 1.0; e[1] = e[2] = 0.0; }   /* not reached: area > 0 */
                 for (k = 0; k < 3; k++) o[k] = e[k] * scale;
@@ -5754,8 +5771,8 @@ static void tt__face_vector_weights(const tt_mesh *mesh, int f, const double *t,
     const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
     const float *c = tt__corner_pos(mesh, 3 * f + 2);
     double e1[3], e2[3], g11, g12, g22, r1, r2, det;
-    int k;
-    for (k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
+    tt__sub3f(b, a, e1);
+    tt__sub3f(c, a, e2);
     g11 = tt__dot3(e1, e1); g12 = tt__dot3(e1, e2); g22 = tt__dot3(e2, e2);
     r1 = tt__dot3(e1, t); r2 = tt__dot3(e2, t);
     det = g11 * g22 - g12 * g12;   /* g11 g22 sin^2 of the angle at corner 0 */
@@ -5840,7 +5857,7 @@ static void tt__propagate_direction(tt__lapper *L, int g, int from, int paste)
     const tt_mesh *mesh = L->mesh;
     double sum[3] = {0.0, 0.0, 0.0}, d[3], *out = L->tangent + 3 * (size_t)g;
     const float *field = L->field + 3 * (size_t)g;
-    double length = sqrt((double)field[0] * field[0] + (double)field[1] * field[1] + (double)field[2] * field[2]);
+    double length = tt__length3f(field);
     int k;
     for (k = 0; k < 3; k++) {
         int t = mesh->twin[3 * g + k], h;
@@ -5886,7 +5903,7 @@ static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2
                    x -> y: the perpendicular offset turns x -> y by +90 deg. */
                 tt__cross3(e, q, n);
                 along = tt__dot3(q, e) / ee;
-                across = sqrt(tt__dot3(n, n)) / ee;
+                across = tt__length3(n) / ee;
                 uv[0] += ux[0] + along * (uy[0] - ux[0]) - across * (uy[1] - ux[1]);
                 uv[1] += ux[1] + along * (uy[1] - ux[1]) + across * (uy[0] - ux[0]);
                 count++;
@@ -6291,9 +6308,9 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
             return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
                             "the field vector of face %d is NaN or infinite", f);
         v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
-        length = sqrt(tt__dot3(v, v));
+        length = tt__length3(v);
         tt__project3(v, n, t);
-        projected = sqrt(tt__dot3(t, t));
+        projected = tt__length3(t);
         if (!(length > 0.0) || projected < 1e-3 * length)
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
                             length > 0.0 ? "the field vector of face %d is perpendicular to the face"
@@ -6308,9 +6325,10 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
             const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
             const float *c = tt__corner_pos(mesh, 3 * f + 2);
             double e1[3], e2[3], cr[3];
-            for (k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
+            tt__sub3f(b, a, e1);
+            tt__sub3f(c, a, e2);
             tt__cross3(e1, e2, cr);
-            estimate += TT_LAPPED_PASTES_PER_AREA * 0.5 * sqrt(tt__dot3(cr, cr)) /
+            estimate += TT_LAPPED_PASTES_PER_AREA * 0.5 * tt__length3(cr) /
                         (projected * projected * opaque_fraction);
         }
     }
@@ -6321,12 +6339,12 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
                         "%.3g pastes, more than the limit of %d (use a larger scale)", estimate, max_pastes);
     for (f = 0; f < nf; f++) {
         const double *t = L->tangent + 3 * (size_t)f;
-        double projected = sqrt(tt__dot3(t, t)), longest = 0.0;
+        double projected = tt__length3(t), longest = 0.0;
         for (k = 0; k < 3; k++) {
             const float *a = tt__corner_pos(mesh, 3 * f + k), *b = tt__corner_pos(mesh, 3 * f + (k + 1) % 3);
             double e[3];
-            e[0] = (double)b[0] - a[0]; e[1] = (double)b[1] - a[1]; e[2] = (double)b[2] - a[2];
-            if (sqrt(tt__dot3(e, e)) > longest) longest = sqrt(tt__dot3(e, e));
+            tt__sub3f(b, a, e);
+            if (tt__length3(e) > longest) longest = tt__length3(e);
         }
         {
             /* Faces so large next to the patch that even its deepest point
@@ -6396,7 +6414,7 @@ static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_
         const float *fv = L->field + 3 * (size_t)f;
         double v[3], across[3], angle = 6.283185307179586 * tt_rng_float(&L->rng), length;
         v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
-        length = sqrt(tt__dot3(v, v));
+        length = tt__length3(v);
         tt__project3(v, L->normal + 3 * (size_t)f, t);
         tt__normalize3(t);
         tt__cross3(L->normal + 3 * (size_t)f, t, across);
