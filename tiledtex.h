@@ -1388,6 +1388,76 @@ static void tt__project3(const double *v, const double *n, double *out)
     out[0] = v[0] - d * n[0]; out[1] = v[1] - d * n[1]; out[2] = v[2] - d * n[2];
 }
 
+/* ---- Binary min-heap of (key, value) items ----
+   Ties are broken by the smaller value, so the order of pops is
+   deterministic. The caller owns the array and its capacity. */
+typedef struct tt__heap_item {
+    double key;
+    int value;
+} tt__heap_item;
+
+static int tt__heap_less(const tt__heap_item *a, const tt__heap_item *b)
+{
+    return a->key < b->key || (a->key == b->key && a->value < b->value);
+}
+
+static void tt__heap_push(tt__heap_item *heap, int *count, double key, int value)
+{
+    int i = (*count)++;
+    tt__heap_item item;
+    item.key = key;
+    item.value = value;
+    while (i > 0) {
+        int parent = (i - 1) / 2;
+        if (!tt__heap_less(&item, &heap[parent])) break;
+        heap[i] = heap[parent];
+        i = parent;
+    }
+    heap[i] = item;
+}
+
+static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
+{
+    tt__heap_item top = heap[0], last = heap[--(*count)];
+    int i = 0, n = *count;
+    for (;;) {
+        int child = 2 * i + 1;
+        if (child >= n) break;
+        if (child + 1 < n && tt__heap_less(&heap[child + 1], &heap[child])) child++;
+        if (!tt__heap_less(&heap[child], &last)) break;
+        heap[i] = heap[child];
+        i = child;
+    }
+    if (n > 0) heap[i] = last;
+    return top;
+}
+
+/* ---- Sorting doubles in place (ascending) ----
+   Heapsort: O(n log n) whatever the input, so the exact median of a million
+   entries never degrades to the quadratic worst case of a quickselect. */
+static void tt__sift_doubles(double *v, int root, int count)
+{
+    for (;;) {
+        int child = 2 * root + 1;
+        double tmp;
+        if (child >= count) return;
+        if (child + 1 < count && v[child] < v[child + 1]) child++;
+        if (!(v[root] < v[child])) return;
+        tmp = v[root]; v[root] = v[child]; v[child] = tmp;
+        root = child;
+    }
+}
+
+static void tt__sort_doubles(double *v, int n)
+{
+    int i;
+    for (i = n / 2 - 1; i >= 0; i--) tt__sift_doubles(v, i, n);
+    for (i = n - 1; i > 0; i--) {
+        double tmp = v[0]; v[0] = v[i]; v[i] = tmp;
+        tt__sift_doubles(v, 0, i);
+    }
+}
+
 /* PCG32 (O'Neill 2014): a 64-bit LCG whose output is a permuted 32-bit word. */
 TTDEF uint32_t tt_rng_next(tt_rng *rng)
 {
@@ -2757,6 +2827,14 @@ static int tt__is_finite_d(double x)
 static int tt__size_fits(size_t count, size_t element_size)
 {
     return element_size == 0 || count <= (size_t)-1 / element_size;
+}
+
+/* The median of values[0 .. count-1] (sorts them); 0 for none. */
+static double tt__median(double *values, int count)
+{
+    if (count <= 0) return 0.0;
+    tt__sort_doubles(values, count);
+    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
 }
 
 TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,
@@ -4174,48 +4252,6 @@ static void tt__field_transport(const tt_mesh *mesh, int c, const double *ns, co
     if (tt__normalize3(out) > 0.0) { out[0] *= len; out[1] *= len; out[2] *= len; }
 }
 
-/* Binary min-heap of (distance, face), ties broken by face: deterministic. */
-typedef struct tt__heap_item {
-    double key;
-    int face;
-} tt__heap_item;
-
-static int tt__heap_less(const tt__heap_item *a, const tt__heap_item *b)
-{
-    return a->key < b->key || (a->key == b->key && a->face < b->face);
-}
-
-static void tt__heap_push(tt__heap_item *heap, int *count, double key, int face)
-{
-    int i = (*count)++;
-    tt__heap_item item;
-    item.key = key;
-    item.face = face;
-    while (i > 0) {
-        int parent = (i - 1) / 2;
-        if (!tt__heap_less(&item, &heap[parent])) break;
-        heap[i] = heap[parent];
-        i = parent;
-    }
-    heap[i] = item;
-}
-
-static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
-{
-    tt__heap_item top = heap[0], last = heap[--(*count)];
-    int i = 0, n = *count;
-    for (;;) {
-        int child = 2 * i + 1;
-        if (child >= n) break;
-        if (child + 1 < n && tt__heap_less(&heap[child + 1], &heap[child])) child++;
-        if (!tt__heap_less(&heap[child], &last)) break;
-        heap[i] = heap[child];
-        i = child;
-    }
-    if (n > 0) heap[i] = last;
-    return top;
-}
-
 /* Distance of one dual step from face a across half-edge c (of a) to face b:
    centroid(a) -> midpoint of the edge -> centroid(b). */
 static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a, int c, int b)
@@ -4387,7 +4423,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
             tt__heap_push(heap, &nheap, 0.0, con->face);
             while (nheap > 0) {
                 tt__heap_item top = tt__heap_pop(heap, &nheap);
-                int g = top.face, begin, end;
+                int g = top.value, begin, end;
                 double *t = trans + 3 * (size_t)g, lw, scl;
                 if (top.key > dist[g]) continue;   /* stale entry */
                 if (parent[g] == -1) {
@@ -5211,7 +5247,7 @@ static tt_result tt__hull_simplify(tt__hull *h, int max_vertices)
             tt__heap_item item = tt__heap_pop(h->heap, &h->heap_count);
             tt__hull_op op;
             tt_result result;
-            v = item.face;
+            v = item.value;
             if (h->state[v] != TT__HULL_LIVE || h->key[v] != item.key || !tt__hull_candidate(h, v, &op)) continue;
             if (!tt__hull_valid(h, v, &op)) {
                 h->state[v] = TT__HULL_BLOCKED;
@@ -5639,7 +5675,7 @@ typedef struct tt__lapper {
     double *vert_uv;            /* 2 per vertex */
     int *patch_faces, npatch_faces;
     int *patch_verts, npatch_verts;
-    tt__heap_item *heap;        /* half-edges to grow across; `face` holds the half-edge */
+    tt__heap_item *heap;        /* half-edges to grow across; `value` holds the half-edge */
     int heap_count;
     tt_triplet *triplets;
     double *solve;              /* 4 per patch vertex: b_s, b_t, x_s, x_t */
@@ -5955,7 +5991,7 @@ static void tt__grow_patch(tt__lapper *L, int paste, int patch)
     L->heap_count = 0;
     for (i = 0; i < count; i++) tt__queue_edges(L, L->patch_faces[i], paste, patch);
     while (L->heap_count > 0) {
-        int c = tt__heap_pop(L->heap, &L->heap_count).face;
+        int c = tt__heap_pop(L->heap, &L->heap_count).value;
         if (tt__try_add_face(L, c, paste))
             tt__queue_edges(L, L->patch_faces[L->npatch_faces - 1], paste, patch);
     }
@@ -6467,39 +6503,6 @@ static int tt__remove_hidden(tt__lapper *L)
                                                           L->covered + L->sample_start[face]);
     }
     return removed;
-}
-
-/* Heapsort: O(n log n) whatever the input, so the exact median of a million
-   entries never degrades to the quadratic worst case of a quickselect. */
-static void tt__sift_doubles(double *v, int root, int count)
-{
-    for (;;) {
-        int child = 2 * root + 1;
-        double tmp;
-        if (child >= count) return;
-        if (child + 1 < count && v[child] < v[child + 1]) child++;
-        if (!(v[root] < v[child])) return;
-        tmp = v[root]; v[root] = v[child]; v[child] = tmp;
-        root = child;
-    }
-}
-
-static void tt__sort_doubles(double *v, int n)
-{
-    int i;
-    for (i = n / 2 - 1; i >= 0; i--) tt__sift_doubles(v, i, n);
-    for (i = n - 1; i > 0; i--) {
-        double tmp = v[0]; v[0] = v[i]; v[i] = tmp;
-        tt__sift_doubles(v, 0, i);
-    }
-}
-
-/* The median of values[0 .. count-1] (sorts them); 0 for none. */
-static double tt__median(double *values, int count)
-{
-    if (count <= 0) return 0.0;
-    tt__sort_doubles(values, count);
-    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
 }
 
 /* Move the surviving entries into the result, pastes that lost every face
