@@ -1306,14 +1306,41 @@ static void tt__free(const tt_allocator *allocator, void *ptr)
     TT_FREE(ptr, allocator ? allocator->user_data : NULL);
 }
 
+/* count elements of element_size bytes fit in a size_t byte count. */
+static int tt__size_fits(size_t count, size_t element_size)
+{
+    return element_size == 0 || count <= (size_t)-1 / element_size;
+}
+
 /* count * element_size bytes, or NULL when that overflows size_t. */
 static void *tt__alloc_array(const tt_allocator *allocator, size_t count, size_t element_size)
 {
-    if (element_size != 0 && count > (size_t)-1 / element_size) return NULL;
+    if (!tt__size_fits(count, element_size)) return NULL;
     return tt__alloc(allocator, count * element_size);
 }
 
 #define TT__ALLOC(allocator, type, count) ((type *)tt__alloc_array((allocator), (size_t)(count), sizeof(type)))
+
+/* Growable array: `array` (holding *capacity elements of `size` bytes)
+   grown to hold at least `need`, doubling; NULL when out of memory, the old
+   array then still the caller's. */
+static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int need, size_t size)
+{
+    int cap = *capacity;
+    void *bigger;
+    if (need <= cap) return array;
+    while (cap < need) {
+        if (cap > INT_MAX / 2) return NULL;
+        cap = cap ? 2 * cap : 64;
+    }
+    if (!tt__size_fits((size_t)cap, size)) return NULL;
+    bigger = tt__alloc(al, (size_t)cap * size);
+    if (!bigger) return NULL;
+    if (array) memcpy(bigger, array, (size_t)*capacity * size);
+    tt__free(al, array);
+    *capacity = cap;
+    return bigger;
+}
 
 static int tt__min_i(int a, int b) { return a < b ? a : b; }
 static int tt__max_i(int a, int b) { return a > b ? a : b; }
@@ -1328,6 +1355,14 @@ static int tt__is_finite(float x)
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
     return (bits & 0x7f800000u) != 0x7f800000u;
+}
+
+/* Double version of tt__is_finite: tested on the bits, like it. */
+static int tt__is_finite_d(double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
 }
 
 static double tt__not_a_number(void)
@@ -2814,20 +2849,6 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
 #define TT__RESTRICT
 #endif
 #endif
-
-/* Double version of tt__is_finite: tested on the bits, like it. */
-static int tt__is_finite_d(double x)
-{
-    uint64_t bits;
-    memcpy(&bits, &x, sizeof bits);
-    return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
-}
-
-/* count elements of element_size bytes fit in a size_t byte count. */
-static int tt__size_fits(size_t count, size_t element_size)
-{
-    return element_size == 0 || count <= (size_t)-1 / element_size;
-}
 
 /* The median of values[0 .. count-1] (sorts them); 0 for none. */
 static double tt__median(double *values, int count)
@@ -5017,14 +5038,9 @@ static tt_result tt__hull_insert_edge(tt__hull *h, int u)
                 h->node_free = h->nodes[k].next;
             } else {
                 if (h->node_count == h->node_cap) {
-                    tt__hull_node *grown;
-                    if (h->node_cap > 0x3fffffff) return TT_ERROR_OUT_OF_MEMORY;
-                    grown = TT__ALLOC(h->allocator, tt__hull_node, 2 * h->node_cap);
+                    void *grown = tt__grow(h->allocator, h->nodes, &h->node_cap, h->node_count + 1, sizeof *h->nodes);
                     if (!grown) return TT_ERROR_OUT_OF_MEMORY;
-                    memcpy(grown, h->nodes, (size_t)h->node_count * sizeof *grown);
-                    tt__free(h->allocator, h->nodes);
-                    h->nodes = grown;
-                    h->node_cap *= 2;
+                    h->nodes = (tt__hull_node *)grown;
                 }
                 k = h->node_count++;
             }
@@ -5684,27 +5700,6 @@ typedef struct tt__lapper {
     tt__entry *entries;
     int nentries, entry_capacity;
 } tt__lapper;
-
-/* `array` (holding *capacity elements of `size` bytes) grown to hold at
-   least `need`, doubling; NULL when out of memory, the old array then still
-   the caller's. */
-static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int need, size_t size)
-{
-    int cap = *capacity;
-    void *bigger;
-    if (need <= cap) return array;
-    while (cap < need) {
-        if (cap > INT_MAX / 2) return NULL;
-        cap = cap ? 2 * cap : 64;
-    }
-    if (!tt__size_fits((size_t)cap, size)) return NULL;
-    bigger = tt__alloc(al, (size_t)cap * size);
-    if (!bigger) return NULL;
-    if (array) memcpy(bigger, array, (size_t)*capacity * size);
-    tt__free(al, array);
-    *capacity = cap;
-    return bigger;
-}
 
 /* Sec. 3.6 counts a face point as covered where a paste is opaque. Here a
    sample point counts only when every texel a bilinear lookup could read
