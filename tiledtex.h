@@ -1423,6 +1423,28 @@ static void tt__project3(const double *v, const double *n, double *out)
     out[0] = v[0] - d * n[0]; out[1] = v[1] - d * n[1]; out[2] = v[2] - d * n[2];
 }
 
+/* ---- Small 2D geometry ---- */
+
+/* Twice the signed area of triangle a, b, c: positive when it turns left. */
+static double tt__orient2(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+/* Distance from (px, py) to the segment from a to b (to a when b == a). */
+static double tt__point_segment_distance(double px, double py, double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay;
+    double wx = px - ax, wy = py - ay, length2 = dx * dx + dy * dy, t = 0.0;
+    if (length2 > 0.0) {
+        t = (wx * dx + wy * dy) / length2;
+        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    }
+    wx -= t * dx;
+    wy -= t * dy;
+    return sqrt(wx * wx + wy * wy);
+}
+
 /* ---- Binary min-heap of (key, value) items ----
    Ties are broken by the smaller value, so the order of pops is
    deterministic. The caller owns the array and its capacity. */
@@ -4960,24 +4982,6 @@ typedef struct tt__hull_op {
     double vx, vy;          /* collapse: the new vertex */
 } tt__hull_op;
 
-/* Twice the signed area of triangle a, b, c: positive when it turns left. */
-static double tt__orient2(double ax, double ay, double bx, double by, double cx, double cy)
-{
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
-}
-
-static double tt__point_segment_distance(double px, double py, double ax, double ay, double bx, double by)
-{
-    double dx = bx - ax, dy = by - ay, len2 = dx * dx + dy * dy, t = 0.0, ex, ey;
-    if (len2 > 0.0) {
-        t = ((px - ax) * dx + (py - ay) * dy) / len2;
-        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    }
-    ex = ax + t * dx - px;
-    ey = ay + t * dy - py;
-    return sqrt(ex * ex + ey * ey);
-}
-
 /* 1 when segments a-b and c-d come closer than eps (crossing counts). */
 static int tt__segments_near(double ax, double ay, double bx, double by, double cx, double cy, double dx,
                              double dy, double eps)
@@ -6852,20 +6856,6 @@ typedef struct tt__bake {
     tt_image *atlas;
 } tt__bake;
 
-/* Distance from (px, py) to the segment from vertex i to vertex j. */
-static double tt__bake_segment_distance(const tt__bake *b, int i, int j, double px, double py)
-{
-    double dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
-    double wx = px - b->x[i], wy = py - b->y[i], length2 = dx * dx + dy * dy, t = 0.0;
-    if (length2 > 0.0) {
-        t = (wx * dx + wy * dy) / length2;
-        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    }
-    wx -= t * dx;
-    wy -= t * dy;
-    return sqrt(wx * wx + wy * wy);
-}
-
 /* Composite the face's pastes at barycentric weights w (Sec. 4: the pastes
    drawn in order with "over"), premultiplied. Weights outside [0, 1] extend
    each paste's linear map across the face's edges. */
@@ -6909,9 +6899,9 @@ static void tt__bake_texel(int x, int y, const float barycentric[3], void *user_
         /* Between gutters the nearer triangle wins, the later face on ties. */
         double d = 0.0;
         if (w[0] < 0.0 || w[1] < 0.0 || w[2] < 0.0) {
-            double d1 = tt__bake_segment_distance(b, 0, 1, px, py);
-            double d2 = tt__bake_segment_distance(b, 1, 2, px, py);
-            double d3 = tt__bake_segment_distance(b, 2, 0, px, py);
+            double d1 = tt__point_segment_distance(px, py, b->x[0], b->y[0], b->x[1], b->y[1]);
+            double d2 = tt__point_segment_distance(px, py, b->x[1], b->y[1], b->x[2], b->y[2]);
+            double d3 = tt__point_segment_distance(px, py, b->x[2], b->y[2], b->x[0], b->y[0]);
             d = d1 < d2 ? d1 : d2;
             d = d < d3 ? d : d3;
         }
