@@ -1342,6 +1342,9 @@ static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int ne
     return bigger;
 }
 
+#define TT__PI 3.14159265358979323846
+#define TT__TWO_PI 6.28318530717958647692
+
 static int tt__min_i(int a, int b) { return a < b ? a : b; }
 static int tt__max_i(int a, int b) { return a > b ? a : b; }
 static int tt__abs_i(int x) { return x < 0 ? -x : x; }
@@ -4836,7 +4839,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         tt_rng_seed(&rng, opt.seed, 0x7061746368ull);   /* "patch" */
         for (k = 0; k < 4; k++) {
             c[k] = (0.5f + 0.5f * tt_rng_float(&rng)) / (float)(k + 2);
-            phi[k] = 6.28318531f * tt_rng_float(&rng);
+            phi[k] = (float)TT__TWO_PI * tt_rng_float(&rng);
             csum += c[k];
         }
         for (k = 0; k < 4; k++) c[k] *= roughness / csum;
@@ -5837,7 +5840,7 @@ static void tt__face_up_image(const tt__lapper *L, int f, double image_t[2])
 static void tt__alignment_error(const double image_t[2], double *angle, double *scale)
 {
     *scale = sqrt(image_t[0] * image_t[0] + image_t[1] * image_t[1]);
-    *angle = *scale > 0.0 ? fabs(atan2(image_t[0], image_t[1])) * (180.0 / 3.14159265358979323846) : 180.0;
+    *angle = *scale > 0.0 ? fabs(atan2(image_t[0], image_t[1])) * (180.0 / TT__PI) : 180.0;
 }
 
 static int tt__lapped_too_distorted(const tt__lapper *L, int f)
@@ -6447,7 +6450,7 @@ static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_
         /* "the center face of the patch is assigned an arbitrary tangent
            direction" (Sec. 3.2): the field's direction turned at random. */
         const float *fv = L->field + 3 * (size_t)f;
-        double v[3], across[3], angle = 6.283185307179586 * tt_rng_float(&L->rng), length;
+        double v[3], across[3], angle = TT__TWO_PI * tt_rng_float(&L->rng), length;
         v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
         length = tt__length3(v);
         tt__project3(v, L->normal + 3 * (size_t)f, t);
