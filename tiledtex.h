@@ -4314,48 +4314,60 @@ static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a,
     return tt__length3(da) + tt__length3(db);
 }
 
-TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
-                                 const tt_allocator *allocator, float *face_vectors, tt_error *error)
-{
-    tt_field_options opt;
-    const tt_allocator *al = allocator;
-    double up[3], diag, scale, sigma, lo[3], hi[3];
-    double *normal = NULL, *vec = NULL, *centroid = NULL, *dist = NULL, *trans = NULL, *sum = NULL,
-           *wsum = NULL, *lsum = NULL, *wlog = NULL, *best = NULL;
-    int *state = NULL, *parent = NULL, *queue = NULL;
-    tt__heap_item *heap = NULL;
-    tt_result result = TT_OK;
-    int nf, f, c, i, k, next_seed;
+/* The tangent field's working state, shared by its phases. */
+typedef struct tt__field {
+    const tt_mesh *mesh;
+    const tt_allocator *al;
+    tt_field_options opt;       /* the caller's options, or all zero */
+    int nf;
+    double up[3];               /* unit global up */
+    double scale, sigma;        /* defaults resolved (mesh units) */
+    double *normal;             /* 3 per face: unit normal, 0 for zero area */
+    double *vec;                /* 3 per face: the field being built */
+    int *state;                 /* -1 = zero-area face (never assigned), 0 = unassigned, 1 + layer =
+                                   assigned in that breadth-first layer (constraints and up: 0) */
+    int *queue;                 /* nf faces, for the breadth-first layers */
+} tt__field;
 
-    if (!mesh || !face_vectors)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_tangent_field needs a mesh and an output array (got NULL)");
-    if (options) opt = *options;
-    else memset(&opt, 0, sizeof opt);
+/* Phase 1 (Sec. 3.2's parameters): check the options, resolve up, and the
+   default scale and sigma from the bounding-box diagonal of the vertices
+   the faces use. Nothing is allocated. */
+static tt_result tt__field_setup(tt__field *F, const tt_mesh *mesh, const tt_field_options *options,
+                                 const tt_allocator *allocator, tt_error *error)
+{
+    tt_field_options *opt = &F->opt;
+    double diag, lo[3], hi[3];
+    int c, k;
+
+    memset(F, 0, sizeof *F);
+    F->mesh = mesh;
+    F->al = allocator;
+    if (options) *opt = *options;
+    else memset(opt, 0, sizeof *opt);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    nf = mesh->nfaces;
+    F->nf = mesh->nfaces;
 
     /* Options. */
     for (k = 0; k < 3; k++)
-        if (!tt__is_finite(opt.up[k]))
+        if (!tt__is_finite(opt->up[k]))
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                            "the up vector (%g, %g, %g) is not finite", opt.up[0], opt.up[1], opt.up[2]);
-    if (opt.up[0] == 0.0f && opt.up[1] == 0.0f && opt.up[2] == 0.0f) opt.up[1] = 1.0f;
-    for (k = 0; k < 3; k++) up[k] = opt.up[k];
-    if (!(tt__normalize3(up) > 0.0))
+                            "the up vector (%g, %g, %g) is not finite", opt->up[0], opt->up[1], opt->up[2]);
+    if (opt->up[0] == 0.0f && opt->up[1] == 0.0f && opt->up[2] == 0.0f) opt->up[1] = 1.0f;
+    for (k = 0; k < 3; k++) F->up[k] = opt->up[k];
+    if (!(tt__normalize3(F->up) > 0.0))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the up vector (%g, %g, %g) has no usable length", opt.up[0], opt.up[1], opt.up[2]);
-    if (!tt__is_finite(opt.scale) || opt.scale < 0.0f)
+                        "the up vector (%g, %g, %g) has no usable length", opt->up[0], opt->up[1], opt->up[2]);
+    if (!tt__is_finite(opt->scale) || opt->scale < 0.0f)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "scale %g must be finite and >= 0 (0 = default)", opt.scale);
-    if (!tt__is_finite(opt.sigma) || opt.sigma < 0.0f)
+                        "scale %g must be finite and >= 0 (0 = default)", opt->scale);
+    if (!tt__is_finite(opt->sigma) || opt->sigma < 0.0f)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "sigma %g must be finite and >= 0 (0 = default)", opt.sigma);
-    if (opt.nconstraints < 0 || (opt.nconstraints > 0 && !opt.constraints))
+                        "sigma %g must be finite and >= 0 (0 = default)", opt->sigma);
+    if (opt->nconstraints < 0 || (opt->nconstraints > 0 && !opt->constraints))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "nconstraints is %d with constraints %s", opt.nconstraints,
-                        opt.constraints ? "given" : "NULL");
-    if (nf <= 0) return tt__ok(error);
+                        "nconstraints is %d with constraints %s", opt->nconstraints,
+                        opt->constraints ? "given" : "NULL");
+    if (F->nf <= 0) return TT_OK;   /* nothing to build: the driver stops here */
 
     /* Bounding-box diagonal of the vertices the faces use. */
     for (k = 0; k < 3; k++) { lo[k] = 1e300; hi[k] = -1e300; }
@@ -4369,294 +4381,374 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
     for (k = 0; k < 3; k++) lo[k] = hi[k] - lo[k];
     diag = tt__length3(lo);
     if (!(diag > 0.0)) diag = 1.0;
-    scale = opt.scale > 0.0f ? (double)opt.scale : TT_DEFAULT_FIELD_SCALE * diag;
-    sigma = opt.sigma > 0.0f ? (double)opt.sigma : TT_DEFAULT_FIELD_SIGMA * diag;
+    F->scale = opt->scale > 0.0f ? (double)opt->scale : TT_DEFAULT_FIELD_SCALE * diag;
+    F->sigma = opt->sigma > 0.0f ? (double)opt->sigma : TT_DEFAULT_FIELD_SIGMA * diag;
+    return TT_OK;
+}
 
-    normal = TT__ALLOC(al, double, 3 * (size_t)nf);
-    vec = TT__ALLOC(al, double, 3 * (size_t)nf);
-    state = TT__ALLOC(al, int, nf);
-    queue = TT__ALLOC(al, int, nf);
-    if (!normal || !vec || !state || !queue) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
-    /* state: -1 = zero-area face (never assigned), 0 = unassigned,
-       1 + layer = assigned in that breadth-first layer (constraints and up: 0). */
-    for (f = 0; f < nf; f++) {
-        state[f] = tt__face_normal_d(mesh, f, normal + 3 * (size_t)f) ? 0 : -1;
-        vec[3 * (size_t)f] = vec[3 * (size_t)f + 1] = vec[3 * (size_t)f + 2] = 0.0;
-    }
-
-    /* Constraints: check them all before any work. */
-    for (i = 0; i < opt.nconstraints; i++) {
-        const tt_field_constraint *con = &opt.constraints[i];
+/* Phase 2, first: every constraint checked before any work (face in range,
+   finite, not negative, on a face with a plane, not perpendicular to it). */
+static tt_result tt__field_check_constraints(const tt__field *F, tt_error *error)
+{
+    int i, k, nf = F->nf;
+    for (i = 0; i < F->opt.nconstraints; i++) {
+        const tt_field_constraint *con = &F->opt.constraints[i];
         double v[3], p[3], len, plen;
+        tt_result result = TT_OK;
         if (con->face < 0 || con->face >= nf) {
             result = tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, con->face, -1, -1, -1,
                               "constraint %d names face %d, but the mesh has %d faces", i, con->face, nf);
-            if (error) error->item = i;
-            goto done;
-        }
-        if (!tt__is_finite(con->vector[0]) || !tt__is_finite(con->vector[1]) || !tt__is_finite(con->vector[2]) ||
-            !tt__is_finite(con->sigma) || !tt__is_finite(con->weight)) {
+        } else if (!tt__is_finite(con->vector[0]) || !tt__is_finite(con->vector[1]) ||
+                   !tt__is_finite(con->vector[2]) || !tt__is_finite(con->sigma) || !tt__is_finite(con->weight)) {
             result = tt__fail(error, TT_ERROR_NON_FINITE, con->face, -1, -1, -1,
                               "constraint %d (face %d) has a NaN or infinite vector, sigma or weight", i, con->face);
-            if (error) error->item = i;
-            goto done;
-        }
-        if (con->sigma < 0.0f || con->weight < 0.0f) {
+        } else if (con->sigma < 0.0f || con->weight < 0.0f) {
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
                               "constraint %d (face %d) has sigma %g and weight %g; neither may be negative", i,
                               con->face, con->sigma, con->weight);
-            if (error) error->item = i;
-            goto done;
-        }
-        if (state[con->face] < 0) {
+        } else if (F->state[con->face] < 0) {
             result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, con->face, -1, -1, -1,
                               "constraint %d is on face %d, which has zero area and no plane", i, con->face);
-            if (error) error->item = i;
-            goto done;
-        }
-        for (k = 0; k < 3; k++) v[k] = con->vector[k];
-        len = tt__length3(v);
-        tt__project3(v, normal + 3 * (size_t)con->face, p);
-        plen = tt__length3(p);
-        if (!(len > 0.0) || !(plen > 1e-3 * len)) {
-            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
-                              "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
-                              con->vector[0], con->vector[1], con->vector[2],
-                              len > 0.0 ? "perpendicular to the face" : "zero");
-            if (error) error->item = i;
-            goto done;
-        }
-    }
-
-    if (opt.nconstraints > 0) {
-        /* Gaussian RBFs over Dijkstra distances, one pass per constraint. */
-        centroid = TT__ALLOC(al, double, 3 * (size_t)nf);
-        dist = TT__ALLOC(al, double, nf);
-        trans = TT__ALLOC(al, double, 3 * (size_t)nf);
-        sum = TT__ALLOC(al, double, 3 * (size_t)nf);
-        wsum = TT__ALLOC(al, double, nf);
-        lsum = TT__ALLOC(al, double, nf);
-        wlog = TT__ALLOC(al, double, nf);
-        best = TT__ALLOC(al, double, 4 * (size_t)nf);
-        parent = TT__ALLOC(al, int, nf);
-        heap = TT__ALLOC(al, tt__heap_item, (size_t)mesh->ncorners + 1);
-        if (!centroid || !dist || !trans || !sum || !wsum || !lsum || !wlog || !best || !parent || !heap) {
-            result = TT_ERROR_OUT_OF_MEMORY;
-            goto done;
-        }
-        for (f = 0; f < nf; f++) {
-            int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
-            double *ce = centroid + 3 * (size_t)f;
-            ce[0] = ce[1] = ce[2] = 0.0;
-            for (c = begin; c < end; c++)
-                for (k = 0; k < 3; k++) ce[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
-            for (k = 0; k < 3; k++) ce[k] /= (double)(end - begin);
-            sum[3 * (size_t)f] = sum[3 * (size_t)f + 1] = sum[3 * (size_t)f + 2] = 0.0;
-            wsum[f] = lsum[f] = 0.0;
-            wlog[f] = -1e300;
-            best[4 * (size_t)f] = -1e300;   /* best log weight, then that constraint's t_i(f) */
-        }
-        for (i = 0; i < opt.nconstraints; i++) {
-            const tt_field_constraint *con = &opt.constraints[i];
-            double s = con->sigma > 0.0f ? (double)con->sigma : sigma;
-            double wt = con->weight > 0.0f ? (double)con->weight : 1.0, len, v[3];
-            int nheap = 0;
+        } else {
             for (k = 0; k < 3; k++) v[k] = con->vector[k];
             len = tt__length3(v);
-            for (f = 0; f < nf; f++) { dist[f] = -1.0; parent[f] = -2; }   /* -2 unreached, -1 source */
-            dist[con->face] = 0.0;
-            parent[con->face] = -1;
-            tt__heap_push(heap, &nheap, 0.0, con->face);
-            while (nheap > 0) {
-                tt__heap_item top = tt__heap_pop(heap, &nheap);
-                int g = top.value, begin, end;
-                double *t = trans + 3 * (size_t)g, lw, scl;
-                if (top.key > dist[g]) continue;   /* stale entry */
-                if (parent[g] == -1) {
-                    tt__project3(v, normal + 3 * (size_t)g, t);
-                    tt__normalize3(t);
-                    t[0] *= len; t[1] *= len; t[2] *= len;
-                } else {
-                    int from = mesh->corner_face[parent[g]];
-                    tt__field_transport(mesh, parent[g], normal + 3 * (size_t)from, normal + 3 * (size_t)g,
-                                        trans + 3 * (size_t)from, t);
-                }
-                parent[g] = -3;   /* settled */
-                /* Accumulate w = wt exp(-d^2 / 2s^2) relative to the largest log weight so far. */
-                lw = log(wt) - top.key * top.key / (2.0 * s * s);
-                if (lw > wlog[g]) {
-                    scl = wsum[g] > 0.0 ? exp(wlog[g] - lw) : 0.0;
-                    for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] *= scl;
-                    wsum[g] *= scl;
-                    lsum[g] *= scl;
-                    wlog[g] = lw;
-                }
-                scl = exp(lw - wlog[g]);
-                for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] += scl * t[k];
-                wsum[g] += scl;
-                lsum[g] += scl * len;
-                if (lw > best[4 * (size_t)g]) {
-                    best[4 * (size_t)g] = lw;
-                    for (k = 0; k < 3; k++) best[4 * (size_t)g + 1 + k] = t[k];
-                }
-                begin = mesh->face_start[g];
-                end = mesh->face_start[g + 1];
-                for (c = begin; c < end; c++) {
-                    int tw = mesh->twin[c], h;
-                    double d;
-                    if (tw < 0) continue;
-                    h = mesh->corner_face[tw];
-                    if (state[h] < 0 || parent[h] == -3 || parent[h] == -1) continue;
-                    d = top.key + tt__field_step(mesh, centroid, g, c, h);
-                    if (dist[h] < 0.0 || d < dist[h]) {
-                        dist[h] = d;
-                        parent[h] = c;
-                        tt__heap_push(heap, &nheap, d, h);
-                    }
-                }
-            }
+            tt__project3(v, F->normal + 3 * (size_t)con->face, p);
+            plen = tt__length3(p);
+            if (!(len > 0.0) || !(plen > 1e-3 * len))
+                result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
+                                  "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
+                                  con->vector[0], con->vector[1], con->vector[2],
+                                  len > 0.0 ? "perpendicular to the face" : "zero");
         }
-        for (f = 0; f < nf; f++) {
-            double *o = vec + 3 * (size_t)f, dir[3];
-            if (state[f] < 0 || !(wsum[f] > 0.0)) continue;
-            for (k = 0; k < 3; k++) dir[k] = sum[3 * (size_t)f + k];
-            tt__project3(dir, normal + 3 * (size_t)f, dir);
-            if (!(tt__normalize3(dir) > 1e-9 * (lsum[f] / wsum[f]))) {
-                for (k = 0; k < 3; k++) dir[k] = best[4 * (size_t)f + 1 + k];
-                tt__normalize3(dir);
-            }
-            for (k = 0; k < 3; k++) o[k] = dir[k] * (lsum[f] / wsum[f]);
-            state[f] = 1;
-        }
-        /* A constrained face gets exactly the average of its own constraints. */
-        for (f = 0; f < nf; f++) wsum[f] = 0.0;
-        for (i = 0; i < opt.nconstraints; i++) {
-            const tt_field_constraint *con = &opt.constraints[i];
-            double *o = sum + 3 * (size_t)con->face;
-            if (wsum[con->face] == 0.0) o[0] = o[1] = o[2] = 0.0;
-            for (k = 0; k < 3; k++) o[k] += con->vector[k];
-            wsum[con->face] += 1.0;
-        }
-        for (i = 0; i < opt.nconstraints; i++) {
-            int g = opt.constraints[i].face;
-            double p[3], *o = vec + 3 * (size_t)g;
-            if (wsum[g] == 0.0) continue;
-            for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] /= wsum[g];
-            tt__project3(sum + 3 * (size_t)g, normal + 3 * (size_t)g, p);
-            if (tt__normalize3(p) > 0.0) {   /* opposite constraints on one face keep the blended one */
-                double l = 0.0;
-                int j;
-                for (j = 0; j < opt.nconstraints; j++)
-                    if (opt.constraints[j].face == g) {
-                        const float *cv = opt.constraints[j].vector;
-                        l += tt__length3f(cv);
-                    }
-                l /= wsum[g];
-                for (k = 0; k < 3; k++) o[k] = p[k] * l;
-            }
-            wsum[g] = 0.0;
+        if (result != TT_OK) {
+            if (error) error->item = i;
+            return result;
         }
     }
+    return TT_OK;
+}
 
-    /* Default rule for every face no constraint reached: projected up. */
+/* Scratch of the constraint phase: per face, the Dijkstra distance and
+   tree, the transported constraint vector, and the running weighted sums. */
+typedef struct tt__field_rbf {
+    double *centroid;           /* 3 per face */
+    double *dist;               /* Dijkstra distance, -1 unreached */
+    double *trans;              /* 3 per face: t_i(f), constraint i carried to f */
+    double *sum, *wsum, *lsum;  /* sum of w t_i (3 per face), of w, of w |c_i|, relative to wlog */
+    double *wlog;               /* the largest log weight so far */
+    double *best;               /* 4 per face: best log weight, then that constraint's t_i(f) */
+    int *parent;                /* half-edge crossed into the face; -2 unreached, -1 source, -3 settled */
+    tt__heap_item *heap;        /* ncorners + 1 */
+} tt__field_rbf;
+
+/* Phase 2a (Sec. 3.2 "Gaussian radial basis functions, where radius is
+   defined as distance over the mesh, as computed using Dijkstra's
+   algorithm"): one Dijkstra pass from constraint con over the dual graph,
+   carrying its vector by parallel transport along the tree and adding
+   w = weight exp(-d^2 / 2 sigma^2) times it into every face reached. */
+static void tt__field_dijkstra(const tt__field *F, tt__field_rbf *R, const tt_field_constraint *con)
+{
+    const tt_mesh *mesh = F->mesh;
+    double s = con->sigma > 0.0f ? (double)con->sigma : F->sigma;
+    double wt = con->weight > 0.0f ? (double)con->weight : 1.0, len, v[3];
+    int nheap = 0, f, c, k;
+    for (k = 0; k < 3; k++) v[k] = con->vector[k];
+    len = tt__length3(v);
+    for (f = 0; f < F->nf; f++) { R->dist[f] = -1.0; R->parent[f] = -2; }   /* -2 unreached, -1 source */
+    R->dist[con->face] = 0.0;
+    R->parent[con->face] = -1;
+    tt__heap_push(R->heap, &nheap, 0.0, con->face);
+    while (nheap > 0) {
+        tt__heap_item top = tt__heap_pop(R->heap, &nheap);
+        int g = top.value, begin, end;
+        double *t = R->trans + 3 * (size_t)g, lw, scl;
+        if (top.key > R->dist[g]) continue;   /* stale entry */
+        if (R->parent[g] == -1) {
+            tt__project3(v, F->normal + 3 * (size_t)g, t);
+            tt__normalize3(t);
+            t[0] *= len; t[1] *= len; t[2] *= len;
+        } else {
+            int from = mesh->corner_face[R->parent[g]];
+            tt__field_transport(mesh, R->parent[g], F->normal + 3 * (size_t)from, F->normal + 3 * (size_t)g,
+                                R->trans + 3 * (size_t)from, t);
+        }
+        R->parent[g] = -3;   /* settled */
+        /* Accumulate w = wt exp(-d^2 / 2s^2) relative to the largest log weight so far. */
+        lw = log(wt) - top.key * top.key / (2.0 * s * s);
+        if (lw > R->wlog[g]) {
+            scl = R->wsum[g] > 0.0 ? exp(R->wlog[g] - lw) : 0.0;
+            for (k = 0; k < 3; k++) R->sum[3 * (size_t)g + k] *= scl;
+            R->wsum[g] *= scl;
+            R->lsum[g] *= scl;
+            R->wlog[g] = lw;
+        }
+        scl = exp(lw - R->wlog[g]);
+        for (k = 0; k < 3; k++) R->sum[3 * (size_t)g + k] += scl * t[k];
+        R->wsum[g] += scl;
+        R->lsum[g] += scl * len;
+        if (lw > R->best[4 * (size_t)g]) {
+            R->best[4 * (size_t)g] = lw;
+            for (k = 0; k < 3; k++) R->best[4 * (size_t)g + 1 + k] = t[k];
+        }
+        begin = mesh->face_start[g];
+        end = mesh->face_start[g + 1];
+        for (c = begin; c < end; c++) {
+            int tw = mesh->twin[c], h;
+            double d;
+            if (tw < 0) continue;
+            h = mesh->corner_face[tw];
+            if (F->state[h] < 0 || R->parent[h] == -3 || R->parent[h] == -1) continue;
+            d = top.key + tt__field_step(mesh, R->centroid, g, c, h);
+            if (R->dist[h] < 0.0 || d < R->dist[h]) {
+                R->dist[h] = d;
+                R->parent[h] = c;
+                tt__heap_push(R->heap, &nheap, d, h);
+            }
+        }
+    }
+}
+
+/* Phase 2b: T_f = (sum w |c_i| / sum w) normalize(sum w t_i(f)) on every face
+   a constraint reached (the strongest constraint's direction where the
+   directions cancel); then a constrained face gets exactly the average of
+   its own constraints. R->sum and R->wsum are reused as scratch. */
+static void tt__field_blend(tt__field *F, tt__field_rbf *R)
+{
+    const tt_field_constraint *cons = F->opt.constraints;
+    int f, i, k;
+    for (f = 0; f < F->nf; f++) {
+        double *o = F->vec + 3 * (size_t)f, dir[3];
+        if (F->state[f] < 0 || !(R->wsum[f] > 0.0)) continue;
+        for (k = 0; k < 3; k++) dir[k] = R->sum[3 * (size_t)f + k];
+        tt__project3(dir, F->normal + 3 * (size_t)f, dir);
+        if (!(tt__normalize3(dir) > 1e-9 * (R->lsum[f] / R->wsum[f]))) {
+            for (k = 0; k < 3; k++) dir[k] = R->best[4 * (size_t)f + 1 + k];
+            tt__normalize3(dir);
+        }
+        for (k = 0; k < 3; k++) o[k] = dir[k] * (R->lsum[f] / R->wsum[f]);
+        F->state[f] = 1;
+    }
+    /* A constrained face gets exactly the average of its own constraints. */
+    for (f = 0; f < F->nf; f++) R->wsum[f] = 0.0;
+    for (i = 0; i < F->opt.nconstraints; i++) {
+        const tt_field_constraint *con = &cons[i];
+        double *o = R->sum + 3 * (size_t)con->face;
+        if (R->wsum[con->face] == 0.0) o[0] = o[1] = o[2] = 0.0;
+        for (k = 0; k < 3; k++) o[k] += con->vector[k];
+        R->wsum[con->face] += 1.0;
+    }
+    for (i = 0; i < F->opt.nconstraints; i++) {
+        int g = cons[i].face;
+        double p[3], *o = F->vec + 3 * (size_t)g;
+        if (R->wsum[g] == 0.0) continue;
+        for (k = 0; k < 3; k++) R->sum[3 * (size_t)g + k] /= R->wsum[g];
+        tt__project3(R->sum + 3 * (size_t)g, F->normal + 3 * (size_t)g, p);
+        if (tt__normalize3(p) > 0.0) {   /* opposite constraints on one face keep the blended one */
+            double l = 0.0;
+            int j;
+            for (j = 0; j < F->opt.nconstraints; j++)
+                if (cons[j].face == g) l += tt__length3f(cons[j].vector);
+            l /= R->wsum[g];
+            for (k = 0; k < 3; k++) o[k] = p[k] * l;
+        }
+        R->wsum[g] = 0.0;
+    }
+}
+
+/* Phase 2 (Sec. 3.2, constraints): Gaussian RBFs over Dijkstra distances,
+   one pass per constraint, then the blend. Faces it assigns get state 1. */
+static tt_result tt__field_constraints(tt__field *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    const tt_allocator *al = F->al;
+    tt__field_rbf R;
+    tt_result result = TT_OK;
+    int nf = F->nf, f, c, i, k;
+    R.centroid = TT__ALLOC(al, double, 3 * (size_t)nf);
+    R.dist = TT__ALLOC(al, double, nf);
+    R.trans = TT__ALLOC(al, double, 3 * (size_t)nf);
+    R.sum = TT__ALLOC(al, double, 3 * (size_t)nf);
+    R.wsum = TT__ALLOC(al, double, nf);
+    R.lsum = TT__ALLOC(al, double, nf);
+    R.wlog = TT__ALLOC(al, double, nf);
+    R.best = TT__ALLOC(al, double, 4 * (size_t)nf);
+    R.parent = TT__ALLOC(al, int, nf);
+    R.heap = TT__ALLOC(al, tt__heap_item, (size_t)mesh->ncorners + 1);
+    if (!R.centroid || !R.dist || !R.trans || !R.sum || !R.wsum || !R.lsum || !R.wlog || !R.best || !R.parent ||
+        !R.heap) {
+        result = TT_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
     for (f = 0; f < nf; f++) {
-        double p[3], *o = vec + 3 * (size_t)f;
-        if (state[f] != 0) continue;
-        tt__project3(up, normal + 3 * (size_t)f, p);
+        int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
+        double *ce = R.centroid + 3 * (size_t)f;
+        ce[0] = ce[1] = ce[2] = 0.0;
+        for (c = begin; c < end; c++)
+            for (k = 0; k < 3; k++) ce[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
+        for (k = 0; k < 3; k++) ce[k] /= (double)(end - begin);
+        R.sum[3 * (size_t)f] = R.sum[3 * (size_t)f + 1] = R.sum[3 * (size_t)f + 2] = 0.0;
+        R.wsum[f] = R.lsum[f] = 0.0;
+        R.wlog[f] = -1e300;
+        R.best[4 * (size_t)f] = -1e300;
+    }
+    for (i = 0; i < F->opt.nconstraints; i++) tt__field_dijkstra(F, &R, &F->opt.constraints[i]);
+    tt__field_blend(F, &R);
+
+done:
+    tt__free(al, R.centroid);
+    tt__free(al, R.dist);
+    tt__free(al, R.trans);
+    tt__free(al, R.sum);
+    tt__free(al, R.wsum);
+    tt__free(al, R.lsum);
+    tt__free(al, R.wlog);
+    tt__free(al, R.best);
+    tt__free(al, R.parent);
+    tt__free(al, R.heap);
+    return result;
+}
+
+/* Phase 3 (Sec. 3.2 "project the global up direction onto the surface, and
+   then normalize"): every face no constraint reached and not nearly
+   perpendicular to up (TT_FIELD_PERPENDICULAR) gets scale * P_f(up) / |P_f(up)|. */
+static void tt__field_default(tt__field *F)
+{
+    int f, k;
+    for (f = 0; f < F->nf; f++) {
+        double p[3], *o = F->vec + 3 * (size_t)f;
+        if (F->state[f] != 0) continue;
+        tt__project3(F->up, F->normal + 3 * (size_t)f, p);
         if (tt__normalize3(p) >= TT_FIELD_PERPENDICULAR) {
-            for (k = 0; k < 3; k++) o[k] = p[k] * scale;
-            state[f] = 1;
+            for (k = 0; k < 3; k++) o[k] = p[k] * F->scale;
+            F->state[f] = 1;
         }
     }
+}
 
-    /* Breadth-first propagation in layers; then one seed per untouched
-       component. state = 1 + layer, layers numbered on across components, so
-       "from an earlier layer" is state <= the current one. O(F) in all. */
-    {
-        int head = 0, tail = 0, layer = 1;
-        for (f = 0; f < nf; f++)
-            if (state[f] == 1) queue[tail++] = f;
-        next_seed = 0;
-        for (;;) {
-            if (head == tail) {
-                /* Nothing left to grow from: seed the lowest unassigned face
-                   with its first edge. */
-                int a;
-                const float *p, *q;
-                double e[3], *o;
-                while (next_seed < nf && state[next_seed] != 0) next_seed++;
-                if (next_seed >= nf) break;
-                a = mesh->face_start[next_seed];
-                p = mesh->pos + 3 * (size_t)mesh->corner_vert[a];
-                q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, a)];
-                o = vec + 3 * (size_t)next_seed;
-                tt__sub3f(q, p, e);
-                tt__project3(e, normal + 3 * (size_t)next_seed, e);
-                if (!(tt__normalize3(e) > 0.0)) { e[0] = 1.0; e[1] = e[2] = 0.0; }   /* not reached: area > 0 */
-                for (k = 0; k < 3; k++) o[k] = e[k] * scale;
-                layer++;
-                state[next_seed] = layer;
-                queue[tail++] = next_seed;
-            }
-            /* Faces of state <= layer are assigned; the unassigned neighbours of
-               the current layer form the next, and each of them averages the
-               transported directions of its neighbours from earlier layers. */
-            {
-                int start = tail, layer_end = tail;
-                for (; head < layer_end; head++) {
-                    int g = queue[head];
-                    for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
-                        int tw = mesh->twin[c], h;
-                        if (tw < 0) continue;
-                        h = mesh->corner_face[tw];
-                        if (state[h] != 0) continue;
-                        state[h] = layer + 1;
-                        queue[tail++] = h;
-                    }
-                }
-                for (i = start; i < tail; i++) {
-                    int h = queue[i], first = 1;
-                    double acc[3] = {0.0, 0.0, 0.0}, firstv[3] = {0.0, 0.0, 0.0}, *o = vec + 3 * (size_t)h;
-                    for (c = mesh->face_start[h]; c < mesh->face_start[h + 1]; c++) {
-                        int tw = mesh->twin[c], g;
-                        double t[3];
-                        if (tw < 0) continue;
-                        g = mesh->corner_face[tw];
-                        if (state[g] <= 0 || state[g] > layer) continue;
-                        tt__field_transport(mesh, tw, normal + 3 * (size_t)g, normal + 3 * (size_t)h,
-                                            vec + 3 * (size_t)g, t);
-                        tt__normalize3(t);
-                        if (first) { firstv[0] = t[0]; firstv[1] = t[1]; firstv[2] = t[2]; first = 0; }
-                        for (k = 0; k < 3; k++) acc[k] += t[k];
-                    }
-                    if (!(tt__normalize3(acc) > 1e-6)) { acc[0] = firstv[0]; acc[1] = firstv[1]; acc[2] = firstv[2]; }
-                    for (k = 0; k < 3; k++) o[k] = acc[k] * scale;
-                }
-                if (tail > start) layer++;
+/* Seed the lowest unassigned face from *next_seed on with its first edge, as
+   a layer of its own; 0 when every face is assigned. */
+static int tt__field_seed(tt__field *F, int *next_seed, int *layer, int *tail)
+{
+    const tt_mesh *mesh = F->mesh;
+    const float *p, *q;
+    double e[3], *o;
+    int a, k, f;
+    while (*next_seed < F->nf && F->state[*next_seed] != 0) (*next_seed)++;
+    if (*next_seed >= F->nf) return 0;
+    f = *next_seed;
+    a = mesh->face_start[f];
+    p = mesh->pos + 3 * (size_t)mesh->corner_vert[a];
+    q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, a)];
+    o = F->vec + 3 * (size_t)f;
+    tt__sub3f(q, p, e);
+    tt__project3(e, F->normal + 3 * (size_t)f, e);
+    if (!(tt__normalize3(e) > 0.0)) { e[0] = 1.0; e[1] = e[2] = 0.0; }   /* not reached: area > 0 */
+    for (k = 0; k < 3; k++) o[k] = e[k] * F->scale;
+    (*layer)++;
+    F->state[f] = *layer;
+    F->queue[(*tail)++] = f;
+    return 1;
+}
+
+/* Face h of the layer after `layer`: the normalised sum of its assigned
+   neighbours' vectors from earlier layers, each carried across the shared
+   edge into h's plane (parallel transport); the first of them where they
+   cancel. */
+static void tt__field_average_neighbours(tt__field *F, int h, int layer)
+{
+    const tt_mesh *mesh = F->mesh;
+    double acc[3] = {0.0, 0.0, 0.0}, firstv[3] = {0.0, 0.0, 0.0}, *o = F->vec + 3 * (size_t)h;
+    int first = 1, c, k;
+    for (c = mesh->face_start[h]; c < mesh->face_start[h + 1]; c++) {
+        int tw = mesh->twin[c], g;
+        double t[3];
+        if (tw < 0) continue;
+        g = mesh->corner_face[tw];
+        if (F->state[g] <= 0 || F->state[g] > layer) continue;
+        tt__field_transport(mesh, tw, F->normal + 3 * (size_t)g, F->normal + 3 * (size_t)h, F->vec + 3 * (size_t)g,
+                            t);
+        tt__normalize3(t);
+        if (first) { firstv[0] = t[0]; firstv[1] = t[1]; firstv[2] = t[2]; first = 0; }
+        for (k = 0; k < 3; k++) acc[k] += t[k];
+    }
+    if (!(tt__normalize3(acc) > 1e-6)) { acc[0] = firstv[0]; acc[1] = firstv[1]; acc[2] = firstv[2]; }
+    for (k = 0; k < 3; k++) o[k] = acc[k] * F->scale;
+}
+
+/* Phase 4 (Sec. 3.2, faces perpendicular to up): breadth-first propagation
+   in layers from the faces already assigned; then one seed per untouched
+   component. state = 1 + layer, layers numbered on across components, so
+   "from an earlier layer" is state <= the current one. O(F) in all. */
+static void tt__field_propagate(tt__field *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    int head = 0, tail = 0, layer = 1, next_seed = 0, f, c, i;
+    for (f = 0; f < F->nf; f++)
+        if (F->state[f] == 1) F->queue[tail++] = f;
+    for (;;) {
+        int start, layer_end;
+        /* Nothing left to grow from: seed the lowest unassigned face. */
+        if (head == tail && !tt__field_seed(F, &next_seed, &layer, &tail)) break;
+        /* Faces of state <= layer are assigned; the unassigned neighbours of
+           the current layer form the next, and each of them averages the
+           transported directions of its neighbours from earlier layers. */
+        start = layer_end = tail;
+        for (; head < layer_end; head++) {
+            int g = F->queue[head];
+            for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
+                int tw = mesh->twin[c], h;
+                if (tw < 0) continue;
+                h = mesh->corner_face[tw];
+                if (F->state[h] != 0) continue;
+                F->state[h] = layer + 1;
+                F->queue[tail++] = h;
             }
         }
+        for (i = start; i < tail; i++) tt__field_average_neighbours(F, F->queue[i], layer);
+        if (tail > start) layer++;
+    }
+}
+
+TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
+                                 const tt_allocator *allocator, float *face_vectors, tt_error *error)
+{
+    tt__field F;
+    tt_result result;
+    int f;
+
+    if (!mesh || !face_vectors)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_tangent_field needs a mesh and an output array (got NULL)");
+    if ((result = tt__field_setup(&F, mesh, options, allocator, error)) != TT_OK) return result;
+    if (F.nf <= 0) return tt__ok(error);
+
+    F.normal = TT__ALLOC(F.al, double, 3 * (size_t)F.nf);
+    F.vec = TT__ALLOC(F.al, double, 3 * (size_t)F.nf);
+    F.state = TT__ALLOC(F.al, int, F.nf);
+    F.queue = TT__ALLOC(F.al, int, F.nf);
+    if (!F.normal || !F.vec || !F.state || !F.queue) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
+    for (f = 0; f < F.nf; f++) {
+        F.state[f] = tt__face_normal_d(mesh, f, F.normal + 3 * (size_t)f) ? 0 : -1;
+        F.vec[3 * (size_t)f] = F.vec[3 * (size_t)f + 1] = F.vec[3 * (size_t)f + 2] = 0.0;
     }
 
-    for (f = 0; f < 3 * nf; f++) face_vectors[f] = (float)vec[f];
+    /* Constraints first (they decide every face they reach), then the
+       default rule, then propagation into what is left. */
+    if ((result = tt__field_check_constraints(&F, error)) != TT_OK) goto done;
+    if (F.opt.nconstraints > 0 && (result = tt__field_constraints(&F)) != TT_OK) goto done;
+    tt__field_default(&F);
+    tt__field_propagate(&F);
+
+    for (f = 0; f < 3 * F.nf; f++) face_vectors[f] = (float)F.vec[f];
     result = tt__ok(error);
 
 done:
     if (result == TT_ERROR_OUT_OF_MEMORY)
         tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory building the tangent field");
-    tt__free(al, normal);
-    tt__free(al, vec);
-    tt__free(al, state);
-    tt__free(al, queue);
-    tt__free(al, centroid);
-    tt__free(al, dist);
-    tt__free(al, trans);
-    tt__free(al, sum);
-    tt__free(al, wsum);
-    tt__free(al, lsum);
-    tt__free(al, wlog);
-    tt__free(al, best);
-    tt__free(al, parent);
-    tt__free(al, heap);
+    tt__free(F.al, F.normal);
+    tt__free(F.al, F.vec);
+    tt__free(F.al, F.state);
+    tt__free(F.al, F.queue);
     return result;
 }
 
