@@ -4812,6 +4812,105 @@ static void tt__distance_transform(float *grid, int gw, int gh, float *line, flo
     }
 }
 
+/* Shape from an image (Sec. 3.1, a patch cut by a mask): grid cell (x+1,
+   y+1) becomes `big` where the source's alpha (source_alpha), the mask's
+   alpha (mask_alpha) or else the mask's grey value is >= 0.5. Returns how
+   many texels are inside. */
+static int tt__patch_mask_shape(const tt_image *src_image, int source_alpha, int mask_alpha, float big,
+                                float *grid, int gw)
+{
+    const float *src = src_image->pixels;
+    int w = src_image->width, h = src_image->height, x, y, inside = 0;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            const float *p = src + 4 * ((size_t)y * (size_t)w + (size_t)x);
+            float value = (source_alpha || mask_alpha) ? p[3] : (p[0] + p[1] + p[2]) * (1.0f / 3.0f);
+            if (value >= 0.5f) {
+                grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
+                inside++;
+            }
+        }
+    return inside;
+}
+
+/* The seeded splotch (Sec. 3.1: for homogeneous textures, a predefined
+   irregular "splotch" shape): q = rho / (1 + g(theta)) where rho <= 1
+   (inside the rounded-square base shape shrunk by the margin), else
+   infinite; inside <=> q <= s, with s found by bisection so that the shape
+   covers TT_PATCH_SPLOTCH_COVERAGE of the w x h image. Inside cells of grid
+   (padded by one, gw wide) become `big`; *inside counts them. */
+static tt_result tt__patch_splotch(int w, int h, uint64_t seed, float roughness, float falloff, float big,
+                                   float *grid, int gw, const tt_allocator *al, int *inside, tt_error *error)
+{
+    size_t count = (size_t)w * (size_t)h, i;
+    tt_rng rng;
+    float c[4], phi[4], csum = 0.0f, lo, hi, ax, ay, margin = falloff > 1.0f ? falloff : 1.0f;
+    long target = (long)((double)TT_PATCH_SPLOTCH_COVERAGE * (double)count + 0.5);
+    int k, it, x, y;
+    float *q = TT__ALLOC(al, float, count);
+    *inside = 0;
+    if (!q)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory making a %d x %d splotch", w,
+                        h);
+    tt_rng_seed(&rng, seed, 0x7061746368ull);   /* "patch" */
+    for (k = 0; k < 4; k++) {
+        c[k] = (0.5f + 0.5f * tt_rng_float(&rng)) / (float)(k + 2);
+        phi[k] = (float)TT__TWO_PI * tt_rng_float(&rng);
+        csum += c[k];
+    }
+    for (k = 0; k < 4; k++) c[k] *= roughness / csum;
+    ax = 0.5f * (float)w - margin;
+    ay = 0.5f * (float)h - margin;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float dx = ((float)x + 0.5f - 0.5f * (float)w) / ax, dy = ((float)y + 0.5f - 0.5f * (float)h) / ay;
+            float dx2 = dx * dx, dy2 = dy * dy, rho = sqrtf(sqrtf(dx2 * dx2 + dy2 * dy2));
+            float theta = atan2f(dy, dx), g = 1.0f;
+            for (k = 0; k < 4; k++) g += c[k] * cosf((float)(k + 2) * theta + phi[k]);
+            q[(size_t)y * (size_t)w + (size_t)x] = rho <= 1.0f ? rho / g : big;
+        }
+    lo = 0.0f;
+    hi = 1.0f / (1.0f - roughness) + 1.0f;
+    for (it = 0; it < 40; it++) {
+        float mid = 0.5f * (lo + hi);
+        long covered = 0;
+        for (i = 0; i < count; i++) covered += q[i] <= mid;
+        if (covered < target) lo = mid;
+        else hi = mid;
+    }
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++)
+            if (q[(size_t)y * (size_t)w + (size_t)x] <= hi) {
+                grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
+                (*inside)++;
+            }
+    tt__free(al, q);
+    return TT_OK;
+}
+
+/* The soft falloff (Sec. 3.1: alpha "falls off near the patch boundary"):
+   the exact Euclidean distance transform of the padded grid (0 outside the
+   shape, `big` inside), then each inside texel's distance to the shape's
+   edge, d - 0.5, in place. Fails when no texel is `falloff` deep. */
+static tt_result tt__patch_soft_edge(float *grid, int gw, int gh, float *line, float *dline, int *v, float *z,
+                                     float big, float falloff, tt_error *error)
+{
+    float deepest = 0.0f;
+    int x, y;
+    tt__distance_transform(grid, gw, gh, line, dline, v, z, big);
+    for (y = 1; y < gh - 1; y++)
+        for (x = 1; x < gw - 1; x++) {
+            float d = sqrtf(grid[(size_t)y * (size_t)gw + (size_t)x]) - 0.5f;
+            grid[(size_t)y * (size_t)gw + (size_t)x] = d;
+            if (d > deepest) deepest = d;
+        }
+    if (deepest < falloff)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "falloff %g leaves no opaque texel: the shape is at most %g texels deep", (double)falloff,
+                        (double)deepest);
+    return TT_OK;
+}
+
 TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
                                       const tt_allocator *allocator, tt_image **out_patch, tt_error *error)
 {
@@ -4820,11 +4919,11 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     const tt_allocator *al = allocator;
     tt_image *patch = NULL;
     tt_result result = TT_OK;
-    float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL, *q = NULL;
+    float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL;
     int *v = NULL;
     int w, h, gw, gh, x, y, n, inside = 0, source_alpha = 0, mask_alpha = 0;
     size_t count, i;
-    float falloff, roughness, deepest = 0.0f;
+    float falloff, roughness;
 
     tt__ok(error);
     if (!out_patch) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_patch is NULL");
@@ -4898,16 +4997,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     /* grid: 0 outside the shape (and on the one-texel frame around the image), big inside. */
     for (i = 0; i < (size_t)gw * (size_t)gh; i++) grid[i] = 0.0f;
     if (source_alpha || mask) {
-        const float *src = source_alpha ? source->pixels : mask->pixels;
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                const float *p = src + 4 * ((size_t)y * (size_t)w + (size_t)x);
-                float value = (source_alpha || mask_alpha) ? p[3] : (p[0] + p[1] + p[2]) * (1.0f / 3.0f);
-                if (value >= 0.5f) {
-                    grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
-                    inside++;
-                }
-            }
+        inside = tt__patch_mask_shape(source_alpha ? source : mask, source_alpha, mask_alpha, big, grid, gw);
         if (inside == 0) {
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                               "the mask has no opaque pixel (no %s value >= 0.5)",
@@ -4915,70 +5005,15 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
             goto done;
         }
     } else {
-        /* Splotch: q = rho / (1 + g(theta)) where rho <= 1 (inside the base
-           shape shrunk by the margin), else infinite; inside <=> q <= s, with
-           s found by bisection so that the shape covers the target fraction. */
-        tt_rng rng;
-        float c[4], phi[4], csum = 0.0f, lo, hi, ax, ay, margin = falloff > 1.0f ? falloff : 1.0f;
-        long target = (long)((double)TT_PATCH_SPLOTCH_COVERAGE * (double)count + 0.5);
-        int k, it;
-        q = TT__ALLOC(al, float, count);
-        if (!q) {
-            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                              "out of memory making a %d x %d splotch", w, h);
-            goto done;
-        }
-        tt_rng_seed(&rng, opt.seed, 0x7061746368ull);   /* "patch" */
-        for (k = 0; k < 4; k++) {
-            c[k] = (0.5f + 0.5f * tt_rng_float(&rng)) / (float)(k + 2);
-            phi[k] = (float)TT__TWO_PI * tt_rng_float(&rng);
-            csum += c[k];
-        }
-        for (k = 0; k < 4; k++) c[k] *= roughness / csum;
-        ax = 0.5f * (float)w - margin;
-        ay = 0.5f * (float)h - margin;
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                float dx = ((float)x + 0.5f - 0.5f * (float)w) / ax, dy = ((float)y + 0.5f - 0.5f * (float)h) / ay;
-                float dx2 = dx * dx, dy2 = dy * dy, rho = sqrtf(sqrtf(dx2 * dx2 + dy2 * dy2));
-                float theta = atan2f(dy, dx), g = 1.0f;
-                for (k = 0; k < 4; k++) g += c[k] * cosf((float)(k + 2) * theta + phi[k]);
-                q[(size_t)y * (size_t)w + (size_t)x] = rho <= 1.0f ? rho / g : big;
-            }
-        lo = 0.0f;
-        hi = 1.0f / (1.0f - roughness) + 1.0f;
-        for (it = 0; it < 40; it++) {
-            float mid = 0.5f * (lo + hi);
-            long covered = 0;
-            for (i = 0; i < count; i++) covered += q[i] <= mid;
-            if (covered < target) lo = mid;
-            else hi = mid;
-        }
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++)
-                if (q[(size_t)y * (size_t)w + (size_t)x] <= hi) {
-                    grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
-                    inside++;
-                }
+        result = tt__patch_splotch(w, h, opt.seed, roughness, falloff, big, grid, gw, al, &inside, error);
+        if (result != TT_OK) goto done;
         if (inside == 0) {   /* not reachable with the margin check above; kept for safety */
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the mask has no opaque pixel");
             goto done;
         }
     }
 
-    tt__distance_transform(grid, gw, gh, line, dline, v, z, big);
-    for (y = 1; y <= h; y++)
-        for (x = 1; x <= w; x++) {
-            float d = sqrtf(grid[(size_t)y * (size_t)gw + (size_t)x]) - 0.5f;
-            grid[(size_t)y * (size_t)gw + (size_t)x] = d;
-            if (d > deepest) deepest = d;
-        }
-    if (deepest < falloff) {
-        result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                          "falloff %g leaves no opaque texel: the shape is at most %g texels deep", (double)falloff,
-                          (double)deepest);
-        goto done;
-    }
+    if ((result = tt__patch_soft_edge(grid, gw, gh, line, dline, v, z, big, falloff, error)) != TT_OK) goto done;
 
     if ((result = tt_image_create(w, h, al, &patch, error)) != TT_OK) goto done;
     for (y = 0; y < h; y++)
@@ -5001,7 +5036,6 @@ done:
     tt__free(al, dline);
     tt__free(al, z);
     tt__free(al, v);
-    tt__free(al, q);
     return result;
 }
 
