@@ -1308,14 +1308,44 @@ static void tt__free(const tt_allocator *allocator, void *ptr)
     TT_FREE(ptr, allocator ? allocator->user_data : NULL);
 }
 
+/* count elements of element_size bytes fit in a size_t byte count. */
+static int tt__size_fits(size_t count, size_t element_size)
+{
+    return element_size == 0 || count <= (size_t)-1 / element_size;
+}
+
 /* count * element_size bytes, or NULL when that overflows size_t. */
 static void *tt__alloc_array(const tt_allocator *allocator, size_t count, size_t element_size)
 {
-    if (element_size != 0 && count > (size_t)-1 / element_size) return NULL;
+    if (!tt__size_fits(count, element_size)) return NULL;
     return tt__alloc(allocator, count * element_size);
 }
 
 #define TT__ALLOC(allocator, type, count) ((type *)tt__alloc_array((allocator), (size_t)(count), sizeof(type)))
+
+/* Growable array: `array` (holding *capacity elements of `size` bytes)
+   grown to hold at least `need`, doubling; NULL when out of memory, the old
+   array then still the caller's. */
+static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int need, size_t size)
+{
+    int cap = *capacity;
+    void *bigger;
+    if (need <= cap) return array;
+    while (cap < need) {
+        if (cap > INT_MAX / 2) return NULL;
+        cap = cap ? 2 * cap : 64;
+    }
+    if (!tt__size_fits((size_t)cap, size)) return NULL;
+    bigger = tt__alloc(al, (size_t)cap * size);
+    if (!bigger) return NULL;
+    if (array) memcpy(bigger, array, (size_t)*capacity * size);
+    tt__free(al, array);
+    *capacity = cap;
+    return bigger;
+}
+
+#define TT__PI 3.14159265358979323846
+#define TT__TWO_PI 6.28318530717958647692
 
 static int tt__min_i(int a, int b) { return a < b ? a : b; }
 static int tt__max_i(int a, int b) { return a > b ? a : b; }
@@ -1332,6 +1362,14 @@ static int tt__is_finite(float x)
     return (bits & 0x7f800000u) != 0x7f800000u;
 }
 
+/* Double version of tt__is_finite: tested on the bits, like it. */
+static int tt__is_finite_d(double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
+}
+
 static double tt__not_a_number(void)
 {
     uint64_t bits = 0x7ff8000000000000ull;
@@ -1346,6 +1384,140 @@ static float tt__infinity(void)
     float x;
     memcpy(&x, &bits, sizeof x);
     return x;
+}
+
+/* ---- Small 3D vector math (doubles) ---- */
+
+static double tt__dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static double tt__length3(const double *v) { return sqrt(tt__dot3(v, v)); }
+
+/* |v| of a float vector, in double. */
+static double tt__length3f(const float *v)
+{
+    double d[3];
+    d[0] = v[0]; d[1] = v[1]; d[2] = v[2];
+    return tt__length3(d);
+}
+
+/* out = a - b for float points, in double. */
+static void tt__sub3f(const float *a, const float *b, double *out)
+{
+    out[0] = (double)a[0] - b[0]; out[1] = (double)a[1] - b[1]; out[2] = (double)a[2] - b[2];
+}
+
+static void tt__cross3(const double *a, const double *b, double *out)
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Scale v to unit length; returns the old length (v untouched when it is 0). */
+static double tt__normalize3(double *v)
+{
+    double len = tt__length3(v);
+    if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
+    return len;
+}
+
+/* v minus its component along the unit normal n. */
+static void tt__project3(const double *v, const double *n, double *out)
+{
+    double d = tt__dot3(v, n);
+    out[0] = v[0] - d * n[0]; out[1] = v[1] - d * n[1]; out[2] = v[2] - d * n[2];
+}
+
+/* ---- Small 2D geometry ---- */
+
+/* Twice the signed area of triangle a, b, c: positive when it turns left. */
+static double tt__orient2(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+/* Distance from (px, py) to the segment from a to b (to a when b == a). */
+static double tt__point_segment_distance(double px, double py, double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay;
+    double wx = px - ax, wy = py - ay, length2 = dx * dx + dy * dy, t = 0.0;
+    if (length2 > 0.0) {
+        t = (wx * dx + wy * dy) / length2;
+        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    }
+    wx -= t * dx;
+    wy -= t * dy;
+    return sqrt(wx * wx + wy * wy);
+}
+
+/* ---- Binary min-heap of (key, value) items ----
+   Ties are broken by the smaller value, so the order of pops is
+   deterministic. The caller owns the array and its capacity. */
+typedef struct tt__heap_item {
+    double key;
+    int value;
+} tt__heap_item;
+
+static int tt__heap_less(const tt__heap_item *a, const tt__heap_item *b)
+{
+    return a->key < b->key || (a->key == b->key && a->value < b->value);
+}
+
+static void tt__heap_push(tt__heap_item *heap, int *count, double key, int value)
+{
+    int i = (*count)++;
+    tt__heap_item item;
+    item.key = key;
+    item.value = value;
+    while (i > 0) {
+        int parent = (i - 1) / 2;
+        if (!tt__heap_less(&item, &heap[parent])) break;
+        heap[i] = heap[parent];
+        i = parent;
+    }
+    heap[i] = item;
+}
+
+static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
+{
+    tt__heap_item top = heap[0], last = heap[--(*count)];
+    int i = 0, n = *count;
+    for (;;) {
+        int child = 2 * i + 1;
+        if (child >= n) break;
+        if (child + 1 < n && tt__heap_less(&heap[child + 1], &heap[child])) child++;
+        if (!tt__heap_less(&heap[child], &last)) break;
+        heap[i] = heap[child];
+        i = child;
+    }
+    if (n > 0) heap[i] = last;
+    return top;
+}
+
+/* ---- Sorting doubles in place (ascending) ----
+   Heapsort: O(n log n) whatever the input, so the exact median of a million
+   entries never degrades to the quadratic worst case of a quickselect. */
+static void tt__sift_doubles(double *v, int root, int count)
+{
+    for (;;) {
+        int child = 2 * root + 1;
+        double tmp;
+        if (child >= count) return;
+        if (child + 1 < count && v[child] < v[child + 1]) child++;
+        if (!(v[root] < v[child])) return;
+        tmp = v[root]; v[root] = v[child]; v[child] = tmp;
+        root = child;
+    }
+}
+
+static void tt__sort_doubles(double *v, int n)
+{
+    int i;
+    for (i = n / 2 - 1; i >= 0; i--) tt__sift_doubles(v, i, n);
+    for (i = n - 1; i > 0; i--) {
+        double tmp = v[0]; v[0] = v[i]; v[i] = tmp;
+        tt__sift_doubles(v, 0, i);
+    }
 }
 
 /* PCG32 (O'Neill 2014): a 64-bit LCG whose output is a permuted 32-bit word. */
@@ -1503,12 +1675,11 @@ static void tt__polygon_newell(const float *pos, const int *verts, int count, do
     *scale = 0.0;
     for (i = 1; i < count; i++) {
         const float *q = pos + 3 * (size_t)verts[i];
-        double b[3];
-        b[0] = (double)q[0] - o[0]; b[1] = (double)q[1] - o[1]; b[2] = (double)q[2] - o[2];
-        n[0] += a[1] * b[2] - a[2] * b[1];
-        n[1] += a[2] * b[0] - a[0] * b[2];
-        n[2] += a[0] * b[1] - a[1] * b[0];
-        *scale += b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+        double b[3], ab[3];
+        tt__sub3f(q, o, b);
+        tt__cross3(a, b, ab);
+        n[0] += ab[0]; n[1] += ab[1]; n[2] += ab[2];
+        *scale += tt__dot3(b, b);
         a[0] = b[0]; a[1] = b[1]; a[2] = b[2];
     }
 }
@@ -1517,7 +1688,7 @@ static void tt__polygon_newell(const float *pos, const int *verts, int count, do
    merely thin. Squares are compared: no square root per face. */
 static int tt__newell_is_zero(const double n[3], double scale)
 {
-    return n[0] * n[0] + n[1] * n[1] + n[2] * n[2] <= 1e-24 * scale * scale;
+    return tt__dot3(n, n) <= 1e-24 * scale * scale;
 }
 
 static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
@@ -1540,6 +1711,30 @@ static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
     }
     tt__polygon_newell(pos, verts, count, n, &scale);
     return tt__newell_is_zero(n, scale);
+}
+
+/* The unit normal, or zero for a face of numerically zero area (judged as
+   tt_mesh_build judges it, through tt__polygon_newell). */
+static int tt__face_normal_d(const tt_mesh *mesh, int face, double normal[3])
+{
+    int begin = mesh->face_start[face];
+    double n[3], scale, inverse;
+    tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, mesh->face_start[face + 1] - begin, n, &scale);
+    if (tt__newell_is_zero(n, scale)) {
+        normal[0] = normal[1] = normal[2] = 0.0;
+        return 0;
+    }
+    inverse = 1.0 / tt__length3(n);
+    normal[0] = n[0] * inverse; normal[1] = n[1] * inverse; normal[2] = n[2] * inverse;
+    return 1;
+}
+
+TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
+{
+    double n[3];
+    TT_ASSERT(mesh && normal && face >= 0 && face < mesh->nfaces);
+    tt__face_normal_d(mesh, face, n);
+    normal[0] = (float)n[0]; normal[1] = (float)n[1]; normal[2] = (float)n[2];
 }
 
 /* A problem found while pairing twins; the one with the smallest corner is
@@ -2776,18 +2971,12 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
 #endif
 #endif
 
-/* Double version of tt__is_finite: tested on the bits, like it. */
-static int tt__is_finite_d(double x)
+/* The median of values[0 .. count-1] (sorts them); 0 for none. */
+static double tt__median(double *values, int count)
 {
-    uint64_t bits;
-    memcpy(&bits, &x, sizeof bits);
-    return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
-}
-
-/* count elements of element_size bytes fit in a size_t byte count. */
-static int tt__size_fits(size_t count, size_t element_size)
-{
-    return element_size == 0 || count <= (size_t)-1 / element_size;
+    if (count <= 0) return 0.0;
+    tt__sort_doubles(values, count);
+    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
 }
 
 TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,
@@ -4181,54 +4370,6 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
 /* 7. Lapped textures                                                       */
 /* ------------------------------------------------------------------------ */
 
-/* The unit normal, or zero for a face of numerically zero area (judged as
-   tt_mesh_build judges it, through tt__polygon_newell). */
-static int tt__face_normal_d(const tt_mesh *mesh, int face, double normal[3])
-{
-    int begin = mesh->face_start[face];
-    double n[3], scale, inverse;
-    tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, mesh->face_start[face + 1] - begin, n, &scale);
-    if (tt__newell_is_zero(n, scale)) {
-        normal[0] = normal[1] = normal[2] = 0.0;
-        return 0;
-    }
-    inverse = 1.0 / sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    normal[0] = n[0] * inverse; normal[1] = n[1] * inverse; normal[2] = n[2] * inverse;
-    return 1;
-}
-
-TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
-{
-    double n[3];
-    TT_ASSERT(mesh && normal && face >= 0 && face < mesh->nfaces);
-    tt__face_normal_d(mesh, face, n);
-    normal[0] = (float)n[0]; normal[1] = (float)n[1]; normal[2] = (float)n[2];
-}
-
-static double tt__dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void tt__cross3(const double *a, const double *b, double *out)
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-/* Scale v to unit length; returns the old length (v untouched when it is 0). */
-static double tt__normalize3(double *v)
-{
-    double len = sqrt(tt__dot3(v, v));
-    if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
-    return len;
-}
-
-/* v minus its component along the unit normal n. */
-static void tt__project3(const double *v, const double *n, double *out)
-{
-    double d = tt__dot3(v, n);
-    out[0] = v[0] - d * n[0]; out[1] = v[1] - d * n[1]; out[2] = v[2] - d * n[2];
-}
-
 /* Parallel transport across half-edge c (of the source face, normal ns) into
    the face across it (normal nt): with e the unit edge direction and
    b = n x e, v = (v.e) e + (v.b_s) b_s  ->  (v.e) e + (v.b_s) b_t, i.e. the
@@ -4240,8 +4381,8 @@ static void tt__field_transport(const tt_mesh *mesh, int c, const double *ns, co
     const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
     const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
     double e[3], bs[3], bt[3], r[3], ve, vb, len;
-    e[0] = (double)q[0] - p[0]; e[1] = (double)q[1] - p[1]; e[2] = (double)q[2] - p[2];
-    len = sqrt(tt__dot3(v, v));
+    tt__sub3f(q, p, e);
+    len = tt__length3(v);
     if (tt__normalize3(e) <= 0.0) { tt__project3(v, nt, out); return; }
     tt__cross3(ns, e, bs);
     tt__cross3(nt, e, bt);
@@ -4252,48 +4393,6 @@ static void tt__field_transport(const tt_mesh *mesh, int c, const double *ns, co
     r[0] = ve * e[0] + vb * bt[0]; r[1] = ve * e[1] + vb * bt[1]; r[2] = ve * e[2] + vb * bt[2];
     tt__project3(r, nt, out);
     if (tt__normalize3(out) > 0.0) { out[0] *= len; out[1] *= len; out[2] *= len; }
-}
-
-/* Binary min-heap of (distance, face), ties broken by face: deterministic. */
-typedef struct tt__heap_item {
-    double key;
-    int face;
-} tt__heap_item;
-
-static int tt__heap_less(const tt__heap_item *a, const tt__heap_item *b)
-{
-    return a->key < b->key || (a->key == b->key && a->face < b->face);
-}
-
-static void tt__heap_push(tt__heap_item *heap, int *count, double key, int face)
-{
-    int i = (*count)++;
-    tt__heap_item item;
-    item.key = key;
-    item.face = face;
-    while (i > 0) {
-        int parent = (i - 1) / 2;
-        if (!tt__heap_less(&item, &heap[parent])) break;
-        heap[i] = heap[parent];
-        i = parent;
-    }
-    heap[i] = item;
-}
-
-static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
-{
-    tt__heap_item top = heap[0], last = heap[--(*count)];
-    int i = 0, n = *count;
-    for (;;) {
-        int child = 2 * i + 1;
-        if (child >= n) break;
-        if (child + 1 < n && tt__heap_less(&heap[child + 1], &heap[child])) child++;
-        if (!tt__heap_less(&heap[child], &last)) break;
-        heap[i] = heap[child];
-        i = child;
-    }
-    if (n > 0) heap[i] = last;
-    return top;
 }
 
 /* Distance of one dual step from face a across half-edge c (of a) to face b:
@@ -4309,51 +4408,63 @@ static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a,
         da[k] = m[k] - centroid[3 * (size_t)a + k];
         db[k] = m[k] - centroid[3 * (size_t)b + k];
     }
-    return sqrt(tt__dot3(da, da)) + sqrt(tt__dot3(db, db));
+    return tt__length3(da) + tt__length3(db);
 }
 
-TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
-                                 const tt_allocator *allocator, float *face_vectors, tt_error *error)
-{
-    tt_field_options opt;
-    const tt_allocator *al = allocator;
-    double up[3], diag, scale, sigma, lo[3], hi[3];
-    double *normal = NULL, *vec = NULL, *centroid = NULL, *dist = NULL, *trans = NULL, *sum = NULL,
-           *wsum = NULL, *lsum = NULL, *wlog = NULL, *best = NULL;
-    int *state = NULL, *parent = NULL, *queue = NULL;
-    tt__heap_item *heap = NULL;
-    tt_result result = TT_OK;
-    int nf, f, c, i, k, next_seed;
+/* The tangent field's working state, shared by its phases. */
+typedef struct tt__field {
+    const tt_mesh *mesh;
+    const tt_allocator *al;
+    tt_field_options opt;       /* the caller's options, or all zero */
+    int nf;
+    double up[3];               /* unit global up */
+    double scale, sigma;        /* defaults resolved (mesh units) */
+    double *normal;             /* 3 per face: unit normal, 0 for zero area */
+    double *vec;                /* 3 per face: the field being built */
+    int *state;                 /* -1 = zero-area face (never assigned), 0 = unassigned, 1 + layer =
+                                   assigned in that breadth-first layer (constraints and up: 0) */
+    int *queue;                 /* nf faces, for the breadth-first layers */
+} tt__field;
 
-    if (!mesh || !face_vectors)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_tangent_field needs a mesh and an output array (got NULL)");
-    if (options) opt = *options;
-    else memset(&opt, 0, sizeof opt);
+/* Phase 1 (Sec. 3.2's parameters): check the options, resolve up, and the
+   default scale and sigma from the bounding-box diagonal of the vertices
+   the faces use. Nothing is allocated. */
+static tt_result tt__field_setup(tt__field *F, const tt_mesh *mesh, const tt_field_options *options,
+                                 const tt_allocator *allocator, tt_error *error)
+{
+    tt_field_options *opt = &F->opt;
+    double diag, lo[3], hi[3];
+    int c, k;
+
+    memset(F, 0, sizeof *F);
+    F->mesh = mesh;
+    F->al = allocator;
+    if (options) *opt = *options;
+    else memset(opt, 0, sizeof *opt);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    nf = mesh->nfaces;
+    F->nf = mesh->nfaces;
 
     /* Options. */
     for (k = 0; k < 3; k++)
-        if (!tt__is_finite(opt.up[k]))
+        if (!tt__is_finite(opt->up[k]))
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                            "the up vector (%g, %g, %g) is not finite", opt.up[0], opt.up[1], opt.up[2]);
-    if (opt.up[0] == 0.0f && opt.up[1] == 0.0f && opt.up[2] == 0.0f) opt.up[1] = 1.0f;
-    for (k = 0; k < 3; k++) up[k] = opt.up[k];
-    if (!(tt__normalize3(up) > 0.0))
+                            "the up vector (%g, %g, %g) is not finite", opt->up[0], opt->up[1], opt->up[2]);
+    if (opt->up[0] == 0.0f && opt->up[1] == 0.0f && opt->up[2] == 0.0f) opt->up[1] = 1.0f;
+    for (k = 0; k < 3; k++) F->up[k] = opt->up[k];
+    if (!(tt__normalize3(F->up) > 0.0))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the up vector (%g, %g, %g) has no usable length", opt.up[0], opt.up[1], opt.up[2]);
-    if (!tt__is_finite(opt.scale) || opt.scale < 0.0f)
+                        "the up vector (%g, %g, %g) has no usable length", opt->up[0], opt->up[1], opt->up[2]);
+    if (!tt__is_finite(opt->scale) || opt->scale < 0.0f)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "scale %g must be finite and >= 0 (0 = default)", opt.scale);
-    if (!tt__is_finite(opt.sigma) || opt.sigma < 0.0f)
+                        "scale %g must be finite and >= 0 (0 = default)", opt->scale);
+    if (!tt__is_finite(opt->sigma) || opt->sigma < 0.0f)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "sigma %g must be finite and >= 0 (0 = default)", opt.sigma);
-    if (opt.nconstraints < 0 || (opt.nconstraints > 0 && !opt.constraints))
+                        "sigma %g must be finite and >= 0 (0 = default)", opt->sigma);
+    if (opt->nconstraints < 0 || (opt->nconstraints > 0 && !opt->constraints))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "nconstraints is %d with constraints %s", opt.nconstraints,
-                        opt.constraints ? "given" : "NULL");
-    if (nf <= 0) return tt__ok(error);
+                        "nconstraints is %d with constraints %s", opt->nconstraints,
+                        opt->constraints ? "given" : "NULL");
+    if (F->nf <= 0) return TT_OK;   /* nothing to build: the driver stops here */
 
     /* Bounding-box diagonal of the vertices the faces use. */
     for (k = 0; k < 3; k++) { lo[k] = 1e300; hi[k] = -1e300; }
@@ -4365,296 +4476,376 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
         }
     }
     for (k = 0; k < 3; k++) lo[k] = hi[k] - lo[k];
-    diag = sqrt(tt__dot3(lo, lo));
+    diag = tt__length3(lo);
     if (!(diag > 0.0)) diag = 1.0;
-    scale = opt.scale > 0.0f ? (double)opt.scale : TT_DEFAULT_FIELD_SCALE * diag;
-    sigma = opt.sigma > 0.0f ? (double)opt.sigma : TT_DEFAULT_FIELD_SIGMA * diag;
+    F->scale = opt->scale > 0.0f ? (double)opt->scale : TT_DEFAULT_FIELD_SCALE * diag;
+    F->sigma = opt->sigma > 0.0f ? (double)opt->sigma : TT_DEFAULT_FIELD_SIGMA * diag;
+    return TT_OK;
+}
 
-    normal = TT__ALLOC(al, double, 3 * (size_t)nf);
-    vec = TT__ALLOC(al, double, 3 * (size_t)nf);
-    state = TT__ALLOC(al, int, nf);
-    queue = TT__ALLOC(al, int, nf);
-    if (!normal || !vec || !state || !queue) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
-    /* state: -1 = zero-area face (never assigned), 0 = unassigned,
-       1 + layer = assigned in that breadth-first layer (constraints and up: 0). */
-    for (f = 0; f < nf; f++) {
-        state[f] = tt__face_normal_d(mesh, f, normal + 3 * (size_t)f) ? 0 : -1;
-        vec[3 * (size_t)f] = vec[3 * (size_t)f + 1] = vec[3 * (size_t)f + 2] = 0.0;
-    }
-
-    /* Constraints: check them all before any work. */
-    for (i = 0; i < opt.nconstraints; i++) {
-        const tt_field_constraint *con = &opt.constraints[i];
+/* Phase 2, first: every constraint checked before any work (face in range,
+   finite, not negative, on a face with a plane, not perpendicular to it). */
+static tt_result tt__field_check_constraints(const tt__field *F, tt_error *error)
+{
+    int i, k, nf = F->nf;
+    for (i = 0; i < F->opt.nconstraints; i++) {
+        const tt_field_constraint *con = &F->opt.constraints[i];
         double v[3], p[3], len, plen;
+        tt_result result = TT_OK;
         if (con->face < 0 || con->face >= nf) {
             result = tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, con->face, -1, -1, -1,
                               "constraint %d names face %d, but the mesh has %d faces", i, con->face, nf);
-            if (error) error->item = i;
-            goto done;
-        }
-        if (!tt__is_finite(con->vector[0]) || !tt__is_finite(con->vector[1]) || !tt__is_finite(con->vector[2]) ||
-            !tt__is_finite(con->sigma) || !tt__is_finite(con->weight)) {
+        } else if (!tt__is_finite(con->vector[0]) || !tt__is_finite(con->vector[1]) ||
+                   !tt__is_finite(con->vector[2]) || !tt__is_finite(con->sigma) || !tt__is_finite(con->weight)) {
             result = tt__fail(error, TT_ERROR_NON_FINITE, con->face, -1, -1, -1,
                               "constraint %d (face %d) has a NaN or infinite vector, sigma or weight", i, con->face);
-            if (error) error->item = i;
-            goto done;
-        }
-        if (con->sigma < 0.0f || con->weight < 0.0f) {
+        } else if (con->sigma < 0.0f || con->weight < 0.0f) {
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
                               "constraint %d (face %d) has sigma %g and weight %g; neither may be negative", i,
                               con->face, con->sigma, con->weight);
-            if (error) error->item = i;
-            goto done;
-        }
-        if (state[con->face] < 0) {
+        } else if (F->state[con->face] < 0) {
             result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, con->face, -1, -1, -1,
                               "constraint %d is on face %d, which has zero area and no plane", i, con->face);
-            if (error) error->item = i;
-            goto done;
-        }
-        for (k = 0; k < 3; k++) v[k] = con->vector[k];
-        len = sqrt(tt__dot3(v, v));
-        tt__project3(v, normal + 3 * (size_t)con->face, p);
-        plen = sqrt(tt__dot3(p, p));
-        if (!(len > 0.0) || !(plen > 1e-3 * len)) {
-            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
-                              "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
-                              con->vector[0], con->vector[1], con->vector[2],
-                              len > 0.0 ? "perpendicular to the face" : "zero");
-            if (error) error->item = i;
-            goto done;
-        }
-    }
-
-    if (opt.nconstraints > 0) {
-        /* Gaussian RBFs over Dijkstra distances, one pass per constraint. */
-        centroid = TT__ALLOC(al, double, 3 * (size_t)nf);
-        dist = TT__ALLOC(al, double, nf);
-        trans = TT__ALLOC(al, double, 3 * (size_t)nf);
-        sum = TT__ALLOC(al, double, 3 * (size_t)nf);
-        wsum = TT__ALLOC(al, double, nf);
-        lsum = TT__ALLOC(al, double, nf);
-        wlog = TT__ALLOC(al, double, nf);
-        best = TT__ALLOC(al, double, 4 * (size_t)nf);
-        parent = TT__ALLOC(al, int, nf);
-        heap = TT__ALLOC(al, tt__heap_item, (size_t)mesh->ncorners + 1);
-        if (!centroid || !dist || !trans || !sum || !wsum || !lsum || !wlog || !best || !parent || !heap) {
-            result = TT_ERROR_OUT_OF_MEMORY;
-            goto done;
-        }
-        for (f = 0; f < nf; f++) {
-            int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
-            double *ce = centroid + 3 * (size_t)f;
-            ce[0] = ce[1] = ce[2] = 0.0;
-            for (c = begin; c < end; c++)
-                for (k = 0; k < 3; k++) ce[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
-            for (k = 0; k < 3; k++) ce[k] /= (double)(end - begin);
-            sum[3 * (size_t)f] = sum[3 * (size_t)f + 1] = sum[3 * (size_t)f + 2] = 0.0;
-            wsum[f] = lsum[f] = 0.0;
-            wlog[f] = -1e300;
-            best[4 * (size_t)f] = -1e300;   /* best log weight, then that constraint's t_i(f) */
-        }
-        for (i = 0; i < opt.nconstraints; i++) {
-            const tt_field_constraint *con = &opt.constraints[i];
-            double s = con->sigma > 0.0f ? (double)con->sigma : sigma;
-            double wt = con->weight > 0.0f ? (double)con->weight : 1.0, len, v[3];
-            int nheap = 0;
+        } else {
             for (k = 0; k < 3; k++) v[k] = con->vector[k];
-            len = sqrt(tt__dot3(v, v));
-            for (f = 0; f < nf; f++) { dist[f] = -1.0; parent[f] = -2; }   /* -2 unreached, -1 source */
-            dist[con->face] = 0.0;
-            parent[con->face] = -1;
-            tt__heap_push(heap, &nheap, 0.0, con->face);
-            while (nheap > 0) {
-                tt__heap_item top = tt__heap_pop(heap, &nheap);
-                int g = top.face, begin, end;
-                double *t = trans + 3 * (size_t)g, lw, scl;
-                if (top.key > dist[g]) continue;   /* stale entry */
-                if (parent[g] == -1) {
-                    tt__project3(v, normal + 3 * (size_t)g, t);
-                    tt__normalize3(t);
-                    t[0] *= len; t[1] *= len; t[2] *= len;
-                } else {
-                    int from = mesh->corner_face[parent[g]];
-                    tt__field_transport(mesh, parent[g], normal + 3 * (size_t)from, normal + 3 * (size_t)g,
-                                        trans + 3 * (size_t)from, t);
-                }
-                parent[g] = -3;   /* settled */
-                /* Accumulate w = wt exp(-d^2 / 2s^2) relative to the largest log weight so far. */
-                lw = log(wt) - top.key * top.key / (2.0 * s * s);
-                if (lw > wlog[g]) {
-                    scl = wsum[g] > 0.0 ? exp(wlog[g] - lw) : 0.0;
-                    for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] *= scl;
-                    wsum[g] *= scl;
-                    lsum[g] *= scl;
-                    wlog[g] = lw;
-                }
-                scl = exp(lw - wlog[g]);
-                for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] += scl * t[k];
-                wsum[g] += scl;
-                lsum[g] += scl * len;
-                if (lw > best[4 * (size_t)g]) {
-                    best[4 * (size_t)g] = lw;
-                    for (k = 0; k < 3; k++) best[4 * (size_t)g + 1 + k] = t[k];
-                }
-                begin = mesh->face_start[g];
-                end = mesh->face_start[g + 1];
-                for (c = begin; c < end; c++) {
-                    int tw = mesh->twin[c], h;
-                    double d;
-                    if (tw < 0) continue;
-                    h = mesh->corner_face[tw];
-                    if (state[h] < 0 || parent[h] == -3 || parent[h] == -1) continue;
-                    d = top.key + tt__field_step(mesh, centroid, g, c, h);
-                    if (dist[h] < 0.0 || d < dist[h]) {
-                        dist[h] = d;
-                        parent[h] = c;
-                        tt__heap_push(heap, &nheap, d, h);
-                    }
-                }
-            }
+            len = tt__length3(v);
+            tt__project3(v, F->normal + 3 * (size_t)con->face, p);
+            plen = tt__length3(p);
+            if (!(len > 0.0) || !(plen > 1e-3 * len))
+                result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, con->face, -1, -1, -1,
+                                  "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
+                                  con->vector[0], con->vector[1], con->vector[2],
+                                  len > 0.0 ? "perpendicular to the face" : "zero");
         }
-        for (f = 0; f < nf; f++) {
-            double *o = vec + 3 * (size_t)f, dir[3];
-            if (state[f] < 0 || !(wsum[f] > 0.0)) continue;
-            for (k = 0; k < 3; k++) dir[k] = sum[3 * (size_t)f + k];
-            tt__project3(dir, normal + 3 * (size_t)f, dir);
-            if (!(tt__normalize3(dir) > 1e-9 * (lsum[f] / wsum[f]))) {
-                for (k = 0; k < 3; k++) dir[k] = best[4 * (size_t)f + 1 + k];
-                tt__normalize3(dir);
-            }
-            for (k = 0; k < 3; k++) o[k] = dir[k] * (lsum[f] / wsum[f]);
-            state[f] = 1;
-        }
-        /* A constrained face gets exactly the average of its own constraints. */
-        for (f = 0; f < nf; f++) wsum[f] = 0.0;
-        for (i = 0; i < opt.nconstraints; i++) {
-            const tt_field_constraint *con = &opt.constraints[i];
-            double *o = sum + 3 * (size_t)con->face;
-            if (wsum[con->face] == 0.0) o[0] = o[1] = o[2] = 0.0;
-            for (k = 0; k < 3; k++) o[k] += con->vector[k];
-            wsum[con->face] += 1.0;
-        }
-        for (i = 0; i < opt.nconstraints; i++) {
-            int g = opt.constraints[i].face;
-            double p[3], *o = vec + 3 * (size_t)g;
-            if (wsum[g] == 0.0) continue;
-            for (k = 0; k < 3; k++) sum[3 * (size_t)g + k] /= wsum[g];
-            tt__project3(sum + 3 * (size_t)g, normal + 3 * (size_t)g, p);
-            if (tt__normalize3(p) > 0.0) {   /* opposite constraints on one face keep the blended one */
-                double l = 0.0;
-                int j;
-                for (j = 0; j < opt.nconstraints; j++)
-                    if (opt.constraints[j].face == g) {
-                        const float *cv = opt.constraints[j].vector;
-                        l += sqrt((double)cv[0] * cv[0] + (double)cv[1] * cv[1] + (double)cv[2] * cv[2]);
-                    }
-                l /= wsum[g];
-                for (k = 0; k < 3; k++) o[k] = p[k] * l;
-            }
-            wsum[g] = 0.0;
+        if (result != TT_OK) {
+            if (error) error->item = i;
+            return result;
         }
     }
+    return TT_OK;
+}
 
-    /* Default rule for every face no constraint reached: projected up. */
+/* Scratch of the constraint phase: per face, the Dijkstra distance and
+   tree, the transported constraint vector, and the running weighted sums. */
+typedef struct tt__field_rbf {
+    double *centroid;           /* 3 per face */
+    double *dist;               /* Dijkstra distance, -1 unreached */
+    double *trans;              /* 3 per face: t_i(f), constraint i carried to f */
+    double *sum, *wsum, *lsum;  /* sum of w t_i (3 per face), of w, of w |c_i|, relative to wlog */
+    double *wlog;               /* the largest log weight so far */
+    double *best;               /* 4 per face: best log weight, then that constraint's t_i(f) */
+    int *parent;                /* half-edge crossed into the face; -2 unreached, -1 source, -3 settled */
+    tt__heap_item *heap;        /* ncorners + 1 */
+} tt__field_rbf;
+
+/* Phase 2a (Sec. 3.2 "Gaussian radial basis functions, where radius is
+   defined as distance over the mesh, as computed using Dijkstra's
+   algorithm"): one Dijkstra pass from constraint con over the dual graph,
+   carrying its vector by parallel transport along the tree and adding
+   w = weight exp(-d^2 / 2 sigma^2) times it into every face reached. */
+static void tt__field_dijkstra(const tt__field *F, tt__field_rbf *R, const tt_field_constraint *con)
+{
+    const tt_mesh *mesh = F->mesh;
+    double s = con->sigma > 0.0f ? (double)con->sigma : F->sigma;
+    double wt = con->weight > 0.0f ? (double)con->weight : 1.0, len, v[3];
+    int nheap = 0, f, c, k;
+    for (k = 0; k < 3; k++) v[k] = con->vector[k];
+    len = tt__length3(v);
+    for (f = 0; f < F->nf; f++) { R->dist[f] = -1.0; R->parent[f] = -2; }   /* -2 unreached, -1 source */
+    R->dist[con->face] = 0.0;
+    R->parent[con->face] = -1;
+    tt__heap_push(R->heap, &nheap, 0.0, con->face);
+    while (nheap > 0) {
+        tt__heap_item top = tt__heap_pop(R->heap, &nheap);
+        int g = top.value, begin, end;
+        double *t = R->trans + 3 * (size_t)g, lw, scl;
+        if (top.key > R->dist[g]) continue;   /* stale entry */
+        if (R->parent[g] == -1) {
+            tt__project3(v, F->normal + 3 * (size_t)g, t);
+            tt__normalize3(t);
+            t[0] *= len; t[1] *= len; t[2] *= len;
+        } else {
+            int from = mesh->corner_face[R->parent[g]];
+            tt__field_transport(mesh, R->parent[g], F->normal + 3 * (size_t)from, F->normal + 3 * (size_t)g,
+                                R->trans + 3 * (size_t)from, t);
+        }
+        R->parent[g] = -3;   /* settled */
+        /* Accumulate w = wt exp(-d^2 / 2s^2) relative to the largest log weight so far. */
+        lw = log(wt) - top.key * top.key / (2.0 * s * s);
+        if (lw > R->wlog[g]) {
+            scl = R->wsum[g] > 0.0 ? exp(R->wlog[g] - lw) : 0.0;
+            for (k = 0; k < 3; k++) R->sum[3 * (size_t)g + k] *= scl;
+            R->wsum[g] *= scl;
+            R->lsum[g] *= scl;
+            R->wlog[g] = lw;
+        }
+        scl = exp(lw - R->wlog[g]);
+        for (k = 0; k < 3; k++) R->sum[3 * (size_t)g + k] += scl * t[k];
+        R->wsum[g] += scl;
+        R->lsum[g] += scl * len;
+        if (lw > R->best[4 * (size_t)g]) {
+            R->best[4 * (size_t)g] = lw;
+            for (k = 0; k < 3; k++) R->best[4 * (size_t)g + 1 + k] = t[k];
+        }
+        begin = mesh->face_start[g];
+        end = mesh->face_start[g + 1];
+        for (c = begin; c < end; c++) {
+            int tw = mesh->twin[c], h;
+            double d;
+            if (tw < 0) continue;
+            h = mesh->corner_face[tw];
+            if (F->state[h] < 0 || R->parent[h] == -3 || R->parent[h] == -1) continue;
+            d = top.key + tt__field_step(mesh, R->centroid, g, c, h);
+            if (R->dist[h] < 0.0 || d < R->dist[h]) {
+                R->dist[h] = d;
+                R->parent[h] = c;
+                tt__heap_push(R->heap, &nheap, d, h);
+            }
+        }
+    }
+}
+
+/* Phase 2b: T_f = (sum w |c_i| / sum w) normalize(sum w t_i(f)) on every face
+   a constraint reached (the strongest constraint's direction where the
+   directions cancel); then a constrained face gets exactly the average of
+   its own constraints. R->sum and R->wsum are reused as scratch. */
+static void tt__field_blend(tt__field *F, tt__field_rbf *R)
+{
+    const tt_field_constraint *cons = F->opt.constraints;
+    int f, i, k;
+    for (f = 0; f < F->nf; f++) {
+        double *o = F->vec + 3 * (size_t)f, dir[3];
+        if (F->state[f] < 0 || !(R->wsum[f] > 0.0)) continue;
+        for (k = 0; k < 3; k++) dir[k] = R->sum[3 * (size_t)f + k];
+        tt__project3(dir, F->normal + 3 * (size_t)f, dir);
+        if (!(tt__normalize3(dir) > 1e-9 * (R->lsum[f] / R->wsum[f]))) {
+            for (k = 0; k < 3; k++) dir[k] = R->best[4 * (size_t)f + 1 + k];
+            tt__normalize3(dir);
+        }
+        for (k = 0; k < 3; k++) o[k] = dir[k] * (R->lsum[f] / R->wsum[f]);
+        F->state[f] = 1;
+    }
+    /* A constrained face gets exactly the average of its own constraints. */
+    for (f = 0; f < F->nf; f++) R->wsum[f] = 0.0;
+    for (i = 0; i < F->opt.nconstraints; i++) {
+        const tt_field_constraint *con = &cons[i];
+        double *o = R->sum + 3 * (size_t)con->face;
+        if (R->wsum[con->face] == 0.0) o[0] = o[1] = o[2] = 0.0;
+        for (k = 0; k < 3; k++) o[k] += con->vector[k];
+        R->wsum[con->face] += 1.0;
+    }
+    for (i = 0; i < F->opt.nconstraints; i++) {
+        int g = cons[i].face;
+        double p[3], *o = F->vec + 3 * (size_t)g;
+        if (R->wsum[g] == 0.0) continue;
+        for (k = 0; k < 3; k++) R->sum[3 * (size_t)g + k] /= R->wsum[g];
+        tt__project3(R->sum + 3 * (size_t)g, F->normal + 3 * (size_t)g, p);
+        if (tt__normalize3(p) > 0.0) {   /* opposite constraints on one face keep the blended one */
+            double l = 0.0;
+            int j;
+            for (j = 0; j < F->opt.nconstraints; j++)
+                if (cons[j].face == g) l += tt__length3f(cons[j].vector);
+            l /= R->wsum[g];
+            for (k = 0; k < 3; k++) o[k] = p[k] * l;
+        }
+        R->wsum[g] = 0.0;
+    }
+}
+
+/* Phase 2 (Sec. 3.2, constraints): Gaussian RBFs over Dijkstra distances,
+   one pass per constraint, then the blend. Faces it assigns get state 1. */
+static tt_result tt__field_constraints(tt__field *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    const tt_allocator *al = F->al;
+    tt__field_rbf R;
+    tt_result result = TT_OK;
+    int nf = F->nf, f, c, i, k;
+    R.centroid = TT__ALLOC(al, double, 3 * (size_t)nf);
+    R.dist = TT__ALLOC(al, double, nf);
+    R.trans = TT__ALLOC(al, double, 3 * (size_t)nf);
+    R.sum = TT__ALLOC(al, double, 3 * (size_t)nf);
+    R.wsum = TT__ALLOC(al, double, nf);
+    R.lsum = TT__ALLOC(al, double, nf);
+    R.wlog = TT__ALLOC(al, double, nf);
+    R.best = TT__ALLOC(al, double, 4 * (size_t)nf);
+    R.parent = TT__ALLOC(al, int, nf);
+    R.heap = TT__ALLOC(al, tt__heap_item, (size_t)mesh->ncorners + 1);
+    if (!R.centroid || !R.dist || !R.trans || !R.sum || !R.wsum || !R.lsum || !R.wlog || !R.best || !R.parent ||
+        !R.heap) {
+        result = TT_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
     for (f = 0; f < nf; f++) {
-        double p[3], *o = vec + 3 * (size_t)f;
-        if (state[f] != 0) continue;
-        tt__project3(up, normal + 3 * (size_t)f, p);
+        int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
+        double *ce = R.centroid + 3 * (size_t)f;
+        ce[0] = ce[1] = ce[2] = 0.0;
+        for (c = begin; c < end; c++)
+            for (k = 0; k < 3; k++) ce[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
+        for (k = 0; k < 3; k++) ce[k] /= (double)(end - begin);
+        R.sum[3 * (size_t)f] = R.sum[3 * (size_t)f + 1] = R.sum[3 * (size_t)f + 2] = 0.0;
+        R.wsum[f] = R.lsum[f] = 0.0;
+        R.wlog[f] = -1e300;
+        R.best[4 * (size_t)f] = -1e300;
+    }
+    for (i = 0; i < F->opt.nconstraints; i++) tt__field_dijkstra(F, &R, &F->opt.constraints[i]);
+    tt__field_blend(F, &R);
+
+done:
+    tt__free(al, R.centroid);
+    tt__free(al, R.dist);
+    tt__free(al, R.trans);
+    tt__free(al, R.sum);
+    tt__free(al, R.wsum);
+    tt__free(al, R.lsum);
+    tt__free(al, R.wlog);
+    tt__free(al, R.best);
+    tt__free(al, R.parent);
+    tt__free(al, R.heap);
+    return result;
+}
+
+/* Phase 3 (Sec. 3.2 "project the global up direction onto the surface, and
+   then normalize"): every face no constraint reached and not nearly
+   perpendicular to up (TT_FIELD_PERPENDICULAR) gets scale * P_f(up) / |P_f(up)|. */
+static void tt__field_default(tt__field *F)
+{
+    int f, k;
+    for (f = 0; f < F->nf; f++) {
+        double p[3], *o = F->vec + 3 * (size_t)f;
+        if (F->state[f] != 0) continue;
+        tt__project3(F->up, F->normal + 3 * (size_t)f, p);
         if (tt__normalize3(p) >= TT_FIELD_PERPENDICULAR) {
-            for (k = 0; k < 3; k++) o[k] = p[k] * scale;
-            state[f] = 1;
+            for (k = 0; k < 3; k++) o[k] = p[k] * F->scale;
+            F->state[f] = 1;
         }
     }
+}
 
-    /* Breadth-first propagation in layers; then one seed per untouched
-       component. state = 1 + layer, layers numbered on across components, so
-       "from an earlier layer" is state <= the current one. O(F) in all. */
-    {
-        int head = 0, tail = 0, layer = 1;
-        for (f = 0; f < nf; f++)
-            if (state[f] == 1) queue[tail++] = f;
-        next_seed = 0;
-        for (;;) {
-            if (head == tail) {
-                /* Nothing left to grow from: seed the lowest unassigned face
-                   with its first edge. */
-                int a;
-                const float *p, *q;
-                double e[3], *o;
-                while (next_seed < nf && state[next_seed] != 0) next_seed++;
-                if (next_seed >= nf) break;
-                a = mesh->face_start[next_seed];
-                p = mesh->pos + 3 * (size_t)mesh->corner_vert[a];
-                q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, a)];
-                o = vec + 3 * (size_t)next_seed;
-                for (k = 0; k < 3; k++) e[k] = (double)q[k] - p[k];
-                tt__project3(e, normal + 3 * (size_t)next_seed, e);
-                if (!(tt__normalize3(e) > 0.0)) { e[0] = 1.0; e[1] = e[2] = 0.0; }   /* not reached: area > 0 */
-                for (k = 0; k < 3; k++) o[k] = e[k] * scale;
-                layer++;
-                state[next_seed] = layer;
-                queue[tail++] = next_seed;
-            }
-            /* Faces of state <= layer are assigned; the unassigned neighbours of
-               the current layer form the next, and each of them averages the
-               transported directions of its neighbours from earlier layers. */
-            {
-                int start = tail, layer_end = tail;
-                for (; head < layer_end; head++) {
-                    int g = queue[head];
-                    for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
-                        int tw = mesh->twin[c], h;
-                        if (tw < 0) continue;
-                        h = mesh->corner_face[tw];
-                        if (state[h] != 0) continue;
-                        state[h] = layer + 1;
-                        queue[tail++] = h;
-                    }
-                }
-                for (i = start; i < tail; i++) {
-                    int h = queue[i], first = 1;
-                    double acc[3] = {0.0, 0.0, 0.0}, firstv[3] = {0.0, 0.0, 0.0}, *o = vec + 3 * (size_t)h;
-                    for (c = mesh->face_start[h]; c < mesh->face_start[h + 1]; c++) {
-                        int tw = mesh->twin[c], g;
-                        double t[3];
-                        if (tw < 0) continue;
-                        g = mesh->corner_face[tw];
-                        if (state[g] <= 0 || state[g] > layer) continue;
-                        tt__field_transport(mesh, tw, normal + 3 * (size_t)g, normal + 3 * (size_t)h,
-                                            vec + 3 * (size_t)g, t);
-                        tt__normalize3(t);
-                        if (first) { firstv[0] = t[0]; firstv[1] = t[1]; firstv[2] = t[2]; first = 0; }
-                        for (k = 0; k < 3; k++) acc[k] += t[k];
-                    }
-                    if (!(tt__normalize3(acc) > 1e-6)) { acc[0] = firstv[0]; acc[1] = firstv[1]; acc[2] = firstv[2]; }
-                    for (k = 0; k < 3; k++) o[k] = acc[k] * scale;
-                }
-                if (tail > start) layer++;
+/* Seed the lowest unassigned face from *next_seed on with its first edge, as
+   a layer of its own; 0 when every face is assigned. */
+static int tt__field_seed(tt__field *F, int *next_seed, int *layer, int *tail)
+{
+    const tt_mesh *mesh = F->mesh;
+    const float *p, *q;
+    double e[3], *o;
+    int a, k, f;
+    while (*next_seed < F->nf && F->state[*next_seed] != 0) (*next_seed)++;
+    if (*next_seed >= F->nf) return 0;
+    f = *next_seed;
+    a = mesh->face_start[f];
+    p = mesh->pos + 3 * (size_t)mesh->corner_vert[a];
+    q = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, a)];
+    o = F->vec + 3 * (size_t)f;
+    tt__sub3f(q, p, e);
+    tt__project3(e, F->normal + 3 * (size_t)f, e);
+    if (!(tt__normalize3(e) > 0.0)) { e[0] = 1.0; e[1] = e[2] = 0.0; }   /* not reached: area > 0 */
+    for (k = 0; k < 3; k++) o[k] = e[k] * F->scale;
+    (*layer)++;
+    F->state[f] = *layer;
+    F->queue[(*tail)++] = f;
+    return 1;
+}
+
+/* Face h of the layer after `layer`: the normalised sum of its assigned
+   neighbours' vectors from earlier layers, each carried across the shared
+   edge into h's plane (parallel transport); the first of them where they
+   cancel. */
+static void tt__field_average_neighbours(tt__field *F, int h, int layer)
+{
+    const tt_mesh *mesh = F->mesh;
+    double acc[3] = {0.0, 0.0, 0.0}, firstv[3] = {0.0, 0.0, 0.0}, *o = F->vec + 3 * (size_t)h;
+    int first = 1, c, k;
+    for (c = mesh->face_start[h]; c < mesh->face_start[h + 1]; c++) {
+        int tw = mesh->twin[c], g;
+        double t[3];
+        if (tw < 0) continue;
+        g = mesh->corner_face[tw];
+        if (F->state[g] <= 0 || F->state[g] > layer) continue;
+        tt__field_transport(mesh, tw, F->normal + 3 * (size_t)g, F->normal + 3 * (size_t)h, F->vec + 3 * (size_t)g,
+                            t);
+        tt__normalize3(t);
+        if (first) { firstv[0] = t[0]; firstv[1] = t[1]; firstv[2] = t[2]; first = 0; }
+        for (k = 0; k < 3; k++) acc[k] += t[k];
+    }
+    if (!(tt__normalize3(acc) > 1e-6)) { acc[0] = firstv[0]; acc[1] = firstv[1]; acc[2] = firstv[2]; }
+    for (k = 0; k < 3; k++) o[k] = acc[k] * F->scale;
+}
+
+/* Phase 4 (Sec. 3.2, faces perpendicular to up): breadth-first propagation
+   in layers from the faces already assigned; then one seed per untouched
+   component. state = 1 + layer, layers numbered on across components, so
+   "from an earlier layer" is state <= the current one. O(F) in all. */
+static void tt__field_propagate(tt__field *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    int head = 0, tail = 0, layer = 1, next_seed = 0, f, c, i;
+    for (f = 0; f < F->nf; f++)
+        if (F->state[f] == 1) F->queue[tail++] = f;
+    for (;;) {
+        int start, layer_end;
+        /* Nothing left to grow from: seed the lowest unassigned face. */
+        if (head == tail && !tt__field_seed(F, &next_seed, &layer, &tail)) break;
+        /* Faces of state <= layer are assigned; the unassigned neighbours of
+           the current layer form the next, and each of them averages the
+           transported directions of its neighbours from earlier layers. */
+        start = layer_end = tail;
+        for (; head < layer_end; head++) {
+            int g = F->queue[head];
+            for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
+                int tw = mesh->twin[c], h;
+                if (tw < 0) continue;
+                h = mesh->corner_face[tw];
+                if (F->state[h] != 0) continue;
+                F->state[h] = layer + 1;
+                F->queue[tail++] = h;
             }
         }
+        for (i = start; i < tail; i++) tt__field_average_neighbours(F, F->queue[i], layer);
+        if (tail > start) layer++;
+    }
+}
+
+TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
+                                 const tt_allocator *allocator, float *face_vectors, tt_error *error)
+{
+    tt__field F;
+    tt_result result;
+    int f;
+
+    if (!mesh || !face_vectors)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_tangent_field needs a mesh and an output array (got NULL)");
+    if ((result = tt__field_setup(&F, mesh, options, allocator, error)) != TT_OK) return result;
+    if (F.nf <= 0) return tt__ok(error);
+
+    F.normal = TT__ALLOC(F.al, double, 3 * (size_t)F.nf);
+    F.vec = TT__ALLOC(F.al, double, 3 * (size_t)F.nf);
+    F.state = TT__ALLOC(F.al, int, F.nf);
+    F.queue = TT__ALLOC(F.al, int, F.nf);
+    if (!F.normal || !F.vec || !F.state || !F.queue) { result = TT_ERROR_OUT_OF_MEMORY; goto done; }
+    for (f = 0; f < F.nf; f++) {
+        F.state[f] = tt__face_normal_d(mesh, f, F.normal + 3 * (size_t)f) ? 0 : -1;
+        F.vec[3 * (size_t)f] = F.vec[3 * (size_t)f + 1] = F.vec[3 * (size_t)f + 2] = 0.0;
     }
 
-    for (f = 0; f < 3 * nf; f++) face_vectors[f] = (float)vec[f];
+    /* Constraints first (they decide every face they reach), then the
+       default rule, then propagation into what is left. */
+    if ((result = tt__field_check_constraints(&F, error)) != TT_OK) goto done;
+    if (F.opt.nconstraints > 0 && (result = tt__field_constraints(&F)) != TT_OK) goto done;
+    tt__field_default(&F);
+    tt__field_propagate(&F);
+
+    for (f = 0; f < 3 * F.nf; f++) face_vectors[f] = (float)F.vec[f];
     result = tt__ok(error);
 
 done:
     if (result == TT_ERROR_OUT_OF_MEMORY)
         tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory building the tangent field");
-    tt__free(al, normal);
-    tt__free(al, vec);
-    tt__free(al, state);
-    tt__free(al, queue);
-    tt__free(al, centroid);
-    tt__free(al, dist);
-    tt__free(al, trans);
-    tt__free(al, sum);
-    tt__free(al, wsum);
-    tt__free(al, lsum);
-    tt__free(al, wlog);
-    tt__free(al, best);
-    tt__free(al, parent);
-    tt__free(al, heap);
+    tt__free(F.al, F.normal);
+    tt__free(F.al, F.vec);
+    tt__free(F.al, F.state);
+    tt__free(F.al, F.queue);
     return result;
 }
 
@@ -4718,6 +4909,105 @@ static void tt__distance_transform(float *grid, int gw, int gh, float *line, flo
     }
 }
 
+/* Shape from an image (Sec. 3.1, a patch cut by a mask): grid cell (x+1,
+   y+1) becomes `big` where the source's alpha (source_alpha), the mask's
+   alpha (mask_alpha) or else the mask's grey value is >= 0.5. Returns how
+   many texels are inside. */
+static int tt__patch_mask_shape(const tt_image *src_image, int source_alpha, int mask_alpha, float big,
+                                float *grid, int gw)
+{
+    const float *src = src_image->pixels;
+    int w = src_image->width, h = src_image->height, x, y, inside = 0;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            const float *p = src + 4 * ((size_t)y * (size_t)w + (size_t)x);
+            float value = (source_alpha || mask_alpha) ? p[3] : (p[0] + p[1] + p[2]) * (1.0f / 3.0f);
+            if (value >= 0.5f) {
+                grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
+                inside++;
+            }
+        }
+    return inside;
+}
+
+/* The seeded splotch (Sec. 3.1: for homogeneous textures, a predefined
+   irregular "splotch" shape): q = rho / (1 + g(theta)) where rho <= 1
+   (inside the rounded-square base shape shrunk by the margin), else
+   infinite; inside <=> q <= s, with s found by bisection so that the shape
+   covers TT_PATCH_SPLOTCH_COVERAGE of the w x h image. Inside cells of grid
+   (padded by one, gw wide) become `big`; *inside counts them. */
+static tt_result tt__patch_splotch(int w, int h, uint64_t seed, float roughness, float falloff, float big,
+                                   float *grid, int gw, const tt_allocator *al, int *inside, tt_error *error)
+{
+    size_t count = (size_t)w * (size_t)h, i;
+    tt_rng rng;
+    float c[4], phi[4], csum = 0.0f, lo, hi, ax, ay, margin = falloff > 1.0f ? falloff : 1.0f;
+    long target = (long)((double)TT_PATCH_SPLOTCH_COVERAGE * (double)count + 0.5);
+    int k, it, x, y;
+    float *q = TT__ALLOC(al, float, count);
+    *inside = 0;
+    if (!q)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory making a %d x %d splotch", w,
+                        h);
+    tt_rng_seed(&rng, seed, 0x7061746368ull);   /* "patch" */
+    for (k = 0; k < 4; k++) {
+        c[k] = (0.5f + 0.5f * tt_rng_float(&rng)) / (float)(k + 2);
+        phi[k] = (float)TT__TWO_PI * tt_rng_float(&rng);
+        csum += c[k];
+    }
+    for (k = 0; k < 4; k++) c[k] *= roughness / csum;
+    ax = 0.5f * (float)w - margin;
+    ay = 0.5f * (float)h - margin;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float dx = ((float)x + 0.5f - 0.5f * (float)w) / ax, dy = ((float)y + 0.5f - 0.5f * (float)h) / ay;
+            float dx2 = dx * dx, dy2 = dy * dy, rho = sqrtf(sqrtf(dx2 * dx2 + dy2 * dy2));
+            float theta = atan2f(dy, dx), g = 1.0f;
+            for (k = 0; k < 4; k++) g += c[k] * cosf((float)(k + 2) * theta + phi[k]);
+            q[(size_t)y * (size_t)w + (size_t)x] = rho <= 1.0f ? rho / g : big;
+        }
+    lo = 0.0f;
+    hi = 1.0f / (1.0f - roughness) + 1.0f;
+    for (it = 0; it < 40; it++) {
+        float mid = 0.5f * (lo + hi);
+        long covered = 0;
+        for (i = 0; i < count; i++) covered += q[i] <= mid;
+        if (covered < target) lo = mid;
+        else hi = mid;
+    }
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++)
+            if (q[(size_t)y * (size_t)w + (size_t)x] <= hi) {
+                grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
+                (*inside)++;
+            }
+    tt__free(al, q);
+    return TT_OK;
+}
+
+/* The soft falloff (Sec. 3.1: alpha "falls off near the patch boundary"):
+   the exact Euclidean distance transform of the padded grid (0 outside the
+   shape, `big` inside), then each inside texel's distance to the shape's
+   edge, d - 0.5, in place. Fails when no texel is `falloff` deep. */
+static tt_result tt__patch_soft_edge(float *grid, int gw, int gh, float *line, float *dline, int *v, float *z,
+                                     float big, float falloff, tt_error *error)
+{
+    float deepest = 0.0f;
+    int x, y;
+    tt__distance_transform(grid, gw, gh, line, dline, v, z, big);
+    for (y = 1; y < gh - 1; y++)
+        for (x = 1; x < gw - 1; x++) {
+            float d = sqrtf(grid[(size_t)y * (size_t)gw + (size_t)x]) - 0.5f;
+            grid[(size_t)y * (size_t)gw + (size_t)x] = d;
+            if (d > deepest) deepest = d;
+        }
+    if (deepest < falloff)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "falloff %g leaves no opaque texel: the shape is at most %g texels deep", (double)falloff,
+                        (double)deepest);
+    return TT_OK;
+}
+
 TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *mask, const tt_patch_options *options,
                                       const tt_allocator *allocator, tt_image **out_patch, tt_error *error)
 {
@@ -4726,11 +5016,11 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     const tt_allocator *al = allocator;
     tt_image *patch = NULL;
     tt_result result = TT_OK;
-    float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL, *q = NULL;
+    float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL;
     int *v = NULL;
     int w, h, gw, gh, x, y, n, inside = 0, source_alpha = 0, mask_alpha = 0;
     size_t count, i;
-    float falloff, roughness, deepest = 0.0f;
+    float falloff, roughness;
 
     tt__ok(error);
     if (!out_patch) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_patch is NULL");
@@ -4804,16 +5094,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     /* grid: 0 outside the shape (and on the one-texel frame around the image), big inside. */
     for (i = 0; i < (size_t)gw * (size_t)gh; i++) grid[i] = 0.0f;
     if (source_alpha || mask) {
-        const float *src = source_alpha ? source->pixels : mask->pixels;
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                const float *p = src + 4 * ((size_t)y * (size_t)w + (size_t)x);
-                float value = (source_alpha || mask_alpha) ? p[3] : (p[0] + p[1] + p[2]) * (1.0f / 3.0f);
-                if (value >= 0.5f) {
-                    grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
-                    inside++;
-                }
-            }
+        inside = tt__patch_mask_shape(source_alpha ? source : mask, source_alpha, mask_alpha, big, grid, gw);
         if (inside == 0) {
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                               "the mask has no opaque pixel (no %s value >= 0.5)",
@@ -4821,70 +5102,15 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
             goto done;
         }
     } else {
-        /* Splotch: q = rho / (1 + g(theta)) where rho <= 1 (inside the base
-           shape shrunk by the margin), else infinite; inside <=> q <= s, with
-           s found by bisection so that the shape covers the target fraction. */
-        tt_rng rng;
-        float c[4], phi[4], csum = 0.0f, lo, hi, ax, ay, margin = falloff > 1.0f ? falloff : 1.0f;
-        long target = (long)((double)TT_PATCH_SPLOTCH_COVERAGE * (double)count + 0.5);
-        int k, it;
-        q = TT__ALLOC(al, float, count);
-        if (!q) {
-            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                              "out of memory making a %d x %d splotch", w, h);
-            goto done;
-        }
-        tt_rng_seed(&rng, opt.seed, 0x7061746368ull);   /* "patch" */
-        for (k = 0; k < 4; k++) {
-            c[k] = (0.5f + 0.5f * tt_rng_float(&rng)) / (float)(k + 2);
-            phi[k] = 6.28318531f * tt_rng_float(&rng);
-            csum += c[k];
-        }
-        for (k = 0; k < 4; k++) c[k] *= roughness / csum;
-        ax = 0.5f * (float)w - margin;
-        ay = 0.5f * (float)h - margin;
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                float dx = ((float)x + 0.5f - 0.5f * (float)w) / ax, dy = ((float)y + 0.5f - 0.5f * (float)h) / ay;
-                float dx2 = dx * dx, dy2 = dy * dy, rho = sqrtf(sqrtf(dx2 * dx2 + dy2 * dy2));
-                float theta = atan2f(dy, dx), g = 1.0f;
-                for (k = 0; k < 4; k++) g += c[k] * cosf((float)(k + 2) * theta + phi[k]);
-                q[(size_t)y * (size_t)w + (size_t)x] = rho <= 1.0f ? rho / g : big;
-            }
-        lo = 0.0f;
-        hi = 1.0f / (1.0f - roughness) + 1.0f;
-        for (it = 0; it < 40; it++) {
-            float mid = 0.5f * (lo + hi);
-            long covered = 0;
-            for (i = 0; i < count; i++) covered += q[i] <= mid;
-            if (covered < target) lo = mid;
-            else hi = mid;
-        }
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++)
-                if (q[(size_t)y * (size_t)w + (size_t)x] <= hi) {
-                    grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
-                    inside++;
-                }
+        result = tt__patch_splotch(w, h, opt.seed, roughness, falloff, big, grid, gw, al, &inside, error);
+        if (result != TT_OK) goto done;
         if (inside == 0) {   /* not reachable with the margin check above; kept for safety */
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the mask has no opaque pixel");
             goto done;
         }
     }
 
-    tt__distance_transform(grid, gw, gh, line, dline, v, z, big);
-    for (y = 1; y <= h; y++)
-        for (x = 1; x <= w; x++) {
-            float d = sqrtf(grid[(size_t)y * (size_t)gw + (size_t)x]) - 0.5f;
-            grid[(size_t)y * (size_t)gw + (size_t)x] = d;
-            if (d > deepest) deepest = d;
-        }
-    if (deepest < falloff) {
-        result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                          "falloff %g leaves no opaque texel: the shape is at most %g texels deep", (double)falloff,
-                          (double)deepest);
-        goto done;
-    }
+    if ((result = tt__patch_soft_edge(grid, gw, gh, line, dline, v, z, big, falloff, error)) != TT_OK) goto done;
 
     if ((result = tt_image_create(w, h, al, &patch, error)) != TT_OK) goto done;
     for (y = 0; y < h; y++)
@@ -4907,7 +5133,6 @@ done:
     tt__free(al, dline);
     tt__free(al, z);
     tt__free(al, v);
-    tt__free(al, q);
     return result;
 }
 
@@ -4983,24 +5208,6 @@ typedef struct tt__hull_op {
     double vx, vy;          /* collapse: the new vertex */
 } tt__hull_op;
 
-/* Twice the signed area of triangle a, b, c: positive when it turns left. */
-static double tt__orient2(double ax, double ay, double bx, double by, double cx, double cy)
-{
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
-}
-
-static double tt__point_segment_distance(double px, double py, double ax, double ay, double bx, double by)
-{
-    double dx = bx - ax, dy = by - ay, len2 = dx * dx + dy * dy, t = 0.0, ex, ey;
-    if (len2 > 0.0) {
-        t = ((px - ax) * dx + (py - ay) * dy) / len2;
-        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    }
-    ex = ax + t * dx - px;
-    ey = ay + t * dy - py;
-    return sqrt(ex * ex + ey * ey);
-}
-
 /* 1 when segments a-b and c-d come closer than eps (crossing counts). */
 static int tt__segments_near(double ax, double ay, double bx, double by, double cx, double cy, double dx,
                              double dy, double eps)
@@ -5061,14 +5268,9 @@ static tt_result tt__hull_insert_edge(tt__hull *h, int u)
                 h->node_free = h->nodes[k].next;
             } else {
                 if (h->node_count == h->node_cap) {
-                    tt__hull_node *grown;
-                    if (h->node_cap > 0x3fffffff) return TT_ERROR_OUT_OF_MEMORY;
-                    grown = TT__ALLOC(h->allocator, tt__hull_node, 2 * h->node_cap);
+                    void *grown = tt__grow(h->allocator, h->nodes, &h->node_cap, h->node_count + 1, sizeof *h->nodes);
                     if (!grown) return TT_ERROR_OUT_OF_MEMORY;
-                    memcpy(grown, h->nodes, (size_t)h->node_count * sizeof *grown);
-                    tt__free(h->allocator, h->nodes);
-                    h->nodes = grown;
-                    h->node_cap *= 2;
+                    h->nodes = (tt__hull_node *)grown;
                 }
                 k = h->node_count++;
             }
@@ -5291,7 +5493,7 @@ static tt_result tt__hull_simplify(tt__hull *h, int max_vertices)
             tt__heap_item item = tt__heap_pop(h->heap, &h->heap_count);
             tt__hull_op op;
             tt_result result;
-            v = item.face;
+            v = item.value;
             if (h->state[v] != TT__HULL_LIVE || h->key[v] != item.key || !tt__hull_candidate(h, v, &op)) continue;
             if (!tt__hull_valid(h, v, &op)) {
                 h->state[v] = TT__HULL_BLOCKED;
@@ -5719,7 +5921,7 @@ typedef struct tt__lapper {
     double *vert_uv;            /* 2 per vertex */
     int *patch_faces, npatch_faces;
     int *patch_verts, npatch_verts;
-    tt__heap_item *heap;        /* half-edges to grow across; `face` holds the half-edge */
+    tt__heap_item *heap;        /* half-edges to grow across; `value` holds the half-edge */
     int heap_count;
     tt_triplet *triplets;
     double *solve;              /* 4 per patch vertex: b_s, b_t, x_s, x_t */
@@ -5728,27 +5930,6 @@ typedef struct tt__lapper {
     tt__entry *entries;
     int nentries, entry_capacity;
 } tt__lapper;
-
-/* `array` (holding *capacity elements of `size` bytes) grown to hold at
-   least `need`, doubling; NULL when out of memory, the old array then still
-   the caller's. */
-static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int need, size_t size)
-{
-    int cap = *capacity;
-    void *bigger;
-    if (need <= cap) return array;
-    while (cap < need) {
-        if (cap > INT_MAX / 2) return NULL;
-        cap = cap ? 2 * cap : 64;
-    }
-    if (!tt__size_fits((size_t)cap, size)) return NULL;
-    bigger = tt__alloc(al, (size_t)cap * size);
-    if (!bigger) return NULL;
-    if (array) memcpy(bigger, array, (size_t)*capacity * size);
-    tt__free(al, array);
-    *capacity = cap;
-    return bigger;
-}
 
 /* Sec. 3.6 counts a face point as covered where a paste is opaque. Here a
    sample point counts only when every texel a bilinear lookup could read
@@ -5851,8 +6032,8 @@ static void tt__face_vector_weights(const tt_mesh *mesh, int f, const double *t,
     const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
     const float *c = tt__corner_pos(mesh, 3 * f + 2);
     double e1[3], e2[3], g11, g12, g22, r1, r2, det;
-    int k;
-    for (k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
+    tt__sub3f(b, a, e1);
+    tt__sub3f(c, a, e2);
     g11 = tt__dot3(e1, e1); g12 = tt__dot3(e1, e2); g22 = tt__dot3(e2, e2);
     r1 = tt__dot3(e1, t); r2 = tt__dot3(e2, t);
     det = g11 * g22 - g12 * g12;   /* g11 g22 sin^2 of the angle at corner 0 */
@@ -5882,7 +6063,7 @@ static void tt__face_up_image(const tt__lapper *L, int f, double image_t[2])
 static void tt__alignment_error(const double image_t[2], double *angle, double *scale)
 {
     *scale = sqrt(image_t[0] * image_t[0] + image_t[1] * image_t[1]);
-    *angle = *scale > 0.0 ? fabs(atan2(image_t[0], image_t[1])) * (180.0 / 3.14159265358979323846) : 180.0;
+    *angle = *scale > 0.0 ? fabs(atan2(image_t[0], image_t[1])) * (180.0 / TT__PI) : 180.0;
 }
 
 static int tt__lapped_too_distorted(const tt__lapper *L, int f)
@@ -5937,7 +6118,7 @@ static void tt__propagate_direction(tt__lapper *L, int g, int from, int paste)
     const tt_mesh *mesh = L->mesh;
     double sum[3] = {0.0, 0.0, 0.0}, d[3], *out = L->tangent + 3 * (size_t)g;
     const float *field = L->field + 3 * (size_t)g;
-    double length = sqrt((double)field[0] * field[0] + (double)field[1] * field[1] + (double)field[2] * field[2]);
+    double length = tt__length3f(field);
     int k;
     for (k = 0; k < 3; k++) {
         int t = mesh->twin[3 * g + k], h;
@@ -5983,7 +6164,7 @@ static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2
                    x -> y: the perpendicular offset turns x -> y by +90 deg. */
                 tt__cross3(e, q, n);
                 along = tt__dot3(q, e) / ee;
-                across = sqrt(tt__dot3(n, n)) / ee;
+                across = tt__length3(n) / ee;
                 uv[0] += ux[0] + along * (uy[0] - ux[0]) - across * (uy[1] - ux[1]);
                 uv[1] += ux[1] + along * (uy[1] - ux[1]) + across * (uy[0] - ux[0]);
                 count++;
@@ -6035,7 +6216,7 @@ static void tt__grow_patch(tt__lapper *L, int paste, int patch)
     L->heap_count = 0;
     for (i = 0; i < count; i++) tt__queue_edges(L, L->patch_faces[i], paste, patch);
     while (L->heap_count > 0) {
-        int c = tt__heap_pop(L->heap, &L->heap_count).face;
+        int c = tt__heap_pop(L->heap, &L->heap_count).value;
         if (tt__try_add_face(L, c, paste))
             tt__queue_edges(L, L->patch_faces[L->npatch_faces - 1], paste, patch);
     }
@@ -6388,9 +6569,9 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
             return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
                             "the field vector of face %d is NaN or infinite", f);
         v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
-        length = sqrt(tt__dot3(v, v));
+        length = tt__length3(v);
         tt__project3(v, n, t);
-        projected = sqrt(tt__dot3(t, t));
+        projected = tt__length3(t);
         if (!(length > 0.0) || projected < 1e-3 * length)
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
                             length > 0.0 ? "the field vector of face %d is perpendicular to the face"
@@ -6405,9 +6586,10 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
             const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
             const float *c = tt__corner_pos(mesh, 3 * f + 2);
             double e1[3], e2[3], cr[3];
-            for (k = 0; k < 3; k++) { e1[k] = (double)b[k] - a[k]; e2[k] = (double)c[k] - a[k]; }
+            tt__sub3f(b, a, e1);
+            tt__sub3f(c, a, e2);
             tt__cross3(e1, e2, cr);
-            estimate += TT_LAPPED_PASTES_PER_AREA * 0.5 * sqrt(tt__dot3(cr, cr)) /
+            estimate += TT_LAPPED_PASTES_PER_AREA * 0.5 * tt__length3(cr) /
                         (projected * projected * opaque_fraction);
         }
     }
@@ -6418,12 +6600,12 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
                         "%.3g pastes, more than the limit of %d (use a larger scale)", estimate, max_pastes);
     for (f = 0; f < nf; f++) {
         const double *t = L->tangent + 3 * (size_t)f;
-        double projected = sqrt(tt__dot3(t, t)), longest = 0.0;
+        double projected = tt__length3(t), longest = 0.0;
         for (k = 0; k < 3; k++) {
             const float *a = tt__corner_pos(mesh, 3 * f + k), *b = tt__corner_pos(mesh, 3 * f + (k + 1) % 3);
             double e[3];
-            e[0] = (double)b[0] - a[0]; e[1] = (double)b[1] - a[1]; e[2] = (double)b[2] - a[2];
-            if (sqrt(tt__dot3(e, e)) > longest) longest = sqrt(tt__dot3(e, e));
+            tt__sub3f(b, a, e);
+            if (tt__length3(e) > longest) longest = tt__length3(e);
         }
         {
             /* Faces so large next to the patch that even its deepest point
@@ -6491,9 +6673,9 @@ static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_
         /* "the center face of the patch is assigned an arbitrary tangent
            direction" (Sec. 3.2): the field's direction turned at random. */
         const float *fv = L->field + 3 * (size_t)f;
-        double v[3], across[3], angle = 6.283185307179586 * tt_rng_float(&L->rng), length;
+        double v[3], across[3], angle = TT__TWO_PI * tt_rng_float(&L->rng), length;
         v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
-        length = sqrt(tt__dot3(v, v));
+        length = tt__length3(v);
         tt__project3(v, L->normal + 3 * (size_t)f, t);
         tt__normalize3(t);
         tt__cross3(L->normal + 3 * (size_t)f, t, across);
@@ -6546,39 +6728,6 @@ static int tt__remove_hidden(tt__lapper *L)
                                                           L->covered + L->sample_start[face]);
     }
     return removed;
-}
-
-/* Heapsort: O(n log n) whatever the input, so the exact median of a million
-   entries never degrades to the quadratic worst case of a quickselect. */
-static void tt__sift_doubles(double *v, int root, int count)
-{
-    for (;;) {
-        int child = 2 * root + 1;
-        double tmp;
-        if (child >= count) return;
-        if (child + 1 < count && v[child] < v[child + 1]) child++;
-        if (!(v[root] < v[child])) return;
-        tmp = v[root]; v[root] = v[child]; v[child] = tmp;
-        root = child;
-    }
-}
-
-static void tt__sort_doubles(double *v, int n)
-{
-    int i;
-    for (i = n / 2 - 1; i >= 0; i--) tt__sift_doubles(v, i, n);
-    for (i = n - 1; i > 0; i--) {
-        double tmp = v[0]; v[0] = v[i]; v[i] = tmp;
-        tt__sift_doubles(v, 0, i);
-    }
-}
-
-/* The median of values[0 .. count-1] (sorts them); 0 for none. */
-static double tt__median(double *values, int count)
-{
-    if (count <= 0) return 0.0;
-    tt__sort_doubles(values, count);
-    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
 }
 
 /* Move the surviving entries into the result, pastes that lost every face
@@ -6933,20 +7082,6 @@ typedef struct tt__bake {
     tt_image *atlas;
 } tt__bake;
 
-/* Distance from (px, py) to the segment from vertex i to vertex j. */
-static double tt__bake_segment_distance(const tt__bake *b, int i, int j, double px, double py)
-{
-    double dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
-    double wx = px - b->x[i], wy = py - b->y[i], length2 = dx * dx + dy * dy, t = 0.0;
-    if (length2 > 0.0) {
-        t = (wx * dx + wy * dy) / length2;
-        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    }
-    wx -= t * dx;
-    wy -= t * dy;
-    return sqrt(wx * wx + wy * wy);
-}
-
 /* Paste item k of the face sampled at barycentric weights w (weights outside
    [0, 1] extend the paste's linear map across the face's edges). */
 static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float sample[4])
@@ -7015,9 +7150,9 @@ static void tt__bake_texel(int x, int y, const float barycentric[3], void *user_
         /* Between gutters the nearer triangle wins, the later face on ties. */
         double d = 0.0;
         if (w[0] < 0.0 || w[1] < 0.0 || w[2] < 0.0) {
-            double d1 = tt__bake_segment_distance(b, 0, 1, px, py);
-            double d2 = tt__bake_segment_distance(b, 1, 2, px, py);
-            double d3 = tt__bake_segment_distance(b, 2, 0, px, py);
+            double d1 = tt__point_segment_distance(px, py, b->x[0], b->y[0], b->x[1], b->y[1]);
+            double d2 = tt__point_segment_distance(px, py, b->x[1], b->y[1], b->x[2], b->y[2]);
+            double d3 = tt__point_segment_distance(px, py, b->x[2], b->y[2], b->x[0], b->y[0]);
             d = d1 < d2 ? d1 : d2;
             d = d < d3 ? d : d3;
         }
