@@ -682,7 +682,7 @@ typedef struct tt_synth_options {
     /* Region from which each tile's S x S background window is drawn; all zero =
        the whole image. */
     tt_rect background;
-    int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16) */
+    int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16); negative is refused */
     tt_progress_fn progress;
     void *progress_user_data;
 } tt_synth_options;
@@ -711,7 +711,7 @@ typedef struct tt_tileset {
    hold what lies across each edge on the surface. Needs a source of at least
    S x 2S texels (TT_ERROR_IMAGE_TOO_SMALL) and finite texels
    (TT_ERROR_NON_FINITE names the first other one by row and column). A
-   feather wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT. Free with
+   negative feather or one wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT. Free with
    tt_tileset_free. */
 TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
                                     const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error);
@@ -3733,6 +3733,8 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
     s.n = layout.colors;
     s.size = S;
     s.gutter = g;
+    if (opt->feather < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "feather %d is negative", opt->feather);
     s.feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
     if (s.feather > S / 4 + 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
