@@ -48,7 +48,8 @@ bench: build/bench build/bench_cg $(if $(EIGEN_INC),build/bench_cg_eigen)
 	@$(if $(EIGEN_INC),./build/bench_cg_eigen,echo "(no Eigen peer: apt-get install libeigen3-dev)" >&2)
 
 # tests/fuzz/run.sh builds the libFuzzer targets (mesh builder, OBJ reader,
-# lapped textures) and runs them side by side, FUZZ_SECONDS each.
+# lapped textures, tile synthesis) and runs them two at a time (FUZZ_JOBS),
+# FUZZ_SECONDS each.
 FUZZ_SECONDS ?= 60
 fuzz: deps
 	@bash tests/fuzz/run.sh $(FUZZ_SECONDS)
