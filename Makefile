@@ -65,7 +65,8 @@ bench-build: build/bench_build $(if $(CGAL_INC),build/bench_build_cgal)
 	@$(if $(CGAL_INC),./build/bench_build_cgal,echo "(no CGAL peer: apt-get install libcgal-dev)" >&2)
 
 # tests/fuzz/run.sh builds the libFuzzer targets (mesh builder, OBJ reader,
-# lapped textures) and runs them side by side, FUZZ_SECONDS each.
+# lapped textures, tile synthesis) and runs them two at a time (FUZZ_JOBS),
+# FUZZ_SECONDS each.
 FUZZ_SECONDS ?= 60
 fuzz: deps
 	@bash tests/fuzz/run.sh $(FUZZ_SECONDS)

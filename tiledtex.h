@@ -331,7 +331,10 @@ typedef enum tt_subdivision {
    edge point of half-edge i-1). New vertex order: old vertices, then edge points
    (edges in order of their first half-edge), then face points. Repeat it to make
    the faces smaller (it is how you choose the texture's scale on the surface).
-   The result inherits the input's flags (without BORROW_POSITIONS). */
+   The result inherits the input's flags (without BORROW_POSITIONS). Errors
+   besides the usual: new points that overflow float (TT_ERROR_NON_FINITE) or,
+   unless TT_MESH_PERMISSIVE, a new quad that rounding to float leaves of zero
+   area (TT_ERROR_ZERO_AREA_FACE, naming the new face). */
 TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error);
 
@@ -680,7 +683,7 @@ typedef struct tt_synth_options {
     /* Region from which each tile's S x S background window is drawn; all zero =
        the whole image. */
     tt_rect background;
-    int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16) */
+    int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16); negative is refused */
     tt_progress_fn progress;
     void *progress_user_data;
 } tt_synth_options;
@@ -709,7 +712,7 @@ typedef struct tt_tileset {
    hold what lies across each edge on the surface. Needs a source of at least
    S x 2S texels (TT_ERROR_IMAGE_TOO_SMALL) and finite texels
    (TT_ERROR_NON_FINITE names the first other one by row and column). A
-   feather wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT. Free with
+   negative feather or one wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT. Free with
    tt_tileset_free. */
 TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
                                     const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error);
@@ -2525,6 +2528,16 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
                               "float limit)", v);
             goto done;
         }
+    /* Rounding the new points to float can collapse a small quad far from the
+       origin: a strict mesh must not hold a face of zero area. */
+    if (!(mesh->flags & TT_MESH_PERMISSIVE))
+        for (f = 0; f < mesh->ncorners; f++)
+            if (tt__face_has_zero_area(pos, quads->corner_vert + 4 * (size_t)f, 4)) {
+                result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, 4 * f, -1, -1,
+                                  "quadrangulation made face %d (from face %d) of zero area: float cannot separate "
+                                  "its new points", f, mesh->corner_face[f]);
+                goto done;
+            }
     quads->pos = pos;
     pos = NULL;
     *out_mesh = quads;
@@ -4006,6 +4019,8 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
     s.n = layout.colors;
     s.size = S;
     s.gutter = g;
+    if (opt->feather < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "feather %d is negative", opt->feather);
     s.feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
     if (s.feather > S / 4 + 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,

@@ -1,15 +1,26 @@
 /* fuzz_common.h - what every fuzz target in tests/fuzz shares: the contract
-   check, a counting allocator that can fail once, and a byte reader.
+   check, a counting allocator that can fail once (passed to the library as a
+   tt_allocator parameter), and a byte reader.
 
    Define FUZZ_NAME ("fuzz_obj") before including; include after tiledtex.h.
    The functions are static inline so a target that needs only CHECK stays
-   warning-free. */
+   warning-free.
+
+   The contract (THE API CONTRACT at the top of tiledtex.h) as checked here:
+     - on failure: the result is negative, error->result equals it, the
+       message is non-empty and NUL-terminated inside the buffer and holds no
+       run of more than 12 digits (numbers are printed compactly), every
+       `T **out` is NULL (fz_check_null), and TT_ERROR_OUT_OF_MEMORY only
+       when the counting allocator really failed an allocation;
+     - after the caller has freed every object (tt_*_free), the allocator's
+       live count is back to zero (fz_check_all_freed). */
 #ifndef TILEDTEX_FUZZ_COMMON_H
 #define TILEDTEX_FUZZ_COMMON_H
 
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* Abort, naming the broken condition, when a result breaks the documented
    contract: libFuzzer saves the input that did it. */
@@ -30,6 +41,7 @@ typedef struct fz_alloc {
     long live;          /* allocations not yet freed */
     long fail_at;       /* 1-based allocation number that returns NULL, 0 = none */
     int failed;         /* an allocation did fail */
+    tt_allocator tt;    /* what the library is given: &a.tt */
 } fz_alloc;
 
 static inline void *fz_malloc(size_t size, void *user)
@@ -50,9 +62,49 @@ static inline void fz_free(void *p, void *user)
 {
     fz_alloc *a = (fz_alloc *)user;
     if (p) {
+        CHECK(a->live > 0, "freeing %p with no live allocation", p);
         a->live--;
         free(p);
     }
+}
+
+/* Zero the counters; allocation number fail_at (1-based, 0 = none) fails. */
+static inline const tt_allocator *fz_alloc_init(fz_alloc *a, long fail_at)
+{
+    memset(a, 0, sizeof *a);
+    a->fail_at = fail_at;
+    a->tt.alloc = fz_malloc;
+    a->tt.free = fz_free;
+    a->tt.user_data = a;
+    return &a->tt;
+}
+
+/* Every object the caller got has been freed: nothing is left live. */
+#define fz_check_all_freed(a)                                                                       \
+    CHECK((a)->live == 0, "%ld allocations not freed (of %ld made, failing number %ld)", (a)->live, \
+          (a)->count, (a)->fail_at)
+
+/* On failure every `T **out` must be NULL. */
+#define fz_check_null(what, r, out) CHECK((out) == NULL, "%s failed (%d) but its output is not NULL", what, (int)(r))
+
+/* An error that the library filled: call it with memset(&err, 0x55, ...) done
+   before the call, so a field left unwritten shows. `a` may be NULL (an
+   allocator that never fails: then out of memory is never right). */
+static inline void fz_check_error(const char *what, tt_result r, const tt_error *err, const fz_alloc *a)
+{
+    size_t len = 0, i, run = 0, longest = 0;
+    while (len < sizeof err->message && err->message[len]) ++len;
+    CHECK(r < 0, "%s: result %d", what, (int)r);
+    CHECK(len > 0 && len < sizeof err->message, "%s: message length %lu (no NUL inside the buffer, or empty)", what,
+          (unsigned long)len);
+    CHECK(err->result == r, "%s: err.result %d, returned %d (%s)", what, (int)err->result, (int)r, err->message);
+    for (i = 0; i < len; ++i) {
+        run = (err->message[i] >= '0' && err->message[i] <= '9') ? run + 1 : 0;
+        if (run > longest) longest = run;
+    }
+    CHECK(longest <= 12, "%s: a run of %lu digits in the message: %s", what, (unsigned long)longest, err->message);
+    CHECK(r != TT_ERROR_OUT_OF_MEMORY || (a && a->failed), "%s: out of memory with no failed allocation: %s", what,
+          err->message);
 }
 
 /* ---- input reader: missing bytes read as 0 ---------------------------------- */
@@ -63,5 +115,6 @@ typedef struct reader {
 } reader;
 
 static inline uint8_t rd_u8(reader *r) { return r->at < r->n ? r->p[r->at++] : 0; }
+static inline size_t rd_left(const reader *r) { return r->n - r->at; }
 
 #endif /* TILEDTEX_FUZZ_COMMON_H */

@@ -51,7 +51,10 @@
    triangle (the pastes cover every face); a progress fraction that decreases;
    a second paste with the same seed that differs; an allocation not given
    back; an error without a sentence or whose result differs from the return
-   value; TT_ERROR_OUT_OF_MEMORY when no allocation failed. */
+   value; TT_ERROR_OUT_OF_MEMORY when no allocation failed; a failed call whose
+   `T **out` is not NULL, or whose message is empty, unterminated or holds a
+   run of more than 12 digits (fz_check_error in fuzz_common.h). Every
+   allocating call gets the counting allocator as its parameter. */
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_lapped"
@@ -71,10 +74,11 @@
 
 /* A smooth, non-repeating straight RGBA image with alpha 1 everywhere (so the
    patch's shape is the seeded splotch, or the mask). */
-static void fixed_source(tt_image *img, int w, int h)
+static tt_image *fixed_source(int w, int h)
 {
+    tt_image *img = NULL;
     int x, y;
-    if (tt_image_create(img, w, h, NULL) != TT_OK) abort();
+    if (tt_image_create(w, h, NULL, &img, NULL) != TT_OK) abort();
     for (y = 0; y < h; ++y)
         for (x = 0; x < w; ++x) {
             float *p = img->pixels + 4 * ((size_t)y * w + x);
@@ -83,49 +87,32 @@ static void fixed_source(tt_image *img, int w, int h)
             p[2] = (float)(x + y) / (float)(w + h);
             p[3] = 1.0f;
         }
+    return img;
 }
 
-static const tt_image *splotch_patch(void)
+/* Made once with the default allocator and kept for the whole run. */
+static tt_image *splotch_patch(void)
 {
-    static tt_image patch;
-    static int made;
-    if (!made) {
-        tt_image src;
+    static tt_image *patch;
+    if (!patch) {
+        tt_image *src;
         tt_patch_options po;
         tt_error err;
         memset(&po, 0, sizeof po);
         po.seed = 7;
-        fixed_source(&src, 32, 32);
-        memset(&patch, 0, sizeof patch);
-        if (tt_make_texture_patch(&src, NULL, &po, &patch, &err) != TT_OK) {
+        src = fixed_source(32, 32);
+        if (tt_make_texture_patch(src, NULL, &po, NULL, &patch, &err) != TT_OK) {
             fprintf(stderr, "fuzz_lapped: the fixed patch: %s\n", err.message);
             abort();
         }
-        tt_image_free(&src);
-        made = 1;
+        tt_image_free(src);
     }
-    return &patch;
+    return patch;
 }
 
 /* ---- contract checks ---------------------------------------------------------- */
 
-static void check_error(const char *what, tt_result r, const tt_error *err, const fz_alloc *a)
-{
-    size_t len = 0;
-    while (len < sizeof err->message && err->message[len]) ++len;
-    CHECK(r < 0, "%s: result %d", what, (int)r);
-    CHECK(err->result == r, "%s: err.result %d, returned %d (%.*s)", what, (int)err->result, (int)r,
-          (int)(len < sizeof err->message ? len : 0), err->message);
-    CHECK(len > 0 && len < sizeof err->message, "%s: message length %lu", what, (unsigned long)len);
-    CHECK(r != TT_ERROR_OUT_OF_MEMORY || a->failed, "%s: out of memory with no failed allocation: %s", what,
-          err->message);
-}
-
-static int is_zeroed_lapped(const tt_lapped *l)
-{
-    return l->npastes == 0 && l->nentries == 0 && !l->pastes && !l->faces && !l->uv && l->coverage == 0.0 &&
-           l->removed_entries == 0;
-}
+#define check_error fz_check_error
 
 typedef struct progress_state {
     float last;
@@ -282,8 +269,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     tt_field_options fo;
     tt_field_constraint con;
     tt_lapped_options lo;
-    tt_lapped lapped, again;
-    tt_image patches[2], atlas;
+    tt_bake_options bo;
+    tt_lapped *lapped = NULL, *again = NULL;
+    tt_image *patches[2], *atlas = NULL;
+    const tt_allocator *alloc;
     progress_state ps;
     uint8_t flags, misc, hdr[24];
     int nverts, ntris, npatches = 1, f, v, k, gutter;
@@ -294,19 +283,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     rd.p = data;
     rd.n = size;
     rd.at = 0;
-    memset(&a, 0, sizeof a);
     memset(&desc, 0, sizeof desc);
-    memset(&lapped, 0, sizeof lapped);
-    memset(&again, 0, sizeof again);
-    memset(patches, 0, sizeof patches);
-    memset(&atlas, 0, sizeof atlas);
-    patches[0] = *splotch_patch();
+    patches[0] = splotch_patch();
+    patches[1] = NULL;
 
     for (k = 0; k < 24; ++k) hdr[k] = rd_u8(&rd);
     flags = hdr[0];
     nverts = hdr[1] % (MAX_VERTS + 1);
     ntris = hdr[2] % (MAX_TRIS + 1);
-    a.fail_at = (flags & 16) ? (long)hdr[4] + 1 : 0;
+    alloc = fz_alloc_init(&a, (flags & 16) ? (long)hdr[4] + 1 : 0);
     misc = hdr[6];
     gutter = (flags >> 5) & 3;
 
@@ -335,13 +320,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     desc.nfaces = ntris;
     desc.fixed_face_size = 3;
     desc.flags = flags & TT_MESH_PERMISSIVE;
-    desc.allocator.alloc = fz_malloc;
-    desc.allocator.free = fz_free;
-    desc.allocator.user_data = &a;
     memset(&err, 0x55, sizeof err);
-    r = tt_mesh_build(&desc, &mesh, &err);
+    mesh = (tt_mesh *)&rd;
+    r = tt_mesh_build(&desc, alloc, &mesh, &err);
     if (r != TT_OK) {
-        CHECK(mesh == NULL, "build failed (%d) but returned a mesh", (int)r);
+        fz_check_null("tt_mesh_build", r, mesh);
         check_error("tt_mesh_build", r, &err, &a);
         goto out;
     }
@@ -383,9 +366,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     memset(&err, 0x55, sizeof err);
     if (flags & 128) {
-        r = tt_tangent_field(mesh, NULL, field, &err);
+        r = tt_tangent_field(mesh, NULL, alloc, field, &err);
     } else {
-        r = tt_tangent_field(mesh, &fo, field, &err);
+        r = tt_tangent_field(mesh, &fo, alloc, field, &err);
     }
     if (r != TT_OK) {
         check_error("tt_tangent_field", r, &err, &a);
@@ -416,36 +399,34 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     /* ---- a second patch with a mask from the input ---- */
     if (flags & 8) {
-        tt_image src, mask;
+        tt_image *src, *mask = NULL;
         tt_patch_options po;
         int x, y;
-        fixed_source(&src, 40, 24);
-        if (tt_image_create(&mask, 40, 24, NULL) != TT_OK) abort();
+        src = fixed_source(40, 24);
+        if (tt_image_create(40, 24, NULL, &mask, NULL) != TT_OK) abort();
         for (y = 0; y < 24; ++y)
             for (x = 0; x < 40; ++x) {
                 int bit = (hdr[16 + y / 3] >> (x / 5)) & 1;
-                float *p = mask.pixels + 4 * ((size_t)y * 40 + x);
+                float *p = mask->pixels + 4 * ((size_t)y * 40 + x);
                 p[0] = p[1] = p[2] = (float)bit;
                 p[3] = 1.0f;
             }
         memset(&po, 0, sizeof po);
         po.falloff = (float)(hdr[15] % 8) * 0.5f;
-        po.allocator.alloc = fz_malloc;
-        po.allocator.free = fz_free;
-        po.allocator.user_data = &a;
         memset(&err, 0x55, sizeof err);
-        r = tt_make_texture_patch(&src, &mask, &po, &patches[1], &err);
+        patches[1] = (tt_image *)&rd;
+        r = tt_make_texture_patch(src, mask, &po, alloc, &patches[1], &err);
         if (r == TT_OK) {
-            CHECK(patches[1].width == 40 && patches[1].height == 24 && patches[1].pixels, "mask patch %dx%d",
-                  patches[1].width, patches[1].height);
+            CHECK(patches[1]->width == 40 && patches[1]->height == 24 && patches[1]->pixels, "mask patch %dx%d",
+                  patches[1]->width, patches[1]->height);
             npatches = 2;
         } else {
             check_error("tt_make_texture_patch", r, &err, &a);
-            CHECK(!patches[1].pixels && patches[1].width == 0, "failed patch left an image");
+            fz_check_null("tt_make_texture_patch", r, patches[1]);
             CHECK(r == TT_ERROR_INVALID_ARGUMENT || r == TT_ERROR_OUT_OF_MEMORY, "mask patch: %s", err.message);
         }
-        tt_image_free(&src);
-        tt_image_free(&mask);
+        tt_image_free(src);
+        tt_image_free(mask);
     }
 
     /* ---- the paste loop ---- */
@@ -460,47 +441,52 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         lo.progress_user_data = &ps;
     }
     memset(&err, 0x55, sizeof err);
-    r = tt_lapped_paste(mesh, field, patches, npatches, &lo, &lapped, &err);
+    lapped = (tt_lapped *)&rd;
+    r = tt_lapped_paste(mesh, field, patches, npatches, &lo, alloc, &lapped, &err);
     if (r != TT_OK) {
         check_error("tt_lapped_paste", r, &err, &a);
-        CHECK(is_zeroed_lapped(&lapped), "failed paste (%d) left a result", (int)r);
+        fz_check_null("tt_lapped_paste", r, lapped);
         CHECK(r != TT_CANCELLED || (ps.cancel_after > 0 && ps.calls == ps.cancel_after),
               "cancelled after %d progress calls, asked after %d", ps.calls, ps.cancel_after);
         goto out;
     }
     CHECK(ps.cancel_after == 0 || ps.calls < ps.cancel_after, "not cancelled after %d calls", ps.calls);
-    check_lapped(mesh, &lapped, npatches);
+    check_lapped(mesh, lapped, npatches);
     if (misc & 1) {
         long count_before = a.count;
         lo.progress = NULL;
         memset(&err, 0x55, sizeof err);
-        r = tt_lapped_paste(mesh, field, patches, npatches, &lo, &again, &err);
+        again = (tt_lapped *)&rd;
+        r = tt_lapped_paste(mesh, field, patches, npatches, &lo, alloc, &again, &err);
         if (r != TT_OK) {
             check_error("tt_lapped_paste (again)", r, &err, &a);
+            fz_check_null("tt_lapped_paste (again)", r, again);
             CHECK(r == TT_ERROR_OUT_OF_MEMORY && a.fail_at > count_before, "second paste failed: %s", err.message);
         } else {
-            CHECK(same_lapped(&lapped, &again), "same seed, different pastes (%d/%d pastes, %d/%d entries)",
-                  lapped.npastes, again.npastes, lapped.nentries, again.nentries);
+            CHECK(same_lapped(lapped, again), "same seed, different pastes (%d/%d pastes, %d/%d entries)",
+                  lapped->npastes, again->npastes, lapped->nentries, again->nentries);
         }
-        tt_lapped_free(&again);
-        CHECK(is_zeroed_lapped(&again), "tt_lapped_free left something");
+        tt_lapped_free(again);
+        again = NULL;
     }
 
     /* ---- measure ---- */
     {
         tt_lapped_report rep;
-        r = tt_lapped_measure(mesh, field, &lapped, &rep);
+        memset(&err, 0x55, sizeof err);
+        r = tt_lapped_measure(mesh, field, lapped, alloc, &rep, &err);
+        if (r != TT_OK) check_error("tt_lapped_measure", r, &err, &a);
         CHECK(r == TT_OK || (r == TT_ERROR_OUT_OF_MEMORY && a.failed), "tt_lapped_measure returned %d", (int)r);
         if (r == TT_OK) {
             CHECK(rep.uncovered_faces == 0, "%d faces uncovered", rep.uncovered_faces);
-            CHECK(fabs(rep.mean_overdraw - lapped.mean_overdraw) <= 1e-9 * lapped.mean_overdraw,
-                  "overdraw %g measured %g", lapped.mean_overdraw, rep.mean_overdraw);
+            CHECK(fabs(rep.mean_overdraw - lapped->mean_overdraw) <= 1e-9 * lapped->mean_overdraw,
+                  "overdraw %g measured %g", lapped->mean_overdraw, rep.mean_overdraw);
             if (!lo.isotropic) {
-                CHECK(fabs(rep.mean_angle_error - lapped.mean_angle_error) <= 0.5 + 1e-3 * lapped.mean_angle_error,
-                      "mean angle error %g, measured %g", lapped.mean_angle_error, rep.mean_angle_error);
-                CHECK(fabs(rep.median_scale_error - lapped.median_scale_error) <=
-                          1e-2 + 1e-3 * lapped.median_scale_error,
-                      "median scale error %g, measured %g", lapped.median_scale_error, rep.median_scale_error);
+                CHECK(fabs(rep.mean_angle_error - lapped->mean_angle_error) <= 0.5 + 1e-3 * lapped->mean_angle_error,
+                      "mean angle error %g, measured %g", lapped->mean_angle_error, rep.mean_angle_error);
+                CHECK(fabs(rep.median_scale_error - lapped->median_scale_error) <=
+                          1e-2 + 1e-3 * lapped->median_scale_error,
+                      "median scale error %g, measured %g", lapped->median_scale_error, rep.median_scale_error);
             }
         }
     }
@@ -517,26 +503,33 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     for (k = 0; k < 2 * mesh->ncorners; ++k)
         CHECK(corner_uv[k] >= 0.0f && corner_uv[k] <= 1.0f, "atlas uv[%d] = %g", k, (double)corner_uv[k]);
-    if (tt_image_create(&atlas, ATLAS_SIZE, ATLAS_SIZE, &desc.allocator) != TT_OK) {
-        CHECK(a.failed, "tt_image_create failed");
+    memset(&err, 0x55, sizeof err);
+    atlas = (tt_image *)&rd;
+    r = tt_image_create(ATLAS_SIZE, ATLAS_SIZE, alloc, &atlas, &err);
+    if (r != TT_OK) {
+        check_error("tt_image_create", r, &err, &a);
+        fz_check_null("tt_image_create", r, atlas);
+        CHECK(r == TT_ERROR_OUT_OF_MEMORY, "tt_image_create: %s", err.message);
         goto out;
     }
+    memset(&bo, 0, sizeof bo);
+    bo.gutter = gutter;
     memset(&err, 0x55, sizeof err);
-    r = tt_lapped_bake(mesh, &lapped, patches, npatches, corner_uv, gutter, &atlas, &err);
+    r = tt_lapped_bake(mesh, lapped, (tt_image *const *)patches, npatches, corner_uv, &bo, alloc, atlas, &err);
     if (r != TT_OK) {
         check_error("tt_lapped_bake", r, &err, &a);
         CHECK(r == TT_ERROR_OUT_OF_MEMORY, "tt_lapped_bake: %s", err.message);
         goto out;
     }
-    check_atlas(mesh, &atlas, corner_uv);
+    check_atlas(mesh, atlas, corner_uv);
 
 out:
-    tt_image_free(&atlas);
-    tt_lapped_free(&lapped);
-    if (npatches == 2 || patches[1].pixels) tt_image_free(&patches[1]);
+    tt_image_free(atlas);
+    tt_lapped_free(lapped);
+    if (npatches == 2) tt_image_free(patches[1]);
     tt_mesh_free(mesh);
     free(field);
     free(corner_uv);
-    CHECK(a.live == 0, "%ld allocations not freed (of %ld made, failing number %ld)", a.live, a.count, a.fail_at);
+    fz_check_all_freed(&a);
     return 0;
 }

@@ -27,7 +27,16 @@
        then   one byte per corner: the vertex index, b % nverts, except
               250 -> -1, 251 -> nverts, 252 -> INT_MAX, 253 -> INT_MIN
        then   positions; one-byte coordinates are (b - 128) / 8, except
-              0 -> NaN, 1 -> +inf, 2 -> -inf, 3 -> FLT_MAX, 4 -> a denormal
+              0 -> NaN, 1 -> +inf, 2 -> -inf, 3 -> FLT_MAX, 4 -> a denormal,
+              5..36 -> an extreme value (EXTREME[b - 5]: +-FLT_MAX, +-1e38,
+              1e-38, denormals, values near 2^24 and 1e10 whose differences
+              collapse, +-0), so that one face mixes huge and tiny coordinates
+              and zero-area and overflow paths run
+
+   The allocator is a parameter of every allocating call: the counting
+   allocator of fuzz_common.h, failing allocation number byte[4] + 1 when
+   bit4 is set. Every call gets a tt_error; on failure fz_check_error and
+   fz_check_null (fuzz_common.h) check the error and the NULL output.
 
    Besides crashes, leaks and undefined behaviour, it aborts when a result breaks
    the documented contract: twins that are not mutual or not reversed, corners not
@@ -35,7 +44,9 @@
    when one exists, stats that disagree with the arrays, boundary types whose twins
    are not complementary (2k+i vs 2k+1-i), UVs outside [0,1], a quadrangulation
    with the wrong counts, an allocation not given back, an error without a place or
-   a sentence, or TT_ERROR_OUT_OF_MEMORY when no allocation failed. */
+   a sentence, or TT_ERROR_OUT_OF_MEMORY when no allocation failed; with any
+   coordinates, a build result outside the documented codes, or a built mesh
+   whose face normal is not a finite unit vector (or, permissive only, zero). */
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_mesh_build"
@@ -48,8 +59,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Extreme but finite coordinates: overflow when subtracted or multiplied
+   (FLT_MAX - -FLT_MAX, 1e38^2), underflow (1e-38^2, denormals), and values
+   whose differences collapse in float (2^24 and 2^24 + 1 are one float;
+   1e10 and 1e10 + 512 too). */
+static const float EXTREME[32] = {
+    FLT_MAX,      -FLT_MAX,      1e38f,        -1e38f,        3e38f,      1e-38f,      -1e-38f,    FLT_MIN,
+    1e-45f,       -1e-45f,       1e-40f,       16777216.0f,   16777217.0f, 16777218.0f, 16777215.0f, -16777216.0f,
+    33554432.0f,  33554436.0f,   8388608.0f,   8388608.5f,    1e20f,      -1e20f,      1e19f,      1e-20f,
+    1.00000012f,  1.0f,          0.99999994f,  0.0f,          -0.0f,      1e10f,       1e10f + 512.0f, 2e19f};
+
 static float coord_from_byte(uint8_t b)
 {
+    if (b >= 5 && b < 5 + 32) return EXTREME[b - 5];
     switch (b) {
     case 0: return NAN;
     case 1: return INFINITY;
@@ -75,16 +97,11 @@ static int index_from_byte(uint8_t b, int nverts)
 
 static void check_error(tt_result r, const tt_error *err, int nfaces, int ncorners, const fz_alloc *a)
 {
-    size_t len = 0;
-    while (len < sizeof err->message && err->message[len]) ++len;
-    CHECK(r < 0, "result %d", (int)r);
-    CHECK(err->result == r, "err.result %d, returned %d", (int)err->result, (int)r);
-    CHECK(len > 0 && len < sizeof err->message, "message length %lu", (unsigned long)len);
+    fz_check_error(FUZZ_NAME, r, err, a);
     CHECK(err->face >= -1 && err->face < (nfaces > 0 ? nfaces : 1), "face %d of %d: %s", err->face, nfaces,
           err->message);
     CHECK(err->corner >= -1 && err->corner < (ncorners > 0 ? ncorners : 1), "corner %d of %d: %s", err->corner,
           ncorners, err->message);
-    CHECK(r != TT_ERROR_OUT_OF_MEMORY || a->failed, "out of memory with no failed allocation: %s", err->message);
 }
 
 /* Everything the header promises about a built mesh. `indices` (may be NULL)
@@ -149,10 +166,17 @@ static void check_types_and_uvs(const tt_mesh *m, const tt_tile_layout *layout, 
     tt_result r, rl;
     int c, n;
     if (!types || !uv) abort();
+    memset(&err, 0x55, sizeof err);
     rl = tt_tile_layout_resolve(layout, &resolved, &err);
+    if (rl != TT_OK) check_error(rl, &err, m->nfaces, m->ncorners, a);
     n = layout->colors ? layout->colors : 1;
-    r = tt_assign_boundaries(m, layout, seed, types);
-    CHECK(r != TT_ERROR_OUT_OF_MEMORY || a->failed, "assign_boundaries out of memory");
+    memset(&err, 0x55, sizeof err);
+    r = tt_assign_boundaries(m, layout, seed, NULL, types, &err);
+    if (r != TT_OK) {
+        check_error(r, &err, m->nfaces, m->ncorners, a);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && (n < 1 || n > TT_MAX_COLORS), "assign_boundaries with %d colors: %s",
+              n, err.message);
+    }
     if (r == TT_OK) {
         for (c = 0; c < m->ncorners; ++c) {
             CHECK(types[c] < 2 * n, "type[%d] = %d with %d colors", c, types[c], n);
@@ -160,13 +184,13 @@ static void check_types_and_uvs(const tt_mesh *m, const tt_tile_layout *layout, 
                 CHECK((types[m->twin[c]] ^ 1) == types[c], "types %d / %d across half-edge %d", types[c],
                       types[m->twin[c]], c);
         }
-        memset(&err, 0, sizeof err);
+        memset(&err, 0x55, sizeof err);
         r = tt_assign_uvs(m, layout, types, uv, &err);
         if (m->min_face_size != 4 || m->max_face_size != 4) {
             CHECK(r != TT_OK, "tt_assign_uvs accepted a mesh with %d..%d-gons", m->min_face_size, m->max_face_size);
         } else if (rl == TT_OK) {
-            CHECK(r == TT_OK || (r == TT_ERROR_OUT_OF_MEMORY && a->failed), "tt_assign_uvs on a quad mesh: %s",
-                  err.message);
+            /* tt_assign_uvs allocates nothing: it cannot run out of memory */
+            CHECK(r == TT_OK, "tt_assign_uvs on a quad mesh: %s", err.message);
         }
         if (r == TT_OK) {
             for (c = 0; c < 2 * m->ncorners; ++c)
@@ -174,16 +198,17 @@ static void check_types_and_uvs(const tt_mesh *m, const tt_tile_layout *layout, 
         } else {
             check_error(r, &err, m->nfaces, m->ncorners, a);
         }
-        if (r == TT_OK && tt_tile_layout_tile_count(&resolved) <= 4096) {
+        if (r == TT_OK && rl == TT_OK && tt_tile_layout_tile_count(&resolved) <= 4096) {
             int *counts;
             size_t ntiles = (size_t)tt_tile_layout_tile_count(&resolved), t;
             long total = 0;
             counts = (int *)malloc(sizeof(int) * (ntiles ? ntiles : 1));
             if (!counts) abort();
-            if (tt_tile_histogram(m, layout, types, counts) == TT_OK) {
-                for (t = 0; t < ntiles; ++t) total += counts[t];
-                CHECK(total == m->nfaces, "tile histogram counts %ld of %d quads", total, m->nfaces);
-            }
+            memset(&err, 0x55, sizeof err);
+            r = tt_tile_histogram(m, layout, types, counts, &err);
+            CHECK(r == TT_OK, "tt_tile_histogram on a quad mesh with valid types: %s", err.message);
+            for (t = 0; t < ntiles; ++t) total += counts[t];
+            CHECK(total == m->nfaces, "tile histogram counts %ld of %d quads", total, m->nfaces);
             free(counts);
         }
     }
@@ -191,10 +216,32 @@ static void check_types_and_uvs(const tt_mesh *m, const tt_tile_layout *layout, 
     free(uv);
 }
 
+/* Face normals: a finite unit vector, or (0,0,0) for a face of numerically
+   zero area, which only a permissive mesh may hold. */
+static void check_normals(const tt_mesh *m, int strict)
+{
+    int f;
+    for (f = 0; f < m->nfaces; ++f) {
+        float n[3];
+        double len;
+        n[0] = n[1] = n[2] = NAN;
+        tt_face_normal(m, f, n);
+        CHECK(isfinite(n[0]) && isfinite(n[1]) && isfinite(n[2]), "face %d normal (%g, %g, %g)", f, (double)n[0],
+              (double)n[1], (double)n[2]);
+        len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (len == 0.0) {
+            CHECK(!strict, "face %d of a strict mesh has a zero normal (zero area, but the build accepted it)", f);
+            continue;
+        }
+        CHECK(fabs(len - 1.0) <= 1e-5, "face %d normal has length %.9g", f, len);
+    }
+}
+
 static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t seed, int strict, fz_alloc *a,
                      int depth)
 {
     tt_mesh_stats st;
+    tt_error err;
     tt_result r;
     int *corner_loop = (int *)malloc(sizeof(int) * (size_t)m->ncorners);
     int *face_comp = (int *)malloc(sizeof(int) * (size_t)m->nfaces);
@@ -203,9 +250,12 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
     if (!corner_loop || !face_comp) abort();
     for (c = 0; c < m->ncorners; ++c) nboundary += m->twin[c] < 0;
 
+    check_normals(m, strict);
     memset(&st, 0, sizeof st);
-    r = tt_mesh_compute_stats(m, &st);
+    memset(&err, 0x55, sizeof err);
+    r = tt_mesh_compute_stats(m, &a->tt, &st, &err);
     stats_ok = r == TT_OK;
+    if (r != TT_OK) check_error(r, &err, m->nfaces, m->ncorners, a);
     CHECK(r == TT_OK || (r == TT_ERROR_OUT_OF_MEMORY && a->failed), "stats returned %d", (int)r);
     if (r == TT_OK) {
         CHECK(st.boundary_edges == nboundary, "%d boundary edges, %d boundary half-edges", st.boundary_edges,
@@ -219,14 +269,19 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
         CHECK(st.min_valence <= st.max_valence, "valence %d..%d", st.min_valence, st.max_valence);
     }
     for (v = 0; v < m->nverts; ++v) CHECK(tt_mesh_valence(m, v) >= 0, "valence(%d)", v);
-    r = tt_mesh_valence_histogram(m, hist, 8);
+    memset(&err, 0x55, sizeof err);
+    r = tt_mesh_valence_histogram(m, &a->tt, hist, 8, &err);
+    if (r != TT_OK) check_error(r, &err, m->nfaces, m->ncorners, a);
+    CHECK(r == TT_OK || (r == TT_ERROR_OUT_OF_MEMORY && a->failed), "valence histogram: %s", err.message);
     if (r == TT_OK && stats_ok) {
         for (s = 0, v = 0; v < 8; ++v) s += hist[v];
         CHECK(st.used_vertices == s, "histogram sums to %d of %d used", s, st.used_vertices);
     }
 
-    r = tt_mesh_boundary_loops(m, corner_loop, &nloops);
-    CHECK(r == TT_OK || (r == TT_ERROR_OUT_OF_MEMORY && a->failed), "boundary_loops returned %d", (int)r);
+    memset(&err, 0x55, sizeof err);
+    r = tt_mesh_boundary_loops(m, corner_loop, &nloops, &err);
+    /* allocates nothing: it cannot fail on a built mesh */
+    CHECK(r == TT_OK, "boundary_loops returned %d", (int)r);
     if (r == TT_OK) {
         for (c = 0; c < m->ncorners; ++c) {
             if (m->twin[c] >= 0)
@@ -238,7 +293,9 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
         CHECK(nloops <= nboundary, "%d loops for %d boundary half-edges", nloops, nboundary);
     }
 
-    r = tt_mesh_components(m, face_comp, &ncomp);
+    memset(&err, 0x55, sizeof err);
+    r = tt_mesh_components(m, &a->tt, face_comp, &ncomp, &err);
+    if (r != TT_OK) check_error(r, &err, m->nfaces, m->ncorners, a);
     CHECK(r == TT_OK || (r == TT_ERROR_OUT_OF_MEMORY && a->failed), "components returned %d", (int)r);
     if (r == TT_OK) {
         int seen = 0;
@@ -258,17 +315,18 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
     if (depth == 0) {
         int scheme;
         for (scheme = 0; scheme < 2; ++scheme) {
-            tt_mesh *q = NULL;
-            tt_error err;
-            memset(&err, 0, sizeof err);
-            r = tt_mesh_quadrangulate(m, (tt_subdivision)scheme, &q, &err);
+            tt_mesh *q = (tt_mesh *)&err;   /* must be set to NULL on failure */
+            memset(&err, 0x55, sizeof err);
+            r = tt_mesh_quadrangulate(m, (tt_subdivision)scheme, &a->tt, &q, &err);
             if (r != TT_OK) {
-                CHECK(q == NULL, "quadrangulate failed (%d) but returned a mesh", (int)r);
+                fz_check_null("tt_mesh_quadrangulate", r, q);
                 /* the error names a face / corner of the new mesh */
                 check_error(r, &err, m->ncorners, 4 * m->ncorners, a);
                 /* A valid mesh must quadrangulate, except that new points may
-                   overflow to infinity. */
-                CHECK(r == TT_ERROR_OUT_OF_MEMORY || r == TT_ERROR_NON_FINITE,
+                   overflow to infinity or (strict meshes) collapse a new quad
+                   when rounded to float. */
+                CHECK(r == TT_ERROR_OUT_OF_MEMORY || r == TT_ERROR_NON_FINITE ||
+                          (strict && r == TT_ERROR_ZERO_AREA_FACE),
                       "quadrangulating a valid mesh failed: %s", err.message);
                 continue;
             }
@@ -298,6 +356,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     reader rd;
     fz_alloc a;
+    const tt_allocator *alloc;
     tt_mesh_desc desc;
     tt_tile_layout layout;
     tt_mesh *mesh = (tt_mesh *)&rd;     /* must be set to NULL on failure */
@@ -312,7 +371,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     rd.p = data;
     rd.n = size;
     rd.at = 0;
-    memset(&a, 0, sizeof a);
     memset(&desc, 0, sizeof desc);
     memset(&layout, 0, sizeof layout);
 
@@ -323,7 +381,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     layout.colors = lay & 0x7f;
     abuse = lay >> 7;
     k = rd_u8(&rd);
-    a.fail_at = (flags & 16) ? (long)k + 1 : 0;
+    alloc = fz_alloc_init(&a, (flags & 16) ? (long)k + 1 : 0);
     lay = rd_u8(&rd);
     layout.tile_size = lay & 15;
     layout.gutter = (lay >> 4) - 1;
@@ -372,9 +430,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     else
         desc.fixed_face_size = fixed;
     desc.flags = flags & (TT_MESH_PERMISSIVE | TT_MESH_BORROW_POSITIONS);
-    desc.allocator.alloc = fz_malloc;
-    desc.allocator.free = fz_free;
-    desc.allocator.user_data = &a;
 
     if (abuse) {
         static const tt_result expect[8] = {TT_ERROR_INVALID_ARGUMENT, TT_ERROR_INVALID_ARGUMENT,
@@ -396,14 +451,33 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         default: desc.nfaces = INT_MAX - (int)(seed >> 3); desc.fixed_face_size = 4; break;
         }
         memset(&err, 0x55, sizeof err);
-        r = tt_mesh_build(&desc, &mesh, &err);
+        r = tt_mesh_build(&desc, alloc, &mesh, &err);
         CHECK(r == expect[how], "abuse %d: got %d, expected %d (%s)", how, (int)r, (int)expect[how],
               r == TT_OK ? "built" : err.message);
-        CHECK(mesh == NULL, "failed build returned a mesh");
-        CHECK(err.result == r && err.message[0] != '\0', "abuse %d: error without a sentence", how);
+        fz_check_null("tt_mesh_build", r, mesh);
+        check_error(r, &err, 1, 0, &a);
         CHECK(a.count == 0, "abuse %d: %ld allocations before the description was checked", how, a.count);
-        CHECK(tt_mesh_build(NULL, &mesh, NULL) == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "NULL desc");
-        CHECK(tt_mesh_build(&desc, NULL, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL out_mesh");
+        mesh = (tt_mesh *)&rd;
+        CHECK(tt_mesh_build(NULL, alloc, &mesh, NULL) == TT_ERROR_INVALID_ARGUMENT && mesh == NULL, "NULL desc");
+        CHECK(tt_mesh_build(&desc, alloc, NULL, NULL) == TT_ERROR_INVALID_ARGUMENT, "NULL out_mesh");
+        {
+            /* an allocator with only one of alloc and free */
+            tt_allocator half = a.tt;
+            if (seed & 8)
+                half.free = NULL;
+            else
+                half.alloc = NULL;
+            desc.nverts = nverts;
+            desc.positions = pos;
+            desc.indices = indices;
+            mesh = (tt_mesh *)&rd;
+            memset(&err, 0x55, sizeof err);
+            r = tt_mesh_build(&desc, &half, &mesh, &err);
+            CHECK(r < 0, "a half allocator was accepted");
+            check_error(r, &err, 1, 0, &a);
+            fz_check_null("tt_mesh_build (half allocator)", r, mesh);
+        }
+        fz_check_all_freed(&a);
         free(sizes);
         free(indices);
         free(pos);
@@ -411,10 +485,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
 
     memset(&err, 0x55, sizeof err);
-    r = tt_mesh_build(&desc, &mesh, &err);
+    r = tt_mesh_build(&desc, alloc, &mesh, &err);
     if (r != TT_OK) {
-        CHECK(mesh == NULL, "build failed (%d) but *out_mesh is not NULL", (int)r);
+        fz_check_null("tt_mesh_build", r, mesh);
         check_error(r, &err, nfaces, ncorners, &a);
+        CHECK(r == TT_ERROR_EMPTY_MESH || r == TT_ERROR_FACE_TOO_SMALL || r == TT_ERROR_TOO_LARGE ||
+                  r == TT_ERROR_NON_FINITE || r == TT_ERROR_INDEX_OUT_OF_RANGE || r == TT_ERROR_REPEATED_VERTEX ||
+                  r == TT_ERROR_ZERO_AREA_FACE || r == TT_ERROR_NON_MANIFOLD_EDGE ||
+                  r == TT_ERROR_INCONSISTENT_ORIENTATION || r == TT_ERROR_NON_MANIFOLD_VERTEX ||
+                  r == TT_ERROR_OUT_OF_MEMORY,
+              "tt_mesh_build returned %d: %s", (int)r, err.message);
+        CHECK(!(flags & TT_MESH_PERMISSIVE) ||
+                  (r != TT_ERROR_ZERO_AREA_FACE && r != TT_ERROR_NON_MANIFOLD_EDGE && r != TT_ERROR_REPEATED_VERTEX &&
+                   r != TT_ERROR_INCONSISTENT_ORIENTATION && r != TT_ERROR_NON_MANIFOLD_VERTEX),
+              "permissive build refused with %d: %s", (int)r, err.message);
     } else {
         int strict = !(flags & TT_MESH_PERMISSIVE);
         CHECK(mesh->nfaces == nfaces && mesh->ncorners == ncorners && mesh->nverts == nverts,
@@ -425,7 +509,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         exercise(mesh, &layout, seed, strict, &a, 0);
         tt_mesh_free(mesh);
     }
-    CHECK(a.live == 0, "%ld allocations not freed (of %ld made, failing number %ld)", a.live, a.count, a.fail_at);
+    fz_check_all_freed(&a);
     free(sizes);
     free(indices);
     free(pos);

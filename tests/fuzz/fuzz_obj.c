@@ -13,8 +13,10 @@
         On failure: -1, a non-empty message, *out zeroed, obj_free still safe.
         On success: every index in range (corners, vt, groups), face sizes >= 3
         adding up to ncorners, group_names[0] == "", strings terminated.
-     2. tt_mesh_build with TT_MESH_PERMISSIVE (real assets are messy); when it
-        builds: stats, boundary types, and UVs for quad meshes.
+     2. tt_mesh_build with TT_MESH_PERMISSIVE (real assets are messy) and the
+        counting allocator of fuzz_common.h; when it builds: stats, boundary
+        types, and UVs for quad meshes. Failures are checked by fz_check_error
+        and fz_check_null; every allocation must be given back.
      3. obj_write the parsed mesh (with per-corner UVs when every corner has
         one, and its groups and mtllib when their names are plain) and parse
         that text again: the same vertices (bit for bit, NaN for NaN), faces,
@@ -104,15 +106,18 @@ static void check_zeroed(const obj_mesh *m)
 static void feed_library(const obj_mesh *m)
 {
     tt_mesh_desc desc;
-    tt_mesh *mesh = NULL;
+    tt_mesh *mesh = (tt_mesh *)&desc;   /* must be set to NULL on failure */
     tt_error err;
     tt_result r;
+    fz_alloc a;
+    const tt_allocator *alloc = fz_alloc_init(&a, 0);
     desc = obj_mesh_desc(m, TT_MESH_PERMISSIVE);
-    r = tt_mesh_build(&desc, &mesh, &err);
+    memset(&err, 0x55, sizeof err);
+    r = tt_mesh_build(&desc, alloc, &mesh, &err);
     if (r != TT_OK) {
-        CHECK(mesh == NULL, "build failed but returned a mesh");
-        CHECK(err.result == r && err.message[0] != '\0', "error %d without a sentence", (int)r);
-        CHECK(r != TT_ERROR_OUT_OF_MEMORY, "out of memory on a tiny mesh: %s", err.message);
+        fz_check_null("tt_mesh_build", r, mesh);
+        fz_check_error("tt_mesh_build", r, &err, &a);
+        fz_check_all_freed(&a);
         return;
     }
     {
@@ -123,18 +128,24 @@ static void feed_library(const obj_mesh *m)
         int c;
         if (!types || !uv) abort();
         memset(&layout, 0, sizeof layout);
-        CHECK(tt_mesh_compute_stats(mesh, &st) == TT_OK, "stats failed");
-        CHECK(tt_assign_boundaries(mesh, &layout, 1, types) == TT_OK, "assign_boundaries failed");
+        memset(&err, 0x55, sizeof err);
+        CHECK(tt_mesh_compute_stats(mesh, alloc, &st, &err) == TT_OK, "stats failed: %s", err.message);
+        memset(&err, 0x55, sizeof err);
+        CHECK(tt_assign_boundaries(mesh, &layout, 1, NULL, types, &err) == TT_OK, "assign_boundaries failed: %s",
+              err.message);
+        memset(&err, 0x55, sizeof err);
         r = tt_assign_uvs(mesh, &layout, types, uv, &err);
         if (mesh->min_face_size == 4 && mesh->max_face_size == 4) {
             CHECK(r == TT_OK, "assign_uvs on quads: %s", err.message);
             for (c = 0; c < 2 * mesh->ncorners; ++c) CHECK(uv[c] >= 0.0f && uv[c] <= 1.0f, "uv %g", (double)uv[c]);
         } else {
             CHECK(r == TT_ERROR_NOT_QUAD_MESH, "assign_uvs on non-quads returned %d", (int)r);
+            fz_check_error("tt_assign_uvs", r, &err, &a);
         }
         free(types);
         free(uv);
         tt_mesh_free(mesh);
+        fz_check_all_freed(&a);
     }
 }
 

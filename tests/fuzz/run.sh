@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # tests/fuzz/run.sh [SECONDS] - build the libFuzzer targets into build/fuzz/ and run
-# each for SECONDS (default 60), side by side. Exits non-zero if a target crashed,
+# each for SECONDS (default 60), FUZZ_JOBS (default 2) at a time: mesh_build,
+# lapped, synth (tiled-texture synthesis, seams, 8-bit images) and obj (the
+# tool's OBJ reader, when examples/tool_io.c compiles). Exits non-zero if a target crashed,
 # leaked, hit undefined behaviour or broke a contract check; the input that did it
 # is saved as build/fuzz/<target>-crash-* (or -leak-, -timeout-, -oom-).
 #
@@ -54,6 +56,12 @@ else
   echo "fuzz: fuzz_lapped does not build" >&2
   exit 2
 fi
+if $cc $flags $warn -I. tests/fuzz/fuzz_synth.c -o "$out/fuzz_synth" -lm; then
+  targets+=(synth)
+else
+  echo "fuzz: fuzz_synth does not build" >&2
+  exit 2
+fi
 # The tool's OBJ reader (examples/obj.c) with what it uses: tool_io.c (errors,
 # files, buffers) and format_number.c (the writer's numbers).
 obj_sources="examples/obj.c examples/tool_io.c examples/format_number.c"
@@ -71,23 +79,30 @@ else
   echo "fuzz: SKIPPED fuzz_obj: one of $obj_sources examples/tool.h is missing" >&2
 fi
 
+jobs_max=${FUZZ_JOBS:-2}
+[ "$jobs_max" -ge 1 ] 2>/dev/null || jobs_max=2
 declare -A pid
-for t in "${targets[@]}"; do
-  corpus="$out/corpus_$t"
+start() {
+  local t=$1 corpus="$out/corpus_$1" extra=()
   mkdir -p "$corpus"
   cp -n tests/fuzz/corpus_"$t"/* "$corpus"/ 2>/dev/null
-  extra=()
   [ -f tests/fuzz/"$t".dict ] && extra+=("-dict=tests/fuzz/$t.dict")
   "$out/fuzz_$t" -max_total_time="$secs" -max_len=4096 -timeout=20 -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$out/fuzz_$t-" "${extra[@]}" "$corpus" \
     >"$out/fuzz_$t.log" 2>&1 &
   pid[$t]=$!
-done
+}
 
+# At most jobs_max targets at once (the machine may be shared): target i
+# starts when target i - jobs_max has finished.
 status=0
-for t in "${targets[@]}"; do
+n=${#targets[@]}
+for ((i = 0; i < n && i < jobs_max; i++)); do start "${targets[$i]}"; done
+for ((i = 0; i < n; i++)); do
+  t=${targets[$i]}
   wait "${pid[$t]}"
   rc=$?
+  [ $((i + jobs_max)) -lt "$n" ] && start "${targets[$((i + jobs_max))]}"
   log="$out/fuzz_$t.log"
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   cov=$(grep -o 'cov: [0-9]* ft: [0-9]* corp: [0-9]*/[^ ]*' "$log" | tail -1)
