@@ -331,10 +331,12 @@ typedef enum tt_subdivision {
    edge point of half-edge i-1). New vertex order: old vertices, then edge points
    (edges in order of their first half-edge), then face points. Repeat it to make
    the faces smaller (it is how you choose the texture's scale on the surface).
-   The result inherits the input's flags (without BORROW_POSITIONS). Errors
-   besides the usual: new points that overflow float (TT_ERROR_NON_FINITE) or,
-   unless TT_MESH_PERMISSIVE, a new quad that rounding to float leaves of zero
-   area (TT_ERROR_ZERO_AREA_FACE, naming the new face). */
+   The result inherits the input's flags (without BORROW_POSITIONS). A valid
+   mesh always quadrangulates, but a new quad can have zero area even in a
+   strict result: where a valid polygon repeats a position at distinct
+   vertices, or where float cannot separate the new points (a tiny face far
+   from the origin); tt_face_normal gives (0, 0, 0) for such a quad. New
+   points that overflow float are TT_ERROR_NON_FINITE. */
 TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error);
 
@@ -2528,16 +2530,6 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
                               "float limit)", v);
             goto done;
         }
-    /* Rounding the new points to float can collapse a small quad far from the
-       origin: a strict mesh must not hold a face of zero area. */
-    if (!(mesh->flags & TT_MESH_PERMISSIVE))
-        for (f = 0; f < mesh->ncorners; f++)
-            if (tt__face_has_zero_area(pos, quads->corner_vert + 4 * (size_t)f, 4)) {
-                result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, 4 * f, -1, -1,
-                                  "quadrangulation made face %d (from face %d) of zero area: float cannot separate "
-                                  "its new points", f, mesh->corner_face[f]);
-                goto done;
-            }
     quads->pos = pos;
     pos = NULL;
     *out_mesh = quads;
