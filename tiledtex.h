@@ -674,6 +674,27 @@ typedef struct tt_rect {
     int x, y, w, h;         /* pixels; (x, y) is the top-left corner, row 0 at the top */
 } tt_rect;
 
+/* --- Tile-set synthesis (Akleman Sec. 4), as a plan and its application ---
+
+   Synthesis has two halves:
+     1. The plan (tt_synth_plan_create), decided once from a guide image
+        (usually the colour map): the edge window of each condition (Sec. 4 /
+        Sec. 6: two S x S squares whose middle line is the condition), the
+        background window of each tile (its XXXX), and, per tile and side, the
+        depth of the edge band in every column, from a minimum-error cut of the
+        band against what lies beneath it (the paper's f4) kept inside the
+        side's wedge (f1..f3). The depths, the feather and the wedge decide
+        each band's alpha, i.e. every mask.
+     2. The application to any image of the guide's size (tt_synth_apply for
+        the whole atlas and its mip chain, tt_synth_compose_tile for one
+        tile): ABCD = AXXX over XBXX over XXCX over XXXD over XXXX with the
+        plan's windows and masks, then the corner texels and the gutters.
+   Applying one plan to several maps of one material (colour, normal,
+   roughness, ...) gives atlases whose tiles line up texel for texel: the
+   masks do not depend on the applied image, and blending is linear, so an
+   image B = a * A + b gives atlas a * atlas_A + b (up to float rounding).
+   tt_synthesize_tiles is plan_create + apply + plan_free in one call. */
+
 typedef struct tt_synth_options {
     tt_tile_layout layout;
     uint64_t seed;
@@ -686,9 +707,103 @@ typedef struct tt_synth_options {
        the whole image. */
     tt_rect background;
     int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16); negative is refused */
+    /* Called by tt_synth_plan_create (which copies it into the plan) and by
+       tt_synth_apply with that plan; tt_synthesize_tiles reports both as one
+       run from 0 to 1. */
     tt_progress_fn progress;
     void *progress_user_data;
 } tt_synth_options;
+
+/* A synthesis plan: everything that decides the tiles except the texels they
+   are made of. Read its fields freely; only progress and progress_user_data
+   may be changed (before an apply). Made by tt_synth_plan_create, freed by
+   tt_synth_plan_free.
+
+   The band of side s (0 bottom, 1 right, 2 top, 3 left: e0..e3) is described
+   in its side frame: x = 0..S-1 runs along the side in the direction of its
+   half-edge, d is the distance from the side into the tile (d = 0 is the
+   side's edge row, d < 0 lies in the gutter, across the edge). Side-frame
+   (x, d) is tile texel tt_rotate_coords(s, S, S, x, S-1-d) (row 0 at the
+   top), which is texel (g + tx, g + ty) of the tile's C x C cell. The band's
+   alpha at (x, d) is tt_synth_plan_band_alpha: 1 on the edge row, then
+   clamp((depth - d - 1/2) / feather + 1/2, 0, 1) times a 2-texel blend at
+   the side's wedge (the triangle between the tile's diagonals), 0 in the
+   two corner columns x = 0 and x = S-1 and beyond depth + feather.
+
+   Memory: one allocation of about sizeof(tt_synth_plan) + 16 * (n + (2n)^4)
+   + 4 * S * (2n)^4 bytes (the last term doubles for S >= 1024, whose depths
+   need 16 bits): n = 1, S = 128: 8.5 KiB; n = 2, S = 64: 68 KiB; about
+   1/(4S) of the atlas level 0 it describes. */
+typedef struct tt_synth_plan {
+    tt_tile_layout layout;          /* resolved: n, S, g */
+    int source_width, source_height;/* the guide's size: every applied image must have it */
+    int feather;                    /* resolved (options.feather or max(2, S/16)) */
+    int max_depth;                  /* max(1, S/4): no band goes deeper (before its feather) */
+    tt_rect *edge_windows;          /* n rects (w = S, h = 2S), one per condition */
+    tt_rect *background_windows;    /* one S x S rect per tile, indexed like tt_tile_index */
+    /* The band depth (0..max_depth) of tile t, side s, column x at entry
+       (4 * t + s) * S + x of the one of these that is not NULL: depth8 when
+       max_depth <= 255 (S < 1024), depth16 otherwise. tt_synth_plan_depth
+       reads either. */
+    uint8_t *depth8;
+    uint16_t *depth16;
+    tt_progress_fn progress;        /* copied from the options; tt_synth_apply reports to it */
+    void *progress_user_data;
+    tt_allocator allocator;         /* the one it was made with */
+} tt_synth_plan;
+
+/* Plan the tile set of options->layout (options may be NULL: all defaults)
+   from `guide`, whose texels decide the edge windows (when not given) and the
+   cuts; the seed decides the rest. Same guide, options and seed: same plan.
+   Errors: NULL out_plan or an empty guide (TT_ERROR_INVALID_ARGUMENT), a bad
+   allocator, a non-finite guide texel (TT_ERROR_NON_FINITE, error->row /
+   column = its y / x), a layout that does not resolve, a guide smaller than S
+   x 2S or a background region that cannot hold a tile
+   (TT_ERROR_IMAGE_TOO_SMALL), a background region outside the guide, a given
+   edge window that does not fit, a feather wider than S/4 + 1
+   (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by the
+   progress callback. *out_plan is NULL on failure and nothing is left
+   allocated. Temporary memory, freed before it returns: about 20 * S * S
+   bytes (a scratch tile and the cut's cost tables). Time: about that of
+   composing every tile once, plus the cuts. */
+TTDEF tt_result tt_synth_plan_create(const tt_image *guide, const tt_synth_options *options,
+                                     const tt_allocator *allocator, tt_synth_plan **out_plan, tt_error *error);
+/* Free a plan (NULL is fine). */
+TTDEF void tt_synth_plan_free(tt_synth_plan *plan);
+
+/* The band depth of tile `tile` (tt_tile_index numbering), side 0..3, column
+   0..S-1, from whichever depth array the plan holds.
+   Preconditions (TT_ASSERT): a plan from tt_synth_plan_create, indices in
+   range. */
+TTDEF int tt_synth_plan_depth(const tt_synth_plan *plan, int tile, int side, int x);
+/* The alpha (0..1) with which the band of `side` covers side-frame texel (x,
+   d) of tile `tile`, d = 0..S-1 (see tt_synth_plan above): the mask the
+   compositing uses, the same for every image the plan is applied to.
+   Preconditions (TT_ASSERT): as tt_synth_plan_depth, 0 <= d < S. */
+TTDEF float tt_synth_plan_band_alpha(const tt_synth_plan *plan, int tile, int side, int x, int d);
+
+/* The per-tile step: compose the tile whose sides have types[0..3] (e0..e3,
+   each below 2n) from `source` with the plan's windows and masks, and write
+   it with its gutters, one C x C cell (C = S + 2g), into `target` with the
+   cell's top-left texel at (x, y); the tile itself is the S x S square at
+   (x + g, y + g). The tile's background window is the plan's
+   background_windows[tt_tile_index(&plan->layout, types)], so the cell is
+   bit for bit the one tt_synth_apply puts in the atlas. Texels outside the
+   cell are not touched; alpha is 1. `target` is any image of yours (an
+   atlas, a one-cell image, a view) that shares no texels with `source`; it
+   is the only thing written, and the tile is composed in place there.
+   Allocates nothing. The plan and source are only read, so several threads
+   may compose with one plan and source at once into cells that do not
+   overlap.
+   Errors: NULL plan, source, types or target, a target without pixels
+   (TT_ERROR_INVALID_ARGUMENT); a source whose size is not the plan's
+   (TT_ERROR_INVALID_ARGUMENT); a type of 2n or more
+   (TT_ERROR_INDEX_OUT_OF_RANGE, error->item = the side); a cell that does
+   not lie inside the target (TT_ERROR_INVALID_ARGUMENT). A non-finite source
+   texel that reaches the tile is TT_ERROR_NON_FINITE (error->row / column =
+   the source texel's y / x); the cell has been written then. */
+TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image *source, const uint8_t types[4],
+                                      tt_image *target, int x, int y, tt_error *error);
 
 #define TT_MAX_MIP_LEVELS 16
 
@@ -706,16 +821,34 @@ typedef struct tt_tileset {
     tt_allocator allocator;         /* the one it was made with */
 } tt_tileset;
 
-/* Akleman Sec. 4, tile-set synthesis: every tile ABCD = AXXX over XBXX over XXCX
-   over XXXD over XXXX (Sec. 4). The band along each side is the edge sample for
-   its type, turned to that side; it is cut against what lies beneath where the
-   two agree (minimum-error cut) and feathered, and every texel of a tile's edge
-   rows except the two corner texels is the edge sample alone, exactly. Gutters
-   hold what lies across each edge on the surface. Needs a source of at least
-   S x 2S texels (TT_ERROR_IMAGE_TOO_SMALL) and finite texels
-   (TT_ERROR_NON_FINITE names the first other one by row and column). A
-   negative feather or one wider than S/4 + 1 is TT_ERROR_INVALID_ARGUMENT. Free with
-   tt_tileset_free. */
+/* Apply a plan to `source` (the guide itself, or another map of the same
+   size): every tile of the layout into its cell of a W x W atlas (tile
+   row 0 of tt_tile_index at the bottom), then the mip chain, as
+   tt_synthesize_tiles. The plan is only read: several threads may apply one
+   plan at once (each then calls plan->progress, if set); the tileset's
+   windows are copies of the plan's. Memory: the
+   atlas and its mips, about 4/3 * W * W * 16 bytes, from `allocator`. Free
+   the result with tt_tileset_free.
+   Errors: NULL plan, source or out (TT_ERROR_INVALID_ARGUMENT), a bad
+   allocator, a source whose size is not the plan's source_width x
+   source_height (TT_ERROR_INVALID_ARGUMENT), a non-finite source texel
+   (TT_ERROR_NON_FINITE, error->row / column = its y / x),
+   TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by plan->progress. *out is NULL on
+   failure and nothing is left allocated. */
+TTDEF tt_result tt_synth_apply(const tt_synth_plan *plan, const tt_image *source, const tt_allocator *allocator,
+                               tt_tileset **out, tt_error *error);
+
+/* Akleman Sec. 4, tile-set synthesis in one call: tt_synth_plan_create from
+   `source`, tt_synth_apply to it, tt_synth_plan_free. Every tile ABCD = AXXX
+   over XBXX over XXCX over XXXD over XXXX. The band along each side is the
+   edge sample for its type, turned to that side; it is cut against what lies
+   beneath where the two agree (minimum-error cut) and feathered, and every
+   texel of a tile's edge rows except the two corner texels is the edge sample
+   alone, exactly. Gutters hold what lies across each edge on the surface.
+   Errors: those of tt_synth_plan_create (a source of at least S x 2S texels,
+   finite, ...) and tt_synth_apply. To synthesise several maps of one
+   material with the same tiles, make the plan once and apply it to each.
+   Free with tt_tileset_free. */
 TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
                                     const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error);
 TTDEF void tt_tileset_free(tt_tileset *tileset);
@@ -3523,7 +3656,28 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
      Sec. 2   tiles named by their four boundary types, placed by their name
      Sec. 3   AssignBoundaries + AssignTextureCoordinates   -> tt_assign_boundaries,
                                                                tt_assign_uvs
-     Sec. 4   tile synthesis by compositing                 -> tt_synthesize_tiles
+     Sec. 4   tile synthesis by compositing, split into a plan and its
+              application (tt_synthesize_tiles does both):
+              plan (tt_synth_plan_create), from a guide image:
+                1. edge windows: one S x 2S window per condition, chosen
+                   from the seed as the least conspicuous of 128 candidates
+                   (or given)                             -> tt__choose_edge_windows
+                2. per tile, its S x S background window XXXX from the seed
+                3. per tile and side (D, C, B, A in that order), the band
+                   depth per column: a minimum-error cut of the band against
+                   what lies beneath (f4), kept inside the side's wedge
+                   (f1..f3), the band then laid over the scratch tile so the
+                   next cut sees it                       -> tt__band_depths
+              application to any image of the guide's size:
+                4. ABCD = AXXX over XBXX over XXCX over XXXD over XXXX, with
+                   each band's alpha from its depths and the feather
+                   (tt__band_alpha), composed in place in the target cell
+                5. corner texels: the mean of the two edge samples there
+                6. gutters (beyond the paper): each side's edge sample
+                   continued across the edge              -> tt__compose_cell
+                7. every tile into the atlas, then the per-tile mip chain
+              tt_synth_compose_tile does 4-6 for one tile (the per-tile step,
+              e.g. for a polycube's quads), tt_synth_apply 4-7 for the atlas.
      Sec. 6   n conditions: types 2k, 2k+1; (2n)^4 tiles
    Beyond the paper: gutters around tiles and a per-tile mip chain, so that
    bilinear filtering and mip-mapping do not bleed across tiles; a measured
@@ -3709,22 +3863,29 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
     return TT_OK;
 }
 
-/* --- tile-set synthesis (Akleman Sec. 4) --------------------------------- */
+/* --- tile-set synthesis (Akleman Sec. 4): plan and application ----------- */
 
-/* Everything one synthesis run shares. Tiles are composed in a "side frame"
-   per side s: x runs along the side in the direction of its half-edge, d is
-   the distance from the side into the tile (d = 0 is the side's edge row,
-   d < 0 lies in the gutter, across the edge). The side frame is the tile's
-   bottom side turned by s quarter turns, so it maps to tile texels through
-   tt_rotate_coords(s, S, S, x, S-1-d). */
+/* What composing one tile needs. Tiles are composed in a "side frame" per
+   side s: x runs along the side in the direction of its half-edge, d is the
+   distance from the side into the tile (d = 0 is the side's edge row, d < 0
+   lies in the gutter, across the edge). The side frame is the tile's bottom
+   side turned by s quarter turns, so it maps to tile texels through
+   tt_rotate_coords(s, S, S, x, S-1-d). The S x S tile being composed lies at
+   `tile`, `stride` floats per row: a scratch tile while planning, the tile's
+   square inside its cell of the caller's image while applying. */
 typedef struct tt__synth {
     const tt_image *source;
     const tt_rect *windows;   /* per condition: S x 2S, top-left (x, y) */
-    int n, size, gutter, feather, min_depth, max_depth;
-    float *tile;              /* S x S RGBA, premultiplied (opaque) */
-    float *cost;              /* S x (max_depth + 1) */
-    int *lo, *hi, *cut;       /* S each */
+    int size, gutter, feather;
+    float *tile;              /* RGBA, premultiplied (opaque) */
+    size_t stride;            /* floats per row of `tile` */
 } tt__synth;
+
+static float *tt__synth_texel(const tt__synth *s, int tx, int ty)
+{
+    /* tx or ty may be negative (the gutter before the tile, inside its cell) */
+    return s->tile + (ptrdiff_t)ty * (ptrdiff_t)s->stride + (ptrdiff_t)tx * 4;
+}
 
 /* The edge sample for a side of type t at side-frame (x, d). Condition k's
    window holds two squares, upper U and lower L, meeting at the line between
@@ -3746,20 +3907,79 @@ static void tt__side_to_tile(const tt__synth *s, int side, int x, int d, int *tx
     tt_rotate_coords(side, s->size, s->size, x, s->size - 1 - d, tx, ty);
 }
 
-/* Lay the band of side `side` (type `type`) over the tile composed so far:
-   AXXX over (what is there). The band's depth follows a minimum-error cut
-   against what lies beneath (the paper's f4: "once colour values of two image
-   layers become similar, the foreground becomes transparent"), kept inside the
-   side's wedge (the triangle between the tile's diagonals, the paper's f1..f3
-   keeping it off the other sides) and feathered across the cut. */
-static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocator *allocator, tt_error *error)
+/* The band depth of entry i ((4 * tile + side) * S + x) of a plan. */
+static int tt__plan_depth_at(const tt_synth_plan *plan, size_t i)
 {
-    const int S = s->size, rows = s->max_depth + 1;
-    /* Near the corners two bands meet along the diagonal; a short blend there
-       keeps both bands' rows next to their edges intact. */
-    const float feather = (float)s->feather, wedge_feather = 2.0f;
+    return plan->depth8 ? plan->depth8[i] : plan->depth16[i];
+}
+
+/* The band's alpha at side-frame (x, d) for a column of depth `depth`: one
+   formula for planning, applying and tt_synth_plan_band_alpha. The edge row
+   is the edge sample, exactly; below it the band fades out across the cut
+   (`feather` texels) and, near the corners where two bands meet along the
+   diagonal, across the side's wedge (a short 2-texel blend that keeps both
+   bands' rows next to their edges intact). Corner columns belong to the
+   neighbouring sides. */
+static float tt__band_alpha(int size, int feather, int depth, int x, int d)
+{
+    float a_cut, a_wedge;
+    int wedge;
+    if (x <= 0 || x >= size - 1 || d < 0 || d > tt__min_i(depth + feather, size - 1)) return 0.0f;
+    if (d == 0) return 1.0f;
+    wedge = tt__min_i(x, size - 1 - x);   /* rows strictly inside this side's wedge */
+    a_cut = tt__clamp_f(((float)depth - (float)d - 0.5f) / (float)feather + 0.5f, 0.0f, 1.0f);
+    a_wedge = tt__clamp_f(((float)wedge - (float)d - 0.5f) / 2.0f + 0.5f, 0.0f, 1.0f);
+    return a_cut * a_wedge;
+}
+
+/* XXXX: the tile's background window, opaque. */
+static void tt__copy_background(const tt__synth *s, const tt_rect *bg)
+{
+    int x, y;
+    for (y = 0; y < s->size; y++)
+        for (x = 0; x < s->size; x++) {
+            const float *p = s->source->pixels + ((size_t)(bg->y + y) * s->source->width + bg->x + x) * 4;
+            float *q = tt__synth_texel(s, x, y);
+            q[0] = p[0]; q[1] = p[1]; q[2] = p[2]; q[3] = 1.0f;
+        }
+}
+
+/* Lay the band of side `side` (type `type`) over the tile composed so far:
+   AXXX over (what is there), with the depths of the plan's entries
+   depth_base .. depth_base + S-1. */
+static void tt__lay_band(const tt__synth *s, const tt_synth_plan *plan, size_t depth_base, int side, int type)
+{
+    const int S = s->size;
     int x, d, k;
-    tt_result result;
+    for (x = 1; x < S - 1; x++) {
+        int depth = tt__plan_depth_at(plan, depth_base + (size_t)x);
+        int last = tt__min_i(depth + s->feather, S - 1);
+        for (d = 0; d <= last; d++) {
+            float alpha = tt__band_alpha(S, s->feather, depth, x, d), premultiplied[4];
+            const float *band;
+            int tx, ty;
+            if (alpha <= 0.0f) continue;
+            band = tt__edge_sample(s, type, x, d);
+            for (k = 0; k < 3; k++) premultiplied[k] = band[k] * alpha;
+            premultiplied[3] = alpha;
+            tt__side_to_tile(s, side, x, d, &tx, &ty);
+            tt_rgba_over(tt__synth_texel(s, tx, ty), premultiplied);
+        }
+    }
+}
+
+/* Planning: the depth of side `side`'s band in every column. It follows a
+   minimum-error cut against what lies beneath (the paper's f4: "once colour
+   values of two image layers become similar, the foreground becomes
+   transparent"), kept inside the side's wedge (the triangle between the
+   tile's diagonals, the paper's f1..f3 keeping it off the other sides) and
+   between min_depth and max_depth. cost has S * (max_depth + 1) floats; lo,
+   hi and cut S ints each. */
+static tt_result tt__band_depths(const tt__synth *s, int side, int type, int min_depth, int max_depth, float *cost,
+                                 int *lo, int *hi, int *cut, const tt_allocator *allocator, tt_error *error)
+{
+    const int S = s->size, rows = max_depth + 1;
+    int x, d, k;
     for (d = 0; d < rows; d++)
         for (x = 0; x < S; x++) {
             int tx, ty;
@@ -3767,65 +3987,73 @@ static tt_result tt__lay_band(tt__synth *s, int side, int type, const tt_allocat
             const float *below;
             float err = 0.0f;
             tt__side_to_tile(s, side, x, d, &tx, &ty);
-            below = s->tile + ((size_t)ty * S + tx) * 4;
+            below = tt__synth_texel(s, tx, ty);
             for (k = 0; k < 3; k++) err += (band[k] - below[k]) * (band[k] - below[k]);
-            s->cost[(size_t)d * S + x] = err;
+            cost[(size_t)d * S + x] = err;
         }
-    for (x = 0; x < S; x++) {
-        int wedge = tt__min_i(x, S - 1 - x);   /* rows strictly inside this side's wedge */
-        s->hi[x] = tt__min_i(wedge, s->max_depth);
-        s->lo[x] = tt__min_i(s->min_depth, s->hi[x]);
-    }
-    result = tt_min_error_cut(s->cost, S, rows, s->lo, s->hi, allocator, s->cut, error);
-    if (result != TT_OK) return result;
     for (x = 0; x < S; x++) {
         int wedge = tt__min_i(x, S - 1 - x);
-        int last = tt__min_i(s->cut[x] + s->feather, S - 1);
-        for (d = 0; d <= last; d++) {
-            float alpha, premultiplied[4];
-            const float *band;
-            int tx, ty;
-            if (x == 0 || x == S - 1) break;    /* corner columns belong to the neighbouring sides */
-            if (d == 0) {
-                alpha = 1.0f;                  /* the edge row is the edge sample, exactly */
-            } else {
-                float a_cut = tt__clamp_f(((float)s->cut[x] - (float)d - 0.5f) / feather + 0.5f, 0.0f, 1.0f);
-                float a_wedge = tt__clamp_f(((float)wedge - (float)d - 0.5f) / wedge_feather + 0.5f, 0.0f, 1.0f);
-                alpha = a_cut * a_wedge;
-            }
-            if (alpha <= 0.0f) continue;
-            band = tt__edge_sample(s, type, x, d);
-            for (k = 0; k < 3; k++) premultiplied[k] = band[k] * alpha;
-            premultiplied[3] = alpha;
-            tt__side_to_tile(s, side, x, d, &tx, &ty);
-            tt_rgba_over(s->tile + ((size_t)ty * S + tx) * 4, premultiplied);
-        }
+        hi[x] = tt__min_i(wedge, max_depth);
+        lo[x] = tt__min_i(min_depth, hi[x]);
     }
-    return TT_OK;
+    return tt_min_error_cut(cost, S, rows, lo, hi, allocator, cut, error);
 }
 
-/* Copy a composed tile and its gutter into its atlas cell. The gutter strip
-   outside each side holds the edge sample continued across the edge (d < 0),
-   i.e. the first rows of whichever tile lies across that edge on the surface;
-   the g x g corner squares repeat the nearest tile texel. */
-static void tt__write_cell(const tt__synth *s, const uint8_t types[4], tt_image *atlas, int cell_x, int cell_y)
+/* Applying: compose tile `tile` (types e0..e3) from `source` with the plan's
+   windows and masks into the C x C cell whose top-left texel is at `cell`
+   (`stride` floats per row): background, the four bands, the corner texels,
+   then the gutters. Checks nothing: the callers have. */
+static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, const uint8_t types[4], int tile,
+                             float *cell, size_t stride)
 {
-    const int S = s->size, g = s->gutter, C = S + 2 * g;
-    int x, y, side, d;
-    for (y = 0; y < C; y++)
+    const int S = plan->layout.tile_size, g = plan->layout.gutter, C = S + 2 * g;
+    tt__synth s;
+    int side, k, x, y, d;
+    s.source = source;
+    s.windows = plan->edge_windows;
+    s.size = S;
+    s.gutter = g;
+    s.feather = plan->feather;
+    s.stride = stride;
+    s.tile = cell + (size_t)g * stride + (size_t)g * 4;
+    tt__copy_background(&s, &plan->background_windows[tile]);
+    /* ABCD = AXXX over XBXX over XXCX over XXXD over XXXX: lay D first. */
+    for (side = 3; side >= 0; side--)
+        tt__lay_band(&s, plan, (4 * (size_t)tile + (size_t)side) * (size_t)S, side, types[side]);
+    /* A corner texel lies on two sides' edge rows, and whatever meets it
+       around a mesh vertex differs from tile to tile: the mean of the two
+       edge samples there matches each neighbour across an edge halfway. */
+    for (side = 0; side < 4; side++) {
+        const float *a = tt__edge_sample(&s, types[side], 0, 0);
+        const float *b = tt__edge_sample(&s, types[(side + 3) % 4], S - 1, 0);
+        int tx, ty;
+        float *corner;
+        tt__side_to_tile(&s, side, 0, 0, &tx, &ty);
+        corner = tt__synth_texel(&s, tx, ty);
+        for (k = 0; k < 3; k++) corner[k] = 0.5f * (a[k] + b[k]);
+    }
+    if (g == 0) return;
+    /* Gutters. The strip outside each side holds the edge sample continued
+       across the edge (d < 0), i.e. the first rows of whichever tile lies
+       across that edge on the surface; the g x g corner squares repeat the
+       nearest tile texel. */
+    for (y = 0; y < C; y++) {
+        if (y >= g && y < g + S) continue;
         for (x = 0; x < C; x++) {
-            int tx = tt__clamp_i(x - g, 0, S - 1), ty = tt__clamp_i(y - g, 0, S - 1);
-            float *out = atlas->pixels + ((size_t)(cell_y + y) * atlas->width + cell_x + x) * 4;
-            memcpy(out, s->tile + ((size_t)ty * S + tx) * 4, 4 * sizeof(float));
+            if (x >= g && x < g + S) continue;
+            memcpy(cell + (size_t)y * stride + (size_t)x * 4,
+                   tt__synth_texel(&s, tt__clamp_i(x - g, 0, S - 1), tt__clamp_i(y - g, 0, S - 1)),
+                   4 * sizeof(float));
         }
+    }
     for (side = 0; side < 4; side++)
         for (d = -g; d < 0; d++)
             for (x = 0; x < S; x++) {
                 int tx, ty;
                 float *out;
-                tt__side_to_tile(s, side, x, d, &tx, &ty);
-                out = atlas->pixels + ((size_t)(cell_y + g + ty) * atlas->width + cell_x + g + tx) * 4;
-                memcpy(out, tt__edge_sample(s, types[side], x, d), 3 * sizeof(float));
+                tt__side_to_tile(&s, side, x, d, &tx, &ty);
+                out = tt__synth_texel(&s, tx, ty);
+                memcpy(out, tt__edge_sample(&s, types[side], x, d), 3 * sizeof(float));
                 out[3] = 1.0f;
             }
 }
@@ -3968,150 +4196,403 @@ static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int siz
     }
 }
 
-TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
-                                    const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error)
+/* Progress of step `done` of `total` within [from, to] of the caller's
+   0..1; non-zero when the callback asks to stop. */
+static int tt__synth_report(tt_progress_fn progress, void *user_data, float from, float to, int done, int total)
+{
+    return progress && progress(from + (to - from) * ((float)done / (float)total), user_data);
+}
+
+/* Share of tt_synthesize_tiles's progress that planning takes. */
+#define TT__PLAN_SHARE 0.5f
+
+static int tt__rect_fits(const tt_rect *r, int w, int h, int width, int height)
+{
+    return r->x >= 0 && r->y >= 0 && r->x <= width - w && r->y <= height - h;
+}
+
+/* A plan as tt_synth_plan_create makes it (it is a public struct: a caller
+   may have changed it): every figure the composing relies on, so that a bad
+   plan is an error and never a read outside an image. Windows are checked by
+   the callers (all of them, or those of one tile). */
+static tt_result tt__check_plan(const tt_synth_plan *plan, tt_error *error)
+{
+    tt_tile_layout resolved;
+    int S = plan->layout.tile_size;
+    if (tt_tile_layout_resolve(&plan->layout, &resolved, NULL) != TT_OK || resolved.colors != plan->layout.colors ||
+        resolved.tile_size != S || resolved.gutter != plan->layout.gutter || plan->feather < 1 ||
+        plan->feather > S / 4 + 1 || plan->max_depth != tt__max_i(1, S / 4) || plan->source_width < S ||
+        plan->source_height < 2 * S || plan->source_width > TT_MAX_IMAGE_SIZE ||
+        plan->source_height > TT_MAX_IMAGE_SIZE || !plan->edge_windows || !plan->background_windows ||
+        (plan->max_depth <= 255 ? !plan->depth8 : !plan->depth16))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the plan is not one tt_synth_plan_create made (its layout, feather, depths or source size "
+                        "have been changed)");
+    return TT_OK;
+}
+
+static tt_result tt__check_plan_source(const tt_synth_plan *plan, const tt_image *source, tt_error *error)
+{
+    if (!source->pixels || source->width != plan->source_width || source->height != plan->source_height)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the source image is %dx%d, but the plan was made for a %dx%d image", source->width,
+                        source->height, plan->source_width, plan->source_height);
+    return TT_OK;
+}
+
+static tt_result tt__bad_plan_window(tt_error *error, const char *which, int index)
+{
+    return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, index, -1, -1,
+                       "the plan's %s window %d does not lie inside its source size (the plan has been changed)",
+                       which, index);
+}
+
+static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_options *options,
+                                       const tt_allocator *allocator, tt_synth_plan **out_plan, tt_error *error,
+                                       const char *what, float progress_from, float progress_to)
 {
     tt_synth_options defaults;
     const tt_synth_options *opt = options;
-    tt_tileset *set = NULL;
+    tt_synth_plan *plan = NULL;
     tt__synth s;
     tt_tile_layout layout;
     tt_rect region;
     tt_rng rng;
     tt_result result;
-    int S, g, C, T, W, ntiles, t, k, side;
+    float *scratch = NULL, *cost = NULL;
+    int *lo = NULL, *hi = NULL, *cut = NULL;
+    int S, g, T, n, ntiles, feather, min_depth, max_depth, depth_size, t, k, side;
+    unsigned long long head, edge_bytes, background_bytes, depth_count, bytes;
 
     tt__ok(error);
-    if (!out_tileset) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_tileset is NULL");
-    *out_tileset = NULL;
+    if (!out_plan) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the output pointer is NULL");
+    *out_plan = NULL;
     if (!opt) {
         memset(&defaults, 0, sizeof defaults);
         opt = &defaults;
     }
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (!source || !source->pixels || source->width <= 0 || source->height <= 0)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is empty");
-    if ((result = tt__check_finite_texels(source, "source image", error)) != TT_OK) return result;
+    if (!guide || !guide->pixels || guide->width <= 0 || guide->height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the %s is empty", what);
+    if ((result = tt__check_finite_texels(guide, what, error)) != TT_OK) return result;
     if ((result = tt_tile_layout_resolve(&opt->layout, &layout, error)) != TT_OK) return result;
     S = layout.tile_size;
     g = layout.gutter;
-    C = S + 2 * g;
+    n = layout.colors;
     T = tt_tile_layout_tiles_per_side(&layout);
-    W = T * C;
-    ntiles = T * T;
-    if (source->width < S || source->height < 2 * S)
+    ntiles = T * T;   /* T <= TT_MAX_IMAGE_SIZE / 4 once resolved: fits an int */
+    if (guide->width < S || guide->height < 2 * S)
         return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
-                        "the source image is %dx%d, but %d-texel tiles need an edge window of %dx%d "
+                        "the %s is %dx%d, but %d-texel tiles need an edge window of %dx%d "
                         "(use a tile size of at most %d)",
-                        source->width, source->height, S, S, 2 * S,
-                        tt__min_i(source->width, source->height / 2));
-
-    memset(&s, 0, sizeof s);
-    s.source = source;
-    s.n = layout.colors;
-    s.size = S;
-    s.gutter = g;
+                        what, guide->width, guide->height, S, S, 2 * S, tt__min_i(guide->width, guide->height / 2));
     if (opt->feather < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "feather %d is negative", opt->feather);
-    s.feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
-    if (s.feather > S / 4 + 1)
+    feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
+    if (feather > S / 4 + 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "feather %d is too wide for %d-texel tiles (at most %d)", s.feather, S, S / 4 + 1);
+                        "feather %d is too wide for %d-texel tiles (at most %d)", feather, S, S / 4 + 1);
     /* Every edge of a type shows the same band, so a deep band repeats
        visibly across the surface: bands go no deeper than the cut needs. At
        least past the gutter's depth plus half the feather (so the rows a
        neighbour's gutter copies are the sample alone), at most S/4 (so most
        of each tile is its own background). */
-    s.max_depth = tt__max_i(1, S / 4);
-    s.min_depth = tt__min_i(tt__max_i(2, g + s.feather / 2 + 1), s.max_depth);
+    max_depth = tt__max_i(1, S / 4);
+    min_depth = tt__min_i(tt__max_i(2, g + feather / 2 + 1), max_depth);
 
     region = opt->background;
     if (region.x == 0 && region.y == 0 && region.w == 0 && region.h == 0) {
-        region.w = source->width;
-        region.h = source->height;
+        region.w = guide->width;
+        region.h = guide->height;
     }
     if (region.x < 0 || region.y < 0 || region.w < S || region.h < S ||
-        region.x > source->width - region.w || region.y > source->height - region.h)
+        region.x > guide->width - region.w || region.y > guide->height - region.h)
         return tt__fail(error, region.w < S || region.h < S ? TT_ERROR_IMAGE_TOO_SMALL : TT_ERROR_INVALID_ARGUMENT,
                         -1, -1, -1, -1,
                         "the background region %d,%d %dx%d must lie inside the %dx%d image and hold a %dx%d tile",
-                        region.x, region.y, region.w, region.h, source->width, source->height, S, S);
+                        region.x, region.y, region.w, region.h, guide->width, guide->height, S, S);
+    if (opt->edge_windows)
+        for (k = 0; k < n; k++)
+            if (!tt__rect_fits(&opt->edge_windows[k], S, 2 * S, guide->width, guide->height))
+                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                                   "edge window %d at %d,%d does not fit: it needs %dx%d texels inside the %dx%d "
+                                   "image", k, opt->edge_windows[k].x, opt->edge_windows[k].y, S, 2 * S,
+                                   guide->width, guide->height);
+
+    /* One block: the struct, the edge windows, the background windows, the
+       depths (each part a multiple of 16 bytes long but the last). */
+    depth_size = max_depth <= 255 ? 1 : 2;
+    head = (sizeof(tt_synth_plan) + 15u) / 16u * 16u;
+    edge_bytes = (unsigned long long)n * sizeof(tt_rect);
+    background_bytes = (unsigned long long)ntiles * sizeof(tt_rect);
+    depth_count = 4ull * (unsigned long long)S * (unsigned long long)ntiles;
+    bytes = head + edge_bytes + background_bytes + depth_count * (unsigned long long)depth_size;
+    if (bytes > (unsigned long long)(size_t)-1)
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "a plan of %d tiles of %d texels needs more memory than this machine can address", ntiles,
+                        S);
+    plan = (tt_synth_plan *)tt__alloc(allocator, (size_t)bytes);
+    scratch = TT__ALLOC(allocator, float, (size_t)S * S * 4);
+    cost = TT__ALLOC(allocator, float, (size_t)S * (max_depth + 1));
+    lo = TT__ALLOC(allocator, int, S);
+    hi = TT__ALLOC(allocator, int, S);
+    cut = TT__ALLOC(allocator, int, S);
+    if (!plan || !scratch || !cost || !lo || !hi || !cut) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+        goto done;
+    }
+    memset(plan, 0, sizeof *plan);
+    plan->layout = layout;
+    plan->source_width = guide->width;
+    plan->source_height = guide->height;
+    plan->feather = feather;
+    plan->max_depth = max_depth;
+    plan->edge_windows = (tt_rect *)(void *)((unsigned char *)plan + head);
+    plan->background_windows = (tt_rect *)(void *)((unsigned char *)plan + head + edge_bytes);
+    if (depth_size == 1) plan->depth8 = (uint8_t *)plan + head + edge_bytes + background_bytes;
+    else plan->depth16 = (uint16_t *)(void *)((unsigned char *)plan + head + edge_bytes + background_bytes);
+    plan->progress = opt->progress;
+    plan->progress_user_data = opt->progress_user_data;
+    plan->allocator = tt__allocator_copy(allocator);
+
+    tt_rng_seed(&rng, opt->seed, 0x74696c6573ull /* "tiles" */);
+    if (opt->edge_windows) {
+        for (k = 0; k < n; k++) {
+            plan->edge_windows[k] = opt->edge_windows[k];
+            plan->edge_windows[k].w = S;
+            plan->edge_windows[k].h = 2 * S;
+        }
+    } else {
+        tt__choose_edge_windows(&rng, guide, S, n, plan->edge_windows);
+    }
+
+    s.source = guide;
+    s.windows = plan->edge_windows;
+    s.size = S;
+    s.gutter = g;
+    s.feather = feather;
+    s.tile = scratch;
+    s.stride = (size_t)S * 4;
+    for (t = 0; t < ntiles; t++) {
+        int column = t % T, row = t / T, base = 2 * n, x;
+        uint8_t types[4];
+        tt_rect *bg = &plan->background_windows[t];
+        types[0] = (uint8_t)(column / base);
+        types[1] = (uint8_t)(column % base);
+        types[2] = (uint8_t)(row / base);
+        types[3] = (uint8_t)(row % base);
+        /* XXXX: a fresh background window per tile gives the aperiodicity. */
+        bg->x = region.x + (int)tt_rng_below(&rng, (uint32_t)(region.w - S + 1));
+        bg->y = region.y + (int)tt_rng_below(&rng, (uint32_t)(region.h - S + 1));
+        bg->w = bg->h = S;
+        tt__copy_background(&s, bg);
+        /* Each band's cut is against what the bands laid before it left
+           (D first); the last band (A) covers nothing that is cut later. */
+        for (side = 3; side >= 0; side--) {
+            size_t depth_base = (4 * (size_t)t + (size_t)side) * (size_t)S;
+            result = tt__band_depths(&s, side, types[side], min_depth, max_depth, cost, lo, hi, cut, allocator, error);
+            if (result != TT_OK) goto done;
+            for (x = 0; x < S; x++) {
+                if (plan->depth8) plan->depth8[depth_base + (size_t)x] = (uint8_t)cut[x];
+                else plan->depth16[depth_base + (size_t)x] = (uint16_t)cut[x];
+            }
+            if (side > 0) tt__lay_band(&s, plan, depth_base, side, types[side]);
+        }
+        if (tt__synth_report(opt->progress, opt->progress_user_data, progress_from, progress_to, t + 1, ntiles)) {
+            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "tile synthesis was cancelled");
+            goto done;
+        }
+    }
+    result = TT_OK;
+
+done:
+    tt__free(allocator, scratch);
+    tt__free(allocator, cost);
+    tt__free(allocator, lo);
+    tt__free(allocator, hi);
+    tt__free(allocator, cut);
+    if (result != TT_OK) {
+        tt__free(allocator, plan);
+        return result;
+    }
+    *out_plan = plan;
+    return TT_OK;
+}
+
+TTDEF tt_result tt_synth_plan_create(const tt_image *guide, const tt_synth_options *options,
+                                     const tt_allocator *allocator, tt_synth_plan **out_plan, tt_error *error)
+{
+    return tt__synth_plan_create(guide, options, allocator, out_plan, error, "guide image", 0.0f, 1.0f);
+}
+
+TTDEF void tt_synth_plan_free(tt_synth_plan *plan)
+{
+    tt_allocator allocator;
+    if (!plan) return;
+    allocator = plan->allocator;
+    tt__free(&allocator, plan);
+}
+
+TTDEF int tt_synth_plan_depth(const tt_synth_plan *plan, int tile, int side, int x)
+{
+    int S;
+    TT_ASSERT(plan && (plan->depth8 || plan->depth16));
+    if (!plan || (!plan->depth8 && !plan->depth16)) return 0;
+    S = plan->layout.tile_size;
+    TT_ASSERT(tile >= 0 && tile < tt_tile_layout_tile_count(&plan->layout) && side >= 0 && side < 4 && x >= 0 &&
+              x < S);
+    if (tile < 0 || tile >= tt_tile_layout_tile_count(&plan->layout) || side < 0 || side > 3 || x < 0 || x >= S)
+        return 0;
+    return tt__plan_depth_at(plan, (4 * (size_t)tile + (size_t)side) * (size_t)S + (size_t)x);
+}
+
+TTDEF float tt_synth_plan_band_alpha(const tt_synth_plan *plan, int tile, int side, int x, int d)
+{
+    TT_ASSERT(plan && d >= 0 && d < plan->layout.tile_size);
+    if (!plan) return 0.0f;
+    return tt__band_alpha(plan->layout.tile_size, plan->feather, tt_synth_plan_depth(plan, tile, side, x), x, d);
+}
+
+/* A compose_tile whose cell came out non-finite: name the source texel that
+   reached it. The tile reads its background window and, per side, its edge
+   sample from g rows across the edge to max_depth + feather rows in. */
+static tt_result tt__compose_non_finite(const tt_synth_plan *plan, const tt_image *source, const uint8_t types[4],
+                                        int tile, int cell_x, int cell_y, tt_error *error)
+{
+    const int S = plan->layout.tile_size, g = plan->layout.gutter;
+    const int deepest = tt__min_i(plan->max_depth + plan->feather, S - 1);
+    const tt_rect *bg = &plan->background_windows[tile];
+    const float *bad = NULL;
+    tt__synth s;
+    int x, y, d, side;
+    s.source = source;
+    s.windows = plan->edge_windows;
+    s.size = S;
+    for (y = 0; y < S && !bad; y++)
+        for (x = 0; x < S && !bad; x++) {
+            const float *p = source->pixels + ((size_t)(bg->y + y) * source->width + bg->x + x) * 4;
+            if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2])) bad = p;
+        }
+    for (side = 0; side < 4 && !bad; side++)
+        for (d = -g; d <= deepest && !bad; d++)
+            for (x = 0; x < S && !bad; x++) {
+                const float *p = tt__edge_sample(&s, types[side], x, d);
+                if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2])) bad = p;
+            }
+    if (bad) {
+        size_t texel = (size_t)(bad - source->pixels) / 4;
+        int sx = (int)(texel % (size_t)source->width), sy = (int)(texel / (size_t)source->width);
+        return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, sy, sx,
+                           "the source image has a non-finite value at texel %d, %d, which tile %d reads", sx, sy,
+                           tile);
+    }
+    return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, -1, -1,
+                       "tile %d composed at %d, %d came out non-finite", tile, cell_x, cell_y);
+}
+
+TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image *source, const uint8_t types[4],
+                                      tt_image *target, int x, int y, tt_error *error)
+{
+    tt_result result;
+    int S, C, base, side, tile, row;
+    tt__ok(error);
+    if (!plan || !source || !types || !target)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_synth_compose_tile needs a plan, a source, types and a target (got NULL)");
+    if ((result = tt__check_plan(plan, error)) != TT_OK) return result;
+    if ((result = tt__check_plan_source(plan, source, error)) != TT_OK) return result;
+    if (!target->pixels || target->width <= 0 || target->height <= 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the target image is empty");
+    base = 2 * plan->layout.colors;
+    for (side = 0; side < 4; side++)
+        if (types[side] >= base)
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, side, -1, -1,
+                               "side %d has boundary type %d, but %d colors allow 0..%d", side, types[side],
+                               plan->layout.colors, base - 1);
+    S = plan->layout.tile_size;
+    C = S + 2 * plan->layout.gutter;
+    if (x < 0 || y < 0 || x > target->width - C || y > target->height - C)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "a %dx%d cell at %d, %d does not lie inside the %dx%d target", C, C, x, y, target->width,
+                        target->height);
+    tile = tt_tile_index(&plan->layout, types);
+    if (!tt__rect_fits(&plan->background_windows[tile], S, S, source->width, source->height))
+        return tt__bad_plan_window(error, "background", tile);
+    for (side = 0; side < 4; side++)
+        if (!tt__rect_fits(&plan->edge_windows[types[side] >> 1], S, 2 * S, source->width, source->height))
+            return tt__bad_plan_window(error, "edge", types[side] >> 1);
+    tt__compose_cell(plan, source, types, tile, target->pixels + ((size_t)y * target->width + (size_t)x) * 4,
+                     (size_t)target->width * 4);
+    for (row = 0; row < C; row++) {
+        const float *p = target->pixels + ((size_t)(y + row) * target->width + (size_t)x) * 4;
+        int i;
+        for (i = 0; i < 4 * C; i++)
+            if (!tt__is_finite(p[i])) return tt__compose_non_finite(plan, source, types, tile, x, y, error);
+    }
+    return TT_OK;
+}
+
+static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *source, const tt_allocator *allocator,
+                                 tt_tileset **out, tt_error *error, int check_source, float progress_from,
+                                 float progress_to)
+{
+    tt_tileset *set = NULL;
+    tt_result result;
+    int S, g, C, T, W, n, ntiles, t, k;
+
+    tt__ok(error);
+    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the output pointer is NULL");
+    *out = NULL;
+    if (!plan || !source)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_synth_apply needs a plan and a source image (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__check_plan(plan, error)) != TT_OK) return result;
+    if ((result = tt__check_plan_source(plan, source, error)) != TT_OK) return result;
+    if (check_source && (result = tt__check_finite_texels(source, "source image", error)) != TT_OK) return result;
+    S = plan->layout.tile_size;
+    g = plan->layout.gutter;
+    n = plan->layout.colors;
+    C = S + 2 * g;
+    T = tt_tile_layout_tiles_per_side(&plan->layout);
+    W = T * C;
+    ntiles = T * T;
+    for (k = 0; k < n; k++)
+        if (!tt__rect_fits(&plan->edge_windows[k], S, 2 * S, source->width, source->height))
+            return tt__bad_plan_window(error, "edge", k);
+    for (t = 0; t < ntiles; t++)
+        if (!tt__rect_fits(&plan->background_windows[t], S, S, source->width, source->height))
+            return tt__bad_plan_window(error, "background", t);
 
     set = TT__ALLOC(allocator, tt_tileset, 1);
     if (!set) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     memset(set, 0, sizeof *set);
     set->allocator = tt__allocator_copy(allocator);
-    set->layout = layout;
-    set->edge_windows = TT__ALLOC(allocator, tt_rect, s.n);
+    set->layout = plan->layout;
+    set->edge_windows = TT__ALLOC(allocator, tt_rect, n);
     set->background_windows = TT__ALLOC(allocator, tt_rect, ntiles);
-    s.tile = TT__ALLOC(allocator, float, (size_t)S * S * 4);
-    s.cost = TT__ALLOC(allocator, float, (size_t)S * (s.max_depth + 1));
-    s.lo = TT__ALLOC(allocator, int, S);
-    s.hi = TT__ALLOC(allocator, int, S);
-    s.cut = TT__ALLOC(allocator, int, S);
-    if (!set->edge_windows || !set->background_windows || !s.tile || !s.cost || !s.lo || !s.hi || !s.cut) {
+    if (!set->edge_windows || !set->background_windows) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
         goto done;
     }
+    memcpy(set->edge_windows, plan->edge_windows, (size_t)n * sizeof(tt_rect));
+    memcpy(set->background_windows, plan->background_windows, (size_t)ntiles * sizeof(tt_rect));
     if ((result = tt__image_init(&set->levels[0], W, W, allocator, error)) != TT_OK) goto done;
     set->nlevels = 1;
 
-    tt_rng_seed(&rng, opt->seed, 0x74696c6573ull /* "tiles" */);
-    if (opt->edge_windows) {
-        for (k = 0; k < s.n; k++) {
-            tt_rect r = opt->edge_windows[k];
-            if (r.x < 0 || r.y < 0 || r.x > source->width - S || r.y > source->height - 2 * S) {
-                result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                                  "edge window %d at %d,%d does not fit: it needs %dx%d texels inside the %dx%d "
-                                  "image", k, r.x, r.y, S, 2 * S, source->width, source->height);
-                goto done;
-            }
-            r.w = S;
-            r.h = 2 * S;
-            set->edge_windows[k] = r;
-        }
-    } else {
-        tt__choose_edge_windows(&rng, source, S, s.n, set->edge_windows);
-    }
-    s.windows = set->edge_windows;
-
     for (t = 0; t < ntiles; t++) {
-        int column = t % T, row = t / T, base = 2 * s.n, x, y;
+        int column = t % T, row = t / T, base = 2 * n;
         uint8_t types[4];
-        tt_rect *bg = &set->background_windows[t];
+        tt_image *atlas = &set->levels[0];
         types[0] = (uint8_t)(column / base);
         types[1] = (uint8_t)(column % base);
         types[2] = (uint8_t)(row / base);
         types[3] = (uint8_t)(row % base);
-
-        /* XXXX: a fresh background window per tile gives the aperiodicity. */
-        bg->x = region.x + (int)tt_rng_below(&rng, (uint32_t)(region.w - S + 1));
-        bg->y = region.y + (int)tt_rng_below(&rng, (uint32_t)(region.h - S + 1));
-        bg->w = bg->h = S;
-        for (y = 0; y < S; y++)
-            for (x = 0; x < S; x++) {
-                const float *p = source->pixels + ((size_t)(bg->y + y) * source->width + bg->x + x) * 4;
-                float *q = s.tile + ((size_t)y * S + x) * 4;
-                q[0] = p[0]; q[1] = p[1]; q[2] = p[2]; q[3] = 1.0f;
-            }
-        /* ABCD = AXXX over XBXX over XXCX over XXXD over XXXX: lay D first. */
-        for (side = 3; side >= 0; side--)
-            if ((result = tt__lay_band(&s, side, types[side], allocator, error)) != TT_OK) goto done;
-        /* A corner texel lies on two sides' edge rows, and whatever meets it
-           around a mesh vertex differs from tile to tile: the mean of the two
-           edge samples there matches each neighbour across an edge halfway. */
-        for (side = 0; side < 4; side++) {
-            const float *a = tt__edge_sample(&s, types[side], 0, 0);
-            const float *b = tt__edge_sample(&s, types[(side + 3) % 4], S - 1, 0);
-            int tx, ty;
-            float *corner;
-            tt__side_to_tile(&s, side, 0, 0, &tx, &ty);
-            corner = s.tile + ((size_t)ty * S + tx) * 4;
-            for (k = 0; k < 3; k++) corner[k] = 0.5f * (a[k] + b[k]);
-        }
         /* Tile row 0 of the formula is at the bottom of the atlas image. */
-        tt__write_cell(&s, types, &set->levels[0], column * C, (T - 1 - row) * C);
-        if (opt->progress && opt->progress((float)(t + 1) / (float)ntiles, opt->progress_user_data)) {
+        tt__compose_cell(plan, source, types, t,
+                         atlas->pixels + ((size_t)(T - 1 - row) * C * (size_t)W + (size_t)column * C) * 4,
+                         (size_t)W * 4);
+        if (tt__synth_report(plan->progress, plan->progress_user_data, progress_from, progress_to, t + 1, ntiles)) {
             result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "tile synthesis was cancelled");
             goto done;
         }
@@ -4132,17 +4613,34 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
     result = TT_OK;
 
 done:
-    tt__free(allocator, s.tile);
-    tt__free(allocator, s.cost);
-    tt__free(allocator, s.lo);
-    tt__free(allocator, s.hi);
-    tt__free(allocator, s.cut);
     if (result != TT_OK) {
         tt_tileset_free(set);
         return result;
     }
-    *out_tileset = set;
+    *out = set;
     return TT_OK;
+}
+
+TTDEF tt_result tt_synth_apply(const tt_synth_plan *plan, const tt_image *source, const tt_allocator *allocator,
+                               tt_tileset **out, tt_error *error)
+{
+    return tt__synth_apply(plan, source, allocator, out, error, 1, 0.0f, 1.0f);
+}
+
+TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
+                                    const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error)
+{
+    tt_synth_plan *plan;
+    tt_result result;
+    tt__ok(error);
+    if (!out_tileset) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_tileset is NULL");
+    *out_tileset = NULL;
+    result = tt__synth_plan_create(source, options, allocator, &plan, error, "source image", 0.0f, TT__PLAN_SHARE);
+    if (result != TT_OK) return result;
+    /* The plan checked the source (size, finite texels) already. */
+    result = tt__synth_apply(plan, source, allocator, out_tileset, error, 0, TT__PLAN_SHARE, 1.0f);
+    tt_synth_plan_free(plan);
+    return result;
 }
 
 /* --- quality report ------------------------------------------------------ */

@@ -139,6 +139,22 @@ int main(void)
         EXPECT(tt_measure_seams(quads, uv, &tiles->levels[0], NULL, NULL, &report, &err) == TT_OK);
         tt_tileset_free(tiles);
     }
+    {
+        /* 6. The same synthesis as a plan applied to an image, and one tile. */
+        tt_synth_plan *plan = NULL;
+        tt_tileset *again = NULL;
+        EXPECT(tt_synth_plan_create(image, &options, NULL, &plan, &err) == TT_OK);
+        if (plan) {
+            EXPECT(tt_synth_plan_depth(plan, 0, 0, 3) >= 0);
+            EXPECT(tt_synth_plan_band_alpha(plan, 0, 0, 3, 0) == 1.0f);
+            EXPECT(tt_synth_apply(plan, image, NULL, &again, &err) == TT_OK && again);
+            if (again) {
+                EXPECT(tt_synth_compose_tile(plan, image, types, &again->levels[0], 0, 0, &err) == TT_OK);
+                tt_tileset_free(again);
+            }
+            tt_synth_plan_free(plan);
+        }
+    }
 
     free(types);
     free(uv);

@@ -361,6 +361,7 @@ int main(void)
     run_numerics_tests();
     run_raster_tests();
     run_tiled_tests();
+    run_tiled_synthesis_tests();
     run_lapped_tests();
     printf("%d passed, %d failed\n", g_passed, g_failed);
     return g_failed ? 1 : 0;

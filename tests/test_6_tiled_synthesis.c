@@ -1,0 +1,934 @@
+/* tests/test_6_tiled_synthesis.c - unit tests for section 6 of tiledtex.h,
+   tile-set synthesis as a plan and its application: tt_synth_plan_create,
+   tt_synth_apply, tt_synth_compose_tile, the plan's depths and masks, and
+   tt_synthesize_tiles (bit-identical to the algorithm before the split).
+   Run by run_tiled_synthesis_tests(). Uses CHECK / RUN, make_allocator and
+   oom_reset / oom_sweep from test_common.h and nothing else of it; its
+   images are made here. */
+#include "test_common.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void run_tiled_synthesis_tests(void);
+
+/* ------------------------------------------------------------------------ */
+/* Images                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/* Integer hash lattice and bilinear value noise using only + - * / on
+   floats, so the image is the same bits on every IEEE machine and compiler
+   (the hashes below depend on it). */
+static uint32_t sy_hash(uint32_t x, uint32_t y, uint32_t s)
+{
+    uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ s * 0xcb1ab31fu;
+    h ^= h >> 13;
+    h *= 0x85ebca6bu;
+    h ^= h >> 16;
+    h *= 0xc2b2ae35u;
+    h ^= h >> 15;
+    return h;
+}
+
+static float sy_lattice(int x, int y, uint32_t s)
+{
+    return (float)(sy_hash((uint32_t)x, (uint32_t)y, s) >> 8) / 16777216.0f;
+}
+
+static float sy_value_noise(int x, int y, int scale, uint32_t s)
+{
+    int cx = x / scale, cy = y / scale;
+    float fx = (float)(x % scale) / (float)scale, fy = (float)(y % scale) / (float)scale;
+    float a = sy_lattice(cx, cy, s), b = sy_lattice(cx + 1, cy, s);
+    float c = sy_lattice(cx, cy + 1, s), d = sy_lattice(cx + 1, cy + 1, s);
+    float top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+    return top + (bottom - top) * fy;
+}
+
+/* A w x h photograph-like image (noise at 7 and 19 texels plus grain, opaque). */
+static tt_image *sy_noise(int w, int h, uint32_t seed)
+{
+    tt_image *im = NULL;
+    int x, y, k;
+    if (tt_image_create(w, h, NULL, &im, NULL) != TT_OK) return NULL;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *p = im->pixels + ((size_t)y * w + x) * 4;
+            for (k = 0; k < 3; k++) {
+                uint32_t s = seed * 4u + (uint32_t)k;
+                p[k] = 0.45f * sy_value_noise(x, y, 7, s) + 0.35f * sy_value_noise(x, y, 19, s + 100u) +
+                       0.2f * sy_lattice(x, y, s + 200u);
+            }
+            p[3] = 1.0f;
+        }
+    return im;
+}
+
+static tt_image *sy_copy(const tt_image *src)
+{
+    tt_image *im = NULL;
+    if (tt_image_create(src->width, src->height, NULL, &im, NULL) != TT_OK) return NULL;
+    memcpy(im->pixels, src->pixels, (size_t)src->width * src->height * 4 * sizeof(float));
+    return im;
+}
+
+static float *sy_px(const tt_image *im, int x, int y) { return im->pixels + ((size_t)y * im->width + x) * 4; }
+
+static size_t sy_floats(const tt_image *im) { return (size_t)im->width * (size_t)im->height * 4; }
+
+/* FNV-1a over the IEEE bits of every float, least significant byte first
+   (the bytes of a little-endian machine, on any machine). */
+static uint64_t sy_hash_image(uint64_t h, const tt_image *im)
+{
+    size_t i, n = sy_floats(im);
+    for (i = 0; i < n; i++) {
+        uint32_t bits;
+        int b;
+        memcpy(&bits, &im->pixels[i], sizeof bits);
+        for (b = 0; b < 4; b++) {
+            h ^= (bits >> (8 * b)) & 0xffu;
+            h *= 1099511628211ull;
+        }
+    }
+    return h;
+}
+
+static int sy_same_levels(const tt_tileset *a, const tt_tileset *b)
+{
+    int l;
+    if (a->nlevels != b->nlevels || a->seamless_levels != b->seamless_levels) return 0;
+    for (l = 0; l < a->nlevels; l++)
+        if (a->levels[l].width != b->levels[l].width || a->levels[l].height != b->levels[l].height ||
+            memcmp(a->levels[l].pixels, b->levels[l].pixels, sy_floats(&a->levels[l]) * sizeof(float)) != 0)
+            return 0;
+    return 1;
+}
+
+/* Does `msg` hold the decimal number n as a whole token? */
+static int sy_has_number(const char *msg, int n)
+{
+    char digits[16];
+    const char *p = msg;
+    size_t len;
+    sprintf(digits, "%d", n);
+    len = strlen(digits);
+    while ((p = strstr(p, digits)) != NULL) {
+        int before = p > msg && (p[-1] >= '0' && p[-1] <= '9');
+        int after = p[len] >= '0' && p[len] <= '9';
+        if (!before && !after) return 1;
+        p += len;
+    }
+    return 0;
+}
+
+/* Half an allocator (free without alloc), which every function refuses. */
+static void sy_free(void *ptr, void *user_data)
+{
+    (void)user_data;
+    free(ptr);
+}
+
+static tt_synth_options sy_options(int colors, int size, int gutter, uint64_t seed)
+{
+    tt_synth_options o;
+    memset(&o, 0, sizeof o);
+    o.layout.colors = colors;
+    o.layout.tile_size = size;
+    o.layout.gutter = gutter;
+    o.seed = seed;
+    return o;
+}
+
+/* The types of tile t (tt_tile_index numbering) and its cell's top-left. */
+static void sy_tile_types(const tt_tile_layout *layout, int t, uint8_t types[4], int *cell_x, int *cell_y)
+{
+    int base = 2 * layout->colors, T = base * base, C = layout->tile_size + 2 * layout->gutter;
+    int column = t % T, row = t / T;
+    types[0] = (uint8_t)(column / base);
+    types[1] = (uint8_t)(column % base);
+    types[2] = (uint8_t)(row / base);
+    types[3] = (uint8_t)(row % base);
+    *cell_x = column * C;
+    *cell_y = (T - 1 - row) * C;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Bit identity with the algorithm before the split                         */
+/* ------------------------------------------------------------------------ */
+
+/* Hashes of tt_synthesize_tiles's output made by the single-pass algorithm
+   of branch `api` (commit e9e89f0, before synthesis became a plan and its
+   application), with gcc -O0/-O2, clang -O2 and tcc: level 0 alone, then
+   every level. Configurations: n, S, g, feather, seed, given edge windows,
+   background region, source size. */
+typedef struct sy_reference {
+    int colors, size, gutter, feather;
+    unsigned seed;
+    int given_windows, background_region, width, height;
+    uint64_t level0, all_levels;
+} sy_reference;
+
+static const sy_reference sy_references[] = {
+    {1, 32, 0, 0, 1u, 0, 0, 96, 128, 0x7cdbe65521ed2c36ull, 0x1e83673be8b2e445ull},
+    {1, 32, 4, 3, 7u, 1, 0, 96, 128, 0xdd55f72f5150993eull, 0x2bf2b3886576e93cull},
+    {2, 16, 4, 0, 3u, 0, 0, 80, 96, 0x5b3f0e2a3bdddbdfull, 0x0907bb32a2a2b611ull},
+    {2, 16, 0, 2, 11u, 1, 1, 80, 96, 0xa9d2f78dbc27466aull, 0x2b45d9506cc59a25ull},
+    {1, 64, 4, 0, 5u, 0, 0, 160, 192, 0x640e0c13336b5037ull, 0xf97e95ef272fe884ull},
+};
+
+static void sy_reference_options(const sy_reference *ref, tt_rect windows[2], tt_synth_options *o)
+{
+    *o = sy_options(ref->colors, ref->size, ref->gutter, ref->seed);
+    o->feather = ref->feather;
+    memset(windows, 0, 2 * sizeof *windows);
+    windows[0].x = 5;
+    windows[0].y = 9;
+    windows[1].x = ref->width - ref->size - 3;
+    windows[1].y = ref->height - 2 * ref->size - 1;
+    if (ref->given_windows) o->edge_windows = windows;
+    if (ref->background_region) {
+        o->background.x = 10;
+        o->background.y = 20;
+        o->background.w = 50;
+        o->background.h = 40;
+    }
+}
+
+static void test_synthesize_matches_old_algorithm(void)
+{
+    size_t i;
+    for (i = 0; i < sizeof sy_references / sizeof sy_references[0]; i++) {
+        const sy_reference *ref = &sy_references[i];
+        tt_image *src = sy_noise(ref->width, ref->height, ref->seed + 1000u);
+        tt_synth_options o;
+        tt_rect windows[2];
+        tt_tileset *set = NULL, *applied = NULL;
+        tt_synth_plan *plan = NULL;
+        tt_error err;
+        tt_result r;
+        uint64_t h0 = 1469598103934665603ull, all;
+        int l;
+        sy_reference_options(ref, windows, &o);
+        r = tt_synthesize_tiles(src, &o, NULL, &set, &err);
+        CHECK(r == TT_OK, "config %d: tt_synthesize_tiles: %d (%s)", (int)i, r, err.message);
+        if (r != TT_OK) { tt_image_free(src); continue; }
+        h0 = sy_hash_image(h0, &set->levels[0]);
+        all = h0;
+        for (l = 1; l < set->nlevels; l++) all = sy_hash_image(all, &set->levels[l]);
+        CHECK(h0 == ref->level0 && all == ref->all_levels,
+              "config %d (n=%d S=%d g=%d): atlas hash %016llx / all levels %016llx, the old algorithm gave "
+              "%016llx / %016llx", (int)i, ref->colors, ref->size, ref->gutter, (unsigned long long)h0,
+              (unsigned long long)all, (unsigned long long)ref->level0, (unsigned long long)ref->all_levels);
+        /* The same through the two public halves, and the windows agree. */
+        r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+        CHECK(r == TT_OK, "config %d: plan: %d (%s)", (int)i, r, err.message);
+        if (r == TT_OK) {
+            r = tt_synth_apply(plan, src, NULL, &applied, &err);
+            CHECK(r == TT_OK && sy_same_levels(applied, set),
+                  "config %d: apply(plan_create(A), A) equals tt_synthesize_tiles(A) in every level (result %d)",
+                  (int)i, r);
+            if (r == TT_OK) {
+                int tiles = tt_tile_layout_tile_count(&set->layout);
+                CHECK(memcmp(applied->edge_windows, set->edge_windows, (size_t)ref->colors * sizeof(tt_rect)) ==
+                              0 &&
+                          memcmp(applied->background_windows, set->background_windows,
+                                 (size_t)tiles * sizeof(tt_rect)) == 0 &&
+                          memcmp(plan->edge_windows, set->edge_windows, (size_t)ref->colors * sizeof(tt_rect)) ==
+                              0,
+                      "config %d: the plan's and both tilesets' windows agree", (int)i);
+            }
+            tt_tileset_free(applied);
+        }
+        tt_synth_plan_free(plan);
+        tt_tileset_free(set);
+        tt_image_free(src);
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* The plan                                                                 */
+/* ------------------------------------------------------------------------ */
+
+static void test_plan_fields(void)
+{
+    tt_image *a = sy_noise(96, 128, 21u), *b = sy_noise(96, 128, 22u);
+    tt_synth_options o = sy_options(2, 16, 4, 77u);
+    tt_synth_plan *plan = NULL, *other = NULL;
+    tt_rect window;
+    tt_error err;
+    tt_result r;
+    int S = 16, tiles, t, side, x, bad_range = 0, bad_step = 0, bad_alpha = 0, bad_raw = 0, min_depth, differ = 0;
+    r = tt_synth_plan_create(a, &o, NULL, &plan, &err);
+    CHECK(r == TT_OK && plan, "plan_create: %d (%s)", r, err.message);
+    if (r != TT_OK) { tt_image_free(a); tt_image_free(b); return; }
+    tiles = tt_tile_layout_tile_count(&plan->layout);
+    CHECK(plan->layout.colors == 2 && plan->layout.tile_size == 16 && plan->layout.gutter == 4 && tiles == 256,
+          "resolved layout %d/%d/%d, %d tiles", plan->layout.colors, plan->layout.tile_size, plan->layout.gutter,
+          tiles);
+    CHECK(plan->source_width == 96 && plan->source_height == 128, "source size %dx%d", plan->source_width,
+          plan->source_height);
+    CHECK(plan->feather == 2 && plan->max_depth == 4, "default feather max(2, S/16) = 2: %d; max depth S/4: %d",
+          plan->feather, plan->max_depth);
+    CHECK(plan->depth8 != NULL && plan->depth16 == NULL, "S < 1024: one byte per depth");
+    CHECK(plan->edge_windows[0].w == S && plan->edge_windows[0].h == 2 * S && plan->edge_windows[1].w == S &&
+              plan->background_windows[0].w == S && plan->background_windows[tiles - 1].h == S,
+          "window sizes: edge %dx%d, background %dx%d", plan->edge_windows[0].w, plan->edge_windows[0].h,
+          plan->background_windows[0].w, plan->background_windows[0].h);
+    /* The cut's constraints: within [min(min_depth, hi), hi], hi =
+       min(wedge, max_depth), steps of at most one row. */
+    min_depth = 4 + 2 / 2 + 1;
+    if (min_depth > plan->max_depth) min_depth = plan->max_depth;
+    for (t = 0; t < tiles; t++)
+        for (side = 0; side < 4; side++)
+            for (x = 0; x < S; x++) {
+                int depth = tt_synth_plan_depth(plan, t, side, x);
+                int wedge = x < S - 1 - x ? x : S - 1 - x;
+                int hi = wedge < plan->max_depth ? wedge : plan->max_depth;
+                int lo = min_depth < hi ? min_depth : hi;
+                float alpha0 = tt_synth_plan_band_alpha(plan, t, side, x, 0);
+                if (depth != plan->depth8[(4 * (size_t)t + (size_t)side) * S + x]) bad_raw++;
+                if (depth < lo || depth > hi) bad_range++;
+                if (x > 0 && abs(depth - tt_synth_plan_depth(plan, t, side, x - 1)) > 1) bad_step++;
+                if ((x == 0 || x == S - 1) ? alpha0 != 0.0f : alpha0 != 1.0f) bad_alpha++;
+                if (depth + plan->feather + 1 < S && tt_synth_plan_band_alpha(plan, t, side, x, depth + plan->feather + 1) != 0.0f)
+                    bad_alpha++;
+                if (x > 0 && x < S - 1 && depth >= 1 && tt_synth_plan_band_alpha(plan, t, side, x, 1) <= 0.0f)
+                    bad_alpha++;
+            }
+    CHECK(bad_raw == 0, "tt_synth_plan_depth reads depth8: %d mismatches", bad_raw);
+    CHECK(bad_range == 0, "%d depths outside [min(min_depth, hi), hi]", bad_range);
+    CHECK(bad_step == 0, "%d cut steps of more than one row", bad_step);
+    CHECK(bad_alpha == 0, "%d band alphas off (edge row 1, corner columns 0, 0 past depth + feather)", bad_alpha);
+    tt_synth_plan_free(plan);
+    plan = NULL;
+    /* The guide decides the cuts: another guide, other depths (same seed and
+       windows). With S = 16 and g = 4 the depths have no freedom (min_depth
+       = max_depth = 4), so S = 32 without gutters: depths 2..8. */
+    o = sy_options(1, 32, 0, 77u);
+    memset(&window, 0, sizeof window);
+    window.x = 5;
+    window.y = 9;
+    o.edge_windows = &window;
+    r = tt_synth_plan_create(a, &o, NULL, &plan, &err);
+    if (r == TT_OK) r = tt_synth_plan_create(b, &o, NULL, &other, &err);
+    CHECK(r == TT_OK, "plans of a and b: %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        tiles = tt_tile_layout_tile_count(&plan->layout);
+        for (t = 0; t < tiles; t++)
+            for (side = 0; side < 4; side++)
+                for (x = 0; x < 32; x++)
+                    if (tt_synth_plan_depth(plan, t, side, x) != tt_synth_plan_depth(other, t, side, x)) differ++;
+        CHECK(differ > 0, "plans of two different guides differ in some depth (%d differ)", differ);
+    }
+    tt_synth_plan_free(other);
+    tt_synth_plan_free(plan);
+    tt_image_free(a);
+    tt_image_free(b);
+}
+
+/* Tiles of 1024 texels or more need 16-bit depths. Only the plan and one
+   composed tile: the atlas would be 4128 texels a side. */
+static void test_plan_wide_depths(void)
+{
+    tt_image *src = sy_noise(1024, 2048, 5u), *cell = NULL;
+    tt_synth_options o = sy_options(1, 1024, 0, 1u);
+    tt_synth_plan *plan = NULL;
+    tt_error err;
+    tt_result r;
+    uint8_t types[4] = {1, 0, 0, 1};
+    int x, bad = 0, max_seen = 0;
+    r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+    CHECK(r == TT_OK && plan && plan->depth16 && !plan->depth8 && plan->max_depth == 256,
+          "S = 1024: 16-bit depths up to 256 (result %d: %s)", r, err.message);
+    if (r == TT_OK && tt_image_create(1024, 1024, NULL, &cell, NULL) == TT_OK) {
+        int tile = tt_tile_index(&plan->layout, types);
+        for (x = 0; x < 1024; x++) {
+            int d = tt_synth_plan_depth(plan, tile, 2, x);
+            if (d > max_seen) max_seen = d;
+            if (d > 256) bad++;
+        }
+        CHECK(bad == 0 && max_seen > 0, "depths within 0..256 (max seen %d)", max_seen);
+        r = tt_synth_compose_tile(plan, src, types, cell, 0, 0, &err);
+        CHECK(r == TT_OK, "compose one 1024-texel tile: %d (%s)", r, err.message);
+        /* Its top edge row (side 2, type 0: the upper square read with x
+           reversed by the half turn) is the edge sample exactly. */
+        for (bad = 0, x = 1; x < 1023; x++) {
+            const tt_rect *w = &plan->edge_windows[0];
+            const float *want = sy_px(src, w->x + 1023 - x, w->y + 1023), *got = sy_px(cell, x, 0);
+            if (memcmp(want, got, 3 * sizeof(float)) != 0) bad++;
+        }
+        CHECK(bad == 0, "top edge row = edge sample: %d texels differ", bad);
+    }
+    tt_image_free(cell);
+    tt_synth_plan_free(plan);
+    tt_image_free(src);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The per-tile step                                                        */
+/* ------------------------------------------------------------------------ */
+
+static void test_compose_tile_matches_apply(void)
+{
+    static const int configs[][3] = {{1, 32, 4}, {2, 16, 0}, {2, 16, 3}};
+    size_t c;
+    for (c = 0; c < sizeof configs / sizeof configs[0]; c++) {
+        tt_image *src = sy_noise(80, 96, 31u + (unsigned)c), *atlas = NULL, *one = NULL;
+        tt_synth_options o = sy_options(configs[c][0], configs[c][1], configs[c][2], 5u + c);
+        tt_synth_plan *plan = NULL;
+        tt_tileset *set = NULL;
+        tt_error err;
+        tt_result r;
+        unsigned char *before = NULL;
+        size_t plan_bytes;
+        int W, C, tiles, t, failures = 0, cell_bad = 0, outside_bad = 0;
+        r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+        if (r == TT_OK) r = tt_synth_apply(plan, src, NULL, &set, &err);
+        CHECK(r == TT_OK, "config %d: plan + apply: %d (%s)", (int)c, r, err.message);
+        if (r != TT_OK) { tt_synth_plan_free(plan); tt_image_free(src); continue; }
+        W = set->levels[0].width;
+        C = plan->layout.tile_size + 2 * plan->layout.gutter;
+        tiles = tt_tile_layout_tile_count(&plan->layout);
+        /* The plan is only read: its whole block is unchanged after. */
+        plan_bytes = (size_t)((unsigned char *)(plan->depth8 + 4 * (size_t)plan->layout.tile_size * tiles) -
+                              (unsigned char *)plan);
+        CHECK(plan_bytes <= (sizeof(tt_synth_plan) + 15) / 16 * 16 +
+                                16 * ((size_t)plan->layout.colors + (size_t)tiles) +
+                                4 * (size_t)plan->layout.tile_size * (size_t)tiles,
+              "config %d: the plan is one block of %lu bytes, as the header says", (int)c, (unsigned long)plan_bytes);
+        before = (unsigned char *)malloc(plan_bytes);
+        if (before) memcpy(before, plan, plan_bytes);
+        tt_image_create(W, W, NULL, &atlas, NULL);
+        tt_image_create(C + 3, C + 5, NULL, &one, NULL);
+        if (!atlas || !one) { CHECK(0, "images"); break; }
+        for (t = 0; t < tiles; t++) {
+            uint8_t types[4];
+            int x, y, i, j;
+            sy_tile_types(&plan->layout, t, types, &x, &y);
+            if (tt_synth_compose_tile(plan, src, types, atlas, x, y, &err) != TT_OK) failures++;
+            /* A one-cell image of the caller's at (2, 3), the rest marked. */
+            for (i = 0; i < (C + 3) * (C + 5) * 4; i++) one->pixels[i] = -7.0f;
+            if (tt_synth_compose_tile(plan, src, types, one, 2, 3, &err) != TT_OK) failures++;
+            for (j = 0; j < C + 5; j++)
+                for (i = 0; i < C + 3; i++) {
+                    const float *p = sy_px(one, i, j);
+                    if (i >= 2 && i < 2 + C && j >= 3 && j < 3 + C) {
+                        if (memcmp(p, sy_px(&set->levels[0], x + i - 2, y + j - 3), 4 * sizeof(float)) != 0)
+                            cell_bad++;
+                    } else if (p[0] != -7.0f || p[1] != -7.0f || p[2] != -7.0f || p[3] != -7.0f) {
+                        outside_bad++;
+                    }
+                }
+        }
+        CHECK(failures == 0, "config %d: %d compose calls failed", (int)c, failures);
+        CHECK(memcmp(atlas->pixels, set->levels[0].pixels, sy_floats(atlas) * sizeof(float)) == 0,
+              "config %d: compose_tile of every tile into one image = apply's level 0, bit for bit", (int)c);
+        CHECK(cell_bad == 0, "config %d: a one-cell target at (2, 3) holds the atlas cell: %d texels differ", (int)c,
+              cell_bad);
+        CHECK(outside_bad == 0, "config %d: %d texels outside the cell were touched", (int)c, outside_bad);
+        CHECK(before && memcmp(before, plan, plan_bytes) == 0, "config %d: composing left the plan unchanged", (int)c);
+        free(before);
+        tt_image_free(one);
+        tt_image_free(atlas);
+        tt_tileset_free(set);
+        tt_synth_plan_free(plan);
+        tt_image_free(src);
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Applying one plan to several maps                                        */
+/* ------------------------------------------------------------------------ */
+
+static void test_second_map_same_masks(void)
+{
+    const int w = 96, h = 128;
+    tt_image *a = sy_noise(w, h, 41u), *b = sy_copy(a), *mark = NULL;
+    tt_synth_options o = sy_options(1, 32, 4, 9u);
+    tt_synth_plan *plan = NULL;
+    tt_tileset *sa = NULL, *sb = NULL, *sm = NULL;
+    tt_error err;
+    tt_result r;
+    int x, y, l, k, changed = 0, bad_same = 0, reached = 0, bad_edge = 0, t, tiles;
+    tt_image_create(w, h, NULL, &mark, NULL);
+    /* B = A but for a block of other texels; `mark` is 1 there, 0 elsewhere. */
+    for (y = 40; y < 90; y++)
+        for (x = 20; x < 70; x++) {
+            float *p = sy_px(b, x, y), *m = sy_px(mark, x, y);
+            for (k = 0; k < 3; k++) { p[k] = 1.0f - p[k] * 0.5f; m[k] = 1.0f; }
+        }
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) sy_px(mark, x, y)[3] = 1.0f;
+    r = tt_synth_plan_create(a, &o, NULL, &plan, &err);
+    if (r == TT_OK) r = tt_synth_apply(plan, a, NULL, &sa, &err);
+    if (r == TT_OK) r = tt_synth_apply(plan, b, NULL, &sb, &err);
+    if (r == TT_OK) r = tt_synth_apply(plan, mark, NULL, &sm, &err);
+    CHECK(r == TT_OK, "plan of A applied to A, B and the mark: %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        /* Blending is convex, so an atlas texel of the mark's atlas is 0
+           exactly when no changed texel reached it: there A's and B's
+           atlases must agree to the bit, in every level. */
+        for (l = 0; l < sa->nlevels; l++) {
+            size_t i, n = sy_floats(&sa->levels[l]);
+            for (i = 0; i < n; i += 4) {
+                int differs = memcmp(sa->levels[l].pixels + i, sb->levels[l].pixels + i, 4 * sizeof(float)) != 0;
+                int touched = sm->levels[l].pixels[i] != 0.0f;
+                if (differs) changed++;
+                if (touched) reached++;
+                if (differs && !touched) bad_same++;
+            }
+        }
+        CHECK(bad_same == 0, "%d atlas texels differ between A and B although no changed texel reaches them",
+              bad_same);
+        CHECK(changed > 0 && reached > 0, "the changed block shows in the atlas (%d texels differ, %d reached)",
+              changed, reached);
+        /* Seamlessness holds for the second map too: the edge row of every
+           side but its corner texels is B's edge sample, exactly. Side 0
+           (bottom) of tile t: texel (g + x, g + S-1) of its cell. */
+        tiles = tt_tile_layout_tile_count(&plan->layout);
+        for (t = 0; t < tiles; t++) {
+            uint8_t types[4];
+            int cx, cy;
+            const tt_rect *wnd;
+            sy_tile_types(&plan->layout, t, types, &cx, &cy);
+            wnd = &plan->edge_windows[types[0] >> 1];
+            for (x = 1; x < 31; x++) {
+                const float *want = (types[0] & 1) == 0 ? sy_px(b, wnd->x + x, wnd->y + 31)
+                                                        : sy_px(b, wnd->x + 31 - x, wnd->y + 32);
+                if (memcmp(want, sy_px(&sb->levels[0], cx + 4 + x, cy + 4 + 31), 3 * sizeof(float)) != 0)
+                    bad_edge++;
+            }
+        }
+        CHECK(bad_edge == 0, "B's bottom edge rows are B's edge samples: %d texels differ", bad_edge);
+    }
+    tt_tileset_free(sa);
+    tt_tileset_free(sb);
+    tt_tileset_free(sm);
+    tt_synth_plan_free(plan);
+    tt_image_free(a);
+    tt_image_free(b);
+    tt_image_free(mark);
+}
+
+/* B = s * A + o texel by texel (one s, o per channel): every atlas level of
+   B is s * atlas_A + o up to float rounding. The masks do not depend on the
+   applied image, and every step (over, corner means, mip averages) is an
+   affine combination with weights summing to 1. */
+static void test_affine_map(void)
+{
+    static const float scale[3] = {0.5f, -0.7f, 2.0f}, offset[3] = {0.25f, 0.9f, -0.5f};
+    tt_image *a = sy_noise(80, 96, 51u), *b = NULL;
+    tt_synth_options o = sy_options(2, 16, 4, 13u);
+    tt_synth_plan *plan = NULL;
+    tt_tileset *sa = NULL, *sb = NULL;
+    tt_error err;
+    tt_result r;
+    size_t i, n;
+    int l, k, bad = 0, alpha_bad = 0;
+    double worst = 0.0;
+    b = sy_copy(a);
+    n = sy_floats(a);
+    for (i = 0; i < n; i += 4)
+        for (k = 0; k < 3; k++) b->pixels[i + k] = scale[k] * a->pixels[i + k] + offset[k];
+    r = tt_synth_plan_create(a, &o, NULL, &plan, &err);
+    if (r == TT_OK) r = tt_synth_apply(plan, a, NULL, &sa, &err);
+    if (r == TT_OK) r = tt_synth_apply(plan, b, NULL, &sb, &err);
+    CHECK(r == TT_OK, "plan + two applies: %d (%s)", r, err.message);
+    if (r == TT_OK) {
+        for (l = 0; l < sa->nlevels; l++) {
+            n = sy_floats(&sa->levels[l]);
+            for (i = 0; i < n; i += 4) {
+                for (k = 0; k < 3; k++) {
+                    double want = (double)scale[k] * sa->levels[l].pixels[i + k] + offset[k];
+                    double e = fabs(want - sb->levels[l].pixels[i + k]);
+                    if (e > worst) worst = e;
+                    if (e > 2e-6) bad++;
+                }
+                if (sa->levels[l].pixels[i + 3] != 1.0f || sb->levels[l].pixels[i + 3] != 1.0f) alpha_bad++;
+            }
+        }
+        CHECK(bad == 0, "atlas_B = s * atlas_A + o: %d values off by more than 2e-6 (worst %g)", bad, worst);
+        CHECK(alpha_bad == 0, "both atlases opaque: %d texels with alpha != 1", alpha_bad);
+    }
+    tt_tileset_free(sa);
+    tt_tileset_free(sb);
+    tt_synth_plan_free(plan);
+    tt_image_free(a);
+    tt_image_free(b);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Errors                                                                   */
+/* ------------------------------------------------------------------------ */
+
+static void test_plan_create_errors(void)
+{
+    tt_image *src = sy_noise(96, 128, 61u), *bad = NULL;
+    tt_synth_options o = sy_options(1, 32, 4, 1u);
+    tt_synth_plan *plan;
+    tt_allocator half;
+    tt_rect windows[2];
+    tt_image empty;
+    tt_error err;
+    tt_result r;
+    memset(&empty, 0, sizeof empty);
+    memset(&half, 0, sizeof half);
+    half.free = sy_free;
+
+    CHECK(tt_synth_plan_create(src, &o, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT && err.message[0],
+          "NULL out_plan");
+    plan = (tt_synth_plan *)&o;
+    CHECK(tt_synth_plan_create(NULL, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT && plan == NULL,
+          "NULL guide: TT_ERROR_INVALID_ARGUMENT, *out_plan NULL");
+    CHECK(tt_synth_plan_create(&empty, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT, "empty guide");
+    CHECK(tt_synth_plan_create(src, &o, &half, &plan, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "an allocator with free but no alloc");
+    r = tt_synth_plan_create(src, NULL, NULL, &plan, &err);
+    CHECK(r == TT_ERROR_IMAGE_TOO_SMALL, "NULL options = defaults: 128-texel tiles need 128x256, the guide is "
+          "96x128: %d", r);
+    /* A NaN and an infinity in the guide, named by row and column. */
+    bad = sy_copy(src);
+    sy_px(bad, 17, 33)[1] = NAN;
+    plan = (tt_synth_plan *)&o;
+    r = tt_synth_plan_create(bad, &o, NULL, &plan, &err);
+    CHECK(r == TT_ERROR_NON_FINITE && err.row == 33 && err.column == 17 && plan == NULL,
+          "NaN guide texel (17, 33): %d, row %d column %d (%s)", r, err.row, err.column, err.message);
+    sy_px(bad, 17, 33)[1] = 0.5f;
+    sy_px(bad, 95, 127)[3] = INFINITY;
+    r = tt_synth_plan_create(bad, &o, NULL, &plan, &err);
+    CHECK(r == TT_ERROR_NON_FINITE && err.row == 127 && err.column == 95,
+          "infinite alpha at the last texel: %d, row %d column %d", r, err.row, err.column);
+    tt_image_free(bad);
+    /* Layout, size, feather, regions, windows. */
+    o.layout.colors = -1;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT, "colors -1");
+    o.layout.colors = 1;
+    o.layout.tile_size = 3;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT, "tile size 3");
+    o.layout.tile_size = 65;
+    r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+    CHECK(r == TT_ERROR_IMAGE_TOO_SMALL && sy_has_number(err.message, 65),
+          "65-texel tiles need 65x130 in a 96x128 guide: %d (%s)", r, err.message);
+    o.layout.tile_size = 32;
+    o.feather = 32 / 4 + 2;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT, "feather S/4 + 2");
+    o.feather = 32 / 4 + 1;
+    r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+    CHECK(r == TT_OK && plan->feather == 9, "feather S/4 + 1 is allowed: %d", r);
+    tt_synth_plan_free(plan);
+    o.feather = 0;
+    o.background.x = 70;
+    o.background.y = 0;
+    o.background.w = 32;
+    o.background.h = 32;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "background region past the right side");
+    o.background.x = 0;
+    o.background.w = 31;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &plan, &err) == TT_ERROR_IMAGE_TOO_SMALL,
+          "background region narrower than a tile");
+    memset(&o.background, 0, sizeof o.background);
+    memset(windows, 0, sizeof windows);
+    windows[0].x = 96 - 32 + 1;
+    o.edge_windows = windows;
+    r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.item == 0 && plan == NULL,
+          "an edge window one texel past the side: %d, item %d", r, err.item);
+    windows[0].x = 96 - 32;
+    windows[0].y = 128 - 64;
+    r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+    CHECK(r == TT_OK && plan->edge_windows[0].x == 64 && plan->edge_windows[0].y == 64 &&
+              plan->edge_windows[0].w == 32 && plan->edge_windows[0].h == 64,
+          "an edge window in the bottom-right corner fits: %d", r);
+    tt_synth_plan_free(plan);
+    tt_synth_plan_free(NULL);
+    tt_image_free(src);
+}
+
+static void test_compose_tile_errors(void)
+{
+    tt_image *src = sy_noise(96, 128, 71u), *small = sy_noise(96, 127, 71u), *target = NULL, *bad = NULL;
+    tt_synth_options o = sy_options(1, 32, 4, 3u);
+    tt_synth_plan *plan = NULL, copy;
+    tt_image no_pixels;
+    uint8_t types[4] = {0, 1, 1, 0}, wrong[4] = {0, 1, 2, 0};
+    tt_error err;
+    tt_result r;
+    int tile, fx = -1, fy = -1, x, y;
+    memset(&no_pixels, 0, sizeof no_pixels);
+    no_pixels.width = no_pixels.height = 64;
+    r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+    tt_image_create(50, 45, NULL, &target, NULL);
+    CHECK(r == TT_OK && target, "plan: %d (%s)", r, err.message);
+    if (r != TT_OK || !target) goto out;
+    CHECK(tt_synth_compose_tile(plan, src, types, target, 10, 5, &err) == TT_OK, "a 40x40 cell at (10, 5) of 50x45");
+    CHECK(tt_synth_compose_tile(NULL, src, types, target, 0, 0, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL plan");
+    CHECK(tt_synth_compose_tile(plan, NULL, types, target, 0, 0, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL source");
+    CHECK(tt_synth_compose_tile(plan, src, NULL, target, 0, 0, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL types");
+    CHECK(tt_synth_compose_tile(plan, src, types, NULL, 0, 0, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL target");
+    CHECK(tt_synth_compose_tile(plan, src, types, &no_pixels, 0, 0, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "a target without pixels");
+    r = tt_synth_compose_tile(plan, src, wrong, target, 0, 0, &err);
+    CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.item == 2,
+          "type 2 with n = 1 on side 2: %d, item %d (%s)", r, err.item, err.message);
+    wrong[2] = 255;
+    CHECK(tt_synth_compose_tile(plan, src, wrong, target, 0, 0, &err) == TT_ERROR_INDEX_OUT_OF_RANGE, "type 255");
+    r = tt_synth_compose_tile(plan, src, types, target, 11, 0, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "cell one texel past the right side: %d", r);
+    CHECK(tt_synth_compose_tile(plan, src, types, target, 0, 6, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "cell one texel past the bottom");
+    CHECK(tt_synth_compose_tile(plan, src, types, target, -1, 0, &err) == TT_ERROR_INVALID_ARGUMENT, "x = -1");
+    CHECK(tt_synth_compose_tile(plan, src, types, target, 0, -1, &err) == TT_ERROR_INVALID_ARGUMENT, "y = -1");
+    CHECK(tt_synth_compose_tile(plan, src, types, target, 0x7fffffff, 0, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "x = INT_MAX");
+    r = tt_synth_compose_tile(plan, small, types, target, 0, 0, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && sy_has_number(err.message, 127),
+          "a 96x127 source for a plan of 96x128: %d (%s)", r, err.message);
+    /* A plan changed by its reader is refused, never a read out of bounds. */
+    copy = *plan;
+    copy.feather = 0;
+    CHECK(tt_synth_compose_tile(&copy, src, types, target, 0, 0, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "a plan with feather 0");
+    copy = *plan;
+    copy.depth8 = NULL;
+    CHECK(tt_synth_compose_tile(&copy, src, types, target, 0, 0, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "a plan without depths");
+    tile = tt_tile_index(&plan->layout, types);
+    {
+        tt_rect keep = plan->background_windows[tile];
+        tt_tileset *set = NULL;
+        plan->background_windows[tile].x = 96 - 31;
+        r = tt_synth_compose_tile(plan, src, types, target, 0, 0, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.item == tile, "a background window moved out: %d, item %d", r,
+              err.item);
+        r = tt_synth_apply(plan, src, NULL, &set, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && set == NULL, "apply with that plan: %d", r);
+        plan->background_windows[tile] = keep;
+    }
+    /* A NaN the tile reads (the middle of its background window, which no
+       band covers) is named; a NaN outside every window the tile reads is
+       not read, but apply, which reads the whole image, names it. */
+    bad = sy_copy(src);
+    {
+        const tt_rect *bg = &plan->background_windows[tile];
+        sy_px(bad, bg->x + 16, bg->y + 16)[0] = NAN;
+        r = tt_synth_compose_tile(plan, bad, types, target, 0, 0, &err);
+        CHECK(r == TT_ERROR_NON_FINITE && err.row == bg->y + 16 && err.column == bg->x + 16,
+              "NaN in the tile's background: %d, row %d column %d (%s)", r, err.row, err.column, err.message);
+        sy_px(bad, bg->x + 16, bg->y + 16)[0] = 0.5f;
+        for (y = 0; y < 128 && fx < 0; y++)
+            for (x = 0; x < 96 && fx < 0; x++) {
+                const tt_rect *e = &plan->edge_windows[0];
+                int in_bg = x >= bg->x && x < bg->x + 32 && y >= bg->y && y < bg->y + 32;
+                int in_edge = x >= e->x && x < e->x + 32 && y >= e->y && y < e->y + 64;
+                if (!in_bg && !in_edge) { fx = x; fy = y; }
+            }
+        CHECK(fx >= 0, "a texel outside the tile's windows");
+        if (fx >= 0) {
+            tt_tileset *set = NULL;
+            sy_px(bad, fx, fy)[2] = INFINITY;
+            r = tt_synth_compose_tile(plan, bad, types, target, 0, 0, &err);
+            CHECK(r == TT_OK, "an infinity the tile does not read: %d (%s)", r, err.message);
+            r = tt_synth_apply(plan, bad, NULL, &set, &err);
+            CHECK(r == TT_ERROR_NON_FINITE && err.row == fy && err.column == fx && set == NULL,
+                  "apply names it: %d, row %d column %d", r, err.row, err.column);
+        }
+    }
+out:
+    tt_image_free(bad);
+    tt_image_free(target);
+    tt_synth_plan_free(plan);
+    tt_image_free(small);
+    tt_image_free(src);
+}
+
+static void test_apply_errors(void)
+{
+    tt_image *src = sy_noise(96, 128, 81u), *other = sy_noise(97, 128, 81u);
+    tt_synth_options o = sy_options(1, 32, 4, 3u);
+    tt_synth_plan *plan = NULL;
+    tt_tileset *set;
+    tt_allocator half;
+    tt_error err;
+    tt_result r;
+    memset(&half, 0, sizeof half);
+    half.free = sy_free;
+    r = tt_synth_plan_create(src, &o, NULL, &plan, &err);
+    CHECK(r == TT_OK, "plan: %d", r);
+    if (r == TT_OK) {
+        set = (tt_tileset *)&o;
+        CHECK(tt_synth_apply(NULL, src, NULL, &set, &err) == TT_ERROR_INVALID_ARGUMENT && set == NULL,
+              "NULL plan, *out NULL");
+        CHECK(tt_synth_apply(plan, NULL, NULL, &set, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL source");
+        CHECK(tt_synth_apply(plan, src, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL out");
+        CHECK(tt_synth_apply(plan, src, &half, &set, &err) == TT_ERROR_INVALID_ARGUMENT, "half an allocator");
+        r = tt_synth_apply(plan, other, NULL, &set, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && set == NULL && sy_has_number(err.message, 97),
+              "a 97x128 source for a 96x128 plan: %d (%s)", r, err.message);
+    }
+    tt_synth_plan_free(plan);
+    tt_image_free(other);
+    tt_image_free(src);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Progress and cancelling                                                  */
+/* ------------------------------------------------------------------------ */
+
+typedef struct sy_progress {
+    int calls, cancel_at, decreasing;
+    float first, last;
+} sy_progress;
+
+static int sy_on_progress(float fraction, void *user_data)
+{
+    sy_progress *p = (sy_progress *)user_data;
+    if (p->calls == 0) p->first = fraction;
+    else if (fraction < p->last) p->decreasing++;
+    p->last = fraction;
+    p->calls++;
+    return p->cancel_at >= 0 && p->calls > p->cancel_at;
+}
+
+static void sy_progress_reset(sy_progress *p, int cancel_at)
+{
+    memset(p, 0, sizeof *p);
+    p->cancel_at = cancel_at;
+}
+
+static void test_progress_and_cancel(void)
+{
+    tt_image *src = sy_noise(80, 96, 91u);
+    tt_synth_options o = sy_options(1, 16, 2, 3u);
+    tt_synth_plan *plan = NULL;
+    tt_tileset *set = NULL;
+    sy_progress p;
+    counter cnt;
+    tt_allocator counting = make_allocator(&cnt, -1);
+    tt_error err;
+    tt_result r;
+    const int tiles = 16;
+    o.progress = sy_on_progress;
+    o.progress_user_data = &p;
+
+    sy_progress_reset(&p, -1);
+    r = tt_synth_plan_create(src, &o, &counting, &plan, &err);
+    CHECK(r == TT_OK && p.calls == tiles && p.decreasing == 0 && p.first > 0.0f && p.last == 1.0f,
+          "plan_create reports once per tile, 0 < first, never decreasing, last 1: %d calls, first %g, last %g, "
+          "%d decreases (result %d)", p.calls, p.first, p.last, p.decreasing, r);
+    CHECK(r == TT_OK && plan->progress == sy_on_progress && plan->progress_user_data == &p,
+          "the plan keeps the callback for apply");
+    if (r == TT_OK) {
+        sy_progress_reset(&p, -1);
+        r = tt_synth_apply(plan, src, &counting, &set, &err);
+        CHECK(r == TT_OK && p.calls == tiles && p.decreasing == 0 && p.last == 1.0f,
+              "apply reports once per tile up to 1: %d calls, last %g", p.calls, p.last);
+        tt_tileset_free(set);
+        sy_progress_reset(&p, 5);
+        set = (tt_tileset *)&o;
+        r = tt_synth_apply(plan, src, &counting, &set, &err);
+        CHECK(r == TT_CANCELLED && set == NULL && p.calls == 6, "apply cancelled at the 6th report: %d, %d calls",
+              r, p.calls);
+        plan->progress = NULL;
+        sy_progress_reset(&p, 0);
+        r = tt_synth_apply(plan, src, &counting, &set, &err);
+        CHECK(r == TT_OK && p.calls == 0, "the plan's callback may be removed: %d, %d calls", r, p.calls);
+        tt_tileset_free(set);
+    }
+    tt_synth_plan_free(plan);
+    CHECK(cnt.live == 0, "plan and tilesets freed: %ld live allocations", cnt.live);
+
+    sy_progress_reset(&p, 3);
+    plan = (tt_synth_plan *)&o;
+    r = tt_synth_plan_create(src, &o, &counting, &plan, &err);
+    CHECK(r == TT_CANCELLED && plan == NULL && cnt.live == 0,
+          "plan_create cancelled: %d, %ld live allocations", r, cnt.live);
+
+    /* One run from 0 to 1 across both halves. */
+    sy_progress_reset(&p, -1);
+    r = tt_synthesize_tiles(src, &o, &counting, &set, &err);
+    CHECK(r == TT_OK && p.calls == 2 * tiles && p.decreasing == 0 && p.first > 0.0f && p.last == 1.0f,
+          "tt_synthesize_tiles: %d calls, first %g, last %g, %d decreases", p.calls, p.first, p.last, p.decreasing);
+    tt_tileset_free(set);
+    sy_progress_reset(&p, tiles + 2);
+    r = tt_synthesize_tiles(src, &o, &counting, &set, &err);
+    CHECK(r == TT_CANCELLED && set == NULL && cnt.live == 0,
+          "tt_synthesize_tiles cancelled while applying: %d, %ld live", r, cnt.live);
+    tt_image_free(src);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Allocation failures                                                      */
+/* ------------------------------------------------------------------------ */
+
+typedef struct sy_oom_context {
+    const tt_image *source;
+    const tt_synth_plan *plan;
+    tt_synth_options options;
+} sy_oom_context;
+
+static tt_result sy_oom_plan(void *ctx, const tt_allocator *allocator)
+{
+    sy_oom_context *c = (sy_oom_context *)ctx;
+    tt_synth_plan *plan = (tt_synth_plan *)ctx;
+    tt_result r = tt_synth_plan_create(c->source, &c->options, allocator, &plan, NULL);
+    if (r != TT_OK && plan != NULL) return TT_RESULT_MAX_ENUM;
+    tt_synth_plan_free(plan);
+    return r;
+}
+
+static tt_result sy_oom_apply(void *ctx, const tt_allocator *allocator)
+{
+    sy_oom_context *c = (sy_oom_context *)ctx;
+    tt_tileset *set = (tt_tileset *)ctx;
+    tt_result r = tt_synth_apply(c->plan, c->source, allocator, &set, NULL);
+    if (r != TT_OK && set != NULL) return TT_RESULT_MAX_ENUM;
+    tt_tileset_free(set);
+    return r;
+}
+
+static tt_result sy_oom_synthesize(void *ctx, const tt_allocator *allocator)
+{
+    sy_oom_context *c = (sy_oom_context *)ctx;
+    tt_tileset *set = (tt_tileset *)ctx;
+    tt_result r = tt_synthesize_tiles(c->source, &c->options, allocator, &set, NULL);
+    if (r != TT_OK && set != NULL) return TT_RESULT_MAX_ENUM;
+    tt_tileset_free(set);
+    return r;
+}
+
+static void test_allocation_failures(void)
+{
+    tt_image *src = sy_noise(64, 64, 101u);
+    sy_oom_context c;
+    tt_synth_plan *plan = NULL;
+    c.source = src;
+    c.options = sy_options(1, 8, 2, 4u);
+    tt_synth_plan_create(src, &c.options, NULL, &plan, NULL);
+    c.plan = plan;
+    oom_reset();
+    oom_sweep("tt_synth_plan_create", sy_oom_plan, &c, TT_OK);
+    oom_sweep("tt_synth_apply", sy_oom_apply, &c, TT_OK);
+    oom_sweep("tt_synthesize_tiles", sy_oom_synthesize, &c, TT_OK);
+    tt_synth_plan_free(plan);
+    tt_image_free(src);
+}
+
+/* ------------------------------------------------------------------------ */
+
+void run_tiled_synthesis_tests(void)
+{
+    RUN(test_synthesize_matches_old_algorithm);
+    RUN(test_plan_fields);
+    RUN(test_plan_wide_depths);
+    RUN(test_compose_tile_matches_apply);
+    RUN(test_second_map_same_masks);
+    RUN(test_affine_map);
+    RUN(test_plan_create_errors);
+    RUN(test_compose_tile_errors);
+    RUN(test_apply_errors);
+    RUN(test_progress_and_cancel);
+    RUN(test_allocation_failures);
+}
