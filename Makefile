@@ -52,12 +52,13 @@ CGAL_INC := $(wildcard /usr/include/CGAL)
 build/bench_build_cgal: bench/bench_build_cgal.cpp bench/bench_build_meshes.h tiledtex.h | build
 	$(CXX) -O2 -DNDEBUG -I. -Ibench bench/bench_build_cgal.cpp -o $@
 
-bench: build/bench build/bench_cg $(if $(EIGEN_INC),build/bench_cg_eigen) build/bench_build $(if $(CGAL_INC),build/bench_build_cgal)
+bench: deps build/bench build/bench_cg $(if $(EIGEN_INC),build/bench_cg_eigen) build/bench_build $(if $(CGAL_INC),build/bench_build_cgal) build/tiledtex
 	@./build/bench
 	@./build/bench_cg
 	@$(if $(EIGEN_INC),./build/bench_cg_eigen,echo "(no Eigen peer: apt-get install libeigen3-dev)" >&2)
 	@./build/bench_build
 	@$(if $(CGAL_INC),./build/bench_build_cgal,echo "(no CGAL peer: apt-get install libcgal-dev)" >&2)
+	@bash bench/bench_tool.sh build/tiledtex
 
 # Only the mesh-build figures (a few seconds each).
 bench-build: build/bench_build $(if $(CGAL_INC),build/bench_build_cgal)
