@@ -46,13 +46,13 @@ static uint64_t image_max_pixels = TOOL_DEFAULT_MAX_PIXELS;
 
 void image_set_max_pixels(uint64_t max_pixels) { image_max_pixels = max_pixels; }
 
-int image_load(const char *path, tt_image *image, char *err, size_t err_size)
+int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size)
 {
     unsigned char *file_data, *pixels;
     size_t file_size;
     int width, height, channels;
-    tt_result result;
-    memset(image, 0, sizeof *image);
+    tt_error error;
+    *image = NULL;
     if (tool_read_file(path, &file_data, &file_size, err, err_size) != 0) return -1;
     if (file_size > INT_MAX) {
         tool_set_error(err, err_size, "'%s' is too large to be an image this tool can read", path);
@@ -83,33 +83,68 @@ int image_load(const char *path, tt_image *image, char *err, size_t err_size)
         return -1;
     }
     pixels = stbi_load_from_memory(file_data, (int)file_size, &width, &height, &channels, 0);
-    free(file_data);
+    free(file_data);    /* the file's bytes are not needed once decoded */
     if (!pixels) {
         tool_set_error(err, err_size, "cannot decode '%s' (%s)", path, stbi_failure_reason());
         return -1;
     }
-    result = tt_image_from_bytes(image, pixels, width, height, channels, 0, NULL);
-    stbi_image_free(pixels);
-    if (result != TT_OK) {
-        tool_set_error(err, err_size, "cannot use '%s': %s", path, tt_result_string(result));
-        memset(image, 0, sizeof *image);
+    /* The 8-bit decode lives only until it is converted to linear light:
+       at most (channels + 16) bytes per pixel at once. */
+    if (tt_image_from_bytes(pixels, width, height, channels, 0, space, NULL, image, &error) != TT_OK) {
+        stbi_image_free(pixels);
+        tool_set_error(err, err_size, "cannot use '%s': %s", path, error.message);
         return -1;
     }
+    stbi_image_free(pixels);
     return 0;
 }
 
-/* stb_image_write hands the encoded PNG over in pieces; collect them. */
-static void collect_png_bytes(void *context, void *bytes, int count)
+/* An opaque image needs no alpha channel: RGBA -> RGB in place (each pixel
+   moves to a lower address, so it never overwrites one not yet moved).
+   Returns the channel count the bytes now have. */
+static int drop_opaque_alpha(unsigned char *rgba, size_t npixels)
 {
-    if (count > 0) buffer_append((tool_buffer *)context, bytes, (size_t)count);
+    size_t i;
+    for (i = 0; i < npixels; i++)
+        if (rgba[4 * i + 3] != 255) return 4;
+    for (i = 0; i < npixels; i++) {
+        rgba[3 * i] = rgba[4 * i];
+        rgba[3 * i + 1] = rgba[4 * i + 1];
+        rgba[3 * i + 2] = rgba[4 * i + 2];
+    }
+    return 3;
 }
 
-int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, char *err, size_t err_size)
+int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char **png, size_t *png_size, char *err,
+                     size_t err_size)
 {
-    tool_buffer buffer = TOOL_BUFFER_INIT;
+    int length = 0, channels;
+    *png = NULL;
+    *png_size = 0;
+    if (!rgba || width <= 0 || height <= 0 || width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) {
+        tool_set_error(err, err_size, "cannot save an empty or oversized image");
+        return -1;
+    }
+    channels = drop_opaque_alpha(rgba, (size_t)width * (size_t)height);
+    /* stb_image_write's own buffer (malloc'ed) becomes ours: no copy of the
+       encoded file. While it works it holds the filtered rows (one more byte
+       per row than `rgba`) and the compressed stream. */
+    *png = stbi_write_png_to_mem(rgba, width * channels, width, height, channels, &length);
+    if (!*png || length <= 0) {
+        free(*png);
+        *png = NULL;
+        tool_set_error(err, err_size, "could not encode a %dx%d PNG (out of memory?)", width, height);
+        return -1;
+    }
+    *png_size = (size_t)length;
+    return 0;
+}
+
+int png_encode(const tt_image *image, tt_color_space space, unsigned char **png, size_t *png_size, char *err,
+               size_t err_size)
+{
     unsigned char *rgba;
-    size_t bytes;
-    int ok;
+    int status;
     *png = NULL;
     *png_size = 0;
     if (!image || !image->pixels || image->width <= 0 || image->height <= 0 ||
@@ -117,34 +152,41 @@ int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, cha
         tool_set_error(err, err_size, "cannot save an empty or oversized image");
         return -1;
     }
-    bytes = (size_t)image->width * (size_t)image->height * 4;
-    rgba = (unsigned char *)malloc(bytes);
+    rgba = (unsigned char *)malloc((size_t)image->width * (size_t)image->height * 4);
     if (!rgba) {
         tool_set_error(err, err_size, "out of memory while encoding a %dx%d PNG", image->width, image->height);
         return -1;
     }
-    tt_image_to_rgba8(image, rgba);
-    ok = stbi_write_png_to_func(collect_png_bytes, &buffer, image->width, image->height, 4, rgba,
-                                image->width * 4);
+    tt_image_to_rgba8(image, space, rgba);
+    status = png_encode_rgba8(rgba, image->width, image->height, png, png_size, err, err_size);
     free(rgba);
-    if (!ok || buffer.failed) {
-        tool_set_error(err, err_size, "could not encode a %dx%d PNG (out of memory?)", image->width, image->height);
-        buffer_free(&buffer);
-        return -1;
-    }
-    *png = (unsigned char *)buffer.data;
-    *png_size = buffer.size;
-    return 0;
+    return status;
 }
 
-int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size)
+static int add_encoded(tool_output *output, const char *path, unsigned char *png, size_t png_size, char *err,
+                       size_t err_size)
 {
-    unsigned char *png;
-    size_t png_size;
-    if (png_encode(image, &png, &png_size, err, err_size) != 0) return -1;
     if (output_add(output, path, png, png_size) != 0) {
         tool_set_error(err, err_size, "out of memory while preparing '%s'", path);
         return -1;
     }
     return 0;
+}
+
+int output_add_png(tool_output *output, const char *path, const tt_image *image, tt_color_space space, char *err,
+                   size_t err_size)
+{
+    unsigned char *png;
+    size_t png_size;
+    if (png_encode(image, space, &png, &png_size, err, err_size) != 0) return -1;
+    return add_encoded(output, path, png, png_size, err, err_size);
+}
+
+int output_add_png_rgba8(tool_output *output, const char *path, unsigned char *rgba, int width, int height,
+                         char *err, size_t err_size)
+{
+    unsigned char *png;
+    size_t png_size;
+    if (png_encode_rgba8(rgba, width, height, &png, &png_size, err, err_size) != 0) return -1;
+    return add_encoded(output, path, png, png_size, err, err_size);
 }
