@@ -46,6 +46,62 @@ static uint64_t image_max_pixels = TOOL_DEFAULT_MAX_PIXELS;
 
 void image_set_max_pixels(uint64_t max_pixels) { image_max_pixels = max_pixels; }
 
+void image_free(tt_image *image)
+{
+    if (!image) return;
+    free(image->pixels);
+    free(image);
+}
+
+/* Rows converted at a time: the 8-bit decode shrinks by this much per step. */
+#define LOAD_STRIP_BYTES (1u << 20)
+
+/* 8-bit pixels (malloc'ed, width * channels bytes a row) to a float image in
+   linear light, the tool's own (a view to the library, see image_free).
+   The float pixels come from malloc untouched, and are filled in strips
+   from the bottom row up; after each strip the 8-bit buffer is cut short by
+   realloc, which gives its pages back. So the bytes and the floats are
+   never both whole: at most 16 bytes a pixel and a strip, where converting
+   in one go would hold 16 + channels. Takes ownership of `pixels`. */
+static int convert_decoded(unsigned char *pixels, int width, int height, int channels, tt_color_space space,
+                           tt_image **out, tt_error *error)
+{
+    size_t row = (size_t)width * (size_t)channels;
+    int rows_per_strip = (int)(LOAD_STRIP_BYTES / row) > 0 ? (int)(LOAD_STRIP_BYTES / row) : 1, y1 = height;
+    tt_image *image = (tt_image *)calloc(1, sizeof *image);
+    *out = NULL;
+    if (image) image->pixels = (float *)malloc((size_t)width * (size_t)height * 4 * sizeof(float));
+    if (!image || !image->pixels) {
+        free(image);
+        free(pixels);
+        memset(error, 0, sizeof *error);
+        error->result = TT_ERROR_OUT_OF_MEMORY;
+        snprintf(error->message, sizeof error->message, "out of memory for a %d x %d image", width, height);
+        return -1;
+    }
+    image->width = width;
+    image->height = height;
+    while (y1 > 0) {
+        int y0 = y1 > rows_per_strip ? y1 - rows_per_strip : 0;
+        tt_image *strip;
+        unsigned char *shorter;
+        if (tt_image_from_bytes(pixels + (size_t)y0 * row, width, y1 - y0, channels, 0, space, NULL, &strip,
+                                error) != TT_OK) {
+            image_free(image);
+            free(pixels);
+            return -1;
+        }
+        memcpy(image->pixels + (size_t)y0 * (size_t)width * 4, strip->pixels,
+               (size_t)(y1 - y0) * (size_t)width * 4 * sizeof(float));
+        tt_image_free(strip);
+        y1 = y0;
+        if (y1 > 0 && (shorter = (unsigned char *)realloc(pixels, (size_t)y1 * row)) != NULL) pixels = shorter;
+    }
+    free(pixels);
+    *out = image;
+    return 0;
+}
+
 int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size)
 {
     unsigned char *file_data, *pixels;
@@ -88,14 +144,12 @@ int image_load(const char *path, tt_color_space space, tt_image **image, char *e
         tool_set_error(err, err_size, "cannot decode '%s' (%s)", path, stbi_failure_reason());
         return -1;
     }
-    /* The 8-bit decode lives only until it is converted to linear light:
-       at most (channels + 16) bytes per pixel at once. */
-    if (tt_image_from_bytes(pixels, width, height, channels, 0, space, NULL, image, &error) != TT_OK) {
-        stbi_image_free(pixels);
+    /* stb_image allocates with malloc (STBI_MALLOC is not overridden), so
+       the decode may be shrunk with realloc and freed with free. */
+    if (convert_decoded(pixels, width, height, channels, space, image, &error) != 0) {
         tool_set_error(err, err_size, "cannot use '%s': %s", path, error.message);
         return -1;
     }
-    stbi_image_free(pixels);
     return 0;
 }
 

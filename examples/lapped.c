@@ -385,7 +385,7 @@ static int make_patch(const lapped_options *options, const tt_image *image, tt_i
     patch_options.seed = options->seed;
     if (tt_make_texture_patch(image, mask, &patch_options, NULL, patch, &error) != TT_OK)
         status = tool_fail("%s: %s", options->mask_path ? options->mask_path : options->image_path, error.message);
-    tt_image_free(mask);
+    image_free(mask);
     return status;
 }
 
@@ -396,17 +396,20 @@ static int make_patch(const lapped_options *options, const tt_image *image, tt_i
    So the image itself becomes the straight patch: its alpha is replaced by
    the patch's, in place (the image is not used afterwards), and it is
    encoded as sRGB colour with linear alpha, as PNG wants it. No float copy
-   is made; the 8-bit pixels go straight to the encoder. */
-static int add_patch_png(tool_output *output, const char *path, tt_image *image, const tt_image *patch)
+   is made, and the image is freed (*image = NULL) as soon as it is 8-bit,
+   before the PNG is compressed. */
+static int add_patch_png(tool_output *output, const char *path, tt_image **image, const tt_image *patch)
 {
     char message[TOOL_ERROR_SIZE];
-    size_t i, n = (size_t)image->width * (size_t)image->height;
+    int width = (*image)->width, height = (*image)->height, status;
+    size_t i, n = (size_t)width * (size_t)height;
     unsigned char *rgba = (unsigned char *)malloc(n * 4);
-    int status;
-    if (!rgba) return tool_fail("out of memory for the %dx%d patch image", image->width, image->height);
-    for (i = 0; i < n; i++) image->pixels[4 * i + 3] = patch->pixels[4 * i + 3];
-    tt_image_to_rgba8(image, TT_COLOR_SRGB, rgba);
-    status = output_add_png_rgba8(output, path, rgba, image->width, image->height, message, sizeof message);
+    if (!rgba) return tool_fail("out of memory for the %dx%d patch image", width, height);
+    for (i = 0; i < n; i++) (*image)->pixels[4 * i + 3] = patch->pixels[4 * i + 3];
+    tt_image_to_rgba8(*image, TT_COLOR_SRGB, rgba);
+    image_free(*image);
+    *image = NULL;
+    status = output_add_png_rgba8(output, path, rgba, width, height, message, sizeof message);
     free(rgba);
     return status != 0 ? tool_fail("%s", message) : 0;
 }
@@ -717,8 +720,8 @@ int cmd_lapped(int argc, char **argv)
     /* Memory: the image is needed only to make the patch and its PNG, so the
        PNG is encoded now and the image freed before the paste loop; from
        here on the command holds the patch and the compressed PNG. */
-    if (status == 0) status = add_patch_png(&output, png_path, image, patch);
-    tt_image_free(image);
+    if (status == 0) status = add_patch_png(&output, png_path, &image, patch);
+    image_free(image);
     image = NULL;
     if (status == 0) status = paste(&options, &mesh, field, patch, &lapped);
 
@@ -738,7 +741,7 @@ int cmd_lapped(int argc, char **argv)
     output_free(&output);
     tt_lapped_free(lapped);
     tt_image_free(patch);
-    tt_image_free(image);
+    image_free(image);
     free(field);
     triangle_mesh_free(&mesh);
     return status;

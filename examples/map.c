@@ -57,7 +57,7 @@ static int load_atlas_for_layout(const char *path, tiled_options *options, tt_im
     if (image_load(path, TT_COLOR_SRGB, out_atlas, message, sizeof message) != 0) return tool_fail("%s", message);
     atlas = *out_atlas;
     if (tt_tile_layout_resolve(&options->layout, &layout, &error) != TT_OK) {
-        tt_image_free(atlas);
+        image_free(atlas);
         *out_atlas = NULL;
         return tool_fail("%s", error.message);
     }
@@ -67,7 +67,7 @@ static int load_atlas_for_layout(const char *path, tiled_options *options, tt_im
         options->layout.tile_size = layout.tile_size = atlas->width / tiles_per_side - 2 * layout.gutter;
     if (atlas->width != tt_tile_layout_atlas_size(&layout) || atlas->height != atlas->width) {
         int expected = tt_tile_layout_atlas_size(&layout), width = atlas->width, height = atlas->height;
-        tt_image_free(atlas);
+        image_free(atlas);
         *out_atlas = NULL;
         return tool_fail("%s is %dx%d, but --colors %d --tile %d --gutter %d make %dx%d atlases", path, width,
                          height, layout.colors, layout.tile_size, layout.gutter, expected, expected);
@@ -96,7 +96,7 @@ int cmd_map(int argc, char **argv)
         return status;
     if ((status = tiled_check_atlas_size(&options)) != 0 ||
         (status = tiled_map_mesh(positional[0], &options, &mesh)) != 0) {
-        tt_image_free(atlas);
+        image_free(atlas);
         return status;
     }
     if (options.atlas_path) {
@@ -122,6 +122,6 @@ int cmd_map(int argc, char **argv)
 done:
     output_free(&output);
     tiled_mesh_free(&mesh);
-    tt_image_free(atlas);
+    image_free(atlas);
     return status;
 }

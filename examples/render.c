@@ -105,7 +105,10 @@ typedef struct mip_texture {
 static void texture_free(mip_texture *texture)
 {
     int i;
-    for (i = 0; i < texture->nlevels; i++) tt_image_free(texture->levels[i]);
+    /* Level 0 is the loaded image (the tool's, image_free); the others are
+       the library's. */
+    if (texture->nlevels > 0) image_free(texture->levels[0]);
+    for (i = 1; i < texture->nlevels; i++) tt_image_free(texture->levels[i]);
     texture->nlevels = 0;
 }
 
@@ -964,7 +967,7 @@ done:
     samples_free(&samples);
     scene_free(&s);
     texture_free(&texture);
-    tt_image_free(image);
+    image_free(image);
     obj_free(&mesh);
     return status;
 }

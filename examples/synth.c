@@ -57,7 +57,7 @@ int cmd_synth(int argc, char **argv)
     if (image_load(positional[0], TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         return tool_fail("%s", message);
     status = tiled_synthesize(image, positional[0], &options, &tiles);
-    tt_image_free(image);       /* not needed past the synthesis */
+    image_free(image);       /* not needed past the synthesis */
     image = NULL;
     if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
@@ -72,6 +72,6 @@ int cmd_synth(int argc, char **argv)
     }
     output_free(&output);
     tt_tileset_free(tiles);
-    tt_image_free(image);
+    image_free(image);
     return status;
 }

@@ -75,7 +75,7 @@ int cmd_tile(int argc, char **argv)
         if (fit == 0) {
             status = tool_fail("%s is %dx%d: too small to cut tiles from (it needs at least 4x8 texels)",
                                positional[1], image_width, image_height);
-            tt_image_free(image);
+            image_free(image);
             return status;
         }
         options.layout.tile_size = fit;
@@ -90,7 +90,7 @@ int cmd_tile(int argc, char **argv)
     if (status == 0) status = tiled_synthesize(image, positional[1], &options, &tiles);
     /* The photo is not needed past the synthesis: free it before the PNGs
        are encoded (it is the largest thing the command holds). */
-    tt_image_free(image);
+    image_free(image);
     image = NULL;
     if (status == 0) status = tiled_measure_seams(positional[0], &mesh, &tiles->levels[0], options.seed, options.report,
                                                        &seams);
@@ -111,6 +111,6 @@ int cmd_tile(int argc, char **argv)
     output_free(&output);
     tiled_mesh_free(&mesh);
     tt_tileset_free(tiles);
-    tt_image_free(image);
+    image_free(image);
     return status;
 }

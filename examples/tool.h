@@ -248,13 +248,17 @@ void image_set_max_pixels(uint64_t max_pixels);
    RGBA tt_image in linear light (grey and grey+alpha become RGB(A); no alpha
    means alpha 1). `space` says how the file's 8-bit values encode colour:
    TT_COLOR_SRGB for colour pictures (photos, atlases, textures),
-   TT_COLOR_LINEAR for data (masks). *image is NULL on failure; free it with
-   tt_image_free. The 8-bit decode is freed as soon as it is converted.
+   TT_COLOR_LINEAR for data (masks). *image is NULL on failure. It is the
+   tool's own memory, handed to the library as a view: free it with
+   image_free, never tt_image_free. The 8-bit decode is converted in strips
+   and shrinks as it goes, so loading holds about 16 bytes a pixel, not
+   16 + channels.
    Errors: the file is missing or unreadable, is not an image stb_image can
    decode, is wider or taller than TT_MAX_IMAGE_SIZE, or has more pixels than
    the budget (image_set_max_pixels). Sizes are read from the header before
    any pixel is decoded. */
 int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size);
+void image_free(tt_image *image);
 
 /* Encode an image as an 8-bit PNG in memory (malloc'ed; free it), its
    colours encoded into `space` (TT_COLOR_SRGB for every colour output).
