@@ -354,9 +354,19 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
            sentence counts constraints and triangles from 0; its face is
            rewritten as the OBJ's face. */
         if (error.item >= 0 && error.item < constraints.count) {
-            char message[sizeof error.message + 32];
+            char message[sizeof error.message + 32], prefix[32];
+            size_t length = (size_t)snprintf(prefix, sizeof prefix, "constraint %d", error.item);
+            const char *text = message;
             rewrite_face(m, &error, message, sizeof message);
-            status = tool_fail("%s:%d: %s", options->constraints_path, constraints.line[error.item], message);
+            /* "constraint 0 (face 7): ..." counts from 0; the line says which. */
+            if (strncmp(message, prefix, length) == 0 && !isdigit((unsigned char)message[length])) {
+                text = message + length;
+                while (*text == ' ') text++;
+                status = tool_fail("%s:%d: the constraint %s", options->constraints_path,
+                                   constraints.line[error.item], text);
+            } else {
+                status = tool_fail("%s:%d: %s", options->constraints_path, constraints.line[error.item], text);
+            }
         } else {
             status = report_error(options->mesh_path, m, &error);
         }
