@@ -177,8 +177,12 @@ static void stone_color(int cell_x, int cell_y, uint32_t key, float rgb[3])
     rgb[2] = base[2] * brightness - warmth;
 }
 
-static int make_stone_texture(int size, uint64_t seed, tt_image *image)
+/* The colours below are designed as displayed (sRGB-encoded) values; the
+   last pass decodes them to linear light, what a tt_image holds, and the
+   PNG is encoded back to sRGB: the file shows the designed values. */
+static int make_stone_texture(int size, uint64_t seed, tt_image **out_image)
 {
+    tt_image *image;
     const float mortar = 0.045f, light[3] = {-0.45f, -0.55f, 0.70f};
     float light_length = sqrtf(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
     stone_keys keys;
@@ -194,7 +198,8 @@ static int make_stone_texture(int size, uint64_t seed, tt_image *image)
     keys.mottle = tt_rng_next(&rng);
     keys.mortar = tt_rng_next(&rng);
     keys.grain = tt_rng_next(&rng);
-    if (tt_image_create(image, size, size, NULL) != TT_OK) return -1;
+    if (tt_image_create(size, size, NULL, out_image, NULL) != TT_OK) return -1;
+    image = *out_image;
 
     /* Pass 1: albedo into RGB, height into alpha (a free scratch channel). */
     for (y = 0; y < size; y++) {
@@ -254,7 +259,7 @@ static int make_stone_texture(int size, uint64_t seed, tt_image *image)
             grain = 0.06f * (hash_unit(hash2(x, y, keys.grain)) - 0.5f);
             for (k = 0; k < 3; k++) {
                 float value = pixel[k] * shade + grain;
-                pixel[k] = value < 0.0f ? 0.0f : value > 1.0f ? 1.0f : value;
+                pixel[k] = tt_srgb_to_linear(value < 0.0f ? 0.0f : value > 1.0f ? 1.0f : value);
             }
         }
     }
@@ -288,7 +293,7 @@ static int generate_texture(int argc, char **argv)
     const char *path = NULL;
     int size = TEXTURE_DEFAULT_SIZE, i, status;
     uint64_t seed = 1;
-    tt_image image;
+    tt_image *image = NULL;
     tool_output output = TOOL_OUTPUT_INIT;
     char err[TOOL_ERROR_SIZE];
     for (i = 2; i < argc; i++) {
@@ -311,12 +316,13 @@ static int generate_texture(int argc, char **argv)
     if (!path) return tool_usage("needs an output file: tiledtex generate texture OUT.png");
     if (make_stone_texture(size, seed, &image) != 0) return tool_fail("out of memory making a %dx%d texture", size, size);
     status = 0;
-    if (output_add_png(&output, path, &image, err, sizeof err) != 0 || output_commit(&output, err, sizeof err) != 0)
+    if (output_add_png(&output, path, image, TT_COLOR_SRGB, err, sizeof err) != 0 ||
+        output_commit(&output, err, sizeof err) != 0)
         status = tool_fail("%s", err);
     else
         printf("wrote %s (%dx%d stones, seed %llu)\n", path, size, size, (unsigned long long)seed);
     output_free(&output);
-    tt_image_free(&image);
+    tt_image_free(image);
     return status;
 }
 
@@ -470,7 +476,7 @@ static int poly_build(const poly_mesh *m, tt_mesh **mesh, tt_error *error)
     desc.indices = m->corner_vert;
     desc.face_sizes = m->face_size;
     desc.nfaces = m->nfaces;
-    return tt_mesh_build(&desc, mesh, error);
+    return tt_mesh_build(&desc, NULL, mesh, error);
 }
 
 static void poly_from_tt_mesh(const tt_mesh *mesh, poly_mesh *out)
@@ -817,13 +823,13 @@ static int smooth_twice(poly_mesh *m, char *err, size_t err_size)
         snprintf(err, err_size, "internal error: the plate is not a valid mesh: %s", error.message);
         return -1;
     }
-    if (tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, &once, &error) != TT_OK) {
+    if (tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &once, &error) != TT_OK) {
         tt_mesh_free(mesh);
         snprintf(err, err_size, "cannot subdivide: %s", error.message);
         return -1;
     }
     tt_mesh_free(mesh);
-    if (tt_mesh_quadrangulate(once, TT_SUBDIVIDE_CATMULL_CLARK, &twice, &error) != TT_OK) {
+    if (tt_mesh_quadrangulate(once, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &twice, &error) != TT_OK) {
         tt_mesh_free(once);
         snprintf(err, err_size, "cannot subdivide: %s", error.message);
         return -1;
@@ -924,10 +930,11 @@ static int describe_mesh(const poly_mesh *m, const char *shape, char *summary, s
     size_t used = 0;
     if (poly_build(m, &mesh, &error) != TT_OK)
         return tool_fail("internal error: the generated %s is not a valid mesh: %s", shape, error.message);
-    if (tt_mesh_compute_stats(mesh, &stats) != TT_OK ||
-        tt_mesh_valence_histogram(mesh, histogram, (int)(sizeof histogram / sizeof histogram[0])) != TT_OK) {
+    if (tt_mesh_compute_stats(mesh, NULL, &stats, &error) != TT_OK ||
+        tt_mesh_valence_histogram(mesh, NULL, histogram, (int)(sizeof histogram / sizeof histogram[0]), &error) !=
+            TT_OK) {
         tt_mesh_free(mesh);
-        return tool_fail("out of memory checking the %s", shape);
+        return tool_fail("cannot check the %s: %s", shape, error.message);
     }
     valences[0] = '\0';
     for (v = 0; v < 16; v++)

@@ -46,13 +46,69 @@ static uint64_t image_max_pixels = TOOL_DEFAULT_MAX_PIXELS;
 
 void image_set_max_pixels(uint64_t max_pixels) { image_max_pixels = max_pixels; }
 
-int image_load(const char *path, tt_image *image, char *err, size_t err_size)
+void image_free(tt_image *image)
+{
+    if (!image) return;
+    free(image->pixels);
+    free(image);
+}
+
+/* Rows converted at a time: the 8-bit decode shrinks by this much per step. */
+#define LOAD_STRIP_BYTES (1u << 20)
+
+/* 8-bit pixels (malloc'ed, width * channels bytes a row) to a float image in
+   linear light, the tool's own (a view to the library, see image_free).
+   The float pixels come from malloc untouched, and are filled in strips
+   from the bottom row up; after each strip the 8-bit buffer is cut short by
+   realloc, which gives its pages back. So the bytes and the floats are
+   never both whole: at most 16 bytes a pixel and a strip, where converting
+   in one go would hold 16 + channels. Takes ownership of `pixels`. */
+static int convert_decoded(unsigned char *pixels, int width, int height, int channels, tt_color_space space,
+                           tt_image **out, tt_error *error)
+{
+    size_t row = (size_t)width * (size_t)channels;
+    int rows_per_strip = (int)(LOAD_STRIP_BYTES / row) > 0 ? (int)(LOAD_STRIP_BYTES / row) : 1, y1 = height;
+    tt_image *image = (tt_image *)calloc(1, sizeof *image);
+    *out = NULL;
+    if (image) image->pixels = (float *)malloc((size_t)width * (size_t)height * 4 * sizeof(float));
+    if (!image || !image->pixels) {
+        free(image);
+        free(pixels);
+        memset(error, 0, sizeof *error);
+        error->result = TT_ERROR_OUT_OF_MEMORY;
+        snprintf(error->message, sizeof error->message, "out of memory for a %d x %d image", width, height);
+        return -1;
+    }
+    image->width = width;
+    image->height = height;
+    while (y1 > 0) {
+        int y0 = y1 > rows_per_strip ? y1 - rows_per_strip : 0;
+        tt_image *strip;
+        unsigned char *shorter;
+        if (tt_image_from_bytes(pixels + (size_t)y0 * row, width, y1 - y0, channels, 0, space, NULL, &strip,
+                                error) != TT_OK) {
+            image_free(image);
+            free(pixels);
+            return -1;
+        }
+        memcpy(image->pixels + (size_t)y0 * (size_t)width * 4, strip->pixels,
+               (size_t)(y1 - y0) * (size_t)width * 4 * sizeof(float));
+        tt_image_free(strip);
+        y1 = y0;
+        if (y1 > 0 && (shorter = (unsigned char *)realloc(pixels, (size_t)y1 * row)) != NULL) pixels = shorter;
+    }
+    free(pixels);
+    *out = image;
+    return 0;
+}
+
+int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size)
 {
     unsigned char *file_data, *pixels;
     size_t file_size;
     int width, height, channels;
-    tt_result result;
-    memset(image, 0, sizeof *image);
+    tt_error error;
+    *image = NULL;
     if (tool_read_file(path, &file_data, &file_size, err, err_size) != 0) return -1;
     if (file_size > INT_MAX) {
         tool_set_error(err, err_size, "'%s' is too large to be an image this tool can read", path);
@@ -83,33 +139,66 @@ int image_load(const char *path, tt_image *image, char *err, size_t err_size)
         return -1;
     }
     pixels = stbi_load_from_memory(file_data, (int)file_size, &width, &height, &channels, 0);
-    free(file_data);
+    free(file_data);    /* the file's bytes are not needed once decoded */
     if (!pixels) {
         tool_set_error(err, err_size, "cannot decode '%s' (%s)", path, stbi_failure_reason());
         return -1;
     }
-    result = tt_image_from_bytes(image, pixels, width, height, channels, 0, NULL);
-    stbi_image_free(pixels);
-    if (result != TT_OK) {
-        tool_set_error(err, err_size, "cannot use '%s': %s", path, tt_result_string(result));
-        memset(image, 0, sizeof *image);
+    /* stb_image allocates with malloc (STBI_MALLOC is not overridden), so
+       the decode may be shrunk with realloc and freed with free. */
+    if (convert_decoded(pixels, width, height, channels, space, image, &error) != 0) {
+        tool_set_error(err, err_size, "cannot use '%s': %s", path, error.message);
         return -1;
     }
     return 0;
 }
 
-/* stb_image_write hands the encoded PNG over in pieces; collect them. */
-static void collect_png_bytes(void *context, void *bytes, int count)
+/* An opaque image needs no alpha channel: RGBA -> RGB in place (each pixel
+   moves to a lower address, so it never overwrites one not yet moved).
+   Returns the channel count the bytes now have. */
+static int drop_opaque_alpha(unsigned char *rgba, size_t npixels)
 {
-    if (count > 0) buffer_append((tool_buffer *)context, bytes, (size_t)count);
+    size_t i;
+    for (i = 0; i < npixels; i++)
+        if (rgba[4 * i + 3] != 255) return 4;
+    for (i = 0; i < npixels; i++) {
+        rgba[3 * i] = rgba[4 * i];
+        rgba[3 * i + 1] = rgba[4 * i + 1];
+        rgba[3 * i + 2] = rgba[4 * i + 2];
+    }
+    return 3;
 }
 
-int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, char *err, size_t err_size)
+int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char **png, size_t *png_size, char *err,
+                     size_t err_size)
 {
-    tool_buffer buffer = TOOL_BUFFER_INIT;
+    int length = 0, channels;
+    *png = NULL;
+    *png_size = 0;
+    if (!rgba || width <= 0 || height <= 0 || width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) {
+        tool_set_error(err, err_size, "cannot save an empty or oversized image");
+        return -1;
+    }
+    channels = drop_opaque_alpha(rgba, (size_t)width * (size_t)height);
+    /* stb_image_write's own buffer (malloc'ed) becomes ours: no copy of the
+       encoded file. While it works it holds the filtered rows (one more byte
+       per row than `rgba`) and the compressed stream. */
+    *png = stbi_write_png_to_mem(rgba, width * channels, width, height, channels, &length);
+    if (!*png || length <= 0) {
+        free(*png);
+        *png = NULL;
+        tool_set_error(err, err_size, "could not encode a %dx%d PNG (out of memory?)", width, height);
+        return -1;
+    }
+    *png_size = (size_t)length;
+    return 0;
+}
+
+int png_encode(const tt_image *image, tt_color_space space, unsigned char **png, size_t *png_size, char *err,
+               size_t err_size)
+{
     unsigned char *rgba;
-    size_t bytes;
-    int ok;
+    int status;
     *png = NULL;
     *png_size = 0;
     if (!image || !image->pixels || image->width <= 0 || image->height <= 0 ||
@@ -117,34 +206,41 @@ int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, cha
         tool_set_error(err, err_size, "cannot save an empty or oversized image");
         return -1;
     }
-    bytes = (size_t)image->width * (size_t)image->height * 4;
-    rgba = (unsigned char *)malloc(bytes);
+    rgba = (unsigned char *)malloc((size_t)image->width * (size_t)image->height * 4);
     if (!rgba) {
         tool_set_error(err, err_size, "out of memory while encoding a %dx%d PNG", image->width, image->height);
         return -1;
     }
-    tt_image_to_rgba8(image, rgba);
-    ok = stbi_write_png_to_func(collect_png_bytes, &buffer, image->width, image->height, 4, rgba,
-                                image->width * 4);
+    tt_image_to_rgba8(image, space, rgba);
+    status = png_encode_rgba8(rgba, image->width, image->height, png, png_size, err, err_size);
     free(rgba);
-    if (!ok || buffer.failed) {
-        tool_set_error(err, err_size, "could not encode a %dx%d PNG (out of memory?)", image->width, image->height);
-        buffer_free(&buffer);
-        return -1;
-    }
-    *png = (unsigned char *)buffer.data;
-    *png_size = buffer.size;
-    return 0;
+    return status;
 }
 
-int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size)
+static int add_encoded(tool_output *output, const char *path, unsigned char *png, size_t png_size, char *err,
+                       size_t err_size)
 {
-    unsigned char *png;
-    size_t png_size;
-    if (png_encode(image, &png, &png_size, err, err_size) != 0) return -1;
     if (output_add(output, path, png, png_size) != 0) {
         tool_set_error(err, err_size, "out of memory while preparing '%s'", path);
         return -1;
     }
     return 0;
+}
+
+int output_add_png(tool_output *output, const char *path, const tt_image *image, tt_color_space space, char *err,
+                   size_t err_size)
+{
+    unsigned char *png;
+    size_t png_size;
+    if (png_encode(image, space, &png, &png_size, err, err_size) != 0) return -1;
+    return add_encoded(output, path, png, png_size, err, err_size);
+}
+
+int output_add_png_rgba8(tool_output *output, const char *path, unsigned char *rgba, int width, int height,
+                         char *err, size_t err_size)
+{
+    unsigned char *png;
+    size_t png_size;
+    if (png_encode_rgba8(rgba, width, height, &png, &png_size, err, err_size) != 0) return -1;
+    return add_encoded(output, path, png, png_size, err, err_size);
 }

@@ -201,7 +201,7 @@ static int triangle_mesh_read(const char *path, triangle_mesh *m)
     desc.indices = m->vert;
     desc.nfaces = total;
     desc.fixed_face_size = 3;
-    if (tt_mesh_build(&desc, &m->mesh, &error) != TT_OK) {
+    if (tt_mesh_build(&desc, NULL, &m->mesh, &error) != TT_OK) {
         int status;
         /* Say it about the OBJ's faces, which the user can find. */
         if (error.face >= 0 && error.face < total) error.face = m->face[error.face];
@@ -216,23 +216,30 @@ static int triangle_mesh_read(const char *path, triangle_mesh *m)
 /* Report a library error. The library counts faces from 0 and means the
    triangles; an error about one is said the OBJ's way, at the line of its
    face and with the face counted from 1. */
+static void rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size)
+{
+    char pattern[32];
+    const char *at = NULL;
+    size_t length = 0;
+    if (error->face >= 0 && error->face < m->ntriangles) {
+        length = (size_t)snprintf(pattern, sizeof pattern, "face %d", error->face);
+        for (at = strstr(error->message, pattern); at && isdigit((unsigned char)at[length]);
+             at = strstr(at + 1, pattern))
+            continue;
+    }
+    if (at)
+        snprintf(message, size, "%.*sface %d%s", (int)(at - error->message), error->message,
+                 m->face[error->face] + 1, at + length);
+    else
+        snprintf(message, size, "%s", error->message);
+}
+
 static int report_error(const char *path, const triangle_mesh *m, const tt_error *error)
 {
-    char message[sizeof error->message + 32], pattern[32];
-    const char *at;
-    size_t length;
-    int face;
+    char message[sizeof error->message + 32];
     if (error->face < 0 || error->face >= m->ntriangles) return tool_fail("%s: %s", path, error->message);
-    face = m->face[error->face];
-    length = (size_t)snprintf(pattern, sizeof pattern, "face %d", error->face);
-    for (at = strstr(error->message, pattern); at && isdigit((unsigned char)at[length]); at = strstr(at + 1, pattern))
-        continue;
-    if (at)
-        snprintf(message, sizeof message, "%.*sface %d%s", (int)(at - error->message), error->message, face + 1,
-                 at + length);
-    else
-        snprintf(message, sizeof message, "%s", error->message);
-    return tool_fail("%s:%d: %s", path, m->obj.face_line[face], message);
+    rewrite_face(m, error, message, sizeof message);
+    return tool_fail("%s:%d: %s", path, m->obj.face_line[m->face[error->face]], message);
 }
 
 /* ======================================================================== */
@@ -331,7 +338,7 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
     constraint_list constraints;
     tt_field_options field;
     tt_error error;
-    int status = 0, i;
+    int status = 0;
     memset(&constraints, 0, sizeof constraints);
     if (options->constraints_path && (status = read_constraints(options->constraints_path, m, &constraints)) != 0)
         return status;
@@ -340,15 +347,29 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
     field.scale = options->scale;
     field.constraints = constraints.items;
     field.nconstraints = constraints.count;
-    if (tt_tangent_field(m->mesh, &field, face_vectors, &error) != TT_OK) {
-        /* What reading the file could not see: a vector that the face's plane
-           reduces to nothing. Name the first line on that face. */
-        for (i = 0; i < constraints.count && constraints.items[i].face != error.face; i++) continue;
-        if (error.face >= 0 && i < constraints.count && error.result == TT_ERROR_INVALID_ARGUMENT)
-            status = tool_fail("%s:%d: the vector is perpendicular to face %d: it must point along the face",
-                               options->constraints_path, constraints.line[i], m->face[error.face] + 1);
-        else
+    if (tt_tangent_field(m->mesh, &field, NULL, face_vectors, &error) != TT_OK) {
+        /* An error about a constraint names it in error.item: say it at its
+           line of the file (what reading the file could not see, such as a
+           vector that the face's plane reduces to nothing). The library's
+           sentence counts constraints and triangles from 0; its face is
+           rewritten as the OBJ's face. */
+        if (error.item >= 0 && error.item < constraints.count) {
+            char message[sizeof error.message + 32], prefix[32];
+            size_t length = (size_t)snprintf(prefix, sizeof prefix, "constraint %d", error.item);
+            const char *text = message;
+            rewrite_face(m, &error, message, sizeof message);
+            /* "constraint 0 (face 7): ..." counts from 0; the line says which. */
+            if (strncmp(message, prefix, length) == 0 && !isdigit((unsigned char)message[length])) {
+                text = message + length;
+                while (*text == ' ') text++;
+                status = tool_fail("%s:%d: the constraint %s", options->constraints_path,
+                                   constraints.line[error.item], text);
+            } else {
+                status = tool_fail("%s:%d: %s", options->constraints_path, constraints.line[error.item], text);
+            }
+        } else {
             status = report_error(options->mesh_path, m, &error);
+        }
     }
     constraint_list_free(&constraints);
     return status;
@@ -358,38 +379,49 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
 /* The texture patch                                                        */
 /* ======================================================================== */
 
-static int make_patch(const lapped_options *options, const tt_image *image, tt_image *patch)
+static int make_patch(const lapped_options *options, const tt_image *image, tt_image **patch)
 {
     char message[TOOL_ERROR_SIZE];
-    tt_image mask;
+    tt_image *mask = NULL;
     tt_patch_options patch_options;
     tt_error error;
     int status = 0;
-    memset(&mask, 0, sizeof mask);
-    if (options->mask_path && image_load(options->mask_path, &mask, message, sizeof message) != 0)
+    *patch = NULL;
+    /* A mask is data, not colour: its bytes are read as they are
+       (TT_COLOR_LINEAR), so grey 128 and up is inside, as the help says. */
+    if (options->mask_path && image_load(options->mask_path, TT_COLOR_LINEAR, &mask, message, sizeof message) != 0)
         return tool_fail("%s", message);
     memset(&patch_options, 0, sizeof patch_options);
     patch_options.seed = options->seed;
-    memset(patch, 0, sizeof *patch);
-    if (tt_make_texture_patch(image, options->mask_path ? &mask : NULL, &patch_options, patch, &error) != TT_OK)
+    if (tt_make_texture_patch(image, mask, &patch_options, NULL, patch, &error) != TT_OK)
         status = tool_fail("%s: %s", options->mask_path ? options->mask_path : options->image_path, error.message);
-    tt_image_free(&mask);
+    image_free(mask);
     return status;
 }
 
 /* The patch as a PNG wants straight alpha. Where alpha > 0 that is the
    premultiplied patch divided by its alpha, which is the image's own colour;
    taking the image's colour everywhere also keeps real colours under alpha 0,
-   so a viewer that filters straight-alpha textures shows no dark fringes. */
-static int straight_patch(const tt_image *image, const tt_image *patch, tt_image *out)
+   so a viewer that filters straight-alpha textures shows no dark fringes.
+   So the image itself becomes the straight patch: its alpha is replaced by
+   the patch's, in place (the image is not used afterwards), and it is
+   encoded as sRGB colour with linear alpha, as PNG wants it. No float copy
+   is made, and the image is freed (*image = NULL) as soon as it is 8-bit,
+   before the PNG is compressed. */
+static int add_patch_png(tool_output *output, const char *path, tt_image **image, const tt_image *patch)
 {
-    size_t i, n = (size_t)image->width * (size_t)image->height;
-    if (tt_image_create(out, image->width, image->height, NULL) != TT_OK) return -1;
-    for (i = 0; i < n; i++) {
-        memcpy(out->pixels + 4 * i, image->pixels + 4 * i, 3 * sizeof(float));
-        out->pixels[4 * i + 3] = patch->pixels[4 * i + 3];
-    }
-    return 0;
+    char message[TOOL_ERROR_SIZE];
+    int width = (*image)->width, height = (*image)->height, status;
+    size_t i, n = (size_t)width * (size_t)height;
+    unsigned char *rgba = (unsigned char *)malloc(n * 4);
+    if (!rgba) return tool_fail("out of memory for the %dx%d patch image", width, height);
+    for (i = 0; i < n; i++) (*image)->pixels[4 * i + 3] = patch->pixels[4 * i + 3];
+    tt_image_to_rgba8(*image, TT_COLOR_SRGB, rgba);
+    image_free(*image);
+    *image = NULL;
+    status = output_add_png_rgba8(output, path, rgba, width, height, message, sizeof message);
+    free(rgba);
+    return status != 0 ? tool_fail("%s", message) : 0;
 }
 
 /* ======================================================================== */
@@ -513,29 +545,40 @@ static int add_mtl(tool_output *output, const char *path, const char *material, 
     return 0;
 }
 
-static int add_png(tool_output *output, const char *path, const tt_image *image)
+/* A colour image (straight alpha) as sRGB bytes; the image is freed as
+   soon as it is converted, before the PNG is compressed. */
+static int add_png(tool_output *output, const char *path, tt_image *image)
 {
     char message[TOOL_ERROR_SIZE];
-    if (output_add_png(output, path, image, message, sizeof message) != 0) return tool_fail("%s", message);
-    return 0;
+    int width = image->width, height = image->height, status;
+    unsigned char *rgba = (unsigned char *)malloc((size_t)width * (size_t)height * 4);
+    if (!rgba) {
+        tt_image_free(image);
+        return tool_fail("out of memory while encoding %s", path);
+    }
+    tt_image_to_rgba8(image, TT_COLOR_SRGB, rgba);
+    tt_image_free(image);
+    status = output_add_png_rgba8(output, path, rgba, width, height, message, sizeof message);
+    free(rgba);
+    return status != 0 ? tool_fail("%s", message) : 0;
 }
 
 /* --bake: texture coordinates per triangle corner, the OBJ's own when every
    corner has one, else an atlas of triangle pairs; the pastes composited
    into a size x size texture over them; an ordinary OBJ + MTL + PNG. */
 static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
-                     const tt_lapped *lapped, const tt_image *patch, int *own_uvs)
+                     const tt_lapped *lapped, tt_image *patch, int *own_uvs)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
     size_t ncorners = 3 * (size_t)m->ntriangles, c;
     float *corner_uv = (float *)malloc(ncorners * 2 * sizeof(float));
-    tt_image atlas;
+    tt_image *atlas = NULL;
+    tt_bake_options bake;
     tt_error error;
     tool_buffer text;
     obj_write_desc desc;
     int status = 0;
 
-    memset(&atlas, 0, sizeof atlas);
     memset(&text, 0, sizeof text);
     snprintf(obj_path, sizeof obj_path, "%s_baked.obj", options->prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s_baked.mtl", options->prefix);
@@ -551,11 +594,13 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
         status = tool_fail("--bake %d: %s", options->bake_size, error.message);
         goto done;
     }
-    if (tt_image_create(&atlas, options->bake_size, options->bake_size, NULL) != TT_OK) {
-        status = tool_fail("out of memory for a %dx%d texture", options->bake_size, options->bake_size);
+    if (tt_image_create(options->bake_size, options->bake_size, NULL, &atlas, &error) != TT_OK) {
+        status = tool_fail("--bake %d: %s", options->bake_size, error.message);
         goto done;
     }
-    if (tt_lapped_bake(m->mesh, lapped, patch, 1, corner_uv, LAPPED_BAKE_GUTTER, &atlas, &error) != TT_OK) {
+    memset(&bake, 0, sizeof bake);
+    bake.gutter = LAPPED_BAKE_GUTTER;
+    if (tt_lapped_bake(m->mesh, lapped, &patch, 1, corner_uv, &bake, NULL, atlas, &error) != TT_OK) {
         status = report_error(options->mesh_path, m, &error);
         goto done;
     }
@@ -577,10 +622,12 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
         goto done;
     }
     status = add_mtl(output, mtl_path, "lapped_baked", png_path, 0);
-    if (status == 0) status = add_png(output, png_path, &atlas);
+    /* The baked texture holds linear straight RGBA: written as sRGB colour. */
+    if (status == 0) status = add_png(output, png_path, atlas);
+    atlas = NULL;   /* add_png freed it */
 done:
     buffer_free(&text);
-    tt_image_free(&atlas);
+    tt_image_free(atlas);
     free(corner_uv);
     return status;
 }
@@ -589,8 +636,8 @@ done:
 /* The command                                                              */
 /* ======================================================================== */
 
-static int paste(const lapped_options *options, const triangle_mesh *m, const float *field, const tt_image *patch,
-                 tt_lapped *lapped)
+static int paste(const lapped_options *options, const triangle_mesh *m, const float *field, tt_image *patch,
+                 tt_lapped **lapped)
 {
     tt_lapped_options paste_options;
     progress_state progress;
@@ -604,7 +651,7 @@ static int paste(const lapped_options *options, const triangle_mesh *m, const fl
     paste_options.isotropic = options->isotropic;
     paste_options.progress = show_progress;
     paste_options.progress_user_data = &progress;
-    result = tt_lapped_paste(m->mesh, field, patch, 1, &paste_options, lapped, &error);
+    result = tt_lapped_paste(m->mesh, field, &patch, 1, &paste_options, NULL, lapped, &error);
     end_progress(&progress);
     return result == TT_OK ? 0 : report_error(options->mesh_path, m, &error);
 }
@@ -613,13 +660,18 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
                           const tt_lapped *lapped, double seconds)
 {
     tt_lapped_report report;
+    tt_error error;
     double angle = lapped->mean_angle_error, scale = lapped->median_scale_error;
     /* Anisotropic: measured again from the UVs that were written, an
        independent check of what the paste loop believes. Isotropic pastes
        choose their own directions, which only the loop knows. */
-    if (!options->isotropic && tt_lapped_measure(m->mesh, field, lapped, &report) == TT_OK) {
-        angle = report.mean_angle_error;
-        scale = report.median_scale_error;
+    if (!options->isotropic) {
+        if (tt_lapped_measure(m->mesh, field, lapped, NULL, &report, &error) == TT_OK) {
+            angle = report.mean_angle_error;
+            scale = report.median_scale_error;
+        } else {
+            tool_note("alignment measured by the paste loop only: %s", error.message);
+        }
     }
     printf("%s: %d triangles", options->mesh_path, m->ntriangles);
     if (m->ntriangles != m->obj.nfaces) printf(" (fans of %d faces)", m->obj.nfaces);
@@ -651,8 +703,8 @@ int cmd_lapped(int argc, char **argv)
 {
     lapped_options options;
     triangle_mesh mesh;
-    tt_image image, patch, straight;
-    tt_lapped lapped;
+    tt_image *image = NULL, *patch = NULL;
+    tt_lapped *lapped = NULL;
     tool_output output;
     float *field = NULL;
     char obj_path[4096], mtl_path[4096], png_path[4096], message[TOOL_ERROR_SIZE];
@@ -664,32 +716,32 @@ int cmd_lapped(int argc, char **argv)
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
     snprintf(png_path, sizeof png_path, "%s_patch.png", options.prefix);
-    memset(&image, 0, sizeof image);
-    memset(&patch, 0, sizeof patch);
-    memset(&straight, 0, sizeof straight);
-    memset(&lapped, 0, sizeof lapped);
     memset(&output, 0, sizeof output);
 
     if ((status = triangle_mesh_read(options.mesh_path, &mesh)) != 0) return status;
     field = (float *)malloc((size_t)mesh.ntriangles * 3 * sizeof(float));
     if (!field) status = tool_fail("out of memory for the field of %s", options.mesh_path);
     if (status == 0) status = make_field(&options, &mesh, field);
-    if (status == 0 && image_load(options.image_path, &image, message, sizeof message) != 0)
+    /* A photo: sRGB bytes in the file, linear light in the library. */
+    if (status == 0 && image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
-    if (status == 0) status = make_patch(&options, &image, &patch);
     if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, png_path);
-    if (status == 0) status = paste(&options, &mesh, field, &patch, &lapped);
+    if (status == 0) status = make_patch(&options, image, &patch);
+    /* Memory: the image is needed only to make the patch and its PNG, so the
+       PNG is encoded now and the image freed before the paste loop; from
+       here on the command holds the patch and the compressed PNG. */
+    if (status == 0) status = add_patch_png(&output, png_path, &image, patch);
+    image_free(image);
+    image = NULL;
+    if (status == 0) status = paste(&options, &mesh, field, patch, &lapped);
 
-    if (status == 0 && straight_patch(&image, &patch, &straight) != 0)
-        status = tool_fail("out of memory for the patch image");
-    if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, &lapped);
+    if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped);
     if (status == 0) status = add_mtl(&output, mtl_path, "lapped", png_path, 1);
-    if (status == 0) status = add_png(&output, png_path, &straight);
-    if (status == 0 && options.bake_size > 0) status = add_baked(&output, &options, &mesh, &lapped, &patch, &own_uvs);
+    if (status == 0 && options.bake_size > 0) status = add_baked(&output, &options, &mesh, lapped, patch, &own_uvs);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0) {
-        print_summary(&options, &mesh, field, &lapped, seconds_now() - start);
+        print_summary(&options, &mesh, field, lapped, seconds_now() - start);
         printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
         if (options.bake_size > 0)
             printf("; %s_baked.obj/.mtl/.png (%dx%d, over %s)", options.prefix, options.bake_size,
@@ -697,10 +749,9 @@ int cmd_lapped(int argc, char **argv)
         printf("\n");
     }
     output_free(&output);
-    tt_lapped_free(&lapped);
-    tt_image_free(&straight);
-    tt_image_free(&patch);
-    tt_image_free(&image);
+    tt_lapped_free(lapped);
+    tt_image_free(patch);
+    image_free(image);
     free(field);
     triangle_mesh_free(&mesh);
     return status;

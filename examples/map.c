@@ -37,22 +37,28 @@ static void print_help(void)
            "  --smooth         use Catmull-Clark positions when subdividing (default: keep the shape)\n"
            "  --atlas A.png    also write OUT.mtl naming A.png, and report the seam score\n"
            "  --permissive     accept non-manifold or mis-oriented edges (they become boundaries)\n"
-           "  --report         also print tile usage and face stretch\n",
-           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
+           "  --report         also print tile usage and face stretch, and measure the seams on\n"
+           "                   every edge (default: a sample of %d edges)\n",
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TILED_REPORT_EDGES);
 }
 
 
 /* With --atlas: the atlas must have the layout's size. When --tile was not
    given, the tile size is read off the atlas instead (W = T * (S + 2g)). */
-static int load_atlas_for_layout(const char *path, tiled_options *options, tt_image *atlas)
+static int load_atlas_for_layout(const char *path, tiled_options *options, tt_image **out_atlas)
 {
     char message[TOOL_ERROR_SIZE];
     tt_tile_layout layout;
     tt_error error;
     int tiles_per_side;
-    if (image_load(path, atlas, message, sizeof message) != 0) return tool_fail("%s", message);
+    tt_image *atlas;
+    /* An atlas is colour (sRGB in the file); the seam measure compares it
+       as displayed. */
+    if (image_load(path, TT_COLOR_SRGB, out_atlas, message, sizeof message) != 0) return tool_fail("%s", message);
+    atlas = *out_atlas;
     if (tt_tile_layout_resolve(&options->layout, &layout, &error) != TT_OK) {
-        tt_image_free(atlas);
+        image_free(atlas);
+        *out_atlas = NULL;
         return tool_fail("%s", error.message);
     }
     tiles_per_side = tt_tile_layout_tiles_per_side(&layout);
@@ -61,7 +67,8 @@ static int load_atlas_for_layout(const char *path, tiled_options *options, tt_im
         options->layout.tile_size = layout.tile_size = atlas->width / tiles_per_side - 2 * layout.gutter;
     if (atlas->width != tt_tile_layout_atlas_size(&layout) || atlas->height != atlas->width) {
         int expected = tt_tile_layout_atlas_size(&layout), width = atlas->width, height = atlas->height;
-        tt_image_free(atlas);
+        image_free(atlas);
+        *out_atlas = NULL;
         return tool_fail("%s is %dx%d, but --colors %d --tile %d --gutter %d make %dx%d atlases", path, width,
                          height, layout.colors, layout.tile_size, layout.gutter, expected, expected);
     }
@@ -74,13 +81,12 @@ int cmd_map(int argc, char **argv)
     int status;
     tiled_options options;
     tiled_mesh mesh;
-    tt_image atlas;
-    tt_seam_report seams;
+    tt_image *atlas = NULL;
+    tiled_seams seams;
     tool_output output;
     char message[TOOL_ERROR_SIZE], mtl_path[4096];
 
     memset(&output, 0, sizeof output);
-    memset(&atlas, 0, sizeof atlas);
     status = tiled_parse_command_line(argc, argv,
                                       TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION,
                                       &options, positional, 2, "MESH.obj and OUT.obj", print_help);
@@ -90,15 +96,13 @@ int cmd_map(int argc, char **argv)
         return status;
     if ((status = tiled_check_atlas_size(&options)) != 0 ||
         (status = tiled_map_mesh(positional[0], &options, &mesh)) != 0) {
-        tt_image_free(&atlas);
+        image_free(atlas);
         return status;
     }
     if (options.atlas_path) {
         char texture[4096];
-        if (tt_measure_seams(mesh.mesh, mesh.corner_uv, &atlas, options.seed, &seams) != TT_OK) {
-            status = tool_fail("out of memory while measuring the seams of %s", positional[0]);
-            goto done;
-        }
+        status = tiled_measure_seams(positional[0], &mesh, atlas, options.seed, options.report, &seams);
+        if (status != 0) goto done;
         /* The MTL sits beside the OBJ, and names the atlas relative to itself. */
         snprintf(mtl_path, sizeof mtl_path, "%.*s.mtl",
                  (int)(strlen(positional[1]) > 4 && strcmp(positional[1] + strlen(positional[1]) - 4, ".obj") == 0
@@ -118,6 +122,6 @@ int cmd_map(int argc, char **argv)
 done:
     output_free(&output);
     tiled_mesh_free(&mesh);
-    tt_image_free(&atlas);
+    image_free(atlas);
     return status;
 }

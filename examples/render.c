@@ -31,7 +31,15 @@
    whose nearest triangle has the same three vertices, it composites its
    texture colour `over` an opaque grey base. Step 5 then lights that colour.
    Only the nearest surface is blended, so a gap between pastes shows grey,
-   never the surface behind. Other meshes are drawn exactly as before. */
+   never the surface behind. Other meshes are drawn exactly as before.
+
+   Colour: everything is computed in linear light, as light adds up. The
+   texture file's sRGB bytes are decoded on load (TT_COLOR_SRGB), so mip
+   levels, bilinear and trilinear filtering, the blending of pastes, the
+   lighting and the 2x2 supersampling average linear values; the finished
+   frame is encoded to sRGB once, when it is saved. The renderer's own
+   colours (background, untextured grey, wireframe ink) are chosen as
+   displayed sRGB values and decoded once. */
 
 #include <math.h>
 #include <stdio.h>
@@ -47,7 +55,10 @@
 #define FIELD_OF_VIEW_DEGREES 35.0f     /* along the picture's shorter side */
 #define FRAME_MARGIN 1.1f               /* a little room around the model's bounding sphere */
 #define CREASE_ANGLE_DEGREES 50.0f      /* faces meeting at a sharper angle are not smoothed together */
-#define UNTEXTURED_GREY 0.75f
+/* Displayed (sRGB-encoded) values; the scene holds their linear-light
+   equivalents. */
+#define UNTEXTURED_GREY_SRGB 0.75f
+#define WIREFRAME_INK_SRGB 0.05f
 
 static const float PI = 3.14159265358979f;
 
@@ -88,13 +99,16 @@ static vec3 vertex_position(const obj_mesh *mesh, int v)
    than the last level can hold is simply sampled from the last level. */
 typedef struct mip_texture {
     int nlevels;
-    tt_image levels[TT_MAX_MIP_LEVELS];
+    tt_image *levels[TT_MAX_MIP_LEVELS];    /* linear light */
 } mip_texture;
 
 static void texture_free(mip_texture *texture)
 {
     int i;
-    for (i = 0; i < texture->nlevels; i++) tt_image_free(&texture->levels[i]);
+    /* Level 0 is the loaded image (the tool's, image_free); the others are
+       the library's. */
+    if (texture->nlevels > 0) image_free(texture->levels[0]);
+    for (i = 1; i < texture->nlevels; i++) tt_image_free(texture->levels[i]);
     texture->nlevels = 0;
 }
 
@@ -110,17 +124,19 @@ static void premultiply_alpha(tt_image *image)
     }
 }
 
-/* Takes ownership of `image`. */
-static int texture_build(mip_texture *texture, tt_image *image)
+/* Takes ownership of `image` (linear light: the mip averages are linear).
+   On failure the library's message is in `message`. */
+static int texture_build(mip_texture *texture, tt_image *image, char *message, size_t message_size)
 {
+    tt_error error;
     memset(texture, 0, sizeof *texture);
-    texture->levels[0] = *image;
-    memset(image, 0, sizeof *image);
+    texture->levels[0] = image;
     texture->nlevels = 1;
     while (texture->nlevels < TT_MAX_MIP_LEVELS) {
-        const tt_image *last = &texture->levels[texture->nlevels - 1];
+        const tt_image *last = texture->levels[texture->nlevels - 1];
         if (last->width % 2 != 0 || last->height % 2 != 0) break;
-        if (tt_image_downsample2(last, &texture->levels[texture->nlevels], NULL) != TT_OK) {
+        if (tt_image_downsample2(last, NULL, &texture->levels[texture->nlevels], &error) != TT_OK) {
+            snprintf(message, message_size, "%s", error.message);
             texture_free(texture);
             return -1;
         }
@@ -187,14 +203,14 @@ static void sample_trilinear(const mip_texture *texture, float u, float v, float
     int level, i;
     if (!isfinite(u) || !isfinite(v)) u = v = 0.0f;
     if (!(lod < (float)(texture->nlevels - 1))) {   /* also catches NaN */
-        sample_bilinear(&texture->levels[texture->nlevels - 1], u, v, repeat, rgba);
+        sample_bilinear(texture->levels[texture->nlevels - 1], u, v, repeat, rgba);
         return;
     }
     level = (int)lod;
     t = lod - (float)level;
-    sample_bilinear(&texture->levels[level], u, v, repeat, rgba);
+    sample_bilinear(texture->levels[level], u, v, repeat, rgba);
     if (t <= 0.0f) return;
-    sample_bilinear(&texture->levels[level + 1], u, v, repeat, coarse);
+    sample_bilinear(texture->levels[level + 1], u, v, repeat, coarse);
     for (i = 0; i < 4; i++) rgba[i] += (coarse[i] - rgba[i]) * t;
 }
 
@@ -283,6 +299,8 @@ typedef struct scene {
     int wireframe;              /* draw the OBJ faces' edges over the surface */
     vec3 light_key, light_fill; /* unit vectors towards the two lights */
     int width, height;          /* of the sample grid */
+    float untextured_grey;      /* linear light */
+    float wireframe_ink;        /* linear light */
 } scene;
 
 static void scene_free(scene *s)
@@ -634,7 +652,7 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
 {
     const obj_mesh *mesh = s->mesh;
     const int *corner = s->triangle_corners + 3 * t;
-    rgba[0] = rgba[1] = rgba[2] = UNTEXTURED_GREY;
+    rgba[0] = rgba[1] = rgba[2] = s->untextured_grey;
     rgba[3] = 1.0f;
     if (s->texture && mesh->corner_uv && mesh->corner_uv[corner[0]] >= 0 && mesh->corner_uv[corner[1]] >= 0 &&
         mesh->corner_uv[corner[2]] >= 0) {
@@ -651,7 +669,7 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
         float uqy = dbdy[0] * uv0[0] * p0[2] + dbdy[1] * uv1[0] * p1[2] + dbdy[2] * uv2[0] * p2[2];
         float vqx = dbdx[0] * uv0[1] * p0[2] + dbdx[1] * uv1[1] * p1[2] + dbdx[2] * uv2[1] * p2[2];
         float vqy = dbdy[0] * uv0[1] * p0[2] + dbdy[1] * uv1[1] * p1[2] + dbdy[2] * uv2[1] * p2[2];
-        const tt_image *base = &s->texture->levels[0];
+        const tt_image *base = s->texture->levels[0];
         float dudx = (uqx - u * qx) / q * (float)base->width, dvdx = (vqx - v * qx) / q * (float)base->height;
         float dudy = (uqy - u * qy) / q * (float)base->width, dvdy = (vqy - v * qy) / q * (float)base->height;
         /* The footprint of one sample in texels: the longer of its two sides. */
@@ -688,7 +706,7 @@ static void light_sample(const scene *s, int t, const surface_point *point, floa
             if ((s->triangle_edges[t] >> k) & 1u && gradient > 0.0f)
                 ink = fmaxf(ink, 1.0f - fminf(1.0f, fmaxf(0.0f, point->b[k] / gradient - 0.6f) / 0.8f));
         }
-        for (k = 0; k < 3; k++) rgb[k] = rgb[k] * (1.0f - 0.85f * ink) + 0.05f * ink;
+        for (k = 0; k < 3; k++) rgb[k] = rgb[k] * (1.0f - 0.85f * ink) + s->wireframe_ink * ink;
     }
 }
 
@@ -724,7 +742,7 @@ static void draw_pastes(const scene *s, sample_buffer *samples)
        as an untextured one would. */
     for (i = 0; i < n; i++) {
         float *base = samples->paste + 4 * i;
-        base[0] = base[1] = base[2] = UNTEXTURED_GREY;
+        base[0] = base[1] = base[2] = s->untextured_grey;
         base[3] = 1.0f;
     }
     job.s = s;
@@ -737,13 +755,14 @@ static void draw_pastes(const scene *s, sample_buffer *samples)
     }
 }
 
-/* A quiet vertical gradient, so both dark and light models stand out. */
+/* A quiet vertical gradient, so both dark and light models stand out:
+   chosen as displayed values, returned in linear light. */
 static void background_color(float y_fraction, float rgb[3])
 {
     float grey = 0.86f - 0.16f * y_fraction;
-    rgb[0] = grey;
-    rgb[1] = grey;
-    rgb[2] = grey + 0.015f;
+    rgb[0] = tt_srgb_to_linear(grey);
+    rgb[1] = rgb[0];
+    rgb[2] = tt_srgb_to_linear(grey + 0.015f);
 }
 
 static void shade_samples(const scene *s, sample_buffer *samples)
@@ -774,11 +793,15 @@ static void shade_samples(const scene *s, sample_buffer *samples)
 /* Resolve: average the samples of each pixel                               */
 /* ======================================================================== */
 
-static int resolve(const sample_buffer *samples, tt_image *picture)
+/* The average is taken in linear light (anti-aliased edges get the colour
+   the eye would average); *out_picture stays linear until it is saved. */
+static int resolve(const sample_buffer *samples, tt_image **out_picture, tt_error *error)
 {
     int width = samples->width / SUPERSAMPLING, height = samples->height / SUPERSAMPLING, x, y;
     const float weight = 1.0f / (float)(SUPERSAMPLING * SUPERSAMPLING);
-    if (tt_image_create(picture, width, height, NULL) != TT_OK) return -1;
+    tt_image *picture;
+    if (tt_image_create(width, height, NULL, out_picture, error) != TT_OK) return -1;
+    picture = *out_picture;
     for (y = 0; y < height; y++) {
         for (x = 0; x < width; x++) {
             float *pixel = picture->pixels + 4 * ((size_t)y * (size_t)width + (size_t)x);
@@ -830,10 +853,11 @@ int cmd_render(int argc, char **argv)
     const char *positional[3];
     int npositional = 0, width = RENDER_DEFAULT_WIDTH, height = RENDER_DEFAULT_HEIGHT, i, status = TOOL_EXIT_FAILURE;
     double yaw = 30.0, pitch = 20.0, zoom = 1.0;
-    int wireframe = 0;
+    int wireframe = 0, built;
     char err[TOOL_ERROR_SIZE];
     obj_mesh mesh;
-    tt_image image, picture;
+    tt_image *image = NULL, *picture = NULL;
+    tt_error error;
     mip_texture texture;
     scene s;
     camera cam;
@@ -879,9 +903,9 @@ int cmd_render(int argc, char **argv)
     memset(&texture, 0, sizeof texture);
     memset(&s, 0, sizeof s);
     memset(&samples, 0, sizeof samples);
-    memset(&picture, 0, sizeof picture);
     if (obj_read(positional[0], &mesh, err, sizeof err) != 0) return tool_fail("%s", err);
-    if (image_load(positional[1], &image, err, sizeof err) != 0) {
+    /* The texture is colour: sRGB bytes, decoded to linear light. */
+    if (image_load(positional[1], TT_COLOR_SRGB, &image, err, sizeof err) != 0) {
         tool_fail("%s", err);
         goto done;
     }
@@ -897,15 +921,19 @@ int cmd_render(int argc, char **argv)
     }
     /* A pasting mesh blends its texture, and blending, like mip-mapping,
        needs premultiplied colours (or transparent texels bleed their colour). */
-    if (s.pasting) premultiply_alpha(&image);
-    if (texture_build(&texture, &image) != 0) {
-        tool_fail("out of memory while preparing the texture");
+    if (s.pasting) premultiply_alpha(image);
+    built = texture_build(&texture, image, err, sizeof err);
+    image = NULL;   /* the texture owns it now */
+    if (built != 0) {
+        tool_fail("cannot prepare the texture %s: %s", positional[1], err);
         goto done;
     }
     s.texture = &texture;
     s.width = width * SUPERSAMPLING;
     s.height = height * SUPERSAMPLING;
     s.wireframe = wireframe;
+    s.untextured_grey = tt_srgb_to_linear(UNTEXTURED_GREY_SRGB);
+    s.wireframe_ink = tt_srgb_to_linear(WIREFRAME_INK_SRGB);
     camera_orbit(&cam, centre, radius, &axis, (float)yaw, (float)pitch, (float)zoom, s.width, s.height);
     /* Key light from the upper left behind the viewer, a weaker fill from the right. */
     s.light_key = vec3_normalize(vec3_add(vec3_add(vec3_scale(cam.right, -0.45f), vec3_scale(cam.up, 0.6f)),
@@ -920,11 +948,12 @@ int cmd_render(int argc, char **argv)
     draw_visibility(&s, &samples);
     if (s.pasting) draw_pastes(&s, &samples);
     shade_samples(&s, &samples);
-    if (resolve(&samples, &picture) != 0) {
-        tool_fail("out of memory while rendering %s", positional[0]);
+    if (resolve(&samples, &picture, &error) != 0) {
+        tool_fail("cannot render %s: %s", positional[0], error.message);
         goto done;
     }
-    if (output_add_png(&output, positional[2], &picture, err, sizeof err) != 0 ||
+    /* The frame is encoded to sRGB once, here. */
+    if (output_add_png(&output, positional[2], picture, TT_COLOR_SRGB, err, sizeof err) != 0 ||
         output_commit(&output, err, sizeof err) != 0) {
         tool_fail("%s", err);
         goto done;
@@ -934,11 +963,11 @@ int cmd_render(int argc, char **argv)
 
 done:
     output_free(&output);
-    tt_image_free(&picture);
+    tt_image_free(picture);
     samples_free(&samples);
     scene_free(&s);
     texture_free(&texture);
-    tt_image_free(&image);
+    image_free(image);
     obj_free(&mesh);
     return status;
 }

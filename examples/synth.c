@@ -42,7 +42,7 @@ int cmd_synth(int argc, char **argv)
     const char *positional[2];
     int k, status;
     tiled_options options;
-    tt_image image;
+    tt_image *image = NULL;
     tt_tileset *tiles = NULL;
     tool_output output;
     char message[TOOL_ERROR_SIZE];
@@ -53,8 +53,12 @@ int cmd_synth(int argc, char **argv)
     if (status >= 0) return status;
 
     if ((status = tiled_check_atlas_size(&options)) != 0) return status;
-    if (image_load(positional[0], &image, message, sizeof message) != 0) return tool_fail("%s", message);
-    status = tiled_synthesize(&image, positional[0], &options, &tiles);
+    /* A photo: sRGB in the file, linear light in the library. */
+    if (image_load(positional[0], TT_COLOR_SRGB, &image, message, sizeof message) != 0)
+        return tool_fail("%s", message);
+    status = tiled_synthesize(image, positional[0], &options, &tiles);
+    image_free(image);       /* not needed past the synthesis */
+    image = NULL;
     if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
@@ -68,6 +72,6 @@ int cmd_synth(int argc, char **argv)
     }
     output_free(&output);
     tt_tileset_free(tiles);
-    tt_image_free(&image);
+    image_free(image);
     return status;
 }

@@ -31,8 +31,9 @@ static void print_help(void)
            "  --edge X,Y             condition k's S x 2S edge window, once per condition\n"
            "  --background X,Y,W,H   region the background windows come from\n"
            "  --mips                 also write the per-tile mip levels, OUT_PREFIX_mip1.png ...\n"
-           "  --report               also print tile usage and face stretch\n",
-           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
+           "  --report               also print tile usage and face stretch, and measure the\n"
+           "                         seams on every edge (default: a sample of %d edges)\n",
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TILED_REPORT_EDGES);
 }
 
 int cmd_tile(int argc, char **argv)
@@ -41,9 +42,10 @@ int cmd_tile(int argc, char **argv)
     int status;
     tiled_options options;
     tiled_mesh mesh;
-    tt_image image;
+    tt_image *image = NULL;
     tt_tileset *tiles = NULL;
-    tt_seam_report seams;
+    tiled_seams seams;
+    int image_width, image_height;
     tool_output output;
     char message[TOOL_ERROR_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
 
@@ -61,15 +63,19 @@ int cmd_tile(int argc, char **argv)
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", positional[2]);
     snprintf(png_path, sizeof png_path, "%s.png", positional[2]);
 
-    if (image_load(positional[1], &image, message, sizeof message) != 0) return tool_fail("%s", message);
+    /* A photo: its 8-bit values are sRGB, the library works in linear light. */
+    if (image_load(positional[1], TT_COLOR_SRGB, &image, message, sizeof message) != 0)
+        return tool_fail("%s", message);
+    image_width = image->width;
+    image_height = image->height;
     /* Without --tile, take the default tile size or the largest this image
        can feed; say so when it is smaller. */
     if (!options.tile_size_given) {
-        int fit = tiled_fit_tile_size(image.width, image.height, options.layout.colors, options.layout.gutter);
+        int fit = tiled_fit_tile_size(image_width, image_height, options.layout.colors, options.layout.gutter);
         if (fit == 0) {
             status = tool_fail("%s is %dx%d: too small to cut tiles from (it needs at least 4x8 texels)",
-                               positional[1], image.width, image.height);
-            tt_image_free(&image);
+                               positional[1], image_width, image_height);
+            image_free(image);
             return status;
         }
         options.layout.tile_size = fit;
@@ -81,9 +87,13 @@ int cmd_tile(int argc, char **argv)
     if (status == 0) status = tool_refuse_input_overwrite(obj_path);
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
     if (status == 0) status = tool_refuse_input_overwrite(png_path);
-    if (status == 0) status = tiled_synthesize(&image, positional[1], &options, &tiles);
-    if (status == 0 && tt_measure_seams(mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, &seams) != TT_OK)
-        status = tool_fail("out of memory while measuring the seams of %s", positional[0]);
+    if (status == 0) status = tiled_synthesize(image, positional[1], &options, &tiles);
+    /* The photo is not needed past the synthesis: free it before the PNGs
+       are encoded (it is the largest thing the command holds). */
+    image_free(image);
+    image = NULL;
+    if (status == 0) status = tiled_measure_seams(positional[0], &mesh, &tiles->levels[0], options.seed, options.report,
+                                                       &seams);
     if (status == 0) status = tiled_add_atlas(&output, png_path, tiles, options.mips);
     if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
     if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));
@@ -92,7 +102,7 @@ int cmd_tile(int argc, char **argv)
         /* Said only on success: a failing command prints its one error line. */
         if (!options.tile_size_given && options.layout.tile_size < TT_DEFAULT_TILE_SIZE)
             fprintf(stderr, "tiledtex: %s is %dx%d: used %d-texel tiles (--tile to choose)\n", positional[1],
-                    image.width, image.height, options.layout.tile_size);
+                    image_width, image_height, options.layout.tile_size);
         tiled_print_notes(positional[0], &mesh);
         tiled_print_summary(positional[0], &mesh, &seams, options.report);
         printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
@@ -101,6 +111,6 @@ int cmd_tile(int argc, char **argv)
     output_free(&output);
     tiled_mesh_free(&mesh);
     tt_tileset_free(tiles);
-    tt_image_free(&image);
+    image_free(image);
     return status;
 }

@@ -108,7 +108,7 @@ static int quadrangulate(tt_mesh **mesh, tt_subdivision scheme, const char *obj_
 {
     tt_mesh *quads;
     tt_error error;
-    if (tt_mesh_quadrangulate(*mesh, scheme, &quads, &error) != TT_OK)
+    if (tt_mesh_quadrangulate(*mesh, scheme, NULL, &quads, &error) != TT_OK)
         return tool_fail("%s: cannot quadrangulate: %s", obj_path, error.message);
     tt_mesh_free(*mesh);
     *mesh = quads;
@@ -130,7 +130,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
 
     desc = obj_mesh_desc(&obj, options->permissive ? TT_MESH_PERMISSIVE : 0);
     out->input_faces = obj.nfaces;
-    if (tt_mesh_build(&desc, &out->mesh, &error) != TT_OK) {
+    if (tt_mesh_build(&desc, NULL, &out->mesh, &error) != TT_OK) {
         status = obj_report_mesh_error(obj_path, &obj, &error, 1);
         obj_free(&obj);
         return status;
@@ -165,13 +165,14 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         status = tool_fail("out of memory for %d corners", out->mesh->ncorners);
         goto fail;
     }
-    tt_assign_boundaries(out->mesh, &out->layout, options->seed, out->corner_type);
-    if (tt_assign_uvs(out->mesh, &out->layout, out->corner_type, out->corner_uv, &error) != TT_OK) {
+    /* NULL edge colours: every edge's condition comes from the seed. */
+    if (tt_assign_boundaries(out->mesh, &out->layout, options->seed, NULL, out->corner_type, &error) != TT_OK ||
+        tt_assign_uvs(out->mesh, &out->layout, out->corner_type, out->corner_uv, &error) != TT_OK) {
         status = tool_fail("%s: %s", obj_path, error.message);
         goto fail;
     }
-    if (tt_mesh_compute_stats(out->mesh, &out->stats) != TT_OK) {
-        status = tool_fail("out of memory while measuring %s", obj_path);
+    if (tt_mesh_compute_stats(out->mesh, NULL, &out->stats, &error) != TT_OK) {
+        status = tool_fail("%s: %s", obj_path, error.message);
         goto fail;
     }
     return 0;
@@ -234,8 +235,16 @@ static void print_quality(const tiled_mesh *mesh)
         most = 0, t, f, degenerate = 0;
     int *counts = (int *)malloc((size_t)ntiles * sizeof(int));
     float *stretch = (float *)malloc((size_t)nfaces * sizeof(float));
-    if (!counts || !stretch || tt_tile_histogram(mesh->mesh, &mesh->layout, mesh->corner_type, counts) != TT_OK ||
-        tt_face_stretch(mesh->mesh, mesh->corner_uv, stretch) != TT_OK) {
+    tt_error error;
+    if (!counts || !stretch) {
+        printf("quality: not measured (out of memory)\n");
+        free(counts);
+        free(stretch);
+        return;
+    }
+    if (tt_tile_histogram(mesh->mesh, &mesh->layout, mesh->corner_type, counts, &error) != TT_OK ||
+        tt_face_stretch(mesh->mesh, mesh->corner_uv, stretch, &error) != TT_OK) {
+        printf("quality: not measured (%s)\n", error.message);
         free(counts);
         free(stretch);
         return;
@@ -287,7 +296,38 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
     }
 }
 
-void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_seam_report *seams, int report)
+int tiled_measure_seams(const char *obj_path, const tiled_mesh *mesh, const tt_image *atlas, uint64_t seed,
+                        int all_edges, tiled_seams *out)
+{
+    tt_seam_options options;
+    tt_error error;
+    tt_result result;
+    int c;
+    size_t length;
+    memset(out, 0, sizeof *out);
+    for (c = 0; c < mesh->mesh->ncorners; c++)
+        if (mesh->mesh->twin[c] > c) out->interior_edges++;
+    /* The summary is a report, not the acceptance measure: a random sample
+       of edges keeps it fast on big meshes (within about 0.01 of the full
+       score). --report asks for the full measure, every interior edge. */
+    memset(&options, 0, sizeof options);
+    options.seed = seed;
+    options.max_edges = all_edges ? 0 : TILED_REPORT_EDGES;
+    out->sampled = !all_edges && out->interior_edges > TILED_REPORT_EDGES;
+    result = tt_measure_seams(mesh->mesh, mesh->corner_uv, atlas, &options, NULL, &out->report, &error);
+    if (result == TT_ERROR_NOT_MEASURED) {
+        /* Not an error: the summary says why there is no number. */
+        snprintf(out->reason, sizeof out->reason, "%s", error.message);
+        length = strlen(out->reason);
+        if (length > 0 && out->reason[length - 1] == '.') out->reason[length - 1] = '\0';
+        return 0;
+    }
+    if (result != TT_OK) return tool_fail("%s: cannot measure the seams: %s", obj_path, error.message);
+    out->measured = 1;
+    return 0;
+}
+
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tiled_seams *seams, int report)
 {
     const tt_mesh_stats *s = &mesh->stats;
     printf("%s: %d quads, %d vertices, genus %d, %d component%s, %d boundary loop%s, valence %d..%d, "
@@ -296,12 +336,20 @@ void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tt_
            s->boundary_loops, s->boundary_loops == 1 ? "" : "s", s->min_valence, s->max_valence,
            tt_tile_layout_tile_count(&mesh->layout), mesh->layout.colors, mesh->layout.tile_size,
            mesh->layout.gutter);
-    if (seams && seams->score == seams->score)
-        printf(", seam score %.3f (seam %.4f, same-face %.4f, unrelated %.4f)", seams->score, seams->seam,
-               seams->same_face, seams->unrelated);
-    else if (seams)
-        printf(", seam score n/a: unrelated places differ no more than neighbours (seam %.4f, same-face %.4f, "
-               "unrelated %.4f)", seams->seam, seams->same_face, seams->unrelated);
+    if (seams && !seams->measured) {
+        printf(", seam score: not measured (%s)", seams->reason);
+    } else if (seams) {
+        const tt_seam_report *r = &seams->report;
+        char edges[96];
+        snprintf(edges, sizeof edges, "%d of %d edges%s", r->edges_measured, seams->interior_edges,
+                 seams->sampled ? " sampled" : "");
+        if (r->score == r->score)
+            printf(", seam score %.3f (%s; seam %.4f, same-face %.4f, unrelated %.4f)", r->score, edges, r->seam,
+                   r->same_face, r->unrelated);
+        else
+            printf(", seam score n/a: unrelated places differ no more than neighbours (%s; seam %.4f, "
+                   "same-face %.4f, unrelated %.4f)", edges, r->seam, r->same_face, r->unrelated);
+    }
     printf("\n");
     if (report) print_quality(mesh);
 }
@@ -338,7 +386,7 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
                               colors == 1 ? "" : "s");
         synth.edge_windows = options->edges;
     }
-    if (tt_synthesize_tiles(image, &synth, out, &error) != TT_OK) {
+    if (tt_synthesize_tiles(image, &synth, NULL, out, &error) != TT_OK) {
         if (error.result == TT_ERROR_IMAGE_TOO_SMALL || error.result == TT_ERROR_INVALID_ARGUMENT)
             return tool_fail("%s: %s", image_path, error.message);
         return tool_fail("%s", error.message);
@@ -351,12 +399,15 @@ int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset 
     char message[TOOL_ERROR_SIZE], path[4096];
     int level;
     size_t stem = strlen(png_path);
-    if (output_add_png(output, png_path, &tiles->levels[0], message, sizeof message) != 0)
+    /* The atlas and its mip levels are colour: encoded to sRGB. The levels
+       are the library's linear-light averages, so a black and white
+       checkerboard's mip is sRGB 188, as the eye averages it. */
+    if (output_add_png(output, png_path, &tiles->levels[0], TT_COLOR_SRGB, message, sizeof message) != 0)
         return tool_fail("%s", message);
     if (stem > 4 && strcmp(png_path + stem - 4, ".png") == 0) stem -= 4;
     for (level = 1; mips && level < tiles->nlevels; level++) {
         snprintf(path, sizeof path, "%.*s_mip%d.png", (int)stem, png_path, level);
-        if (output_add_png(output, path, &tiles->levels[level], message, sizeof message) != 0)
+        if (output_add_png(output, path, &tiles->levels[level], TT_COLOR_SRGB, message, sizeof message) != 0)
             return tool_fail("%s", message);
     }
     return 0;

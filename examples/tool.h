@@ -245,17 +245,35 @@ void output_free(tool_output *output);
 void image_set_max_pixels(uint64_t max_pixels);
 
 /* Load a PNG / JPEG / TGA / BMP / PSD / GIF / HDR / PIC / PNM file as a float
-   RGBA tt_image (grey and grey+alpha become RGB(A); no alpha means alpha 1).
+   RGBA tt_image in linear light (grey and grey+alpha become RGB(A); no alpha
+   means alpha 1). `space` says how the file's 8-bit values encode colour:
+   TT_COLOR_SRGB for colour pictures (photos, atlases, textures),
+   TT_COLOR_LINEAR for data (masks). *image is NULL on failure. It is the
+   tool's own memory, handed to the library as a view: free it with
+   image_free, never tt_image_free. The 8-bit decode is converted in strips
+   and shrinks as it goes, so loading holds about 16 bytes a pixel, not
+   16 + channels.
    Errors: the file is missing or unreadable, is not an image stb_image can
    decode, is wider or taller than TT_MAX_IMAGE_SIZE, or has more pixels than
    the budget (image_set_max_pixels). Sizes are read from the header before
    any pixel is decoded. */
-int image_load(const char *path, tt_image *image, char *err, size_t err_size);
+int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size);
+void image_free(tt_image *image);
 
-/* Encode an image as an 8-bit RGBA PNG in memory (malloc'ed; free it). */
-int png_encode(const tt_image *image, unsigned char **png, size_t *png_size, char *err, size_t err_size);
-/* Encode `image` as PNG and add it to an output batch. */
-int output_add_png(tool_output *output, const char *path, const tt_image *image, char *err, size_t err_size);
+/* Encode an image as an 8-bit PNG in memory (malloc'ed; free it), its
+   colours encoded into `space` (TT_COLOR_SRGB for every colour output).
+   Opaque images are written as RGB, others as RGBA (straight alpha). */
+int png_encode(const tt_image *image, tt_color_space space, unsigned char **png, size_t *png_size, char *err,
+               size_t err_size);
+/* The same from 8-bit RGBA already encoded (width * height * 4 bytes), which
+   the encoder may rewrite in place (an opaque image is packed to RGB). */
+int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char **png, size_t *png_size, char *err,
+                     size_t err_size);
+/* Encode as PNG and add it to an output batch. */
+int output_add_png(tool_output *output, const char *path, const tt_image *image, tt_color_space space, char *err,
+                   size_t err_size);
+int output_add_png_rgba8(tool_output *output, const char *path, unsigned char *rgba, int width, int height,
+                         char *err, size_t err_size);
 
 /* ---------------------------------------------------------------------- */
 /* Wavefront OBJ (obj.c)                                                    */

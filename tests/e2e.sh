@@ -1062,6 +1062,72 @@ check "positions survive writing and reading" "identical v lines" "differ" \
 cd "$W" || exit 1
 
 # ======================================================================
+# Colour: linear light inside, sRGB in the files (converted once each way);
+# the seam report
+# ======================================================================
+cat >"$W/pixstat.c" <<'EOF_C'
+/* pixstat FILE: "min max" of every r, g, b byte of an image;
+   pixstat FILE X Y: "r g b" of one pixel. */
+#define STB_IMAGE_IMPLEMENTATION
+#include "stb_image.h"
+#include <stdio.h>
+#include <stdlib.h>
+int main(int argc, char **argv)
+{
+    int w, h, n, lo = 255, hi = 0;
+    long i;
+    unsigned char *p = argc > 1 ? stbi_load(argv[1], &w, &h, &n, 3) : NULL;
+    if (!p) return 1;
+    if (argc == 4) {
+        long at = 3 * ((long)atoi(argv[3]) * w + atoi(argv[2]));
+        printf("%d %d %d\n", p[at], p[at + 1], p[at + 2]);
+        return 0;
+    }
+    for (i = 0; i < 3L * w * h; i++) {
+        if (p[i] < lo) lo = p[i];
+        if (p[i] > hi) hi = p[i];
+    }
+    printf("%d %d\n", lo, hi);
+    return 0;
+}
+EOF_C
+newdir
+# a flat mid-grey image (sRGB 128, binary PGM), a unit square facing +z with UVs
+{ printf 'P5\n64 64\n255\n'; head -c 4096 /dev/zero | tr '\0' '\200'; } >grey.pgm
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n' >square_uv.obj
+CMD="$HELPER_CC $STB_INC pixstat.c (test helper)"
+if $HELPER_CC -O2 -w $STB_INC "$W/pixstat.c" -o "$W/pixstat" -lm 2>"$W/err"; then
+    # sRGB 128 is linear 0.216; decoded twice it would come out darker, never
+    # decoded it would be encoded to 188: the atlas and its mip stay 128.
+    expect_ok "synth a flat mid-grey image" synth grey.pgm grey_atlas.png --tile 16 --mips
+    CMD="pixstat grey_atlas.png"
+    check "synth keeps sRGB 128 grey (no double conversion)" "128 128" "$("$W/pixstat" grey_atlas.png 2>&1)" \
+        "$([ "$("$W/pixstat" grey_atlas.png 2>/dev/null)" = "128 128" ]; echo $?)"
+    check "synth --mips: the mip of flat grey stays 128" "128 128" "$("$W/pixstat" grey_atlas_mip1.png 2>&1)" \
+        "$([ "$("$W/pixstat" grey_atlas_mip1.png 2>/dev/null)" = "128 128" ]; echo $?)"
+    # Rendered face-on, lit by 0.32 ambient + 0.72 key (cos 45 deg) + 0.22
+    # fill (cos 63.4 deg) = 0.928 in linear light: 0.216 * 0.928 encodes to
+    # 124. A double gamma would give about 182 (never decoded) or 51 (never
+    # encoded).
+    expect_ok "render a flat mid-grey texture" render square_uv.obj grey.pgm view.png --size 64x64 --yaw 0 --pitch 0
+    CMD="pixstat view.png 32 32"
+    px=$("$W/pixstat" view.png 32 32 2>/dev/null)
+    check "render: mid-grey stays mid-grey (no double gamma)" "r g b each 124 +- 4" "$px" \
+        "$(printf '%s\n' "$px" | awk '{exit !(NF == 3 && $1 >= 120 && $1 <= 128 && $2 == $1 && $3 == $1)}'; echo $?)"
+else
+    fail "helper for reading pixels" "$CMD" "compiles" "$(head -c 300 "$W/err")"
+fi
+# one quad has no interior edge: the summary says the seams were not measured
+expect_ok "tile a one-quad mesh" tile square_uv.obj ../in/tex.png one
+check "tile one quad: seam score not measured" "'seam score: not measured (reason)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE 'seam score: not measured \(.+\)' && [ -z "$(summary_seam)" ]; echo $?)"
+# the report says how many edges it measured of how many
+expect_ok "tile the torus for the seam report" tile ../in/torus.obj ../in/tex.png t
+check "tile: seam score names the edges measured" "'seam score X (N of M edges'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE 'seam score -?[0-9.]+ \([0-9]+ of [0-9]+ edges'; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
 # Sanitizers
 # ======================================================================
 CMD="all $RUNS runs"
