@@ -1440,7 +1440,8 @@ static void tt__free(const tt_allocator *allocator, void *ptr)
 {
     if (!ptr) return;
     if (allocator && allocator->alloc) {
-        allocator->free(ptr, allocator->user_data);
+        void (*release)(void *, void *) = allocator->free;   /* set: tt__check_allocator */
+        release(ptr, allocator->user_data);
         return;
     }
     TT_FREE(ptr, allocator ? allocator->user_data : NULL);
