@@ -117,4 +117,22 @@ typedef struct reader {
 static inline uint8_t rd_u8(reader *r) { return r->at < r->n ? r->p[r->at++] : 0; }
 static inline size_t rd_left(const reader *r) { return r->n - r->at; }
 
+/* A progress callback that checks the contract (fractions in [0, 1], never
+   decreasing) and cancels after cancel_after calls (0 = never). */
+typedef struct fz_progress {
+    float last;
+    int calls;
+    int cancel_after;
+} fz_progress;
+
+static inline int fz_on_progress(float fraction, void *user)
+{
+    fz_progress *ps = (fz_progress *)user;
+    CHECK(fraction >= 0.0f && fraction <= 1.0f, "progress fraction %g", (double)fraction);
+    CHECK(fraction >= ps->last, "progress went back from %g to %g", (double)ps->last, (double)fraction);
+    ps->last = fraction;
+    ps->calls++;
+    return ps->cancel_after > 0 && ps->calls >= ps->cancel_after;
+}
+
 #endif /* TILEDTEX_FUZZ_COMMON_H */

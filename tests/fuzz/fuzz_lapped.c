@@ -114,21 +114,6 @@ static tt_image *splotch_patch(void)
 
 #define check_error fz_check_error
 
-typedef struct progress_state {
-    float last;
-    int calls;
-    int cancel_after;   /* 0 = never */
-} progress_state;
-
-static int on_progress(float fraction, void *user)
-{
-    progress_state *ps = (progress_state *)user;
-    CHECK(fraction >= 0.0f && fraction <= 1.0f, "progress fraction %g", (double)fraction);
-    CHECK(fraction >= ps->last, "progress went back from %g to %g", (double)ps->last, (double)fraction);
-    ps->last = fraction;
-    ps->calls++;
-    return ps->cancel_after > 0 && ps->calls >= ps->cancel_after;
-}
 
 static void check_field(const tt_mesh *m, const float *fv, int constrained, double scale)
 {
@@ -273,7 +258,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     tt_lapped *lapped = NULL, *again = NULL;
     tt_image *patches[2], *atlas = NULL;
     const tt_allocator *alloc;
-    progress_state ps;
+    fz_progress ps;
     uint8_t flags, misc, hdr[24];
     int nverts, ntris, npatches = 1, f, v, k, gutter;
     int indices[3 * MAX_TRIS];
@@ -437,7 +422,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memset(&ps, 0, sizeof ps);
     if (misc & 2) {
         ps.cancel_after = misc >> 2;
-        lo.progress = on_progress;
+        lo.progress = fz_on_progress;
         lo.progress_user_data = &ps;
     }
     memset(&err, 0x55, sizeof err);

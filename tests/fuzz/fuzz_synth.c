@@ -81,21 +81,6 @@
 
 static const float HUGE_TEXEL[8] = {1e30f, -1e30f, FLT_MAX, -FLT_MAX, -0.5f, 2.0f, 1e-40f, 3e38f};
 
-typedef struct progress_state {
-    float last;
-    int calls;
-    int cancel_after;
-} progress_state;
-
-static int on_progress(float fraction, void *user)
-{
-    progress_state *ps = (progress_state *)user;
-    CHECK(fraction >= 0.0f && fraction <= 1.0f, "progress fraction %g", (double)fraction);
-    CHECK(fraction >= ps->last, "progress went back from %g to %g", (double)ps->last, (double)fraction);
-    ps->last = fraction;
-    ps->calls++;
-    return ps->cancel_after > 0 && ps->calls >= ps->cancel_after;
-}
 
 static int is_finite_texel(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]) && isfinite(p[3]); }
 
@@ -399,7 +384,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     tt_synth_options opt;
     tt_tile_layout resolved;
     tt_rect windows[3];
-    progress_state ps;
+    fz_progress ps;
     tt_error err;
     tt_result r;
 
@@ -513,7 +498,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memset(&ps, 0, sizeof ps);
     if (flags & 128) {
         ps.cancel_after = hdr[28] & 7;
-        opt.progress = on_progress;
+        opt.progress = fz_on_progress;
         opt.progress_user_data = &ps;
     }
     big_enough = w >= S && h >= 2 * S;
