@@ -1199,57 +1199,86 @@ static void test_seams(void)
     tt_mesh_free(mesh);
 }
 
+/* A textured torus for the seam tests: a nu x nv torus of quads, a tile set
+   synthesised from value noise, and room for corner types and UVs. */
+typedef struct seam_fixture {
+    tt_mesh *mesh;
+    tt_image *src;
+    tt_tileset *set;
+    tt_tile_layout layout;
+    uint8_t *types;
+    float *uv;
+} seam_fixture;
+
+static void seam_fixture_free(seam_fixture *fx)
+{
+    free(fx->types);
+    free(fx->uv);
+    tt_tileset_free(fx->set);
+    tt_image_free(fx->src);
+    tt_mesh_free(fx->mesh);
+    memset(fx, 0, sizeof *fx);
+}
+
+static int seam_fixture_make(seam_fixture *fx, int nu, int nv, int noise_width, unsigned noise_seed, int colors,
+                             uint64_t synth_seed, const char *what)
+{
+    tmesh m;
+    tt_synth_options opt;
+    tt_error err;
+    tt_result r;
+    memset(fx, 0, sizeof *fx);
+    memset(&m, 0, sizeof m);
+    make_torus(&m, nu, nv, 3.0, 1.0);
+    r = build(&m, 0, &fx->mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "%s: torus build %d", what, r);
+    if (r != TT_OK) return 0;
+    make_value_noise(&fx->src, noise_width, 256, noise_seed);
+    memset(&opt, 0, sizeof opt);
+    opt.layout = fx->layout = make_layout(colors, 32, 4);
+    opt.seed = synth_seed;
+    r = fx->src ? tt_synthesize_tiles(fx->src, &opt, NULL, &fx->set, &err) : TT_ERROR_OUT_OF_MEMORY;
+    CHECK(r == TT_OK, "%s: synthesize %d (%s)", what, r, err.message);
+    fx->types = (uint8_t *)malloc((size_t)fx->mesh->ncorners);
+    fx->uv = (float *)malloc(sizeof(float) * 2 * (size_t)fx->mesh->ncorners);
+    if (r != TT_OK || !fx->types || !fx->uv) {
+        seam_fixture_free(fx);
+        return 0;
+    }
+    return 1;
+}
+
 /* The control, on displayed colours: one random tile per face (corner types
    that do not match across edges) scores badly where the real assignment
    scores near 0, with the same atlas. */
 static void test_seams_control(void)
 {
-    tmesh m;
-    tt_mesh *mesh = NULL;
-    tt_error err;
-    tt_image *src = NULL;
-    tt_synth_options opt;
-    tt_tileset *set = NULL;
-    uint8_t *types;
-    float *uv;
+    seam_fixture fx;
     tt_seam_report real, random;
+    tt_error err;
     tt_result r;
     int c, matching = 0, interior = 0;
-    memset(&m, 0, sizeof m);
-    make_torus(&m, 40, 24, 3.0, 1.0);
-    r = build(&m, 0, &mesh, &err);
-    tm_free(&m);
-    CHECK(r == TT_OK, "control torus build %d", r);
-    if (r != TT_OK) return;
-    make_value_noise(&src, 160, 256, 21);
-    memset(&opt, 0, sizeof opt);
-    opt.layout = make_layout(2, 32, 4);
-    opt.seed = 4;
-    r = src ? tt_synthesize_tiles(src, &opt, NULL, &set, &err) : TT_ERROR_OUT_OF_MEMORY;
-    CHECK(r == TT_OK, "control: synthesize %d (%s)", r, err.message);
-    if (r != TT_OK) { tt_image_free(src); tt_mesh_free(mesh); return; }
-    types = (uint8_t *)malloc((size_t)mesh->ncorners);
-    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
-    tt_assign_boundaries(mesh, &opt.layout, 8, NULL, types, NULL);
-    tt_assign_uvs(mesh, &opt.layout, types, uv, NULL);
-    r = tt_measure_seams(mesh, uv, &set->levels[0], NULL, NULL, &real, &err);
+    if (!seam_fixture_make(&fx, 40, 24, 160, 21, 2, 4, "control")) return;
+    tt_assign_boundaries(fx.mesh, &fx.layout, 8, NULL, fx.types, NULL);
+    tt_assign_uvs(fx.mesh, &fx.layout, fx.types, fx.uv, NULL);
+    r = tt_measure_seams(fx.mesh, fx.uv, &fx.set->levels[0], NULL, NULL, &real, &err);
     CHECK(r == TT_OK && real.score < 0.1, "control, real assignment: %d, score %.4f (want < 0.1)", r, real.score);
-    random_face_types(mesh, 2, 4242, types);
-    for (c = 0; c < mesh->ncorners; c++)
-        if (mesh->twin[c] > c) { interior++; matching += types[mesh->twin[c]] == (types[c] ^ 1); }
+    random_face_types(fx.mesh, 2, 4242, fx.types);
+    for (c = 0; c < fx.mesh->ncorners; c++)
+        if (fx.mesh->twin[c] > c) {
+            interior++;
+            matching += fx.types[fx.mesh->twin[c]] == (fx.types[c] ^ 1);
+        }
     CHECK(matching < interior / 2, "control: %d of %d random edges match; the control is not random", matching,
           interior);
-    r = tt_assign_uvs(mesh, &opt.layout, types, uv, &err);
+    r = tt_assign_uvs(fx.mesh, &fx.layout, fx.types, fx.uv, &err);
     CHECK(r == TT_OK, "control: assign_uvs of random types %d", r);
-    r = tt_measure_seams(mesh, uv, &set->levels[0], NULL, NULL, &random, &err);
+    r = tt_measure_seams(fx.mesh, fx.uv, &fx.set->levels[0], NULL, NULL, &random, &err);
     CHECK(r == TT_OK && random.score > 0.3 && random.score > real.score + 0.25,
           "control, random tiles per face: %d, score %.4f (want > 0.3; real %.4f; seam %.4f, same face %.4f, "
           "unrelated %.4f)", r, random.score, real.score, random.seam, random.same_face, random.unrelated);
-    free(types);
-    free(uv);
-    tt_tileset_free(set);
-    tt_image_free(src);
-    tt_mesh_free(mesh);
+    seam_fixture_free(&fx);
 }
 
 /* The seam measure compares colours as displayed: three unit quads in a row,
@@ -1370,34 +1399,14 @@ static void test_seams_not_measured(void)
 /* max_edges: a random subset of edges estimates the full score. */
 static void test_seams_sampled(void)
 {
-    tmesh m;
-    tt_mesh *mesh = NULL;
+    seam_fixture fx;
     tt_error err;
-    tt_image *src = NULL;
-    tt_synth_options opt;
-    tt_tileset *set = NULL;
-    uint8_t *types;
-    float *uv;
     tt_seam_options so;
     tt_seam_report full, part, again;
     tt_result r;
     int pass, interior;
-    memset(&m, 0, sizeof m);
-    make_torus(&m, 48, 32, 3.0, 1.0);
-    r = build(&m, 0, &mesh, &err);
-    tm_free(&m);
-    CHECK(r == TT_OK, "sampled torus build %d", r);
-    if (r != TT_OK) return;
-    interior = 2 * mesh->nfaces;
-    make_value_noise(&src, 128, 256, 17);
-    memset(&opt, 0, sizeof opt);
-    opt.layout = make_layout(1, 32, 4);
-    opt.seed = 2;
-    r = src ? tt_synthesize_tiles(src, &opt, NULL, &set, &err) : TT_ERROR_OUT_OF_MEMORY;
-    CHECK(r == TT_OK, "sampled: synthesize %d (%s)", r, err.message);
-    if (r != TT_OK) { tt_image_free(src); tt_mesh_free(mesh); return; }
-    types = (uint8_t *)malloc((size_t)mesh->ncorners);
-    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    if (!seam_fixture_make(&fx, 48, 32, 128, 17, 1, 2, "sampled")) return;
+    interior = 2 * fx.mesh->nfaces;
     /* pass 0: the real assignment (score near 0), 200 edges; pass 1: random
        tiles per face (a high score, and edges that differ a lot from each
        other: half match by type, half do not), so a larger subset for the
@@ -1406,23 +1415,23 @@ static void test_seams_sampled(void)
         const char *what = pass ? "random tiles" : "real assignment";
         const int subset = pass ? 1000 : 200;
         const double tolerance = pass ? 0.06 : 0.05;
-        if (pass == 0) tt_assign_boundaries(mesh, &opt.layout, 6, NULL, types, NULL);
-        else random_face_types(mesh, 1, 99, types);
-        tt_assign_uvs(mesh, &opt.layout, types, uv, NULL);
+        if (pass == 0) tt_assign_boundaries(fx.mesh, &fx.layout, 6, NULL, fx.types, NULL);
+        else random_face_types(fx.mesh, 1, 99, fx.types);
+        tt_assign_uvs(fx.mesh, &fx.layout, fx.types, fx.uv, NULL);
         memset(&so, 0, sizeof so);
         so.seed = 5;
-        r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &full, &err);
+        r = tt_measure_seams(fx.mesh, fx.uv, &fx.set->levels[0], &so, NULL, &full, &err);
         CHECK(r == TT_OK && full.edges_measured == interior, "%s, all edges: %d, %d of %d edges", what, r,
               full.edges_measured, interior);
         so.max_edges = subset;
-        r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &part, &err);
+        r = tt_measure_seams(fx.mesh, fx.uv, &fx.set->levels[0], &so, NULL, &part, &err);
         CHECK(r == TT_OK && part.edges_measured == subset && part.samples < full.samples && part.samples > 0,
               "%s, max_edges %d: %d, %d edges measured, %lld samples (full: %lld)", what, subset, r,
               part.edges_measured, part.samples, full.samples);
         CHECK(near(part.score, full.score, tolerance),
               "%s: max_edges %d scores %.4f, all %d edges %.4f (want within %g)", what, subset, part.score, interior,
               full.score, tolerance);
-        tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &again, NULL);
+        tt_measure_seams(fx.mesh, fx.uv, &fx.set->levels[0], &so, NULL, &again, NULL);
         CHECK(again.score == part.score && again.samples == part.samples,
               "%s, max_edges %d: the same seed should give the same estimate", what, subset);
         if (pass == 1)
@@ -1431,20 +1440,16 @@ static void test_seams_sampled(void)
                   part.score);
         /* max_edges at or above the number of edges measures them all */
         so.max_edges = interior;
-        r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &part, &err);
+        r = tt_measure_seams(fx.mesh, fx.uv, &fx.set->levels[0], &so, NULL, &part, &err);
         CHECK(r == TT_OK && part.edges_measured == interior && part.samples == full.samples,
               "%s, max_edges = all %d edges: %d, %d edges, %lld samples (full %lld)", what, interior, r,
               part.edges_measured, part.samples, full.samples);
     }
     so.max_edges = -1;
-    r = tt_measure_seams(mesh, uv, &set->levels[0], &so, NULL, &part, &err);
+    r = tt_measure_seams(fx.mesh, fx.uv, &fx.set->levels[0], &so, NULL, &part, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0] && isnan(part.score),
           "max_edges -1: expected TT_ERROR_INVALID_ARGUMENT (score NaN), got %d score %g", r, part.score);
-    free(types);
-    free(uv);
-    tt_tileset_free(set);
-    tt_image_free(src);
-    tt_mesh_free(mesh);
+    seam_fixture_free(&fx);
 }
 
 typedef struct seams_ctx {
