@@ -604,6 +604,20 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
 /* 6. Tiled textures                                                        */
 /* ======================================================================== */
 
+/* Based on: E. Akleman, J. Chen, V. Meenakshisundaram, V. Srinivasan, "Tiled
+   Textures: A Simple and Practical Technique for Seamless Texturing".
+   The steps, for a quad mesh (tt_mesh_quadrangulate any other first):
+     1. tt_assign_boundaries: a boundary type per half-edge (Sec. 3, 6);
+     2. tt_assign_uvs: each quad's UVs from its four types alone (Sec. 3);
+     3. tt_synthesize_tiles, or tt_synth_plan_create + tt_synth_apply for
+        several maps of one material: the (2n)^4 tiles composited from
+        windows of the photo (Sec. 4), with gutters and mips;
+     4. tt_measure_seams, tt_tile_histogram, tt_face_stretch: the report.
+   Memory: nothing per photo pixel beyond the photo itself (16 bytes a
+   pixel, yours): synthesis reads windows of it. The atlas and its mips take
+   about 4/3 * W * W * 16 bytes, the plan about 4 * S bytes per tile, and
+   planning about 20 * S * S bytes of scratch. */
+
 #define TT_MAX_COLORS 128           /* boundary conditions n; types 0..2n-1 fit a byte */
 #define TT_DEFAULT_TILE_SIZE 128
 #define TT_NO_GUTTER 0
@@ -910,9 +924,22 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
 /* 7. Lapped textures                                                       */
 /* ======================================================================== */
 
-/* Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
-   Sec. 3.2 (establishing local orientation and scale: the tangent field).
+/* Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000).
+   The steps, for a triangle mesh:
+     1. tt_tangent_field: the texture's up and scale per face (Sec. 3.2);
+     2. tt_make_texture_patch: the photo with a soft-edged alpha (Sec. 3.1);
+     3. tt_lapped_paste: the paste loop, until every face is covered
+        (Sec. 3.3-3.6), returning the runtime pasting list (Sec. 4);
+     4. tt_lapped_measure, and tt_atlas_pack_pairs + tt_lapped_bake for an
+        ordinary texture (Sec. 4).
+   Memory per photo pixel, besides the photo (16 bytes, yours): the patch
+   holds 16 bytes, and making it takes 8 more while it runs; the paste loop
+   keeps 4 bytes per patch pixel (its opaque depth) and takes up to 5 more
+   while it traces the patch's hull. A caller that frees the photo once the
+   patch is made (as the tiledtex tool does) peaks at about 40 bytes per
+   photo pixel. The bake's scratch is 8 bytes per atlas texel.
 
+   The tangent field, Sec. 3.2 (establishing local orientation and scale).
    Each face f gets a vector T_f in its plane: its direction is the texture's
    "up", its length the texture's local scale (the side of a texture patch in
    mesh units). The "right" direction is S = T x N (Sec. 3.2). Isotropic
