@@ -1660,18 +1660,18 @@ typedef struct tt__builder {
     int *count;         /* nlocal: edges in the bucket of a local id (bucket_start + 1) */
 } tt__builder;
 
-/* One face of the face loop: range-check and copy its corners, number their
+/* One face of the face loop: range-check its corners, number their
    vertices, count its edges into buckets, and (strict) check it for repeated
    vertices and zero area. Called with a constant size for all-triangle and
-   all-quad meshes, so that the loops unroll. */
-static TT__BUILD_INLINE tt_result tt__build_face(tt__builder *b, int f, int first, int size, int *stamp,
-                                                 tt_error *error)
+   all-quad meshes, so that the loops unroll, and a constant `prefetch`. */
+static TT__BUILD_INLINE tt_result tt__build_face(tt__builder *b, int f, int first, int size, int prefetch,
+                                                 int *stamp, tt_error *error)
 {
     int i, c, repeated;
     const int *verts = b->indices + first;
     for (i = 0, c = first; i < size; i++, c++) {
         int vert = b->indices[c], l;
-        if (c + TT__BUILD_PREFETCH < b->ncorners) {
+        if (prefetch && c + TT__BUILD_PREFETCH < b->ncorners) {
             /* With scattered vertex ids these two reads are the build's
                cache misses: start them early. */
             unsigned ahead = (unsigned)b->indices[c + TT__BUILD_PREFETCH];
@@ -1710,6 +1710,27 @@ static TT__BUILD_INLINE tt_result tt__build_face(tt__builder *b, int f, int firs
         return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, first, verts[0], -1,
                         "face %d has zero area: its %d corners coincide or lie on one line", f, size);
     return TT_OK;
+}
+
+/* Whether the face loop should prefetch: when many consecutive corners'
+   vertex ids are far apart (shuffled ids: about 3 in 4 steps of a quad mesh,
+   the others are shared corners), where it saves most of the cache misses;
+   ids that follow the index buffer (grids, welded files) are served by the
+   caches, and the prefetches would only cost instructions. Judged on four
+   samples of 256 corners spread over the index buffer; in doubt, prefetch
+   (a needless prefetch costs far less than a missing one). */
+static int tt__build_should_prefetch(const int *indices, int ncorners)
+{
+    int window = 256, far = 0, pairs = 0, w, c;
+    if (ncorners < 4 * window) return 1;
+    for (w = 0; w < 4; w++) {
+        int first = (int)((long long)(ncorners - window) * w / 3);
+        for (c = first + 1; c < first + window; c++, pairs++) {
+            long long step = (long long)indices[c] - indices[c - 1];
+            far += step > 4096 || step < -4096;
+        }
+    }
+    return far * 5 > pairs * 2;
 }
 
 /* Put a face's half-edges into the buckets of their edges' smaller local id
@@ -1759,7 +1780,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
     tt__builder builder;
     tt__edge_problem problem;
     tt_result result = TT_OK;
-    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, boundary = 0, f, c, v;
+    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, boundary = 0, prefetch, f, c, v;
     long long total_corners;
 
     tt__ok(error);
@@ -1861,17 +1882,22 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
     builder.out_count = out_count;
     builder.inverse = inverse;
     builder.count = bucket_start + 1;
+    prefetch = tt__build_should_prefetch(desc->indices, ncorners);
     if (fixed_size == 3) {
         mesh->min_face_size = mesh->max_face_size = 3;
         for (f = 0; f < nfaces; f++) {
             mesh->face_start[f] = 3 * f;
-            if ((result = tt__build_face(&builder, f, 3 * f, 3, NULL, error)) != TT_OK) goto cleanup;
+            result = prefetch ? tt__build_face(&builder, f, 3 * f, 3, 1, NULL, error)
+                              : tt__build_face(&builder, f, 3 * f, 3, 0, NULL, error);
+            if (result != TT_OK) goto cleanup;
         }
     } else if (fixed_size == 4) {
         mesh->min_face_size = mesh->max_face_size = 4;
         for (f = 0; f < nfaces; f++) {
             mesh->face_start[f] = 4 * f;
-            if ((result = tt__build_face(&builder, f, 4 * f, 4, NULL, error)) != TT_OK) goto cleanup;
+            result = prefetch ? tt__build_face(&builder, f, 4 * f, 4, 1, NULL, error)
+                              : tt__build_face(&builder, f, 4 * f, 4, 0, NULL, error);
+            if (result != TT_OK) goto cleanup;
         }
     } else {
         for (f = 0, c = 0; f < nfaces; f++) {
@@ -1887,7 +1913,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                 }
                 memset(stamp, 0xff, (size_t)nverts * sizeof(int));
             }
-            if ((result = tt__build_face(&builder, f, c, size, stamp, error)) != TT_OK) goto cleanup;
+            if ((result = tt__build_face(&builder, f, c, size, prefetch, stamp, error)) != TT_OK) goto cleanup;
             c += size;
         }
     }
