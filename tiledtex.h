@@ -1757,52 +1757,77 @@ TTDEF void tt_mesh_free(tt_mesh *mesh)
     tt__free(&allocator, mesh);
 }
 
-/* A half-edge in the bucket of its edge's smaller vertex: `other` is the
-   larger vertex, corner_dir = 2 * corner + 1 when the half-edge runs from the
-   larger vertex to the smaller. Both halves of an edge share one bucket, so
-   pairing never has to look into another vertex's bucket. */
-typedef struct tt__edge_entry {
-    int other;
-    int corner_dir;
-} tt__edge_entry;
+/* A half-edge in the bucket of its edge's smaller vertex, as one sort key:
+   the larger vertex in the high 32 bits, corner_dir = 2 * corner + 1 when the
+   half-edge runs from the larger vertex to the smaller in the low ones. Both
+   halves of an edge share one bucket, so pairing never has to look into
+   another vertex's bucket. */
+#define TT__EDGE_KEY(other, corner_dir) (((uint64_t)(uint32_t)(other) << 32) | (uint32_t)(corner_dir))
+#define TT__KEY_OTHER(key) ((int)((key) >> 32))
+#define TT__KEY_CORNER_DIR(key) ((int)((key) & 0xffffffffu))
 
-static int tt__edge_entry_less(const tt__edge_entry *a, const tt__edge_entry *b)
-{
-    return a->other < b->other || (a->other == b->other && a->corner_dir < b->corner_dir);
-}
-
-static void tt__sift_down(tt__edge_entry *items, int root, int count)
+static void tt__sift_down(uint64_t *items, int root, int count)
 {
     for (;;) {
         int child = 2 * root + 1;
-        tt__edge_entry tmp;
+        uint64_t tmp;
         if (child >= count) return;
-        if (child + 1 < count && tt__edge_entry_less(&items[child], &items[child + 1])) child++;
-        if (!tt__edge_entry_less(&items[root], &items[child])) return;
+        if (child + 1 < count && items[child] < items[child + 1]) child++;
+        if (!(items[root] < items[child])) return;
         tmp = items[root]; items[root] = items[child]; items[child] = tmp;
         root = child;
     }
 }
 
-/* Buckets hold about half a vertex's valence worth of edges: insertion sort
-   for the usual handful, heapsort so that a pathological fan of a million
-   faces around one vertex is still O(n log n) rather than quadratic. */
-static void tt__sort_edge_entries(tt__edge_entry *items, int count)
+/* Sorting networks for the usual bucket sizes (a grid's buckets hold 4
+   half-edges, a triangle mesh's 4 to 8): compare-exchanges without branches,
+   where an insertion sort mispredicts about once per entry. */
+#define TT__SORT2(k, i, j)                                              \
+    do {                                                                \
+        uint64_t x_ = (k)[i], y_ = (k)[j];                              \
+        (k)[i] = x_ < y_ ? x_ : y_;                                     \
+        (k)[j] = x_ < y_ ? y_ : x_;                                     \
+    } while (0)
+
+/* Buckets hold about half a vertex's valence worth of edges: a network or an
+   insertion sort for the usual handful, heapsort so that a pathological fan
+   of a million faces around one vertex is still O(n log n) rather than
+   quadratic. */
+static void tt__sort_edge_keys(uint64_t *k, int count)
 {
     int i;
+    switch (count) {
+    case 0: case 1: return;
+    case 2: TT__SORT2(k, 0, 1); return;
+    case 4:
+        TT__SORT2(k, 0, 1); TT__SORT2(k, 2, 3); TT__SORT2(k, 0, 2); TT__SORT2(k, 1, 3); TT__SORT2(k, 1, 2);
+        return;
+    case 6:
+        TT__SORT2(k, 1, 2); TT__SORT2(k, 4, 5); TT__SORT2(k, 0, 2); TT__SORT2(k, 3, 5); TT__SORT2(k, 0, 1);
+        TT__SORT2(k, 3, 4); TT__SORT2(k, 2, 5); TT__SORT2(k, 0, 3); TT__SORT2(k, 1, 4); TT__SORT2(k, 2, 4);
+        TT__SORT2(k, 1, 3); TT__SORT2(k, 2, 3);
+        return;
+    case 8:
+        TT__SORT2(k, 0, 2); TT__SORT2(k, 1, 3); TT__SORT2(k, 4, 6); TT__SORT2(k, 5, 7); TT__SORT2(k, 0, 4);
+        TT__SORT2(k, 1, 5); TT__SORT2(k, 2, 6); TT__SORT2(k, 3, 7); TT__SORT2(k, 0, 1); TT__SORT2(k, 2, 3);
+        TT__SORT2(k, 4, 5); TT__SORT2(k, 6, 7); TT__SORT2(k, 2, 4); TT__SORT2(k, 3, 5); TT__SORT2(k, 1, 4);
+        TT__SORT2(k, 3, 6); TT__SORT2(k, 1, 2); TT__SORT2(k, 3, 4); TT__SORT2(k, 5, 6);
+        return;
+    default: break;
+    }
     if (count <= 24) {
         for (i = 1; i < count; i++) {
-            tt__edge_entry key = items[i];
+            uint64_t key = k[i];
             int j = i - 1;
-            while (j >= 0 && tt__edge_entry_less(&key, &items[j])) { items[j + 1] = items[j]; j--; }
-            items[j + 1] = key;
+            while (j >= 0 && key < k[j]) { k[j + 1] = k[j]; j--; }
+            k[j + 1] = key;
         }
         return;
     }
-    for (i = count / 2 - 1; i >= 0; i--) tt__sift_down(items, i, count);
+    for (i = count / 2 - 1; i >= 0; i--) tt__sift_down(k, i, count);
     for (i = count - 1; i > 0; i--) {
-        tt__edge_entry tmp = items[0]; items[0] = items[i]; items[i] = tmp;
-        tt__sift_down(items, 0, i);
+        uint64_t tmp = k[0]; k[0] = k[i]; k[i] = tmp;
+        tt__sift_down(k, 0, i);
     }
 }
 
@@ -1974,6 +1999,117 @@ static int tt__face_of_corner(const tt_mesh *mesh, int corner)
 /* How many corners ahead the builder prefetches a vertex's id and position. */
 #define TT__BUILD_PREFETCH 48
 
+/* Forced inlining, so that the builder's face loop is compiled once per fixed
+   face size (3, 4) with the per-face loops unrolled. */
+#if defined(__GNUC__) || defined(__clang__)
+#define TT__BUILD_INLINE __attribute__((always_inline)) inline
+#elif defined(_MSC_VER)
+#define TT__BUILD_INLINE __forceinline
+#else
+#define TT__BUILD_INLINE
+#endif
+
+/* The builder's face loop state (see tt_mesh_build). */
+typedef struct tt__builder {
+    const int *indices;
+    const float *positions;
+    int nverts, ncorners, permissive, nused;
+    int *local_of;      /* nverts: local id of a vertex, -1 unseen (the mesh's vert_corner) */
+    int *lid;           /* ncorners: local id of corner c's vertex (the mesh's corner_vert) */
+    int *last;          /* nlocal: the last corner of a local id so far (the mesh's corner_face) */
+    int *out_count;     /* nlocal: outgoing half-edges */
+    int *inverse;       /* nlocal: the vertex of a local id */
+    int *count;         /* nlocal: edges in the bucket of a local id (bucket_start + 1) */
+} tt__builder;
+
+/* One face of the face loop: range-check its corners, number their
+   vertices, count its edges into buckets, and (strict) check it for repeated
+   vertices and zero area. Called with a constant size for all-triangle and
+   all-quad meshes, so that the loops unroll, and a constant `prefetch`. */
+static TT__BUILD_INLINE tt_result tt__build_face(tt__builder *b, int f, int first, int size, int prefetch,
+                                                 int *stamp, tt_error *error)
+{
+    int i, c, repeated;
+    const int *verts = b->indices + first;
+    for (i = 0, c = first; i < size; i++, c++) {
+        int vert = b->indices[c], l;
+        if (prefetch && c + TT__BUILD_PREFETCH < b->ncorners) {
+            /* With scattered vertex ids these two reads are the build's
+               cache misses: start them early. */
+            unsigned ahead = (unsigned)b->indices[c + TT__BUILD_PREFETCH];
+            if (ahead < (unsigned)b->nverts) {
+                TT__PREFETCH(b->local_of + ahead);
+                if (!b->permissive) TT__PREFETCH(b->positions + 3 * (size_t)ahead);
+            }
+        }
+        if (vert < 0 || vert >= b->nverts)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, f, c, vert, -1,
+                            "face %d (corner %d) refers to vertex %d, but the mesh has %d vertices (0..%d)", f, c,
+                            vert, b->nverts, b->nverts - 1);
+        l = b->local_of[vert];
+        if (l < 0) {
+            l = b->nused++;
+            b->local_of[vert] = l;
+            b->inverse[l] = vert;
+            b->out_count[l] = 0;
+            b->count[l] = 0;
+        }
+        b->out_count[l]++;
+        b->last[l] = c;
+        b->lid[c] = l;
+    }
+    for (i = 0; i < size; i++) {
+        int x = b->lid[first + i], y = b->lid[first + (i + 1 < size ? i + 1 : 0)];
+        b->count[x < y ? x : y]++;
+    }
+    if (b->permissive) return TT_OK;
+    /* A repeated vertex makes a degenerate edge or pinches the face. */
+    repeated = tt__repeated_corner(verts, size, f, size > 16 ? stamp : NULL);
+    if (repeated >= 0)
+        return tt__fail(error, TT_ERROR_REPEATED_VERTEX, f, first + repeated, verts[repeated], -1,
+                        "face %d uses vertex %d more than once (corner %d)", f, verts[repeated], first + repeated);
+    if (tt__face_has_zero_area(b->positions, verts, size))
+        return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, first, verts[0], -1,
+                        "face %d has zero area: its %d corners coincide or lie on one line", f, size);
+    return TT_OK;
+}
+
+/* Whether the face loop should prefetch: when many consecutive corners'
+   vertex ids are far apart (shuffled ids: about 3 in 4 steps of a quad mesh,
+   the others are shared corners), where it saves most of the cache misses;
+   ids that follow the index buffer (grids, welded files) are served by the
+   caches, and the prefetches would only cost instructions. Judged on four
+   samples of 256 corners spread over the index buffer; in doubt, prefetch
+   (a needless prefetch costs far less than a missing one). */
+static int tt__build_should_prefetch(const int *indices, int ncorners)
+{
+    int window = 256, far = 0, pairs = 0, w, c;
+    if (ncorners < 4 * window) return 1;
+    for (w = 0; w < 4; w++) {
+        int first = (int)((long long)(ncorners - window) * w / 3);
+        for (c = first + 1; c < first + window; c++, pairs++) {
+            long long step = (long long)indices[c] - indices[c - 1];
+            far += step > 4096 || step < -4096;
+        }
+    }
+    return far * 5 > pairs * 2;
+}
+
+/* Put a face's half-edges into the buckets of their edges' smaller local id
+   (slot[l]: the next free entry of bucket l), an entry's fields in two arrays:
+   other[] and corner_dir[] (see TT__EDGE_KEY). */
+static TT__BUILD_INLINE void tt__scatter_face(const int *lid, int first, int size, int *slot, int *other,
+                                              int *corner_dir)
+{
+    int i, a = lid[first];
+    for (i = 0; i < size; i++) {
+        int b = lid[i + 1 < size ? first + i + 1 : first], at = slot[a < b ? a : b]++;
+        other[at] = a < b ? b : a;
+        corner_dir[at] = 2 * (first + i) + (a > b);
+        a = b;
+    }
+}
+
 /* A mesh with its arrays allocated (positions excepted), or NULL. */
 static tt_mesh *tt__mesh_alloc(const tt_allocator *allocator, int nverts, int nfaces, int ncorners, unsigned flags)
 {
@@ -2001,11 +2137,13 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                               tt_error *error)
 {
     tt_mesh *mesh = NULL;
-    int *bucket_start = NULL, *out_count = NULL, *inverse = NULL, *stamp = NULL, *entries, largest_bucket = 0;
-    tt__edge_entry *local = NULL;
+    int *bucket_start = NULL, *out_count = NULL, *inverse = NULL, *stamp = NULL, largest_bucket = 0;
+    uint64_t *local = NULL;
+    float *copy = NULL;
+    tt__builder builder;
     tt__edge_problem problem;
     tt_result result = TT_OK;
-    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, boundary = 0, f, c, v;
+    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, boundary = 0, prefetch, f, c, v;
     long long total_corners;
 
     tt__ok(error);
@@ -2062,8 +2200,7 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
         mesh->flags = desc->flags;
         mesh->pos = desc->positions;
     } else {
-        float *copy = TT__ALLOC(allocator, float, (size_t)nverts * 3);
-        if (copy && nverts > 0) memcpy(copy, desc->positions, (size_t)nverts * 3 * sizeof(float));
+        copy = TT__ALLOC(allocator, float, (size_t)nverts * 3);
         mesh->pos = copy;
     }
     if (!bucket_start || !out_count || !inverse || !mesh->pos) {
@@ -2072,8 +2209,23 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
         goto cleanup;
     }
 
-    /* Coordinates must be finite: everything downstream measures lengths. */
-    for (v = 0; v < nverts; v++) {
+    /* Coordinates must be finite: everything downstream measures lengths.
+       Whole blocks of 1024 vertices are copied (unless borrowed) and then
+       tested while in the cache, without branches (the loop vectorises); a
+       block with a bad coordinate, and the tail, vertex by vertex. */
+    for (v = 0; v + 1024 <= nverts; v += 1024) {
+        const float *p = desc->positions + 3 * (size_t)v;
+        uint32_t bad = 0;
+        int k;
+        if (copy) memcpy(copy + 3 * (size_t)v, p, 3 * 1024 * sizeof(float));
+        for (k = 0; k < 3 * 1024; k++) {
+            uint32_t bits;
+            memcpy(&bits, p + k, sizeof bits);
+            bad |= (bits & 0x7f800000u) == 0x7f800000u;
+        }
+        if (bad) break;
+    }
+    for (; v < nverts; v++) {
         const float *p = desc->positions + 3 * (size_t)v;
         if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2])) {
             result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, v, -1,
@@ -2081,68 +2233,57 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                               p[2]);
             goto cleanup;
         }
+        if (copy) memcpy(copy + 3 * (size_t)v, p, 3 * sizeof(float));
     }
 
-    /* Corners: copy and range-check them, and give the used vertices local
-       ids in order of first use (the index buffer's order). Everything the
-       pairing touches afterwards is indexed by corner or by local id, so it
-       runs through memory in index-buffer order whatever the numbering of the
-       vertices: a mesh with shuffled vertex ids costs about what a grid-ordered
-       one does. While the loop runs, vert_corner[v] is v's local id (-1:
-       unseen), inverse[l] the vertex of local id l, corner_face[l] its last
-       corner so far, out_count[l] its outgoing half-edges (for the fan check),
-       and twin[c] = 2 * (local id of corner c's vertex) + (c is the last corner
-       of its face). bucket_start counts each edge in the bucket of its end
-       with the smaller local id. */
+    /* Corners: range-check them, and give the used vertices local ids in
+       order of first use (the index buffer's order). Everything the pairing
+       touches afterwards is indexed by corner or by local id, so it runs
+       through memory in index-buffer order whatever the numbering of the
+       vertices: a mesh with shuffled vertex ids costs about what a
+       grid-ordered one does. While the loop runs, vert_corner[v] is v's local
+       id (-1: unseen), corner_vert[c] the local id of corner c's vertex,
+       corner_face[l] the last corner of local id l so far; see tt__builder.
+       bucket_start counts each edge in the bucket of its end with the smaller
+       local id. */
     memset(mesh->vert_corner, 0xff, (size_t)nverts * sizeof(int));
     bucket_start[0] = 0;
-    c = 0;
-    for (f = 0; f < nfaces; f++) {
-        int size = fixed_size ? fixed_size : desc->face_sizes[f];
-        int first = c, i;
-        const int *verts = mesh->corner_vert + first;
-        mesh->face_start[f] = first;
-        if (size > mesh->max_face_size) mesh->max_face_size = size;
-        if (f == 0 || size < mesh->min_face_size) mesh->min_face_size = size;
-        for (i = 0; i < size; i++, c++) {
-            int vert = desc->indices[c], l;
-            if (c + TT__BUILD_PREFETCH < ncorners) {
-                /* With scattered vertex ids these two reads are the build's
-                   cache misses: start them early. */
-                unsigned ahead = (unsigned)desc->indices[c + TT__BUILD_PREFETCH];
-                if (ahead < (unsigned)nverts) {
-                    TT__PREFETCH(mesh->vert_corner + ahead);
-                    if (!permissive) TT__PREFETCH(desc->positions + 3 * (size_t)ahead);
-                }
-            }
-            if (vert < 0 || vert >= nverts) {
-                result = tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, f, c, vert, -1,
-                                  "face %d (corner %d) refers to vertex %d, but the mesh has %d vertices (0..%d)",
-                                  f, c, vert, nverts, nverts - 1);
-                goto cleanup;
-            }
-            mesh->corner_vert[c] = vert;
-            l = mesh->vert_corner[vert];
-            if (l < 0) {
-                l = nused++;
-                mesh->vert_corner[vert] = l;
-                inverse[l] = vert;
-                out_count[l] = 0;
-                bucket_start[l + 1] = 0;
-            }
-            out_count[l]++;
-            mesh->corner_face[l] = c;
-            mesh->twin[c] = 2 * l;
+    builder.indices = desc->indices;
+    builder.positions = desc->positions;
+    builder.nverts = nverts;
+    builder.ncorners = ncorners;
+    builder.permissive = permissive;
+    builder.nused = 0;
+    builder.local_of = mesh->vert_corner;
+    builder.lid = mesh->corner_vert;
+    builder.last = mesh->corner_face;
+    builder.out_count = out_count;
+    builder.inverse = inverse;
+    builder.count = bucket_start + 1;
+    prefetch = tt__build_should_prefetch(desc->indices, ncorners);
+    if (fixed_size == 3) {
+        mesh->min_face_size = mesh->max_face_size = 3;
+        for (f = 0; f < nfaces; f++) {
+            mesh->face_start[f] = 3 * f;
+            result = prefetch ? tt__build_face(&builder, f, 3 * f, 3, 1, NULL, error)
+                              : tt__build_face(&builder, f, 3 * f, 3, 0, NULL, error);
+            if (result != TT_OK) goto cleanup;
         }
-        mesh->twin[c - 1] |= 1;
-        for (i = 0; i < size; i++) {
-            int a = mesh->twin[first + i] >> 1, b = mesh->twin[first + (i + 1 < size ? i + 1 : 0)] >> 1;
-            bucket_start[(a < b ? a : b) + 1]++;
+    } else if (fixed_size == 4) {
+        mesh->min_face_size = mesh->max_face_size = 4;
+        for (f = 0; f < nfaces; f++) {
+            mesh->face_start[f] = 4 * f;
+            result = prefetch ? tt__build_face(&builder, f, 4 * f, 4, 1, NULL, error)
+                              : tt__build_face(&builder, f, 4 * f, 4, 0, NULL, error);
+            if (result != TT_OK) goto cleanup;
         }
-        if (!permissive) {
-            /* A repeated vertex makes a degenerate edge or pinches the face. */
-            int repeated;
-            if (size > 16 && !stamp) {
+    } else {
+        for (f = 0, c = 0; f < nfaces; f++) {
+            int size = fixed_size ? fixed_size : desc->face_sizes[f];
+            mesh->face_start[f] = c;
+            if (size > mesh->max_face_size) mesh->max_face_size = size;
+            if (f == 0 || size < mesh->min_face_size) mesh->min_face_size = size;
+            if (size > 16 && !permissive && !stamp) {
                 stamp = TT__ALLOC(allocator, int, nverts);
                 if (!stamp) {
                     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
@@ -2150,114 +2291,111 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                 }
                 memset(stamp, 0xff, (size_t)nverts * sizeof(int));
             }
-            repeated = tt__repeated_corner(verts, size, f, size > 16 ? stamp : NULL);
-            if (repeated >= 0) {
-                result = tt__fail(error, TT_ERROR_REPEATED_VERTEX, f, first + repeated, verts[repeated], -1,
-                                  "face %d uses vertex %d more than once (corner %d)", f, verts[repeated],
-                                  first + repeated);
-                goto cleanup;
-            }
-            if (tt__face_has_zero_area(desc->positions, verts, size)) {
-                result = tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, first, verts[0], -1,
-                                  "face %d has zero area: its %d corners coincide or lie on one line", f, size);
-                goto cleanup;
-            }
+            if ((result = tt__build_face(&builder, f, c, size, prefetch, stamp, error)) != TT_OK) goto cleanup;
+            c += size;
         }
     }
     mesh->face_start[nfaces] = ncorners;
+    nused = builder.nused;
     /* vert_corner starts as the vertex's last corner (any outgoing half-edge). */
     for (v = 0; v < nused; v++) mesh->vert_corner[inverse[v]] = mesh->corner_face[v];
 
-    /* Counting sort of the half-edges into their buckets: 2 * corner + 1 when
-       the half-edge runs from the larger local id to the smaller. The entries
-       live in corner_face, which is only filled at the end: no extra memory
-       for the largest array of the build. */
-    entries = mesh->corner_face;
+    /* Counting sort of the half-edges into their buckets, an entry
+       (TT__EDGE_KEY: other end's local id, 2 * corner + 1 when the
+       half-edge runs from the larger local id to the smaller) split between
+       corner_face (other) and twin (corner_dir), which are only filled at the
+       end: with the far end in the entry, the pairing reads nothing else, and
+       no extra memory for the largest arrays of the build. Afterwards
+       bucket_start[l] is where bucket l ends. */
     for (v = 0; v < nused; v++) {
         if (bucket_start[v + 1] > largest_bucket) largest_bucket = bucket_start[v + 1];
         bucket_start[v + 1] += bucket_start[v];
     }
-    for (f = 0; f < nfaces; f++) {
-        int first = mesh->face_start[f], end = mesh->face_start[f + 1], a = mesh->twin[first] >> 1, b;
-        for (c = first; c < end; c++, a = b) {
-            b = mesh->twin[c + 1 < end ? c + 1 : first] >> 1;
-            entries[bucket_start[a < b ? a : b]++] = 2 * c + (a > b);
-        }
+    if (fixed_size == 3) {
+        for (f = 0; f < nfaces; f++)
+            tt__scatter_face(mesh->corner_vert, 3 * f, 3, bucket_start, mesh->corner_face, mesh->twin);
+    } else if (fixed_size == 4) {
+        for (f = 0; f < nfaces; f++)
+            tt__scatter_face(mesh->corner_vert, 4 * f, 4, bucket_start, mesh->corner_face, mesh->twin);
+    } else {
+        for (f = 0; f < nfaces; f++)
+            tt__scatter_face(mesh->corner_vert, mesh->face_start[f], mesh->face_start[f + 1] - mesh->face_start[f],
+                             bucket_start, mesh->corner_face, mesh->twin);
     }
-    for (v = nused; v > 0; v--) bucket_start[v] = bucket_start[v - 1];
-    bucket_start[0] = 0;
-    local = TT__ALLOC(allocator, tt__edge_entry, largest_bucket);
+    local = TT__ALLOC(allocator, uint64_t, largest_bucket);
     if (!local) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
         goto cleanup;
     }
 
-    /* Pair twins bucket by bucket: the bucket's entries, keyed by the other
-       end's local id, sorted by (other end, corner) so the halves of an edge
-       sit side by side in corner order; then one run of equal `other` is one
-       edge. One half-edge each way is an interior edge, a single one a
-       boundary; anything else is non-manifold (three or more) or flipped (two
-       the same way). Those are cut loose into boundaries; the problem with the
-       smallest corner is the one reported, so errors come in index-buffer
-       order. twin still holds the local ids here (a half-edge's far end is the
-       next corner's), so the outcome goes back into the bucket in place: a
-       pair as 2 * a + 1 followed by 2 * b, a boundary half-edge h as ~h. */
+    /* Pair twins bucket by bucket: the bucket's entries sorted by (other end,
+       corner) so the halves of an edge sit side by side in corner order; then
+       one run of equal `other` is one edge. One half-edge each way is an
+       interior edge, a single one a boundary; anything else is non-manifold
+       (three or more) or flipped (two the same way). Those are cut loose into
+       boundaries; the problem with the smallest corner is the one reported,
+       so errors come in index-buffer order. The local ids are no longer
+       needed: the twins go into corner_vert's array, which then becomes
+       twin, while twin's array becomes corner_vert (a copy of the indices). */
     memset(&problem, 0, sizeof problem);
     problem.corner = -1;
     for (v = 0; v < nused; v++) {
-        tt__edge_entry *e = local;
-        int *bucket = entries + bucket_start[v];
-        int count = bucket_start[v + 1] - bucket_start[v], i = 0, k;
-        for (k = 0; k < count; k++) {
-            int corner_dir = bucket[k], h = corner_dir >> 1, far;
-            if (corner_dir & 1) {
-                far = h;                                    /* runs from the other end to v */
-            } else if (!(mesh->twin[h] & 1)) {
-                far = h + 1;
-            } else if (fixed_size) {
-                far = h - fixed_size + 1;
-            } else {
-                for (far = h; far > 0 && !(mesh->twin[far - 1] & 1); far--) {}
-            }
-            e[k].other = mesh->twin[far] >> 1;
-            e[k].corner_dir = corner_dir;
+        uint64_t *e = local;
+        int begin = v > 0 ? bucket_start[v - 1] : 0, count = bucket_start[v] - begin, i = 0, k, paired;
+        int *twin = mesh->corner_vert;
+        for (k = 0; k < count; k++) e[k] = TT__EDGE_KEY(mesh->corner_face[begin + k], mesh->twin[begin + k]);
+        tt__sort_edge_keys(e, count);
+        /* The usual bucket: every edge an interior one, its two halves side
+           by side, one each way. Checked and paired without branches. */
+        paired = (count & 1) == 0;
+        for (k = 0; paired && k < count; k += 2) {
+            uint64_t x = e[k], y = e[k + 1];
+            paired = ((x ^ y) >> 32) == 0 && ((x ^ y) & 1) && TT__KEY_OTHER(x) != v &&
+                     (k + 2 == count || TT__KEY_OTHER(e[k + 2]) != TT__KEY_OTHER(x));
         }
-        tt__sort_edge_entries(e, count);
+        if (paired) {
+            for (k = 0; k < count; k += 2) {
+                int a = TT__KEY_CORNER_DIR(e[k]) >> 1, b = TT__KEY_CORNER_DIR(e[k + 1]) >> 1;
+                twin[a] = b;
+                twin[b] = a;
+            }
+            continue;
+        }
         while (i < count) {
-            int other = e[i].other, run_end = i + 1, backward = e[i].corner_dir & 1;
-            while (run_end < count && e[run_end].other == other) backward += e[run_end++].corner_dir & 1;
+            int other = TT__KEY_OTHER(e[i]), run_end = i + 1, backward = TT__KEY_CORNER_DIR(e[i]) & 1;
+            while (run_end < count && TT__KEY_OTHER(e[run_end]) == other)
+                backward += TT__KEY_CORNER_DIR(e[run_end++]) & 1;
             if (other != v && run_end - i == 2 && backward == 1) {
-                bucket[i] = (e[i].corner_dir | 1);
-                bucket[i + 1] = (e[i + 1].corner_dir & ~1);
+                int a = TT__KEY_CORNER_DIR(e[i]) >> 1, b = TT__KEY_CORNER_DIR(e[i + 1]) >> 1;
+                twin[a] = b;
+                twin[b] = a;
             } else if (other != v && run_end - i == 1) {
-                bucket[i] = ~(e[i].corner_dir >> 1);
+                twin[TT__KEY_CORNER_DIR(e[i]) >> 1] = -1;
+                boundary = 1;
             } else {
-                if (!permissive && other != v && (problem.corner < 0 || (e[i].corner_dir >> 1) < problem.corner)) {
-                    int lowest = e[i].corner_dir >> 1;
+                int lowest = TT__KEY_CORNER_DIR(e[i]) >> 1;
+                if (!permissive && other != v && (problem.corner < 0 || lowest < problem.corner)) {
                     problem.corner = lowest;
-                    problem.a = mesh->corner_vert[lowest];
+                    problem.a = desc->indices[lowest];
                     problem.b = problem.a == inverse[v] ? inverse[other] : inverse[v];
                     problem.result = run_end - i > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
                     problem.nfaces = run_end - i;
                     for (k = 0; k < 3; k++)
-                        problem.faces[k] = i + k < run_end ? tt__face_of_corner(mesh, e[i + k].corner_dir >> 1) : -1;
+                        problem.faces[k] =
+                            i + k < run_end ? tt__face_of_corner(mesh, TT__KEY_CORNER_DIR(e[i + k]) >> 1) : -1;
                 }
-                for (k = i; k < run_end; k++) bucket[k] = ~(e[k].corner_dir >> 1);
+                for (k = i; k < run_end; k++) twin[TT__KEY_CORNER_DIR(e[k]) >> 1] = -1;
+                boundary = 1;
                 mesh->repaired_edges++;
             }
             i = run_end;
         }
     }
-    for (c = 0; c < ncorners; c++) {
-        int x = entries[c];
-        if (x < 0) {
-            mesh->twin[~x] = -1;
-            boundary = 1;
-        } else {
-            int a = x >> 1, b = entries[++c] >> 1;
-            mesh->twin[a] = b;
-            mesh->twin[b] = a;
-        }
+    {
+        int *twin = mesh->corner_vert;
+        mesh->corner_vert = mesh->twin;
+        mesh->twin = twin;
+        memcpy(mesh->corner_vert, desc->indices, (size_t)ncorners * sizeof(int));
     }
     if (problem.corner >= 0) {
         result = tt__report_edge_problem(&problem, error);
