@@ -395,7 +395,9 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
                                     tt_error *error);
 /* To 8-bit RGBA, width * height * 4 bytes: r, g, b encoded into `space`
    (straight alpha: pass an un-premultiplied image), everything rounded to
-   the nearest byte and clamped to [0, 255]; NaN becomes 0.
+   the nearest byte and clamped to [0, 255]; NaN becomes 0. `out` may be the
+   image's own pixels: each texel's bytes land on floats already read, so a
+   large image converts without a second buffer (the floats are gone then).
    Preconditions (TT_ASSERT): image, its pixels and out are not NULL. */
 TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out);
 
@@ -933,11 +935,12 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
      4. tt_lapped_measure, and tt_atlas_pack_pairs + tt_lapped_bake for an
         ordinary texture (Sec. 4).
    Memory per photo pixel, besides the photo (16 bytes, yours): the patch
-   holds 16 bytes, and making it takes 8 more while it runs; the paste loop
-   keeps 4 bytes per patch pixel (its opaque depth) and takes up to 5 more
-   while it traces the patch's hull. A caller that frees the photo once the
-   patch is made (as the tiledtex tool does) peaks at about 40 bytes per
-   photo pixel. The bake's scratch is 8 bytes per atlas texel.
+   holds 16 bytes, and making it takes nothing more (its scratch lives in
+   the patch's own pixels); the paste loop keeps 4 bytes per patch pixel
+   (its opaque depth) and takes up to 5 more while it traces the patch's
+   hull. A caller that frees the photo once the patch is made (as the
+   tiledtex tool does) peaks at 32 bytes per photo pixel, while the patch is
+   made. The bake's scratch is 8 bytes per atlas texel.
 
    The tangent field, Sec. 3.2 (establishing local orientation and scale).
    Each face f gets a vector T_f in its plane: its direction is the texture's
@@ -3035,11 +3038,14 @@ TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsign
     for (b = 0; b < 255; b++) alpha_bound[b] = ((float)b + 0.5f) / 255.0f;
     n = (size_t)image->width * image->height;
     for (i = 0; i < n; i++) {
+        /* Read the whole texel before writing: out may alias the pixels
+           (bytes 4i.. lie on floats of texel i/4 <= i, read already). */
         const float *p = image->pixels + 4 * i;
-        out[4 * i] = tt__encode_byte(bound, p[0]);
-        out[4 * i + 1] = tt__encode_byte(bound, p[1]);
-        out[4 * i + 2] = tt__encode_byte(bound, p[2]);
-        out[4 * i + 3] = tt__encode_byte(alpha_bound, p[3]);
+        float red = p[0], green = p[1], blue = p[2], alpha = p[3];
+        out[4 * i] = tt__encode_byte(bound, red);
+        out[4 * i + 1] = tt__encode_byte(bound, green);
+        out[4 * i + 2] = tt__encode_byte(bound, blue);
+        out[4 * i + 3] = tt__encode_byte(alpha_bound, alpha);
     }
 }
 
@@ -5606,20 +5612,17 @@ static int tt__patch_mask_shape(const tt_image *src_image, int source_alpha, int
    (inside the rounded-square base shape shrunk by the margin), else
    infinite; inside <=> q <= s, with s found by bisection so that the shape
    covers TT_PATCH_SPLOTCH_COVERAGE of the w x h image. Inside cells of grid
-   (padded by one, gw wide) become `big`; *inside counts them. */
-static tt_result tt__patch_splotch(int w, int h, uint64_t seed, float roughness, float falloff, float big,
-                                   float *grid, int gw, const tt_allocator *al, int *inside, tt_error *error)
+   (padded by one, gw wide) become `big`; *inside counts them. q is w * h
+   floats of scratch. */
+static void tt__patch_splotch(int w, int h, uint64_t seed, float roughness, float falloff, float big, float *grid,
+                              int gw, float *q, int *inside)
 {
     size_t count = (size_t)w * (size_t)h, i;
     tt_rng rng;
     float c[4], phi[4], csum = 0.0f, lo, hi, ax, ay, margin = falloff > 1.0f ? falloff : 1.0f;
     long target = (long)((double)TT_PATCH_SPLOTCH_COVERAGE * (double)count + 0.5);
     int k, it, x, y;
-    float *q = TT__ALLOC(al, float, count);
     *inside = 0;
-    if (!q)
-        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory making a %d x %d splotch", w,
-                        h);
     tt_rng_seed(&rng, seed, 0x7061746368ull);   /* "patch" */
     for (k = 0; k < 4; k++) {
         c[k] = (0.5f + 0.5f * tt_rng_float(&rng)) / (float)(k + 2);
@@ -5652,8 +5655,6 @@ static tt_result tt__patch_splotch(int w, int h, uint64_t seed, float roughness,
                 grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] = big;
                 (*inside)++;
             }
-    tt__free(al, q);
-    return TT_OK;
 }
 
 /* The soft falloff (Sec. 3.1: alpha "falls off near the patch boundary"):
@@ -5687,9 +5688,9 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     const tt_allocator *al = allocator;
     tt_image *patch = NULL;
     tt_result result = TT_OK;
-    float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL;
+    float *grid = NULL, *line = NULL, *dline = NULL, *z = NULL, *alpha;
     int *v = NULL;
-    int w, h, gw, gh, x, y, n, inside = 0, source_alpha = 0, mask_alpha = 0;
+    int w, h, gw, gh, x, y, n, inside = 0, source_alpha = 0, mask_alpha = 0, in_place = 0;
     size_t count, i;
     float falloff, roughness;
 
@@ -5748,10 +5749,18 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
                             "falloff %g leaves no room for a splotch in a %d x %d image", (double)falloff, w, h);
     }
 
+    /* The patch's own pixels (4 floats a texel) are the scratch space: the
+       padded distance grid, (w + 2)(h + 2) floats, at their start, the
+       splotch's w * h values after it, and at the end (from 3 w h on) the
+       alpha plane, read back as the colours are written from the start. So a
+       patch costs its 16 bytes a texel and nothing more per texel (w, h >= 4
+       keep the three apart; smaller images get a scratch grid of their own). */
     gw = w + 2;
     gh = h + 2;
     n = (gw > gh ? gw : gh);
-    grid = TT__ALLOC(al, float, (size_t)gw * (size_t)gh);
+    if ((result = tt_image_create(w, h, al, &patch, error)) != TT_OK) return result;
+    in_place = (size_t)gw * (size_t)gh + count <= 3 * count;
+    grid = in_place ? patch->pixels : TT__ALLOC(al, float, (size_t)gw * (size_t)gh + count);
     line = TT__ALLOC(al, float, n);
     dline = TT__ALLOC(al, float, n);
     z = TT__ALLOC(al, float, n + 1);
@@ -5773,8 +5782,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
             goto done;
         }
     } else {
-        result = tt__patch_splotch(w, h, opt.seed, roughness, falloff, big, grid, gw, al, &inside, error);
-        if (result != TT_OK) goto done;
+        tt__patch_splotch(w, h, opt.seed, roughness, falloff, big, grid, gw, grid + (size_t)gw * (size_t)gh, &inside);
         if (inside == 0) {   /* not reachable with the margin check above; kept for safety */
             result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the mask has no opaque pixel");
             goto done;
@@ -5783,23 +5791,30 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
 
     if ((result = tt__patch_soft_edge(grid, gw, gh, line, dline, v, z, big, falloff, error)) != TT_OK) goto done;
 
-    if ((result = tt_image_create(w, h, al, &patch, error)) != TT_OK) goto done;
+    /* The alpha plane first (it lies beyond the grid), then the colours from
+       the start: texel `at` is written after its alpha is read, and never
+       over an alpha still to be read (3 w h + at' >= 4 at + 4 for at' > at). */
+    alpha = patch->pixels + 3 * count;
     for (y = 0; y < h; y++)
-        for (x = 0; x < w; x++) {
-            size_t at = (size_t)y * (size_t)w + (size_t)x;
-            float a = tt__clamp_f(grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] / falloff, 0.0f, 1.0f);
-            const float *s = source->pixels + 4 * at;
-            float *o = patch->pixels + 4 * at;
-            o[0] = s[0] * a;
-            o[1] = s[1] * a;
-            o[2] = s[2] * a;
-            o[3] = a;
-        }
+        for (x = 0; x < w; x++)
+            alpha[(size_t)y * (size_t)w + (size_t)x] =
+                tt__clamp_f(grid[(size_t)(y + 1) * (size_t)gw + (size_t)(x + 1)] / falloff, 0.0f, 1.0f);
+    for (i = 0; i < count; i++) {
+        float a = alpha[i];
+        const float *src = source->pixels + 4 * i;
+        float *o = patch->pixels + 4 * i;
+        o[0] = src[0] * a;
+        o[1] = src[1] * a;
+        o[2] = src[2] * a;
+        o[3] = a;
+    }
     *out_patch = patch;
+    patch = NULL;
     result = tt__ok(error);
 
 done:
-    tt__free(al, grid);
+    if (!in_place) tt__free(al, grid);
+    tt_image_free(patch);
     tt__free(al, line);
     tt__free(al, dline);
     tt__free(al, z);

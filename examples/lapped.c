@@ -405,20 +405,24 @@ static int make_patch(const lapped_options *options, const tt_image *image, tt_i
    so a viewer that filters straight-alpha textures shows no dark fringes.
    So the image itself becomes the straight patch: its alpha is replaced by
    the patch's, in place (the image is not used afterwards), and it is
-   encoded as sRGB colour with linear alpha, as PNG wants it. No float copy
-   is made, and the image is freed (*image = NULL) as soon as it is 8-bit,
-   before the PNG is compressed. */
+   encoded as sRGB colour with linear alpha, as PNG wants it, into its own
+   pixels (tt_image_to_rgba8 may write over the floats it reads): no second
+   buffer, and the photo is gone (*image = NULL) before the PNG is
+   compressed. */
 static int add_patch_png(tool_output *output, const char *path, tt_image **image, const tt_image *patch)
 {
     char message[TOOL_ERROR_SIZE];
     int width = (*image)->width, height = (*image)->height, status;
     size_t i, n = (size_t)width * (size_t)height;
-    unsigned char *rgba = (unsigned char *)malloc(n * 4);
-    if (!rgba) return tool_fail("out of memory for the %dx%d patch image", width, height);
+    unsigned char *rgba = (unsigned char *)(*image)->pixels, *shorter;
     for (i = 0; i < n; i++) (*image)->pixels[4 * i + 3] = patch->pixels[4 * i + 3];
     tt_image_to_rgba8(*image, TT_COLOR_SRGB, rgba);
+    (*image)->pixels = NULL;
     image_free(*image);
     *image = NULL;
+    /* The bytes fill the first quarter of the old float buffer: give the
+       rest back before compressing. */
+    if ((shorter = (unsigned char *)realloc(rgba, n * 4)) != NULL) rgba = shorter;
     status = output_add_png_rgba8(output, path, rgba, width, height, message, sizeof message);
     free(rgba);
     return status != 0 ? tool_fail("%s", message) : 0;

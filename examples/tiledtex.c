@@ -45,7 +45,7 @@ static void print_help(void)
     printf("\nglobal option (before or after the command):\n"
            "  --max-pixels N  refuse images of more than N pixels, checked before decoding them\n"
            "                  (default %d = 4096x4096). Peak memory per input pixel:\n"
-           "                  lapped needs about 41 bytes, tile and synth about 17\n",
+           "                  lapped needs about 32 bytes, tile and synth about 17\n",
            TOOL_DEFAULT_MAX_PIXELS);
     printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
            "Try it: tiledtex generate mesh torus.obj --shape torus\n"

@@ -324,6 +324,27 @@ static void test_color_mip(void)
     }
 }
 
+/* tt_image_to_rgba8 into the image's own pixels gives the same bytes as
+   into a separate buffer (the tool converts large photos that way). */
+static void test_color_bytes_in_place(void)
+{
+    tt_image *im = NULL;
+    unsigned char *apart;
+    int i, n = 37 * 23, sp, bad;
+    if (tt_image_create(37, 23, NULL, &im, NULL) != TT_OK) { CHECK(0, "create 37x23"); return; }
+    apart = (unsigned char *)malloc((size_t)n * 4);
+    for (sp = 0; sp < 2 && apart; sp++) {
+        tt_color_space space = sp ? TT_COLOR_LINEAR : TT_COLOR_SRGB;
+        for (i = 0; i < 4 * n; i++) im->pixels[i] = (float)((i * 7919) % 1000) / 999.0f;
+        tt_image_to_rgba8(im, space, apart);
+        tt_image_to_rgba8(im, space, (unsigned char *)im->pixels);
+        for (i = 0, bad = 0; i < 4 * n; i++) bad += ((unsigned char *)im->pixels)[i] != apart[i];
+        CHECK(bad == 0, "space %d: %d of %d bytes differ when converting in place", (int)space, bad, 4 * n);
+    }
+    free(apart);
+    tt_image_free(im);
+}
+
 /* Alpha is never sRGB-converted; NaN encodes to 0 in every channel. */
 static void test_color_alpha_nan(void)
 {
@@ -783,6 +804,7 @@ void run_image_tests(void)
     RUN(test_color_transfer);
     RUN(test_color_bytes_identity);
     RUN(test_color_mip);
+    RUN(test_color_bytes_in_place);
     RUN(test_color_alpha_nan);
     RUN(test_from_bytes_errors);
     RUN(test_rotate);
