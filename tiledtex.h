@@ -2954,15 +2954,21 @@ TTDEF float tt_linear_to_srgb(float linear)
     return v <= 0.0031308f ? v * 12.92f : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
 }
 
-/* decode[b]: the linear value of byte b. bound[b], b = 0..254: the linear
-   value halfway (in the encoded scale) between bytes b and b + 1, so that
-   encoding rounds to the nearest byte by a search among the bounds, with no
-   power function per texel, and decode then encode gives back every byte. */
-static void tt__byte_tables(tt_color_space space, float decode[256], float bound[255])
+/* decode[b]: the linear value of byte b. */
+static void tt__decode_table(tt_color_space space, float decode[256])
 {
     int b;
     for (b = 0; b < 256; b++)
         decode[b] = space == TT_COLOR_SRGB ? tt_srgb_to_linear((float)b / 255.0f) : (float)b / 255.0f;
+}
+
+/* bound[b], b = 0..254: the linear value halfway (in the encoded scale)
+   between bytes b and b + 1, so that encoding rounds to the nearest byte by
+   a search among the bounds, with no power function per texel, and decode
+   then encode gives back every byte. */
+static void tt__encode_bounds(tt_color_space space, float bound[255])
+{
+    int b;
     for (b = 0; b < 255; b++)
         bound[b] = space == TT_COLOR_SRGB ? tt_srgb_to_linear(((float)b + 0.5f) / 255.0f)
                                           : ((float)b + 0.5f) / 255.0f;
@@ -2983,11 +2989,11 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
                                     tt_color_space space, const tt_allocator *allocator, tt_image **out_image,
                                     tt_error *error)
 {
-    float decode[256], bound[255], alpha[256];
+    float decode[256], alpha[256];
     tt_image *image;
     tt_result result;
     long long row_bytes;
-    int x, y, b;
+    int x, y;
     tt__ok(error);
     if (!out_image) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_image is NULL");
     *out_image = NULL;
@@ -3005,8 +3011,8 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
                         channels);
     if (stride == 0) stride = (int)row_bytes;
     if ((result = tt_image_create(width, height, allocator, &image, error)) != TT_OK) return result;
-    tt__byte_tables(space, decode, bound);
-    for (b = 0; b < 256; b++) alpha[b] = (float)b / 255.0f;
+    tt__decode_table(space, decode);
+    tt__decode_table(TT_COLOR_LINEAR, alpha);
     for (y = 0; y < height; y++) {
         const unsigned char *row = data + (size_t)y * (size_t)stride;
         float *out = image->pixels + (size_t)y * width * 4;
@@ -3022,20 +3028,18 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
             }
         }
     }
-    (void)bound;
     *out_image = image;
     return TT_OK;
 }
 
 TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out)
 {
-    float decode[256], bound[255], alpha_bound[255];
+    float bound[255], alpha_bound[255];
     size_t i, n;
-    int b;
     TT_ASSERT(image && image->pixels && out);
     if (!image || !image->pixels || !out) return;
-    tt__byte_tables(space, decode, bound);
-    for (b = 0; b < 255; b++) alpha_bound[b] = ((float)b + 0.5f) / 255.0f;
+    tt__encode_bounds(space, bound);
+    tt__encode_bounds(TT_COLOR_LINEAR, alpha_bound);
     n = (size_t)image->width * image->height;
     for (i = 0; i < n; i++) {
         /* Read the whole texel before writing: out may alias the pixels
