@@ -3,7 +3,10 @@
 #
 #   1. compile checks of tiledtex.h (each counts as one test): gcc C99 with
 #      strict warnings, g++ as C++, clang, tcc, TILEDTEX_STATIC (every function
-#      used, and only one used), user-defined TT_MALLOC/TT_FREE, and no raw
+#      used, and only one used), user-defined TT_MALLOC/TT_FREE, the helpers'
+#      preconditions caught by TT_ASSERT (tests/assert_check.c), the two
+#      QUICK START blocks compiled and run, every public declaration checked
+#      against the API contract (tests/check_api.sh), and no raw
 #      malloc/free/realloc/calloc outside the TT_MALLOC/TT_FREE defaults;
 #   2. the unit tests, tests/test_*.c (test_common.c and one file per section
 #      of the header, built into one program), with ASan + UBSan;
@@ -71,6 +74,22 @@ compile_check "TILEDTEX_STATIC (every function used)" static \
     gcc -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror -DTILEDTEX_STATIC
 compile_check "user-defined TT_MALLOC/TT_FREE" user_alloc \
     gcc -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror -DCOMPILE_CHECK_USER_ALLOC
+
+# The helpers that return no tt_result state their preconditions: each broken
+# one must reach TT_ASSERT before touching memory, and under NDEBUG the ones
+# that promise a safe answer must give it (tests/assert_check.c).
+for variant in debug ndebug; do
+    flags=""
+    [ "$variant" = ndebug ] && flags="-DASSERT_CHECK_NDEBUG"
+    # shellcheck disable=SC2086  # flags is empty or one flag
+    if log=$(gcc -std=c99 -g -Wall -Wextra -pedantic -Werror -fsanitize=address,undefined -fno-sanitize-recover=all \
+            $flags -I. tests/assert_check.c -o "$OUT/assert_check_$variant" -lm 2>&1) &&
+        log=$("$OUT/assert_check_$variant" 2>&1); then
+        pass "asserts: every documented precondition of the helpers is checked ($variant build)"
+    else
+        fail "asserts: a broken precondition is not caught ($variant build)" "$log"
+    fi
+done
 
 # TILEDTEX_STATIC in a file that uses one function, as a user would: the
 # functions it does not call must not warn (-Wunused-function) under -Wall.
