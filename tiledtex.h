@@ -220,7 +220,8 @@ typedef struct tt_rng {
 } tt_rng;
 
 /* Start a sequence. Different `stream` values give independent sequences for
-   the same seed. */
+   the same seed. Then draw from it.
+   Preconditions (TT_ASSERT): rng is not NULL. */
 TTDEF void tt_rng_seed(tt_rng *rng, uint64_t seed, uint64_t stream);
 TTDEF uint32_t tt_rng_next(tt_rng *rng);                    /* uniform 32 bits */
 TTDEF uint32_t tt_rng_below(tt_rng *rng, uint32_t bound);   /* uniform in [0, bound); 0 if bound==0 */
@@ -1692,8 +1693,10 @@ static void tt__sort_doubles(double *v, int n)
 /* PCG32 (O'Neill 2014): a 64-bit LCG whose output is a permuted 32-bit word. */
 TTDEF uint32_t tt_rng_next(tt_rng *rng)
 {
-    uint64_t old = rng->state;
+    uint64_t old;
     uint32_t xorshifted, rotation;
+    TT_ASSERT(rng);
+    old = rng->state;
     rng->state = old * 6364136223846793005ull + rng->increment;
     xorshifted = (uint32_t)(((old >> 18) ^ old) >> 27);
     rotation = (uint32_t)(old >> 59);
@@ -1702,6 +1705,7 @@ TTDEF uint32_t tt_rng_next(tt_rng *rng)
 
 TTDEF void tt_rng_seed(tt_rng *rng, uint64_t seed, uint64_t stream)
 {
+    TT_ASSERT(rng);
     rng->state = 0;
     rng->increment = (stream << 1) | 1u;
     tt_rng_next(rng);

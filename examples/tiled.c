@@ -149,7 +149,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
        memory long before it is tried. */
     if (options->subdivide > 0 &&
         (double)out->mesh->nfaces * pow(4.0, options->subdivide) > (double)TILED_MAX_QUADS) {
-        status = tool_fail("%s: --subdivide %d would make %.0f quads; the limit is %d (use a smaller level)",
+        status = tool_fail("%s: --subdivide %d would make %.3g quads; the limit is %d (use a smaller level)",
                            obj_path, options->subdivide, (double)out->mesh->nfaces * pow(4.0, options->subdivide),
                            TILED_MAX_QUADS);
         goto fail;

@@ -114,6 +114,7 @@ int main(void)
     EXPECT_ASSERT("tt_rotate_coords(NULL out)", tt_rotate_coords(1, 4, 4, 0, 0, NULL, &ry));
     EXPECT_ASSERT("tt_rotate_coords(result beyond int)",
                   tt_rotate_coords(1, 0x7fffffff, 4, -0x7fffffff, 0, &rx, &ry));
+    EXPECT_ASSERT("tt_rng_next(NULL)", tt_rng_next(NULL));
     EXPECT_ASSERT("tt_raster_triangle(NULL xy)", tt_raster_triangle(NULL, 8, 8, on_pixel, NULL));
     EXPECT_ASSERT("tt_raster_triangle(NULL fn)", tt_raster_triangle(xy, 8, 8, NULL, NULL));
 #endif

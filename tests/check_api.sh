@@ -32,7 +32,7 @@ objects=$(printf '%s\n' "$decls" | cut -f2 | grep -oE '\btt_[a-z0-9_]+ \*\*' | s
 frees=$(printf '%s\n' "$decls" | cut -f2 | grep -oE 'void tt_[a-z0-9_]+_free\(' | sed 's/void //; s/($//')
 
 # Functions that return their answer directly and cannot fail by definition.
-total_functions=" tt_result_string tt_version tt_rng_seed tt_rng_next tt_rng_below tt_rng_float tt_srgb_to_linear tt_linear_to_srgb "
+total_functions=" tt_result_string tt_version tt_srgb_to_linear tt_linear_to_srgb "
 
 while IFS=$'\t' read -r comment decl; do
   [ -n "$decl" ] || continue
