@@ -104,7 +104,8 @@
                   rotations, premultiplied `over`, box downsampling,
                   minimum-error cut
      4. Numerics - triplets to CSR sparse matrices, Jacobi-preconditioned
-                  conjugate gradients (symmetric positive definite systems)
+                  conjugate gradients (symmetric positive definite systems),
+                  radix-2 FFTs (1D, 2D, real input), masked cross-correlation
      5. Raster  - 2D triangle rasterisation with barycentrics
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
@@ -585,6 +586,222 @@ typedef struct tt_cg_report {
    distinct x. */
 TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, const tt_cg_options *options,
                             const tt_allocator *allocator, double *x, tt_cg_report *report, tt_error *error);
+
+/* ---- Fast Fourier transforms and masked cross-correlation ----
+
+   Hierarchical pattern mapping (Soler et al. Sec. 4.2) finds where a masked
+   piece of texture fits best in an image by correlating it with the image
+   at every offset at once, with the FFT. This part gives the transforms and
+   that masked correlation.
+
+   Transforms. Complex double, in place, radix-2 family (sizes are powers of
+   two, pad the data to them), iterative: a bit-reversal permutation, one
+   radix-2 stage when log2 n is odd, then radix-4 stages (each does the work of
+   two radix-2 stages with one load and store of 4 points and 3 complex
+   multiplies instead of 4). The twiddle factors of each stage are stored
+   contiguously in the plan, each computed directly with cos and sin (no
+   recurrence, so no drift). Arrays are row-major, `height` rows of `width`
+   values; complex values are interleaved (re, im) doubles. A 2D transform
+   runs the 1D transform along every row, then along every column. The
+   column pass works on strips of 32 adjacent columns at once, in place:
+   each butterfly then combines row segments of 32 complex numbers with one
+   twiddle, a unit-stride loop the compiler vectorises, where gathering one
+   column at a time would touch a row's worth of cache line per value (about
+   4x slower at 512 x 512). The stages that combine rows close together run
+   on 64 KB blocks of a strip while they are in cache: with a power-of-two
+   row stride a whole strip maps onto a fraction of the cache's sets and
+   would not stay there. Width and height are independent (64 x 32 is fine);
+   height 1 is a 1D transform. Measured at 512 x 512 (make bench), forward
+   plus inverse takes 2.2-2.4x the time of FFTW's measured plans.
+
+   Conventions (as FFTW's): forward (TT_FFT_FORWARD = -1)
+       X(k, l) = sum over x < width, y < height of x(x, y) e^(-2 pi i (k x / width + l y / height)),
+   inverse (TT_FFT_INVERSE = +1) the same with e^(+2 pi i ...) and NOT
+   normalised: inverse(forward(x)) = width * height * x. Callers fold the
+   1 / (width * height) into a pass they make anyway.
+
+   Memory and threads. The plan holds the twiddles and the bit-reversal table
+   (about 40 bytes per value of the larger side); the transforms allocate
+   nothing and need no scratch, so a plan is read-only after
+   tt_fft_plan_create and several threads may transform distinct arrays with
+   one plan at once. Values are not checked before a transform (that pass
+   would cost about a tenth of it); the result is: a NaN or infinity in the
+   data, or an overflow, comes out as TT_ERROR_NON_FINITE.
+
+   Masked correlation. See tt_xcorr_masked: with the correlation
+       (f * g)(x0) = sum over x of f(x) g(x + x0) = F^-1( conj(F(f)) F(g) )(x0)
+   (Soler et al.'s footnote 2; the paper's printed F^-1(F(f) conj(F(g)))
+   is the mirror image, and would return -x0). */
+
+#define TT_FFT_FORWARD (-1)   /* e^(-2 pi i ...) */
+#define TT_FFT_INVERSE 1      /* e^(+2 pi i ...), unnormalised */
+#define TT_FFT_MAX_SIZE 32768 /* the largest width or height of a plan (2^15) */
+
+/* The sizes and tables of transforms of height x width values. Read-only
+   after creation: several threads may use it at once. The arrays are the
+   plan's own; do not change them. */
+typedef struct tt_fft_plan {
+    int width, height;          /* powers of two in [1, TT_FFT_MAX_SIZE] */
+    int log2_width, log2_height;
+    int size;                   /* max(width, height): the tables' size */
+    double *twiddles;           /* per radix-4 stage of quarter length L = 1, 2, 4, .., size / 4: at 6 (L - 1),
+                                   L triples (cos, sin) of 2 pi k m / (4 L), m = 1, 2, 3, k < L */
+    double *real_twiddles;      /* (cos, sin) of 2 pi k / width for k < width / 2: the real transforms' pass */
+    int *bit_reverse;           /* size entries: i with its log2(size) bits reversed */
+    tt_allocator allocator;     /* the one the arrays came from */
+} tt_fft_plan;
+
+/* Make the plan for transforms of height rows by width columns (height 1:
+   a 1D transform of width values). Fails, with *out NULL and nothing left
+   allocated, on:
+     TT_ERROR_INVALID_ARGUMENT  a size that is not a power of two from 1 to
+                                TT_FFT_MAX_SIZE (the message says the nearest
+                                power of two and the one to pad to), NULL out,
+                                a bad allocator,
+     TT_ERROR_OUT_OF_MEMORY.
+   Time O(size) cos/sin calls; memory about 40 bytes per value of the larger
+   side. Free it with tt_fft_plan_free. Thread-safe. */
+TTDEF tt_result tt_fft_plan_create(int width, int height, const tt_allocator *allocator, tt_fft_plan **out,
+                                   tt_error *error);
+
+/* Release a plan (NULL is fine). */
+TTDEF void tt_fft_plan_free(tt_fft_plan *plan);
+
+/* Transform data, height x width complex values (2 * width * height
+   doubles, interleaved re, im; row y starts at data[2 * width * y]), in place:
+   direction TT_FFT_FORWARD or TT_FFT_INVERSE (unnormalised; see the
+   conventions above). width and height are the data's, and must be the
+   plan's: they guard against transforming a 512 x 512 array with a 256 x 256
+   plan. Returns
+     TT_ERROR_INVALID_ARGUMENT  NULL plan or data, a direction other than -1
+                                or +1, sizes that are not the plan's (data
+                                untouched);
+     TT_ERROR_NON_FINITE        the result holds a NaN or infinity: the data
+                                did, or its values overflowed (above about
+                                1e300 / (width * height)); the data is then
+                                transformed as IEEE arithmetic made it.
+   Allocates nothing; O(n log n) for n = width * height. Thread-safe for
+   distinct data. */
+TTDEF tt_result tt_fft_c2c(const tt_fft_plan *plan, double *data, int width, int height, int direction,
+                           tt_error *error);
+
+/* Forward transform of real data, height x width doubles (row-major), into
+   its half spectrum: height x (width / 2 + 1) complex values (2 * height *
+   (width / 2 + 1) doubles, interleaved; row l starts at
+   spectrum[2 * (width / 2 + 1) * l]), where spectrum entry (l, k) is the
+   forward c2c transform's X(k, l) for k = 0 .. width / 2. The other half is
+   redundant: X(k, l) = conj(X(width - k, (height - l) mod height)).
+   The rows use the two-for-one packing: a row of width reals is read as
+   width / 2 complex values (x[2m] + i x[2m + 1]), transformed, and split
+   into bins 0 .. width / 2 by one pass; about half the work of the complex
+   transform. real and spectrum must not overlap. Errors as tt_fft_c2c
+   (width and height are the real data's; TT_ERROR_NON_FINITE leaves the
+   spectrum unspecified). Allocates nothing; thread-safe for distinct
+   outputs. */
+TTDEF tt_result tt_fft_r2c(const tt_fft_plan *plan, const double *real, int width, int height, double *spectrum,
+                           tt_error *error);
+
+/* Inverse of tt_fft_r2c, unnormalised like tt_fft_c2c:
+   c2r(r2c(x)) = width * height * x. spectrum (the half spectrum, laid out as
+   tt_fft_r2c writes it) is used as work space and destroyed; real gets
+   height x width doubles and must not overlap it. The spectrum is taken to
+   be that of real data (Hermitian), as r2c's output and sums and products of
+   such spectra are: the imaginary parts of bins k = 0 and k = width / 2 after
+   the column pass are ignored, as FFTW's c2r does. Errors as tt_fft_r2c.
+   Allocates nothing; thread-safe for distinct arrays. */
+TTDEF tt_result tt_fft_c2r(const tt_fft_plan *plan, double *spectrum, int width, int height, double *real,
+                           tt_error *error);
+
+/* The cached part of a masked correlation against one image T: its plan
+   and the half spectra (tt_fft_r2c) of each channel T_c and of sum_c T_c^2.
+   Read-only after creation: several threads may correlate against it at
+   once. */
+typedef struct tt_xcorr_texture {
+    int width, height;          /* T's size: powers of two (pad T to them) */
+    int channels;
+    size_t work_size;           /* doubles of work space tt_xcorr_masked needs: 2 * spectrum_size */
+    size_t spectrum_size;       /* doubles in one half spectrum: 2 * height * (width / 2 + 1) */
+    tt_fft_plan *plan;          /* width x height; the object's own */
+    double *spectra;            /* channels + 1 half spectra, spectrum_size doubles apart: F(T_0), ..,
+                                   F(T_channels-1), F(sum_c T_c^2) */
+    tt_allocator allocator;     /* the one everything here came from */
+} tt_xcorr_texture;
+
+/* Cache an image T for tt_xcorr_masked: `texture` holds `channels` planes of
+   height x width doubles, plane c starting at texture[c * width * height]
+   (row-major). Correlation is circular (toroidal): an offset compares the
+   mask with T(x mod width, y mod height). For a bounded image, pad it with
+   zeros to a power-of-two size and restrict the offsets (the `allowed` map
+   of tt_xcorr_masked); for a periodic one of another size, fill the padded
+   size periodically. Use a Euclidean colour space (the channels' squared
+   differences are added). Fails, with *out NULL and nothing left allocated,
+   on:
+     TT_ERROR_INVALID_ARGUMENT  sizes that are not powers of two from 1 to
+                                TT_FFT_MAX_SIZE, channels < 1, NULL texture
+                                or out, a bad allocator,
+     TT_ERROR_NON_FINITE        a NaN or infinite value (error->row, column
+                                and item = channel name it), or values whose
+                                squares overflow,
+     TT_ERROR_TOO_LARGE         byte counts that overflow size_t,
+     TT_ERROR_OUT_OF_MEMORY.
+   Time: channels + 1 real transforms; memory: (channels + 1) half spectra,
+   16 bytes per texel of each. Free it with tt_xcorr_texture_free.
+   Thread-safe: reads only `texture`. */
+TTDEF tt_result tt_xcorr_texture_create(int width, int height, int channels, const double *texture,
+                                        const tt_allocator *allocator, tt_xcorr_texture **out, tt_error *error);
+
+/* Release a cached texture (NULL is fine). */
+TTDEF void tt_xcorr_texture_free(tt_xcorr_texture *texture);
+
+/* The best offset of a masked correlation. */
+typedef struct tt_xcorr_match {
+    int x, y;                   /* the allowed offset with the smallest E; -1, -1 when there is none */
+    double e;                   /* E(x, y) there (>= 0); 0 when there is none */
+    double mask_sum;            /* |J| = sum of the mask's weights */
+    double masked_energy;       /* sum over texels and channels of J I^2: E if T were 0 */
+} tt_xcorr_match;
+
+/* Masked sum of squared differences between values I (under mask J) and
+   the cached image T, at every offset (x, y) at once:
+       E(x, y) = sum over texels p and channels c of J(p) (I_c(p) - T_c(p + (x, y)))^2
+               = sum J I^2 - 2 sum_c ((J I_c) * T_c)(x, y) + (J * sum_c T_c^2)(x, y)
+   with p + (x, y) taken mod (width, height) and * the correlation of the
+   section comment (F^-1(conj(F(f)) F(g))): so E(x, y) compares the value at
+   texel p with T at p + (x, y). In other words, if the values are a crop of
+   T placed at (x0, y0), I(p) = T(p + (x0, y0)) under the mask, then
+   E(x0, y0) = 0. Computed with real transforms in double: channels + 1
+   forward ones and one inverse per call; each E is clamped at 0 (the sum of
+   three large terms can round below 0).
+     mask     height x width weights J >= 0 (1 / 0 for a binary mask; soft
+              coverage works too: the weighted form above is exact for it).
+     values   `channels` planes of height x width, laid out as the texture;
+              read only where J > 0 (elsewhere anything, even NaN).
+     allowed  height x width bytes, non-zero where an offset may be chosen
+              (row y, column x = offset (x, y)); NULL: every offset.
+     work     texture->work_size doubles of scratch (the caller's, so that
+              repeated fits allocate nothing); must not overlap the others.
+     out_map  height x width doubles receiving E(x, y) at every offset (row
+              y, column x), allowed or not; may be NULL when only the match
+              is wanted.
+     out_match  the allowed offset with the smallest E, ties broken by the
+              smallest y * width + x (the first in row-major order); may be
+              NULL when only the map is wanted (not both NULL).
+   Returns
+     TT_ERROR_NOT_MEASURED      the mask is all zero (every offset fits
+                                equally: E = 0 everywhere, out_match
+                                {-1, -1, 0, 0, 0}) or no offset is allowed
+                                (out_match -1, -1; the map is filled),
+     TT_ERROR_INVALID_ARGUMENT  NULL texture, mask, values or work, both
+                                outputs NULL, a negative mask weight
+                                (error->row, column),
+     TT_ERROR_NON_FINITE        a NaN or infinite weight, or value under the
+                                mask (error->row, column and item = channel),
+                                or sums that overflow.
+   Allocates nothing. Thread-safe: several threads may use one texture with
+   their own work and outputs. */
+TTDEF tt_result tt_xcorr_masked(const tt_xcorr_texture *texture, const double *mask, const double *values,
+                                const unsigned char *allowed, double *work, double *out_map,
+                                tt_xcorr_match *out_match, tt_error *error);
 
 /* ======================================================================== */
 /* 5. Raster                                                                */
@@ -3746,6 +3963,714 @@ done:
     tt__free(allocator, block);
     if (report) *report = rep;
     return result;
+}
+
+/* ---- Fast Fourier transforms ---- */
+
+/* log2 n for a power of two n >= 1, else -1. */
+static int tt__fft_log2(int n)
+{
+    int k = 0;
+    if (n < 1 || (n & (n - 1)) != 0) return -1;
+    while ((1 << k) < n) k++;
+    return k;
+}
+
+/* TT_OK when n is a power of two in [1, TT_FFT_MAX_SIZE]; otherwise the
+   error, naming the nearest power of two and the one to pad to. */
+static tt_result tt__fft_check_size(const char *what, int n, tt_error *error)
+{
+    int below = 1;
+    if (n >= 1 && n <= TT_FFT_MAX_SIZE && tt__fft_log2(n) >= 0) return TT_OK;
+    if (n < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "%s %d: FFT sizes are powers of two from 1 to %d", what, n, TT_FFT_MAX_SIZE);
+    if (n > TT_FFT_MAX_SIZE)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "%s %d is above the largest FFT size, %d (the nearest power of two allowed)", what, n,
+                        TT_FFT_MAX_SIZE);
+    while (below * 2 < n) below *= 2;
+    return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                    "%s %d is not a power of two: the nearest is %d; pad the data to %d", what, n,
+                    n - below <= 2 * below - n ? below : 2 * below, 2 * below);
+}
+
+TTDEF void tt_fft_plan_free(tt_fft_plan *plan)
+{
+    tt_allocator allocator;
+    if (!plan) return;
+    allocator = plan->allocator;
+    tt__free(&allocator, plan->twiddles);
+    tt__free(&allocator, plan->real_twiddles);
+    tt__free(&allocator, plan->bit_reverse);
+    tt__free(&allocator, plan);
+}
+
+TTDEF tt_result tt_fft_plan_create(int width, int height, const tt_allocator *allocator, tt_fft_plan **out,
+                                   tt_error *error)
+{
+    tt_fft_plan *plan;
+    int size, log2_size, i, L;
+    tt__ok(error);
+    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
+    *out = NULL;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (tt__fft_check_size("the width", width, error) != TT_OK ||
+        tt__fft_check_size("the height", height, error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
+    plan = TT__ALLOC(allocator, tt_fft_plan, 1);
+    if (!plan) goto out_of_memory;
+    memset(plan, 0, sizeof *plan);
+    plan->allocator = tt__allocator_copy(allocator);
+    plan->width = width;
+    plan->height = height;
+    plan->log2_width = tt__fft_log2(width);
+    plan->log2_height = tt__fft_log2(height);
+    size = width > height ? width : height;
+    log2_size = tt__fft_log2(size);
+    plan->size = size;
+    /* 6 (L - 1) doubles before the stage of quarter length L: 6 (size / 2 - 1)
+       in all (at least one, so that a size-1 plan still has an array). */
+    plan->twiddles = TT__ALLOC(&plan->allocator, double, size >= 4 ? 6 * (size / 2 - 1) : 1);
+    plan->real_twiddles = TT__ALLOC(&plan->allocator, double, width);
+    plan->bit_reverse = TT__ALLOC(&plan->allocator, int, size);
+    if (!plan->twiddles || !plan->real_twiddles || !plan->bit_reverse) {
+        tt_fft_plan_free(plan);
+        goto out_of_memory;
+    }
+    for (L = 1; 4 * L <= size; L *= 2) {
+        double *t = plan->twiddles + 6 * (L - 1);
+        int k, m;
+        for (k = 0; k < L; k++)
+            for (m = 1; m <= 3; m++) {
+                /* Each entry directly from its angle: no recurrence, no drift. */
+                double angle = TT__TWO_PI * (double)(k * m) / (double)(4 * L);
+                t[6 * k + 2 * (m - 1)] = cos(angle);
+                t[6 * k + 2 * (m - 1) + 1] = sin(angle);
+            }
+    }
+    for (i = 0; i < width / 2; i++) {
+        double angle = TT__TWO_PI * (double)i / (double)width;
+        plan->real_twiddles[2 * i] = cos(angle);
+        plan->real_twiddles[2 * i + 1] = sin(angle);
+    }
+    if (width == 1) plan->real_twiddles[0] = 1.0;
+    for (i = 0; i < size; i++) {
+        int b, r = 0;
+        for (b = 0; b < log2_size; b++)
+            if (i & (1 << b)) r |= 1 << (log2_size - 1 - b);
+        plan->bit_reverse[i] = r;
+    }
+    *out = plan;
+    return TT_OK;
+
+out_of_memory:
+    return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for a %d x %d FFT plan", width,
+                    height);
+}
+
+/* Non-zero (bit 63) when one of v[0 .. n-1] is a NaN or infinity: adding 1
+   to an all-ones exponent carries into the sign bit. Integer operations on
+   the bits, so it holds under -ffast-math and vectorises. */
+static uint64_t tt__fft_nonfinite(const double *v, size_t n)
+{
+    uint64_t found = 0;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        uint64_t bits;
+        memcpy(&bits, v + i, sizeof bits);
+        found |= (bits & 0x7ff0000000000000ull) + 0x0010000000000000ull;
+    }
+    return found >> 63;
+}
+
+/* The 1D transform of n = 2^log2n contiguous complex values x (a row), in
+   place; sign = direction. Bit reversal, one radix-2 stage when log2n is
+   odd, then radix-4 stages. After the stages of quarter length L, each block
+   of 4 L values holds, as radix-2 bit reversal leaves them, the transforms of
+   its elements r mod 4 in the order r = 0, 2, 1, 3; the radix-4 butterfly
+   combines them as X(k + q L) = sum_r w^(r k) Y_r(k) (sign i)^(r q). */
+static void tt__fft_row(const tt_fft_plan *plan, double *TT__RESTRICT x, int n, int log2n, double sign)
+{
+    int i, L, shift = tt__fft_log2(plan->size) - log2n;
+    for (i = 0; i < n; i++) {
+        int j = plan->bit_reverse[i] >> shift;
+        if (i < j) {
+            double re = x[2 * i], im = x[2 * i + 1];
+            x[2 * i] = x[2 * j];
+            x[2 * i + 1] = x[2 * j + 1];
+            x[2 * j] = re;
+            x[2 * j + 1] = im;
+        }
+    }
+    L = 1;
+    if (log2n & 1) {
+        for (i = 0; i < 2 * n; i += 4) {
+            double ar = x[i], ai = x[i + 1], br = x[i + 2], bi = x[i + 3];
+            x[i] = ar + br;
+            x[i + 1] = ai + bi;
+            x[i + 2] = ar - br;
+            x[i + 3] = ai - bi;
+        }
+        L = 2;
+    }
+    for (; 4 * L <= n; L *= 4) {
+        const double *tw = plan->twiddles + 6 * (L - 1);
+        int base, k;
+        for (base = 0; base < n; base += 4 * L) {
+            {
+                double *p0 = x + 2 * base, *p1 = p0 + 2 * L, *p2 = p1 + 2 * L, *p3 = p2 + 2 * L;
+                double ar = p0[0], ai = p0[1], br = p2[0], bi = p2[1], cr = p1[0], ci = p1[1], dr = p3[0];
+                double di = p3[1], t0r = ar + cr, t0i = ai + ci, t1r = ar - cr, t1i = ai - ci;   /* k = 0: w = 1 */
+                double t2r = br + dr, t2i = bi + di, t3r = sign * (br - dr), t3i = sign * (bi - di);
+                p0[0] = t0r + t2r;
+                p0[1] = t0i + t2i;
+                p2[0] = t0r - t2r;
+                p2[1] = t0i - t2i;
+                p1[0] = t1r - t3i;
+                p1[1] = t1i + t3r;
+                p3[0] = t1r + t3i;
+                p3[1] = t1i - t3r;
+            }
+            for (k = 1; k < L; k++) {
+                double *p0 = x + 2 * (base + k), *p1 = p0 + 2 * L, *p2 = p1 + 2 * L, *p3 = p2 + 2 * L;
+                double w1r = tw[6 * k], w1i = sign * tw[6 * k + 1], w2r = tw[6 * k + 2], w2i = sign * tw[6 * k + 3];
+                double w3r = tw[6 * k + 4], w3i = sign * tw[6 * k + 5];
+                double ar = p0[0], ai = p0[1];
+                double br = w1r * p2[0] - w1i * p2[1], bi = w1r * p2[1] + w1i * p2[0];   /* w^k Y1 */
+                double cr = w2r * p1[0] - w2i * p1[1], ci = w2r * p1[1] + w2i * p1[0];   /* w^2k Y2 */
+                double dr = w3r * p3[0] - w3i * p3[1], di = w3r * p3[1] + w3i * p3[0];   /* w^3k Y3 */
+                double t0r = ar + cr, t0i = ai + ci, t1r = ar - cr, t1i = ai - ci;
+                double t2r = br + dr, t2i = bi + di, t3r = sign * (br - dr), t3i = sign * (bi - di);
+                p0[0] = t0r + t2r;
+                p0[1] = t0i + t2i;
+                p2[0] = t0r - t2r;
+                p2[1] = t0i - t2i;
+                p1[0] = t1r - t3i;   /* t1 + sign i t3 */
+                p1[1] = t1i + t3r;
+                p3[0] = t1r + t3i;   /* t1 - sign i t3 */
+                p3[1] = t1i - t3r;
+            }
+        }
+    }
+}
+
+/* The radix-4 butterfly on four row segments of `count` complex values
+   with one set of twiddles: the column pass's inner loop, unit-stride and
+   free of branches so that it vectorises. */
+static void tt__fft_strip_butterfly(double *TT__RESTRICT p0, double *TT__RESTRICT p1, double *TT__RESTRICT p2,
+                                    double *TT__RESTRICT p3, int count, const double *w, double sign)
+{
+    double w1r = w[0], w1i = sign * w[1], w2r = w[2], w2i = sign * w[3], w3r = w[4], w3i = sign * w[5];
+    int j;
+    for (j = 0; j < 2 * count; j += 2) {
+        double ar = p0[j], ai = p0[j + 1];
+        double br = w1r * p2[j] - w1i * p2[j + 1], bi = w1r * p2[j + 1] + w1i * p2[j];
+        double cr = w2r * p1[j] - w2i * p1[j + 1], ci = w2r * p1[j + 1] + w2i * p1[j];
+        double dr = w3r * p3[j] - w3i * p3[j + 1], di = w3r * p3[j + 1] + w3i * p3[j];
+        double t0r = ar + cr, t0i = ai + ci, t1r = ar - cr, t1i = ai - ci;
+        double t2r = br + dr, t2i = bi + di, t3r = sign * (br - dr), t3i = sign * (bi - di);
+        p0[j] = t0r + t2r;
+        p0[j + 1] = t0i + t2i;
+        p2[j] = t0r - t2r;
+        p2[j + 1] = t0i - t2i;
+        p1[j] = t1r - t3i;
+        p1[j + 1] = t1i + t3r;
+        p3[j] = t1r + t3i;
+        p3[j + 1] = t1i - t3r;
+    }
+}
+
+/* The same for k = 0, whose twiddles are 1: no multiplies. */
+static void tt__fft_strip_butterfly1(double *TT__RESTRICT p0, double *TT__RESTRICT p1, double *TT__RESTRICT p2,
+                                     double *TT__RESTRICT p3, int count, double sign)
+{
+    int j;
+    for (j = 0; j < 2 * count; j += 2) {
+        double ar = p0[j], ai = p0[j + 1], br = p2[j], bi = p2[j + 1];
+        double cr = p1[j], ci = p1[j + 1], dr = p3[j], di = p3[j + 1];
+        double t0r = ar + cr, t0i = ai + ci, t1r = ar - cr, t1i = ai - ci;
+        double t2r = br + dr, t2i = bi + di, t3r = sign * (br - dr), t3i = sign * (bi - di);
+        p0[j] = t0r + t2r;
+        p0[j + 1] = t0i + t2i;
+        p2[j] = t0r - t2r;
+        p2[j + 1] = t0i - t2i;
+        p1[j] = t1r - t3i;
+        p1[j + 1] = t1i + t3r;
+        p3[j] = t1r + t3i;
+        p3[j + 1] = t1i - t3r;
+    }
+}
+
+/* The radix-2 butterfly (twiddle 1) on two row segments. */
+static void tt__fft_strip_radix2(double *TT__RESTRICT p0, double *TT__RESTRICT p1, int count)
+{
+    int j;
+    for (j = 0; j < 2 * count; j++) {
+        double a = p0[j], b = p1[j];
+        p0[j] = a + b;
+        p1[j] = a - b;
+    }
+}
+
+static void tt__fft_strip_swap(double *TT__RESTRICT p0, double *TT__RESTRICT p1, int count)
+{
+    int j;
+    for (j = 0; j < 2 * count; j++) {
+        double t = p0[j];
+        p0[j] = p1[j];
+        p1[j] = t;
+    }
+}
+
+/* One radix-4 stage of quarter length L over `rows` rows of a strip. With
+   `check`, tt__fft_nonfinite over the rows written, while they are hot. */
+static uint64_t tt__fft_strip_stage(const tt_fft_plan *plan, double *strip, size_t stride, int count, int rows,
+                                    int L, double sign, int check)
+{
+    const double *tw = plan->twiddles + 6 * (L - 1);
+    uint64_t found = 0;
+    int base, k, q;
+    for (base = 0; base < rows; base += 4 * L)
+        for (k = 0; k < L; k++) {
+            double *p0 = strip + stride * (size_t)(base + k), *p1 = p0 + stride * (size_t)L;
+            double *p2 = p1 + stride * (size_t)L, *p3 = p2 + stride * (size_t)L;
+            if (k == 0) tt__fft_strip_butterfly1(p0, p1, p2, p3, count, sign);
+            else tt__fft_strip_butterfly(p0, p1, p2, p3, count, tw + 6 * k, sign);
+            if (check)
+                for (q = 0; q < 4; q++) found |= tt__fft_nonfinite(p0 + stride * (size_t)(q * L), 2 * (size_t)count);
+        }
+    return found;
+}
+
+#define TT__FFT_STRIP 32          /* columns transformed together by the column pass */
+#define TT__FFT_BLOCK_BYTES 65536 /* the rows of a strip whose first stages run together */
+
+/* The 1D transform along the columns of n = 2^log2n rows of `columns`
+   complex values, `stride` doubles apart: strips of TT__FFT_STRIP columns,
+   each run through the same stages as tt__fft_row with whole row segments
+   as its points. The stages that combine rows less than a block apart (a
+   block: TT__FFT_BLOCK_BYTES of the strip) run block by block while it is in
+   cache; the rest sweep the strip, one stage at a time. That matters because
+   a power-of-two row stride maps a strip's rows onto a fraction of the
+   cache's sets: a 512 x 512 strip of 256 KB does not stay in a 2 MB L2.
+   Returns tt__fft_nonfinite over the result, checked where it is last
+   written. */
+static uint64_t tt__fft_columns(const tt_fft_plan *plan, double *data, int columns, size_t stride, int n,
+                                int log2n, double sign)
+{
+    int shift = tt__fft_log2(plan->size) - log2n, first;
+    uint64_t found = 0;
+    for (first = 0; first < columns; first += TT__FFT_STRIP) {
+        double *strip = data + 2 * (size_t)first;
+        int count = columns - first < TT__FFT_STRIP ? columns - first : TT__FFT_STRIP, i, L = 1, block, b;
+        for (i = 0; i < n; i++) {
+            int j = plan->bit_reverse[i] >> shift;
+            if (i < j) tt__fft_strip_swap(strip + stride * (size_t)i, strip + stride * (size_t)j, count);
+        }
+        block = 1;
+        while (block < n && (size_t)block * 2 * count * 16 <= TT__FFT_BLOCK_BYTES) block *= 2;
+        for (b = 0; b < n; b += block) {
+            double *rows = strip + stride * (size_t)b;
+            L = 1;
+            if (log2n & 1) {
+                for (i = 0; i < block; i += 2)
+                    tt__fft_strip_radix2(rows + stride * (size_t)i, rows + stride * (size_t)(i + 1), count);
+                L = 2;
+            }
+            for (; 4 * L <= block; L *= 4) tt__fft_strip_stage(plan, rows, stride, count, block, L, sign, 0);
+            if (block == n)
+                for (i = 0; i < n; i++) found |= tt__fft_nonfinite(rows + stride * (size_t)i, 2 * (size_t)count);
+        }
+        for (; 4 * L <= n; L *= 4) found |= tt__fft_strip_stage(plan, strip, stride, count, n, L, sign, 16 * L >= n);
+    }
+    return found;
+}
+
+/* The 2D complex transform of a plan-sized array (no argument checks). */
+static uint64_t tt__fft_c2c(const tt_fft_plan *plan, double *data, double sign)
+{
+    int y, w = plan->width, h = plan->height;
+    uint64_t found = 0;
+    if (w > 1)
+        for (y = 0; y < h; y++) tt__fft_row(plan, data + 2 * (size_t)w * y, w, plan->log2_width, sign);
+    if (h == 1) return tt__fft_nonfinite(data, 2 * (size_t)w);
+    if (w == 1) {
+        /* One column: contiguous, so the row kernel does it. */
+        tt__fft_row(plan, data, h, plan->log2_height, sign);
+        return tt__fft_nonfinite(data, 2 * (size_t)h);
+    }
+    found = tt__fft_columns(plan, data, w, 2 * (size_t)w, h, plan->log2_height, sign);
+    return found;
+}
+
+/* The forward real transform in place: rows of 2 (width / 2 + 1) doubles, each
+   holding `width` reals on entry and its width / 2 + 1 bins on return. Row
+   reals x[2m] + i x[2m + 1] are transformed as width / 2 complex values Z;
+   then, with w = e^(-2 pi i / width), bins k and width / 2 - k come from
+   E = (Z(k) + conj Z(n - k)) / 2 and O = (Z(k) - conj Z(n - k)) / (2i)
+   (n = width / 2, indices mod n) as X(k) = E + w^k O and
+   X(n - k) = conj(E - w^k O). */
+static uint64_t tt__fft_r2c_inplace(const tt_fft_plan *plan, double *data)
+{
+    int y, w = plan->width, h = plan->height, n = w / 2;
+    size_t stride = 2 * (size_t)(w / 2 + 1);
+    for (y = 0; y < h; y++) {
+        double *x = data + stride * (size_t)y;
+        int k;
+        if (w == 1) {
+            x[1] = 0.0;
+            continue;
+        }
+        if (n > 1) tt__fft_row(plan, x, n, plan->log2_width - 1, -1.0);
+        {
+            double z0r = x[0], z0i = x[1];
+            x[0] = z0r + z0i;
+            x[1] = 0.0;
+            x[2 * n] = z0r - z0i;
+            x[2 * n + 1] = 0.0;
+        }
+        for (k = 1; 2 * k <= n; k++) {
+            double *a = x + 2 * k, *b = x + 2 * (n - k);
+            double wr = plan->real_twiddles[2 * k], wi = -plan->real_twiddles[2 * k + 1];
+            double er = 0.5 * (a[0] + b[0]), ei = 0.5 * (a[1] - b[1]);
+            double or_ = 0.5 * (a[1] + b[1]), oi = -0.5 * (a[0] - b[0]);   /* (a - conj b) / 2i */
+            double mr = wr * or_ - wi * oi, mi = wr * oi + wi * or_;
+            a[0] = er + mr;
+            a[1] = ei + mi;
+            if (2 * k != n) {
+                b[0] = er - mr;
+                b[1] = -(ei - mi);
+            }
+        }
+    }
+    if (h == 1) return tt__fft_nonfinite(data, 2 * (size_t)(n + 1));
+    return tt__fft_columns(plan, data, n + 1, stride, h, plan->log2_height, -1.0);
+}
+
+/* The inverse of tt__fft_r2c_inplace, unnormalised, in place: rows of
+   2 (width / 2 + 1) doubles holding width / 2 + 1 bins on entry and `width` reals on
+   return. The inverse of the split: Z(k) = (X(k) + conj X(n - k)) +
+   i conj(w^k) (X(k) - conj X(n - k)), then the inverse of Z gives
+   x[2m] + i x[2m + 1]. */
+static uint64_t tt__fft_c2r_inplace(const tt_fft_plan *plan, double *data)
+{
+    int y, w = plan->width, h = plan->height, n = w / 2;
+    size_t stride = 2 * (size_t)(w / 2 + 1);
+    uint64_t found = 0;
+    if (h > 1) tt__fft_columns(plan, data, n + 1, stride, h, plan->log2_height, 1.0);
+    for (y = 0; y < h; y++) {
+        double *x = data + stride * (size_t)y;
+        int k;
+        if (w == 1) {
+            found |= tt__fft_nonfinite(x, 1);
+            continue;
+        }
+        {
+            double x0 = x[0], xn = x[2 * n];
+            x[0] = x0 + xn;
+            x[1] = x0 - xn;
+        }
+        for (k = 1; 2 * k <= n; k++) {
+            double *a = x + 2 * k, *b = x + 2 * (n - k);
+            double wr = plan->real_twiddles[2 * k], wi = plan->real_twiddles[2 * k + 1];   /* conj(w^k) */
+            double er = a[0] + b[0], ei = a[1] - b[1];       /* X(k) + conj X(n - k) */
+            double dr = a[0] - b[0], di = a[1] + b[1];       /* X(k) - conj X(n - k) */
+            double mr = wr * dr - wi * di, mi = wr * di + wi * dr;   /* conj(w^k) d */
+            a[0] = er - mi;   /* e + i m */
+            a[1] = ei + mr;
+            if (2 * k != n) {
+                /* Z(n - k) = conj(e) + i (-w^k) conj(d) = conj(e - i m) */
+                b[0] = er + mi;
+                b[1] = -(ei - mr);
+            }
+        }
+        if (n > 1) tt__fft_row(plan, x, n, plan->log2_width - 1, 1.0);
+        found |= tt__fft_nonfinite(x, (size_t)w);
+    }
+    return found;
+}
+
+/* The checks every transform makes. */
+static tt_result tt__fft_check_call(const tt_fft_plan *plan, const void *a, const void *b, int width, int height,
+                                    const char *name, tt_error *error)
+{
+    if (!plan || !a || !b)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "%s needs a plan and its arrays; %s is NULL",
+                        name, !plan ? "the plan" : "an array");
+    if (width != plan->width || height != plan->height)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "%s: the data is %d x %d (width x height) but the plan is for %d x %d", name, width, height,
+                        plan->width, plan->height);
+    return TT_OK;
+}
+
+static tt_result tt__fft_nonfinite_error(const char *name, tt_error *error)
+{
+    return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                    "%s: the result holds a NaN or infinity: the input has one, or its values overflow", name);
+}
+
+TTDEF tt_result tt_fft_c2c(const tt_fft_plan *plan, double *data, int width, int height, int direction,
+                           tt_error *error)
+{
+    tt__ok(error);
+    if (tt__fft_check_call(plan, data, data, width, height, "tt_fft_c2c", error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
+    if (direction != TT_FFT_FORWARD && direction != TT_FFT_INVERSE)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the direction is %d: use TT_FFT_FORWARD (-1) or TT_FFT_INVERSE (+1)", direction);
+    if (tt__fft_c2c(plan, data, (double)direction)) return tt__fft_nonfinite_error("tt_fft_c2c", error);
+    return TT_OK;
+}
+
+TTDEF tt_result tt_fft_r2c(const tt_fft_plan *plan, const double *real, int width, int height, double *spectrum,
+                           tt_error *error)
+{
+    int y;
+    tt__ok(error);
+    if (tt__fft_check_call(plan, real, spectrum, width, height, "tt_fft_r2c", error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
+    /* Each row of reals into its row of the spectrum (width / 2 + 1 complex
+       values: room for the bins), transformed there. */
+    for (y = 0; y < height; y++)
+        memcpy(spectrum + 2 * (size_t)(width / 2 + 1) * y, real + (size_t)width * y,
+               sizeof(double) * (size_t)width);
+    if (tt__fft_r2c_inplace(plan, spectrum)) return tt__fft_nonfinite_error("tt_fft_r2c", error);
+    return TT_OK;
+}
+
+TTDEF tt_result tt_fft_c2r(const tt_fft_plan *plan, double *spectrum, int width, int height, double *real,
+                           tt_error *error)
+{
+    int y;
+    uint64_t found;
+    tt__ok(error);
+    if (tt__fft_check_call(plan, spectrum, real, width, height, "tt_fft_c2r", error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
+    found = tt__fft_c2r_inplace(plan, spectrum);
+    for (y = 0; y < height; y++)
+        memcpy(real + (size_t)width * y, spectrum + 2 * (size_t)(width / 2 + 1) * y,
+               sizeof(double) * (size_t)width);
+    if (found) return tt__fft_nonfinite_error("tt_fft_c2r", error);
+    return TT_OK;
+}
+
+/* ---- Masked cross-correlation ---- */
+
+TTDEF void tt_xcorr_texture_free(tt_xcorr_texture *texture)
+{
+    tt_allocator allocator;
+    if (!texture) return;
+    allocator = texture->allocator;
+    tt_fft_plan_free(texture->plan);
+    tt__free(&allocator, texture->spectra);
+    tt__free(&allocator, texture);
+}
+
+TTDEF tt_result tt_xcorr_texture_create(int width, int height, int channels, const double *texture,
+                                        const tt_allocator *allocator, tt_xcorr_texture **out, tt_error *error)
+{
+    tt_xcorr_texture *tex;
+    size_t plane, half, stride;
+    tt_result result;
+    int c, x, y;
+    double *sum;
+    tt__ok(error);
+    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
+    *out = NULL;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (tt__fft_check_size("the texture's width", width, error) != TT_OK ||
+        tt__fft_check_size("the texture's height", height, error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
+    if (channels < 1 || !texture)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "a texture needs 1 or more channels and its values (got %d channels%s)", channels,
+                        texture ? "" : ", values NULL");
+    plane = (size_t)width * (size_t)height;
+    stride = 2 * (size_t)(width / 2 + 1);
+    if (!tt__size_fits(stride, (size_t)height) || !tt__size_fits(stride * height, 2 * sizeof(double)) ||
+        !tt__size_fits(stride * height, ((size_t)channels + 1) * sizeof(double)))
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "the spectra of a %d x %d texture of %d channels need more bytes than size_t can count", width,
+                        height, channels);
+    half = stride * (size_t)height;
+    for (c = 0; c < channels; c++)
+        for (y = 0; y < height; y++)
+            for (x = 0; x < width; x++) {
+                double v = texture[plane * c + (size_t)width * y + x];
+                if (!tt__is_finite_d(v) || !tt__is_finite_d(v * v))
+                    return tt__fail_at(error, TT_ERROR_NON_FINITE, c, y, x,
+                                       "the texture's channel %d at row %d, column %d is %g%s", c, y, x, v,
+                                       tt__is_finite_d(v) ? ", whose square overflows" : "");
+            }
+    tex = TT__ALLOC(allocator, tt_xcorr_texture, 1);
+    if (!tex) goto out_of_memory;
+    memset(tex, 0, sizeof *tex);
+    tex->allocator = tt__allocator_copy(allocator);
+    tex->width = width;
+    tex->height = height;
+    tex->channels = channels;
+    tex->spectrum_size = half;
+    tex->work_size = 2 * half;
+    result = tt_fft_plan_create(width, height, &tex->allocator, &tex->plan, NULL);
+    tex->spectra = TT__ALLOC(&tex->allocator, double, half * ((size_t)channels + 1));
+    if (result != TT_OK || !tex->spectra) {
+        tt_xcorr_texture_free(tex);
+        goto out_of_memory;
+    }
+    sum = tex->spectra + half * (size_t)channels;
+    memset(sum, 0, sizeof(double) * half);
+    for (c = 0; c < channels; c++) {
+        double *spectrum = tex->spectra + half * (size_t)c;
+        for (y = 0; y < height; y++) {
+            const double *row = texture + plane * c + (size_t)width * y;
+            double *dst = spectrum + stride * y, *s = sum + stride * y;
+            for (x = 0; x < width; x++) {
+                dst[x] = row[x];
+                s[x] += row[x] * row[x];
+            }
+        }
+        tt__fft_r2c_inplace(tex->plan, spectrum);
+    }
+    if (tt__fft_nonfinite(sum, half) || tt__fft_r2c_inplace(tex->plan, sum)) {
+        tt_xcorr_texture_free(tex);
+        return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                        "the sum of the texture's squares overflows: scale the values");
+    }
+    *out = tex;
+    return TT_OK;
+
+out_of_memory:
+    return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                    "out of memory for the spectra of a %d x %d texture of %d channels", width, height, channels);
+}
+
+/* acc (+)= scale conj(a) b over n complex values. */
+static void tt__xcorr_accumulate(double *TT__RESTRICT acc, const double *TT__RESTRICT a,
+                                 const double *TT__RESTRICT b, size_t n, double scale, int first)
+{
+    size_t i;
+    if (first)
+        for (i = 0; i < 2 * n; i += 2) {
+            acc[i] = scale * (a[i] * b[i] + a[i + 1] * b[i + 1]);
+            acc[i + 1] = scale * (a[i] * b[i + 1] - a[i + 1] * b[i]);
+        }
+    else
+        for (i = 0; i < 2 * n; i += 2) {
+            acc[i] += scale * (a[i] * b[i] + a[i + 1] * b[i + 1]);
+            acc[i + 1] += scale * (a[i] * b[i + 1] - a[i + 1] * b[i]);
+        }
+}
+
+TTDEF tt_result tt_xcorr_masked(const tt_xcorr_texture *texture, const double *mask, const double *values,
+                                const unsigned char *allowed, double *work, double *out_map,
+                                tt_xcorr_match *out_match, tt_error *error)
+{
+    int w, h, c, x, y, best = -1;
+    size_t plane, half, stride, i;
+    double *acc, *tmp, *map, mask_sum = 0.0, energy = 0.0, inv_n, best_e = 0.0;
+    tt_xcorr_match match;
+    match.x = match.y = -1;
+    match.e = match.mask_sum = match.masked_energy = 0.0;
+    if (out_match) *out_match = match;
+    tt__ok(error);
+    if (!texture || !mask || !values || !work)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_xcorr_masked needs a texture, a mask, values and work space; %s is NULL",
+                        !texture ? "the texture" : !mask ? "the mask" : !values ? "values" : "work");
+    if (!out_map && !out_match)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_xcorr_masked: out_map and out_match are both NULL, so there is nothing to compute");
+    w = texture->width;
+    h = texture->height;
+    plane = (size_t)w * (size_t)h;
+    half = texture->spectrum_size;
+    stride = 2 * (size_t)(w / 2 + 1);
+    /* The inputs, and the two sums that need no transform. */
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            double j = mask[(size_t)w * y + x];
+            if (!tt__is_finite_d(j))
+                return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, y, x, "the mask at row %d, column %d is %g", y, x,
+                                   j);
+            if (j < 0.0)
+                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, y, x,
+                                   "the mask at row %d, column %d is %g: weights must not be negative", y, x, j);
+            if (j == 0.0) continue;
+            mask_sum += j;
+            for (c = 0; c < texture->channels; c++) {
+                double v = values[plane * c + (size_t)w * y + x];
+                if (!tt__is_finite_d(v))
+                    return tt__fail_at(error, TT_ERROR_NON_FINITE, c, y, x,
+                                       "the value of channel %d at row %d, column %d (under the mask) is %g", c, y, x,
+                                       v);
+                energy += j * v * v;
+            }
+        }
+    if (!tt__is_finite_d(mask_sum) || !tt__is_finite_d(energy))
+        return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                        "the sums of the mask (%g) or of J I^2 (%g) overflow: scale the values", mask_sum, energy);
+    match.mask_sum = mask_sum;
+    match.masked_energy = energy;
+    map = out_map ? out_map : work + half;
+    if (mask_sum == 0.0) {
+        for (i = 0; i < plane; i++) map[i] = 0.0;
+        if (out_match) *out_match = match;
+        return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                        "the mask is all zero: every offset fits equally (E = 0)");
+    }
+
+    /* acc = (conj F(J) F(sum T^2) - 2 sum_c conj F(J I_c) F(T_c)) / (w h), so
+       that the unnormalised inverse gives the two correlation terms. */
+    acc = work;
+    tmp = work + half;
+    inv_n = 1.0 / (double)plane;   /* a power of two: exact */
+    for (c = -1; c < texture->channels; c++) {
+        for (y = 0; y < h; y++) {
+            const double *jr = mask + (size_t)w * y;
+            double *dst = tmp + stride * y;
+            if (c < 0) {
+                memcpy(dst, jr, sizeof(double) * (size_t)w);
+            } else {
+                const double *vr = values + plane * c + (size_t)w * y;
+                for (x = 0; x < w; x++) dst[x] = jr[x] != 0.0 ? jr[x] * vr[x] : 0.0;
+            }
+        }
+        tt__fft_r2c_inplace(texture->plan, tmp);
+        if (c < 0)
+            tt__xcorr_accumulate(acc, tmp, texture->spectra + half * (size_t)texture->channels, half / 2, inv_n, 1);
+        else
+            tt__xcorr_accumulate(acc, tmp, texture->spectra + half * (size_t)c, half / 2, -2.0 * inv_n, 0);
+    }
+    tt__fft_c2r_inplace(texture->plan, acc);
+    /* E = sum J I^2 + the correlations, clamped at 0; then the argmin. */
+    for (y = 0; y < h; y++) {
+        const double *src = acc + stride * y;
+        double *dst = map + (size_t)w * y;
+        for (x = 0; x < w; x++) {
+            double e = energy + src[x];
+            dst[x] = e > 0.0 ? e : 0.0;
+        }
+    }
+    if (tt__fft_nonfinite(map, plane))
+        return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                        "the correlation overflows (a NaN or infinity in E): scale the values");
+    for (i = 0; i < plane; i++)
+        if ((!allowed || allowed[i]) && (best < 0 || map[i] < best_e)) {
+            best = (int)i;
+            best_e = map[i];
+        }
+    if (best < 0) {
+        if (out_match) *out_match = match;
+        return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                        "no offset is allowed (the allowed map is all zero)");
+    }
+    match.x = best % w;
+    match.y = best / w;
+    match.e = best_e;
+    if (out_match) *out_match = match;
+    return TT_OK;
 }
 
 /* ------------------------------------------------------------------------ */

@@ -240,6 +240,29 @@ int main(void)
         EXPECT(tt_result_string(TT_ERROR_NOT_CONVERGED)[0] && tt_result_string(TT_ERROR_NOT_POSITIVE_DEFINITE)[0]);
         tt_sparse_matrix_free(sm);
     }
+    {
+        /* 4. Numerics, the FFTs and the masked correlation: every public function once. */
+        static const double tex4[4] = {0.25, 0.5, 0.75, 1.0};
+        static const double mask4[4] = {1.0, 0.0, 0.0, 0.0};
+        double cplx[8] = {1, 0, 2, 0, 3, 0, 4, 0}, spec4[8], real4[4], work[16], map4[4];
+        double values4[4] = {0.75, 0.0, 0.0, 0.0};
+        tt_fft_plan *plan = NULL;
+        tt_xcorr_texture *xt = NULL;
+        tt_xcorr_match match;
+        EXPECT(tt_fft_plan_create(2, 2, NULL, &plan, &err) == TT_OK);
+        if (!plan) return 1;
+        EXPECT(tt_fft_c2c(plan, cplx, 2, 2, TT_FFT_FORWARD, &err) == TT_OK && cplx[0] == 10.0);
+        EXPECT(tt_fft_c2c(plan, cplx, 2, 2, TT_FFT_INVERSE, &err) == TT_OK && cplx[2] == 8.0);
+        EXPECT(tt_fft_r2c(plan, tex4, 2, 2, spec4, &err) == TT_OK && spec4[0] == 2.5);
+        EXPECT(tt_fft_c2r(plan, spec4, 2, 2, real4, &err) == TT_OK && real4[3] == 4.0);
+        tt_fft_plan_free(plan);
+        EXPECT(tt_xcorr_texture_create(2, 2, 1, tex4, NULL, &xt, &err) == TT_OK);
+        if (!xt) return 1;
+        EXPECT(xt->work_size <= 16);
+        EXPECT(tt_xcorr_masked(xt, mask4, values4, NULL, work, map4, &match, &err) == TT_OK && match.x == 0 &&
+               match.y == 1 && match.e < 1e-12);
+        tt_xcorr_texture_free(xt);
+    }
 #ifdef COMPILE_CHECK_USER_ALLOC
     EXPECT(user_allocs > 0);
     EXPECT(user_allocs == user_frees);

@@ -359,6 +359,7 @@ int main(void)
     run_mesh_tests();
     run_image_tests();
     run_numerics_tests();
+    run_fft_tests();
     run_raster_tests();
     run_tiled_tests();
     run_tiled_synthesis_tests();

@@ -34,6 +34,7 @@ void run_common_tests(void);     /* tests/test_1_common.c */
 void run_mesh_tests(void);       /* tests/test_2_mesh.c */
 void run_image_tests(void);      /* tests/test_3_image.c */
 void run_numerics_tests(void);   /* tests/test_4_numerics.c */
+void run_fft_tests(void);        /* tests/test_4_fft.c */
 void run_raster_tests(void);     /* tests/test_5_raster.c */
 void run_tiled_tests(void);      /* tests/test_6_tiled.c */
 void run_tiled_synthesis_tests(void); /* tests/test_6_tiled_synthesis.c */
