@@ -4570,6 +4570,7 @@ TTDEF tt_result tt_xcorr_masked(const tt_xcorr_texture *texture, const double *m
     int w, h, c, x, y, best = -1;
     size_t plane, half, stride, i;
     double *acc, *tmp, *map, mask_sum = 0.0, energy = 0.0, inv_n, best_e = 0.0;
+    uint64_t found = 0;
     tt_xcorr_match match;
     match.x = match.y = -1;
     match.e = match.mask_sum = match.masked_energy = 0.0;
@@ -4637,14 +4638,15 @@ TTDEF tt_result tt_xcorr_masked(const tt_xcorr_texture *texture, const double *m
                 for (x = 0; x < w; x++) dst[x] = jr[x] != 0.0 ? jr[x] * vr[x] : 0.0;
             }
         }
-        tt__fft_r2c_inplace(texture->plan, tmp);
+        found |= tt__fft_r2c_inplace(texture->plan, tmp);
         if (c < 0)
             tt__xcorr_accumulate(acc, tmp, texture->spectra + half * (size_t)texture->channels, half / 2, inv_n, 1);
         else
             tt__xcorr_accumulate(acc, tmp, texture->spectra + half * (size_t)c, half / 2, -2.0 * inv_n, 0);
     }
-    tt__fft_c2r_inplace(texture->plan, acc);
-    /* E = sum J I^2 + the correlations, clamped at 0; then the argmin. */
+    found |= tt__fft_c2r_inplace(texture->plan, acc);
+    /* E = sum J I^2 + the correlations, clamped at 0 (the flags say whether
+       a NaN, which the clamp would hide, came up); then the argmin. */
     for (y = 0; y < h; y++) {
         const double *src = acc + stride * y;
         double *dst = map + (size_t)w * y;
@@ -4653,7 +4655,7 @@ TTDEF tt_result tt_xcorr_masked(const tt_xcorr_texture *texture, const double *m
             dst[x] = e > 0.0 ? e : 0.0;
         }
     }
-    if (tt__fft_nonfinite(map, plane))
+    if (found || tt__fft_nonfinite(map, plane))
         return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
                         "the correlation overflows (a NaN or infinity in E): scale the values");
     for (i = 0; i < plane; i++)

@@ -663,6 +663,25 @@ static void test_xcorr_errors(void)
     CHECK(tt_xcorr_masked(k.tex, k.mask, k.values, NULL, k.work, k.map, &m, &err) == TT_ERROR_NON_FINITE,
           "values whose squares overflow (%s)", err.message);
     xc_close(&k);
+    /* Inputs that pass every check but whose spectra's products overflow
+       (J = 1e300 against T^2 = 1e300): an error, never E = 0 from a NaN
+       clamped away. */
+    {
+        double big[8 * 4], wmask[8 * 4], small[8 * 4], work[2 * 5 * 4 * 2], map[8 * 4];
+        int i;
+        for (i = 0; i < 32; i++) {
+            big[i] = 1e150;
+            wmask[i] = i == 3 ? 1e300 : 0.0;
+            small[i] = 1e-100;
+        }
+        tex = NULL;
+        CHECK(tt_xcorr_texture_create(8, 4, 1, big, NULL, &tex, &err) == TT_OK && tex && tex->work_size <= 80,
+              "a texture of 1e150 (%s)", err.message);
+        if (!tex) return;
+        CHECK(tt_xcorr_masked(tex, wmask, small, NULL, work, map, &m, &err) == TT_ERROR_NON_FINITE,
+              "spectra whose products overflow: TT_ERROR_NON_FINITE (%s)", err.message);
+        tt_xcorr_texture_free(tex);
+    }
 }
 
 typedef struct fft_oom_ctx {
