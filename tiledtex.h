@@ -611,22 +611,24 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, const tt
    on 64 KB blocks of a strip while they are in cache: with a power-of-two
    row stride a whole strip maps onto a fraction of the cache's sets and
    would not stay there. Width and height are independent (64 x 32 is fine);
-   height 1 is a 1D transform. Measured at 512 x 512 (make bench), forward
-   plus inverse takes 2.2-2.4x the time of FFTW's measured plans.
+   height 1 is a 1D transform. Forward plus inverse at 256 x 256 and
+   512 x 512 takes 2-2.5x the time of FFTW's FFTW_MEASURE plans in a plain
+   -O2 build (make bench; no SIMD intrinsics here, FFTW uses AVX).
 
    Conventions (as FFTW's): forward (TT_FFT_FORWARD = -1)
-       X(k, l) = sum over x < width, y < height of x(x, y) e^(-2 pi i (k x / width + l y / height)),
+       X(k, l) = sum over x < width, y < height of d(x, y) e^(-2 pi i (k x / width + l y / height)),
    inverse (TT_FFT_INVERSE = +1) the same with e^(+2 pi i ...) and NOT
-   normalised: inverse(forward(x)) = width * height * x. Callers fold the
+   normalised: inverse(forward(d)) = width * height * d. Callers fold the
    1 / (width * height) into a pass they make anyway.
 
    Memory and threads. The plan holds the twiddles and the bit-reversal table
    (about 40 bytes per value of the larger side); the transforms allocate
    nothing and need no scratch, so a plan is read-only after
    tt_fft_plan_create and several threads may transform distinct arrays with
-   one plan at once. Values are not checked before a transform (that pass
-   would cost about a tenth of it); the result is: a NaN or infinity in the
-   data, or an overflow, comes out as TT_ERROR_NON_FINITE.
+   one plan at once. The data is not checked before a transform (another
+   pass over memory); the result is, where the last stage writes it while it
+   is in cache: a NaN or infinity in the data, or an overflow, comes out as
+   TT_ERROR_NON_FINITE.
 
    Masked correlation. See tt_xcorr_masked: with the correlation
        (f * g)(x0) = sum over x of f(x) g(x + x0) = F^-1( conj(F(f)) F(g) )(x0)
@@ -691,7 +693,7 @@ TTDEF tt_result tt_fft_c2c(const tt_fft_plan *plan, double *data, int width, int
    spectrum[2 * (width / 2 + 1) * l]), where spectrum entry (l, k) is the
    forward c2c transform's X(k, l) for k = 0 .. width / 2. The other half is
    redundant: X(k, l) = conj(X(width - k, (height - l) mod height)).
-   The rows use the two-for-one packing: a row of width reals is read as
+   The rows use the N/2 packing: a row of width reals is read as
    width / 2 complex values (x[2m] + i x[2m + 1]), transformed, and split
    into bins 0 .. width / 2 by one pass; about half the work of the complex
    transform. real and spectrum must not overlap. Errors as tt_fft_c2c
@@ -4282,7 +4284,7 @@ static uint64_t tt__fft_columns(const tt_fft_plan *plan, double *data, int colum
             if (block == n)
                 for (i = 0; i < n; i++) found |= tt__fft_nonfinite(rows + stride * (size_t)i, 2 * (size_t)count);
         }
-        for (; 4 * L <= n; L *= 4) found |= tt__fft_strip_stage(plan, strip, stride, count, n, L, sign, 16 * L >= n);
+        for (; 4 * L <= n; L *= 4) found |= tt__fft_strip_stage(plan, strip, stride, count, n, L, sign, 4 * L == n);
     }
     return found;
 }
