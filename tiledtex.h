@@ -2235,17 +2235,35 @@ static int tt__face_of_corner(const tt_mesh *mesh, int corner)
 #define TT__BUILD_INLINE
 #endif
 
-/* The builder's face loop state (see tt_mesh_build). */
+/* The state of one tt_mesh_build, handed from phase to phase (see
+   tt_mesh_build). While the build runs, the mesh's own arrays hold much of
+   its scratch (each phase says what they hold), so that its largest arrays
+   cost no extra memory. A local id numbers the used vertices in order of
+   first use; there are nused <= nlocal = min(nverts, ncorners) of them. */
 typedef struct tt__builder {
+    const tt_mesh_desc *desc;
+    const tt_allocator *allocator;
     const int *indices;
     const float *positions;
-    int nverts, ncorners, permissive, nused;
+    int nverts, nfaces, ncorners, nlocal;
+    int fixed_size;     /* every face's corners, or 0 when desc->face_sizes gives them */
+    int permissive;
+    tt_mesh *mesh;      /* the result, its arrays allocated */
+    float *copy;        /* the mesh's own copy of the positions; NULL when borrowed */
+    /* The face loop (tt__build_face). */
+    int nused;          /* local ids handed out so far */
     int *local_of;      /* nverts: local id of a vertex, -1 unseen (the mesh's vert_corner) */
     int *lid;           /* ncorners: local id of corner c's vertex (the mesh's corner_vert) */
     int *last;          /* nlocal: the last corner of a local id so far (the mesh's corner_face) */
     int *out_count;     /* nlocal: outgoing half-edges */
     int *inverse;       /* nlocal: the vertex of a local id */
     int *count;         /* nlocal: edges in the bucket of a local id (bucket_start + 1) */
+    int *stamp;         /* nverts: tt__repeated_corner's marks, for strict faces over 16 corners */
+    /* The pairing. */
+    int *bucket_start;  /* nlocal + 1: each local id's bucket of edges, see tt__build_buckets */
+    int largest_bucket; /* entries in the largest bucket */
+    uint64_t *keys;     /* largest_bucket: one bucket's entries, to sort */
+    int boundary;       /* whether some half-edge has no twin */
 } tt__builder;
 
 /* One face of the face loop: range-check its corners, number their
@@ -2359,40 +2377,30 @@ static tt_mesh *tt__mesh_alloc(const tt_allocator *allocator, int nverts, int nf
     return mesh;
 }
 
-TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allocator, tt_mesh **out_mesh,
-                              tt_error *error)
+/* Phase 1: the counts and the face sizes, checked before anything is
+   allocated: they decide how many corners there are, and so how large
+   every array is. */
+static tt_result tt__build_check_counts(tt__builder *b, tt_error *error)
 {
-    tt_mesh *mesh = NULL;
-    int *bucket_start = NULL, *out_count = NULL, *inverse = NULL, *stamp = NULL, largest_bucket = 0;
-    uint64_t *local = NULL;
-    float *copy = NULL;
-    tt__builder builder;
-    tt__edge_problem problem;
-    tt_result result = TT_OK;
-    int permissive, fixed_size, nverts, nfaces, ncorners, nlocal, nused = 0, boundary = 0, prefetch, f, c, v;
+    const tt_mesh_desc *desc = b->desc;
     long long total_corners;
-
-    tt__ok(error);
-    if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
-    *out_mesh = NULL;
-    if (!desc) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "desc is NULL");
-    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    permissive = (desc->flags & TT_MESH_PERMISSIVE) != 0;
-    nverts = desc->nverts;
-    nfaces = desc->nfaces;
-    if (nverts < 0 || nfaces < 0)
+    int f;
+    b->permissive = (desc->flags & TT_MESH_PERMISSIVE) != 0;
+    b->nverts = desc->nverts;
+    b->nfaces = desc->nfaces;
+    b->indices = desc->indices;
+    b->positions = desc->positions;
+    if (b->nverts < 0 || b->nfaces < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "negative count: nverts = %d, nfaces = %d", nverts, nfaces);
-    if (nfaces == 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
-    if (!desc->indices || (nverts > 0 && !desc->positions))
+                        "negative count: nverts = %d, nfaces = %d", b->nverts, b->nfaces);
+    if (b->nfaces == 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    if (!desc->indices || (b->nverts > 0 && !desc->positions))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "desc->indices or desc->positions is NULL");
-
-    /* Face sizes first: they decide how many corners there are. */
-    fixed_size = desc->face_sizes ? 0 : (desc->fixed_face_size ? desc->fixed_face_size : 3);
+    b->fixed_size = desc->face_sizes ? 0 : (desc->fixed_face_size ? desc->fixed_face_size : 3);
     if (desc->face_sizes) {
         total_corners = 0;
-        for (f = 0; f < nfaces; f++) {
+        for (f = 0; f < b->nfaces; f++) {
             int size = desc->face_sizes[f];
             if (size < 3)
                 return tt__fail(error, TT_ERROR_FACE_TOO_SMALL, f, size > 0 ? (int)total_corners : -1, -1, -1,
@@ -2403,44 +2411,61 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                                 "the faces have more than %d corners in all", 0x3fffffff);
         }
     } else {
-        if (fixed_size < 3)
+        if (b->fixed_size < 3)
             return tt__fail(error, TT_ERROR_FACE_TOO_SMALL, 0, 0, -1, -1,
-                            "fixed_face_size is %d; a face needs at least 3 corners", fixed_size);
-        total_corners = (long long)nfaces * fixed_size;
+                            "fixed_face_size is %d; a face needs at least 3 corners", b->fixed_size);
+        total_corners = (long long)b->nfaces * b->fixed_size;
         if (total_corners > 0x3fffffff)
             return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                            "%d faces of %d corners are more than %d corners", nfaces, fixed_size, 0x3fffffff);
+                            "%d faces of %d corners are more than %d corners", b->nfaces, b->fixed_size,
+                            0x3fffffff);
     }
-    ncorners = (int)total_corners;
+    b->ncorners = (int)total_corners;
+    b->nlocal = b->nverts < b->ncorners ? b->nverts : b->ncorners;
+    return TT_OK;
+}
 
-    mesh = tt__mesh_alloc(allocator, nverts, nfaces, ncorners, desc->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS);
-    if (!mesh)
+/* Phase 2: the mesh, the per-local-id scratch, and the mesh's copy of the
+   positions (or the caller's, borrowed), together, so that most builds too
+   large for memory fail before any work is done. (Two smaller arrays come
+   later: the sort buffer, sized by the largest bucket, and the marks for
+   faces of over 16 corners.) */
+static tt_result tt__build_alloc(tt__builder *b, tt_error *error)
+{
+    const tt_allocator *allocator = b->allocator;
+    tt_mesh *mesh = tt__mesh_alloc(allocator, b->nverts, b->nfaces, b->ncorners,
+                                   b->desc->flags & ~(unsigned)TT_MESH_BORROW_POSITIONS);
+    b->mesh = mesh;
+    if (mesh) {
+        b->bucket_start = TT__ALLOC(allocator, int, (size_t)b->nlocal + 1);
+        b->out_count = TT__ALLOC(allocator, int, b->nlocal);
+        b->inverse = TT__ALLOC(allocator, int, b->nlocal);
+        if (b->desc->flags & TT_MESH_BORROW_POSITIONS) {
+            mesh->flags = b->desc->flags;
+            mesh->pos = b->positions;
+        } else {
+            b->copy = TT__ALLOC(allocator, float, (size_t)b->nverts * 3);
+            mesh->pos = b->copy;
+        }
+    }
+    if (!mesh || !b->bucket_start || !b->out_count || !b->inverse || !mesh->pos)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                        "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
-    /* Per used vertex: there are at most ncorners of them. */
-    nlocal = nverts < ncorners ? nverts : ncorners;
-    bucket_start = TT__ALLOC(allocator, int, (size_t)nlocal + 1);
-    out_count = TT__ALLOC(allocator, int, nlocal);
-    inverse = TT__ALLOC(allocator, int, nlocal);
-    if (desc->flags & TT_MESH_BORROW_POSITIONS) {
-        mesh->flags = desc->flags;
-        mesh->pos = desc->positions;
-    } else {
-        copy = TT__ALLOC(allocator, float, (size_t)nverts * 3);
-        mesh->pos = copy;
-    }
-    if (!bucket_start || !out_count || !inverse || !mesh->pos) {
-        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                          "out of memory for a mesh of %d faces and %d corners", nfaces, ncorners);
-        goto cleanup;
-    }
+                        "out of memory for a mesh of %d faces and %d corners", b->nfaces, b->ncorners);
+    return TT_OK;
+}
 
-    /* Coordinates must be finite: everything downstream measures lengths.
-       Whole blocks of 1024 vertices are copied (unless borrowed) and then
-       tested while in the cache, without branches (the loop vectorises); a
-       block with a bad coordinate, and the tail, vertex by vertex. */
+/* Phase 3: coordinates must be finite, since everything downstream measures
+   lengths; copied unless borrowed. Whole blocks of 1024 vertices are copied
+   and then tested while in the cache, without branches (the loop
+   vectorises); a block with a bad coordinate, and the tail, vertex by
+   vertex, to name the first bad vertex. */
+static tt_result tt__build_positions(tt__builder *b, tt_error *error)
+{
+    const float *positions = b->positions;
+    float *copy = b->copy;
+    int nverts = b->nverts, v;
     for (v = 0; v + 1024 <= nverts; v += 1024) {
-        const float *p = desc->positions + 3 * (size_t)v;
+        const float *p = positions + 3 * (size_t)v;
         uint32_t bad = 0;
         int k;
         if (copy) memcpy(copy + 3 * (size_t)v, p, 3 * 1024 * sizeof(float));
@@ -2452,187 +2477,211 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
         if (bad) break;
     }
     for (; v < nverts; v++) {
-        const float *p = desc->positions + 3 * (size_t)v;
-        if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2])) {
-            result = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, v, -1,
-                              "vertex %d has a coordinate that is NaN or infinite (%g, %g, %g)", v, p[0], p[1],
-                              p[2]);
-            goto cleanup;
-        }
+        const float *p = positions + 3 * (size_t)v;
+        if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2]))
+            return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, v, -1,
+                            "vertex %d has a coordinate that is NaN or infinite (%g, %g, %g)", v, p[0], p[1],
+                            p[2]);
         if (copy) memcpy(copy + 3 * (size_t)v, p, 3 * sizeof(float));
     }
+    return TT_OK;
+}
 
-    /* Corners: range-check them, and give the used vertices local ids in
-       order of first use (the index buffer's order). Everything the pairing
-       touches afterwards is indexed by corner or by local id, so it runs
-       through memory in index-buffer order whatever the numbering of the
-       vertices: a mesh with shuffled vertex ids costs about what a
-       grid-ordered one does. While the loop runs, vert_corner[v] is v's local
-       id (-1: unseen), corner_vert[c] the local id of corner c's vertex,
-       corner_face[l] the last corner of local id l so far; see tt__builder.
-       bucket_start counts each edge in the bucket of its end with the smaller
-       local id. */
-    memset(mesh->vert_corner, 0xff, (size_t)nverts * sizeof(int));
-    bucket_start[0] = 0;
-    builder.indices = desc->indices;
-    builder.positions = desc->positions;
-    builder.nverts = nverts;
-    builder.ncorners = ncorners;
-    builder.permissive = permissive;
-    builder.nused = 0;
-    builder.local_of = mesh->vert_corner;
-    builder.lid = mesh->corner_vert;
-    builder.last = mesh->corner_face;
-    builder.out_count = out_count;
-    builder.inverse = inverse;
-    builder.count = bucket_start + 1;
-    prefetch = tt__build_should_prefetch(desc->indices, ncorners);
-    if (fixed_size == 3) {
+/* Phase 4, the face loop (tt__build_face on every face, in order): range-
+   check the corners, check strict faces for repeated vertices and zero
+   area, and give the used vertices local ids in order of first use (the
+   index buffer's order). Everything the pairing touches afterwards is
+   indexed by corner or by local id, so it runs through memory in
+   index-buffer order whatever the numbering of the vertices: a mesh with
+   shuffled vertex ids costs about what a grid-ordered one does. Also fills
+   face_start and the face size range, and counts each edge in the bucket of
+   its end with the smaller local id. Afterwards vert_corner[v] is the last
+   corner of v, an outgoing half-edge (-1: unused). */
+static tt_result tt__build_faces(tt__builder *b, tt_error *error)
+{
+    /* The loop works on a local copy of the builder: stores through its
+       arrays could otherwise alias its int fields, which would then be
+       reloaded at every corner. */
+    tt__builder s = *b;
+    tt_mesh *mesh = s.mesh;
+    int nfaces = s.nfaces, prefetch = tt__build_should_prefetch(s.indices, s.ncorners), f, c, l;
+    tt_result result = TT_OK;
+    s.local_of = mesh->vert_corner;
+    s.lid = mesh->corner_vert;
+    s.last = mesh->corner_face;
+    s.count = s.bucket_start + 1;
+    s.nused = 0;
+    memset(s.local_of, 0xff, (size_t)s.nverts * sizeof(int));
+    s.bucket_start[0] = 0;
+    if (s.fixed_size == 3) {
         mesh->min_face_size = mesh->max_face_size = 3;
-        for (f = 0; f < nfaces; f++) {
+        for (f = 0; f < nfaces && result == TT_OK; f++) {
             mesh->face_start[f] = 3 * f;
-            result = prefetch ? tt__build_face(&builder, f, 3 * f, 3, 1, NULL, error)
-                              : tt__build_face(&builder, f, 3 * f, 3, 0, NULL, error);
-            if (result != TT_OK) goto cleanup;
+            result = prefetch ? tt__build_face(&s, f, 3 * f, 3, 1, NULL, error)
+                              : tt__build_face(&s, f, 3 * f, 3, 0, NULL, error);
         }
-    } else if (fixed_size == 4) {
+    } else if (s.fixed_size == 4) {
         mesh->min_face_size = mesh->max_face_size = 4;
-        for (f = 0; f < nfaces; f++) {
+        for (f = 0; f < nfaces && result == TT_OK; f++) {
             mesh->face_start[f] = 4 * f;
-            result = prefetch ? tt__build_face(&builder, f, 4 * f, 4, 1, NULL, error)
-                              : tt__build_face(&builder, f, 4 * f, 4, 0, NULL, error);
-            if (result != TT_OK) goto cleanup;
+            result = prefetch ? tt__build_face(&s, f, 4 * f, 4, 1, NULL, error)
+                              : tt__build_face(&s, f, 4 * f, 4, 0, NULL, error);
         }
     } else {
-        for (f = 0, c = 0; f < nfaces; f++) {
-            int size = fixed_size ? fixed_size : desc->face_sizes[f];
+        for (f = 0, c = 0; f < nfaces && result == TT_OK; f++) {
+            int size = s.fixed_size ? s.fixed_size : s.desc->face_sizes[f];
             mesh->face_start[f] = c;
             if (size > mesh->max_face_size) mesh->max_face_size = size;
             if (f == 0 || size < mesh->min_face_size) mesh->min_face_size = size;
-            if (size > 16 && !permissive && !stamp) {
-                stamp = TT__ALLOC(allocator, int, nverts);
-                if (!stamp) {
+            if (size > 16 && !s.permissive && !s.stamp) {
+                s.stamp = TT__ALLOC(s.allocator, int, s.nverts);
+                if (!s.stamp) {
                     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
-                    goto cleanup;
+                    break;
                 }
-                memset(stamp, 0xff, (size_t)nverts * sizeof(int));
+                memset(s.stamp, 0xff, (size_t)s.nverts * sizeof(int));
             }
-            if ((result = tt__build_face(&builder, f, c, size, prefetch, stamp, error)) != TT_OK) goto cleanup;
+            result = tt__build_face(&s, f, c, size, prefetch, s.stamp, error);
             c += size;
         }
     }
-    mesh->face_start[nfaces] = ncorners;
-    nused = builder.nused;
-    /* vert_corner starts as the vertex's last corner (any outgoing half-edge). */
-    for (v = 0; v < nused; v++) mesh->vert_corner[inverse[v]] = mesh->corner_face[v];
+    *b = s;
+    if (result != TT_OK) return result;
+    mesh->face_start[nfaces] = s.ncorners;
+    for (l = 0; l < s.nused; l++) mesh->vert_corner[s.inverse[l]] = s.last[l];
+    return TT_OK;
+}
 
-    /* Counting sort of the half-edges into their buckets, an entry
-       (TT__EDGE_KEY: other end's local id, 2 * corner + 1 when the
-       half-edge runs from the larger local id to the smaller) split between
-       corner_face (other) and twin (corner_dir), which are only filled at the
-       end: with the far end in the entry, the pairing reads nothing else, and
-       no extra memory for the largest arrays of the build. Afterwards
-       bucket_start[l] is where bucket l ends. */
-    for (v = 0; v < nused; v++) {
-        if (bucket_start[v + 1] > largest_bucket) largest_bucket = bucket_start[v + 1];
-        bucket_start[v + 1] += bucket_start[v];
+/* Phase 5: a counting sort of the half-edges into the buckets of their
+   edges' smaller local ids, so that an edge's halves meet in one small
+   bucket. An entry (TT__EDGE_KEY: the other end's local id, and
+   2 * corner + 1 when the half-edge runs from the larger local id to the
+   smaller) is split between corner_face (other) and twin (corner_dir),
+   which are only filled at the end: with the far end in the entry, the
+   pairing reads nothing else, and no extra memory for the largest arrays of
+   the build. Afterwards bucket_start[l] is where bucket l ends. */
+static void tt__build_buckets(tt__builder *b)
+{
+    tt_mesh *mesh = b->mesh;
+    int *bucket_start = b->bucket_start, *lid = mesh->corner_vert, *other = mesh->corner_face;
+    int *corner_dir = mesh->twin, nfaces = b->nfaces, nused = b->nused, largest = 0, f, l;
+    for (l = 0; l < nused; l++) {
+        if (bucket_start[l + 1] > largest) largest = bucket_start[l + 1];
+        bucket_start[l + 1] += bucket_start[l];
     }
-    if (fixed_size == 3) {
-        for (f = 0; f < nfaces; f++)
-            tt__scatter_face(mesh->corner_vert, 3 * f, 3, bucket_start, mesh->corner_face, mesh->twin);
-    } else if (fixed_size == 4) {
-        for (f = 0; f < nfaces; f++)
-            tt__scatter_face(mesh->corner_vert, 4 * f, 4, bucket_start, mesh->corner_face, mesh->twin);
+    b->largest_bucket = largest;
+    if (b->fixed_size == 3) {
+        for (f = 0; f < nfaces; f++) tt__scatter_face(lid, 3 * f, 3, bucket_start, other, corner_dir);
+    } else if (b->fixed_size == 4) {
+        for (f = 0; f < nfaces; f++) tt__scatter_face(lid, 4 * f, 4, bucket_start, other, corner_dir);
     } else {
         for (f = 0; f < nfaces; f++)
-            tt__scatter_face(mesh->corner_vert, mesh->face_start[f], mesh->face_start[f + 1] - mesh->face_start[f],
-                             bucket_start, mesh->corner_face, mesh->twin);
+            tt__scatter_face(lid, mesh->face_start[f], mesh->face_start[f + 1] - mesh->face_start[f], bucket_start,
+                             other, corner_dir);
     }
-    local = TT__ALLOC(allocator, uint64_t, largest_bucket);
-    if (!local) {
-        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
-        goto cleanup;
-    }
+}
 
-    /* Pair twins bucket by bucket: the bucket's entries sorted by (other end,
-       corner) so the halves of an edge sit side by side in corner order; then
-       one run of equal `other` is one edge. One half-edge each way is an
-       interior edge, a single one a boundary; anything else is non-manifold
-       (three or more) or flipped (two the same way). Those are cut loose into
-       boundaries; the problem with the smallest corner is the one reported,
-       so errors come in index-buffer order. The local ids are no longer
-       needed: the twins go into corner_vert's array, which then becomes
-       twin, while twin's array becomes corner_vert (a copy of the indices). */
+/* The usual bucket, sorted (see tt__build_pair_twins): every edge an
+   interior one, its two halves side by side, one each way. Checked, and then
+   paired, without branches; 0 when the bucket is not like that. */
+static TT__BUILD_INLINE int tt__pair_interior_bucket(const uint64_t *e, int count, int l, int *twin)
+{
+    int paired = (count & 1) == 0, k;
+    for (k = 0; paired && k < count; k += 2) {
+        uint64_t x = e[k], y = e[k + 1];
+        paired = ((x ^ y) >> 32) == 0 && ((x ^ y) & 1) && TT__KEY_OTHER(x) != l &&
+                 (k + 2 == count || TT__KEY_OTHER(e[k + 2]) != TT__KEY_OTHER(x));
+    }
+    if (!paired) return 0;
+    for (k = 0; k < count; k += 2) {
+        int x = TT__KEY_CORNER_DIR(e[k]) >> 1, y = TT__KEY_CORNER_DIR(e[k + 1]) >> 1;
+        twin[x] = y;
+        twin[y] = x;
+    }
+    return 1;
+}
+
+/* Any other bucket, sorted, run by run of equal `other` (one run, one edge):
+   one half-edge each way is an interior edge, a single one a boundary;
+   anything else is non-manifold (three or more) or flipped (two the same
+   way), and cut loose into boundaries. In strict mode the problem with the
+   smallest corner is kept in *problem, so that errors come in index-buffer
+   order. */
+static void tt__pair_bucket_runs(tt__builder *b, const uint64_t *e, int count, int l, int *twin,
+                                 tt__edge_problem *problem)
+{
+    int i = 0, k;
+    while (i < count) {
+        int other = TT__KEY_OTHER(e[i]), run_end = i + 1, backward = TT__KEY_CORNER_DIR(e[i]) & 1;
+        while (run_end < count && TT__KEY_OTHER(e[run_end]) == other)
+            backward += TT__KEY_CORNER_DIR(e[run_end++]) & 1;
+        if (other != l && run_end - i == 2 && backward == 1) {
+            int x = TT__KEY_CORNER_DIR(e[i]) >> 1, y = TT__KEY_CORNER_DIR(e[i + 1]) >> 1;
+            twin[x] = y;
+            twin[y] = x;
+        } else if (other != l && run_end - i == 1) {
+            twin[TT__KEY_CORNER_DIR(e[i]) >> 1] = -1;
+            b->boundary = 1;
+        } else {
+            int lowest = TT__KEY_CORNER_DIR(e[i]) >> 1;
+            if (!b->permissive && other != l && (problem->corner < 0 || lowest < problem->corner)) {
+                problem->corner = lowest;
+                problem->a = b->indices[lowest];
+                problem->b = problem->a == b->inverse[l] ? b->inverse[other] : b->inverse[l];
+                problem->result = run_end - i > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
+                problem->nfaces = run_end - i;
+                for (k = 0; k < 3; k++)
+                    problem->faces[k] =
+                        i + k < run_end ? tt__face_of_corner(b->mesh, TT__KEY_CORNER_DIR(e[i + k]) >> 1) : -1;
+            }
+            for (k = i; k < run_end; k++) twin[TT__KEY_CORNER_DIR(e[k]) >> 1] = -1;
+            b->boundary = 1;
+            b->mesh->repaired_edges++;
+        }
+        i = run_end;
+    }
+}
+
+/* Phase 6: pair the twins bucket by bucket, each bucket's entries sorted by
+   (other end, corner) so that the halves of an edge sit side by side in
+   corner order, and find the edge problems (strict mode fails on the first).
+   The local ids are no longer needed: the twins go into corner_vert's
+   array, which then becomes twin, while twin's array becomes corner_vert (a
+   copy of the indices). */
+static tt_result tt__build_pair_twins(tt__builder *b, tt_error *error)
+{
+    tt_mesh *mesh = b->mesh;
+    const int *bucket_start = b->bucket_start, *other = mesh->corner_face, *corner_dir = mesh->twin;
+    int *twin = mesh->corner_vert, nused = b->nused, l, k;
+    uint64_t *e;
+    tt__edge_problem problem;
+    e = b->keys = TT__ALLOC(b->allocator, uint64_t, b->largest_bucket);
+    if (!e) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     memset(&problem, 0, sizeof problem);
     problem.corner = -1;
-    for (v = 0; v < nused; v++) {
-        uint64_t *e = local;
-        int begin = v > 0 ? bucket_start[v - 1] : 0, count = bucket_start[v] - begin, i = 0, k, paired;
-        int *twin = mesh->corner_vert;
-        for (k = 0; k < count; k++) e[k] = TT__EDGE_KEY(mesh->corner_face[begin + k], mesh->twin[begin + k]);
+    for (l = 0; l < nused; l++) {
+        int begin = l > 0 ? bucket_start[l - 1] : 0, count = bucket_start[l] - begin;
+        for (k = 0; k < count; k++) e[k] = TT__EDGE_KEY(other[begin + k], corner_dir[begin + k]);
         tt__sort_edge_keys(e, count);
-        /* The usual bucket: every edge an interior one, its two halves side
-           by side, one each way. Checked and paired without branches. */
-        paired = (count & 1) == 0;
-        for (k = 0; paired && k < count; k += 2) {
-            uint64_t x = e[k], y = e[k + 1];
-            paired = ((x ^ y) >> 32) == 0 && ((x ^ y) & 1) && TT__KEY_OTHER(x) != v &&
-                     (k + 2 == count || TT__KEY_OTHER(e[k + 2]) != TT__KEY_OTHER(x));
-        }
-        if (paired) {
-            for (k = 0; k < count; k += 2) {
-                int a = TT__KEY_CORNER_DIR(e[k]) >> 1, b = TT__KEY_CORNER_DIR(e[k + 1]) >> 1;
-                twin[a] = b;
-                twin[b] = a;
-            }
-            continue;
-        }
-        while (i < count) {
-            int other = TT__KEY_OTHER(e[i]), run_end = i + 1, backward = TT__KEY_CORNER_DIR(e[i]) & 1;
-            while (run_end < count && TT__KEY_OTHER(e[run_end]) == other)
-                backward += TT__KEY_CORNER_DIR(e[run_end++]) & 1;
-            if (other != v && run_end - i == 2 && backward == 1) {
-                int a = TT__KEY_CORNER_DIR(e[i]) >> 1, b = TT__KEY_CORNER_DIR(e[i + 1]) >> 1;
-                twin[a] = b;
-                twin[b] = a;
-            } else if (other != v && run_end - i == 1) {
-                twin[TT__KEY_CORNER_DIR(e[i]) >> 1] = -1;
-                boundary = 1;
-            } else {
-                int lowest = TT__KEY_CORNER_DIR(e[i]) >> 1;
-                if (!permissive && other != v && (problem.corner < 0 || lowest < problem.corner)) {
-                    problem.corner = lowest;
-                    problem.a = desc->indices[lowest];
-                    problem.b = problem.a == inverse[v] ? inverse[other] : inverse[v];
-                    problem.result = run_end - i > 2 ? TT_ERROR_NON_MANIFOLD_EDGE : TT_ERROR_INCONSISTENT_ORIENTATION;
-                    problem.nfaces = run_end - i;
-                    for (k = 0; k < 3; k++)
-                        problem.faces[k] =
-                            i + k < run_end ? tt__face_of_corner(mesh, TT__KEY_CORNER_DIR(e[i + k]) >> 1) : -1;
-                }
-                for (k = i; k < run_end; k++) twin[TT__KEY_CORNER_DIR(e[k]) >> 1] = -1;
-                boundary = 1;
-                mesh->repaired_edges++;
-            }
-            i = run_end;
-        }
+        if (!tt__pair_interior_bucket(e, count, l, twin)) tt__pair_bucket_runs(b, e, count, l, twin, &problem);
     }
-    {
-        int *twin = mesh->corner_vert;
-        mesh->corner_vert = mesh->twin;
-        mesh->twin = twin;
-        memcpy(mesh->corner_vert, desc->indices, (size_t)ncorners * sizeof(int));
-    }
-    if (problem.corner >= 0) {
-        result = tt__report_edge_problem(&problem, error);
-        goto cleanup;
-    }
-    if (!permissive) mesh->repaired_edges = 0;
+    mesh->corner_vert = mesh->twin;
+    mesh->twin = twin;
+    memcpy(mesh->corner_vert, b->indices, (size_t)b->ncorners * sizeof(int));
+    if (problem.corner >= 0) return tt__report_edge_problem(&problem, error);
+    if (!b->permissive) mesh->repaired_edges = 0;
+    return TT_OK;
+}
 
-    /* vert_corner prefers a boundary half-edge: of a vertex's boundary
-       half-edges, the one to the largest vertex id (then the largest corner),
-       whatever order they were paired in. */
-    for (f = 0; boundary && f < nfaces; f++) {
+/* Phase 7, when some half-edge has no twin: vert_corner prefers a boundary
+   half-edge (the fan walks and tt_mesh_valence start there). Of a vertex's
+   boundary half-edges, the one to the largest vertex id (then the largest
+   corner), whatever order they were paired in. */
+static void tt__build_prefer_boundary(tt__builder *b)
+{
+    tt_mesh *mesh = b->mesh;
+    int f, c;
+    for (f = 0; f < b->nfaces; f++) {
         int first = mesh->face_start[f], end = mesh->face_start[f + 1];
         for (c = first; c < end; c++)
             if (mesh->twin[c] < 0) {
@@ -2643,50 +2692,91 @@ TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allo
                 if (mesh->twin[cur] >= 0 || cur_w < w || (cur_w == w && cur < c)) mesh->vert_corner[u] = c;
             }
     }
+}
 
-    /* In strict mode every vertex's faces must form one fan (tt__fan_size's
-       walk); the smallest vertex id that does not is reported. The walk is a
-       chain of dependent loads, so each step is made one load: corner_face
-       first holds fan_next[h] = twin[prev(h)]. */
-    if (!permissive) {
-        int bad = -1, bad_local = -1, *fan_next = mesh->corner_face;
-        for (f = 0; f < nfaces; f++) {
-            int first = mesh->face_start[f], end = mesh->face_start[f + 1];
-            fan_next[first] = mesh->twin[end - 1];
-            for (c = first + 1; c < end; c++) fan_next[c] = mesh->twin[c - 1];
-        }
-        for (v = 0; v < nused; v++) {
-            int start = mesh->vert_corner[inverse[v]], h = start, fan = 1, next;
-            while ((next = fan_next[h]) >= 0 && next != start) h = next, fan++;
-            if (fan != out_count[v] && (bad < 0 || inverse[v] < bad)) {
-                bad = inverse[v];
-                bad_local = v;
-            }
-        }
-        if (bad >= 0) {
-            int bad_corner = mesh->vert_corner[bad];
-            result = tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, tt__face_of_corner(mesh, bad_corner), bad_corner,
-                              bad, -1,
-                              "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
-                              "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
-                              bad, out_count[bad_local]);
-            goto cleanup;
+/* Phase 8, strict mode: every vertex's faces must form one fan
+   (tt__fan_size's walk reaches all of its outgoing half-edges); the
+   smallest vertex id that does not is reported. The walk is a chain of
+   dependent loads, so each step is made one load: corner_face first holds
+   fan_next[h] = twin[prev(h)]. */
+static tt_result tt__build_check_fans(tt__builder *b, tt_error *error)
+{
+    tt_mesh *mesh = b->mesh;
+    const int *inverse = b->inverse, *out_count = b->out_count;
+    int bad = -1, bad_local = -1, *fan_next = mesh->corner_face, f, c, l;
+    for (f = 0; f < b->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+        fan_next[first] = mesh->twin[end - 1];
+        for (c = first + 1; c < end; c++) fan_next[c] = mesh->twin[c - 1];
+    }
+    for (l = 0; l < b->nused; l++) {
+        int start = mesh->vert_corner[inverse[l]], h = start, fan = 1, next;
+        while ((next = fan_next[h]) >= 0 && next != start) h = next, fan++;
+        if (fan != out_count[l] && (bad < 0 || inverse[l] < bad)) {
+            bad = inverse[l];
+            bad_local = l;
         }
     }
-    for (f = 0; f < nfaces; f++)
-        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++) mesh->corner_face[c] = f;
+    if (bad >= 0) {
+        int bad_corner = mesh->vert_corner[bad];
+        return tt__fail(error, TT_ERROR_NON_MANIFOLD_VERTEX, tt__face_of_corner(mesh, bad_corner), bad_corner, bad,
+                        -1,
+                        "vertex %d is non-manifold: its %d faces form more than one fan (surfaces "
+                        "touching at a point); build with TT_MESH_PERMISSIVE to accept it",
+                        bad, out_count[bad_local]);
+    }
+    return TT_OK;
+}
 
-cleanup:
-    tt__free(allocator, bucket_start);
-    tt__free(allocator, out_count);
-    tt__free(allocator, inverse);
-    tt__free(allocator, local);
-    tt__free(allocator, stamp);
+/* Phase 9: corner_face, the last array still holding scratch. */
+static void tt__build_corner_faces(tt__builder *b)
+{
+    tt_mesh *mesh = b->mesh;
+    int f, c;
+    for (f = 0; f < b->nfaces; f++)
+        for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++) mesh->corner_face[c] = f;
+}
+
+/* The build as a driver of its phases (above, in order). Each phase leaves
+   the builder ready for the next, or fails with the error filled in; the
+   scratch is freed either way, and the mesh too on failure. */
+TTDEF tt_result tt_mesh_build(const tt_mesh_desc *desc, const tt_allocator *allocator, tt_mesh **out_mesh,
+                              tt_error *error)
+{
+    tt__builder b;
+    tt_result result;
+    tt__ok(error);
+    if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
+    *out_mesh = NULL;
+    if (!desc) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "desc is NULL");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    memset(&b, 0, sizeof b);
+    b.desc = desc;
+    b.allocator = allocator;
+    result = tt__build_check_counts(&b, error);
+    if (result != TT_OK) return result;
+
+    result = tt__build_alloc(&b, error);
+    if (result == TT_OK) result = tt__build_positions(&b, error);
+    if (result == TT_OK) result = tt__build_faces(&b, error);
+    if (result == TT_OK) {
+        tt__build_buckets(&b);
+        result = tt__build_pair_twins(&b, error);
+    }
+    if (result == TT_OK && b.boundary) tt__build_prefer_boundary(&b);
+    if (result == TT_OK && !b.permissive) result = tt__build_check_fans(&b, error);
+    if (result == TT_OK) tt__build_corner_faces(&b);
+
+    tt__free(allocator, b.bucket_start);
+    tt__free(allocator, b.out_count);
+    tt__free(allocator, b.inverse);
+    tt__free(allocator, b.keys);
+    tt__free(allocator, b.stamp);
     if (result != TT_OK) {
-        tt_mesh_free(mesh);
+        tt_mesh_free(b.mesh);
         return result;
     }
-    *out_mesh = mesh;
+    *out_mesh = b.mesh;
     return TT_OK;
 }
 
