@@ -1883,31 +1883,38 @@ static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
     return top;
 }
 
-/* ---- Sorting doubles in place (ascending) ----
+/* ---- Sorting in place (ascending) ----
    Heapsort: O(n log n) whatever the input, so the exact median of a million
-   entries never degrades to the quadratic worst case of a quickselect. */
-static void tt__sift_doubles(double *v, int root, int count)
-{
-    for (;;) {
-        int child = 2 * root + 1;
-        double tmp;
-        if (child >= count) return;
-        if (child + 1 < count && v[child] < v[child + 1]) child++;
-        if (!(v[root] < v[child])) return;
-        tmp = v[root]; v[root] = v[child]; v[child] = tmp;
-        root = child;
+   entries, or the edges of a million-face fan around one vertex, never
+   degrade to a quadratic worst case. One definition, made for each element
+   type the library sorts (any type `<` compares): doubles here, the half-edge
+   builder's 64-bit edge keys in the mesh section. */
+#define TT__DEFINE_HEAPSORT(name, type)                                         \
+    static void name(type *v, int n)                                            \
+    {                                                                           \
+        int start = n / 2 - 1, end = n;                                         \
+        while (end > 1) {                                                       \
+            int root;                                                           \
+            type tmp;                                                           \
+            if (start >= 0) {                                                   \
+                root = start--;      /* building the heap */                    \
+            } else {                                                            \
+                end--;               /* moving the largest behind the heap */   \
+                tmp = v[0]; v[0] = v[end]; v[end] = tmp;                        \
+                root = 0;                                                       \
+            }                                                                   \
+            for (;;) {                                                          \
+                int child = 2 * root + 1;                                       \
+                if (child >= end) break;                                        \
+                if (child + 1 < end && v[child] < v[child + 1]) child++;        \
+                if (!(v[root] < v[child])) break;                               \
+                tmp = v[root]; v[root] = v[child]; v[child] = tmp;              \
+                root = child;                                                   \
+            }                                                                   \
+        }                                                                       \
     }
-}
 
-static void tt__sort_doubles(double *v, int n)
-{
-    int i;
-    for (i = n / 2 - 1; i >= 0; i--) tt__sift_doubles(v, i, n);
-    for (i = n - 1; i > 0; i--) {
-        double tmp = v[0]; v[0] = v[i]; v[i] = tmp;
-        tt__sift_doubles(v, 0, i);
-    }
-}
+TT__DEFINE_HEAPSORT(tt__sort_doubles, double)
 
 /* PCG32 (O'Neill 2014): a 64-bit LCG whose output is a permuted 32-bit word. */
 TTDEF uint32_t tt_rng_next(tt_rng *rng)
@@ -1992,18 +1999,7 @@ TTDEF void tt_mesh_free(tt_mesh *mesh)
 #define TT__KEY_OTHER(key) ((int)((key) >> 32))
 #define TT__KEY_CORNER_DIR(key) ((int)((key) & 0xffffffffu))
 
-static void tt__sift_down(uint64_t *items, int root, int count)
-{
-    for (;;) {
-        int child = 2 * root + 1;
-        uint64_t tmp;
-        if (child >= count) return;
-        if (child + 1 < count && items[child] < items[child + 1]) child++;
-        if (!(items[root] < items[child])) return;
-        tmp = items[root]; items[root] = items[child]; items[child] = tmp;
-        root = child;
-    }
-}
+TT__DEFINE_HEAPSORT(tt__heapsort_keys, uint64_t)
 
 /* Sorting networks for the usual bucket sizes (a grid's buckets hold 4
    half-edges, a triangle mesh's 4 to 8): compare-exchanges without branches,
@@ -2050,11 +2046,7 @@ static void tt__sort_edge_keys(uint64_t *k, int count)
         }
         return;
     }
-    for (i = count / 2 - 1; i >= 0; i--) tt__sift_down(k, i, count);
-    for (i = count - 1; i > 0; i--) {
-        uint64_t tmp = k[0]; k[0] = k[i]; k[i] = tmp;
-        tt__sift_down(k, 0, i);
-    }
+    tt__heapsort_keys(k, count);
 }
 
 /* The corner of the first repeated vertex in a face, or -1. Triangles and
