@@ -620,6 +620,7 @@ static void test_hpm_errors(void)
     tt_cluster_hierarchy_free(NULL);
 
     ctx.mesh = mesh;
+    oom_reset();
     oom_sweep("tt_cluster_hierarchy_build(two components)", hpm_oom_call, &ctx, TT_OK);
     tt_mesh_free(quads);
     tt_mesh_free(mesh);
