@@ -118,6 +118,10 @@
                 - the paste loop: surface patches grown over the mesh, aligned
                   with the field by least squares, until covered (Sec. 3.3-3.6)
                 - runtime pasting lists, alignment measure, atlas and baking (Sec. 4)
+     8. Hierarchical pattern mapping (Soler, Cani, Angelidis, "Hierarchical
+                  Pattern Mapping")
+                - the face-cluster hierarchy: components down to single faces,
+                  discs checked, control vertices (Sec. 2.1, 3.1)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
@@ -1522,6 +1526,139 @@ typedef struct tt_bake_options {
 TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
                                int npatches, const float *corner_uv, const tt_bake_options *options,
                                const tt_allocator *allocator, tt_image *atlas, tt_error *error);
+
+/* ======================================================================== */
+/* 8. Hierarchical pattern mapping                                          */
+/* ======================================================================== */
+
+/* Based on: Soler, Cani, Angelidis, "Hierarchical Pattern Mapping"
+   (SIGGRAPH 2002). The steps, for a triangle mesh:
+     1. tt_cluster_hierarchy_build: the face-cluster hierarchy, from whole
+        components down to single faces, with control vertices (Sec. 2.1,
+        3.1) - this block;
+     2. flattening of a cluster over its control polygon (Sec. 3.2);
+     3. fitting: the band of textured neighbours matched against the image
+        by FFT over several orientations (Sec. 4.1-4.2);
+     4. the coarse-to-fine traversal with one priority queue per level
+        (Sec. 2.2);
+     5. texture coordinates, crack removal and relaxation (Sec. 4.3-4.4).
+
+   The face-cluster hierarchy (Sec. 3.1). Level 0 holds one cluster per
+   connected component. A cluster of more than one face is split into n
+   children, n = max(2, round(area / (component area / branching^(level+1))))
+   (at most its face count): n seed faces by farthest-point sampling (the
+   first drawn from the seeded RNG) and a geodesic Voronoi partition of the
+   parent, a multi-source Dijkstra over the faces of the parent with the
+   step centroid -> shared edge's midpoint -> centroid; then one Lloyd-like
+   round moves each seed to its cell's centre (the face farthest from the
+   cell's border) and partitions again, which halves the spread of sizes
+   (largest / smallest cluster of a level: 4.3 instead of 9.4 on the tests'
+   meshes). A child is a disc
+   when its faces are edge-connected, its border is one loop that meets no
+   vertex twice, and V - E + F = 1 over its faces. When a child is not a
+   disc the parent is split again with n + 1 seeds, at most TT_CLUSTER_RESEEDS
+   times; the split with the fewest non-disc children is kept (the first of
+   equals), its non-disc children flagged and still split further. Single
+   faces are discs and are not split: the tree ends there. Border
+   regularisation and the non-alignment test of the spec (D14) are not done.
+
+   What holds per level. Levels are depths in the tree (a cluster's children
+   are at its level + 1). The *regions* of level l are its clusters plus the
+   leaves (single faces) of levels above l, carried down unchanged. The
+   regions of every level partition the mesh's faces; the clusters of level
+   l alone partition the faces not in a shallower leaf. A cluster's children
+   partition its faces. Every face's deepest cluster is a leaf holding just
+   that face (hierarchy->face_leaf).
+
+   Control vertices (Sec. 3.1, spec D12). A vertex of a cluster's border is
+   a control vertex when the faces around it belong to at least 3 regions
+   of the cluster's level, a mesh boundary counting as one more region
+   ("outside"). A border loop with fewer than 3 (4 when the loop has at least
+   TT_CLUSTER_LONG_LOOP vertices) gets extra ones: with none, at equal
+   arc-length fractions from the loop's first vertex; otherwise one at a
+   time, at the loop vertex nearest the middle of the longest arc between
+   control vertices. A single face's control vertices are its corners. The
+   top cluster of a closed component has no border and no control vertex.
+
+   Memory: fewer than 2 * faces clusters (each split makes at least 2
+   children and the leaves are the faces); the face array holds at most
+   mesh->nfaces entries per level and the control and neighbour arrays at
+   most 3 * faces per level, so O(faces * levels) in all (horse, 97k faces:
+   11 levels, 0.93M face entries). Scratch while building: 140 bytes per
+   face, 29 per corner, 10 per vertex. Time: O(F log F) per level, each
+   split costing about four Dijkstra passes over its parent, more where a
+   split is retried (horse: 0.5 s; 26k faces: 0.08 s, at -O2). */
+
+/* Re-splits of a parent with a non-disc child (spec D13). */
+#define TT_CLUSTER_RESEEDS 3
+/* A border loop of at least this many vertices gets at least 4 control
+   vertices, a shorter one at least 3. */
+#define TT_CLUSTER_LONG_LOOP 12
+/* options->branching = 0: this many children per split on average. */
+#define TT_DEFAULT_CLUSTER_BRANCHING 4
+
+enum {
+    TT_CLUSTER_DISC = 1u << 0,      /* connected, one simple border loop, V - E + F = 1 */
+    TT_CLUSTER_MAPPABLE = 1u << 1   /* a disc with at least 3 control vertices: may be flattened */
+};
+
+typedef struct tt_cluster_options {
+    uint64_t seed;      /* seeds the RNG that draws each split's first seed (any value, 0 included) */
+    int branching;      /* average children per split: each level's target cluster area is the
+                           level above's divided by this; 0 = TT_DEFAULT_CLUSTER_BRANCHING; 2..64 */
+} tt_cluster_options;
+
+typedef struct tt_cluster {
+    int level;              /* depth in the tree: 0 = a whole connected component */
+    int parent;             /* cluster index, -1 at level 0 */
+    int first_child;        /* children are clusters first_child .. first_child + nchildren - 1, */
+    int nchildren;          /*   all at level + 1; 0 for a leaf (a single face) */
+    int first_face;         /* faces are hierarchy->faces[first_face .. first_face + nfaces - 1], */
+    int nfaces;             /*   ascending within the cluster */
+    int first_control;      /* control vertices are hierarchy->control[first_control .. + ncontrol - 1]: */
+    int ncontrol;           /*   mesh vertex indices, loop after loop, each loop in border order
+                               (counter-clockwise seen from outside: the direction of the cluster's
+                               own half-edges on its border), starting at the control vertex met
+                               first from the loop's smallest border half-edge */
+    int nloops;             /* border loops: 1 for a disc, 0 for a closed component */
+    int first_neighbour;    /* neighbours are hierarchy->neighbours[first_neighbour .. + nneighbours - 1]: */
+    int nneighbours;        /*   the regions of this level sharing an edge with it, ascending cluster
+                               indices (same-level clusters, or shallower leaves carried down) */
+    int component;          /* connected component, numbered as tt_mesh_components numbers them */
+    unsigned flags;         /* TT_CLUSTER_DISC, TT_CLUSTER_MAPPABLE */
+    double area;            /* sum of its faces' areas (mesh units squared) */
+} tt_cluster;
+
+/* The hierarchy as flat arrays. Clusters are numbered level by level, so
+   level l's clusters are level_start[l] .. level_start[l + 1] - 1, and each
+   cluster's children follow one another in the order of their parents. */
+typedef struct tt_cluster_hierarchy {
+    int nclusters;
+    tt_cluster *clusters;       /* nclusters */
+    int nlevels;                /* depth + 1: levels 0 .. nlevels - 1 */
+    int *level_start;           /* nlevels + 1 */
+    int nface_entries;
+    int *faces;                 /* nface_entries: each cluster's faces, contiguous */
+    int ncontrol;
+    int *control;               /* ncontrol vertex indices: each cluster's control vertices */
+    int nneighbour_entries;
+    int *neighbours;            /* nneighbour_entries cluster indices: each cluster's neighbours */
+    int nfaces;                 /* the mesh's face count */
+    int *face_leaf;             /* nfaces: the leaf (single-face cluster) of each face */
+    int ncomponents;            /* level 0's cluster count */
+    tt_allocator allocator;     /* the one it was built with */
+} tt_cluster_hierarchy;
+
+/* Build the face-cluster hierarchy of `mesh` (triangles only). options may
+   be NULL (defaults, seed 0). The same mesh, options and seed give the same
+   hierarchy. *out gets it (free it with tt_cluster_hierarchy_free), NULL on
+   failure. Errors: NULL mesh or out, a bad allocator, a face that is not a
+   triangle (error->face), branching outside 2..64 (TT_ERROR_INVALID_ARGUMENT);
+   no faces (TT_ERROR_EMPTY_MESH); TT_ERROR_OUT_OF_MEMORY. */
+TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster_options *options,
+                                           const tt_allocator *allocator, tt_cluster_hierarchy **out,
+                                           tt_error *error);
+TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
 
 #ifdef __cplusplus
 }
@@ -9140,6 +9277,611 @@ done:
     tt__free(al, state);
     tt__free(al, queue);
     return result;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 8. Hierarchical pattern mapping                                          */
+/* ------------------------------------------------------------------------ */
+
+/* ---- The face-cluster hierarchy (Soler et al. Sec. 3.1; spec D12-D14) ---- */
+
+TT__DEFINE_HEAPSORT(tt__sort_ints, int)
+
+/* The hierarchy builder's state. `region[f]` is face f's region at the level
+   being processed (see the header: a cluster of that level, or a shallower
+   leaf); a split writes its children's ids there once that level's control
+   vertices and neighbours are known. */
+typedef struct tt__hier {
+    const tt_mesh *mesh;
+    const tt_allocator *al;
+    int nf, nv, branching;
+    tt_rng rng;
+    double *centroid;           /* 3 per face */
+    double *step;               /* per corner: the dual step across its edge (tt__field_step), 0 on a boundary */
+    double *farea;              /* per face */
+    double *comp_area;          /* per component */
+    int *region;                /* per face */
+    int *vstart, *vcorner;      /* corners at vertex v: vcorner[vstart[v] .. vstart[v + 1] - 1] */
+    unsigned char *vboundary;   /* per vertex: on a mesh boundary (an edge with one face) */
+    unsigned char *vcount;      /* per vertex: regions around it at this level, "outside" included, capped at 3 */
+    int *vstamp, *cstamp, *fstamp;  /* per vertex, corner, face: visited marks, compared with `stamp` */
+    int stamp;
+    double *dist;               /* per face: Dijkstra distance to the nearest seed */
+    int *label;                 /* per face: the seed (child) it belongs to */
+    int *best;                  /* per face of the parent being split: the kept split's labels */
+    int *scratch;               /* 3 per face */
+    tt__heap_item *heap;        /* 4 per face + 1: a Dijkstra from up to all faces, 3 pushes per face */
+    int *loopv;                 /* per corner: one border loop's vertices */
+    double *loops;              /* per corner: arc length from the loop's first vertex */
+    unsigned char *loopc;       /* per corner: the loop vertex is a control vertex */
+    tt_cluster *cl;             /* the output, grown */
+    int ncl, cap_cl;
+    int *faces, nfe, cap_fe;
+    int *control, nctl, cap_ctl;
+    int *nb, nnb, cap_nb;
+    int *level_start, nlev, cap_lev;
+} tt__hier;
+
+/* Border half-edge of cluster `id`: its twin is missing or in another region. */
+static int tt__hier_border(const tt__hier *H, int id, int c)
+{
+    int t = H->mesh->twin[c];
+    return t < 0 || H->region[H->mesh->corner_face[t]] != id;
+}
+
+/* The border half-edge after border half-edge h of cluster id: turn around
+   h's end vertex through the cluster's faces. */
+static int tt__hier_next_border(const tt__hier *H, int id, int h)
+{
+    const tt_mesh *m = H->mesh;
+    int x = tt_mesh_next(m, h), guard;
+    for (guard = 0; guard < m->ncorners && !tt__hier_border(H, id, x); guard++) x = tt_mesh_next(m, m->twin[x]);
+    return x;
+}
+
+/* Topology of cluster `id` (faces fl[0..n-1], region[] == id): its flags
+   (TT_CLUSTER_DISC or 0) and its number of border loops. A disc has one
+   border loop meeting no vertex twice and V - E + F = 1 (the faces are
+   edge-connected by construction: components, and Voronoi cells whose faces
+   each joined through a neighbour of the same cell). */
+static unsigned tt__hier_topology(tt__hier *H, int id, const int *fl, int n, int *nloops)
+{
+    const tt_mesh *m = H->mesh;
+    long v = 0, e2 = 0, border = 0, border_verts = 0;
+    int i, c, loops = 0, vmark, bmark;
+    vmark = ++H->stamp;
+    bmark = ++H->stamp;
+    for (i = 0; i < n; i++) {
+        for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++) {
+            int vert = m->corner_vert[c];
+            if (H->vstamp[vert] != vmark && H->vstamp[vert] != bmark) { H->vstamp[vert] = vmark; v++; }
+            if (tt__hier_border(H, id, c)) {
+                e2 += 2;
+                border++;
+                if (H->vstamp[vert] != bmark) { H->vstamp[vert] = bmark; border_verts++; }
+            } else {
+                e2 += 1;
+            }
+        }
+    }
+    for (i = 0; i < n; i++) {
+        for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++) {
+            int h = c, guard;
+            if (H->cstamp[c] == bmark || !tt__hier_border(H, id, c)) continue;
+            loops++;
+            for (guard = 0; guard <= m->ncorners && H->cstamp[h] != bmark; guard++) {
+                H->cstamp[h] = bmark;
+                h = tt__hier_next_border(H, id, h);
+            }
+        }
+    }
+    *nloops = loops;
+    return (loops == 1 && border == border_verts && v - e2 / 2 + n == 1) ? (unsigned)TT_CLUSTER_DISC : 0u;
+}
+
+/* Relaxation rounds after the farthest-point seeds. */
+#define TT__HIER_RELAX 1
+
+/* Geodesic Voronoi split of parent p (faces fl[0..n-1], region[] == p) into
+   k cells: farthest-point seeds, the first one random, each added by a
+   Dijkstra from it that takes every face it brings closer. label[] gets the
+   cells 0..k-1; each cell holds its seed and is edge-connected. */
+/* Dijkstra over the faces of parent p from the faces already in the heap,
+   staying within one cell when `within_cell` (label[] then fixed), else
+   giving each face it brings closer the label of the face it came from. */
+static void tt__hier_dijkstra(tt__hier *H, int p, int nheap, int within_cell)
+{
+    const tt_mesh *m = H->mesh;
+    while (nheap > 0) {
+        tt__heap_item top = tt__heap_pop(H->heap, &nheap);
+        int g = top.value, c;
+        if (top.key > H->dist[g]) continue;
+        for (c = m->face_start[g]; c < m->face_start[g + 1]; c++) {
+            int t = m->twin[c], h;
+            double d;
+            if (t < 0) continue;
+            h = m->corner_face[t];
+            if (H->region[h] != p || (within_cell && H->label[h] != H->label[g])) continue;
+            d = top.key + H->step[c];
+            if (d < H->dist[h]) {
+                H->dist[h] = d;
+                if (!within_cell) H->label[h] = H->label[g];
+                tt__heap_push(H->heap, &nheap, d, h);
+            }
+        }
+    }
+}
+
+static void tt__hier_voronoi(tt__hier *H, int p, const int *fl, int n, int k)
+{
+    const tt_mesh *m = H->mesh;
+    int i, j, iter, seed = fl[tt_rng_below(&H->rng, (uint32_t)n)], smark = ++H->stamp;
+    for (i = 0; i < n; i++) {
+        H->dist[fl[i]] = HUGE_VAL;
+        H->label[fl[i]] = -1;
+    }
+    for (j = 0; j < k; j++) {
+        int nheap = 0;
+        if (j > 0) {
+            double far = -1.0;
+            for (i = 0; i < n; i++)
+                if (H->fstamp[fl[i]] != smark && H->dist[fl[i]] > far) { far = H->dist[fl[i]]; seed = fl[i]; }
+        }
+        H->fstamp[seed] = smark;
+        H->dist[seed] = 0.0;
+        H->label[seed] = j;
+        tt__heap_push(H->heap, &nheap, 0.0, seed);
+        tt__hier_dijkstra(H, p, nheap, 0);
+    }
+    /* Lloyd-like relaxation, for evener sizes (spec 1.1 step 3): move each
+       seed to its cell's centre, the face farthest from the cell's border
+       (ties: the smallest face index), and partition again. The seeds live
+       in scratch[0..k-1], the centres' distances in loops[0..k-1]. */
+    for (iter = 0; iter < TT__HIER_RELAX; iter++) {
+        int nheap = 0, c;
+        for (i = 0; i < n; i++) {
+            int f = fl[i], border = 0;
+            for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+                int t = m->twin[c];
+                border |= t < 0 || H->region[m->corner_face[t]] != p || H->label[m->corner_face[t]] != H->label[f];
+            }
+            H->dist[f] = border ? 0.0 : HUGE_VAL;
+            if (border) tt__heap_push(H->heap, &nheap, 0.0, f);
+        }
+        tt__hier_dijkstra(H, p, nheap, 1);
+        for (j = 0; j < k; j++) H->loops[j] = -1.0;
+        for (i = 0; i < n; i++) {
+            int f = fl[i], cell = H->label[f];
+            if (H->dist[f] > H->loops[cell]) { H->loops[cell] = H->dist[f]; H->scratch[cell] = f; }
+        }
+        nheap = 0;
+        for (i = 0; i < n; i++) H->dist[fl[i]] = HUGE_VAL;
+        for (j = 0; j < k; j++) {
+            H->dist[H->scratch[j]] = 0.0;
+            H->label[H->scratch[j]] = j;
+            tt__heap_push(H->heap, &nheap, 0.0, H->scratch[j]);
+        }
+        tt__hier_dijkstra(H, p, nheap, 0);
+    }
+}
+
+/* Room for `more` clusters, face entries, control vertices or neighbours. */
+static int tt__hier_reserve(tt__hier *H, int clusters, int faces, int control, int neighbours)
+{
+    void *g;
+    if (H->ncl >= INT_MAX - clusters || H->nfe >= INT_MAX - faces || H->nctl >= INT_MAX - control ||
+        H->nnb >= INT_MAX - neighbours)
+        return 0;
+    /* Each array exists (at least 64 entries) once reserved, even for 0. */
+    if (!(g = tt__grow(H->al, H->cl, &H->cap_cl, H->ncl + clusters + 1, sizeof *H->cl))) return 0;
+    H->cl = (tt_cluster *)g;
+    if (!(g = tt__grow(H->al, H->faces, &H->cap_fe, H->nfe + faces + 1, sizeof *H->faces))) return 0;
+    H->faces = (int *)g;
+    if (!(g = tt__grow(H->al, H->control, &H->cap_ctl, H->nctl + control + 1, sizeof *H->control))) return 0;
+    H->control = (int *)g;
+    if (!(g = tt__grow(H->al, H->nb, &H->cap_nb, H->nnb + neighbours + 1, sizeof *H->nb))) return 0;
+    H->nb = (int *)g;
+    return 1;
+}
+
+/* Split cluster p (more than one face) into its children, appended. */
+static int tt__hier_split(tt__hier *H, int p)
+{
+    tt_cluster P = H->cl[p];
+    int n = P.nfaces, i, j, k, attempt, best_bad = INT_MAX, best_k = 0, base = H->ncl;
+    double target = H->comp_area[P.component] / pow((double)H->branching, (double)(P.level + 1));
+    double x = target > 0.0 ? P.area / target : 0.0;
+    int *fl, *count;
+    k = x < (double)n ? (int)floor(x + 0.5) : n;     /* NaN and infinity: n */
+    k = tt__min_i(tt__max_i(k, 2), n);
+    for (attempt = 0; attempt <= TT_CLUSTER_RESEEDS && k + attempt <= n; attempt++) {
+        int bad = 0, nloops;
+        fl = H->faces + P.first_face;
+        tt__hier_voronoi(H, p, fl, n, k + attempt);
+        for (i = 0; i < n; i++) H->region[fl[i]] = base + H->label[fl[i]];
+        /* Each cell's faces, ascending, into scratch; its start in count. */
+        count = H->scratch + n;
+        for (j = 0; j <= k + attempt; j++) count[j] = 0;
+        for (i = 0; i < n; i++) count[H->label[fl[i]] + 1]++;
+        for (j = 0; j < k + attempt; j++) count[j + 1] += count[j];
+        for (i = 0; i < n; i++) H->scratch[count[H->label[fl[i]]]++] = fl[i];
+        for (j = 0, i = 0; j < k + attempt; j++) {
+            int start = i;
+            while (i < n && H->label[H->scratch[i]] == j) i++;
+            if (!(tt__hier_topology(H, base + j, H->scratch + start, i - start, &nloops) & TT_CLUSTER_DISC)) bad++;
+        }
+        for (i = 0; i < n; i++) H->region[fl[i]] = p;
+        if (bad < best_bad) {
+            best_bad = bad;
+            best_k = k + attempt;
+            for (i = 0; i < n; i++) H->best[i] = H->label[fl[i]];
+        }
+        if (bad == 0) break;
+    }
+    if (!tt__hier_reserve(H, best_k, n, 0, 0)) return 0;
+    fl = H->faces + P.first_face;
+    count = H->scratch;
+    for (j = 0; j <= best_k; j++) count[j] = 0;
+    for (i = 0; i < n; i++) count[H->best[i] + 1]++;
+    for (j = 0; j < best_k; j++) count[j + 1] += count[j];
+    for (j = 0; j < best_k; j++) {
+        tt_cluster *ch = &H->cl[base + j];
+        memset(ch, 0, sizeof *ch);
+        ch->level = P.level + 1;
+        ch->parent = p;
+        ch->first_child = -1;
+        ch->first_face = H->nfe + count[j];
+        ch->nfaces = count[j + 1] - count[j];
+        ch->component = P.component;
+    }
+    for (i = 0; i < n; i++) {
+        tt_cluster *ch = &H->cl[base + H->best[i]];
+        H->faces[H->nfe + count[H->best[i]]++] = fl[i];
+        H->region[fl[i]] = base + H->best[i];
+        ch->area += H->farea[fl[i]];
+    }
+    H->nfe += n;
+    H->ncl += best_k;
+    H->cl[p].first_child = base;
+    H->cl[p].nchildren = best_k;
+    for (j = 0; j < best_k; j++) {
+        tt_cluster *ch = &H->cl[base + j];
+        ch->flags = tt__hier_topology(H, base + j, H->faces + ch->first_face, ch->nfaces, &ch->nloops);
+    }
+    return 1;
+}
+
+/* Control vertices of the border loop through border half-edge h0 of
+   cluster id (spec D12), appended to H->control (room reserved by the
+   caller: at most the loop's length); marks the loop's half-edges with
+   `mark`. */
+static void tt__hier_loop_control(tt__hier *H, int id, int h0, int mark, int single_face)
+{
+    const tt_mesh *m = H->mesh;
+    int len = 0, h = h0, i, j, count = 0, target, first, guard;
+    double perimeter = 0.0;
+    for (guard = 0; guard <= m->ncorners && H->cstamp[h] != mark; guard++) {
+        const float *a = m->pos + 3 * (size_t)m->corner_vert[h];
+        const float *b = m->pos + 3 * (size_t)m->corner_vert[tt_mesh_next(m, h)];
+        double d[3];
+        H->cstamp[h] = mark;
+        H->loopv[len] = m->corner_vert[h];
+        H->loopc[len] = (unsigned char)(single_face || H->vcount[m->corner_vert[h]] >= 3);
+        count += H->loopc[len];
+        H->loops[len] = perimeter;
+        tt__sub3f(b, a, d);
+        perimeter += tt__length3(d);
+        len++;
+        h = tt__hier_next_border(H, id, h);
+    }
+    target = tt__min_i(len >= TT_CLUSTER_LONG_LOOP ? 4 : 3, len);
+    if (count == 0) {
+        /* At equal arc-length fractions j / target from the first vertex
+           (equal index steps on a loop of zero length). */
+        for (j = 0; j < target; j++) {
+            double want = perimeter * j / target;
+            i = 0;
+            if (perimeter > 0.0) {
+                while (i < len - 1 && H->loops[i] < want) i++;
+            } else {
+                i = (int)((long)len * j / target);
+            }
+            while (H->loopc[i]) i = (i + 1) % len;
+            H->loopc[i] = 1;
+            count++;
+        }
+    }
+    while (count < target) {
+        /* The vertex nearest the middle of the longest arc between
+           consecutive control vertices that has a vertex inside. */
+        int bi = -1, bj = -1, bk = -1;
+        double barc = -1.0, mid, bdist = HUGE_VAL;
+        for (i = 0; i < len; i++) {
+            double arc;
+            if (!H->loopc[i]) continue;
+            j = (i + 1) % len;
+            while (!H->loopc[j]) j = (j + 1) % len;
+            if (j == (i + 1) % len) continue;
+            arc = H->loops[j] - H->loops[i] + (j <= i ? perimeter : 0.0);
+            if (arc > barc) { barc = arc; bi = i; bj = j; }
+        }
+        if (bi < 0) break;
+        mid = H->loops[bi] + 0.5 * barc;
+        for (i = (bi + 1) % len; i != bj; i = (i + 1) % len) {
+            double at = H->loops[i] + (i <= bi ? perimeter : 0.0);
+            if (fabs(at - mid) < bdist) { bdist = fabs(at - mid); bk = i; }
+        }
+        H->loopc[bk] = 1;
+        count++;
+    }
+    for (first = 0; first < len && !H->loopc[first]; first++) {}
+    for (i = 0; i < len; i++) {
+        int at = (first + i) % len;
+        if (H->loopc[at]) H->control[H->nctl++] = H->loopv[at];
+    }
+}
+
+/* The neighbours, control vertices and mappable flag of the clusters
+   ls .. le - 1 of one level, from region[] at that level. */
+static int tt__hier_level(tt__hier *H, int ls, int le)
+{
+    const tt_mesh *m = H->mesh;
+    int v, id, i, c;
+    for (v = 0; v < H->nv; v++) {
+        int r0 = -1, r1 = -1, n = H->vboundary[v];
+        for (i = H->vstart[v]; i < H->vstart[v + 1] && n < 3; i++) {
+            int r = H->region[m->corner_face[H->vcorner[i]]];
+            if (r == r0 || r == r1) continue;
+            if (r0 < 0) r0 = r; else if (r1 < 0) r1 = r;
+            n++;
+        }
+        H->vcount[v] = (unsigned char)n;
+    }
+    for (id = ls; id < le; id++) {
+        int n = H->cl[id].nfaces, nn = 0, unique = 0, mark;
+        const int *fl = H->faces + H->cl[id].first_face;
+        for (i = 0; i < n; i++)
+            for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++)
+                if (tt__hier_border(H, id, c) && m->twin[c] >= 0)
+                    H->scratch[nn++] = H->region[m->corner_face[m->twin[c]]];
+        tt__sort_ints(H->scratch, nn);
+        for (i = 0; i < nn; i++)
+            if (i == 0 || H->scratch[i] != H->scratch[i - 1]) H->scratch[unique++] = H->scratch[i];
+        if (!tt__hier_reserve(H, 0, 0, 3 * n, unique)) return 0;
+        fl = H->faces + H->cl[id].first_face;
+        H->cl[id].first_neighbour = H->nnb;
+        H->cl[id].nneighbours = unique;
+        for (i = 0; i < unique; i++) H->nb[H->nnb++] = H->scratch[i];
+        mark = ++H->stamp;
+        H->cl[id].first_control = H->nctl;
+        for (i = 0; i < n; i++)
+            for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++)
+                if (H->cstamp[c] != mark && tt__hier_border(H, id, c)) tt__hier_loop_control(H, id, c, mark, n == 1);
+        H->cl[id].ncontrol = H->nctl - H->cl[id].first_control;
+        if ((H->cl[id].flags & TT_CLUSTER_DISC) && H->cl[id].ncontrol >= 3) H->cl[id].flags |= TT_CLUSTER_MAPPABLE;
+    }
+    return 1;
+}
+
+static void tt__hier_release(tt__hier *H)
+{
+    const tt_allocator *al = H->al;
+    tt__free(al, H->centroid);
+    tt__free(al, H->step);
+    tt__free(al, H->farea);
+    tt__free(al, H->comp_area);
+    tt__free(al, H->region);
+    tt__free(al, H->vstart);
+    tt__free(al, H->vcorner);
+    tt__free(al, H->vboundary);
+    tt__free(al, H->vcount);
+    tt__free(al, H->vstamp);
+    tt__free(al, H->cstamp);
+    tt__free(al, H->fstamp);
+    tt__free(al, H->dist);
+    tt__free(al, H->label);
+    tt__free(al, H->best);
+    tt__free(al, H->scratch);
+    tt__free(al, H->heap);
+    tt__free(al, H->loopv);
+    tt__free(al, H->loops);
+    tt__free(al, H->loopc);
+    tt__free(al, H->cl);
+    tt__free(al, H->faces);
+    tt__free(al, H->control);
+    tt__free(al, H->nb);
+    tt__free(al, H->level_start);
+}
+
+/* Level 0: one cluster per connected component (region[] holds the
+   component ids), faces ascending. */
+static int tt__hier_components(tt__hier *H, int ncomp)
+{
+    int f, j, *count = H->scratch;
+    if (!tt__hier_reserve(H, ncomp, H->nf, 0, 0)) return 0;
+    for (j = 0; j <= ncomp; j++) count[j] = 0;
+    for (f = 0; f < H->nf; f++) count[H->region[f] + 1]++;
+    for (j = 0; j < ncomp; j++) count[j + 1] += count[j];
+    for (j = 0; j < ncomp; j++) {
+        tt_cluster *C = &H->cl[j];
+        memset(C, 0, sizeof *C);
+        C->parent = C->first_child = -1;
+        C->first_face = count[j];
+        C->nfaces = count[j + 1] - count[j];
+        C->component = j;
+    }
+    for (f = 0; f < H->nf; f++) {
+        H->faces[count[H->region[f]]++] = f;
+        H->cl[H->region[f]].area += H->farea[f];
+    }
+    H->nfe = H->nf;
+    H->ncl = ncomp;
+    for (j = 0; j < ncomp; j++) {
+        tt_cluster *C = &H->cl[j];
+        H->comp_area[j] = C->area;
+        C->flags = tt__hier_topology(H, j, H->faces + C->first_face, C->nfaces, &C->nloops);
+    }
+    return 1;
+}
+
+TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster_options *options,
+                                           const tt_allocator *allocator, tt_cluster_hierarchy **out,
+                                           tt_error *error)
+{
+    tt__hier H;
+    tt_cluster_hierarchy *hier;
+    int f, c, v, ncomp = 0, level, branching;
+    size_t nf, nc;
+
+    if (out) *out = NULL;
+    tt__ok(error);
+    if (!mesh || !out)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_cluster_hierarchy_build needs a mesh and an output (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (mesh->nfaces <= 0)
+        return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces to cluster");
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners: the cluster hierarchy needs triangles (triangulate first)",
+                            f, mesh->face_start[f + 1] - mesh->face_start[f]);
+    branching = options && options->branching ? options->branching : TT_DEFAULT_CLUSTER_BRANCHING;
+    if (branching < 2 || branching > 64)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the cluster branching is %d: it must be 2..64 (0 for the default, %d)",
+                        options->branching, TT_DEFAULT_CLUSTER_BRANCHING);
+
+    memset(&H, 0, sizeof H);
+    H.mesh = mesh;
+    H.al = allocator;
+    H.nf = mesh->nfaces;
+    H.nv = mesh->nverts;
+    H.branching = branching;
+    tt_rng_seed(&H.rng, options ? options->seed : 0u, 0x48504du);   /* stream "HPM" */
+    nf = (size_t)H.nf;
+    nc = (size_t)mesh->ncorners;
+    H.centroid = TT__ALLOC(allocator, double, 3 * nf);
+    H.farea = TT__ALLOC(allocator, double, nf);
+    H.step = TT__ALLOC(allocator, double, nc);
+    H.comp_area = TT__ALLOC(allocator, double, nf);
+    H.region = TT__ALLOC(allocator, int, nf);
+    H.vstart = TT__ALLOC(allocator, int, (size_t)H.nv + 1);
+    H.vcorner = TT__ALLOC(allocator, int, nc);
+    H.vboundary = TT__ALLOC(allocator, unsigned char, (size_t)H.nv);
+    H.vcount = TT__ALLOC(allocator, unsigned char, (size_t)H.nv);
+    H.vstamp = TT__ALLOC(allocator, int, (size_t)H.nv);
+    H.cstamp = TT__ALLOC(allocator, int, nc);
+    H.fstamp = TT__ALLOC(allocator, int, nf);
+    H.dist = TT__ALLOC(allocator, double, nf);
+    H.label = TT__ALLOC(allocator, int, nf);
+    H.best = TT__ALLOC(allocator, int, nf);
+    H.scratch = TT__ALLOC(allocator, int, 3 * nf + 1);
+    H.heap = TT__ALLOC(allocator, tt__heap_item, 4 * nf + 1);
+    H.loopv = TT__ALLOC(allocator, int, nc);
+    H.loops = TT__ALLOC(allocator, double, nc);
+    H.loopc = TT__ALLOC(allocator, unsigned char, nc);
+    if (!H.centroid || !H.step || !H.farea || !H.comp_area || !H.region || !H.vstart || !H.vcorner || !H.vboundary ||
+        !H.vcount || !H.vstamp || !H.cstamp || !H.fstamp || !H.dist || !H.label || !H.best || !H.scratch ||
+        !H.heap || !H.loopv || !H.loops || !H.loopc)
+        goto oom;
+    if (tt_mesh_components(mesh, allocator, H.region, &ncomp, NULL) != TT_OK) goto oom;
+
+    for (f = 0; f < H.nf; f++) {
+        const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f];
+        const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 1];
+        const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 2];
+        double e1[3], e2[3], n[3];
+        int k;
+        for (k = 0; k < 3; k++) H.centroid[3 * (size_t)f + k] = ((double)p0[k] + p1[k] + p2[k]) / 3.0;
+        tt__sub3f(p1, p0, e1);
+        tt__sub3f(p2, p0, e2);
+        tt__cross3(e1, e2, n);
+        H.farea[f] = 0.5 * tt__length3(n);
+        H.fstamp[f] = 0;
+    }
+    for (c = 0; c < mesh->ncorners; c++)
+        H.step[c] = mesh->twin[c] < 0 ? 0.0
+                                      : tt__field_step(mesh, H.centroid, mesh->corner_face[c], c,
+                                                       mesh->corner_face[mesh->twin[c]]);
+    for (v = 0; v <= H.nv; v++) H.vstart[v] = 0;
+    for (v = 0; v < H.nv; v++) H.vboundary[v] = 0, H.vstamp[v] = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        H.vstart[mesh->corner_vert[c] + 1]++;
+        H.cstamp[c] = 0;
+        if (mesh->twin[c] < 0) {
+            H.vboundary[mesh->corner_vert[c]] = 1;
+            H.vboundary[mesh->corner_vert[tt_mesh_next(mesh, c)]] = 1;
+        }
+    }
+    for (v = 0; v < H.nv; v++) H.vstart[v + 1] += H.vstart[v];
+    for (c = 0; c < mesh->ncorners; c++) H.vcorner[H.vstart[mesh->corner_vert[c]]++] = c;
+    for (v = H.nv; v > 0; v--) H.vstart[v] = H.vstart[v - 1];
+    H.vstart[0] = 0;
+
+    if (!tt__hier_components(&H, ncomp)) goto oom;
+    for (level = 0;; level++) {
+        int ls, le = H.ncl, id;
+        int *g = (int *)tt__grow(allocator, H.level_start, &H.cap_lev, level + 2, sizeof(int));
+        if (!g) goto oom;
+        H.level_start = g;
+        if (level == 0) H.level_start[0] = 0;
+        ls = H.level_start[level];
+        H.level_start[level + 1] = le;
+        if (!tt__hier_level(&H, ls, le)) goto oom;
+        for (id = ls; id < le; id++)
+            if (H.cl[id].nfaces > 1 && !tt__hier_split(&H, id)) goto oom;
+        if (H.ncl == le) break;
+    }
+    H.nlev = level + 1;
+
+    hier = TT__ALLOC(allocator, tt_cluster_hierarchy, 1);
+    if (!hier) goto oom;
+    memset(hier, 0, sizeof *hier);
+    hier->face_leaf = TT__ALLOC(allocator, int, nf);
+    if (!hier->face_leaf) {
+        tt__free(allocator, hier);
+        goto oom;
+    }
+    for (c = 0; c < H.ncl; c++)
+        if (H.cl[c].nfaces == 1) hier->face_leaf[H.faces[H.cl[c].first_face]] = c;
+    hier->nclusters = H.ncl;
+    hier->clusters = H.cl;
+    hier->nlevels = H.nlev;
+    hier->level_start = H.level_start;
+    hier->nface_entries = H.nfe;
+    hier->faces = H.faces;
+    hier->ncontrol = H.nctl;
+    hier->control = H.control;
+    hier->nneighbour_entries = H.nnb;
+    hier->neighbours = H.nb;
+    hier->nfaces = H.nf;
+    hier->ncomponents = ncomp;
+    hier->allocator = tt__allocator_copy(allocator);
+    H.cl = NULL;
+    H.level_start = NULL;
+    H.faces = H.control = H.nb = NULL;
+    tt__hier_release(&H);
+    *out = hier;
+    return TT_OK;
+
+oom:
+    tt__hier_release(&H);
+    return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory building the cluster hierarchy");
+}
+
+TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy)
+{
+    tt_allocator al;
+    if (!hierarchy) return;
+    al = hierarchy->allocator;
+    tt__free(&al, hierarchy->clusters);
+    tt__free(&al, hierarchy->level_start);
+    tt__free(&al, hierarchy->faces);
+    tt__free(&al, hierarchy->control);
+    tt__free(&al, hierarchy->neighbours);
+    tt__free(&al, hierarchy->face_leaf);
+    tt__free(&al, hierarchy);
 }
 
 #ifdef __cplusplus

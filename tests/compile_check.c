@@ -215,6 +215,16 @@ int main(void)
                     tt_image_free(baked);
                     tt_lapped_free(lapped);
                 }
+                {
+                    /* 8. Hierarchical pattern mapping: every public function once. */
+                    tt_cluster_options co;
+                    tt_cluster_hierarchy *ch = NULL;
+                    memset(&co, 0, sizeof co);
+                    co.seed = 5;
+                    EXPECT(tt_cluster_hierarchy_build(tris, &co, NULL, &ch, &err) == TT_OK && ch &&
+                           ch->clusters[ch->nclusters - 1].nfaces == 1);
+                    tt_cluster_hierarchy_free(ch);
+                }
                 tt_mesh_free(tris);
             }
         }

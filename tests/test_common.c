@@ -364,6 +364,7 @@ int main(void)
     run_tiled_tests();
     run_tiled_synthesis_tests();
     run_lapped_tests();
+    run_hpm_tests();
     printf("%d passed, %d failed\n", g_passed, g_failed);
     return g_failed ? 1 : 0;
 }

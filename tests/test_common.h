@@ -39,6 +39,7 @@ void run_raster_tests(void);     /* tests/test_5_raster.c */
 void run_tiled_tests(void);      /* tests/test_6_tiled.c */
 void run_tiled_synthesis_tests(void); /* tests/test_6_tiled_synthesis.c */
 void run_lapped_tests(void);     /* tests/test_7_lapped.c */
+void run_hpm_tests(void);        /* tests/test_8_hpm.c */
 
 /* ------------------------------------------------------------------------ */
 /* Counting and failing allocators                                          */
