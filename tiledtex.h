@@ -1697,14 +1697,21 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
    E_flat <= max_error and (if asked) the area-weighted 95th percentile
    stretch <= max_stretch.
 
-   Memory: O(n) for a cluster of n faces (about 700 bytes per face at
-   most, with the sparse matrix), nothing proportional to the whole mesh,
+   Memory: O(n) for a cluster of n faces (about 650 bytes per face at
+   most, with the triplets, the sparse matrix and the CG scratch), nothing proportional to the whole mesh,
    so flattening every cluster costs O(faces * levels) in all. Time:
    O(n log n) plus the CG solves (O(n^1.5) steps for a disc), plus an
    O(k^2) polygon test for k control vertices and, in the projected border
-   mode, an O(b^2) border test for b border vertices (bunny, 70k faces:
-   see the README of the tests; every mappable cluster of every level in
-   well under a second at -O2). */
+   mode, an O(b^2) border test for b border vertices. Every mappable
+   cluster of every level, at -O2: bunny (3.7k faces) 15 ms; horse (97k
+   faces) 1.0 s, 0.45 s of it for level 1's four 24k-face clusters.
+
+   What it accepts at the default 0.10 (projected border): bunny levels 1-6
+   0 %, 5 %, 66 %, 86 %, 97 %, 98 % of the mappable clusters; horse levels
+   1-9 0 %, 7 %, 44 %, 68 %, 88 %, 98 %, 99.3 %, 99.8 %, 97 %. The chord
+   border accepts far fewer (bunny level 4: 19 % against 86 %), mostly
+   because triangles whose corners all lie on one straight polygon edge
+   lose their area and count as folds. */
 
 /* options->max_error = 0: E_flat above this refuses the cluster (D9: a
    spherical cap of half-angle up to about 35 degrees maps in one piece). */

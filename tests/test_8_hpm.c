@@ -797,10 +797,10 @@ end:
 
 /* (9) T5: spherical caps. E_flat follows tan^2(alpha/2) (the cap's border
    circle projects onto itself, so this holds whatever the control
-   vertices), within 2 % + 2e-3 for 64 x 128 rings (the polyhedral cap's
-   area and the 128-gon's area are each a little below the smooth ones); the
-   0.10 threshold accepts 20 and 30 degrees and refuses 40 and 50; no
-   accepted map has a flipped triangle. */
+   vertices), within 0.5 % + 1e-4 for 32 rings of 128 (measured: 0.01 %;
+   the polyhedral cap's area and the 128-gon's fall short of the smooth ones
+   alike); the 0.10 threshold accepts 20, 30 and 35 degrees (E_flat 0.0994)
+   and refuses 40 and 50; no map has a flipped triangle. */
 static void test_flatten_caps(void)
 {
     const double pi = 3.14159265358979323846;
@@ -827,17 +827,16 @@ static void test_flatten_caps(void)
         r = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep, &err);
         if (r == TT_OK) flat_measure(m, h, 0, uv, &flips, &edge, &area);
         CHECK(r == TT_OK && rep.mapped && flips == 0 && rep.flipped == 0 &&
-                  fabs(rep.flattening_error - expect) <= 0.02 * expect + 2e-3 &&
+                  fabs(rep.flattening_error - expect) <= 0.005 * expect + 1e-4 &&
                   fabs(area - rep.mapped_area) <= 1e-5 * area,
               "cap %g deg: %d, E_flat %.5f, tan^2(alpha/2) %.5f, %d flips (%s)", degrees[i], r, rep.flattening_error,
               expect, flips, err.message);
         r2 = tt_flatten_cluster(m, h, 0, NULL, NULL, uv, &rep2, &err);
-        if (degrees[i] != 35)
-            CHECK((degrees[i] < 35) == (r2 == TT_OK) &&
-                      (r2 == TT_OK || (r2 == TT_ERROR_NOT_FLAT && err.result == r2 && err.item == 0 &&
-                                       rep2.mapped && rep2.flattening_error > TT_DEFAULT_FLATTEN_MAX_ERROR)),
-                  "cap %g deg at the default threshold: %d, E_flat %.4f (%s)", degrees[i], r2,
-                  rep2.flattening_error, err.message);
+        CHECK((degrees[i] <= 35) == (r2 == TT_OK) &&
+                  (r2 == TT_OK || (r2 == TT_ERROR_NOT_FLAT && err.result == r2 && err.item == 0 &&
+                                   rep2.mapped && rep2.flattening_error > TT_DEFAULT_FLATTEN_MAX_ERROR)),
+              "cap %g deg at the default threshold: %d, E_flat %.4f (%s)", degrees[i], r2, rep2.flattening_error,
+              err.message);
         /* The shear check: a cap stretches a little, a limit of 1.0001 refuses it. */
         opt.max_stretch = 1.0001;
         r2 = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep2, &err);
