@@ -1698,11 +1698,12 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
    stretch <= max_stretch.
 
    Memory: O(n) for a cluster of n faces (about 650 bytes per face at
-   most, with the triplets, the sparse matrix and the CG scratch), nothing proportional to the whole mesh,
-   so flattening every cluster costs O(faces * levels) in all. Time:
-   O(n log n) plus the CG solves (O(n^1.5) steps for a disc), plus an
-   O(k^2) polygon test for k control vertices and, in the projected border
-   mode, an O(b^2) border test for b border vertices. Every mappable
+   most, with the triplets, the sparse matrix and the CG scratch), nothing
+   proportional to the whole mesh, so flattening every cluster costs
+   O(faces * levels) in all. Time: O(n log n) plus the two CG solves (about
+   sqrt(n) steps of O(n) each for a disc), plus an O(k^2) polygon test for
+   k control vertices and, in the projected border mode, an O(b^2) border
+   test for b border vertices. Every mappable
    cluster of every level, at -O2: bunny (3.7k faces) 15 ms; horse (97k
    faces) 1.0 s, 0.45 s of it for level 1's four 24k-face clusters.
 
@@ -10186,6 +10187,10 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
                            C->ncontrol);
     n = C->nfaces;
     k = C->ncontrol;
+    if (n < 1 || C->first_face < 0 || C->first_face > hierarchy->nface_entries - n || C->first_control < 0 ||
+        C->first_control > hierarchy->ncontrol - k)
+        return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, cluster, -1, -1,
+                           "cluster %d names faces or control vertices outside the hierarchy's arrays", cluster);
     faces = hierarchy->faces + C->first_face;
     ctl = hierarchy->control + C->first_control;
     for (i = 0; i < n; i++)
