@@ -223,6 +223,16 @@ int main(void)
                     co.seed = 5;
                     EXPECT(tt_cluster_hierarchy_build(tris, &co, NULL, &ch, &err) == TT_OK && ch &&
                            ch->clusters[ch->nclusters - 1].nfaces == 1);
+                    if (ch) {
+                        tt_flatten_options flo;
+                        tt_flatten_report fr;
+                        memset(&flo, 0, sizeof flo);
+                        flo.max_error = TT_DEFAULT_FLATTEN_MAX_ERROR;
+                        flo.border = TT_FLATTEN_BORDER_PROJECTED;
+                        /* a single face maps isometrically */
+                        EXPECT(tt_flatten_cluster(tris, ch, ch->nclusters - 1, &flo, NULL, corner_uv, &fr, &err) ==
+                                   TT_OK && fr.mapped && fr.flattening_error < 1e-6 && fr.flipped == 0);
+                    }
                     tt_cluster_hierarchy_free(ch);
                 }
                 tt_mesh_free(tris);

@@ -117,13 +117,12 @@ static void test_version(void)
 
 static void test_result_strings(void)
 {
-    /* Every code from TT_OK down to the last one, TT_ERROR_NOT_MEASURED. */
-    const char *s[19];
+    /* Every code from TT_OK down to the last one, TT_ERROR_NOT_FLAT. */
+    const char *s[20];
     const char *unknown = tt_result_string((tt_result)-99);
     int i, j, empty = 0, same = 0, generic = 0;
-    CHECK(TT_ERROR_NOT_MEASURED == -18, "TT_ERROR_NOT_MEASURED is the last code, -18 (got %d)",
-          (int)TT_ERROR_NOT_MEASURED);
-    for (i = 0; i < 19; i++) {
+    CHECK(TT_ERROR_NOT_FLAT == -19, "TT_ERROR_NOT_FLAT is the last code, -19 (got %d)", (int)TT_ERROR_NOT_FLAT);
+    for (i = 0; i < 20; i++) {
         s[i] = tt_result_string((tt_result)-i);
         if (!s[i] || !s[i][0]) { empty++; continue; }
         if (strcmp(s[i], unknown) == 0) {
@@ -133,15 +132,15 @@ static void test_result_strings(void)
     }
     CHECK(empty == 0, "%d result codes have an empty or NULL sentence", empty);
     CHECK(generic == 0, "%d result codes have no sentence of their own", generic);
-    for (i = 0; i < 19; i++)
-        for (j = i + 1; j < 19; j++)
+    for (i = 0; i < 20; i++)
+        for (j = i + 1; j < 20; j++)
             if (s[i] && s[j] && strcmp(s[i], s[j]) == 0) {
                 if (!same) DETAIL("results %d and %d share the sentence \"%s\"", -i, -j, s[i]);
                 same++;
             }
     CHECK(same == 0, "%d pairs of result codes share a sentence", same);
-    CHECK(s[18] && strcmp(s[18], tt_result_string(TT_ERROR_NOT_MEASURED)) == 0 && strlen(s[18]) > 5,
-          "TT_ERROR_NOT_MEASURED: \"%s\"", s[18] ? s[18] : "(null)");
+    CHECK(s[19] && strcmp(s[19], tt_result_string(TT_ERROR_NOT_FLAT)) == 0 && strlen(s[19]) > 5,
+          "TT_ERROR_NOT_FLAT: \"%s\"", s[19] ? s[19] : "(null)");
     CHECK(unknown && unknown[0] && tt_result_string(TT_RESULT_MAX_ENUM) && tt_result_string((tt_result)1),
           "unknown codes still get a sentence");
 }

@@ -1,5 +1,5 @@
 /* tests/test_8_hpm.c - unit tests for section 8 of tiledtex.h, hierarchical
-   pattern mapping: the face-cluster hierarchy. Run by run_hpm_tests()
+   pattern mapping: the face-cluster hierarchy and flattening. Run by run_hpm_tests()
    (tests/test_common.c calls it). Every property is recomputed here from the
    mesh's own arrays, independently of the implementation's helpers. */
 #include "test_common.h"
@@ -626,6 +626,490 @@ static void test_hpm_errors(void)
     tt_mesh_free(mesh);
 }
 
+
+/* ------------------------------------------------------------------------ */
+/* Flattening (tt_flatten_cluster)                                          */
+/* ------------------------------------------------------------------------ */
+
+static const float FLAT_SENTINEL = -12345.0f;
+
+/* A planar (nx x ny) grid of unit squares, triangulated, rotated into a
+   tilted plane (so the map's frame is not the xy plane). */
+static tt_mesh *flat_tilted_grid(int nx, int ny)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    int i, j;
+    const double c1 = cos(0.7), s1 = sin(0.7), c2 = cos(0.4), s2 = sin(0.4);
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= ny; j++)
+        for (i = 0; i <= nx; i++) {
+            double x = i, y = j, z = 0, x1 = c1 * x - s1 * y, y1 = s1 * x + c1 * y;  /* about z */
+            double y2 = c2 * y1 - s2 * z, z2 = s2 * y1 + c2 * z;                     /* about x */
+            tm_vert(&m, x1 + 3, y2 - 1, z2 + 2);
+        }
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++) {
+            int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 2, d = a + nx + 1;
+            tm_tri(&m, a, b, c);
+            tm_tri(&m, a, c, d);
+        }
+    if (build(&m, 0, &mesh, &err) != TT_OK) CHECK(0, "building the tilted grid failed: %s", err.message);
+    tm_free(&m);
+    return mesh;
+}
+
+/* A spherical cap of radius 1 and half-angle alpha: a centre vertex, nr
+   rings of nphi vertices. */
+static tt_mesh *flat_cap(double alpha, int nr, int nphi)
+{
+    const double pi = 3.14159265358979323846;
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    tm_vert(&m, 0, 0, 1);
+    for (i = 1; i <= nr; i++)
+        for (j = 0; j < nphi; j++) {
+            double t = alpha * i / nr, p = 2 * pi * j / nphi;
+            tm_vert(&m, sin(t) * cos(p), sin(t) * sin(p), cos(t));
+        }
+    for (j = 0; j < nphi; j++) tm_tri(&m, 0, 1 + j, 1 + (j + 1) % nphi);
+    for (i = 1; i < nr; i++)
+        for (j = 0; j < nphi; j++) {
+            int in0 = 1 + (i - 1) * nphi + j, in1 = 1 + (i - 1) * nphi + (j + 1) % nphi;
+            int out0 = in0 + nphi, out1 = in1 + nphi;
+            tm_tri(&m, in0, out0, out1);
+            tm_tri(&m, in0, out1, in1);
+        }
+    if (build(&m, 0, &mesh, &err) != TT_OK) CHECK(0, "building the cap failed: %s", err.message);
+    tm_free(&m);
+    return mesh;
+}
+
+/* Independent checks of a map written into uv for cluster c: counts of
+   triangles with a non-positive signed area, the largest relative edge
+   length error and the largest |corner disagreement| over shared vertices. */
+static void flat_measure(const tt_mesh *m, const tt_cluster_hierarchy *h, int c, const float *uv, int *flips,
+                         double *max_edge_error, double *mapped_area)
+{
+    const tt_cluster *C = &h->clusters[c];
+    int i, k;
+    *flips = 0;
+    *max_edge_error = 0;
+    *mapped_area = 0;
+    for (i = 0; i < C->nfaces; i++) {
+        int f = h->faces[C->first_face + i], c0 = m->face_start[f];
+        const float *u0 = uv + 2 * c0, *u1 = uv + 2 * (c0 + 1), *u2 = uv + 2 * (c0 + 2);
+        double a = 0.5 * (((double)u1[0] - u0[0]) * ((double)u2[1] - u0[1]) -
+                          ((double)u2[0] - u0[0]) * ((double)u1[1] - u0[1]));
+        *mapped_area += a;
+        if (!(a > 0)) (*flips)++;
+        for (k = 0; k < 3; k++) {
+            int ca = c0 + k, cb = c0 + (k + 1) % 3, va = m->corner_vert[ca], vb = m->corner_vert[cb];
+            double dx = m->pos[3 * va] - m->pos[3 * vb], dy = m->pos[3 * va + 1] - m->pos[3 * vb + 1];
+            double dz = m->pos[3 * va + 2] - m->pos[3 * vb + 2], L3 = sqrt(dx * dx + dy * dy + dz * dz);
+            double du = (double)uv[2 * ca] - uv[2 * cb], dv = (double)uv[2 * ca + 1] - uv[2 * cb + 1];
+            double e = fabs(sqrt(du * du + dv * dv) - L3) / L3;
+            if (e > *max_edge_error) *max_edge_error = e;
+        }
+    }
+}
+
+static float *flat_uv(const tt_mesh *m)
+{
+    float *uv = (float *)malloc(sizeof(float) * 2 * (size_t)m->ncorners);
+    int i;
+    for (i = 0; uv && i < 2 * m->ncorners; i++) uv[i] = FLAT_SENTINEL;
+    return uv;
+}
+
+/* (8) T5: a planar disc maps isometrically at every level, in both border
+   modes where the border between control vertices is straight, and in the
+   projected mode whatever the border's shape. */
+static void test_flatten_plane(void)
+{
+    tt_mesh *m = flat_tilted_grid(20, 20);
+    tt_cluster_hierarchy *h = m ? hpm_build(m, 7) : NULL;
+    float *uv = m ? flat_uv(m) : NULL;
+    tt_flatten_report rep;
+    tt_flatten_options opt;
+    tt_error err;
+    tt_result r;
+    int c, mapped = 0, refused = 0, flips, bad = 0;
+    double worst_e = 0, worst_len = 0, worst_stretch = 0, edge, area;
+    if (!h || !uv) goto end;
+    for (c = 0; c < h->nclusters; c++) {
+        if (!(h->clusters[c].flags & TT_CLUSTER_MAPPABLE)) continue;
+        r = tt_flatten_cluster(m, h, c, NULL, NULL, uv, &rep, &err);
+        if (r != TT_OK) {
+            if (!refused) DETAIL("cluster %d (level %d) refused: %s", c, h->clusters[c].level, err.message);
+            refused++;
+            continue;
+        }
+        mapped++;
+        flat_measure(m, h, c, uv, &flips, &edge, &area);
+        if (flips) bad++;
+        if (rep.flattening_error > worst_e) worst_e = rep.flattening_error;
+        if (edge > worst_len) worst_len = edge;
+        if (rep.max_stretch - 1 > worst_stretch) worst_stretch = rep.max_stretch - 1;
+    }
+    CHECK(mapped > 100 && refused == 0, "planar grid: %d clusters mapped, %d refused", mapped, refused);
+    CHECK(worst_e < 1e-9, "planar grid: E_flat %.3g (< 1e-9)", worst_e);
+    /* positions are floats, so a rotated grid is planar to about 1e-7 */
+    CHECK(worst_stretch < 1e-5, "planar grid: stretch 1 + %.3g", worst_stretch);
+    CHECK(worst_len < 1e-5, "planar grid: the UVs keep every edge length (worst relative error %.3g)", worst_len);
+    CHECK(bad == 0, "planar grid: %d maps with a flipped triangle", bad);
+
+    /* The whole square with its 4 corners as control vertices (hand-made):
+       the borders between them are straight, so the chord mode is isometric
+       too, up to the float rounding of the rotated positions (the chord
+       lengths the polygon is fitted to carry it: E_flat about 4e-8). */
+    {
+        tt_cluster_hierarchy fake = *h;
+        tt_cluster one = h->clusters[0];
+        int corner_ids[4] = {0, 20, 21 * 21 - 1, 21 * 20};
+        one.first_control = 0;
+        one.ncontrol = 4;
+        fake.clusters = &one;
+        fake.nclusters = 1;
+        fake.control = corner_ids;
+        fake.ncontrol = 4;
+        memset(&opt, 0, sizeof opt);
+        opt.border = TT_FLATTEN_BORDER_CHORD;
+        r = tt_flatten_cluster(m, &fake, 0, &opt, NULL, uv, &rep, &err);
+        flat_measure(m, &fake, 0, uv, &flips, &edge, &area);
+        CHECK(r == TT_OK && rep.mapped && rep.flattening_error < 1e-6 && rep.max_stretch < 1 + 1e-5 &&
+                  rep.stretch_p95 < 1 + 1e-5 && edge < 1e-5 && flips == 0 && rep.ninterior == 19 * 19 &&
+                  rep.nborder == 80 && rep.cg_iterations > 0,
+              "chord mode, whole square: %d, E %.3g, stretch %.9g, edge error %.3g, %d interior, %d border, %d "
+              "CG steps (%s)",
+              r, rep.flattening_error, rep.max_stretch, edge, rep.ninterior, rep.nborder, rep.cg_iterations,
+              err.message);
+    }
+end:
+    free(uv);
+    tt_cluster_hierarchy_free(h);
+    tt_mesh_free(m);
+}
+
+/* (9) T5: spherical caps. E_flat follows tan^2(alpha/2) (the cap's border
+   circle projects onto itself, so this holds whatever the control
+   vertices), within 0.5 % + 1e-4 for 32 rings of 128 (measured: 0.01 %;
+   the polyhedral cap's area and the 128-gon's fall short of the smooth ones
+   alike); the 0.10 threshold accepts 20, 30 and 35 degrees (E_flat 0.0994)
+   and refuses 40 and 50; no map has a flipped triangle. */
+static void test_flatten_caps(void)
+{
+    const double pi = 3.14159265358979323846;
+    static const double degrees[5] = {20, 30, 35, 40, 50};
+    int i;
+    for (i = 0; i < 5; i++) {
+        double alpha = degrees[i] * pi / 180, expect = tan(alpha / 2) * tan(alpha / 2), edge, area;
+        tt_mesh *m = flat_cap(alpha, 32, 128);
+        tt_cluster_hierarchy *h = m ? hpm_build(m, 1) : NULL;
+        float *uv = m ? flat_uv(m) : NULL;
+        tt_flatten_options opt;
+        tt_flatten_report rep, rep2;
+        tt_error err;
+        tt_result r, r2;
+        int flips = -1;
+        if (!h || !uv) {
+            free(uv);
+            tt_cluster_hierarchy_free(h);
+            tt_mesh_free(m);
+            continue;
+        }
+        memset(&opt, 0, sizeof opt);
+        opt.max_error = 1e300 * 1e300;   /* +infinity: no limit, so the map always comes back */
+        r = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep, &err);
+        if (r == TT_OK) flat_measure(m, h, 0, uv, &flips, &edge, &area);
+        CHECK(r == TT_OK && rep.mapped && flips == 0 && rep.flipped == 0 &&
+                  fabs(rep.flattening_error - expect) <= 0.005 * expect + 1e-4 &&
+                  fabs(area - rep.mapped_area) <= 1e-5 * area,
+              "cap %g deg: %d, E_flat %.5f, tan^2(alpha/2) %.5f, %d flips (%s)", degrees[i], r, rep.flattening_error,
+              expect, flips, err.message);
+        r2 = tt_flatten_cluster(m, h, 0, NULL, NULL, uv, &rep2, &err);
+        CHECK((degrees[i] <= 35) == (r2 == TT_OK) &&
+                  (r2 == TT_OK || (r2 == TT_ERROR_NOT_FLAT && err.result == r2 && err.item == 0 &&
+                                   rep2.mapped && rep2.flattening_error > TT_DEFAULT_FLATTEN_MAX_ERROR)),
+              "cap %g deg at the default threshold: %d, E_flat %.4f (%s)", degrees[i], r2, rep2.flattening_error,
+              err.message);
+        /* The shear check: a cap stretches a little, a limit of 1.0001 refuses it. */
+        opt.max_stretch = 1.0001;
+        r2 = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep2, &err);
+        CHECK(r2 == TT_ERROR_NOT_FLAT && rep2.stretch_p95 > 1.0001 && rep2.stretch_p95 < 2 &&
+                  rep2.max_stretch >= rep2.stretch_p95,
+              "cap %g deg with max_stretch 1.0001: %d, p95 %.5f, max %.5f", degrees[i], r2, rep2.stretch_p95,
+              rep2.max_stretch);
+        free(uv);
+        tt_cluster_hierarchy_free(h);
+        tt_mesh_free(m);
+    }
+}
+
+/* (10) Folds and polygons that are not simple: a hand-made hierarchy with 3
+   control vertices on a planar square, (0,0), (n,0), (n,n): in the chord
+   mode the top and left borders collapse onto the diagonal and the corner
+   triangle between them loses all its area (refused, the folded face
+   named); in the
+   projected mode the same cluster is isometric. Sheets rolled round a
+   cylinder: the projected border, or the control polygon, is not simple. */
+static void test_flatten_folds(void)
+{
+    tt_mesh *m = flat_tilted_grid(8, 8);
+    tt_cluster_hierarchy *h = m ? hpm_build(m, 3) : NULL;
+    float *uv = m ? flat_uv(m) : NULL;
+    tt_cluster_hierarchy fake;
+    tt_cluster one;
+    int ctl[3] = {0, 8, 80}, i, untouched = 1, flips;
+    tt_flatten_options opt;
+    tt_flatten_report rep;
+    tt_error err;
+    tt_result r;
+    double edge, area;
+    if (h && uv) {
+        fake = *h;
+        one = h->clusters[0];
+        one.first_control = 0;
+        one.ncontrol = 3;
+        fake.clusters = &one;
+        fake.nclusters = 1;
+        fake.control = ctl;
+        fake.ncontrol = 3;
+        memset(&opt, 0, sizeof opt);
+        opt.border = TT_FLATTEN_BORDER_CHORD;
+        r = tt_flatten_cluster(m, &fake, 0, &opt, NULL, uv, &rep, &err);
+        for (i = 0; i < 2 * m->ncorners; i++) untouched &= uv[i] == FLAT_SENTINEL;
+        CHECK(r == TT_ERROR_NOT_FLAT && err.result == r && rep.mapped && rep.polygon_simple && rep.flipped >= 1 &&
+                  err.face >= 0 && err.item == 0 && untouched,
+              "chord mode over a triangle of corners: %d, %d flipped, face %d, corner_uv untouched %d (%s)", r,
+              rep.flipped, err.face, untouched, err.message);
+        r = tt_flatten_cluster(m, &fake, 0, NULL, NULL, uv, &rep, &err);
+        flat_measure(m, &fake, 0, uv, &flips, &edge, &area);
+        CHECK(r == TT_OK && rep.flattening_error < 1e-9 && flips == 0 && edge < 1e-5,
+              "projected mode, same cluster: %d, E %.3g, edge error %.3g (%s)", r, rep.flattening_error, edge,
+              err.message);
+    }
+    free(uv);
+    tt_cluster_hierarchy_free(h);
+    tt_mesh_free(m);
+
+    {
+        /* 240 degrees: the 4 corners make a fine rectangle but the border arcs
+           fold back in projection; 300 degrees: the rectangle itself turns
+           clockwise. */
+        const double pi = 3.14159265358979323846;
+        static const double arcs[2] = {240, 300};
+        static const char *const what[2] = {"its border", "its control polygon"};
+        int a;
+        for (a = 0; a < 2; a++) {
+            tmesh q;
+            int j, nu = 40, nv = 4;
+            memset(&q, 0, sizeof q);
+            for (j = 0; j <= nv; j++)
+                for (i = 0; i <= nu; i++) {
+                    double t = arcs[a] / 180.0 * pi * i / nu;
+                    tm_vert(&q, cos(t), sin(t), 0.5 * j);
+                }
+            for (j = 0; j < nv; j++)
+                for (i = 0; i < nu; i++) {
+                    int v0 = j * (nu + 1) + i, v1 = v0 + 1, v2 = v0 + nu + 2, v3 = v0 + nu + 1;
+                    tm_tri(&q, v0, v1, v2);
+                    tm_tri(&q, v0, v2, v3);
+                }
+            m = NULL;
+            if (build(&q, 0, &m, &err) != TT_OK) CHECK(0, "building the rolled sheet: %s", err.message);
+            tm_free(&q);
+            h = m ? hpm_build(m, 1) : NULL;
+            uv = m ? flat_uv(m) : NULL;
+            if (h && uv) {
+                r = tt_flatten_cluster(m, h, 0, NULL, NULL, uv, &rep, &err);
+                CHECK(r == TT_ERROR_NOT_FLAT && !rep.mapped && !rep.polygon_simple && rep.nborder > 0 &&
+                          uv[0] == FLAT_SENTINEL && strstr(err.message, what[a]) && strstr(err.message, "not simple"),
+                      "a sheet rolled %g degrees: %d, mapped %d, simple %d (%s)", arcs[a], r, rep.mapped,
+                      rep.polygon_simple, err.message);
+            }
+            free(uv);
+            tt_cluster_hierarchy_free(h);
+            tt_mesh_free(m);
+        }
+    }
+}
+
+/* (11) Refusals, corners outside the cluster, determinism. */
+static void test_flatten_clusters(void)
+{
+    tt_mesh *torus = hpm_mesh(M_TORUS), *holes = hpm_mesh(M_HOLES), *sphere = hpm_mesh(M_SPHERE);
+    tt_cluster_hierarchy *ht = torus ? hpm_build(torus, 2) : NULL, *hh = holes ? hpm_build(holes, 2) : NULL;
+    float *uv = sphere ? flat_uv(sphere) : NULL, *uv2 = sphere ? flat_uv(sphere) : NULL, *uvt = torus ? flat_uv(torus) : NULL;
+    tt_cluster_hierarchy *hs = sphere ? hpm_build(sphere, 2) : NULL;
+    tt_flatten_report rep, rep2;
+    tt_error err;
+    tt_result r, r2;
+    int c, i, touched = 0, missing = 0, differ = 0, ok = 0, notflat = 0, tested = 0;
+    if (ht && uvt) {
+        r = tt_flatten_cluster(torus, ht, 0, NULL, NULL, uvt, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.item == 0 && !rep.mapped && uvt[0] == FLAT_SENTINEL &&
+                  strstr(err.message, "not mappable"),
+              "the torus's closed top cluster: %d (%s)", r, err.message);
+    }
+    if (hh) {
+        float *uvh = flat_uv(holes);
+        CHECK(!(hh->clusters[0].flags & TT_CLUSTER_DISC), "the grid with two holes is not a disc");
+        r = tt_flatten_cluster(holes, hh, 0, NULL, NULL, uvh, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.item == 0 && strstr(err.message, "not a disc") && uvh &&
+                  uvh[0] == FLAT_SENTINEL,
+              "a cluster with three border loops: %d (%s)", r, err.message);
+        free(uvh);
+    }
+    if (hs && uv && uv2) {
+        r = tt_flatten_cluster(sphere, hs, 0, NULL, NULL, uv, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.item == 0, "the sphere's closed top cluster: %d", r);
+        /* every mappable cluster of level 2, one at a time into fresh buffers */
+        for (c = hs->level_start[2]; c < hs->level_start[3] && c < hs->nclusters; c++) {
+            const tt_cluster *C = &hs->clusters[c];
+            if (!(C->flags & TT_CLUSTER_MAPPABLE)) continue;
+            for (i = 0; i < 2 * sphere->ncorners; i++) uv[i] = uv2[i] = FLAT_SENTINEL;
+            r = tt_flatten_cluster(sphere, hs, c, NULL, NULL, uv, &rep, &err);
+            r2 = tt_flatten_cluster(sphere, hs, c, NULL, NULL, uv2, &rep2, &err);
+            tested++;
+            if (r != r2 || memcmp(uv, uv2, sizeof(float) * 2 * (size_t)sphere->ncorners) != 0 ||
+                memcmp(&rep, &rep2, sizeof rep) != 0)
+                differ++;
+            if (r == TT_OK) {
+                int f, k, j;
+                ok++;
+                for (f = 0; f < sphere->nfaces; f++) {
+                    int in = 0;
+                    for (j = 0; j < C->nfaces; j++) in |= hs->faces[C->first_face + j] == f;
+                    for (k = 0; k < 3; k++) {
+                        int cc = sphere->face_start[f] + k;
+                        if (!in && (uv[2 * cc] != FLAT_SENTINEL || uv[2 * cc + 1] != FLAT_SENTINEL)) touched++;
+                        if (in && (uv[2 * cc] == FLAT_SENTINEL || !(fabs(uv[2 * cc]) < 100))) missing++;
+                    }
+                }
+                if (rep.flipped != 0) missing++;
+            } else if (r == TT_ERROR_NOT_FLAT) {
+                notflat++;
+                for (i = 0; i < 2 * sphere->ncorners; i++) touched += uv[i] != FLAT_SENTINEL;
+            } else {
+                DETAIL("cluster %d: unexpected %d (%s)", c, r, err.message);
+                missing++;
+            }
+        }
+        CHECK(tested > 5 && ok > 0, "sphere level 2: %d clusters, %d mapped, %d not flat", tested, ok, notflat);
+        CHECK(touched == 0 && missing == 0, "sphere level 2: %d corners outside written, %d inside missing", touched,
+              missing);
+        CHECK(differ == 0, "sphere level 2: %d clusters flatten differently on a second run", differ);
+    }
+    free(uv);
+    free(uv2);
+    free(uvt);
+    tt_cluster_hierarchy_free(ht);
+    tt_cluster_hierarchy_free(hh);
+    tt_cluster_hierarchy_free(hs);
+    tt_mesh_free(torus);
+    tt_mesh_free(holes);
+    tt_mesh_free(sphere);
+}
+
+typedef struct flat_oom_ctx {
+    const tt_mesh *mesh;
+    const tt_cluster_hierarchy *h;
+    int cluster;
+    float *uv;
+} flat_oom_ctx;
+
+static tt_result flat_oom_call(void *ctx, const tt_allocator *al)
+{
+    flat_oom_ctx *c = (flat_oom_ctx *)ctx;
+    tt_flatten_report rep;
+    tt_error err;
+    int i;
+    tt_result r;
+    for (i = 0; i < 2 * c->mesh->ncorners; i++) c->uv[i] = FLAT_SENTINEL;
+    r = tt_flatten_cluster(c->mesh, c->h, c->cluster, NULL, al, c->uv, &rep, &err);
+    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    if (r != TT_OK)
+        for (i = 0; i < 2 * c->mesh->ncorners; i++)
+            if (c->uv[i] != FLAT_SENTINEL) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+/* (12) Errors, and every allocation failing in turn. */
+static void test_flatten_errors(void)
+{
+    tt_mesh *m = flat_tilted_grid(6, 6), *other = flat_tilted_grid(5, 6);
+    tt_cluster_hierarchy *h = m ? hpm_build(m, 4) : NULL;
+    float *uv = m ? flat_uv(m) : NULL;
+    tt_flatten_options opt;
+    tt_flatten_report rep;
+    tt_allocator half;
+    tt_error err;
+    tt_result r;
+    flat_oom_ctx ctx;
+    if (!h || !uv || !other) goto end;
+    r = tt_flatten_cluster(NULL, h, 0, NULL, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0], "NULL mesh: %d", r);
+    r = tt_flatten_cluster(m, NULL, 0, NULL, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r, "NULL hierarchy: %d", r);
+    r = tt_flatten_cluster(m, h, 0, NULL, NULL, NULL, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r, "NULL corner_uv: %d", r);
+    r = tt_flatten_cluster(m, h, -1, NULL, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.item == -1 && err.result == r, "cluster -1: %d", r);
+    r = tt_flatten_cluster(m, h, h->nclusters, NULL, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.item == h->nclusters && msg_has_number(err.message, h->nclusters),
+          "cluster nclusters: %d (%s)", r, err.message);
+    r = tt_flatten_cluster(other, h, 0, NULL, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r, "a hierarchy of another mesh: %d (%s)", r,
+          err.message);
+    memset(&half, 0, sizeof half);
+    half.free = hpm_free_only;
+    r = tt_flatten_cluster(m, h, 0, NULL, &half, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && strstr(err.message, "alloc"),
+          "an allocator with free only: %d", r);
+    memset(&opt, 0, sizeof opt);
+    opt.max_error = -1;
+    r = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "max_error -1: %d", r);
+    opt.max_error = 0;
+    opt.max_stretch = 0.5;
+    r = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "max_stretch 0.5: %d", r);
+    opt.max_stretch = 0;
+    opt.border = 2;
+    r = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "border 2: %d", r);
+    opt.border = 0;
+    opt.cg_tolerance = 1;
+    r = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "cg_tolerance 1: %d", r);
+    opt.cg_tolerance = 0;
+    opt.cg_max_iterations = 1;
+    r = tt_flatten_cluster(m, h, 0, &opt, NULL, uv, &rep, &err);
+    CHECK(r == TT_ERROR_NOT_CONVERGED && err.result == r && uv[0] == FLAT_SENTINEL,
+          "one CG step: %d (%s)", r, err.message);
+    r = tt_flatten_cluster(m, h, 0, NULL, NULL, uv, NULL, NULL);
+    CHECK(r == TT_OK, "NULL report and error: %d", r);
+    CHECK(strcmp(tt_result_string(TT_ERROR_NOT_FLAT), tt_result_string(TT_ERROR_INVALID_ARGUMENT)) != 0,
+          "TT_ERROR_NOT_FLAT has its own sentence");
+
+    ctx.mesh = m;
+    ctx.h = h;
+    ctx.cluster = 0;
+    ctx.uv = uv;
+    oom_reset();
+    oom_sweep("tt_flatten_cluster(6 x 6 grid)", flat_oom_call, &ctx, TT_OK);
+end:
+    free(uv);
+    tt_cluster_hierarchy_free(h);
+    tt_mesh_free(m);
+    tt_mesh_free(other);
+}
+
 void run_hpm_tests(void)
 {
     RUN(test_hpm_properties);
@@ -633,4 +1117,9 @@ void run_hpm_tests(void)
     RUN(test_hpm_determinism);
     RUN(test_hpm_uniform);
     RUN(test_hpm_errors);
+    RUN(test_flatten_plane);
+    RUN(test_flatten_caps);
+    RUN(test_flatten_folds);
+    RUN(test_flatten_clusters);
+    RUN(test_flatten_errors);
 }
