@@ -30,10 +30,10 @@ demo: deps build/tiledtex
 test: test-deps
 	@bash tests/run.sh
 
-build/bench: bench/bench.c tiledtex.h | build
+build/bench: bench/bench.c bench/bench_clock.h tiledtex.h | build
 	$(CC) -O2 -g $(WARN) -I. bench/bench.c -o $@ -lm
 
-build/bench_cg: bench/bench_cg.c bench/bench_cg_problem.h tiledtex.h | build
+build/bench_cg: bench/bench_cg.c bench/bench_cg_problem.h bench/bench_clock.h tiledtex.h | build
 	$(CC) -O2 -g $(WARN) -I. bench/bench_cg.c -o $@ -lm
 
 # The optional peer: the same CG system solved by Eigen, when Debian's
@@ -42,24 +42,24 @@ EIGEN_INC := $(wildcard /usr/include/eigen3)
 build/bench_cg_eigen: bench/bench_cg_eigen.cpp bench/bench_cg_problem.h | build
 	$(CXX) -O2 -DNDEBUG -I$(EIGEN_INC) -Ibench bench/bench_cg_eigen.cpp -o $@
 
-build/bench_fft: bench/bench_fft.c tiledtex.h | build
+build/bench_fft: bench/bench_fft.c bench/bench_clock.h tiledtex.h | build
 	$(CC) -O2 -g $(WARN) -I. bench/bench_fft.c -o $@ -lm
 
 # The optional peer: the same transforms through FFTW's FFTW_MEASURE plans,
 # timed in the same process, when Debian's libfftw3-dev is installed (the
 # target is ours within 3x of it). FFTW is GPL: a bench peer only.
 FFTW_INC := $(wildcard /usr/include/fftw3.h)
-build/bench_fft_fftw: bench/bench_fft.c tiledtex.h | build
+build/bench_fft_fftw: bench/bench_fft.c bench/bench_clock.h tiledtex.h | build
 	$(CC) -O2 -g $(WARN) -I. -DBENCH_FFTW bench/bench_fft.c -o $@ -lfftw3 -lm
 
-build/bench_build: bench/bench_build.c bench/bench_build_meshes.h bench/bench_radix_pairing.h tiledtex.h | build
+build/bench_build: bench/bench_build.c bench/bench_build_meshes.h bench/bench_clock.h bench/bench_radix_pairing.h tiledtex.h | build
 	$(CC) -O2 -g $(WARN) -I. bench/bench_build.c -o $@ -lm
 
 # The optional peer of bench_build: CGAL's Surface_mesh built from the same
 # meshes, when Debian's libcgal-dev is installed (the target is tiledtex 2x
 # faster on the grid and soup meshes, 1.5x on the shuffled one).
 CGAL_INC := $(wildcard /usr/include/CGAL)
-build/bench_build_cgal: bench/bench_build_cgal.cpp bench/bench_build_meshes.h tiledtex.h | build
+build/bench_build_cgal: bench/bench_build_cgal.cpp bench/bench_build_meshes.h bench/bench_clock.h tiledtex.h | build
 	$(CXX) -O2 -DNDEBUG -I. -Ibench bench/bench_build_cgal.cpp -o $@
 
 bench: deps build/bench build/bench_cg $(if $(EIGEN_INC),build/bench_cg_eigen) $(if $(FFTW_INC),build/bench_fft_fftw,build/bench_fft) build/bench_build $(if $(CGAL_INC),build/bench_build_cgal) build/tiledtex

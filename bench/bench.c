@@ -37,6 +37,7 @@
 #define _POSIX_C_SOURCE 199309L
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
+#include "bench_clock.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -53,13 +54,6 @@
 #define SLOW_MS 2500.0      /* a warm-up slower than this gets a single timed run */
 
 static int bench_failed = 0;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 static void *xmalloc(size_t size)
 {
@@ -123,12 +117,6 @@ static int wanted(const char *name)
 /* One run: do untimed setup, time the work, do untimed teardown; return ms. */
 typedef double (*run_fn)(void *ctx);
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static double median_ms(run_fn fn, void *ctx, int runs)
 {
     double t[16];
@@ -137,7 +125,7 @@ static double median_ms(run_fn fn, void *ctx, int runs)
     if (warm > SLOW_MS) runs = 1;
     if (runs > 16) runs = 16;
     for (i = 0; i < runs; ++i) t[i] = fn(ctx);
-    qsort(t, (size_t)runs, sizeof t[0], cmp_double);
+    qsort(t, (size_t)runs, sizeof t[0], bench_cmp_double);
     return t[runs / 2];
 }
 
@@ -287,9 +275,9 @@ static double run_build(void *p)
     tt_mesh_desc d = grid_desc(ctx->grid);
     tt_mesh *mesh = NULL;
     tt_error err;
-    double t0 = now_ms(), t1;
+    double t0 = bench_now_ms(), t1;
     tt_result r = tt_mesh_build(&d, NULL, &mesh, &err);
-    t1 = now_ms();
+    t1 = bench_now_ms();
     if (r != TT_OK) fail("tt_mesh_build", r, &err);
     tt_mesh_free(mesh);
     return t1 - t0;
@@ -310,10 +298,10 @@ static double run_assign(void *p)
     tt_result r;
     double t0, t1;
     memset(&layout, 0, sizeof layout);
-    t0 = now_ms();
+    t0 = bench_now_ms();
     r = tt_assign_boundaries(ctx->mesh, &layout, ctx->seed++, NULL, ctx->types, &err);
     if (r == TT_OK) r = tt_assign_uvs(ctx->mesh, &layout, ctx->types, ctx->uv, &err);
-    t1 = now_ms();
+    t1 = bench_now_ms();
     if (r != TT_OK) fail("tt_assign_boundaries / tt_assign_uvs", r, NULL);
     return t1 - t0;
 }
@@ -330,14 +318,14 @@ static double run_build_assign(void *p)
     tt_result r;
     double t0, t1;
     memset(&layout, 0, sizeof layout);
-    t0 = now_ms();
+    t0 = bench_now_ms();
     r = tt_mesh_build(&d, NULL, &mesh, &err);
     if (r != TT_OK) fail("tt_mesh_build", r, &err);
     types = (uint8_t *)xmalloc((size_t)mesh->ncorners);
     uv = (float *)xmalloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
     r = tt_assign_boundaries(mesh, &layout, 42, NULL, types, &err);
     if (r == TT_OK) r = tt_assign_uvs(mesh, &layout, types, uv, &err);
-    t1 = now_ms();
+    t1 = bench_now_ms();
     if (r != TT_OK) fail("tt_assign_boundaries / tt_assign_uvs", r, NULL);
     free(uv);
     free(types);
@@ -352,12 +340,12 @@ static double run_memcpy(void *p)
     size_t pbytes = sizeof(float) * 3 * (size_t)ctx->grid->nverts;
     int *idx;
     float *pos;
-    double t0 = now_ms(), t1;
+    double t0 = bench_now_ms(), t1;
     idx = (int *)xmalloc(ibytes);
     pos = (float *)xmalloc(pbytes);
     memcpy(idx, ctx->grid->idx, ibytes);
     memcpy(pos, ctx->grid->pos, pbytes);
-    t1 = now_ms();
+    t1 = bench_now_ms();
     /* keep the copy observable so it cannot be optimised away */
     if (idx[ctx->grid->nfaces] != ctx->grid->idx[ctx->grid->nfaces] || pos[1] != ctx->grid->pos[1])
         fail("memcpy check", TT_OK, NULL);
@@ -375,9 +363,9 @@ static double run_quadrangulate(void *p)
     quad_ctx *ctx = (quad_ctx *)p;
     tt_mesh *out = NULL;
     tt_error err;
-    double t0 = now_ms(), t1;
+    double t0 = bench_now_ms(), t1;
     tt_result r = tt_mesh_quadrangulate(ctx->mesh, TT_SUBDIVIDE_LINEAR, NULL, &out, &err);
-    t1 = now_ms();
+    t1 = bench_now_ms();
     if (r != TT_OK) fail("tt_mesh_quadrangulate", r, &err);
     tt_mesh_free(out);
     return t1 - t0;
@@ -401,9 +389,9 @@ static double run_synth(void *p)
     opt.layout.colors = ctx->colors;
     opt.layout.tile_size = ctx->tile_size;
     opt.seed = ctx->seed++;
-    t0 = now_ms();
+    t0 = bench_now_ms();
     r = tt_synthesize_tiles(ctx->source, &opt, NULL, &tiles, &err);
-    t1 = now_ms();
+    t1 = bench_now_ms();
     if (r != TT_OK) fail("tt_synthesize_tiles", r, &err);
     tt_tileset_free(tiles);
     return t1 - t0;
@@ -428,13 +416,13 @@ static double run_lapped(void *p)
     tt_lapped_options options;
     tt_error err;
     tt_result r;
-    double t0 = now_ms(), t1;
+    double t0 = bench_now_ms(), t1;
     r = tt_tangent_field(c->mesh, NULL, NULL, c->field, &err);
     if (r != TT_OK) fail("tt_tangent_field", r, &err);
     memset(&options, 0, sizeof options);
     options.seed = 1;
     r = tt_lapped_paste(c->mesh, c->field, &c->patch, 1, &options, NULL, &lapped, &err);
-    t1 = now_ms();
+    t1 = bench_now_ms();
     if (r != TT_OK) fail("tt_lapped_paste", r, &err);
     c->pastes = lapped->npastes;
     c->angle = lapped->mean_angle_error;

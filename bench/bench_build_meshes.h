@@ -26,7 +26,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include "bench_clock.h"
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
@@ -186,13 +186,6 @@ static void bench_make_meshes(bench_mesh *m)
 
 /* ---- clock, memory state, runs ---------------------------------------------- */
 
-static double bench_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
 /* Cold: every big block is a fresh mapping (page faults paid in the run).
    Warm: every block comes from the heap (mmap off, so even blocks over
    glibc's 32 MB mmap ceiling) and stays there after free, so a run reuses the
@@ -214,12 +207,6 @@ static void bench_malloc_warm(void)
     mallopt(M_MMAP_MAX, 0);
     mallopt(M_TRIM_THRESHOLD, 1 << 30);
 #endif
-}
-
-static int bench_cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 static double bench_median(double *t, int n)

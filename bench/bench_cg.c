@@ -18,6 +18,7 @@
 #define _POSIX_C_SOURCE 199309L
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
+#include "bench_clock.h"
 #include "bench_cg_problem.h"
 
 #include <stdio.h>
@@ -25,19 +26,6 @@
 #include <time.h>
 
 #define RUNS 5
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 int main(void)
 {
@@ -76,9 +64,9 @@ int main(void)
     for (run = 0; run <= RUNS; run++) {   /* run 0 warms up */
         double start;
         memset(x, 0, sizeof(double) * (size_t)n);
-        start = now_ms();
+        start = bench_now_ms();
         r = tt_cg_solve(A, b, &opt, NULL, x, &rep, &error);
-        ms[run] = now_ms() - start;
+        ms[run] = bench_now_ms() - start;
         if (r != TT_OK) {
             fprintf(stderr, "bench_cg: tt_cg_solve: %s\n", error.message);
             return 1;
@@ -88,7 +76,7 @@ int main(void)
     }
     for (i = 0; i < n; i++)
         if (fabs(x[i] - xs[i]) > err) err = fabs(x[i] - xs[i]);
-    qsort(ms + 1, RUNS, sizeof ms[0], cmp_double);
+    qsort(ms + 1, RUNS, sizeof ms[0], bench_cmp_double);
     printf("cg_laplacian_100k %.1f ms\n", ms[1 + RUNS / 2]);
     printf("cg_laplacian_100k %d iterations\n", iterations);
     fprintf(stderr, "bench_cg: %d unknowns, %d entries; runs %.1f..%.1f ms (warm-up %.1f); %.3f ms a step; "

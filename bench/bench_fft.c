@@ -23,6 +23,7 @@
 #define _POSIX_C_SOURCE 199309L
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
+#include "bench_clock.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,23 +35,10 @@
 
 #define REPS 31
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* Sorts ms[0 .. REPS-1]; the minimum is then ms[0]. */
 static double median(double *ms)
 {
-    qsort(ms, REPS, sizeof ms[0], cmp_double);
+    qsort(ms, REPS, sizeof ms[0], bench_cmp_double);
     return ms[REPS / 2];
 }
 
@@ -81,10 +69,10 @@ static int bench_size(int n)
         return 1;
     }
 #ifdef BENCH_FFTW
-    start = now_ms();
+    start = bench_now_ms();
     forward = fftw_plan_dft_2d(n, n, buf, buf, FFTW_FORWARD, FFTW_MEASURE);
     inverse = fftw_plan_dft_2d(n, n, buf, buf, FFTW_BACKWARD, FFTW_MEASURE);
-    fprintf(stderr, "bench_fft: FFTW_MEASURE planning at %d x %d took %.0f ms (not timed)\n", n, n, now_ms() - start);
+    fprintf(stderr, "bench_fft: FFTW_MEASURE planning at %d x %d took %.0f ms (not timed)\n", n, n, bench_now_ms() - start);
     /* The two forward transforms agree? */
     memcpy(ours, input, sizeof(double) * count);
     memcpy(buf, input, sizeof(double) * count);
@@ -102,19 +90,19 @@ static int bench_size(int n)
 #endif
     for (rep = -1; rep < REPS; rep++) {   /* rep -1 warms up */
         memcpy(ours, input, sizeof(double) * count);
-        start = now_ms();
+        start = bench_now_ms();
         if (tt_fft_c2c(plan, ours, n, n, TT_FFT_FORWARD, &err) != TT_OK ||
             tt_fft_c2c(plan, ours, n, n, TT_FFT_INVERSE, &err) != TT_OK) {
             fprintf(stderr, "bench_fft: %s\n", err.message);
             return 1;
         }
-        if (rep >= 0) ms[rep] = now_ms() - start;
+        if (rep >= 0) ms[rep] = bench_now_ms() - start;
 #ifdef BENCH_FFTW
         memcpy(buf, input, sizeof(double) * count);
-        start = now_ms();
+        start = bench_now_ms();
         fftw_execute(forward);
         fftw_execute(inverse);
-        if (rep >= 0) peer[rep] = now_ms() - start;
+        if (rep >= 0) peer[rep] = bench_now_ms() - start;
 #endif
     }
     if (ours[7] / ((double)n * n) - input[7] > 1e-12 || ours[7] / ((double)n * n) - input[7] < -1e-12) {
@@ -167,12 +155,12 @@ static int bench_xcorr(int n)
     work = (double *)malloc(sizeof(double) * tex->work_size);
     if (!work) return 1;
     for (rep = -1; rep < REPS; rep++) {
-        start = now_ms();
+        start = bench_now_ms();
         if (tt_xcorr_masked(tex, mask, values, NULL, work, map, &match, &err) != TT_OK) {
             fprintf(stderr, "bench_fft: %s\n", err.message);
             return 1;
         }
-        if (rep >= 0) ms[rep] = now_ms() - start;
+        if (rep >= 0) ms[rep] = bench_now_ms() - start;
     }
     if (match.x != 123 || match.y != 77) {
         fprintf(stderr, "bench_fft: the planted offset (123, 77) came out as (%d, %d)\n", match.x, match.y);
