@@ -1786,6 +1786,137 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
                                    const tt_flatten_options *options, const tt_allocator *allocator,
                                    float *corner_uv, tt_flatten_report *report, tt_error *error);
 
+/* ---- The pipeline: tt_hpm_map (Sec. 2.2, 4; spec D2-D8, D15-D17, D22-D33) ----
+
+   tt_hpm_map textures a triangle mesh with texture coordinates into the
+   original image: no new texture is made. Coarse to fine, each cluster of
+   the hierarchy is flattened (above) and placed on the image where its
+   content best continues the already textured neighbours:
+     1. The matching copy of the image (D3, D30): r, g, b as displayed
+        (sRGB-encoded) turned into Y, Cb, Cr - a Euclidean colour space, so
+        squared differences add up; one channel (Y) for a grey image - and
+        box-filtered by 2^k until its larger side is at most match_size.
+        rotations copies of it, turned by 2 pi i / rotations, are laid out
+        on a P x P grid (P a power of two holding a turned copy, or for a
+        toroidal image two periods of it) and their spectra cached once
+        (tt_xcorr_texture): this is the memory of the method, R * (channels
+        + 1) * P * (P / 2 + 1) * 16 bytes (19 rotations, 3 channels,
+        P = 256: 40 MB; match_size 64: 10 MB).
+     2. The band (Sec. 4.1, D15, D16): the textured faces near the cluster
+        C are drawn into C's flattened frame, each textured neighbour N
+        through the rigid map that best takes N's texture coordinates of the
+        vertices it shares with C onto C's flattened positions (a 2D
+        Procrustes fit), with the colours of the image at N's coordinates,
+        so the mask holds a rigid copy of what N shows; only pixels outside
+        C within `band` texels of it are kept. C's frame is first turned by
+        a random angle (D8), so that the exact continuation of a single
+        neighbour is not the answer unless asked for.
+     3. The fit (Sec. 4.2, D1, D5-D7, D27, D33): one masked correlation of
+        the band against every turned copy (tt_xcorr_masked_best), offsets
+        restricted so that C's footprint and its band stay inside a bounded
+        image with a margin of one texel (D6; for a toroidal image, inside
+        the copy's grid). The best offset is refined at full resolution by a
+        direct sum over +-2^k texels. Its normalised error (D4)
+            eps = (sum of squared differences) / (channels * band pixels) / (2 sigma^2)
+        with sigma^2 the image's mean per-channel variance: 0 for a perfect
+        continuation, about 1 for unrelated pixels.
+     4. The traversal (Sec. 2.2, D22, D23): one priority queue per level,
+        the cluster with most textured neighbouring regions first (then the
+        larger share of textured border, then the smaller index). A cluster
+        is split (its children queued at the next level) when it is not a
+        disc, not flat enough, has no room in a bounded image, or fits worse
+        than `threshold` - unless its children would be smaller than the
+        floor (min_footprint texels^2 or min_faces faces), where the best
+        fit is taken whatever its error. A cluster smaller than the floor
+        (reached only below a cluster that could not be flattened) is not
+        fitted: it continues the map of the neighbour it shares most
+        vertices with. A cluster with no textured neighbour waits until
+        nothing else can be done; then it starts a new textured region at
+        a random place (the first cluster, each further component, regions
+        the queues never reached).
+     5. Texture coordinates (Sec. 4.3, D17, D19-D21): per corner, a
+        similarity of the cluster's flattened map - continuous inside a
+        cluster, never wrapped per vertex; for a toroidal image each cluster
+        is moved by whole periods so its centre lies in [0, 1)^2, the rest
+        continues outside (sample with REPEAT). For a bounded image every
+        UV lies at least one texel inside the image.
+   The same mesh, image, options and seed give the same bits. */
+
+#define TT_DEFAULT_HPM_THRESHOLD 0.35   /* eps above which a fit splits the cluster (D4) */
+#define TT_DEFAULT_HPM_ROTATIONS 19     /* orientations per fit: the paper's (Sec. 4.2) */
+#define TT_DEFAULT_HPM_MATCH_SIZE 128   /* larger side of the matching copy of the image (D30) */
+#define TT_DEFAULT_HPM_MIN_FACES 16     /* the floor in faces (D23) */
+#define TT_DEFAULT_HPM_MIN_FOOTPRINT 576.0  /* the floor in texels^2: a patch 24 texels across */
+#define TT_HPM_MAX_LEVELS 32            /* levels the report counts one by one (deeper ones go to the last) */
+
+enum {
+    TT_HPM_TOROIDAL = 1u << 0,          /* the image tiles: offsets wrap, UVs may leave [0, 1] */
+    TT_HPM_RANDOM_PLACEMENT = 1u << 1,  /* the control: the same traversal and decisions, but every
+                                           cluster is output at a random place and orientation */
+    TT_HPM_NO_RANDOM_TURN = 1u << 2     /* no random turn of the frame before a fit (D8) and
+                                           starts at angle 0: a neighbour's exact continuation
+                                           can then be found (tests) */
+};
+
+typedef struct tt_hpm_options {
+    uint64_t seed;          /* hierarchy seeds, random turns and starts (any value, 0 included) */
+    double scale;           /* world units covered by the image's width (D26); 0 = the bounding box's
+                               diagonal / 4 */
+    double threshold;       /* the largest accepted eps; 0 = TT_DEFAULT_HPM_THRESHOLD; +infinity
+                               accepts every fit (clusters split only when not flat or with no room) */
+    int rotations;          /* orientations per fit, 1..64; 0 = TT_DEFAULT_HPM_ROTATIONS */
+    double band;            /* band width in image texels; 0 = per cluster clamp(0.2 * r, 3, 24), r the
+                               radius of a disc of the cluster's area (D15) */
+    int match_size;         /* 0 = TT_DEFAULT_HPM_MATCH_SIZE; a power of two from 16 to 512 */
+    double min_footprint;   /* the floor in texels^2; 0 = TT_DEFAULT_HPM_MIN_FOOTPRINT */
+    int min_faces;          /* the floor in faces; 0 = TT_DEFAULT_HPM_MIN_FACES */
+    unsigned flags;         /* TT_HPM_* */
+    int branching;          /* the hierarchy's (tt_cluster_options); 0 = its default */
+    double max_flattening_error; /* tt_flatten_options.max_error; 0 = its default (0.10) */
+    tt_progress_fn progress;     /* fraction of faces textured; may cancel */
+    void *progress_user_data;
+} tt_hpm_options;
+
+typedef struct tt_hpm_report {
+    int levels;                             /* the hierarchy's */
+    int clusters;                           /* clusters textured */
+    int mapped_per_level[TT_HPM_MAX_LEVELS];/* clusters textured at each level */
+    int fits;                               /* masked correlations run (each over every rotation) */
+    int accepted_fits;                      /* fits at or below the threshold */
+    int floor_fits;                         /* fits above it, accepted at the floor */
+    int rejected_fits;                      /* fits above it: the cluster was split */
+    int continued;                          /* small clusters continuing a neighbour's map (no fit) */
+    int starts;                             /* clusters placed at random (no textured neighbour) */
+    int not_flat;                           /* clusters split because they did not flatten */
+    int no_room;                            /* clusters split because they did not fit in the image */
+    double mean_error, max_error;           /* eps over the accepted fits (floor ones included) */
+    double texels_per_unit;                 /* the texel density: image width / scale */
+    int match_width, match_height;          /* the matching copy's size */
+    int fft_size;                           /* P */
+} tt_hpm_report;
+
+/* Texture `mesh` (triangles) from `image` (linear RGBA; alpha ignored).
+   corner_uv gets 2 * mesh->ncorners floats, (u, v) per corner in the
+   library's UV convention; face_cluster (may be NULL) gets, per face, the
+   hierarchy cluster whose map it shows (the numbering of
+   tt_cluster_hierarchy_build with the same seed and branching). options and
+   report may be NULL. Results:
+     TT_OK;
+     TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, a bad
+                                allocator, options out of range, a face
+                                that is not a triangle (error->face);
+     TT_ERROR_EMPTY_MESH        no faces;
+     TT_ERROR_ZERO_AREA_FACE    every face has zero area (no scale);
+     TT_ERROR_NON_FINITE        a NaN or infinite texel (error->row, column);
+     TT_CANCELLED               the progress callback stopped it;
+     TT_ERROR_OUT_OF_MEMORY.
+   On any error corner_uv and face_cluster are untouched. Time: the
+   hierarchy and flattening (above) plus about 10 ms per fit at P = 256
+   (report->fits), typically a few hundred fits for 20k faces. */
+TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
+                           const tt_allocator *allocator, float *corner_uv, int *face_cluster,
+                           tt_hpm_report *report, tt_error *error);
+
 #ifdef __cplusplus
 }
 #endif
@@ -10578,6 +10709,1261 @@ done:
     tt__free(allocator, bxy);
     tt__free(allocator, keys);
     tt__free(allocator, trip);
+    return res;
+}
+
+
+/* SHIM-XBEST (temporary until the xbest branch lands) */
+static tt_result tt_xcorr_masked_best(const tt_xcorr_texture *const *textures, int ntextures, const double *mask,
+                                      const double *values, const unsigned char *const *allowed, double *work,
+                                      tt_xcorr_match *out_match, int *out_texture, tt_error *error)
+{
+    int k, found = 0;
+    tt_xcorr_match m;
+    *out_texture = -1;
+    for (k = 0; k < ntextures; k++) {
+        tt_result r = tt_xcorr_masked(textures[k], mask, values, allowed ? allowed[k] : NULL, work, NULL, &m, error);
+        if (r == TT_ERROR_NOT_MEASURED) continue;
+        if (r != TT_OK) return r;
+        if (!found || m.e < out_match->e) { *out_match = m; *out_texture = k; found = 1; }
+    }
+    return found ? TT_OK : TT_ERROR_NOT_MEASURED;
+}
+
+/* ---- The pipeline (tt_hpm_map) ---- */
+
+/* A textured neighbour of the cluster being placed, and the rigid map
+   q = R(angle) (x / s) + shift that best takes its texture coordinates x
+   (texels) of the shared vertices onto the cluster's flattened positions q
+   (spec D16). */
+typedef struct tt__hpm_owner {
+    int cluster;
+    int shared;                 /* shared border vertices */
+    double cos_a, sin_a;        /* R(angle) */
+    double shift[2];
+    int valid;                  /* at least two distinct shared vertices */
+} tt__hpm_owner;
+
+typedef struct tt__hpm {
+    const tt_mesh *mesh;
+    const tt_allocator *al;
+    tt_cluster_hierarchy *H;
+    tt_rng rng;                 /* turns, starts */
+    tt_rng place_rng;           /* the random-placement control's own stream: decisions do not change */
+    double s;                   /* texels per world unit */
+    double threshold, band, floor_px;
+    int rotations, min_faces, toroidal;
+    unsigned flags;
+    tt_flatten_options fopt;
+    /* the image in the matching colour space (D3) */
+    int W, Hh, nch;
+    float *full;                /* nch planes W x Hh */
+    double sigma2;              /* mean per-channel variance */
+    int f, ww, wh, P;           /* box factor, matching copy's size, FFT size */
+    float *match;               /* nch planes ww x wh */
+    tt_xcorr_texture **tex;     /* rotations turned copies */
+    double *xwork, *mask, *values;
+    unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band */
+    unsigned char *allowed_mem; /* rotations x P x P */
+    const unsigned char **allowed;
+    float *dist;                /* P x P distance to the footprint, canvas texels */
+    float *src;                 /* 2 x P x P: the neighbour's texel position shown at a band pixel */
+    int *band_pixels, nband;
+    /* the mesh's state */
+    float *flat;                /* 2 * ncorners: flattened positions, world units */
+    double *uv;                 /* 2 * ncorners: the fitted map, texels */
+    double *out;                /* the random-placement control's map, or NULL */
+    int *owner;                 /* per face: the textured cluster showing it, or -1 */
+    int *in_c, *seen;           /* per face stamps */
+    int stamp;
+    unsigned char *state;       /* per cluster: 0 new, 1 done, 2 waiting */
+    tt__heap_item **queue;
+    int *qcount, *qcap;
+    int *waiting, nwaiting, waitcap;
+    tt__heap_item *heap;        /* the band search (3 * nfaces) */
+    int *near_faces, nnear;
+    tt__hpm_owner *owners;
+    int nowners, ownercap;
+    double *pairs;              /* per shared (vertex, owner): owner index, a.x, a.y, b.x, b.y */
+    int npairs, paircap;
+    int textured;
+    tt_progress_fn progress;
+    void *progress_user_data;
+    tt_hpm_report rep;
+    double error_sum;
+} tt__hpm;
+
+/* Bilinear sample of nch float planes (w x h, texel i covering [i, i+1)),
+   clamped to the edge or wrapped. */
+static void tt__hpm_sample(const float *planes, int w, int h, int nch, double x, double y, int wrap, double *out)
+{
+    double fx = x - 0.5, fy = y - 0.5, tx, ty;
+    int x0, y0, x1, y1, c;
+    size_t plane = (size_t)w * h;
+    if (!(fx > -1e9 && fx < 1e9)) fx = 0;
+    if (!(fy > -1e9 && fy < 1e9)) fy = 0;
+    x0 = (int)floor(fx);
+    y0 = (int)floor(fy);
+    tx = fx - x0;
+    ty = fy - y0;
+    x1 = x0 + 1;
+    y1 = y0 + 1;
+    if (wrap) {
+        x0 = ((x0 % w) + w) % w;
+        x1 = ((x1 % w) + w) % w;
+        y0 = ((y0 % h) + h) % h;
+        y1 = ((y1 % h) + h) % h;
+    } else {
+        x0 = tt__clamp_i(x0, 0, w - 1);
+        x1 = tt__clamp_i(x1, 0, w - 1);
+        y0 = tt__clamp_i(y0, 0, h - 1);
+        y1 = tt__clamp_i(y1, 0, h - 1);
+    }
+    for (c = 0; c < nch; c++) {
+        const float *p = planes + c * plane;
+        double top = p[(size_t)y0 * w + x0] * (1 - tx) + p[(size_t)y0 * w + x1] * tx;
+        double bottom = p[(size_t)y1 * w + x0] * (1 - tx) + p[(size_t)y1 * w + x1] * tx;
+        out[c] = top * (1 - ty) + bottom * ty;
+    }
+}
+
+/* Step 1: the matching colour space, the matching copy and the cached
+   spectra of its turned copies. */
+static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int match_size, tt_error *error)
+{
+    size_t n = (size_t)image->width * image->height, i, pp;
+    int c, k, x, y, grey = 1, big;
+    double mean[3] = {0, 0, 0}, var = 0;
+    double *buffer = NULL;
+    tt_result res = TT_OK;
+    S->W = image->width;
+    S->Hh = image->height;
+    S->full = TT__ALLOC(S->al, float, 3 * n);
+    if (!S->full) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (image copy)");
+    for (i = 0; i < n; i++) {
+        const float *p = image->pixels + 4 * i;
+        double r, g, b;
+        if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2]))
+            return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, (int)(i / (size_t)image->width),
+                               (int)(i % (size_t)image->width), "texel (%d, %d) of the image is not finite",
+                               (int)(i % (size_t)image->width), (int)(i / (size_t)image->width));
+        /* As displayed (D3, and as the seam measure compares them). */
+        r = tt_linear_to_srgb(p[0]);
+        g = tt_linear_to_srgb(p[1]);
+        b = tt_linear_to_srgb(p[2]);
+        S->full[i] = (float)(0.299 * r + 0.587 * g + 0.114 * b);
+        S->full[n + i] = (float)(-0.168736 * r - 0.331264 * g + 0.5 * b);
+        S->full[2 * n + i] = (float)(0.5 * r - 0.418688 * g - 0.081312 * b);
+        if (fabs(S->full[n + i]) > 1e-4 || fabs(S->full[2 * n + i]) > 1e-4) grey = 0;
+    }
+    S->nch = grey ? 1 : 3; /* D32: no chroma planes for a grey image */
+    for (c = 0; c < S->nch; c++) {
+        for (i = 0; i < n; i++) mean[c] += S->full[c * n + i];
+        mean[c] /= (double)n;
+        for (i = 0; i < n; i++) var += (S->full[c * n + i] - mean[c]) * (S->full[c * n + i] - mean[c]);
+    }
+    S->sigma2 = var / ((double)n * S->nch);
+    if (!(S->sigma2 > 1e-12)) S->sigma2 = 1e-12; /* a flat image: every fit is perfect */
+
+    /* The matching copy: f x f box filter (D30). */
+    big = tt__max_i(S->W, S->Hh);
+    S->f = 1;
+    while (big > match_size * S->f) S->f *= 2;
+    S->ww = (S->W + S->f - 1) / S->f;
+    S->wh = (S->Hh + S->f - 1) / S->f;
+    S->match = TT__ALLOC(S->al, float, (size_t)S->nch * S->ww * S->wh);
+    if (!S->match) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (image copy)");
+    for (c = 0; c < S->nch; c++)
+        for (y = 0; y < S->wh; y++)
+            for (x = 0; x < S->ww; x++) {
+                double sum = 0;
+                int cnt = 0, a, b;
+                for (b = y * S->f; b < tt__min_i((y + 1) * S->f, S->Hh); b++)
+                    for (a = x * S->f; a < tt__min_i((x + 1) * S->f, S->W); a++) {
+                        sum += S->full[c * n + (size_t)b * S->W + a];
+                        cnt++;
+                    }
+                S->match[(size_t)c * S->ww * S->wh + (size_t)y * S->ww + x] = (float)(sum / cnt);
+            }
+
+    /* P: a turned copy fits (bounded), or two periods do (toroidal; D5). */
+    {
+        double need = S->toroidal ? 2.0 * tt__max_i(S->ww, S->wh)
+                                  : sqrt((double)S->ww * S->ww + (double)S->wh * S->wh) + 2;
+        S->P = 16;
+        while (S->P < need) S->P *= 2;
+    }
+    pp = (size_t)S->P * S->P;
+    S->tex = TT__ALLOC(S->al, tt_xcorr_texture *, (size_t)S->rotations);
+    if (S->tex)
+        for (k = 0; k < S->rotations; k++) S->tex[k] = NULL;
+    buffer = TT__ALLOC(S->al, double, (size_t)S->nch * pp);
+    if (!S->tex || !buffer) {
+        tt__free(S->al, buffer);
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (turned copies)");
+    }
+    for (k = 0; k < S->rotations && res == TT_OK; k++) {
+        double th = TT__TWO_PI * k / S->rotations, ct = cos(th), st = sin(th);
+        double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
+        for (y = 0; y < S->P; y++)
+            for (x = 0; x < S->P; x++) {
+                /* buffer point b -> matching copy R(-theta) (b - c_B) + c_T */
+                double bx = x + 0.5 - cb, by = y + 0.5 - cb, v[3];
+                double wx = ct * bx + st * by + ctx, wy = -st * bx + ct * by + cty;
+                size_t at = (size_t)y * S->P + x;
+                if (!S->toroidal && (wx < 0 || wy < 0 || wx > S->ww || wy > S->wh)) {
+                    for (c = 0; c < S->nch; c++) buffer[c * pp + at] = 0;
+                    continue;
+                }
+                tt__hpm_sample(S->match, S->ww, S->wh, S->nch, wx, wy, S->toroidal, v);
+                for (c = 0; c < S->nch; c++) buffer[c * pp + at] = v[c];
+            }
+        res = tt_xcorr_texture_create(S->P, S->P, S->nch, buffer, S->al, &S->tex[k], error);
+    }
+    tt__free(S->al, buffer);
+    if (res != TT_OK) return res;
+    S->xwork = TT__ALLOC(S->al, double, S->tex[0]->work_size);
+    S->mask = TT__ALLOC(S->al, double, pp);
+    S->values = TT__ALLOC(S->al, double, (size_t)S->nch * pp);
+    S->support = TT__ALLOC(S->al, unsigned char, pp);
+    S->allowed_mem = TT__ALLOC(S->al, unsigned char, pp * (size_t)S->rotations);
+    S->allowed = TT__ALLOC(S->al, const unsigned char *, (size_t)S->rotations);
+    S->dist = TT__ALLOC(S->al, float, pp);
+    S->src = TT__ALLOC(S->al, float, 2 * pp);
+    S->band_pixels = TT__ALLOC(S->al, int, pp);
+    if (!S->xwork || !S->mask || !S->values || !S->support || !S->allowed_mem || !S->allowed || !S->dist ||
+        !S->src || !S->band_pixels)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
+    for (k = 0; k < S->rotations; k++) S->allowed[k] = S->allowed_mem + (size_t)k * pp;
+    return TT_OK;
+}
+
+/* Mark cluster C's faces in in_c with a fresh stamp; returns it. */
+static int tt__hpm_mark(tt__hpm *S, int C)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    int i;
+    S->stamp++;
+    for (i = 0; i < cl->nfaces; i++) S->in_c[S->H->faces[cl->first_face + i]] = S->stamp;
+    return S->stamp;
+}
+
+/* 0: no face of C is textured, 1: some, 2: all. */
+static int tt__hpm_textured_state(const tt__hpm *S, int C)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    int i, t = 0;
+    for (i = 0; i < cl->nfaces; i++) t += S->owner[S->H->faces[cl->first_face + i]] >= 0;
+    return t == 0 ? 0 : (t == cl->nfaces ? 2 : 1);
+}
+
+/* The queue key of C (D22): textured neighbouring regions (any level),
+   then the textured share of its border. Smaller keys pop first. */
+static double tt__hpm_key(tt__hpm *S, int C, int *count)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    int stamp = tt__hpm_mark(S, C), i, j, n = 0, seen[8], nseen = 0, border = 0, shared = 0;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
+            int t = m->twin[j], g, o, k, dup = 0;
+            if (t < 0) continue;
+            g = m->corner_face[t];
+            if (S->in_c[g] == stamp) continue;
+            border++;
+            o = S->owner[g];
+            if (o < 0) continue;
+            shared++;
+            for (k = 0; k < nseen; k++) dup |= seen[k] == o;
+            if (!dup) {
+                n++;
+                if (nseen < 8) seen[nseen++] = o;
+            }
+        }
+    }
+    *count = n;
+    return -(n + (border > 0 ? 0.999 * shared / border : 0));
+}
+
+static int tt__hpm_push(tt__hpm *S, int level, int C)
+{
+    int count;
+    double key;
+    if (S->state[C] == 1) return 1;
+    if (level >= S->H->nlevels) level = S->H->nlevels - 1;
+    key = tt__hpm_key(S, C, &count);
+    if (S->qcount[level] == S->qcap[level]) {
+        int cap = S->qcap[level] ? 2 * S->qcap[level] : 64;
+        tt__heap_item *q = (tt__heap_item *)tt__alloc_array(S->al, (size_t)cap, sizeof(tt__heap_item));
+        if (!q) return 0;
+        if (S->qcount[level]) memcpy(q, S->queue[level], (size_t)S->qcount[level] * sizeof *q);
+        tt__free(S->al, S->queue[level]);
+        S->queue[level] = q;
+        S->qcap[level] = cap;
+    }
+    tt__heap_push(S->queue[level], &S->qcount[level], key, C);
+    return 1;
+}
+
+/* Queue the children of C at the next level (a split). */
+static int tt__hpm_split(tt__hpm *S, int C)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    int i;
+    for (i = 0; i < cl->nchildren; i++)
+        if (!tt__hpm_push(S, cl->level + 1, cl->first_child + i)) return 0;
+    return 1;
+}
+
+/* q (texel-frame orientation: y mirrored so that a rotation keeps the UVs
+   counter-clockwise with v up) of corner c after flattening. */
+static void tt__hpm_q(const tt__hpm *S, int c, double *q)
+{
+    q[0] = S->flat[2 * c];
+    q[1] = -(double)S->flat[2 * c + 1];
+}
+
+/* The textured neighbours of C and their rigid maps (D16). C's faces are
+   marked in in_c with `stamp`. */
+static int tt__hpm_owners(tt__hpm *S, int C, int stamp)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    int i, j, k, p;
+    S->nowners = 0;
+    S->npairs = 0;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
+            int t = m->twin[j], v = m->corner_vert[j], start, h, local[16], nlocal = 0, guard = 0;
+            double q[2];
+            if (t >= 0 && S->in_c[m->corner_face[t]] == stamp) continue;
+            /* j is a border half-edge: its origin v is a border vertex, met once. */
+            tt__hpm_q(S, j, q);
+            start = h = m->vert_corner[v];
+            while (h >= 0 && guard++ <= m->ncorners) {
+                int g = m->corner_face[h], o = S->owner[g], prev;
+                if (S->in_c[g] != stamp && o >= 0) {
+                    int dup = 0;
+                    for (k = 0; k < nlocal; k++) dup |= local[k] == o;
+                    if (!dup && nlocal < 16) {
+                        int oi = -1;
+                        local[nlocal++] = o;
+                        for (k = 0; k < S->nowners; k++)
+                            if (S->owners[k].cluster == o) oi = k;
+                        if (oi < 0) {
+                            if (S->nowners == S->ownercap) {
+                                tt__hpm_owner *no = (tt__hpm_owner *)tt__grow(S->al, S->owners, &S->ownercap,
+                                                                              S->nowners + 1, sizeof *no);
+                                if (!no) return 0;
+                                S->owners = no;
+                            }
+                            oi = S->nowners++;
+                            memset(&S->owners[oi], 0, sizeof S->owners[oi]);
+                            S->owners[oi].cluster = o;
+                        }
+                        S->owners[oi].shared++;
+                        if (S->npairs == S->paircap) {
+                            double *np = (double *)tt__grow(S->al, S->pairs, &S->paircap, S->npairs + 1,
+                                                            5 * sizeof(double));
+                            if (!np) return 0;
+                            S->pairs = np;
+                        }
+                        p = 5 * S->npairs++;
+                        S->pairs[p] = oi;
+                        S->pairs[p + 1] = S->uv[2 * h] / S->s;
+                        S->pairs[p + 2] = S->uv[2 * h + 1] / S->s;
+                        S->pairs[p + 3] = q[0];
+                        S->pairs[p + 4] = q[1];
+                    }
+                }
+                prev = tt_mesh_prev(m, h);
+                h = m->twin[prev];
+                if (h == start) break;
+            }
+        }
+    }
+    /* 2D Procrustes per owner: centre both point sets, the angle is
+       atan2(sum of cross products, sum of dot products). */
+    for (k = 0; k < S->nowners; k++) {
+        tt__hpm_owner *O = &S->owners[k];
+        double ca[2] = {0, 0}, cb[2] = {0, 0}, dot = 0, cross = 0, spread = 0, len;
+        for (p = 0; p < S->npairs; p++) {
+            const double *r = S->pairs + 5 * p;
+            if ((int)r[0] != k) continue;
+            ca[0] += r[1] / O->shared;
+            ca[1] += r[2] / O->shared;
+            cb[0] += r[3] / O->shared;
+            cb[1] += r[4] / O->shared;
+        }
+        for (p = 0; p < S->npairs; p++) {
+            const double *r = S->pairs + 5 * p;
+            double ax, ay, bx, by;
+            if ((int)r[0] != k) continue;
+            ax = r[1] - ca[0];
+            ay = r[2] - ca[1];
+            bx = r[3] - cb[0];
+            by = r[4] - cb[1];
+            dot += ax * bx + ay * by;
+            cross += ax * by - ay * bx;
+            spread += ax * ax + ay * ay;
+        }
+        len = sqrt(dot * dot + cross * cross);
+        O->valid = O->shared >= 2 && spread > 0 && len > 0;
+        if (!O->valid) continue;
+        O->cos_a = dot / len;
+        O->sin_a = cross / len;
+        O->shift[0] = cb[0] - (O->cos_a * ca[0] - O->sin_a * ca[1]);
+        O->shift[1] = cb[1] - (O->sin_a * ca[0] + O->cos_a * ca[1]);
+    }
+    return 1;
+}
+
+/* A placement x = s R(angle) q + shift, in texels. */
+typedef struct tt__hpm_place {
+    double cos_a, sin_a, shift[2];
+} tt__hpm_place;
+
+static void tt__hpm_apply(const tt__hpm *S, const tt__hpm_place *pl, const double *q, double *x)
+{
+    x[0] = S->s * (pl->cos_a * q[0] - pl->sin_a * q[1]) + pl->shift[0];
+    x[1] = S->s * (pl->sin_a * q[0] + pl->cos_a * q[1]) + pl->shift[1];
+}
+
+/* Bounding box of C's corners under the rotation part of pl (shift 0). */
+static void tt__hpm_bbox(const tt__hpm *S, int C, double cos_a, double sin_a, double *box)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    tt__hpm_place pl;
+    int i, j;
+    pl.cos_a = cos_a;
+    pl.sin_a = sin_a;
+    pl.shift[0] = pl.shift[1] = 0;
+    box[0] = box[1] = 1e300;
+    box[2] = box[3] = -1e300;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (j = S->mesh->face_start[f]; j < S->mesh->face_start[f + 1]; j++) {
+            double q[2], x[2];
+            tt__hpm_q(S, j, q);
+            tt__hpm_apply(S, &pl, q, x);
+            if (x[0] < box[0]) box[0] = x[0];
+            if (x[1] < box[1]) box[1] = x[1];
+            if (x[0] > box[2]) box[2] = x[0];
+            if (x[1] > box[3]) box[3] = x[1];
+        }
+    }
+}
+
+/* A random place (a start, or the control's output): a random angle (0
+   with TT_HPM_NO_RANDOM_TURN) and a random shift keeping the cluster one
+   texel inside a bounded image, trying the other rotations' angles when it
+   does not fit. Returns 0 when it fits at no angle. */
+static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, tt__hpm_place *pl)
+{
+    double a0 = (S->flags & TT_HPM_NO_RANDOM_TURN) ? 0 : TT__TWO_PI * tt_rng_float(rng);
+    double ux = tt_rng_float(rng), uy = tt_rng_float(rng);
+    int k;
+    for (k = 0; k < S->rotations; k++) {
+        double a = a0 + TT__TWO_PI * k / S->rotations, box[4];
+        pl->cos_a = cos(a);
+        pl->sin_a = sin(a);
+        tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, box);
+        if (S->toroidal) {
+            pl->shift[0] = ux * S->W - 0.5 * (box[0] + box[2]);
+            pl->shift[1] = uy * S->Hh - 0.5 * (box[1] + box[3]);
+            return 1;
+        }
+        if (box[2] - box[0] <= S->W - 2 && box[3] - box[1] <= S->Hh - 2) {
+            pl->shift[0] = 1 - box[0] + ux * (S->W - 2 - (box[2] - box[0]));
+            pl->shift[1] = 1 - box[1] + uy * (S->Hh - 2 - (box[3] - box[1]));
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Continue the map of C's best textured neighbour (most shared vertices,
+   then the smaller cluster index): the inverse of its rigid map. */
+static const tt__hpm_owner *tt__hpm_best_owner(const tt__hpm *S)
+{
+    const tt__hpm_owner *best = NULL;
+    int k;
+    for (k = 0; k < S->nowners; k++) {
+        const tt__hpm_owner *O = &S->owners[k];
+        if (!O->valid) continue;
+        if (!best || O->shared > best->shared || (O->shared == best->shared && O->cluster < best->cluster))
+            best = O;
+    }
+    return best;
+}
+
+static int tt__hpm_continue_place(const tt__hpm *S, int C, tt__hpm_place *pl)
+{
+    const tt__hpm_owner *best = tt__hpm_best_owner(S);
+    if (!best) return 0;
+    /* q = R(b) x / s + d  =>  x = s R(-b) (q - d) */
+    pl->cos_a = best->cos_a;
+    pl->sin_a = -best->sin_a;
+    pl->shift[0] = -S->s * (pl->cos_a * best->shift[0] - pl->sin_a * best->shift[1]);
+    pl->shift[1] = -S->s * (pl->sin_a * best->shift[0] + pl->cos_a * best->shift[1]);
+    if (!S->toroidal) {
+        /* a bounded image: only when the cluster stays a texel inside */
+        double box[4];
+        tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, box);
+        if (box[0] + pl->shift[0] < 1 || box[1] + pl->shift[1] < 1 || box[2] + pl->shift[0] > S->W - 1 ||
+            box[3] + pl->shift[1] > S->Hh - 1)
+            return 0;
+    }
+    return 1;
+}
+
+typedef struct tt__hpm_raster {
+    tt__hpm *S;
+    double x[6];                /* the neighbour's texel positions of the three corners */
+    double band;                /* canvas texels */
+} tt__hpm_raster;
+
+static void tt__hpm_raster_footprint(int x, int y, const float bary[3], void *user)
+{
+    tt__hpm_raster *r = (tt__hpm_raster *)user;
+    (void)bary;
+    r->S->support[(size_t)y * r->S->P + x] = 1;
+}
+
+static void tt__hpm_raster_band(int x, int y, const float bary[3], void *user)
+{
+    tt__hpm_raster *r = (tt__hpm_raster *)user;
+    tt__hpm *S = r->S;
+    size_t at = (size_t)y * S->P + x, pp = (size_t)S->P * S->P;
+    double sx, sy, v[3];
+    int c;
+    if (S->support[at] != 0 || S->dist[at] > r->band) return;
+    sx = bary[0] * r->x[0] + bary[1] * r->x[2] + bary[2] * r->x[4];
+    sy = bary[0] * r->x[1] + bary[1] * r->x[3] + bary[2] * r->x[5];
+    tt__hpm_sample(S->match, S->ww, S->wh, S->nch, sx / S->f, sy / S->f, S->toroidal, v);
+    for (c = 0; c < S->nch; c++) S->values[c * pp + at] = v[c];
+    S->mask[at] = 1;
+    S->support[at] = 2;
+    S->src[2 * at] = (float)sx;
+    S->src[2 * at + 1] = (float)sy;
+    S->band_pixels[S->nband++] = (int)at;
+}
+
+/* Distance (texels) of every canvas pixel to the footprint, by two
+   chamfer passes (1, sqrt 2) over the w x h corner of the canvas. */
+static void tt__hpm_distance(tt__hpm *S, int w, int h)
+{
+    const float diag = 1.41421356f;
+    int x, y, P = S->P;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) S->dist[(size_t)y * P + x] = S->support[(size_t)y * P + x] == 1 ? 0.0f : 1e30f;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float *d = &S->dist[(size_t)y * P + x];
+            if (x > 0 && d[-1] + 1 < *d) *d = d[-1] + 1;
+            if (y > 0) {
+                if (d[-P] + 1 < *d) *d = d[-P] + 1;
+                if (x > 0 && d[-P - 1] + diag < *d) *d = d[-P - 1] + diag;
+                if (x + 1 < w && d[-P + 1] + diag < *d) *d = d[-P + 1] + diag;
+            }
+        }
+    for (y = h - 1; y >= 0; y--)
+        for (x = w - 1; x >= 0; x--) {
+            float *d = &S->dist[(size_t)y * P + x];
+            if (x + 1 < w && d[1] + 1 < *d) *d = d[1] + 1;
+            if (y + 1 < h) {
+                if (d[P] + 1 < *d) *d = d[P] + 1;
+                if (x + 1 < w && d[P + 1] + diag < *d) *d = d[P + 1] + diag;
+                if (x > 0 && d[P - 1] + diag < *d) *d = d[P - 1] + diag;
+            }
+        }
+}
+
+/* The textured faces near C whose owner has a rigid map, by a Dijkstra
+   over face centroids from the faces across C's border, up to `reach`
+   world units. */
+static void tt__hpm_near_faces(tt__hpm *S, int C, int stamp, double reach)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    int i, j, nheap = 0;
+    S->nnear = 0;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
+            int t = m->twin[j], g;
+            if (t < 0) continue;
+            g = m->corner_face[t];
+            if (S->in_c[g] == stamp || S->owner[g] < 0 || S->seen[g] == stamp) continue;
+            S->seen[g] = stamp;
+            tt__heap_push(S->heap, &nheap, 0, g);
+        }
+    }
+    while (nheap > 0) {
+        tt__heap_item it = tt__heap_pop(S->heap, &nheap);
+        int g = it.value, k, valid = 0;
+        double cg[3] = {0, 0, 0};
+        for (k = 0; k < S->nowners; k++)
+            if (S->owners[k].cluster == S->owner[g]) valid = S->owners[k].valid;
+        if (!valid) continue;
+        S->near_faces[S->nnear++] = g;
+        if (it.key > reach) continue;
+        for (j = m->face_start[g]; j < m->face_start[g + 1]; j++) {
+            const float *p = m->pos + 3 * m->corner_vert[j];
+            cg[0] += p[0] / 3;
+            cg[1] += p[1] / 3;
+            cg[2] += p[2] / 3;
+        }
+        for (j = m->face_start[g]; j < m->face_start[g + 1]; j++) {
+            int t = m->twin[j], h, l;
+            double ch[3] = {0, 0, 0}, d[3];
+            if (t < 0) continue;
+            h = m->corner_face[t];
+            if (S->in_c[h] == stamp || S->owner[h] < 0 || S->seen[h] == stamp) continue;
+            S->seen[h] = stamp;
+            for (l = m->face_start[h]; l < m->face_start[h + 1]; l++) {
+                const float *p = m->pos + 3 * m->corner_vert[l];
+                ch[0] += p[0] / 3;
+                ch[1] += p[1] / 3;
+                ch[2] += p[2] / 3;
+            }
+            for (l = 0; l < 3; l++) d[l] = ch[l] - cg[l];
+            tt__heap_push(S->heap, &nheap, it.key + tt__length3(d), h);
+        }
+    }
+}
+
+/* Steps 2 and 3: the band and the fit. Returns 1 with *pl and *eps when
+   a fit was made, 0 when there is no band to fit (continue or start
+   instead), -1 when there is no room for C in the image, -2 on
+   TT_ERROR_OUT_OF_MEMORY-free failures reported in *res. */
+static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *eps, tt_result *res,
+                       tt_error *error)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    double s_w = S->s / S->f, area_px = cl->area * S->s * S->s, w_full, w_w, phi, cph, sph, box[4], o[2];
+    double cont[2] = {0, 0};
+    double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
+    size_t pp = (size_t)S->P * S->P;
+    int cw, ch, i, j, k, P = S->P, best_k = -1, has_cont;
+    tt__hpm_raster r;
+    tt_xcorr_match match = {-1, -1, 0, 0, 0};
+    tt_result xr;
+
+    w_full = S->band > 0 ? S->band : 0.2 * sqrt(area_px / TT__PI);
+    if (S->band <= 0) w_full = w_full < 3 ? 3 : (w_full > 24 ? 24 : w_full);
+    w_w = w_full / S->f;
+    if (w_w < 1.5) w_w = 1.5;
+    /* The canvas is turned so that the texture of the neighbour sharing
+       most vertices keeps its orientation in the turned copy 0: the
+       orientation then propagates from patch to patch (Sec. 2.2) without
+       the drift that a random turn of the frame would add at every fit. */
+    {
+        const tt__hpm_owner *best = tt__hpm_best_owner(S);
+        cph = best ? best->cos_a : 1;
+        sph = best ? -best->sin_a : 0;
+        phi = atan2(sph, cph);
+        if (best) {
+            cont[0] = -S->s * (cph * best->shift[0] - sph * best->shift[1]);
+            cont[1] = -S->s * (sph * best->shift[0] + cph * best->shift[1]);
+        }
+        has_cont = best != NULL;
+    }
+    /* The canvas: c = s_w R(phi) q - o. */
+    tt__hpm_bbox(S, C, cph, sph, box);
+    for (i = 0; i < 4; i++) box[i] /= S->f;
+    o[0] = floor(box[0] - w_w - 3);
+    o[1] = floor(box[1] - w_w - 3);
+    if (has_cont) {
+        /* Shift the canvas by a fraction of a texel so that the main
+           neighbour's texel grid falls on the canvas grid: its continuation
+           is then an integer offset (an exact match, D20), and every
+           offset samples the copy where the neighbour's samples were. */
+        o[0] -= (cont[0] / S->f + cb - ctx) - floor(cont[0] / S->f + cb - ctx);
+        o[1] -= (cont[1] / S->f + cb - cty) - floor(cont[1] / S->f + cb - cty);
+    }
+    cw = (int)ceil(box[2] + w_w + 2 - o[0]);
+    ch = (int)ceil(box[3] + w_w + 2 - o[1]);
+    if (cw >= P || ch >= P) return -1;
+    memset(S->support, 0, pp);
+    memset(S->mask, 0, pp * sizeof(double));
+    r.S = S;
+    r.band = w_w;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        float xy[6];
+        for (j = 0; j < 3; j++) {
+            double q[2];
+            tt__hpm_q(S, m->face_start[f] + j, q);
+            xy[2 * j] = (float)(s_w * (cph * q[0] - sph * q[1]) - o[0]);
+            xy[2 * j + 1] = (float)(s_w * (sph * q[0] + cph * q[1]) - o[1]);
+        }
+        tt_raster_triangle(xy, P, P, tt__hpm_raster_footprint, &r);
+    }
+    tt__hpm_distance(S, cw, ch);
+    tt__hpm_near_faces(S, C, stamp, 2 * w_full / S->s);
+    S->nband = 0;
+    for (i = 0; i < S->nnear; i++) {
+        int g = S->near_faces[i];
+        const tt__hpm_owner *O = NULL;
+        float xy[6];
+        for (k = 0; k < S->nowners; k++)
+            if (S->owners[k].cluster == S->owner[g]) O = &S->owners[k];
+        for (j = 0; j < 3; j++) {
+            int c = m->face_start[g] + j;
+            double ax = S->uv[2 * c] / S->s, ay = S->uv[2 * c + 1] / S->s;
+            double bx = O->cos_a * ax - O->sin_a * ay + O->shift[0], by = O->sin_a * ax + O->cos_a * ay + O->shift[1];
+            r.x[2 * j] = S->uv[2 * c];
+            r.x[2 * j + 1] = S->uv[2 * c + 1];
+            xy[2 * j] = (float)(s_w * (cph * bx - sph * by) - o[0]);
+            xy[2 * j + 1] = (float)(s_w * (sph * bx + cph * by) - o[1]);
+        }
+        tt_raster_triangle(xy, cw, ch, tt__hpm_raster_band, &r);
+    }
+    if (S->nband < 8) return 0;
+
+    /* Allowed offsets per turned copy: the support (footprint and band)
+       stays on the grid without wrapping, and for a bounded image inside
+       the turned image with a margin of one texel (D6). */
+    {
+        double m_w = 1.0 / S->f;
+        int maxx = 0, maxy = 0, any = 0;
+        for (j = 0; j < ch; j++)
+            for (i = 0; i < cw; i++)
+                if (S->support[(size_t)j * P + i]) {
+                    if (i > maxx) maxx = i;
+                    if (j > maxy) maxy = j;
+                }
+        for (k = 0; k < S->rotations; k++) {
+            unsigned char *a = S->allowed_mem + (size_t)k * pp;
+            double th = TT__TWO_PI * k / S->rotations, ct = cos(th), st = sin(th);
+            /* n' = R(theta) n for n = +x, -x, +y, -y; limits L - n.c_T */
+            double nx[4], ny[4], lim[4], mx[4];
+            int d, tx, ty;
+            nx[0] = ct; ny[0] = st; lim[0] = S->ww - m_w - ctx;
+            nx[1] = -ct; ny[1] = -st; lim[1] = -m_w + ctx;
+            nx[2] = -st; ny[2] = ct; lim[2] = S->wh - m_w - cty;
+            nx[3] = st; ny[3] = -ct; lim[3] = -m_w + cty;
+            for (d = 0; d < 4; d++) mx[d] = -1e300;
+            if (!S->toroidal)
+                for (j = 0; j < ch; j++)
+                    for (i = 0; i < cw; i++)
+                        if (S->support[(size_t)j * P + i])
+                            for (d = 0; d < 4; d++) {
+                                double v = nx[d] * (i - cb) + ny[d] * (j - cb) + (nx[d] > 0 ? nx[d] : 0) +
+                                           (ny[d] > 0 ? ny[d] : 0);
+                                if (v > mx[d]) mx[d] = v;
+                            }
+            memset(a, 0, pp);
+            for (ty = 0; ty < P - maxy; ty++)
+                for (tx = 0; tx < P - maxx; tx++) {
+                    int ok = 1;
+                    if (!S->toroidal)
+                        for (d = 0; d < 4 && ok; d++) ok = nx[d] * tx + ny[d] * ty <= lim[d] - mx[d];
+                    a[(size_t)ty * P + tx] = (unsigned char)ok;
+                    any |= ok;
+                }
+        }
+        /* D8: not the exact continuation of that neighbour (copy 0 at
+           the offset that repeats its map), nor anything within the
+           cluster's radius of it, which would show the same texels shifted
+           a little; unless asked for (TT_HPM_NO_RANDOM_TURN). */
+        if (has_cont && !(S->flags & TT_HPM_NO_RANDOM_TURN)) {
+            double tcx = cont[0] / S->f + o[0] + cb - ctx, tcy = cont[1] / S->f + o[1] + cb - cty;
+            double rad = sqrt(area_px / TT__PI) / S->f, px = S->toroidal ? S->ww : 1e300, py = S->toroidal ? S->wh : 1e300;
+            int tx, ty, a, b;
+            if (rad < w_w) rad = w_w;
+            if (S->toroidal) {
+                /* copy 0 repeats with the image's period */
+                tcx -= px * floor(tcx / px);
+                tcy -= py * floor(tcy / py);
+            }
+            for (b = 0; b == 0 || (S->toroidal && tcy + (b - 1) * py - rad < P); b++)
+                for (a = 0; a == 0 || (S->toroidal && tcx + (a - 1) * px - rad < P); a++) {
+                    double cx = tcx + (S->toroidal ? (a - 1) * px : 0), cy = tcy + (S->toroidal ? (b - 1) * py : 0);
+                    for (ty = (int)floor(cy - rad); ty <= (int)ceil(cy + rad); ty++)
+                        for (tx = (int)floor(cx - rad); tx <= (int)ceil(cx + rad); tx++)
+                            if (tx >= 0 && ty >= 0 && tx < P && ty < P &&
+                                (tx - cx) * (tx - cx) + (ty - cy) * (ty - cy) <= rad * rad)
+                                S->allowed_mem[(size_t)ty * P + tx] = 0;
+                }
+        }
+        if (!any) return -1;
+    }
+    xr = tt_xcorr_masked_best((const tt_xcorr_texture *const *)S->tex, S->rotations, S->mask, S->values,
+                              S->allowed, S->xwork, &match, &best_k, error);
+    if (xr == TT_ERROR_NOT_MEASURED) return -1;
+    if (xr != TT_OK) {
+        *res = xr;
+        return -2;
+    }
+    S->rep.fits++;
+
+    /* The placement of the best offset, refined at full resolution by a
+       direct sum over +-(f - 1) texels (D30). */
+    {
+        double th = TT__TWO_PI * best_k / S->rotations, ct = cos(th), st = sin(th);
+        double tx = match.x - o[0] - cb, ty = match.y - o[1] - cb, best = -1, vb[3], vc[3];
+        double pbox[4];
+        int dx, dy, bdx = 0, bdy = 0, reach = S->f - 1, c;
+        pl->cos_a = cos(phi - th);
+        pl->sin_a = sin(phi - th);
+        pl->shift[0] = S->f * (ct * tx + st * ty + ctx);
+        pl->shift[1] = S->f * (-st * tx + ct * ty + cty);
+        tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, pbox);
+        for (dy = -reach; dy <= reach; dy++)
+            for (dx = -reach; dx <= reach; dx++) {
+                double sum = 0;
+                if (!S->toroidal && (pbox[0] + pl->shift[0] + dx < 1 || pbox[1] + pl->shift[1] + dy < 1 ||
+                                     pbox[2] + pl->shift[0] + dx > S->W - 1 ||
+                                     pbox[3] + pl->shift[1] + dy > S->Hh - 1))
+                    continue;
+                for (i = 0; i < S->nband; i++) {
+                    int at = S->band_pixels[i];
+                    double cx = at % P + 0.5 + match.x - cb, cy = at / P + 0.5 + match.y - cb;
+                    double xcx = S->f * (ct * cx + st * cy + ctx) + dx, xcy = S->f * (-st * cx + ct * cy + cty) + dy;
+                    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, S->src[2 * at], S->src[2 * at + 1], S->toroidal,
+                                   vb);
+                    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, xcx, xcy, S->toroidal, vc);
+                    for (c = 0; c < S->nch; c++) sum += (vb[c] - vc[c]) * (vb[c] - vc[c]);
+                }
+                if (best < 0 || sum < best) {
+                    best = sum;
+                    bdx = dx;
+                    bdy = dy;
+                }
+            }
+        if (best < 0) return -1;
+        pl->shift[0] += bdx;
+        pl->shift[1] += bdy;
+        *eps = best / ((double)S->nch * S->nband) / (2 * S->sigma2);
+    }
+    return 1;
+}
+
+/* Step 5: C's corners get s R q + shift; for a toroidal image the whole
+   cluster moves by periods so that its centre lies in the image. */
+static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    double sum[2] = {0, 0}, px = 0, py = 0;
+    int i, j, n = 0;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (j = S->mesh->face_start[f]; j < S->mesh->face_start[f + 1]; j++) {
+            double q[2];
+            tt__hpm_q(S, j, q);
+            tt__hpm_apply(S, pl, q, uv + 2 * j);
+            sum[0] += uv[2 * j];
+            sum[1] += uv[2 * j + 1];
+            n++;
+        }
+    }
+    if (S->toroidal) {
+        px = S->W * floor(sum[0] / n / S->W);
+        py = S->Hh * floor(sum[1] / n / S->Hh);
+        for (i = 0; i < cl->nfaces; i++) {
+            int f = S->H->faces[cl->first_face + i];
+            for (j = S->mesh->face_start[f]; j < S->mesh->face_start[f + 1]; j++) {
+                uv[2 * j] -= px;
+                uv[2 * j + 1] -= py;
+            }
+        }
+    }
+}
+
+/* C is textured by placement pl: write its corners, record it, queue its
+   same-level neighbours. */
+static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    int i;
+    tt__hpm_write(S, C, pl, S->uv);
+    if (S->out) {
+        tt__hpm_place rp;
+        if (!tt__hpm_random_place(S, &S->place_rng, C, &rp)) rp = *pl;
+        tt__hpm_write(S, C, &rp, S->out);
+    }
+    for (i = 0; i < cl->nfaces; i++) S->owner[S->H->faces[cl->first_face + i]] = C;
+    S->textured += cl->nfaces;
+    S->rep.clusters++;
+    S->rep.mapped_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
+    for (i = 0; i < cl->nneighbours; i++) {
+        int nb = S->H->neighbours[cl->first_neighbour + i];
+        if (S->state[nb] != 1 && tt__hpm_textured_state(S, nb) == 0 && !tt__hpm_push(S, cl->level, nb)) return 0;
+    }
+    return 1;
+}
+
+/* One cluster taken from the queues (Sec. 2.2 step 2). Returns 1, or 0 on
+   an error in *res. */
+static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res, tt_error *error)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    double area_px = cl->area * S->s * S->s, eps = 0;
+    int below_floor, at_floor, stamp, fit;
+    tt__hpm_place pl;
+    tt_result fr;
+    tt_flatten_report frep;
+    S->state[C] = 1;
+    if (!(cl->flags & TT_CLUSTER_MAPPABLE)) return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    fr = tt_flatten_cluster(S->mesh, S->H, C, &S->fopt, S->al, S->flat, &frep, NULL);
+    if (fr == TT_ERROR_OUT_OF_MEMORY) {
+        *res = tt__fail(error, fr, -1, -1, -1, -1, "out of memory flattening cluster %d", C);
+        return 0;
+    }
+    if (fr != TT_OK) {
+        /* Not flat (or a degenerate single face): split; a face that
+           cannot be flattened shows its neighbours' texture at the end. */
+        S->rep.not_flat++;
+        if (cl->nchildren == 0) return 1;
+        return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    }
+    below_floor = area_px < S->floor_px || cl->nfaces < S->min_faces;
+    at_floor = cl->nchildren == 0 || area_px / cl->nchildren < S->floor_px ||
+               cl->nfaces / cl->nchildren < S->min_faces;
+    stamp = tt__hpm_mark(S, C);
+    if (!tt__hpm_owners(S, C, stamp)) {
+        *res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory placing cluster %d", C);
+        return 0;
+    }
+    fit = 0;
+    if (has_neighbours && below_floor && tt__hpm_continue_place(S, C, &pl)) {
+        S->rep.continued++;
+        return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    }
+    if (has_neighbours) {
+        fit = tt__hpm_fit(S, C, stamp, &pl, &eps, res, error);
+        if (fit == -2) return 0;
+    }
+    if (fit == 1) {
+        if (eps <= S->threshold || at_floor) {
+            if (eps <= S->threshold)
+                S->rep.accepted_fits++;
+            else
+                S->rep.floor_fits++;
+            S->error_sum += eps;
+            if (eps > S->rep.max_error) S->rep.max_error = eps;
+            return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+        }
+        S->rep.rejected_fits++;
+        return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    }
+    if (fit == -1 && !at_floor) {
+        S->rep.no_room++;
+        return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    }
+    if (tt__hpm_continue_place(S, C, &pl)) {
+        S->rep.continued++;
+        return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    }
+    if (tt__hpm_random_place(S, &S->rng, C, &pl)) {
+        S->rep.starts++;
+        return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    }
+    S->rep.no_room++;
+    if (cl->nchildren == 0) return 1;
+    return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+}
+
+/* The traversal (Sec. 2.2, D22). */
+static tt_result tt__hpm_traverse(tt__hpm *S, tt_error *error)
+{
+    tt_result res = TT_OK;
+    int level, next_start = 0;
+    for (;;) {
+        int C, count, l, others = 0;
+        tt__heap_item it;
+        for (level = 0; level < S->H->nlevels && S->qcount[level] == 0; level++) {}
+        if (level == S->H->nlevels) {
+            /* The queues are empty: a waiting cluster that now has a
+               textured neighbour, else the first waiting one as a new
+               start, else the first cluster never reached (D22). */
+            int i, pick = -1, kept = 0;
+            for (i = 0; i < S->nwaiting; i++) {
+                int w = S->waiting[i];
+                if (S->state[w] == 1) continue;
+                S->waiting[kept++] = w;
+                tt__hpm_key(S, w, &count);
+                if (count > 0 || tt__hpm_textured_state(S, w) != 0) {
+                    S->state[w] = 0;
+                    if (!tt__hpm_push(S, S->H->clusters[w].level, w)) goto oom;
+                    kept--;
+                }
+            }
+            S->nwaiting = kept;
+            for (level = 0; level < S->H->nlevels && S->qcount[level] == 0; level++) {}
+            if (level < S->H->nlevels) continue;
+            if (S->nwaiting > 0) {
+                pick = S->waiting[0];
+                for (i = 1; i < S->nwaiting; i++) S->waiting[i - 1] = S->waiting[i];
+                S->nwaiting--;
+                if (!tt__hpm_process(S, pick, 0, &res, error)) return res;
+                continue;
+            }
+            while (next_start < S->H->nclusters && S->state[next_start] == 1) next_start++;
+            if (next_start == S->H->nclusters) break;
+            if (!tt__hpm_push(S, S->H->clusters[next_start].level, next_start)) goto oom;
+            next_start++;
+            continue;
+        }
+        it = tt__heap_pop(S->queue[level], &S->qcount[level]);
+        C = it.value;
+        if (S->state[C] == 1) continue;
+        switch (tt__hpm_textured_state(S, C)) {
+        case 2:
+            S->state[C] = 1;
+            continue;
+        case 1:
+            S->state[C] = 1;
+            if (!tt__hpm_split(S, C)) goto oom;
+            continue;
+        default:
+            break;
+        }
+        tt__hpm_key(S, C, &count);
+        for (l = 0; l < S->H->nlevels; l++) others += S->qcount[l];
+        if (count == 0 && others > 0) {
+            /* No textured neighbour yet: wait, rather than start a region
+               that nothing will continue. */
+            if (S->state[C] != 2) {
+                if (S->nwaiting == S->waitcap) {
+                    int *nw = (int *)tt__grow(S->al, S->waiting, &S->waitcap, S->nwaiting + 1, sizeof(int));
+                    if (!nw) goto oom;
+                    S->waiting = nw;
+                }
+                S->waiting[S->nwaiting++] = C;
+                S->state[C] = 2;
+            }
+            continue;
+        }
+        if (!tt__hpm_process(S, C, count > 0, &res, error)) return res;
+        if (S->progress && S->progress((float)S->textured / S->mesh->nfaces, S->progress_user_data))
+            return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "hierarchical pattern mapping cancelled");
+    }
+    return TT_OK;
+oom:
+    return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory in the traversal");
+}
+
+/* Faces that could not be flattened (degenerate single faces): each
+   corner takes the texture coordinate a textured face around its vertex
+   gives it. */
+static void tt__hpm_leftovers(tt__hpm *S, double *uv)
+{
+    const tt_mesh *m = S->mesh;
+    int f, j;
+    for (f = 0; f < m->nfaces; f++) {
+        if (S->owner[f] >= 0) continue;
+        for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
+            int v = m->corner_vert[j], h = m->vert_corner[v], start = h, guard = 0, found = 0;
+            while (h >= 0 && guard++ <= m->ncorners) {
+                if (S->owner[m->corner_face[h]] >= 0) {
+                    uv[2 * j] = uv[2 * h];
+                    uv[2 * j + 1] = uv[2 * h + 1];
+                    found = 1;
+                    break;
+                }
+                h = m->twin[tt_mesh_prev(m, h)];
+                if (h == start) break;
+            }
+            if (!found) {
+                uv[2 * j] = 0.5 * S->W;
+                uv[2 * j + 1] = 0.5 * S->Hh;
+            }
+        }
+    }
+}
+
+static void tt__hpm_release(tt__hpm *S)
+{
+    int k;
+    if (S->tex)
+        for (k = 0; k < S->rotations; k++) tt_xcorr_texture_free(S->tex[k]);
+    if (S->queue)
+        for (k = 0; k < S->H->nlevels; k++) tt__free(S->al, S->queue[k]);
+    tt__free(S->al, S->tex);
+    tt__free(S->al, S->queue);
+    tt__free(S->al, S->qcount);
+    tt__free(S->al, S->qcap);
+    tt__free(S->al, S->full);
+    tt__free(S->al, S->match);
+    tt__free(S->al, S->xwork);
+    tt__free(S->al, S->mask);
+    tt__free(S->al, S->values);
+    tt__free(S->al, S->support);
+    tt__free(S->al, S->allowed_mem);
+    tt__free(S->al, (void *)S->allowed);
+    tt__free(S->al, S->dist);
+    tt__free(S->al, S->src);
+    tt__free(S->al, S->band_pixels);
+    tt__free(S->al, S->flat);
+    tt__free(S->al, S->uv);
+    tt__free(S->al, S->out);
+    tt__free(S->al, S->owner);
+    tt__free(S->al, S->in_c);
+    tt__free(S->al, S->seen);
+    tt__free(S->al, S->state);
+    tt__free(S->al, S->waiting);
+    tt__free(S->al, S->heap);
+    tt__free(S->al, S->near_faces);
+    tt__free(S->al, S->owners);
+    tt__free(S->al, S->pairs);
+    tt_cluster_hierarchy_free(S->H);
+}
+
+TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
+                           const tt_allocator *allocator, float *corner_uv, int *face_cluster,
+                           tt_hpm_report *report, tt_error *error)
+{
+    tt__hpm S;
+    tt_hpm_options o;
+    tt_cluster_options copt;
+    tt_result res;
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag, total_area = 0;
+    int i, f, match_size;
+
+    memset(&S, 0, sizeof S);
+    if (report) memset(report, 0, sizeof *report);
+    tt__ok(error);
+    if (!mesh || !image || !corner_uv)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_hpm_map needs a mesh, an image and corner_uv (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (!image->pixels || image->width < 1 || image->height < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "tt_hpm_map: the image is empty");
+    if (mesh->nfaces < 1) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    if (options)
+        o = *options;
+    else
+        memset(&o, 0, sizeof o);
+    match_size = o.match_size ? o.match_size : TT_DEFAULT_HPM_MATCH_SIZE;
+    if (!(o.scale >= 0 && o.scale < 1e300) || !(o.threshold >= 0) || o.rotations < 0 || o.rotations > 64 ||
+        !(o.band >= 0 && o.band <= 1e6) || match_size < 16 || match_size > 512 ||
+        (match_size & (match_size - 1)) != 0 || !(o.min_footprint >= 0 && o.min_footprint < 1e300) ||
+        o.min_faces < 0 || (o.flags & ~7u) != 0 || !(o.max_flattening_error >= 0) ||
+        (o.branching != 0 && (o.branching < 2 || o.branching > 64)))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "hpm options out of range: scale %g (>= 0), threshold %g (>= 0), rotations %d (0..64), "
+                        "band %g (0..1e6), match_size %d (a power of two, 16..512), min_footprint %g (>= 0), "
+                        "min_faces %d (>= 0), flags 0x%x, branching %d (0 or 2..64), max_flattening_error %g "
+                        "(>= 0)",
+                        o.scale, o.threshold, o.rotations, o.band, match_size, o.min_footprint, o.min_faces,
+                        o.flags, o.branching, o.max_flattening_error);
+    for (f = 0; f < mesh->nfaces; f++) {
+        const int *c = mesh->corner_vert + mesh->face_start[f];
+        double e[3], g[3], cr[3];
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d has %d corners: hierarchical pattern mapping needs triangles", f,
+                            mesh->face_start[f + 1] - mesh->face_start[f]);
+        tt__sub3f(mesh->pos + 3 * c[1], mesh->pos + 3 * c[0], e);
+        tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[0], g);
+        tt__cross3(e, g, cr);
+        total_area += 0.5 * tt__length3(cr);
+        for (i = 0; i < 3; i++) {
+            int k;
+            for (k = 0; k < 3; k++) {
+                double v = mesh->pos[3 * c[i] + k];
+                if (v < lo[k]) lo[k] = v;
+                if (v > hi[k]) hi[k] = v;
+            }
+        }
+    }
+    if (!(total_area > 0))
+        return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, -1, -1, -1, -1,
+                        "every face of the mesh has zero area: nothing to texture");
+    diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+
+    S.mesh = mesh;
+    S.al = allocator;
+    S.flags = o.flags;
+    S.toroidal = (o.flags & TT_HPM_TOROIDAL) != 0;
+    S.threshold = o.threshold > 0 ? o.threshold : TT_DEFAULT_HPM_THRESHOLD;
+    S.rotations = o.rotations ? o.rotations : TT_DEFAULT_HPM_ROTATIONS;
+    S.band = o.band;
+    S.floor_px = o.min_footprint > 0 ? o.min_footprint : TT_DEFAULT_HPM_MIN_FOOTPRINT;
+    S.min_faces = o.min_faces ? o.min_faces : TT_DEFAULT_HPM_MIN_FACES;
+    S.s = image->width / (o.scale > 0 ? o.scale : diag / 4);
+    S.fopt.max_error = o.max_flattening_error;
+    S.progress = o.progress;
+    S.progress_user_data = o.progress_user_data;
+    tt_rng_seed(&S.rng, o.seed, 0x68706d);
+    tt_rng_seed(&S.place_rng, o.seed, 0x706c6163);
+    if (!(S.s > 0 && S.s < 1e300))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "hpm: scale %g gives no texel density (the mesh's bounding box diagonal is %g)", o.scale,
+                        diag);
+
+    memset(&copt, 0, sizeof copt);
+    copt.seed = o.seed;
+    copt.branching = o.branching;
+    res = tt_cluster_hierarchy_build(mesh, &copt, allocator, &S.H, error);
+    if (res != TT_OK) return res;
+    res = tt__hpm_prepare_image(&S, image, match_size, error);
+    if (res != TT_OK) goto done;
+
+    S.flat = TT__ALLOC(allocator, float, 2 * (size_t)mesh->ncorners);
+    S.uv = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
+    if (o.flags & TT_HPM_RANDOM_PLACEMENT) S.out = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
+    S.owner = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
+    S.in_c = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
+    S.seen = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
+    S.state = TT__ALLOC(allocator, unsigned char, (size_t)S.H->nclusters);
+    S.queue = TT__ALLOC(allocator, tt__heap_item *, (size_t)S.H->nlevels);
+    if (S.queue)
+        for (i = 0; i < S.H->nlevels; i++) S.queue[i] = NULL;
+    S.qcount = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
+    S.qcap = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
+    S.heap = TT__ALLOC(allocator, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
+    S.near_faces = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
+    if (!S.flat || !S.uv || ((o.flags & TT_HPM_RANDOM_PLACEMENT) && !S.out) || !S.owner || !S.in_c || !S.seen ||
+        !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap || !S.near_faces) {
+        res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
+        goto done;
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        S.owner[f] = -1;
+        S.in_c[f] = S.seen[f] = 0;
+    }
+    memset(S.state, 0, (size_t)S.H->nclusters);
+    for (i = 0; i < S.H->nlevels; i++) {
+        S.queue[i] = NULL;
+        S.qcount[i] = S.qcap[i] = 0;
+    }
+    for (i = 0; i < 2 * mesh->ncorners; i++) {
+        S.uv[i] = 0;
+        if (S.out) S.out[i] = 0;
+    }
+    res = tt__hpm_traverse(&S, error);
+    if (res != TT_OK) goto done;
+    tt__hpm_leftovers(&S, S.uv);
+    if (S.out) tt__hpm_leftovers(&S, S.out);
+    {
+        const double *x = S.out ? S.out : S.uv;
+        for (i = 0; i < mesh->ncorners; i++) {
+            corner_uv[2 * i] = (float)(x[2 * i] / S.W);
+            corner_uv[2 * i + 1] = (float)(1 - x[2 * i + 1] / S.Hh);
+        }
+    }
+    if (face_cluster)
+        for (f = 0; f < mesh->nfaces; f++) face_cluster[f] = S.owner[f];
+    S.rep.levels = S.H->nlevels;
+    S.rep.texels_per_unit = S.s;
+    S.rep.match_width = S.ww;
+    S.rep.match_height = S.wh;
+    S.rep.fft_size = S.P;
+    {
+        int accepted = S.rep.accepted_fits + S.rep.floor_fits;
+        S.rep.mean_error = accepted > 0 ? S.error_sum / accepted : 0;
+    }
+    if (report) *report = S.rep;
+done:
+    tt__hpm_release(&S);
     return res;
 }
 

@@ -1110,6 +1110,346 @@ end:
     tt_mesh_free(other);
 }
 
+
+/* ------------------------------------------------------------------------ */
+/* The pipeline: tt_hpm_map                                                 */
+/* ------------------------------------------------------------------------ */
+
+/* A plane folded along x = 0 by `fold` radians (0: flat), nx x ny unit
+   quads, triangulated, CCW seen from +z. */
+static tt_mesh *hpm_book(int nx, int ny, double fold)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= ny; j++)
+        for (i = 0; i <= nx; i++) {
+            double x = i - nx / 2.0;
+            if (x <= 0)
+                tm_vert(&m, x, j, 0);
+            else
+                tm_vert(&m, x * cos(fold), j, x * sin(fold));
+        }
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++) {
+            int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 2, d = a + nx + 1;
+            tm_tri(&m, a, b, c);
+            tm_tri(&m, a, c, d);
+        }
+    if (build(&m, 0, &mesh, &err) != TT_OK) CHECK(0, "building the book failed: %s", err.message);
+    tm_free(&m);
+    return mesh;
+}
+
+static tt_result hpm_run(const tt_mesh *mesh, const tt_image *im, const tt_hpm_options *o, float **uv,
+                         int **cluster, tt_hpm_report *rep)
+{
+    tt_error err;
+    tt_result r;
+    *uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    *cluster = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+    r = tt_hpm_map(mesh, im, o, NULL, *uv, *cluster, rep, &err);
+    CHECK(r == TT_OK, "tt_hpm_map returned %d (%s)", r, err.message);
+    return r;
+}
+
+/* UV triangles with a signed area <= 0 (v up), and corners that are not
+   finite or (bounded) closer than one texel to the border. */
+static void hpm_uv_checks(const tt_mesh *mesh, const float *uv, int w, int h, int bounded, int *flipped,
+                          int *bad)
+{
+    int f, k;
+    *flipped = *bad = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        const float *a = uv + 2 * mesh->face_start[f], *b = a + 2, *c = a + 4;
+        double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if (!(area > 0)) (*flipped)++;
+    }
+    for (k = 0; k < mesh->ncorners; k++) {
+        double u = uv[2 * k], v = uv[2 * k + 1];
+        if (!isfinite(u) || !isfinite(v)) (*bad)++;
+        else if (bounded && (u * w < 1 - 1e-3 || u * w > w - 1 + 1e-3 || v * h < 1 - 1e-3 || v * h > h - 1 + 1e-3))
+            (*bad)++;
+    }
+}
+
+/* Largest jump of a vertex's texel position across interior edges. */
+static double hpm_max_jump(const tt_mesh *mesh, const float *uv, int w, int h, int periodic)
+{
+    int c;
+    double worst = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], k;
+        if (t < 0) continue;
+        /* corner c and the corner after t sit on the same vertex */
+        k = tt_mesh_next(mesh, t);
+        {
+            double du = (uv[2 * c] - uv[2 * k]) * w, dv = (uv[2 * c + 1] - uv[2 * k + 1]) * h;
+            /* toroidal maps: whole clusters move by whole periods */
+            if (periodic) {
+                du -= w * floor(du / w + 0.5);
+                dv -= h * floor(dv / h + 0.5);
+            }
+            double d = sqrt(du * du + dv * dv);
+            if (d > worst) worst = d;
+        }
+    }
+    return worst;
+}
+
+/* T6: a plane that fits in a bounded image maps as one undistorted piece. */
+static void test_hpm_map_plane(void)
+{
+    tt_mesh *mesh = hpm_book(30, 20, 0);
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    tt_hpm_report rep;
+    float *uv = NULL;
+    int *cl = NULL, f, flipped, bad, differ = 0;
+    double worst = 0;
+    make_value_noise(&im, 96, 80, 3);
+    memset(&o, 0, sizeof o);
+    o.scale = 60; /* 30 units across = half the image */
+    if (!mesh || !im || hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    CHECK(rep.clusters == 1 && rep.fits == 0 && rep.starts == 1, "one cluster, placed once (%d clusters, %d fits)",
+          rep.clusters, rep.fits);
+    for (f = 1; f < mesh->nfaces; f++) differ += cl[f] != cl[0];
+    CHECK(differ == 0 && cl[0] >= 0, "every face shows cluster %d (%d differ)", cl[0], differ);
+    CHECK(near(rep.texels_per_unit, 96.0 / 60, 1e-12), "texel density %g", rep.texels_per_unit);
+    /* A similarity: texel distances are world distances times the density. */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int c = mesh->face_start[f], k;
+        for (k = 0; k < 3; k++) {
+            int a = c + k, b = c + (k + 1) % 3;
+            const float *pa = mesh->pos + 3 * mesh->corner_vert[a], *pb = mesh->pos + 3 * mesh->corner_vert[b];
+            double d3 = sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]));
+            double du = (uv[2 * a] - uv[2 * b]) * 96, dv = (uv[2 * a + 1] - uv[2 * b + 1]) * 80;
+            double e = fabs(sqrt(du * du + dv * dv) - d3 * 96 / 60);
+            if (e > worst) worst = e;
+        }
+    }
+    CHECK(worst < 1e-3, "edge lengths kept to %g texels", worst);
+    CHECK(hpm_max_jump(mesh, uv, 96, 80, 0) < 1e-3, "no UV discontinuity inside the plane (%g texels)",
+          hpm_max_jump(mesh, uv, 96, 80, 0));
+    hpm_uv_checks(mesh, uv, 96, 80, 1, &flipped, &bad);
+    CHECK(flipped == 0 && bad == 0, "%d flipped, %d corners outside the image's margin", flipped, bad);
+done:
+    free(uv);
+    free(cl);
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
+/* T7: with no random turn and one orientation, a cluster next to a textured
+   one is placed as its exact continuation, so a folded sheet (two planes,
+   neither flat across the fold) comes out as one continuous map; with the
+   default exclusion of that continuation (D8) it does not. */
+static void test_hpm_map_continuation(void)
+{
+    tt_mesh *mesh = hpm_book(40, 24, 1.2);
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    tt_hpm_report rep;
+    float *uv = NULL;
+    int *cl = NULL, flipped, bad;
+    make_value_noise(&im, 64, 64, 5);
+    memset(&o, 0, sizeof o);
+    o.scale = 20;
+    o.rotations = 1;
+    o.flags = TT_HPM_TOROIDAL | TT_HPM_NO_RANDOM_TURN;
+    o.min_faces = 4;
+    o.min_footprint = 16;
+    /* only exactly planar clusters: a cluster across the fold flattens
+       with a little distortion, and its continuation is then not exact */
+    o.max_flattening_error = 1e-9;
+    if (!mesh || !im || hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    CHECK(rep.fits >= 2, "the sheet needs fits (%d, %d clusters)", rep.fits, rep.clusters);
+    CHECK(rep.max_error < 1e-4, "continuations fit exactly (largest eps %g)", rep.max_error);
+    CHECK(hpm_max_jump(mesh, uv, 64, 64, 1) < 0.01, "the map is continuous across every border (%g texels)",
+          hpm_max_jump(mesh, uv, 64, 64, 1));
+    hpm_uv_checks(mesh, uv, 64, 64, 0, &flipped, &bad);
+    CHECK(flipped == 0 && bad == 0, "%d flipped, %d non-finite", flipped, bad);
+    free(uv);
+    free(cl);
+    uv = NULL;
+    cl = NULL;
+    o.flags = TT_HPM_TOROIDAL;
+    if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    CHECK(rep.fits >= 2 && rep.max_error > 1e-3, "without the switch no fit is the exact continuation (eps %g)",
+          rep.max_error);
+    CHECK(hpm_max_jump(mesh, uv, 64, 64, 1) > 1, "and the borders show (%g texels)", hpm_max_jump(mesh, uv, 64, 64, 1));
+done:
+    free(uv);
+    free(cl);
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
+/* Seams on cluster borders: the fit against random placement of the same
+   clusters (the control must score much worse). */
+static void test_hpm_map_seams(void)
+{
+    tt_mesh *mesh = hpm_mesh(M_SPHERE);
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    tt_hpm_report rep, rep_random;
+    tt_seam_options so;
+    tt_seam_report fit, rnd;
+    float *uv = NULL, *uv_random = NULL;
+    int *cl = NULL, *cl_random = NULL, f, same = 1, flipped, bad;
+    make_value_noise(&im, 128, 128, 9);
+    memset(&o, 0, sizeof o);
+    o.scale = 6;
+    if (!mesh || !im || hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    o.flags = TT_HPM_RANDOM_PLACEMENT;
+    if (hpm_run(mesh, im, &o, &uv_random, &cl_random, &rep_random) != TT_OK) goto done;
+    for (f = 0; f < mesh->nfaces; f++) same &= cl[f] == cl_random[f];
+    CHECK(same && rep.clusters == rep_random.clusters && rep.clusters > 4,
+          "the control textures the same %d clusters", rep.clusters);
+    hpm_uv_checks(mesh, uv, 128, 128, 1, &flipped, &bad);
+    CHECK(flipped == 0 && bad == 0, "fit: %d flipped, %d corners outside the margin", flipped, bad);
+    hpm_uv_checks(mesh, uv_random, 128, 128, 1, &flipped, &bad);
+    CHECK(flipped == 0 && bad == 0, "control: %d flipped, %d corners outside the margin", flipped, bad);
+    memset(&so, 0, sizeof so);
+    CHECK(tt_measure_seams(mesh, uv, im, &so, NULL, &fit, NULL) == TT_OK &&
+              tt_measure_seams(mesh, uv_random, im, &so, NULL, &rnd, NULL) == TT_OK,
+          "seams measured");
+    CHECK(fit.seam - fit.same_face < 0.5 * (rnd.seam - rnd.same_face),
+          "fitted borders differ less than random ones (seam excess %g against %g)", fit.seam - fit.same_face,
+          rnd.seam - rnd.same_face);
+done:
+    free(uv);
+    free(uv_random);
+    free(cl);
+    free(cl_random);
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
+/* T10 and A10: every face textured, no flip, UVs finite (bounded: inside
+   the margin) on a torus, a sphere, an open grid, two components and a
+   grid with holes, with a non-square, non-power-of-two image; the same seed
+   gives the same bits, another seed other bits. */
+static void test_hpm_map_topology(void)
+{
+    int which;
+    tt_image *im = NULL;
+    make_value_noise(&im, 90, 70, 2);
+    for (which = 0; which < M_COUNT && im; which++) {
+        tt_mesh *mesh = hpm_mesh(which);
+        tt_hpm_options o;
+        tt_hpm_report rep;
+        float *uv = NULL, *uv2 = NULL;
+        int *cl = NULL, *cl2 = NULL, f, untextured = 0, flipped, bad, t;
+        for (t = 0; t < 2 && mesh; t++) {
+            memset(&o, 0, sizeof o);
+            o.seed = 7;
+            o.flags = t ? TT_HPM_TOROIDAL : 0;
+            if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) break;
+            for (f = 0; f < mesh->nfaces; f++) untextured += cl[f] < 0;
+            hpm_uv_checks(mesh, uv, 90, 70, !t, &flipped, &bad);
+            CHECK(untextured == 0 && flipped == 0 && bad == 0,
+                  "%s (%s): %d faces untextured, %d flipped, %d bad corners", mesh_names[which],
+                  t ? "toroidal" : "bounded", untextured, flipped, bad);
+            if (hpm_run(mesh, im, &o, &uv2, &cl2, &rep) == TT_OK)
+                CHECK(memcmp(uv, uv2, sizeof(float) * 2 * (size_t)mesh->ncorners) == 0,
+                      "%s: the same seed gives the same UVs", mesh_names[which]);
+            free(uv2);
+            free(cl2);
+            o.seed = 8;
+            if (hpm_run(mesh, im, &o, &uv2, &cl2, &rep) == TT_OK)
+                CHECK(memcmp(uv, uv2, sizeof(float) * 2 * (size_t)mesh->ncorners) != 0,
+                      "%s: another seed gives other UVs", mesh_names[which]);
+            free(uv);
+            free(cl);
+            free(uv2);
+            free(cl2);
+            uv = uv2 = NULL;
+            cl = cl2 = NULL;
+        }
+        free(uv);
+        free(cl);
+        tt_mesh_free(mesh);
+    }
+    tt_image_free(im);
+}
+
+typedef struct hpm_map_ctx {
+    const tt_mesh *mesh;
+    const tt_image *im;
+    float *uv;
+} hpm_map_ctx;
+
+static tt_result hpm_map_oom_call(void *ctx, const tt_allocator *al)
+{
+    hpm_map_ctx *c = (hpm_map_ctx *)ctx;
+    tt_hpm_options o;
+    memset(&o, 0, sizeof o);
+    o.rotations = 3;
+    o.match_size = 16;
+    return tt_hpm_map(c->mesh, c->im, &o, al, c->uv, NULL, NULL, NULL);
+}
+
+static void test_hpm_map_errors(void)
+{
+    tt_mesh *mesh = hpm_mesh(M_GRID), *quads = NULL;
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    tt_error err;
+    tmesh q;
+    float *uv;
+    hpm_map_ctx ctx;
+    make_value_noise(&im, 40, 40, 1);
+    if (!mesh || !im) goto done;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_hpm_map(NULL, im, NULL, NULL, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh");
+    CHECK(tt_hpm_map(mesh, NULL, NULL, NULL, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL image");
+    CHECK(tt_hpm_map(mesh, im, NULL, NULL, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL uv");
+    memset(&o, 0, sizeof o);
+    o.rotations = 65;
+    CHECK(tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              strstr(err.message, "rotations"),
+          "rotations 65: %s", err.message);
+    memset(&o, 0, sizeof o);
+    o.match_size = 100;
+    CHECK(tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "match_size 100");
+    memset(&o, 0, sizeof o);
+    o.scale = -1;
+    CHECK(tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "negative scale");
+    memset(&o, 0, sizeof o);
+    o.threshold = (double)NAN;
+    CHECK(tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NaN threshold");
+    memset(&o, 0, sizeof o);
+    o.flags = 1u << 7;
+    CHECK(tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "unknown flag");
+    px(im, 3, 4)[1] = (float)NAN;
+    CHECK(tt_hpm_map(mesh, im, NULL, NULL, uv, NULL, NULL, &err) == TT_ERROR_NON_FINITE && err.row == 4 &&
+              err.column == 3,
+          "a NaN texel is named (row %d, column %d)", err.row, err.column);
+    px(im, 3, 4)[1] = 0.5f;
+    memset(&q, 0, sizeof q);
+    make_grid(&q, 3, 3);
+    if (build(&q, 0, &quads, &err) == TT_OK) {
+        float quv[2 * 36];
+        CHECK(tt_hpm_map(quads, im, NULL, NULL, quv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  err.face == 0,
+              "quads are refused, naming face 0 (%d)", err.face);
+    }
+    tm_free(&q);
+    tt_mesh_free(quads);
+    ctx.mesh = mesh;
+    ctx.im = im;
+    ctx.uv = uv;
+    oom_reset();
+    oom_sweep("tt_hpm_map", hpm_map_oom_call, &ctx, TT_OK);
+    free(uv);
+done:
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
 void run_hpm_tests(void)
 {
     RUN(test_hpm_properties);
@@ -1122,4 +1462,9 @@ void run_hpm_tests(void)
     RUN(test_flatten_folds);
     RUN(test_flatten_clusters);
     RUN(test_flatten_errors);
+    RUN(test_hpm_map_plane);
+    RUN(test_hpm_map_continuation);
+    RUN(test_hpm_map_seams);
+    RUN(test_hpm_map_topology);
+    RUN(test_hpm_map_errors);
 }
