@@ -1796,12 +1796,20 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         (sRGB-encoded) turned into Y, Cb, Cr - a Euclidean colour space, so
         squared differences add up; one channel (Y) for a grey image - and
         box-filtered by 2^k until its larger side is at most match_size.
-        rotations copies of it, turned by 2 pi i / rotations, are laid out
-        on a P x P grid (P a power of two holding a turned copy, or for a
-        toroidal image two periods of it) and their spectra cached once
-        (tt_xcorr_texture): this is the memory of the method, R * (channels
-        + 1) * P * (P / 2 + 1) * 16 bytes (19 rotations, 3 channels,
-        P = 256: 40 MB; match_size 64: 10 MB).
+        Copies of it turned by 2 pi i / rotations, those within max_turn of
+        no turn, are laid out on a P x P grid (P a power of two holding a
+        turned copy, or for a toroidal image two periods of it) and their
+        spectra cached once (tt_xcorr_texture): this is the memory of the
+        method, copies * (channels + 1) * P * (P / 2 + 1) * 16 bytes (5
+        copies, 3 channels, P = 256: 10 MB; all 19: 40 MB).
+        Why max_turn: the paper tries all 19 orientations and lets the
+        orientation "propagate from the first texture patch" (Sec. 2.2)
+        through the fit alone; with a band a few texels wide, a brick or a
+        plank turned by 60 or 120 degrees often matches about as well, and
+        the pattern's direction then wanders from patch to patch. Copy 0 is
+        the main neighbour's orientation (step 2), so limiting the turn
+        keeps the direction coherent and makes each fit 2 to 4 times
+        cheaper; max_turn 180 restores the paper's search.
      2. The band (Sec. 4.1, D15, D16): the textured faces near the cluster
         C are drawn into C's flattened frame, each textured neighbour N
         through the rigid map that best takes N's texture coordinates of the
@@ -1843,7 +1851,8 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
    The same mesh, image, options and seed give the same bits. */
 
 #define TT_DEFAULT_HPM_THRESHOLD 0.35   /* eps above which a fit splits the cluster (D4) */
-#define TT_DEFAULT_HPM_ROTATIONS 19     /* orientations per fit: the paper's (Sec. 4.2) */
+#define TT_DEFAULT_HPM_ROTATIONS 19     /* orientations around the circle: the paper's (Sec. 4.2) */
+#define TT_DEFAULT_HPM_MAX_TURN 40.0    /* degrees a patch may turn from its main neighbour: 5 of the 19 */
 #define TT_DEFAULT_HPM_MATCH_SIZE 128   /* larger side of the matching copy of the image (D30) */
 #define TT_DEFAULT_HPM_MIN_FACES 16     /* the floor in faces (D23) */
 #define TT_DEFAULT_HPM_MIN_FOOTPRINT 576.0  /* the floor in texels^2: a patch 24 texels across */
@@ -1853,9 +1862,11 @@ enum {
     TT_HPM_TOROIDAL = 1u << 0,          /* the image tiles: offsets wrap, UVs may leave [0, 1] */
     TT_HPM_RANDOM_PLACEMENT = 1u << 1,  /* the control: the same traversal and decisions, but every
                                            cluster is output at a random place and orientation */
-    TT_HPM_NO_RANDOM_TURN = 1u << 2     /* no random turn of the frame before a fit (D8) and
+    TT_HPM_NO_RANDOM_TURN = 1u << 2,    /* no random turn of the frame before a fit (D8) and
                                            starts at angle 0: a neighbour's exact continuation
                                            can then be found (tests) */
+    TT_HPM_NO_RELAXATION = 1u << 3      /* no relaxation of the borders after each placement
+                                           (Sec. 4.4): the fits alone */
 };
 
 typedef struct tt_hpm_options {
@@ -1864,7 +1875,11 @@ typedef struct tt_hpm_options {
                                diagonal / 4 */
     double threshold;       /* the largest accepted eps; 0 = TT_DEFAULT_HPM_THRESHOLD; +infinity
                                accepts every fit (clusters split only when not flat or with no room) */
-    int rotations;          /* orientations per fit, 1..64; 0 = TT_DEFAULT_HPM_ROTATIONS */
+    int rotations;          /* orientations around the circle, 1..64 (steps of 360 / rotations
+                               degrees); 0 = TT_DEFAULT_HPM_ROTATIONS */
+    double max_turn;        /* degrees, 0..180: a fit tries only the orientations within this turn of
+                               the main textured neighbour's; 0 = TT_DEFAULT_HPM_MAX_TURN; 180 = every
+                               one (the paper) */
     double band;            /* band width in image texels; 0 = per cluster clamp(0.2 * r, 3, 24), r the
                                radius of a disc of the cluster's area (D15) */
     int match_size;         /* 0 = TT_DEFAULT_HPM_MATCH_SIZE; a power of two from 16 to 512 */
@@ -1881,7 +1896,8 @@ typedef struct tt_hpm_report {
     int levels;                             /* the hierarchy's */
     int clusters;                           /* clusters textured */
     int mapped_per_level[TT_HPM_MAX_LEVELS];/* clusters textured at each level */
-    int fits;                               /* masked correlations run (each over every rotation) */
+    int fits;                               /* masked correlations run (each over every copy) */
+    int copies;                             /* turned copies of the image each fit tries */
     int accepted_fits;                      /* fits at or below the threshold */
     int floor_fits;                         /* fits above it, accepted at the floor */
     int rejected_fits;                      /* fits above it: the cluster was split */
@@ -10753,6 +10769,8 @@ typedef struct tt__hpm {
     double s;                   /* texels per world unit */
     double threshold, band, floor_px;
     int rotations, min_faces, toroidal;
+    int copies;                 /* turned copies matched per fit (those within max_turn) */
+    double angle[64];           /* their angles, radians: 0 first, then by growing |angle| */
     unsigned flags;
     tt_flatten_options fopt;
     /* the image in the matching colour space (D3) */
@@ -10761,10 +10779,10 @@ typedef struct tt__hpm {
     double sigma2;              /* mean per-channel variance */
     int f, ww, wh, P;           /* box factor, matching copy's size, FFT size */
     float *match;               /* nch planes ww x wh */
-    tt_xcorr_texture **tex;     /* rotations turned copies */
+    tt_xcorr_texture **tex;     /* `copies` turned copies */
     double *xwork, *mask, *values;
     unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band */
-    unsigned char *allowed_mem; /* rotations x P x P */
+    unsigned char *allowed_mem; /* copies x P x P */
     const unsigned char **allowed;
     float *dist;                /* P x P distance to the footprint, canvas texels */
     float *src;                 /* 2 x P x P: the neighbour's texel position shown at a band pixel */
@@ -10894,16 +10912,16 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
         while (S->P < need) S->P *= 2;
     }
     pp = (size_t)S->P * S->P;
-    S->tex = TT__ALLOC(S->al, tt_xcorr_texture *, (size_t)S->rotations);
+    S->tex = TT__ALLOC(S->al, tt_xcorr_texture *, (size_t)S->copies);
     if (S->tex)
-        for (k = 0; k < S->rotations; k++) S->tex[k] = NULL;
+        for (k = 0; k < S->copies; k++) S->tex[k] = NULL;
     buffer = TT__ALLOC(S->al, double, (size_t)S->nch * pp);
     if (!S->tex || !buffer) {
         tt__free(S->al, buffer);
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (turned copies)");
     }
-    for (k = 0; k < S->rotations && res == TT_OK; k++) {
-        double th = TT__TWO_PI * k / S->rotations, ct = cos(th), st = sin(th);
+    for (k = 0; k < S->copies && res == TT_OK; k++) {
+        double th = S->angle[k], ct = cos(th), st = sin(th);
         double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
         for (y = 0; y < S->P; y++)
             for (x = 0; x < S->P; x++) {
@@ -10926,15 +10944,15 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
     S->mask = TT__ALLOC(S->al, double, pp);
     S->values = TT__ALLOC(S->al, double, (size_t)S->nch * pp);
     S->support = TT__ALLOC(S->al, unsigned char, pp);
-    S->allowed_mem = TT__ALLOC(S->al, unsigned char, pp * (size_t)S->rotations);
-    S->allowed = TT__ALLOC(S->al, const unsigned char *, (size_t)S->rotations);
+    S->allowed_mem = TT__ALLOC(S->al, unsigned char, pp * (size_t)S->copies);
+    S->allowed = TT__ALLOC(S->al, const unsigned char *, (size_t)S->copies);
     S->dist = TT__ALLOC(S->al, float, pp);
     S->src = TT__ALLOC(S->al, float, 2 * pp);
     S->band_pixels = TT__ALLOC(S->al, int, pp);
     if (!S->xwork || !S->mask || !S->values || !S->support || !S->allowed_mem || !S->allowed || !S->dist ||
         !S->src || !S->band_pixels)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
-    for (k = 0; k < S->rotations; k++) S->allowed[k] = S->allowed_mem + (size_t)k * pp;
+    for (k = 0; k < S->copies; k++) S->allowed[k] = S->allowed_mem + (size_t)k * pp;
     return TT_OK;
 }
 
@@ -11335,6 +11353,15 @@ static void tt__hpm_near_faces(tt__hpm *S, int C, int stamp, double reach)
     }
 }
 
+/* The band width in image texels for cluster C (D15). */
+static double tt__hpm_band_width(const tt__hpm *S, int C)
+{
+    double w;
+    if (S->band > 0) return S->band;
+    w = 0.2 * sqrt(S->H->clusters[C].area * S->s * S->s / TT__PI);
+    return w < 3 ? 3 : (w > 24 ? 24 : w);
+}
+
 /* Steps 2 and 3: the band and the fit. Returns 1 with *pl and *eps when
    a fit was made, 0 when there is no band to fit (continue or start
    instead), -1 when there is no room for C in the image, -2 on
@@ -11353,8 +11380,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     tt_xcorr_match match = {-1, -1, 0, 0, 0};
     tt_result xr;
 
-    w_full = S->band > 0 ? S->band : 0.2 * sqrt(area_px / TT__PI);
-    if (S->band <= 0) w_full = w_full < 3 ? 3 : (w_full > 24 ? 24 : w_full);
+    w_full = tt__hpm_band_width(S, C);
     w_w = w_full / S->f;
     if (w_w < 1.5) w_w = 1.5;
     /* The canvas is turned so that the texture of the neighbour sharing
@@ -11437,9 +11463,9 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
                     if (i > maxx) maxx = i;
                     if (j > maxy) maxy = j;
                 }
-        for (k = 0; k < S->rotations; k++) {
+        for (k = 0; k < S->copies; k++) {
             unsigned char *a = S->allowed_mem + (size_t)k * pp;
-            double th = TT__TWO_PI * k / S->rotations, ct = cos(th), st = sin(th);
+            double th = S->angle[k], ct = cos(th), st = sin(th);
             /* n' = R(theta) n for n = +x, -x, +y, -y; limits L - n.c_T */
             double nx[4], ny[4], lim[4], mx[4];
             int d, tx, ty;
@@ -11493,7 +11519,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         }
         if (!any) return -1;
     }
-    xr = tt_xcorr_masked_best((const tt_xcorr_texture *const *)S->tex, S->rotations, S->mask, S->values,
+    xr = tt_xcorr_masked_best((const tt_xcorr_texture *const *)S->tex, S->copies, S->mask, S->values,
                               S->allowed, S->xwork, &match, &best_k, error);
     if (xr == TT_ERROR_NOT_MEASURED) return -1;
     if (xr != TT_OK) {
@@ -11505,7 +11531,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     /* The placement of the best offset, refined at full resolution by a
        direct sum over +-(f - 1) texels (D30). */
     {
-        double th = TT__TWO_PI * best_k / S->rotations, ct = cos(th), st = sin(th);
+        double th = S->angle[best_k], ct = cos(th), st = sin(th);
         double tx = match.x - o[0] - cb, ty = match.y - o[1] - cb, best = -1, vb[3], vc[3];
         double pbox[4];
         int dx, dy, bdx = 0, bdy = 0, reach = S->f - 1, c;
@@ -11575,6 +11601,203 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
     }
 }
 
+/* ---- The local relaxation along shared borders (Sec. 4.4, D25) ----
+
+   After C is placed, each vertex on its border with textured faces moves
+   C's texture coordinates there by a few texels when that lowers the colour
+   difference across the border: the difference is taken at 8 points of
+   each border edge at the vertex, half a texel on either side of it (where
+   the seam measure looks; tt__hpm_edge_mismatch), and moving
+   the vertex moves the points of its edges by (1 - t) of the move - the
+   hat weight of D25. Each vertex gets TT__HPM_RELAX_TRIALS random trials
+   per pass, greedy, in passes of radius w/2, w/4, w/8 (w the band width).
+   D25's radius w / 2^(depth + 1) is below a texel at the depths where most
+   clusters map, so it would move nothing: the passes shrink instead. A move
+   is refused when an incident triangle of C would flip, shrink below a
+   quarter of its area, or stretch more than TT__HPM_RELAX_MAX_STRETCH (so
+   the stretch measure keeps its bound), or when it would leave a bounded
+   image's margin. The interior is not re-solved (D25's last step): the
+   moves are a few texels and only C's border triangles absorb them. */
+#define TT__HPM_RELAX_TRIALS 8
+#define TT__HPM_RELAX_PASSES 3
+#define TT__HPM_RELAX_SAMPLES 8
+#define TT__HPM_RELAX_MAX_STRETCH 1.3
+
+/* Squared colour difference across border half-edge h of C (twin in a
+   textured face), summed over its sample points: what each side shows half
+   a texel inside its face against what the other side's map, continued
+   across the edge, shows at the same place - 0 for an exact continuation. */
+static double tt__hpm_edge_mismatch(const tt__hpm *S, int h)
+{
+    const tt_mesh *m = S->mesh;
+    int t = m->twin[h], side, i, c;
+    int ends[2][3];     /* per side: corner at the edge's start, at its end, the apex */
+    double sum = 0, n[2][2];
+    ends[0][0] = h;
+    ends[0][1] = tt_mesh_next(m, h);
+    ends[0][2] = tt_mesh_prev(m, h);
+    ends[1][0] = tt_mesh_next(m, t); /* the twin runs the other way */
+    ends[1][1] = t;
+    ends[1][2] = tt_mesh_prev(m, t);
+    for (side = 0; side < 2; side++) {
+        const double *a = S->uv + 2 * ends[side][0], *b = S->uv + 2 * ends[side][1], *x = S->uv + 2 * ends[side][2];
+        double ex = b[0] - a[0], ey = b[1] - a[1], len = sqrt(ex * ex + ey * ey);
+        n[side][0] = n[side][1] = 0;
+        if (len > 0) {
+            n[side][0] = -ey / len;
+            n[side][1] = ex / len;
+            if (n[side][0] * (x[0] - a[0]) + n[side][1] * (x[1] - a[1]) < 0) {
+                n[side][0] = -n[side][0];
+                n[side][1] = -n[side][1];
+            }
+        }
+    }
+    for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) {
+        double tt = (i + 0.5) / TT__HPM_RELAX_SAMPLES, in[2][3], out[2][3];
+        for (side = 0; side < 2; side++) {
+            const double *a = S->uv + 2 * ends[side][0], *b = S->uv + 2 * ends[side][1];
+            double ex = a[0] + tt * (b[0] - a[0]), ey = a[1] + tt * (b[1] - a[1]);
+            tt__hpm_sample(S->full, S->W, S->Hh, S->nch, ex + 0.5 * n[side][0], ey + 0.5 * n[side][1], S->toroidal,
+                           in[side]);
+            tt__hpm_sample(S->full, S->W, S->Hh, S->nch, ex - 0.5 * n[side][0], ey - 0.5 * n[side][1], S->toroidal,
+                           out[side]);
+        }
+        for (c = 0; c < S->nch; c++)
+            sum += (in[0][c] - out[1][c]) * (in[0][c] - out[1][c]) + (in[1][c] - out[0][c]) * (in[1][c] - out[0][c]);
+    }
+    return sum;
+}
+
+/* Twice the signed area of corner c's triangle in texels, and its stretch
+   (ratio of singular values) against the flattened triangle. */
+static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
+{
+    const tt_mesh *m = S->mesh;
+    int k[3], i;
+    double q[3][2], du[2][2], dq[2][2], det, a[2][2], g11, g12, g22, tr, disc, big, small;
+    k[0] = m->face_start[m->corner_face[c]];
+    k[1] = k[0] + 1;
+    k[2] = k[0] + 2;
+    for (i = 0; i < 3; i++) tt__hpm_q(S, k[i], q[i]);
+    for (i = 0; i < 2; i++) {
+        du[i][0] = S->uv[2 * k[i + 1]] - S->uv[2 * k[0]];
+        du[i][1] = S->uv[2 * k[i + 1] + 1] - S->uv[2 * k[0] + 1];
+        dq[i][0] = S->s * (q[i + 1][0] - q[0][0]);
+        dq[i][1] = S->s * (q[i + 1][1] - q[0][1]);
+    }
+    det = dq[0][0] * dq[1][1] - dq[0][1] * dq[1][0];
+    *stretch = 1e300;
+    if (det != 0) {
+        /* A = dU dQ^-1, columns: dU/dq_x, dU/dq_y */
+        for (i = 0; i < 2; i++) {
+            a[i][0] = (du[0][i] * dq[1][1] - du[1][i] * dq[0][1]) / det;
+            a[i][1] = (du[1][i] * dq[0][0] - du[0][i] * dq[1][0]) / det;
+        }
+        g11 = a[0][0] * a[0][0] + a[1][0] * a[1][0];
+        g12 = a[0][0] * a[0][1] + a[1][0] * a[1][1];
+        g22 = a[0][1] * a[0][1] + a[1][1] * a[1][1];
+        tr = g11 + g22;
+        disc = sqrt((g11 - g22) * (g11 - g22) + 4 * g12 * g12);
+        big = 0.5 * (tr + disc);
+        small = 0.5 * (tr - disc);
+        if (small > 1e-30 * big) *stretch = sqrt(big / small);
+    }
+    return du[0][0] * du[1][1] - du[0][1] * du[1][0];
+}
+
+typedef struct tt__hpm_vc {
+    int vert, corner;
+} tt__hpm_vc;
+
+static int tt__hpm_vc_compare(const void *a, const void *b)
+{
+    const tt__hpm_vc *x = (const tt__hpm_vc *)a, *y = (const tt__hpm_vc *)b;
+    if (x->vert != y->vert) return x->vert < y->vert ? -1 : 1;
+    return x->corner < y->corner ? -1 : (x->corner > y->corner);
+}
+
+/* Relax C's border (C's faces not yet owned; its neighbours' are).
+   Returns 0 when out of memory. */
+static int tt__hpm_relax(tt__hpm *S, int C)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    tt__hpm_vc *vc;
+    int *border, nborder = 0, n = 0, i, j, pass;
+    double w = tt__hpm_band_width(S, C);
+    vc = TT__ALLOC(S->al, tt__hpm_vc, 3 * (size_t)cl->nfaces);
+    border = TT__ALLOC(S->al, int, 3 * (size_t)cl->nfaces);
+    if (!vc || !border) {
+        tt__free(S->al, vc);
+        tt__free(S->al, border);
+        return 0;
+    }
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i], c;
+        for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+            int t = m->twin[c];
+            vc[n].vert = m->corner_vert[c];
+            vc[n++].corner = c;
+            if (t >= 0 && S->owner[m->corner_face[t]] >= 0) border[nborder++] = c;
+        }
+    }
+    qsort(vc, (size_t)n, sizeof *vc, tt__hpm_vc_compare);
+    for (pass = 0; pass < TT__HPM_RELAX_PASSES && nborder > 0; pass++) {
+        double radius = w / (2 << pass);
+        if (radius < 0.25) break;
+        for (i = 0; i < n;) {
+            int v = vc[i].vert, first = i, last, trial, touches = 0;
+            double before = 0, old[2];
+            for (last = i; last < n && vc[last].vert == v; last++) {}
+            i = last;
+            for (j = 0; j < nborder; j++)
+                if (m->corner_vert[border[j]] == v || m->corner_vert[tt_mesh_next(m, border[j])] == v) {
+                    before += tt__hpm_edge_mismatch(S, border[j]);
+                    touches = 1;
+                }
+            if (!touches) continue;
+            old[0] = S->uv[2 * vc[first].corner];
+            old[1] = S->uv[2 * vc[first].corner + 1];
+            for (trial = 0; trial < TT__HPM_RELAX_TRIALS; trial++) {
+                double ang = TT__TWO_PI * tt_rng_float(&S->rng), r = radius * sqrt(tt_rng_float(&S->rng));
+                double nx = old[0] + r * cos(ang), ny = old[1] + r * sin(ang), after = 0, area0, area1, st;
+                int k, ok = 1;
+                if (!S->toroidal && (nx < 1 || ny < 1 || nx > S->W - 1 || ny > S->Hh - 1)) continue;
+                for (k = first; k < last && ok; k++) {
+                    area0 = tt__hpm_tri_area(S, vc[k].corner, &st);
+                    S->uv[2 * vc[k].corner] = nx;
+                    S->uv[2 * vc[k].corner + 1] = ny;
+                    area1 = tt__hpm_tri_area(S, vc[k].corner, &st);
+                    S->uv[2 * vc[k].corner] = old[0];
+                    S->uv[2 * vc[k].corner + 1] = old[1];
+                    ok = area0 * area1 > 0 && fabs(area1) >= 0.25 * fabs(area0) && st <= TT__HPM_RELAX_MAX_STRETCH;
+                }
+                if (!ok) continue;
+                for (k = first; k < last; k++) {
+                    S->uv[2 * vc[k].corner] = nx;
+                    S->uv[2 * vc[k].corner + 1] = ny;
+                }
+                for (j = 0; j < nborder; j++)
+                    if (m->corner_vert[border[j]] == v || m->corner_vert[tt_mesh_next(m, border[j])] == v)
+                        after += tt__hpm_edge_mismatch(S, border[j]);
+                if (after < before) {
+                    before = after;
+                    old[0] = nx;
+                    old[1] = ny;
+                } else {
+                    for (k = first; k < last; k++) {
+                        S->uv[2 * vc[k].corner] = old[0];
+                        S->uv[2 * vc[k].corner + 1] = old[1];
+                    }
+                }
+            }
+        }
+    }
+    tt__free(S->al, vc);
+    tt__free(S->al, border);
+    return 1;
+}
+
 /* C is textured by placement pl: write its corners, record it, queue its
    same-level neighbours. */
 static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
@@ -11582,6 +11805,7 @@ static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
     const tt_cluster *cl = &S->H->clusters[C];
     int i;
     tt__hpm_write(S, C, pl, S->uv);
+    if (!(S->flags & TT_HPM_NO_RELAXATION) && !tt__hpm_relax(S, C)) return 0;
     if (S->out) {
         tt__hpm_place rp;
         if (!tt__hpm_random_place(S, &S->place_rng, C, &rp)) rp = *pl;
@@ -11782,7 +12006,7 @@ static void tt__hpm_release(tt__hpm *S)
 {
     int k;
     if (S->tex)
-        for (k = 0; k < S->rotations; k++) tt_xcorr_texture_free(S->tex[k]);
+        for (k = 0; k < S->copies; k++) tt_xcorr_texture_free(S->tex[k]);
     if (S->queue)
         for (k = 0; k < S->H->nlevels; k++) tt__free(S->al, S->queue[k]);
     tt__free(S->al, S->tex);
@@ -11842,16 +12066,17 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         memset(&o, 0, sizeof o);
     match_size = o.match_size ? o.match_size : TT_DEFAULT_HPM_MATCH_SIZE;
     if (!(o.scale >= 0 && o.scale < 1e300) || !(o.threshold >= 0) || o.rotations < 0 || o.rotations > 64 ||
+        !(o.max_turn >= 0 && o.max_turn <= 180) ||
         !(o.band >= 0 && o.band <= 1e6) || match_size < 16 || match_size > 512 ||
         (match_size & (match_size - 1)) != 0 || !(o.min_footprint >= 0 && o.min_footprint < 1e300) ||
-        o.min_faces < 0 || (o.flags & ~7u) != 0 || !(o.max_flattening_error >= 0) ||
+        o.min_faces < 0 || (o.flags & ~15u) != 0 || !(o.max_flattening_error >= 0) ||
         (o.branching != 0 && (o.branching < 2 || o.branching > 64)))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "hpm options out of range: scale %g (>= 0), threshold %g (>= 0), rotations %d (0..64), "
-                        "band %g (0..1e6), match_size %d (a power of two, 16..512), min_footprint %g (>= 0), "
+                        "max_turn %g (0..180), band %g (0..1e6), match_size %d (a power of two, 16..512), min_footprint %g (>= 0), "
                         "min_faces %d (>= 0), flags 0x%x, branching %d (0 or 2..64), max_flattening_error %g "
                         "(>= 0)",
-                        o.scale, o.threshold, o.rotations, o.band, match_size, o.min_footprint, o.min_faces,
+                        o.scale, o.threshold, o.rotations, o.max_turn, o.band, match_size, o.min_footprint, o.min_faces,
                         o.flags, o.branching, o.max_flattening_error);
     for (f = 0; f < mesh->nfaces; f++) {
         const int *c = mesh->corner_vert + mesh->face_start[f];
@@ -11885,6 +12110,22 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.toroidal = (o.flags & TT_HPM_TOROIDAL) != 0;
     S.threshold = o.threshold > 0 ? o.threshold : TT_DEFAULT_HPM_THRESHOLD;
     S.rotations = o.rotations ? o.rotations : TT_DEFAULT_HPM_ROTATIONS;
+    {
+        /* The copies a fit tries: orientation k at 2 pi k / rotations when
+           it turns no more than max_turn from the main neighbour (copy 0),
+           in the order 0, +1, -1, +2, -2, ... so that ties (D33) keep the
+           smaller turn. */
+        double limit = (o.max_turn > 0 ? o.max_turn : TT_DEFAULT_HPM_MAX_TURN) * TT__PI / 180 + 1e-9;
+        int step;
+        S.copies = 0;
+        S.angle[S.copies++] = 0;
+        for (step = 1; 2 * step <= S.rotations; step++) {
+            double a = TT__TWO_PI * step / S.rotations;
+            if (a > limit) break;
+            S.angle[S.copies++] = a;
+            if (2 * step < S.rotations) S.angle[S.copies++] = -a;
+        }
+    }
     S.band = o.band;
     S.floor_px = o.min_footprint > 0 ? o.min_footprint : TT_DEFAULT_HPM_MIN_FOOTPRINT;
     S.min_faces = o.min_faces ? o.min_faces : TT_DEFAULT_HPM_MIN_FACES;
@@ -11957,6 +12198,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.rep.match_width = S.ww;
     S.rep.match_height = S.wh;
     S.rep.fft_size = S.P;
+    S.rep.copies = S.copies;
     {
         int accepted = S.rep.accepted_fits + S.rep.floor_fits;
         S.rep.mean_error = accepted > 0 ? S.error_sum / accepted : 0;
