@@ -410,10 +410,24 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
    Preconditions (TT_ASSERT): image, its pixels and out are not NULL. */
 TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out);
 
+/* How a sample outside the image is addressed. */
+typedef enum tt_wrap {
+    TT_WRAP_CLAMP = 0,      /* the edge texels continue outward */
+    TT_WRAP_REPEAT = 1      /* the image tiles the plane (a periodic texture): x is taken modulo the
+                               width, y modulo the height, and texels blend across the borders */
+} tt_wrap;
+
 /* Bilinear sample at continuous pixel coordinates: texel (i, j) covers
    [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5). Clamps to the edge.
    Preconditions (TT_ASSERT): image has pixels and a size of at least 1 x 1. */
 TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4]);
+/* The same with a choice of addressing; TT_WRAP_CLAMP is
+   tt_image_sample_bilinear exactly. With TT_WRAP_REPEAT a NaN or infinite
+   coordinate samples texel 0 of its axis (clamping takes texel 0 for NaN
+   and the edge for an infinity).
+   Preconditions (TT_ASSERT): as tt_image_sample_bilinear, and wrap is a
+   tt_wrap value. */
+TTDEF void tt_image_sample_bilinear_wrap(const tt_image *image, float x, float y, tt_wrap wrap, float rgba[4]);
 
 /* Where pixel (x, y) of a width x height image lands after `quarter_turns`
    counter-clockwise quarter turns (as the picture is seen, row 0 on top).
@@ -1105,13 +1119,45 @@ TTDEF void tt_tileset_free(tt_tileset *tileset);
    score = (seam - same_face) / (unrelated - same_face): about 0 when an edge
    looks like any other place in the image, about 1 when tiles do not match.
    When unrelated places differ no more than neighbours do (pure noise at the
-   texel scale) the score means nothing and is NaN; read seam - same_face. */
+   texel scale) the score means nothing and is NaN; read seam - same_face.
+
+   UV-discontinuous edges. An interior edge's UVs are continuous when each of
+   its two ends has the same UV seen from both faces: for the half-edge a ->
+   a' and its twin b -> b', uv[a] equals uv[b'] and uv[a'] equals uv[b], each
+   coordinate within TT_SEAM_UV_TOLERANCE * max(1, |x|, |y|) (1e-6 of the UV
+   scale, about 16 float roundings: UVs written once per vertex and copied
+   per corner compare equal). Otherwise, or when one of them is not finite,
+   the edge is discontinuous. Continuous edges lie inside one chart, where
+   the texture is continuous by construction; the discontinuous ones are the
+   chart borders (every edge of a tiled-texture mesh, the cluster borders of
+   hierarchical pattern mapping). UVs a whole period apart count as
+   discontinuous: they are what TT_SEAM_WRAP then measures. */
+#define TT_SEAM_UV_TOLERANCE 1e-6
+enum {
+    /* Measure only the UV-discontinuous interior edges (see above): on a mesh
+       of large charts, every edge dilutes the border's score with the many
+       edges inside charts, seamless by construction. max_edges then samples
+       among these edges. The same-face reference is taken next to the
+       measured edges, as always; the unrelated pairs are still drawn from
+       every interior edge, because they describe how different two places of
+       the texture are, a property of the texture rather than of the borders:
+       the reference is then the same in both modes, so restricted and full
+       scores compare, and it stays defined with a single border edge. With
+       no discontinuous edge the result is TT_ERROR_NOT_MEASURED. */
+    TT_SEAM_UV_DISCONTINUOUS = 1u << 0,
+    /* Sample the atlas with TT_WRAP_REPEAT: UVs outside [0, 1] on a periodic
+       (toroidal) image, as a charting that continues across the image's
+       borders produces. Without it samples clamp to the atlas's edge. */
+    TT_SEAM_WRAP = 1u << 1
+};
+
 typedef struct tt_seam_options {
     uint64_t seed;          /* picks the sample positions, unrelated pairs and sampled edges */
-    /* 0: every interior edge (the acceptance measure). Otherwise at most this
-       many edges, drawn at random without replacement: an estimate for quick
+    /* 0: every measured edge (the acceptance measure). Otherwise at most this
+       many of them, drawn at random without replacement: an estimate for quick
        reports (with 20000 edges it stays within about 0.01 of the full score). */
     int max_edges;
+    unsigned flags;         /* TT_SEAM_*; 0 = every interior edge, clamped sampling */
 } tt_seam_options;
 
 typedef struct tt_seam_report {
@@ -1119,17 +1165,21 @@ typedef struct tt_seam_report {
     double same_face;       /* the same distance apart inside one face */
     double unrelated;       /* between unrelated edges */
     double score;           /* NaN when unrelated - same_face <= 1e-9 (see above) */
-    int edges_measured;     /* interior edges that gave at least one sample */
+    int edges_measured;     /* measured edges that gave at least one sample */
     long long samples;
+    int edges_discontinuous;/* interior edges with discontinuous UVs (see above), counted in every mode:
+                               how many chart borders there are */
 } tt_seam_report;
 
 /* Works on any mesh with per-corner UVs (2 * ncorners floats) and any atlas.
-   options may be NULL (every edge, seed 0). Not measured reads as not
-   measured: when no sample could be taken (no interior edge, fewer than two,
-   or every edge of zero length or non-finite UVs) the result is
-   TT_ERROR_NOT_MEASURED and the report is zero with score NaN. Other errors:
-   NULL pointers or an empty atlas (TT_ERROR_INVALID_ARGUMENT), a negative
-   max_edges, TT_ERROR_OUT_OF_MEMORY. */
+   options may be NULL (every edge, seed 0, flags 0). Not measured reads as
+   not measured: when no sample could be taken (no interior edge, fewer than
+   two, every measured edge of zero length or non-finite UVs, or with
+   TT_SEAM_UV_DISCONTINUOUS no discontinuous edge) the result is
+   TT_ERROR_NOT_MEASURED and the report is zero with score NaN, except
+   edges_discontinuous, which is counted before any sampling. Other errors: NULL pointers or an empty atlas
+   (TT_ERROR_INVALID_ARGUMENT), a negative max_edges or an unknown flag bit
+   (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  const tt_seam_options *options, const tt_allocator *allocator,
                                  tt_seam_report *report, tt_error *error);
@@ -3753,24 +3803,45 @@ TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsign
     }
 }
 
-TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4])
+/* Repeat addressing along one axis of `size` texels: the texel pair (*lo,
+   *hi) that bilinear filtering blends at coordinate f (pixel units, texel
+   centres at integers), and the weight of *hi. The reduction modulo `size` is
+   done in double; where rounding still leaves [0, size) (a tiny negative f,
+   or one so huge that its period is lost) and for NaN and infinities (whose
+   remainder is NaN), texel 0 is taken. */
+static float tt__repeat_axis(float f, int size, int *lo, int *hi)
+{
+    double reduced = (double)f - floor((double)f / size) * size;
+    if (!(reduced >= 0.0 && reduced < size)) reduced = 0.0;   /* NaN, or rounding at a huge or tiny f */
+    *lo = (int)floor(reduced);
+    *hi = *lo + 1 == size ? 0 : *lo + 1;
+    return (float)(reduced - *lo);
+}
+
+TTDEF void tt_image_sample_bilinear_wrap(const tt_image *image, float x, float y, tt_wrap wrap, float rgba[4])
 {
     float fx = x - 0.5f, fy = y - 0.5f, tx, ty;
     int x0, y0, x1, y1, k;
     const float *p00, *p10, *p01, *p11;
     TT_ASSERT(image && image->pixels && image->width > 0 && image->height > 0 && rgba);
-    /* Far outside is the same as just outside (clamping), and it keeps the
-       conversion to int defined; NaN samples the first texel. */
-    fx = fx != fx ? 0.0f : tt__clamp_f(fx, -1.0f, (float)image->width);
-    fy = fy != fy ? 0.0f : tt__clamp_f(fy, -1.0f, (float)image->height);
-    x0 = (int)floorf(fx);
-    y0 = (int)floorf(fy);
-    tx = fx - (float)x0;
-    ty = fy - (float)y0;
-    x1 = tt__clamp_i(x0 + 1, 0, image->width - 1);
-    y1 = tt__clamp_i(y0 + 1, 0, image->height - 1);
-    x0 = tt__clamp_i(x0, 0, image->width - 1);
-    y0 = tt__clamp_i(y0, 0, image->height - 1);
+    TT_ASSERT(wrap == TT_WRAP_CLAMP || wrap == TT_WRAP_REPEAT);
+    if (wrap == TT_WRAP_REPEAT) {
+        tx = tt__repeat_axis(fx, image->width, &x0, &x1);
+        ty = tt__repeat_axis(fy, image->height, &y0, &y1);
+    } else {
+        /* Far outside is the same as just outside (clamping), and it keeps
+           the conversion to int defined; NaN samples the first texel. */
+        fx = fx != fx ? 0.0f : tt__clamp_f(fx, -1.0f, (float)image->width);
+        fy = fy != fy ? 0.0f : tt__clamp_f(fy, -1.0f, (float)image->height);
+        x0 = (int)floorf(fx);
+        y0 = (int)floorf(fy);
+        tx = fx - (float)x0;
+        ty = fy - (float)y0;
+        x1 = tt__clamp_i(x0 + 1, 0, image->width - 1);
+        y1 = tt__clamp_i(y0 + 1, 0, image->height - 1);
+        x0 = tt__clamp_i(x0, 0, image->width - 1);
+        y0 = tt__clamp_i(y0, 0, image->height - 1);
+    }
     p00 = image->pixels + ((size_t)y0 * image->width + x0) * 4;
     p10 = image->pixels + ((size_t)y0 * image->width + x1) * 4;
     p01 = image->pixels + ((size_t)y1 * image->width + x0) * 4;
@@ -3780,6 +3851,11 @@ TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, flo
         float bottom = p01[k] + (p11[k] - p01[k]) * tx;
         rgba[k] = top + (bottom - top) * ty;
     }
+}
+
+TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4])
+{
+    tt_image_sample_bilinear_wrap(image, x, y, TT_WRAP_CLAMP, rgba);
 }
 
 TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y)
@@ -6261,30 +6337,51 @@ static int tt__edge_point_at(const tt_mesh *mesh, const float *uv, const tt_imag
     return 1;
 }
 
-static void tt__sample_inside(const tt_image *atlas, const tt__edge_point *p, float depth, float rgba[4])
-{
-    tt_image_sample_bilinear(atlas, p->px + p->nx * depth, p->py + p->ny * depth, rgba);
-}
-
-/* A colour as displayed: the seam measure's thresholds are about what the
-   eye sees, and they were set when images held sRGB-encoded values. */
-static void tt__displayed(const tt_image *atlas, const tt__edge_point *p, float depth, float rgb[3])
+/* A colour as displayed, `depth` pixels inside the face from edge point p:
+   the seam measure's thresholds are about what the eye sees, and they were
+   set when images held sRGB-encoded values. */
+static void tt__displayed(const tt_image *atlas, tt_wrap wrap, const tt__edge_point *p, float depth, float rgb[3])
 {
     float rgba[4];
-    tt__sample_inside(atlas, p, depth, rgba);
+    tt_image_sample_bilinear_wrap(atlas, p->px + p->nx * depth, p->py + p->ny * depth, wrap, rgba);
     rgb[0] = tt_linear_to_srgb(rgba[0]);
     rgb[1] = tt_linear_to_srgb(rgba[1]);
     rgb[2] = tt_linear_to_srgb(rgba[2]);
+}
+
+/* Do two UV coordinates agree within TT_SEAM_UV_TOLERANCE of their scale?
+   NaN agrees with nothing. */
+static int tt__uv_coordinate_agrees(float x, float y)
+{
+    double scale = fabs((double)x) > fabs((double)y) ? fabs((double)x) : fabs((double)y);
+    if (!(scale > 1.0)) scale = 1.0;
+    return fabs((double)x - (double)y) <= TT_SEAM_UV_TOLERANCE * scale;
+}
+
+/* Interior half-edge a -> a' with twin b -> b': its UVs are continuous when
+   uv[a] == uv[b'] and uv[a'] == uv[b] (see TT_SEAM_UV_TOLERANCE). */
+static int tt__edge_uv_discontinuous(const tt_mesh *mesh, const float *uv, int a)
+{
+    int b = mesh->twin[a], ends[2][2], k;
+    ends[0][0] = a; ends[0][1] = tt_mesh_next(mesh, b);
+    ends[1][0] = tt_mesh_next(mesh, a); ends[1][1] = b;
+    for (k = 0; k < 2; k++)
+        if (!tt__uv_coordinate_agrees(uv[2 * ends[k][0]], uv[2 * ends[k][1]]) ||
+            !tt__uv_coordinate_agrees(uv[2 * ends[k][0] + 1], uv[2 * ends[k][1] + 1]))
+            return 1;
+    return 0;
 }
 
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  const tt_seam_options *options, const tt_allocator *allocator,
                                  tt_seam_report *report, tt_error *error)
 {
-    int *interior, ninterior = 0, nmeasured, c, i, j, points_per_edge;
+    const unsigned known_flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
+    int *interior, ninterior = 0, npopulation, nmeasured, ndiscontinuous = 0, c, i, j, points_per_edge;
     double seam = 0.0, same = 0.0, unrelated = 0.0;
     long long samples = 0;
     tt_seam_options opt;
+    tt_wrap wrap;
     tt_rng rng;
     tt__ok(error);
     if (report) {
@@ -6301,22 +6398,52 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
     if (opt.max_edges < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_edges is %d: 0 (all) or more",
                         opt.max_edges);
+    if (opt.flags & ~known_flags)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "seam option flags 0x%x include unknown bits 0x%x (known: TT_SEAM_UV_DISCONTINUOUS, "
+                        "TT_SEAM_WRAP)", opt.flags, opt.flags & ~known_flags);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    wrap = (opt.flags & TT_SEAM_WRAP) ? TT_WRAP_REPEAT : TT_WRAP_CLAMP;
     interior = TT__ALLOC(allocator, int, mesh->ncorners);
     if (!interior)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d corners",
                         mesh->ncorners);
     for (c = 0; c < mesh->ncorners; c++)
-        if (mesh->twin[c] > c) interior[ninterior++] = c;
+        if (mesh->twin[c] > c) {
+            interior[ninterior++] = c;
+            ndiscontinuous += tt__edge_uv_discontinuous(mesh, corner_uv, c);
+        }
+    report->edges_discontinuous = ndiscontinuous;
+    /* The measured population is interior[0 .. npopulation-1]: every interior
+       edge, or in restricted mode the discontinuous ones, swapped to the
+       front (the continuous ones follow: they remain candidates for
+       unrelated pairs). */
+    npopulation = ninterior;
+    if (opt.flags & TT_SEAM_UV_DISCONTINUOUS) {
+        int front = 0;
+        if (ndiscontinuous == 0) {
+            tt__free(allocator, interior);
+            return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                            "no interior edge has discontinuous UVs: nothing to measure in "
+                            "TT_SEAM_UV_DISCONTINUOUS mode");
+        }
+        for (i = 0; i < ninterior; i++)
+            if (tt__edge_uv_discontinuous(mesh, corner_uv, interior[i])) {
+                int edge = interior[i];
+                interior[i] = interior[front];
+                interior[front++] = edge;
+            }
+        npopulation = ndiscontinuous;
+    }
     tt_rng_seed(&rng, opt.seed, 0x7365616d73ull /* "seams" */);
-    /* A quick estimate measures a random subset: the first max_edges of a
-       partial Fisher-Yates shuffle. Unrelated pairs are still drawn from
-       every interior edge. */
-    nmeasured = ninterior;
-    if (opt.max_edges > 0 && opt.max_edges < ninterior) {
+    /* A quick estimate measures a random subset of the population: the first
+       max_edges of a partial Fisher-Yates shuffle. Unrelated pairs are still
+       drawn from every interior edge. */
+    nmeasured = npopulation;
+    if (opt.max_edges > 0 && opt.max_edges < npopulation) {
         nmeasured = opt.max_edges;
         for (i = 0; i < nmeasured; i++) {
-            int pick = i + (int)tt_rng_below(&rng, (uint32_t)(ninterior - i)), swap = interior[i];
+            int pick = i + (int)tt_rng_below(&rng, (uint32_t)(npopulation - i)), swap = interior[i];
             interior[i] = interior[pick];
             interior[pick] = swap;
         }
@@ -6337,10 +6464,10 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
                 !tt__edge_point_at(mesh, corner_uv, atlas, b, 1.0f - t, &pb) ||
                 !tt__edge_point_at(mesh, corner_uv, atlas, other, t_other, &po))
                 continue;
-            tt__displayed(atlas, &pa, 0.5f, sa);
-            tt__displayed(atlas, &pa, 1.5f, sa_deeper);
-            tt__displayed(atlas, &pb, 0.5f, sb);
-            tt__displayed(atlas, &po, 0.5f, so);
+            tt__displayed(atlas, wrap, &pa, 0.5f, sa);
+            tt__displayed(atlas, wrap, &pa, 1.5f, sa_deeper);
+            tt__displayed(atlas, wrap, &pb, 0.5f, sb);
+            tt__displayed(atlas, wrap, &po, 0.5f, so);
             seam += tt__texel_difference(sa, sb);
             same += tt__texel_difference(sa, sa_deeper);
             unrelated += tt__texel_difference(sa, so);
@@ -6354,9 +6481,9 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         report->edges_measured = 0;
         return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
                         ninterior < 2 ? "the mesh has %d interior edges: the seam measure needs at least two"
-                                      : "none of the %d interior edges could be sampled (zero length or non-finite "
-                                        "UVs)",
-                        ninterior);
+                                      : "none of the %d measured interior edges could be sampled (zero length or "
+                                        "non-finite UVs)",
+                        ninterior < 2 ? ninterior : npopulation);
     }
     report->samples = samples;
     report->seam = seam / (double)samples;

@@ -1500,6 +1500,230 @@ static void test_seams_oom(void)
     tt_mesh_free(mesh);
 }
 
+/* Two charts on one open grid of 16 x 8 unit quads: corner UVs (0.05 + x/32,
+   0.1 + y/32), each quad 4 x 4 texels of a 128 x 128 atlas, with the right
+   half's faces (column 8 on) shifted by `shift` in u. The 8 edges on the
+   line x = 8 are then the only UV-discontinuous ones (when shift != 0). */
+static float *two_chart_uvs(const tt_mesh *mesh, float shift)
+{
+    float *uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    int f, k;
+    if (!uv) return NULL;
+    for (f = 0; f < mesh->nfaces; f++)
+        for (k = mesh->face_start[f]; k < mesh->face_start[f + 1]; k++) {
+            const float *p = mesh->pos + 3 * mesh->corner_vert[k];
+            uv[2 * k] = 0.05f + p[0] / 32.0f + (f % 16 >= 8 ? shift : 0.0f);
+            uv[2 * k + 1] = 0.1f + p[1] / 32.0f;
+        }
+    return uv;
+}
+
+static tt_mesh *two_chart_grid(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 16, 8);
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "16 x 8 grid build: %d", r);
+    return mesh;
+}
+
+/* TT_SEAM_UV_DISCONTINUOUS: measured on the chart border alone, a shifted
+   chart scores like unrelated places (about 1); measured on every edge the
+   same border is diluted by the 224 continuous edges inside the charts. */
+static void test_seams_discontinuous(void)
+{
+    tt_mesh *mesh = two_chart_grid();
+    tt_image *atlas = NULL;
+    float *uv = NULL;
+    tt_seam_options so;
+    tt_seam_report all, border, sampled;
+    tt_error err;
+    tt_result r;
+    make_value_noise(&atlas, 128, 128, 7);
+    if (mesh) uv = two_chart_uvs(mesh, 0.4f);
+    if (!mesh || !atlas || !uv) {
+        CHECK(0, "two-chart setup");
+        goto done;
+    }
+    memset(&so, 0, sizeof so);
+    so.seed = 3;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+    CHECK(r == TT_OK && all.edges_discontinuous == 8 && all.edges_measured == 232,
+          "two charts, every edge: %d, %d discontinuous edges (want 8), %d measured (want 232) (%s)", r,
+          all.edges_discontinuous, all.edges_measured, err.message);
+    so.flags = TT_SEAM_UV_DISCONTINUOUS;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &border, &err);
+    CHECK(r == TT_OK && border.edges_discontinuous == 8 && border.edges_measured == 8,
+          "two charts, border only: %d, %d discontinuous, %d measured (want 8 and 8) (%s)", r,
+          border.edges_discontinuous, border.edges_measured, err.message);
+    CHECK(border.score >= 0.8 && all.score < 0.2 && all.score < border.score - 0.6,
+          "a shifted chart: border-only score %.4f (want >= 0.8), every edge %.4f (want < 0.2: diluted)",
+          border.score, all.score);
+    /* max_edges samples within the border */
+    so.max_edges = 3;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &sampled, &err);
+    CHECK(r == TT_OK && sampled.edges_measured == 3 && sampled.edges_discontinuous == 8 && sampled.score > 0.5,
+          "border only, max_edges 3: %d, %d measured (want 3), %d discontinuous, score %.4f", r,
+          sampled.edges_measured, sampled.edges_discontinuous, sampled.score);
+    /* one chart: nothing to measure in restricted mode; every edge still is */
+    free(uv);
+    uv = two_chart_uvs(mesh, 0.0f);
+    if (!uv) goto done;
+    so.max_edges = 0;
+    memset(&border, 0x55, sizeof border);
+    memset(&err, 0, sizeof err);
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &border, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && err.result == r && strstr(err.message, "discontinuous") &&
+              isnan(border.score) && border.edges_discontinuous == 0 && border.edges_measured == 0 &&
+              border.samples == 0 && border.seam == 0.0 && border.same_face == 0.0 && border.unrelated == 0.0,
+          "one chart, border only: expected TT_ERROR_NOT_MEASURED with an empty report, got %d, score %g, %d "
+          "discontinuous, %d measured (\"%s\")", r, border.score, border.edges_discontinuous, border.edges_measured,
+          err.message);
+    so.flags = 0;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+    CHECK(r == TT_OK && all.edges_discontinuous == 0 && all.edges_measured == 232 && fabs(all.score) < 0.1,
+          "one chart, every edge: %d, %d discontinuous, %d measured, score %.4f (want about 0)", r,
+          all.edges_discontinuous, all.edges_measured, all.score);
+    /* a difference below the tolerance is continuous, one above it is not */
+    {
+        int c = 0, twin_next;
+        while (mesh->twin[c] < 0) c++;
+        twin_next = tt_mesh_next(mesh, mesh->twin[c]);
+        uv[2 * twin_next] += 1e-8f;
+        r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+        CHECK(r == TT_OK && all.edges_discontinuous == 0, "a UV 1e-8 away: %d discontinuous edges (want 0)",
+              all.edges_discontinuous);
+        uv[2 * twin_next] += 1e-4f;
+        r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+        CHECK(r == TT_OK && all.edges_discontinuous >= 1 && all.edges_discontinuous <= 2,
+              "a UV 1e-4 away: %d discontinuous edges (want the one or two edges at that corner)",
+              all.edges_discontinuous);
+    }
+    /* unknown flag bits are refused */
+    so.flags = 1u << 7;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0] && isnan(all.score),
+          "unknown seam flag 0x80: expected TT_ERROR_INVALID_ARGUMENT, got %d (\"%s\")", r, err.message);
+done:
+    free(uv);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
+/* flags 0 is the measure as it was before the flags existed: the reports of
+   the two-chart case, taken with the library before this change. */
+static void test_seams_flags_zero_unchanged(void)
+{
+    static const struct {
+        int max_edges;
+        double seam, same_face, unrelated, score;
+        int edges_measured;
+        long long samples;
+    } before[2] = {
+        {100, 0.0052313029418389074, 0.0044668324440717789, 0.017892654771606096, 0.056940310926006814, 100, 4000},
+        {0, 0.0049949636061986345, 0.0045134528332904491, 0.018369188188418404, 0.034751729920273061, 232, 3944}};
+    tt_mesh *mesh = two_chart_grid();
+    tt_image *atlas = NULL;
+    float *uv = NULL;
+    int i;
+    make_value_noise(&atlas, 128, 128, 7);
+    if (mesh) uv = two_chart_uvs(mesh, 0.4f);
+    for (i = 0; i < 2 && mesh && atlas && uv; i++) {
+        tt_seam_options so;
+        tt_seam_report rep;
+        tt_error err;
+        tt_result r;
+        memset(&so, 0, sizeof so);
+        so.seed = 3;
+        so.max_edges = before[i].max_edges;
+        r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &rep, &err);
+        CHECK(r == TT_OK && rep.edges_measured == before[i].edges_measured && rep.samples == before[i].samples &&
+                  near(rep.seam, before[i].seam, 1e-12) && near(rep.same_face, before[i].same_face, 1e-12) &&
+                  near(rep.unrelated, before[i].unrelated, 1e-12) && near(rep.score, before[i].score, 1e-9),
+              "flags 0, max_edges %d: %d, seam %.17g same %.17g unrelated %.17g score %.17g, %d edges, %lld "
+              "samples; before: %.17g %.17g %.17g %.17g, %d, %lld", before[i].max_edges, r, rep.seam,
+              rep.same_face, rep.unrelated, rep.score, rep.edges_measured, rep.samples, before[i].seam,
+              before[i].same_face, before[i].unrelated, before[i].score, before[i].edges_measured,
+              before[i].samples);
+    }
+    CHECK(mesh && atlas && uv, "flags 0 setup");
+    free(uv);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
+/* A periodic atlas: a sum of waves with whole numbers of periods across the
+   64 x 64 image, so that TT_WRAP_REPEAT sampling is continuous everywhere. */
+static tt_image *make_periodic_waves(void)
+{
+    tt_image *im = NULL;
+    int x, y;
+    if (tt_image_create(64, 64, NULL, &im, NULL) != TT_OK) return NULL;
+    for (y = 0; y < 64; y++)
+        for (x = 0; x < 64; x++) {
+            double s = (x + 0.5) / 64.0 * 6.283185307179586, t = (y + 0.5) / 64.0 * 6.283185307179586;
+            double a = 0.5 + 0.18 * sin(3 * s + 0.7) + 0.12 * sin(2 * s + 5 * t + 1.9) + 0.1 * sin(7 * t - 4 * s);
+            px(im, x, y)[0] = (float)a;
+            px(im, x, y)[1] = (float)(1.0 - a);
+            px(im, x, y)[2] = (float)(0.5 + 0.3 * sin(4 * t + 1.0));
+            px(im, x, y)[3] = 1.0f;
+        }
+    return im;
+}
+
+/* TT_SEAM_WRAP: the right chart shifted by a whole period (u + 1) continues
+   the left one on a periodic atlas; clamped sampling breaks it. */
+static void test_seams_wrap(void)
+{
+    tt_mesh *mesh = two_chart_grid();
+    tt_image *atlas = make_periodic_waves();
+    float *uv = NULL;
+    tt_seam_options so;
+    tt_seam_report wrapped, clamped, crossing;
+    tt_error err;
+    tt_result r;
+    int c;
+    if (mesh) uv = two_chart_uvs(mesh, 1.0f);
+    if (!mesh || !atlas || !uv) {
+        CHECK(0, "wrap setup");
+        goto done;
+    }
+    memset(&so, 0, sizeof so);
+    so.seed = 9;
+    so.flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &wrapped, &err);
+    CHECK(r == TT_OK && wrapped.edges_discontinuous == 8 && wrapped.edges_measured == 8 &&
+              fabs(wrapped.score) < 0.15,
+          "a chart one period over, wrapped: %d, %d discontinuous (want 8), score %.4f (want about 0; seam %.4f, "
+          "same face %.4f, unrelated %.4f)", r, wrapped.edges_discontinuous, wrapped.score, wrapped.seam,
+          wrapped.same_face, wrapped.unrelated);
+    so.flags = TT_SEAM_UV_DISCONTINUOUS;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &clamped, &err);
+    CHECK(r == TT_OK && clamped.score > 0.3 && clamped.score > wrapped.score + 0.3,
+          "a chart one period over, clamped: %d, score %.4f (want > 0.3: the clamp breaks it; wrapped %.4f)", r,
+          clamped.score, wrapped.score);
+    /* one continuous chart whose UVs cross the image's border (u in 0.75 ..
+       1.25): continuous when wrapped */
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *p = mesh->pos + 3 * mesh->corner_vert[c];
+        uv[2 * c] = 0.75f + p[0] / 32.0f;
+    }
+    so.flags = TT_SEAM_WRAP;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &crossing, &err);
+    CHECK(r == TT_OK && crossing.edges_discontinuous == 0 && fabs(crossing.score) < 0.1,
+          "one chart across the border, wrapped: %d, %d discontinuous, score %.4f (want about 0)", r,
+          crossing.edges_discontinuous, crossing.score);
+done:
+    free(uv);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
 static void check_histogram(int grid, int n, double tolerance)
 {
     tmesh m;
@@ -1660,6 +1884,9 @@ void run_tiled_tests(void)
     RUN(test_seams_not_measured);
     RUN(test_seams_sampled);
     RUN(test_seams_oom);
+    RUN(test_seams_discontinuous);
+    RUN(test_seams_flags_zero_unchanged);
+    RUN(test_seams_wrap);
     RUN(test_histogram);
     RUN(test_stretch);
 }
