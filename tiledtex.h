@@ -855,7 +855,8 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
      3. tt_synthesize_tiles, or tt_synth_plan_create + tt_synth_apply for
         several maps of one material: the (2n)^4 tiles composited from
         windows of the photo (Sec. 4), with gutters and mips;
-     4. tt_measure_seams, tt_tile_histogram, tt_face_stretch: the report.
+     4. tt_measure_seams, tt_tile_histogram, tt_face_stretch: the report
+        (tt_measure_uv_distortion measures any charting, tiled or not).
    Memory: nothing per photo pixel beyond the photo itself (16 bytes a
    pixel, yours): synthesis reads windows of it. The atlas and its mips take
    about 4/3 * W * W * 16 bytes, the plan about 4 * S bytes per tile, and
@@ -1198,6 +1199,64 @@ TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *lay
    (TT_ERROR_INVALID_ARGUMENT), a non-finite UV (TT_ERROR_NON_FINITE, naming
    the corner). */
 TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch, tt_error *error);
+
+/* UV distortion of a charting (the acceptance measure of pipelines that map
+   into an existing image, such as tt_hpm_map): how far each face's map from
+   surface to texture is from a similarity of the intended scale. Texture
+   space is measured in texels, (u * width, v * height), so a non-square
+   image weighs its axes right. Per face:
+     stretch  = sigma_max / sigma_min of the surface -> texture map at the
+                face's centre, as tt_face_stretch computes it (1 = no
+                stretch; a triangle's map is linear, a quad's the bilinear
+                patch's at its centre, another polygon's its first
+                triangle's);
+     density  = sqrt(UV area in texels^2 / surface area), whole polygons
+                (Newell's vector area on the surface, the shoelace in UV);
+     density error = |density / texels_per_unit - 1|.
+   Statistics are weighted by surface area: the weighted p-th percentile is
+   the smallest per-face value v at which the area of the faces with values
+   <= v reaches p times the total (the median is p = 0.5, always one face's
+   value). */
+typedef struct tt_uv_distortion_options {
+    double texels_per_unit;     /* intended texels per world unit; 0 = the area-weighted median of the
+                                   measured faces' own densities (then density errors say how uniform the
+                                   scale is, not whether it is the one intended) */
+    double margin_texels;       /* outside_margin counts corners closer than this to the image's border
+                                   (or beyond it); 0 = no check */
+} tt_uv_distortion_options;
+
+typedef struct tt_uv_distortion_report {
+    double stretch_median;      /* area-weighted median of the per-face stretch (1 = none) */
+    double stretch_p95;         /* area-weighted 95th percentile of it */
+    double stretch_max;         /* the largest over measured faces (unweighted) */
+    double density_median;      /* area-weighted median of the relative density error (0 = as intended) */
+    double density_p95;         /* area-weighted 95th percentile of it */
+    double texels_per_unit;     /* the scale the density errors are relative to: given or measured */
+    int faces_measured;         /* faces in the statistics: not degenerate, finite UVs */
+    int flipped;                /* measured faces whose UV polygon turns clockwise (negative signed area in
+                                   texels, v up) while the face is counter-clockwise on the surface: the
+                                   texture is mirrored there. They stay in the statistics */
+    int degenerate;             /* faces with zero surface area or zero UV area (numerically zero against
+                                   the polygon's own size, as tt_mesh_build judges faces) or a singular
+                                   map at the centre; not in the statistics */
+    int non_finite;             /* faces with a NaN or infinite UV; not in the statistics */
+    int outside_margin;         /* corners with finite UVs within margin_texels of the image's border or
+                                   outside [0, 1]; 0 when margin_texels is 0 */
+} tt_uv_distortion_report;
+
+/* Measure the UV distortion of per-corner UVs (2 * mesh->ncorners floats)
+   into a width x height image; options NULL = all defaults. The report is
+   the point: non-finite UVs, degenerate and flipped faces are counted, not
+   refused. Temporary memory: 32 bytes a face, through `allocator`. Only
+   reads its inputs: safe from several threads.
+   Errors: NULL mesh, UVs or report, width or height below 1, a negative or
+   non-finite option, a bad allocator (TT_ERROR_INVALID_ARGUMENT);
+   TT_ERROR_OUT_OF_MEMORY; no face measurable (TT_ERROR_NOT_MEASURED: the
+   counts are filled in, the statistics are NaN). On an argument error the
+   report is zero with NaN statistics. */
+TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                                         const tt_uv_distortion_options *options, const tt_allocator *allocator,
+                                         tt_uv_distortion_report *report, tt_error *error);
 
 /* ======================================================================== */
 /* 7. Lapped textures                                                       */
@@ -2332,9 +2391,11 @@ static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
    Heapsort: O(n log n) whatever the input, so the exact median of a million
    entries, or the edges of a million-face fan around one vertex, never
    degrade to a quadratic worst case. One definition, made for each element
-   type the library sorts (any type `<` compares): doubles here, the half-edge
-   builder's 64-bit edge keys in the mesh section. */
-#define TT__DEFINE_HEAPSORT(name, type)                                         \
+   type the library sorts: by `<` (TT__DEFINE_HEAPSORT: doubles here, the
+   half-edge builder's 64-bit edge keys in the mesh section), or by a
+   comparison `less(a, b)` on two elements (TT__DEFINE_HEAPSORT_BY: structs
+   sorted by one field). */
+#define TT__DEFINE_HEAPSORT_BY(name, type, less)                                \
     static void name(type *v, int n)                                            \
     {                                                                           \
         int start = n / 2 - 1, end = n;                                         \
@@ -2351,13 +2412,16 @@ static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
             for (;;) {                                                          \
                 int child = 2 * root + 1;                                       \
                 if (child >= end) break;                                        \
-                if (child + 1 < end && v[child] < v[child + 1]) child++;        \
-                if (!(v[root] < v[child])) break;                               \
+                if (child + 1 < end && less(v[child], v[child + 1])) child++;   \
+                if (!less(v[root], v[child])) break;                            \
                 tmp = v[root]; v[root] = v[child]; v[child] = tmp;              \
                 root = child;                                                   \
             }                                                                   \
         }                                                                       \
     }
+
+#define TT__LESS_THAN(a, b) ((a) < (b))
+#define TT__DEFINE_HEAPSORT(name, type) TT__DEFINE_HEAPSORT_BY(name, type, TT__LESS_THAN)
 
 TT__DEFINE_HEAPSORT(tt__sort_doubles, double)
 
@@ -4067,6 +4131,43 @@ static double tt__median(double *values, int count)
     if (count <= 0) return 0.0;
     tt__sort_doubles(values, count);
     return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+/* A value and its weight (an area, say), for weighted percentiles. */
+typedef struct tt__weighted {
+    double value, weight;
+} tt__weighted;
+
+#define TT__WEIGHTED_LESS(a, b) ((a).value < (b).value)
+TT__DEFINE_HEAPSORT_BY(tt__sort_weighted, tt__weighted, TT__WEIGHTED_LESS)
+
+/* Weighted percentiles: out[k] = the smallest value v of the items at which
+   the weight of the items with values <= v reaches fraction[k] of the total
+   weight (fraction 0.5: the weighted median, which is always one of the
+   values, never an average of two). Sorts the items by value once for all
+   the fractions. Preconditions (the callers': TT_ASSERT): count >= 1, values
+   not NaN, weights >= 0 with a positive total, fractions in [0, 1]. */
+static void tt__weighted_percentiles(tt__weighted *items, int count, const double *fraction, int nfractions,
+                                     double *out)
+{
+    double total = 0.0;
+    int i, k;
+    TT_ASSERT(items && count >= 1);
+    tt__sort_weighted(items, count);
+    for (i = 0; i < count; i++) total += items[i].weight;
+    for (k = 0; k < nfractions; k++) {
+        double goal = fraction[k] * total, cumulative = 0.0;
+        /* The last value when rounding keeps the sum just below a goal of
+           the whole total. */
+        out[k] = items[count - 1].value;
+        for (i = 0; i < count; i++) {
+            cumulative += items[i].weight;
+            if (cumulative >= goal) {
+                out[k] = items[i].value;
+                break;
+            }
+        }
+    }
 }
 
 TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,
@@ -6538,6 +6639,56 @@ static void tt__face_tangents(const float *const point[4], int dims, int size, d
     }
 }
 
+/* The map from texture to surface of `face` at its centre, M (3x2, columns
+   dP/du and dP/dv), through the face's own parametrisation (s, t): for a
+   quad the bilinear patch's derivatives, otherwise the first triangle.
+   A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2) with texture coordinates
+   (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
+   M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
+   M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
+static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
+                                       double v_scale, double *big, double *small)
+{
+    int first = mesh->face_start[face], size = mesh->face_start[face + 1] - first, k;
+    const float *p[4], *q[4];
+    double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc;
+    for (k = 0; k < 4; k++) {
+        int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
+        p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
+        q[k] = corner_uv + 2 * (size_t)corner;
+    }
+    tt__face_tangents(p, 3, size, a);
+    tt__face_tangents(q, 2, size, b);
+    for (k = 0; k < 2; k++) {
+        b[k][0] *= u_scale;
+        b[k][1] *= v_scale;
+    }
+    /* b[i] is d(u,v)/d(param i); rows of A likewise. Solve M B = A for the
+       two texture axes: M's column for u and v. */
+    det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
+    if (fabs(det) < 1e-30) return 0;
+    for (k = 0; k < 3; k++) {
+        m[0][k] = (a[0][k] * b[1][1] - a[1][k] * b[0][1]) / det;   /* dP/du */
+        m[1][k] = (a[1][k] * b[0][0] - a[0][k] * b[1][0]) / det;   /* dP/dv */
+        g11 += m[0][k] * m[0][k];
+        g12 += m[0][k] * m[1][k];
+        g22 += m[1][k] * m[1][k];
+    }
+    tr = g11 + g22;
+    disc = sqrt((g11 - g22) * (g11 - g22) + 4.0 * g12 * g12);
+    *big = 0.5 * (tr + disc);
+    *small = 0.5 * (tr - disc);
+    return 1;
+}
+
+/* sigma_max / sigma_min from the eigenvalues of tt__face_texture_to_surface
+   (the same ratio for the map and its inverse, surface -> texture);
+   infinity when the smaller one vanishes against the larger. */
+static double tt__stretch_ratio(double big, double small)
+{
+    return small > 1e-30 * (big > 0 ? big : 1) ? sqrt(big / small) : (double)tt__infinity();
+}
+
 TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch, tt_error *error)
 {
     int f, c;
@@ -6550,37 +6701,128 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
                             "corner %d (face %d) has a non-finite UV", c / 2, mesh->corner_face[c / 2]);
     for (f = 0; f < mesh->nfaces; f++) {
-        /* Tangents of the face's own parametrisation s,t at its centre: for a
-           quad the bilinear patch's derivatives, otherwise the first triangle.
-           A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2); texture -> surface is
-           M = A B^-1, and the ratio of M's singular values is the stretch. */
-        int first = mesh->face_start[f], size = mesh->face_start[f + 1] - first, k;
-        const float *p[4], *q[4];
-        double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc, big, small;
-        for (k = 0; k < 4; k++) {
-            int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
-            p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
-            q[k] = corner_uv + 2 * (size_t)corner;
-        }
-        tt__face_tangents(p, 3, size, a);
-        tt__face_tangents(q, 2, size, b);
-        /* b[i] is d(u,v)/d(param i); rows of A likewise. Solve M B = A for the
-           two texture axes: M's column for u and v. */
-        det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
-        if (fabs(det) < 1e-30) { stretch[f] = tt__infinity(); continue; }
-        for (k = 0; k < 3; k++) {
-            m[0][k] = (a[0][k] * b[1][1] - a[1][k] * b[0][1]) / det;   /* dP/du */
-            m[1][k] = (a[1][k] * b[0][0] - a[0][k] * b[1][0]) / det;   /* dP/dv */
-            g11 += m[0][k] * m[0][k];
-            g12 += m[0][k] * m[1][k];
-            g22 += m[1][k] * m[1][k];
-        }
-        tr = g11 + g22;
-        disc = sqrt((g11 - g22) * (g11 - g22) + 4.0 * g12 * g12);
-        big = 0.5 * (tr + disc);
-        small = 0.5 * (tr - disc);
-        stretch[f] = small > 1e-30 * (big > 0 ? big : 1) ? (float)sqrt(big / small) : tt__infinity();
+        double big, small;
+        stretch[f] = tt__face_texture_to_surface(mesh, corner_uv, f, 1.0, 1.0, &big, &small)
+                         ? (float)tt__stretch_ratio(big, small)
+                         : tt__infinity();
     }
+    return TT_OK;
+}
+
+/* Twice the signed area of face f's UV polygon in texels (u * width, v *
+   height; positive counter-clockwise with v up), taken relative to its first
+   corner as tt__polygon_newell does in 3D, and the polygon's own size (the
+   sum of squared distances to that corner) to judge it zero against. */
+static void tt__uv_polygon_area(const tt_mesh *mesh, const float *corner_uv, int face, int width, int height,
+                                double *twice_area, double *scale)
+{
+    int first = mesh->face_start[face], end = mesh->face_start[face + 1], c;
+    double ox = (double)corner_uv[2 * first] * width, oy = (double)corner_uv[2 * first + 1] * height;
+    double ax = 0.0, ay = 0.0;
+    *twice_area = 0.0;
+    *scale = 0.0;
+    for (c = first + 1; c < end; c++) {
+        double bx = (double)corner_uv[2 * c] * width - ox, by = (double)corner_uv[2 * c + 1] * height - oy;
+        *twice_area += ax * by - ay * bx;
+        *scale += bx * bx + by * by;
+        ax = bx;
+        ay = by;
+    }
+}
+
+TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                                         const tt_uv_distortion_options *options, const tt_allocator *allocator,
+                                         tt_uv_distortion_report *report, tt_error *error)
+{
+    static const double median_and_p95[2] = {0.5, 0.95};
+    tt_uv_distortion_options opt;
+    tt__weighted *stretch, *density;
+    double texels_per_unit, stats[2];
+    int f, c, n = 0;
+    tt__ok(error);
+    if (report) {
+        double not_measured = tt__not_a_number();
+        memset(report, 0, sizeof *report);
+        report->stretch_median = report->stretch_p95 = report->stretch_max = not_measured;
+        report->density_median = report->density_p95 = report->texels_per_unit = not_measured;
+    }
+    if (!mesh || !corner_uv || !report)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_measure_uv_distortion needs a mesh, UVs and a report (got NULL)");
+    if (width < 1 || height < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the image is %d x %d texels: both sizes must be at least 1", width, height);
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    if (!tt__is_finite_d(opt.texels_per_unit) || opt.texels_per_unit < 0.0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "texels_per_unit is %g: 0 (measure it) or a positive finite number", opt.texels_per_unit);
+    if (!tt__is_finite_d(opt.margin_texels) || opt.margin_texels < 0.0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "margin_texels is %g: 0 (no check) or a positive finite number", opt.margin_texels);
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    stretch = TT__ALLOC(allocator, tt__weighted, 2 * (size_t)mesh->nfaces);
+    if (!stretch)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                        "out of memory measuring the UV distortion of %d faces", mesh->nfaces);
+    density = stretch + mesh->nfaces;
+
+    if (opt.margin_texels > 0.0)
+        for (c = 0; c < mesh->ncorners; c++) {
+            double x = (double)corner_uv[2 * c] * width, y = (double)corner_uv[2 * c + 1] * height;
+            double m = opt.margin_texels;
+            if (tt__is_finite_d(x) && tt__is_finite_d(y) && (x < m || x > width - m || y < m || y > height - m))
+                report->outside_margin++;
+        }
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], size = mesh->face_start[f + 1] - first, finite = 1;
+        double normal[3], surface_scale, twice_uv_area, uv_scale, uv_normal[3], big, small, surface_area, ratio;
+        for (c = first; c < first + size; c++)
+            finite &= tt__is_finite(corner_uv[2 * c]) && tt__is_finite(corner_uv[2 * c + 1]);
+        if (!finite) {
+            report->non_finite++;
+            continue;
+        }
+        /* Zero area in either space is judged as tt_mesh_build judges it:
+           against the polygon's own size. */
+        tt__polygon_newell(mesh->pos, mesh->corner_vert + first, size, normal, &surface_scale);
+        tt__uv_polygon_area(mesh, corner_uv, f, width, height, &twice_uv_area, &uv_scale);
+        uv_normal[0] = uv_normal[1] = 0.0;
+        uv_normal[2] = twice_uv_area;
+        if (tt__newell_is_zero(normal, surface_scale) || tt__newell_is_zero(uv_normal, uv_scale) ||
+            !tt__face_texture_to_surface(mesh, corner_uv, f, width, height, &big, &small) ||
+            !tt__is_finite_d(ratio = tt__stretch_ratio(big, small))) {
+            report->degenerate++;
+            continue;
+        }
+        if (twice_uv_area < 0.0) report->flipped++;
+        surface_area = 0.5 * tt__length3(normal);
+        stretch[n].value = ratio;
+        stretch[n].weight = surface_area;
+        /* texel density = sqrt(UV area in texels^2 / surface area) */
+        density[n].value = sqrt(0.5 * fabs(twice_uv_area) / surface_area);
+        density[n].weight = surface_area;
+        if (!(ratio <= report->stretch_max)) report->stretch_max = ratio;   /* the first replaces the NaN */
+        n++;
+    }
+    report->faces_measured = n;
+    if (n == 0) {
+        tt__free(allocator, stretch);
+        return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                        "none of the %d faces could be measured: %d have zero surface or UV area, %d a non-finite "
+                        "UV", mesh->nfaces, report->degenerate, report->non_finite);
+    }
+    tt__weighted_percentiles(stretch, n, median_and_p95, 2, stats);
+    report->stretch_median = stats[0];
+    report->stretch_p95 = stats[1];
+    texels_per_unit = opt.texels_per_unit;
+    if (texels_per_unit == 0.0) tt__weighted_percentiles(density, n, median_and_p95, 1, &texels_per_unit);
+    report->texels_per_unit = texels_per_unit;
+    for (f = 0; f < n; f++) density[f].value = fabs(density[f].value / texels_per_unit - 1.0);
+    tt__weighted_percentiles(density, n, median_and_p95, 2, stats);
+    report->density_median = stats[0];
+    report->density_p95 = stats[1];
+    tt__free(allocator, stretch);
     return TT_OK;
 }
 

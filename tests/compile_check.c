@@ -131,6 +131,14 @@ int main(void)
     EXPECT(tt_assign_uvs(quads, &layout, types, uv, &err) == TT_OK);
     EXPECT(tt_tile_histogram(quads, &layout, types, counts, &err) == TT_OK);
     EXPECT(tt_face_stretch(quads, uv, stretch, &err) == TT_OK);
+    {
+        tt_uv_distortion_options distortion_options;
+        tt_uv_distortion_report distortion;
+        memset(&distortion_options, 0, sizeof distortion_options);
+        distortion_options.margin_texels = 0.5;
+        EXPECT(tt_measure_uv_distortion(quads, uv, 256, 128, &distortion_options, NULL, &distortion, &err) == TT_OK &&
+               distortion.faces_measured > 0);
+    }
 
     memset(&options, 0, sizeof options);
     options.layout = layout;

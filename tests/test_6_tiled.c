@@ -1868,6 +1868,316 @@ static void test_stretch(void)
     tm_free(&m);
 }
 
+/* ---- UV distortion ---- */
+
+/* An open grid of nx x ny unit squares in the plane z = 0, each cut into two
+   counter-clockwise triangles. */
+static tt_mesh *triangle_grid(int nx, int ny)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_result r;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= ny; j++)
+        for (i = 0; i <= nx; i++) tm_vert(&m, i, j, 0);
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++) {
+            int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 2, d = a + nx + 1;
+            tm_tri(&m, a, b, c);
+            tm_tri(&m, a, c, d);
+        }
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "triangle grid build: %d", r);
+    return mesh;
+}
+
+/* UV of every corner: its vertex's (x, y) times (sx, sy) texels per unit,
+   plus (ox, oy) texels, in a width x height image. */
+static void linear_uvs(const tt_mesh *mesh, double sx, double sy, double ox, double oy, int width, int height,
+                       float *uv)
+{
+    int c;
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+        uv[2 * c] = (float)((p[0] * sx + ox) / width);
+        uv[2 * c + 1] = (float)((p[1] * sy + oy) / height);
+    }
+}
+
+static tt_result distortion(const tt_mesh *mesh, const float *uv, int width, int height, double texels_per_unit,
+                            double margin, tt_uv_distortion_report *rep, tt_error *err)
+{
+    tt_uv_distortion_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.texels_per_unit = texels_per_unit;
+    opt.margin_texels = margin;
+    return tt_measure_uv_distortion(mesh, uv, width, height, &opt, NULL, rep, err);
+}
+
+/* Linear maps of known distortion on a non-square 256 x 128 image:
+   isometric, uniformly scaled, anisotropic; triangles and quads. */
+static void test_uv_distortion_maps(void)
+{
+    tt_mesh *tris = triangle_grid(6, 4), *quads = NULL;
+    tt_uv_distortion_report rep;
+    tt_error err;
+    tt_result r;
+    float *uv;
+    tmesh m;
+    if (!tris) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)tris->ncorners);
+    if (!uv) { tt_mesh_free(tris); return; }
+    /* isometric at 16 texels a unit: given or measured, the density is right */
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.faces_measured == 48 && near(rep.stretch_median, 1, 1e-9) &&
+              near(rep.stretch_p95, 1, 1e-9) && near(rep.stretch_max, 1, 1e-9) && near(rep.density_median, 0, 1e-6) &&
+              near(rep.density_p95, 0, 1e-6) && rep.texels_per_unit == 16 && rep.flipped == 0 &&
+              rep.degenerate == 0 && rep.non_finite == 0 && rep.outside_margin == 0,
+          "isometric: %d, %d faces, stretch %g / %g / %g, density error %g / %g, %g texels a unit, flipped %d, "
+          "degenerate %d (%s)", r, rep.faces_measured, rep.stretch_median, rep.stretch_p95, rep.stretch_max,
+          rep.density_median, rep.density_p95, rep.texels_per_unit, rep.flipped, rep.degenerate, err.message);
+    r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.texels_per_unit, 16, 1e-4) && near(rep.density_p95, 0, 1e-6),
+          "isometric, scale measured: %d, %g texels a unit (want 16), density error p95 %g", r, rep.texels_per_unit,
+          rep.density_p95);
+    /* uniformly twice the intended scale: no stretch, density error exactly 1 */
+    linear_uvs(tris, 32, 32, 10, 10, 256, 128, uv);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.stretch_max, 1, 1e-9) && near(rep.density_median, 1, 1e-6) &&
+              near(rep.density_p95, 1, 1e-6),
+          "uniform scale 2: %d, stretch max %g, density error %g / %g (want 1)", r, rep.stretch_max,
+          rep.density_median, rep.density_p95);
+    /* 3 : 1 in texels (u three times as fine as v): stretch exactly 3 */
+    linear_uvs(tris, 48, 16, 10, 10, 256, 128, uv);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.stretch_median, 3, 1e-6) && near(rep.stretch_max, 3, 1e-6) &&
+              near(rep.density_median, sqrt(3.0) - 1, 1e-6),
+          "anisotropic 3 : 1: %d, stretch %g / %g (want 3), density error %g (want %g)", r, rep.stretch_median,
+          rep.stretch_max, rep.density_median, sqrt(3.0) - 1);
+    /* the same UVs in a square image are a different map: u in texels 256 / 128 as fine */
+    r = distortion(tris, uv, 128, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.stretch_median, 1.5, 1e-6),
+          "the 3 : 1 UVs in a 128 x 128 image: stretch %g (want 1.5)", rep.stretch_median);
+    free(uv);
+    tt_mesh_free(tris);
+    /* quads, their map taken at the centre */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 5, 3);
+    r = build(&m, 0, &quads, &err);
+    tm_free(&m);
+    if (r == TT_OK) {
+        uv = (float *)malloc(sizeof(float) * 2 * (size_t)quads->ncorners);
+        if (uv) {
+            linear_uvs(quads, 20, 40, 3, 3, 256, 128, uv);
+            r = distortion(quads, uv, 256, 128, 0, 0, &rep, &err);
+            CHECK(r == TT_OK && rep.faces_measured == 15 && near(rep.stretch_max, 2, 1e-6) &&
+                      near(rep.texels_per_unit, sqrt(800.0), 1e-3) && near(rep.density_p95, 0, 1e-6),
+                  "quads at 20 x 40 texels a unit: %d, %d faces, stretch %g (want 2), %g texels a unit (want %g)",
+                  r, rep.faces_measured, rep.stretch_max, rep.texels_per_unit, sqrt(800.0));
+            free(uv);
+        }
+        tt_mesh_free(quads);
+    }
+}
+
+/* Flipped, degenerate and non-finite faces and corners near the border are
+   counted; only the flipped ones stay in the statistics. */
+static void test_uv_distortion_counts(void)
+{
+    tt_mesh *tris = triangle_grid(6, 4);
+    tt_uv_distortion_report rep;
+    tt_error err;
+    tt_result r;
+    float *uv, keep[2];
+    int c, expect_margin = 0;
+    if (!tris) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)tris->ncorners);
+    if (!uv) { tt_mesh_free(tris); return; }
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    /* face 5 mirrored: its first two corners swap UVs */
+    keep[0] = uv[30]; keep[1] = uv[31];
+    uv[30] = uv[32]; uv[31] = uv[33];
+    uv[32] = keep[0]; uv[33] = keep[1];
+    /* face 7 collapsed onto one UV point */
+    for (c = 21; c < 24; c++) { uv[2 * c] = 0.5f; uv[2 * c + 1] = 0.5f; }
+    /* face 9 has a NaN UV, face 11 an infinite one */
+    uv[2 * 28 + 1] = (float)internal_not_a_number();
+    uv[2 * 34] = internal_infinity();
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.flipped == 1 && rep.degenerate == 1 && rep.non_finite == 2 && rep.faces_measured == 45,
+          "one mirrored, one collapsed, two non-finite faces: %d, flipped %d, degenerate %d, non-finite %d, %d "
+          "measured (want 1, 1, 2, 45) (%s)", r, rep.flipped, rep.degenerate, rep.non_finite, rep.faces_measured,
+          err.message);
+    /* the mirrored face is the reflection across its hypotenuse (corners
+       (0,0) and (1,1) swap, (0,1) stays): flipped, yet no stretch; and the
+       excluded faces do not count */
+    CHECK(near(rep.stretch_median, 1, 1e-9) && near(rep.stretch_max, 1, 1e-9) && near(rep.density_p95, 0, 1e-6),
+          "a mirrored isometric face and excluded faces: stretch median %g, max %g (want 1), density error p95 %g "
+          "(want 0)", rep.stretch_median, rep.stretch_max, rep.density_p95);
+    /* a stretched face among similar ones: the area-weighted median stays 1,
+       the maximum shows it; face 0 (corners (0,0) (1,0) (1,1)) gets its
+       second corner moved to (3, 0) in texture units of 16 texels */
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    uv[2] = (float)((3 * 16 + 10) / 256.0);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.faces_measured == 48 && rep.flipped == 0 && near(rep.stretch_median, 1, 1e-6) &&
+              rep.stretch_max > 2,
+          "one stretched face: %d, stretch median %g (want 1), max %g (want > 2)", r, rep.stretch_median,
+          rep.stretch_max);
+    /* margins: the grid spans texels 10 .. 106 x 10 .. 74; a margin of 12
+       catches the corners on x = 0 and y = 0 (texel 10) */
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    for (c = 0; c < tris->ncorners; c++) {
+        const float *p = tris->pos + 3 * (size_t)tris->corner_vert[c];
+        expect_margin += p[0] == 0.0f || p[1] == 0.0f;
+    }
+    uv[0] = 1.01f;   /* corner 0 (at the origin) outside the image: counted once */
+    r = distortion(tris, uv, 256, 128, 16, 12, &rep, &err);
+    CHECK(r == TT_OK && rep.outside_margin == expect_margin, "margin 12 texels: %d corners (want %d)",
+          rep.outside_margin, expect_margin);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.outside_margin == 0, "no margin check: %d corners (want 0)", rep.outside_margin);
+    r = distortion(tris, uv, 256, 128, 16, 9.5, &rep, &err);
+    CHECK(r == TT_OK && rep.outside_margin == 1, "margin 9.5 texels: %d corners (want only the one outside)",
+          rep.outside_margin);
+    /* nothing measurable */
+    for (c = 0; c < 2 * tris->ncorners; c++) uv[c] = (float)internal_not_a_number();
+    memset(&err, 0, sizeof err);
+    r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && err.result == r && err.message[0] && rep.non_finite == 48 &&
+              rep.faces_measured == 0 && isnan(rep.stretch_median) && isnan(rep.density_p95) &&
+              isnan(rep.stretch_max),
+          "all-NaN UVs: expected TT_ERROR_NOT_MEASURED with 48 non-finite faces and NaN statistics, got %d, %d, "
+          "stretch %g (\"%s\")", r, rep.non_finite, rep.stretch_median, err.message);
+    for (c = 0; c < 2 * tris->ncorners; c++) uv[c] = 0.25f;
+    r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && rep.degenerate == 48, "every UV at one point: %d, %d degenerate", r,
+          rep.degenerate);
+    free(uv);
+    tt_mesh_free(tris);
+}
+
+/* The weighted percentile against its definition, evaluated naively:
+   integer weights, so that every sum is exact in both. */
+static void test_weighted_percentile(void)
+{
+    static const double fractions[5] = {0.0, 0.25, 0.5, 0.95, 1.0};
+    double values[40], weights[40];
+    int trial, k, i, j, bad = 0;
+    lcg_seed(606);
+    for (trial = 0; trial < 200; trial++) {
+        int n = 1 + lcg_below(40);
+        for (i = 0; i < n; i++) {
+            values[i] = (double)lcg_below(12) + (lcg_below(2) ? 0.5 : 0.0);   /* ties on purpose */
+            weights[i] = (double)lcg_below(6);   /* zero weights too */
+        }
+        weights[lcg_below(n)] += 1.0;   /* a positive total */
+        for (k = 0; k < 5; k++) {
+            double total = 0.0, want = 0.0, got;
+            int found = 0;
+            for (i = 0; i < n; i++) total += weights[i];
+            /* the smallest value whose at-or-below weight reaches the goal */
+            for (i = 0; i < n; i++) {
+                double below = 0.0;
+                for (j = 0; j < n; j++)
+                    if (values[j] <= values[i]) below += weights[j];
+                if (below >= fractions[k] * total && (!found || values[i] < want)) {
+                    want = values[i];
+                    found = 1;
+                }
+            }
+            got = internal_weighted_percentile(values, weights, n, fractions[k]);
+            if (got != want) {
+                if (!bad) DETAIL("trial %d, %d items, fraction %g: got %g, want %g", trial, n, fractions[k], got, want);
+                bad++;
+            }
+        }
+    }
+    CHECK(bad == 0, "weighted percentiles: %d of 1000 differ from the naive reference", bad);
+}
+
+static void test_uv_distortion_errors(void)
+{
+    tt_mesh *tris = triangle_grid(2, 2);
+    tt_uv_distortion_options opt;
+    tt_uv_distortion_report rep;
+    counter cnt;
+    tt_allocator half = make_allocator(&cnt, -1);
+    tt_error err;
+    float uv[2 * 24];
+    int i;
+    struct {
+        double texels_per_unit, margin;
+        const char *what;
+    } bad_options[5] = {{-1, 0, "texels_per_unit -1"}, {0, -0.5, "margin -0.5"}, {0, 0, "texels_per_unit NaN"},
+                        {16, 0, "margin inf"}, {0, 0, "texels_per_unit inf"}};
+    if (!tris) return;
+    bad_options[2].texels_per_unit = internal_not_a_number();
+    bad_options[3].margin = internal_infinity();
+    bad_options[4].texels_per_unit = internal_infinity();
+    linear_uvs(tris, 16, 16, 1, 1, 64, 64, uv);
+    CHECK(tt_measure_uv_distortion(tris, uv, 64, 64, NULL, NULL, &rep, &err) == TT_OK && rep.faces_measured == 8,
+          "options NULL: %s", err.message);
+    CHECK(tt_measure_uv_distortion(NULL, uv, 64, 64, NULL, NULL, &rep, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_uv_distortion(tris, NULL, 64, 64, NULL, NULL, &rep, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_uv_distortion(tris, uv, 64, 64, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "tt_measure_uv_distortion with NULL arguments should be rejected");
+    for (i = 0; i < 2; i++) {
+        tt_result r = tt_measure_uv_distortion(tris, uv, i ? 64 : 0, i ? -3 : 64, NULL, NULL, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0] && isnan(rep.stretch_median) &&
+                  rep.faces_measured == 0,
+              "image %d x %d: expected TT_ERROR_INVALID_ARGUMENT with an empty report, got %d", i ? 64 : 0,
+              i ? -3 : 64, r);
+    }
+    for (i = 0; i < 5; i++) {
+        tt_result r;
+        memset(&opt, 0, sizeof opt);
+        opt.texels_per_unit = bad_options[i].texels_per_unit;
+        opt.margin_texels = bad_options[i].margin;
+        memset(&err, 0, sizeof err);
+        r = tt_measure_uv_distortion(tris, uv, 64, 64, &opt, NULL, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0],
+              "%s: expected TT_ERROR_INVALID_ARGUMENT, got %d (\"%s\")", bad_options[i].what, r, err.message);
+    }
+    half.alloc = NULL;
+    CHECK(tt_measure_uv_distortion(tris, uv, 64, 64, NULL, &half, &rep, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "an allocator with free but no alloc should be rejected");
+    tt_mesh_free(tris);
+}
+
+typedef struct distortion_ctx {
+    const tt_mesh *mesh;
+    const float *uv;
+} distortion_ctx;
+
+static tt_result oom_distortion(void *ctx, const tt_allocator *al)
+{
+    distortion_ctx *d = (distortion_ctx *)ctx;
+    tt_uv_distortion_report rep;
+    tt_error err;
+    tt_result r = tt_measure_uv_distortion(d->mesh, d->uv, 64, 32, NULL, al, &rep, &err);
+    if (r != TT_OK && (err.result != r || !isnan(rep.stretch_median))) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_uv_distortion_oom(void)
+{
+    tt_mesh *tris = triangle_grid(3, 2);
+    float uv[2 * 36];
+    distortion_ctx d;
+    if (!tris) return;
+    linear_uvs(tris, 8, 8, 1, 1, 64, 32, uv);
+    d.mesh = tris;
+    d.uv = uv;
+    oom_reset();
+    oom_sweep("tt_measure_uv_distortion", oom_distortion, &d, TT_OK);
+    tt_mesh_free(tris);
+}
+
 void run_tiled_tests(void)
 {
     RUN(test_layout);
@@ -1889,4 +2199,9 @@ void run_tiled_tests(void)
     RUN(test_seams_wrap);
     RUN(test_histogram);
     RUN(test_stretch);
+    RUN(test_weighted_percentile);
+    RUN(test_uv_distortion_maps);
+    RUN(test_uv_distortion_counts);
+    RUN(test_uv_distortion_errors);
+    RUN(test_uv_distortion_oom);
 }
