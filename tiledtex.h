@@ -11619,6 +11619,11 @@ static void tt__hpm_raster_footprint(int x, int y, const float bary[3], void *us
     r->S->support[(size_t)y * r->S->P + x] = 1;
 }
 
+static double tt__hpm_band_weight(double d)
+{
+    return 1.0 / (1.0 + d);
+}
+
 static void tt__hpm_raster_band(int x, int y, const float bary[3], void *user)
 {
     tt__hpm_raster *r = (tt__hpm_raster *)user;
@@ -11631,7 +11636,7 @@ static void tt__hpm_raster_band(int x, int y, const float bary[3], void *user)
     sy = bary[0] * r->x[1] + bary[1] * r->x[3] + bary[2] * r->x[5];
     tt__hpm_sample(S->match, S->ww, S->wh, S->nch, sx / S->f, sy / S->f, S->toroidal, v);
     for (c = 0; c < S->nch; c++) S->values[c * pp + at] = v[c];
-    S->mask[at] = 1;
+    S->mask[at] = tt__hpm_band_weight(S->dist[at] * S->f);
     S->support[at] = 2;
     S->src[2 * at] = (float)sx;
     S->src[2 * at + 1] = (float)sy;
@@ -11923,7 +11928,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
                     tt__hpm_sample(S->full, S->W, S->Hh, S->nch, S->src[2 * at], S->src[2 * at + 1], S->toroidal,
                                    vb);
                     tt__hpm_sample(S->full, S->W, S->Hh, S->nch, xcx, xcy, S->toroidal, vc);
-                    for (c = 0; c < S->nch; c++) sum += (vb[c] - vc[c]) * (vb[c] - vc[c]);
+                    for (c = 0; c < S->nch; c++) sum += S->mask[at] * (vb[c] - vc[c]) * (vb[c] - vc[c]);
                 }
                 if (best < 0 || sum < best) {
                     best = sum;
@@ -11934,7 +11939,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         if (best < 0) return -1;
         pl->shift[0] += bdx;
         pl->shift[1] += bdy;
-        *eps = best / ((double)S->nch * S->nband) / (2 * S->sigma2);
+        *eps = best / ((double)S->nch * match.mask_sum) / (2 * S->sigma2);
     }
     return 1;
 }
@@ -11976,7 +11981,7 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    C's texture coordinates there by a few texels when that lowers the colour
    difference across the border: the difference is taken at 8 points of
    each border edge at the vertex, half a texel on either side of it (where
-   the seam measure looks; tt__hpm_edge_mismatch), and moving
+   the eye and the seam measure look; tt__hpm_edge_mismatch), and moving
    the vertex moves the points of its edges by (1 - t) of the move - the
    hat weight of D25. Each vertex gets TT__HPM_RELAX_TRIALS random trials
    per pass, greedy, in passes of radius w/2, w/4, w/8 (w the band width).
@@ -11991,17 +11996,21 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
 #define TT__HPM_RELAX_PASSES 3
 #define TT__HPM_RELAX_SAMPLES 8
 #define TT__HPM_RELAX_MAX_STRETCH 1.3
+#define TT__HPM_RELAX_ACROSS 4.0
 
-/* Squared colour difference across border half-edge h of C (twin in a
-   textured face), summed over its sample points: what each side shows half
-   a texel inside its face against what the other side's map, continued
-   across the edge, shows at the same place - 0 for an exact continuation. */
-static double tt__hpm_edge_mismatch(const tt__hpm *S, int h)
+/* Colour mismatch along border half-edge h of C (twin in a textured face),
+   summed over its sample points: the squared difference across the border,
+   half a texel inside either face (D25's error, what the eye and the seam
+   measure see), weighted TT__HPM_RELAX_ACROSS; plus what each side shows
+   against the other side's map continued over the edge to the same place.
+   The second part is 0 for an exact continuation, where the first is not
+   (two places a texel apart differ), so a continuation stays one. */
+static double tt__hpm_edge_mismatch(const tt__hpm *S, int h, double *continuation)
 {
     const tt_mesh *m = S->mesh;
     int t = m->twin[h], side, i, c;
     int ends[2][3];     /* per side: corner at the edge's start, at its end, the apex */
-    double sum = 0, n[2][2];
+    double across = 0, cont = 0, n[2][2];
     ends[0][0] = h;
     ends[0][1] = tt_mesh_next(m, h);
     ends[0][2] = tt_mesh_prev(m, h);
@@ -12031,10 +12040,13 @@ static double tt__hpm_edge_mismatch(const tt__hpm *S, int h)
             tt__hpm_sample(S->full, S->W, S->Hh, S->nch, ex - 0.5 * n[side][0], ey - 0.5 * n[side][1], S->toroidal,
                            out[side]);
         }
-        for (c = 0; c < S->nch; c++)
-            sum += (in[0][c] - out[1][c]) * (in[0][c] - out[1][c]) + (in[1][c] - out[0][c]) * (in[1][c] - out[0][c]);
+        for (c = 0; c < S->nch; c++) {
+            across += (in[0][c] - in[1][c]) * (in[0][c] - in[1][c]);
+            cont += (in[0][c] - out[1][c]) * (in[0][c] - out[1][c]) + (in[1][c] - out[0][c]) * (in[1][c] - out[0][c]);
+        }
     }
-    return sum;
+    if (continuation) *continuation += cont;
+    return TT__HPM_RELAX_ACROSS * across + cont;
 }
 
 /* Twice the signed area of corner c's triangle in texels, and its stretch
@@ -12116,15 +12128,16 @@ static int tt__hpm_relax(tt__hpm *S, int C)
         if (radius < 0.25) break;
         for (i = 0; i < n;) {
             int v = vc[i].vert, first = i, last, trial, touches = 0;
-            double before = 0, old[2];
+            double before = 0, continued = 0, old[2];
             for (last = i; last < n && vc[last].vert == v; last++) {}
             i = last;
             for (j = 0; j < nborder; j++)
                 if (m->corner_vert[border[j]] == v || m->corner_vert[tt_mesh_next(m, border[j])] == v) {
-                    before += tt__hpm_edge_mismatch(S, border[j]);
+                    before += tt__hpm_edge_mismatch(S, border[j], &continued);
                     touches = 1;
                 }
-            if (!touches) continue;
+            /* no border here, or the exact continuation of the neighbour */
+            if (!touches || continued <= 1e-12) continue;
             old[0] = S->uv[2 * vc[first].corner];
             old[1] = S->uv[2 * vc[first].corner + 1];
             for (trial = 0; trial < TT__HPM_RELAX_TRIALS; trial++) {
@@ -12148,7 +12161,7 @@ static int tt__hpm_relax(tt__hpm *S, int C)
                 }
                 for (j = 0; j < nborder; j++)
                     if (m->corner_vert[border[j]] == v || m->corner_vert[tt_mesh_next(m, border[j])] == v)
-                        after += tt__hpm_edge_mismatch(S, border[j]);
+                        after += tt__hpm_edge_mismatch(S, border[j], NULL);
                 if (after < before) {
                     before = after;
                     old[0] = nx;
