@@ -1,5 +1,6 @@
 /* tool_io.c - the plumbing every `tiledtex` subcommand shares: error lines,
-   reading files, growing byte buffers, paths, and atomic output.
+   reading files, growing byte buffers, paths, atomic output, and progress
+   on a terminal.
    See tool.h for the interface. Command-line parsing is in cli.c, images in
    image_io.c, OBJ / MTL in obj.c. */
 
@@ -11,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -481,4 +483,44 @@ void output_free(tool_output *output)
     }
     free(output->files);
     memset(output, 0, sizeof *output);
+}
+
+/* ======================================================================== */
+/* Time and progress on a terminal                                          */
+/* ======================================================================== */
+
+double tool_seconds_now(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+}
+
+void tool_progress_begin(tool_progress *progress, const char *activity, const char *what)
+{
+    memset(progress, 0, sizeof *progress);
+    progress->activity = activity;
+    progress->what = what;
+    progress->start = tool_seconds_now();
+    progress->terminal = isatty(STDERR_FILENO);
+}
+
+int tool_show_progress(float fraction, void *user_data)
+{
+    tool_progress *progress = (tool_progress *)user_data;
+    double now = tool_seconds_now();
+    if (!progress->terminal || now - progress->start < 1.0 || (progress->shown && now - progress->last < 0.1))
+        return 0;
+    fprintf(stderr, "\r%s: %s: %5.1f%% %s", TOOL_NAME, progress->activity, 100.0 * (double)fraction,
+            progress->what);
+    fflush(stderr);
+    progress->shown = 1;
+    progress->last = now;
+    return 0;
+}
+
+void tool_progress_end(tool_progress *progress)
+{
+    if (progress->shown) fputc('\n', stderr);
+    progress->shown = 0;
 }
