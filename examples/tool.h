@@ -457,8 +457,10 @@ const char *tool_basename(const char *path);
 /* `target` (a path from the current directory) as seen from the directory of
    `from_file`: what an MTL beside from_file should write to name target
    ("out/a.mtl", "out/tex.png" -> "tex.png"; "out/a.mtl", "tex.png" ->
-   "../tex.png"). Absolute targets are kept; so is target when from_file's
-   directory climbs with "..". */
+   "../tex.png"). Absolute targets are kept. When from_file's directory
+   climbs with ".." ("../out/a.mtl"), the text alone cannot say the way
+   back, so both are resolved on the file system (target must exist, and
+   from_file's directory); failing that, target's absolute path is used. */
 void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size);
 
 #endif /* TILEDTEX_TOOL_H */
