@@ -410,10 +410,24 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
    Preconditions (TT_ASSERT): image, its pixels and out are not NULL. */
 TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out);
 
+/* How a sample outside the image is addressed. */
+typedef enum tt_wrap {
+    TT_WRAP_CLAMP = 0,      /* the edge texels continue outward */
+    TT_WRAP_REPEAT = 1      /* the image tiles the plane (a periodic texture): x is taken modulo the
+                               width, y modulo the height, and texels blend across the borders */
+} tt_wrap;
+
 /* Bilinear sample at continuous pixel coordinates: texel (i, j) covers
    [i, i+1) x [j, j+1), so its centre is (i + 0.5, j + 0.5). Clamps to the edge.
    Preconditions (TT_ASSERT): image has pixels and a size of at least 1 x 1. */
 TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4]);
+/* The same with a choice of addressing; TT_WRAP_CLAMP is
+   tt_image_sample_bilinear exactly. With TT_WRAP_REPEAT a NaN or infinite
+   coordinate samples texel 0 of its axis (clamping takes texel 0 for NaN
+   and the edge for an infinity).
+   Preconditions (TT_ASSERT): as tt_image_sample_bilinear, and wrap is a
+   tt_wrap value. */
+TTDEF void tt_image_sample_bilinear_wrap(const tt_image *image, float x, float y, tt_wrap wrap, float rgba[4]);
 
 /* Where pixel (x, y) of a width x height image lands after `quarter_turns`
    counter-clockwise quarter turns (as the picture is seen, row 0 on top).
@@ -841,7 +855,8 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
      3. tt_synthesize_tiles, or tt_synth_plan_create + tt_synth_apply for
         several maps of one material: the (2n)^4 tiles composited from
         windows of the photo (Sec. 4), with gutters and mips;
-     4. tt_measure_seams, tt_tile_histogram, tt_face_stretch: the report.
+     4. tt_measure_seams, tt_tile_histogram, tt_face_stretch: the report
+        (tt_measure_uv_distortion measures any charting, tiled or not).
    Memory: nothing per photo pixel beyond the photo itself (16 bytes a
    pixel, yours): synthesis reads windows of it. The atlas and its mips take
    about 4/3 * W * W * 16 bytes, the plan about 4 * S bytes per tile, and
@@ -1105,13 +1120,45 @@ TTDEF void tt_tileset_free(tt_tileset *tileset);
    score = (seam - same_face) / (unrelated - same_face): about 0 when an edge
    looks like any other place in the image, about 1 when tiles do not match.
    When unrelated places differ no more than neighbours do (pure noise at the
-   texel scale) the score means nothing and is NaN; read seam - same_face. */
+   texel scale) the score means nothing and is NaN; read seam - same_face.
+
+   UV-discontinuous edges. An interior edge's UVs are continuous when each of
+   its two ends has the same UV seen from both faces: for the half-edge a ->
+   a' and its twin b -> b', uv[a] equals uv[b'] and uv[a'] equals uv[b], each
+   coordinate within TT_SEAM_UV_TOLERANCE * max(1, |x|, |y|) (1e-6 of the UV
+   scale, about 16 float roundings: UVs written once per vertex and copied
+   per corner compare equal). Otherwise, or when one of them is not finite,
+   the edge is discontinuous. Continuous edges lie inside one chart, where
+   the texture is continuous by construction; the discontinuous ones are the
+   chart borders (every edge of a tiled-texture mesh, the cluster borders of
+   hierarchical pattern mapping). UVs a whole period apart count as
+   discontinuous: they are what TT_SEAM_WRAP then measures. */
+#define TT_SEAM_UV_TOLERANCE 1e-6
+enum {
+    /* Measure only the UV-discontinuous interior edges (see above): on a mesh
+       of large charts, every edge dilutes the border's score with the many
+       edges inside charts, seamless by construction. max_edges then samples
+       among these edges. The same-face reference is taken next to the
+       measured edges, as always; the unrelated pairs are still drawn from
+       every interior edge, because they describe how different two places of
+       the texture are, a property of the texture rather than of the borders:
+       the reference is then the same in both modes, so restricted and full
+       scores compare, and it stays defined with a single border edge. With
+       no discontinuous edge the result is TT_ERROR_NOT_MEASURED. */
+    TT_SEAM_UV_DISCONTINUOUS = 1u << 0,
+    /* Sample the atlas with TT_WRAP_REPEAT: UVs outside [0, 1] on a periodic
+       (toroidal) image, as a charting that continues across the image's
+       borders produces. Without it samples clamp to the atlas's edge. */
+    TT_SEAM_WRAP = 1u << 1
+};
+
 typedef struct tt_seam_options {
     uint64_t seed;          /* picks the sample positions, unrelated pairs and sampled edges */
-    /* 0: every interior edge (the acceptance measure). Otherwise at most this
-       many edges, drawn at random without replacement: an estimate for quick
+    /* 0: every measured edge (the acceptance measure). Otherwise at most this
+       many of them, drawn at random without replacement: an estimate for quick
        reports (with 20000 edges it stays within about 0.01 of the full score). */
     int max_edges;
+    unsigned flags;         /* TT_SEAM_*; 0 = every interior edge, clamped sampling */
 } tt_seam_options;
 
 typedef struct tt_seam_report {
@@ -1119,17 +1166,21 @@ typedef struct tt_seam_report {
     double same_face;       /* the same distance apart inside one face */
     double unrelated;       /* between unrelated edges */
     double score;           /* NaN when unrelated - same_face <= 1e-9 (see above) */
-    int edges_measured;     /* interior edges that gave at least one sample */
+    int edges_measured;     /* measured edges that gave at least one sample */
     long long samples;
+    int edges_discontinuous;/* interior edges with discontinuous UVs (see above), counted in every mode:
+                               how many chart borders there are */
 } tt_seam_report;
 
 /* Works on any mesh with per-corner UVs (2 * ncorners floats) and any atlas.
-   options may be NULL (every edge, seed 0). Not measured reads as not
-   measured: when no sample could be taken (no interior edge, fewer than two,
-   or every edge of zero length or non-finite UVs) the result is
-   TT_ERROR_NOT_MEASURED and the report is zero with score NaN. Other errors:
-   NULL pointers or an empty atlas (TT_ERROR_INVALID_ARGUMENT), a negative
-   max_edges, TT_ERROR_OUT_OF_MEMORY. */
+   options may be NULL (every edge, seed 0, flags 0). Not measured reads as
+   not measured: when no sample could be taken (no interior edge, fewer than
+   two, every measured edge of zero length or non-finite UVs, or with
+   TT_SEAM_UV_DISCONTINUOUS no discontinuous edge) the result is
+   TT_ERROR_NOT_MEASURED and the report is zero with score NaN, except
+   edges_discontinuous, which is counted before any sampling. Other errors: NULL pointers or an empty atlas
+   (TT_ERROR_INVALID_ARGUMENT), a negative max_edges or an unknown flag bit
+   (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  const tt_seam_options *options, const tt_allocator *allocator,
                                  tt_seam_report *report, tt_error *error);
@@ -1148,6 +1199,64 @@ TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *lay
    (TT_ERROR_INVALID_ARGUMENT), a non-finite UV (TT_ERROR_NON_FINITE, naming
    the corner). */
 TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch, tt_error *error);
+
+/* UV distortion of a charting (the acceptance measure of pipelines that map
+   into an existing image, such as tt_hpm_map): how far each face's map from
+   surface to texture is from a similarity of the intended scale. Texture
+   space is measured in texels, (u * width, v * height), so a non-square
+   image weighs its axes right. Per face:
+     stretch  = sigma_max / sigma_min of the surface -> texture map at the
+                face's centre, as tt_face_stretch computes it (1 = no
+                stretch; a triangle's map is linear, a quad's the bilinear
+                patch's at its centre, another polygon's its first
+                triangle's);
+     density  = sqrt(UV area in texels^2 / surface area), whole polygons
+                (Newell's vector area on the surface, the shoelace in UV);
+     density error = |density / texels_per_unit - 1|.
+   Statistics are weighted by surface area: the weighted p-th percentile is
+   the smallest per-face value v at which the area of the faces with values
+   <= v reaches p times the total (the median is p = 0.5, always one face's
+   value). */
+typedef struct tt_uv_distortion_options {
+    double texels_per_unit;     /* intended texels per world unit; 0 = the area-weighted median of the
+                                   measured faces' own densities (then density errors say how uniform the
+                                   scale is, not whether it is the one intended) */
+    double margin_texels;       /* outside_margin counts corners closer than this to the image's border
+                                   (or beyond it); 0 = no check */
+} tt_uv_distortion_options;
+
+typedef struct tt_uv_distortion_report {
+    double stretch_median;      /* area-weighted median of the per-face stretch (1 = none) */
+    double stretch_p95;         /* area-weighted 95th percentile of it */
+    double stretch_max;         /* the largest over measured faces (unweighted) */
+    double density_median;      /* area-weighted median of the relative density error (0 = as intended) */
+    double density_p95;         /* area-weighted 95th percentile of it */
+    double texels_per_unit;     /* the scale the density errors are relative to: given or measured */
+    int faces_measured;         /* faces in the statistics: not degenerate, finite UVs */
+    int flipped;                /* measured faces whose UV polygon turns clockwise (negative signed area in
+                                   texels, v up) while the face is counter-clockwise on the surface: the
+                                   texture is mirrored there. They stay in the statistics */
+    int degenerate;             /* faces with zero surface area or zero UV area (numerically zero against
+                                   the polygon's own size, as tt_mesh_build judges faces) or a singular
+                                   map at the centre; not in the statistics */
+    int non_finite;             /* faces with a NaN or infinite UV; not in the statistics */
+    int outside_margin;         /* corners with finite UVs within margin_texels of the image's border or
+                                   outside [0, 1]; 0 when margin_texels is 0 */
+} tt_uv_distortion_report;
+
+/* Measure the UV distortion of per-corner UVs (2 * mesh->ncorners floats)
+   into a width x height image; options NULL = all defaults. The report is
+   the point: non-finite UVs, degenerate and flipped faces are counted, not
+   refused. Temporary memory: 32 bytes a face, through `allocator`. Only
+   reads its inputs: safe from several threads.
+   Errors: NULL mesh, UVs or report, width or height below 1, a negative or
+   non-finite option, a bad allocator (TT_ERROR_INVALID_ARGUMENT);
+   TT_ERROR_OUT_OF_MEMORY; no face measurable (TT_ERROR_NOT_MEASURED: the
+   counts are filled in, the statistics are NaN). On an argument error the
+   report is zero with NaN statistics. */
+TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                                         const tt_uv_distortion_options *options, const tt_allocator *allocator,
+                                         tt_uv_distortion_report *report, tt_error *error);
 
 /* ======================================================================== */
 /* 7. Lapped textures                                                       */
@@ -2282,9 +2391,11 @@ static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
    Heapsort: O(n log n) whatever the input, so the exact median of a million
    entries, or the edges of a million-face fan around one vertex, never
    degrade to a quadratic worst case. One definition, made for each element
-   type the library sorts (any type `<` compares): doubles here, the half-edge
-   builder's 64-bit edge keys in the mesh section. */
-#define TT__DEFINE_HEAPSORT(name, type)                                         \
+   type the library sorts: by `<` (TT__DEFINE_HEAPSORT: doubles here, the
+   half-edge builder's 64-bit edge keys in the mesh section), or by a
+   comparison `less(a, b)` on two elements (TT__DEFINE_HEAPSORT_BY: structs
+   sorted by one field). */
+#define TT__DEFINE_HEAPSORT_BY(name, type, less)                                \
     static void name(type *v, int n)                                            \
     {                                                                           \
         int start = n / 2 - 1, end = n;                                         \
@@ -2301,13 +2412,16 @@ static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
             for (;;) {                                                          \
                 int child = 2 * root + 1;                                       \
                 if (child >= end) break;                                        \
-                if (child + 1 < end && v[child] < v[child + 1]) child++;        \
-                if (!(v[root] < v[child])) break;                               \
+                if (child + 1 < end && less(v[child], v[child + 1])) child++;   \
+                if (!less(v[root], v[child])) break;                            \
                 tmp = v[root]; v[root] = v[child]; v[child] = tmp;              \
                 root = child;                                                   \
             }                                                                   \
         }                                                                       \
     }
+
+#define TT__LESS_THAN(a, b) ((a) < (b))
+#define TT__DEFINE_HEAPSORT(name, type) TT__DEFINE_HEAPSORT_BY(name, type, TT__LESS_THAN)
 
 TT__DEFINE_HEAPSORT(tt__sort_doubles, double)
 
@@ -3753,24 +3867,45 @@ TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsign
     }
 }
 
-TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4])
+/* Repeat addressing along one axis of `size` texels: the texel pair (*lo,
+   *hi) that bilinear filtering blends at coordinate f (pixel units, texel
+   centres at integers), and the weight of *hi. The reduction modulo `size` is
+   done in double; where rounding still leaves [0, size) (a tiny negative f,
+   or one so huge that its period is lost) and for NaN and infinities (whose
+   remainder is NaN), texel 0 is taken. */
+static float tt__repeat_axis(float f, int size, int *lo, int *hi)
+{
+    double reduced = (double)f - floor((double)f / size) * size;
+    if (!(reduced >= 0.0 && reduced < size)) reduced = 0.0;   /* NaN, or rounding at a huge or tiny f */
+    *lo = (int)floor(reduced);
+    *hi = *lo + 1 == size ? 0 : *lo + 1;
+    return (float)(reduced - *lo);
+}
+
+TTDEF void tt_image_sample_bilinear_wrap(const tt_image *image, float x, float y, tt_wrap wrap, float rgba[4])
 {
     float fx = x - 0.5f, fy = y - 0.5f, tx, ty;
     int x0, y0, x1, y1, k;
     const float *p00, *p10, *p01, *p11;
     TT_ASSERT(image && image->pixels && image->width > 0 && image->height > 0 && rgba);
-    /* Far outside is the same as just outside (clamping), and it keeps the
-       conversion to int defined; NaN samples the first texel. */
-    fx = fx != fx ? 0.0f : tt__clamp_f(fx, -1.0f, (float)image->width);
-    fy = fy != fy ? 0.0f : tt__clamp_f(fy, -1.0f, (float)image->height);
-    x0 = (int)floorf(fx);
-    y0 = (int)floorf(fy);
-    tx = fx - (float)x0;
-    ty = fy - (float)y0;
-    x1 = tt__clamp_i(x0 + 1, 0, image->width - 1);
-    y1 = tt__clamp_i(y0 + 1, 0, image->height - 1);
-    x0 = tt__clamp_i(x0, 0, image->width - 1);
-    y0 = tt__clamp_i(y0, 0, image->height - 1);
+    TT_ASSERT(wrap == TT_WRAP_CLAMP || wrap == TT_WRAP_REPEAT);
+    if (wrap == TT_WRAP_REPEAT) {
+        tx = tt__repeat_axis(fx, image->width, &x0, &x1);
+        ty = tt__repeat_axis(fy, image->height, &y0, &y1);
+    } else {
+        /* Far outside is the same as just outside (clamping), and it keeps
+           the conversion to int defined; NaN samples the first texel. */
+        fx = fx != fx ? 0.0f : tt__clamp_f(fx, -1.0f, (float)image->width);
+        fy = fy != fy ? 0.0f : tt__clamp_f(fy, -1.0f, (float)image->height);
+        x0 = (int)floorf(fx);
+        y0 = (int)floorf(fy);
+        tx = fx - (float)x0;
+        ty = fy - (float)y0;
+        x1 = tt__clamp_i(x0 + 1, 0, image->width - 1);
+        y1 = tt__clamp_i(y0 + 1, 0, image->height - 1);
+        x0 = tt__clamp_i(x0, 0, image->width - 1);
+        y0 = tt__clamp_i(y0, 0, image->height - 1);
+    }
     p00 = image->pixels + ((size_t)y0 * image->width + x0) * 4;
     p10 = image->pixels + ((size_t)y0 * image->width + x1) * 4;
     p01 = image->pixels + ((size_t)y1 * image->width + x0) * 4;
@@ -3780,6 +3915,11 @@ TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, flo
         float bottom = p01[k] + (p11[k] - p01[k]) * tx;
         rgba[k] = top + (bottom - top) * ty;
     }
+}
+
+TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4])
+{
+    tt_image_sample_bilinear_wrap(image, x, y, TT_WRAP_CLAMP, rgba);
 }
 
 TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y)
@@ -3991,6 +4131,43 @@ static double tt__median(double *values, int count)
     if (count <= 0) return 0.0;
     tt__sort_doubles(values, count);
     return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+/* A value and its weight (an area, say), for weighted percentiles. */
+typedef struct tt__weighted {
+    double value, weight;
+} tt__weighted;
+
+#define TT__WEIGHTED_LESS(a, b) ((a).value < (b).value)
+TT__DEFINE_HEAPSORT_BY(tt__sort_weighted, tt__weighted, TT__WEIGHTED_LESS)
+
+/* Weighted percentiles: out[k] = the smallest value v of the items at which
+   the weight of the items with values <= v reaches fraction[k] of the total
+   weight (fraction 0.5: the weighted median, which is always one of the
+   values, never an average of two). Sorts the items by value once for all
+   the fractions. Preconditions (the callers': TT_ASSERT): count >= 1, values
+   not NaN, weights >= 0 with a positive total, fractions in [0, 1]. */
+static void tt__weighted_percentiles(tt__weighted *items, int count, const double *fraction, int nfractions,
+                                     double *out)
+{
+    double total = 0.0;
+    int i, k;
+    TT_ASSERT(items && count >= 1);
+    tt__sort_weighted(items, count);
+    for (i = 0; i < count; i++) total += items[i].weight;
+    for (k = 0; k < nfractions; k++) {
+        double goal = fraction[k] * total, cumulative = 0.0;
+        /* The last value when rounding keeps the sum just below a goal of
+           the whole total. */
+        out[k] = items[count - 1].value;
+        for (i = 0; i < count; i++) {
+            cumulative += items[i].weight;
+            if (cumulative >= goal) {
+                out[k] = items[i].value;
+                break;
+            }
+        }
+    }
 }
 
 TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,
@@ -6261,30 +6438,51 @@ static int tt__edge_point_at(const tt_mesh *mesh, const float *uv, const tt_imag
     return 1;
 }
 
-static void tt__sample_inside(const tt_image *atlas, const tt__edge_point *p, float depth, float rgba[4])
-{
-    tt_image_sample_bilinear(atlas, p->px + p->nx * depth, p->py + p->ny * depth, rgba);
-}
-
-/* A colour as displayed: the seam measure's thresholds are about what the
-   eye sees, and they were set when images held sRGB-encoded values. */
-static void tt__displayed(const tt_image *atlas, const tt__edge_point *p, float depth, float rgb[3])
+/* A colour as displayed, `depth` pixels inside the face from edge point p:
+   the seam measure's thresholds are about what the eye sees, and they were
+   set when images held sRGB-encoded values. */
+static void tt__displayed(const tt_image *atlas, tt_wrap wrap, const tt__edge_point *p, float depth, float rgb[3])
 {
     float rgba[4];
-    tt__sample_inside(atlas, p, depth, rgba);
+    tt_image_sample_bilinear_wrap(atlas, p->px + p->nx * depth, p->py + p->ny * depth, wrap, rgba);
     rgb[0] = tt_linear_to_srgb(rgba[0]);
     rgb[1] = tt_linear_to_srgb(rgba[1]);
     rgb[2] = tt_linear_to_srgb(rgba[2]);
+}
+
+/* Do two UV coordinates agree within TT_SEAM_UV_TOLERANCE of their scale?
+   NaN agrees with nothing. */
+static int tt__uv_coordinate_agrees(float x, float y)
+{
+    double scale = fabs((double)x) > fabs((double)y) ? fabs((double)x) : fabs((double)y);
+    if (!(scale > 1.0)) scale = 1.0;
+    return fabs((double)x - (double)y) <= TT_SEAM_UV_TOLERANCE * scale;
+}
+
+/* Interior half-edge a -> a' with twin b -> b': its UVs are continuous when
+   uv[a] == uv[b'] and uv[a'] == uv[b] (see TT_SEAM_UV_TOLERANCE). */
+static int tt__edge_uv_discontinuous(const tt_mesh *mesh, const float *uv, int a)
+{
+    int b = mesh->twin[a], ends[2][2], k;
+    ends[0][0] = a; ends[0][1] = tt_mesh_next(mesh, b);
+    ends[1][0] = tt_mesh_next(mesh, a); ends[1][1] = b;
+    for (k = 0; k < 2; k++)
+        if (!tt__uv_coordinate_agrees(uv[2 * ends[k][0]], uv[2 * ends[k][1]]) ||
+            !tt__uv_coordinate_agrees(uv[2 * ends[k][0] + 1], uv[2 * ends[k][1] + 1]))
+            return 1;
+    return 0;
 }
 
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  const tt_seam_options *options, const tt_allocator *allocator,
                                  tt_seam_report *report, tt_error *error)
 {
-    int *interior, ninterior = 0, nmeasured, c, i, j, points_per_edge;
+    const unsigned known_flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
+    int *interior, ninterior = 0, npopulation, nmeasured, ndiscontinuous = 0, c, i, j, points_per_edge;
     double seam = 0.0, same = 0.0, unrelated = 0.0;
     long long samples = 0;
     tt_seam_options opt;
+    tt_wrap wrap;
     tt_rng rng;
     tt__ok(error);
     if (report) {
@@ -6301,22 +6499,52 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
     if (opt.max_edges < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_edges is %d: 0 (all) or more",
                         opt.max_edges);
+    if (opt.flags & ~known_flags)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "seam option flags 0x%x include unknown bits 0x%x (known: TT_SEAM_UV_DISCONTINUOUS, "
+                        "TT_SEAM_WRAP)", opt.flags, opt.flags & ~known_flags);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    wrap = (opt.flags & TT_SEAM_WRAP) ? TT_WRAP_REPEAT : TT_WRAP_CLAMP;
     interior = TT__ALLOC(allocator, int, mesh->ncorners);
     if (!interior)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d corners",
                         mesh->ncorners);
     for (c = 0; c < mesh->ncorners; c++)
-        if (mesh->twin[c] > c) interior[ninterior++] = c;
+        if (mesh->twin[c] > c) {
+            interior[ninterior++] = c;
+            ndiscontinuous += tt__edge_uv_discontinuous(mesh, corner_uv, c);
+        }
+    report->edges_discontinuous = ndiscontinuous;
+    /* The measured population is interior[0 .. npopulation-1]: every interior
+       edge, or in restricted mode the discontinuous ones, swapped to the
+       front (the continuous ones follow: they remain candidates for
+       unrelated pairs). */
+    npopulation = ninterior;
+    if (opt.flags & TT_SEAM_UV_DISCONTINUOUS) {
+        int front = 0;
+        if (ndiscontinuous == 0) {
+            tt__free(allocator, interior);
+            return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                            "no interior edge has discontinuous UVs: nothing to measure in "
+                            "TT_SEAM_UV_DISCONTINUOUS mode");
+        }
+        for (i = 0; i < ninterior; i++)
+            if (tt__edge_uv_discontinuous(mesh, corner_uv, interior[i])) {
+                int edge = interior[i];
+                interior[i] = interior[front];
+                interior[front++] = edge;
+            }
+        npopulation = ndiscontinuous;
+    }
     tt_rng_seed(&rng, opt.seed, 0x7365616d73ull /* "seams" */);
-    /* A quick estimate measures a random subset: the first max_edges of a
-       partial Fisher-Yates shuffle. Unrelated pairs are still drawn from
-       every interior edge. */
-    nmeasured = ninterior;
-    if (opt.max_edges > 0 && opt.max_edges < ninterior) {
+    /* A quick estimate measures a random subset of the population: the first
+       max_edges of a partial Fisher-Yates shuffle. Unrelated pairs are still
+       drawn from every interior edge. */
+    nmeasured = npopulation;
+    if (opt.max_edges > 0 && opt.max_edges < npopulation) {
         nmeasured = opt.max_edges;
         for (i = 0; i < nmeasured; i++) {
-            int pick = i + (int)tt_rng_below(&rng, (uint32_t)(ninterior - i)), swap = interior[i];
+            int pick = i + (int)tt_rng_below(&rng, (uint32_t)(npopulation - i)), swap = interior[i];
             interior[i] = interior[pick];
             interior[pick] = swap;
         }
@@ -6337,10 +6565,10 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
                 !tt__edge_point_at(mesh, corner_uv, atlas, b, 1.0f - t, &pb) ||
                 !tt__edge_point_at(mesh, corner_uv, atlas, other, t_other, &po))
                 continue;
-            tt__displayed(atlas, &pa, 0.5f, sa);
-            tt__displayed(atlas, &pa, 1.5f, sa_deeper);
-            tt__displayed(atlas, &pb, 0.5f, sb);
-            tt__displayed(atlas, &po, 0.5f, so);
+            tt__displayed(atlas, wrap, &pa, 0.5f, sa);
+            tt__displayed(atlas, wrap, &pa, 1.5f, sa_deeper);
+            tt__displayed(atlas, wrap, &pb, 0.5f, sb);
+            tt__displayed(atlas, wrap, &po, 0.5f, so);
             seam += tt__texel_difference(sa, sb);
             same += tt__texel_difference(sa, sa_deeper);
             unrelated += tt__texel_difference(sa, so);
@@ -6354,9 +6582,9 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         report->edges_measured = 0;
         return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
                         ninterior < 2 ? "the mesh has %d interior edges: the seam measure needs at least two"
-                                      : "none of the %d interior edges could be sampled (zero length or non-finite "
-                                        "UVs)",
-                        ninterior);
+                                      : "none of the %d measured interior edges could be sampled (zero length or "
+                                        "non-finite UVs)",
+                        ninterior < 2 ? ninterior : npopulation);
     }
     report->samples = samples;
     report->seam = seam / (double)samples;
@@ -6411,6 +6639,56 @@ static void tt__face_tangents(const float *const point[4], int dims, int size, d
     }
 }
 
+/* The map from texture to surface of `face` at its centre, M (3x2, columns
+   dP/du and dP/dv), through the face's own parametrisation (s, t): for a
+   quad the bilinear patch's derivatives, otherwise the first triangle.
+   A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2) with texture coordinates
+   (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
+   M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
+   M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
+static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
+                                       double v_scale, double *big, double *small)
+{
+    int first = mesh->face_start[face], size = mesh->face_start[face + 1] - first, k;
+    const float *p[4], *q[4];
+    double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc;
+    for (k = 0; k < 4; k++) {
+        int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
+        p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
+        q[k] = corner_uv + 2 * (size_t)corner;
+    }
+    tt__face_tangents(p, 3, size, a);
+    tt__face_tangents(q, 2, size, b);
+    for (k = 0; k < 2; k++) {
+        b[k][0] *= u_scale;
+        b[k][1] *= v_scale;
+    }
+    /* b[i] is d(u,v)/d(param i); rows of A likewise. Solve M B = A for the
+       two texture axes: M's column for u and v. */
+    det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
+    if (fabs(det) < 1e-30) return 0;
+    for (k = 0; k < 3; k++) {
+        m[0][k] = (a[0][k] * b[1][1] - a[1][k] * b[0][1]) / det;   /* dP/du */
+        m[1][k] = (a[1][k] * b[0][0] - a[0][k] * b[1][0]) / det;   /* dP/dv */
+        g11 += m[0][k] * m[0][k];
+        g12 += m[0][k] * m[1][k];
+        g22 += m[1][k] * m[1][k];
+    }
+    tr = g11 + g22;
+    disc = sqrt((g11 - g22) * (g11 - g22) + 4.0 * g12 * g12);
+    *big = 0.5 * (tr + disc);
+    *small = 0.5 * (tr - disc);
+    return 1;
+}
+
+/* sigma_max / sigma_min from the eigenvalues of tt__face_texture_to_surface
+   (the same ratio for the map and its inverse, surface -> texture);
+   infinity when the smaller one vanishes against the larger. */
+static double tt__stretch_ratio(double big, double small)
+{
+    return small > 1e-30 * (big > 0 ? big : 1) ? sqrt(big / small) : (double)tt__infinity();
+}
+
 TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch, tt_error *error)
 {
     int f, c;
@@ -6423,37 +6701,128 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
                             "corner %d (face %d) has a non-finite UV", c / 2, mesh->corner_face[c / 2]);
     for (f = 0; f < mesh->nfaces; f++) {
-        /* Tangents of the face's own parametrisation s,t at its centre: for a
-           quad the bilinear patch's derivatives, otherwise the first triangle.
-           A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2); texture -> surface is
-           M = A B^-1, and the ratio of M's singular values is the stretch. */
-        int first = mesh->face_start[f], size = mesh->face_start[f + 1] - first, k;
-        const float *p[4], *q[4];
-        double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc, big, small;
-        for (k = 0; k < 4; k++) {
-            int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
-            p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
-            q[k] = corner_uv + 2 * (size_t)corner;
-        }
-        tt__face_tangents(p, 3, size, a);
-        tt__face_tangents(q, 2, size, b);
-        /* b[i] is d(u,v)/d(param i); rows of A likewise. Solve M B = A for the
-           two texture axes: M's column for u and v. */
-        det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
-        if (fabs(det) < 1e-30) { stretch[f] = tt__infinity(); continue; }
-        for (k = 0; k < 3; k++) {
-            m[0][k] = (a[0][k] * b[1][1] - a[1][k] * b[0][1]) / det;   /* dP/du */
-            m[1][k] = (a[1][k] * b[0][0] - a[0][k] * b[1][0]) / det;   /* dP/dv */
-            g11 += m[0][k] * m[0][k];
-            g12 += m[0][k] * m[1][k];
-            g22 += m[1][k] * m[1][k];
-        }
-        tr = g11 + g22;
-        disc = sqrt((g11 - g22) * (g11 - g22) + 4.0 * g12 * g12);
-        big = 0.5 * (tr + disc);
-        small = 0.5 * (tr - disc);
-        stretch[f] = small > 1e-30 * (big > 0 ? big : 1) ? (float)sqrt(big / small) : tt__infinity();
+        double big, small;
+        stretch[f] = tt__face_texture_to_surface(mesh, corner_uv, f, 1.0, 1.0, &big, &small)
+                         ? (float)tt__stretch_ratio(big, small)
+                         : tt__infinity();
     }
+    return TT_OK;
+}
+
+/* Twice the signed area of face f's UV polygon in texels (u * width, v *
+   height; positive counter-clockwise with v up), taken relative to its first
+   corner as tt__polygon_newell does in 3D, and the polygon's own size (the
+   sum of squared distances to that corner) to judge it zero against. */
+static void tt__uv_polygon_area(const tt_mesh *mesh, const float *corner_uv, int face, int width, int height,
+                                double *twice_area, double *scale)
+{
+    int first = mesh->face_start[face], end = mesh->face_start[face + 1], c;
+    double ox = (double)corner_uv[2 * first] * width, oy = (double)corner_uv[2 * first + 1] * height;
+    double ax = 0.0, ay = 0.0;
+    *twice_area = 0.0;
+    *scale = 0.0;
+    for (c = first + 1; c < end; c++) {
+        double bx = (double)corner_uv[2 * c] * width - ox, by = (double)corner_uv[2 * c + 1] * height - oy;
+        *twice_area += ax * by - ay * bx;
+        *scale += bx * bx + by * by;
+        ax = bx;
+        ay = by;
+    }
+}
+
+TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                                         const tt_uv_distortion_options *options, const tt_allocator *allocator,
+                                         tt_uv_distortion_report *report, tt_error *error)
+{
+    static const double median_and_p95[2] = {0.5, 0.95};
+    tt_uv_distortion_options opt;
+    tt__weighted *stretch, *density;
+    double texels_per_unit, stats[2];
+    int f, c, n = 0;
+    tt__ok(error);
+    if (report) {
+        double not_measured = tt__not_a_number();
+        memset(report, 0, sizeof *report);
+        report->stretch_median = report->stretch_p95 = report->stretch_max = not_measured;
+        report->density_median = report->density_p95 = report->texels_per_unit = not_measured;
+    }
+    if (!mesh || !corner_uv || !report)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_measure_uv_distortion needs a mesh, UVs and a report (got NULL)");
+    if (width < 1 || height < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the image is %d x %d texels: both sizes must be at least 1", width, height);
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    if (!tt__is_finite_d(opt.texels_per_unit) || opt.texels_per_unit < 0.0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "texels_per_unit is %g: 0 (measure it) or a positive finite number", opt.texels_per_unit);
+    if (!tt__is_finite_d(opt.margin_texels) || opt.margin_texels < 0.0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "margin_texels is %g: 0 (no check) or a positive finite number", opt.margin_texels);
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    stretch = TT__ALLOC(allocator, tt__weighted, 2 * (size_t)mesh->nfaces);
+    if (!stretch)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                        "out of memory measuring the UV distortion of %d faces", mesh->nfaces);
+    density = stretch + mesh->nfaces;
+
+    if (opt.margin_texels > 0.0)
+        for (c = 0; c < mesh->ncorners; c++) {
+            double x = (double)corner_uv[2 * c] * width, y = (double)corner_uv[2 * c + 1] * height;
+            double m = opt.margin_texels;
+            if (tt__is_finite_d(x) && tt__is_finite_d(y) && (x < m || x > width - m || y < m || y > height - m))
+                report->outside_margin++;
+        }
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], size = mesh->face_start[f + 1] - first, finite = 1;
+        double normal[3], surface_scale, twice_uv_area, uv_scale, uv_normal[3], big, small, surface_area, ratio;
+        for (c = first; c < first + size; c++)
+            finite &= tt__is_finite(corner_uv[2 * c]) && tt__is_finite(corner_uv[2 * c + 1]);
+        if (!finite) {
+            report->non_finite++;
+            continue;
+        }
+        /* Zero area in either space is judged as tt_mesh_build judges it:
+           against the polygon's own size. */
+        tt__polygon_newell(mesh->pos, mesh->corner_vert + first, size, normal, &surface_scale);
+        tt__uv_polygon_area(mesh, corner_uv, f, width, height, &twice_uv_area, &uv_scale);
+        uv_normal[0] = uv_normal[1] = 0.0;
+        uv_normal[2] = twice_uv_area;
+        if (tt__newell_is_zero(normal, surface_scale) || tt__newell_is_zero(uv_normal, uv_scale) ||
+            !tt__face_texture_to_surface(mesh, corner_uv, f, width, height, &big, &small) ||
+            !tt__is_finite_d(ratio = tt__stretch_ratio(big, small))) {
+            report->degenerate++;
+            continue;
+        }
+        if (twice_uv_area < 0.0) report->flipped++;
+        surface_area = 0.5 * tt__length3(normal);
+        stretch[n].value = ratio;
+        stretch[n].weight = surface_area;
+        /* texel density = sqrt(UV area in texels^2 / surface area) */
+        density[n].value = sqrt(0.5 * fabs(twice_uv_area) / surface_area);
+        density[n].weight = surface_area;
+        if (!(ratio <= report->stretch_max)) report->stretch_max = ratio;   /* the first replaces the NaN */
+        n++;
+    }
+    report->faces_measured = n;
+    if (n == 0) {
+        tt__free(allocator, stretch);
+        return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                        "none of the %d faces could be measured: %d have zero surface or UV area, %d a non-finite "
+                        "UV", mesh->nfaces, report->degenerate, report->non_finite);
+    }
+    tt__weighted_percentiles(stretch, n, median_and_p95, 2, stats);
+    report->stretch_median = stats[0];
+    report->stretch_p95 = stats[1];
+    texels_per_unit = opt.texels_per_unit;
+    if (texels_per_unit == 0.0) tt__weighted_percentiles(density, n, median_and_p95, 1, &texels_per_unit);
+    report->texels_per_unit = texels_per_unit;
+    for (f = 0; f < n; f++) density[f].value = fabs(density[f].value / texels_per_unit - 1.0);
+    tt__weighted_percentiles(density, n, median_and_p95, 2, stats);
+    report->density_median = stats[0];
+    report->density_p95 = stats[1];
+    tt__free(allocator, stretch);
     return TT_OK;
 }
 

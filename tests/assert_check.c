@@ -63,7 +63,8 @@ int main(void)
     float normal[3], uv[2], rgba[4], xy[6] = {0, 0, 4, 0, 0, 4};
     unsigned char bytes[16];
     int rx, ry;
-    tt_image empty;
+    tt_image empty, one;
+    float one_texel[4] = {0.25f, 0.5f, 0.75f, 1.0f};
 
     memset(&desc, 0, sizeof desc);
     desc.positions = pos;
@@ -79,7 +80,10 @@ int main(void)
     bad_layout.colors = 1000;   /* (2n)^2 tiles a side would overflow an atlas, and an int squared */
     memset(&layout, 0, sizeof layout);
     memset(&empty, 0, sizeof empty);
-    (void)normal; (void)uv; (void)rgba; (void)xy; (void)bytes; (void)rx; (void)ry; (void)types; (void)big_types;
+    memset(&one, 0, sizeof one);
+    one.width = one.height = 1;
+    one.pixels = one_texel;
+    (void)one; (void)normal; (void)uv; (void)rgba; (void)xy; (void)bytes; (void)rx; (void)ry; (void)types; (void)big_types;
 
 #ifdef ASSERT_CHECK_NDEBUG
     if (tt_tile_layout_tiles_per_side(&bad_layout) != 0 || tt_tile_layout_atlas_size(&bad_layout) != 0 ||
@@ -109,6 +113,10 @@ int main(void)
     EXPECT_ASSERT("tt_tile_layout_tiles_per_side(colors 1000)", tt_tile_layout_tiles_per_side(&bad_layout));
     EXPECT_ASSERT("tt_tile_layout_atlas_size(NULL)", tt_tile_layout_atlas_size(NULL));
     EXPECT_ASSERT("tt_image_sample_bilinear(empty image)", tt_image_sample_bilinear(&empty, 0.5f, 0.5f, rgba));
+    EXPECT_ASSERT("tt_image_sample_bilinear_wrap(empty image)",
+                  tt_image_sample_bilinear_wrap(&empty, 0.5f, 0.5f, TT_WRAP_REPEAT, rgba));
+    EXPECT_ASSERT("tt_image_sample_bilinear_wrap(wrap 7)",
+                  tt_image_sample_bilinear_wrap(&one, 0.5f, 0.5f, (tt_wrap)7, rgba));
     EXPECT_ASSERT("tt_image_to_rgba8(empty image)", tt_image_to_rgba8(&empty, TT_COLOR_SRGB, bytes));
     EXPECT_ASSERT("tt_rgba_over(NULL)", tt_rgba_over(NULL, rgba));
     EXPECT_ASSERT("tt_rotate_coords(NULL out)", tt_rotate_coords(1, 4, 4, 0, 0, NULL, &ry));

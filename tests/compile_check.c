@@ -96,6 +96,7 @@ int main(void)
     if (!image) return 1;
     EXPECT(tt_srgb_to_linear(tt_linear_to_srgb(0.25f)) > 0.2499f);
     tt_image_sample_bilinear(image, 1.5f, 1.5f, rgba);
+    tt_image_sample_bilinear_wrap(image, -1.5f, 17.5f, TT_WRAP_REPEAT, rgba);
     tt_rotate_coords(1, 16, 32, 0, 0, &rx, &ry);
     EXPECT(rx == 0 && ry == 15);
     EXPECT(tt_image_rotate90(image, 1, NULL, &rotated, &err) == TT_OK && rotated->width == 32);
@@ -130,6 +131,14 @@ int main(void)
     EXPECT(tt_assign_uvs(quads, &layout, types, uv, &err) == TT_OK);
     EXPECT(tt_tile_histogram(quads, &layout, types, counts, &err) == TT_OK);
     EXPECT(tt_face_stretch(quads, uv, stretch, &err) == TT_OK);
+    {
+        tt_uv_distortion_options distortion_options;
+        tt_uv_distortion_report distortion;
+        memset(&distortion_options, 0, sizeof distortion_options);
+        distortion_options.margin_texels = 0.5;
+        EXPECT(tt_measure_uv_distortion(quads, uv, 256, 128, &distortion_options, NULL, &distortion, &err) == TT_OK &&
+               distortion.faces_measured > 0);
+    }
 
     memset(&options, 0, sizeof options);
     options.layout = layout;
@@ -137,6 +146,13 @@ int main(void)
     EXPECT(tt_synthesize_tiles(image, &options, NULL, &tiles, &err) == TT_OK);
     if (tiles) {
         EXPECT(tt_measure_seams(quads, uv, &tiles->levels[0], NULL, NULL, &report, &err) == TT_OK);
+        {
+            tt_seam_options seam_options;
+            memset(&seam_options, 0, sizeof seam_options);
+            seam_options.flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
+            EXPECT(tt_measure_seams(quads, uv, &tiles->levels[0], &seam_options, NULL, &report, &err) == TT_OK &&
+                   report.edges_discontinuous > 0);
+        }
         tt_tileset_free(tiles);
     }
     {

@@ -193,6 +193,44 @@ static void test_image_basics(void)
     CHECK(cnt.live == 0, "image basics: %ld allocations leaked", cnt.live);
 }
 
+/* TT_WRAP_REPEAT: the image tiles the plane. Whole periods change nothing,
+   the borders blend the last texel with the first, and coordinates that are
+   not finite or far too large still sample a texel; TT_WRAP_CLAMP is the
+   plain sampler. */
+static void test_sample_wrap(void)
+{
+    tt_image *im = NULL;
+    float s[4], t[4];
+    int x, y, k, bad_period = 0, bad_clamp = 0;
+    CHECK(tt_image_create(5, 4, NULL, &im, NULL) == TT_OK, "create 5x4");
+    if (!im) return;
+    fill_random(im, 31);
+    for (y = 0; y < 8; y++)
+        for (x = 0; x < 10; x++) {
+            float fx = 0.37f * (float)x + 0.2f, fy = 0.55f * (float)y + 0.1f;
+            tt_image_sample_bilinear_wrap(im, fx, fy, TT_WRAP_REPEAT, s);
+            tt_image_sample_bilinear_wrap(im, fx + 10.0f, fy - 8.0f, TT_WRAP_REPEAT, t);
+            for (k = 0; k < 4; k++) bad_period += !near(s[k], t[k], 1e-5);
+            tt_image_sample_bilinear_wrap(im, fx * 3.0f - 4.0f, fy * 3.0f - 4.0f, TT_WRAP_CLAMP, s);
+            tt_image_sample_bilinear(im, fx * 3.0f - 4.0f, fy * 3.0f - 4.0f, t);
+            bad_clamp += memcmp(s, t, sizeof s) != 0;
+        }
+    CHECK(bad_period == 0, "repeat: %d values change by whole periods (10, -8)", bad_period);
+    CHECK(bad_clamp == 0, "TT_WRAP_CLAMP: %d samples differ from tt_image_sample_bilinear", bad_clamp);
+    /* x = 0 lies halfway between the last column's centre (4.5 - 5) and the
+       first one's (0.5) */
+    tt_image_sample_bilinear_wrap(im, 0.0f, 2.5f, TT_WRAP_REPEAT, s);
+    for (k = 0; k < 4; k++) bad_period += !near(s[k], 0.5 * (px(im, 4, 2)[k] + px(im, 0, 2)[k]), 1e-6);
+    tt_image_sample_bilinear_wrap(im, 2.5f, 4.0f, TT_WRAP_REPEAT, s);
+    for (k = 0; k < 4; k++) bad_period += !near(s[k], 0.5 * (px(im, 2, 3)[k] + px(im, 2, 0)[k]), 1e-6);
+    CHECK(bad_period == 0, "repeat blends the last texel with the first across each border");
+    tt_image_sample_bilinear_wrap(im, (float)NAN, internal_infinity(), TT_WRAP_REPEAT, s);
+    CHECK(memcmp(s, px(im, 0, 0), sizeof s) == 0, "repeat at (NaN, inf) should sample texel (0, 0): got %g", s[0]);
+    tt_image_sample_bilinear_wrap(im, -3e38f, 1e30f, TT_WRAP_REPEAT, s);   /* must not crash */
+    CHECK(s[0] == s[0], "repeat at (-3e38, 1e30) should return a number");
+    tt_image_free(im);
+}
+
 /* IEC 61966-2-1 in double precision. */
 static double ref_srgb_to_linear(double v)
 {
@@ -801,6 +839,7 @@ static void test_min_error_cut(void)
 void run_image_tests(void)
 {
     RUN(test_image_basics);
+    RUN(test_sample_wrap);
     RUN(test_color_transfer);
     RUN(test_color_bytes_identity);
     RUN(test_color_mip);

@@ -1500,6 +1500,230 @@ static void test_seams_oom(void)
     tt_mesh_free(mesh);
 }
 
+/* Two charts on one open grid of 16 x 8 unit quads: corner UVs (0.05 + x/32,
+   0.1 + y/32), each quad 4 x 4 texels of a 128 x 128 atlas, with the right
+   half's faces (column 8 on) shifted by `shift` in u. The 8 edges on the
+   line x = 8 are then the only UV-discontinuous ones (when shift != 0). */
+static float *two_chart_uvs(const tt_mesh *mesh, float shift)
+{
+    float *uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    int f, k;
+    if (!uv) return NULL;
+    for (f = 0; f < mesh->nfaces; f++)
+        for (k = mesh->face_start[f]; k < mesh->face_start[f + 1]; k++) {
+            const float *p = mesh->pos + 3 * mesh->corner_vert[k];
+            uv[2 * k] = 0.05f + p[0] / 32.0f + (f % 16 >= 8 ? shift : 0.0f);
+            uv[2 * k + 1] = 0.1f + p[1] / 32.0f;
+        }
+    return uv;
+}
+
+static tt_mesh *two_chart_grid(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 16, 8);
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "16 x 8 grid build: %d", r);
+    return mesh;
+}
+
+/* TT_SEAM_UV_DISCONTINUOUS: measured on the chart border alone, a shifted
+   chart scores like unrelated places (about 1); measured on every edge the
+   same border is diluted by the 224 continuous edges inside the charts. */
+static void test_seams_discontinuous(void)
+{
+    tt_mesh *mesh = two_chart_grid();
+    tt_image *atlas = NULL;
+    float *uv = NULL;
+    tt_seam_options so;
+    tt_seam_report all, border, sampled;
+    tt_error err;
+    tt_result r;
+    make_value_noise(&atlas, 128, 128, 7);
+    if (mesh) uv = two_chart_uvs(mesh, 0.4f);
+    if (!mesh || !atlas || !uv) {
+        CHECK(0, "two-chart setup");
+        goto done;
+    }
+    memset(&so, 0, sizeof so);
+    so.seed = 3;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+    CHECK(r == TT_OK && all.edges_discontinuous == 8 && all.edges_measured == 232,
+          "two charts, every edge: %d, %d discontinuous edges (want 8), %d measured (want 232) (%s)", r,
+          all.edges_discontinuous, all.edges_measured, err.message);
+    so.flags = TT_SEAM_UV_DISCONTINUOUS;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &border, &err);
+    CHECK(r == TT_OK && border.edges_discontinuous == 8 && border.edges_measured == 8,
+          "two charts, border only: %d, %d discontinuous, %d measured (want 8 and 8) (%s)", r,
+          border.edges_discontinuous, border.edges_measured, err.message);
+    CHECK(border.score >= 0.8 && all.score < 0.2 && all.score < border.score - 0.6,
+          "a shifted chart: border-only score %.4f (want >= 0.8), every edge %.4f (want < 0.2: diluted)",
+          border.score, all.score);
+    /* max_edges samples within the border */
+    so.max_edges = 3;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &sampled, &err);
+    CHECK(r == TT_OK && sampled.edges_measured == 3 && sampled.edges_discontinuous == 8 && sampled.score > 0.5,
+          "border only, max_edges 3: %d, %d measured (want 3), %d discontinuous, score %.4f", r,
+          sampled.edges_measured, sampled.edges_discontinuous, sampled.score);
+    /* one chart: nothing to measure in restricted mode; every edge still is */
+    free(uv);
+    uv = two_chart_uvs(mesh, 0.0f);
+    if (!uv) goto done;
+    so.max_edges = 0;
+    memset(&border, 0x55, sizeof border);
+    memset(&err, 0, sizeof err);
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &border, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && err.result == r && strstr(err.message, "discontinuous") &&
+              isnan(border.score) && border.edges_discontinuous == 0 && border.edges_measured == 0 &&
+              border.samples == 0 && border.seam == 0.0 && border.same_face == 0.0 && border.unrelated == 0.0,
+          "one chart, border only: expected TT_ERROR_NOT_MEASURED with an empty report, got %d, score %g, %d "
+          "discontinuous, %d measured (\"%s\")", r, border.score, border.edges_discontinuous, border.edges_measured,
+          err.message);
+    so.flags = 0;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+    CHECK(r == TT_OK && all.edges_discontinuous == 0 && all.edges_measured == 232 && fabs(all.score) < 0.1,
+          "one chart, every edge: %d, %d discontinuous, %d measured, score %.4f (want about 0)", r,
+          all.edges_discontinuous, all.edges_measured, all.score);
+    /* a difference below the tolerance is continuous, one above it is not */
+    {
+        int c = 0, twin_next;
+        while (mesh->twin[c] < 0) c++;
+        twin_next = tt_mesh_next(mesh, mesh->twin[c]);
+        uv[2 * twin_next] += 1e-8f;
+        r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+        CHECK(r == TT_OK && all.edges_discontinuous == 0, "a UV 1e-8 away: %d discontinuous edges (want 0)",
+              all.edges_discontinuous);
+        uv[2 * twin_next] += 1e-4f;
+        r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+        CHECK(r == TT_OK && all.edges_discontinuous >= 1 && all.edges_discontinuous <= 2,
+              "a UV 1e-4 away: %d discontinuous edges (want the one or two edges at that corner)",
+              all.edges_discontinuous);
+    }
+    /* unknown flag bits are refused */
+    so.flags = 1u << 7;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &all, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0] && isnan(all.score),
+          "unknown seam flag 0x80: expected TT_ERROR_INVALID_ARGUMENT, got %d (\"%s\")", r, err.message);
+done:
+    free(uv);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
+/* flags 0 is the measure as it was before the flags existed: the reports of
+   the two-chart case, taken with the library before this change. */
+static void test_seams_flags_zero_unchanged(void)
+{
+    static const struct {
+        int max_edges;
+        double seam, same_face, unrelated, score;
+        int edges_measured;
+        long long samples;
+    } before[2] = {
+        {100, 0.0052313029418389074, 0.0044668324440717789, 0.017892654771606096, 0.056940310926006814, 100, 4000},
+        {0, 0.0049949636061986345, 0.0045134528332904491, 0.018369188188418404, 0.034751729920273061, 232, 3944}};
+    tt_mesh *mesh = two_chart_grid();
+    tt_image *atlas = NULL;
+    float *uv = NULL;
+    int i;
+    make_value_noise(&atlas, 128, 128, 7);
+    if (mesh) uv = two_chart_uvs(mesh, 0.4f);
+    for (i = 0; i < 2 && mesh && atlas && uv; i++) {
+        tt_seam_options so;
+        tt_seam_report rep;
+        tt_error err;
+        tt_result r;
+        memset(&so, 0, sizeof so);
+        so.seed = 3;
+        so.max_edges = before[i].max_edges;
+        r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &rep, &err);
+        CHECK(r == TT_OK && rep.edges_measured == before[i].edges_measured && rep.samples == before[i].samples &&
+                  near(rep.seam, before[i].seam, 1e-12) && near(rep.same_face, before[i].same_face, 1e-12) &&
+                  near(rep.unrelated, before[i].unrelated, 1e-12) && near(rep.score, before[i].score, 1e-9),
+              "flags 0, max_edges %d: %d, seam %.17g same %.17g unrelated %.17g score %.17g, %d edges, %lld "
+              "samples; before: %.17g %.17g %.17g %.17g, %d, %lld", before[i].max_edges, r, rep.seam,
+              rep.same_face, rep.unrelated, rep.score, rep.edges_measured, rep.samples, before[i].seam,
+              before[i].same_face, before[i].unrelated, before[i].score, before[i].edges_measured,
+              before[i].samples);
+    }
+    CHECK(mesh && atlas && uv, "flags 0 setup");
+    free(uv);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
+/* A periodic atlas: a sum of waves with whole numbers of periods across the
+   64 x 64 image, so that TT_WRAP_REPEAT sampling is continuous everywhere. */
+static tt_image *make_periodic_waves(void)
+{
+    tt_image *im = NULL;
+    int x, y;
+    if (tt_image_create(64, 64, NULL, &im, NULL) != TT_OK) return NULL;
+    for (y = 0; y < 64; y++)
+        for (x = 0; x < 64; x++) {
+            double s = (x + 0.5) / 64.0 * 6.283185307179586, t = (y + 0.5) / 64.0 * 6.283185307179586;
+            double a = 0.5 + 0.18 * sin(3 * s + 0.7) + 0.12 * sin(2 * s + 5 * t + 1.9) + 0.1 * sin(7 * t - 4 * s);
+            px(im, x, y)[0] = (float)a;
+            px(im, x, y)[1] = (float)(1.0 - a);
+            px(im, x, y)[2] = (float)(0.5 + 0.3 * sin(4 * t + 1.0));
+            px(im, x, y)[3] = 1.0f;
+        }
+    return im;
+}
+
+/* TT_SEAM_WRAP: the right chart shifted by a whole period (u + 1) continues
+   the left one on a periodic atlas; clamped sampling breaks it. */
+static void test_seams_wrap(void)
+{
+    tt_mesh *mesh = two_chart_grid();
+    tt_image *atlas = make_periodic_waves();
+    float *uv = NULL;
+    tt_seam_options so;
+    tt_seam_report wrapped, clamped, crossing;
+    tt_error err;
+    tt_result r;
+    int c;
+    if (mesh) uv = two_chart_uvs(mesh, 1.0f);
+    if (!mesh || !atlas || !uv) {
+        CHECK(0, "wrap setup");
+        goto done;
+    }
+    memset(&so, 0, sizeof so);
+    so.seed = 9;
+    so.flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &wrapped, &err);
+    CHECK(r == TT_OK && wrapped.edges_discontinuous == 8 && wrapped.edges_measured == 8 &&
+              fabs(wrapped.score) < 0.15,
+          "a chart one period over, wrapped: %d, %d discontinuous (want 8), score %.4f (want about 0; seam %.4f, "
+          "same face %.4f, unrelated %.4f)", r, wrapped.edges_discontinuous, wrapped.score, wrapped.seam,
+          wrapped.same_face, wrapped.unrelated);
+    so.flags = TT_SEAM_UV_DISCONTINUOUS;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &clamped, &err);
+    CHECK(r == TT_OK && clamped.score > 0.3 && clamped.score > wrapped.score + 0.3,
+          "a chart one period over, clamped: %d, score %.4f (want > 0.3: the clamp breaks it; wrapped %.4f)", r,
+          clamped.score, wrapped.score);
+    /* one continuous chart whose UVs cross the image's border (u in 0.75 ..
+       1.25): continuous when wrapped */
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *p = mesh->pos + 3 * mesh->corner_vert[c];
+        uv[2 * c] = 0.75f + p[0] / 32.0f;
+    }
+    so.flags = TT_SEAM_WRAP;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &crossing, &err);
+    CHECK(r == TT_OK && crossing.edges_discontinuous == 0 && fabs(crossing.score) < 0.1,
+          "one chart across the border, wrapped: %d, %d discontinuous, score %.4f (want about 0)", r,
+          crossing.edges_discontinuous, crossing.score);
+done:
+    free(uv);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
 static void check_histogram(int grid, int n, double tolerance)
 {
     tmesh m;
@@ -1644,6 +1868,316 @@ static void test_stretch(void)
     tm_free(&m);
 }
 
+/* ---- UV distortion ---- */
+
+/* An open grid of nx x ny unit squares in the plane z = 0, each cut into two
+   counter-clockwise triangles. */
+static tt_mesh *triangle_grid(int nx, int ny)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_result r;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= ny; j++)
+        for (i = 0; i <= nx; i++) tm_vert(&m, i, j, 0);
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++) {
+            int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 2, d = a + nx + 1;
+            tm_tri(&m, a, b, c);
+            tm_tri(&m, a, c, d);
+        }
+    r = build(&m, 0, &mesh, &err);
+    tm_free(&m);
+    CHECK(r == TT_OK, "triangle grid build: %d", r);
+    return mesh;
+}
+
+/* UV of every corner: its vertex's (x, y) times (sx, sy) texels per unit,
+   plus (ox, oy) texels, in a width x height image. */
+static void linear_uvs(const tt_mesh *mesh, double sx, double sy, double ox, double oy, int width, int height,
+                       float *uv)
+{
+    int c;
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+        uv[2 * c] = (float)((p[0] * sx + ox) / width);
+        uv[2 * c + 1] = (float)((p[1] * sy + oy) / height);
+    }
+}
+
+static tt_result distortion(const tt_mesh *mesh, const float *uv, int width, int height, double texels_per_unit,
+                            double margin, tt_uv_distortion_report *rep, tt_error *err)
+{
+    tt_uv_distortion_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.texels_per_unit = texels_per_unit;
+    opt.margin_texels = margin;
+    return tt_measure_uv_distortion(mesh, uv, width, height, &opt, NULL, rep, err);
+}
+
+/* Linear maps of known distortion on a non-square 256 x 128 image:
+   isometric, uniformly scaled, anisotropic; triangles and quads. */
+static void test_uv_distortion_maps(void)
+{
+    tt_mesh *tris = triangle_grid(6, 4), *quads = NULL;
+    tt_uv_distortion_report rep;
+    tt_error err;
+    tt_result r;
+    float *uv;
+    tmesh m;
+    if (!tris) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)tris->ncorners);
+    if (!uv) { tt_mesh_free(tris); return; }
+    /* isometric at 16 texels a unit: given or measured, the density is right */
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.faces_measured == 48 && near(rep.stretch_median, 1, 1e-9) &&
+              near(rep.stretch_p95, 1, 1e-9) && near(rep.stretch_max, 1, 1e-9) && near(rep.density_median, 0, 1e-6) &&
+              near(rep.density_p95, 0, 1e-6) && rep.texels_per_unit == 16 && rep.flipped == 0 &&
+              rep.degenerate == 0 && rep.non_finite == 0 && rep.outside_margin == 0,
+          "isometric: %d, %d faces, stretch %g / %g / %g, density error %g / %g, %g texels a unit, flipped %d, "
+          "degenerate %d (%s)", r, rep.faces_measured, rep.stretch_median, rep.stretch_p95, rep.stretch_max,
+          rep.density_median, rep.density_p95, rep.texels_per_unit, rep.flipped, rep.degenerate, err.message);
+    r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.texels_per_unit, 16, 1e-4) && near(rep.density_p95, 0, 1e-6),
+          "isometric, scale measured: %d, %g texels a unit (want 16), density error p95 %g", r, rep.texels_per_unit,
+          rep.density_p95);
+    /* uniformly twice the intended scale: no stretch, density error exactly 1 */
+    linear_uvs(tris, 32, 32, 10, 10, 256, 128, uv);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.stretch_max, 1, 1e-9) && near(rep.density_median, 1, 1e-6) &&
+              near(rep.density_p95, 1, 1e-6),
+          "uniform scale 2: %d, stretch max %g, density error %g / %g (want 1)", r, rep.stretch_max,
+          rep.density_median, rep.density_p95);
+    /* 3 : 1 in texels (u three times as fine as v): stretch exactly 3 */
+    linear_uvs(tris, 48, 16, 10, 10, 256, 128, uv);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.stretch_median, 3, 1e-6) && near(rep.stretch_max, 3, 1e-6) &&
+              near(rep.density_median, sqrt(3.0) - 1, 1e-6),
+          "anisotropic 3 : 1: %d, stretch %g / %g (want 3), density error %g (want %g)", r, rep.stretch_median,
+          rep.stretch_max, rep.density_median, sqrt(3.0) - 1);
+    /* the same UVs in a square image are a different map: u in texels 256 / 128 as fine */
+    r = distortion(tris, uv, 128, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_OK && near(rep.stretch_median, 1.5, 1e-6),
+          "the 3 : 1 UVs in a 128 x 128 image: stretch %g (want 1.5)", rep.stretch_median);
+    free(uv);
+    tt_mesh_free(tris);
+    /* quads, their map taken at the centre */
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 5, 3);
+    r = build(&m, 0, &quads, &err);
+    tm_free(&m);
+    if (r == TT_OK) {
+        uv = (float *)malloc(sizeof(float) * 2 * (size_t)quads->ncorners);
+        if (uv) {
+            linear_uvs(quads, 20, 40, 3, 3, 256, 128, uv);
+            r = distortion(quads, uv, 256, 128, 0, 0, &rep, &err);
+            CHECK(r == TT_OK && rep.faces_measured == 15 && near(rep.stretch_max, 2, 1e-6) &&
+                      near(rep.texels_per_unit, sqrt(800.0), 1e-3) && near(rep.density_p95, 0, 1e-6),
+                  "quads at 20 x 40 texels a unit: %d, %d faces, stretch %g (want 2), %g texels a unit (want %g)",
+                  r, rep.faces_measured, rep.stretch_max, rep.texels_per_unit, sqrt(800.0));
+            free(uv);
+        }
+        tt_mesh_free(quads);
+    }
+}
+
+/* Flipped, degenerate and non-finite faces and corners near the border are
+   counted; only the flipped ones stay in the statistics. */
+static void test_uv_distortion_counts(void)
+{
+    tt_mesh *tris = triangle_grid(6, 4);
+    tt_uv_distortion_report rep;
+    tt_error err;
+    tt_result r;
+    float *uv, keep[2];
+    int c, expect_margin = 0;
+    if (!tris) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)tris->ncorners);
+    if (!uv) { tt_mesh_free(tris); return; }
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    /* face 5 mirrored: its first two corners swap UVs */
+    keep[0] = uv[30]; keep[1] = uv[31];
+    uv[30] = uv[32]; uv[31] = uv[33];
+    uv[32] = keep[0]; uv[33] = keep[1];
+    /* face 7 collapsed onto one UV point */
+    for (c = 21; c < 24; c++) { uv[2 * c] = 0.5f; uv[2 * c + 1] = 0.5f; }
+    /* face 9 has a NaN UV, face 11 an infinite one */
+    uv[2 * 28 + 1] = (float)internal_not_a_number();
+    uv[2 * 34] = internal_infinity();
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.flipped == 1 && rep.degenerate == 1 && rep.non_finite == 2 && rep.faces_measured == 45,
+          "one mirrored, one collapsed, two non-finite faces: %d, flipped %d, degenerate %d, non-finite %d, %d "
+          "measured (want 1, 1, 2, 45) (%s)", r, rep.flipped, rep.degenerate, rep.non_finite, rep.faces_measured,
+          err.message);
+    /* the mirrored face is the reflection across its hypotenuse (corners
+       (0,0) and (1,1) swap, (0,1) stays): flipped, yet no stretch; and the
+       excluded faces do not count */
+    CHECK(near(rep.stretch_median, 1, 1e-9) && near(rep.stretch_max, 1, 1e-9) && near(rep.density_p95, 0, 1e-6),
+          "a mirrored isometric face and excluded faces: stretch median %g, max %g (want 1), density error p95 %g "
+          "(want 0)", rep.stretch_median, rep.stretch_max, rep.density_p95);
+    /* a stretched face among similar ones: the area-weighted median stays 1,
+       the maximum shows it; face 0 (corners (0,0) (1,0) (1,1)) gets its
+       second corner moved to (3, 0) in texture units of 16 texels */
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    uv[2] = (float)((3 * 16 + 10) / 256.0);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.faces_measured == 48 && rep.flipped == 0 && near(rep.stretch_median, 1, 1e-6) &&
+              rep.stretch_max > 2,
+          "one stretched face: %d, stretch median %g (want 1), max %g (want > 2)", r, rep.stretch_median,
+          rep.stretch_max);
+    /* margins: the grid spans texels 10 .. 106 x 10 .. 74; a margin of 12
+       catches the corners on x = 0 and y = 0 (texel 10) */
+    linear_uvs(tris, 16, 16, 10, 10, 256, 128, uv);
+    for (c = 0; c < tris->ncorners; c++) {
+        const float *p = tris->pos + 3 * (size_t)tris->corner_vert[c];
+        expect_margin += p[0] == 0.0f || p[1] == 0.0f;
+    }
+    uv[0] = 1.01f;   /* corner 0 (at the origin) outside the image: counted once */
+    r = distortion(tris, uv, 256, 128, 16, 12, &rep, &err);
+    CHECK(r == TT_OK && rep.outside_margin == expect_margin, "margin 12 texels: %d corners (want %d)",
+          rep.outside_margin, expect_margin);
+    r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
+    CHECK(r == TT_OK && rep.outside_margin == 0, "no margin check: %d corners (want 0)", rep.outside_margin);
+    r = distortion(tris, uv, 256, 128, 16, 9.5, &rep, &err);
+    CHECK(r == TT_OK && rep.outside_margin == 1, "margin 9.5 texels: %d corners (want only the one outside)",
+          rep.outside_margin);
+    /* nothing measurable */
+    for (c = 0; c < 2 * tris->ncorners; c++) uv[c] = (float)internal_not_a_number();
+    memset(&err, 0, sizeof err);
+    r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && err.result == r && err.message[0] && rep.non_finite == 48 &&
+              rep.faces_measured == 0 && isnan(rep.stretch_median) && isnan(rep.density_p95) &&
+              isnan(rep.stretch_max),
+          "all-NaN UVs: expected TT_ERROR_NOT_MEASURED with 48 non-finite faces and NaN statistics, got %d, %d, "
+          "stretch %g (\"%s\")", r, rep.non_finite, rep.stretch_median, err.message);
+    for (c = 0; c < 2 * tris->ncorners; c++) uv[c] = 0.25f;
+    r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && rep.degenerate == 48, "every UV at one point: %d, %d degenerate", r,
+          rep.degenerate);
+    free(uv);
+    tt_mesh_free(tris);
+}
+
+/* The weighted percentile against its definition, evaluated naively:
+   integer weights, so that every sum is exact in both. */
+static void test_weighted_percentile(void)
+{
+    static const double fractions[5] = {0.0, 0.25, 0.5, 0.95, 1.0};
+    double values[40], weights[40];
+    int trial, k, i, j, bad = 0;
+    lcg_seed(606);
+    for (trial = 0; trial < 200; trial++) {
+        int n = 1 + lcg_below(40);
+        for (i = 0; i < n; i++) {
+            values[i] = (double)lcg_below(12) + (lcg_below(2) ? 0.5 : 0.0);   /* ties on purpose */
+            weights[i] = (double)lcg_below(6);   /* zero weights too */
+        }
+        weights[lcg_below(n)] += 1.0;   /* a positive total */
+        for (k = 0; k < 5; k++) {
+            double total = 0.0, want = 0.0, got;
+            int found = 0;
+            for (i = 0; i < n; i++) total += weights[i];
+            /* the smallest value whose at-or-below weight reaches the goal */
+            for (i = 0; i < n; i++) {
+                double below = 0.0;
+                for (j = 0; j < n; j++)
+                    if (values[j] <= values[i]) below += weights[j];
+                if (below >= fractions[k] * total && (!found || values[i] < want)) {
+                    want = values[i];
+                    found = 1;
+                }
+            }
+            got = internal_weighted_percentile(values, weights, n, fractions[k]);
+            if (got != want) {
+                if (!bad) DETAIL("trial %d, %d items, fraction %g: got %g, want %g", trial, n, fractions[k], got, want);
+                bad++;
+            }
+        }
+    }
+    CHECK(bad == 0, "weighted percentiles: %d of 1000 differ from the naive reference", bad);
+}
+
+static void test_uv_distortion_errors(void)
+{
+    tt_mesh *tris = triangle_grid(2, 2);
+    tt_uv_distortion_options opt;
+    tt_uv_distortion_report rep;
+    counter cnt;
+    tt_allocator half = make_allocator(&cnt, -1);
+    tt_error err;
+    float uv[2 * 24];
+    int i;
+    struct {
+        double texels_per_unit, margin;
+        const char *what;
+    } bad_options[5] = {{-1, 0, "texels_per_unit -1"}, {0, -0.5, "margin -0.5"}, {0, 0, "texels_per_unit NaN"},
+                        {16, 0, "margin inf"}, {0, 0, "texels_per_unit inf"}};
+    if (!tris) return;
+    bad_options[2].texels_per_unit = internal_not_a_number();
+    bad_options[3].margin = internal_infinity();
+    bad_options[4].texels_per_unit = internal_infinity();
+    linear_uvs(tris, 16, 16, 1, 1, 64, 64, uv);
+    CHECK(tt_measure_uv_distortion(tris, uv, 64, 64, NULL, NULL, &rep, &err) == TT_OK && rep.faces_measured == 8,
+          "options NULL: %s", err.message);
+    CHECK(tt_measure_uv_distortion(NULL, uv, 64, 64, NULL, NULL, &rep, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_uv_distortion(tris, NULL, 64, 64, NULL, NULL, &rep, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_uv_distortion(tris, uv, 64, 64, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "tt_measure_uv_distortion with NULL arguments should be rejected");
+    for (i = 0; i < 2; i++) {
+        tt_result r = tt_measure_uv_distortion(tris, uv, i ? 64 : 0, i ? -3 : 64, NULL, NULL, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0] && isnan(rep.stretch_median) &&
+                  rep.faces_measured == 0,
+              "image %d x %d: expected TT_ERROR_INVALID_ARGUMENT with an empty report, got %d", i ? 64 : 0,
+              i ? -3 : 64, r);
+    }
+    for (i = 0; i < 5; i++) {
+        tt_result r;
+        memset(&opt, 0, sizeof opt);
+        opt.texels_per_unit = bad_options[i].texels_per_unit;
+        opt.margin_texels = bad_options[i].margin;
+        memset(&err, 0, sizeof err);
+        r = tt_measure_uv_distortion(tris, uv, 64, 64, &opt, NULL, &rep, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0],
+              "%s: expected TT_ERROR_INVALID_ARGUMENT, got %d (\"%s\")", bad_options[i].what, r, err.message);
+    }
+    half.alloc = NULL;
+    CHECK(tt_measure_uv_distortion(tris, uv, 64, 64, NULL, &half, &rep, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "an allocator with free but no alloc should be rejected");
+    tt_mesh_free(tris);
+}
+
+typedef struct distortion_ctx {
+    const tt_mesh *mesh;
+    const float *uv;
+} distortion_ctx;
+
+static tt_result oom_distortion(void *ctx, const tt_allocator *al)
+{
+    distortion_ctx *d = (distortion_ctx *)ctx;
+    tt_uv_distortion_report rep;
+    tt_error err;
+    tt_result r = tt_measure_uv_distortion(d->mesh, d->uv, 64, 32, NULL, al, &rep, &err);
+    if (r != TT_OK && (err.result != r || !isnan(rep.stretch_median))) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_uv_distortion_oom(void)
+{
+    tt_mesh *tris = triangle_grid(3, 2);
+    float uv[2 * 36];
+    distortion_ctx d;
+    if (!tris) return;
+    linear_uvs(tris, 8, 8, 1, 1, 64, 32, uv);
+    d.mesh = tris;
+    d.uv = uv;
+    oom_reset();
+    oom_sweep("tt_measure_uv_distortion", oom_distortion, &d, TT_OK);
+    tt_mesh_free(tris);
+}
+
 void run_tiled_tests(void)
 {
     RUN(test_layout);
@@ -1660,6 +2194,14 @@ void run_tiled_tests(void)
     RUN(test_seams_not_measured);
     RUN(test_seams_sampled);
     RUN(test_seams_oom);
+    RUN(test_seams_discontinuous);
+    RUN(test_seams_flags_zero_unchanged);
+    RUN(test_seams_wrap);
     RUN(test_histogram);
     RUN(test_stretch);
+    RUN(test_weighted_percentile);
+    RUN(test_uv_distortion_maps);
+    RUN(test_uv_distortion_counts);
+    RUN(test_uv_distortion_errors);
+    RUN(test_uv_distortion_oom);
 }

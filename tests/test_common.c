@@ -317,6 +317,21 @@ void make_value_noise(tt_image **out, int w, int h, unsigned seed)
 void internal_free(const tt_allocator *allocator, void *ptr) { tt__free(allocator, ptr); }
 float internal_infinity(void) { return tt__infinity(); }
 double internal_not_a_number(void) { return tt__not_a_number(); }
+double internal_weighted_percentile(const double *values, const double *weights, int count, double fraction)
+{
+    tt__weighted *items = (tt__weighted *)malloc(sizeof(tt__weighted) * (size_t)count);
+    double result = tt__not_a_number();
+    int i;
+    if (!items) return result;
+    for (i = 0; i < count; i++) {
+        items[i].value = values[i];
+        items[i].weight = weights[i];
+    }
+    tt__weighted_percentiles(items, count, &fraction, 1, &result);
+    free(items);
+    return result;
+}
+
 double internal_orient2(double ax, double ay, double bx, double by, double cx, double cy)
 {
     return tt__orient2(ax, ay, bx, by, cx, cy);

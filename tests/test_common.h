@@ -153,6 +153,8 @@ void internal_free(const tt_allocator *allocator, void *ptr);
 float internal_infinity(void);
 double internal_not_a_number(void);
 double internal_orient2(double ax, double ay, double bx, double by, double cx, double cy);
+/* tt__weighted_percentiles of (values[i], weights[i]) at one fraction. */
+double internal_weighted_percentile(const double *values, const double *weights, int count, double fraction);
 double internal_point_segment_distance(double px_, double py_, double ax, double ay, double bx, double by);
 int internal_point_on_segment(double px_, double py_, double ax, double ay, double bx, double by);
 int internal_segments_near(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy,
