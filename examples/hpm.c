@@ -15,6 +15,7 @@
                          band fits, traversal, per-corner UVs
      tt_measure_seams    how well the texture continues across the cluster
                          borders (and across every edge)
+     tt_measure_uv_distortion  stretch, texel density, flipped triangles
 */
 #include <math.h>
 #include <stdio.h>
@@ -186,12 +187,72 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
 }
 
 /* ======================================================================== */
-/* The summary                                                              */
+/* The measures and the summary                                             */
 /* ======================================================================== */
 
-static void print_summary(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
-                          const tt_hpm_report *report, double seconds)
+/* A bounded image's coordinates stay this far inside it (the library's
+   promise, checked here): bilinear filtering then never reads past the
+   image's edge. */
+#define HPM_MARGIN_TEXELS 1.0
+
+typedef struct hpm_quality {
+    tool_seams borders;             /* UV-discontinuous edges: where clusters meet */
+    tool_seams all;                 /* every interior edge */
+    tt_uv_distortion_report distortion;
+    int distortion_measured;
+    char distortion_reason[224];
+} hpm_quality;
+
+/* The seams are measured on the image itself, the texture the OBJ uses;
+   a toroidal image is sampled the way it is drawn, repeated. */
+static int measure_quality(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
+                           const float *corner_uv, const tt_hpm_report *report, hpm_quality *quality)
 {
+    unsigned wrap = (options->map.flags & TT_HPM_TOROIDAL) ? TT_SEAM_WRAP : 0u;
+    tt_uv_distortion_options distortion;
+    tt_error error;
+    tt_result result;
+    int status;
+    memset(quality, 0, sizeof *quality);
+    status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, image, options->map.seed,
+                                TT_SEAM_UV_DISCONTINUOUS | wrap, 0, &quality->borders);
+    if (status == 0)
+        status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, image, options->map.seed, wrap, 0,
+                                    &quality->all);
+    if (status != 0) return status;
+    memset(&distortion, 0, sizeof distortion);
+    distortion.texels_per_unit = report->texels_per_unit;
+    distortion.margin_texels = (options->map.flags & TT_HPM_TOROIDAL) ? 0.0 : HPM_MARGIN_TEXELS;
+    result = tt_measure_uv_distortion(m->mesh, corner_uv, image->width, image->height, &distortion, NULL,
+                                      &quality->distortion, &error);
+    if (result == TT_ERROR_NOT_MEASURED) {
+        snprintf(quality->distortion_reason, sizeof quality->distortion_reason, "%s", error.message);
+        return 0;
+    }
+    if (result != TT_OK) return tool_fail("%s: cannot measure the distortion: %s", options->mesh_path, error.message);
+    quality->distortion_measured = 1;
+    return 0;
+}
+
+/* "0.123 (456 of 789 edges sampled)", "n/a ..." or "not measured (...)". */
+static void format_seams(const tool_seams *seams, const char *edges, char *text, size_t size)
+{
+    const tt_seam_report *r = &seams->report;
+    if (!seams->measured)
+        snprintf(text, size, "not measured (%s)", seams->reason);
+    else if (r->score == r->score)
+        snprintf(text, size, "%.3f (%d of %d %s%s)", r->score, r->edges_measured, seams->edges, edges,
+                 seams->sampled ? " sampled" : "");
+    else
+        snprintf(text, size, "n/a: unrelated places differ no more than neighbours (%d %s; seam - same-face %.4f)",
+                 r->edges_measured, edges, r->seam - r->same_face);
+}
+
+static void print_summary(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
+                          const tt_hpm_report *report, const hpm_quality *quality, double seconds)
+{
+    const tt_uv_distortion_report *d = &quality->distortion;
+    char borders[320], all[320];
     int level, last = -1, counted = report->levels < TT_HPM_MAX_LEVELS ? report->levels : TT_HPM_MAX_LEVELS;
     for (level = 0; level < counted; level++)
         if (report->mapped_per_level[level] > 0) last = level;
@@ -212,6 +273,23 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
                options->map.threshold > 0 ? options->map.threshold : TT_DEFAULT_HPM_THRESHOLD);
     printf("texel density %.4g texels per unit (the image's %d texels span %.4g units); %.1f s\n",
            report->texels_per_unit, image->width, (double)image->width / report->texels_per_unit, seconds);
+    format_seams(&quality->borders, "border edges", borders, sizeof borders);
+    format_seams(&quality->all, "edges", all, sizeof all);
+    printf("seam score: cluster borders %s; all edges %s\n", borders, all);
+    if (!quality->distortion_measured) {
+        printf("UV distortion: not measured (%s)\n", quality->distortion_reason);
+        return;
+    }
+    printf("UV distortion: stretch median %.3f, p95 %.3f; density error median %.1f%%, p95 %.1f%%; "
+           "%d flipped UV triangle%s",
+           d->stretch_median, d->stretch_p95, 100.0 * d->density_median, 100.0 * d->density_p95, d->flipped,
+           d->flipped == 1 ? "" : "s");
+    if (d->degenerate > 0) printf(", %d degenerate", d->degenerate);
+    if (d->non_finite > 0) printf(", %d with non-finite coordinates", d->non_finite);
+    if (d->outside_margin > 0)
+        printf(", %d corner%s closer than %g texel to the image's border", d->outside_margin,
+               d->outside_margin == 1 ? "" : "s", HPM_MARGIN_TEXELS);
+    printf("\n");
 }
 
 /* ======================================================================== */
@@ -224,6 +302,7 @@ int cmd_hpm(int argc, char **argv)
     triangle_mesh mesh;
     tt_image *image = NULL;
     tt_hpm_report report;
+    hpm_quality quality;
     tool_output output = TOOL_OUTPUT_INIT;
     float *corner_uv = NULL;
     char obj_path[4096], mtl_path[4096], message[TOOL_ERROR_SIZE];
@@ -249,13 +328,14 @@ int cmd_hpm(int argc, char **argv)
         if (!corner_uv) status = tool_fail("out of memory for the texture coordinates of %s", options.mesh_path);
     }
     if (status == 0) status = map_mesh(&options, &mesh, image, corner_uv, &report);
+    if (status == 0) status = measure_quality(&options, &mesh, image, corner_uv, &report, &quality);
 
     if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
     if (status == 0) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0) {
-        print_summary(&options, &mesh, image, &report, tool_seconds_now() - start);
+        print_summary(&options, &mesh, image, &report, &quality, tool_seconds_now() - start);
         printf("wrote %s, %s\n", obj_path, mtl_path);
     }
     output_free(&output);

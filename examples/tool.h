@@ -15,6 +15,7 @@
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
                  MTL writing             mtl_add_material, output_add_mtl
      triangle_mesh.c  an OBJ as triangles   triangle_mesh_read (lapped, hpm)
+     measure.c   quality for summaries   tool_measure_seams
      format_number.c  numbers as text   tool_format_float, tool_format_int
 
    Conventions every command follows:
@@ -400,6 +401,33 @@ void triangle_mesh_free(triangle_mesh *m);
    TOOL_EXIT_FAILURE. */
 void triangle_mesh_rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size);
 int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const tt_error *error);
+
+/* ---------------------------------------------------------------------- */
+/* Quality measures for the summaries (measure.c)                          */
+/* ---------------------------------------------------------------------- */
+
+/* The seam report the commands print: tt_measure_seams on at most this many
+   edges drawn at random (the library's full measure, every edge, is the
+   acceptance measure; 20000 edges stay within about 0.01 of it and keep the
+   report fast on meshes of hundreds of thousands of faces). */
+#define TOOL_REPORT_EDGES 20000
+
+typedef struct tool_seams {
+    int measured;               /* 0: TT_ERROR_NOT_MEASURED, `reason` says why */
+    int sampled;                /* 1: fewer edges measured than `edges` */
+    int edges;                  /* the edges the mode measures: every interior edge, or with
+                                   TT_SEAM_UV_DISCONTINUOUS the chart borders */
+    tt_seam_report report;
+    char reason[224];           /* the library's sentence, without its full stop */
+} tool_seams;
+
+/* Measure the seams of per-corner UVs on `atlas` for a summary: flags are
+   tt_seam_options.flags; a sample of TOOL_REPORT_EDGES edges, or with
+   all_edges every one. Nothing measurable (a one-face mesh, say) is not an
+   error: seams->measured is 0. Other library errors are printed as one line
+   naming obj_path; returns the exit status. */
+int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
+                       uint64_t seed, unsigned flags, int all_edges, tool_seams *seams);
 
 /* ---------------------------------------------------------------------- */
 /* Numbers as text without printf (format_number.c)                        */
