@@ -8,6 +8,8 @@
 #   5. lapped textures (Praun et al.) on the same surface, runtime pasting and baked:
 #                                           build/demo/lapped.obj/.mtl, lapped_patch.png, lapped_baked.*,
 #                                           pictures build/demo/lapped_front.png, lapped_baked_front.png
+#   6. hierarchical pattern mapping (Soler et al.): texture coordinates into the texture itself:
+#                                           build/demo/hpm.obj/.mtl, picture build/demo/hpm_front.png
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,6 +31,9 @@ mkdir -p "$out"
 "$tool" lapped "$out/double_torus_mesh.obj" "$out/texture.png" "$out/lapped" --scale 1.2 --seed 1 --bake 2048
 "$tool" render "$out/lapped.obj" "$out/lapped_patch.png" "$out/lapped_front.png" --yaw 20 --pitch 15
 "$tool" render "$out/lapped_baked.obj" "$out/lapped_baked.png" "$out/lapped_baked_front.png" --yaw 20 --pitch 15
+# The texture's width spans 3 of the surface's 5.7 units: stones large enough to see where clusters meet.
+"$tool" hpm "$out/double_torus_mesh.obj" "$out/texture.png" "$out/hpm" --scale 3 --seed 1
+"$tool" render "$out/hpm.obj" "$out/texture.png" "$out/hpm_front.png" --yaw 20 --pitch 15
 
 echo
 echo "pictures:"
@@ -39,3 +44,4 @@ echo "  $out/double_torus_side.png     the same from another side"
 echo "  $out/double_torus_closeup.png  close up, with the quads drawn: the stones run across every edge"
 echo "  $out/lapped_front.png          lapped textures: overlapping pastes of one patch, drawn in order"
 echo "  $out/lapped_baked_front.png    the same pastes baked into one texture over an atlas of triangle pairs"
+echo "  $out/hpm_front.png             hierarchical pattern mapping: patches of the example image itself, fitted to their neighbours"

@@ -20,15 +20,11 @@
      tt_atlas_pack_pairs,   --bake: an atlas (unless the OBJ has UVs) and the
      tt_lapped_bake         pastes composited into it
 */
-#define _POSIX_C_SOURCE 200112L     /* clock_gettime, isatty */
-
 #include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include <unistd.h>
 
 #include "tool.h"
 
@@ -150,99 +146,6 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
 }
 
 /* ======================================================================== */
-/* The mesh: the OBJ split into triangles                                   */
-/* ======================================================================== */
-
-typedef struct triangle_mesh {
-    obj_mesh obj;
-    int ntriangles;
-    int *corner;            /* 3 per triangle: its OBJ corners (index into obj.corner_vert, obj.corner_uv) */
-    int *vert;              /* 3 per triangle: their vertices */
-    int *face;              /* per triangle: its OBJ face */
-    int *first_triangle;    /* per OBJ face: the first triangle of its fan */
-    tt_mesh *mesh;          /* the triangles, validated */
-} triangle_mesh;
-
-static void triangle_mesh_free(triangle_mesh *m)
-{
-    obj_free(&m->obj);
-    free(m->corner);
-    free(m->vert);
-    free(m->face);
-    free(m->first_triangle);
-    tt_mesh_free(m->mesh);
-    memset(m, 0, sizeof *m);
-}
-
-/* Read the OBJ, split its faces into triangle fans and build those. */
-static int triangle_mesh_read(const char *path, triangle_mesh *m)
-{
-    char message[TOOL_ERROR_SIZE];
-    tt_mesh_desc desc;
-    tt_error error;
-    int c, t, total;
-    memset(m, 0, sizeof *m);
-    if (obj_read(path, &m->obj, message, sizeof message) != 0) return tool_fail("%s", message);
-    total = m->ntriangles = obj_triangle_fans(&m->obj, &m->corner, &m->face);
-    if (total >= 0) {
-        m->vert = (int *)malloc((size_t)total * 3 * sizeof(int));
-        m->first_triangle = (int *)malloc((size_t)m->obj.nfaces * sizeof(int));
-    }
-    if (!m->vert || !m->first_triangle) {
-        triangle_mesh_free(m);
-        return tool_fail("out of memory for the triangles of %s", path);
-    }
-    for (c = 0; c < 3 * total; c++) m->vert[c] = m->obj.corner_vert[m->corner[c]];
-    for (t = total - 1; t >= 0; t--) m->first_triangle[m->face[t]] = t;
-
-    memset(&desc, 0, sizeof desc);
-    desc.positions = m->obj.pos;
-    desc.nverts = m->obj.nverts;
-    desc.indices = m->vert;
-    desc.nfaces = total;
-    desc.fixed_face_size = 3;
-    if (tt_mesh_build(&desc, NULL, &m->mesh, &error) != TT_OK) {
-        int status;
-        /* Say it about the OBJ's faces, which the user can find. */
-        if (error.face >= 0 && error.face < total) error.face = m->face[error.face];
-        if (error.other_face >= 0 && error.other_face < total) error.other_face = m->face[error.other_face];
-        status = obj_report_mesh_error(path, &m->obj, &error, 0);
-        triangle_mesh_free(m);
-        return status;
-    }
-    return 0;
-}
-
-/* Report a library error. The library counts faces from 0 and means the
-   triangles; an error about one is said the OBJ's way, at the line of its
-   face and with the face counted from 1. */
-static void rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size)
-{
-    char pattern[32];
-    const char *at = NULL;
-    size_t length = 0;
-    if (error->face >= 0 && error->face < m->ntriangles) {
-        length = (size_t)snprintf(pattern, sizeof pattern, "face %d", error->face);
-        for (at = strstr(error->message, pattern); at && isdigit((unsigned char)at[length]);
-             at = strstr(at + 1, pattern))
-            continue;
-    }
-    if (at)
-        snprintf(message, size, "%.*sface %d%s", (int)(at - error->message), error->message,
-                 m->face[error->face] + 1, at + length);
-    else
-        snprintf(message, size, "%s", error->message);
-}
-
-static int report_error(const char *path, const triangle_mesh *m, const tt_error *error)
-{
-    char message[sizeof error->message + 32];
-    if (error->face < 0 || error->face >= m->ntriangles) return tool_fail("%s: %s", path, error->message);
-    rewrite_face(m, error, message, sizeof message);
-    return tool_fail("%s:%d: %s", path, m->obj.face_line[m->face[error->face]], message);
-}
-
-/* ======================================================================== */
 /* The tangent field and its constraints file                               */
 /* ======================================================================== */
 
@@ -357,7 +260,7 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
             char message[sizeof error.message + 32], prefix[32];
             size_t length = (size_t)snprintf(prefix, sizeof prefix, "constraint %d", error.item);
             const char *text = message;
-            rewrite_face(m, &error, message, sizeof message);
+            triangle_mesh_rewrite_face(m, &error, message, sizeof message);
             /* "constraint 0 (face 7): ..." counts from 0; the line says which. */
             if (strncmp(message, prefix, length) == 0 && !isdigit((unsigned char)message[length])) {
                 text = message + length;
@@ -368,7 +271,7 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
                 status = tool_fail("%s:%d: %s", options->constraints_path, constraints.line[error.item], text);
             }
         } else {
-            status = report_error(options->mesh_path, m, &error);
+            status = triangle_mesh_report_error(options->mesh_path, m, &error);
         }
     }
     constraint_list_free(&constraints);
@@ -426,44 +329,6 @@ static int add_patch_png(tool_output *output, const char *path, tt_image **image
     status = output_add_png_rgba8(output, path, rgba, width, height, message, sizeof message);
     free(rgba);
     return status != 0 ? tool_fail("%s", message) : 0;
-}
-
-/* ======================================================================== */
-/* Progress on a terminal                                                   */
-/* ======================================================================== */
-
-typedef struct progress_state {
-    double start, last;     /* seconds */
-    int terminal;           /* stderr is a terminal: a "\r" line can be redrawn */
-    int shown;
-} progress_state;
-
-static double seconds_now(void)
-{
-    struct timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
-}
-
-/* A tt_progress_fn. Quiet for the first second (most runs are shorter) and
-   when stderr is not a terminal (a log would fill with "\r" lines). */
-static int show_progress(float fraction, void *user_data)
-{
-    progress_state *progress = (progress_state *)user_data;
-    double now = seconds_now();
-    if (!progress->terminal || now - progress->start < 1.0 || (progress->shown && now - progress->last < 0.1))
-        return 0;
-    fprintf(stderr, "\rtiledtex: pasting: %5.1f%% of the surface covered", 100.0 * (double)fraction);
-    fflush(stderr);
-    progress->shown = 1;
-    progress->last = now;
-    return 0;
-}
-
-static void end_progress(progress_state *progress)
-{
-    if (progress->shown) fputc('\n', stderr);
-    progress->shown = 0;
 }
 
 /* ======================================================================== */
@@ -534,21 +399,6 @@ done:
     return status;
 }
 
-static int add_mtl(tool_output *output, const char *path, const char *material, const char *texture_path,
-                   int texture_alpha)
-{
-    tool_buffer text;
-    char texture[4096];
-    memset(&text, 0, sizeof text);
-    tool_relative_path(texture_path, path, texture, sizeof texture);
-    mtl_add_material(&text, material, texture, texture_alpha);
-    if (output_add_buffer(output, path, &text) != 0) {
-        buffer_free(&text);
-        return tool_fail("out of memory while writing %s", path);
-    }
-    return 0;
-}
-
 /* A colour image (straight alpha) as sRGB bytes; the image is freed as
    soon as it is converted, before the PNG is compressed. */
 static int add_png(tool_output *output, const char *path, tt_image *image)
@@ -605,7 +455,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     memset(&bake, 0, sizeof bake);
     bake.gutter = LAPPED_BAKE_GUTTER;
     if (tt_lapped_bake(m->mesh, lapped, &patch, 1, corner_uv, &bake, NULL, atlas, &error) != TT_OK) {
-        status = report_error(options->mesh_path, m, &error);
+        status = triangle_mesh_report_error(options->mesh_path, m, &error);
         goto done;
     }
 
@@ -625,7 +475,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
         status = tool_fail("out of memory while writing %s", obj_path);
         goto done;
     }
-    status = add_mtl(output, mtl_path, "lapped_baked", png_path, 0);
+    status = output_add_mtl(output, mtl_path, "lapped_baked", png_path, 0);
     /* The baked texture holds linear straight RGBA: written as sRGB colour. */
     if (status == 0) status = add_png(output, png_path, atlas);
     atlas = NULL;   /* add_png freed it */
@@ -644,20 +494,18 @@ static int paste(const lapped_options *options, const triangle_mesh *m, const fl
                  tt_lapped **lapped)
 {
     tt_lapped_options paste_options;
-    progress_state progress;
+    tool_progress progress;
     tt_error error;
     tt_result result;
-    memset(&progress, 0, sizeof progress);
-    progress.start = seconds_now();
-    progress.terminal = isatty(STDERR_FILENO);
+    tool_progress_begin(&progress, "pasting", "of the surface covered");
     memset(&paste_options, 0, sizeof paste_options);
     paste_options.seed = options->seed;
     paste_options.isotropic = options->isotropic;
-    paste_options.progress = show_progress;
+    paste_options.progress = tool_show_progress;
     paste_options.progress_user_data = &progress;
     result = tt_lapped_paste(m->mesh, field, &patch, 1, &paste_options, NULL, lapped, &error);
-    end_progress(&progress);
-    return result == TT_OK ? 0 : report_error(options->mesh_path, m, &error);
+    tool_progress_end(&progress);
+    return result == TT_OK ? 0 : triangle_mesh_report_error(options->mesh_path, m, &error);
 }
 
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
@@ -712,7 +560,7 @@ int cmd_lapped(int argc, char **argv)
     tool_output output;
     float *field = NULL;
     char obj_path[4096], mtl_path[4096], png_path[4096], message[TOOL_ERROR_SIZE];
-    double start = seconds_now();
+    double start = tool_seconds_now();
     int status, own_uvs = 0;
 
     status = parse_command_line(argc, argv, &options);
@@ -740,12 +588,12 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0) status = paste(&options, &mesh, field, patch, &lapped);
 
     if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped);
-    if (status == 0) status = add_mtl(&output, mtl_path, "lapped", png_path, 1);
+    if (status == 0) status = output_add_mtl(&output, mtl_path, "lapped", png_path, 1);
     if (status == 0 && options.bake_size > 0) status = add_baked(&output, &options, &mesh, lapped, patch, &own_uvs);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0) {
-        print_summary(&options, &mesh, field, lapped, seconds_now() - start);
+        print_summary(&options, &mesh, field, lapped, tool_seconds_now() - start);
         printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
         if (options.bake_size > 0)
             printf("; %s_baked.obj/.mtl/.png (%dx%d, over %s)", options.prefix, options.bake_size,

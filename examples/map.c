@@ -39,7 +39,7 @@ static void print_help(void)
            "  --permissive     accept non-manifold or mis-oriented edges (they become boundaries)\n"
            "  --report         also print tile usage and face stretch, and measure the seams on\n"
            "                   every edge (default: a sample of %d edges)\n",
-           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TILED_REPORT_EDGES);
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
 }
 
 
@@ -82,7 +82,7 @@ int cmd_map(int argc, char **argv)
     tiled_options options;
     tiled_mesh mesh;
     tt_image *atlas = NULL;
-    tiled_seams seams;
+    tool_seams seams;
     tool_output output;
     char message[TOOL_ERROR_SIZE], mtl_path[4096];
 
@@ -101,7 +101,8 @@ int cmd_map(int argc, char **argv)
     }
     if (options.atlas_path) {
         char texture[4096];
-        status = tiled_measure_seams(positional[0], &mesh, atlas, options.seed, options.report, &seams);
+        status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas, options.seed, 0, options.report,
+                                    &seams);
         if (status != 0) goto done;
         /* The MTL sits beside the OBJ, and names the atlas relative to itself. */
         snprintf(mtl_path, sizeof mtl_path, "%.*s.mtl",

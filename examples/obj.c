@@ -762,3 +762,17 @@ void mtl_add_material(tool_buffer *out, const char *name, const char *texture, i
     if (texture && texture_alpha) write_name_line(out, "map_d", texture);
     buffer_printf(out, "\n");
 }
+
+int output_add_mtl(tool_output *output, const char *mtl_path, const char *material, const char *texture_path,
+                   int texture_alpha)
+{
+    tool_buffer text = TOOL_BUFFER_INIT;
+    char texture[4096];
+    tool_relative_path(texture_path, mtl_path, texture, sizeof texture);
+    mtl_add_material(&text, material, texture, texture_alpha);
+    if (output_add_buffer(output, mtl_path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", mtl_path);
+    }
+    return 0;
+}

@@ -33,7 +33,7 @@ static void print_help(void)
            "  --mips                 also write the per-tile mip levels, OUT_PREFIX_mip1.png ...\n"
            "  --report               also print tile usage and face stretch, and measure the\n"
            "                         seams on every edge (default: a sample of %d edges)\n",
-           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TILED_REPORT_EDGES);
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
 }
 
 int cmd_tile(int argc, char **argv)
@@ -44,7 +44,7 @@ int cmd_tile(int argc, char **argv)
     tiled_mesh mesh;
     tt_image *image = NULL;
     tt_tileset *tiles = NULL;
-    tiled_seams seams;
+    tool_seams seams;
     int image_width, image_height;
     tool_output output;
     char message[TOOL_ERROR_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
@@ -92,8 +92,9 @@ int cmd_tile(int argc, char **argv)
        are encoded (it is the largest thing the command holds). */
     image_free(image);
     image = NULL;
-    if (status == 0) status = tiled_measure_seams(positional[0], &mesh, &tiles->levels[0], options.seed, options.report,
-                                                       &seams);
+    if (status == 0)
+        status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, 0,
+                                    options.report, &seams);
     if (status == 0) status = tiled_add_atlas(&output, png_path, tiles, options.mips);
     if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
     if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));

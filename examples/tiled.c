@@ -296,38 +296,7 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
     }
 }
 
-int tiled_measure_seams(const char *obj_path, const tiled_mesh *mesh, const tt_image *atlas, uint64_t seed,
-                        int all_edges, tiled_seams *out)
-{
-    tt_seam_options options;
-    tt_error error;
-    tt_result result;
-    int c;
-    size_t length;
-    memset(out, 0, sizeof *out);
-    for (c = 0; c < mesh->mesh->ncorners; c++)
-        if (mesh->mesh->twin[c] > c) out->interior_edges++;
-    /* The summary is a report, not the acceptance measure: a random sample
-       of edges keeps it fast on big meshes (within about 0.01 of the full
-       score). --report asks for the full measure, every interior edge. */
-    memset(&options, 0, sizeof options);
-    options.seed = seed;
-    options.max_edges = all_edges ? 0 : TILED_REPORT_EDGES;
-    out->sampled = !all_edges && out->interior_edges > TILED_REPORT_EDGES;
-    result = tt_measure_seams(mesh->mesh, mesh->corner_uv, atlas, &options, NULL, &out->report, &error);
-    if (result == TT_ERROR_NOT_MEASURED) {
-        /* Not an error: the summary says why there is no number. */
-        snprintf(out->reason, sizeof out->reason, "%s", error.message);
-        length = strlen(out->reason);
-        if (length > 0 && out->reason[length - 1] == '.') out->reason[length - 1] = '\0';
-        return 0;
-    }
-    if (result != TT_OK) return tool_fail("%s: cannot measure the seams: %s", obj_path, error.message);
-    out->measured = 1;
-    return 0;
-}
-
-void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tiled_seams *seams, int report)
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tool_seams *seams, int report)
 {
     const tt_mesh_stats *s = &mesh->stats;
     printf("%s: %d quads, %d vertices, genus %d, %d component%s, %d boundary loop%s, valence %d..%d, "
@@ -341,7 +310,7 @@ void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const til
     } else if (seams) {
         const tt_seam_report *r = &seams->report;
         char edges[96];
-        snprintf(edges, sizeof edges, "%d of %d edges%s", r->edges_measured, seams->interior_edges,
+        snprintf(edges, sizeof edges, "%d of %d edges%s", r->edges_measured, seams->edges,
                  seams->sampled ? " sampled" : "");
         if (r->score == r->score)
             printf(", seam score %.3f (%s; seam %.4f, same-face %.4f, unrelated %.4f)", r->score, edges, r->seam,

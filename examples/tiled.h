@@ -100,29 +100,8 @@ int tiled_check_atlas_size(const tiled_options *options);
    cut open): said only on success, so a failing command prints one line. */
 void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh);
 
-/* The seam report map and tile print: tt_measure_seams on at most this
-   many interior edges drawn at random (the library's full measure, every
-   edge, is the acceptance measure; 20000 edges stay within about 0.01 of
-   it and keep the report fast on meshes of hundreds of thousands of quads). */
-#define TILED_REPORT_EDGES 20000
-
-typedef struct tiled_seams {
-    int measured;               /* 0: TT_ERROR_NOT_MEASURED, `reason` says why */
-    int sampled;                /* 1: fewer edges measured than the mesh has */
-    int interior_edges;         /* of the mesh */
-    tt_seam_report report;
-    char reason[224];           /* the library's sentence, without its full stop */
-} tiled_seams;
-
-/* Measure the seams of `mesh` on `atlas` for the summary: a sample of
-   TILED_REPORT_EDGES edges, or with all_edges (--report) every one. Nothing
-   measurable (a one-quad mesh, say) is not an error: seams->measured is 0.
-   Other library errors are printed as one line; returns the exit status. */
-int tiled_measure_seams(const char *obj_path, const tiled_mesh *mesh, const tt_image *atlas, uint64_t seed,
-                        int all_edges, tiled_seams *seams);
-
 /* The one-line summary map and tile print; seams may be NULL. With `report`
    a second line gives tile usage and face stretch. */
-void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tiled_seams *seams, int report);
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tool_seams *seams, int report);
 
 #endif /* TILEDTEX_TILED_H */

@@ -1,17 +1,21 @@
 /* tool.h - shared pieces of the `tiledtex` command-line tool (not the library).
 
    The tool is a set of subcommands, one file each (synth.c, map.c, tile.c,
-   lapped.c, render.c, generate.c), dispatched by tiledtex.c; synth, map and
-   tile also share tiled.c (see tiled.h). They share what is declared here:
+   lapped.c, hpm.c, render.c, generate.c), dispatched by tiledtex.c; synth,
+   map and tile also share tiled.c (see tiled.h). They share what is
+   declared here:
 
      tool_io.c   one-line errors         tool_fail, tool_usage
                  files, byte buffers     tool_read_file, tool_buffer
                  atomic output           tool_output: build every file in
                                          memory, then commit them all or none
+                 progress, time          tool_progress, tool_seconds_now
      cli.c       command-line helpers    tool_option, parse_int, parse_size, ...
      image_io.c  images                  image_load, png_encode, output_add_png
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
-                 MTL writing             mtl_add_material
+                 MTL writing             mtl_add_material, output_add_mtl
+     triangle_mesh.c  an OBJ as triangles   triangle_mesh_read (lapped, hpm)
+     measure.c   quality for summaries   tool_measure_seams
      format_number.c  numbers as text   tool_format_float, tool_format_int
 
    Conventions every command follows:
@@ -55,6 +59,7 @@ int cmd_synth(int argc, char **argv);
 int cmd_map(int argc, char **argv);
 int cmd_tile(int argc, char **argv);
 int cmd_lapped(int argc, char **argv);
+int cmd_hpm(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 
@@ -360,6 +365,69 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc);
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
    "map_d TEXTURE": the texture's alpha channel is the material's opacity. */
 void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha);
+/* Add a one-material MTL file to an output batch; it names texture_path
+   (a path from the current directory) relative to the MTL's own directory
+   (tool_relative_path), so the folder can move. Returns 0, or the exit
+   status after printing the error. */
+int output_add_mtl(tool_output *output, const char *mtl_path, const char *material, const char *texture_path,
+                   int texture_alpha);
+
+/* ---------------------------------------------------------------------- */
+/* An OBJ as triangles (triangle_mesh.c), for lapped and hpm                */
+/* ---------------------------------------------------------------------- */
+
+typedef struct triangle_mesh {
+    obj_mesh obj;
+    int ntriangles;
+    int *corner;            /* 3 per triangle: its OBJ corners (index into obj.corner_vert, obj.corner_uv) */
+    int *vert;              /* 3 per triangle: their vertices */
+    int *face;              /* per triangle: its OBJ face */
+    int *first_triangle;    /* per OBJ face: the first triangle of its fan */
+    tt_mesh *mesh;          /* the triangles, validated */
+} triangle_mesh;
+
+/* Read the OBJ, split its faces into triangle fans (obj_triangle_fans) and
+   build those with tt_mesh_build. A build error is printed about the OBJ's
+   own face and line. Returns 0, or the exit status after printing the
+   error (*m is then empty). */
+int triangle_mesh_read(const char *path, triangle_mesh *m);
+void triangle_mesh_free(triangle_mesh *m);
+
+/* A library error about the triangles said the OBJ's way: the library counts
+   faces from 0 and means the triangles. rewrite_face writes error->message
+   into `message` with its "face N" replaced by the OBJ face, counted from 1;
+   report_error prints "MESH.obj:LINE: ..." at that face's line (or
+   "MESH.obj: ..." when the error names no face) and returns
+   TOOL_EXIT_FAILURE. */
+void triangle_mesh_rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size);
+int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const tt_error *error);
+
+/* ---------------------------------------------------------------------- */
+/* Quality measures for the summaries (measure.c)                          */
+/* ---------------------------------------------------------------------- */
+
+/* The seam report the commands print: tt_measure_seams on at most this many
+   edges drawn at random (the library's full measure, every edge, is the
+   acceptance measure; 20000 edges stay within about 0.01 of it and keep the
+   report fast on meshes of hundreds of thousands of faces). */
+#define TOOL_REPORT_EDGES 20000
+
+typedef struct tool_seams {
+    int measured;               /* 0: TT_ERROR_NOT_MEASURED, `reason` says why */
+    int sampled;                /* 1: fewer edges measured than `edges` */
+    int edges;                  /* the edges the mode measures: every interior edge, or with
+                                   TT_SEAM_UV_DISCONTINUOUS the chart borders */
+    tt_seam_report report;
+    char reason[224];           /* the library's sentence, without its full stop */
+} tool_seams;
+
+/* Measure the seams of per-corner UVs on `atlas` for a summary: flags are
+   tt_seam_options.flags; a sample of TOOL_REPORT_EDGES edges, or with
+   all_edges every one. Nothing measurable (a one-face mesh, say) is not an
+   error: seams->measured is 0. Other library errors are printed as one line
+   naming obj_path; returns the exit status. */
+int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
+                       uint64_t seed, unsigned flags, int all_edges, tool_seams *seams);
 
 /* ---------------------------------------------------------------------- */
 /* Numbers as text without printf (format_number.c)                        */
@@ -378,6 +446,31 @@ int tool_format_float(float value, char *out);
 int tool_format_int(long value, char *out);
 
 /* ---------------------------------------------------------------------- */
+/* Time and progress on a terminal (tool_io.c)                              */
+/* ---------------------------------------------------------------------- */
+
+/* Seconds on a monotonic clock, for "took 1.2 s". */
+double tool_seconds_now(void);
+
+/* A progress line for a long library call: fill one with
+   tool_progress_begin, pass tool_show_progress as the options' tt_progress_fn
+   and the state as its user data, and call tool_progress_end afterwards.
+   The line, "tiledtex: ACTIVITY: 42.0% WHAT", is redrawn in place at most
+   ten times a second, only after the first second (most runs are shorter)
+   and only when stderr is a terminal (a log would fill with "\r" lines). */
+typedef struct tool_progress {
+    const char *activity, *what;    /* "pasting", "of the surface covered" */
+    double start, last;             /* seconds */
+    int terminal;                   /* stderr is a terminal: a "\r" line can be redrawn */
+    int shown;
+} tool_progress;
+
+void tool_progress_begin(tool_progress *progress, const char *activity, const char *what);
+int tool_show_progress(float fraction, void *user_data);
+/* Ends a line that was shown. */
+void tool_progress_end(tool_progress *progress);
+
+/* ---------------------------------------------------------------------- */
 /* Paths and strings (tool_io.c)                                            */
 /* ---------------------------------------------------------------------- */
 
@@ -392,8 +485,10 @@ const char *tool_basename(const char *path);
 /* `target` (a path from the current directory) as seen from the directory of
    `from_file`: what an MTL beside from_file should write to name target
    ("out/a.mtl", "out/tex.png" -> "tex.png"; "out/a.mtl", "tex.png" ->
-   "../tex.png"). Absolute targets are kept; so is target when from_file's
-   directory climbs with "..". */
+   "../tex.png"). Absolute targets are kept. When from_file's directory
+   climbs with ".." ("../out/a.mtl"), the text alone cannot say the way
+   back, so both are resolved on the file system (target must exist, and
+   from_file's directory); failing that, target's absolute path is used. */
 void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size);
 
 #endif /* TILEDTEX_TOOL_H */

@@ -1,9 +1,10 @@
 /* tool_io.c - the plumbing every `tiledtex` subcommand shares: error lines,
-   reading files, growing byte buffers, paths, and atomic output.
+   reading files, growing byte buffers, paths, atomic output, and progress
+   on a terminal.
    See tool.h for the interface. Command-line parsing is in cli.c, images in
    image_io.c, OBJ / MTL in obj.c. */
 
-#define _POSIX_C_SOURCE 200809L    /* open, fdopen, fileno, stat */
+#define _XOPEN_SOURCE 700          /* open, fdopen, fileno, stat, isatty, clock_gettime, realpath */
 
 #include <errno.h>
 #include <fcntl.h>
@@ -11,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -267,17 +269,17 @@ int tool_read_file(const char *path, unsigned char **data, size_t *size, char *e
     return 0;
 }
 
-void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size)
+/* The relative path from from_file's directory to target, both relative
+   to the same directory or both absolute; 0, or -1 when from_file's
+   directory climbs with ".." after the parts they share (the way back down
+   cannot be named from the text alone). */
+static int relative_path_between(const char *target, const char *from_file, char *out, size_t out_size)
 {
     /* Directory parts of both, as text ranges; "." parts are skipped. */
     const char *from_end = tool_basename(from_file), *target_name = tool_basename(target);
     const char *f = from_file, *t = target;
     size_t used = 0;
     int ups = 0;
-    if (target[0] == '/') {
-        snprintf(out, out_size, "%s", target);
-        return;
-    }
     /* Skip the directories both paths share, one part at a time. */
     for (;;) {
         const char *fe, *te;
@@ -291,15 +293,11 @@ void tool_relative_path(const char *target, const char *from_file, char *out, si
         f = fe;
         t = te;
     }
-    /* Every directory left on the file's side is one step up, unless it is a
-       step up itself: then the way back cannot be named, so keep the path. */
+    /* Every directory left on the file's side is one step up. */
     while (f < from_end) {
         const char *fe = f;
         while (fe < from_end && *fe != '/') fe++;
-        if (fe - f == 2 && f[0] == '.' && f[1] == '.') {
-            snprintf(out, out_size, "%s", target);
-            return;
-        }
+        if (fe - f == 2 && f[0] == '.' && f[1] == '.') return -1;
         if (fe > f && !(fe - f == 1 && f[0] == '.')) ups++;
         f = fe;
         while (f < from_end && *f == '/') f++;
@@ -310,6 +308,38 @@ void tool_relative_path(const char *target, const char *from_file, char *out, si
         used += 3;
     }
     snprintf(out + used, out_size - used, "%s", t);
+    return 0;
+}
+
+void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size)
+{
+    char *real_target = NULL, *real_directory = NULL, *directory = NULL, *real_file = NULL;
+    size_t length;
+    if (target[0] == '/') {
+        snprintf(out, out_size, "%s", target);
+        return;
+    }
+    if (relative_path_between(target, from_file, out, out_size) == 0) return;
+    /* from_file's directory climbs out of the current one ("../out/a.mtl"):
+       ask the file system where both are. The target exists (it was read)
+       and so does the file's directory (the file is about to be written
+       there); when either cannot be resolved, an absolute target still
+       names the right file from anywhere. */
+    length = (size_t)(tool_basename(from_file) - from_file);
+    directory = tool_copy_string(from_file, length);
+    real_target = realpath(target, NULL);
+    real_directory = directory ? realpath(directory, NULL) : NULL;
+    if (real_directory) real_file = (char *)malloc(strlen(real_directory) + 3);
+    if (real_target && real_file) {
+        sprintf(real_file, "%s/x", real_directory);
+        relative_path_between(real_target, real_file, out, out_size);
+    } else {
+        snprintf(out, out_size, "%s", real_target ? real_target : target);
+    }
+    free(real_file);
+    free(real_directory);
+    free(real_target);
+    free(directory);
 }
 
 const char *tool_basename(const char *path)
@@ -481,4 +511,44 @@ void output_free(tool_output *output)
     }
     free(output->files);
     memset(output, 0, sizeof *output);
+}
+
+/* ======================================================================== */
+/* Time and progress on a terminal                                          */
+/* ======================================================================== */
+
+double tool_seconds_now(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+}
+
+void tool_progress_begin(tool_progress *progress, const char *activity, const char *what)
+{
+    memset(progress, 0, sizeof *progress);
+    progress->activity = activity;
+    progress->what = what;
+    progress->start = tool_seconds_now();
+    progress->terminal = isatty(STDERR_FILENO);
+}
+
+int tool_show_progress(float fraction, void *user_data)
+{
+    tool_progress *progress = (tool_progress *)user_data;
+    double now = tool_seconds_now();
+    if (!progress->terminal || now - progress->start < 1.0 || (progress->shown && now - progress->last < 0.1))
+        return 0;
+    fprintf(stderr, "\r%s: %s: %5.1f%% %s", TOOL_NAME, progress->activity, 100.0 * (double)fraction,
+            progress->what);
+    fflush(stderr);
+    progress->shown = 1;
+    progress->last = now;
+    return 0;
+}
+
+void tool_progress_end(tool_progress *progress)
+{
+    if (progress->shown) fputc('\n', stderr);
+    progress->shown = 0;
 }

@@ -173,7 +173,7 @@ mkdir -p "$W/in"
 cd "$W/in" || exit 1
 
 # --help everywhere
-for sub in synth map tile lapped render generate; do
+for sub in synth map tile lapped hpm render generate; do
     run $sub --help
     check "$sub --help" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes, stderr: $ERR" \
         "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
@@ -686,6 +686,144 @@ check "lapped non-manifold edge: no --permissive hint (lapped has none)" "no '--
     "$(! printf '%s' "$ERR" | grep -q -- '--permissive'; echo $?)"
 
 # ======================================================================
+# Hierarchical pattern mapping
+# ======================================================================
+# hpm_obj_report OBJ -> "faces nontri corners nvt badc reused nonfinite outside":
+#   f lines, f lines without 3 corners, corners, vt lines, corners whose v or vt
+#   index is missing or out of range, vt lines referenced other than exactly
+#   once, vt values that are not finite numbers, finite ones outside [0,1].
+hpm_obj_report() {
+    awk '
+        function isnum(s) { return s ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?$/ }
+        $1 == "v"  { nv++ }
+        $1 == "vt" { nvt++
+                     for (i = 2; i <= 3; i++)
+                         if (!isnum($i)) nonfinite++
+                         else if ($i + 0 < 0 || $i + 0 > 1) outside++ }
+        $1 == "f"  { nf++
+                     if (NF - 1 != 3) nontri++
+                     for (i = 2; i <= NF; i++) { corners++; c[corners] = $i } }
+        END {
+            for (k = 1; k <= corners; k++) {
+                n = split(c[k], p, "/")
+                if (n < 2 || p[1] !~ /^[0-9]+$/ || p[2] !~ /^[0-9]+$/ ||
+                    p[1] + 0 < 1 || p[1] + 0 > nv || p[2] + 0 < 1 || p[2] + 0 > nvt) badc++
+                else uses[p[2] + 0]++
+            }
+            for (k = 1; k <= nvt; k++) if (uses[k] != 1) reused++
+            printf "%d %d %d %d %d %d %d %d\n", nf, nontri, corners, nvt, badc, reused, nonfinite, outside
+        }' "$1" 2>/dev/null
+}
+# fan_triangles OBJ -> the number of triangles its faces split into
+fan_triangles() { awk '$1 == "f" { n += NF - 3 } END { print n + 0 }' "$1" 2>/dev/null; }
+
+# hpm_case NAME MESH BOUNDED ARGS... : in a fresh directory, hpm writes
+# exactly out.obj and out.mtl; the OBJ holds the mesh's triangle fans with one
+# vt per corner, each used once, finite (and in [0,1] when BOUNDED is "bounded");
+# the MTL names the input image from out.mtl's directory; the summary has its lines.
+hpm_case() {
+    local name=$1 mesh=$2 bounded=$3 faces nontri corners nvt badc reused nonfinite outside want
+    shift 3
+    newdir
+    run hpm "../in/$mesh" ../in/lap.png out "$@"
+    check "hpm $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
+    check "hpm $name: exactly out.mtl, out.obj" "out.mtl out.obj" "$(ls -A | tr '\n' ' ')" \
+        "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj " ]; echo $?)"
+    check "hpm $name: mtl names the input image, no copy" "map_Kd ../in/lap.png, mtllib out.mtl" \
+        "$(grep -h -E 'map_|mtllib' out.mtl out.obj 2>&1)" \
+        "$(grep -qE '^map_Kd +\.\./in/lap\.png$' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl' out.obj 2>/dev/null; echo $?)"
+    read -r faces nontri corners nvt badc reused nonfinite outside <<<"$(hpm_obj_report out.obj)"
+    want=$(fan_triangles "$W/in/$mesh")
+    check "hpm $name: the mesh's $want triangles" "$want triangle f lines" "$faces f lines, $nontri not triangles" \
+        "$([ "${faces:-0}" = "$want" ] && [ "${nontri:-1}" = 0 ]; echo $?)"
+    check "hpm $name: one vt per face corner, each used once" "vt lines = corners = $((3 * want)), 0 bad, 0 shared" \
+        "$nvt vt, $corners corners, $badc bad corners, $reused vt not used exactly once" \
+        "$([ "${nvt:-x}" = "${corners:-y}" ] && [ "${corners:-0}" = $((3 * want)) ] && [ "${badc:-1}" = 0 ] &&
+            [ "${reused:-1}" = 0 ]; echo $?)"
+    check "hpm $name: UVs finite" "0 non-finite vt values" "$nonfinite" "$([ "${nonfinite:-1}" = 0 ]; echo $?)"
+    if [ "$bounded" = bounded ]; then
+        check "hpm $name: UVs inside [0,1] (bounded image)" "0 vt values outside" "$outside" \
+            "$([ "${outside:-1}" = 0 ]; echo $?)"
+    fi
+    check "hpm $name: summary" "'clusters per level: L0 N, ...', 'fits: N accepted', 'texel density'" "$OUT" \
+        "$(printf '%s' "$OUT" | grep -qE '^clusters per level: L0 [0-9]+' &&
+            printf '%s' "$OUT" | grep -qE '^fits: [0-9]+ accepted, [0-9]+ at the floor, [0-9]+ rejected' &&
+            printf '%s' "$OUT" | grep -q 'texel density'; echo $?)"
+    check "hpm $name: summary measures" "'seam score: cluster borders X (N of M border edges); all edges Y', \
+'UV distortion: stretch median X, p95 Y; density error ...; 0 flipped UV triangles'" "$OUT" \
+        "$(printf '%s' "$OUT" | grep -qE '^seam score: cluster borders -?[0-9.]+ \([0-9]+ of [0-9]+ border edges\); all edges -?[0-9.]+ ' &&
+            printf '%s' "$OUT" | grep -qE '^UV distortion: stretch median [0-9.]+, p95 [0-9.]+; density error median [0-9.]+%, p95 [0-9.]+%; 0 flipped UV triangles$'; echo $?)"
+    cd "$W" || exit 1
+}
+
+hpm_case torus torus.obj bounded --rotations 3 --seed 2
+HPM_TORUS=$W/d$NEWDIR_N
+check "hpm torus: says it split the quads into triangles" "'1024 triangles (fans of 512 faces)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '1024 triangles (fans of 512 faces)'; echo $?)"
+hpm_case sphere-triangles spheretri.obj bounded --rotations 3
+hpm_case "grid (open)" grid.obj bounded --rotations 3 --threshold inf
+hpm_case "pair (two components)" pair.obj bounded --rotations 1 --band 4
+hpm_case "torus --toroidal" torus.obj toroidal --rotations 3 --toroidal --scale 0.5
+check "hpm --toroidal: coordinates leave [0,1]" "some vt outside [0,1] (the image repeats)" \
+    "$(hpm_obj_report "$W/d$NEWDIR_N/out.obj")" \
+    "$(read -r _ _ _ _ _ _ _ outside <<<"$(hpm_obj_report "$W/d$NEWDIR_N/out.obj")"; [ "${outside:-0}" -gt 0 ]; echo $?)"
+hpm_case "torus --no-fit" torus.obj bounded --rotations 3 --seed 2 --no-fit
+HPM_RANDOM=$W/d$NEWDIR_N
+check "hpm --no-fit: says the clusters were placed at random" "'placed at random'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q 'placed at random'; echo $?)"
+CMD="tiledtex hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 [--no-fit]"
+check "hpm --no-fit: other coordinates than the fitted ones" "files differ" "identical" \
+    "$(! cmp -s "$HPM_TORUS/out.obj" "$HPM_RANDOM/out.obj"; echo $?)"
+
+# the same seed twice: the same file; another seed: another result
+newdir
+expect_ok "hpm seed 2 again" hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2
+CMD="tiledtex hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 (twice)"
+check "hpm same seed twice: identical .obj" "cmp equal" "$(cmp out.obj "$HPM_TORUS/out.obj" 2>&1)" \
+    "$(cmp -s out.obj "$HPM_TORUS/out.obj"; echo $?)"
+expect_ok "hpm seed 3" hpm ../in/torus.obj ../in/lap.png other --rotations 3 --seed 3
+CMD="tiledtex hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 / --seed 3"
+check "hpm different seed: different .obj" "files differ" "identical" "$(! cmp -s out.obj other.obj; echo $?)"
+# the result renders with the image itself as its texture
+expect_ok "render an hpm OBJ" render out.obj ../in/lap.png view.png --size 160x120
+check "render hpm OBJ: 160x120 PNG" "160 120" "$(png_size view.png)" \
+    "$(is_png view.png && [ "$(png_size view.png)" = "160 120" ]; echo $?)"
+# outputs elsewhere: the MTL still finds the image, also from a directory reached with ".."
+mkdir -p sub images run
+cp ../in/lap.png images/stones.png
+expect_ok "hpm into a subdirectory" hpm ../in/torus.obj images/stones.png sub/out --rotations 3
+check "hpm into a subdirectory: map_Kd finds the image from sub/" "sub/<map_Kd> is images/stones.png" \
+    "$(grep map_Kd sub/out.mtl 2>&1)" \
+    "$(cmp -s "sub/$(awk '$1 == "map_Kd" { print $2 }' sub/out.mtl 2>/dev/null)" images/stones.png; echo $?)"
+cd run || exit 1
+expect_ok "hpm into ../sub from another directory" hpm ../../in/torus.obj ../images/stones.png ../sub/up --rotations 3
+check "hpm into ../sub: map_Kd finds the image from sub/" "map_Kd ../images/stones.png" "$(grep map_Kd ../sub/up.mtl 2>&1)" \
+    "$(grep -qE '^map_Kd +\.\./images/stones\.png$' ../sub/up.mtl 2>/dev/null; echo $?)"
+cd "$W" || exit 1
+
+# bad inputs: one line, non-zero exit, no files
+expect_error "hpm missing mesh" hpm ../in/nope.obj ../in/lap.png out
+err_mentions "hpm missing mesh: names the file" 'nope\.obj'
+expect_error "hpm missing image" hpm ../in/torus.obj ../in/nope.png out
+err_mentions "hpm missing image: names the file" 'nope\.png'
+expect_error "hpm image not an image" hpm ../in/torus.obj ../in/torus.obj out
+expect_error "hpm --rotations 0" hpm ../in/torus.obj ../in/lap.png out --rotations 0
+expect_error "hpm --rotations 65" hpm ../in/torus.obj ../in/lap.png out --rotations 65
+expect_error "hpm --threshold -1" hpm ../in/torus.obj ../in/lap.png out --threshold -1
+expect_error "hpm --threshold 0" hpm ../in/torus.obj ../in/lap.png out --threshold 0
+expect_error "hpm --threshold abc" hpm ../in/torus.obj ../in/lap.png out --threshold abc
+expect_error "hpm --threshold nan" hpm ../in/torus.obj ../in/lap.png out --threshold nan
+expect_error "hpm --scale -1" hpm ../in/torus.obj ../in/lap.png out --scale -1
+expect_error "hpm --scale 0" hpm ../in/torus.obj ../in/lap.png out --scale 0
+expect_error "hpm --band 0" hpm ../in/torus.obj ../in/lap.png out --band 0
+expect_error "hpm --seed abc" hpm ../in/torus.obj ../in/lap.png out --seed abc
+expect_error "hpm zero-area face" hpm ../in/lapped_degenerate.obj ../in/lap.png out
+err_mentions "hpm zero-area face: FILE:LINE and face 1" 'lapped_degenerate\.obj:5: face 1 '
+expect_error "hpm non-manifold edge" hpm ../in/nonmanifold.obj ../in/lap.png out
+no_zero_index "hpm non-manifold edge"
+expect_error "hpm OBJ truncated mid face line" hpm ../in/truncated_face.obj ../in/lap.png out
+
+# ======================================================================
 # Bad files, images and options
 # ======================================================================
 expect_error "missing mesh file" tile ../in/nope.obj ../in/tex.png out
@@ -727,12 +865,12 @@ expect_error "--seed abc (map)" map ../in/torus.obj m.obj --seed abc
 expect_error "--seed abc (tile)" tile ../in/torus.obj ../in/tex.png out --seed abc
 expect_error "--seed abc (generate)" generate texture t.png --seed abc
 expect_error "--seed without a value" synth ../in/tex.png a.png --seed
-for sub in synth map tile lapped render generate; do
+for sub in synth map tile lapped hpm render generate; do
     case $sub in
         synth) args="../in/tex.png a.png" ;;
         map) args="../in/torus.obj m.obj" ;;
         tile) args="../in/torus.obj ../in/tex.png out" ;;
-        lapped) args="../in/torus.obj ../in/tex.png out" ;;
+        lapped | hpm) args="../in/torus.obj ../in/tex.png out" ;;
         render) args="../in/torus.obj ../in/tex.png r.png" ;;
         generate) args="mesh g.obj --shape torus" ;;
     esac
@@ -746,6 +884,8 @@ expect_error "missing positional args (map)" map ../in/torus.obj
 expect_error "missing positional args (tile)" tile ../in/torus.obj ../in/tex.png
 expect_error "missing positional args (tile, none)" tile
 expect_error "missing positional args (lapped)" lapped ../in/torus.obj ../in/tex.png
+expect_error "missing positional args (hpm)" hpm ../in/torus.obj ../in/tex.png
+expect_error "too many positional args (hpm)" hpm ../in/torus.obj ../in/tex.png out extra
 expect_error "missing positional args (render)" render ../in/torus.obj ../in/tex.png
 expect_error "missing positional args (generate)" generate
 expect_error "missing positional args (generate mesh)" generate mesh
@@ -883,6 +1023,9 @@ cp img.png x_patch.png
 expect_refused "lapped IMAGE that is OUT_PREFIX_patch.png" lapped m.obj x_patch.png x --scale 1.5
 cp img.png y_baked.png
 expect_refused "lapped --bake output that is the IMAGE" lapped m.obj y_baked.png y --scale 1.5 --bake 64
+expect_refused "hpm with OUT_PREFIX naming the mesh" hpm m.obj img.png m --rotations 3
+cp m.obj z.mtl
+expect_refused "hpm with OUT_PREFIX.mtl an input (the mesh)" hpm z.mtl img.png z --rotations 3
 expect_refused "synth onto its image" synth img.png img.png --tile 16
 expect_refused "synth onto its image (other spelling)" synth img.png ../$(basename "$PWD")/img.png --tile 16
 expect_refused "render onto its texture" render m.obj img.png img.png --size 32x32
@@ -933,11 +1076,11 @@ if $HELPER_CC -O2 -w $STB_INC "$W/bigpng.c" -o "$W/bigpng" -lm 2>"$W/err" && "$W
     pass
     check "helper PNG: 8000x8000, under 1 MB" "8000 8000, < 1000000 bytes" "$(png_size "$W/in/big.png"), $(wc -c <"$W/in/big.png") bytes" \
         "$([ "$(png_size "$W/in/big.png")" = "8000 8000" ] && [ "$(wc -c <"$W/in/big.png")" -lt 1000000 ]; echo $?)"
-    for sub in synth tile lapped render; do
+    for sub in synth tile lapped hpm render; do
         case $sub in
             synth) args="../in/big.png a.png" ;;
             tile) args="../in/torus.obj ../in/big.png out" ;;
-            lapped) args="../in/torus.obj ../in/big.png out" ;;
+            lapped | hpm) args="../in/torus.obj ../in/big.png out" ;;
             render) args="../in/torus.obj ../in/big.png r.png" ;;
         esac
         # shellcheck disable=SC2086

@@ -1,0 +1,349 @@
+/* hpm.c - `tiledtex hpm`: texture a mesh with Soler et al.'s hierarchical
+   pattern mapping.
+
+   MESH.obj + IMAGE -> OUT_PREFIX.obj, the mesh's triangles with one texture
+   coordinate per face corner into IMAGE itself, and OUT_PREFIX.mtl naming
+   IMAGE where it is. No texture is made: the method cuts the surface into
+   clusters, coarse to fine, and places each on the image where what it shows
+   best continues its textured neighbours.
+
+   The library calls, as a user of tiledtex.h makes them:
+
+     tt_mesh_build       validate the OBJ's faces, split into triangle fans
+                         first: the method works on triangles
+     tt_hpm_map          the whole pipeline: cluster hierarchy, flattening,
+                         band fits, traversal, per-corner UVs
+     tt_measure_seams    how well the texture continues across the cluster
+                         borders (and across every edge)
+     tt_measure_uv_distortion  stretch, texel density, flipped triangles
+*/
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tool.h"
+
+static void print_help(void)
+{
+    printf("usage: tiledtex hpm MESH.obj IMAGE OUT_PREFIX [options]\n"
+           "\n"
+           "Texture MESH.obj with coordinates into IMAGE itself (Soler et al., Hierarchical Pattern\n"
+           "Mapping): no new texture is made. The surface is cut into clusters, coarse to fine;\n"
+           "each is flattened and placed on the image where its content best continues the\n"
+           "clusters already textured around it, and split into smaller ones when no place fits\n"
+           "well enough. Writes OUT_PREFIX.obj (the triangles with one texture coordinate per\n"
+           "face corner) and OUT_PREFIX.mtl, which names IMAGE relative to itself: keep IMAGE\n"
+           "where it is. Look at it with 'tiledtex render OUT_PREFIX.obj IMAGE view.png'.\n"
+           "Faces with more than 3 corners are split into triangle fans first. The mesh must be\n"
+           "manifold and consistently oriented.\n"
+           "\n"
+           "options:\n"
+           "  --scale X        mesh units covered by the image's width (default: a quarter of the\n"
+           "                   mesh's bounding-box diagonal)\n"
+           "  --seed K         random seed: clusters, turns, starting places (default 0)\n"
+           "  --threshold E    the largest fit error accepted before a cluster is split into\n"
+           "                   smaller ones (default %g; 0 is a perfect continuation, about 1\n"
+           "                   unrelated pixels; 'inf' accepts every fit)\n"
+           "  --rotations R    orientations of the image tried per fit, 1 to 64 (default %d)\n"
+           "  --band W         width in texels of the textured border a fit matches (default:\n"
+           "                   per cluster, a fifth of its radius, 3 to 24)\n"
+           "  --toroidal       IMAGE tiles: placements wrap around its edges, and texture\n"
+           "                   coordinates leave [0,1] (render with repeat, as 'tiledtex render'\n"
+           "                   does); without it every coordinate stays inside the image\n"
+           "  --no-fit         the control: the same clusters, each placed at random\n"
+           "\n"
+           "Prints the clusters textured per level of the hierarchy, the fits (accepted, accepted\n"
+           "at the smallest cluster size, rejected: split), clusters that continue a neighbour's\n"
+           "map without a fit, new starts, the fit error, the texel density and the time; then the\n"
+           "seam score on the cluster borders and over all edges (about 0: the texture continues,\n"
+           "about 1: unrelated), the faces' stretch, the texel density's error and the number of\n"
+           "mirrored triangles.\n"
+           "\n"
+           "example: tiledtex generate mesh torus.obj --shape torus\n"
+           "         tiledtex generate texture stones.png --size 256\n"
+           "         tiledtex hpm torus.obj stones.png torus_hpm --scale 3\n"
+           "         tiledtex render torus_hpm.obj stones.png view.png\n",
+           TT_DEFAULT_HPM_THRESHOLD, TT_DEFAULT_HPM_ROTATIONS);
+}
+
+typedef struct hpm_command_options {
+    const char *mesh_path, *image_path, *prefix;
+    tt_hpm_options map;     /* zero fields: the library's defaults */
+} hpm_command_options;
+
+/* --threshold: a number above 0, or "inf" (every fit accepted). */
+static int parse_threshold(const char *value, double *threshold)
+{
+    if (!value) return tool_usage("--threshold needs a value");
+    if (strcmp(value, "inf") == 0 || strcmp(value, "infinity") == 0) {
+        *threshold = INFINITY;
+        return 0;
+    }
+    if (parse_whole_double(value, threshold) != 0 || !(*threshold > 0.0))
+        return tool_usage("--threshold wants a fit error above 0 or 'inf', got '%s'", value);
+    return 0;
+}
+
+/* Returns -1 to go on, or the exit status to return now. */
+static int parse_command_line(int argc, char **argv, hpm_command_options *options)
+{
+    const char *positional[3];
+    int npositional = 0, i;
+    memset(options, 0, sizeof *options);
+    for (i = 1; i < argc; i++) {
+        const char *value;
+        double number;
+        if (tool_is_help(argv[i])) {
+            print_help();
+            return 0;
+        } else if (tool_option(argc, argv, &i, "--scale", &value)) {
+            if (!value) return tool_usage("--scale needs a value");
+            if (parse_whole_double(value, &number) != 0 || !(number > 0.0) || number > 1e30)
+                return tool_usage("--scale wants the mesh units the image's width covers, above 0, got '%s'",
+                                  value);
+            options->map.scale = number;
+        } else if (tool_option(argc, argv, &i, "--seed", &value)) {
+            if (parse_u64("--seed", value, &options->map.seed) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--threshold", &value)) {
+            if (parse_threshold(value, &options->map.threshold) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--rotations", &value)) {
+            if (parse_int("--rotations", value, 1, 64, &options->map.rotations) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--band", &value)) {
+            if (parse_float("--band", value, 1.0, 1e6, &options->map.band) != 0) return TOOL_EXIT_USAGE;
+        } else if (strcmp(argv[i], "--toroidal") == 0) {
+            options->map.flags |= TT_HPM_TOROIDAL;
+        } else if (strcmp(argv[i], "--no-fit") == 0) {
+            options->map.flags |= TT_HPM_RANDOM_PLACEMENT;
+        } else if (tool_is_option(argv[i])) {
+            return tool_unknown_option(argv[i]);
+        } else if (npositional == 3) {
+            return tool_usage("too many arguments (see 'tiledtex hpm --help')");
+        } else {
+            positional[npositional++] = argv[i];
+        }
+    }
+    if (npositional != 3) return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see 'tiledtex hpm --help')");
+    options->mesh_path = positional[0];
+    options->image_path = positional[1];
+    options->prefix = positional[2];
+    if (strlen(options->prefix) + 16 > 4096) return tool_usage("OUT_PREFIX is too long");
+    if (tool_basename(options->prefix)[0] == '\0')
+        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",
+                          options->prefix, options->prefix);
+    return -1;
+}
+
+/* ======================================================================== */
+/* The mapping                                                              */
+/* ======================================================================== */
+
+/* corner_uv gets 2 floats per triangle corner. */
+static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
+                    float *corner_uv, tt_hpm_report *report)
+{
+    tt_hpm_options map = options->map;
+    tool_progress progress;
+    tt_error error;
+    tt_result result;
+    tool_progress_begin(&progress, "mapping", "of the faces textured");
+    map.progress = tool_show_progress;
+    map.progress_user_data = &progress;
+    result = tt_hpm_map(m->mesh, image, &map, NULL, corner_uv, NULL, report, &error);
+    tool_progress_end(&progress);
+    if (result == TT_OK) return 0;
+    /* A texel error is about the image (an HDR file with infinities), the
+       rest about the mesh. */
+    if (result == TT_ERROR_NON_FINITE && error.face < 0)
+        return tool_fail("%s: %s", options->image_path, error.message);
+    return triangle_mesh_report_error(options->mesh_path, m, &error);
+}
+
+/* OUT_PREFIX.obj: the vertices, the triangles, one vt per triangle corner. */
+static int add_obj(tool_output *output, const char *path, const char *mtl_name, const hpm_command_options *options,
+                   const triangle_mesh *m, const float *corner_uv)
+{
+    char comment[512];
+    tool_buffer text = TOOL_BUFFER_INIT;
+    obj_write_desc desc;
+    snprintf(comment, sizeof comment,
+             "hierarchical pattern mapping by tiledtex %s (Soler et al.): texture coordinates into %s\n%s",
+             TILEDTEX_VERSION_STRING, tool_basename(options->image_path),
+             (options->map.flags & TT_HPM_TOROIDAL)
+                 ? "the image tiles: coordinates leave [0,1], sample it with repeat addressing"
+                 : "every coordinate lies inside the image");
+    memset(&desc, 0, sizeof desc);
+    desc.comment = comment;
+    desc.nverts = m->mesh->nverts;
+    desc.pos = m->mesh->pos;
+    desc.nfaces = m->ntriangles;
+    desc.fixed_face_size = 3;
+    desc.corner_vert = m->vert;
+    desc.corner_uv = corner_uv;
+    desc.mtllib = mtl_name;
+    desc.material = "hpm";
+    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", path);
+    }
+    return 0;
+}
+
+/* ======================================================================== */
+/* The measures and the summary                                             */
+/* ======================================================================== */
+
+/* A bounded image's coordinates stay this far inside it (the library's
+   promise, checked here): bilinear filtering then never reads past the
+   image's edge. */
+#define HPM_MARGIN_TEXELS 1.0
+
+typedef struct hpm_quality {
+    tool_seams borders;             /* UV-discontinuous edges: where clusters meet */
+    tool_seams all;                 /* every interior edge */
+    tt_uv_distortion_report distortion;
+    int distortion_measured;
+    char distortion_reason[224];
+} hpm_quality;
+
+/* The seams are measured on the image itself, the texture the OBJ uses;
+   a toroidal image is sampled the way it is drawn, repeated. */
+static int measure_quality(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
+                           const float *corner_uv, const tt_hpm_report *report, hpm_quality *quality)
+{
+    unsigned wrap = (options->map.flags & TT_HPM_TOROIDAL) ? TT_SEAM_WRAP : 0u;
+    tt_uv_distortion_options distortion;
+    tt_error error;
+    tt_result result;
+    int status;
+    memset(quality, 0, sizeof *quality);
+    status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, image, options->map.seed,
+                                TT_SEAM_UV_DISCONTINUOUS | wrap, 0, &quality->borders);
+    if (status == 0)
+        status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, image, options->map.seed, wrap, 0,
+                                    &quality->all);
+    if (status != 0) return status;
+    memset(&distortion, 0, sizeof distortion);
+    distortion.texels_per_unit = report->texels_per_unit;
+    distortion.margin_texels = (options->map.flags & TT_HPM_TOROIDAL) ? 0.0 : HPM_MARGIN_TEXELS;
+    result = tt_measure_uv_distortion(m->mesh, corner_uv, image->width, image->height, &distortion, NULL,
+                                      &quality->distortion, &error);
+    if (result == TT_ERROR_NOT_MEASURED) {
+        snprintf(quality->distortion_reason, sizeof quality->distortion_reason, "%s", error.message);
+        return 0;
+    }
+    if (result != TT_OK) return tool_fail("%s: cannot measure the distortion: %s", options->mesh_path, error.message);
+    quality->distortion_measured = 1;
+    return 0;
+}
+
+/* "0.123 (456 of 789 edges sampled)", "n/a ..." or "not measured (...)". */
+static void format_seams(const tool_seams *seams, const char *edges, char *text, size_t size)
+{
+    const tt_seam_report *r = &seams->report;
+    if (!seams->measured)
+        snprintf(text, size, "not measured (%s)", seams->reason);
+    else if (r->score == r->score)
+        snprintf(text, size, "%.3f (%d of %d %s%s)", r->score, r->edges_measured, seams->edges, edges,
+                 seams->sampled ? " sampled" : "");
+    else
+        snprintf(text, size, "n/a: unrelated places differ no more than neighbours (%d %s; seam - same-face %.4f)",
+                 r->edges_measured, edges, r->seam - r->same_face);
+}
+
+static void print_summary(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
+                          const tt_hpm_report *report, const hpm_quality *quality, double seconds)
+{
+    const tt_uv_distortion_report *d = &quality->distortion;
+    char borders[320], all[320];
+    int level, last = -1, counted = report->levels < TT_HPM_MAX_LEVELS ? report->levels : TT_HPM_MAX_LEVELS;
+    for (level = 0; level < counted; level++)
+        if (report->mapped_per_level[level] > 0) last = level;
+    printf("%s: %d triangles", options->mesh_path, m->ntriangles);
+    if (m->ntriangles != m->obj.nfaces) printf(" (fans of %d faces)", m->obj.nfaces);
+    printf(", %d levels, %d clusters textured%s\n", report->levels, report->clusters,
+           (options->map.flags & TT_HPM_RANDOM_PLACEMENT) ? " (--no-fit: each placed at random)" : "");
+    printf("clusters per level:");
+    for (level = 0; level <= last; level++)
+        printf("%s L%d %d", level == 0 ? "" : ",", level, report->mapped_per_level[level]);
+    printf("\n");
+    printf("fits: %d accepted, %d at the floor, %d rejected (split); %d continued, %d starts; "
+           "split before fitting: %d not flat, %d no room\n",
+           report->accepted_fits, report->floor_fits, report->rejected_fits, report->continued, report->starts,
+           report->not_flat, report->no_room);
+    if (report->accepted_fits + report->floor_fits > 0)
+        printf("fit error: mean %.3f, max %.3f (threshold %g)\n", report->mean_error, report->max_error,
+               options->map.threshold > 0 ? options->map.threshold : TT_DEFAULT_HPM_THRESHOLD);
+    printf("texel density %.4g texels per unit (the image's %d texels span %.4g units); %.1f s\n",
+           report->texels_per_unit, image->width, (double)image->width / report->texels_per_unit, seconds);
+    format_seams(&quality->borders, "border edges", borders, sizeof borders);
+    format_seams(&quality->all, "edges", all, sizeof all);
+    printf("seam score: cluster borders %s; all edges %s\n", borders, all);
+    if (!quality->distortion_measured) {
+        printf("UV distortion: not measured (%s)\n", quality->distortion_reason);
+        return;
+    }
+    printf("UV distortion: stretch median %.3f, p95 %.3f; density error median %.1f%%, p95 %.1f%%; "
+           "%d flipped UV triangle%s",
+           d->stretch_median, d->stretch_p95, 100.0 * d->density_median, 100.0 * d->density_p95, d->flipped,
+           d->flipped == 1 ? "" : "s");
+    if (d->degenerate > 0) printf(", %d degenerate", d->degenerate);
+    if (d->non_finite > 0) printf(", %d with non-finite coordinates", d->non_finite);
+    if (d->outside_margin > 0)
+        printf(", %d corner%s closer than %g texel to the image's border", d->outside_margin,
+               d->outside_margin == 1 ? "" : "s", HPM_MARGIN_TEXELS);
+    printf("\n");
+}
+
+/* ======================================================================== */
+/* The command                                                              */
+/* ======================================================================== */
+
+int cmd_hpm(int argc, char **argv)
+{
+    hpm_command_options options;
+    triangle_mesh mesh;
+    tt_image *image = NULL;
+    tt_hpm_report report;
+    hpm_quality quality;
+    tool_output output = TOOL_OUTPUT_INIT;
+    float *corner_uv = NULL;
+    char obj_path[4096], mtl_path[4096], message[TOOL_ERROR_SIZE];
+    double start = tool_seconds_now();
+    int status;
+
+    status = parse_command_line(argc, argv, &options);
+    if (status >= 0) return status;
+    snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
+    snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
+
+    if ((status = triangle_mesh_read(options.mesh_path, &mesh)) != 0) return status;
+    /* A photo: sRGB bytes in the file, linear light in the library (which
+       matches colours as displayed again, by itself). */
+    if (image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
+        status = tool_fail("%s", message);
+    /* Refuse, before the long part, outputs that would replace an input
+       (the commit checks again, but only after mapping). */
+    if (status == 0) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0) {
+        corner_uv = (float *)malloc((size_t)mesh.ntriangles * 6 * sizeof(float));
+        if (!corner_uv) status = tool_fail("out of memory for the texture coordinates of %s", options.mesh_path);
+    }
+    if (status == 0) status = map_mesh(&options, &mesh, image, corner_uv, &report);
+    if (status == 0) status = measure_quality(&options, &mesh, image, corner_uv, &report, &quality);
+
+    if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
+    if (status == 0) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0);
+    if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
+
+    if (status == 0) {
+        print_summary(&options, &mesh, image, &report, &quality, tool_seconds_now() - start);
+        printf("wrote %s, %s\n", obj_path, mtl_path);
+    }
+    output_free(&output);
+    image_free(image);
+    free(corner_uv);
+    triangle_mesh_free(&mesh);
+    return status;
+}

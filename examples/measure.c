@@ -1,0 +1,43 @@
+/* measure.c - the library's quality measures as the commands' summaries
+   report them. See tool.h for the interface. */
+
+#include <stdio.h>
+#include <string.h>
+
+#include "tool.h"
+
+int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
+                       uint64_t seed, unsigned flags, int all_edges, tool_seams *out)
+{
+    tt_seam_options options;
+    tt_error error;
+    tt_result result;
+    size_t length;
+    int c;
+    memset(out, 0, sizeof *out);
+    /* The summary is a report, not the acceptance measure: a random sample
+       of edges keeps it fast on big meshes (within about 0.01 of the full
+       score). all_edges asks for the full measure. */
+    memset(&options, 0, sizeof options);
+    options.seed = seed;
+    options.flags = flags;
+    options.max_edges = all_edges ? 0 : TOOL_REPORT_EDGES;
+    result = tt_measure_seams(mesh, corner_uv, atlas, &options, NULL, &out->report, &error);
+    if (flags & TT_SEAM_UV_DISCONTINUOUS) {
+        out->edges = out->report.edges_discontinuous;
+    } else {
+        for (c = 0; c < mesh->ncorners; c++)
+            if (mesh->twin[c] > c) out->edges++;
+    }
+    out->sampled = !all_edges && out->edges > TOOL_REPORT_EDGES;
+    if (result == TT_ERROR_NOT_MEASURED) {
+        /* Not an error: the summary says why there is no number. */
+        snprintf(out->reason, sizeof out->reason, "%s", error.message);
+        length = strlen(out->reason);
+        if (length > 0 && out->reason[length - 1] == '.') out->reason[length - 1] = '\0';
+        return 0;
+    }
+    if (result != TT_OK) return tool_fail("%s: cannot measure the seams: %s", obj_path, error.message);
+    out->measured = 1;
+    return 0;
+}
