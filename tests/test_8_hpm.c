@@ -1312,18 +1312,126 @@ static void test_hpm_map_seams(void)
     CHECK(flipped == 0 && bad == 0, "fit: %d flipped, %d corners outside the margin", flipped, bad);
     hpm_uv_checks(mesh, uv_random, 128, 128, 1, &flipped, &bad);
     CHECK(flipped == 0 && bad == 0, "control: %d flipped, %d corners outside the margin", flipped, bad);
+    /* A1: on the cluster borders only (inside a cluster the map is
+       continuous, which would dilute the score) */
     memset(&so, 0, sizeof so);
+    so.flags = TT_SEAM_UV_DISCONTINUOUS;
     CHECK(tt_measure_seams(mesh, uv, im, &so, NULL, &fit, NULL) == TT_OK &&
               tt_measure_seams(mesh, uv_random, im, &so, NULL, &rnd, NULL) == TT_OK,
           "seams measured");
-    CHECK(fit.seam - fit.same_face < 0.5 * (rnd.seam - rnd.same_face),
-          "fitted borders differ less than random ones (seam excess %g against %g)", fit.seam - fit.same_face,
-          rnd.seam - rnd.same_face);
+    CHECK(fit.edges_discontinuous > 50 && fit.edges_discontinuous == rnd.edges_discontinuous,
+          "the same border edges (%d, %d)", fit.edges_discontinuous, rnd.edges_discontinuous);
+    printf("     seams on %d cluster-border edges: fitted %.3f, placed at random %.3f\n", fit.edges_discontinuous,
+           fit.score, rnd.score);
+    CHECK(fit.score <= 0.3, "fitted borders score %g (at most 0.3)", fit.score);
+    CHECK(rnd.score >= 0.8, "the control's borders score %g (at least 0.8)", rnd.score);
+    /* A3: stretch and texel density */
+    {
+        tt_uv_distortion_options dop;
+        tt_uv_distortion_report d;
+        memset(&dop, 0, sizeof dop);
+        dop.texels_per_unit = rep.texels_per_unit;
+        CHECK(tt_measure_uv_distortion(mesh, uv, 128, 128, &dop, NULL, &d, NULL) == TT_OK, "distortion measured");
+        CHECK(d.stretch_median <= 1.15 && d.stretch_p95 <= 1.6 && d.density_median <= 0.10 && d.flipped == 0,
+              "stretch median %g (<= 1.15), p95 %g (<= 1.6), density error median %g (<= 0.1), %d flipped",
+              d.stretch_median, d.stretch_p95, d.density_median, d.flipped);
+    }
 done:
     free(uv);
     free(uv_random);
     free(cl);
     free(cl_random);
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
+/* Per face of a mesh in the z = 0 plane: the angle (radians, mod pi) of
+   the world direction along which u stays constant - the direction of the
+   image's vertical stripes on the surface. */
+static double hpm_stripe_angle(const tt_mesh *mesh, const float *uv, int f, int w)
+{
+    int c = mesh->face_start[f];
+    const float *p0 = mesh->pos + 3 * mesh->corner_vert[c], *p1 = mesh->pos + 3 * mesh->corner_vert[c + 1],
+                *p2 = mesh->pos + 3 * mesh->corner_vert[c + 2];
+    double x1 = p1[0] - p0[0], y1 = p1[1] - p0[1], x2 = p2[0] - p0[0], y2 = p2[1] - p0[1];
+    double u1 = (uv[2 * c + 2] - uv[2 * c]) * w, u2 = (uv[2 * c + 4] - uv[2 * c]) * w;
+    double det = x1 * y2 - x2 * y1, gx = (u1 * y2 - u2 * y1) / det, gy = (x1 * u2 - x2 * u1) / det;
+    double a = atan2(gx, -gy); /* perpendicular to grad u */
+    return a - 3.14159265358979323846 * floor(a / 3.14159265358979323846);
+}
+
+static int hpm_double_compare(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : (x > y);
+}
+
+/* Median turn (degrees, 0..90) of the stripe direction across the edges
+   between clusters. */
+static double hpm_median_turn(const tt_mesh *mesh, const float *uv, const int *cl, int w, int *count)
+{
+    double *d = (double *)malloc(sizeof(double) * (size_t)mesh->ncorners), m = 180;
+    int c, n = 0;
+    for (c = 0; d && c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], f = mesh->corner_face[c], g;
+        double a;
+        if (t < 0) continue;
+        g = mesh->corner_face[t];
+        if (f > g || cl[f] == cl[g]) continue;
+        a = fabs(hpm_stripe_angle(mesh, uv, f, w) - hpm_stripe_angle(mesh, uv, g, w)) * 180 / 3.14159265358979323846;
+        if (a > 90) a = 180 - a;
+        d[n++] = a;
+    }
+    if (n > 0) {
+        qsort(d, (size_t)n, sizeof *d, hpm_double_compare);
+        m = d[n / 2];
+    }
+    *count = n;
+    free(d);
+    return m;
+}
+
+/* T11: the orientation propagates. Vertical stripes on a plane split into
+   many clusters keep their direction across the borders (median turn at
+   most 10 degrees; the fit tries turns of 0, +-19 and +-38 degrees); the
+   same clusters placed at random turn by about 45 degrees. */
+static void test_hpm_map_orientation(void)
+{
+    tt_mesh *mesh = hpm_book(60, 40, 0);
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    tt_hpm_report rep;
+    float *uv = NULL;
+    int *cl = NULL, x, y, edges;
+    double turn;
+    CHECK(tt_image_create(128, 128, NULL, &im, NULL) == TT_OK, "image");
+    if (!mesh || !im) goto done;
+    for (y = 0; y < 128; y++)
+        for (x = 0; x < 128; x++) {
+            float *p = im->pixels + 4 * (y * 128 + x);
+            /* stripes 8 texels apart, their widths varying so that places differ */
+            double v = 0.5 + 0.4 * sin(x * 0.785398 + 0.8 * sin(y * 0.09) + 0.5 * sin(x * 0.031 + y * 0.05));
+            p[0] = p[1] = p[2] = (float)v;
+            p[3] = 1;
+        }
+    memset(&o, 0, sizeof o);
+    o.scale = 20; /* the plane is three image widths across */
+    o.seed = 4;
+    if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    turn = hpm_median_turn(mesh, uv, cl, 128, &edges);
+    CHECK(rep.clusters >= 4 && edges > 20, "%d clusters, %d border edges", rep.clusters, edges);
+    printf("     stripes across %d cluster-border edges turn by %.1f degrees (median)", edges, turn);
+    CHECK(turn <= 10, "the stripes turn by %g degrees across borders (median; at most 10)", turn);
+    free(uv);
+    free(cl);
+    o.flags = TT_HPM_RANDOM_PLACEMENT;
+    if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    turn = hpm_median_turn(mesh, uv, cl, 128, &edges);
+    printf(", placed at random %.1f\n", turn);
+    CHECK(turn >= 25, "placed at random they turn by %g degrees (median; at least 25)", turn);
+done:
+    free(uv);
+    free(cl);
     tt_image_free(im);
     tt_mesh_free(mesh);
 }
@@ -1465,6 +1573,7 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_plane);
     RUN(test_hpm_map_continuation);
     RUN(test_hpm_map_seams);
+    RUN(test_hpm_map_orientation);
     RUN(test_hpm_map_topology);
     RUN(test_hpm_map_errors);
 }
