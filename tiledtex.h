@@ -124,6 +124,10 @@
                   discs checked, control vertices (Sec. 2.1, 3.1)
                 - flattening of a cluster over its control polygon: a harmonic
                   map, its flattening error and fold check (Sec. 3.2)
+                - the pipeline, tt_hpm_map: coarse to fine, each cluster placed
+                  where the image best continues its textured neighbours (a
+                  masked FFT correlation over turned copies), its borders
+                  relaxed; per-corner UVs into the original image (Sec. 2.2, 4)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H

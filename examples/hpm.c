@@ -45,7 +45,11 @@ static void print_help(void)
            "  --threshold E    the largest fit error accepted before a cluster is split into\n"
            "                   smaller ones (default %g; 0 is a perfect continuation, about 1\n"
            "                   unrelated pixels; 'inf' accepts every fit)\n"
-           "  --rotations R    orientations of the image tried per fit, 1 to 64 (default %d)\n"
+           "  --rotations R    orientations around the circle, 1 to 64 (default %d: steps of 19\n"
+           "                   degrees)\n"
+           "  --max-turn DEG   a fit tries only the orientations within DEG degrees of its main\n"
+           "                   textured neighbour's, so the pattern keeps its direction (default\n"
+           "                   %g; 180: every orientation, as in the paper)\n"
            "  --band W         width in texels of the textured border a fit matches (default:\n"
            "                   per cluster, a fifth of its radius, 3 to 24)\n"
            "  --toroidal       IMAGE tiles: placements wrap around its edges, and texture\n"
@@ -64,7 +68,7 @@ static void print_help(void)
            "         tiledtex generate texture stones.png --size 256\n"
            "         tiledtex hpm torus.obj stones.png torus_hpm --scale 3\n"
            "         tiledtex render torus_hpm.obj stones.png view.png\n",
-           TT_DEFAULT_HPM_THRESHOLD, TT_DEFAULT_HPM_ROTATIONS);
+           TT_DEFAULT_HPM_THRESHOLD, TT_DEFAULT_HPM_ROTATIONS, TT_DEFAULT_HPM_MAX_TURN);
 }
 
 typedef struct hpm_command_options {
@@ -109,6 +113,8 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
             if (parse_threshold(value, &options->map.threshold) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--rotations", &value)) {
             if (parse_int("--rotations", value, 1, 64, &options->map.rotations) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--max-turn", &value)) {
+            if (parse_float("--max-turn", value, 0.01, 180.0, &options->map.max_turn) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--band", &value)) {
             if (parse_float("--band", value, 1.0, 1e6, &options->map.band) != 0) return TOOL_EXIT_USAGE;
         } else if (strcmp(argv[i], "--toroidal") == 0) {
