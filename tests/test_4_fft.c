@@ -771,8 +771,7 @@ static int xb_agree(xb_set *s, const unsigned char *const *allowed, const char *
     tt_result r_want = xb_reference(s, allowed, &want, &want_k);
     tt_result r_got;
     long calls = s->cnt.calls;
-    tt_xcorr_texture *const *tex = s->tex;
-    r_got = tt_xcorr_masked_best((const tt_xcorr_texture *const *)tex, s->n, s->mask, s->values, allowed, s->work,
+    r_got = tt_xcorr_masked_best((const tt_xcorr_texture *const *)s->tex, s->n, s->mask, s->values, allowed, s->work,
                                  &got, &got_k, &err);
     if (s->cnt.calls != calls) {
         DETAIL("%s: %ld allocations", what, s->cnt.calls - calls);
