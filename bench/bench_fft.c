@@ -8,6 +8,14 @@
        xcorr_512_3ch <ms> ms           one tt_xcorr_masked fit against a cached 3-channel
        xcorr_512_3ch_median <ms> ms    512 x 512 texture (4 real forward transforms, 1
                                        inverse, the products and the argmin)
+       correlate_512_19rot <ms> ms     one tt_xcorr_masked_best fit of a ring-shaped band
+                                       (16 texels around a disc of radius 150) against
+                                       19 cached 3-channel 512 x 512 textures, as
+                                       hierarchical pattern mapping makes: median of 9
+       correlate_512_19rot_naive <ms> ms  the same fit as 19 tt_xcorr_masked calls (the
+                                       forward transforms redone per texture): median of 9
+       correlate_256_19rot <ms> ms     the tt_xcorr_masked_best fit at 256 x 256 (disc
+                                       radius 75)
    Built with -DBENCH_FFTW and -lfftw3 (the Makefile does so when Debian's
    libfftw3-dev is installed), it also times the same operation through
    FFTW's FFTW_MEASURE plans, interleaved with ours in the same process
@@ -25,6 +33,7 @@
 #include "tiledtex.h"
 #include "bench_clock.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,12 +44,16 @@
 
 #define REPS 31
 
-/* Sorts ms[0 .. REPS-1]; the minimum is then ms[0]. */
-static double median(double *ms)
+#define BEST_REPS 9   /* the 19-texture fits take up to 0.2 s each */
+
+/* Sorts ms[0 .. count-1]; the minimum is then ms[0]. */
+static double median_of(double *ms, int count)
 {
-    qsort(ms, REPS, sizeof ms[0], bench_cmp_double);
-    return ms[REPS / 2];
+    qsort(ms, (size_t)count, sizeof ms[0], bench_cmp_double);
+    return ms[count / 2];
 }
+
+static double median(double *ms) { return median_of(ms, REPS); }
 
 static unsigned long long g_state = 12345;
 static double random_unit(void)
@@ -179,8 +192,94 @@ static int bench_xcorr(int n)
     return 0;
 }
 
+/* The fit of hierarchical pattern mapping: a band of 16 texels around a
+   disc of radius 150 n / 512 against 19 cached 3-channel n x n textures
+   (random, standing in for the turned copies of one image), the values a
+   crop of texture 11 at (201, 45) so that the answer can be checked. Times
+   tt_xcorr_masked_best, and with `naive` also 19 tt_xcorr_masked calls
+   keeping the best, in the same run. */
+#define BEST_TEXTURES 19
+static int bench_xcorr_best(int n, int naive)
+{
+    size_t plane = (size_t)n * n, i;
+    double *t = (double *)malloc(sizeof(double) * 3 * plane), *values = (double *)malloc(sizeof(double) * 3 * plane);
+    double *mask = (double *)calloc(plane, sizeof(double)), *work = NULL;
+    double ms[BEST_REPS], ms_naive[BEST_REPS], start, radius = 150.0 * n / 512, band = 16.0;
+    tt_xcorr_texture *tex[BEST_TEXTURES] = {NULL};
+    tt_xcorr_match match;
+    tt_error err;
+    int rep, x, y, c, k, best_k = -1, planted = 11, x0 = 201 % n, y0 = 45;
+    if (!t || !values || !mask) return 1;
+    for (k = 0; k < BEST_TEXTURES; k++) {
+        for (i = 0; i < 3 * plane; i++) t[i] = random_unit();
+        if (k == planted)
+            for (y = 0; y < n; y++)
+                for (x = 0; x < n; x++) {
+                    double dx = x - n / 2 + 0.5, dy = y - n / 2 + 0.5, r = sqrt(dx * dx + dy * dy);
+                    if (r < radius || r > radius + band) continue;
+                    mask[(size_t)n * y + x] = 1.0;
+                    for (c = 0; c < 3; c++)
+                        values[plane * c + (size_t)n * y + x] =
+                            t[plane * c + (size_t)n * ((y + y0) % n) + (x + x0) % n];
+                }
+        if (tt_xcorr_texture_create(n, n, 3, t, NULL, &tex[k], &err) != TT_OK) {
+            fprintf(stderr, "bench_fft: %s\n", err.message);
+            return 1;
+        }
+    }
+    work = (double *)malloc(sizeof(double) * tex[0]->best_work_size);
+    if (!work) return 1;
+    for (rep = -1; rep < BEST_REPS; rep++) {   /* rep -1 warms up */
+        start = bench_now_ms();
+        if (tt_xcorr_masked_best((const tt_xcorr_texture *const *)tex, BEST_TEXTURES, mask, values, NULL, work,
+                                 &match, &best_k, &err) != TT_OK) {
+            fprintf(stderr, "bench_fft: %s\n", err.message);
+            return 1;
+        }
+        if (rep >= 0) ms[rep] = bench_now_ms() - start;
+        if (!naive) continue;
+        start = bench_now_ms();
+        {
+            tt_xcorr_match m, best;
+            int which = -1;
+            for (k = 0; k < BEST_TEXTURES; k++) {
+                if (tt_xcorr_masked(tex[k], mask, values, NULL, work, NULL, &m, &err) != TT_OK) {
+                    fprintf(stderr, "bench_fft: %s\n", err.message);
+                    return 1;
+                }
+                if (which < 0 || m.e < best.e) {
+                    best = m;
+                    which = k;
+                }
+            }
+            if (rep >= 0) ms_naive[rep] = bench_now_ms() - start;
+            if (which != best_k || best.x != match.x || best.y != match.y || best.e != match.e) {
+                fprintf(stderr, "bench_fft: 19 tt_xcorr_masked calls disagree with tt_xcorr_masked_best\n");
+                return 1;
+            }
+        }
+    }
+    if (best_k != planted || match.x != x0 || match.y != y0) {
+        fprintf(stderr, "bench_fft: the planted crop (texture %d at (%d, %d)) came out as texture %d at (%d, %d)\n",
+                planted, x0, y0, best_k, match.x, match.y);
+        return 1;
+    }
+    fprintf(stderr, "bench_fft: correlate %d x %d x 3 against %d textures: planted crop found, E there %.3g\n", n,
+            n, BEST_TEXTURES, match.e);
+    printf("correlate_%d_19rot %.3f ms\n", n, median_of(ms, BEST_REPS));
+    if (naive) printf("correlate_%d_19rot_naive %.3f ms\n", n, median_of(ms_naive, BEST_REPS));
+    for (k = 0; k < BEST_TEXTURES; k++) tt_xcorr_texture_free(tex[k]);
+    free(t);
+    free(values);
+    free(mask);
+    free(work);
+    return 0;
+}
+
 int main(void)
 {
-    if (bench_size(512) || bench_size(256) || bench_xcorr(512)) return 1;
+    if (bench_size(512) || bench_size(256) || bench_xcorr(512) || bench_xcorr_best(512, 1) ||
+        bench_xcorr_best(256, 0))
+        return 1;
     return 0;
 }

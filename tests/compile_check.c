@@ -280,7 +280,7 @@ int main(void)
         /* 4. Numerics, the FFTs and the masked correlation: every public function once. */
         static const double tex4[4] = {0.25, 0.5, 0.75, 1.0};
         static const double mask4[4] = {1.0, 0.0, 0.0, 0.0};
-        double cplx[8] = {1, 0, 2, 0, 3, 0, 4, 0}, spec4[8], real4[4], work[16], map4[4];
+        double cplx[8] = {1, 0, 2, 0, 3, 0, 4, 0}, spec4[8], real4[4], work[24], map4[4];
         double values4[4] = {0.75, 0.0, 0.0, 0.0};
         tt_fft_plan *plan = NULL;
         tt_xcorr_texture *xt = NULL;
@@ -297,6 +297,15 @@ int main(void)
         EXPECT(xt->work_size <= 16);
         EXPECT(tt_xcorr_masked(xt, mask4, values4, NULL, work, map4, &match, &err) == TT_OK && match.x == 0 &&
                match.y == 1 && match.e < 1e-12);
+        {
+            const tt_xcorr_texture *both[2];
+            int which = -1;
+            both[0] = xt;
+            both[1] = xt;
+            EXPECT(xt->best_work_size <= 24);
+            EXPECT(tt_xcorr_masked_best(both, 2, mask4, values4, NULL, work, &match, &which, &err) == TT_OK &&
+                   which == 0 && match.x == 0 && match.y == 1 && match.e < 1e-12);
+        }
         tt_xcorr_texture_free(xt);
     }
 #ifdef COMPILE_CHECK_USER_ALLOC

@@ -684,6 +684,384 @@ static void test_xcorr_errors(void)
     }
 }
 
+/* ------------------------------------------------------------------------ */
+/* tt_xcorr_masked_best: several cached textures at once                    */
+/* ------------------------------------------------------------------------ */
+
+#define XB_MAX 6
+
+/* ntextures textures of one size (random, or copies of `copy_of` when it is
+   not NULL), made through a counting allocator, so a test can see that
+   correlating against them allocates nothing; a mask, values, work space
+   for both functions. */
+typedef struct xb_set {
+    int w, h, channels, n;
+    double *t[XB_MAX], *mask, *values, *work;
+    tt_xcorr_texture *tex[XB_MAX];
+    counter cnt;
+    tt_allocator al;
+} xb_set;
+
+static int xb_open(xb_set *s, int w, int h, int channels, int n, const double *copy_of)
+{
+    size_t count = (size_t)w * h * channels, need;
+    tt_error err;
+    int k, ok = 1;
+    memset(s, 0, sizeof *s);
+    s->w = w;
+    s->h = h;
+    s->channels = channels;
+    s->n = n;
+    s->al = make_allocator(&s->cnt, -1);
+    for (k = 0; k < n; k++) {
+        s->t[k] = fft_random(count);
+        if (copy_of) memcpy(s->t[k], copy_of, sizeof(double) * count);
+        if (tt_xcorr_texture_create(w, h, channels, s->t[k], &s->al, &s->tex[k], &err) != TT_OK) ok = 0;
+    }
+    CHECK(ok, "%d textures %d x %d x %d: %s", n, w, h, channels, ok ? "" : err.message);
+    if (!ok) return 0;
+    s->mask = (double *)calloc((size_t)w * h, sizeof(double));
+    s->values = fft_random(count);
+    need = s->tex[0]->best_work_size > s->tex[0]->work_size ? s->tex[0]->best_work_size : s->tex[0]->work_size;
+    s->work = (double *)malloc(sizeof(double) * need);
+    return 1;
+}
+
+static void xb_close(xb_set *s)
+{
+    int k;
+    for (k = 0; k < s->n; k++) {
+        tt_xcorr_texture_free(s->tex[k]);
+        free(s->t[k]);
+    }
+    CHECK(s->cnt.live == 0 && s->cnt.bad_frees == 0, "the textures freed all they held (%ld live)", s->cnt.live);
+    free(s->mask);
+    free(s->values);
+    free(s->work);
+}
+
+/* The reference: tt_xcorr_masked per texture, the smallest E kept, an
+   earlier texture kept on an exact tie. Returns TT_OK, NOT_MEASURED when
+   no texture gave a match, or the first other error. */
+static tt_result xb_reference(xb_set *s, const unsigned char *const *allowed, tt_xcorr_match *best, int *best_k)
+{
+    int k, found = 0;
+    *best_k = -1;
+    for (k = 0; k < s->n; k++) {
+        tt_xcorr_match m;
+        tt_result r = tt_xcorr_masked(s->tex[k], s->mask, s->values, allowed ? allowed[k] : NULL, s->work, NULL, &m,
+                                      NULL);
+        if (r == TT_ERROR_NOT_MEASURED) continue;
+        if (r != TT_OK) return r;
+        if (!found || m.e < best->e) {
+            *best = m;
+            *best_k = k;
+            found = 1;
+        }
+    }
+    return found ? TT_OK : TT_ERROR_NOT_MEASURED;
+}
+
+/* Runs both and compares them bit for bit; returns 1 when they agree. */
+static int xb_agree(xb_set *s, const unsigned char *const *allowed, const char *what)
+{
+    tt_xcorr_match want, got;
+    int want_k, got_k;
+    tt_error err;
+    tt_result r_want = xb_reference(s, allowed, &want, &want_k);
+    tt_result r_got;
+    long calls = s->cnt.calls;
+    r_got = tt_xcorr_masked_best((const tt_xcorr_texture *const *)s->tex, s->n, s->mask, s->values, allowed, s->work,
+                                 &got, &got_k, &err);
+    if (s->cnt.calls != calls) {
+        DETAIL("%s: %ld allocations", what, s->cnt.calls - calls);
+        return 0;
+    }
+    if (r_got != r_want || got_k != want_k ||
+        (r_got == TT_OK && (got.x != want.x || got.y != want.y || got.e != want.e || got.mask_sum != want.mask_sum ||
+                            got.masked_energy != want.masked_energy))) {
+        DETAIL("%s: %d x %d x %d, %d textures: best %d texture %d (%d, %d) E %.17g; reference %d texture %d (%d, %d) "
+               "E %.17g (%s)",
+               what, s->w, s->h, s->channels, s->n, r_got, got_k, got.x, got.y, got.e, r_want, want_k, want.x,
+               want.y, want.e, err.message);
+        return 0;
+    }
+    return 1;
+}
+
+/* Random textures, masks and allowed maps, square and not, 1 and 3
+   channels: the same answer as tt_xcorr_masked texture by texture, bit for
+   bit, and E there is the direct masked sum. */
+static void test_xcorr_best_reference(void)
+{
+    static const int sizes[][4] = {{32, 16, 3, 5}, {16, 32, 1, 4}, {32, 32, 3, 3}, {8, 4, 1, 6}, {64, 8, 3, 1}};
+    int si, trial, cases = 0, bad = 0, bad_direct = 0;
+    lcg_seed(4107);
+    for (si = 0; si < (int)(sizeof sizes / sizeof sizes[0]); si++)
+        for (trial = 0; trial < 6; trial++) {
+            xb_set s;
+            unsigned char *maps;
+            const unsigned char *allowed[XB_MAX];
+            int i, k, plane, soft = trial % 2, mode = trial / 2;
+            char what[96];
+            if (!xb_open(&s, sizes[si][0], sizes[si][1], sizes[si][2], sizes[si][3], NULL)) return;
+            plane = s.w * s.h;
+            maps = (unsigned char *)malloc((size_t)plane * s.n);
+            for (i = 0; i < plane; i++)
+                s.mask[i] = lcg_below(3) == 0 ? (soft ? lcg_unit() : 1.0) : 0.0;
+            s.mask[lcg_below(plane)] = 1.0;   /* never all zero */
+            /* mode 0: no allowed maps; 1: random ones, some textures free;
+               2: sparse random ones, texture 0's all zero. */
+            for (k = 0; k < s.n; k++) {
+                for (i = 0; i < plane; i++) maps[plane * k + i] = (unsigned char)(lcg_below(mode == 2 ? 10 : 2) == 0);
+                if (mode == 2 && k == 0) memset(maps, 0, (size_t)plane);
+                allowed[k] = mode == 1 && k % 2 == 1 ? NULL : maps + plane * k;
+            }
+            sprintf(what, "size %d, trial %d", si, trial);
+            if (!xb_agree(&s, mode == 0 ? NULL : allowed, what)) bad++;
+            cases++;
+            {
+                tt_xcorr_match m;
+                int best_k, only_texture_excluded = s.n == 1 && mode == 2;
+                double direct;
+                tt_result r = tt_xcorr_masked_best((const tt_xcorr_texture *const *)s.tex, s.n, s.mask, s.values,
+                                                   mode == 0 ? NULL : allowed, s.work, &m, &best_k, NULL);
+                if (r == TT_OK) {
+                    direct = xc_direct(s.t[best_k], s.mask, s.values, s.w, s.h, s.channels, m.x, m.y);
+                    if (!(fabs(m.e - direct) <= 1e-12 * direct) && bad_direct++ == 0)
+                        DETAIL("%s: E %.17g, direct %.17g", what, m.e, direct);
+                } else if (!(only_texture_excluded && r == TT_ERROR_NOT_MEASURED) && bad_direct++ == 0)
+                    DETAIL("%s: no match (%d)", what, r);
+            }
+            free(maps);
+            xb_close(&s);
+        }
+    CHECK(bad == 0, "tt_xcorr_masked_best equals tt_xcorr_masked per texture, bit for bit, in %d of %d cases",
+          cases - bad, cases);
+    CHECK(bad_direct == 0, "E of the best match equals the direct masked sum within 1e-12 (%d do not)", bad_direct);
+}
+
+/* Exact ties across textures: the smallest (texture, y, x) wins. */
+static void test_xcorr_best_ties(void)
+{
+    xb_set s;
+    tt_xcorr_match m, one;
+    tt_error err;
+    int k = -7, i, plane;
+    unsigned char *maps;
+    const unsigned char *allowed[3];
+    lcg_seed(4108);
+    {
+        double *same = fft_random(32 * 16 * 3);
+        int ok = xb_open(&s, 32, 16, 3, 3, same);
+        free(same);
+        if (!ok) return;
+    }
+    plane = s.w * s.h;
+    for (i = 0; i < plane; i++) s.mask[i] = lcg_below(4) == 0 ? 1.0 : 0.0;
+    CHECK(tt_xcorr_masked_best((const tt_xcorr_texture *const *)s.tex, 3, s.mask, s.values, NULL, s.work, &m, &k,
+                               &err) == TT_OK && k == 0,
+          "three identical textures: texture 0 wins the tie (got %d: %s)", k, err.message);
+    CHECK(tt_xcorr_masked(s.tex[0], s.mask, s.values, NULL, s.work, NULL, &one, &err) == TT_OK && one.x == m.x &&
+              one.y == m.y && one.e == m.e,
+          "at texture 0's own best (%d, %d), E %.17g (alone: (%d, %d), %.17g)", m.x, m.y, m.e, one.x, one.y, one.e);
+    maps = (unsigned char *)malloc((size_t)plane * 3);
+    memset(maps, 0, (size_t)plane * 3);
+    allowed[0] = maps;   /* texture 0: nothing allowed */
+    allowed[1] = NULL;
+    allowed[2] = NULL;
+    CHECK(tt_xcorr_masked_best((const tt_xcorr_texture *const *)s.tex, 3, s.mask, s.values, allowed, s.work, &m, &k,
+                               &err) == TT_OK && k == 1 && m.x == one.x && m.y == one.y && m.e == one.e,
+          "identical copies, the first excluded: texture 1 wins (got %d at (%d, %d))", k, m.x, m.y);
+    memset(maps, 1, (size_t)plane);
+    maps[s.w * one.y + one.x] = 0;   /* texture 0: all but its best offset */
+    CHECK(tt_xcorr_masked_best((const tt_xcorr_texture *const *)s.tex, 3, s.mask, s.values, allowed, s.work, &m, &k,
+                               &err) == TT_OK && k == 1 && m.x == one.x && m.y == one.y,
+          "texture 0 without its best offset: texture 1 at (%d, %d) (got %d at (%d, %d))", one.x, one.y, k, m.x, m.y);
+    xb_close(&s);
+    free(maps);
+    /* T = 0 and I = 0: E = 0 at every offset of every texture. Texture 0
+       allows only (5, 3), texture 1 every offset: (texture 0, 5, 3) comes
+       first in (texture, y, x) order, although texture 1 has (0, 0). */
+    {
+        double *zero = (double *)calloc(16 * 8, sizeof(double));
+        int ok = xb_open(&s, 16, 8, 1, 2, zero);
+        free(zero);
+        if (!ok) return;
+    }
+    maps = (unsigned char *)calloc(16 * 8, 1);
+    maps[16 * 3 + 5] = 1;
+    allowed[0] = maps;
+    allowed[1] = NULL;
+    for (i = 0; i < 16 * 8; i++) {
+        s.mask[i] = i % 5 == 0;
+        s.values[i] = 0.0;
+    }
+    CHECK(tt_xcorr_masked_best((const tt_xcorr_texture *const *)s.tex, 2, s.mask, s.values, allowed, s.work, &m, &k,
+                               &err) == TT_OK && k == 0 && m.x == 5 && m.y == 3 && m.e == 0.0,
+          "E = 0 everywhere: texture 0 at (5, 3) (got %d at (%d, %d), E %g)", k, m.x, m.y, m.e);
+    allowed[0] = NULL;
+    CHECK(tt_xcorr_masked_best((const tt_xcorr_texture *const *)s.tex, 2, s.mask, s.values, allowed, s.work, &m, &k,
+                               &err) == TT_OK && k == 0 && m.x == 0 && m.y == 0,
+          "E = 0 everywhere, all allowed: texture 0 at (0, 0) (got %d at (%d, %d))", k, m.x, m.y);
+    free(maps);
+    xb_close(&s);
+}
+
+/* A crop of texture k at (x0, y0) under a ring-shaped mask that wraps the
+   border: texture k, that offset, E about 0. 3 channels and 1. */
+static void test_xcorr_best_planted(void)
+{
+    static const int cases[][6] = {/* w, h, channels, n, k, x0 */ {64, 32, 3, 5, 3, 41}, {32, 64, 1, 4, 0, 9},
+                                   {32, 32, 3, 2, 1, 30}};
+    int ci;
+    lcg_seed(4109);
+    for (ci = 0; ci < 3; ci++) {
+        xb_set s;
+        tt_xcorr_match m;
+        tt_error err;
+        int w = cases[ci][0], h = cases[ci][1], k = cases[ci][4], x0 = cases[ci][5], y0 = h - 5, best_k = -1;
+        int x, y, c;
+        size_t plane = (size_t)w * h;
+        if (!xb_open(&s, w, h, cases[ci][2], cases[ci][3], NULL)) return;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                /* A ring of radii 4 and 9 around (2, 1): crosses both borders. */
+                double dx = (double)((x + w / 2 - 2) % w) - w / 2, dy = (double)((y + h / 2 - 1) % h) - h / 2;
+                double r2 = dx * dx + dy * dy;
+                s.mask[w * y + x] = r2 >= 16.0 && r2 <= 81.0 ? 1.0 : 0.0;
+                for (c = 0; c < s.channels; c++)
+                    s.values[plane * c + (size_t)w * y + x] =
+                        s.mask[w * y + x] != 0.0 ? s.t[k][plane * c + (size_t)w * ((y + y0) % h) + (x + x0) % w]
+                                                 : internal_not_a_number();   /* never read */
+            }
+        CHECK(tt_xcorr_masked_best((const tt_xcorr_texture *const *)s.tex, s.n, s.mask, s.values, NULL, s.work, &m,
+                                   &best_k, &err) == TT_OK &&
+                  best_k == k && m.x == x0 && m.y == y0 && m.e < 1e-9 && m.mask_sum > 100.0,
+              "%d x %d x %d: the crop of texture %d at (%d, %d) found: texture %d at (%d, %d), E %g (%s)", w, h,
+              s.channels, k, x0, y0, best_k, m.x, m.y, m.e, err.message);
+        xb_close(&s);
+    }
+}
+
+static void test_xcorr_best_errors(void)
+{
+    xb_set s, other;
+    tt_xcorr_match m;
+    tt_error err;
+    int k, i;
+    long calls;
+    const tt_xcorr_texture *tex[3];
+    unsigned char zero[8 * 4];
+    const unsigned char *allowed[3];
+    lcg_seed(4110);
+    if (!xb_open(&s, 8, 4, 2, 3, NULL)) return;
+    for (i = 0; i < 3; i++) tex[i] = s.tex[i];
+    s.mask[3] = 1.0;
+    calls = s.cnt.calls;
+#define XB_CALL(textures, n, mask, values, allowed_, work, out, which) \
+    (k = 7, m.x = 7, tt_xcorr_masked_best(textures, n, mask, values, allowed_, work, out, which, &err))
+#define XB_UNSET (k == -1 && m.x == -1 && m.y == -1)
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_OK && err.result == TT_OK && k >= 0,
+          "the valid call (%s)", err.message);
+    CHECK(XB_CALL(NULL, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              strstr(err.message, "textures"),
+          "textures NULL (%s)", err.message);
+    CHECK(XB_CALL(tex, 3, NULL, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              strstr(err.message, "mask"),
+          "mask NULL (%s)", err.message);
+    CHECK(XB_CALL(tex, 3, s.mask, NULL, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              strstr(err.message, "values is NULL"),
+          "values NULL (%s)", err.message);
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, NULL, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              strstr(err.message, "work is NULL"),
+          "work NULL (%s)", err.message);
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, NULL, &k) == TT_ERROR_INVALID_ARGUMENT && k == -1 &&
+              strstr(err.message, "out_match is NULL"),
+          "out_match NULL (%s)", err.message);
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, NULL) == TT_ERROR_INVALID_ARGUMENT && m.x == -1 &&
+              strstr(err.message, "out_texture is NULL"),
+          "out_texture NULL (%s)", err.message);
+    CHECK(XB_CALL(tex, 0, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              msg_has_number(err.message, 0),
+          "no textures (%s)", err.message);
+    CHECK(XB_CALL(tex, -2, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET,
+          "-2 textures (%s)", err.message);
+    tex[1] = NULL;
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              err.item == 1,
+          "texture 1 NULL names item 1 (%s)", err.message);
+    tex[1] = s.tex[1];
+    /* Textures unlike texture 0: another size, another channel count. */
+    if (!xb_open(&other, 8, 8, 2, 1, NULL)) return;
+    tex[2] = other.tex[0];
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              err.item == 2 && msg_has_number(err.message, 2),
+          "texture 2 of another height (%s)", err.message);
+    xb_close(&other);
+    if (!xb_open(&other, 8, 4, 3, 1, NULL)) return;
+    tex[1] = other.tex[0];
+    tex[2] = other.tex[0];
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              err.item == 1,
+          "textures 1 and 2 of 3 channels: texture 1 is named (%s)", err.message);
+    xb_close(&other);
+    tex[1] = s.tex[1];
+    tex[2] = s.tex[2];
+    /* The mask and the values: as tt_xcorr_masked. */
+    s.mask[8 * 2 + 5] = -0.5;
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_INVALID_ARGUMENT && XB_UNSET &&
+              err.row == 2 && err.column == 5,
+          "a negative weight at row 2, column 5 (%s)", err.message);
+    s.mask[8 * 2 + 5] = internal_not_a_number();
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_NON_FINITE && XB_UNSET &&
+              err.row == 2 && err.column == 5,
+          "a NaN weight (%s)", err.message);
+    s.mask[8 * 2 + 5] = 0.0;
+    s.values[32 + 3] = (double)internal_infinity();   /* channel 1, row 0, column 3: under the mask */
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_NON_FINITE && XB_UNSET &&
+              err.item == 1 && err.row == 0 && err.column == 3,
+          "an infinite value under the mask names channel 1 (%s)", err.message);
+    s.values[32 + 3] = 0.5;
+    /* Nothing to measure. */
+    memset(zero, 0, sizeof zero);
+    allowed[0] = allowed[1] = allowed[2] = zero;
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, allowed, s.work, &m, &k) == TT_ERROR_NOT_MEASURED && XB_UNSET &&
+              m.e == 0.0 && m.mask_sum == 1.0 && err.result == TT_ERROR_NOT_MEASURED,
+          "no offset of any texture allowed: TT_ERROR_NOT_MEASURED (%s)", err.message);
+    s.mask[3] = 0.0;
+    CHECK(XB_CALL(tex, 3, s.mask, s.values, NULL, s.work, &m, &k) == TT_ERROR_NOT_MEASURED && XB_UNSET &&
+              m.e == 0.0 && m.mask_sum == 0.0 && m.masked_energy == 0.0,
+          "an all-zero mask: TT_ERROR_NOT_MEASURED, match {-1, -1, 0, 0, 0} (%s)", err.message);
+    CHECK(s.cnt.calls == calls, "no call allocated (%ld allocations)", s.cnt.calls - calls);
+    xb_close(&s);
+    /* Spectra whose products overflow, for texture 1 only (J = 1e300 against
+       T^2 = 1e300): TT_ERROR_NON_FINITE naming it, never E = 0 from a NaN
+       clamped away. */
+    {
+        double big[8 * 4], wmask[8 * 4], small[8 * 4], work[3 * 2 * 5 * 4];   /* (channels + 2) half spectra of 2 (8 / 2 + 1) x 4 doubles */
+        tt_xcorr_texture *pair[2] = {NULL, NULL};
+        for (i = 0; i < 32; i++) {
+            big[i] = 1e150;
+            wmask[i] = i == 3 ? 1e300 : 0.0;
+            small[i] = 1e-100;
+        }
+        CHECK(tt_xcorr_texture_create(8, 4, 1, small, NULL, &pair[0], &err) == TT_OK &&
+                  tt_xcorr_texture_create(8, 4, 1, big, NULL, &pair[1], &err) == TT_OK &&
+                  pair[1]->best_work_size <= 3 * 2 * 5 * 4,
+              "textures of 1e-100 and 1e150 (%s)", err.message);
+        if (pair[0] && pair[1])
+            CHECK(XB_CALL((const tt_xcorr_texture *const *)pair, 2, wmask, small, NULL, work, &m, &k) ==
+                          TT_ERROR_NON_FINITE &&
+                      XB_UNSET && err.item == 1,
+                  "spectra whose products overflow with texture 1: TT_ERROR_NON_FINITE naming it (%s)", err.message);
+        tt_xcorr_texture_free(pair[0]);
+        tt_xcorr_texture_free(pair[1]);
+    }
+#undef XB_CALL
+#undef XB_UNSET
+}
+
 typedef struct fft_oom_ctx {
     int w, h, channels;
     const double *t;
@@ -745,5 +1123,9 @@ void run_fft_tests(void)
     RUN(test_xcorr_planted_bounded);
     RUN(test_xcorr_empty_and_ties);
     RUN(test_xcorr_errors);
+    RUN(test_xcorr_best_reference);
+    RUN(test_xcorr_best_ties);
+    RUN(test_xcorr_best_planted);
+    RUN(test_xcorr_best_errors);
     RUN(test_fft_oom);
 }
