@@ -2061,6 +2061,8 @@ typedef struct tt_hpm_report {
     int levels;                             /* the hierarchy's */
     int clusters;                           /* clusters textured */
     int mapped_per_level[TT_HPM_MAX_LEVELS];/* clusters textured at each level */
+    int fits_per_level[TT_HPM_MAX_LEVELS];  /* fits run at each level */
+    int accepted_per_level[TT_HPM_MAX_LEVELS]; /* of those, accepted under the threshold */
     int fits;                               /* masked correlations run (each over every copy) */
     int copies;                             /* turned copies of the image each fit tries */
     int accepted_fits;                      /* fits at or below the threshold */
@@ -12144,6 +12146,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         return -2;
     }
     S->rep.fits++;
+    S->rep.fits_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
 
     /* The placement of the best offset, refined at full resolution by a
        direct sum over +-(f - 1) texels (D30). */
@@ -12235,8 +12238,8 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    the stretch measure keeps its bound), or when it would leave a bounded
    image's margin. The interior is not re-solved (D25's last step): the
    moves are a few texels and only C's border triangles absorb them. */
-#define TT__HPM_RELAX_TRIALS 8
-#define TT__HPM_RELAX_PASSES 3
+#define TT__HPM_RELAX_TRIALS 16
+#define TT__HPM_RELAX_PASSES 4
 #define TT__HPM_RELAX_SAMPLES 8
 #define TT__HPM_RELAX_MAX_STRETCH 1.3
 #define TT__HPM_RELAX_ACROSS 4.0
@@ -12490,10 +12493,12 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
     }
     if (fit == 1) {
         if (eps <= S->threshold || at_floor) {
-            if (eps <= S->threshold)
+            if (eps <= S->threshold) {
                 S->rep.accepted_fits++;
-            else
+                S->rep.accepted_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
+            } else {
                 S->rep.floor_fits++;
+            }
             S->error_sum += eps;
             if (eps > S->rep.max_error) S->rep.max_error = eps;
             return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);

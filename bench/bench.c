@@ -645,6 +645,8 @@ int main(int argc, char **argv)
         hc.uv = (float *)xmalloc(sizeof(float) * 2 * (size_t)hc.mesh->ncorners);
         report("hpm_20k_faces", median_ms(run_hpm, &hc, RUNS_SLOW), "ms");
         report("hpm_20k_faces_fits", hc.report.fits, "fits");
+        report("hpm_20k_faces_fits_accepted", hc.report.accepted_fits, "fits");
+        report("hpm_20k_faces_fits_rejected", hc.report.rejected_fits, "fits");
         report("hpm_20k_faces_clusters", hc.report.clusters, "clusters");
         report("hpm_20k_faces_mean_error", hc.report.mean_error, "eps");
         free(hc.uv);
