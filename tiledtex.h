@@ -2030,8 +2030,9 @@ enum {
     TT_HPM_NO_RANDOM_TURN = 1u << 2,    /* no random turn of the frame before a fit (D8) and
                                            starts at angle 0: a neighbour's exact continuation
                                            can then be found (tests) */
-    TT_HPM_NO_RELAXATION = 1u << 3      /* no relaxation of the borders after each placement
-                                           (Sec. 4.4): the fits alone */
+    TT_HPM_NO_RELAXATION = 1u << 3      /* no work on the borders after each placement: neither
+                                           the crack closing (D17) nor the relaxation (Sec. 4.4);
+                                           the fits alone */
 };
 
 typedef struct tt_hpm_options {
@@ -12482,6 +12483,77 @@ static int tt__hpm_relax(tt__hpm *S, int C)
     return 1;
 }
 
+/* D17: the band that C's place was fitted to shows each textured
+   neighbour N through its rigid map S_N (D16), and C's own flattening
+   puts a shared border vertex a little away from where S_N puts it (the
+   two flattenings differ): the image would then be cut at C's border
+   texels away from where the matched band ends, a crack. So each shared
+   vertex takes S_N's position, placed like the rest of C - for a cluster
+   continuing N, exactly N's texture coordinates, a continuous border -
+   unless that would flip, collapse or overstretch one of C's triangles
+   there. N is the neighbour sharing most vertices with C among those at
+   the vertex. */
+static void tt__hpm_close_cracks(tt__hpm *S, int C, const tt__hpm_place *pl)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    int i, c;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+            int ring[TT__HPM_RING_MAX], n, k, o, from = -1, ok = 1;
+            const tt__hpm_owner *N = NULL;
+            double target[2], old[2], q[2], area0[TT__HPM_RING_MAX], st0[TT__HPM_RING_MAX], st;
+            n = tt__hpm_ring(m, m->corner_vert[c], ring, TT__HPM_RING_MAX);
+            for (k = 0; k < n; k++) {
+                int K = S->owner[m->corner_face[ring[k]]];
+                if (K < 0 || K == C) continue;
+                for (o = 0; o < S->nowners; o++)
+                    if (S->owners[o].cluster == K && S->owners[o].valid &&
+                        (!N || S->owners[o].shared > N->shared)) {
+                        N = &S->owners[o];
+                        from = ring[k];
+                    }
+            }
+            if (!N) continue;
+            {
+                double ax = S->uv[2 * from] / S->s, ay = S->uv[2 * from + 1] / S->s;
+                q[0] = N->cos_a * ax - N->sin_a * ay + N->shift[0];
+                q[1] = N->sin_a * ax + N->cos_a * ay + N->shift[1];
+            }
+            tt__hpm_apply(S, pl, q, target);
+            old[0] = S->uv[2 * c];
+            old[1] = S->uv[2 * c + 1];
+            if (S->toroidal) {
+                /* C was moved by whole periods when written */
+                target[0] += S->W * floor((old[0] - target[0]) / S->W + 0.5);
+                target[1] += S->Hh * floor((old[1] - target[1]) / S->Hh + 0.5);
+            }
+            if (target[0] == old[0] && target[1] == old[1]) continue;
+            if (!S->toroidal && (target[0] < 1 || target[1] < 1 || target[0] > S->W - 1 || target[1] > S->Hh - 1))
+                continue;
+            for (k = 0; k < n; k++) area0[k] = tt__hpm_tri_area(S, ring[k], &st0[k]);
+            for (k = 0; k < n; k++)
+                if (S->owner[m->corner_face[ring[k]]] == C) {
+                    S->uv[2 * ring[k]] = target[0];
+                    S->uv[2 * ring[k] + 1] = target[1];
+                }
+            for (k = 0; k < n && ok; k++)
+                if (S->owner[m->corner_face[ring[k]]] == C) {
+                    double a = tt__hpm_tri_area(S, ring[k], &st);
+                    ok = a * area0[k] > 0 && fabs(a) >= 0.25 * fabs(area0[k]) &&
+                         st <= (st0[k] > TT__HPM_RELAX_MAX_STRETCH ? st0[k] : TT__HPM_RELAX_MAX_STRETCH);
+                }
+            if (!ok)
+                for (k = 0; k < n; k++)
+                    if (S->owner[m->corner_face[ring[k]]] == C) {
+                        S->uv[2 * ring[k]] = old[0];
+                        S->uv[2 * ring[k] + 1] = old[1];
+                    }
+        }
+    }
+}
+
 /* C is textured by placement pl: write its corners, record it, queue its
    same-level neighbours. */
 static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
@@ -12490,6 +12562,7 @@ static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
     int i;
     tt__hpm_write(S, C, pl, S->uv);
     for (i = 0; i < cl->nfaces; i++) S->owner[S->H->faces[cl->first_face + i]] = C;
+    if (!(S->flags & TT_HPM_NO_RELAXATION)) tt__hpm_close_cracks(S, C, pl);
     if (!(S->flags & TT_HPM_NO_RELAXATION) && !tt__hpm_relax(S, C)) return 0;
     if (S->out) {
         tt__hpm_place rp;

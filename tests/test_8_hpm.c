@@ -1319,8 +1319,12 @@ static void test_hpm_map_seams(void)
     CHECK(tt_measure_seams(mesh, uv, im, &so, NULL, &fit, NULL) == TT_OK &&
               tt_measure_seams(mesh, uv_random, im, &so, NULL, &rnd, NULL) == TT_OK,
           "seams measured");
-    CHECK(fit.edges_discontinuous > 50 && fit.edges_discontinuous == rnd.edges_discontinuous,
-          "the same border edges (%d, %d)", fit.edges_discontinuous, rnd.edges_discontinuous);
+    /* the control jumps on every cluster border; the fit on most (where it
+       closed a crack the border is continuous, no seam at all, and it is
+       left out: the score is over the harder rest) */
+    CHECK(fit.edges_discontinuous > 50 && fit.edges_discontinuous <= rnd.edges_discontinuous &&
+              fit.edges_discontinuous >= 0.8 * rnd.edges_discontinuous,
+          "the border edges: %d of the control's %d", fit.edges_discontinuous, rnd.edges_discontinuous);
     printf("     seams on %d cluster-border edges: fitted %.3f, placed at random %.3f\n", fit.edges_discontinuous,
            fit.score, rnd.score);
     CHECK(fit.score <= 0.3, "fitted borders score %g (at most 0.3)", fit.score);
