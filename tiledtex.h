@@ -2064,7 +2064,8 @@ typedef struct tt_hpm_report {
     int mapped_per_level[TT_HPM_MAX_LEVELS];/* clusters textured at each level */
     int fits_per_level[TT_HPM_MAX_LEVELS];  /* fits run at each level */
     int accepted_per_level[TT_HPM_MAX_LEVELS]; /* of those, accepted under the threshold */
-    int fits;                               /* masked correlations run (each over every copy) */
+    int fits;                               /* fits that found a place: accepted + floor + rejected
+                                               (each a masked correlation over every copy) */
     int copies;                             /* turned copies of the image each fit tries */
     int accepted_fits;                      /* fits at or below the threshold */
     int floor_fits;                         /* fits above it, accepted at the floor */
@@ -12146,8 +12147,6 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         *res = xr;
         return -2;
     }
-    S->rep.fits++;
-    S->rep.fits_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
 
     /* The placement of the best offset, refined at full resolution by a
        direct sum over +-(f - 1) texels (D30). */
@@ -12188,6 +12187,8 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         pl->shift[1] += bdy;
         *eps = best / ((double)S->nch * match.mask_sum) / (2 * S->sigma2);
     }
+    S->rep.fits++;
+    S->rep.fits_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
     return 1;
 }
 

@@ -1440,6 +1440,50 @@ done:
     tt_mesh_free(mesh);
 }
 
+/* T12, the budget (D23): a 6144-face torus at a scale where clusters of
+   a few dozen faces are needed, with a threshold almost no fit meets, so
+   every cluster is split down to the floor. The floor stops it there,
+   fitting the clusters at the floor once each: far fewer fits than faces
+   (measured: 58, about 1 per 100 faces; without the floor the splits
+   would go on down to single faces, thousands of fits). */
+static void test_hpm_map_budget(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    tt_hpm_report rep;
+    tt_error err;
+    float *uv = NULL;
+    int *cl = NULL, level, per_level = 0, accepted = 0;
+    memset(&m, 0, sizeof m);
+    hpm_torus(&m, 96, 32, 0.0);
+    if (build(&m, 0, &mesh, &err) != TT_OK) CHECK(0, "building the torus failed: %s", err.message);
+    tm_free(&m);
+    make_value_noise(&im, 128, 128, 6);
+    memset(&o, 0, sizeof o);
+    o.scale = 5;
+    o.rotations = 7;
+    o.threshold = 0.05; /* nearly every fit is rejected: the clusters go down to the floor */
+    if (!mesh || !im || hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    printf("     budget: %d faces, %d clusters, %d fits (%d accepted, %d at the floor, %d rejected)\n", mesh->nfaces,
+           rep.clusters, rep.fits, rep.accepted_fits, rep.floor_fits, rep.rejected_fits);
+    CHECK(rep.fits >= 10 && rep.fits <= mesh->nfaces / 30, "%d fits for %d faces (at most one per 30 faces)",
+          rep.fits, mesh->nfaces);
+    CHECK(rep.fits == rep.accepted_fits + rep.floor_fits + rep.rejected_fits, "every fit is counted once");
+    for (level = 0; level < TT_HPM_MAX_LEVELS; level++) {
+        per_level += rep.fits_per_level[level];
+        accepted += rep.accepted_per_level[level];
+    }
+    CHECK(per_level == rep.fits && accepted == rep.accepted_fits, "fits per level add up (%d, %d)", per_level,
+          accepted);
+done:
+    free(uv);
+    free(cl);
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
 /* T10 and A10: every face textured, no flip, UVs finite (bounded: inside
    the margin) on a torus, a sphere, an open grid, two components and a
    grid with holes, with a non-square, non-power-of-two image; the same seed
@@ -1578,6 +1622,7 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_continuation);
     RUN(test_hpm_map_seams);
     RUN(test_hpm_map_orientation);
+    RUN(test_hpm_map_budget);
     RUN(test_hpm_map_topology);
     RUN(test_hpm_map_errors);
 }
