@@ -2031,8 +2031,8 @@ enum {
                                            starts at angle 0: a neighbour's exact continuation
                                            can then be found (tests) */
     TT_HPM_NO_RELAXATION = 1u << 3      /* no work on the borders after each placement: neither
-                                           the crack closing (D17) nor the relaxation (Sec. 4.4);
-                                           the fits alone */
+                                           the crack closing (D17), the relaxation (Sec. 4.4)
+                                           nor the interior re-solve (D25): the fits alone */
 };
 
 typedef struct tt_hpm_options {
@@ -11409,6 +11409,9 @@ typedef struct tt__hpm {
     double *out;                /* the random-placement control's map, or NULL */
     int *owner;                 /* per face: the textured cluster showing it, or -1 */
     int *in_c, *seen;           /* per face stamps */
+    double *placed;             /* 2 * ncorners: each cluster's rigid placement, before its border work */
+    double *vdisp;              /* 5 * nverts: displacement, its sums, for the interior re-solve */
+    int *vmark;                 /* per vertex: stamp of the cluster it is inside (not on its border) */
     int stamp;
     unsigned char *state;       /* per cluster: 0 new, 1 done, 2 waiting */
     tt__heap_item **queue;
@@ -12555,6 +12558,91 @@ static void tt__hpm_close_cracks(tt__hpm *S, int C, const tt__hpm_place *pl)
     }
 }
 
+/* D25's last step, the interior re-solve: the crack closing and the
+   relaxation moved C's border vertices; carried by the border triangles
+   alone, those moves would stretch them. So the displacement from C's
+   rigid placement is spread into C's interior, each interior vertex
+   taking the mean displacement of its neighbours (TT__HPM_SMOOTH_SWEEPS
+   Jacobi sweeps of the Laplace equation, the border fixed): a few rings
+   absorb the move instead of one. Undone if it would flip or collapse a
+   triangle. */
+#define TT__HPM_SMOOTH_SWEEPS 24
+
+static void tt__hpm_smooth(tt__hpm *S, int C)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    double *d = S->vdisp; /* per vertex: displacement x, y; sums x, y; corners summed */
+    int i, c, k, sweep, inside = ++S->stamp, moved = 0, undo = 0;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) S->vmark[m->corner_vert[c]] = inside;
+    }
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+            size_t v = (size_t)m->corner_vert[c];
+            int e[2];
+            e[0] = c;
+            e[1] = tt_mesh_prev(m, c);
+            /* an edge C does not have on both sides fixes both its ends */
+            for (k = 0; k < 2; k++) {
+                int t = m->twin[e[k]];
+                if (t < 0 || S->owner[m->corner_face[t]] != C) {
+                    S->vmark[m->corner_vert[e[k]]] = -1;
+                    S->vmark[m->corner_vert[tt_mesh_next(m, e[k])]] = -1;
+                }
+            }
+            d[5 * v] = S->uv[2 * c] - S->placed[2 * c];
+            d[5 * v + 1] = S->uv[2 * c + 1] - S->placed[2 * c + 1];
+            moved |= d[5 * v] != 0 || d[5 * v + 1] != 0;
+        }
+    }
+    if (!moved) return;
+    for (sweep = 0; sweep < TT__HPM_SMOOTH_SWEEPS; sweep++)
+        for (k = 0; k < 3; k++)
+            for (i = 0; i < cl->nfaces; i++) {
+                int f = S->H->faces[cl->first_face + i];
+                for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+                    size_t v = (size_t)m->corner_vert[c], a = (size_t)m->corner_vert[tt_mesh_next(m, c)],
+                           b = (size_t)m->corner_vert[tt_mesh_prev(m, c)];
+                    if (S->vmark[v] != inside) continue;
+                    if (k == 0) { /* clear the sums */
+                        d[5 * v + 2] = d[5 * v + 3] = d[5 * v + 4] = 0;
+                    } else if (k == 1) { /* add up the neighbours */
+                        d[5 * v + 2] += d[5 * a] + d[5 * b];
+                        d[5 * v + 3] += d[5 * a + 1] + d[5 * b + 1];
+                        d[5 * v + 4] += 2;
+                    } else { /* their mean */
+                        d[5 * v] = d[5 * v + 2] / d[5 * v + 4];
+                        d[5 * v + 1] = d[5 * v + 3] / d[5 * v + 4];
+                    }
+                }
+            }
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i], first = m->face_start[f];
+        const double *p0 = S->placed + 2 * first, *p1 = p0 + 2, *p2 = p0 + 4;
+        double before = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]), after, st;
+        for (c = first; c < m->face_start[f + 1]; c++) {
+            size_t v = (size_t)m->corner_vert[c];
+            if (S->vmark[v] != inside) continue;
+            S->uv[2 * c] = S->placed[2 * c] + d[5 * v];
+            S->uv[2 * c + 1] = S->placed[2 * c + 1] + d[5 * v + 1];
+        }
+        after = tt__hpm_tri_area(S, first, &st);
+        undo |= !(after * before > 0 && fabs(after) >= 0.25 * fabs(before));
+    }
+    if (undo)
+        for (i = 0; i < cl->nfaces; i++) {
+            int f = S->H->faces[cl->first_face + i];
+            for (c = m->face_start[f]; c < m->face_start[f + 1]; c++)
+                if (S->vmark[m->corner_vert[c]] == inside) {
+                    S->uv[2 * c] = S->placed[2 * c];
+                    S->uv[2 * c + 1] = S->placed[2 * c + 1];
+                }
+        }
+}
+
 /* C is textured by placement pl: write its corners, record it, queue its
    same-level neighbours. */
 static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
@@ -12562,9 +12650,16 @@ static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
     const tt_cluster *cl = &S->H->clusters[C];
     int i;
     tt__hpm_write(S, C, pl, S->uv);
-    for (i = 0; i < cl->nfaces; i++) S->owner[S->H->faces[cl->first_face + i]] = C;
-    if (!(S->flags & TT_HPM_NO_RELAXATION)) tt__hpm_close_cracks(S, C, pl);
-    if (!(S->flags & TT_HPM_NO_RELAXATION) && !tt__hpm_relax(S, C)) return 0;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i], c;
+        S->owner[f] = C;
+        for (c = 2 * S->mesh->face_start[f]; c < 2 * S->mesh->face_start[f + 1]; c++) S->placed[c] = S->uv[c];
+    }
+    if (!(S->flags & TT_HPM_NO_RELAXATION)) {
+        tt__hpm_close_cracks(S, C, pl);
+        if (!tt__hpm_relax(S, C)) return 0;
+        tt__hpm_smooth(S, C);
+    }
     if (S->out) {
         tt__hpm_place rp;
         if (!tt__hpm_random_place(S, &S->place_rng, C, &rp)) rp = *pl;
@@ -12790,6 +12885,9 @@ static void tt__hpm_release(tt__hpm *S)
     tt__free(S->al, S->owner);
     tt__free(S->al, S->in_c);
     tt__free(S->al, S->seen);
+    tt__free(S->al, S->placed);
+    tt__free(S->al, S->vdisp);
+    tt__free(S->al, S->vmark);
     tt__free(S->al, S->state);
     tt__free(S->al, S->waiting);
     tt__free(S->al, S->heap);
@@ -12833,9 +12931,9 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         (o.branching != 0 && (o.branching < 2 || o.branching > 64)))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "hpm options out of range: scale %g (>= 0), threshold %g (>= 0), rotations %d (0..64), "
-                        "max_turn %g (0..180), band %g (0..1e6), match_size %d (a power of two, 16..512), min_footprint %g (>= 0), "
-                        "min_faces %d (>= 0), flags 0x%x, branching %d (0 or 2..64), max_flattening_error %g "
-                        "(>= 0)",
+                        "max_turn %g (0..180), band %g (0..1e6), match_size %d (a power of two, 16..512), "
+                        "min_footprint %g (>= 0), min_faces %d (>= 0), flags 0x%x, branching %d (0 or 2..64), "
+                        "max_flattening_error %g (>= 0)",
                         o.scale, o.threshold, o.rotations, o.max_turn, o.band, match_size, o.min_footprint, o.min_faces,
                         o.flags, o.branching, o.max_flattening_error);
     for (f = 0; f < mesh->nfaces; f++) {
@@ -12914,6 +13012,9 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.owner = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
     S.in_c = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
     S.seen = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
+    S.placed = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
+    S.vdisp = TT__ALLOC(allocator, double, 5 * (size_t)mesh->nverts);
+    S.vmark = TT__ALLOC(allocator, int, (size_t)mesh->nverts);
     S.state = TT__ALLOC(allocator, unsigned char, (size_t)S.H->nclusters);
     S.queue = TT__ALLOC(allocator, tt__heap_item *, (size_t)S.H->nlevels);
     if (S.queue)
@@ -12923,7 +13024,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.heap = TT__ALLOC(allocator, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
     S.near_faces = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
     if (!S.flat || !S.uv || ((o.flags & TT_HPM_RANDOM_PLACEMENT) && !S.out) || !S.owner || !S.in_c || !S.seen ||
-        !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap || !S.near_faces) {
+        !S.placed || !S.vdisp || !S.vmark || !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap ||
+        !S.near_faces) {
         res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
         goto done;
     }
@@ -12931,6 +13033,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         S.owner[f] = -1;
         S.in_c[f] = S.seen[f] = 0;
     }
+    for (i = 0; i < mesh->nverts; i++) S.vmark[i] = 0;
     memset(S.state, 0, (size_t)S.H->nclusters);
     for (i = 0; i < S.H->nlevels; i++) {
         S.queue[i] = NULL;

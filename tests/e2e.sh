@@ -768,6 +768,7 @@ check "hpm --toroidal: coordinates leave [0,1]" "some vt outside [0,1] (the imag
     "$(hpm_obj_report "$W/d$NEWDIR_N/out.obj")" \
     "$(read -r _ _ _ _ _ _ _ outside <<<"$(hpm_obj_report "$W/d$NEWDIR_N/out.obj")"; [ "${outside:-0}" -gt 0 ]; echo $?)"
 hpm_case "torus --no-fit" torus.obj bounded --rotations 3 --seed 2 --no-fit
+hpm_case "torus --max-turn 180" torus.obj bounded --rotations 5 --max-turn 180
 HPM_RANDOM=$W/d$NEWDIR_N
 check "hpm --no-fit: says the clusters were placed at random" "'placed at random'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'placed at random'; echo $?)"
@@ -816,6 +817,8 @@ expect_error "hpm --threshold nan" hpm ../in/torus.obj ../in/lap.png out --thres
 expect_error "hpm --scale -1" hpm ../in/torus.obj ../in/lap.png out --scale -1
 expect_error "hpm --scale 0" hpm ../in/torus.obj ../in/lap.png out --scale 0
 expect_error "hpm --band 0" hpm ../in/torus.obj ../in/lap.png out --band 0
+expect_error "hpm --max-turn 0" hpm ../in/torus.obj ../in/lap.png out --max-turn 0
+expect_error "hpm --max-turn 181" hpm ../in/torus.obj ../in/lap.png out --max-turn 181
 expect_error "hpm --seed abc" hpm ../in/torus.obj ../in/lap.png out --seed abc
 expect_error "hpm zero-area face" hpm ../in/lapped_degenerate.obj ../in/lap.png out
 err_mentions "hpm zero-area face: FILE:LINE and face 1" 'lapped_degenerate\.obj:5: face 1 '
