@@ -767,8 +767,8 @@ hpm_case "torus --toroidal" torus.obj toroidal --rotations 3 --toroidal --scale 
 check "hpm --toroidal: coordinates leave [0,1]" "some vt outside [0,1] (the image repeats)" \
     "$(hpm_obj_report "$W/d$NEWDIR_N/out.obj")" \
     "$(read -r _ _ _ _ _ _ _ outside <<<"$(hpm_obj_report "$W/d$NEWDIR_N/out.obj")"; [ "${outside:-0}" -gt 0 ]; echo $?)"
-hpm_case "torus --no-fit" torus.obj bounded --rotations 3 --seed 2 --no-fit
 hpm_case "torus --max-turn 180" torus.obj bounded --rotations 5 --max-turn 180
+hpm_case "torus --no-fit" torus.obj bounded --rotations 3 --seed 2 --no-fit
 HPM_RANDOM=$W/d$NEWDIR_N
 check "hpm --no-fit: says the clusters were placed at random" "'placed at random'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'placed at random'; echo $?)"
