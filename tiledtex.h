@@ -6926,12 +6926,21 @@ static void tt__face_tangents(const float *const point[4], int dims, int size, d
    (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
    M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
    M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
+/* Eigenvalues big >= small of the symmetric 2x2 matrix [g11 g12; g12 g22]:
+   a map's metric, whose square roots are its singular values. */
+static void tt__metric_eigenvalues(double g11, double g12, double g22, double *big, double *small)
+{
+    double tr = g11 + g22, disc = sqrt((g11 - g22) * (g11 - g22) + 4.0 * g12 * g12);
+    *big = 0.5 * (tr + disc);
+    *small = 0.5 * (tr - disc);
+}
+
 static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
                                        double v_scale, double *big, double *small)
 {
     int first = mesh->face_start[face], size = mesh->face_start[face + 1] - first, k;
     const float *p[4], *q[4];
-    double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0, tr, disc;
+    double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0;
     for (k = 0; k < 4; k++) {
         int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
         p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
@@ -6954,10 +6963,7 @@ static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_
         g12 += m[0][k] * m[1][k];
         g22 += m[1][k] * m[1][k];
     }
-    tr = g11 + g22;
-    disc = sqrt((g11 - g22) * (g11 - g22) + 4.0 * g12 * g12);
-    *big = 0.5 * (tr + disc);
-    *small = 0.5 * (tr - disc);
+    tt__metric_eigenvalues(g11, g12, g22, big, small);
     return 1;
 }
 
@@ -10793,16 +10799,6 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy)
 
 /* ---- Flattening (Sec. 3.2) ---- */
 
-typedef struct tt__flat_key {
-    double value, weight;
-} tt__flat_key;
-
-static int tt__flat_key_compare(const void *a, const void *b)
-{
-    double x = ((const tt__flat_key *)a)->value, y = ((const tt__flat_key *)b)->value;
-    return x < y ? -1 : (x > y ? 1 : 0);
-}
-
 static int tt__int_compare(const void *a, const void *b)
 {
     int x = *(const int *)a, y = *(const int *)b;
@@ -10921,13 +10917,13 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
     int n, k, nv = 0, nb = 0, nunk = 0, nt = 0, i, j, p, first_flip = -1;
     int *lv = NULL, *cv = NULL, *next = NULL, *loop = NULL, *at = NULL, *unk = NULL;
     double *uv = NULL, *w = NULL, *q = NULL, *arc = NULL, *rhs = NULL, *x = NULL, *bxy = NULL;
-    tt__flat_key *keys = NULL;
+    tt__weighted *keys = NULL;
     tt_triplet *trip = NULL;
     tt_sparse_matrix *A = NULL;
     tt_flatten_report rep;
     tt_result res = TT_OK;
     double area_vec[3] = {0, 0, 0}, centre[3] = {0, 0, 0}, cov[3][3], nrm[3], e1[3], e2[3];
-    double surface = 0, mapped = 0, mean_w = 0, total_w = 0, cum;
+    double surface = 0, mapped = 0, mean_w = 0, total_w = 0, p95 = 0.95;
     int nedges = 0;
 
     memset(&rep, 0, sizeof rep);
@@ -10993,7 +10989,7 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
     rhs = TT__ALLOC(allocator, double, 6 * (size_t)n);
     x = TT__ALLOC(allocator, double, 6 * (size_t)n);
     bxy = TT__ALLOC(allocator, double, 6 * (size_t)n);
-    keys = TT__ALLOC(allocator, tt__flat_key, (size_t)n);
+    keys = TT__ALLOC(allocator, tt__weighted, (size_t)n);
     trip = TT__ALLOC(allocator, tt_triplet, 12 * (size_t)n);
     if (!lv || !cv || !next || !loop || !at || !unk || !uv || !w || !q || !arc || !rhs || !x || !bxy || !keys ||
         !trip)
@@ -11292,16 +11288,7 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         keys[i].weight = area3;
         if (keys[i].value > rep.max_stretch) rep.max_stretch = keys[i].value;
     }
-    qsort(keys, (size_t)n, sizeof *keys, tt__flat_key_compare);
-    cum = 0;
-    rep.stretch_p95 = keys[n - 1].value;
-    for (i = 0; i < n; i++) {
-        cum += keys[i].weight;
-        if (cum >= 0.95 * surface) {
-            rep.stretch_p95 = keys[i].value;
-            break;
-        }
-    }
+    tt__weighted_percentiles(keys, n, &p95, 1, &rep.stretch_p95);
     rep.mapped_area = mapped;
     rep.r = mapped > 0 ? surface / mapped : (double)tt__infinity();
     rep.flattening_error = fabs(rep.r - 1);
@@ -12316,7 +12303,7 @@ static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
     int k0 = m->face_start[m->corner_face[c]], i;
     const float *p0 = m->pos + 3 * (size_t)m->corner_vert[k0], *p1 = m->pos + 3 * (size_t)m->corner_vert[k0 + 1],
                 *p2 = m->pos + 3 * (size_t)m->corner_vert[k0 + 2];
-    double e1[3], e2[3], cr[3], len, du[2][2], dq[2][2], det, a[2][2], g11, g12, g22, tr, disc, big, small;
+    double e1[3], e2[3], cr[3], len, du[2][2], dq[2][2], det, a[2][2], big, small;
     tt__sub3f(p1, p0, e1);
     tt__sub3f(p2, p0, e2);
     tt__cross3(e1, e2, cr);
@@ -12331,21 +12318,16 @@ static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
         du[i][1] = S->uv[2 * (k0 + i + 1) + 1] - S->uv[2 * k0 + 1];
     }
     det = dq[0][0] * dq[1][1] - dq[0][1] * dq[1][0];
-    *stretch = 1e300;
+    *stretch = tt__infinity();
     if (det != 0) {
         /* A = dU dQ^-1, columns: dU/dq_x, dU/dq_y */
         for (i = 0; i < 2; i++) {
             a[i][0] = (du[0][i] * dq[1][1] - du[1][i] * dq[0][1]) / det;
             a[i][1] = (du[1][i] * dq[0][0] - du[0][i] * dq[1][0]) / det;
         }
-        g11 = a[0][0] * a[0][0] + a[1][0] * a[1][0];
-        g12 = a[0][0] * a[0][1] + a[1][0] * a[1][1];
-        g22 = a[0][1] * a[0][1] + a[1][1] * a[1][1];
-        tr = g11 + g22;
-        disc = sqrt((g11 - g22) * (g11 - g22) + 4 * g12 * g12);
-        big = 0.5 * (tr + disc);
-        small = 0.5 * (tr - disc);
-        if (small > 1e-30 * big) *stretch = sqrt(big / small);
+        tt__metric_eigenvalues(a[0][0] * a[0][0] + a[1][0] * a[1][0], a[0][0] * a[0][1] + a[1][0] * a[1][1],
+                               a[0][1] * a[0][1] + a[1][1] * a[1][1], &big, &small);
+        *stretch = tt__stretch_ratio(big, small);
     }
     return du[0][0] * du[1][1] - du[0][1] * du[1][0];
 }
