@@ -33,6 +33,23 @@ int tool_unknown_option(const char *arg)
     return tool_usage("unknown option '%s' (see '%s --help')", arg, TOOL_NAME);
 }
 
+int tool_mesh_image_prefix(const char *const *positional, int npositional, const char **mesh, const char **image,
+                           const char **prefix)
+{
+    const char *command = tool_command() ? tool_command() : "CMD";
+    if (npositional > 3) return tool_usage("too many arguments (see '%s %s --help')", TOOL_NAME, command);
+    if (npositional < 3)
+        return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see '%s %s --help')", TOOL_NAME, command);
+    if (strlen(positional[2]) + 16 > 4096) return tool_usage("OUT_PREFIX is too long");
+    if (tool_basename(positional[2])[0] == '\0')
+        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",
+                          positional[2], positional[2]);
+    *mesh = positional[0];
+    *image = positional[1];
+    *prefix = positional[2];
+    return 0;
+}
+
 int tool_option(int argc, char **argv, int *index, const char *name, const char **value)
 {
     const char *arg = argv[*index];

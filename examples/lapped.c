@@ -128,20 +128,15 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             options->isotropic = 1;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
-        } else if (npositional == 3) {
-            return tool_usage("too many arguments (see 'tiledtex lapped --help')");
-        } else {
+        } else if (npositional < 3) {
             positional[npositional++] = argv[i];
+        } else {
+            npositional++; /* counted, to say there are too many */
         }
     }
-    if (npositional != 3) return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see 'tiledtex lapped --help')");
-    options->mesh_path = positional[0];
-    options->image_path = positional[1];
-    options->prefix = positional[2];
-    if (strlen(options->prefix) + 16 > 4096) return tool_usage("OUT_PREFIX is too long");
-    if (tool_basename(options->prefix)[0] == '\0')
-        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",
-                          options->prefix, options->prefix);
+    if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
+                               &options->prefix) != 0)
+        return TOOL_EXIT_USAGE;
     return -1;
 }
 

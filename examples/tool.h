@@ -132,6 +132,12 @@ int tool_is_help(const char *arg);
 int tool_is_option(const char *arg);
 /* Report "unknown option '--foo' (see 'tiledtex CMD --help')"; returns TOOL_EXIT_USAGE. */
 int tool_unknown_option(const char *arg);
+/* The three arguments MESH.obj IMAGE OUT_PREFIX of the commands that read a
+   mesh and an image: checks there are exactly three and that OUT_PREFIX
+   names files (not a directory, not too long), reporting it otherwise
+   (returns TOOL_EXIT_USAGE); 0 with the three set. */
+int tool_mesh_image_prefix(const char *const *positional, int npositional, const char **mesh, const char **image,
+                           const char **prefix);
 
 /* If argv[*index] is `name` ("--size"), consume its value - the next argument,
    or the text after '=' in "--size=800x600" - into *value, advance *index past
