@@ -2013,6 +2013,12 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         is moved by whole periods so its centre lies in [0, 1)^2, the rest
         continues outside (sample with REPEAT). For a bounded image every
         UV lies at least one texel inside the image.
+     6. The borders (Sec. 4.4, D17, D25), after each placement: the cracks
+        against the matched band closed, the border vertices of the cluster
+        and of its neighbours relaxed to lower the colour difference across
+        the border, the interior re-solved. After the traversal, faces on a
+        border may change sides where that lowers the mismatch (the border
+        choice). TT_HPM_NO_RELAXATION leaves all of this out.
    The same mesh, image, options and seed give the same bits. */
 
 #define TT_DEFAULT_HPM_THRESHOLD 0.35   /* eps above which a fit splits the cluster (D4) */
@@ -2071,6 +2077,7 @@ typedef struct tt_hpm_report {
     int floor_fits;                         /* fits above it, accepted at the floor */
     int rejected_fits;                      /* fits above it: the cluster was split */
     int continued;                          /* small clusters continuing a neighbour's map (no fit) */
+    int faces_moved;                        /* faces that changed sides in the border choice */
     int starts;                             /* clusters placed at random (no textured neighbour) */
     int not_flat;                           /* clusters split because they did not flatten */
     int no_room;                            /* clusters split because they did not fit in the image */
@@ -12294,6 +12301,29 @@ static double tt__hpm_edge_mismatch(const tt__hpm *S, int h, double *continuatio
     return TT__HPM_RELAX_ACROSS * across + cont;
 }
 
+/* 1 when texel positions a and b are the same point of the image (on a
+   toroidal image, up to whole periods). */
+static int tt__hpm_same_place(const tt__hpm *S, const double *a, const double *b)
+{
+    double dx = a[0] - b[0], dy = a[1] - b[1];
+    if (S->toroidal) {
+        dx -= S->W * floor(dx / S->W + 0.5);
+        dy -= S->Hh * floor(dy / S->Hh + 0.5);
+    }
+    return fabs(dx) <= 1e-9 * (1 + fabs(a[0])) && fabs(dy) <= 1e-9 * (1 + fabs(a[1]));
+}
+
+/* 1 when half-edge c is a border: both faces textured and the map jumps
+   across it. */
+static int tt__hpm_is_border(const tt__hpm *S, int c)
+{
+    const tt_mesh *m = S->mesh;
+    int t = m->twin[c];
+    if (t < 0 || S->owner[m->corner_face[c]] < 0 || S->owner[m->corner_face[t]] < 0) return 0;
+    return !tt__hpm_same_place(S, S->uv + 2 * c, S->uv + 2 * tt_mesh_next(m, t)) ||
+           !tt__hpm_same_place(S, S->uv + 2 * tt_mesh_next(m, c), S->uv + 2 * t);
+}
+
 /* Twice the signed area of corner c's triangle in texels, and its stretch:
    the ratio of the singular values of its surface -> texture map (what
    the stretch measure reads). */
@@ -12813,6 +12843,161 @@ oom:
 /* Faces that could not be flattened (degenerate single faces): each
    corner takes the texture coordinate a textured face around its vertex
    gives it. */
+/* The border choice, after the traversal: the fits and the relaxation
+   choose where each cluster's map is placed, but the borders themselves
+   stay where the hierarchy cut the mesh, and on a coarse mesh a border
+   edge runs tens of texels straight through the pattern. So, as image
+   quilting chooses its cut and not only its placement (spec section 4,
+   "choose the band edges"), a face on a border may change sides: it shows
+   the map of the neighbouring cluster across one of its edges instead -
+   the neighbour's coordinates at the two shared vertices, the third
+   unfolded isometrically from the surface (or the neighbour's own there,
+   when it has one) - when that lowers the colour mismatch over the face's
+   three edges (the edge it crosses becomes continuous, the others may
+   become borders), without flipping, overstretching or leaving a bounded
+   image. TT__HPM_BORDER_SWEEPS passes over the faces, in index order. The
+   random-placement control gets the same partition, each moved face
+   unfolded into its new cluster's random map, so both show the same
+   clusters. */
+#define TT__HPM_BORDER_SWEEPS 3
+
+/* Face f's three corner positions if it showed the map of the face across
+   its half-edge c (in array uv); 0 when that face is not usable. */
+static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, double out[3][2])
+{
+    const tt_mesh *m = S->mesh;
+    int t = m->twin[c], nc = tt_mesh_next(m, c), pc = tt_mesh_prev(m, c), K, ring[TT__HPM_RING_MAX], n, k;
+    const double *a, *b, *g;
+    double e[2], len, ex[3], ey[3], x, y, l3, cr[3], side;
+    if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0) return 0;
+    a = uv + 2 * tt_mesh_next(m, t); /* at corner_vert[c] */
+    b = uv + 2 * t;                  /* at corner_vert[nc] */
+    g = uv + 2 * tt_mesh_prev(m, t);
+    out[0][0] = a[0];
+    out[0][1] = a[1];
+    out[1][0] = b[0];
+    out[1][1] = b[1];
+    /* the neighbour's own coordinates at the third vertex, when it has some */
+    n = tt__hpm_ring(m, m->corner_vert[pc], ring, TT__HPM_RING_MAX);
+    for (k = 0; k < n; k++)
+        if (m->corner_face[ring[k]] != m->corner_face[c] && S->owner[m->corner_face[ring[k]]] == K) {
+            out[2][0] = uv[2 * ring[k]];
+            out[2][1] = uv[2 * ring[k] + 1];
+            return 1;
+        }
+    /* else unfolded across the edge, on the side away from the neighbour's
+       third corner, at the scale of the neighbour's edge */
+    e[0] = b[0] - a[0];
+    e[1] = b[1] - a[1];
+    len = sqrt(e[0] * e[0] + e[1] * e[1]);
+    tt__sub3f(m->pos + 3 * (size_t)m->corner_vert[nc], m->pos + 3 * (size_t)m->corner_vert[c], ex);
+    tt__sub3f(m->pos + 3 * (size_t)m->corner_vert[pc], m->pos + 3 * (size_t)m->corner_vert[c], ey);
+    l3 = tt__length3(ex);
+    if (!(len > 0) || !(l3 > 0)) return 0;
+    x = tt__dot3(ex, ey) / l3;
+    tt__cross3(ex, ey, cr);
+    y = tt__length3(cr) / l3;
+    side = e[0] * (g[1] - a[1]) - e[1] * (g[0] - a[0]) > 0 ? -1 : 1;
+    x *= len / l3;
+    y *= side * len / l3;
+    out[2][0] = a[0] + (x * e[0] - y * e[1]) / len;
+    out[2][1] = a[1] + (x * e[1] + y * e[0]) / len;
+    return 1;
+}
+
+/* Mismatch over face f's edges to textured faces (0 where continuous). */
+static double tt__hpm_face_mismatch(const tt__hpm *S, int f)
+{
+    const tt_mesh *m = S->mesh;
+    double sum = 0;
+    int c;
+    for (c = m->face_start[f]; c < m->face_start[f + 1]; c++)
+        if (tt__hpm_is_border(S, c)) sum += tt__hpm_edge_mismatch(S, c, NULL);
+    return sum;
+}
+
+static void tt__hpm_choose_borders(tt__hpm *S)
+{
+    const tt_mesh *m = S->mesh;
+    int sweep, f, c, k;
+    for (sweep = 0; sweep < TT__HPM_BORDER_SWEEPS; sweep++) {
+        int changed = 0;
+        for (f = 0; f < m->nfaces; f++) {
+            int first = m->face_start[f], best = -1, C = S->owner[f];
+            double old[3][2], cand[3][2], keep[3][2], before, best_cost, st_old, st, unused;
+            if (C < 0) continue;
+            for (k = 0; k < 3; k++) {
+                old[k][0] = S->uv[2 * (first + k)];
+                old[k][1] = S->uv[2 * (first + k) + 1];
+            }
+            before = tt__hpm_face_mismatch(S, f);
+            if (before <= 0) continue;
+            best_cost = before * 0.95; /* a clear gain, not noise */
+            (void)tt__hpm_tri_area(S, first, &st_old);
+            for (c = first; c < first + 3; c++) {
+                int t = m->twin[c], K, ok = 1, j;
+                double area_n, area_f;
+                if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0 || K == C) continue;
+                if (!tt__hpm_face_as_neighbour(S, S->uv, c, cand)) continue;
+                /* cand is in the order c, next(c), prev(c) */
+                for (j = 0; j < 3; j++) {
+                    int at = first + (c - first + j) % 3;
+                    S->uv[2 * at] = cand[j][0];
+                    S->uv[2 * at + 1] = cand[j][1];
+                    if (!S->toroidal && (cand[j][0] < 1 || cand[j][1] < 1 || cand[j][0] > S->W - 1 ||
+                                         cand[j][1] > S->Hh - 1))
+                        ok = 0;
+                }
+                area_f = tt__hpm_tri_area(S, first, &st);
+                area_n = tt__hpm_tri_area(S, t, &unused);
+                ok = ok && area_f * area_n > 0 && (st <= TT__HPM_RELAX_MAX_STRETCH || st <= st_old);
+                if (ok) {
+                    double cost = tt__hpm_face_mismatch(S, f);
+                    if (cost < best_cost) {
+                        best_cost = cost;
+                        best = c;
+                        for (j = 0; j < 3; j++) {
+                            keep[j][0] = S->uv[2 * (first + j)];
+                            keep[j][1] = S->uv[2 * (first + j) + 1];
+                        }
+                    }
+                }
+                for (k = 0; k < 3; k++) {
+                    S->uv[2 * (first + k)] = old[k][0];
+                    S->uv[2 * (first + k) + 1] = old[k][1];
+                }
+            }
+            if (best < 0) continue;
+            for (k = 0; k < 3; k++) {
+                S->uv[2 * (first + k)] = keep[k][0];
+                S->uv[2 * (first + k) + 1] = keep[k][1];
+            }
+            if (S->out && tt__hpm_face_as_neighbour(S, S->out, best, cand)) {
+                /* the control follows where it can; where the random map
+                   would leave the image or fold, the face keeps its own */
+                const double *g0 = S->out + 2 * m->face_start[m->corner_face[m->twin[best]]];
+                double area_g = (g0[2] - g0[0]) * (g0[5] - g0[1]) - (g0[3] - g0[1]) * (g0[4] - g0[0]);
+                double area_c = (cand[1][0] - cand[0][0]) * (cand[2][1] - cand[0][1]) -
+                                (cand[1][1] - cand[0][1]) * (cand[2][0] - cand[0][0]);
+                int fits = area_g * area_c > 0;
+                for (k = 0; k < 3; k++)
+                    if (!S->toroidal && (cand[k][0] < 1 || cand[k][1] < 1 || cand[k][0] > S->W - 1 ||
+                                         cand[k][1] > S->Hh - 1))
+                        fits = 0;
+                for (k = 0; k < 3 && fits; k++) {
+                    int at = first + (best - first + k) % 3;
+                    S->out[2 * at] = cand[k][0];
+                    S->out[2 * at + 1] = cand[k][1];
+                }
+            }
+            S->owner[f] = S->owner[m->corner_face[m->twin[best]]];
+            S->rep.faces_moved++;
+            changed = 1;
+        }
+        if (!changed) break;
+    }
+}
+
 static void tt__hpm_leftovers(tt__hpm *S, double *uv)
 {
     const tt_mesh *m = S->mesh;
@@ -13027,6 +13212,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     }
     res = tt__hpm_traverse(&S, error);
     if (res != TT_OK) goto done;
+    if (!(o.flags & TT_HPM_NO_RELAXATION)) tt__hpm_choose_borders(&S);
     tt__hpm_leftovers(&S, S.uv);
     if (S.out) tt__hpm_leftovers(&S, S.out);
     {

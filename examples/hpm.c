@@ -269,9 +269,9 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
         printf("%s L%d %d", level == 0 ? "" : ",", level, report->mapped_per_level[level]);
     printf("\n");
     printf("fits: %d accepted, %d at the floor, %d rejected (split); %d continued, %d starts; "
-           "split before fitting: %d not flat, %d no room\n",
+           "split before fitting: %d not flat, %d no room; %d faces changed sides at borders\n",
            report->accepted_fits, report->floor_fits, report->rejected_fits, report->continued, report->starts,
-           report->not_flat, report->no_room);
+           report->not_flat, report->no_room, report->faces_moved);
     if (report->accepted_fits + report->floor_fits > 0)
         printf("fit error: mean %.3f, max %.3f (threshold %g)\n", report->mean_error, report->max_error,
                options->map.threshold > 0 ? options->map.threshold : TT_DEFAULT_HPM_THRESHOLD);
