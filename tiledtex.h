@@ -2184,10 +2184,14 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    Cost. Time O(sum over triangles of the cubes in their bounding boxes)
    for the voxelisation (twice: cubes and corner cells), O(cubes) per
    repair, fill and topology count, with the correction's retries
-   O(components * cubes) at worst. Memory: about 10 bytes per grid cube
-   while building (occupancy, the surface's cubes and cells, a queue),
-   plus 4 bytes per lattice point and the surface mesh; the grid, padding
-   included, is capped at TT_POLYCUBE_MAX_CUBES cubes. */
+   O(components * cubes) at worst (many separate parts whose correction
+   changes the topology). Bunny, flange, elephant (4-6k faces): 2-10 ms at
+   resolution 16-32, 30-45 ms at 64 (-O2). Memory while building: up to
+   about 14 bytes per grid cube (occupancy, the cubes and cells the surface
+   meets, a queue, the correction's copy and labels), 4 bytes per lattice
+   point while extracting, and the result: 1 byte per cube plus the
+   surface mesh. The grid, padding included, is capped at
+   TT_POLYCUBE_MAX_CUBES cubes. */
 
 #define TT_POLYCUBE_DEFAULT_RESOLUTION 16
 #define TT_POLYCUBE_MAX_RESOLUTION 1024       /* cubes along any axis, padding excluded */
@@ -13485,7 +13489,9 @@ static int tt__polycube_mask_critical(int mask, int *spoke_axis, int *side)
 
 /* How near cube `index` is to the model, at the grid's resolution (smaller
    is nearer): the surface meets it, then the number of its face neighbours
-   the surface meets (see the doc comment). */
+   the surface meets (see the doc comment). The repair asks only about
+   cubes next to occupied ones, never in the grid's outer layer, so index
+   +-1 stays in the cube's row. */
 static int tt__polycube_farness(const tt__voxels *vox, int index)
 {
     const int step[3] = {1, vox->dims[0], vox->dims[0] * vox->dims[1]};
