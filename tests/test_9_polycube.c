@@ -524,6 +524,71 @@ static void test_open_and_flat(void)
 }
 
 /* ------------------------------------------------------------------------ */
+/* The correction step (spec P5)                                            */
+/* ------------------------------------------------------------------------ */
+
+static void test_correction(void)
+{
+    tmesh m;
+    tt_polycube_options o;
+    tt_polycube_report with, without, again;
+    tt_result r;
+    tt_polycube *pc, *plain, *pc2;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 24, 3.0, 1.0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 16;
+    pc = polycube_of(&m, &o, &with, &r);
+    pc2 = polycube_of(&m, &o, &again, &r);
+    o.flags = TT_POLYCUBE_NO_CORRECT;
+    plain = polycube_of(&m, &o, &without, &r);
+    if (pc && plain && pc2) {
+        int c, only_plain = 0, only_corrected = 0;
+        for (c = 0; c < pc->dims[0] * pc->dims[1] * pc->dims[2]; c++) {
+            only_plain += plain->occupied[c] && !pc->occupied[c];
+            only_corrected += pc->occupied[c] && !plain->occupied[c];
+        }
+        CHECK(with.removed > 0 && with.correction_reverted == 0 && without.removed == 0,
+              "the correction removes cubes of the torus (%d), the flag skips it", with.removed);
+        CHECK(only_plain > 0 && only_plain <= with.removed && only_corrected <= with.repaired,
+              "it only removes cubes, and adds only the repair's: %d fewer, %d more (removed %d, repaired %d)",
+              only_plain, only_corrected, with.removed, with.repaired);
+        CHECK(with.components == without.components && with.polycube_genus == without.polycube_genus &&
+                  pc_bad_points(pc) == 0,
+              "and keeps the topology (genus %d vs %d) and a manifold S", with.polycube_genus,
+              without.polycube_genus);
+        CHECK(memcmp(pc->occupied, pc2->occupied, (size_t)pc->dims[0] * pc->dims[1] * pc->dims[2]) == 0 &&
+                  pc->surface->nfaces == pc2->surface->nfaces &&
+                  memcmp(pc->surface->corner_vert, pc2->surface->corner_vert,
+                         sizeof(int) * (size_t)pc->surface->ncorners) == 0,
+              "the same input gives the same polycube and surface");
+    }
+    tt_polycube_free(pc);
+    tt_polycube_free(pc2);
+    tt_polycube_free(plain);
+    tm_free(&m);
+
+    {   /* A small triangle in the middle of a single cube (the grid is centred on it): the cells of
+           most of the cube's corners miss it, so the correction would remove the only cube; that
+           changes the topology and is undone. */
+        o.flags = 0;
+        o.resolution = 0;
+        o.cube_size = 1.0;
+        memset(&m, 0, sizeof m);
+        tm_vert(&m, 0.1, 0.1, 0.2);
+        tm_vert(&m, 0.3, 0.1, 0.2);
+        tm_vert(&m, 0.1, 0.3, 0.2);
+        tm_tri(&m, 0, 1, 2);
+        pc = polycube_of(&m, &o, &with, &r);
+        CHECK(pc && with.cubes == 1 && with.removed == 0 && with.correction_reverted == 1 && with.quads == 6,
+              "a correction that would empty the polycube is undone (%d cubes, %d reverted)", with.cubes,
+              with.correction_reverted);
+        tt_polycube_free(pc);
+        tm_free(&m);
+    }
+}
+
+/* ------------------------------------------------------------------------ */
 /* Corner 0: the tile's orientation (spec P9)                               */
 /* ------------------------------------------------------------------------ */
 
@@ -765,6 +830,7 @@ void run_polycube_tests(void)
     RUN(test_contacts);
     RUN(test_torus);
     RUN(test_open_and_flat);
+    RUN(test_correction);
     RUN(test_orientation);
     RUN(test_edge_colors);
     RUN(test_errors);
