@@ -13248,7 +13248,7 @@ typedef struct tt__voxels {
     unsigned char *occupied;    /* per cube: 1 in the polycube */
     unsigned char *hit;         /* per cube: the model's surface meets it */
     unsigned char *cell_hit;    /* per lattice point: the model meets the unit cell centred on it */
-    int *queue;                 /* count entries of scratch (fill, components, correction labels) */
+    int *queue;                 /* count entries of scratch: the fill's and the component search's queue */
     const tt_allocator *allocator;
 } tt__voxels;
 
