@@ -257,6 +257,27 @@ int main(void)
         tt_image_free(patch);
         tt_image_free(source);
     }
+    {
+        /* 9. Polycube + Wang tiles: the unit cube at resolution 2 is a 2 x 2 x 2 block with 24 quads,
+           whose edge colours tt_assign_boundaries accepts. */
+        tt_polycube_options po;
+        tt_polycube_report pr;
+        tt_polycube *pc = NULL;
+        memset(&po, 0, sizeof po);
+        po.resolution = 2;
+        EXPECT(tt_polycube_build(mesh, &po, NULL, &pc, &pr, &err) == TT_OK && pc && pr.cubes == 8 && pr.quads == 24);
+        if (pc) {
+            int edge_colors[96];
+            uint8_t pc_types[96];
+            tt_tile_layout pl;
+            pl.colors = 4;
+            pl.tile_size = 0;
+            pl.gutter = 0;
+            EXPECT(tt_polycube_edge_colors(pc, 4, 1, 9, edge_colors, &err) == TT_OK);
+            EXPECT(tt_assign_boundaries(pc->surface, &pl, 9, edge_colors, pc_types, &err) == TT_OK);
+        }
+        tt_polycube_free(pc);
+    }
     tt_mesh_free(quads);
     tt_mesh_free(mesh);
     {

@@ -315,6 +315,13 @@ void make_value_noise(tt_image **out, int w, int h, unsigned seed)
 /* ------------------------------------------------------------------------ */
 
 void internal_free(const tt_allocator *allocator, void *ptr) { tt__free(allocator, ptr); }
+int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], double h, const int dims[3],
+                               unsigned char *mark)
+{
+    return tt__polycube_voxelize(mesh, origin, h, dims, tt__polycube_tie(mesh, h), mark);
+}
+int internal_polycube_mask_is_disc(int mask) { return tt__polycube_mask_is_disc(mask); }
+int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
 float internal_infinity(void) { return tt__infinity(); }
 double internal_not_a_number(void) { return tt__not_a_number(); }
 double internal_weighted_percentile(const double *values, const double *weights, int count, double fraction)
@@ -380,6 +387,7 @@ int main(void)
     run_tiled_synthesis_tests();
     run_lapped_tests();
     run_hpm_tests();
+    run_polycube_tests();
     printf("%d passed, %d failed\n", g_passed, g_failed);
     return g_failed ? 1 : 0;
 }

@@ -40,6 +40,7 @@ void run_tiled_tests(void);      /* tests/test_6_tiled.c */
 void run_tiled_synthesis_tests(void); /* tests/test_6_tiled_synthesis.c */
 void run_lapped_tests(void);     /* tests/test_7_lapped.c */
 void run_hpm_tests(void);        /* tests/test_8_hpm.c */
+void run_polycube_tests(void);   /* tests/test_9_polycube.c */
 
 /* ------------------------------------------------------------------------ */
 /* Counting and failing allocators                                          */
@@ -164,5 +165,14 @@ tt_result internal_hull_convex(const tt_image *patch, const tt_allocator *alloca
                                int *out_n);
 tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_allocator *allocator, float **out_xy,
                               int *out_count);
+
+/* Section 9's voxeliser (marks boxes of side h at origin + h * (i + 1/2, ...)
+   that the mesh meets under the tie rule; returns the zero-area triangles
+   skipped), its disc predicate and its critical-configuration classifier
+   (0 none, 1 C1, 2 C2, 3 C2's complement) on a mask of 8 cubes. */
+int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], double h, const int dims[3],
+                               unsigned char *mark);
+int internal_polycube_mask_is_disc(int mask);
+int internal_polycube_mask_critical(int mask);
 
 #endif /* TEST_COMMON_H */

@@ -1,0 +1,837 @@
+/* tests/test_9_polycube.c - unit tests for section 9 of tiledtex.h, the
+   polycube of Chang and Lin: voxelisation, fill, repair, correction, the
+   surface S and its Wang colouring. Run by run_polycube_tests()
+   (tests/test_common.c calls it). The spec's tests Q1-Q5 and Q7
+   (specs/polycube.md Sec. 3.3); occupancy is checked against the shapes'
+   own definitions and masks are recomputed from the occupancy array. */
+#include "test_common.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------ */
+/* Shapes                                                                   */
+/* ------------------------------------------------------------------------ */
+
+/* The closed surface of a set of unit cubes: set[i + nx * (j + ny * k)] for
+   cube [i, i+1] x [j, j+1] x [k, k+1] (times scale). One quad per cube face
+   with an empty neighbour, outward CCW, on shared lattice vertices; each
+   quad split into 2 triangles when `triangles`. The set must be
+   well-composed (no edge or vertex contacts) for the result to be a
+   manifold mesh. */
+static void make_cube_set(tmesh *m, const unsigned char *set, int nx, int ny, int nz, double scale, int triangles)
+{
+    int *vid = (int *)malloc(sizeof(int) * (size_t)(nx + 1) * (ny + 1) * (nz + 1));
+    int i, j, k, side, n = (nx + 1) * (ny + 1) * (nz + 1);
+    for (i = 0; i < n; i++) vid[i] = -1;
+    for (k = 0; k < nz; k++)
+        for (j = 0; j < ny; j++)
+            for (i = 0; i < nx; i++) {
+                if (!set[i + nx * (j + ny * k)]) continue;
+                for (side = 0; side < 6; side++) {
+                    int a = side / 2, sign = side % 2 ? -1 : 1, c[3], nb[3], b = (a + 1) % 3, d = (a + 2) % 3;
+                    int corner[4][3], q, v[4];
+                    c[0] = i; c[1] = j; c[2] = k;
+                    nb[0] = i; nb[1] = j; nb[2] = k;
+                    nb[a] += sign;
+                    if (nb[0] >= 0 && nb[1] >= 0 && nb[2] >= 0 && nb[0] < nx && nb[1] < ny && nb[2] < nz &&
+                        set[nb[0] + nx * (nb[1] + ny * nb[2])])
+                        continue;
+                    /* (e_b, e_d, e_a) is right-handed: b -> d turns CCW seen from +a. */
+                    for (q = 0; q < 4; q++) {
+                        int db = (q == 1 || q == 2), dd = (q >= 2);
+                        if (sign < 0) { int t = db; db = dd; dd = t; }
+                        corner[q][a] = c[a] + (sign > 0);
+                        corner[q][b] = c[b] + db;
+                        corner[q][d] = c[d] + dd;
+                    }
+                    for (q = 0; q < 4; q++) {
+                        int id = corner[q][0] + (nx + 1) * (corner[q][1] + (ny + 1) * corner[q][2]);
+                        if (vid[id] < 0)
+                            vid[id] = tm_vert(m, scale * corner[q][0], scale * corner[q][1], scale * corner[q][2]);
+                        v[q] = vid[id];
+                    }
+                    if (triangles) {
+                        tm_tri(m, v[0], v[1], v[2]);
+                        tm_tri(m, v[0], v[2], v[3]);
+                    } else {
+                        tm_quad(m, v[0], v[1], v[2], v[3]);
+                    }
+                }
+            }
+    free(vid);
+}
+
+/* A closed box [lo, hi] of 12 triangles with its own 8 vertices. */
+static void make_box(tmesh *m, const double lo[3], const double hi[3])
+{
+    unsigned char one = 1;
+    tmesh unit;
+    int i;
+    memset(&unit, 0, sizeof unit);
+    make_cube_set(&unit, &one, 1, 1, 1, 1.0, 1);
+    for (i = 0; i < unit.nv; i++)
+        tm_vert(m, unit.pos[3 * i] ? hi[0] : lo[0], unit.pos[3 * i + 1] ? hi[1] : lo[1],
+                unit.pos[3 * i + 2] ? hi[2] : lo[2]);
+    for (i = 0; i < unit.nf; i++)
+        tm_tri(m, m->nv - unit.nv + unit.idx[3 * i], m->nv - unit.nv + unit.idx[3 * i + 1],
+               m->nv - unit.nv + unit.idx[3 * i + 2]);
+    tm_free(&unit);
+}
+
+static tt_polycube *polycube_of(const tmesh *m, const tt_polycube_options *o, tt_polycube_report *rep,
+                                tt_result *result)
+{
+    tt_mesh *mesh = NULL;
+    tt_polycube *pc = NULL;
+    tt_error err;
+    *result = build(m, 0, &mesh, &err);
+    if (*result != TT_OK) {
+        printf("test mesh does not build: %s\n", err.message);
+        return NULL;
+    }
+    *result = tt_polycube_build(mesh, o, NULL, &pc, rep, &err);
+    if (*result != TT_OK) printf("tt_polycube_build: %s\n", err.message);
+    tt_mesh_free(mesh);
+    return pc;
+}
+
+/* The 8-cube mask around lattice point (i, j, k) of pc's occupancy. */
+static int pc_mask(const tt_polycube *pc, int i, int j, int k)
+{
+    int mask = 0, bit;
+    for (bit = 0; bit < 8; bit++) {
+        int x = i - 1 + (bit & 1), y = j - 1 + ((bit >> 1) & 1), z = k - 1 + (bit >> 2);
+        if (x < 0 || y < 0 || z < 0 || x >= pc->dims[0] || y >= pc->dims[1] || z >= pc->dims[2]) continue;
+        if (pc->occupied[x + pc->dims[0] * (y + pc->dims[1] * z)]) mask |= 1 << bit;
+    }
+    return mask;
+}
+
+/* Lattice points whose mask is neither empty, full nor a disc. */
+static int pc_bad_points(const tt_polycube *pc)
+{
+    int i, j, k, bad = 0;
+    for (k = 0; k <= pc->dims[2]; k++)
+        for (j = 0; j <= pc->dims[1]; j++)
+            for (i = 0; i <= pc->dims[0]; i++) {
+                int mask = pc_mask(pc, i, j, k);
+                if (mask != 0 && mask != 255 && !internal_polycube_mask_is_disc(mask)) bad++;
+            }
+    return bad;
+}
+
+/* Does pc's occupancy equal `set` (nx x ny x nz, each set cube `sub` x sub x
+   sub polycube cubes) placed at the padding offset 2? */
+static int pc_equals_set(const tt_polycube *pc, const unsigned char *set, int nx, int ny, int nz, int sub)
+{
+    int i, j, k, wrong = 0;
+    if (pc->dims[0] != nx * sub + 4 || pc->dims[1] != ny * sub + 4 || pc->dims[2] != nz * sub + 4) return 0;
+    for (k = 0; k < pc->dims[2]; k++)
+        for (j = 0; j < pc->dims[1]; j++)
+            for (i = 0; i < pc->dims[0]; i++) {
+                int x = i - 2, y = j - 2, z = k - 2, want = 0;
+                if (x >= 0 && y >= 0 && z >= 0 && x < nx * sub && y < ny * sub && z < nz * sub)
+                    want = set[x / sub + nx * (y / sub + ny * (z / sub))];
+                wrong += pc->occupied[i + pc->dims[0] * (j + pc->dims[1] * k)] != want;
+            }
+    return wrong == 0;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Q5: the configuration table                                              */
+/* ------------------------------------------------------------------------ */
+
+static void test_masks(void)
+{
+    int mask, discs = 0, disagree = 0, by_type[7][9];
+    memset(by_type, 0, sizeof by_type);
+    for (mask = 0; mask < 256; mask++) {
+        int disc = internal_polycube_mask_is_disc(mask), critical = internal_polycube_mask_critical(mask);
+        int pop = 0, facelets = 0, bit, b;
+        for (bit = 0; bit < 8; bit++) pop += (mask >> bit) & 1;
+        for (bit = 0; bit < 8; bit++)
+            for (b = 0; b < 3; b++)
+                if (!((bit >> b) & 1) && ((mask >> bit) & 1) != ((mask >> (bit | 1 << b)) & 1)) facelets++;
+        if (disc) {
+            discs++;
+            by_type[facelets][pop]++;
+        }
+        if (mask != 0 && mask != 255 && disc == (critical != 0)) {
+            if (!disagree) DETAIL("mask 0x%02x: disc %d, critical %d", mask, disc, critical);
+            disagree++;
+        }
+    }
+    CHECK(discs == 126, "masks whose surface is a disc: 126 (spec P6), got %d", discs);
+    CHECK(disagree == 0, "disc <=> no C1/C2 on all non-empty, non-full masks: %d disagree", disagree);
+    CHECK(!internal_polycube_mask_is_disc(0) && !internal_polycube_mask_is_disc(255) &&
+              !internal_polycube_mask_critical(0) && !internal_polycube_mask_critical(255),
+          "empty and full masks have no surface and no critical configuration");
+    CHECK(by_type[3][1] == 8 && by_type[3][7] == 8, "corners: 8 + 8, got %d + %d", by_type[3][1], by_type[3][7]);
+    CHECK(by_type[4][2] == 12 && by_type[4][6] == 12 && by_type[4][4] == 6, "edges 12 + 12, flat 6: %d %d %d",
+          by_type[4][2], by_type[4][6], by_type[4][4]);
+    CHECK(by_type[5][3] == 24 && by_type[5][5] == 24, "L: 24 + 24, got %d + %d", by_type[5][3], by_type[5][5]);
+    CHECK(by_type[6][4] == 32, "tripod 8 + staircase 24 = 32, got %d", by_type[6][4]);
+    CHECK(internal_polycube_mask_critical(0x09) == 1 && internal_polycube_mask_critical(0x81) == 2 &&
+              internal_polycube_mask_critical(0x7e) == 3,
+          "an edge-only pair is C1, an antipodal pair C2, its complement C2's complement");
+}
+
+/* ------------------------------------------------------------------------ */
+/* Q1: voxelisation against an independent computation                     */
+/* ------------------------------------------------------------------------ */
+
+/* Does the triangle t (9 doubles) meet the box [lo, hi]? Sutherland-Hodgman
+   clipping of the triangle against the box's 6 planes: non-empty after all. */
+static int clip_meets_box(const double *t, const double lo[3], const double hi[3])
+{
+    double poly[2][24][3];
+    int count = 3, cur = 0, a, s, i, k;
+    for (i = 0; i < 3; i++)
+        for (k = 0; k < 3; k++) poly[0][i][k] = t[3 * i + k];
+    for (a = 0; a < 3 && count > 0; a++)
+        for (s = 0; s < 2 && count > 0; s++) {
+            int out = 0;
+            for (i = 0; i < count; i++) {
+                const double *p = poly[cur][i], *q = poly[cur][(i + 1) % count];
+                double dp = s ? hi[a] - p[a] : p[a] - lo[a], dq = s ? hi[a] - q[a] : q[a] - lo[a];
+                if (dp >= 0) { memcpy(poly[1 - cur][out++], p, sizeof(double) * 3); }
+                if ((dp >= 0) != (dq >= 0)) {
+                    double tt = dp / (dp - dq);
+                    for (k = 0; k < 3; k++) poly[1 - cur][out][k] = p[k] + tt * (q[k] - p[k]);
+                    out++;
+                }
+            }
+            count = out;
+            cur = 1 - cur;
+        }
+    return count > 0;
+}
+
+/* Voxelise one triangle on a unit grid at the origin; count marked cubes
+   that do not meet the box grown by tol and unmarked ones whose box shrunk
+   by tol it meets. */
+static void voxelize_triangle(const double *t, int n, unsigned char *mark, int *extra, int *missing, int *zero)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    const double origin[3] = {0, 0, 0}, tol = 1e-4;
+    int dims[3], i, j, k;
+    dims[0] = dims[1] = dims[2] = n;
+    memset(&m, 0, sizeof m);
+    for (i = 0; i < 3; i++) tm_vert(&m, t[3 * i], t[3 * i + 1], t[3 * i + 2]);
+    tm_tri(&m, 0, 1, 2);
+    *extra = *missing = 0;
+    memset(mark, 0, (size_t)n * n * n);
+    if (build(&m, TT_MESH_PERMISSIVE, &mesh, &err) != TT_OK) {
+        tm_free(&m);
+        *missing = -1;
+        return;
+    }
+    *zero = internal_polycube_voxelize(mesh, origin, 1.0, dims, mark);
+    for (k = 0; k < n; k++)
+        for (j = 0; j < n; j++)
+            for (i = 0; i < n; i++) {
+                double glo[3], ghi[3], slo[3], shi[3];
+                glo[0] = i - tol; glo[1] = j - tol; glo[2] = k - tol;
+                ghi[0] = i + 1 + tol; ghi[1] = j + 1 + tol; ghi[2] = k + 1 + tol;
+                slo[0] = i + tol; slo[1] = j + tol; slo[2] = k + tol;
+                shi[0] = i + 1 - tol; shi[1] = j + 1 - tol; shi[2] = k + 1 - tol;
+                if (mark[i + n * (j + n * k)]) *extra += !clip_meets_box(t, glo, ghi);
+                else *missing += clip_meets_box(t, slo, shi) && !*zero;
+            }
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+static void test_voxelize(void)
+{
+    const int n = 12;
+    unsigned char *mark = (unsigned char *)malloc(40 * 40 * 40);
+    int trial, extra = 0, missing = 0, zero = 0, unsampled = 0, e, mi, s;
+    double t[9];
+    lcg_seed(91);
+    for (trial = 0; trial < 60; trial++) {
+        for (e = 0; e < 9; e++) t[e] = 1.0 + 10.0 * lcg_unit();
+        if (trial % 3 == 0)   /* a small one, inside a few cubes */
+            for (e = 3; e < 9; e++) t[e] = t[e % 3] + 1.5 * (lcg_unit() - 0.5);
+        voxelize_triangle(t, n, mark, &e, &mi, &zero);
+        extra += e;
+        missing += mi;
+        /* 10^4 samples: the cube of every sample away from the lattice planes is marked */
+        for (s = 0; s < 10000; s++) {
+            double a = lcg_unit(), b = lcg_unit(), p[3];
+            int k, cube[3], near_plane = 0;
+            if (a + b > 1) { a = 1 - a; b = 1 - b; }
+            for (k = 0; k < 3; k++) {
+                p[k] = t[k] + a * (t[3 + k] - t[k]) + b * (t[6 + k] - t[k]);
+                cube[k] = (int)floor(p[k]);
+                near_plane |= fabs(p[k] - floor(p[k] + 0.5)) < 1e-4;
+            }
+            if (!near_plane) unsampled += !mark[cube[0] + n * (cube[1] + n * cube[2])];
+        }
+    }
+    CHECK(extra == 0, "marked cubes all within 1e-4 h of the triangle: %d are not", extra);
+    CHECK(missing == 0, "cubes the triangle enters (by more than 1e-4 h) all marked: %d are not", missing);
+    CHECK(unsampled == 0, "cubes holding a sample point all marked: %d samples in unmarked cubes", unsampled);
+
+    {   /* A triangle in the lattice plane z = 5, normal +z: only the cubes behind it (k = 4). */
+        const double flat[9] = {2.2, 2.3, 5, 8.7, 3.1, 5, 4.4, 9.6, 5};
+        int i, in_front = 0, behind = 0;
+        voxelize_triangle(flat, n, mark, &e, &mi, &zero);
+        for (i = 0; i < n * n * n; i++) {
+            if (!mark[i]) continue;
+            if (i / (n * n) == 4) behind++;
+            else in_front++;
+        }
+        CHECK(behind > 10 && in_front == 0, "a face on a lattice plane claims the layer behind it only (%d, %d)",
+              behind, in_front);
+    }
+    {   /* Touching a lattice edge at one point: the cubes across it stay unmarked. */
+        const double touch[9] = {5, 5, 5.5, 3, 4, 5.2, 4, 3, 5.7};
+        voxelize_triangle(touch, n, mark, &e, &mi, &zero);
+        CHECK(mark[4 + n * (4 + n * 5)] && !mark[5 + n * (5 + n * 5)] && !mark[4 + n * (5 + n * 5)] &&
+                  !mark[5 + n * (4 + n * 5)],
+              "a triangle touching a cube edge at a point claims only its own cube");
+        CHECK(e == 0 && mi == 0, "and agrees with clipping (%d extra, %d missing)", e, mi);
+    }
+    {   /* Zero area: counted, nothing marked. */
+        const double line[9] = {1, 1, 1, 5, 5, 5, 3, 3, 3};
+        int i, marked = 0;
+        voxelize_triangle(line, n, mark, &e, &mi, &zero);
+        for (i = 0; i < n * n * n; i++) marked += mark[i];
+        CHECK(zero == 1 && marked == 0, "a zero-area triangle is skipped and counted (%d, %d marked)", zero, marked);
+    }
+    {   /* Axis-parallel, inside one cube (MathGeoLib#51). */
+        const double inside[9] = {5.2, 5.2, 5.5, 5.8, 5.3, 5.5, 5.4, 5.9, 5.5};
+        int i, marked = 0;
+        voxelize_triangle(inside, n, mark, &e, &mi, &zero);
+        for (i = 0; i < n * n * n; i++) marked += mark[i];
+        CHECK(marked == 1 && mark[5 + n * (5 + n * 5)], "an axis-parallel triangle inside a cube marks it (%d)",
+              marked);
+    }
+    {   /* One triangle over about 1000 cubes. */
+        const double big[9] = {0.5, 0.5, 0.5, 39.3, 1.7, 20.2, 2.1, 38.9, 37.6};
+        int i, marked = 0;
+        voxelize_triangle(big, 40, mark, &e, &mi, &zero);
+        for (i = 0; i < 40 * 40 * 40; i++) marked += mark[i];
+        CHECK(marked > 1000 && e == 0 && mi == 0, "a triangle over %d cubes: %d extra, %d missing", marked, e, mi);
+    }
+    free(mark);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Q2, Q3: cubes and unions of boxes give themselves                         */
+/* ------------------------------------------------------------------------ */
+
+static void test_cube_block(void)
+{
+    unsigned char one = 1;
+    int n, bad = 0, as_quads;
+    for (as_quads = 0; as_quads < 2; as_quads++)
+        for (n = 1; n <= 8; n++) {
+            tmesh m;
+            tt_polycube_options o;
+            tt_polycube_report rep;
+            tt_result r;
+            tt_polycube *pc;
+            unsigned char block[1];
+            memset(&m, 0, sizeof m);
+            make_cube_set(&m, &one, 1, 1, 1, 1.0, !as_quads);
+            memset(&o, 0, sizeof o);
+            o.resolution = n;
+            pc = polycube_of(&m, &o, &rep, &r);
+            block[0] = 1;
+            if (!pc || !pc_equals_set(pc, block, 1, 1, 1, n) || rep.cubes != n * n * n ||
+                rep.quads != 6 * n * n || pc->surface->nfaces != 6 * n * n || rep.components != 1 ||
+                rep.polycube_genus != 0 || rep.mesh_genus != 0 || rep.genus_differs || rep.removed != 0 ||
+                rep.repaired != 0 || rep.resolution != n || !near(rep.cube_size, 1.0 / n, 1e-12)) {
+                if (!bad)
+                    DETAIL("N = %d (%s): result %d, cubes %d, quads %d, removed %d, repaired %d", n,
+                           as_quads ? "quads" : "triangles", r, rep.cubes, rep.quads, rep.removed, rep.repaired);
+                bad++;
+            }
+            tt_polycube_free(pc);
+            tm_free(&m);
+        }
+    CHECK(bad == 0, "the unit cube at N = 1..8 (triangles and quads) is the N^3 block, 6N^2 quads: %d wrong", bad);
+}
+
+static void check_set(const char *name, const unsigned char *set, int nx, int ny, int nz)
+{
+    int sub;
+    for (sub = 1; sub <= 2; sub++) {
+        tmesh m;
+        tt_polycube_options o;
+        tt_polycube_report rep;
+        tt_result r;
+        tt_polycube *pc;
+        int longest = nx > ny ? (nx > nz ? nx : nz) : (ny > nz ? ny : nz);
+        memset(&m, 0, sizeof m);
+        make_cube_set(&m, set, nx, ny, nz, 0.7, 1);
+        memset(&o, 0, sizeof o);
+        o.resolution = longest * sub;
+        pc = polycube_of(&m, &o, &rep, &r);
+        CHECK(pc && pc_equals_set(pc, set, nx, ny, nz, sub), "%s at %d cubes per unit: the polycube is the union",
+              name, sub);
+        if (pc && !pc_equals_set(pc, set, nx, ny, nz, sub))
+            DETAIL("dims %d %d %d, %d cubes, %d filled, %d repaired, %d removed, %d reverted", rep.dims[0],
+                   rep.dims[1], rep.dims[2], rep.cubes, rep.filled, rep.repaired, rep.removed,
+                   rep.correction_reverted);
+        CHECK(pc && pc_bad_points(pc) == 0 && rep.components == 1 && rep.polycube_genus == 0 && !rep.genus_differs,
+              "%s: manifold S, one component, genus 0 (%d components, genus %d)", name, rep.components,
+              rep.polycube_genus);
+        if (pc && sub == 1 && set[0] == 1 && nx == 2 && ny == 2 && nz == 2) {
+            int i, j, k, concave_corner = 0;
+            for (k = 0; k <= pc->dims[2]; k++)
+                for (j = 0; j <= pc->dims[1]; j++)
+                    for (i = 0; i <= pc->dims[0]; i++) concave_corner += pc_mask(pc, i, j, k) == (255 & ~0x80);
+            CHECK(concave_corner == 1, "%s has one concave corner (7 of 8 cubes), got %d", name, concave_corner);
+        }
+        tt_polycube_free(pc);
+        tm_free(&m);
+    }
+}
+
+static void test_unions(void)
+{
+    /* L: 3 x 2 x 1 without cube (2, 1, 0); U: 3 x 2 x 2 without the middle column on top. */
+    const unsigned char L[6] = {1, 1, 1, 1, 1, 0};
+    const unsigned char U[12] = {1, 1, 1, 1, 1, 1, 1, 0, 1, 1, 0, 1};
+    const unsigned char notched[8] = {1, 1, 1, 1, 1, 1, 1, 0};
+    check_set("L-shape", L, 3, 2, 1);
+    check_set("U-shape", U, 3, 2, 2);
+    check_set("cube without one octant", notched, 2, 2, 2);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Q4: contacts along an edge and at a vertex                                */
+/* ------------------------------------------------------------------------ */
+
+static void check_contact(const char *name, const double lo2[3], const double hi2[3], unsigned flags)
+{
+    const double lo1[3] = {0, 0, 0}, hi1[3] = {1, 1, 1};
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_polycube *pc = NULL;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_error err;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    make_box(&m, lo1, hi1);
+    make_box(&m, lo2, hi2);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "%s: two boxes build", name);
+    if (!mesh) { tm_free(&m); return; }
+    {   /* Before repair: the voxels alone hold a critical configuration. */
+        const double origin[3] = {-2, -2, -2};
+        const int dims[3] = {6, 6, 6};
+        unsigned char mark[216];
+        int i, j, k, critical = 0, cubes = 0;
+        memset(mark, 0, sizeof mark);
+        internal_polycube_voxelize(mesh, origin, 1.0, dims, mark);
+        for (i = 0; i < 216; i++) cubes += mark[i];
+        for (k = 1; k < 6; k++)
+            for (j = 1; j < 6; j++)
+                for (i = 1; i < 6; i++) {
+                    int mask = 0, bit;
+                    for (bit = 0; bit < 8; bit++)
+                        mask |= mark[(i - 1 + (bit & 1)) + 6 * ((j - 1 + ((bit >> 1) & 1)) + 6 * (k - 1 + (bit >> 2)))]
+                                << bit;
+                    critical += internal_polycube_mask_critical(mask) != 0;
+                }
+        CHECK(cubes == 2 && critical > 0, "%s: the voxels are the 2 boxes (%d) and the detector finds the contact (%d)",
+              name, cubes, critical);
+    }
+    memset(&o, 0, sizeof o);
+    o.cube_size = 1.0;
+    o.flags = flags;
+    r = tt_polycube_build(mesh, &o, NULL, &pc, &rep, &err);
+    CHECK(r == TT_OK && pc, "%s: the polycube builds, S passes the strict builder (%d: %s)", name, r, err.message);
+    if (pc) {
+        CHECK(pc_bad_points(pc) == 0, "%s: every lattice point is a disc, empty or full after repair", name);
+        CHECK(rep.repaired > 0 && rep.components == 1 && rep.polycube_genus == 0,
+              "%s: repaired %d cubes, one component (%d), genus 0 (%d)", name, rep.repaired, rep.components,
+              rep.polycube_genus);
+        CHECK(rep.mesh_genus == 0 && rep.genus_differs == 0, "%s: two spheres (genus 0) and a sphere agree", name);
+    }
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+static void test_contacts(void)
+{
+    const double edge_lo[3] = {1, 1, 0}, edge_hi[3] = {2, 2, 1};
+    const double vertex_lo[3] = {1, 1, 1}, vertex_hi[3] = {2, 2, 2};
+    check_contact("edge contact", edge_lo, edge_hi, 0);
+    check_contact("vertex contact", vertex_lo, vertex_hi, 0);
+    check_contact("vertex contact, no correction", vertex_lo, vertex_hi, TT_POLYCUBE_NO_CORRECT);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Q7: torus genus; open and flat meshes                                     */
+/* ------------------------------------------------------------------------ */
+
+static void test_torus(void)
+{
+    tmesh m;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_result r;
+    tt_polycube *pc;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 24, 3.0, 1.0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 4;
+    pc = polycube_of(&m, &o, &rep, &r);
+    CHECK(pc && rep.mesh_genus == 1 && rep.polycube_genus == 0 && rep.genus_differs == 1,
+          "torus at resolution 4: the hole closes, genus %d vs %d, warned %d", rep.polycube_genus, rep.mesh_genus,
+          rep.genus_differs);
+    tt_polycube_free(pc);
+    o.resolution = 16;
+    pc = polycube_of(&m, &o, &rep, &r);
+    CHECK(pc && rep.polycube_genus == 1 && rep.components == 1 && rep.genus_differs == 0 && pc_bad_points(pc) == 0,
+          "torus at resolution 16: chi 0 (genus %d), one component (%d), no warning (%d)", rep.polycube_genus,
+          rep.components, rep.genus_differs);
+    CHECK(pc && rep.filled > 0, "the torus's inside is filled (%d cubes)", rep.filled);
+    tt_polycube_free(pc);
+    tm_free(&m);
+}
+
+static void test_open_and_flat(void)
+{
+    tmesh m;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_result r;
+    tt_polycube *pc;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 5, 3);
+    memset(&o, 0, sizeof o);
+    o.resolution = 5;
+    pc = polycube_of(&m, &o, &rep, &r);
+    CHECK(pc && rep.dims[0] == 9 && rep.dims[1] == 7 && rep.dims[2] == 5 && rep.cubes == 15 && rep.filled == 0,
+          "a flat 5 x 3 grid: one layer of 5 x 3 cubes (dims %d %d %d, %d cubes)", rep.dims[0], rep.dims[1],
+          rep.dims[2], rep.cubes);
+    CHECK(pc && rep.mesh_genus == -1 && rep.genus_differs == 0 && rep.polycube_genus == 0,
+          "an open mesh has no genus to compare (%d)", rep.mesh_genus);
+    tt_polycube_free(pc);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The correction step (spec P5)                                            */
+/* ------------------------------------------------------------------------ */
+
+static void test_correction(void)
+{
+    tmesh m;
+    tt_polycube_options o;
+    tt_polycube_report with, without, again;
+    tt_result r;
+    tt_polycube *pc, *plain, *pc2;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 24, 3.0, 1.0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 16;
+    pc = polycube_of(&m, &o, &with, &r);
+    pc2 = polycube_of(&m, &o, &again, &r);
+    o.flags = TT_POLYCUBE_NO_CORRECT;
+    plain = polycube_of(&m, &o, &without, &r);
+    if (pc && plain && pc2) {
+        int c, only_plain = 0, only_corrected = 0;
+        for (c = 0; c < pc->dims[0] * pc->dims[1] * pc->dims[2]; c++) {
+            only_plain += plain->occupied[c] && !pc->occupied[c];
+            only_corrected += pc->occupied[c] && !plain->occupied[c];
+        }
+        CHECK(with.removed > 0 && with.correction_reverted == 0 && without.removed == 0,
+              "the correction removes cubes of the torus (%d), the flag skips it", with.removed);
+        CHECK(only_plain > 0 && only_plain <= with.removed && only_corrected <= with.repaired,
+              "it only removes cubes, and adds only the repair's: %d fewer, %d more (removed %d, repaired %d)",
+              only_plain, only_corrected, with.removed, with.repaired);
+        CHECK(with.components == without.components && with.polycube_genus == without.polycube_genus &&
+                  pc_bad_points(pc) == 0,
+              "and keeps the topology (genus %d vs %d) and a manifold S", with.polycube_genus,
+              without.polycube_genus);
+        CHECK(memcmp(pc->occupied, pc2->occupied, (size_t)pc->dims[0] * pc->dims[1] * pc->dims[2]) == 0 &&
+                  pc->surface->nfaces == pc2->surface->nfaces &&
+                  memcmp(pc->surface->corner_vert, pc2->surface->corner_vert,
+                         sizeof(int) * (size_t)pc->surface->ncorners) == 0,
+              "the same input gives the same polycube and surface");
+    }
+    tt_polycube_free(pc);
+    tt_polycube_free(pc2);
+    tt_polycube_free(plain);
+    tm_free(&m);
+
+    {   /* A small triangle in the middle of a single cube (the grid is centred on it): the cells of
+           most of the cube's corners miss it, so the correction would remove the only cube; that
+           changes the topology and is undone. */
+        o.flags = 0;
+        o.resolution = 0;
+        o.cube_size = 1.0;
+        memset(&m, 0, sizeof m);
+        tm_vert(&m, 0.1, 0.1, 0.2);
+        tm_vert(&m, 0.3, 0.1, 0.2);
+        tm_vert(&m, 0.1, 0.3, 0.2);
+        tm_tri(&m, 0, 1, 2);
+        pc = polycube_of(&m, &o, &with, &r);
+        CHECK(pc && with.cubes == 1 && with.removed == 0 && with.correction_reverted == 1 && with.quads == 6,
+              "a correction that would empty the polycube is undone (%d cubes, %d reverted)", with.cubes,
+              with.correction_reverted);
+        tt_polycube_free(pc);
+        tm_free(&m);
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Corner 0: the tile's orientation (spec P9)                               */
+/* ------------------------------------------------------------------------ */
+
+static void check_orientation(const tt_polycube *pc, int up_axis, int up_sign, const char *name)
+{
+    int f, wrong = 0;
+    const tt_mesh *s = pc->surface;
+    for (f = 0; f < s->nfaces; f++) {
+        const float *p0 = s->pos + 3 * s->corner_vert[4 * f], *p1 = s->pos + 3 * s->corner_vert[4 * f + 1];
+        const float *p3 = s->pos + 3 * s->corner_vert[4 * f + 3];
+        double u[3], v[3], n[3], want_v[3] = {0, 0, 0}, want_n[3] = {0, 0, 0};
+        int a, side = pc->quad_side[f], normal_axis = side / 2, ok = 1;
+        for (a = 0; a < 3; a++) {
+            u[a] = (p1[a] - p0[a]) / pc->h;
+            v[a] = (p3[a] - p0[a]) / pc->h;
+        }
+        n[0] = u[1] * v[2] - u[2] * v[1];
+        n[1] = u[2] * v[0] - u[0] * v[2];
+        n[2] = u[0] * v[1] - u[1] * v[0];
+        want_n[normal_axis] = side % 2 ? -1 : 1;
+        if (normal_axis != up_axis) want_v[up_axis] = up_sign;
+        else want_v[(up_axis + 1) % 3] = -up_sign;
+        for (a = 0; a < 3; a++) ok &= near(v[a], want_v[a], 1e-4) && near(n[a], want_n[a], 1e-4);
+        if (!ok && !wrong) DETAIL("%s: quad %d side %d: v (%g %g %g)", name, f, side, v[0], v[1], v[2]);
+        wrong += !ok;
+    }
+    CHECK(wrong == 0, "%s: every quad's v axis (corner 0 -> 3) follows the up rule, u x v outward: %d wrong", name,
+          wrong);
+}
+
+static void test_orientation(void)
+{
+    const unsigned char L[6] = {1, 1, 1, 1, 1, 0};
+    tmesh m;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_result r;
+    tt_polycube *pc;
+    memset(&m, 0, sizeof m);
+    make_cube_set(&m, L, 3, 2, 1, 1.0, 1);
+    memset(&o, 0, sizeof o);
+    o.resolution = 6;
+    pc = polycube_of(&m, &o, &rep, &r);
+    if (pc) check_orientation(pc, 1, 1, "default up (+Y): sides v = +Y, top and bottom v = -Z");
+    tt_polycube_free(pc);
+    o.up[2] = -0.9;
+    o.up[0] = 0.3;
+    pc = polycube_of(&m, &o, &rep, &r);
+    if (pc) check_orientation(pc, 2, -1, "up (0.3, 0, -0.9): -Z");
+    tt_polycube_free(pc);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The Wang colouring (spec P9)                                             */
+/* ------------------------------------------------------------------------ */
+
+static void test_edge_colors(void)
+{
+    unsigned char one = 1;
+    tmesh m;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_result r;
+    tt_polycube *pc;
+    tt_error err;
+    memset(&m, 0, sizeof m);
+    make_cube_set(&m, &one, 1, 1, 1, 1.0, 1);
+    memset(&o, 0, sizeof o);
+    o.resolution = 4;
+    pc = polycube_of(&m, &o, &rep, &r);
+    if (pc) {
+        const tt_mesh *s = pc->surface;
+        int *colors = (int *)malloc(sizeof(int) * (size_t)s->ncorners);
+        int *again = (int *)malloc(sizeof(int) * (size_t)s->ncorners);
+        uint8_t *types = (uint8_t *)malloc((size_t)s->ncorners);
+        int used[3][4], c, a, k, too_many = 0, twins_differ = 0, all_used = 0;
+        tt_tile_layout layout = {4, 0, 0};
+        CHECK(tt_polycube_edge_colors(pc, 4, 1, 7, colors, &err) == TT_OK, "axis palettes: %s", err.message);
+        memset(used, 0, sizeof used);
+        for (c = 0; c < s->ncorners; c++) {
+            const float *p = s->pos + 3 * s->corner_vert[c], *q = s->pos + 3 * s->corner_vert[tt_mesh_next(s, c)];
+            a = fabs(q[0] - p[0]) > 0 ? 0 : (fabs(q[1] - p[1]) > 0 ? 1 : 2);
+            used[a][colors[c]] = 1;
+            twins_differ += colors[s->twin[c]] != colors[c];
+        }
+        for (a = 0; a < 3; a++) {
+            int n = 0;
+            for (k = 0; k < 4; k++) n += used[a][k];
+            too_many += n != 2;
+        }
+        CHECK(too_many == 0 && twins_differ == 0, "each axis uses exactly its 2 colours (%d axes do not), twins agree (%d)",
+              too_many, twins_differ);
+        CHECK(tt_assign_boundaries(s, &layout, 3, colors, types, &err) == TT_OK,
+              "the colours are valid input for tt_assign_boundaries: %s", err.message);
+        for (c = 0; c < s->ncorners; c++) too_many += types[c] / 2 != colors[c];
+        CHECK(too_many == 0, "tt_assign_boundaries kept the prescribed colours");
+        CHECK(tt_polycube_edge_colors(pc, 4, 1, 7, again, &err) == TT_OK &&
+                  memcmp(colors, again, sizeof(int) * (size_t)s->ncorners) == 0,
+              "same seed, same colours");
+        CHECK(tt_polycube_edge_colors(pc, 4, 0, 7, colors, &err) == TT_OK, "all colours: %s", err.message);
+        memset(used, 0, sizeof used);
+        for (c = 0; c < s->ncorners; c++) used[0][colors[c]] = 1;
+        for (k = 0; k < 4; k++) all_used += used[0][k];
+        CHECK(all_used == 4, "without palettes all 4 colours appear (%d)", all_used);
+        CHECK(tt_polycube_edge_colors(pc, 1, 1, 7, colors, &err) == TT_OK && colors[0] == 0, "one colour");
+        CHECK(tt_polycube_edge_colors(pc, 0, 1, 7, colors, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  tt_polycube_edge_colors(pc, TT_MAX_COLORS + 1, 0, 7, colors, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  tt_polycube_edge_colors(NULL, 2, 0, 7, colors, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  tt_polycube_edge_colors(pc, 2, 0, 7, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+              "colors 0 or above TT_MAX_COLORS, NULL polycube or output: invalid");
+        free(colors);
+        free(again);
+        free(types);
+    }
+    tt_polycube_free(pc);
+    tm_free(&m);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Errors and allocation failures                                           */
+/* ------------------------------------------------------------------------ */
+
+typedef struct pc_oom_ctx {
+    const tt_mesh *mesh;
+    unsigned flags;
+} pc_oom_ctx;
+
+static tt_result pc_oom_call(void *ctx, const tt_allocator *al)
+{
+    pc_oom_ctx *c = (pc_oom_ctx *)ctx;
+    tt_polycube *pc = (tt_polycube *)&pc;
+    tt_polycube_options o;
+    tt_error err;
+    tt_result r;
+    memset(&o, 0, sizeof o);
+    o.cube_size = 0.5;
+    o.flags = c->flags;
+    r = tt_polycube_build(c->mesh, &o, al, &pc, NULL, &err);
+    if (err.result != r || (r != TT_OK) != (pc == NULL)) return TT_RESULT_MAX_ENUM;
+    tt_polycube_free(pc);
+    return r;
+}
+
+static void free_only(void *ptr, void *user_data)
+{
+    (void)ptr;
+    (void)user_data;
+}
+
+static void test_errors(void)
+{
+    const double lo1[3] = {0, 0, 0}, hi1[3] = {1, 1, 1}, lo2[3] = {1, 1, 1}, hi2[3] = {2, 2, 2};
+    tmesh m;
+    tt_mesh *mesh = NULL, empty;
+    tt_polycube *pc = (tt_polycube *)&pc;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_allocator half;
+    tt_error err;
+    tt_result r;
+    pc_oom_ctx ctx;
+    memset(&m, 0, sizeof m);
+    make_box(&m, lo1, hi1);
+    make_box(&m, lo2, hi2);
+    if (build(&m, 0, &mesh, &err) != TT_OK) { tm_free(&m); CHECK(0, "two boxes build"); return; }
+    memset(&o, 0, sizeof o);
+    CHECK(tt_polycube_build(mesh, NULL, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL out");
+    r = tt_polycube_build(NULL, NULL, NULL, &pc, &rep, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && pc == NULL, "NULL mesh: %d", r);
+    memset(&empty, 0, sizeof empty);
+    r = tt_polycube_build(&empty, NULL, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_EMPTY_MESH && pc == NULL, "no faces: %d", r);
+    o.resolution = -1;
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && msg_has_number(err.message, -1), "resolution -1: %d (%s)", r, err.message);
+    o.resolution = TT_POLYCUBE_MAX_RESOLUTION + 1;
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE, "resolution above the limit: %d", r);
+    o.resolution = 0;
+    o.cube_size = internal_not_a_number();
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_NON_FINITE, "cube_size NaN: %d", r);
+    o.cube_size = -1;
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "cube_size -1: %d", r);
+    o.cube_size = 1e-4;
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE && pc == NULL, "a cube size making 20000 cubes per axis: %d (%s)", r, err.message);
+    o.cube_size = 0.005;
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE && pc == NULL, "400^3 cubes, above TT_POLYCUBE_MAX_CUBES: %d (%s)", r, err.message);
+    o.cube_size = 0;
+    o.up[1] = internal_infinity();
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_NON_FINITE, "an infinite up: %d", r);
+    o.up[1] = 0;
+    o.flags = 2;
+    r = tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "unknown flags: %d", r);
+    memset(&half, 0, sizeof half);
+    half.free = free_only;
+    r = tt_polycube_build(mesh, NULL, &half, &pc, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && pc == NULL, "an allocator with free only: %d", r);
+    tt_polycube_free(NULL);
+
+    {   /* Zero area everywhere: degenerate triangles of a permissive mesh. */
+        tmesh line;
+        tt_mesh *flat = NULL;
+        memset(&line, 0, sizeof line);
+        tm_vert(&line, 0, 0, 0);
+        tm_vert(&line, 1, 1, 0);
+        tm_vert(&line, 2, 2, 0);
+        tm_tri(&line, 0, 1, 2);
+        if (build(&line, TT_MESH_PERMISSIVE, &flat, &err) == TT_OK) {
+            r = tt_polycube_build(flat, NULL, NULL, &pc, &rep, &err);
+            CHECK(r == TT_ERROR_ZERO_AREA_FACE && pc == NULL, "a mesh of zero area: %d", r);
+        }
+        tt_mesh_free(flat);
+        tm_free(&line);
+    }
+
+    ctx.mesh = mesh;
+    ctx.flags = 0;
+    oom_reset();
+    oom_sweep("tt_polycube_build(two boxes at a vertex)", pc_oom_call, &ctx, TT_OK);
+    ctx.flags = TT_POLYCUBE_NO_CORRECT;
+    oom_sweep("tt_polycube_build(two boxes at a vertex, no correction)", pc_oom_call, &ctx, TT_OK);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+void run_polycube_tests(void)
+{
+    RUN(test_masks);
+    RUN(test_voxelize);
+    RUN(test_cube_block);
+    RUN(test_unions);
+    RUN(test_contacts);
+    RUN(test_torus);
+    RUN(test_open_and_flat);
+    RUN(test_correction);
+    RUN(test_orientation);
+    RUN(test_edge_colors);
+    RUN(test_errors);
+}
