@@ -821,6 +821,85 @@ static void test_errors(void)
     tm_free(&m);
 }
 
+/* Q12 and B5/B6 on S itself: the polycube's Wang tiling through the
+   tiled-textures machinery. The per-axis colours, tt_assign_boundaries,
+   tt_assign_uvs and tt_synthesize_tiles texture S seamlessly: the seam
+   score over every edge of S is about 0 (at most 0.05), and the same tiles
+   with the quads' coordinates shuffled score at least 0.8 (B6; measured
+   0.86 - with n = 2 a quarter of the shuffled edges still match by type,
+   so it cannot reach 1). The
+   paper's rotation rules (Figs. 3-5) need no code: this is the test that
+   they come out of Akleman's per-side rule on S (spec P9). */
+static void test_wang_tiling(void)
+{
+    tmesh m;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_result r;
+    tt_polycube *pc;
+    tt_error err;
+    tt_image *photo = NULL;
+    tt_tileset *tiles = NULL;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 24, 3.0, 1.0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 10;
+    pc = polycube_of(&m, &o, &rep, &r);
+    make_value_noise(&photo, 160, 256, 9);
+    if (pc && photo) {
+        const tt_mesh *s = pc->surface;
+        int pal, f, k;
+        int *colors = (int *)malloc(sizeof(int) * (size_t)s->ncorners);
+        uint8_t *types = (uint8_t *)malloc((size_t)s->ncorners);
+        float *uv = (float *)malloc(sizeof(float) * 2 * (size_t)s->ncorners);
+        float *shuffled = (float *)malloc(sizeof(float) * 2 * (size_t)s->ncorners);
+        for (pal = 0; pal < 2; pal++) {
+            tt_synth_options so;
+            tt_seam_report fit, control;
+            memset(&so, 0, sizeof so);
+            so.layout.colors = 2;
+            so.layout.tile_size = 32;
+            so.layout.gutter = 4;
+            so.seed = 5;
+            CHECK(tt_polycube_edge_colors(pc, 2, pal, 11, colors, &err) == TT_OK &&
+                      tt_assign_boundaries(s, &so.layout, 11, colors, types, &err) == TT_OK &&
+                      tt_assign_uvs(s, &so.layout, types, uv, &err) == TT_OK,
+                  "the tiling of S (%s)", err.message);
+            if (!tiles) CHECK(tt_synthesize_tiles(photo, &so, NULL, &tiles, &err) == TT_OK, "tiles: %s", err.message);
+            if (!tiles) break;
+            /* a random permutation of the quads' coordinates */
+            {
+                int *perm = (int *)malloc(sizeof(int) * (size_t)s->nfaces);
+                lcg_seed(77);
+                for (f = 0; f < s->nfaces; f++) perm[f] = f;
+                for (f = s->nfaces - 1; f > 0; f--) {
+                    int j = lcg_below(f + 1), t = perm[f];
+                    perm[f] = perm[j];
+                    perm[j] = t;
+                }
+                for (f = 0; f < s->nfaces; f++)
+                    for (k = 0; k < 8; k++) shuffled[8 * f + k] = uv[8 * perm[f] + k];
+                free(perm);
+            }
+            CHECK(tt_measure_seams(s, uv, &tiles->levels[0], NULL, NULL, &fit, &err) == TT_OK &&
+                      tt_measure_seams(s, shuffled, &tiles->levels[0], NULL, NULL, &control, &err) == TT_OK,
+                  "seams measured: %s", err.message);
+            printf("     Wang tiling of S (%d quads, %s): seam score %.3f, shuffled %.3f\n", s->nfaces,
+                   pal ? "per-axis palettes" : "all colours", fit.score, control.score);
+            CHECK(fit.score <= 0.05, "S is seamless (score %g)", fit.score);
+            CHECK(control.score >= 0.8, "shuffled coordinates show seams (score %g)", control.score);
+        }
+        free(colors);
+        free(types);
+        free(uv);
+        free(shuffled);
+    }
+    tt_tileset_free(tiles);
+    tt_image_free(photo);
+    tt_polycube_free(pc);
+    tm_free(&m);
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -833,5 +912,6 @@ void run_polycube_tests(void)
     RUN(test_correction);
     RUN(test_orientation);
     RUN(test_edge_colors);
+    RUN(test_wang_tiling);
     RUN(test_errors);
 }
