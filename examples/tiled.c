@@ -293,6 +293,13 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
                       mesh->input_max_face_size);
         fprintf(stderr, "tiledtex: %s has %s: quadrangulated %d face%s into %d quads\n", obj_path, sizes,
                 mesh->input_faces, mesh->input_faces == 1 ? "" : "s", mesh->quadrangulated);
+        /* Each triangle becomes three kite-shaped quads, each showing a
+           whole tile: on a dense scan the texture comes out a fraction of
+           the part's size, with stars at the vertices, whatever --tile. */
+        if (mesh->input_max_face_size == 3 && mesh->input_faces >= TILED_DENSE_TRIANGLES)
+            fprintf(stderr, "tiledtex: %d triangles make %d tiny tiles with stars at the vertices: for a dense "
+                            "triangle mesh use 'tiledtex hpm' or 'tiledtex lapped', which texture it at the scale "
+                            "you choose\n", mesh->input_faces, mesh->quadrangulated);
     }
 }
 

@@ -24,6 +24,10 @@ enum {
    about 1.5 GB of text). */
 #define TILED_MAX_QUADS (1 << 24)
 
+/* From this many triangles on, a mesh counts as a dense triangle mesh, for
+   which tiled textures are the wrong tool (tiled_print_notes says so). */
+#define TILED_DENSE_TRIANGLES 1000
+
 typedef struct tiled_options {
     tt_tile_layout layout;       /* zeros = the library's defaults */
     int tile_size_given;

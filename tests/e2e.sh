@@ -223,9 +223,14 @@ tile_case() {
 }
 
 tile_case double-torus double-torus.obj 2
+check "tile double-torus (quads): no advice for triangle meshes" "no 'tiledtex hpm' in stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q "tiledtex hpm"; echo $?)"
 tile_case sphere-triangles spheretri.obj 0
 check "tile sphere-triangles: says it quadrangulated" "stderr mentions quadrangulat" "$ERR" \
     "$(printf '%s' "$ERR" | grep -qi quadrangulat; echo $?)"
+check "tile sphere-triangles (1280): points to the tools for dense triangle meshes" \
+    "one line naming 'tiledtex hpm' and 'tiledtex lapped'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -c "tiledtex hpm' or 'tiledtex lapped'" | grep -qx 1; echo $?)"
 tile_case grid grid.obj -
 check "tile grid: one boundary loop" "'1 boundary loop' in summary" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])1 boundary loop'; echo $?)"
