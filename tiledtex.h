@@ -2308,21 +2308,26 @@ typedef struct tt_polycube_projection_report {
     int rays;           /* by a ray along the projection field (P11 step 2, the first choice) */
     int nearest;        /* by the closest point among the facelets facing the vertex's side (the second) */
     int fallbacks;      /* by the plain closest point on S, side ignored (target 0) */
-    int on_surface;     /* already on S (closer than 1e-9 h): mapped to themselves */
+    int on_surface;     /* already on S (closer than 1e-9 h to a facelet facing their side): mapped to themselves */
     double mean_distance, max_distance;   /* |p - q(v)| in units of h */
 } tt_polycube_projection_report;
 
 /* Projection of the model's vertices onto S (Sec. 4; spec P11 step 2): for
    each vertex v of `mesh` (normally the mesh the polycube was built from)
    its point q(v) on S, into points[v] (mesh->nverts entries).
-   Method. The projection field d: at each lattice point of S the sum of
-   the normals of its facelets (the normal on a flat, the diagonal of a
-   fold or a corner), normalised after trilinear interpolation at the
-   vertex; n_v is the vertex's area-weighted normal, and a facelet "faces
-   v's side" when its outward normal n_f has n_f . n_v > 0. In order:
-     - a vertex closer than 1e-9 h to S maps to itself (on a quad's edge or
-       corner: the quad facing v's side best, then the smallest index), so
-       a mesh lying on the lattice keeps its exact positions;
+   Method. n_v is the vertex's area-weighted normal, and a facelet "faces
+   v's side" when its outward normal n_f has n_f . n_v > 0. The projection
+   field d: at each lattice point of S the sum of the normals of its
+   facelets facing v's side (the normal on a flat, the diagonal of a fold
+   or a corner), interpolated trilinearly at the vertex and normalised.
+   The spec sums all facelets; on a filled polycube that is the same but
+   where the two sides of a thin part meet, and on the hollow shell of an
+   open mesh (spec P4) the inner and outer sheets lie within a cube of each
+   other, so their normals cancel and d turns along the surface. In order:
+     - a vertex closer than 1e-9 h to a facelet facing its side maps to
+       itself (on a quad's edge or corner: the quad facing v's side best,
+       then the smallest index), so a mesh lying on the lattice keeps its
+       exact positions;
      - rays from p_v along +d and -d, 3 h long, through the cubes (a 3D
        DDA; S is where the ray passes from an occupied cube to an empty one
        or back): the nearest crossing of a facelet facing v's side. This
@@ -14385,26 +14390,38 @@ typedef struct tt__facelet_hit {
     double agreement;
 } tt__facelet_hit;
 
-/* The projection field at lattice point (i, j, k): the sum of its
-   facelets' outward normals, from the 8-cube mask. The cube of bit b lies
-   below the point along axis a when bit a of b is 0, so its face through
-   the point looks along +a; that face is a facelet when the cube across it
+/* n_f . n_v for a facelet on `side`; a vertex without a normal faces every
+   side (reported as agreement 1). */
+static double tt__polycube_agreement(int side, const double normal[3])
+{
+    if (normal[0] == 0.0 && normal[1] == 0.0 && normal[2] == 0.0) return 1.0;
+    return side % 2 ? -normal[side / 2] : normal[side / 2];
+}
+
+/* The projection field at lattice point (i, j, k) for a vertex with this
+   normal: the sum of the outward normals of the point's facelets that face
+   the vertex's side, from the 8-cube mask. The cube of bit b lies below
+   the point along axis a when bit a of b is 0, so its face through the
+   point looks along +a; that face is a facelet when the cube across it
    (bit a flipped) is empty. */
-static void tt__polycube_field_at(const tt__voxels *grid, int i, int j, int k, double d[3])
+static void tt__polycube_field_at(const tt__voxels *grid, int i, int j, int k, const double normal[3], double d[3])
 {
     int mask = tt__polycube_mask(grid, i, j, k), bit, a;
     d[0] = d[1] = d[2] = 0.0;
     for (bit = 0; bit < 8; bit++) {
         if (!((mask >> bit) & 1)) continue;
-        for (a = 0; a < 3; a++)
-            if (!((mask >> (bit ^ (1 << a))) & 1)) d[a] += (bit >> a) & 1 ? -1.0 : 1.0;
+        for (a = 0; a < 3; a++) {
+            int below = !((bit >> a) & 1);
+            if ((mask >> (bit ^ (1 << a))) & 1) continue;
+            if (tt__polycube_agreement(2 * a + !below, normal) > 0.0) d[a] += below ? 1.0 : -1.0;
+        }
     }
 }
 
 /* The field interpolated trilinearly at g (spec P11 step 1): continuous,
    and exactly the lattice values at lattice points. Zero outside the
    lattice. Not normalised. */
-static void tt__polycube_field(const tt__voxels *grid, const double g[3], double d[3])
+static void tt__polycube_field(const tt__voxels *grid, const double g[3], const double normal[3], double d[3])
 {
     int base[3], corner, a;
     double f[3];
@@ -14419,17 +14436,9 @@ static void tt__polycube_field(const tt__voxels *grid, const double g[3], double
         for (a = 0; a < 3; a++) weight *= (corner >> a) & 1 ? f[a] : 1.0 - f[a];
         if (weight == 0.0) continue;
         tt__polycube_field_at(grid, base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + (corner >> 2),
-                              at);
+                              normal, at);
         for (a = 0; a < 3; a++) d[a] += weight * at[a];
     }
-}
-
-/* n_f . n_v for a facelet on `side`; a vertex without a normal faces every
-   side (reported as agreement 1). */
-static double tt__polycube_agreement(int side, const double normal[3])
-{
-    if (normal[0] == 0.0 && normal[1] == 0.0 && normal[2] == 0.0) return 1.0;
-    return side % 2 ? -normal[side / 2] : normal[side / 2];
 }
 
 /* Is candidate a better than b? Nearer; at equal distance the one facing
@@ -14519,8 +14528,9 @@ static double tt__polycube_facelet_closest(const int cube[3], int side, const do
 
 /* The facelets of the occupied cubes at Chebyshev distance `ring` from cube
    `center` (within the grid) as candidates: into *any (every facelet), into
-   *facing (those facing the vertex's side) and into *touching (those closer
-   than `touch`, best facing first; on a quad's edge or corner several are). */
+   *facing (those facing the vertex's side) and into *touching (those
+   facing its side closer than `touch`, the best facing first: on a quad's
+   edge or corner several are). */
 static void tt__polycube_scan_ring(const tt__voxels *grid, const int center[3], int ring, const double g[3],
                                    const double normal[3], double touch, tt__facelet_hit *any,
                                    tt__facelet_hit *facing, tt__facelet_hit *touching)
@@ -14554,7 +14564,8 @@ static void tt__polycube_scan_ring(const tt__voxels *grid, const int center[3], 
                     candidate.agreement = tt__polycube_agreement(side, normal);
                     if (tt__polycube_better(&candidate, any)) *any = candidate;
                     if (candidate.agreement > 0.0 && tt__polycube_better(&candidate, facing)) *facing = candidate;
-                    if (touching && candidate.distance < touch && tt__polycube_faces_better(&candidate, touching))
+                    if (touching && candidate.distance < touch && candidate.agreement > 0.0 &&
+                    tt__polycube_faces_better(&candidate, touching))
                         *touching = candidate;
                 }
             }
@@ -14755,7 +14766,8 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
         tt__normalize3(normal);
         chosen.found = 0;
         /* On S already: a point within 1e-9 h of a facelet is within 1e-9 h of a lattice plane, and the
-           facelet's cube is at most one ring from g's. */
+           facelet's cube is at most one ring from g's. Only facelets facing v's side count, as for the
+           rays: the rim of an open sheet lying on the side face of its slab goes to the slab's top. */
         if (near_plane) {
             int center[3], ring;
             any.found = facing.found = touching.found = 0;
@@ -14769,7 +14781,7 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
         }
         if (!chosen.found) {
             /* The rays along the field, or along n_v where the field vanishes. */
-            tt__polycube_field(&grid, g, d);
+            tt__polycube_field(&grid, g, normal, d);
             if (tt__normalize3(d) < 1e-6)
                 for (a = 0; a < 3; a++) d[a] = normal[a];
             along.found = against.found = 0;
