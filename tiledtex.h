@@ -135,6 +135,9 @@
                   with tile orientation from an up direction (Sec. 3.1)
                 - the Wang colouring of S's edges per axis group, for the
                   tiled-textures boundary assignment (Sec. 3.2)
+                - the first step of the mapping: each vertex of the model
+                  projected to a point of S, on the side its normal faces
+                  (Sec. 4)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
@@ -2140,7 +2143,11 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         tt_synthesize_tiles makes the tiles: the paper's rotation rules
         (Figs. 3-5) come out of Akleman's per-side rule on any consistently
         oriented quad mesh, which S is (spec P9, P10).
-     3. The mapping of the model onto S (Sec. 4) comes in a later part.
+     3. The mapping of the model onto S (Sec. 4, spec P11), whose first
+        step is tt_polycube_project: each vertex of the model gets its point
+        q(v) = (quad, s, t) on S (P11 step 2). The edge paths on S, the
+        triangle splitting and the UVs (P11 steps 3-7) follow in a later
+        part.
 
    The grid (spec P2). L = the bounding box's longest side; the cube edge is
    h = L / resolution, or options->cube_size. Each axis has
@@ -2289,6 +2296,84 @@ TTDEF void tt_polycube_free(tt_polycube *polycube);
    Allocates nothing; thread-safe. */
 TTDEF tt_result tt_polycube_edge_colors(const tt_polycube *polycube, int colors, int axis_palettes, uint64_t seed,
                                         int *edge_colors, tt_error *error);
+
+/* A point of S: a quad and its coordinates in it. s runs along the quad's
+   corner 0 -> 1 and t along corner 0 -> 3, both in [0, 1]: the tile's u and
+   v (spec P9), so corners 0..3 are (0,0), (1,0), (1,1), (0,1). */
+typedef struct tt_surface_point {
+    int quad;           /* face of polycube->surface */
+    float s, t;
+} tt_surface_point;
+
+/* How tt_polycube_project placed the vertices (every vertex counts in
+   exactly one of the first four). */
+typedef struct tt_polycube_projection_report {
+    int rays;           /* by a ray along the projection field (P11 step 2, the first choice) */
+    int nearest;        /* by the closest point among the facelets facing the vertex's side (the second) */
+    int fallbacks;      /* by the plain closest point on S, side ignored (target 0) */
+    int on_surface;     /* already on S (closer than 1e-9 h to a facelet facing their side): mapped to themselves */
+    double mean_distance, max_distance;   /* |p - q(v)| in units of h */
+} tt_polycube_projection_report;
+
+/* Projection of the model's vertices onto S (Sec. 4; spec P11 step 2): for
+   each vertex v of `mesh` (normally the mesh the polycube was built from)
+   its point q(v) on S, into points[v] (mesh->nverts entries).
+   Method. n_v is the vertex's area-weighted normal, and a facelet "faces
+   v's side" when its outward normal n_f has n_f . n_v > 0. The projection
+   field d: at each lattice point of S the sum of the normals of its
+   facelets facing v's side (the normal on a flat, the diagonal of a fold
+   or a corner), interpolated trilinearly at the vertex and normalised.
+   The spec sums all facelets; on a filled polycube that is the same but
+   where the two sides of a thin part meet, and on the hollow shell of an
+   open mesh (spec P4) the inner and outer sheets lie within a cube of each
+   other, so their normals cancel and d turns along the surface. In order:
+     - a vertex closer than 1e-9 h to a facelet facing its side maps to
+       itself (on a quad's edge or corner: the quad facing v's side best,
+       then the smallest index), so a mesh lying on the lattice keeps its
+       exact positions;
+     - rays from p_v along +d and -d, 3 h long, through the cubes (a 3D
+       DDA; S is where the ray passes from an occupied cube to an empty one
+       or back): the nearest crossing of a facelet facing v's side. This
+       sends the two sides of a thin part to opposite faces of its slab
+       (spec P4, P14) and works on both sides of S, as the correction
+       leaves the model partly outside (P5);
+     - else the closest point of S among the facelets facing v's side, by
+       a search of the cubes in growing shells around p_v, up to
+       TT_POLYCUBE_PROJECT_SIDE_REACH h away;
+     - else the plain closest point of S, counted as a fallback.
+   Where d vanishes (a vertex inside the solid, far from S) the rays go
+   along n_v. A vertex with no area around it (unused, or only on zero-area
+   faces) has no side: every facelet faces it.
+   report may be NULL. Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL
+   polycube, mesh or points, a bad allocator, or a polycube whose quads do
+   not match its cubes (not made by tt_polycube_build, or a surface without
+   quads); TT_ERROR_EMPTY_MESH for a mesh without faces;
+   TT_ERROR_NON_FINITE for a NaN or infinite coordinate (error->vertex says
+   which); TT_ERROR_OUT_OF_MEMORY. On failure the report is zeroed,
+   points is untouched and nothing stays allocated.
+   Same input, same output. Cost: a check of the polycube, O(cubes), then
+   per vertex the cubes its two rays cross (at most 20) or, for the few
+   vertices the rays miss, the cubes of the shells searched ((2 reach +
+   1)^3 = 2197 at most, farther only for a fallback); a ray grazing a
+   lattice plane (a rim lying on one) may miss and go to the shells.
+   Measured at -O2: 2-3 ms for the bunny, flange and elephant (2-3k
+   vertices) at resolution 16-64, 23 ms for the horse (48k) at 16-64.
+   The side rule needs outward normals: on an inside-out closed mesh no
+   facelet near a vertex faces its side, most vertices go to the shells and
+   land on the far side of thin parts (the horse as shipped: 85 % by the
+   shells, 391 fallbacks at 64, 280 ms); flip such a mesh first.
+   Memory: 24 bytes per vertex (the normals) while it runs; S's quads are
+   found by binary search in quad_cube, so no table is built.
+   Thread-safe: reads only its inputs. */
+#define TT_POLYCUBE_PROJECT_SIDE_REACH 6
+TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *mesh, const tt_allocator *allocator,
+                                    tt_surface_point *points, tt_polycube_projection_report *report,
+                                    tt_error *error);
+
+/* The 3D position of a point of S, into xyz.
+   Preconditions (TT_ASSERT): polycube and its surface are not NULL,
+   0 <= p.quad < polycube->surface->nfaces, xyz is not NULL. */
+TTDEF void tt_polycube_point_position(const tt_polycube *polycube, tt_surface_point p, double xyz[3]);
 
 #ifdef __cplusplus
 }
@@ -14405,6 +14490,447 @@ TTDEF tt_result tt_polycube_edge_colors(const tt_polycube *polycube, int colors,
         edge_colors[c] = k;
         if (t >= 0) edge_colors[t] = k;
     }
+    return TT_OK;
+}
+
+/* ---- Projection of the model's vertices onto S (Sec. 4; spec P11 step 2) ----
+   Everything runs in lattice coordinates g = (p - origin) / h, where cube
+   (i, j, k) is [i, i+1] x [j, j+1] x [k, k+1] and distances are in units
+   of h. A facelet is named by its cube's linear index and its side
+   (0..5 = +x, -x, +y, -y, +z, -z); S's quads are stored in that order
+   (tt__polycube_extract), so (cube, side) order is quad index order and a
+   quad is found by binary search in quad_cube: no lookup table to build. */
+
+/* A candidate point of S: on facelet (cube, side), at `point`, `distance`
+   from the vertex, with `agreement` = n_f . n_v. */
+typedef struct tt__facelet_hit {
+    int found;
+    int cube, side;
+    double point[3];
+    double distance;
+    double agreement;
+} tt__facelet_hit;
+
+/* n_f . n_v for a facelet on `side`; a vertex without a normal faces every
+   side (reported as agreement 1). */
+static double tt__polycube_agreement(int side, const double normal[3])
+{
+    if (normal[0] == 0.0 && normal[1] == 0.0 && normal[2] == 0.0) return 1.0;
+    return side % 2 ? -normal[side / 2] : normal[side / 2];
+}
+
+/* The projection field at lattice point (i, j, k) for a vertex with this
+   normal: the sum of the outward normals of the point's facelets that face
+   the vertex's side, from the 8-cube mask. The cube of bit b lies below
+   the point along axis a when bit a of b is 0, so its face through the
+   point looks along +a; that face is a facelet when the cube across it
+   (bit a flipped) is empty. */
+static void tt__polycube_field_at(const tt__voxels *grid, int i, int j, int k, const double normal[3], double d[3])
+{
+    int mask = tt__polycube_mask(grid, i, j, k), bit, a;
+    d[0] = d[1] = d[2] = 0.0;
+    for (bit = 0; bit < 8; bit++) {
+        if (!((mask >> bit) & 1)) continue;
+        for (a = 0; a < 3; a++) {
+            int below = !((bit >> a) & 1);
+            if ((mask >> (bit ^ (1 << a))) & 1) continue;
+            if (tt__polycube_agreement(2 * a + !below, normal) > 0.0) d[a] += below ? 1.0 : -1.0;
+        }
+    }
+}
+
+/* The field for a vertex with this normal, interpolated trilinearly at g
+   (spec P11 step 1): continuous in g, and exactly the lattice values at
+   lattice points. Zero outside the lattice. Not normalised. */
+static void tt__polycube_field(const tt__voxels *grid, const double g[3], const double normal[3], double d[3])
+{
+    int base[3], corner, a;
+    double f[3];
+    d[0] = d[1] = d[2] = 0.0;
+    for (a = 0; a < 3; a++) {
+        if (!(g[a] >= 0.0 && g[a] <= grid->dims[a])) return;
+        base[a] = tt__min_i((int)floor(g[a]), grid->dims[a] - 1);
+        f[a] = g[a] - base[a];
+    }
+    for (corner = 0; corner < 8; corner++) {
+        double weight = 1.0, at[3];
+        for (a = 0; a < 3; a++) weight *= (corner >> a) & 1 ? f[a] : 1.0 - f[a];
+        if (weight == 0.0) continue;
+        tt__polycube_field_at(grid, base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + (corner >> 2),
+                              normal, at);
+        for (a = 0; a < 3; a++) d[a] += weight * at[a];
+    }
+}
+
+/* Is candidate a better than b? Nearer; at equal distance the one facing
+   v's side better; then the smaller (cube, side), i.e. the smaller quad
+   index. */
+static int tt__polycube_better(const tt__facelet_hit *a, const tt__facelet_hit *b)
+{
+    if (!b->found) return 1;
+    if (a->distance != b->distance) return a->distance < b->distance;
+    if (a->agreement != b->agreement) return a->agreement > b->agreement;
+    if (a->cube != b->cube) return a->cube < b->cube;
+    return a->side < b->side;
+}
+
+/* Among facelets that all contain the vertex (on a quad's edge or corner):
+   is a better than b? The one facing v's side better, then the smaller
+   quad index. */
+static int tt__polycube_faces_better(const tt__facelet_hit *a, const tt__facelet_hit *b)
+{
+    if (!b->found) return 1;
+    if (a->agreement != b->agreement) return a->agreement > b->agreement;
+    if (a->cube != b->cube) return a->cube < b->cube;
+    return a->side < b->side;
+}
+
+/* A ray from g along the unit vector dir, at most `limit` long, through the
+   cubes by a 3D DDA (the next lattice plane crossed is the nearest of the
+   three; ties cross the lowest axis first). S is where the ray passes
+   between an occupied cube and an empty one; the facelet belongs to the
+   occupied cube and looks toward the empty one. The first facelet facing
+   the vertex's side goes into *hit. The padding keeps S away from the
+   grid's border, so leaving the grid ends the search. */
+static void tt__polycube_ray(const tt__voxels *grid, const double g[3], const double dir[3], const double normal[3],
+                             double limit, tt__facelet_hit *hit)
+{
+    int cell[3], step[3], a, b;
+    double next[3], delta[3];
+    hit->found = 0;
+    for (a = 0; a < 3; a++) {
+        if (!(g[a] >= 0.0 && g[a] < grid->dims[a])) return;
+        cell[a] = (int)floor(g[a]);
+        step[a] = dir[a] > 0.0 ? 1 : (dir[a] < 0.0 ? -1 : 0);
+        delta[a] = step[a] ? 1.0 / fabs(dir[a]) : HUGE_VAL;
+        next[a] = step[a] > 0 ? (cell[a] + 1 - g[a]) * delta[a] : (step[a] < 0 ? (g[a] - cell[a]) * delta[a] : HUGE_VAL);
+    }
+    for (;;) {
+        int from = cell[0] + grid->dims[0] * (cell[1] + grid->dims[1] * cell[2]), to, cube, side;
+        double t;
+        a = 0;
+        if (next[1] < next[a]) a = 1;
+        if (next[2] < next[a]) a = 2;
+        t = next[a];
+        if (t > limit) return;
+        cell[a] += step[a];
+        if (cell[a] < 0 || cell[a] >= grid->dims[a]) return;
+        to = cell[0] + grid->dims[0] * (cell[1] + grid->dims[1] * cell[2]);
+        next[a] += delta[a];
+        if (grid->occupied[from] == grid->occupied[to]) continue;
+        /* The facelet's normal points from the occupied cube into the empty one. */
+        cube = grid->occupied[from] ? from : to;
+        side = 2 * a + ((grid->occupied[from] ? step[a] : -step[a]) < 0);
+        if (!(tt__polycube_agreement(side, normal) > 0.0)) continue;
+        hit->found = 1;
+        hit->cube = cube;
+        hit->side = side;
+        hit->distance = t;
+        hit->agreement = tt__polycube_agreement(side, normal);
+        for (b = 0; b < 3; b++) hit->point[b] = g[b] + t * dir[b];
+        /* on the lattice plane exactly: the plane between the two cubes */
+        hit->point[a] = step[a] > 0 ? cell[a] : cell[a] + 1;
+        return;
+    }
+}
+
+/* The closest point to g of the face on `side` of cube (x, y, z). */
+static double tt__polycube_facelet_closest(const int cube[3], int side, const double g[3], double point[3])
+{
+    int a;
+    double d[3];
+    for (a = 0; a < 3; a++) {
+        if (a == side / 2) point[a] = cube[a] + (side % 2 ? 0 : 1);
+        else point[a] = g[a] < cube[a] ? cube[a] : (g[a] > cube[a] + 1 ? cube[a] + 1 : g[a]);
+        d[a] = g[a] - point[a];
+    }
+    return tt__length3(d);
+}
+
+/* The facelets of the occupied cubes at Chebyshev distance `ring` from cube
+   `center` (within the grid) as candidates: into *any (every facelet), into
+   *facing (those facing the vertex's side) and into *touching (those
+   facing its side closer than `touch`, the best facing first: on a quad's
+   edge or corner several are). */
+static void tt__polycube_scan_ring(const tt__voxels *grid, const int center[3], int ring, const double g[3],
+                                   const double normal[3], double touch, tt__facelet_hit *any,
+                                   tt__facelet_hit *facing, tt__facelet_hit *touching)
+{
+    int lo[3], hi[3], a, x, y, z, side;
+    for (a = 0; a < 3; a++) {
+        lo[a] = tt__max_i(center[a] - ring, 0);
+        hi[a] = tt__min_i(center[a] + ring, grid->dims[a] - 1);
+    }
+    for (z = lo[2]; z <= hi[2]; z++)
+        for (y = lo[1]; y <= hi[1]; y++) {
+            /* Inside the shell's two faces along z and y only the two ends of each row are on it. */
+            int whole_row = tt__abs_i(z - center[2]) == ring || tt__abs_i(y - center[1]) == ring;
+            int x_step = whole_row || ring == 0 ? 1 : 2 * ring;
+            for (x = whole_row ? lo[0] : center[0] - ring; x <= hi[0]; x += x_step) {
+                int cube[3], index = x + grid->dims[0] * (y + grid->dims[1] * z);
+                if (x < lo[0] || !grid->occupied[index]) continue;
+                cube[0] = x; cube[1] = y; cube[2] = z;
+                for (side = 0; side < 6; side++) {
+                    int neighbour[3];
+                    tt__facelet_hit candidate;
+                    neighbour[0] = x; neighbour[1] = y; neighbour[2] = z;
+                    neighbour[side / 2] += side % 2 ? -1 : 1;
+                    if (neighbour[side / 2] >= 0 && neighbour[side / 2] < grid->dims[side / 2] &&
+                        grid->occupied[neighbour[0] + grid->dims[0] * (neighbour[1] + grid->dims[1] * neighbour[2])])
+                        continue;
+                    candidate.found = 1;
+                    candidate.cube = index;
+                    candidate.side = side;
+                    candidate.distance = tt__polycube_facelet_closest(cube, side, g, candidate.point);
+                    candidate.agreement = tt__polycube_agreement(side, normal);
+                    if (tt__polycube_better(&candidate, any)) *any = candidate;
+                    if (candidate.agreement > 0.0 && tt__polycube_better(&candidate, facing)) *facing = candidate;
+                    if (touching && candidate.distance < touch && candidate.agreement > 0.0 &&
+                    tt__polycube_faces_better(&candidate, touching))
+                        *touching = candidate;
+                }
+            }
+        }
+}
+
+/* The cube nearest to g (g's own cube when inside the grid). */
+static void tt__polycube_center(const tt__voxels *grid, const double g[3], int center[3])
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        double c = floor(g[a]);
+        center[a] = c < 0.0 ? 0 : (c > grid->dims[a] - 1 ? grid->dims[a] - 1 : (int)c);
+    }
+}
+
+/* The closest point of S among the facelets facing the vertex's side, if
+   one lies within `reach`; else the plain closest point (*is_fallback
+   set). Shells of cubes around g's cube, ring by ring: every cube of ring
+   r + 1 is at least r away from g (g lies in the centre cube or, outside
+   the grid, beyond the border the centre cube is on), so a candidate no
+   farther than r is final once ring r is done. */
+static tt__facelet_hit tt__polycube_nearest(const tt__voxels *grid, const double g[3], const double normal[3],
+                                            double reach, int *is_fallback)
+{
+    tt__facelet_hit any, facing;
+    int center[3], ring, last = 0, a;
+    any.found = facing.found = 0;
+    tt__polycube_center(grid, g, center);
+    for (a = 0; a < 3; a++) last = tt__max_i(last, tt__max_i(center[a], grid->dims[a] - 1 - center[a]));
+    *is_fallback = 0;
+    for (ring = 0; ring <= last; ring++) {
+        tt__polycube_scan_ring(grid, center, ring, g, normal, 0.0, &any, &facing, NULL);
+        if (facing.found && facing.distance <= ring && facing.distance <= reach) return facing;
+        if (ring >= reach && any.found && any.distance <= ring) break;
+    }
+    if (facing.found && facing.distance <= reach) return facing;
+    *is_fallback = 1;
+    return any;
+}
+
+/* The quad of facelet (cube, side): S's quads are sorted by cube, then
+   side (checked by tt_polycube_project). -1 if there is none. */
+static int tt__polycube_find_quad(const tt_polycube *pc, int cube, int side)
+{
+    int lo = 0, hi = pc->surface->nfaces;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (pc->quad_cube[mid] < cube || (pc->quad_cube[mid] == cube && pc->quad_side[mid] < side)) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < pc->surface->nfaces && pc->quad_cube[lo] == cube && pc->quad_side[lo] == side ? lo : -1;
+}
+
+/* A quad's corner 0 and its unit axes u (corner 0 -> 1) and v (0 -> 3), in
+   lattice coordinates. */
+static void tt__polycube_quad_frame(const tt_polycube *pc, int quad, int origin[3], int u[3], int v[3])
+{
+    const tt_mesh *s = pc->surface;
+    int corner, k, a, at[3][3];
+    const int order[3] = {0, 1, 3};
+    for (k = 0; k < 3; k++) {
+        int point;
+        corner = s->face_start[quad] + order[k];
+        point = pc->vertex_lattice[s->corner_vert[corner]];
+        at[k][0] = point % (pc->dims[0] + 1);
+        point /= pc->dims[0] + 1;
+        at[k][1] = point % (pc->dims[1] + 1);
+        at[k][2] = point / (pc->dims[1] + 1);
+    }
+    for (a = 0; a < 3; a++) {
+        origin[a] = at[0][a];
+        u[a] = at[1][a] - at[0][a];
+        v[a] = at[2][a] - at[0][a];
+    }
+}
+
+/* The surface point of a candidate. */
+static tt_surface_point tt__polycube_surface_point(const tt_polycube *pc, int quad, const double point[3])
+{
+    tt_surface_point q;
+    int origin[3], u[3], v[3], a;
+    double s = 0.0, t = 0.0;
+    tt__polycube_quad_frame(pc, quad, origin, u, v);
+    for (a = 0; a < 3; a++) {
+        s += (point[a] - origin[a]) * u[a];
+        t += (point[a] - origin[a]) * v[a];
+    }
+    q.quad = quad;
+    q.s = (float)(s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s));
+    q.t = (float)(t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t));
+    return q;
+}
+
+TTDEF void tt_polycube_point_position(const tt_polycube *polycube, tt_surface_point p, double xyz[3])
+{
+    int origin[3], u[3], v[3], a;
+    TT_ASSERT(polycube && polycube->surface && xyz && p.quad >= 0 && p.quad < polycube->surface->nfaces);
+    tt__polycube_quad_frame(polycube, p.quad, origin, u, v);
+    for (a = 0; a < 3; a++)
+        xyz[a] = polycube->origin[a] + polycube->h * (origin[a] + (double)p.s * u[a] + (double)p.t * v[a]);
+}
+
+/* Is the cube across side `side` of cube c empty (or outside the grid)? */
+static int tt__polycube_neighbour_empty(const tt_polycube *pc, int c, int side)
+{
+    int at[3], a = side / 2;
+    at[0] = c % pc->dims[0];
+    at[1] = (c / pc->dims[0]) % pc->dims[1];
+    at[2] = c / (pc->dims[0] * pc->dims[1]);
+    at[a] += side % 2 ? -1 : 1;
+    if (at[a] < 0 || at[a] >= pc->dims[a]) return 1;
+    return !pc->occupied[at[0] + pc->dims[0] * (at[1] + pc->dims[1] * at[2])];
+}
+
+/* Does the polycube hold together: a surface of quads, sorted by (cube,
+   side) without repeats, each on an exposed face of an occupied cube, and
+   as many as there are exposed faces (so every exposed face has its
+   quad)? O(cubes). */
+static int tt__polycube_consistent(const tt_polycube *pc)
+{
+    int q, count, c, side, exposed = 0;
+    if (!pc->surface || !pc->occupied || !pc->quad_cube || !pc->quad_side || !pc->vertex_lattice ||
+        pc->surface->nfaces <= 0 || pc->dims[0] <= 0 || pc->dims[1] <= 0 || pc->dims[2] <= 0 || !(pc->h > 0.0))
+        return 0;
+    count = pc->dims[0] * pc->dims[1] * pc->dims[2];
+    for (c = 0; c < count; c++)
+        for (side = 0; side < 6 && pc->occupied[c]; side++)
+            exposed += tt__polycube_neighbour_empty(pc, c, side);
+    if (exposed != pc->surface->nfaces) return 0;
+    for (q = 0; q < pc->surface->nfaces; q++) {
+        if (pc->quad_cube[q] < 0 || pc->quad_cube[q] >= count || pc->quad_side[q] > 5 ||
+            !pc->occupied[pc->quad_cube[q]] || !tt__polycube_neighbour_empty(pc, pc->quad_cube[q], pc->quad_side[q]) ||
+            pc->surface->face_start[q + 1] - pc->surface->face_start[q] != 4)
+            return 0;
+        if (q > 0 && (pc->quad_cube[q] < pc->quad_cube[q - 1] ||
+                      (pc->quad_cube[q] == pc->quad_cube[q - 1] && pc->quad_side[q] <= pc->quad_side[q - 1])))
+            return 0;
+    }
+    return 1;
+}
+
+TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *mesh, const tt_allocator *allocator,
+                                    tt_surface_point *points, tt_polycube_projection_report *report,
+                                    tt_error *error)
+{
+    /* Spec P11 step 2: the rays' reach, and "on S" */
+    const double ray_reach = 3.0, on_surface = 1e-9;
+    tt_polycube_projection_report local;
+    tt__voxels grid;
+    double *normals, distance_sum = 0.0;
+    int v, f, a;
+    tt__ok(error);
+    if (!report) report = &local;
+    memset(report, 0, sizeof *report);
+    if (!polycube || !mesh || !points)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_project needs a polycube, a mesh and points (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    if (!tt__polycube_consistent(polycube))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the polycube's surface has no quads or does not match its cubes: make it with "
+                        "tt_polycube_build and leave it unchanged");
+    for (v = 0; v < mesh->nverts; v++)
+        for (a = 0; a < 3; a++)
+            if (!tt__is_finite(mesh->pos[3 * v + a]))
+                return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, v, -1, "vertex %d has a coordinate %g", v,
+                                (double)mesh->pos[3 * v + a]);
+    normals = TT__ALLOC(allocator, double, (size_t)mesh->nverts * 3);
+    if (!normals)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory projecting onto the polycube");
+
+    /* n_v: the sum of the Newell vectors (twice the area times the normal) of the faces around v. */
+    memset(normals, 0, sizeof(double) * 3 * (size_t)mesh->nverts);
+    for (f = 0; f < mesh->nfaces; f++) {
+        int begin = mesh->face_start[f], count = mesh->face_start[f + 1] - begin, c;
+        double n[3], scale;
+        tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, count, n, &scale);
+        for (c = begin; c < begin + count; c++)
+            for (a = 0; a < 3; a++) normals[3 * mesh->corner_vert[c] + a] += n[a];
+    }
+
+    memset(&grid, 0, sizeof grid);
+    for (a = 0; a < 3; a++) grid.dims[a] = polycube->dims[a];
+    grid.count = grid.dims[0] * grid.dims[1] * grid.dims[2];
+    grid.occupied = polycube->occupied;
+
+    for (v = 0; v < mesh->nverts; v++) {
+        double g[3], normal[3], d[3], *n = normals + 3 * v, gap[3];
+        tt__facelet_hit chosen, along, against, any, facing, touching;
+        int near_plane = 0, quad;
+        for (a = 0; a < 3; a++) {
+            g[a] = ((double)mesh->pos[3 * v + a] - polycube->origin[a]) / polycube->h;
+            near_plane |= fabs(g[a] - floor(g[a] + 0.5)) < on_surface;
+            normal[a] = n[a];
+        }
+        tt__normalize3(normal);
+        chosen.found = 0;
+        /* On S already: a point within 1e-9 h of a facelet is within 1e-9 h of a lattice plane, and the
+           facelet's cube is at most one ring from g's. Only facelets facing v's side count, as for the
+           rays: the rim of an open sheet lying on the side face of its slab goes to the slab's top. */
+        if (near_plane) {
+            int center[3], ring;
+            any.found = facing.found = touching.found = 0;
+            tt__polycube_center(&grid, g, center);
+            for (ring = 0; ring <= 1; ring++)
+                tt__polycube_scan_ring(&grid, center, ring, g, normal, on_surface, &any, &facing, &touching);
+            if (touching.found) {
+                chosen = touching;
+                report->on_surface++;
+            }
+        }
+        if (!chosen.found) {
+            /* The rays along the field, or along n_v where the field vanishes. */
+            tt__polycube_field(&grid, g, normal, d);
+            if (tt__normalize3(d) < 1e-6)
+                for (a = 0; a < 3; a++) d[a] = normal[a];
+            along.found = against.found = 0;
+            if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) {
+                tt__polycube_ray(&grid, g, d, normal, ray_reach, &along);
+                for (a = 0; a < 3; a++) d[a] = -d[a];
+                tt__polycube_ray(&grid, g, d, normal, ray_reach, &against);
+            }
+            if (along.found && (!against.found || along.distance <= against.distance)) chosen = along;
+            else if (against.found) chosen = against;
+            if (chosen.found) report->rays++;
+        }
+        if (!chosen.found) {
+            int is_fallback;
+            chosen = tt__polycube_nearest(&grid, g, normal, TT_POLYCUBE_PROJECT_SIDE_REACH, &is_fallback);
+            if (is_fallback) report->fallbacks++;
+            else report->nearest++;
+        }
+        quad = tt__polycube_find_quad(polycube, chosen.cube, chosen.side);
+        TT_ASSERT(quad >= 0);   /* tt__polycube_consistent: every exposed face has its quad */
+        points[v] = tt__polycube_surface_point(polycube, quad, chosen.point);
+        for (a = 0; a < 3; a++) gap[a] = g[a] - chosen.point[a];
+        chosen.distance = tt__length3(gap);
+        distance_sum += chosen.distance;
+        if (chosen.distance > report->max_distance) report->max_distance = chosen.distance;
+    }
+    report->mean_distance = mesh->nverts > 0 ? distance_sum / mesh->nverts : 0.0;
+    tt__free(allocator, normals);
     return TT_OK;
 }
 

@@ -65,6 +65,9 @@ int main(void)
     int rx, ry;
     tt_image empty, one;
     float one_texel[4] = {0.25f, 0.5f, 0.75f, 1.0f};
+    tt_polycube *polycube = NULL;
+    tt_surface_point point;
+    double xyz[3];
 
     memset(&desc, 0, sizeof desc);
     desc.positions = pos;
@@ -83,6 +86,13 @@ int main(void)
     memset(&one, 0, sizeof one);
     one.width = one.height = 1;
     one.pixels = one_texel;
+    if (tt_polycube_build(mesh, NULL, NULL, &polycube, NULL, NULL) != TT_OK) {
+        printf("assert_check: the quad's polycube does not build\n");
+        tt_mesh_free(mesh);
+        return 1;
+    }
+    memset(&point, 0, sizeof point);
+    (void)point; (void)xyz;
     (void)one; (void)normal; (void)uv; (void)rgba; (void)xy; (void)bytes; (void)rx; (void)ry; (void)types; (void)big_types;
 
 #ifdef ASSERT_CHECK_NDEBUG
@@ -125,7 +135,14 @@ int main(void)
     EXPECT_ASSERT("tt_rng_next(NULL)", tt_rng_next(NULL));
     EXPECT_ASSERT("tt_raster_triangle(NULL xy)", tt_raster_triangle(NULL, 8, 8, on_pixel, NULL));
     EXPECT_ASSERT("tt_raster_triangle(NULL fn)", tt_raster_triangle(xy, 8, 8, NULL, NULL));
+    EXPECT_ASSERT("tt_polycube_point_position(NULL polycube)", tt_polycube_point_position(NULL, point, xyz));
+    EXPECT_ASSERT("tt_polycube_point_position(NULL xyz)", tt_polycube_point_position(polycube, point, NULL));
+    point.quad = -1;
+    EXPECT_ASSERT("tt_polycube_point_position(quad -1)", tt_polycube_point_position(polycube, point, xyz));
+    point.quad = polycube->surface->nfaces;
+    EXPECT_ASSERT("tt_polycube_point_position(quad nfaces)", tt_polycube_point_position(polycube, point, xyz));
 #endif
+    tt_polycube_free(polycube);
     tt_mesh_free(mesh);
     if (failures == 0) printf("assert_check: ok\n");
     return failures ? 1 : 0;

@@ -276,6 +276,20 @@ int main(void)
             EXPECT(tt_polycube_edge_colors(pc, 4, 1, 9, edge_colors, &err) == TT_OK);
             EXPECT(tt_assign_boundaries(pc->surface, &pl, 9, edge_colors, pc_types, &err) == TT_OK);
         }
+        if (pc) {
+            /* The cube's 8 corners lie on S: each maps to itself. */
+            tt_surface_point points[8];
+            tt_polycube_projection_report ppr;
+            double at[3];
+            EXPECT(mesh->nverts == 8);
+            EXPECT(tt_polycube_project(pc, mesh, NULL, points, &ppr, &err) == TT_OK && ppr.on_surface == 8 &&
+                   ppr.fallbacks == 0);
+            tt_polycube_point_position(pc, points[0], at);
+            at[0] -= mesh->pos[0];
+            at[1] -= mesh->pos[1];
+            at[2] -= mesh->pos[2];
+            EXPECT(at[0] * at[0] + at[1] * at[1] + at[2] * at[2] < 1e-12);
+        }
         tt_polycube_free(pc);
     }
     tt_mesh_free(quads);

@@ -900,6 +900,385 @@ static void test_wang_tiling(void)
     tm_free(&m);
 }
 
+/* ------------------------------------------------------------------------ */
+/* The vertices' points on S (spec P11 step 2)                              */
+/* ------------------------------------------------------------------------ */
+
+/* A latitude-longitude sphere of triangles (closed: one vertex per pole),
+   outward CCW; with `hemisphere` only the upper half (z >= 0), open at
+   the equator. */
+static void make_sphere(tmesh *m, int slices, int stacks, double r, const double c[3], int hemisphere)
+{
+    int i, j, first = m->nv, top, rings = hemisphere ? stacks / 2 : stacks - 1, bottom = -1;
+    top = tm_vert(m, c[0], c[1], c[2] + r);
+    for (j = 1; j <= rings; j++) {
+        double theta = 3.14159265358979323846 * j / stacks;
+        for (i = 0; i < slices; i++) {
+            double phi = 2.0 * 3.14159265358979323846 * i / slices;
+            tm_vert(m, c[0] + r * sin(theta) * cos(phi), c[1] + r * sin(theta) * sin(phi), c[2] + r * cos(theta));
+        }
+    }
+    if (!hemisphere) bottom = tm_vert(m, c[0], c[1], c[2] - r);
+    for (i = 0; i < slices; i++) {
+        int a = first + 1 + i, b = first + 1 + (i + 1) % slices;
+        tm_tri(m, top, a, b);
+        for (j = 1; j < rings; j++) {
+            int a2 = a + slices, b2 = b + slices;
+            tm_tri(m, a, a2, b2);
+            tm_tri(m, a, b2, b);
+            a = a2;
+            b = b2;
+        }
+        if (bottom >= 0) tm_tri(m, a, bottom, b);
+    }
+}
+
+/* The area-weighted normal of every vertex (unnormalised; malloc). */
+static double *vertex_normals(const tt_mesh *mesh)
+{
+    double *n = (double *)calloc((size_t)mesh->nverts * 3, sizeof(double));
+    int f;
+    for (f = 0; f < mesh->nfaces; f++) {
+        float fn[3];
+        const float *p0 = mesh->pos + 3 * mesh->corner_vert[mesh->face_start[f]];
+        const float *p1 = mesh->pos + 3 * mesh->corner_vert[mesh->face_start[f] + 1];
+        const float *p2 = mesh->pos + 3 * mesh->corner_vert[mesh->face_start[f] + 2];
+        double e1[3], e2[3], area, c[3];
+        int k, a;
+        for (a = 0; a < 3; a++) {
+            e1[a] = p1[a] - p0[a];
+            e2[a] = p2[a] - p0[a];
+        }
+        c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        area = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);   /* triangles only */
+        tt_face_normal(mesh, f, fn);
+        for (k = mesh->face_start[f]; k < mesh->face_start[f + 1]; k++)
+            for (a = 0; a < 3; a++) n[3 * mesh->corner_vert[k] + a] += area * fn[a];
+    }
+    return n;
+}
+
+/* n_f . n for the quad of point p. */
+static double quad_agreement(const tt_polycube *pc, tt_surface_point p, const double *n)
+{
+    int side = pc->quad_side[p.quad];
+    return side % 2 ? -n[side / 2] : n[side / 2];
+}
+
+/* What a projection looks like: the points valid, s and t in [0, 1], the
+   distance from p to q (by tt_polycube_point_position) in units of h, and
+   the vertices whose quad does not face their side. */
+typedef struct projection_check {
+    int bad_points, disagreeing;
+    double max_distance;
+} projection_check;
+
+static projection_check check_projection(const tt_polycube *pc, const tt_mesh *mesh, const tt_surface_point *pts)
+{
+    projection_check c;
+    double *n = vertex_normals(mesh);
+    int v, a;
+    memset(&c, 0, sizeof c);
+    for (v = 0; v < mesh->nverts; v++) {
+        double x[3], d = 0;
+        if (pts[v].quad < 0 || pts[v].quad >= pc->surface->nfaces || !(pts[v].s >= 0 && pts[v].s <= 1) ||
+            !(pts[v].t >= 0 && pts[v].t <= 1)) {
+            c.bad_points++;
+            continue;
+        }
+        tt_polycube_point_position(pc, pts[v], x);
+        for (a = 0; a < 3; a++) d += (x[a] - mesh->pos[3 * v + a]) * (x[a] - mesh->pos[3 * v + a]);
+        d = sqrt(d) / pc->h;
+        if (d > c.max_distance) c.max_distance = d;
+        c.disagreeing += !(quad_agreement(pc, pts[v], n + 3 * v) > 0);
+    }
+    free(n);
+    return c;
+}
+
+/* Build the polycube of m and project m's vertices onto it; NULL (and a
+   failed CHECK) when something fails. *mesh_out and *pts_out to free. */
+static tt_polycube *projected(const tmesh *m, const tt_polycube_options *o, tt_mesh **mesh_out,
+                              tt_surface_point **pts_out, tt_polycube_projection_report *pr, tt_polycube_report *rep)
+{
+    tt_error err;
+    tt_polycube *pc = NULL;
+    tt_result r;
+    *mesh_out = NULL;
+    *pts_out = NULL;
+    if (build(m, 0, mesh_out, &err) != TT_OK) {
+        CHECK(0, "test mesh builds: %s", err.message);
+        return NULL;
+    }
+    r = tt_polycube_build(*mesh_out, o, NULL, &pc, rep, &err);
+    if (r != TT_OK) {
+        CHECK(0, "tt_polycube_build: %s", err.message);
+        return NULL;
+    }
+    *pts_out = (tt_surface_point *)malloc(sizeof(tt_surface_point) * (size_t)(*mesh_out)->nverts);
+    r = tt_polycube_project(pc, *mesh_out, NULL, *pts_out, pr, &err);
+    if (r != TT_OK) {
+        CHECK(0, "tt_polycube_project: %s", err.message);
+        tt_polycube_free(pc);
+        return NULL;
+    }
+    return pc;
+}
+
+static void test_project_cube(void)
+{
+    unsigned char one = 1;
+    int n, bad = 0;
+    for (n = 1; n <= 8; n++) {
+        tmesh m;
+        tt_mesh *mesh;
+        tt_surface_point *pts;
+        tt_polycube_options o;
+        tt_polycube_projection_report pr;
+        tt_polycube_report rep;
+        tt_polycube *pc;
+        projection_check c;
+        memset(&m, 0, sizeof m);
+        make_cube_set(&m, &one, 1, 1, 1, 1.0, 1);
+        memset(&o, 0, sizeof o);
+        o.resolution = n;
+        pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+        if (pc) {
+            c = check_projection(pc, mesh, pts);
+            if (pr.on_surface != mesh->nverts || c.bad_points || c.max_distance > 1e-9 || pr.max_distance > 1e-9 ||
+                c.disagreeing) {
+                if (!bad)
+                    DETAIL("N = %d: on S %d of %d, bad %d, distance %g (report %g), facing the other way %d", n,
+                           pr.on_surface, mesh->nverts, c.bad_points, c.max_distance, pr.max_distance, c.disagreeing);
+                bad++;
+            }
+        } else {
+            bad++;
+        }
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        free(pts);
+        tm_free(&m);
+    }
+    CHECK(bad == 0, "the cube mesh at N = 1..8: every vertex on S, mapped to itself within 1e-9 h: %d wrong", bad);
+}
+
+static void test_project_sphere(void)
+{
+    const double center[3] = {0.13, -0.07, 0.21};
+    int k;
+    for (k = 0; k < 2; k++) {
+        int res = k ? 16 : 8, in_empty = 0, v;
+        tmesh m;
+        tt_mesh *mesh;
+        tt_surface_point *pts;
+        tt_polycube_options o;
+        tt_polycube_projection_report pr;
+        tt_polycube_report rep;
+        tt_polycube *pc;
+        projection_check c;
+        memset(&m, 0, sizeof m);
+        make_sphere(&m, 48, 24, 1.0, center, 0);
+        memset(&o, 0, sizeof o);
+        o.resolution = res;
+        pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+        if (!pc) { tm_free(&m); continue; }
+        c = check_projection(pc, mesh, pts);
+        for (v = 0; v < mesh->nverts; v++) {
+            int x = (int)floor((mesh->pos[3 * v] - pc->origin[0]) / pc->h);
+            int y = (int)floor((mesh->pos[3 * v + 1] - pc->origin[1]) / pc->h);
+            int z = (int)floor((mesh->pos[3 * v + 2] - pc->origin[2]) / pc->h);
+            in_empty += !pc->occupied[x + pc->dims[0] * (y + pc->dims[1] * z)];
+        }
+        CHECK(c.bad_points == 0 && pr.rays + pr.nearest + pr.fallbacks + pr.on_surface == mesh->nverts,
+              "sphere at resolution %d: all %d vertices mapped, s and t in [0, 1] (%d bad; rays %d, nearest %d, "
+              "fallbacks %d, on S %d)", res, mesh->nverts, c.bad_points, pr.rays, pr.nearest, pr.fallbacks,
+              pr.on_surface);
+        CHECK(pr.fallbacks == 0 && c.disagreeing == 0,
+              "sphere at resolution %d: no fallback (%d), every quad faces its vertex's side (%d do not)", res,
+              pr.fallbacks, c.disagreeing);
+        CHECK(c.max_distance < 1.5 && near(c.max_distance, pr.max_distance, 1e-5) && pr.mean_distance <= pr.max_distance,
+              "sphere at resolution %d: |p - q| at most %.3f h (report: max %.3f, mean %.3f), below 1.5 h", res,
+              c.max_distance, pr.max_distance, pr.mean_distance);
+        CHECK(rep.removed > 0 && in_empty > 0,
+              "sphere at resolution %d: the correction removed %d cubes and left %d vertices outside the polycube, "
+              "mapped inward", res, rep.removed, in_empty);
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        free(pts);
+        tm_free(&m);
+    }
+}
+
+/* Spec Q9, P14: a plate 0.25 h thick is one slab of cubes; its top maps to
+   the slab's top, its bottom to the slab's bottom. */
+static void test_project_thin_plate(void)
+{
+    unsigned char set[36];
+    const double h = 0.45, thickness = 0.25 * 0.45;
+    tmesh m;
+    tt_mesh *mesh;
+    tt_surface_point *pts;
+    tt_polycube_options o;
+    tt_polycube_projection_report pr;
+    tt_polycube_report rep;
+    tt_polycube *pc;
+    projection_check c;
+    int v, wrong_inside = 0, wrong_sheet = 0, top = 0, bottom = 0;
+    memset(set, 1, sizeof set);
+    memset(&m, 0, sizeof m);
+    make_cube_set(&m, set, 6, 1, 6, 1.0, 1);
+    for (v = 0; v < m.nv; v++) {
+        /* 3 x thickness x 3, off the lattice in x and z */
+        m.pos[3 * v] *= 0.5f;
+        m.pos[3 * v + 1] *= (float)thickness;
+        m.pos[3 * v + 2] *= 0.5f;
+    }
+    memset(&o, 0, sizeof o);
+    o.cube_size = h;
+    pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+    if (!pc) { tm_free(&m); return; }
+    c = check_projection(pc, mesh, pts);
+    for (v = 0; v < mesh->nverts; v++) {
+        const float *p = mesh->pos + 3 * v;
+        int is_top = p[1] > 0.5 * thickness, side = pc->quad_side[pts[v].quad];
+        int inside = p[0] > 0 && p[0] < 3 && p[2] > 0 && p[2] < 3;
+        top += is_top;
+        bottom += !is_top;
+        if (inside && side != (is_top ? 2 : 3)) wrong_inside++;
+        if (side == (is_top ? 3 : 2)) wrong_sheet++;
+    }
+    CHECK(rep.dims[1] == 5, "the plate is one layer of cubes (%d with padding)", rep.dims[1]);
+    CHECK(wrong_inside == 0 && wrong_sheet == 0 && c.disagreeing == 0 && pr.fallbacks == 0,
+          "thin plate (%d top, %d bottom vertices): inner vertices on their own side's quads (%d wrong), no vertex "
+          "on the opposite sheet (%d), all facing their side (%d not), %d fallbacks", top, bottom, wrong_inside,
+          wrong_sheet, c.disagreeing, pr.fallbacks);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    free(pts);
+    tm_free(&m);
+}
+
+/* Spec Q10: open meshes stay shells (P4); the side rule picks the sheet. */
+static void test_project_open(void)
+{
+    const double center[3] = {0.05, 0.11, -0.02};
+    int k;
+    for (k = 0; k < 2; k++) {
+        tmesh m;
+        tt_mesh *mesh;
+        tt_surface_point *pts;
+        tt_polycube_options o;
+        tt_polycube_projection_report pr;
+        tt_polycube_report rep;
+        tt_polycube *pc;
+        projection_check c;
+        const char *name = k ? "a disc (a 7 x 5 grid)" : "a hemisphere";
+        memset(&m, 0, sizeof m);
+        if (k) make_grid(&m, 7, 5);
+        else make_sphere(&m, 40, 20, 1.0, center, 1);
+        memset(&o, 0, sizeof o);
+        o.resolution = 10;
+        pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+        if (!pc) { tm_free(&m); continue; }
+        c = check_projection(pc, mesh, pts);
+        CHECK(c.bad_points == 0 && pr.fallbacks == 0 && c.disagreeing == 0 && c.max_distance < 1.5,
+              "%s at resolution 10: all %d vertices mapped (%d bad), %d fallbacks, %d facing the other way, "
+              "|p - q| at most %.3f h (rays %d, nearest %d, on S %d)", name, mesh->nverts, c.bad_points,
+              pr.fallbacks, c.disagreeing, c.max_distance, pr.rays, pr.nearest, pr.on_surface);
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        free(pts);
+        tm_free(&m);
+    }
+}
+
+typedef struct project_oom_ctx {
+    const tt_polycube *pc;
+    const tt_mesh *mesh;
+    tt_surface_point *pts;
+} project_oom_ctx;
+
+static tt_result project_oom_call(void *ctx, const tt_allocator *al)
+{
+    project_oom_ctx *c = (project_oom_ctx *)ctx;
+    tt_polycube_projection_report pr;
+    tt_error err;
+    tt_result r;
+    pr.rays = -1;
+    r = tt_polycube_project(c->pc, c->mesh, al, c->pts, &pr, &err);
+    if (err.result != r || (r != TT_OK && pr.rays != 0)) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_project_determinism_and_errors(void)
+{
+    const double center[3] = {0.31, 0.02, -0.17};
+    tmesh m;
+    tt_mesh *mesh, empty;
+    tt_surface_point *pts, *again;
+    tt_polycube_options o;
+    tt_polycube_projection_report pr, pr2;
+    tt_polycube_report rep;
+    tt_polycube *pc, tampered;
+    tt_allocator half;
+    tt_error err;
+    tt_result r;
+    project_oom_ctx ctx;
+    memset(&m, 0, sizeof m);
+    make_sphere(&m, 32, 16, 1.0, center, 0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 8;
+    pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+    if (!pc) { tm_free(&m); return; }
+    again = (tt_surface_point *)malloc(sizeof(tt_surface_point) * (size_t)mesh->nverts);
+    r = tt_polycube_project(pc, mesh, NULL, again, &pr2, NULL);
+    CHECK(r == TT_OK && memcmp(pts, again, sizeof(tt_surface_point) * (size_t)mesh->nverts) == 0 &&
+              memcmp(&pr, &pr2, sizeof pr) == 0,
+          "same input, same points and report");
+
+    CHECK(tt_polycube_project(NULL, mesh, NULL, again, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_polycube_project(pc, NULL, NULL, again, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_polycube_project(pc, mesh, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "NULL polycube, mesh or points: invalid");
+    memset(&half, 0, sizeof half);
+    half.free = free_only;
+    CHECK(tt_polycube_project(pc, mesh, &half, again, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "an allocator with free only: invalid");
+    memset(&empty, 0, sizeof empty);
+    pr2.rays = 5;
+    r = tt_polycube_project(pc, &empty, NULL, again, &pr2, &err);
+    CHECK(r == TT_ERROR_EMPTY_MESH && pr2.rays == 0, "a mesh without faces: %d, report zeroed", r);
+    tampered = *pc;
+    tampered.surface = NULL;
+    r = tt_polycube_project(&tampered, mesh, NULL, again, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "a polycube without a surface: %d", r);
+    tampered = *pc;
+    tampered.dims[0] -= 1;   /* the occupancy no longer matches the quads */
+    r = tt_polycube_project(&tampered, mesh, NULL, again, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "a polycube whose cubes do not match its quads: %d (%s)", r, err.message);
+    {
+        float *pos = (float *)mesh->pos, keep = pos[3 * 7 + 1];
+        pos[3 * 7 + 1] = internal_infinity();
+        r = tt_polycube_project(pc, mesh, NULL, again, NULL, &err);
+        CHECK(r == TT_ERROR_NON_FINITE && err.vertex == 7, "an infinite coordinate of vertex 7: %d at vertex %d", r,
+              err.vertex);
+        pos[3 * 7 + 1] = keep;
+    }
+    ctx.pc = pc;
+    ctx.mesh = mesh;
+    ctx.pts = again;
+    oom_reset();
+    oom_sweep("tt_polycube_project(sphere at resolution 8)", project_oom_call, &ctx, TT_OK);
+    free(again);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    free(pts);
+    tm_free(&m);
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -914,4 +1293,9 @@ void run_polycube_tests(void)
     RUN(test_edge_colors);
     RUN(test_wang_tiling);
     RUN(test_errors);
+    RUN(test_project_cube);
+    RUN(test_project_sphere);
+    RUN(test_project_thin_plate);
+    RUN(test_project_open);
+    RUN(test_project_determinism_and_errors);
 }
