@@ -6044,7 +6044,7 @@ TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout 
    computed from a resolved copy, so no product can overflow. */
 static int tt__layout_figure(const tt_tile_layout *layout, int which)
 {
-    tt_tile_layout resolved;
+    tt_tile_layout resolved = {0, 0, 0}; /* written by tt_tile_layout_resolve; set so no compiler sees it unset */
     int side;
     TT_ASSERT(layout);
     if (!layout || tt_tile_layout_resolve(layout, &resolved, NULL) != TT_OK) {
@@ -6140,7 +6140,7 @@ TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *
 TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                               float *corner_uv, tt_error *error)
 {
-    tt_tile_layout resolved;
+    tt_tile_layout resolved = {0, 0, 0}; /* written by tt_tile_layout_resolve; set so no compiler sees it unset */
     tt_result result;
     double cell, atlas;
     int f, base, c;
@@ -6533,7 +6533,7 @@ static int tt__rect_fits(const tt_rect *r, int w, int h, int width, int height)
    the callers (all of them, or those of one tile). */
 static tt_result tt__check_plan(const tt_synth_plan *plan, tt_error *error)
 {
-    tt_tile_layout resolved;
+    tt_tile_layout resolved = {0, 0, 0}; /* written by tt_tile_layout_resolve; set so no compiler sees it unset */
     int S = plan->layout.tile_size;
     if (tt_tile_layout_resolve(&plan->layout, &resolved, NULL) != TT_OK || resolved.colors != plan->layout.colors ||
         resolved.tile_size != S || resolved.gutter != plan->layout.gutter || plan->feather < 1 ||
@@ -7151,7 +7151,7 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
 TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                                   int *counts, tt_error *error)
 {
-    tt_tile_layout resolved;
+    tt_tile_layout resolved = {0, 0, 0}; /* written by tt_tile_layout_resolve; set so no compiler sees it unset */
     tt_result result;
     int f, c, base;
     tt__ok(error);
@@ -14714,7 +14714,8 @@ static tt__facelet_hit tt__polycube_nearest(const tt__voxels *grid, const double
 {
     tt__facelet_hit any, facing;
     int center[3], ring, last = 0, a;
-    any.found = facing.found = 0;
+    memset(&any, 0, sizeof any);
+    memset(&facing, 0, sizeof facing);
     tt__polycube_center(grid, g, center);
     for (a = 0; a < 3; a++) last = tt__max_i(last, tt__max_i(center[a], grid->dims[a] - 1 - center[a]));
     *is_fallback = 0;

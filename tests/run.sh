@@ -2,7 +2,7 @@
 # tests/run.sh - the test runner behind `make test`.
 #
 #   1. compile checks of tiledtex.h (each counts as one test): gcc C99 with
-#      strict warnings, g++ as C++, clang, tcc, TILEDTEX_STATIC (every function
+#      strict warnings (also at -O3), g++ as C++, clang, tcc, TILEDTEX_STATIC (every function
 #      used, and only one used), user-defined TT_MALLOC/TT_FREE, the helpers'
 #      preconditions caught by TT_ASSERT (tests/assert_check.c), the two
 #      QUICK START blocks compiled and run, every public declaration checked
@@ -61,6 +61,8 @@ compile_check() {
 echo "== compile checks"
 compile_check "gcc -std=c99 strict" gcc_c99 \
     gcc -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror
+compile_check "gcc -O3 strict (the warnings only the optimiser finds)" gcc_o3 \
+    gcc -std=c99 -O3 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes -Werror
 compile_check "g++ as C++" gxx \
     g++ -x c++ -Wall -Wextra -pedantic -Werror
 compile_check "clang -std=c99" clang \
