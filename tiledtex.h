@@ -12794,14 +12794,17 @@ static int tt__hpm_relax(tt__hpm *S, int C)
     const tt_cluster *cl = &S->H->clusters[C];
     int *verts, nverts = 0, i, j, pass;
     double w = tt__hpm_band_width(S, C);
-    verts = TT__ALLOC(S->al, int, 3 * (size_t)cl->nfaces);
+    verts = TT__ALLOC(S->al, int, 6 * (size_t)cl->nfaces);
     if (!verts) return 0;
+    /* both ends of every edge C shares with a textured neighbour */
     for (i = 0; i < cl->nfaces; i++) {
         int f = S->H->faces[cl->first_face + i], c;
         for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
             int t = m->twin[c];
-            if (t >= 0 && S->owner[m->corner_face[t]] >= 0 && S->owner[m->corner_face[t]] != C)
+            if (t >= 0 && S->owner[m->corner_face[t]] >= 0 && S->owner[m->corner_face[t]] != C) {
                 verts[nverts++] = m->corner_vert[c];
+                verts[nverts++] = m->corner_vert[tt_mesh_next(m, c)];
+            }
         }
     }
     qsort(verts, (size_t)nverts, sizeof(int), tt__int_compare);
