@@ -12353,6 +12353,82 @@ static double tt__hpm_refine_turn(const tt__hpm *S, int C, tt__hpm_place *pl, do
     return best;
 }
 
+/* Step 3's allowed offsets, per turned copy (canvas cw x ch with C's
+   support drawn): the support (footprint and band) stays on the grid
+   without wrapping, and for a bounded image inside the turned image with
+   a margin of one texel (D6). With a main neighbour whose continuation is
+   at canvas offset cont (o: the canvas origin), the offsets within
+   `exclusion` texels of it in copy 0 are left out (D8). Returns 0 when no
+   offset is allowed. */
+static int tt__hpm_allowed_offsets(tt__hpm *S, int cw, int ch, int has_cont, const double *cont, const double *o,
+                                   double exclusion)
+{
+    double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
+    double m_w = 1.0 / S->f;
+    size_t pp = (size_t)S->P * S->P;
+    int i, j, k, P = S->P, maxx = 0, maxy = 0, any = 0;
+    for (j = 0; j < ch; j++)
+        for (i = 0; i < cw; i++)
+            if (S->support[(size_t)j * P + i]) {
+                if (i > maxx) maxx = i;
+                if (j > maxy) maxy = j;
+            }
+    for (k = 0; k < S->copies; k++) {
+        unsigned char *a = S->allowed_mem + (size_t)k * pp;
+        double th = S->angle[k], ct = cos(th), st = sin(th);
+        /* n' = R(theta) n for n = +x, -x, +y, -y; limits L - n.c_T */
+        double nx[4], ny[4], lim[4], mx[4];
+        int d, tx, ty;
+        nx[0] = ct; ny[0] = st; lim[0] = S->ww - m_w - ctx;
+        nx[1] = -ct; ny[1] = -st; lim[1] = -m_w + ctx;
+        nx[2] = -st; ny[2] = ct; lim[2] = S->wh - m_w - cty;
+        nx[3] = st; ny[3] = -ct; lim[3] = -m_w + cty;
+        for (d = 0; d < 4; d++) mx[d] = -1e300;
+        if (!S->toroidal)
+            for (j = 0; j < ch; j++)
+                for (i = 0; i < cw; i++)
+                    if (S->support[(size_t)j * P + i])
+                        for (d = 0; d < 4; d++) {
+                            double v = nx[d] * (i - cb) + ny[d] * (j - cb) + (nx[d] > 0 ? nx[d] : 0) +
+                                       (ny[d] > 0 ? ny[d] : 0);
+                            if (v > mx[d]) mx[d] = v;
+                        }
+        memset(a, 0, pp);
+        for (ty = 0; ty < P - maxy; ty++)
+            for (tx = 0; tx < P - maxx; tx++) {
+                int ok = 1;
+                if (!S->toroidal)
+                    for (d = 0; d < 4 && ok; d++) ok = nx[d] * tx + ny[d] * ty <= lim[d] - mx[d];
+                a[(size_t)ty * P + tx] = (unsigned char)ok;
+                any |= ok;
+            }
+    }
+    /* D8: not the exact continuation of that neighbour (copy 0 at
+       the offset that repeats its map), nor anything within the
+       cluster's radius of it, which would show the same texels shifted
+       a little; unless asked for (TT_HPM_NO_RANDOM_TURN). */
+    if (has_cont && !(S->flags & TT_HPM_NO_RANDOM_TURN)) {
+        double tcx = cont[0] / S->f + o[0] + cb - ctx, tcy = cont[1] / S->f + o[1] + cb - cty;
+        double rad = exclusion, px = S->toroidal ? S->ww : 1e300, py = S->toroidal ? S->wh : 1e300;
+        int tx, ty, a, b;
+        if (S->toroidal) {
+            /* copy 0 repeats with the image's period */
+            tcx -= px * floor(tcx / px);
+            tcy -= py * floor(tcy / py);
+        }
+        for (b = 0; b == 0 || (S->toroidal && tcy + (b - 1) * py - rad < P); b++)
+            for (a = 0; a == 0 || (S->toroidal && tcx + (a - 1) * px - rad < P); a++) {
+                double cx = tcx + (S->toroidal ? (a - 1) * px : 0), cy = tcy + (S->toroidal ? (b - 1) * py : 0);
+                for (ty = (int)floor(cy - rad); ty <= (int)ceil(cy + rad); ty++)
+                    for (tx = (int)floor(cx - rad); tx <= (int)ceil(cx + rad); tx++)
+                        if (tx >= 0 && ty >= 0 && tx < P && ty < P &&
+                            (tx - cx) * (tx - cx) + (ty - cy) * (ty - cy) <= rad * rad)
+                            S->allowed_mem[(size_t)ty * P + tx] = 0;
+            }
+    }
+    return any;
+}
+
 /* Steps 2 and 3: the band and the fit. Returns 1 with *pl and *eps when
    a fit was made, 0 when there is no band to fit (continue or start
    instead), -1 when there is no room for C in the image, -2 on
@@ -12442,74 +12518,10 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     }
     if (S->nband < 8) return 0;
 
-    /* Allowed offsets per turned copy: the support (footprint and band)
-       stays on the grid without wrapping, and for a bounded image inside
-       the turned image with a margin of one texel (D6). */
-    {
-        double m_w = 1.0 / S->f;
-        int maxx = 0, maxy = 0, any = 0;
-        for (j = 0; j < ch; j++)
-            for (i = 0; i < cw; i++)
-                if (S->support[(size_t)j * P + i]) {
-                    if (i > maxx) maxx = i;
-                    if (j > maxy) maxy = j;
-                }
-        for (k = 0; k < S->copies; k++) {
-            unsigned char *a = S->allowed_mem + (size_t)k * pp;
-            double th = S->angle[k], ct = cos(th), st = sin(th);
-            /* n' = R(theta) n for n = +x, -x, +y, -y; limits L - n.c_T */
-            double nx[4], ny[4], lim[4], mx[4];
-            int d, tx, ty;
-            nx[0] = ct; ny[0] = st; lim[0] = S->ww - m_w - ctx;
-            nx[1] = -ct; ny[1] = -st; lim[1] = -m_w + ctx;
-            nx[2] = -st; ny[2] = ct; lim[2] = S->wh - m_w - cty;
-            nx[3] = st; ny[3] = -ct; lim[3] = -m_w + cty;
-            for (d = 0; d < 4; d++) mx[d] = -1e300;
-            if (!S->toroidal)
-                for (j = 0; j < ch; j++)
-                    for (i = 0; i < cw; i++)
-                        if (S->support[(size_t)j * P + i])
-                            for (d = 0; d < 4; d++) {
-                                double v = nx[d] * (i - cb) + ny[d] * (j - cb) + (nx[d] > 0 ? nx[d] : 0) +
-                                           (ny[d] > 0 ? ny[d] : 0);
-                                if (v > mx[d]) mx[d] = v;
-                            }
-            memset(a, 0, pp);
-            for (ty = 0; ty < P - maxy; ty++)
-                for (tx = 0; tx < P - maxx; tx++) {
-                    int ok = 1;
-                    if (!S->toroidal)
-                        for (d = 0; d < 4 && ok; d++) ok = nx[d] * tx + ny[d] * ty <= lim[d] - mx[d];
-                    a[(size_t)ty * P + tx] = (unsigned char)ok;
-                    any |= ok;
-                }
-        }
-        /* D8: not the exact continuation of that neighbour (copy 0 at
-           the offset that repeats its map), nor anything within the
-           cluster's radius of it, which would show the same texels shifted
-           a little; unless asked for (TT_HPM_NO_RANDOM_TURN). */
-        if (has_cont && !(S->flags & TT_HPM_NO_RANDOM_TURN)) {
-            double tcx = cont[0] / S->f + o[0] + cb - ctx, tcy = cont[1] / S->f + o[1] + cb - cty;
-            double rad = sqrt(area_px / TT__PI) / S->f, px = S->toroidal ? S->ww : 1e300, py = S->toroidal ? S->wh : 1e300;
-            int tx, ty, a, b;
-            if (rad < w_w) rad = w_w;
-            if (S->toroidal) {
-                /* copy 0 repeats with the image's period */
-                tcx -= px * floor(tcx / px);
-                tcy -= py * floor(tcy / py);
-            }
-            for (b = 0; b == 0 || (S->toroidal && tcy + (b - 1) * py - rad < P); b++)
-                for (a = 0; a == 0 || (S->toroidal && tcx + (a - 1) * px - rad < P); a++) {
-                    double cx = tcx + (S->toroidal ? (a - 1) * px : 0), cy = tcy + (S->toroidal ? (b - 1) * py : 0);
-                    for (ty = (int)floor(cy - rad); ty <= (int)ceil(cy + rad); ty++)
-                        for (tx = (int)floor(cx - rad); tx <= (int)ceil(cx + rad); tx++)
-                            if (tx >= 0 && ty >= 0 && tx < P && ty < P &&
-                                (tx - cx) * (tx - cx) + (ty - cy) * (ty - cy) <= rad * rad)
-                                S->allowed_mem[(size_t)ty * P + tx] = 0;
-                }
-        }
-        if (!any) return -1;
-    }
+    /* the exclusion disc: the cluster's radius, at least the band's width */
+    if (!tt__hpm_allowed_offsets(S, cw, ch, has_cont, cont, o,
+                                 sqrt(area_px / TT__PI) / S->f > w_w ? sqrt(area_px / TT__PI) / S->f : w_w))
+        return -1;
     xr = tt_xcorr_masked_best((const tt_xcorr_texture *const *)S->tex, S->copies, S->mask, S->values,
                               S->allowed, S->xwork, &match, &best_k, error);
     if (xr == TT_ERROR_NOT_MEASURED) return -1;
