@@ -33,6 +33,8 @@
 
    `hpm_20k_faces` runs tt_hpm_map on a 20k-triangle torus with a 256 x 256
    three-channel image, and prints the fits it made beside the time.
+   `polycube_100k_faces_res32_*` time the polycube's construction and the
+   vertices' projection onto it on a 100k-triangle torus.
 
    Peers: bench/bench_build.c times the half-edge build on three 1M-face
    meshes beside a radix-sort pairing yardstick, and bench_build_cgal.cpp
@@ -489,6 +491,47 @@ typedef struct hpm_ctx {
     tt_hpm_report report;
 } hpm_ctx;
 
+typedef struct polycube_ctx {
+    tt_mesh *mesh;
+    tt_polycube *polycube;      /* the last build's, kept for the projection */
+    tt_surface_point *points;
+    tt_polycube_report report;
+    tt_polycube_projection_report projection;
+} polycube_ctx;
+
+/* The polycube of a mesh at resolution 32: voxelisation, fill, repair,
+   correction and the surface S. */
+static double run_polycube_build(void *p)
+{
+    polycube_ctx *c = (polycube_ctx *)p;
+    tt_polycube_options options;
+    tt_error err;
+    tt_result r;
+    double t0, t1;
+    tt_polycube_free(c->polycube);
+    c->polycube = NULL;
+    memset(&options, 0, sizeof options);
+    options.resolution = 32;
+    t0 = bench_now_ms();
+    r = tt_polycube_build(c->mesh, &options, NULL, &c->polycube, &c->report, &err);
+    t1 = bench_now_ms();
+    if (r != TT_OK) fail("tt_polycube_build", r, &err);
+    return t1 - t0;
+}
+
+/* Every vertex's point on S (the mapping's first step). */
+static double run_polycube_project(void *p)
+{
+    polycube_ctx *c = (polycube_ctx *)p;
+    tt_error err;
+    tt_result r;
+    double t0 = bench_now_ms(), t1;
+    r = tt_polycube_project(c->polycube, c->mesh, NULL, c->points, &c->projection, &err);
+    t1 = bench_now_ms();
+    if (r != TT_OK) fail("tt_polycube_project", r, &err);
+    return t1 - t0;
+}
+
 /* Hierarchical pattern mapping end to end: hierarchy, flattening, the
    turned copies' spectra, the fits and the texture coordinates. */
 static double run_hpm(void *p)
@@ -652,6 +695,22 @@ int main(int argc, char **argv)
         free(hc.uv);
         tt_image_free(hc.image);
         tt_mesh_free(hc.mesh);
+    }
+    if (wanted("polycube_100k_faces_res32")) {
+        /* the polycube's first steps on a 100k-triangle torus; the mapping
+           of the triangles onto it (spec B10: voxelise -> UVs <= 1 s) is
+           still to come */
+        polycube_ctx pc;
+        memset(&pc, 0, sizeof pc);
+        pc.mesh = make_triangle_torus(224);
+        pc.points = (tt_surface_point *)xmalloc(sizeof(tt_surface_point) * (size_t)pc.mesh->nverts);
+        report("polycube_100k_faces_res32_build", median_ms(run_polycube_build, &pc, RUNS_FAST), "ms");
+        report("polycube_100k_faces_res32_quads", pc.report.quads, "quads");
+        report("polycube_100k_faces_res32_project", median_ms(run_polycube_project, &pc, RUNS_FAST), "ms");
+        report("polycube_100k_faces_res32_fallbacks", pc.projection.fallbacks, "vertices");
+        free(pc.points);
+        tt_polycube_free(pc.polycube);
+        tt_mesh_free(pc.mesh);
     }
     return bench_failed;
 }
