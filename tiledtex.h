@@ -2240,6 +2240,9 @@ typedef struct tt_polycube_report {
     int polycube_genus;         /* sum over S's components of (2 - chi) / 2 */
     int genus_differs;          /* mesh_genus >= 0 and differs from polycube_genus: raise the resolution (P8) */
     int zero_area_triangles;    /* fan triangles the voxeliser skipped */
+    int inside_out;             /* the mesh is closed and its faces wind inward (negative volume): its normals
+                                   point in, and tt_polycube_project's side rule then picks the wrong side;
+                                   reverse its faces */
 } tt_polycube_report;
 
 /* A polycube and its surface S. Read the fields freely; do not modify them. */
@@ -14370,6 +14373,29 @@ static tt_result tt__polycube_genus(const tt_mesh *mesh, const tt_polycube *pc, 
     if (result != TT_OK) return result;
     report->mesh_genus = stats.boundary_edges == 0 && stats.nonmanifold_vertices == 0 ? stats.genus : -1;
     report->genus_differs = report->mesh_genus >= 0 && report->mesh_genus != report->polycube_genus;
+    if (report->mesh_genus >= 0) {
+        /* the signed volume of a closed mesh, by the divergence theorem over
+           its faces' fans: negative when the faces wind inward */
+        double volume = 0;
+        int f, k;
+        for (f = 0; f < mesh->nfaces; f++) {
+            const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f]];
+            for (k = mesh->face_start[f] + 1; k + 1 < mesh->face_start[f + 1]; k++) {
+                const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[k];
+                const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[k + 1];
+                double a[3], b[3], cr[3];
+                tt__sub3f(p1, p0, a);
+                tt__sub3f(p2, p0, b);
+                tt__cross3(a, b, cr);
+                /* (p0 - c) . ((p1 - p0) x (p2 - p0)) is 6 x the signed volume of
+                   the tetrahedron (c, p0, p1, p2), c the first vertex; they add
+                   up to the enclosed volume */
+                volume += (p0[0] - mesh->pos[0]) * cr[0] + (p0[1] - mesh->pos[1]) * cr[1] +
+                          (p0[2] - mesh->pos[2]) * cr[2];
+            }
+        }
+        report->inside_out = volume < 0;
+    }
     return TT_OK;
 }
 

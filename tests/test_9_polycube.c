@@ -498,7 +498,23 @@ static void test_torus(void)
           "torus at resolution 16: chi 0 (genus %d), one component (%d), no warning (%d)", rep.polycube_genus,
           rep.components, rep.genus_differs);
     CHECK(pc && rep.filled > 0, "the torus's inside is filled (%d cubes)", rep.filled);
+    CHECK(pc && rep.inside_out == 0, "the torus winds outward (inside_out %d)", rep.inside_out);
     tt_polycube_free(pc);
+    {
+        /* the same torus with every face reversed */
+        int f, k, first = 0;
+        for (f = 0; f < m.nf; f++) {
+            for (k = 0; k < m.sizes[f] / 2; k++) {
+                int t = m.idx[first + k];
+                m.idx[first + k] = m.idx[first + m.sizes[f] - 1 - k];
+                m.idx[first + m.sizes[f] - 1 - k] = t;
+            }
+            first += m.sizes[f];
+        }
+        pc = polycube_of(&m, &o, &rep, &r);
+        CHECK(pc && rep.inside_out == 1, "reversed, the torus is reported inside-out (%d)", rep.inside_out);
+        tt_polycube_free(pc);
+    }
     tm_free(&m);
 }
 
