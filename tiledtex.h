@@ -15047,6 +15047,7 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
 #define TT__EDGE_EPS 1e-9               /* lengths in the unfolded plane, in units of h */
 #define TT__EDGE_ANGLE_EPS 1e-9         /* the funnel's directions, radians */
 #define TT__EDGE_SEARCH_BUDGET 200000   /* path steps per edge: a guard for large max_quads */
+#define TT__EDGE_BEND_QUADS 6           /* paths of at most this many quads may bend at saddles */
 
 /* Corner k (mod 4) of a quad in its own frame: (0,0), (1,0), (1,1), (0,1). */
 static void tt__quad_corner_st(int k, int st[2])
@@ -15210,94 +15211,183 @@ static double tt__angle2(const double x[2], const double y[2])
     return atan2(fabs(x[0] * y[1] - x[1] * y[0]), x[0] * y[0] + x[1] * y[1]);
 }
 
+/* The bends of a path (tt__edge_path_crossings): a choice, portal by
+   portal, of where its straight legs end. Bend m is at vertex at[m] (in
+   the plane), where the path crosses portals first[m]..end[m]-1 (the run of
+   quads around the vertex, all crossed at one t). */
+typedef struct tt__edge_bends {
+    const tt_mesh *s;
+    const int *halfedges;
+    const tt_quad_map *maps;
+    int portals, count, best_count;
+    double a[2], b[2], length, best_length;
+    int first[TT__EDGE_BEND_QUADS], end[TT__EDGE_BEND_QUADS];
+    int best_first[TT__EDGE_BEND_QUADS], best_end[TT__EDGE_BEND_QUADS];
+    double at[TT__EDGE_BEND_QUADS][2], best_at[TT__EDGE_BEND_QUADS][2];
+    tt_edge_crossing scratch[TT__EDGE_BEND_QUADS];
+} tt__edge_bends;
+
+/* Is bend m locally shortest, the path coming from `from` and going on to
+   `to`? The angle on the run's side (from the way back, over the run's
+   quads, to the way on) and the rest of the turn around the vertex must
+   both be at least half a turn; only a saddle (more than 4 quads around
+   it) has room for that. */
+static int tt__edge_bend_holds(const tt__edge_bends *B, int m, const double from[2], const double to[2])
+{
+    const tt_mesh *s = B->s;
+    const double *v = B->at[m];
+    int h = B->halfedges[B->first[m]], quad = s->corner_face[h], k = h - s->face_start[quad], valence, i, outer;
+    double back[2], on[2], edge_in[2], edge_out[2], run = 0.0;
+    int corner = s->face_start[quad] + k;
+    /* The portal's corner at the vertex: its start, or the next corner. */
+    int st[2];
+    double point[2];
+    tt__quad_corner_st(k, st);
+    tt_quad_map_apply(B->maps[B->first[m]], st[0], st[1], point);
+    if (fabs(point[0] - v[0]) + fabs(point[1] - v[1]) > 0.5) corner = s->face_start[quad] + ((k + 1) & 3);
+    valence = tt__surface_valence(s, corner);
+    if (valence < 5) return 0;
+    back[0] = from[0] - v[0];
+    back[1] = from[1] - v[1];
+    on[0] = to[0] - v[0];
+    on[1] = to[1] - v[1];
+    for (outer = 0; outer < 2; outer++) {
+        double e0[2], e1[2], *edge = outer ? edge_out : edge_in;
+        i = outer ? B->end[m] - 1 : B->first[m];
+        tt__edge_in_plane(s, B->halfedges[i], B->maps[i], e0, e1);
+        if (fabs(e0[0] - v[0]) + fabs(e0[1] - v[1]) < 0.5) {
+            edge[0] = e1[0] - v[0];
+            edge[1] = e1[1] - v[1];
+        } else {
+            edge[0] = e0[0] - v[0];
+            edge[1] = e0[1] - v[1];
+        }
+    }
+    run = tt__angle2(back, edge_in) + (B->end[m] - B->first[m] - 1) * 0.5 * TT__PI + tt__angle2(edge_out, on);
+    return run >= TT__PI - TT__EDGE_ANGLE_EPS && valence * 0.5 * TT__PI - run >= TT__PI - TT__EDGE_ANGLE_EPS;
+}
+
+static double tt__distance2(const double p[2], const double q[2])
+{
+    return sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]));
+}
+
+/* Does portal i of the path have vertex v (in the plane) as an end? */
+static int tt__edge_portal_has(const tt__edge_bends *B, int i, const double v[2])
+{
+    double e0[2], e1[2];
+    tt__edge_in_plane(B->s, B->halfedges[i], B->maps[i], e0, e1);
+    return (e0[0] == v[0] && e0[1] == v[1]) || (e1[0] == v[0] && e1[1] == v[1]);
+}
+
+/* From portal i on, the current leg starting at p after portal `leg_first`
+   (bends before it: B->count): end the leg at a vertex of portal i, or go
+   on. At the last portal the leg goes to q_b; a complete choice whose legs
+   all cross their portals and whose bends all hold is kept when shorter. */
+static void tt__edge_bend_search(tt__edge_bends *B, int i, int leg_first, const double p[2])
+{
+    int end, j;
+    if (i == B->portals) {
+        double length = B->length + tt__distance2(p, B->b);
+        if (B->count == 0 || (B->best_count && length >= B->best_length - TT__EDGE_EPS)) return;
+        if (!tt__edge_leg(B->s, B->halfedges, B->maps, leg_first, B->portals, p, B->b, 0.0, 1.0, B->scratch) ||
+            !tt__edge_bend_holds(B, B->count - 1, B->count > 1 ? B->at[B->count - 2] : B->a, B->b))
+            return;
+        B->best_count = B->count;
+        B->best_length = length;
+        memcpy(B->best_first, B->first, sizeof B->first);
+        memcpy(B->best_end, B->end, sizeof B->end);
+        memcpy(B->best_at, B->at, sizeof B->at);
+        return;
+    }
+    tt__edge_bend_search(B, i + 1, leg_first, p);
+    if (B->count == TT__EDGE_BEND_QUADS) return;
+    for (end = 0; end < 2; end++) {
+        double e0[2], e1[2], *v = B->at[B->count], leg = 0.0, kept_length = B->length;
+        tt__edge_in_plane(B->s, B->halfedges[i], B->maps[i], e0, e1);
+        v[0] = end ? e1[0] : e0[0];
+        v[1] = end ? e1[1] : e0[1];
+        leg = tt__distance2(p, v);
+        if (leg <= TT__EDGE_EPS || !tt__edge_leg(B->s, B->halfedges, B->maps, leg_first, i, p, v, 0.0, 1.0, B->scratch))
+            continue;
+        if (B->count > 0 && !tt__edge_bend_holds(B, B->count - 1, B->count > 1 ? B->at[B->count - 2] : B->a, v))
+            continue;
+        B->first[B->count] = i;
+        for (j = i + 1; j <= B->portals; j++) {
+            if (j > i + 1 && !tt__edge_portal_has(B, j - 1, v)) break;
+            B->end[B->count] = j;
+            B->length = kept_length + leg;
+            B->count++;
+            tt__edge_bend_search(B, j, j, v);
+            B->count--;
+        }
+        B->length = kept_length;
+    }
+}
+
 /* Is the path of `count` quads leaving by halfedges[0..count-2] the image
    of the edge? Unfolded into q_a's plane it must be either straight from
    q_a to q_b (see tt__edge_leg), or - paths of at most
-   TT_POLYCUBE_EDGE_DEFAULT_QUADS quads only - two straight legs meeting at
-   a saddle vertex of S (5 or 6 quads around it, more than a full turn), if
-   the quads the path passes around it (its edges there crossed at the
-   vertex, at one t) are a run of the path and the angles on both sides of
-   the bend are at least half a turn: then it is a shortest path, which on
-   a saddle no straight one replaces (sphere staircases are full of them).
-   The crossings go to crossing[], the length to *length; t runs in
-   proportion to the length along the path. */
+   TT__EDGE_BEND_QUADS quads only - straight legs meeting at
+   saddle vertices of S (5 or 6 quads around them, more than a full turn),
+   each bend passing around its vertex through a run of the path's quads
+   (their edges crossed at the vertex, at one t), with at least half a turn
+   on both sides: a shortest path, which on a saddle no straight one
+   replaces (the staircases of a sphere are full of them). The shortest
+   choice of bends wins. The crossings go to crossing[], the length to
+   *length; t runs in proportion to the length along the path. */
 static int tt__edge_path_crossings(const tt__edge_search *S, const int *halfedges, int count,
                                    tt_edge_crossing *crossing, double *length)
 {
     const tt_mesh *s = S->pc->surface;
     tt_quad_map maps[TT_POLYCUBE_EDGE_MAX_QUADS];
-    tt_edge_crossing bent[TT_POLYCUBE_EDGE_MAX_QUADS];
-    double b[2], best = -1.0;
-    int i, j, m;
+    tt__edge_bends B;
+    double b[2], walked = 0.0;
+    int i, m;
     maps[0].turns = maps[0].offset[0] = maps[0].offset[1] = 0;
     for (i = 0; i + 1 < count; i++) maps[i + 1] = tt_quad_map_compose(maps[i], tt_polycube_unfold(S->pc, halfedges[i]));
     tt_quad_map_apply(maps[count - 1], S->b[0], S->b[1], b);
     if (tt__edge_leg(s, halfedges, maps, 0, count - 1, S->a, b, 0.0, 1.0, crossing)) {
-        *length = sqrt((b[0] - S->a[0]) * (b[0] - S->a[0]) + (b[1] - S->a[1]) * (b[1] - S->a[1]));
+        *length = tt__distance2(S->a, b);
         return 1;
     }
-    if (count > TT_POLYCUBE_EDGE_DEFAULT_QUADS) return 0;
-    /* A bend at vertex V, passing around it through quads i..j. */
-    for (i = 0; i + 1 < count; i++)
-        for (j = i + 1; j < count; j++) {
-            const int h = halfedges[i], quad = s->corner_face[h], k = h - s->face_start[quad];
-            int end, corner, vertex, st[2], starts_at_v;
-            double v[2], other[2], u[2], w[2], e_first[2], e_last[2], e0[2], e1[2], first, second, total, run;
-            for (end = 0; end < 2; end++) {
-                corner = s->face_start[quad] + ((k + end) & 3);
-                vertex = s->corner_vert[corner];
-                for (m = i + 1; m < j; m++) {
-                    int hm = halfedges[m], qm = s->corner_face[hm];
-                    int next = s->face_start[qm] + ((hm - s->face_start[qm] + 1) & 3);
-                    if (s->corner_vert[hm] != vertex && s->corner_vert[next] != vertex) break;
-                }
-                if (m < j || tt__surface_valence(s, corner) < 5) continue;
-                tt__quad_corner_st(k + end, st);
-                tt_quad_map_apply(maps[i], st[0], st[1], v);
-                tt__edge_in_plane(s, h, maps[i], e0, e1);
-                other[0] = end ? e0[0] : e1[0];
-                other[1] = end ? e0[1] : e1[1];
-                first = sqrt((v[0] - S->a[0]) * (v[0] - S->a[0]) + (v[1] - S->a[1]) * (v[1] - S->a[1]));
-                second = sqrt((b[0] - v[0]) * (b[0] - v[0]) + (b[1] - v[1]) * (b[1] - v[1]));
-                total = first + second;
-                if (first <= TT__EDGE_EPS || second <= TT__EDGE_EPS || (best >= 0.0 && total >= best - TT__EDGE_EPS))
-                    continue;
-                /* The angle on the run's side: from the way back to q_a, over the run's quads, to q_b. */
-                u[0] = S->a[0] - v[0];
-                u[1] = S->a[1] - v[1];
-                w[0] = b[0] - v[0];
-                w[1] = b[1] - v[1];
-                e_first[0] = other[0] - v[0];
-                e_first[1] = other[1] - v[1];
-                tt__edge_in_plane(s, halfedges[j - 1], maps[j - 1], e0, e1);
-                starts_at_v = fabs(e0[0] - v[0]) + fabs(e0[1] - v[1]) < 0.5;
-                e_last[0] = (starts_at_v ? e1[0] : e0[0]) - v[0];
-                e_last[1] = (starts_at_v ? e1[1] : e0[1]) - v[1];
-                run = tt__angle2(u, e_first) + (j - i - 1) * 0.5 * TT__PI + tt__angle2(e_last, w);
-                if (run < TT__PI - TT__EDGE_ANGLE_EPS ||
-                    tt__surface_valence(s, corner) * 0.5 * TT__PI - run < TT__PI - TT__EDGE_ANGLE_EPS)
-                    continue;
-                if (!tt__edge_leg(s, halfedges, maps, 0, i, S->a, v, 0.0, first / total, bent) ||
-                    !tt__edge_leg(s, halfedges, maps, j, count - 1, v, b, first / total, 1.0, bent))
-                    continue;
-                for (m = i; m < j; m++) {
-                    bent[m].halfedge = halfedges[m];
-                    bent[m].along = s->corner_vert[halfedges[m]] == vertex ? 0.0 : 1.0;
-                    bent[m].t = first / total;
-                }
-                best = total;
-                memcpy(crossing, bent, sizeof(tt_edge_crossing) * (size_t)(count - 1));
-            }
+    if (count > TT__EDGE_BEND_QUADS) return 0;
+    memset(&B, 0, sizeof B);
+    B.s = s;
+    B.halfedges = halfedges;
+    B.maps = maps;
+    B.portals = count - 1;
+    B.a[0] = S->a[0];
+    B.a[1] = S->a[1];
+    B.b[0] = b[0];
+    B.b[1] = b[1];
+    tt__edge_bend_search(&B, 0, 0, B.a);
+    if (!B.best_count) return 0;
+    /* The legs again, now with t: A, the bends, B, t in proportion to the length walked. */
+    for (m = 0; m <= B.best_count; m++) {
+        const double *from = m ? B.best_at[m - 1] : B.a, *to = m < B.best_count ? B.best_at[m] : B.b;
+        int leg_first = m ? B.best_end[m - 1] : 0, leg_last = m < B.best_count ? B.best_first[m] : count - 1;
+        double t0 = walked / B.best_length, t1;
+        walked += tt__distance2(from, to);
+        t1 = m < B.best_count ? walked / B.best_length : 1.0;
+        tt__edge_leg(s, halfedges, maps, leg_first, leg_last, from, to, t0, t1, crossing);
+        for (i = leg_last; m < B.best_count && i < B.best_end[m]; i++) {
+            double e0[2], e1[2];
+            tt__edge_in_plane(s, halfedges[i], maps[i], e0, e1);
+            crossing[i].halfedge = halfedges[i];
+            crossing[i].along = e0[0] == to[0] && e0[1] == to[1] ? 0.0 : 1.0;
+            crossing[i].t = t1;
         }
-    *length = best;
-    return best >= 0.0;
+    }
+    *length = B.best_length;
+    return 1;
 }
 
 /* The funnel: the directions from q_a through every edge crossed so far
    (angles relative to `reference`, in [lo, hi]); `has` once an edge not
    through q_a has narrowed it, `closed` once no straight segment from q_a
    crosses them all. A closed funnel ends a path only beyond
-   TT_POLYCUBE_EDGE_DEFAULT_QUADS quads, as shorter paths may bend at a
+   TT__EDGE_BEND_QUADS quads, as shorter paths may bend at a
    saddle (tt__edge_path_crossings). */
 typedef struct tt__edge_funnel {
     int has, closed;
@@ -15362,7 +15452,7 @@ static void tt__edge_search_from(tt__edge_search *S, int depth, tt__edge_funnel 
                 }
             }
         }
-        if (narrowed.closed && depth + 1 > TT_POLYCUBE_EDGE_DEFAULT_QUADS) continue;
+        if (narrowed.closed && depth + 1 > TT__EDGE_BEND_QUADS) continue;
         S->halfedges[depth - 1] = h;
         S->quads[depth] = next;
         S->maps[depth] = tt_quad_map_compose(S->maps[depth - 1], tt_polycube_unfold(S->pc, h));
