@@ -2397,13 +2397,13 @@ typedef struct tt_quad_map {
    a twin (S is closed, so every one has). */
 TTDEF tt_quad_map tt_polycube_unfold(const tt_polycube *polycube, int halfedge);
 
-/* outer after inner: the map taking p to outer(inner(p)). Preconditions
-   (TT_ASSERT): both turns in 0..3. */
+/* outer after inner: the map taking p to outer(inner(p)).
+   Preconditions (TT_ASSERT): both turns in 0..3. */
 TTDEF tt_quad_map tt_quad_map_compose(tt_quad_map outer, tt_quad_map inner);
 
 /* map applied to (s, t), into out[2]. Exact: the results are sums of the
-   inputs' values, their negations and small integers. Preconditions
-   (TT_ASSERT): map.turns in 0..3, out is not NULL. */
+   inputs' values, their negations and small integers.
+   Preconditions (TT_ASSERT): map.turns in 0..3, out is not NULL. */
 TTDEF void tt_quad_map_apply(tt_quad_map map, double s, double t, double out[2]);
 
 /* Where the image of a mesh edge crosses an edge of S. */
