@@ -2486,13 +2486,14 @@ typedef struct tt_polycube_edges {
    The search gives up on an edge after 200000 steps (reachable only with
    a large max_quads), keeping the best path found by then.
    Measured (-O2, the default 4 quads; the models of
-   tt_polycube_project's cost note): bunny (5.5k edges) 19 ms at
-   resolution 16 with none failed, 32 ms at 32 with 72 failed (1.3 %);
-   flange (9.7k) 26 ms and 408 (4.2 %), 45 ms and 110 (1.1 %); elephant
-   (8.3k) 18 ms and 116 (1.4 %), 36 ms and 317 (3.8 %). Raising max_quads
-   to 6 takes 7-10 times as long and leaves 0, 40 (0.4 %) and 170 (2 %)
-   failed at 32: the rest are vertices that the projection folded over or
-   sent to another sheet, which the relaxation of P11 step 5 is for.
+   tt_polycube_project's cost note): bunny (5.5k edges) 12 ms at
+   resolution 16 with none failed, 22 ms at 32 with 72 failed (1.3 %);
+   flange (9.7k) 17 ms and 408 (4.2 %), 29 ms and 110 (1.1 %); elephant
+   (8.3k) 13 ms and 116 (1.4 %), 25 ms and 317 (3.8 %). Raising max_quads
+   to 6 takes about 5 times as long and leaves 0, 40 (0.4 %) and 170 (2 %)
+   failed at 32: the rest join vertices that the projection sent to
+   different sheets (more than 6 quads apart on S though less than 1 h
+   apart in 3D), which the relaxation of P11 step 5 is for.
    Memory: the result (4 bytes per half-edge, 9 per edge, 24 per crossing)
    and a search state of about 3 KB; the search recurses max_quads deep.
    options and the allocator may be NULL. Results: TT_OK;
@@ -15153,8 +15154,8 @@ typedef struct tt__edge_search {
     tt_quad_map maps[TT_POLYCUBE_EDGE_MAX_QUADS];
     int best_count;     /* quads of the best path so far; 0 = none */
     double best_length;
-    int best_halfedges[TT_POLYCUBE_EDGE_MAX_QUADS];
-    tt_edge_crossing crossings[TT_POLYCUBE_EDGE_MAX_QUADS];   /* a path's, while it is judged */
+    tt_edge_crossing crossings[TT_POLYCUBE_EDGE_MAX_QUADS];        /* a path's, while it is judged */
+    tt_edge_crossing best_crossings[TT_POLYCUBE_EDGE_MAX_QUADS];
 } tt__edge_search;
 
 /* The ends of half-edge h of S in the plane, through `map` (its quad's). */
@@ -15250,7 +15251,7 @@ typedef struct tt__edge_bends {
     const int *halfedges;
     const tt_quad_map *maps;
     int portals, count, best_count;
-    double a[2], b[2], length, best_length;
+    double a[2], b[2], length, best_length;     /* best_length starts as a bound: the search's best path */
     int first[TT__EDGE_BEND_QUADS], end[TT__EDGE_BEND_QUADS];
     int best_first[TT__EDGE_BEND_QUADS], best_end[TT__EDGE_BEND_QUADS];
     double at[TT__EDGE_BEND_QUADS][2], best_at[TT__EDGE_BEND_QUADS][2];
@@ -15317,7 +15318,7 @@ static void tt__edge_bend_search(tt__edge_bends *B, int i, int leg_first, const 
     int end, j;
     if (i == B->portals) {
         double length = B->length + tt__distance2(p, B->b);
-        if (B->count == 0 || (B->best_count && length >= B->best_length - TT__EDGE_EPS)) return;
+        if (B->count == 0 || length >= B->best_length - TT__EDGE_EPS) return;
         if (!tt__edge_leg(B->s, B->halfedges, B->maps, leg_first, B->portals, p, B->b, 0.0, 1.0, B->scratch) ||
             !tt__edge_bend_holds(B, B->count - 1, B->count > 1 ? B->at[B->count - 2] : B->a, B->b))
             return;
@@ -15331,12 +15332,17 @@ static void tt__edge_bend_search(tt__edge_bends *B, int i, int leg_first, const 
     tt__edge_bend_search(B, i + 1, leg_first, p);
     if (B->count == TT__EDGE_BEND_QUADS) return;
     for (end = 0; end < 2; end++) {
-        double e0[2], e1[2], *v = B->at[B->count], leg = 0.0, kept_length = B->length;
-        tt__edge_in_plane(B->s, B->halfedges[i], B->maps[i], e0, e1);
+        const int h = B->halfedges[i], quad = B->s->corner_face[h];
+        double e0[2], e1[2], *v = B->at[B->count], leg, kept_length = B->length;
+        /* Only a saddle can hold a bend; and the path through v is at least as long as the straight line on. */
+        if (tt__surface_valence(B->s, B->s->face_start[quad] + ((h - B->s->face_start[quad] + end) & 3)) < 5)
+            continue;
+        tt__edge_in_plane(B->s, h, B->maps[i], e0, e1);
         v[0] = end ? e1[0] : e0[0];
         v[1] = end ? e1[1] : e0[1];
         leg = tt__distance2(p, v);
-        if (leg <= TT__EDGE_EPS || !tt__edge_leg(B->s, B->halfedges, B->maps, leg_first, i, p, v, 0.0, 1.0, B->scratch))
+        if (leg <= TT__EDGE_EPS || B->length + leg + tt__distance2(v, B->b) >= B->best_length - TT__EDGE_EPS ||
+            !tt__edge_leg(B->s, B->halfedges, B->maps, leg_first, i, p, v, 0.0, 1.0, B->scratch))
             continue;
         if (B->count > 0 && !tt__edge_bend_holds(B, B->count - 1, B->count > 1 ? B->at[B->count - 2] : B->a, v))
             continue;
@@ -15389,6 +15395,8 @@ static int tt__edge_path_crossings(const tt__edge_search *S, const int *halfedge
     B.a[1] = S->a[1];
     B.b[0] = b[0];
     B.b[1] = b[1];
+    /* Only a path no longer than the best so far can win (of equal ones, the one with fewer quads). */
+    B.best_length = S->best_count ? S->best_length + 2.0 * TT__EDGE_EPS : HUGE_VAL;
     tt__edge_bend_search(&B, 0, 0, B.a);
     if (!B.best_count) return 0;
     /* The legs again, now with t: A, the bends, B, t in proportion to the length walked. */
@@ -15435,7 +15443,7 @@ static void tt__edge_search_from(tt__edge_search *S, int depth, tt__edge_funnel 
              (length <= S->best_length + TT__EDGE_EPS && depth < S->best_count))) {
             S->best_count = depth;
             S->best_length = length;
-            memcpy(S->best_halfedges, S->halfedges, sizeof(int) * (size_t)(depth - 1));
+            memcpy(S->best_crossings, S->crossings, sizeof(tt_edge_crossing) * (size_t)(depth - 1));
         }
         return;
     }
@@ -15571,8 +15579,7 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
     for (e = 0; e < E->nedges; e++) {
         tt_surface_point qa = points[E->edge_vertices[2 * e]], qb = points[E->edge_vertices[2 * e + 1]];
         tt__edge_funnel funnel;
-        tt_edge_crossing *crossing = S->crossings;
-        double length;
+        const tt_edge_crossing *crossing = S->best_crossings;
         int count, i;
         E->first_crossing[e] = E->ncrossings;
         S->a[0] = qa.s;
@@ -15592,7 +15599,6 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
             continue;
         }
         count = S->best_count - 1;
-        tt__edge_path_crossings(S, S->best_halfedges, S->best_count, crossing, &length);
         if (count > 0) {
             tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(allocator, E->crossings, &capacity,
                                                                    E->ncrossings + count, sizeof(tt_edge_crossing));
@@ -15601,9 +15607,10 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
         }
         for (i = 0; i < count; i++) {
             /* P11 step 4.5, once per edge: no zero-length piece next to a vertex or a quad corner. */
-            crossing[i].along = tt__edge_snap(crossing[i].along);
-            crossing[i].t = tt__edge_snap(crossing[i].t);
-            E->crossings[E->ncrossings++] = crossing[i];
+            tt_edge_crossing snapped = crossing[i];
+            snapped.along = tt__edge_snap(snapped.along);
+            snapped.t = tt__edge_snap(snapped.t);
+            E->crossings[E->ncrossings++] = snapped;
         }
     }
     E->first_crossing[E->nedges] = E->ncrossings;

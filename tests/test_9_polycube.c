@@ -1413,10 +1413,18 @@ static void test_edges_cube(void)
 }
 
 /* Is the record of `edges` a connected path from quad(q_a) to quad(q_b),
-   ordered by t? Counts the offending edges. */
+   ordered by t, with t in proportion to the length walked on S? Each piece
+   between two crossings lies in one flat quad, so its 3D length is its
+   length on S: piece k must be (t_k+1 - t_k) times the path's length
+   (1e-5 h for the snapping). Counts the offending edges. */
 typedef struct edges_check {
-    int disordered, disconnected, out_of_range, mismatched_halfedges;
+    int disordered, disconnected, out_of_range, mismatched_halfedges, wrong_lengths;
 } edges_check;
+
+static double distance3(const double *p, const double *q)
+{
+    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+}
 
 static edges_check check_edges(const tt_polycube *pc, const tt_mesh *mesh, const tt_surface_point *pts,
                                const tt_polycube_edges *edges)
@@ -1439,6 +1447,26 @@ static edges_check check_edges(const tt_polycube *pc, const tt_mesh *mesh, const
                 if (!bad_path) quad = s->corner_face[s->twin[x.halfedge]];
             }
             bad_path |= quad != pts[edges->edge_vertices[2 * e + 1]].quad;
+            if (!bad_path && !bad_order) {
+                int first = edges->first_crossing[e], last = edges->first_crossing[e + 1], n = last - first + 2, i;
+                double *at = (double *)malloc(sizeof(double) * 3 * (size_t)n);
+                double *t = (double *)malloc(sizeof(double) * (size_t)n);
+                double walked = 0.0;
+                tt_polycube_point_position(pc, pts[edges->edge_vertices[2 * e]], at);
+                tt_polycube_point_position(pc, pts[edges->edge_vertices[2 * e + 1]], at + 3 * (n - 1));
+                t[0] = 0.0;
+                t[n - 1] = 1.0;
+                for (i = 1; i + 1 < n; i++) {
+                    crossing_position(pc, edges->crossings[first + i - 1], at + 3 * i);
+                    t[i] = edges->crossings[first + i - 1].t;
+                }
+                for (i = 0; i + 1 < n; i++) walked += distance3(at + 3 * i, at + 3 * i + 3);
+                for (i = 0; i + 1 < n; i++)
+                    if (fabs(distance3(at + 3 * i, at + 3 * i + 3) - (t[i + 1] - t[i]) * walked) > 1e-5 * pc->h) break;
+                c.wrong_lengths += i + 1 < n;
+                free(at);
+                free(t);
+            }
         }
         c.disordered += bad_order;
         c.disconnected += bad_path;
@@ -1483,17 +1511,22 @@ static void test_edges_sphere(void)
             CHECK(edges->nedges == mesh->ncorners / 2 && c.mismatched_halfedges == 0,
                   "sphere at resolution %d: %d edges for %d half-edges, both half-edges of each on its record "
                   "(%d not)", res, edges->nedges, mesh->ncorners, c.mismatched_halfedges);
-            CHECK(c.disordered == 0 && c.disconnected == 0 && c.out_of_range == 0,
+            CHECK(c.disordered == 0 && c.disconnected == 0 && c.out_of_range == 0 && c.wrong_lengths == 0,
                   "sphere at resolution %d: %d crossings, ordered by t on every edge (%d not), each a connected "
-                  "path from q_a's quad to q_b's (%d not), t and along in [0, 1] (%d not)", res, edges->ncrossings,
-                  c.disordered, c.disconnected, c.out_of_range);
+                  "path from q_a's quad to q_b's (%d not), t and along in [0, 1] (%d not), t in proportion to "
+                  "the length on S (%d not)", res, edges->ncrossings, c.disordered, c.disconnected, c.out_of_range,
+                  c.wrong_lengths);
             /* At 16 the equator's edges are 1.5 h long; where they cross a staircase some need 5 quads. */
             CHECK(res == 8 ? edges->nfailed == 0 : edges->nfailed * 100 <= edges->nedges,
                   "sphere at resolution %d: %d of %d edges without a path of at most 4 quads (at most %s)", res,
                   edges->nfailed, edges->nedges, res == 8 ? "none" : "1 %");
             if (res == 16) {
                 tt_polycube_edges *longer = traced(pc, mesh, pts, 6);
-                CHECK(longer && longer->nfailed == 0 && check_edges(pc, mesh, pts, longer).disconnected == 0,
+                edges_check lc;
+                memset(&lc, 0, sizeof lc);
+                if (longer) lc = check_edges(pc, mesh, pts, longer);
+                CHECK(longer && longer->nfailed == 0 && lc.disconnected == 0 && lc.disordered == 0 &&
+                          lc.wrong_lengths == 0,
                       "sphere at resolution 16 with paths of up to 6 quads: every edge traced (%d failed)",
                       longer ? longer->nfailed : -1);
                 tt_polycube_edges_free(longer);
