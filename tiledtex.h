@@ -2435,7 +2435,11 @@ typedef struct tt_polycube_edge_options {
    them. Edge e runs from edge_vertices[2e] to edge_vertices[2e + 1], the
    smaller vertex id first, whichever way its half-edges run; a half-edge
    running the other way reads the crossings backwards, with t -> 1 - t,
-   halfedge -> its twin and along -> 1 - along (the same point). */
+   halfedge -> its twin and along -> 1 - along (the same point). Several
+   crossings at one t at a quad corner (along 0 or 1) pass an S vertex: on
+   a flat vertex (4 quads) the path goes straight through it, on a saddle
+   (5 or 6) it may bend there, so a chart unfolded across that vertex is
+   not flat (spec P11 step 4.3's cone points, met on an edge). */
 typedef struct tt_polycube_edges {
     int nedges;                 /* the mesh's undirected edges */
     int ncrossings;
@@ -2463,13 +2467,16 @@ typedef struct tt_polycube_edges {
    S may pass to the quad across it where it enters that edge. The shortest
    unfolded segment wins, then the path with fewer quads, then the one found
    first, so the result is deterministic. Paths are pruned while they grow:
-   the directions from q_a through every edge crossed so far must still
-   overlap (a funnel), and the distance from q_a to the last edge must not
-   exceed the best length found. An edge whose points lie in one quad has
-   no crossing. A path of at most 6 quads may also bend at saddle vertices
-   of S (5 or 6 quads around, more than a full turn): the staircases of a
-   slope are full of them, and a shortest path on S between points on
-   either side goes through the vertex, on no straight unfolding. A bend is
+   the distance from q_a to the last edge crossed must not exceed the best
+   length found, and beyond 6 quads (where only straight paths count) the
+   directions from q_a through every edge crossed must still overlap (a
+   funnel), which keeps long searches (max_quads up to 2N + 2 for the
+   N-cube's edges in the tests) small. An edge whose points lie in one
+   quad has no crossing. A path of at most 6 quads may also bend at saddle
+   vertices of S (5 or 6 quads around, more than a full turn): the
+   staircases of a slope are full of them, and a shortest path on S
+   between points on either side goes through the vertex, on no straight
+   unfolding. A bend is
    kept when the angles on both sides of it are at least half a turn, its
    crossings are the edges around the vertex the path passes, all at the
    vertex (along 0 or 1) and at one t; t runs in proportion to the length
@@ -2495,7 +2502,7 @@ typedef struct tt_polycube_edges {
    different sheets (more than 6 quads apart on S though less than 1 h
    apart in 3D), which the relaxation of P11 step 5 is for.
    Memory: the result (4 bytes per half-edge, 9 per edge, 24 per crossing)
-   and a search state of about 3 KB; the search recurses max_quads deep.
+   and a search state of about 5 KB; the search recurses max_quads deep.
    options and the allocator may be NULL. Results: TT_OK;
    TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh, points or out, a
    bad allocator, npoints other than mesh->nverts, max_quads outside
