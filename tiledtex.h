@@ -135,9 +135,10 @@
                   with tile orientation from an up direction (Sec. 3.1)
                 - the Wang colouring of S's edges per axis group, for the
                   tiled-textures boundary assignment (Sec. 3.2)
-                - the first step of the mapping: each vertex of the model
-                  projected to a point of S, on the side its normal faces
-                  (Sec. 4)
+                - the first steps of the mapping: each vertex of the model
+                  projected to a point of S, on the side its normal faces;
+                  each edge traced on S as a path of quads, with the exact
+                  unfolding of neighbouring quads into one plane (Sec. 4)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
