@@ -135,9 +135,10 @@
                   with tile orientation from an up direction (Sec. 3.1)
                 - the Wang colouring of S's edges per axis group, for the
                   tiled-textures boundary assignment (Sec. 3.2)
-                - the first step of the mapping: each vertex of the model
-                  projected to a point of S, on the side its normal faces
-                  (Sec. 4)
+                - the first steps of the mapping: each vertex of the model
+                  projected to a point of S, on the side its normal faces;
+                  each edge traced on S as a path of quads, with the exact
+                  unfolding of neighbouring quads into one plane (Sec. 4)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
@@ -2143,11 +2144,21 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         tt_synthesize_tiles makes the tiles: the paper's rotation rules
         (Figs. 3-5) come out of Akleman's per-side rule on any consistently
         oriented quad mesh, which S is (spec P9, P10).
-     3. The mapping of the model onto S (Sec. 4, spec P11), whose first
-        step is tt_polycube_project: each vertex of the model gets its point
-        q(v) = (quad, s, t) on S (P11 step 2). The edge paths on S, the
-        triangle splitting and the UVs (P11 steps 3-7) follow in a later
-        part.
+     3. The mapping of the model onto S (Sec. 4, spec P11), so far:
+        a. tt_polycube_project: each vertex of the model gets its point
+           q(v) = (quad, s, t) on S (P11 step 2);
+        b. tt_polycube_trace_edges: each edge of the model gets its image on
+           S, the quads it passes and where it crosses their edges (S
+           half-edge, position on it, t on the mesh edge), one record per
+           edge, so the two triangles on an edge will split it at the same
+           points (P11 step 3, P12, Q11); tt_polycube_unfold lays two quads
+           side by side, exactly.
+        What follows: the triangle split (P11 step 4: a triangle's three
+        edge paths unfolded into one chart by tt_polycube_unfold, clipped by
+        the quad grid into pieces inside one quad each, the edge points
+        taken from the records), the relaxation of the points on S (step
+        5), the UVs (step 6), and for the triangles on a failed edge the
+        fallback (step 7).
 
    The grid (spec P2). L = the bounding box's longest side; the cube edge is
    h = L / resolution, or options->cube_size. Each axis has
@@ -2377,6 +2388,139 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    Preconditions (TT_ASSERT): polycube and its surface are not NULL,
    0 <= p.quad < polycube->surface->nfaces, xyz is not NULL. */
 TTDEF void tt_polycube_point_position(const tt_polycube *polycube, tt_surface_point p, double xyz[3]);
+
+/* Unfolding (spec P11 steps 3-4). Each quad of S is the unit square of its
+   own (s, t) frame; two quads sharing an edge unfold into one plane by a
+   rigid map that turns by a multiple of 90 degrees and shifts by whole
+   units, so it is exact in floating point and any chain of them composes
+   exactly. A tt_quad_map takes (s, t) to R^turns (s, t) + offset, R the
+   quarter turn counter-clockwise ((s, t) -> (-t, s)). */
+typedef struct tt_quad_map {
+    int turns;          /* 0..3 quarter turns, counter-clockwise */
+    int offset[2];
+} tt_quad_map;
+
+/* The map from the frame of the quad across S half-edge `halfedge` (the
+   quad of its twin) into the frame of halfedge's own quad, so the two
+   squares lie side by side along that edge. Derived from the half-edge
+   structure alone: half-edge i of a quad runs from corner i to corner i + 1
+   and its twin j the other way, so corner j of the far quad lands on
+   corner i + 1 and corner j + 1 on corner i. The map across the twin is its
+   inverse. Preconditions (TT_ASSERT): polycube and its surface are not
+   NULL, 0 <= halfedge < polycube->surface->ncorners, and the half-edge has
+   a twin (S is closed, so every one has). */
+TTDEF tt_quad_map tt_polycube_unfold(const tt_polycube *polycube, int halfedge);
+
+/* outer after inner: the map taking p to outer(inner(p)).
+   Preconditions (TT_ASSERT): both turns in 0..3. */
+TTDEF tt_quad_map tt_quad_map_compose(tt_quad_map outer, tt_quad_map inner);
+
+/* map applied to (s, t), into out[2]. Exact: the results are sums of the
+   inputs' values, their negations and small integers.
+   Preconditions (TT_ASSERT): map.turns in 0..3, out is not NULL. */
+TTDEF void tt_quad_map_apply(tt_quad_map map, double s, double t, double out[2]);
+
+/* Where the image of a mesh edge crosses an edge of S. */
+typedef struct tt_edge_crossing {
+    int halfedge;       /* the S half-edge crossed, as seen from the quad the path leaves */
+    double along;       /* the point on that half-edge from its start corner, 0..1 */
+    double t;           /* the point on the mesh edge from its first vertex, 0..1 */
+} tt_edge_crossing;
+
+#define TT_POLYCUBE_EDGE_DEFAULT_QUADS 4      /* spec P11 step 3 */
+#define TT_POLYCUBE_EDGE_MAX_QUADS 64
+
+typedef struct tt_polycube_edge_options {
+    int max_quads;      /* the longest quad path searched, quads counted; 0 = TT_POLYCUBE_EDGE_DEFAULT_QUADS,
+                           at most TT_POLYCUBE_EDGE_MAX_QUADS */
+} tt_polycube_edge_options;
+
+/* The images of a mesh's edges on S. Read the fields freely; do not modify
+   them. Edge e runs from edge_vertices[2e] to edge_vertices[2e + 1], the
+   smaller vertex id first, whichever way its half-edges run; a half-edge
+   running the other way reads the crossings backwards, with t -> 1 - t,
+   halfedge -> its twin and along -> 1 - along (the same point). Several
+   crossings at one t at a quad corner (along 0 or 1) pass an S vertex: on
+   a flat vertex (4 quads) the path goes straight through it, on a saddle
+   (5 or 6) it may bend there, so a chart unfolded across that vertex is
+   not flat (spec P11 step 4.3's cone points, met on an edge). */
+typedef struct tt_polycube_edges {
+    int nedges;                 /* the mesh's undirected edges */
+    int ncrossings;
+    int *edge_of_halfedge;      /* per mesh half-edge (corner): its edge */
+    int *edge_vertices;         /* 2 * nedges: first and second vertex */
+    int *first_crossing;        /* nedges + 1: edge e's crossings are [first_crossing[e], first_crossing[e+1]),
+                                   in order of t */
+    tt_edge_crossing *crossings;
+    unsigned char *failed;      /* per edge: 1 = no consistent path within max_quads (P11 step 7's fallback) */
+    int nfailed;
+    tt_allocator allocator;     /* the one it was made with */
+} tt_polycube_edges;
+
+/* The image on S of every edge of `mesh` (spec P11 step 3, "edge images
+   (intrinsic)"), from its vertices' points (tt_polycube_project; npoints
+   = mesh->nverts). For edge (a, b) the search runs over the quad paths
+   from q_a's quad to q_b's with at most max_quads quads, none twice,
+   depth first, a quad's half-edges in corner order; each path is unfolded
+   into q_a's quad plane (tt_polycube_unfold) and kept when the straight
+   segment q_a -> q_b crosses exactly its edges in order: each crossing on
+   the closed edge, in the direction out of the quad left, at a t no
+   smaller than the one before. A segment through a quad corner is a path
+   through one of the quads at that corner with two crossings at the same t
+   (the lattice lines it crosses there); a segment running along an edge of
+   S may pass to the quad across it where it enters that edge. The shortest
+   unfolded segment wins, then the path with fewer quads, then the one found
+   first, so the result is deterministic. Paths are pruned while they grow:
+   the distance from q_a to the last edge crossed must not exceed the best
+   length found, and beyond 6 quads (where only straight paths count) the
+   directions from q_a through every edge crossed must still overlap (a
+   funnel), which keeps long searches (max_quads up to 2N + 2 for the
+   N-cube's edges in the tests) small. An edge whose points lie in one
+   quad has no crossing. A path of at most 6 quads may also bend at saddle
+   vertices of S (5 or 6 quads around, more than a full turn): the
+   staircases of a slope are full of them, and a shortest path on S
+   between points on either side goes through the vertex, on no straight
+   unfolding. A bend is
+   kept when the angles on both sides of it are at least half a turn, its
+   crossings are the edges around the vertex the path passes, all at the
+   vertex (along 0 or 1) and at one t; t runs in proportion to the length
+   along the path. An edge with no consistent path is flagged in `failed`
+   and has no crossing; the triangles around it are for P11 step 7's
+   fallback.
+   Snapping (P11 step 4.5): along and t within 1e-6 of 0 or 1 are set to
+   0 or 1; the record is made once per edge, so the triangles on both sides
+   read the same numbers and split the edge at bitwise identical points
+   (spec Q11): p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
+   the half-edge crossed. along and t are double: an edge may cross many
+   quads and step 4 rebuilds chart points from them, where float's 6e-8
+   would be up to 1e-6 h on an edge 16 h long, the size of the snap.
+   The search gives up on an edge after 200000 steps (reachable only with
+   a large max_quads), keeping the best path found by then.
+   Measured (-O2, the default 4 quads; the models of
+   tt_polycube_project's cost note): bunny (5.5k edges) 12 ms at
+   resolution 16 with none failed, 22 ms at 32 with 72 failed (1.3 %);
+   flange (9.7k) 17 ms and 408 (4.2 %), 29 ms and 110 (1.1 %); elephant
+   (8.3k) 13 ms and 116 (1.4 %), 25 ms and 317 (3.8 %). Raising max_quads
+   to 6 takes about 5 times as long and leaves 0, 40 (0.4 %) and 170 (2 %)
+   failed at 32: the rest join vertices that the projection sent to
+   different sheets (more than 6 quads apart on S though less than 1 h
+   apart in 3D), which the relaxation of P11 step 5 is for.
+   Memory: the result (4 bytes per half-edge, 9 per edge, 24 per crossing)
+   and a search state of about 5 KB; the search recurses max_quads deep.
+   options and the allocator may be NULL. Results: TT_OK;
+   TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh, points or out, a
+   bad allocator, npoints other than mesh->nverts, max_quads outside
+   0..TT_POLYCUBE_EDGE_MAX_QUADS, a polycube whose quads do not match its
+   cubes, or a point with a quad outside S or s, t outside [0, 1]
+   (error->vertex says which); TT_ERROR_EMPTY_MESH for a mesh without
+   faces; TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL and nothing stays
+   allocated. Free the result with tt_polycube_edges_free. Same input, same
+   output; thread-safe. */
+TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_mesh *mesh,
+                                        const tt_surface_point *points, int npoints,
+                                        const tt_polycube_edge_options *options, const tt_allocator *allocator,
+                                        tt_polycube_edges **out, tt_error *error);
+TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
 
 #ifdef __cplusplus
 }
@@ -14974,6 +15118,559 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
     report->mean_distance = mesh->nverts > 0 ? distance_sum / mesh->nverts : 0.0;
     tt__free(allocator, normals);
     return TT_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Edge images on S (spec P11 step 3)                                       */
+/* ------------------------------------------------------------------------ */
+
+#define TT__EDGE_SNAP 1e-6              /* spec P11 step 4.5 */
+#define TT__EDGE_EPS 1e-9               /* lengths in the unfolded plane, in units of h */
+#define TT__EDGE_ANGLE_EPS 1e-9         /* the funnel's directions, radians */
+#define TT__EDGE_SEARCH_BUDGET 200000   /* path steps per edge: a guard for large max_quads */
+#define TT__EDGE_BEND_QUADS 6           /* paths of at most this many quads may bend at saddles */
+
+/* Corner k (mod 4) of a quad in its own frame: (0,0), (1,0), (1,1), (0,1). */
+static void tt__quad_corner_st(int k, int st[2])
+{
+    k &= 3;
+    st[0] = k == 1 || k == 2;
+    st[1] = k >= 2;
+}
+
+/* (x, y) turned by `turns` quarter turns counter-clockwise. */
+static void tt__quarter_turns(int turns, double x, double y, double out[2])
+{
+    switch (turns & 3) {
+    case 0: out[0] = x; out[1] = y; break;
+    case 1: out[0] = -y; out[1] = x; break;
+    case 2: out[0] = -x; out[1] = -y; break;
+    default: out[0] = y; out[1] = -x; break;
+    }
+}
+
+TTDEF void tt_quad_map_apply(tt_quad_map map, double s, double t, double out[2])
+{
+    TT_ASSERT(out && map.turns >= 0 && map.turns < 4);
+    tt__quarter_turns(map.turns, s, t, out);
+    out[0] += map.offset[0];
+    out[1] += map.offset[1];
+}
+
+TTDEF tt_quad_map tt_quad_map_compose(tt_quad_map outer, tt_quad_map inner)
+{
+    tt_quad_map m;
+    double shifted[2];
+    TT_ASSERT(outer.turns >= 0 && outer.turns < 4 && inner.turns >= 0 && inner.turns < 4);
+    tt_quad_map_apply(outer, inner.offset[0], inner.offset[1], shifted);
+    m.turns = (outer.turns + inner.turns) & 3;
+    m.offset[0] = (int)shifted[0];
+    m.offset[1] = (int)shifted[1];
+    return m;
+}
+
+TTDEF tt_quad_map tt_polycube_unfold(const tt_polycube *polycube, int halfedge)
+{
+    const tt_mesh *s;
+    int twin, i, j, target[2], source[2];
+    double turned[2];
+    tt_quad_map m;
+    TT_ASSERT(polycube && polycube->surface && halfedge >= 0 && halfedge < polycube->surface->ncorners);
+    s = polycube->surface;
+    twin = s->twin[halfedge];
+    TT_ASSERT(twin >= 0);
+    i = halfedge - s->face_start[s->corner_face[halfedge]];
+    j = twin - s->face_start[s->corner_face[twin]];
+    /* Half-edge k of a quad points along +s turned k quarter turns; the twin, turned into this frame, must
+       point the opposite way: turns + j = i + 2. Then corner j of the far quad goes to corner i + 1 here. */
+    m.turns = (i - j + 6) & 3;
+    tt__quad_corner_st(i + 1, target);
+    tt__quad_corner_st(j, source);
+    tt__quarter_turns(m.turns, source[0], source[1], turned);
+    m.offset[0] = target[0] - (int)turned[0];
+    m.offset[1] = target[1] - (int)turned[1];
+    return m;
+}
+
+/* The search for one edge's path: the path grows from q_a's quad; every
+   quad's frame is mapped into the plane of q_a's quad. */
+typedef struct tt__edge_search {
+    const tt_polycube *pc;
+    double a[2];        /* q_a: in the plane, as its quad is the plane's frame */
+    double b[2];        /* q_b in its own quad's frame */
+    int quad_b, max_quads, steps;
+    int quads[TT_POLYCUBE_EDGE_MAX_QUADS];
+    int halfedges[TT_POLYCUBE_EDGE_MAX_QUADS];  /* halfedges[i] leaves quads[i] for quads[i + 1] */
+    tt_quad_map maps[TT_POLYCUBE_EDGE_MAX_QUADS];
+    int best_count;     /* quads of the best path so far; 0 = none */
+    double best_length;
+    tt_edge_crossing crossings[TT_POLYCUBE_EDGE_MAX_QUADS];        /* a path's, while it is judged */
+    tt_edge_crossing best_crossings[TT_POLYCUBE_EDGE_MAX_QUADS];
+} tt__edge_search;
+
+/* The ends of half-edge h of S in the plane, through `map` (its quad's). */
+static void tt__edge_in_plane(const tt_mesh *s, int h, tt_quad_map map, double e0[2], double e1[2])
+{
+    int k = h - s->face_start[s->corner_face[h]], st0[2], st1[2];
+    tt__quad_corner_st(k, st0);
+    tt__quad_corner_st(k + 1, st1);
+    tt_quad_map_apply(map, st0[0], st0[1], e0);
+    tt_quad_map_apply(map, st1[0], st1[1], e1);
+}
+
+/* One straight leg of a path in the plane, from p to q, crossing
+   halfedges[first..last) (halfedges[i] leaves quad i, mapped into the plane
+   by maps[i]); t runs from t0 at p to t1 at q. 0 when it does not cross
+   exactly those edges in order. Each crossing must lie on the closed edge,
+   the leg must leave the quad through it (or run along it, passing where
+   it enters the edge), and t must not decrease: between two crossings the
+   leg joins two points of one convex square, so it stays inside it. */
+static int tt__edge_leg(const tt_mesh *s, const int *halfedges, const tt_quad_map *maps, int first, int last,
+                        const double p[2], const double q[2], double t0, double t1, tt_edge_crossing *crossing)
+{
+    double d[2], dd, length, previous = 0.0, tolerance;
+    int i;
+    d[0] = q[0] - p[0];
+    d[1] = q[1] - p[1];
+    dd = d[0] * d[0] + d[1] * d[1];
+    length = sqrt(dd);
+    tolerance = TT__EDGE_EPS / (length > TT__EDGE_EPS ? length : TT__EDGE_EPS);   /* in the leg's parameter */
+    for (i = first; i < last; i++) {
+        double e0[2], e1[2], dir[2], normal[2], outward, gap, u, along, at[2];
+        tt__edge_in_plane(s, halfedges[i], maps[i], e0, e1);
+        dir[0] = e1[0] - e0[0];
+        dir[1] = e1[1] - e0[1];
+        normal[0] = dir[1];          /* the quad lies to the left of its CCW edge */
+        normal[1] = -dir[0];
+        outward = d[0] * normal[0] + d[1] * normal[1];
+        gap = (e0[0] - p[0]) * normal[0] + (e0[1] - p[1]) * normal[1];
+        if (outward > TT__EDGE_EPS) {
+            u = gap / outward;
+        } else if (fabs(outward) <= TT__EDGE_EPS && fabs(gap) <= TT__EDGE_EPS) {
+            /* Along the edge's line: pass where the leg enters the edge, or at once if it is on it. */
+            if (dd <= TT__EDGE_EPS * TT__EDGE_EPS) {
+                u = previous;
+            } else {
+                double u0 = ((e0[0] - p[0]) * d[0] + (e0[1] - p[1]) * d[1]) / dd;
+                double u1 = ((e1[0] - p[0]) * d[0] + (e1[1] - p[1]) * d[1]) / dd;
+                u = u0 < u1 ? u0 : u1;
+                if ((u0 > u1 ? u0 : u1) < previous - tolerance) return 0;
+                if (u < previous) u = previous;
+            }
+        } else {
+            return 0;
+        }
+        if (u < previous - tolerance || u > 1.0 + tolerance) return 0;
+        u = u < previous ? previous : (u > 1.0 ? 1.0 : u);
+        at[0] = p[0] + u * d[0];
+        at[1] = p[1] + u * d[1];
+        along = (at[0] - e0[0]) * dir[0] + (at[1] - e0[1]) * dir[1];
+        if (along < -TT__EDGE_EPS || along > 1.0 + TT__EDGE_EPS) return 0;
+        crossing[i].halfedge = halfedges[i];
+        crossing[i].along = along < 0.0 ? 0.0 : (along > 1.0 ? 1.0 : along);
+        crossing[i].t = t0 + u * (t1 - t0);
+        previous = u;
+    }
+    return 1;
+}
+
+/* The number of quads around the S vertex that half-edge h leaves. */
+static int tt__surface_valence(const tt_mesh *s, int h)
+{
+    int around = h, count = 0;
+    do {
+        int quad = s->corner_face[around];
+        around = s->twin[s->face_start[quad] + ((around - s->face_start[quad] + 3) & 3)];
+        count++;
+    } while (around != h && count <= s->ncorners);
+    return count;
+}
+
+/* The angle between two vectors, 0..pi. */
+static double tt__angle2(const double x[2], const double y[2])
+{
+    return atan2(fabs(x[0] * y[1] - x[1] * y[0]), x[0] * y[0] + x[1] * y[1]);
+}
+
+/* The bends of a path (tt__edge_path_crossings): a choice, portal by
+   portal, of where its straight legs end. Bend m is at vertex at[m] (in
+   the plane), where the path crosses portals first[m]..end[m]-1 (the run of
+   quads around the vertex, all crossed at one t). */
+typedef struct tt__edge_bends {
+    const tt_mesh *s;
+    const int *halfedges;
+    const tt_quad_map *maps;
+    int portals, count, best_count;
+    double a[2], b[2], length, best_length;     /* best_length starts as a bound: the search's best path */
+    int first[TT__EDGE_BEND_QUADS], end[TT__EDGE_BEND_QUADS];
+    int best_first[TT__EDGE_BEND_QUADS], best_end[TT__EDGE_BEND_QUADS];
+    double at[TT__EDGE_BEND_QUADS][2], best_at[TT__EDGE_BEND_QUADS][2];
+    tt_edge_crossing scratch[TT__EDGE_BEND_QUADS];
+} tt__edge_bends;
+
+/* Is bend m locally shortest, the path coming from `from` and going on to
+   `to`? The angle on the run's side (from the way back, over the run's
+   quads, to the way on) and the rest of the turn around the vertex must
+   both be at least half a turn; only a saddle (more than 4 quads around
+   it) has room for that. */
+static int tt__edge_bend_holds(const tt__edge_bends *B, int m, const double from[2], const double to[2])
+{
+    const tt_mesh *s = B->s;
+    const double *v = B->at[m];
+    int h = B->halfedges[B->first[m]], quad = s->corner_face[h], k = h - s->face_start[quad], valence, i, outer;
+    int corner = s->face_start[quad] + k, st[2];
+    double back[2], on[2], edge_in[2], edge_out[2], run, point[2];
+    /* The vertex is the first portal's start corner or the next one. */
+    tt__quad_corner_st(k, st);
+    tt_quad_map_apply(B->maps[B->first[m]], st[0], st[1], point);
+    if (fabs(point[0] - v[0]) + fabs(point[1] - v[1]) > 0.5) corner = s->face_start[quad] + ((k + 1) & 3);
+    valence = tt__surface_valence(s, corner);
+    if (valence < 5) return 0;
+    back[0] = from[0] - v[0];
+    back[1] = from[1] - v[1];
+    on[0] = to[0] - v[0];
+    on[1] = to[1] - v[1];
+    for (outer = 0; outer < 2; outer++) {
+        double e0[2], e1[2], *edge = outer ? edge_out : edge_in;
+        i = outer ? B->end[m] - 1 : B->first[m];
+        tt__edge_in_plane(s, B->halfedges[i], B->maps[i], e0, e1);
+        if (fabs(e0[0] - v[0]) + fabs(e0[1] - v[1]) < 0.5) {
+            edge[0] = e1[0] - v[0];
+            edge[1] = e1[1] - v[1];
+        } else {
+            edge[0] = e0[0] - v[0];
+            edge[1] = e0[1] - v[1];
+        }
+    }
+    run = tt__angle2(back, edge_in) + (B->end[m] - B->first[m] - 1) * 0.5 * TT__PI + tt__angle2(edge_out, on);
+    return run >= TT__PI - TT__EDGE_ANGLE_EPS && valence * 0.5 * TT__PI - run >= TT__PI - TT__EDGE_ANGLE_EPS;
+}
+
+static double tt__distance2(const double p[2], const double q[2])
+{
+    return sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]));
+}
+
+/* Does portal i of the path have vertex v (in the plane) as an end? */
+static int tt__edge_portal_has(const tt__edge_bends *B, int i, const double v[2])
+{
+    double e0[2], e1[2];
+    tt__edge_in_plane(B->s, B->halfedges[i], B->maps[i], e0, e1);
+    return (e0[0] == v[0] && e0[1] == v[1]) || (e1[0] == v[0] && e1[1] == v[1]);
+}
+
+/* From portal i on, the current leg starting at p after portal `leg_first`
+   (bends before it: B->count): end the leg at a vertex of portal i, or go
+   on. At the last portal the leg goes to q_b; a complete choice whose legs
+   all cross their portals and whose bends all hold is kept when shorter. */
+static void tt__edge_bend_search(tt__edge_bends *B, int i, int leg_first, const double p[2])
+{
+    int end, j;
+    if (i == B->portals) {
+        double length = B->length + tt__distance2(p, B->b);
+        if (B->count == 0 || length >= B->best_length - TT__EDGE_EPS) return;
+        if (!tt__edge_leg(B->s, B->halfedges, B->maps, leg_first, B->portals, p, B->b, 0.0, 1.0, B->scratch) ||
+            !tt__edge_bend_holds(B, B->count - 1, B->count > 1 ? B->at[B->count - 2] : B->a, B->b))
+            return;
+        B->best_count = B->count;
+        B->best_length = length;
+        memcpy(B->best_first, B->first, sizeof B->first);
+        memcpy(B->best_end, B->end, sizeof B->end);
+        memcpy(B->best_at, B->at, sizeof B->at);
+        return;
+    }
+    tt__edge_bend_search(B, i + 1, leg_first, p);
+    if (B->count == TT__EDGE_BEND_QUADS) return;
+    for (end = 0; end < 2; end++) {
+        const int h = B->halfedges[i], quad = B->s->corner_face[h];
+        double e0[2], e1[2], *v = B->at[B->count], leg, kept_length = B->length;
+        /* Only a saddle can hold a bend; and the path through v is at least as long as the straight line on. */
+        if (tt__surface_valence(B->s, B->s->face_start[quad] + ((h - B->s->face_start[quad] + end) & 3)) < 5)
+            continue;
+        tt__edge_in_plane(B->s, h, B->maps[i], e0, e1);
+        v[0] = end ? e1[0] : e0[0];
+        v[1] = end ? e1[1] : e0[1];
+        leg = tt__distance2(p, v);
+        if (leg <= TT__EDGE_EPS || B->length + leg + tt__distance2(v, B->b) >= B->best_length - TT__EDGE_EPS ||
+            !tt__edge_leg(B->s, B->halfedges, B->maps, leg_first, i, p, v, 0.0, 1.0, B->scratch))
+            continue;
+        if (B->count > 0 && !tt__edge_bend_holds(B, B->count - 1, B->count > 1 ? B->at[B->count - 2] : B->a, v))
+            continue;
+        B->first[B->count] = i;
+        for (j = i + 1; j <= B->portals; j++) {
+            if (j > i + 1 && !tt__edge_portal_has(B, j - 1, v)) break;
+            B->end[B->count] = j;
+            B->length = kept_length + leg;
+            B->count++;
+            tt__edge_bend_search(B, j, j, v);
+            B->count--;
+        }
+        B->length = kept_length;
+    }
+}
+
+/* Is the path of `count` quads leaving by halfedges[0..count-2] the image
+   of the edge? Unfolded into q_a's plane it must be either straight from
+   q_a to q_b (see tt__edge_leg), or - paths of at most
+   TT__EDGE_BEND_QUADS quads only - straight legs meeting at
+   saddle vertices of S (5 or 6 quads around them, more than a full turn),
+   each bend passing around its vertex through a run of the path's quads
+   (their edges crossed at the vertex, at one t), with at least half a turn
+   on both sides: a shortest path, which on a saddle no straight one
+   replaces (the staircases of a sphere are full of them). The shortest
+   choice of bends wins. The crossings go to crossing[], the length to
+   *length; t runs in proportion to the length along the path. */
+static int tt__edge_path_crossings(const tt__edge_search *S, const int *halfedges, int count,
+                                   tt_edge_crossing *crossing, double *length)
+{
+    const tt_mesh *s = S->pc->surface;
+    tt_quad_map maps[TT_POLYCUBE_EDGE_MAX_QUADS];
+    tt__edge_bends B;
+    double b[2], walked = 0.0;
+    int i, m;
+    maps[0].turns = maps[0].offset[0] = maps[0].offset[1] = 0;
+    for (i = 0; i + 1 < count; i++) maps[i + 1] = tt_quad_map_compose(maps[i], tt_polycube_unfold(S->pc, halfedges[i]));
+    tt_quad_map_apply(maps[count - 1], S->b[0], S->b[1], b);
+    if (tt__edge_leg(s, halfedges, maps, 0, count - 1, S->a, b, 0.0, 1.0, crossing)) {
+        *length = tt__distance2(S->a, b);
+        return 1;
+    }
+    if (count > TT__EDGE_BEND_QUADS) return 0;
+    memset(&B, 0, sizeof B);
+    B.s = s;
+    B.halfedges = halfedges;
+    B.maps = maps;
+    B.portals = count - 1;
+    B.a[0] = S->a[0];
+    B.a[1] = S->a[1];
+    B.b[0] = b[0];
+    B.b[1] = b[1];
+    /* Only a path no longer than the best so far can win (of equal ones, the one with fewer quads). */
+    B.best_length = S->best_count ? S->best_length + 2.0 * TT__EDGE_EPS : HUGE_VAL;
+    tt__edge_bend_search(&B, 0, 0, B.a);
+    if (!B.best_count) return 0;
+    /* The legs again, now with t: A, the bends, B, t in proportion to the length walked. */
+    for (m = 0; m <= B.best_count; m++) {
+        const double *from = m ? B.best_at[m - 1] : B.a, *to = m < B.best_count ? B.best_at[m] : B.b;
+        int leg_first = m ? B.best_end[m - 1] : 0, leg_last = m < B.best_count ? B.best_first[m] : count - 1;
+        double t0 = walked / B.best_length, t1;
+        walked += tt__distance2(from, to);
+        t1 = m < B.best_count ? walked / B.best_length : 1.0;
+        tt__edge_leg(s, halfedges, maps, leg_first, leg_last, from, to, t0, t1, crossing);
+        for (i = leg_last; m < B.best_count && i < B.best_end[m]; i++) {
+            double e0[2], e1[2];
+            tt__edge_in_plane(s, halfedges[i], maps[i], e0, e1);
+            crossing[i].halfedge = halfedges[i];
+            crossing[i].along = e0[0] == to[0] && e0[1] == to[1] ? 0.0 : 1.0;
+            crossing[i].t = t1;
+        }
+    }
+    *length = B.best_length;
+    return 1;
+}
+
+/* The funnel: the directions from q_a through every edge crossed so far
+   (angles relative to `reference`, in [lo, hi]); `has` once an edge not
+   through q_a has narrowed it, `closed` once no straight segment from q_a
+   crosses them all. A closed funnel ends a path only beyond
+   TT__EDGE_BEND_QUADS quads, as shorter paths may bend at a
+   saddle (tt__edge_path_crossings). */
+typedef struct tt__edge_funnel {
+    int has, closed;
+    double reference, lo, hi;
+} tt__edge_funnel;
+
+/* Grow the path from quads[depth - 1], depth first, half-edges in corner
+   order; at q_b's quad judge it (tt__edge_path_crossings). */
+static void tt__edge_search_from(tt__edge_search *S, int depth, tt__edge_funnel funnel)
+{
+    const tt_mesh *s = S->pc->surface;
+    int quad = S->quads[depth - 1], k;
+    if (quad == S->quad_b) {
+        double length;
+        if (tt__edge_path_crossings(S, S->halfedges, depth, S->crossings, &length) &&
+            (!S->best_count || length < S->best_length - TT__EDGE_EPS ||
+             (length <= S->best_length + TT__EDGE_EPS && depth < S->best_count))) {
+            S->best_count = depth;
+            S->best_length = length;
+            memcpy(S->best_crossings, S->crossings, sizeof(tt_edge_crossing) * (size_t)(depth - 1));
+        }
+        return;
+    }
+    if (depth == S->max_quads) return;
+    for (k = 0; k < 4; k++) {
+        int h = s->face_start[quad] + k, next = s->corner_face[s->twin[h]], i, seen = 0;
+        double e0[2], e1[2], d0[2], d1[2], inside;
+        tt__edge_funnel narrowed = funnel;
+        for (i = 0; i < depth && !seen; i++) seen = S->quads[i] == next;
+        if (seen || ++S->steps > TT__EDGE_SEARCH_BUDGET) continue;
+        tt__edge_in_plane(s, h, S->maps[depth - 1], e0, e1);
+        if (S->best_count &&
+            tt__point_segment_distance(S->a[0], S->a[1], e0[0], e0[1], e1[0], e1[1]) > S->best_length + TT__EDGE_EPS)
+            continue;
+        d0[0] = e0[0] - S->a[0];
+        d0[1] = e0[1] - S->a[1];
+        d1[0] = e1[0] - S->a[0];
+        d1[1] = e1[1] - S->a[1];
+        /* q_a's distance from the edge's line, positive on the quad's side (the edge has length 1). */
+        inside = d0[0] * d1[1] - d0[1] * d1[0];
+        if (inside < -TT__EDGE_EPS) narrowed.closed = 1;   /* a straight segment could only cross it before q_a */
+        if (inside > TT__EDGE_EPS && !narrowed.closed) {
+            double start = atan2(d0[1], d0[0]), width = atan2(inside, d0[0] * d1[0] + d0[1] * d1[1]);
+            if (!funnel.has) {
+                narrowed.has = 1;
+                narrowed.reference = start + 0.5 * width;
+                narrowed.lo = -0.5 * width;
+                narrowed.hi = 0.5 * width;
+            } else {
+                /* Both the funnel and this edge's directions span less than half a turn, so they overlap
+                   in at most one piece: here, or one turn lower. */
+                double from = start - funnel.reference;
+                while (from > TT__PI) from -= TT__TWO_PI;
+                while (from <= -TT__PI) from += TT__TWO_PI;
+                if (from > funnel.hi + TT__EDGE_ANGLE_EPS) from -= TT__TWO_PI;
+                if (from > funnel.hi + TT__EDGE_ANGLE_EPS || from + width < funnel.lo - TT__EDGE_ANGLE_EPS) {
+                    narrowed.closed = 1;
+                } else {
+                    if (from > narrowed.lo) narrowed.lo = from;
+                    if (from + width < narrowed.hi) narrowed.hi = from + width;
+                    if (narrowed.lo > narrowed.hi) narrowed.lo = narrowed.hi = 0.5 * (narrowed.lo + narrowed.hi);
+                }
+            }
+        }
+        if (narrowed.closed && depth + 1 > TT__EDGE_BEND_QUADS) continue;
+        S->halfedges[depth - 1] = h;
+        S->quads[depth] = next;
+        S->maps[depth] = tt_quad_map_compose(S->maps[depth - 1], tt_polycube_unfold(S->pc, h));
+        tt__edge_search_from(S, depth + 1, narrowed);
+    }
+}
+
+static double tt__edge_snap(double x)
+{
+    return x < TT__EDGE_SNAP ? 0.0 : (x > 1.0 - TT__EDGE_SNAP ? 1.0 : x);
+}
+
+TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges)
+{
+    tt_allocator allocator;
+    if (!edges) return;
+    allocator = edges->allocator;
+    tt__free(&allocator, edges->edge_of_halfedge);
+    tt__free(&allocator, edges->edge_vertices);
+    tt__free(&allocator, edges->first_crossing);
+    tt__free(&allocator, edges->crossings);
+    tt__free(&allocator, edges->failed);
+    tt__free(&allocator, edges);
+}
+
+TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_mesh *mesh,
+                                        const tt_surface_point *points, int npoints,
+                                        const tt_polycube_edge_options *options, const tt_allocator *allocator,
+                                        tt_polycube_edges **out, tt_error *error)
+{
+    tt_polycube_edges *E = NULL;
+    tt__edge_search *S = NULL;
+    int max_quads = options && options->max_quads ? options->max_quads : TT_POLYCUBE_EDGE_DEFAULT_QUADS;
+    int c, v, e, capacity = 0;
+    tt__ok(error);
+    if (out) *out = NULL;
+    if (!polycube || !mesh || !points || !out)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_trace_edges needs a polycube, a mesh, points and out (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (options && (options->max_quads < 0 || options->max_quads > TT_POLYCUBE_EDGE_MAX_QUADS))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_quads %d is outside 0..%d",
+                        options->max_quads, TT_POLYCUBE_EDGE_MAX_QUADS);
+    if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    if (npoints != mesh->nverts)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "%d points for a mesh of %d vertices: give one point per vertex", npoints, mesh->nverts);
+    if (!tt__polycube_consistent(polycube))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the polycube's surface has no quads or does not match its cubes: make it with "
+                        "tt_polycube_build and leave it unchanged");
+    for (v = 0; v < npoints; v++)
+        if (points[v].quad < 0 || points[v].quad >= polycube->surface->nfaces || !(points[v].s >= 0.0f) ||
+            !(points[v].s <= 1.0f) || !(points[v].t >= 0.0f) || !(points[v].t <= 1.0f))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, v, -1,
+                            "the point of vertex %d (quad %d, s %g, t %g) is not on S: the quad must be one of "
+                            "S's %d and s, t in [0, 1]", v, points[v].quad, (double)points[v].s,
+                            (double)points[v].t, polycube->surface->nfaces);
+
+    E = TT__ALLOC(allocator, tt_polycube_edges, 1);
+    if (!E) goto out_of_memory;
+    memset(E, 0, sizeof *E);
+    E->allocator = tt__allocator_copy(allocator);
+    S = TT__ALLOC(allocator, tt__edge_search, 1);
+    if (!S) goto out_of_memory;
+    /* One edge per twin pair, numbered in order of its first half-edge. */
+    E->edge_of_halfedge = TT__ALLOC(allocator, int, mesh->ncorners);
+    if (!E->edge_of_halfedge) goto out_of_memory;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int twin = mesh->twin[c];
+        E->edge_of_halfedge[c] = twin >= 0 && twin < c ? E->edge_of_halfedge[twin] : E->nedges++;
+    }
+    E->edge_vertices = TT__ALLOC(allocator, int, (size_t)E->nedges * 2);
+    E->first_crossing = TT__ALLOC(allocator, int, (size_t)E->nedges + 1);
+    E->failed = TT__ALLOC(allocator, unsigned char, E->nedges);
+    if (!E->edge_vertices || !E->first_crossing || !E->failed) goto out_of_memory;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int f = mesh->corner_face[c], next = c + 1 < mesh->face_start[f + 1] ? c + 1 : mesh->face_start[f];
+        int from = mesh->corner_vert[c], to = mesh->corner_vert[next];
+        e = E->edge_of_halfedge[c];
+        E->edge_vertices[2 * e] = from < to ? from : to;
+        E->edge_vertices[2 * e + 1] = from < to ? to : from;
+    }
+
+    memset(S, 0, sizeof *S);
+    S->pc = polycube;
+    S->max_quads = max_quads;
+    for (e = 0; e < E->nedges; e++) {
+        tt_surface_point qa = points[E->edge_vertices[2 * e]], qb = points[E->edge_vertices[2 * e + 1]];
+        tt__edge_funnel funnel;
+        const tt_edge_crossing *crossing = S->best_crossings;
+        int count, i;
+        E->first_crossing[e] = E->ncrossings;
+        S->a[0] = qa.s;
+        S->a[1] = qa.t;
+        S->b[0] = qb.s;
+        S->b[1] = qb.t;
+        S->quad_b = qb.quad;
+        S->quads[0] = qa.quad;
+        S->maps[0].turns = S->maps[0].offset[0] = S->maps[0].offset[1] = 0;
+        S->best_count = 0;
+        S->steps = 0;
+        memset(&funnel, 0, sizeof funnel);
+        tt__edge_search_from(S, 1, funnel);
+        E->failed[e] = S->best_count == 0;
+        if (E->failed[e]) {
+            E->nfailed++;
+            continue;
+        }
+        count = S->best_count - 1;
+        if (count > 0) {
+            tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(allocator, E->crossings, &capacity,
+                                                                   E->ncrossings + count, sizeof(tt_edge_crossing));
+            if (!grown) goto out_of_memory;
+            E->crossings = grown;
+        }
+        for (i = 0; i < count; i++) {
+            /* P11 step 4.5, once per edge: no zero-length piece next to a vertex or a quad corner. */
+            tt_edge_crossing snapped = crossing[i];
+            snapped.along = tt__edge_snap(snapped.along);
+            snapped.t = tt__edge_snap(snapped.t);
+            E->crossings[E->ncrossings++] = snapped;
+        }
+    }
+    E->first_crossing[E->nedges] = E->ncrossings;
+    tt__free(allocator, S);
+    *out = E;
+    return TT_OK;
+out_of_memory:
+    tt__free(allocator, S);
+    tt_polycube_edges_free(E);
+    return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory tracing the mesh's edges on S");
 }
 
 #ifdef __cplusplus

@@ -289,6 +289,24 @@ int main(void)
             at[1] -= mesh->pos[1];
             at[2] -= mesh->pos[2];
             EXPECT(at[0] * at[0] + at[1] * at[1] + at[2] * at[2] < 1e-12);
+            {
+                /* The cube's 12 edges on S (each passes the lattice point at its middle), and the unfolding
+                   across one of S's edges and back. */
+                tt_polycube_edges *pe = NULL;
+                tt_polycube_edge_options peo;
+                tt_quad_map there, back, round;
+                double st[2];
+                peo.max_quads = 6;
+                EXPECT(tt_polycube_trace_edges(pc, mesh, points, 8, &peo, NULL, &pe, &err) == TT_OK && pe &&
+                       pe->nedges == 12 && pe->nfailed == 0 && pe->ncrossings >= 12 &&
+                       pe->first_crossing[pe->nedges] == pe->ncrossings);
+                tt_polycube_edges_free(pe);
+                there = tt_polycube_unfold(pc, 0);
+                back = tt_polycube_unfold(pc, pc->surface->twin[0]);
+                round = tt_quad_map_compose(there, back);
+                tt_quad_map_apply(round, 0.25, 0.5, st);
+                EXPECT(round.turns == 0 && st[0] == 0.25 && st[1] == 0.5);
+            }
         }
         tt_polycube_free(pc);
     }

@@ -1295,6 +1295,442 @@ static void test_project_determinism_and_errors(void)
     tm_free(&m);
 }
 
+/* ------------------------------------------------------------------------ */
+/* The images of the mesh's edges on S (spec P11 step 3)                    */
+/* ------------------------------------------------------------------------ */
+
+/* The 3D point of a crossing: `along` on its S half-edge, between the
+   half-edge's two corners (in double). */
+static void crossing_position(const tt_polycube *pc, tt_edge_crossing x, double xyz[3])
+{
+    const tt_mesh *s = pc->surface;
+    int quad = s->corner_face[x.halfedge], k = x.halfedge - s->face_start[quad], i, a;
+    double end[2][3];
+    for (i = 0; i < 2; i++) {
+        int corner = (k + i) & 3;
+        tt_surface_point p;
+        p.quad = quad;
+        p.s = (float)(corner == 1 || corner == 2);
+        p.t = (float)(corner >= 2);
+        tt_polycube_point_position(pc, p, end[i]);
+    }
+    for (a = 0; a < 3; a++) xyz[a] = end[0][a] + x.along * (end[1][a] - end[0][a]);
+}
+
+/* The axis an S half-edge runs along. */
+static int halfedge_axis(const tt_polycube *pc, int h)
+{
+    const tt_mesh *s = pc->surface;
+    int quad = s->corner_face[h], next = s->face_start[quad] + ((h - s->face_start[quad] + 1) & 3), a, best = 0;
+    const float *p0 = s->pos + 3 * s->corner_vert[h], *p1 = s->pos + 3 * s->corner_vert[next];
+    for (a = 1; a < 3; a++)
+        if (fabs(p1[a] - p0[a]) > fabs(p1[best] - p0[best])) best = a;
+    return best;
+}
+
+static tt_polycube_edges *traced(const tt_polycube *pc, const tt_mesh *mesh, const tt_surface_point *pts,
+                                 int max_quads)
+{
+    tt_polycube_edges *edges = NULL;
+    tt_polycube_edge_options eo;
+    tt_error err;
+    eo.max_quads = max_quads;
+    if (tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, &eo, NULL, &edges, &err) != TT_OK)
+        CHECK(0, "tt_polycube_trace_edges: %s", err.message);
+    return edges;
+}
+
+/* Spec Q2 for the edges: the cube mesh lies on S, so every edge's image is
+   the edge itself. Edges are N or N sqrt 2 cubes long here, so the path
+   limit is raised to 2N + 2 quads (a face diagonal passes N - 1 quad
+   corners: 2N - 1 quads). */
+static void test_edges_cube(void)
+{
+    unsigned char one = 1;
+    int n;
+    for (n = 1; n <= 8; n++) {
+        tmesh m;
+        tt_mesh *mesh;
+        tt_surface_point *pts;
+        tt_polycube_options o;
+        tt_polycube_projection_report pr;
+        tt_polycube_report rep;
+        tt_polycube *pc;
+        tt_polycube_edges *edges;
+        int e, failed = 0, wrong_count = 0, off_edge = 0, wrong_line = 0, at_ends = 0, unsnapped = 0, along_fold = 0;
+        double worst = 0.0;
+        memset(&m, 0, sizeof m);
+        make_cube_set(&m, &one, 1, 1, 1, 1.0, 1);
+        memset(&o, 0, sizeof o);
+        o.resolution = n;
+        pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+        edges = pc ? traced(pc, mesh, pts, 2 * n + 2) : NULL;
+        if (!edges) {
+            tt_polycube_free(pc);
+            tt_mesh_free(mesh);
+            free(pts);
+            tm_free(&m);
+            continue;
+        }
+        for (e = 0; e < edges->nedges; e++) {
+            const float *pa = mesh->pos + 3 * edges->edge_vertices[2 * e];
+            const float *pb = mesh->pos + 3 * edges->edge_vertices[2 * e + 1];
+            int expected = 0, interior = 0, a, k, marks[3][9];
+            memset(marks, 0, sizeof marks);
+            for (a = 0; a < 3; a++) {
+                int span = (int)floor(fabs(pb[a] - pa[a]) / pc->h + 0.5);
+                if (span > 1) expected += span - 1;
+            }
+            if (edges->failed[e]) { failed++; continue; }
+            for (k = edges->first_crossing[e]; k < edges->first_crossing[e + 1]; k++) {
+                tt_edge_crossing x = edges->crossings[k];
+                double at[3], on_edge[3], d = 0, g;
+                int axis = halfedge_axis(pc, x.halfedge), line = -1;
+                crossing_position(pc, x, at);
+                for (a = 0; a < 3; a++) {
+                    on_edge[a] = pa[a] + x.t * (pb[a] - pa[a]);
+                    d += (at[a] - on_edge[a]) * (at[a] - on_edge[a]);
+                }
+                d = sqrt(d) / pc->h;
+                if (d > worst) worst = d;
+                off_edge += d > 1e-6;
+                if (x.t == 0.0 || x.t == 1.0) { at_ends++; continue; }
+                /* The lattice line crossed: across an axis the edge runs along and the S edge does not. */
+                for (a = 0; a < 3; a++)
+                    if (a != axis && fabs(pb[a] - pa[a]) > 0.5 * pc->h) line = a;
+                if (line < 0) {
+                    /* The S edge runs along the mesh edge (a fold of the cube): the path passes to the quad
+                       across the fold where the segment enters that S edge, crossing no lattice line. */
+                    along_fold++;
+                    continue;
+                }
+                interior++;
+                g = (at[line] - pc->origin[line]) / pc->h;
+                if (fabs(g - floor(g + 0.5)) > 1e-6) { wrong_line++; continue; }
+                g = fabs(at[line] - pa[line]) / pc->h;
+                if (marks[line][(int)floor(g + 0.5)]++) wrong_line++;
+                /* A crossing at a quad corner is snapped onto it exactly. */
+                unsnapped += x.along != 0.0 && x.along != 1.0 && fabs(x.along - floor(x.along + 0.5)) < 1e-3;
+            }
+            wrong_count += interior != expected;
+        }
+        CHECK(failed == 0 && wrong_count == 0 && off_edge == 0 && wrong_line == 0 && unsnapped == 0,
+              "cube at N = %d: %d edges, %d crossings, none failed (%d), inner crossings as many as the lattice "
+              "lines crossed in 3D on every edge (%d edges wrong), each on a distinct line crossed (%d not), at "
+              "the mesh edge's point of t within 1e-6 h (%d not, worst %.2g h), corners snapped (%d not); %d "
+              "crossings at the edge's ends, %d onto the quad across a fold", n, edges->nedges, edges->ncrossings,
+              failed, wrong_count, wrong_line, off_edge, worst, unsnapped, at_ends, along_fold);
+        tt_polycube_edges_free(edges);
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        free(pts);
+        tm_free(&m);
+    }
+}
+
+/* Is the record of `edges` a connected path from quad(q_a) to quad(q_b),
+   ordered by t, with t in proportion to the length walked on S? Each piece
+   between two crossings lies in one flat quad, so its 3D length is its
+   length on S: piece k must be (t_k+1 - t_k) times the path's length
+   (1e-5 h for the snapping). Counts the offending edges. */
+typedef struct edges_check {
+    int disordered, disconnected, out_of_range, mismatched_halfedges, wrong_lengths;
+} edges_check;
+
+static double distance3(const double *p, const double *q)
+{
+    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+static edges_check check_edges(const tt_polycube *pc, const tt_mesh *mesh, const tt_surface_point *pts,
+                               const tt_polycube_edges *edges)
+{
+    const tt_mesh *s = pc->surface;
+    edges_check c;
+    int e, h, failed = 0;
+    memset(&c, 0, sizeof c);
+    for (e = 0; e < edges->nedges; e++) {
+        int quad = pts[edges->edge_vertices[2 * e]].quad, k, bad_order = 0, bad_path = 0, bad_range = 0;
+        failed += edges->failed[e];
+        if (edges->failed[e]) {
+            bad_path = edges->first_crossing[e] != edges->first_crossing[e + 1];
+        } else {
+            for (k = edges->first_crossing[e]; k < edges->first_crossing[e + 1]; k++) {
+                tt_edge_crossing x = edges->crossings[k];
+                bad_range |= !(x.t >= 0 && x.t <= 1 && x.along >= 0 && x.along <= 1);
+                bad_order |= k > edges->first_crossing[e] && !(edges->crossings[k - 1].t <= x.t);
+                bad_path |= x.halfedge < 0 || x.halfedge >= s->ncorners || s->corner_face[x.halfedge] != quad;
+                if (!bad_path) quad = s->corner_face[s->twin[x.halfedge]];
+            }
+            bad_path |= quad != pts[edges->edge_vertices[2 * e + 1]].quad;
+            if (!bad_path && !bad_order) {
+                int first = edges->first_crossing[e], last = edges->first_crossing[e + 1], n = last - first + 2, i;
+                double *at = (double *)malloc(sizeof(double) * 3 * (size_t)n);
+                double *t = (double *)malloc(sizeof(double) * (size_t)n);
+                double walked = 0.0;
+                tt_polycube_point_position(pc, pts[edges->edge_vertices[2 * e]], at);
+                tt_polycube_point_position(pc, pts[edges->edge_vertices[2 * e + 1]], at + 3 * (n - 1));
+                t[0] = 0.0;
+                t[n - 1] = 1.0;
+                for (i = 1; i + 1 < n; i++) {
+                    crossing_position(pc, edges->crossings[first + i - 1], at + 3 * i);
+                    t[i] = edges->crossings[first + i - 1].t;
+                }
+                for (i = 0; i + 1 < n; i++) walked += distance3(at + 3 * i, at + 3 * i + 3);
+                for (i = 0; i + 1 < n; i++)
+                    if (fabs(distance3(at + 3 * i, at + 3 * i + 3) - (t[i + 1] - t[i]) * walked) > 1e-5 * pc->h) break;
+                c.wrong_lengths += i + 1 < n;
+                free(at);
+                free(t);
+            }
+        }
+        c.disordered += bad_order;
+        c.disconnected += bad_path;
+        c.out_of_range += bad_range;
+    }
+    for (h = 0; h < mesh->ncorners; h++) {
+        int f = mesh->corner_face[h], next = h + 1 < mesh->face_start[f + 1] ? h + 1 : mesh->face_start[f];
+        int e = edges->edge_of_halfedge[h], a = mesh->corner_vert[h], b = mesh->corner_vert[next];
+        c.mismatched_halfedges += e < 0 || e >= edges->nedges ||
+                                  (mesh->twin[h] >= 0 && edges->edge_of_halfedge[mesh->twin[h]] != e) ||
+                                  edges->edge_vertices[2 * e] != (a < b ? a : b) ||
+                                  edges->edge_vertices[2 * e + 1] != (a < b ? b : a);
+    }
+    c.out_of_range += failed != edges->nfailed || edges->first_crossing[0] != 0 ||
+                      edges->first_crossing[edges->nedges] != edges->ncrossings;
+    return c;
+}
+
+static void test_edges_sphere(void)
+{
+    const double center[3] = {0.13, -0.07, 0.21};
+    int k;
+    for (k = 0; k < 2; k++) {
+        int res = k ? 16 : 8;
+        tmesh m;
+        tt_mesh *mesh;
+        tt_surface_point *pts;
+        tt_polycube_options o;
+        tt_polycube_projection_report pr;
+        tt_polycube_report rep;
+        tt_polycube *pc;
+        tt_polycube_edges *edges;
+        edges_check c;
+        memset(&m, 0, sizeof m);
+        make_sphere(&m, 48, 24, 1.0, center, 0);
+        memset(&o, 0, sizeof o);
+        o.resolution = res;
+        pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+        edges = pc ? traced(pc, mesh, pts, 0) : NULL;
+        if (edges) {
+            c = check_edges(pc, mesh, pts, edges);
+            CHECK(edges->nedges == mesh->ncorners / 2 && c.mismatched_halfedges == 0,
+                  "sphere at resolution %d: %d edges for %d half-edges, both half-edges of each on its record "
+                  "(%d not)", res, edges->nedges, mesh->ncorners, c.mismatched_halfedges);
+            CHECK(c.disordered == 0 && c.disconnected == 0 && c.out_of_range == 0 && c.wrong_lengths == 0,
+                  "sphere at resolution %d: %d crossings, ordered by t on every edge (%d not), each a connected "
+                  "path from q_a's quad to q_b's (%d not), t and along in [0, 1] (%d not), t in proportion to "
+                  "the length on S (%d not)", res, edges->ncrossings, c.disordered, c.disconnected, c.out_of_range,
+                  c.wrong_lengths);
+            /* At 16 the equator's edges are 1.5 h long; where they cross a staircase some need 5 quads. */
+            CHECK(res == 8 ? edges->nfailed == 0 : edges->nfailed * 100 <= edges->nedges,
+                  "sphere at resolution %d: %d of %d edges without a path of at most 4 quads (at most %s)", res,
+                  edges->nfailed, edges->nedges, res == 8 ? "none" : "1 %");
+            if (res == 16) {
+                tt_polycube_edges *longer = traced(pc, mesh, pts, 6);
+                edges_check lc;
+                memset(&lc, 0, sizeof lc);
+                if (longer) lc = check_edges(pc, mesh, pts, longer);
+                CHECK(longer && longer->nfailed == 0 && lc.disconnected == 0 && lc.disordered == 0 &&
+                          lc.wrong_lengths == 0,
+                      "sphere at resolution 16 with paths of up to 6 quads: every edge traced (%d failed)",
+                      longer ? longer->nfailed : -1);
+                tt_polycube_edges_free(longer);
+            }
+        }
+        tt_polycube_edges_free(edges);
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        free(pts);
+        tm_free(&m);
+    }
+}
+
+/* Unfolding across an edge and back is the identity; the shared edge's
+   corners land on each other (the map is fixed by the half-edges alone). */
+static void test_unfold(void)
+{
+    unsigned char set[8] = {1, 1, 1, 0, 1, 0, 0, 0};   /* an L of cubes: convex and concave folds, corners */
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_polycube *pc = NULL;
+    tt_polycube_options o;
+    tt_error err;
+    int h, not_identity = 0, corners_apart = 0, turns_seen = 0;
+    memset(&m, 0, sizeof m);
+    make_cube_set(&m, set, 2, 2, 2, 1.0, 1);
+    memset(&o, 0, sizeof o);
+    o.resolution = 2;
+    if (build(&m, 0, &mesh, &err) != TT_OK || tt_polycube_build(mesh, &o, NULL, &pc, NULL, &err) != TT_OK) {
+        CHECK(0, "L-shape polycube: %s", err.message);
+        tt_mesh_free(mesh);
+        tm_free(&m);
+        return;
+    }
+    for (h = 0; h < pc->surface->ncorners; h++) {
+        const tt_mesh *s = pc->surface;
+        int twin = s->twin[h], i = h - s->face_start[s->corner_face[h]], j = twin - s->face_start[s->corner_face[twin]];
+        tt_quad_map there = tt_polycube_unfold(pc, h), back = tt_polycube_unfold(pc, twin);
+        tt_quad_map round = tt_quad_map_compose(there, back);
+        double p[2], q[2], c0[2], c1[2];
+        not_identity += round.turns != 0 || round.offset[0] != 0 || round.offset[1] != 0;
+        tt_quad_map_apply(there, (j & 3) == 1 || (j & 3) == 2, (j & 3) >= 2, p);
+        tt_quad_map_apply(there, ((j + 1) & 3) == 1 || ((j + 1) & 3) == 2, ((j + 1) & 3) >= 2, q);
+        c0[0] = ((i + 1) & 3) == 1 || ((i + 1) & 3) == 2;
+        c0[1] = ((i + 1) & 3) >= 2;
+        c1[0] = (i & 3) == 1 || (i & 3) == 2;
+        c1[1] = (i & 3) >= 2;
+        corners_apart += p[0] != c0[0] || p[1] != c0[1] || q[0] != c1[0] || q[1] != c1[1];
+        turns_seen |= 1 << there.turns;
+        {
+            /* The far quad's centre lands on the other side of the shared edge, one unit away. */
+            double centre[2], dx, dy;
+            tt_quad_map_apply(there, 0.5, 0.5, centre);
+            dx = centre[0] - 0.5;
+            dy = centre[1] - 0.5;
+            corners_apart += !(fabs(dx) + fabs(dy) == 1.0);
+        }
+    }
+    CHECK(not_identity == 0 && corners_apart == 0,
+          "L-shape at resolution 2, %d half-edges: across and back is the identity (%d not), the shared edge's "
+          "corners meet and the far quad lies beside (%d not)", pc->surface->ncorners, not_identity, corners_apart);
+    CHECK(turns_seen == 15, "every quarter turn occurs among the maps (mask %d)", turns_seen);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+typedef struct edges_oom_ctx {
+    const tt_polycube *pc;
+    const tt_mesh *mesh;
+    const tt_surface_point *pts;
+} edges_oom_ctx;
+
+static tt_result edges_oom_call(void *ctx, const tt_allocator *al)
+{
+    edges_oom_ctx *c = (edges_oom_ctx *)ctx;
+    tt_polycube_edges *edges = (tt_polycube_edges *)&edges;
+    tt_error err;
+    tt_result r = tt_polycube_trace_edges(c->pc, c->mesh, c->pts, c->mesh->nverts, NULL, al, &edges, &err);
+    if (err.result != r || (r != TT_OK) != (edges == NULL)) return TT_RESULT_MAX_ENUM;
+    tt_polycube_edges_free(edges);
+    return r;
+}
+
+static void test_edges_determinism_and_errors(void)
+{
+    const double center[3] = {0.31, 0.02, -0.17};
+    tmesh m;
+    tt_mesh *mesh, empty;
+    tt_surface_point *pts;
+    tt_polycube_options o;
+    tt_polycube_projection_report pr;
+    tt_polycube_report rep;
+    tt_polycube *pc;
+    tt_polycube_edges *edges, *again = NULL, *none = (tt_polycube_edges *)&none;
+    tt_polycube_edge_options eo;
+    tt_allocator half;
+    tt_error err;
+    tt_result r;
+    edges_oom_ctx ctx;
+    int same;
+    memset(&m, 0, sizeof m);
+    make_sphere(&m, 32, 16, 1.0, center, 0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 8;
+    pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+    edges = pc ? traced(pc, mesh, pts, 0) : NULL;
+    if (!edges) {
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        free(pts);
+        tm_free(&m);
+        return;
+    }
+    r = tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, NULL, NULL, &again, NULL);
+    same = r == TT_OK && again->nedges == edges->nedges && again->ncrossings == edges->ncrossings &&
+           again->nfailed == edges->nfailed &&
+           memcmp(again->first_crossing, edges->first_crossing, sizeof(int) * (size_t)(edges->nedges + 1)) == 0 &&
+           memcmp(again->failed, edges->failed, (size_t)edges->nedges) == 0 &&
+           memcmp(again->edge_vertices, edges->edge_vertices, sizeof(int) * 2 * (size_t)edges->nedges) == 0;
+    if (same) {
+        int k;
+        for (k = 0; k < edges->ncrossings; k++)
+            same &= again->crossings[k].halfedge == edges->crossings[k].halfedge &&
+                    memcmp(&again->crossings[k].along, &edges->crossings[k].along, sizeof(double)) == 0 &&
+                    memcmp(&again->crossings[k].t, &edges->crossings[k].t, sizeof(double)) == 0;
+    }
+    CHECK(same, "same input (options NULL = max_quads 0), bitwise the same record");
+    tt_polycube_edges_free(again);
+
+    CHECK(tt_polycube_trace_edges(NULL, mesh, pts, mesh->nverts, NULL, NULL, &none, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              none == NULL &&
+              tt_polycube_trace_edges(pc, NULL, pts, mesh->nverts, NULL, NULL, &none, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_polycube_trace_edges(pc, mesh, NULL, mesh->nverts, NULL, NULL, &none, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "NULL polycube, mesh, points or out: invalid, *out NULL");
+    none = (tt_polycube_edges *)&none;
+    r = tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts - 1, NULL, NULL, &none, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && none == NULL && msg_has_number(err.message, mesh->nverts - 1),
+          "one point too few: %d (%s)", r, err.message);
+    memset(&half, 0, sizeof half);
+    half.free = free_only;
+    CHECK(tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, NULL, &half, &none, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "an allocator with free only: invalid");
+    eo.max_quads = TT_POLYCUBE_EDGE_MAX_QUADS + 1;
+    r = tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, &eo, NULL, &none, &err);
+    eo.max_quads = -1;
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT &&
+              tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, &eo, NULL, &none, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "max_quads above TT_POLYCUBE_EDGE_MAX_QUADS or below 0: invalid");
+    memset(&empty, 0, sizeof empty);
+    CHECK(tt_polycube_trace_edges(pc, &empty, pts, 0, NULL, NULL, &none, &err) == TT_ERROR_EMPTY_MESH,
+          "a mesh without faces: empty");
+    {
+        tt_surface_point keep = pts[5];
+        int bad = 0, variant;
+        for (variant = 0; variant < 4; variant++) {
+            pts[5] = keep;
+            if (variant == 0) pts[5].quad = -1;
+            if (variant == 1) pts[5].quad = pc->surface->nfaces;
+            if (variant == 2) pts[5].s = 1.5f;
+            if (variant == 3) pts[5].t = (float)internal_not_a_number();
+            r = tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, NULL, NULL, &none, &err);
+            bad += !(r == TT_ERROR_INVALID_ARGUMENT && err.vertex == 5 && none == NULL);
+        }
+        pts[5] = keep;
+        CHECK(bad == 0, "a point with a quad outside S (-1, nfaces) or s, t outside [0, 1] (1.5, NaN): invalid at "
+                        "its vertex (%d cases not)", bad);
+    }
+    {
+        tt_polycube tampered = *pc;
+        tampered.dims[0] -= 1;
+        CHECK(tt_polycube_trace_edges(&tampered, mesh, pts, mesh->nverts, NULL, NULL, &none, &err) ==
+                  TT_ERROR_INVALID_ARGUMENT,
+              "a polycube whose cubes do not match its quads: invalid");
+    }
+    ctx.pc = pc;
+    ctx.mesh = mesh;
+    ctx.pts = pts;
+    oom_reset();
+    oom_sweep("tt_polycube_trace_edges(sphere at resolution 8)", edges_oom_call, &ctx, TT_OK);
+    tt_polycube_edges_free(edges);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    free(pts);
+    tm_free(&m);
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -1314,4 +1750,8 @@ void run_polycube_tests(void)
     RUN(test_project_thin_plate);
     RUN(test_project_open);
     RUN(test_project_determinism_and_errors);
+    RUN(test_unfold);
+    RUN(test_edges_cube);
+    RUN(test_edges_sphere);
+    RUN(test_edges_determinism_and_errors);
 }
