@@ -2534,13 +2534,18 @@ TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
    it interpolates, so normals, colours or skin weights carry through. */
 typedef struct tt_polycube_map_options {
     int max_quads;      /* the longest edge path, as tt_polycube_edge_options; 0 = its default */
+    double max_edge;    /* model edges longer than this (mesh units) are halved first, until none is;
+                           0 = TT_POLYCUBE_MAP_DEFAULT_EDGE times the cube size h; HUGE_VAL: never */
 } tt_polycube_map_options;
 
+#define TT_POLYCUBE_MAP_DEFAULT_EDGE 0.5
+
 typedef struct tt_polycube_map_report {
-    tt_polycube_projection_report projection;   /* how the vertices went onto S */
+    int triangles;          /* triangles of the model after refinement (max_edge), the ones mapped */
+    tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
-    int fallback_triangles; /* input triangles put whole into one quad (P11 step 7): a local seam; target 0 */
+    int fallback_triangles; /* of `triangles`, those put whole into one quad (P11 step 7): a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold of the projection) */
 } tt_polycube_map_report;
 
@@ -15823,6 +15828,218 @@ typedef struct tt__split_cell {
     tt_quad_map map;
 } tt__split_cell;
 
+/* The model refined for the split: its triangles halved along every edge
+   longer than a bound until none is, so that a triangle spans few quads of
+   S and holds at most about one vertex of S (a coarse model's large
+   triangles would each hold several cone points, which no single chart or
+   fan maps). Refined vertex v < mesh->nverts is input vertex v; each
+   refined vertex interpolates at most 3 vertices of one input triangle
+   (the midpoint of a midpoint stays on its triangle), and each refined
+   triangle knows its input face. */
+typedef struct tt__refined {
+    tt_mesh *mesh;
+    int *source;                /* 3 per vertex: input vertices... */
+    double *weight;             /* ...and their weights */
+    int *face;                  /* per triangle: its input face */
+} tt__refined;
+
+static void tt__refined_free(const tt_allocator *allocator, tt__refined *r)
+{
+    tt_mesh_free(r->mesh);
+    tt__free(allocator, r->source);
+    tt__free(allocator, r->weight);
+    tt__free(allocator, r->face);
+    memset(r, 0, sizeof *r);
+}
+
+/* The sources of the midpoint of refined vertices a and b: half of each,
+   the same input vertices added up (at most 3 distinct: both lie on one
+   input triangle). */
+static void tt__refined_midpoint_sources(const int *source, const double *weight, int a, int b, int out_source[3],
+                                         double out_weight[3])
+{
+    int n = 0, i, j, k;
+    for (k = 0; k < 3; k++) {
+        out_source[k] = source[3 * a];
+        out_weight[k] = 0.0;
+    }
+    for (i = 0; i < 6; i++) {
+        int v = source[3 * (i < 3 ? a : b) + i % 3];
+        double w = 0.5 * weight[3 * (i < 3 ? a : b) + i % 3];
+        if (w == 0.0) continue;
+        for (j = 0; j < n && out_source[j] != v; j++) continue;
+        if (j == n) {
+            if (n == 3) continue;
+            out_source[n++] = v;
+        }
+        out_weight[j] += w;
+    }
+}
+
+#define TT__REFINE_MAX_TRIANGLES (1 << 24)   /* refining stops short of this many triangles */
+
+static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
+                                     tt__refined *out, tt_error *error)
+{
+    float *positions = NULL;
+    int *triangles = NULL, *faces = NULL, *source = NULL, *mid = NULL, *next_triangles = NULL, *next_faces = NULL;
+    double *weight = NULL;
+    int nverts = mesh->nverts, ntriangles = mesh->nfaces, vertex_capacity = 0, pass, c, v, f;
+    tt_mesh *current = NULL;
+    tt_result result = TT_OK;
+    memset(out, 0, sizeof *out);
+    positions = (float *)tt__grow(allocator, NULL, &vertex_capacity, nverts > 0 ? nverts : 1, 3 * sizeof(float));
+    source = TT__ALLOC(allocator, int, 3 * (size_t)vertex_capacity);
+    weight = TT__ALLOC(allocator, double, 3 * (size_t)vertex_capacity);
+    triangles = TT__ALLOC(allocator, int, 3 * (size_t)ntriangles);
+    faces = TT__ALLOC(allocator, int, ntriangles);
+    if (!positions || !source || !weight || !triangles || !faces) goto out_of_memory;
+    memcpy(positions, mesh->pos, sizeof(float) * 3 * (size_t)nverts);
+    for (v = 0; v < nverts; v++) {
+        source[3 * v] = source[3 * v + 1] = source[3 * v + 2] = v;
+        weight[3 * v] = 1.0;
+        weight[3 * v + 1] = weight[3 * v + 2] = 0.0;
+    }
+    memcpy(triangles, mesh->corner_vert, sizeof(int) * 3 * (size_t)ntriangles);
+    for (f = 0; f < ntriangles; f++) faces[f] = f;
+    for (pass = 0;; pass++) {
+        tt_mesh_desc desc;
+        int marked = 0, next_count = 0;
+        memset(&desc, 0, sizeof desc);
+        desc.positions = positions;
+        desc.nverts = nverts;
+        desc.indices = triangles;
+        desc.nfaces = ntriangles;
+        desc.fixed_face_size = 3;
+        desc.flags = mesh->flags & TT_MESH_PERMISSIVE;
+        if ((result = tt_mesh_build(&desc, allocator, &current, error)) != TT_OK) goto failed;
+        mid = TT__ALLOC(allocator, int, current->ncorners);
+        if (!mid) goto out_of_memory;
+        for (c = 0; c < current->ncorners; c++) {
+            int a = current->corner_vert[c], b = current->corner_vert[tt_mesh_next(current, c)], twin = current->twin[c];
+            double d2 = 0.0;
+            int k;
+            for (k = 0; k < 3; k++) d2 += ((double)positions[3 * b + k] - positions[3 * a + k]) *
+                                          ((double)positions[3 * b + k] - positions[3 * a + k]);
+            mid[c] = -1;
+            if (d2 <= longest * longest) continue;
+            marked++;
+            if (twin >= 0 && twin < c) {
+                mid[c] = mid[twin];
+                continue;
+            }
+            if (nverts == vertex_capacity) {
+                int capacity = vertex_capacity, *grown_source;
+                float *grown_positions;
+                double *grown_weight;
+                if (nverts >= INT_MAX / 4) goto too_large;
+                grown_positions = (float *)tt__grow(allocator, positions, &capacity, nverts + 1, 3 * sizeof(float));
+                if (!grown_positions) goto out_of_memory;
+                positions = grown_positions;
+                capacity = vertex_capacity;
+                grown_source = (int *)tt__grow(allocator, source, &capacity, nverts + 1, 3 * sizeof(int));
+                if (!grown_source) goto out_of_memory;
+                source = grown_source;
+                capacity = vertex_capacity;
+                grown_weight = (double *)tt__grow(allocator, weight, &capacity, nverts + 1, 3 * sizeof(double));
+                if (!grown_weight) goto out_of_memory;
+                weight = grown_weight;
+                vertex_capacity = capacity;
+            }
+            for (k = 0; k < 3; k++)
+                positions[3 * nverts + k] = (float)(0.5 * ((double)positions[3 * a + k] + positions[3 * b + k]));
+            tt__refined_midpoint_sources(source, weight, a, b, source + 3 * nverts, weight + 3 * nverts);
+            mid[c] = nverts++;
+        }
+        if (!marked || ntriangles > TT__REFINE_MAX_TRIANGLES / 4) break;
+        if (ntriangles > (INT_MAX / 3) / 4) goto too_large;
+        next_triangles = TT__ALLOC(allocator, int, 12 * (size_t)ntriangles);
+        next_faces = TT__ALLOC(allocator, int, 4 * (size_t)ntriangles);
+        if (!next_triangles || !next_faces) goto out_of_memory;
+        for (f = 0; f < ntriangles; f++) {
+            int r, split = 0, *t;
+            const int *corner = triangles + 3 * f, *m = mid + 3 * f;
+            for (r = 0; r < 3; r++) split += m[r] >= 0;
+            /* Turn the triangle so its split edges come first: (a, b) always split when any is. */
+            for (r = 0; r < 3 && split > 0 && split < 3; r++)
+                if (m[r] >= 0 && m[(r + 2) % 3] < 0) break;
+            if (split == 0 || split == 3) r = 0;
+            {
+                int a = corner[r], b = corner[(r + 1) % 3], cc = corner[(r + 2) % 3];
+                int ab = m[r], bc = m[(r + 1) % 3], ca = m[(r + 2) % 3], add[12], n = 0, k;
+                if (split == 0) {
+                    add[n++] = a; add[n++] = b; add[n++] = cc;
+                } else if (split == 1) {
+                    add[n++] = a; add[n++] = ab; add[n++] = cc;
+                    add[n++] = ab; add[n++] = b; add[n++] = cc;
+                } else if (split == 2) {
+                    /* (a, b) and (b, c) split: the corner at b, then the quad a, ab, bc, c by its shorter
+                       diagonal. */
+                    double d_a = 0.0, d_c = 0.0;
+                    for (k = 0; k < 3; k++) {
+                        d_a += ((double)positions[3 * a + k] - positions[3 * bc + k]) *
+                               ((double)positions[3 * a + k] - positions[3 * bc + k]);
+                        d_c += ((double)positions[3 * cc + k] - positions[3 * ab + k]) *
+                               ((double)positions[3 * cc + k] - positions[3 * ab + k]);
+                    }
+                    add[n++] = ab; add[n++] = b; add[n++] = bc;
+                    if (d_a <= d_c) {
+                        add[n++] = a; add[n++] = ab; add[n++] = bc;
+                        add[n++] = a; add[n++] = bc; add[n++] = cc;
+                    } else {
+                        add[n++] = a; add[n++] = ab; add[n++] = cc;
+                        add[n++] = ab; add[n++] = bc; add[n++] = cc;
+                    }
+                } else {
+                    add[n++] = a; add[n++] = ab; add[n++] = ca;
+                    add[n++] = ab; add[n++] = b; add[n++] = bc;
+                    add[n++] = ca; add[n++] = bc; add[n++] = cc;
+                    add[n++] = ab; add[n++] = bc; add[n++] = ca;
+                }
+                t = next_triangles + 3 * next_count;
+                memcpy(t, add, sizeof(int) * (size_t)n);
+                for (k = 0; k < n / 3; k++) next_faces[next_count++] = faces[f];
+            }
+        }
+        tt__free(allocator, triangles);
+        tt__free(allocator, faces);
+        tt__free(allocator, mid);
+        tt_mesh_free(current);
+        current = NULL;
+        mid = NULL;
+        triangles = next_triangles;
+        faces = next_faces;
+        next_triangles = next_faces = NULL;
+        ntriangles = next_count;
+    }
+    tt__free(allocator, mid);
+    tt__free(allocator, triangles);
+    tt__free(allocator, positions);
+    out->mesh = current;
+    out->source = source;
+    out->weight = weight;
+    out->face = faces;
+    return TT_OK;
+too_large:
+    result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                      "refining the model's triangles to edges of at most %g would pass %d vertices or "
+                      "triangles: choose a larger max_edge or a coarser polycube", longest, INT_MAX / 4);
+    goto failed;
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory refining the model");
+failed:
+    tt_mesh_free(current);
+    tt__free(allocator, mid);
+    tt__free(allocator, next_triangles);
+    tt__free(allocator, next_faces);
+    tt__free(allocator, triangles);
+    tt__free(allocator, faces);
+    tt__free(allocator, positions);
+    tt__free(allocator, source);
+    tt__free(allocator, weight);
+    return result;
+}
+
 /* A vertex of a piece while the chart triangle is clipped: a corner of the
    triangle, a cut of side `index` by the grid line x[axis] = bound, or a
    point inside (where two grid lines cross). */
@@ -16060,6 +16277,7 @@ static int tt__split_walk(tt__split *S, int f, int *linked, int *chart)
     int k, i, n, quad = S->points[S->vert[0]].quad, holds = 1;
     double st[2];
     identity.turns = identity.offset[0] = identity.offset[1] = 0;
+    closing = identity;
     S->nboundary = 0;
     for (k = 0; k < 3; k++) {
         int v = S->vert[k], e = E->edge_of_halfedge[mesh->face_start[f] + k];
@@ -16714,14 +16932,18 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt_polycube_edge_options edge_options;
     tt_surface_point *points = NULL;
     tt_polycube_edges *edges = NULL;
+    const tt_mesh *model;
+    tt__refined R;
     tt__split S;
     tt_result result;
+    double longest;
     int f, v, j;
     tt__ok(error);
     if (out) *out = NULL;
     if (!report) report = &local;
     memset(report, 0, sizeof *report);
     memset(&S, 0, sizeof S);
+    memset(&R, 0, sizeof R);
     if (!polycube || !mesh || !out)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_polycube_map needs a polycube, a mesh and out (got NULL)");
@@ -16734,24 +16956,36 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
                             "face %d has %d corners: tt_polycube_map needs triangles (split the faces into fans "
                             "first)", f, mesh->face_start[f + 1] - mesh->face_start[f]);
-    points = TT__ALLOC(allocator, tt_surface_point, mesh->nverts > 0 ? mesh->nverts : 1);
+    if (!tt__polycube_consistent(polycube))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the polycube's surface has no quads or does not match its cubes: make it with "
+                        "tt_polycube_build and leave it unchanged");
+    longest = options && options->max_edge != 0.0 ? options->max_edge : TT_POLYCUBE_MAP_DEFAULT_EDGE * polycube->h;
+    if (!(longest > 0.0))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "max_edge %g: give a length above 0 (0 for the default, HUGE_VAL for no refinement)",
+                        options->max_edge);
+    if ((result = tt__polycube_refine(mesh, longest, allocator, &R, error)) != TT_OK) goto failed;
+    model = R.mesh;
+    report->triangles = model->nfaces;
+    points = TT__ALLOC(allocator, tt_surface_point, model->nverts > 0 ? model->nverts : 1);
     if (!points) goto out_of_memory;
-    if ((result = tt_polycube_project(polycube, mesh, allocator, points, &report->projection, error)) != TT_OK)
+    if ((result = tt_polycube_project(polycube, model, allocator, points, &report->projection, error)) != TT_OK)
         goto failed;
     /* A point within TT__EDGE_SNAP of a quad's edge is on it: the points are float, and a model vertex on a
        lattice line (a CAD part's edge, a face in a lattice plane) must be on S's edge exactly, or the
        triangles there split into slivers of rounding. */
-    for (v = 0; v < mesh->nverts; v++) {
+    for (v = 0; v < model->nverts; v++) {
         points[v].s = (float)tt__edge_snap(points[v].s);
         points[v].t = (float)tt__edge_snap(points[v].t);
     }
-    if ((result = tt_polycube_trace_edges(polycube, mesh, points, mesh->nverts, &edge_options, allocator, &edges,
+    if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
                                           error)) != TT_OK)
         goto failed;
     report->failed_edges = edges->nfailed;
 
     S.pc = polycube;
-    S.mesh = mesh;
+    S.mesh = model;
     S.edges = edges;
     S.points = points;
     S.allocator = allocator;
@@ -16762,15 +16996,15 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     S.crossing_vertex = TT__ALLOC(allocator, int, edges->ncrossings > 0 ? edges->ncrossings : 1);
     if (!S.crossing_vertex) goto out_of_memory;
     for (j = 0; j < edges->ncrossings; j++) S.crossing_vertex[j] = -1;
-    for (v = 0; v < mesh->nverts; v++) {
+    for (v = 0; v < model->nverts; v++) {
         int source[3];
         double weight[3] = {1.0, 0.0, 0.0};
         source[0] = source[1] = source[2] = v;
         if (tt__split_vertex(&S, source, weight) < 0) goto out_of_memory;
     }
-    for (f = 0; f < mesh->nfaces; f++) {
+    for (f = 0; f < model->nfaces; f++) {
         int linked = 0, chart = 0, pieces = 0, done = 0, k, kept_vertices, kept_triangles;
-        for (k = 0; k < 3; k++) S.vert[k] = mesh->corner_vert[mesh->face_start[f] + k];
+        for (k = 0; k < 3; k++) S.vert[k] = model->corner_vert[3 * f + k];
         if (!tt__split_walk(&S, f, &linked, &chart)) goto out_of_memory;
         kept_vertices = S.out->nverts;
         kept_triangles = S.out->ntriangles;
@@ -16791,9 +17025,44 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             S.out->ntriangles = kept_triangles;
             if (!tt__split_fallback(&S, f)) goto out_of_memory;
             report->fallback_triangles++;
-        } else if (pieces > 1) {
-            report->split_triangles++;
         }
+    }
+    /* Back to the input: each output vertex's refined sources become input vertices (at most 3, all of one
+       input triangle), each output triangle's refined face its input face. */
+    for (v = 0; v < S.out->nverts; v++) {
+        int source[3], n = 0, k, i;
+        double weight[3] = {0.0, 0.0, 0.0};
+        for (k = 0; k < 3; k++) {
+            int r = S.out->source[3 * v + k];
+            double w = S.out->weights[3 * v + k];
+            for (i = 0; i < 3 && w != 0.0; i++) {
+                int u = R.source[3 * r + i], m;
+                double wu = w * R.weight[3 * r + i];
+                if (wu == 0.0) continue;
+                for (m = 0; m < n && source[m] != u; m++) continue;
+                if (m == n) {
+                    if (n == 3) continue;
+                    source[n++] = u;
+                }
+                weight[m] += wu;
+            }
+        }
+        for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * S.out->source[3 * v]];
+        for (k = 0; k < 3; k++) {
+            S.out->source[3 * v + k] = source[k];
+            S.out->weights[3 * v + k] = (float)weight[k];
+        }
+    }
+    {
+        int *outputs_of_face = TT__ALLOC(allocator, int, mesh->nfaces);
+        if (!outputs_of_face) goto out_of_memory;
+        memset(outputs_of_face, 0, sizeof(int) * (size_t)mesh->nfaces);
+        for (j = 0; j < S.out->ntriangles; j++) {
+            S.out->triangle_face[j] = R.face[S.out->triangle_face[j]];
+            outputs_of_face[S.out->triangle_face[j]]++;
+        }
+        for (f = 0; f < mesh->nfaces; f++) report->split_triangles += outputs_of_face[f] > 1;
+        tt__free(allocator, outputs_of_face);
     }
     for (j = 0; j < S.out->ntriangles; j++) {
         const tt_surface_point *p = S.out->corner_points + 3 * j;
@@ -16808,6 +17077,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, S.grid_points);
     tt_polycube_edges_free(edges);
     tt__free(allocator, points);
+    tt__refined_free(allocator, &R);
     *out = S.out;
     return TT_OK;
 out_of_memory:
@@ -16821,6 +17091,7 @@ failed:
     tt_polycube_mapping_free(S.out);
     tt_polycube_edges_free(edges);
     tt__free(allocator, points);
+    tt__refined_free(allocator, &R);
     memset(report, 0, sizeof *report);
     return result;
 }

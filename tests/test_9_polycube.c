@@ -1811,8 +1811,8 @@ static mapping_check check_mapping(const tt_polycube *pc, const tt_mesh *mesh, c
     return c;
 }
 
-static tt_polycube_mapping *mapped(const tmesh *m, int resolution, int max_quads, tt_polycube **pc_out,
-                                   tt_mesh **mesh_out, tt_polycube_map_report *report)
+static tt_polycube_mapping *mapped(const tmesh *m, int resolution, int max_quads, double max_edge,
+                                   tt_polycube **pc_out, tt_mesh **mesh_out, tt_polycube_map_report *report)
 {
     tt_polycube_map_options mo;
     tt_polycube_options o;
@@ -1833,6 +1833,7 @@ static tt_polycube_mapping *mapped(const tmesh *m, int resolution, int max_quads
     }
     memset(&mo, 0, sizeof mo);
     mo.max_quads = max_quads;
+    mo.max_edge = max_edge;
     CHECK(tt_polycube_map(*pc_out, *mesh_out, &mo, NULL, &mapping, report, &err) == TT_OK, "tt_polycube_map: %s",
           err.message);
     return mapping;
@@ -1876,7 +1877,7 @@ static void test_map_cube(void)
         int f;
         memset(&m, 0, sizeof m);
         make_cube_set(&m, &one, 1, 1, 1, 1.0, 1);
-        map = mapped(&m, n, 2 * n + 2, &pc, &mesh, &rep);
+        map = mapped(&m, n, 2 * n + 2, HUGE_VAL, &pc, &mesh, &rep);
         if (map) {
             c = check_mapping(pc, mesh, map);
             for (f = 0; f < map->ntriangles; f++) worst = fmax(worst, isometry_error(pc, map, f));
@@ -1910,7 +1911,7 @@ static void test_map_sphere(void)
     const double centre[3] = {0.13, -0.21, 0.05};
     int resolution, hemisphere;
     for (hemisphere = 0; hemisphere < 2; hemisphere++)
-        for (resolution = 4; resolution <= 8; resolution *= 2) {
+        for (resolution = 4; resolution <= 32; resolution *= 2) {
             tmesh m;
             tt_mesh *mesh;
             tt_polycube *pc;
@@ -1918,15 +1919,15 @@ static void test_map_sphere(void)
             tt_polycube_mapping *map;
             memset(&m, 0, sizeof m);
             make_sphere(&m, 48, 24, 1.0, centre, hemisphere);
-            map = mapped(&m, resolution, 0, &pc, &mesh, &rep);
+            map = mapped(&m, resolution, 0, 0.0, &pc, &mesh, &rep);
             if (map) {
                 mapping_check c = check_mapping(pc, mesh, map);
-                printf("     %s at resolution %d: %d triangles -> %d, %d split, %d fallbacks, %d flipped\n",
-                       hemisphere ? "hemisphere" : "sphere", resolution, mesh->nfaces, map->ntriangles,
-                       rep.split_triangles, rep.fallback_triangles, rep.flipped);
+                printf("     %s at resolution %d: %d triangles (%d refined) -> %d, %d split, %d fallbacks, %d "
+                       "flipped\n", hemisphere ? "hemisphere" : "sphere", resolution, mesh->nfaces, rep.triangles,
+                       map->ntriangles, rep.split_triangles, rep.fallback_triangles, rep.flipped);
                 CHECK(c.off_surface == 0 && c.moved_inputs == 0 && c.bad_points == 0 && c.bad_faces == 0 &&
                           c.area_error <= 1e-6 && !c.strict_fails && (hemisphere || c.open_edges == 0) &&
-                          rep.split_triangles > 0 && rep.fallback_triangles <= mesh->nfaces / 10,
+                          rep.split_triangles > 0 && rep.fallback_triangles <= rep.triangles / 50,
                       "%s at resolution %d: %d vertices off the model, %d inputs moved, %d corner points off one "
                       "quad, area error %.2g, strict build %s, %d open edges, %d split, %d fallbacks",
                       hemisphere ? "hemisphere" : "sphere", resolution, c.off_surface, c.moved_inputs,
@@ -1973,7 +1974,7 @@ static void test_map_uvs_and_seams(void)
         memset(&m, 0, sizeof m);
         if (shape == 0) make_cube_set(&m, &one, 1, 1, 1, 1.0, 1);
         else make_sphere(&m, 48, 24, 1.0, centre, 0);
-        map = mapped(&m, shape == 0 ? 3 : 8, shape == 0 ? 8 : 0, &pc, &mesh, &rep);
+        map = mapped(&m, shape == 0 ? 3 : 8, shape == 0 ? 8 : 0, 0.0, &pc, &mesh, &rep);
         if (map) {
             const tt_mesh *s = pc->surface;
             int *colors = (int *)malloc(sizeof(int) * (size_t)s->ncorners);
@@ -2078,7 +2079,7 @@ static void test_map_determinism_and_errors(void)
     unsigned char one = 1;
     memset(&m, 0, sizeof m);
     make_sphere(&m, 24, 12, 1.0, centre, 0);
-    map = mapped(&m, 6, 0, &pc, &mesh, &rep);
+    map = mapped(&m, 6, 0, 0.0, &pc, &mesh, &rep);
     if (!map) {
         tt_polycube_free(pc);
         tt_mesh_free(mesh);
