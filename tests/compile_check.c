@@ -4,6 +4,7 @@
    build has no unused function, and exits 0 when a tiny smoke run works.
    Valid C99 and C++98. Define COMPILE_CHECK_USER_ALLOC to route the default
    allocator through counting TT_MALLOC / TT_FREE macros. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -330,6 +331,7 @@ int main(void)
                     tt_polycube_mapping *pm = NULL;
                     memset(&pmo, 0, sizeof pmo);
                     pmo.max_quads = 6;
+                    pmo.max_edge = HUGE_VAL;   /* the exact split, unrefined */
                     EXPECT(tt_polycube_map(pc, tri_cube, &pmo, NULL, &pm, &pmr, &err) == TT_OK && pm &&
                            pm->ntriangles == 48 && pmr.fallback_triangles == 0 && pmr.flipped == 0);
                     if (pm) {
