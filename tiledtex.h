@@ -2543,6 +2543,8 @@ typedef struct tt_polycube_map_options {
 typedef struct tt_polycube_map_report {
     int triangles;          /* triangles of the model after refinement (max_edge), the ones mapped */
     tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
+    int relaxed;            /* moves of points on S that unfolded a fold or joined a vertex to its neighbours'
+                               sheet (P11 step 5) */
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
     int fallback_triangles; /* of `triangles`, those put whole into one quad (P11 step 7): a local seam; target 0 */
@@ -15293,6 +15295,17 @@ TTDEF tt_quad_map tt_polycube_unfold(const tt_polycube *polycube, int halfedge)
     return m;
 }
 
+static int tt__quad_map_equal(tt_quad_map a, tt_quad_map b)
+{
+    return a.turns == b.turns && a.offset[0] == b.offset[0] && a.offset[1] == b.offset[1];
+}
+
+/* The point of the chart `at` in the frame of the quad `map` places there. */
+static void tt__quad_map_invert_point(tt_quad_map map, const double at[2], double st[2])
+{
+    tt__quarter_turns(4 - map.turns, at[0] - map.offset[0], at[1] - map.offset[1], st);
+}
+
 /* The search for one edge's path: the path grows from q_a's quad; every
    quad's frame is mapped into the plane of q_a's quad. */
 typedef struct tt__edge_search {
@@ -15828,6 +15841,281 @@ typedef struct tt__split_cell {
     tt_quad_map map;
 } tt__split_cell;
 
+/* ---- Relaxation of the points on S (spec P11 step 5) ---- */
+
+#define TT__RELAX_RADIUS 4          /* steps across S's edges a vertex's local chart spans */
+#define TT__RELAX_SEAT_RADIUS 2     /* the same around a neighbour's point, where a vertex may be re-seated */
+#define TT__RELAX_CHART 96          /* quads a local chart holds at most */
+#define TT__RELAX_SWEEPS 12
+
+/* A local chart of S around a quad: the quads within `radius` steps
+   across S's edges, found breadth first, each with the map of its frame into the
+   centre quad's frame (the first way found: around a cone point of S the
+   chart is cut where the search meets itself). */
+typedef struct tt__relax_chart {
+    int count;
+    int quad[TT__RELAX_CHART];
+    tt_quad_map map[TT__RELAX_CHART];
+    int cell[TT__RELAX_CHART][2];   /* the unit cell of the chart the quad covers */
+} tt__relax_chart;
+
+static void tt__relax_chart_build(const tt_polycube *pc, int centre, int radius, tt__relax_chart *c)
+{
+    const tt_mesh *s = pc->surface;
+    int head = 0, ring_end, ring;
+    double middle[2];
+    c->count = 1;
+    c->quad[0] = centre;
+    c->map[0].turns = c->map[0].offset[0] = c->map[0].offset[1] = 0;
+    c->cell[0][0] = c->cell[0][1] = 0;
+    for (ring = 0; ring < radius; ring++) {
+        ring_end = c->count;
+        for (; head < ring_end; head++) {
+            int k;
+            for (k = 0; k < 4 && c->count < TT__RELAX_CHART; k++) {
+                int h = s->face_start[c->quad[head]] + k, next = s->corner_face[s->twin[h]], i;
+                for (i = 0; i < c->count && c->quad[i] != next; i++) continue;
+                if (i < c->count) continue;
+                c->quad[c->count] = next;
+                c->map[c->count] = tt_quad_map_compose(c->map[head], tt_polycube_unfold(pc, h));
+                tt_quad_map_apply(c->map[c->count], 0.5, 0.5, middle);
+                c->cell[c->count][0] = (int)floor(middle[0]);
+                c->cell[c->count][1] = (int)floor(middle[1]);
+                c->count++;
+            }
+        }
+    }
+}
+
+/* Point p of S in the chart; 0 when its quad is not in it. */
+static int tt__relax_chart_place(const tt__relax_chart *c, tt_surface_point p, double at[2])
+{
+    int i;
+    for (i = 0; i < c->count; i++)
+        if (c->quad[i] == p.quad) {
+            tt_quad_map_apply(c->map[i], p.s, p.t, at);
+            return 1;
+        }
+    return 0;
+}
+
+/* The point of S at chart place `at`: the first chart quad whose cell holds
+   it. 0 when none does. */
+static int tt__relax_chart_point(const tt__relax_chart *c, const double at[2], tt_surface_point *p)
+{
+    int i, x = (int)floor(at[0]), y = (int)floor(at[1]);
+    for (i = 0; i < c->count; i++)
+        if (c->cell[i][0] == x && c->cell[i][1] == y) {
+            double st[2];
+            tt__quad_map_invert_point(c->map[i], at, st);
+            p->quad = c->quad[i];
+            p->s = (float)(st[0] < 0.0 ? 0.0 : (st[0] > 1.0 ? 1.0 : st[0]));
+            p->t = (float)(st[1] < 0.0 ? 0.0 : (st[1] > 1.0 ? 1.0 : st[1]));
+            return 1;
+        }
+    return 0;
+}
+
+/* Point p of S in the frame of quad `centre`: directly in the same quad,
+   across one edge of S for a quad next to it, else through the local
+   chart around `centre` (built into *scratch). 0 when it lies beyond. */
+static int tt__relax_place_near(const tt_polycube *pc, int centre, tt_surface_point p, double at[2],
+                                tt__relax_chart *scratch)
+{
+    const tt_mesh *s = pc->surface;
+    int k;
+    if (p.quad == centre) {
+        at[0] = p.s;
+        at[1] = p.t;
+        return 1;
+    }
+    for (k = 0; k < 4; k++) {
+        int h = s->face_start[centre] + k;
+        if (s->corner_face[s->twin[h]] == p.quad) {
+            tt_quad_map_apply(tt_polycube_unfold(pc, h), p.s, p.t, at);
+            return 1;
+        }
+    }
+    tt__relax_chart_build(pc, centre, TT__RELAX_RADIUS, scratch);
+    return tt__relax_chart_place(scratch, p, at);
+}
+
+/* How badly vertex v sits among its triangles with its point at `at` in
+   the chart around it: each triangle whose other points lie outside the
+   chart (their edge has no short path on S) counts 2, each one turning
+   clockwise on S (a fold) counts 1. */
+static int tt__relax_badness(const tt_mesh *model, const tt_surface_point *points, const int *first_triangle,
+                             const int *triangle_corners, int v, const tt__relax_chart *c, const double at[2])
+{
+    int i, bad = 0;
+    for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
+        int corner = triangle_corners[i], f = corner / 3, k = corner % 3;
+        int u = model->corner_vert[3 * f + (k + 1) % 3], w = model->corner_vert[3 * f + (k + 2) % 3];
+        double pu[2], pw[2];
+        if (!tt__relax_chart_place(c, points[u], pu) || !tt__relax_chart_place(c, points[w], pw)) {
+            bad += 2;
+            continue;
+        }
+        bad += (pu[0] - at[0]) * (pw[1] - at[1]) - (pu[1] - at[1]) * (pw[0] - at[0]) <= 0.0;
+    }
+    return bad;
+}
+
+/* Spec P11 step 5: points that leave a triangle folded on S or its edge
+   without a short path (a vertex projected onto the wrong sheet, a fold
+   in a concavity) are moved, a few sweeps over the vertices in order:
+     - toward the mean of its neighbours' points (half way), in a local
+       chart of S around it, when they all lie in it;
+     - else to the closest point to its 3D position on the quads around a
+       neighbour's point (onto its neighbours' sheet);
+   a move is kept only when it leaves the vertex's triangles less badly
+   placed (tt__relax_badness). Vertices whose triangles are all fine never
+   move, and the ones whose points lie on S (the model touches the
+   polycube) stay. Returns the number of moves, -1 when out of memory. */
+static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
+                              const tt_allocator *allocator)
+{
+    int *first_triangle = NULL, *triangle_corners = NULL, *count = NULL;
+    unsigned char *bad = NULL;
+    tt__relax_chart *chart = NULL;
+    int v, c, sweep, moves = 0, nverts = model->nverts;
+    first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
+    triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
+    count = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
+    bad = TT__ALLOC(allocator, unsigned char, nverts > 0 ? nverts : 1);
+    chart = TT__ALLOC(allocator, tt__relax_chart, 1);
+    if (!first_triangle || !triangle_corners || !count || !bad || !chart) {
+        moves = -1;
+        goto done;
+    }
+    /* The triangles around each vertex, as the corners at it. */
+    memset(count, 0, sizeof(int) * (size_t)nverts);
+    for (c = 0; c < model->ncorners; c++) count[model->corner_vert[c]]++;
+    first_triangle[0] = 0;
+    for (v = 0; v < nverts; v++) first_triangle[v + 1] = first_triangle[v] + count[v];
+    for (v = 0; v < nverts; v++) count[v] = first_triangle[v];
+    for (c = 0; c < model->ncorners; c++) triangle_corners[count[model->corner_vert[c]]++] = c;
+    for (sweep = 0; sweep < TT__RELAX_SWEEPS; sweep++) {
+        int moved = 0;
+        /* The vertices of badly placed triangles: the triangle judged in its first vertex's quad frame,
+           the others' quads mapped in across one edge of S when they are next to it, else through a
+           local chart. */
+        memset(bad, 0, (size_t)nverts);
+        for (c = 0; c < model->ncorners; c += 3) {
+            const int *t = model->corner_vert + c;
+            double at[3][2];
+            int k, placed = 1;
+            at[0][0] = points[t[0]].s;
+            at[0][1] = points[t[0]].t;
+            for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(pc, points[t[0]].quad, points[t[k]], at[k], chart);
+            if (placed && (at[1][0] - at[0][0]) * (at[2][1] - at[0][1]) - (at[1][1] - at[0][1]) * (at[2][0] - at[0][0]) > 0.0)
+                continue;
+            bad[t[0]] = bad[t[1]] = bad[t[2]] = 1;
+        }
+        for (v = 0; v < nverts; v++) {
+            double at[2], mean[2] = {0.0, 0.0}, here[3], candidate_at[2];
+            int i, n = 0, reachable = 1, before, best_bad, a;
+            tt_surface_point best, candidate;
+            if (!bad[v]) continue;
+            tt_polycube_point_position(pc, points[v], here);
+            {
+                double d2 = 0.0;
+                for (a = 0; a < 3; a++) d2 += (here[a] - model->pos[3 * v + a]) * (here[a] - model->pos[3 * v + a]);
+                if (d2 <= 1e-18 * pc->h * pc->h) continue;
+            }
+            tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
+            tt__relax_chart_place(chart, points[v], at);
+            before = best_bad = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, at);
+            if (before == 0) continue;
+            best = points[v];
+            for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
+                int corner = triangle_corners[i], f = corner / 3, k;
+                for (k = 1; k < 3; k++) {
+                    double pu[2];
+                    if (tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], pu)) {
+                        mean[0] += pu[0];
+                        mean[1] += pu[1];
+                        n++;
+                    } else {
+                        reachable = 0;
+                    }
+                }
+            }
+            if (reachable && n > 0) {
+                candidate_at[0] = at[0] + 0.5 * (mean[0] / n - at[0]);
+                candidate_at[1] = at[1] + 0.5 * (mean[1] / n - at[1]);
+                if (tt__relax_chart_point(chart, candidate_at, &candidate)) {
+                    int after;
+                    tt_surface_point kept = points[v];
+                    points[v] = candidate;
+                    tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
+                    tt__relax_chart_place(chart, candidate, candidate_at);
+                    after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, candidate_at);
+                    points[v] = kept;
+                    if (after < best_bad) {
+                        best_bad = after;
+                        best = candidate;
+                    }
+                }
+            } else {
+                /* Onto a neighbour's sheet: the closest point to v on the quads around each neighbour's. */
+                double lattice[3];
+                for (a = 0; a < 3; a++) lattice[a] = ((double)model->pos[3 * v + a] - pc->origin[a]) / pc->h;
+                for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
+                    int corner = triangle_corners[i], f = corner / 3, k, q, j;
+                    for (k = 1; k < 3; k++) {
+                        int u = model->corner_vert[3 * f + (corner % 3 + k) % 3], after;
+                        double nearest = HUGE_VAL;
+                        tt__relax_chart around;
+                        tt_surface_point kept = points[v];
+                        for (j = first_triangle[v]; j < i; j++) {
+                            int other = triangle_corners[j];
+                            if (model->corner_vert[3 * (other / 3) + (other % 3 + 1) % 3] == u ||
+                                model->corner_vert[3 * (other / 3) + (other % 3 + 2) % 3] == u)
+                                break;
+                        }
+                        if (j < i || (k == 2 && model->corner_vert[3 * f + (corner % 3 + 1) % 3] == u)) continue;
+                        tt__relax_chart_build(pc, points[u].quad, TT__RELAX_SEAT_RADIUS, &around);
+                        for (q = 0; q < around.count; q++) {
+                            tt_surface_point p = tt__polycube_surface_point(pc, around.quad[q], lattice);
+                            double xyz[3], d2 = 0.0;
+                            tt_polycube_point_position(pc, p, xyz);
+                            for (a = 0; a < 3; a++) d2 += (xyz[a] - model->pos[3 * v + a]) * (xyz[a] - model->pos[3 * v + a]);
+                            if (d2 < nearest) {
+                                nearest = d2;
+                                candidate = p;
+                            }
+                        }
+                        points[v] = candidate;
+                        tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
+                        tt__relax_chart_place(chart, candidate, candidate_at);
+                        after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart,
+                                                  candidate_at);
+                        points[v] = kept;
+                        if (after < best_bad) {
+                            best_bad = after;
+                            best = candidate;
+                        }
+                    }
+                }
+            }
+            if (best_bad < before) {
+                points[v] = best;
+                moved++;
+            }
+        }
+        moves += moved;
+        if (!moved) break;
+    }
+done:
+    tt__free(allocator, first_triangle);
+    tt__free(allocator, triangle_corners);
+    tt__free(allocator, count);
+    tt__free(allocator, bad);
+    tt__free(allocator, chart);
+    return moves;
+}
+
 /* The model refined for the split: its triangles halved along every edge
    longer than a bound until none is, so that a triangle spans few quads of
    S and holds at most about one vertex of S (a coarse model's large
@@ -16071,17 +16359,6 @@ typedef struct tt__split {
     int *grid_points;           /* grid points inside the triangle: x, y, output vertex */
     int ngrid, grid_capacity;
 } tt__split;
-
-static int tt__quad_map_equal(tt_quad_map a, tt_quad_map b)
-{
-    return a.turns == b.turns && a.offset[0] == b.offset[0] && a.offset[1] == b.offset[1];
-}
-
-/* The point of the chart `at` in the frame of the quad `map` places there. */
-static void tt__quad_map_invert_point(tt_quad_map map, const double at[2], double st[2])
-{
-    tt__quarter_turns(4 - map.turns, at[0] - map.offset[0], at[1] - map.offset[1], st);
-}
 
 /* A new output vertex interpolating up to three input vertices; -1 when out of memory. */
 static int tt__split_vertex(tt__split *S, const int source[3], const double weight[3])
@@ -16979,6 +17256,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         points[v].s = (float)tt__edge_snap(points[v].s);
         points[v].t = (float)tt__edge_snap(points[v].t);
     }
+    if ((report->relaxed = tt__polycube_relax(polycube, model, points, allocator)) < 0) goto out_of_memory;
     if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
                                           error)) != TT_OK)
         goto failed;
