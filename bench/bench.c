@@ -34,7 +34,11 @@
    `hpm_20k_faces` runs tt_hpm_map on a 20k-triangle torus with a 256 x 256
    three-channel image, and prints the fits it made beside the time.
    `polycube_100k_faces_res32_*` time the polycube's construction and the
-   vertices' projection onto it on a 100k-triangle torus.
+   vertices' projection onto it on a 100k-triangle torus;
+   `polycube_100k_faces_res32` the whole mapping of that torus, voxelisation
+   to UVs (spec B10), with the triangles it made and the ones left to the
+   fallback; `polycube_synth_n2_tile64` the paper's 256-tile atlas at 64
+   texels a tile, apart (spec P17).
 
    Peers: bench/bench_build.c times the half-edge build on three 1M-face
    meshes beside a radix-sort pairing yardstick, and bench_build_cgal.cpp
@@ -497,6 +501,9 @@ typedef struct polycube_ctx {
     tt_surface_point *points;
     tt_polycube_report report;
     tt_polycube_projection_report projection;
+    tt_polycube_map_report map_report;
+    int output_triangles;
+    tt_image *source;           /* for the tiles' synthesis */
 } polycube_ctx;
 
 /* The polycube of a mesh at resolution 32: voxelisation, fill, repair,
@@ -529,6 +536,73 @@ static double run_polycube_project(void *p)
     r = tt_polycube_project(c->polycube, c->mesh, NULL, c->points, &c->projection, &err);
     t1 = bench_now_ms();
     if (r != TT_OK) fail("tt_polycube_project", r, &err);
+    return t1 - t0;
+}
+
+/* The whole mapping, voxelisation to UVs (spec B10): the polycube, its
+   Wang colouring and tile types, the model split on S, the UVs. The
+   atlas's synthesis is timed apart (run_polycube_synth). */
+static double run_polycube_map(void *p)
+{
+    polycube_ctx *c = (polycube_ctx *)p;
+    tt_polycube_options options;
+    tt_polycube *polycube = NULL;
+    tt_polycube_mapping *mapping = NULL;
+    tt_tile_layout layout;
+    int *colors = NULL;
+    uint8_t *types = NULL;
+    float *uv = NULL;
+    tt_error err;
+    tt_result r;
+    double t0, t1;
+    memset(&options, 0, sizeof options);
+    options.resolution = 32;
+    layout.colors = 2;
+    layout.tile_size = 64;
+    layout.gutter = 4;
+    t0 = bench_now_ms();
+    r = tt_polycube_build(c->mesh, &options, NULL, &polycube, NULL, &err);
+    if (r != TT_OK) fail("tt_polycube_build", r, &err);
+    colors = (int *)xmalloc(sizeof(int) * (size_t)polycube->surface->ncorners);
+    types = (uint8_t *)xmalloc((size_t)polycube->surface->ncorners);
+    if ((r = tt_polycube_edge_colors(polycube, 2, 1, 7, colors, &err)) != TT_OK ||
+        (r = tt_assign_boundaries(polycube->surface, &layout, 7, colors, types, &err)) != TT_OK)
+        fail("the polycube's tile types", r, &err);
+    r = tt_polycube_map(polycube, c->mesh, NULL, NULL, &mapping, &c->map_report, &err);
+    if (r != TT_OK) fail("tt_polycube_map", r, &err);
+    uv = (float *)xmalloc(sizeof(float) * 6 * (size_t)mapping->ntriangles);
+    r = tt_polycube_mapping_uvs(polycube, mapping, &layout, types, uv, &err);
+    t1 = bench_now_ms();
+    if (r != TT_OK) fail("tt_polycube_mapping_uvs", r, &err);
+    c->output_triangles = mapping->ntriangles;
+    free(uv);
+    free(types);
+    free(colors);
+    tt_polycube_mapping_free(mapping);
+    tt_polycube_free(polycube);
+    return t1 - t0;
+}
+
+/* The atlas of the paper's layout (n = 2 colours per axis, 256 tiles) at
+   64 texels a tile, 4 of gutter (spec P17). */
+static double run_polycube_synth(void *p)
+{
+    polycube_ctx *c = (polycube_ctx *)p;
+    tt_synth_options options;
+    tt_tileset *tiles = NULL;
+    tt_error err;
+    tt_result r;
+    double t0, t1;
+    memset(&options, 0, sizeof options);
+    options.layout.colors = 2;
+    options.layout.tile_size = 64;
+    options.layout.gutter = 4;
+    options.seed = 7;
+    t0 = bench_now_ms();
+    r = tt_synthesize_tiles(c->source, &options, NULL, &tiles, &err);
+    t1 = bench_now_ms();
+    if (r != TT_OK) fail("tt_synthesize_tiles", r, &err);
+    tt_tileset_free(tiles);
     return t1 - t0;
 }
 
@@ -697,9 +771,9 @@ int main(int argc, char **argv)
         tt_mesh_free(hc.mesh);
     }
     if (wanted("polycube_100k_faces_res32")) {
-        /* the polycube's first steps on a 100k-triangle torus; the mapping
-           of the triangles onto it (spec B10: voxelise -> UVs <= 1 s) is
-           still to come */
+        /* the polycube on a 100k-triangle torus: its construction and the
+           projection alone, then the whole mapping, voxelisation to UVs
+           (spec B10: <= 1 s), and the atlas's synthesis apart (P17) */
         polycube_ctx pc;
         memset(&pc, 0, sizeof pc);
         pc.mesh = make_triangle_torus(224);
@@ -708,6 +782,13 @@ int main(int argc, char **argv)
         report("polycube_100k_faces_res32_quads", pc.report.quads, "quads");
         report("polycube_100k_faces_res32_project", median_ms(run_polycube_project, &pc, RUNS_FAST), "ms");
         report("polycube_100k_faces_res32_fallbacks", pc.projection.fallbacks, "vertices");
+        report("polycube_100k_faces_res32", median_ms(run_polycube_map, &pc, RUNS_SLOW), "ms");
+        report("polycube_100k_faces_res32_output_triangles", pc.output_triangles, "triangles");
+        report("polycube_100k_faces_res32_fallback_triangles", pc.map_report.fallback_triangles, "triangles");
+        report("polycube_100k_faces_res32_flipped", pc.map_report.flipped, "triangles");
+        pc.source = make_source(256);
+        report("polycube_synth_n2_tile64", median_ms(run_polycube_synth, &pc, RUNS_SLOW), "ms");
+        tt_image_free(pc.source);
         free(pc.points);
         tt_polycube_free(pc.polycube);
         tt_mesh_free(pc.mesh);
