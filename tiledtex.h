@@ -15821,6 +15821,7 @@ out_of_memory:
 #define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
                                        above the records' snap (1e-6), far below any real piece */
 #define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
+#define TT__MAP_SNAP 1e-5f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
 #define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
 
 /* A point on a triangle's boundary (a model vertex or a split point of an
@@ -17249,12 +17250,12 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if (!points) goto out_of_memory;
     if ((result = tt_polycube_project(polycube, model, allocator, points, &report->projection, error)) != TT_OK)
         goto failed;
-    /* A point within TT__EDGE_SNAP of a quad's edge is on it: the points are float, and a model vertex on a
-       lattice line (a CAD part's edge, a face in a lattice plane) must be on S's edge exactly, or the
-       triangles there split into slivers of rounding. */
+    /* A point within TT__MAP_SNAP of a quad's edge is on it: the points are float (and the projection adds
+       its rounding), and a model vertex on a lattice line (a CAD part's edge, a face in a lattice plane) must
+       be on S's edge exactly, or the edges through that corner of S split next to it into slivers. */
     for (v = 0; v < model->nverts; v++) {
-        points[v].s = (float)tt__edge_snap(points[v].s);
-        points[v].t = (float)tt__edge_snap(points[v].t);
+        points[v].s = points[v].s < TT__MAP_SNAP ? 0.0f : (points[v].s > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].s);
+        points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
     }
     if ((report->relaxed = tt__polycube_relax(polycube, model, points, allocator)) < 0) goto out_of_memory;
     if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
