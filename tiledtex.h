@@ -2522,6 +2522,91 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
                                         tt_polycube_edges **out, tt_error *error);
 TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
 
+/* The model mapped onto S (spec P11 steps 4, 6, 7; the paper's Sec. 4.3
+   with its cells replaced by S's quads, P12): every triangle of the model
+   is split where its image on S crosses an edge of S, so that each output
+   triangle lies in one quad, and each output corner gets its point on S.
+   The split points of a model edge come from its record of
+   tt_polycube_trace_edges, made once per edge, so the two triangles on it
+   share the very same output vertices (no T-junction, no crack; spec Q11).
+   Output vertex v < mesh->nverts is input vertex v; the others lie on the
+   model's triangles, each with the (up to 3) input vertices and weights
+   it interpolates, so normals, colours or skin weights carry through. */
+typedef struct tt_polycube_map_options {
+    int max_quads;      /* the longest edge path, as tt_polycube_edge_options; 0 = its default */
+} tt_polycube_map_options;
+
+typedef struct tt_polycube_map_report {
+    tt_polycube_projection_report projection;   /* how the vertices went onto S */
+    int failed_edges;       /* model edges with no path on S within max_quads */
+    int split_triangles;    /* input triangles cut into two or more output triangles */
+    int fallback_triangles; /* input triangles put whole into one quad (P11 step 7): a local seam; target 0 */
+    int flipped;            /* output triangles whose points on S turn clockwise (a fold of the projection) */
+} tt_polycube_map_report;
+
+typedef struct tt_polycube_mapping {
+    int nverts;
+    float *positions;       /* 3 * nverts */
+    int *source;            /* 3 * nverts: the input vertices output vertex v interpolates... */
+    float *weights;         /* 3 * nverts: ...with these weights (sum 1; unused slots have weight 0) */
+    int ntriangles;
+    int *triangles;         /* 3 * ntriangles output vertex indices, wound as the input */
+    int *triangle_face;     /* per output triangle: the input face it is part of */
+    tt_surface_point *corner_points;    /* 3 * ntriangles: each corner's point on S, the three in one quad */
+    tt_allocator allocator; /* the one it was made with */
+} tt_polycube_mapping;
+
+/* Map `mesh` (triangles; the mesh the polycube was built from, or any
+   other near its surface) onto S: tt_polycube_project, then
+   tt_polycube_trace_edges, then per triangle:
+     - its three edge paths are unfolded one after another into one chart
+       (tt_polycube_unfold, starting in its first vertex's quad); when the
+       walk comes back to that quad in the same frame and every crossing
+       lies on the straight chart triangle (no bend at a saddle, no cone
+       point of S inside), the chart triangle is clipped by the unit grid
+       of the chart (Sutherland-Hodgman) into convex pieces, one per quad,
+       each fanned into triangles; the quads of the grid cells are found by
+       walking across S's edges from the first quad, and must agree;
+     - a point on a model edge is the edge's record: at t, between the
+       edge's first and second vertex, shared by both triangles; a grid
+       point inside the triangle interpolates its three vertices with its
+       barycentric coordinates in the chart;
+     - a triangle on an edge with no path, or whose chart does not close
+       or agree (P11 step 7), keeps its boundary (the model vertices and
+       the split points of its edges, so its neighbours still meet it
+       without a crack) and is fanned from its centroid into the quad of
+       its first vertex, the points on S projected orthogonally onto that
+       quad's plane and clamped to it: a local seam, counted in
+       fallback_triangles.
+   Pieces of zero area (an edge along a lattice line) are dropped; the
+   output's area equals the input's. report may be NULL.
+   Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
+   out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
+   a face that is not a triangle (error->face; triangulate first), or a
+   polycube not made by tt_polycube_build; TT_ERROR_EMPTY_MESH;
+   TT_ERROR_NON_FINITE; TT_ERROR_TOO_LARGE when the output would exceed
+   INT_MAX / 3 triangles; TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL
+   and nothing stays allocated. Free the result with
+   tt_polycube_mapping_free. Same input, same output; thread-safe. */
+TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
+                                const tt_polycube_map_options *options, const tt_allocator *allocator,
+                                tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error);
+TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping);
+
+/* Texture coordinates of a mapping (spec P11 step 6): corner i of output
+   triangle f at point (quad, s, t) gets the point (s, t) of that quad's
+   tile, u = (column*C + g + s*S) / W, v = (row*C + g + t*S) / W, the tile
+   from the quad's four boundary types (corner_type: one per S half-edge,
+   from tt_assign_boundaries on polycube->surface with this layout), as
+   tt_tile_corner_uv gives at s, t in {0, 1}. corner_uv gets
+   6 * mapping->ntriangles floats. Errors: NULL arguments, a layout that
+   does not resolve, a type of 2n or more (TT_ERROR_INVALID_ARGUMENT,
+   TT_ERROR_TOO_LARGE as tt_tile_layout_resolve), a corner point outside S
+   (TT_ERROR_INDEX_OUT_OF_RANGE). Allocates nothing; thread-safe. */
+TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
+                                        const tt_tile_layout *layout, const uint8_t *corner_type,
+                                        float *corner_uv, tt_error *error);
+
 #ifdef __cplusplus
 }
 #endif
