@@ -146,6 +146,11 @@ int tool_mesh_image_prefix(const char *const *positional, int npositional, const
    is some other argument. */
 int tool_option(int argc, char **argv, int *index, const char *name, const char **value);
 
+/* An axis name: x, y or z (either case), with an optional sign: "-z",
+   "+y". *axis gets 0, 1 or 2 and *sign +1 or -1; returns 0, or -1 without
+   a message for anything else (NULL included), so that the caller can say
+   what else it accepts. */
+int parse_axis_name(const char *text, int *axis, int *sign);
 /* An integer in [min, max]: "tiledtex CMD: --seed wants an integer from 0 to 9, got 'x'". */
 int parse_int(const char *option, const char *text, int min, int max, int *out);
 /* An unsigned 64-bit integer (seeds), decimal or 0x hexadecimal. */
@@ -434,6 +439,11 @@ typedef struct tool_seams {
    naming obj_path; returns the exit status. */
 int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                        uint64_t seed, unsigned flags, int all_edges, tool_seams *seams);
+/* The score as a summary says it, `edges` naming what was measured
+   ("border edges"): "0.123 (456 of 789 border edges sampled)", "n/a: ..."
+   when unrelated places differ no more than neighbours, or "not measured
+   (reason)". */
+void tool_format_seams(const tool_seams *seams, const char *edges, char *text, size_t size);
 
 /* ---------------------------------------------------------------------- */
 /* Numbers as text without printf (format_number.c)                        */
