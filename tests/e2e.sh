@@ -922,6 +922,14 @@ check "polycube torus: says it split the quads into triangles" "'1024 triangles 
 polycube_case "sphere --cube-size" spheretri.obj 1 --cube-size 0.5
 check "polycube --cube-size 0.5: cubes of 0.5 units" "'cubes of 0.5 units'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'cubes of 0.5 units'; echo $?)"
+newdir
+expect_ok "polycube torus at resolution 2" polycube ../in/torus.obj ../in/tex.png out --tile 16 --colors 1 --resolution 2
+check "polycube torus at resolution 2: warns that the genus differs" \
+    "one stderr line 'the polycube has genus 0, the mesh 1 ... raise --resolution'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -c 'the polycube has genus 0, the mesh 1.*raise --resolution' | grep -qx 1; echo $?)"
+check "polycube torus at resolution 2: the summary says so" "'genus 0 (the mesh's 1: they differ)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q "genus 0 (the mesh's 1: they differ)"; echo $?)"
+cd "$W" || exit 1
 polycube_case "sphere --up -z --no-correct" spheretri.obj 1 --resolution 6 --up -z --no-correct
 polycube_case "sphere --up 1,2,0" spheretri.obj 1 --resolution 6 --up 1,2,0
 
