@@ -2534,13 +2534,18 @@ TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
    it interpolates, so normals, colours or skin weights carry through. */
 typedef struct tt_polycube_map_options {
     int max_quads;      /* the longest edge path, as tt_polycube_edge_options; 0 = its default */
+    double max_edge;    /* model edges longer than this (mesh units) are halved first, until none is;
+                           0 = TT_POLYCUBE_MAP_DEFAULT_EDGE times the cube size h; HUGE_VAL: never */
 } tt_polycube_map_options;
 
+#define TT_POLYCUBE_MAP_DEFAULT_EDGE 0.5
+
 typedef struct tt_polycube_map_report {
-    tt_polycube_projection_report projection;   /* how the vertices went onto S */
+    int triangles;          /* triangles of the model after refinement (max_edge), the ones mapped */
+    tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
-    int fallback_triangles; /* input triangles put whole into one quad (P11 step 7): a local seam; target 0 */
+    int fallback_triangles; /* of `triangles`, those put whole into one quad (P11 step 7): a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold of the projection) */
 } tt_polycube_map_report;
 
@@ -2557,36 +2562,47 @@ typedef struct tt_polycube_mapping {
 } tt_polycube_mapping;
 
 /* Map `mesh` (triangles; the mesh the polycube was built from, or any
-   other near its surface) onto S: tt_polycube_project, then
-   tt_polycube_trace_edges, then per triangle:
-     - its three edge paths are unfolded one after another into one chart
-       (tt_polycube_unfold, starting in its first vertex's quad); when the
-       walk comes back to that quad in the same frame and every crossing
-       lies on the straight chart triangle (no bend at a saddle, no cone
-       point of S inside), the chart triangle is clipped by the unit grid
-       of the chart (Sutherland-Hodgman) into convex pieces, one per quad,
-       each fanned into triangles; the quads of the grid cells are found by
-       walking across S's edges from the first quad, and must agree;
-     - a point on a model edge is the edge's record: at t, between the
-       edge's first and second vertex, shared by both triangles; a grid
-       point inside the triangle interpolates its three vertices with its
-       barycentric coordinates in the chart;
-     - a triangle on an edge with no path, or whose chart does not close
-       or agree (P11 step 7), keeps its boundary (the model vertices and
-       the split points of its edges, so its neighbours still meet it
-       without a crack) and is fanned from its centroid into the quad of
-       its first vertex, the points on S projected orthogonally onto that
-       quad's plane and clamped to it: a local seam, counted in
-       fallback_triangles.
-   Pieces of zero area (an edge along a lattice line) are dropped; the
-   output's area equals the input's. report may be NULL.
+   other near its surface) onto S: tt_polycube_project (points within
+   1e-6 of a quad's edge are put on it), then tt_polycube_trace_edges, then
+   per triangle:
+     - its boundary (its vertices and its edges' split points, from the
+       records) is unfolded into one chart from its first vertex's quad;
+       where an edge runs along an edge of S the quad on the triangle's side
+       is taken, and the quads follow each other across S's edges, or
+       clockwise around a vertex of S (through the triangle's side);
+     - when the chart closes (back in the first quad, in the same frame)
+       and every split point lies on the straight chart triangle (no cone
+       point of S inside, no bend at a saddle), the chart triangle is
+       clipped by the unit grid of the chart (Sutherland-Hodgman) into
+       convex pieces, one per quad, each fanned into triangles; the quads
+       of the grid cells are found by walking across S's edges from the
+       boundary's quads, and must agree. A cut of a side is that side's
+       split point on the grid line (the record's numbers, so the
+       neighbour's split is the same), a grid point inside interpolates
+       the triangle's vertices with its barycentric coordinates; every
+       split point must end up a corner of a piece;
+     - otherwise, when every quad the boundary passes is around one vertex
+       V of S and the boundary winds once around V (a cone point inside)
+       or passes through it (a bend), the triangle is the fan from V over
+       its boundary, each fan triangle in its segment's quad; a V inside
+       becomes a vertex at the boundary's mean value coordinates seen from
+       V, which lie on the triangle;
+     - otherwise (an edge with no path, a fold of the projection, several
+       cones) the triangle keeps its boundary, so its neighbours still
+       meet it without a crack, and is fanned from its centroid into the
+       quad of its first vertex, the points on S projected orthogonally
+       onto that quad's plane and clamped to it (P11 step 7): a local
+       seam, counted in fallback_triangles.
+   Every split point of an edge is one output vertex shared by the two
+   triangles on the edge: a closed manifold model gives a closed manifold
+   output. Pieces of zero area (an edge along a lattice line) are dropped;
+   the output's area equals the input's. report may be NULL.
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
    a face that is not a triangle (error->face; triangulate first), or a
    polycube not made by tt_polycube_build; TT_ERROR_EMPTY_MESH;
-   TT_ERROR_NON_FINITE; TT_ERROR_TOO_LARGE when the output would exceed
-   INT_MAX / 3 triangles; TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL
-   and nothing stays allocated. Free the result with
+   TT_ERROR_NON_FINITE; TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL,
+   the report zeroed, and nothing stays allocated. Free the result with
    tt_polycube_mapping_free. Same input, same output; thread-safe. */
 TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
                                 const tt_polycube_map_options *options, const tt_allocator *allocator,
@@ -15740,12 +15756,41 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
             if (!grown) goto out_of_memory;
             E->crossings = grown;
         }
-        for (i = 0; i < count; i++) {
-            /* P11 step 4.5, once per edge: no zero-length piece next to a vertex or a quad corner. */
-            tt_edge_crossing snapped = crossing[i];
-            snapped.along = tt__edge_snap(snapped.along);
-            snapped.t = tt__edge_snap(snapped.t);
-            E->crossings[E->ncrossings++] = snapped;
+        {
+            /* P11 step 4.5, once per edge: no zero-length piece next to a vertex or a quad corner. Besides t
+               and along within TT__EDGE_SNAP of their ends, a crossing within TT__EDGE_SNAP h of either
+               end of the edge - on S, or in space - is at that end (a vertex's point a float ulp off a quad
+               corner gives a crossing there at a t far from 0, and its 3D point would round onto the
+               vertex's), and one that close to the crossing before it is at that one's t. */
+            const float *pa = mesh->pos + 3 * (size_t)E->edge_vertices[2 * e];
+            const float *pb = mesh->pos + 3 * (size_t)E->edge_vertices[2 * e + 1];
+            double b_plane[2], length3 = 0.0;
+            tt_quad_map map;
+            int a;
+            for (a = 0; a < 3; a++) length3 += ((double)pb[a] - pa[a]) * ((double)pb[a] - pa[a]);
+            length3 = sqrt(length3) / polycube->h;
+            map.turns = map.offset[0] = map.offset[1] = 0;
+            for (i = 0; i < count; i++) map = tt_quad_map_compose(map, tt_polycube_unfold(polycube, crossing[i].halfedge));
+            tt_quad_map_apply(map, S->b[0], S->b[1], b_plane);
+            map.turns = map.offset[0] = map.offset[1] = 0;
+            for (i = 0; i < count; i++) {
+                tt_edge_crossing snapped = crossing[i];
+                double e0[2], e1[2], at[2];
+                tt__edge_in_plane(polycube->surface, snapped.halfedge, map, e0, e1);
+                at[0] = e0[0] + snapped.along * (e1[0] - e0[0]);
+                at[1] = e0[1] + snapped.along * (e1[1] - e0[1]);
+                snapped.along = tt__edge_snap(snapped.along);
+                snapped.t = tt__edge_snap(snapped.t);
+                if (tt__distance2(at, S->a) <= TT__EDGE_SNAP || snapped.t * length3 <= TT__EDGE_SNAP) snapped.t = 0.0;
+                if (tt__distance2(at, b_plane) <= TT__EDGE_SNAP || (1.0 - snapped.t) * length3 <= TT__EDGE_SNAP)
+                    snapped.t = 1.0;
+                /* Two crossings this close pass one S vertex: one split point (their 3D points would round
+                   to one). */
+                if (i > 0 && (snapped.t - E->crossings[E->ncrossings - 1].t) * length3 <= TT__EDGE_SNAP)
+                    snapped.t = E->crossings[E->ncrossings - 1].t;
+                E->crossings[E->ncrossings++] = snapped;
+                map = tt_quad_map_compose(map, tt_polycube_unfold(polycube, crossing[i].halfedge));
+            }
         }
     }
     E->first_crossing[E->nedges] = E->ncrossings;
@@ -15756,6 +15801,1334 @@ out_of_memory:
     tt__free(allocator, S);
     tt_polycube_edges_free(E);
     return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory tracing the mesh's edges on S");
+}
+
+/* ---- The model split on S and its UVs (spec P11 steps 4, 6, 7) ---- */
+
+#define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
+                                       above the records' snap (1e-6), far below any real piece */
+#define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
+#define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
+
+/* A point on a triangle's boundary (a model vertex or a split point of an
+   edge) and the boundary segment from it to the next point: the quad the
+   segment lies in, both ends in that quad's frame, the map of that frame
+   into the triangle's chart, and the point in the chart. */
+typedef struct tt__split_point {
+    int vertex;                 /* output vertex */
+    int quad;
+    double a[2], b[2];
+    tt_quad_map map;
+    double at[2];
+    int used;                   /* a corner of some piece (tt__split_pieces) */
+} tt__split_point;
+
+typedef struct tt__split_cell {
+    int quad;                   /* -1: not known yet */
+    tt_quad_map map;
+} tt__split_cell;
+
+/* The model refined for the split: its triangles halved along every edge
+   longer than a bound until none is, so that a triangle spans few quads of
+   S and holds at most about one vertex of S (a coarse model's large
+   triangles would each hold several cone points, which no single chart or
+   fan maps). Refined vertex v < mesh->nverts is input vertex v; each
+   refined vertex interpolates at most 3 vertices of one input triangle
+   (the midpoint of a midpoint stays on its triangle), and each refined
+   triangle knows its input face. */
+typedef struct tt__refined {
+    tt_mesh *mesh;
+    int *source;                /* 3 per vertex: input vertices... */
+    double *weight;             /* ...and their weights */
+    int *face;                  /* per triangle: its input face */
+} tt__refined;
+
+static void tt__refined_free(const tt_allocator *allocator, tt__refined *r)
+{
+    tt_mesh_free(r->mesh);
+    tt__free(allocator, r->source);
+    tt__free(allocator, r->weight);
+    tt__free(allocator, r->face);
+    memset(r, 0, sizeof *r);
+}
+
+/* The sources of the midpoint of refined vertices a and b: half of each,
+   the same input vertices added up (at most 3 distinct: both lie on one
+   input triangle). */
+static void tt__refined_midpoint_sources(const int *source, const double *weight, int a, int b, int out_source[3],
+                                         double out_weight[3])
+{
+    int n = 0, i, j, k;
+    for (k = 0; k < 3; k++) {
+        out_source[k] = source[3 * a];
+        out_weight[k] = 0.0;
+    }
+    for (i = 0; i < 6; i++) {
+        int v = source[3 * (i < 3 ? a : b) + i % 3];
+        double w = 0.5 * weight[3 * (i < 3 ? a : b) + i % 3];
+        if (w == 0.0) continue;
+        for (j = 0; j < n && out_source[j] != v; j++) continue;
+        if (j == n) {
+            if (n == 3) continue;
+            out_source[n++] = v;
+        }
+        out_weight[j] += w;
+    }
+}
+
+#define TT__REFINE_MAX_TRIANGLES (1 << 24)   /* refining stops short of this many triangles */
+
+static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
+                                     tt__refined *out, tt_error *error)
+{
+    float *positions = NULL;
+    int *triangles = NULL, *faces = NULL, *source = NULL, *mid = NULL, *next_triangles = NULL, *next_faces = NULL;
+    double *weight = NULL;
+    int nverts = mesh->nverts, ntriangles = mesh->nfaces, vertex_capacity = 0, pass, c, v, f;
+    tt_mesh *current = NULL;
+    tt_result result = TT_OK;
+    memset(out, 0, sizeof *out);
+    positions = (float *)tt__grow(allocator, NULL, &vertex_capacity, nverts > 0 ? nverts : 1, 3 * sizeof(float));
+    source = TT__ALLOC(allocator, int, 3 * (size_t)vertex_capacity);
+    weight = TT__ALLOC(allocator, double, 3 * (size_t)vertex_capacity);
+    triangles = TT__ALLOC(allocator, int, 3 * (size_t)ntriangles);
+    faces = TT__ALLOC(allocator, int, ntriangles);
+    if (!positions || !source || !weight || !triangles || !faces) goto out_of_memory;
+    memcpy(positions, mesh->pos, sizeof(float) * 3 * (size_t)nverts);
+    for (v = 0; v < nverts; v++) {
+        source[3 * v] = source[3 * v + 1] = source[3 * v + 2] = v;
+        weight[3 * v] = 1.0;
+        weight[3 * v + 1] = weight[3 * v + 2] = 0.0;
+    }
+    memcpy(triangles, mesh->corner_vert, sizeof(int) * 3 * (size_t)ntriangles);
+    for (f = 0; f < ntriangles; f++) faces[f] = f;
+    for (pass = 0;; pass++) {
+        tt_mesh_desc desc;
+        int marked = 0, next_count = 0;
+        memset(&desc, 0, sizeof desc);
+        desc.positions = positions;
+        desc.nverts = nverts;
+        desc.indices = triangles;
+        desc.nfaces = ntriangles;
+        desc.fixed_face_size = 3;
+        desc.flags = mesh->flags & TT_MESH_PERMISSIVE;
+        if ((result = tt_mesh_build(&desc, allocator, &current, error)) != TT_OK) goto failed;
+        mid = TT__ALLOC(allocator, int, current->ncorners);
+        if (!mid) goto out_of_memory;
+        for (c = 0; c < current->ncorners; c++) {
+            int a = current->corner_vert[c], b = current->corner_vert[tt_mesh_next(current, c)], twin = current->twin[c];
+            double d2 = 0.0;
+            int k;
+            for (k = 0; k < 3; k++) d2 += ((double)positions[3 * b + k] - positions[3 * a + k]) *
+                                          ((double)positions[3 * b + k] - positions[3 * a + k]);
+            mid[c] = -1;
+            if (d2 <= longest * longest) continue;
+            marked++;
+            if (twin >= 0 && twin < c) {
+                mid[c] = mid[twin];
+                continue;
+            }
+            if (nverts == vertex_capacity) {
+                int capacity = vertex_capacity, *grown_source;
+                float *grown_positions;
+                double *grown_weight;
+                if (nverts >= INT_MAX / 4) goto too_large;
+                grown_positions = (float *)tt__grow(allocator, positions, &capacity, nverts + 1, 3 * sizeof(float));
+                if (!grown_positions) goto out_of_memory;
+                positions = grown_positions;
+                capacity = vertex_capacity;
+                grown_source = (int *)tt__grow(allocator, source, &capacity, nverts + 1, 3 * sizeof(int));
+                if (!grown_source) goto out_of_memory;
+                source = grown_source;
+                capacity = vertex_capacity;
+                grown_weight = (double *)tt__grow(allocator, weight, &capacity, nverts + 1, 3 * sizeof(double));
+                if (!grown_weight) goto out_of_memory;
+                weight = grown_weight;
+                vertex_capacity = capacity;
+            }
+            for (k = 0; k < 3; k++)
+                positions[3 * nverts + k] = (float)(0.5 * ((double)positions[3 * a + k] + positions[3 * b + k]));
+            tt__refined_midpoint_sources(source, weight, a, b, source + 3 * nverts, weight + 3 * nverts);
+            mid[c] = nverts++;
+        }
+        if (!marked || ntriangles > TT__REFINE_MAX_TRIANGLES / 4) break;
+        if (ntriangles > (INT_MAX / 3) / 4) goto too_large;
+        next_triangles = TT__ALLOC(allocator, int, 12 * (size_t)ntriangles);
+        next_faces = TT__ALLOC(allocator, int, 4 * (size_t)ntriangles);
+        if (!next_triangles || !next_faces) goto out_of_memory;
+        for (f = 0; f < ntriangles; f++) {
+            int r, split = 0, *t;
+            const int *corner = triangles + 3 * f, *m = mid + 3 * f;
+            for (r = 0; r < 3; r++) split += m[r] >= 0;
+            /* Turn the triangle so its split edges come first: (a, b) always split when any is. */
+            for (r = 0; r < 3 && split > 0 && split < 3; r++)
+                if (m[r] >= 0 && m[(r + 2) % 3] < 0) break;
+            if (split == 0 || split == 3) r = 0;
+            {
+                int a = corner[r], b = corner[(r + 1) % 3], cc = corner[(r + 2) % 3];
+                int ab = m[r], bc = m[(r + 1) % 3], ca = m[(r + 2) % 3], add[12], n = 0, k;
+                if (split == 0) {
+                    add[n++] = a; add[n++] = b; add[n++] = cc;
+                } else if (split == 1) {
+                    add[n++] = a; add[n++] = ab; add[n++] = cc;
+                    add[n++] = ab; add[n++] = b; add[n++] = cc;
+                } else if (split == 2) {
+                    /* (a, b) and (b, c) split: the corner at b, then the quad a, ab, bc, c by its shorter
+                       diagonal. */
+                    double d_a = 0.0, d_c = 0.0;
+                    for (k = 0; k < 3; k++) {
+                        d_a += ((double)positions[3 * a + k] - positions[3 * bc + k]) *
+                               ((double)positions[3 * a + k] - positions[3 * bc + k]);
+                        d_c += ((double)positions[3 * cc + k] - positions[3 * ab + k]) *
+                               ((double)positions[3 * cc + k] - positions[3 * ab + k]);
+                    }
+                    add[n++] = ab; add[n++] = b; add[n++] = bc;
+                    if (d_a <= d_c) {
+                        add[n++] = a; add[n++] = ab; add[n++] = bc;
+                        add[n++] = a; add[n++] = bc; add[n++] = cc;
+                    } else {
+                        add[n++] = a; add[n++] = ab; add[n++] = cc;
+                        add[n++] = ab; add[n++] = bc; add[n++] = cc;
+                    }
+                } else {
+                    add[n++] = a; add[n++] = ab; add[n++] = ca;
+                    add[n++] = ab; add[n++] = b; add[n++] = bc;
+                    add[n++] = ca; add[n++] = bc; add[n++] = cc;
+                    add[n++] = ab; add[n++] = bc; add[n++] = ca;
+                }
+                t = next_triangles + 3 * next_count;
+                memcpy(t, add, sizeof(int) * (size_t)n);
+                for (k = 0; k < n / 3; k++) next_faces[next_count++] = faces[f];
+            }
+        }
+        tt__free(allocator, triangles);
+        tt__free(allocator, faces);
+        tt__free(allocator, mid);
+        tt_mesh_free(current);
+        current = NULL;
+        mid = NULL;
+        triangles = next_triangles;
+        faces = next_faces;
+        next_triangles = next_faces = NULL;
+        ntriangles = next_count;
+    }
+    tt__free(allocator, mid);
+    tt__free(allocator, triangles);
+    tt__free(allocator, positions);
+    out->mesh = current;
+    out->source = source;
+    out->weight = weight;
+    out->face = faces;
+    return TT_OK;
+too_large:
+    result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                      "refining the model's triangles to edges of at most %g would pass %d vertices or "
+                      "triangles: choose a larger max_edge or a coarser polycube", longest, INT_MAX / 4);
+    goto failed;
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory refining the model");
+failed:
+    tt_mesh_free(current);
+    tt__free(allocator, mid);
+    tt__free(allocator, next_triangles);
+    tt__free(allocator, next_faces);
+    tt__free(allocator, triangles);
+    tt__free(allocator, faces);
+    tt__free(allocator, positions);
+    tt__free(allocator, source);
+    tt__free(allocator, weight);
+    return result;
+}
+
+/* A vertex of a piece while the chart triangle is clipped: a corner of the
+   triangle, a cut of side `index` by the grid line x[axis] = bound, or a
+   point inside (where two grid lines cross). */
+enum { TT__CLIP_CORNER, TT__CLIP_SIDE, TT__CLIP_GRID };
+typedef struct tt__clip_point {
+    double p[2];
+    int kind, index, axis;
+    double bound;
+} tt__clip_point;
+
+typedef struct tt__split {
+    const tt_polycube *pc;
+    const tt_mesh *mesh;
+    const tt_polycube_edges *edges;
+    const tt_surface_point *points;
+    const tt_allocator *allocator;
+    tt_polycube_mapping *out;
+    int vertex_capacity, triangle_capacity;
+    int *crossing_vertex;       /* per crossing of the records: its output vertex, -1 until made */
+    /* One triangle at a time: */
+    int vert[3];
+    double corner[3][2];        /* its vertices in the chart */
+    tt__split_point *boundary;  /* vertex 0, edge 0's split points, vertex 1, ... */
+    int nboundary, boundary_capacity;
+    int side_start[3];          /* the boundary index of vertex k, where side k (vertex k to k + 1) starts */
+    tt__split_cell *cells;      /* the chart's grid cells over the triangle's box */
+    int cell_capacity, box[4];  /* first cell x, y; cells across, up */
+    int *queue;
+    int *grid_points;           /* grid points inside the triangle: x, y, output vertex */
+    int ngrid, grid_capacity;
+} tt__split;
+
+static int tt__quad_map_equal(tt_quad_map a, tt_quad_map b)
+{
+    return a.turns == b.turns && a.offset[0] == b.offset[0] && a.offset[1] == b.offset[1];
+}
+
+/* The point of the chart `at` in the frame of the quad `map` places there. */
+static void tt__quad_map_invert_point(tt_quad_map map, const double at[2], double st[2])
+{
+    tt__quarter_turns(4 - map.turns, at[0] - map.offset[0], at[1] - map.offset[1], st);
+}
+
+/* A new output vertex interpolating up to three input vertices; -1 when out of memory. */
+static int tt__split_vertex(tt__split *S, const int source[3], const double weight[3])
+{
+    tt_polycube_mapping *m = S->out;
+    int capacity = S->vertex_capacity, k, a;
+    double p[3] = {0.0, 0.0, 0.0};
+    if (m->nverts >= INT_MAX / 3 - 1) return -1;
+    if (m->nverts == capacity) {
+        /* Each array grows from the same old capacity; a failure leaves the arrays as they were, all owned. */
+        float *positions, *weights;
+        int *sources;
+        capacity = S->vertex_capacity;
+        positions = (float *)tt__grow(S->allocator, m->positions, &capacity, m->nverts + 1, 3 * sizeof(float));
+        if (!positions) return -1;
+        m->positions = positions;
+        capacity = S->vertex_capacity;
+        sources = (int *)tt__grow(S->allocator, m->source, &capacity, m->nverts + 1, 3 * sizeof(int));
+        if (!sources) return -1;
+        m->source = sources;
+        capacity = S->vertex_capacity;
+        weights = (float *)tt__grow(S->allocator, m->weights, &capacity, m->nverts + 1, 3 * sizeof(float));
+        if (!weights) return -1;
+        m->weights = weights;
+        S->vertex_capacity = capacity;
+    }
+    for (k = 0; k < 3; k++) {
+        m->source[3 * m->nverts + k] = source[k];
+        m->weights[3 * m->nverts + k] = (float)weight[k];
+        for (a = 0; a < 3; a++) p[a] += weight[k] * S->mesh->pos[3 * source[k] + a];
+    }
+    for (a = 0; a < 3; a++) m->positions[3 * m->nverts + a] = (float)p[a];
+    return m->nverts++;
+}
+
+/* A new output triangle in `quad`; 0 when out of memory. */
+static int tt__split_triangle(tt__split *S, int face, int quad, const int vertex[3], double st[3][2])
+{
+    tt_polycube_mapping *m = S->out;
+    int k;
+    if (m->ntriangles >= INT_MAX / 6 - 1) return 0;
+    if (m->ntriangles == S->triangle_capacity) {
+        int capacity = S->triangle_capacity, *triangles, *faces;
+        tt_surface_point *points;
+        triangles = (int *)tt__grow(S->allocator, m->triangles, &capacity, m->ntriangles + 1, 3 * sizeof(int));
+        if (!triangles) return 0;
+        m->triangles = triangles;
+        capacity = S->triangle_capacity;
+        faces = (int *)tt__grow(S->allocator, m->triangle_face, &capacity, m->ntriangles + 1, sizeof(int));
+        if (!faces) return 0;
+        m->triangle_face = faces;
+        capacity = S->triangle_capacity;
+        points = (tt_surface_point *)tt__grow(S->allocator, m->corner_points, &capacity, m->ntriangles + 1,
+                                              3 * sizeof(tt_surface_point));
+        if (!points) return 0;
+        m->corner_points = points;
+        S->triangle_capacity = capacity;
+    }
+    for (k = 0; k < 3; k++) {
+        tt_surface_point *p = &m->corner_points[3 * m->ntriangles + k];
+        m->triangles[3 * m->ntriangles + k] = vertex[k];
+        p->quad = quad;
+        p->s = (float)(st[k][0] < 0.0 ? 0.0 : (st[k][0] > 1.0 ? 1.0 : st[k][0]));
+        p->t = (float)(st[k][1] < 0.0 ? 0.0 : (st[k][1] > 1.0 ? 1.0 : st[k][1]));
+    }
+    m->triangle_face[m->ntriangles++] = face;
+    return 1;
+}
+
+/* The output vertex of crossing j of edge e: the edge's end at t = 0 or 1,
+   else one vertex per t (crossings at one t pass one S vertex), made the
+   first time either triangle asks. -1 when out of memory. */
+static int tt__split_crossing_vertex(tt__split *S, int e, int j)
+{
+    const tt_polycube_edges *E = S->edges;
+    const int *ends = E->edge_vertices + 2 * e;
+    double t = E->crossings[j].t;
+    if (t == 0.0) return ends[0];
+    if (t == 1.0) return ends[1];
+    while (j > E->first_crossing[e] && E->crossings[j - 1].t == t) j--;
+    if (S->crossing_vertex[j] < 0) {
+        int source[3];
+        double weight[3];
+        source[0] = ends[0];
+        source[1] = source[2] = ends[1];
+        weight[0] = 1.0 - t;
+        weight[1] = t;
+        weight[2] = 0.0;
+        S->crossing_vertex[j] = tt__split_vertex(S, source, weight);
+    }
+    return S->crossing_vertex[j];
+}
+
+/* Append boundary point `vertex`, its segment starting in `quad` at st; the
+   segment before it (if any) ends at st_in in its own quad. */
+static int tt__split_push(tt__split *S, int vertex, int quad, const double st_in[2], const double st[2])
+{
+    tt__split_point *p;
+    tt__split_point *grown = (tt__split_point *)tt__grow(S->allocator, S->boundary, &S->boundary_capacity,
+                                                         S->nboundary + 1, sizeof(tt__split_point));
+    if (!grown) return 0;
+    S->boundary = grown;
+    if (S->nboundary > 0) {
+        S->boundary[S->nboundary - 1].b[0] = st_in[0];
+        S->boundary[S->nboundary - 1].b[1] = st_in[1];
+    }
+    p = &S->boundary[S->nboundary++];
+    memset(p, 0, sizeof *p);
+    p->vertex = vertex;
+    p->quad = quad;
+    p->a[0] = st[0];
+    p->a[1] = st[1];
+    return 1;
+}
+
+/* The edge of a quad's square (0..3: the half-edge from corner k to k + 1)
+   that both points lie on, within TT__EDGE_SNAP (the points on S of model
+   vertices are float), or -1. */
+static int tt__square_edge_of(const double p[2], const double q[2])
+{
+    if (fabs(p[1]) <= TT__EDGE_SNAP && fabs(q[1]) <= TT__EDGE_SNAP) return 0;
+    if (fabs(p[0] - 1.0) <= TT__EDGE_SNAP && fabs(q[0] - 1.0) <= TT__EDGE_SNAP) return 1;
+    if (fabs(p[1] - 1.0) <= TT__EDGE_SNAP && fabs(q[1] - 1.0) <= TT__EDGE_SNAP) return 2;
+    if (fabs(p[0]) <= TT__EDGE_SNAP && fabs(q[0]) <= TT__EDGE_SNAP) return 3;
+    return -1;
+}
+
+/* The map of the next segment's quad into the chart, from the map of the
+   segment before, at boundary point p (in the frame of the quad before):
+   the same quad; the quad across the edge through p; or, where p is a
+   corner, the quads met turning clockwise around it, i.e. through the
+   triangle's side of the boundary (its interior lies to the left). 0 when
+   the next quad is none of these. */
+static int tt__split_next_map(const tt__split *S, int quad, tt_quad_map map, const double p[2], int next,
+                              tt_quad_map *out)
+{
+    const tt_mesh *s = S->pc->surface;
+    int k, corner = -1, turns;
+    if (next == quad) {
+        *out = map;
+        return 1;
+    }
+    for (k = 0; k < 4; k++) {
+        int st[2];
+        tt__quad_corner_st(k, st);
+        if (fabs(p[0] - st[0]) + fabs(p[1] - st[1]) <= TT__EDGE_SNAP) corner = k;
+    }
+    if (corner < 0) {
+        for (k = 0; k < 4; k++) {
+            int h = s->face_start[quad] + k;
+            if (tt__square_edge_of(p, p) == k && s->corner_face[s->twin[h]] == next) {
+                *out = tt_quad_map_compose(map, tt_polycube_unfold(S->pc, h));
+                return 1;
+            }
+        }
+        return 0;
+    }
+    /* Clockwise around the corner: across the half-edge leaving it. */
+    for (turns = 0; turns < 8; turns++) {
+        int h = s->face_start[quad] + corner, twin = s->twin[h];
+        map = tt_quad_map_compose(map, tt_polycube_unfold(S->pc, h));
+        quad = s->corner_face[twin];
+        corner = (twin - s->face_start[quad] + 1) & 3;
+        if (quad == next) {
+            *out = map;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Triangle f's boundary: its vertices and the split points of its edges,
+   in order, with their output vertices (made when new), and the segments
+   between them in their quads, as the edge records give them (spec P11
+   step 3). Then, for the chart:
+     - the points one record puts at one place (a path passing a vertex of
+       S, or leaving a model vertex that lies on a quad's edge) are one
+       point: only the quad after them counts;
+     - a segment along an edge of S lies in both quads there; the record
+       picks one, the triangle needs the one on its side (to the left);
+     - the segments' maps are chained from the first (the identity): the
+       same quad, the quad across the edge through the point, or clockwise
+       around a corner (tt__split_next_map).
+   *linked is 1 when every step of that holds; *chart is 1 when, moreover,
+   the chain comes back to the first quad in the same frame and every
+   split point lies on the straight chart triangle (no cone point of S
+   inside, no bend at a saddle). 0 when out of memory. */
+static int tt__split_walk(tt__split *S, int f, int *linked, int *chart)
+{
+    const tt_mesh *mesh = S->mesh, *s = S->pc->surface;
+    const tt_polycube_edges *E = S->edges;
+    tt_quad_map identity, closing;
+    int k, i, n, quad = S->points[S->vert[0]].quad, holds = 1;
+    double st[2];
+    identity.turns = identity.offset[0] = identity.offset[1] = 0;
+    closing = identity;
+    S->nboundary = 0;
+    for (k = 0; k < 3; k++) {
+        int v = S->vert[k], e = E->edge_of_halfedge[mesh->face_start[f] + k];
+        int forward = E->edge_vertices[2 * e] == v, first = E->first_crossing[e];
+        int count = E->first_crossing[e + 1] - first;
+        tt_surface_point q = S->points[v];
+        holds = holds && q.quad == quad && !E->failed[e];
+        quad = q.quad;
+        st[0] = q.s;
+        st[1] = q.t;
+        if (!tt__split_push(S, v, quad, st, st)) return 0;
+        for (i = 0; i < count; i++) {
+            int j = forward ? first + i : first + count - 1 - i, vertex, kh, st0[2], st1[2];
+            tt_edge_crossing x = E->crossings[j];
+            int h = forward ? x.halfedge : s->twin[x.halfedge];
+            double along = forward ? x.along : 1.0 - x.along, st_in[2];
+            vertex = tt__split_crossing_vertex(S, e, j);
+            if (vertex < 0) return 0;
+            holds = holds && s->corner_face[h] == quad;
+            kh = h - s->face_start[s->corner_face[h]];
+            tt__quad_corner_st(kh, st0);
+            tt__quad_corner_st(kh + 1, st1);
+            st_in[0] = st0[0] + along * (st1[0] - st0[0]);
+            st_in[1] = st0[1] + along * (st1[1] - st0[1]);
+            quad = s->corner_face[s->twin[h]];
+            kh = s->twin[h] - s->face_start[quad];
+            tt__quad_corner_st(kh, st0);
+            tt__quad_corner_st(kh + 1, st1);
+            st[0] = st1[0] + along * (st0[0] - st1[0]);
+            st[1] = st1[1] + along * (st0[1] - st1[1]);
+            if (!tt__split_push(S, vertex, quad, st_in, st)) return 0;
+        }
+    }
+    holds = holds && quad == S->points[S->vert[0]].quad;
+    st[0] = S->points[S->vert[0]].s;
+    st[1] = S->points[S->vert[0]].t;
+    S->boundary[S->nboundary - 1].b[0] = st[0];
+    S->boundary[S->nboundary - 1].b[1] = st[1];
+    *linked = *chart = 0;
+    if (!holds) return 1;
+    /* One point per place: a run of points with one output vertex keeps the first's place on the segment
+       before and the last's segment after. */
+    n = 0;
+    for (i = 0; i < S->nboundary; i++) {
+        if (n > 0 && S->boundary[n - 1].vertex == S->boundary[i].vertex) {
+            S->boundary[n - 1].quad = S->boundary[i].quad;
+            S->boundary[n - 1].a[0] = S->boundary[i].a[0];
+            S->boundary[n - 1].a[1] = S->boundary[i].a[1];
+            S->boundary[n - 1].b[0] = S->boundary[i].b[0];
+            S->boundary[n - 1].b[1] = S->boundary[i].b[1];
+            continue;
+        }
+        S->boundary[n++] = S->boundary[i];
+    }
+    /* The run around vertex 0 wraps: its last points' segments have no length. */
+    while (n > 1 && S->boundary[n - 1].vertex == S->boundary[0].vertex) n--;
+    S->nboundary = n;
+    if (n < 3) return 1;
+    /* Segments along an edge of S, on its far side: into the quad on the triangle's side. */
+    for (i = 0; i < n; i++) {
+        tt__split_point *p = &S->boundary[i];
+        int edge = tt__square_edge_of(p->a, p->b), st0[2], st1[2];
+        double along_edge;
+        if (edge < 0) continue;
+        tt__quad_corner_st(edge, st0);
+        tt__quad_corner_st(edge + 1, st1);
+        along_edge = (p->b[0] - p->a[0]) * (st1[0] - st0[0]) + (p->b[1] - p->a[1]) * (st1[1] - st0[1]);
+        if (along_edge < 0.0) {
+            int h = s->face_start[p->quad] + edge;
+            tt_quad_map back = tt_polycube_unfold(S->pc, s->twin[h]);
+            double a[2], b[2];
+            tt_quad_map_apply(back, p->a[0], p->a[1], a);
+            tt_quad_map_apply(back, p->b[0], p->b[1], b);
+            p->quad = s->corner_face[s->twin[h]];
+            p->a[0] = a[0];
+            p->a[1] = a[1];
+            p->b[0] = b[0];
+            p->b[1] = b[1];
+        }
+    }
+    /* The chain of maps. */
+    S->boundary[0].map = identity;
+    for (i = 1; i <= n; i++) {
+        const tt__split_point *p = &S->boundary[i - 1];
+        tt_quad_map next;
+        if (!tt__split_next_map(S, p->quad, p->map, p->b, S->boundary[i % n].quad, &next)) return 1;
+        if (i < n) S->boundary[i].map = next;
+        else closing = next;
+    }
+    for (i = 0; i < n; i++) {
+        tt__split_point *p = &S->boundary[i];
+        double before[2];
+        tt_quad_map_apply(p->map, p->a[0], p->a[1], p->at);
+        tt_quad_map_apply(S->boundary[(i + n - 1) % n].map, S->boundary[(i + n - 1) % n].b[0],
+                          S->boundary[(i + n - 1) % n].b[1], before);
+        if (i > 0 && fabs(before[0] - p->at[0]) + fabs(before[1] - p->at[1]) > TT__SPLIT_MATCH) return 1;
+    }
+    *linked = 1;
+    for (k = 0; k < 3; k++) {
+        for (i = 0; i < n && S->boundary[i].vertex != S->vert[k]; i++) continue;
+        if (i == n) return 1;
+        S->side_start[k] = i;
+        S->corner[k][0] = S->boundary[i].at[0];
+        S->corner[k][1] = S->boundary[i].at[1];
+    }
+    if (S->side_start[0] != 0 || S->side_start[1] > S->side_start[2]) return 1;
+    holds = tt__quad_map_equal(closing, identity);
+    for (k = 0; k < 3 && holds; k++) {
+        const double *a = S->corner[k], *b = S->corner[(k + 1) % 3];
+        int end = k < 2 ? S->side_start[k + 1] : n;
+        for (i = S->side_start[k] + 1; i < end && holds; i++)
+            holds = tt__point_segment_distance(S->boundary[i].at[0], S->boundary[i].at[1], a[0], a[1], b[0], b[1]) <=
+                    TT__SPLIT_MATCH;
+    }
+    *chart = holds;
+    return 1;
+}
+
+/* The stretch of segment e0 -> e1 (in the chart) strictly inside the
+   triangle, as the parameter interval's length; the triangle's corners run
+   counter-clockwise when orient is 1, clockwise when -1. */
+static double tt__split_inside_length(const tt__split *S, double orient, const double e0[2], const double e1[2])
+{
+    double lo = 0.0, hi = 1.0;
+    int i;
+    for (i = 0; i < 3; i++) {
+        const double *a = S->corner[i], *b = S->corner[(i + 1) % 3];
+        double f0 = orient * ((b[0] - a[0]) * (e0[1] - a[1]) - (b[1] - a[1]) * (e0[0] - a[0])) - TT__SPLIT_AREA;
+        double f1 = orient * ((b[0] - a[0]) * (e1[1] - a[1]) - (b[1] - a[1]) * (e1[0] - a[0])) - TT__SPLIT_AREA;
+        if (f0 <= 0.0 && f1 <= 0.0) return 0.0;
+        if (f0 <= 0.0) {
+            double u = f0 / (f0 - f1);
+            if (u > lo) lo = u;
+        } else if (f1 <= 0.0) {
+            double u = f0 / (f0 - f1);
+            if (u < hi) hi = u;
+        }
+    }
+    return hi - lo;
+}
+
+static tt__split_cell *tt__split_cell_at(tt__split *S, tt_quad_map map)
+{
+    double centre[2];
+    int x, y;
+    tt_quad_map_apply(map, 0.5, 0.5, centre);
+    x = (int)floor(centre[0]) - S->box[0];
+    y = (int)floor(centre[1]) - S->box[1];
+    if (x < 0 || y < 0 || x >= S->box[2] || y >= S->box[3]) return NULL;
+    return &S->cells[x + S->box[2] * y];
+}
+
+/* Give the chart's cells their quads: the boundary's quads first, then
+   across every side of S a known cell shares with a neighbour where the
+   side passes through the triangle. 0 when two ways disagree: a cone point
+   of S (3, 5 or 6 quads around it) inside the triangle. */
+static int tt__split_cells(tt__split *S, double orient)
+{
+    const tt_mesh *s = S->pc->surface;
+    int ncells = S->box[2] * S->box[3], head = 0, tail = 0, i, k;
+    for (i = 0; i < ncells; i++) S->cells[i].quad = -1;
+    for (i = 0; i < S->nboundary; i++) {
+        tt__split_cell *cell = tt__split_cell_at(S, S->boundary[i].map);
+        if (!cell) continue;
+        if (cell->quad < 0) {
+            cell->quad = S->boundary[i].quad;
+            cell->map = S->boundary[i].map;
+            S->queue[tail++] = (int)(cell - S->cells);
+        } else if (cell->quad != S->boundary[i].quad || !tt__quad_map_equal(cell->map, S->boundary[i].map)) {
+            return 0;
+        }
+    }
+    while (head < tail) {
+        tt__split_cell from = S->cells[S->queue[head++]];
+        for (k = 0; k < 4; k++) {
+            int h = s->face_start[from.quad] + k;
+            double e0[2], e1[2];
+            tt__split_cell *cell;
+            tt_quad_map map;
+            tt__edge_in_plane(s, h, from.map, e0, e1);
+            if (tt__split_inside_length(S, orient, e0, e1) <= TT__EDGE_EPS) continue;
+            map = tt_quad_map_compose(from.map, tt_polycube_unfold(S->pc, h));
+            cell = tt__split_cell_at(S, map);
+            if (!cell) continue;
+            if (cell->quad < 0) {
+                cell->quad = s->corner_face[s->twin[h]];
+                cell->map = map;
+                S->queue[tail++] = (int)(cell - S->cells);
+            } else if (cell->quad != s->corner_face[s->twin[h]] || !tt__quad_map_equal(cell->map, map)) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+/* The sides of the chart triangle a clipped point lies on, as bits. */
+static int tt__clip_sides(const tt__clip_point *c)
+{
+    if (c->kind == TT__CLIP_CORNER) return (1 << c->index) | (1 << ((c->index + 2) % 3));
+    return c->kind == TT__CLIP_SIDE ? 1 << c->index : 0;
+}
+
+/* Sutherland-Hodgman: the part of polygon in[0..n) with sign * (x[axis] -
+   bound) >= 0, into out; its size. A cut between two points on one side
+   of the triangle is on that side; any other cut runs along an earlier
+   grid line, so it is a grid point. */
+static int tt__split_clip(const tt__clip_point *in, int n, int axis, double bound, double sign, tt__clip_point *out)
+{
+    int i, m = 0;
+    for (i = 0; i < n; i++) {
+        const tt__clip_point *p = &in[i], *q = &in[(i + 1) % n];
+        double dp = sign * (p->p[axis] - bound), dq = sign * (q->p[axis] - bound);
+        if (dp >= 0.0) out[m++] = *p;
+        if ((dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0)) {
+            double u = dp / (dp - dq);
+            int common = tt__clip_sides(p) & tt__clip_sides(q), k;
+            tt__clip_point *x = &out[m++];
+            x->p[0] = p->p[0] + u * (q->p[0] - p->p[0]);
+            x->p[1] = p->p[1] + u * (q->p[1] - p->p[1]);
+            x->p[axis] = bound;
+            x->kind = TT__CLIP_GRID;
+            x->index = -1;
+            x->axis = axis;
+            x->bound = bound;
+            for (k = 0; k < 3; k++)
+                if (common & (1 << k)) {
+                    x->kind = TT__CLIP_SIDE;
+                    x->index = k;
+                }
+        }
+    }
+    return m;
+}
+
+static double tt__split_area(const tt__clip_point *p, int n)
+{
+    double area = 0.0;
+    int i;
+    for (i = 0; i < n; i++) area += p[i].p[0] * p[(i + 1) % n].p[1] - p[(i + 1) % n].p[0] * p[i].p[1];
+    return 0.5 * area;
+}
+
+/* The output vertex of a piece's vertex, and its exact chart place, from
+   the edge records where the piece meets the triangle's boundary:
+     - a corner of the triangle is its vertex;
+     - a cut of side k by a grid line is side k's split point on that line
+       (the records put split points on S's edges, which are the chart's
+       grid lines exactly), the nearest along it; a side's end on the line
+       when no split point is (a vertex on S's edge);
+     - a grid point is a boundary point lying on it (a record passing that
+       corner of S) or else a vertex of its own, made once per triangle,
+       interpolating the triangle's vertices with its barycentric
+       coordinates in the chart; on a side it must be a boundary point.
+   Marks the boundary points used. -1 when the records and the chart
+   disagree, -2 when out of memory. */
+static int tt__split_identify(tt__split *S, const tt__clip_point *c, double area2, double at[2])
+{
+    int i, x, y, k, best = -1;
+    double weight[3], best_distance = HUGE_VAL;
+    if (c->kind == TT__CLIP_CORNER) {
+        i = S->side_start[c->index];
+    } else if (c->kind == TT__CLIP_SIDE) {
+        int first = S->side_start[c->index], end = c->index < 2 ? S->side_start[c->index + 1] : S->nboundary;
+        int pass;
+        for (pass = 0; pass < 2 && best < 0; pass++)
+            for (i = pass ? first : first + 1; i <= (pass ? end : end - 1); i++) {
+                const tt__split_point *q = &S->boundary[i % S->nboundary];
+                double d = fabs(q->at[1 - c->axis] - c->p[1 - c->axis]);
+                if (fabs(q->at[c->axis] - c->bound) <= 1e-9 && d < best_distance) {
+                    best_distance = d;
+                    best = i % S->nboundary;
+                }
+            }
+        if (best < 0 || best_distance > TT__SPLIT_MATCH) return -1;
+        i = best;
+    } else {
+        x = (int)floor(c->p[0] + 0.5);
+        y = (int)floor(c->p[1] + 0.5);
+        at[0] = x;
+        at[1] = y;
+        for (i = 0; i < S->nboundary; i++)
+            if (fabs(S->boundary[i].at[0] - x) + fabs(S->boundary[i].at[1] - y) <= 1e-9) break;
+        if (i == S->nboundary) {
+            for (i = 0; i < S->ngrid; i++)
+                if (S->grid_points[3 * i] == x && S->grid_points[3 * i + 1] == y) return S->grid_points[3 * i + 2];
+            for (k = 0; k < 3; k++) {
+                const double *a = S->corner[(k + 1) % 3], *b = S->corner[(k + 2) % 3];
+                weight[k] = ((b[0] - a[0]) * (at[1] - a[1]) - (b[1] - a[1]) * (at[0] - a[0])) / area2;
+                if (weight[k] <= TT__SPLIT_AREA) return -1;   /* on a side, where no record passes */
+            }
+            {
+                int *grown = (int *)tt__grow(S->allocator, S->grid_points, &S->grid_capacity, 3 * (S->ngrid + 1),
+                                             sizeof(int));
+                if (!grown) return -2;
+                S->grid_points = grown;
+            }
+            k = tt__split_vertex(S, S->vert, weight);
+            if (k < 0) return -2;
+            S->grid_points[3 * S->ngrid] = x;
+            S->grid_points[3 * S->ngrid + 1] = y;
+            S->grid_points[3 * S->ngrid + 2] = k;
+            S->ngrid++;
+            return k;
+        }
+    }
+    S->boundary[i].used = 1;
+    at[0] = S->boundary[i].at[0];
+    at[1] = S->boundary[i].at[1];
+    return S->boundary[i].vertex;
+}
+
+/* A convex piece (m output vertices at chart points `at`, in order) fanned
+   into triangles of quad `cell`. The apex is a vertex from which no fan
+   triangle is flat (points along one side of the piece are split points
+   the neighbour shares: a flat triangle would drop them); when there is
+   none, a new vertex at the piece's centroid. 0 when out of memory. */
+static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const int *ids, double (*at)[2], int m,
+                         double area2, int *pieces)
+{
+    int apex, i, j, centre = -1;
+    double middle[2] = {0.0, 0.0};
+    for (apex = 0; apex < m; apex++) {
+        int flat = 0;
+        for (i = 1; i + 1 < m && !flat; i++) {
+            const double *a = at[apex], *b = at[(apex + i) % m], *c = at[(apex + i + 1) % m];
+            flat = fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) <= 2.0 * TT__SPLIT_AREA;
+        }
+        if (!flat) break;
+    }
+    if (apex == m) {
+        double weight[3];
+        int k;
+        for (i = 0; i < m; i++) {
+            middle[0] += at[i][0] / m;
+            middle[1] += at[i][1] / m;
+        }
+        for (k = 0; k < 3; k++) {
+            const double *a = S->corner[(k + 1) % 3], *b = S->corner[(k + 2) % 3];
+            weight[k] = ((b[0] - a[0]) * (middle[1] - a[1]) - (b[1] - a[1]) * (middle[0] - a[0])) / area2;
+        }
+        centre = tt__split_vertex(S, S->vert, weight);
+        if (centre < 0) return 0;
+    }
+    for (i = 0; i < (centre >= 0 ? m : m - 2); i++) {
+        double st[3][2];
+        int corners[3];
+        const double *order[3];
+        if (centre >= 0) {
+            order[0] = middle;
+            corners[0] = centre;
+            order[1] = at[i];
+            corners[1] = ids[i];
+            order[2] = at[(i + 1) % m];
+            corners[2] = ids[(i + 1) % m];
+        } else {
+            order[0] = at[apex];
+            corners[0] = ids[apex];
+            order[1] = at[(apex + i + 1) % m];
+            corners[1] = ids[(apex + i + 1) % m];
+            order[2] = at[(apex + i + 2) % m];
+            corners[2] = ids[(apex + i + 2) % m];
+        }
+        for (j = 0; j < 3; j++) tt__quad_map_invert_point(cell->map, order[j], st[j]);
+        if (!tt__split_triangle(S, f, cell->quad, corners, st)) return 0;
+        (*pieces)++;
+    }
+    return 1;
+}
+
+/* Triangle f cut by the chart's grid into pieces, one per quad, each
+   fanned into output triangles (P11 step 4). 1 when done, 0 when the chart
+   does not allow it (the caller rolls back and takes the fallback), -1
+   when out of memory. */
+static int tt__split_pieces(tt__split *S, int f, int *pieces)
+{
+    double lo[2], hi[2], area2, orient;
+    int k, x, y, ncells, i;
+    area2 = (S->corner[1][0] - S->corner[0][0]) * (S->corner[2][1] - S->corner[0][1]) -
+            (S->corner[1][1] - S->corner[0][1]) * (S->corner[2][0] - S->corner[0][0]);
+    if (fabs(area2) <= 2.0 * TT__SPLIT_AREA) return 0;
+    orient = area2 > 0.0 ? 1.0 : -1.0;
+    for (k = 0; k < 2; k++) {
+        lo[k] = hi[k] = S->corner[0][k];
+        if (S->corner[1][k] < lo[k]) lo[k] = S->corner[1][k];
+        if (S->corner[2][k] < lo[k]) lo[k] = S->corner[2][k];
+        if (S->corner[1][k] > hi[k]) hi[k] = S->corner[1][k];
+        if (S->corner[2][k] > hi[k]) hi[k] = S->corner[2][k];
+        if (hi[k] - lo[k] > TT__SPLIT_MAX_CELLS) return 0;
+        S->box[k] = (int)floor(lo[k]);
+        S->box[k + 2] = (int)ceil(hi[k]) - S->box[k];
+        if (S->box[k + 2] < 1) S->box[k + 2] = 1;
+    }
+    ncells = S->box[2] * S->box[3];
+    if (ncells > TT__SPLIT_MAX_CELLS) return 0;
+    if (ncells > S->cell_capacity) {
+        tt__free(S->allocator, S->cells);
+        tt__free(S->allocator, S->queue);
+        S->cells = TT__ALLOC(S->allocator, tt__split_cell, ncells);
+        S->queue = TT__ALLOC(S->allocator, int, ncells);
+        S->cell_capacity = S->cells && S->queue ? ncells : 0;
+        if (!S->cell_capacity) return -1;
+    }
+    if (!tt__split_cells(S, orient)) return 0;
+    S->ngrid = 0;
+    *pieces = 0;
+    for (i = 0; i < S->nboundary; i++) S->boundary[i].used = 0;
+    for (y = 0; y < S->box[3]; y++) {
+        for (x = 0; x < S->box[2]; x++) {
+            const tt__split_cell *cell = &S->cells[x + S->box[2] * y];
+            tt__clip_point poly[8], tmp[8];
+            double X = S->box[0] + x, Y = S->box[1] + y, at[8][2];
+            int n = 3, m = 0, ids[8];
+            for (i = 0; i < 3; i++) {
+                tmp[i].p[0] = S->corner[i][0];
+                tmp[i].p[1] = S->corner[i][1];
+                tmp[i].kind = TT__CLIP_CORNER;
+                tmp[i].index = i;
+            }
+            n = tt__split_clip(tmp, n, 0, X, 1.0, poly);
+            n = tt__split_clip(poly, n, 0, X + 1.0, -1.0, tmp);
+            n = tt__split_clip(tmp, n, 1, Y, 1.0, poly);
+            n = tt__split_clip(poly, n, 1, Y + 1.0, -1.0, tmp);
+            if (n < 3 || fabs(tt__split_area(tmp, n)) <= TT__SPLIT_AREA) continue;
+            if (cell->quad < 0) return 0;
+            for (i = 0; i < n; i++) {
+                double place[2];
+                int id = tt__split_identify(S, &tmp[i], area2, place);
+                if (id == -2) return -1;
+                if (id < 0) return 0;
+                if (m > 0 && ids[m - 1] == id) continue;
+                at[m][0] = place[0];
+                at[m][1] = place[1];
+                ids[m++] = id;
+            }
+            if (m > 1 && ids[m - 1] == ids[0]) m--;
+            if (m >= 3 && !tt__split_fan(S, f, cell, ids, at, m, area2, pieces)) return -1;
+        }
+    }
+    /* Every split point of the records must be a corner of some piece, or the neighbour across would meet
+       this triangle at a vertex it does not have. */
+    for (i = 0; i < S->nboundary; i++)
+        if (!S->boundary[i].used) return 0;
+    return 1;
+}
+
+/* The corner of `quad` at S vertex `vertex`, or -1. */
+static int tt__quad_corner_of(const tt_mesh *s, int quad, int vertex)
+{
+    int k;
+    for (k = 0; k < 4; k++)
+        if (s->corner_vert[s->face_start[quad] + k] == vertex) return k;
+    return -1;
+}
+
+/* The angle at the origin from x to y, -pi..pi. */
+static double tt__turn_angle(const double x[2], const double y[2])
+{
+    return atan2(x[0] * y[1] - x[1] * y[0], x[0] * y[0] + x[1] * y[1]);
+}
+
+/* Boundary point i of a triangle (and the next, along the segment i ->
+   i + 1 in point i's quad) relative to the S vertex at corner `corner_st`
+   of that quad. */
+static void tt__split_segment_from(const tt__split *S, int i, const int corner_st[2], double x[2], double y[2])
+{
+    const tt__split_point *p = &S->boundary[i];
+    x[0] = p->a[0] - corner_st[0];
+    x[1] = p->a[1] - corner_st[1];
+    y[0] = p->b[0] - corner_st[0];
+    y[1] = p->b[1] - corner_st[1];
+}
+
+/* The area of the 3D triangle of output vertices a, b and of point p. */
+static double tt__split_area3(const tt__split *S, int a, int b, const double p[3])
+{
+    const float *x = S->out->positions + 3 * a, *y = S->out->positions + 3 * b;
+    double u[3], v[3], n[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        u[k] = (double)x[k] - p[k];
+        v[k] = (double)y[k] - p[k];
+    }
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+    return 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+/* P11 step 4.3, for a triangle whose chart does not close or is not flat
+   (a cone point of S inside it, or a bend at a saddle on an edge): when
+   every quad its boundary passes is around one S vertex V, the triangle
+   is the fan from V over its boundary, each boundary segment with V a
+   triangle inside that segment's quad. It holds when the angles at V add
+   up to V's full angle (a quarter turn per quad: V inside) or V is on the
+   boundary, and every fan triangle of non-zero area on the model turns
+   counter-clockwise on S (else the projection folds there). A V inside
+   becomes a new output vertex at the boundary's mean value coordinates
+   seen from V (exact where S is flat), so it lies on the triangle and the
+   fan covers it exactly. 1 when done, 0 when no V works, -1 when out of
+   memory. */
+static int tt__split_star(tt__split *S, int f, double area, int *pieces)
+{
+    const tt_mesh *s = S->pc->surface;
+    const int n = S->nboundary;
+    int c, i, k;
+    for (c = 0; c < 4; c++) {
+        const int apex = s->corner_vert[s->face_start[S->boundary[0].quad] + c];
+        int on_boundary = -1, holds = 1, centre = -1;
+        double total = 0.0, sum = 0.0, weight[3] = {0.0, 0.0, 0.0}, position[3] = {0.0, 0.0, 0.0};
+        for (i = 0; i < n && holds; i++) holds = tt__quad_corner_of(s, S->boundary[i].quad, apex) >= 0;
+        if (!holds) continue;
+        for (i = 0; i < n; i++) {
+            int v[2];
+            double x[2], y[2];
+            tt__quad_corner_st(tt__quad_corner_of(s, S->boundary[i].quad, apex), v);
+            tt__split_segment_from(S, i, v, x, y);
+            if (fabs(x[0]) + fabs(x[1]) <= TT__SPLIT_MATCH) on_boundary = i;
+            else if (fabs(y[0]) + fabs(y[1]) > TT__SPLIT_MATCH) total += tt__turn_angle(x, y);
+        }
+        if (on_boundary >= 0) {
+            centre = S->boundary[on_boundary].vertex;
+            for (k = 0; k < 3; k++) position[k] = S->out->positions[3 * centre + k];
+        } else {
+            if (fabs(total - tt__surface_valence(s, s->face_start[S->boundary[0].quad] + c) * 0.5 * TT__PI) > 1e-6)
+                continue;
+            /* Mean value coordinates: w_i = (tan(a_(i-1) / 2) + tan(a_i / 2)) / r_i, a_i the angle at V
+               from boundary point i to i + 1, r_i the distance from V to point i. */
+            for (i = 0; i < n; i++) {
+                const int p = S->boundary[i].vertex;
+                int v[2], j;
+                double x[2], y[2], w;
+                tt__quad_corner_st(tt__quad_corner_of(s, S->boundary[i].quad, apex), v);
+                tt__split_segment_from(S, i, v, x, y);
+                w = tan(0.5 * tt__turn_angle(x, y));
+                tt__quad_corner_st(tt__quad_corner_of(s, S->boundary[(i + n - 1) % n].quad, apex), v);
+                tt__split_segment_from(S, (i + n - 1) % n, v, y, x);
+                w = (w + tan(0.5 * tt__turn_angle(y, x))) / sqrt(x[0] * x[0] + x[1] * x[1]);
+                sum += w;
+                for (j = 0; j < 3; j++)
+                    for (k = 0; k < 3; k++)
+                        if (S->out->source[3 * p + j] == S->vert[k]) {
+                            weight[k] += w * S->out->weights[3 * p + j];
+                            break;
+                        }
+            }
+            if (!(sum > 0.0)) continue;
+            for (k = 0; k < 3; k++) {
+                int a;
+                weight[k] /= sum;
+                for (a = 0; a < 3; a++) position[a] += weight[k] * S->mesh->pos[3 * S->vert[k] + a];
+            }
+        }
+        for (i = 0; i < n && holds; i++) {
+            int v[2];
+            double x[2], y[2];
+            if (i == on_boundary || (i + 1) % n == on_boundary ||
+                S->boundary[i].vertex == S->boundary[(i + 1) % n].vertex ||
+                S->boundary[i].vertex == centre || S->boundary[(i + 1) % n].vertex == centre)
+                continue;
+            /* A fan triangle flat on the model would drop its boundary segment, which the neighbour has. */
+            if (tt__split_area3(S, S->boundary[i].vertex, S->boundary[(i + 1) % n].vertex, position) <= 1e-9 * area) {
+                holds = 0;
+                break;
+            }
+            tt__quad_corner_st(tt__quad_corner_of(s, S->boundary[i].quad, apex), v);
+            tt__split_segment_from(S, i, v, x, y);
+            holds = x[0] * y[1] - x[1] * y[0] > TT__SPLIT_AREA;
+        }
+        if (!holds) continue;
+        if (centre < 0 && (centre = tt__split_vertex(S, S->vert, weight)) < 0) return -1;
+        *pieces = 0;
+        for (i = 0; i < n; i++) {
+            const tt__split_point *p = &S->boundary[i], *q = &S->boundary[(i + 1) % n];
+            int corners[3], v[2];
+            double st[3][2];
+            corners[0] = centre;
+            corners[1] = p->vertex;
+            corners[2] = q->vertex;
+            if (corners[0] == corners[1] || corners[1] == corners[2] || corners[0] == corners[2]) continue;
+            tt__quad_corner_st(tt__quad_corner_of(s, p->quad, apex), v);
+            st[0][0] = v[0];
+            st[0][1] = v[1];
+            st[1][0] = p->a[0];
+            st[1][1] = p->a[1];
+            st[2][0] = p->b[0];
+            st[2][1] = p->b[1];
+            if (!tt__split_triangle(S, f, p->quad, corners, st)) return -1;
+            (*pieces)++;
+        }
+        return 1;
+    }
+    return 0;
+}
+
+/* P11 step 7: triangle f whole in vertex 0's quad, its boundary (vertices
+   and split points, so the neighbours meet it) fanned from its centroid,
+   each point projected orthogonally onto the quad's plane and clamped to
+   the quad. 0 when out of memory. */
+static int tt__split_fallback(tt__split *S, int f)
+{
+    const tt_polycube *pc = S->pc;
+    int quad = S->points[S->vert[0]].quad, ids[3], i, n = 0, centre = -1, k;
+    double st[3][2];
+    for (i = 0; i < S->nboundary; i++) {
+        int id = S->boundary[i].vertex;
+        if (n > 0 && S->boundary[n - 1].vertex == id) continue;
+        S->boundary[n++].vertex = id;
+    }
+    if (n > 1 && S->boundary[n - 1].vertex == S->boundary[0].vertex) n--;
+    if (n > 3) {
+        double third[3] = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
+        centre = tt__split_vertex(S, S->vert, third);
+        if (centre < 0) return 0;
+    }
+    for (i = 0; i < (n > 3 ? n : 1); i++) {
+        for (k = 0; k < 3; k++) {
+            double lattice[3];
+            tt_surface_point q;
+            int a;
+            ids[k] = n > 3 ? (k == 0 ? centre : S->boundary[(i + k - 1) % n].vertex) : S->vert[k];
+            for (a = 0; a < 3; a++)
+                lattice[a] = ((double)S->out->positions[3 * ids[k] + a] - pc->origin[a]) / pc->h;
+            q = tt__polycube_surface_point(pc, quad, lattice);
+            st[k][0] = q.s;
+            st[k][1] = q.t;
+        }
+        if (!tt__split_triangle(S, f, quad, ids, st)) return 0;
+    }
+    return 1;
+}
+
+TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping)
+{
+    tt_allocator allocator;
+    if (!mapping) return;
+    allocator = mapping->allocator;
+    tt__free(&allocator, mapping->positions);
+    tt__free(&allocator, mapping->source);
+    tt__free(&allocator, mapping->weights);
+    tt__free(&allocator, mapping->triangles);
+    tt__free(&allocator, mapping->triangle_face);
+    tt__free(&allocator, mapping->corner_points);
+    tt__free(&allocator, mapping);
+}
+
+TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
+                                const tt_polycube_map_options *options, const tt_allocator *allocator,
+                                tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error)
+{
+    tt_polycube_map_report local;
+    tt_polycube_edge_options edge_options;
+    tt_surface_point *points = NULL;
+    tt_polycube_edges *edges = NULL;
+    const tt_mesh *model;
+    tt__refined R;
+    tt__split S;
+    tt_result result;
+    double longest;
+    int f, v, j;
+    tt__ok(error);
+    if (out) *out = NULL;
+    if (!report) report = &local;
+    memset(report, 0, sizeof *report);
+    memset(&S, 0, sizeof S);
+    memset(&R, 0, sizeof R);
+    if (!polycube || !mesh || !out)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_map needs a polycube, a mesh and out (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    memset(&edge_options, 0, sizeof edge_options);
+    if (options) edge_options.max_quads = options->max_quads;
+    if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d has %d corners: tt_polycube_map needs triangles (split the faces into fans "
+                            "first)", f, mesh->face_start[f + 1] - mesh->face_start[f]);
+    if (!tt__polycube_consistent(polycube))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the polycube's surface has no quads or does not match its cubes: make it with "
+                        "tt_polycube_build and leave it unchanged");
+    longest = options && options->max_edge != 0.0 ? options->max_edge : TT_POLYCUBE_MAP_DEFAULT_EDGE * polycube->h;
+    if (!(longest > 0.0))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "max_edge %g: give a length above 0 (0 for the default, HUGE_VAL for no refinement)",
+                        options->max_edge);
+    if ((result = tt__polycube_refine(mesh, longest, allocator, &R, error)) != TT_OK) goto failed;
+    model = R.mesh;
+    report->triangles = model->nfaces;
+    points = TT__ALLOC(allocator, tt_surface_point, model->nverts > 0 ? model->nverts : 1);
+    if (!points) goto out_of_memory;
+    if ((result = tt_polycube_project(polycube, model, allocator, points, &report->projection, error)) != TT_OK)
+        goto failed;
+    /* A point within TT__EDGE_SNAP of a quad's edge is on it: the points are float, and a model vertex on a
+       lattice line (a CAD part's edge, a face in a lattice plane) must be on S's edge exactly, or the
+       triangles there split into slivers of rounding. */
+    for (v = 0; v < model->nverts; v++) {
+        points[v].s = (float)tt__edge_snap(points[v].s);
+        points[v].t = (float)tt__edge_snap(points[v].t);
+    }
+    if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
+                                          error)) != TT_OK)
+        goto failed;
+    report->failed_edges = edges->nfailed;
+
+    S.pc = polycube;
+    S.mesh = model;
+    S.edges = edges;
+    S.points = points;
+    S.allocator = allocator;
+    S.out = TT__ALLOC(allocator, tt_polycube_mapping, 1);
+    if (!S.out) goto out_of_memory;
+    memset(S.out, 0, sizeof *S.out);
+    S.out->allocator = tt__allocator_copy(allocator);
+    S.crossing_vertex = TT__ALLOC(allocator, int, edges->ncrossings > 0 ? edges->ncrossings : 1);
+    if (!S.crossing_vertex) goto out_of_memory;
+    for (j = 0; j < edges->ncrossings; j++) S.crossing_vertex[j] = -1;
+    for (v = 0; v < model->nverts; v++) {
+        int source[3];
+        double weight[3] = {1.0, 0.0, 0.0};
+        source[0] = source[1] = source[2] = v;
+        if (tt__split_vertex(&S, source, weight) < 0) goto out_of_memory;
+    }
+    for (f = 0; f < model->nfaces; f++) {
+        int linked = 0, chart = 0, pieces = 0, done = 0, k, kept_vertices, kept_triangles;
+        for (k = 0; k < 3; k++) S.vert[k] = model->corner_vert[3 * f + k];
+        if (!tt__split_walk(&S, f, &linked, &chart)) goto out_of_memory;
+        kept_vertices = S.out->nverts;
+        kept_triangles = S.out->ntriangles;
+        if (chart) {
+            done = tt__split_pieces(&S, f, &pieces);
+            if (done < 0) goto out_of_memory;
+        }
+        if (!done && linked) {
+            double p0[3];
+            S.out->nverts = kept_vertices;
+            S.out->ntriangles = kept_triangles;
+            for (k = 0; k < 3; k++) p0[k] = S.out->positions[3 * S.vert[0] + k];
+            done = tt__split_star(&S, f, tt__split_area3(&S, S.vert[1], S.vert[2], p0), &pieces);
+            if (done < 0) goto out_of_memory;
+        }
+        if (!done) {
+            S.out->nverts = kept_vertices;
+            S.out->ntriangles = kept_triangles;
+            if (!tt__split_fallback(&S, f)) goto out_of_memory;
+            report->fallback_triangles++;
+        }
+    }
+    /* Back to the input: each output vertex's refined sources become input vertices (at most 3, all of one
+       input triangle), each output triangle's refined face its input face. */
+    for (v = 0; v < S.out->nverts; v++) {
+        int source[3], n = 0, k, i;
+        double weight[3] = {0.0, 0.0, 0.0};
+        for (k = 0; k < 3; k++) {
+            int r = S.out->source[3 * v + k];
+            double w = S.out->weights[3 * v + k];
+            for (i = 0; i < 3 && w != 0.0; i++) {
+                int u = R.source[3 * r + i], m;
+                double wu = w * R.weight[3 * r + i];
+                if (wu == 0.0) continue;
+                for (m = 0; m < n && source[m] != u; m++) continue;
+                if (m == n) {
+                    if (n == 3) continue;
+                    source[n++] = u;
+                }
+                weight[m] += wu;
+            }
+        }
+        for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * S.out->source[3 * v]];
+        for (k = 0; k < 3; k++) {
+            S.out->source[3 * v + k] = source[k];
+            S.out->weights[3 * v + k] = (float)weight[k];
+        }
+    }
+    {
+        int *outputs_of_face = TT__ALLOC(allocator, int, mesh->nfaces);
+        if (!outputs_of_face) goto out_of_memory;
+        memset(outputs_of_face, 0, sizeof(int) * (size_t)mesh->nfaces);
+        for (j = 0; j < S.out->ntriangles; j++) {
+            S.out->triangle_face[j] = R.face[S.out->triangle_face[j]];
+            outputs_of_face[S.out->triangle_face[j]]++;
+        }
+        for (f = 0; f < mesh->nfaces; f++) report->split_triangles += outputs_of_face[f] > 1;
+        tt__free(allocator, outputs_of_face);
+    }
+    for (j = 0; j < S.out->ntriangles; j++) {
+        const tt_surface_point *p = S.out->corner_points + 3 * j;
+        double turn = ((double)p[1].s - p[0].s) * ((double)p[2].t - p[0].t) -
+                      ((double)p[1].t - p[0].t) * ((double)p[2].s - p[0].s);
+        report->flipped += turn <= 0.0;
+    }
+    tt__free(allocator, S.crossing_vertex);
+    tt__free(allocator, S.boundary);
+    tt__free(allocator, S.cells);
+    tt__free(allocator, S.queue);
+    tt__free(allocator, S.grid_points);
+    tt_polycube_edges_free(edges);
+    tt__free(allocator, points);
+    tt__refined_free(allocator, &R);
+    *out = S.out;
+    return TT_OK;
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory mapping the mesh onto S");
+failed:
+    tt__free(allocator, S.crossing_vertex);
+    tt__free(allocator, S.boundary);
+    tt__free(allocator, S.cells);
+    tt__free(allocator, S.queue);
+    tt__free(allocator, S.grid_points);
+    tt_polycube_mapping_free(S.out);
+    tt_polycube_edges_free(edges);
+    tt__free(allocator, points);
+    tt__refined_free(allocator, &R);
+    memset(report, 0, sizeof *report);
+    return result;
+}
+
+TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
+                                        const tt_tile_layout *layout, const uint8_t *corner_type,
+                                        float *corner_uv, tt_error *error)
+{
+    tt_tile_layout resolved;
+    tt_result result;
+    int i, q;
+    tt__ok(error);
+    if (!polycube || !polycube->surface || !mapping || !layout || !corner_type || !corner_uv)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_mapping_uvs needs a polycube, a mapping, a layout, corner types and corner_uv "
+                        "(got NULL)");
+    if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
+    for (q = 0; q < polycube->surface->ncorners; q++)
+        if (corner_type[q] >= 2 * resolved.colors)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, q / 4, q, -1, -1,
+                            "corner %d of S has type %d, beyond the layout's %d types (2 per colour)", q,
+                            corner_type[q], 2 * resolved.colors);
+    for (i = 0; i < 3 * mapping->ntriangles; i++)
+        if (mapping->corner_points[i].quad < 0 || mapping->corner_points[i].quad >= polycube->surface->nfaces)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, i / 3, i, -1, -1,
+                            "corner %d of the mapping names quad %d; S has %d", i, mapping->corner_points[i].quad,
+                            polycube->surface->nfaces);
+    for (i = 0; i < 3 * mapping->ntriangles; i++) {
+        const tt_surface_point p = mapping->corner_points[i];
+        const uint8_t *types = corner_type + polycube->surface->face_start[p.quad];
+        float low[2], high[2];
+        tt_tile_corner_uv(&resolved, types, 0, low);
+        tt_tile_corner_uv(&resolved, types, 2, high);
+        corner_uv[2 * i] = low[0] + p.s * (high[0] - low[0]);
+        corner_uv[2 * i + 1] = low[1] + p.t * (high[1] - low[1]);
+    }
+    return TT_OK;
 }
 
 #ifdef __cplusplus

@@ -4,6 +4,7 @@
    build has no unused function, and exits 0 when a tiny smoke run works.
    Valid C99 and C++98. Define COMPILE_CHECK_USER_ALLOC to route the default
    allocator through counting TT_MALLOC / TT_FREE macros. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -306,6 +307,48 @@ int main(void)
                 round = tt_quad_map_compose(there, back);
                 tt_quad_map_apply(round, 0.25, 0.5, st);
                 EXPECT(round.turns == 0 && st[0] == 0.25 && st[1] == 0.5);
+            }
+            {
+                /* The cube as 12 triangles mapped onto S: each is cut at the lattice lines into 4, and its
+                   UVs come from the quads' tiles. */
+                int tri_index[36], q, c;
+                tt_mesh_desc td;
+                tt_mesh *tri_cube = NULL;
+                for (q = 0; q < 6; q++)
+                    for (c = 0; c < 3; c++) {
+                        tri_index[6 * q + c] = mesh->corner_vert[4 * q + c];
+                        tri_index[6 * q + 3 + c] = mesh->corner_vert[4 * q + (c + 2) % 4];
+                    }
+                memset(&td, 0, sizeof td);
+                td.positions = mesh->pos;
+                td.nverts = 8;
+                td.indices = tri_index;
+                td.nfaces = 12;
+                EXPECT(tt_mesh_build(&td, NULL, &tri_cube, &err) == TT_OK);
+                if (tri_cube) {
+                    tt_polycube_map_options pmo;
+                    tt_polycube_map_report pmr;
+                    tt_polycube_mapping *pm = NULL;
+                    memset(&pmo, 0, sizeof pmo);
+                    pmo.max_quads = 6;
+                    pmo.max_edge = HUGE_VAL;   /* the exact split, unrefined */
+                    EXPECT(tt_polycube_map(pc, tri_cube, &pmo, NULL, &pm, &pmr, &err) == TT_OK && pm &&
+                           pm->ntriangles == 48 && pmr.fallback_triangles == 0 && pmr.flipped == 0);
+                    if (pm) {
+                        float *muv = (float *)malloc(sizeof(float) * 6 * (size_t)pm->ntriangles);
+                        uint8_t cube_types[96];
+                        tt_tile_layout ml;
+                        ml.colors = 1;
+                        ml.tile_size = 0;
+                        ml.gutter = 0;
+                        memset(cube_types, 0, sizeof cube_types);
+                        EXPECT(muv && tt_polycube_mapping_uvs(pc, pm, &ml, cube_types, muv, &err) == TT_OK &&
+                               muv[0] >= 0.0f && muv[0] <= 1.0f);
+                        free(muv);
+                    }
+                    tt_polycube_mapping_free(pm);
+                }
+                tt_mesh_free(tri_cube);
             }
         }
         tt_polycube_free(pc);
