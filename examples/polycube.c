@@ -317,9 +317,12 @@ static void print_summary(const polycube_command_options *options, const polycub
     if (b->mesh_genus < 0) printf(" (the mesh's: not closed)\n");
     else if (b->genus_differs) printf(" (the mesh's %d: they differ)\n", b->mesh_genus);
     else printf(" (as the mesh)\n");
-    printf("mapping: %d triangles, %d split, %d fallback, %d failed edges, %d flipped; vertices onto the polycube: "
-           "%d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n",
-           job->mapping->ntriangles, m->split_triangles, m->fallback_triangles, m->failed_edges, m->flipped, p->rays,
+    printf("mapping: %d triangles, %d split, %d fallback, %d failed edges, %d flipped", job->mapping->ntriangles,
+           m->split_triangles, m->fallback_triangles, m->failed_edges, m->flipped);
+    /* The library halves edges longer than half a cube first, so that no
+       triangle holds several corners of the polycube. */
+    if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
+    printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);
     printf("tiles: %d (n=%d, %d texels, gutter %d), %dx%d atlas; %.4g texels per unit\n",
            tt_tile_layout_tile_count(&job->layout), job->layout.colors, job->layout.tile_size, job->layout.gutter,
