@@ -210,8 +210,8 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
     job->surface_uv = (float *)malloc((size_t)ncorners * 2 * sizeof(float));
     if (!job->edge_colors || !job->surface_type || !job->surface_uv)
         return tool_fail("out of memory for the %d quads of the polycube", job->polycube->surface->nfaces);
-    /* Each axis draws its two colours from the palette (the paper's rule),
-       so the tiles of one axis group all meet in the same conditions. */
+    /* axis_palettes = 1: the edges along each axis draw from two colours
+       of the palette picked for that axis, the paper's scheme. */
     if (tt_polycube_edge_colors(job->polycube, job->layout.colors, 1, options->tiles.seed, job->edge_colors,
                                 &error) != TT_OK ||
         tt_assign_boundaries(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
