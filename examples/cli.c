@@ -50,6 +50,24 @@ int tool_mesh_image_prefix(const char *const *positional, int npositional, const
     return 0;
 }
 
+int parse_axis_name(const char *text, int *axis, int *sign)
+{
+    const char *name = text;
+    if (!text) return -1;
+    *sign = 1;
+    if (name[0] == '+' || name[0] == '-') {
+        if (name[0] == '-') *sign = -1;
+        name++;
+    }
+    if (name[0] == '\0' || name[1] != '\0') return -1;
+    switch (name[0]) {
+    case 'x': case 'X': *axis = 0; return 0;
+    case 'y': case 'Y': *axis = 1; return 0;
+    case 'z': case 'Z': *axis = 2; return 0;
+    default: return -1;
+    }
+}
+
 int tool_option(int argc, char **argv, int *index, const char *name, const char **value)
 {
     const char *arg = argv[*index];

@@ -10,6 +10,9 @@
 #                                           pictures build/demo/lapped_front.png, lapped_baked_front.png
 #   6. hierarchical pattern mapping (Soler et al.): texture coordinates into the texture itself:
 #                                           build/demo/hpm.obj/.mtl, picture build/demo/hpm_front.png
+#   7. polycube + Wang tiles (Chang and Lin): the triangles split along a polycube's squares:
+#                                           build/demo/polycube.obj/.mtl/.png, polycube_polycube.obj,
+#                                           pictures build/demo/polycube_front.png, polycube_cubes.png
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -34,6 +37,9 @@ mkdir -p "$out"
 # The texture's width spans 3 of the surface's 5.7 units: stones large enough to see where clusters meet.
 "$tool" hpm "$out/double_torus_mesh.obj" "$out/texture.png" "$out/hpm" --scale 3 --seed 1
 "$tool" render "$out/hpm.obj" "$out/texture.png" "$out/hpm_front.png" --yaw 20 --pitch 15
+"$tool" polycube "$out/double_torus_mesh.obj" "$out/texture.png" "$out/polycube" --seed 1
+"$tool" render "$out/polycube.obj" "$out/polycube.png" "$out/polycube_front.png" --yaw 20 --pitch 15
+"$tool" render "$out/polycube_polycube.obj" "$out/polycube.png" "$out/polycube_cubes.png" --yaw 20 --pitch 15
 
 echo
 echo "pictures:"
@@ -45,3 +51,5 @@ echo "  $out/double_torus_closeup.png  close up, with the quads drawn: the stone
 echo "  $out/lapped_front.png          lapped textures: overlapping pastes of one patch, drawn in order"
 echo "  $out/lapped_baked_front.png    the same pastes baked into one texture over an atlas of triangle pairs"
 echo "  $out/hpm_front.png             hierarchical pattern mapping: patches of the example image itself, fitted to their neighbours"
+echo "  $out/polycube_front.png        polycube + Wang tiles: the surface carries the tiles of the polycube around it"
+echo "  $out/polycube_cubes.png        that polycube, each square one tile"

@@ -238,20 +238,6 @@ static int measure_quality(const hpm_command_options *options, const triangle_me
     return 0;
 }
 
-/* "0.123 (456 of 789 edges sampled)", "n/a ..." or "not measured (...)". */
-static void format_seams(const tool_seams *seams, const char *edges, char *text, size_t size)
-{
-    const tt_seam_report *r = &seams->report;
-    if (!seams->measured)
-        snprintf(text, size, "not measured (%s)", seams->reason);
-    else if (r->score == r->score)
-        snprintf(text, size, "%.3f (%d of %d %s%s)", r->score, r->edges_measured, seams->edges, edges,
-                 seams->sampled ? " sampled" : "");
-    else
-        snprintf(text, size, "n/a: unrelated places differ no more than neighbours (%d %s; seam - same-face %.4f)",
-                 r->edges_measured, edges, r->seam - r->same_face);
-}
-
 static void print_summary(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
                           const tt_hpm_report *report, const hpm_quality *quality, double seconds)
 {
@@ -277,8 +263,8 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
                options->map.threshold > 0 ? options->map.threshold : TT_DEFAULT_HPM_THRESHOLD);
     printf("texel density %.4g texels per unit (the image's %d texels span %.4g units); %.1f s\n",
            report->texels_per_unit, image->width, (double)image->width / report->texels_per_unit, seconds);
-    format_seams(&quality->borders, "border edges", borders, sizeof borders);
-    format_seams(&quality->all, "edges", all, sizeof all);
+    tool_format_seams(&quality->borders, "border edges", borders, sizeof borders);
+    tool_format_seams(&quality->all, "edges", all, sizeof all);
     printf("seam score: cluster borders %s; all edges %s\n", borders, all);
     if (!quality->distortion_measured) {
         printf("UV distortion: not measured (%s)\n", quality->distortion_reason);

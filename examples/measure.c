@@ -41,3 +41,16 @@ int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *c
     out->measured = 1;
     return 0;
 }
+
+void tool_format_seams(const tool_seams *seams, const char *edges, char *text, size_t size)
+{
+    const tt_seam_report *r = &seams->report;
+    if (!seams->measured)
+        snprintf(text, size, "not measured (%s)", seams->reason);
+    else if (r->score == r->score)
+        snprintf(text, size, "%.3f (%d of %d %s%s)", r->score, r->edges_measured, seams->edges, edges,
+                 seams->sampled ? " sampled" : "");
+    else
+        snprintf(text, size, "n/a: unrelated places differ no more than neighbours (%d %s; seam - same-face %.4f)",
+                 r->edges_measured, edges, r->seam - r->same_face);
+}

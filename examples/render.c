@@ -234,22 +234,17 @@ typedef struct up_axis {
 
 static int parse_up_axis(const char *text, up_axis *axis)
 {
-    static const char *const names[] = {"y", "z", "x", "-y", "-z", "-x"};
-    int i;
-    if (!text) return -1;
-    for (i = 0; i < 6; i++) {
-        if (strcmp(text, names[i]) == 0) break;
-    }
-    if (i == 6) return -1;
-    switch (i % 3) {
-    case 0: /* y up, looking from +z */
+    int index, sign;
+    if (parse_axis_name(text, &index, &sign) != 0) return -1;
+    switch (index) {
+    case 1: /* y up, looking from +z */
         axis->up = vec3_make(0, 1, 0); axis->side = vec3_make(1, 0, 0); axis->front = vec3_make(0, 0, 1); break;
-    case 1: /* z up, looking from -y */
+    case 2: /* z up, looking from -y */
         axis->up = vec3_make(0, 0, 1); axis->side = vec3_make(1, 0, 0); axis->front = vec3_make(0, -1, 0); break;
     default: /* x up, looking from +z */
         axis->up = vec3_make(1, 0, 0); axis->side = vec3_make(0, -1, 0); axis->front = vec3_make(0, 0, 1); break;
     }
-    if (i >= 3) {   /* upside down: turn the frame half a turn about `front` */
+    if (sign < 0) {   /* upside down: turn the frame half a turn about `front` */
         axis->up = vec3_scale(axis->up, -1.0f);
         axis->side = vec3_scale(axis->side, -1.0f);
     }

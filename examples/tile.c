@@ -45,7 +45,6 @@ int cmd_tile(int argc, char **argv)
     tt_image *image = NULL;
     tt_tileset *tiles = NULL;
     tool_seams seams;
-    int image_width, image_height;
     tool_output output;
     char message[TOOL_ERROR_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
 
@@ -66,21 +65,11 @@ int cmd_tile(int argc, char **argv)
     /* A photo: its 8-bit values are sRGB, the library works in linear light. */
     if (image_load(positional[1], TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         return tool_fail("%s", message);
-    image_width = image->width;
-    image_height = image->height;
-    /* Without --tile, take the default tile size or the largest this image
-       can feed; say so when it is smaller. */
-    if (!options.tile_size_given) {
-        int fit = tiled_fit_tile_size(image_width, image_height, options.layout.colors, options.layout.gutter);
-        if (fit == 0) {
-            status = tool_fail("%s is %dx%d: too small to cut tiles from (it needs at least 4x8 texels)",
-                               positional[1], image_width, image_height);
-            image_free(image);
-            return status;
-        }
-        options.layout.tile_size = fit;
+    status = tiled_pick_tile_size(positional[1], image->width, image->height, &options);
+    if (status != 0) {
+        image_free(image);
+        return status;
     }
-
     status = tiled_check_atlas_size(&options);
     if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
     /* Before the synthesis: no output may replace an input (checked again at the commit). */
@@ -101,9 +90,6 @@ int cmd_tile(int argc, char **argv)
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
         /* Said only on success: a failing command prints its one error line. */
-        if (!options.tile_size_given && options.layout.tile_size < TT_DEFAULT_TILE_SIZE)
-            fprintf(stderr, "tiledtex: %s is %dx%d: used %d-texel tiles (--tile to choose)\n", positional[1],
-                    image_width, image_height, options.layout.tile_size);
         tiled_print_notes(positional[0], &mesh);
         tiled_print_summary(positional[0], &mesh, &seams, options.report);
         printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,

@@ -298,8 +298,8 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
            the part's size, with stars at the vertices, whatever --tile. */
         if (mesh->input_max_face_size == 3 && mesh->input_faces >= TILED_DENSE_TRIANGLES)
             fprintf(stderr, "tiledtex: %d triangles make %d tiny tiles with stars at the vertices: for a dense "
-                            "triangle mesh use 'tiledtex hpm' or 'tiledtex lapped', which texture it at the scale "
-                            "you choose\n", mesh->input_faces, mesh->quadrangulated);
+                            "triangle mesh use 'tiledtex polycube', 'tiledtex hpm' or 'tiledtex lapped', which "
+                            "texture it at the scale you choose\n", mesh->input_faces, mesh->quadrangulated);
     }
 }
 
@@ -343,6 +343,20 @@ int tiled_fit_tile_size(int width, int height, int colors, int gutter)
     if (fit > fits_atlas) fit = fits_atlas;
     if (fit >= 8) return fit - fit % 8;
     if (fits_atlas >= 4 && width >= 4 && height >= 8) return 4;
+    return 0;
+}
+
+int tiled_pick_tile_size(const char *image_path, int width, int height, tiled_options *options)
+{
+    int fit;
+    if (options->tile_size_given) return 0;
+    fit = tiled_fit_tile_size(width, height, options->layout.colors, options->layout.gutter);
+    if (fit == 0)
+        return tool_fail("%s is %dx%d: too small to cut tiles from (it needs at least 4x8 texels)", image_path,
+                         width, height);
+    options->layout.tile_size = fit;
+    if (fit < TT_DEFAULT_TILE_SIZE)
+        tool_note("%s is %dx%d: used %d-texel tiles (--tile to choose)", image_path, width, height, fit);
     return 0;
 }
 

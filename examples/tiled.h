@@ -90,6 +90,12 @@ int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture
    4 x 8 edge window does not fit. */
 int tiled_fit_tile_size(int width, int height, int colors, int gutter);
 
+/* Without --tile, set the layout's tile size to tiled_fit_tile_size's for
+   a width x height image, with a note (tool_note) when it is below
+   TT_DEFAULT_TILE_SIZE. Prints the error and returns an exit status when
+   the image is too small for any tile, 0 otherwise. */
+int tiled_pick_tile_size(const char *image_path, int width, int height, tiled_options *options);
+
 /* Synthesise the atlas from an image already loaded. Prints the error and
    returns an exit status on failure. */
 int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options,

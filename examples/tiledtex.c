@@ -1,6 +1,6 @@
 /* tiledtex.c - the `tiledtex` command-line tool: main() and the list of
    subcommands. Each subcommand lives in its own file (synth.c, map.c, tile.c,
-   lapped.c, hpm.c, render.c, generate.c) as `int cmd_NAME(int argc, char **argv)`.
+   lapped.c, hpm.c, polycube.c, render.c, generate.c) as `int cmd_NAME(int argc, char **argv)`.
 
    This is the one translation unit that compiles the library itself: */
 #define TILEDTEX_IMPLEMENTATION
@@ -21,6 +21,7 @@ static const subcommand subcommands[] = {
     {"tile", cmd_tile, "texture a mesh with Akleman et al.'s tiled textures: OBJ + MTL + atlas PNG"},
     {"lapped", cmd_lapped, "texture a mesh with Praun et al.'s lapped textures: overlapping pastes of one patch"},
     {"hpm", cmd_hpm, "texture a mesh with Soler et al.'s hierarchical pattern mapping: UVs into the image itself"},
+    {"polycube", cmd_polycube, "texture any mesh with Chang and Lin's polycube map and Wang tiles: OBJ + MTL + atlas"},
     {"synth", cmd_synth, "synthesise a tile set (the atlas) from an example image"},
     {"map", cmd_map, "give a mesh tiled-texture UVs for a given tile layout"},
     {"render", cmd_render, "draw a textured OBJ to a PNG with the built-in software renderer"},
@@ -56,7 +57,9 @@ static void print_help(void)
            "        tiledtex lapped torus.obj stones.png torus_lapped\n"
            "        tiledtex render torus_lapped.obj torus_lapped_patch.png lapped.png\n"
            "        tiledtex hpm torus.obj stones.png torus_hpm\n"
-           "        tiledtex render torus_hpm.obj stones.png hpm.png\n");
+           "        tiledtex render torus_hpm.obj stones.png hpm.png\n"
+           "        tiledtex polycube torus.obj stones.png torus_pc\n"
+           "        tiledtex render torus_pc.obj torus_pc.png polycube.png\n");
 }
 
 /* The global options, accepted before or after the command name (the error
@@ -93,7 +96,7 @@ int main(int argc, char **argv)
     int status;
     if ((status = take_global_options(&argc, argv)) != 0) return status;
     if (argc < 2)
-        return tool_usage("needs a command: tile, lapped, hpm, synth, map, render or generate (see 'tiledtex --help')");
+        return tool_usage("needs a command: tile, lapped, hpm, polycube, synth, map, render or generate (see 'tiledtex --help')");
     if (tool_is_help(argv[1])) {
         print_help();
         return 0;

@@ -1,8 +1,9 @@
 /* tool.h - shared pieces of the `tiledtex` command-line tool (not the library).
 
    The tool is a set of subcommands, one file each (synth.c, map.c, tile.c,
-   lapped.c, hpm.c, render.c, generate.c), dispatched by tiledtex.c; synth,
-   map and tile also share tiled.c (see tiled.h). They share what is
+   lapped.c, hpm.c, polycube.c, render.c, generate.c), dispatched by
+   tiledtex.c; synth, map, tile and polycube also share tiled.c (see
+   tiled.h). They share what is
    declared here:
 
      tool_io.c   one-line errors         tool_fail, tool_usage
@@ -10,12 +11,12 @@
                  atomic output           tool_output: build every file in
                                          memory, then commit them all or none
                  progress, time          tool_progress, tool_seconds_now
-     cli.c       command-line helpers    tool_option, parse_int, parse_size, ...
+     cli.c       command-line helpers    tool_option, parse_int, parse_axis_name, ...
      image_io.c  images                  image_load, png_encode, output_add_png
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
                  MTL writing             mtl_add_material, output_add_mtl
-     triangle_mesh.c  an OBJ as triangles   triangle_mesh_read (lapped, hpm)
-     measure.c   quality for summaries   tool_measure_seams
+     triangle_mesh.c  an OBJ as triangles   triangle_mesh_read (lapped, hpm, polycube)
+     measure.c   quality for summaries   tool_measure_seams, tool_format_seams
      format_number.c  numbers as text   tool_format_float, tool_format_int
 
    Conventions every command follows:
@@ -60,6 +61,7 @@ int cmd_map(int argc, char **argv);
 int cmd_tile(int argc, char **argv);
 int cmd_lapped(int argc, char **argv);
 int cmd_hpm(int argc, char **argv);
+int cmd_polycube(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 
@@ -146,6 +148,11 @@ int tool_mesh_image_prefix(const char *const *positional, int npositional, const
    is some other argument. */
 int tool_option(int argc, char **argv, int *index, const char *name, const char **value);
 
+/* An axis name: x, y or z (either case), with an optional sign: "-z",
+   "+y". *axis gets 0, 1 or 2 and *sign +1 or -1; returns 0, or -1 without
+   a message for anything else (NULL included), so that the caller can say
+   what else it accepts. */
+int parse_axis_name(const char *text, int *axis, int *sign);
 /* An integer in [min, max]: "tiledtex CMD: --seed wants an integer from 0 to 9, got 'x'". */
 int parse_int(const char *option, const char *text, int min, int max, int *out);
 /* An unsigned 64-bit integer (seeds), decimal or 0x hexadecimal. */
@@ -379,7 +386,7 @@ int output_add_mtl(tool_output *output, const char *mtl_path, const char *materi
                    int texture_alpha);
 
 /* ---------------------------------------------------------------------- */
-/* An OBJ as triangles (triangle_mesh.c), for lapped and hpm                */
+/* An OBJ as triangles (triangle_mesh.c), for lapped, hpm, polycube               */
 /* ---------------------------------------------------------------------- */
 
 typedef struct triangle_mesh {
@@ -434,6 +441,11 @@ typedef struct tool_seams {
    naming obj_path; returns the exit status. */
 int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                        uint64_t seed, unsigned flags, int all_edges, tool_seams *seams);
+/* The score as a summary says it, `edges` naming what was measured
+   ("border edges"): "0.123 (456 of 789 border edges sampled)", "n/a: ..."
+   when unrelated places differ no more than neighbours, or "not measured
+   (reason)". */
+void tool_format_seams(const tool_seams *seams, const char *edges, char *text, size_t size);
 
 /* ---------------------------------------------------------------------- */
 /* Numbers as text without printf (format_number.c)                        */

@@ -173,7 +173,7 @@ mkdir -p "$W/in"
 cd "$W/in" || exit 1
 
 # --help everywhere
-for sub in synth map tile lapped hpm render generate; do
+for sub in synth map tile lapped hpm polycube render generate; do
     run $sub --help
     check "$sub --help" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes, stderr: $ERR" \
         "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
@@ -229,8 +229,8 @@ tile_case sphere-triangles spheretri.obj 0
 check "tile sphere-triangles: says it quadrangulated" "stderr mentions quadrangulat" "$ERR" \
     "$(printf '%s' "$ERR" | grep -qi quadrangulat; echo $?)"
 check "tile sphere-triangles (1280): points to the tools for dense triangle meshes" \
-    "one line naming 'tiledtex hpm' and 'tiledtex lapped'" "$ERR" \
-    "$(printf '%s' "$ERR" | grep -c "tiledtex hpm' or 'tiledtex lapped'" | grep -qx 1; echo $?)"
+    "one line naming 'tiledtex polycube', 'tiledtex hpm' and 'tiledtex lapped'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -c "'tiledtex polycube', 'tiledtex hpm' or 'tiledtex lapped'" | grep -qx 1; echo $?)"
 tile_case grid grid.obj -
 check "tile grid: one boundary loop" "'1 boundary loop' in summary" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])1 boundary loop'; echo $?)"
@@ -832,6 +832,164 @@ no_zero_index "hpm non-manifold edge"
 expect_error "hpm OBJ truncated mid face line" hpm ../in/truncated_face.obj ../in/lap.png out
 
 # ======================================================================
+# Polycube + Wang tiles
+# ======================================================================
+# polycube_obj_report OBJ COLORS TILE GUTTER ->
+#   "faces nontri corners nvt badc reused outside straddling":
+#   f lines, f lines without 3 corners, corners, vt lines, corners whose v or
+#   vt index is missing or out of range, vt lines referenced other than exactly
+#   once, vt values that are not numbers in [0,1], and triangles whose three vt
+#   do not fall in one tile's cell of the atlas ((2n)^2 cells of S + 2G texels a side).
+polycube_obj_report() {
+    awk -v n="$2" -v s="$3" -v g="$4" '
+        function isnum(x) { return x ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?$/ }
+        BEGIN { cell = s + 2 * g; side = 4 * n * n * cell }
+        $1 == "v"  { nv++ }
+        $1 == "vt" { nvt++; u[nvt] = $2; v[nvt] = $3
+                     for (i = 2; i <= 3; i++)
+                         if (!isnum($i) || $i + 0 < 0 || $i + 0 > 1) outside++ }
+        $1 == "f"  { nf++
+                     if (NF - 1 != 3) nontri++
+                     for (i = 2; i <= NF; i++) { corners++; c[corners] = $i; cf[corners] = nf } }
+        END {
+            for (k = 1; k <= corners; k++) {
+                m = split(c[k], p, "/")
+                if (m < 2 || p[1] !~ /^[0-9]+$/ || p[2] !~ /^[0-9]+$/ ||
+                    p[1] + 0 < 1 || p[1] + 0 > nv || p[2] + 0 < 1 || p[2] + 0 > nvt) { badc++; continue }
+                t = p[2] + 0
+                uses[t]++
+                key = int(u[t] * side / cell) "," int(v[t] * side / cell)
+                if (!(cf[k] in tile)) tile[cf[k]] = key
+                else if (tile[cf[k]] != key && !(cf[k] in straddles)) { straddles[cf[k]] = 1; straddling++ }
+            }
+            for (k = 1; k <= nvt; k++) if (uses[k] != 1) reused++
+            printf "%d %d %d %d %d %d %d %d\n", nf, nontri, corners, nvt, badc, reused, outside, straddling
+        }' "$1" 2>/dev/null
+}
+
+# polycube_case NAME MESH COLORS ARGS... : in a fresh directory, polycube with
+# 16-texel tiles writes exactly out.obj, out.mtl, out.png, out_polycube.obj;
+# the OBJ holds at least the mesh's triangle fans, one vt per corner inside its
+# triangle's tile; the polycube's surface is quads with tile UVs; the summary has its lines.
+polycube_case() {
+    local name=$1 mesh=$2 colors=$3 faces nontri corners nvt badc reused outside straddling want side
+    shift 3
+    newdir
+    run polycube "../in/$mesh" ../in/tex.png out --tile 16 --colors "$colors" "$@"
+    check "polycube $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
+    check "polycube $name: exactly out.mtl, out.obj, out.png, out_polycube.obj" \
+        "out.mtl out.obj out.png out_polycube.obj" "$(ls -A | tr '\n' ' ')" \
+        "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out.png out_polycube.obj " ]; echo $?)"
+    check "polycube $name: mtl names the atlas, both OBJs the mtl" "map_Kd out.png, mtllib out.mtl twice" \
+        "$(grep -h -E 'map_|mtllib' out.mtl out.obj out_polycube.obj 2>&1)" \
+        "$(grep -qE '^map_Kd +out\.png$' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl$' out.obj 2>/dev/null &&
+            grep -qE '^mtllib +out\.mtl$' out_polycube.obj 2>/dev/null; echo $?)"
+    side=$((4 * colors * colors * (16 + 2 * 4)))
+    check "polycube $name: the atlas is ${side}x$side" "$side $side" "$(png_size out.png)" \
+        "$(is_png out.png && [ "$(png_size out.png)" = "$side $side" ]; echo $?)"
+    read -r faces nontri corners nvt badc reused outside straddling <<<"$(polycube_obj_report out.obj "$colors" 16 4)"
+    want=$(fan_triangles "$W/in/$mesh")
+    check "polycube $name: triangles, at least the mesh's $want" ">= $want triangle f lines" \
+        "$faces f lines, $nontri not triangles" \
+        "$([ "${faces:-0}" -ge "$want" ] && [ "${nontri:-1}" = 0 ]; echo $?)"
+    check "polycube $name: one vt per face corner, each used once" "vt lines = corners = 3 x faces, 0 bad, 0 shared" \
+        "$nvt vt, $corners corners, $badc bad corners, $reused vt not used exactly once" \
+        "$([ "${nvt:-x}" = "${corners:-y}" ] && [ "${corners:-0}" = $((3 * ${faces:-0})) ] && [ "${badc:-1}" = 0 ] &&
+            [ "${reused:-1}" = 0 ]; echo $?)"
+    check "polycube $name: UVs in [0,1]" "0 bad vt values" "$outside" "$([ "${outside:-1}" = 0 ]; echo $?)"
+    check "polycube $name: each triangle's three vt in one tile" "0 triangles across tiles" "$straddling" \
+        "$([ "${straddling:-1}" = 0 ]; echo $?)"
+    [ -f out_polycube.obj ] && check_obj "polycube $name: out_polycube.obj" out_polycube.obj
+    check "polycube $name: summary" "'polycube: N cubes', 'mapping: N triangles, N split, N fallback, N failed edges', \
+'stretch: median X, p95 Y, max Z', 'seam score: tile borders X (...); all edges Y', 'time: build'" "$OUT" \
+        "$(printf '%s' "$OUT" | grep -qE '; polycube: [0-9]+ cubes of [0-9.e+-]+ units \(resolution [0-9]+\), [0-9]+ quads, [0-9]+ components?, genus [0-9]+' &&
+            printf '%s' "$OUT" | grep -qE '^mapping: [0-9]+ triangles, [0-9]+ split, [0-9]+ fallback, [0-9]+ failed edges, [0-9]+ flipped' &&
+            printf '%s' "$OUT" | grep -qE '^stretch: median [0-9.]+, p95 [0-9.]+, max [0-9.]+' &&
+            printf '%s' "$OUT" | grep -qE '^seam score: tile borders -?[0-9.]+ \([0-9]+ of [0-9]+ border edges( sampled)?\); all edges -?[0-9.]+ ' &&
+            printf '%s' "$OUT" | grep -qE '^time: build [0-9.]+ s, synthesis [0-9.]+ s, mapping [0-9.]+ s$'; echo $?)"
+    cd "$W" || exit 1
+}
+
+polycube_case "sphere-triangles" spheretri.obj 2 --resolution 8
+POLYCUBE_SPHERE=$W/d$NEWDIR_N
+check "polycube sphere: genus 0 as the mesh" "'genus 0 (as the mesh)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q 'genus 0 (as the mesh)'; echo $?)"
+check "polycube sphere: the paper's 256 tiles" "'tiles: 256 (n=2'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '^tiles: 256 (n=2, 16 texels, gutter 4)'; echo $?)"
+polycube_case "torus (quads as fans)" torus.obj 1 --seed 3
+check "polycube torus: says it split the quads into triangles" "'1024 triangles (fans of 512 faces)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '1024 triangles (fans of 512 faces)'; echo $?)"
+polycube_case "sphere --cube-size" spheretri.obj 1 --cube-size 0.5
+check "polycube --cube-size 0.5: cubes of 0.5 units" "'cubes of 0.5 units'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q 'cubes of 0.5 units'; echo $?)"
+newdir
+expect_ok "polycube torus at resolution 2" polycube ../in/torus.obj ../in/tex.png out --tile 16 --colors 1 --resolution 2
+check "polycube torus at resolution 2: warns that the genus differs" \
+    "one stderr line 'the polycube has genus 0, the mesh 1 ... raise --resolution'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -c 'the polycube has genus 0, the mesh 1.*raise --resolution' | grep -qx 1; echo $?)"
+check "polycube torus at resolution 2: the summary says so" "'genus 0 (the mesh's 1: they differ)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q "genus 0 (the mesh's 1: they differ)"; echo $?)"
+cd "$W" || exit 1
+polycube_case "sphere --up -z --no-correct" spheretri.obj 1 --resolution 6 --up -z --no-correct
+polycube_case "sphere --up 1,2,0" spheretri.obj 1 --resolution 6 --up 1,2,0
+
+# the same seed twice: the same files; another seed: another result
+newdir
+expect_ok "polycube sphere again" polycube ../in/spheretri.obj ../in/tex.png out --tile 16 --colors 2 --resolution 8
+for f in out.obj out.mtl out.png out_polycube.obj; do
+    CMD="tiledtex polycube ../in/spheretri.obj ../in/tex.png out --tile 16 --colors 2 --resolution 8 (twice)"
+    check "polycube same seed twice: identical $f" "cmp equal" "$(cmp "$f" "$POLYCUBE_SPHERE/$f" 2>&1)" \
+        "$(cmp -s "$f" "$POLYCUBE_SPHERE/$f"; echo $?)"
+done
+expect_ok "polycube seed 5" polycube ../in/spheretri.obj ../in/tex.png other --tile 16 --colors 2 --resolution 8 --seed 5
+CMD="tiledtex polycube ... --seed 0 / --seed 5"
+check "polycube different seed: different atlas and UVs" "files differ" "identical" \
+    "$(! cmp -s out.png other.png && ! cmp -s out.obj other.obj; echo $?)"
+# the result renders with its atlas
+expect_ok "render a polycube OBJ" render out.obj out.png view.png --size 160x120
+check "render polycube OBJ: 160x120 PNG" "160 120" "$(png_size view.png)" \
+    "$(is_png view.png && [ "$(png_size view.png)" = "160 120" ]; echo $?)"
+cd "$W" || exit 1
+
+# bad command lines: exit 2, one line, no files
+# expect_usage_error WHAT ARGS... : expect_error, and the status is TOOL_EXIT_USAGE (2)
+expect_usage_error() {
+    local what=$1
+    expect_error "$@"
+    check "$what: exit status 2 (usage)" "exit 2" "exit $RC" "$([ $RC -eq 2 ]; echo $?)"
+}
+expect_usage_error "polycube --resolution 0" polycube ../in/spheretri.obj ../in/tex.png out --resolution 0
+expect_usage_error "polycube --resolution -4" polycube ../in/spheretri.obj ../in/tex.png out --resolution -4
+expect_usage_error "polycube --resolution 99999" polycube ../in/spheretri.obj ../in/tex.png out --resolution 99999
+expect_usage_error "polycube --resolution abc" polycube ../in/spheretri.obj ../in/tex.png out --resolution abc
+expect_usage_error "polycube --resolution without a value" polycube ../in/spheretri.obj ../in/tex.png out --resolution
+expect_usage_error "polycube --cube-size 0" polycube ../in/spheretri.obj ../in/tex.png out --cube-size 0
+expect_usage_error "polycube --cube-size -1" polycube ../in/spheretri.obj ../in/tex.png out --cube-size -1
+expect_usage_error "polycube --cube-size nan" polycube ../in/spheretri.obj ../in/tex.png out --cube-size nan
+expect_usage_error "polycube --resolution with --cube-size" polycube ../in/spheretri.obj ../in/tex.png out \
+    --resolution 8 --cube-size 0.5
+err_mentions "polycube --resolution with --cube-size: names both" 'resolution.*cube-size'
+expect_usage_error "polycube --colors 0" polycube ../in/spheretri.obj ../in/tex.png out --colors 0
+expect_usage_error "polycube --tile 2" polycube ../in/spheretri.obj ../in/tex.png out --tile 2
+expect_usage_error "polycube --up w" polycube ../in/spheretri.obj ../in/tex.png out --up w
+expect_usage_error "polycube --up 0,0,0" polycube ../in/spheretri.obj ../in/tex.png out --up 0,0,0
+expect_usage_error "polycube --up 1,2" polycube ../in/spheretri.obj ../in/tex.png out --up 1,2
+expect_usage_error "polycube --seed abc" polycube ../in/spheretri.obj ../in/tex.png out --seed abc
+expect_usage_error "polycube unknown option" polycube ../in/spheretri.obj ../in/tex.png out --bogus
+expect_usage_error "polycube two arguments" polycube ../in/spheretri.obj ../in/tex.png
+expect_usage_error "polycube four arguments" polycube ../in/spheretri.obj ../in/tex.png out more
+# bad inputs: one line, non-zero exit, no files
+expect_error "polycube missing mesh" polycube ../in/nope.obj ../in/tex.png out
+err_mentions "polycube missing mesh: names the file" 'nope\.obj'
+expect_error "polycube missing image" polycube ../in/spheretri.obj ../in/nope.png out
+err_mentions "polycube missing image: names the file" 'nope\.png'
+expect_error "polycube image not an image" polycube ../in/spheretri.obj ../in/spheretri.obj out
+expect_error "polycube zero-area face" polycube ../in/lapped_degenerate.obj ../in/tex.png out
+err_mentions "polycube zero-area face: FILE:LINE and face 1" 'lapped_degenerate\.obj:5: face 1 '
+expect_error "polycube non-manifold edge" polycube ../in/nonmanifold.obj ../in/tex.png out
+no_zero_index "polycube non-manifold edge"
+
+# ======================================================================
 # Bad files, images and options
 # ======================================================================
 expect_error "missing mesh file" tile ../in/nope.obj ../in/tex.png out
@@ -1034,6 +1192,10 @@ expect_refused "lapped --bake output that is the IMAGE" lapped m.obj y_baked.png
 expect_refused "hpm with OUT_PREFIX naming the mesh" hpm m.obj img.png m --rotations 3
 cp m.obj z.mtl
 expect_refused "hpm with OUT_PREFIX.mtl an input (the mesh)" hpm z.mtl img.png z --rotations 3
+expect_refused "polycube with OUT_PREFIX naming the mesh" polycube m.obj img.png m --tile 16
+expect_refused "polycube with OUT_PREFIX naming the image" polycube m.obj img.png img --tile 16
+cp m.obj w_polycube.obj
+expect_refused "polycube with OUT_PREFIX_polycube.obj the mesh" polycube w_polycube.obj img.png w --tile 16
 expect_refused "synth onto its image" synth img.png img.png --tile 16
 expect_refused "synth onto its image (other spelling)" synth img.png ../$(basename "$PWD")/img.png --tile 16
 expect_refused "render onto its texture" render m.obj img.png img.png --size 32x32

@@ -1,0 +1,461 @@
+/* polycube.c - `tiledtex polycube`: texture any triangle mesh with Chang
+   and Lin's polycube map and Wang tiles.
+
+   MESH.obj + IMAGE -> OUT_PREFIX.obj (the mesh's triangles, split where
+   they cross the tiles' borders, one texture coordinate per corner),
+   OUT_PREFIX.mtl, OUT_PREFIX.png (the tile atlas) and
+   OUT_PREFIX_polycube.obj (the polycube's surface S with its tiles, to look
+   at what the mesh was mapped onto). Unlike `tile`, the tiles' size on the
+   surface is the cube size, whatever the mesh's triangles.
+
+   The library calls, as a user of tiledtex.h makes them:
+
+     tt_mesh_build            the OBJ's faces as triangle fans (the mapping
+                              works on triangles)
+     tt_polycube_build        the polycube: voxels, interior fill, manifold
+                              repair, correction, its surface S of quads
+     tt_polycube_edge_colors  the Wang colouring of S's edges, a palette of
+                              two colours per axis (the paper's n = 2)
+     tt_assign_boundaries     tile types from those colours; tt_assign_uvs
+                              gives S its own texture coordinates
+     tt_synthesize_tiles      the atlas (shared with `tile`: tiled.c)
+     tt_polycube_map          the triangles split along S's quad edges,
+                              each corner's point on S
+     tt_polycube_mapping_uvs  those points as texture coordinates
+     tt_measure_uv_distortion, tt_measure_seams   the summary's quality
+*/
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tiled.h"
+
+/* The paper's colours: two per axis, drawn from a palette of this many. */
+#define POLYCUBE_DEFAULT_COLORS 2
+
+static void print_help(void)
+{
+    printf("usage: tiledtex polycube MESH.obj IMAGE OUT_PREFIX [options]\n"
+           "\n"
+           "Texture MESH.obj from IMAGE with no seams (Chang and Lin, polycube maps and Wang\n"
+           "tiles): the mesh is wrapped in a polycube, a block of equal cubes; each square of its\n"
+           "surface shows one tile of an atlas made from IMAGE, tiles that match across every\n"
+           "edge, and the mesh's triangles are split where they cross the squares' borders and\n"
+           "given the texture of the part of the polycube they lie over. Works on any closed\n"
+           "triangle or polygon mesh, dense scans included; n-gons are split into triangle fans.\n"
+           "Writes OUT_PREFIX.obj (the split triangles, one texture coordinate per corner),\n"
+           "OUT_PREFIX.mtl, OUT_PREFIX.png (the atlas) and OUT_PREFIX_polycube.obj (the polycube's\n"
+           "surface with its tiles). Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX.png\n"
+           "view.png'.\n"
+           "\n"
+           "options:\n"
+           "  --resolution N   cubes along the mesh's longest side, 1 to %d (default %d)\n"
+           "  --cube-size X    the cubes' edge in mesh units instead: one tile covers X x X of the\n"
+           "                   surface (not with --resolution)\n"
+           "  --colors N       edge colours of the palette each axis draws 2 from (default %d:\n"
+           "                   the paper's 256 tiles); 1 gives 16 tiles\n"
+           "  --seed K         random seed: colours, tiles, synthesis (default 0)\n"
+           "  --tile S         tile size in texels (default: %d, or what IMAGE can feed)\n"
+           "  --gutter G       texels of gutter around each tile, 0 for none (default %d)\n"
+           "  --no-correct     skip the polycube's correction step (keeps every cube the surface\n"
+           "                   meets)\n"
+           "  --up AXIS        the direction the tiles' up follows: x, y, z, -x, -y, -z or X,Y,Z\n"
+           "                   (its largest component counts; default y)\n"
+           "\n"
+           "Prints the polycube (cubes, squares, components, genus against the mesh's), the\n"
+           "mapping (triangles split, triangles that fell back to one square: local seams, edges\n"
+           "with no path on the polycube, folds), the stretch of the texture on the triangles, the\n"
+           "seam score on the tiles' borders and over all edges (about 0: the texture continues,\n"
+           "about 1: unrelated) and the time of each stage.\n"
+           "\n"
+           "example: tiledtex generate mesh sphere.obj --shape sphere --triangles\n"
+           "         tiledtex generate texture stones.png --size 256\n"
+           "         tiledtex polycube sphere.obj stones.png sphere_pc --resolution 8\n"
+           "         tiledtex render sphere_pc.obj sphere_pc.png view.png\n",
+           TT_POLYCUBE_MAX_RESOLUTION, TT_POLYCUBE_DEFAULT_RESOLUTION, POLYCUBE_DEFAULT_COLORS,
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
+}
+
+typedef struct polycube_command_options {
+    const char *mesh_path, *image_path, *prefix;
+    tiled_options tiles;            /* --colors --tile --gutter --seed, as `tile` takes them */
+    tt_polycube_options build;      /* zero fields: the library's defaults */
+} polycube_command_options;
+
+/* --up: an axis name, or a direction X,Y,Z of which the library takes the
+   largest component's axis. */
+static int parse_up(const char *value, double up[3])
+{
+    int axis, sign;
+    if (!value) return tool_usage("--up needs a value");
+    if (parse_axis_name(value, &axis, &sign) == 0) {
+        up[0] = up[1] = up[2] = 0.0;
+        up[axis] = sign;
+        return 0;
+    }
+    if (!strchr(value, ','))
+        return tool_usage("--up wants an axis (x, y, z, -x, -y or -z) or a direction X,Y,Z, got '%s'", value);
+    if (parse_float_list("--up", value, 3, up) != 0) return TOOL_EXIT_USAGE;
+    if (up[0] == 0.0 && up[1] == 0.0 && up[2] == 0.0)
+        return tool_usage("--up wants a direction, got the zero vector '%s'", value);
+    return 0;
+}
+
+/* Returns -1 to go on, or the exit status to return now. */
+static int parse_command_line(int argc, char **argv, polycube_command_options *options)
+{
+    const char *positional[3];
+    int npositional = 0, resolution_given = 0, cube_size_given = 0, i;
+    memset(options, 0, sizeof *options);
+    tiled_default_options(&options->tiles);
+    for (i = 1; i < argc; i++) {
+        const char *value;
+        int taken;
+        if (tool_is_help(argv[i])) {
+            print_help();
+            return 0;
+        }
+        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS, &options->tiles);
+        if (taken < 0) return TOOL_EXIT_USAGE;
+        if (taken) continue;
+        if (tool_option(argc, argv, &i, "--resolution", &value)) {
+            if (parse_int("--resolution", value, 1, TT_POLYCUBE_MAX_RESOLUTION, &options->build.resolution) != 0)
+                return TOOL_EXIT_USAGE;
+            resolution_given = 1;
+        } else if (tool_option(argc, argv, &i, "--cube-size", &value)) {
+            double size;
+            if (!value) return tool_usage("--cube-size needs a value");
+            if (parse_whole_double(value, &size) != 0 || !(size > 0.0) || size > 1e30)
+                return tool_usage("--cube-size wants the cubes' edge in mesh units, above 0, got '%s'", value);
+            options->build.cube_size = size;
+            cube_size_given = 1;
+        } else if (strcmp(argv[i], "--no-correct") == 0) {
+            options->build.flags |= TT_POLYCUBE_NO_CORRECT;
+        } else if (tool_option(argc, argv, &i, "--up", &value)) {
+            int status = parse_up(value, options->build.up);
+            if (status != 0) return status;
+        } else if (tool_is_option(argv[i])) {
+            return tool_unknown_option(argv[i]);
+        } else if (npositional < 3) {
+            positional[npositional++] = argv[i];
+        } else {
+            npositional++; /* counted, to say there are too many */
+        }
+    }
+    if (resolution_given && cube_size_given)
+        return tool_usage("give --resolution or --cube-size, not both (both set the cubes' size)");
+    if (options->tiles.layout.colors == 0) options->tiles.layout.colors = POLYCUBE_DEFAULT_COLORS;
+    if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
+                               &options->prefix) != 0)
+        return TOOL_EXIT_USAGE;
+    return -1;
+}
+
+/* ======================================================================== */
+/* The pipeline                                                             */
+/* ======================================================================== */
+
+/* Everything the command makes, freed by polycube_job_free. */
+typedef struct polycube_job {
+    triangle_mesh mesh;
+    tt_polycube *polycube;
+    tt_polycube_report build_report;
+    tt_tile_layout layout;          /* resolved */
+    int *edge_colors;               /* per S half-edge */
+    uint8_t *surface_type;          /* per S half-edge: its boundary type */
+    float *surface_uv;              /* per S corner: S's own texture coordinates */
+    tt_tileset *tiles;
+    tt_polycube_mapping *mapping;
+    tt_polycube_map_report map_report;
+    float *corner_uv;               /* 6 per mapped triangle */
+    double build_seconds, synth_seconds, map_seconds;
+} polycube_job;
+
+static void polycube_job_free(polycube_job *job)
+{
+    triangle_mesh_free(&job->mesh);
+    tt_polycube_free(job->polycube);
+    free(job->edge_colors);
+    free(job->surface_type);
+    free(job->surface_uv);
+    tt_tileset_free(job->tiles);
+    tt_polycube_mapping_free(job->mapping);
+    free(job->corner_uv);
+    memset(job, 0, sizeof *job);
+}
+
+/* The polycube and the tiles of its surface S. */
+static int build_polycube(const polycube_command_options *options, polycube_job *job)
+{
+    const char *path = options->mesh_path;
+    tt_error error;
+    double start = tool_seconds_now();
+    int ncorners;
+    if (tt_polycube_build(job->mesh.mesh, &options->build, NULL, &job->polycube, &job->build_report, &error) != TT_OK)
+        return triangle_mesh_report_error(path, &job->mesh, &error);
+    job->build_seconds = tool_seconds_now() - start;
+    if (job->build_report.genus_differs)
+        tool_note("%s: the polycube has genus %d, the mesh %d: handles are closed or opened where the cubes are "
+                  "too coarse (raise --resolution)",
+                  path, job->build_report.polycube_genus, job->build_report.mesh_genus);
+    if (job->build_report.inside_out)
+        tool_note("%s: the faces wind inward (the mesh is inside out), so vertices may go onto the wrong side of "
+                  "the polycube: reverse the order of every face's corners",
+                  path);
+
+    ncorners = job->polycube->surface->ncorners;
+    job->edge_colors = (int *)malloc((size_t)ncorners * sizeof(int));
+    job->surface_type = (uint8_t *)malloc((size_t)ncorners);
+    job->surface_uv = (float *)malloc((size_t)ncorners * 2 * sizeof(float));
+    if (!job->edge_colors || !job->surface_type || !job->surface_uv)
+        return tool_fail("out of memory for the %d quads of the polycube", job->polycube->surface->nfaces);
+    /* axis_palettes = 1: the edges along each axis draw from two colours
+       of the palette picked for that axis, the paper's scheme. */
+    if (tt_polycube_edge_colors(job->polycube, job->layout.colors, 1, options->tiles.seed, job->edge_colors,
+                                &error) != TT_OK ||
+        tt_assign_boundaries(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
+                             job->surface_type, &error) != TT_OK ||
+        tt_assign_uvs(job->polycube->surface, &job->layout, job->surface_type, job->surface_uv, &error) != TT_OK)
+        return tool_fail("%s: the polycube's tiles: %s", path, error.message);
+    return 0;
+}
+
+/* The triangles split along S's quads, with their texture coordinates. */
+static int map_mesh(const polycube_command_options *options, polycube_job *job)
+{
+    tt_error error;
+    double start = tool_seconds_now();
+    if (tt_polycube_map(job->polycube, job->mesh.mesh, NULL, NULL, &job->mapping, &job->map_report, &error) != TT_OK)
+        return triangle_mesh_report_error(options->mesh_path, &job->mesh, &error);
+    job->map_seconds = tool_seconds_now() - start;
+    job->corner_uv = (float *)malloc((size_t)job->mapping->ntriangles * 6 * sizeof(float));
+    if (!job->corner_uv)
+        return tool_fail("out of memory for the texture coordinates of %d triangles", job->mapping->ntriangles);
+    if (tt_polycube_mapping_uvs(job->polycube, job->mapping, &job->layout, job->surface_type, job->corner_uv,
+                                &error) != TT_OK)
+        return tool_fail("%s: the texture coordinates: %s", options->mesh_path, error.message);
+    return 0;
+}
+
+/* ======================================================================== */
+/* The measures and the summary                                             */
+/* ======================================================================== */
+
+typedef struct polycube_quality {
+    tool_seams borders;             /* UV-discontinuous edges: the tiles' borders */
+    tool_seams all;                 /* every interior edge */
+    tt_uv_distortion_report distortion;
+    int distortion_measured;
+    char distortion_reason[224];    /* why the distortion was not measured */
+    int mesh_built;                 /* 0: the mapped triangles made no tt_mesh, nothing was measured */
+    char mesh_reason[TOOL_ERROR_SIZE];   /* why */
+} polycube_quality;
+
+/* The measures take a tt_mesh: the mapped triangles make one, the same
+   surface as the input's, cut along the tiles' borders. */
+static int measure_quality(const polycube_command_options *options, const polycube_job *job,
+                           polycube_quality *quality)
+{
+    const tt_image *atlas = &job->tiles->levels[0];
+    tt_mesh_desc desc;
+    tt_mesh *mapped = NULL;
+    tt_uv_distortion_options distortion;
+    tt_error error;
+    tt_result result;
+    int status;
+    memset(quality, 0, sizeof *quality);
+    memset(&desc, 0, sizeof desc);
+    desc.positions = job->mapping->positions;
+    desc.nverts = job->mapping->nverts;
+    desc.indices = job->mapping->triangles;
+    desc.nfaces = job->mapping->ntriangles;
+    desc.fixed_face_size = 3;
+    if (tt_mesh_build(&desc, NULL, &mapped, &error) != TT_OK) {
+        /* A report, not the job: the files are still right. */
+        snprintf(quality->mesh_reason, sizeof quality->mesh_reason, "the mapped triangles: %s", error.message);
+        return 0;
+    }
+    quality->mesh_built = 1;
+    status = tool_measure_seams(options->mesh_path, mapped, job->corner_uv, atlas, options->tiles.seed,
+                                TT_SEAM_UV_DISCONTINUOUS, 0, &quality->borders);
+    if (status == 0)
+        status = tool_measure_seams(options->mesh_path, mapped, job->corner_uv, atlas, options->tiles.seed, 0, 0,
+                                    &quality->all);
+    if (status == 0) {
+        /* One tile covers one cube face: the intended density is the tile's
+           texels over the cube's edge. */
+        memset(&distortion, 0, sizeof distortion);
+        distortion.texels_per_unit = job->layout.tile_size / job->polycube->h;
+        result = tt_measure_uv_distortion(mapped, job->corner_uv, atlas->width, atlas->height, &distortion, NULL,
+                                          &quality->distortion, &error);
+        if (result == TT_OK)
+            quality->distortion_measured = 1;
+        else if (result == TT_ERROR_NOT_MEASURED)
+            snprintf(quality->distortion_reason, sizeof quality->distortion_reason, "%s", error.message);
+        else
+            status = tool_fail("%s: cannot measure the distortion: %s", options->mesh_path, error.message);
+    }
+    tt_mesh_free(mapped);
+    return status;
+}
+
+static void print_summary(const polycube_command_options *options, const polycube_job *job,
+                          const polycube_quality *quality)
+{
+    const tt_polycube_report *b = &job->build_report;
+    const tt_polycube_map_report *m = &job->map_report;
+    const tt_polycube_projection_report *p = &m->projection;
+    const tt_uv_distortion_report *d = &quality->distortion;
+    char borders[320], all[320];
+    int atlas = tt_tile_layout_atlas_size(&job->layout);
+
+    printf("%s: %d triangles", options->mesh_path, job->mesh.ntriangles);
+    if (job->mesh.ntriangles != job->mesh.obj.nfaces) printf(" (fans of %d faces)", job->mesh.obj.nfaces);
+    printf("; polycube: %d cubes of %.4g units (resolution %d), %d quads, %d component%s, genus %d", b->cubes,
+           b->cube_size, b->resolution, b->quads, b->components, b->components == 1 ? "" : "s", b->polycube_genus);
+    if (b->mesh_genus < 0) printf(" (the mesh's: not closed)\n");
+    else if (b->genus_differs) printf(" (the mesh's %d: they differ)\n", b->mesh_genus);
+    else printf(" (as the mesh)\n");
+    printf("mapping: %d triangles, %d split, %d fallback, %d failed edges, %d flipped", job->mapping->ntriangles,
+           m->split_triangles, m->fallback_triangles, m->failed_edges, m->flipped);
+    /* The library halves edges longer than half a cube first, so that no
+       triangle holds several corners of the polycube. */
+    if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
+    printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
+           p->nearest, p->fallbacks, p->mean_distance);
+    printf("tiles: %d (n=%d, %d texels, gutter %d), %dx%d atlas; %.4g texels per unit\n",
+           tt_tile_layout_tile_count(&job->layout), job->layout.colors, job->layout.tile_size, job->layout.gutter,
+           atlas, atlas, job->layout.tile_size / job->polycube->h);
+    if (!quality->mesh_built) {
+        printf("stretch and seam score: not measured (%s)\n", quality->mesh_reason);
+    } else {
+        if (quality->distortion_measured) {
+            printf("stretch: median %.3f, p95 %.3f, max %.3f; density error median %.1f%%, p95 %.1f%%; "
+                   "%d flipped UV triangle%s",
+                   d->stretch_median, d->stretch_p95, d->stretch_max, 100.0 * d->density_median,
+                   100.0 * d->density_p95, d->flipped, d->flipped == 1 ? "" : "s");
+            if (d->degenerate > 0) printf(", %d degenerate", d->degenerate);
+            printf("\n");
+        } else {
+            printf("stretch: not measured (%s)\n", quality->distortion_reason);
+        }
+        tool_format_seams(&quality->borders, "border edges", borders, sizeof borders);
+        tool_format_seams(&quality->all, "edges", all, sizeof all);
+        printf("seam score: tile borders %s; all edges %s\n", borders, all);
+    }
+    printf("time: build %.2f s, synthesis %.2f s, mapping %.2f s\n", job->build_seconds, job->synth_seconds,
+           job->map_seconds);
+}
+
+/* ======================================================================== */
+/* The files                                                                */
+/* ======================================================================== */
+
+/* OUT_PREFIX.obj: the mapped triangles, one vt per corner. */
+static int add_obj(tool_output *output, const char *path, const char *mtl_name, const polycube_job *job)
+{
+    char comment[512];
+    tool_buffer text = TOOL_BUFFER_INIT;
+    obj_write_desc desc;
+    snprintf(comment, sizeof comment,
+             "polycube texture by tiledtex %s (Chang and Lin): %d triangles over %d polycube quads of %.9g units,\n"
+             "%d colors, %d-texel tiles, gutter %d",
+             TILEDTEX_VERSION_STRING, job->mapping->ntriangles, job->polycube->surface->nfaces, job->polycube->h,
+             job->layout.colors, job->layout.tile_size, job->layout.gutter);
+    memset(&desc, 0, sizeof desc);
+    desc.comment = comment;
+    desc.nverts = job->mapping->nverts;
+    desc.pos = job->mapping->positions;
+    desc.nfaces = job->mapping->ntriangles;
+    desc.fixed_face_size = 3;
+    desc.corner_vert = job->mapping->triangles;
+    desc.corner_uv = job->corner_uv;
+    desc.mtllib = mtl_name;
+    desc.material = "tiled";
+    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", path);
+    }
+    return 0;
+}
+
+/* OUT_PREFIX_polycube.obj: S with its own tiles, written the way `tile`
+   writes a quad mesh (S is one, with the tiles' UVs). */
+static int add_surface_obj(tool_output *output, const char *path, const char *mtl_name, const polycube_job *job)
+{
+    tiled_mesh surface;
+    memset(&surface, 0, sizeof surface);
+    surface.mesh = job->polycube->surface;
+    surface.corner_uv = job->surface_uv;
+    surface.layout = job->layout;
+    return tiled_add_obj(output, path, &surface, mtl_name);
+}
+
+/* ======================================================================== */
+/* The command                                                              */
+/* ======================================================================== */
+
+int cmd_polycube(int argc, char **argv)
+{
+    polycube_command_options options;
+    polycube_job job;
+    polycube_quality quality;
+    tt_image *image = NULL;
+    tool_output output = TOOL_OUTPUT_INIT;
+    tt_error error;
+    char obj_path[4096], mtl_path[4096], png_path[4096], surface_path[4096], message[TOOL_ERROR_SIZE];
+    int status;
+    double start;
+
+    memset(&job, 0, sizeof job);
+    status = parse_command_line(argc, argv, &options);
+    if (status >= 0) return status;
+    snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
+    snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
+    snprintf(png_path, sizeof png_path, "%s.png", options.prefix);
+    snprintf(surface_path, sizeof surface_path, "%s_polycube.obj", options.prefix);
+
+    if ((status = triangle_mesh_read(options.mesh_path, &job.mesh)) != 0) return status;
+    /* A photo: sRGB bytes in the file, linear light in the library. */
+    if (image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
+        status = tool_fail("%s", message);
+    if (status == 0) status = tiled_pick_tile_size(options.image_path, image->width, image->height, &options.tiles);
+    if (status == 0) status = tiled_check_atlas_size(&options.tiles);
+    if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
+        status = tool_fail("%s", error.message);
+    /* Refuse, before the long part, outputs that would replace an input
+       (the commit checks again). */
+    if (status == 0) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0) status = tool_refuse_input_overwrite(png_path);
+    if (status == 0) status = tool_refuse_input_overwrite(surface_path);
+
+    if (status == 0) status = build_polycube(&options, &job);
+    if (status == 0) {
+        start = tool_seconds_now();
+        status = tiled_synthesize(image, options.image_path, &options.tiles, &job.tiles);
+        job.synth_seconds = tool_seconds_now() - start;
+    }
+    /* The photo is not needed past the synthesis; it is the largest thing
+       the command holds. */
+    image_free(image);
+    image = NULL;
+    if (status == 0) status = map_mesh(&options, &job);
+    if (status == 0) status = measure_quality(&options, &job, &quality);
+
+    if (status == 0) status = tiled_add_atlas(&output, png_path, job.tiles, 0);
+    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
+    if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
+    if (status == 0) status = add_surface_obj(&output, surface_path, tool_basename(mtl_path), &job);
+    if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
+
+    if (status == 0) {
+        print_summary(&options, &job, &quality);
+        printf("wrote %s, %s, %s, %s\n", obj_path, mtl_path, png_path, surface_path);
+    }
+    output_free(&output);
+    image_free(image);
+    polycube_job_free(&job);
+    return status;
+}
