@@ -2144,21 +2144,26 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         tt_synthesize_tiles makes the tiles: the paper's rotation rules
         (Figs. 3-5) come out of Akleman's per-side rule on any consistently
         oriented quad mesh, which S is (spec P9, P10).
-     3. The mapping of the model onto S (Sec. 4, spec P11), so far:
-        a. tt_polycube_project: each vertex of the model gets its point
-           q(v) = (quad, s, t) on S (P11 step 2);
-        b. tt_polycube_trace_edges: each edge of the model gets its image on
-           S, the quads it passes and where it crosses their edges (S
-           half-edge, position on it, t on the mesh edge), one record per
-           edge, so the two triangles on an edge will split it at the same
-           points (P11 step 3, P12, Q11); tt_polycube_unfold lays two quads
-           side by side, exactly.
-        What follows: the triangle split (P11 step 4: a triangle's three
-        edge paths unfolded into one chart by tt_polycube_unfold, clipped by
-        the quad grid into pieces inside one quad each, the edge points
-        taken from the records), the relaxation of the points on S (step
-        5), the UVs (step 6), and for the triangles on a failed edge the
-        fallback (step 7).
+     3. tt_polycube_map: the mapping of the model onto S (Sec. 4, spec
+        P11), in place of the paper's per-cell configurations (P11, P12):
+        a. the model refined until no edge is longer than half a cube, so
+           a triangle holds about one vertex of S at most;
+        b. tt_polycube_project: each vertex gets its point q(v) = (quad,
+           s, t) on S (P11 step 2);
+        c. the relaxation of the points on S where a triangle folds or an
+           edge finds no short path (step 5);
+        d. tt_polycube_trace_edges: each edge gets its image on S, the
+           quads it passes and where it crosses their edges (S half-edge,
+           position on it, t on the mesh edge), one record per edge, so
+           the two triangles on an edge split it at the same points (step
+           3, P12, Q11); tt_polycube_unfold lays two quads side by side,
+           exactly;
+        e. the triangle split (step 4): a triangle's boundary unfolded
+           into one chart and clipped by the quad grid into pieces inside
+           one quad each, or fanned around the one vertex of S inside it,
+           or - the fallback (step 7) - put whole into one quad.
+     4. tt_polycube_mapping_uvs: each piece's points on S as texture
+        coordinates in its quad's tile (step 6).
 
    The grid (spec P2). L = the bounding box's longest side; the cube edge is
    h = L / resolution, or options->cube_size. Each axis has
@@ -15816,31 +15821,214 @@ out_of_memory:
     return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory tracing the mesh's edges on S");
 }
 
-/* ---- The model split on S and its UVs (spec P11 steps 4, 6, 7) ---- */
+/* ---- The model refined (before spec P11 step 2) ---- */
 
-#define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
-                                       above the records' snap (1e-6), far below any real piece */
-#define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
-#define TT__MAP_SNAP 1e-5f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
-#define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
+/* The model refined for the split: its triangles halved along every edge
+   longer than a bound until none is, so that a triangle spans few quads of
+   S and holds at most about one vertex of S (a coarse model's large
+   triangles would each hold several cone points, which no single chart or
+   fan maps). Refined vertex v < mesh->nverts is input vertex v; each
+   refined vertex interpolates at most 3 vertices of one input triangle
+   (the midpoint of a midpoint stays on its triangle), and each refined
+   triangle knows its input face. */
+typedef struct tt__refined {
+    tt_mesh *mesh;
+    int *source;                /* 3 per vertex: input vertices... */
+    double *weight;             /* ...and their weights */
+    int *face;                  /* per triangle: its input face */
+} tt__refined;
 
-/* A point on a triangle's boundary (a model vertex or a split point of an
-   edge) and the boundary segment from it to the next point: the quad the
-   segment lies in, both ends in that quad's frame, the map of that frame
-   into the triangle's chart, and the point in the chart. */
-typedef struct tt__split_point {
-    int vertex;                 /* output vertex */
-    int quad;
-    double a[2], b[2];
-    tt_quad_map map;
-    double at[2];
-    int used;                   /* a corner of some piece (tt__split_pieces) */
-} tt__split_point;
+static void tt__refined_free(const tt_allocator *allocator, tt__refined *r)
+{
+    tt_mesh_free(r->mesh);
+    tt__free(allocator, r->source);
+    tt__free(allocator, r->weight);
+    tt__free(allocator, r->face);
+    memset(r, 0, sizeof *r);
+}
 
-typedef struct tt__split_cell {
-    int quad;                   /* -1: not known yet */
-    tt_quad_map map;
-} tt__split_cell;
+/* The sources of the midpoint of refined vertices a and b: half of each,
+   the same input vertices added up (at most 3 distinct: both lie on one
+   input triangle). */
+static void tt__refined_midpoint_sources(const int *source, const double *weight, int a, int b, int out_source[3],
+                                         double out_weight[3])
+{
+    int n = 0, i, j, k;
+    for (k = 0; k < 3; k++) {
+        out_source[k] = source[3 * a];
+        out_weight[k] = 0.0;
+    }
+    for (i = 0; i < 6; i++) {
+        int v = source[3 * (i < 3 ? a : b) + i % 3];
+        double w = 0.5 * weight[3 * (i < 3 ? a : b) + i % 3];
+        if (w == 0.0) continue;
+        for (j = 0; j < n && out_source[j] != v; j++) continue;
+        if (j == n) {
+            if (n == 3) continue;
+            out_source[n++] = v;
+        }
+        out_weight[j] += w;
+    }
+}
+
+#define TT__REFINE_MAX_TRIANGLES (1 << 24)   /* refining stops short of this many triangles */
+
+static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
+                                     tt__refined *out, tt_error *error)
+{
+    float *positions = NULL;
+    int *triangles = NULL, *faces = NULL, *source = NULL, *mid = NULL, *next_triangles = NULL, *next_faces = NULL;
+    double *weight = NULL;
+    int nverts = mesh->nverts, ntriangles = mesh->nfaces, vertex_capacity = 0, pass, c, v, f;
+    tt_mesh *current = NULL;
+    tt_result result = TT_OK;
+    memset(out, 0, sizeof *out);
+    positions = (float *)tt__grow(allocator, NULL, &vertex_capacity, nverts > 0 ? nverts : 1, 3 * sizeof(float));
+    source = TT__ALLOC(allocator, int, 3 * (size_t)vertex_capacity);
+    weight = TT__ALLOC(allocator, double, 3 * (size_t)vertex_capacity);
+    triangles = TT__ALLOC(allocator, int, 3 * (size_t)ntriangles);
+    faces = TT__ALLOC(allocator, int, ntriangles);
+    if (!positions || !source || !weight || !triangles || !faces) goto out_of_memory;
+    memcpy(positions, mesh->pos, sizeof(float) * 3 * (size_t)nverts);
+    for (v = 0; v < nverts; v++) {
+        source[3 * v] = source[3 * v + 1] = source[3 * v + 2] = v;
+        weight[3 * v] = 1.0;
+        weight[3 * v + 1] = weight[3 * v + 2] = 0.0;
+    }
+    memcpy(triangles, mesh->corner_vert, sizeof(int) * 3 * (size_t)ntriangles);
+    for (f = 0; f < ntriangles; f++) faces[f] = f;
+    for (pass = 0;; pass++) {
+        tt_mesh_desc desc;
+        int marked = 0, next_count = 0;
+        memset(&desc, 0, sizeof desc);
+        desc.positions = positions;
+        desc.nverts = nverts;
+        desc.indices = triangles;
+        desc.nfaces = ntriangles;
+        desc.fixed_face_size = 3;
+        desc.flags = mesh->flags & TT_MESH_PERMISSIVE;
+        if ((result = tt_mesh_build(&desc, allocator, &current, error)) != TT_OK) goto failed;
+        mid = TT__ALLOC(allocator, int, current->ncorners);
+        if (!mid) goto out_of_memory;
+        for (c = 0; c < current->ncorners; c++) {
+            int a = current->corner_vert[c], b = current->corner_vert[tt_mesh_next(current, c)], twin = current->twin[c];
+            double edge[3];
+            int k;
+            tt__sub3f(positions + 3 * b, positions + 3 * a, edge);
+            mid[c] = -1;
+            if (tt__length3(edge) <= longest) continue;
+            marked++;
+            if (twin >= 0 && twin < c) {
+                mid[c] = mid[twin];
+                continue;
+            }
+            if (nverts == vertex_capacity) {
+                int capacity = vertex_capacity, *grown_source;
+                float *grown_positions;
+                double *grown_weight;
+                if (nverts >= INT_MAX / 4) goto too_large;
+                grown_positions = (float *)tt__grow(allocator, positions, &capacity, nverts + 1, 3 * sizeof(float));
+                if (!grown_positions) goto out_of_memory;
+                positions = grown_positions;
+                capacity = vertex_capacity;
+                grown_source = (int *)tt__grow(allocator, source, &capacity, nverts + 1, 3 * sizeof(int));
+                if (!grown_source) goto out_of_memory;
+                source = grown_source;
+                capacity = vertex_capacity;
+                grown_weight = (double *)tt__grow(allocator, weight, &capacity, nverts + 1, 3 * sizeof(double));
+                if (!grown_weight) goto out_of_memory;
+                weight = grown_weight;
+                vertex_capacity = capacity;
+            }
+            for (k = 0; k < 3; k++)
+                positions[3 * nverts + k] = (float)(0.5 * ((double)positions[3 * a + k] + positions[3 * b + k]));
+            tt__refined_midpoint_sources(source, weight, a, b, source + 3 * nverts, weight + 3 * nverts);
+            mid[c] = nverts++;
+        }
+        if (!marked || ntriangles > TT__REFINE_MAX_TRIANGLES / 4) break;
+        if (ntriangles > (INT_MAX / 3) / 4) goto too_large;
+        next_triangles = TT__ALLOC(allocator, int, 12 * (size_t)ntriangles);
+        next_faces = TT__ALLOC(allocator, int, 4 * (size_t)ntriangles);
+        if (!next_triangles || !next_faces) goto out_of_memory;
+        for (f = 0; f < ntriangles; f++) {
+            int r, split = 0, *t;
+            const int *corner = triangles + 3 * f, *m = mid + 3 * f;
+            for (r = 0; r < 3; r++) split += m[r] >= 0;
+            /* Turn the triangle so its split edges come first: (a, b) always split when any is. */
+            for (r = 0; r < 3 && split > 0 && split < 3; r++)
+                if (m[r] >= 0 && m[(r + 2) % 3] < 0) break;
+            if (split == 0 || split == 3) r = 0;
+            {
+                int a = corner[r], b = corner[(r + 1) % 3], cc = corner[(r + 2) % 3];
+                int ab = m[r], bc = m[(r + 1) % 3], ca = m[(r + 2) % 3], add[12], n = 0, k;
+                if (split == 0) {
+                    add[n++] = a; add[n++] = b; add[n++] = cc;
+                } else if (split == 1) {
+                    add[n++] = a; add[n++] = ab; add[n++] = cc;
+                    add[n++] = ab; add[n++] = b; add[n++] = cc;
+                } else if (split == 2) {
+                    /* (a, b) and (b, c) split: the corner at b, then the quad a, ab, bc, c by its shorter
+                       diagonal. */
+                    double diagonal_a[3], diagonal_c[3];
+                    tt__sub3f(positions + 3 * a, positions + 3 * bc, diagonal_a);
+                    tt__sub3f(positions + 3 * cc, positions + 3 * ab, diagonal_c);
+                    add[n++] = ab; add[n++] = b; add[n++] = bc;
+                    if (tt__length3(diagonal_a) <= tt__length3(diagonal_c)) {
+                        add[n++] = a; add[n++] = ab; add[n++] = bc;
+                        add[n++] = a; add[n++] = bc; add[n++] = cc;
+                    } else {
+                        add[n++] = a; add[n++] = ab; add[n++] = cc;
+                        add[n++] = ab; add[n++] = bc; add[n++] = cc;
+                    }
+                } else {
+                    add[n++] = a; add[n++] = ab; add[n++] = ca;
+                    add[n++] = ab; add[n++] = b; add[n++] = bc;
+                    add[n++] = ca; add[n++] = bc; add[n++] = cc;
+                    add[n++] = ab; add[n++] = bc; add[n++] = ca;
+                }
+                t = next_triangles + 3 * next_count;
+                memcpy(t, add, sizeof(int) * (size_t)n);
+                for (k = 0; k < n / 3; k++) next_faces[next_count++] = faces[f];
+            }
+        }
+        tt__free(allocator, triangles);
+        tt__free(allocator, faces);
+        tt__free(allocator, mid);
+        tt_mesh_free(current);
+        current = NULL;
+        mid = NULL;
+        triangles = next_triangles;
+        faces = next_faces;
+        next_triangles = next_faces = NULL;
+        ntriangles = next_count;
+    }
+    tt__free(allocator, mid);
+    tt__free(allocator, triangles);
+    tt__free(allocator, positions);
+    out->mesh = current;
+    out->source = source;
+    out->weight = weight;
+    out->face = faces;
+    return TT_OK;
+too_large:
+    result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                      "refining the model's triangles to edges of at most %g would pass %d vertices or "
+                      "triangles: choose a larger max_edge or a coarser polycube", longest, INT_MAX / 4);
+    goto failed;
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory refining the model");
+failed:
+    tt_mesh_free(current);
+    tt__free(allocator, mid);
+    tt__free(allocator, next_triangles);
+    tt__free(allocator, next_faces);
+    tt__free(allocator, triangles);
+    tt__free(allocator, faces);
+    tt__free(allocator, positions);
+    tt__free(allocator, source);
+    tt__free(allocator, weight);
+    return result;
+}
 
 /* ---- Relaxation of the points on S (spec P11 step 5) ---- */
 
@@ -16117,217 +16305,31 @@ done:
     return moves;
 }
 
-/* The model refined for the split: its triangles halved along every edge
-   longer than a bound until none is, so that a triangle spans few quads of
-   S and holds at most about one vertex of S (a coarse model's large
-   triangles would each hold several cone points, which no single chart or
-   fan maps). Refined vertex v < mesh->nverts is input vertex v; each
-   refined vertex interpolates at most 3 vertices of one input triangle
-   (the midpoint of a midpoint stays on its triangle), and each refined
-   triangle knows its input face. */
-typedef struct tt__refined {
-    tt_mesh *mesh;
-    int *source;                /* 3 per vertex: input vertices... */
-    double *weight;             /* ...and their weights */
-    int *face;                  /* per triangle: its input face */
-} tt__refined;
+/* ---- The model split on S and its UVs (spec P11 steps 4, 6, 7) ---- */
 
-static void tt__refined_free(const tt_allocator *allocator, tt__refined *r)
-{
-    tt_mesh_free(r->mesh);
-    tt__free(allocator, r->source);
-    tt__free(allocator, r->weight);
-    tt__free(allocator, r->face);
-    memset(r, 0, sizeof *r);
-}
+#define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
+                                       above the records' snap (1e-6), far below any real piece */
+#define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
+#define TT__MAP_SNAP 1e-5f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
+#define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
 
-/* The sources of the midpoint of refined vertices a and b: half of each,
-   the same input vertices added up (at most 3 distinct: both lie on one
-   input triangle). */
-static void tt__refined_midpoint_sources(const int *source, const double *weight, int a, int b, int out_source[3],
-                                         double out_weight[3])
-{
-    int n = 0, i, j, k;
-    for (k = 0; k < 3; k++) {
-        out_source[k] = source[3 * a];
-        out_weight[k] = 0.0;
-    }
-    for (i = 0; i < 6; i++) {
-        int v = source[3 * (i < 3 ? a : b) + i % 3];
-        double w = 0.5 * weight[3 * (i < 3 ? a : b) + i % 3];
-        if (w == 0.0) continue;
-        for (j = 0; j < n && out_source[j] != v; j++) continue;
-        if (j == n) {
-            if (n == 3) continue;
-            out_source[n++] = v;
-        }
-        out_weight[j] += w;
-    }
-}
+/* A point on a triangle's boundary (a model vertex or a split point of an
+   edge) and the boundary segment from it to the next point: the quad the
+   segment lies in, both ends in that quad's frame, the map of that frame
+   into the triangle's chart, and the point in the chart. */
+typedef struct tt__split_point {
+    int vertex;                 /* output vertex */
+    int quad;
+    double a[2], b[2];
+    tt_quad_map map;
+    double at[2];
+    int used;                   /* a corner of some piece (tt__split_pieces) */
+} tt__split_point;
 
-#define TT__REFINE_MAX_TRIANGLES (1 << 24)   /* refining stops short of this many triangles */
-
-static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
-                                     tt__refined *out, tt_error *error)
-{
-    float *positions = NULL;
-    int *triangles = NULL, *faces = NULL, *source = NULL, *mid = NULL, *next_triangles = NULL, *next_faces = NULL;
-    double *weight = NULL;
-    int nverts = mesh->nverts, ntriangles = mesh->nfaces, vertex_capacity = 0, pass, c, v, f;
-    tt_mesh *current = NULL;
-    tt_result result = TT_OK;
-    memset(out, 0, sizeof *out);
-    positions = (float *)tt__grow(allocator, NULL, &vertex_capacity, nverts > 0 ? nverts : 1, 3 * sizeof(float));
-    source = TT__ALLOC(allocator, int, 3 * (size_t)vertex_capacity);
-    weight = TT__ALLOC(allocator, double, 3 * (size_t)vertex_capacity);
-    triangles = TT__ALLOC(allocator, int, 3 * (size_t)ntriangles);
-    faces = TT__ALLOC(allocator, int, ntriangles);
-    if (!positions || !source || !weight || !triangles || !faces) goto out_of_memory;
-    memcpy(positions, mesh->pos, sizeof(float) * 3 * (size_t)nverts);
-    for (v = 0; v < nverts; v++) {
-        source[3 * v] = source[3 * v + 1] = source[3 * v + 2] = v;
-        weight[3 * v] = 1.0;
-        weight[3 * v + 1] = weight[3 * v + 2] = 0.0;
-    }
-    memcpy(triangles, mesh->corner_vert, sizeof(int) * 3 * (size_t)ntriangles);
-    for (f = 0; f < ntriangles; f++) faces[f] = f;
-    for (pass = 0;; pass++) {
-        tt_mesh_desc desc;
-        int marked = 0, next_count = 0;
-        memset(&desc, 0, sizeof desc);
-        desc.positions = positions;
-        desc.nverts = nverts;
-        desc.indices = triangles;
-        desc.nfaces = ntriangles;
-        desc.fixed_face_size = 3;
-        desc.flags = mesh->flags & TT_MESH_PERMISSIVE;
-        if ((result = tt_mesh_build(&desc, allocator, &current, error)) != TT_OK) goto failed;
-        mid = TT__ALLOC(allocator, int, current->ncorners);
-        if (!mid) goto out_of_memory;
-        for (c = 0; c < current->ncorners; c++) {
-            int a = current->corner_vert[c], b = current->corner_vert[tt_mesh_next(current, c)], twin = current->twin[c];
-            double d2 = 0.0;
-            int k;
-            for (k = 0; k < 3; k++) d2 += ((double)positions[3 * b + k] - positions[3 * a + k]) *
-                                          ((double)positions[3 * b + k] - positions[3 * a + k]);
-            mid[c] = -1;
-            if (d2 <= longest * longest) continue;
-            marked++;
-            if (twin >= 0 && twin < c) {
-                mid[c] = mid[twin];
-                continue;
-            }
-            if (nverts == vertex_capacity) {
-                int capacity = vertex_capacity, *grown_source;
-                float *grown_positions;
-                double *grown_weight;
-                if (nverts >= INT_MAX / 4) goto too_large;
-                grown_positions = (float *)tt__grow(allocator, positions, &capacity, nverts + 1, 3 * sizeof(float));
-                if (!grown_positions) goto out_of_memory;
-                positions = grown_positions;
-                capacity = vertex_capacity;
-                grown_source = (int *)tt__grow(allocator, source, &capacity, nverts + 1, 3 * sizeof(int));
-                if (!grown_source) goto out_of_memory;
-                source = grown_source;
-                capacity = vertex_capacity;
-                grown_weight = (double *)tt__grow(allocator, weight, &capacity, nverts + 1, 3 * sizeof(double));
-                if (!grown_weight) goto out_of_memory;
-                weight = grown_weight;
-                vertex_capacity = capacity;
-            }
-            for (k = 0; k < 3; k++)
-                positions[3 * nverts + k] = (float)(0.5 * ((double)positions[3 * a + k] + positions[3 * b + k]));
-            tt__refined_midpoint_sources(source, weight, a, b, source + 3 * nverts, weight + 3 * nverts);
-            mid[c] = nverts++;
-        }
-        if (!marked || ntriangles > TT__REFINE_MAX_TRIANGLES / 4) break;
-        if (ntriangles > (INT_MAX / 3) / 4) goto too_large;
-        next_triangles = TT__ALLOC(allocator, int, 12 * (size_t)ntriangles);
-        next_faces = TT__ALLOC(allocator, int, 4 * (size_t)ntriangles);
-        if (!next_triangles || !next_faces) goto out_of_memory;
-        for (f = 0; f < ntriangles; f++) {
-            int r, split = 0, *t;
-            const int *corner = triangles + 3 * f, *m = mid + 3 * f;
-            for (r = 0; r < 3; r++) split += m[r] >= 0;
-            /* Turn the triangle so its split edges come first: (a, b) always split when any is. */
-            for (r = 0; r < 3 && split > 0 && split < 3; r++)
-                if (m[r] >= 0 && m[(r + 2) % 3] < 0) break;
-            if (split == 0 || split == 3) r = 0;
-            {
-                int a = corner[r], b = corner[(r + 1) % 3], cc = corner[(r + 2) % 3];
-                int ab = m[r], bc = m[(r + 1) % 3], ca = m[(r + 2) % 3], add[12], n = 0, k;
-                if (split == 0) {
-                    add[n++] = a; add[n++] = b; add[n++] = cc;
-                } else if (split == 1) {
-                    add[n++] = a; add[n++] = ab; add[n++] = cc;
-                    add[n++] = ab; add[n++] = b; add[n++] = cc;
-                } else if (split == 2) {
-                    /* (a, b) and (b, c) split: the corner at b, then the quad a, ab, bc, c by its shorter
-                       diagonal. */
-                    double d_a = 0.0, d_c = 0.0;
-                    for (k = 0; k < 3; k++) {
-                        d_a += ((double)positions[3 * a + k] - positions[3 * bc + k]) *
-                               ((double)positions[3 * a + k] - positions[3 * bc + k]);
-                        d_c += ((double)positions[3 * cc + k] - positions[3 * ab + k]) *
-                               ((double)positions[3 * cc + k] - positions[3 * ab + k]);
-                    }
-                    add[n++] = ab; add[n++] = b; add[n++] = bc;
-                    if (d_a <= d_c) {
-                        add[n++] = a; add[n++] = ab; add[n++] = bc;
-                        add[n++] = a; add[n++] = bc; add[n++] = cc;
-                    } else {
-                        add[n++] = a; add[n++] = ab; add[n++] = cc;
-                        add[n++] = ab; add[n++] = bc; add[n++] = cc;
-                    }
-                } else {
-                    add[n++] = a; add[n++] = ab; add[n++] = ca;
-                    add[n++] = ab; add[n++] = b; add[n++] = bc;
-                    add[n++] = ca; add[n++] = bc; add[n++] = cc;
-                    add[n++] = ab; add[n++] = bc; add[n++] = ca;
-                }
-                t = next_triangles + 3 * next_count;
-                memcpy(t, add, sizeof(int) * (size_t)n);
-                for (k = 0; k < n / 3; k++) next_faces[next_count++] = faces[f];
-            }
-        }
-        tt__free(allocator, triangles);
-        tt__free(allocator, faces);
-        tt__free(allocator, mid);
-        tt_mesh_free(current);
-        current = NULL;
-        mid = NULL;
-        triangles = next_triangles;
-        faces = next_faces;
-        next_triangles = next_faces = NULL;
-        ntriangles = next_count;
-    }
-    tt__free(allocator, mid);
-    tt__free(allocator, triangles);
-    tt__free(allocator, positions);
-    out->mesh = current;
-    out->source = source;
-    out->weight = weight;
-    out->face = faces;
-    return TT_OK;
-too_large:
-    result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                      "refining the model's triangles to edges of at most %g would pass %d vertices or "
-                      "triangles: choose a larger max_edge or a coarser polycube", longest, INT_MAX / 4);
-    goto failed;
-out_of_memory:
-    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory refining the model");
-failed:
-    tt_mesh_free(current);
-    tt__free(allocator, mid);
-    tt__free(allocator, next_triangles);
-    tt__free(allocator, next_faces);
-    tt__free(allocator, triangles);
-    tt__free(allocator, faces);
-    tt__free(allocator, positions);
-    tt__free(allocator, source);
-    tt__free(allocator, weight);
-    return result;
-}
+typedef struct tt__split_cell {
+    int quad;                   /* -1: not known yet */
+    tt_quad_map map;
+} tt__split_cell;
 
 /* A vertex of a piece while the chart triangle is clipped: a corner of the
    triangle, a cut of side `index` by the grid line x[axis] = bound, or a
@@ -17039,10 +17041,8 @@ static double tt__split_area3(const tt__split *S, int a, int b, const double p[3
         u[k] = (double)x[k] - p[k];
         v[k] = (double)y[k] - p[k];
     }
-    n[0] = u[1] * v[2] - u[2] * v[1];
-    n[1] = u[2] * v[0] - u[0] * v[2];
-    n[2] = u[0] * v[1] - u[1] * v[0];
-    return 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    tt__cross3(u, v, n);
+    return 0.5 * tt__length3(n);
 }
 
 /* P11 step 4.3, for a triangle whose chart does not close or is not flat
