@@ -2554,6 +2554,7 @@ typedef struct tt_polycube_map_report {
     int split_triangles;    /* input triangles cut into two or more output triangles */
     int fallback_triangles; /* of `triangles`, those put whole into one quad (P11 step 7): a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold of the projection) */
+    int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
 } tt_polycube_map_report;
 
 typedef struct tt_polycube_mapping {
@@ -17051,8 +17052,12 @@ static double tt__split_area3(const tt__split *S, int a, int b, const double p[3
    is the fan from V over its boundary, each boundary segment with V a
    triangle inside that segment's quad. It holds when the angles at V add
    up to V's full angle (a quarter turn per quad: V inside) or V is on the
-   boundary, and every fan triangle of non-zero area on the model turns
-   counter-clockwise on S (else the projection folds there). A V inside
+   boundary, and no fan triangle of non-zero area on the model turns
+   clockwise on S (the projection folds there). One of zero area on S is
+   kept: where two edges of the triangle pass through V (a point next to a
+   saddle of S, whose shortest paths to both sides run through it), the
+   corner between them collapses onto a line, a sliver of stretched
+   texture rather than the seam of the fallback. A V inside
    becomes a new output vertex at the boundary's mean value coordinates
    seen from V (exact where S is flat), so it lies on the triangle and the
    fan covers it exactly. 1 when done, 0 when no V works, -1 when out of
@@ -17123,7 +17128,7 @@ static int tt__split_star(tt__split *S, int f, double area, int *pieces)
             }
             tt__quad_corner_st(tt__quad_corner_of(s, S->boundary[i].quad, apex), v);
             tt__split_segment_from(S, i, v, x, y);
-            holds = x[0] * y[1] - x[1] * y[0] > TT__SPLIT_AREA;
+            holds = x[0] * y[1] - x[1] * y[0] >= -TT__SPLIT_AREA;
         }
         if (!holds) continue;
         if (centre < 0 && (centre = tt__split_vertex(S, S->vert, weight)) < 0) return -1;
@@ -17347,7 +17352,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         const tt_surface_point *p = S.out->corner_points + 3 * j;
         double turn = ((double)p[1].s - p[0].s) * ((double)p[2].t - p[0].t) -
                       ((double)p[1].t - p[0].t) * ((double)p[2].s - p[0].s);
-        report->flipped += turn <= 0.0;
+        report->flipped += turn < -TT__SPLIT_AREA;
+        report->collapsed += fabs(turn) <= TT__SPLIT_AREA;
     }
     tt__free(allocator, S.crossing_vertex);
     tt__free(allocator, S.boundary);

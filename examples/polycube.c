@@ -317,8 +317,9 @@ static void print_summary(const polycube_command_options *options, const polycub
     if (b->mesh_genus < 0) printf(" (the mesh's: not closed)\n");
     else if (b->genus_differs) printf(" (the mesh's %d: they differ)\n", b->mesh_genus);
     else printf(" (as the mesh)\n");
-    printf("mapping: %d triangles, %d split, %d fallback, %d failed edges, %d flipped", job->mapping->ntriangles,
-           m->split_triangles, m->fallback_triangles, m->failed_edges, m->flipped);
+    printf("mapping: %d triangles, %d split, %d fallback, %d failed edges, %d flipped, %d collapsed",
+           job->mapping->ntriangles, m->split_triangles, m->fallback_triangles, m->failed_edges, m->flipped,
+           m->collapsed);
     /* The library halves edges longer than half a cube first, so that no
        triangle holds several corners of the polycube. */
     if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
