@@ -16133,29 +16133,36 @@ static int tt__relax_place_near(const tt_polycube *pc, int centre, tt_surface_po
 /* How badly vertex v sits among its triangles with its point at `at` in
    the chart around it: each triangle whose other points lie outside the
    chart (their edge has no short path on S) counts 2, each one turning
-   clockwise on S (a fold) counts 1. */
-static int tt__relax_badness(const tt_mesh *model, const tt_surface_point *points, const int *first_triangle,
-                             const int *triangle_corners, int v, const tt__relax_chart *c, const double at[2])
+   clockwise on S (a fold) counts 1, and the folded area breaks ties, so a
+   move that only shrinks a fold still counts as progress. */
+static double tt__relax_badness(const tt_mesh *model, const tt_surface_point *points, const int *first_triangle,
+                                const int *triangle_corners, int v, const tt__relax_chart *c, const double at[2])
 {
     int i, bad = 0;
+    double folded = 0.0;
     for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
         int corner = triangle_corners[i], f = corner / 3, k = corner % 3;
         int u = model->corner_vert[3 * f + (k + 1) % 3], w = model->corner_vert[3 * f + (k + 2) % 3];
-        double pu[2], pw[2];
+        double pu[2], pw[2], turn;
         if (!tt__relax_chart_place(c, points[u], pu) || !tt__relax_chart_place(c, points[w], pw)) {
             bad += 2;
             continue;
         }
-        bad += (pu[0] - at[0]) * (pw[1] - at[1]) - (pu[1] - at[1]) * (pw[0] - at[0]) <= 0.0;
+        turn = (pu[0] - at[0]) * (pw[1] - at[1]) - (pu[1] - at[1]) * (pw[0] - at[0]);
+        if (turn <= 0.0) {
+            bad++;
+            folded -= turn;
+        }
     }
-    return bad;
+    /* The count first; among equal counts, less folded area (in (0, 1), so it never outweighs a triangle). */
+    return bad + 0.9 * folded / (1.0 + folded);
 }
 
 /* Spec P11 step 5: points that leave a triangle folded on S or its edge
    without a short path (a vertex projected onto the wrong sheet, a fold
    in a concavity) are moved, a few sweeps over the vertices in order:
-     - toward the mean of its neighbours' points (half way), in a local
-       chart of S around it, when they all lie in it;
+     - toward the mean of its neighbours' points (half way, or all the
+       way), in a local chart of S around it, when they all lie in it;
      - else to the closest point to its 3D position on the quads around a
        neighbour's point (onto its neighbours' sheet);
    a move is kept only when it leaves the vertex's triangles less badly
@@ -16204,7 +16211,8 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         }
         for (v = 0; v < nverts; v++) {
             double at[2], mean[2] = {0.0, 0.0}, here[3], candidate_at[2];
-            int i, n = 0, reachable = 1, before, best_bad, a;
+            int i, n = 0, reachable = 1, a, step;
+            double before, best_bad;
             tt_surface_point best, candidate;
             if (!bad[v]) continue;
             tt_polycube_point_position(pc, points[v], here);
@@ -16231,30 +16239,33 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                     }
                 }
             }
-            if (reachable && n > 0) {
-                candidate_at[0] = at[0] + 0.5 * (mean[0] / n - at[0]);
-                candidate_at[1] = at[1] + 0.5 * (mean[1] / n - at[1]);
+            for (step = 1; step <= 2 && reachable && n > 0; step++) {
+                candidate_at[0] = at[0] + 0.5 * step * (mean[0] / n - at[0]);
+                candidate_at[1] = at[1] + 0.5 * step * (mean[1] / n - at[1]);
+                tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
                 if (tt__relax_chart_point(chart, candidate_at, &candidate)) {
-                    int after;
+                    double after;
                     tt_surface_point kept = points[v];
                     points[v] = candidate;
                     tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
                     tt__relax_chart_place(chart, candidate, candidate_at);
                     after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, candidate_at);
                     points[v] = kept;
-                    if (after < best_bad) {
+                    if (after < best_bad - 1e-12) {
                         best_bad = after;
                         best = candidate;
                     }
                 }
-            } else {
+            }
+            if (!reachable || n == 0) {
                 /* Onto a neighbour's sheet: the closest point to v on the quads around each neighbour's. */
                 double lattice[3];
                 for (a = 0; a < 3; a++) lattice[a] = ((double)model->pos[3 * v + a] - pc->origin[a]) / pc->h;
                 for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
                     int corner = triangle_corners[i], f = corner / 3, k, q, j;
                     for (k = 1; k < 3; k++) {
-                        int u = model->corner_vert[3 * f + (corner % 3 + k) % 3], after;
+                        int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
+                        double after;
                         double nearest = HUGE_VAL;
                         tt__relax_chart around;
                         tt_surface_point kept = points[v];
@@ -16282,14 +16293,14 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                         after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart,
                                                   candidate_at);
                         points[v] = kept;
-                        if (after < best_bad) {
+                        if (after < best_bad - 1e-12) {
                             best_bad = after;
                             best = candidate;
                         }
                     }
                 }
             }
-            if (best_bad < before) {
+            if (best_bad < before - 1e-12) {
                 points[v] = best;
                 moved++;
             }
