@@ -2025,7 +2025,7 @@ static void test_map_uvs_and_seams(void)
                 printf("     %s mapped and textured: seam %.3f on tile borders, %.3f over all edges; shuffled "
                        "%.3f, %.3f; %d fallbacks\n", shape ? "sphere" : "cube", fit_border.score, fit_all.score,
                        control_border.score, control_all.score, rep.fallback_triangles);
-                CHECK(fit_border.score <= (shape ? 0.1 : 0.05) && fit_all.score <= 0.05,
+                CHECK(fit_border.score <= 0.05 && fit_all.score <= 0.05,
                       "%s seamless: %.3f on tile borders, %.3f over all edges", shape ? "sphere" : "cube",
                       fit_border.score, fit_all.score);
                 CHECK(control_border.score >= 0.8 && control_all.score >= 0.8,
