@@ -16950,8 +16950,10 @@ static int tt__split_pieces(tt__split *S, int f, int *pieces)
     int k, x, y, ncells, i;
     area2 = (S->corner[1][0] - S->corner[0][0]) * (S->corner[2][1] - S->corner[0][1]) -
             (S->corner[1][1] - S->corner[0][1]) * (S->corner[2][0] - S->corner[0][0]);
-    if (fabs(area2) <= 2.0 * TT__SPLIT_AREA) return 0;
-    orient = area2 > 0.0 ? 1.0 : -1.0;
+    /* A chart turning clockwise is a fold of the projection the relaxation could not open: its pieces would
+       show the texture mirrored; the fallback does not. */
+    if (area2 <= 2.0 * TT__SPLIT_AREA) return 0;
+    orient = 1.0;
     for (k = 0; k < 2; k++) {
         lo[k] = hi[k] = S->corner[0][k];
         if (S->corner[1][k] < lo[k]) lo[k] = S->corner[1][k];
@@ -17167,15 +17169,29 @@ static int tt__split_star(tt__split *S, int f, double area, int *pieces)
     return 0;
 }
 
-/* P11 step 7: triangle f whole in vertex 0's quad, its boundary (vertices
-   and split points, so the neighbours meet it) fanned from its centroid,
-   each point projected orthogonally onto the quad's plane and clamped to
-   the quad. 0 when out of memory. */
+/* P11 step 7: triangle f whole in one quad - of its vertices' quads, the
+   one facing most like it - its boundary (vertices and split points, so
+   the neighbours meet it) fanned from its centroid, each point projected
+   orthogonally onto the quad's plane and clamped to the quad. 0 when out
+   of memory. */
 static int tt__split_fallback(tt__split *S, int f)
 {
     const tt_polycube *pc = S->pc;
     int quad = S->points[S->vert[0]].quad, ids[3], i, n = 0, centre = -1, k;
-    double st[3][2];
+    double st[3][2], edge1[3], edge2[3], normal[3], best = -HUGE_VAL;
+    /* Of its vertices' quads, the one facing most like the triangle: projected onto that quad's plane the
+       triangle keeps its turn wherever it can. */
+    tt__sub3f(S->mesh->pos + 3 * S->vert[1], S->mesh->pos + 3 * S->vert[0], edge1);
+    tt__sub3f(S->mesh->pos + 3 * S->vert[2], S->mesh->pos + 3 * S->vert[0], edge2);
+    tt__cross3(edge1, edge2, normal);
+    for (k = 0; k < 3; k++) {
+        int candidate = S->points[S->vert[k]].quad, side = pc->quad_side[candidate];
+        double facing = (side % 2 ? -1.0 : 1.0) * normal[side / 2];
+        if (facing > best) {
+            best = facing;
+            quad = candidate;
+        }
+    }
     for (i = 0; i < S->nboundary; i++) {
         int id = S->boundary[i].vertex;
         if (n > 0 && S->boundary[n - 1].vertex == id) continue;
