@@ -2569,48 +2569,71 @@ typedef struct tt_polycube_mapping {
     tt_allocator allocator; /* the one it was made with */
 } tt_polycube_mapping;
 
-/* Map `mesh` (triangles; the mesh the polycube was built from, or any
-   other near its surface) onto S: tt_polycube_project (points within
-   1e-6 of a quad's edge are put on it), then tt_polycube_trace_edges, then
-   per triangle:
-     - its boundary (its vertices and its edges' split points, from the
-       records) is unfolded into one chart from its first vertex's quad;
-       where an edge runs along an edge of S the quad on the triangle's side
-       is taken, and the quads follow each other across S's edges, or
-       clockwise around a vertex of S (through the triangle's side);
-     - when the chart closes (back in the first quad, in the same frame)
-       and every split point lies on the straight chart triangle (no cone
-       point of S inside, no bend at a saddle), the chart triangle is
-       clipped by the unit grid of the chart (Sutherland-Hodgman) into
-       convex pieces, one per quad, each fanned into triangles; the quads
-       of the grid cells are found by walking across S's edges from the
-       boundary's quads, and must agree. A cut of a side is that side's
-       split point on the grid line (the record's numbers, so the
-       neighbour's split is the same), a grid point inside interpolates
-       the triangle's vertices with its barycentric coordinates; every
-       split point must end up a corner of a piece;
-     - otherwise, when every quad the boundary passes is around one vertex
-       V of S and the boundary winds once around V (a cone point inside)
-       or passes through it (a bend), the triangle is the fan from V over
-       its boundary, each fan triangle in its segment's quad; a V inside
-       becomes a vertex at the boundary's mean value coordinates seen from
-       V, which lie on the triangle;
-     - otherwise (an edge with no path, a fold of the projection, several
-       cones) the triangle keeps its boundary, so its neighbours still
-       meet it without a crack, and is fanned from its centroid into the
-       quad of its first vertex, the points on S projected orthogonally
-       onto that quad's plane and clamped to it (P11 step 7): a local
-       seam, counted in fallback_triangles.
+/* Map `mesh` (triangles, outward facing; the mesh the polycube was built
+   from, or any other near its surface) onto S:
+     1. refinement: edges longer than max_edge (half a cube by default)
+        are halved until none is, so a triangle spans few quads and holds
+        about one vertex of S at most;
+     2. tt_polycube_project (points within 1e-5 of a quad's edge are put
+        on it, so the model's vertices on lattice lines are on S's edges
+        exactly);
+     3. relaxation (P11 step 5): points of folded triangles move toward
+        their neighbours' in a local chart of S, points cut off from their
+        neighbours (no short path) onto a neighbour's sheet, a move kept
+        only when it leaves the vertex's triangles better placed;
+     4. tt_polycube_trace_edges (max_quads);
+     5. per triangle, the split (P11 step 4):
+        - its boundary (its vertices and its edges' split points, from
+          the records) is unfolded into one chart from its first vertex's
+          quad; where an edge runs along an edge of S the quad on the
+          triangle's side is taken, and the quads follow each other across
+          S's edges, or clockwise around a vertex of S (through the
+          triangle's side);
+        - when the chart closes (back in the first quad, in the same
+          frame), turns counter-clockwise and every split point lies on
+          the straight chart triangle (no cone point of S inside, no bend
+          at a saddle), the chart triangle is clipped by the unit grid of
+          the chart (Sutherland-Hodgman) into convex pieces, one per quad,
+          each fanned into triangles; the quads of the grid cells are found
+          by walking across S's edges from the boundary's quads, and must
+          agree. A cut of a side is that side's split point on the grid
+          line (the record's numbers, so the neighbour's split is the
+          same), a grid point inside interpolates the triangle's vertices
+          with its barycentric coordinates; every split point must end up
+          a corner of a piece;
+        - otherwise, when every quad the boundary passes is around one
+          vertex V of S and the boundary winds once around V (a cone point
+          inside) or passes through it (a bend), the triangle is the fan
+          from V over its boundary, each fan triangle in its segment's
+          quad (one may collapse to a line on S: counted in collapsed); a
+          V inside becomes a vertex at the boundary's mean value
+          coordinates seen from V, which lie on the triangle;
+        - otherwise (an edge with no path, a fold the relaxation could not
+          open, several cones) the triangle keeps its boundary, so its
+          neighbours still meet it without a crack, and is fanned from its
+          centroid into one quad - of its vertices' quads, the one facing
+          most like it - the points projected orthogonally onto that
+          quad's plane and clamped to it (P11 step 7): a local seam,
+          counted in fallback_triangles.
    Every split point of an edge is one output vertex shared by the two
    triangles on the edge: a closed manifold model gives a closed manifold
    output. Pieces of zero area (an edge along a lattice line) are dropped;
-   the output's area equals the input's. report may be NULL.
+   the output's area equals the input's. An inside-out mesh
+   (tt_polycube_report::inside_out) must be reversed first: the points go
+   to the wrong sides of thin parts and every chart turns clockwise.
+   Measured (-O2, default options, resolution 32): a 100k-triangle torus
+   in about 0.4 s (make bench) with no fallback and no flip; the bunny
+   (3.7k triangles, 51k refined) in 0.3 s with 0.04 % fallbacks; a CAD
+   flange 0.2 %. report may be NULL.
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
-   a face that is not a triangle (error->face; triangulate first), or a
-   polycube not made by tt_polycube_build; TT_ERROR_EMPTY_MESH;
-   TT_ERROR_NON_FINITE; TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL,
-   the report zeroed, and nothing stays allocated. Free the result with
+   max_edge not above 0, a face that is not a triangle (error->face;
+   triangulate first), or a polycube not made by tt_polycube_build;
+   TT_ERROR_EMPTY_MESH; TT_ERROR_NON_FINITE; TT_ERROR_TOO_LARGE when the
+   refinement would pass INT_MAX / 4 vertices; TT_ERROR_OUT_OF_MEMORY. On
+   failure *out is NULL, the report zeroed, and nothing stays allocated.
+   Memory: the refined model and the edge records (about 100 bytes per
+   refined triangle) while it runs, and the result. Free the result with
    tt_polycube_mapping_free. Same input, same output; thread-safe. */
 TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
                                 const tt_polycube_map_options *options, const tt_allocator *allocator,

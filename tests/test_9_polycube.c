@@ -2104,11 +2104,19 @@ static void test_map_determinism_and_errors(void)
               tt_polycube_map(pc, NULL, NULL, NULL, &none, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
               tt_polycube_map(pc, mesh, NULL, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
           "NULL polycube, mesh or out: invalid, *out NULL");
+    memset(&mo, 0, sizeof mo);
     mo.max_quads = TT_POLYCUBE_EDGE_MAX_QUADS + 1;
     none = (tt_polycube_mapping *)&none;
     r = tt_polycube_map(pc, mesh, &mo, NULL, &none, &rep, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && none == NULL && rep.flipped == 0 && rep.projection.rays == 0,
           "max_quads out of range: invalid, the report zeroed (%s)", err.message);
+    mo.max_quads = 0;
+    mo.max_edge = -1.0;
+    r = tt_polycube_map(pc, mesh, &mo, NULL, &none, &rep, &err);
+    mo.max_edge = internal_not_a_number();
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && none == NULL &&
+              tt_polycube_map(pc, mesh, &mo, NULL, &none, &rep, &err) == TT_ERROR_INVALID_ARGUMENT && none == NULL,
+          "max_edge negative or NaN: invalid (%s)", err.message);
     memset(&quads, 0, sizeof quads);
     make_cube_set(&quads, &one, 1, 1, 1, 1.0, 0);
     if (build(&quads, 0, &quad_mesh, &err) == TT_OK) {
