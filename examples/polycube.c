@@ -199,10 +199,15 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
         tool_note("%s: the polycube has genus %d, the mesh %d: handles are closed or opened where the cubes are "
                   "too coarse (raise --resolution)",
                   path, job->build_report.polycube_genus, job->build_report.mesh_genus);
-    if (job->build_report.inside_out)
-        tool_note("%s: the faces wind inward (the mesh is inside out), so vertices may go onto the wrong side of "
-                  "the polycube: reverse the order of every face's corners",
-                  path);
+    if (job->build_report.inside_out) {
+        /* The mapping needs outward faces (its projection tells the sides of a thin part by the normals, and
+           the polycube's squares turn counter-clockwise seen from outside): map the faces reversed, and write
+           them so. */
+        int status = triangle_mesh_reverse(path, &job->mesh);
+        if (status != 0) return status;
+        tool_note("%s: the faces wind inward (the mesh is inside out): mapped them reversed, and the output's "
+                  "faces wind outward", path);
+    }
 
     ncorners = job->polycube->surface->ncorners;
     job->edge_colors = (int *)malloc((size_t)ncorners * sizeof(int));

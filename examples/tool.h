@@ -405,6 +405,10 @@ typedef struct triangle_mesh {
    error (*m is then empty). */
 int triangle_mesh_read(const char *path, triangle_mesh *m);
 void triangle_mesh_free(triangle_mesh *m);
+/* Reverse every triangle's corners (an inside-out mesh turned outward) and
+   build the mesh again. Returns 0, or the exit status after printing the
+   error. */
+int triangle_mesh_reverse(const char *path, triangle_mesh *m);
 
 /* A library error about the triangles said the OBJ's way: the library counts
    faces from 0 and means the triangles. rewrite_face writes error->message

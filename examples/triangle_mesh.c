@@ -20,13 +20,34 @@ void triangle_mesh_free(triangle_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
+/* (Re)build m->mesh from m->vert; a build error is said about the OBJ's
+   face. */
+static int triangle_mesh_build(const char *path, triangle_mesh *m)
+{
+    tt_mesh_desc desc;
+    tt_error error;
+    tt_mesh_free(m->mesh);
+    m->mesh = NULL;
+    memset(&desc, 0, sizeof desc);
+    desc.positions = m->obj.pos;
+    desc.nverts = m->obj.nverts;
+    desc.indices = m->vert;
+    desc.nfaces = m->ntriangles;
+    desc.fixed_face_size = 3;
+    if (tt_mesh_build(&desc, NULL, &m->mesh, &error) != TT_OK) {
+        /* Say it about the OBJ's faces, which the user can find. */
+        if (error.face >= 0 && error.face < m->ntriangles) error.face = m->face[error.face];
+        if (error.other_face >= 0 && error.other_face < m->ntriangles) error.other_face = m->face[error.other_face];
+        return obj_report_mesh_error(path, &m->obj, &error, 0);
+    }
+    return 0;
+}
+
 /* Read the OBJ, split its faces into triangle fans and build those. */
 int triangle_mesh_read(const char *path, triangle_mesh *m)
 {
     char message[TOOL_ERROR_SIZE];
-    tt_mesh_desc desc;
-    tt_error error;
-    int c, t, total;
+    int c, t, total, status;
     memset(m, 0, sizeof *m);
     if (obj_read(path, &m->obj, message, sizeof message) != 0) return tool_fail("%s", message);
     total = m->ntriangles = obj_triangle_fans(&m->obj, &m->corner, &m->face);
@@ -40,23 +61,22 @@ int triangle_mesh_read(const char *path, triangle_mesh *m)
     }
     for (c = 0; c < 3 * total; c++) m->vert[c] = m->obj.corner_vert[m->corner[c]];
     for (t = total - 1; t >= 0; t--) m->first_triangle[m->face[t]] = t;
+    if ((status = triangle_mesh_build(path, m)) != 0) triangle_mesh_free(m);
+    return status;
+}
 
-    memset(&desc, 0, sizeof desc);
-    desc.positions = m->obj.pos;
-    desc.nverts = m->obj.nverts;
-    desc.indices = m->vert;
-    desc.nfaces = total;
-    desc.fixed_face_size = 3;
-    if (tt_mesh_build(&desc, NULL, &m->mesh, &error) != TT_OK) {
-        int status;
-        /* Say it about the OBJ's faces, which the user can find. */
-        if (error.face >= 0 && error.face < total) error.face = m->face[error.face];
-        if (error.other_face >= 0 && error.other_face < total) error.other_face = m->face[error.other_face];
-        status = obj_report_mesh_error(path, &m->obj, &error, 0);
-        triangle_mesh_free(m);
-        return status;
+int triangle_mesh_reverse(const char *path, triangle_mesh *m)
+{
+    int t;
+    for (t = 0; t < m->ntriangles; t++) {
+        int swap = m->vert[3 * t + 1];
+        m->vert[3 * t + 1] = m->vert[3 * t + 2];
+        m->vert[3 * t + 2] = swap;
+        swap = m->corner[3 * t + 1];
+        m->corner[3 * t + 1] = m->corner[3 * t + 2];
+        m->corner[3 * t + 2] = swap;
     }
-    return 0;
+    return triangle_mesh_build(path, m);
 }
 
 /* The library's "face N" is the Nth triangle counted from 0: replace the

@@ -933,6 +933,26 @@ cd "$W" || exit 1
 polycube_case "sphere --up -z --no-correct" spheretri.obj 1 --resolution 6 --up -z --no-correct
 polycube_case "sphere --up 1,2,0" spheretri.obj 1 --resolution 6 --up 1,2,0
 
+# an inside-out mesh (every face's corners reversed): mapped reversed, said on stderr, and written outward
+awk '$1 == "f" { print "f", $2, $4, $3; next } { print }' "$W/in/spheretri.obj" >"$W/in/spheretri_inward.obj"
+# the signed volume of an OBJ's triangles (v and f lines; f corners as v or v/vt): > 0 when they wind outward
+obj_volume() {
+    awk '$1 == "v" { n++; x[n] = $2; y[n] = $3; z[n] = $4 }
+         $1 == "f" { split($2, a, "/"); split($3, b, "/"); split($4, c, "/"); i = a[1]; j = b[1]; k = c[1];
+                     v += x[i] * (y[j] * z[k] - z[j] * y[k]) - y[i] * (x[j] * z[k] - z[j] * x[k]) + z[i] * (x[j] * y[k] - y[j] * x[k]) }
+         END { printf "%.6f\n", v / 6 }' "$1"
+}
+polycube_case "inside-out sphere" spheretri_inward.obj 1 --resolution 6
+cd "$W/d$NEWDIR_N" || exit 1
+check "polycube inside-out sphere: one stderr line says it mapped the faces reversed" "'wind inward ... reversed'" \
+    "$ERR" "$(printf '%s' "$ERR" | grep -c 'faces wind inward.*mapped them reversed' | grep -qx 1; echo $?)"
+check "polycube inside-out sphere: the output winds outward (volume > 0; the input's < 0)" \
+    "out.obj $(obj_volume out.obj 2>/dev/null) > 0, input $(obj_volume ../in/spheretri_inward.obj) < 0" \
+    "$(obj_volume out.obj 2>&1)" \
+    "$(awk -v o="$(obj_volume out.obj 2>/dev/null)" -v i="$(obj_volume ../in/spheretri_inward.obj)" \
+        'BEGIN { exit !(o > 0 && i < 0) }'; echo $?)"
+cd "$W" || exit 1
+
 # the same seed twice: the same files; another seed: another result
 newdir
 expect_ok "polycube sphere again" polycube ../in/spheretri.obj ../in/tex.png out --tile 16 --colors 2 --resolution 8
