@@ -165,7 +165,6 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
                    const triangle_mesh *m, const float *corner_uv)
 {
     char comment[512];
-    tool_buffer text = TOOL_BUFFER_INIT;
     obj_write_desc desc;
     snprintf(comment, sizeof comment,
              "hierarchical pattern mapping by tiledtex %s (Soler et al.): texture coordinates into %s\n%s",
@@ -183,11 +182,7 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
     desc.corner_uv = corner_uv;
     desc.mtllib = mtl_name;
     desc.material = "hpm";
-    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, path, &text) != 0) {
-        buffer_free(&text);
-        return tool_fail("out of memory while writing %s", path);
-    }
-    return 0;
+    return output_add_obj(output, path, &desc);
 }
 
 /* ======================================================================== */

@@ -424,11 +424,9 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     tt_image *atlas = NULL;
     tt_bake_options bake;
     tt_error error;
-    tool_buffer text;
     obj_write_desc desc;
     int status = 0;
 
-    memset(&text, 0, sizeof text);
     snprintf(obj_path, sizeof obj_path, "%s_baked.obj", options->prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s_baked.mtl", options->prefix);
     snprintf(png_path, sizeof png_path, "%s_baked.png", options->prefix);
@@ -466,16 +464,12 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     desc.corner_uv = corner_uv;
     desc.mtllib = tool_basename(mtl_path);
     desc.material = "lapped_baked";
-    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, obj_path, &text) != 0) {
-        status = tool_fail("out of memory while writing %s", obj_path);
-        goto done;
-    }
+    if ((status = output_add_obj(output, obj_path, &desc)) != 0) goto done;
     status = output_add_mtl(output, mtl_path, "lapped_baked", png_path, 0);
     /* The baked texture holds linear straight RGBA: written as sRGB colour. */
     if (status == 0) status = add_png(output, png_path, atlas);
     atlas = NULL;   /* add_png freed it */
 done:
-    buffer_free(&text);
     tt_image_free(atlas);
     free(corner_uv);
     return status;

@@ -362,7 +362,6 @@ static void print_summary(const polycube_command_options *options, const polycub
 static int add_obj(tool_output *output, const char *path, const char *mtl_name, const polycube_job *job)
 {
     char comment[512];
-    tool_buffer text = TOOL_BUFFER_INIT;
     obj_write_desc desc;
     snprintf(comment, sizeof comment,
              "polycube texture by tiledtex %s (Chang and Lin): %d triangles over %d polycube quads of %.9g units,\n"
@@ -379,11 +378,7 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
     desc.corner_uv = job->corner_uv;
     desc.mtllib = mtl_name;
     desc.material = "tiled";
-    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, path, &text) != 0) {
-        buffer_free(&text);
-        return tool_fail("out of memory while writing %s", path);
-    }
-    return 0;
+    return output_add_obj(output, path, &desc);
 }
 
 /* OUT_PREFIX_polycube.obj: S with its own tiles, written the way `tile`

@@ -183,10 +183,8 @@ fail:
 
 int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name)
 {
-    tool_buffer text;
     obj_write_desc desc;
     char comment[256];
-    memset(&text, 0, sizeof text);
     memset(&desc, 0, sizeof desc);
     snprintf(comment, sizeof comment,
              "tiled texture by tiledtex %s: %d quads, %d colors, %d-texel tiles, gutter %d",
@@ -201,11 +199,7 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
     desc.corner_uv = mesh->corner_uv;
     desc.mtllib = mtl_name;
     desc.material = mtl_name ? "tiled" : NULL;
-    if (obj_write(&text, &desc) != 0 || output_add_buffer(output, obj_path, &text) != 0) {
-        buffer_free(&text);
-        return tool_fail("out of memory while writing %s", obj_path);
-    }
-    return 0;
+    return output_add_obj(output, obj_path, &desc);
 }
 
 int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name)

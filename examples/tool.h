@@ -373,6 +373,9 @@ typedef struct obj_write_desc {
    use 9 significant digits (tool_format_float), so floats read back exactly. Returns 0, or -1 on
    an invalid description or when the buffer ran out of memory. */
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
+/* obj_write into a new file of the batch; on failure (out of memory) one
+   line "out of memory while writing PATH" and the failure exit status. */
+int output_add_obj(tool_output *output, const char *path, const obj_write_desc *desc);
 
 /* Append one MTL material: "newmtl NAME", white diffuse colour, and
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also

@@ -401,6 +401,16 @@ int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer
     return output_add(output, path, data, size);
 }
 
+int output_add_obj(tool_output *output, const char *path, const obj_write_desc *desc)
+{
+    tool_buffer text = TOOL_BUFFER_INIT;
+    if (obj_write(&text, desc) != 0 || output_add_buffer(output, path, &text) != 0) {
+        buffer_free(&text);
+        return tool_fail("out of memory while writing %s", path);
+    }
+    return 0;
+}
+
 #define TEMPORARY_SUFFIX ".tiledtex-tmp"
 #define TEMPORARY_ATTEMPTS 100
 
