@@ -16712,16 +16712,15 @@ static int tt__split_walk(tt__split *S, int f, int *linked, int *chart)
 }
 
 /* The stretch of segment e0 -> e1 (in the chart) strictly inside the
-   triangle, as the parameter interval's length; the triangle's corners run
-   counter-clockwise when orient is 1, clockwise when -1. */
-static double tt__split_inside_length(const tt__split *S, double orient, const double e0[2], const double e1[2])
+   chart triangle (counter-clockwise), as the parameter interval's length. */
+static double tt__split_inside_length(const tt__split *S, const double e0[2], const double e1[2])
 {
     double lo = 0.0, hi = 1.0;
     int i;
     for (i = 0; i < 3; i++) {
         const double *a = S->corner[i], *b = S->corner[(i + 1) % 3];
-        double f0 = orient * ((b[0] - a[0]) * (e0[1] - a[1]) - (b[1] - a[1]) * (e0[0] - a[0])) - TT__SPLIT_AREA;
-        double f1 = orient * ((b[0] - a[0]) * (e1[1] - a[1]) - (b[1] - a[1]) * (e1[0] - a[0])) - TT__SPLIT_AREA;
+        double f0 = (b[0] - a[0]) * (e0[1] - a[1]) - (b[1] - a[1]) * (e0[0] - a[0]) - TT__SPLIT_AREA;
+        double f1 = (b[0] - a[0]) * (e1[1] - a[1]) - (b[1] - a[1]) * (e1[0] - a[0]) - TT__SPLIT_AREA;
         if (f0 <= 0.0 && f1 <= 0.0) return 0.0;
         if (f0 <= 0.0) {
             double u = f0 / (f0 - f1);
@@ -16749,7 +16748,7 @@ static tt__split_cell *tt__split_cell_at(tt__split *S, tt_quad_map map)
    across every side of S a known cell shares with a neighbour where the
    side passes through the triangle. 0 when two ways disagree: a cone point
    of S (3, 5 or 6 quads around it) inside the triangle. */
-static int tt__split_cells(tt__split *S, double orient)
+static int tt__split_cells(tt__split *S)
 {
     const tt_mesh *s = S->pc->surface;
     int ncells = S->box[2] * S->box[3], head = 0, tail = 0, i, k;
@@ -16773,7 +16772,7 @@ static int tt__split_cells(tt__split *S, double orient)
             tt__split_cell *cell;
             tt_quad_map map;
             tt__edge_in_plane(s, h, from.map, e0, e1);
-            if (tt__split_inside_length(S, orient, e0, e1) <= TT__EDGE_EPS) continue;
+            if (tt__split_inside_length(S, e0, e1) <= TT__EDGE_EPS) continue;
             map = tt_quad_map_compose(from.map, tt_polycube_unfold(S->pc, h));
             cell = tt__split_cell_at(S, map);
             if (!cell) continue;
@@ -16969,14 +16968,13 @@ static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const 
    when out of memory. */
 static int tt__split_pieces(tt__split *S, int f, int *pieces)
 {
-    double lo[2], hi[2], area2, orient;
+    double lo[2], hi[2], area2;
     int k, x, y, ncells, i;
     area2 = (S->corner[1][0] - S->corner[0][0]) * (S->corner[2][1] - S->corner[0][1]) -
             (S->corner[1][1] - S->corner[0][1]) * (S->corner[2][0] - S->corner[0][0]);
     /* A chart turning clockwise is a fold of the projection the relaxation could not open: its pieces would
        show the texture mirrored; the fallback does not. */
     if (area2 <= 2.0 * TT__SPLIT_AREA) return 0;
-    orient = 1.0;
     for (k = 0; k < 2; k++) {
         lo[k] = hi[k] = S->corner[0][k];
         if (S->corner[1][k] < lo[k]) lo[k] = S->corner[1][k];
@@ -16998,7 +16996,7 @@ static int tt__split_pieces(tt__split *S, int f, int *pieces)
         S->cell_capacity = S->cells && S->queue ? ncells : 0;
         if (!S->cell_capacity) return -1;
     }
-    if (!tt__split_cells(S, orient)) return 0;
+    if (!tt__split_cells(S)) return 0;
     S->ngrid = 0;
     *pieces = 0;
     for (i = 0; i < S->nboundary; i++) S->boundary[i].used = 0;
