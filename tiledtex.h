@@ -135,10 +135,12 @@
                   with tile orientation from an up direction (Sec. 3.1)
                 - the Wang colouring of S's edges per axis group, for the
                   tiled-textures boundary assignment (Sec. 3.2)
-                - the first steps of the mapping: each vertex of the model
-                  projected to a point of S, on the side its normal faces;
-                  each edge traced on S as a path of quads, with the exact
-                  unfolding of neighbouring quads into one plane (Sec. 4)
+                - the mapping, tt_polycube_map: the model refined, each
+                  vertex projected to a point of S on the side its normal
+                  faces, the points relaxed, each edge traced on S as a path
+                  of quads (exact unfoldings), each triangle split along S's
+                  quad edges into pieces inside one quad; the UVs from the
+                  tiles (Sec. 4)
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
