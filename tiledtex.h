@@ -16072,15 +16072,19 @@ typedef struct tt__relax_chart {
     int quad[TT__RELAX_CHART];
     tt_quad_map map[TT__RELAX_CHART];
     int cell[TT__RELAX_CHART][2];   /* the unit cell of the chart the quad covers */
+    int *index_of;      /* per quad of S: its place in quad[], or -1 (all -1 outside the chart) */
+    const tt_quad_map *unfold;  /* per half-edge of S: tt_polycube_unfold, made once */
 } tt__relax_chart;
 
 static void tt__relax_chart_build(const tt_polycube *pc, int centre, int radius, tt__relax_chart *c)
 {
     const tt_mesh *s = pc->surface;
-    int head = 0, ring_end, ring;
+    int head = 0, ring_end, ring, i;
     double middle[2];
+    for (i = 0; i < c->count; i++) c->index_of[c->quad[i]] = -1;
     c->count = 1;
     c->quad[0] = centre;
+    c->index_of[centre] = 0;
     c->map[0].turns = c->map[0].offset[0] = c->map[0].offset[1] = 0;
     c->cell[0][0] = c->cell[0][1] = 0;
     for (ring = 0; ring < radius; ring++) {
@@ -16088,11 +16092,11 @@ static void tt__relax_chart_build(const tt_polycube *pc, int centre, int radius,
         for (; head < ring_end; head++) {
             int k;
             for (k = 0; k < 4 && c->count < TT__RELAX_CHART; k++) {
-                int h = s->face_start[c->quad[head]] + k, next = s->corner_face[s->twin[h]], i;
-                for (i = 0; i < c->count && c->quad[i] != next; i++) continue;
-                if (i < c->count) continue;
+                int h = s->face_start[c->quad[head]] + k, next = s->corner_face[s->twin[h]];
+                if (c->index_of[next] >= 0) continue;
+                c->index_of[next] = c->count;
                 c->quad[c->count] = next;
-                c->map[c->count] = tt_quad_map_compose(c->map[head], tt_polycube_unfold(pc, h));
+                c->map[c->count] = tt_quad_map_compose(c->map[head], c->unfold[h]);
                 tt_quad_map_apply(c->map[c->count], 0.5, 0.5, middle);
                 c->cell[c->count][0] = (int)floor(middle[0]);
                 c->cell[c->count][1] = (int)floor(middle[1]);
@@ -16105,13 +16109,10 @@ static void tt__relax_chart_build(const tt_polycube *pc, int centre, int radius,
 /* Point p of S in the chart; 0 when its quad is not in it. */
 static int tt__relax_chart_place(const tt__relax_chart *c, tt_surface_point p, double at[2])
 {
-    int i;
-    for (i = 0; i < c->count; i++)
-        if (c->quad[i] == p.quad) {
-            tt_quad_map_apply(c->map[i], p.s, p.t, at);
-            return 1;
-        }
-    return 0;
+    int i = c->index_of[p.quad];
+    if (i < 0) return 0;
+    tt_quad_map_apply(c->map[i], p.s, p.t, at);
+    return 1;
 }
 
 /* The point of S at chart place `at`: the first chart quad whose cell holds
@@ -16147,7 +16148,7 @@ static int tt__relax_place_near(const tt_polycube *pc, int centre, tt_surface_po
     for (k = 0; k < 4; k++) {
         int h = s->face_start[centre] + k;
         if (s->corner_face[s->twin[h]] == p.quad) {
-            tt_quad_map_apply(tt_polycube_unfold(pc, h), p.s, p.t, at);
+            tt_quad_map_apply(scratch->unfold[h], p.s, p.t, at);
             return 1;
         }
     }
@@ -16197,19 +16198,30 @@ static double tt__relax_badness(const tt_mesh *model, const tt_surface_point *po
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                               const tt_allocator *allocator)
 {
-    int *first_triangle = NULL, *triangle_corners = NULL, *count = NULL;
+    int *first_triangle = NULL, *triangle_corners = NULL, *count = NULL, *index_of = NULL;
+    tt_quad_map *unfold = NULL;
     unsigned char *bad = NULL;
-    tt__relax_chart *chart = NULL;
-    int v, c, sweep, moves = 0, nverts = model->nverts;
+    tt__relax_chart *chart = NULL, *around = NULL;
+    int v, c, sweep, moves = 0, nverts = model->nverts, nquads = pc->surface->nfaces;
     first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
     count = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
     bad = TT__ALLOC(allocator, unsigned char, nverts > 0 ? nverts : 1);
-    chart = TT__ALLOC(allocator, tt__relax_chart, 1);
-    if (!first_triangle || !triangle_corners || !count || !bad || !chart) {
+    chart = TT__ALLOC(allocator, tt__relax_chart, 2);
+    index_of = TT__ALLOC(allocator, int, 2 * (size_t)nquads);
+    unfold = TT__ALLOC(allocator, tt_quad_map, pc->surface->ncorners);
+    if (!first_triangle || !triangle_corners || !count || !bad || !chart || !index_of || !unfold) {
         moves = -1;
         goto done;
     }
+    for (c = 0; c < pc->surface->ncorners; c++) unfold[c] = tt_polycube_unfold(pc, c);
+    /* Two charts (around a vertex, around a neighbour), each with its own quad index. */
+    around = chart + 1;
+    for (c = 0; c < 2 * nquads; c++) index_of[c] = -1;
+    chart->count = around->count = 0;
+    chart->index_of = index_of;
+    around->index_of = index_of + nquads;
+    chart->unfold = around->unfold = unfold;
     /* The triangles around each vertex, as the corners at it. */
     memset(count, 0, sizeof(int) * (size_t)nverts);
     for (c = 0; c < model->ncorners; c++) count[model->corner_vert[c]]++;
@@ -16292,7 +16304,6 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                         int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
                         double after;
                         double nearest = HUGE_VAL;
-                        tt__relax_chart around;
                         tt_surface_point kept = points[v];
                         for (j = first_triangle[v]; j < i; j++) {
                             int other = triangle_corners[j];
@@ -16301,9 +16312,9 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                                 break;
                         }
                         if (j < i || (k == 2 && model->corner_vert[3 * f + (corner % 3 + 1) % 3] == u)) continue;
-                        tt__relax_chart_build(pc, points[u].quad, TT__RELAX_SEAT_RADIUS, &around);
-                        for (q = 0; q < around.count; q++) {
-                            tt_surface_point p = tt__polycube_surface_point(pc, around.quad[q], lattice);
+                        tt__relax_chart_build(pc, points[u].quad, TT__RELAX_SEAT_RADIUS, around);
+                        for (q = 0; q < around->count; q++) {
+                            tt_surface_point p = tt__polycube_surface_point(pc, around->quad[q], lattice);
                             double xyz[3], d2 = 0.0;
                             tt_polycube_point_position(pc, p, xyz);
                             for (a = 0; a < 3; a++) d2 += (xyz[a] - model->pos[3 * v + a]) * (xyz[a] - model->pos[3 * v + a]);
@@ -16339,6 +16350,8 @@ done:
     tt__free(allocator, count);
     tt__free(allocator, bad);
     tt__free(allocator, chart);
+    tt__free(allocator, index_of);
+    tt__free(allocator, unfold);
     return moves;
 }
 
