@@ -37,8 +37,8 @@
    vertices' projection onto it on a 100k-triangle torus;
    `polycube_100k_faces_res32` the whole mapping of that torus, voxelisation
    to UVs (spec B10), with the triangles it made and the ones left to the
-   fallback; `polycube_synth_n2_tile64` the paper's 256-tile atlas at 64
-   texels a tile, apart (spec P17).
+   fallback; its atlas (spec P17: timed apart) is `synth_n2_tile64`, the
+   paper's 256 tiles at 64 texels.
 
    Peers: bench/bench_build.c times the half-edge build on three 1M-face
    meshes beside a radix-sort pairing yardstick, and bench_build_cgal.cpp
@@ -503,7 +503,6 @@ typedef struct polycube_ctx {
     tt_polycube_projection_report projection;
     tt_polycube_map_report map_report;
     int output_triangles;
-    tt_image *source;           /* for the tiles' synthesis */
 } polycube_ctx;
 
 /* The polycube of a mesh at resolution 32: voxelisation, fill, repair,
@@ -541,7 +540,8 @@ static double run_polycube_project(void *p)
 
 /* The whole mapping, voxelisation to UVs (spec B10): the polycube, its
    Wang colouring and tile types, the model split on S, the UVs. The
-   atlas's synthesis is timed apart (run_polycube_synth). */
+   atlas's synthesis is timed apart: synth_n2_tile64, the paper's 256-tile
+   layout. */
 static double run_polycube_map(void *p)
 {
     polycube_ctx *c = (polycube_ctx *)p;
@@ -580,29 +580,6 @@ static double run_polycube_map(void *p)
     free(colors);
     tt_polycube_mapping_free(mapping);
     tt_polycube_free(polycube);
-    return t1 - t0;
-}
-
-/* The atlas of the paper's layout (n = 2 colours per axis, 256 tiles) at
-   64 texels a tile, 4 of gutter (spec P17). */
-static double run_polycube_synth(void *p)
-{
-    polycube_ctx *c = (polycube_ctx *)p;
-    tt_synth_options options;
-    tt_tileset *tiles = NULL;
-    tt_error err;
-    tt_result r;
-    double t0, t1;
-    memset(&options, 0, sizeof options);
-    options.layout.colors = 2;
-    options.layout.tile_size = 64;
-    options.layout.gutter = 4;
-    options.seed = 7;
-    t0 = bench_now_ms();
-    r = tt_synthesize_tiles(c->source, &options, NULL, &tiles, &err);
-    t1 = bench_now_ms();
-    if (r != TT_OK) fail("tt_synthesize_tiles", r, &err);
-    tt_tileset_free(tiles);
     return t1 - t0;
 }
 
@@ -773,7 +750,7 @@ int main(int argc, char **argv)
     if (wanted("polycube_100k_faces_res32")) {
         /* the polycube on a 100k-triangle torus: its construction and the
            projection alone, then the whole mapping, voxelisation to UVs
-           (spec B10: <= 1 s), and the atlas's synthesis apart (P17) */
+           (spec B10: <= 1 s); its atlas is synth_n2_tile64 (P17) */
         polycube_ctx pc;
         memset(&pc, 0, sizeof pc);
         pc.mesh = make_triangle_torus(224);
@@ -786,9 +763,6 @@ int main(int argc, char **argv)
         report("polycube_100k_faces_res32_output_triangles", pc.output_triangles, "triangles");
         report("polycube_100k_faces_res32_fallback_triangles", pc.map_report.fallback_triangles, "triangles");
         report("polycube_100k_faces_res32_flipped", pc.map_report.flipped, "triangles");
-        pc.source = make_source(256);
-        report("polycube_synth_n2_tile64", median_ms(run_polycube_synth, &pc, RUNS_SLOW), "ms");
-        tt_image_free(pc.source);
         free(pc.points);
         tt_polycube_free(pc.polycube);
         tt_mesh_free(pc.mesh);
