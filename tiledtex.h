@@ -15431,10 +15431,16 @@ static int tt__surface_valence(const tt_mesh *s, int h)
     return count;
 }
 
+/* The angle at the origin from x to y, -pi..pi. */
+static double tt__turn_angle(const double x[2], const double y[2])
+{
+    return atan2(tt__orient2(0.0, 0.0, x[0], x[1], y[0], y[1]), x[0] * y[0] + x[1] * y[1]);
+}
+
 /* The angle between two vectors, 0..pi. */
 static double tt__angle2(const double x[2], const double y[2])
 {
-    return atan2(fabs(x[0] * y[1] - x[1] * y[0]), x[0] * y[0] + x[1] * y[1]);
+    return fabs(tt__turn_angle(x, y));
 }
 
 /* The bends of a path (tt__edge_path_crossings): a choice, portal by
@@ -16174,7 +16180,7 @@ static double tt__relax_badness(const tt_mesh *model, const tt_surface_point *po
             bad += 2;
             continue;
         }
-        turn = (pu[0] - at[0]) * (pw[1] - at[1]) - (pu[1] - at[1]) * (pw[0] - at[0]);
+        turn = tt__orient2(at[0], at[1], pu[0], pu[1], pw[0], pw[1]);
         if (turn <= 0.0) {
             bad++;
             folded -= turn;
@@ -16242,7 +16248,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
             at[0][0] = points[t[0]].s;
             at[0][1] = points[t[0]].t;
             for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(pc, points[t[0]].quad, points[t[k]], at[k], chart);
-            if (placed && (at[1][0] - at[0][0]) * (at[2][1] - at[0][1]) - (at[1][1] - at[0][1]) * (at[2][0] - at[0][0]) > 0.0)
+            if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0)
                 continue;
             bad[t[0]] = bad[t[1]] = bad[t[2]] = 1;
         }
@@ -16734,8 +16740,8 @@ static double tt__split_inside_length(const tt__split *S, const double e0[2], co
     int i;
     for (i = 0; i < 3; i++) {
         const double *a = S->corner[i], *b = S->corner[(i + 1) % 3];
-        double f0 = (b[0] - a[0]) * (e0[1] - a[1]) - (b[1] - a[1]) * (e0[0] - a[0]) - TT__SPLIT_AREA;
-        double f1 = (b[0] - a[0]) * (e1[1] - a[1]) - (b[1] - a[1]) * (e1[0] - a[0]) - TT__SPLIT_AREA;
+        double f0 = tt__orient2(a[0], a[1], b[0], b[1], e0[0], e0[1]) - TT__SPLIT_AREA;
+        double f1 = tt__orient2(a[0], a[1], b[0], b[1], e1[0], e1[1]) - TT__SPLIT_AREA;
         if (f0 <= 0.0 && f1 <= 0.0) return 0.0;
         if (f0 <= 0.0) {
             double u = f0 / (f0 - f1);
@@ -16895,7 +16901,7 @@ static int tt__split_identify(tt__split *S, const tt__clip_point *c, double area
                 if (S->grid_points[3 * i] == x && S->grid_points[3 * i + 1] == y) return S->grid_points[3 * i + 2];
             for (k = 0; k < 3; k++) {
                 const double *a = S->corner[(k + 1) % 3], *b = S->corner[(k + 2) % 3];
-                weight[k] = ((b[0] - a[0]) * (at[1] - a[1]) - (b[1] - a[1]) * (at[0] - a[0])) / area2;
+                weight[k] = tt__orient2(a[0], a[1], b[0], b[1], at[0], at[1]) / area2;
                 if (weight[k] <= TT__SPLIT_AREA) return -1;   /* on a side, where no record passes */
             }
             {
@@ -16933,7 +16939,7 @@ static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const 
         int flat = 0;
         for (i = 1; i + 1 < m && !flat; i++) {
             const double *a = at[apex], *b = at[(apex + i) % m], *c = at[(apex + i + 1) % m];
-            flat = fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) <= 2.0 * TT__SPLIT_AREA;
+            flat = fabs(tt__orient2(a[0], a[1], b[0], b[1], c[0], c[1])) <= 2.0 * TT__SPLIT_AREA;
         }
         if (!flat) break;
     }
@@ -16946,7 +16952,7 @@ static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const 
         }
         for (k = 0; k < 3; k++) {
             const double *a = S->corner[(k + 1) % 3], *b = S->corner[(k + 2) % 3];
-            weight[k] = ((b[0] - a[0]) * (middle[1] - a[1]) - (b[1] - a[1]) * (middle[0] - a[0])) / area2;
+            weight[k] = tt__orient2(a[0], a[1], b[0], b[1], middle[0], middle[1]) / area2;
         }
         centre = tt__split_vertex(S, S->vert, weight);
         if (centre < 0) return 0;
@@ -16985,8 +16991,8 @@ static int tt__split_pieces(tt__split *S, int f, int *pieces)
 {
     double lo[2], hi[2], area2;
     int k, x, y, ncells, i;
-    area2 = (S->corner[1][0] - S->corner[0][0]) * (S->corner[2][1] - S->corner[0][1]) -
-            (S->corner[1][1] - S->corner[0][1]) * (S->corner[2][0] - S->corner[0][0]);
+    area2 = tt__orient2(S->corner[0][0], S->corner[0][1], S->corner[1][0], S->corner[1][1], S->corner[2][0],
+                        S->corner[2][1]);
     /* A chart turning clockwise is a fold of the projection the relaxation could not open: its pieces would
        show the texture mirrored; the fallback does not. */
     if (area2 <= 2.0 * TT__SPLIT_AREA) return 0;
@@ -17061,12 +17067,6 @@ static int tt__quad_corner_of(const tt_mesh *s, int quad, int vertex)
     for (k = 0; k < 4; k++)
         if (s->corner_vert[s->face_start[quad] + k] == vertex) return k;
     return -1;
-}
-
-/* The angle at the origin from x to y, -pi..pi. */
-static double tt__turn_angle(const double x[2], const double y[2])
-{
-    return atan2(x[0] * y[1] - x[1] * y[0], x[0] * y[0] + x[1] * y[1]);
 }
 
 /* Boundary point i of a triangle (and the next, along the segment i ->
@@ -17177,7 +17177,7 @@ static int tt__split_star(tt__split *S, int f, double area, int *pieces)
             }
             tt__quad_corner_st(tt__quad_corner_of(s, S->boundary[i].quad, apex), v);
             tt__split_segment_from(S, i, v, x, y);
-            holds = x[0] * y[1] - x[1] * y[0] >= -TT__SPLIT_AREA;
+            holds = tt__orient2(0.0, 0.0, x[0], x[1], y[0], y[1]) >= -TT__SPLIT_AREA;
         }
         if (!holds) continue;
         if (centre < 0 && (centre = tt__split_vertex(S, S->vert, weight)) < 0) return -1;
@@ -17413,8 +17413,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     }
     for (j = 0; j < S.out->ntriangles; j++) {
         const tt_surface_point *p = S.out->corner_points + 3 * j;
-        double turn = ((double)p[1].s - p[0].s) * ((double)p[2].t - p[0].t) -
-                      ((double)p[1].t - p[0].t) * ((double)p[2].s - p[0].s);
+        double turn = tt__orient2(p[0].s, p[0].t, p[1].s, p[1].t, p[2].s, p[2].t);
         report->flipped += turn < -TT__SPLIT_AREA;
         report->collapsed += fabs(turn) <= TT__SPLIT_AREA;
     }
