@@ -15862,7 +15862,8 @@ out_of_memory:
    fan maps). Refined vertex v < mesh->nverts is input vertex v; each
    refined vertex interpolates at most 3 vertices of one input triangle
    (the midpoint of a midpoint stays on its triangle), and each refined
-   triangle knows its input face. */
+   triangle knows its input face. When no edge is too long, all four stay
+   NULL: the model is the input. */
 typedef struct tt__refined {
     tt_mesh *mesh;
     int *source;                /* 3 per vertex: input vertices... */
@@ -15915,6 +15916,13 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
     tt_mesh *current = NULL;
     tt_result result = TT_OK;
     memset(out, 0, sizeof *out);
+    /* Nothing to halve (a dense scan): the model is the input itself, out->mesh stays NULL. */
+    for (c = 0; c < mesh->ncorners; c++) {
+        double edge[3];
+        tt__sub3f(mesh->pos + 3 * mesh->corner_vert[tt_mesh_next(mesh, c)], mesh->pos + 3 * mesh->corner_vert[c], edge);
+        if (tt__length3(edge) > longest) break;
+    }
+    if (c == mesh->ncorners) return TT_OK;
     positions = (float *)tt__grow(allocator, NULL, &vertex_capacity, nverts > 0 ? nverts : 1, 3 * sizeof(float));
     source = TT__ALLOC(allocator, int, 3 * (size_t)vertex_capacity);
     weight = TT__ALLOC(allocator, double, 3 * (size_t)vertex_capacity);
@@ -17312,7 +17320,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
                         "max_edge %g: give a length above 0 (0 for the default, HUGE_VAL for no refinement)",
                         options->max_edge);
     if ((result = tt__polycube_refine(mesh, longest, allocator, &R, error)) != TT_OK) goto failed;
-    model = R.mesh;
+    model = R.mesh ? R.mesh : mesh;
     report->triangles = model->nfaces;
     points = TT__ALLOC(allocator, tt_surface_point, model->nverts > 0 ? model->nverts : 1);
     if (!points) goto out_of_memory;
@@ -17376,7 +17384,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     }
     /* Back to the input: each output vertex's refined sources become input vertices (at most 3, all of one
        input triangle), each output triangle's refined face its input face. */
-    for (v = 0; v < S.out->nverts; v++) {
+    for (v = 0; v < S.out->nverts && R.mesh; v++) {
         int source[3], n = 0, k, i;
         double weight[3] = {0.0, 0.0, 0.0};
         for (k = 0; k < 3; k++) {
@@ -17405,7 +17413,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         if (!outputs_of_face) goto out_of_memory;
         memset(outputs_of_face, 0, sizeof(int) * (size_t)mesh->nfaces);
         for (j = 0; j < S.out->ntriangles; j++) {
-            S.out->triangle_face[j] = R.face[S.out->triangle_face[j]];
+            if (R.face) S.out->triangle_face[j] = R.face[S.out->triangle_face[j]];
             outputs_of_face[S.out->triangle_face[j]]++;
         }
         for (f = 0; f < mesh->nfaces; f++) report->split_triangles += outputs_of_face[f] > 1;
