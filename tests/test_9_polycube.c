@@ -2148,7 +2148,7 @@ static void test_map_determinism_and_errors(void)
 /* The per-face stretch of a mapping: each output triangle against its
    points on S scaled to cube units (all three lie in one quad, whose frame
    is a unit square of side h), through tt_measure_uv_distortion. */
-static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map, const tt_polycube *pc)
+static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map)
 {
     tt_uv_distortion_report d;
     tt_mesh_desc desc;
@@ -2169,7 +2169,6 @@ static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map, c
     desc.flags = TT_MESH_PERMISSIVE;
     if (tt_mesh_build(&desc, NULL, &out, NULL) == TT_OK)
         tt_measure_uv_distortion(out, uv, 256, 256, NULL, NULL, &d, NULL);
-    (void)pc;
     tt_mesh_free(out);
     free(uv);
     return d;
@@ -2201,7 +2200,7 @@ static void test_map_stretch_floor(void)
         }
         map = mapped(&m, resolution, 0, 0.0, &pc, &mesh, &rep);
         if (map) {
-            tt_uv_distortion_report d = mapping_stretch(map, pc);
+            tt_uv_distortion_report d = mapping_stretch(map);
             printf("     cube turned 45 degrees at resolution %d: stretch median %.3f, p95 %.3f; %d fallbacks of %d, "
                    "%d flipped\n", resolution, d.stretch_median, d.stretch_p95, rep.fallback_triangles,
                    rep.triangles, rep.flipped);
