@@ -2459,6 +2459,9 @@ typedef struct tt_polycube_edges {
     int *first_crossing;        /* nedges + 1: edge e's crossings are [first_crossing[e], first_crossing[e+1]),
                                    in order of t */
     tt_edge_crossing *crossings;
+    int *end_quads;             /* 2 * nedges: the quad edge e's image leaves its first vertex's point in, and the
+                                   one it reaches the second's in; another than the point's own quad only where
+                                   that point is a corner of S (then it lies in every quad around the corner) */
     unsigned char *failed;      /* per edge: 1 = no consistent path within max_quads (P11 step 7's fallback) */
     int nfailed;
     tt_allocator allocator;     /* the one it was made with */
@@ -2555,7 +2558,7 @@ typedef struct tt_polycube_map_report {
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
     int fallback_triangles; /* of `triangles`, those put whole into one quad (P11 step 7): a local seam; target 0 */
-    int flipped;            /* output triangles whose points on S turn clockwise (a fold of the projection) */
+    int flipped;            /* output triangles whose points on S turn clockwise (a fold; none is expected) */
     int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
 } tt_polycube_map_report;
 
@@ -2583,7 +2586,12 @@ typedef struct tt_polycube_mapping {
         their neighbours' in a local chart of S, points cut off from their
         neighbours (no short path) onto a neighbour's sheet, a move kept
         only when it leaves the vertex's triangles better placed;
-     4. tt_polycube_trace_edges (max_quads);
+     4. tt_polycube_trace_edges (max_quads); then spikes: a vertex whose
+        two edges in one triangle leave it through the same corner W of S
+        (it lies just behind a saddle) would map part of that triangle
+        onto a line; it is moved onto W unless another point is there,
+        and the edges are traced again (a vertex whose edges then find no
+        path goes back, and they are traced once more);
      5. per triangle, the split (P11 step 4):
         - its boundary (its vertices and its edges' split points, from
           the records) is unfolded into one chart from its first vertex's
@@ -2614,9 +2622,12 @@ typedef struct tt_polycube_mapping {
           open, several cones) the triangle keeps its boundary, so its
           neighbours still meet it without a crack, and is fanned from its
           centroid into one quad - of its vertices' quads, the one facing
-          most like it - the points projected orthogonally onto that
-          quad's plane and clamped to it (P11 step 7): a local seam,
-          counted in fallback_triangles.
+          most like it - laid flat in its own plane, turned so that its
+          axis nearest the quad's s runs along s, at the model's scale or
+          shrunk to fit the quad, over its centroid's projection (P11 step
+          7, whose clamped projection would fold triangles facing away
+          from the quad): a local seam, counted in fallback_triangles,
+          but no flipped piece.
    Every split point of an edge is one output vertex shared by the two
    triangles on the edge: a closed manifold model gives a closed manifold
    output. Pieces of zero area (an edge along a lattice line) are dropped;
@@ -15263,6 +15274,7 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
 #define TT__EDGE_ANGLE_EPS 1e-9         /* the funnel's directions, radians */
 #define TT__EDGE_SEARCH_BUDGET 200000   /* path steps per edge: a guard for large max_quads */
 #define TT__EDGE_BEND_QUADS 6           /* paths of at most this many quads may bend at saddles */
+#define TT__CORNER_QUADS 6              /* quads around a vertex of S: 3 to 6 */
 
 /* Corner k (mod 4) of a quad in its own frame: (0,0), (1,0), (1,1), (0,1). */
 static void tt__quad_corner_st(int k, int st[2])
@@ -15270,6 +15282,15 @@ static void tt__quad_corner_st(int k, int st[2])
     k &= 3;
     st[0] = k == 1 || k == 2;
     st[1] = k >= 2;
+}
+
+/* The corner of `quad` at S vertex `vertex`, or -1. */
+static int tt__quad_corner_of(const tt_mesh *s, int quad, int vertex)
+{
+    int k;
+    for (k = 0; k < 4; k++)
+        if (s->corner_vert[s->face_start[quad] + k] == vertex) return k;
+    return -1;
 }
 
 /* (x, y) turned by `turns` quarter turns counter-clockwise. */
@@ -15631,6 +15652,53 @@ typedef struct tt__edge_funnel {
     double reference, lo, hi;
 } tt__edge_funnel;
 
+/* The corner (0..3) of its quad that point p is on; p must be on one. */
+static int tt__point_corner(tt_surface_point p)
+{
+    return p.t == 0.0f ? (p.s == 0.0f ? 0 : 1) : (p.s == 0.0f ? 3 : 2);
+}
+
+/* Point p in the frame of `quad`: its own quad's, or, when p is a corner
+   of S, that corner in any quad around it. 0 (p's own coordinates in st)
+   when p does not lie in `quad`. */
+static int tt__point_in_quad(const tt_mesh *s, tt_surface_point p, int quad, double st[2])
+{
+    int corner, k[2];
+    st[0] = p.s;
+    st[1] = p.t;
+    if (quad == p.quad) return 1;
+    if ((p.s != 0.0f && p.s != 1.0f) || (p.t != 0.0f && p.t != 1.0f)) return 0;
+    corner = tt__quad_corner_of(s, quad, s->corner_vert[s->face_start[p.quad] + tt__point_corner(p)]);
+    if (corner < 0) return 0;
+    tt__quad_corner_st(corner, k);
+    st[0] = k[0];
+    st[1] = k[1];
+    return 1;
+}
+
+/* The quads point p lies in, p's own first, with p in each one's frame: one,
+   or every quad around the corner of S that p is on. Returns the count. */
+static int tt__quads_at_point(const tt_mesh *s, tt_surface_point p, int quads[TT__CORNER_QUADS],
+                              double st[TT__CORNER_QUADS][2])
+{
+    int n = 0, h, around;
+    quads[0] = p.quad;
+    st[0][0] = p.s;
+    st[0][1] = p.t;
+    if ((p.s != 0.0f && p.s != 1.0f) || (p.t != 0.0f && p.t != 1.0f)) return 1;
+    h = around = s->face_start[p.quad] + tt__point_corner(p);
+    do {
+        int quad = s->corner_face[around], k[2];
+        tt__quad_corner_st(around - s->face_start[quad], k);
+        quads[n] = quad;
+        st[n][0] = k[0];
+        st[n][1] = k[1];
+        n++;
+        around = s->twin[s->face_start[quad] + ((around - s->face_start[quad] + 3) & 3)];
+    } while (around != h && n < TT__CORNER_QUADS);
+    return n;
+}
+
 /* Grow the path from quads[depth - 1], depth first, half-edges in corner
    order; at q_b's quad judge it (tt__edge_path_crossings). */
 static void tt__edge_search_from(tt__edge_search *S, int depth, tt__edge_funnel funnel)
@@ -15711,6 +15779,7 @@ TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges)
     tt__free(&allocator, edges->edge_vertices);
     tt__free(&allocator, edges->first_crossing);
     tt__free(&allocator, edges->crossings);
+    tt__free(&allocator, edges->end_quads);
     tt__free(&allocator, edges->failed);
     tt__free(&allocator, edges);
 }
@@ -15765,7 +15834,8 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
     E->edge_vertices = TT__ALLOC(allocator, int, (size_t)E->nedges * 2);
     E->first_crossing = TT__ALLOC(allocator, int, (size_t)E->nedges + 1);
     E->failed = TT__ALLOC(allocator, unsigned char, E->nedges);
-    if (!E->edge_vertices || !E->first_crossing || !E->failed) goto out_of_memory;
+    E->end_quads = TT__ALLOC(allocator, int, (size_t)E->nedges * 2);
+    if (!E->edge_vertices || !E->first_crossing || !E->failed || !E->end_quads) goto out_of_memory;
     for (c = 0; c < mesh->ncorners; c++) {
         int f = mesh->corner_face[c], next = c + 1 < mesh->face_start[f + 1] ? c + 1 : mesh->face_start[f];
         int from = mesh->corner_vert[c], to = mesh->corner_vert[next];
@@ -15779,26 +15849,48 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
     S->max_quads = max_quads;
     for (e = 0; e < E->nedges; e++) {
         tt_surface_point qa = points[E->edge_vertices[2 * e]], qb = points[E->edge_vertices[2 * e + 1]];
-        tt__edge_funnel funnel;
         const tt_edge_crossing *crossing = S->best_crossings;
-        int count, i;
+        int count, i, quads_a[TT__CORNER_QUADS], quads_b[TT__CORNER_QUADS], na, nb, ia, ib;
+        double st_a[TT__CORNER_QUADS][2], st_b[TT__CORNER_QUADS][2];
         E->first_crossing[e] = E->ncrossings;
-        S->a[0] = qa.s;
-        S->a[1] = qa.t;
-        S->b[0] = qb.s;
-        S->b[1] = qb.t;
-        S->quad_b = qb.quad;
-        S->quads[0] = qa.quad;
-        S->maps[0].turns = S->maps[0].offset[0] = S->maps[0].offset[1] = 0;
+        /* An end on a corner of S lies in every quad there: the path may start (or end) in any of them, the
+           point's own quad first, so that it keeps ties. */
+        na = tt__quads_at_point(polycube->surface, qa, quads_a, st_a);
+        nb = tt__quads_at_point(polycube->surface, qb, quads_b, st_b);
         S->best_count = 0;
         S->steps = 0;
-        memset(&funnel, 0, sizeof funnel);
-        tt__edge_search_from(S, 1, funnel);
+        E->end_quads[2 * e] = qa.quad;
+        E->end_quads[2 * e + 1] = qb.quad;
+        for (ia = 0; ia < na; ia++)
+            for (ib = 0; ib < nb; ib++) {
+                tt__edge_funnel funnel;
+                int best_count = S->best_count;
+                double best_length = S->best_length;
+                S->a[0] = st_a[ia][0];
+                S->a[1] = st_a[ia][1];
+                S->b[0] = st_b[ib][0];
+                S->b[1] = st_b[ib][1];
+                S->quad_b = quads_b[ib];
+                S->quads[0] = quads_a[ia];
+                S->maps[0].turns = S->maps[0].offset[0] = S->maps[0].offset[1] = 0;
+                memset(&funnel, 0, sizeof funnel);
+                tt__edge_search_from(S, 1, funnel);
+                if (S->best_count != best_count || S->best_length != best_length) {
+                    E->end_quads[2 * e] = quads_a[ia];
+                    E->end_quads[2 * e + 1] = quads_b[ib];
+                }
+            }
         E->failed[e] = S->best_count == 0;
         if (E->failed[e]) {
             E->nfailed++;
             continue;
         }
+        for (ia = 0; quads_a[ia] != E->end_quads[2 * e]; ia++) continue;
+        for (ib = 0; quads_b[ib] != E->end_quads[2 * e + 1]; ib++) continue;
+        S->a[0] = st_a[ia][0];
+        S->a[1] = st_a[ia][1];
+        S->b[0] = st_b[ib][0];
+        S->b[1] = st_b[ib][1];
         count = S->best_count - 1;
         if (count > 0) {
             tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(allocator, E->crossings, &capacity,
@@ -16369,13 +16461,68 @@ done:
     return moves;
 }
 
+/* The crossing of edge e's image nearest its end v, NULL when it has none. */
+static const tt_edge_crossing *tt__edge_crossing_nearest(const tt_polycube_edges *edges, int e, int v)
+{
+    const int first = edges->first_crossing[e], last = edges->first_crossing[e + 1];
+    if (first == last) return NULL;
+    return &edges->crossings[edges->edge_vertices[2 * e] == v ? first : last - 1];
+}
+
+/* The S vertex through which the image of edge e first leaves its end v
+   (its crossing nearest v lies on a corner of S), or -1. */
+static int tt__edge_apex_from(const tt_mesh *s, const tt_polycube_edges *edges, int e, int v)
+{
+    const tt_edge_crossing *x = tt__edge_crossing_nearest(edges, e, v);
+    if (!x || (x->along != 0.0 && x->along != 1.0)) return -1;
+    return s->corner_vert[x->along == 0.0 ? x->halfedge : tt_mesh_next(s, x->halfedge)];
+}
+
+/* Two edges of a triangle leaving its vertex v through the same corner W of
+   S (v's point lies just behind a saddle, and both straight images bend
+   there) bound a region of zero area on S: the part of the triangle between
+   them would map onto the segment v -> W, a piece with no texture area. v
+   is moved onto W, where both edges then start, unless another point is
+   there already (two vertices at one place would make the same kind of
+   piece). Returns the number of points moved, -1 when out of memory. */
+static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
+                                tt_surface_point *points, const tt_allocator *allocator)
+{
+    const tt_mesh *s = pc->surface;
+    unsigned char *taken = TT__ALLOC(allocator, unsigned char, s->nverts);
+    int moved = 0, c, v;
+    if (!taken) return -1;
+    memset(taken, 0, (size_t)s->nverts);
+    for (v = 0; v < model->nverts; v++)
+        if ((points[v].s == 0.0f || points[v].s == 1.0f) && (points[v].t == 0.0f || points[v].t == 1.0f))
+            taken[s->corner_vert[s->face_start[points[v].quad] + tt__point_corner(points[v])]] = 1;
+    for (c = 0; c < model->ncorners; c++) {
+        const int e = edges->edge_of_halfedge[c];
+        const int apex = tt__edge_apex_from(s, edges, e, (v = model->corner_vert[c]));
+        int quad, st[2];
+        if (apex < 0 || taken[apex] ||
+            apex != tt__edge_apex_from(s, edges, edges->edge_of_halfedge[tt_mesh_prev(model, c)], v))
+            continue;
+        quad = s->corner_face[tt__edge_crossing_nearest(edges, e, v)->halfedge];
+        tt__quad_corner_st(tt__quad_corner_of(s, quad, apex), st);
+        points[v].quad = quad;
+        points[v].s = (float)st[0];
+        points[v].t = (float)st[1];
+        taken[apex] = 1;
+        moved++;
+    }
+    tt__free(allocator, taken);
+    return moved;
+}
+
 /* ---- The model split on S and its UVs (spec P11 steps 4, 6, 7) ---- */
 
 #define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
                                        above the records' snap (1e-6), far below any real piece */
 #define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
 #define TT__MAP_SNAP 1e-5f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
-#define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
+#define TT__SPLIT_MAX_CELLS 4096
+#define TT__MAP_UNSPIKE_ROUNDS 3    /* edge tracings redone after points are moved off spikes */    /* grid cells of a chart's box beyond which a triangle takes the fallback */
 
 /* A point on a triangle's boundary (a model vertex or a split point of an
    edge) and the boundary segment from it to the next point: the quad the
@@ -16618,7 +16765,10 @@ static int tt__split_walk(tt__split *S, int f, int *linked, int *chart)
     const tt_mesh *mesh = S->mesh, *s = S->pc->surface;
     const tt_polycube_edges *E = S->edges;
     tt_quad_map identity, closing;
-    int k, i, n, quad = S->points[S->vert[0]].quad, holds = 1;
+    const int last_edge = E->edge_of_halfedge[mesh->face_start[f] + 2];
+    /* The quad the last edge reaches vertex 0 in, where the walk starts. */
+    const int first_quad = E->end_quads[2 * last_edge + (E->edge_vertices[2 * last_edge] == S->vert[2])];
+    int k, i, n, quad = first_quad, holds = 1;
     double st[2];
     identity.turns = identity.offset[0] = identity.offset[1] = 0;
     closing = identity;
@@ -16626,13 +16776,17 @@ static int tt__split_walk(tt__split *S, int f, int *linked, int *chart)
     for (k = 0; k < 3; k++) {
         int v = S->vert[k], e = E->edge_of_halfedge[mesh->face_start[f] + k];
         int forward = E->edge_vertices[2 * e] == v, first = E->first_crossing[e];
-        int count = E->first_crossing[e + 1] - first;
-        tt_surface_point q = S->points[v];
-        holds = holds && q.quad == quad && !E->failed[e];
-        quad = q.quad;
-        st[0] = q.s;
-        st[1] = q.t;
+        int count = E->first_crossing[e + 1] - first, leaves = E->end_quads[2 * e + !forward];
+        /* The edge before reached v's point in `quad`, this one leaves it in `leaves`: both v's own quad,
+           unless v is on a corner of S (tt_polycube_edges.end_quads). */
+        holds = holds && !E->failed[e] && tt__point_in_quad(s, S->points[v], quad, st);
         if (!tt__split_push(S, v, quad, st, st)) return 0;
+        if (leaves != quad) {
+            double st_leaving[2];
+            holds = holds && tt__point_in_quad(s, S->points[v], leaves, st_leaving);
+            if (!tt__split_push(S, v, leaves, st, st_leaving)) return 0;
+            quad = leaves;
+        }
         for (i = 0; i < count; i++) {
             int j = forward ? first + i : first + count - 1 - i, vertex, kh, st0[2], st1[2];
             tt_edge_crossing x = E->crossings[j];
@@ -16655,9 +16809,7 @@ static int tt__split_walk(tt__split *S, int f, int *linked, int *chart)
             if (!tt__split_push(S, vertex, quad, st_in, st)) return 0;
         }
     }
-    holds = holds && quad == S->points[S->vert[0]].quad;
-    st[0] = S->points[S->vert[0]].s;
-    st[1] = S->points[S->vert[0]].t;
+    holds = holds && quad == first_quad && tt__point_in_quad(s, S->points[S->vert[0]], quad, st);
     S->boundary[S->nboundary - 1].b[0] = st[0];
     S->boundary[S->nboundary - 1].b[1] = st[1];
     *linked = *chart = 0;
@@ -17068,15 +17220,6 @@ static int tt__split_pieces(tt__split *S, int f, int *pieces)
     return 1;
 }
 
-/* The corner of `quad` at S vertex `vertex`, or -1. */
-static int tt__quad_corner_of(const tt_mesh *s, int quad, int vertex)
-{
-    int k;
-    for (k = 0; k < 4; k++)
-        if (s->corner_vert[s->face_start[quad] + k] == vertex) return k;
-    return -1;
-}
-
 /* Boundary point i of a triangle (and the next, along the segment i ->
    i + 1 in point i's quad) relative to the S vertex at corner `corner_st`
    of that quad. */
@@ -17215,16 +17358,20 @@ static int tt__split_star(tt__split *S, int f, double area, int *pieces)
 
 /* P11 step 7: triangle f whole in one quad - of its vertices' quads, the
    one facing most like it - its boundary (vertices and split points, so
-   the neighbours meet it) fanned from its centroid, each point projected
-   orthogonally onto the quad's plane and clamped to the quad. 0 when out
-   of memory. */
+   the neighbours meet it) fanned from its centroid. The paper's clamped
+   projection onto the quad would fold a triangle that faces away from
+   the quad, or squash one that overhangs it; instead the triangle is laid
+   flat in its own plane (turned so that its axis nearest the quad's s
+   runs along s), at the model's scale where the quad has room, shrunk
+   to fit where not, and placed over its centroid's projection: a local
+   seam, but every piece keeps its turn. 0 when out of memory. */
 static int tt__split_fallback(tt__split *S, int f)
 {
     const tt_polycube *pc = S->pc;
-    int quad = S->points[S->vert[0]].quad, ids[3], i, n = 0, centre = -1, k;
-    double st[3][2], edge1[3], edge2[3], normal[3], best = -HUGE_VAL;
-    /* Of its vertices' quads, the one facing most like the triangle: projected onto that quad's plane the
-       triangle keeps its turn wherever it can. */
+    int quad = S->points[S->vert[0]].quad, ids[3], i, n = 0, centre = -1, k, a;
+    double edge1[3], edge2[3], normal[3], axis_s[3], axis_w[3], corner0[3], corner1[3], centroid[3] = {0, 0, 0};
+    double best = -HUGE_VAL, lo[2] = {0.0, 0.0}, hi[2] = {0.0, 0.0}, scale = 1.0, place[2], st[3][2];
+    tt_surface_point q;
     tt__sub3f(S->mesh->pos + 3 * S->vert[1], S->mesh->pos + 3 * S->vert[0], edge1);
     tt__sub3f(S->mesh->pos + 3 * S->vert[2], S->mesh->pos + 3 * S->vert[0], edge2);
     tt__cross3(edge1, edge2, normal);
@@ -17242,6 +17389,48 @@ static int tt__split_fallback(tt__split *S, int f)
         S->boundary[n++].vertex = id;
     }
     if (n > 1 && S->boundary[n - 1].vertex == S->boundary[0].vertex) n--;
+    /* The triangle's frame: s along the quad's s laid into the plane (or along its first edge where the
+       planes are square to each other), w a quarter turn on, counter-clockwise about the normal. */
+    q.quad = quad;
+    q.s = q.t = 0.0f;
+    tt_polycube_point_position(pc, q, corner0);
+    q.s = 1.0f;
+    tt_polycube_point_position(pc, q, corner1);
+    tt__normalize3(normal);
+    for (a = 0; a < 3; a++) axis_s[a] = corner1[a] - corner0[a];
+    for (a = 0; a < 3; a++) axis_s[a] -= tt__dot3(axis_s, normal) * normal[a];
+    if (tt__normalize3(axis_s) < 1e-3 * pc->h) {
+        for (a = 0; a < 3; a++) axis_s[a] = edge1[a];
+        tt__normalize3(axis_s);
+    }
+    tt__cross3(normal, axis_s, axis_w);
+    for (k = 0; k < 3; k++)
+        for (a = 0; a < 3; a++) centroid[a] += S->mesh->pos[3 * S->vert[k] + a] / 3.0;
+    for (i = 0; i < n; i++) {
+        double d[3], x[2];
+        for (a = 0; a < 3; a++) d[a] = ((double)S->out->positions[3 * S->boundary[i].vertex + a] - centroid[a]) / pc->h;
+        x[0] = tt__dot3(d, axis_s);
+        x[1] = tt__dot3(d, axis_w);
+        S->boundary[i].at[0] = x[0];
+        S->boundary[i].at[1] = x[1];
+        for (a = 0; a < 2; a++) {
+            if (x[a] < lo[a]) lo[a] = x[a];
+            if (x[a] > hi[a]) hi[a] = x[a];
+        }
+    }
+    for (a = 0; a < 2; a++)
+        if (hi[a] - lo[a] > 0.0 && 1.0 / (hi[a] - lo[a]) < scale) scale = 1.0 / (hi[a] - lo[a]);
+    {
+        double lattice[3];
+        for (a = 0; a < 3; a++) lattice[a] = (centroid[a] - pc->origin[a]) / pc->h;
+        q = tt__polycube_surface_point(pc, quad, lattice);
+        place[0] = q.s;
+        place[1] = q.t;
+    }
+    for (a = 0; a < 2; a++) {
+        if (place[a] + scale * lo[a] < 0.0) place[a] = -scale * lo[a];
+        if (place[a] + scale * hi[a] > 1.0) place[a] = 1.0 - scale * hi[a];
+    }
     if (n > 3) {
         double third[3] = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
         centre = tt__split_vertex(S, S->vert, third);
@@ -17249,15 +17438,11 @@ static int tt__split_fallback(tt__split *S, int f)
     }
     for (i = 0; i < (n > 3 ? n : 1); i++) {
         for (k = 0; k < 3; k++) {
-            double lattice[3];
-            tt_surface_point q;
-            int a;
-            ids[k] = n > 3 ? (k == 0 ? centre : S->boundary[(i + k - 1) % n].vertex) : S->vert[k];
-            for (a = 0; a < 3; a++)
-                lattice[a] = ((double)S->out->positions[3 * ids[k] + a] - pc->origin[a]) / pc->h;
-            q = tt__polycube_surface_point(pc, quad, lattice);
-            st[k][0] = q.s;
-            st[k][1] = q.t;
+            const int b = n > 3 ? (i + k - 1) % n : k;
+            const double *x = n > 3 && k == 0 ? NULL : S->boundary[b].at;
+            ids[k] = n > 3 && k == 0 ? centre : S->boundary[b].vertex;
+            st[k][0] = place[0] + (x ? scale * x[0] : 0.0);
+            st[k][1] = place[1] + (x ? scale * x[1] : 0.0);
         }
         if (!tt__split_triangle(S, f, quad, ids, st)) return 0;
     }
@@ -17284,14 +17469,14 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
 {
     tt_polycube_map_report local;
     tt_polycube_edge_options edge_options;
-    tt_surface_point *points = NULL;
+    tt_surface_point *points = NULL, *before_unspike = NULL;
     tt_polycube_edges *edges = NULL;
     const tt_mesh *model;
     tt__refined R;
     tt__split S;
     tt_result result;
     double longest;
-    int f, v, j;
+    int f, v, j, tracing;
     tt__ok(error);
     if (out) *out = NULL;
     if (!report) report = &local;
@@ -17334,9 +17519,33 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
     }
     if ((report->relaxed = tt__polycube_relax(polycube, model, points, allocator)) < 0) goto out_of_memory;
-    if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
-                                          error)) != TT_OK)
-        goto failed;
+    /* Spikes (tt__polycube_unspike) are taken off and the edges traced again; a vertex whose edges then
+       find no path goes back where it was, and they are traced once more. */
+    for (tracing = 0;; tracing++) {
+        int changed = 0;
+        if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator,
+                                              &edges, error)) != TT_OK)
+            goto failed;
+        if (tracing == 0) {
+            if (!(before_unspike = TT__ALLOC(allocator, tt_surface_point, model->nverts))) goto out_of_memory;
+            memcpy(before_unspike, points, sizeof *points * (size_t)model->nverts);
+            if ((changed = tt__polycube_unspike(polycube, model, edges, points, allocator)) < 0) goto out_of_memory;
+        } else if (tracing == 1) {
+            int c;
+            for (c = 0; c < model->ncorners; c++) {
+                v = model->corner_vert[c];
+                if (!edges->failed[edges->edge_of_halfedge[c]] || (points[v].quad == before_unspike[v].quad &&
+                                                                   points[v].s == before_unspike[v].s &&
+                                                                   points[v].t == before_unspike[v].t))
+                    continue;
+                points[v] = before_unspike[v];
+                changed = 1;
+            }
+        }
+        if (!changed) break;
+        tt_polycube_edges_free(edges);
+        edges = NULL;
+    }
     report->failed_edges = edges->nfailed;
 
     S.pc = polycube;
@@ -17431,6 +17640,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, S.queue);
     tt__free(allocator, S.grid_points);
     tt_polycube_edges_free(edges);
+    tt__free(allocator, before_unspike);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     *out = S.out;
@@ -17445,6 +17655,7 @@ failed:
     tt__free(allocator, S.grid_points);
     tt_polycube_mapping_free(S.out);
     tt_polycube_edges_free(edges);
+    tt__free(allocator, before_unspike);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     memset(report, 0, sizeof *report);
