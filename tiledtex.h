@@ -16168,6 +16168,8 @@ failed:
 #define TT__RELAX_SEAT_RADIUS 2     /* the same around a neighbour's point, where a vertex may be re-seated */
 #define TT__RELAX_CHART 96          /* quads a local chart holds at most */
 #define TT__RELAX_SWEEPS 12
+#define TT__RELAX_KERNEL_POINTS 64  /* a star's kernel polygon: its box's 4 corners and one per triangle */
+#define TT__RELAX_KERNEL_MARGIN 1e-9    /* twice the least area (quad units) of a star triangle around a kernel point */
 
 /* A local chart of S around a quad: the quads within `radius` steps
    across S's edges, found breadth first, each with the map of its frame into the
@@ -16290,6 +16292,58 @@ static double tt__relax_badness(const tt_mesh *model, const tt_surface_point *po
     return bad + 0.9 * folded / (1.0 + folded);
 }
 
+/* The centre (vertex mean) of the kernel of a vertex's star in a chart:
+   the points p with every triangle (p, ring[2i], ring[2i + 1]) turning
+   counter-clockwise by more than TT__RELAX_KERNEL_MARGIN, where
+   no triangle of the star folds. The box around the ring clipped by one
+   half-plane per triangle (Sutherland-Hodgman). 0 when the kernel is
+   empty (or the star too large). */
+static int tt__relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2])
+{
+    double polygon[2][TT__RELAX_KERNEL_POINTS][2], lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+    int n = 4, i, j, k, from = 0;
+    if (ntriangles <= 0 || ntriangles + 4 > TT__RELAX_KERNEL_POINTS) return 0;
+    for (i = 0; i < 2 * ntriangles; i++)
+        for (k = 0; k < 2; k++) {
+            if (ring[i][k] < lo[k]) lo[k] = ring[i][k];
+            if (ring[i][k] > hi[k]) hi[k] = ring[i][k];
+        }
+    polygon[0][0][0] = lo[0]; polygon[0][0][1] = lo[1];
+    polygon[0][1][0] = hi[0]; polygon[0][1][1] = lo[1];
+    polygon[0][2][0] = hi[0]; polygon[0][2][1] = hi[1];
+    polygon[0][3][0] = lo[0]; polygon[0][3][1] = hi[1];
+    for (i = 0; i < ntriangles && n > 0; i++) {
+        const double *a = ring[2 * i], *b = ring[2 * i + 1];
+        double (*in)[2] = polygon[from], (*out)[2] = polygon[!from];
+        int m = 0;
+        for (j = 0; j < n; j++) {
+            const double *p = in[j], *q = in[(j + 1) % n];
+            double fp = tt__orient2(a[0], a[1], b[0], b[1], p[0], p[1]) - TT__RELAX_KERNEL_MARGIN;
+            double fq = tt__orient2(a[0], a[1], b[0], b[1], q[0], q[1]) - TT__RELAX_KERNEL_MARGIN;
+            if (fp >= 0.0) {
+                out[m][0] = p[0];
+                out[m][1] = p[1];
+                m++;
+            }
+            if ((fp >= 0.0) != (fq >= 0.0)) {
+                double u = fp / (fp - fq);
+                out[m][0] = p[0] + u * (q[0] - p[0]);
+                out[m][1] = p[1] + u * (q[1] - p[1]);
+                m++;
+            }
+        }
+        n = m;
+        from = !from;
+    }
+    if (n < 3) return 0;
+    centre[0] = centre[1] = 0.0;
+    for (j = 0; j < n; j++) {
+        centre[0] += polygon[from][j][0] / n;
+        centre[1] += polygon[from][j][1] / n;
+    }
+    return 1;
+}
+
 /* Spec P11 step 5: points that leave a triangle folded on S or its edge
    without a short path (a vertex projected onto the wrong sheet, a fold
    in a concavity) are moved, a few sweeps over the vertices in order:
@@ -16387,6 +16441,31 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                 candidate_at[1] = at[1] + 0.5 * step * (mean[1] / n - at[1]);
                 tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
                 if (tt__relax_chart_point(chart, candidate_at, &candidate)) {
+                    double after;
+                    tt_surface_point kept = points[v];
+                    points[v] = candidate;
+                    tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
+                    tt__relax_chart_place(chart, candidate, candidate_at);
+                    after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, candidate_at);
+                    points[v] = kept;
+                    if (after < best_bad - 1e-12) {
+                        best_bad = after;
+                        best = candidate;
+                    }
+                }
+            }
+            if (reachable && n > 0 && n <= 2 * (TT__RELAX_KERNEL_POINTS - 4)) {
+                /* Into the kernel of v's star, where none of its triangles folds (when its ring allows). */
+                double ring[2 * (TT__RELAX_KERNEL_POINTS - 4)][2];
+                int m = 0;
+                tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
+                for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
+                    int corner = triangle_corners[i], f = corner / 3, k;
+                    for (k = 1; k < 3; k++)
+                        tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], ring[m++]);
+                }
+                if (tt__relax_kernel_centre((const double (*)[2])ring, m / 2, candidate_at) &&
+                    tt__relax_chart_point(chart, candidate_at, &candidate)) {
                     double after;
                     tt_surface_point kept = points[v];
                     points[v] = candidate;
