@@ -2583,9 +2583,12 @@ typedef struct tt_polycube_mapping {
         on it, so the model's vertices on lattice lines are on S's edges
         exactly);
      3. relaxation (P11 step 5): points of folded triangles move toward
-        their neighbours' in a local chart of S, points cut off from their
-        neighbours (no short path) onto a neighbour's sheet, a move kept
-        only when it leaves the vertex's triangles better placed;
+        their neighbours' in a local chart of S, or into the kernel of
+        their star, points cut off from their neighbours (no short path)
+        onto a neighbour's sheet, a move kept only when it leaves the
+        vertex's triangles better placed; then the folds left (a whole
+        patch folded, where no vertex has a good place of its own) are
+        untangled by Escobar et al.'s energy, from their rims inward;
      4. tt_polycube_trace_edges (max_quads); then spikes: a vertex whose
         two edges in one triangle leave it through the same corner W of S
         (it lies just behind a saddle) would map part of that triangle
@@ -16168,6 +16171,12 @@ failed:
 #define TT__RELAX_SEAT_RADIUS 2     /* the same around a neighbour's point, where a vertex may be re-seated */
 #define TT__RELAX_CHART 96          /* quads a local chart holds at most */
 #define TT__RELAX_SWEEPS 12
+#define TT__UNTANGLE_SWEEPS 20      /* untangling sweeps over the vertices near folds */
+#define TT__UNTANGLE_STAR 64        /* triangles around a vertex it untangles at most */
+#define TT__UNTANGLE_EPSILON 0.01   /* Escobar et al.'s epsilon: det J below which delta grows */
+#define TT__UNTANGLE_STEPS 10       /* descent steps per vertex and sweep */
+#define TT__UNTANGLE_FIRST_STEP 0.1 /* a descent step's first length (quad units), halved until it helps */
+#define TT__UNTANGLE_HALVINGS 20
 #define TT__RELAX_KERNEL_POINTS 64  /* a star's kernel polygon: its box's 4 corners and one per triangle */
 #define TT__RELAX_KERNEL_MARGIN 1e-9    /* twice the least area (quad units) of a star triangle around a kernel point */
 
@@ -16176,7 +16185,7 @@ failed:
    centre quad's frame (the first way found: around a cone point of S the
    chart is cut where the search meets itself). */
 typedef struct tt__relax_chart {
-    int count;
+    int count, radius;  /* quads in it; the reach it was built with (around quad[0]) */
     int quad[TT__RELAX_CHART];
     tt_quad_map map[TT__RELAX_CHART];
     int cell[TT__RELAX_CHART][2];   /* the unit cell of the chart the quad covers */
@@ -16189,7 +16198,9 @@ static void tt__relax_chart_build(const tt_polycube *pc, int centre, int radius,
     const tt_mesh *s = pc->surface;
     int head = 0, ring_end, ring, i;
     double middle[2];
+    if (c->count > 0 && c->quad[0] == centre && c->radius == radius) return;   /* built already */
     for (i = 0; i < c->count; i++) c->index_of[c->quad[i]] = -1;
+    c->radius = radius;
     c->count = 1;
     c->quad[0] = centre;
     c->index_of[centre] = 0;
@@ -16344,6 +16355,162 @@ static int tt__relax_kernel_centre(const double (*ring)[2], int ntriangles, doub
     return 1;
 }
 
+/* Flags the vertices of badly placed triangles in bad[] (cleared first)
+   and returns how many triangles are: a triangle is judged in its first
+   vertex's quad frame, the others' quads mapped in across one edge of S
+   when they are next to it, else through a local chart (*scratch); it is
+   bad when folded (not counter-clockwise) or out of the chart's reach. */
+static int tt__relax_mark_bad(const tt_polycube *pc, const tt_mesh *model, const tt_surface_point *points,
+                              tt__relax_chart *scratch, unsigned char *bad)
+{
+    int c, count = 0;
+    memset(bad, 0, (size_t)model->nverts);
+    for (c = 0; c < model->ncorners; c += 3) {
+        const int *t = model->corner_vert + c;
+        double at[3][2];
+        int k, placed = 1;
+        at[0][0] = points[t[0]].s;
+        at[0][1] = points[t[0]].t;
+        for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(pc, points[t[0]].quad, points[t[k]], at[k], scratch);
+        if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0) continue;
+        bad[t[0]] = bad[t[1]] = bad[t[2]] = 1;
+        count++;
+    }
+    return count;
+}
+
+/* Whether vertex v's point is its own 3D position (the model touches S
+   there): such points never move. */
+static int tt__relax_on_surface(const tt_polycube *pc, const tt_mesh *model, const tt_surface_point *points, int v)
+{
+    double here[3], d2 = 0.0;
+    int a;
+    tt_polycube_point_position(pc, points[v], here);
+    for (a = 0; a < 3; a++) d2 += (here[a] - model->pos[3 * v + a]) * (here[a] - model->pos[3 * v + a]);
+    return d2 <= 1e-18 * pc->h * pc->h;
+}
+
+/* A vertex's star for untangling: per triangle (v, a, b), a and b in the
+   chart, and the triangle's own shape (its 3D edges v -> a, v -> b laid
+   flat, in cube units), which the map should keep. */
+typedef struct tt__untangle_star {
+    int n;
+    double ring[TT__UNTANGLE_STAR][2][2];
+    double shape[TT__UNTANGLE_STAR][2][2];
+} tt__untangle_star;
+
+/* The untangling energy of Escobar et al. ("Simultaneous untangling and
+   smoothing of tetrahedral meshes", CMAME 2003), in 2D, with v at x: per
+   triangle, J maps its own shape onto the chart triangle (x, a, b) and
+   costs |J|^2 / (2 h(det J)), h(s) = (s + sqrt(s^2 + delta2)) / 2. With
+   delta2 > 0 it is finite for folded triangles and falls steeply toward
+   unfolding them; unfolded, it is least where J is a similarity (1 per
+   triangle). The gradient in x goes to gradient[2]; *folded counts the
+   triangles with det J <= 0. */
+static double tt__untangle_energy(const tt__untangle_star *star, const double x[2], double delta2,
+                                  double gradient[2], int *folded)
+{
+    double energy = 0.0;
+    int i;
+    gradient[0] = gradient[1] = 0.0;
+    *folded = 0;
+    for (i = 0; i < star->n; i++) {
+        const double *a = star->ring[i][0], *b = star->ring[i][1], *sa = star->shape[i][0], *sb = star->shape[i][1];
+        const double shape_det = sa[0] * sb[1] - sb[0] * sa[1];
+        /* J = [a - x, b - x] times the shape's inverse. */
+        const double i00 = sb[1] / shape_det, i01 = -sb[0] / shape_det, i10 = -sa[1] / shape_det, i11 = sa[0] / shape_det;
+        const double j00 = (a[0] - x[0]) * i00 + (b[0] - x[0]) * i10, j01 = (a[0] - x[0]) * i01 + (b[0] - x[0]) * i11;
+        const double j10 = (a[1] - x[1]) * i00 + (b[1] - x[1]) * i10, j11 = (a[1] - x[1]) * i01 + (b[1] - x[1]) * i11;
+        /* Moving x by e_k adds d = -(i00 + i10, i01 + i11) to row k of J. */
+        const double d0 = -(i00 + i10), d1 = -(i01 + i11);
+        const double det = j00 * j11 - j01 * j10, frobenius = j00 * j00 + j01 * j01 + j10 * j10 + j11 * j11;
+        const double root = sqrt(det * det + delta2), h = 0.5 * (det + root);
+        const double dh = root > 0.0 ? 0.5 * (1.0 + det / root) : 0.5;
+        double dfrobenius[2], ddet[2];
+        int k;
+        *folded += det <= 0.0;
+        dfrobenius[0] = 2.0 * (j00 * d0 + j01 * d1);
+        dfrobenius[1] = 2.0 * (j10 * d0 + j11 * d1);
+        ddet[0] = d0 * j11 - d1 * j10;
+        ddet[1] = j00 * d1 - j01 * d0;
+        energy += frobenius / (2.0 * h);
+        for (k = 0; k < 2; k++) gradient[k] += dfrobenius[k] / (2.0 * h) - frobenius * dh * ddet[k] / (2.0 * h * h);
+    }
+    return energy;
+}
+
+/* One untangling step of vertex v: its star in a chart around its point,
+   a few steepest-descent steps of tt__untangle_energy with halving step
+   lengths, kept when no more of its triangles fold than before. Returns
+   1 when v moved. */
+static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
+                               const int *first_triangle, const int *triangle_corners, int v, tt__relax_chart *chart,
+                               tt__untangle_star *star)
+{
+    double x[2], gradient[2], energy, least_det = HUGE_VAL, delta2;
+    int i, step, folded_before, folded;
+    tt_surface_point moved;
+    if (first_triangle[v + 1] - first_triangle[v] > TT__UNTANGLE_STAR) return 0;
+    tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
+    tt__relax_chart_place(chart, points[v], x);
+    star->n = 0;
+    for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
+        const int corner = triangle_corners[i], f = corner / 3;
+        const int a = model->corner_vert[3 * f + (corner % 3 + 1) % 3], b = model->corner_vert[3 * f + (corner % 3 + 2) % 3];
+        double edge_a[3], edge_b[3], normal[3], along[3], across[3], length;
+        int k;
+        if (!tt__relax_chart_place(chart, points[a], star->ring[star->n][0]) ||
+            !tt__relax_chart_place(chart, points[b], star->ring[star->n][1]))
+            return 0;
+        for (k = 0; k < 3; k++) {
+            edge_a[k] = ((double)model->pos[3 * a + k] - model->pos[3 * v + k]) / pc->h;
+            edge_b[k] = ((double)model->pos[3 * b + k] - model->pos[3 * v + k]) / pc->h;
+        }
+        tt__cross3(edge_a, edge_b, normal);
+        if (!((length = tt__length3(edge_a)) > 0.0) || !(tt__normalize3(normal) > 0.0)) return 0;
+        for (k = 0; k < 3; k++) along[k] = edge_a[k] / length;
+        tt__cross3(normal, along, across);
+        star->shape[star->n][0][0] = length;
+        star->shape[star->n][0][1] = 0.0;
+        star->shape[star->n][1][0] = tt__dot3(edge_b, along);
+        star->shape[star->n][1][1] = tt__dot3(edge_b, across);
+        /* det J of this triangle, for delta below. */
+        {
+            const double turn = tt__orient2(x[0], x[1], star->ring[star->n][0][0], star->ring[star->n][0][1],
+                                            star->ring[star->n][1][0], star->ring[star->n][1][1]);
+            const double det = turn / (length * star->shape[star->n][1][1]);
+            if (det < least_det) least_det = det;
+        }
+        star->n++;
+    }
+    /* Escobar et al.'s delta: 0 once nothing is near folding, else growing with the worst fold. */
+    delta2 = least_det < TT__UNTANGLE_EPSILON ? TT__UNTANGLE_EPSILON * (TT__UNTANGLE_EPSILON - least_det) : 0.0;
+    energy = tt__untangle_energy(star, x, delta2, gradient, &folded_before);
+    for (step = 0; step < TT__UNTANGLE_STEPS; step++) {
+        const double norm = sqrt(gradient[0] * gradient[0] + gradient[1] * gradient[1]);
+        double length = TT__UNTANGLE_FIRST_STEP, trial[2], trial_gradient[2], trial_energy = energy;
+        int halvings;
+        if (!(norm > 0.0)) break;
+        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS; halvings++, length *= 0.5) {
+            trial[0] = x[0] - length * gradient[0] / norm;
+            trial[1] = x[1] - length * gradient[1] / norm;
+            trial_energy = tt__untangle_energy(star, trial, delta2, trial_gradient, &folded);
+            if (trial_energy < energy) break;
+        }
+        if (halvings == TT__UNTANGLE_HALVINGS) break;
+        x[0] = trial[0];
+        x[1] = trial[1];
+        energy = trial_energy;
+        gradient[0] = trial_gradient[0];
+        gradient[1] = trial_gradient[1];
+    }
+    tt__untangle_energy(star, x, delta2, gradient, &folded);
+    if (folded > folded_before || !tt__relax_chart_point(chart, x, &moved)) return 0;
+    if (moved.quad == points[v].quad && moved.s == points[v].s && moved.t == points[v].t) return 0;
+    points[v] = moved;
+    return 1;
+}
+
 /* Spec P11 step 5: points that leave a triangle folded on S or its edge
    without a short path (a vertex projected onto the wrong sheet, a fold
    in a concavity) are moved, a few sweeps over the vertices in order:
@@ -16351,10 +16518,15 @@ static int tt__relax_kernel_centre(const double (*ring)[2], int ntriangles, doub
        way), in a local chart of S around it, when they all lie in it;
      - else to the closest point to its 3D position on the quads around a
        neighbour's point (onto its neighbours' sheet);
+     - into the centre of its star's kernel (tt__relax_kernel_centre);
    a move is kept only when it leaves the vertex's triangles less badly
    placed (tt__relax_badness). Vertices whose triangles are all fine never
    move, and the ones whose points lie on S (the model touches the
-   polycube) stay. Returns the number of moves, -1 when out of memory. */
+   polycube) stay. A patch folded all through defeats these moves (each
+   vertex's ring is folded too), so then the vertices of bad triangles and
+   their neighbours are untangled (tt__untangle_vertex), sweep by sweep,
+   until no fold is left or nothing moves. Returns the number of moves, -1
+   when out of memory. */
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                               const tt_allocator *allocator)
 {
@@ -16362,6 +16534,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     tt_quad_map *unfold = NULL;
     unsigned char *bad = NULL;
     tt__relax_chart *chart = NULL, *around = NULL;
+    tt__untangle_star *star = NULL;
     int v, c, sweep, moves = 0, nverts = model->nverts, nquads = pc->surface->nfaces;
     first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
@@ -16370,7 +16543,8 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     chart = TT__ALLOC(allocator, tt__relax_chart, 2);
     index_of = TT__ALLOC(allocator, int, 2 * (size_t)nquads);
     unfold = TT__ALLOC(allocator, tt_quad_map, pc->surface->ncorners);
-    if (!first_triangle || !triangle_corners || !count || !bad || !chart || !index_of || !unfold) {
+    star = TT__ALLOC(allocator, tt__untangle_star, 1);
+    if (!first_triangle || !triangle_corners || !count || !bad || !chart || !index_of || !unfold || !star) {
         moves = -1;
         goto done;
     }
@@ -16391,33 +16565,13 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     for (c = 0; c < model->ncorners; c++) triangle_corners[count[model->corner_vert[c]]++] = c;
     for (sweep = 0; sweep < TT__RELAX_SWEEPS; sweep++) {
         int moved = 0;
-        /* The vertices of badly placed triangles: the triangle judged in its first vertex's quad frame,
-           the others' quads mapped in across one edge of S when they are next to it, else through a
-           local chart. */
-        memset(bad, 0, (size_t)nverts);
-        for (c = 0; c < model->ncorners; c += 3) {
-            const int *t = model->corner_vert + c;
-            double at[3][2];
-            int k, placed = 1;
-            at[0][0] = points[t[0]].s;
-            at[0][1] = points[t[0]].t;
-            for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(pc, points[t[0]].quad, points[t[k]], at[k], chart);
-            if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0)
-                continue;
-            bad[t[0]] = bad[t[1]] = bad[t[2]] = 1;
-        }
+        tt__relax_mark_bad(pc, model, points, chart, bad);
         for (v = 0; v < nverts; v++) {
-            double at[2], mean[2] = {0.0, 0.0}, here[3], candidate_at[2];
+            double at[2], mean[2] = {0.0, 0.0}, candidate_at[2];
             int i, n = 0, reachable = 1, a, step;
             double before, best_bad;
             tt_surface_point best, candidate;
-            if (!bad[v]) continue;
-            tt_polycube_point_position(pc, points[v], here);
-            {
-                double d2 = 0.0;
-                for (a = 0; a < 3; a++) d2 += (here[a] - model->pos[3 * v + a]) * (here[a] - model->pos[3 * v + a]);
-                if (d2 <= 1e-18 * pc->h * pc->h) continue;
-            }
+            if (!bad[v] || tt__relax_on_surface(pc, model, points, v)) continue;
             tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
             tt__relax_chart_place(chart, points[v], at);
             before = best_bad = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, at);
@@ -16529,6 +16683,25 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         moves += moved;
         if (!moved) break;
     }
+    /* The folds these moves leave (a vertex whose ring is itself folded has no good place of its own):
+       untangling, over the vertices of bad triangles and their neighbours, so that folds open from
+       their rims inward. */
+    for (sweep = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
+        int moved = 0;
+        if (!tt__relax_mark_bad(pc, model, points, chart, bad)) break;
+        for (c = 0; c < model->ncorners; c += 3) {
+            const int *t = model->corner_vert + c;
+            int k;
+            if (bad[t[0]] != 1 && bad[t[1]] != 1 && bad[t[2]] != 1) continue;
+            for (k = 0; k < 3; k++)
+                if (!bad[t[k]]) bad[t[k]] = 2;
+        }
+        for (v = 0; v < nverts; v++)
+            if (bad[v] && !tt__relax_on_surface(pc, model, points, v))
+                moved += tt__untangle_vertex(pc, model, points, first_triangle, triangle_corners, v, chart, star);
+        moves += moved;
+        if (!moved) break;
+    }
 done:
     tt__free(allocator, first_triangle);
     tt__free(allocator, triangle_corners);
@@ -16537,6 +16710,7 @@ done:
     tt__free(allocator, chart);
     tt__free(allocator, index_of);
     tt__free(allocator, unfold);
+    tt__free(allocator, star);
     return moves;
 }
 

@@ -2428,6 +2428,192 @@ static void test_map_open_and_messy(void)
     }
 }
 
+/* ------------------------------------------------------------------------ */
+/* P11 step 5: the relaxation's kernel move and its untangling              */
+/* ------------------------------------------------------------------------ */
+
+/* Whether p sees every triangle (p, a, b) of the star turning
+   counter-clockwise by more than `margin` (twice the area). */
+static int star_unfolded(const double (*ring)[2], int n, const double p[2], double margin)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        const double *a = ring[2 * i], *b = ring[2 * i + 1];
+        if ((a[0] - p[0]) * (b[1] - p[1]) - (a[1] - p[1]) * (b[0] - p[0]) <= margin) return 0;
+    }
+    return 1;
+}
+
+/* The kernel centre against brute force: on random rings around a point
+   (some star-shaped, some not), a centre when found unfolds the whole star,
+   and wherever a fine grid finds a point that does, a centre is found. */
+static void test_relax_kernel(void)
+{
+    int round, found = 0, missed = 0, wrong = 0, empty = 0;
+    lcg_seed(99);
+    for (round = 0; round < 400; round++) {
+        double ring[2 * 12][2], angle[12], radius[12], centre[2], lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+        int n = 3 + lcg_below(10), i, j, k, grid_found = 0, got;
+        /* Even turns around the origin (star-shaped there), random ones sorted, whose gaps may pass half a
+           turn (star-shaped or not), or unsorted (a ring crossing itself: mostly no kernel). */
+        for (i = 0; i < n; i++) {
+            angle[i] = round % 2 ? 6.283185307179586 * lcg_unit() : 6.283185307179586 * (i + 0.8 * lcg_unit()) / n;
+            radius[i] = 0.2 + lcg_unit();
+        }
+        for (i = 1; i < n && round % 4 != 3; i++)
+            for (j = i; j > 0 && angle[j - 1] > angle[j]; j--) {
+                double swap = angle[j];
+                angle[j] = angle[j - 1];
+                angle[j - 1] = swap;
+            }
+        for (i = 0; i < n; i++)
+            for (k = 0; k < 2; k++) {
+                const int at = (i + k) % n;
+                ring[2 * i + k][0] = radius[at] * cos(angle[at]);
+                ring[2 * i + k][1] = radius[at] * sin(angle[at]);
+                for (j = 0; j < 2; j++) {
+                    if (ring[2 * i + k][j] < lo[j]) lo[j] = ring[2 * i + k][j];
+                    if (ring[2 * i + k][j] > hi[j]) hi[j] = ring[2 * i + k][j];
+                }
+            }
+        for (i = 0; i <= 200 && !grid_found; i++)
+            for (j = 0; j <= 200 && !grid_found; j++) {
+                double p[2];
+                p[0] = lo[0] + (hi[0] - lo[0]) * i / 200.0;
+                p[1] = lo[1] + (hi[1] - lo[1]) * j / 200.0;
+                grid_found = star_unfolded((const double (*)[2])ring, n, p, 1e-6);
+            }
+        got = internal_relax_kernel_centre((const double (*)[2])ring, n, centre);
+        found += got;
+        empty += !grid_found;
+        missed += grid_found && !got;
+        wrong += got && !star_unfolded((const double (*)[2])ring, n, centre, 0.0);
+    }
+    CHECK(missed == 0 && wrong == 0 && found > 50 && empty > 50,
+          "star kernels of 400 random rings: %d found (%d empty by a 200 x 200 grid), %d missed where the grid "
+          "found a point, %d centres that leave a triangle folded", found, empty, missed, wrong);
+}
+
+/* The untangling energy (Escobar et al. in 2D): 1 per triangle for a
+   similarity of the triangle's shape, its gradient as central differences
+   give it, and its fold count as orientation gives it. */
+static void test_untangle_energy(void)
+{
+    double ring[8][2][2], shape[8][2][2], x[2] = {0.0, 0.0}, gradient[2];
+    int round, i, folded, bad_gradient = 0, bad_folds = 0;
+    double worst = 0.0, similarity;
+    lcg_seed(7);
+    for (i = 0; i < 6; i++) {
+        double a0 = 6.283185307179586 * i / 6, a1 = 6.283185307179586 * (i + 1) / 6;
+        double scale = 0.3, turn = 0.7, k;
+        shape[i][0][0] = cos(a0);
+        shape[i][0][1] = sin(a0);
+        shape[i][1][0] = cos(a1);
+        shape[i][1][1] = sin(a1);
+        for (k = 0; k < 2; k++) {
+            const double *p = shape[i][(int)k];
+            ring[i][(int)k][0] = scale * (cos(turn) * p[0] - sin(turn) * p[1]);
+            ring[i][(int)k][1] = scale * (sin(turn) * p[0] + cos(turn) * p[1]);
+        }
+    }
+    similarity = internal_untangle_energy(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.0,
+                                          gradient, &folded);
+    CHECK(fabs(similarity - 6.0) < 1e-12 && folded == 0 && fabs(gradient[0]) + fabs(gradient[1]) < 1e-9,
+          "a star turned and scaled as a whole costs 1 per triangle (%.15g for 6), none folded (%d), and is "
+          "a minimum (gradient %.2g, %.2g)", similarity, folded, gradient[0], gradient[1]);
+    for (round = 0; round < 200; round++) {
+        double delta2 = round % 4 ? 1e-4 + 1e-3 * lcg_unit() : 0.0, step = 1e-6, plus, minus, p[2], g[2];
+        int n = 3 + lcg_below(6), naive = 0, k;
+        for (i = 0; i < n; i++)
+            for (k = 0; k < 2; k++) {
+                ring[i][k][0] = 2.0 * lcg_unit() - 1.0;
+                ring[i][k][1] = 2.0 * lcg_unit() - 1.0;
+                shape[i][k][0] = k ? 0.2 + lcg_unit() : 0.5 + lcg_unit();
+                shape[i][k][1] = k ? 0.3 + lcg_unit() : 0.0;
+            }
+        x[0] = 0.5 * lcg_unit() - 0.25;
+        x[1] = 0.5 * lcg_unit() - 0.25;
+        internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, delta2, gradient,
+                                 &folded);
+        for (i = 0; i < n; i++)
+            naive += (ring[i][0][0] - x[0]) * (ring[i][1][1] - x[1]) - (ring[i][0][1] - x[1]) * (ring[i][1][0] - x[0]) <= 0.0;
+        bad_folds += naive != folded;
+        if (delta2 == 0.0 && naive) continue;   /* without delta a fold has no finite energy */
+        for (k = 0; k < 2; k++) {
+            double scale;
+            p[0] = x[0];
+            p[1] = x[1];
+            p[k] += step;
+            plus = internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, p, delta2,
+                                            g, &folded);
+            p[k] -= 2.0 * step;
+            minus = internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, p, delta2,
+                                             g, &folded);
+            scale = fabs(gradient[k]) > 1.0 ? fabs(gradient[k]) : 1.0;
+            if (fabs((plus - minus) / (2.0 * step) - gradient[k]) / scale > worst)
+                worst = fabs((plus - minus) / (2.0 * step) - gradient[k]) / scale;
+        }
+        bad_gradient += worst > 1e-4;
+    }
+    CHECK(bad_gradient == 0 && bad_folds == 0,
+          "untangling energy on 200 random stars: gradient as central differences (worst relative error %.2g), "
+          "folds as orientation (%d stars differ)", worst, bad_folds);
+}
+
+/* A patch of points mirrored inside its quad is folded all through: no
+   vertex inside it has a place of its own that unfolds its star (its ring
+   is folded too), so moves one vertex at a time cannot open it. The
+   untangling opens it from its rim. */
+static void test_relax_untangles(void)
+{
+    const double centre[3] = {0.0, 0.0, 0.0};
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_surface_point *pts = NULL;
+    tt_polycube_options o;
+    tt_polycube_projection_report pr;
+    tt_polycube_report rep;
+    tt_polycube *pc;
+    int *in_quad, best = -1, v, c, mirrored = 0, before = 0, after = 0;
+    memset(&m, 0, sizeof m);
+    make_sphere(&m, 96, 48, 1.0, centre, 0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 4;
+    pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+    if (!pc) { tm_free(&m); return; }
+    in_quad = (int *)calloc((size_t)pc->surface->nfaces, sizeof(int));
+    for (v = 0; v < mesh->nverts; v++) in_quad[pts[v].quad]++;
+    for (c = 0; c < pc->surface->nfaces; c++)
+        if (best < 0 || in_quad[c] > in_quad[best]) best = c;
+    /* Mirror the points near the middle of the fullest quad: s -> 1 - s about its middle line. */
+    for (v = 0; v < mesh->nverts; v++)
+        if (pts[v].quad == best && fabs(pts[v].s - 0.5f) < 0.3f && fabs(pts[v].t - 0.5f) < 0.3f) {
+            pts[v].s = 1.0f - pts[v].s;
+            mirrored++;
+        }
+    for (c = 0; c < mesh->ncorners; c += 3) {
+        const tt_surface_point *a = &pts[mesh->corner_vert[c]], *b = &pts[mesh->corner_vert[c + 1]],
+                               *d = &pts[mesh->corner_vert[c + 2]];
+        if (a->quad == best && b->quad == best && d->quad == best)
+            before += (b->s - a->s) * (d->t - a->t) - (b->t - a->t) * (d->s - a->s) <= 0.0f;
+    }
+    internal_polycube_relax(pc, mesh, pts);
+    for (c = 0; c < mesh->ncorners; c += 3) {
+        const tt_surface_point *a = &pts[mesh->corner_vert[c]], *b = &pts[mesh->corner_vert[c + 1]],
+                               *d = &pts[mesh->corner_vert[c + 2]];
+        if (a->quad == b->quad && a->quad == d->quad)
+            after += (b->s - a->s) * (d->t - a->t) - (b->t - a->t) * (d->s - a->s) <= 0.0f;
+    }
+    CHECK(mirrored >= 20 && before >= 30 && after == 0,
+          "a mirrored patch of %d points (%d triangles folded in its quad) untangled: %d triangles within one quad "
+          "still folded", mirrored, before, after);
+    free(in_quad);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    free(pts);
+    tm_free(&m);
+}
+
 /* Q13 in short: small random closed meshes (bumpy spheres, turned and
    scaled at random) at random resolutions map without a crack (closed
    strict output), with their area, every corner in one quad. */
@@ -2507,6 +2693,9 @@ void run_polycube_tests(void)
     RUN(test_edges_cube);
     RUN(test_edges_sphere);
     RUN(test_edges_from_corner);
+    RUN(test_relax_kernel);
+    RUN(test_untangle_energy);
+    RUN(test_relax_untangles);
     RUN(test_edges_determinism_and_errors);
     RUN(test_map_cube);
     RUN(test_map_sphere);

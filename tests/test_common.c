@@ -321,6 +321,26 @@ int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], doub
     return tt__polycube_voxelize(mesh, origin, h, dims, tt__polycube_tie(mesh, h), mark);
 }
 int internal_polycube_mask_is_disc(int mask) { return tt__polycube_mask_is_disc(mask); }
+int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points)
+{
+    return tt__polycube_relax(polycube, model, points, NULL);
+}
+int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2])
+{
+    return tt__relax_kernel_centre(ring, ntriangles, centre);
+}
+double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
+                                double delta2, double gradient[2], int *folded)
+{
+    tt__untangle_star star;
+    int i;
+    star.n = n;
+    for (i = 0; i < n; i++) {
+        memcpy(star.ring[i], ring[i], sizeof star.ring[i]);
+        memcpy(star.shape[i], shape[i], sizeof star.shape[i]);
+    }
+    return tt__untangle_energy(&star, x, delta2, gradient, folded);
+}
 int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
 float internal_infinity(void) { return tt__infinity(); }
 double internal_not_a_number(void) { return tt__not_a_number(); }

@@ -173,6 +173,14 @@ tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_
 int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], double h, const int dims[3],
                                unsigned char *mark);
 int internal_polycube_mask_is_disc(int mask);
+/* Section 9's relaxation and untangling of points on S (P11 step 5; NULL
+   allocator; returns the moves, -1 out of memory), the kernel centre of a
+   star (ring: two points per triangle, its far edge counter-clockwise; 0
+   when empty) and the untangling energy of a star of n <= 64 triangles. */
+int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points);
+int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2]);
+double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
+                                double delta2, double gradient[2], int *folded);
 int internal_polycube_mask_critical(int mask);
 
 #endif /* TEST_COMMON_H */
