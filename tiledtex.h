@@ -15787,10 +15787,14 @@ TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges)
     tt__free(&allocator, edges);
 }
 
-TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_mesh *mesh,
-                                        const tt_surface_point *points, int npoints,
-                                        const tt_polycube_edge_options *options, const tt_allocator *allocator,
-                                        tt_polycube_edges **out, tt_error *error)
+/* tt_polycube_trace_edges, or, given the records `previous` made from the
+   same mesh and the same points except those of the vertices flagged in
+   `moved`, a copy of those records with only the edges at a moved vertex
+   traced again. */
+static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mesh, const tt_surface_point *points,
+                                 int npoints, const tt_polycube_edge_options *options,
+                                 const tt_allocator *allocator, const tt_polycube_edges *previous,
+                                 const unsigned char *moved, tt_polycube_edges **out, tt_error *error)
 {
     tt_polycube_edges *E = NULL;
     tt__edge_search *S = NULL;
@@ -15856,6 +15860,23 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
         int count, i, quads_a[TT__CORNER_QUADS], quads_b[TT__CORNER_QUADS], na, nb, ia, ib;
         double st_a[TT__CORNER_QUADS][2], st_b[TT__CORNER_QUADS][2];
         E->first_crossing[e] = E->ncrossings;
+        if (previous && !moved[E->edge_vertices[2 * e]] && !moved[E->edge_vertices[2 * e + 1]]) {
+            const int first = previous->first_crossing[e];
+            count = previous->first_crossing[e + 1] - first;
+            if (count > 0) {
+                tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(allocator, E->crossings, &capacity,
+                                                                       E->ncrossings + count, sizeof(tt_edge_crossing));
+                if (!grown) goto out_of_memory;
+                E->crossings = grown;
+                memcpy(E->crossings + E->ncrossings, previous->crossings + first, sizeof(tt_edge_crossing) * (size_t)count);
+                E->ncrossings += count;
+            }
+            E->end_quads[2 * e] = previous->end_quads[2 * e];
+            E->end_quads[2 * e + 1] = previous->end_quads[2 * e + 1];
+            E->failed[e] = previous->failed[e];
+            E->nfailed += E->failed[e];
+            continue;
+        }
         /* An end on a corner of S lies in every quad there: the path may start (or end) in any of them, the
            point's own quad first, so that it keeps ties. */
         na = tt__quads_at_point(polycube->surface, qa, quads_a, st_a);
@@ -15946,6 +15967,14 @@ out_of_memory:
     tt__free(allocator, S);
     tt_polycube_edges_free(E);
     return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory tracing the mesh's edges on S");
+}
+
+TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_mesh *mesh,
+                                        const tt_surface_point *points, int npoints,
+                                        const tt_polycube_edge_options *options, const tt_allocator *allocator,
+                                        tt_polycube_edges **out, tt_error *error)
+{
+    return tt__trace_edges(polycube, mesh, points, npoints, options, allocator, NULL, NULL, out, error);
 }
 
 /* ---- The model refined (before spec P11 step 2) ---- */
@@ -16172,6 +16201,7 @@ failed:
 #define TT__RELAX_CHART 96          /* quads a local chart holds at most */
 #define TT__RELAX_SWEEPS 12
 #define TT__UNTANGLE_SWEEPS 20      /* untangling sweeps over the vertices near folds */
+#define TT__UNTANGLE_PATIENCE 3     /* sweeps without fewer bad triangles after which it stops */
 #define TT__UNTANGLE_STAR 64        /* triangles around a vertex it untangles at most */
 #define TT__UNTANGLE_EPSILON 0.01   /* Escobar et al.'s epsilon: det J below which delta grows */
 #define TT__UNTANGLE_STEPS 10       /* descent steps per vertex and sweep */
@@ -16355,13 +16385,31 @@ static int tt__relax_kernel_centre(const double (*ring)[2], int ntriangles, doub
     return 1;
 }
 
+/* Whether triangle t turns clockwise in the frames of all three of its
+   points' quads. Around a cone of S the chart of one quad may show a
+   triangle folded that lies flat on S, but not the charts of all three. */
+static int tt__relax_folded_everywhere(const tt_polycube *pc, const tt_surface_point *points, const int *t,
+                                       tt__relax_chart *scratch)
+{
+    int first, k;
+    for (first = 1; first < 3; first++) {
+        double at[3][2];
+        at[0][0] = points[t[first]].s;
+        at[0][1] = points[t[first]].t;
+        for (k = 1; k < 3; k++)
+            if (!tt__relax_place_near(pc, points[t[first]].quad, points[t[(first + k) % 3]], at[k], scratch)) return 0;
+        if (tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0) return 0;
+    }
+    return 1;
+}
+
 /* Flags the vertices of badly placed triangles in bad[] (cleared first)
    and returns how many triangles are: a triangle is judged in its first
    vertex's quad frame, the others' quads mapped in across one edge of S
    when they are next to it, else through a local chart (*scratch); it is
    bad when folded (not counter-clockwise) or out of the chart's reach. */
 static int tt__relax_mark_bad(const tt_polycube *pc, const tt_mesh *model, const tt_surface_point *points,
-                              tt__relax_chart *scratch, unsigned char *bad)
+                              tt__relax_chart *scratch, int folds_only, unsigned char *bad)
 {
     int c, count = 0;
     memset(bad, 0, (size_t)model->nverts);
@@ -16373,6 +16421,7 @@ static int tt__relax_mark_bad(const tt_polycube *pc, const tt_mesh *model, const
         at[0][1] = points[t[0]].t;
         for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(pc, points[t[0]].quad, points[t[k]], at[k], scratch);
         if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0) continue;
+        if (folds_only && (!placed || !tt__relax_folded_everywhere(pc, points, t, scratch))) continue;
         bad[t[0]] = bad[t[1]] = bad[t[2]] = 1;
         count++;
     }
@@ -16535,7 +16584,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     unsigned char *bad = NULL;
     tt__relax_chart *chart = NULL, *around = NULL;
     tt__untangle_star *star = NULL;
-    int v, c, sweep, moves = 0, nverts = model->nverts, nquads = pc->surface->nfaces;
+    int v, c, sweep, moves = 0, nverts = model->nverts, nquads = pc->surface->nfaces, least_bad, stalled;
     first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
     count = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
@@ -16565,7 +16614,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     for (c = 0; c < model->ncorners; c++) triangle_corners[count[model->corner_vert[c]]++] = c;
     for (sweep = 0; sweep < TT__RELAX_SWEEPS; sweep++) {
         int moved = 0;
-        tt__relax_mark_bad(pc, model, points, chart, bad);
+        tt__relax_mark_bad(pc, model, points, chart, 0, bad);
         for (v = 0; v < nverts; v++) {
             double at[2], mean[2] = {0.0, 0.0}, candidate_at[2];
             int i, n = 0, reachable = 1, a, step;
@@ -16686,9 +16735,17 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     /* The folds these moves leave (a vertex whose ring is itself folded has no good place of its own):
        untangling, over the vertices of bad triangles and their neighbours, so that folds open from
        their rims inward. */
-    for (sweep = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
-        int moved = 0;
-        if (!tt__relax_mark_bad(pc, model, points, chart, bad)) break;
+    for (sweep = 0, least_bad = INT_MAX, stalled = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
+        int moved = 0, nbad = tt__relax_mark_bad(pc, model, points, chart, 1, bad);
+        /* Done when no fold is left, or when the count has not fallen for a few sweeps (folds it cannot
+           reach: the vertices just keep smoothing around them). */
+        if (!nbad) break;
+        if (nbad < least_bad) {
+            least_bad = nbad;
+            stalled = 0;
+        } else if (++stalled == TT__UNTANGLE_PATIENCE) {
+            break;
+        }
         for (c = 0; c < model->ncorners; c += 3) {
             const int *t = model->corner_vert + c;
             int k;
@@ -16737,9 +16794,10 @@ static int tt__edge_apex_from(const tt_mesh *s, const tt_polycube_edges *edges, 
    them would map onto the segment v -> W, a piece with no texture area. v
    is moved onto W, where both edges then start, unless another point is
    there already (two vertices at one place would make the same kind of
-   piece). Returns the number of points moved, -1 when out of memory. */
+   piece). Each point moved is flagged in moved_points[]. Returns the
+   number of points moved, -1 when out of memory. */
 static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
-                                tt_surface_point *points, const tt_allocator *allocator)
+                                tt_surface_point *points, unsigned char *moved_points, const tt_allocator *allocator)
 {
     const tt_mesh *s = pc->surface;
     unsigned char *taken = TT__ALLOC(allocator, unsigned char, s->nverts);
@@ -16762,6 +16820,7 @@ static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, con
         points[v].s = (float)st[0];
         points[v].t = (float)st[1];
         taken[apex] = 1;
+        moved_points[v] = 1;
         moved++;
     }
     tt__free(allocator, taken);
@@ -17723,6 +17782,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt_polycube_map_report local;
     tt_polycube_edge_options edge_options;
     tt_surface_point *points = NULL, *before_unspike = NULL;
+    unsigned char *moved = NULL;
     tt_polycube_edges *edges = NULL;
     const tt_mesh *model;
     tt__refined R;
@@ -17772,19 +17832,24 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
     }
     if ((report->relaxed = tt__polycube_relax(polycube, model, points, allocator)) < 0) goto out_of_memory;
-    /* Spikes (tt__polycube_unspike) are taken off and the edges traced again; a vertex whose edges then
-       find no path goes back where it was, and they are traced once more. */
-    for (tracing = 0;; tracing++) {
-        int changed = 0;
-        if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator,
-                                              &edges, error)) != TT_OK)
-            goto failed;
+    /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
+       vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
+    if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
+                                          error)) != TT_OK)
+        goto failed;
+    if (!(before_unspike = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
+        !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)))
+        goto out_of_memory;
+    memcpy(before_unspike, points, sizeof *points * (size_t)model->nverts);
+    memset(moved, 0, (size_t)model->nverts);
+    for (tracing = 0; tracing < 2; tracing++) {
+        tt_polycube_edges *again = NULL;
+        int changed = 0, c;
         if (tracing == 0) {
-            if (!(before_unspike = TT__ALLOC(allocator, tt_surface_point, model->nverts))) goto out_of_memory;
-            memcpy(before_unspike, points, sizeof *points * (size_t)model->nverts);
-            if ((changed = tt__polycube_unspike(polycube, model, edges, points, allocator)) < 0) goto out_of_memory;
-        } else if (tracing == 1) {
-            int c;
+            if ((changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator)) < 0)
+                goto out_of_memory;
+        } else {
+            memset(moved, 0, (size_t)model->nverts);
             for (c = 0; c < model->ncorners; c++) {
                 v = model->corner_vert[c];
                 if (!edges->failed[edges->edge_of_halfedge[c]] || (points[v].quad == before_unspike[v].quad &&
@@ -17792,12 +17857,16 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
                                                                    points[v].t == before_unspike[v].t))
                     continue;
                 points[v] = before_unspike[v];
+                moved[v] = 1;
                 changed = 1;
             }
         }
         if (!changed) break;
+        if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, edges, moved,
+                                      &again, error)) != TT_OK)
+            goto failed;
         tt_polycube_edges_free(edges);
-        edges = NULL;
+        edges = again;
     }
     report->failed_edges = edges->nfailed;
 
@@ -17894,6 +17963,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, S.grid_points);
     tt_polycube_edges_free(edges);
     tt__free(allocator, before_unspike);
+    tt__free(allocator, moved);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     *out = S.out;
@@ -17909,6 +17979,7 @@ failed:
     tt_polycube_mapping_free(S.out);
     tt_polycube_edges_free(edges);
     tt__free(allocator, before_unspike);
+    tt__free(allocator, moved);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     memset(report, 0, sizeof *report);
