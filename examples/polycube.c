@@ -319,7 +319,8 @@ static void print_summary(const polycube_command_options *options, const polycub
     if (job->mesh.ntriangles != job->mesh.obj.nfaces) printf(" (fans of %d faces)", job->mesh.obj.nfaces);
     printf("; polycube: %d cubes of %.4g units (resolution %d), %d quads, %d component%s, genus %d", b->cubes,
            b->cube_size, b->resolution, b->quads, b->components, b->components == 1 ? "" : "s", b->polycube_genus);
-    if (b->mesh_genus < 0) printf(" (the mesh's: not closed)\n");
+    if (b->mesh_genus < 0 && b->sealed > 0) printf(" (the mesh's: not closed; %d cubes sealed behind its holes)\n", b->sealed);
+    else if (b->mesh_genus < 0) printf(" (the mesh's: not closed)\n");
     else if (b->genus_differs) printf(" (the mesh's %d: they differ)\n", b->mesh_genus);
     else printf(" (as the mesh)\n");
     printf("mapping: %d triangles, %d split, %d fallback, %d failed edges, %d flipped, %d collapsed",

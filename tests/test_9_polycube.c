@@ -2614,6 +2614,59 @@ static void test_relax_untangles(void)
     tm_free(&m);
 }
 
+/* Spec P4 as the library reads it: an open mesh whose holes are narrower
+   than a couple of cubes (a scan missing a few faces) is sealed, its
+   polycube solid like the closed mesh's, one sheet instead of a shell;
+   a bowl (a hemisphere, its rim a whole side) is not, nor is a closed
+   mesh touched. */
+static void test_seal(void)
+{
+    const double centre[3] = {0.0, 0.0, 0.0};
+    int shape;
+    tt_polycube_report reports[3];
+    tt_polycube_map_report maps[3];
+    for (shape = 0; shape < 3; shape++) {
+        tmesh full, m;
+        tt_mesh *mesh = NULL;
+        tt_polycube *pc = NULL;
+        tt_polycube_options o;
+        tt_polycube_mapping *map = NULL;
+        tt_error err;
+        int i;
+        memset(&full, 0, sizeof full);
+        memset(&m, 0, sizeof m);
+        make_sphere(&full, 48, 32, 1.0, centre, shape == 2);
+        /* shape 1: the sphere without the faces at its top pole's first ring, a hole 0.39 wide (3 cubes). */
+        for (i = 0; i < full.nv; i++) tm_vert(&m, full.pos[3 * i], full.pos[3 * i + 1], full.pos[3 * i + 2]);
+        for (i = 0; i < full.nf; i++) {
+            const int *v = full.idx + 3 * i;
+            if (shape == 1 && (v[0] <= 48 || v[1] <= 48 || v[2] <= 48)) continue;
+            tm_tri(&m, v[0], v[1], v[2]);
+        }
+        memset(&o, 0, sizeof o);
+        o.resolution = 16;
+        memset(&reports[shape], 0, sizeof reports[shape]);
+        memset(&maps[shape], 0, sizeof maps[shape]);
+        if (build(&m, 0, &mesh, &err) == TT_OK && tt_polycube_build(mesh, &o, NULL, &pc, &reports[shape], &err) == TT_OK)
+            tt_polycube_map(pc, mesh, NULL, NULL, &map, &maps[shape], &err);
+        else
+            CHECK(0, "sealing test mesh %d builds: %s", shape, err.message);
+        tt_polycube_mapping_free(map);
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        tm_free(&m);
+        tm_free(&full);
+    }
+    CHECK(reports[0].sealed == 0 && reports[1].sealed > 0 && reports[1].quads == reports[0].quads &&
+              abs(reports[1].cubes - reports[0].cubes) <= reports[0].cubes / 100 && maps[1].failed_edges == 0 &&
+              maps[1].fallback_triangles <= maps[1].triangles / 1000,
+          "a sphere with a hole 3 cubes wide is sealed (%d cubes) into the closed sphere's polycube (%d and %d "
+          "quads, %d and %d cubes), mapped with %d failed edges and %d fallbacks of %d", reports[1].sealed,
+          reports[1].quads, reports[0].quads, reports[1].cubes, reports[0].cubes, maps[1].failed_edges,
+          maps[1].fallback_triangles, maps[1].triangles);
+    CHECK(reports[2].sealed == 0, "a hemisphere (a bowl) is not sealed (%d cubes)", reports[2].sealed);
+}
+
 /* Q13 in short: small random closed meshes (bumpy spheres, turned and
    scaled at random) at random resolutions map without a crack (closed
    strict output), with their area, every corner in one quad. */
@@ -2696,6 +2749,7 @@ void run_polycube_tests(void)
     RUN(test_relax_kernel);
     RUN(test_untangle_energy);
     RUN(test_relax_untangles);
+    RUN(test_seal);
     RUN(test_edges_determinism_and_errors);
     RUN(test_map_cube);
     RUN(test_map_sphere);
