@@ -16655,11 +16655,11 @@ static double tt__untangle_energy(const tt__untangle_star *star, const double x[
 
 /* One untangling step of vertex v: its star in a chart around its point,
    a few steepest-descent steps of tt__untangle_energy with halving step
-   lengths, kept when no more of its triangles fold than before. Returns
-   1 when v moved. */
+   lengths; when `strict`, kept only if no more of its triangles fold than
+   before. Returns 1 when v moved. */
 static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                               const int *first_triangle, const int *triangle_corners, int v, tt__relax_chart *chart,
-                               tt__untangle_star *star)
+                               const int *first_triangle, const int *triangle_corners, int v, int strict,
+                               tt__relax_chart *chart, tt__untangle_star *star)
 {
     double x[2], gradient[2], energy, least_det = HUGE_VAL, delta2;
     int i, step, folded_before, folded;
@@ -16719,10 +16719,55 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
         gradient[1] = trial_gradient[1];
     }
     tt__untangle_energy(star, x, delta2, gradient, &folded);
-    if (folded > folded_before || !tt__relax_chart_point(chart, x, &moved)) return 0;
+    if ((strict && folded > folded_before) || !tt__relax_chart_point(chart, x, &moved)) return 0;
     if (moved.quad == points[v].quad && moved.s == points[v].s && moved.t == points[v].t) return 0;
     points[v] = moved;
     return 1;
+}
+
+/* Untangling sweeps over the vertices of folded triangles (those every
+   one of the triangle's quads sees folded) and their neighbours, each
+   vertex a tt__untangle_vertex step, until no fold is left, nothing
+   moves, or the folds have not become fewer for TT__UNTANGLE_PATIENCE
+   sweeps. Strict steps never fold more of a star; free ones may, on the
+   way to opening a fold that a strict step cannot start on (the horse at
+   32: 156 folds left strictly, 46 freely), and then the points return to
+   the sweep with the fewest folds (saved in best_sweep, nverts points).
+   Returns the bad triangles left (tt__relax_mark_bad, every kind); the
+   moves made go to *moves. */
+static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
+                        const int *first_triangle, const int *triangle_corners, int strict, tt__relax_chart *chart,
+                        tt__untangle_star *star, unsigned char *bad, tt_surface_point *best_sweep, int *moves)
+{
+    const size_t size = sizeof *points * (size_t)model->nverts;
+    int sweep, least = INT_MAX, stalled = 0, v, c;
+    for (sweep = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
+        int moved = 0, folds = tt__relax_mark_bad(pc, model, points, chart, 1, bad);
+        if (!folds) break;
+        if (folds < least) {
+            least = folds;
+            stalled = 0;
+            if (!strict) memcpy(best_sweep, points, size);
+        } else if (++stalled == TT__UNTANGLE_PATIENCE) {
+            break;
+        }
+        for (c = 0; c < model->ncorners; c += 3) {
+            const int *t = model->corner_vert + c;
+            int k;
+            if (bad[t[0]] != 1 && bad[t[1]] != 1 && bad[t[2]] != 1) continue;
+            for (k = 0; k < 3; k++)
+                if (!bad[t[k]]) bad[t[k]] = 2;
+        }
+        for (v = 0; v < model->nverts; v++)
+            if (bad[v] && !tt__relax_on_surface(pc, model, points, v))
+                moved += tt__untangle_vertex(pc, model, points, first_triangle, triangle_corners, v, strict, chart,
+                                             star);
+        *moves += moved;
+        if (!moved) break;
+    }
+    if (!strict && least < INT_MAX && tt__relax_mark_bad(pc, model, points, chart, 1, bad) > least)
+        memcpy(points, best_sweep, size);
+    return tt__relax_mark_bad(pc, model, points, chart, 0, bad);
 }
 
 /* Spec P11 step 5: points that leave a triangle folded on S or its edge
@@ -16737,10 +16782,10 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
    placed (tt__relax_badness). Vertices whose triangles are all fine never
    move, and the ones whose points lie on S (the model touches the
    polycube) stay. A patch folded all through defeats these moves (each
-   vertex's ring is folded too), so then the vertices of bad triangles and
-   their neighbours are untangled (tt__untangle_vertex), sweep by sweep,
-   until no fold is left or nothing moves. Returns the number of moves, -1
-   when out of memory. */
+   vertex's ring is folded too), so then the vertices of folded triangles
+   and their neighbours are untangled (tt__untangle), with strict steps
+   and with free ones from the same start, keeping the result with fewer
+   bad triangles. Returns the number of moves, -1 when out of memory. */
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                               const tt_allocator *allocator)
 {
@@ -16749,7 +16794,8 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     unsigned char *bad = NULL;
     tt__relax_chart *chart = NULL, *around = NULL;
     tt__untangle_star *star = NULL;
-    int v, c, sweep, moves = 0, nverts = model->nverts, nquads = pc->surface->nfaces, least_bad, stalled;
+    tt_surface_point *initial = NULL, *strict_points = NULL, *best_sweep = NULL;
+    int v, c, sweep, moves = 0, nverts = model->nverts, nquads = pc->surface->nfaces;
     first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
     count = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
@@ -16758,7 +16804,11 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     index_of = TT__ALLOC(allocator, int, 2 * (size_t)nquads);
     unfold = TT__ALLOC(allocator, tt_quad_map, pc->surface->ncorners);
     star = TT__ALLOC(allocator, tt__untangle_star, 1);
-    if (!first_triangle || !triangle_corners || !count || !bad || !chart || !index_of || !unfold || !star) {
+    initial = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
+    strict_points = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
+    best_sweep = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
+    if (!first_triangle || !triangle_corners || !count || !bad || !chart || !index_of || !unfold || !star || !initial ||
+        !strict_points || !best_sweep) {
         moves = -1;
         goto done;
     }
@@ -16898,31 +16948,18 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         if (!moved) break;
     }
     /* The folds these moves leave (a vertex whose ring is itself folded has no good place of its own):
-       untangling, over the vertices of bad triangles and their neighbours, so that folds open from
-       their rims inward. */
-    for (sweep = 0, least_bad = INT_MAX, stalled = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
-        int moved = 0, nbad = tt__relax_mark_bad(pc, model, points, chart, 1, bad);
-        /* Done when no fold is left, or when the count has not fallen for a few sweeps (folds it cannot
-           reach: the vertices just keep smoothing around them). */
-        if (!nbad) break;
-        if (nbad < least_bad) {
-            least_bad = nbad;
-            stalled = 0;
-        } else if (++stalled == TT__UNTANGLE_PATIENCE) {
-            break;
-        }
-        for (c = 0; c < model->ncorners; c += 3) {
-            const int *t = model->corner_vert + c;
-            int k;
-            if (bad[t[0]] != 1 && bad[t[1]] != 1 && bad[t[2]] != 1) continue;
-            for (k = 0; k < 3; k++)
-                if (!bad[t[k]]) bad[t[k]] = 2;
-        }
-        for (v = 0; v < nverts; v++)
-            if (bad[v] && !tt__relax_on_surface(pc, model, points, v))
-                moved += tt__untangle_vertex(pc, model, points, first_triangle, triangle_corners, v, chart, star);
-        moves += moved;
-        if (!moved) break;
+       untangling, both ways (tt__untangle), keeping the one that leaves fewer bad triangles. */
+    if (tt__relax_mark_bad(pc, model, points, chart, 1, bad)) {
+        int strict_left, free_left, strict_moves = 0, free_moves = 0;
+        memcpy(initial, points, sizeof *points * (size_t)nverts);
+        strict_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 1, chart, star, bad, NULL,
+                                   &strict_moves);
+        memcpy(strict_points, points, sizeof *points * (size_t)nverts);
+        memcpy(points, initial, sizeof *points * (size_t)nverts);
+        free_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 0, chart, star, bad, best_sweep,
+                                 &free_moves);
+        if (strict_left <= free_left) memcpy(points, strict_points, sizeof *points * (size_t)nverts);
+        moves += strict_left <= free_left ? strict_moves : free_moves;
     }
 done:
     tt__free(allocator, first_triangle);
@@ -16933,6 +16970,9 @@ done:
     tt__free(allocator, index_of);
     tt__free(allocator, unfold);
     tt__free(allocator, star);
+    tt__free(allocator, initial);
+    tt__free(allocator, strict_points);
+    tt__free(allocator, best_sweep);
     return moves;
 }
 
