@@ -16568,6 +16568,26 @@ static int tt__relax_folded_everywhere(const tt_polycube *pc, const tt_surface_p
     return 1;
 }
 
+/* Vertex v tried at `candidate`: its badness there (tt__relax_badness, in
+   a chart around the candidate, built into *chart), which replaces *best
+   when below *best_bad. points[v] is left as it was. */
+static void tt__relax_try(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
+                          const int *first_triangle, const int *triangle_corners, int v, tt_surface_point candidate,
+                          tt__relax_chart *chart, double *best_bad, tt_surface_point *best)
+{
+    const tt_surface_point kept = points[v];
+    double at[2], after;
+    points[v] = candidate;
+    tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
+    tt__relax_chart_place(chart, candidate, at);
+    after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, at);
+    points[v] = kept;
+    if (after < *best_bad - 1e-12) {
+        *best_bad = after;
+        *best = candidate;
+    }
+}
+
 /* Flags the vertices of badly placed triangles in bad[] (cleared first)
    and returns how many triangles are: a triangle is judged in its first
    vertex's quad frame, the others' quads mapped in across one edge of S
@@ -16858,19 +16878,9 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                 candidate_at[0] = at[0] + 0.5 * step * (mean[0] / n - at[0]);
                 candidate_at[1] = at[1] + 0.5 * step * (mean[1] / n - at[1]);
                 tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
-                if (tt__relax_chart_point(chart, candidate_at, &candidate)) {
-                    double after;
-                    tt_surface_point kept = points[v];
-                    points[v] = candidate;
-                    tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
-                    tt__relax_chart_place(chart, candidate, candidate_at);
-                    after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, candidate_at);
-                    points[v] = kept;
-                    if (after < best_bad - 1e-12) {
-                        best_bad = after;
-                        best = candidate;
-                    }
-                }
+                if (tt__relax_chart_point(chart, candidate_at, &candidate))
+                    tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
+                                  &best);
             }
             if (reachable && n > 0 && n <= 2 * (TT__RELAX_KERNEL_POINTS - 4)) {
                 /* Into the kernel of v's star, where none of its triangles folds (when its ring allows). */
@@ -16883,19 +16893,9 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                         tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], ring[m++]);
                 }
                 if (tt__relax_kernel_centre((const double (*)[2])ring, m / 2, candidate_at) &&
-                    tt__relax_chart_point(chart, candidate_at, &candidate)) {
-                    double after;
-                    tt_surface_point kept = points[v];
-                    points[v] = candidate;
-                    tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
-                    tt__relax_chart_place(chart, candidate, candidate_at);
-                    after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, candidate_at);
-                    points[v] = kept;
-                    if (after < best_bad - 1e-12) {
-                        best_bad = after;
-                        best = candidate;
-                    }
-                }
+                    tt__relax_chart_point(chart, candidate_at, &candidate))
+                    tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
+                                  &best);
             }
             if (!reachable || n == 0) {
                 /* Onto a neighbour's sheet: the closest point to v on the quads around each neighbour's. */
@@ -16905,9 +16905,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                     int corner = triangle_corners[i], f = corner / 3, k, q, j;
                     for (k = 1; k < 3; k++) {
                         int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
-                        double after;
                         double nearest = HUGE_VAL;
-                        tt_surface_point kept = points[v];
                         for (j = first_triangle[v]; j < i; j++) {
                             int other = triangle_corners[j];
                             if (model->corner_vert[3 * (other / 3) + (other % 3 + 1) % 3] == u ||
@@ -16926,16 +16924,8 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                                 candidate = p;
                             }
                         }
-                        points[v] = candidate;
-                        tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
-                        tt__relax_chart_place(chart, candidate, candidate_at);
-                        after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart,
-                                                  candidate_at);
-                        points[v] = kept;
-                        if (after < best_bad - 1e-12) {
-                            best_bad = after;
-                            best = candidate;
-                        }
+                        tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart,
+                                      &best_bad, &best);
                     }
                 }
             }
