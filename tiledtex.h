@@ -16365,8 +16365,8 @@ failed:
 #define TT__RELAX_SEAT_RADIUS 2     /* the same around a neighbour's point, where a vertex may be re-seated */
 #define TT__RELAX_CHART 96          /* quads a local chart holds at most */
 #define TT__RELAX_SWEEPS 12
-#define TT__UNTANGLE_SWEEPS 20      /* untangling sweeps over the vertices near folds */
-#define TT__UNTANGLE_PATIENCE 3     /* sweeps without fewer bad triangles after which it stops */
+#define TT__UNTANGLE_SWEEPS 40      /* untangling sweeps over the vertices near folds */
+#define TT__UNTANGLE_PATIENCE 6     /* sweeps without fewer bad triangles after which it stops */
 #define TT__UNTANGLE_STAR 64        /* triangles around a vertex it untangles at most */
 #define TT__UNTANGLE_EPSILON 0.01   /* Escobar et al.'s epsilon: det J below which delta grows */
 #define TT__UNTANGLE_STEPS 10       /* descent steps per vertex and sweep */
