@@ -14079,45 +14079,50 @@ static int tt__polycube_voxelize(const tt_mesh *mesh, const double origin[3], do
     return zero_area;
 }
 
+/* Breadth first through the faces of the cubes: from the seeds in
+   vox->queue[0, seeds) (already labelled `to`), every cube labelled `from`
+   that they reach is labelled `to`. Returns how many cubes are labelled
+   `to` by then, the seeds included; vox->queue lists them in the order
+   reached. */
+static int tt__polycube_flood(tt__voxels *vox, unsigned char *label, unsigned char from, unsigned char to, int seeds)
+{
+    const int step[3] = {1, vox->dims[0], vox->dims[0] * vox->dims[1]};
+    int head = 0, tail = seeds;
+    while (head < tail) {
+        int c = vox->queue[head++], a, rest = c, coord[3];
+        coord[0] = rest % vox->dims[0]; rest /= vox->dims[0];
+        coord[1] = rest % vox->dims[1];
+        coord[2] = rest / vox->dims[1];
+        for (a = 0; a < 3; a++) {
+            if (coord[a] > 0 && label[c - step[a]] == from) {
+                label[c - step[a]] = to;
+                vox->queue[tail++] = c - step[a];
+            }
+            if (coord[a] + 1 < vox->dims[a] && label[c + step[a]] == from) {
+                label[c + step[a]] = to;
+                vox->queue[tail++] = c + step[a];
+            }
+        }
+    }
+    return tail;
+}
+
 /* Interior fill (spec P4): flood the exterior from cube 0 (padding, so
    empty, and the padding connects the whole outside) through 6-connected
    empty cubes; the empty cubes it does not reach become occupied. Returns
    how many. Uses vox->queue. */
 static int tt__polycube_fill(tt__voxels *vox)
 {
-    int head = 0, tail = 0, added = 0, i;
-    const int step[3] = {1, vox->dims[0], vox->dims[0] * vox->dims[1]};
+    int added = 0, i;
     unsigned char *occ = vox->occupied;
     occ[0] = 2;   /* 2 = empty and reached, for the duration of the flood */
-    vox->queue[tail++] = 0;
-    while (head < tail) {
-        int c = vox->queue[head++], a, rest = c;
-        int coord[3];
-        coord[0] = rest % vox->dims[0]; rest /= vox->dims[0];
-        coord[1] = rest % vox->dims[1];
-        coord[2] = rest / vox->dims[1];
-        for (a = 0; a < 3; a++) {
-            if (coord[a] > 0 && occ[c - step[a]] == 0) { occ[c - step[a]] = 2; vox->queue[tail++] = c - step[a]; }
-            if (coord[a] + 1 < vox->dims[a] && occ[c + step[a]] == 0) {
-                occ[c + step[a]] = 2;
-                vox->queue[tail++] = c + step[a];
-            }
-        }
-    }
+    vox->queue[0] = 0;
+    tt__polycube_flood(vox, occ, 0, 2, 1);
     for (i = 0; i < vox->count; i++) {
         if (occ[i] == 0) { occ[i] = 1; added++; }
         else if (occ[i] == 2) occ[i] = 0;
     }
     return added;
-}
-
-/* Whether cubes a and b (indices of vox's grid) share a face. */
-static int tt__face_neighbours(const tt__voxels *vox, int a, int b)
-{
-    const int d = a > b ? a - b : b - a;
-    if (d == 1) return a / vox->dims[0] == b / vox->dims[0];   /* the same row */
-    if (d == vox->dims[0]) return a / (vox->dims[0] * vox->dims[1]) == b / (vox->dims[0] * vox->dims[1]);
-    return d == vox->dims[0] * vox->dims[1];
 }
 
 /* The generalised winding number of `mesh` at p: the solid angle its
@@ -14147,23 +14152,26 @@ static double tt__winding_number(const tt_mesh *mesh, const double p[3])
     return total / (4.0 * TT__PI);
 }
 
-/* Runs `body` with `id` set to each cube within Chebyshev distance r of
-   cube c (c itself included; cubes outside the grid skipped). */
-#define TT__FOR_CUBES_NEAR(vox, c, r, id, body)                                                              \
-    do {                                                                                                      \
-        const int x_ = (c) % (vox)->dims[0], y_ = ((c) / (vox)->dims[0]) % (vox)->dims[1];                   \
-        const int z_ = (c) / ((vox)->dims[0] * (vox)->dims[1]);                                              \
-        int i_, j_, k_;                                                                                       \
-        for (k_ = z_ - (r); k_ <= z_ + (r); k_++)                                                            \
-            for (j_ = y_ - (r); j_ <= y_ + (r); j_++)                                                        \
-                for (i_ = x_ - (r); i_ <= x_ + (r); i_++) {                                                  \
-                    if (i_ < 0 || j_ < 0 || k_ < 0 || i_ >= (vox)->dims[0] || j_ >= (vox)->dims[1] ||         \
-                        k_ >= (vox)->dims[2])                                                                 \
-                        continue;                                                                             \
-                    id = i_ + (vox)->dims[0] * (j_ + (vox)->dims[1] * k_);                                    \
-                    body;                                                                                     \
-                }                                                                                             \
-    } while (0)
+/* Every cube within Chebyshev distance `radius` of a cube labelled `from`
+   in `source`, except the cubes of `walls` (NULL: none), is labelled `to`
+   in `target` (which may not be `source`). */
+static void tt__polycube_dilate(const tt__voxels *vox, const unsigned char *source, unsigned char from, int radius,
+                                const unsigned char *walls, unsigned char *target, unsigned char to)
+{
+    int c, i, j, k;
+    for (c = 0; c < vox->count; c++) {
+        const int x = c % vox->dims[0], y = (c / vox->dims[0]) % vox->dims[1], z = c / (vox->dims[0] * vox->dims[1]);
+        if (source[c] != from) continue;
+        for (k = z - radius; k <= z + radius; k++)
+            for (j = y - radius; j <= y + radius; j++)
+                for (i = x - radius; i <= x + radius; i++) {
+                    int id;
+                    if (i < 0 || j < 0 || k < 0 || i >= vox->dims[0] || j >= vox->dims[1] || k >= vox->dims[2]) continue;
+                    id = i + vox->dims[0] * (j + vox->dims[1] * k);
+                    if (!walls || !walls[id]) target[id] = to;
+                }
+    }
+}
 
 /* Seals the holes of an open mesh (see "Interior" in the section's notes):
    fills the components of empty cubes that the exterior reaches only
@@ -14173,63 +14181,47 @@ static double tt__winding_number(const tt_mesh *mesh, const double p[3])
 static int tt__polycube_seal(tt__voxels *vox, const tt_mesh *mesh, int radius)
 {
     const int n = vox->count;
-    unsigned char *near = NULL, *outside = NULL;
-    int c, id, head = 0, tail = 0, added = 0, grow;
+    unsigned char *state = NULL, *grown = NULL;
+    int c, seeds = 0, added = 0, grow;
     for (c = 0; c < mesh->ncorners && mesh->twin[c] >= 0; c++) continue;
     if (c == mesh->ncorners) return 0;   /* no hole */
-    near = TT__ALLOC(vox->allocator, unsigned char, n);
-    outside = TT__ALLOC(vox->allocator, unsigned char, n);
-    if (!near || !outside) {
-        tt__free(vox->allocator, near);
-        tt__free(vox->allocator, outside);
+    state = TT__ALLOC(vox->allocator, unsigned char, n);
+    grown = TT__ALLOC(vox->allocator, unsigned char, n);
+    if (!state || !grown) {
+        tt__free(vox->allocator, state);
+        tt__free(vox->allocator, grown);
         return -1;
     }
-    /* The exterior, kept `radius` cubes away from the polycube: it cannot pass a hole that narrow. */
-    memset(near, 0, (size_t)n);
-    memset(outside, 0, (size_t)n);
-    for (c = 0; c < n; c++)
-        if (vox->occupied[c]) TT__FOR_CUBES_NEAR(vox, c, radius, id, near[id] = 1);
+    /* state: 1 within `radius` cubes of the polycube, 2 the exterior flooded around that (it cannot pass a
+       hole that narrow), 0 the rest. */
+    memset(state, 0, (size_t)n);
+    tt__polycube_dilate(vox, vox->occupied, 1, radius, NULL, state, 1);
     for (c = 0; c < n; c++) {
         const int x = c % vox->dims[0], y = (c / vox->dims[0]) % vox->dims[1], z = c / (vox->dims[0] * vox->dims[1]);
         if ((x == 0 || y == 0 || z == 0 || x == vox->dims[0] - 1 || y == vox->dims[1] - 1 || z == vox->dims[2] - 1) &&
-            !near[c]) {
-            outside[c] = 1;
-            vox->queue[tail++] = c;
+            !state[c]) {
+            state[c] = 2;
+            vox->queue[seeds++] = c;
         }
     }
-    while (head < tail) {
-        c = vox->queue[head++];
-        TT__FOR_CUBES_NEAR(vox, c, 1, id, {
-            if (!outside[id] && !near[id] && tt__face_neighbours(vox, c, id)) {
-                outside[id] = 1;
-                vox->queue[tail++] = id;
-            }
-        });
-    }
-    /* Grown back by `radius` through empty cubes: the exterior up to the polycube again, except behind holes. */
+    tt__polycube_flood(vox, state, 0, 2, seeds);
+    /* Grown back by `radius` cubes through empty ones: the exterior up to the polycube again, except behind
+       holes. */
     for (grow = 0; grow < radius; grow++) {
-        memcpy(near, outside, (size_t)n);
-        for (c = 0; c < n; c++)
-            if (near[c]) TT__FOR_CUBES_NEAR(vox, c, 1, id, if (!vox->occupied[id]) outside[id] = 1);
+        memcpy(grown, state, (size_t)n);
+        tt__polycube_dilate(vox, grown, 2, 1, vox->occupied, state, 2);
     }
+    for (c = 0; c < n; c++)
+        if (state[c] != 2) state[c] = vox->occupied[c] ? 1 : 0;
     /* Each component of what is left, filled when inside the mesh. */
     for (c = 0; c < n; c++) {
-        int inside = 0, sample;
-        if (vox->occupied[c] || outside[c]) continue;
-        head = tail = 0;
-        outside[c] = 2;
-        vox->queue[tail++] = c;
-        while (head < tail) {
-            const int at = vox->queue[head++];
-            TT__FOR_CUBES_NEAR(vox, at, 1, id, {
-                if (!vox->occupied[id] && !outside[id] && tt__face_neighbours(vox, at, id)) {
-                    outside[id] = 2;
-                    vox->queue[tail++] = id;
-                }
-            });
-        }
+        int inside = 0, sample, reached, i;
+        if (state[c]) continue;
+        state[c] = 3;
+        vox->queue[0] = c;
+        reached = tt__polycube_flood(vox, state, 0, 3, 1);
         for (sample = 0; sample < 3; sample++) {
-            const int cube = vox->queue[(int)((long)(tail - 1) * sample / 2)];
+            const int cube = vox->queue[(int)((long)(reached - 1) * sample / 2)];
             const int x = cube % vox->dims[0], y = (cube / vox->dims[0]) % vox->dims[1];
             const int z = cube / (vox->dims[0] * vox->dims[1]);
             double centre[3];
@@ -14239,12 +14231,12 @@ static int tt__polycube_seal(tt__voxels *vox, const tt_mesh *mesh, int radius)
             inside += fabs(tt__winding_number(mesh, centre)) > TT__POLYCUBE_SEAL_WINDING;
         }
         if (inside >= 2) {
-            for (head = 0; head < tail; head++) vox->occupied[vox->queue[head]] = 1;
-            added += tail;
+            for (i = 0; i < reached; i++) vox->occupied[vox->queue[i]] = 1;
+            added += reached;
         }
     }
-    tt__free(vox->allocator, near);
-    tt__free(vox->allocator, outside);
+    tt__free(vox->allocator, state);
+    tt__free(vox->allocator, grown);
     return added;
 }
 
@@ -14483,28 +14475,15 @@ static tt_result tt__polycube_repair(tt__voxels *vox, int *added, tt_error *erro
    cubes). Uses vox->queue, and marks visited cubes 2 while it runs. */
 static int tt__polycube_components(tt__voxels *vox, int *labels)
 {
-    const int step[3] = {1, vox->dims[0], vox->dims[0] * vox->dims[1]};
     unsigned char *occ = vox->occupied;
     int components = 0, start, i;
     for (start = 0; start < vox->count; start++) {
-        int head = 0, tail = 0;
+        int reached;
         if (occ[start] != 1) continue;
         occ[start] = 2;
-        vox->queue[tail++] = start;
-        while (head < tail) {
-            int c = vox->queue[head++], a, rest = c, coord[3];
-            coord[0] = rest % vox->dims[0]; rest /= vox->dims[0];
-            coord[1] = rest % vox->dims[1];
-            coord[2] = rest / vox->dims[1];
-            if (labels) labels[c] = components;
-            for (a = 0; a < 3; a++) {
-                if (coord[a] > 0 && occ[c - step[a]] == 1) { occ[c - step[a]] = 2; vox->queue[tail++] = c - step[a]; }
-                if (coord[a] + 1 < vox->dims[a] && occ[c + step[a]] == 1) {
-                    occ[c + step[a]] = 2;
-                    vox->queue[tail++] = c + step[a];
-                }
-            }
-        }
+        vox->queue[0] = start;
+        reached = tt__polycube_flood(vox, occ, 1, 2, 1);
+        for (i = 0; labels && i < reached; i++) labels[vox->queue[i]] = components;
         components++;
     }
     for (i = 0; i < vox->count; i++) {
