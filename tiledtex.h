@@ -15799,10 +15799,11 @@ typedef struct tt__edge_funnel {
     double reference, lo, hi;
 } tt__edge_funnel;
 
-/* The corner (0..3) of its quad that point p is on; p must be on one. */
-static int tt__point_corner(tt_surface_point p)
+/* The vertex of S that point p is on (a corner of its quad), or -1. */
+static int tt__point_vertex(const tt_mesh *s, tt_surface_point p)
 {
-    return p.t == 0.0f ? (p.s == 0.0f ? 0 : 1) : (p.s == 0.0f ? 3 : 2);
+    if ((p.s != 0.0f && p.s != 1.0f) || (p.t != 0.0f && p.t != 1.0f)) return -1;
+    return s->corner_vert[s->face_start[p.quad] + (p.t == 0.0f ? (p.s == 0.0f ? 0 : 1) : (p.s == 0.0f ? 3 : 2))];
 }
 
 /* Point p in the frame of `quad`: its own quad's, or, when p is a corner
@@ -15810,13 +15811,12 @@ static int tt__point_corner(tt_surface_point p)
    when p does not lie in `quad`. */
 static int tt__point_in_quad(const tt_mesh *s, tt_surface_point p, int quad, double st[2])
 {
+    const int vertex = tt__point_vertex(s, p);
     int corner, k[2];
     st[0] = p.s;
     st[1] = p.t;
     if (quad == p.quad) return 1;
-    if ((p.s != 0.0f && p.s != 1.0f) || (p.t != 0.0f && p.t != 1.0f)) return 0;
-    corner = tt__quad_corner_of(s, quad, s->corner_vert[s->face_start[p.quad] + tt__point_corner(p)]);
-    if (corner < 0) return 0;
+    if (vertex < 0 || (corner = tt__quad_corner_of(s, quad, vertex)) < 0) return 0;
     tt__quad_corner_st(corner, k);
     st[0] = k[0];
     st[1] = k[1];
@@ -15828,12 +15828,13 @@ static int tt__point_in_quad(const tt_mesh *s, tt_surface_point p, int quad, dou
 static int tt__quads_at_point(const tt_mesh *s, tt_surface_point p, int quads[TT__CORNER_QUADS],
                               double st[TT__CORNER_QUADS][2])
 {
+    const int vertex = tt__point_vertex(s, p);
     int n = 0, h, around;
     quads[0] = p.quad;
     st[0][0] = p.s;
     st[0][1] = p.t;
-    if ((p.s != 0.0f && p.s != 1.0f) || (p.t != 0.0f && p.t != 1.0f)) return 1;
-    h = around = s->face_start[p.quad] + tt__point_corner(p);
+    if (vertex < 0) return 1;
+    h = around = s->face_start[p.quad] + tt__quad_corner_of(s, p.quad, vertex);
     do {
         int quad = s->corner_face[around], k[2];
         tt__quad_corner_st(around - s->face_start[quad], k);
@@ -16979,8 +16980,7 @@ static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, con
     if (!taken) return -1;
     memset(taken, 0, (size_t)s->nverts);
     for (v = 0; v < model->nverts; v++)
-        if ((points[v].s == 0.0f || points[v].s == 1.0f) && (points[v].t == 0.0f || points[v].t == 1.0f))
-            taken[s->corner_vert[s->face_start[points[v].quad] + tt__point_corner(points[v])]] = 1;
+        if ((c = tt__point_vertex(s, points[v])) >= 0) taken[c] = 1;
     for (c = 0; c < model->ncorners; c++) {
         const int e = edges->edge_of_halfedge[c];
         const int apex = tt__edge_apex_from(s, edges, e, (v = model->corner_vert[c]));
