@@ -2658,8 +2658,8 @@ typedef struct tt_polycube_mapping {
    to the wrong sides of thin parts and every chart turns clockwise.
    Measured (-O2, default options, resolution 32): a 100k-triangle torus
    in about 0.4 s (make bench) with no fallback; the bunny (3.7k
-   triangles, 51k refined) in 0.3 s with 0.02 % fallbacks; a 97k-triangle
-   horse in 0.6 s with 0.17 %; a CAD flange 0.14 %; no flipped triangle on
+   triangles, 51k refined) in 0.4 s with 0.01 % fallbacks; a 97k-triangle
+   horse in 1 s with 0.04 %; a CAD flange 0.11 %; no flipped triangle on
    any. report may be NULL.
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
@@ -16346,11 +16346,11 @@ failed:
 #define TT__RELAX_CHART 96          /* quads a local chart holds at most */
 #define TT__RELAX_SWEEPS 12
 #define TT__UNTANGLE_SWEEPS 40      /* untangling sweeps over the vertices near folds */
-#define TT__UNTANGLE_PATIENCE 6     /* sweeps without fewer bad triangles after which it stops */
+#define TT__UNTANGLE_PATIENCE 6     /* sweeps without fewer bad triangles after which the rings double */
+#define TT__UNTANGLE_RINGS 16       /* rings around the folds untangled at most */
 #define TT__UNTANGLE_STAR 64        /* triangles around a vertex it untangles at most */
 #define TT__UNTANGLE_EPSILON 0.01   /* Escobar et al.'s epsilon: det J below which delta grows */
 #define TT__UNTANGLE_STEPS 10       /* descent steps per vertex and sweep */
-#define TT__UNTANGLE_FIRST_STEP 0.1 /* a descent step's first length (quad units), halved until it helps */
 #define TT__UNTANGLE_HALVINGS 20
 #define TT__RELAX_KERNEL_POINTS 64  /* a star's kernel polygon: its box's 4 corners and one per triangle */
 #define TT__RELAX_KERNEL_MARGIN 1e-9    /* twice the least area (quad units) of a star triangle around a kernel point */
@@ -16605,13 +16605,25 @@ static int tt__relax_on_surface(const tt_polycube *pc, const tt_mesh *model, con
 }
 
 /* A vertex's star for untangling: per triangle (v, a, b), a and b in the
-   chart, and the triangle's own shape (its 3D edges v -> a, v -> b laid
-   flat, in cube units), which the map should keep. */
+   chart, and the inverse of the triangle's own shape (its 3D edges
+   v -> a, v -> b laid flat, in cube units), which the map should keep. */
 typedef struct tt__untangle_star {
     int n;
     double ring[TT__UNTANGLE_STAR][2][2];
-    double shape[TT__UNTANGLE_STAR][2][2];
+    double inverse[TT__UNTANGLE_STAR][2][2];
 } tt__untangle_star;
+
+/* Sets triangle i's shape (edge v -> a, edge v -> b, in 2D); 0 when it has no area. */
+static int tt__untangle_star_shape(tt__untangle_star *star, int i, const double shape[2][2])
+{
+    const double det = shape[0][0] * shape[1][1] - shape[1][0] * shape[0][1];
+    if (!(det != 0.0)) return 0;
+    star->inverse[i][0][0] = shape[1][1] / det;
+    star->inverse[i][0][1] = -shape[1][0] / det;
+    star->inverse[i][1][0] = -shape[0][1] / det;
+    star->inverse[i][1][1] = shape[0][0] / det;
+    return 1;
+}
 
 /* The untangling energy of Escobar et al. ("Simultaneous untangling and
    smoothing of tetrahedral meshes", CMAME 2003), in 2D, with v at x: per
@@ -16629,10 +16641,10 @@ static double tt__untangle_energy(const tt__untangle_star *star, const double x[
     gradient[0] = gradient[1] = 0.0;
     *folded = 0;
     for (i = 0; i < star->n; i++) {
-        const double *a = star->ring[i][0], *b = star->ring[i][1], *sa = star->shape[i][0], *sb = star->shape[i][1];
-        const double shape_det = sa[0] * sb[1] - sb[0] * sa[1];
+        const double *a = star->ring[i][0], *b = star->ring[i][1];
         /* J = [a - x, b - x] times the shape's inverse. */
-        const double i00 = sb[1] / shape_det, i01 = -sb[0] / shape_det, i10 = -sa[1] / shape_det, i11 = sa[0] / shape_det;
+        const double i00 = star->inverse[i][0][0], i01 = star->inverse[i][0][1];
+        const double i10 = star->inverse[i][1][0], i11 = star->inverse[i][1][1];
         const double j00 = (a[0] - x[0]) * i00 + (b[0] - x[0]) * i10, j01 = (a[0] - x[0]) * i01 + (b[0] - x[0]) * i11;
         const double j10 = (a[1] - x[1]) * i00 + (b[1] - x[1]) * i10, j11 = (a[1] - x[1]) * i01 + (b[1] - x[1]) * i11;
         /* Moving x by e_k adds d = -(i00 + i10, i01 + i11) to row k of J. */
@@ -16661,7 +16673,7 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
                                const int *first_triangle, const int *triangle_corners, int v, int strict,
                                tt__relax_chart *chart, tt__untangle_star *star)
 {
-    double x[2], gradient[2], energy, least_det = HUGE_VAL, delta2;
+    double x[2], gradient[2], energy, least_det = HUGE_VAL, delta2, reach = 0.0, step_length = 0.0;
     int i, step, folded_before, folded;
     tt_surface_point moved;
     if (first_triangle[v + 1] - first_triangle[v] > TT__UNTANGLE_STAR) return 0;
@@ -16671,7 +16683,7 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
     for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
         const int corner = triangle_corners[i], f = corner / 3;
         const int a = model->corner_vert[3 * f + (corner % 3 + 1) % 3], b = model->corner_vert[3 * f + (corner % 3 + 2) % 3];
-        double edge_a[3], edge_b[3], normal[3], along[3], across[3], length;
+        double edge_a[3], edge_b[3], normal[3], along[3], across[3], length, shape[2][2];
         int k;
         if (!tt__relax_chart_place(chart, points[a], star->ring[star->n][0]) ||
             !tt__relax_chart_place(chart, points[b], star->ring[star->n][1]))
@@ -16684,15 +16696,18 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
         if (!((length = tt__length3(edge_a)) > 0.0) || !(tt__normalize3(normal) > 0.0)) return 0;
         for (k = 0; k < 3; k++) along[k] = edge_a[k] / length;
         tt__cross3(normal, along, across);
-        star->shape[star->n][0][0] = length;
-        star->shape[star->n][0][1] = 0.0;
-        star->shape[star->n][1][0] = tt__dot3(edge_b, along);
-        star->shape[star->n][1][1] = tt__dot3(edge_b, across);
+        shape[0][0] = length;
+        shape[0][1] = 0.0;
+        shape[1][0] = tt__dot3(edge_b, along);
+        shape[1][1] = tt__dot3(edge_b, across);
+        if (!tt__untangle_star_shape(star, star->n, (const double (*)[2])shape)) return 0;
+        for (k = 0; k < 2; k++)
+            reach = fmax(reach, fabs(star->ring[star->n][k][0] - x[0]) + fabs(star->ring[star->n][k][1] - x[1]));
         /* det J of this triangle, for delta below. */
         {
             const double turn = tt__orient2(x[0], x[1], star->ring[star->n][0][0], star->ring[star->n][0][1],
                                             star->ring[star->n][1][0], star->ring[star->n][1][1]);
-            const double det = turn / (length * star->shape[star->n][1][1]);
+            const double det = turn / (length * shape[1][1]);
             if (det < least_det) least_det = det;
         }
         star->n++;
@@ -16702,12 +16717,14 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
     energy = tt__untangle_energy(star, x, delta2, gradient, &folded_before);
     for (step = 0; step < TT__UNTANGLE_STEPS; step++) {
         const double norm = sqrt(gradient[0] * gradient[0] + gradient[1] * gradient[1]);
-        double length = TT__UNTANGLE_FIRST_STEP, trial[2], trial_gradient[2], trial_energy = energy;
+        double trial[2], trial_gradient[2], trial_energy = energy;
         int halvings;
         if (!(norm > 0.0)) break;
-        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS; halvings++, length *= 0.5) {
-            trial[0] = x[0] - length * gradient[0] / norm;
-            trial[1] = x[1] - length * gradient[1] / norm;
+        /* From twice the last step that helped: the first is as long as the star is wide. */
+        step_length = step == 0 ? reach : 2.0 * step_length;
+        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS; halvings++, step_length *= 0.5) {
+            trial[0] = x[0] - step_length * gradient[0] / norm;
+            trial[1] = x[1] - step_length * gradient[1] / norm;
             trial_energy = tt__untangle_energy(star, trial, delta2, trial_gradient, &folded);
             if (trial_energy < energy) break;
         }
@@ -16726,37 +16743,56 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
 }
 
 /* Untangling sweeps over the vertices of folded triangles (those every
-   one of the triangle's quads sees folded) and their neighbours, each
-   vertex a tt__untangle_vertex step, until no fold is left, nothing
-   moves, or the folds have not become fewer for TT__UNTANGLE_PATIENCE
-   sweeps. Strict steps never fold more of a star; free ones may, on the
-   way to opening a fold that a strict step cannot start on (the horse at
-   32: 156 folds left strictly, 46 freely), and then the points return to
-   the sweep with the fewest folds (saved in best_sweep, nverts points).
-   Returns the bad triangles left (tt__relax_mark_bad, every kind); the
-   moves made go to *moves. */
+   one of the triangle's quads sees folded) and the vertices up to `rings`
+   edges from them, each vertex a tt__untangle_vertex step, until no fold
+   is left, nothing moves, or the folds have not become fewer for
+   TT__UNTANGLE_PATIENCE sweeps even with TT__UNTANGLE_RINGS rings. The
+   rings start at 1 and double at each stall: a pleat (the model laid on a
+   part of S twice, then back) opens only when the vertices around it move
+   together, and a wide region from the start would move far more
+   vertices than a small fold needs (the bunny at 16: 21 fallbacks with
+   one ring, 11 with up to 16). Strict steps never fold more of a star;
+   free ones may, on the way to opening a fold that a strict step cannot
+   start on (the horse at 32: 156 folds left strictly, 46 freely), and then
+   the points return to the sweep with the fewest folds (saved in
+   best_sweep, nverts points). `active` holds nverts vertices. Returns the
+   bad triangles left (tt__relax_mark_bad, every kind); the moves made go
+   to *moves. */
 static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                         const int *first_triangle, const int *triangle_corners, int strict, tt__relax_chart *chart,
-                        tt__untangle_star *star, unsigned char *bad, tt_surface_point *best_sweep, int *moves)
+                        tt__untangle_star *star, unsigned char *bad, int *active, tt_surface_point *best_sweep,
+                        int *moves)
 {
     const size_t size = sizeof *points * (size_t)model->nverts;
-    int sweep, least = INT_MAX, stalled = 0, v, c;
+    int sweep, least = INT_MAX, stalled = 0, rings = 1, v, i;
     for (sweep = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
-        int moved = 0, folds = tt__relax_mark_bad(pc, model, points, chart, 1, bad);
+        int moved = 0, nactive = 0, head, folds = tt__relax_mark_bad(pc, model, points, chart, 1, bad);
         if (!folds) break;
         if (folds < least) {
             least = folds;
             stalled = 0;
             if (!strict) memcpy(best_sweep, points, size);
         } else if (++stalled == TT__UNTANGLE_PATIENCE) {
-            break;
+            if (rings == TT__UNTANGLE_RINGS) break;
+            rings *= 2;
+            stalled = 0;
         }
-        for (c = 0; c < model->ncorners; c += 3) {
-            const int *t = model->corner_vert + c;
-            int k;
-            if (bad[t[0]] != 1 && bad[t[1]] != 1 && bad[t[2]] != 1) continue;
-            for (k = 0; k < 3; k++)
-                if (!bad[t[k]]) bad[t[k]] = 2;
+        /* The vertices within `rings` edges of a fold, breadth first; bad[v] - 1 is v's distance. */
+        for (v = 0; v < model->nverts; v++)
+            if (bad[v]) active[nactive++] = v;
+        for (head = 0; head < nactive; head++) {
+            const int u = active[head];
+            if (bad[u] > rings) continue;
+            for (i = first_triangle[u]; i < first_triangle[u + 1]; i++) {
+                const int corner = triangle_corners[i], f = corner / 3;
+                int k;
+                for (k = 1; k < 3; k++) {
+                    const int w = model->corner_vert[3 * f + (corner % 3 + k) % 3];
+                    if (bad[w]) continue;
+                    bad[w] = (unsigned char)(bad[u] + 1);
+                    active[nactive++] = w;
+                }
+            }
         }
         for (v = 0; v < model->nverts; v++)
             if (bad[v] && !tt__relax_on_surface(pc, model, points, v))
@@ -16789,7 +16825,7 @@ static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                               const tt_allocator *allocator)
 {
-    int *first_triangle = NULL, *triangle_corners = NULL, *count = NULL, *index_of = NULL;
+    int *first_triangle = NULL, *triangle_corners = NULL, *count = NULL, *index_of = NULL, *active = NULL;
     tt_quad_map *unfold = NULL;
     unsigned char *bad = NULL;
     tt__relax_chart *chart = NULL, *around = NULL;
@@ -16807,8 +16843,9 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     initial = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
     strict_points = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
     best_sweep = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
+    active = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
     if (!first_triangle || !triangle_corners || !count || !bad || !chart || !index_of || !unfold || !star || !initial ||
-        !strict_points || !best_sweep) {
+        !strict_points || !best_sweep || !active) {
         moves = -1;
         goto done;
     }
@@ -16922,12 +16959,12 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     if (tt__relax_mark_bad(pc, model, points, chart, 1, bad)) {
         int strict_left, free_left, strict_moves = 0, free_moves = 0;
         memcpy(initial, points, sizeof *points * (size_t)nverts);
-        strict_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 1, chart, star, bad, NULL,
-                                   &strict_moves);
+        strict_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 1, chart, star, bad, active,
+                                   NULL, &strict_moves);
         memcpy(strict_points, points, sizeof *points * (size_t)nverts);
         memcpy(points, initial, sizeof *points * (size_t)nverts);
-        free_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 0, chart, star, bad, best_sweep,
-                                 &free_moves);
+        free_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 0, chart, star, bad, active,
+                                 best_sweep, &free_moves);
         if (strict_left <= free_left) memcpy(points, strict_points, sizeof *points * (size_t)nverts);
         moves += strict_left <= free_left ? strict_moves : free_moves;
     }
@@ -16943,6 +16980,7 @@ done:
     tt__free(allocator, initial);
     tt__free(allocator, strict_points);
     tt__free(allocator, best_sweep);
+    tt__free(allocator, active);
     return moves;
 }
 

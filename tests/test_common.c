@@ -337,7 +337,7 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
     star.n = n;
     for (i = 0; i < n; i++) {
         memcpy(star.ring[i], ring[i], sizeof star.ring[i]);
-        memcpy(star.shape[i], shape[i], sizeof star.shape[i]);
+        if (!tt__untangle_star_shape(&star, i, shape[i])) return -1.0;
     }
     return tt__untangle_energy(&star, x, delta2, gradient, folded);
 }
