@@ -1030,6 +1030,19 @@ typedef struct tt_synth_options {
        2k, the lower one (turned 180 degrees) edges of type 2k+1. NULL: chosen
        from the seed. Otherwise `colors` rects; only x and y are read. */
     const tt_rect *edge_windows;
+    /* Nonzero: upright tiles. Plain tiles turn each edge's band to its side,
+       so on the left and right sides an anisotropic texture (bricks, planks,
+       grain) runs a quarter turn off: walls come out a maze. Upright tiles
+       cut the bands of sides 1 and 3 from a second window per condition
+       (`vertical_windows` of the plan, 2S x S, the condition the line
+       between its left and right squares), so every band keeps the source's
+       up (or is turned half a turn). Two upright tiles meet seamlessly
+       across an edge that both see as a left/right side or both as a
+       bottom/top side; an edge that is bottom/top to both also meets a plain
+       tile of a plan with the same edge_windows seamlessly (the walls and
+       the tops of a polycube, tt_polycube_mapping_uvs_upright). Needs a
+       source of at least 2S x 2S. */
+    int upright;
     /* Region from which each tile's S x S background window is drawn; all zero =
        the whole image. */
     tt_rect background;
@@ -1058,7 +1071,7 @@ typedef struct tt_synth_options {
    two corner columns x = 0 and x = S-1 and beyond depth + feather.
 
    Memory: one allocation of about sizeof(tt_synth_plan) + 16 * (n + (2n)^4)
-   + 4 * S * (2n)^4 bytes (the last term doubles for S >= 1024, whose depths
+   (2n for an upright plan) + 4 * S * (2n)^4 bytes (the last term doubles for S >= 1024, whose depths
    need 16 bits): n = 1, S = 128: 8.5 KiB; n = 2, S = 64: 68 KiB; about
    1/(4S) of the atlas level 0 it describes. */
 typedef struct tt_synth_plan {
@@ -1067,6 +1080,7 @@ typedef struct tt_synth_plan {
     int feather;                    /* resolved (options.feather or max(2, S/16)) */
     int max_depth;                  /* max(1, S/4): no band goes deeper (before its feather) */
     tt_rect *edge_windows;          /* n rects (w = S, h = 2S), one per condition */
+    tt_rect *vertical_windows;      /* upright plans: n rects (w = 2S, h = S) for sides 1 and 3; else NULL */
     tt_rect *background_windows;    /* one S x S rect per tile, indexed like tt_tile_index */
     /* The band depth (0..max_depth) of tile t, side s, column x at entry
        (4 * t + s) * S + x of the one of these that is not NULL: depth8 when
@@ -1144,6 +1158,7 @@ typedef struct tt_tileset {
     int seamless_levels;
     tt_image levels[TT_MAX_MIP_LEVELS];
     tt_rect *edge_windows;          /* colors rects actually used (w = S, h = 2S) */
+    tt_rect *vertical_windows;      /* upright tiles: colors rects (w = 2S, h = S) for sides 1 and 3; else NULL */
     tt_rect *background_windows;    /* one per tile, indexed like tt_tile_index */
     tt_allocator allocator;         /* the one it was made with */
 } tt_tileset;
@@ -2292,6 +2307,7 @@ typedef struct tt_polycube {
     int *quad_cube;             /* per quad: its cube's linear index */
     unsigned char *quad_side;   /* per quad: its outward normal, 0..5 = +x, -x, +y, -y, +z, -z */
     int *vertex_lattice;        /* per S vertex: its lattice point's linear index */
+    int up_axis, up_sign;       /* the up of the tiles (tt_polycube_options::up): lattice axis 0..2, +1 or -1 */
     tt_allocator allocator;     /* the one it was built with */
 } tt_polycube;
 
@@ -2689,6 +2705,19 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping);
 TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                         const tt_tile_layout *layout, const uint8_t *corner_type,
                                         float *corner_uv, tt_error *error);
+/* As tt_polycube_mapping_uvs, for upright tiles on the walls (so bricks,
+   planks and grain keep their direction all round the model, see
+   tt_synth_options::upright): the atlas is 2W x W, the W x W atlas of a
+   plain plan on the left and that of an upright plan made with the plain
+   plan's edge_windows (same layout) on the right. A quad facing sideways
+   (its normal not along polycube->up_axis) takes its tile from the right,
+   the tops and bottoms from the left: every edge of S then meets seamlessly,
+   as the edges along the up axis are left/right sides of both their quads
+   (upright tiles both) and every other edge is a bottom/top side of each
+   wall it borders. Errors and the rest as tt_polycube_mapping_uvs. */
+TTDEF tt_result tt_polycube_mapping_uvs_upright(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
+                                                const tt_tile_layout *layout, const uint8_t *corner_type,
+                                                float *corner_uv, tt_error *error);
 
 #ifdef __cplusplus
 }
@@ -6507,6 +6536,7 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
 typedef struct tt__synth {
     const tt_image *source;
     const tt_rect *windows;   /* per condition: S x 2S, top-left (x, y) */
+    const tt_rect *vertical;  /* upright tiles: per condition, 2S x S, for sides 1 and 3; else NULL */
     int size, gutter, feather;
     float *tile;              /* RGBA, premultiplied (opaque) */
     size_t stride;            /* floats per row of `tile` */
@@ -6518,18 +6548,31 @@ static float *tt__synth_texel(const tt__synth *s, int tx, int ty)
     return s->tile + (ptrdiff_t)ty * (ptrdiff_t)s->stride + (ptrdiff_t)tx * 4;
 }
 
-/* The edge sample for a side of type t at side-frame (x, d). Condition k's
-   window holds two squares, upper U and lower L, meeting at the line between
-   rows S-1 and S. Type 2k lines the side with U as it is, so d counts rows up
-   from that line; type 2k+1 lines it with L turned 180 degrees. For d < 0 both
-   continue across the line, which is exactly what the neighbour across the
-   edge (with the other type) shows: this is why tiles meet seamlessly. */
-static const float *tt__edge_sample(const tt__synth *s, int type, int x, int d)
+/* The edge sample for side `side` of type t at side-frame (x, d). Condition
+   k's window holds two squares, upper U and lower L, meeting at the line
+   between rows S-1 and S. Type 2k lines the side with U as it is, so d counts
+   rows up from that line; type 2k+1 lines it with L turned 180 degrees. For
+   d < 0 both continue across the line, which is exactly what the neighbour
+   across the edge (with the other type) shows: this is why tiles meet
+   seamlessly. Upright tiles read sides 1 and 3 from the vertical window, a
+   left and a right square meeting at the line between columns S-1 and S,
+   turned back by the side's quarter turn: type 2k lines side 1 with the left
+   square as it is (the band's tile texels are the window's, shifted), type
+   2k+1 with the right square turned 180 degrees, and across the line each
+   continues into the other as before. */
+static const float *tt__edge_sample(const tt__synth *s, int side, int type, int x, int d)
 {
-    const tt_rect *w = &s->windows[type >> 1];
+    const int S = s->size;
     int sx, sy;
-    if ((type & 1) == 0) { sx = w->x + x; sy = w->y + s->size - 1 - d; }
-    else { sx = w->x + s->size - 1 - x; sy = w->y + s->size + d; }
+    if (s->vertical && (side & 1)) {
+        const tt_rect *w = &s->vertical[type >> 1];
+        if ((type & 1) == 0) { sx = w->x + S - 1 - d; sy = w->y + S - 1 - x; }
+        else { sx = w->x + S + d; sy = w->y + x; }
+    } else {
+        const tt_rect *w = &s->windows[type >> 1];
+        if ((type & 1) == 0) { sx = w->x + x; sy = w->y + S - 1 - d; }
+        else { sx = w->x + S - 1 - x; sy = w->y + S + d; }
+    }
     return s->source->pixels + ((size_t)sy * s->source->width + sx) * 4;
 }
 
@@ -6590,7 +6633,7 @@ static void tt__lay_band(const tt__synth *s, const tt_synth_plan *plan, size_t d
             const float *band;
             int tx, ty;
             if (alpha <= 0.0f) continue;
-            band = tt__edge_sample(s, type, x, d);
+            band = tt__edge_sample(s, side, type, x, d);
             for (k = 0; k < 3; k++) premultiplied[k] = band[k] * alpha;
             premultiplied[3] = alpha;
             tt__side_to_tile(s, side, x, d, &tx, &ty);
@@ -6614,7 +6657,7 @@ static tt_result tt__band_depths(const tt__synth *s, int side, int type, int min
     for (d = 0; d < rows; d++)
         for (x = 0; x < S; x++) {
             int tx, ty;
-            const float *band = tt__edge_sample(s, type, x, d);
+            const float *band = tt__edge_sample(s, side, type, x, d);
             const float *below;
             float err = 0.0f;
             tt__side_to_tile(s, side, x, d, &tx, &ty);
@@ -6642,6 +6685,7 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
     int side, k, x, y, d;
     s.source = source;
     s.windows = plan->edge_windows;
+    s.vertical = plan->vertical_windows;
     s.size = S;
     s.gutter = g;
     s.feather = plan->feather;
@@ -6655,8 +6699,8 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
        around a mesh vertex differs from tile to tile: the mean of the two
        edge samples there matches each neighbour across an edge halfway. */
     for (side = 0; side < 4; side++) {
-        const float *a = tt__edge_sample(&s, types[side], 0, 0);
-        const float *b = tt__edge_sample(&s, types[(side + 3) % 4], S - 1, 0);
+        const float *a = tt__edge_sample(&s, side, types[side], 0, 0);
+        const float *b = tt__edge_sample(&s, (side + 3) % 4, types[(side + 3) % 4], S - 1, 0);
         int tx, ty;
         float *corner;
         tt__side_to_tile(&s, side, 0, 0, &tx, &ty);
@@ -6684,7 +6728,7 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
                 float *out;
                 tt__side_to_tile(&s, side, x, d, &tx, &ty);
                 out = tt__synth_texel(&s, tx, ty);
-                memcpy(out, tt__edge_sample(&s, types[side], x, d), 3 * sizeof(float));
+                memcpy(out, tt__edge_sample(&s, side, types[side], x, d), 3 * sizeof(float));
                 out[3] = 1.0f;
             }
 }
@@ -6697,6 +6741,7 @@ TTDEF void tt_tileset_free(tt_tileset *tileset)
     allocator = tileset->allocator;
     for (i = 0; i < tileset->nlevels; i++) tt__image_release(&tileset->levels[i]);
     tt__free(&allocator, tileset->edge_windows);
+    tt__free(&allocator, tileset->vertical_windows);
     tt__free(&allocator, tileset->background_windows);
     tt__free(&allocator, tileset);
 }
@@ -6878,6 +6923,21 @@ static tt_result tt__bad_plan_window(tt_error *error, const char *which, int ind
                        which, index);
 }
 
+/* Whether every edge (and vertical) window of a plan lies inside a source of its size. */
+static tt_result tt__check_plan_windows(const tt_synth_plan *plan, const tt_image *source, tt_error *error)
+{
+    const int S = plan->layout.tile_size;
+    int k;
+    for (k = 0; k < plan->layout.colors; k++) {
+        if (!tt__rect_fits(&plan->edge_windows[k], S, 2 * S, source->width, source->height))
+            return tt__bad_plan_window(error, "edge", k);
+        if (plan->vertical_windows &&
+            !tt__rect_fits(&plan->vertical_windows[k], 2 * S, S, source->width, source->height))
+            return tt__bad_plan_window(error, "vertical", k);
+    }
+    return TT_OK;
+}
+
 static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_options *options,
                                        const tt_allocator *allocator, tt_synth_plan **out_plan, tt_error *error,
                                        const char *what, float progress_from, float progress_to)
@@ -6912,11 +6972,13 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     n = layout.colors;
     T = tt_tile_layout_tiles_per_side(&layout);
     ntiles = T * T;   /* T <= TT_MAX_IMAGE_SIZE / 4 once resolved: fits an int */
-    if (guide->width < S || guide->height < 2 * S)
+    if (guide->width < (opt->upright ? 2 * S : S) || guide->height < 2 * S)
         return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
-                        "the %s is %dx%d, but %d-texel tiles need an edge window of %dx%d "
+                        "the %s is %dx%d, but %d-texel %stiles need an edge window of %dx%d "
                         "(use a tile size of at most %d)",
-                        what, guide->width, guide->height, S, S, 2 * S, tt__min_i(guide->width, guide->height / 2));
+                        what, guide->width, guide->height, S, opt->upright ? "upright " : "",
+                        opt->upright ? 2 * S : S, 2 * S,
+                        tt__min_i(opt->upright ? guide->width / 2 : guide->width, guide->height / 2));
     if (opt->feather < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "feather %d is negative", opt->feather);
     feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
@@ -6954,7 +7016,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
        depths (each part a multiple of 16 bytes long but the last). */
     depth_size = max_depth <= 255 ? 1 : 2;
     head = (sizeof(tt_synth_plan) + 15u) / 16u * 16u;
-    edge_bytes = (unsigned long long)n * sizeof(tt_rect);
+    edge_bytes = (unsigned long long)(opt->upright ? 2 * n : n) * sizeof(tt_rect);
     background_bytes = (unsigned long long)ntiles * sizeof(tt_rect);
     depth_count = 4ull * (unsigned long long)S * (unsigned long long)ntiles;
     bytes = head + edge_bytes + background_bytes + depth_count * (unsigned long long)depth_size;
@@ -6979,6 +7041,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     plan->feather = feather;
     plan->max_depth = max_depth;
     plan->edge_windows = (tt_rect *)(void *)((unsigned char *)plan + head);
+    if (opt->upright) plan->vertical_windows = plan->edge_windows + n;
     plan->background_windows = (tt_rect *)(void *)((unsigned char *)plan + head + edge_bytes);
     if (depth_size == 1) plan->depth8 = (uint8_t *)plan + head + edge_bytes + background_bytes;
     else plan->depth16 = (uint16_t *)(void *)((unsigned char *)plan + head + edge_bytes + background_bytes);
@@ -6996,9 +7059,29 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     } else {
         tt__choose_edge_windows(&rng, guide, S, n, plan->edge_windows);
     }
+    if (opt->upright) {
+        /* The vertical windows: edge windows of the guide turned over its
+           diagonal (x and y swapped), whose line then runs down the guide. */
+        tt_image across;
+        if ((result = tt__image_init(&across, guide->height, guide->width, allocator, error)) != TT_OK) goto done;
+        for (t = 0; t < guide->height; t++)
+            for (k = 0; k < guide->width; k++)
+                memcpy(across.pixels + ((size_t)k * across.width + (size_t)t) * 4,
+                       guide->pixels + ((size_t)t * guide->width + (size_t)k) * 4, 4 * sizeof(float));
+        tt__choose_edge_windows(&rng, &across, S, n, plan->vertical_windows);
+        tt__image_release(&across);
+        for (k = 0; k < n; k++) {
+            tt_rect r = plan->vertical_windows[k];
+            plan->vertical_windows[k].x = r.y;
+            plan->vertical_windows[k].y = r.x;
+            plan->vertical_windows[k].w = 2 * S;
+            plan->vertical_windows[k].h = S;
+        }
+    }
 
     s.source = guide;
     s.windows = plan->edge_windows;
+    s.vertical = plan->vertical_windows;
     s.size = S;
     s.gutter = g;
     s.feather = feather;
@@ -7098,6 +7181,7 @@ static tt_result tt__compose_non_finite(const tt_synth_plan *plan, const tt_imag
     int x, y, d, side;
     s.source = source;
     s.windows = plan->edge_windows;
+    s.vertical = plan->vertical_windows;
     s.size = S;
     for (y = 0; y < S && !bad; y++)
         for (x = 0; x < S && !bad; x++) {
@@ -7107,7 +7191,7 @@ static tt_result tt__compose_non_finite(const tt_synth_plan *plan, const tt_imag
     for (side = 0; side < 4 && !bad; side++)
         for (d = -g; d <= deepest && !bad; d++)
             for (x = 0; x < S && !bad; x++) {
-                const float *p = tt__edge_sample(&s, types[side], x, d);
+                const float *p = tt__edge_sample(&s, side, types[side], x, d);
                 if (!tt__is_finite(p[0]) || !tt__is_finite(p[1]) || !tt__is_finite(p[2])) bad = p;
             }
     if (bad) {
@@ -7149,9 +7233,7 @@ TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image 
     tile = tt_tile_index(&plan->layout, types);
     if (!tt__rect_fits(&plan->background_windows[tile], S, S, source->width, source->height))
         return tt__bad_plan_window(error, "background", tile);
-    for (side = 0; side < 4; side++)
-        if (!tt__rect_fits(&plan->edge_windows[types[side] >> 1], S, 2 * S, source->width, source->height))
-            return tt__bad_plan_window(error, "edge", types[side] >> 1);
+    if ((result = tt__check_plan_windows(plan, source, error)) != TT_OK) return result;
     tt__compose_cell(plan, source, types, tile, target->pixels + ((size_t)y * target->width + (size_t)x) * 4,
                      (size_t)target->width * 4);
     for (row = 0; row < C; row++) {
@@ -7169,7 +7251,7 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
 {
     tt_tileset *set = NULL;
     tt_result result;
-    int S, g, C, T, W, n, ntiles, t, k;
+    int S, g, C, T, W, n, ntiles, t;
 
     tt__ok(error);
     if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the output pointer is NULL");
@@ -7188,9 +7270,7 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
     T = tt_tile_layout_tiles_per_side(&plan->layout);
     W = T * C;
     ntiles = T * T;
-    for (k = 0; k < n; k++)
-        if (!tt__rect_fits(&plan->edge_windows[k], S, 2 * S, source->width, source->height))
-            return tt__bad_plan_window(error, "edge", k);
+    if ((result = tt__check_plan_windows(plan, source, error)) != TT_OK) return result;
     for (t = 0; t < ntiles; t++)
         if (!tt__rect_fits(&plan->background_windows[t], S, S, source->width, source->height))
             return tt__bad_plan_window(error, "background", t);
@@ -7202,11 +7282,13 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
     set->layout = plan->layout;
     set->edge_windows = TT__ALLOC(allocator, tt_rect, n);
     set->background_windows = TT__ALLOC(allocator, tt_rect, ntiles);
-    if (!set->edge_windows || !set->background_windows) {
+    if (plan->vertical_windows) set->vertical_windows = TT__ALLOC(allocator, tt_rect, n);
+    if (!set->edge_windows || !set->background_windows || (plan->vertical_windows && !set->vertical_windows)) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
         goto done;
     }
     memcpy(set->edge_windows, plan->edge_windows, (size_t)n * sizeof(tt_rect));
+    if (plan->vertical_windows) memcpy(set->vertical_windows, plan->vertical_windows, (size_t)n * sizeof(tt_rect));
     memcpy(set->background_windows, plan->background_windows, (size_t)ntiles * sizeof(tt_rect));
     if ((result = tt__image_init(&set->levels[0], W, W, allocator, error)) != TT_OK) goto done;
     set->nlevels = 1;
@@ -14874,6 +14956,8 @@ TTDEF tt_result tt_polycube_build(const tt_mesh *mesh, const tt_polycube_options
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory building the polycube");
         goto done;
     }
+    pc->up_axis = up_axis;
+    pc->up_sign = up_sign;
 
     /* Sec. 3.1 / spec P1-P3: the cubes the surface meets. */
     memset(vox.hit, 0, (size_t)vox.count);
@@ -18198,9 +18282,11 @@ failed:
     return result;
 }
 
-TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
-                                        const tt_tile_layout *layout, const uint8_t *corner_type,
-                                        float *corner_uv, tt_error *error)
+/* tt_polycube_mapping_uvs and its upright form: `upright` puts the walls'
+   tiles in the right half of a 2W x W atlas. */
+static tt_result tt__polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
+                                          const tt_tile_layout *layout, const uint8_t *corner_type, int upright,
+                                          float *corner_uv, tt_error *error)
 {
     tt_tile_layout resolved;
     tt_result result;
@@ -18229,8 +18315,23 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
         tt_tile_corner_uv(&resolved, types, 2, high);
         corner_uv[2 * i] = low[0] + p.s * (high[0] - low[0]);
         corner_uv[2 * i + 1] = low[1] + p.t * (high[1] - low[1]);
+        if (upright) corner_uv[2 * i] = 0.5f * (corner_uv[2 * i] + (polycube->quad_side[p.quad] / 2 != polycube->up_axis));
     }
     return TT_OK;
+}
+
+TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
+                                        const tt_tile_layout *layout, const uint8_t *corner_type,
+                                        float *corner_uv, tt_error *error)
+{
+    return tt__polycube_mapping_uvs(polycube, mapping, layout, corner_type, 0, corner_uv, error);
+}
+
+TTDEF tt_result tt_polycube_mapping_uvs_upright(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
+                                                const tt_tile_layout *layout, const uint8_t *corner_type,
+                                                float *corner_uv, tt_error *error)
+{
+    return tt__polycube_mapping_uvs(polycube, mapping, layout, corner_type, 1, corner_uv, error);
 }
 
 #ifdef __cplusplus

@@ -18,10 +18,12 @@
                               two colours per axis (the paper's n = 2)
      tt_assign_boundaries     tile types from those colours; tt_assign_uvs
                               gives S its own texture coordinates
-     tt_synthesize_tiles      the atlas (shared with `tile`: tiled.c)
+     tt_synthesize_tiles      the atlas (shared with `tile`: tiled.c): plain
+                              tiles for the tops, upright ones (the same
+                              edge windows) for the walls, side by side
      tt_polycube_map          the triangles split along S's quad edges,
                               each corner's point on S
-     tt_polycube_mapping_uvs  those points as texture coordinates
+     tt_polycube_mapping_uvs_upright  those points as texture coordinates
      tt_measure_uv_distortion, tt_measure_seams   the summary's quality
 */
 #include <math.h>
@@ -62,6 +64,10 @@ static void print_help(void)
            "                   meets)\n"
            "  --up AXIS        the direction the tiles' up follows: x, y, z, -x, -y, -z or X,Y,Z\n"
            "                   (its largest component counts; default y)\n"
+           "  --no-upright     one set of plain tiles: half the atlas, but on the walls the left and\n"
+           "                   right quarter of each tile turns a quarter (bricks, planks and grain\n"
+           "                   run crosswise there); by default the walls' tiles keep IMAGE's up\n"
+           "                   throughout, from a second set of tiles beside the first\n"
            "\n"
            "Prints the polycube (cubes, squares, components, genus against the mesh's), the\n"
            "mapping (triangles split, triangles that fell back to one square: local seams, edges\n"
@@ -81,6 +87,7 @@ typedef struct polycube_command_options {
     const char *mesh_path, *image_path, *prefix;
     tiled_options tiles;            /* --colors --tile --gutter --seed, as `tile` takes them */
     tt_polycube_options build;      /* zero fields: the library's defaults */
+    int plain;                      /* --no-upright */
 } polycube_command_options;
 
 /* --up: an axis name, or a direction X,Y,Z of which the library takes the
@@ -130,6 +137,8 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
                 return tool_usage("--cube-size wants the cubes' edge in mesh units, above 0, got '%s'", value);
             options->build.cube_size = size;
             cube_size_given = 1;
+        } else if (strcmp(argv[i], "--no-upright") == 0) {
+            options->plain = 1;
         } else if (strcmp(argv[i], "--no-correct") == 0) {
             options->build.flags |= TT_POLYCUBE_NO_CORRECT;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
@@ -165,7 +174,9 @@ typedef struct polycube_job {
     int *edge_colors;               /* per S half-edge */
     uint8_t *surface_type;          /* per S half-edge: its boundary type */
     float *surface_uv;              /* per S corner: S's own texture coordinates */
-    tt_tileset *tiles;
+    tt_tileset *tiles;              /* plain: the tops and bottoms (all of S with --no-upright) */
+    tt_tileset *upright_tiles;      /* the walls; NULL with --no-upright */
+    tt_image *atlas;                /* the two side by side; NULL with --no-upright (then tiles->levels[0]) */
     tt_polycube_mapping *mapping;
     tt_polycube_map_report map_report;
     float *corner_uv;               /* 6 per mapped triangle */
@@ -180,6 +191,8 @@ static void polycube_job_free(polycube_job *job)
     free(job->surface_type);
     free(job->surface_uv);
     tt_tileset_free(job->tiles);
+    tt_tileset_free(job->upright_tiles);
+    tt_image_free(job->atlas);
     tt_polycube_mapping_free(job->mapping);
     free(job->corner_uv);
     memset(job, 0, sizeof *job);
@@ -226,6 +239,41 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
     return 0;
 }
 
+/* The walls' upright tiles, on the plain tiles' edge windows, and the
+   atlas of both: plain on the left, upright on the right, as
+   tt_polycube_mapping_uvs_upright reads it; S's own texture coordinates
+   move into their halves. An image too narrow for upright tiles (they need
+   2S x 2S) keeps the plain ones, with a note. */
+static int synthesize_upright(const polycube_command_options *options, const tt_image *image, polycube_job *job)
+{
+    const tt_image *plain = &job->tiles->levels[0];
+    tiled_options upright = options->tiles;
+    tt_error error;
+    int row, c, status;
+    if (image->width < 2 * job->layout.tile_size || image->height < 2 * job->layout.tile_size) {
+        tool_note("%s: %dx%d is too small for upright %d-texel tiles (they need %dx%d): the walls' tiles are "
+                  "plain, turned a quarter on their left and right sides (use a smaller --tile)",
+                  options->image_path, image->width, image->height, job->layout.tile_size,
+                  2 * job->layout.tile_size, 2 * job->layout.tile_size);
+        return 0;
+    }
+    upright.upright_over = job->tiles->edge_windows;
+    if ((status = tiled_synthesize(image, options->image_path, &upright, &job->upright_tiles)) != 0) return status;
+    if (tt_image_create(2 * plain->width, plain->height, NULL, &job->atlas, &error) != TT_OK)
+        return tool_fail("the %dx%d atlas: %s", 2 * plain->width, plain->height, error.message);
+    for (row = 0; row < plain->height; row++) {
+        float *out = job->atlas->pixels + (size_t)row * job->atlas->width * 4;
+        memcpy(out, plain->pixels + (size_t)row * plain->width * 4, (size_t)plain->width * 4 * sizeof(float));
+        memcpy(out + (size_t)plain->width * 4, job->upright_tiles->levels[0].pixels + (size_t)row * plain->width * 4,
+               (size_t)plain->width * 4 * sizeof(float));
+    }
+    for (c = 0; c < job->polycube->surface->ncorners; c++) {
+        int wall = job->polycube->quad_side[job->polycube->surface->corner_face[c]] / 2 != job->polycube->up_axis;
+        job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] + (float)wall);
+    }
+    return 0;
+}
+
 /* The triangles split along S's quads, with their texture coordinates. */
 static int map_mesh(const polycube_command_options *options, polycube_job *job)
 {
@@ -237,8 +285,8 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
     job->corner_uv = (float *)malloc((size_t)job->mapping->ntriangles * 6 * sizeof(float));
     if (!job->corner_uv)
         return tool_fail("out of memory for the texture coordinates of %d triangles", job->mapping->ntriangles);
-    if (tt_polycube_mapping_uvs(job->polycube, job->mapping, &job->layout, job->surface_type, job->corner_uv,
-                                &error) != TT_OK)
+    if ((job->atlas ? tt_polycube_mapping_uvs_upright : tt_polycube_mapping_uvs)(
+            job->polycube, job->mapping, &job->layout, job->surface_type, job->corner_uv, &error) != TT_OK)
         return tool_fail("%s: the texture coordinates: %s", options->mesh_path, error.message);
     return 0;
 }
@@ -262,7 +310,7 @@ typedef struct polycube_quality {
 static int measure_quality(const polycube_command_options *options, const polycube_job *job,
                            polycube_quality *quality)
 {
-    const tt_image *atlas = &job->tiles->levels[0];
+    const tt_image *atlas = job->atlas ? job->atlas : &job->tiles->levels[0];
     tt_mesh_desc desc;
     tt_mesh *mapped = NULL;
     tt_uv_distortion_options distortion;
@@ -331,9 +379,10 @@ static void print_summary(const polycube_command_options *options, const polycub
     if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
     printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);
-    printf("tiles: %d (n=%d, %d texels, gutter %d), %dx%d atlas; %.4g texels per unit\n",
+    printf("tiles: %s%d (n=%d, %d texels, gutter %d), %dx%d atlas%s; %.4g texels per unit\n", job->atlas ? "2 x " : "",
            tt_tile_layout_tile_count(&job->layout), job->layout.colors, job->layout.tile_size, job->layout.gutter,
-           atlas, atlas, job->layout.tile_size / job->polycube->h);
+           job->atlas ? 2 * atlas : atlas, atlas, job->atlas ? " (plain for the tops, upright for the walls)" : "",
+           job->layout.tile_size / job->polycube->h);
     if (!quality->mesh_built) {
         printf("stretch and seam score: not measured (%s)\n", quality->mesh_reason);
     } else {
@@ -437,6 +486,7 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) {
         start = tool_seconds_now();
         status = tiled_synthesize(image, options.image_path, &options.tiles, &job.tiles);
+        if (status == 0 && !options.plain) status = synthesize_upright(&options, image, &job);
         job.synth_seconds = tool_seconds_now() - start;
     }
     /* The photo is not needed past the synthesis; it is the largest thing
@@ -446,7 +496,10 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = map_mesh(&options, &job);
     if (status == 0) status = measure_quality(&options, &job, &quality);
 
-    if (status == 0) status = tiled_add_atlas(&output, png_path, job.tiles, 0);
+    if (status == 0 && job.atlas && output_add_png(&output, png_path, job.atlas, TT_COLOR_SRGB, message,
+                                                   sizeof message) != 0)
+        status = tool_fail("%s", message);
+    if (status == 0 && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0);
     if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
     if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
     if (status == 0) status = add_surface_obj(&output, surface_path, tool_basename(mtl_path), &job);

@@ -370,6 +370,10 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
                               colors == 1 ? "" : "s");
         synth.edge_windows = options->edges;
     }
+    if (options->upright_over) {
+        synth.edge_windows = options->upright_over;
+        synth.upright = 1;
+    }
     if (tt_synthesize_tiles(image, &synth, NULL, out, &error) != TT_OK) {
         if (error.result == TT_ERROR_IMAGE_TOO_SMALL || error.result == TT_ERROR_INVALID_ARGUMENT)
             return tool_fail("%s: %s", image_path, error.message);

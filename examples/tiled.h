@@ -41,6 +41,7 @@ typedef struct tiled_options {
     int mips;                    /* also write the per-tile mip levels */
     const char *atlas_path;      /* --atlas */
     int report;                  /* --report: tile usage and stretch under the summary */
+    const tt_rect *upright_over; /* not NULL: upright tiles (tt_synth_options::upright) on these edge windows */
 } tiled_options;
 
 /* The tool's defaults: the library's, with a gutter of TT_RECOMMENDED_GUTTER

@@ -834,14 +834,15 @@ expect_error "hpm OBJ truncated mid face line" hpm ../in/truncated_face.obj ../i
 # ======================================================================
 # Polycube + Wang tiles
 # ======================================================================
-# polycube_obj_report OBJ COLORS TILE GUTTER ->
+# polycube_obj_report OBJ COLORS TILE GUTTER WIDE ->
 #   "faces nontri corners nvt badc reused outside straddling":
 #   f lines, f lines without 3 corners, corners, vt lines, corners whose v or
 #   vt index is missing or out of range, vt lines referenced other than exactly
 #   once, vt values that are not numbers in [0,1], and triangles whose three vt
-#   do not fall in one tile's cell of the atlas ((2n)^2 cells of S + 2G texels a side).
+#   do not fall in one tile's cell of the atlas ((2n)^2 cells of S + 2G texels a side, WIDE
+#   times as many across: 2 for the plain and upright tiles side by side).
 polycube_obj_report() {
-    awk -v n="$2" -v s="$3" -v g="$4" '
+    awk -v n="$2" -v s="$3" -v g="$4" -v wide="$5" '
         function isnum(x) { return x ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?$/ }
         BEGIN { cell = s + 2 * g; side = 4 * n * n * cell }
         $1 == "v"  { nv++ }
@@ -858,7 +859,7 @@ polycube_obj_report() {
                     p[1] + 0 < 1 || p[1] + 0 > nv || p[2] + 0 < 1 || p[2] + 0 > nvt) { badc++; continue }
                 t = p[2] + 0
                 uses[t]++
-                key = int(u[t] * side / cell) "," int(v[t] * side / cell)
+                key = int(u[t] * wide * side / cell) "," int(v[t] * side / cell)
                 if (!(cf[k] in tile)) tile[cf[k]] = key
                 else if (tile[cf[k]] != key && !(cf[k] in straddles)) { straddles[cf[k]] = 1; straddling++ }
             }
@@ -872,8 +873,9 @@ polycube_obj_report() {
 # the OBJ holds at least the mesh's triangle fans, one vt per corner inside its
 # triangle's tile; the polycube's surface is quads with tile UVs; the summary has its lines.
 polycube_case() {
-    local name=$1 mesh=$2 colors=$3 faces nontri corners nvt badc reused outside straddling want side
+    local name=$1 mesh=$2 colors=$3 faces nontri corners nvt badc reused outside straddling want side wide=2
     shift 3
+    case " $* " in *" --no-upright "*) wide=1 ;; esac
     newdir
     run polycube "../in/$mesh" ../in/tex.png out --tile 16 --colors "$colors" "$@"
     check "polycube $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
@@ -885,9 +887,10 @@ polycube_case() {
         "$(grep -qE '^map_Kd +out\.png$' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl$' out.obj 2>/dev/null &&
             grep -qE '^mtllib +out\.mtl$' out_polycube.obj 2>/dev/null; echo $?)"
     side=$((4 * colors * colors * (16 + 2 * 4)))
-    check "polycube $name: the atlas is ${side}x$side" "$side $side" "$(png_size out.png)" \
-        "$(is_png out.png && [ "$(png_size out.png)" = "$side $side" ]; echo $?)"
-    read -r faces nontri corners nvt badc reused outside straddling <<<"$(polycube_obj_report out.obj "$colors" 16 4)"
+    check "polycube $name: the atlas is $((wide * side))x$side" "$((wide * side)) $side" "$(png_size out.png)" \
+        "$(is_png out.png && [ "$(png_size out.png)" = "$((wide * side)) $side" ]; echo $?)"
+    read -r faces nontri corners nvt badc reused outside straddling \
+        <<<"$(polycube_obj_report out.obj "$colors" 16 4 "$wide")"
     want=$(fan_triangles "$W/in/$mesh")
     check "polycube $name: triangles, at least the mesh's $want" ">= $want triangle f lines" \
         "$faces f lines, $nontri not triangles" \
@@ -914,8 +917,11 @@ polycube_case "sphere-triangles" spheretri.obj 2 --resolution 8
 POLYCUBE_SPHERE=$W/d$NEWDIR_N
 check "polycube sphere: genus 0 as the mesh" "'genus 0 (as the mesh)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'genus 0 (as the mesh)'; echo $?)"
-check "polycube sphere: the paper's 256 tiles" "'tiles: 256 (n=2'" "$OUT" \
-    "$(printf '%s' "$OUT" | grep -q '^tiles: 256 (n=2, 16 texels, gutter 4)'; echo $?)"
+check "polycube sphere: the paper's 256 tiles, plain and upright" "'tiles: 2 x 256 (n=2 ... (plain for the tops, upright for the walls)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '^tiles: 2 x 256 (n=2, 16 texels, gutter 4), 768x384 atlas (plain for the tops, upright for the walls)'; echo $?)"
+polycube_case "sphere --no-upright" spheretri.obj 2 --resolution 8 --no-upright
+check "polycube --no-upright: one set of 256 tiles" "'tiles: 256 (n=2, 16 texels, gutter 4), 384x384 atlas;'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '^tiles: 256 (n=2, 16 texels, gutter 4), 384x384 atlas;'; echo $?)"
 polycube_case "torus (quads as fans)" torus.obj 1 --seed 3
 check "polycube torus: says it split the quads into triangles" "'1024 triangles (fans of 512 faces)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q '1024 triangles (fans of 512 faces)'; echo $?)"

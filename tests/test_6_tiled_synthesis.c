@@ -516,6 +516,127 @@ static void test_second_map_same_masks(void)
    B is s * atlas_A + o up to float rounding. The masks do not depend on the
    applied image, and every step (over, corner means, mip averages) is an
    affine combination with weights summing to 1. */
+/* tt_synth_options::upright: every band of an upright tile keeps the
+   source's up (a source of horizontal stripes gives tiles of horizontal
+   stripes, changing along the rows only where layers blend; plain tiles
+   turn the left and right bands into vertical stripes), and two upright tiles still meet seamlessly across a left/right
+   edge: the gutter beyond tile A's right side (type t) is what tile B shows
+   along its left side (type t ^ 1), and not what a B of type t shows. */
+static void test_upright_tiles(void)
+{
+    const int S = 32, g = 4;
+    tt_image *stripes = NULL, *noise = sy_noise(96, 80, 41u);
+    int upright, x, y, k;
+    tt_error err;
+    tt_image_create(80, 72, NULL, &stripes, NULL);
+    if (!stripes || !noise) {
+        CHECK(0, "images");
+        tt_image_free(stripes);
+        tt_image_free(noise);
+        return;
+    }
+    for (y = 0; y < stripes->height; y++)
+        for (x = 0; x < stripes->width; x++) {
+            float *p = sy_px(stripes, x, y);
+            for (k = 0; k < 3; k++) p[k] = (float)(sy_hash((uint32_t)y, (uint32_t)k, 5u) % 1000u) / 1000.0f;
+            p[3] = 1.0f;
+        }
+    for (upright = 0; upright < 2; upright++) {
+        tt_synth_options o = sy_options(2, S, g, 9u);
+        tt_synth_plan *plan = NULL;
+        tt_tileset *set = NULL;
+        double along = 0.0, across = 0.0;
+        int tiles, t;
+        o.upright = upright;
+        if (tt_synth_plan_create(stripes, &o, NULL, &plan, &err) != TT_OK ||
+            tt_synth_apply(plan, stripes, NULL, &set, &err) != TT_OK) {
+            CHECK(0, "upright %d: stripes tiles: %s", upright, err.message);
+            tt_synth_plan_free(plan);
+            continue;
+        }
+        CHECK(upright ? plan->vertical_windows && set->vertical_windows && plan->vertical_windows[1].w == 2 * S &&
+                            plan->vertical_windows[1].h == S
+                      : !plan->vertical_windows && !set->vertical_windows,
+              "upright %d: the vertical windows are %s", upright, upright ? "there, 2S x S" : "absent");
+        tiles = tt_tile_layout_tile_count(&plan->layout);
+        for (t = 0; t < tiles; t++) {
+            uint8_t types[4];
+            int cx, cy;
+            sy_tile_types(&plan->layout, t, types, &cx, &cy);
+            for (y = 1; y < S - 1; y++)
+                for (x = 1; x < S - 1; x++)
+                    for (k = 0; k < 3; k++) {
+                        const float *p = sy_px(&set->levels[0], cx + g + x, cy + g + y);
+                        along += fabs(sy_px(&set->levels[0], cx + g + x + 1, cy + g + y)[k] - p[k]);
+                        across += fabs(sy_px(&set->levels[0], cx + g + x, cy + g + y + 1)[k] - p[k]);
+                    }
+        }
+        printf("     %s tiles of horizontal stripes: change along the rows %.3f of that across them\n",
+               upright ? "upright" : "plain", along / across);
+        if (upright)
+            CHECK(along < 0.15 * across, "upright tiles keep stripes horizontal: change along the rows %.3f of that "
+                  "across", along / across);
+        else
+            CHECK(along > 0.3 * across, "plain tiles turn the side bands' stripes: change along the rows %.3f of "
+                  "that across", along / across);
+        tt_tileset_free(set);
+        tt_synth_plan_free(plan);
+    }
+    {
+        tt_synth_options o = sy_options(2, S, g, 12u);
+        tt_synth_plan *plan = NULL;
+        tt_image *a = NULL, *b = NULL;
+        int type, matched = 1, control_differs = 0;
+        o.upright = 1;
+        tt_image_create(S + 2 * g, S + 2 * g, NULL, &a, NULL);
+        tt_image_create(S + 2 * g, S + 2 * g, NULL, &b, NULL);
+        if (!a || !b || tt_synth_plan_create(noise, &o, NULL, &plan, &err) != TT_OK) {
+            CHECK(0, "upright plan of noise");
+        } else {
+            for (type = 0; type < 4; type++) {
+                const uint8_t ta[4] = {1, (uint8_t)type, 2, 0};
+                const uint8_t tb[4] = {3, 0, 0, (uint8_t)(type ^ 1)};
+                const uint8_t tc[4] = {3, 0, 0, (uint8_t)type};
+                int j;
+                CHECK(tt_synth_compose_tile(plan, noise, ta, a, 0, 0, &err) == TT_OK &&
+                          tt_synth_compose_tile(plan, noise, tb, b, 0, 0, &err) == TT_OK,
+                      "compose upright tiles");
+                for (y = g + 2; y < S - g - 2; y++)
+                    for (j = 0; j < g; j++)
+                        matched &= memcmp(sy_px(a, g + S + j, g + y), sy_px(b, g + j, g + y), 3 * sizeof(float)) == 0;
+                CHECK(tt_synth_compose_tile(plan, noise, tc, b, 0, 0, &err) == TT_OK, "compose the control");
+                for (y = g + 2; y < S - g - 2; y++)
+                    for (j = 0; j < g; j++)
+                        control_differs += memcmp(sy_px(a, g + S + j, g + y), sy_px(b, g + j, g + y),
+                                                  3 * sizeof(float)) != 0;
+            }
+            CHECK(matched, "upright tiles: the gutter beyond the right side is the left side of the tile across");
+            CHECK(control_differs > 0, "the same type on both sides of the edge does not match (%d texels differ)",
+                  control_differs);
+        }
+        tt_synth_plan_free(plan);
+        tt_image_free(a);
+        tt_image_free(b);
+    }
+    /* Upright tiles need the vertical windows' 2S columns. */
+    {
+        tt_synth_options o = sy_options(2, 40, g, 1u);
+        tt_synth_plan *plan = NULL;
+        tt_image *narrow = sy_noise(60, 100, 3u);
+        o.upright = 1;
+        CHECK(narrow && tt_synth_plan_create(narrow, &o, NULL, &plan, &err) == TT_ERROR_IMAGE_TOO_SMALL && !plan &&
+                  strstr(err.message, "upright") && sy_has_number(err.message, 80),
+              "a 60x100 image for upright 40-texel tiles: %s", err.message);
+        o.upright = 0;
+        CHECK(narrow && tt_synth_plan_create(narrow, &o, NULL, &plan, &err) == TT_OK, "plain 40-texel tiles fit: %s",
+              err.message);
+        tt_synth_plan_free(plan);
+        tt_image_free(narrow);
+    }
+    tt_image_free(stripes);
+    tt_image_free(noise);
+}
+
 static void test_affine_map(void)
 {
     static const float scale[3] = {0.5f, -0.7f, 2.0f}, offset[3] = {0.25f, 0.9f, -0.5f};
@@ -924,6 +1045,7 @@ void run_tiled_synthesis_tests(void)
     RUN(test_plan_fields);
     RUN(test_plan_wide_depths);
     RUN(test_compose_tile_matches_apply);
+    RUN(test_upright_tiles);
     RUN(test_second_map_same_masks);
     RUN(test_affine_map);
     RUN(test_plan_create_errors);

@@ -2162,6 +2162,117 @@ static void test_map_uvs_and_seams(void)
     tt_image_free(photo);
 }
 
+/* Upright tiles on the walls (tt_polycube_mapping_uvs_upright): a sphere
+   textured from a plain and an upright tile set side by side is seamless
+   on the tile borders; the walls' UVs lie in the right half, the tops' in
+   the left. Upright tiles on every quad instead (the tops too) break the
+   edges where a top's left or right side meets a wall's top side. */
+static void test_map_uvs_upright(void)
+{
+    const double centre[3] = {0.02, 0.11, -0.07};
+    tt_image *photo = NULL, *atlas = NULL;
+    tt_tileset *plain = NULL, *upright = NULL;
+    tt_synth_options so;
+    tt_polycube *pc = NULL;
+    tt_mesh *mesh = NULL, *out = NULL;
+    tt_polycube_map_report rep;
+    tt_polycube_mapping *map;
+    tt_error err;
+    tmesh m;
+    int row;
+    memset(&so, 0, sizeof so);
+    so.layout.colors = 2;
+    so.layout.tile_size = 32;
+    so.layout.gutter = 4;
+    so.seed = 3;
+    make_value_noise(&photo, 160, 256, 9);
+    if (!photo || tt_synthesize_tiles(photo, &so, NULL, &plain, &err) != TT_OK) {
+        CHECK(0, "plain tiles");
+        tt_image_free(photo);
+        return;
+    }
+    so.upright = 1;
+    so.edge_windows = plain->edge_windows;
+    if (tt_synthesize_tiles(photo, &so, NULL, &upright, &err) != TT_OK ||
+        tt_image_create(2 * plain->levels[0].width, plain->levels[0].height, NULL, &atlas, &err) != TT_OK) {
+        CHECK(0, "upright tiles: %s", err.message);
+        tt_tileset_free(plain);
+        tt_tileset_free(upright);
+        tt_image_free(photo);
+        return;
+    }
+    for (row = 0; row < atlas->height; row++) {
+        const size_t W = (size_t)plain->levels[0].width;
+        memcpy(atlas->pixels + (size_t)row * 2 * W * 4, plain->levels[0].pixels + (size_t)row * W * 4,
+               W * 4 * sizeof(float));
+        memcpy(atlas->pixels + ((size_t)row * 2 * W + W) * 4, upright->levels[0].pixels + (size_t)row * W * 4,
+               W * 4 * sizeof(float));
+    }
+    memset(&m, 0, sizeof m);
+    make_sphere(&m, 48, 24, 1.0, centre, 0);
+    map = mapped(&m, 8, 0, 0.0, &pc, &mesh, &rep);
+    if (map) {
+        const tt_mesh *s = pc->surface;
+        int *colors = (int *)malloc(sizeof(int) * (size_t)s->ncorners);
+        uint8_t *types = (uint8_t *)malloc((size_t)s->ncorners);
+        float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
+        float *everywhere = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
+        int i, wrong_half = 0, walls = 0;
+        tt_mesh_desc d;
+        tt_seam_options border;
+        tt_seam_report fit, control;
+        CHECK(colors && types && uv && everywhere && tt_polycube_edge_colors(pc, 2, 1, 7, colors, &err) == TT_OK &&
+                  tt_assign_boundaries(s, &so.layout, 7, colors, types, &err) == TT_OK &&
+                  tt_polycube_mapping_uvs_upright(pc, map, &so.layout, types, uv, &err) == TT_OK &&
+                  tt_polycube_mapping_uvs(pc, map, &so.layout, types, everywhere, &err) == TT_OK,
+              "the upright UVs: %s", err.message);
+        CHECK(pc->up_axis == 1 && pc->up_sign == 1, "the default up is +y: axis %d, sign %d", pc->up_axis,
+              pc->up_sign);
+        for (i = 0; i < 3 * map->ntriangles; i++) {
+            const int wall = pc->quad_side[map->corner_points[i].quad] / 2 != pc->up_axis;
+            walls += wall;
+            wrong_half += wall ? uv[2 * i] < 0.5f : uv[2 * i] > 0.5f;
+            everywhere[2 * i] = 0.5f * (everywhere[2 * i] + 1.0f);
+        }
+        CHECK(wrong_half == 0 && walls > 0 && walls < 3 * map->ntriangles,
+              "walls in the right half, tops and bottoms in the left: %d corners not", wrong_half);
+        memset(&d, 0, sizeof d);
+        d.positions = map->positions;
+        d.nverts = map->nverts;
+        d.indices = map->triangles;
+        d.nfaces = map->ntriangles;
+        d.fixed_face_size = 3;
+        memset(&border, 0, sizeof border);
+        border.flags = TT_SEAM_UV_DISCONTINUOUS;
+        if (tt_mesh_build(&d, NULL, &out, &err) == TT_OK &&
+            tt_measure_seams(out, uv, atlas, &border, NULL, &fit, &err) == TT_OK &&
+            tt_measure_seams(out, everywhere, atlas, &border, NULL, &control, &err) == TT_OK) {
+            printf("     sphere with upright tiles on its walls: seam %.3f on tile borders; upright tiles on the "
+                   "tops too: %.3f\n", fit.score, control.score);
+            CHECK(fit.score <= 0.05, "upright walls seamless: %.3f on the tile borders", fit.score);
+            /* Only the edges where a top's left or right side meets a wall break (a tenth of the borders),
+               so the control's score rises by less than a seam's full 1. */
+            CHECK(control.score >= fit.score + 0.08, "upright tops show seams at the walls: %.3f against %.3f",
+                  control.score, fit.score);
+        } else {
+            CHECK(0, "seams measured: %s", err.message);
+        }
+        free(colors);
+        free(types);
+        free(uv);
+        free(everywhere);
+    }
+    tt_mesh_free(out);
+    tt_polycube_mapping_free(map);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+    tt_image_free(atlas);
+    tt_tileset_free(plain);
+    tt_tileset_free(upright);
+    tt_image_free(photo);
+}
+
 typedef struct map_oom_ctx {
     const tt_polycube *pc;
     const tt_mesh *mesh;
@@ -2754,6 +2865,7 @@ void run_polycube_tests(void)
     RUN(test_map_cube);
     RUN(test_map_sphere);
     RUN(test_map_uvs_and_seams);
+    RUN(test_map_uvs_upright);
     RUN(test_map_determinism_and_errors);
     RUN(test_map_stretch_floor);
     RUN(test_map_thin_plate);
