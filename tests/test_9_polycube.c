@@ -2058,6 +2058,37 @@ static void test_map_sphere(void)
         }
 }
 
+/* The seam tests' tiles: n = 2, 32-texel tiles with a 4-texel gutter, seed 3,
+   from a 160 x 256 value noise (*photo, to free); NULL on failure. */
+static tt_tileset *seam_test_tiles(tt_synth_options *so, tt_image **photo)
+{
+    tt_tileset *tiles = NULL;
+    tt_error err;
+    memset(so, 0, sizeof *so);
+    so->layout.colors = 2;
+    so->layout.tile_size = 32;
+    so->layout.gutter = 4;
+    so->seed = 3;
+    make_value_noise(photo, 160, 256, 9);
+    if (!*photo || tt_synthesize_tiles(*photo, so, NULL, &tiles, &err) != TT_OK) return NULL;
+    return tiles;
+}
+
+/* A mapping's triangles as a strict tt_mesh (for the seam measure); NULL when they make none. */
+static tt_mesh *mapping_mesh(const tt_polycube_mapping *map)
+{
+    tt_mesh_desc d;
+    tt_mesh *out = NULL;
+    memset(&d, 0, sizeof d);
+    d.positions = map->positions;
+    d.nverts = map->nverts;
+    d.indices = map->triangles;
+    d.nfaces = map->ntriangles;
+    d.fixed_face_size = 3;
+    if (tt_mesh_build(&d, NULL, &out, NULL) != TT_OK) return NULL;
+    return out;
+}
+
 /* Spec P11 step 6 and B3, B5, B6: the UVs of a mapping put each output
    triangle inside its quad's tile (the three UVs in one tile rectangle),
    the textured model is seamless on the tile borders and over all edges,
@@ -2070,13 +2101,7 @@ static void test_map_uvs_and_seams(void)
     tt_tileset *tiles = NULL;
     tt_synth_options so;
     tt_error err;
-    memset(&so, 0, sizeof so);
-    so.layout.colors = 2;
-    so.layout.tile_size = 32;
-    so.layout.gutter = 4;
-    so.seed = 3;
-    make_value_noise(&photo, 160, 256, 9);
-    if (!photo || tt_synthesize_tiles(photo, &so, NULL, &tiles, &err) != TT_OK) {
+    if (!(tiles = seam_test_tiles(&so, &photo))) {
         CHECK(0, "tiles for the seam test");
         tt_image_free(photo);
         return;
@@ -2099,7 +2124,6 @@ static void test_map_uvs_and_seams(void)
             float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
             float *shuffled = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
             int f, k, outside = 0;
-            tt_mesh_desc d;
             tt_seam_options border;
             tt_seam_report fit_border, fit_all, control_border, control_all;
             CHECK(tt_polycube_edge_colors(pc, 2, 1, 7, colors, &err) == TT_OK &&
@@ -2122,15 +2146,9 @@ static void test_map_uvs_and_seams(void)
                 int other = lcg_below(map->ntriangles);
                 for (k = 0; k < 6; k++) shuffled[6 * f + k] = uv[6 * other + k];
             }
-            memset(&d, 0, sizeof d);
-            d.positions = map->positions;
-            d.nverts = map->nverts;
-            d.indices = map->triangles;
-            d.nfaces = map->ntriangles;
-            d.fixed_face_size = 3;
             memset(&border, 0, sizeof border);
             border.flags = TT_SEAM_UV_DISCONTINUOUS;
-            if (tt_mesh_build(&d, NULL, &out, &err) == TT_OK &&
+            if ((out = mapping_mesh(map)) != NULL &&
                 tt_measure_seams(out, uv, &tiles->levels[0], &border, NULL, &fit_border, &err) == TT_OK &&
                 tt_measure_seams(out, uv, &tiles->levels[0], NULL, NULL, &fit_all, &err) == TT_OK &&
                 tt_measure_seams(out, shuffled, &tiles->levels[0], &border, NULL, &control_border, &err) == TT_OK &&
@@ -2180,13 +2198,7 @@ static void test_map_uvs_upright(void)
     tt_error err;
     tmesh m;
     int row;
-    memset(&so, 0, sizeof so);
-    so.layout.colors = 2;
-    so.layout.tile_size = 32;
-    so.layout.gutter = 4;
-    so.seed = 3;
-    make_value_noise(&photo, 160, 256, 9);
-    if (!photo || tt_synthesize_tiles(photo, &so, NULL, &plain, &err) != TT_OK) {
+    if (!(plain = seam_test_tiles(&so, &photo))) {
         CHECK(0, "plain tiles");
         tt_image_free(photo);
         return;
@@ -2218,7 +2230,6 @@ static void test_map_uvs_upright(void)
         float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
         float *everywhere = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
         int i, wrong_half = 0, walls = 0;
-        tt_mesh_desc d;
         tt_seam_options border;
         tt_seam_report fit, control;
         CHECK(colors && types && uv && everywhere && tt_polycube_edge_colors(pc, 2, 1, 7, colors, &err) == TT_OK &&
@@ -2236,15 +2247,9 @@ static void test_map_uvs_upright(void)
         }
         CHECK(wrong_half == 0 && walls > 0 && walls < 3 * map->ntriangles,
               "walls in the right half, tops and bottoms in the left: %d corners not", wrong_half);
-        memset(&d, 0, sizeof d);
-        d.positions = map->positions;
-        d.nverts = map->nverts;
-        d.indices = map->triangles;
-        d.nfaces = map->ntriangles;
-        d.fixed_face_size = 3;
         memset(&border, 0, sizeof border);
         border.flags = TT_SEAM_UV_DISCONTINUOUS;
-        if (tt_mesh_build(&d, NULL, &out, &err) == TT_OK &&
+        if ((out = mapping_mesh(map)) != NULL &&
             tt_measure_seams(out, uv, atlas, &border, NULL, &fit, &err) == TT_OK &&
             tt_measure_seams(out, everywhere, atlas, &border, NULL, &control, &err) == TT_OK) {
             printf("     sphere with upright tiles on its walls: seam %.3f on tile borders; upright tiles on the "
