@@ -16428,14 +16428,14 @@ failed:
 #define TT__RELAX_RADIUS 4          /* steps across S's edges a vertex's local chart spans */
 #define TT__RELAX_SEAT_RADIUS 2     /* the same around a neighbour's point, where a vertex may be re-seated */
 #define TT__RELAX_CHART 96          /* quads a local chart holds at most */
-#define TT__RELAX_SWEEPS 12
+#define TT__RELAX_SWEEPS 12         /* one-vertex sweeps before the untangling */
 #define TT__UNTANGLE_SWEEPS 40      /* untangling sweeps over the vertices near folds */
 #define TT__UNTANGLE_PATIENCE 6     /* sweeps without fewer bad triangles after which the rings double */
 #define TT__UNTANGLE_RINGS 16       /* rings around the folds untangled at most */
 #define TT__UNTANGLE_STAR 64        /* triangles around a vertex it untangles at most */
 #define TT__UNTANGLE_EPSILON 0.01   /* Escobar et al.'s epsilon: det J below which delta grows */
 #define TT__UNTANGLE_STEPS 10       /* descent steps per vertex and sweep */
-#define TT__UNTANGLE_HALVINGS 20
+#define TT__UNTANGLE_HALVINGS 20    /* halvings of a descent step before the vertex stops */
 #define TT__RELAX_KERNEL_POINTS 64  /* a star's kernel polygon: its box's 4 corners and one per triangle */
 #define TT__RELAX_KERNEL_MARGIN 1e-9    /* twice the least area (quad units) of a star triangle around a kernel point */
 
@@ -16952,7 +16952,8 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         int moved = 0;
         tt__relax_mark_bad(pc, model, points, chart, 0, bad);
         for (v = 0; v < nverts; v++) {
-            double at[2], mean[2] = {0.0, 0.0}, candidate_at[2];
+            /* v's ring in its chart: per triangle, the points of its other two vertices. */
+            double at[2], mean[2] = {0.0, 0.0}, candidate_at[2], ring[2 * (TT__RELAX_KERNEL_POINTS - 4)][2];
             int i, n = 0, reachable = 1, a, step;
             double before, best_bad;
             tt_surface_point best, candidate;
@@ -16969,6 +16970,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                     if (tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], pu)) {
                         mean[0] += pu[0];
                         mean[1] += pu[1];
+                        if (n < 2 * (TT__RELAX_KERNEL_POINTS - 4)) memcpy(ring[n], pu, sizeof pu);
                         n++;
                     } else {
                         reachable = 0;
@@ -16985,15 +16987,8 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
             }
             if (reachable && n > 0 && n <= 2 * (TT__RELAX_KERNEL_POINTS - 4)) {
                 /* Into the kernel of v's star, where none of its triangles folds (when its ring allows). */
-                double ring[2 * (TT__RELAX_KERNEL_POINTS - 4)][2];
-                int m = 0;
                 tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
-                for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
-                    int corner = triangle_corners[i], f = corner / 3, k;
-                    for (k = 1; k < 3; k++)
-                        tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], ring[m++]);
-                }
-                if (tt__relax_kernel_centre((const double (*)[2])ring, m / 2, candidate_at) &&
+                if (tt__relax_kernel_centre((const double (*)[2])ring, n / 2, candidate_at) &&
                     tt__relax_chart_point(chart, candidate_at, &candidate))
                     tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
                                   &best);
@@ -17129,8 +17124,7 @@ static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, con
                                        above the records' snap (1e-6), far below any real piece */
 #define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
 #define TT__MAP_SNAP 1e-5f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
-#define TT__SPLIT_MAX_CELLS 4096
-#define TT__MAP_UNSPIKE_ROUNDS 3    /* edge tracings redone after points are moved off spikes */    /* grid cells of a chart's box beyond which a triangle takes the fallback */
+#define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
 
 /* A point on a triangle's boundary (a model vertex or a split point of an
    edge) and the boundary segment from it to the next point: the quad the
