@@ -1040,7 +1040,7 @@ typedef struct tt_synth_options {
        across an edge that both see as a left/right side or both as a
        bottom/top side; an edge that is bottom/top to both also meets a plain
        tile of a plan with the same edge_windows seamlessly (the walls and
-       the tops of a polycube, tt_polycube_mapping_uvs_upright). Needs a
+       the tops of a polycube, tt_polycube_upright_atlas). Needs a
        source of at least 2S x 2S. */
     int upright;
     /* Region from which each tile's S x S background window is drawn; all zero =
@@ -2705,16 +2705,33 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping);
 TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                         const tt_tile_layout *layout, const uint8_t *corner_type,
                                         float *corner_uv, tt_error *error);
-/* As tt_polycube_mapping_uvs, for upright tiles on the walls (so bricks,
-   planks and grain keep their direction all round the model, see
-   tt_synth_options::upright): the atlas is 2W x W, the W x W atlas of a
-   plain plan on the left and that of an upright plan made with the plain
-   plan's edge_windows (same layout) on the right. A quad facing sideways
-   (its normal not along polycube->up_axis) takes its tile from the right,
-   the tops and bottoms from the left: every edge of S then meets seamlessly,
-   as the edges along the up axis are left/right sides of both their quads
-   (upright tiles both) and every other edge is a bottom/top side of each
-   wall it borders. Errors and the rest as tt_polycube_mapping_uvs. */
+/* Upright tiles on the walls, so bricks, planks and grain keep their
+   direction all round the model (tt_synth_options::upright). The walls -
+   quads facing sideways, their normal not along polycube->up_axis: 1 from
+   tt_polycube_quad_upright - take upright tiles, the tops and bottoms plain
+   ones. Every edge of S then meets seamlessly: the edges along the up axis
+   are left/right sides of both their quads (upright tiles both), and every
+   other edge is a bottom/top side of each wall it borders, alike in both
+   sets when they share their edge windows.
+     1. tt_synthesize_tiles (or plan and apply) the plain tiles, then the
+        upright ones with the same layout and seed, options.upright = 1 and
+        options.edge_windows = the plain tileset's edge_windows;
+     2. tt_polycube_upright_atlas: the two side by side, 2W x W, plain on
+        the left (per mip level, as you need them);
+     3. tt_polycube_mapping_uvs_upright: as tt_polycube_mapping_uvs, u
+        halved, and moved to the right half for a wall.
+   tt_polycube_quad_upright is 1 for a wall, 0 for a top or bottom.
+   Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad <
+   its surface's nfaces. */
+TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
+/* Errors: NULL arguments, a bad allocator, tilesets of different layouts,
+   a plain tileset with vertical windows or an upright one without, edge
+   windows that differ (TT_ERROR_INVALID_ARGUMENT); a level that is not in
+   both tilesets (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
+   failure; free it with tt_image_free. */
+TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
+                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error);
+/* Errors and the rest as tt_polycube_mapping_uvs. */
 TTDEF tt_result tt_polycube_mapping_uvs_upright(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                                 const tt_tile_layout *layout, const uint8_t *corner_type,
                                                 float *corner_uv, tt_error *error);
@@ -7060,19 +7077,17 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
         tt__choose_edge_windows(&rng, guide, S, n, plan->edge_windows);
     }
     if (opt->upright) {
-        /* The vertical windows: edge windows of the guide turned over its
-           diagonal (x and y swapped), whose line then runs down the guide. */
-        tt_image across;
-        if ((result = tt__image_init(&across, guide->height, guide->width, allocator, error)) != TT_OK) goto done;
-        for (t = 0; t < guide->height; t++)
-            for (k = 0; k < guide->width; k++)
-                memcpy(across.pixels + ((size_t)k * across.width + (size_t)t) * 4,
-                       guide->pixels + ((size_t)t * guide->width + (size_t)k) * 4, 4 * sizeof(float));
-        tt__choose_edge_windows(&rng, &across, S, n, plan->vertical_windows);
-        tt__image_release(&across);
+        /* The vertical windows: edge windows chosen on the guide turned a
+           quarter, whose lines then run down the guide. Texel (x, y) of the
+           guide is (y, W-1-x) of the turned image, so the turned window at
+           (x, y) covers guide columns W-y-2S .. W-y-1 and rows x .. x+S-1. */
+        tt_image *turned = NULL;
+        if ((result = tt_image_rotate90(guide, 1, allocator, &turned, error)) != TT_OK) goto done;
+        tt__choose_edge_windows(&rng, turned, S, n, plan->vertical_windows);
+        tt_image_free(turned);
         for (k = 0; k < n; k++) {
             tt_rect r = plan->vertical_windows[k];
-            plan->vertical_windows[k].x = r.y;
+            plan->vertical_windows[k].x = guide->width - r.y - 2 * S;
             plan->vertical_windows[k].y = r.x;
             plan->vertical_windows[k].w = 2 * S;
             plan->vertical_windows[k].h = S;
@@ -18276,6 +18291,56 @@ failed:
     return result;
 }
 
+TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad)
+{
+    TT_ASSERT(polycube && polycube->surface && quad >= 0 && quad < polycube->surface->nfaces);
+    return polycube->quad_side[quad] / 2 != polycube->up_axis;
+}
+
+TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
+                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error)
+{
+    const tt_image *left, *right;
+    tt_result result;
+    int k, row;
+    tt__ok(error);
+    if (out_image) *out_image = NULL;
+    if (!plain || !upright || !out_image)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_upright_atlas needs a plain and an upright tileset and out_image (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (plain->vertical_windows || !upright->vertical_windows)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the first tileset must be plain and the second upright (tt_synth_options.upright)");
+    if (plain->layout.colors != upright->layout.colors || plain->layout.tile_size != upright->layout.tile_size ||
+        plain->layout.gutter != upright->layout.gutter)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the tilesets' layouts differ (%d colors, %d texels, gutter %d against %d, %d, %d)",
+                        plain->layout.colors, plain->layout.tile_size, plain->layout.gutter, upright->layout.colors,
+                        upright->layout.tile_size, upright->layout.gutter);
+    for (k = 0; k < plain->layout.colors; k++)
+        if (plain->edge_windows[k].x != upright->edge_windows[k].x ||
+            plain->edge_windows[k].y != upright->edge_windows[k].y)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                               "edge window %d differs between the tilesets: make the upright tiles with the plain "
+                               "ones' edge_windows, or the tops and the walls do not meet", k);
+    if (level < 0 || level >= plain->nlevels || level >= upright->nlevels)
+        return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
+                        "level %d: the tilesets have levels 0 to %d", level,
+                        tt__min_i(plain->nlevels, upright->nlevels) - 1);
+    left = &plain->levels[level];
+    right = &upright->levels[level];
+    if ((result = tt_image_create(2 * left->width, left->height, allocator, out_image, error)) != TT_OK)
+        return result;
+    for (row = 0; row < left->height; row++) {
+        float *out = (*out_image)->pixels + (size_t)row * 2 * (size_t)left->width * 4;
+        memcpy(out, left->pixels + (size_t)row * left->width * 4, (size_t)left->width * 4 * sizeof(float));
+        memcpy(out + (size_t)left->width * 4, right->pixels + (size_t)row * right->width * 4,
+               (size_t)right->width * 4 * sizeof(float));
+    }
+    return TT_OK;
+}
+
 /* tt_polycube_mapping_uvs and its upright form: `upright` puts the walls'
    tiles in the right half of a 2W x W atlas. */
 static tt_result tt__polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
@@ -18309,7 +18374,7 @@ static tt_result tt__polycube_mapping_uvs(const tt_polycube *polycube, const tt_
         tt_tile_corner_uv(&resolved, types, 2, high);
         corner_uv[2 * i] = low[0] + p.s * (high[0] - low[0]);
         corner_uv[2 * i + 1] = low[1] + p.t * (high[1] - low[1]);
-        if (upright) corner_uv[2 * i] = 0.5f * (corner_uv[2 * i] + (polycube->quad_side[p.quad] / 2 != polycube->up_axis));
+        if (upright) corner_uv[2 * i] = 0.5f * (corner_uv[2 * i] + (float)tt_polycube_quad_upright(polycube, p.quad));
     }
     return TT_OK;
 }

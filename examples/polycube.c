@@ -23,6 +23,7 @@
                               edge windows) for the walls, side by side
      tt_polycube_map          the triangles split along S's quad edges,
                               each corner's point on S
+     tt_polycube_upright_atlas        the two tile sets side by side
      tt_polycube_mapping_uvs_upright  those points as texture coordinates
      tt_measure_uv_distortion, tt_measure_seams   the summary's quality
 */
@@ -249,7 +250,7 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
     const tt_image *plain = &job->tiles->levels[0];
     tiled_options upright = options->tiles;
     tt_error error;
-    int row, c, status;
+    int c, status;
     if (image->width < 2 * job->layout.tile_size || image->height < 2 * job->layout.tile_size) {
         tool_note("%s: %dx%d is too small for upright %d-texel tiles (they need %dx%d): the walls' tiles are "
                   "plain, turned a quarter on their left and right sides (use a smaller --tile)",
@@ -259,18 +260,12 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
     }
     upright.upright_over = job->tiles->edge_windows;
     if ((status = tiled_synthesize(image, options->image_path, &upright, &job->upright_tiles)) != 0) return status;
-    if (tt_image_create(2 * plain->width, plain->height, NULL, &job->atlas, &error) != TT_OK)
+    if (tt_polycube_upright_atlas(job->tiles, job->upright_tiles, 0, NULL, &job->atlas, &error) != TT_OK)
         return tool_fail("the %dx%d atlas: %s", 2 * plain->width, plain->height, error.message);
-    for (row = 0; row < plain->height; row++) {
-        float *out = job->atlas->pixels + (size_t)row * job->atlas->width * 4;
-        memcpy(out, plain->pixels + (size_t)row * plain->width * 4, (size_t)plain->width * 4 * sizeof(float));
-        memcpy(out + (size_t)plain->width * 4, job->upright_tiles->levels[0].pixels + (size_t)row * plain->width * 4,
-               (size_t)plain->width * 4 * sizeof(float));
-    }
-    for (c = 0; c < job->polycube->surface->ncorners; c++) {
-        int wall = job->polycube->quad_side[job->polycube->surface->corner_face[c]] / 2 != job->polycube->up_axis;
-        job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] + (float)wall);
-    }
+    for (c = 0; c < job->polycube->surface->ncorners; c++)
+        job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] +
+                                         (float)tt_polycube_quad_upright(job->polycube,
+                                                                         job->polycube->surface->corner_face[c]));
     return 0;
 }
 

@@ -1034,6 +1034,13 @@ static void test_allocation_failures(void)
     oom_sweep("tt_synth_apply", sy_oom_apply, &c, TT_OK);
     oom_sweep("tt_synthesize_tiles", sy_oom_synthesize, &c, TT_OK);
     tt_synth_plan_free(plan);
+    /* Upright: the turned guide the vertical windows are chosen on, and the tileset's copy of them. */
+    c.options.upright = 1;
+    tt_synth_plan_create(src, &c.options, NULL, &plan, NULL);
+    c.plan = plan;
+    oom_sweep("tt_synth_plan_create upright", sy_oom_plan, &c, TT_OK);
+    oom_sweep("tt_synth_apply upright", sy_oom_apply, &c, TT_OK);
+    tt_synth_plan_free(plan);
     tt_image_free(src);
 }
 

@@ -2180,6 +2180,64 @@ static void test_map_uvs_and_seams(void)
     tt_image_free(photo);
 }
 
+typedef struct upright_atlas_oom_ctx {
+    const tt_tileset *plain, *upright;
+} upright_atlas_oom_ctx;
+
+static tt_result upright_atlas_oom_call(void *ctx, const tt_allocator *al)
+{
+    upright_atlas_oom_ctx *c = (upright_atlas_oom_ctx *)ctx;
+    tt_image *atlas = (tt_image *)&atlas;
+    tt_error err;
+    tt_result r = tt_polycube_upright_atlas(c->plain, c->upright, 0, al, &atlas, &err);
+    if (err.result != r || (r != TT_OK) != (atlas == NULL)) return TT_RESULT_MAX_ENUM;
+    tt_image_free(atlas);
+    return r;
+}
+
+/* tt_polycube_upright_atlas: level L of both tilesets side by side, plain
+   on the left, texel for texel; tilesets that do not go together are
+   refused. */
+static void upright_atlas_checks(const tt_tileset *plain, const tt_tileset *upright, const tt_image *atlas)
+{
+    tt_tileset swapped_windows;
+    tt_rect moved[TT_MAX_COLORS];
+    tt_image *level1 = NULL, *bad = (tt_image *)&bad;
+    upright_atlas_oom_ctx ctx;
+    tt_error err;
+    int row, same = 1, W = plain->levels[0].width;
+    CHECK(atlas->width == 2 * W && atlas->height == W, "the atlas is %dx%d (want %dx%d)", atlas->width,
+          atlas->height, 2 * W, W);
+    for (row = 0; row < W && same; row++)
+        same = memcmp(atlas->pixels + (size_t)row * 2 * W * 4, plain->levels[0].pixels + (size_t)row * W * 4,
+                      (size_t)W * 4 * sizeof(float)) == 0 &&
+               memcmp(atlas->pixels + ((size_t)row * 2 * W + W) * 4, upright->levels[0].pixels + (size_t)row * W * 4,
+                      (size_t)W * 4 * sizeof(float)) == 0;
+    CHECK(same, "the atlas is the plain tiles beside the upright ones");
+    CHECK(tt_polycube_upright_atlas(plain, upright, 1, NULL, &level1, &err) == TT_OK && level1 &&
+              level1->width == W && level1->height == W / 2 &&
+              memcmp(level1->pixels, plain->levels[1].pixels, (size_t)W / 2 * 4 * sizeof(float)) == 0,
+          "level 1: %s", err.message);
+    tt_image_free(level1);
+    CHECK(tt_polycube_upright_atlas(upright, plain, 0, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
+          "upright first refused: %s", err.message);
+    bad = (tt_image *)&bad;
+    CHECK(tt_polycube_upright_atlas(plain, upright, plain->nlevels, NULL, &bad, &err) ==
+                  TT_ERROR_INDEX_OUT_OF_RANGE && !bad,
+          "level %d refused: %s", plain->nlevels, err.message);
+    swapped_windows = *upright;
+    memcpy(moved, upright->edge_windows, sizeof(tt_rect) * (size_t)upright->layout.colors);
+    moved[1].x += 1;
+    swapped_windows.edge_windows = moved;
+    bad = (tt_image *)&bad;
+    CHECK(tt_polycube_upright_atlas(plain, &swapped_windows, 0, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              !bad && err.item == 1,
+          "other edge windows refused: %s", err.message);
+    ctx.plain = plain;
+    ctx.upright = upright;
+    oom_sweep("tt_polycube_upright_atlas", upright_atlas_oom_call, &ctx, TT_OK);
+}
+
 /* Upright tiles on the walls (tt_polycube_mapping_uvs_upright): a sphere
    textured from a plain and an upright tile set side by side is seamless
    on the tile borders; the walls' UVs lie in the right half, the tops' in
@@ -2197,7 +2255,6 @@ static void test_map_uvs_upright(void)
     tt_polycube_mapping *map;
     tt_error err;
     tmesh m;
-    int row;
     if (!(plain = seam_test_tiles(&so, &photo))) {
         CHECK(0, "plain tiles");
         tt_image_free(photo);
@@ -2206,20 +2263,14 @@ static void test_map_uvs_upright(void)
     so.upright = 1;
     so.edge_windows = plain->edge_windows;
     if (tt_synthesize_tiles(photo, &so, NULL, &upright, &err) != TT_OK ||
-        tt_image_create(2 * plain->levels[0].width, plain->levels[0].height, NULL, &atlas, &err) != TT_OK) {
-        CHECK(0, "upright tiles: %s", err.message);
+        tt_polycube_upright_atlas(plain, upright, 0, NULL, &atlas, &err) != TT_OK) {
+        CHECK(0, "upright tiles and their atlas: %s", err.message);
         tt_tileset_free(plain);
         tt_tileset_free(upright);
         tt_image_free(photo);
         return;
     }
-    for (row = 0; row < atlas->height; row++) {
-        const size_t W = (size_t)plain->levels[0].width;
-        memcpy(atlas->pixels + (size_t)row * 2 * W * 4, plain->levels[0].pixels + (size_t)row * W * 4,
-               W * 4 * sizeof(float));
-        memcpy(atlas->pixels + ((size_t)row * 2 * W + W) * 4, upright->levels[0].pixels + (size_t)row * W * 4,
-               W * 4 * sizeof(float));
-    }
+    upright_atlas_checks(plain, upright, atlas);
     memset(&m, 0, sizeof m);
     make_sphere(&m, 48, 24, 1.0, centre, 0);
     map = mapped(&m, 8, 0, 0.0, &pc, &mesh, &rep);
@@ -2240,7 +2291,7 @@ static void test_map_uvs_upright(void)
         CHECK(pc->up_axis == 1 && pc->up_sign == 1, "the default up is +y: axis %d, sign %d", pc->up_axis,
               pc->up_sign);
         for (i = 0; i < 3 * map->ntriangles; i++) {
-            const int wall = pc->quad_side[map->corner_points[i].quad] / 2 != pc->up_axis;
+            const int wall = tt_polycube_quad_upright(pc, map->corner_points[i].quad);
             walls += wall;
             wrong_half += wall ? uv[2 * i] < 0.5f : uv[2 * i] > 0.5f;
             everywhere[2 * i] = 0.5f * (everywhere[2 * i] + 1.0f);
