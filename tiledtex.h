@@ -2624,7 +2624,12 @@ typedef struct tt_polycube_mapping {
         vertex's triangles better placed; then the folds left (a whole
         patch folded, where no vertex has a good place of its own) are
         untangled by Escobar et al.'s energy, from their rims inward;
-     4. tt_polycube_trace_edges (max_quads); then spikes: a vertex whose
+     4. tt_polycube_trace_edges (max_quads); a vertex with an edge that
+        finds no path (the projection seated it on the far side of a part
+        about a cube thick) is tried on each neighbour's sheet and kept
+        where fewest of its edges fail, then fewest of its triangles fold;
+        its edges are traced again, and the relaxation of step 3 runs
+        again around the points so moved; then spikes: a vertex whose
         two edges in one triangle leave it through the same corner W of S
         (it lies just behind a saddle) would map part of that triangle
         onto a line; it is moved onto W unless another point is there,
@@ -2675,8 +2680,10 @@ typedef struct tt_polycube_mapping {
    Measured (-O2, default options, resolution 32): a 100k-triangle torus
    in about 0.4 s (make bench) with no fallback; the bunny (3.7k
    triangles, 51k refined) in 0.4 s with 0.01 % fallbacks; a 97k-triangle
-   horse in 1 s with 0.04 %; a CAD flange 0.11 %; no flipped triangle on
-   any. report may be NULL.
+   horse in 1 s with 0.04 %; a CAD flange in 0.6 s with 0.10 %; no
+   flipped triangle on any. Parts about a cube thick cost more time and
+   leave more fallbacks (an elephant's trunk and legs: 2.4 %, 2.5 s).
+   report may be NULL.
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
    max_edge not above 0, a face that is not a triangle (error->face;
@@ -16012,6 +16019,48 @@ static void tt__edge_search_from(tt__edge_search *S, int depth, tt__edge_funnel 
     }
 }
 
+/* The shortest path on S of the edge from point qa to point qb, searched
+   from each quad at either end (an end on a corner of S lies in all of
+   them; its own quad first, so that it keeps ties). Returns whether there
+   is one; S->best_count and S->best_crossings hold it, ends[] the quads it
+   starts and ends in, and S->a, S->b the ends in those quads' frames. */
+static int tt__edge_find_path(tt__edge_search *S, tt_surface_point qa, tt_surface_point qb, int ends[2])
+{
+    const tt_mesh *s = S->pc->surface;
+    int quads_a[TT__CORNER_QUADS], quads_b[TT__CORNER_QUADS], na, nb, ia, ib, best_a = 0, best_b = 0;
+    double st_a[TT__CORNER_QUADS][2], st_b[TT__CORNER_QUADS][2];
+    na = tt__quads_at_point(s, qa, quads_a, st_a);
+    nb = tt__quads_at_point(s, qb, quads_b, st_b);
+    S->best_count = 0;
+    S->steps = 0;
+    for (ia = 0; ia < na; ia++)
+        for (ib = 0; ib < nb; ib++) {
+            tt__edge_funnel funnel;
+            int best_count = S->best_count;
+            double best_length = S->best_length;
+            S->a[0] = st_a[ia][0];
+            S->a[1] = st_a[ia][1];
+            S->b[0] = st_b[ib][0];
+            S->b[1] = st_b[ib][1];
+            S->quad_b = quads_b[ib];
+            S->quads[0] = quads_a[ia];
+            S->maps[0].turns = S->maps[0].offset[0] = S->maps[0].offset[1] = 0;
+            memset(&funnel, 0, sizeof funnel);
+            tt__edge_search_from(S, 1, funnel);
+            if (S->best_count != best_count || S->best_length != best_length) {
+                best_a = ia;
+                best_b = ib;
+            }
+        }
+    ends[0] = quads_a[best_a];
+    ends[1] = quads_b[best_b];
+    S->a[0] = st_a[best_a][0];
+    S->a[1] = st_a[best_a][1];
+    S->b[0] = st_b[best_b][0];
+    S->b[1] = st_b[best_b][1];
+    return S->best_count > 0;
+}
+
 static double tt__edge_snap(double x)
 {
     return x < TT__EDGE_SNAP ? 0.0 : (x > 1.0 - TT__EDGE_SNAP ? 1.0 : x);
@@ -16101,8 +16150,7 @@ static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mes
     for (e = 0; e < E->nedges; e++) {
         tt_surface_point qa = points[E->edge_vertices[2 * e]], qb = points[E->edge_vertices[2 * e + 1]];
         const tt_edge_crossing *crossing = S->best_crossings;
-        int count, i, quads_a[TT__CORNER_QUADS], quads_b[TT__CORNER_QUADS], na, nb, ia, ib;
-        double st_a[TT__CORNER_QUADS][2], st_b[TT__CORNER_QUADS][2];
+        int count, i;
         E->first_crossing[e] = E->ncrossings;
         if (previous && !moved[E->edge_vertices[2 * e]] && !moved[E->edge_vertices[2 * e + 1]]) {
             const int first = previous->first_crossing[e];
@@ -16121,44 +16169,11 @@ static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mes
             E->nfailed += E->failed[e];
             continue;
         }
-        /* An end on a corner of S lies in every quad there: the path may start (or end) in any of them, the
-           point's own quad first, so that it keeps ties. */
-        na = tt__quads_at_point(polycube->surface, qa, quads_a, st_a);
-        nb = tt__quads_at_point(polycube->surface, qb, quads_b, st_b);
-        S->best_count = 0;
-        S->steps = 0;
-        E->end_quads[2 * e] = qa.quad;
-        E->end_quads[2 * e + 1] = qb.quad;
-        for (ia = 0; ia < na; ia++)
-            for (ib = 0; ib < nb; ib++) {
-                tt__edge_funnel funnel;
-                int best_count = S->best_count;
-                double best_length = S->best_length;
-                S->a[0] = st_a[ia][0];
-                S->a[1] = st_a[ia][1];
-                S->b[0] = st_b[ib][0];
-                S->b[1] = st_b[ib][1];
-                S->quad_b = quads_b[ib];
-                S->quads[0] = quads_a[ia];
-                S->maps[0].turns = S->maps[0].offset[0] = S->maps[0].offset[1] = 0;
-                memset(&funnel, 0, sizeof funnel);
-                tt__edge_search_from(S, 1, funnel);
-                if (S->best_count != best_count || S->best_length != best_length) {
-                    E->end_quads[2 * e] = quads_a[ia];
-                    E->end_quads[2 * e + 1] = quads_b[ib];
-                }
-            }
-        E->failed[e] = S->best_count == 0;
+        E->failed[e] = !tt__edge_find_path(S, qa, qb, E->end_quads + 2 * e);
         if (E->failed[e]) {
             E->nfailed++;
             continue;
         }
-        for (ia = 0; quads_a[ia] != E->end_quads[2 * e]; ia++) continue;
-        for (ib = 0; quads_b[ib] != E->end_quads[2 * e + 1]; ib++) continue;
-        S->a[0] = st_a[ia][0];
-        S->a[1] = st_a[ia][1];
-        S->b[0] = st_b[ib][0];
-        S->b[1] = st_b[ib][1];
         count = S->best_count - 1;
         if (count > 0) {
             tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(allocator, E->crossings, &capacity,
@@ -16447,6 +16462,9 @@ failed:
 #define TT__UNTANGLE_SWEEPS 40      /* untangling sweeps over the vertices near folds */
 #define TT__UNTANGLE_PATIENCE 6     /* sweeps without fewer bad triangles after which the rings double */
 #define TT__UNTANGLE_RINGS 16       /* rings around the folds untangled at most */
+#define TT__UNTANGLE_REGION 16      /* vertices per fold beyond which the region stops growing: the folds
+                                       such a region leaves rarely open in a larger one, which costs more
+                                       (the pig at 16: 0.25 s to 0.13 s, the same 3 fallbacks) */
 #define TT__UNTANGLE_STAR 64        /* triangles around a vertex it untangles at most */
 #define TT__UNTANGLE_EPSILON 0.01   /* Escobar et al.'s epsilon: det J below which delta grows */
 #define TT__UNTANGLE_STEPS 10       /* descent steps per vertex and sweep */
@@ -16523,6 +16541,90 @@ static int tt__relax_chart_point(const tt__relax_chart *c, const double at[2], t
             return 1;
         }
     return 0;
+}
+
+/* What the relaxation, the untangling and the re-seating share: each
+   vertex's triangles, as the corners at it, two local charts (around a
+   vertex, around a neighbour) with a quad index each, and the vertices
+   whose triangles they judge. */
+typedef struct tt__relax_context {
+    int *first_triangle;        /* per vertex and one more: where its corners start in triangle_corners */
+    int *triangle_corners;
+    tt__relax_chart *chart, *around;
+    int *index_of;              /* the two charts' quad indices, one after the other */
+    tt_quad_map *unfold;        /* per half-edge of S: tt_polycube_unfold */
+    const unsigned char *focus; /* per vertex: only triangles at a flagged vertex are judged; NULL = all */
+} tt__relax_context;
+
+static void tt__relax_context_free(const tt_allocator *allocator, tt__relax_context *x)
+{
+    tt__free(allocator, x->first_triangle);
+    tt__free(allocator, x->triangle_corners);
+    tt__free(allocator, x->chart);
+    tt__free(allocator, x->index_of);
+    tt__free(allocator, x->unfold);
+    memset(x, 0, sizeof *x);
+}
+
+/* 0 when out of memory (nothing left allocated). */
+static int tt__relax_context_init(const tt_polycube *pc, const tt_mesh *model, const tt_allocator *allocator,
+                                  tt__relax_context *x)
+{
+    const int nverts = model->nverts, nquads = pc->surface->nfaces;
+    int v, c, *next;
+    memset(x, 0, sizeof *x);
+    x->first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
+    x->triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
+    x->chart = TT__ALLOC(allocator, tt__relax_chart, 2);
+    x->index_of = TT__ALLOC(allocator, int, 2 * (size_t)nquads);
+    x->unfold = TT__ALLOC(allocator, tt_quad_map, pc->surface->ncorners);
+    next = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
+    if (!x->first_triangle || !x->triangle_corners || !x->chart || !x->index_of || !x->unfold || !next) {
+        tt__free(allocator, next);
+        tt__relax_context_free(allocator, x);
+        return 0;
+    }
+    for (c = 0; c < pc->surface->ncorners; c++) x->unfold[c] = tt_polycube_unfold(pc, c);
+    x->around = x->chart + 1;
+    for (c = 0; c < 2 * nquads; c++) x->index_of[c] = -1;
+    x->chart->count = x->around->count = 0;
+    x->chart->index_of = x->index_of;
+    x->around->index_of = x->index_of + nquads;
+    x->chart->unfold = x->around->unfold = x->unfold;
+    memset(next, 0, sizeof(int) * (size_t)nverts);
+    for (c = 0; c < model->ncorners; c++) next[model->corner_vert[c]]++;
+    x->first_triangle[0] = 0;
+    for (v = 0; v < nverts; v++) x->first_triangle[v + 1] = x->first_triangle[v] + next[v];
+    for (v = 0; v < nverts; v++) next[v] = x->first_triangle[v];
+    for (c = 0; c < model->ncorners; c++) x->triangle_corners[next[model->corner_vert[c]]++] = c;
+    tt__free(allocator, next);
+    return 1;
+}
+
+/* The point of S closest to model vertex v on the quads within
+   TT__RELAX_SEAT_RADIUS of `quad` (the chart built into *around): v seated
+   on the sheet of S there. */
+static tt_surface_point tt__relax_seat(const tt_polycube *pc, const tt_mesh *model, int v, int quad,
+                                       tt__relax_chart *around)
+{
+    tt_surface_point best;
+    double lattice[3], nearest = HUGE_VAL;
+    int a, q;
+    for (a = 0; a < 3; a++) lattice[a] = ((double)model->pos[3 * v + a] - pc->origin[a]) / pc->h;
+    tt__relax_chart_build(pc, quad, TT__RELAX_SEAT_RADIUS, around);
+    best.quad = quad;
+    best.s = best.t = 0.5f;
+    for (q = 0; q < around->count; q++) {
+        tt_surface_point p = tt__polycube_surface_point(pc, around->quad[q], lattice);
+        double xyz[3], d2 = 0.0;
+        tt_polycube_point_position(pc, p, xyz);
+        for (a = 0; a < 3; a++) d2 += (xyz[a] - model->pos[3 * v + a]) * (xyz[a] - model->pos[3 * v + a]);
+        if (d2 < nearest) {
+            nearest = d2;
+            best = p;
+        }
+    }
+    return best;
 }
 
 /* Point p of S in the frame of quad `centre`: directly in the same quad,
@@ -16670,17 +16772,20 @@ static void tt__relax_try(const tt_polycube *pc, const tt_mesh *model, tt_surfac
 /* Flags the vertices of badly placed triangles in bad[] (cleared first)
    and returns how many triangles are: a triangle is judged in its first
    vertex's quad frame, the others' quads mapped in across one edge of S
-   when they are next to it, else through a local chart (*scratch); it is
-   bad when folded (not counter-clockwise) or out of the chart's reach. */
+   when they are next to it, else through a local chart (x->chart); it is
+   bad when folded (not counter-clockwise) or out of the chart's reach.
+   Only triangles at a vertex in x->focus are judged. */
 static int tt__relax_mark_bad(const tt_polycube *pc, const tt_mesh *model, const tt_surface_point *points,
-                              tt__relax_chart *scratch, int folds_only, unsigned char *bad)
+                              const tt__relax_context *x, int folds_only, unsigned char *bad)
 {
+    tt__relax_chart *scratch = x->chart;
     int c, count = 0;
     memset(bad, 0, (size_t)model->nverts);
     for (c = 0; c < model->ncorners; c += 3) {
         const int *t = model->corner_vert + c;
         double at[3][2];
         int k, placed = 1;
+        if (x->focus && !x->focus[t[0]] && !x->focus[t[1]] && !x->focus[t[2]]) continue;
         at[0][0] = points[t[0]].s;
         at[0][1] = points[t[0]].t;
         for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(pc, points[t[0]].quad, points[t[k]], at[k], scratch);
@@ -16845,7 +16950,8 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
    one of the triangle's quads sees folded) and the vertices up to `rings`
    edges from them, each vertex a tt__untangle_vertex step, until no fold
    is left, nothing moves, or the folds have not become fewer for
-   TT__UNTANGLE_PATIENCE sweeps even with TT__UNTANGLE_RINGS rings. The
+   TT__UNTANGLE_PATIENCE sweeps even with TT__UNTANGLE_RINGS rings (or a
+   region of TT__UNTANGLE_REGION vertices per fold). The
    rings start at 1 and double at each stall: a pleat (the model laid on a
    part of S twice, then back) opens only when the vertices around it move
    together, and a wide region from the start would move far more
@@ -16858,21 +16964,21 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
    bad triangles left (tt__relax_mark_bad, every kind); the moves made go
    to *moves. */
 static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                        const int *first_triangle, const int *triangle_corners, int strict, tt__relax_chart *chart,
-                        tt__untangle_star *star, unsigned char *bad, int *active, tt_surface_point *best_sweep,
-                        int *moves)
+                        const tt__relax_context *x, int strict, tt__untangle_star *star, unsigned char *bad,
+                        int *active, tt_surface_point *best_sweep, int *moves)
 {
+    const int *first_triangle = x->first_triangle, *triangle_corners = x->triangle_corners;
     const size_t size = sizeof *points * (size_t)model->nverts;
-    int sweep, least = INT_MAX, stalled = 0, rings = 1, v, i;
+    int sweep, least = INT_MAX, stalled = 0, rings = 1, v, i, region = 0;
     for (sweep = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
-        int moved = 0, nactive = 0, head, folds = tt__relax_mark_bad(pc, model, points, chart, 1, bad);
+        int moved = 0, nactive = 0, head, folds = tt__relax_mark_bad(pc, model, points, x, 1, bad);
         if (!folds) break;
         if (folds < least) {
             least = folds;
             stalled = 0;
             if (!strict) memcpy(best_sweep, points, size);
         } else if (++stalled == TT__UNTANGLE_PATIENCE) {
-            if (rings == TT__UNTANGLE_RINGS) break;
+            if (rings == TT__UNTANGLE_RINGS || region > TT__UNTANGLE_REGION * folds) break;
             rings *= 2;
             stalled = 0;
         }
@@ -16893,16 +16999,17 @@ static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_
                 }
             }
         }
+        region = nactive;
         for (v = 0; v < model->nverts; v++)
             if (bad[v] && !tt__relax_on_surface(pc, model, points, v))
-                moved += tt__untangle_vertex(pc, model, points, first_triangle, triangle_corners, v, strict, chart,
+                moved += tt__untangle_vertex(pc, model, points, first_triangle, triangle_corners, v, strict, x->chart,
                                              star);
         *moves += moved;
         if (!moved) break;
     }
-    if (!strict && least < INT_MAX && tt__relax_mark_bad(pc, model, points, chart, 1, bad) > least)
+    if (!strict && least < INT_MAX && tt__relax_mark_bad(pc, model, points, x, 1, bad) > least)
         memcpy(points, best_sweep, size);
-    return tt__relax_mark_bad(pc, model, points, chart, 0, bad);
+    return tt__relax_mark_bad(pc, model, points, x, 0, bad);
 }
 
 /* Spec P11 step 5: points that leave a triangle folded on S or its edge
@@ -16920,56 +17027,42 @@ static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_
    vertex's ring is folded too), so then the vertices of folded triangles
    and their neighbours are untangled (tt__untangle), with strict steps
    and with free ones from the same start, keeping the result with fewer
-   bad triangles. Returns the number of moves, -1 when out of memory. */
+   bad triangles. With `focus` (per vertex), only triangles at a flagged
+   vertex are judged; NULL judges all. Returns the number of moves, -1
+   when out of memory. */
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                              const tt_allocator *allocator)
+                              const unsigned char *focus, const tt_allocator *allocator)
 {
-    int *first_triangle = NULL, *triangle_corners = NULL, *count = NULL, *index_of = NULL, *active = NULL;
-    tt_quad_map *unfold = NULL;
+    tt__relax_context x;
+    int *first_triangle, *triangle_corners, *active = NULL;
     unsigned char *bad = NULL;
-    tt__relax_chart *chart = NULL, *around = NULL;
+    tt__relax_chart *chart, *around;
     tt__untangle_star *star = NULL;
     tt_surface_point *initial = NULL, *strict_points = NULL, *best_sweep = NULL;
-    int v, c, sweep, moves = 0, nverts = model->nverts, nquads = pc->surface->nfaces;
-    first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
-    triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
-    count = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
+    int v, sweep, moves = 0, nverts = model->nverts;
+    if (!tt__relax_context_init(pc, model, allocator, &x)) return -1;
+    x.focus = focus;
+    first_triangle = x.first_triangle;
+    triangle_corners = x.triangle_corners;
+    chart = x.chart;
+    around = x.around;
     bad = TT__ALLOC(allocator, unsigned char, nverts > 0 ? nverts : 1);
-    chart = TT__ALLOC(allocator, tt__relax_chart, 2);
-    index_of = TT__ALLOC(allocator, int, 2 * (size_t)nquads);
-    unfold = TT__ALLOC(allocator, tt_quad_map, pc->surface->ncorners);
     star = TT__ALLOC(allocator, tt__untangle_star, 1);
     initial = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
     strict_points = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
     best_sweep = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
     active = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
-    if (!first_triangle || !triangle_corners || !count || !bad || !chart || !index_of || !unfold || !star || !initial ||
-        !strict_points || !best_sweep || !active) {
+    if (!bad || !star || !initial || !strict_points || !best_sweep || !active) {
         moves = -1;
         goto done;
     }
-    for (c = 0; c < pc->surface->ncorners; c++) unfold[c] = tt_polycube_unfold(pc, c);
-    /* Two charts (around a vertex, around a neighbour), each with its own quad index. */
-    around = chart + 1;
-    for (c = 0; c < 2 * nquads; c++) index_of[c] = -1;
-    chart->count = around->count = 0;
-    chart->index_of = index_of;
-    around->index_of = index_of + nquads;
-    chart->unfold = around->unfold = unfold;
-    /* The triangles around each vertex, as the corners at it. */
-    memset(count, 0, sizeof(int) * (size_t)nverts);
-    for (c = 0; c < model->ncorners; c++) count[model->corner_vert[c]]++;
-    first_triangle[0] = 0;
-    for (v = 0; v < nverts; v++) first_triangle[v + 1] = first_triangle[v] + count[v];
-    for (v = 0; v < nverts; v++) count[v] = first_triangle[v];
-    for (c = 0; c < model->ncorners; c++) triangle_corners[count[model->corner_vert[c]]++] = c;
     for (sweep = 0; sweep < TT__RELAX_SWEEPS; sweep++) {
         int moved = 0;
-        tt__relax_mark_bad(pc, model, points, chart, 0, bad);
+        tt__relax_mark_bad(pc, model, points, &x, 0, bad);
         for (v = 0; v < nverts; v++) {
             /* v's ring in its chart: per triangle, the points of its other two vertices. */
             double at[2], mean[2] = {0.0, 0.0}, candidate_at[2], ring[2 * (TT__RELAX_KERNEL_POINTS - 4)][2];
-            int i, n = 0, reachable = 1, a, step;
+            int i, n = 0, reachable = 1, step;
             double before, best_bad;
             tt_surface_point best, candidate;
             if (!bad[v] || tt__relax_on_surface(pc, model, points, v)) continue;
@@ -17010,13 +17103,10 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
             }
             if (!reachable || n == 0) {
                 /* Onto a neighbour's sheet: the closest point to v on the quads around each neighbour's. */
-                double lattice[3];
-                for (a = 0; a < 3; a++) lattice[a] = ((double)model->pos[3 * v + a] - pc->origin[a]) / pc->h;
                 for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
-                    int corner = triangle_corners[i], f = corner / 3, k, q, j;
+                    int corner = triangle_corners[i], f = corner / 3, k, j;
                     for (k = 1; k < 3; k++) {
                         int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
-                        double nearest = HUGE_VAL;
                         for (j = first_triangle[v]; j < i; j++) {
                             int other = triangle_corners[j];
                             if (model->corner_vert[3 * (other / 3) + (other % 3 + 1) % 3] == u ||
@@ -17024,17 +17114,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
                                 break;
                         }
                         if (j < i || (k == 2 && model->corner_vert[3 * f + (corner % 3 + 1) % 3] == u)) continue;
-                        tt__relax_chart_build(pc, points[u].quad, TT__RELAX_SEAT_RADIUS, around);
-                        for (q = 0; q < around->count; q++) {
-                            tt_surface_point p = tt__polycube_surface_point(pc, around->quad[q], lattice);
-                            double xyz[3], d2 = 0.0;
-                            tt_polycube_point_position(pc, p, xyz);
-                            for (a = 0; a < 3; a++) d2 += (xyz[a] - model->pos[3 * v + a]) * (xyz[a] - model->pos[3 * v + a]);
-                            if (d2 < nearest) {
-                                nearest = d2;
-                                candidate = p;
-                            }
-                        }
+                        candidate = tt__relax_seat(pc, model, v, points[u].quad, around);
                         tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart,
                                       &best_bad, &best);
                     }
@@ -17050,26 +17130,19 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     }
     /* The folds these moves leave (a vertex whose ring is itself folded has no good place of its own):
        untangling, both ways (tt__untangle), keeping the one that leaves fewer bad triangles. */
-    if (tt__relax_mark_bad(pc, model, points, chart, 1, bad)) {
+    if (tt__relax_mark_bad(pc, model, points, &x, 1, bad)) {
         int strict_left, free_left, strict_moves = 0, free_moves = 0;
         memcpy(initial, points, sizeof *points * (size_t)nverts);
-        strict_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 1, chart, star, bad, active,
-                                   NULL, &strict_moves);
+        strict_left = tt__untangle(pc, model, points, &x, 1, star, bad, active, NULL, &strict_moves);
         memcpy(strict_points, points, sizeof *points * (size_t)nverts);
         memcpy(points, initial, sizeof *points * (size_t)nverts);
-        free_left = tt__untangle(pc, model, points, first_triangle, triangle_corners, 0, chart, star, bad, active,
-                                 best_sweep, &free_moves);
+        free_left = tt__untangle(pc, model, points, &x, 0, star, bad, active, best_sweep, &free_moves);
         if (strict_left <= free_left) memcpy(points, strict_points, sizeof *points * (size_t)nverts);
         moves += strict_left <= free_left ? strict_moves : free_moves;
     }
 done:
-    tt__free(allocator, first_triangle);
-    tt__free(allocator, triangle_corners);
-    tt__free(allocator, count);
+    tt__relax_context_free(allocator, &x);
     tt__free(allocator, bad);
-    tt__free(allocator, chart);
-    tt__free(allocator, index_of);
-    tt__free(allocator, unfold);
     tt__free(allocator, star);
     tt__free(allocator, initial);
     tt__free(allocator, strict_points);
@@ -17130,6 +17203,101 @@ static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, con
         moved++;
     }
     tt__free(allocator, taken);
+    return moved;
+}
+
+#define TT__RESEAT_ROUNDS 2     /* rounds of re-seating stray vertices and tracing their edges again */
+#define TT__RESEAT_CYCLES 2     /* re-seatings, each followed by the relaxation */
+#define TT__RESEAT_SEATS 16     /* seats (neighbours' quads) tried per vertex at most */
+#define TT__RESEAT_FOCUS_RINGS 8    /* rings around the re-seated points the relaxation after them looks at */
+
+/* How many of v's edges, counted once per triangle at v, find no path on
+   S with the points as they are. */
+static int tt__reseat_failures(tt__edge_search *S, const tt_mesh *model, const tt_surface_point *points,
+                               const tt__relax_context *x, int v)
+{
+    int i, k, failures = 0, ends[2];
+    for (i = x->first_triangle[v]; i < x->first_triangle[v + 1]; i++) {
+        int corner = x->triangle_corners[i], f = corner / 3;
+        for (k = 1; k < 3; k++) {
+            int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
+            failures += !(u < v ? tt__edge_find_path(S, points[u], points[v], ends)
+                                : tt__edge_find_path(S, points[v], points[u], ends));
+        }
+    }
+    return failures;
+}
+
+/* A vertex with an edge that finds no path on S (P11 step 7 would put both
+   its triangles whole into one quad, a local seam) sits on another sheet
+   of S than its neighbour: the closest point chose the far side of a part
+   about a cube thick, or of a fold of S. The relaxation cannot see it
+   (both points lie within its chart), so each such vertex is tried seated
+   on the sheet of each neighbour (tt__relax_seat) and kept where fewest of
+   its edges fail, then fewest of its triangles fold (tt__relax_badness),
+   when that is better than where it is. Each point moved is flagged in
+   moved_points[]. Returns the number moved, -1 when out of memory. */
+static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
+                               int max_quads, tt_surface_point *points, unsigned char *moved_points,
+                               const tt_allocator *allocator)
+{
+    tt__relax_context x;
+    tt__edge_search *S = TT__ALLOC(allocator, tt__edge_search, 1);
+    unsigned char *stray = TT__ALLOC(allocator, unsigned char, model->nverts > 0 ? model->nverts : 1);
+    int moved = 0, e, v;
+    if (!S || !stray || !tt__relax_context_init(pc, model, allocator, &x)) {
+        tt__free(allocator, S);
+        tt__free(allocator, stray);
+        return -1;
+    }
+    memset(S, 0, sizeof *S);
+    S->pc = pc;
+    S->max_quads = max_quads;
+    memset(stray, 0, (size_t)model->nverts);
+    for (e = 0; e < edges->nedges; e++)
+        if (edges->failed[e]) stray[edges->edge_vertices[2 * e]] = stray[edges->edge_vertices[2 * e + 1]] = 1;
+    for (v = 0; v < model->nverts; v++) {
+        const tt_surface_point kept = points[v];
+        tt_surface_point best = kept;
+        double at[2], best_score;
+        int i, k, tried[TT__RESEAT_SEATS], ntried = 0;
+        if (!stray[v] || tt__relax_on_surface(pc, model, points, v)) continue;
+        tt__relax_chart_build(pc, kept.quad, TT__RELAX_RADIUS, x.chart);
+        tt__relax_chart_place(x.chart, kept, at);
+        best_score = 2.0 * tt__reseat_failures(S, model, points, &x, v) +
+                     tt__relax_badness(model, points, x.first_triangle, x.triangle_corners, v, x.chart, at);
+        for (i = x.first_triangle[v]; i < x.first_triangle[v + 1]; i++) {
+            int corner = x.triangle_corners[i], f = corner / 3;
+            for (k = 1; k < 3; k++) {
+                int u = model->corner_vert[3 * f + (corner % 3 + k) % 3], j;
+                tt_surface_point candidate;
+                double score;
+                /* Neighbours in one quad give one seat. */
+                for (j = 0; j < ntried && tried[j] != points[u].quad; j++) continue;
+                if (j < ntried || ntried == TT__RESEAT_SEATS) continue;
+                tried[ntried++] = points[u].quad;
+                candidate = tt__relax_seat(pc, model, v, points[u].quad, x.around);
+                if (candidate.quad == kept.quad && candidate.s == kept.s && candidate.t == kept.t) continue;
+                points[v] = candidate;
+                tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, x.chart);
+                tt__relax_chart_place(x.chart, candidate, at);
+                score = 2.0 * tt__reseat_failures(S, model, points, &x, v) +
+                        tt__relax_badness(model, points, x.first_triangle, x.triangle_corners, v, x.chart, at);
+                if (score < best_score - 1e-12) {
+                    best_score = score;
+                    best = candidate;
+                }
+            }
+        }
+        points[v] = best;
+        if (best.quad != kept.quad || best.s != kept.s || best.t != kept.t) {
+            moved_points[v] = 1;
+            moved++;
+        }
+    }
+    tt__relax_context_free(allocator, &x);
+    tt__free(allocator, S);
+    tt__free(allocator, stray);
     return moved;
 }
 
@@ -18087,14 +18255,14 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt_polycube_map_report local;
     tt_polycube_edge_options edge_options;
     tt_surface_point *points = NULL, *before_unspike = NULL;
-    unsigned char *moved = NULL;
+    unsigned char *moved = NULL, *focus = NULL;
     tt_polycube_edges *edges = NULL;
     const tt_mesh *model;
     tt__refined R;
     tt__split S;
     tt_result result;
     double longest;
-    int f, v, j, tracing;
+    int f, v, j, tracing, cycle, moves, max_quads;
     tt__ok(error);
     if (out) *out = NULL;
     if (!report) report = &local;
@@ -18107,6 +18275,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     memset(&edge_options, 0, sizeof edge_options);
     if (options) edge_options.max_quads = options->max_quads;
+    max_quads = edge_options.max_quads ? edge_options.max_quads : TT_POLYCUBE_EDGE_DEFAULT_QUADS;
     if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
     for (f = 0; f < mesh->nfaces; f++)
         if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
@@ -18136,15 +18305,60 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         points[v].s = points[v].s < TT__MAP_SNAP ? 0.0f : (points[v].s > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].s);
         points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
     }
-    if ((report->relaxed = tt__polycube_relax(polycube, model, points, allocator)) < 0) goto out_of_memory;
-    /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
-       vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
+    if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, allocator)) < 0) goto out_of_memory;
     if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
                                           error)) != TT_OK)
         goto failed;
     if (!(before_unspike = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
-        !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)))
+        !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
+        !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)))
         goto out_of_memory;
+    /* Vertices with an edge that finds no path are re-seated (tt__polycube_reseat) and their edges traced
+       again, up to TT__RESEAT_ROUNDS times; the relaxation then opens the folds that leaves near them, and
+       the edges at the points it moved are traced again. */
+    for (cycle = 0; cycle < TT__RESEAT_CYCLES && edges->nfailed > 0; cycle++) {
+        tt_polycube_edges *again = NULL;
+        int reseated = 0, round, e;
+        memset(focus, 0, (size_t)model->nverts);
+        for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
+            int n, failed_before = edges->nfailed;
+            memset(moved, 0, (size_t)model->nverts);
+            if ((n = tt__polycube_reseat(polycube, model, edges, max_quads, points, moved, allocator)) < 0)
+                goto out_of_memory;
+            if (!n) break;
+            reseated += n;
+            for (v = 0; v < model->nverts; v++) focus[v] |= moved[v];
+            if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, edges,
+                                          moved, &again, error)) != TT_OK)
+                goto failed;
+            tt_polycube_edges_free(edges);
+            edges = again;
+            if (edges->nfailed >= failed_before) break;
+        }
+        if (!reseated) break;
+        /* The relaxation looks only near the re-seated points: elsewhere it has done what it can. */
+        for (round = 0; round < TT__RESEAT_FOCUS_RINGS; round++) {
+            for (e = 0; e < edges->nedges; e++) {
+                const int a = edges->edge_vertices[2 * e], b = edges->edge_vertices[2 * e + 1];
+                if (focus[a] == 1 && !focus[b]) focus[b] = 2;
+                if (focus[b] == 1 && !focus[a]) focus[a] = 2;
+            }
+            for (v = 0; v < model->nverts; v++) focus[v] = focus[v] != 0;
+        }
+        memcpy(before_unspike, points, sizeof *points * (size_t)model->nverts);
+        if ((moves = tt__polycube_relax(polycube, model, points, focus, allocator)) < 0) goto out_of_memory;
+        report->relaxed += moves;
+        for (v = 0; v < model->nverts; v++)
+            moved[v] = points[v].quad != before_unspike[v].quad || points[v].s != before_unspike[v].s ||
+                       points[v].t != before_unspike[v].t;
+        if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, edges, moved,
+                                      &again, error)) != TT_OK)
+            goto failed;
+        tt_polycube_edges_free(edges);
+        edges = again;
+    }
+    /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
+       vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
     memcpy(before_unspike, points, sizeof *points * (size_t)model->nverts);
     memset(moved, 0, (size_t)model->nverts);
     for (tracing = 0; tracing < 2; tracing++) {
@@ -18269,6 +18483,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt_polycube_edges_free(edges);
     tt__free(allocator, before_unspike);
     tt__free(allocator, moved);
+    tt__free(allocator, focus);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     *out = S.out;
@@ -18285,6 +18500,7 @@ failed:
     tt_polycube_edges_free(edges);
     tt__free(allocator, before_unspike);
     tt__free(allocator, moved);
+    tt__free(allocator, focus);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     memset(report, 0, sizeof *report);

@@ -2781,6 +2781,94 @@ static void test_relax_untangles(void)
     tm_free(&m);
 }
 
+static int failed_edges(const tt_polycube *pc, const tt_mesh *mesh, const tt_surface_point *pts)
+{
+    tt_polycube_edges *edges = NULL;
+    int n;
+    if (tt_polycube_trace_edges(pc, mesh, pts, mesh->nverts, NULL, NULL, &edges, NULL) != TT_OK) return -1;
+    n = edges->nfailed;
+    tt_polycube_edges_free(edges);
+    return n;
+}
+
+typedef struct reseat_oom_ctx {
+    const tt_polycube *pc;
+    const tt_mesh *mesh;
+    const tt_surface_point *start;
+    tt_surface_point *pts;
+    unsigned char *moved;
+} reseat_oom_ctx;
+
+static tt_result reseat_oom_call(void *ctx, const tt_allocator *al)
+{
+    reseat_oom_ctx *c = (reseat_oom_ctx *)ctx;
+    memcpy(c->pts, c->start, sizeof *c->pts * (size_t)c->mesh->nverts);
+    memset(c->moved, 0, (size_t)c->mesh->nverts);
+    return internal_polycube_reseat(c->pc, c->mesh, c->pts, c->moved, al) == 1 ? TT_OK : TT_ERROR_OUT_OF_MEMORY;
+}
+
+/* A vertex seated on the far side of S (as the closest point does across a
+   part about a cube thick) has edges with no path on S; re-seating puts it
+   back on its neighbours' sheet, next to its own position, and moves
+   nothing else. */
+static void test_reseat(void)
+{
+    const double centre[3] = {0.0, 0.0, 0.0};
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_surface_point *pts = NULL;
+    tt_polycube_options o;
+    tt_polycube_projection_report pr;
+    tt_polycube_report rep;
+    tt_polycube *pc;
+    unsigned char *moved;
+    tt_surface_point *start, *copy;
+    reseat_oom_ctx ctx;
+    int v, far = 0, near = 0, before, after, reseated, others = 0, a;
+    double at[3], d2 = 0.0;
+    memset(&m, 0, sizeof m);
+    make_sphere(&m, 48, 24, 1.0, centre, 0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 6;
+    pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
+    if (!pc) { tm_free(&m); return; }
+    for (v = 0; v < mesh->nverts; v++) {
+        if (mesh->pos[3 * v] > mesh->pos[3 * near]) near = v;
+        if (mesh->pos[3 * v] < mesh->pos[3 * far]) far = v;
+    }
+    CHECK(failed_edges(pc, mesh, pts) == 0, "the sphere's edges all trace before the test moves a point");
+    /* The vertex at +x seated next to the one at -x. */
+    pts[near] = pts[far];
+    pts[near].s = pts[far].s < 0.5f ? pts[far].s + 0.05f : pts[far].s - 0.05f;
+    before = failed_edges(pc, mesh, pts);
+    moved = (unsigned char *)calloc((size_t)mesh->nverts, 1);
+    start = (tt_surface_point *)malloc(sizeof *start * (size_t)mesh->nverts);
+    copy = (tt_surface_point *)malloc(sizeof *copy * (size_t)mesh->nverts);
+    memcpy(start, pts, sizeof *start * (size_t)mesh->nverts);
+    reseated = internal_polycube_reseat(pc, mesh, pts, moved, NULL);
+    after = failed_edges(pc, mesh, pts);
+    for (v = 0; v < mesh->nverts; v++) others += moved[v] && v != near;
+    tt_polycube_point_position(pc, pts[near], at);
+    for (a = 0; a < 3; a++) d2 += (at[a] - mesh->pos[3 * near + a]) * (at[a] - mesh->pos[3 * near + a]);
+    CHECK(before >= 4 && reseated == 1 && moved[near] && others == 0 && after == 0 && sqrt(d2) <= pc->h,
+          "a vertex seated across the sphere (%d edges with no path) re-seated: %d moved (%d others), %d edges "
+          "fail after, %.3g cubes from its position", before, reseated, others, after, sqrt(d2) / pc->h);
+    ctx.pc = pc;
+    ctx.mesh = mesh;
+    ctx.start = start;
+    ctx.pts = copy;
+    ctx.moved = moved;
+    oom_reset();
+    oom_sweep("re-seating (sphere at resolution 6, one vertex across)", reseat_oom_call, &ctx, TT_OK);
+    free(start);
+    free(copy);
+    free(moved);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    free(pts);
+    tm_free(&m);
+}
+
 /* Spec P4 as the library reads it: an open mesh whose holes are narrower
    than a couple of cubes (a scan missing a few faces) is sealed, its
    polycube solid like the closed mesh's, one sheet instead of a shell;
@@ -2916,6 +3004,7 @@ void run_polycube_tests(void)
     RUN(test_relax_kernel);
     RUN(test_untangle_energy);
     RUN(test_relax_untangles);
+    RUN(test_reseat);
     RUN(test_seal);
     RUN(test_edges_determinism_and_errors);
     RUN(test_map_cube);

@@ -323,7 +323,18 @@ int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], doub
 int internal_polycube_mask_is_disc(int mask) { return tt__polycube_mask_is_disc(mask); }
 int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points)
 {
-    return tt__polycube_relax(polycube, model, points, NULL);
+    return tt__polycube_relax(polycube, model, points, NULL, NULL);
+}
+int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
+                             unsigned char *moved, const tt_allocator *allocator)
+{
+    tt_polycube_edges *edges = NULL;
+    int n;
+    if (tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, allocator, &edges, NULL) != TT_OK)
+        return -2;
+    n = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, allocator);
+    tt_polycube_edges_free(edges);
+    return n;
 }
 int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2])
 {

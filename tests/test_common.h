@@ -178,6 +178,10 @@ int internal_polycube_mask_is_disc(int mask);
    star (ring: two points per triangle, its far edge counter-clockwise; 0
    when empty) and the untangling energy of a star of n <= 64 triangles. */
 int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points);
+/* Traces the edges and re-seats the vertices with a failed one (flagged in moved[], cleared by the caller);
+   returns how many moved, -1 when out of memory re-seating, -2 tracing. */
+int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
+                             unsigned char *moved, const tt_allocator *allocator);
 int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2]);
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
                                 double delta2, double gradient[2], int *folded);
