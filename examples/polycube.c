@@ -277,6 +277,12 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
     if (tt_polycube_map(job->polycube, job->mesh.mesh, NULL, NULL, &job->mapping, &job->map_report, &error) != TT_OK)
         return triangle_mesh_report_error(options->mesh_path, &job->mesh, &error);
     job->map_seconds = tool_seconds_now() - start;
+    /* Above 0.1 % (the target), the cuts show: say why they come and what may help. */
+    if (job->map_report.fallback_triangles > 0.001 * job->map_report.triangles)
+        tool_note("%s: %d of the %d triangles mapped (%.2g %%) have no seamless place on the polycube and show a cut each: "
+                  "parts thinner than about two cubes, handles the polycube lacks, or wide holes; try another "
+                  "--resolution", options->mesh_path, job->map_report.fallback_triangles, job->map_report.triangles,
+                  100.0 * job->map_report.fallback_triangles / job->map_report.triangles);
     job->corner_uv = (float *)malloc((size_t)job->mapping->ntriangles * 6 * sizeof(float));
     if (!job->corner_uv)
         return tool_fail("out of memory for the texture coordinates of %d triangles", job->mapping->ntriangles);

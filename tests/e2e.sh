@@ -917,6 +917,8 @@ polycube_case "sphere-triangles" spheretri.obj 2 --resolution 8
 POLYCUBE_SPHERE=$W/d$NEWDIR_N
 check "polycube sphere: genus 0 as the mesh" "'genus 0 (as the mesh)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'genus 0 (as the mesh)'; echo $?)"
+check "polycube sphere: no note about cuts (none beyond 0.1 %)" "no 'no seamless place' on stderr" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -q 'no seamless place'; [ $? -ne 0 ]; echo $?)"
 check "polycube sphere: the paper's 256 tiles, plain and upright" "'tiles: 2 x 256 (n=2 ... (plain for the tops, upright for the walls)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q '^tiles: 2 x 256 (n=2, 16 texels, gutter 4), 768x384 atlas (plain for the tops, upright for the walls)'; echo $?)"
 polycube_case "sphere --no-upright" spheretri.obj 2 --resolution 8 --no-upright
@@ -935,6 +937,10 @@ check "polycube torus at resolution 2: warns that the genus differs" \
     "$(printf '%s' "$ERR" | grep -c 'the polycube has genus 0, the mesh 1.*raise --resolution' | grep -qx 1; echo $?)"
 check "polycube torus at resolution 2: the summary says so" "'genus 0 (the mesh's 1: they differ)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q "genus 0 (the mesh's 1: they differ)"; echo $?)"
+check "polycube torus at resolution 2: one stderr line says how many triangles show a cut, and what may help" \
+    "'N of M triangles (P %) have no seamless place ... try another --resolution'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -cE '[0-9]+ of the [0-9]+ triangles mapped \([0-9.e+-]+ %\) have no seamless place.*--resolution' |
+        grep -qx 1; echo $?)"
 cd "$W" || exit 1
 polycube_case "sphere --up -z --no-correct" spheretri.obj 1 --resolution 6 --up -z --no-correct
 polycube_case "sphere --up 1,2,0" spheretri.obj 1 --resolution 6 --up 1,2,0
