@@ -418,6 +418,17 @@ typedef struct lapped_ctx {
     double angle, scale, overdraw;
 } lapped_ctx;
 
+/* The default tangent field alone (a sparse solve, part of run_lapped). */
+static double run_lapped_field(void *p)
+{
+    lapped_ctx *c = (lapped_ctx *)p;
+    tt_error err;
+    double t0 = bench_now_ms();
+    tt_result r = tt_tangent_field(c->mesh, NULL, NULL, c->field, &err);
+    if (r != TT_OK) fail("tt_tangent_field", r, &err);
+    return bench_now_ms() - t0;
+}
+
 static double run_lapped(void *p)
 {
     lapped_ctx *c = (lapped_ctx *)p;
@@ -476,6 +487,8 @@ static void bench_lapped(const char *name, int n, tt_image *patch)
     lc.patch = patch;
     lc.field = (float *)xmalloc(sizeof(float) * 3 * (size_t)lc.mesh->nfaces);
     report(name, median_ms(run_lapped, &lc, RUNS_SLOW), "ms");
+    snprintf(label, sizeof label, "%s_field", name);
+    report(label, median_ms(run_lapped_field, &lc, RUNS_SLOW), "ms");
     snprintf(label, sizeof label, "%s_pastes", name);
     report(label, lc.pastes, "pastes");
     snprintf(label, sizeof label, "%s_overdraw", name);

@@ -124,8 +124,9 @@ static void check_field_plane_length(const tt_mesh *mesh, const float *v, double
     CHECK(bad_len == 0, "%s: %d of %d vectors do not have length %g", what, bad_len, mesh->nfaces, len);
 }
 
-/* Faces not perpendicular to `up` must point along up projected on the face.
-   Returns how many faces were perpendicular (left to propagation). */
+/* Faces tilted 30 degrees or more from facing up (|projected up| >= 0.5,
+   where up decides the direction) must point along up projected on the
+   face, within 1 degree. Returns how many faces up does not decide. */
 static int check_field_up(const tt_mesh *mesh, int first_face, const float *v, const float up_in[3], const char *what)
 {
     double up[3], lu;
@@ -139,9 +140,9 @@ static int check_field_up(const tt_mesh *mesh, int first_face, const float *v, c
         tt_face_normal(mesh, f, n);
         d = up[0] * n[0] + up[1] * n[1] + up[2] * n[2];
         for (k = 0; k < 3; k++) { p[k] = up[k] - d * n[k]; a[k] = v[3 * f + k]; }
-        if (sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) < TT_FIELD_PERPENDICULAR + 1e-4) { perpendicular++; continue; }
+        if (sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) < 0.5) { perpendicular++; continue; }
         ang = fv_angle(a, p);
-        if (!(ang < 1e-4)) {
+        if (!(ang < 3.14159265358979323846 / 180.0)) {
             if (!bad) DETAIL("%s: face %d is %g rad from projected up", what, f, ang);
             bad++;
         }
@@ -241,8 +242,8 @@ static void test_field_default(void)
     tm_free(&m);
 }
 
-/* Surfaces facing up: no face has a usable projection, so everything comes
-   from the seed face's first edge, carried breadth-first. */
+/* Surfaces facing up: up decides no face's direction, so the field is the
+   tie axis (x for up = +z) where nothing else reaches, and smooth. */
 static void test_field_fallback(void)
 {
     tmesh m;
@@ -263,13 +264,13 @@ static void test_field_fallback(void)
     CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "flat grid facing up: %s", err.message);
     for (f = 0; f < mesh->nfaces; f++)
         if (!near(v[3 * f], 1.0, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
-    CHECK(bad == 0, "flat grid facing up: %d faces not (1, 0, 0) (face 0's first edge)", bad);
+    CHECK(bad == 0, "flat grid facing up: %d faces not (1, 0, 0) (the tie axis)", bad);
     free(v);
     tt_mesh_free(mesh);
     tm_free(&m);
 
-    /* A gentle dome facing up (normals within ~8 degrees of +z, under the 11.5 of TT_FIELD_PERPENDICULAR): propagation
-       must stay tangent, keep the scale and vary slowly. */
+    /* A gentle dome facing up (normals within ~8 degrees of +z, where up hardly decides): the field must stay
+       tangent, keep the scale and vary slowly. */
     memset(&m, 0, sizeof m);
     for (j = 0; j <= 12; j++)
         for (i = 0; i <= 12; i++) {
@@ -442,16 +443,214 @@ static void test_field_constraints(void)
         if (!near(v[3 * f], 0.5, 1e-6) || !near(v[3 * f + 1], 0.0, 1e-6) || !near(v[3 * f + 2], 0.0, 1e-6)) bad++;
     CHECK(bad == 0, "constrained grid: %d faces differ from (0.5, 0, 0)", bad);
     {
-        int perpendicular;
-        const float up[3] = {0, 1, 0};
+        /* The torus alone, without constraints: the same field. */
+        tmesh alone;
+        tt_mesh *torus = NULL;
+        float *w;
+        double worst = 0.0;
+        memset(&alone, 0, sizeof alone);
+        make_torus(&alone, 12, 8, 3.0, 1.0);
+        CHECK(build(&alone, 0, &torus, &err) == TT_OK, "torus builds: %s", err.message);
+        w = (float *)malloc(sizeof(float) * 3 * (size_t)torus->nfaces);
+        opt.constraints = NULL;
+        opt.nconstraints = 0;
+        CHECK(tt_tangent_field(torus, &opt, NULL, w, &err) == TT_OK, "torus alone: %s", err.message);
         bad = 0;
-        for (f = 9; f < mesh->nfaces; f++)
+        for (f = 9; f < mesh->nfaces; f++) {
+            double a[3], b[3], angle;
+            int k;
             if (!near(fv_len(v + 3 * f), 0.7, 1e-5)) bad++;
+            for (k = 0; k < 3; k++) {
+                a[k] = v[3 * f + k];
+                b[k] = w[3 * (f - 9) + k];
+            }
+            angle = fv_angle(a, b);
+            if (angle > worst) worst = angle;
+        }
         CHECK(bad == 0, "unconstrained torus: %d faces without the scale 0.7", bad);
-        perpendicular = check_field_up(mesh, 9, v, up, "grid + torus, torus part");
-        (void)perpendicular;
+        CHECK(worst < 1e-4, "the torus beside a constrained grid takes the default field (%g rad from it at most)",
+              worst);
+        free(w);
+        tt_mesh_free(torus);
+        tm_free(&alone);
     }
     free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* Mean angle (degrees) the field turns across interior edges: each
+   neighbour's vector carried into the face's plane by the rotation about
+   their shared edge (parallel transport), every edge seen from both sides. */
+static double field_mean_turn(const tt_mesh *mesh, const float *v)
+{
+    double sum = 0.0;
+    int c, count = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int f = mesh->corner_face[c], g, k, next = c + 1 < mesh->face_start[f + 1] ? c + 1 : mesh->face_start[f];
+        float nf[3], ng[3];
+        double e[3], le = 0.0, bf[3], bg[3], lf = 0.0, lg = 0.0, along, across, carried[3], a[3];
+        if (mesh->twin[c] < 0) continue;
+        g = mesh->corner_face[mesh->twin[c]];
+        tt_face_normal(mesh, f, nf);
+        tt_face_normal(mesh, g, ng);
+        for (k = 0; k < 3; k++) {
+            e[k] = mesh->pos[3 * mesh->corner_vert[next] + k] - mesh->pos[3 * mesh->corner_vert[c] + k];
+            le += e[k] * e[k];
+        }
+        le = sqrt(le);
+        for (k = 0; k < 3; k++) e[k] /= le;
+        /* b = n x e in each face: the direction across the edge. */
+        bf[0] = nf[1] * e[2] - nf[2] * e[1]; bf[1] = nf[2] * e[0] - nf[0] * e[2]; bf[2] = nf[0] * e[1] - nf[1] * e[0];
+        bg[0] = ng[1] * e[2] - ng[2] * e[1]; bg[1] = ng[2] * e[0] - ng[0] * e[2]; bg[2] = ng[0] * e[1] - ng[1] * e[0];
+        /* A bent quad's edge leaves its plane a little: b made unit all the same. */
+        for (k = 0; k < 3; k++) {
+            lf += bf[k] * bf[k];
+            lg += bg[k] * bg[k];
+        }
+        for (k = 0; k < 3; k++) {
+            bf[k] /= sqrt(lf);
+            bg[k] /= sqrt(lg);
+        }
+        along = across = 0.0;
+        for (k = 0; k < 3; k++) {
+            along += v[3 * g + k] * e[k];
+            across += v[3 * g + k] * bg[k];
+        }
+        for (k = 0; k < 3; k++) {
+            carried[k] = along * e[k] + across * bf[k];
+            a[k] = v[3 * f + k];
+        }
+        sum += fv_angle(a, carried) * 180.0 / 3.14159265358979323846;
+        count++;
+    }
+    return count ? sum / count : 0.0;
+}
+
+/* The default field is the smoothest that follows up where up decides:
+   on a closed box the walls point up and the top (where up says nothing,
+   and the walls' vectors, perpendicular to it, say nothing either) is
+   constant; on a bumpy sphere it turns across edges less than half as much
+   as the projected up does (the control, the paper's plain rule). */
+static void test_field_smooth(void)
+{
+    static const double box[6][3][3] = {
+        /* origin, u, v (u x v outward) of each side of the box [0,2]x[0,1]x[0,1.5] */
+        {{0, 0, 1.5}, {2, 0, 0}, {0, 1, 0}},   {{2, 0, 0}, {-2, 0, 0}, {0, 1, 0}}, {{2, 0, 1.5}, {0, 0, -1.5}, {0, 1, 0}},
+        {{0, 0, 0}, {0, 0, 1.5}, {0, 1, 0}},   {{0, 1, 1.5}, {2, 0, 0}, {0, 0, -1.5}}, {{0, 0, 0}, {2, 0, 0}, {0, 0, 1.5}}};
+    const int n = 8;
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    float *v, *control;
+    int side, i, j, f, k;
+    double walls = 0.0, top = 0.0, bottom = 0.0, smooth, plain;
+    memset(&m, 0, sizeof m);
+    for (side = 0; side < 6; side++) {
+        int base = m.nv;
+        for (j = 0; j <= n; j++)
+            for (i = 0; i <= n; i++) {
+                double p[3];
+                for (k = 0; k < 3; k++) p[k] = box[side][0][k] + box[side][1][k] * i / n + box[side][2][k] * j / n;
+                tm_vert(&m, p[0], p[1], p[2]);
+            }
+        for (j = 0; j < n; j++)
+            for (i = 0; i < n; i++) {
+                int a = base + j * (n + 1) + i;
+                tm_tri(&m, a, a + 1, a + n + 2);
+                tm_tri(&m, a, a + n + 2, a + n + 1);
+            }
+    }
+    /* Weld the sides' shared edges. */
+    {
+        tmesh welded;
+        int *map = (int *)malloc(sizeof(int) * (size_t)m.nv);
+        memset(&welded, 0, sizeof welded);
+        for (i = 0; i < m.nv; i++) {
+            for (j = 0; j < welded.nv; j++)
+                if (fabs(welded.pos[3 * j] - m.pos[3 * i]) < 1e-6 && fabs(welded.pos[3 * j + 1] - m.pos[3 * i + 1]) < 1e-6 &&
+                    fabs(welded.pos[3 * j + 2] - m.pos[3 * i + 2]) < 1e-6)
+                    break;
+            map[i] = j < welded.nv ? j : tm_vert(&welded, m.pos[3 * i], m.pos[3 * i + 1], m.pos[3 * i + 2]);
+        }
+        for (f = 0; f < m.nf; f++)
+            tm_tri(&welded, map[m.idx[3 * f]], map[m.idx[3 * f + 1]], map[m.idx[3 * f + 2]]);
+        free(map);
+        tm_free(&m);
+        m = welded;
+    }
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "box builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    CHECK(tt_tangent_field(mesh, NULL, NULL, v, &err) == TT_OK, "box field: %s", err.message);
+    {
+        double top_mean[3] = {0, 0, 0}, bottom_mean[3] = {0, 0, 0};
+        for (f = 0; f < mesh->nfaces; f++) {
+            float nrm[3];
+            tt_face_normal(mesh, f, nrm);
+            for (k = 0; k < 3; k++) (nrm[1] > 0.5f ? top_mean : bottom_mean)[k] += nrm[1] > 0.5f || nrm[1] < -0.5f ? v[3 * f + k] : 0.0;
+        }
+        for (f = 0; f < mesh->nfaces; f++) {
+            float nrm[3];
+            double a[3], up[3] = {0, 1, 0};
+            tt_face_normal(mesh, f, nrm);
+            for (k = 0; k < 3; k++) a[k] = v[3 * f + k];
+            if (nrm[1] > 0.5f) top = fmax(top, fv_angle(a, top_mean));
+            else if (nrm[1] < -0.5f) bottom = fmax(bottom, fv_angle(a, bottom_mean));
+            else walls = fmax(walls, fv_angle(a, up));
+        }
+    }
+    printf("     default field on a closed box: walls %.3f degrees from up, top and bottom %.3f and %.3f from constant\n",
+           walls * 180.0 / 3.14159265358979323846, top * 180.0 / 3.14159265358979323846,
+           bottom * 180.0 / 3.14159265358979323846);
+    CHECK(walls * 180.0 / 3.14159265358979323846 <= 1.0 && top * 180.0 / 3.14159265358979323846 <= 1.0 &&
+              bottom * 180.0 / 3.14159265358979323846 <= 1.0,
+          "closed box: the walls' field within 1 degree of up (%.3g), the top's and bottom's constant within 1 degree "
+          "(%.3g, %.3g)", walls * 180.0 / 3.14159265358979323846, top * 180.0 / 3.14159265358979323846,
+          bottom * 180.0 / 3.14159265358979323846);
+    free(v);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+
+    /* A bumpy sphere of triangles (a bent quad has no one plane to carry a vector in), its poles on z, up = +y:
+       the control is the projected up, normalised. */
+    {
+        tmesh quads;
+        int corner = 0;
+        memset(&quads, 0, sizeof quads);
+        make_field_sphere(&quads, 40, 64, 1.0);
+        memset(&m, 0, sizeof m);
+        lcg_seed(7);
+        for (i = 0; i < quads.nv; i++) {
+            double r = 1.0 + 0.04 * (lcg_unit() - 0.5);
+            tm_vert(&m, quads.pos[3 * i] * r, quads.pos[3 * i + 1] * r, quads.pos[3 * i + 2] * r);
+        }
+        for (f = 0; f < quads.nf; f++) {
+            for (k = 2; k < quads.sizes[f]; k++)
+                tm_tri(&m, quads.idx[corner], quads.idx[corner + k - 1], quads.idx[corner + k]);
+            corner += quads.sizes[f];
+        }
+        tm_free(&quads);
+    }
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "bumpy sphere builds: %s", err.message);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    control = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    CHECK(tt_tangent_field(mesh, NULL, NULL, v, &err) == TT_OK, "bumpy sphere field: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++) {
+        float nrm[3];
+        double l;
+        tt_face_normal(mesh, f, nrm);
+        for (k = 0; k < 3; k++) control[3 * f + k] = (float)((k == 1) - nrm[1] * nrm[k]);
+        l = fv_len(control + 3 * f);
+        for (k = 0; k < 3; k++) control[3 * f + k] = (float)(control[3 * f + k] / (l > 0.0 ? l : 1.0));
+    }
+    smooth = field_mean_turn(mesh, v);
+    plain = field_mean_turn(mesh, control);
+    CHECK(smooth <= 0.5 * plain, "bumpy sphere: the field turns %.3g degrees across an edge on average, the projected "
+          "up %.3g (at most half wanted)", smooth, plain);
+    printf("     default field: mean turn across edges %.2f degrees on a bumpy sphere, %.2f for the projected up\n",
+           smooth, plain);
+    free(v);
+    free(control);
     tt_mesh_free(mesh);
     tm_free(&m);
 }
@@ -3427,6 +3626,7 @@ void run_lapped_tests(void)
 {
     RUN(test_field_default);
     RUN(test_field_fallback);
+    RUN(test_field_smooth);
     RUN(test_field_constraints);
     RUN(test_field_errors);
     RUN(test_field_constraint_items);
