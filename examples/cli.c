@@ -247,3 +247,18 @@ int parse_int_list(const char *option, const char *text, int count, int *out)
 {
     return parse_list(option, text, count, out, parse_one_int);
 }
+
+int parse_mesh_option(int argc, char **argv, int *index, tool_mesh_options *options)
+{
+    const char *value;
+    if (tool_option(argc, argv, index, "--subdivide", &value)) {
+        if (parse_int("--subdivide", value, 0, 8, &options->subdivide) != 0) return -1;
+    } else if (strcmp(argv[*index], "--smooth") == 0) {
+        options->smooth = 1;
+    } else if (strcmp(argv[*index], "--permissive") == 0) {
+        options->permissive = 1;
+    } else {
+        return 0;
+    }
+    return 1;
+}

@@ -299,7 +299,7 @@ int cmd_hpm(int argc, char **argv)
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
 
-    if ((status = triangle_mesh_read(options.mesh_path, &mesh)) != 0) return status;
+    if ((status = triangle_mesh_read(options.mesh_path, NULL, &mesh)) != 0) return status;
     /* A photo: sRGB bytes in the file, linear light in the library (which
        matches colours as displayed again, by itself). */
     if (image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)

@@ -5,13 +5,19 @@
    coordinates), OUT_PREFIX.mtl and OUT_PREFIX_patch.png, the texture patch
    (straight alpha). Drawn in file order with alpha blending, the pastes cover
    the surface (Praun et al. Sec. 4, "runtime pasting"); `tiledtex render`
-   draws such a file that way. --bake also writes an ordinary textured mesh
-   (Sec. 4, "rendering with a texture atlas").
+   draws such a file that way, as do engines that composite in order; an
+   importer that merges the copies of a triangle (Blender's) cannot, so
+   --bake also writes an ordinary textured mesh to exchange (Sec. 4,
+   "rendering with a texture atlas"). The MTL files name the textures beside
+   them by file name, so the folder can move.
 
    The library calls, as a user of tiledtex.h makes them:
 
      tt_mesh_build          validate the OBJ's faces, split into triangle
                             fans here first: lapped textures work on triangles
+                            (--permissive cuts bad edges open)
+     tt_mesh_quadrangulate  --subdivide: the triangles quadrangulated, each
+                            quad split in two again (triangle_mesh.c)
      tt_tangent_field       each face's texture "up" and scale (Sec. 3.2):
                             --up, --scale, --constraints
      tt_make_texture_patch  the image with a soft splotch (or --mask) alpha (Sec. 3.1)
@@ -41,10 +47,14 @@ static void print_help(void)
            "beneath it. Writes OUT_PREFIX.obj (group paste_N holds the triangles of paste N with\n"
            "its texture coordinates; draw the groups in order with alpha blending and clamped\n"
            "texture coordinates), OUT_PREFIX.mtl and OUT_PREFIX_patch.png (the patch, straight\n"
-           "alpha; the MTL names it as map_Kd and map_d). Look at it with\n"
-           "'tiledtex render OUT_PREFIX.obj OUT_PREFIX_patch.png view.png'.\n"
+           "alpha; the MTL names it as map_Kd and map_d, by file name: the folder can move).\n"
+           "Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX_patch.png view.png'.\n"
+           "That OBJ is for this tool's renderer and for engines that draw the faces in file order\n"
+           "with blending; Blender's importer cannot stack copies of a triangle. To take the\n"
+           "result to other programs, use --bake (one texture on the mesh).\n"
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
-           "triangle fans first. The mesh must be manifold and consistently oriented.\n"
+           "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
+           "--permissive.\n"
            "\n"
            "options:\n"
            "  --scale X            side of one texture patch on the surface, in mesh units\n"
@@ -66,6 +76,14 @@ static void print_help(void)
            "                       SIZE x SIZE texture (16 to %d) over the OBJ's own texture\n"
            "                       coordinates when every corner has one, else over an atlas of\n"
            "                       triangle pairs\n"
+           "  --subdivide L        make the triangles smaller before pasting, L from 0 to 8 (default\n"
+           "                       0): quadrangulate them L times, as 'tiledtex tile' does, and split\n"
+           "                       every quad into two triangles, so a triangle becomes 6, 24, 96, ...\n"
+           "                       (the outputs have these). A paste covers whole triangles: subdivide\n"
+           "                       a coarse mesh when --scale is not several faces wide\n"
+           "  --smooth             Catmull-Clark positions when subdividing (rounder, a little smaller)\n"
+           "  --permissive         accept non-manifold or mis-oriented edges (an edge shared by three\n"
+           "                       faces, as some exports have): they are cut open into boundaries\n"
            "\n"
            "Prints the number of pastes, the coverage, how often a face is drawn (overdraw), how\n"
            "well the texture follows the field (angle and scale error) and how many face entries\n"
@@ -87,6 +105,7 @@ typedef struct lapped_options {
     int isotropic;
     const char *mask_path;          /* or NULL */
     int bake_size;                  /* 0 = no --bake */
+    tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
 } lapped_options;
 
 /* Returns -1 to go on, or the exit status to return now. */
@@ -99,9 +118,12 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
     for (i = 1; i < argc; i++) {
         const char *value;
         double number, xyz[3];
+        int taken;
         if (tool_is_help(argv[i])) {
             print_help();
             return 0;
+        } else if ((taken = parse_mesh_option(argc, argv, &i, &options->mesh)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--scale", &value)) {
             if (!value) return tool_usage("--scale needs a value");
             if (parse_whole_double(value, &number) != 0 || !(number > 0.0) || number > 1e30)
@@ -419,7 +441,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
                      const tt_lapped *lapped, tt_image *patch, int *own_uvs)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
-    size_t ncorners = 3 * (size_t)m->ntriangles, c;
+    size_t ncorners = 3 * (size_t)m->ntriangles;
     float *corner_uv = (float *)malloc(ncorners * 2 * sizeof(float));
     tt_image *atlas = NULL;
     tt_bake_options bake;
@@ -432,11 +454,9 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     snprintf(png_path, sizeof png_path, "%s_baked.png", options->prefix);
     if (!corner_uv) return tool_fail("out of memory for the texture coordinates of %s", obj_path);
 
-    *own_uvs = m->obj.corner_uv != NULL;
-    for (c = 0; c < ncorners && *own_uvs; c++) *own_uvs = m->obj.corner_uv[m->corner[c]] >= 0;
+    *own_uvs = m->corner_uv != NULL;
     if (*own_uvs) {
-        for (c = 0; c < ncorners; c++) memcpy(corner_uv + 2 * c, m->obj.uv + 2 * m->obj.corner_uv[m->corner[c]],
-                                              2 * sizeof(float));
+        memcpy(corner_uv, m->corner_uv, ncorners * 2 * sizeof(float));
     } else if (tt_atlas_pack_pairs(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, corner_uv, &error) != TT_OK) {
         status = tool_fail("--bake %d: %s", options->bake_size, error.message);
         goto done;
@@ -515,7 +535,8 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
         }
     }
     printf("%s: %d triangles", options->mesh_path, m->ntriangles);
-    if (m->ntriangles != m->obj.nfaces) printf(" (fans of %d faces)", m->obj.nfaces);
+    if (m->subdivided > 0) printf(" (%d faces, --subdivide %d)", m->obj.nfaces, m->subdivided);
+    else if (m->ntriangles != m->obj.nfaces) printf(" (fans of %d faces)", m->obj.nfaces);
     printf(", %d pastes, coverage %.1f%%, mean overdraw %.2f\n", lapped->npastes, 100.0 * lapped->coverage,
            lapped->mean_overdraw);
     printf("alignment: mean angle error %.1f degrees, median scale error %.1f%%%s\n", angle, 100.0 * scale,
@@ -559,7 +580,7 @@ int cmd_lapped(int argc, char **argv)
     snprintf(png_path, sizeof png_path, "%s_patch.png", options.prefix);
     memset(&output, 0, sizeof output);
 
-    if ((status = triangle_mesh_read(options.mesh_path, &mesh)) != 0) return status;
+    if ((status = triangle_mesh_read(options.mesh_path, &options.mesh, &mesh)) != 0) return status;
     field = (float *)malloc((size_t)mesh.ntriangles * 3 * sizeof(float));
     if (!field) status = tool_fail("out of memory for the field of %s", options.mesh_path);
     if (status == 0) status = make_field(&options, &mesh, field);

@@ -468,7 +468,7 @@ int cmd_polycube(int argc, char **argv)
     snprintf(png_path, sizeof png_path, "%s.png", options.prefix);
     snprintf(surface_path, sizeof surface_path, "%s_polycube.obj", options.prefix);
 
-    if ((status = triangle_mesh_read(options.mesh_path, &job.mesh)) != 0) return status;
+    if ((status = triangle_mesh_read(options.mesh_path, NULL, &job.mesh)) != 0) return status;
     /* A photo: sRGB bytes in the file, linear light in the library. */
     if (image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);

@@ -12,7 +12,6 @@
      tt_assign_uvs          one UV per corner: the tile named by its four
                             boundary types, at its place in the atlas
 */
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,7 +27,7 @@ void tiled_default_options(tiled_options *options)
 int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled_options *options)
 {
     const char *value;
-    int number;
+    int number, taken;
     if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--colors", &value)) {
         if (parse_int("--colors", value, 1, 8, &options->layout.colors) != 0) return -1;
     } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--tile", &value)) {
@@ -39,12 +38,8 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         options->layout.gutter = number;
     } else if ((accept & TILED_LAYOUT_OPTIONS) && tool_option(argc, argv, index, "--seed", &value)) {
         if (parse_u64("--seed", value, &options->seed) != 0) return -1;
-    } else if ((accept & TILED_MESH_OPTIONS) && tool_option(argc, argv, index, "--subdivide", &value)) {
-        if (parse_int("--subdivide", value, 0, 8, &options->subdivide) != 0) return -1;
-    } else if ((accept & TILED_MESH_OPTIONS) && strcmp(argv[*index], "--smooth") == 0) {
-        options->smooth = 1;
-    } else if ((accept & TILED_MESH_OPTIONS) && strcmp(argv[*index], "--permissive") == 0) {
-        options->permissive = 1;
+    } else if ((accept & TILED_MESH_OPTIONS) && (taken = parse_mesh_option(argc, argv, index, &options->mesh)) != 0) {
+        if (taken < 0) return -1;
     } else if ((accept & TILED_SYNTH_OPTIONS) && tool_option(argc, argv, index, "--edge", &value)) {
         int xy[2];
         if (parse_int_list("--edge", value, 2, xy) != 0) return -1;
@@ -103,18 +98,6 @@ void tiled_mesh_free(tiled_mesh *mesh)
     memset(mesh, 0, sizeof *mesh);
 }
 
-/* Replace *mesh by one quadrangulation step of it. */
-static int quadrangulate(tt_mesh **mesh, tt_subdivision scheme, const char *obj_path)
-{
-    tt_mesh *quads;
-    tt_error error;
-    if (tt_mesh_quadrangulate(*mesh, scheme, NULL, &quads, &error) != TT_OK)
-        return tool_fail("%s: cannot quadrangulate: %s", obj_path, error.message);
-    tt_mesh_free(*mesh);
-    *mesh = quads;
-    return 0;
-}
-
 int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out)
 {
     obj_mesh obj;
@@ -128,7 +111,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         return tool_fail("%s", error.message);
     if (obj_read(obj_path, &obj, message, sizeof message) != 0) return tool_fail("%s", message);
 
-    desc = obj_mesh_desc(&obj, options->permissive ? TT_MESH_PERMISSIVE : 0);
+    desc = obj_mesh_desc(&obj, options->mesh.permissive ? TT_MESH_PERMISSIVE : 0);
     out->input_faces = obj.nfaces;
     if (tt_mesh_build(&desc, NULL, &out->mesh, &error) != TT_OK) {
         status = obj_report_mesh_error(obj_path, &obj, &error, 1);
@@ -142,22 +125,12 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
 
     /* Tiles are square: every face must be a quad. */
     if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
-        if ((status = quadrangulate(&out->mesh, TT_SUBDIVIDE_LINEAR, obj_path)) != 0) goto fail;
+        if ((status = tool_quadrangulate(obj_path, &out->mesh, 0)) != 0) goto fail;
         out->quadrangulated = out->mesh->nfaces;
     }
-    /* Each step makes four times the quads: refuse what would not fit in
-       memory long before it is tried. */
-    if (options->subdivide > 0 &&
-        (double)out->mesh->nfaces * pow(4.0, options->subdivide) > (double)TILED_MAX_QUADS) {
-        status = tool_fail("%s: --subdivide %d would make %.3g quads; the limit is %d (use a smaller level)",
-                           obj_path, options->subdivide, (double)out->mesh->nfaces * pow(4.0, options->subdivide),
-                           TILED_MAX_QUADS);
-        goto fail;
-    }
-    for (step = 0; step < options->subdivide; step++)
-        if ((status = quadrangulate(&out->mesh, options->smooth ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR,
-                                    obj_path)) != 0)
-            goto fail;
+    if ((status = tool_check_subdivide(obj_path, out->mesh, options->mesh.subdivide)) != 0) goto fail;
+    for (step = 0; step < options->mesh.subdivide; step++)
+        if ((status = tool_quadrangulate(obj_path, &out->mesh, options->mesh.smooth)) != 0) goto fail;
 
     out->corner_type = (uint8_t *)malloc((size_t)out->mesh->ncorners);
     out->corner_uv = (float *)malloc((size_t)out->mesh->ncorners * 2 * sizeof(float));
@@ -277,9 +250,7 @@ int tiled_check_atlas_size(const tiled_options *options)
 
 void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
 {
-    if (mesh->repaired_edges > 0)
-        fprintf(stderr, "tiledtex: %s: --permissive cut %d non-manifold or mis-oriented edge%s open\n", obj_path,
-                mesh->repaired_edges, mesh->repaired_edges == 1 ? "" : "s");
+    tool_note_cut_edges(obj_path, mesh->repaired_edges);
     if (mesh->quadrangulated) {
         char sizes[64];
         if (mesh->input_max_face_size == 3) snprintf(sizes, sizeof sizes, "triangles");

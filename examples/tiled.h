@@ -20,10 +20,6 @@ enum {
     TILED_REPORT_OPTION = 1 << 4     /* --report: quality line, seams measured on every edge */
 };
 
-/* Subdividing past this many quads is refused (an OBJ of 16M quads is already
-   about 1.5 GB of text). */
-#define TILED_MAX_QUADS (1 << 24)
-
 /* From this many triangles on, a mesh counts as a dense triangle mesh, for
    which tiled textures are the wrong tool (tiled_print_notes says so). */
 #define TILED_DENSE_TRIANGLES 1000
@@ -32,9 +28,7 @@ typedef struct tiled_options {
     tt_tile_layout layout;       /* zeros = the library's defaults */
     int tile_size_given;
     uint64_t seed;
-    int subdivide;               /* extra quadrangulation steps */
-    int smooth;                  /* Catmull-Clark positions for those steps */
-    int permissive;
+    tool_mesh_options mesh;      /* --subdivide (extra quadrangulation steps), --smooth, --permissive */
     int nedges;                  /* --edge X,Y given this many times */
     tt_rect edges[TT_MAX_COLORS];
     tt_rect background;          /* all zero = whole image */

@@ -11,11 +11,13 @@
                  atomic output           tool_output: build every file in
                                          memory, then commit them all or none
                  progress, time          tool_progress, tool_seconds_now
-     cli.c       command-line helpers    tool_option, parse_int, parse_axis_name, ...
+     cli.c       command-line helpers    tool_option, parse_int, parse_mesh_option, ...
      image_io.c  images                  image_load, png_encode, output_add_png
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
                  MTL writing             mtl_add_material, output_add_mtl
      triangle_mesh.c  an OBJ as triangles   triangle_mesh_read (lapped, hpm, polycube)
+                 mesh options            tool_quadrangulate, tool_check_subdivide,
+                 (parsed in cli.c)       tool_note_cut_edges
      measure.c   quality for summaries   tool_measure_seams, tool_format_seams
      format_number.c  numbers as text   tool_format_float, tool_format_int
 
@@ -389,24 +391,71 @@ int output_add_mtl(tool_output *output, const char *mtl_path, const char *materi
                    int texture_alpha);
 
 /* ---------------------------------------------------------------------- */
-/* An OBJ as triangles (triangle_mesh.c), for lapped, hpm, polycube               */
+/* Meshes refined and repaired: --subdivide, --smooth, --permissive         */
+/* (cli.c parses them, triangle_mesh.c applies them)                        */
+/* ---------------------------------------------------------------------- */
+
+/* The options of the commands that may refine or repair the mesh they read
+   (map, tile, lapped). */
+typedef struct tool_mesh_options {
+    int subdivide;          /* --subdivide L: quadrangulation steps */
+    int smooth;             /* --smooth: Catmull-Clark positions for those steps */
+    int permissive;         /* --permissive: built with TT_MESH_PERMISSIVE, bad edges cut open */
+} tool_mesh_options;
+
+/* If argv[*index] is --subdivide L (0 to 8), --smooth or --permissive,
+   consume it and return 1; 0 for any other argument; -1 after printing a
+   bad value. */
+int parse_mesh_option(int argc, char **argv, int *index, tool_mesh_options *options);
+
+/* Subdividing past this many quads is refused (an OBJ of 16M quads is already
+   about 1.5 GB of text). */
+#define TOOL_MAX_QUADS (1 << 24)
+
+/* One quadrangulation step (tt_mesh_quadrangulate) replacing *mesh: linear,
+   which keeps the shape, or with smooth Catmull-Clark positions. Prints the
+   error and returns the exit status on failure. */
+int tool_quadrangulate(const char *obj_path, tt_mesh **mesh, int smooth);
+/* Before `steps` such steps of `mesh`: refuse (one line, the exit status)
+   what would make more than TOOL_MAX_QUADS quads; 0 otherwise. */
+int tool_check_subdivide(const char *obj_path, const tt_mesh *mesh, int steps);
+
+/* The note a successful command gives (tool_note) when --permissive cut
+   `edges` edges open. */
+void tool_note_cut_edges(const char *obj_path, int edges);
+
+/* ---------------------------------------------------------------------- */
+/* An OBJ as triangles (triangle_mesh.c), for lapped, hpm, polycube         */
 /* ---------------------------------------------------------------------- */
 
 typedef struct triangle_mesh {
     obj_mesh obj;
     int ntriangles;
-    int *corner;            /* 3 per triangle: its OBJ corners (index into obj.corner_vert, obj.corner_uv) */
-    int *vert;              /* 3 per triangle: their vertices */
+    int nverts;
+    const float *pos;       /* 3 * nverts: the triangles' vertices, obj.pos or subdivided_pos */
+    float *subdivided_pos;  /* --subdivide: the OBJ's vertices, then the new ones; else NULL */
+    int *vert;              /* 3 per triangle: its vertices */
+    float *corner_uv;       /* 6 per triangle: the OBJ's texture coordinates at its corners
+                               (interpolated on subdivided triangles), or NULL when some
+                               corner of the OBJ has none */
     int *face;              /* per triangle: its OBJ face */
-    int *first_triangle;    /* per OBJ face: the first triangle of its fan */
+    int *first_triangle;    /* per OBJ face: the first of its triangles (they follow one another) */
+    int subdivided;         /* --subdivide steps taken */
+    int repaired_edges;     /* edges --permissive cut open in the OBJ's triangles */
+    unsigned flags;         /* TT_MESH_* the triangles are built with */
     tt_mesh *mesh;          /* the triangles, validated */
 } triangle_mesh;
 
 /* Read the OBJ, split its faces into triangle fans (obj_triangle_fans) and
-   build those with tt_mesh_build. A build error is printed about the OBJ's
-   own face and line. Returns 0, or the exit status after printing the
-   error (*m is then empty). */
-int triangle_mesh_read(const char *path, triangle_mesh *m);
+   build those with tt_mesh_build. `options` is NULL for a command without
+   the mesh options; with them, --permissive builds with TT_MESH_PERMISSIVE
+   (and a build error says when it would help), and --subdivide L
+   quadrangulates the triangles L times (with Catmull-Clark positions under
+   --smooth) and splits every quad into two triangles: a triangle becomes 6,
+   then 24, 96, ... A build error is printed about the OBJ's own face and
+   line. Returns 0, or the exit status after printing the error (*m is then
+   empty). */
+int triangle_mesh_read(const char *path, const tool_mesh_options *options, triangle_mesh *m);
 void triangle_mesh_free(triangle_mesh *m);
 /* Reverse every triangle's corners (an inside-out mesh turned outward) and
    build the mesh again. Returns 0, or the exit status after printing the
@@ -507,13 +556,17 @@ char *tool_copy_string(const char *text, size_t length);
    lines that must be relative to the OBJ / MTL file. */
 const char *tool_basename(const char *path);
 
-/* `target` (a path from the current directory) as seen from the directory of
-   `from_file`: what an MTL beside from_file should write to name target
-   ("out/a.mtl", "out/tex.png" -> "tex.png"; "out/a.mtl", "tex.png" ->
-   "../tex.png"). Absolute targets are kept. When from_file's directory
-   climbs with ".." ("../out/a.mtl"), the text alone cannot say the way
-   back, so both are resolved on the file system (target must exist, and
-   from_file's directory); failing that, target's absolute path is used. */
+/* `target` (a path from the current directory, or absolute) as seen from
+   the directory of `from_file`: what an MTL beside from_file should write to
+   name target, so that the folder can move ("out/a.mtl", "out/tex.png" ->
+   "tex.png"; "out/a.mtl", "tex.png" -> "../tex.png"; "/tmp/out/a.mtl",
+   "/tmp/out/tex.png" -> "tex.png"). Absolute paths that share nothing but
+   the root give target's absolute path: climbing to the root breaks as
+   soon as the folder moves, where the absolute path still names the file.
+   When one path is absolute and the other is not, or from_file's directory
+   climbs with ".." ("../out/a.mtl"), the text alone cannot say the way, so
+   both are resolved on the file system (their directories must exist);
+   failing that, target's absolute path is used, or target as given. */
 void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size);
 
 #endif /* TILEDTEX_TOOL_H */

@@ -270,16 +270,18 @@ int tool_read_file(const char *path, unsigned char **data, size_t *size, char *e
 }
 
 /* The relative path from from_file's directory to target, both relative
-   to the same directory or both absolute; 0, or -1 when from_file's
-   directory climbs with ".." after the parts they share (the way back down
-   cannot be named from the text alone). */
-static int relative_path_between(const char *target, const char *from_file, char *out, size_t out_size)
+   to the same directory or both absolute. Returns how many directories the
+   two share at the start, with *ups the "../" steps the path then climbs;
+   or -1 when from_file's directory climbs with ".." after the parts they
+   share (the way back down cannot be named from the text alone). */
+static int relative_path_between(const char *target, const char *from_file, char *out, size_t out_size, int *ups)
 {
     /* Directory parts of both, as text ranges; "." parts are skipped. */
     const char *from_end = tool_basename(from_file), *target_name = tool_basename(target);
     const char *f = from_file, *t = target;
     size_t used = 0;
-    int ups = 0;
+    int shared = 0, steps;
+    *ups = 0;
     /* Skip the directories both paths share, one part at a time. */
     for (;;) {
         const char *fe, *te;
@@ -292,54 +294,70 @@ static int relative_path_between(const char *target, const char *from_file, char
         if (f == from_end || t == target_name || fe - f != te - t || strncmp(f, t, (size_t)(fe - f)) != 0) break;
         f = fe;
         t = te;
+        shared++;
     }
     /* Every directory left on the file's side is one step up. */
     while (f < from_end) {
         const char *fe = f;
         while (fe < from_end && *fe != '/') fe++;
         if (fe - f == 2 && f[0] == '.' && f[1] == '.') return -1;
-        if (fe > f && !(fe - f == 1 && f[0] == '.')) ups++;
+        if (fe > f && !(fe - f == 1 && f[0] == '.')) (*ups)++;
         f = fe;
         while (f < from_end && *f == '/') f++;
     }
     out[0] = '\0';
-    while (ups-- > 0 && used + 3 < out_size) {
+    for (steps = *ups; steps > 0 && used + 3 < out_size; steps--) {
         memcpy(out + used, "../", 3);
         used += 3;
     }
     snprintf(out + used, out_size - used, "%s", t);
-    return 0;
+    return shared;
+}
+
+/* A path from the root, through the file system: its directory's real path
+   and its name, so that a file not written yet resolves too. Malloc'ed;
+   NULL when the directory does not resolve. */
+static char *resolve_path(const char *path)
+{
+    const char *name = tool_basename(path);
+    char *directory = tool_copy_string(path, (size_t)(name - path)), *real = NULL, *resolved = NULL;
+    if (directory) real = realpath(directory[0] ? directory : ".", NULL);
+    if (real) {
+        size_t length = strlen(real);
+        resolved = (char *)malloc(length + strlen(name) + 2);
+        if (resolved) sprintf(resolved, "%s%s%s", real, real[length - 1] == '/' ? "" : "/", name);
+    }
+    free(real);
+    free(directory);
+    return resolved;
 }
 
 void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size)
 {
-    char *real_target = NULL, *real_directory = NULL, *directory = NULL, *real_file = NULL;
-    size_t length;
-    if (target[0] == '/') {
-        snprintf(out, out_size, "%s", target);
-        return;
+    char *resolved_target = NULL, *resolved_file = NULL;
+    const char *named = target;
+    int shared = -1, ups = 0;
+    if ((target[0] == '/') == (from_file[0] == '/'))
+        shared = relative_path_between(target, from_file, out, out_size, &ups);
+    if (shared < 0) {
+        /* One path is absolute and the other is not, or from_file's
+           directory climbs out of the current one ("../out/a.mtl"): ask the
+           file system where both are. Target's directory exists (it was
+           read, or is being written) and so does the file's; when either
+           cannot be resolved, target's absolute path, or target as given,
+           is the best left. */
+        resolved_target = resolve_path(target);
+        resolved_file = resolve_path(from_file);
+        if (resolved_target) named = resolved_target;
+        if (resolved_target && resolved_file)
+            shared = relative_path_between(resolved_target, resolved_file, out, out_size, &ups);
     }
-    if (relative_path_between(target, from_file, out, out_size) == 0) return;
-    /* from_file's directory climbs out of the current one ("../out/a.mtl"):
-       ask the file system where both are. The target exists (it was read)
-       and so does the file's directory (the file is about to be written
-       there); when either cannot be resolved, an absolute target still
-       names the right file from anywhere. */
-    length = (size_t)(tool_basename(from_file) - from_file);
-    directory = tool_copy_string(from_file, length);
-    real_target = realpath(target, NULL);
-    real_directory = directory ? realpath(directory, NULL) : NULL;
-    if (real_directory) real_file = (char *)malloc(strlen(real_directory) + 3);
-    if (real_target && real_file) {
-        sprintf(real_file, "%s/x", real_directory);
-        relative_path_between(real_target, real_file, out, out_size);
-    } else {
-        snprintf(out, out_size, "%s", real_target ? real_target : target);
-    }
-    free(real_file);
-    free(real_directory);
-    free(real_target);
-    free(directory);
+    /* Absolute paths that share nothing but the root: the way up to it breaks
+       as soon as the folder moves, where the absolute path still names the
+       file. */
+    if (shared < 0 || (named[0] == '/' && shared == 0 && ups > 0)) snprintf(out, out_size, "%s", named);
+    free(resolved_target);
+    free(resolved_file);
 }
 
 const char *tool_basename(const char *path)

@@ -686,9 +686,120 @@ expect_error "lapped --bake too small for the atlas" lapped ../in/torus.obj ../i
 expect_error "lapped --up 0,0,0" lapped ../in/torus.obj ../in/lap.png out --up 0,0,0
 expect_error "lapped zero-area face" lapped ../in/lapped_degenerate.obj ../in/lap.png out
 err_mentions "lapped zero-area face: FILE:LINE and face 1" 'lapped_degenerate\.obj:5: face 1 '
-expect_error "lapped non-manifold edge" lapped ../in/nonmanifold.obj ../in/lap.png out
-check "lapped non-manifold edge: no --permissive hint (lapped has none)" "no '--permissive'" "$ERR" \
+check "lapped zero-area face: no --permissive hint (the paste refuses such faces too)" "no '--permissive'" "$ERR" \
     "$(! printf '%s' "$ERR" | grep -q -- '--permissive'; echo $?)"
+expect_error "lapped non-manifold edge" lapped ../in/nonmanifold.obj ../in/lap.png out
+check "lapped non-manifold edge: suggests --permissive" "'--permissive cuts it open'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -q -- '--permissive cuts it open'; echo $?)"
+for arg in -1 abc 9 ''; do
+    expect_error "lapped --subdivide '$arg'" lapped ../in/torus.obj ../in/lap.png out --subdivide "$arg"
+    check "lapped --subdivide '$arg': says what it wants" "'--subdivide wants an integer from 0 to 8' or 'needs a value'" \
+        "$ERR" "$(printf '%s' "$ERR" | grep -qE -- '--subdivide (wants an integer from 0 to 8, got|needs a value)'; echo $?)"
+done
+expect_error "lapped --subdivide without a value" lapped ../in/torus.obj ../in/lap.png out --subdivide
+expect_error "lapped --subdivide 8: too many quads" lapped ../in/torus.obj ../in/lap.png out --subdivide 8
+err_mentions "lapped --subdivide 8: says the limit" 'would make .* quads; the limit is'
+
+# --permissive: an edge shared by three faces, as triangulated exports have
+# (the torus with a fin on its edge 1-2), is cut open
+{ cat "$W/in/torus.obj"; printf 'v 0 0 3\nf 1 2 513\n'; } >"$W/in/torus_fin.obj"
+expect_error "lapped edge shared by three faces" lapped ../in/torus_fin.obj ../in/lap.png out --scale 1.5
+check "lapped edge shared by three faces: one line naming the edge and suggesting --permissive" \
+    "'torus_fin.obj:LINE: the edge between vertices 2 and 1 is shared by more than two faces ...; --permissive cuts it open'" \
+    "$ERR" "$(printf '%s' "$ERR" | grep -qE 'torus_fin\.obj:[0-9]+: the edge between vertices [0-9]+ and [0-9]+ is shared by more than two faces.*--permissive cuts it open'; echo $?)"
+lapped_case "edge shared by three faces --permissive" torus_fin.obj --scale 1.5 --permissive
+check "lapped --permissive: says it cut the edge open" "'--permissive cut 1 non-manifold or mis-oriented edge open'" \
+    "$ERR" "$(printf '%s' "$ERR" | grep -q 'torus_fin\.obj: --permissive cut 1 non-manifold or mis-oriented edge open'; echo $?)"
+newdir
+expect_ok "lapped three triangles on one edge --permissive" lapped ../in/nonmanifold.obj ../in/lap.png out --permissive
+expect_ok "lapped flipped face --permissive" lapped ../in/cube_flipped.obj ../in/lap.png out --permissive --subdivide 1
+cd "$W" || exit 1
+
+# --subdivide L: each triangle quadrangulated L times, each quad split in two
+# lapped_triangles OUT -> "distinct vertices": how many distinct triangles
+# (by their vertex sets) the pastes draw, and the v lines
+lapped_triangles() {
+    awk '$1 == "v" { nv++ }
+         $1 == "f" { for (i = 2; i <= 4; i++) { split($i, p, "/"); c[i] = p[1] + 0 }
+                     if (c[2] > c[3]) { t = c[2]; c[2] = c[3]; c[3] = t }
+                     if (c[3] > c[4]) { t = c[3]; c[3] = c[4]; c[4] = t }
+                     if (c[2] > c[3]) { t = c[2]; c[2] = c[3]; c[3] = t }
+                     k = c[2] " " c[3] " " c[4]; if (!(k in seen)) { seen[k] = 1; n++ } }
+         END { printf "%d %d\n", n, nv }' "$1" 2>/dev/null
+}
+newdir
+expect_ok "lapped --subdivide 1" lapped ../in/spheretri.obj ../in/lap.png out --scale 0.9 --subdivide 1
+check "lapped --subdivide 1: 6 triangles per triangle" "'7680 triangles (1280 faces, --subdivide 1)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '7680 triangles (1280 faces, --subdivide 1)'; echo $?)"
+check "lapped --subdivide 1: coverage 100.0%" "'coverage 100.0%'" "$OUT" "$(printf '%s' "$OUT" | grep -q 'coverage 100\.0%'; echo $?)"
+read -r triangles verts <<<"$(lapped_triangles out.obj)"
+# 642 vertices + 1920 edge points + 1280 face points
+check "lapped --subdivide 1: the pastes draw the 7680 triangles over 3842 vertices" "7680 3842" \
+    "$triangles $verts" "$([ "$triangles $verts" = "7680 3842" ]; echo $?)"
+expect_ok "lapped --subdivide 2" lapped ../in/spheretri.obj ../in/lap.png two --scale 0.9 --subdivide 2
+check "lapped --subdivide 2: 24 triangles per triangle" "'30720 triangles (1280 faces, --subdivide 2)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '30720 triangles (1280 faces, --subdivide 2)'; echo $?)"
+expect_ok "lapped --subdivide 1 --smooth" lapped ../in/spheretri.obj ../in/lap.png smooth --scale 0.9 --subdivide 1 --smooth
+check "lapped --smooth: other positions than the linear subdivision" "v lines differ" "identical" \
+    "$(! cmp -s <(grep '^v ' out.obj) <(grep '^v ' smooth.obj); echo $?)"
+expect_ok "lapped --subdivide 0: as without it" lapped ../in/spheretri.obj ../in/lap.png zero --scale 0.9 --subdivide 0
+check "lapped --subdivide 0: 1280 triangles" "'1280 triangles,'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '1280 triangles,'; echo $?)"
+expect_ok "lapped --subdivide 1 --constraints (faces of the OBJ)" lapped ../in/pair.obj ../in/lap.png pair \
+    --scale 1.5 --subdivide 1 --constraints ../in/constraints.txt
+expect_error "lapped --subdivide 1 --constraints face out of range" lapped ../in/torus.obj ../in/lap.png out \
+    --subdivide 1 --constraints ../in/constraints_range.txt
+err_mentions "lapped --subdivide constraint out of range: counts the OBJ's faces" 'constraints_range\.txt:2:.*1 to 512'
+newdir
+expect_ok "tile for lapped --subdivide --bake" tile ../in/torus.obj ../in/lap.png t --tile 16
+expect_ok "lapped --subdivide 1 --bake over the OBJ's own vt" lapped t.obj ../in/lap.png own --scale 1.5 --subdivide 1 \
+    --bake 256
+check "lapped --subdivide --bake over own vt: says so" "'over the OBJ's texture coordinates'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q "over the OBJ's texture coordinates"; echo $?)"
+read -r corners nvt nonquad badc baduv nf <<<"$(obj_report own_baked.obj)"
+check "lapped --subdivide --bake: one vt in [0,1] per corner of 6144 triangles" "18432 18432 0 0" \
+    "$corners corners, $nvt vt, $badc bad corners, $baduv bad vt" \
+    "$([ "${corners:-0}" = 18432 ] && [ "${nvt:-0}" = 18432 ] && [ "${badc:-1}" = 0 ] && [ "${baduv:-1}" = 0 ]; echo $?)"
+check "lapped --subdivide --bake: the OBJ's vt are still there (the corners keep theirs)" "every vt of t.obj" \
+    "$(comm -23 <(grep '^vt' t.obj | sort -u) <(grep '^vt' own_baked.obj | sort -u) | head -3)" \
+    "$([ -z "$(comm -23 <(grep '^vt' t.obj | sort -u) <(grep '^vt' own_baked.obj | sort -u))" ]; echo $?)"
+cd "$W" || exit 1
+
+# an absolute OUT_PREFIX: the OBJ names the MTL, the MTL the texture, by file
+# name, so the folder can move; render the moved OBJ with the texture its MTL names
+newdir
+mkdir -p assets elsewhere pc
+expect_ok "lapped into an absolute OUT_PREFIX" lapped ../in/torus.obj ../in/lap.png "$PWD/assets/out" --scale 1.5 \
+    --bake 256
+check "lapped absolute OUT_PREFIX: mtllib lines name the MTL files by name" "mtllib out.mtl, mtllib out_baked.mtl" \
+    "$(grep -h '^mtllib' assets/out.obj assets/out_baked.obj 2>&1)" \
+    "$(grep -qx 'mtllib out.mtl' assets/out.obj && grep -qx 'mtllib out_baked.mtl' assets/out_baked.obj; echo $?)"
+check "lapped absolute OUT_PREFIX: map_ lines name the textures by name" \
+    "map_Kd/map_d out_patch.png, map_Kd out_baked.png, no '/'" "$(grep -h '^map_' assets/out.mtl assets/out_baked.mtl 2>&1)" \
+    "$(grep -qx 'map_Kd out_patch.png' assets/out.mtl && grep -qx 'map_d out_patch.png' assets/out.mtl &&
+        grep -qx 'map_Kd out_baked.png' assets/out_baked.mtl && ! grep -h -E '^(mtllib|map_)' assets/*.obj assets/*.mtl | grep -q /
+        echo $?)"
+mv assets elsewhere/moved
+for obj in out out_baked; do
+    mtl=$(awk '$1 == "mtllib" { print $2; exit }' "elsewhere/moved/$obj.obj" 2>/dev/null)
+    texture=$(awk '$1 == "map_Kd" { print $2; exit }' "elsewhere/moved/$mtl" 2>/dev/null)
+    case $texture in /*) ;; *) texture=elsewhere/moved/${texture:-missing} ;; esac
+    expect_ok "render the moved $obj.obj with the texture its MTL names" render "elsewhere/moved/$obj.obj" \
+        "$texture" "$obj.png" --size 64x48
+done
+# the other commands that write an MTL, with absolute paths
+expect_ok "polycube into an absolute OUT_PREFIX" polycube ../in/spheretri.obj ../in/tex.png "$PWD/pc/out" --tile 16 \
+    --colors 1 --resolution 6
+check "polycube absolute OUT_PREFIX: map_Kd out.png, mtllib out.mtl twice" "no '/' in map_Kd and mtllib lines" \
+    "$(grep -h -E '^(map_|mtllib)' pc/out.mtl pc/out.obj pc/out_polycube.obj 2>&1)" \
+    "$(grep -qx 'map_Kd out.png' pc/out.mtl && grep -qx 'mtllib out.mtl' pc/out.obj &&
+        grep -qx 'mtllib out.mtl' pc/out_polycube.obj; echo $?)"
+expect_ok "tile for map --atlas with absolute paths" tile ../in/torus.obj ../in/tex.png "$PWD/pc/t" --tile 16
+expect_ok "map --atlas with absolute paths" map ../in/torus.obj "$PWD/pc/m.obj" --tile 16 --atlas "$PWD/pc/t.png"
+check "map --atlas absolute paths: map_Kd t.png, mtllib m.mtl" "map_Kd t.png, mtllib m.mtl" \
+    "$(grep -h -E '^(map_|mtllib)' pc/m.mtl pc/m.obj 2>&1)" \
+    "$(grep -qx 'map_Kd t.png' pc/m.mtl && grep -qx 'mtllib m.mtl' pc/m.obj; echo $?)"
+cd "$W" || exit 1
 
 # ======================================================================
 # Hierarchical pattern mapping
@@ -805,6 +916,13 @@ cd run || exit 1
 expect_ok "hpm into ../sub from another directory" hpm ../../in/torus.obj ../images/stones.png ../sub/up --rotations 3
 check "hpm into ../sub: map_Kd finds the image from sub/" "map_Kd ../images/stones.png" "$(grep map_Kd ../sub/up.mtl 2>&1)" \
     "$(grep -qE '^map_Kd +\.\./images/stones\.png$' ../sub/up.mtl 2>/dev/null; echo $?)"
+cd .. || exit 1
+# absolute paths too: relative to the MTL, so sub/ and images/ can move together
+expect_ok "hpm with an absolute IMAGE and OUT_PREFIX" hpm ../in/torus.obj "$PWD/images/stones.png" "$PWD/sub/abs" \
+    --rotations 3
+check "hpm absolute paths: map_Kd ../images/stones.png, mtllib abs.mtl" "map_Kd ../images/stones.png, mtllib abs.mtl" \
+    "$(grep -h -E '^(map_Kd|mtllib)' sub/abs.mtl sub/abs.obj 2>&1)" \
+    "$(grep -qx 'map_Kd ../images/stones.png' sub/abs.mtl 2>/dev/null && grep -qx 'mtllib abs.mtl' sub/abs.obj; echo $?)"
 cd "$W" || exit 1
 
 # bad inputs: one line, non-zero exit, no files
