@@ -1581,6 +1581,9 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
 #define TT_LAPPED_MAX_DISTORTION 20.0f
 /* A sample counts as covered under an alpha of at least this. */
 #define TT_LAPPED_OPAQUE 0.99f
+/* tt_lapped.visible_cuts: a paste that stops at an edge with at least this
+   alpha there shows a hard edge. */
+#define TT_LAPPED_VISIBLE_CUT 0.25f
 /* options->max_pastes = 0: this cap (a few minutes of work). */
 #define TT_LAPPED_MAX_PASTES 200000
 /* Pastes take about this many times the surface area over the patch's
@@ -1624,6 +1627,9 @@ typedef struct tt_lapped {
     double mean_angle_error;    /* degrees, mean over entries of the angle between phi(T_f) and (0,1)
                                    (isotropic: against each paste's propagated direction) */
     double median_scale_error;  /* median over entries of | |phi(T_f)| - 1 | */
+    int top_changes;            /* interior edges whose two faces show different pastes on top */
+    int visible_cuts;           /* of those, the ones where the upper paste stops while still at least
+                                   TT_LAPPED_VISIBLE_CUT opaque along the edge: a hard edge (target 0) */
     tt_allocator allocator;     /* the one it was made with */
 } tt_lapped;
 
@@ -9403,6 +9409,8 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 /* A sample's nearest texel, and the 2 x 2 texels a bilinear lookup reads
    within reach of it, lie within this many texels of the sample. */
 #define TT__LAPPED_TEXEL_REACH 2.2
+/* Points along an edge where a paste's alpha is probed, less one. */
+#define TT__LAPPED_CUT_PROBES 4
 /* Vertices of a patch's conservative hull (Sec. 3.3, Fig. 4). */
 #define TT__LAPPED_HULL_VERTICES 32
 /* Grow-and-solve rounds per paste (Sec. 3.3: "when this occurs, we further
@@ -9866,6 +9874,22 @@ static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, 
     return added;
 }
 
+/* The paste's alpha along the segment from uv a to uv b: the largest of
+   TT__LAPPED_CUT_PROBES + 1 bilinear lookups, clamped at the patch's border
+   as pastes are drawn. */
+static float tt__paste_alpha_along(const tt_image *patch, const float a[2], const float b[2])
+{
+    float most = 0.0f;
+    int i;
+    for (i = 0; i <= TT__LAPPED_CUT_PROBES; i++) {
+        const float t = (float)i / TT__LAPPED_CUT_PROBES, u = a[0] + t * (b[0] - a[0]), v = a[1] + t * (b[1] - a[1]);
+        float rgba[4];
+        tt_image_sample_bilinear(patch, u * patch->width, (1.0f - v) * patch->height, rgba);
+        if (rgba[3] > most) most = rgba[3];
+    }
+    return most;
+}
+
 /* Face f got `count` more covered samples; a face now fully covered leaves
    the list seed points are drawn from. Returns count. */
 static int tt__count_covered(tt__lapper *L, int f, int count)
@@ -10266,6 +10290,35 @@ static int tt__remove_hidden(tt__lapper *L)
     return removed;
 }
 
+/* The edges where the paste on top changes, and of those the cuts: the
+   upper of the two pastes (absent from the other face) still at least
+   TT_LAPPED_VISIBLE_CUT opaque along the edge. 0 when out of memory. */
+static int tt__lapped_count_cuts(const tt__lapper *L, tt_lapped *out)
+{
+    const tt_mesh *mesh = L->mesh;
+    int *top = TT__ALLOC(L->al, int, mesh->nfaces), e, c;
+    if (!top) return 0;
+    for (c = 0; c < mesh->nfaces; c++) top[c] = -1;
+    for (e = 0; e < L->nentries; e++)
+        if (L->entries[e].face >= 0) top[L->entries[e].face] = e;
+    out->top_changes = out->visible_cuts = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        const int t = mesh->twin[c];
+        const tt__entry *upper;
+        int corner, ef, eg;
+        if (t < c || (ef = top[c / 3]) < 0 || (eg = top[t / 3]) < 0 || L->entries[ef].paste == L->entries[eg].paste)
+            continue;
+        out->top_changes++;
+        upper = L->entries[ef].paste > L->entries[eg].paste ? &L->entries[ef] : &L->entries[eg];
+        corner = upper == &L->entries[ef] ? c % 3 : t % 3;
+        if (tt__paste_alpha_along(L->patches[L->paste_patch[upper->paste]], upper->uv + 2 * corner,
+                                  upper->uv + 2 * ((corner + 1) % 3)) >= TT_LAPPED_VISIBLE_CUT)
+            out->visible_cuts++;
+    }
+    tt__free(L->al, top);
+    return 1;
+}
+
 /* Move the surviving entries into the result, pastes that lost every face
    dropped. */
 static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
@@ -10307,7 +10360,7 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
     out->mean_angle_error = n > 0 ? angle_sum / n : 0.0;
     out->median_scale_error = tt__median(scales, n);
     tt__free(L->al, scales);
-    return TT_OK;
+    return tt__lapped_count_cuts(L, out) ? TT_OK : TT_ERROR_OUT_OF_MEMORY;
 }
 
 TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, tt_image *const *patches,

@@ -86,8 +86,9 @@ static void print_help(void)
            "                       faces, as some exports have): they are cut open into boundaries\n"
            "\n"
            "Prints the number of pastes, the coverage, how often a face is drawn (overdraw), how\n"
-           "well the texture follows the field (angle and scale error) and how many face entries\n"
-           "hidden by later pastes were dropped.\n"
+           "well the texture follows the field (angle and scale error), the hard edges (where the\n"
+           "paste on top stops while still at least 25%% opaque) and how many face entries hidden\n"
+           "by later pastes were dropped.\n"
            "\n"
            "example: tiledtex generate mesh torus.obj --shape torus\n"
            "         tiledtex generate texture stones.png --size 128\n"
@@ -541,6 +542,8 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
            lapped->mean_overdraw);
     printf("alignment: mean angle error %.1f degrees, median scale error %.1f%%%s\n", angle, 100.0 * scale,
            options->isotropic ? " (isotropic: against each paste's own direction)" : "");
+    printf("cuts: %d of %d edges where the top paste changes end it at %.0f%% alpha or more\n", lapped->visible_cuts,
+           lapped->top_changes, 100.0 * TT_LAPPED_VISIBLE_CUT);
     printf("removed %d hidden face entries; %.1f s\n", lapped->removed_entries, seconds);
 }
 

@@ -1361,6 +1361,84 @@ static int lapped_run(const tmesh *m, int isotropic, uint64_t seed, float scale,
     return r == TT_OK && *out ? 0 : -1;
 }
 
+/* tt_lapped.top_changes and visible_cuts recomputed from the output alone:
+   the last entry of each face is on top; across an edge whose tops are two
+   pastes, the later one stops there, and it is a cut when its alpha at one
+   of 5 even points along the edge (clamped lookups) reaches
+   TT_LAPPED_VISIBLE_CUT. */
+static void lapped_count_cuts(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches, int *changes,
+                              int *cuts)
+{
+    int *top = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces), *paste_of = (int *)malloc(sizeof(int) *
+                                                                                               (size_t)(lapped->nentries + 1));
+    int p, e, c;
+    for (c = 0; c < mesh->nfaces; c++) top[c] = -1;
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) {
+            paste_of[e] = p;
+            top[lapped->faces[e]] = e;
+        }
+    *changes = *cuts = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], ef, eg, upper, corner, i;
+        float most = 0.0f;
+        if (t < c || (ef = top[c / 3]) < 0 || (eg = top[t / 3]) < 0 || paste_of[ef] == paste_of[eg]) continue;
+        (*changes)++;
+        upper = paste_of[ef] > paste_of[eg] ? ef : eg;
+        corner = upper == ef ? c % 3 : t % 3;
+        for (i = 0; i <= 4; i++) {
+            const float *a = lapped->uv + 6 * (size_t)upper + 2 * corner, *b = lapped->uv + 6 * (size_t)upper + 2 * ((corner + 1) % 3);
+            const tt_image *im = patches[lapped->pastes[paste_of[upper]].patch];
+            float u = a[0] + 0.25f * i * (b[0] - a[0]), v = a[1] + 0.25f * i * (b[1] - a[1]), rgba[4];
+            tt_image_sample_bilinear(im, u * im->width, (1.0f - v) * im->height, rgba);
+            if (rgba[3] > most) most = rgba[3];
+        }
+        *cuts += most >= TT_LAPPED_VISIBLE_CUT;
+    }
+    free(top);
+    free(paste_of);
+}
+
+/* The hard edges counted: against the recount from the output, and a
+   fully opaque patch (every paste ends at a cut; the control) against the
+   soft splotch on the same sphere. */
+static void test_lapped_cuts(void)
+{
+    tt_image *patch = lapped_patch(64, 5), *opaque = lapped_patch(64, 5);
+    int which, fraction_ok = 1;
+    double fractions[2] = {0.0, 0.0};
+    size_t i;
+    for (i = 0; opaque && i < (size_t)opaque->width * opaque->height; i++) opaque->pixels[4 * i + 3] = 1.0f;
+    for (which = 0; which < 2 && patch && opaque; which++) {
+        tmesh m;
+        tt_mesh *mesh;
+        float *field;
+        tt_lapped *lapped = NULL;
+        tt_image *used = which ? opaque : patch;
+        int changes, cuts;
+        make_lapped_shape(&m, 0);
+        if (lapped_run(&m, 0, 11, 0.0f, &mesh, &field, used, &lapped) == 0) {
+            lapped_count_cuts(mesh, lapped, &used, &changes, &cuts);
+            CHECK(changes == lapped->top_changes && cuts == lapped->visible_cuts,
+                  "%s patch: %d of %d edges cuts, recounted from the output %d of %d", which ? "opaque" : "splotch",
+                  lapped->visible_cuts, lapped->top_changes, cuts, changes);
+            fractions[which] = changes ? (double)cuts / changes : 0.0;
+            fraction_ok &= changes > 0;
+            tt_lapped_free(lapped);
+        }
+        tt_mesh_free(mesh);
+        free(field);
+        tm_free(&m);
+    }
+    CHECK(fraction_ok && fractions[1] >= 0.9 && fractions[0] <= 0.5 * fractions[1],
+          "cuts among the edges where the top paste changes: %.2f with the soft splotch, %.2f with an opaque patch "
+          "(the control: every paste ends at a cut)", fractions[0], fractions[1]);
+    printf("     hard edges on a sphere: %.0f%% of the top paste's changes with the soft splotch, %.0f%% with an "
+           "opaque patch\n", 100.0 * fractions[0], 100.0 * fractions[1]);
+    tt_image_free(patch);
+    tt_image_free(opaque);
+}
+
 static void test_lapped_cover(void)
 {
     tt_image *patch;
@@ -3638,6 +3716,7 @@ void run_lapped_tests(void)
     RUN(test_patch_oom);
     RUN(test_lapped_plane);
     RUN(test_lapped_cover);
+    RUN(test_lapped_cuts);
     RUN(test_lapped_determinism);
     RUN(test_lapped_patches);
     RUN(test_lapped_errors);
