@@ -435,15 +435,32 @@ static int add_png(tool_output *output, const char *path, tt_image *image)
     return status != 0 ? tool_fail("%s", message) : 0;
 }
 
-/* --bake: texture coordinates per triangle corner, the OBJ's own when every
-   corner has one, else an atlas of triangle pairs; the pastes composited
-   into a size x size texture over them; an ordinary OBJ + MTL + PNG. */
+/* --bake's texture coordinates per triangle corner: the OBJ's own when every
+   corner has one, else an atlas of triangle pairs. Made before anything is
+   pasted, so a size too small for the mesh is said at once. */
+static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float **corner_uv, int *own_uvs)
+{
+    const size_t ncorners = 3 * (size_t)m->ntriangles;
+    tt_error error;
+    *own_uvs = m->corner_uv != NULL;
+    *corner_uv = (float *)malloc(ncorners * 2 * sizeof(float));
+    if (!*corner_uv) return tool_fail("out of memory for the texture coordinates of %s", options->mesh_path);
+    if (*own_uvs) {
+        memcpy(*corner_uv, m->corner_uv, ncorners * 2 * sizeof(float));
+    } else if (tt_atlas_pack_pairs(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, *corner_uv, &error) != TT_OK) {
+        free(*corner_uv);
+        *corner_uv = NULL;
+        return tool_fail("--bake %d: %s", options->bake_size, error.message);
+    }
+    return 0;
+}
+
+/* --bake: the pastes composited into a size x size texture over corner_uv
+   (from bake_uvs; freed here); an ordinary OBJ + MTL + PNG. */
 static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
-                     const tt_lapped *lapped, tt_image *patch, int *own_uvs)
+                     const tt_lapped *lapped, tt_image *patch, float *corner_uv)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
-    size_t ncorners = 3 * (size_t)m->ntriangles;
-    float *corner_uv = (float *)malloc(ncorners * 2 * sizeof(float));
     tt_image *atlas = NULL;
     tt_bake_options bake;
     tt_error error;
@@ -453,15 +470,6 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     snprintf(obj_path, sizeof obj_path, "%s_baked.obj", options->prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s_baked.mtl", options->prefix);
     snprintf(png_path, sizeof png_path, "%s_baked.png", options->prefix);
-    if (!corner_uv) return tool_fail("out of memory for the texture coordinates of %s", obj_path);
-
-    *own_uvs = m->corner_uv != NULL;
-    if (*own_uvs) {
-        memcpy(corner_uv, m->corner_uv, ncorners * 2 * sizeof(float));
-    } else if (tt_atlas_pack_pairs(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, corner_uv, &error) != TT_OK) {
-        status = tool_fail("--bake %d: %s", options->bake_size, error.message);
-        goto done;
-    }
     if (tt_image_create(options->bake_size, options->bake_size, NULL, &atlas, &error) != TT_OK) {
         status = tool_fail("--bake %d: %s", options->bake_size, error.message);
         goto done;
@@ -571,7 +579,7 @@ int cmd_lapped(int argc, char **argv)
     tt_image *image = NULL, *patch = NULL;
     tt_lapped *lapped = NULL;
     tool_output output;
-    float *field = NULL;
+    float *field = NULL, *bake_uv = NULL;
     char obj_path[4096], mtl_path[4096], png_path[4096], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
     int status, own_uvs = 0;
@@ -591,6 +599,7 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
     if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, png_path);
+    if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &own_uvs);
     if (status == 0) status = make_patch(&options, image, &patch);
     /* Memory: the image is needed only to make the patch and its PNG, so the
        PNG is encoded now and the image freed before the paste loop; from
@@ -602,7 +611,10 @@ int cmd_lapped(int argc, char **argv)
 
     if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped);
     if (status == 0) status = output_add_mtl(&output, mtl_path, "lapped", png_path, 1);
-    if (status == 0 && options.bake_size > 0) status = add_baked(&output, &options, &mesh, lapped, patch, &own_uvs);
+    if (status == 0 && options.bake_size > 0) {
+        status = add_baked(&output, &options, &mesh, lapped, patch, bake_uv);
+        bake_uv = NULL;   /* add_baked freed it */
+    }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0) {
@@ -618,6 +630,7 @@ int cmd_lapped(int argc, char **argv)
     tt_image_free(patch);
     image_free(image);
     free(field);
+    free(bake_uv);
     triangle_mesh_free(&mesh);
     return status;
 }

@@ -683,6 +683,7 @@ expect_error "lapped --constraints missing file" lapped ../in/torus.obj ../in/la
 expect_error "lapped --bake 0" lapped ../in/torus.obj ../in/lap.png out --bake 0
 expect_error "lapped --bake 100000" lapped ../in/torus.obj ../in/lap.png out --bake 100000
 expect_error "lapped --bake too small for the atlas" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --bake 16
+err_mentions "lapped --bake too small: says the size" 'bake 16: .*the smallest size that works is'
 expect_error "lapped --up 0,0,0" lapped ../in/torus.obj ../in/lap.png out --up 0,0,0
 expect_error "lapped zero-area face" lapped ../in/lapped_degenerate.obj ../in/lap.png out
 err_mentions "lapped zero-area face: FILE:LINE and face 1" 'lapped_degenerate\.obj:5: face 1 '
