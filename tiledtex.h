@@ -1568,10 +1568,13 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    already in the patch, projected on its plane; only |T_f| is used.
 
    Hard edges: where growth stops (a disc would close, or distortion), the
-   paste ends at a mesh edge without its soft falloff; later pastes usually
-   cover such places (Sec. 3.3 finds them "less objectionable than distorted
-   texture"). A patch may fold over itself in texture space (allowed by the
-   paper); coverage is still counted per face, correctly. */
+   paste ends at a mesh edge without its soft falloff; later pastes cover
+   some of those places (Sec. 3.3 finds them "less objectionable than
+   distorted texture"). tt_lapped.visible_cuts counts the ones left on top:
+   5 % of the edges where the paste on top changes on a sphere, 17 % on the
+   bunny, half on the elephant, nearly all refused for distortion. A patch
+   may fold over itself in texture space (allowed by the paper); coverage
+   is still counted per face, correctly. */
 
 /* Growth does not cross into a face whose predicted map turns T_f by more
    than this many degrees, or scales it by more than 1 + this / 90 or less
