@@ -1591,8 +1591,38 @@ static void test_lapped_determinism(void)
     tt_image_free(patch);
 }
 
-/* Several texture patches: each paste picks one at random, all get used,
-   and the mesh is covered with the right patch's alpha. */
+/* Across the edges where the paste on top changes, how often both sides
+   show the same patch; *random gets what random picks would give (the sum
+   of the patches' squared shares of the pastes, times the edges). */
+static int lapped_same_patch_edges(const tt_mesh *mesh, const tt_lapped *out, int npatches, int *changes,
+                                   double *random)
+{
+    int *top = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces), *used = (int *)calloc((size_t)npatches, sizeof(int));
+    int f, p, e, c, same = 0;
+    for (f = 0; f < mesh->nfaces; f++) top[f] = -1;
+    for (p = 0; p < out->npastes; p++) {
+        used[out->pastes[p].patch]++;
+        for (e = out->pastes[p].first; e < out->pastes[p].first + out->pastes[p].nfaces; e++) top[out->faces[e]] = p;
+    }
+    *changes = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], a, b;
+        if (t < c || (a = top[mesh->corner_face[c]]) < 0 || (b = top[mesh->corner_face[t]]) < 0 || a == b) continue;
+        (*changes)++;
+        same += out->pastes[a].patch == out->pastes[b].patch;
+    }
+    *random = 0.0;
+    for (p = 0; p < npatches; p++) *random += ((double)used[p] / out->npastes) * ((double)used[p] / out->npastes);
+    *random *= *changes;
+    free(top);
+    free(used);
+    return same;
+}
+
+/* Several texture patches: all get used, the mesh is covered with the
+   right patch's alpha, and a paste avoids the patches around its seed:
+   across the edges where the paste on top changes, both sides show the same
+   patch less often than random picks would (the control). */
 static void test_lapped_patches(void)
 {
     tmesh m;
@@ -1628,6 +1658,64 @@ static void test_lapped_patches(void)
             if (lapped_alpha_at(out, patches, f, w) < 0.98) bad++;
         }
         CHECK(bad == 0, "three patches: %d face centres not opaque", bad);
+        {
+            int changes = 0, same;
+            double random = 0.0;
+            same = lapped_same_patch_edges(mesh, out, 3, &changes, &random);
+            CHECK(changes > 0 && same <= 0.85 * random, "three patches: %d of %d edges where the paste on top changes "
+                  "show one patch on both sides (random picks: about %.0f)", same, changes, random);
+            printf("     three patches of three masks: one patch on both sides of %d of %d top changes (random: "
+                   "about %.0f)\n", same, changes, random);
+        }
+    }
+    tt_lapped_free(out);
+    for (p = 0; p < 3; p++) tt_image_free(patches[p]);
+    tt_mesh_free(mesh);
+    free(field);
+    tm_free(&m);
+}
+
+/* Patches of one mask (windows of one photo, as the tool cuts them) are
+   interchangeable once a paste's faces are known: each paste takes the one
+   its faces show least, so neighbours rarely share a patch; against the
+   random pick as control. */
+static void test_lapped_patch_twins(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options fo;
+    tt_lapped_options lo;
+    tt_lapped *out = NULL;
+    tt_error err;
+    tt_image *patches[3] = {NULL, NULL, NULL};
+    float *field;
+    int p, changes = 0, same;
+    double random = 0.0;
+    size_t i;
+    make_lapped_shape(&m, 0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
+    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&fo, 0, sizeof fo);
+    tt_tangent_field(mesh, &fo, NULL, field, &err);
+    patches[0] = lapped_patch(64, 4);
+    for (p = 1; p < 3 && patches[0]; p++) {
+        CHECK(tt_image_create(64, 64, NULL, &patches[p], &err) == TT_OK, "patch copy: %s", err.message);
+        if (!patches[p]) continue;
+        for (i = 0; i < 4 * 64 * 64; i++)
+            patches[p]->pixels[i] = i % 4 == 3 ? patches[0]->pixels[i] : patches[0]->pixels[i] * (float)(1.0 - 0.3 * p);
+    }
+    memset(&lo, 0, sizeof lo);
+    lo.seed = 5;
+    if (patches[1] && patches[2]) {
+        CHECK(tt_lapped_paste(mesh, field, patches, 3, &lo, NULL, &out, &err) == TT_OK && out, "three twins: %s",
+              err.message);
+        if (out) {
+            same = lapped_same_patch_edges(mesh, out, 3, &changes, &random);
+            CHECK(changes > 0 && same <= 0.4 * random, "three patches of one mask: %d of %d edges where the paste "
+                  "on top changes show one patch on both sides (random picks: about %.0f)", same, changes, random);
+            printf("     three patches of one mask: one patch on both sides of %d of %d top changes (random: about "
+                   "%.0f)\n", same, changes, random);
+        }
     }
     tt_lapped_free(out);
     for (p = 0; p < 3; p++) tt_image_free(patches[p]);
@@ -3719,6 +3807,7 @@ void run_lapped_tests(void)
     RUN(test_lapped_cuts);
     RUN(test_lapped_determinism);
     RUN(test_lapped_patches);
+    RUN(test_lapped_patch_twins);
     RUN(test_lapped_errors);
     RUN(test_lapped_oom);
     RUN(test_hull_shapes);
