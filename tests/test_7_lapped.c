@@ -1619,6 +1619,18 @@ static int lapped_same_patch_edges(const tt_mesh *mesh, const tt_lapped *out, in
     return same;
 }
 
+/* At most `share` of the random picks' borders with one patch on both sides. */
+static void check_patch_borders(const tt_mesh *mesh, const tt_lapped *out, int npatches, double share, const char *what)
+{
+    int changes = 0, same;
+    double random = 0.0;
+    same = lapped_same_patch_edges(mesh, out, npatches, &changes, &random);
+    CHECK(changes > 0 && same <= share * random, "%s: %d of %d edges where the paste on top changes show one patch "
+          "on both sides (random picks: about %.0f)", what, same, changes, random);
+    printf("     %s: one patch on both sides of %d of %d top changes (random picks: about %.0f)\n", what, same, changes,
+           random);
+}
+
 /* Several texture patches: all get used, the mesh is covered with the
    right patch's alpha, and a paste avoids the patches around its seed:
    across the edges where the paste on top changes, both sides show the same
@@ -1658,15 +1670,7 @@ static void test_lapped_patches(void)
             if (lapped_alpha_at(out, patches, f, w) < 0.98) bad++;
         }
         CHECK(bad == 0, "three patches: %d face centres not opaque", bad);
-        {
-            int changes = 0, same;
-            double random = 0.0;
-            same = lapped_same_patch_edges(mesh, out, 3, &changes, &random);
-            CHECK(changes > 0 && same <= 0.85 * random, "three patches: %d of %d edges where the paste on top changes "
-                  "show one patch on both sides (random picks: about %.0f)", same, changes, random);
-            printf("     three patches of three masks: one patch on both sides of %d of %d top changes (random: "
-                   "about %.0f)\n", same, changes, random);
-        }
+        check_patch_borders(mesh, out, 3, 0.85, "three patches of three masks");
     }
     tt_lapped_free(out);
     for (p = 0; p < 3; p++) tt_image_free(patches[p]);
@@ -1689,8 +1693,7 @@ static void test_lapped_patch_twins(void)
     tt_error err;
     tt_image *patches[3] = {NULL, NULL, NULL};
     float *field;
-    int p, changes = 0, same;
-    double random = 0.0;
+    int p;
     size_t i;
     make_lapped_shape(&m, 0);
     CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
@@ -1709,13 +1712,7 @@ static void test_lapped_patch_twins(void)
     if (patches[1] && patches[2]) {
         CHECK(tt_lapped_paste(mesh, field, patches, 3, &lo, NULL, &out, &err) == TT_OK && out, "three twins: %s",
               err.message);
-        if (out) {
-            same = lapped_same_patch_edges(mesh, out, 3, &changes, &random);
-            CHECK(changes > 0 && same <= 0.4 * random, "three patches of one mask: %d of %d edges where the paste "
-                  "on top changes show one patch on both sides (random picks: about %.0f)", same, changes, random);
-            printf("     three patches of one mask: one patch on both sides of %d of %d top changes (random: about "
-                   "%.0f)\n", same, changes, random);
-        }
+        if (out) check_patch_borders(mesh, out, 3, 0.4, "three patches of one mask");
     }
     tt_lapped_free(out);
     for (p = 0; p < 3; p++) tt_image_free(patches[p]);
