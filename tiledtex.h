@@ -10281,6 +10281,7 @@ static int tt__pick_patch(tt__lapper *L, int paste, int f)
     const tt_mesh *mesh = L->mesh;
     double centre[3] = {0.0, 0.0, 0.0}, reach;
     int head = 0, tail = 0, i, k, least = INT_MAX, ties = 0, pick;
+    /* One patch: the draw the uniform pick always made, so that seeds give the pastes they gave. */
     if (L->npatches == 1) return (int)tt_rng_below(&L->rng, 1u);
     for (k = 0; k < 3; k++) {
         const float *p = tt__corner_pos(mesh, 3 * f + k);
