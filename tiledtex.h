@@ -577,25 +577,43 @@ typedef struct tt_cg_options {
        log(residual) / log(tolerance). Non-zero return cancels. May be NULL. */
     tt_progress_fn progress;
     void *progress_user_data;
+    int preconditioner;         /* TT_CG_JACOBI (0, the default) or TT_CG_INCOMPLETE_CHOLESKY */
 } tt_cg_options;
+
+/* tt_cg_options.preconditioner. Jacobi (the diagonal) needs no setup. The
+   incomplete Cholesky factor IC(0) (L L^T close to A, L on A's lower
+   pattern) costs one pass to make and about two products with A per step,
+   and takes far fewer steps on mesh matrices (4 times fewer in the lapped
+   textures' alignment solves, for 15 % less time). It needs each row's
+   columns strictly increasing (as tt_sparse_from_triplets makes them); when
+   the factorisation breaks down (a pivot <= 0, possible for some positive
+   definite matrices) the solve uses Jacobi instead and says so in
+   tt_cg_report.preconditioner. */
+#define TT_CG_JACOBI 0
+#define TT_CG_INCOMPLETE_CHOLESKY 1
 
 typedef struct tt_cg_report {
     int iterations;             /* CG steps taken (0 when x0 already solved the system) */
     double residual;            /* |b - A x| / |b| for the x returned, recomputed from A, x, b; 0 when b = 0 */
     int converged;              /* 1 when residual <= tolerance */
+    int preconditioner;         /* the one used (see TT_CG_INCOMPLETE_CHOLESKY) */
 } tt_cg_report;
 
-/* Solve A x = b for a symmetric positive definite n x n A by Jacobi
-   preconditioned conjugate gradients (see the section comment).
+/* Solve A x = b for a symmetric positive definite n x n A by preconditioned
+   conjugate gradients (see the section comment), Jacobi or incomplete
+   Cholesky (options->preconditioner).
      b   n values, read only; must not overlap x. Any finite values: the
          norms are scaled, so b = (1e155, 1) or entries of 1e-200 are solved
          like any other.
      x   n values: in, the initial guess (warm start; zeros if you have none),
          out, the solution. It must be finite.
-     options, allocator (for 5 n scratch doubles), report, error may be NULL
-     (defaults; TT_MALLOC; no report; no details).
+     options, allocator (for 5 n scratch doubles; with incomplete Cholesky
+     n more and the factor, 12 bytes per entry of A's lower triangle and 4
+     per row), report, error may be NULL (defaults; TT_MALLOC; no report; no
+     details).
      report is filled on every return; before any step it reads
-     {0, 0.0, 0} (converged = 1 for b = 0 or an x0 that already solves).
+     {0, 0.0, 0, the preconditioner} (converged = 1 for b = 0 or an x0 that
+     already solves).
    Returns
      TT_OK                          converged: report->residual <= tolerance;
      TT_ERROR_NOT_CONVERGED         max_iterations steps did not get there: x is
@@ -609,7 +627,10 @@ typedef struct tt_cg_report {
                                     iteration;
      TT_ERROR_INVALID_ARGUMENT      NULL pointers, b == x, A not square or its
                                     row_start array inconsistent, negative
-                                    max_iterations or tolerance;
+                                    max_iterations or tolerance, an unknown
+                                    preconditioner, or incomplete Cholesky on
+                                    a row whose columns do not increase
+                                    (error->row);
      TT_ERROR_INDEX_OUT_OF_RANGE    a column index outside the matrix (only
                                     possible in a CSR you filled yourself);
      TT_CANCELLED                   the progress callback asked to stop (x is
@@ -1645,7 +1666,7 @@ typedef struct tt_lapped {
    show least on top (random among equals), so that one part of the photo
    does not land next to itself; patches of one size and alpha (windows of
    one photo under one mask) are interchangeable, and a paste then takes
-   the one the pastes it borders show least (on a sphere, a third as many
+   the one the pastes it borders show least (on a sphere, half as many
    borders with one patch on both sides as random picks give).
    *out_lapped gets the result (free it with tt_lapped_free), NULL on failure.
    Errors:
@@ -5212,17 +5233,150 @@ static tt_result tt__cg_check_matrix(const tt_sparse_matrix *A, double *inv_diag
     return TT_OK;
 }
 
+/* The incomplete Cholesky factor IC(0): row i of L holds A's entries of
+   row i at columns <= i, the diagonal last; L L^T matches A on that
+   pattern. */
+typedef struct tt__ic0 {
+    int *start;                 /* n + 1 */
+    int *col;
+    double *value;
+} tt__ic0;
+
+/* Makes the factor (arrays from the allocator, into *F). Returns 1, 0 when a
+   pivot is not positive (F freed), -1 when out of memory, -2 when row
+   *bad_row's columns do not increase. */
+static int tt__ic0_factor(const tt_sparse_matrix *A, const tt_allocator *allocator, tt__ic0 *F, int *bad_row)
+{
+    const int n = A->rows;
+    int i, k, m = 0;
+    memset(F, 0, sizeof *F);
+    for (i = 0; i < n; i++)
+        for (k = A->row_start[i]; k < A->row_start[i + 1]; k++) {
+            if (k > A->row_start[i] && A->col[k] <= A->col[k - 1]) {
+                *bad_row = i;
+                return -2;
+            }
+            m += A->col[k] <= i;
+        }
+    F->start = TT__ALLOC(allocator, int, (size_t)n + 1);
+    F->col = TT__ALLOC(allocator, int, m > 0 ? m : 1);
+    F->value = TT__ALLOC(allocator, double, m > 0 ? m : 1);
+    if (!F->start || !F->col || !F->value) goto failed;
+    m = 0;
+    for (i = 0; i < n; i++) {
+        F->start[i] = m;
+        for (k = A->row_start[i]; k < A->row_start[i + 1] && A->col[k] <= i; k++) {
+            F->col[m] = A->col[k];
+            F->value[m++] = A->value[k];
+        }
+        /* Every row has its diagonal (tt__cg_check_matrix), last. */
+    }
+    F->start[n] = m;
+    for (i = 0; i < n; i++)
+        for (k = F->start[i]; k < F->start[i + 1]; k++) {
+            const int c = F->col[k];
+            int a = F->start[i], b = F->start[c];
+            double sum = F->value[k];
+            /* sum over the columns j < c that rows i and c both have */
+            while (a < k && b < F->start[c + 1] - 1) {
+                if (F->col[a] == F->col[b]) sum -= F->value[a++] * F->value[b++];
+                else if (F->col[a] < F->col[b]) a++;
+                else b++;
+            }
+            if (c < i) {
+                F->value[k] = sum / F->value[F->start[c + 1] - 1];
+            } else if (sum > 0.0) {
+                F->value[k] = sqrt(sum);
+            } else {
+                tt__free(allocator, F->start);
+                tt__free(allocator, F->col);
+                tt__free(allocator, F->value);
+                memset(F, 0, sizeof *F);
+                return 0;
+            }
+        }
+    return 1;
+failed:
+    tt__free(allocator, F->start);
+    tt__free(allocator, F->col);
+    tt__free(allocator, F->value);
+    memset(F, 0, sizeof *F);
+    return -1;
+}
+
+/* z = (L L^T)^-1 r: forward, then backward (L^T by columns of L's rows). */
+static void tt__ic0_apply(const tt__ic0 *F, int n, const double *TT__RESTRICT r, double *TT__RESTRICT z)
+{
+    int i, k;
+    for (i = 0; i < n; i++) {
+        const int last = F->start[i + 1] - 1;
+        double sum = r[i];
+        for (k = F->start[i]; k < last; k++) sum -= F->value[k] * z[F->col[k]];
+        z[i] = sum / F->value[last];
+    }
+    for (i = n - 1; i >= 0; i--) {
+        const int last = F->start[i + 1] - 1;
+        z[i] /= F->value[last];
+        for (k = F->start[i]; k < last; k++) z[F->col[k]] -= F->value[k] * z[i];
+    }
+}
+
+/* r -= alpha Ap (*rr_out = r . r), z = M^-1 r; returns r . z. */
+static double tt__ic0_update(const tt__ic0 *F, int n, double alpha, double *TT__RESTRICT r,
+                             const double *TT__RESTRICT Ap, double *TT__RESTRICT z, double *rr_out)
+{
+    double rr = 0.0, rz = 0.0;
+    int i;
+    for (i = 0; i < n; i++) {
+        r[i] -= alpha * Ap[i];
+        rr += r[i] * r[i];
+    }
+    tt__ic0_apply(F, n, r, z);
+    for (i = 0; i < n; i++) rz += r[i] * z[i];
+    *rr_out = rr;
+    return rz;
+}
+
+/* x += alpha p with the old direction, then p = z + beta p. */
+static void tt__ic0_direction(int n, double alpha, double beta, const double *TT__RESTRICT z, double *TT__RESTRICT p,
+                              double *TT__RESTRICT x)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        x[i] += alpha * p[i];
+        p[i] = z[i] + beta * p[i];
+    }
+}
+
+/* p = z = M^-1 r; returns r . z. */
+static double tt__ic0_restart(const tt__ic0 *F, int n, const double *TT__RESTRICT r, double *TT__RESTRICT z,
+                              double *TT__RESTRICT p)
+{
+    double rz = 0.0;
+    int i;
+    tt__ic0_apply(F, n, r, z);
+    for (i = 0; i < n; i++) {
+        p[i] = z[i];
+        rz += r[i] * z[i];
+    }
+    return rz;
+}
+
 TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const tt_cg_options *options,
                             const tt_allocator *allocator, double *x, tt_cg_report *report, tt_error *error)
 {
     tt_cg_options opt;
     tt_cg_report rep;
     tt_result result = TT_OK;
-    double *block, *r, *p, *Ap, *inv_diag, *b;
+    double *block, *r, *p, *Ap, *inv_diag, *b, *z = NULL;
+    tt__ic0 factor;
+    int ic = 0;
     double bb = 0.0, b_max = 0.0, norm_b, limit, rr, rz, shown = 0.0;
     int i, n, max_iterations, r_is_true, b_exponent = 0;
 
     memset(&rep, 0, sizeof rep);
+    memset(&factor, 0, sizeof factor);
+    if (options) rep.preconditioner = options->preconditioner;
     if (report) *report = rep;
     tt__ok(error);
     if (options) opt = *options;
@@ -5238,6 +5392,9 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "max_iterations %d and tolerance %g: neither may be negative (0 = default)", opt.max_iterations,
                         opt.tolerance);
+    if (opt.preconditioner != TT_CG_JACOBI && opt.preconditioner != TT_CG_INCOMPLETE_CHOLESKY)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "preconditioner %d: use TT_CG_JACOBI (0) or TT_CG_INCOMPLETE_CHOLESKY (1)", opt.preconditioner);
     if (A->rows != A->cols || A->rows < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the matrix is %d x %d; conjugate gradients need a square matrix", A->rows, A->cols);
@@ -5248,10 +5405,10 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
 
     /* One block for the whole solve: r, p, Ap, the inverse diagonal and b
        scaled (below). */
-    if (!tt__size_fits((size_t)n, 5 * sizeof(double)))
+    if (!tt__size_fits((size_t)n, 6 * sizeof(double)))
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "%d unknowns need more bytes than size_t can count",
                         n);
-    block = TT__ALLOC(allocator, double, (size_t)n * 5);
+    block = TT__ALLOC(allocator, double, (size_t)n * (opt.preconditioner == TT_CG_INCOMPLETE_CHOLESKY ? 6 : 5));
     if (!block)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for %d unknowns", n);
     r = block;
@@ -5261,6 +5418,23 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
     b = inv_diag + n;
 
     if ((result = tt__cg_check_matrix(A, inv_diag, error)) != TT_OK) goto done;
+    if (opt.preconditioner == TT_CG_INCOMPLETE_CHOLESKY) {
+        int bad_row = -1, made = tt__ic0_factor(A, allocator, &factor, &bad_row);
+        if (made == -1) {
+            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                              "out of memory for the incomplete Cholesky factor of %d unknowns", n);
+            goto done;
+        }
+        if (made == -2) {
+            result = tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, bad_row, -1,
+                                 "row %d's columns do not increase: incomplete Cholesky needs them strictly "
+                                 "increasing (as tt_sparse_from_triplets makes them)", bad_row);
+            goto done;
+        }
+        ic = made == 1;
+        z = b + n;
+        rep.preconditioner = ic ? TT_CG_INCOMPLETE_CHOLESKY : TT_CG_JACOBI;   /* a pivot <= 0: Jacobi */
+    }
     for (i = 0; i < n; i++) {
         if (!tt__is_finite_d(b_in[i])) {
             result = tt__fail_at(error, TT_ERROR_NON_FINITE, -1, i, -1, "the right-hand side b[%d] is %g", i, b_in[i]);
@@ -5293,7 +5467,7 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
 
     rr = tt__cg_residual(A, b, x, r);
     r_is_true = 1;
-    rz = tt__cg_restart(n, r, inv_diag, p);
+    rz = ic ? tt__ic0_restart(&factor, n, r, z, p) : tt__cg_restart(n, r, inv_diag, p);
     for (;;) {
         double pAp, alpha, rz_next;
         if (sqrt(rr) <= limit) {
@@ -5308,7 +5482,7 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
                 rep.converged = 1;
                 break;
             }
-            rz = tt__cg_restart(n, r, inv_diag, p);
+            rz = ic ? tt__ic0_restart(&factor, n, r, z, p) : tt__cg_restart(n, r, inv_diag, p);
         }
         if (rep.iterations >= max_iterations) {
             result = TT_ERROR_NOT_CONVERGED;   /* the message, with the final residual, below */
@@ -5341,14 +5515,15 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
             break;
         }
         alpha = rz / pAp;
-        rz_next = tt__cg_update(n, alpha, r, Ap, inv_diag, &rr);
+        rz_next = ic ? tt__ic0_update(&factor, n, alpha, r, Ap, z, &rr) : tt__cg_update(n, alpha, r, Ap, inv_diag, &rr);
         rep.iterations++;
         r_is_true = 0;
         if (sqrt(rr) <= limit) {
             tt__cg_axpy(n, alpha, p, x);
             continue;   /* confirmed (or restarted) at the top */
         }
-        tt__cg_direction(n, alpha, rz_next / rz, r, inv_diag, p, x);
+        if (ic) tt__ic0_direction(n, alpha, rz_next / rz, z, p, x);
+        else tt__cg_direction(n, alpha, rz_next / rz, r, inv_diag, p, x);
         rz = rz_next;
     }
     if (!r_is_true) rr = tt__cg_residual(A, b, x, r);
@@ -5365,6 +5540,9 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
 
 done:
     tt__free(allocator, block);
+    tt__free(allocator, factor.start);
+    tt__free(allocator, factor.col);
+    tt__free(allocator, factor.value);
     if (report) *report = rep;
     return result;
 }
@@ -9861,6 +10039,7 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
     if (r != TT_OK) return r == TT_ERROR_OUT_OF_MEMORY ? r : TT_OK;
     memset(&cg, 0, sizeof cg);
     cg.tolerance = TT__LAPPED_CG_TOLERANCE;
+    cg.preconditioner = TT_CG_INCOMPLETE_CHOLESKY;
     r = tt_cg_solve(A, b_s, &cg, L->al, x_s, NULL, NULL);
     if (r == TT_OK || r == TT_ERROR_NOT_CONVERGED) r = tt_cg_solve(A, b_t, &cg, L->al, x_t, NULL, NULL);
     tt_sparse_matrix_free(A);
@@ -10320,8 +10499,9 @@ static int tt__pick_patch(tt__lapper *L, int paste, int f)
    `patch` (tt__lapper.shape_of), the one shown least on top by the faces
    just outside the paste (across its boundary edges: the pastes it will
    border), `patch` itself on ties. On a sphere with three patches of one
-   mask, 31 of 252 borders between pastes show one patch on both sides
-   (random picks: about 84; counting the faces it covers instead: 47). */
+   mask, 248 of 1575 borders between pastes (six seeds) show one patch on
+   both sides, against about 525 for random picks; counting the faces it
+   covers instead of its border did less (one seed: 47 of 252 against 31). */
 static int tt__least_overlapping_twin(tt__lapper *L, int patch)
 {
     const tt_mesh *mesh = L->mesh;

@@ -336,6 +336,32 @@ int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, 
     tt_polycube_edges_free(edges);
     return n;
 }
+ic0_check_result internal_ic0_check(const tt_sparse_matrix *A)
+{
+    ic0_check_result result;
+    tt__ic0 F;
+    int bad = -1, i, k;
+    result.worst = 0.0;
+    result.made = tt__ic0_factor(A, NULL, &F, &bad);
+    if (result.made != 1) return result;
+    for (i = 0; i < A->rows; i++)
+        for (k = A->row_start[i]; k < A->row_start[i + 1]; k++) {
+            const int c = A->col[k];
+            double product = 0.0, scale = 0.0;
+            int a, b, d;
+            if (c > i) continue;
+            for (a = F.start[i]; a < F.start[i + 1]; a++)
+                for (b = F.start[c]; b < F.start[c + 1]; b++)
+                    if (F.col[a] == F.col[b]) product += F.value[a] * F.value[b];
+            for (d = A->row_start[i]; d < A->row_start[i + 1]; d++)
+                if (A->col[d] == i) scale = fabs(A->value[d]);
+            if (fabs(product - A->value[k]) / scale > result.worst) result.worst = fabs(product - A->value[k]) / scale;
+        }
+    tt__free(NULL, F.start);
+    tt__free(NULL, F.col);
+    tt__free(NULL, F.value);
+    return result;
+}
 int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2])
 {
     return tt__relax_kernel_centre(ring, ntriangles, centre);

@@ -177,6 +177,14 @@ int internal_polycube_mask_is_disc(int mask);
    allocator; returns the moves, -1 out of memory), the kernel centre of a
    star (ring: two points per triangle, its far edge counter-clockwise; 0
    when empty) and the untangling energy of a star of n <= 64 triangles. */
+/* The incomplete Cholesky factor of A (columns increasing, no repeats)
+   checked against A: made as tt__ic0_factor returns, worst |(L L^T)_ij -
+   A_ij| / |A_ii| over A's lower pattern. */
+typedef struct ic0_check_result {
+    int made;
+    double worst;
+} ic0_check_result;
+ic0_check_result internal_ic0_check(const tt_sparse_matrix *A);
 int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points);
 /* Traces the edges and re-seats the vertices with a failed one (flagged in moved[], cleared by the caller);
    returns how many moved, -1 when out of memory re-seating, -2 tracing. */
