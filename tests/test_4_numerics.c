@@ -454,10 +454,13 @@ static double cg_relres(const tt_sparse_matrix *m, const double *b, const double
     return sqrt(rr / bb);
 }
 
+static tt_sparse_matrix *cg_small(int rows, int cols, const double *dense);
+
 /* Incomplete Cholesky: on a grid Laplacian with every fourth row of cells
    squeezed (strong and weak couplings, as slivers give), the same solution
    as Jacobi in far fewer steps; the factor against a dense reference
-   (L L^T equals A on A's pattern); bad requests refused. */
+   (L L^T equals A on A's pattern); a breakdown falls back to Jacobi; bad
+   requests refused. */
 static void test_cg_incomplete_cholesky(void)
 {
     const int w = 30, h = 30, n = w * h;
@@ -510,6 +513,21 @@ static void test_cg_incomplete_cholesky(void)
         ic0_check_result check = internal_ic0_check(m);
         CHECK(check.made == 1 && check.worst <= 1e-9, "L L^T against A on its pattern: made %d, worst %g", check.made,
               check.worst);
+    }
+    /* Kershaw's matrix: positive definite, yet IC(0) meets a negative pivot (-5 at row 3): the solve falls back to
+       Jacobi, says so, and still solves. */
+    {
+        static const double kershaw[16] = {3, -2, 0, 2, -2, 3, -2, 0, 0, -2, 3, -2, 2, 0, -2, 3};
+        tt_sparse_matrix *k = cg_small(4, 4, kershaw);
+        double kb[4] = {1, 2, 3, 4}, kx[4] = {0, 0, 0, 0};
+        tt_cg_report kr;
+        opt.preconditioner = TT_CG_INCOMPLETE_CHOLESKY;
+        CHECK(k && internal_ic0_check(k).made == 0, "Kershaw's matrix: IC(0) breaks down");
+        CHECK(k && tt_cg_solve(k, kb, &opt, NULL, kx, &kr, &err) == TT_OK && kr.preconditioner == TT_CG_JACOBI &&
+                  cg_relres(k, kb, kx) <= 1e-9,
+              "Kershaw's matrix: solved with Jacobi instead (%s; preconditioner %d, residual %g)", err.message,
+              kr.preconditioner, k ? cg_relres(k, kb, kx) : -1.0);
+        tt_sparse_matrix_free(k);
     }
     /* Refusals: an unknown preconditioner; columns that do not increase. */
     opt.preconditioner = 2;
