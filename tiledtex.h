@@ -3416,6 +3416,17 @@ static double tt__face_area_d(const tt_mesh *mesh, int face)
     return 0.5 * tt__length3(n);
 }
 
+/* Mean of a face's corner positions. */
+static void tt__face_centroid(const tt_mesh *mesh, int face, double centroid[3])
+{
+    const int begin = mesh->face_start[face], end = mesh->face_start[face + 1];
+    int c, k;
+    centroid[0] = centroid[1] = centroid[2] = 0.0;
+    for (c = begin; c < end; c++)
+        for (k = 0; k < 3; k++) centroid[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
+    for (k = 0; k < 3; k++) centroid[k] /= (double)(end - begin);
+}
+
 TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
 {
     double n[3];
@@ -8313,7 +8324,7 @@ static tt_result tt__field_constraints(tt__field *F)
     const tt_allocator *al = F->al;
     tt__field_rbf R;
     tt_result result = TT_OK;
-    int nf = F->nf, f, c, i, k;
+    int nf = F->nf, f, i;
     R.centroid = TT__ALLOC(al, double, 3 * (size_t)nf);
     R.dist = TT__ALLOC(al, double, nf);
     R.trans = TT__ALLOC(al, double, 3 * (size_t)nf);
@@ -8330,12 +8341,7 @@ static tt_result tt__field_constraints(tt__field *F)
         goto done;
     }
     for (f = 0; f < nf; f++) {
-        int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
-        double *ce = R.centroid + 3 * (size_t)f;
-        ce[0] = ce[1] = ce[2] = 0.0;
-        for (c = begin; c < end; c++)
-            for (k = 0; k < 3; k++) ce[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
-        for (k = 0; k < 3; k++) ce[k] /= (double)(end - begin);
+        tt__face_centroid(mesh, f, R.centroid + 3 * (size_t)f);
         R.sum[3 * (size_t)f] = R.sum[3 * (size_t)f + 1] = R.sum[3 * (size_t)f + 2] = 0.0;
         R.wsum[f] = R.lsum[f] = 0.0;
         R.wlog[f] = -1e300;
@@ -8432,11 +8438,9 @@ static tt_result tt__field_smooth(tt__field *F)
     }
     length = F->scale < TT__FIELD_SMOOTHING_EDGES * mean_edge ? F->scale : TT__FIELD_SMOOTHING_EDGES * mean_edge;
     for (f = 0; f < F->nf; f++) {
-        const int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
-        double *e1 = frame + 6 * (size_t)f, *e2 = e1 + 3, *middle = centroid + 3 * (size_t)f;
-        middle[0] = middle[1] = middle[2] = 0.0;
-        for (c = begin; c < end; c++)
-            for (k = 0; k < 3; k++) middle[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k] / (double)(end - begin);
+        const int begin = mesh->face_start[f];
+        double *e1 = frame + 6 * (size_t)f, *e2 = e1 + 3;
+        tt__face_centroid(mesh, f, centroid + 3 * (size_t)f);
         tt__sub3f(mesh->pos + 3 * (size_t)mesh->corner_vert[begin + 1], mesh->pos + 3 * (size_t)mesh->corner_vert[begin],
                   e1);
         tt__project3(e1, F->normal + 3 * (size_t)f, e1);
@@ -8486,12 +8490,11 @@ static tt_result tt__field_smooth(tt__field *F)
     }
     /* Data: toward the projected up as much as it decides, else toward the tie axis; the start is the data. */
     for (f = 0; f < F->nf; f++) {
-        const int u = unknown[f], begin = mesh->face_start[f];
-        double p[3], q[3], newell[3], newell_scale, area, decided, to_up, to_tie, start[2];
+        const int u = unknown[f];
+        const double area = u >= 0 ? tt__face_area_d(mesh, f) : 0.0;
+        double p[3], q[3], decided, to_up, to_tie, start[2];
         int i;
         if (u < 0) continue;
-        tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, mesh->face_start[f + 1] - begin, newell, &newell_scale);
-        area = 0.5 * tt__length3(newell);
         tt__project3(F->up, F->normal + 3 * (size_t)f, p);
         decided = tt__field_decided(tt__normalize3(p));
         tt__project3(tie, F->normal + 3 * (size_t)f, q);
@@ -10458,14 +10461,11 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
 static int tt__pick_patch(tt__lapper *L, int paste, int f)
 {
     const tt_mesh *mesh = L->mesh;
-    double centre[3] = {0.0, 0.0, 0.0}, reach;
+    double centre[3], reach;
     int head = 0, tail = 0, i, k, least = INT_MAX, ties = 0, pick;
     /* One patch: the draw the uniform pick always made, so that seeds give the pastes they gave. */
     if (L->npatches == 1) return (int)tt_rng_below(&L->rng, 1u);
-    for (k = 0; k < 3; k++) {
-        const float *p = tt__corner_pos(mesh, 3 * f + k);
-        for (i = 0; i < 3; i++) centre[i] += p[i] / 3.0;
-    }
+    tt__face_centroid(mesh, f, centre);
     reach = tt__length3f(L->field + 3 * (size_t)f);
     reach *= reach;
     for (i = 0; i < L->npatches; i++) L->patch_count[i] = 0;
