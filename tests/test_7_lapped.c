@@ -1591,6 +1591,19 @@ static void test_lapped_determinism(void)
     tt_image_free(patch);
 }
 
+/* The sphere of make_lapped_shape built, with its default field (*field,
+   malloc'ed). */
+static tt_mesh *lapped_sphere(tmesh *m, float **field)
+{
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    make_lapped_shape(m, 0);
+    CHECK(build(m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
+    *field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    CHECK(tt_tangent_field(mesh, NULL, NULL, *field, &err) == TT_OK, "sphere field: %s", err.message);
+    return mesh;
+}
+
 /* Across the edges where the paste on top changes, how often both sides
    show the same patch; *random gets what random picks would give (the sum
    of the patches' squared shares of the pastes, times the edges). */
@@ -1636,8 +1649,7 @@ static void check_patch_borders(int same, int changes, double random, double sha
 static void test_lapped_patches(void)
 {
     tmesh m;
-    tt_mesh *mesh = NULL;
-    tt_field_options fo;
+    tt_mesh *mesh;
     tt_lapped_options lo;
     tt_lapped *out = NULL;
     tt_error err;
@@ -1645,11 +1657,7 @@ static void test_lapped_patches(void)
     float *field;
     int used[3] = {0, 0, 0}, p, f, bad = 0;
     tt_result r;
-    make_lapped_shape(&m, 0);
-    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
-    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    memset(&fo, 0, sizeof fo);
-    tt_tangent_field(mesh, &fo, NULL, field, &err);
+    mesh = lapped_sphere(&m, &field);
     patches[0] = lapped_patch(48, 1);
     patches[1] = lapped_patch(64, 2);
     patches[2] = lapped_patch(40, 3);
@@ -1687,8 +1695,7 @@ static void test_lapped_patches(void)
 static void test_lapped_patch_twins(void)
 {
     tmesh m;
-    tt_mesh *mesh = NULL;
-    tt_field_options fo;
+    tt_mesh *mesh;
     tt_lapped_options lo;
     tt_lapped *out = NULL;
     tt_error err;
@@ -1697,11 +1704,7 @@ static void test_lapped_patch_twins(void)
     int p, same_sum = 0, changes_sum = 0;
     double random_sum = 0.0;
     size_t i;
-    make_lapped_shape(&m, 0);
-    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
-    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    memset(&fo, 0, sizeof fo);
-    tt_tangent_field(mesh, &fo, NULL, field, &err);
+    mesh = lapped_sphere(&m, &field);
     patches[0] = lapped_patch(64, 4);
     for (p = 1; p < 3 && patches[0]; p++) {
         CHECK(tt_image_create(64, 64, NULL, &patches[p], &err) == TT_OK, "patch copy: %s", err.message);
