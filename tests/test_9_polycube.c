@@ -1043,6 +1043,22 @@ static tt_polycube *projected(const tmesh *m, const tt_polycube_options *o, tt_m
     return pc;
 }
 
+/* A unit sphere of `segments` x `rings` (make_sphere) built, its polycube
+   at `resolution` and its points on S (projected). */
+static tt_polycube *projected_sphere(int segments, int rings, int resolution, tmesh *m, tt_mesh **mesh,
+                                     tt_surface_point **pts)
+{
+    const double centre[3] = {0.0, 0.0, 0.0};
+    tt_polycube_options o;
+    tt_polycube_projection_report pr;
+    tt_polycube_report rep;
+    memset(m, 0, sizeof *m);
+    make_sphere(m, segments, rings, 1.0, centre, 0);
+    memset(&o, 0, sizeof o);
+    o.resolution = resolution;
+    return projected(m, &o, mesh, pts, &pr, &rep);
+}
+
 static void test_project_cube(void)
 {
     unsigned char one = 1;
@@ -2733,20 +2749,11 @@ static void test_untangle_energy(void)
    untangling opens it from its rim. */
 static void test_relax_untangles(void)
 {
-    const double centre[3] = {0.0, 0.0, 0.0};
     tmesh m;
     tt_mesh *mesh = NULL;
     tt_surface_point *pts = NULL;
-    tt_polycube_options o;
-    tt_polycube_projection_report pr;
-    tt_polycube_report rep;
-    tt_polycube *pc;
+    tt_polycube *pc = projected_sphere(96, 48, 4, &m, &mesh, &pts);
     int *in_quad, best = -1, v, c, mirrored = 0, before = 0, after = 0;
-    memset(&m, 0, sizeof m);
-    make_sphere(&m, 96, 48, 1.0, centre, 0);
-    memset(&o, 0, sizeof o);
-    o.resolution = 4;
-    pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
     if (!pc) { tm_free(&m); return; }
     in_quad = (int *)calloc((size_t)pc->surface->nfaces, sizeof(int));
     for (v = 0; v < mesh->nverts; v++) in_quad[pts[v].quad]++;
@@ -2813,24 +2820,15 @@ static tt_result reseat_oom_call(void *ctx, const tt_allocator *al)
    nothing else. */
 static void test_reseat(void)
 {
-    const double centre[3] = {0.0, 0.0, 0.0};
     tmesh m;
     tt_mesh *mesh = NULL;
     tt_surface_point *pts = NULL;
-    tt_polycube_options o;
-    tt_polycube_projection_report pr;
-    tt_polycube_report rep;
-    tt_polycube *pc;
+    tt_polycube *pc = projected_sphere(48, 24, 6, &m, &mesh, &pts);
     unsigned char *moved;
     tt_surface_point *start, *copy;
     reseat_oom_ctx ctx;
     int v, far = 0, near = 0, before, after, reseated, others = 0, a;
     double at[3], d2 = 0.0;
-    memset(&m, 0, sizeof m);
-    make_sphere(&m, 48, 24, 1.0, centre, 0);
-    memset(&o, 0, sizeof o);
-    o.resolution = 6;
-    pc = projected(&m, &o, &mesh, &pts, &pr, &rep);
     if (!pc) { tm_free(&m); return; }
     for (v = 0; v < mesh->nverts; v++) {
         if (mesh->pos[3 * v] > mesh->pos[3 * near]) near = v;
