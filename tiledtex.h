@@ -16356,6 +16356,12 @@ typedef struct tt__edge_funnel {
     double reference, lo, hi;
 } tt__edge_funnel;
 
+/* Whether two points of S are the same (quad and bits of s and t). */
+static int tt__same_point(tt_surface_point a, tt_surface_point b)
+{
+    return a.quad == b.quad && a.s == b.s && a.t == b.t;
+}
+
 /* The vertex of S that point p is on (a corner of its quad), or -1. */
 static int tt__point_vertex(const tt_mesh *s, tt_surface_point p)
 {
@@ -16685,6 +16691,21 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
                                         tt_polycube_edges **out, tt_error *error)
 {
     return tt__trace_edges(polycube, mesh, points, npoints, options, allocator, NULL, NULL, out, error);
+}
+
+/* *edges replaced by records whose edges at the points flagged in moved[]
+   are traced again (tt__trace_edges); on failure *edges stays. */
+static tt_result tt__retrace_moved(const tt_polycube *polycube, const tt_mesh *mesh, const tt_surface_point *points,
+                                   const tt_polycube_edge_options *options, const tt_allocator *allocator,
+                                   const unsigned char *moved, tt_polycube_edges **edges, tt_error *error)
+{
+    tt_polycube_edges *again = NULL;
+    tt_result result = tt__trace_edges(polycube, mesh, points, mesh->nverts, options, allocator, *edges, moved, &again,
+                                       error);
+    if (result != TT_OK) return result;
+    tt_polycube_edges_free(*edges);
+    *edges = again;
+    return TT_OK;
 }
 
 /* ---- The model refined (before spec P11 step 2) ---- */
@@ -17392,7 +17413,7 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
     }
     tt__untangle_energy(star, x, delta2, gradient, &folded);
     if ((strict && folded > folded_before) || !tt__relax_chart_point(chart, x, &moved)) return 0;
-    if (moved.quad == points[v].quad && moved.s == points[v].s && moved.t == points[v].t) return 0;
+    if (tt__same_point(moved, points[v])) return 0;
     points[v] = moved;
     return 1;
 }
@@ -17728,7 +17749,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
                 if (j < ntried || ntried == TT__RESEAT_SEATS) continue;
                 tried[ntried++] = points[u].quad;
                 candidate = tt__relax_seat(pc, model, v, points[u].quad, x.around);
-                if (candidate.quad == kept.quad && candidate.s == kept.s && candidate.t == kept.t) continue;
+                if (tt__same_point(candidate, kept)) continue;
                 points[v] = candidate;
                 tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, x.chart);
                 tt__relax_chart_place(x.chart, candidate, at);
@@ -17741,7 +17762,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
             }
         }
         points[v] = best;
-        if (best.quad != kept.quad || best.s != kept.s || best.t != kept.t) {
+        if (!tt__same_point(best, kept)) {
             moved_points[v] = 1;
             moved++;
         }
@@ -18705,7 +18726,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
 {
     tt_polycube_map_report local;
     tt_polycube_edge_options edge_options;
-    tt_surface_point *points = NULL, *before_unspike = NULL;
+    tt_surface_point *points = NULL, *earlier = NULL;
     unsigned char *moved = NULL, *focus = NULL;
     tt_polycube_edges *edges = NULL;
     const tt_mesh *model;
@@ -18760,7 +18781,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
                                           error)) != TT_OK)
         goto failed;
-    if (!(before_unspike = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
+    if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
         !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
         !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)))
         goto out_of_memory;
@@ -18768,7 +18789,6 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
        again, up to TT__RESEAT_ROUNDS times; the relaxation then opens the folds that leaves near them, and
        the edges at the points it moved are traced again. */
     for (cycle = 0; cycle < TT__RESEAT_CYCLES && edges->nfailed > 0; cycle++) {
-        tt_polycube_edges *again = NULL;
         int reseated = 0, round, e;
         memset(focus, 0, (size_t)model->nverts);
         for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
@@ -18779,11 +18799,9 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             if (!n) break;
             reseated += n;
             for (v = 0; v < model->nverts; v++) focus[v] |= moved[v];
-            if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, edges,
-                                          moved, &again, error)) != TT_OK)
+            if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges,
+                                            error)) != TT_OK)
                 goto failed;
-            tt_polycube_edges_free(edges);
-            edges = again;
             if (edges->nfailed >= failed_before) break;
         }
         if (!reseated) break;
@@ -18796,24 +18814,20 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             }
             for (v = 0; v < model->nverts; v++) focus[v] = focus[v] != 0;
         }
-        memcpy(before_unspike, points, sizeof *points * (size_t)model->nverts);
+        memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
         if ((moves = tt__polycube_relax(polycube, model, points, focus, allocator)) < 0) goto out_of_memory;
         report->relaxed += moves;
         for (v = 0; v < model->nverts; v++)
-            moved[v] = points[v].quad != before_unspike[v].quad || points[v].s != before_unspike[v].s ||
-                       points[v].t != before_unspike[v].t;
-        if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, edges, moved,
-                                      &again, error)) != TT_OK)
+            moved[v] = !tt__same_point(points[v], earlier[v]);
+        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=
+            TT_OK)
             goto failed;
-        tt_polycube_edges_free(edges);
-        edges = again;
     }
     /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
        vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
-    memcpy(before_unspike, points, sizeof *points * (size_t)model->nverts);
+    memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
     memset(moved, 0, (size_t)model->nverts);
     for (tracing = 0; tracing < 2; tracing++) {
-        tt_polycube_edges *again = NULL;
         int changed = 0, c;
         if (tracing == 0) {
             if ((changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator)) < 0)
@@ -18822,21 +18836,16 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             memset(moved, 0, (size_t)model->nverts);
             for (c = 0; c < model->ncorners; c++) {
                 v = model->corner_vert[c];
-                if (!edges->failed[edges->edge_of_halfedge[c]] || (points[v].quad == before_unspike[v].quad &&
-                                                                   points[v].s == before_unspike[v].s &&
-                                                                   points[v].t == before_unspike[v].t))
-                    continue;
-                points[v] = before_unspike[v];
+                if (!edges->failed[edges->edge_of_halfedge[c]] || tt__same_point(points[v], earlier[v])) continue;
+                points[v] = earlier[v];
                 moved[v] = 1;
                 changed = 1;
             }
         }
         if (!changed) break;
-        if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, edges, moved,
-                                      &again, error)) != TT_OK)
+        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=
+            TT_OK)
             goto failed;
-        tt_polycube_edges_free(edges);
-        edges = again;
     }
     report->failed_edges = edges->nfailed;
 
@@ -18932,7 +18941,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, S.queue);
     tt__free(allocator, S.grid_points);
     tt_polycube_edges_free(edges);
-    tt__free(allocator, before_unspike);
+    tt__free(allocator, earlier);
     tt__free(allocator, moved);
     tt__free(allocator, focus);
     tt__free(allocator, points);
@@ -18949,7 +18958,7 @@ failed:
     tt__free(allocator, S.grid_points);
     tt_polycube_mapping_free(S.out);
     tt_polycube_edges_free(edges);
-    tt__free(allocator, before_unspike);
+    tt__free(allocator, earlier);
     tt__free(allocator, moved);
     tt__free(allocator, focus);
     tt__free(allocator, points);
