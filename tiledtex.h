@@ -5259,7 +5259,7 @@ typedef struct tt__ic0 {
 static int tt__ic0_factor(const tt_sparse_matrix *A, const tt_allocator *allocator, tt__ic0 *F, int *bad_row)
 {
     const int n = A->rows;
-    int i, k, m = 0;
+    int i, k, m = 0, made = -1;
     memset(F, 0, sizeof *F);
     for (i = 0; i < n; i++)
         for (k = A->row_start[i]; k < A->row_start[i + 1]; k++) {
@@ -5299,11 +5299,8 @@ static int tt__ic0_factor(const tt_sparse_matrix *A, const tt_allocator *allocat
             } else if (sum > 0.0) {
                 F->value[k] = sqrt(sum);
             } else {
-                tt__free(allocator, F->start);
-                tt__free(allocator, F->col);
-                tt__free(allocator, F->value);
-                memset(F, 0, sizeof *F);
-                return 0;
+                made = 0;
+                goto failed;
             }
         }
     return 1;
@@ -5312,7 +5309,7 @@ failed:
     tt__free(allocator, F->col);
     tt__free(allocator, F->value);
     memset(F, 0, sizeof *F);
-    return -1;
+    return made;
 }
 
 /* z = (L L^T)^-1 r: forward, then backward (L^T by columns of L's rows). */
