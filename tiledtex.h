@@ -1264,6 +1264,14 @@ typedef struct tt_seam_options {
        reports (with 20000 edges it stays within about 0.01 of the full score). */
     int max_edges;
     unsigned flags;         /* TT_SEAM_*; 0 = every interior edge, clamped sampling */
+    /* NULL: every interior edge (with TT_SEAM_UV_DISCONTINUOUS, every
+       discontinuous one). Otherwise only the interior edges listed, each named
+       by either of its two corners (half-edges); a list naming nothing
+       measurable gives TT_ERROR_NOT_MEASURED. Where a lapped texture's paste
+       on top changes, for example: that is where a paste can end with a hard
+       edge. The same-face and unrelated references are taken as always. */
+    const int *edges;
+    int nedges;
 } tt_seam_options;
 
 typedef struct tt_seam_report {
@@ -1284,8 +1292,11 @@ typedef struct tt_seam_report {
    TT_SEAM_UV_DISCONTINUOUS no discontinuous edge) the result is
    TT_ERROR_NOT_MEASURED and the report is zero with score NaN, except
    edges_discontinuous, which is counted before any sampling. Other errors: NULL pointers or an empty atlas
-   (TT_ERROR_INVALID_ARGUMENT), a negative max_edges or an unknown flag bit
-   (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY. */
+   (TT_ERROR_INVALID_ARGUMENT), a negative max_edges or nedges, edges NULL with
+   nedges > 0, an unknown flag bit (TT_ERROR_INVALID_ARGUMENT); a listed edge
+   that is not a corner of the mesh (TT_ERROR_INDEX_OUT_OF_RANGE) or lies on
+   the boundary (TT_ERROR_INVALID_ARGUMENT), error->item naming its place in
+   the list; TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  const tt_seam_options *options, const tt_allocator *allocator,
                                  tt_seam_report *report, tt_error *error);
@@ -1562,7 +1573,8 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         first, across an edge only when (a) the face keeps the patch a disc,
         (b) the edge's image meets the patch's conservative polygonal hull
         (Sec. 3.3, Fig. 4), (c) the face's predicted map is not too distorted
-        (TT_LAPPED_MAX_DISTORTION); each new vertex is placed by similar-
+        (a looser limit than the solved map's, as the prediction drifts from
+        the field: TT_LAPPED_GROW_DISTORTION); each new vertex is placed by similar-
         triangle prediction from every patch face containing it and a mapped
         edge, taking the centroid (Sec. 3.3, after Maillot et al.);
      4. solve the least-squares alignment of Sec. 3.4, sum over the patch's
@@ -1571,7 +1583,10 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         (s and t decouple: one matrix, two right-hand sides); if the new map
         moved an edge of the patch back over the hull, grow and solve again;
         faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
-        are dropped from the paste, except the seed face;
+        are dropped from the paste, except the seed face and the fringe:
+        faces up to TT_LAPPED_GROW_DISTORTION off where the patch's alpha
+        over them stays below one half, kept for the paste's soft border
+        (faint there) and covering nothing;
      5. mark coverage (Sec. 3.6): each face carries a fixed set of sample
         points (its own barycentric raster: tt_raster_triangle on a right
         triangle, about 64 points per patch side, at least 4 and at most 256
@@ -1592,17 +1607,29 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    paste ends at a mesh edge without its soft falloff; later pastes cover
    some of those places (Sec. 3.3 finds them "less objectionable than
    distorted texture"). tt_lapped.visible_cuts counts the ones left on top:
-   5 % of the edges where the paste on top changes on a sphere, 17 % on the
-   bunny, half on the elephant, nearly all refused for distortion. A patch
+   3 % of the edges where the paste on top changes on a sphere, 13 % on the
+   bunny, 45 % on the elephant (whose trunk and legs are thinner than a
+   patch: a smaller --scale halves that), most of them refused for
+   distortion. A patch
    may fold over itself in texture space (allowed by the paper); coverage
    is still counted per face, correctly. */
 
-/* Growth does not cross into a face whose predicted map turns T_f by more
-   than this many degrees, or scales it by more than 1 + this / 90 or less
-   than 1 / (1 + this / 90) (a "hard edge", Sec. 3.3); faces the optimized
-   map leaves that far off are left out of the paste as well. Lower values
-   align better and leave more hard edges. */
+/* Faces whose solved map (Sec. 3.4) turns T_f by more than this many
+   degrees, or scales it by more than 1 + this / 90 or less than
+   1 / (1 + this / 90), are left out of the paste (a "hard edge", Sec. 3.3),
+   unless the patch is already fading out over them (the fringe, below).
+   Lower values align better and leave more hard edges. */
 #define TT_LAPPED_MAX_DISTORTION 20.0f
+/* Growth crosses into a face whose predicted map is up to this far off
+   (the same measure), and the fringe shows faces up to this far off where
+   the patch's alpha over them stays below one half. The prediction, an
+   unfolding, drifts from the field that the solve then follows, so a face
+   it puts 20 to 45 degrees off mostly lands within TT_LAPPED_MAX_DISTORTION
+   once solved. Growth stopped at TT_LAPPED_MAX_DISTORTION instead left half
+   as many hard edges again (bunny: 260 against 176 of about 1400 edges where
+   the top paste changes); at 60 or 90 degrees more faces drift off in the
+   solve and are dropped after it. */
+#define TT_LAPPED_GROW_DISTORTION 45.0f
 /* A sample counts as covered under an alpha of at least this. */
 #define TT_LAPPED_OPAQUE 0.99f
 /* tt_lapped.visible_cuts: a paste that stops at an edge with at least this
@@ -7668,6 +7695,7 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
 {
     const unsigned known_flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
     int *interior, ninterior = 0, npopulation, nmeasured, ndiscontinuous = 0, c, i, j, points_per_edge;
+    unsigned char *listed;      /* with an edge list: per corner, 1 on the lower corner of a listed edge */
     double seam = 0.0, same = 0.0, unrelated = 0.0;
     long long samples = 0;
     tt_seam_options opt;
@@ -7692,12 +7720,38 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "seam option flags 0x%x include unknown bits 0x%x (known: TT_SEAM_UV_DISCONTINUOUS, "
                         "TT_SEAM_WRAP)", opt.flags, opt.flags & ~known_flags);
+    if (opt.nedges < 0 || (!opt.edges && opt.nedges > 0))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the edge list has %d entries at %s: give a list and its length, or NULL for every edge",
+                        opt.nedges, opt.edges ? "an address" : "NULL");
+    for (i = 0; opt.edges && i < opt.nedges; i++) {
+        if (opt.edges[i] < 0 || opt.edges[i] >= mesh->ncorners)
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, i, -1, -1,
+                               "listed edge %d is corner %d, outside the mesh's %d corners", i, opt.edges[i],
+                               mesh->ncorners);
+        if (mesh->twin[opt.edges[i]] < 0)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
+                               "listed edge %d (corner %d) is on the boundary: a seam needs a face on each side", i,
+                               opt.edges[i]);
+    }
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     wrap = (opt.flags & TT_SEAM_WRAP) ? TT_WRAP_REPEAT : TT_WRAP_CLAMP;
     interior = TT__ALLOC(allocator, int, mesh->ncorners);
-    if (!interior)
+    listed = opt.edges ? TT__ALLOC(allocator, unsigned char, mesh->ncorners) : NULL;
+    if (!interior || (opt.edges && !listed)) {
+        tt__free(allocator, interior);
+        tt__free(allocator, listed);
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d corners",
                         mesh->ncorners);
+    }
+    if (listed) {
+        /* Each edge marked on its lower corner, the one the loop below visits. */
+        memset(listed, 0, (size_t)mesh->ncorners);
+        for (i = 0; i < opt.nedges; i++) {
+            int a = opt.edges[i], b = mesh->twin[a];
+            listed[a < b ? a : b] = 1;
+        }
+    }
     for (c = 0; c < mesh->ncorners; c++)
         if (mesh->twin[c] > c) {
             interior[ninterior++] = c;
@@ -7705,25 +7759,29 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         }
     report->edges_discontinuous = ndiscontinuous;
     /* The measured population is interior[0 .. npopulation-1]: every interior
-       edge, or in restricted mode the discontinuous ones, swapped to the
-       front (the continuous ones follow: they remain candidates for
-       unrelated pairs). */
+       edge, or those listed and, in restricted mode, discontinuous, swapped
+       to the front (the others follow: they remain candidates for unrelated
+       pairs). */
     npopulation = ninterior;
-    if (opt.flags & TT_SEAM_UV_DISCONTINUOUS) {
-        int front = 0;
-        if (ndiscontinuous == 0) {
-            tt__free(allocator, interior);
+    if ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) || listed) {
+        npopulation = 0;
+        for (i = 0; i < ninterior; i++)
+            if ((!listed || listed[interior[i]]) &&
+                (!(opt.flags & TT_SEAM_UV_DISCONTINUOUS) || tt__edge_uv_discontinuous(mesh, corner_uv, interior[i]))) {
+                int edge = interior[i];
+                interior[i] = interior[npopulation];
+                interior[npopulation++] = edge;
+            }
+    }
+    tt__free(allocator, listed);
+    if (npopulation == 0 && ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) || listed)) {
+        tt__free(allocator, interior);
+        if ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) && ndiscontinuous == 0)
             return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
                             "no interior edge has discontinuous UVs: nothing to measure in "
                             "TT_SEAM_UV_DISCONTINUOUS mode");
-        }
-        for (i = 0; i < ninterior; i++)
-            if (tt__edge_uv_discontinuous(mesh, corner_uv, interior[i])) {
-                int edge = interior[i];
-                interior[i] = interior[front];
-                interior[front++] = edge;
-            }
-        npopulation = ndiscontinuous;
+        return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1, "no listed edge is left to measure (%d listed%s)",
+                        opt.nedges, (opt.flags & TT_SEAM_UV_DISCONTINUOUS) ? ", none of them discontinuous" : "");
     }
     tt_rng_seed(&rng, opt.seed, 0x7365616d73ull /* "seams" */);
     /* A quick estimate measures a random subset of the population: the first
@@ -9609,6 +9667,10 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 #define TT__LAPPED_CUT_PROBES 4
 /* Faces looked at around a seed to pick its patch (tt__pick_patch), at most. */
 #define TT__LAPPED_NEAR_FACES 4096
+/* The fringe (tt__paste_may_show): a paste may show a face mapped up to
+   TT_LAPPED_GROW_DISTORTION off the field where its alpha over the face
+   stays below this. */
+#define TT__LAPPED_FRINGE_ALPHA 0.5f
 /* Vertices of a patch's conservative hull (Sec. 3.3, Fig. 4). */
 #define TT__LAPPED_HULL_VERTICES 32
 /* Grow-and-solve rounds per paste (Sec. 3.3: "when this occurs, we further
@@ -9813,12 +9875,71 @@ static void tt__alignment_error(const double image_t[2], double *angle, double *
     *angle = *scale > 0.0 ? fabs(atan2(image_t[0], image_t[1])) * (180.0 / TT__PI) : 180.0;
 }
 
-static int tt__lapped_too_distorted(const tt__lapper *L, int f)
+/* The paste's alpha along the segment from uv a to uv b: the largest of
+   TT__LAPPED_CUT_PROBES + 1 bilinear lookups, clamped at the patch's border
+   as pastes are drawn. */
+static float tt__paste_alpha_along(const tt_image *patch, const float a[2], const float b[2])
 {
-    double image_t[2], angle, scale, limit = 1.0 + TT_LAPPED_MAX_DISTORTION / 90.0;
+    float most = 0.0f;
+    int i;
+    for (i = 0; i <= TT__LAPPED_CUT_PROBES; i++) {
+        const float t = (float)i / TT__LAPPED_CUT_PROBES, u = a[0] + t * (b[0] - a[0]), v = a[1] + t * (b[1] - a[1]);
+        float rgba[4];
+        tt_image_sample_bilinear(patch, u * patch->width, (1.0f - v) * patch->height, rgba);
+        if (rgba[3] > most) most = rgba[3];
+    }
+    return most;
+}
+
+/* The most of the paste's alpha over a face whose corners map to uv[6]:
+   along its edges and at its centre. */
+static float tt__face_alpha_most(const tt_image *patch, const float uv[6])
+{
+    const float centre[2] = {(uv[0] + uv[2] + uv[4]) / 3.0f, (uv[1] + uv[3] + uv[5]) / 3.0f};
+    float most = tt__paste_alpha_along(patch, centre, centre);
+    int k;
+    for (k = 0; k < 3; k++) {
+        float a = tt__paste_alpha_along(patch, uv + 2 * k, uv + 2 * ((k + 1) % 3));
+        if (a > most) most = a;
+    }
+    return most;
+}
+
+/* Whether face f's current map turns T_f by more than `most` degrees or
+   scales it beyond 1 + most / 90 either way (TT_LAPPED_MAX_DISTORTION). */
+static int tt__distorted_beyond(const tt__lapper *L, int f, double most)
+{
+    double image_t[2], angle, scale, limit = 1.0 + most / 90.0;
     tt__face_up_image(L, f, image_t);
     tt__alignment_error(image_t, &angle, &scale);
-    return !(angle <= TT_LAPPED_MAX_DISTORTION && scale <= limit && scale * limit >= 1.0);
+    return !(angle <= most && scale <= limit && scale * limit >= 1.0);
+}
+
+/* Face f's corner UVs as the current map has them. */
+static void tt__face_uv(const tt__lapper *L, int f, float uv[6])
+{
+    int k;
+    for (k = 0; k < 3; k++) {
+        const double *p = L->vert_uv + 2 * (size_t)L->mesh->corner_vert[3 * f + k];
+        uv[2 * k] = (float)p[0];
+        uv[2 * k + 1] = (float)p[1];
+    }
+}
+
+/* Whether a paste of `patch` may show face f under its current map: within
+   TT_LAPPED_MAX_DISTORTION, or within TT_LAPPED_GROW_DISTORTION where
+   the patch is already fading out over the face (its alpha below
+   TT__LAPPED_FRINGE_ALPHA). The fringe keeps the paste's soft border where
+   the map drifts from the field toward the paste's rim, so that it need
+   not end there with a hard edge; the texture shown there is faint, and
+   covers nothing (Sec. 3.6 counts opaque points only). */
+static int tt__paste_may_show(const tt__lapper *L, int f, int patch)
+{
+    float uv[6];
+    if (!tt__distorted_beyond(L, f, TT_LAPPED_MAX_DISTORTION)) return 1;
+    if (tt__distorted_beyond(L, f, TT_LAPPED_GROW_DISTORTION)) return 0;
+    tt__face_uv(L, f, uv);
+    return tt__face_alpha_most(L->patches[patch], uv) < TT__LAPPED_FRINGE_ALPHA;
 }
 
 static void tt__map_vertex(tt__lapper *L, int v, int paste)
@@ -9949,7 +10070,7 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
         L->vert_uv[2 * (size_t)v] = uv[0];        /* provisional until v is stamped */
         L->vert_uv[2 * (size_t)v + 1] = uv[1];
     }
-    if (tt__lapped_too_distorted(L, g)) return 0;
+    if (tt__distorted_beyond(L, g, TT_LAPPED_GROW_DISTORTION)) return 0;
     L->face_stamp[g] = paste;
     L->patch_faces[L->npatch_faces++] = g;
     if (!mapped) tt__map_vertex(L, v, paste);
@@ -10087,22 +10208,6 @@ static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, 
     return added;
 }
 
-/* The paste's alpha along the segment from uv a to uv b: the largest of
-   TT__LAPPED_CUT_PROBES + 1 bilinear lookups, clamped at the patch's border
-   as pastes are drawn. */
-static float tt__paste_alpha_along(const tt_image *patch, const float a[2], const float b[2])
-{
-    float most = 0.0f;
-    int i;
-    for (i = 0; i <= TT__LAPPED_CUT_PROBES; i++) {
-        const float t = (float)i / TT__LAPPED_CUT_PROBES, u = a[0] + t * (b[0] - a[0]), v = a[1] + t * (b[1] - a[1]);
-        float rgba[4];
-        tt_image_sample_bilinear(patch, u * patch->width, (1.0f - v) * patch->height, rgba);
-        if (rgba[3] > most) most = rgba[3];
-    }
-    return most;
-}
-
 /* Face f got `count` more covered samples; a face now fully covered leaves
    the list seed points are drawn from. Returns count. */
 static int tt__count_covered(tt__lapper *L, int f, int count)
@@ -10122,9 +10227,8 @@ static int tt__count_covered(tt__lapper *L, int f, int count)
    number of samples newly covered, or -1 when out of memory. */
 static long long tt__record_paste(tt__lapper *L, int patch)
 {
-    const tt_mesh *mesh = L->mesh;
     long long added = 0;
-    int i, k, paste = L->npastes;
+    int i, paste = L->npastes;
     void *grown = tt__grow(L->al, L->paste_patch, &L->paste_capacity, paste + 1, sizeof(int));
     if (!grown) return -1;
     L->paste_patch = (int *)grown;
@@ -10133,20 +10237,18 @@ static long long tt__record_paste(tt__lapper *L, int patch)
     if (!grown) return -1;
     L->entries = (tt__entry *)grown;
     for (i = 0; i < L->npatch_faces; i++) {
-        int f = L->patch_faces[i], got;
+        int f = L->patch_faces[i], got, fringe;
         tt__entry *entry;
         double image_t[2], angle, scale;
         /* Sec. 3.3 stops growth where distortion becomes excessive; the
            optimization can still leave faces far off the field (near its
            singularities), and they are left out of the paste too: a hard
-           edge there, and another paste covers them. The seed face stays. */
-        if (f != L->seed_face && tt__lapped_too_distorted(L, f)) continue;
+           edge there, and another paste covers them. Faces of the fringe
+           stay but cover nothing. The seed face always stays. */
+        if (f != L->seed_face && !tt__paste_may_show(L, f, patch)) continue;
+        fringe = f != L->seed_face && tt__distorted_beyond(L, f, TT_LAPPED_MAX_DISTORTION);
         entry = &L->entries[L->nentries++];
-        for (k = 0; k < 3; k++) {
-            const double *p = L->vert_uv + 2 * (size_t)mesh->corner_vert[3 * f + k];
-            entry->uv[2 * k] = (float)p[0];
-            entry->uv[2 * k + 1] = (float)p[1];
-        }
+        tt__face_uv(L, f, entry->uv);
         tt__face_up_image(L, f, image_t);
         tt__alignment_error(image_t, &angle, &scale);
         entry->face = f;
@@ -10154,7 +10256,7 @@ static long long tt__record_paste(tt__lapper *L, int patch)
         L->top_patch[f] = patch;
         entry->angle_error = (float)angle;
         entry->scale_error = (float)fabs(scale - 1.0);
-        if (L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) continue;
+        if (fringe || L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) continue;
         got = tt__mark_opaque_samples(L, f, entry->uv, patch, L->covered + L->sample_start[f]);
         added += tt__count_covered(L, f, got);
     }

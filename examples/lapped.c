@@ -88,7 +88,9 @@ static void print_help(void)
            "Prints the number of pastes, the coverage, how often a face is drawn (overdraw), how\n"
            "well the texture follows the field (angle and scale error), the hard edges (where the\n"
            "paste on top stops while still at least 25%% opaque) and how many face entries hidden\n"
-           "by later pastes were dropped.\n"
+           "by later pastes were dropped. With --bake, also the baked texture's seam score (about 0:\n"
+           "the texture continues across edges; about 1: it jumps) over every edge and over the\n"
+           "edges where the paste on top changes.\n"
            "\n"
            "example: tiledtex generate mesh torus.obj --shape torus\n"
            "         tiledtex generate texture stones.png --size 128\n"
@@ -455,10 +457,58 @@ static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float
     return 0;
 }
 
+typedef struct baked_seams {
+    tool_seams all;             /* every interior edge */
+    tool_seams top_changes;     /* the edges where the paste on top changes */
+} baked_seams;
+
+/* The interior edges whose two faces show different pastes on top, each
+   named by one of its corners (*edges is malloc'd): where pastes end, softly
+   or with a hard edge. */
+static int top_change_edges(const tt_mesh *mesh, const tt_lapped *lapped, int **edges, int *count)
+{
+    int *top = (int *)malloc((size_t)(mesh->nfaces > 0 ? mesh->nfaces : 1) * sizeof(int));
+    int p, e, c;
+    *count = 0;
+    *edges = (int *)malloc((size_t)(mesh->ncorners > 0 ? mesh->ncorners : 1) * sizeof(int));
+    if (!top || !*edges) {
+        free(top);
+        free(*edges);
+        *edges = NULL;
+        return tool_fail("out of memory for the edges of %d faces", mesh->nfaces);
+    }
+    for (c = 0; c < mesh->nfaces; c++) top[c] = -1;
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++)
+            top[lapped->faces[e]] = p;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] > c && top[mesh->corner_face[c]] != top[mesh->corner_face[mesh->twin[c]]])
+            (*edges)[(*count)++] = c;
+    free(top);
+    return 0;
+}
+
+/* The baked texture's seam score (tt_measure_seams) over every edge and over
+   the edges where the paste on top changes: about 0 where pastes fade out
+   softly, about 1 where one ends with a hard edge. */
+static int measure_baked(const lapped_options *options, const triangle_mesh *m, const tt_lapped *lapped,
+                         const float *corner_uv, const tt_image *atlas, baked_seams *seams)
+{
+    int *edges = NULL, nedges = 0;
+    int status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, atlas, options->seed, 0, NULL, 0, 0,
+                                    &seams->all);
+    if (status == 0) status = top_change_edges(m->mesh, lapped, &edges, &nedges);
+    if (status == 0)
+        status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, atlas, options->seed, 0, edges, nedges, 0,
+                                    &seams->top_changes);
+    free(edges);
+    return status;
+}
+
 /* --bake: the pastes composited into a size x size texture over corner_uv
    (from bake_uvs; freed here); an ordinary OBJ + MTL + PNG. */
 static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
-                     const tt_lapped *lapped, tt_image *patch, float *corner_uv)
+                     const tt_lapped *lapped, tt_image *patch, float *corner_uv, baked_seams *seams)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
     tt_image *atlas = NULL;
@@ -480,6 +530,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
         status = triangle_mesh_report_error(options->mesh_path, m, &error);
         goto done;
     }
+    if ((status = measure_baked(options, m, lapped, corner_uv, atlas, seams)) != 0) goto done;
 
     snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
              tool_basename(png_path));
@@ -527,8 +578,9 @@ static int paste(const lapped_options *options, const triangle_mesh *m, const fl
 }
 
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
-                          const tt_lapped *lapped, double seconds)
+                          const tt_lapped *lapped, const baked_seams *baked, double seconds)
 {
+    char all[256], top[256];
     tt_lapped_report report;
     tt_error error;
     double angle = lapped->mean_angle_error, scale = lapped->median_scale_error;
@@ -552,6 +604,11 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
            options->isotropic ? " (isotropic: against each paste's own direction)" : "");
     printf("cuts: %d of %d edges where the top paste changes end it at %.0f%% alpha or more\n", lapped->visible_cuts,
            lapped->top_changes, 100.0 * TT_LAPPED_VISIBLE_CUT);
+    if (options->bake_size > 0) {
+        tool_format_seams(&baked->all, "edges", all, sizeof all);
+        tool_format_seams(&baked->top_changes, "edges", top, sizeof top);
+        printf("baked seam score: all edges %s; where the top paste changes %s\n", all, top);
+    }
     printf("removed %d hidden face entries; %.1f s\n", lapped->removed_entries, seconds);
 }
 
@@ -580,6 +637,7 @@ int cmd_lapped(int argc, char **argv)
     tt_lapped *lapped = NULL;
     tool_output output;
     float *field = NULL, *bake_uv = NULL;
+    baked_seams baked;
     char obj_path[4096], mtl_path[4096], png_path[4096], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
     int status, own_uvs = 0;
@@ -590,6 +648,7 @@ int cmd_lapped(int argc, char **argv)
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
     snprintf(png_path, sizeof png_path, "%s_patch.png", options.prefix);
     memset(&output, 0, sizeof output);
+    memset(&baked, 0, sizeof baked);
 
     if ((status = triangle_mesh_read(options.mesh_path, &options.mesh, &mesh)) != 0) return status;
     field = (float *)malloc((size_t)mesh.ntriangles * 3 * sizeof(float));
@@ -612,13 +671,13 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped);
     if (status == 0) status = output_add_mtl(&output, mtl_path, "lapped", png_path, 1);
     if (status == 0 && options.bake_size > 0) {
-        status = add_baked(&output, &options, &mesh, lapped, patch, bake_uv);
+        status = add_baked(&output, &options, &mesh, lapped, patch, bake_uv, &baked);
         bake_uv = NULL;   /* add_baked freed it */
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0) {
-        print_summary(&options, &mesh, field, lapped, tool_seconds_now() - start);
+        print_summary(&options, &mesh, field, lapped, &baked, tool_seconds_now() - start);
         printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
         if (options.bake_size > 0)
             printf("; %s_baked.obj/.mtl/.png (%dx%d, over %s)", options.prefix, options.bake_size,

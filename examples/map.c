@@ -101,8 +101,8 @@ int cmd_map(int argc, char **argv)
     }
     if (options.atlas_path) {
         char texture[4096];
-        status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas, options.seed, 0, options.report,
-                                    &seams);
+        status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas, options.seed, 0, NULL, 0,
+                                    options.report, &seams);
         if (status != 0) goto done;
         /* The MTL sits beside the OBJ, and names the atlas relative to itself. */
         snprintf(mtl_path, sizeof mtl_path, "%.*s.mtl",

@@ -7,7 +7,8 @@
 #include "tool.h"
 
 int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
-                       uint64_t seed, unsigned flags, int all_edges, tool_seams *out)
+                       uint64_t seed, unsigned flags, const int *edges, int nedges, int all_edges,
+                       tool_seams *out)
 {
     tt_seam_options options;
     tt_error error;
@@ -22,8 +23,12 @@ int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *c
     options.seed = seed;
     options.flags = flags;
     options.max_edges = all_edges ? 0 : TOOL_REPORT_EDGES;
+    options.edges = edges;
+    options.nedges = nedges;
     result = tt_measure_seams(mesh, corner_uv, atlas, &options, NULL, &out->report, &error);
-    if (flags & TT_SEAM_UV_DISCONTINUOUS) {
+    if (edges) {
+        out->edges = nedges;
+    } else if (flags & TT_SEAM_UV_DISCONTINUOUS) {
         out->edges = out->report.edges_discontinuous;
     } else {
         for (c = 0; c < mesh->ncorners; c++)

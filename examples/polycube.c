@@ -332,10 +332,10 @@ static int measure_quality(const polycube_command_options *options, const polycu
     }
     quality->mesh_built = 1;
     status = tool_measure_seams(options->mesh_path, mapped, job->corner_uv, atlas, options->tiles.seed,
-                                TT_SEAM_UV_DISCONTINUOUS, 0, &quality->borders);
+                                TT_SEAM_UV_DISCONTINUOUS, NULL, 0, 0, &quality->borders);
     if (status == 0)
-        status = tool_measure_seams(options->mesh_path, mapped, job->corner_uv, atlas, options->tiles.seed, 0, 0,
-                                    &quality->all);
+        status = tool_measure_seams(options->mesh_path, mapped, job->corner_uv, atlas, options->tiles.seed, 0, NULL,
+                                    0, 0, &quality->all);
     if (status == 0) {
         /* One tile covers one cube face: the intended density is the tile's
            texels over the cube's edge. */

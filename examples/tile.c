@@ -83,7 +83,7 @@ int cmd_tile(int argc, char **argv)
     image = NULL;
     if (status == 0)
         status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, 0,
-                                    options.report, &seams);
+                                    NULL, 0, options.report, &seams);
     if (status == 0) status = tiled_add_atlas(&output, png_path, tiles, options.mips);
     if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
     if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));

@@ -484,19 +484,21 @@ int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const t
 typedef struct tool_seams {
     int measured;               /* 0: TT_ERROR_NOT_MEASURED, `reason` says why */
     int sampled;                /* 1: fewer edges measured than `edges` */
-    int edges;                  /* the edges the mode measures: every interior edge, or with
-                                   TT_SEAM_UV_DISCONTINUOUS the chart borders */
+    int edges;                  /* the edges the mode measures: every interior edge, with
+                                   TT_SEAM_UV_DISCONTINUOUS the chart borders, or those listed */
     tt_seam_report report;
     char reason[224];           /* the library's sentence, without its full stop */
 } tool_seams;
 
 /* Measure the seams of per-corner UVs on `atlas` for a summary: flags are
-   tt_seam_options.flags; a sample of TOOL_REPORT_EDGES edges, or with
-   all_edges every one. Nothing measurable (a one-face mesh, say) is not an
+   tt_seam_options.flags; edges (nedges of them, each named by a corner) the
+   edges to measure, or NULL for every one the flags allow; a sample of
+   TOOL_REPORT_EDGES edges, or with all_edges every one. Nothing measurable (a one-face mesh, say) is not an
    error: seams->measured is 0. Other library errors are printed as one line
    naming obj_path; returns the exit status. */
 int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
-                       uint64_t seed, unsigned flags, int all_edges, tool_seams *seams);
+                       uint64_t seed, unsigned flags, const int *edges, int nedges, int all_edges,
+                       tool_seams *seams);
 /* The score as a summary says it, `edges` naming what was measured
    ("border edges"): "0.123 (456 of 789 border edges sampled)", "n/a: ..."
    when unrelated places differ no more than neighbours, or "not measured

@@ -636,6 +636,11 @@ cd "$W" || exit 1
 # --bake: over an atlas of triangle pairs (no vt in the OBJ) ...
 newdir
 expect_ok "lapped --bake 256" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --bake 256
+seams_line=$(printf '%s\n' "$OUT" | grep '^baked seam score: ')
+check "lapped --bake: the summary gives the baked seam score over every edge and where the top paste changes" \
+    "'baked seam score: all edges S (1536 of 1536 edges); where the top paste changes S (N of N edges)'" \
+    "$seams_line" \
+    "$(printf '%s\n' "$seams_line" | grep -qE '^baked seam score: all edges -?[0-9]+\.[0-9]{3} \(1536 of 1536 edges\); where the top paste changes -?[0-9]+\.[0-9]{3} \(([0-9]+) of \1 edges\)$'; echo $?)"
 check "lapped --bake: writes out_baked.obj/.mtl/.png too" "6 files" "$(ls -A | tr '\n' ' ')" \
     "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_baked.mtl out_baked.obj out_baked.png out_patch.png " ]; echo $?)"
 check "lapped --bake: 256x256 texture" "256 256" "$(png_size out_baked.png)" \

@@ -1456,6 +1456,7 @@ typedef struct seams_ctx {
     const tt_mesh *mesh;
     const float *uv;
     const tt_image *atlas;
+    const tt_seam_options *options;
 } seams_ctx;
 
 static tt_result oom_seams(void *ctx, const tt_allocator *al)
@@ -1463,7 +1464,7 @@ static tt_result oom_seams(void *ctx, const tt_allocator *al)
     seams_ctx *s = (seams_ctx *)ctx;
     tt_seam_report rep;
     tt_error err;
-    tt_result r = tt_measure_seams(s->mesh, s->uv, s->atlas, NULL, al, &rep, &err);
+    tt_result r = tt_measure_seams(s->mesh, s->uv, s->atlas, s->options, al, &rep, &err);
     if (r != TT_OK && (err.result != r || !isnan(rep.score))) return TT_RESULT_MAX_ENUM;
     return r;
 }
@@ -1494,8 +1495,20 @@ static void test_seams_oom(void)
     s.mesh = mesh;
     s.uv = uv;
     s.atlas = atlas;
+    s.options = NULL;
     oom_reset();
     oom_sweep("tt_measure_seams", oom_seams, &s, TT_OK);
+    /* with an edge list (one more allocation) */
+    {
+        int edges[2] = {0, 5};
+        tt_seam_options listed;
+        memset(&listed, 0, sizeof listed);
+        listed.edges = edges;
+        listed.nedges = 2;
+        s.options = &listed;
+        oom_reset();
+        oom_sweep("tt_measure_seams with an edge list", oom_seams, &s, TT_OK);
+    }
     tt_image_free(atlas);
     tt_mesh_free(mesh);
 }
@@ -1610,6 +1623,128 @@ static void test_seams_discontinuous(void)
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.result == r && err.message[0] && isnan(all.score),
           "unknown seam flag 0x80: expected TT_ERROR_INVALID_ARGUMENT, got %d (\"%s\")", r, err.message);
 done:
+    free(uv);
+    tt_image_free(atlas);
+    tt_mesh_free(mesh);
+}
+
+static int same_seam_report(const tt_seam_report *a, const tt_seam_report *b)
+{
+    return a->seam == b->seam && a->same_face == b->same_face && a->unrelated == b->unrelated &&
+           a->edges_measured == b->edges_measured && a->samples == b->samples &&
+           a->edges_discontinuous == b->edges_discontinuous;
+}
+
+/* An edge list (tt_seam_options.edges) measures just those edges: listing
+   every interior edge, by either corner, is the full measure; listing the
+   chart border is the TT_SEAM_UV_DISCONTINUOUS measure; the edges inside one
+   chart score about 0 where the border scores about 1. Lists that name
+   nothing measurable or no edge at all are refused. */
+static void test_seams_edge_list(void)
+{
+    tt_mesh *mesh = two_chart_grid();
+    tt_image *atlas = NULL;
+    float *uv = NULL;
+    int *list = NULL, nlist, c, boundary = -1;
+    tt_seam_options so;
+    tt_seam_report expected, got;
+    tt_error err;
+    tt_result r;
+    make_value_noise(&atlas, 128, 128, 7);
+    if (mesh) {
+        uv = two_chart_uvs(mesh, 0.4f);
+        list = (int *)malloc((size_t)mesh->ncorners * sizeof(int));
+    }
+    if (!mesh || !atlas || !uv || !list) {
+        CHECK(0, "edge-list setup");
+        goto done;
+    }
+    memset(&so, 0, sizeof so);
+    so.seed = 5;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &expected, &err);
+    /* every interior edge, named by its higher corner (the library visits the lower) */
+    for (nlist = 0, c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] >= 0 && mesh->twin[c] < c) list[nlist++] = c;
+    so.edges = list;
+    so.nedges = nlist;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_OK && nlist == 232 && same_seam_report(&expected, &got),
+          "every edge listed by its other corner: %d, %d listed, score %.6f against %.6f unlisted (%s)", r, nlist,
+          got.score, expected.score, err.message);
+    /* the chart border, found here by comparing the corners' UVs */
+    so.edges = NULL;
+    so.nedges = 0;
+    so.flags = TT_SEAM_UV_DISCONTINUOUS;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &expected, &err);
+    for (nlist = 0, c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], a_end, b_end;
+        if (t < c) continue;
+        a_end = tt_mesh_next(mesh, c);
+        b_end = tt_mesh_next(mesh, t);
+        if (uv[2 * c] != uv[2 * b_end] || uv[2 * c + 1] != uv[2 * b_end + 1] || uv[2 * a_end] != uv[2 * t] ||
+            uv[2 * a_end + 1] != uv[2 * t + 1])
+            list[nlist++] = c;
+    }
+    so.flags = 0;
+    so.edges = list;
+    so.nedges = nlist;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_OK && nlist == 8 && same_seam_report(&expected, &got) && got.score >= 0.8,
+          "the border listed: %d, %d listed (want 8), score %.4f against %.4f for TT_SEAM_UV_DISCONTINUOUS (%s)", r,
+          nlist, got.score, expected.score, err.message);
+    /* the border listed twice and in both directions measures the same edges */
+    for (c = 0; c < 8; c++) list[8 + c] = mesh->twin[list[c]];
+    so.nedges = 16;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_OK && same_seam_report(&expected, &got), "the border listed twice: %d, %d edges measured", r,
+          got.edges_measured);
+    /* the edges inside the charts: continuous, about 0 */
+    for (nlist = 0, c = 0; c < mesh->ncorners; c++) {
+        int k, on_border = 0;
+        if (mesh->twin[c] < c) continue;
+        for (k = 0; k < 8; k++) on_border |= list[k] == c;
+        if (!on_border) list[8 + nlist++] = c;
+    }
+    so.edges = list + 8;
+    so.nedges = nlist;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_OK && got.edges_measured == 224 && fabs(got.score) < 0.15,
+          "the 224 edges inside the charts: %d, %d measured, score %.4f (want about 0)", r, got.edges_measured,
+          got.score);
+    /* listed, but none discontinuous: nothing to measure */
+    so.flags = TT_SEAM_UV_DISCONTINUOUS;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && isnan(got.score) && strstr(err.message, "listed"),
+          "inside edges, discontinuous only: expected TT_ERROR_NOT_MEASURED, got %d (\"%s\")", r, err.message);
+    so.flags = 0;
+    so.nedges = 0;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_ERROR_NOT_MEASURED && isnan(got.score), "an empty list: expected TT_ERROR_NOT_MEASURED, got %d", r);
+    /* bad lists */
+    so.nedges = -1;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "nedges -1: expected TT_ERROR_INVALID_ARGUMENT, got %d", r);
+    so.edges = NULL;
+    so.nedges = 3;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "no list but nedges 3: expected TT_ERROR_INVALID_ARGUMENT, got %d", r);
+    for (c = 0; mesh->twin[c] < 0; c++) {}
+    list[0] = c;
+    list[1] = mesh->ncorners;
+    so.edges = list;
+    so.nedges = 2;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_ERROR_INDEX_OUT_OF_RANGE && err.item == 1,
+          "a listed corner past the end: expected TT_ERROR_INDEX_OUT_OF_RANGE at item 1, got %d at %d", r, err.item);
+    for (c = 0; c < mesh->ncorners && boundary < 0; c++)
+        if (mesh->twin[c] < 0) boundary = c;
+    list[1] = boundary;
+    r = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.item == 1 && strstr(err.message, "boundary"),
+          "a listed boundary edge: expected TT_ERROR_INVALID_ARGUMENT at item 1, got %d at %d (\"%s\")", r, err.item,
+          err.message);
+done:
+    free(list);
     free(uv);
     tt_image_free(atlas);
     tt_mesh_free(mesh);
@@ -2195,6 +2330,7 @@ void run_tiled_tests(void)
     RUN(test_seams_sampled);
     RUN(test_seams_oom);
     RUN(test_seams_discontinuous);
+    RUN(test_seams_edge_list);
     RUN(test_seams_flags_zero_unchanged);
     RUN(test_seams_wrap);
     RUN(test_histogram);

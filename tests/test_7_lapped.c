@@ -3440,6 +3440,98 @@ static void test_lapped_bake_seams(void)
     tt_mesh_free(mesh);
 }
 
+/* The interior edges where the paste on top changes, each named by its
+   lower corner; returns how many (edges holds ncorners). */
+static int lapped_top_change_edges(const tt_mesh *mesh, const tt_lapped *lapped, int *edges)
+{
+    int *top = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces), f, p, e, c, n = 0;
+    for (f = 0; f < mesh->nfaces; f++) top[f] = -1;
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++)
+            top[lapped->faces[e]] = p;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] > c && top[mesh->corner_face[c]] != top[mesh->corner_face[mesh->twin[c]]]) edges[n++] = c;
+    free(top);
+    return n;
+}
+
+/* The acceptance measure of soft edges: the seam score (tt_measure_seams)
+   of the baked texture over an atlas of triangle pairs, over every edge and
+   over the edges where the paste on top changes. Controls that must score
+   badly: the same bake with each face given another face's UVs, and a fully
+   opaque patch (every paste ends with a hard edge). */
+static void test_lapped_baked_seams(void)
+{
+    tt_image *patch = lapped_patch(64, 5), *opaque = lapped_patch(64, 5);
+    double scores[2][2] = {{0, 0}, {0, 0}}, shuffled = 0.0;
+    int which, ok = 1;
+    size_t i;
+    for (i = 0; opaque && i < (size_t)opaque->width * opaque->height; i++) opaque->pixels[4 * i + 3] = 1.0f;
+    for (which = 0; which < 2 && patch && opaque; which++) {
+        tmesh m;
+        tt_mesh *mesh;
+        float *field, *uv = NULL, *moved = NULL;
+        int *edges = NULL, nedges = 0, f, k;
+        tt_lapped *lapped = NULL;
+        tt_image *used = which ? opaque : patch, *atlas = NULL;
+        tt_seam_options so;
+        tt_seam_report rep;
+        tt_error err;
+        make_lapped_shape(&m, 0);
+        if (lapped_run(&m, 0, 11, 0.0f, &mesh, &field, used, &lapped) != 0) {
+            ok = 0;
+            tm_free(&m);
+            continue;
+        }
+        uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+        moved = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+        edges = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners);
+        tt_image_create(512, 512, NULL, &atlas, NULL);
+        ok &= uv && moved && edges && atlas && tt_atlas_pack_pairs(mesh, 512, 2, uv, &err) == TT_OK &&
+              bake_gutter(mesh, lapped, &used, 1, uv, 2, atlas, &err) == TT_OK;
+        if (ok) {
+            memset(&so, 0, sizeof so);
+            so.seed = 3;
+            ok &= tt_measure_seams(mesh, uv, atlas, &so, NULL, &rep, &err) == TT_OK;
+            scores[which][0] = rep.score;
+            nedges = lapped_top_change_edges(mesh, lapped, edges);
+            so.edges = edges;
+            so.nedges = nedges;
+            ok &= nedges > 0 && tt_measure_seams(mesh, uv, atlas, &so, NULL, &rep, &err) == TT_OK;
+            scores[which][1] = rep.score;
+            if (which == 0) {
+                /* each face reads the atlas triangle of the face a third of the mesh further on */
+                for (f = 0; f < mesh->nfaces; f++)
+                    for (k = 0; k < 6; k++)
+                        moved[6 * f + k] = uv[6 * ((f + mesh->nfaces / 3) % mesh->nfaces) + k];
+                so.edges = NULL;
+                so.nedges = 0;
+                ok &= tt_measure_seams(mesh, moved, atlas, &so, NULL, &rep, &err) == TT_OK;
+                shuffled = rep.score;
+            }
+        }
+        free(uv);
+        free(moved);
+        free(edges);
+        tt_image_free(atlas);
+        tt_lapped_free(lapped);
+        tt_mesh_free(mesh);
+        free(field);
+        tm_free(&m);
+    }
+    CHECK(ok && scores[0][0] <= 0.05 && scores[0][1] <= 0.1,
+          "baked seam score with the soft splotch: %.3f over every edge (want <= 0.05), %.3f where the top paste "
+          "changes (want <= 0.1)", scores[0][0], scores[0][1]);
+    CHECK(ok && shuffled >= 0.8, "the control, faces given other faces' UVs: %.3f (want >= 0.8)", shuffled);
+    CHECK(ok && scores[1][1] >= 0.5 && scores[1][1] >= 4.0 * scores[0][1],
+          "the control, an opaque patch: %.3f where the top paste changes (want >= 0.5 and 4 times the splotch's %.3f)",
+          scores[1][1], scores[0][1]);
+    printf("     baked seam score on a sphere: %.3f over every edge, %.3f where the top paste changes; controls: "
+           "shuffled UVs %.3f, an opaque patch %.3f\n", scores[0][0], scores[0][1], shuffled, scores[1][1]);
+    tt_image_free(patch);
+    tt_image_free(opaque);
+}
+
 /* Two faces with the same atlas triangle: the later face's pastes win. */
 static void test_lapped_bake_order(void)
 {
@@ -3832,6 +3924,7 @@ void run_lapped_tests(void)
     RUN(test_atlas_pack_odd);
     RUN(test_atlas_pack_errors);
     RUN(test_lapped_bake_constant);
+    RUN(test_lapped_baked_seams);
     RUN(test_lapped_bake_gutter);
     RUN(test_lapped_bake_seams);
     RUN(test_lapped_bake_order);
