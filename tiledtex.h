@@ -117,7 +117,8 @@
                 - texture patches with soft splotch masks (Sec. 3.1)
                 - the paste loop: surface patches grown over the mesh, aligned
                   with the field by least squares, until covered (Sec. 3.3-3.6)
-                - runtime pasting lists, alignment measure, atlas and baking (Sec. 4)
+                - runtime pasting lists, alignment measure, atlases (triangle
+                  pairs or charts), a UV check, and baking (Sec. 4)
      8. Hierarchical pattern mapping (Soler, Cani, Angelidis, "Hierarchical
                   Pattern Mapping")
                 - the face-cluster hierarchy: components down to single faces,
@@ -1384,8 +1385,9 @@ TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corne
      2. tt_make_texture_patch: the photo with a soft-edged alpha (Sec. 3.1);
      3. tt_lapped_paste: the paste loop, until every face is covered
         (Sec. 3.3-3.6), returning the runtime pasting list (Sec. 4);
-     4. tt_lapped_measure, and tt_atlas_pack_pairs + tt_lapped_bake for an
-        ordinary texture (Sec. 4).
+     4. tt_lapped_measure, and an atlas (tt_atlas_pack_charts, or
+        tt_atlas_pack_pairs; tt_uv_check says whether the mesh's own UVs
+        would do) + tt_lapped_bake for an ordinary texture (Sec. 4).
    Memory per photo pixel, besides the photo (16 bytes, yours): the patch
    holds 16 bytes, and making it takes nothing more (its scratch lives in
    the patch's own pixels); the paste loop keeps 4 bytes per patch pixel
@@ -1756,6 +1758,83 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
    (TT_ERROR_IMAGE_TOO_SMALL; the message gives the smallest size that
    works). */
 TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, float *corner_uv, tt_error *error);
+
+/* An atlas of charts (Sec. 4 "rendering with a texture atlas", made
+   automatically): far fewer seams and one texel density, where the pair
+   atlas above gives every triangle the same texel area whatever its size.
+   Charts come from the mesh alone (so an atlas that cannot fit is known
+   before anything is pasted): each grows breadth-first from the lowest
+   unplaced face across edges, taking a face when its normal lies within
+   TT_ATLAS_CHART_CONE degrees of the seed face's and its image, projected
+   on the plane perpendicular to the seed's normal, overlaps none of the
+   chart's faces already taken (tested in a hashed grid); a face refused
+   starts or joins a later chart. Within the cone every face keeps its
+   winding (no flips), and the projection shrinks a face's area by at most
+   cos(cone), so density varies by at most sqrt(1 / cos(cone)) across a
+   chart, less after each chart is scaled to keep its total area. Each
+   chart is turned to its smallest bounding box (16 angles tried), laid
+   with its long side across, and the boxes, `gutter` texels of margin on
+   every side (2 * gutter between charts), are packed in shelves by
+   decreasing height; the largest scale that fits size x size is found by
+   bisection. Faces of zero area (permissive meshes) join a neighbouring
+   chart. */
+
+/* Degrees: the normals of a chart's faces stay within this of its seed face's normal. */
+#define TT_ATLAS_CHART_CONE 40.0
+
+typedef struct tt_chart_atlas_report {
+    int ncharts;
+    double texels_per_unit;     /* atlas texels per mesh unit of length, the same on every chart */
+    double fill;                /* fraction of the atlas the triangles cover */
+} tt_chart_atlas_report;
+
+/* corner_uv gets 2 floats per corner (mesh->ncorners * 2, origin
+   bottom-left), report (may be NULL) the charts made. The texels within
+   `gutter` of a chart's triangles belong to no other chart (what
+   tt_lapped_bake with that gutter fills). Errors: NULL mesh or corner_uv,
+   non-triangles (error->face), size outside [1, TT_MAX_IMAGE_SIZE], gutter
+   < 0, a half-set allocator (TT_ERROR_INVALID_ARGUMENT); charts that do
+   not fit even when shrunk to nothing - each needs 2 * gutter + 1 texels a
+   side (TT_ERROR_IMAGE_TOO_SMALL; the message gives the smallest size that
+   holds them); TT_ERROR_OUT_OF_MEMORY. corner_uv is written only on
+   success. Temporary memory only: about 200 bytes per face. Time O(faces)
+   for the charts (with the faces of a chart in a bounded number of grid
+   cells each) and O(charts log charts) for the packing. Deterministic;
+   reentrant and thread-safe on distinct outputs. */
+TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_allocator *allocator,
+                                     float *corner_uv, tt_chart_atlas_report *report, tt_error *error);
+
+/* What tt_uv_check finds first, in this order of kinds (each the lowest face). */
+typedef enum tt_uv_problem {
+    TT_UV_USABLE = 0,       /* none: every triangle has its own part of [0, 1]^2 */
+    TT_UV_NON_FINITE,       /* face: a corner's UV is NaN or infinite */
+    TT_UV_OUTSIDE,          /* face: a corner's UV lies outside [0, 1] */
+    TT_UV_DEGENERATE,       /* face: its UV triangle has zero area */
+    TT_UV_FLIPPED,          /* face: its UV triangle turns the other way from most of them */
+    TT_UV_OVERLAP           /* face and other_face: their UV triangles overlap */
+} tt_uv_problem;
+
+typedef struct tt_uv_report {
+    tt_uv_problem problem;
+    int face, other_face;   /* where; -1 when unused */
+    int flipped_faces;      /* how many turn the other way from most (0 unless problem >= TT_UV_FLIPPED) */
+} tt_uv_report;
+
+/* Can texture coordinates (2 per corner, e.g. an OBJ's) take a bake, each
+   texel belonging to one triangle? They must be finite, inside [0, 1],
+   every triangle of non-zero area turning the same way, and no two
+   triangles overlapping by more than 1e-6 (a 250th of a texel at 4096:
+   triangles sharing an edge or touching do not count). The problems found
+   are the answer, in *report (the first kind of the list that occurs, at
+   its lowest face; an overlap names the pair found first), not errors:
+   the result is TT_OK whenever the check ran. Overlaps are found in a
+   hashed grid of about one cell per triangle, each triangle tested
+   against those sharing a cell with it: O(faces) for ordinary layouts.
+   Errors: NULL mesh, corner_uv or report, non-triangles (error->face), a
+   half-set allocator (TT_ERROR_INVALID_ARGUMENT); TT_ERROR_OUT_OF_MEMORY.
+   Temporary memory only; reentrant and thread-safe. */
+TTDEF tt_result tt_uv_check(const tt_mesh *mesh, const float *corner_uv, const tt_allocator *allocator,
+                            tt_uv_report *report, tt_error *error);
 
 typedef struct tt_bake_options {
     int gutter;             /* texels past each triangle's image filled by extrapolating its
@@ -11062,6 +11141,696 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
         }
     }
     return tt__ok(error);
+}
+
+/* ---- Triangles in a hashed grid: which ones overlap (the chart atlas, tt_uv_check) ---- */
+
+/* 1 when triangles a and b (x, y of three corners each) overlap by more than
+   eps. Separating axes: two convex polygons whose interiors are disjoint are
+   separated along a normal of one of their edges, so the triangles overlap
+   when no edge normal of either keeps them eps apart. Triangles that share an
+   edge or only touch do not overlap, nor does one of zero area. */
+static int tt__triangles_overlap(const double *a, const double *b, double eps)
+{
+    const double *tri[2];
+    int t, i, k, j;
+    if (tt__orient2(a[0], a[1], a[2], a[3], a[4], a[5]) == 0.0 || tt__orient2(b[0], b[1], b[2], b[3], b[4], b[5]) == 0.0)
+        return 0;
+    tri[0] = a;
+    tri[1] = b;
+    for (t = 0; t < 2; t++)
+        for (i = 0; i < 3; i++) {
+            const double *p = tri[t] + 2 * i, *q = tri[t] + 2 * ((i + 1) % 3);
+            double nx = p[1] - q[1], ny = q[0] - p[0], length = sqrt(nx * nx + ny * ny), lo[2], hi[2];
+            if (!(length > 0.0)) continue;
+            nx /= length;
+            ny /= length;
+            for (k = 0; k < 2; k++) {
+                lo[k] = hi[k] = nx * tri[k][0] + ny * tri[k][1];
+                for (j = 1; j < 3; j++) {
+                    double d = nx * tri[k][2 * j] + ny * tri[k][2 * j + 1];
+                    if (d < lo[k]) lo[k] = d;
+                    if (d > hi[k]) hi[k] = d;
+                }
+            }
+            if (hi[0] <= lo[1] + eps || hi[1] <= lo[0] + eps) return 0;
+        }
+    return 1;
+}
+
+/* The x range of triangle t inside the slab y0 <= y <= y1: the ends of its
+   edges clipped to the slab (the extremes of a convex polygon are at its
+   vertices). 0 when the triangle misses the slab. */
+static int tt__triangle_slab(const double *t, double y0, double y1, double *x0, double *x1)
+{
+    int i, any = 0;
+    for (i = 0; i < 3; i++) {
+        const double *p = t + 2 * i, *q = t + 2 * ((i + 1) % 3);
+        double from = 0.0, to = 1.0, dy = q[1] - p[1], xa, xb;
+        if (dy == 0.0) {
+            if (p[1] < y0 || p[1] > y1) continue;
+        } else {
+            double s0 = (y0 - p[1]) / dy, s1 = (y1 - p[1]) / dy;
+            if (s0 > s1) { double swap = s0; s0 = s1; s1 = swap; }
+            if (s0 > from) from = s0;
+            if (s1 < to) to = s1;
+            if (from > to) continue;
+        }
+        xa = p[0] + from * (q[0] - p[0]);
+        xb = p[0] + to * (q[0] - p[0]);
+        if (!any) *x0 = *x1 = xa;
+        any = 1;
+        if (xa < *x0) *x0 = xa;
+        if (xa > *x1) *x1 = xa;
+        if (xb < *x0) *x0 = xb;
+        if (xb > *x1) *x1 = xb;
+    }
+    return any;
+}
+
+/* One grid cell a triangle meets, in its bucket's list. */
+typedef struct tt__tri_cell {
+    int cx, cy;
+    int tri;
+    int next;               /* next entry of the bucket, -1 at its end */
+} tt__tri_cell;
+
+/* Triangles (6 doubles each in xy, the caller's) filed under the square
+   cells of side `cell` they meet - exactly those, row by row, not their
+   bounding boxes, so a long sliver takes a line of cells - in a hash table
+   of cells, so the grid needs no bounds. */
+typedef struct tt__tri_grid {
+    const tt_allocator *al;
+    const double *xy;
+    double cell;
+    int *bucket;            /* mask + 1 of them: first entry, -1 when empty */
+    unsigned mask;
+    tt__tri_cell *entry;
+    int nentries, capacity;
+    int *seen;              /* per triangle: the query that last tested it */
+    int ntriangles, query;
+} tt__tri_grid;
+
+static void tt__tri_grid_free(tt__tri_grid *g)
+{
+    tt__free(g->al, g->bucket);
+    tt__free(g->al, g->entry);
+    tt__free(g->al, g->seen);
+    g->bucket = NULL;
+    g->entry = NULL;
+    g->seen = NULL;
+}
+
+/* A grid for triangles 0 .. ntriangles - 1; 0 when out of memory (then
+   nothing is held). */
+static int tt__tri_grid_init(tt__tri_grid *g, const tt_allocator *al, const double *xy, int ntriangles, double cell)
+{
+    unsigned buckets = 64;
+    int i;
+    memset(g, 0, sizeof *g);
+    g->al = al;
+    g->xy = xy;
+    g->cell = cell;
+    g->ntriangles = ntriangles;
+    while (buckets < (unsigned)ntriangles * 2u && buckets < (1u << 26)) buckets *= 2u;
+    g->mask = buckets - 1u;
+    g->bucket = TT__ALLOC(al, int, buckets);
+    g->seen = TT__ALLOC(al, int, ntriangles);
+    if (!g->bucket || !g->seen) {
+        tt__tri_grid_free(g);
+        return 0;
+    }
+    for (i = 0; i < (int)buckets; i++) g->bucket[i] = -1;
+    for (i = 0; i < ntriangles; i++) g->seen[i] = 0;
+    return 1;
+}
+
+static unsigned tt__tri_grid_bucket(const tt__tri_grid *g, int cx, int cy)
+{
+    return ((unsigned)cx * 73856093u ^ (unsigned)cy * 19349663u) & g->mask;
+}
+
+/* The cell index of coordinate x, kept inside int. */
+static int tt__tri_grid_index(const tt__tri_grid *g, double x)
+{
+    double i = floor(x / g->cell);
+    return i < -1e9 ? -1000000000 : (i > 1e9 ? 1000000000 : (int)i);
+}
+
+/* The rows of cells triangle t meets, and in row cy its columns. */
+static void tt__tri_grid_rows(const tt__tri_grid *g, const double *t, int *cy0, int *cy1)
+{
+    double lo = t[1], hi = t[1];
+    if (t[3] < lo) lo = t[3];
+    if (t[3] > hi) hi = t[3];
+    if (t[5] < lo) lo = t[5];
+    if (t[5] > hi) hi = t[5];
+    *cy0 = tt__tri_grid_index(g, lo);
+    *cy1 = tt__tri_grid_index(g, hi);
+}
+
+static int tt__tri_grid_columns(const tt__tri_grid *g, const double *t, int cy, int *cx0, int *cx1)
+{
+    double x0, x1;
+    if (!tt__triangle_slab(t, cy * g->cell, (cy + 1.0) * g->cell, &x0, &x1)) return 0;
+    *cx0 = tt__tri_grid_index(g, x0);
+    *cx1 = tt__tri_grid_index(g, x1);
+    return 1;
+}
+
+/* File triangle tri under its cells; 0 when out of memory. */
+static int tt__tri_grid_insert(tt__tri_grid *g, int tri)
+{
+    const double *t = g->xy + 6 * (size_t)tri;
+    int cy, cy0, cy1, cx, cx0, cx1;
+    tt__tri_grid_rows(g, t, &cy0, &cy1);
+    for (cy = cy0; cy <= cy1; cy++) {
+        if (!tt__tri_grid_columns(g, t, cy, &cx0, &cx1)) continue;
+        for (cx = cx0; cx <= cx1; cx++) {
+            unsigned b = tt__tri_grid_bucket(g, cx, cy);
+            tt__tri_cell *e;
+            if (g->nentries == g->capacity) {
+                tt__tri_cell *grown =
+                    (tt__tri_cell *)tt__grow(g->al, g->entry, &g->capacity, g->nentries + 1, sizeof(tt__tri_cell));
+                if (!grown) return 0;
+                g->entry = grown;
+            }
+            e = g->entry + g->nentries;
+            e->cx = cx;
+            e->cy = cy;
+            e->tri = tri;
+            e->next = g->bucket[b];
+            g->bucket[b] = g->nentries++;
+        }
+    }
+    return 1;
+}
+
+/* A filed triangle that overlaps triangle tri (of the same xy) by more than
+   eps, or -1; each filed triangle is tested once however many cells it
+   shares with tri. */
+static int tt__tri_grid_overlap(tt__tri_grid *g, int tri, double eps)
+{
+    const double *t = g->xy + 6 * (size_t)tri;
+    int cy, cy0, cy1, cx, cx0, cx1, e;
+    if (g->query == INT_MAX) {
+        /* The stamps wrap: forget them all once. */
+        memset(g->seen, 0, sizeof(int) * (size_t)g->ntriangles);
+        g->query = 0;
+    }
+    g->query++;
+    tt__tri_grid_rows(g, t, &cy0, &cy1);
+    for (cy = cy0; cy <= cy1; cy++) {
+        if (!tt__tri_grid_columns(g, t, cy, &cx0, &cx1)) continue;
+        for (cx = cx0; cx <= cx1; cx++)
+            for (e = g->bucket[tt__tri_grid_bucket(g, cx, cy)]; e >= 0; e = g->entry[e].next) {
+                const tt__tri_cell *c = g->entry + e;
+                if (c->cx != cx || c->cy != cy || g->seen[c->tri] == g->query) continue;
+                g->seen[c->tri] = g->query;
+                if (tt__triangles_overlap(t, g->xy + 6 * (size_t)c->tri, eps)) return c->tri;
+            }
+    }
+    return -1;
+}
+
+/* Empty the grid for the next set of triangles (its buckets reset through
+   its own entries: time for what was filed, not for the table). */
+static void tt__tri_grid_clear(tt__tri_grid *g)
+{
+    int e;
+    for (e = 0; e < g->nentries; e++) g->bucket[tt__tri_grid_bucket(g, g->entry[e].cx, g->entry[e].cy)] = -1;
+    g->nentries = 0;
+}
+
+/* ---- The chart atlas ---- */
+
+/* u, v: an orthonormal basis of the plane perpendicular to the unit vector
+   n, with u x v = n, so that counter-clockwise about n stays
+   counter-clockwise in (u, v). u starts from the world axis least along n. */
+static void tt__plane_frame(const double *n, double *u, double *v)
+{
+    int k, least = 0;
+    for (k = 1; k < 3; k++)
+        if (fabs(n[k]) < fabs(n[least])) least = k;
+    u[0] = u[1] = u[2] = 0.0;
+    u[least] = 1.0;
+    tt__project3(u, n, u);
+    tt__normalize3(u);
+    tt__cross3(n, u, v);
+}
+
+/* A chart: faces members[first .. first + count - 1]; once shaped, its
+   corners (xy) lie in [0, width] x [0, height], mesh units. */
+typedef struct tt__chart {
+    int first, count;
+    double width, height;
+} tt__chart;
+
+/* Packing order: taller first, then wider, then by index (deterministic). */
+typedef struct tt__chart_order {
+    double height, width;
+    int chart;
+} tt__chart_order;
+
+#define TT__CHART_BEFORE(a, b)                                                                                 \
+    ((a).height > (b).height ||                                                                               \
+     ((a).height == (b).height && ((a).width > (b).width || ((a).width == (b).width && (a).chart < (b).chart))))
+TT__DEFINE_HEAPSORT_BY(tt__sort_chart_order, tt__chart_order, TT__CHART_BEFORE)
+
+/* Face `face`'s corners projected on the plane (origin, u, v): 6 doubles. */
+static void tt__chart_project(const tt_mesh *mesh, int face, const double *origin, const double *u, const double *v,
+                              double *out)
+{
+    int k;
+    for (k = 0; k < 3; k++) {
+        const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[face] + k];
+        double d[3];
+        d[0] = p[0] - origin[0];
+        d[1] = p[1] - origin[1];
+        d[2] = p[2] - origin[2];
+        out[2 * k] = tt__dot3(d, u);
+        out[2 * k + 1] = tt__dot3(d, v);
+    }
+}
+
+/* Bounds (lo x, lo y, hi x, hi y) of a chart's corners mapped by
+   (x, y) -> (a x - b y, b x + a y). */
+static void tt__chart_bounds(const double *xy, const int *faces, int count, double a, double b, double box[4])
+{
+    int i, k;
+    box[0] = box[1] = 1e300;
+    box[2] = box[3] = -1e300;
+    for (i = 0; i < count; i++)
+        for (k = 0; k < 3; k++) {
+            const double *p = xy + 6 * (size_t)faces[i] + 2 * k;
+            double x = a * p[0] - b * p[1], y = b * p[0] + a * p[1];
+            if (x < box[0]) box[0] = x;
+            if (y < box[1]) box[1] = y;
+            if (x > box[2]) box[2] = x;
+            if (y > box[3]) box[3] = y;
+        }
+}
+
+/* Angles tried per quarter turn for a chart's smallest bounding box. */
+#define TT__CHART_ANGLES 16
+
+/* Scale a chart's projection to its surface area (the projection shrank
+   each face by the cosine of its tilt: scaled back, the chart's density is
+   its faces' mean), turn it to its smallest bounding box among
+   TT__CHART_ANGLES angles (a quarter turn more when it is then taller than
+   wide: shelves of flat boxes waste less), and move it to start at (0, 0).
+   Turns and a positive scale keep every face's winding. */
+static void tt__chart_shape(const double *area, const int *members, double *xy, tt__chart *chart)
+{
+    const int *faces = members + chart->first;
+    double projected = 0.0, surface = 0.0, scale = 1.0, best = -1.0, best_angle = 0.0, a, b, box[4];
+    int i, k;
+    for (i = 0; i < chart->count; i++) {
+        const double *t = xy + 6 * (size_t)faces[i];
+        projected += 0.5 * fabs(tt__orient2(t[0], t[1], t[2], t[3], t[4], t[5]));
+        surface += area[faces[i]];
+    }
+    if (projected > 0.0 && surface > 0.0) scale = sqrt(surface / projected);
+    for (k = 0; k < TT__CHART_ANGLES; k++) {
+        double angle = k * (0.5 * TT__PI) / TT__CHART_ANGLES, box_area;
+        tt__chart_bounds(xy, faces, chart->count, cos(angle), sin(angle), box);
+        box_area = (box[2] - box[0]) * (box[3] - box[1]);
+        if (best < 0.0 || box_area < best) {
+            best = box_area;
+            best_angle = angle;
+        }
+    }
+    a = cos(best_angle) * scale;
+    b = sin(best_angle) * scale;
+    tt__chart_bounds(xy, faces, chart->count, a, b, box);
+    if (box[3] - box[1] > box[2] - box[0]) {
+        double turned = a;   /* (a, b) turned a quarter: cos(t + 90) = -sin t, sin(t + 90) = cos t */
+        a = -b;
+        b = turned;
+        tt__chart_bounds(xy, faces, chart->count, a, b, box);
+    }
+    for (i = 0; i < chart->count; i++)
+        for (k = 0; k < 3; k++) {
+            double *p = xy + 6 * (size_t)faces[i] + 2 * k, x = p[0];
+            p[0] = a * x - b * p[1] - box[0];
+            p[1] = b * x + a * p[1] - box[1];
+        }
+    chart->width = box[2] - box[0];
+    chart->height = box[3] - box[1];
+}
+
+/* A chart's box at scale s (texels per mesh unit): the chart plus `gutter`
+   texels on every side, whole texels, at least one. */
+static double tt__chart_box(double extent, double s, int gutter)
+{
+    double texels = ceil(s * extent + 2.0 * gutter);
+    return texels < 1.0 ? 1.0 : texels;
+}
+
+/* Shelf packing: the boxes in `order` left to right along a shelf, the next
+   shelf below the tallest box of the last (image rows grow down). 1 when
+   all fit in size x size; then (x, y), if given, get each chart's box's
+   top-left texel. */
+static int tt__pack_shelves(const tt__chart *charts, const tt__chart_order *order, int n, double s, int gutter,
+                            int size, int *x, int *y)
+{
+    int i, at_x = 0, at_y = 0, shelf = 0;
+    for (i = 0; i < n; i++) {
+        const tt__chart *chart = charts + order[i].chart;
+        double w = tt__chart_box(chart->width, s, gutter), h = tt__chart_box(chart->height, s, gutter);
+        if (w > size || h > size) return 0;
+        if (at_x + (int)w > size) {
+            at_y += shelf;
+            at_x = 0;
+            shelf = 0;
+        }
+        if (at_y + (int)h > size) return 0;
+        if (x) {
+            x[order[i].chart] = at_x;
+            y[order[i].chart] = at_y;
+        }
+        at_x += (int)w;
+        if ((int)h > shelf) shelf = (int)h;
+    }
+    return 1;
+}
+
+/* The charts of the mesh (see tt_atlas_pack_charts): chart[f] for every
+   face, members listing each chart's faces in the order they joined, xy
+   their projections (6 per face). Returns the number of charts, or -1 when
+   out of memory. */
+static int tt__grow_charts(const tt_mesh *mesh, const double *normal, const double *area, tt__tri_grid *grid,
+                           double eps, int *chart, int *tried, int *members, tt__chart *charts, double *xy)
+{
+    const double cos_cone = cos(TT_ATLAS_CHART_CONE * TT__PI / 180.0), up[3] = {0.0, 0.0, 1.0};
+    int nf = mesh->nfaces, ncharts = 0, placed = 0, zero_area, seed, f, k;
+    for (f = 0; f < nf; f++) {
+        chart[f] = -1;
+        tried[f] = -1;
+    }
+    /* Faces with an area seed the charts; a face of zero area has no normal
+       and never overlaps, so it joins the first chart that reaches it, and
+       one no chart reached (all its neighbours have zero area too) makes a
+       chart of its own afterwards. */
+    for (zero_area = 0; zero_area < 2; zero_area++)
+        for (seed = 0; seed < nf; seed++) {
+            const double *axis = zero_area ? up : normal + 3 * (size_t)seed;
+            double u[3], v[3], origin[3];
+            int c = ncharts, head;
+            if (chart[seed] >= 0 || (area[seed] == 0.0) != zero_area) continue;
+            ncharts++;
+            tt__plane_frame(axis, u, v);
+            tt__face_centroid(mesh, seed, origin);
+            charts[c].first = placed;
+            tt__chart_project(mesh, seed, origin, u, v, xy + 6 * (size_t)seed);
+            if (!tt__tri_grid_insert(grid, seed)) return -1;
+            chart[seed] = c;
+            members[placed++] = seed;
+            /* Breadth-first: the chart stays round, its border short. */
+            for (head = charts[c].first; head < placed; head++) {
+                int from = members[head];
+                for (k = 0; k < 3; k++) {
+                    int twin = mesh->twin[mesh->face_start[from] + k], face;
+                    if (twin < 0) continue;
+                    face = mesh->corner_face[twin];
+                    if (chart[face] >= 0 || tried[face] == c) continue;
+                    tried[face] = c;   /* a refusal stands: the chart only grows */
+                    if (area[face] > 0.0 && tt__dot3(normal + 3 * (size_t)face, axis) < cos_cone) continue;
+                    tt__chart_project(mesh, face, origin, u, v, xy + 6 * (size_t)face);
+                    if (area[face] > 0.0 && tt__tri_grid_overlap(grid, face, eps) >= 0) continue;
+                    if (!tt__tri_grid_insert(grid, face)) return -1;
+                    chart[face] = c;
+                    members[placed++] = face;
+                }
+            }
+            charts[c].count = placed - charts[c].first;
+            tt__tri_grid_clear(grid);
+        }
+    return ncharts;
+}
+
+/* Sec. 4 "rendering with a texture atlas", the charts made automatically;
+   see the declaration for the method. The scale is bisected between a size
+   at which every chart is under a millionth of a texel (when even that does
+   not fit, nothing does) and the one at which the charts' boxes alone would
+   fill the atlas. */
+TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_allocator *allocator,
+                                     float *corner_uv, tt_chart_atlas_report *report, tt_error *error)
+{
+    const tt_allocator *al = allocator;
+    double *normal = NULL, *area = NULL, *xy = NULL;
+    int *chart = NULL, *tried = NULL, *members = NULL, *box_x = NULL, *box_y = NULL;
+    tt__chart *charts = NULL;
+    tt__chart_order *order = NULL;
+    tt__tri_grid grid;
+    double lo[3], hi[3], edges = 0.0, longest = 0.0, surface = 0.0, boxes = 0.0, largest = 0.0;
+    double cell, diagonal, tiny, s_lo, s_hi;
+    int nf, f, k, c, i, ncharts;
+    tt_result result;
+
+    tt__ok(error);
+    if (report) memset(report, 0, sizeof *report);
+    if (!mesh || !corner_uv)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_atlas_pack_charts needs a mesh and an output array (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (size < 1 || size > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "atlas size %d is outside 1..%d", size,
+                        TT_MAX_IMAGE_SIZE);
+    if (gutter < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
+    nf = mesh->nfaces;
+    for (f = 0; f < nf; f++) {
+        int count = mesh->face_start[f + 1] - mesh->face_start[f];
+        if (count != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners: the atlas packs triangles only", f, count);
+    }
+
+    memset(&grid, 0, sizeof grid);
+    normal = TT__ALLOC(al, double, 3 * (size_t)nf);
+    area = TT__ALLOC(al, double, nf);
+    xy = TT__ALLOC(al, double, 6 * (size_t)nf);
+    chart = TT__ALLOC(al, int, nf);
+    tried = TT__ALLOC(al, int, nf);
+    members = TT__ALLOC(al, int, nf);
+    charts = TT__ALLOC(al, tt__chart, nf);
+    order = TT__ALLOC(al, tt__chart_order, nf);
+    box_x = TT__ALLOC(al, int, nf);
+    box_y = TT__ALLOC(al, int, nf);
+    if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !box_x || !box_y ||
+        !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
+        goto out_of_memory;
+
+    /* The grid's cells: the mean edge, but no face across more than 32 of
+       them (very uneven meshes), so every face meets a bounded number. */
+    lo[0] = lo[1] = lo[2] = 1e300;
+    hi[0] = hi[1] = hi[2] = -1e300;
+    for (f = 0; f < nf; f++) {
+        if (tt__face_normal_d(mesh, f, normal + 3 * (size_t)f)) area[f] = tt__face_area_d(mesh, f);
+        else area[f] = 0.0;
+        surface += area[f];
+        for (k = 0; k < 3; k++) {
+            const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + k];
+            const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + (k + 1) % 3];
+            double d[3], length;
+            int j;
+            tt__sub3f(q, p, d);
+            length = tt__length3(d);
+            edges += length;
+            if (length > longest) longest = length;
+            for (j = 0; j < 3; j++) {
+                if (p[j] < lo[j]) lo[j] = p[j];
+                if (p[j] > hi[j]) hi[j] = p[j];
+            }
+        }
+    }
+    cell = nf > 0 ? edges / (3.0 * nf) : 1.0;
+    if (cell < longest / 32.0) cell = longest / 32.0;
+    if (!(cell > 0.0)) cell = 1.0;
+    grid.cell = cell;
+    diagonal = nf > 0 ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                             (hi[2] - lo[2]) * (hi[2] - lo[2]))
+                      : 1.0;
+    /* Overlaps smaller than this are rounding (neighbours share an edge). */
+    ncharts = tt__grow_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), chart, tried,
+                              members, charts, xy);
+    if (ncharts < 0) goto out_of_memory;
+
+    for (c = 0; c < ncharts; c++) {
+        tt__chart_shape(area, members, xy, charts + c);
+        order[c].height = charts[c].height;
+        order[c].width = charts[c].width;
+        order[c].chart = c;
+        boxes += charts[c].width * charts[c].height;
+        if (charts[c].width > largest) largest = charts[c].width;
+    }
+    tt__sort_chart_order(order, ncharts);
+
+    tiny = largest > 0.0 ? 1e-6 / largest : 1.0;
+    if (!tt__pack_shelves(charts, order, ncharts, tiny, gutter, size, NULL, NULL)) {
+        /* The smallest size that holds them: tiny boxes pack monotonically in the size. */
+        int fits = TT_MAX_IMAGE_SIZE + 1, fails = size;
+        if (tt__pack_shelves(charts, order, ncharts, tiny, gutter, TT_MAX_IMAGE_SIZE, NULL, NULL)) {
+            fits = TT_MAX_IMAGE_SIZE;
+            while (fits - fails > 1) {
+                int mid = fails + (fits - fails) / 2;
+                if (tt__pack_shelves(charts, order, ncharts, tiny, gutter, mid, NULL, NULL)) fits = mid;
+                else fails = mid;
+            }
+            result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                              "%d charts need at least %d x %d texels each for gutter %d: they do not fit %d x %d, "
+                              "the smallest size that holds them is %d (with the charts shrunk to nothing)",
+                              ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, size, size, fits);
+        } else {
+            result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                              "%d charts need at least %d x %d texels each for gutter %d: more than the limit of %d "
+                              "x %d holds; lower the gutter",
+                              ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
+        }
+        goto done;
+    }
+    s_lo = tiny;
+    s_hi = boxes > 0.0 ? size / sqrt(boxes) : tiny;
+    if (s_hi < s_lo) s_hi = s_lo;
+    if (tt__pack_shelves(charts, order, ncharts, s_hi, gutter, size, NULL, NULL)) s_lo = s_hi;
+    for (i = 0; i < 100 && s_hi - s_lo > 1e-6 * s_hi; i++) {
+        double mid = 0.5 * (s_lo + s_hi);
+        if (tt__pack_shelves(charts, order, ncharts, mid, gutter, size, NULL, NULL)) s_lo = mid;
+        else s_hi = mid;
+    }
+    tt__pack_shelves(charts, order, ncharts, s_lo, gutter, size, box_x, box_y);
+
+    for (c = 0; c < ncharts; c++)
+        for (i = 0; i < charts[c].count; i++) {
+            int face = members[charts[c].first + i];
+            for (k = 0; k < 3; k++) {
+                const double *p = xy + 6 * (size_t)face + 2 * k;
+                int corner = mesh->face_start[face] + k;
+                /* The chart's y grows up, image rows down: its top at the box's top. */
+                double tx = box_x[c] + gutter + s_lo * p[0];
+                double ty = box_y[c] + gutter + s_lo * (charts[c].height - p[1]);
+                corner_uv[2 * (size_t)corner] = tt__clamp_f((float)(tx / size), 0.0f, 1.0f);
+                corner_uv[2 * (size_t)corner + 1] = tt__clamp_f((float)(1.0 - ty / size), 0.0f, 1.0f);
+            }
+        }
+    if (report) {
+        report->ncharts = ncharts;
+        report->texels_per_unit = s_lo;
+        report->fill = s_lo * s_lo * surface / ((double)size * size);
+    }
+    result = tt__ok(error);
+    goto done;
+
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory making a chart atlas of %d faces",
+                      nf);
+done:
+    tt__tri_grid_free(&grid);
+    tt__free(al, normal);
+    tt__free(al, area);
+    tt__free(al, xy);
+    tt__free(al, chart);
+    tt__free(al, tried);
+    tt__free(al, members);
+    tt__free(al, charts);
+    tt__free(al, order);
+    tt__free(al, box_x);
+    tt__free(al, box_y);
+    return result;
+}
+
+TTDEF tt_result tt_uv_check(const tt_mesh *mesh, const float *corner_uv, const tt_allocator *allocator,
+                            tt_uv_report *report, tt_error *error)
+{
+    const tt_allocator *al = allocator;
+    double *xy = NULL;
+    tt__tri_grid grid;
+    int nf, f, k, positive = 0, negative = 0, side;
+    tt_result result = TT_OK;
+
+    tt__ok(error);
+    if (!mesh || !corner_uv || !report)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_uv_check needs a mesh, UVs and a report (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    memset(report, 0, sizeof *report);
+    report->problem = TT_UV_USABLE;
+    report->face = report->other_face = -1;
+    nf = mesh->nfaces;
+    for (f = 0; f < nf; f++) {
+        int count = mesh->face_start[f + 1] - mesh->face_start[f];
+        if (count != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners: the UV check takes triangles only", f, count);
+    }
+    for (f = 0; f < nf && report->problem == TT_UV_USABLE; f++)
+        for (k = 0; k < 6; k++)
+            if (!tt__is_finite(corner_uv[6 * (size_t)f + k])) {
+                report->problem = TT_UV_NON_FINITE;
+                report->face = f;
+                break;
+            }
+    for (f = 0; f < nf && report->problem == TT_UV_USABLE; f++)
+        for (k = 0; k < 6; k++)
+            if (!(corner_uv[6 * (size_t)f + k] >= 0.0f && corner_uv[6 * (size_t)f + k] <= 1.0f)) {
+                report->problem = TT_UV_OUTSIDE;
+                report->face = f;
+                break;
+            }
+    if (report->problem != TT_UV_USABLE) return TT_OK;
+
+    xy = TT__ALLOC(al, double, 6 * (size_t)nf);
+    if (!xy) goto out_of_memory;
+    for (f = 0; f < nf; f++) {
+        double *t = xy + 6 * (size_t)f, area2;
+        for (k = 0; k < 6; k++) t[k] = corner_uv[6 * (size_t)f + k];
+        area2 = tt__orient2(t[0], t[1], t[2], t[3], t[4], t[5]);
+        positive += area2 > 0.0;
+        negative += area2 < 0.0;
+        if (area2 == 0.0 && report->problem == TT_UV_USABLE) {
+            report->problem = TT_UV_DEGENERATE;
+            report->face = f;
+        }
+    }
+    /* Most triangles decide the winding; the rest are flipped. */
+    side = positive >= negative ? 1 : -1;
+    report->flipped_faces = side > 0 ? negative : positive;
+    for (f = 0; f < nf && report->problem == TT_UV_USABLE; f++) {
+        const double *t = xy + 6 * (size_t)f;
+        if (tt__orient2(t[0], t[1], t[2], t[3], t[4], t[5]) * side < 0.0) {
+            report->problem = TT_UV_FLIPPED;
+            report->face = f;
+        }
+    }
+    if (report->problem != TT_UV_USABLE) goto done;
+
+    /* About one cell per triangle over the unit square. */
+    if (!tt__tri_grid_init(&grid, al, xy, nf, 1.0 / tt__clamp_i((int)ceil(sqrt((double)nf)), 1, 4096)))
+        goto out_of_memory;
+    for (f = 0; f < nf; f++) {
+        int other = tt__tri_grid_overlap(&grid, f, 1e-6);
+        if (other >= 0) {
+            report->problem = TT_UV_OVERLAP;
+            report->face = other;
+            report->other_face = f;
+            break;
+        }
+        if (!tt__tri_grid_insert(&grid, f)) {
+            tt__tri_grid_free(&grid);
+            goto out_of_memory;
+        }
+    }
+    tt__tri_grid_free(&grid);
+    goto done;
+
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory checking the UVs of %d faces", nf);
+    memset(report, 0, sizeof *report);
+    report->face = report->other_face = -1;
+done:
+    tt__free(al, xy);
+    return result;
 }
 
 /* State of one face's bake, shared by its raster callbacks. */

@@ -226,6 +226,13 @@ int main(void)
                     EXPECT(tt_lapped_measure(tris, field, lapped, NULL, &lr, &err) == TT_OK &&
                            lr.uncovered_faces == 0);
                     EXPECT(tt_atlas_pack_pairs(tris, 64, 2, corner_uv, &err) == TT_OK);
+                    {
+                        tt_chart_atlas_report ar;
+                        tt_uv_report ur;
+                        EXPECT(tt_atlas_pack_charts(tris, 64, 2, NULL, corner_uv, &ar, &err) == TT_OK &&
+                               ar.ncharts >= 1);
+                        EXPECT(tt_uv_check(tris, corner_uv, NULL, &ur, &err) == TT_OK && ur.problem == TT_UV_USABLE);
+                    }
                     EXPECT(tt_image_create(64, 64, NULL, &baked, &err) == TT_OK);
                     if (baked)
                         EXPECT(tt_lapped_bake(tris, lapped, &patch, 1, corner_uv, &bo, NULL, baked, &err) == TT_OK);
