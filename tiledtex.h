@@ -11680,7 +11680,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
             }
             result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
                               "%d charts need at least %d x %d texels each for gutter %d: they do not fit %d x %d, "
-                              "the smallest size that holds them is %d (with the charts shrunk to nothing)",
+                              "the smallest size that works is %d (with the charts shrunk to nothing)",
                               ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, size, size, fits);
         } else {
             result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,

@@ -23,8 +23,9 @@
      tt_make_texture_patch  the image with a soft splotch (or --mask) alpha (Sec. 3.1)
      tt_lapped_paste        the paste loop (Sec. 3.3 - 3.6, 4)
      tt_lapped_measure      alignment measured from the written UVs alone
-     tt_atlas_pack_pairs,   --bake: an atlas (unless the OBJ has UVs) and the
-     tt_lapped_bake         pastes composited into it
+     tt_uv_check,           --bake: the OBJ's own texture coordinates when they
+     tt_atlas_pack_charts,  can take a bake (--bake-uv), else an atlas of
+     tt_lapped_bake         charts, and the pastes composited into it
 */
 #include <ctype.h>
 #include <math.h>
@@ -73,10 +74,19 @@ static void print_help(void)
            "                       (white = inside); same size as IMAGE (default: a random splotch,\n"
            "                       or IMAGE's own alpha when it has one)\n"
            "  --bake SIZE          also write OUT_PREFIX_baked.obj/.mtl/.png: the pastes baked into a\n"
-           "                       SIZE x SIZE texture (16 to %d) over the OBJ's own texture\n"
-           "                       coordinates when every corner has one, else over an atlas of\n"
-           "                       triangle pairs\n"
-           "  --subdivide L        make the triangles smaller before pasting, L from 0 to 8 (default\n"
+           "                       SIZE x SIZE texture (16 to %d) over texture coordinates that\n"
+           "                       --bake-uv chooses\n"
+           "  --bake-uv auto|mesh|atlas\n"
+           "                       where --bake bakes: 'mesh' over the OBJ's own texture coordinates,\n"
+           "                       refused unless every corner has one, all in [0,1], no triangle\n"
+           "                       flipped, none overlapping another (two triangles drawing the same\n"
+           "                       texels would bake scrambled); 'atlas' over a new atlas of charts\n"
+           "                       (pieces of the surface flattened, one texel density, 2 texels\n"
+           "                       apart); 'auto' (default) the OBJ's own when they are fit, else an\n"
+           "                       atlas, with a warning saying why when the OBJ has some\n",
+           TT_DEFAULT_FIELD_SCALE, TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS);
+    /* Two calls: C99 compilers need not take a string longer than 4095 characters. */
+    printf("  --subdivide L        make the triangles smaller before pasting, L from 0 to 8 (default\n"
            "                       0): quadrangulate them L times, as 'tiledtex tile' does, and split\n"
            "                       every quad into two triangles, so a triangle becomes 6, 24, 96, ...\n"
            "                       (the outputs have these). A paste covers whole triangles: subdivide\n"
@@ -95,9 +105,11 @@ static void print_help(void)
            "example: tiledtex generate mesh torus.obj --shape torus\n"
            "         tiledtex generate texture stones.png --size 128\n"
            "         tiledtex lapped torus.obj stones.png torus_lapped --scale 1.5\n"
-           "         tiledtex render torus_lapped.obj torus_lapped_patch.png view.png\n",
-           TT_DEFAULT_FIELD_SCALE, TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS);
+           "         tiledtex render torus_lapped.obj torus_lapped_patch.png view.png\n");
 }
+
+/* --bake-uv: where --bake bakes. */
+typedef enum bake_uv_choice { BAKE_UV_AUTO = 0, BAKE_UV_MESH, BAKE_UV_ATLAS } bake_uv_choice;
 
 typedef struct lapped_options {
     const char *mesh_path, *image_path, *prefix;
@@ -108,6 +120,7 @@ typedef struct lapped_options {
     int isotropic;
     const char *mask_path;          /* or NULL */
     int bake_size;                  /* 0 = no --bake */
+    bake_uv_choice bake_uv;         /* --bake-uv */
     tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
 } lapped_options;
 
@@ -149,6 +162,12 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             options->mask_path = value;
         } else if (tool_option(argc, argv, &i, "--bake", &value)) {
             if (parse_int("--bake", value, 16, TOOL_MAX_ATLAS, &options->bake_size) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--bake-uv", &value)) {
+            if (!value) return tool_usage("--bake-uv needs a value: auto, mesh or atlas");
+            if (strcmp(value, "auto") == 0) options->bake_uv = BAKE_UV_AUTO;
+            else if (strcmp(value, "mesh") == 0) options->bake_uv = BAKE_UV_MESH;
+            else if (strcmp(value, "atlas") == 0) options->bake_uv = BAKE_UV_ATLAS;
+            else return tool_usage("--bake-uv wants auto, mesh or atlas, got '%s'", value);
         } else if (strcmp(argv[i], "--isotropic") == 0) {
             options->isotropic = 1;
         } else if (tool_is_option(argv[i])) {
@@ -437,23 +456,68 @@ static int add_png(tool_output *output, const char *path, tt_image *image)
     return status != 0 ? tool_fail("%s", message) : 0;
 }
 
-/* --bake's texture coordinates per triangle corner: the OBJ's own when every
-   corner has one, else an atlas of triangle pairs. Made before anything is
-   pasted, so a size too small for the mesh is said at once. */
-static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float **corner_uv, int *own_uvs)
+/* Why the OBJ's texture coordinates cannot take a bake, as the end of a
+   sentence about them ("its texture coordinates ..."), with the OBJ's face
+   numbers (from 1); "" when they can. */
+static void describe_uv_problem(const triangle_mesh *m, const tt_uv_report *report, char *text, size_t size)
+{
+    int face = report->face >= 0 ? m->face[report->face] + 1 : 0;
+    int other = report->other_face >= 0 ? m->face[report->other_face] + 1 : 0;
+    text[0] = '\0';
+    switch (report->problem) {
+    case TT_UV_USABLE: break;
+    case TT_UV_NON_FINITE: snprintf(text, size, "are not finite numbers (face %d)", face); break;
+    case TT_UV_OUTSIDE: snprintf(text, size, "reach outside [0,1] (face %d): they repeat the texture", face); break;
+    case TT_UV_DEGENERATE: snprintf(text, size, "give face %d no area in the texture", face); break;
+    case TT_UV_FLIPPED:
+        snprintf(text, size, "are mirrored on %d triangle%s (face %d first)", report->flipped_faces,
+                 report->flipped_faces == 1 ? "" : "s", face);
+        break;
+    case TT_UV_OVERLAP:
+        if (face == other) snprintf(text, size, "overlap within face %d (its triangle fan folds)", face);
+        else snprintf(text, size, "overlap (faces %d and %d)", face, other);
+        break;
+    }
+}
+
+/* --bake's texture coordinates per triangle corner, as --bake-uv chooses:
+   the OBJ's own when they can take a bake (tt_uv_check), else an atlas of
+   charts; *charts gets the number of charts, 0 for the OBJ's own. Made
+   before anything is pasted, so a size too small for the mesh, or UVs
+   --bake-uv mesh refuses, are said at once. */
+static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float **corner_uv, int *charts)
 {
     const size_t ncorners = 3 * (size_t)m->ntriangles;
+    char problem[160] = "have none at some corners";
+    tt_chart_atlas_report atlas;
+    tt_uv_report check;
     tt_error error;
-    *own_uvs = m->corner_uv != NULL;
+    *charts = 0;
+    if (options->bake_uv != BAKE_UV_ATLAS && m->corner_uv) {
+        if (tt_uv_check(m->mesh, m->corner_uv, NULL, &check, &error) != TT_OK)
+            return tool_fail("%s: cannot check its texture coordinates: %s", options->mesh_path, error.message);
+        describe_uv_problem(m, &check, problem, sizeof problem);
+    }
+    if (options->bake_uv == BAKE_UV_MESH && problem[0])
+        return tool_fail("--bake-uv mesh: %s: its texture coordinates %s, and baking over them would scramble the "
+                         "texture (--bake-uv atlas makes a new atlas)",
+                         options->mesh_path, problem);
     *corner_uv = (float *)malloc(ncorners * 2 * sizeof(float));
     if (!*corner_uv) return tool_fail("out of memory for the texture coordinates of %s", options->mesh_path);
-    if (*own_uvs) {
+    if (options->bake_uv != BAKE_UV_ATLAS && !problem[0]) {
         memcpy(*corner_uv, m->corner_uv, ncorners * 2 * sizeof(float));
-    } else if (tt_atlas_pack_pairs(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, *corner_uv, &error) != TT_OK) {
+        return 0;
+    }
+    if (tt_atlas_pack_charts(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, NULL, *corner_uv, &atlas, &error) !=
+        TT_OK) {
         free(*corner_uv);
         *corner_uv = NULL;
         return tool_fail("--bake %d: %s", options->bake_size, error.message);
     }
+    /* Only an OBJ that has texture coordinates was asked for them. */
+    if (options->bake_uv == BAKE_UV_AUTO && m->corner_uv)
+        tool_note("%s: its texture coordinates %s; baking over a new atlas", options->mesh_path, problem);
+    *charts = atlas.ncharts;
     return 0;
 }
 
@@ -640,7 +704,7 @@ int cmd_lapped(int argc, char **argv)
     baked_seams baked;
     char obj_path[4096], mtl_path[4096], png_path[4096], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
-    int status, own_uvs = 0;
+    int status, charts = 0;
 
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
@@ -658,7 +722,7 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
     if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, png_path);
-    if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &own_uvs);
+    if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &charts);
     if (status == 0) status = make_patch(&options, image, &patch);
     /* Memory: the image is needed only to make the patch and its PNG, so the
        PNG is encoded now and the image freed before the paste loop; from
@@ -679,9 +743,12 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0) {
         print_summary(&options, &mesh, field, lapped, &baked, tool_seconds_now() - start);
         printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
-        if (options.bake_size > 0)
-            printf("; %s_baked.obj/.mtl/.png (%dx%d, over %s)", options.prefix, options.bake_size,
-                   options.bake_size, own_uvs ? "the OBJ's texture coordinates" : "an atlas of triangle pairs");
+        if (options.bake_size > 0 && charts == 0)
+            printf("; %s_baked.obj/.mtl/.png (%dx%d, over the OBJ's texture coordinates)", options.prefix,
+                   options.bake_size, options.bake_size);
+        else if (options.bake_size > 0)
+            printf("; %s_baked.obj/.mtl/.png (%dx%d, over an atlas of %d chart%s)", options.prefix, options.bake_size,
+                   options.bake_size, charts, charts == 1 ? "" : "s");
         printf("\n");
     }
     output_free(&output);

@@ -633,7 +633,7 @@ check "render pasting OBJ: 160x120 PNG" "160 120" "$(png_size view.png)" \
     "$(is_png view.png && [ "$(png_size view.png)" = "160 120" ]; echo $?)"
 cd "$W" || exit 1
 
-# --bake: over an atlas of triangle pairs (no vt in the OBJ) ...
+# --bake: over an atlas of charts (no vt in the OBJ) ...
 newdir
 expect_ok "lapped --bake 256" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --bake 256
 seams_line=$(printf '%s\n' "$OUT" | grep '^baked seam score: ')
@@ -641,6 +641,8 @@ check "lapped --bake: the summary gives the baked seam score over every edge and
     "'baked seam score: all edges S (1536 of 1536 edges); where the top paste changes S (N of N edges)'" \
     "$seams_line" \
     "$(printf '%s\n' "$seams_line" | grep -qE '^baked seam score: all edges -?[0-9]+\.[0-9]{3} \(1536 of 1536 edges\); where the top paste changes -?[0-9]+\.[0-9]{3} \(([0-9]+) of \1 edges\)$'; echo $?)"
+check "lapped --bake without vt: over an atlas of charts, no warning" "'over an atlas of N charts', empty stderr" \
+    "$OUT | $ERR" "$(printf '%s' "$OUT" | grep -qE 'over an atlas of [0-9]+ charts?\)' && [ -z "$ERR" ]; echo $?)"
 check "lapped --bake: writes out_baked.obj/.mtl/.png too" "6 files" "$(ls -A | tr '\n' ' ')" \
     "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_baked.mtl out_baked.obj out_baked.png out_patch.png " ]; echo $?)"
 check "lapped --bake: 256x256 texture" "256 256" "$(png_size out_baked.png)" \
@@ -653,14 +655,38 @@ check "lapped --bake: baked OBJ has one vt in [0,1] per corner of 1024 triangles
 check "lapped --bake: mtl names the baked texture" "map_Kd out_baked.png" "$(cat out_baked.mtl 2>&1)" \
     "$(grep -qE '^map_Kd +out_baked\.png' out_baked.mtl 2>/dev/null && grep -qE '^mtllib +out_baked\.mtl' out_baked.obj; echo $?)"
 expect_ok "render the baked OBJ" render out_baked.obj out_baked.png view.png --size 64x48
-# ... and over the OBJ's own texture coordinates (a tiled-texture OBJ has one per corner)
-expect_ok "tile for lapped --bake" tile ../in/torus.obj ../in/lap.png t --tile 16
-expect_ok "lapped --bake over the OBJ's own vt" lapped t.obj ../in/lap.png own --scale 1.5 --bake 128
-check "lapped --bake over own vt: says so" "'over the OBJ's texture coordinates'" "$OUT" \
-    "$(printf '%s' "$OUT" | grep -q "over the OBJ's texture coordinates"; echo $?)"
+# ... and over the OBJ's own texture coordinates when they can take a bake
+# (the chart atlas just written can) ...
+expect_ok "lapped --bake over the OBJ's own vt" lapped out_baked.obj ../in/lap.png own --scale 1.5 --bake 128
+check "lapped --bake over own vt: says so, no warning" "'over the OBJ's texture coordinates', empty stderr" \
+    "$OUT | $ERR" "$(printf '%s' "$OUT" | grep -q "over the OBJ's texture coordinates" && [ -z "$ERR" ]; echo $?)"
 check "lapped --bake over own vt: same vt values as the OBJ" "identical sorted vt lines" "differ" \
-    "$(diff -q <(grep '^vt' t.obj | sort -u) <(grep '^vt' own_baked.obj | sort -u) >/dev/null; echo $?)"
+    "$(diff -q <(grep '^vt' out_baked.obj | sort -u) <(grep '^vt' own_baked.obj | sort -u) >/dev/null; echo $?)"
+expect_ok "lapped --bake-uv atlas: a new atlas even over fit vt" lapped out_baked.obj ../in/lap.png new --scale 1.5 \
+    --bake 128 --bake-uv atlas
+check "lapped --bake-uv atlas: says so, no warning" "'over an atlas of N charts', empty stderr" "$OUT | $ERR" \
+    "$(printf '%s' "$OUT" | grep -qE 'over an atlas of [0-9]+ charts?\)' && [ -z "$ERR" ]; echo $?)"
+# ... but not over a tiled-texture OBJ's: its faces share tiles, so their vt
+# overlap and a bake over them would scramble: auto warns once and makes an
+# atlas, mesh refuses.
+expect_ok "tile for lapped --bake" tile ../in/torus.obj ../in/lap.png t --tile 16
+expect_ok "lapped --bake over overlapping vt" lapped t.obj ../in/lap.png tiled --scale 1.5 --bake 256
+check "lapped --bake over overlapping vt: one warning naming two faces, then an atlas" \
+    "one stderr line 'tiledtex: t.obj: its texture coordinates overlap (faces A and B); baking over a new atlas'" \
+    "$OUT | $ERR" \
+    "$([ "$(printf '%s\n' "$ERR" | wc -l)" = 1 ] &&
+        printf '%s' "$ERR" | grep -qE '^tiledtex: t\.obj: its texture coordinates overlap \(faces [0-9]+ and [0-9]+\); baking over a new atlas$' &&
+        printf '%s' "$OUT" | grep -qE 'over an atlas of [0-9]+ charts?\)'; echo $?)"
+TILED_OBJ=$PWD/t.obj
+NO_VT_OBJ=$W/in/torus.obj
 cd "$W" || exit 1
+expect_error "lapped --bake-uv mesh over overlapping vt" lapped "$TILED_OBJ" ../in/lap.png out --scale 1.5 --bake 256 \
+    --bake-uv mesh
+err_mentions "lapped --bake-uv mesh over overlapping vt: says why" 'bake-uv mesh: .*t\.obj: its texture coordinates overlap \(faces [0-9]+ and [0-9]+\)'
+expect_error "lapped --bake-uv mesh without vt" lapped "$NO_VT_OBJ" ../in/lap.png out --scale 1.5 --bake 256 --bake-uv mesh
+err_mentions "lapped --bake-uv mesh without vt: says so" 'bake-uv mesh: .*torus\.obj: its texture coordinates have none'
+expect_error "lapped --bake-uv bogus" lapped "$NO_VT_OBJ" ../in/lap.png out --bake 256 --bake-uv bogus
+err_mentions "lapped --bake-uv bogus: names the choices" 'auto, mesh or atlas'
 
 # bad inputs: one line, non-zero exit, no files
 expect_error "lapped missing mesh" lapped ../in/nope.obj ../in/lap.png out
@@ -757,9 +783,10 @@ expect_error "lapped --subdivide 1 --constraints face out of range" lapped ../in
     --subdivide 1 --constraints ../in/constraints_range.txt
 err_mentions "lapped --subdivide constraint out of range: counts the OBJ's faces" 'constraints_range\.txt:2:.*1 to 512'
 newdir
-expect_ok "tile for lapped --subdivide --bake" tile ../in/torus.obj ../in/lap.png t --tile 16
+expect_ok "an atlas OBJ for lapped --subdivide --bake" lapped ../in/torus.obj ../in/lap.png a --scale 1.5 --bake 256
+mv a_baked.obj t.obj
 expect_ok "lapped --subdivide 1 --bake over the OBJ's own vt" lapped t.obj ../in/lap.png own --scale 1.5 --subdivide 1 \
-    --bake 256
+    --bake 256 --bake-uv mesh
 check "lapped --subdivide --bake over own vt: says so" "'over the OBJ's texture coordinates'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q "over the OBJ's texture coordinates"; echo $?)"
 read -r corners nvt nonquad badc baduv nf <<<"$(obj_report own_baked.obj)"
