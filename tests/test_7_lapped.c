@@ -3143,6 +3143,513 @@ static void test_atlas_pack_errors(void)
     tt_mesh_free(qm);
 }
 
+/* ---- tt_atlas_pack_charts ---- */
+
+/* A torus of nu x nv quads, each split in two, every vertex moved by up to
+   jitter (mesh units) along each axis: 2 nu nv triangles. */
+static tt_mesh *chart_torus(int nu, int nv, double jitter)
+{
+    tmesh q, t;
+    tt_mesh *mesh;
+    int i;
+    memset(&q, 0, sizeof q);
+    make_torus(&q, nu, nv, 3.0, 1.0);
+    for (i = 0; i < 3 * q.nv; i++) q.pos[i] += (float)(jitter * (lcg_unit() - 0.5));
+    tm_triangulate(&q, &t);
+    mesh = bake_build(&t, NULL);
+    tm_free(&q);
+    tm_free(&t);
+    return mesh;
+}
+
+/* An n x n wavy sheet whose rows and columns are spaced geometrically by
+   `ratio`: its triangles' sides differ by ratio^(n-1) (areas by its
+   square), the uneven tessellation of real scans and CAD exports. */
+static tt_mesh *chart_uneven_sheet(int n, double ratio)
+{
+    tmesh q, t;
+    tt_mesh *mesh;
+    int i, j;
+    memset(&q, 0, sizeof q);
+    make_grid(&q, n, n);
+    for (j = 0; j <= n; j++)
+        for (i = 0; i <= n; i++) {
+            float *p = q.pos + 3 * (j * (n + 1) + i);
+            double x = pow(ratio, i) - 1.0, y = pow(ratio, j) - 1.0;
+            p[0] = (float)x;
+            p[1] = (float)y;
+            p[2] = (float)(3.0 * sin(x / 6.0) * cos(y / 7.0));
+        }
+    tm_triangulate(&q, &t);
+    mesh = bake_build(&t, NULL);
+    tm_free(&q);
+    tm_free(&t);
+    return mesh;
+}
+
+/* A ramp winding `turns` times round the z axis (radii 1 to 2, rising 0.2
+   a turn): its normals stay within 5 degrees of +z, so one direction would
+   take it all, but seen along z it covers itself `turns` times. */
+static tt_mesh *chart_spiral_ramp(double turns)
+{
+    const double pi = 3.14159265358979323846;
+    const int steps = (int)(48 * turns);
+    tmesh q, t;
+    tt_mesh *mesh;
+    int i;
+    memset(&q, 0, sizeof q);
+    for (i = 0; i <= steps; i++) {
+        double a = 2.0 * pi * turns * i / steps, z = 0.2 * turns * i / steps;
+        tm_vert(&q, cos(a), sin(a), z);
+        tm_vert(&q, 2.0 * cos(a), 2.0 * sin(a), z);
+    }
+    for (i = 0; i < steps; i++) tm_quad(&q, 2 * i, 2 * i + 1, 2 * i + 3, 2 * i + 2);
+    tm_triangulate(&q, &t);
+    mesh = bake_build(&t, NULL);
+    tm_free(&q);
+    tm_free(&t);
+    return mesh;
+}
+
+/* Union-find root of face f. */
+static int chart_root(int *parent, int f)
+{
+    while (parent[f] != f) f = parent[f] = parent[parent[f]];
+    return f;
+}
+
+/* The charts of an atlas as its UVs show them: faces joined across every
+   edge whose two ends have the same UVs on both sides. label gets a chart
+   per face (a face index); returns the number of charts. */
+static int chart_labels(const tt_mesh *mesh, const float *uv, int *label)
+{
+    int f, c, count = 0;
+    for (f = 0; f < mesh->nfaces; f++) label[f] = f;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], cn, tn;
+        if (t < 0) continue;
+        cn = tt_mesh_next(mesh, c);
+        tn = tt_mesh_next(mesh, t);
+        if (uv[2 * c] == uv[2 * tn] && uv[2 * c + 1] == uv[2 * tn + 1] && uv[2 * cn] == uv[2 * t] &&
+            uv[2 * cn + 1] == uv[2 * t + 1]) {
+            int a = chart_root(label, mesh->corner_face[c]), b = chart_root(label, mesh->corner_face[t]);
+            if (a != b) label[a] = b;
+        }
+    }
+    for (f = 0; f < mesh->nfaces; f++) label[f] = chart_root(label, f);
+    for (f = 0; f < mesh->nfaces; f++) count += label[f] == f;
+    return count;
+}
+
+/* Texels whose centre lies within `gutter` of triangles of two different
+   charts (what a bake with that gutter would write twice). */
+static int chart_gutters_shared(const tt_mesh *mesh, const float *uv, const int *label, int size, int gutter)
+{
+    int *owner = (int *)malloc(sizeof(int) * (size_t)size * size);
+    int f, i, shared = 0;
+    for (i = 0; i < size * size; i++) owner[i] = -1;
+    for (f = 0; f < mesh->nfaces; f++) {
+        double x[3], y[3], lo_x = 1e30, hi_x = -1e30, lo_y = 1e30, hi_y = -1e30;
+        int k, j;
+        for (k = 0; k < 3; k++) {
+            int c = mesh->face_start[f] + k;
+            x[k] = uv[2 * c] * (double)size;
+            y[k] = (1.0 - uv[2 * c + 1]) * (double)size;
+            lo_x = fmin(lo_x, x[k]); hi_x = fmax(hi_x, x[k]);
+            lo_y = fmin(lo_y, y[k]); hi_y = fmax(hi_y, y[k]);
+        }
+        for (j = (int)floor(lo_y - gutter - 1); j <= (int)ceil(hi_y + gutter + 1); j++)
+            for (i = (int)floor(lo_x - gutter - 1); i <= (int)ceil(hi_x + gutter + 1); i++) {
+                int *o;
+                if (i < 0 || j < 0 || i >= size || j >= size) continue;
+                if (bake_triangle_distance(x, y, i + 0.5, j + 0.5) > gutter + 1e-3) continue;
+                o = owner + (size_t)j * size + i;
+                if (*o < 0) *o = label[f];
+                else if (*o != label[f]) shared++;
+            }
+    }
+    free(owner);
+    return shared;
+}
+
+/* Texel density per triangle, sqrt(UV area in texels / surface area), at
+   the 5th, 50th and 95th percentile over the triangles (each counts once,
+   whatever its area: small triangles are as visible as large ones). */
+static void chart_density(const tt_mesh *mesh, const float *uv, int size, double out[3])
+{
+    static const double fractions[3] = {0.05, 0.5, 0.95};
+    double *value = (double *)malloc(sizeof(double) * (size_t)mesh->nfaces);
+    double *weight = (double *)malloc(sizeof(double) * (size_t)mesh->nfaces);
+    int f, k;
+    for (f = 0; f < mesh->nfaces; f++) {
+        const float *a = uv + 6 * f;
+        double uv_area = 0.5 * fabs(internal_orient2(a[0], a[1], a[2], a[3], a[4], a[5])) * size * size;
+        float n[3];
+        double surface;
+        const float *p[3];
+        double e1[3], e2[3], cr[3];
+        for (k = 0; k < 3; k++) p[k] = mesh->pos + 3 * mesh->corner_vert[mesh->face_start[f] + k];
+        for (k = 0; k < 3; k++) {
+            e1[k] = (double)p[1][k] - p[0][k];
+            e2[k] = (double)p[2][k] - p[0][k];
+        }
+        cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        surface = 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+        (void)n;
+        value[f] = surface > 0.0 ? sqrt(uv_area / surface) : 0.0;
+        weight[f] = 1.0;
+    }
+    for (k = 0; k < 3; k++) out[k] = internal_weighted_percentile(value, weight, mesh->nfaces, fractions[k]);
+    free(value);
+    free(weight);
+}
+
+/* UV triangles of zero or negative area (v up: counter-clockwise is positive). */
+static int chart_flipped(const tt_mesh *mesh, const float *uv)
+{
+    int f, bad = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        const float *a = uv + 6 * f;
+        bad += !(internal_orient2(a[0], a[1], a[2], a[3], a[4], a[5]) > 0.0);
+    }
+    return bad;
+}
+
+/* Every promise of a chart atlas on `mesh` at `size`: UVs in [0, 1], no
+   flips, the report's charts are the UVs' charts, no texel within the
+   gutter of two charts, no texel centre in two triangles, the density
+   spread within +-25 % of the median (returned in spread[3]). */
+static void chart_check_atlas(const char *what, const tt_mesh *mesh, const float *uv,
+                              const tt_chart_atlas_report *report, int size, int gutter, double spread[3])
+{
+    int *label = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces), bad, f, charts;
+    bake_count cb;
+    bad = bake_uv_outside(uv, 2 * mesh->ncorners);
+    CHECK(bad == 0, "%s: %d UVs outside [0,1]", what, bad);
+    bad = chart_flipped(mesh, uv);
+    CHECK(bad == 0, "%s: %d triangles flipped or empty", what, bad);
+    charts = chart_labels(mesh, uv, label);
+    CHECK(charts == report->ncharts, "%s: the UVs show %d charts, the report says %d", what, charts, report->ncharts);
+    bad = chart_gutters_shared(mesh, uv, label, size, gutter);
+    CHECK(bad == 0, "%s: %d texels within the gutter of two charts", what, bad);
+    cb.width = size;
+    cb.overlaps = 0;
+    cb.count = (int *)calloc((size_t)size * size, sizeof(int));
+    for (f = 0; f < mesh->nfaces; f++) {
+        float xy[6];
+        int k;
+        for (k = 0; k < 3; k++) {
+            xy[2 * k] = uv[6 * f + 2 * k] * (float)size;
+            xy[2 * k + 1] = (1.0f - uv[6 * f + 2 * k + 1]) * (float)size;
+        }
+        tt_raster_triangle(xy, size, size, bake_count_texel, &cb);
+    }
+    CHECK(cb.overlaps == 0, "%s: %d texel centres in two triangles", what, cb.overlaps);
+    free(cb.count);
+    chart_density(mesh, uv, size, spread);
+    CHECK(spread[0] >= 0.75 * spread[1] && spread[2] <= 1.25 * spread[1],
+          "%s: density 5th-95th percentile %.4g..%.4g within 25%% of the median %.4g", what, spread[0], spread[2],
+          spread[1]);
+    CHECK(report->texels_per_unit > 0.0 && report->fill > 0.0 && report->fill <= 1.0,
+          "%s: report %.4g texels per unit, fill %.4g", what, report->texels_per_unit, report->fill);
+    free(label);
+}
+
+/* A 20k-triangle torus, jittered: fits 1024 with gutter 2 and keeps every
+   promise; the density is the report's; the same call gives the same UVs. */
+static void test_atlas_pack_charts(void)
+{
+    tt_mesh *mesh;
+    float *uv, *again;
+    tt_chart_atlas_report report, report2;
+    tt_error err;
+    double spread[3];
+    lcg_seed(41);
+    mesh = chart_torus(100, 100, 0.02);
+    if (!mesh) return;
+    CHECK(mesh->nfaces == 20000, "20000 triangles, got %d", mesh->nfaces);
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    again = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_atlas_pack_charts(mesh, 1024, 2, NULL, uv, &report, &err) == TT_OK, "20k triangles fit 1024: %s",
+          err.message);
+    chart_check_atlas("torus at 1024", mesh, uv, &report, 1024, 2, spread);
+    CHECK(fabs(spread[1] / report.texels_per_unit - 1.0) < 0.05, "median density %.4g is the report's %.4g", spread[1],
+          report.texels_per_unit);
+    CHECK(report.fill > 0.25, "the triangles fill %.3g of the atlas", report.fill);
+    CHECK(tt_atlas_pack_charts(mesh, 1024, 2, NULL, again, &report2, NULL) == TT_OK &&
+              memcmp(uv, again, sizeof(float) * 2 * (size_t)mesh->ncorners) == 0,
+          "deterministic");
+    /* Gutter 0 and 4, a small size: still every promise. */
+    CHECK(tt_atlas_pack_charts(mesh, 256, 4, NULL, uv, &report, &err) == TT_OK, "gutter 4 at 256: %s", err.message);
+    chart_check_atlas("torus at 256, gutter 4", mesh, uv, &report, 256, 4, spread);
+    CHECK(tt_atlas_pack_charts(mesh, 512, 0, NULL, uv, &report, &err) == TT_OK, "gutter 0 at 512: %s", err.message);
+    chart_check_atlas("torus at 512, gutter 0", mesh, uv, &report, 512, 0, spread);
+    free(uv);
+    free(again);
+    tt_mesh_free(mesh);
+}
+
+/* Triangles whose sides differ 40-fold: one density for all of them with
+   charts; the pair atlas, which gives every triangle the same texels, is
+   the control that must break the same bound. */
+static void test_atlas_pack_charts_uneven(void)
+{
+    tt_mesh *mesh = chart_uneven_sheet(32, 1.125);
+    float *uv;
+    tt_chart_atlas_report report;
+    tt_error err;
+    double spread[3];
+    if (!mesh) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_atlas_pack_charts(mesh, 512, 2, NULL, uv, &report, &err) == TT_OK, "uneven sheet: %s", err.message);
+    chart_check_atlas("uneven sheet", mesh, uv, &report, 512, 2, spread);
+    CHECK(tt_atlas_pack_pairs(mesh, 512, 2, uv, &err) == TT_OK, "pairs: %s", err.message);
+    chart_density(mesh, uv, 512, spread);
+    CHECK(spread[0] < 0.75 * spread[1] || spread[2] > 1.25 * spread[1],
+          "control: the pair atlas spreads the density beyond 25%% (%.4g..%.4g, median %.4g)", spread[0], spread[2],
+          spread[1]);
+    free(uv);
+    tt_mesh_free(mesh);
+}
+
+/* A ramp that covers itself seen from one direction: its charts are split
+   where the flattening would overlap, and the UVs pass tt_uv_check. */
+static void test_atlas_pack_charts_overlap(void)
+{
+    tt_mesh *mesh = chart_spiral_ramp(2.5);
+    float *uv;
+    tt_chart_atlas_report report;
+    tt_uv_report check;
+    tt_error err;
+    tt_result result;
+    double spread[3];
+    if (!mesh) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_atlas_pack_charts(mesh, 512, 2, NULL, uv, &report, &err) == TT_OK, "ramp: %s", err.message);
+    CHECK(report.ncharts >= 3, "2.5 turns need at least 3 charts, got %d", report.ncharts);
+    chart_check_atlas("spiral ramp", mesh, uv, &report, 512, 2, spread);
+    result = tt_uv_check(mesh, uv, NULL, &check, &err);
+    CHECK(result == TT_OK && check.problem == TT_UV_USABLE,
+          "the ramp's atlas passes the UV check (problem %d at faces %d, %d)", (int)check.problem, check.face,
+          check.other_face);
+    free(uv);
+    tt_mesh_free(mesh);
+}
+
+/* Too small: the size the message names is the smallest that works. */
+static void test_atlas_pack_charts_small(void)
+{
+    const char *key = "smallest size that works is ";
+    tt_mesh *mesh;
+    float *uv;
+    tt_chart_atlas_report report;
+    tt_error err;
+    const char *hint;
+    int size = 0, f;
+    lcg_seed(43);
+    mesh = chart_torus(24, 12, 0.05);
+    if (!mesh) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    for (f = 0; f < 2 * mesh->ncorners; f++) uv[f] = -7.0f;
+    CHECK(tt_atlas_pack_charts(mesh, 8, 2, NULL, uv, &report, &err) == TT_ERROR_IMAGE_TOO_SMALL,
+          "8 texels too small: %s", err.message);
+    CHECK(uv[0] == -7.0f && report.ncharts == 0, "nothing written on failure");
+    hint = strstr(err.message, key);
+    CHECK(hint != NULL, "the message suggests a size: %s", err.message);
+    if (hint) size = atoi(hint + strlen(key));
+    CHECK(tt_atlas_pack_charts(mesh, size, 2, NULL, uv, &report, &err) == TT_OK, "suggested size %d works: %s", size,
+          err.message);
+    CHECK(tt_atlas_pack_charts(mesh, size - 1, 2, NULL, uv, &report, &err) == TT_ERROR_IMAGE_TOO_SMALL,
+          "size %d - 1 does not", size);
+    CHECK(tt_atlas_pack_charts(mesh, 1024, 10000, NULL, uv, &report, &err) == TT_ERROR_IMAGE_TOO_SMALL &&
+              strstr(err.message, "lower the gutter"),
+          "a gutter no size holds: %s", err.message);
+    free(uv);
+    tt_mesh_free(mesh);
+}
+
+static void test_atlas_pack_charts_errors(void)
+{
+    tt_mesh *mesh = bake_grid(2, 2, 0.0, NULL), *qm;
+    float uv[48];
+    counter count;
+    tt_allocator half = make_allocator(&count, -1);
+    tt_error err;
+    half.free = NULL;
+    CHECK(tt_atlas_pack_charts(NULL, 64, 1, NULL, uv, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh refused");
+    CHECK(tt_atlas_pack_charts(mesh, 64, 1, NULL, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL uv refused");
+    CHECK(tt_atlas_pack_charts(mesh, 0, 1, NULL, uv, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "size 0 refused");
+    CHECK(tt_atlas_pack_charts(mesh, TT_MAX_IMAGE_SIZE + 1, 1, NULL, uv, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "size above TT_MAX_IMAGE_SIZE refused");
+    CHECK(tt_atlas_pack_charts(mesh, 64, -1, NULL, uv, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "negative gutter refused");
+    CHECK(tt_atlas_pack_charts(mesh, 64, 1, &half, uv, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "an allocator without free refused: %s", err.message);
+    CHECK(tt_atlas_pack_charts(mesh, 64, 1, NULL, uv, NULL, NULL) == TT_OK, "no report, no error: fine");
+    tt_mesh_free(mesh);
+    qm = bake_quad();
+    CHECK(tt_atlas_pack_charts(qm, 64, 1, NULL, uv, NULL, &err) == TT_ERROR_INVALID_ARGUMENT && err.face == 0,
+          "quads refused, face 0 named: %s", err.message);
+    tt_mesh_free(qm);
+}
+
+typedef struct chart_oom_ctx {
+    const tt_mesh *mesh;
+    float *uv;
+} chart_oom_ctx;
+
+static tt_result chart_oom_call(void *ctx, const tt_allocator *al)
+{
+    chart_oom_ctx *c = (chart_oom_ctx *)ctx;
+    tt_chart_atlas_report report;
+    tt_error err;
+    tt_result r = tt_atlas_pack_charts(c->mesh, 256, 2, al, c->uv, &report, &err);
+    if (err.result != r || (r != TT_OK && report.ncharts != 0)) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_atlas_pack_charts_oom(void)
+{
+    chart_oom_ctx c;
+    tt_mesh *mesh;
+    lcg_seed(47);
+    mesh = chart_torus(16, 8, 0.05);
+    if (!mesh) return;
+    c.mesh = mesh;
+    c.uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    oom_reset();
+    oom_sweep("tt_atlas_pack_charts", chart_oom_call, &c, TT_OK);
+    free(c.uv);
+    tt_mesh_free(mesh);
+}
+
+/* ---- tt_uv_check ---- */
+
+/* Each kind of problem, at the face it is put on; atlases of both kinds
+   pass; triangles that only share an edge in UV do not overlap. */
+static void test_uv_check(void)
+{
+    tt_mesh *mesh;
+    float *uv, keep[6];
+    tt_uv_report r;
+    tt_error err;
+    tt_result result;
+    int k;
+    lcg_seed(53);
+    mesh = bake_grid(6, 5, 0.4, NULL);
+    if (!mesh) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_atlas_pack_charts(mesh, 128, 2, NULL, uv, NULL, &err) == TT_OK, "charts: %s", err.message);
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_USABLE && r.face == -1 &&
+              r.other_face == -1 && r.flipped_faces == 0,
+          "a chart atlas is usable (problem %d)", (int)r.problem);
+    CHECK(tt_atlas_pack_pairs(mesh, 128, 2, uv, &err) == TT_OK, "pairs: %s", err.message);
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_USABLE, "a pair atlas is usable (%d)",
+          (int)r.problem);
+    /* The grid's own positions as UVs: neighbours share edges exactly. */
+    for (k = 0; k < mesh->ncorners; k++) {
+        uv[2 * k] = mesh->pos[3 * mesh->corner_vert[k]] / 6.0f;
+        uv[2 * k + 1] = mesh->pos[3 * mesh->corner_vert[k] + 1] / 5.0f;
+    }
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_USABLE,
+          "the planar layout of the grid is usable (problem %d at %d, %d)", (int)r.problem, r.face, r.other_face);
+    memcpy(keep, uv + 6 * 7, sizeof keep);
+    /* Face 7 mirrored (u -> 1 - u): flipped, and the only one. */
+    for (k = 0; k < 3; k++) uv[6 * 7 + 2 * k] = 1.0f - uv[6 * 7 + 2 * k];
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_FLIPPED && r.face == 7 &&
+              r.flipped_faces == 1,
+          "mirrored face 7: flipped (problem %d, face %d, %d flipped)", (int)r.problem, r.face, r.flipped_faces);
+    /* Face 7 on top of face 3: an overlap naming both. */
+    memcpy(uv + 6 * 7, uv + 6 * 3, sizeof keep);
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_OVERLAP && r.face == 3 &&
+              r.other_face == 7,
+          "face 7 over face 3: overlap (problem %d, faces %d and %d)", (int)r.problem, r.face, r.other_face);
+    memcpy(uv + 6 * 7, keep, sizeof keep);
+    /* Face 9 collapsed onto a line. */
+    memcpy(keep, uv + 6 * 9, sizeof keep);
+    uv[6 * 9 + 4] = uv[6 * 9 + 2];
+    uv[6 * 9 + 5] = uv[6 * 9 + 3];
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_DEGENERATE && r.face == 9,
+          "face 9 of zero area: degenerate (problem %d, face %d)", (int)r.problem, r.face);
+    memcpy(uv + 6 * 9, keep, sizeof keep);
+    uv[6 * 11 + 3] = 1.0001f;
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_OUTSIDE && r.face == 11,
+          "face 11 past v = 1: outside (problem %d, face %d)", (int)r.problem, r.face);
+    uv[6 * 2 + 1] = (float)internal_not_a_number();
+    result = tt_uv_check(mesh, uv, NULL, &r, &err);
+    CHECK(result == TT_OK && r.problem == TT_UV_NON_FINITE && r.face == 2,
+          "NaN at face 2: non-finite first (problem %d, face %d)", (int)r.problem, r.face);
+    free(uv);
+    tt_mesh_free(mesh);
+}
+
+static void test_uv_check_errors(void)
+{
+    tt_mesh *mesh = bake_grid(2, 2, 0.0, NULL), *qm;
+    float uv[48] = {0};
+    tt_uv_report r;
+    counter count;
+    tt_allocator half = make_allocator(&count, -1);
+    tt_error err;
+    half.alloc = NULL;
+    CHECK(tt_uv_check(NULL, uv, NULL, &r, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh refused");
+    CHECK(tt_uv_check(mesh, NULL, NULL, &r, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL uv refused");
+    CHECK(tt_uv_check(mesh, uv, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL report refused");
+    CHECK(tt_uv_check(mesh, uv, &half, &r, &err) == TT_ERROR_INVALID_ARGUMENT, "an allocator without alloc refused");
+    tt_mesh_free(mesh);
+    qm = bake_quad();
+    CHECK(tt_uv_check(qm, uv, NULL, &r, &err) == TT_ERROR_INVALID_ARGUMENT && err.face == 0,
+          "quads refused, face 0 named: %s", err.message);
+    tt_mesh_free(qm);
+}
+
+typedef struct uv_check_oom_ctx {
+    const tt_mesh *mesh;
+    const float *uv;
+    tt_uv_problem expected;
+} uv_check_oom_ctx;
+
+static tt_result uv_check_oom_call(void *ctx, const tt_allocator *al)
+{
+    uv_check_oom_ctx *c = (uv_check_oom_ctx *)ctx;
+    tt_uv_report report;
+    tt_error err;
+    tt_result r = tt_uv_check(c->mesh, c->uv, al, &report, &err);
+    if (err.result != r || (r == TT_OK && report.problem != c->expected)) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+static void test_uv_check_oom(void)
+{
+    uv_check_oom_ctx c;
+    tt_mesh *mesh;
+    float *uv;
+    lcg_seed(59);
+    mesh = bake_grid(5, 5, 0.3, NULL);
+    if (!mesh) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    tt_atlas_pack_pairs(mesh, 128, 2, uv, NULL);
+    c.mesh = mesh;
+    c.uv = uv;
+    c.expected = TT_UV_USABLE;
+    oom_reset();
+    oom_sweep("tt_uv_check (usable)", uv_check_oom_call, &c, TT_OK);
+    memcpy(uv + 6 * 4, uv + 6 * 1, 6 * sizeof(float));
+    c.expected = TT_UV_OVERLAP;
+    oom_sweep("tt_uv_check (overlap)", uv_check_oom_call, &c, TT_OK);
+    free(uv);
+    tt_mesh_free(mesh);
+}
+
 /* ---- tt_lapped_bake ---- */
 
 /* tt_lapped_bake with only a gutter set (default allocator). */
@@ -3923,6 +4430,15 @@ void run_lapped_tests(void)
     RUN(test_atlas_pack_pairs);
     RUN(test_atlas_pack_odd);
     RUN(test_atlas_pack_errors);
+    RUN(test_atlas_pack_charts);
+    RUN(test_atlas_pack_charts_uneven);
+    RUN(test_atlas_pack_charts_overlap);
+    RUN(test_atlas_pack_charts_small);
+    RUN(test_atlas_pack_charts_errors);
+    RUN(test_atlas_pack_charts_oom);
+    RUN(test_uv_check);
+    RUN(test_uv_check_errors);
+    RUN(test_uv_check_oom);
     RUN(test_lapped_bake_constant);
     RUN(test_lapped_baked_seams);
     RUN(test_lapped_bake_gutter);
