@@ -3522,6 +3522,20 @@ static double tt__face_area_d(const tt_mesh *mesh, int face)
     return 0.5 * tt__length3(n);
 }
 
+/* TT_OK when every face is a triangle; else TT_ERROR_INVALID_ARGUMENT
+   naming the first other face: "face F has N corners: <why>". */
+static tt_result tt__require_triangles(const tt_mesh *mesh, const char *why, tt_error *error)
+{
+    int f;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int count = mesh->face_start[f + 1] - mesh->face_start[f];
+        if (count != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners: %s", f, count, why);
+    }
+    return TT_OK;
+}
+
 /* Mean of a face's corner positions. */
 static void tt__face_centroid(const tt_mesh *mesh, int face, double centroid[3])
 {
@@ -11090,12 +11104,8 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
                         TT_MAX_IMAGE_SIZE);
     if (gutter < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
-    for (f = 0; f < mesh->nfaces; f++) {
-        int count = mesh->face_start[f + 1] - mesh->face_start[f];
-        if (count != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
-                            "face %d has %d corners: the atlas packs triangles only", f, count);
-    }
+    if (tt__require_triangles(mesh, "the atlas packs triangles only", error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
 
     npairs = mesh->nfaces / 2 + mesh->nfaces % 2;
     per_side = (int)ceil(sqrt((double)npairs));
@@ -11600,12 +11610,8 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     if (gutter < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
     nf = mesh->nfaces;
-    for (f = 0; f < nf; f++) {
-        int count = mesh->face_start[f + 1] - mesh->face_start[f];
-        if (count != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
-                            "face %d has %d corners: the atlas packs triangles only", f, count);
-    }
+    if (tt__require_triangles(mesh, "the atlas packs triangles only", error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
 
     memset(&grid, 0, sizeof grid);
     normal = TT__ALLOC(al, double, 3 * (size_t)nf);
@@ -11758,12 +11764,8 @@ TTDEF tt_result tt_uv_check(const tt_mesh *mesh, const float *corner_uv, const t
     report->problem = TT_UV_USABLE;
     report->face = report->other_face = -1;
     nf = mesh->nfaces;
-    for (f = 0; f < nf; f++) {
-        int count = mesh->face_start[f + 1] - mesh->face_start[f];
-        if (count != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
-                            "face %d has %d corners: the UV check takes triangles only", f, count);
-    }
+    if (tt__require_triangles(mesh, "the UV check takes triangles only", error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
     for (f = 0; f < nf && report->problem == TT_UV_USABLE; f++)
         for (k = 0; k < 6; k++)
             if (!tt__is_finite(corner_uv[6 * (size_t)f + k])) {
@@ -12046,12 +12048,8 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     for (p = 0; p < npatches; p++)
         if (!patches[p] || !patches[p]->pixels || patches[p]->width <= 0 || patches[p]->height <= 0)
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1, "patch %d is NULL or empty", p);
-    for (f = 0; f < mesh->nfaces; f++) {
-        int count = mesh->face_start[f + 1] - mesh->face_start[f];
-        if (count != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, mesh->face_start[f], -1, -1,
-                            "face %d has %d corners: baking needs triangles", f, count);
-    }
+    if (tt__require_triangles(mesh, "baking needs triangles", error) != TT_OK)
+        return TT_ERROR_INVALID_ARGUMENT;
     for (c = 0; c < 2 * mesh->ncorners; c++)
         if (!tt__is_finite(corner_uv[c]))
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,

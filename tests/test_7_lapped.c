@@ -3001,15 +3001,17 @@ static double bake_triangle_distance(const double *x, const double *y, double qx
     return inside ? 0.0 : best;
 }
 
-/* Texel centres within `gutter` of each atlas triangle, counted per
-   triangle: the number of texels counted more than once. */
-static int bake_gutter_overlaps(const tt_mesh *mesh, const float *uv, int size, int gutter)
+/* Texel centres within `gutter` of atlas triangles of two different
+   charts, label[f] being face f's chart (NULL: every triangle its own): the
+   texels a bake with that gutter would write twice. */
+static int bake_gutter_overlaps(const tt_mesh *mesh, const float *uv, const int *label, int size, int gutter)
 {
-    int *count = (int *)calloc((size_t)size * size, sizeof(int));
-    int f, over = 0;
+    int *owner = (int *)malloc(sizeof(int) * (size_t)size * size);
+    int f, i, shared = 0;
+    for (i = 0; i < size * size; i++) owner[i] = -1;
     for (f = 0; f < mesh->nfaces; f++) {
         double x[3], y[3], lo_x = 1e30, hi_x = -1e30, lo_y = 1e30, hi_y = -1e30;
-        int k, i, j;
+        int k, j, chart = label ? label[f] : f;
         for (k = 0; k < 3; k++) {
             int c = mesh->face_start[f] + k;
             x[k] = uv[2 * c] * (double)size;
@@ -3019,13 +3021,37 @@ static int bake_gutter_overlaps(const tt_mesh *mesh, const float *uv, int size, 
         }
         for (j = (int)floor(lo_y - gutter - 1); j <= (int)ceil(hi_y + gutter + 1); j++)
             for (i = (int)floor(lo_x - gutter - 1); i <= (int)ceil(hi_x + gutter + 1); i++) {
+                int *o;
                 if (i < 0 || j < 0 || i >= size || j >= size) continue;
-                if (bake_triangle_distance(x, y, i + 0.5, j + 0.5) <= gutter + 1e-3)
-                    if (++count[j * size + i] > 1) over++;
+                if (bake_triangle_distance(x, y, i + 0.5, j + 0.5) > gutter + 1e-3) continue;
+                o = owner + (size_t)j * size + i;
+                if (*o < 0) *o = chart;
+                else if (*o != chart) shared++;
             }
     }
-    free(count);
-    return over;
+    free(owner);
+    return shared;
+}
+
+/* Texel centres inside two atlas triangles (tt_raster_triangle's rule). */
+static int bake_raster_overlaps(const tt_mesh *mesh, const float *uv, int size)
+{
+    bake_count cb;
+    int f, k;
+    cb.width = size;
+    cb.overlaps = 0;
+    cb.count = (int *)calloc((size_t)size * size, sizeof(int));
+    for (f = 0; f < mesh->nfaces; f++) {
+        float xy[6];
+        for (k = 0; k < 3; k++) {
+            int c = mesh->face_start[f] + k;
+            xy[2 * k] = uv[2 * c] * (float)size;
+            xy[2 * k + 1] = (1.0f - uv[2 * c + 1]) * (float)size;
+        }
+        tt_raster_triangle(xy, size, size, bake_count_texel, &cb);
+    }
+    free(cb.count);
+    return cb.overlaps;
 }
 
 /* UVs outside [0, 1] (or NaN) among the first n floats. */
@@ -3063,7 +3089,7 @@ static void test_atlas_pack_pairs(void)
         CHECK(tt_atlas_pack_pairs(mesh, size, gutter, uv, &err) == TT_OK, "grid %d: size %d again", t, size);
         bad = bake_uv_outside(uv, 2 * mesh->ncorners);
         CHECK(bad == 0, "grid %d: %d UVs outside [0,1]", t, bad);
-        bad = bake_gutter_overlaps(mesh, uv, size, gutter);
+        bad = bake_gutter_overlaps(mesh, uv, NULL, size, gutter);
         CHECK(bad == 0, "grid %d: gutters disjoint at the smallest size, %d texels shared", t, bad);
         /* Orientation kept (CCW in UV, v up) and area positive. */
         bad = 0;
@@ -3076,25 +3102,10 @@ static void test_atlas_pack_pairs(void)
         /* A larger size too, and the rasters of the triangles are disjoint. */
         s2 = size * 2 + 3;
         CHECK(tt_atlas_pack_pairs(mesh, s2, gutter, uv, &err) == TT_OK, "grid %d: size %d", t, s2);
-        bad = bake_gutter_overlaps(mesh, uv, s2, gutter);
+        bad = bake_gutter_overlaps(mesh, uv, NULL, s2, gutter);
         CHECK(bad == 0, "grid %d: gutters disjoint at size %d, %d texels shared", t, s2, bad);
-        {
-            bake_count cb;
-            cb.width = s2;
-            cb.overlaps = 0;
-            cb.count = (int *)calloc((size_t)s2 * s2, sizeof(int));
-            for (f = 0; f < mesh->nfaces; f++) {
-                float xy[6];
-                int k;
-                for (k = 0; k < 3; k++) {
-                    xy[2 * k] = uv[6 * f + 2 * k] * (float)s2;
-                    xy[2 * k + 1] = (1.0f - uv[6 * f + 2 * k + 1]) * (float)s2;
-                }
-                tt_raster_triangle(xy, s2, s2, bake_count_texel, &cb);
-            }
-            CHECK(cb.overlaps == 0, "grid %d: raster overlaps %d", t, cb.overlaps);
-            free(cb.count);
-        }
+        bad = bake_raster_overlaps(mesh, uv, s2);
+        CHECK(bad == 0, "grid %d: raster overlaps %d", t, bad);
         free(uv);
         tt_mesh_free(mesh);
     }
@@ -3110,7 +3121,7 @@ static void test_atlas_pack_odd(void)
     CHECK(tt_atlas_pack_pairs(m3, 64, 2, uv, &err) == TT_OK, "3 triangles: %s", err.message);
     bad = bake_uv_outside(uv, 18);
     CHECK(bad == 0, "3 triangles: %d UVs outside [0,1]", bad);
-    bad = bake_gutter_overlaps(m3, uv, 64, 2);
+    bad = bake_gutter_overlaps(m3, uv, NULL, 64, 2);
     CHECK(bad == 0, "3 triangles: gutters disjoint, %d texels shared", bad);
     /* The largest angle becomes the right angle: face 0's corner 0 (the right
        angle at (0,0)) sits at its cell's lower-left, (2, 30) texels. */
@@ -3241,37 +3252,6 @@ static int chart_labels(const tt_mesh *mesh, const float *uv, int *label)
     return count;
 }
 
-/* Texels whose centre lies within `gutter` of triangles of two different
-   charts (what a bake with that gutter would write twice). */
-static int chart_gutters_shared(const tt_mesh *mesh, const float *uv, const int *label, int size, int gutter)
-{
-    int *owner = (int *)malloc(sizeof(int) * (size_t)size * size);
-    int f, i, shared = 0;
-    for (i = 0; i < size * size; i++) owner[i] = -1;
-    for (f = 0; f < mesh->nfaces; f++) {
-        double x[3], y[3], lo_x = 1e30, hi_x = -1e30, lo_y = 1e30, hi_y = -1e30;
-        int k, j;
-        for (k = 0; k < 3; k++) {
-            int c = mesh->face_start[f] + k;
-            x[k] = uv[2 * c] * (double)size;
-            y[k] = (1.0 - uv[2 * c + 1]) * (double)size;
-            lo_x = fmin(lo_x, x[k]); hi_x = fmax(hi_x, x[k]);
-            lo_y = fmin(lo_y, y[k]); hi_y = fmax(hi_y, y[k]);
-        }
-        for (j = (int)floor(lo_y - gutter - 1); j <= (int)ceil(hi_y + gutter + 1); j++)
-            for (i = (int)floor(lo_x - gutter - 1); i <= (int)ceil(hi_x + gutter + 1); i++) {
-                int *o;
-                if (i < 0 || j < 0 || i >= size || j >= size) continue;
-                if (bake_triangle_distance(x, y, i + 0.5, j + 0.5) > gutter + 1e-3) continue;
-                o = owner + (size_t)j * size + i;
-                if (*o < 0) *o = label[f];
-                else if (*o != label[f]) shared++;
-            }
-    }
-    free(owner);
-    return shared;
-}
-
 /* Texel density per triangle, sqrt(UV area in texels / surface area), at
    the 5th, 50th and 95th percentile over the triangles (each counts once,
    whatever its area: small triangles are as visible as large ones). */
@@ -3324,30 +3304,17 @@ static int chart_flipped(const tt_mesh *mesh, const float *uv)
 static void chart_check_atlas(const char *what, const tt_mesh *mesh, const float *uv,
                               const tt_chart_atlas_report *report, int size, int gutter, double spread[3])
 {
-    int *label = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces), bad, f, charts;
-    bake_count cb;
+    int *label = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces), bad, charts;
     bad = bake_uv_outside(uv, 2 * mesh->ncorners);
     CHECK(bad == 0, "%s: %d UVs outside [0,1]", what, bad);
     bad = chart_flipped(mesh, uv);
     CHECK(bad == 0, "%s: %d triangles flipped or empty", what, bad);
     charts = chart_labels(mesh, uv, label);
     CHECK(charts == report->ncharts, "%s: the UVs show %d charts, the report says %d", what, charts, report->ncharts);
-    bad = chart_gutters_shared(mesh, uv, label, size, gutter);
+    bad = bake_gutter_overlaps(mesh, uv, label, size, gutter);
     CHECK(bad == 0, "%s: %d texels within the gutter of two charts", what, bad);
-    cb.width = size;
-    cb.overlaps = 0;
-    cb.count = (int *)calloc((size_t)size * size, sizeof(int));
-    for (f = 0; f < mesh->nfaces; f++) {
-        float xy[6];
-        int k;
-        for (k = 0; k < 3; k++) {
-            xy[2 * k] = uv[6 * f + 2 * k] * (float)size;
-            xy[2 * k + 1] = (1.0f - uv[6 * f + 2 * k + 1]) * (float)size;
-        }
-        tt_raster_triangle(xy, size, size, bake_count_texel, &cb);
-    }
-    CHECK(cb.overlaps == 0, "%s: %d texel centres in two triangles", what, cb.overlaps);
-    free(cb.count);
+    bad = bake_raster_overlaps(mesh, uv, size);
+    CHECK(bad == 0, "%s: %d texel centres in two triangles", what, bad);
     chart_density(mesh, uv, size, spread);
     CHECK(spread[0] >= 0.75 * spread[1] && spread[2] <= 1.25 * spread[1],
           "%s: density 5th-95th percentile %.4g..%.4g within 25%% of the median %.4g", what, spread[0], spread[2],
