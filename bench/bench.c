@@ -38,7 +38,9 @@
    `polycube_100k_faces_res32` the whole mapping of that torus, voxelisation
    to UVs (spec B10), with the triangles it made and the ones left to the
    fallback; its atlas (spec P17: timed apart) is `synth_n2_tile64`, the
-   paper's 256 tiles at 64 texels.
+   paper's 256 tiles at 64 texels. `atlas_charts_100k_faces` times
+   tt_atlas_pack_charts on that torus at 2048 x 2048 (gutter 2, the tool's
+   --bake), with the charts it made and the fraction of the atlas they fill.
 
    Peers: bench/bench_build.c times the half-edge build on three 1M-face
    meshes beside a radix-sort pairing yardstick, and bench_build_cgal.cpp
@@ -624,6 +626,25 @@ static double run_hpm(void *p)
     return t1 - t0;
 }
 
+/* The chart atlas of a mesh at 2048 x 2048, gutter 2 (the tool's --bake). */
+typedef struct atlas_ctx {
+    tt_mesh *mesh;
+    float *uv;
+    tt_chart_atlas_report report;
+} atlas_ctx;
+
+static double run_atlas_charts(void *p)
+{
+    atlas_ctx *c = (atlas_ctx *)p;
+    tt_error err;
+    tt_result r;
+    double t0 = bench_now_ms(), t1;
+    r = tt_atlas_pack_charts(c->mesh, 2048, 2, NULL, c->uv, &c->report, &err);
+    t1 = bench_now_ms();
+    if (r != TT_OK) fail("tt_atlas_pack_charts", r, &err);
+    return t1 - t0;
+}
+
 static void check_mesh(const tt_mesh *mesh, const char *what)
 {
     tt_mesh_stats st;
@@ -776,6 +797,18 @@ int main(int argc, char **argv)
         free(hc.uv);
         tt_image_free(hc.image);
         tt_mesh_free(hc.mesh);
+    }
+    if (wanted("atlas_charts_100k_faces")) {
+        /* the chart atlas of a 100k-triangle torus at 2048 x 2048, gutter 2:
+           growing the charts, flattening, packing at the largest scale */
+        atlas_ctx ac;
+        ac.mesh = make_triangle_torus(224, 0.0);
+        ac.uv = (float *)xmalloc(sizeof(float) * 2 * (size_t)ac.mesh->ncorners);
+        report("atlas_charts_100k_faces", median_ms(run_atlas_charts, &ac, RUNS_FAST), "ms");
+        report("atlas_charts_100k_faces_charts", ac.report.ncharts, "charts");
+        report("atlas_charts_100k_faces_fill", ac.report.fill, "fraction");
+        free(ac.uv);
+        tt_mesh_free(ac.mesh);
     }
     if (wanted("polycube_100k_faces_res32")) {
         /* the polycube on a 100k-triangle torus: its construction and the
