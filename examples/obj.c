@@ -25,6 +25,17 @@
 #define OBJ_MAX_NUMBER_LENGTH 128   /* longer "numbers" are not numbers */
 #define OBJ_MAX_NAME_LENGTH 1024    /* group / material names are cut here */
 
+/* A list of names (groups, materials) the mesh owns, with an open-
+   addressing hash over it, so that a file with many names (one group per
+   paste, say) stays linear-time. */
+typedef struct name_index {
+    char ***names;              /* the mesh's array */
+    int *count;                 /* the mesh's count */
+    int capacity;
+    int *table;                 /* name index + 1, 0 = empty */
+    int table_size;             /* a power of two, kept at least twice *count */
+} name_index;
+
 typedef struct obj_parser {
     const char *p, *end;        /* cursor over the text */
     int line;                   /* physical line of the cursor, 1-based */
@@ -34,11 +45,10 @@ typedef struct obj_parser {
     char *err;
     size_t err_size;
     obj_mesh *mesh;
-    int pos_capacity, vert_line_capacity, uv_capacity, face_capacity, corner_capacity, group_capacity;
+    int pos_capacity, vert_line_capacity, uv_capacity, face_capacity, corner_capacity;
     int nnormals;
-    int current_group;
-    int *group_table;           /* open-addressing hash: group index + 1, 0 = empty */
-    int group_table_size;       /* a power of two, kept at least twice ngroups */
+    int current_group, current_material;
+    name_index groups, materials;
 } obj_parser;
 
 /* The capacity to grow an array to so that `needed` elements fit: doubling,
@@ -370,17 +380,19 @@ static int parse_face(obj_parser *P)
     if (corners < 3) return obj_error(P, "face with fewer than 3 corners");
     if (mesh->nfaces >= OBJ_MAX_COUNT) return obj_error(P, "too many faces (at most %d)", OBJ_MAX_COUNT);
     if (mesh->nfaces == P->face_capacity) {
-        /* face_size, face_group and face_line share one capacity. */
+        /* face_size, face_group, face_material and face_line share one capacity. */
         int capacity;
         if (grown_capacity(P->face_capacity, mesh->nfaces + 1, sizeof(int), &capacity) != 0 ||
             resize_array((void **)&mesh->face_size, capacity, sizeof(int)) != 0 ||
             resize_array((void **)&mesh->face_group, capacity, sizeof(int)) != 0 ||
+            resize_array((void **)&mesh->face_material, capacity, sizeof(int)) != 0 ||
             resize_array((void **)&mesh->face_line, capacity, sizeof(int)) != 0)
             return out_of_memory(P);
         P->face_capacity = capacity;
     }
     mesh->face_size[mesh->nfaces] = corners;
     mesh->face_group[mesh->nfaces] = P->current_group;
+    mesh->face_material[mesh->nfaces] = P->current_material;
     mesh->face_line[mesh->nfaces] = P->statement_line;
     mesh->nfaces++;
     return 0;
@@ -411,38 +423,35 @@ static uint32_t hash_name(const char *name)
     return h;
 }
 
-/* Index of the group called `name`, adding it if it is new. Names are looked
-   up in a hash table, so a file with many groups (one per paste, say) stays
-   linear-time. */
-static int find_or_add_group(obj_parser *P, const char *name, size_t length)
+/* Index of `name` in the index's list, adding it if it is new. */
+static int find_or_add_name(obj_parser *P, name_index *index, const char *name, size_t length)
 {
-    obj_mesh *mesh = P->mesh;
     uint32_t mask, slot;
-    if (mesh->ngroups * 2 >= P->group_table_size) {
+    if (*index->count * 2 >= index->table_size) {
         /* Rebuild the table twice as large. */
-        int size = P->group_table_size ? P->group_table_size * 2 : 64, g;
+        int size = index->table_size ? index->table_size * 2 : 64, g;
         int *table;
         if (size > OBJ_MAX_COUNT) return out_of_memory(P);
         table = (int *)calloc((size_t)size, sizeof(int));
         if (!table) return out_of_memory(P);
-        for (g = 0; g < mesh->ngroups; g++) {
-            uint32_t s = hash_name(mesh->group_names[g]) & (uint32_t)(size - 1);
+        for (g = 0; g < *index->count; g++) {
+            uint32_t s = hash_name((*index->names)[g]) & (uint32_t)(size - 1);
             while (table[s]) s = (s + 1) & (uint32_t)(size - 1);
             table[s] = g + 1;
         }
-        free(P->group_table);
-        P->group_table = table;
-        P->group_table_size = size;
+        free(index->table);
+        index->table = table;
+        index->table_size = size;
     }
-    mask = (uint32_t)P->group_table_size - 1;
-    for (slot = hash_name(name) & mask; P->group_table[slot]; slot = (slot + 1) & mask)
-        if (strcmp(mesh->group_names[P->group_table[slot] - 1], name) == 0) return P->group_table[slot] - 1;
-    if (grow_array((void **)&mesh->group_names, &P->group_capacity, mesh->ngroups + 1, sizeof(char *)) != 0)
+    mask = (uint32_t)index->table_size - 1;
+    for (slot = hash_name(name) & mask; index->table[slot]; slot = (slot + 1) & mask)
+        if (strcmp((*index->names)[index->table[slot] - 1], name) == 0) return index->table[slot] - 1;
+    if (grow_array((void **)index->names, &index->capacity, *index->count + 1, sizeof(char *)) != 0)
         return out_of_memory(P);
-    mesh->group_names[mesh->ngroups] = tool_copy_string(name, length);
-    if (!mesh->group_names[mesh->ngroups]) return out_of_memory(P);
-    P->group_table[slot] = mesh->ngroups + 1;
-    return mesh->ngroups++;
+    (*index->names)[*index->count] = tool_copy_string(name, length);
+    if (!(*index->names)[*index->count]) return out_of_memory(P);
+    index->table[slot] = *index->count + 1;
+    return (*index->count)++;
 }
 
 /* Statements that are valid OBJ but carry nothing this tool uses: normals
@@ -472,9 +481,14 @@ static int parse_statement(obj_parser *P)
     }
     if (token_is(keyword, length, "g") || token_is(keyword, length, "o") || token_is(keyword, length, "usemtl")) {
         size_t name_length = read_name(P, name, sizeof name);
-        int group = find_or_add_group(P, name, name_length);
+        int group = find_or_add_name(P, &P->groups, name, name_length);
         if (group < 0) return -1;
         P->current_group = group;
+        if (token_is(keyword, length, "usemtl")) {
+            int material = find_or_add_name(P, &P->materials, name, name_length);
+            if (material < 0) return -1;
+            P->current_material = material;
+        }
         return 0;
     }
     if (token_is(keyword, length, "mtllib")) {
@@ -517,9 +531,14 @@ static int obj_parse_named(const char *text, size_t length, const char *source, 
     P->err = err;
     P->err_size = err_size;
     P->mesh = out;
+    P->groups.names = &out->group_names;
+    P->groups.count = &out->ngroups;
+    P->materials.names = &out->material_names;
+    P->materials.count = &out->nmaterials;
     tool_set_error(err, err_size, "no error");
 
-    if (find_or_add_group(P, "", 0) != 0) goto fail;    /* group 0: faces before any g / o / usemtl */
+    /* group 0: faces before any g / o / usemtl; material 0: before any usemtl */
+    if (find_or_add_name(P, &P->groups, "", 0) != 0 || find_or_add_name(P, &P->materials, "", 0) != 0) goto fail;
     while (P->p < P->end) {
         skip_blanks(P);
         if (at_statement_end(P)) {      /* blank line */
@@ -536,11 +555,13 @@ static int obj_parse_named(const char *text, size_t length, const char *source, 
         else tool_set_error(err, err_size, "no faces");
         goto fail;
     }
-    free(P->group_table);
+    free(P->groups.table);
+    free(P->materials.table);
     return 0;
 
 fail:
-    free(P->group_table);
+    free(P->groups.table);
+    free(P->materials.table);
     obj_free(out);
     return -1;
 }
@@ -566,6 +587,91 @@ int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size)
         tool_note("%s:%d: skipped %d lines with unknown keywords, the first '%s'", path,
                   out->first_unknown_line, out->unknown_statements, out->first_unknown);
     return result;
+}
+
+/* ======================================================================== */
+/* MTL reading                                                              */
+/* ======================================================================== */
+
+/* A map_ statement's file name: what follows its options. Options start
+   with '-' and take numbers or on/off, so when the value starts with '-'
+   the name is its last word ("-s 2 2 1 stone.png" -> "stone.png"); a name
+   with blanks in it is read whole when no option comes first. */
+static const char *map_file_name(const char *value)
+{
+    const char *last_blank = strrchr(value, ' ');
+    return value[0] == '-' && last_blank ? last_blank + 1 : value;
+}
+
+int mtl_read(const char *path, mtl_library *out, char *err, size_t err_size)
+{
+    unsigned char *data;
+    size_t size;
+    obj_parser parser;
+    obj_parser *P = &parser;
+    char name[OBJ_MAX_NAME_LENGTH];
+    int capacity = 0, status = 0;
+    memset(out, 0, sizeof *out);
+    if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
+    memset(P, 0, sizeof *P);
+    P->p = (const char *)data;
+    P->end = P->p + size;
+    P->line = 1;
+    P->source = path;
+    P->err = err;
+    P->err_size = err_size;
+    while (P->p < P->end && status == 0) {
+        const char *keyword;
+        size_t length;
+        skip_blanks(P);
+        P->statement = P->p;
+        P->statement_line = P->line;
+        length = next_token(P, &keyword);
+        if (token_is(keyword, length, "newmtl")) {
+            size_t name_length = read_name(P, name, sizeof name);
+            int had = capacity;
+            /* names and diffuse_maps share one capacity. */
+            if (out->count >= OBJ_MAX_COUNT ||
+                grow_array((void **)&out->names, &capacity, out->count + 1, sizeof(char *)) != 0 ||
+                (capacity != had && resize_array((void **)&out->diffuse_maps, capacity, sizeof(char *)) != 0) ||
+                !(out->names[out->count] = tool_copy_string(name, name_length))) {
+                status = out_of_memory(P);
+                break;
+            }
+            out->diffuse_maps[out->count++] = NULL;
+        } else if (token_is(keyword, length, "map_Kd") && out->count > 0) {
+            const char *file;
+            char **map = &out->diffuse_maps[out->count - 1];
+            read_name(P, name, sizeof name);
+            file = map_file_name(name);
+            free(*map);
+            if (!(*map = tool_copy_string(file, strlen(file)))) status = out_of_memory(P);
+        }
+        finish_statement(P);
+    }
+    free(data);
+    if (status != 0) mtl_free(out);
+    return status;
+}
+
+void mtl_free(mtl_library *library)
+{
+    int k;
+    for (k = 0; k < library->count; k++) {
+        free(library->names[k]);
+        free(library->diffuse_maps[k]);
+    }
+    free(library->names);
+    free(library->diffuse_maps);
+    memset(library, 0, sizeof *library);
+}
+
+int mtl_find(const mtl_library *library, const char *name)
+{
+    int k;
+    for (k = 0; k < library->count; k++)
+        if (strcmp(library->names[k], name) == 0) return k;
+    return -1;
 }
 
 tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags)
@@ -654,10 +760,13 @@ void obj_free(obj_mesh *mesh)
     free(mesh->uv);
     free(mesh->corner_uv);
     free(mesh->face_group);
+    free(mesh->face_material);
     free(mesh->face_line);
     free(mesh->vert_line);
     for (g = 0; g < mesh->ngroups; g++) free(mesh->group_names[g]);
     free(mesh->group_names);
+    for (g = 0; g < mesh->nmaterials; g++) free(mesh->material_names[g]);
+    free(mesh->material_names);
     free(mesh->mtllib);
     memset(mesh, 0, sizeof *mesh);
 }

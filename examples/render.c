@@ -2,7 +2,8 @@
 
    A small software renderer, written to be read. The steps:
 
-     1. Read the OBJ (positions, per-corner vt) and the texture; build the
+     1. Read the OBJ (positions, per-corner vt) and the texture, and the
+        textures its materials name (MTL map_Kd), if any; build each
         texture's mip chain (each level half the size of the one before).
      2. Split every polygon into a fan of triangles; give every face corner a
         smooth normal (faces meeting at a sharp crease keep their own).
@@ -24,7 +25,7 @@
    time with the texture patch at other coordinates; drawn in file order
    with alpha blending, the pastes cover the surface. A mesh is drawn that way
    when some triangle occurs more than once (the same three vertices). Then
-   the texture is premultiplied by its own alpha (the lapped MTL names the
+   each texture is premultiplied by its own alpha (the lapped MTL names the
    same PNG as map_d) before its mip chain is built, its coordinates are clamped instead
    of repeated (outside [0,1] is transparent), and between steps 4 and 5 a
    pasting pass rasterises every triangle again in file order: at each sample
@@ -290,7 +291,8 @@ typedef struct scene {
     signed char *triangle_facing; /* +1: the camera sees the side the winding calls "outside", -1: the inside */
     float *corner_normal;       /* 3 per OBJ corner, unit length */
     float *screen;              /* 3 per vertex: x and y in samples, then q = 1 / depth */
-    const mip_texture *texture; /* NULL: draw grey */
+    const mip_texture *textures; /* the textures faces are drawn with */
+    const int *face_texture;    /* per OBJ face: index into textures, -1: draw grey */
     int wireframe;              /* draw the OBJ faces' edges over the surface */
     vec3 light_key, light_fill; /* unit vectors towards the two lights */
     int width, height;          /* of the sample grid */
@@ -647,9 +649,11 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
 {
     const obj_mesh *mesh = s->mesh;
     const int *corner = s->triangle_corners + 3 * t;
+    const int index = s->face_texture[s->triangle_face[t]];
+    const mip_texture *texture = index >= 0 ? &s->textures[index] : NULL;
     rgba[0] = rgba[1] = rgba[2] = s->untextured_grey;
     rgba[3] = 1.0f;
-    if (s->texture && mesh->corner_uv && mesh->corner_uv[corner[0]] >= 0 && mesh->corner_uv[corner[1]] >= 0 &&
+    if (texture && mesh->corner_uv && mesh->corner_uv[corner[0]] >= 0 && mesh->corner_uv[corner[1]] >= 0 &&
         mesh->corner_uv[corner[2]] >= 0) {
         const float *uv0 = mesh->uv + 2 * mesh->corner_uv[corner[0]];
         const float *uv1 = mesh->uv + 2 * mesh->corner_uv[corner[1]];
@@ -664,12 +668,12 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
         float uqy = dbdy[0] * uv0[0] * p0[2] + dbdy[1] * uv1[0] * p1[2] + dbdy[2] * uv2[0] * p2[2];
         float vqx = dbdx[0] * uv0[1] * p0[2] + dbdx[1] * uv1[1] * p1[2] + dbdx[2] * uv2[1] * p2[2];
         float vqy = dbdy[0] * uv0[1] * p0[2] + dbdy[1] * uv1[1] * p1[2] + dbdy[2] * uv2[1] * p2[2];
-        const tt_image *base = s->texture->levels[0];
+        const tt_image *base = texture->levels[0];
         float dudx = (uqx - u * qx) / q * (float)base->width, dvdx = (vqx - v * qx) / q * (float)base->height;
         float dudy = (uqy - u * qy) / q * (float)base->width, dvdy = (vqy - v * qy) / q * (float)base->height;
         /* The footprint of one sample in texels: the longer of its two sides. */
         float footprint = sqrtf(fmaxf(dudx * dudx + dvdx * dvdx, dudy * dudy + dvdy * dvdy));
-        sample_trilinear(s->texture, u, v, footprint, !s->pasting, rgba);
+        sample_trilinear(texture, u, v, footprint, !s->pasting, rgba);
     }
 }
 
@@ -815,23 +819,136 @@ static int resolve(const sample_buffer *samples, tt_image **out_picture, tt_erro
 }
 
 /* ======================================================================== */
+/* Textures: TEXTURE, and those the OBJ's materials name                    */
+/* ======================================================================== */
+
+/* The textures faces are drawn with: textures[0] is TEXTURE; a face whose
+   material (its latest usemtl) has a map_Kd in the OBJ's MTL file is drawn
+   with that texture, each file loaded once - so a pasting OBJ with one
+   material per texture patch shows each paste with its own patch. TEXTURE
+   stands in wherever a material names no texture, or one that cannot be
+   read (a note says so). */
+typedef struct texture_set {
+    int count;
+    mip_texture *textures;      /* up to 1 + materials */
+    char **paths;               /* the file each was loaded from (textures[0]: TEXTURE) */
+    int *face_texture;          /* per OBJ face: index into textures */
+} texture_set;
+
+static void texture_set_free(texture_set *set)
+{
+    int k;
+    for (k = 0; k < set->count; k++) {
+        texture_free(&set->textures[k]);
+        free(set->paths[k]);
+    }
+    free(set->textures);
+    free(set->paths);
+    free(set->face_texture);
+    memset(set, 0, sizeof *set);
+}
+
+/* Load a colour texture (sRGB bytes, decoded to linear light) into the set,
+   premultiplied for a pasting mesh: blending, like mip-mapping, needs
+   premultiplied colours (or transparent texels bleed their colour).
+   Returns its index, or -1 with the reason in err. */
+static int texture_set_add(texture_set *set, const char *path, int premultiply, char *err, size_t err_size)
+{
+    char message[TOOL_ERROR_SIZE];
+    tt_image *image;
+    int k;
+    for (k = 0; k < set->count; k++)
+        if (strcmp(set->paths[k], path) == 0) return k;
+    if (image_load(path, TT_COLOR_SRGB, &image, err, err_size) != 0) return -1;
+    if (premultiply) premultiply_alpha(image);
+    if (!(set->paths[set->count] = tool_copy_string(path, strlen(path)))) {
+        image_free(image);
+        tool_set_error(err, err_size, "out of memory for the texture %s", path);
+        return -1;
+    }
+    if (texture_build(&set->textures[set->count], image, message, sizeof message) != 0) {
+        free(set->paths[set->count]);
+        tool_set_error(err, err_size, "cannot prepare the texture %s: %s", path, message);
+        return -1;
+    }
+    return set->count++;
+}
+
+/* TEXTURE (must load: the command fails otherwise), then, unless
+   use_materials is 0, the textures of the materials the faces use.
+   Returns 0, or the exit status after printing the error. */
+static int load_textures(const char *obj_path, const char *texture_path, const obj_mesh *mesh, int pasting,
+                         int use_materials, texture_set *set)
+{
+    char err[TOOL_ERROR_SIZE], mtl_path[4096], map_path[4096];
+    mtl_library library;
+    int *material_texture = NULL, f, m, status = 0;
+    memset(set, 0, sizeof *set);
+    memset(&library, 0, sizeof library);
+    set->textures = (mip_texture *)calloc((size_t)mesh->nmaterials + 1, sizeof(mip_texture));
+    set->paths = (char **)calloc((size_t)mesh->nmaterials + 1, sizeof(char *));
+    set->face_texture = (int *)calloc((size_t)mesh->nfaces, sizeof(int));      /* 0: TEXTURE */
+    material_texture = (int *)calloc((size_t)mesh->nmaterials, sizeof(int));
+    if (!set->textures || !set->paths || !set->face_texture || !material_texture) {
+        status = tool_fail("out of memory while rendering %s", obj_path);
+        goto done;
+    }
+    if (texture_set_add(set, texture_path, pasting, err, sizeof err) < 0) {
+        status = tool_fail("%s", err);
+        goto done;
+    }
+    if (!use_materials || !mesh->mtllib || mesh->nmaterials < 2) goto done;
+    tool_path_beside(mesh->mtllib, obj_path, mtl_path, sizeof mtl_path);
+    if (mtl_read(mtl_path, &library, err, sizeof err) != 0) {
+        tool_note("%s; drawn with %s", err, texture_path);
+        goto done;
+    }
+    /* Only the materials some face uses: a texture no face shows is not loaded. */
+    for (f = 0; f < mesh->nfaces; f++) material_texture[mesh->face_material[f]] = -1;
+    for (m = 1; m < mesh->nmaterials; m++) {
+        int k;
+        if (material_texture[m] == 0) continue;
+        material_texture[m] = 0;
+        k = mtl_find(&library, mesh->material_names[m]);
+        if (k < 0 || !library.diffuse_maps[k]) continue;
+        tool_path_beside(library.diffuse_maps[k], mtl_path, map_path, sizeof map_path);
+        material_texture[m] = texture_set_add(set, map_path, pasting, err, sizeof err);
+        if (material_texture[m] < 0) {
+            tool_note("material %s of %s: %s; drawn with %s", mesh->material_names[m], obj_path, err, texture_path);
+            material_texture[m] = 0;
+        }
+    }
+    for (f = 0; f < mesh->nfaces; f++) set->face_texture[f] = material_texture[mesh->face_material[f]];
+done:
+    mtl_free(&library);
+    free(material_texture);
+    return status;
+}
+
+/* ======================================================================== */
 /* The command                                                              */
 /* ======================================================================== */
 
 static void print_render_help(void)
 {
     printf("usage: tiledtex render MESH.obj TEXTURE OUT.png [--size WxH] [--yaw DEG] [--pitch DEG] [--up AXIS]\n"
-           "                       [--zoom F] [--wireframe]\n"
+           "                       [--zoom F] [--wireframe] [--no-materials]\n"
            "\n"
            "Draw MESH with TEXTURE (PNG, JPEG, TGA, BMP, ...) applied through the mesh's per-corner\n"
            "texture coordinates (vt) and save the picture as OUT.png. Faces without texture\n"
            "coordinates are drawn in grey. The camera looks at the whole model; texture\n"
            "coordinates outside [0,1] repeat the texture.\n"
            "\n"
+           "Materials: when MESH names an MTL file (mtllib) and its faces materials (usemtl), a face\n"
+           "whose material has a texture (map_Kd, a path relative to the MTL, which is relative to\n"
+           "MESH) is drawn with that texture; TEXTURE serves the other faces, and stands in for a\n"
+           "material texture that cannot be read (a note says so). So a mesh with several\n"
+           "textures shows each where it belongs, whichever TEXTURE is given.\n"
+           "\n"
            "Pasting meshes (from 'tiledtex lapped'), where the same triangle occurs several times,\n"
            "are drawn as the paper draws them: each occurrence in file order, blended over the\n"
-           "ones before through TEXTURE's alpha, which is the texture patch; its coordinates\n"
-           "are clamped, not repeated.\n"
+           "ones before through its texture's alpha, which is the texture patch (each paste's\n"
+           "material names its patch); the coordinates are clamped, not repeated.\n"
            "\n"
            "  --size WxH    picture size in pixels, each side up to %d (default %dx%d)\n"
            "  --yaw DEG     turn the camera around the model's up axis (default 30)\n"
@@ -839,7 +956,8 @@ static void print_render_help(void)
            "  --up AXIS     the model's up axis: y (default, usual for OBJ), z (usual for CAD\n"
            "                and scans), x, -y, -z or -x\n"
            "  --zoom F      magnify the view F times, 0.1 to 100 (default 1: the whole model)\n"
-           "  --wireframe   draw the edges of the mesh's faces over the surface\n",
+           "  --wireframe   draw the edges of the mesh's faces over the surface\n"
+           "  --no-materials  draw every face with TEXTURE, whatever its material names\n",
            RENDER_MAX_SIZE, RENDER_DEFAULT_WIDTH, RENDER_DEFAULT_HEIGHT);
 }
 
@@ -848,12 +966,12 @@ int cmd_render(int argc, char **argv)
     const char *positional[3];
     int npositional = 0, width = RENDER_DEFAULT_WIDTH, height = RENDER_DEFAULT_HEIGHT, i, status = TOOL_EXIT_FAILURE;
     double yaw = 30.0, pitch = 20.0, zoom = 1.0;
-    int wireframe = 0, built;
+    int wireframe = 0, use_materials = 1;
     char err[TOOL_ERROR_SIZE];
     obj_mesh mesh;
-    tt_image *image = NULL, *picture = NULL;
+    tt_image *picture = NULL;
     tt_error error;
-    mip_texture texture;
+    texture_set textures;
     scene s;
     camera cam;
     sample_buffer samples;
@@ -880,6 +998,8 @@ int cmd_render(int argc, char **argv)
             if (parse_float("--zoom", value, 0.1, 100.0, &zoom) != 0) return TOOL_EXIT_USAGE;
         } else if (strcmp(argv[i], "--wireframe") == 0) {
             wireframe = 1;
+        } else if (strcmp(argv[i], "--no-materials") == 0) {
+            use_materials = 0;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
             if (parse_up_axis(value, &axis) != 0)
                 return value ? tool_usage("--up wants x, y, z, -x, -y or -z, got '%s'", value)
@@ -895,15 +1015,10 @@ int cmd_render(int argc, char **argv)
     if (npositional < 3)
         return tool_usage("needs MESH.obj TEXTURE OUT.png (see 'tiledtex render --help')");
 
-    memset(&texture, 0, sizeof texture);
+    memset(&textures, 0, sizeof textures);
     memset(&s, 0, sizeof s);
     memset(&samples, 0, sizeof samples);
     if (obj_read(positional[0], &mesh, err, sizeof err) != 0) return tool_fail("%s", err);
-    /* The texture is colour: sRGB bytes, decoded to linear light. */
-    if (image_load(positional[1], TT_COLOR_SRGB, &image, err, sizeof err) != 0) {
-        tool_fail("%s", err);
-        goto done;
-    }
     if (mesh_bounding_sphere(&mesh, &centre, &radius, &bad_vertex) != 0) {
         tool_fail("%s: vertex %d has a coordinate that is not a finite number", positional[0], bad_vertex + 1);
         goto done;
@@ -914,16 +1029,9 @@ int cmd_render(int argc, char **argv)
         tool_fail("out of memory while rendering %s", positional[0]);
         goto done;
     }
-    /* A pasting mesh blends its texture, and blending, like mip-mapping,
-       needs premultiplied colours (or transparent texels bleed their colour). */
-    if (s.pasting) premultiply_alpha(image);
-    built = texture_build(&texture, image, err, sizeof err);
-    image = NULL;   /* the texture owns it now */
-    if (built != 0) {
-        tool_fail("cannot prepare the texture %s: %s", positional[1], err);
-        goto done;
-    }
-    s.texture = &texture;
+    if (load_textures(positional[0], positional[1], &mesh, s.pasting, use_materials, &textures) != 0) goto done;
+    s.textures = textures.textures;
+    s.face_texture = textures.face_texture;
     s.width = width * SUPERSAMPLING;
     s.height = height * SUPERSAMPLING;
     s.wireframe = wireframe;
@@ -961,8 +1069,7 @@ done:
     tt_image_free(picture);
     samples_free(&samples);
     scene_free(&s);
-    texture_free(&texture);
-    image_free(image);
+    texture_set_free(&textures);
     obj_free(&mesh);
     return status;
 }

@@ -307,6 +307,8 @@ typedef struct obj_mesh {
     int *corner_uv;                   /* ncorners entries (0-based vt index) or NULL when no face has vt; -1 for a corner without one */
     int *face_group;                  /* nfaces: index into group_names of the `g`/`o`/`usemtl` group the face is in (0 = before any) */
     int ngroups; char **group_names;  /* group_names[0] = "" */
+    int *face_material;               /* nfaces: index into material_names of the latest `usemtl` (0 = before any) */
+    int nmaterials; char **material_names;  /* material_names[0] = "" */
     char *mtllib;                     /* first mtllib name or NULL */
     int *vert_line;                   /* nverts: the file line of each `v`, for messages */
     int *face_line;                   /* nfaces: the file line of each `f` */
@@ -318,7 +320,9 @@ typedef struct obj_mesh {
 /* Parse OBJ text (`length` bytes, need not end in NUL; any bytes are safe).
    Reads v, vt, f (corners v, v/vt, v//vn, v/vt/vn; negative indices count
    back from the latest vertex), g / o / usemtl (which group each face is in;
-   the latest of these statements names it), and the first mtllib. Everything
+   the latest of these statements names it), usemtl again on its own (each
+   face's material: the latest usemtl, whatever g / o came after it), and
+   the first mtllib. Everything
    else (vn values, s, l, p, comments, unknown statements) is skipped; unknown
    statements are counted in unknown_statements. Lines end in LF, CRLF or a
    lone CR; a UTF-8 byte-order mark at the start is skipped. A line ending in
@@ -333,6 +337,23 @@ tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
    Unknown statements give one tool_note naming the first and the count. */
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
+
+/* The materials of an MTL file: newmtl NAME and its map_Kd (the diffuse
+   texture) as the file names it: relative to the MTL's directory unless
+   absolute; options before the name are skipped. Everything else in the
+   file is skipped. */
+typedef struct mtl_library {
+    int count;
+    char **names;           /* count material names */
+    char **diffuse_maps;    /* count map_Kd file names, NULL for a material without one */
+} mtl_library;
+
+/* Read an MTL file. Returns 0, or -1 with a message in err (a file that
+   cannot be read, out of memory). */
+int mtl_read(const char *path, mtl_library *out, char *err, size_t err_size);
+void mtl_free(mtl_library *library);
+/* The index of the material called `name`, or -1. */
+int mtl_find(const mtl_library *library, const char *name);
 
 /* Split every face (c0, c1, ..., cn-1) into the fan of triangles (c0, ci,
    ci+1), in face order: exact for triangles and convex polygons, which is
@@ -570,5 +591,9 @@ const char *tool_basename(const char *path);
    both are resolved on the file system (their directories must exist);
    failing that, target's absolute path is used, or target as given. */
 void tool_relative_path(const char *target, const char *from_file, char *out, size_t out_size);
+/* The other way: `name`, as a file beside from_file names it (relative to
+   from_file's directory, or absolute), as a path from the current
+   directory ("out/a.obj", "a.mtl" -> "out/a.mtl"). */
+void tool_path_beside(const char *name, const char *from_file, char *out, size_t out_size);
 
 #endif /* TILEDTEX_TOOL_H */

@@ -360,6 +360,13 @@ void tool_relative_path(const char *target, const char *from_file, char *out, si
     free(resolved_file);
 }
 
+void tool_path_beside(const char *name, const char *from_file, char *out, size_t out_size)
+{
+    const char *directory_end = tool_basename(from_file);
+    if (name[0] == '/' || directory_end == from_file) snprintf(out, out_size, "%s", name);
+    else snprintf(out, out_size, "%.*s%s", (int)(directory_end - from_file), from_file, name);
+}
+
 const char *tool_basename(const char *path)
 {
     const char *base = path, *p;

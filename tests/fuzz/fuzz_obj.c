@@ -76,6 +76,8 @@ static void check_parsed(const obj_mesh *m)
         c += m->face_size[i];
         CHECK(m->face_group[i] >= 0 && m->face_group[i] < m->ngroups, "face %d group %d of %d", i, m->face_group[i],
               m->ngroups);
+        CHECK(m->face_material[i] >= 0 && m->face_material[i] < m->nmaterials, "face %d material %d of %d", i,
+              m->face_material[i], m->nmaterials);
     }
     CHECK(c == m->ncorners, "face sizes add up to %d, ncorners %d", c, m->ncorners);
     for (i = 0; i < m->ncorners; ++i) {
@@ -91,15 +93,23 @@ static void check_parsed(const obj_mesh *m)
         CHECK(m->group_names[i] != NULL, "group name %d is NULL", i);
         (void)strlen(m->group_names[i]);
     }
+    if (m->nmaterials >= 1)
+        CHECK(m->material_names[0] && m->material_names[0][0] == '\0', "material_names[0] is not \"\"");
+    for (i = 0; i < m->nmaterials; ++i) {
+        CHECK(m->material_names[i] != NULL, "material name %d is NULL", i);
+        (void)strlen(m->material_names[i]);
+    }
     if (m->mtllib) (void)strlen(m->mtllib);
 }
 
 static void check_zeroed(const obj_mesh *m)
 {
-    CHECK(m->nverts == 0 && m->nfaces == 0 && m->ncorners == 0 && m->nuvs == 0 && m->ngroups == 0,
-          "failed parse left counts %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->ngroups);
+    CHECK(m->nverts == 0 && m->nfaces == 0 && m->ncorners == 0 && m->nuvs == 0 && m->ngroups == 0 &&
+              m->nmaterials == 0,
+          "failed parse left counts %d %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->ngroups,
+          m->nmaterials);
     CHECK(!m->pos && !m->face_size && !m->corner_vert && !m->uv && !m->corner_uv && !m->face_group &&
-              !m->group_names && !m->mtllib,
+              !m->group_names && !m->face_material && !m->material_names && !m->mtllib,
           "failed parse left pointers behind");
 }
 
