@@ -6,7 +6,7 @@
 #   3. tiled textures (Akleman et al.):     build/demo/double_torus.obj/.mtl/.png
 #   4. pictures of the result               build/demo/double_torus_front.png, _side.png, _closeup.png
 #   5. lapped textures (Praun et al.) on the same surface, runtime pasting and baked:
-#                                           build/demo/lapped.obj/.mtl, lapped_patch.png, lapped_baked.*,
+#                                           build/demo/lapped.obj/.mtl, lapped_patch_1..4.png, lapped_baked.*,
 #                                           pictures build/demo/lapped_front.png, lapped_baked_front.png
 #   6. hierarchical pattern mapping (Soler et al.): texture coordinates into the texture itself:
 #                                           build/demo/hpm.obj/.mtl, picture build/demo/hpm_front.png
@@ -32,7 +32,8 @@ mkdir -p "$out"
 "$tool" render "$out/double_torus.obj" "$out/double_torus.png" "$out/double_torus_closeup.png" \
     --yaw 10 --pitch 30 --zoom 3 --size 900x600 --wireframe
 "$tool" lapped "$out/double_torus_mesh.obj" "$out/texture.png" "$out/lapped" --scale 1.2 --seed 1 --bake 2048
-"$tool" render "$out/lapped.obj" "$out/lapped_patch.png" "$out/lapped_front.png" --yaw 20 --pitch 15
+# Four patches (windows of the 512x512 texture): render takes each paste's from its material.
+"$tool" render "$out/lapped.obj" "$out/lapped_patch_1.png" "$out/lapped_front.png" --yaw 20 --pitch 15
 "$tool" render "$out/lapped_baked.obj" "$out/lapped_baked.png" "$out/lapped_baked_front.png" --yaw 20 --pitch 15
 # The texture's width spans 3 of the surface's 5.7 units: stones large enough to see where clusters meet.
 "$tool" hpm "$out/double_torus_mesh.obj" "$out/texture.png" "$out/hpm" --scale 3 --seed 1

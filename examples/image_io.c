@@ -53,6 +53,26 @@ void image_free(tt_image *image)
     free(image);
 }
 
+int image_crop(const tt_image *image, int x, int y, int width, int height, tt_image **out)
+{
+    tt_image *crop = (tt_image *)calloc(1, sizeof *crop);
+    int row;
+    *out = NULL;
+    if (crop) crop->pixels = (float *)malloc((size_t)width * (size_t)height * 4 * sizeof(float));
+    if (!crop || !crop->pixels) {
+        free(crop);
+        return -1;
+    }
+    crop->width = width;
+    crop->height = height;
+    for (row = 0; row < height; row++)
+        memcpy(crop->pixels + (size_t)row * (size_t)width * 4,
+               image->pixels + ((size_t)(y + row) * (size_t)image->width + (size_t)x) * 4,
+               (size_t)width * 4 * sizeof(float));
+    *out = crop;
+    return 0;
+}
+
 /* Rows converted at a time: the 8-bit decode shrinks by this much per step. */
 #define LOAD_STRIP_BYTES (1u << 20)
 

@@ -2,8 +2,11 @@
 
    MESH.obj + IMAGE -> OUT_PREFIX.obj, whose faces are the pastes in order
    (group paste_N: the triangles paste N covers, with that paste's texture
-   coordinates), OUT_PREFIX.mtl and OUT_PREFIX_patch.png, the texture patch
-   (straight alpha). Drawn in file order with alpha blending, the pastes cover
+   coordinates, and the material of its patch), OUT_PREFIX.mtl and the
+   texture patches (straight alpha): OUT_PREFIX_patch.png when there is one,
+   OUT_PREFIX_patch_K.png when there are several (--patches: windows of the
+   image, so that the pastes do not all show the same part of the photo).
+   Drawn in file order with alpha blending, the pastes cover
    the surface (Praun et al. Sec. 4, "runtime pasting"); `tiledtex render`
    draws such a file that way, as do engines that composite in order; an
    importer that merges the copies of a triangle (Blender's) cannot, so
@@ -20,8 +23,9 @@
                             quad split in two again (triangle_mesh.c)
      tt_tangent_field       each face's texture "up" and scale (Sec. 3.2):
                             --up, --scale, --constraints
-     tt_make_texture_patch  the image with a soft splotch (or --mask) alpha (Sec. 3.1)
-     tt_lapped_paste        the paste loop (Sec. 3.3 - 3.6, 4)
+     tt_make_texture_patch  the image, or each window of it, with a soft splotch (or
+                            --mask) alpha (Sec. 3.1)
+     tt_lapped_paste        the paste loop over all the patches (Sec. 3.3 - 3.6, 4)
      tt_lapped_measure      alignment measured from the written UVs alone
      tt_uv_check,           --bake: the OBJ's own texture coordinates when they
      tt_atlas_pack_charts,  can take a bake (--bake-uv), else an atlas of
@@ -39,28 +43,57 @@
    each chart: enough for bilinear filtering and the first mip level. */
 #define LAPPED_BAKE_GUTTER 2
 
+/* --patches: at most this many (one PNG each). */
+#define LAPPED_MAX_PATCHES 256
+/* Windows smaller than this many texels a side are refused: a patch needs
+   room inside its soft edge (TT_DEFAULT_PATCH_FALLOFF texels) for the part
+   of the photo it shows. */
+#define LAPPED_MIN_WINDOW 32
+/* The default cuts 4 windows when they can be at least this large; from a
+   smaller image a quarter holds too little of the photo to be worth it, and
+   the whole image stays the one patch. */
+#define LAPPED_DEFAULT_PATCHES 4
+#define LAPPED_DEFAULT_MIN_WINDOW 64
+
 static void print_help(void)
 {
     printf("usage: tiledtex lapped MESH.obj IMAGE OUT_PREFIX [options]\n"
            "\n"
-           "Cover MESH.obj with overlapping pastes of one texture patch cut from IMAGE (Praun et\n"
+           "Cover MESH.obj with overlapping pastes of texture patches cut from IMAGE (Praun et\n"
            "al., Lapped Textures): no seams show, because every paste fades out over the ones\n"
            "beneath it. Writes OUT_PREFIX.obj (group paste_N holds the triangles of paste N with\n"
-           "its texture coordinates; draw the groups in order with alpha blending and clamped\n"
-           "texture coordinates), OUT_PREFIX.mtl and OUT_PREFIX_patch.png (the patch, straight\n"
-           "alpha; the MTL names it as map_Kd and map_d, by file name: the folder can move).\n"
-           "Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX_patch.png view.png'.\n"
+           "its texture coordinates and its patch's material; draw the groups in order with alpha\n"
+           "blending and clamped texture coordinates), OUT_PREFIX.mtl and the patches (straight\n"
+           "alpha): OUT_PREFIX_patch.png when there is one, OUT_PREFIX_patch_1.png, _2, ... when\n"
+           "there are several (the MTL has a material lapped_K for each, naming its PNG as map_Kd\n"
+           "and map_d by file name: the folder can move).\n"
+           "Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX_patch_1.png view.png' (or\n"
+           "OUT_PREFIX_patch.png when there is one patch): render draws each paste with the patch\n"
+           "its material names.\n"
            "That OBJ is for this tool's renderer and for engines that draw the faces in file order\n"
            "with blending; Blender's importer cannot stack copies of a triangle. To take the\n"
            "result to other programs, use --bake (one texture on the mesh).\n"
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
            "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
            "--permissive.\n"
-           "\n"
-           "options:\n"
+           "\n");
+    /* Two pieces: C99 compilers need only take string literals of 4095 bytes. */
+    printf("options:\n"
            "  --scale X            side of one texture patch on the surface, in mesh units\n"
            "                       (default: %g of the mesh's bounding-box diagonal)\n"
-           "  --seed K             random seed: patch shape, paste order (default 0)\n"
+           "  --seed K             random seed: patch shape, windows, paste order (default 0)\n"
+           "  --patches N          cut N patches (1 to %d) from different parts of IMAGE: square\n"
+           "                       windows that do not overlap, spread over the image, picked by the\n"
+           "                       seed, each with the same soft shape; a paste takes the patch its\n"
+           "                       neighbours show least, so a blotch or crack of the photo is not\n"
+           "                       stamped like wallpaper. Default: %d when %d windows of at least\n"
+           "                       %dx%d texels fit (IMAGE at least %d texels on its shorter side),\n"
+           "                       else 1. --patches 1 is the whole IMAGE as one patch. --scale is\n"
+           "                       the side of one patch: a window half as wide as IMAGE shows the\n"
+           "                       photo twice as large as the whole image would (halve --scale to\n"
+           "                       keep the photo's size)\n"
+           "  --patch-size S       side of each window in texels, %d or more (default: the largest\n"
+           "                       that lets the N windows fit; with --patches 1, the whole IMAGE)\n"
            "  --up X,Y,Z           the texture's up direction, projected on each face\n"
            "                       (default 0,1,0)\n"
            "  --constraints FILE   the texture's direction and scale at chosen faces, one per line:\n"
@@ -69,10 +102,11 @@ static void print_help(void)
            "                       SIGMA (mesh units, default %g of the diagonal) is how far it\n"
            "                       reaches, WEIGHT its weight (default 1); '#' starts a comment.\n"
            "                       Directions elsewhere blend the constraints; --up is unused\n"
-           "  --isotropic          the texture has no direction: each paste takes a random one\n"
-           "  --mask MASK.png      the patch's shape: MASK's alpha, or its grey when opaque\n"
-           "                       (white = inside); same size as IMAGE (default: a random splotch,\n"
-           "                       or IMAGE's own alpha when it has one)\n"
+           "  --isotropic          the texture has no direction: each paste turns its patch at random\n"
+           "  --mask MASK.png      the patches' shape: MASK's alpha, or its grey when opaque\n"
+           "                       (white = inside); one shape for every patch: MASK is the size of a\n"
+           "                       patch, or of IMAGE and then scaled to the patch's (default: a random\n"
+           "                       splotch, or the window's own alpha when IMAGE has one)\n"
            "  --bake SIZE          also write OUT_PREFIX_baked.obj/.mtl/.png: the pastes baked into a\n"
            "                       SIZE x SIZE texture (16 to %d) over texture coordinates that\n"
            "                       --bake-uv chooses\n"
@@ -84,8 +118,9 @@ static void print_help(void)
            "                       (pieces of the surface flattened, one texel density, 2 texels\n"
            "                       apart); 'auto' (default) the OBJ's own when they are fit, else an\n"
            "                       atlas, with a warning saying why when the OBJ has some\n",
-           TT_DEFAULT_FIELD_SCALE, TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS);
-    /* Two calls: C99 compilers need not take a string longer than 4095 characters. */
+           TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
+           LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
+           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS);
     printf("  --subdivide L        make the triangles smaller before pasting, L from 0 to 8 (default\n"
            "                       0): quadrangulate them L times, as 'tiledtex tile' does, and split\n"
            "                       every quad into two triangles, so a triangle becomes 6, 24, 96, ...\n"
@@ -97,15 +132,15 @@ static void print_help(void)
            "\n"
            "Prints the number of pastes, the coverage, how often a face is drawn (overdraw), how\n"
            "well the texture follows the field (angle and scale error), the hard edges (where the\n"
-           "paste on top stops while still at least 25%% opaque) and how many face entries hidden\n"
-           "by later pastes were dropped. With --bake, also the baked texture's seam score (about 0:\n"
-           "the texture continues across edges; about 1: it jumps) over every edge and over the\n"
-           "edges where the paste on top changes.\n"
+           "paste on top stops while still at least 25%% opaque), how many face entries hidden\n"
+           "by later pastes were dropped, and how many pastes each patch got. With --bake, also the\n"
+           "baked texture's seam score (about 0: the texture continues across edges; about 1: it\n"
+           "jumps) over every edge and over the edges where the paste on top changes.\n"
            "\n"
            "example: tiledtex generate mesh torus.obj --shape torus\n"
            "         tiledtex generate texture stones.png --size 128\n"
            "         tiledtex lapped torus.obj stones.png torus_lapped --scale 1.5\n"
-           "         tiledtex render torus_lapped.obj torus_lapped_patch.png view.png\n");
+           "         tiledtex render torus_lapped.obj torus_lapped_patch_1.png view.png\n");
 }
 
 /* --bake-uv: where --bake bakes. */
@@ -119,6 +154,8 @@ typedef struct lapped_options {
     const char *constraints_path;   /* or NULL */
     int isotropic;
     const char *mask_path;          /* or NULL */
+    int npatches;                   /* --patches N; 0 = the default (choose_windows) */
+    int patch_size;                 /* --patch-size S in texels; 0 = the default */
     int bake_size;                  /* 0 = no --bake */
     bake_uv_choice bake_uv;         /* --bake-uv */
     tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
@@ -160,6 +197,11 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
         } else if (tool_option(argc, argv, &i, "--mask", &value)) {
             if (!value) return tool_usage("--mask needs a value");
             options->mask_path = value;
+        } else if (tool_option(argc, argv, &i, "--patches", &value)) {
+            if (parse_int("--patches", value, 1, LAPPED_MAX_PATCHES, &options->npatches) != 0) return TOOL_EXIT_USAGE;
+        } else if (tool_option(argc, argv, &i, "--patch-size", &value)) {
+            if (parse_int("--patch-size", value, LAPPED_MIN_WINDOW, TT_MAX_IMAGE_SIZE, &options->patch_size) != 0)
+                return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--bake", &value)) {
             if (parse_int("--bake", value, 16, TOOL_MAX_ATLAS, &options->bake_size) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--bake-uv", &value)) {
@@ -321,24 +363,166 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
 /* The texture patch                                                        */
 /* ======================================================================== */
 
-static int make_patch(const lapped_options *options, const tt_image *image, tt_image **patch)
+/* Where the patches come from: `count` square windows of `size` texels,
+   the k-th with its top-left texel at (x[k], y[k]); or, with size 0, the
+   whole image as the one patch (what the tool did before it cut windows,
+   kept exactly). */
+typedef struct patch_windows {
+    int count, size;
+    int x[LAPPED_MAX_PATCHES], y[LAPPED_MAX_PATCHES];
+} patch_windows;
+
+static int windows_that_fit(int width, int height, int size)
+{
+    return (width / size) * (height / size);
+}
+
+/* The largest window side at which `count` windows fit without
+   overlapping; 0 when not even 1-texel windows do. */
+static int largest_window(int width, int height, int count)
+{
+    int size = width < height ? width : height;
+    while (size > 0 && windows_that_fit(width, height, size) < count) size--;
+    return size;
+}
+
+/* Place the windows: the image holds a grid of cols x rows cells of the
+   window's size, spread evenly from edge to edge (so that they do not
+   overlap and together reach every part of it); the first window takes a
+   cell at random, and each next the cell farthest from those taken (the
+   first of equals in a seeded order), so that few windows still come from
+   far-apart parts of the photo. Returns 0, or -1 when out of memory. */
+static int place_windows(int width, int height, uint64_t seed, patch_windows *windows)
+{
+    const int size = windows->size, cols = width / size, rows = height / size, ncells = cols * rows;
+    int *order = (int *)malloc((size_t)ncells * sizeof(int));
+    double *nearest = (double *)malloc((size_t)ncells * sizeof(double));     /* squared distance to the taken */
+    tt_rng rng;
+    int i, k;
+    if (!order || !nearest) {
+        free(order);
+        free(nearest);
+        return -1;
+    }
+    tt_rng_seed(&rng, seed, 0x77196);
+    for (i = 0; i < ncells; i++) {
+        int j = (int)tt_rng_below(&rng, (uint32_t)i + 1u);
+        order[i] = order[j];
+        order[j] = i;
+        nearest[i] = HUGE_VAL;
+    }
+    for (k = 0; k < windows->count; k++) {
+        int best = -1, cell;
+        for (i = 0; i < ncells; i++)
+            if (nearest[i] > 0.0 && (best < 0 || nearest[i] > nearest[best])) best = i;
+        cell = order[best];
+        windows->x[k] = cols > 1 ? (int)((long long)(cell % cols) * (width - size) / (cols - 1)) : (width - size) / 2;
+        windows->y[k] = rows > 1 ? (int)((long long)(cell / cols) * (height - size) / (rows - 1)) : (height - size) / 2;
+        for (i = 0; i < ncells; i++) {
+            double dx = (double)(order[i] % cols - cell % cols), dy = (double)(order[i] / cols - cell / cols);
+            if (dx * dx + dy * dy < nearest[i]) nearest[i] = dx * dx + dy * dy;
+        }
+    }
+    free(order);
+    free(nearest);
+    return 0;
+}
+
+/* How many patches, of what size, from where: --patches and --patch-size,
+   or their defaults (see the help). Returns 0, or the exit status after
+   printing why the windows do not fit the image. */
+static int choose_windows(const lapped_options *options, int width, int height, patch_windows *windows)
+{
+    int count = options->npatches, size = options->patch_size;
+    if (count == 0 && size == 0) {
+        size = largest_window(width, height, LAPPED_DEFAULT_PATCHES);
+        count = size >= LAPPED_DEFAULT_MIN_WINDOW ? LAPPED_DEFAULT_PATCHES : 1;
+        if (count == 1) size = 0;
+    } else if (count == 0) {
+        count = size <= width && size <= height && windows_that_fit(width, height, size) >= LAPPED_DEFAULT_PATCHES
+                    ? LAPPED_DEFAULT_PATCHES : 1;
+    } else if (count > 1 && size == 0) {
+        size = largest_window(width, height, count);
+        if (size < LAPPED_MIN_WINDOW)
+            return tool_fail("--patches %d: %d windows fit in %s (%dx%d) only at %dx%d texels, below the least "
+                             "patch of %dx%d: use fewer patches", count, count, options->image_path, width,
+                             height, size, size, LAPPED_MIN_WINDOW, LAPPED_MIN_WINDOW);
+    }
+    windows->count = count;
+    windows->size = size;
+    if (size == 0) {
+        windows->x[0] = windows->y[0] = 0;
+        return 0;
+    }
+    if (size > width || size > height)
+        return tool_fail("--patch-size %d: %s is only %dx%d texels", size, options->image_path, width, height);
+    if (windows_that_fit(width, height, size) < count)
+        return tool_fail("--patches %d: only %d window%s of %dx%d texels fit%s in %s (%dx%d) without overlapping: "
+                         "use fewer patches or a smaller --patch-size", count, windows_that_fit(width, height, size),
+                         windows_that_fit(width, height, size) == 1 ? "" : "s", size, size,
+                         windows_that_fit(width, height, size) == 1 ? "s" : "", options->image_path, width, height);
+    if (place_windows(width, height, options->seed, windows) != 0)
+        return tool_fail("out of memory while placing the patches in %s", options->image_path);
+    return 0;
+}
+
+/* The --mask image, read once for every patch, at the patches' size: a
+   mask of the image's size is scaled to a window's (nearest texel: it is a
+   shape, cut at one half by tt_make_texture_patch). NULL without --mask. */
+static int load_mask(const lapped_options *options, int width, int height, const patch_windows *windows,
+                     tt_image **mask)
 {
     char message[TOOL_ERROR_SIZE];
-    tt_image *mask = NULL;
-    tt_patch_options patch_options;
-    tt_error error;
-    int status = 0;
-    *patch = NULL;
+    const int size = windows->size;
+    tt_image *scaled;
+    int x, y;
+    *mask = NULL;
+    if (!options->mask_path) return 0;
     /* A mask is data, not colour: its bytes are read as they are
        (TT_COLOR_LINEAR), so grey 128 and up is inside, as the help says. */
-    if (options->mask_path && image_load(options->mask_path, TT_COLOR_LINEAR, &mask, message, sizeof message) != 0)
+    if (image_load(options->mask_path, TT_COLOR_LINEAR, mask, message, sizeof message) != 0)
         return tool_fail("%s", message);
+    /* The whole image as the patch: tt_make_texture_patch says it when the
+       sizes differ, as it always did. */
+    if (size == 0 || ((*mask)->width == size && (*mask)->height == size)) return 0;
+    if ((*mask)->width != width || (*mask)->height != height) {
+        int status = tool_fail("%s is %dx%d: a mask must be the size of a patch (%dx%d) or of %s (%dx%d)",
+                               options->mask_path, (*mask)->width, (*mask)->height, size, size,
+                               options->image_path, width, height);
+        image_free(*mask);
+        *mask = NULL;
+        return status;
+    }
+    /* A tool image of the patch's size (its texels are all set below). */
+    if (image_crop(*mask, 0, 0, size, size, &scaled) != 0) {
+        image_free(*mask);
+        *mask = NULL;
+        return tool_fail("out of memory for the mask %s", options->mask_path);
+    }
+    for (y = 0; y < size; y++)
+        for (x = 0; x < size; x++) {
+            int from_x = (int)(((long long)x * 2 + 1) * width / (2 * size));
+            int from_y = (int)(((long long)y * 2 + 1) * height / (2 * size));
+            memcpy(scaled->pixels + 4 * ((size_t)y * size + x),
+                   (*mask)->pixels + 4 * ((size_t)from_y * width + from_x), 4 * sizeof(float));
+        }
+    image_free(*mask);
+    *mask = scaled;
+    return 0;
+}
+
+static int make_patch(const lapped_options *options, const tt_image *source, const tt_image *mask, tt_image **patch)
+{
+    tt_patch_options patch_options;
+    tt_error error;
+    *patch = NULL;
+    /* One seed for every window: windows of one size get one splotch, and
+       the paste loop takes them for interchangeable twins. */
     memset(&patch_options, 0, sizeof patch_options);
     patch_options.seed = options->seed;
-    if (tt_make_texture_patch(image, mask, &patch_options, NULL, patch, &error) != TT_OK)
-        status = tool_fail("%s: %s", options->mask_path ? options->mask_path : options->image_path, error.message);
-    image_free(mask);
-    return status;
+    if (tt_make_texture_patch(source, mask, &patch_options, NULL, patch, &error) != TT_OK)
+        return tool_fail("%s: %s", options->mask_path ? options->mask_path : options->image_path, error.message);
+    return 0;
 }
 
 /* The patch as a PNG wants straight alpha. Where alpha > 0 that is the
@@ -370,6 +554,91 @@ static int add_patch_png(tool_output *output, const char *path, tt_image **image
     return status != 0 ? tool_fail("%s", message) : 0;
 }
 
+/* The texture patches and what the outputs call them. */
+typedef struct lapped_patches {
+    int count;
+    int size;               /* window side in texels; 0 = the whole image */
+    tt_image **images;      /* count patches (premultiplied), NULL until made */
+    char **png_paths;       /* OUT_PREFIX_patch.png for one, else OUT_PREFIX_patch_K.png, K from 1 */
+    char **materials;       /* "lapped" for one, else "lapped_K" */
+} lapped_patches;
+
+static void lapped_patches_free(lapped_patches *patches)
+{
+    int k;
+    for (k = 0; k < patches->count; k++) {
+        if (patches->images) tt_image_free(patches->images[k]);
+        if (patches->png_paths) free(patches->png_paths[k]);
+        if (patches->materials) free(patches->materials[k]);
+    }
+    free(patches->images);
+    free(patches->png_paths);
+    free(patches->materials);
+    memset(patches, 0, sizeof *patches);
+}
+
+/* The names, before anything is made: the paths are checked against the
+   inputs before the long part. One patch keeps the names it always had. */
+static int lapped_patches_name(const char *prefix, const patch_windows *windows, lapped_patches *patches)
+{
+    const size_t path_size = strlen(prefix) + 32;
+    int k;
+    memset(patches, 0, sizeof *patches);
+    patches->images = (tt_image **)calloc((size_t)windows->count, sizeof(tt_image *));
+    patches->png_paths = (char **)calloc((size_t)windows->count, sizeof(char *));
+    patches->materials = (char **)calloc((size_t)windows->count, sizeof(char *));
+    if (!patches->images || !patches->png_paths || !patches->materials) {
+        lapped_patches_free(patches);
+        return tool_fail("out of memory for the patches' names");
+    }
+    patches->count = windows->count;
+    patches->size = windows->size;
+    for (k = 0; k < patches->count; k++) {
+        patches->png_paths[k] = (char *)malloc(path_size);
+        patches->materials[k] = (char *)malloc(32);
+        if (!patches->png_paths[k] || !patches->materials[k]) {
+            lapped_patches_free(patches);
+            return tool_fail("out of memory for the patches' names");
+        }
+        if (patches->count == 1) {
+            snprintf(patches->png_paths[k], path_size, "%s_patch.png", prefix);
+            snprintf(patches->materials[k], 32, "lapped");
+        } else {
+            snprintf(patches->png_paths[k], path_size, "%s_patch_%d.png", prefix, k + 1);
+            snprintf(patches->materials[k], 32, "lapped_%d", k + 1);
+        }
+    }
+    return 0;
+}
+
+/* Each window of *image made a patch, and its PNG added to the output;
+   the image is freed here (*image = NULL). The whole image as the one
+   patch becomes the PNG in its own memory (add_patch_png); a window is
+   copied out first, and that copy becomes the PNG. */
+static int make_patches(const lapped_options *options, tt_image **image, const patch_windows *windows,
+                        const tt_image *mask, tool_output *output, lapped_patches *patches)
+{
+    int k, status = 0;
+    if (windows->size == 0) {
+        status = make_patch(options, *image, mask, &patches->images[0]);
+        if (status == 0) status = add_patch_png(output, patches->png_paths[0], image, patches->images[0]);
+    } else {
+        for (k = 0; k < windows->count && status == 0; k++) {
+            tt_image *window;
+            if (image_crop(*image, windows->x[k], windows->y[k], windows->size, windows->size, &window) != 0) {
+                status = tool_fail("out of memory for patch %d of %s", k + 1, options->image_path);
+                break;
+            }
+            status = make_patch(options, window, mask, &patches->images[k]);
+            if (status == 0) status = add_patch_png(output, patches->png_paths[k], &window, patches->images[k]);
+            image_free(window);
+        }
+    }
+    image_free(*image);
+    *image = NULL;
+    return status;
+}
+
 /* ======================================================================== */
 /* Output files                                                             */
 /* ======================================================================== */
@@ -378,26 +647,28 @@ static int add_patch_png(tool_output *output, const char *path, tt_image **image
    (N counts the pastes from 1) with its triangles and their texture
    coordinates in the patch. A paste whose faces were all hidden has none. */
 static int add_pasting_obj(tool_output *output, const char *path, const char *mtl_name, const triangle_mesh *m,
-                           const tt_lapped *lapped)
+                           const tt_lapped *lapped, const lapped_patches *patches)
 {
     const tt_mesh *mesh = m->mesh;
     int *corner_vert = (int *)malloc((size_t)lapped->nentries * 3 * sizeof(int));
     float *corner_uv = (float *)malloc((size_t)lapped->nentries * 6 * sizeof(float));
     int *face_group = (int *)malloc((size_t)lapped->nentries * sizeof(int));
     char **names = (char **)calloc((size_t)lapped->npastes + 1, sizeof(char *));
+    const char **materials = (const char **)calloc((size_t)lapped->npastes + 1, sizeof(char *));
     char comment[512];
     tool_buffer text;
     obj_write_desc desc;
     int p, n = 0, status = 0;
 
     memset(&text, 0, sizeof text);
-    if (!corner_vert || !corner_uv || !face_group || !names) goto out_of_memory;
+    if (!corner_vert || !corner_uv || !face_group || !names || !materials) goto out_of_memory;
     for (p = 0; p < lapped->npastes; p++) {
         const tt_paste *paste = &lapped->pastes[p];
         int e, k;
         names[p] = (char *)malloc(24);
         if (!names[p]) goto out_of_memory;
         snprintf(names[p], 24, "paste_%d", p + 1);
+        materials[p] = patches->materials[paste->patch];
         for (e = paste->first; e < paste->first + paste->nfaces; e++, n++) {
             int face = lapped->faces[e];
             for (k = 0; k < 3; k++) corner_vert[3 * n + k] = mesh->corner_vert[mesh->face_start[face] + k];
@@ -406,10 +677,11 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
         }
     }
     snprintf(comment, sizeof comment,
-             "lapped texture by tiledtex %s (Praun et al.): %d pastes over %d triangles\n"
+             "lapped texture by tiledtex %s (Praun et al.): %d pastes over %d triangles%s\n"
              "draw the groups in order, each blended over the ones before through the patch's alpha,\n"
              "with texture coordinates clamped (outside [0,1] is transparent)",
-             TILEDTEX_VERSION_STRING, lapped->npastes, mesh->nfaces);
+             TILEDTEX_VERSION_STRING, lapped->npastes, mesh->nfaces,
+             patches->count > 1 ? ", each with its patch's material" : "");
     memset(&desc, 0, sizeof desc);
     desc.comment = comment;
     desc.nverts = mesh->nverts;
@@ -419,10 +691,12 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
     desc.corner_vert = corner_vert;
     desc.corner_uv = corner_uv;
     desc.mtllib = mtl_name;
-    desc.material = "lapped";
+    desc.material = patches->materials[0];
     desc.face_group = face_group;
     desc.ngroups = lapped->npastes;
     desc.group_names = (const char *const *)names;
+    /* One patch: one usemtl for the whole file, as before there were several. */
+    if (patches->count > 1) desc.group_materials = materials;
     if (obj_write(&text, &desc) != 0 || output_add_buffer(output, path, &text) != 0) goto out_of_memory;
     goto done;
 out_of_memory:
@@ -432,6 +706,7 @@ done:
     if (names)
         for (p = 0; p < lapped->npastes; p++) free(names[p]);
     free(names);
+    free(materials);
     free(corner_vert);
     free(corner_uv);
     free(face_group);
@@ -572,7 +847,8 @@ static int measure_baked(const lapped_options *options, const triangle_mesh *m, 
 /* --bake: the pastes composited into a size x size texture over corner_uv
    (from bake_uvs; freed here); an ordinary OBJ + MTL + PNG. */
 static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
-                     const tt_lapped *lapped, tt_image *patch, float *corner_uv, baked_seams *seams)
+                     const tt_lapped *lapped, const lapped_patches *patches, float *corner_uv,
+                     baked_seams *seams)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
     tt_image *atlas = NULL;
@@ -590,7 +866,8 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     }
     memset(&bake, 0, sizeof bake);
     bake.gutter = LAPPED_BAKE_GUTTER;
-    if (tt_lapped_bake(m->mesh, lapped, &patch, 1, corner_uv, &bake, NULL, atlas, &error) != TT_OK) {
+    if (tt_lapped_bake(m->mesh, lapped, patches->images, patches->count, corner_uv, &bake, NULL, atlas, &error) !=
+        TT_OK) {
         status = triangle_mesh_report_error(options->mesh_path, m, &error);
         goto done;
     }
@@ -623,8 +900,8 @@ done:
 /* The command                                                              */
 /* ======================================================================== */
 
-static int paste(const lapped_options *options, const triangle_mesh *m, const float *field, tt_image *patch,
-                 tt_lapped **lapped)
+static int paste(const lapped_options *options, const triangle_mesh *m, const float *field,
+                 const lapped_patches *patches, tt_lapped **lapped)
 {
     tt_lapped_options paste_options;
     tool_progress progress;
@@ -636,9 +913,26 @@ static int paste(const lapped_options *options, const triangle_mesh *m, const fl
     paste_options.isotropic = options->isotropic;
     paste_options.progress = tool_show_progress;
     paste_options.progress_user_data = &progress;
-    result = tt_lapped_paste(m->mesh, field, &patch, 1, &paste_options, NULL, lapped, &error);
+    result = tt_lapped_paste(m->mesh, field, patches->images, patches->count, &paste_options, NULL, lapped, &error);
     tool_progress_end(&progress);
     return result == TT_OK ? 0 : triangle_mesh_report_error(options->mesh_path, m, &error);
+}
+
+/* "patches: 4 of 4 used (512x512 windows), 98/95/92/95 pastes": the pastes
+   each patch got (they add up to the pastes). */
+static void print_patch_use(const lapped_patches *patches, const tt_lapped *lapped)
+{
+    int *uses = (int *)calloc((size_t)patches->count, sizeof(int));
+    int p, k, used = 0;
+    if (!uses) return;
+    for (p = 0; p < lapped->npastes; p++) uses[lapped->pastes[p].patch]++;
+    for (k = 0; k < patches->count; k++) used += uses[k] > 0;
+    printf("patches: %d of %d used", used, patches->count);
+    if (patches->size > 0) printf(" (%dx%d windows)", patches->size, patches->size);
+    else printf(" (the whole image)");
+    for (k = 0; k < patches->count; k++) printf("%s%d", k == 0 ? ", " : "/", uses[k]);
+    printf(" pastes\n");
+    free(uses);
 }
 
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
@@ -679,13 +973,13 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
 /* Refuse, before the long part, outputs that would replace an input (the
    commit checks again, but only after pasting). */
 static int refuse_overwriting_inputs(const lapped_options *options, const char *obj_path, const char *mtl_path,
-                                     const char *png_path)
+                                     const lapped_patches *patches)
 {
     static const char *const baked[] = {"_baked.obj", "_baked.mtl", "_baked.png"};
     char path[4096 + 16];
     int status = tool_refuse_input_overwrite(obj_path), k;
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
-    if (status == 0) status = tool_refuse_input_overwrite(png_path);
+    for (k = 0; k < patches->count && status == 0; k++) status = tool_refuse_input_overwrite(patches->png_paths[k]);
     for (k = 0; k < 3 && status == 0 && options->bake_size > 0; k++) {
         snprintf(path, sizeof path, "%s%s", options->prefix, baked[k]);
         status = tool_refuse_input_overwrite(path);
@@ -697,12 +991,14 @@ int cmd_lapped(int argc, char **argv)
 {
     lapped_options options;
     triangle_mesh mesh;
-    tt_image *image = NULL, *patch = NULL;
+    tt_image *image = NULL, *mask = NULL;
     tt_lapped *lapped = NULL;
     tool_output output;
+    patch_windows windows;
+    lapped_patches patches;
     float *field = NULL, *bake_uv = NULL;
     baked_seams baked;
-    char obj_path[4096], mtl_path[4096], png_path[4096], message[TOOL_ERROR_SIZE];
+    char obj_path[4096], mtl_path[4096], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
     int status, charts = 0;
 
@@ -710,9 +1006,10 @@ int cmd_lapped(int argc, char **argv)
     if (status >= 0) return status;
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
-    snprintf(png_path, sizeof png_path, "%s_patch.png", options.prefix);
     memset(&output, 0, sizeof output);
     memset(&baked, 0, sizeof baked);
+    memset(&patches, 0, sizeof patches);
+    memset(&windows, 0, sizeof windows);
 
     if ((status = triangle_mesh_read(options.mesh_path, &options.mesh, &mesh)) != 0) return status;
     field = (float *)malloc((size_t)mesh.ntriangles * 3 * sizeof(float));
@@ -721,28 +1018,37 @@ int cmd_lapped(int argc, char **argv)
     /* A photo: sRGB bytes in the file, linear light in the library. */
     if (status == 0 && image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
-    if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, png_path);
+    if (status == 0) status = choose_windows(&options, image->width, image->height, &windows);
+    if (status == 0) status = lapped_patches_name(options.prefix, &windows, &patches);
+    if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, &patches);
     if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &charts);
-    if (status == 0) status = make_patch(&options, image, &patch);
-    /* Memory: the image is needed only to make the patch and its PNG, so the
-       PNG is encoded now and the image freed before the paste loop; from
-       here on the command holds the patch and the compressed PNG. */
-    if (status == 0) status = add_patch_png(&output, png_path, &image, patch);
+    if (status == 0) status = load_mask(&options, image->width, image->height, &windows, &mask);
+    /* Memory: the image is needed only to make the patches and their PNGs,
+       so the PNGs are encoded now and the image freed before the paste
+       loop; from here on the command holds the patches and the compressed
+       PNGs. */
+    if (status == 0) status = make_patches(&options, &image, &windows, mask, &output, &patches);
     image_free(image);
     image = NULL;
-    if (status == 0) status = paste(&options, &mesh, field, patch, &lapped);
+    image_free(mask);
+    mask = NULL;
+    if (status == 0) status = paste(&options, &mesh, field, &patches, &lapped);
 
-    if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped);
-    if (status == 0) status = output_add_mtl(&output, mtl_path, "lapped", png_path, 1);
+    if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped, &patches);
+    if (status == 0)
+        status = output_add_mtl_materials(&output, mtl_path, patches.count, (const char *const *)patches.materials,
+                                          (const char *const *)patches.png_paths, 1);
     if (status == 0 && options.bake_size > 0) {
-        status = add_baked(&output, &options, &mesh, lapped, patch, bake_uv, &baked);
+        status = add_baked(&output, &options, &mesh, lapped, &patches, bake_uv, &baked);
         bake_uv = NULL;   /* add_baked freed it */
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0) {
         print_summary(&options, &mesh, field, lapped, &baked, tool_seconds_now() - start);
-        printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
+        print_patch_use(&patches, lapped);
+        printf("wrote %s, %s, %s", obj_path, mtl_path, patches.png_paths[0]);
+        if (patches.count > 1) printf(" to %s", patches.png_paths[patches.count - 1]);
         if (options.bake_size > 0 && charts == 0)
             printf("; %s_baked.obj/.mtl/.png (%dx%d, over the OBJ's texture coordinates)", options.prefix,
                    options.bake_size, options.bake_size);
@@ -753,7 +1059,7 @@ int cmd_lapped(int argc, char **argv)
     }
     output_free(&output);
     tt_lapped_free(lapped);
-    tt_image_free(patch);
+    lapped_patches_free(&patches);
     image_free(image);
     free(field);
     free(bake_uv);

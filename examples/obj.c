@@ -875,10 +875,19 @@ void mtl_add_material(tool_buffer *out, const char *name, const char *texture, i
 int output_add_mtl(tool_output *output, const char *mtl_path, const char *material, const char *texture_path,
                    int texture_alpha)
 {
+    return output_add_mtl_materials(output, mtl_path, 1, &material, &texture_path, texture_alpha);
+}
+
+int output_add_mtl_materials(tool_output *output, const char *mtl_path, int count, const char *const *materials,
+                             const char *const *texture_paths, int texture_alpha)
+{
     tool_buffer text = TOOL_BUFFER_INIT;
     char texture[4096];
-    tool_relative_path(texture_path, mtl_path, texture, sizeof texture);
-    mtl_add_material(&text, material, texture, texture_alpha);
+    int k;
+    for (k = 0; k < count; k++) {
+        tool_relative_path(texture_paths[k], mtl_path, texture, sizeof texture);
+        mtl_add_material(&text, materials[k], texture, texture_alpha);
+    }
     if (output_add_buffer(output, mtl_path, &text) != 0) {
         buffer_free(&text);
         return tool_fail("out of memory while writing %s", mtl_path);

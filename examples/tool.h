@@ -279,6 +279,10 @@ void image_set_max_pixels(uint64_t max_pixels);
    any pixel is decoded. */
 int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size);
 void image_free(tt_image *image);
+/* A copy of the width x height rectangle of `image` whose top-left texel is
+   (x, y), which must lie inside it; the tool's own memory, like image_load's
+   (free it with image_free). Returns 0, or -1 when out of memory. */
+int image_crop(const tt_image *image, int x, int y, int width, int height, tt_image **out);
 
 /* Encode an image as an 8-bit PNG in memory (malloc'ed; free it), its
    colours encoded into `space` (TT_COLOR_SRGB for every colour output).
@@ -410,6 +414,9 @@ void mtl_add_material(tool_buffer *out, const char *name, const char *texture, i
    status after printing the error. */
 int output_add_mtl(tool_output *output, const char *mtl_path, const char *material, const char *texture_path,
                    int texture_alpha);
+/* The same with `count` materials, materials[k] naming texture_paths[k]. */
+int output_add_mtl_materials(tool_output *output, const char *mtl_path, int count, const char *const *materials,
+                             const char *const *texture_paths, int texture_alpha);
 
 /* ---------------------------------------------------------------------- */
 /* Meshes refined and repaired: --subdivide, --smooth, --permissive         */
