@@ -166,6 +166,10 @@ summary_seam() { printf '%s\n' "$OUT" | grep -oE 'seam score -?[0-9.]+([eE][-+]?
 
 nonempty() { [ -s "$1" ]; }
 
+# test helpers (small C programs) are compiled with these
+HELPER_CC=${CC:-cc}
+STB_INC=$(pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
+
 # ======================================================================
 # Inputs
 # ======================================================================
@@ -834,6 +838,212 @@ check "map --atlas absolute paths: map_Kd t.png, mtllib m.mtl" "map_Kd t.png, mt
     "$(grep -qx 'map_Kd t.png' pc/m.mtl && grep -qx 'mtllib m.mtl' pc/m.obj; echo $?)"
 cd "$W" || exit 1
 
+# ----------------------------------------------------------------------
+# Several texture patches (--patches): windows of the image, one material
+# each, so that the pastes do not all show the same part of the photo
+# ----------------------------------------------------------------------
+cd "$W/in" || exit 1
+expect_ok "generate 256x256 texture for lapped --patches" generate texture lap256.png --size 256 --seed 3
+expect_ok "generate 128x128 texture for the stamping measure" generate texture lap128.png --size 128 --seed 3
+cd "$W" || exit 1
+# patch_summary -> "used of sum": from "patches: U of N used (...), a/b/c pastes"
+patch_summary() {
+    printf '%s\n' "$OUT" | awk '/^patches: / { n = split($NF == "pastes" ? $(NF - 1) : "", c, "/"); s = 0
+        for (i = 1; i <= n; i++) s += c[i]; printf "%d %d %d\n", $2, $4, s; exit }'
+}
+
+newdir
+expect_ok "lapped default on a 256x256 image" lapped ../in/torus.obj ../in/lap256.png out --scale 1.5
+check "lapped default, 256x256 image: 4 patches of 128x128" "out.mtl out.obj out_patch_1.png ... out_patch_4.png" \
+    "$(ls -A | tr '\n' ' ')" \
+    "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_patch_1.png out_patch_2.png out_patch_3.png out_patch_4.png " ] &&
+        for k in 1 2 3 4; do [ "$(png_size out_patch_$k.png)" = "128 128" ] || exit 1; done; echo $?)"
+check "lapped 4 patches: the MTL has materials lapped_1..4, each naming its patch" "4 x newmtl lapped_K, map_Kd out_patch_K.png" \
+    "$(grep -E '^(newmtl|map_Kd)' out.mtl 2>&1)" \
+    "$([ "$(grep -cE '^newmtl lapped_[1-4]$' out.mtl)" = 4 ] &&
+        for k in 1 2 3 4; do grep -A6 -x "newmtl lapped_$k" out.mtl | grep -qx "map_Kd out_patch_$k.png" || exit 1; done; echo $?)"
+check "lapped 4 patches: every group paste_N names a material lapped_K" "g paste_N then usemtl lapped_1..4, each used" \
+    "$(grep -m4 -A1 '^g ' out.obj 2>&1)" \
+    "$(awk '$1 == "g" { groups++; expect = 1; next }
+            expect { if ($1 != "usemtl" || $2 !~ /^lapped_[1-4]$/) bad++; else used[$2] = 1; expect = 0 }
+            END { n = 0; for (m in used) n++; exit !(groups > 1 && !bad && n == 4) }' out.obj; echo $?)"
+read -r used total sum <<<"$(patch_summary)"
+pastes=$(summary_pastes)
+check "lapped 4 patches: the summary counts each patch's pastes, adding up to the pastes" \
+    "'patches: 4 of 4 used (128x128 windows), a/b/c/d pastes', a+b+c+d = $pastes" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE '^patches: 4 of 4 used \(128x128 windows\), [0-9]+/[0-9]+/[0-9]+/[0-9]+ pastes$' &&
+        [ "${used:-0}" = 4 ] && [ "${sum:-0}" = "${pastes:-x}" ]; echo $?)"
+expect_ok "lapped 4 patches again" lapped ../in/torus.obj ../in/lap256.png again --scale 1.5
+CMD="tiledtex lapped ../in/torus.obj ../in/lap256.png out / again (same seed)"
+check "lapped 4 patches: same seed, same windows and pastes" "identical patches and OBJ bodies" "differ" \
+    "$(for k in 1 2 3 4; do cmp -s out_patch_$k.png again_patch_$k.png || exit 1; done
+        cmp -s <(grep -v mtllib out.obj) <(grep -v mtllib again.obj); echo $?)"
+# render: each paste with its own material's patch, whichever TEXTURE is given
+expect_ok "render a 4-patch pasting OBJ" render out.obj out_patch_1.png view.png --size 160x120
+expect_ok "render a 4-patch pasting OBJ, another TEXTURE" render out.obj out_patch_2.png view2.png --size 160x120
+expect_ok "render a 4-patch pasting OBJ with one texture (--no-materials)" render out.obj out_patch_1.png one.png \
+    --size 160x120 --no-materials
+CMD="tiledtex render out.obj out_patch_1.png / out_patch_2.png / --no-materials"
+check "render 4 patches: the materials' textures are drawn, not TEXTURE" "view.png = view2.png" "differ" \
+    "$(cmp -s view.png view2.png; echo $?)"
+check "render 4 patches: differs from one texture on every paste" "view.png != one.png" "identical" \
+    "$(! cmp -s view.png one.png; echo $?)"
+cd "$W" || exit 1
+
+# a small image keeps the whole image as the one patch; --patches 1 is that
+newdir
+expect_ok "lapped default on a 64x64 image" lapped ../in/torus.obj ../in/lap.png out --scale 1.5
+check "lapped default, 64x64 image: one patch, the whole image" "out_patch.png 64x64, 'patches: 1 of 1 used (the whole image)'" \
+    "$(ls -A | tr '\n' ' '); $OUT" \
+    "$([ "$(png_size out_patch.png)" = "64 64" ] && [ ! -e out_patch_1.png ] &&
+        printf '%s' "$OUT" | grep -qE '^patches: 1 of 1 used \(the whole image\), [0-9]+ pastes$'; echo $?)"
+mkdir one && cd one || exit 1
+expect_ok "lapped --patches 1 on a 64x64 image" lapped ../../in/torus.obj ../../in/lap.png out --scale 1.5 --patches 1
+CMD="tiledtex lapped torus.obj lap.png out --scale 1.5 (default / --patches 1)"
+check "lapped --patches 1 = the default on a small image" "identical out.obj, out.mtl, out_patch.png" "differ" \
+    "$(cmp -s out.obj ../out.obj && cmp -s out.mtl ../out.mtl && cmp -s out_patch.png ../out_patch.png; echo $?)"
+cd "$W" || exit 1
+newdir
+expect_ok "lapped --patches 1 on a 256x256 image" lapped ../in/torus.obj ../in/lap256.png out --scale 1.5 --patches 1
+check "lapped --patches 1: the whole image, one material for the file" "out_patch.png 256x256, one usemtl lapped" \
+    "$(png_size out_patch.png); $(grep -c '^usemtl' out.obj) usemtl" \
+    "$([ "$(png_size out_patch.png)" = "256 256" ] && [ "$(grep -c '^usemtl' out.obj)" = 1 ] &&
+        grep -qx 'usemtl lapped' out.obj && [ "$(grep -c '^newmtl' out.mtl)" = 1 ]; echo $?)"
+expect_ok "lapped --patches 9" lapped ../in/torus.obj ../in/lap256.png nine --scale 1.5 --patches 9
+check "lapped --patches 9: 9 windows of 85x85 (the largest that fit 3 x 3)" "nine_patch_1..9.png, 85x85" \
+    "$(ls nine_patch_* | tr '\n' ' '); $(png_size nine_patch_9.png)" \
+    "$([ "$(ls nine_patch_*.png | wc -l)" = 9 ] && [ "$(png_size nine_patch_9.png)" = "85 85" ]; echo $?)"
+expect_ok "lapped --patch-size 64 (default count 4)" lapped ../in/torus.obj ../in/lap256.png sized --scale 1.5 \
+    --patch-size 64 --isotropic --bake 256
+check "lapped --patch-size 64 --isotropic --bake: 4 patches of 64x64, a baked texture" "sized_patch_4.png 64x64, sized_baked.png" \
+    "$(ls sized* | tr '\n' ' ')" "$([ "$(png_size sized_patch_4.png)" = "64 64" ] && is_png sized_baked.png; echo $?)"
+# one --mask for every patch: the image's size (scaled to the patch's) or a patch's
+{ printf 'P5\n256 256\n255\n'; head -c 65536 /dev/zero | tr '\0' '\377'; } >mask256.pgm
+{ printf 'P5\n128 128\n255\n'; head -c 16384 /dev/zero | tr '\0' '\377'; } >mask128.pgm
+expect_ok "lapped 4 patches, --mask the image's size" lapped ../in/torus.obj ../in/lap256.png m1 --scale 1.5 --mask mask256.pgm
+expect_ok "lapped 4 patches, --mask a patch's size" lapped ../in/torus.obj ../in/lap256.png m2 --scale 1.5 --mask mask128.pgm
+CMD="tiledtex lapped ... --mask mask256.pgm / mask128.pgm (both all white)"
+check "lapped --mask: the image-sized mask scaled to the patch is the patch-sized one" "identical patches" "differ" \
+    "$(for k in 1 2 3 4; do cmp -s m1_patch_$k.png m2_patch_$k.png || exit 1; done; echo $?)"
+cd "$W" || exit 1
+# refused: with one line, the usage status for the command line, 1 for windows the image cannot hold
+for arg in 0 -1 257 x; do
+    expect_error "lapped --patches '$arg'" lapped ../in/torus.obj ../in/lap256.png out --patches "$arg"
+    check "lapped --patches '$arg': usage status 2, says what it wants" "exit 2, '--patches wants an integer from 1 to 256'" \
+        "exit $RC: $ERR" "$([ $RC -eq 2 ] && printf '%s' "$ERR" | grep -q -- '--patches wants an integer from 1 to 256'; echo $?)"
+done
+expect_error "lapped --patch-size 16" lapped ../in/torus.obj ../in/lap256.png out --patch-size 16
+check "lapped --patch-size 16: usage status 2" "exit 2" "exit $RC" "$([ $RC -eq 2 ]; echo $?)"
+expect_error "lapped --patches 5 on a 64x64 image" lapped ../in/torus.obj ../in/lap.png out --patches 5
+err_mentions "lapped --patches 5 on 64x64: too small windows" 'patches 5: 5 windows fit in .*lap\.png \(64x64\) only at [0-9]+x[0-9]+ texels'
+check "lapped --patches 5 on 64x64: status 1" "exit 1" "exit $RC" "$([ $RC -eq 1 ]; echo $?)"
+expect_error "lapped --patches 2 --patch-size 40 on a 64x64 image" lapped ../in/torus.obj ../in/lap.png out --patches 2 \
+    --patch-size 40
+err_mentions "lapped --patches 2 --patch-size 40 on 64x64: says how many fit" 'only 1 window of 40x40 texels fits'
+expect_error "lapped --patch-size larger than the image" lapped ../in/torus.obj ../in/lap.png out --patch-size 100
+err_mentions "lapped --patch-size 100 on 64x64: says the image's size" 'patch-size 100: .*lap\.png is only 64x64'
+expect_error "lapped --mask of neither size" lapped ../in/torus.obj ../in/lap256.png out --mask ../in/black_mask.pgm
+err_mentions "lapped --mask of neither size: names both" 'black_mask\.pgm is 64x64: a mask must be the size of a patch \(128x128\) or of'
+
+# render: each face's material is its latest usemtl, whatever g follows; a
+# material texture that cannot be read is a note, and TEXTURE stands in
+newdir
+printf 'mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n' >two.obj
+printf 'usemtl dark\ng left\nf 1/1 2/2 3/3\nusemtl missing\ng right\nf 1/1 3/3 4/4\n' >>two.obj
+{ printf 'P5\n4 4\n255\n'; head -c 16 /dev/zero; } >dark.pgm
+{ printf 'P5\n4 4\n255\n'; head -c 16 /dev/zero | tr '\0' '\377'; } >light.pgm
+printf 'newmtl dark\nmap_Kd -s 1 1 1 dark.pgm\nnewmtl missing\nmap_Kd nope.png\n' >two.mtl
+expect_ok "render materials: usemtl before g, one texture missing" render two.obj light.pgm mat.png --size 32x32 --yaw 0 --pitch 0
+err_mentions "render materials: a note names the missing texture and the stand-in" 'material missing of two\.obj: .*nope\.png.*drawn with light\.pgm'
+expect_ok "render materials: --no-materials" render two.obj light.pgm plain.png --size 32x32 --yaw 0 --pitch 0 --no-materials
+CMD="tiledtex render two.obj light.pgm (materials / --no-materials)"
+check "render materials: the dark material's texture is drawn" "mat.png != plain.png" "identical" \
+    "$(! cmp -s mat.png plain.png; echo $?)"
+cd "$W" || exit 1
+
+# A control that can fail: --patches 1 stamps one patch like wallpaper, and
+# several patches stamp each part of the photo less. On a flat plane baked
+# over its own texture coordinates (an undistorted picture of the pastes),
+# count for 16 probe windows of 24x24 texels the other places where the
+# same content recurs (normalised cross-correlation >= 0.9, local maxima).
+cat >"$W/repeats.c" <<'EOF_C'
+/* repeats IMAGE: the mean number of times the content of a probe window
+   recurs elsewhere in IMAGE (see tests/e2e.sh). */
+#define STB_IMAGE_IMPLEMENTATION
+#include "stb_image.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#define WIN 24
+int main(int argc, char **argv)
+{
+    int w, h, n, probe, x, y, i, j, total = 0, probes = 0;
+    unsigned char *p = argc == 2 ? stbi_load(argv[1], &w, &h, &n, 3) : NULL;
+    double *lum, *ncc;
+    if (!p || w < 4 * WIN || h < 4 * WIN) return 1;
+    lum = (double *)malloc(sizeof(double) * w * h);
+    ncc = (double *)calloc((size_t)w * h, sizeof(double));
+    if (!lum || !ncc) return 1;
+    for (x = 0; x < w * h; x++) lum[x] = 0.299 * p[3 * x] + 0.587 * p[3 * x + 1] + 0.114 * p[3 * x + 2];
+    for (probe = 0; probe < 16; probe++) {
+        int px = (probe % 4) * (w - WIN) / 3, py = (probe / 4) * (h - WIN) / 3;
+        double ma = 0, va = 0;
+        for (j = 0; j < WIN; j++) for (i = 0; i < WIN; i++) ma += lum[(py + j) * w + px + i];
+        ma /= WIN * WIN;
+        for (j = 0; j < WIN; j++) for (i = 0; i < WIN; i++) va += pow(lum[(py + j) * w + px + i] - ma, 2);
+        if (va < WIN * WIN * 4.0) continue;     /* flat: nothing to recognise */
+        probes++;
+        for (y = 0; y + WIN <= h; y++)
+            for (x = 0; x + WIN <= w; x++) {
+                double mb = 0, vb = 0, c = 0;
+                for (j = 0; j < WIN; j++) for (i = 0; i < WIN; i++) mb += lum[(y + j) * w + x + i];
+                mb /= WIN * WIN;
+                for (j = 0; j < WIN; j++)
+                    for (i = 0; i < WIN; i++) {
+                        double b = lum[(y + j) * w + x + i] - mb;
+                        vb += b * b;
+                        c += (lum[(py + j) * w + px + i] - ma) * b;
+                    }
+                ncc[y * w + x] = vb > 0 ? c / sqrt(va * vb) : 0;
+            }
+        for (y = 1; y + WIN < h; y++)
+            for (x = 1; x + WIN < w; x++) {
+                double v = ncc[y * w + x];
+                int peak = v >= 0.9 && (abs(x - px) >= WIN || abs(y - py) >= WIN);
+                for (j = -1; j <= 1 && peak; j++)
+                    for (i = -1; i <= 1 && peak; i++)
+                        if ((i || j) && ncc[(y + j) * w + x + i] > v) peak = 0;
+                total += peak;
+            }
+    }
+    if (probes == 0) return 1;
+    printf("%.2f\n", (double)total / probes);
+    return 0;
+}
+EOF_C
+newdir
+# a 4 x 4 plane of 32 x 32 quads facing +z, texture coordinates = position / 4
+awk 'BEGIN { n = 32; for (j = 0; j <= n; j++) for (i = 0; i <= n; i++) {
+        printf "v %g %g 0\nvt %g %g\n", 4 * i / n, 4 * j / n, i / n, j / n }
+    for (j = 0; j < n; j++) for (i = 0; i < n; i++) { a = j * (n + 1) + i + 1
+        printf "f %d/%d %d/%d %d/%d %d/%d\n", a, a, a + 1, a + 1, a + n + 2, a + n + 2, a + n + 1, a + n + 1 } }' >plane.obj
+CMD="$HELPER_CC $STB_INC repeats.c (test helper)"
+# shellcheck disable=SC2086
+if $HELPER_CC -O2 -w $STB_INC "$W/repeats.c" -o "$W/repeats" -lm 2>"$W/err"; then
+    expect_ok "lapped a plane, --patches 1, baked" lapped plane.obj ../in/lap128.png p1 --scale 1 --patches 1 --bake 256
+    expect_ok "lapped a plane, --patches 4, baked" lapped plane.obj ../in/lap128.png p4 --scale 1 --patches 4 --bake 256
+    r1=$("$W/repeats" p1_baked.png 2>&1)
+    r4=$("$W/repeats" p4_baked.png 2>&1)
+    CMD="repeats p1_baked.png / p4_baked.png"
+    check "stamping control: one patch recurs like wallpaper" "at least 3 recurrences per probe" "$r1" \
+        "$(awk -v a="$r1" 'BEGIN { exit !(a + 0 >= 3) }'; echo $?)"
+    check "stamping: 4 patches recur less than half as often as one" "repeats(p4) < repeats(p1) / 2" "$r4 against $r1" \
+        "$(awk -v a="$r1" -v b="$r4" 'BEGIN { exit !(b + 0 < (a + 0) / 2) }'; echo $?)"
+else
+    fail "helper for the stamping measure" "$CMD" "compiles" "$(head -c 300 "$W/err")"
+fi
+cd "$W" || exit 1
+
 # ======================================================================
 # Hierarchical pattern mapping
 # ======================================================================
@@ -1408,8 +1618,6 @@ cd "$W" || exit 1
 # ======================================================================
 # Image size budget (--max-pixels): refused from the header, before decoding
 # ======================================================================
-HELPER_CC=${CC:-cc}
-STB_INC=$(pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
 # A valid 8000x8000 all-black PNG of well under 1 MB: 64 M pixels to decode.
 cat >"$W/bigpng.c" <<'EOF_C'
 #define STB_IMAGE_WRITE_IMPLEMENTATION
