@@ -63,10 +63,11 @@ static void print_help(void)
            "al., Lapped Textures): no seams show, because every paste fades out over the ones\n"
            "beneath it. Writes OUT_PREFIX.obj (group paste_N holds the triangles of paste N with\n"
            "its texture coordinates and its patch's material; draw the groups in order with alpha\n"
-           "blending and clamped texture coordinates), OUT_PREFIX.mtl and the patches (straight\n"
-           "alpha): OUT_PREFIX_patch.png when there is one, OUT_PREFIX_patch_1.png, _2, ... when\n"
-           "there are several (the MTL has a material lapped_K for each, naming its PNG as map_Kd\n"
-           "and map_d by file name: the folder can move).\n"
+           "blending and clamped texture coordinates, the alpha times each vt's third number, the\n"
+           "paste's fade: 0 where it had to stop short of its soft edge), OUT_PREFIX.mtl and the\n"
+           "patches (straight alpha): OUT_PREFIX_patch.png when there is one, OUT_PREFIX_patch_1.png,\n"
+           "_2, ... when there are several (the MTL has a material lapped_K for each, naming its PNG\n"
+           "as map_Kd and map_d by file name: the folder can move).\n"
            "Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX_patch_1.png view.png' (or\n"
            "OUT_PREFIX_patch.png when there is one patch): render draws each paste with the patch\n"
            "its material names.\n"
@@ -678,8 +679,9 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
     }
     snprintf(comment, sizeof comment,
              "lapped texture by tiledtex %s (Praun et al.): %d pastes over %d triangles%s\n"
-             "draw the groups in order, each blended over the ones before through the patch's alpha,\n"
-             "with texture coordinates clamped (outside [0,1] is transparent)",
+             "draw the groups in order, each blended over the ones before through the patch's alpha\n"
+             "times the fade, each vt's third number (0 where a paste had to stop short of its soft\n"
+             "edge), with texture coordinates clamped (outside [0,1] is transparent)",
              TILEDTEX_VERSION_STRING, lapped->npastes, mesh->nfaces,
              patches->count > 1 ? ", each with its patch's material" : "");
     memset(&desc, 0, sizeof desc);
@@ -690,6 +692,7 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
     desc.fixed_face_size = 3;
     desc.corner_vert = corner_vert;
     desc.corner_uv = corner_uv;
+    desc.corner_uv_w = lapped->fade;   /* entries are written in order: entry e is OBJ face e */
     desc.mtllib = mtl_name;
     desc.material = patches->materials[0];
     desc.face_group = face_group;

@@ -45,7 +45,7 @@ typedef struct obj_parser {
     char *err;
     size_t err_size;
     obj_mesh *mesh;
-    int pos_capacity, vert_line_capacity, uv_capacity, face_capacity, corner_capacity;
+    int pos_capacity, vert_line_capacity, uv_capacity, uv_w_capacity, face_capacity, corner_capacity;
     int nnormals;
     int current_group, current_material;
     name_index groups, materials;
@@ -254,9 +254,9 @@ static int parse_vertex(obj_parser *P)
 static int parse_texture_vertex(obj_parser *P)
 {
     obj_mesh *mesh = P->mesh;
-    float uv[2] = {0.0f, 0.0f};     /* "vt u" alone means v = 0 */
-    int i;
-    for (i = 0; i < 2; i++) {
+    float uv[3] = {0.0f, 0.0f, 1.0f};   /* "vt u" alone means v = 0; w is 1 where absent (see uv_w) */
+    int i, j;
+    for (i = 0; i < 3; i++) {
         int got = read_number(P, &uv[i]);
         if (got < 0 || (got == 0 && i == 0)) {
             char quoted[80];
@@ -271,6 +271,14 @@ static int parse_texture_vertex(obj_parser *P)
         return out_of_memory(P);
     mesh->uv[2 * (size_t)mesh->nuvs] = uv[0];
     mesh->uv[2 * (size_t)mesh->nuvs + 1] = uv[1];
+    if (i == 3 || mesh->uv_w) {
+        /* The first w: every vt before it had none, so 1. */
+        int first = mesh->uv_w ? mesh->nuvs : 0;
+        if (grow_array((void **)&mesh->uv_w, &P->uv_w_capacity, mesh->nuvs + 1, sizeof(float)) != 0)
+            return out_of_memory(P);
+        for (j = first; j < mesh->nuvs; j++) mesh->uv_w[j] = 1.0f;
+        mesh->uv_w[mesh->nuvs] = uv[2];
+    }
     mesh->nuvs++;
     return 0;
 }
@@ -758,6 +766,7 @@ void obj_free(obj_mesh *mesh)
     free(mesh->face_size);
     free(mesh->corner_vert);
     free(mesh->uv);
+    free(mesh->uv_w);
     free(mesh->corner_uv);
     free(mesh->face_group);
     free(mesh->face_material);
@@ -826,8 +835,13 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         /* One vt per face corner, in corner order: corner c uses vt c + 1. */
         int ncorners = 0;
         for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
-        for (c = 0; c < ncorners; c++)
-            write_floats(out, "vt", desc->corner_uv + 2 * (size_t)c, 2);
+        for (c = 0; c < ncorners; c++) {
+            float uvw[3];
+            uvw[0] = desc->corner_uv[2 * (size_t)c];
+            uvw[1] = desc->corner_uv[2 * (size_t)c + 1];
+            uvw[2] = desc->corner_uv_w ? desc->corner_uv_w[c] : 0.0f;
+            write_floats(out, "vt", uvw, desc->corner_uv_w ? 3 : 2);
+        }
         c = 0;
     }
 

@@ -643,8 +643,9 @@ static void locate_sample(const scene *s, int t, float px, float py, surface_poi
 }
 
 /* Triangle t's texture colour at a point: the texture (straight alpha, or
-   premultiplied for a pasting mesh, whose texture is premultiplied), or
-   opaque grey when a corner has no UV. */
+   premultiplied for a pasting mesh, whose texture is premultiplied, times
+   the paste's fade when its vt carry one), or opaque grey when a corner
+   has no UV. */
 static void texture_color(const scene *s, int t, const surface_point *point, float rgba[4])
 {
     const obj_mesh *mesh = s->mesh;
@@ -674,6 +675,16 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
         /* The footprint of one sample in texels: the longer of its two sides. */
         float footprint = sqrtf(fmaxf(dudx * dudx + dvdx * dvdx, dudy * dudy + dvdy * dvdy));
         sample_trilinear(texture, u, v, footprint, !s->pasting, rgba);
+        if (s->pasting && mesh->uv_w) {
+            /* A paste's fade (the vt's third number, written by 'lapped'):
+               its alpha goes to 0 where it had to stop; premultiplied, so
+               colour and alpha alike. */
+            float fade = w[0] * mesh->uv_w[mesh->corner_uv[corner[0]]] + w[1] * mesh->uv_w[mesh->corner_uv[corner[1]]] +
+                         w[2] * mesh->uv_w[mesh->corner_uv[corner[2]]];
+            int k;
+            fade = fade < 0.0f ? 0.0f : (fade > 1.0f ? 1.0f : fade);
+            for (k = 0; k < 4; k++) rgba[k] *= fade;
+        }
     }
 }
 

@@ -308,6 +308,8 @@ typedef struct obj_mesh {
     int nfaces;  int *face_size;      /* corners per face */
     int ncorners; int *corner_vert;   /* 0-based vertex per corner, faces one after another */
     int nuvs;    float *uv;           /* 2 * nuvs, from vt lines */
+    float *uv_w;                      /* nuvs: each vt's third number, 1 where a vt has none; NULL
+                                         when none has one (the tool writes w as a paste's fade) */
     int *corner_uv;                   /* ncorners entries (0-based vt index) or NULL when no face has vt; -1 for a corner without one */
     int *face_group;                  /* nfaces: index into group_names of the `g`/`o`/`usemtl` group the face is in (0 = before any) */
     int ngroups; char **group_names;  /* group_names[0] = "" */
@@ -384,6 +386,8 @@ typedef struct obj_write_desc {
     int fixed_face_size;
     const int *corner_vert;         /* 0-based, faces one after another */
     const float *corner_uv;         /* 2 floats per corner, or NULL: no vt, faces are "f v v v" */
+    const float *corner_uv_w;       /* 1 float per corner written as each vt's third number (a
+                                       lapped paste's fade), or NULL: "vt u v" */
     const char *mtllib;             /* "mtllib NAME" line, or NULL */
     const char *material;           /* "usemtl NAME" before the faces, or NULL */
     /* Optional groups: face_group[f] indexes group_names (and group_materials,

@@ -635,6 +635,21 @@ check "lapped different seed: different .obj" "files differ" "identical" "$(! cm
 expect_ok "render a pasting OBJ" render out.obj out_patch.png view.png --size 160x120
 check "render pasting OBJ: 160x120 PNG" "160 120" "$(png_size view.png)" \
     "$(is_png view.png && [ "$(png_size view.png)" = "160 120" ]; echo $?)"
+# each vt carries the paste's fade as its third number: in [0, 1], below 1
+# where a paste had to stop short of its soft edge (this torus is thinner
+# than its patch: pastes wrap and meet themselves), and render applies it
+read -r nvt bad faded <<<"$(awk '$1=="vt"{n++; if (NF!=4 || $4<0 || $4>1) bad++; if ($4<1) f++} END{print n+0, bad+0, f+0}' out.obj)"
+check "lapped: every vt has a fade in [0,1], some below 1" "vt u v w, 0 <= w <= 1, some w < 1" \
+    "$nvt vt, $bad without or outside, $faded below 1" \
+    "$([ "${nvt:-0}" -gt 0 ] && [ "${bad:-1}" = 0 ] && [ "${faded:-0}" -gt 0 ]; echo $?)"
+awk '$1=="vt"{print "vt", $2, $3; next} {print}' out.obj > nofade.obj
+expect_ok "render the pasting OBJ without its fades" render nofade.obj out_patch.png nofade.png --size 160x120
+check "render: the fade in vt's third number changes the picture" "PNGs differ" "identical" \
+    "$(! cmp -s view.png nofade.png; echo $?)"
+awk '$1=="vt"{print "vt", $2, $3, 1; next} {print}' out.obj > ones.obj
+expect_ok "render the pasting OBJ with fades of 1" render ones.obj out_patch.png ones.png --size 160x120
+check "render: fades of 1 draw as no fade" "cmp equal" "$(cmp ones.png nofade.png 2>&1)" \
+    "$(cmp -s ones.png nofade.png; echo $?)"
 cd "$W" || exit 1
 
 # --bake: over an atlas of charts (no vt in the OBJ) ...

@@ -1285,8 +1285,9 @@ static tt_image *lapped_patch(int size, unsigned seed)
     return patch;
 }
 
-/* Composite alpha of every entry of face f at barycentric point w, the
-   pastes drawn in order with "over", recomputed from the output alone. */
+/* Composite alpha (times the fade) of every entry of face f at barycentric
+   point w, the pastes drawn in order with "over", recomputed from the
+   output alone. */
 static double lapped_alpha_at(const tt_lapped *lapped, tt_image *const *patches, int f, const double w[3])
 {
     double alpha = 0.0;
@@ -1301,6 +1302,10 @@ static double lapped_alpha_at(const tt_lapped *lapped, tt_image *const *patches,
             u = w[0] * uv[0] + w[1] * uv[2] + w[2] * uv[4];
             v = w[0] * uv[1] + w[1] * uv[3] + w[2] * uv[5];
             tt_image_sample_bilinear(im, (float)(u * im->width), (float)((1.0 - v) * im->height), rgba);
+            if (lapped->fade) {
+                const float *fade = lapped->fade + 3 * (size_t)e;
+                rgba[3] *= (float)(w[0] * fade[0] + w[1] * fade[1] + w[2] * fade[2]);
+            }
             alpha = rgba[3] + alpha * (1.0 - rgba[3]);
         }
     return alpha;
@@ -1363,9 +1368,9 @@ static int lapped_run(const tmesh *m, int isotropic, uint64_t seed, float scale,
 
 /* tt_lapped.top_changes and visible_cuts recomputed from the output alone:
    the last entry of each face is on top; across an edge whose tops are two
-   pastes, the later one stops there, and it is a cut when its alpha at one
-   of 5 even points along the edge (clamped lookups) reaches
-   TT_LAPPED_VISIBLE_CUT. */
+   pastes, the later one stops there, and it is a cut when its alpha times
+   its fade (lapped->fade, linear along the edge; NULL is 1) at one of 5 even
+   points along the edge (clamped lookups) reaches TT_LAPPED_VISIBLE_CUT. */
 static void lapped_count_cuts(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches, int *changes,
                               int *cuts)
 {
@@ -1389,9 +1394,13 @@ static void lapped_count_cuts(const tt_mesh *mesh, const tt_lapped *lapped, tt_i
         for (i = 0; i <= 4; i++) {
             const float *a = lapped->uv + 6 * (size_t)upper + 2 * corner, *b = lapped->uv + 6 * (size_t)upper + 2 * ((corner + 1) % 3);
             const tt_image *im = patches[lapped->pastes[paste_of[upper]].patch];
-            float u = a[0] + 0.25f * i * (b[0] - a[0]), v = a[1] + 0.25f * i * (b[1] - a[1]), rgba[4];
+            float u = a[0] + 0.25f * i * (b[0] - a[0]), v = a[1] + 0.25f * i * (b[1] - a[1]), rgba[4], fade = 1.0f;
+            if (lapped->fade) {
+                const float *f = lapped->fade + 3 * (size_t)upper;
+                fade = f[corner] + 0.25f * i * (f[(corner + 1) % 3] - f[corner]);
+            }
             tt_image_sample_bilinear(im, u * im->width, (1.0f - v) * im->height, rgba);
-            if (rgba[3] > most) most = rgba[3];
+            if (rgba[3] * fade > most) most = rgba[3] * fade;
         }
         *cuts += most >= TT_LAPPED_VISIBLE_CUT;
     }
@@ -1399,14 +1408,76 @@ static void lapped_count_cuts(const tt_mesh *mesh, const tt_lapped *lapped, tt_i
     free(paste_of);
 }
 
-/* The hard edges counted: against the recount from the output, and a
-   fully opaque patch (every paste ends at a cut; the control) against the
-   soft splotch on the same sphere. */
+/* The fade (tt_lapped.fade): within [0, 1]; one value per vertex of each
+   paste (entries of a paste meeting at a vertex agree), so a paste's alpha
+   is continuous; used (some paste fades on the sphere, where pastes stop
+   short of the poles' bends; the sheet's cuts are all at its boundary,
+   where nothing fades); and with it the
+   composite stays opaque everywhere, not only at face centres: 25 points a
+   face on a sphere and on a wavy sheet (a boundary, where nothing fades). */
+static void test_lapped_fade(void)
+{
+    tt_image *patch = lapped_patch(64, 3);
+    int shape;
+    for (shape = 0; shape < 2 && patch; shape++) {
+        tmesh m;
+        tt_mesh *mesh;
+        float *field;
+        tt_lapped *lapped = NULL;
+        int e, k, f, i, bad_range = 0, disagree = 0, faded = 0, thin = 0;
+        double least = 1.0;
+        float *at_vertex;
+        make_lapped_shape(&m, shape);
+        if (lapped_run(&m, 0, 7, 0.0f, &mesh, &field, patch, &lapped) != 0) {
+            tm_free(&m);
+            continue;
+        }
+        CHECK(lapped->fade != NULL, "shape %d: the output has a fade", shape);
+        at_vertex = (float *)malloc(sizeof(float) * (size_t)mesh->nverts);
+        for (i = 0; lapped->fade && i < lapped->npastes; i++) {
+            const tt_paste *paste = &lapped->pastes[i];
+            for (k = 0; k < mesh->nverts; k++) at_vertex[k] = -1.0f;
+            for (e = paste->first; e < paste->first + paste->nfaces; e++)
+                for (k = 0; k < 3; k++) {
+                    float value = lapped->fade[3 * (size_t)e + k];
+                    int v = mesh->corner_vert[3 * lapped->faces[e] + k];
+                    bad_range += !(value >= 0.0f && value <= 1.0f);
+                    faded += value < 1.0f;
+                    if (at_vertex[v] < 0.0f) at_vertex[v] = value;
+                    else disagree += at_vertex[v] != value;
+                }
+        }
+        for (f = 0; f < mesh->nfaces; f++)
+            for (i = 0; i < 25; i++) {
+                double w[3], a = (i % 5 + 0.5) / 5.0, b = (i / 5 + 0.5) / 5.0, alpha;
+                if (a + b > 1.0) { a = 1.0 - a; b = 1.0 - b; }
+                w[0] = 1.0 - a - b; w[1] = a; w[2] = b;
+                alpha = lapped_alpha_at(lapped, &patch, f, w);
+                if (alpha < least) least = alpha;
+                thin += alpha < 0.98;
+            }
+        CHECK(bad_range == 0 && disagree == 0 && (shape != 0 || faded > 0),
+              "shape %d: %d fades outside [0, 1], %d corners disagreeing with their paste's vertex, %d faded corners "
+              "(want some on the sphere)", shape, bad_range, disagree, faded);
+        CHECK(thin == 0, "shape %d: %d of %d points with composite alpha below 0.98 (least %.3f): a translucent hole",
+              shape, thin, 25 * mesh->nfaces, least);
+        free(at_vertex);
+        tt_lapped_free(lapped);
+        tt_mesh_free(mesh);
+        free(field);
+        tm_free(&m);
+    }
+    tt_image_free(patch);
+}
+
+/* The hard edges counted: against the recount from the output; the
+   control, a fully opaque patch with its fade ignored (every paste ends at
+   a cut), against the soft splotch with its fade on the same sphere. */
 static void test_lapped_cuts(void)
 {
     tt_image *patch = lapped_patch(64, 5), *opaque = lapped_patch(64, 5);
     int which, fraction_ok = 1;
-    double fractions[2] = {0.0, 0.0};
+    double fractions[2] = {0.0, 0.0}, opaque_faded = 0.0;
     size_t i;
     for (i = 0; opaque && i < (size_t)opaque->width * opaque->height; i++) opaque->pixels[4 * i + 3] = 1.0f;
     for (which = 0; which < 2 && patch && opaque; which++) {
@@ -1423,6 +1494,14 @@ static void test_lapped_cuts(void)
                   "%s patch: %d of %d edges cuts, recounted from the output %d of %d", which ? "opaque" : "splotch",
                   lapped->visible_cuts, lapped->top_changes, cuts, changes);
             fractions[which] = changes ? (double)cuts / changes : 0.0;
+            if (which) {
+                float *fade = lapped->fade;
+                opaque_faded = fractions[1];
+                lapped->fade = NULL;
+                lapped_count_cuts(mesh, lapped, &used, &changes, &cuts);
+                lapped->fade = fade;
+                fractions[1] = changes ? (double)cuts / changes : 0.0;
+            }
             fraction_ok &= changes > 0;
             tt_lapped_free(lapped);
         }
@@ -1430,11 +1509,13 @@ static void test_lapped_cuts(void)
         free(field);
         tm_free(&m);
     }
-    CHECK(fraction_ok && fractions[1] >= 0.9 && fractions[0] <= 0.5 * fractions[1],
+    CHECK(fraction_ok && fractions[1] >= 0.9 && fractions[0] <= 0.25 * fractions[1] && opaque_faded < fractions[1],
           "cuts among the edges where the top paste changes: %.2f with the soft splotch, %.2f with an opaque patch "
-          "(the control: every paste ends at a cut)", fractions[0], fractions[1]);
+          "and no fade (the control: every paste ends at a cut), %.2f with its fade", fractions[0], fractions[1],
+          opaque_faded);
     printf("     hard edges on a sphere: %.0f%% of the top paste's changes with the soft splotch, %.0f%% with an "
-           "opaque patch\n", 100.0 * fractions[0], 100.0 * fractions[1]);
+           "opaque patch without its fade (%.0f%% with it)\n", 100.0 * fractions[0], 100.0 * fractions[1],
+           100.0 * opaque_faded);
     tt_image_free(patch);
     tt_image_free(opaque);
 }
@@ -3933,7 +4014,8 @@ static int lapped_top_change_edges(const tt_mesh *mesh, const tt_lapped *lapped,
    of the baked texture over an atlas of triangle pairs, over every edge and
    over the edges where the paste on top changes. Controls that must score
    badly: the same bake with each face given another face's UVs, and a fully
-   opaque patch (every paste ends with a hard edge). */
+   opaque patch baked without its fade (every paste ends with a hard
+   edge). */
 static void test_lapped_baked_seams(void)
 {
     tt_image *patch = lapped_patch(64, 5), *opaque = lapped_patch(64, 5);
@@ -3946,6 +4028,7 @@ static void test_lapped_baked_seams(void)
         tt_mesh *mesh;
         float *field, *uv = NULL, *moved = NULL;
         int *edges = NULL, nedges = 0, f, k;
+        float *fade;
         tt_lapped *lapped = NULL;
         tt_image *used = which ? opaque : patch, *atlas = NULL;
         tt_seam_options so;
@@ -3960,6 +4043,8 @@ static void test_lapped_baked_seams(void)
         uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
         moved = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
         edges = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners);
+        fade = lapped->fade;
+        if (which) lapped->fade = NULL;
         tt_image_create(512, 512, NULL, &atlas, NULL);
         ok &= uv && moved && edges && atlas && tt_atlas_pack_pairs(mesh, 512, 2, uv, &err) == TT_OK &&
               bake_gutter(mesh, lapped, &used, 1, uv, 2, atlas, &err) == TT_OK;
@@ -3988,6 +4073,7 @@ static void test_lapped_baked_seams(void)
         free(moved);
         free(edges);
         tt_image_free(atlas);
+        lapped->fade = fade;
         tt_lapped_free(lapped);
         tt_mesh_free(mesh);
         free(field);
@@ -3998,10 +4084,11 @@ static void test_lapped_baked_seams(void)
           "changes (want <= 0.1)", scores[0][0], scores[0][1]);
     CHECK(ok && shuffled >= 0.8, "the control, faces given other faces' UVs: %.3f (want >= 0.8)", shuffled);
     CHECK(ok && scores[1][1] >= 0.5 && scores[1][1] >= 4.0 * scores[0][1],
-          "the control, an opaque patch: %.3f where the top paste changes (want >= 0.5 and 4 times the splotch's %.3f)",
+          "the control, an opaque patch without its fade: %.3f where the top paste changes (want >= 0.5 and 4 times "
+          "the splotch's %.3f)",
           scores[1][1], scores[0][1]);
     printf("     baked seam score on a sphere: %.3f over every edge, %.3f where the top paste changes; controls: "
-           "shuffled UVs %.3f, an opaque patch %.3f\n", scores[0][0], scores[0][1], shuffled, scores[1][1]);
+           "shuffled UVs %.3f, an opaque patch without its fade %.3f\n", scores[0][0], scores[0][1], shuffled, scores[1][1]);
     tt_image_free(patch);
     tt_image_free(opaque);
 }
@@ -4380,6 +4467,7 @@ void run_lapped_tests(void)
     RUN(test_lapped_plane);
     RUN(test_lapped_cover);
     RUN(test_lapped_cuts);
+    RUN(test_lapped_fade);
     RUN(test_lapped_determinism);
     RUN(test_lapped_patches);
     RUN(test_lapped_patch_twins);
