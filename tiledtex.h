@@ -10135,15 +10135,20 @@ static void tt__propagate_direction(tt__lapper *L, int g, int from, int paste)
 
 /* Similar-triangle prediction (Sec. 3.3, after Maillot et al.): for every
    face around vertex v whose other two corners x, y are mapped, place v so
-   the UV triangle is similar to the 3D one; v gets the centroid of the
-   predictions. The fan walk starts at vert_corner, the outgoing boundary
-   half-edge when v is on a boundary, so one sweep sees every face. Returns 0
-   when no face predicts v. */
+   the UV triangle is similar to the 3D one; v gets the mean of the
+   predictions, each weighted by 1 / (a^2 + b^2) where (a, b) is v's place
+   in units of the edge x y it comes from (along it and across it): the
+   error of x's and y's UVs reaches v scaled by about that distance, so a
+   short edge (a sliver's) seeing v far away would throw the mean off. The fan
+   walk starts at vert_corner, the outgoing boundary half-edge when v is on
+   a boundary, so one sweep sees every face. Returns 0 when no face
+   predicts v. */
 static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2])
 {
     const tt_mesh *mesh = L->mesh;
     const float *pv = mesh->pos + 3 * (size_t)v;
-    int start = mesh->vert_corner[v], c = start, count = 0, guard = 0;
+    int start = mesh->vert_corner[v], c = start, guard = 0;
+    double weight = 0.0;
     uv[0] = uv[1] = 0.0;
     while (c >= 0 && guard++ < mesh->ncorners) {
         int f = c / 3, k = c % 3;
@@ -10151,7 +10156,7 @@ static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2
         if (L->vert_stamp[x] == paste && L->vert_stamp[y] == paste) {
             const float *px = mesh->pos + 3 * (size_t)x, *py = mesh->pos + 3 * (size_t)y;
             const double *ux = L->vert_uv + 2 * (size_t)x, *uy = L->vert_uv + 2 * (size_t)y;
-            double e[3], q[3], n[3], ee, along, across;
+            double e[3], q[3], n[3], ee, along, across, w;
             int j;
             for (j = 0; j < 3; j++) { e[j] = (double)py[j] - px[j]; q[j] = (double)pv[j] - px[j]; }
             ee = tt__dot3(e, e);
@@ -10161,17 +10166,18 @@ static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2
                 tt__cross3(e, q, n);
                 along = tt__dot3(q, e) / ee;
                 across = tt__length3(n) / ee;
-                uv[0] += ux[0] + along * (uy[0] - ux[0]) - across * (uy[1] - ux[1]);
-                uv[1] += ux[1] + along * (uy[1] - ux[1]) + across * (uy[0] - ux[0]);
-                count++;
+                w = 1.0 / (along * along + across * across + 1e-12);
+                uv[0] += w * (ux[0] + along * (uy[0] - ux[0]) - across * (uy[1] - ux[1]));
+                uv[1] += w * (ux[1] + along * (uy[1] - ux[1]) + across * (uy[0] - ux[0]));
+                weight += w;
             }
         }
         c = mesh->twin[3 * f + (k + 2) % 3];
         if (c == start) break;
     }
-    if (count == 0) return 0;
-    uv[0] /= count;
-    uv[1] /= count;
+    if (!(weight > 0.0)) return 0;
+    uv[0] /= weight;
+    uv[1] /= weight;
     return 1;
 }
 
