@@ -166,6 +166,9 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
 {
     char comment[512];
     obj_write_desc desc;
+    float *normals = tool_corner_normals(path, m->mesh);
+    int status;
+    if (!normals) return TOOL_EXIT_FAILURE;
     snprintf(comment, sizeof comment,
              "hierarchical pattern mapping by tiledtex %s (Soler et al.): texture coordinates into %s\n%s",
              TILEDTEX_VERSION_STRING, tool_basename(options->image_path),
@@ -180,9 +183,12 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
     desc.fixed_face_size = 3;
     desc.corner_vert = m->vert;
     desc.corner_uv = corner_uv;
+    desc.corner_normal = normals;
     desc.mtllib = mtl_name;
     desc.material = "hpm";
-    return output_add_obj(output, path, &desc);
+    status = output_add_obj(output, path, &desc);
+    free(normals);
+    return status;
 }
 
 /* ======================================================================== */

@@ -653,6 +653,8 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
     const tt_mesh *mesh = m->mesh;
     int *corner_vert = (int *)malloc((size_t)lapped->nentries * 3 * sizeof(int));
     float *corner_uv = (float *)malloc((size_t)lapped->nentries * 6 * sizeof(float));
+    float *corner_normal = (float *)malloc((size_t)lapped->nentries * 9 * sizeof(float));
+    float *mesh_normals = tool_corner_normals(path, m->mesh);
     int *face_group = (int *)malloc((size_t)lapped->nentries * sizeof(int));
     char **names = (char **)calloc((size_t)lapped->npastes + 1, sizeof(char *));
     const char **materials = (const char **)calloc((size_t)lapped->npastes + 1, sizeof(char *));
@@ -662,7 +664,11 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
     int p, n = 0, status = 0;
 
     memset(&text, 0, sizeof text);
-    if (!corner_vert || !corner_uv || !face_group || !names || !materials) goto out_of_memory;
+    if (!mesh_normals) {
+        status = TOOL_EXIT_FAILURE;
+        goto done;
+    }
+    if (!corner_vert || !corner_uv || !corner_normal || !face_group || !names || !materials) goto out_of_memory;
     for (p = 0; p < lapped->npastes; p++) {
         const tt_paste *paste = &lapped->pastes[p];
         int e, k;
@@ -674,6 +680,7 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
             int face = lapped->faces[e];
             for (k = 0; k < 3; k++) corner_vert[3 * n + k] = mesh->corner_vert[mesh->face_start[face] + k];
             memcpy(corner_uv + 6 * n, lapped->uv + 6 * (size_t)e, 6 * sizeof(float));
+            memcpy(corner_normal + 9 * n, mesh_normals + 3 * (size_t)mesh->face_start[face], 9 * sizeof(float));
             face_group[n] = p;
         }
     }
@@ -693,6 +700,7 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
     desc.corner_vert = corner_vert;
     desc.corner_uv = corner_uv;
     desc.corner_uv_w = lapped->fade;   /* entries are written in order: entry e is OBJ face e */
+    desc.corner_normal = corner_normal;
     desc.mtllib = mtl_name;
     desc.material = patches->materials[0];
     desc.face_group = face_group;
@@ -712,6 +720,8 @@ done:
     free(materials);
     free(corner_vert);
     free(corner_uv);
+    free(corner_normal);
+    free(mesh_normals);
     free(face_group);
     return status;
 }
@@ -855,6 +865,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
     tt_image *atlas = NULL;
+    float *normals = NULL;
     tt_bake_options bake;
     tt_error error;
     obj_write_desc desc;
@@ -878,6 +889,10 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
 
     snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
              tool_basename(png_path));
+    if (!(normals = tool_corner_normals(obj_path, m->mesh))) {
+        status = TOOL_EXIT_FAILURE;
+        goto done;
+    }
     memset(&desc, 0, sizeof desc);
     desc.comment = comment;
     desc.nverts = m->mesh->nverts;
@@ -886,6 +901,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     desc.fixed_face_size = 3;
     desc.corner_vert = m->vert;
     desc.corner_uv = corner_uv;
+    desc.corner_normal = normals;
     desc.mtllib = tool_basename(mtl_path);
     desc.material = "lapped_baked";
     if ((status = output_add_obj(output, obj_path, &desc)) != 0) goto done;
@@ -895,6 +911,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     atlas = NULL;   /* add_png freed it */
 done:
     tt_image_free(atlas);
+    free(normals);
     free(corner_uv);
     return status;
 }

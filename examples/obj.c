@@ -844,6 +844,13 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         }
         c = 0;
     }
+    if (desc->corner_normal) {
+        /* One vn per face corner too: corner c uses vn c + 1. */
+        int ncorners = 0;
+        for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
+        for (c = 0; c < ncorners; c++) write_floats(out, "vn", desc->corner_normal + 3 * (size_t)c, 3);
+        c = 0;
+    }
 
     if (desc->material && !(desc->face_group && desc->group_materials)) write_name_line(out, "usemtl", desc->material);
     for (f = 0; f < desc->nfaces; f++) {
@@ -861,12 +868,16 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         }
         buffer_append(out, "f", 1);
         for (i = 0; i < size; i++, c++) {
-            char text[2 * TOOL_NUMBER_TEXT_SIZE + 2];
+            char text[3 * TOOL_NUMBER_TEXT_SIZE + 3];
             int vertex = desc->corner_vert[c], length;
             if (vertex < 0 || vertex >= desc->nverts) return -1;
             text[0] = ' ';
             length = 1 + tool_format_int((long)vertex + 1, text + 1);
-            if (desc->corner_uv) {
+            if (desc->corner_uv || desc->corner_normal) {
+                text[length++] = '/';
+                if (desc->corner_uv) length += tool_format_int((long)c + 1, text + length);
+            }
+            if (desc->corner_normal) {
                 text[length++] = '/';
                 length += tool_format_int((long)c + 1, text + length);
             }

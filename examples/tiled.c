@@ -158,6 +158,9 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
 {
     obj_write_desc desc;
     char comment[256];
+    float *normals = tool_corner_normals(obj_path, mesh->mesh);
+    int status;
+    if (!normals) return TOOL_EXIT_FAILURE;
     memset(&desc, 0, sizeof desc);
     snprintf(comment, sizeof comment,
              "tiled texture by tiledtex %s: %d quads, %d colors, %d-texel tiles, gutter %d",
@@ -170,9 +173,12 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
     desc.fixed_face_size = 4;
     desc.corner_vert = mesh->mesh->corner_vert;
     desc.corner_uv = mesh->corner_uv;
+    desc.corner_normal = normals;
     desc.mtllib = mtl_name;
     desc.material = mtl_name ? "tiled" : NULL;
-    return output_add_obj(output, obj_path, &desc);
+    status = output_add_obj(output, obj_path, &desc);
+    free(normals);
+    return status;
 }
 
 int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name)

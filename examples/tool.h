@@ -388,6 +388,8 @@ typedef struct obj_write_desc {
     const float *corner_uv;         /* 2 floats per corner, or NULL: no vt, faces are "f v v v" */
     const float *corner_uv_w;       /* 1 float per corner written as each vt's third number (a
                                        lapped paste's fade), or NULL: "vt u v" */
+    const float *corner_normal;     /* 3 floats per corner written as "vn", faces "f v/vt/vn" (or
+                                       "v//vn"), or NULL: no normals */
     const char *mtllib;             /* "mtllib NAME" line, or NULL */
     const char *material;           /* "usemtl NAME" before the faces, or NULL */
     /* Optional groups: face_group[f] indexes group_names (and group_materials,
@@ -400,13 +402,24 @@ typedef struct obj_write_desc {
 } obj_write_desc;
 
 /* Append the OBJ text to `out`: "v x y z", then one "vt u v" per face corner
-   (when corner_uv is given), then "f v/vt ..." with 1-based indices. Numbers
+   (when corner_uv is given), one "vn x y z" per face corner (when
+   corner_normal is given), then "f v/vt/vn ..." with 1-based indices. Numbers
    use 9 significant digits (tool_format_float), so floats read back exactly. Returns 0, or -1 on
    an invalid description or when the buffer ran out of memory. */
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
 /* obj_write into a new file of the batch; on failure (out of memory) one
    line "out of memory while writing PATH" and the failure exit status. */
 int output_add_obj(tool_output *output, const char *path, const obj_write_desc *desc);
+
+/* Faces meeting at more than this many degrees keep their own normals in
+   the OBJs the commands write (a CAD part's edges); the rest are smoothed
+   (a scan). */
+#define TOOL_CREASE_DEGREES 60.0f
+
+/* Shading normals for an output OBJ, 3 floats per corner of `mesh`
+   (tt_corner_normals at TOOL_CREASE_DEGREES), malloc'd; NULL when out of
+   memory, with the error printed naming `path`. */
+float *tool_corner_normals(const char *path, const tt_mesh *mesh);
 
 /* Append one MTL material: "newmtl NAME", white diffuse colour, and
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also

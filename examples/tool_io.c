@@ -426,6 +426,22 @@ int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer
     return output_add(output, path, data, size);
 }
 
+float *tool_corner_normals(const char *path, const tt_mesh *mesh)
+{
+    float *normals = (float *)malloc(3 * (size_t)(mesh->ncorners > 0 ? mesh->ncorners : 1) * sizeof(float));
+    tt_error error;
+    if (!normals) {
+        tool_fail("out of memory for the normals of %s", path);
+        return NULL;
+    }
+    if (tt_corner_normals(mesh, TOOL_CREASE_DEGREES, NULL, normals, &error) != TT_OK) {
+        tool_fail("%s: %s", path, error.message);
+        free(normals);
+        return NULL;
+    }
+    return normals;
+}
+
 int output_add_obj(tool_output *output, const char *path, const obj_write_desc *desc)
 {
     tool_buffer text = TOOL_BUFFER_INIT;

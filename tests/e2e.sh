@@ -147,6 +147,37 @@ obj_report() {
         }' "$1" 2>/dev/null
 }
 
+# normals_report FILE: "corners vn bad creased": face corners, vn lines, corners
+# without a vn index in range or with a vn not of unit length, and vertices
+# whose corners carry more than one normal (a crease: 0 on a smooth surface)
+normals_report() {
+    awk '
+        $1 == "vn" { nvn++; x[nvn] = $2; y[nvn] = $3; z[nvn] = $4 }
+        $1 == "f"  { for (i = 2; i <= NF; i++) { corners++; c[corners] = $i } }
+        END {
+            for (k = 1; k <= corners; k++) {
+                n = split(c[k], p, "/")
+                if (n < 3 || p[3] !~ /^[0-9]+$/ || p[3] + 0 < 1 || p[3] + 0 > nvn) { bad++; continue }
+                q = p[3] + 0
+                len = x[q] * x[q] + y[q] * y[q] + z[q] * z[q]
+                if (len < 0.998 || len > 1.002) bad++
+                key = sprintf("%.3f %.3f %.3f", x[q], y[q], z[q])
+                if (!(p[1] in first)) first[p[1]] = key
+                else if (first[p[1]] != key && !(p[1] in creased)) { creased[p[1]] = 1; ncreased++ }
+            }
+            printf "%d %d %d %d\n", corners, nvn, bad, ncreased
+        }' "$1" 2>/dev/null
+}
+
+# check_normals WHAT FILE: a unit vn for every face corner (1 check)
+check_normals() {
+    local corners nvn bad creased
+    read -r corners nvn bad creased <<<"$(normals_report "$2")"
+    check "$1: a unit normal (vn) at every face corner" "vn lines = corners, 0 bad" \
+        "$nvn vn, $corners corners, $bad bad" \
+        "$([ "${corners:-0}" -gt 0 ] && [ "${nvn:-x}" = "${corners:-y}" ] && [ "${bad:-1}" = 0 ]; echo $?)"
+}
+
 # check_obj WHAT FILE : one vt per corner, all quads, UVs in [0,1] (4 checks)
 check_obj() {
     local r corners nvt nonquad badc baduv nf
@@ -213,6 +244,7 @@ tile_case() {
     check "tile $name: outputs non-empty" "out.obj out.mtl out.png non-empty" "$(ls -l 2>&1)" \
         "$(nonempty out.obj && nonempty out.mtl && nonempty out.png; echo $?)"
     check "tile $name: atlas is a PNG" "PNG signature" "$(od -An -tx1 -N8 out.png 2>&1)" "$(is_png out.png; echo $?)"
+    check_normals "tile $name" out.obj
     check "tile $name: mtl names the atlas" "map_Kd out.png in out.mtl, mtllib out.mtl in out.obj" \
         "$(grep -h -E 'map_Kd|mtllib' out.mtl out.obj 2>&1)" \
         "$(grep -qE '^map_Kd +out\.png' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl' out.obj 2>/dev/null; echo $?)"
@@ -235,6 +267,17 @@ check "tile sphere-triangles: says it quadrangulated" "stderr mentions quadrangu
 check "tile sphere-triangles (1280): points to the tools for dense triangle meshes" \
     "one line naming 'tiledtex polycube', 'tiledtex hpm' and 'tiledtex lapped'" "$ERR" \
     "$(printf '%s' "$ERR" | grep -c "'tiledtex polycube', 'tiledtex hpm' or 'tiledtex lapped'" | grep -qx 1; echo $?)"
+read -r corners nvn bad creased <<<"$(normals_report "$W/d$NEWDIR_N/out.obj")"
+check "tile sphere-triangles: smooth normals (every vertex one normal)" "0 creased vertices" \
+    "$creased creased vertices of $corners corners" "$([ "${creased:-1}" = 0 ] && [ "${corners:-0}" -gt 0 ]; echo $?)"
+newdir
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n' > cube.obj
+expect_ok "tile a cube" tile cube.obj ../in/tex.png out
+read -r corners nvn bad creased <<<"$(normals_report out.obj)"
+check "tile a cube: its edges stay sharp (each of its 8 vertices has a normal per face)" \
+    "8 creased vertices, unit normals" "$creased creased vertices, $bad bad of $corners corners" \
+    "$([ "${creased:-0}" = 8 ] && [ "${bad:-1}" = 0 ]; echo $?)"
+cd "$W" || exit 1
 tile_case grid grid.obj -
 check "tile grid: one boundary loop" "'1 boundary loop' in summary" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE '(^|[^0-9])1 boundary loop'; echo $?)"
@@ -662,6 +705,8 @@ check "lapped --bake: the summary gives the baked seam score over every edge and
     "$(printf '%s\n' "$seams_line" | grep -qE '^baked seam score: all edges -?[0-9]+\.[0-9]{3} \(1536 of 1536 edges\); where the top paste changes -?[0-9]+\.[0-9]{3} \(([0-9]+) of \1 edges\)$'; echo $?)"
 check "lapped --bake without vt: over an atlas of charts, no warning" "'over an atlas of N charts', empty stderr" \
     "$OUT | $ERR" "$(printf '%s' "$OUT" | grep -qE 'over an atlas of [0-9]+ charts?\)' && [ -z "$ERR" ]; echo $?)"
+check_normals "lapped --bake: the pasting OBJ" out.obj
+check_normals "lapped --bake: the baked OBJ" out_baked.obj
 check "lapped --bake: writes out_baked.obj/.mtl/.png too" "6 files" "$(ls -A | tr '\n' ' ')" \
     "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_baked.mtl out_baked.obj out_baked.png out_patch.png " ]; echo $?)"
 check "lapped --bake: 256x256 texture" "256 256" "$(png_size out_baked.png)" \
@@ -1157,6 +1202,7 @@ CMD="tiledtex hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 (twic
 check "hpm same seed twice: identical .obj" "cmp equal" "$(cmp out.obj "$HPM_TORUS/out.obj" 2>&1)" \
     "$(cmp -s out.obj "$HPM_TORUS/out.obj"; echo $?)"
 expect_ok "hpm seed 3" hpm ../in/torus.obj ../in/lap.png other --rotations 3 --seed 3
+check_normals "hpm" other.obj
 CMD="tiledtex hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 / --seed 3"
 check "hpm different seed: different .obj" "files differ" "identical" "$(! cmp -s out.obj other.obj; echo $?)"
 # the result renders with the image itself as its texture

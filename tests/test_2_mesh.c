@@ -1445,6 +1445,146 @@ static void test_mesh_query_allocators(void)
     tm_free(&m);
 }
 
+/* ------------------------------------------------------------------------ */
+/* Corner normals                                                           */
+/* ------------------------------------------------------------------------ */
+
+static double normal_dot(const float *a, const float *b)
+{
+    return (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+}
+
+typedef struct normals_ctx {
+    const tt_mesh *mesh;
+    float *out;
+} normals_ctx;
+
+static tt_result oom_normals(void *ctx, const tt_allocator *al)
+{
+    normals_ctx *c = (normals_ctx *)ctx;
+    return tt_corner_normals(c->mesh, 45.0f, al, c->out, NULL);
+}
+
+/* tt_corner_normals against what they must be: a cube keeps its edges at 45
+   degrees (each corner its face's normal) and rounds them at 180 (every
+   corner the diagonal); a torus is smooth at 60 degrees, every corner of a
+   vertex the same and within 2 degrees of the analytic normal; the same
+   torus split into triangles gives the same normals (the angle weights);
+   an open grid is written at every corner; bad angles are refused. */
+static void test_corner_normals(void)
+{
+    tmesh m, t;
+    tt_mesh *cube = NULL, *torus = NULL, *split = NULL, *grid = NULL;
+    float *a = NULL, *b = NULL, face[3];
+    tt_error err;
+    int c, bad = 0, i;
+    double worst = 1.0;
+    memset(&m, 0, sizeof m);
+    make_cube(&m, 0);
+    CHECK(build(&m, 0, &cube, &err) == TT_OK, "cube: %s", err.message);
+    tm_free(&m);
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 24, 12, 3.0, 1.0);
+    CHECK(build(&m, 0, &torus, &err) == TT_OK, "torus: %s", err.message);
+    /* the same torus, each quad split into two triangles */
+    memset(&t, 0, sizeof t);
+    for (i = 0; i < m.nv; i++) tm_vert(&t, m.pos[3 * i], m.pos[3 * i + 1], m.pos[3 * i + 2]);
+    for (i = 0; i < m.nf; i++) {
+        const int *q = m.idx + 4 * i;
+        tm_tri(&t, q[0], q[1], q[2]);
+        tm_tri(&t, q[0], q[2], q[3]);
+    }
+    CHECK(build(&t, 0, &split, &err) == TT_OK, "split torus: %s", err.message);
+    tm_free(&t);
+    tm_free(&m);
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 4, 3);
+    CHECK(build(&m, 0, &grid, &err) == TT_OK, "grid: %s", err.message);
+    tm_free(&m);
+    if (!cube || !torus || !split || !grid) goto done;
+    a = (float *)malloc(sizeof(float) * 3 * (size_t)split->ncorners);
+    b = (float *)malloc(sizeof(float) * 3 * (size_t)split->ncorners);
+
+    CHECK(tt_corner_normals(cube, 45.0f, NULL, a, &err) == TT_OK, "cube at 45: %s", err.message);
+    for (c = 0; c < cube->ncorners; c++) {
+        tt_face_normal(cube, cube->corner_face[c], face);
+        bad += normal_dot(a + 3 * c, face) < 0.99999;
+    }
+    CHECK(bad == 0, "cube at 45 degrees: %d corners not their face's normal", bad);
+    CHECK(tt_corner_normals(cube, 180.0f, NULL, a, &err) == TT_OK, "cube at 180: %s", err.message);
+    for (bad = 0, c = 0; c < cube->ncorners; c++) {
+        const float *p = cube->pos + 3 * cube->corner_vert[c];
+        float centre[3] = {0.5f, 0.5f, 0.5f}, d[3];
+        double length;
+        for (i = 0; i < 3; i++) d[i] = p[i] - centre[i];
+        length = sqrt(normal_dot(d, d));
+        bad += normal_dot(a + 3 * c, d) / length < 0.99999;
+    }
+    CHECK(bad == 0, "cube at 180 degrees: %d corners off the diagonal through their vertex", bad);
+
+    CHECK(tt_corner_normals(torus, 60.0f, NULL, a, &err) == TT_OK, "torus: %s", err.message);
+    for (bad = 0, c = 0; c < torus->ncorners; c++) {
+        const float *p = torus->pos + 3 * torus->corner_vert[c];
+        /* the analytic normal: from the nearest point of the centre circle */
+        double ring = sqrt((double)p[0] * p[0] + (double)p[1] * p[1]), n[3], length, dot;
+        float nf[3];
+        n[0] = p[0] - 3.0 * p[0] / ring;
+        n[1] = p[1] - 3.0 * p[1] / ring;
+        n[2] = p[2];
+        length = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (i = 0; i < 3; i++) nf[i] = (float)(n[i] / length);
+        dot = normal_dot(a + 3 * c, nf);
+        if (dot < worst) worst = dot;
+        bad += normal_dot(a + 3 * c, a + 3 * torus->vert_corner[torus->corner_vert[c]]) < 0.999999;
+    }
+    CHECK(bad == 0 && worst > cos(2.0 * 3.14159265358979 / 180.0),
+          "torus at 60 degrees: %d corners differ from their vertex's other corners; worst angle to the true "
+          "normal %.3f degrees (want under 2, the mesh is coarse)", bad, acos(worst < 1.0 ? worst : 1.0) * 180.0 / 3.14159265358979);
+    /* split into triangles: per vertex the same normal as the quads give */
+    CHECK(tt_corner_normals(split, 60.0f, NULL, b, &err) == TT_OK, "split torus: %s", err.message);
+    for (bad = 0, c = 0; c < split->ncorners; c++) {
+        int v = split->corner_vert[c];
+        bad += normal_dot(b + 3 * c, a + 3 * torus->vert_corner[v]) < 0.999999;
+    }
+    CHECK(bad == 0, "the torus split into triangles: %d corners differ from the quads' normals", bad);
+    /* flat at 0 degrees: each corner its face's normal */
+    CHECK(tt_corner_normals(torus, 0.0f, NULL, a, &err) == TT_OK, "torus at 0: %s", err.message);
+    for (bad = 0, c = 0; c < torus->ncorners; c++) {
+        tt_face_normal(torus, torus->corner_face[c], face);
+        bad += normal_dot(a + 3 * c, face) < 0.99999;
+    }
+    CHECK(bad == 0, "torus at 0 degrees: %d corners not flat", bad);
+
+    /* an open grid: every corner written, all (0, 0, 1) */
+    for (c = 0; c < 3 * grid->ncorners; c++) a[c] = -7.0f;
+    CHECK(tt_corner_normals(grid, 30.0f, NULL, a, &err) == TT_OK, "grid: %s", err.message);
+    for (bad = 0, c = 0; c < grid->ncorners; c++)
+        bad += !(fabs(a[3 * c]) < 1e-6 && fabs(a[3 * c + 1]) < 1e-6 && fabs(a[3 * c + 2] - 1.0) < 1e-6);
+    CHECK(bad == 0, "open grid: %d corners not (0, 0, 1)", bad);
+
+    /* errors */
+    CHECK(tt_corner_normals(NULL, 30.0f, NULL, a, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL mesh refused");
+    CHECK(tt_corner_normals(grid, 30.0f, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL output refused");
+    CHECK(tt_corner_normals(grid, -1.0f, NULL, a, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              strstr(err.message, "crease") != NULL, "crease -1 refused: %s", err.message);
+    CHECK(tt_corner_normals(grid, 181.0f, NULL, a, NULL) == TT_ERROR_INVALID_ARGUMENT, "crease 181 refused");
+    CHECK(tt_corner_normals(grid, (float)NAN, NULL, a, NULL) == TT_ERROR_INVALID_ARGUMENT, "crease NaN refused");
+    {
+        normals_ctx ctx;
+        ctx.mesh = torus;
+        ctx.out = a;
+        oom_reset();
+        oom_sweep("tt_corner_normals", oom_normals, &ctx, TT_OK);
+    }
+done:
+    free(a);
+    free(b);
+    tt_mesh_free(cube);
+    tt_mesh_free(torus);
+    tt_mesh_free(split);
+    tt_mesh_free(grid);
+}
+
 void run_mesh_tests(void)
 {
     RUN(test_builder_valid);
@@ -1454,6 +1594,7 @@ void run_mesh_tests(void)
     RUN(test_queries_oom);
     RUN(test_quadrangulate);
     RUN(test_quadrangulate_direct);
+    RUN(test_corner_normals);
     RUN(test_mesh_null_errors);
     RUN(test_mesh_query_allocators);
 }
