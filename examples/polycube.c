@@ -409,11 +409,57 @@ static void print_summary(const polycube_command_options *options, const polycub
 /* The files                                                                */
 /* ======================================================================== */
 
-/* OUT_PREFIX.obj: the mapped triangles, one vt per corner. */
+/* The mapped triangles' corner normals: the input mesh's (tt_corner_normals,
+   so its creases stay), carried to each output vertex by the mapping's
+   source vertices and weights within the input face the triangle is part
+   of. NULL when out of memory (said). */
+static float *mapped_corner_normals(const char *path, const polycube_job *job)
+{
+    const tt_mesh *input = job->mesh.mesh;
+    const tt_polycube_mapping *mapping = job->mapping;
+    float *from = tool_corner_normals(path, input);
+    float *out = (float *)malloc(9 * (size_t)(mapping->ntriangles > 0 ? mapping->ntriangles : 1) * sizeof(float));
+    int t, k, s, j;
+    if (!from || !out) {
+        if (from && !out) tool_fail("out of memory for the normals of %s", path);
+        free(from);
+        free(out);
+        return NULL;
+    }
+    for (t = 0; t < mapping->ntriangles; t++) {
+        int face = mapping->triangle_face[t];
+        for (k = 0; k < 3; k++) {
+            int v = mapping->triangles[3 * t + k];
+            float *n = out + 9 * (size_t)t + 3 * k;
+            double sum[3] = {0.0, 0.0, 0.0}, length;
+            for (s = 0; s < 3; s++) {
+                double w = mapping->weights[3 * (size_t)v + s];
+                if (w == 0.0) continue;
+                for (j = input->face_start[face]; j < input->face_start[face + 1]; j++)
+                    if (input->corner_vert[j] == mapping->source[3 * (size_t)v + s]) {
+                        sum[0] += w * from[3 * (size_t)j];
+                        sum[1] += w * from[3 * (size_t)j + 1];
+                        sum[2] += w * from[3 * (size_t)j + 2];
+                    }
+            }
+            length = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+            n[0] = length > 0.0 ? (float)(sum[0] / length) : 0.0f;
+            n[1] = length > 0.0 ? (float)(sum[1] / length) : 0.0f;
+            n[2] = length > 0.0 ? (float)(sum[2] / length) : 0.0f;
+        }
+    }
+    free(from);
+    return out;
+}
+
+/* OUT_PREFIX.obj: the mapped triangles, one vt and one vn per corner. */
 static int add_obj(tool_output *output, const char *path, const char *mtl_name, const polycube_job *job)
 {
     char comment[512];
     obj_write_desc desc;
+    float *normals = mapped_corner_normals(path, job);
+    int status;
+    if (!normals) return TOOL_EXIT_FAILURE;
     snprintf(comment, sizeof comment,
              "polycube texture by tiledtex %s (Chang and Lin): %d triangles over %d polycube quads of %.9g units,\n"
              "%d colors, %d-texel tiles, gutter %d",
@@ -427,9 +473,12 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
     desc.fixed_face_size = 3;
     desc.corner_vert = job->mapping->triangles;
     desc.corner_uv = job->corner_uv;
+    desc.corner_normal = normals;
     desc.mtllib = mtl_name;
     desc.material = "tiled";
-    return output_add_obj(output, path, &desc);
+    status = output_add_obj(output, path, &desc);
+    free(normals);
+    return status;
 }
 
 /* OUT_PREFIX_polycube.obj: S with its own tiles, written the way `tile`

@@ -1390,6 +1390,12 @@ cd "$W" || exit 1
 # the same seed twice: the same files; another seed: another result
 newdir
 expect_ok "polycube sphere again" polycube ../in/spheretri.obj ../in/tex.png out --tile 16 --colors 2 --resolution 8
+check_normals "polycube" out.obj
+check_normals "polycube: the polycube's own OBJ" out_polycube.obj
+read -r corners nvn bad creased <<<"$(normals_report out.obj)"
+check "polycube: the sphere's normals carried smooth onto the split triangles (every vertex one normal)" \
+    "0 creased vertices" "$creased creased vertices of $corners corners" \
+    "$([ "${creased:-1}" = 0 ] && [ "${corners:-0}" -gt 0 ]; echo $?)"
 for f in out.obj out.mtl out.png out_polycube.obj; do
     CMD="tiledtex polycube ../in/spheretri.obj ../in/tex.png out --tile 16 --colors 2 --resolution 8 (twice)"
     check "polycube same seed twice: identical $f" "cmp equal" "$(cmp "$f" "$POLYCUBE_SPHERE/$f" 2>&1)" \
