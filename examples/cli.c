@@ -262,3 +262,24 @@ int parse_mesh_option(int argc, char **argv, int *index, tool_mesh_options *opti
     }
     return 1;
 }
+
+int parse_up(const char *option, const char *text, double up[3])
+{
+    int axis, sign;
+    if (!text) return missing_value(option);
+    if (parse_axis_name(text, &axis, &sign) == 0) {
+        up[0] = up[1] = up[2] = 0.0;
+        up[axis] = sign;
+        return 0;
+    }
+    if (!strchr(text, ',')) {
+        tool_usage("%s wants an axis (x, y, z, -x, -y or -z) or a direction X,Y,Z, got '%s'", option, text);
+        return -1;
+    }
+    if (parse_float_list(option, text, 3, up) != 0) return -1;
+    if (up[0] == 0.0 && up[1] == 0.0 && up[2] == 0.0) {
+        tool_usage("%s wants a direction, got the zero vector '%s'", option, text);
+        return -1;
+    }
+    return 0;
+}

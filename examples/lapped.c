@@ -95,8 +95,8 @@ static void print_help(void)
            "                       keep the photo's size)\n"
            "  --patch-size S       side of each window in texels, %d or more (default: the largest\n"
            "                       that lets the N windows fit; with --patches 1, the whole IMAGE)\n"
-           "  --up X,Y,Z           the texture's up direction, projected on each face\n"
-           "                       (default 0,1,0)\n"
+           "  --up DIR             the texture's up direction, projected on each face: x, y, z,\n"
+           "                       -x, -y, -z or X,Y,Z (default y)\n"
            "  --constraints FILE   the texture's direction and scale at chosen faces, one per line:\n"
            "                       FACE X Y Z [SIGMA [WEIGHT]]; FACE counts the OBJ's faces from 1,\n"
            "                       X Y Z points up along the face and its length is the scale there,\n"
@@ -186,9 +186,7 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
         } else if (tool_option(argc, argv, &i, "--seed", &value)) {
             if (parse_u64("--seed", value, &options->seed) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
-            if (parse_float_list("--up", value, 3, xyz) != 0) return TOOL_EXIT_USAGE;
-            if (xyz[0] == 0.0 && xyz[1] == 0.0 && xyz[2] == 0.0)
-                return tool_usage("--up wants a direction, got the zero vector '%s'", value);
+            if (parse_up("--up", value, xyz) != 0) return TOOL_EXIT_USAGE;
             options->up[0] = (float)xyz[0];
             options->up[1] = (float)xyz[1];
             options->up[2] = (float)xyz[2];

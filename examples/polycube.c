@@ -91,25 +91,6 @@ typedef struct polycube_command_options {
     int plain;                      /* --no-upright */
 } polycube_command_options;
 
-/* --up: an axis name, or a direction X,Y,Z of which the library takes the
-   largest component's axis. */
-static int parse_up(const char *value, double up[3])
-{
-    int axis, sign;
-    if (!value) return tool_usage("--up needs a value");
-    if (parse_axis_name(value, &axis, &sign) == 0) {
-        up[0] = up[1] = up[2] = 0.0;
-        up[axis] = sign;
-        return 0;
-    }
-    if (!strchr(value, ','))
-        return tool_usage("--up wants an axis (x, y, z, -x, -y or -z) or a direction X,Y,Z, got '%s'", value);
-    if (parse_float_list("--up", value, 3, up) != 0) return TOOL_EXIT_USAGE;
-    if (up[0] == 0.0 && up[1] == 0.0 && up[2] == 0.0)
-        return tool_usage("--up wants a direction, got the zero vector '%s'", value);
-    return 0;
-}
-
 /* Returns -1 to go on, or the exit status to return now. */
 static int parse_command_line(int argc, char **argv, polycube_command_options *options)
 {
@@ -143,8 +124,7 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
         } else if (strcmp(argv[i], "--no-correct") == 0) {
             options->build.flags |= TT_POLYCUBE_NO_CORRECT;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
-            int status = parse_up(value, options->build.up);
-            if (status != 0) return status;
+            if (parse_up("--up", value, options->build.up) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
         } else if (npositional < 3) {

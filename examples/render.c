@@ -233,23 +233,19 @@ typedef struct up_axis {
     vec3 up, side, front;
 } up_axis;
 
-static int parse_up_axis(const char *text, up_axis *axis)
+/* The frame around an up direction (parse_up: an axis or any X,Y,Z). The
+   front is +z, or -y when up is closest to the z axis, made perpendicular
+   to up; side = up x front. For the six axes this is the usual frame: y up
+   looks from +z with +x to the right, z up looks from -y, and a negative
+   axis turns the picture upside down. */
+static void up_axis_from(const double direction[3], up_axis *axis)
 {
-    int index, sign;
-    if (parse_axis_name(text, &index, &sign) != 0) return -1;
-    switch (index) {
-    case 1: /* y up, looking from +z */
-        axis->up = vec3_make(0, 1, 0); axis->side = vec3_make(1, 0, 0); axis->front = vec3_make(0, 0, 1); break;
-    case 2: /* z up, looking from -y */
-        axis->up = vec3_make(0, 0, 1); axis->side = vec3_make(1, 0, 0); axis->front = vec3_make(0, -1, 0); break;
-    default: /* x up, looking from +z */
-        axis->up = vec3_make(1, 0, 0); axis->side = vec3_make(0, -1, 0); axis->front = vec3_make(0, 0, 1); break;
-    }
-    if (sign < 0) {   /* upside down: turn the frame half a turn about `front` */
-        axis->up = vec3_scale(axis->up, -1.0f);
-        axis->side = vec3_scale(axis->side, -1.0f);
-    }
-    return 0;
+    vec3 up = vec3_normalize(vec3_make((float)direction[0], (float)direction[1], (float)direction[2]));
+    vec3 front = fabsf(up.z) > fabsf(up.x) && fabsf(up.z) > fabsf(up.y) ? vec3_make(0, -1, 0) : vec3_make(0, 0, 1);
+    front = vec3_normalize(vec3_sub(front, vec3_scale(up, vec3_dot(front, up))));
+    axis->up = up;
+    axis->front = front;
+    axis->side = vec3_cross(up, front);
 }
 
 /* Orbit: yaw turns the camera around the up axis, pitch raises it above the
@@ -965,7 +961,7 @@ static void print_render_help(void)
            "  --yaw DEG     turn the camera around the model's up axis (default 30)\n"
            "  --pitch DEG   raise the camera above the model, -89 to 89 (default 20)\n"
            "  --up AXIS     the model's up axis: y (default, usual for OBJ), z (usual for CAD\n"
-           "                and scans), x, -y, -z or -x\n"
+           "                and scans), x, -y, -z or -x, or a direction X,Y,Z\n"
            "  --zoom F      magnify the view F times, 0.1 to 100 (default 1: the whole model)\n"
            "  --wireframe   draw the edges of the mesh's faces over the surface\n"
            "  --no-materials  draw every face with TEXTURE, whatever its material names\n",
@@ -991,8 +987,7 @@ int cmd_render(int argc, char **argv)
     float radius;
     int bad_vertex = -1;
     up_axis axis;
-
-    parse_up_axis("y", &axis);
+    double up[3] = {0.0, 1.0, 0.0};   /* y up, usual for OBJ */
 
     for (i = 1; i < argc; i++) {
         const char *value;
@@ -1012,9 +1007,7 @@ int cmd_render(int argc, char **argv)
         } else if (strcmp(argv[i], "--no-materials") == 0) {
             use_materials = 0;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
-            if (parse_up_axis(value, &axis) != 0)
-                return value ? tool_usage("--up wants x, y, z, -x, -y or -z, got '%s'", value)
-                             : tool_usage("--up needs a value");
+            if (parse_up("--up", value, up) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
         } else if (npositional < 3) {
@@ -1025,6 +1018,7 @@ int cmd_render(int argc, char **argv)
     }
     if (npositional < 3)
         return tool_usage("needs MESH.obj TEXTURE OUT.png (see 'tiledtex render --help')");
+    up_axis_from(up, &axis);
 
     memset(&textures, 0, sizeof textures);
     memset(&s, 0, sizeof s);

@@ -155,6 +155,10 @@ int tool_option(int argc, char **argv, int *index, const char *name, const char 
    a message for anything else (NULL included), so that the caller can say
    what else it accepts. */
 int parse_axis_name(const char *text, int *axis, int *sign);
+/* --up and the like: an axis name (parse_axis_name) or a nonzero direction
+   X,Y,Z, into up[3] (an axis becomes a unit vector, a direction is kept as
+   given). Prints the error and returns -1 otherwise. */
+int parse_up(const char *option, const char *text, double up[3]);
 /* An integer in [min, max]: "tiledtex CMD: --seed wants an integer from 0 to 9, got 'x'". */
 int parse_int(const char *option, const char *text, int min, int max, int *out);
 /* An unsigned 64-bit integer (seeds), decimal or 0x hexadecimal. */

@@ -1899,6 +1899,27 @@ check "tile: seam score names the edges measured" "'seam score X (N of M edges'"
 cd "$W" || exit 1
 
 # ======================================================================
+# Command-line conventions (issue 11, item 5)
+# ======================================================================
+# --up: an axis name or X,Y,Z wherever it exists, the same meaning in both forms
+newdir
+expect_ok "render --up z" render ../in/torus.obj ../in/tex.png z.png --size 48x48 --up z
+expect_ok "render --up 0,0,3" render ../in/torus.obj ../in/tex.png zv.png --size 48x48 --up 0,0,3
+CMD="cmp z.png zv.png"
+check "render --up 0,0,3 draws what --up z does" "identical PNGs" "$(cmp z.png zv.png 2>&1)" \
+    "$(cmp -s z.png zv.png; echo $?)"
+expect_ok "render --up 1,1,0 (a slanted up)" render ../in/torus.obj ../in/tex.png s.png --size 48x48 --up 1,1,0
+expect_ok "lapped --up z" lapped ../in/torus.obj ../in/lap.png a --scale 1.5 --up z
+expect_ok "lapped --up 0,0,1" lapped ../in/torus.obj ../in/lap.png b --scale 1.5 --up 0,0,1
+CMD="cmp a.obj b.obj (but the mtllib line)"
+check "lapped --up z pastes as --up 0,0,1" "identical OBJs" "$(diff <(grep -v mtllib a.obj 2>&1) <(grep -v mtllib b.obj 2>&1) | head -3)" \
+    "$(cmp -s <(grep -v mtllib a.obj 2>/dev/null) <(grep -v mtllib b.obj 2>/dev/null) && [ -s a.obj ]; echo $?)"
+cd "$W" || exit 1
+expect_usage_error "render --up w" render ../in/torus.obj ../in/tex.png v.png --up w
+expect_usage_error "render --up 0,0,0" render ../in/torus.obj ../in/tex.png v.png --up 0,0,0
+expect_usage_error "lapped --up w" lapped ../in/torus.obj ../in/lap.png out --up w
+
+# ======================================================================
 # Sanitizers
 # ======================================================================
 CMD="all $RUNS runs"
