@@ -42,12 +42,14 @@ static void print_help(void)
     int i;
     printf("tiledtex %s - texture any mesh from one example image, without seams or visible repetition\n\n",
            TILEDTEX_VERSION_STRING);
-    printf("usage: tiledtex [--max-pixels N] COMMAND [ARGUMENTS]\n\ncommands:\n");
+    printf("usage: tiledtex [--max-pixels N] COMMAND [ARGUMENTS]\n"
+           "       tiledtex --version\n\ncommands:\n");
     for (i = 0; i < SUBCOMMAND_COUNT; i++) printf("  %-9s %s\n", subcommands[i].name, subcommands[i].summary);
-    printf("\nglobal option (before or after the command):\n"
+    printf("\nglobal options (before or after the command):\n"
            "  --max-pixels N  refuse images of more than N pixels, checked before decoding them\n"
            "                  (default %d = 4096x4096). Peak memory per input pixel:\n"
-           "                  lapped needs about 32 bytes, tile and synth about 17\n",
+           "                  lapped needs about 32 bytes, tile and synth about 17\n"
+           "  -V, --version   print the version and exit\n",
            TOOL_DEFAULT_MAX_PIXELS);
     printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
            "Try it: tiledtex generate mesh torus.obj --shape torus\n"
@@ -101,7 +103,7 @@ int main(int argc, char **argv)
         print_help();
         return 0;
     }
-    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
+    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "-V") == 0 || strcmp(argv[1], "version") == 0) {
         printf("tiledtex %s\n", TILEDTEX_VERSION_STRING);
         return 0;
     }
@@ -114,7 +116,8 @@ int main(int argc, char **argv)
             return 0;
         }
         command = find_subcommand(argv[2]);
-        if (!command) return tool_fail("no command called '%s' (try 'tiledtex --help')", argv[2]);
+        /* A bad command line like any other: the usage status. */
+        if (!command) return tool_usage("no command called '%s' (try 'tiledtex --help')", argv[2]);
         help_argv[0] = argv[2];
         help_argv[1] = help_flag;
         help_argv[2] = NULL;

@@ -1919,6 +1919,18 @@ expect_usage_error "render --up w" render ../in/torus.obj ../in/tex.png v.png --
 expect_usage_error "render --up 0,0,0" render ../in/torus.obj ../in/tex.png v.png --up 0,0,0
 expect_usage_error "lapped --up w" lapped ../in/torus.obj ../in/lap.png out --up w
 
+# help for a command that does not exist is a usage error like any other
+expect_usage_error "help nosuch" help nosuch
+err_mentions "help nosuch: names it" "nosuch"
+
+# -V and --version print the header's version and exit 0
+VERSION=$(sed -n 's/^#define TILEDTEX_VERSION_STRING "\(.*\)"$/\1/p' "$ROOT/tiledtex.h")
+for flag in -V --version; do
+    run $flag
+    check "$flag prints the version" "exit 0, stdout 'tiledtex $VERSION'" "exit $RC, stdout: $OUT, stderr: $ERR" \
+        "$([ $RC -eq 0 ] && [ "$OUT" = "tiledtex $VERSION" ] && [ -n "$VERSION" ]; echo $?)"
+done
+
 # ======================================================================
 # Sanitizers
 # ======================================================================
