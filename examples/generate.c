@@ -319,7 +319,7 @@ static int generate_texture(int argc, char **argv)
     if (output_add_png(&output, path, image, TT_COLOR_SRGB, err, sizeof err) != 0 ||
         output_commit(&output, err, sizeof err) != 0)
         status = tool_fail("%s", err);
-    else
+    else if (!tool_quiet())
         printf("wrote %s (%dx%d stones, seed %llu)\n", path, size, size, (unsigned long long)seed);
     output_free(&output);
     tt_image_free(image);
@@ -1018,7 +1018,7 @@ static int generate_mesh(int argc, char **argv)
         tool_fail("%s", err);
         goto done;
     }
-    printf("wrote %s: %s\n", path, summary);
+    if (!tool_quiet()) printf("wrote %s: %s\n", path, summary);
     status = 0;
 done:
     buffer_free(&text);

@@ -325,7 +325,7 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
-    if (status == 0) {
+    if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, image, &report, &quality, tool_seconds_now() - start);
         printf("wrote %s, %s\n", obj_path, mtl_path);
     }

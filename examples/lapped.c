@@ -1062,7 +1062,7 @@ int cmd_lapped(int argc, char **argv)
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
-    if (status == 0) {
+    if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, field, lapped, &baked, tool_seconds_now() - start);
         print_patch_use(&patches, lapped);
         printf("wrote %s, %s, %s", obj_path, mtl_path, patches.png_paths[0]);

@@ -118,7 +118,8 @@ int cmd_map(int argc, char **argv)
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
         tiled_print_notes(positional[0], &mesh);
-        tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL, options.report);
+        if (!tool_quiet())
+            tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL, options.report);
     }
 done:
     output_free(&output);

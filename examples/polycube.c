@@ -535,7 +535,7 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = add_surface_obj(&output, surface_path, tool_basename(mtl_path), &job);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
-    if (status == 0) {
+    if (status == 0 && !tool_quiet()) {
         print_summary(&options, &job, &quality);
         printf("wrote %s, %s, %s, %s\n", obj_path, mtl_path, png_path, surface_path);
     }

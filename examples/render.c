@@ -1066,7 +1066,7 @@ int cmd_render(int argc, char **argv)
         tool_fail("%s", err);
         goto done;
     }
-    printf("wrote %s (%dx%d, %d triangles)\n", positional[2], width, height, s.ntriangles);
+    if (!tool_quiet()) printf("wrote %s (%dx%d, %d triangles)\n", positional[2], width, height, s.ntriangles);
     status = 0;
 
 done:

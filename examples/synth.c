@@ -61,7 +61,7 @@ int cmd_synth(int argc, char **argv)
     image = NULL;
     if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
-    if (status == 0) {
+    if (status == 0 && !tool_quiet()) {
         printf("%s: %dx%d atlas of %d tiles (n=%d, %d texels, gutter %d) from %s; edge windows",
                positional[1], tiles->levels[0].width, tiles->levels[0].height,
                tt_tile_layout_tile_count(&tiles->layout), tiles->layout.colors, tiles->layout.tile_size,

@@ -91,9 +91,11 @@ int cmd_tile(int argc, char **argv)
     if (status == 0) {
         /* Said only on success: a failing command prints its one error line. */
         tiled_print_notes(positional[0], &mesh);
-        tiled_print_summary(positional[0], &mesh, &seams, options.report);
-        printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
-               tiles->levels[0].height);
+        if (!tool_quiet()) {
+            tiled_print_summary(positional[0], &mesh, &seams, options.report);
+            printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
+                   tiles->levels[0].height);
+        }
     }
     output_free(&output);
     tiled_mesh_free(&mesh);

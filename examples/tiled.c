@@ -262,6 +262,8 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
         if (mesh->input_max_face_size == 3) snprintf(sizes, sizeof sizes, "triangles");
         else snprintf(sizes, sizeof sizes, "faces of %d to %d corners", mesh->input_min_face_size,
                       mesh->input_max_face_size);
+        /* Like the notes: nothing but errors under --quiet. */
+        if (tool_quiet()) return;
         fprintf(stderr, "tiledtex: %s has %s: quadrangulated %d face%s into %d quads\n", obj_path, sizes,
                 mesh->input_faces, mesh->input_faces == 1 ? "" : "s", mesh->quadrangulated);
         /* Each triangle becomes three kite-shaped quads, each showing a

@@ -42,13 +42,14 @@ static void print_help(void)
     int i;
     printf("tiledtex %s - texture any mesh from one example image, without seams or visible repetition\n\n",
            TILEDTEX_VERSION_STRING);
-    printf("usage: tiledtex [--max-pixels N] COMMAND [ARGUMENTS]\n"
+    printf("usage: tiledtex [--max-pixels N] [--quiet] COMMAND [ARGUMENTS]\n"
            "       tiledtex --version\n\ncommands:\n");
     for (i = 0; i < SUBCOMMAND_COUNT; i++) printf("  %-9s %s\n", subcommands[i].name, subcommands[i].summary);
     printf("\nglobal options (before or after the command):\n"
            "  --max-pixels N  refuse images of more than N pixels, checked before decoding them\n"
            "                  (default %d = 4096x4096). Peak memory per input pixel:\n"
            "                  lapped needs about 32 bytes, tile and synth about 17\n"
+           "  -q, --quiet     print nothing but errors: no summary, progress line or warning\n"
            "  -V, --version   print the version and exit\n",
            TOOL_DEFAULT_MAX_PIXELS);
     printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
@@ -77,6 +78,8 @@ static int take_global_options(int *argc, char **argv)
         if (tool_option(*argc, argv, &i, "--max-pixels", &value)) {
             max_pixels = value;
             given = 1;
+        } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
+            tool_set_quiet(1);
         } else {
             argv[kept++] = argv[i];
         }

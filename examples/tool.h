@@ -76,6 +76,11 @@ int cmd_generate(int argc, char **argv);
 void tool_set_command(const char *name);
 const char *tool_command(void);
 
+/* --quiet (a global option main takes): commands print nothing but errors:
+   no summary, no progress line, no note (tool_print_notes). */
+void tool_set_quiet(int quiet);
+int tool_quiet(void);
+
 /* Print "tiledtex: <message>" on stderr and return TOOL_EXIT_FAILURE, so a
    command can write `return tool_fail("cannot ...");`. */
 int tool_fail(const char *format, ...)

@@ -31,6 +31,12 @@ static const char *tool_command_name = NULL;
 void tool_set_command(const char *name) { tool_command_name = name; }
 const char *tool_command(void) { return tool_command_name; }
 
+/* --quiet, set once by main like the command name above. */
+static int tool_quiet_flag = 0;
+
+void tool_set_quiet(int quiet) { tool_quiet_flag = quiet; }
+int tool_quiet(void) { return tool_quiet_flag; }
+
 static void print_error_line(const char *prefix_command, const char *format, va_list args)
 {
     /* Format into a buffer first so the line reaches stderr in one piece, and
@@ -81,7 +87,7 @@ void tool_note(const char *format, ...)
 void tool_print_notes(void)
 {
     int i;
-    for (i = 0; i < tool_note_count; i++) {
+    for (i = 0; i < tool_note_count && !tool_quiet_flag; i++) {
         char *c;
         for (c = tool_notes[i]; *c; c++)
             if (*c == '\n' || *c == '\r') *c = ' ';
@@ -581,7 +587,8 @@ void tool_progress_begin(tool_progress *progress, const char *activity, const ch
     progress->activity = activity;
     progress->what = what;
     progress->start = tool_seconds_now();
-    progress->terminal = isatty(STDERR_FILENO);
+    /* --quiet: never a progress line, whatever stderr is. */
+    progress->terminal = !tool_quiet() && isatty(STDERR_FILENO);
 }
 
 int tool_show_progress(float fraction, void *user_data)

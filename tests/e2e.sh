@@ -1919,6 +1919,31 @@ expect_usage_error "render --up w" render ../in/torus.obj ../in/tex.png v.png --
 expect_usage_error "render --up 0,0,0" render ../in/torus.obj ../in/tex.png v.png --up 0,0,0
 expect_usage_error "lapped --up w" lapped ../in/torus.obj ../in/lap.png out --up w
 
+# --quiet (or -q, before or after the command): nothing but errors - no
+# summary on stdout, no progress, report or warning line on stderr; the
+# files are still written.
+quiet_case() {
+    local what=$1 file=$2
+    shift 2
+    newdir
+    run "$@"
+    check "$what: silent" "exit 0, nothing on stdout or stderr, $file written" \
+        "exit $RC, stdout: $OUT, stderr: $ERR, files: $(ls | tr '\n' ' ')" \
+        "$([ $RC -eq 0 ] && [ -z "$OUT" ] && [ -z "$ERR" ] && [ -s "$file" ]; echo $?)"
+    cd "$W" || exit 1
+}
+quiet_case "tile --quiet (triangles: the quadrangulation line too)" o.png tile ../in/spheretri.obj ../in/tex.png o --quiet
+quiet_case "-q lapped" o.obj -q lapped ../in/torus.obj ../in/lap.png o --scale 1.5
+quiet_case "hpm -q" o.obj hpm ../in/torus.obj ../in/lap.png o -q
+quiet_case "polycube --quiet" o.png polycube ../in/spheretri.obj ../in/tex.png o --resolution 4 --quiet
+quiet_case "synth --quiet" a.png synth ../in/tex.png a.png --quiet
+quiet_case "map --quiet" o.obj map ../in/torus.obj o.obj --quiet
+quiet_case "render --quiet" v.png render ../in/torus.obj ../in/tex.png v.png --size 32x32 --quiet
+quiet_case "generate texture --quiet" t.png --quiet generate texture t.png --size 32
+quiet_case "generate mesh -q" m.obj generate mesh m.obj --shape torus -q
+expect_error "--quiet still prints errors" --quiet tile ../in/nope.obj ../in/tex.png out
+err_mentions "--quiet still prints errors: names the file" 'nope\.obj'
+
 # help for a command that does not exist is a usage error like any other
 expect_usage_error "help nosuch" help nosuch
 err_mentions "help nosuch: names it" "nosuch"
