@@ -33,20 +33,57 @@ int tool_unknown_option(const char *arg)
     return tool_usage("unknown option '%s' (see '%s --help')", arg, TOOL_NAME);
 }
 
+/* Extensions an output prefix may end with by mistake: the files the
+   commands write, and the glTF a user may expect from a mesh tool. */
+static const char *const output_extensions[] = {".obj", ".mtl", ".png", ".glb", ".gltf"};
+
+static int ends_with_ignoring_case(const char *text, size_t length, const char *ending)
+{
+    size_t n = strlen(ending), i;
+    if (length < n) return 0;
+    for (i = 0; i < n; i++)
+        if (tolower((unsigned char)text[length - n + i]) != tolower((unsigned char)ending[i])) return 0;
+    return 1;
+}
+
+int tool_output_prefix(const char *text, char *prefix)
+{
+    size_t length = strlen(text), k;
+    if (strcmp(text, "-") == 0)
+        return tool_usage("OUT_PREFIX cannot be '-' (standard output): it names several files; give a name such as 'out'");
+    if (length + 16 > TOOL_PREFIX_SIZE) return tool_usage("OUT_PREFIX is too long");
+    for (k = 0; k < sizeof output_extensions / sizeof output_extensions[0]; k++) {
+        /* Only when something is left of the name: ".obj" alone stays a name. */
+        if (ends_with_ignoring_case(text, length, output_extensions[k]) &&
+            length - strlen(output_extensions[k]) > (size_t)(tool_basename(text) - text)) {
+            length -= strlen(output_extensions[k]);
+            break;
+        }
+    }
+    memcpy(prefix, text, length);
+    prefix[length] = '\0';
+    if (tool_basename(prefix)[0] == '\0')
+        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'", text, text);
+    return 0;
+}
+
 int tool_mesh_image_prefix(const char *const *positional, int npositional, const char **mesh, const char **image,
-                           const char **prefix)
+                           char *prefix)
 {
     const char *command = tool_command() ? tool_command() : "CMD";
     if (npositional > 3) return tool_usage("too many arguments (see '%s %s --help')", TOOL_NAME, command);
     if (npositional < 3)
         return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see '%s %s --help')", TOOL_NAME, command);
-    if (strlen(positional[2]) + 16 > 4096) return tool_usage("OUT_PREFIX is too long");
-    if (tool_basename(positional[2])[0] == '\0')
-        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",
-                          positional[2], positional[2]);
+    if (tool_output_prefix(positional[2], prefix) != 0) return TOOL_EXIT_USAGE;
     *mesh = positional[0];
     *image = positional[1];
-    *prefix = positional[2];
+    return 0;
+}
+
+int tool_refuse_stdout(const char *path, int several, const char *what)
+{
+    if (several && strcmp(path, "-") == 0)
+        return tool_usage("%s cannot be '-' (standard output): that makes several files; give a file name", what);
     return 0;
 }
 

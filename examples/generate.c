@@ -272,6 +272,7 @@ static void print_generate_help(void)
 {
     printf("usage: tiledtex generate texture OUT.png [--size N] [--seed K]\n"
            "       tiledtex generate mesh OUT.obj --shape NAME [--triangles]\n"
+           "OUT.png or OUT.obj may be '-': the file goes to the standard output.\n"
            "\n"
            "texture: a photograph-like pavement of rounded stones that never repeats, N x N pixels\n"
            "         (default %d, at most %d); --seed K picks another pavement (default 1).\n"

@@ -37,6 +37,8 @@ static void print_help(void)
            "where it is. Look at it with 'tiledtex render OUT_PREFIX.obj IMAGE view.png'.\n"
            "Faces with more than 3 corners are split into triangle fans first. The mesh must be\n"
            "manifold and consistently oriented.\n"
+           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png, .glb or .gltf\n"
+           "loses it ('out.obj' writes out.obj, not out.obj.obj). It cannot be '-'.\n"
            "\n"
            "options:\n"
            "  --scale X        mesh units covered by the image's width (default: a quarter of the\n"
@@ -72,7 +74,8 @@ static void print_help(void)
 }
 
 typedef struct hpm_command_options {
-    const char *mesh_path, *image_path, *prefix;
+    const char *mesh_path, *image_path;
+    char prefix[TOOL_PREFIX_SIZE];  /* OUT_PREFIX without a known extension */
     tt_hpm_options map;     /* zero fields: the library's defaults */
 } hpm_command_options;
 
@@ -130,7 +133,7 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
         }
     }
     if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
-                               &options->prefix) != 0)
+                               options->prefix) != 0)
         return TOOL_EXIT_USAGE;
     return -1;
 }

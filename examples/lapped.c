@@ -77,6 +77,8 @@ static void print_help(void)
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
            "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
            "--permissive.\n"
+           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png, .glb or .gltf\n"
+           "loses it ('out.obj' writes out.obj, not out.obj.obj). It cannot be '-'.\n"
            "\n");
     /* Two pieces: C99 compilers need only take string literals of 4095 bytes. */
     printf("options:\n"
@@ -148,7 +150,8 @@ static void print_help(void)
 typedef enum bake_uv_choice { BAKE_UV_AUTO = 0, BAKE_UV_MESH, BAKE_UV_ATLAS } bake_uv_choice;
 
 typedef struct lapped_options {
-    const char *mesh_path, *image_path, *prefix;
+    const char *mesh_path, *image_path;
+    char prefix[TOOL_PREFIX_SIZE];  /* OUT_PREFIX without a known extension */
     float scale;                    /* 0 = the library's default */
     uint64_t seed;
     float up[3];
@@ -220,7 +223,7 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
         }
     }
     if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
-                               &options->prefix) != 0)
+                               options->prefix) != 0)
         return TOOL_EXIT_USAGE;
     return -1;
 }

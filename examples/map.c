@@ -27,6 +27,7 @@ static void print_help(void)
            "texture coordinate per face corner. Triangles and n-gons are quadrangulated\n"
            "first (each n-gon into n quads). The UVs fit any atlas that `tiledtex synth`\n"
            "makes with the same --colors, --tile and --gutter.\n"
+           "OUT.obj may be '-' (the standard output), but not with --atlas, which adds OUT.mtl.\n"
            "\n"
            "options:\n"
            "  --colors N       edge conditions n; the atlas holds (2n)^4 tiles (default 1)\n"
@@ -91,6 +92,8 @@ int cmd_map(int argc, char **argv)
                                       TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION,
                                       &options, positional, 2, "MESH.obj and OUT.obj", print_help);
     if (status >= 0) return status;
+    if ((status = tool_refuse_stdout(positional[1], options.atlas_path != NULL, "OUT.obj with --atlas")) != 0)
+        return status;
 
     if (options.atlas_path && (status = load_atlas_for_layout(options.atlas_path, &options, &atlas)) != 0)
         return status;

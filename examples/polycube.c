@@ -51,6 +51,8 @@ static void print_help(void)
            "OUT_PREFIX.mtl, OUT_PREFIX.png (the atlas) and OUT_PREFIX_polycube.obj (the polycube's\n"
            "surface with its tiles). Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX.png\n"
            "view.png'.\n"
+           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png, .glb or .gltf\n"
+           "loses it ('out.obj' writes out.obj, not out.obj.obj). It cannot be '-'.\n"
            "\n"
            "options:\n"
            "  --resolution N   cubes along the mesh's longest side, 1 to %d (default %d)\n"
@@ -85,7 +87,8 @@ static void print_help(void)
 }
 
 typedef struct polycube_command_options {
-    const char *mesh_path, *image_path, *prefix;
+    const char *mesh_path, *image_path;
+    char prefix[TOOL_PREFIX_SIZE];  /* OUT_PREFIX without a known extension */
     tiled_options tiles;            /* --colors --tile --gutter --seed, as `tile` takes them */
     tt_polycube_options build;      /* zero fields: the library's defaults */
     int plain;                      /* --no-upright */
@@ -137,7 +140,7 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
         return tool_usage("give --resolution or --cube-size, not both (both set the cubes' size)");
     if (options->tiles.layout.colors == 0) options->tiles.layout.colors = POLYCUBE_DEFAULT_COLORS;
     if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
-                               &options->prefix) != 0)
+                               options->prefix) != 0)
         return TOOL_EXIT_USAGE;
     return -1;
 }

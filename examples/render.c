@@ -939,6 +939,7 @@ done:
 static void print_render_help(void)
 {
     printf("usage: tiledtex render MESH.obj TEXTURE OUT.png [--size WxH] [--yaw DEG] [--pitch DEG] [--up AXIS]\n"
+           "OUT.png may be '-': the PNG goes to the standard output.\n"
            "                       [--zoom F] [--wireframe] [--no-materials]\n"
            "\n"
            "Draw MESH with TEXTURE (PNG, JPEG, TGA, BMP, ...) applied through the mesh's per-corner\n"

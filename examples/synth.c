@@ -22,6 +22,7 @@ static void print_help(void)
            "\n"
            "Make a tiled-texture atlas of (2n)^4 tiles from IMAGE (PNG, JPEG, TGA, BMP, ...).\n"
            "Tiles meet seamlessly in any arrangement `tiledtex map` gives them.\n"
+           "ATLAS.png may be '-' (the standard output), but not with --mips.\n"
            "\n"
            "options:\n"
            "  --colors N             edge conditions n (default 1: 16 tiles; 2: 256 tiles)\n"
@@ -52,6 +53,7 @@ int cmd_synth(int argc, char **argv)
                                       "IMAGE and ATLAS.png", print_help);
     if (status >= 0) return status;
 
+    if ((status = tool_refuse_stdout(positional[1], options.mips, "ATLAS.png with --mips")) != 0) return status;
     if ((status = tiled_check_atlas_size(&options)) != 0) return status;
     /* A photo: sRGB in the file, linear light in the library. */
     if (image_load(positional[0], TT_COLOR_SRGB, &image, message, sizeof message) != 0)

@@ -19,6 +19,8 @@ static void print_help(void)
            "and OUT_PREFIX.png (the tile atlas). Triangles and n-gons are quadrangulated\n"
            "first; each quad shows one tile, so --subdivide makes the texture smaller on the\n"
            "surface.\n"
+           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png, .glb or .gltf\n"
+           "loses it ('out.obj' writes out.obj, not out.obj.obj). It cannot be '-'.\n"
            "\n"
            "options:\n"
            "  --colors N             edge conditions n; (2n)^4 tiles (default 1)\n"
@@ -46,7 +48,7 @@ int cmd_tile(int argc, char **argv)
     tt_tileset *tiles = NULL;
     tool_seams seams;
     tool_output output;
-    char message[TOOL_ERROR_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
+    char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
 
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
@@ -54,13 +56,10 @@ int cmd_tile(int argc, char **argv)
                                       TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS | TILED_REPORT_OPTION,
                                       &options, positional, 3, "MESH.obj, IMAGE and OUT_PREFIX", print_help);
     if (status >= 0) return status;
-    if (strlen(positional[2]) + 8 > sizeof obj_path) return tool_usage("OUT_PREFIX is too long");
-    if (tool_basename(positional[2])[0] == '\0')
-        return tool_usage("OUT_PREFIX '%s' names a directory: give a name for the files, such as '%sout'",
-                          positional[2], positional[2]);
-    snprintf(obj_path, sizeof obj_path, "%s.obj", positional[2]);
-    snprintf(mtl_path, sizeof mtl_path, "%s.mtl", positional[2]);
-    snprintf(png_path, sizeof png_path, "%s.png", positional[2]);
+    if (tool_output_prefix(positional[2], prefix) != 0) return TOOL_EXIT_USAGE;
+    snprintf(obj_path, sizeof obj_path, "%s.obj", prefix);
+    snprintf(mtl_path, sizeof mtl_path, "%s.mtl", prefix);
+    snprintf(png_path, sizeof png_path, "%s.png", prefix);
 
     /* A photo: its 8-bit values are sRGB, the library works in linear light. */
     if (image_load(positional[1], TT_COLOR_SRGB, &image, message, sizeof message) != 0)

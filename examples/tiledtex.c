@@ -50,7 +50,10 @@ static void print_help(void)
            "                  (default %d = 4096x4096). Peak memory per input pixel:\n"
            "                  lapped needs about 32 bytes, tile and synth about 17\n"
            "  -q, --quiet     print nothing but errors: no summary, progress line or warning\n"
-           "  -V, --version   print the version and exit\n",
+           "  -V, --version   print the version and exit\n"
+           "\nOUT_PREFIX may end in .obj (or .mtl, .png, .glb, .gltf), which is taken off; an\n"
+           "output of exactly one file (render, generate, synth, map without --atlas) may be\n"
+           "'-' for the standard output.\n",
            TOOL_DEFAULT_MAX_PIXELS);
     printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
            "Try it: tiledtex generate mesh torus.obj --shape torus\n"

@@ -77,7 +77,9 @@ void tool_set_command(const char *name);
 const char *tool_command(void);
 
 /* --quiet (a global option main takes): commands print nothing but errors:
-   no summary, no progress line, no note (tool_print_notes). */
+   no summary, no progress line, no note (tool_print_notes). tool_quiet()
+   is also true once the one output went to the standard output ("-"),
+   which a summary would corrupt; the notes still print then, on stderr. */
 void tool_set_quiet(int quiet);
 int tool_quiet(void);
 
@@ -141,12 +143,25 @@ int tool_is_help(const char *arg);
 int tool_is_option(const char *arg);
 /* Report "unknown option '--foo' (see 'tiledtex CMD --help')"; returns TOOL_EXIT_USAGE. */
 int tool_unknown_option(const char *arg);
+/* Room for an OUT_PREFIX: tool_output_prefix refuses longer ones, leaving
+   room for the longest name a command adds ("_polycube.obj", "_patch_12.png"). */
+#define TOOL_PREFIX_SIZE 4000
+/* OUT_PREFIX as given into `prefix` (TOOL_PREFIX_SIZE bytes), less a known
+   extension (.obj, .mtl, .png, .glb, .gltf, any case): "out.obj" means
+   out.obj + out.mtl + out.png, not out.obj.obj. Refuses "-" (the prefix
+   names several files, standard output takes one), a directory and a too
+   long prefix: prints the error and returns TOOL_EXIT_USAGE; 0 otherwise. */
+int tool_output_prefix(const char *text, char *prefix);
 /* The three arguments MESH.obj IMAGE OUT_PREFIX of the commands that read a
-   mesh and an image: checks there are exactly three and that OUT_PREFIX
-   names files (not a directory, not too long), reporting it otherwise
-   (returns TOOL_EXIT_USAGE); 0 with the three set. */
+   mesh and an image: checks there are exactly three and reads OUT_PREFIX
+   with tool_output_prefix, reporting a problem (returns TOOL_EXIT_USAGE);
+   0 with the three set. */
 int tool_mesh_image_prefix(const char *const *positional, int npositional, const char **mesh, const char **image,
-                           const char **prefix);
+                           char *prefix);
+/* Refuse "-" for `path` when the command writes several files this time
+   (the standard output takes one): prints a usage error about `what`
+   ("OUT.obj with --atlas") and returns TOOL_EXIT_USAGE; 0 otherwise. */
+int tool_refuse_stdout(const char *path, int several, const char *what);
 
 /* If argv[*index] is `name` ("--size"), consume its value - the next argument,
    or the text after '=' in "--size=800x600" - into *value, advance *index past
@@ -194,9 +209,10 @@ int tool_read_file(const char *path, unsigned char **data, size_t *size, char *e
 /* tool_read_file remembers every regular file it read (device and inode,
    which catches "./m.obj" for "m.obj" and hard links). An output path that
    is a directory or is one of those inputs gives -1 and the reason in err;
-   a path that does not exist yet is fine. output_commit checks every
-   output; a command may check its outputs earlier, before a long
-   computation, with tool_refuse_input_overwrite (prints the error, returns
+   a path that does not exist yet is fine, and so is "-" (the standard
+   output). output_commit checks every output; a command may check its
+   outputs earlier, before a long computation, with
+   tool_refuse_input_overwrite (prints the error, returns
    TOOL_EXIT_FAILURE, or 0 when the path is fine). */
 int tool_check_output_path(const char *path, char *err, size_t err_size);
 int tool_refuse_input_overwrite(const char *path);
@@ -260,7 +276,10 @@ int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer
    created are removed, as is every file already renamed in this commit, so
    the command leaves no output at all; no other path is ever removed.
    Returns 0 or -1 with the reason in err. The batch stays valid; free it with
-   output_free. */
+   output_free.
+   A batch of one file whose path is "-" goes to the standard output instead
+   (and tool_quiet() is then true: no summary after the data); "-" in a
+   batch of several is refused. */
 int output_commit(tool_output *output, char *err, size_t err_size);
 void output_free(tool_output *output);
 

@@ -31,11 +31,14 @@ static const char *tool_command_name = NULL;
 void tool_set_command(const char *name) { tool_command_name = name; }
 const char *tool_command(void) { return tool_command_name; }
 
-/* --quiet, set once by main like the command name above. */
+/* --quiet, set once by main like the command name above; and whether the
+   standard output carries the command's one output file, which silences
+   the summary but not the notes on stderr. */
 static int tool_quiet_flag = 0;
+static int tool_stdout_taken = 0;
 
 void tool_set_quiet(int quiet) { tool_quiet_flag = quiet; }
-int tool_quiet(void) { return tool_quiet_flag; }
+int tool_quiet(void) { return tool_quiet_flag || tool_stdout_taken; }
 
 static void print_error_line(const char *prefix_command, const char *format, va_list args)
 {
@@ -197,6 +200,7 @@ int tool_check_output_path(const char *path, char *err, size_t err_size)
 {
     struct stat info;
     int i;
+    if (strcmp(path, "-") == 0) return 0;      /* standard output: never a file on disk */
     if (stat(path, &info) != 0) return 0;      /* does not exist (yet): cannot be an input */
     if (S_ISDIR(info.st_mode)) {
         tool_set_error(err, err_size, "cannot write '%s': it is a directory", path);
@@ -502,11 +506,35 @@ static int write_whole_file(FILE *file, const unsigned char *data, size_t size)
     return ok ? 0 : -1;
 }
 
+/* The one output file as the standard output ("-"). The summary a command
+   prints next would land in the middle of the data, so it is silenced as if
+   by --quiet. */
+static int write_standard_output(const void *data, size_t size, char *err, size_t err_size)
+{
+    tool_stdout_taken = 1;
+    if ((size > 0 && fwrite(data, 1, size, stdout) != size) || fflush(stdout) != 0) {
+        tool_set_error(err, err_size, "cannot write to the standard output: %s", strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
 int output_commit(tool_output *output, char *err, size_t err_size)
 {
     char **temporaries;     /* the temporaries this commit created (NULL: none for that file) */
     int renamed = 0, i, failed = 0;
     if (output->count == 0) return 0;
+    for (i = 0; i < output->count; i++) {
+        if (strcmp(output->files[i].path, "-") != 0) continue;
+        /* Commands refuse "-" on their command line when they write several
+           files; this is the backstop, so that no file called "-" appears. */
+        if (output->count != 1) {
+            tool_set_error(err, err_size, "'-' (standard output) can take only one file, and this command writes %d",
+                           output->count);
+            return -1;
+        }
+        return write_standard_output(output->files[0].data, output->files[0].size, err, err_size);
+    }
     /* Before anything is written: no output may name a directory, or the
        same file as one of the command's inputs. */
     for (i = 0; i < output->count; i++) {

@@ -64,7 +64,7 @@ run() {
     RUNS=$((RUNS + 1))
     timeout 60 "$TOOL" "$@" >"$W/out" 2>"$W/err" </dev/null
     RC=$?
-    OUT=$(cat "$W/out")
+    OUT=$(tr -d '\000' <"$W/out")   # binary output ("-") holds NUL bytes
     ERR=$(cat "$W/err")
     if grep -qE 'ERROR: (AddressSanitizer|LeakSanitizer)|runtime error:|SUMMARY: [A-Za-z]*Sanitizer' "$W/err"; then
         SANITIZER_REPORTS=$((SANITIZER_REPORTS + 1))
@@ -1901,6 +1901,52 @@ cd "$W" || exit 1
 # ======================================================================
 # Command-line conventions (issue 11, item 5)
 # ======================================================================
+# An OUT_PREFIX ending in a known extension loses it: "out.obj" writes
+# out.obj + out.mtl, never out.obj.obj, in every command that takes a prefix.
+prefix_case() {
+    local what=$1 expect=$2
+    shift 2
+    newdir
+    expect_ok "$what" "$@"
+    CMD="ls after tiledtex $*"
+    check "$what: writes $expect" "$expect" "$(ls | tr '\n' ' ')" \
+        "$(for f in $expect; do [ -s "$f" ] || exit 1; done; ! ls | grep -qE '\.(obj|mtl|png|glb|gltf)\.'; echo $?)"
+    cd "$W" || exit 1
+}
+prefix_case "tile OUT_PREFIX out.obj" "out.obj out.mtl out.png" tile ../in/torus.obj ../in/tex.png out.obj
+check "tile OUT_PREFIX out.obj: mtllib names out.mtl" "mtllib out.mtl" "$(grep mtllib "$W/d$NEWDIR_N/out.obj" 2>&1)" \
+    "$(grep -qx 'mtllib out.mtl' "$W/d$NEWDIR_N/out.obj" 2>/dev/null; echo $?)"
+prefix_case "tile OUT_PREFIX out.PNG" "out.obj out.mtl out.png" tile ../in/torus.obj ../in/tex.png out.PNG
+prefix_case "lapped OUT_PREFIX l.mtl" "l.obj l.mtl l_patch.png" lapped ../in/torus.obj ../in/lap.png l.mtl --scale 1.5
+prefix_case "hpm OUT_PREFIX h.gltf" "h.obj h.mtl" hpm ../in/torus.obj ../in/lap.png h.gltf
+prefix_case "polycube OUT_PREFIX p.glb" "p.obj p.mtl p.png p_polycube.obj" polycube ../in/spheretri.obj ../in/tex.png \
+    p.glb --resolution 4
+
+# "-" is the standard output where a command writes one file, and refused
+# (usage error, no file called "-") where it writes several.
+for c in tile lapped hpm polycube; do
+    expect_usage_error "$c OUT_PREFIX -" $c ../in/spheretri.obj ../in/lap.png -
+    err_mentions "$c OUT_PREFIX -: says why" "standard output"
+done
+expect_usage_error "map - --atlas (OBJ + MTL)" map ../in/torus.obj - --atlas ../in/tex.png
+expect_usage_error "synth - --mips (several PNGs)" synth ../in/lap.png - --mips
+newdir
+run render ../in/torus.obj ../in/tex.png - --size 32x32
+check "render to -: a PNG on stdout, no file" "exit 0, stdout starting \\x89PNG, empty directory" \
+    "exit $RC, stdout $(head -c 4 "$W/out" | od -An -c | tr -s ' '), files: $(ls -A)" \
+    "$([ $RC -eq 0 ] && [ "$(head -c 4 "$W/out" | od -An -tx1 | tr -d ' ')" = 89504e47 ] && [ -z "$(ls -A)" ]; echo $?)"
+run generate texture - --size 32
+check "generate texture to -: a 32x32 PNG on stdout" "exit 0, 32 32" "exit $RC, $(png_size "$W/out")" \
+    "$([ $RC -eq 0 ] && [ "$(png_size "$W/out")" = "32 32" ] && [ -z "$(ls -A)" ]; echo $?)"
+run generate mesh - --shape torus
+check "generate mesh to -: the OBJ on stdout, no summary" "exit 0, only OBJ lines" "exit $RC, $(head -c 200 "$W/out")" \
+    "$([ $RC -eq 0 ] && grep -q '^f ' "$W/out" && ! grep -q '^wrote' "$W/out" && [ -z "$(ls -A)" ]; echo $?)"
+run map ../in/torus.obj -
+check "map to -: the OBJ with UVs on stdout" "exit 0, vt and f lines, no file" "exit $RC, $(head -c 200 "$W/out")" \
+    "$([ $RC -eq 0 ] && grep -q '^vt ' "$W/out" && grep -q '^f ' "$W/out" && ! grep -q '^\.\./in/torus\.obj:' "$W/out" &&
+       [ -z "$(ls -A)" ]; echo $?)"
+cd "$W" || exit 1
+
 # --up: an axis name or X,Y,Z wherever it exists, the same meaning in both forms
 newdir
 expect_ok "render --up z" render ../in/torus.obj ../in/tex.png z.png --size 48x48 --up z
