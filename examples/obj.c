@@ -586,8 +586,14 @@ int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size)
     int result;
     memset(out, 0, sizeof *out);
     if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
-    result = obj_parse_named((const char *)data, size, path, out, err, err_size);
+    result = obj_read_text(path, (const char *)data, size, out, err, err_size);
     free(data);
+    return result;
+}
+
+int obj_read_text(const char *path, const char *text, size_t size, obj_mesh *out, char *err, size_t err_size)
+{
+    int result = obj_parse_named(text, size, path, out, err, err_size);
     if (result == 0 && out->unknown_statements == 1)
         tool_note("%s:%d: skipped a line with an unknown keyword, '%s'", path, out->first_unknown_line,
                   out->first_unknown);

@@ -1024,7 +1024,7 @@ int cmd_render(int argc, char **argv)
     memset(&textures, 0, sizeof textures);
     memset(&s, 0, sizeof s);
     memset(&samples, 0, sizeof samples);
-    if (obj_read(positional[0], &mesh, err, sizeof err) != 0) return tool_fail("%s", err);
+    if (mesh_read(positional[0], &mesh, err, sizeof err) != 0) return tool_fail("%s", err);
     if (mesh_bounding_sphere(&mesh, &centre, &radius, &bad_vertex) != 0) {
         tool_fail("%s: vertex %d has a coordinate that is not a finite number", positional[0], bad_vertex + 1);
         goto done;

@@ -109,7 +109,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
     memset(out, 0, sizeof *out);
     if (tt_tile_layout_resolve(&options->layout, &out->layout, &error) != TT_OK)
         return tool_fail("%s", error.message);
-    if (obj_read(obj_path, &obj, message, sizeof message) != 0) return tool_fail("%s", message);
+    if (mesh_read(obj_path, &obj, message, sizeof message) != 0) return tool_fail("%s", message);
 
     desc = obj_mesh_desc(&obj, options->mesh.permissive ? TT_MESH_PERMISSIVE : 0);
     out->input_faces = obj.nfaces;

@@ -42,7 +42,7 @@ static void print_help(void)
     int i;
     printf("tiledtex %s - texture any mesh from one example image, without seams or visible repetition\n\n",
            TILEDTEX_VERSION_STRING);
-    printf("usage: tiledtex [--max-pixels N] [--quiet] COMMAND [ARGUMENTS]\n"
+    printf("usage: tiledtex [--max-pixels N] [--quiet] [--weld] COMMAND [ARGUMENTS]\n"
            "       tiledtex --version\n\ncommands:\n");
     for (i = 0; i < SUBCOMMAND_COUNT; i++) printf("  %-9s %s\n", subcommands[i].name, subcommands[i].summary);
     printf("\nglobal options (before or after the command):\n"
@@ -51,10 +51,14 @@ static void print_help(void)
            "                  lapped needs about 32 bytes, tile and synth about 17\n"
            "  -q, --quiet     print nothing but errors: no summary, progress line or warning\n"
            "  -V, --version   print the version and exit\n"
+           "  --weld          merge mesh vertices closer than %g of the bounding box diagonal,\n"
+           "                  for meshes exported with each face's own vertices\n"
            "\nOUT_PREFIX may end in .obj (or .mtl, .png, .glb, .gltf), which is taken off; an\n"
            "output of exactly one file (render, generate, synth, map without --atlas) may be\n"
-           "'-' for the standard output.\n",
-           TOOL_DEFAULT_MAX_PIXELS);
+           "'-' for the standard output.\n"
+           "\nmeshes: Wavefront OBJ, STL (ASCII or binary, always welded) or OFF; other\n"
+           "formats are named, with a conversion command (assimp export from assimp-utils)\n",
+           TOOL_DEFAULT_MAX_PIXELS, TOOL_WELD_TOLERANCE);
     printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
            "Try it: tiledtex generate mesh torus.obj --shape torus\n"
            "        tiledtex generate texture stones.png\n"
@@ -83,6 +87,8 @@ static int take_global_options(int *argc, char **argv)
             given = 1;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
             tool_set_quiet(1);
+        } else if (strcmp(argv[i], "--weld") == 0) {
+            mesh_set_weld(1);
         } else {
             argv[kept++] = argv[i];
         }

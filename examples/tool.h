@@ -14,6 +14,7 @@
      cli.c       command-line helpers    tool_option, parse_int, parse_mesh_option, ...
      image_io.c  images                  image_load, png_encode, output_add_png
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
+     mesh_file.c any mesh file, --weld   mesh_read, mesh_weld
                  MTL writing             mtl_add_material, output_add_mtl
      triangle_mesh.c  an OBJ as triangles   triangle_mesh_read (lapped, hpm, polycube)
                  mesh options            tool_quadrangulate, tool_check_subdivide,
@@ -370,7 +371,41 @@ tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
 /* Read and parse a file; messages start with the path ("mesh.obj:12: ...").
    Unknown statements give one tool_note naming the first and the count. */
 int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
+/* The same on text already read from `path` (size bytes). */
+int obj_read_text(const char *path, const char *text, size_t size, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
+
+/* ---------------------------------------------------------------------- */
+/* Mesh files (mesh_file.c): how every command reads its mesh               */
+/* ---------------------------------------------------------------------- */
+
+/* --weld merges vertices closer than this times the diagonal of the mesh's
+   bounding box (and only those: vertices of one face that merge make a
+   face that repeats a vertex, which the build then names). */
+#define TOOL_WELD_TOLERANCE 1e-6
+
+/* The global option --weld: mesh_read welds every mesh it reads. */
+void mesh_set_weld(int weld);
+
+/* Read a mesh file into an obj_mesh: a Wavefront OBJ (obj_read_text), an
+   STL (ASCII or binary; always welded at exactly equal positions, since
+   STL has no shared vertices) or an OFF file. The format is told by the
+   first bytes, then by the extension (any case); glTF / GLB, PLY, FBX,
+   COLLADA and 3DS files are refused with one line naming the format and a
+   conversion command. Under --weld the mesh is welded (mesh_weld with
+   TOOL_WELD_TOLERANCE); without it, a mesh whose every vertex is in one
+   corner while positions repeat gets a note suggesting --weld. STL and
+   OFF meshes have no texture coordinates, groups or materials; a binary
+   STL's faces have no line (face_line 0). Returns 0, or -1 with the
+   message in err. */
+int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size);
+
+/* Merge every vertex into the first (by index) within `tolerance` times
+   the bounding box diagonal (0: exactly equal positions), renumbering the
+   vertices in that order and the corners with them; non-finite positions
+   stay apart. Returns how many vertices were merged away, or -1 when out
+   of memory (the mesh is then unchanged). */
+int mesh_weld(obj_mesh *mesh, double tolerance);
 
 /* The materials of an MTL file: newmtl NAME and its map_Kd (the diffuse
    texture) as the file names it: relative to the MTL's directory unless

@@ -234,7 +234,7 @@ int triangle_mesh_read(const char *path, const tool_mesh_options *options, trian
     char message[TOOL_ERROR_SIZE];
     int c, total, status, *corner = NULL;
     memset(m, 0, sizeof *m);
-    if (obj_read(path, &m->obj, message, sizeof message) != 0) return tool_fail("%s", message);
+    if (mesh_read(path, &m->obj, message, sizeof message) != 0) return tool_fail("%s", message);
     m->nverts = m->obj.nverts;
     m->pos = m->obj.pos;
     m->flags = options && options->permissive ? TT_MESH_PERMISSIVE : 0;
