@@ -1620,6 +1620,126 @@ check "known unused statements: no warning" "empty stderr" "$ERR" "$([ -z "$ERR"
 cd "$W" || exit 1
 
 # ======================================================================
+# Other mesh formats: STL and OFF read, the rest named; --weld
+# ======================================================================
+cd "$W/in" || exit 1
+# Formats the tool does not read: each named, with a conversion command.
+printf 'ply\nformat ascii 1.0\nelement vertex 0\nend_header\n' >model.ply
+printf 'glTF\002\000\000\000\024\000\000\000' >model.glb
+printf '{"asset": {"version": "2.0"}, "meshes": []}\n' >model.gltf
+printf 'Kaydara FBX Binary  \000\032\000' >model.fbx
+printf '<?xml version="1.0"?>\n<COLLADA version="1.4.1"></COLLADA>\n' >model.dae
+printf 'MM\012\000\000\000\002\000\012\000' >model.3ds
+cp model.ply MODEL.PLY
+cp model.ply ply_named.obj
+cp model.glb glb_named.obj
+# A tetrahedron, outward, as ASCII STL (its facets' normals are not used)...
+stl_facet() { printf ' facet normal 0 0 0\n  outer loop\n   vertex %s\n   vertex %s\n   vertex %s\n  endloop\n endfacet\n' "$@"; }
+{
+    printf 'solid tetra\n'
+    stl_facet '0 0 0' '0 1 0' '1 0 0'
+    stl_facet '0 0 0' '1 0 0' '0 0 1'
+    stl_facet '0 0 0' '0 0 1' '0 1 0'
+    stl_facet '1 0 0' '0 1 0' '0 0 1'
+    printf 'endsolid tetra\n'
+} >tetra.stl
+cp tetra.stl stl_named.obj
+# ... as binary STL (80-byte header that starts "solid", like some exporters
+# write, a count, 50 bytes per triangle: normal, 3 corners, 2 spare bytes) ...
+O='\000\000\000\000'
+I='\000\000\200\077'
+stl_triangle() { printf "$O$O$O$1$2$3$4$5$6$7$8$9\000\000"; }
+{
+    printf 'solid binary header%61s' ''
+    printf '\004\000\000\000'
+    stl_triangle "$O" "$O" "$O" "$O" "$I" "$O" "$I" "$O" "$O"
+    stl_triangle "$O" "$O" "$O" "$I" "$O" "$O" "$O" "$O" "$I"
+    stl_triangle "$O" "$O" "$O" "$O" "$O" "$I" "$O" "$I" "$O"
+    stl_triangle "$I" "$O" "$O" "$O" "$I" "$O" "$O" "$O" "$I"
+} >tetra_binary.stl
+# ... and the cube as OFF: a comment, colours after some vertices and faces.
+printf 'OFF\n# a cube\n8 6 12\n-1 -1 -1\n1 -1 -1 0.5 0.5 0.5\n1 1 -1\n-1 1 -1\n-1 -1 1\n1 -1 1\n1 1 1\n-1 1 1\n4 0 3 2 1 255 0 0\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n' >cube.off
+printf 'OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 4\n' >bad_index.off
+printf 'solid bad\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n  endloop\n endfacet\nendsolid bad\n' >two_corners.stl
+# The torus exported per face: every corner its own vertex ("v" lines
+# before each face); the noisy twin moves each copy by up to 2e-6, within
+# --weld's 1e-6 of the diagonal (about 3.6).
+awk '$1 == "v" { v[++n] = $0 }
+     $1 == "f" { s = "f"; for (i = 2; i <= NF; i++) { split($i, c, "/"); print v[c[1]]; s = s " " ++m }; print s }' \
+    torus.obj >torus_per_face.obj
+awk '$1 == "v" { k++; printf "v %.9g %.9g %.9g\n", $2 + (k % 3) * 1e-6, $3 - (k % 2) * 1e-6, $4; next } { print }' \
+    torus_per_face.obj >torus_per_face_noisy.obj
+cd "$W" || exit 1
+
+for format in ply:PLY glb:'binary glTF \(GLB\)' gltf:glTF fbx:FBX dae:COLLADA 3ds:3DS; do
+    ext=${format%%:*}
+    name=${format#*:}
+    expect_error "mesh .$ext refused" map ../in/model.$ext m.obj
+    err_mentions "mesh .$ext: names the format and how to convert it" \
+        "model\\.$ext: an? $name mesh; tiledtex reads Wavefront OBJ, STL and OFF: convert it \\(e\\.g\\. assimp export ../in/model\\.$ext ../in/model\\.obj, from Debian's assimp-utils\\)"
+done
+expect_error "mesh .PLY (upper case) refused" tile ../in/MODEL.PLY ../in/tex.png out
+err_mentions "mesh .PLY: names the format" 'MODEL\.PLY: a PLY mesh'
+expect_error "PLY named .obj refused" lapped ../in/ply_named.obj ../in/tex.png out
+err_mentions "PLY named .obj: recognised by its first bytes" 'ply_named\.obj: a PLY mesh \(by its first bytes.*assimp export ../in/ply_named\.obj ../in/ply_named_converted\.obj'
+expect_error "GLB named .obj refused (render)" render ../in/glb_named.obj ../in/tex.png r.png
+err_mentions "GLB named .obj: recognised by its first bytes" 'glb_named\.obj: a binary glTF \(GLB\) mesh \(by its first bytes'
+
+newdir
+expect_ok "map ASCII STL" map ../in/tetra.stl a.obj
+check "ASCII STL: 4 triangles welded to 4 vertices, one closed component" "'12 quads, 14 vertices, genus 0, 1 component, 0 boundary loops'" \
+    "$OUT" "$(printf '%s' "$OUT" | grep -q '12 quads, 14 vertices, genus 0, 1 component, 0 boundary loops'; echo $?)"
+expect_ok "map binary STL (header starting 'solid')" map ../in/tetra_binary.stl b.obj
+check "binary STL: the same mesh as the ASCII one" "identical v and f lines" "differ" \
+    "$(cmp -s <(grep -E '^(v|f) ' a.obj) <(grep -E '^(v|f) ' b.obj); echo $?)"
+expect_ok "map STL named .obj" map ../in/stl_named.obj c.obj
+check "STL named .obj: read as STL" "identical v and f lines to the .stl" "differ" \
+    "$(cmp -s <(grep -E '^(v|f) ' a.obj) <(grep -E '^(v|f) ' c.obj); echo $?)"
+run render ../in/tetra_binary.stl ../in/tex.png r.png --size 32x32
+check "render binary STL: 4 triangles" "'4 triangles'" "exit $RC, $OUT" \
+    "$([ $RC -eq 0 ] && printf '%s' "$OUT" | grep -q '4 triangles'; echo $?)"
+expect_ok "map OFF cube" map ../in/cube.off d.obj
+check "OFF cube: 6 quads, 8 vertices, closed" "'6 quads, 8 vertices, genus 0, 1 component, 0 boundary loops'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '6 quads, 8 vertices, genus 0, 1 component, 0 boundary loops'; echo $?)"
+check "OFF cube: the cube's corners" "8 v lines, all at |x|=|y|=|z|=1" "$(grep -cE '^v -?1 -?1 -?1$' d.obj)" \
+    "$([ "$(grep -cE '^v -?1 -?1 -?1$' d.obj)" = 8 ]; echo $?)"
+cd "$W" || exit 1
+expect_error "OFF face index out of range" map ../in/bad_index.off m.obj
+err_mentions "OFF index out of range: names line and corner" 'bad_index\.off:7: face 1: corner 3 is not a vertex index from 0 to 3'
+expect_error "STL facet with 2 vertices" map ../in/two_corners.stl m.obj
+err_mentions "STL facet with 2 vertices: names the line" 'two_corners\.stl:7: a facet with 2 vertices'
+
+newdir
+expect_ok "tile torus (for --weld)" tile ../in/torus.obj ../in/tex.png orig --tile 16
+ORIG_SUMMARY=$(printf '%s\n' "$OUT" | head -1 | sed 's/^[^:]*: //')
+expect_ok "tile per-face torus without --weld" tile ../in/torus_per_face.obj ../in/tex.png pf --tile 16
+check "per-face torus without --weld: 512 components" "'512 components'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '512 components'; echo $?)"
+err_mentions "per-face torus without --weld: a note suggests --weld" 'torus_per_face\.obj looks unwelded \(each face has its own vertices\): try --weld'
+expect_ok "tile per-face torus --weld" tile ../in/torus_per_face.obj ../in/tex.png w --tile 16 --weld
+check "--weld: the same summary as the torus it came from" "$ORIG_SUMMARY" "$OUT" \
+    "$([ "$(printf '%s\n' "$OUT" | head -1 | sed 's/^[^:]*: //')" = "$ORIG_SUMMARY" ]; echo $?)"
+check "--weld: no note about welding" "empty stderr" "$ERR" "$([ -z "$ERR" ]; echo $?)"
+check "--weld: the same atlas as the torus it came from" "cmp equal" "$(cmp orig.png w.png 2>&1)" \
+    "$(cmp -s orig.png w.png; echo $?)"
+expect_ok "tile per-face torus, positions off by 1e-6, --weld (before the command)" \
+    --weld tile ../in/torus_per_face_noisy.obj ../in/tex.png n --tile 16
+check "--weld within the tolerance: the same summary" "$ORIG_SUMMARY" "$OUT" \
+    "$([ "$(printf '%s\n' "$OUT" | head -1 | sed 's/^[^:]*: //')" = "$ORIG_SUMMARY" ]; echo $?)"
+expect_ok "lapped per-face torus --weld" lapped ../in/torus_per_face.obj ../in/lap.png lw --weld
+LW_OUT=$(printf '%s\n' "$OUT" | sed 's/torus_per_face\.obj/torus.obj/')
+expect_ok "lapped torus (for --weld)" lapped ../in/torus.obj ../in/lap.png lo
+check "lapped --weld: the same summary numbers as the torus it came from" "$(oneline "$OUT")" "$LW_OUT" \
+    "$([ "$(printf '%s\n' "$OUT" | sed 's/ lo[._]/ X/g; s/[0-9.]* s\b//g')" = "$(printf '%s\n' "$LW_OUT" | sed 's/ lw[._]/ X/g; s/[0-9.]* s\b//g')" ]; echo $?)"
+expect_ok "map torus --weld" map ../in/torus.obj mw.obj --weld
+expect_ok "map torus" map ../in/torus.obj mo.obj
+check "--weld on a welded mesh changes nothing" "cmp equal" "$(cmp mo.obj mw.obj 2>&1)" "$(cmp -s mo.obj mw.obj; echo $?)"
+run --help
+check "--help documents --weld and the mesh formats" "'--weld' and 'STL' in the usage" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q -- '--weld' && printf '%s' "$OUT" | grep -q 'STL'; echo $?)"
+cd "$W" || exit 1
+
+# ======================================================================
 # Outputs never replace inputs; the rollback removes only its own files
 # ======================================================================
 # expect_refused WHAT ARGS... : run in the current directory, whose files are
