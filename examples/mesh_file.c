@@ -153,19 +153,22 @@ static void refuse_format(const char *path, mesh_format format, int misnamed, ch
 
 typedef struct mesh_builder {
     obj_mesh *mesh;
-    int pos_capacity, face_capacity, corner_capacity;
+    int vert_capacity, face_capacity, corner_capacity;
 } mesh_builder;
 
-static int grow(void **array, int *capacity, int needed, size_t element_size)
+/* The capacity, doubled from `capacity`, that holds `needed` elements. */
+static int grown(int capacity, int needed)
 {
-    void *grown;
-    int new_capacity = *capacity > 0 ? *capacity : 64;
-    if (needed <= *capacity) return 0;
-    while (new_capacity < needed) new_capacity = new_capacity > MESH_MAX_COUNT ? needed : 2 * new_capacity;
-    grown = realloc(*array, (size_t)new_capacity * element_size);
-    if (!grown) return -1;
-    *array = grown;
-    *capacity = new_capacity;
+    capacity = capacity > 0 ? capacity : 64;
+    while (capacity < needed) capacity = capacity > MESH_MAX_COUNT ? needed : 2 * capacity;
+    return capacity;
+}
+
+static int resize(void **array, int count, size_t element_size)
+{
+    void *resized = realloc(*array, (size_t)count * element_size);
+    if (!resized) return -1;
+    *array = resized;
     return 0;
 }
 
@@ -188,11 +191,15 @@ static int builder_start(mesh_builder *b, obj_mesh *mesh)
 static int add_vertex(mesh_builder *b, const double xyz[3], int line)
 {
     obj_mesh *m = b->mesh;
-    int capacity = b->pos_capacity, k;
+    int k;
     if (m->nverts >= MESH_MAX_COUNT) return -1;
-    if (grow((void **)&m->pos, &b->pos_capacity, 3 * (m->nverts + 1), sizeof(float)) != 0 ||
-        grow((void **)&m->vert_line, &capacity, 3 * (m->nverts + 1), sizeof(int)) != 0)
-        return -1;
+    if (m->nverts == b->vert_capacity) {
+        int capacity = grown(b->vert_capacity, m->nverts + 1);
+        if (resize((void **)&m->pos, 3 * capacity, sizeof(float)) != 0 ||
+            resize((void **)&m->vert_line, capacity, sizeof(int)) != 0)
+            return -1;
+        b->vert_capacity = capacity;
+    }
     for (k = 0; k < 3; k++)   /* beyond float range: infinity, which the library names */
         m->pos[3 * (size_t)m->nverts + k] = fabs(xyz[k]) > FLT_MAX ? (float)(xyz[k] > 0 ? INFINITY : -INFINITY)
                                                                      : (float)xyz[k];
@@ -200,18 +207,26 @@ static int add_vertex(mesh_builder *b, const double xyz[3], int line)
     return 0;
 }
 
-/* A face of the given corners (vertex indices already checked). */
+/* A face of the given corners (vertex indices already checked), in group 0
+   and material 0. */
 static int add_face(mesh_builder *b, const int *corners, int count, int line)
 {
     obj_mesh *m = b->mesh;
-    int capacity = b->face_capacity, capacity2 = b->face_capacity, capacity3 = b->face_capacity;
     if (m->nfaces >= MESH_MAX_COUNT || m->ncorners > MESH_MAX_COUNT - count) return -1;
-    if (grow((void **)&m->corner_vert, &b->corner_capacity, m->ncorners + count, sizeof(int)) != 0 ||
-        grow((void **)&m->face_size, &b->face_capacity, m->nfaces + 1, sizeof(int)) != 0 ||
-        grow((void **)&m->face_line, &capacity, m->nfaces + 1, sizeof(int)) != 0 ||
-        grow((void **)&m->face_group, &capacity2, m->nfaces + 1, sizeof(int)) != 0 ||
-        grow((void **)&m->face_material, &capacity3, m->nfaces + 1, sizeof(int)) != 0)
-        return -1;
+    if (m->ncorners + count > b->corner_capacity) {
+        int capacity = grown(b->corner_capacity, m->ncorners + count);
+        if (resize((void **)&m->corner_vert, capacity, sizeof(int)) != 0) return -1;
+        b->corner_capacity = capacity;
+    }
+    if (m->nfaces == b->face_capacity) {
+        int capacity = grown(b->face_capacity, m->nfaces + 1);
+        if (resize((void **)&m->face_size, capacity, sizeof(int)) != 0 ||
+            resize((void **)&m->face_line, capacity, sizeof(int)) != 0 ||
+            resize((void **)&m->face_group, capacity, sizeof(int)) != 0 ||
+            resize((void **)&m->face_material, capacity, sizeof(int)) != 0)
+            return -1;
+        b->face_capacity = capacity;
+    }
     memcpy(m->corner_vert + m->ncorners, corners, (size_t)count * sizeof(int));
     m->ncorners += count;
     m->face_size[m->nfaces] = count;
