@@ -579,28 +579,16 @@ int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size)
     size_t size;
     mesh_builder builder;
     mesh_format format;
-    int status = -1;
+    int status = -1, is_stl;
     memset(out, 0, sizeof *out);
     if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
     format = detect_format(path, data, size);
-    if (format == MESH_OBJ) {
-        status = obj_read_text(path, (const char *)data, size, out, err, err_size);
-        free(data);
-        if (status == 0 && weld_requested && mesh_weld(out, TOOL_WELD_TOLERANCE) < 0) {
-            obj_free(out);
-            tool_set_error(err, err_size, "%s: out of memory", path);
-            return -1;
-        }
-        if (status == 0 && !weld_requested && looks_unwelded(out))
-            tool_note("%s looks unwelded (each face has its own vertices): try --weld", path);
-        return status;
-    }
+    is_stl = format == MESH_STL_ASCII || format == MESH_STL_BINARY;
     if (format > MESH_OFF) {
         refuse_format(path, format, format_by_extension(path) != (int)format, err, err_size);
-        free(data);
-        return -1;
-    }
-    if (builder_start(&builder, out) != 0) {
+    } else if (format == MESH_OBJ) {
+        status = obj_read_text(path, (const char *)data, size, out, err, err_size);
+    } else if (builder_start(&builder, out) != 0) {
         tool_set_error(err, err_size, "%s: out of memory", path);
     } else if (format == MESH_STL_BINARY) {
         status = read_stl_binary(path, data, &builder, err, err_size);
@@ -610,16 +598,18 @@ int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size)
         status = read_off(path, (const char *)data, size, &builder, err, err_size);
     }
     free(data);
-    if (status == 0 && out->nfaces == 0) {
+    if (status == 0 && out->nfaces == 0) {   /* (obj_read_text says so itself) */
         tool_set_error(err, err_size, "%s: no faces", path);
         status = -1;
     }
-    /* STL is welded always (exactly equal positions), OFF only on request. */
-    if (status == 0 && (weld_requested || format != MESH_OFF) &&
+    /* STL always (exactly equal positions), the others on request. */
+    if (status == 0 && (weld_requested || is_stl) &&
         mesh_weld(out, weld_requested ? TOOL_WELD_TOLERANCE : 0.0) < 0) {
         tool_set_error(err, err_size, "%s: out of memory", path);
         status = -1;
     }
     if (status != 0) obj_free(out);
+    else if (!weld_requested && !is_stl && looks_unwelded(out))
+        tool_note("%s looks unwelded (each face has its own vertices): try --weld", path);
     return status;
 }

@@ -1660,6 +1660,8 @@ stl_triangle() { printf "$O$O$O$1$2$3$4$5$6$7$8$9\000\000"; }
 # ... and the cube as OFF: a comment, colours after some vertices and faces.
 printf 'OFF\n# a cube\n8 6 12\n-1 -1 -1\n1 -1 -1 0.5 0.5 0.5\n1 1 -1\n-1 1 -1\n-1 -1 1\n1 -1 1\n1 1 1\n-1 1 1\n4 0 3 2 1 255 0 0\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n' >cube.off
 printf 'OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 4\n' >bad_index.off
+# two triangles of a square, each with its own vertices
+printf 'OFF\n6 2 0\n0 0 0\n1 0 0\n0 1 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 3 4 5\n' >per_face.off
 printf 'solid bad\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n  endloop\n endfacet\nendsolid bad\n' >two_corners.stl
 # The torus exported per face: every corner its own vertex ("v" lines
 # before each face); the noisy twin moves each copy by up to 2e-6, within
@@ -1703,6 +1705,12 @@ check "OFF cube: 6 quads, 8 vertices, closed" "'6 quads, 8 vertices, genus 0, 1 
     "$(printf '%s' "$OUT" | grep -q '6 quads, 8 vertices, genus 0, 1 component, 0 boundary loops'; echo $?)"
 check "OFF cube: the cube's corners" "8 v lines, all at |x|=|y|=|z|=1" "$(grep -cE '^v -?1 -?1 -?1$' d.obj)" \
     "$([ "$(grep -cE '^v -?1 -?1 -?1$' d.obj)" = 8 ]; echo $?)"
+expect_ok "map per-face OFF" map ../in/per_face.off pf.obj
+check "per-face OFF: two components" "'2 components'" "$OUT" "$(printf '%s' "$OUT" | grep -q '2 components'; echo $?)"
+err_mentions "per-face OFF: a note suggests --weld" 'per_face\.off looks unwelded .*try --weld'
+expect_ok "map per-face OFF --weld" map ../in/per_face.off pfw.obj --weld
+check "per-face OFF --weld: one component, one boundary loop" "'1 component, 1 boundary loop'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '1 component, 1 boundary loop'; echo $?)"
 cd "$W" || exit 1
 expect_error "OFF face index out of range" map ../in/bad_index.off m.obj
 err_mentions "OFF index out of range: names line and corner" 'bad_index\.off:7: face 1: corner 3 is not a vertex index from 0 to 3'
