@@ -394,7 +394,11 @@ static int read_off(const char *path, const char *text, size_t size, mesh_builde
     t.p = text;
     t.end = text + size;
     t.line = 1;
-    next_word(&t, &word, 0);   /* the header, checked by is_off_header */
+    if (!is_off_header((const unsigned char *)text, size)) {   /* a .off file without one */
+        tool_set_error(err, err_size, "%s:1: an OFF file starts with 'OFF'", path);
+        return -1;
+    }
+    next_word(&t, &word, 0);
     if (read_numbers(&t, counts, 3, 0) != 0 || counts[0] < 0 || counts[1] < 0 || counts[0] > MESH_MAX_COUNT ||
         counts[1] > MESH_MAX_COUNT || counts[0] != floor(counts[0]) || counts[1] != floor(counts[1])) {
         tool_set_error(err, err_size, "%s:%d: an OFF file needs its counts (vertices faces edges) after 'OFF'",

@@ -1714,6 +1714,9 @@ check "per-face OFF --weld: one component, one boundary loop" "'1 component, 1 b
 cd "$W" || exit 1
 expect_error "OFF face index out of range" map ../in/bad_index.off m.obj
 err_mentions "OFF index out of range: names line and corner" 'bad_index\.off:7: face 1: corner 3 is not a vertex index from 0 to 3'
+printf '4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n' >"$W/in/no_header.off"
+expect_error "OFF without its header" map ../in/no_header.off m.obj
+err_mentions "OFF without its header: says what it must start with" "no_header\.off:1: an OFF file starts with 'OFF'"
 expect_error "STL facet with 2 vertices" map ../in/two_corners.stl m.obj
 err_mentions "STL facet with 2 vertices: names the line" 'two_corners\.stl:7: a facet with 2 vertices'
 
