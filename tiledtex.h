@@ -9914,6 +9914,7 @@ typedef struct tt__entry {
     int face, paste;
     float uv[6];
     float fade[3];              /* per corner: the factor on the patch's alpha (tt__paste_fade) */
+    unsigned char covers;       /* the paste may cover samples of the face (not the fringe) */
     float angle_error, scale_error;
 } tt__entry;
 
@@ -10136,14 +10137,13 @@ static float tt__face_alpha_most(const tt_image *patch, const float uv[6])
     return most;
 }
 
-/* Whether face f's current map turns T_f by more than `most` degrees or
-   scales it beyond 1 + most / 90 either way (TT_LAPPED_MAX_DISTORTION). */
-static int tt__distorted_beyond(const tt__lapper *L, int f, double most)
+/* Whether an alignment error (tt__alignment_error) turns T_f by at most
+   `most` degrees and scales it within 1 + most / 90 either way
+   (TT_LAPPED_MAX_DISTORTION). */
+static int tt__aligned_within(double angle, double scale, double most)
 {
-    double image_t[2], angle, scale, limit = 1.0 + most / 90.0;
-    tt__face_up_image(L, f, image_t);
-    tt__alignment_error(image_t, &angle, &scale);
-    return !(angle <= most && scale <= limit && scale * limit >= 1.0);
+    double limit = 1.0 + most / 90.0;
+    return angle <= most && scale <= limit && scale * limit >= 1.0;
 }
 
 /* Face f's corner UVs as the current map has them. */
@@ -10163,12 +10163,13 @@ static void tt__face_uv(const tt__lapper *L, int f, float uv[6])
    TT__LAPPED_FRINGE_ALPHA). The fringe keeps the paste's soft border where
    the map drifts from the field toward the paste's rim, so that it need
    not end there with a hard edge; the texture shown there is faint, and
-   covers nothing (Sec. 3.6 counts opaque points only). */
-static int tt__paste_may_show(const tt__lapper *L, int f, int patch)
+   covers nothing (Sec. 3.6 counts opaque points only). angle and scale are
+   the face's alignment error (tt__alignment_error). */
+static int tt__paste_may_show(const tt__lapper *L, int f, int patch, double angle, double scale)
 {
     float uv[6];
-    if (!tt__distorted_beyond(L, f, TT_LAPPED_MAX_DISTORTION)) return 1;
-    if (tt__distorted_beyond(L, f, TT_LAPPED_GROW_DISTORTION)) return 0;
+    if (tt__aligned_within(angle, scale, TT_LAPPED_MAX_DISTORTION)) return 1;
+    if (!tt__aligned_within(angle, scale, TT_LAPPED_GROW_DISTORTION)) return 0;
     tt__face_uv(L, f, uv);
     return tt__face_alpha_most(L->patches[patch], uv) < TT__LAPPED_FRINGE_ALPHA;
 }
@@ -10293,7 +10294,7 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
 {
     const tt_mesh *mesh = L->mesh;
     int t = mesh->twin[c], g = t / 3, v = mesh->corner_vert[3 * g + (t % 3 + 2) % 3], shared = 0, k, mapped;
-    double uv[2];
+    double uv[2], image_t[2], angle, scale;
     if (L->face_stamp[g] == paste) return 0;
     for (k = 0; k < 3; k++) {
         int u = mesh->twin[3 * g + k];
@@ -10307,7 +10308,9 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
         L->vert_uv[2 * (size_t)v] = uv[0];        /* provisional until v is stamped */
         L->vert_uv[2 * (size_t)v + 1] = uv[1];
     }
-    if (tt__distorted_beyond(L, g, TT_LAPPED_GROW_DISTORTION)) return 0;
+    tt__face_up_image(L, g, image_t);
+    tt__alignment_error(image_t, &angle, &scale);
+    if (!tt__aligned_within(angle, scale, TT_LAPPED_GROW_DISTORTION)) return 0;
     L->face_stamp[g] = paste;
     L->patch_faces[L->npatch_faces++] = g;
     if (!mapped) tt__map_vertex(L, v, paste);
@@ -10602,17 +10605,18 @@ static long long tt__record_paste(tt__lapper *L, int patch)
         int f = L->patch_faces[i];
         tt__entry *entry;
         double image_t[2], angle, scale;
+        tt__face_up_image(L, f, image_t);
+        tt__alignment_error(image_t, &angle, &scale);
         /* Sec. 3.3 stops growth where distortion becomes excessive; the
            optimization can still leave faces far off the field (near its
            singularities), and they are left out of the paste too: a cut
            there (faded, tt__paste_fade), and another paste covers them.
            Faces of the fringe stay but cover nothing. The seed face always
-           stays. */
-        if (f != L->seed_face && !tt__paste_may_show(L, f, patch)) continue;
+           stays, and covers. */
+        if (f != L->seed_face && !tt__paste_may_show(L, f, patch, angle, scale)) continue;
         entry = &L->entries[L->nentries++];
         tt__face_uv(L, f, entry->uv);
-        tt__face_up_image(L, f, image_t);
-        tt__alignment_error(image_t, &angle, &scale);
+        entry->covers = f == L->seed_face || tt__aligned_within(angle, scale, TT_LAPPED_MAX_DISTORTION);
         entry->face = f;
         entry->paste = paste;
         L->top_patch[f] = patch;
@@ -10630,9 +10634,7 @@ static long long tt__record_paste(tt__lapper *L, int patch)
         for (i = first; i < L->nentries; i++) {
             const tt__entry *entry = &L->entries[i];
             int f = entry->face, got, none = 0;
-            if ((f != L->seed_face && tt__distorted_beyond(L, f, TT_LAPPED_MAX_DISTORTION)) ||
-                L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f])
-                continue;
+            if (!entry->covers || L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) continue;
             if (pass == 0) {
                 faded += tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, L->covered + L->sample_start[f],
                                                  &none);

@@ -815,7 +815,7 @@ static void write_floats(tool_buffer *out, const char *keyword, const float *val
 
 int obj_write(tool_buffer *out, const obj_write_desc *desc)
 {
-    int v, f, c = 0, previous_group = -1;
+    int v, f, c = 0, ncorners = 0, previous_group = -1;
     if (!desc || desc->nverts < 0 || desc->nfaces < 0 || (desc->nverts > 0 && !desc->pos) ||
         (desc->nfaces > 0 && !desc->corner_vert) || (!desc->face_size && desc->fixed_face_size < 3 && desc->nfaces > 0))
         return -1;
@@ -837,10 +837,9 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
        nothing. */
     for (v = 0; v < desc->nverts; v++) write_floats(out, "v", desc->pos + 3 * (size_t)v, 3);
 
+    for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
     if (desc->corner_uv) {
         /* One vt per face corner, in corner order: corner c uses vt c + 1. */
-        int ncorners = 0;
-        for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
         for (c = 0; c < ncorners; c++) {
             float uvw[3];
             uvw[0] = desc->corner_uv[2 * (size_t)c];
@@ -852,8 +851,6 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     }
     if (desc->corner_normal) {
         /* One vn per face corner too: corner c uses vn c + 1. */
-        int ncorners = 0;
-        for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
         for (c = 0; c < ncorners; c++) write_floats(out, "vn", desc->corner_normal + 3 * (size_t)c, 3);
         c = 0;
     }
