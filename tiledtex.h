@@ -94,6 +94,16 @@
        photos arrive sRGB-encoded: convert them with tt_image_from_bytes(...,
        TT_COLOR_SRGB, ...) and back with tt_image_to_rgba8. Data maps (normals,
        roughness, height) are TT_COLOR_LINEAR and never converted.
+     - Tangent-space normal maps follow glTF (OpenGL style): x to the right of
+       the image, y up it (towards row 0, i.e. along +v), z out of the surface.
+       Decoded with TT_COLOR_NORMAL (or TT_COLOR_NORMAL_Y_DOWN for DirectX-
+       style maps, whose y points down), they become images of kind
+       TT_IMAGE_NORMAL holding unit vectors in r, g, b. Every step that turns
+       texture content (a tile's bands, a paste baked into a chart, a 90-degree
+       rotation) turns those vectors with it, and every blend of them is
+       renormalised. One plan, one set of pastes or one set of UVs applied to
+       each map of a material (colour, normal, roughness, metallic, occlusion,
+       height) gives maps that line up texel for texel.
 
    SECTIONS (each uses only the ones above it; read top to bottom)
      1. Common  - results and errors, allocator hooks, asserts, seeded RNG,
@@ -400,9 +410,20 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
    kin and are freed with tt_image_free. You may also fill this struct
    yourself to hand the library your own pixels (a view): leave `allocator`
    zeroed and never pass a view to tt_image_free. */
+
+/* What an image's r, g, b hold, which decides how it is turned and blended. */
+typedef enum tt_image_kind {
+    TT_IMAGE_COLOR = 0,         /* colour, or any data that blends channel by channel: albedo,
+                                   roughness, metallic, occlusion, height, masks */
+    TT_IMAGE_NORMAL = 1         /* a tangent-space normal map (see CONVENTIONS): r, g, b are a unit
+                                   vector x, y, z; turning the image turns x and y with it, and
+                                   blended texels are renormalised (a zero blend becomes 0, 0, 1) */
+} tt_image_kind;
+
 typedef struct tt_image {
     int width, height;
     float *pixels;              /* 4 * width * height */
+    tt_image_kind kind;         /* images the library makes take their source's; 0 = colour */
     tt_allocator allocator;     /* the one it was created with */
 } tt_image;
 
@@ -410,7 +431,12 @@ typedef struct tt_image {
 typedef enum tt_color_space {
     TT_COLOR_SRGB = 0,          /* colour photos and albedo maps: sRGB transfer curve on r, g, b
                                    (IEC 61966-2-1); alpha is always linear */
-    TT_COLOR_LINEAR = 1         /* data maps (normals, roughness, height, masks): v / 255 as is */
+    TT_COLOR_LINEAR = 1,        /* data maps (roughness, metallic, occlusion, height, masks): v / 255 as is */
+    TT_COLOR_NORMAL = 2,        /* tangent-space normal maps, +Y up (OpenGL, glTF, Blender): each of r,
+                                   g, b is 2 v / 255 - 1, and the vector is normalised; the image is
+                                   of kind TT_IMAGE_NORMAL */
+    TT_COLOR_NORMAL_Y_DOWN = 3  /* the same with y pointing down the image (DirectX, Unreal): g is
+                                   negated on the way in and out, so the image holds +Y up */
 } tt_color_space;
 
 /* The sRGB transfer curve and its inverse, on values in [0, 1] (clamped). */
@@ -429,12 +455,17 @@ TTDEF void tt_image_free(tt_image *image);
 /* From 8-bit pixels with 1 (grey), 2 (grey+alpha), 3 (RGB) or 4 (RGBA)
    channels, `stride` bytes per row (0 = width * channels; otherwise at least
    that). r, g, b are decoded from `space` into linear light (alpha: v / 255).
-   Bytes -> linear -> bytes (tt_image_to_rgba8, same space) is exact. */
+   Bytes -> linear -> bytes (tt_image_to_rgba8, same space) is exact. A
+   normal space (3 or 4 channels only: TT_ERROR_INVALID_ARGUMENT otherwise)
+   makes an image of kind TT_IMAGE_NORMAL holding unit vectors; the round
+   trip is then exact for bytes that encode a unit vector to within a byte,
+   which is what normal-map tools write. */
 TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int height, int channels, int stride,
                                     tt_color_space space, const tt_allocator *allocator, tt_image **out_image,
                                     tt_error *error);
 /* To 8-bit RGBA, width * height * 4 bytes: r, g, b encoded into `space`
-   (straight alpha: pass an un-premultiplied image), everything rounded to
+   (a normal space maps -1..1 to 0..255; TT_COLOR_NORMAL_Y_DOWN negates g
+   first) (straight alpha: pass an un-premultiplied image), everything rounded to
    the nearest byte and clamped to [0, 255]; NaN becomes 0. `out` may be the
    image's own pixels: each texel's bytes land on floats already read, so a
    large image converts without a second buffer (the floats are gone then).
@@ -468,7 +499,8 @@ TTDEF void tt_image_sample_bilinear_wrap(const tt_image *image, float x, float y
 TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y);
 
 /* *dst = src turned counter-clockwise by quarter_turns * 90 degrees (any
-   integer, negative = clockwise); sizes swap for odd turns. */
+   integer, negative = clockwise); sizes swap for odd turns. A normal map's
+   vectors turn with it: (x, y) becomes (-y, x) per quarter turn. */
 TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const tt_allocator *allocator,
                                   tt_image **out_image, tt_error *error);
 
@@ -480,7 +512,8 @@ TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *erro
 TTDEF void tt_rgba_over(float dst[4], const float src_premultiplied[4]);
 
 /* *dst = src halved by a 2x2 box filter (width and height must be even; in
-   linear light, so a black and white checkerboard becomes sRGB 188, not 128). */
+   linear light, so a black and white checkerboard becomes sRGB 188, not 128).
+   A normal map's averaged vectors are renormalised. */
 TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *allocator, tt_image **out_image,
                                      tt_error *error);
 
@@ -1055,6 +1088,10 @@ typedef struct tt_rect {
    roughness, ...) gives atlases whose tiles line up texel for texel: the
    masks do not depend on the applied image, and blending is linear, so an
    image B = a * A + b gives atlas a * atlas_A + b (up to float rounding).
+   A normal map (tt_image::kind TT_IMAGE_NORMAL) is applied with the same
+   masks, but each band's vectors are turned as the band is (a band turned a
+   quarter turn onto the right side turns (x, y) into (-y, x)), and every
+   texel of the tile is renormalised; the atlas and its mips are normal maps.
    tt_synthesize_tiles is plan_create + apply + plan_free in one call. */
 
 typedef struct tt_synth_options {
@@ -1548,6 +1585,10 @@ typedef struct tt_patch_options {
    beyond the last inside centre) to 1. So a shape that reaches the image
    border still fades out there.
 
+   The patch is of the source's kind: cut from a normal map, it holds the
+   unit vectors times alpha. The shape depends only on the mask, or the
+   seed and size, so every map of a material cut with the same mask (or
+   seed) gives patches that line up.
    Errors (*patch is NULL, memory freed on every path):
      TT_ERROR_INVALID_ARGUMENT  NULL or empty source or patch; a mask of
                                 another size (the message gives both sizes);
@@ -1894,8 +1935,17 @@ typedef struct tt_bake_options {
    the pastes cover the face). Where two triangles' images overlap, the
    later face wins. Work: proportional to the texels the triangles and
    their gutters cover plus one pass over the atlas. options may be NULL
-   (no gutter). Errors: NULL pointers, an empty atlas, non-triangles,
-   npatches < 1, a negative gutter (TT_ERROR_INVALID_ARGUMENT); an entry
+   (no gutter).
+   Material maps: bake each map with the same pastes, UVs and options, from
+   patches cut from that map with the same mask or seed (tt_make_texture_
+   patch), and the maps line up texel for texel. Normal-map patches (kind
+   TT_IMAGE_NORMAL, all of them) have their vectors turned, per face and
+   paste, from the patch's frame into the atlas's (the rotation nearest the
+   map between the two), composited, and renormalised; texels nothing
+   covers read (0, 0, 1). The atlas takes the patches' kind.
+   Errors: NULL pointers, an empty atlas, non-triangles,
+   npatches < 1, a negative gutter, patches of which some are normal maps
+   and some not (TT_ERROR_INVALID_ARGUMENT); an entry
    naming a patch or face out of range (TT_ERROR_INDEX_OUT_OF_RANGE,
    error->item names the paste or entry); non-finite corner_uv
    (TT_ERROR_NON_FINITE); TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch
@@ -2912,9 +2962,10 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
    Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad <
    its surface's nfaces. */
 TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
-/* Errors: NULL arguments, a bad allocator, tilesets of different layouts,
-   a plain tileset with vertical windows or an upright one without, edge
-   windows that differ (TT_ERROR_INVALID_ARGUMENT); a level that is not in
+/* The atlas is of the tilesets' kind (a normal map when they are).
+   Errors: NULL arguments, a bad allocator, tilesets of different layouts
+   or kinds, a plain tileset with vertical windows or an upright one
+   without, edge windows that differ (TT_ERROR_INVALID_ARGUMENT); a level that is not in
    both tilesets (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
    failure; free it with tt_image_free. */
 TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
@@ -4736,6 +4787,43 @@ static tt_result tt__check_finite_texels(const tt_image *image, const char *what
     return TT_OK;
 }
 
+/* Normal maps (TT_IMAGE_NORMAL): a blend of unit vectors is shorter than
+   one, and a renderer reads the texel as a direction, so every step that
+   blends them ends here. A blend that cancels out (or a texel nothing
+   covered) reads as the unperturbed normal, straight out of the surface. */
+static void tt__normalize_vector_texel(float *texel)
+{
+    double x = texel[0], y = texel[1], z = texel[2], length = sqrt(x * x + y * y + z * z);
+    if (length > 1e-12) {
+        texel[0] = (float)(x / length);
+        texel[1] = (float)(y / length);
+        texel[2] = (float)(z / length);
+    } else {
+        texel[0] = 0.0f;
+        texel[1] = 0.0f;
+        texel[2] = 1.0f;
+    }
+}
+
+/* `rows` rows of `columns` texels from `first`, `stride` floats apart. */
+static void tt__normalize_vector_texels(float *first, int columns, int rows, size_t stride)
+{
+    int x, y;
+    for (y = 0; y < rows; y++)
+        for (x = 0; x < columns; x++) tt__normalize_vector_texel(first + (size_t)y * stride + (size_t)x * 4);
+}
+
+/* A tangent-space vector's x, y turned by the 2 x 2 map m (row-major) of
+   image offsets, in image axes (x right, y DOWN): the vector holds y up, so
+   it is flipped into image axes, mapped and flipped back. */
+static void tt__turn_vector(const float m[4], const float in[3], float out[3])
+{
+    float x = in[0], y = -in[1];
+    out[0] = m[0] * x + m[1] * y;
+    out[1] = -(m[2] * x + m[3] * y);
+    out[2] = in[2];
+}
+
 /* The struct and its pixels share one block; the header is padded to 64
    bytes so the pixels keep the allocator's alignment. */
 #define TT__IMAGE_HEADER 64
@@ -4792,7 +4880,9 @@ static void tt__decode_table(tt_color_space space, float decode[256])
 {
     int b;
     for (b = 0; b < 256; b++)
-        decode[b] = space == TT_COLOR_SRGB ? tt_srgb_to_linear((float)b / 255.0f) : (float)b / 255.0f;
+        decode[b] = space == TT_COLOR_SRGB     ? tt_srgb_to_linear((float)b / 255.0f)
+                    : space == TT_COLOR_LINEAR ? (float)b / 255.0f
+                                               : 2.0f * (float)b / 255.0f - 1.0f;
 }
 
 /* bound[b], b = 0..254: the linear value halfway (in the encoded scale)
@@ -4803,8 +4893,9 @@ static void tt__encode_bounds(tt_color_space space, float bound[255])
 {
     int b;
     for (b = 0; b < 255; b++)
-        bound[b] = space == TT_COLOR_SRGB ? tt_srgb_to_linear(((float)b + 0.5f) / 255.0f)
-                                          : ((float)b + 0.5f) / 255.0f;
+        bound[b] = space == TT_COLOR_SRGB     ? tt_srgb_to_linear(((float)b + 0.5f) / 255.0f)
+                   : space == TT_COLOR_LINEAR ? ((float)b + 0.5f) / 255.0f
+                                              : 2.0f * ((float)b + 0.5f) / 255.0f - 1.0f;
 }
 
 static unsigned char tt__encode_byte(const float bound[255], float value)
@@ -4834,8 +4925,12 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
     if (channels < 1 || channels > 4)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "%d channels: need 1, 2, 3 or 4",
                         channels);
-    if (space != TT_COLOR_SRGB && space != TT_COLOR_LINEAR)
+    if (space != TT_COLOR_SRGB && space != TT_COLOR_LINEAR && space != TT_COLOR_NORMAL &&
+        space != TT_COLOR_NORMAL_Y_DOWN)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "unknown colour space %d", (int)space);
+    if ((space == TT_COLOR_NORMAL || space == TT_COLOR_NORMAL_Y_DOWN) && channels < 3)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "a normal map needs 3 or 4 channels (x, y, z), not %d", channels);
     if ((result = tt__check_image_size(width, height, error)) != TT_OK) return result;
     row_bytes = (long long)width * channels;   /* width <= 32768: no overflow */
     if (stride < 0 || (stride > 0 && stride < row_bytes))
@@ -4844,6 +4939,7 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
                         channels);
     if (stride == 0) stride = (int)row_bytes;
     if ((result = tt_image_create(width, height, allocator, &image, error)) != TT_OK) return result;
+    if (space == TT_COLOR_NORMAL || space == TT_COLOR_NORMAL_Y_DOWN) image->kind = TT_IMAGE_NORMAL;
     tt__decode_table(space, decode);
     tt__decode_table(TT_COLOR_LINEAR, alpha);
     for (y = 0; y < height; y++) {
@@ -4858,6 +4954,10 @@ TTDEF tt_result tt_image_from_bytes(const unsigned char *data, int width, int he
             default:
                 out[0] = decode[p[0]]; out[1] = decode[p[1]]; out[2] = decode[p[2]]; out[3] = alpha[p[3]];
                 break;
+            }
+            if (image->kind == TT_IMAGE_NORMAL) {
+                if (space == TT_COLOR_NORMAL_Y_DOWN) out[1] = -out[1];
+                tt__normalize_vector_texel(out);
             }
         }
     }
@@ -4878,7 +4978,7 @@ TTDEF void tt_image_to_rgba8(const tt_image *image, tt_color_space space, unsign
         /* Read the whole texel before writing: out may alias the pixels
            (bytes 4i.. lie on floats of texel i/4 <= i, read already). */
         const float *p = image->pixels + 4 * i;
-        float red = p[0], green = p[1], blue = p[2], alpha = p[3];
+        float red = p[0], green = space == TT_COLOR_NORMAL_Y_DOWN ? -p[1] : p[1], blue = p[2], alpha = p[3];
         out[4 * i] = tt__encode_byte(bound, red);
         out[4 * i + 1] = tt__encode_byte(bound, green);
         out[4 * i + 2] = tt__encode_byte(bound, blue);
@@ -4974,12 +5074,22 @@ TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const 
     odd = (((quarter_turns % 4) + 4) % 4) & 1;
     result = tt_image_create(odd ? src->height : src->width, odd ? src->width : src->height, allocator, &dst, error);
     if (result != TT_OK) return result;
+    dst->kind = src->kind;
     for (y = 0; y < src->height; y++)
         for (x = 0; x < src->width; x++) {
             int rx, ry;
+            float *to;
             tt_rotate_coords(quarter_turns, src->width, src->height, x, y, &rx, &ry);
-            memcpy(dst->pixels + ((size_t)ry * dst->width + rx) * 4, src->pixels + ((size_t)y * src->width + x) * 4,
-                   4 * sizeof(float));
+            to = dst->pixels + ((size_t)ry * dst->width + rx) * 4;
+            memcpy(to, src->pixels + ((size_t)y * src->width + x) * 4, 4 * sizeof(float));
+            if (src->kind == TT_IMAGE_NORMAL) {
+                int turn;
+                for (turn = 0; turn < (((quarter_turns % 4) + 4) % 4); turn++) {
+                    float vx = to[0];
+                    to[0] = -to[1];
+                    to[1] = vx;
+                }
+            }
         }
     *out_image = dst;
     return TT_OK;
@@ -5021,7 +5131,9 @@ static void tt__downsample_into(const tt_image *src, tt_image *dst)
             const float *b = a + (size_t)src->width * 4;
             float *out = dst->pixels + ((size_t)y * w + x) * 4;
             for (k = 0; k < 4; k++) out[k] = 0.25f * (a[k] + a[4 + k] + b[k] + b[4 + k]);
+            if (src->kind == TT_IMAGE_NORMAL) tt__normalize_vector_texel(out);
         }
+    dst->kind = src->kind;
 }
 
 TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *allocator, tt_image **out_image,
@@ -7020,6 +7132,10 @@ typedef struct tt__synth {
     int size, gutter, feather;
     float *tile;              /* RGBA, premultiplied (opaque) */
     size_t stride;            /* floats per row of `tile` */
+    /* A normal map (applying only): turn[side] maps the side's edge-sample
+       offsets to tile offsets (tt__band_turn), which turns its vectors. */
+    int normal;
+    float turn[4][4];
 } tt__synth;
 
 static float *tt__synth_texel(const tt__synth *s, int tx, int ty)
@@ -7040,25 +7156,66 @@ static float *tt__synth_texel(const tt__synth *s, int tx, int ty)
    square as it is (the band's tile texels are the window's, shifted), type
    2k+1 with the right square turned 180 degrees, and across the line each
    continues into the other as before. */
-static const float *tt__edge_sample(const tt__synth *s, int side, int type, int x, int d)
+static void tt__edge_source_texel(const tt__synth *s, int side, int type, int x, int d, int *sx, int *sy)
 {
     const int S = s->size;
-    int sx, sy;
     if (s->vertical && (side & 1)) {
         const tt_rect *w = &s->vertical[type >> 1];
-        if ((type & 1) == 0) { sx = w->x + S - 1 - d; sy = w->y + S - 1 - x; }
-        else { sx = w->x + S + d; sy = w->y + x; }
+        if ((type & 1) == 0) { *sx = w->x + S - 1 - d; *sy = w->y + S - 1 - x; }
+        else { *sx = w->x + S + d; *sy = w->y + x; }
     } else {
         const tt_rect *w = &s->windows[type >> 1];
-        if ((type & 1) == 0) { sx = w->x + x; sy = w->y + S - 1 - d; }
-        else { sx = w->x + S - 1 - x; sy = w->y + S + d; }
+        if ((type & 1) == 0) { *sx = w->x + x; *sy = w->y + S - 1 - d; }
+        else { *sx = w->x + S - 1 - x; *sy = w->y + S + d; }
     }
+}
+
+static const float *tt__edge_sample(const tt__synth *s, int side, int type, int x, int d)
+{
+    int sx, sy;
+    tt__edge_source_texel(s, side, type, x, d, &sx, &sy);
     return s->source->pixels + ((size_t)sy * s->source->width + sx) * 4;
 }
 
 static void tt__side_to_tile(const tt__synth *s, int side, int x, int d, int *tx, int *ty)
 {
     tt_rotate_coords(side, s->size, s->size, x, s->size - 1 - d, tx, ty);
+}
+
+/* How the edge sample of `side` (type `type`) is turned on its way into the
+   tile: the map of image offsets (row-major 2 x 2, image axes) taking a step
+   in the source window to the step it becomes in the tile. Both the window
+   and the tile are walked by the side frame's x and d, so the map sends the
+   source's x- and d-steps to the tile's; those steps are axis steps of
+   length 1, so the inverse of the source's is its transpose. A quarter or
+   half turn, never a mirror: the content keeps its handedness. */
+static void tt__band_turn(const tt__synth *s, int side, int type, float m[4])
+{
+    int sx0, sy0, sx1, sy1, sx2, sy2, tx0, ty0, tx1, ty1, tx2, ty2;
+    int ax, ay, bx, by, cx, cy, dx, dy;   /* source x-, d-steps; tile x-, d-steps */
+    tt__edge_source_texel(s, side, type, 1, 1, &sx0, &sy0);
+    tt__edge_source_texel(s, side, type, 2, 1, &sx1, &sy1);
+    tt__edge_source_texel(s, side, type, 1, 2, &sx2, &sy2);
+    tt__side_to_tile(s, side, 1, 1, &tx0, &ty0);
+    tt__side_to_tile(s, side, 2, 1, &tx1, &ty1);
+    tt__side_to_tile(s, side, 1, 2, &tx2, &ty2);
+    ax = sx1 - sx0; ay = sy1 - sy0;
+    bx = sx2 - sx0; by = sy2 - sy0;
+    cx = tx1 - tx0; cy = ty1 - ty0;
+    dx = tx2 - tx0; dy = ty2 - ty0;
+    /* [c d] [a b]^T */
+    m[0] = (float)(cx * ax + dx * bx);
+    m[1] = (float)(cx * ay + dx * by);
+    m[2] = (float)(cy * ax + dy * bx);
+    m[3] = (float)(cy * ay + dy * by);
+}
+
+/* The edge sample's colour, or its vector turned into the tile's frame. */
+static void tt__edge_value(const tt__synth *s, int side, int type, int x, int d, float out[3])
+{
+    const float *p = tt__edge_sample(s, side, type, x, d);
+    if (s->normal) tt__turn_vector(s->turn[side], p, out);
+    else { out[0] = p[0]; out[1] = p[1]; out[2] = p[2]; }
 }
 
 /* The band depth of entry i ((4 * tile + side) * S + x) of a plan. */
@@ -7109,11 +7266,10 @@ static void tt__lay_band(const tt__synth *s, const tt_synth_plan *plan, size_t d
         int depth = tt__plan_depth_at(plan, depth_base + (size_t)x);
         int last = tt__min_i(depth + s->feather, S - 1);
         for (d = 0; d <= last; d++) {
-            float alpha = tt__band_alpha(S, s->feather, depth, x, d), premultiplied[4];
-            const float *band;
+            float alpha = tt__band_alpha(S, s->feather, depth, x, d), premultiplied[4], band[3];
             int tx, ty;
             if (alpha <= 0.0f) continue;
-            band = tt__edge_sample(s, side, type, x, d);
+            tt__edge_value(s, side, type, x, d, band);
             for (k = 0; k < 3; k++) premultiplied[k] = band[k] * alpha;
             premultiplied[3] = alpha;
             tt__side_to_tile(s, side, x, d, &tx, &ty);
@@ -7171,6 +7327,8 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
     s.feather = plan->feather;
     s.stride = stride;
     s.tile = cell + (size_t)g * stride + (size_t)g * 4;
+    s.normal = source->kind == TT_IMAGE_NORMAL;
+    for (side = 0; side < 4; side++) tt__band_turn(&s, side, types[side], s.turn[side]);
     tt__copy_background(&s, &plan->background_windows[tile]);
     /* ABCD = AXXX over XBXX over XXCX over XXXD over XXXX: lay D first. */
     for (side = 3; side >= 0; side--)
@@ -7179,14 +7337,16 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
        around a mesh vertex differs from tile to tile: the mean of the two
        edge samples there matches each neighbour across an edge halfway. */
     for (side = 0; side < 4; side++) {
-        const float *a = tt__edge_sample(&s, side, types[side], 0, 0);
-        const float *b = tt__edge_sample(&s, (side + 3) % 4, types[(side + 3) % 4], S - 1, 0);
+        float a[3], b[3];
         int tx, ty;
         float *corner;
+        tt__edge_value(&s, side, types[side], 0, 0, a);
+        tt__edge_value(&s, (side + 3) % 4, types[(side + 3) % 4], S - 1, 0, b);
         tt__side_to_tile(&s, side, 0, 0, &tx, &ty);
         corner = tt__synth_texel(&s, tx, ty);
         for (k = 0; k < 3; k++) corner[k] = 0.5f * (a[k] + b[k]);
     }
+    if (s.normal) tt__normalize_vector_texels(s.tile, S, S, stride);
     if (g == 0) return;
     /* Gutters. The strip outside each side holds the edge sample continued
        across the edge (d < 0), i.e. the first rows of whichever tile lies
@@ -7208,7 +7368,7 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
                 float *out;
                 tt__side_to_tile(&s, side, x, d, &tx, &ty);
                 out = tt__synth_texel(&s, tx, ty);
-                memcpy(out, tt__edge_sample(&s, side, types[side], x, d), 3 * sizeof(float));
+                tt__edge_value(&s, side, types[side], x, d, out);
                 out[3] = 1.0f;
             }
 }
@@ -7557,6 +7717,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
         }
     }
 
+    memset(&s, 0, sizeof s);   /* the guide's texels as they are: the cuts compare them */
     s.source = guide;
     s.windows = plan->edge_windows;
     s.vertical = plan->vertical_windows;
@@ -7657,6 +7818,7 @@ static tt_result tt__compose_non_finite(const tt_synth_plan *plan, const tt_imag
     const float *bad = NULL;
     tt__synth s;
     int x, y, d, side;
+    memset(&s, 0, sizeof s);
     s.source = source;
     s.windows = plan->edge_windows;
     s.vertical = plan->vertical_windows;
@@ -7769,6 +7931,7 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
     if (plan->vertical_windows) memcpy(set->vertical_windows, plan->vertical_windows, (size_t)n * sizeof(tt_rect));
     memcpy(set->background_windows, plan->background_windows, (size_t)ntiles * sizeof(tt_rect));
     if ((result = tt__image_init(&set->levels[0], W, W, allocator, error)) != TT_OK) goto done;
+    set->levels[0].kind = source->kind;
     set->nlevels = 1;
 
     for (t = 0; t < ntiles; t++) {
@@ -9081,6 +9244,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     gh = h + 2;
     n = (gw > gh ? gw : gh);
     if ((result = tt_image_create(w, h, al, &patch, error)) != TT_OK) return result;
+    patch->kind = source->kind;
     in_place = (size_t)gw * (size_t)gh + count <= 3 * count;
     grid = in_place ? patch->pixels : TT__ALLOC(al, float, (size_t)gw * (size_t)gh + count);
     line = TT__ALLOC(al, float, n);
@@ -12151,6 +12315,9 @@ typedef struct tt__bake {
     tt_image *const *patches;
     const int *items;           /* pairs (entry, patch) of this face, in paste order */
     int nitems;
+    /* Normal-map patches: per item, the turn (row-major 2 x 2, image axes)
+       from its patch's frame to the atlas's; NULL for colour. */
+    const float *turns;
     double x[3], y[3];          /* the face's atlas triangle, pixels */
     double inverse_area2;       /* 1 / twice its signed area */
     double gutter;              /* texels */
@@ -12179,6 +12346,7 @@ static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float s
     px = px < -1.0 ? -1.0 : (px > patch->width + 1.0 ? patch->width + 1.0 : px);
     py = py < -1.0 ? -1.0 : (py > patch->height + 1.0 ? patch->height + 1.0 : py);
     tt_image_sample_bilinear(patch, (float)px, (float)py, sample);
+    if (b->turns) tt__turn_vector(b->turns + 4 * k, sample, sample);
     if (b->lapped->fade) {
         /* premultiplied: the fade scales colour and alpha alike; clamped, as
            the gutter's extrapolated weights may carry it past [0, 1] */
@@ -12315,6 +12483,45 @@ static void tt__bake_gutter(tt__bake *b)
     }
 }
 
+/* The turn a normal map's vectors take from a paste's patch into the atlas
+   over one face: the rotation nearest (polar decomposition) to the linear
+   map from the patch's pixel offsets to the atlas's, in image axes, with
+   the mirror when the map flips. A renderer builds each texel's tangent
+   frame from the atlas UVs, so the vectors must be expressed in it; the two
+   maps are nearly conformal, so the rotation is what carries the frame. A
+   degenerate face keeps the vectors as they are. */
+static void tt__bake_turn(const tt__bake *b, const float *uv, const tt_image *patch, float m[4])
+{
+    double px[3], py[3], p1x, p1y, p2x, p2y, a1x, a1y, a2x, a2y, det, a, bb, c, d, angle, cs, sn;
+    int i;
+    for (i = 0; i < 3; i++) {
+        px[i] = uv[2 * i] * patch->width;
+        py[i] = (1.0 - uv[2 * i + 1]) * patch->height;
+    }
+    p1x = px[1] - px[0]; p1y = py[1] - py[0];
+    p2x = px[2] - px[0]; p2y = py[2] - py[0];
+    a1x = b->x[1] - b->x[0]; a1y = b->y[1] - b->y[0];
+    a2x = b->x[2] - b->x[0]; a2y = b->y[2] - b->y[0];
+    det = p1x * p2y - p2x * p1y;
+    m[0] = m[3] = 1.0f;
+    m[1] = m[2] = 0.0f;
+    if (!(fabs(det) > 1e-12) || !tt__is_finite_d(det)) return;
+    /* M = [a1 a2] [p1 p2]^-1 */
+    a = (a1x * p2y - a2x * p1y) / det;
+    bb = (a2x * p1x - a1x * p2x) / det;
+    c = (a1y * p2y - a2y * p1y) / det;
+    d = (a2y * p1x - a1y * p2x) / det;
+    if (a * d - bb * c >= 0.0) {
+        angle = atan2(c - bb, a + d);
+        cs = cos(angle); sn = sin(angle);
+        m[0] = (float)cs; m[1] = (float)-sn; m[2] = (float)sn; m[3] = (float)cs;
+    } else {
+        angle = atan2(c + bb, a - d);
+        cs = cos(angle); sn = sin(angle);
+        m[0] = (float)cs; m[1] = (float)sn; m[2] = (float)sn; m[3] = (float)-cs;
+    }
+}
+
 /* A face whose atlas triangle is thinner than this (texels) gets no gutter of
    its own: extrapolating g texels across it would multiply its barycentrics,
    and their rounding, by g / height. The final fill covers its surroundings. */
@@ -12339,10 +12546,10 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     tt_result result;
     tt__bake bake;
     int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL;
-    float *state = NULL;
+    float *state = NULL, *turns = NULL;
     size_t texels, t, total = 0, head = 0, tail = 0;
     float empty = tt__infinity();
-    int f, p, e, k, c, width, height;
+    int f, p, e, k, c, width, height, normal;
 
     tt__ok(error);
     if (!mesh || !lapped || !patches || !corner_uv || !atlas)
@@ -12366,6 +12573,12 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     for (p = 0; p < npatches; p++)
         if (!patches[p] || !patches[p]->pixels || patches[p]->width <= 0 || patches[p]->height <= 0)
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1, "patch %d is NULL or empty", p);
+    normal = patches[0]->kind == TT_IMAGE_NORMAL;
+    for (p = 1; p < npatches; p++)
+        if ((patches[p]->kind == TT_IMAGE_NORMAL) != normal)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1,
+                               "patch %d is %sa normal map but patch 0 is %s: bake each map of a material on its "
+                               "own", p, normal ? "not " : "", normal ? "one" : "not");
     if (tt__require_triangles(mesh, "baking needs triangles", error) != TT_OK)
         return TT_ERROR_INVALID_ARGUMENT;
     for (c = 0; c < 2 * mesh->ncorners; c++)
@@ -12413,7 +12626,8 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     items = TT__ALLOC(al, int, 2 * total);
     state = TT__ALLOC(al, float, texels);
     queue = TT__ALLOC(al, int, texels);
-    if (!start || !fill || !items || !state || !queue) {
+    if (normal) turns = TT__ALLOC(al, float, 4 * total + 4);
+    if (!start || !fill || !items || !state || !queue || (normal && !turns)) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                           "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
         goto done;
@@ -12470,6 +12684,12 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
         bake.inverse_area2 = 1.0 / area2;
         bake.items = items + 2 * (size_t)start[f];
         bake.nitems = start[f + 1] - start[f];
+        if (normal) {
+            bake.turns = turns + 4 * (size_t)start[f];
+            for (k = 0; k < bake.nitems; k++)
+                tt__bake_turn(&bake, lapped->uv + 6 * (size_t)bake.items[2 * k], patches[bake.items[2 * k + 1]],
+                              turns + 4 * ((size_t)start[f] + (size_t)k));
+        }
         bake.inside = 1;
         tt_raster_triangle(xy, width, height, tt__bake_texel, &bake);
         if (bake.gutter <= 0.0) continue;
@@ -12487,7 +12707,8 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     for (t = 0; t < texels; t++) {
         float *px = atlas->pixels + 4 * t;
         if (!(state[t] < empty)) continue;
-        if (px[3] > 0.0f) {
+        if (normal) tt__normalize_vector_texel(px);   /* premultiplied or not: the direction */
+        else if (px[3] > 0.0f) {
             float inverse = 1.0f / px[3];
             px[0] *= inverse;
             px[1] *= inverse;
@@ -12495,7 +12716,12 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
         }
         queue[tail++] = (int)t;
     }
-    if (tail == 0) memset(atlas->pixels, 0, texels * 4 * sizeof(float));
+    if (tail == 0) {
+        memset(atlas->pixels, 0, texels * 4 * sizeof(float));
+        if (normal)
+            for (t = 0; t < texels; t++) atlas->pixels[4 * t + 2] = 1.0f;
+    }
+    atlas->kind = normal ? TT_IMAGE_NORMAL : TT_IMAGE_COLOR;
     while (head < tail) {
         int from = queue[head++], x = from % width, y = from / width, side;
         for (side = 0; side < 4; side++) {
@@ -12516,6 +12742,7 @@ done:
     tt__free(al, items);
     tt__free(al, state);
     tt__free(al, queue);
+    tt__free(al, turns);
     return result;
 }
 
@@ -20190,8 +20417,12 @@ TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tile
                         tt__min_i(plain->nlevels, upright->nlevels) - 1);
     left = &plain->levels[level];
     right = &upright->levels[level];
+    if (left->kind != right->kind)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "one tileset is a normal map and the other is not: apply both plans to the same map");
     if ((result = tt_image_create(2 * left->width, left->height, allocator, out_image, error)) != TT_OK)
         return result;
+    (*out_image)->kind = left->kind;
     for (row = 0; row < left->height; row++) {
         float *out = (*out_image)->pixels + (size_t)row * 2 * (size_t)left->width * 4;
         memcpy(out, left->pixels + (size_t)row * left->width * 4, (size_t)left->width * 4 * sizeof(float));

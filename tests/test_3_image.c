@@ -836,6 +836,102 @@ static void test_min_error_cut(void)
     CHECK(cnt.live == 0, "min_error_cut: %ld allocations leaked", cnt.live);
 }
 
+
+/* Normal maps: bytes <-> unit vectors in both conventions, and the steps that
+   turn or blend an image keep them unit vectors turned with the content. */
+static void test_normal_maps(void)
+{
+    unsigned char bytes[4 * 3 * 4], back[4 * 3 * 4];
+    tt_image *gl = NULL, *dx = NULL, *turned = NULL, *half = NULL;
+    counter cnt;
+    tt_allocator al = make_allocator(&cnt, -1);
+    tt_error err;
+    int i, x, y, bad = 0, turns;
+    /* a few directions encoded the usual way: (n + 1) / 2 * 255 */
+    static const float dirs[4][3] = {{0.0f, 0.0f, 1.0f}, {0.6f, 0.0f, 0.8f}, {0.0f, -0.6f, 0.8f}, {0.48f, 0.36f, 0.8f}};
+    for (i = 0; i < 12; i++) {
+        const float *n = dirs[i % 4];
+        int k;
+        for (k = 0; k < 3; k++) bytes[4 * i + k] = (unsigned char)floor((n[k] + 1.0) * 0.5 * 255.0 + 0.5);
+        bytes[4 * i + 3] = 255;
+    }
+    CHECK(tt_image_from_bytes(bytes, 4, 3, 4, 0, TT_COLOR_NORMAL, &al, &gl, &err) == TT_OK && gl,
+          "decode a normal map: %s", err.message);
+    CHECK(tt_image_from_bytes(bytes, 4, 3, 4, 0, TT_COLOR_NORMAL_Y_DOWN, &al, &dx, &err) == TT_OK && dx,
+          "decode a Y-down normal map: %s", err.message);
+    if (!gl || !dx) goto done;
+    CHECK(gl->kind == TT_IMAGE_NORMAL && dx->kind == TT_IMAGE_NORMAL, "decoded normal maps are of kind normal");
+    for (i = 0; i < 12; i++) {
+        const float *n = dirs[i % 4], *a = gl->pixels + 4 * i, *b = dx->pixels + 4 * i;
+        double length = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+        if (fabs(length - 1.0) > 1e-5 || fabs(a[0] - n[0]) > 0.01f || fabs(a[1] - n[1]) > 0.01f ||
+            fabs(a[2] - n[2]) > 0.01f || b[0] != a[0] || b[1] != -a[1] || b[2] != a[2] || a[3] != 1.0f)
+            bad++;
+    }
+    CHECK(bad == 0, "decoded unit vectors, y negated for Y-down: %d texels wrong", bad);
+    tt_image_to_rgba8(gl, TT_COLOR_NORMAL, back);
+    CHECK(memcmp(back, bytes, sizeof bytes) == 0, "bytes of unit vectors -> normal map -> the same bytes");
+    tt_image_to_rgba8(dx, TT_COLOR_NORMAL_Y_DOWN, back);
+    CHECK(memcmp(back, bytes, sizeof bytes) == 0, "the same round trip in the Y-down convention");
+    /* a quarter turn counter-clockwise turns a vector pointing right to one pointing up */
+    for (turns = -3; turns <= 5; turns++) {
+        double angle = turns * 1.5707963267948966;
+        int worst = 0;
+        turned = NULL;
+        CHECK(tt_image_rotate90(gl, turns, &al, &turned, NULL) == TT_OK && turned, "rotate90(%d)", turns);
+        if (!turned) continue;
+        CHECK(turned->kind == TT_IMAGE_NORMAL, "a turned normal map stays a normal map");
+        for (y = 0; y < gl->height; y++)
+            for (x = 0; x < gl->width; x++) {
+                int rx, ry;
+                const float *a = gl->pixels + 4 * (y * gl->width + x), *b;
+                double ex = cos(angle) * a[0] - sin(angle) * a[1], ey = sin(angle) * a[0] + cos(angle) * a[1];
+                tt_rotate_coords(turns, gl->width, gl->height, x, y, &rx, &ry);
+                b = turned->pixels + 4 * (ry * turned->width + rx);
+                if (fabs(b[0] - ex) > 1e-6 || fabs(b[1] - ey) > 1e-6 || b[2] != a[2]) worst++;
+            }
+        CHECK(worst == 0, "rotate90(%d) turns each vector by %d quarter turns: %d texels wrong", turns, turns, worst);
+        tt_image_free(turned);
+    }
+    /* a 2x2 average of two directions is renormalised, and a colour image is not */
+    {
+        tt_image *sq = NULL;
+        if (tt_image_create(2, 2, &al, &sq, NULL) == TT_OK) {
+            sq->kind = TT_IMAGE_NORMAL;
+            for (i = 0; i < 4; i++) {
+                sq->pixels[4 * i] = i % 2 ? 0.6f : -0.6f;
+                sq->pixels[4 * i + 2] = 0.8f;
+                sq->pixels[4 * i + 3] = 1.0f;
+            }
+            CHECK(tt_image_downsample2(sq, &al, &half, NULL) == TT_OK && half, "halve a normal map");
+            if (half)
+                CHECK(half->kind == TT_IMAGE_NORMAL && fabs(half->pixels[0]) < 1e-6 && fabs(half->pixels[2] - 1.0f) < 1e-6,
+                      "the mean of (-0.6, 0, 0.8) and (0.6, 0, 0.8) is renormalised to (0, 0, 1), got (%g, %g, %g)",
+                      half->pixels[0], half->pixels[1], half->pixels[2]);
+            tt_image_free(half);
+            half = NULL;
+            sq->kind = TT_IMAGE_COLOR;
+            CHECK(tt_image_downsample2(sq, &al, &half, NULL) == TT_OK && half && fabs(half->pixels[2] - 0.8f) < 1e-6,
+                  "a colour image is averaged as it is");
+            tt_image_free(half);
+            half = NULL;
+            tt_image_free(sq);
+        }
+    }
+    {
+        tt_image *im = (tt_image *)&im;
+        CHECK(tt_image_from_bytes(bytes, 4, 3, 2, 0, TT_COLOR_NORMAL, &al, &im, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  im == NULL && strstr(err.message, "channels"),
+              "a grey normal map is refused: %s", err.message);
+        CHECK(tt_image_from_bytes(bytes, 4, 3, 4, 0, (tt_color_space)7, &al, &im, &err) == TT_ERROR_INVALID_ARGUMENT,
+              "an unknown colour space is refused");
+    }
+done:
+    tt_image_free(gl);
+    tt_image_free(dx);
+    CHECK(cnt.live == 0, "normal maps: %ld blocks left", cnt.live);
+}
+
 void run_image_tests(void)
 {
     RUN(test_image_basics);
@@ -849,5 +945,6 @@ void run_image_tests(void)
     RUN(test_rotate);
     RUN(test_rotate_coords_large);
     RUN(test_over_downsample);
+    RUN(test_normal_maps);
     RUN(test_min_error_cut);
 }

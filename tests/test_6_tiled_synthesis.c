@@ -512,6 +512,123 @@ static void test_second_map_same_masks(void)
     tt_image_free(mark);
 }
 
+/* A normal map is applied with the guide's plan, its vectors turned as the
+   content is. Where a band's edge row lies (alpha 1: the edge sample alone),
+   a ramp image r = x, g = y applied with the same plan tells which source
+   step each tile step came from, hence the band's turn; the normal atlas
+   must hold the source vector turned by exactly that (a constant "up" on a
+   band turned a quarter turn reads as the turned direction). Checked for
+   plain and upright plans, every tile, every side; every texel of every
+   level is a unit vector. The control, the same vectors applied as a colour
+   image, must fail the check. */
+static void test_normal_map_turns(void)
+{
+    const int S = 24, g = 3, W = 96, H = 96;
+    tt_image *guide = sy_noise(W, H, 17u), *ramp = NULL, *normal = NULL;
+    int upright, x, y;
+    const float v[3] = {0.3f, 0.5f, 0.81240384f};   /* |v| = 1, no axis */
+    tt_image_create(W, H, NULL, &ramp, NULL);
+    tt_image_create(W, H, NULL, &normal, NULL);
+    if (!guide || !ramp || !normal) {
+        CHECK(0, "test images");
+        goto done;
+    }
+    normal->kind = TT_IMAGE_NORMAL;
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            float *r = sy_px(ramp, x, y), *n = sy_px(normal, x, y);
+            r[0] = (float)x; r[1] = (float)y; r[2] = 0.0f; r[3] = 1.0f;
+            n[0] = v[0]; n[1] = v[1]; n[2] = v[2]; n[3] = 1.0f;
+        }
+    for (upright = 0; upright <= 1; upright++) {
+        tt_synth_options o = sy_options(1, S, g, 5u);
+        tt_synth_plan *plan = NULL;
+        tt_tileset *ramps = NULL, *normals = NULL, *control = NULL;
+        tt_error err;
+        tt_result r;
+        int t, side, checked = 0, bad = 0, control_bad = 0, not_unit = 0, level, turned = 0;
+        o.upright = upright;
+        r = tt_synth_plan_create(guide, &o, NULL, &plan, &err);
+        if (r == TT_OK) r = tt_synth_apply(plan, ramp, NULL, &ramps, &err);
+        if (r == TT_OK) r = tt_synth_apply(plan, normal, NULL, &normals, &err);
+        normal->kind = TT_IMAGE_COLOR;
+        if (r == TT_OK) r = tt_synth_apply(plan, normal, NULL, &control, &err);
+        normal->kind = TT_IMAGE_NORMAL;
+        CHECK(r == TT_OK, "upright %d: plan, ramp, normal map, control: %d (%s)", upright, r, err.message);
+        if (r != TT_OK) goto next;
+        CHECK(normals->levels[0].kind == TT_IMAGE_NORMAL && control->levels[0].kind == TT_IMAGE_COLOR,
+              "the atlas is of its source's kind");
+        for (t = 0; t < tt_tile_layout_tile_count(&plan->layout); t++) {
+            uint8_t types[4];
+            int cx, cy;
+            sy_tile_types(&plan->layout, t, types, &cx, &cy);
+            for (side = 0; side < 4; side++)
+                for (x = 2; x < S - 2; x++) {
+                    int tx0, ty0, tx1, ty1, stx, sty, ssx, ssy;
+                    const float *r0, *r1, *n, *c;
+                    double ex, ey;
+                    /* edge row d = 0 of the side: texels x and x + 1 */
+                    tt_rotate_coords(side, S, S, x, S - 1, &tx0, &ty0);
+                    tt_rotate_coords(side, S, S, x + 1, S - 1, &tx1, &ty1);
+                    r0 = sy_px(&ramps->levels[0], cx + g + tx0, cy + g + ty0);
+                    r1 = sy_px(&ramps->levels[0], cx + g + tx1, cy + g + ty1);
+                    stx = tx1 - tx0; sty = ty1 - ty0;                             /* the tile step */
+                    ssx = (int)lrintf(r1[0] - r0[0]); ssy = (int)lrintf(r1[1] - r0[1]);  /* its source step */
+                    /* the rotation taking (ssx, ssy) to (stx, sty), both unit axis steps, image axes
+                       (y down), applied to v flipped into image axes and back */
+                    {
+                        double cs = ssx * stx + ssy * sty, sn = ssx * sty - ssy * stx;
+                        double ix = v[0], iy = -v[1];
+                        ex = cs * ix - sn * iy;
+                        ey = -(sn * ix + cs * iy);
+                    }
+                    if (abs(ssx) + abs(ssy) != 1) {
+                        bad++;
+                        continue;
+                    }
+                    n = sy_px(&normals->levels[0], cx + g + tx0, cy + g + ty0);
+                    c = sy_px(&control->levels[0], cx + g + tx0, cy + g + ty0);
+                    checked++;
+                    if (fabs(ex - v[0]) > 1e-3 || fabs(ey - v[1]) > 1e-3) turned++;
+                    if (fabs(n[0] - ex) > 1e-5 || fabs(n[1] - ey) > 1e-5 || fabs(n[2] - v[2]) > 1e-5) {
+                        if (bad == 0)
+                            DETAIL("upright %d tile %d side %d x %d: (%g, %g), want (%g, %g)", upright, t, side, x,
+                                   n[0], n[1], ex, ey);
+                        bad++;
+                    }
+                    if (fabs(c[0] - ex) > 1e-5 || fabs(c[1] - ey) > 1e-5) control_bad++;
+                }
+        }
+        CHECK(checked > 0 && bad == 0, "upright %d: %d of %d edge-row texels hold the wrong turn", upright, bad,
+              checked);
+        CHECK(turned > checked / 4, "upright %d: %d of %d edge-row texels are turned content (the test can fail)",
+              upright, turned, checked);
+        CHECK(control_bad > checked / 4, "control (vectors not turned): %d of %d edge-row texels wrong", control_bad,
+              checked);
+        for (level = 0; level < normals->nlevels; level++) {
+            const tt_image *im = &normals->levels[level];
+            size_t i, count = (size_t)im->width * (size_t)im->height;
+            CHECK(im->kind == TT_IMAGE_NORMAL, "level %d is a normal map", level);
+            for (i = 0; i < count; i++) {
+                const float *p = im->pixels + 4 * i;
+                double length = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+                if (fabs(length - 1.0) > 1e-5) not_unit++;
+            }
+        }
+        CHECK(not_unit == 0, "upright %d: %d texels of the normal atlas and its mips are not unit vectors", upright,
+              not_unit);
+    next:
+        tt_tileset_free(ramps);
+        tt_tileset_free(normals);
+        tt_tileset_free(control);
+        tt_synth_plan_free(plan);
+    }
+done:
+    tt_image_free(guide);
+    tt_image_free(ramp);
+    tt_image_free(normal);
+}
+
 /* B = s * A + o texel by texel (one s, o per channel): every atlas level of
    B is s * atlas_A + o up to float rounding. The masks do not depend on the
    applied image, and every step (over, corner means, mip averages) is an
@@ -1054,6 +1171,7 @@ void run_tiled_synthesis_tests(void)
     RUN(test_compose_tile_matches_apply);
     RUN(test_upright_tiles);
     RUN(test_second_map_same_masks);
+    RUN(test_normal_map_turns);
     RUN(test_affine_map);
     RUN(test_plan_create_errors);
     RUN(test_compose_tile_errors);

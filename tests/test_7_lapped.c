@@ -3819,6 +3819,83 @@ static void test_lapped_bake_constant(void)
     tt_mesh_free(mesh);
 }
 
+/* Normal-map patches: the vectors are turned from each paste's frame into
+   the atlas's. A grid whose atlas UVs are its positions (scaled), pasted
+   with uv = s R(theta) (x, y) + o: the patch's axes lie along R(-theta) of
+   the atlas's, so a constant patch vector v bakes to R(-theta) v; a
+   half-transparent paste over another bakes to the normalised blend of the
+   two turned vectors. The control, the same patch baked as colour, keeps v
+   unturned and must fail; patches of mixed kinds are refused. */
+static void test_lapped_bake_normals(void)
+{
+    tt_mesh *mesh = bake_grid(4, 4, 0.3, NULL);
+    const double t0 = 0.7, t1 = -2.1, zero[2] = {0.5, 0.5};
+    const float v[3] = {0.36f, 0.48f, 0.8f};
+    double m0[4], m1[4], e0[2], e1[2], mix[3], length;
+    tt_image *patches[2], *atlas = NULL;
+    float *uv = NULL;
+    lb_builder b;
+    tt_error err;
+    unsigned char *inside = NULL;
+    int c, i, bad, control_bad, pass;
+    if (!mesh) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *p = mesh->pos + 3 * mesh->corner_vert[c];
+        uv[2 * c] = 0.1f + 0.2f * p[0];
+        uv[2 * c + 1] = 0.1f + 0.2f * p[1];
+    }
+    m0[0] = 0.2 * cos(t0); m0[1] = -0.2 * sin(t0); m0[2] = 0.2 * sin(t0); m0[3] = 0.2 * cos(t0);
+    m1[0] = 0.2 * cos(t1); m1[1] = -0.2 * sin(t1); m1[2] = 0.2 * sin(t1); m1[3] = 0.2 * cos(t1);
+    e0[0] = cos(-t0) * v[0] - sin(-t0) * v[1]; e0[1] = sin(-t0) * v[0] + cos(-t0) * v[1];
+    e1[0] = cos(-t1) * v[0] - sin(-t1) * v[1]; e1[1] = sin(-t1) * v[0] + cos(-t1) * v[1];
+    mix[0] = 0.5 * (e0[0] + e1[0]); mix[1] = 0.5 * (e0[1] + e1[1]); mix[2] = v[2];
+    length = sqrt(mix[0] * mix[0] + mix[1] * mix[1] + mix[2] * mix[2]);
+    patches[0] = bake_constant(32, 32, v[0], v[1], v[2], 1.0f);
+    patches[1] = bake_constant(32, 32, v[0], v[1], v[2], 0.5f);
+    tt_image_create(64, 64, NULL, &atlas, NULL);
+    inside = bake_raster_mask(mesh, uv, 64, 64);
+    lb_init(&b);
+    lb_paste_all(&b, mesh, 0, m0, zero);
+    for (pass = 0; pass < 3; pass++) {
+        const double *want = pass == 0 ? e0 : mix;
+        double wz = pass == 0 ? v[2] : v[2] / length, wx = pass == 0 ? want[0] : want[0] / length,
+               wy = pass == 0 ? want[1] : want[1] / length;
+        int normal = pass < 2;
+        if (pass == 1) lb_paste_all(&b, mesh, 1, m1, zero);
+        patches[0]->kind = patches[1]->kind = normal ? TT_IMAGE_NORMAL : TT_IMAGE_COLOR;
+        CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 2, atlas, &err) == TT_OK, "bake pass %d: %s", pass,
+              err.message);
+        bad = control_bad = 0;
+        for (i = 0; i < 64 * 64; i++) {
+            const float *p = atlas->pixels + 4 * i;
+            int off = fabs(p[0] - wx) > 1e-4 || fabs(p[1] - wy) > 1e-4 || fabs(p[2] - wz) > 1e-4;
+            if (!inside[i]) continue;
+            if (normal) bad += off;
+            else control_bad += off;
+        }
+        if (normal) {
+            CHECK(atlas->kind == TT_IMAGE_NORMAL, "the atlas of normal patches is a normal map");
+            CHECK(bad == 0, "pass %d: %d texels are not the turned (and blended) vector (%g, %g, %g)", pass, bad, wx,
+                  wy, wz);
+        } else {
+            CHECK(atlas->kind == TT_IMAGE_COLOR, "the atlas of colour patches is colour");
+            CHECK(control_bad > 100, "control (patches as colour): %d texels off the turned blend", control_bad);
+        }
+    }
+    patches[1]->kind = TT_IMAGE_NORMAL;
+    CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 2, atlas, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              strstr(err.message, "normal map"),
+          "a colour patch and a normal patch in one bake are refused: %s", err.message);
+    free(inside);
+    free(uv);
+    lb_free(&b);
+    tt_image_free(atlas);
+    tt_image_free(patches[0]);
+    tt_image_free(patches[1]);
+    tt_mesh_free(mesh);
+}
+
 /* A smooth colour ramp patch: r = x / w, g = y / h, b = 0.5, opaque. */
 static tt_image *bake_ramp(int w, int h)
 {
@@ -4495,6 +4572,7 @@ void run_lapped_tests(void)
     RUN(test_uv_check_errors);
     RUN(test_uv_check_oom);
     RUN(test_lapped_bake_constant);
+    RUN(test_lapped_bake_normals);
     RUN(test_lapped_baked_seams);
     RUN(test_lapped_bake_gutter);
     RUN(test_lapped_bake_seams);
