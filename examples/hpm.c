@@ -58,6 +58,10 @@ static void print_help(void)
            "                   coordinates leave [0,1] (render with repeat, as 'tiledtex render'\n"
            "                   does); without it every coordinate stays inside the image\n"
            "  --no-fit         the control: the same clusters, each placed at random\n"
+           MATERIAL_OPTIONS_HELP("                   ")
+           "                   (here the MTL names each map where it is, as it names IMAGE: the\n"
+           "                   UVs serve every map; only a --normal-y-down map is written, turned\n"
+           "                   +Y up, as OUT_PREFIX_normal.png)\n"
            "\n"
            "Prints the clusters textured per level of the hierarchy, the fits (accepted, accepted\n"
            "at the smallest cluster size, rejected: split), clusters that continue a neighbour's\n"
@@ -77,6 +81,7 @@ typedef struct hpm_command_options {
     const char *mesh_path, *image_path;
     char prefix[TOOL_PREFIX_SIZE];  /* OUT_PREFIX without a known extension */
     tt_hpm_options map;     /* zero fields: the library's defaults */
+    material_maps maps;     /* --normal ...: the material's other maps, on the same UVs */
 } hpm_command_options;
 
 /* --threshold: a number above 0, or "inf" (every fit accepted). */
@@ -96,7 +101,7 @@ static int parse_threshold(const char *value, double *threshold)
 static int parse_command_line(int argc, char **argv, hpm_command_options *options)
 {
     const char *positional[3];
-    int npositional = 0, i;
+    int npositional = 0, i, taken;
     memset(options, 0, sizeof *options);
     for (i = 1; i < argc; i++) {
         const char *value;
@@ -124,6 +129,8 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
             options->map.flags |= TT_HPM_TOROIDAL;
         } else if (strcmp(argv[i], "--no-fit") == 0) {
             options->map.flags |= TT_HPM_RANDOM_PLACEMENT;
+        } else if ((taken = material_parse_option(argc, argv, &i, &options->maps)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
         } else if (npositional < 3) {
@@ -299,24 +306,32 @@ int cmd_hpm(int argc, char **argv)
     hpm_quality quality;
     tool_output output = TOOL_OUTPUT_INIT;
     float *corner_uv = NULL;
-    char obj_path[4096], mtl_path[4096], message[TOOL_ERROR_SIZE];
+    char obj_path[4096], mtl_path[4096], message[TOOL_ERROR_SIZE], normal_path[4200];
+    const char *map_paths[MATERIAL_MAPS];
     double start = tool_seconds_now();
-    int status;
+    int status, map;
 
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
+    /* The UVs are into IMAGE itself, so they serve every map of its size as
+       it is; a Y-down normal map alone is rewritten, +Y up. */
+    material_path(normal_path, sizeof normal_path, options.prefix, MATERIAL_NORMAL);
+    for (map = 0; map < MATERIAL_MAPS; map++) map_paths[map] = options.maps.paths[map];
+    if (options.maps.normal_y_down) map_paths[MATERIAL_NORMAL] = normal_path;
 
     if ((status = triangle_mesh_read(options.mesh_path, NULL, &mesh)) != 0) return status;
     /* A photo: sRGB bytes in the file, linear light in the library (which
        matches colours as displayed again, by itself). */
     if (image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
+    if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again, but only after mapping). */
     if (status == 0) status = tool_refuse_input_overwrite(obj_path);
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0 && options.maps.normal_y_down) status = tool_refuse_input_overwrite(normal_path);
     if (status == 0) {
         corner_uv = (float *)malloc((size_t)mesh.ntriangles * 6 * sizeof(float));
         if (!corner_uv) status = tool_fail("out of memory for the texture coordinates of %s", options.mesh_path);
@@ -325,15 +340,19 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0) status = measure_quality(&options, &mesh, image, corner_uv, &report, &quality);
 
     if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
-    if (status == 0) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0);
+    if (status == 0) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0, map_paths);
+    if (status == 0 && options.maps.normal_y_down)
+        status = output_add_map_png(&output, normal_path, MATERIAL_NORMAL, options.maps.images[MATERIAL_NORMAL]);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, image, &report, &quality, tool_seconds_now() - start);
-        printf("wrote %s, %s\n", obj_path, mtl_path);
+        printf("wrote %s, %s%s%s\n", obj_path, mtl_path, options.maps.normal_y_down ? ", " : "",
+               options.maps.normal_y_down ? normal_path : "");
     }
     output_free(&output);
     image_free(image);
+    material_free(&options.maps);
     free(corner_uv);
     triangle_mesh_free(&mesh);
     return status;

@@ -65,6 +65,7 @@ int image_crop(const tt_image *image, int x, int y, int width, int height, tt_im
     }
     crop->width = width;
     crop->height = height;
+    crop->kind = image->kind;
     for (row = 0; row < height; row++)
         memcpy(crop->pixels + (size_t)row * (size_t)width * 4,
                image->pixels + ((size_t)(y + row) * (size_t)image->width + (size_t)x) * 4,
@@ -113,6 +114,7 @@ static int convert_decoded(unsigned char *pixels, int width, int height, int cha
         }
         memcpy(image->pixels + (size_t)y0 * (size_t)width * 4, strip->pixels,
                (size_t)(y1 - y0) * (size_t)width * 4 * sizeof(float));
+        image->kind = strip->kind;   /* a normal map's vectors */
         tt_image_free(strip);
         y1 = y0;
         if (y1 > 0 && (shorter = (unsigned char *)realloc(pixels, (size_t)y1 * row)) != NULL) pixels = shorter;

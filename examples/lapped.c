@@ -124,6 +124,10 @@ static void print_help(void)
            TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
            LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
            TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS);
+    printf(MATERIAL_OPTIONS_HELP("                       ")
+           "                       (here each patch's window of each map: OUT_PREFIX_patch_1_normal.png,\n"
+           "                       ...; with --bake the maps baked with the same pastes as IMAGE,\n"
+           "                       OUT_PREFIX_baked_normal.png, ..., normals turned into the atlas)\n");
     printf("  --subdivide L        make the triangles smaller before pasting, L from 0 to 8 (default\n"
            "                       0): quadrangulate them L times, as 'tiledtex tile' does, and split\n"
            "                       every quad into two triangles, so a triangle becomes 6, 24, 96, ...\n"
@@ -163,6 +167,7 @@ typedef struct lapped_options {
     int bake_size;                  /* 0 = no --bake */
     bake_uv_choice bake_uv;         /* --bake-uv */
     tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
+    material_maps maps;             /* --normal ...: the material's other maps, pasted alike */
 } lapped_options;
 
 /* Returns -1 to go on, or the exit status to return now. */
@@ -214,6 +219,8 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             else return tool_usage("--bake-uv wants auto, mesh or atlas, got '%s'", value);
         } else if (strcmp(argv[i], "--isotropic") == 0) {
             options->isotropic = 1;
+        } else if ((taken = material_parse_option(argc, argv, &i, &options->maps)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
         } else if (npositional < 3) {
@@ -563,6 +570,12 @@ typedef struct lapped_patches {
     tt_image **images;      /* count patches (premultiplied), NULL until made */
     char **png_paths;       /* OUT_PREFIX_patch.png for one, else OUT_PREFIX_patch_K.png, K from 1 */
     char **materials;       /* "lapped" for one, else "lapped_K" */
+    /* The material's other maps: patch k's window of map m is written as
+       map_png_paths[k * MATERIAL_MAPS + m] (its PNG name with _normal, ...;
+       NULL for a map not given), and with --bake kept, premultiplied by
+       patch k's alpha, as map_images[k * MATERIAL_MAPS + m]. */
+    char **map_png_paths;
+    tt_image **map_images;
 } lapped_patches;
 
 static void lapped_patches_free(lapped_patches *patches)
@@ -573,23 +586,33 @@ static void lapped_patches_free(lapped_patches *patches)
         if (patches->png_paths) free(patches->png_paths[k]);
         if (patches->materials) free(patches->materials[k]);
     }
+    for (k = 0; k < patches->count * MATERIAL_MAPS; k++) {
+        if (patches->map_png_paths) free(patches->map_png_paths[k]);
+        if (patches->map_images) tt_image_free(patches->map_images[k]);
+    }
     free(patches->images);
     free(patches->png_paths);
     free(patches->materials);
+    free(patches->map_png_paths);
+    free(patches->map_images);
     memset(patches, 0, sizeof *patches);
 }
 
 /* The names, before anything is made: the paths are checked against the
    inputs before the long part. One patch keeps the names it always had. */
-static int lapped_patches_name(const char *prefix, const patch_windows *windows, lapped_patches *patches)
+static int lapped_patches_name(const char *prefix, const patch_windows *windows, const material_maps *maps,
+                               lapped_patches *patches)
 {
-    const size_t path_size = strlen(prefix) + 32;
-    int k;
+    const size_t path_size = strlen(prefix) + 48;
+    int k, map;
     memset(patches, 0, sizeof *patches);
     patches->images = (tt_image **)calloc((size_t)windows->count, sizeof(tt_image *));
     patches->png_paths = (char **)calloc((size_t)windows->count, sizeof(char *));
     patches->materials = (char **)calloc((size_t)windows->count, sizeof(char *));
-    if (!patches->images || !patches->png_paths || !patches->materials) {
+    patches->map_png_paths = (char **)calloc((size_t)windows->count * MATERIAL_MAPS, sizeof(char *));
+    patches->map_images = (tt_image **)calloc((size_t)windows->count * MATERIAL_MAPS, sizeof(tt_image *));
+    if (!patches->images || !patches->png_paths || !patches->materials || !patches->map_png_paths ||
+        !patches->map_images) {
         lapped_patches_free(patches);
         return tool_fail("out of memory for the patches' names");
     }
@@ -609,8 +632,66 @@ static int lapped_patches_name(const char *prefix, const patch_windows *windows,
             snprintf(patches->png_paths[k], path_size, "%s_patch_%d.png", prefix, k + 1);
             snprintf(patches->materials[k], 32, "lapped_%d", k + 1);
         }
+        for (map = 0; map < MATERIAL_MAPS; map++) {
+            char **path = &patches->map_png_paths[k * MATERIAL_MAPS + map];
+            if (!maps->paths[map]) continue;
+            if (!(*path = (char *)malloc(path_size))) {
+                lapped_patches_free(patches);
+                return tool_fail("out of memory for the patches' names");
+            }
+            /* beside the patch's PNG: OUT_PREFIX_patch_K_normal.png */
+            snprintf(*path, path_size, "%.*s_%s.png", (int)(strlen(patches->png_paths[k]) - 4),
+                     patches->png_paths[k], material_map_names[map]);
+        }
     }
     return 0;
+}
+
+/* Each patch's window of each map: its PNG (the map as it is, opaque: the
+   colour patch's alpha shows where it lies) and, for --bake, the window
+   premultiplied by the colour patch's alpha, so that every map is
+   composited exactly where and as much as the colour is. Frees the maps. */
+static int make_map_patches(const lapped_options *options, material_maps *maps, const patch_windows *windows,
+                            tool_output *output, lapped_patches *patches)
+{
+    int k, map, status = 0;
+    for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
+        const tt_image *image = maps->images[map];
+        if (!image) continue;
+        for (k = 0; k < patches->count && status == 0; k++) {
+            const tt_image *alpha = patches->images[k];
+            tt_image *window = NULL, *patch = NULL;
+            size_t i, count;
+            tt_error error;
+            if (windows->size == 0) {
+                status = output_add_map_png(output, patches->map_png_paths[k * MATERIAL_MAPS + map], map, image);
+            } else if (image_crop(image, windows->x[k], windows->y[k], windows->size, windows->size, &window) != 0) {
+                status = tool_fail("out of memory for patch %d of %s", k + 1, maps->paths[map]);
+            } else {
+                status = output_add_map_png(output, patches->map_png_paths[k * MATERIAL_MAPS + map], map, window);
+            }
+            if (status == 0 && options->bake_size > 0) {
+                const tt_image *source = window ? window : image;
+                if (tt_image_create(source->width, source->height, NULL, &patch, &error) != TT_OK) {
+                    status = tool_fail("%s: %s", maps->paths[map], error.message);
+                } else {
+                    patch->kind = source->kind;
+                    count = (size_t)source->width * (size_t)source->height;
+                    for (i = 0; i < count; i++) {
+                        float a = alpha->pixels[4 * i + 3];
+                        patch->pixels[4 * i] = source->pixels[4 * i] * a;
+                        patch->pixels[4 * i + 1] = source->pixels[4 * i + 1] * a;
+                        patch->pixels[4 * i + 2] = source->pixels[4 * i + 2] * a;
+                        patch->pixels[4 * i + 3] = a;
+                    }
+                    patches->map_images[k * MATERIAL_MAPS + map] = patch;
+                }
+            }
+            image_free(window);
+        }
+    }
+    material_free(maps);
+    return status;
 }
 
 /* Each window of *image made a patch, and its PNG added to the output;
@@ -864,13 +945,15 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
                      const tt_lapped *lapped, const lapped_patches *patches, float *corner_uv,
                      baked_seams *seams)
 {
-    char obj_path[4096], mtl_path[4096], png_path[4096], comment[256];
-    tt_image *atlas = NULL;
+    char obj_path[4096], mtl_path[4096], png_path[4096], comment[256], map_paths[MATERIAL_MAPS][4200];
+    char stem[TOOL_PREFIX_SIZE + 16];
+    const char *map_names[MATERIAL_MAPS];
+    tt_image *atlas = NULL, **map_patches = NULL;
     float *normals = NULL;
     tt_bake_options bake;
     tt_error error;
     obj_write_desc desc;
-    int status = 0;
+    int status = 0, map, k;
 
     snprintf(obj_path, sizeof obj_path, "%s_baked.obj", options->prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s_baked.mtl", options->prefix);
@@ -906,12 +989,37 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     desc.mtllib = tool_basename(mtl_path);
     desc.material = "lapped_baked";
     if ((status = output_add_obj(output, obj_path, &desc)) != 0) goto done;
-    status = output_add_mtl(output, mtl_path, "lapped_baked", png_path, 0);
+    snprintf(stem, sizeof stem, "%s_baked", options->prefix);
+    for (map = 0; map < MATERIAL_MAPS; map++) {
+        material_path(map_paths[map], sizeof map_paths[map], stem, map);
+        map_names[map] = options->maps.paths[map] ? map_paths[map] : NULL;
+    }
+    status = output_add_mtl(output, mtl_path, "lapped_baked", png_path, 0, map_names);
     /* The baked texture holds linear straight RGBA: written as sRGB colour. */
     if (status == 0) status = add_png(output, png_path, atlas);
     atlas = NULL;   /* add_png freed it */
+    if (status != 0 || material_count(&options->maps) == 0) goto done;
+
+    /* Every map baked with the same pastes, UVs and gutter, from its own
+       patches (the colour's alpha): the maps line up texel for texel. One
+       atlas at a time, the colour's memory given back first. */
+    map_patches = (tt_image **)malloc((size_t)patches->count * sizeof(tt_image *));
+    if (!map_patches || tt_image_create(options->bake_size, options->bake_size, NULL, &atlas, &error) != TT_OK) {
+        status = tool_fail("out of memory for the baked maps");
+        goto done;
+    }
+    for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
+        if (!map_names[map]) continue;
+        for (k = 0; k < patches->count; k++) map_patches[k] = patches->map_images[k * MATERIAL_MAPS + map];
+        if (tt_lapped_bake(m->mesh, lapped, map_patches, patches->count, corner_uv, &bake, NULL, atlas, &error) !=
+            TT_OK)
+            status = triangle_mesh_report_error(options->mesh_path, m, &error);
+        else
+            status = output_add_map_png(output, map_paths[map], map, atlas);
+    }
 done:
     tt_image_free(atlas);
+    free(map_patches);
     free(normals);
     free(corner_uv);
     return status;
@@ -1001,6 +1109,12 @@ static int refuse_overwriting_inputs(const lapped_options *options, const char *
     int status = tool_refuse_input_overwrite(obj_path), k;
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
     for (k = 0; k < patches->count && status == 0; k++) status = tool_refuse_input_overwrite(patches->png_paths[k]);
+    for (k = 0; k < patches->count * MATERIAL_MAPS && status == 0; k++)
+        if (patches->map_png_paths[k]) status = tool_refuse_input_overwrite(patches->map_png_paths[k]);
+    if (status == 0 && options->bake_size > 0) {
+        snprintf(path, sizeof path, "%s_baked", options->prefix);
+        status = material_refuse_overwrite(&options->maps, path);
+    }
     for (k = 0; k < 3 && status == 0 && options->bake_size > 0; k++) {
         snprintf(path, sizeof path, "%s%s", options->prefix, baked[k]);
         status = tool_refuse_input_overwrite(path);
@@ -1039,8 +1153,9 @@ int cmd_lapped(int argc, char **argv)
     /* A photo: sRGB bytes in the file, linear light in the library. */
     if (status == 0 && image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
+    if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     if (status == 0) status = choose_windows(&options, image->width, image->height, &windows);
-    if (status == 0) status = lapped_patches_name(options.prefix, &windows, &patches);
+    if (status == 0) status = lapped_patches_name(options.prefix, &windows, &options.maps, &patches);
     if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, &patches);
     if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &charts);
     if (status == 0) status = load_mask(&options, image->width, image->height, &windows, &mask);
@@ -1049,6 +1164,8 @@ int cmd_lapped(int argc, char **argv)
        loop; from here on the command holds the patches and the compressed
        PNGs. */
     if (status == 0) status = make_patches(&options, &image, &windows, mask, &output, &patches);
+    if (status == 0) status = make_map_patches(&options, &options.maps, &windows, &output, &patches);
+    material_free(&options.maps);
     image_free(image);
     image = NULL;
     image_free(mask);
@@ -1058,7 +1175,8 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped, &patches);
     if (status == 0)
         status = output_add_mtl_materials(&output, mtl_path, patches.count, (const char *const *)patches.materials,
-                                          (const char *const *)patches.png_paths, 1);
+                                          (const char *const *)patches.png_paths, 1,
+                                          (const char *const *)patches.map_png_paths);
     if (status == 0 && options.bake_size > 0) {
         status = add_baked(&output, &options, &mesh, lapped, &patches, bake_uv, &baked);
         bake_uv = NULL;   /* add_baked freed it */

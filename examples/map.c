@@ -113,7 +113,7 @@ int cmd_map(int argc, char **argv)
                            ? strlen(positional[1]) - 4 : strlen(positional[1])),
                  positional[1]);
         tool_relative_path(options.atlas_path, mtl_path, texture, sizeof texture);
-        status = tiled_add_mtl(&output, mtl_path, texture);
+        status = tiled_add_mtl(&output, mtl_path, texture, NULL);
         if (status == 0) status = tiled_add_obj(&output, positional[1], &mesh, tool_basename(mtl_path));
     } else {
         status = tiled_add_obj(&output, positional[1], &mesh, NULL);

@@ -891,30 +891,46 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     return out->failed ? -1 : 0;
 }
 
-void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha)
+void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha,
+                      const char *const *maps)
 {
     write_name_line(out, "newmtl", name);
     buffer_printf(out, "Ka 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\n");
     if (texture) write_name_line(out, "map_Kd", texture);
     if (texture && texture_alpha) write_name_line(out, "map_d", texture);
+    if (maps && maps[MATERIAL_NORMAL]) {
+        write_name_line(out, "map_Bump -bm 1", maps[MATERIAL_NORMAL]);
+        write_name_line(out, "norm", maps[MATERIAL_NORMAL]);
+    }
+    if (maps && maps[MATERIAL_ROUGHNESS]) write_name_line(out, "map_Pr", maps[MATERIAL_ROUGHNESS]);
+    if (maps && maps[MATERIAL_METALLIC]) write_name_line(out, "map_Pm", maps[MATERIAL_METALLIC]);
+    if (maps && maps[MATERIAL_HEIGHT]) write_name_line(out, "disp", maps[MATERIAL_HEIGHT]);
+    if (maps && maps[MATERIAL_AO]) write_name_line(out, "# ambient occlusion:", maps[MATERIAL_AO]);
     buffer_printf(out, "\n");
 }
 
 int output_add_mtl(tool_output *output, const char *mtl_path, const char *material, const char *texture_path,
-                   int texture_alpha)
+                   int texture_alpha, const char *const *map_paths)
 {
-    return output_add_mtl_materials(output, mtl_path, 1, &material, &texture_path, texture_alpha);
+    return output_add_mtl_materials(output, mtl_path, 1, &material, &texture_path, texture_alpha, map_paths);
 }
-
 int output_add_mtl_materials(tool_output *output, const char *mtl_path, int count, const char *const *materials,
-                             const char *const *texture_paths, int texture_alpha)
+                             const char *const *texture_paths, int texture_alpha, const char *const *map_paths)
 {
     tool_buffer text = TOOL_BUFFER_INIT;
-    char texture[4096];
-    int k;
+    char texture[4096], maps[MATERIAL_MAPS][4096];
+    int k, map;
     for (k = 0; k < count; k++) {
+        const char *names[MATERIAL_MAPS];
         tool_relative_path(texture_paths[k], mtl_path, texture, sizeof texture);
-        mtl_add_material(&text, materials[k], texture, texture_alpha);
+        for (map = 0; map < MATERIAL_MAPS; map++) {
+            const char *path = map_paths ? map_paths[(size_t)k * MATERIAL_MAPS + map] : NULL;
+            names[map] = NULL;
+            if (!path) continue;
+            tool_relative_path(path, mtl_path, maps[map], sizeof maps[map]);
+            names[map] = maps[map];
+        }
+        mtl_add_material(&text, materials[k], texture, texture_alpha, names);
     }
     if (output_add_buffer(output, mtl_path, &text) != 0) {
         buffer_free(&text);

@@ -71,6 +71,7 @@ static void print_help(void)
            "                   right quarter of each tile turns a quarter (bricks, planks and grain\n"
            "                   run crosswise there); by default the walls' tiles keep IMAGE's up\n"
            "                   throughout, from a second set of tiles beside the first\n"
+           MATERIAL_OPTIONS_HELP("                   ")
            "\n"
            "Prints the polycube (cubes, squares, components, genus against the mesh's), the\n"
            "mapping (triangles split, triangles that fell back to one square: local seams, edges\n"
@@ -108,7 +109,7 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
             print_help();
             return 0;
         }
-        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS, &options->tiles);
+        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_MATERIAL_OPTIONS, &options->tiles);
         if (taken < 0) return TOOL_EXIT_USAGE;
         if (taken) continue;
         if (tool_option(argc, argv, &i, "--resolution", &value)) {
@@ -161,6 +162,9 @@ typedef struct polycube_job {
     tt_tileset *tiles;              /* plain: the tops and bottoms (all of S with --no-upright) */
     tt_tileset *upright_tiles;      /* the walls; NULL with --no-upright */
     tt_image *atlas;                /* the two side by side; NULL with --no-upright (then tiles->levels[0]) */
+    /* The same for each map of the material (NULL for the maps not given). */
+    tt_tileset *map_tiles[MATERIAL_MAPS], *map_upright_tiles[MATERIAL_MAPS];
+    tt_image *map_atlas[MATERIAL_MAPS];
     tt_polycube_mapping *mapping;
     tt_polycube_map_report map_report;
     float *corner_uv;               /* 6 per mapped triangle */
@@ -169,14 +173,16 @@ typedef struct polycube_job {
 
 static void polycube_job_free(polycube_job *job)
 {
+    int map;
     triangle_mesh_free(&job->mesh);
     tt_polycube_free(job->polycube);
     free(job->edge_colors);
     free(job->surface_type);
     free(job->surface_uv);
-    tt_tileset_free(job->tiles);
-    tt_tileset_free(job->upright_tiles);
+    tiled_tilesets_free(&job->tiles, job->map_tiles);
+    tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
     tt_image_free(job->atlas);
+    for (map = 0; map < MATERIAL_MAPS; map++) tt_image_free(job->map_atlas[map]);
     tt_polycube_mapping_free(job->mapping);
     free(job->corner_uv);
     memset(job, 0, sizeof *job);
@@ -233,7 +239,7 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
     const tt_image *plain = &job->tiles->levels[0];
     tiled_options upright = options->tiles;
     tt_error error;
-    int c, status;
+    int c, status, map;
     if (image->width < 2 * job->layout.tile_size || image->height < 2 * job->layout.tile_size) {
         tool_note("%s: %dx%d is too small for upright %d-texel tiles (they need %dx%d): the walls' tiles are "
                   "plain, turned a quarter on their left and right sides (use a smaller --tile)",
@@ -242,9 +248,17 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
         return 0;
     }
     upright.upright_over = job->tiles->edge_windows;
-    if ((status = tiled_synthesize(image, options->image_path, &upright, &job->upright_tiles)) != 0) return status;
+    if ((status = tiled_synthesize(image, options->image_path, &upright, &options->tiles.maps, &job->upright_tiles,
+                                   job->map_upright_tiles)) != 0)
+        return status;
     if (tt_polycube_upright_atlas(job->tiles, job->upright_tiles, 0, NULL, &job->atlas, &error) != TT_OK)
         return tool_fail("the %dx%d atlas: %s", 2 * plain->width, plain->height, error.message);
+    for (map = 0; map < MATERIAL_MAPS; map++)
+        if (job->map_tiles[map] &&
+            tt_polycube_upright_atlas(job->map_tiles[map], job->map_upright_tiles[map], 0, NULL, &job->map_atlas[map],
+                                      &error) != TT_OK)
+            return tool_fail("the %dx%d %s atlas: %s", 2 * plain->width, plain->height, material_map_names[map],
+                             error.message);
     for (c = 0; c < job->polycube->surface->ncorners; c++)
         job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] +
                                          (float)tt_polycube_quad_upright(job->polycube,
@@ -489,7 +503,9 @@ int cmd_polycube(int argc, char **argv)
     tool_output output = TOOL_OUTPUT_INIT;
     tt_error error;
     char obj_path[4096], mtl_path[4096], png_path[4096], surface_path[4096], message[TOOL_ERROR_SIZE];
-    int status;
+    char map_paths[MATERIAL_MAPS][4200];
+    const char *map_names[MATERIAL_MAPS];
+    int status, map;
     double start;
 
     memset(&job, 0, sizeof job);
@@ -499,12 +515,17 @@ int cmd_polycube(int argc, char **argv)
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
     snprintf(png_path, sizeof png_path, "%s.png", options.prefix);
     snprintf(surface_path, sizeof surface_path, "%s_polycube.obj", options.prefix);
+    for (map = 0; map < MATERIAL_MAPS; map++) {
+        material_path(map_paths[map], sizeof map_paths[map], options.prefix, map);
+        map_names[map] = options.tiles.maps.paths[map] ? tool_basename(map_paths[map]) : NULL;
+    }
 
     if ((status = triangle_mesh_read(options.mesh_path, NULL, &job.mesh)) != 0) return status;
     /* A photo: sRGB bytes in the file, linear light in the library. */
     if (image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
     if (status == 0) status = tiled_pick_tile_size(options.image_path, image->width, image->height, &options.tiles);
+    if (status == 0) status = material_load(&options.tiles.maps, options.image_path, image->width, image->height);
     if (status == 0) status = tiled_check_atlas_size(&options.tiles);
     if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
         status = tool_fail("%s", error.message);
@@ -514,36 +535,48 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
     if (status == 0) status = tool_refuse_input_overwrite(png_path);
     if (status == 0) status = tool_refuse_input_overwrite(surface_path);
+    if (status == 0) status = material_refuse_overwrite(&options.tiles.maps, options.prefix);
 
     if (status == 0) status = build_polycube(&options, &job);
     if (status == 0) {
         start = tool_seconds_now();
-        status = tiled_synthesize(image, options.image_path, &options.tiles, &job.tiles);
+        status = tiled_synthesize(image, options.image_path, &options.tiles, &options.tiles.maps, &job.tiles,
+                                  job.map_tiles);
         if (status == 0 && !options.plain) status = synthesize_upright(&options, image, &job);
         job.synth_seconds = tool_seconds_now() - start;
     }
-    /* The photo is not needed past the synthesis; it is the largest thing
-       the command holds. */
+    /* The photo and the maps are not needed past the synthesis; they are
+       the largest things the command holds. */
     image_free(image);
     image = NULL;
+    material_free(&options.tiles.maps);
     if (status == 0) status = map_mesh(&options, &job);
     if (status == 0) status = measure_quality(&options, &job, &quality);
 
     if (status == 0 && job.atlas && output_add_png(&output, png_path, job.atlas, TT_COLOR_SRGB, message,
                                                    sizeof message) != 0)
         status = tool_fail("%s", message);
-    if (status == 0 && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0);
-    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
+    if (status == 0 && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0, TT_COLOR_SRGB);
+    for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
+        if (job.map_atlas[map]) status = output_add_map_png(&output, map_paths[map], map, job.map_atlas[map]);
+        else if (job.map_tiles[map])
+            status = tiled_add_atlas(&output, map_paths[map], job.map_tiles[map], 0, material_space(map));
+    }
+    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
     if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
     if (status == 0) status = add_surface_obj(&output, surface_path, tool_basename(mtl_path), &job);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &job, &quality);
-        printf("wrote %s, %s, %s, %s\n", obj_path, mtl_path, png_path, surface_path);
+        printf("wrote %s, %s, %s, %s", obj_path, mtl_path, png_path, surface_path);
+        for (map = 0; map < MATERIAL_MAPS; map++)
+            if (job.map_tiles[map]) printf(", %s", map_paths[map]);
+        printf("\n");
     }
     output_free(&output);
     image_free(image);
+    material_free(&options.tiles.maps);
     polycube_job_free(&job);
     return status;
 }

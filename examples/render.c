@@ -288,6 +288,7 @@ typedef struct scene {
     float *corner_normal;       /* 3 per OBJ corner, unit length */
     float *screen;              /* 3 per vertex: x and y in samples, then q = 1 / depth */
     const mip_texture *textures; /* the textures faces are drawn with */
+    const mip_texture *normal_map; /* --normal: a tangent-space normal map over the same UVs, or NULL */
     const int *face_texture;    /* per OBJ face: index into textures, -1: draw grey */
     int wireframe;              /* draw the OBJ faces' edges over the surface */
     vec3 light_key, light_fill; /* unit vectors towards the two lights */
@@ -638,6 +639,49 @@ static void locate_sample(const scene *s, int t, float px, float py, surface_poi
     point->w[2] = b[2] * p2[2] / q;
 }
 
+/* Triangle t's texture coordinates at a point, with their steps per sample
+   in x and y (uv[0..1]; du/dx, dv/dx, du/dy, dv/dy in uv[2..5]); 0 when a
+   corner has none. */
+static int surface_uv(const scene *s, int t, const surface_point *point, float uv[6])
+{
+    const obj_mesh *mesh = s->mesh;
+    const int *corner = s->triangle_corners + 3 * t;
+    const float *uv0, *uv1, *uv2, *w = point->w, *dbdx = point->dbdx, *dbdy = point->dbdy;
+    const float *p0 = point->corner[0], *p1 = point->corner[1], *p2 = point->corner[2];
+    float q = point->q, qx = point->qx, qy = point->qy, u, v, uqx, uqy, vqx, vqy;
+    if (!mesh->corner_uv || mesh->corner_uv[corner[0]] < 0 || mesh->corner_uv[corner[1]] < 0 ||
+        mesh->corner_uv[corner[2]] < 0)
+        return 0;
+    uv0 = mesh->uv + 2 * mesh->corner_uv[corner[0]];
+    uv1 = mesh->uv + 2 * mesh->corner_uv[corner[1]];
+    uv2 = mesh->uv + 2 * mesh->corner_uv[corner[2]];
+    u = w[0] * uv0[0] + w[1] * uv1[0] + w[2] * uv2[0];
+    v = w[0] * uv0[1] + w[1] * uv1[1] + w[2] * uv2[1];
+    /* d(u)/dx = (d(u q)/dx - u dq/dx) / q, the quotient rule on u = (u q) / q. */
+    uqx = dbdx[0] * uv0[0] * p0[2] + dbdx[1] * uv1[0] * p1[2] + dbdx[2] * uv2[0] * p2[2];
+    uqy = dbdy[0] * uv0[0] * p0[2] + dbdy[1] * uv1[0] * p1[2] + dbdy[2] * uv2[0] * p2[2];
+    vqx = dbdx[0] * uv0[1] * p0[2] + dbdx[1] * uv1[1] * p1[2] + dbdx[2] * uv2[1] * p2[2];
+    vqy = dbdy[0] * uv0[1] * p0[2] + dbdy[1] * uv1[1] * p1[2] + dbdy[2] * uv2[1] * p2[2];
+    uv[0] = u;
+    uv[1] = v;
+    uv[2] = (uqx - u * qx) / q;
+    uv[3] = (vqx - v * qx) / q;
+    uv[4] = (uqy - u * qy) / q;
+    uv[5] = (vqy - v * qy) / q;
+    return 1;
+}
+
+/* A texture's trilinear sample at texture coordinates from surface_uv. */
+static void sample_surface(const mip_texture *texture, const float uv[6], int repeat, float rgba[4])
+{
+    const tt_image *base = texture->levels[0];
+    float dudx = uv[2] * (float)base->width, dvdx = uv[3] * (float)base->height;
+    float dudy = uv[4] * (float)base->width, dvdy = uv[5] * (float)base->height;
+    /* The footprint of one sample in texels: the longer of its two sides. */
+    float footprint = sqrtf(fmaxf(dudx * dudx + dvdx * dvdx, dudy * dudy + dvdy * dvdy));
+    sample_trilinear(texture, uv[0], uv[1], footprint, repeat, rgba);
+}
+
 /* Triangle t's texture colour at a point: the texture (straight alpha, or
    premultiplied for a pasting mesh, whose texture is premultiplied, times
    the paste's fade when its vt carry one), or opaque grey when a corner
@@ -648,29 +692,12 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
     const int *corner = s->triangle_corners + 3 * t;
     const int index = s->face_texture[s->triangle_face[t]];
     const mip_texture *texture = index >= 0 ? &s->textures[index] : NULL;
+    const float *w = point->w;
+    float uv[6];
     rgba[0] = rgba[1] = rgba[2] = s->untextured_grey;
     rgba[3] = 1.0f;
-    if (texture && mesh->corner_uv && mesh->corner_uv[corner[0]] >= 0 && mesh->corner_uv[corner[1]] >= 0 &&
-        mesh->corner_uv[corner[2]] >= 0) {
-        const float *uv0 = mesh->uv + 2 * mesh->corner_uv[corner[0]];
-        const float *uv1 = mesh->uv + 2 * mesh->corner_uv[corner[1]];
-        const float *uv2 = mesh->uv + 2 * mesh->corner_uv[corner[2]];
-        const float *w = point->w, *dbdx = point->dbdx, *dbdy = point->dbdy;
-        const float *p0 = point->corner[0], *p1 = point->corner[1], *p2 = point->corner[2];
-        float q = point->q, qx = point->qx, qy = point->qy;
-        float u = w[0] * uv0[0] + w[1] * uv1[0] + w[2] * uv2[0];
-        float v = w[0] * uv0[1] + w[1] * uv1[1] + w[2] * uv2[1];
-        /* d(u)/dx = (d(u q)/dx - u dq/dx) / q, the quotient rule on u = (u q) / q. */
-        float uqx = dbdx[0] * uv0[0] * p0[2] + dbdx[1] * uv1[0] * p1[2] + dbdx[2] * uv2[0] * p2[2];
-        float uqy = dbdy[0] * uv0[0] * p0[2] + dbdy[1] * uv1[0] * p1[2] + dbdy[2] * uv2[0] * p2[2];
-        float vqx = dbdx[0] * uv0[1] * p0[2] + dbdx[1] * uv1[1] * p1[2] + dbdx[2] * uv2[1] * p2[2];
-        float vqy = dbdy[0] * uv0[1] * p0[2] + dbdy[1] * uv1[1] * p1[2] + dbdy[2] * uv2[1] * p2[2];
-        const tt_image *base = texture->levels[0];
-        float dudx = (uqx - u * qx) / q * (float)base->width, dvdx = (vqx - v * qx) / q * (float)base->height;
-        float dudy = (uqy - u * qy) / q * (float)base->width, dvdy = (vqy - v * qy) / q * (float)base->height;
-        /* The footprint of one sample in texels: the longer of its two sides. */
-        float footprint = sqrtf(fmaxf(dudx * dudx + dvdx * dvdx, dudy * dudy + dvdy * dvdy));
-        sample_trilinear(texture, u, v, footprint, !s->pasting, rgba);
+    if (texture && surface_uv(s, t, point, uv)) {
+        sample_surface(texture, uv, !s->pasting, rgba);
         if (s->pasting && mesh->uv_w) {
             /* A paste's fade (the vt's third number, written by 'lapped'):
                its alpha goes to 0 where it had to stop; premultiplied, so
@@ -682,6 +709,38 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
             for (k = 0; k < 4; k++) rgba[k] *= fade;
         }
     }
+}
+
+/* The normal a tangent-space normal map gives at a point of triangle t
+   whose interpolated normal is n: the map's vector in the frame of the
+   triangle's texture axes (tangent along +u, bitangent along +v, each made
+   perpendicular to n) - the frame glTF and Blender build from the UVs. */
+static vec3 mapped_normal(const scene *s, int t, const surface_point *point, vec3 n)
+{
+    const obj_mesh *mesh = s->mesh;
+    const int *corner = s->triangle_corners + 3 * t;
+    float uv[6], sample[4], du1, dv1, du2, dv2, det;
+    vec3 p0, e1, e2, tangent, bitangent;
+    const float *a, *b, *c;
+    if (!surface_uv(s, t, point, uv)) return n;
+    a = mesh->uv + 2 * mesh->corner_uv[corner[0]];
+    b = mesh->uv + 2 * mesh->corner_uv[corner[1]];
+    c = mesh->uv + 2 * mesh->corner_uv[corner[2]];
+    p0 = vertex_position(mesh, mesh->corner_vert[corner[0]]);
+    e1 = vec3_sub(vertex_position(mesh, mesh->corner_vert[corner[1]]), p0);
+    e2 = vec3_sub(vertex_position(mesh, mesh->corner_vert[corner[2]]), p0);
+    du1 = b[0] - a[0]; dv1 = b[1] - a[1];
+    du2 = c[0] - a[0]; dv2 = c[1] - a[1];
+    det = du1 * dv2 - du2 * dv1;
+    if (det == 0.0f) return n;
+    /* dP/du and dP/dv of the triangle's linear map */
+    tangent = vec3_scale(vec3_sub(vec3_scale(e1, dv2), vec3_scale(e2, dv1)), 1.0f / det);
+    bitangent = vec3_scale(vec3_sub(vec3_scale(e2, du1), vec3_scale(e1, du2)), 1.0f / det);
+    tangent = vec3_normalize(vec3_sub(tangent, vec3_scale(n, vec3_dot(tangent, n))));
+    bitangent = vec3_normalize(vec3_sub(bitangent, vec3_scale(n, vec3_dot(bitangent, n))));
+    sample_surface(s->normal_map, uv, 1, sample);
+    return vec3_normalize(vec3_add(vec3_add(vec3_scale(tangent, sample[0]), vec3_scale(bitangent, sample[1])),
+                                   vec3_scale(n, sample[2])));
 }
 
 /* Light an RGB colour on triangle t at a point, and draw the wireframe. */
@@ -698,7 +757,9 @@ static void light_sample(const scene *s, int t, const surface_point *point, floa
         const float *n = s->corner_normal + 3 * corner[k];
         normal = vec3_add(normal, vec3_scale(vec3_make(n[0], n[1], n[2]), point->w[k]));
     }
-    normal = vec3_scale(vec3_normalize(normal), (float)s->triangle_facing[t]);
+    normal = vec3_normalize(normal);
+    if (s->normal_map) normal = mapped_normal(s, t, point, normal);
+    normal = vec3_scale(normal, (float)s->triangle_facing[t]);
     light = 0.32f + 0.72f * fmaxf(0.0f, vec3_dot(normal, s->light_key)) +
             0.22f * fmaxf(0.0f, vec3_dot(normal, s->light_fill));
     for (k = 0; k < 3; k++) rgb[k] *= light;
@@ -965,7 +1026,12 @@ static void print_render_help(void)
            "                and scans), x, -y, -z or -x, or a direction X,Y,Z\n"
            "  --zoom F      magnify the view F times, 0.1 to 100 (default 1: the whole model)\n"
            "  --wireframe   draw the edges of the mesh's faces over the surface\n"
-           "  --no-materials  draw every face with TEXTURE, whatever its material names\n",
+           "  --no-materials  draw every face with TEXTURE, whatever its material names\n"
+           "  --normal N.png  light the surface through a tangent-space normal map over the same\n"
+           "                texture coordinates (+Y up, as the tool writes them; the frame is the\n"
+           "                texture's u and v axes on each triangle, as glTF and Blender take it);\n"
+           "                not for pasting meshes: render their --bake output\n"
+           "  --normal-y-down  N.png is DirectX style (y down)\n",
            RENDER_MAX_SIZE, RENDER_DEFAULT_WIDTH, RENDER_DEFAULT_HEIGHT);
 }
 
@@ -974,7 +1040,9 @@ int cmd_render(int argc, char **argv)
     const char *positional[3];
     int npositional = 0, width = RENDER_DEFAULT_WIDTH, height = RENDER_DEFAULT_HEIGHT, i, status = TOOL_EXIT_FAILURE;
     double yaw = 30.0, pitch = 20.0, zoom = 1.0;
-    int wireframe = 0, use_materials = 1;
+    int wireframe = 0, use_materials = 1, normal_y_down = 0;
+    const char *normal_path = NULL;
+    mip_texture normal_map;
     char err[TOOL_ERROR_SIZE];
     obj_mesh mesh;
     tt_image *picture = NULL;
@@ -1007,6 +1075,11 @@ int cmd_render(int argc, char **argv)
             wireframe = 1;
         } else if (strcmp(argv[i], "--no-materials") == 0) {
             use_materials = 0;
+        } else if (tool_option(argc, argv, &i, "--normal", &value)) {
+            if (!value || !*value) return tool_usage("--normal needs an image");
+            normal_path = value;
+        } else if (strcmp(argv[i], "--normal-y-down") == 0) {
+            normal_y_down = 1;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
             if (parse_up("--up", value, up) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_is_option(argv[i])) {
@@ -1021,7 +1094,10 @@ int cmd_render(int argc, char **argv)
         return tool_usage("needs MESH.obj TEXTURE OUT.png (see 'tiledtex render --help')");
     up_axis_from(up, &axis);
 
+    if (normal_y_down && !normal_path)
+        return tool_usage("--normal-y-down says how --normal N.png is encoded, but no --normal was given");
     memset(&textures, 0, sizeof textures);
+    memset(&normal_map, 0, sizeof normal_map);
     memset(&s, 0, sizeof s);
     memset(&samples, 0, sizeof samples);
     if (mesh_read(positional[0], &mesh, err, sizeof err) != 0) return tool_fail("%s", err);
@@ -1036,6 +1112,24 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     if (load_textures(positional[0], positional[1], &mesh, s.pasting, use_materials, &textures) != 0) goto done;
+    if (normal_path) {
+        tt_image *image;
+        if (s.pasting) {
+            tool_fail("%s is a pasting mesh: --normal needs one texture over the surface (render its --bake output)",
+                      positional[0]);
+            goto done;
+        }
+        if (image_load(normal_path, normal_y_down ? TT_COLOR_NORMAL_Y_DOWN : TT_COLOR_NORMAL, &image, err,
+                       sizeof err) != 0) {
+            tool_fail("%s", err);
+            goto done;
+        }
+        if (texture_build(&normal_map, image, err, sizeof err) != 0) {
+            tool_fail("cannot prepare the normal map %s: %s", normal_path, err);
+            goto done;
+        }
+        s.normal_map = &normal_map;
+    }
     s.textures = textures.textures;
     s.face_texture = textures.face_texture;
     s.width = width * SUPERSAMPLING;
@@ -1076,6 +1170,7 @@ done:
     samples_free(&samples);
     scene_free(&s);
     texture_set_free(&textures);
+    texture_free(&normal_map);
     obj_free(&mesh);
     return status;
 }

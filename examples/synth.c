@@ -58,10 +58,10 @@ int cmd_synth(int argc, char **argv)
     /* A photo: sRGB in the file, linear light in the library. */
     if (image_load(positional[0], TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         return tool_fail("%s", message);
-    status = tiled_synthesize(image, positional[0], &options, &tiles);
+    status = tiled_synthesize(image, positional[0], &options, NULL, &tiles, NULL);
     image_free(image);       /* not needed past the synthesis */
     image = NULL;
-    if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips);
+    if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips, TT_COLOR_SRGB);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0 && !tool_quiet()) {
         printf("%s: %dx%d atlas of %d tiles (n=%d, %d texels, gutter %d) from %s; edge windows",

@@ -34,7 +34,11 @@ static void print_help(void)
            "  --background X,Y,W,H   region the background windows come from\n"
            "  --mips                 also write the per-tile mip levels, OUT_PREFIX_mip1.png ...\n"
            "  --report               also print tile usage and face stretch, and measure the\n"
-           "                         seams on every edge (default: a sample of %d edges)\n",
+           "                         seams on every edge (default: a sample of %d edges)\n"
+           MATERIAL_OPTIONS_HELP("                         ")
+           "\n"
+           "A material's maps share IMAGE's tiles: the cuts are decided once, from IMAGE, and\n"
+           "every map is cut and blended the same way, so the atlases line up texel for texel.\n",
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
 }
 
@@ -45,26 +49,36 @@ int cmd_tile(int argc, char **argv)
     tiled_options options;
     tiled_mesh mesh;
     tt_image *image = NULL;
-    tt_tileset *tiles = NULL;
+    tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS];
     tool_seams seams;
     tool_output output;
     char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
+    char map_paths[MATERIAL_MAPS][4200];
+    const char *map_names[MATERIAL_MAPS];
+    int map;
 
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
+    memset(map_tiles, 0, sizeof map_tiles);
     status = tiled_parse_command_line(argc, argv,
-                                      TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS | TILED_REPORT_OPTION,
+                                      TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS |
+                                          TILED_REPORT_OPTION | TILED_MATERIAL_OPTIONS,
                                       &options, positional, 3, "MESH.obj, IMAGE and OUT_PREFIX", print_help);
     if (status >= 0) return status;
     if (tool_output_prefix(positional[2], prefix) != 0) return TOOL_EXIT_USAGE;
     snprintf(obj_path, sizeof obj_path, "%s.obj", prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", prefix);
     snprintf(png_path, sizeof png_path, "%s.png", prefix);
+    for (map = 0; map < MATERIAL_MAPS; map++) {
+        material_path(map_paths[map], sizeof map_paths[map], prefix, map);
+        map_names[map] = options.maps.paths[map] ? tool_basename(map_paths[map]) : NULL;
+    }
 
     /* A photo: its 8-bit values are sRGB, the library works in linear light. */
     if (image_load(positional[1], TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         return tool_fail("%s", message);
     status = tiled_pick_tile_size(positional[1], image->width, image->height, &options);
+    if (status == 0) status = material_load(&options.maps, positional[1], image->width, image->height);
     if (status != 0) {
         image_free(image);
         return status;
@@ -75,16 +89,22 @@ int cmd_tile(int argc, char **argv)
     if (status == 0) status = tool_refuse_input_overwrite(obj_path);
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
     if (status == 0) status = tool_refuse_input_overwrite(png_path);
-    if (status == 0) status = tiled_synthesize(image, positional[1], &options, &tiles);
-    /* The photo is not needed past the synthesis: free it before the PNGs
-       are encoded (it is the largest thing the command holds). */
+    if (status == 0) status = material_refuse_overwrite(&options.maps, prefix);
+    if (status == 0) status = tiled_synthesize(image, positional[1], &options, &options.maps, &tiles, map_tiles);
+    /* The photo and the maps are not needed past the synthesis: free them
+       before the PNGs are encoded (they are the largest things the command
+       holds). */
     image_free(image);
     image = NULL;
+    material_free(&options.maps);
     if (status == 0)
         status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, 0,
                                     NULL, 0, options.report, &seams);
-    if (status == 0) status = tiled_add_atlas(&output, png_path, tiles, options.mips);
-    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path));
+    if (status == 0) status = tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
+    for (map = 0; map < MATERIAL_MAPS && status == 0; map++)
+        if (map_tiles[map])
+            status = tiled_add_atlas(&output, map_paths[map], map_tiles[map], options.mips, material_space(map));
+    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
     if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
@@ -92,13 +112,16 @@ int cmd_tile(int argc, char **argv)
         tiled_print_notes(positional[0], &mesh);
         if (!tool_quiet()) {
             tiled_print_summary(positional[0], &mesh, &seams, options.report);
-            printf("wrote %s, %s, %s (%dx%d atlas)\n", obj_path, mtl_path, png_path, tiles->levels[0].width,
-                   tiles->levels[0].height);
+            printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
+            for (map = 0; map < MATERIAL_MAPS; map++)
+                if (map_tiles[map]) printf(", %s", map_paths[map]);
+            printf(" (%dx%d atlas)\n", tiles->levels[0].width, tiles->levels[0].height);
         }
     }
     output_free(&output);
     tiled_mesh_free(&mesh);
-    tt_tileset_free(tiles);
+    tiled_tilesets_free(&tiles, map_tiles);
+    material_free(&options.maps);
     image_free(image);
     return status;
 }

@@ -59,6 +59,8 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         options->mips = 1;
     } else if ((accept & TILED_REPORT_OPTION) && strcmp(argv[*index], "--report") == 0) {
         options->report = 1;
+    } else if ((accept & TILED_MATERIAL_OPTIONS) && (taken = material_parse_option(argc, argv, index, &options->maps))) {
+        if (taken < 0) return -1;
     } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
         if (!value) { tool_usage("--atlas needs a value"); return -1; }
         options->atlas_path = value;
@@ -181,11 +183,11 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
     return status;
 }
 
-int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name)
+int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name, const char *const *map_names)
 {
     tool_buffer text;
     memset(&text, 0, sizeof text);
-    mtl_add_material(&text, "tiled", texture_name, 0);
+    mtl_add_material(&text, "tiled", texture_name, 0, map_names);
     if (output_add_buffer(output, mtl_path, &text) != 0) {
         buffer_free(&text);
         return tool_fail("out of memory while writing %s", mtl_path);
@@ -333,10 +335,15 @@ int tiled_pick_tile_size(const char *image_path, int width, int height, tiled_op
     return 0;
 }
 
-int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options, tt_tileset **out)
+int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options,
+                     const material_maps *maps, tt_tileset **out, tt_tileset **map_tiles)
 {
     tt_synth_options synth;
+    tt_synth_plan *plan = NULL;
     tt_error error;
+    int map;
+    *out = NULL;
+    for (map = 0; maps && map < MATERIAL_MAPS; map++) map_tiles[map] = NULL;
     memset(&synth, 0, sizeof synth);
     synth.layout = options->layout;
     synth.seed = options->seed;
@@ -353,15 +360,41 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
         synth.edge_windows = options->upright_over;
         synth.upright = 1;
     }
-    if (tt_synthesize_tiles(image, &synth, NULL, out, &error) != TT_OK) {
+    /* One plan, from the colour image, for every map: the maps' tiles are
+       cut where the colour's are, and line up texel for texel. */
+    if (tt_synth_plan_create(image, &synth, NULL, &plan, &error) != TT_OK ||
+        tt_synth_apply(plan, image, NULL, out, &error) != TT_OK) {
+        tt_synth_plan_free(plan);
         if (error.result == TT_ERROR_IMAGE_TOO_SMALL || error.result == TT_ERROR_INVALID_ARGUMENT)
             return tool_fail("%s: %s", image_path, error.message);
         return tool_fail("%s", error.message);
     }
+    for (map = 0; maps && map < MATERIAL_MAPS; map++) {
+        if (!maps->images[map]) continue;
+        if (tt_synth_apply(plan, maps->images[map], NULL, &map_tiles[map], &error) != TT_OK) {
+            int status = tool_fail("%s: %s", maps->paths[map], error.message);
+            tt_synth_plan_free(plan);
+            tiled_tilesets_free(out, maps ? map_tiles : NULL);
+            return status;
+        }
+    }
+    tt_synth_plan_free(plan);
     return 0;
 }
 
-int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips)
+void tiled_tilesets_free(tt_tileset **tiles, tt_tileset **map_tiles)
+{
+    int map;
+    tt_tileset_free(*tiles);
+    *tiles = NULL;
+    for (map = 0; map_tiles && map < MATERIAL_MAPS; map++) {
+        tt_tileset_free(map_tiles[map]);
+        map_tiles[map] = NULL;
+    }
+}
+
+int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips,
+                    tt_color_space space)
 {
     char message[TOOL_ERROR_SIZE], path[4096];
     int level;
@@ -369,12 +402,12 @@ int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset 
     /* The atlas and its mip levels are colour: encoded to sRGB. The levels
        are the library's linear-light averages, so a black and white
        checkerboard's mip is sRGB 188, as the eye averages it. */
-    if (output_add_png(output, png_path, &tiles->levels[0], TT_COLOR_SRGB, message, sizeof message) != 0)
+    if (output_add_png(output, png_path, &tiles->levels[0], space, message, sizeof message) != 0)
         return tool_fail("%s", message);
     if (stem > 4 && strcmp(png_path + stem - 4, ".png") == 0) stem -= 4;
     for (level = 1; mips && level < tiles->nlevels; level++) {
         snprintf(path, sizeof path, "%.*s_mip%d.png", (int)stem, png_path, level);
-        if (output_add_png(output, path, &tiles->levels[level], TT_COLOR_SRGB, message, sizeof message) != 0)
+        if (output_add_png(output, path, &tiles->levels[level], space, message, sizeof message) != 0)
             return tool_fail("%s", message);
     }
     return 0;

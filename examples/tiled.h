@@ -17,7 +17,8 @@ enum {
     TILED_MESH_OPTIONS = 1 << 1,     /* --subdivide --smooth --permissive */
     TILED_SYNTH_OPTIONS = 1 << 2,    /* --edge --background --mips */
     TILED_ATLAS_OPTION = 1 << 3,     /* --atlas */
-    TILED_REPORT_OPTION = 1 << 4     /* --report: quality line, seams measured on every edge */
+    TILED_REPORT_OPTION = 1 << 4,    /* --report: quality line, seams measured on every edge */
+    TILED_MATERIAL_OPTIONS = 1 << 5  /* --normal --roughness --metallic --ao --height --normal-y-down */
 };
 
 /* From this many triangles on, a mesh counts as a dense triangle mesh, for
@@ -36,6 +37,7 @@ typedef struct tiled_options {
     const char *atlas_path;      /* --atlas */
     int report;                  /* --report: tile usage and stretch under the summary */
     const tt_rect *upright_over; /* not NULL: upright tiles (tt_synth_options::upright) on these edge windows */
+    material_maps maps;          /* the material's other maps (their paths; material_load loads them) */
 } tiled_options;
 
 /* The tool's defaults: the library's, with a gutter of TT_RECOMMENDED_GUTTER
@@ -76,8 +78,9 @@ void tiled_mesh_free(tiled_mesh *mesh);
 /* Add OBJ_PATH (positions + one vt per corner, using MATERIAL from MTL_NAME
    when mtl_name is not NULL) to the output batch. */
 int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name);
-/* Add an MTL file with one material, "tiled", whose texture is TEXTURE_NAME. */
-int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name);
+/* Add an MTL file with one material, "tiled", whose texture is TEXTURE_NAME
+   and whose other maps are map_names (as mtl_add_material's maps). */
+int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name, const char *const *map_names);
 
 /* The tile size `tile` picks when none is given: TT_DEFAULT_TILE_SIZE, or for
    a small image a multiple of 8 up to 2/5 of its smaller side, or less so the
@@ -91,12 +94,19 @@ int tiled_fit_tile_size(int width, int height, int colors, int gutter);
    the image is too small for any tile, 0 otherwise. */
 int tiled_pick_tile_size(const char *image_path, int width, int height, tiled_options *options);
 
-/* Synthesise the atlas from an image already loaded. Prints the error and
-   returns an exit status on failure. */
+/* Synthesise the atlas from an image already loaded, and with `maps` (may
+   be NULL) the atlas of each map loaded there into map_tiles[map] (NULL for
+   the others), all with the one plan the colour image decides. Prints the
+   error and returns an exit status on failure (nothing stays allocated). */
 int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options,
-                     tt_tileset **out);
-/* Add the atlas (and with --mips its levels as PREFIX_mipL.png) to the batch. */
-int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips);
+                     const material_maps *maps, tt_tileset **out, tt_tileset **map_tiles);
+/* Free what tiled_synthesize made (map_tiles may be NULL) and set it NULL. */
+void tiled_tilesets_free(tt_tileset **tiles, tt_tileset **map_tiles);
+/* Add the atlas (and with --mips its levels as PREFIX_mipL.png) to the
+   batch, encoded into `space` (TT_COLOR_SRGB for colour, material_space's
+   for a map). */
+int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips,
+                    tt_color_space space);
 
 /* Check a layout against the tool's atlas limit; prints the error. */
 int tiled_check_atlas_size(const tiled_options *options);

@@ -16,6 +16,8 @@
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
      mesh_file.c any mesh file, --weld   mesh_read, mesh_weld
                  MTL writing             mtl_add_material, output_add_mtl
+     material.c  a material's maps       material_parse_option, material_load,
+                 (--normal, ...)         output_add_map_png
      triangle_mesh.c  an OBJ as triangles   triangle_mesh_read (lapped, hpm, polycube)
                  mesh options            tool_quadrangulate, tool_check_subdivide,
                  (parsed in cli.c)       tool_note_cut_edges
@@ -329,6 +331,56 @@ int output_add_png_rgba8(tool_output *output, const char *path, unsigned char *r
                          char *err, size_t err_size);
 
 /* ---------------------------------------------------------------------- */
+/* A material's maps (material.c)                                           */
+/* ---------------------------------------------------------------------- */
+
+/* The maps a material may have beside its colour (IMAGE), in this order;
+   material_map_names gives each one's name in options, output names
+   (OUT_PREFIX_normal.png) and summaries. */
+enum { MATERIAL_NORMAL, MATERIAL_ROUGHNESS, MATERIAL_METALLIC, MATERIAL_AO, MATERIAL_HEIGHT, MATERIAL_MAPS };
+extern const char *const material_map_names[MATERIAL_MAPS];
+
+typedef struct material_maps {
+    const char *paths[MATERIAL_MAPS];   /* --normal N.png ..., NULL when not given */
+    int normal_y_down;                  /* --normal-y-down: N.png is DirectX-style, its y points down */
+    tt_image *images[MATERIAL_MAPS];    /* material_load's, NULL when not given: the normal map as
+                                           unit vectors +Y up (TT_IMAGE_NORMAL), the others linear
+                                           data; alpha 1 */
+} material_maps;
+
+/* The help lines of the options, for the commands' help texts: INDENT is
+   the string of spaces before the command's option descriptions. */
+#define MATERIAL_OPTIONS_HELP(INDENT)                                                                  \
+    "  --normal N.png\n" INDENT "a tangent-space normal map of IMAGE (+Y up: OpenGL, glTF, Blender),\n" \
+    INDENT "laid out like IMAGE's texture, written as OUT_PREFIX_normal.png; its\n"                      \
+    INDENT "vectors turn wherever the texture turns\n"                                                   \
+    "  --normal-y-down\n" INDENT "N.png is DirectX style (y down); the output is +Y up all the same\n"   \
+    "  --roughness R.png, --metallic M.png, --ao A.png, --height H.png\n" INDENT                          \
+    "data maps of IMAGE (read as they are, never as sRGB colour), laid out\n" INDENT                      \
+    "the same way: OUT_PREFIX_roughness.png, ... Every map must be IMAGE's\n" INDENT                      \
+    "size; the MTL names them all\n"
+
+/* If argv[*index] is one of the options above, consume it (and its value)
+   and return 1; 0 for another argument; -1 after printing a bad value. */
+int material_parse_option(int argc, char **argv, int *index, material_maps *maps);
+/* How many maps were given. */
+int material_count(const material_maps *maps);
+/* Load every map given, each checked to be width x height (the colour
+   image's, named image_path in the message). Prints the error and returns
+   the exit status (nothing stays loaded then); 0 otherwise. */
+int material_load(material_maps *maps, const char *image_path, int width, int height);
+void material_free(material_maps *maps);
+/* How a map is written to 8 bits: TT_COLOR_NORMAL or TT_COLOR_LINEAR. */
+tt_color_space material_space(int map);
+/* STEM_NAME.png, the output name of `map` beside STEM.png. */
+void material_path(char *path, size_t size, const char *stem, int map);
+/* tool_refuse_input_overwrite for each map's output beside STEM. */
+int material_refuse_overwrite(const material_maps *maps, const char *stem);
+/* Encode a map (of any kind: alpha is written as 1) as a PNG into the
+   batch; prints the error and returns the exit status on failure. */
+int output_add_map_png(tool_output *output, const char *path, int map, const tt_image *image);
+
+/* ---------------------------------------------------------------------- */
 /* Wavefront OBJ (obj.c)                                                    */
 /* ---------------------------------------------------------------------- */
 
@@ -486,17 +538,27 @@ float *tool_corner_normals(const char *path, const tt_mesh *mesh);
 
 /* Append one MTL material: "newmtl NAME", white diffuse colour, and
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
-   "map_d TEXTURE": the texture's alpha channel is the material's opacity. */
-void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha);
+   "map_d TEXTURE": the texture's alpha channel is the material's opacity.
+   maps (NULL, or MATERIAL_MAPS names, each NULL when absent) adds the
+   material's other maps: the normal map as "map_Bump -bm 1" (how Blender
+   writes and reads one) and "norm" (the PBR extension's name, which
+   assimp and three.js read), roughness "map_Pr", metallic "map_Pm", height
+   "disp", and the occlusion map as a comment (MTL has no statement for it;
+   the .glb output carries it). */
+void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha,
+                      const char *const *maps);
 /* Add a one-material MTL file to an output batch; it names texture_path
    (a path from the current directory) relative to the MTL's own directory
-   (tool_relative_path), so the folder can move. Returns 0, or the exit
-   status after printing the error. */
+   (tool_relative_path), so the folder can move; map_paths as
+   mtl_add_material's maps, paths from the current directory too. Returns 0,
+   or the exit status after printing the error. */
 int output_add_mtl(tool_output *output, const char *mtl_path, const char *material, const char *texture_path,
-                   int texture_alpha);
-/* The same with `count` materials, materials[k] naming texture_paths[k]. */
+                   int texture_alpha, const char *const *map_paths);
+/* The same with `count` materials, materials[k] naming texture_paths[k] and
+   the MATERIAL_MAPS map paths from map_paths + k * MATERIAL_MAPS (map_paths
+   may be NULL: colour only). */
 int output_add_mtl_materials(tool_output *output, const char *mtl_path, int count, const char *const *materials,
-                             const char *const *texture_paths, int texture_alpha);
+                             const char *const *texture_paths, int texture_alpha, const char *const *map_paths);
 
 /* ---------------------------------------------------------------------- */
 /* Meshes refined and repaired: --subdivide, --smooth, --permissive         */
