@@ -6,6 +6,7 @@
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -46,20 +47,61 @@ static int ends_with_ignoring_case(const char *text, size_t length, const char *
     return 1;
 }
 
-int tool_output_prefix(const char *text, char *prefix)
+int parse_mesh_output_option(int argc, char **argv, int *index, int accept_format, tool_mesh_output *output)
+{
+    const char *value;
+    if (accept_format && tool_option(argc, argv, index, "--format", &value)) {
+        if (!value) {
+            tool_usage("--format needs a value: obj or glb");
+            return -1;
+        }
+        if (strcmp(value, "obj") == 0) output->format = TOOL_FORMAT_OBJ;
+        else if (strcmp(value, "glb") == 0) output->format = TOOL_FORMAT_GLB;
+        else {
+            tool_usage("--format wants obj or glb, got '%s'", value);
+            return -1;
+        }
+        output->format_given = 1;
+    } else if (strcmp(argv[*index], "--triangles") == 0) {
+        output->triangles = 1;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+/* The known extension `text` ends with (output_extensions), or NULL; only
+   when something is left of the name: ".obj" alone stays a name. */
+static const char *output_extension(const char *text)
 {
     size_t length = strlen(text), k;
-    if (strcmp(text, "-") == 0)
-        return tool_usage("OUT_PREFIX cannot be '-' (standard output): it names several files; give a name such as 'out'");
-    if (length + 16 > TOOL_PREFIX_SIZE) return tool_usage("OUT_PREFIX is too long");
-    for (k = 0; k < sizeof output_extensions / sizeof output_extensions[0]; k++) {
-        /* Only when something is left of the name: ".obj" alone stays a name. */
+    for (k = 0; k < sizeof output_extensions / sizeof output_extensions[0]; k++)
         if (ends_with_ignoring_case(text, length, output_extensions[k]) &&
-            length - strlen(output_extensions[k]) > (size_t)(tool_basename(text) - text)) {
-            length -= strlen(output_extensions[k]);
-            break;
-        }
+            length - strlen(output_extensions[k]) > (size_t)(tool_basename(text) - text))
+            return text + length - strlen(output_extensions[k]);
+    return NULL;
+}
+
+int tool_output_prefix(const char *text, tool_mesh_output *output, char *prefix)
+{
+    const char *extension = output_extension(text);
+    size_t length = extension ? (size_t)(extension - text) : strlen(text);
+    int glb_name = extension && ends_with_ignoring_case(extension, strlen(extension), ".glb");
+    if (output && glb_name && output->format_given && output->format != TOOL_FORMAT_GLB)
+        return tool_usage("OUT_PREFIX '%s' names a GLB file, but --format obj asks for OBJ files: drop one of them",
+                          text);
+    if (output && extension && !glb_name && output->format == TOOL_FORMAT_GLB)
+        return tool_usage("OUT_PREFIX '%s' ends in %s, but --format glb writes one .glb file: name it '%.*s.glb'",
+                          text, extension, (int)length, text);
+    if (output && glb_name) output->format = TOOL_FORMAT_GLB;
+    if (strcmp(text, "-") == 0 && output && output->format == TOOL_FORMAT_GLB) {
+        strcpy(prefix, "-");
+        return 0;
     }
+    if (strcmp(text, "-") == 0)
+        return tool_usage("OUT_PREFIX cannot be '-' (standard output): it names several files; give a name such as "
+                          "'out'%s", output ? ", or add --format glb for one file" : "");
+    if (length + 16 > TOOL_PREFIX_SIZE) return tool_usage("OUT_PREFIX is too long");
     memcpy(prefix, text, length);
     prefix[length] = '\0';
     if (tool_basename(prefix)[0] == '\0')
@@ -67,14 +109,20 @@ int tool_output_prefix(const char *text, char *prefix)
     return 0;
 }
 
+void tool_output_path(const char *prefix, const char *suffix, char *path, size_t size)
+{
+    if (strcmp(prefix, "-") == 0) snprintf(path, size, "-");
+    else snprintf(path, size, "%s%s", prefix, suffix);
+}
+
 int tool_mesh_image_prefix(const char *const *positional, int npositional, const char **mesh, const char **image,
-                           char *prefix)
+                           tool_mesh_output *output, char *prefix)
 {
     const char *command = tool_command() ? tool_command() : "CMD";
     if (npositional > 3) return tool_usage("too many arguments (see '%s %s --help')", TOOL_NAME, command);
     if (npositional < 3)
         return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see '%s %s --help')", TOOL_NAME, command);
-    if (tool_output_prefix(positional[2], prefix) != 0) return TOOL_EXIT_USAGE;
+    if (tool_output_prefix(positional[2], output, prefix) != 0) return TOOL_EXIT_USAGE;
     *mesh = positional[0];
     *image = positional[1];
     return 0;

@@ -82,6 +82,7 @@ typedef struct hpm_command_options {
     char prefix[TOOL_PREFIX_SIZE];  /* OUT_PREFIX without a known extension */
     tt_hpm_options map;     /* zero fields: the library's defaults */
     material_maps maps;     /* --normal ...: the material's other maps, on the same UVs */
+    tool_mesh_output output;        /* --format, --triangles */
 } hpm_command_options;
 
 /* --threshold: a number above 0, or "inf" (every fit accepted). */
@@ -101,14 +102,17 @@ static int parse_threshold(const char *value, double *threshold)
 static int parse_command_line(int argc, char **argv, hpm_command_options *options)
 {
     const char *positional[3];
-    int npositional = 0, i, taken;
+    int npositional = 0, i;
     memset(options, 0, sizeof *options);
     for (i = 1; i < argc; i++) {
         const char *value;
         double number;
+        int taken;
         if (tool_is_help(argv[i])) {
             print_help();
             return 0;
+        } else if ((taken = parse_mesh_output_option(argc, argv, &i, 1, &options->output)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--scale", &value)) {
             if (!value) return tool_usage("--scale needs a value");
             if (parse_whole_double(value, &number) != 0 || !(number > 0.0) || number > 1e30)
@@ -140,7 +144,7 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
         }
     }
     if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
-                               options->prefix) != 0)
+                               &options->output, options->prefix) != 0)
         return TOOL_EXIT_USAGE;
     return -1;
 }
@@ -170,6 +174,20 @@ static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, 
     return triangle_mesh_report_error(options->mesh_path, m, &error);
 }
 
+/* The triangles with one texture coordinate and one normal per corner, for
+   either file. */
+static void hpm_write_desc(const triangle_mesh *m, const float *corner_uv, const float *normals, obj_write_desc *desc)
+{
+    memset(desc, 0, sizeof *desc);
+    desc->nverts = m->mesh->nverts;
+    desc->pos = m->mesh->pos;
+    desc->nfaces = m->ntriangles;
+    desc->fixed_face_size = 3;
+    desc->corner_vert = m->vert;
+    desc->corner_uv = corner_uv;
+    desc->corner_normal = normals;
+}
+
 /* OUT_PREFIX.obj: the vertices, the triangles, one vt per triangle corner. */
 static int add_obj(tool_output *output, const char *path, const char *mtl_name, const hpm_command_options *options,
                    const triangle_mesh *m, const float *corner_uv)
@@ -185,18 +203,32 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
              (options->map.flags & TT_HPM_TOROIDAL)
                  ? "the image tiles: coordinates leave [0,1], sample it with repeat addressing"
                  : "every coordinate lies inside the image");
-    memset(&desc, 0, sizeof desc);
+    hpm_write_desc(m, corner_uv, normals, &desc);
     desc.comment = comment;
-    desc.nverts = m->mesh->nverts;
-    desc.pos = m->mesh->pos;
-    desc.nfaces = m->ntriangles;
-    desc.fixed_face_size = 3;
-    desc.corner_vert = m->vert;
-    desc.corner_uv = corner_uv;
-    desc.corner_normal = normals;
     desc.mtllib = mtl_name;
     desc.material = "hpm";
     status = output_add_obj(output, path, &desc);
+    free(normals);
+    return status;
+}
+
+/* OUT_PREFIX.glb: the same triangles, IMAGE embedded as the material's
+   colour; repeated when --toroidal lets the coordinates leave [0,1]. */
+static int add_glb(tool_output *output, const char *path, const hpm_command_options *options, const triangle_mesh *m,
+                   const float *corner_uv, const tt_image *image)
+{
+    obj_write_desc desc;
+    tool_material material;
+    float *normals = tool_corner_normals(path, m->mesh);
+    int status;
+    if (!normals) return TOOL_EXIT_FAILURE;
+    hpm_write_desc(m, corner_uv, normals, &desc);
+    memset(&material, 0, sizeof material);
+    material.name = "hpm";
+    material.base_color = image;
+    material_for_glb(&material, &options->maps, (const tt_image *const *)options->maps.images);
+    material.repeat = (options->map.flags & TT_HPM_TOROIDAL) != 0;
+    status = output_add_glb(output, path, &desc, &material);
     free(normals);
     return status;
 }
@@ -306,15 +338,17 @@ int cmd_hpm(int argc, char **argv)
     hpm_quality quality;
     tool_output output = TOOL_OUTPUT_INIT;
     float *corner_uv = NULL;
-    char obj_path[4096], mtl_path[4096], message[TOOL_ERROR_SIZE], normal_path[4200];
+    char obj_path[4096], mtl_path[4096], glb_path[4096], message[TOOL_ERROR_SIZE], normal_path[4200];
     const char *map_paths[MATERIAL_MAPS];
     double start = tool_seconds_now();
-    int status, map;
+    int status, map, glb;
 
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
+    tool_output_path(options.prefix, ".glb", glb_path, sizeof glb_path);
+    glb = options.output.format == TOOL_FORMAT_GLB;
     /* The UVs are into IMAGE itself, so they serve every map of its size as
        it is; a Y-down normal map alone is rewritten, +Y up. */
     material_path(normal_path, sizeof normal_path, options.prefix, MATERIAL_NORMAL);
@@ -329,9 +363,10 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again, but only after mapping). */
-    if (status == 0) status = tool_refuse_input_overwrite(obj_path);
-    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
-    if (status == 0 && options.maps.normal_y_down) status = tool_refuse_input_overwrite(normal_path);
+    if (status == 0 && glb) status = tool_refuse_input_overwrite(glb_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0 && !glb && options.maps.normal_y_down) status = tool_refuse_input_overwrite(normal_path);
     if (status == 0) {
         corner_uv = (float *)malloc((size_t)mesh.ntriangles * 6 * sizeof(float));
         if (!corner_uv) status = tool_fail("out of memory for the texture coordinates of %s", options.mesh_path);
@@ -339,16 +374,19 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0) status = map_mesh(&options, &mesh, image, corner_uv, &report);
     if (status == 0) status = measure_quality(&options, &mesh, image, corner_uv, &report, &quality);
 
-    if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
-    if (status == 0) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0, map_paths);
-    if (status == 0 && options.maps.normal_y_down)
+    if (status == 0 && glb) status = add_glb(&output, glb_path, &options, &mesh, corner_uv, image);
+    if (status == 0 && !glb) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
+    if (status == 0 && !glb) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0, map_paths);
+    if (status == 0 && !glb && options.maps.normal_y_down)
         status = output_add_map_png(&output, normal_path, MATERIAL_NORMAL, options.maps.images[MATERIAL_NORMAL]);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, image, &report, &quality, tool_seconds_now() - start);
-        printf("wrote %s, %s%s%s\n", obj_path, mtl_path, options.maps.normal_y_down ? ", " : "",
-               options.maps.normal_y_down ? normal_path : "");
+        if (glb) printf("wrote %s (with %s in it)\n", glb_path, options.image_path);
+        else
+            printf("wrote %s, %s%s%s\n", obj_path, mtl_path, options.maps.normal_y_down ? ", " : "",
+                   options.maps.normal_y_down ? normal_path : "");
     }
     output_free(&output);
     image_free(image);

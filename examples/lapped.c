@@ -54,6 +54,9 @@
    the whole image stays the one patch. */
 #define LAPPED_DEFAULT_PATCHES 4
 #define LAPPED_DEFAULT_MIN_WINDOW 64
+/* A GLB holds the pastes baked (see cmd_lapped); without --bake, into a
+   texture of this size. */
+#define LAPPED_GLB_BAKE_SIZE 2048
 
 static void print_help(void)
 {
@@ -168,6 +171,7 @@ typedef struct lapped_options {
     bake_uv_choice bake_uv;         /* --bake-uv */
     tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
     material_maps maps;             /* --normal ...: the material's other maps, pasted alike */
+    tool_mesh_output output;        /* --format, --triangles */
 } lapped_options;
 
 /* Returns -1 to go on, or the exit status to return now. */
@@ -185,6 +189,8 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             print_help();
             return 0;
         } else if ((taken = parse_mesh_option(argc, argv, &i, &options->mesh)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
+        } else if ((taken = parse_mesh_output_option(argc, argv, &i, 1, &options->output)) != 0) {
             if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--scale", &value)) {
             if (!value) return tool_usage("--scale needs a value");
@@ -230,8 +236,11 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
         }
     }
     if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
-                               options->prefix) != 0)
+                               &options->output, options->prefix) != 0)
         return TOOL_EXIT_USAGE;
+    /* A glTF renderer does not draw stacked blended copies of a triangle in
+       their order, so a GLB holds the pastes baked into one texture. */
+    if (options->output.format == TOOL_FORMAT_GLB && options->bake_size == 0) options->bake_size = LAPPED_GLB_BAKE_SIZE;
     return -1;
 }
 
@@ -648,9 +657,10 @@ static int lapped_patches_name(const char *prefix, const patch_windows *windows,
 }
 
 /* Each patch's window of each map: its PNG (the map as it is, opaque: the
-   colour patch's alpha shows where it lies) and, for --bake, the window
-   premultiplied by the colour patch's alpha, so that every map is
-   composited exactly where and as much as the colour is. Frees the maps. */
+   colour patch's alpha shows where it lies; none when output is NULL) and,
+   for --bake, the window premultiplied by the colour patch's alpha, so that
+   every map is composited exactly where and as much as the colour is. Frees
+   the maps. */
 static int make_map_patches(const lapped_options *options, material_maps *maps, const patch_windows *windows,
                             tool_output *output, lapped_patches *patches)
 {
@@ -663,13 +673,12 @@ static int make_map_patches(const lapped_options *options, material_maps *maps, 
             tt_image *window = NULL, *patch = NULL;
             size_t i, count;
             tt_error error;
-            if (windows->size == 0) {
-                status = output_add_map_png(output, patches->map_png_paths[k * MATERIAL_MAPS + map], map, image);
-            } else if (image_crop(image, windows->x[k], windows->y[k], windows->size, windows->size, &window) != 0) {
+            if (windows->size > 0 &&
+                image_crop(image, windows->x[k], windows->y[k], windows->size, windows->size, &window) != 0)
                 status = tool_fail("out of memory for patch %d of %s", k + 1, maps->paths[map]);
-            } else {
-                status = output_add_map_png(output, patches->map_png_paths[k * MATERIAL_MAPS + map], map, window);
-            }
+            else if (output)
+                status = output_add_map_png(output, patches->map_png_paths[k * MATERIAL_MAPS + map], map,
+                                            window ? window : image);
             if (status == 0 && options->bake_size > 0) {
                 const tt_image *source = window ? window : image;
                 if (tt_image_create(source->width, source->height, NULL, &patch, &error) != TT_OK) {
@@ -694,17 +703,18 @@ static int make_map_patches(const lapped_options *options, material_maps *maps, 
     return status;
 }
 
-/* Each window of *image made a patch, and its PNG added to the output;
-   the image is freed here (*image = NULL). The whole image as the one
-   patch becomes the PNG in its own memory (add_patch_png); a window is
-   copied out first, and that copy becomes the PNG. */
+/* Each window of *image made a patch, and its PNG added to the output
+   (none when output is NULL: a GLB holds only the baked result); the image
+   is freed here (*image = NULL). The whole image as the one patch becomes
+   the PNG in its own memory (add_patch_png); a window is copied out first,
+   and that copy becomes the PNG. */
 static int make_patches(const lapped_options *options, tt_image **image, const patch_windows *windows,
                         const tt_image *mask, tool_output *output, lapped_patches *patches)
 {
     int k, status = 0;
     if (windows->size == 0) {
         status = make_patch(options, *image, mask, &patches->images[0]);
-        if (status == 0) status = add_patch_png(output, patches->png_paths[0], image, patches->images[0]);
+        if (status == 0 && output) status = add_patch_png(output, patches->png_paths[0], image, patches->images[0]);
     } else {
         for (k = 0; k < windows->count && status == 0; k++) {
             tt_image *window;
@@ -713,7 +723,8 @@ static int make_patches(const lapped_options *options, tt_image **image, const p
                 break;
             }
             status = make_patch(options, window, mask, &patches->images[k]);
-            if (status == 0) status = add_patch_png(output, patches->png_paths[k], &window, patches->images[k]);
+            if (status == 0 && output)
+                status = add_patch_png(output, patches->png_paths[k], &window, patches->images[k]);
             image_free(window);
         }
     }
@@ -939,21 +950,42 @@ static int measure_baked(const lapped_options *options, const triangle_mesh *m, 
     return status;
 }
 
+/* Map `map` baked into `atlas` with the pastes, UVs and options the colour
+   was baked with, from its own patches (the colour's alpha): the maps line
+   up with the colour texel for texel. map_patches has room for one patch
+   per window. */
+static int bake_map(const lapped_options *options, const triangle_mesh *m, const tt_lapped *lapped,
+                    const lapped_patches *patches, const float *corner_uv, const tt_bake_options *bake, int map,
+                    tt_image **map_patches, tt_image *atlas)
+{
+    tt_error error;
+    int k;
+    for (k = 0; k < patches->count; k++) map_patches[k] = patches->map_images[k * MATERIAL_MAPS + map];
+    if (tt_lapped_bake(m->mesh, lapped, map_patches, patches->count, corner_uv, bake, NULL, atlas, &error) != TT_OK)
+        return triangle_mesh_report_error(options->mesh_path, m, &error);
+    return 0;
+}
+
 /* --bake: the pastes composited into a size x size texture over corner_uv
-   (from bake_uvs; freed here); an ordinary OBJ + MTL + PNG. */
+   (from bake_uvs; freed here); an ordinary OBJ + MTL + PNG (and a PNG per
+   map), or with a glb_path (not NULL) that GLB. */
 static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
                      const tt_lapped *lapped, const lapped_patches *patches, float *corner_uv,
-                     baked_seams *seams)
+                     const char *glb_path, baked_seams *seams)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256], map_paths[MATERIAL_MAPS][4200];
     char stem[TOOL_PREFIX_SIZE + 16];
     const char *map_names[MATERIAL_MAPS];
-    tt_image *atlas = NULL, **map_patches = NULL;
+    tt_image *atlas = NULL, **map_patches = NULL, *map_atlases[MATERIAL_MAPS];
     float *normals = NULL;
     tt_bake_options bake;
     tt_error error;
     obj_write_desc desc;
-    int status = 0, map, k;
+    int status = 0, map;
+
+    memset(map_atlases, 0, sizeof map_atlases);
+    map_patches = (tt_image **)malloc((size_t)patches->count * sizeof(tt_image *));
+    if (!map_patches) return tool_fail("out of memory for the baked maps");
 
     snprintf(obj_path, sizeof obj_path, "%s_baked.obj", options->prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s_baked.mtl", options->prefix);
@@ -973,12 +1005,11 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
 
     snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
              tool_basename(png_path));
-    if (!(normals = tool_corner_normals(obj_path, m->mesh))) {
+    if (!(normals = tool_corner_normals(glb_path ? glb_path : obj_path, m->mesh))) {
         status = TOOL_EXIT_FAILURE;
         goto done;
     }
     memset(&desc, 0, sizeof desc);
-    desc.comment = comment;
     desc.nverts = m->mesh->nverts;
     desc.pos = m->mesh->pos;
     desc.nfaces = m->ntriangles;
@@ -986,6 +1017,25 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     desc.corner_vert = m->vert;
     desc.corner_uv = corner_uv;
     desc.corner_normal = normals;
+    if (glb_path) {
+        /* The GLB is written at once: every map baked into an atlas of its own. */
+        tool_material material;
+        for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
+            if (!options->maps.paths[map]) continue;
+            if (tt_image_create(options->bake_size, options->bake_size, NULL, &map_atlases[map], &error) != TT_OK)
+                status = tool_fail("out of memory for the baked %s map", material_map_names[map]);
+            else
+                status = bake_map(options, m, lapped, patches, corner_uv, &bake, map, map_patches, map_atlases[map]);
+        }
+        if (status != 0) goto done;
+        memset(&material, 0, sizeof material);
+        material.name = "lapped_baked";
+        material.base_color = atlas;
+        material_for_glb(&material, &options->maps, (const tt_image *const *)map_atlases);
+        status = output_add_glb(output, glb_path, &desc, &material);
+        goto done;
+    }
+    desc.comment = comment;
     desc.mtllib = tool_basename(mtl_path);
     desc.material = "lapped_baked";
     if ((status = output_add_obj(output, obj_path, &desc)) != 0) goto done;
@@ -1000,25 +1050,19 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     atlas = NULL;   /* add_png freed it */
     if (status != 0 || material_count(&options->maps) == 0) goto done;
 
-    /* Every map baked with the same pastes, UVs and gutter, from its own
-       patches (the colour's alpha): the maps line up texel for texel. One
-       atlas at a time, the colour's memory given back first. */
-    map_patches = (tt_image **)malloc((size_t)patches->count * sizeof(tt_image *));
-    if (!map_patches || tt_image_create(options->bake_size, options->bake_size, NULL, &atlas, &error) != TT_OK) {
+    /* The maps one atlas at a time, the colour's memory given back first. */
+    if (tt_image_create(options->bake_size, options->bake_size, NULL, &atlas, &error) != TT_OK) {
         status = tool_fail("out of memory for the baked maps");
         goto done;
     }
     for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
         if (!map_names[map]) continue;
-        for (k = 0; k < patches->count; k++) map_patches[k] = patches->map_images[k * MATERIAL_MAPS + map];
-        if (tt_lapped_bake(m->mesh, lapped, map_patches, patches->count, corner_uv, &bake, NULL, atlas, &error) !=
-            TT_OK)
-            status = triangle_mesh_report_error(options->mesh_path, m, &error);
-        else
-            status = output_add_map_png(output, map_paths[map], map, atlas);
+        status = bake_map(options, m, lapped, patches, corner_uv, &bake, map, map_patches, atlas);
+        if (status == 0) status = output_add_map_png(output, map_paths[map], map, atlas);
     }
 done:
     tt_image_free(atlas);
+    for (map = 0; map < MATERIAL_MAPS; map++) tt_image_free(map_atlases[map]);
     free(map_patches);
     free(normals);
     free(corner_uv);
@@ -1102,11 +1146,13 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
 /* Refuse, before the long part, outputs that would replace an input (the
    commit checks again, but only after pasting). */
 static int refuse_overwriting_inputs(const lapped_options *options, const char *obj_path, const char *mtl_path,
-                                     const lapped_patches *patches)
+                                     const char *glb_path, const lapped_patches *patches)
 {
     static const char *const baked[] = {"_baked.obj", "_baked.mtl", "_baked.png"};
     char path[4096 + 16];
-    int status = tool_refuse_input_overwrite(obj_path), k;
+    int status, k;
+    if (options->output.format == TOOL_FORMAT_GLB) return tool_refuse_input_overwrite(glb_path);
+    status = tool_refuse_input_overwrite(obj_path);
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
     for (k = 0; k < patches->count && status == 0; k++) status = tool_refuse_input_overwrite(patches->png_paths[k]);
     for (k = 0; k < patches->count * MATERIAL_MAPS && status == 0; k++)
@@ -1133,14 +1179,16 @@ int cmd_lapped(int argc, char **argv)
     lapped_patches patches;
     float *field = NULL, *bake_uv = NULL;
     baked_seams baked;
-    char obj_path[4096], mtl_path[4096], message[TOOL_ERROR_SIZE];
+    char obj_path[4096], mtl_path[4096], glb_path[4096], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
-    int status, charts = 0;
+    int status, charts = 0, glb;
 
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
+    tool_output_path(options.prefix, ".glb", glb_path, sizeof glb_path);
+    glb = options.output.format == TOOL_FORMAT_GLB;
     memset(&output, 0, sizeof output);
     memset(&baked, 0, sizeof baked);
     memset(&patches, 0, sizeof patches);
@@ -1156,15 +1204,15 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     if (status == 0) status = choose_windows(&options, image->width, image->height, &windows);
     if (status == 0) status = lapped_patches_name(options.prefix, &windows, &options.maps, &patches);
-    if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, &patches);
+    if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, glb_path, &patches);
     if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &charts);
     if (status == 0) status = load_mask(&options, image->width, image->height, &windows, &mask);
     /* Memory: the image is needed only to make the patches and their PNGs,
        so the PNGs are encoded now and the image freed before the paste
        loop; from here on the command holds the patches and the compressed
        PNGs. */
-    if (status == 0) status = make_patches(&options, &image, &windows, mask, &output, &patches);
-    if (status == 0) status = make_map_patches(&options, &options.maps, &windows, &output, &patches);
+    if (status == 0) status = make_patches(&options, &image, &windows, mask, glb ? NULL : &output, &patches);
+    if (status == 0) status = make_map_patches(&options, &options.maps, &windows, glb ? NULL : &output, &patches);
     material_free(&options.maps);
     image_free(image);
     image = NULL;
@@ -1172,13 +1220,14 @@ int cmd_lapped(int argc, char **argv)
     mask = NULL;
     if (status == 0) status = paste(&options, &mesh, field, &patches, &lapped);
 
-    if (status == 0) status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped, &patches);
-    if (status == 0)
+    if (status == 0 && !glb)
+        status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped, &patches);
+    if (status == 0 && !glb)
         status = output_add_mtl_materials(&output, mtl_path, patches.count, (const char *const *)patches.materials,
                                           (const char *const *)patches.png_paths, 1,
                                           (const char *const *)patches.map_png_paths);
     if (status == 0 && options.bake_size > 0) {
-        status = add_baked(&output, &options, &mesh, lapped, &patches, bake_uv, &baked);
+        status = add_baked(&output, &options, &mesh, lapped, &patches, bake_uv, glb ? glb_path : NULL, &baked);
         bake_uv = NULL;   /* add_baked freed it */
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
@@ -1186,15 +1235,21 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, field, lapped, &baked, tool_seconds_now() - start);
         print_patch_use(&patches, lapped);
-        printf("wrote %s, %s, %s", obj_path, mtl_path, patches.png_paths[0]);
-        if (patches.count > 1) printf(" to %s", patches.png_paths[patches.count - 1]);
-        if (options.bake_size > 0 && charts == 0)
-            printf("; %s_baked.obj/.mtl/.png (%dx%d, over the OBJ's texture coordinates)", options.prefix,
-                   options.bake_size, options.bake_size);
-        else if (options.bake_size > 0)
-            printf("; %s_baked.obj/.mtl/.png (%dx%d, over an atlas of %d chart%s)", options.prefix, options.bake_size,
-                   options.bake_size, charts, charts == 1 ? "" : "s");
-        printf("\n");
+        if (glb) {
+            printf("wrote %s (the pastes baked into %dx%d, over ", glb_path, options.bake_size, options.bake_size);
+            if (charts == 0) printf("the OBJ's texture coordinates)\n");
+            else printf("an atlas of %d chart%s)\n", charts, charts == 1 ? "" : "s");
+        } else {
+            printf("wrote %s, %s, %s", obj_path, mtl_path, patches.png_paths[0]);
+            if (patches.count > 1) printf(" to %s", patches.png_paths[patches.count - 1]);
+            if (options.bake_size > 0 && charts == 0)
+                printf("; %s_baked.obj/.mtl/.png (%dx%d, over the OBJ's texture coordinates)", options.prefix,
+                       options.bake_size, options.bake_size);
+            else if (options.bake_size > 0)
+                printf("; %s_baked.obj/.mtl/.png (%dx%d, over an atlas of %d chart%s)", options.prefix,
+                       options.bake_size, options.bake_size, charts, charts == 1 ? "" : "s");
+            printf("\n");
+        }
     }
     output_free(&output);
     tt_lapped_free(lapped);

@@ -39,7 +39,9 @@ static void print_help(void)
            "  --atlas A.png    also write OUT.mtl naming A.png, and report the seam score\n"
            "  --permissive     accept non-manifold or mis-oriented edges (they become boundaries)\n"
            "  --report         also print tile usage and face stretch, and measure the seams on\n"
-           "                   every edge (default: a sample of %d edges)\n",
+           "                   every edge (default: a sample of %d edges)\n"
+           "  --triangles      write each quad as two triangles (same texture coordinates), for\n"
+           "                   programs that read only triangles\n",
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
 }
 
@@ -89,7 +91,8 @@ int cmd_map(int argc, char **argv)
 
     memset(&output, 0, sizeof output);
     status = tiled_parse_command_line(argc, argv,
-                                      TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION,
+                                      TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION |
+                                          TILED_TRIANGLES_OPTION,
                                       &options, positional, 2, "MESH.obj and OUT.obj", print_help);
     if (status >= 0) return status;
     if ((status = tool_refuse_stdout(positional[1], options.atlas_path != NULL, "OUT.obj with --atlas")) != 0)
@@ -114,9 +117,10 @@ int cmd_map(int argc, char **argv)
                  positional[1]);
         tool_relative_path(options.atlas_path, mtl_path, texture, sizeof texture);
         status = tiled_add_mtl(&output, mtl_path, texture, NULL);
-        if (status == 0) status = tiled_add_obj(&output, positional[1], &mesh, tool_basename(mtl_path));
+        if (status == 0) status = tiled_add_obj(&output, positional[1], &mesh, tool_basename(mtl_path),
+                                                options.output.triangles);
     } else {
-        status = tiled_add_obj(&output, positional[1], &mesh, NULL);
+        status = tiled_add_obj(&output, positional[1], &mesh, NULL, options.output.triangles);
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {

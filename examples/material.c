@@ -110,6 +110,16 @@ int material_refuse_overwrite(const material_maps *maps, const char *stem)
     return status;
 }
 
+void material_for_glb(tool_material *material, const material_maps *maps, const tt_image *const *images)
+{
+    material->normal = images[MATERIAL_NORMAL];
+    material->roughness = images[MATERIAL_ROUGHNESS];
+    material->metallic = images[MATERIAL_METALLIC];
+    material->occlusion = images[MATERIAL_AO];
+    if (maps->paths[MATERIAL_HEIGHT])
+        tool_note("glTF has no height map: %s is not in the GLB (the OBJ output writes it)", maps->paths[MATERIAL_HEIGHT]);
+}
+
 int output_add_map_png(tool_output *output, const char *path, int map, const tt_image *image)
 {
     char message[TOOL_ERROR_SIZE];

@@ -813,6 +813,35 @@ static void write_floats(tool_buffer *out, const char *keyword, const float *val
     buffer_append(out, line, length);
 }
 
+/* One corner of an "f" line: " v", " v/vt", " v//vn" or " v/vt/vn", where
+   corner c uses vt c + 1 and vn c + 1. */
+static void write_corner(tool_buffer *out, const obj_write_desc *desc, int c)
+{
+    char text[3 * TOOL_NUMBER_TEXT_SIZE + 3];
+    int length;
+    text[0] = ' ';
+    length = 1 + tool_format_int((long)desc->corner_vert[c] + 1, text + 1);
+    if (desc->corner_uv || desc->corner_normal) {
+        text[length++] = '/';
+        if (desc->corner_uv) length += tool_format_int((long)c + 1, text + length);
+    }
+    if (desc->corner_normal) {
+        text[length++] = '/';
+        length += tool_format_int((long)c + 1, text + length);
+    }
+    buffer_append(out, text, (size_t)length);
+}
+
+/* "f" with corner `first`, then `count` corners from `next` on. */
+static void write_face_corners(tool_buffer *out, const obj_write_desc *desc, int first, int next, int count)
+{
+    int i;
+    buffer_append(out, "f", 1);
+    write_corner(out, desc, first);
+    for (i = 0; i < count; i++) write_corner(out, desc, next + i);
+    buffer_append(out, "\n", 1);
+}
+
 int obj_write(tool_buffer *out, const obj_write_desc *desc)
 {
     int v, f, c = 0, ncorners = 0, previous_group = -1;
@@ -869,24 +898,16 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
                 previous_group = group;
             }
         }
-        buffer_append(out, "f", 1);
-        for (i = 0; i < size; i++, c++) {
-            char text[3 * TOOL_NUMBER_TEXT_SIZE + 3];
-            int vertex = desc->corner_vert[c], length;
-            if (vertex < 0 || vertex >= desc->nverts) return -1;
-            text[0] = ' ';
-            length = 1 + tool_format_int((long)vertex + 1, text + 1);
-            if (desc->corner_uv || desc->corner_normal) {
-                text[length++] = '/';
-                if (desc->corner_uv) length += tool_format_int((long)c + 1, text + length);
-            }
-            if (desc->corner_normal) {
-                text[length++] = '/';
-                length += tool_format_int((long)c + 1, text + length);
-            }
-            buffer_append(out, text, (size_t)length);
+        for (i = 0; i < size; i++)
+            if (desc->corner_vert[c + i] < 0 || desc->corner_vert[c + i] >= desc->nverts) return -1;
+        if (desc->triangles) {
+            /* The fan from the first corner, as readers split a polygon
+               themselves: each triangle keeps the face's winding. */
+            for (i = 1; i + 1 < size; i++) write_face_corners(out, desc, c, c + i, 2);
+        } else {
+            write_face_corners(out, desc, c, c + 1, size - 1);
         }
-        buffer_append(out, "\n", 1);
+        c += size;
     }
     return out->failed ? -1 : 0;
 }

@@ -109,7 +109,10 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
             print_help();
             return 0;
         }
-        taken = tiled_parse_option(argc, argv, &i, TILED_LAYOUT_OPTIONS | TILED_MATERIAL_OPTIONS, &options->tiles);
+        taken = tiled_parse_option(argc, argv, &i,
+                                   TILED_LAYOUT_OPTIONS | TILED_MATERIAL_OPTIONS | TILED_TRIANGLES_OPTION |
+                                       TILED_FORMAT_OPTION,
+                                   &options->tiles);
         if (taken < 0) return TOOL_EXIT_USAGE;
         if (taken) continue;
         if (tool_option(argc, argv, &i, "--resolution", &value)) {
@@ -141,7 +144,7 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
         return tool_usage("give --resolution or --cube-size, not both (both set the cubes' size)");
     if (options->tiles.layout.colors == 0) options->tiles.layout.colors = POLYCUBE_DEFAULT_COLORS;
     if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
-                               options->prefix) != 0)
+                               &options->tiles.output, options->prefix) != 0)
         return TOOL_EXIT_USAGE;
     return -1;
 }
@@ -449,7 +452,21 @@ static float *mapped_corner_normals(const char *path, const polycube_job *job)
     return out;
 }
 
-/* OUT_PREFIX.obj: the mapped triangles, one vt and one vn per corner. */
+/* The mapped triangles, one texture coordinate and one normal per corner,
+   for either file. */
+static void mapped_write_desc(const polycube_job *job, const float *normals, obj_write_desc *desc)
+{
+    memset(desc, 0, sizeof *desc);
+    desc->nverts = job->mapping->nverts;
+    desc->pos = job->mapping->positions;
+    desc->nfaces = job->mapping->ntriangles;
+    desc->fixed_face_size = 3;
+    desc->corner_vert = job->mapping->triangles;
+    desc->corner_uv = job->corner_uv;
+    desc->corner_normal = normals;
+}
+
+/* OUT_PREFIX.obj: the mapped triangles. */
 static int add_obj(tool_output *output, const char *path, const char *mtl_name, const polycube_job *job)
 {
     char comment[512];
@@ -462,15 +479,8 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
              "%d colors, %d-texel tiles, gutter %d",
              TILEDTEX_VERSION_STRING, job->mapping->ntriangles, job->polycube->surface->nfaces, job->polycube->h,
              job->layout.colors, job->layout.tile_size, job->layout.gutter);
-    memset(&desc, 0, sizeof desc);
+    mapped_write_desc(job, normals, &desc);
     desc.comment = comment;
-    desc.nverts = job->mapping->nverts;
-    desc.pos = job->mapping->positions;
-    desc.nfaces = job->mapping->ntriangles;
-    desc.fixed_face_size = 3;
-    desc.corner_vert = job->mapping->triangles;
-    desc.corner_uv = job->corner_uv;
-    desc.corner_normal = normals;
     desc.mtllib = mtl_name;
     desc.material = "tiled";
     status = output_add_obj(output, path, &desc);
@@ -478,16 +488,33 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
     return status;
 }
 
+/* OUT_PREFIX.glb: the mapped triangles with `material`. The polycube's
+   surface, a look at what the mesh was mapped onto, stays out of it: a GLB
+   is the textured mesh to take to other programs, and the surface would
+   enclose it. */
+static int add_glb(tool_output *output, const char *path, const polycube_job *job, const tool_material *material)
+{
+    obj_write_desc desc;
+    float *normals = mapped_corner_normals(path, job);
+    int status;
+    if (!normals) return TOOL_EXIT_FAILURE;
+    mapped_write_desc(job, normals, &desc);
+    status = output_add_glb(output, path, &desc, material);
+    free(normals);
+    return status;
+}
+
 /* OUT_PREFIX_polycube.obj: S with its own tiles, written the way `tile`
    writes a quad mesh (S is one, with the tiles' UVs). */
-static int add_surface_obj(tool_output *output, const char *path, const char *mtl_name, const polycube_job *job)
+static int add_surface_obj(tool_output *output, const char *path, const char *mtl_name, const polycube_job *job,
+                           int triangles)
 {
     tiled_mesh surface;
     memset(&surface, 0, sizeof surface);
     surface.mesh = job->polycube->surface;
     surface.corner_uv = job->surface_uv;
     surface.layout = job->layout;
-    return tiled_add_obj(output, path, &surface, mtl_name);
+    return tiled_add_obj(output, path, &surface, mtl_name, triangles);
 }
 
 /* ======================================================================== */
@@ -502,10 +529,11 @@ int cmd_polycube(int argc, char **argv)
     tt_image *image = NULL;
     tool_output output = TOOL_OUTPUT_INIT;
     tt_error error;
-    char obj_path[4096], mtl_path[4096], png_path[4096], surface_path[4096], message[TOOL_ERROR_SIZE];
+    char obj_path[4096], mtl_path[4096], png_path[4096], surface_path[4096], glb_path[4096],
+        message[TOOL_ERROR_SIZE];
     char map_paths[MATERIAL_MAPS][4200];
     const char *map_names[MATERIAL_MAPS];
-    int status, map;
+    int status, map, glb;
     double start;
 
     memset(&job, 0, sizeof job);
@@ -515,6 +543,8 @@ int cmd_polycube(int argc, char **argv)
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
     snprintf(png_path, sizeof png_path, "%s.png", options.prefix);
     snprintf(surface_path, sizeof surface_path, "%s_polycube.obj", options.prefix);
+    tool_output_path(options.prefix, ".glb", glb_path, sizeof glb_path);
+    glb = options.tiles.output.format == TOOL_FORMAT_GLB;
     for (map = 0; map < MATERIAL_MAPS; map++) {
         material_path(map_paths[map], sizeof map_paths[map], options.prefix, map);
         map_names[map] = options.tiles.maps.paths[map] ? tool_basename(map_paths[map]) : NULL;
@@ -531,11 +561,12 @@ int cmd_polycube(int argc, char **argv)
         status = tool_fail("%s", error.message);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again). */
-    if (status == 0) status = tool_refuse_input_overwrite(obj_path);
-    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
-    if (status == 0) status = tool_refuse_input_overwrite(png_path);
-    if (status == 0) status = tool_refuse_input_overwrite(surface_path);
-    if (status == 0) status = material_refuse_overwrite(&options.tiles.maps, options.prefix);
+    if (status == 0 && glb) status = tool_refuse_input_overwrite(glb_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(png_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(surface_path);
+    if (status == 0 && !glb) status = material_refuse_overwrite(&options.tiles.maps, options.prefix);
 
     if (status == 0) status = build_polycube(&options, &job);
     if (status == 0) {
@@ -553,26 +584,43 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = map_mesh(&options, &job);
     if (status == 0) status = measure_quality(&options, &job, &quality);
 
-    if (status == 0 && job.atlas && output_add_png(&output, png_path, job.atlas, TT_COLOR_SRGB, message,
-                                                   sizeof message) != 0)
+    if (status == 0 && glb) {
+        tool_material material;
+        const tt_image *map_images[MATERIAL_MAPS];
+        memset(&material, 0, sizeof material);
+        material.name = "tiled";
+        material.base_color = job.atlas ? job.atlas : &job.tiles->levels[0];
+        for (map = 0; map < MATERIAL_MAPS; map++)
+            map_images[map] = job.map_atlas[map] ? job.map_atlas[map]
+                              : job.map_tiles[map] ? &job.map_tiles[map]->levels[0] : NULL;
+        material_for_glb(&material, &options.tiles.maps, map_images);
+        status = add_glb(&output, glb_path, &job, &material);
+    }
+    if (status == 0 && !glb && job.atlas &&
+        output_add_png(&output, png_path, job.atlas, TT_COLOR_SRGB, message, sizeof message) != 0)
         status = tool_fail("%s", message);
-    if (status == 0 && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0, TT_COLOR_SRGB);
-    for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
+    if (status == 0 && !glb && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0, TT_COLOR_SRGB);
+    for (map = 0; map < MATERIAL_MAPS && status == 0 && !glb; map++) {
         if (job.map_atlas[map]) status = output_add_map_png(&output, map_paths[map], map, job.map_atlas[map]);
         else if (job.map_tiles[map])
             status = tiled_add_atlas(&output, map_paths[map], job.map_tiles[map], 0, material_space(map));
     }
-    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
-    if (status == 0) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
-    if (status == 0) status = add_surface_obj(&output, surface_path, tool_basename(mtl_path), &job);
+    if (status == 0 && !glb) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
+    if (status == 0 && !glb) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
+    if (status == 0 && !glb)
+        status = add_surface_obj(&output, surface_path, tool_basename(mtl_path), &job, options.tiles.output.triangles);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &job, &quality);
-        printf("wrote %s, %s, %s, %s", obj_path, mtl_path, png_path, surface_path);
-        for (map = 0; map < MATERIAL_MAPS; map++)
-            if (job.map_tiles[map]) printf(", %s", map_paths[map]);
-        printf("\n");
+        if (glb) {
+            printf("wrote %s\n", glb_path);
+        } else {
+            printf("wrote %s, %s, %s, %s", obj_path, mtl_path, png_path, surface_path);
+            for (map = 0; map < MATERIAL_MAPS; map++)
+                if (job.map_tiles[map]) printf(", %s", map_paths[map]);
+            printf("\n");
+        }
     }
     output_free(&output);
     image_free(image);

@@ -52,23 +52,30 @@ int cmd_tile(int argc, char **argv)
     tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS];
     tool_seams seams;
     tool_output output;
-    char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096];
+    char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096],
+        glb_path[4096];
     char map_paths[MATERIAL_MAPS][4200];
     const char *map_names[MATERIAL_MAPS];
-    int map;
+    int map, glb;
 
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
     memset(map_tiles, 0, sizeof map_tiles);
     status = tiled_parse_command_line(argc, argv,
                                       TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS |
-                                          TILED_REPORT_OPTION | TILED_MATERIAL_OPTIONS,
+                                          TILED_REPORT_OPTION | TILED_MATERIAL_OPTIONS | TILED_TRIANGLES_OPTION |
+                                          TILED_FORMAT_OPTION,
                                       &options, positional, 3, "MESH.obj, IMAGE and OUT_PREFIX", print_help);
     if (status >= 0) return status;
-    if (tool_output_prefix(positional[2], prefix) != 0) return TOOL_EXIT_USAGE;
+    if (tool_output_prefix(positional[2], &options.output, prefix) != 0) return TOOL_EXIT_USAGE;
+    glb = options.output.format == TOOL_FORMAT_GLB;
+    /* The per-tile mip levels keep coarse levels from blending neighbouring
+       tiles; a GLB has no place for them (its viewer makes its own). */
+    if (glb && options.mips) return tool_usage("--mips writes PNG files beside an OBJ: not with a GLB");
     snprintf(obj_path, sizeof obj_path, "%s.obj", prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", prefix);
     snprintf(png_path, sizeof png_path, "%s.png", prefix);
+    tool_output_path(prefix, ".glb", glb_path, sizeof glb_path);
     for (map = 0; map < MATERIAL_MAPS; map++) {
         material_path(map_paths[map], sizeof map_paths[map], prefix, map);
         map_names[map] = options.maps.paths[map] ? tool_basename(map_paths[map]) : NULL;
@@ -86,10 +93,11 @@ int cmd_tile(int argc, char **argv)
     status = tiled_check_atlas_size(&options);
     if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
     /* Before the synthesis: no output may replace an input (checked again at the commit). */
-    if (status == 0) status = tool_refuse_input_overwrite(obj_path);
-    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
-    if (status == 0) status = tool_refuse_input_overwrite(png_path);
-    if (status == 0) status = material_refuse_overwrite(&options.maps, prefix);
+    if (status == 0 && glb) status = tool_refuse_input_overwrite(glb_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0 && !glb) status = tool_refuse_input_overwrite(png_path);
+    if (status == 0 && !glb) status = material_refuse_overwrite(&options.maps, prefix);
     if (status == 0) status = tiled_synthesize(image, positional[1], &options, &options.maps, &tiles, map_tiles);
     /* The photo and the maps are not needed past the synthesis: free them
        before the PNGs are encoded (they are the largest things the command
@@ -100,22 +108,37 @@ int cmd_tile(int argc, char **argv)
     if (status == 0)
         status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, 0,
                                     NULL, 0, options.report, &seams);
-    if (status == 0) status = tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
-    for (map = 0; map < MATERIAL_MAPS && status == 0; map++)
+    if (status == 0 && glb) {
+        tool_material material;
+        const tt_image *map_atlases[MATERIAL_MAPS];
+        for (map = 0; map < MATERIAL_MAPS; map++) map_atlases[map] = map_tiles[map] ? &map_tiles[map]->levels[0] : NULL;
+        memset(&material, 0, sizeof material);
+        material.name = "tiled";
+        material.base_color = &tiles->levels[0];
+        material_for_glb(&material, &options.maps, map_atlases);
+        status = tiled_add_glb(&output, glb_path, &mesh, &material);
+    }
+    if (status == 0 && !glb) status = tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
+    for (map = 0; map < MATERIAL_MAPS && status == 0 && !glb; map++)
         if (map_tiles[map])
             status = tiled_add_atlas(&output, map_paths[map], map_tiles[map], options.mips, material_space(map));
-    if (status == 0) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
-    if (status == 0) status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path));
+    if (status == 0 && !glb) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
+    if (status == 0 && !glb)
+        status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path), options.output.triangles);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
         /* Said only on success: a failing command prints its one error line. */
         tiled_print_notes(positional[0], &mesh);
         if (!tool_quiet()) {
             tiled_print_summary(positional[0], &mesh, &seams, options.report);
-            printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
-            for (map = 0; map < MATERIAL_MAPS; map++)
-                if (map_tiles[map]) printf(", %s", map_paths[map]);
-            printf(" (%dx%d atlas)\n", tiles->levels[0].width, tiles->levels[0].height);
+            if (glb) {
+                printf("wrote %s (%dx%d atlas)\n", glb_path, tiles->levels[0].width, tiles->levels[0].height);
+            } else {
+                printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
+                for (map = 0; map < MATERIAL_MAPS; map++)
+                    if (map_tiles[map]) printf(", %s", map_paths[map]);
+                printf(" (%dx%d atlas)\n", tiles->levels[0].width, tiles->levels[0].height);
+            }
         }
     }
     output_free(&output);

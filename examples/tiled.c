@@ -61,6 +61,10 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         options->report = 1;
     } else if ((accept & TILED_MATERIAL_OPTIONS) && (taken = material_parse_option(argc, argv, index, &options->maps))) {
         if (taken < 0) return -1;
+    } else if ((accept & (TILED_TRIANGLES_OPTION | TILED_FORMAT_OPTION)) &&
+               (taken = parse_mesh_output_option(argc, argv, index, accept & TILED_FORMAT_OPTION,
+                                                 &options->output)) != 0) {
+        if (taken < 0) return -1;
     } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
         if (!value) { tool_usage("--atlas needs a value"); return -1; }
         options->atlas_path = value;
@@ -156,29 +160,49 @@ fail:
     return status;
 }
 
-int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name)
+/* The quads with their tiles' UVs and shading normals, for either file. */
+static void tiled_write_desc(const tiled_mesh *mesh, const float *normals, obj_write_desc *desc)
+{
+    memset(desc, 0, sizeof *desc);
+    desc->nverts = mesh->mesh->nverts;
+    desc->pos = mesh->mesh->pos;
+    desc->nfaces = mesh->mesh->nfaces;
+    desc->fixed_face_size = 4;
+    desc->corner_vert = mesh->mesh->corner_vert;
+    desc->corner_uv = mesh->corner_uv;
+    desc->corner_normal = normals;
+}
+
+int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name,
+                  int triangles)
 {
     obj_write_desc desc;
     char comment[256];
     float *normals = tool_corner_normals(obj_path, mesh->mesh);
     int status;
     if (!normals) return TOOL_EXIT_FAILURE;
-    memset(&desc, 0, sizeof desc);
+    tiled_write_desc(mesh, normals, &desc);
     snprintf(comment, sizeof comment,
              "tiled texture by tiledtex %s: %d quads, %d colors, %d-texel tiles, gutter %d",
              TILEDTEX_VERSION_STRING, mesh->mesh->nfaces, mesh->layout.colors, mesh->layout.tile_size,
              mesh->layout.gutter);
     desc.comment = comment;
-    desc.nverts = mesh->mesh->nverts;
-    desc.pos = mesh->mesh->pos;
-    desc.nfaces = mesh->mesh->nfaces;
-    desc.fixed_face_size = 4;
-    desc.corner_vert = mesh->mesh->corner_vert;
-    desc.corner_uv = mesh->corner_uv;
-    desc.corner_normal = normals;
     desc.mtllib = mtl_name;
     desc.material = mtl_name ? "tiled" : NULL;
+    desc.triangles = triangles;
     status = output_add_obj(output, obj_path, &desc);
+    free(normals);
+    return status;
+}
+
+int tiled_add_glb(tool_output *output, const char *glb_path, const tiled_mesh *mesh, const tool_material *material)
+{
+    obj_write_desc desc;
+    float *normals = tool_corner_normals(glb_path, mesh->mesh);
+    int status;
+    if (!normals) return TOOL_EXIT_FAILURE;
+    tiled_write_desc(mesh, normals, &desc);
+    status = output_add_glb(output, glb_path, &desc, material);
     free(normals);
     return status;
 }

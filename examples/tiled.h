@@ -18,7 +18,9 @@ enum {
     TILED_SYNTH_OPTIONS = 1 << 2,    /* --edge --background --mips */
     TILED_ATLAS_OPTION = 1 << 3,     /* --atlas */
     TILED_REPORT_OPTION = 1 << 4,    /* --report: quality line, seams measured on every edge */
-    TILED_MATERIAL_OPTIONS = 1 << 5  /* --normal --roughness --metallic --ao --height --normal-y-down */
+    TILED_MATERIAL_OPTIONS = 1 << 5, /* --normal --roughness --metallic --ao --height --normal-y-down */
+    TILED_TRIANGLES_OPTION = 1 << 6, /* --triangles */
+    TILED_FORMAT_OPTION = 1 << 7     /* --format obj|glb */
 };
 
 /* From this many triangles on, a mesh counts as a dense triangle mesh, for
@@ -36,6 +38,7 @@ typedef struct tiled_options {
     int mips;                    /* also write the per-tile mip levels */
     const char *atlas_path;      /* --atlas */
     int report;                  /* --report: tile usage and stretch under the summary */
+    tool_mesh_output output;     /* --format, --triangles */
     const tt_rect *upright_over; /* not NULL: upright tiles (tt_synth_options::upright) on these edge windows */
     material_maps maps;          /* the material's other maps (their paths; material_load loads them) */
 } tiled_options;
@@ -76,8 +79,12 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
 void tiled_mesh_free(tiled_mesh *mesh);
 
 /* Add OBJ_PATH (positions + one vt per corner, using MATERIAL from MTL_NAME
-   when mtl_name is not NULL) to the output batch. */
-int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name);
+   when mtl_name is not NULL; with `triangles` each quad as two triangles)
+   to the output batch. */
+int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name,
+                  int triangles);
+/* Add GLB_PATH: the same mesh with `material` (its base colour the atlas). */
+int tiled_add_glb(tool_output *output, const char *glb_path, const tiled_mesh *mesh, const tool_material *material);
 /* Add an MTL file with one material, "tiled", whose texture is TEXTURE_NAME
    and whose other maps are map_names (as mtl_add_material's maps). */
 int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name, const char *const *map_names);

@@ -14,6 +14,8 @@
      cli.c       command-line helpers    tool_option, parse_int, parse_mesh_option, ...
      image_io.c  images                  image_load, png_encode, output_add_png
      obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
+     gltf.c      glTF 2.0 binary (.glb)  gltf_write, output_add_glb,
+                                         gltf_pack_metallic_roughness
      mesh_file.c any mesh file, --weld   mesh_read, mesh_weld
                  MTL writing             mtl_add_material, output_add_mtl
      material.c  a material's maps       material_parse_option, material_load,
@@ -149,18 +151,40 @@ int tool_unknown_option(const char *arg);
 /* Room for an OUT_PREFIX: tool_output_prefix refuses longer ones, leaving
    room for the longest name a command adds ("_polycube.obj", "_patch_12.png"). */
 #define TOOL_PREFIX_SIZE 4000
+
+/* What the commands that write a textured mesh (tile, lapped, hpm,
+   polycube) write it as: an OBJ with its MTL and PNGs, or one binary glTF
+   file. Zero-initialised: OBJ, faces as they are. */
+typedef enum tool_mesh_format { TOOL_FORMAT_OBJ = 0, TOOL_FORMAT_GLB = 1 } tool_mesh_format;
+typedef struct tool_mesh_output {
+    tool_mesh_format format;    /* --format obj|glb, or an OUT_PREFIX ending in .glb */
+    int format_given;           /* --format was given */
+    int triangles;              /* --triangles: OBJ faces written as triangle fans */
+} tool_mesh_output;
+/* If argv[*index] is --format obj|glb (only when accept_format) or
+   --triangles, consume it and return 1; 0 for any other argument; -1 after
+   printing a bad value. */
+int parse_mesh_output_option(int argc, char **argv, int *index, int accept_format, tool_mesh_output *output);
+
 /* OUT_PREFIX as given into `prefix` (TOOL_PREFIX_SIZE bytes), less a known
    extension (.obj, .mtl, .png, .glb, .gltf, any case): "out.obj" means
-   out.obj + out.mtl + out.png, not out.obj.obj. Refuses "-" (the prefix
-   names several files, standard output takes one), a directory and a too
-   long prefix: prints the error and returns TOOL_EXIT_USAGE; 0 otherwise. */
-int tool_output_prefix(const char *text, char *prefix);
+   out.obj + out.mtl + out.png, not out.obj.obj. With `output` (NULL for a
+   command without --format) an OUT_PREFIX ending in .glb also sets
+   output->format to GLB, and one that names the other format than --format
+   asks for is refused ("out.glb --format obj", "out.obj --format glb"). A GLB is
+   one file, so for GLB "-" (the standard output) is kept as the prefix;
+   otherwise "-" is refused (the prefix names several files, standard
+   output takes one), as are a directory and a too long prefix: prints the
+   error and returns TOOL_EXIT_USAGE; 0 otherwise. */
+int tool_output_prefix(const char *text, tool_mesh_output *output, char *prefix);
+/* The file PREFIX + SUFFIX ("out" + ".glb"), or "-" when the prefix is "-". */
+void tool_output_path(const char *prefix, const char *suffix, char *path, size_t size);
 /* The three arguments MESH.obj IMAGE OUT_PREFIX of the commands that read a
    mesh and an image: checks there are exactly three and reads OUT_PREFIX
-   with tool_output_prefix, reporting a problem (returns TOOL_EXIT_USAGE);
-   0 with the three set. */
+   with tool_output_prefix (and `output`, which may be NULL), reporting a
+   problem (returns TOOL_EXIT_USAGE); 0 with the three set. */
 int tool_mesh_image_prefix(const char *const *positional, int npositional, const char **mesh, const char **image,
-                           char *prefix);
+                           tool_mesh_output *output, char *prefix);
 /* Refuse "-" for `path` when the command writes several files this time
    (the standard output takes one): prints a usage error about `what`
    ("OUT.obj with --atlas") and returns TOOL_EXIT_USAGE; 0 otherwise. */
@@ -379,6 +403,11 @@ int material_refuse_overwrite(const material_maps *maps, const char *stem);
 /* Encode a map (of any kind: alpha is written as 1) as a PNG into the
    batch; prints the error and returns the exit status on failure. */
 int output_add_map_png(tool_output *output, const char *path, int map, const tt_image *image);
+/* A GLB's material gets the maps laid out as images[map] (NULL for a map
+   not given): normal, roughness, metallic and occlusion; glTF has no slot
+   for the height map, which a note then says. */
+struct tool_material;
+void material_for_glb(struct tool_material *material, const material_maps *maps, const tt_image *const *images);
 
 /* ---------------------------------------------------------------------- */
 /* Wavefront OBJ (obj.c)                                                    */
@@ -507,6 +536,8 @@ typedef struct obj_write_desc {
                                        "v//vn"), or NULL: no normals */
     const char *mtllib;             /* "mtllib NAME" line, or NULL */
     const char *material;           /* "usemtl NAME" before the faces, or NULL */
+    int triangles;                  /* --triangles: each face written as the fan of triangles
+                                       (c0, ci, ci+1), with its corners' vt and vn */
     /* Optional groups: face_group[f] indexes group_names (and group_materials,
        when given); "g NAME" (and "usemtl MATERIAL") is written before every
        run of faces whose group differs from the previous face's. */
@@ -559,6 +590,63 @@ int output_add_mtl(tool_output *output, const char *mtl_path, const char *materi
    may be NULL: colour only). */
 int output_add_mtl_materials(tool_output *output, const char *mtl_path, int count, const char *const *materials,
                              const char *const *texture_paths, int texture_alpha, const char *const *map_paths);
+
+/* ---------------------------------------------------------------------- */
+/* glTF 2.0 binary, .glb (gltf.c)                                           */
+/* ---------------------------------------------------------------------- */
+
+/* The material of a GLB, as a command holds it: its images, each NULL when
+   the command has none. Every image is the tool's float RGBA, row 0 at the
+   top (image_load's, or one the library made); colour in linear light, the
+   data maps as their bytes say (loaded with TT_COLOR_LINEAR). Absent maps
+   take glTF's neutral meaning: no normal or occlusion texture, roughness 1
+   (matte, as the tool's MTL files ask with Ks 0) and metalness 0. */
+typedef struct tool_material {
+    const char *name;               /* the material's name ("tiled"); NULL: the object's */
+    const tt_image *base_color;     /* colour (written as sRGB, as glTF reads it); its alpha is
+                                       not used: the material is opaque. NULL: white */
+    const tt_image *normal;         /* tangent-space normal map, +Y up (OpenGL's and glTF's
+                                       convention): unit vectors (TT_IMAGE_NORMAL, as
+                                       material_load gives them), or RGB = (n + 1) / 2 */
+    const tt_image *roughness;      /* roughness in R (a grey map); packed with metallic into
+                                       glTF's metallicRoughness texture (G roughness, B metallic) */
+    const tt_image *metallic;       /* metalness in R, the same size as roughness when both are given */
+    const tt_image *occlusion;      /* ambient occlusion in R, 1 = open */
+    int repeat;                     /* the texture coordinates leave [0,1] and the images tile
+                                       (hpm --toroidal): REPEAT addressing; 0: CLAMP_TO_EDGE, for
+                                       atlases, whose coordinates stay inside their tiles or charts */
+} tool_material;
+
+/* glTF's metallicRoughness texture from separate maps, either of which may
+   be NULL (not both): G = roughness's R, B = metallic's R, each rounded to
+   a byte; an absent map's channel is 255, so that the material's factor
+   alone gives its value (gltf_write writes metallicFactor 0 without a
+   metallic map, roughnessFactor 1); R and alpha are 255 (glTF reads neither).
+   *rgba gets width * height * 4 bytes, malloc'ed. Returns 0, or -1 with the
+   reason in err: both NULL, sizes that differ, out of memory. */
+int gltf_pack_metallic_roughness(const tt_image *roughness, const tt_image *metallic, unsigned char **rgba,
+                                 int *width, int *height, char *err, size_t err_size);
+
+/* A whole GLB file in memory (*glb malloc'ed, *glb_size bytes): one scene
+   with one node and mesh called `name`, the mesh's faces as triangle fans
+   with one material, and the material's images as embedded PNGs. The mesh
+   is the one obj_write takes - positions, faces of any size, texture
+   coordinates and normals per corner; its comment, mtllib, material and
+   groups are not used, nor corner_uv_w, nor triangles (a GLB holds
+   triangles only). Texture coordinates are required when the material has
+   an image, and are given the OBJ's way (v up from the image's bottom row;
+   they are flipped for glTF, whose v runs down from the top). Each
+   distinct (position, texture coordinate, normal) of a corner becomes one
+   glTF vertex; normals are made unit length (a zero normal takes its
+   face's). Returns 0, or -1 with the reason in err: a face of fewer than 3
+   corners or none at all, a corner naming no vertex, a NaN or infinite
+   coordinate, a file over 4 GB, out of memory. */
+int gltf_write(const obj_write_desc *mesh, const tool_material *material, const char *name, unsigned char **glb,
+               size_t *glb_size, char *err, size_t err_size);
+/* gltf_write into a new file of the batch, its object named after the
+   file ("out" for out.glb; "tiledtex" for "-"). On failure one line naming
+   PATH, and the failure exit status. */
+int output_add_glb(tool_output *output, const char *path, const obj_write_desc *mesh, const tool_material *material);
 
 /* ---------------------------------------------------------------------- */
 /* Meshes refined and repaired: --subdivide, --smooth, --permissive         */

@@ -2050,8 +2050,8 @@ check "tile OUT_PREFIX out.obj: mtllib names out.mtl" "mtllib out.mtl" "$(grep m
 prefix_case "tile OUT_PREFIX out.PNG" "out.obj out.mtl out.png" tile ../in/torus.obj ../in/tex.png out.PNG
 prefix_case "lapped OUT_PREFIX l.mtl" "l.obj l.mtl l_patch.png" lapped ../in/torus.obj ../in/lap.png l.mtl --scale 1.5
 prefix_case "hpm OUT_PREFIX h.gltf" "h.obj h.mtl" hpm ../in/torus.obj ../in/lap.png h.gltf
-prefix_case "polycube OUT_PREFIX p.glb" "p.obj p.mtl p.png p_polycube.obj" polycube ../in/spheretri.obj ../in/tex.png \
-    p.glb --resolution 4
+prefix_case "polycube OUT_PREFIX p.OBJ" "p.obj p.mtl p.png p_polycube.obj" polycube ../in/spheretri.obj ../in/tex.png \
+    p.OBJ --resolution 4
 
 # "-" is the standard output where a command writes one file, and refused
 # (usage error, no file called "-") where it writes several.
