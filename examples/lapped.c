@@ -76,12 +76,14 @@ static void print_help(void)
            "its material names.\n"
            "That OBJ is for this tool's renderer and for engines that draw the faces in file order\n"
            "with blending; Blender's importer cannot stack copies of a triangle. To take the\n"
-           "result to other programs, use --bake (one texture on the mesh).\n"
+           "result to other programs, use --bake (one texture on the mesh) or write a GLB, which\n"
+           "holds the pastes baked (--format glb, or OUT_PREFIX.glb).\n"
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
            "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
            "--permissive.\n"
-           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png, .glb or .gltf\n"
-           "loses it ('out.obj' writes out.obj, not out.obj.obj). It cannot be '-'.\n"
+           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+           "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
+           "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
            "\n");
     /* Two pieces: C99 compilers need only take string literals of 4095 bytes. */
     printf("options:\n"
@@ -123,10 +125,16 @@ static void print_help(void)
            "                       texels would bake scrambled); 'atlas' over a new atlas of charts\n"
            "                       (pieces of the surface flattened, one texel density, 2 texels\n"
            "                       apart); 'auto' (default) the OBJ's own when they are fit, else an\n"
-           "                       atlas, with a warning saying why when the OBJ has some\n",
+           "                       atlas, with a warning saying why when the OBJ has some\n"
+           "  --format obj|glb     obj (default): the files above; glb: one binary glTF file,\n"
+           "                       OUT_PREFIX.glb, holding the pastes baked into one texture (--bake\n"
+           "                       SIZE, default %d, and --bake-uv apply): a glTF renderer does not\n"
+           "                       draw stacked copies of a triangle in order, so the pasting OBJ stays\n"
+           "                       the way to composite at run time\n"
+           "  --triangles          accepted for the OBJ, whose faces are triangles already\n",
            TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
            LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
-           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS);
+           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS, LAPPED_GLB_BAKE_SIZE);
     printf(MATERIAL_OPTIONS_HELP("                       ")
            "                       (here each patch's window of each map: OUT_PREFIX_patch_1_normal.png,\n"
            "                       ...; with --bake the maps baked with the same pastes as IMAGE,\n"

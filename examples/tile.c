@@ -19,8 +19,9 @@ static void print_help(void)
            "and OUT_PREFIX.png (the tile atlas). Triangles and n-gons are quadrangulated\n"
            "first; each quad shows one tile, so --subdivide makes the texture smaller on the\n"
            "surface.\n"
-           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png, .glb or .gltf\n"
-           "loses it ('out.obj' writes out.obj, not out.obj.obj). It cannot be '-'.\n"
+           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+           "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
+           "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
            "\n"
            "options:\n"
            "  --colors N             edge conditions n; (2n)^4 tiles (default 1)\n"
@@ -36,6 +37,10 @@ static void print_help(void)
            "  --report               also print tile usage and face stretch, and measure the\n"
            "                         seams on every edge (default: a sample of %d edges)\n"
            MATERIAL_OPTIONS_HELP("                         ")
+           "  --format obj|glb       obj (default): the OBJ, MTL and PNG above; glb: one binary glTF\n"
+           "                         file, OUT_PREFIX.glb, with the atlas in it (not with --mips)\n"
+           "  --triangles            write each quad of the OBJ as two triangles, for programs that\n"
+           "                         read only triangles (a GLB holds triangles anyway)\n"
            "\n"
            "A material's maps share IMAGE's tiles: the cuts are decided once, from IMAGE, and\n"
            "every map is cut and blended the same way, so the atlases line up texel for texel.\n",

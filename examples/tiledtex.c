@@ -53,9 +53,10 @@ static void print_help(void)
            "  -V, --version   print the version and exit\n"
            "  --weld          merge mesh vertices closer than %g of the bounding box diagonal,\n"
            "                  for meshes exported with each face's own vertices\n"
-           "\nOUT_PREFIX may end in .obj (or .mtl, .png, .glb, .gltf), which is taken off; an\n"
-           "output of exactly one file (render, generate, synth, map without --atlas) may be\n"
-           "'-' for the standard output.\n"
+           "\nOUT_PREFIX may end in .obj (or .mtl, .png, .gltf), which is taken off; one ending\n"
+           "in .glb, or --format glb, makes tile, lapped, hpm and polycube write one binary glTF\n"
+           "file instead of OBJ, MTL and PNGs. An output of exactly one file (render, generate,\n"
+           "synth, map without --atlas, a GLB) may be '-' for the standard output.\n"
            "\nmeshes: Wavefront OBJ, STL (ASCII or binary, always welded) or OFF; other\n"
            "formats are named, with a conversion command (assimp export from assimp-utils)\n",
            TOOL_DEFAULT_MAX_PIXELS, TOOL_WELD_TOLERANCE);

@@ -2135,8 +2135,7 @@ done
 
 # ======================================================================
 # Material maps (issue 11, item 1): one layout for every map
-# ======================================================================
-cat >"$W/maps.c" <<'EOF_C'
+# ===============================================================cat >"$W/maps.c" <<'EOF_C'
 /* maps: the test helper for material maps.
      maps pbr IN.png STEM [ydown]   height (luminance), normal (from the height's slopes, 4 per
                                     unit per texel, +Y up, or y down) and roughness maps of IN
@@ -2281,6 +2280,112 @@ int main(int argc, char **argv)
             same += ok;
         }
         printf("%.3f\n", (double)same / ((double)aw * ah));
+=======
+# glTF output (.glb): tile, lapped, hpm, polycube; --triangles
+# ======================================================================
+# glb_probe: a test helper built from the tool's own gltf.c. It reads the
+# container (header, chunks) and the BIN chunk's numbers, so the checks
+# below need no JSON or glTF library; and it writes a GLB with every
+# material slot through gltf_write, the way a command hands over its maps.
+cat >"$W/glb_probe.c" <<'EOF_C'
+/* glb_probe check FILE.glb           "ok" and the JSON chunk on one line, or "bad: why" (exit 1)
+   glb_probe floats FILE.glb OFF N    N little-endian floats from byte OFF of the BIN chunk, %.9g a line
+   glb_probe ushorts|uints FILE.glb OFF N   N little-endian 16/32-bit integers, one a line
+   glb_probe bytes FILE.glb OFF N     N bytes of the BIN chunk, raw, on stdout
+   glb_probe write OUT.glb MAPS       a quad and a triangle through gltf_write, with the maps named in MAPS
+                                      (comma-separated: base normal roughness metallic occlusion small_metallic,
+                                      or none); prints the error and exits 1 when gltf_write refuses */
+#define TILEDTEX_IMPLEMENTATION
+#include "tiledtex.h"
+#include "tool.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+static unsigned long u32(const unsigned char *p) { return p[0] | (unsigned long)p[1] << 8 | (unsigned long)p[2] << 16 | (unsigned long)p[3] << 24; }
+static int bad(const char *why) { printf("bad: %s\n", why); return 1; }
+static tt_image *flat(int size, float r, float g, float b)
+{
+    tt_image *image;
+    int i;
+    if (tt_image_create(size, size, NULL, &image, NULL) != TT_OK) exit(3);
+    for (i = 0; i < size * size; i++) {
+        image->pixels[4 * i] = r; image->pixels[4 * i + 1] = g; image->pixels[4 * i + 2] = b; image->pixels[4 * i + 3] = 1;
+    }
+    return image;
+}
+int main(int argc, char **argv)
+{
+    unsigned char *data;
+    size_t size;
+    char err[512];
+    if (argc == 4 && strcmp(argv[1], "write") == 0) {
+        static const float pos[15] = {0,0,0, 1,0,0, 1,1,0, 0,1,0, 2,0.5f,0};
+        static const int corner_vert[7] = {0, 1, 2, 3, 1, 4, 2}, face_size[2] = {4, 3};
+        static const float uv[14] = {0,0, 1,0, 1,1, 0,1, 1,0, 1.5f,0.5f, 1,1};
+        /* the triangle's last corner has no normal (zero): it takes its face's, (0, 0, 1) */
+        static const float normal[21] = {0,0,1, 0,0,1, 0,0,1, 0,0,1, 0,0,1, 0,0,1, 0,0,0};
+        obj_write_desc mesh;
+        tool_material material;
+        const char *maps = argv[3];
+        unsigned char *glb;
+        size_t glb_size;
+        FILE *f;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.nverts = 5; mesh.pos = pos; mesh.nfaces = 2; mesh.face_size = face_size;
+        mesh.corner_vert = corner_vert; mesh.corner_uv = uv; mesh.corner_normal = normal;
+        memset(&material, 0, sizeof material);
+        material.name = "probe";
+        if (strstr(maps, "base")) material.base_color = flat(8, 0.2f, 0.4f, 0.6f);
+        if (strstr(maps, "normal")) material.normal = flat(8, 0.5f, 0.5f, 1.0f);
+        if (strstr(maps, "roughness")) material.roughness = flat(8, 0.25f, 0.25f, 0.25f);
+        if (strstr(maps, "small_metallic")) material.metallic = flat(4, 0.5f, 0.5f, 0.5f);
+        else if (strstr(maps, "metallic")) material.metallic = flat(8, 0.5f, 0.5f, 0.5f);
+        if (strstr(maps, "occlusion")) material.occlusion = flat(8, 0.75f, 0.75f, 0.75f);
+        if (gltf_write(&mesh, &material, "probe", &glb, &glb_size, err, sizeof err) != 0) {
+            printf("gltf_write: %s\n", err);
+            return 1;
+        }
+        f = fopen(argv[2], "wb");
+        if (!f || fwrite(glb, 1, glb_size, f) != glb_size || fclose(f) != 0) return 3;
+        free(glb);
+        tt_image_free((tt_image *)material.base_color); tt_image_free((tt_image *)material.normal);
+        tt_image_free((tt_image *)material.roughness); tt_image_free((tt_image *)material.metallic);
+        tt_image_free((tt_image *)material.occlusion);
+        return 0;
+    }
+    if (argc < 3 || tool_read_file(argv[2], &data, &size, err, sizeof err) != 0) return 2;
+    if (strcmp(argv[1], "check") == 0) {
+        unsigned long json_length, bin_length;
+        if (size < 28 || memcmp(data, "glTF", 4) != 0) return bad("no glTF magic");
+        if (u32(data + 4) != 2) return bad("version is not 2");
+        if (u32(data + 8) != size) return bad("the header's length is not the file's");
+        json_length = u32(data + 12);
+        if (memcmp(data + 16, "JSON", 4) != 0) return bad("the first chunk is not JSON");
+        if (json_length % 4 || 20 + json_length + 8 > size) return bad("the JSON chunk's length");
+        bin_length = u32(data + 20 + json_length);
+        if (memcmp(data + 24 + json_length, "BIN\0", 4) != 0) return bad("the second chunk is not BIN");
+        if (bin_length % 4 || 28 + json_length + bin_length != size) return bad("the BIN chunk's length");
+        if (memchr(data + 20, '\n', json_length)) return bad("a newline in the JSON (this helper prints it on one line)");
+        printf("ok\n%.*s\n", (int)json_length, (const char *)data + 20);
+        return 0;
+    }
+    if (argc == 5) {
+        unsigned long json_length = u32(data + 12), bin = 28 + json_length, offset = strtoul(argv[3], NULL, 10),
+                      count = strtoul(argv[4], NULL, 10), i;
+        unsigned long width = strcmp(argv[1], "ushorts") == 0 ? 2 : strcmp(argv[1], "bytes") == 0 ? 1 : 4;
+        if (bin + offset + count * width > size) return bad("past the end of the BIN chunk");
+        for (i = 0; i < count; i++) {
+            const unsigned char *p = data + bin + offset + width * i;
+            if (strcmp(argv[1], "floats") == 0) {
+                unsigned long bits = u32(p);
+                uint32_t b32 = (uint32_t)bits;
+                float value;
+                memcpy(&value, &b32, 4);
+                printf("%.9g\n", value);
+            } else if (width == 2) printf("%u\n", (unsigned)(p[0] | p[1] << 8));
+            else if (width == 4) printf("%lu\n", u32(p));
+            else putchar(*p);
+        }
         return 0;
     }
     return 2;
@@ -2435,6 +2540,353 @@ else
     fail "helper for material maps" "$CMD" "compiles" "$(head -c 300 "$W/err")"
 fi
 cd "$W" || exit 1
+
+GLB_PROBE=""
+CMD="$HELPER_CC glb_probe.c examples/gltf.c image_io.c tool_io.c obj.c format_number.c (test helper)"
+if $HELPER_CC -std=c99 -O1 -w -I"$ROOT" -I"$ROOT/examples" $STB_INC "$W/glb_probe.c" "$ROOT/examples/gltf.c" \
+    "$ROOT/examples/image_io.c" "$ROOT/examples/tool_io.c" "$ROOT/examples/obj.c" "$ROOT/examples/format_number.c" \
+    -o "$W/glb_probe" -lm 2>"$W/err"; then
+    GLB_PROBE=$W/glb_probe
+else
+    fail "helper for GLB files" "$CMD" "compiles" "$(head -c 300 "$W/err")"
+fi
+
+# The Khronos validator, when tests/ensure_deps.sh could install it (node and
+# npm's gltf-validator in build/gltf-validator): every GLB below goes through
+# it. Without it those checks are skipped, and said so once.
+GLTF_VALIDATOR=""
+if command -v node >/dev/null 2>&1 && node "$ROOT/tests/gltf_validate.js" --version >/dev/null 2>&1; then
+    GLTF_VALIDATOR=yes
+else
+    echo "note: the glTF validator is not installed (node + npm's gltf-validator; bash tests/ensure_deps.sh test" \
+        "installs it as root): the GLB files are checked without it"
+fi
+# validate WHAT FILE: 0 errors from the Khronos validator (skipped without it)
+validate() {
+    local report
+    [ -n "$GLTF_VALIDATOR" ] || return 0
+    report=$(node "$ROOT/tests/gltf_validate.js" "$2" 2>&1)
+    CMD="node tests/gltf_validate.js $2"
+    check "$1: the Khronos glTF validator finds no error" "0 errors" "$report" \
+        "$(printf '%s' "$report" | grep -q ': 0 errors' && ! printf '%s' "$report" | grep -q '^  error'; echo $?)"
+}
+
+# GLB_JSON is the JSON chunk of the last glb_check.
+# glb_check WHAT FILE: a well-formed GLB container (1 check)
+glb_check() {
+    local out
+    GLB_JSON=""
+    if [ -z "$GLB_PROBE" ]; then return; fi
+    out=$("$GLB_PROBE" check "$2" 2>&1)
+    CMD="glb_probe check $2"
+    check "$1: a GLB: magic, version 2, length, a JSON then a BIN chunk, 4-byte aligned" "ok" "$(printf '%s' "$out" | head -1)" \
+        "$([ "$(printf '%s' "$out" | head -1)" = ok ]; echo $?)"
+    GLB_JSON=$(printf '%s\n' "$out" | sed -n 2p)
+}
+# json_items NAME: the objects of GLB_JSON's top-level array NAME, one a line
+json_items() {
+    printf '%s' "$GLB_JSON" | awk -v name="\"$1\":[" '
+        { s = s $0 }
+        END {
+            i = index(s, name)
+            if (!i) exit 1
+            depth = 0; item = ""
+            for (i += length(name); i <= length(s); i++) {
+                c = substr(s, i, 1)
+                if (depth == 0 && c == "]") break
+                if (c == "[" || c == "{") depth++
+                if (c == "]" || c == "}") depth--
+                if (depth == 0 && c == ",") { print item; item = ""; continue }
+                item = item c
+            }
+            if (item != "") print item
+        }'
+}
+# json_number TEXT FIELD: the first "FIELD":N in TEXT
+json_number() { printf '%s' "$1" | grep -oE "\"$2\":[0-9]+" | head -1 | cut -d: -f2; }
+# glb_accessor FILE N: accessor N's numbers, one a line (floats or indices)
+glb_accessor() {
+    local accessor view count type components offset kind start
+    accessor=$(json_items accessors | sed -n "$(($2 + 1))p")
+    view=$(json_number "$accessor" bufferView)
+    count=$(json_number "$accessor" count)
+    type=$(printf '%s' "$accessor" | grep -oE '"type":"[A-Z0-9]+"' | cut -d'"' -f4)
+    case $type in VEC3) components=3 ;; VEC2) components=2 ;; *) components=1 ;; esac
+    case $(json_number "$accessor" componentType) in 5126) kind=floats ;; 5123) kind=ushorts ;; *) kind=uints ;; esac
+    offset=$(json_number "$(json_items bufferViews | sed -n "$((view + 1))p")" byteOffset)
+    start=$(json_number "$accessor" byteOffset)
+    "$GLB_PROBE" $kind "$1" "$((${offset:-0} + ${start:-0}))" "$((count * components))"
+}
+# glb_image FILE SLOT OUT.png: the embedded image named SLOT (baseColor,
+# normal, metallicRoughness, occlusion) written out
+glb_image() {
+    local image view
+    image=$(json_items images | grep "\"name\":\"$2\"")
+    view=$(json_items bufferViews | sed -n "$(($(json_number "$image" bufferView) + 1))p")
+    "$GLB_PROBE" bytes "$1" "$(json_number "$view" byteOffset)" "$(json_number "$view" byteLength)" >"$3"
+}
+# corner_set FILE.obj: every corner of every face as "x y z u v", sorted, unique
+corner_set() {
+    awk '$1 == "v" { v[++nv] = $2 " " $3 " " $4 } $1 == "vt" { t[++nt] = $2 " " $3 }
+         $1 == "f" { for (i = 2; i <= NF; i++) { split($i, p, "/"); print v[p[1]] " " t[p[2]] } }' "$1" | sort -u
+}
+# glb_uvs_match_obj FILE.glb FILE.obj: "M N E": of the N distinct (position,
+# texture coordinate) corners of the OBJ, M are vertices of the GLB with v
+# flipped (glTF's v runs down from the image's top row), and E vertices of
+# the GLB are none of the OBJ's corners (within 1e-6)
+glb_uvs_match_obj() {
+    awk '
+        function key(u, v) { return int(u * 1000 + 1e6) " " int(v * 1000 + 1e6) }
+        # the OBJ corner at (x, y, z, u, v), or 0
+        function near(x, y, z, u, v,   du, dv, i, n, ids, c) {
+            for (du = -1; du <= 1; du++) for (dv = -1; dv <= 1; dv++) {
+                n = split(bucket[key(u + du / 1000, v + dv / 1000)], ids, " ")
+                for (i = 1; i <= n; i++) {
+                    split(corner[ids[i]], c, " ")
+                    if ((c[1] - x) ^ 2 + (c[2] - y) ^ 2 + (c[3] - z) ^ 2 < 1e-12 && (c[4] - u) ^ 2 < 1e-12 &&
+                        (c[5] - v) ^ 2 < 1e-12) return ids[i]
+                }
+            }
+            return 0
+        }
+        FNR == NR { corner[++nobj] = $0; bucket[key($4, $5)] = bucket[key($4, $5)] " " nobj; next }
+        { id = near($1, $2, $3, $4, 1 - $5); if (id) { if (!(id in matched)) found++; matched[id] = 1 } else extra++ }
+        END { printf "%d %d %d\n", found, nobj, extra }' <(corner_set "$2") \
+        <(paste -d' ' <(glb_accessor "$1" "$(json_number "$GLB_JSON" POSITION)" | paste -d' ' - - -) \
+                      <(glb_accessor "$1" "$(json_number "$GLB_JSON" TEXCOORD_0)" | paste -d' ' - -))
+}
+
+# --- tile: OUT_PREFIX.glb, and --format glb, write the same one file -----
+newdir
+expect_ok "tile OUT.glb" tile ../in/torus.obj ../in/tex.png t.glb
+CMD="ls after tiledtex tile ../in/torus.obj ../in/tex.png t.glb"
+check "tile OUT.glb: writes t.glb and nothing else" "t.glb" "$(ls | tr '\n' ' ')" "$([ "$(ls)" = t.glb ]; echo $?)"
+check "tile OUT.glb: the summary names it" "'wrote t.glb'" "$OUT" "$(printf '%s' "$OUT" | grep -q '^wrote t\.glb'; echo $?)"
+# (the object inside is named after the file: the same name, in another folder)
+mkdir f
+expect_ok "tile --format glb" tile ../in/torus.obj ../in/tex.png f/t --format glb
+expect_ok "tile, the same as an OBJ" tile ../in/torus.obj ../in/tex.png t
+CMD="cmp t.glb f/t.glb"
+check "tile: OUT_PREFIX.glb and --format glb write the same file" "identical" "$(cmp t.glb f/t.glb 2>&1)" \
+    "$(cmp -s t.glb f/t.glb && [ -s t.glb ]; echo $?)"
+glb_check "tile GLB" t.glb
+if [ -n "$GLB_JSON" ]; then
+    J=$GLB_JSON
+    check "tile GLB: one material 'tiled' with the atlas as baseColorTexture" \
+        "baseColorTexture, material tiled, 1 image/png called baseColor" "$J" \
+        "$(printf '%s' "$J" | grep -q '"name":"tiled","pbrMetallicRoughness":{"baseColorTexture":{"index":0}' &&
+           [ "$(json_items images | wc -l)" -eq 1 ] && json_items images | grep -q '"mimeType":"image/png","name":"baseColor"' &&
+           ! printf '%s' "$J" | grep -qE 'normalTexture|occlusionTexture|metallicRoughnessTexture'; echo $?)"
+    check "tile GLB: not metal, matte, two-sided, clamped texture, named after the file" \
+        "metallicFactor 0, roughnessFactor 1, doubleSided, wrap 33071, node t" "$J" \
+        "$(printf '%s' "$J" | grep -q '"metallicFactor":0,"roughnessFactor":1' && printf '%s' "$J" | grep -q '"doubleSided":true' &&
+           printf '%s' "$J" | grep -q '"wrapS":33071,"wrapT":33071' && printf '%s' "$J" | grep -q '"nodes":\[{"mesh":0,"name":"t"}'; echo $?)"
+    # the atlas embedded is the PNG the OBJ's MTL names, byte for byte
+    glb_image t.glb baseColor atlas_in_glb.png
+    CMD="cmp atlas_in_glb.png t.png"
+    check "tile GLB: its image is the atlas PNG" "identical to t.png" "$(cmp atlas_in_glb.png t.png 2>&1; png_size atlas_in_glb.png)" \
+        "$(cmp -s atlas_in_glb.png t.png; echo $?)"
+    # triangles: two per quad; positions: the OBJ's bounding box
+    quads=$(grep -c '^f ' t.obj)
+    indices=$(json_number "$(json_items accessors | sed -n "$(($(json_number "$J" indices) + 1))p")" count)
+    check "tile GLB: two triangles per quad of the OBJ" "$((6 * quads)) indices" "$indices" \
+        "$([ "${indices:-0}" -eq $((6 * quads)) ] && [ "$quads" -gt 0 ]; echo $?)"
+    read -r found total extra <<<"$(glb_uvs_match_obj t.glb t.obj)"
+    CMD="GLB POSITION and TEXCOORD_0 against the OBJ's corners (v flipped)"
+    check "tile GLB: the OBJ's corners, texture coordinates with v flipped for glTF's top-left origin" \
+        "every distinct (v, vt) corner of the OBJ is a vertex, no other" "$found of $total found, $extra others" \
+        "$([ "${total:-0}" -gt 0 ] && [ "$found" = "$total" ] && [ "$extra" = 0 ]; echo $?)"
+    # every index names a vertex; every normal is unit length
+    nverts=$(json_number "$(json_items accessors | sed -n 1p)" count)
+    CMD="GLB indices and NORMAL of t.glb"
+    bad=$(glb_accessor t.glb "$(json_number "$J" indices)" | awk -v n="$nverts" '$1 >= n { bad++ } END { print bad + 0 }')
+    check "tile GLB: every index names one of the vertices" "0 out of range" "$bad of $indices (vertices $nverts)" \
+        "$([ "$bad" = 0 ] && [ "${nverts:-0}" -gt 0 ]; echo $?)"
+    bad=$(glb_accessor t.glb "$(json_number "$J" NORMAL)" |
+        awk '{ s += $1 * $1 } NR % 3 == 0 { if (s < 0.9999 || s > 1.0001) bad++; s = 0; n++ } END { print bad + 0, n + 0 }')
+    check "tile GLB: unit normals" "0 not unit length, one per vertex" "$bad" "$([ "$bad" = "0 $nverts" ]; echo $?)"
+fi
+validate "tile GLB" t.glb
+# the standard output takes the one file (whose object is then "tiledtex")
+expect_ok "tile OUT.glb named tiledtex.glb" tile ../in/torus.obj ../in/tex.png f/tiledtex.glb
+run tile ../in/torus.obj ../in/tex.png - --format glb
+CMD="tiledtex tile ../in/torus.obj ../in/tex.png - --format glb | cmp - f/tiledtex.glb"
+check "tile - --format glb: the GLB on stdout, no summary, no file" "exit 0, the bytes of f/tiledtex.glb" \
+    "exit $RC, $(cmp "$W/out" f/tiledtex.glb 2>&1), files: $(ls | tr '\n' ' ')" \
+    "$([ $RC -eq 0 ] && cmp -s "$W/out" f/tiledtex.glb && [ ! -e ./- ] && [ ! -e -.glb ]; echo $?)"
+cd "$W" || exit 1
+
+# --- lapped: the GLB holds the pastes baked ---------------------------------
+newdir
+expect_ok "lapped OUT.glb (bakes by itself)" lapped ../in/torus.obj ../in/lap.png l.glb --scale 1.5
+CMD="ls after tiledtex lapped ../in/torus.obj ../in/lap.png l.glb"
+check "lapped OUT.glb: writes l.glb alone (no pasting OBJ, no patch PNG)" "l.glb" "$(ls | tr '\n' ' ')" \
+    "$([ "$(ls)" = l.glb ]; echo $?)"
+check "lapped OUT.glb: says it baked at 2048 (the default)" "'wrote l.glb (the pastes baked into 2048x2048'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '^wrote l\.glb (the pastes baked into 2048x2048'; echo $?)"
+glb_check "lapped GLB" l.glb
+if [ -n "$GLB_JSON" ]; then
+    check "lapped GLB: one material, lapped_baked, with the baked texture" "material lapped_baked, one 2048x2048 image" \
+        "$GLB_JSON" "$(printf '%s' "$GLB_JSON" | grep -q '"name":"lapped_baked","pbrMetallicRoughness":{"baseColorTexture"' &&
+                      [ "$(json_items materials | wc -l)" -eq 1 ] && glb_image l.glb baseColor baked.png &&
+                      [ "$(png_size baked.png)" = "2048 2048" ]; echo $?)"
+fi
+validate "lapped GLB" l.glb
+expect_ok "lapped --format glb --bake 256" lapped ../in/torus.obj ../in/lap.png l2 --scale 1.5 --format glb --bake 256
+expect_ok "lapped --bake 256, as OBJ" lapped ../in/torus.obj ../in/lap.png l2 --scale 1.5 --bake 256
+glb_check "lapped --bake 256 GLB" l2.glb
+if [ -n "$GLB_JSON" ]; then
+    glb_image l2.glb baseColor baked256.png
+    CMD="cmp baked256.png l2_baked.png"
+    check "lapped GLB --bake 256: the baked texture of the OBJ's --bake" "identical PNGs" "$(cmp baked256.png l2_baked.png 2>&1)" \
+        "$(cmp -s baked256.png l2_baked.png; echo $?)"
+    read -r found total extra <<<"$(glb_uvs_match_obj l2.glb l2_baked.obj)"
+    CMD="GLB TEXCOORD_0 against l2_baked.obj's vt"
+    check "lapped GLB: the baked OBJ's texture coordinates, v flipped" "all, no other" "$found of $total, $extra others" \
+        "$([ "${total:-0}" -gt 0 ] && [ "$found" = "$total" ] && [ "$extra" = 0 ]; echo $?)"
+fi
+validate "lapped --bake 256 GLB" l2.glb
+cd "$W" || exit 1
+
+# --- hpm: IMAGE embedded, repeated only under --toroidal --------------------
+newdir
+expect_ok "hpm --format glb" hpm ../in/torus.obj ../in/lap.png h --format glb
+check "hpm --format glb: h.glb alone" "h.glb" "$(ls | tr '\n' ' ')" "$([ "$(ls)" = h.glb ]; echo $?)"
+glb_check "hpm GLB" h.glb
+if [ -n "$GLB_JSON" ]; then
+    check "hpm GLB: material hpm with IMAGE, clamped" "material hpm, wrap 33071, a 64x64 image" "$GLB_JSON" \
+        "$(printf '%s' "$GLB_JSON" | grep -q '"name":"hpm","pbrMetallicRoughness":{"baseColorTexture"' &&
+           printf '%s' "$GLB_JSON" | grep -q '"wrapS":33071' && glb_image h.glb baseColor image.png &&
+           [ "$(png_size image.png)" = "64 64" ]; echo $?)"
+fi
+validate "hpm GLB" h.glb
+expect_ok "hpm --toroidal OUT.glb" hpm ../in/torus.obj ../in/lap.png ht.glb --toroidal
+glb_check "hpm --toroidal GLB" ht.glb
+check "hpm --toroidal GLB: the texture repeats" "wrapS/wrapT 10497" "$GLB_JSON" \
+    "$(printf '%s' "$GLB_JSON" | grep -q '"wrapS":10497,"wrapT":10497'; echo $?)"
+validate "hpm --toroidal GLB" ht.glb
+expect_ok "hpm, the same as an OBJ" hpm ../in/torus.obj ../in/lap.png h
+glb_check "hpm GLB again" h.glb
+if [ -n "$GLB_JSON" ]; then
+    read -r found total extra <<<"$(glb_uvs_match_obj h.glb h.obj)"
+    CMD="GLB TEXCOORD_0 against h.obj's vt"
+    check "hpm GLB: the OBJ's texture coordinates, v flipped" "all, no other" "$found of $total, $extra others" \
+        "$([ "${total:-0}" -gt 0 ] && [ "$found" = "$total" ] && [ "$extra" = 0 ]; echo $?)"
+fi
+cd "$W" || exit 1
+
+# --- polycube: the textured mesh only ---------------------------------------
+newdir
+expect_ok "polycube OUT.glb" polycube ../in/spheretri.obj ../in/tex.png p.glb --resolution 4
+check "polycube OUT.glb: p.glb alone (no polycube surface)" "p.glb" "$(ls | tr '\n' ' ')" "$([ "$(ls)" = p.glb ]; echo $?)"
+glb_check "polycube GLB" p.glb
+if [ -n "$GLB_JSON" ]; then
+    check "polycube GLB: one mesh, material tiled with the atlas" "1 mesh, 1 node, material tiled" "$GLB_JSON" \
+        "$([ "$(json_items meshes | wc -l)" -eq 1 ] && [ "$(json_items nodes | wc -l)" -eq 1 ] &&
+           printf '%s' "$GLB_JSON" | grep -q '"name":"tiled","pbrMetallicRoughness":{"baseColorTexture"'; echo $?)"
+fi
+validate "polycube GLB" p.glb
+cd "$W" || exit 1
+
+# --- what a GLB is refused with ----------------------------------------------
+expect_usage_error "tile OUT.glb --format obj (they disagree)" tile ../in/torus.obj ../in/tex.png o.glb --format obj
+err_mentions "tile OUT.glb --format obj: says why" "names a GLB.*format obj"
+expect_usage_error "hpm OUT.obj --format glb (they disagree)" hpm ../in/torus.obj ../in/lap.png o.obj --format glb
+err_mentions "hpm OUT.obj --format glb: names o.glb" "o\.glb"
+expect_usage_error "polycube OUT.gltf --format glb (a GLB is not .gltf)" polycube ../in/spheretri.obj ../in/tex.png o.gltf \
+    --format glb
+expect_usage_error "lapped --format gltf" lapped ../in/torus.obj ../in/lap.png o --format gltf
+err_mentions "lapped --format gltf: names the formats" "obj or glb"
+expect_usage_error "tile --format without a value" tile ../in/torus.obj ../in/tex.png o --format
+expect_usage_error "tile --mips with a GLB" tile ../in/torus.obj ../in/tex.png o.glb --mips
+expect_usage_error "hpm - (OBJ: several files)" hpm ../in/torus.obj ../in/lap.png -
+err_mentions "hpm -: says --format glb makes one file" "add .*format glb"
+expect_usage_error "map --format glb (map writes OBJ)" map ../in/torus.obj o.obj --format glb
+
+# --- --triangles: fans of triangles with the same corners --------------------
+newdir
+expect_ok "tile" tile ../in/torus.obj ../in/tex.png q
+expect_ok "tile --triangles" tile ../in/torus.obj ../in/tex.png tr --triangles
+CMD="tiledtex tile ../in/torus.obj ../in/tex.png tr --triangles"
+faces=$(awk '$1 == "f" { n[NF - 1]++ } END { for (k in n) printf "%d-corner:%d ", k, n[k] }' tr.obj)
+check "tile --triangles: only triangles, two per quad" "3-corner:$((2 * $(grep -c '^f ' q.obj)))" "$faces" \
+    "$([ "$faces" = "3-corner:$((2 * $(grep -c '^f ' q.obj))) " ]; echo $?)"
+check "tile --triangles: the same vertices, vt and vn lines" "identical v/vt/vn lines" "differ" \
+    "$(cmp -s <(grep -E '^(v|vt|vn) ' q.obj) <(grep -E '^(v|vt|vn) ' tr.obj) && grep -q '^vt ' q.obj; echo $?)"
+check "tile --triangles: every corner keeps its position and texture coordinate" "the same set of (v, vt) corners" \
+    "$(diff <(corner_set q.obj) <(corner_set tr.obj) | head -3)" \
+    "$(cmp -s <(corner_set q.obj) <(corner_set tr.obj) && [ -n "$(corner_set q.obj)" ]; echo $?)"
+check "tile --triangles: each triangle a fan of its quad (q1 q2 q3, q1 q3 q4)" "fans from each quad's first corner" \
+    "$(awk '$1 == "f" { print $2, $3, $4; print $2, $4, $5 }' q.obj | head -2)" \
+    "$(cmp -s <(awk '$1 == "f" { print $2, $3, $4; print $2, $4, $5 }' q.obj) <(awk '$1 == "f" { print $2, $3, $4 }' tr.obj); echo $?)"
+read -r corners nvn bad creased <<<"$(normals_report tr.obj)"
+check "tile --triangles: a unit normal (vn) at every triangle corner" "0 corners without one" "$bad of $corners" \
+    "$([ "${corners:-0}" -gt 0 ] && [ "${bad:-1}" = 0 ]; echo $?)"
+expect_ok "map --triangles" map ../in/double-torus.obj m.obj --triangles
+expect_ok "map" map ../in/double-torus.obj mq.obj
+check "map --triangles: only triangles, the same corners" "3-corner faces only, the same (v, vt) set" \
+    "$(awk '$1 == "f" { n[NF - 1]++ } END { for (k in n) printf "%d-corner:%d ", k, n[k] }' m.obj)" \
+    "$([ "$(awk '$1 == "f" && NF != 4' m.obj | wc -l)" -eq 0 ] && cmp -s <(corner_set m.obj) <(corner_set mq.obj) &&
+       [ "$(grep -c '^f ' m.obj)" -eq $((2 * $(grep -c '^f ' mq.obj))) ]; echo $?)"
+expect_ok "polycube --triangles" polycube ../in/spheretri.obj ../in/tex.png pc --resolution 4 --triangles
+check "polycube --triangles: the polycube surface as triangles too" "3-corner faces only in pc_polycube.obj" \
+    "$(awk '$1 == "f" { n[NF - 1]++ } END { for (k in n) printf "%d-corner:%d ", k, n[k] }' pc_polycube.obj)" \
+    "$([ "$(awk '$1 == "f" && NF != 4' pc_polycube.obj pc.obj | wc -l)" -eq 0 ] && grep -q '^f ' pc_polycube.obj; echo $?)"
+expect_ok "hpm --triangles" hpm ../in/torus.obj ../in/lap.png ht --triangles
+expect_ok "lapped --triangles" lapped ../in/torus.obj ../in/lap.png lt --scale 1.5 --triangles
+check "hpm and lapped --triangles: their OBJs are triangles" "3-corner faces only" \
+    "$(awk '$1 == "f" && NF != 4' ht.obj lt.obj | head -2)" \
+    "$([ "$(awk '$1 == "f" && NF != 4' ht.obj lt.obj | wc -l)" -eq 0 ]; echo $?)"
+cd "$W" || exit 1
+
+# --- every material slot, through gltf_write as a command calls it ----------
+if [ -n "$GLB_PROBE" ]; then
+    newdir
+    CMD="glb_probe write all.glb base,normal,roughness,metallic,occlusion"
+    out=$("$GLB_PROBE" write all.glb base,normal,roughness,metallic,occlusion 2>&1)
+    check "gltf_write with every map" "exit 0" "$out" "$([ -s all.glb ]; echo $?)"
+    glb_check "every map" all.glb
+    J=$GLB_JSON
+    check "every map: each slot names its own texture" \
+        "baseColorTexture 0, metallicRoughnessTexture 2, normalTexture 1, occlusionTexture 3, metallicFactor 1" "$J" \
+        "$(printf '%s' "$J" | grep -q '"pbrMetallicRoughness":{"baseColorTexture":{"index":0},"metallicRoughnessTexture":{"index":2},"metallicFactor":1,"roughnessFactor":1},"normalTexture":{"index":1},"occlusionTexture":{"index":3}' &&
+           [ "$(json_items textures | wc -l)" -eq 4 ] && [ "$(json_items images | wc -l)" -eq 4 ]; echo $?)"
+    check "every map: a quad and a triangle sharing an edge make 5 vertices, 3 triangles (a zero normal takes its face's)" \
+        "POSITION count 5, 9 indices" "$(json_items accessors | tr '\n' ' ')" \
+        "$([ "$(json_number "$(json_items accessors | sed -n 1p)" count)" = 5 ] &&
+           [ "$(json_number "$(json_items accessors | sed -n "$(($(json_number "$J" indices) + 1))p")" count)" = 9 ]; echo $?)"
+    CMD="glb_probe: POSITION min/max"
+    check "every map: POSITION's bounds" "min [0,0,0], max [2,1,0]" "$(json_items accessors | sed -n 1p)" \
+        "$(json_items accessors | sed -n 1p | grep -q '"min":\[0,0,0\],"max":\[2,1,0\]'; echo $?)"
+    if [ -x "$W/pixstat" ]; then
+        # linear 0.2 0.4 0.6 is sRGB 124 170 203; the data maps keep their bytes
+        for slot in "baseColor:124 170 203" "normal:128 128 255" "metallicRoughness:255 64 128" "occlusion:191 191 191"; do
+            name=${slot%%:*}
+            want=${slot##*:}
+            glb_image all.glb "$name" "$name.png"
+            px=$("$W/pixstat" "$name.png" 3 3 2>&1)
+            CMD="pixstat $name.png 3 3 (from all.glb)"
+            check "every map: the $name texture's bytes" "$want" "$px" "$([ "$px" = "$want" ]; echo $?)"
+        done
+    fi
+    validate "every map" all.glb
+    out=$("$GLB_PROBE" write rough.glb base,roughness 2>&1)
+    glb_check "roughness without metallic" rough.glb
+    check "roughness without metallic: metalness 0 from the factor, B 255" "metallicFactor 0 and the texture's B = 255" \
+        "$GLB_JSON" "$(printf '%s' "$GLB_JSON" | grep -q '"metallicRoughnessTexture":{"index":1},"metallicFactor":0,' &&
+                       glb_image rough.glb metallicRoughness mr.png && { [ ! -x "$W/pixstat" ] || [ "$("$W/pixstat" mr.png 0 0)" = "255 64 255" ]; }; echo $?)"
+    validate "roughness without metallic" rough.glb
+    out=$("$GLB_PROBE" write bad.glb roughness,small_metallic 2>&1)
+    CMD="glb_probe write bad.glb roughness,small_metallic"
+    check "roughness and metallic of different sizes are refused" "an error naming both sizes, no file" "$out" \
+        "$(printf '%s' "$out" | grep -q '8x8 and the metallic map 4x4' && [ ! -e bad.glb ]; echo $?)"
+    out=$("$GLB_PROBE" write plain.glb none 2>&1)
+    glb_check "no map at all" plain.glb
+    check "no map at all: no texture, image or sampler" "none" "$GLB_JSON" \
+        "$(! printf '%s' "$GLB_JSON" | grep -qE '"(textures|images|samplers)"' && [ -n "$GLB_JSON" ]; echo $?)"
+    validate "no map at all" plain.glb
+    cd "$W" || exit 1
+fi
 
 # ======================================================================
 # Sanitizers

@@ -1,12 +1,41 @@
 #!/usr/bin/env bash
 # Make sure what `make demo` or `make test` needs is installed: a C and a C++
 # compiler, and stb_image (Debian: libstb-dev) for the tool; for the tests also
-# clang and tcc, the other compilers the header must build with.
+# clang and tcc, the other compilers the header must build with, and the
+# Khronos glTF validator (npm's gltf-validator, run by node) for the GLB files.
 #   bash tests/ensure_deps.sh demo|test
 # As root with apt-get, installs what is missing; otherwise prints the one
-# command to run and fails.
+# command to run and fails. The validator is optional: without it the
+# end-to-end tests say that they skipped it, so failing to install it only
+# prints why.
 set -u
 mode=${1:-test}
+
+# node and npm from Debian, then gltf-validator into the build tree, where
+# tests/gltf_validate.js looks for it.
+validator_dir="$(cd "$(dirname "$0")/.." && pwd)/build/gltf-validator"
+ensure_validator() {
+  if command -v node >/dev/null 2>&1 && [ -f "$validator_dir/node_modules/gltf-validator/package.json" ]; then
+    return 0
+  fi
+  local install="npm install --prefix build/gltf-validator gltf-validator"
+  if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
+    echo "the GLB checks of make test need the glTF validator: run  sudo apt-get install nodejs npm && $install" >&2
+    return 0
+  fi
+  if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+    echo "installing nodejs npm (the glTF validator's runtime, for make test) ..."
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get install -y -qq nodejs npm >/dev/null 2>&1 ||
+      { apt-get update -qq >/dev/null 2>&1 && apt-get install -y -qq nodejs npm >/dev/null 2>&1; } ||
+      { echo "could not install nodejs npm: the GLB files will not be validated" >&2; return 0; }
+  fi
+  echo "installing gltf-validator into build/gltf-validator (for make test) ..."
+  npm install --prefix "$validator_dir" --no-audit --no-fund gltf-validator >/dev/null 2>&1 ||
+    echo "could not install gltf-validator ($install): the GLB files will not be validated" >&2
+  return 0
+}
+[ "$mode" = test ] && ensure_validator
 need=()
 have_stb() {
   local dir

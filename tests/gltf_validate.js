@@ -2,6 +2,7 @@
 // (the npm package gltf-validator).
 //
 //   node tests/gltf_validate.js FILE.glb...
+//   node tests/gltf_validate.js --version     (is it installed? exit 0 or 2)
 //
 // The package is looked for in build/gltf-validator (where
 // tests/ensure_deps.sh installs it), then wherever node's require finds it.
@@ -35,6 +36,10 @@ async function main() {
     if (!validator) {
         console.error('gltf-validator is not installed: npm install --prefix build/gltf-validator gltf-validator');
         return 2;
+    }
+    if (files.length === 1 && files[0] === '--version') {
+        console.log(`gltf-validator ${validator.version()}`);
+        return 0;
     }
     let status = 0;
     for (const file of files) {
