@@ -397,23 +397,41 @@ static int make_vertices(const obj_write_desc *mesh, glb_vertices *v, char *err,
 /* The JSON chunk                                                           */
 /* ======================================================================== */
 
-/* A JSON string: quotes, backslashes and control bytes escaped; other
-   bytes as they are (names are UTF-8 or ASCII). */
+/* The length of the well-formed UTF-8 sequence at s (2 to 4 bytes), or 0:
+   no overlong forms, no surrogates, nothing past U+10FFFF. */
+static int utf8_length(const unsigned char *s)
+{
+    int n = s[0] >= 0xC2 && s[0] <= 0xDF ? 2 : s[0] >= 0xE0 && s[0] <= 0xEF ? 3 : s[0] >= 0xF0 && s[0] <= 0xF4 ? 4 : 0;
+    int i;
+    if (n == 0) return 0;
+    for (i = 1; i < n; i++)
+        if ((s[i] & 0xC0) != 0x80) return 0;
+    if ((s[0] == 0xE0 && s[1] < 0xA0) || (s[0] == 0xED && s[1] >= 0xA0) || (s[0] == 0xF0 && s[1] < 0x90) ||
+        (s[0] == 0xF4 && s[1] >= 0x90))
+        return 0;
+    return n;
+}
+
+/* A JSON string: quotes, backslashes and control bytes escaped, UTF-8 kept;
+   a byte that is not UTF-8 (a file name in Latin-1, say) becomes '?', since
+   glTF's JSON must be UTF-8. */
 static void json_string(tool_buffer *out, const char *text)
 {
+    const unsigned char *p = (const unsigned char *)text;
     buffer_append(out, "\"", 1);
-    for (; *text; text++) {
-        unsigned char c = (unsigned char)*text;
-        if (c == '"' || c == '\\') {
+    while (*p) {
+        int length = *p < 0x80 ? 1 : utf8_length(p);
+        if (*p == '"' || *p == '\\') {
             char escaped[2];
             escaped[0] = '\\';
-            escaped[1] = (char)c;
+            escaped[1] = (char)*p;
             buffer_append(out, escaped, 2);
-        } else if (c < 0x20) {
-            buffer_printf(out, "\\u%04x", c);
+        } else if (*p < 0x20) {
+            buffer_printf(out, "\\u%04x", *p);
         } else {
-            buffer_append(out, text, 1);
+            buffer_append(out, length ? (const char *)p : "?", length ? (size_t)length : 1);
         }
+        p += length ? length : 1;
     }
     buffer_append(out, "\"", 1);
 }

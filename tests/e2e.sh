@@ -2751,6 +2751,7 @@ cd "$W" || exit 1
 # --- hpm: IMAGE embedded, repeated only under --toroidal --------------------
 newdir
 expect_ok "hpm --format glb" hpm ../in/torus.obj ../in/lap.png h --format glb
+CMD="ls after tiledtex hpm ../in/torus.obj ../in/lap.png h --format glb"
 check "hpm --format glb: h.glb alone" "h.glb" "$(ls | tr '\n' ' ')" "$([ "$(ls)" = h.glb ]; echo $?)"
 glb_check "hpm GLB" h.glb
 if [ -n "$GLB_JSON" ]; then
@@ -2760,6 +2761,15 @@ if [ -n "$GLB_JSON" ]; then
            [ "$(png_size image.png)" = "64 64" ]; echo $?)"
 fi
 validate "hpm GLB" h.glb
+# the object is named after the file; glTF's JSON must be UTF-8, so a byte
+# that is not (a Latin-1 name) becomes '?', and quotes are escaped
+latin1_name=$(printf 'caf\351 "q"')
+expect_ok "hpm into a Latin-1 file name" hpm ../in/torus.obj ../in/lap.png "$latin1_name.glb"
+cp "$latin1_name.glb" latin1.glb
+glb_check "hpm GLB with a Latin-1 name" latin1.glb
+check "hpm GLB with a Latin-1 name: the object's name is UTF-8 JSON" '"name":"caf? \"q\""' "$GLB_JSON" \
+    "$(printf '%s' "$GLB_JSON" | grep -qF '"nodes":[{"mesh":0,"name":"caf? \"q\""}]'; echo $?)"
+validate "hpm GLB with a Latin-1 name" latin1.glb
 expect_ok "hpm --toroidal OUT.glb" hpm ../in/torus.obj ../in/lap.png ht.glb --toroidal
 glb_check "hpm --toroidal GLB" ht.glb
 check "hpm --toroidal GLB: the texture repeats" "wrapS/wrapT 10497" "$GLB_JSON" \
@@ -2778,6 +2788,7 @@ cd "$W" || exit 1
 # --- polycube: the textured mesh only ---------------------------------------
 newdir
 expect_ok "polycube OUT.glb" polycube ../in/spheretri.obj ../in/tex.png p.glb --resolution 4
+CMD="ls after tiledtex polycube ../in/spheretri.obj ../in/tex.png p.glb --resolution 4"
 check "polycube OUT.glb: p.glb alone (no polycube surface)" "p.glb" "$(ls | tr '\n' ' ')" "$([ "$(ls)" = p.glb ]; echo $?)"
 glb_check "polycube GLB" p.glb
 if [ -n "$GLB_JSON" ]; then
