@@ -248,7 +248,8 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
         return TOOL_EXIT_USAGE;
     /* A glTF renderer does not draw stacked blended copies of a triangle in
        their order, so a GLB holds the pastes baked into one texture. */
-    if (options->output.format == TOOL_FORMAT_GLB && options->bake_size == 0) options->bake_size = LAPPED_GLB_BAKE_SIZE;
+    if (options->output.format == TOOL_FORMAT_GLB && options->bake_size == 0)
+        options->bake_size = LAPPED_GLB_BAKE_SIZE;
     return -1;
 }
 
