@@ -2134,153 +2134,6 @@ for flag in -V --version; do
 done
 
 # ======================================================================
-# Material maps (issue 11, item 1): one layout for every map
-# ===============================================================cat >"$W/maps.c" <<'EOF_C'
-/* maps: the test helper for material maps.
-     maps pbr IN.png STEM [ydown]   height (luminance), normal (from the height's slopes, 4 per
-                                    unit per texel, +Y up, or y down) and roughness maps of IN
-     maps coords W H OUT.png        r = x, g = y (bytes): where each texel came from
-     maps const W H R G B OUT.png   one colour
-     maps slope HEIGHT NORMAL       median and 90th percentile (degrees) of the angle between
-                                    the direction a normal map tilts and the one the height map's
-                                    slopes imply, where both tilt
-     maps turns NORMAL X Y          the share of tilted texels whose tilt is (X, Y) (bytes, +Y
-                                    up) turned by 0, 1, 2, 3 quarter turns counter-clockwise,
-                                    within 10 degrees
-     maps origin IMAGE COORDS ATLAS the share of atlas texels equal (within 2 per channel) to
-                                    IMAGE's texel at the position COORDS' atlas gives there */
-#define STB_IMAGE_IMPLEMENTATION
-#include "stb_image.h"
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include "stb_image_write.h"
-#include <math.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-static int by_value(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
-}
-static float angle(float ax, float ay, float bx, float by)
-{
-    float c = (ax * bx + ay * by) / (sqrtf(ax * ax + ay * ay) * sqrtf(bx * bx + by * by));
-    return acosf(c > 1.0f ? 1.0f : (c < -1.0f ? -1.0f : c)) * 57.29578f;
-}
-int main(int argc, char **argv)
-{
-    int w, h, n, x, y;
-    char path[4096];
-    if (argc >= 4 && strcmp(argv[1], "pbr") == 0) {
-        unsigned char *p = stbi_load(argv[2], &w, &h, &n, 3), *o;
-        float *L;
-        if (!p) return 1;
-        L = malloc(sizeof(float) * w * h);
-        o = malloc(3 * (size_t)w * h);
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                unsigned char *q = p + 3 * (y * w + x);
-                L[y * w + x] = (0.299f * q[0] + 0.587f * q[1] + 0.114f * q[2]) / 255.0f;
-            }
-        for (x = 0; x < w * h; x++) o[3 * x] = o[3 * x + 1] = o[3 * x + 2] = (unsigned char)(L[x] * 255.0f + 0.5f);
-        snprintf(path, sizeof path, "%s_height.png", argv[3]);
-        if (!stbi_write_png(path, w, h, 3, o, 3 * w)) return 1;
-        for (x = 0; x < w * h; x++) o[3 * x] = o[3 * x + 1] = o[3 * x + 2] = (unsigned char)(255.0f - L[x] * 200.0f);
-        snprintf(path, sizeof path, "%s_roughness.png", argv[3]);
-        if (!stbi_write_png(path, w, h, 3, o, 3 * w)) return 1;
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                int xl = x > 0 ? x - 1 : x, xr = x < w - 1 ? x + 1 : x, yu = y > 0 ? y - 1 : y, yd = y < h - 1 ? y + 1 : y;
-                float nx = -(L[y * w + xr] - L[y * w + xl]) * 4.0f, ny = (L[yd * w + x] - L[yu * w + x]) * 4.0f;
-                float len = sqrtf(nx * nx + ny * ny + 1.0f);
-                if (argc > 4) ny = -ny;
-                o[3 * (y * w + x)] = (unsigned char)lrintf((nx / len * 0.5f + 0.5f) * 255.0f);
-                o[3 * (y * w + x) + 1] = (unsigned char)lrintf((ny / len * 0.5f + 0.5f) * 255.0f);
-                o[3 * (y * w + x) + 2] = (unsigned char)lrintf((1.0f / len * 0.5f + 0.5f) * 255.0f);
-            }
-        snprintf(path, sizeof path, "%s_normal.png", argv[3]);
-        return !stbi_write_png(path, w, h, 3, o, 3 * w);
-    }
-    if (argc == 5 && strcmp(argv[1], "coords") == 0) {
-        unsigned char *o;
-        w = atoi(argv[2]);
-        h = atoi(argv[3]);
-        o = malloc(3 * (size_t)w * h);
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                o[3 * (y * w + x)] = (unsigned char)x;
-                o[3 * (y * w + x) + 1] = (unsigned char)y;
-                o[3 * (y * w + x) + 2] = 0;
-            }
-        return !stbi_write_png(argv[4], w, h, 3, o, 3 * w);
-    }
-    if (argc == 8 && strcmp(argv[1], "const") == 0) {
-        unsigned char *o;
-        w = atoi(argv[2]);
-        h = atoi(argv[3]);
-        o = malloc(3 * (size_t)w * h);
-        for (x = 0; x < w * h; x++) {
-            o[3 * x] = (unsigned char)atoi(argv[4]);
-            o[3 * x + 1] = (unsigned char)atoi(argv[5]);
-            o[3 * x + 2] = (unsigned char)atoi(argv[6]);
-        }
-        return !stbi_write_png(argv[7], w, h, 3, o, 3 * w);
-    }
-    if (argc == 4 && strcmp(argv[1], "slope") == 0) {
-        int w2, h2, count = 0;
-        unsigned char *H = stbi_load(argv[2], &w, &h, &n, 1), *N = stbi_load(argv[3], &w2, &h2, &n, 3);
-        float *angles;
-        if (!H || !N || w != w2 || h != h2) return 1;
-        angles = malloc(sizeof(float) * w * h);
-        for (y = 1; y < h - 1; y++)
-            for (x = 1; x < w - 1; x++) {
-                float ex = -(H[y * w + x + 1] - H[y * w + x - 1]) / 255.0f * 4.0f;
-                float ey = (H[(y + 1) * w + x] - H[(y - 1) * w + x]) / 255.0f * 4.0f;
-                const unsigned char *p = N + 3 * (y * w + x);
-                float nx = p[0] / 127.5f - 1.0f, ny = p[1] / 127.5f - 1.0f, nz = p[2] / 127.5f - 1.0f;
-                if (sqrtf(ex * ex + ey * ey) < 0.08f || sqrtf(nx * nx + ny * ny) < 0.08f * sqrtf(nx * nx + ny * ny + nz * nz))
-                    continue;
-                angles[count++] = angle(ex, ey, nx, ny);
-            }
-        if (count < 100) return 1;
-        qsort(angles, (size_t)count, sizeof(float), by_value);
-        printf("%.2f %.2f %d\n", angles[count / 2], angles[count * 9 / 10], count);
-        return 0;
-    }
-    if (argc == 5 && strcmp(argv[1], "turns") == 0) {
-        unsigned char *N = stbi_load(argv[2], &w, &h, &n, 3);
-        float vx = atoi(argv[3]) / 127.5f - 1.0f, vy = atoi(argv[4]) / 127.5f - 1.0f;
-        long counts[4] = {0, 0, 0, 0}, tilted = 0;
-        int k;
-        if (!N) return 1;
-        for (x = 0; x < w * h; x++) {
-            float nx = N[3 * x] / 127.5f - 1.0f, ny = N[3 * x + 1] / 127.5f - 1.0f;
-            if (sqrtf(nx * nx + ny * ny) < 0.05f) continue;
-            tilted++;
-            for (k = 0; k < 4; k++) {
-                float c = cosf(k * 1.5707963f), s = sinf(k * 1.5707963f);
-                if (angle(nx, ny, c * vx - s * vy, s * vx + c * vy) < 10.0f) counts[k]++;
-            }
-        }
-        if (tilted == 0) return 1;
-        printf("%.3f %.3f %.3f %.3f\n", (double)counts[0] / tilted, (double)counts[1] / tilted,
-               (double)counts[2] / tilted, (double)counts[3] / tilted);
-        return 0;
-    }
-    if (argc == 5 && strcmp(argv[1], "origin") == 0) {
-        int cw, ch, aw, ah, k;
-        long same = 0;
-        unsigned char *I = stbi_load(argv[2], &w, &h, &n, 3), *C = stbi_load(argv[3], &cw, &ch, &n, 3),
-                      *A = stbi_load(argv[4], &aw, &ah, &n, 3);
-        if (!I || !C || !A || cw != aw || ch != ah) return 1;
-        for (x = 0; x < aw * ah; x++) {
-            int sx = C[3 * x], sy = C[3 * x + 1], ok = 1;
-            if (sx >= w || sy >= h) continue;
-            for (k = 0; k < 3; k++) ok &= abs(A[3 * x + k] - I[3 * (sy * w + sx) + k]) <= 2;
-            same += ok;
-        }
-        printf("%.3f\n", (double)same / ((double)aw * ah));
-=======
 # glTF output (.glb): tile, lapped, hpm, polycube; --triangles
 # ======================================================================
 # glb_probe: a test helper built from the tool's own gltf.c. It reads the
@@ -2391,156 +2244,6 @@ int main(int argc, char **argv)
     return 2;
 }
 EOF_C
-newdir
-MD=$PWD
-CMD="$HELPER_CC $STB_INC maps.c (test helper)"
-if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
-    MAPS=$W/maps
-    # a 256 x 256 material: the colour, its height, the normal map its slopes imply (+Y up
-    # and y down) and a roughness map; a map of where each texel is; an "up" normal map
-    "$MAPS" pbr ../in/tex.png m && "$MAPS" pbr ../in/tex.png dx ydown && "$MAPS" coords 256 256 coords.png &&
-        "$MAPS" const 256 256 128 200 218 upmap.png && "$MAPS" const 128 128 128 128 255 small.png
-    check "material helper makes its maps" "m_normal.png m_height.png coords.png upmap.png" "$(ls)" \
-        "$([ -s m_normal.png ] && [ -s dx_normal.png ] && [ -s coords.png ] && [ -s upmap.png ]; echo $?)"
-
-    # tile: an atlas per map, one layout; the MTL names them
-    expect_ok "tile with a material" tile ../in/torus.obj ../in/tex.png t --tile 48 --normal m_normal.png \
-        --roughness m_roughness.png --height m_height.png --metallic coords.png --ao m_height.png
-    check "tile: one atlas per map, of the colour's size" "t_normal/_roughness/_metallic/_ao/_height.png, $(png_size t.png)" \
-        "$(for m in normal roughness metallic ao height; do printf '%s: %s; ' $m "$(png_size t_$m.png)"; done)" \
-        "$(for m in normal roughness metallic ao height; do [ "$(png_size t_$m.png)" = "$(png_size t.png)" ] || exit 1; done; echo $?)"
-    check "tile: the MTL names every map" "map_Bump -bm 1 / norm t_normal.png, map_Pr, map_Pm, disp, an AO comment" \
-        "$(cat t.mtl)" \
-        "$(grep -qx 'map_Bump -bm 1 t_normal.png' t.mtl && grep -qx 'norm t_normal.png' t.mtl &&
-            grep -qx 'map_Pr t_roughness.png' t.mtl && grep -qx 'map_Pm t_metallic.png' t.mtl &&
-            grep -qx 'disp t_height.png' t.mtl && grep -q '^# ambient occlusion: t_ao.png' t.mtl; echo $?)"
-    expect_ok "tile the colour alone" tile ../in/torus.obj ../in/tex.png alone --tile 48
-    check "tile: the maps change nothing of the colour's atlas" "cmp equal" "$(cmp t.png alone.png 2>&1)" \
-        "$(cmp -s t.png alone.png; echo $?)"
-    check "tile: the same map twice gives the same atlas" "t_height.png = t_ao.png" "$(cmp t_height.png t_ao.png 2>&1)" \
-        "$(cmp -s t_height.png t_ao.png; echo $?)"
-    # one layout: where the map of positions says an atlas texel came from, the colour
-    # atlas shows that very texel of the colour image (blends aside); the control, the
-    # positions laid out by another seed's tiles, agrees only by chance
-    expect_ok "tile: positions by another seed (control)" tile ../in/torus.obj ../in/tex.png other --tile 48 \
-        --seed 9 --metallic coords.png
-    same=$("$MAPS" origin ../in/tex.png t_metallic.png t.png 2>&1)
-    control=$("$MAPS" origin ../in/tex.png other_metallic.png t.png 2>&1)
-    CMD="maps origin ../in/tex.png t_metallic.png t.png (and other_metallic.png)"
-    check "tile: every map is cut where the colour is" "share >= 0.6 (control, another seed's: <= 0.2)" \
-        "$same (control $control)" \
-        "$(awk -v a="$same" -v b="$control" 'BEGIN{exit !(a >= 0.6 && b <= 0.2)}'; echo $?)"
-    # normals turned with the content: the normal atlas tilts where the height atlas's
-    # slopes say; read as y-down (a wrong turn of every vector) it does not
-    slope=$("$MAPS" slope t_height.png t_normal.png 2>&1)
-    CMD="maps slope t_height.png t_normal.png"
-    check "tile: the normal atlas follows the height atlas's slopes" "median <= 5 deg, p90 <= 45" "$slope" \
-        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 5 && $2 <= 45)}'; echo $?)"
-    expect_ok "tile: a +Y-up normal map read as y-down (control)" tile ../in/torus.obj ../in/tex.png flip --tile 48 \
-        --normal m_normal.png --normal-y-down --height m_height.png
-    slope=$("$MAPS" slope flip_height.png flip_normal.png 2>&1)
-    check "tile: the control's normals disagree with the slopes" "median above 20 deg" "$slope" \
-        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 > 20)}'; echo $?)"
-    expect_ok "tile: a y-down normal map with --normal-y-down" tile ../in/torus.obj ../in/tex.png dxt --tile 48 \
-        --normal dx_normal.png --normal-y-down --height m_height.png
-    slope=$("$MAPS" slope dxt_height.png dxt_normal.png 2>&1)
-    check "tile --normal-y-down: written +Y up, following the slopes" "median <= 5 deg" "$slope" \
-        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 5)}'; echo $?)"
-    # a constant tilt "up" (0, 0.57): the bottom and top sides' bands keep it or turn it
-    # half a turn, the left and right sides' turn it a quarter: all four directions show
-    expect_ok "tile a constant 'up' normal map" tile ../in/torus.obj ../in/tex.png up --tile 48 --normal upmap.png
-    turns=$("$MAPS" turns up_normal.png 128 200 2>&1)
-    CMD="maps turns up_normal.png 128 200"
-    check "tile: a constant up reads as its quarter turns where bands are turned" \
-        "each of 0, 90, 180, 270 degrees on >= 5% of the texels, >= 90% in all" "$turns" \
-        "$(printf '%s\n' "$turns" | awk '{exit !(NF == 4 && $1 >= 0.05 && $2 >= 0.05 && $3 >= 0.05 && $4 >= 0.05 &&
-            $1 + $2 + $3 + $4 >= 0.9)}'; echo $?)"
-
-    # polycube: plain and upright tiles, each map in both halves of the atlas
-    expect_ok "polycube with a material" polycube ../in/spheretri.obj ../in/tex.png p --resolution 4 --tile 48 \
-        --normal m_normal.png --height m_height.png
-    check "polycube: the maps have the atlas's size" "$(png_size p.png)" "$(png_size p_normal.png), $(png_size p_height.png)" \
-        "$([ "$(png_size p_normal.png)" = "$(png_size p.png)" ] && [ "$(png_size p_height.png)" = "$(png_size p.png)" ]; echo $?)"
-    slope=$("$MAPS" slope p_height.png p_normal.png 2>&1)
-    CMD="maps slope p_height.png p_normal.png"
-    check "polycube: the normal atlas follows the height atlas's slopes" "median <= 5 deg" "$slope" \
-        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 5)}'; echo $?)"
-
-    # lapped: each patch's window of each map, and the bake turns the normals into the atlas
-    # (a plane, pastes turned at random, the atlas a little finer than the patches)
-    { for j in 0 1 2 3 4 5 6 7 8 9 10 11 12; do for i in 0 1 2 3 4 5 6 7 8 9 10 11 12; do
-          echo "v $i $j 0"; echo "vt $(awk -v i=$i 'BEGIN{print i/12}') $(awk -v j=$j 'BEGIN{print j/12}')"; done; done
-      for j in $(seq 0 11); do for i in $(seq 0 11); do a=$((j * 13 + i + 1)); b=$((a + 1)); c=$((a + 14)); d=$((a + 13))
-          echo "f $a/$a $b/$b $c/$c"; echo "f $a/$a $c/$c $d/$d"; done; done; } >plane.obj
-    expect_ok "lapped with a material" lapped plane.obj ../in/tex.png l --isotropic --scale 8 --patches 1 \
-        --bake 512 --bake-uv mesh --normal m_normal.png --height m_height.png
-    check "lapped: the patch's maps and the baked maps" "l_patch_normal.png, l_patch_height.png, l_baked_normal.png, ..." \
-        "$(ls l_*)" \
-        "$([ -s l_patch_normal.png ] && [ -s l_patch_height.png ] && [ -s l_baked_normal.png ] && [ -s l_baked_height.png ]; echo $?)"
-    check "lapped: both MTLs name the normal maps" "norm l_patch_normal.png, norm l_baked_normal.png" \
-        "$(grep -h norm l.mtl l_baked.mtl)" \
-        "$(grep -qx 'norm l_patch_normal.png' l.mtl && grep -qx 'norm l_baked_normal.png' l_baked.mtl; echo $?)"
-    slope=$("$MAPS" slope l_baked_height.png l_baked_normal.png 2>&1)
-    CMD="maps slope l_baked_height.png l_baked_normal.png"
-    check "lapped --bake: the baked normals follow the baked height's slopes" "median <= 15 deg" "$slope" \
-        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 15)}'; echo $?)"
-    expect_ok "lapped: y-down read of a +Y-up map (control)" lapped plane.obj ../in/tex.png lc --isotropic --scale 8 \
-        --patches 1 --bake 512 --bake-uv mesh --normal m_normal.png --normal-y-down --height m_height.png
-    slope=$("$MAPS" slope lc_baked_height.png lc_baked_normal.png 2>&1)
-    check "lapped: the control's baked normals disagree" "median above 30 deg" "$slope" \
-        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 > 30)}'; echo $?)"
-
-    # hpm: the UVs serve every map where it is; a y-down normal map is rewritten +Y up
-    expect_ok "hpm with a material" hpm ../in/torus.obj ../in/tex.png h --normal m_normal.png --roughness m_roughness.png
-    check "hpm: the MTL names the maps where they are" "norm m_normal.png, map_Pr m_roughness.png" "$(cat h.mtl)" \
-        "$(grep -qx 'norm m_normal.png' h.mtl && grep -qx 'map_Pr m_roughness.png' h.mtl && [ ! -e h_normal.png ]; echo $?)"
-    expect_ok "hpm --normal-y-down" hpm ../in/torus.obj ../in/tex.png hd --normal dx_normal.png --normal-y-down
-    check "hpm --normal-y-down: writes hd_normal.png +Y up and names it" "norm hd_normal.png" "$(cat hd.mtl)" \
-        "$(grep -qx 'norm hd_normal.png' hd.mtl && [ -s hd_normal.png ]; echo $?)"
-    px_in=$("$W/pixstat" m_normal.png 17 23 2>/dev/null)
-    px_out=$("$W/pixstat" hd_normal.png 17 23 2>/dev/null)
-    CMD="pixstat m_normal.png / hd_normal.png 17 23"
-    check "hpm --normal-y-down: the rewritten map is the +Y-up map" "$px_in (within 2)" "$px_out" \
-        "$(printf '%s\n%s\n' "$px_in" "$px_out" | awk 'NR==1{a=$1;b=$2;c=$3} NR==2{exit !(NF==3 && ($1-a)^2<=4 && ($2-b)^2<=4 && ($3-c)^2<=4)}'; echo $?)"
-
-    # render --normal: the lighting changes; refused on a pasting mesh
-    expect_ok "render with the normal map" render t.obj t.png nm.png --size 64x64 --normal t_normal.png
-    expect_ok "render without it" render t.obj t.png plain.png --size 64x64
-    check "render --normal: the normal map changes the picture" "files differ" "identical" \
-        "$(! cmp -s nm.png plain.png; echo $?)"
-    # a square facing the camera, u to the right and v up the screen: a normal map tilted
-    # towards the key light (upper left) brightens it, one tilted away darkens it
-    printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n' >sq.obj
-    "$MAPS" const 64 64 80 176 218 towards.png && "$MAPS" const 64 64 176 80 218 away.png
-    for n in towards away; do
-        expect_ok "render a square with the normal map '$n'" render sq.obj small.png sq_$n.png --size 32x32 \
-            --yaw 0 --pitch 0 --normal $n.png
-    done
-    expect_ok "render the square unmapped" render sq.obj small.png sq_flat.png --size 32x32 --yaw 0 --pitch 0
-    lit=$(for n in towards flat away; do "$W/pixstat" sq_$n.png 16 16 | awk '{print $1}'; done | tr '\n' ' ')
-    CMD="pixstat sq_towards.png / sq_flat.png / sq_away.png 16 16"
-    check "render --normal: tilted towards the light is brighter, away darker (u right, v up)" \
-        "towards > flat > away" "$lit" "$(printf '%s\n' "$lit" | awk '{exit !(NF == 3 && $1 > $2 && $2 > $3)}'; echo $?)"
-
-    # bad input (each in an empty directory of its own)
-    expect_error "render --normal on a pasting mesh" render "$MD/l.obj" "$MD/l_patch.png" v.png \
-        --normal "$MD/l_patch_normal.png"
-    err_mentions "render --normal on a pasting mesh: says to render the bake" "bake"
-    expect_error "a map of another size" tile "$W/in/torus.obj" "$W/in/tex.png" bad --normal "$MD/small.png"
-    err_mentions "a map of another size: names both sizes" "128x128.*256x256"
-    expect_usage_error "--normal-y-down without --normal" tile "$W/in/torus.obj" "$W/in/tex.png" bad --normal-y-down
-    expect_usage_error "--roughness without a value" lapped "$W/in/torus.obj" "$W/in/tex.png" bad --roughness
-    expect_error "a missing map" polycube "$W/in/spheretri.obj" "$W/in/tex.png" bad --height nope.png
-    err_mentions "a missing map: names it" "nope\.png"
-    cd "$MD" || exit 1
-    run tile ../in/torus.obj ../in/tex.png m --height m_height.png
-    check "a map's output that would replace an input map is refused" "exit 1, m_height.png unchanged" \
-        "exit $RC: $ERR" "$([ $RC -eq 1 ] && "$MAPS" slope m_height.png m_normal.png >/dev/null; echo $?)"
-else
-    fail "helper for material maps" "$CMD" "compiles" "$(head -c 300 "$W/err")"
-fi
-cd "$W" || exit 1
-
 GLB_PROBE=""
 CMD="$HELPER_CC glb_probe.c examples/gltf.c image_io.c tool_io.c obj.c format_number.c (test helper)"
 if $HELPER_CC -std=c99 -O1 -w -I"$ROOT" -I"$ROOT/examples" $STB_INC "$W/glb_probe.c" "$ROOT/examples/gltf.c" \
@@ -2898,6 +2601,309 @@ if [ -n "$GLB_PROBE" ]; then
     validate "no map at all" plain.glb
     cd "$W" || exit 1
 fi
+
+# ======================================================================
+# Material maps (issue 11, item 1): one layout for every map
+# ======================================================================
+cat >"$W/maps.c" <<'EOF_C'
+/* maps: the test helper for material maps.
+     maps pbr IN.png STEM [ydown]   height (luminance), normal (from the height's slopes, 4 per
+                                    unit per texel, +Y up, or y down) and roughness maps of IN
+     maps coords W H OUT.png        r = x, g = y (bytes): where each texel came from
+     maps const W H R G B OUT.png   one colour
+     maps slope HEIGHT NORMAL       median and 90th percentile (degrees) of the angle between
+                                    the direction a normal map tilts and the one the height map's
+                                    slopes imply, where both tilt
+     maps turns NORMAL X Y          the share of tilted texels whose tilt is (X, Y) (bytes, +Y
+                                    up) turned by 0, 1, 2, 3 quarter turns counter-clockwise,
+                                    within 10 degrees
+     maps origin IMAGE COORDS ATLAS the share of atlas texels equal (within 2 per channel) to
+                                    IMAGE's texel at the position COORDS' atlas gives there */
+#define STB_IMAGE_IMPLEMENTATION
+#include "stb_image.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include "stb_image_write.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+static int by_value(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+static float angle(float ax, float ay, float bx, float by)
+{
+    float c = (ax * bx + ay * by) / (sqrtf(ax * ax + ay * ay) * sqrtf(bx * bx + by * by));
+    return acosf(c > 1.0f ? 1.0f : (c < -1.0f ? -1.0f : c)) * 57.29578f;
+}
+int main(int argc, char **argv)
+{
+    int w, h, n, x, y;
+    char path[4096];
+    if (argc >= 4 && strcmp(argv[1], "pbr") == 0) {
+        unsigned char *p = stbi_load(argv[2], &w, &h, &n, 3), *o;
+        float *L;
+        if (!p) return 1;
+        L = malloc(sizeof(float) * w * h);
+        o = malloc(3 * (size_t)w * h);
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                unsigned char *q = p + 3 * (y * w + x);
+                L[y * w + x] = (0.299f * q[0] + 0.587f * q[1] + 0.114f * q[2]) / 255.0f;
+            }
+        for (x = 0; x < w * h; x++) o[3 * x] = o[3 * x + 1] = o[3 * x + 2] = (unsigned char)(L[x] * 255.0f + 0.5f);
+        snprintf(path, sizeof path, "%s_height.png", argv[3]);
+        if (!stbi_write_png(path, w, h, 3, o, 3 * w)) return 1;
+        for (x = 0; x < w * h; x++) o[3 * x] = o[3 * x + 1] = o[3 * x + 2] = (unsigned char)(255.0f - L[x] * 200.0f);
+        snprintf(path, sizeof path, "%s_roughness.png", argv[3]);
+        if (!stbi_write_png(path, w, h, 3, o, 3 * w)) return 1;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                int xl = x > 0 ? x - 1 : x, xr = x < w - 1 ? x + 1 : x, yu = y > 0 ? y - 1 : y, yd = y < h - 1 ? y + 1 : y;
+                float nx = -(L[y * w + xr] - L[y * w + xl]) * 4.0f, ny = (L[yd * w + x] - L[yu * w + x]) * 4.0f;
+                float len = sqrtf(nx * nx + ny * ny + 1.0f);
+                if (argc > 4) ny = -ny;
+                o[3 * (y * w + x)] = (unsigned char)lrintf((nx / len * 0.5f + 0.5f) * 255.0f);
+                o[3 * (y * w + x) + 1] = (unsigned char)lrintf((ny / len * 0.5f + 0.5f) * 255.0f);
+                o[3 * (y * w + x) + 2] = (unsigned char)lrintf((1.0f / len * 0.5f + 0.5f) * 255.0f);
+            }
+        snprintf(path, sizeof path, "%s_normal.png", argv[3]);
+        return !stbi_write_png(path, w, h, 3, o, 3 * w);
+    }
+    if (argc == 5 && strcmp(argv[1], "coords") == 0) {
+        unsigned char *o;
+        w = atoi(argv[2]);
+        h = atoi(argv[3]);
+        o = malloc(3 * (size_t)w * h);
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                o[3 * (y * w + x)] = (unsigned char)x;
+                o[3 * (y * w + x) + 1] = (unsigned char)y;
+                o[3 * (y * w + x) + 2] = 0;
+            }
+        return !stbi_write_png(argv[4], w, h, 3, o, 3 * w);
+    }
+    if (argc == 8 && strcmp(argv[1], "const") == 0) {
+        unsigned char *o;
+        w = atoi(argv[2]);
+        h = atoi(argv[3]);
+        o = malloc(3 * (size_t)w * h);
+        for (x = 0; x < w * h; x++) {
+            o[3 * x] = (unsigned char)atoi(argv[4]);
+            o[3 * x + 1] = (unsigned char)atoi(argv[5]);
+            o[3 * x + 2] = (unsigned char)atoi(argv[6]);
+        }
+        return !stbi_write_png(argv[7], w, h, 3, o, 3 * w);
+    }
+    if (argc == 4 && strcmp(argv[1], "slope") == 0) {
+        int w2, h2, count = 0;
+        unsigned char *H = stbi_load(argv[2], &w, &h, &n, 1), *N = stbi_load(argv[3], &w2, &h2, &n, 3);
+        float *angles;
+        if (!H || !N || w != w2 || h != h2) return 1;
+        angles = malloc(sizeof(float) * w * h);
+        for (y = 1; y < h - 1; y++)
+            for (x = 1; x < w - 1; x++) {
+                float ex = -(H[y * w + x + 1] - H[y * w + x - 1]) / 255.0f * 4.0f;
+                float ey = (H[(y + 1) * w + x] - H[(y - 1) * w + x]) / 255.0f * 4.0f;
+                const unsigned char *p = N + 3 * (y * w + x);
+                float nx = p[0] / 127.5f - 1.0f, ny = p[1] / 127.5f - 1.0f, nz = p[2] / 127.5f - 1.0f;
+                if (sqrtf(ex * ex + ey * ey) < 0.08f || sqrtf(nx * nx + ny * ny) < 0.08f * sqrtf(nx * nx + ny * ny + nz * nz))
+                    continue;
+                angles[count++] = angle(ex, ey, nx, ny);
+            }
+        if (count < 100) return 1;
+        qsort(angles, (size_t)count, sizeof(float), by_value);
+        printf("%.2f %.2f %d\n", angles[count / 2], angles[count * 9 / 10], count);
+        return 0;
+    }
+    if (argc == 5 && strcmp(argv[1], "turns") == 0) {
+        unsigned char *N = stbi_load(argv[2], &w, &h, &n, 3);
+        float vx = atoi(argv[3]) / 127.5f - 1.0f, vy = atoi(argv[4]) / 127.5f - 1.0f;
+        long counts[4] = {0, 0, 0, 0}, tilted = 0;
+        int k;
+        if (!N) return 1;
+        for (x = 0; x < w * h; x++) {
+            float nx = N[3 * x] / 127.5f - 1.0f, ny = N[3 * x + 1] / 127.5f - 1.0f;
+            if (sqrtf(nx * nx + ny * ny) < 0.05f) continue;
+            tilted++;
+            for (k = 0; k < 4; k++) {
+                float c = cosf(k * 1.5707963f), s = sinf(k * 1.5707963f);
+                if (angle(nx, ny, c * vx - s * vy, s * vx + c * vy) < 10.0f) counts[k]++;
+            }
+        }
+        if (tilted == 0) return 1;
+        printf("%.3f %.3f %.3f %.3f\n", (double)counts[0] / tilted, (double)counts[1] / tilted,
+               (double)counts[2] / tilted, (double)counts[3] / tilted);
+        return 0;
+    }
+    if (argc == 5 && strcmp(argv[1], "origin") == 0) {
+        int cw, ch, aw, ah, k;
+        long same = 0;
+        unsigned char *I = stbi_load(argv[2], &w, &h, &n, 3), *C = stbi_load(argv[3], &cw, &ch, &n, 3),
+                      *A = stbi_load(argv[4], &aw, &ah, &n, 3);
+        if (!I || !C || !A || cw != aw || ch != ah) return 1;
+        for (x = 0; x < aw * ah; x++) {
+            int sx = C[3 * x], sy = C[3 * x + 1], ok = 1;
+            if (sx >= w || sy >= h) continue;
+            for (k = 0; k < 3; k++) ok &= abs(A[3 * x + k] - I[3 * (sy * w + sx) + k]) <= 2;
+            same += ok;
+        }
+        printf("%.3f\n", (double)same / ((double)aw * ah));
+        return 0;
+    }
+    return 2;
+}
+EOF_C
+newdir
+MD=$PWD
+CMD="$HELPER_CC $STB_INC maps.c (test helper)"
+if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
+    MAPS=$W/maps
+    # a 256 x 256 material: the colour, its height, the normal map its slopes imply (+Y up
+    # and y down) and a roughness map; a map of where each texel is; an "up" normal map
+    "$MAPS" pbr ../in/tex.png m && "$MAPS" pbr ../in/tex.png dx ydown && "$MAPS" coords 256 256 coords.png &&
+        "$MAPS" const 256 256 128 200 218 upmap.png && "$MAPS" const 128 128 128 128 255 small.png
+    check "material helper makes its maps" "m_normal.png m_height.png coords.png upmap.png" "$(ls)" \
+        "$([ -s m_normal.png ] && [ -s dx_normal.png ] && [ -s coords.png ] && [ -s upmap.png ]; echo $?)"
+
+    # tile: an atlas per map, one layout; the MTL names them
+    expect_ok "tile with a material" tile ../in/torus.obj ../in/tex.png t --tile 48 --normal m_normal.png \
+        --roughness m_roughness.png --height m_height.png --metallic coords.png --ao m_height.png
+    check "tile: one atlas per map, of the colour's size" "t_normal/_roughness/_metallic/_ao/_height.png, $(png_size t.png)" \
+        "$(for m in normal roughness metallic ao height; do printf '%s: %s; ' $m "$(png_size t_$m.png)"; done)" \
+        "$(for m in normal roughness metallic ao height; do [ "$(png_size t_$m.png)" = "$(png_size t.png)" ] || exit 1; done; echo $?)"
+    check "tile: the MTL names every map" "map_Bump -bm 1 / norm t_normal.png, map_Pr, map_Pm, disp, an AO comment" \
+        "$(cat t.mtl)" \
+        "$(grep -qx 'map_Bump -bm 1 t_normal.png' t.mtl && grep -qx 'norm t_normal.png' t.mtl &&
+            grep -qx 'map_Pr t_roughness.png' t.mtl && grep -qx 'map_Pm t_metallic.png' t.mtl &&
+            grep -qx 'disp t_height.png' t.mtl && grep -q '^# ambient occlusion: t_ao.png' t.mtl; echo $?)"
+    expect_ok "tile the colour alone" tile ../in/torus.obj ../in/tex.png alone --tile 48
+    check "tile: the maps change nothing of the colour's atlas" "cmp equal" "$(cmp t.png alone.png 2>&1)" \
+        "$(cmp -s t.png alone.png; echo $?)"
+    check "tile: the same map twice gives the same atlas" "t_height.png = t_ao.png" "$(cmp t_height.png t_ao.png 2>&1)" \
+        "$(cmp -s t_height.png t_ao.png; echo $?)"
+    # one layout: where the map of positions says an atlas texel came from, the colour
+    # atlas shows that very texel of the colour image (blends aside); the control, the
+    # positions laid out by another seed's tiles, agrees only by chance
+    expect_ok "tile: positions by another seed (control)" tile ../in/torus.obj ../in/tex.png other --tile 48 \
+        --seed 9 --metallic coords.png
+    same=$("$MAPS" origin ../in/tex.png t_metallic.png t.png 2>&1)
+    control=$("$MAPS" origin ../in/tex.png other_metallic.png t.png 2>&1)
+    CMD="maps origin ../in/tex.png t_metallic.png t.png (and other_metallic.png)"
+    check "tile: every map is cut where the colour is" "share >= 0.6 (control, another seed's: <= 0.2)" \
+        "$same (control $control)" \
+        "$(awk -v a="$same" -v b="$control" 'BEGIN{exit !(a >= 0.6 && b <= 0.2)}'; echo $?)"
+    # normals turned with the content: the normal atlas tilts where the height atlas's
+    # slopes say; read as y-down (a wrong turn of every vector) it does not
+    slope=$("$MAPS" slope t_height.png t_normal.png 2>&1)
+    CMD="maps slope t_height.png t_normal.png"
+    check "tile: the normal atlas follows the height atlas's slopes" "median <= 5 deg, p90 <= 45" "$slope" \
+        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 5 && $2 <= 45)}'; echo $?)"
+    expect_ok "tile: a +Y-up normal map read as y-down (control)" tile ../in/torus.obj ../in/tex.png flip --tile 48 \
+        --normal m_normal.png --normal-y-down --height m_height.png
+    slope=$("$MAPS" slope flip_height.png flip_normal.png 2>&1)
+    check "tile: the control's normals disagree with the slopes" "median above 20 deg" "$slope" \
+        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 > 20)}'; echo $?)"
+    expect_ok "tile: a y-down normal map with --normal-y-down" tile ../in/torus.obj ../in/tex.png dxt --tile 48 \
+        --normal dx_normal.png --normal-y-down --height m_height.png
+    slope=$("$MAPS" slope dxt_height.png dxt_normal.png 2>&1)
+    check "tile --normal-y-down: written +Y up, following the slopes" "median <= 5 deg" "$slope" \
+        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 5)}'; echo $?)"
+    # a constant tilt "up" (0, 0.57): the bottom and top sides' bands keep it or turn it
+    # half a turn, the left and right sides' turn it a quarter: all four directions show
+    expect_ok "tile a constant 'up' normal map" tile ../in/torus.obj ../in/tex.png up --tile 48 --normal upmap.png
+    turns=$("$MAPS" turns up_normal.png 128 200 2>&1)
+    CMD="maps turns up_normal.png 128 200"
+    check "tile: a constant up reads as its quarter turns where bands are turned" \
+        "each of 0, 90, 180, 270 degrees on >= 5% of the texels, >= 90% in all" "$turns" \
+        "$(printf '%s\n' "$turns" | awk '{exit !(NF == 4 && $1 >= 0.05 && $2 >= 0.05 && $3 >= 0.05 && $4 >= 0.05 &&
+            $1 + $2 + $3 + $4 >= 0.9)}'; echo $?)"
+
+    # polycube: plain and upright tiles, each map in both halves of the atlas
+    expect_ok "polycube with a material" polycube ../in/spheretri.obj ../in/tex.png p --resolution 4 --tile 48 \
+        --normal m_normal.png --height m_height.png
+    check "polycube: the maps have the atlas's size" "$(png_size p.png)" "$(png_size p_normal.png), $(png_size p_height.png)" \
+        "$([ "$(png_size p_normal.png)" = "$(png_size p.png)" ] && [ "$(png_size p_height.png)" = "$(png_size p.png)" ]; echo $?)"
+    slope=$("$MAPS" slope p_height.png p_normal.png 2>&1)
+    CMD="maps slope p_height.png p_normal.png"
+    check "polycube: the normal atlas follows the height atlas's slopes" "median <= 5 deg" "$slope" \
+        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 5)}'; echo $?)"
+
+    # lapped: each patch's window of each map, and the bake turns the normals into the atlas
+    # (a plane, pastes turned at random, the atlas a little finer than the patches)
+    { for j in 0 1 2 3 4 5 6 7 8 9 10 11 12; do for i in 0 1 2 3 4 5 6 7 8 9 10 11 12; do
+          echo "v $i $j 0"; echo "vt $(awk -v i=$i 'BEGIN{print i/12}') $(awk -v j=$j 'BEGIN{print j/12}')"; done; done
+      for j in $(seq 0 11); do for i in $(seq 0 11); do a=$((j * 13 + i + 1)); b=$((a + 1)); c=$((a + 14)); d=$((a + 13))
+          echo "f $a/$a $b/$b $c/$c"; echo "f $a/$a $c/$c $d/$d"; done; done; } >plane.obj
+    expect_ok "lapped with a material" lapped plane.obj ../in/tex.png l --isotropic --scale 8 --patches 1 \
+        --bake 512 --bake-uv mesh --normal m_normal.png --height m_height.png
+    check "lapped: the patch's maps and the baked maps" "l_patch_normal.png, l_patch_height.png, l_baked_normal.png, ..." \
+        "$(ls l_*)" \
+        "$([ -s l_patch_normal.png ] && [ -s l_patch_height.png ] && [ -s l_baked_normal.png ] && [ -s l_baked_height.png ]; echo $?)"
+    check "lapped: both MTLs name the normal maps" "norm l_patch_normal.png, norm l_baked_normal.png" \
+        "$(grep -h norm l.mtl l_baked.mtl)" \
+        "$(grep -qx 'norm l_patch_normal.png' l.mtl && grep -qx 'norm l_baked_normal.png' l_baked.mtl; echo $?)"
+    slope=$("$MAPS" slope l_baked_height.png l_baked_normal.png 2>&1)
+    CMD="maps slope l_baked_height.png l_baked_normal.png"
+    check "lapped --bake: the baked normals follow the baked height's slopes" "median <= 15 deg" "$slope" \
+        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 15)}'; echo $?)"
+    expect_ok "lapped: y-down read of a +Y-up map (control)" lapped plane.obj ../in/tex.png lc --isotropic --scale 8 \
+        --patches 1 --bake 512 --bake-uv mesh --normal m_normal.png --normal-y-down --height m_height.png
+    slope=$("$MAPS" slope lc_baked_height.png lc_baked_normal.png 2>&1)
+    check "lapped: the control's baked normals disagree" "median above 30 deg" "$slope" \
+        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 > 30)}'; echo $?)"
+
+    # hpm: the UVs serve every map where it is; a y-down normal map is rewritten +Y up
+    expect_ok "hpm with a material" hpm ../in/torus.obj ../in/tex.png h --normal m_normal.png --roughness m_roughness.png
+    check "hpm: the MTL names the maps where they are" "norm m_normal.png, map_Pr m_roughness.png" "$(cat h.mtl)" \
+        "$(grep -qx 'norm m_normal.png' h.mtl && grep -qx 'map_Pr m_roughness.png' h.mtl && [ ! -e h_normal.png ]; echo $?)"
+    expect_ok "hpm --normal-y-down" hpm ../in/torus.obj ../in/tex.png hd --normal dx_normal.png --normal-y-down
+    check "hpm --normal-y-down: writes hd_normal.png +Y up and names it" "norm hd_normal.png" "$(cat hd.mtl)" \
+        "$(grep -qx 'norm hd_normal.png' hd.mtl && [ -s hd_normal.png ]; echo $?)"
+    px_in=$("$W/pixstat" m_normal.png 17 23 2>/dev/null)
+    px_out=$("$W/pixstat" hd_normal.png 17 23 2>/dev/null)
+    CMD="pixstat m_normal.png / hd_normal.png 17 23"
+    check "hpm --normal-y-down: the rewritten map is the +Y-up map" "$px_in (within 2)" "$px_out" \
+        "$(printf '%s\n%s\n' "$px_in" "$px_out" | awk 'NR==1{a=$1;b=$2;c=$3} NR==2{exit !(NF==3 && ($1-a)^2<=4 && ($2-b)^2<=4 && ($3-c)^2<=4)}'; echo $?)"
+
+    # render --normal: the lighting changes; refused on a pasting mesh
+    expect_ok "render with the normal map" render t.obj t.png nm.png --size 64x64 --normal t_normal.png
+    expect_ok "render without it" render t.obj t.png plain.png --size 64x64
+    check "render --normal: the normal map changes the picture" "files differ" "identical" \
+        "$(! cmp -s nm.png plain.png; echo $?)"
+    # a square facing the camera, u to the right and v up the screen: a normal map tilted
+    # towards the key light (upper left) brightens it, one tilted away darkens it
+    printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n' >sq.obj
+    "$MAPS" const 64 64 80 176 218 towards.png && "$MAPS" const 64 64 176 80 218 away.png
+    for n in towards away; do
+        expect_ok "render a square with the normal map '$n'" render sq.obj small.png sq_$n.png --size 32x32 \
+            --yaw 0 --pitch 0 --normal $n.png
+    done
+    expect_ok "render the square unmapped" render sq.obj small.png sq_flat.png --size 32x32 --yaw 0 --pitch 0
+    lit=$(for n in towards flat away; do "$W/pixstat" sq_$n.png 16 16 | awk '{print $1}'; done | tr '\n' ' ')
+    CMD="pixstat sq_towards.png / sq_flat.png / sq_away.png 16 16"
+    check "render --normal: tilted towards the light is brighter, away darker (u right, v up)" \
+        "towards > flat > away" "$lit" "$(printf '%s\n' "$lit" | awk '{exit !(NF == 3 && $1 > $2 && $2 > $3)}'; echo $?)"
+
+    # bad input (each in an empty directory of its own)
+    expect_error "render --normal on a pasting mesh" render "$MD/l.obj" "$MD/l_patch.png" v.png \
+        --normal "$MD/l_patch_normal.png"
+    err_mentions "render --normal on a pasting mesh: says to render the bake" "bake"
+    expect_error "a map of another size" tile "$W/in/torus.obj" "$W/in/tex.png" bad --normal "$MD/small.png"
+    err_mentions "a map of another size: names both sizes" "128x128.*256x256"
+    expect_usage_error "--normal-y-down without --normal" tile "$W/in/torus.obj" "$W/in/tex.png" bad --normal-y-down
+    expect_usage_error "--roughness without a value" lapped "$W/in/torus.obj" "$W/in/tex.png" bad --roughness
+    expect_error "a missing map" polycube "$W/in/spheretri.obj" "$W/in/tex.png" bad --height nope.png
+    err_mentions "a missing map: names it" "nope\.png"
+    cd "$MD" || exit 1
+    run tile ../in/torus.obj ../in/tex.png m --height m_height.png
+    check "a map's output that would replace an input map is refused" "exit 1, m_height.png unchanged" \
+        "exit $RC: $ERR" "$([ $RC -eq 1 ] && "$MAPS" slope m_height.png m_normal.png >/dev/null; echo $?)"
+else
+    fail "helper for material maps" "$CMD" "compiles" "$(head -c 300 "$W/err")"
+fi
+cd "$W" || exit 1
 
 # ======================================================================
 # Sanitizers
