@@ -2618,7 +2618,8 @@ cat >"$W/maps.c" <<'EOF_C'
                                     up) turned by 0, 1, 2, 3 quarter turns counter-clockwise,
                                     within 10 degrees
      maps origin IMAGE COORDS ATLAS the share of atlas texels equal (within 2 per channel) to
-                                    IMAGE's texel at the position COORDS' atlas gives there */
+                                    IMAGE's texel at the position COORDS' atlas gives there
+     maps diff A B                  the largest difference of a byte of r, g, b (-1: sizes differ) */
 #define STB_IMAGE_IMPLEMENTATION
 #include "stb_image.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -2737,6 +2738,16 @@ int main(int argc, char **argv)
                (double)counts[2] / tilted, (double)counts[3] / tilted);
         return 0;
     }
+    if (argc == 4 && strcmp(argv[1], "diff") == 0) {
+        int w2, h2, most = 0;
+        unsigned char *A = stbi_load(argv[2], &w, &h, &n, 3), *B = stbi_load(argv[3], &w2, &h2, &n, 3);
+        if (!A || !B) return 1;
+        if (w != w2 || h != h2) most = -1;
+        for (x = 0; most >= 0 && x < 3 * w * h; x++)
+            if (abs(A[x] - B[x]) > most) most = abs(A[x] - B[x]);
+        printf("%d\n", most);
+        return 0;
+    }
     if (argc == 5 && strcmp(argv[1], "origin") == 0) {
         int cw, ch, aw, ah, k;
         long same = 0;
@@ -2853,6 +2864,37 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
     slope=$("$MAPS" slope lc_baked_height.png lc_baked_normal.png 2>&1)
     check "lapped: the control's baked normals disagree" "median above 30 deg" "$slope" \
         "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 > 30)}'; echo $?)"
+
+    # the GLB of a material: normal, metallicRoughness and occlusion textures beside the
+    # colour, the normal map the very atlas the OBJ run wrote; lapped's and hpm's too
+    expect_ok "tile a material into a GLB" tile ../in/torus.obj ../in/tex.png t.glb --tile 48 --normal m_normal.png \
+        --roughness m_roughness.png --height m_height.png --metallic coords.png --ao m_height.png
+    err_mentions "tile GLB with --height: says glTF has no height map" "no height map"
+    glb_check "tile GLB with a material" t.glb
+    check "tile GLB: the material has every texture glTF takes" "normalTexture, metallicRoughnessTexture, occlusionTexture" \
+        "$GLB_JSON" "$(printf '%s' "$GLB_JSON" | grep -q '"normalTexture"' &&
+            printf '%s' "$GLB_JSON" | grep -q '"metallicRoughnessTexture"' &&
+            printf '%s' "$GLB_JSON" | grep -q '"occlusionTexture"'; echo $?)"
+    if [ -n "$GLB_PROBE" ]; then
+        glb_image t.glb normal glb_normal.png
+        most=$("$MAPS" diff glb_normal.png t_normal.png 2>&1)
+        CMD="maps diff glb_normal.png t_normal.png"
+        check "tile GLB: its normal map is the OBJ run's normal atlas" "the same pixels (largest difference 0)" \
+            "$most" "$([ "$most" = 0 ]; echo $?)"
+    fi
+    validate "tile GLB with a material" t.glb
+    expect_ok "lapped: a material baked into a GLB" lapped plane.obj ../in/tex.png lg.glb --scale 8 --patches 1 \
+        --bake 128 --normal m_normal.png --roughness m_roughness.png
+    glb_check "lapped GLB with a material" lg.glb
+    check "lapped GLB: the baked normal and roughness maps" "normalTexture, metallicRoughnessTexture" "$GLB_JSON" \
+        "$(printf '%s' "$GLB_JSON" | grep -q '"normalTexture"' &&
+            printf '%s' "$GLB_JSON" | grep -q '"metallicRoughnessTexture"'; echo $?)"
+    validate "lapped GLB with a material" lg.glb
+    expect_ok "hpm: a material into a GLB" hpm ../in/torus.obj ../in/tex.png hg.glb --normal m_normal.png --ao m_height.png
+    validate "hpm GLB with a material" hg.glb
+    expect_ok "polycube: a material into a GLB" polycube ../in/spheretri.obj ../in/tex.png pg.glb --resolution 4 \
+        --tile 48 --normal m_normal.png --metallic m_roughness.png
+    validate "polycube GLB with a material" pg.glb
 
     # hpm: the UVs serve every map where it is; a y-down normal map is rewritten +Y up
     expect_ok "hpm with a material" hpm ../in/torus.obj ../in/tex.png h --normal m_normal.png --roughness m_roughness.png
