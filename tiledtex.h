@@ -78,7 +78,8 @@
 
    Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first
    (the per-corner outputs then line up with the quadrangulated mesh's corners:
-   mesh->corner_vert is its index buffer).
+   mesh->corner_vert is its index buffer). Your normals, colours and UVs follow
+   through tt_mesh_quadrangulate_sources() and tt_corner_sources_apply().
 
    CONVENTIONS
      - Half-edges are corners: the half-edges of face f are stored contiguously in
@@ -108,7 +109,8 @@
    SECTIONS (each uses only the ones above it; read top to bottom)
      1. Common  - results and errors, allocator hooks, asserts, seeded RNG,
                   version, and the small tools every section shares
-     2. Mesh    - half-edge builder with validation, queries, quadrangulation,
+     2. Mesh    - half-edge builder with validation, queries, quadrangulation
+                  (with each new corner's sources, to carry attributes),
                   face normals, corner normals with creases
      3. Image   - float RGBA images, colour spaces, bilinear sampling, 90-degree
                   rotations, premultiplied `over`, box downsampling,
@@ -376,6 +378,66 @@ typedef enum tt_subdivision {
    points that overflow float are TT_ERROR_NON_FINITE. */
 TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error);
+
+/* Where each corner of a quadrangulated mesh comes from, so that any
+   per-corner attribute (normals, colours, UVs, lightmap UVs) can follow the
+   mesh: new corner c interpolates the input's corners
+   source[source_start[c] .. source_start[c+1]-1] with the matching weights.
+   Compressed rows, as tt_sparse_matrix. Read the fields freely; do not
+   modify them. */
+typedef struct tt_corner_sources {
+    int ncorners;           /* corners of the quadrangulated mesh: 4 * input_corners */
+    int input_corners;      /* corners of the mesh it was made from */
+    int nsources;           /* source_start[ncorners] */
+    int *source_start;      /* ncorners + 1, source_start[0] == 0 */
+    int *source;            /* nsources input corners, all of the new corner's own input face */
+    float *weights;         /* nsources, each in (0, 1], summing to 1 per new corner */
+    tt_allocator allocator; /* the one it was made with */
+} tt_corner_sources;
+
+/* The sources of the corners tt_mesh_quadrangulate(mesh, ...) makes, with
+   either scheme. Quad c (from input corner c of face f, with n the next
+   corner of f and p the previous) has the corners
+     4c      corner c's vertex:           c, weight 1;
+     4c + 1  the point of half-edge c:    c and n, 1/2 each;
+     4c + 2  the face point:              f's corners in order, 1/|f| each;
+     4c + 3  the point of half-edge p:    p and c, 1/2 each.
+   The weights are linear for both schemes. Linear positions are exactly
+   these interpolations of the input's positions; Catmull-Clark positions
+   weigh in the faces around (the surface moves, and shrinks a little), but
+   an attribute is interpolated within the corner's own face, which keeps
+   creases, UV seams and hard edges where the input has them (a quad's
+   corners never mix values from two faces). Apply them with
+   tt_corner_sources_apply; after several steps apply each step's sources
+   in turn (renormalise normals once at the end, or after each step).
+   Per-vertex attributes (skin weights on a welded mesh): new vertex v
+   interpolates the vertices mesh->corner_vert[source] of any of its corners
+   (all of them give the same vertices and weights): old vertex v itself,
+   an edge point the edge's two ends, a face point the face's vertices.
+   Errors: NULL mesh or out, a bad allocator (TT_ERROR_INVALID_ARGUMENT);
+   TT_ERROR_TOO_LARGE when the quadrangulation itself would be (as
+   tt_mesh_quadrangulate) or the sources would pass INT_MAX / 2;
+   TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL and nothing stays
+   allocated. Memory: 8 bytes per source, 5 + |f| sources per input corner
+   of face f (a face point lists its face's corners in each of its quads,
+   so an n-gon costs n * n; 9 per corner of a triangle, 9 per quad corner),
+   plus 4 bytes per new corner. Free the result with
+   tt_corner_sources_free. Thread-safe. */
+TTDEF tt_result tt_mesh_quadrangulate_sources(const tt_mesh *mesh, const tt_allocator *allocator,
+                                              tt_corner_sources **out, tt_error *error);
+TTDEF void tt_corner_sources_free(tt_corner_sources *sources);
+
+/* Interpolate a per-corner attribute of `components` floats per corner:
+   input has components * sources->input_corners floats, output gets
+   components * sources->ncorners, output[c] = the weighted sum of its
+   sources' values (accumulated in double). Unit vectors come out shorter
+   where they differ (a face point of a curved face): renormalise them.
+   Errors: NULL arguments, components < 1, input and output overlapping
+   (TT_ERROR_INVALID_ARGUMENT); TT_ERROR_NON_FINITE for a result that is
+   not finite (error->corner: the new corner; a NaN or infinite input, or a
+   sum that overflows float). Allocates nothing; thread-safe. */
+TTDEF tt_result tt_corner_sources_apply(const tt_corner_sources *sources, int components, const float *input,
+                                        float *output, tt_error *error);
 
 /* Unit normal of face f by Newell's method (the normal of the best-fit plane,
    so non-planar polygons are fine), CCW seen from outside. A face of
@@ -2991,6 +3053,7 @@ TTDEF tt_result tt_polycube_mapping_uvs_upright(const tt_polycube *polycube, con
 #ifndef TILEDTEX_IMPLEMENTATION_INCLUDED
 #define TILEDTEX_IMPLEMENTATION_INCLUDED
 
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -4727,6 +4790,119 @@ done:
     tt__free(allocator, count);
     tt_mesh_free(quads);
     return result;
+}
+
+TTDEF void tt_corner_sources_free(tt_corner_sources *sources)
+{
+    tt_allocator allocator;
+    if (!sources) return;
+    allocator = sources->allocator;
+    tt__free(&allocator, sources->source_start);
+    tt__free(&allocator, sources->source);
+    tt__free(&allocator, sources->weights);
+    tt__free(&allocator, sources);
+}
+
+/* The layout of quad c is tt_mesh_quadrangulate's; see the declaration for
+   the rows. */
+TTDEF tt_result tt_mesh_quadrangulate_sources(const tt_mesh *mesh, const tt_allocator *allocator,
+                                              tt_corner_sources **out, tt_error *error)
+{
+    tt_corner_sources *s;
+    long long nsources = 0;
+    int f, c, k, at = 0;
+    tt__ok(error);
+    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
+    *out = NULL;
+    if (!mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "mesh is NULL");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    for (f = 0; f < mesh->nfaces; f++) {
+        long long n = mesh->face_start[f + 1] - mesh->face_start[f];
+        nsources += n * (5 + n);
+    }
+    if (4LL * mesh->ncorners > 0x3fffffff || nsources > 0x3fffffff)
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "the sources of quadrangulating %d corners would be %lld corners and %lld sources, more "
+                        "than %d", mesh->ncorners, 4LL * mesh->ncorners, nsources, 0x3fffffff);
+    s = TT__ALLOC(allocator, tt_corner_sources, 1);
+    if (!s) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    memset(s, 0, sizeof *s);
+    s->allocator = tt__allocator_copy(allocator);
+    s->ncorners = 4 * mesh->ncorners;
+    s->input_corners = mesh->ncorners;
+    s->nsources = (int)nsources;
+    s->source_start = TT__ALLOC(allocator, int, (size_t)s->ncorners + 1);
+    s->source = TT__ALLOC(allocator, int, s->nsources);
+    s->weights = TT__ALLOC(allocator, float, s->nsources);
+    if (!s->source_start || !s->source || !s->weights) {
+        tt_corner_sources_free(s);
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+        float share = 1.0f / (float)(end - first);
+        for (c = first; c < end; c++) {
+            int n = c + 1 < end ? c + 1 : first, p = c > first ? c - 1 : end - 1;
+            int *start = s->source_start + 4 * (size_t)c;
+            start[0] = at;
+            s->source[at] = c;
+            s->weights[at++] = 1.0f;
+            start[1] = at;
+            s->source[at] = c;
+            s->weights[at++] = 0.5f;
+            s->source[at] = n;
+            s->weights[at++] = 0.5f;
+            start[2] = at;
+            for (k = first; k < end; k++) {
+                s->source[at] = k;
+                s->weights[at++] = share;
+            }
+            start[3] = at;
+            s->source[at] = p;
+            s->weights[at++] = 0.5f;
+            s->source[at] = c;
+            s->weights[at++] = 0.5f;
+        }
+    }
+    s->source_start[s->ncorners] = at;
+    *out = s;
+    return TT_OK;
+}
+
+TTDEF tt_result tt_corner_sources_apply(const tt_corner_sources *sources, int components, const float *input,
+                                        float *output, tt_error *error)
+{
+    int c, k, j;
+    size_t input_size, output_size;
+    tt__ok(error);
+    if (!sources || !input || !output)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_corner_sources_apply needs sources, an input and an output (got NULL)");
+    if (components < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "an attribute needs at least 1 component per corner, got %d", components);
+    input_size = (size_t)sources->input_corners * (size_t)components;
+    output_size = (size_t)sources->ncorners * (size_t)components;
+    /* Compared as addresses: output is written while input is still read. */
+    if ((uintptr_t)output < (uintptr_t)(input + input_size) && (uintptr_t)input < (uintptr_t)(output + output_size))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the input and output of tt_corner_sources_apply overlap");
+    for (c = 0; c < sources->ncorners; c++) {
+        float *out = output + (size_t)c * (size_t)components;
+        for (k = 0; k < components; k++) {
+            double sum = 0.0;
+            for (j = sources->source_start[c]; j < sources->source_start[c + 1]; j++)
+                sum += (double)sources->weights[j] *
+                       input[(size_t)sources->source[j] * (size_t)components + (size_t)k];
+            /* (NaN fails both comparisons.) */
+            if (!(sum >= -FLT_MAX && sum <= FLT_MAX))
+                return tt__fail(error, TT_ERROR_NON_FINITE, -1, c, -1, -1,
+                                "corner %d's interpolated value (component %d) is not finite: a NaN or infinite "
+                                "input, or a sum beyond float", c, k);
+            out[k] = (float)sum;
+        }
+    }
+    return TT_OK;
 }
 
 /* ------------------------------------------------------------------------ */

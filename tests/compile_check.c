@@ -91,6 +91,15 @@ int main(void)
     EXPECT(tt_mesh_boundary_loops(mesh, loops, &nl, &err) == TT_OK && nl == 0);
     EXPECT(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &quads, &err) == TT_OK);
     if (!quads) return 1;
+    {
+        /* the cube's corners' x carried onto the quads' corners */
+        tt_corner_sources *sources = NULL;
+        float corner_x[24], quad_x[96] = {0};
+        for (i = 0; i < 24; i++) corner_x[i] = cube_pos[3 * cube_idx[i]];
+        EXPECT(tt_mesh_quadrangulate_sources(mesh, NULL, &sources, &err) == TT_OK && sources->ncorners == 96);
+        EXPECT(tt_corner_sources_apply(sources, 1, corner_x, quad_x, &err) == TT_OK && quad_x[2] == 0.5f);
+        tt_corner_sources_free(sources);
+    }
 
     for (i = 0; i < (int)sizeof bytes; i++) bytes[i] = (unsigned char)(i * 7);
     EXPECT(tt_image_from_bytes(bytes, 16, 32, 3, 0, TT_COLOR_SRGB, NULL, &image, &err) == TT_OK);

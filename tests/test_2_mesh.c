@@ -3,6 +3,7 @@
    (tests/test_common.c calls it). */
 #include "test_common.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1585,6 +1586,285 @@ done:
     tt_mesh_free(grid);
 }
 
+/* ------------------------------------------------------------------------ */
+/* 2d. Quadrangulation's sources: per-corner attributes carried through     */
+/* ------------------------------------------------------------------------ */
+
+/* The positions of mesh's corners (each its vertex's), 3 floats per corner. */
+static float *corner_positions(const tt_mesh *mesh)
+{
+    float *out = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->ncorners);
+    int c;
+    for (c = 0; c < mesh->ncorners && out; c++) memcpy(out + 3 * c, mesh->pos + 3 * mesh->corner_vert[c], 3 * sizeof(float));
+    return out;
+}
+
+/* Each corner's interpolated position (3 per corner) against the position
+   of its vertex in `quads`; returns how many differ by more than tol. */
+static int count_position_mismatches(const tt_mesh *quads, const float *interpolated, double tol)
+{
+    int c, k, bad = 0;
+    for (c = 0; c < quads->ncorners; c++) {
+        const float *p = quads->pos + 3 * quads->corner_vert[c];
+        int off = 0;
+        for (k = 0; k < 3; k++) off |= !near(interpolated[3 * c + k], p[k], tol);
+        if (off && bad++ == 0)
+            DETAIL("corner %d: interpolated (%g, %g, %g), its vertex %d is at (%g, %g, %g)", c, interpolated[3 * c],
+                   interpolated[3 * c + 1], interpolated[3 * c + 2], quads->corner_vert[c], p[0], p[1], p[2]);
+    }
+    return bad;
+}
+
+/* The structure of one step's sources, checked naively: the rows, the
+   weights, each new corner's sources within its own input face; then, by
+   applying them, the linear quadrangulation's positions, a per-face value
+   kept exactly (creases and seams stay), and random per-vertex values that
+   give every corner of a new vertex the same value (per-vertex attributes
+   follow too). Returns the sources (or NULL). */
+static tt_corner_sources *check_sources_step(const tt_mesh *mesh, const char *name)
+{
+    tt_corner_sources *s = NULL;
+    tt_mesh *linear = NULL, *smooth = NULL;
+    tt_error err;
+    float *in = NULL, *out = NULL, *vertex_value = NULL;
+    int c, j, bad_rows = 0, bad_weights = 0, bad_face = 0, bad_layout = 0, bad_vertex = 0, v, k;
+    CHECK(tt_mesh_quadrangulate_sources(mesh, NULL, &s, &err) == TT_OK && s, "%s: sources: %s", name, err.message);
+    CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &linear, &err) == TT_OK, "%s: linear: %s", name,
+          err.message);
+    CHECK(tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_CATMULL_CLARK, NULL, &smooth, &err) == TT_OK, "%s: CC: %s", name,
+          err.message);
+    if (!s || !linear || !smooth) goto done;
+    CHECK(s->ncorners == 4 * mesh->ncorners && s->input_corners == mesh->ncorners &&
+              s->ncorners == linear->ncorners,
+          "%s: %d new corners from %d (expected %d from %d)", name, s->ncorners, s->input_corners,
+          linear->ncorners, mesh->ncorners);
+    CHECK(s->source_start[0] == 0 && s->source_start[s->ncorners] == s->nsources, "%s: rows [%d, %d), %d sources",
+          name, s->source_start[0], s->source_start[s->ncorners], s->nsources);
+    for (c = 0; c < s->ncorners; c++) {
+        int input = c / 4, face = mesh->corner_face[input], size = mesh->face_start[face + 1] - mesh->face_start[face];
+        int expected = c % 4 == 0 ? 1 : c % 4 == 2 ? size : 2;
+        double sum = 0.0;
+        if (s->source_start[c + 1] - s->source_start[c] != expected) {
+            if (bad_rows++ == 0)
+                DETAIL("%s: corner %d has %d sources, expected %d", name, c, s->source_start[c + 1] - s->source_start[c],
+                       expected);
+            continue;
+        }
+        for (j = s->source_start[c]; j < s->source_start[c + 1]; j++) {
+            sum += s->weights[j];
+            bad_weights += !(s->weights[j] > 0.0f && s->weights[j] <= 1.0f);
+            bad_face += s->source[j] < 0 || s->source[j] >= mesh->ncorners || mesh->corner_face[s->source[j]] != face;
+        }
+        bad_weights += !near(sum, 1.0, 1e-6);
+        /* A single source of weight 1 is an old vertex: the same vertex in
+           either scheme's mesh. */
+        if (expected == 1)
+            bad_layout += s->source[s->source_start[c]] != input ||
+                          linear->corner_vert[c] != mesh->corner_vert[input] ||
+                          smooth->corner_vert[c] != mesh->corner_vert[input];
+        else
+            bad_layout += linear->corner_vert[c] != smooth->corner_vert[c];
+    }
+    CHECK(bad_rows == 0, "%s: %d corners with the wrong number of sources", name, bad_rows);
+    CHECK(bad_weights == 0, "%s: %d weights outside (0, 1] or rows not summing to 1", name, bad_weights);
+    CHECK(bad_face == 0, "%s: %d sources outside the new corner's own input face", name, bad_face);
+    CHECK(bad_layout == 0, "%s: %d corners disagree with tt_mesh_quadrangulate's layout", name, bad_layout);
+
+    in = corner_positions(mesh);
+    out = (float *)malloc(sizeof(float) * 4 * (size_t)s->ncorners);
+    if (!in || !out) goto done;
+    CHECK(tt_corner_sources_apply(s, 3, in, out, &err) == TT_OK, "%s: apply: %s", name, err.message);
+    CHECK(count_position_mismatches(linear, out, 1e-5) == 0, "%s: interpolated corner positions are not the linear "
+          "quadrangulation's", name);
+    /* a per-face value (a crease, a UV island): every new corner keeps its face's */
+    for (c = 0; c < mesh->ncorners; c++) in[c] = (float)(mesh->corner_face[c] * 3 + 1);
+    CHECK(tt_corner_sources_apply(s, 1, in, out, &err) == TT_OK, "%s: apply 1: %s", name, err.message);
+    for (bad_face = 0, c = 0; c < s->ncorners; c++) bad_face += !near(out[c], in[c / 4], 1e-5);
+    CHECK(bad_face == 0, "%s: %d new corners lost their face's value", name, bad_face);
+    /* random per-vertex values, 4 components: one value per new vertex */
+    free(in);
+    in = (float *)malloc(sizeof(float) * 4 * (size_t)mesh->ncorners);
+    vertex_value = (float *)malloc(sizeof(float) * 4 * (size_t)mesh->nverts);
+    if (!in || !vertex_value) goto done;
+    lcg_seed(17);
+    for (v = 0; v < 4 * mesh->nverts; v++) vertex_value[v] = (float)lcg_unit();
+    for (c = 0; c < mesh->ncorners; c++) memcpy(in + 4 * c, vertex_value + 4 * mesh->corner_vert[c], 4 * sizeof(float));
+    CHECK(tt_corner_sources_apply(s, 4, in, out, &err) == TT_OK, "%s: apply 4: %s", name, err.message);
+    for (c = 0; c < s->ncorners; c++) {
+        int first = linear->vert_corner[linear->corner_vert[c]];
+        for (k = 0; k < 4; k++) bad_vertex += !near(out[4 * c + k], out[4 * first + k], 1e-6);
+    }
+    CHECK(bad_vertex == 0, "%s: %d per-vertex values differ between the corners of one new vertex", name,
+          bad_vertex);
+    for (bad_vertex = 0, v = 0; v < linear->nverts; v++) bad_vertex += linear->vert_corner[v] < 0;
+    CHECK(bad_vertex == 0, "%s: %d new vertices without a corner", name, bad_vertex);
+done:
+    free(in);
+    free(out);
+    free(vertex_value);
+    tt_mesh_free(linear);
+    tt_mesh_free(smooth);
+    return s;
+}
+
+typedef struct sources_ctx {
+    const tt_mesh *mesh;
+} sources_ctx;
+
+static tt_result oom_sources(void *ctx, const tt_allocator *al)
+{
+    tt_corner_sources *out = (tt_corner_sources *)&out;
+    tt_result r = tt_mesh_quadrangulate_sources(((sources_ctx *)ctx)->mesh, al, &out, NULL);
+    if (r == TT_OK) tt_corner_sources_free(out);
+    else if (out != NULL) return TT_RESULT_MAX_ENUM;
+    return r;
+}
+
+/* Quadrangulation's sources on meshes of several face sizes (triangles,
+   quads, pentagons, open and closed), then twice in a row: each step's
+   sources applied in turn carry the corners' positions to the twice
+   linearly quadrangulated mesh. Errors, the allocator, and an
+   allocation-failure sweep. */
+static void test_quadrangulate_sources(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *q1 = NULL, *q2 = NULL;
+    tt_corner_sources *s1 = NULL, *s2 = NULL, *s = NULL;
+    tt_error err;
+    int which;
+    memset(&m, 0, sizeof m);
+    for (which = 0; which < 5; which++) {
+        const char *name = which == 0 ? "tetrahedron" : which == 1 ? "mixed" : which == 2 ? "open grid"
+                         : which == 3 ? "torus" : "hexagon fan";
+        if (which == 0) make_tetra(&m, 0);
+        if (which == 1) make_mixed(&m);
+        if (which == 2) { make_grid(&m, 3, 2); tm_tri(&m, 1, 0, tm_vert(&m, 0.5, -1, 0)); }
+        if (which == 3) make_torus(&m, 5, 4, 3.0, 1.0);
+        if (which == 4) {
+            /* a hexagon and a triangle on each of its sides */
+            int hex[6], i;
+            for (i = 0; i < 6; i++) hex[i] = tm_vert(&m, cos(i * 1.0471975511965976), sin(i * 1.0471975511965976), 0.1 * i);
+            tm_face(&m, 6, hex);
+            for (i = 0; i < 6; i++)
+                tm_tri(&m, hex[(i + 1) % 6], hex[i], tm_vert(&m, 2 * cos((i + 0.5) * 1.0471975511965976),
+                                                               2 * sin((i + 0.5) * 1.0471975511965976), 0));
+        }
+        CHECK(build(&m, 0, &mesh, &err) == TT_OK, "%s: build: %s", name, err.message);
+        tm_free(&m);
+        if (!mesh) continue;
+        s = check_sources_step(mesh, name);
+        tt_corner_sources_free(s);
+        tt_mesh_free(mesh);
+        mesh = NULL;
+    }
+
+    /* two steps compose: mixed -> q1 -> q2, positions carried by s1 then s2 */
+    make_mixed(&m);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "mixed: %s", err.message);
+    tm_free(&m);
+    if (mesh && tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &q1, &err) == TT_OK &&
+        tt_mesh_quadrangulate(q1, TT_SUBDIVIDE_LINEAR, NULL, &q2, &err) == TT_OK &&
+        tt_mesh_quadrangulate_sources(mesh, NULL, &s1, &err) == TT_OK &&
+        tt_mesh_quadrangulate_sources(q1, NULL, &s2, &err) == TT_OK) {
+        float *p0 = corner_positions(mesh);
+        float *p1 = (float *)malloc(sizeof(float) * 3 * (size_t)s1->ncorners);
+        float *p2 = (float *)malloc(sizeof(float) * 3 * (size_t)s2->ncorners);
+        CHECK(s2->input_corners == s1->ncorners, "the second step reads %d corners, the first made %d",
+              s2->input_corners, s1->ncorners);
+        if (p0 && p1 && p2) {
+            CHECK(tt_corner_sources_apply(s1, 3, p0, p1, &err) == TT_OK &&
+                      tt_corner_sources_apply(s2, 3, p1, p2, &err) == TT_OK, "apply twice: %s", err.message);
+            CHECK(count_position_mismatches(q2, p2, 1e-5) == 0, "two steps' sources do not carry positions to the "
+                  "twice quadrangulated mesh");
+        }
+        free(p0);
+        free(p1);
+        free(p2);
+    } else {
+        CHECK(0, "mixed twice: %s", err.message);
+    }
+    tt_corner_sources_free(s2);
+    s2 = NULL;
+
+    if (mesh && s1) {
+        float *in = corner_positions(mesh), *out = (float *)malloc(sizeof(float) * 3 * (size_t)s1->ncorners);
+        tt_allocator half;
+        counter used;
+        int c;
+        CHECK(in && out, "memory for the error cases");
+        /* errors */
+        s = (tt_corner_sources *)&s;
+        CHECK(tt_mesh_quadrangulate_sources(NULL, NULL, &s, &err) == TT_ERROR_INVALID_ARGUMENT && s == NULL,
+              "NULL mesh refused and *out cleared");
+        CHECK(tt_mesh_quadrangulate_sources(mesh, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL out refused");
+        half = make_allocator(&used, -1);
+        half.free = NULL;
+        s = (tt_corner_sources *)&s;
+        CHECK(tt_mesh_quadrangulate_sources(mesh, &half, &s, &err) == TT_ERROR_INVALID_ARGUMENT && s == NULL &&
+                  strstr(err.message, "allocator") != NULL, "an allocator without free refused: %s", err.message);
+        CHECK(tt_corner_sources_apply(NULL, 3, in, out, &err) == TT_ERROR_INVALID_ARGUMENT, "apply: NULL sources");
+        CHECK(tt_corner_sources_apply(s1, 3, NULL, out, &err) == TT_ERROR_INVALID_ARGUMENT, "apply: NULL input");
+        CHECK(tt_corner_sources_apply(s1, 3, in, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "apply: NULL output");
+        CHECK(tt_corner_sources_apply(s1, 0, in, out, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  msg_has_number(err.message, 0), "apply: 0 components refused: %s", err.message);
+        CHECK(tt_corner_sources_apply(s1, 1, out, out, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  strstr(err.message, "overlap") != NULL, "apply: input == output refused: %s", err.message);
+        CHECK(tt_corner_sources_apply(s1, 1, out + s1->ncorners - 1, out, &err) == TT_ERROR_INVALID_ARGUMENT,
+              "apply: the input inside the output refused");
+        CHECK(tt_corner_sources_apply(s1, 1, out + 4 * (size_t)s1->input_corners, out, &err) == TT_OK,
+              "apply: an input just past the output is fine: %s", err.message);
+        /* input corner 5 (the bottom pentagon's first) is first read by new corner 20 */
+        in[3 * 5 + 1] = (float)internal_not_a_number();
+        CHECK(tt_corner_sources_apply(s1, 3, in, out, &err) == TT_ERROR_NON_FINITE && err.corner == 20,
+              "apply: a NaN input is refused at the first corner it reaches (20, got %d): %s", err.corner,
+              err.message);
+        /* every value the largest float: the pentagon's weights, 1/5 rounded
+           up, sum past 1, so its face point (new corner 2) overflows */
+        for (c = 0; c < 3 * mesh->ncorners; c++) in[c] = FLT_MAX;
+        CHECK(tt_corner_sources_apply(s1, 3, in, out, &err) == TT_ERROR_NON_FINITE && err.corner == 2,
+              "apply at FLT_MAX: the face point overflows (corner 2, got %d): %s", err.corner, err.message);
+        /* the allocator: the sources live in it and go back to it */
+        {
+            tt_allocator al = make_allocator(&used, -1);
+            CHECK(tt_mesh_quadrangulate_sources(mesh, &al, &s, &err) == TT_OK && used.live == 4,
+                  "the sources should be 4 allocations of the allocator given (%ld live)", used.live);
+            tt_corner_sources_free(s);
+            CHECK(used.live == 0 && used.bad_frees == 0, "tt_corner_sources_free: %ld live, %ld bad frees",
+                  used.live, used.bad_frees);
+        }
+        tt_corner_sources_free(NULL);
+        {
+            sources_ctx ctx;
+            ctx.mesh = mesh;
+            oom_reset();
+            oom_sweep("tt_mesh_quadrangulate_sources", oom_sources, &ctx, TT_OK);
+        }
+        free(in);
+        free(out);
+    }
+    tt_corner_sources_free(s1);
+    tt_mesh_free(q1);
+    tt_mesh_free(q2);
+    tt_mesh_free(mesh);
+    mesh = NULL;
+
+    /* a 32768-gon: 32768 * (5 + 32768) sources would pass the limit */
+    {
+        int n = 32768, i, *ring = (int *)malloc(sizeof(int) * (size_t)n);
+        memset(&m, 0, sizeof m);
+        for (i = 0; i < n && ring; i++) ring[i] = tm_vert(&m, cos(i * 6.283185307179586 / n), sin(i * 6.283185307179586 / n), 0);
+        if (ring) tm_face(&m, n, ring);
+        free(ring);
+        CHECK(build(&m, 0, &mesh, &err) == TT_OK, "32768-gon: %s", err.message);
+        tm_free(&m);
+        s = (tt_corner_sources *)&s;
+        if (mesh)
+            CHECK(tt_mesh_quadrangulate_sources(mesh, NULL, &s, &err) == TT_ERROR_TOO_LARGE && s == NULL,
+                  "a 32768-gon's sources are too many: got %s", err.message);
+        tt_mesh_free(mesh);
+    }
+}
+
 void run_mesh_tests(void)
 {
     RUN(test_builder_valid);
@@ -1594,6 +1874,7 @@ void run_mesh_tests(void)
     RUN(test_queries_oom);
     RUN(test_quadrangulate);
     RUN(test_quadrangulate_direct);
+    RUN(test_quadrangulate_sources);
     RUN(test_corner_normals);
     RUN(test_mesh_null_errors);
     RUN(test_mesh_query_allocators);
