@@ -198,7 +198,7 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
 {
     char comment[512];
     obj_write_desc desc;
-    float *normals = tool_corner_normals(path, m->mesh);
+    float *normals = tool_corner_normals(path, m->mesh, m->corner_normal);
     int status;
     if (!normals) return TOOL_EXIT_FAILURE;
     snprintf(comment, sizeof comment,
@@ -223,7 +223,7 @@ static int add_glb(tool_output *output, const char *path, const hpm_command_opti
 {
     obj_write_desc desc;
     tool_material material;
-    float *normals = tool_corner_normals(path, m->mesh);
+    float *normals = tool_corner_normals(path, m->mesh, m->corner_normal);
     int status;
     if (!normals) return TOOL_EXIT_FAILURE;
     hpm_write_desc(m, corner_uv, normals, &desc);

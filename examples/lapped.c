@@ -756,7 +756,7 @@ static int add_pasting_obj(tool_output *output, const char *path, const char *mt
     int *corner_vert = (int *)malloc((size_t)lapped->nentries * 3 * sizeof(int));
     float *corner_uv = (float *)malloc((size_t)lapped->nentries * 6 * sizeof(float));
     float *corner_normal = (float *)malloc((size_t)lapped->nentries * 9 * sizeof(float));
-    float *mesh_normals = tool_corner_normals(path, m->mesh);
+    float *mesh_normals = tool_corner_normals(path, m->mesh, m->corner_normal);
     int *face_group = (int *)malloc((size_t)lapped->nentries * sizeof(int));
     char **names = (char **)calloc((size_t)lapped->npastes + 1, sizeof(char *));
     const char **materials = (const char **)calloc((size_t)lapped->npastes + 1, sizeof(char *));
@@ -1014,7 +1014,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
 
     snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
              tool_basename(png_path));
-    if (!(normals = tool_corner_normals(glb_path ? glb_path : obj_path, m->mesh))) {
+    if (!(normals = tool_corner_normals(glb_path ? glb_path : obj_path, m->mesh, m->corner_normal))) {
         status = TOOL_EXIT_FAILURE;
         goto done;
     }

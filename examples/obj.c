@@ -45,8 +45,8 @@ typedef struct obj_parser {
     char *err;
     size_t err_size;
     obj_mesh *mesh;
-    int pos_capacity, vert_line_capacity, uv_capacity, uv_w_capacity, face_capacity, corner_capacity;
-    int nnormals;
+    int pos_capacity, vert_line_capacity, uv_capacity, uv_w_capacity, normal_capacity, face_capacity,
+        corner_capacity;
     int current_group, current_material;
     name_index groups, materials;
 } obj_parser;
@@ -283,6 +283,39 @@ static int parse_texture_vertex(obj_parser *P)
     return 0;
 }
 
+static int parse_normal(obj_parser *P)
+{
+    obj_mesh *mesh = P->mesh;
+    float xyz[3];
+    int i;
+    for (i = 0; i < 3; i++) {
+        int got = read_number(P, &xyz[i]);
+        if (got <= 0) {
+            char quoted[80];
+            return obj_error(P, got < 0 ? "cannot read a number in '%s'" : "a normal needs 3 coordinates: '%s'",
+                             quote_statement(P, quoted, sizeof quoted));
+        }
+    }
+    if (mesh->nnormals >= OBJ_MAX_COUNT) return obj_error(P, "too many normals (at most %d)", OBJ_MAX_COUNT);
+    if (grow_array((void **)&mesh->normal, &P->normal_capacity, (mesh->nnormals + 1) * 3, sizeof(float)) != 0)
+        return out_of_memory(P);
+    memcpy(mesh->normal + 3 * (size_t)mesh->nnormals, xyz, sizeof xyz);
+    mesh->nnormals++;
+    return 0;
+}
+
+/* A per-corner index array (corner_uv, corner_normal) made when the first
+   corner with such an index comes: the corners before it had none (-1). It
+   shares corner_vert's capacity. */
+static int start_corner_indices(obj_parser *P, int **indices)
+{
+    int c;
+    *indices = (int *)malloc((size_t)P->corner_capacity * sizeof(int));
+    if (!*indices) return out_of_memory(P);
+    for (c = 0; c < P->mesh->ncorners; c++) (*indices)[c] = -1;
+    return 0;
+}
+
 /* One index field of a face corner ("12", "-3"). Returns the number of bytes
    read (0 if the field is empty). *value saturates at +-(INT_MAX + 1), which is
    out of range for every count, so overflow cannot slip through. */
@@ -324,9 +357,10 @@ static int parse_face(obj_parser *P)
     int corners = 0;
     for (;;) {
         const char *token, *p, *token_end;
-        long long v_index, vt_index = 0, vn_index;
-        size_t v_length;
-        int v_valid, vt_valid = 0, vn_valid, vertex, uv = -1;
+        long long v_index, vt_index = 0, vn_index = 0;
+        const char *vn_text = NULL;
+        size_t v_length, vn_length = 0;
+        int v_valid, vt_valid = 0, vn_valid = 0, vertex, uv = -1, normal = -1;
         size_t length = next_token(P, &token);
         char quoted[80];
         if (length == 0 || token[0] == '#') break;
@@ -339,11 +373,11 @@ static int parse_face(obj_parser *P)
             p++;
             p += read_index(p, token_end, &vt_index, &vt_valid);
             if (p < token_end && *p == '/') {
-                const char *normal = ++p;
-                p += read_index(p, token_end, &vn_index, &vn_valid);
-                if (p == normal) vn_valid = 1;   /* "v/vt/" : tolerated, as many readers do */
-                (void)vn_index;                  /* normals are recomputed, not read */
-                if (!vn_valid) p = token;        /* force the error below */
+                vn_text = ++p;
+                vn_length = read_index(p, token_end, &vn_index, &vn_valid);
+                p += vn_length;
+                /* "v/vt/" : no normal, tolerated as many readers do */
+                if (!vn_valid && vn_length > 0) p = token;   /* force the error below */
             }
         }
         if (!v_valid || p != token_end) {
@@ -361,27 +395,26 @@ static int parse_face(obj_parser *P)
             if (resolve_index(P, vt_index, mesh->nuvs, "texture vertex", vt_text, vt_length, &uv) != 0)
                 return -1;
         }
+        if (vn_valid && resolve_index(P, vn_index, mesh->nnormals, "normal", vn_text, vn_length, &normal) != 0)
+            return -1;
 
         if (mesh->ncorners >= OBJ_MAX_COUNT) return obj_error(P, "too many face corners (at most %d)", OBJ_MAX_COUNT);
         if (mesh->ncorners == P->corner_capacity) {
-            /* corner_vert and corner_uv (once it exists) share one capacity. */
+            /* corner_vert, corner_uv and corner_normal (once they exist)
+               share one capacity. */
             int capacity;
             if (grown_capacity(P->corner_capacity, mesh->ncorners + 1, sizeof(int), &capacity) != 0 ||
                 resize_array((void **)&mesh->corner_vert, capacity, sizeof(int)) != 0 ||
-                (mesh->corner_uv && resize_array((void **)&mesh->corner_uv, capacity, sizeof(int)) != 0))
+                (mesh->corner_uv && resize_array((void **)&mesh->corner_uv, capacity, sizeof(int)) != 0) ||
+                (mesh->corner_normal && resize_array((void **)&mesh->corner_normal, capacity, sizeof(int)) != 0))
                 return out_of_memory(P);
             P->corner_capacity = capacity;
         }
-        if (uv >= 0 && !mesh->corner_uv) {
-            /* The first corner with a texture vertex: from now on every corner
-               records one, and the earlier corners had none. */
-            int c;
-            mesh->corner_uv = (int *)malloc((size_t)P->corner_capacity * sizeof(int));
-            if (!mesh->corner_uv) return out_of_memory(P);
-            for (c = 0; c < mesh->ncorners; c++) mesh->corner_uv[c] = -1;
-        }
+        if (uv >= 0 && !mesh->corner_uv && start_corner_indices(P, &mesh->corner_uv) != 0) return -1;
+        if (normal >= 0 && !mesh->corner_normal && start_corner_indices(P, &mesh->corner_normal) != 0) return -1;
         mesh->corner_vert[mesh->ncorners] = vertex;
         if (mesh->corner_uv) mesh->corner_uv[mesh->ncorners] = uv;
+        if (mesh->corner_normal) mesh->corner_normal[mesh->ncorners] = normal;
         mesh->ncorners++;
         corners++;
     }
@@ -462,12 +495,12 @@ static int find_or_add_name(obj_parser *P, name_index *index, const char *name, 
     return (*index->count)++;
 }
 
-/* Statements that are valid OBJ but carry nothing this tool uses: normals
-   (recomputed when needed), smoothing groups, lines, points, parameter-space
-   vertices and display attributes. They are skipped without a word. */
+/* Statements that are valid OBJ but carry nothing this tool uses: smoothing
+   groups (the normals say it), lines, points, parameter-space vertices and
+   display attributes. They are skipped without a word. */
 static int is_ignored_keyword(const char *keyword, size_t length)
 {
-    static const char *const ignored[] = {"vn", "vp", "s", "l", "p", "lod", "bevel", "c_interp", "d_interp",
+    static const char *const ignored[] = {"vp", "s", "l", "p", "lod", "bevel", "c_interp", "d_interp",
                                           "maplib", "usemap", "shadow_obj", "trace_obj"};
     size_t i;
     for (i = 0; i < sizeof ignored / sizeof ignored[0]; i++)
@@ -483,10 +516,7 @@ static int parse_statement(obj_parser *P)
     if (token_is(keyword, length, "v")) return parse_vertex(P);
     if (token_is(keyword, length, "vt")) return parse_texture_vertex(P);
     if (token_is(keyword, length, "f")) return parse_face(P);
-    if (token_is(keyword, length, "vn")) {
-        P->nnormals++;      /* counted only; normals are recomputed by whoever needs them */
-        return 0;
-    }
+    if (token_is(keyword, length, "vn")) return parse_normal(P);
     if (token_is(keyword, length, "g") || token_is(keyword, length, "o") || token_is(keyword, length, "usemtl")) {
         size_t name_length = read_name(P, name, sizeof name);
         int group = find_or_add_name(P, &P->groups, name, name_length);
@@ -726,6 +756,34 @@ int obj_triangle_fans(const obj_mesh *mesh, int **corners, int **faces)
     return total;
 }
 
+int obj_corner_normals(const char *path, const obj_mesh *mesh, float **out)
+{
+    int c, k, unusable = 0;
+    *out = NULL;
+    if (!mesh->corner_normal) return 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int n = mesh->corner_normal[c];
+        const float *v = n >= 0 ? mesh->normal + 3 * (size_t)n : NULL;
+        double length = v ? sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]) : 0.0;
+        /* (NaN fails the comparison too) */
+        unusable += !(length > 0.0 && length < HUGE_VAL);
+    }
+    if (unusable > 0) {
+        tool_note("%s: %d of %d face corners have no usable normal (no vn, or a zero or non-finite one): every "
+                  "output gets computed normals instead of the file's",
+                  path, unusable, mesh->ncorners);
+        return 0;
+    }
+    *out = (float *)malloc((size_t)mesh->ncorners * 3 * sizeof(float));
+    if (!*out) return -1;
+    for (c = 0; c < mesh->ncorners; c++) {
+        const float *v = mesh->normal + 3 * (size_t)mesh->corner_normal[c];
+        double length = sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
+        for (k = 0; k < 3; k++) (*out)[3 * (size_t)c + k] = (float)(v[k] / length);
+    }
+    return 0;
+}
+
 /* The library counts faces and vertices from 0, as C arrays do; an OBJ file
    counts them from 1 and a user finds them by line. Say it the file's way,
    from the error's fields. */
@@ -774,6 +832,8 @@ void obj_free(obj_mesh *mesh)
     free(mesh->uv);
     free(mesh->uv_w);
     free(mesh->corner_uv);
+    free(mesh->normal);
+    free(mesh->corner_normal);
     free(mesh->face_group);
     free(mesh->face_material);
     free(mesh->face_line);

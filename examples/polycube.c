@@ -415,15 +415,16 @@ static void print_summary(const polycube_command_options *options, const polycub
 /* The files                                                                */
 /* ======================================================================== */
 
-/* The mapped triangles' corner normals: the input mesh's (tt_corner_normals,
-   so its creases stay), carried to each output vertex by the mapping's
-   source vertices and weights within the input face the triangle is part
-   of. NULL when out of memory (said). */
+/* The mapped triangles' corner normals: the input mesh's (the file's when
+   every corner has one, else tt_corner_normals, so its creases stay),
+   carried to each output vertex by the mapping's source vertices and
+   weights within the input face the triangle is part of, renormalised.
+   NULL when out of memory (said). */
 static float *mapped_corner_normals(const char *path, const polycube_job *job)
 {
     const tt_mesh *input = job->mesh.mesh;
     const tt_polycube_mapping *mapping = job->mapping;
-    float *from = tool_corner_normals(path, input);
+    float *from = tool_corner_normals(path, input, job->mesh.corner_normal);
     float *out = (float *)malloc(9 * (size_t)(mapping->ntriangles > 0 ? mapping->ntriangles : 1) * sizeof(float));
     int t, k, s, j;
     if (!from || !out) {

@@ -99,6 +99,7 @@ int tiled_parse_command_line(int argc, char **argv, unsigned accept, tiled_optio
 void tiled_mesh_free(tiled_mesh *mesh)
 {
     tt_mesh_free(mesh->mesh);
+    free(mesh->corner_normal);
     free(mesh->corner_type);
     free(mesh->corner_uv);
     memset(mesh, 0, sizeof *mesh);
@@ -124,19 +125,27 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         obj_free(&obj);
         return status;
     }
+    /* The mesh's corners are the OBJ's, in order. */
+    status = obj_corner_normals(obj_path, &obj, &out->corner_normal);
     obj_free(&obj);
+    if (status != 0) {
+        tiled_mesh_free(out);
+        return tool_fail("out of memory for the normals of %s", obj_path);
+    }
     out->repaired_edges = out->mesh->repaired_edges;
     out->input_min_face_size = out->mesh->min_face_size;
     out->input_max_face_size = out->mesh->max_face_size;
 
     /* Tiles are square: every face must be a quad. */
     if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
-        if ((status = tool_quadrangulate(obj_path, &out->mesh, 0)) != 0) goto fail;
+        if ((status = tool_quadrangulate(obj_path, &out->mesh, 0, NULL, &out->corner_normal)) != 0) goto fail;
         out->quadrangulated = out->mesh->nfaces;
     }
     if ((status = tool_check_subdivide(obj_path, out->mesh, options->mesh.subdivide)) != 0) goto fail;
     for (step = 0; step < options->mesh.subdivide; step++)
-        if ((status = tool_quadrangulate(obj_path, &out->mesh, options->mesh.smooth)) != 0) goto fail;
+        if ((status = tool_quadrangulate(obj_path, &out->mesh, options->mesh.smooth, NULL, &out->corner_normal)) !=
+            0)
+            goto fail;
 
     out->corner_type = (uint8_t *)malloc((size_t)out->mesh->ncorners);
     out->corner_uv = (float *)malloc((size_t)out->mesh->ncorners * 2 * sizeof(float));
@@ -178,7 +187,7 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
 {
     obj_write_desc desc;
     char comment[256];
-    float *normals = tool_corner_normals(obj_path, mesh->mesh);
+    float *normals = tool_corner_normals(obj_path, mesh->mesh, mesh->corner_normal);
     int status;
     if (!normals) return TOOL_EXIT_FAILURE;
     tiled_write_desc(mesh, normals, &desc);
@@ -198,7 +207,7 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
 int tiled_add_glb(tool_output *output, const char *glb_path, const tiled_mesh *mesh, const tool_material *material)
 {
     obj_write_desc desc;
-    float *normals = tool_corner_normals(glb_path, mesh->mesh);
+    float *normals = tool_corner_normals(glb_path, mesh->mesh, mesh->corner_normal);
     int status;
     if (!normals) return TOOL_EXIT_FAILURE;
     tiled_write_desc(mesh, normals, &desc);

@@ -64,6 +64,8 @@ typedef struct tiled_mesh {
     tt_mesh *mesh;
     uint8_t *corner_type;        /* ncorners boundary types */
     float *corner_uv;            /* 2 * ncorners */
+    float *corner_normal;        /* 3 * ncorners: the OBJ's normals carried through quadrangulation, or
+                                    NULL (obj_corner_normals): the OBJ gets computed ones */
     tt_tile_layout layout;       /* resolved */
     tt_mesh_stats stats;
     int input_faces;             /* faces in the OBJ */

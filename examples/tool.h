@@ -421,6 +421,8 @@ typedef struct obj_mesh {
     float *uv_w;                      /* nuvs: each vt's third number, 1 where a vt has none; NULL
                                          when none has one (the tool writes w as a paste's fade) */
     int *corner_uv;                   /* ncorners entries (0-based vt index) or NULL when no face has vt; -1 for a corner without one */
+    int nnormals; float *normal;      /* 3 * nnormals, from vn lines, as written (not normalised) */
+    int *corner_normal;               /* ncorners entries (0-based vn index) or NULL when no face has vn; -1 for a corner without one */
     int *face_group;                  /* nfaces: index into group_names of the `g`/`o`/`usemtl` group the face is in (0 = before any) */
     int ngroups; char **group_names;  /* group_names[0] = "" */
     int *face_material;               /* nfaces: index into material_names of the latest `usemtl` (0 = before any) */
@@ -434,17 +436,24 @@ typedef struct obj_mesh {
 } obj_mesh;
 
 /* Parse OBJ text (`length` bytes, need not end in NUL; any bytes are safe).
-   Reads v, vt, f (corners v, v/vt, v//vn, v/vt/vn; negative indices count
-   back from the latest vertex), g / o / usemtl (which group each face is in;
-   the latest of these statements names it), usemtl again on its own (each
-   face's material: the latest usemtl, whatever g / o came after it), and
-   the first mtllib. Everything
-   else (vn values, s, l, p, comments, unknown statements) is skipped; unknown
+   Reads v, vt, vn, f (corners v, v/vt, v//vn, v/vt/vn; negative indices count
+   back from the latest vertex, texture vertex or normal), g / o / usemtl
+   (which group each face is in; the latest of these statements names it),
+   usemtl again on its own (each face's material: the latest usemtl,
+   whatever g / o came after it), and the first mtllib. Everything
+   else (s, l, p, comments, unknown statements) is skipped; unknown
    statements are counted in unknown_statements. Lines end in LF, CRLF or a
    lone CR; a UTF-8 byte-order mark at the start is skipped. A line ending in
    '\' continues on the next. Returns 0, or -1 with a message naming the line
    in err ("line 12: face with fewer than 3 corners") and *out zeroed. */
 int obj_parse(const char *text, size_t length, obj_mesh *out, char *err, size_t err_size);
+/* The file's normals at the face corners (unit length, 3 floats per corner,
+   malloc'd) when every corner has a usable one: a vn that is neither zero
+   nor NaN nor infinite. Otherwise *out is NULL: silently when no corner
+   has a vn (STL, OFF, most scans), with a note naming `path` when only
+   some have one (the outputs then get computed normals). Returns 0, or -1
+   when out of memory. */
+int obj_corner_normals(const char *path, const obj_mesh *mesh, float **out);
 /* The description that hands an OBJ's arrays to tt_mesh_build as they are:
    corners are faces one after another, the library's index-buffer layout. */
 tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
@@ -475,8 +484,10 @@ void mesh_set_weld(int weld);
    COLLADA and 3DS files are refused with one line naming the format and a
    conversion command. Under --weld the mesh is welded (mesh_weld with
    TOOL_WELD_TOLERANCE); without it, a mesh whose every vertex is in one
-   corner while positions repeat gets a note suggesting --weld. STL and
-   OFF meshes have no texture coordinates, groups or materials; a binary
+   corner while positions repeat gets a note suggesting --weld (welding
+   leaves the corners as they are, with their normals). STL and OFF
+   meshes have no texture coordinates, normals (an STL's facet normals are
+   flat: they are skipped), groups or materials; a binary
    STL's faces have no line (face_line 0). Returns 0, or -1 with the
    message in err. */
 int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size);
@@ -562,10 +573,12 @@ int output_add_obj(tool_output *output, const char *path, const obj_write_desc *
    (a scan). */
 #define TOOL_CREASE_DEGREES 60.0f
 
-/* Shading normals for an output OBJ, 3 floats per corner of `mesh`
-   (tt_corner_normals at TOOL_CREASE_DEGREES), malloc'd; NULL when out of
-   memory, with the error printed naming `path`. */
-float *tool_corner_normals(const char *path, const tt_mesh *mesh);
+/* Shading normals for an output OBJ, 3 floats per corner of `mesh`,
+   malloc'd: `carried` renormalised (the input file's normals carried to
+   these corners, interpolated) when it is not NULL, else computed (tt_corner_normals at
+   TOOL_CREASE_DEGREES). NULL when out of memory, with the error printed
+   naming `path`. */
+float *tool_corner_normals(const char *path, const tt_mesh *mesh, const float *carried);
 
 /* Append one MTL material: "newmtl NAME", white diffuse colour, and
    "map_Kd TEXTURE" when texture is not NULL; with texture_alpha also
@@ -671,9 +684,14 @@ int parse_mesh_option(int argc, char **argv, int *index, tool_mesh_options *opti
 #define TOOL_MAX_QUADS (1 << 24)
 
 /* One quadrangulation step (tt_mesh_quadrangulate) replacing *mesh: linear,
-   which keeps the shape, or with smooth Catmull-Clark positions. Prints the
-   error and returns the exit status on failure. */
-int tool_quadrangulate(const char *obj_path, tt_mesh **mesh, int smooth);
+   which keeps the shape, or with smooth Catmull-Clark positions. Per-corner
+   values go along (tt_mesh_quadrangulate_sources, interpolated linearly
+   within each face): *corner_uv (2 floats per corner) and *corner_normal
+   (3; renormalised only when written, by tool_corner_normals, so several
+   steps interpolate as one) are replaced by the new corners' (malloc'd, the old ones freed), each when
+   neither the pointer nor the array it points to is NULL. Prints the error
+   and returns the exit status on failure, everything then unchanged. */
+int tool_quadrangulate(const char *obj_path, tt_mesh **mesh, int smooth, float **corner_uv, float **corner_normal);
 /* Before `steps` such steps of `mesh`: refuse (one line, the exit status)
    what would make more than TOOL_MAX_QUADS quads; 0 otherwise. */
 int tool_check_subdivide(const char *obj_path, const tt_mesh *mesh, int steps);
@@ -696,6 +714,10 @@ typedef struct triangle_mesh {
     float *corner_uv;       /* 6 per triangle: the OBJ's texture coordinates at its corners
                                (interpolated on subdivided triangles), or NULL when some
                                corner of the OBJ has none */
+    float *corner_normal;   /* 9 per triangle: the OBJ's normals at its corners, unit length
+                               (interpolated, not renormalised, on subdivided triangles), or
+                               NULL unless every corner of the OBJ has one (obj_corner_normals):
+                               pass it to tool_corner_normals */
     int *face;              /* per triangle: its OBJ face */
     int *first_triangle;    /* per OBJ face: the first of its triangles (they follow one another) */
     int subdivided;         /* --subdivide steps taken */
@@ -716,8 +738,9 @@ typedef struct triangle_mesh {
 int triangle_mesh_read(const char *path, const tool_mesh_options *options, triangle_mesh *m);
 void triangle_mesh_free(triangle_mesh *m);
 /* Reverse every triangle's corners (an inside-out mesh turned outward) and
-   build the mesh again. Returns 0, or the exit status after printing the
-   error. */
+   build the mesh again; the file's normals, if any, are turned round too
+   unless they already faced the new way. Returns 0, or the exit status
+   after printing the error. */
 int triangle_mesh_reverse(const char *path, triangle_mesh *m);
 
 /* A library error about the triangles said the OBJ's way: the library counts

@@ -8,6 +8,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -436,13 +437,24 @@ int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer
     return output_add(output, path, data, size);
 }
 
-float *tool_corner_normals(const char *path, const tt_mesh *mesh)
+float *tool_corner_normals(const char *path, const tt_mesh *mesh, const float *carried)
 {
     float *normals = (float *)malloc(3 * (size_t)(mesh->ncorners > 0 ? mesh->ncorners : 1) * sizeof(float));
     tt_error error;
     if (!normals) {
         tool_fail("out of memory for the normals of %s", path);
         return NULL;
+    }
+    if (carried) {
+        int c, k;
+        for (c = 0; c < mesh->ncorners; c++) {
+            const float *n = carried + 3 * (size_t)c;
+            double length = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+            /* Opposite normals averaged to nothing stay (0, 0, 0), as
+               tt_corner_normals leaves a corner with nothing to average. */
+            for (k = 0; k < 3; k++) normals[3 * (size_t)c + k] = length > 0.0 ? (float)(n[k] / length) : 0.0f;
+        }
+        return normals;
     }
     if (tt_corner_normals(mesh, TOOL_CREASE_DEGREES, NULL, normals, &error) != TT_OK) {
         tool_fail("%s: %s", path, error.message);

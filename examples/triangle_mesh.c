@@ -15,15 +15,58 @@
 /* The mesh options                                                         */
 /* ======================================================================== */
 
-int tool_quadrangulate(const char *obj_path, tt_mesh **mesh, int smooth)
+/* values (components floats per corner of the mesh `sources` reads) carried
+   to the new corners. NULL when out of memory or when a value is not finite
+   (said). */
+static float *carry_corner_values(const char *obj_path, const tt_corner_sources *sources, int components,
+                                  const float *values)
 {
-    tt_mesh *quads;
+    float *carried = (float *)malloc((size_t)sources->ncorners * (size_t)components * sizeof(float));
     tt_error error;
-    if (tt_mesh_quadrangulate(*mesh, smooth ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR, NULL, &quads,
-                              &error) != TT_OK)
+    if (!carried) {
+        tool_fail("out of memory quadrangulating %s", obj_path);
+        return NULL;
+    }
+    if (tt_corner_sources_apply(sources, components, values, carried, &error) != TT_OK) {
+        tool_fail("%s: cannot carry the corners' values through quadrangulation: %s", obj_path, error.message);
+        free(carried);
+        return NULL;
+    }
+    return carried;
+}
+
+int tool_quadrangulate(const char *obj_path, tt_mesh **mesh, int smooth, float **corner_uv, float **corner_normal)
+{
+    tt_mesh *quads = NULL;
+    tt_corner_sources *sources = NULL;
+    float *uv = NULL, *normal = NULL;
+    tt_error error;
+    int carry_uv = corner_uv && *corner_uv, carry_normal = corner_normal && *corner_normal;
+    if ((carry_uv || carry_normal) && tt_mesh_quadrangulate_sources(*mesh, NULL, &sources, &error) != TT_OK)
         return tool_fail("%s: cannot quadrangulate: %s", obj_path, error.message);
+    if (tt_mesh_quadrangulate(*mesh, smooth ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR, NULL, &quads,
+                              &error) != TT_OK) {
+        tt_corner_sources_free(sources);
+        return tool_fail("%s: cannot quadrangulate: %s", obj_path, error.message);
+    }
+    if ((carry_uv && !(uv = carry_corner_values(obj_path, sources, 2, *corner_uv))) ||
+        (carry_normal && !(normal = carry_corner_values(obj_path, sources, 3, *corner_normal)))) {
+        free(uv);
+        tt_corner_sources_free(sources);
+        tt_mesh_free(quads);
+        return TOOL_EXIT_FAILURE;
+    }
+    tt_corner_sources_free(sources);
     tt_mesh_free(*mesh);
     *mesh = quads;
+    if (carry_uv) {
+        free(*corner_uv);
+        *corner_uv = uv;
+    }
+    if (carry_normal) {
+        free(*corner_normal);
+        *corner_normal = normal;
+    }
     return 0;
 }
 
@@ -56,6 +99,7 @@ void triangle_mesh_free(triangle_mesh *m)
     free(m->subdivided_pos);
     free(m->vert);
     free(m->corner_uv);
+    free(m->corner_normal);
     free(m->face);
     free(m->first_triangle);
     tt_mesh_free(m->mesh);
@@ -100,6 +144,21 @@ static void find_first_triangles(triangle_mesh *m)
     for (t = m->ntriangles - 1; t >= 0; t--) m->first_triangle[m->face[t]] = t;
 }
 
+/* The file's normals at the corners of the triangles (obj_corner_normals),
+   when every corner has one (m->corner_normal stays NULL otherwise). */
+static int take_corner_normals(const char *path, triangle_mesh *m, const int *corner)
+{
+    float *normals;
+    size_t c, ncorners = 3 * (size_t)m->ntriangles;
+    if (obj_corner_normals(path, &m->obj, &normals) != 0) return -1;
+    if (!normals) return 0;
+    m->corner_normal = (float *)malloc(ncorners * 3 * sizeof(float));
+    for (c = 0; c < ncorners && m->corner_normal; c++)
+        memcpy(m->corner_normal + 3 * c, normals + 3 * (size_t)corner[c], 3 * sizeof(float));
+    free(normals);
+    return m->corner_normal ? 0 : -1;
+}
+
 /* The OBJ's texture coordinates at the corners of the triangles, when every
    one of those corners has one (m->corner_uv stays NULL otherwise). */
 static int take_corner_uvs(triangle_mesh *m, const int *corner)
@@ -117,95 +176,76 @@ static int take_corner_uvs(triangle_mesh *m, const int *corner)
 }
 
 /* One quadrangulation step's bookkeeping, before tool_quadrangulate makes
-   quad c of the next mesh from corner c of `mesh`: its corners are the
-   corner's vertex, the point of the edge after it, the face point and the
-   point of the edge before it (tt_mesh_quadrangulate's order). Each quad
-   gets its OBJ face, and texture coordinates where the linear step puts
-   those points: the corner's own, the edges' midpoints, the face's
-   average. */
-static int quad_sources(const tt_mesh *mesh, const int *face, const float *uv, int **quad_face, float **quad_uv)
+   quad c of the next mesh from corner c of `mesh`: each quad gets the OBJ
+   face of the triangle it grows in. NULL when out of memory. */
+static int *quad_faces(const tt_mesh *mesh, const int *face)
 {
-    int f;
-    *quad_face = (int *)malloc((size_t)mesh->ncorners * sizeof(int));
-    *quad_uv = uv ? (float *)malloc((size_t)mesh->ncorners * 8 * sizeof(float)) : NULL;
-    if (!*quad_face || (uv && !*quad_uv)) {
-        free(*quad_face);
-        free(*quad_uv);
-        *quad_face = NULL;
-        *quad_uv = NULL;
-        return -1;
-    }
-    for (f = 0; f < mesh->nfaces; f++) {
-        int first = mesh->face_start[f], end = mesh->face_start[f + 1], c, k;
-        double centre[2] = {0.0, 0.0};
-        for (c = first; c < end && uv; c++)
-            for (k = 0; k < 2; k++) centre[k] += uv[2 * c + k];
-        for (c = first; c < end; c++) {
-            int next = c + 1 < end ? c + 1 : first, previous = c > first ? c - 1 : end - 1;
-            float *q = uv ? *quad_uv + 8 * (size_t)c : NULL;
-            (*quad_face)[c] = face[f];
-            for (k = 0; k < 2 && q; k++) {
-                q[k] = uv[2 * c + k];
-                q[2 + k] = 0.5f * (uv[2 * c + k] + uv[2 * next + k]);
-                q[4 + k] = (float)(centre[k] / (end - first));
-                q[6 + k] = 0.5f * (uv[2 * previous + k] + uv[2 * c + k]);
-            }
-        }
-    }
-    return 0;
+    int *quad_face = (int *)malloc((size_t)mesh->ncorners * sizeof(int)), c;
+    for (c = 0; c < mesh->ncorners && quad_face; c++) quad_face[c] = face[mesh->corner_face[c]];
+    return quad_face;
+}
+
+/* --subdivide splits every quad into two triangles along the diagonal from
+   its first corner (the vertex it grew from) to its third (the face point),
+   which halves a square into two right triangles: corner k of the triangles
+   of quad q is corner split[k] of q. */
+static const int quad_split[6] = {0, 1, 2, 0, 2, 3};
+
+/* Per-corner values of the quads (components floats per corner) at the
+   corners of their triangles; malloc'd. */
+static float *split_corner_values(const tt_mesh *quads, const float *values, int components)
+{
+    float *split = (float *)malloc((size_t)quads->nfaces * 6 * (size_t)components * sizeof(float));
+    int q, k;
+    for (q = 0; q < quads->nfaces && split; q++)
+        for (k = 0; k < 6; k++)
+            memcpy(split + (6 * (size_t)q + (size_t)k) * (size_t)components,
+                   values + ((size_t)quads->face_start[q] + (size_t)quad_split[k]) * (size_t)components,
+                   (size_t)components * sizeof(float));
+    return split;
 }
 
 /* --subdivide L: the validated triangles quadrangulated L times, then every
-   quad split into two triangles along the diagonal from its first corner
-   (the vertex it grew from) to its third (the face point), which halves a
-   square into two right triangles. Every triangle keeps its OBJ face, and
-   the OBJ's texture coordinates are carried along. Replaces the triangles of
-   m and builds them again. */
+   quad split into two triangles (quad_split). Every triangle keeps its OBJ
+   face, and the OBJ's texture coordinates and normals are carried along.
+   Replaces the triangles of m and builds them again. */
 static int triangle_mesh_subdivide(const char *path, const tool_mesh_options *options, triangle_mesh *m)
 {
-    static const int split[6] = {0, 1, 2, 0, 2, 3};
     tt_mesh *mesh = m->mesh;
     int *face = m->face, *quad_face, *vert = NULL, step, q, k, status;
-    float *uv = m->corner_uv, *quad_uv, *pos = NULL;
-    /* This function owns mesh, face and uv from here on. */
+    float *uv = m->corner_uv, *normal = m->corner_normal, *split_uv = NULL, *split_normal = NULL, *pos = NULL;
+    /* This function owns mesh, face, uv and normal from here on. */
     m->mesh = NULL;
     m->face = NULL;
     m->corner_uv = NULL;
+    m->corner_normal = NULL;
     if ((status = tool_check_subdivide(path, mesh, options->subdivide)) != 0) goto done;
     for (step = 0; step < options->subdivide; step++) {
-        if (quad_sources(mesh, face, uv, &quad_face, &quad_uv) != 0) goto out_of_memory;
+        if (!(quad_face = quad_faces(mesh, face))) goto out_of_memory;
         free(face);
-        free(uv);
         face = quad_face;
-        uv = quad_uv;
-        if ((status = tool_quadrangulate(path, &mesh, options->smooth)) != 0) goto done;
+        if ((status = tool_quadrangulate(path, &mesh, options->smooth, &uv, &normal)) != 0) goto done;
     }
 
     quad_face = (int *)malloc((size_t)mesh->nfaces * 2 * sizeof(int));
-    quad_uv = uv ? (float *)malloc((size_t)mesh->nfaces * 12 * sizeof(float)) : NULL;
     vert = (int *)malloc((size_t)mesh->nfaces * 6 * sizeof(int));
     pos = (float *)malloc((size_t)mesh->nverts * 3 * sizeof(float));
-    if (!quad_face || (uv && !quad_uv) || !vert || !pos) {
+    if (uv) split_uv = split_corner_values(mesh, uv, 2);
+    if (normal) split_normal = split_corner_values(mesh, normal, 3);
+    if (!quad_face || !vert || !pos || (uv && !split_uv) || (normal && !split_normal)) {
         free(quad_face);
-        free(quad_uv);
         goto out_of_memory;
     }
     for (q = 0; q < mesh->nfaces; q++) {
-        const int *corner = mesh->corner_vert + mesh->face_start[q];
-        const float *corner_uv = uv ? uv + 2 * (size_t)mesh->face_start[q] : NULL;
-        int *triangles = vert + 6 * (size_t)q;
-        float *triangles_uv = uv ? quad_uv + 12 * (size_t)q : NULL;
-        for (k = 0; k < 6; k++) {
-            triangles[k] = corner[split[k]];
-            if (uv) memcpy(triangles_uv + 2 * k, corner_uv + 2 * split[k], 2 * sizeof(float));
-        }
+        for (k = 0; k < 6; k++) vert[6 * (size_t)q + k] = mesh->corner_vert[mesh->face_start[q] + quad_split[k]];
         quad_face[2 * q] = quad_face[2 * q + 1] = face[q];
     }
     memcpy(pos, mesh->pos, (size_t)mesh->nverts * 3 * sizeof(float));
     free(m->vert);
     m->vert = vert;
     m->face = quad_face;
-    m->corner_uv = quad_uv;
+    m->corner_uv = split_uv;
+    m->corner_normal = split_normal;
     m->subdivided_pos = pos;
     m->pos = pos;
     m->nverts = mesh->nverts;
@@ -213,6 +253,7 @@ static int triangle_mesh_subdivide(const char *path, const tool_mesh_options *op
     m->subdivided = options->subdivide;
     vert = NULL;
     pos = NULL;
+    split_uv = split_normal = NULL;
     find_first_triangles(m);
     status = triangle_mesh_build(path, m, 1);
     goto done;
@@ -223,6 +264,9 @@ done:
     free(pos);
     free(face);
     free(uv);
+    free(normal);
+    free(split_uv);
+    free(split_normal);
     tt_mesh_free(mesh);
     return status;
 }
@@ -243,7 +287,8 @@ int triangle_mesh_read(const char *path, const tool_mesh_options *options, trian
         m->vert = (int *)malloc((size_t)total * 3 * sizeof(int));
         m->first_triangle = (int *)malloc((size_t)m->obj.nfaces * sizeof(int));
     }
-    if (!m->vert || !m->first_triangle || take_corner_uvs(m, corner) != 0) {
+    if (!m->vert || !m->first_triangle || take_corner_uvs(m, corner) != 0 ||
+        take_corner_normals(path, m, corner) != 0) {
         free(corner);
         triangle_mesh_free(m);
         return tool_fail("out of memory for the triangles of %s", path);
@@ -259,9 +304,29 @@ int triangle_mesh_read(const char *path, const tool_mesh_options *options, trian
     return status;
 }
 
+/* The file's normals after its faces were reversed: a file whose normals
+   follow its (inward) winding gets them turned round with the faces, one
+   whose normals already faced out despite the winding keeps them. Which,
+   by the faces' normals against the file's over the whole mesh. */
+static void orient_carried_normals(triangle_mesh *m)
+{
+    double agreement = 0.0;
+    int t, k;
+    float face[3];
+    for (t = 0; t < m->ntriangles; t++) {
+        tt_face_normal(m->mesh, t, face);
+        for (k = 0; k < 3; k++) {
+            const float *n = m->corner_normal + 9 * (size_t)t + 3 * k;
+            agreement += (double)n[0] * face[0] + (double)n[1] * face[1] + (double)n[2] * face[2];
+        }
+    }
+    if (agreement < 0.0)
+        for (k = 0; k < 9 * m->ntriangles; k++) m->corner_normal[k] = -m->corner_normal[k];
+}
+
 int triangle_mesh_reverse(const char *path, triangle_mesh *m)
 {
-    int t, k;
+    int t, k, status;
     for (t = 0; t < m->ntriangles; t++) {
         int swap = m->vert[3 * t + 1];
         m->vert[3 * t + 1] = m->vert[3 * t + 2];
@@ -271,8 +336,15 @@ int triangle_mesh_reverse(const char *path, triangle_mesh *m)
             uv[2 + k] = uv[4 + k];
             uv[4 + k] = swap_uv;
         }
+        for (k = 0; k < 3 && m->corner_normal; k++) {
+            float *normal = m->corner_normal + 9 * (size_t)t, swap_normal = normal[3 + k];
+            normal[3 + k] = normal[6 + k];
+            normal[6 + k] = swap_normal;
+        }
     }
-    return triangle_mesh_build(path, m, 0);
+    status = triangle_mesh_build(path, m, 0);
+    if (status == 0 && m->corner_normal) orient_carried_normals(m);
+    return status;
 }
 
 /* The library's "face N" is the Nth triangle counted from 0: replace the

@@ -17,10 +17,12 @@
         counting allocator of fuzz_common.h; when it builds: stats, boundary
         types, and UVs for quad meshes. Failures are checked by fz_check_error
         and fz_check_null; every allocation must be given back.
-     3. obj_write the parsed mesh (with per-corner UVs when every corner has
-        one, and its groups and mtllib when their names are plain) and parse
-        that text again: the same vertices (bit for bit, NaN for NaN), faces,
-        UVs, group names per face and mtllib must come back. */
+     3. obj_write the parsed mesh (with per-corner UVs and normals when every
+        corner has one, and its groups and mtllib when their names are plain)
+        and parse that text again: the same vertices (bit for bit, NaN for
+        NaN), faces, UVs, normals, group names per face and mtllib must come
+        back; obj_corner_normals gives unit normals exactly when every corner
+        has a finite non-zero one. */
 #define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #include "tool.h"
@@ -65,10 +67,11 @@ static void check_parsed(const obj_mesh *m)
 {
     volatile float sink = 0.0f;
     int i, c = 0;
-    CHECK(m->nverts >= 0 && m->nfaces >= 0 && m->ncorners >= 0 && m->nuvs >= 0, "counts %d %d %d %d", m->nverts,
-          m->nfaces, m->ncorners, m->nuvs);
+    CHECK(m->nverts >= 0 && m->nfaces >= 0 && m->ncorners >= 0 && m->nuvs >= 0 && m->nnormals >= 0,
+          "counts %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->nnormals);
     for (i = 0; i < 3 * m->nverts; ++i) sink += m->pos[i];
     for (i = 0; i < 2 * m->nuvs; ++i) sink += m->uv[i];
+    for (i = 0; i < 3 * m->nnormals; ++i) sink += m->normal[i];
     (void)sink;
     for (i = 0; i < m->nfaces; ++i) {
         CHECK(m->face_size[i] >= 3, "face %d has %d corners", i, m->face_size[i]);
@@ -86,6 +89,9 @@ static void check_parsed(const obj_mesh *m)
         if (m->corner_uv)
             CHECK(m->corner_uv[i] >= -1 && m->corner_uv[i] < m->nuvs, "corner %d vt %d of %d", i, m->corner_uv[i],
                   m->nuvs);
+        if (m->corner_normal)
+            CHECK(m->corner_normal[i] >= -1 && m->corner_normal[i] < m->nnormals, "corner %d vn %d of %d", i,
+                  m->corner_normal[i], m->nnormals);
     }
     CHECK(m->ngroups >= 1 || m->nfaces == 0, "%d groups for %d faces", m->ngroups, m->nfaces);
     if (m->ngroups >= 1) CHECK(m->group_names[0] && m->group_names[0][0] == '\0', "group_names[0] is not \"\"");
@@ -104,11 +110,12 @@ static void check_parsed(const obj_mesh *m)
 
 static void check_zeroed(const obj_mesh *m)
 {
-    CHECK(m->nverts == 0 && m->nfaces == 0 && m->ncorners == 0 && m->nuvs == 0 && m->ngroups == 0 &&
-              m->nmaterials == 0,
-          "failed parse left counts %d %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->ngroups,
-          m->nmaterials);
-    CHECK(!m->pos && !m->face_size && !m->corner_vert && !m->uv && !m->corner_uv && !m->face_group &&
+    CHECK(m->nverts == 0 && m->nfaces == 0 && m->ncorners == 0 && m->nuvs == 0 && m->nnormals == 0 &&
+              m->ngroups == 0 && m->nmaterials == 0,
+          "failed parse left counts %d %d %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->nnormals,
+          m->ngroups, m->nmaterials);
+    CHECK(!m->pos && !m->face_size && !m->corner_vert && !m->uv && !m->corner_uv && !m->normal &&
+              !m->corner_normal && !m->face_group &&
               !m->group_names && !m->face_material && !m->material_names && !m->mtllib,
           "failed parse left pointers behind");
 }
@@ -159,15 +166,47 @@ static void feed_library(const obj_mesh *m)
     }
 }
 
+/* obj_corner_normals: unit normals exactly when every corner names a vn of
+   finite, non-zero length. */
+static void check_corner_normals(const obj_mesh *m)
+{
+    float *normals = (float *)&normals;
+    int c, usable = m->corner_normal != NULL;
+    CHECK(obj_corner_normals("fuzz.obj", m, &normals) == 0, "obj_corner_normals failed (out of memory?)");
+    for (c = 0; c < m->ncorners && usable; ++c) {
+        const float *v = m->corner_normal[c] >= 0 ? m->normal + 3 * m->corner_normal[c] : NULL;
+        double length = v ? sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]) : 0.0;
+        usable = length > 0.0 && length < HUGE_VAL;
+    }
+    CHECK(!normals == !usable, "obj_corner_normals %s normals, every corner %s a usable one", normals ? "gave" : "gave no",
+          usable ? "has" : "does not have");
+    for (c = 0; c < m->ncorners && normals; ++c) {
+        const float *n = normals + 3 * c;
+        double length = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        CHECK(fabs(length - 1.0) < 1e-5, "corner %d's normal has length %.9g", c, length);
+    }
+    free(normals);
+}
+
 static void round_trip(const obj_mesh *m)
 {
     tool_buffer buf;
     obj_write_desc d;
     obj_mesh back;
     char err[TOOL_ERROR_SIZE];
-    float *corner_uv = NULL;
+    float *corner_uv = NULL, *corner_normal = NULL;
     int i, rc, names_plain;
     if (m->nfaces == 0) return;
+    if (m->corner_normal) {
+        corner_normal = (float *)malloc(sizeof(float) * 3 * (size_t)m->ncorners);
+        if (!corner_normal) abort();
+        for (i = 0; i < m->ncorners && m->corner_normal[i] >= 0; ++i)
+            memcpy(corner_normal + 3 * i, m->normal + 3 * m->corner_normal[i], 3 * sizeof(float));
+        if (i < m->ncorners) {
+            free(corner_normal);
+            corner_normal = NULL;
+        }
+    }
     memset(&buf, 0, sizeof buf);
     memset(&d, 0, sizeof d);
     if (m->corner_uv) {
@@ -189,6 +228,7 @@ static void round_trip(const obj_mesh *m)
     d.face_size = m->face_size;
     d.corner_vert = m->corner_vert;
     d.corner_uv = corner_uv;
+    d.corner_normal = corner_normal;
     names_plain = plain_name(m->mtllib) && !(m->mtllib && !m->mtllib[0]);
     for (i = 0; i < m->ngroups; ++i) names_plain &= plain_name(m->group_names[i]);
     if (names_plain) {
@@ -233,10 +273,21 @@ static void round_trip(const obj_mesh *m)
                       "corner %d uv (%.9g, %.9g) read back as (%.9g, %.9g)", i, (double)corner_uv[2 * i],
                       (double)corner_uv[2 * i + 1], (double)back.uv[2 * t], (double)back.uv[2 * t + 1]);
             }
+        CHECK(!corner_normal == !back.corner_normal, "normals %s on the way", corner_normal ? "lost" : "appeared");
+        if (corner_normal)
+            for (i = 0; i < m->ncorners; ++i) {
+                int n = back.corner_normal[i], k;
+                CHECK(n >= 0, "corner %d lost its vn", i);
+                for (k = 0; k < 3; ++k)
+                    CHECK(same_float(back.normal[3 * n + k], corner_normal[3 * i + k]),
+                          "corner %d normal component %d: wrote %.9g, read %.9g", i, k,
+                          (double)corner_normal[3 * i + k], (double)back.normal[3 * n + k]);
+            }
         obj_free(&back);
     }
     buffer_free(&buf);
     free(corner_uv);
+    free(corner_normal);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -259,6 +310,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     check_parsed(&m);
     feed_library(&m);
+    check_corner_normals(&m);
     round_trip(&m);
     obj_free(&m);
     return 0;
