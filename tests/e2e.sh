@@ -2134,6 +2134,124 @@ for flag in -V --version; do
 done
 
 # ======================================================================
+# The input's normals (vn) carried into every OBJ output
+# ======================================================================
+# The unit sphere of triangles with deliberately turned normals: at vertex
+# p the file says R p, p turned 90 degrees about z, (-y, x, z), which the
+# tool would never compute. Carried linearly (within each face) to a new
+# point sum w_i p_i and renormalised, they stay R p / |p| there exactly,
+# for any number of steps: so every output corner's vn must be R of its
+# vertex, normalised. TURN is the sign: -1 writes -R p (facing inward).
+# tilted_obj SOURCE TURN > FILE
+tilted_obj() {
+    awk -v turn="$2" '
+        $1 == "v" { print; n++; x[n] = $2; y[n] = $3; z[n] = $4; next }
+        $1 == "f" { if (!normals) { for (i = 1; i <= n; i++) printf "vn %.9g %.9g %.9g\n", -turn * y[i], turn * x[i], turn * z[i]; normals = 1 }
+                    printf "f"; for (i = 2; i <= NF; i++) printf " %s//%s", $i, $i; print ""; next }
+        { print }' "$1"
+}
+# normals_against FILE MODE: "corners worst": face corners with a vn, and the
+# worst angle in degrees between a corner's vn and its vertex's expected
+# normal: MODE turned = R p, radial = p; a corner without a vn counts 180.
+normals_against() {
+    awk -v mode="$2" '
+        $1 == "v"  { nv++; x[nv] = $2; y[nv] = $3; z[nv] = $4 }
+        $1 == "vn" { nn++; a[nn] = $2; b[nn] = $3; c[nn] = $4 }
+        $1 == "f"  { for (i = 2; i <= NF; i++) {
+                         corners++; split($i, p, "/"); v = p[1]; q = p[3]
+                         if (q == "" || q < 1 || q > nn) { worst = 180; continue }
+                         ex = mode == "turned" ? -y[v] : x[v]; ey = mode == "turned" ? x[v] : y[v]; ez = z[v]
+                         d = ex * a[q] + ey * b[q] + ez * c[q]
+                         d = d / sqrt((ex * ex + ey * ey + ez * ez) * (a[q] * a[q] + b[q] * b[q] + c[q] * c[q]))
+                         if (d > 1) d = 1
+                         angle = atan2(sqrt(1 - d * d), d) * 57.2957795
+                         if (angle > worst) worst = angle } }
+        END { printf "%d %.6f\n", corners, worst }' "$1" 2>/dev/null
+}
+# check_turned WHAT FILE: every corner of FILE has the file's turned normal
+# (within 0.01 degrees: 9 digits written, float arithmetic)
+check_turned() {
+    local corners worst
+    read -r corners worst <<<"$(normals_against "$2" turned)"
+    check "$1: the input's (turned) normals at every corner, interpolated where new vertices are" \
+        "worst angle to R p under 0.01 degrees" "$worst degrees over $corners corners" \
+        "$(awk -v c="${corners:-0}" -v w="${worst:-x}" 'BEGIN { exit !(c > 0 && w ~ /^[0-9.]+$/ && w + 0 < 0.01) }'; echo $?)"
+}
+tilted_obj "$W/in/spheretri.obj" 1 >"$W/in/sphere_turned.obj"
+newdir
+expect_ok "tile, normals from the file" tile ../in/sphere_turned.obj ../in/tex.png t --tile 16 --subdivide 1
+check_turned "tile (quadrangulated, --subdivide 1)" t.obj
+expect_ok "map --subdivide 2, normals from the file" map ../in/sphere_turned.obj m.obj --subdivide 2
+check_turned "map --subdivide 2" m.obj
+expect_ok "lapped --subdivide 1 --bake, normals from the file" lapped ../in/sphere_turned.obj ../in/lap.png l \
+    --subdivide 1 --bake 128 --patches 1
+check_turned "lapped --subdivide 1: the pasting OBJ" l.obj
+check_turned "lapped --subdivide 1: the baked OBJ" l_baked.obj
+expect_ok "hpm, normals from the file" hpm ../in/sphere_turned.obj ../in/lap.png h
+check_turned "hpm" h.obj
+expect_ok "polycube, normals from the file" polycube ../in/sphere_turned.obj ../in/tex.png p --tile 16 --resolution 6
+check_turned "polycube (split triangles)" p.obj
+# the same sphere without vn: the same files but for the normals (computed)
+expect_ok "tile, the same sphere without normals" tile ../in/spheretri.obj ../in/tex.png plain --tile 16 --subdivide 1
+CMD="diff t.obj plain.obj"
+check "tile: the file's normals change the vn lines and nothing else" "same v/vt/f lines, different vn lines" \
+    "$(diff <(grep -v '^#' t.obj) <(grep -v '^#' plain.obj) 2>&1 | grep -c '^[<>] vn') vn lines differ" \
+    "$(diff -q <(grep -E '^(v|vt|f) ' t.obj) <(grep -E '^(v|vt|f) ' plain.obj) >/dev/null &&
+        ! diff -q <(grep '^vn ' t.obj) <(grep '^vn ' plain.obj) >/dev/null; echo $?)"
+cd "$W" || exit 1
+
+# a vn on some corners only: computed normals, and a note
+tilted_obj "$W/in/spheretri.obj" 1 | awk '$1 == "f" && ++k % 2 == 0 { gsub(/\/\/[0-9]+/, ""); } { print }' \
+    >"$W/in/sphere_some_normals.obj"
+newdir
+expect_ok "map, a vn on some corners only" map ../in/sphere_some_normals.obj m.obj
+read -r corners worst <<<"$(normals_against m.obj radial)"
+check "map, a vn on some corners only: a note, and computed (radial, not turned) normals" \
+    "one note '1920 of 3840 face corners have no usable normal', worst angle to p under 10 degrees" \
+    "stderr: $ERR; worst $worst degrees" \
+    "$(printf '%s' "$ERR" | grep -c '1920 of 3840 face corners have no usable normal' | grep -qx 1 &&
+        awk -v w="${worst:-x}" 'BEGIN { exit !(w ~ /^[0-9.]+$/ && w + 0 < 10) }'; echo $?)"
+cd "$W" || exit 1
+
+# --weld: a sphere with every triangle's own three vertices (and normals),
+# welded; the corners keep their normals
+awk '$1 == "v" { n++; p[n] = $2 " " $3 " " $4 }
+     $1 == "vn" { m++; q[m] = $2 " " $3 " " $4 }
+     $1 == "f" { f = f "f"; for (i = 2; i <= NF; i++) { split($i, c, "/"); k++; vp[k] = p[c[1]]; vq[k] = q[c[3]]
+                 f = f " " k "//" k } f = f "\n" }
+     END { for (i = 1; i <= k; i++) print "v " vp[i]; for (i = 1; i <= k; i++) print "vn " vq[i]; printf "%s", f }' \
+    "$W/in/sphere_turned.obj" >"$W/in/sphere_turned_unwelded.obj"
+newdir
+expect_ok "--weld lapped, normals from the file" --weld lapped ../in/sphere_turned_unwelded.obj ../in/lap.png l \
+    --patches 1
+read -r corners worst <<<"$(normals_against l.obj turned)"
+check "--weld lapped: the sphere welded (1280 triangles, no --weld note), each corner with its own turned normal" \
+    "'1280 triangles', worst angle to R p under 0.01 degrees" "$OUT $ERR; worst $worst degrees" \
+    "$(printf '%s' "$OUT" | grep -q '1280 triangles' && ! printf '%s' "$ERR" | grep -q -- '--weld' &&
+        awk -v w="${worst:-x}" 'BEGIN { exit !(w ~ /^[0-9.]+$/ && w + 0 < 0.01) }'; echo $?)"
+cd "$W" || exit 1
+
+# an inside-out sphere: its normals turn round with its faces when they
+# followed the inward winding (-R p), and stay when they faced out (R p)
+for turn in -1 1; do
+    tilted_obj "$W/in/spheretri.obj" "$turn" | awk '$1 == "f" { print "f", $2, $4, $3; next } { print }' \
+        >"$W/in/sphere_inward_$turn.obj"
+    newdir
+    expect_ok "polycube inside-out, file normals ${turn/1/R} p" polycube ../in/sphere_inward_$turn.obj ../in/tex.png p \
+        --tile 16 --resolution 6
+    check_turned "polycube inside-out sphere whose normals were ${turn/1/R} p" p.obj
+    cd "$W" || exit 1
+done
+
+# a face naming a normal that does not exist is an error at its line
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n' >"$W/in/bad_vn.obj"
+expect_error "map, a vn index out of range" map ../in/bad_vn.obj m.obj
+err_mentions "a vn index out of range: the line and the normal named" 'bad_vn\.obj:5: face refers to normal 2 but only 1 is defined'
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//-2\n' >"$W/in/bad_vn_relative.obj"
+expect_error "hpm, a relative vn index out of range" hpm ../in/bad_vn_relative.obj ../in/lap.png h
+err_mentions "a relative vn index out of range: named" 'normal -2'
+
+# ======================================================================
 # glTF output (.glb): tile, lapped, hpm, polycube; --triangles
 # ======================================================================
 # glb_probe: a test helper built from the tool's own gltf.c. It reads the
