@@ -21,6 +21,16 @@ int tool_is_help(const char *arg)
     return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
 }
 
+void tool_print_mesh_help(int writes_obj)
+{
+    printf("MESH is a Wavefront OBJ, an STL (ASCII or binary) or an OFF file (see 'tiledtex --help').\n");
+    if (writes_obj)
+        printf("The OBJs written keep MESH's own normals (an OBJ's vn) when every face corner has one,\n"
+               "interpolated where new vertices appear; otherwise they get smooth normals, with a\n"
+               "crease where faces meet at more than %g degrees.\n",
+               (double)TOOL_CREASE_DEGREES);
+}
+
 int tool_is_option(const char *arg)
 {
     /* "-" alone often means standard input, and "-3" is a number. */
@@ -121,7 +131,7 @@ int tool_mesh_image_prefix(const char *const *positional, int npositional, const
     const char *command = tool_command() ? tool_command() : "CMD";
     if (npositional > 3) return tool_usage("too many arguments (see '%s %s --help')", TOOL_NAME, command);
     if (npositional < 3)
-        return tool_usage("needs MESH.obj, IMAGE and OUT_PREFIX (see '%s %s --help')", TOOL_NAME, command);
+        return tool_usage("needs MESH, IMAGE and OUT_PREFIX (see '%s %s --help')", TOOL_NAME, command);
     if (tool_output_prefix(positional[2], output, prefix) != 0) return TOOL_EXIT_USAGE;
     *mesh = positional[0];
     *image = positional[1];

@@ -26,9 +26,9 @@
 
 static void print_help(void)
 {
-    printf("usage: tiledtex hpm MESH.obj IMAGE OUT_PREFIX [options]\n"
+    printf("usage: tiledtex hpm MESH IMAGE OUT_PREFIX [options]\n"
            "\n"
-           "Texture MESH.obj with coordinates into IMAGE itself (Soler et al., Hierarchical Pattern\n"
+           "Texture MESH with coordinates into IMAGE itself (Soler et al., Hierarchical Pattern\n"
            "Mapping): no new texture is made. The surface is cut into clusters, coarse to fine;\n"
            "each is flattened and placed on the image where its content best continues the\n"
            "clusters already textured around it, and split into smaller ones when no place fits\n"
@@ -36,8 +36,9 @@ static void print_help(void)
            "face corner) and OUT_PREFIX.mtl, which names IMAGE relative to itself: keep IMAGE\n"
            "where it is. Look at it with 'tiledtex render OUT_PREFIX.obj IMAGE view.png'.\n"
            "Faces with more than 3 corners are split into triangle fans first. The mesh must be\n"
-           "manifold and consistently oriented.\n"
-           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+           "manifold and consistently oriented.\n");
+    tool_print_mesh_help(1);
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
            "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
            "\n"

@@ -60,9 +60,9 @@
 
 static void print_help(void)
 {
-    printf("usage: tiledtex lapped MESH.obj IMAGE OUT_PREFIX [options]\n"
+    printf("usage: tiledtex lapped MESH IMAGE OUT_PREFIX [options]\n"
            "\n"
-           "Cover MESH.obj with overlapping pastes of texture patches cut from IMAGE (Praun et\n"
+           "Cover MESH with overlapping pastes of texture patches cut from IMAGE (Praun et\n"
            "al., Lapped Textures): no seams show, because every paste fades out over the ones\n"
            "beneath it. Writes OUT_PREFIX.obj (group paste_N holds the triangles of paste N with\n"
            "its texture coordinates and its patch's material; draw the groups in order with alpha\n"
@@ -80,8 +80,9 @@ static void print_help(void)
            "holds the pastes baked (--format glb, or OUT_PREFIX.glb).\n"
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
            "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
-           "--permissive.\n"
-           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+           "--permissive.\n");
+    tool_print_mesh_help(1);
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
            "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
            "\n");

@@ -21,13 +21,14 @@
 
 static void print_help(void)
 {
-    printf("usage: tiledtex map MESH.obj OUT.obj [options]\n"
+    printf("usage: tiledtex map MESH OUT.obj [options]\n"
            "\n"
-           "Give every face of MESH.obj a tile of a tiled texture: writes OUT.obj with one\n"
+           "Give every face of MESH a tile of a tiled texture: writes OUT.obj with one\n"
            "texture coordinate per face corner. Triangles and n-gons are quadrangulated\n"
            "first (each n-gon into n quads). The UVs fit any atlas that `tiledtex synth`\n"
-           "makes with the same --colors, --tile and --gutter.\n"
-           "OUT.obj may be '-' (the standard output), but not with --atlas, which adds OUT.mtl.\n"
+           "makes with the same --colors, --tile and --gutter.\n");
+    tool_print_mesh_help(1);
+    printf("OUT.obj may be '-' (the standard output), but not with --atlas, which adds OUT.mtl.\n"
            "\n"
            "options:\n"
            "  --colors N       edge conditions n; the atlas holds (2n)^4 tiles (default 1)\n"
@@ -93,7 +94,7 @@ int cmd_map(int argc, char **argv)
     status = tiled_parse_command_line(argc, argv,
                                       TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_ATLAS_OPTION | TILED_REPORT_OPTION |
                                           TILED_TRIANGLES_OPTION,
-                                      &options, positional, 2, "MESH.obj and OUT.obj", print_help);
+                                      &options, positional, 2, "MESH and OUT.obj", print_help);
     if (status >= 0) return status;
     if ((status = tool_refuse_stdout(positional[1], options.atlas_path != NULL, "OUT.obj with --atlas")) != 0)
         return status;

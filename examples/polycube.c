@@ -39,9 +39,9 @@
 
 static void print_help(void)
 {
-    printf("usage: tiledtex polycube MESH.obj IMAGE OUT_PREFIX [options]\n"
+    printf("usage: tiledtex polycube MESH IMAGE OUT_PREFIX [options]\n"
            "\n"
-           "Texture MESH.obj from IMAGE with no seams (Chang and Lin, polycube maps and Wang\n"
+           "Texture MESH from IMAGE with no seams (Chang and Lin, polycube maps and Wang\n"
            "tiles): the mesh is wrapped in a polycube, a block of equal cubes; each square of its\n"
            "surface shows one tile of an atlas made from IMAGE, tiles that match across every\n"
            "edge, and the mesh's triangles are split where they cross the squares' borders and\n"
@@ -50,8 +50,9 @@ static void print_help(void)
            "Writes OUT_PREFIX.obj (the split triangles, one texture coordinate per corner),\n"
            "OUT_PREFIX.mtl, OUT_PREFIX.png (the atlas) and OUT_PREFIX_polycube.obj (the polycube's\n"
            "surface with its tiles). Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX.png\n"
-           "view.png'.\n"
-           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+           "view.png'.\n");
+    tool_print_mesh_help(1);
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
            "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
            "\n"

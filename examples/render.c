@@ -999,15 +999,16 @@ done:
 
 static void print_render_help(void)
 {
-    printf("usage: tiledtex render MESH.obj TEXTURE OUT.png [--size WxH] [--yaw DEG] [--pitch DEG] [--up AXIS]\n"
-           "OUT.png may be '-': the PNG goes to the standard output.\n"
+    printf("usage: tiledtex render MESH TEXTURE OUT.png [--size WxH] [--yaw DEG] [--pitch DEG] [--up AXIS]\n"
            "                       [--zoom F] [--wireframe] [--no-materials]\n"
+           "OUT.png may be '-': the PNG goes to the standard output.\n"
            "\n"
            "Draw MESH with TEXTURE (PNG, JPEG, TGA, BMP, ...) applied through the mesh's per-corner\n"
            "texture coordinates (vt) and save the picture as OUT.png. Faces without texture\n"
-           "coordinates are drawn in grey. The camera looks at the whole model; texture\n"
-           "coordinates outside [0,1] repeat the texture.\n"
-           "\n"
+           "coordinates are drawn in grey (an STL or OFF mesh has none). The camera looks at the\n"
+           "whole model; texture coordinates outside [0,1] repeat the texture.\n");
+    tool_print_mesh_help(0);
+    printf("\n"
            "Materials: when MESH names an MTL file (mtllib) and its faces materials (usemtl), a face\n"
            "whose material has a texture (map_Kd, a path relative to the MTL, which is relative to\n"
            "MESH) is drawn with that texture; TEXTURE serves the other faces, and stands in for a\n"
@@ -1087,11 +1088,11 @@ int cmd_render(int argc, char **argv)
         } else if (npositional < 3) {
             positional[npositional++] = argv[i];
         } else {
-            return tool_usage("too many arguments: '%s' (usage: tiledtex render MESH.obj TEXTURE OUT.png)", argv[i]);
+            return tool_usage("too many arguments: '%s' (usage: tiledtex render MESH TEXTURE OUT.png)", argv[i]);
         }
     }
     if (npositional < 3)
-        return tool_usage("needs MESH.obj TEXTURE OUT.png (see 'tiledtex render --help')");
+        return tool_usage("needs MESH, TEXTURE and OUT.png (see 'tiledtex render --help')");
     up_axis_from(up, &axis);
 
     if (normal_y_down && !normal_path)

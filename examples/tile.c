@@ -13,13 +13,14 @@
 
 static void print_help(void)
 {
-    printf("usage: tiledtex tile MESH.obj IMAGE OUT_PREFIX [options]\n"
+    printf("usage: tiledtex tile MESH IMAGE OUT_PREFIX [options]\n"
            "\n"
-           "Texture MESH.obj from IMAGE with no seams: writes OUT_PREFIX.obj, OUT_PREFIX.mtl\n"
+           "Texture MESH from IMAGE with no seams: writes OUT_PREFIX.obj, OUT_PREFIX.mtl\n"
            "and OUT_PREFIX.png (the tile atlas). Triangles and n-gons are quadrangulated\n"
            "first; each quad shows one tile, so --subdivide makes the texture smaller on the\n"
-           "surface.\n"
-           "OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+           "surface.\n");
+    tool_print_mesh_help(1);
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
            "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
            "\n"
@@ -70,7 +71,7 @@ int cmd_tile(int argc, char **argv)
                                       TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS |
                                           TILED_REPORT_OPTION | TILED_MATERIAL_OPTIONS | TILED_TRIANGLES_OPTION |
                                           TILED_FORMAT_OPTION,
-                                      &options, positional, 3, "MESH.obj, IMAGE and OUT_PREFIX", print_help);
+                                      &options, positional, 3, "MESH, IMAGE and OUT_PREFIX", print_help);
     if (status >= 0) return status;
     if (tool_output_prefix(positional[2], &options.output, prefix) != 0) return TOOL_EXIT_USAGE;
     glb = options.output.format == TOOL_FORMAT_GLB;

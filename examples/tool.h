@@ -144,6 +144,10 @@ void tool_set_error(char *err, size_t err_size, const char *format, ...)
 
 /* "-h" or "--help". */
 int tool_is_help(const char *arg);
+/* The lines a command's help gives about its MESH argument: the formats
+   mesh_read takes and, for the commands that write OBJs (writes_obj), the
+   normals those get. */
+void tool_print_mesh_help(int writes_obj);
 /* Looks like an option: starts with '-' and is not just "-" or a number. */
 int tool_is_option(const char *arg);
 /* Report "unknown option '--foo' (see 'tiledtex CMD --help')"; returns TOOL_EXIT_USAGE. */
@@ -179,7 +183,7 @@ int parse_mesh_output_option(int argc, char **argv, int *index, int accept_forma
 int tool_output_prefix(const char *text, tool_mesh_output *output, char *prefix);
 /* The file PREFIX + SUFFIX ("out" + ".glb"), or "-" when the prefix is "-". */
 void tool_output_path(const char *prefix, const char *suffix, char *path, size_t size);
-/* The three arguments MESH.obj IMAGE OUT_PREFIX of the commands that read a
+/* The three arguments MESH IMAGE OUT_PREFIX of the commands that read a
    mesh and an image: checks there are exactly three and reads OUT_PREFIX
    with tool_output_prefix (and `output`, which may be NULL), reporting a
    problem (returns TOOL_EXIT_USAGE); 0 with the three set. */

@@ -213,6 +213,18 @@ for sub in synth map tile lapped hpm polycube render generate; do
     check "$sub --help" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes, stderr: $ERR" \
         "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
 done
+# the commands that read a mesh say which formats MESH may be (not MESH.obj)
+for sub in map tile lapped hpm polycube render; do
+    run help $sub
+    check "help $sub: MESH is OBJ, STL or OFF" "'usage: tiledtex $sub MESH ', the three formats, no 'MESH.obj'" \
+        "$(printf '%s\n' "$OUT" | grep -E 'usage|MESH' | head -3)" \
+        "$(printf '%s' "$OUT" | grep -q "^usage: tiledtex $sub MESH " &&
+            printf '%s' "$OUT" | grep -q 'MESH is a Wavefront OBJ, an STL (ASCII or binary) or an OFF file' &&
+            ! printf '%s' "$OUT" | grep -q 'MESH\.obj'; echo $?)"
+done
+run tile
+check "tile without arguments: the usage error names MESH, not MESH.obj" "'needs MESH, IMAGE and OUT_PREFIX'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -q 'needs MESH, IMAGE and OUT_PREFIX'; echo $?)"
 run --help
 check "--help" "exit 0 and usage on stdout" "exit $RC, stdout ${#OUT} bytes" "$([ $RC -eq 0 ] && [ -n "$OUT" ]; echo $?)"
 run help tile
