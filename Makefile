@@ -77,7 +77,7 @@ bench-build: build/bench_build $(if $(CGAL_INC),build/bench_build_cgal)
 	@$(if $(CGAL_INC),./build/bench_build_cgal,echo "(no CGAL peer: apt-get install libcgal-dev)" >&2)
 
 # tests/fuzz/run.sh builds the libFuzzer targets (mesh builder, OBJ reader,
-# lapped textures, tile synthesis) and runs them two at a time (FUZZ_JOBS),
+# STL/OFF mesh files, lapped textures, tile synthesis) and runs them two at a time (FUZZ_JOBS),
 # FUZZ_SECONDS each.
 FUZZ_SECONDS ?= 60
 fuzz: deps

@@ -581,11 +581,21 @@ int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size)
 {
     unsigned char *data;
     size_t size;
+    int status;
+    memset(out, 0, sizeof *out);
+    if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
+    status = mesh_read_data(path, data, size, out, err, err_size);
+    free(data);
+    return status;
+}
+
+int mesh_read_data(const char *path, const unsigned char *data, size_t size, obj_mesh *out, char *err,
+                   size_t err_size)
+{
     mesh_builder builder;
     mesh_format format;
     int status = -1, is_stl;
     memset(out, 0, sizeof *out);
-    if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
     format = detect_format(path, data, size);
     is_stl = format == MESH_STL_ASCII || format == MESH_STL_BINARY;
     if (format > MESH_OFF) {
@@ -601,7 +611,6 @@ int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size)
     } else {
         status = read_off(path, (const char *)data, size, &builder, err, err_size);
     }
-    free(data);
     if (status == 0 && out->nfaces == 0) {   /* (obj_read_text says so itself) */
         tool_set_error(err, err_size, "%s: no faces", path);
         status = -1;

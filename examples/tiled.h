@@ -75,8 +75,9 @@ typedef struct tiled_mesh {
 } tiled_mesh;
 
 /* Read an OBJ, build and validate it, quadrangulate when it is not all quads
-   (said on stderr), subdivide, assign boundaries and UVs. Prints the error and
-   returns an exit status on failure, 0 on success. */
+   (said on stderr), subdivide (the file's normals carried along when every
+   corner has one), assign boundaries and UVs. Prints the error and returns
+   an exit status on failure, 0 on success. */
 int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out);
 void tiled_mesh_free(tiled_mesh *mesh);
 

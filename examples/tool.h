@@ -495,6 +495,11 @@ void mesh_set_weld(int weld);
    STL's faces have no line (face_line 0). Returns 0, or -1 with the
    message in err. */
 int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size);
+/* The same on the file's bytes already read (`size` of them, any bytes;
+   need not end in NUL): `path` names the file in messages and lends its
+   extension to the format's detection. */
+int mesh_read_data(const char *path, const unsigned char *data, size_t size, obj_mesh *out, char *err,
+                   size_t err_size);
 
 /* Merge every vertex into the first (by index) within `tolerance` times
    the bounding box diagonal (0: exactly equal positions), renumbering the
@@ -736,8 +741,9 @@ typedef struct triangle_mesh {
    (and a build error says when it would help), and --subdivide L
    quadrangulates the triangles L times (with Catmull-Clark positions under
    --smooth) and splits every quad into two triangles: a triangle becomes 6,
-   then 24, 96, ... A build error is printed about the OBJ's own face and
-   line. Returns 0, or the exit status after printing the error (*m is then
+   then 24, 96, ...; the file's texture coordinates and normals, when every
+   corner has them, go along (corner_uv, corner_normal). A build error is
+   printed about the OBJ's own face and line. Returns 0, or the exit status after printing the error (*m is then
    empty). */
 int triangle_mesh_read(const char *path, const tool_mesh_options *options, triangle_mesh *m);
 void triangle_mesh_free(triangle_mesh *m);

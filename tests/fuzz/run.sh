@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # tests/fuzz/run.sh [SECONDS] - build the libFuzzer targets into build/fuzz/ and run
 # each for SECONDS (default 60), FUZZ_JOBS (default 2) at a time: mesh_build,
-# lapped, synth (tiled-texture synthesis, seams, 8-bit images) and obj (the
-# tool's OBJ reader, when examples/tool_io.c compiles). Exits non-zero if a target crashed,
+# lapped, synth (tiled-texture synthesis, seams, 8-bit images), obj (the
+# tool's OBJ reader, when examples/tool_io.c compiles) and mesh_file (the
+# tool's mesh files: STL, OFF, format detection, welding). Exits non-zero if a target crashed,
 # leaked, hit undefined behaviour or broke a contract check; the input that did it
 # is saved as build/fuzz/<target>-crash-* (or -leak-, -timeout-, -oom-).
 #
@@ -77,6 +78,16 @@ if [ -f examples/obj.c ] && [ -f examples/tool_io.c ] && [ -f examples/format_nu
   fi
 else
   echo "fuzz: SKIPPED fuzz_obj: one of $obj_sources examples/tool.h is missing" >&2
+fi
+# The tool's mesh files (examples/mesh_file.c), with the OBJ reader it hands
+# OBJs to and cli.c for its number parsing.
+mesh_file_sources="examples/mesh_file.c $obj_sources examples/cli.c"
+# shellcheck disable=SC2086
+if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_mesh_file.c $mesh_file_sources -o "$out/fuzz_mesh_file" -lm; then
+  targets+=(mesh_file)
+else
+  echo "fuzz: fuzz_mesh_file does not build" >&2
+  exit 2
 fi
 
 jobs_max=${FUZZ_JOBS:-2}
