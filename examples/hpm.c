@@ -1,7 +1,7 @@
 /* hpm.c - `tiledtex hpm`: texture a mesh with Soler et al.'s hierarchical
    pattern mapping.
 
-   MESH.obj + IMAGE -> OUT_PREFIX.obj, the mesh's triangles with one texture
+   MESH + IMAGE -> OUT_PREFIX.obj, the mesh's triangles with one texture
    coordinate per face corner into IMAGE itself, and OUT_PREFIX.mtl naming
    IMAGE where it is. No texture is made: the method cuts the surface into
    clusters, coarse to fine, and places each on the image where what it shows

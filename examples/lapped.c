@@ -1,6 +1,6 @@
 /* lapped.c - `tiledtex lapped`: texture a mesh with Praun et al.'s lapped textures.
 
-   MESH.obj + IMAGE -> OUT_PREFIX.obj, whose faces are the pastes in order
+   MESH + IMAGE -> OUT_PREFIX.obj, whose faces are the pastes in order
    (group paste_N: the triangles paste N covers, with that paste's texture
    coordinates, and the material of its patch), OUT_PREFIX.mtl and the
    texture patches (straight alpha): OUT_PREFIX_patch.png when there is one,

@@ -1,7 +1,7 @@
 /* polycube.c - `tiledtex polycube`: texture any triangle mesh with Chang
    and Lin's polycube map and Wang tiles.
 
-   MESH.obj + IMAGE -> OUT_PREFIX.obj (the mesh's triangles, split where
+   MESH + IMAGE -> OUT_PREFIX.obj (the mesh's triangles, split where
    they cross the tiles' borders, one texture coordinate per corner),
    OUT_PREFIX.mtl, OUT_PREFIX.png (the tile atlas) and
    OUT_PREFIX_polycube.obj (the polycube's surface S with its tiles, to look

@@ -1,6 +1,6 @@
 /* tile.c - `tiledtex tile`: the whole tiled-texture job in one step.
 
-   MESH.obj + IMAGE -> OUT_PREFIX.obj (one UV per corner), OUT_PREFIX.mtl and
+   MESH + IMAGE -> OUT_PREFIX.obj (one UV per corner), OUT_PREFIX.mtl and
    OUT_PREFIX.png (the atlas): `tiledtex map` and `tiledtex synth` together,
    with the seam score measured on the result. Open the OBJ in Blender, or
    look at it with `tiledtex render OUT_PREFIX.obj OUT_PREFIX.png view.png`.
