@@ -6,7 +6,9 @@
         textures its materials name (MTL map_Kd), if any; build each
         texture's mip chain (each level half the size of the one before).
      2. Split every polygon into a fan of triangles; give every face corner a
-        smooth normal (faces meeting at a sharp crease keep their own).
+        normal: the file's (vn) when every corner has one, as other programs
+        shade it, else a smooth one (faces meeting at a sharp crease keep
+        their own).
      3. Put a perspective camera on a sphere around the model: it looks at the
         centre of the model's bounding sphere from far enough away that the whole
         sphere fits the picture; --yaw and --pitch move it around, --up says
@@ -391,6 +393,30 @@ static vec3 polygon_normal(const obj_mesh *mesh, int first_corner, int size)
         n.z += (a.x - b.x) * (a.y + b.y);
     }
     return n;
+}
+
+/* The file's own normals (vn, one per corner: obj_corner_normals) instead
+   of computed ones, each turned to the side its face's winding calls
+   outside: lighting is two-sided and turns normals towards the viewer by
+   the winding, so a normal must agree with it (an inside-out file's
+   normals would otherwise light its surface from behind). */
+static void scene_use_file_normals(scene *s, float *normals)
+{
+    const obj_mesh *mesh = s->mesh;
+    int f, c = 0, i;
+    for (f = 0; f < mesh->nfaces; f++) {
+        vec3 face = polygon_normal(mesh, c, mesh->face_size[f]);
+        for (i = 0; i < mesh->face_size[f]; i++, c++) {
+            float *n = normals + 3 * (size_t)c;
+            if (vec3_dot(face, vec3_make(n[0], n[1], n[2])) < 0.0f) {
+                n[0] = -n[0];
+                n[1] = -n[1];
+                n[2] = -n[2];
+            }
+        }
+    }
+    free(s->corner_normal);
+    s->corner_normal = normals;
 }
 
 /* Smooth normals per corner: the area-weighted average of the normals of the
@@ -1006,7 +1032,9 @@ static void print_render_help(void)
            "Draw MESH with TEXTURE (PNG, JPEG, TGA, BMP, ...) applied through the mesh's per-corner\n"
            "texture coordinates (vt) and save the picture as OUT.png. Faces without texture\n"
            "coordinates are drawn in grey (an STL or OFF mesh has none). The camera looks at the\n"
-           "whole model; texture coordinates outside [0,1] repeat the texture.\n");
+           "whole model; texture coordinates outside [0,1] repeat the texture. The surface is shaded\n"
+           "with the mesh's own normals (vn) when every face corner has one, as Blender and engines\n"
+           "shade it, else with smooth normals that keep edges sharper than 50 degrees.\n");
     tool_print_mesh_help(0);
     printf("\n"
            "Materials: when MESH names an MTL file (mtllib) and its faces materials (usemtl), a face\n"
@@ -1043,6 +1071,7 @@ int cmd_render(int argc, char **argv)
     double yaw = 30.0, pitch = 20.0, zoom = 1.0;
     int wireframe = 0, use_materials = 1, normal_y_down = 0;
     const char *normal_path = NULL;
+    float *file_normals = NULL;
     mip_texture normal_map;
     char err[TOOL_ERROR_SIZE];
     obj_mesh mesh;
@@ -1143,11 +1172,12 @@ int cmd_render(int argc, char **argv)
     s.light_key = vec3_normalize(vec3_add(vec3_add(vec3_scale(cam.right, -0.45f), vec3_scale(cam.up, 0.6f)),
                                           vec3_scale(cam.forward, -0.75f)));
     s.light_fill = vec3_normalize(vec3_add(vec3_scale(cam.right, 0.8f), vec3_scale(cam.forward, -0.4f)));
-    if (scene_compute_normals(&s) != 0 || scene_project(&s, &cam) != 0 ||
-        samples_create(&samples, s.width, s.height, s.pasting) != 0) {
+    if (scene_compute_normals(&s) != 0 || obj_corner_normals(positional[0], &mesh, &file_normals) != 0 ||
+        scene_project(&s, &cam) != 0 || samples_create(&samples, s.width, s.height, s.pasting) != 0) {
         tool_fail("out of memory while rendering %s", positional[0]);
         goto done;
     }
+    if (file_normals) scene_use_file_normals(&s, file_normals);
 
     draw_visibility(&s, &samples);
     if (s.pasting) draw_pastes(&s, &samples);

@@ -3053,6 +3053,18 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
             --yaw 0 --pitch 0 --normal $n.png
     done
     expect_ok "render the square unmapped" render sq.obj small.png sq_flat.png --size 32x32 --yaw 0 --pitch 0
+    # the file's own normals light it as Blender would: tilted up-left (towards the key light)
+    # the square is brighter than with the normals computed, tilted down-right darker
+    for n in "-0.5 0.5 0.7:up" "0.5 -0.5 0.7:down"; do
+        { printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn %s\n' "${n%%:*}"
+          printf 'f 1/1/1 2/2/1 3/3/1 4/4/1\n'; } >sq_vn_${n##*:}.obj
+        expect_ok "render a square with its own normals (${n##*:})" render sq_vn_${n##*:}.obj small.png \
+            sq_vn_${n##*:}.png --size 32x32 --yaw 0 --pitch 0
+    done
+    lit=$(for n in up flat down; do f=sq_vn_$n.png; [ $n = flat ] && f=sq_flat.png; "$W/pixstat" $f 16 16 | awk '{print $1}'; done | tr '\n' ' ')
+    CMD="pixstat sq_vn_up.png / sq_flat.png / sq_vn_down.png 16 16"
+    check "render: the file's normals (vn) shade the surface" "up-left > computed > down-right" "$lit" \
+        "$(printf '%s\n' "$lit" | awk '{exit !(NF == 3 && $1 > $2 && $2 > $3)}'; echo $?)"
     lit=$(for n in towards flat away; do "$W/pixstat" sq_$n.png 16 16 | awk '{print $1}'; done | tr '\n' ' ')
     CMD="pixstat sq_towards.png / sq_flat.png / sq_away.png 16 16"
     check "render --normal: tilted towards the light is brighter, away darker (u right, v up)" \
