@@ -5,9 +5,9 @@
 
    A GLB is a 12-byte header, a JSON chunk describing the scene and a BIN
    chunk holding the data the JSON points into. Here the BIN chunk holds,
-   each from a 4-byte boundary: the vertices' positions, normals and
-   texture coordinates (one array each), the triangles' indices, and the
-   material's PNG files. Every number in the file is little-endian, whatever
+   each from a 4-byte boundary: the vertices' positions, normals, tangents
+   (with a normal map) and texture coordinates (one array each), the
+   triangles' indices, and the material's PNG files. Every number in the file is little-endian, whatever
    the machine writing it.
 
    glTF keeps one texture coordinate and one normal per vertex, where the
@@ -229,6 +229,7 @@ typedef struct glb_vertices {
     int *source;            /* per vertex: the first corner that made it */
     int *corner_vertex;     /* per corner: its vertex */
     float *unit_normal;     /* 3 per corner: the corner's normal made unit length; NULL without normals */
+    float *tangent;         /* 4 per vertex (make_tangents), or NULL */
     int ntriangles;
     float min[3], max[3];   /* the positions' bounds */
 } glb_vertices;
@@ -238,6 +239,7 @@ static void glb_vertices_free(glb_vertices *v)
     free(v->source);
     free(v->corner_vertex);
     free(v->unit_normal);
+    free(v->tangent);
     memset(v, 0, sizeof *v);
 }
 
@@ -393,6 +395,83 @@ static int make_vertices(const obj_write_desc *mesh, glb_vertices *v, char *err,
     return 0;
 }
 
+/* Tangents for a normal map: glTF reads a normal texture in the frame of
+   each vertex's tangent (xyz, along +u) and bitangent (cross(normal,
+   tangent) * w, along the image's up, which is +v in the tool's
+   coordinates). Without them a renderer derives its own (the validator
+   warns that those may differ between programs). Each triangle's texture
+   axes dP/du and dP/dv, made unit so that every triangle counts alike, are
+   summed at its vertices; a vertex's tangent is the sum made perpendicular
+   to its normal, and w says on which side the summed bitangent lies. These
+   are the axes the tool's maps were laid out along (its renderer takes
+   them per triangle), and what MikkTSpace gives where the texture is
+   continuous. Returns -1 when out of memory. */
+static int make_tangents(const obj_write_desc *mesh, glb_vertices *v)
+{
+    double *sum = (double *)calloc((size_t)v->count * 6, sizeof(double));
+    int f, i, k, first = 0;
+    v->tangent = (float *)malloc((size_t)v->count * 4 * sizeof(float));
+    if (!sum || !v->tangent) {
+        free(sum);
+        free(v->tangent);
+        v->tangent = NULL;
+        return -1;
+    }
+    for (f = 0; f < mesh->nfaces; first += face_size_of(mesh, f), f++)
+        for (i = 1; i + 1 < face_size_of(mesh, f); i++) {
+            int corner[3] = {first, first + i, first + i + 1};
+            const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[corner[0]];
+            const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[corner[1]];
+            const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[corner[2]];
+            const float *t0 = mesh->corner_uv + 2 * (size_t)corner[0];
+            const float *t1 = mesh->corner_uv + 2 * (size_t)corner[1];
+            const float *t2 = mesh->corner_uv + 2 * (size_t)corner[2];
+            double du1 = (double)t1[0] - t0[0], dv1 = (double)t1[1] - t0[1];
+            double du2 = (double)t2[0] - t0[0], dv2 = (double)t2[1] - t0[1];
+            double det = du1 * dv2 - du2 * dv1, axes[6], lt = 0.0, lb = 0.0;
+            if (!(fabs(det) > 0.0)) continue;
+            for (k = 0; k < 3; k++) {
+                double e1 = (double)p1[k] - p0[k], e2 = (double)p2[k] - p0[k];
+                axes[k] = (e1 * dv2 - e2 * dv1) / det;       /* dP/du */
+                axes[3 + k] = (e2 * du1 - e1 * du2) / det;   /* dP/dv */
+                lt += axes[k] * axes[k];
+                lb += axes[3 + k] * axes[3 + k];
+            }
+            lt = sqrt(lt);
+            lb = sqrt(lb);
+            if (!(lt > 0.0) || !(lb > 0.0) || !(lt < HUGE_VAL) || !(lb < HUGE_VAL)) continue;
+            for (k = 0; k < 3; k++) {
+                int j;
+                double *s = sum + 6 * (size_t)v->corner_vertex[corner[k]];
+                for (j = 0; j < 3; j++) {
+                    s[j] += axes[j] / lt;
+                    s[3 + j] += axes[3 + j] / lb;
+                }
+            }
+        }
+    for (i = 0; i < v->count; i++) {
+        const float *n = v->unit_normal + 3 * (size_t)v->source[i];
+        const double *s = sum + 6 * (size_t)i;
+        double along = s[0] * n[0] + s[1] * n[1] + s[2] * n[2], t[3], length, c[3];
+        for (k = 0; k < 3; k++) t[k] = s[k] - along * n[k];
+        length = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        if (!(length > 1e-12)) {
+            /* no texture axes here: any direction across the normal */
+            double a[3] = {fabs(n[0]) < 0.9 ? 1.0 : 0.0, fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+            along = a[0] * n[0] + a[1] * n[1];
+            for (k = 0; k < 3; k++) t[k] = a[k] - along * n[k];
+            length = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        }
+        for (k = 0; k < 3; k++) v->tangent[4 * (size_t)i + k] = (float)(t[k] / length);
+        c[0] = n[1] * t[2] - n[2] * t[1];
+        c[1] = n[2] * t[0] - n[0] * t[2];
+        c[2] = n[0] * t[1] - n[1] * t[0];
+        v->tangent[4 * (size_t)i + 3] = c[0] * s[3] + c[1] * s[4] + c[2] * s[5] < 0.0 ? -1.0f : 1.0f;
+    }
+    free(sum);
+    return 0;
+}
+
 /* ======================================================================== */
 /* The JSON chunk                                                           */
 /* ======================================================================== */
@@ -451,29 +530,30 @@ static void json_floats(tool_buffer *out, const float *values, int count)
     buffer_append(out, "]", 1);
 }
 
+enum { VIEW_POSITION, VIEW_NORMAL, VIEW_TANGENT, VIEW_UV, VIEW_INDEX, VIEW_IMAGE };
 /* Where each array starts in the BIN chunk, and how long it is. */
 typedef struct glb_layout {
-    size_t offset[4 + SLOT_COUNT], length[4 + SLOT_COUNT];
-    int view[4 + SLOT_COUNT];   /* its bufferView, -1 when absent */
+    size_t offset[VIEW_IMAGE + SLOT_COUNT], length[VIEW_IMAGE + SLOT_COUNT];
+    int view[VIEW_IMAGE + SLOT_COUNT];   /* its bufferView, -1 when absent */
     int nviews;
     size_t bin_size;
     int short_indices;
 } glb_layout;
-enum { VIEW_POSITION, VIEW_NORMAL, VIEW_UV, VIEW_INDEX, VIEW_IMAGE };
 
 static void plan_layout(const glb_vertices *v, int has_normals, int has_uvs, const glb_images *images,
                         glb_layout *layout)
 {
-    size_t lengths[4 + SLOT_COUNT];
+    size_t lengths[VIEW_IMAGE + SLOT_COUNT];
     int i;
     memset(layout, 0, sizeof *layout);
     layout->short_indices = v->count <= GLB_MAX_SHORT_VERTICES;
     lengths[VIEW_POSITION] = 12 * (size_t)v->count;
     lengths[VIEW_NORMAL] = has_normals ? 12 * (size_t)v->count : 0;
+    lengths[VIEW_TANGENT] = v->tangent ? 16 * (size_t)v->count : 0;
     lengths[VIEW_UV] = has_uvs ? 8 * (size_t)v->count : 0;
     lengths[VIEW_INDEX] = 3 * (size_t)v->ntriangles * (layout->short_indices ? 2 : 4);
     for (i = 0; i < SLOT_COUNT; i++) lengths[VIEW_IMAGE + i] = images->png[i] ? images->size[i] : 0;
-    for (i = 0; i < 4 + SLOT_COUNT; i++) {
+    for (i = 0; i < VIEW_IMAGE + SLOT_COUNT; i++) {
         layout->view[i] = lengths[i] > 0 ? layout->nviews++ : -1;
         layout->offset[i] = layout->bin_size;
         layout->length[i] = lengths[i];
@@ -493,7 +573,7 @@ static void write_json(tool_buffer *out, const tool_material *material, const ch
                        const glb_layout *layout)
 {
     int texture[SLOT_COUNT], ntextures = 0, s, accessor = 0;
-    int normal_accessor = -1, uv_accessor = -1, index_accessor;
+    int normal_accessor = -1, tangent_accessor = -1, uv_accessor = -1, index_accessor;
     for (s = 0; s < SLOT_COUNT; s++) texture[s] = layout->view[VIEW_IMAGE + s] >= 0 ? ntextures++ : -1;
 
     buffer_printf(out, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"tiledtex %s\"},", TILEDTEX_VERSION_STRING);
@@ -513,6 +593,11 @@ static void write_json(tool_buffer *out, const tool_material *material, const ch
         buffer_printf(out, ",{\"bufferView\":%d,\"componentType\":%d,\"count\":%d,\"type\":\"VEC3\"}",
                       layout->view[VIEW_NORMAL], GL_FLOAT, v->count);
     }
+    if (layout->view[VIEW_TANGENT] >= 0) {
+        tangent_accessor = ++accessor;
+        buffer_printf(out, ",{\"bufferView\":%d,\"componentType\":%d,\"count\":%d,\"type\":\"VEC4\"}",
+                      layout->view[VIEW_TANGENT], GL_FLOAT, v->count);
+    }
     if (layout->view[VIEW_UV] >= 0) {
         uv_accessor = ++accessor;
         buffer_printf(out, ",{\"bufferView\":%d,\"componentType\":%d,\"count\":%d,\"type\":\"VEC2\"}",
@@ -527,6 +612,7 @@ static void write_json(tool_buffer *out, const tool_material *material, const ch
     json_string(out, name);
     buffer_printf(out, ",\"primitives\":[{\"attributes\":{\"POSITION\":0");
     if (normal_accessor >= 0) buffer_printf(out, ",\"NORMAL\":%d", normal_accessor);
+    if (tangent_accessor >= 0) buffer_printf(out, ",\"TANGENT\":%d", tangent_accessor);
     if (uv_accessor >= 0) buffer_printf(out, ",\"TEXCOORD_0\":%d", uv_accessor);
     buffer_printf(out, "},\"indices\":%d,\"material\":0,\"mode\":%d}]}],", index_accessor, GLTF_TRIANGLES);
 
@@ -576,6 +662,7 @@ static void write_json(tool_buffer *out, const tool_material *material, const ch
     buffer_printf(out, "\"bufferViews\":[");
     json_view(out, layout, VIEW_POSITION, GL_ARRAY_BUFFER);
     if (layout->view[VIEW_NORMAL] >= 0) json_view(out, layout, VIEW_NORMAL, GL_ARRAY_BUFFER);
+    if (layout->view[VIEW_TANGENT] >= 0) json_view(out, layout, VIEW_TANGENT, GL_ARRAY_BUFFER);
     if (layout->view[VIEW_UV] >= 0) json_view(out, layout, VIEW_UV, GL_ARRAY_BUFFER);
     json_view(out, layout, VIEW_INDEX, GL_ELEMENT_ARRAY_BUFFER);
     for (s = 0; s < SLOT_COUNT; s++)
@@ -599,6 +686,10 @@ static void write_bin(unsigned char *bin, const obj_write_desc *mesh, const glb_
     if (layout->view[VIEW_NORMAL] >= 0) {
         p = bin + layout->offset[VIEW_NORMAL];
         for (i = 0; i < v->count; i++) p = put_floats(p, v->unit_normal + 3 * (size_t)v->source[i], 3);
+    }
+    if (layout->view[VIEW_TANGENT] >= 0) {
+        p = bin + layout->offset[VIEW_TANGENT];
+        for (i = 0; i < v->count; i++) p = put_floats(p, v->tangent + 4 * (size_t)i, 4);
     }
     if (layout->view[VIEW_UV] >= 0) {
         /* The tool's v runs up from the image's bottom row (OBJ's
@@ -664,6 +755,10 @@ int gltf_write(const obj_write_desc *mesh, const tool_material *material, const 
     if (make_vertices(mesh, &v, err, err_size) != 0) {
         glb_images_free(&images);
         return -1;
+    }
+    if (images.png[SLOT_NORMAL] && v.unit_normal && make_tangents(mesh, &v) != 0) {
+        tool_set_error(err, err_size, "out of memory for the tangents of %d vertices", v.count);
+        goto fail;
     }
     plan_layout(&v, mesh->corner_normal != NULL, mesh->corner_uv != NULL, &images, &layout);
     write_json(&json, material, name, &v, &layout);

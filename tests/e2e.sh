@@ -3013,6 +3013,33 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
             "$most" "$([ "$most" = 0 ]; echo $?)"
     fi
     validate "tile GLB with a material" t.glb
+    # with a normal map, a tangent per vertex: unit, across the normal, w = +-1, and along
+    # +u (the first triangle's texture axis)
+    if [ -n "$GLB_PROBE" ]; then
+        tangents=$(glb_accessor t.glb "$(json_number "$GLB_JSON" TANGENT)" | paste -d' ' - - - -)
+        normals=$(glb_accessor t.glb "$(json_number "$GLB_JSON" NORMAL)" | paste -d' ' - - -)
+        bad=$(paste -d' ' <(printf '%s\n' "$tangents") <(printf '%s\n' "$normals") | awk '
+            NF == 7 { n++; l = sqrt($1*$1 + $2*$2 + $3*$3); d = $1*$5 + $2*$6 + $3*$7
+                      if (l < 0.999 || l > 1.001 || d > 0.001 || d < -0.001 || ($4 != 1 && $4 != -1)) bad++ }
+            END { print (n > 0 ? bad + 0 : "none") }')
+        CMD="glb_accessor t.glb TANGENT / NORMAL"
+        check "tile GLB: a unit tangent across each normal, w = +-1" "0 bad of $(printf '%s\n' "$tangents" | wc -l)" \
+            "$bad" "$([ "$bad" = 0 ]; echo $?)"
+        # a square whose u runs along +x and v along +y: every tangent is (1, 0, 0), w = 1
+        printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n' >square.obj
+        expect_ok "tile a square into a GLB with a normal map" tile square.obj small.png square.glb --tile 48 \
+            --normal small.png
+        glb_check "square GLB" square.glb
+        tangents=$(glb_accessor square.glb "$(json_number "$GLB_JSON" TANGENT)" | paste -d' ' - - - - | sort -u)
+        CMD="glb_accessor square.glb TANGENT"
+        check "square GLB: the tangent runs along +u, the bitangent along +v" "1 0 0 1" "$tangents" \
+            "$(printf '%s\n' "$tangents" | awk 'NF == 4 && ($1 < 0.9999 || $2*$2 > 1e-8 || $3*$3 > 1e-8 || $4 != 1) {bad++}
+                END {exit !(NR > 0 && bad == 0)}'; echo $?)"
+        expect_ok "tile a GLB without a normal map" tile ../in/torus.obj ../in/tex.png plain.glb --tile 48
+        glb_check "tile GLB without a normal map" plain.glb
+        check "tile GLB without a normal map: no tangents" "no TANGENT" "$GLB_JSON" \
+            "$(! printf '%s' "$GLB_JSON" | grep -q TANGENT; echo $?)"
+    fi
     expect_ok "lapped: a material baked into a GLB" lapped plane.obj ../in/tex.png lg.glb --scale 8 --patches 1 \
         --bake 128 --normal m_normal.png --roughness m_roughness.png
     glb_check "lapped GLB with a material" lg.glb
