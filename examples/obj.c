@@ -226,20 +226,28 @@ static int read_number(obj_parser *P, float *out)
     return 1;
 }
 
-static int parse_vertex(obj_parser *P)
+/* The three numbers of a `v` or `vn` statement (`what` names it in the
+   error: "a vertex"). Returns 0, or obj_error's status. */
+static int read_three(obj_parser *P, const char *what, float xyz[3])
 {
-    obj_mesh *mesh = P->mesh;
-    float xyz[3];
     int i;
     for (i = 0; i < 3; i++) {
         int got = read_number(P, &xyz[i]);
         if (got <= 0) {
             char quoted[80];
-            return obj_error(P, got < 0 ? "cannot read a number in '%s'"
-                                        : "a vertex needs 3 coordinates: '%s'",
-                             quote_statement(P, quoted, sizeof quoted));
+            quote_statement(P, quoted, sizeof quoted);
+            return got < 0 ? obj_error(P, "cannot read a number in '%s'", quoted)
+                           : obj_error(P, "%s needs 3 coordinates: '%s'", what, quoted);
         }
     }
+    return 0;
+}
+
+static int parse_vertex(obj_parser *P)
+{
+    obj_mesh *mesh = P->mesh;
+    float xyz[3];
+    if (read_three(P, "a vertex", xyz) != 0) return -1;
     /* A 4th number (w) or vertex colours may follow; they are not needed. */
     if (mesh->nverts >= OBJ_MAX_COUNT) return obj_error(P, "too many vertices (at most %d)", OBJ_MAX_COUNT);
     if (grow_array((void **)&mesh->pos, &P->pos_capacity, (mesh->nverts + 1) * 3, sizeof(float)) != 0 ||
@@ -287,15 +295,7 @@ static int parse_normal(obj_parser *P)
 {
     obj_mesh *mesh = P->mesh;
     float xyz[3];
-    int i;
-    for (i = 0; i < 3; i++) {
-        int got = read_number(P, &xyz[i]);
-        if (got <= 0) {
-            char quoted[80];
-            return obj_error(P, got < 0 ? "cannot read a number in '%s'" : "a normal needs 3 coordinates: '%s'",
-                             quote_statement(P, quoted, sizeof quoted));
-        }
-    }
+    if (read_three(P, "a normal", xyz) != 0) return -1;
     if (mesh->nnormals >= OBJ_MAX_COUNT) return obj_error(P, "too many normals (at most %d)", OBJ_MAX_COUNT);
     if (grow_array((void **)&mesh->normal, &P->normal_capacity, (mesh->nnormals + 1) * 3, sizeof(float)) != 0)
         return out_of_memory(P);
