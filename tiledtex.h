@@ -61,6 +61,14 @@
        tt_synth_options opt = {0};  opt.layout = layout;
        if (tt_synthesize_tiles(photo, &opt, NULL, &tiles, &err) != TT_OK) { puts(err.message); return 1; }
        tt_image_to_rgba8(&tiles->levels[0], TT_COLOR_SRGB, rgba); // the atlas, W * W * 4 bytes
+       // The other maps of the material (normal, roughness, height, ...) on the same
+       // tiles: plan once from the photo, apply the plan to each map of its size.
+       tt_synth_plan *plan; tt_image *bumps; tt_tileset *normals;
+       tt_image_from_bytes(nbytes, w, h, 3, 0, TT_COLOR_NORMAL, NULL, &bumps, &err); // +Y up
+       tt_synth_plan_create(photo, &opt, NULL, &plan, &err);
+       tt_synth_apply(plan, bumps, NULL, &normals, &err);       // vectors turned with the bands
+       tt_image_to_rgba8(&normals->levels[0], TT_COLOR_NORMAL, rgba);
+       tt_tileset_free(normals); tt_synth_plan_free(plan); tt_image_free(bumps);
        tt_tileset_free(tiles); tt_image_free(photo); tt_mesh_free(mesh);
 
    QUICK START: lapped textures on a triangle mesh (Praun et al.)
