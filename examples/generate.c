@@ -180,7 +180,13 @@ static void stone_color(int cell_x, int cell_y, uint32_t key, float rgb[3])
 /* The colours below are designed as displayed (sRGB-encoded) values; the
    last pass decodes them to linear light, what a tt_image holds, and the
    PNG is encoded back to sRGB: the file shows the designed values. */
-static int make_stone_texture(int size, uint64_t seed, tt_image **out_image)
+/* The pavement's colour into *out_image; with `maps` (MATERIAL_MAPS
+   images, NULL entries filled here) also its material: the normal map of
+   the height field the colour is lit from (unit vectors, +Y up), the
+   height itself, the roughness (polished stones, rough mortar) and the
+   ambient occlusion the colour is darkened by - maps that match the
+   colour texel for texel, to try the commands' --normal and the rest on. */
+static int make_stone_texture(int size, uint64_t seed, tt_image **out_image, tt_image **maps)
 {
     tt_image *image;
     const float mortar = 0.045f, light[3] = {-0.45f, -0.55f, 0.70f};
@@ -200,6 +206,12 @@ static int make_stone_texture(int size, uint64_t seed, tt_image **out_image)
     keys.grain = tt_rng_next(&rng);
     if (tt_image_create(size, size, NULL, out_image, NULL) != TT_OK) return -1;
     image = *out_image;
+    if (maps) {
+        int map;
+        for (map = 0; map < MATERIAL_MAPS; map++)
+            if (map != MATERIAL_METALLIC && tt_image_create(size, size, NULL, &maps[map], NULL) != TT_OK) return -1;
+        maps[MATERIAL_NORMAL]->kind = TT_IMAGE_NORMAL;
+    }
 
     /* Pass 1: albedo into RGB, height into alpha (a free scratch channel). */
     for (y = 0; y < size; y++) {
@@ -225,6 +237,13 @@ static int make_stone_texture(int size, uint64_t seed, tt_image **out_image)
             height = 0.8f * dome + 0.18f * fractal_noise(fx / 5.0f, fy / 5.0f, 3, keys.bumps) * stone +
                      0.10f * grit * (1.0f - stone);
 
+            if (maps) {
+                float *rough = maps[MATERIAL_ROUGHNESS]->pixels + 4 * ((size_t)y * (size_t)size + (size_t)x);
+                float *high = maps[MATERIAL_HEIGHT]->pixels + 4 * ((size_t)y * (size_t)size + (size_t)x);
+                rough[0] = rough[1] = rough[2] = 0.9f - (0.45f - 0.15f * mottle) * stone;
+                high[0] = high[1] = high[2] = height;
+                rough[3] = high[3] = 1.0f;
+            }
             stone_color(hit.cell_x, hit.cell_y, keys.colors, albedo);
             for (k = 0; k < 3; k++) {
                 float on_stone = albedo[k] * (0.80f + 0.40f * mottle);
@@ -256,6 +275,16 @@ static int make_stone_texture(int size, uint64_t seed, tt_image **out_image)
             if (diffuse < 0.0f) diffuse = 0.0f;
             occlusion = 0.62f + 0.38f * (pixel[3] > 0.8f ? 1.0f : pixel[3] / 0.8f);
             shade = (0.25f + 0.9f * diffuse) * occlusion;
+            if (maps) {
+                /* nx, ny are in the image's axes (y down); the map holds y up */
+                float *normal = maps[MATERIAL_NORMAL]->pixels + 4 * ((size_t)y * (size_t)size + (size_t)x);
+                float *ao = maps[MATERIAL_AO]->pixels + 4 * ((size_t)y * (size_t)size + (size_t)x);
+                normal[0] = nx / length;
+                normal[1] = -ny / length;
+                normal[2] = nz / length;
+                ao[0] = ao[1] = ao[2] = occlusion;
+                normal[3] = ao[3] = 1.0f;
+            }
             grain = 0.06f * (hash_unit(hash2(x, y, keys.grain)) - 0.5f);
             for (k = 0; k < 3; k++) {
                 float value = pixel[k] * shade + grain;
@@ -270,12 +299,15 @@ static int make_stone_texture(int size, uint64_t seed, tt_image **out_image)
 
 static void print_generate_help(void)
 {
-    printf("usage: tiledtex generate texture OUT.png [--size N] [--seed K]\n"
+    printf("usage: tiledtex generate texture OUT.png [--size N] [--seed K] [--material]\n"
            "       tiledtex generate mesh OUT.obj --shape NAME [--triangles]\n"
            "OUT.png or OUT.obj may be '-': the file goes to the standard output.\n"
            "\n"
            "texture: a photograph-like pavement of rounded stones that never repeats, N x N pixels\n"
            "         (default %d, at most %d); --seed K picks another pavement (default 1).\n"
+           "         --material also writes the pavement's other maps beside OUT.png, texel for\n"
+           "         texel: OUT_normal.png (tangent space, +Y up), OUT_height.png, OUT_roughness.png\n"
+           "         and OUT_ao.png, to try the commands' --normal, --height, ... on.\n"
            "mesh:    a test surface as an OBJ file. Shapes:\n"
            "           double-torus  genus 2, smooth, all quads with vertices of valence 3, 4, 5 and 6\n"
            "                         (a plate with two holes, built from triangles, quads, a pentagon and\n"
@@ -292,11 +324,12 @@ static void print_generate_help(void)
 static int generate_texture(int argc, char **argv)
 {
     const char *path = NULL;
-    int size = TEXTURE_DEFAULT_SIZE, i, status;
+    int size = TEXTURE_DEFAULT_SIZE, i, status, material = 0, map;
     uint64_t seed = 1;
-    tt_image *image = NULL;
+    tt_image *image = NULL, *maps[MATERIAL_MAPS];
     tool_output output = TOOL_OUTPUT_INIT;
-    char err[TOOL_ERROR_SIZE];
+    char err[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], map_path[TOOL_PREFIX_SIZE + 32];
+    memset(maps, 0, sizeof maps);
     for (i = 2; i < argc; i++) {
         const char *value;
         if (tool_is_help(argv[i])) {
@@ -306,6 +339,8 @@ static int generate_texture(int argc, char **argv)
             if (parse_int("--size", value, 16, TEXTURE_MAX_SIZE, &size) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--seed", &value)) {
             if (parse_u64("--seed", value, &seed) != 0) return TOOL_EXIT_USAGE;
+        } else if (strcmp(argv[i], "--material") == 0) {
+            material = 1;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
         } else if (!path) {
@@ -315,15 +350,29 @@ static int generate_texture(int argc, char **argv)
         }
     }
     if (!path) return tool_usage("needs an output file: tiledtex generate texture OUT.png");
-    if (make_stone_texture(size, seed, &image) != 0) return tool_fail("out of memory making a %dx%d texture", size, size);
+    /* The maps go beside OUT.png: OUT_normal.png, ... ("-" takes one file). */
+    if (material && (tool_refuse_stdout(path, 1, "OUT.png with --material") != 0 ||
+                     tool_output_prefix(path, NULL, prefix) != 0))
+        return TOOL_EXIT_USAGE;
     status = 0;
-    if (output_add_png(&output, path, image, TT_COLOR_SRGB, err, sizeof err) != 0 ||
-        output_commit(&output, err, sizeof err) != 0)
+    if (make_stone_texture(size, seed, &image, material ? maps : NULL) != 0)
+        status = tool_fail("out of memory making a %dx%d texture", size, size);
+    if (status == 0 && output_add_png(&output, path, image, TT_COLOR_SRGB, err, sizeof err) != 0)
         status = tool_fail("%s", err);
-    else if (!tool_quiet())
-        printf("wrote %s (%dx%d stones, seed %llu)\n", path, size, size, (unsigned long long)seed);
+    for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
+        if (!maps[map]) continue;
+        material_path(map_path, sizeof map_path, prefix, map);
+        status = output_add_map_png(&output, map_path, map, maps[map]);
+    }
+    if (status == 0 && output_commit(&output, err, sizeof err) != 0) status = tool_fail("%s", err);
+    if (status == 0 && !tool_quiet()) {
+        printf("wrote %s (%dx%d stones, seed %llu)", path, size, size, (unsigned long long)seed);
+        if (material) printf(" and its normal, height, roughness and ao maps beside it");
+        printf("\n");
+    }
     output_free(&output);
     tt_image_free(image);
+    for (map = 0; map < MATERIAL_MAPS; map++) tt_image_free(maps[map]);
     return status;
 }
 

@@ -2908,6 +2908,20 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
     check "material helper makes its maps" "m_normal.png m_height.png coords.png upmap.png" "$(ls)" \
         "$([ -s m_normal.png ] && [ -s dx_normal.png ] && [ -s coords.png ] && [ -s upmap.png ]; echo $?)"
 
+    # generate texture --material: the pavement's own maps beside it, the normal map the
+    # one its height implies
+    expect_ok "generate texture --material" generate texture g.png --size 128 --material
+    check "generate --material: the maps beside OUT.png, each its size" "g_normal/_height/_roughness/_ao.png 128 128" \
+        "$(for m in normal height roughness ao; do printf '%s: %s; ' $m "$(png_size g_$m.png)"; done; ls g_metallic.png 2>&1)" \
+        "$(for m in normal height roughness ao; do [ "$(png_size g_$m.png)" = "128 128" ] || exit 1; done
+            [ ! -e g_metallic.png ]; echo $?)"
+    slope=$("$MAPS" slope g_height.png g_normal.png 2>&1)
+    CMD="maps slope g_height.png g_normal.png"
+    check "generate --material: the normal map follows the height map's slopes" "median <= 3 deg" "$slope" \
+        "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 3)}'; echo $?)"
+    expect_usage_error "generate --material to the standard output" generate texture - --material
+    cd "$MD" || exit 1
+
     # tile: an atlas per map, one layout; the MTL names them
     expect_ok "tile with a material" tile ../in/torus.obj ../in/tex.png t --tile 48 --normal m_normal.png \
         --roughness m_roughness.png --height m_height.png --metallic coords.png --ao m_height.png
