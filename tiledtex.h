@@ -1272,7 +1272,9 @@ TTDEF float tt_synth_plan_band_alpha(const tt_synth_plan *plan, int tile, int si
    (x + g, y + g). The tile's background window is the plan's
    background_windows[tt_tile_index(&plan->layout, types)], so the cell is
    bit for bit the one tt_synth_apply puts in the atlas. Texels outside the
-   cell are not touched; alpha is 1. `target` is any image of yours (an
+   cell are not touched; alpha is 1. A normal-map source (TT_IMAGE_NORMAL)
+   composes unit vectors, each band's turned with it; the target's kind is
+   yours to set. `target` is any image of yours (an
    atlas, a one-cell image, a view) that shares no texels with `source`; it
    is the only thing written, and the tile is composed in place there.
    Allocates nothing. The plan and source are only read, so several threads
@@ -1292,10 +1294,11 @@ TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image 
 
 typedef struct tt_tileset {
     tt_tile_layout layout;          /* resolved */
-    /* levels[0] is the atlas (W x W, opaque, straight alpha = 1); level L is built
-       per tile by halving each cell, for as long as the cell size stays even.
-       Levels 0..seamless_levels-1 (up to log2(g)) keep every edge seamless under
-       bilinear filtering. */
+    /* levels[0] is the atlas (W x W, opaque, straight alpha = 1), of the
+       applied image's kind (a normal map's vectors renormalised at every
+       level); level L is built per tile by halving each cell, for as long as
+       the cell size stays even. Levels 0..seamless_levels-1 (up to log2(g))
+       keep every edge seamless under bilinear filtering. */
     int nlevels;
     int seamless_levels;
     tt_image levels[TT_MAX_MIP_LEVELS];
