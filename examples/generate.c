@@ -1009,6 +1009,9 @@ static int generate_mesh(int argc, char **argv)
     char err[TOOL_ERROR_SIZE], comment[200], summary[400];
     poly_mesh m, split;
     obj_write_desc desc;
+    tt_mesh *built = NULL;
+    tt_error error;
+    float *normals = NULL;
     tool_buffer text = TOOL_BUFFER_INIT;
     tool_output output = TOOL_OUTPUT_INIT;
     for (i = 2; i < argc; i++) {
@@ -1050,6 +1053,13 @@ static int generate_mesh(int argc, char **argv)
         }
     }
     if (describe_mesh(&m, shape, summary, sizeof summary) != 0) goto done;
+    /* Normals per corner, as every OBJ the tool writes has them: the shapes
+       are smooth, but for the grid's sheet edges (crease normals). */
+    if (poly_build(&m, &built, &error) != TT_OK) {
+        tool_fail("internal error: the generated %s is not a valid mesh: %s", shape, error.message);
+        goto done;
+    }
+    if (!(normals = tool_corner_normals(path, built, NULL))) goto done;
 
     snprintf(comment, sizeof comment, "tiledtex generate mesh --shape %s%s\n%d vertices, %d faces", shape,
              triangles ? " --triangles" : "", m.nverts, m.nfaces);
@@ -1060,6 +1070,7 @@ static int generate_mesh(int argc, char **argv)
     desc.nfaces = m.nfaces;
     desc.face_size = m.face_size;
     desc.corner_vert = m.corner_vert;
+    desc.corner_normal = normals;
     if (obj_write(&text, &desc) != 0 || output_add_buffer(&output, path, &text) != 0) {
         tool_fail("out of memory writing %s", path);
         goto done;
@@ -1073,6 +1084,8 @@ static int generate_mesh(int argc, char **argv)
 done:
     buffer_free(&text);
     output_free(&output);
+    tt_mesh_free(built);
+    free(normals);
     poly_free(&m);
     return status;
 }

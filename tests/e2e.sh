@@ -238,6 +238,10 @@ for shape in double-torus torus sphere grid pair genus3; do
     check "generate mesh $shape: non-empty" "non-empty $shape.obj" "$(ls -l $shape.obj 2>&1)" "$(nonempty $shape.obj; echo $?)"
 done
 expect_ok "generate mesh sphere --triangles" generate mesh spheretri.obj --shape sphere --triangles
+check "generate mesh: a normal per face corner" "every f corner v//vn, vn lines" \
+    "$(grep -c '^vn' spheretri.obj) vn; $(grep -m1 '^f' spheretri.obj)" \
+    "$(awk '$1 == "vn" { n++ } $1 == "f" { for (i = 2; i <= NF; i++) if ($i !~ /^[0-9]+\/\/[0-9]+$/) bad++ }
+        END { exit !(n > 0 && bad == 0) }' spheretri.obj; echo $?)"
 check "generate --triangles: all triangles" "only 3-corner faces" \
     "$(awk '$1=="f"{n[NF-1]++} END{for(k in n) printf "%d-gons:%d ", k, n[k]}' spheretri.obj 2>/dev/null)" \
     "$(awk '$1=="f"{f++; if (NF!=4) bad++} END{exit !(f>0 && bad==0)}' spheretri.obj 2>/dev/null; echo $?)"
@@ -2158,8 +2162,9 @@ done
 tilted_obj() {
     awk -v turn="$2" '
         $1 == "v" { print; n++; x[n] = $2; y[n] = $3; z[n] = $4; next }
+        $1 == "vn" { next }
         $1 == "f" { if (!normals) { for (i = 1; i <= n; i++) printf "vn %.9g %.9g %.9g\n", -turn * y[i], turn * x[i], turn * z[i]; normals = 1 }
-                    printf "f"; for (i = 2; i <= NF; i++) printf " %s//%s", $i, $i; print ""; next }
+                    printf "f"; for (i = 2; i <= NF; i++) { split($i, c, "/"); printf " %s//%s", c[1], c[1] }; print ""; next }
         { print }' "$1"
 }
 # normals_against FILE MODE: "corners worst": face corners with a vn, and the
@@ -2203,8 +2208,9 @@ expect_ok "hpm, normals from the file" hpm ../in/sphere_turned.obj ../in/lap.png
 check_turned "hpm" h.obj
 expect_ok "polycube, normals from the file" polycube ../in/sphere_turned.obj ../in/tex.png p --tile 16 --resolution 6
 check_turned "polycube (split triangles)" p.obj
-# the same sphere without vn: the same files but for the normals (computed)
-expect_ok "tile, the same sphere without normals" tile ../in/spheretri.obj ../in/tex.png plain --tile 16 --subdivide 1
+# the same sphere with the normals `generate` computes: the same files but for the normals
+expect_ok "tile, the same sphere with computed normals" tile ../in/spheretri.obj ../in/tex.png plain --tile 16 \
+    --subdivide 1
 CMD="diff t.obj plain.obj"
 check "tile: the file's normals change the vn lines and nothing else" "same v/vt/f lines, different vn lines" \
     "$(diff <(grep -v '^#' t.obj) <(grep -v '^#' plain.obj) 2>&1 | grep -c '^[<>] vn') vn lines differ" \
