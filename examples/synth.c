@@ -33,7 +33,9 @@ static void print_help(void)
            "                         per condition (default: chosen from the seed)\n"
            "  --background X,Y,W,H   region the per-tile background windows come from\n"
            "                         (default: the whole image)\n"
-           "  --mips                 also write the per-tile mip levels as ATLAS_mipL.png\n",
+           "  --mips                 also write the per-tile mip levels as ATLAS_mipL.png\n"
+           MATERIAL_OPTIONS_HELP("                         ")
+           "                         (here beside ATLAS.png: ATLAS_normal.png, ...; not with '-')\n",
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
 }
 
@@ -41,27 +43,40 @@ static void print_help(void)
 int cmd_synth(int argc, char **argv)
 {
     const char *positional[2];
-    int k, status;
+    int k, status, map;
     tiled_options options;
     tt_image *image = NULL;
-    tt_tileset *tiles = NULL;
+    tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS];
     tool_output output;
-    char message[TOOL_ERROR_SIZE];
+    char message[TOOL_ERROR_SIZE], stem[TOOL_PREFIX_SIZE], map_paths[MATERIAL_MAPS][TOOL_PREFIX_SIZE + 32];
 
     memset(&output, 0, sizeof output);
-    status = tiled_parse_command_line(argc, argv, TILED_LAYOUT_OPTIONS | TILED_SYNTH_OPTIONS, &options, positional, 2,
-                                      "IMAGE and ATLAS.png", print_help);
+    memset(map_tiles, 0, sizeof map_tiles);
+    status = tiled_parse_command_line(argc, argv, TILED_LAYOUT_OPTIONS | TILED_SYNTH_OPTIONS | TILED_MATERIAL_OPTIONS,
+                                      &options, positional, 2, "IMAGE and ATLAS.png", print_help);
     if (status >= 0) return status;
 
-    if ((status = tool_refuse_stdout(positional[1], options.mips, "ATLAS.png with --mips")) != 0) return status;
+    if ((status = tool_refuse_stdout(positional[1], options.mips || material_count(&options.maps) > 0,
+                                     "ATLAS.png with --mips or a material's maps")) != 0)
+        return status;
+    /* The maps' atlases go beside ATLAS.png: ATLAS_normal.png, ... */
+    if (material_count(&options.maps) > 0 && tool_output_prefix(positional[1], NULL, stem) != 0)
+        return TOOL_EXIT_USAGE;
+    for (map = 0; map < MATERIAL_MAPS; map++) material_path(map_paths[map], sizeof map_paths[map], stem, map);
     if ((status = tiled_check_atlas_size(&options)) != 0) return status;
     /* A photo: sRGB in the file, linear light in the library. */
     if (image_load(positional[0], TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         return tool_fail("%s", message);
-    status = tiled_synthesize(image, positional[0], &options, NULL, &tiles, NULL);
-    image_free(image);       /* not needed past the synthesis */
+    status = material_load(&options.maps, positional[0], image->width, image->height);
+    if (status == 0) status = material_refuse_overwrite(&options.maps, stem);
+    if (status == 0) status = tiled_synthesize(image, positional[0], &options, &options.maps, &tiles, map_tiles);
+    image_free(image);       /* not needed past the synthesis, nor are the maps */
     image = NULL;
+    material_free(&options.maps);
     if (status == 0) status = tiled_add_atlas(&output, positional[1], tiles, options.mips, TT_COLOR_SRGB);
+    for (map = 0; map < MATERIAL_MAPS && status == 0; map++)
+        if (map_tiles[map])
+            status = tiled_add_atlas(&output, map_paths[map], map_tiles[map], options.mips, material_space(map));
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0 && !tool_quiet()) {
         printf("%s: %dx%d atlas of %d tiles (n=%d, %d texels, gutter %d) from %s; edge windows",
@@ -70,10 +85,14 @@ int cmd_synth(int argc, char **argv)
                tiles->layout.gutter, positional[0]);
         for (k = 0; k < tiles->layout.colors; k++)
             printf(" %d,%d", tiles->edge_windows[k].x, tiles->edge_windows[k].y);
-        printf("; seamless mip levels: %d\n", tiles->seamless_levels);
+        printf("; seamless mip levels: %d", tiles->seamless_levels);
+        for (map = 0, k = 0; map < MATERIAL_MAPS; map++)
+            if (map_tiles[map]) printf("%s %s", k++ == 0 ? "; with" : ",", map_paths[map]);
+        printf("\n");
     }
     output_free(&output);
-    tt_tileset_free(tiles);
+    tiled_tilesets_free(&tiles, map_tiles);
+    material_free(&options.maps);
     image_free(image);
     return status;
 }

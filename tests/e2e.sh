@@ -2944,6 +2944,11 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
         "$(cmp -s t.png alone.png; echo $?)"
     check "tile: the same map twice gives the same atlas" "t_height.png = t_ao.png" "$(cmp t_height.png t_ao.png 2>&1)" \
         "$(cmp -s t_height.png t_ao.png; echo $?)"
+    # synth: the same maps' atlases beside ATLAS.png, the very ones tile made
+    expect_ok "synth with a material" synth ../in/tex.png s.png --tile 48 --normal m_normal.png --height m_height.png
+    check "synth: the colour and normal atlases are tile's" "s.png = t.png, s_normal.png = t_normal.png" \
+        "$(cmp s.png t.png 2>&1; cmp s_normal.png t_normal.png 2>&1)" \
+        "$(cmp -s s.png t.png && cmp -s s_normal.png t_normal.png && cmp -s s_height.png t_height.png; echo $?)"
     # one layout: where the map of positions says an atlas texel came from, the colour
     # atlas shows that very texel of the colour image (blends aside); the control, the
     # positions laid out by another seed's tiles, agrees only by chance
