@@ -467,6 +467,16 @@ static void test_second_map_same_masks(void)
     if (r == TT_OK) r = tt_synth_apply(plan, mark, NULL, &sm, &err);
     CHECK(r == TT_OK, "plan of A applied to A, B and the mark: %d (%s)", r, err.message);
     if (r == TT_OK) {
+        /* A map identical to the guide (another image with A's texels)
+           synthesises to A's atlas, every level, bit for bit. */
+        tt_image *same = sy_copy(a);
+        tt_tileset *ss = NULL;
+        CHECK(same && tt_synth_apply(plan, same, NULL, &ss, &err) == TT_OK && ss && sy_same_levels(ss, sa),
+              "a map identical to the guide gives the guide's atlas");
+        tt_tileset_free(ss);
+        tt_image_free(same);
+    }
+    if (r == TT_OK) {
         /* Blending is convex, so an atlas texel of the mark's atlas is 0
            exactly when no changed texel reached it: there A's and B's
            atlases must agree to the bit, in every level. */
