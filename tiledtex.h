@@ -1,4 +1,4 @@
-/* tiledtex.h - v0.2.0 - texture any mesh from one example image, with no seams,
+/* tiledtex.h - v0.3.0 - texture any mesh from one example image, with no seams,
    no singularities and no visible repetition.   MIT license: see end of file.
 
    Do this in *one* C or C++ file before including this file:
@@ -167,9 +167,9 @@
 #define TILEDTEX_H
 
 #define TILEDTEX_VERSION_MAJOR 0
-#define TILEDTEX_VERSION_MINOR 2
+#define TILEDTEX_VERSION_MINOR 3
 #define TILEDTEX_VERSION_PATCH 0
-#define TILEDTEX_VERSION_STRING "0.2.0"
+#define TILEDTEX_VERSION_STRING "0.3.0"
 
 #include <stddef.h>
 #include <stdint.h>

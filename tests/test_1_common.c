@@ -107,8 +107,8 @@ static void test_version(void)
           "tt_version numbers: expected %d.%d.%d, got %d.%d.%d", TILEDTEX_VERSION_MAJOR, TILEDTEX_VERSION_MINOR,
           TILEDTEX_VERSION_PATCH, major, minor, patch);
     sprintf(expect, "%d.%d.%d", TILEDTEX_VERSION_MAJOR, TILEDTEX_VERSION_MINOR, TILEDTEX_VERSION_PATCH);
-    CHECK(strcmp(expect, TILEDTEX_VERSION_STRING) == 0 && strcmp(TILEDTEX_VERSION_STRING, "0.2.0") == 0,
-          "TILEDTEX_VERSION_STRING \"%s\" should be the numbers \"%s\" (0.2.0)", TILEDTEX_VERSION_STRING, expect);
+    CHECK(strcmp(expect, TILEDTEX_VERSION_STRING) == 0 && strcmp(TILEDTEX_VERSION_STRING, "0.3.0") == 0,
+          "TILEDTEX_VERSION_STRING \"%s\" should be the numbers \"%s\" (0.3.0)", TILEDTEX_VERSION_STRING, expect);
     /* Each pointer may be NULL. */
     major = -1;
     CHECK(tt_version(NULL, NULL, NULL) == v && tt_version(&major, NULL, NULL) == v && major == TILEDTEX_VERSION_MAJOR,
