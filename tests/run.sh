@@ -132,14 +132,15 @@ quickstart_check() {
 
 # Tiled textures: a 2x2 grid of quads and an 8-bit photo; it must make the
 # atlas, encode it and free everything (LeakSanitizer checks the frees).
-quickstart_check quickstart "QUICK START: tile" "QUICK START: lapped" "makes and frees a 544x544 atlas" \
+quickstart_check quickstart "QUICK START: tile" "QUICK START: lapped" "makes and frees a 544x544 atlas and its normal atlas" \
     'static const float xyz[27] = {0,0,0, 1,0,0, 2,0,0, 0,1,0, 1,1,0, 2,1,0, 0,2,0, 1,2,0, 2,2,0};
 static const int quads[16] = {0,1,4,3, 1,2,5,4, 3,4,7,6, 4,5,8,7};
 int nverts = 9, nquads = 4, w = 128, h = 256, channels = 3, x; uint8_t types[16]; float uv[32];
-static unsigned char bytes[128 * 256 * 3];
+static unsigned char bytes[128 * 256 * 3], nbytes[128 * 256 * 3];
 unsigned char *rgba = (unsigned char *)malloc(544 * 544 * 4);
-for (x = 0; x < 128 * 256 * 3; x++) bytes[x] = (unsigned char)((x * 37) % 251);' \
-    'if (rgba[4 * 1000 + 3] != 255 || uv[4] <= uv[0]) return 2;
+for (x = 0; x < 128 * 256 * 3; x++) bytes[x] = (unsigned char)((x * 37) % 251);
+for (x = 0; x < 128 * 256 * 3; x++) nbytes[x] = (unsigned char)(x % 3 == 2 ? 230 : 100 + (x * 13) % 56);' \
+    'if (rgba[4 * 1000 + 3] != 255 || rgba[4 * 1000 + 2] < 200 || uv[4] <= uv[0]) return 2;
 free(rgba); }
 return 0; }'
 
