@@ -678,14 +678,17 @@ int mtl_read(const char *path, mtl_library *out, char *err, size_t err_size)
             if (out->count >= OBJ_MAX_COUNT ||
                 grow_array((void **)&out->names, &capacity, out->count + 1, sizeof(char *)) != 0 ||
                 (capacity != had && resize_array((void **)&out->diffuse_maps, capacity, sizeof(char *)) != 0) ||
+                (capacity != had && resize_array((void **)&out->normal_maps, capacity, sizeof(char *)) != 0) ||
                 !(out->names[out->count] = tool_copy_string(name, name_length))) {
                 status = out_of_memory(P);
                 break;
             }
-            out->diffuse_maps[out->count++] = NULL;
-        } else if (token_is(keyword, length, "map_Kd") && out->count > 0) {
+            out->diffuse_maps[out->count] = NULL;
+            out->normal_maps[out->count++] = NULL;
+        } else if ((token_is(keyword, length, "map_Kd") || token_is(keyword, length, "norm")) && out->count > 0) {
             const char *file;
-            char **map = &out->diffuse_maps[out->count - 1];
+            char **map = token_is(keyword, length, "norm") ? &out->normal_maps[out->count - 1]
+                                                           : &out->diffuse_maps[out->count - 1];
             read_name(P, name, sizeof name);
             file = map_file_name(name);
             free(*map);
@@ -704,9 +707,11 @@ void mtl_free(mtl_library *library)
     for (k = 0; k < library->count; k++) {
         free(library->names[k]);
         free(library->diffuse_maps[k]);
+        free(library->normal_maps[k]);
     }
     free(library->names);
     free(library->diffuse_maps);
+    free(library->normal_maps);
     memset(library, 0, sizeof *library);
 }
 

@@ -927,6 +927,8 @@ typedef struct texture_set {
     mip_texture *textures;      /* up to 1 + materials */
     char **paths;               /* the file each was loaded from (textures[0]: TEXTURE) */
     int *face_texture;          /* per OBJ face: index into textures */
+    char *normal_map;           /* the normal map (norm) the faces' materials name, when they name
+                                   one and the same; NULL otherwise */
 } texture_set;
 
 static void texture_set_free(texture_set *set)
@@ -939,6 +941,7 @@ static void texture_set_free(texture_set *set)
     free(set->textures);
     free(set->paths);
     free(set->face_texture);
+    free(set->normal_map);
     memset(set, 0, sizeof *set);
 }
 
@@ -976,7 +979,7 @@ static int load_textures(const char *obj_path, const char *texture_path, const o
 {
     char err[TOOL_ERROR_SIZE], mtl_path[4096], map_path[4096];
     mtl_library library;
-    int *material_texture = NULL, f, m, status = 0;
+    int *material_texture = NULL, f, m, status = 0, several_normal_maps = 0;
     memset(set, 0, sizeof *set);
     memset(&library, 0, sizeof library);
     set->textures = (mip_texture *)calloc((size_t)mesh->nmaterials + 1, sizeof(mip_texture));
@@ -1004,6 +1007,21 @@ static int load_textures(const char *obj_path, const char *texture_path, const o
         if (material_texture[m] == 0) continue;
         material_texture[m] = 0;
         k = mtl_find(&library, mesh->material_names[m]);
+        if (k >= 0 && library.normal_maps[k] && !several_normal_maps) {
+            tool_path_beside(library.normal_maps[k], mtl_path, map_path, sizeof map_path);
+            if (!set->normal_map) {
+                if (!(set->normal_map = tool_copy_string(map_path, strlen(map_path)))) {
+                    status = tool_fail("out of memory while rendering %s", obj_path);
+                    goto done;
+                }
+            } else if (strcmp(set->normal_map, map_path) != 0) {
+                /* one normal map lights the whole surface here */
+                several_normal_maps = 1;
+                free(set->normal_map);
+                set->normal_map = NULL;
+                tool_note("the materials of %s name different normal maps: drawn without them", obj_path);
+            }
+        }
         if (k < 0 || !library.diffuse_maps[k]) continue;
         tool_path_beside(library.diffuse_maps[k], mtl_path, map_path, sizeof map_path);
         material_texture[m] = texture_set_add(set, map_path, pasting, err, sizeof err);
@@ -1041,7 +1059,9 @@ static void print_render_help(void)
            "whose material has a texture (map_Kd, a path relative to the MTL, which is relative to\n"
            "MESH) is drawn with that texture; TEXTURE serves the other faces, and stands in for a\n"
            "material texture that cannot be read (a note says so). So a mesh with several\n"
-           "textures shows each where it belongs, whichever TEXTURE is given.\n"
+           "textures shows each where it belongs, whichever TEXTURE is given. A normal map the\n"
+           "materials name (norm, as the tool's MTL files do) lights the surface, as --normal\n"
+           "does, when they all name the same one.\n"
            "\n"
            "Pasting meshes (from 'tiledtex lapped'), where the same triangle occurs several times,\n"
            "are drawn as the paper draws them: each occurrence in file order, blended over the\n"
@@ -1142,7 +1162,19 @@ int cmd_render(int argc, char **argv)
         goto done;
     }
     if (load_textures(positional[0], positional[1], &mesh, s.pasting, use_materials, &textures) != 0) goto done;
-    if (normal_path) {
+    /* The materials' normal map lights the surface unless --normal names
+       another (a pasting mesh's per-patch maps are for engines that
+       composite in order). */
+    if (!normal_path && textures.normal_map && !s.pasting) {
+        tt_image *image;
+        /* as a material texture that cannot be read: a note, and drawn without */
+        if (image_load(textures.normal_map, TT_COLOR_NORMAL, &image, err, sizeof err) != 0)
+            tool_note("%s; drawn without the materials' normal map", err);
+        else if (texture_build(&normal_map, image, err, sizeof err) != 0)
+            tool_note("cannot prepare the normal map %s: %s; drawn without it", textures.normal_map, err);
+        else
+            s.normal_map = &normal_map;
+    } else if (normal_path) {
         tt_image *image;
         if (s.pasting) {
             tool_fail("%s is a pasting mesh: --normal needs one texture over the surface (render its --bake output)",

@@ -508,14 +508,15 @@ int mesh_read_data(const char *path, const unsigned char *data, size_t size, obj
    of memory (the mesh is then unchanged). */
 int mesh_weld(obj_mesh *mesh, double tolerance);
 
-/* The materials of an MTL file: newmtl NAME and its map_Kd (the diffuse
-   texture) as the file names it: relative to the MTL's directory unless
-   absolute; options before the name are skipped. Everything else in the
-   file is skipped. */
+/* The materials of an MTL file: newmtl NAME, its map_Kd (the diffuse
+   texture) and its norm (a tangent-space normal map) as the file names
+   them: relative to the MTL's directory unless absolute; options before
+   the name are skipped. Everything else in the file is skipped. */
 typedef struct mtl_library {
     int count;
     char **names;           /* count material names */
     char **diffuse_maps;    /* count map_Kd file names, NULL for a material without one */
+    char **normal_maps;     /* count norm file names, NULL for a material without one */
 } mtl_library;
 
 /* Read an MTL file. Returns 0, or -1 with a message in err (a file that

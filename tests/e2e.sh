@@ -3093,9 +3093,12 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
 
     # render --normal: the lighting changes; refused on a pasting mesh
     expect_ok "render with the normal map" render t.obj t.png nm.png --size 64x64 --normal t_normal.png
-    expect_ok "render without it" render t.obj t.png plain.png --size 64x64
+    expect_ok "render without it" render t.obj t.png plain.png --size 64x64 --no-materials
     check "render --normal: the normal map changes the picture" "files differ" "identical" \
         "$(! cmp -s nm.png plain.png; echo $?)"
+    expect_ok "render with the MTL's normal map" render t.obj t.png auto.png --size 64x64
+    check "render: the material's normal map (norm) lights the surface as --normal does" "cmp equal" \
+        "$(cmp auto.png nm.png 2>&1)" "$(cmp -s auto.png nm.png; echo $?)"
     # a square facing the camera, u to the right and v up the screen: a normal map tilted
     # towards the key light (upper left) brightens it, one tilted away darkens it
     printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n' >sq.obj
