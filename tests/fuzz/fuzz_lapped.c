@@ -48,7 +48,9 @@
    tt_lapped_measure failing or finding an uncovered face; pair-atlas UVs
    outside [0,1]; tt_lapped_bake failing, or writing a non-finite value, a
    value outside [0,1], or alpha below 1/2 at a texel centre well inside a
-   triangle (the pastes cover every face); a progress fraction that decreases;
+   triangle (the pastes cover every face); the same bake from normal-map
+   patches (kind TT_IMAGE_NORMAL, one tilted vector times each patch's
+   alpha) failing, or leaving a texel that is not a unit vector; a progress fraction that decreases;
    a second paste with the same seed that differs; an allocation not given
    back; an error without a sentence or whose result differs from the return
    value; TT_ERROR_OUT_OF_MEMORY when no allocation failed; a failed call whose
@@ -256,7 +258,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     tt_lapped_options lo;
     tt_bake_options bo;
     tt_lapped *lapped = NULL, *again = NULL;
-    tt_image *patches[2], *atlas = NULL;
+    tt_image *patches[2], *atlas = NULL, *normals[2] = {NULL, NULL};
     const tt_allocator *alloc;
     fz_progress ps;
     uint8_t flags, misc, hdr[24];
@@ -508,7 +510,44 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     check_atlas(mesh, atlas, corner_uv);
 
+    /* ---- the same pastes baked from normal-map patches ---- */
+    for (k = 0; k < npatches; ++k) {
+        int i, n = patches[k]->width * patches[k]->height;
+        memset(&err, 0x55, sizeof err);
+        normals[k] = (tt_image *)&rd;
+        r = tt_image_create(patches[k]->width, patches[k]->height, alloc, &normals[k], &err);
+        if (r != TT_OK) {
+            check_error("tt_image_create", r, &err, &a);
+            fz_check_null("tt_image_create", r, normals[k]);
+            CHECK(r == TT_ERROR_OUT_OF_MEMORY, "tt_image_create: %s", err.message);
+            goto out;
+        }
+        normals[k]->kind = TT_IMAGE_NORMAL;
+        for (i = 0; i < n; ++i) {
+            float alpha = patches[k]->pixels[4 * i + 3];
+            normals[k]->pixels[4 * i] = 0.3f * alpha;
+            normals[k]->pixels[4 * i + 1] = (k ? -0.4f : 0.4f) * alpha;
+            normals[k]->pixels[4 * i + 2] = 0.8660254f * alpha;
+            normals[k]->pixels[4 * i + 3] = alpha;
+        }
+    }
+    memset(&err, 0x55, sizeof err);
+    r = tt_lapped_bake(mesh, lapped, (tt_image *const *)normals, npatches, corner_uv, &bo, alloc, atlas, &err);
+    if (r != TT_OK) {
+        check_error("tt_lapped_bake (normal maps)", r, &err, &a);
+        CHECK(r == TT_ERROR_OUT_OF_MEMORY, "tt_lapped_bake (normal maps): %s", err.message);
+        goto out;
+    }
+    CHECK(atlas->kind == TT_IMAGE_NORMAL, "a bake of normal-map patches made an atlas of kind %d", (int)atlas->kind);
+    for (k = 0; k < ATLAS_SIZE * ATLAS_SIZE; ++k) {
+        const float *p = atlas->pixels + 4 * (size_t)k;
+        double length = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+        CHECK(fabs(length - 1.0) < 1e-5, "normal atlas texel %d has length %.9g", k, length);
+    }
+
 out:
+    tt_image_free(normals[0]);
+    tt_image_free(normals[1]);
     tt_image_free(atlas);
     tt_lapped_free(lapped);
     if (npatches == 2) tt_image_free(patches[1]);

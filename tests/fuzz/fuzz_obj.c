@@ -28,6 +28,7 @@
 #include "tool.h"
 #define FUZZ_NAME "fuzz_obj"
 #include "fuzz_common.h"
+#include "fuzz_obj_mesh.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -66,26 +67,15 @@ static size_t bounded_strlen(const char *s, size_t max)
 static void check_parsed(const obj_mesh *m)
 {
     volatile float sink = 0.0f;
-    int i, c = 0;
+    int i;
     CHECK(m->nverts >= 0 && m->nfaces >= 0 && m->ncorners >= 0 && m->nuvs >= 0 && m->nnormals >= 0,
           "counts %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->nnormals);
     for (i = 0; i < 3 * m->nverts; ++i) sink += m->pos[i];
     for (i = 0; i < 2 * m->nuvs; ++i) sink += m->uv[i];
     for (i = 0; i < 3 * m->nnormals; ++i) sink += m->normal[i];
     (void)sink;
-    for (i = 0; i < m->nfaces; ++i) {
-        CHECK(m->face_size[i] >= 3, "face %d has %d corners", i, m->face_size[i]);
-        CHECK(m->face_size[i] <= m->ncorners - c, "face sizes overrun %d corners", m->ncorners);
-        c += m->face_size[i];
-        CHECK(m->face_group[i] >= 0 && m->face_group[i] < m->ngroups, "face %d group %d of %d", i, m->face_group[i],
-              m->ngroups);
-        CHECK(m->face_material[i] >= 0 && m->face_material[i] < m->nmaterials, "face %d material %d of %d", i,
-              m->face_material[i], m->nmaterials);
-    }
-    CHECK(c == m->ncorners, "face sizes add up to %d, ncorners %d", c, m->ncorners);
+    fz_check_obj_faces(m);
     for (i = 0; i < m->ncorners; ++i) {
-        CHECK(m->corner_vert[i] >= 0 && m->corner_vert[i] < m->nverts, "corner %d vertex %d of %d", i,
-              m->corner_vert[i], m->nverts);
         if (m->corner_uv)
             CHECK(m->corner_uv[i] >= -1 && m->corner_uv[i] < m->nuvs, "corner %d vt %d of %d", i, m->corner_uv[i],
                   m->nuvs);

@@ -33,10 +33,12 @@
        27     prescribed colours: per edge (b + 7 * edge) % (n + 2) - 1 (so -1..n:
               n is out of range); b & 0x80: one twin disagrees
        28     progress cancel count (bits 0..2), seam options max_edges (bits 3..5:
-              0 all, 7 = -1 invalid, else that many), bit 6 NULL seam options
+              0 all, 7 = -1 invalid, else that many), bit 6 NULL seam options,
+              bit 7 the source is a normal map (its texels made unit vectors)
        29..35 tt_image_from_bytes: width, height (b % 24, 0 = 0; 255 = 32769),
               channels (b % 6), stride mode (b % 5: 0 packed, 1 exact, 2 padded,
-              3 too short, 4 negative), colour space (b % 3, 2 = invalid), NULL
+              3 too short, 4 negative), colour space (b % 5: 0 sRGB, 1 linear,
+              2 and 3 normal maps, 4 invalid), NULL
               data (b & 1), NULL out (b & 1)
        then   pixel bytes: the source is RGB from these bytes (cycled, with the
               position mixed in), decoded sRGB or linear by byte 0's parity of
@@ -51,7 +53,8 @@
        code), and valid inputs succeed (or run out of memory / are
        cancelled when asked). On success levels[0] is W x W with
        W = tt_tile_layout_atlas_size, every texel finite, in [0, 1] when the
-       source was, alpha 1; each mip level half the one before and finite;
+       source was (a unit vector at every level from a normal-map source),
+       alpha 1; each mip level half the one before and finite;
        edge windows S x 2S inside the source (the given ones when given);
      - boundaries: prescribed colours out of range give
        TT_ERROR_INDEX_OUT_OF_RANGE and twins that disagree
@@ -60,7 +63,9 @@
      - UVs in [0, 1]; tt_measure_seams TT_OK (finite seam when samples > 0)
        or TT_ERROR_NOT_MEASURED (score NaN), a negative max_edges refused;
      - tt_image_from_bytes: the result predicted from the arguments; bytes ->
-       image -> bytes (tt_image_to_rgba8, same space) is the identity;
+       image -> bytes (tt_image_to_rgba8, same space) is the identity for
+       colour spaces; a normal space gives an image of kind normal holding
+       unit vectors (alpha still exact both ways);
      - every failure: fz_check_error and fz_check_null (fuzz_common.h); the
        counting allocator's live count back to zero at the end. */
 #define TILEDTEX_IMPLEMENTATION
@@ -88,7 +93,8 @@ static int is_finite_texel(const float *p) { return isfinite(p[0]) && isfinite(p
 
 static void check_bytes(reader *rd, const uint8_t *hdr, fz_alloc *a)
 {
-    int w = hdr[29] % 24, h = hdr[30] % 24, channels = hdr[31] % 6, smode = hdr[32] % 5, space = hdr[33] % 3;
+    int w = hdr[29] % 24, h = hdr[30] % 24, channels = hdr[31] % 6, smode = hdr[32] % 5, space = hdr[33] % 5;
+    int normal = space == TT_COLOR_NORMAL || space == TT_COLOR_NORMAL_Y_DOWN;
     int null_data = hdr[34] & 1, null_out = hdr[35] & 1, stride, row, x, y, k;
     size_t need = 1, i;
     unsigned char *data, *back;
@@ -106,7 +112,8 @@ static void check_bytes(reader *rd, const uint8_t *hdr, fz_alloc *a)
     default: stride = -1 - hdr[32]; break;
     }
     /* what the header promises, in its order of checks */
-    if (null_out || null_data || channels < 1 || channels > 4 || space > 1 || w < 1 || h < 1)
+    if (null_out || null_data || channels < 1 || channels > 4 || space > 3 || (normal && channels < 3) || w < 1 ||
+        h < 1)
         expect = TT_ERROR_INVALID_ARGUMENT;
     else if (w > TT_MAX_IMAGE_SIZE || h > TT_MAX_IMAGE_SIZE)
         expect = TT_ERROR_TOO_LARGE;
@@ -137,6 +144,15 @@ static void check_bytes(reader *rd, const uint8_t *hdr, fz_alloc *a)
         return;
     }
     CHECK(img->width == w && img->height == h && img->pixels, "image %dx%d from %dx%d", img->width, img->height, w, h);
+    CHECK(img->kind == (normal ? TT_IMAGE_NORMAL : TT_IMAGE_COLOR), "space %d made an image of kind %d", space,
+          (int)img->kind);
+    if (normal)
+        for (i = 0; i < (size_t)w * (size_t)h; ++i) {
+            const float *p = img->pixels + 4 * i;
+            double length = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+            CHECK(fabs(length - 1.0) < 1e-5, "space %d: texel %d is not a unit vector (length %g)", space, (int)i,
+                  length);
+        }
     back = (unsigned char *)malloc((size_t)w * h * 4);
     if (!back) abort();
     tt_image_to_rgba8(img, (tt_color_space)space, back);
@@ -151,7 +167,7 @@ static void check_bytes(reader *rd, const uint8_t *hdr, fz_alloc *a)
             case 3: want[0] = p[0]; want[1] = p[1]; want[2] = p[2]; want[3] = 255; break;
             default: memcpy(want, p, 4); break;
             }
-            for (k = 0; k < 4; ++k)
+            for (k = normal ? 3 : 0; k < 4; ++k)
                 CHECK(q[k] == want[k], "round trip (space %d, %d channels): texel %d,%d channel %d: %d -> %.9g -> %d",
                       space, channels, x, y, k, want[k], (double)img->pixels[4 * ((size_t)y * w + x) + k], q[k]);
         }
@@ -318,7 +334,7 @@ static void use_atlas(const tt_mesh *m, const tt_tileset *set, const tt_tile_lay
 /* ---- synthesis ------------------------------------------------------------- */
 
 static void check_tileset(const tt_tileset *set, const tt_tile_layout *layout, const tt_image *src, int in_unit,
-                          const tt_rect *windows)
+                          int normal, const tt_rect *windows)
 {
     tt_tile_layout res;
     int W, L, k, S;
@@ -345,7 +361,11 @@ static void check_tileset(const tt_tileset *set, const tt_tile_layout *layout, c
             CHECK(is_finite_texel(p), "level %d texel %lu (%g, %g, %g, %g) from a finite source", L,
                   (unsigned long)i, (double)p[0], (double)p[1], (double)p[2], (double)p[3]);
             CHECK(fabsf(p[3] - 1.0f) <= 1e-6f, "level %d texel %lu alpha %.9g", L, (unsigned long)i, (double)p[3]);
-            if (in_unit)
+            if (normal) {
+                double length = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+                CHECK(fabs(length - 1.0) < 1e-5, "level %d texel %lu of a normal map has length %.9g", L,
+                      (unsigned long)i, length);
+            } else if (in_unit)
                 for (k = 0; k < 3; ++k)
                     CHECK(p[k] >= 0.0f && p[k] <= 1.0f, "level %d texel %lu channel %d = %.9g from a [0,1] source", L,
                           (unsigned long)i, k, (double)p[k]);
@@ -403,6 +423,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     h = 8 + hdr[3] % 73;
     src = make_source(&rd, w, h, (tt_color_space)(hdr[29] & 1), &a);
     if (!src) goto out;
+    if (hdr[28] & 0x80) {
+        /* a normal map: each texel's colour read as a vector and made unit */
+        src->kind = TT_IMAGE_NORMAL;
+        for (k = 0; k < w * h; ++k) {
+            float *p = src->pixels + 4 * (size_t)k;
+            double x = 2.0 * p[0] - 1.0, y = 2.0 * p[1] - 1.0, z = 2.0 * p[2] - 1.0, l = sqrt(x * x + y * y + z * z);
+            if (!(l > 1e-6)) { x = 0.0; y = 0.0; z = 1.0; l = 1.0; }
+            p[0] = (float)(x / l);
+            p[1] = (float)(y / l);
+            p[2] = (float)(z / l);
+        }
+    }
     if (flags & 2) {
         float *p = src->pixels + 4 * ((size_t)(hdr[25] % h) * w + hdr[24] % w);
         p[hdr[26] % 3] = HUGE_TEXEL[hdr[26] % 8];
@@ -548,7 +580,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     CHECK(opt.feather >= 0, "synthesis accepted feather %d", opt.feather);
     CHECK(feather <= S / 4 + 1, "synthesis accepted feather %d for %d-texel tiles", feather, S);
     CHECK(ps.cancel_after == 0 || ps.calls < ps.cancel_after, "not cancelled after %d calls", ps.calls);
-    check_tileset(set, &opt.layout, src, in_unit, (flags & 4) ? windows : NULL);
+    check_tileset(set, &opt.layout, src, in_unit, src->kind == TT_IMAGE_NORMAL, (flags & 4) ? windows : NULL);
 
     mesh = make_mesh((flags & 32) != 0, &a);
     if (mesh) use_atlas(mesh, set, &opt.layout, hdr, (flags & 8) != 0, &a);
