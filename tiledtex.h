@@ -101,8 +101,9 @@
      - tt_image holds linear-light RGBA floats, nominally in [0, 1]: blending,
        feathering, filtering and mip averaging are done in linear light. Colour
        photos arrive sRGB-encoded: convert them with tt_image_from_bytes(...,
-       TT_COLOR_SRGB, ...) and back with tt_image_to_rgba8. Data maps (normals,
-       roughness, height) are TT_COLOR_LINEAR and never converted.
+       TT_COLOR_SRGB, ...) and back with tt_image_to_rgba8. Data maps
+       (roughness, metallic, occlusion, height) are TT_COLOR_LINEAR and never
+       converted; normal maps are TT_COLOR_NORMAL (next).
      - Tangent-space normal maps follow glTF (OpenGL style): x to the right of
        the image, y up it (towards row 0, i.e. along +v), z out of the surface.
        Decoded with TT_COLOR_NORMAL (or TT_COLOR_NORMAL_Y_DOWN for DirectX-
@@ -474,13 +475,6 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
 /* Width or height above this is refused with TT_ERROR_TOO_LARGE. */
 #define TT_MAX_IMAGE_SIZE 32768
 
-/* Float RGBA, row-major, row 0 at the top, in linear light (see CONVENTIONS).
-   Colours may be straight or premultiplied by alpha: each function says which
-   it expects. Images the library creates come from tt_image_create and its
-   kin and are freed with tt_image_free. You may also fill this struct
-   yourself to hand the library your own pixels (a view): leave `allocator`
-   zeroed and never pass a view to tt_image_free. */
-
 /* What an image's r, g, b hold, which decides how it is turned and blended. */
 typedef enum tt_image_kind {
     TT_IMAGE_COLOR = 0,         /* colour, or any data that blends channel by channel: albedo,
@@ -490,6 +484,12 @@ typedef enum tt_image_kind {
                                    blended texels are renormalised (a zero blend becomes 0, 0, 1) */
 } tt_image_kind;
 
+/* Float RGBA, row-major, row 0 at the top, in linear light (see CONVENTIONS).
+   Colours may be straight or premultiplied by alpha: each function says which
+   it expects. Images the library creates come from tt_image_create and its
+   kin and are freed with tt_image_free. You may also fill this struct
+   yourself to hand the library your own pixels (a view): leave `allocator`
+   zeroed and never pass a view to tt_image_free. */
 typedef struct tt_image {
     int width, height;
     float *pixels;              /* 4 * width * height */
