@@ -2010,8 +2010,8 @@ typedef struct tt_bake_options {
    their gutters cover plus one pass over the atlas. options may be NULL
    (no gutter).
    Material maps: bake each map with the same pastes, UVs and options, from
-   patches cut from that map with the same mask or seed (tt_make_texture_
-   patch), and the maps line up texel for texel. Normal-map patches (kind
+   patches cut from that map with the same mask or seed
+   (tt_make_texture_patch), and the maps line up texel for texel. Normal-map patches (kind
    TT_IMAGE_NORMAL, all of them) have their vectors turned, per face and
    paste, from the patch's frame into the atlas's (the rotation nearest the
    map between the two), composited, and renormalised; texels nothing
@@ -3038,8 +3038,8 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
 /* The atlas is of the tilesets' kind (a normal map when they are).
    Errors: NULL arguments, a bad allocator, tilesets of different layouts
    or kinds, a plain tileset with vertical windows or an upright one
-   without, edge windows that differ (TT_ERROR_INVALID_ARGUMENT); a level that is not in
-   both tilesets (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
+   without, edge windows that differ (TT_ERROR_INVALID_ARGUMENT); a level
+   that is not in both tilesets (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
    failure; free it with tt_image_free. */
 TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
                                           const tt_allocator *allocator, tt_image **out_image, tt_error *error);
