@@ -5250,7 +5250,7 @@ TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int
 TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const tt_allocator *allocator,
                                   tt_image **out_image, tt_error *error)
 {
-    int odd, x, y;
+    int turns, odd, x, y;
     tt_image *dst;
     tt_result result;
     tt__ok(error);
@@ -5258,7 +5258,8 @@ TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const 
     *out_image = NULL;
     if (!src || !src->pixels)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
-    odd = (((quarter_turns % 4) + 4) % 4) & 1;
+    turns = ((quarter_turns % 4) + 4) % 4;
+    odd = turns & 1;
     result = tt_image_create(odd ? src->height : src->width, odd ? src->width : src->height, allocator, &dst, error);
     if (result != TT_OK) return result;
     dst->kind = src->kind;
@@ -5270,8 +5271,9 @@ TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const 
             to = dst->pixels + ((size_t)ry * dst->width + rx) * 4;
             memcpy(to, src->pixels + ((size_t)y * src->width + x) * 4, 4 * sizeof(float));
             if (src->kind == TT_IMAGE_NORMAL) {
+                /* each counter-clockwise quarter turn: (x, y) -> (-y, x) */
                 int turn;
-                for (turn = 0; turn < (((quarter_turns % 4) + 4) % 4); turn++) {
+                for (turn = 0; turn < turns; turn++) {
                     float vx = to[0];
                     to[0] = -to[1];
                     to[1] = vx;
