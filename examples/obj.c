@@ -609,17 +609,6 @@ int obj_parse(const char *text, size_t length, obj_mesh *out, char *err, size_t 
     return obj_parse_named(text, length, NULL, out, err, err_size);
 }
 
-int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size)
-{
-    unsigned char *data;
-    size_t size;
-    int result;
-    memset(out, 0, sizeof *out);
-    if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
-    result = obj_read_text(path, (const char *)data, size, out, err, err_size);
-    free(data);
-    return result;
-}
 
 int obj_read_text(const char *path, const char *text, size_t size, obj_mesh *out, char *err, size_t err_size)
 {

@@ -13,7 +13,7 @@
                  progress, time          tool_progress, tool_seconds_now
      cli.c       command-line helpers    tool_option, parse_int, parse_mesh_option, ...
      image_io.c  images                  image_load, png_encode, output_add_png
-     obj.c       OBJ reading, writing    obj_parse, obj_read, obj_write
+     obj.c       OBJ reading, writing    obj_parse, obj_read_text, obj_write
      gltf.c      glTF 2.0 binary (.glb)  gltf_write, output_add_glb,
                                          gltf_pack_metallic_roughness
      mesh_file.c any mesh file, --weld   mesh_read, mesh_weld
@@ -462,10 +462,9 @@ int obj_corner_normals(const char *path, const obj_mesh *mesh, float **out);
    corners are faces one after another, the library's index-buffer layout. */
 tt_mesh_desc obj_mesh_desc(const obj_mesh *mesh, unsigned flags);
 
-/* Read and parse a file; messages start with the path ("mesh.obj:12: ...").
-   Unknown statements give one tool_note naming the first and the count. */
-int obj_read(const char *path, obj_mesh *out, char *err, size_t err_size);
-/* The same on text already read from `path` (size bytes). */
+/* Parse the text of the OBJ file `path` (size bytes; mesh_read reads the
+   file); messages start with the path ("mesh.obj:12: ..."). Unknown
+   statements give one tool_note naming the first and the count. */
 int obj_read_text(const char *path, const char *text, size_t size, obj_mesh *out, char *err, size_t err_size);
 void obj_free(obj_mesh *mesh);
 

@@ -62,18 +62,6 @@ static void check_read(const obj_mesh *m, int welded)
         }
 }
 
-static void check_zeroed(const obj_mesh *m)
-{
-    CHECK(m->nverts == 0 && m->nfaces == 0 && m->ncorners == 0 && m->nuvs == 0 && m->nnormals == 0 &&
-              m->ngroups == 0 && m->nmaterials == 0,
-          "failed read left counts %d %d %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->nnormals,
-          m->ngroups, m->nmaterials);
-    CHECK(!m->pos && !m->face_size && !m->corner_vert && !m->uv && !m->corner_uv && !m->normal &&
-              !m->corner_normal && !m->face_group && !m->group_names && !m->face_material && !m->material_names &&
-              !m->mtllib && !m->vert_line && !m->face_line,
-          "failed read left pointers behind");
-}
-
 /* The library on what was read: built permissively, one linear step and
    its sources, which carry the corners' positions to the step's. */
 static void feed_library(const obj_mesh *m)
@@ -166,7 +154,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         CHECK(n > 0 && n < sizeof err, "message length %lu", (unsigned long)n);
         CHECK(strncmp(err, name, strlen(name)) == 0, "the message does not name the file: %s", err);
         CHECK(!memchr(err, '\n', n), "the message is more than one line: %s", err);
-        check_zeroed(&m);
+        fz_check_obj_zeroed(&m);
         obj_free(&m);
     } else {
         check_read(&m, weld);

@@ -98,17 +98,6 @@ static void check_parsed(const obj_mesh *m)
     if (m->mtllib) (void)strlen(m->mtllib);
 }
 
-static void check_zeroed(const obj_mesh *m)
-{
-    CHECK(m->nverts == 0 && m->nfaces == 0 && m->ncorners == 0 && m->nuvs == 0 && m->nnormals == 0 &&
-              m->ngroups == 0 && m->nmaterials == 0,
-          "failed parse left counts %d %d %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->nnormals,
-          m->ngroups, m->nmaterials);
-    CHECK(!m->pos && !m->face_size && !m->corner_vert && !m->uv && !m->corner_uv && !m->normal &&
-              !m->corner_normal && !m->face_group &&
-              !m->group_names && !m->face_material && !m->material_names && !m->mtllib,
-          "failed parse left pointers behind");
-}
 
 static void feed_library(const obj_mesh *m)
 {
@@ -294,7 +283,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         size_t len = bounded_strlen(err, sizeof err);
         CHECK(rc == -1, "obj_parse returned %d", rc);
         CHECK(len > 0 && len < sizeof err, "message length %lu", (unsigned long)len);
-        check_zeroed(&m);
+        fz_check_obj_zeroed(&m);
         obj_free(&m);
         return 0;
     }

@@ -1,5 +1,5 @@
 /* fuzz_obj_mesh.h - the checks the fuzz targets of the tool's mesh readers
-   (fuzz_obj, fuzz_mesh_file) share on an obj_mesh they read: include after
+   (fuzz_obj, fuzz_mesh_file) share on an obj_mesh they read, or failed to: include after
    fuzz_common.h and tool.h. */
 #ifndef TILEDTEX_FUZZ_OBJ_MESH_H
 #define TILEDTEX_FUZZ_OBJ_MESH_H
@@ -22,6 +22,19 @@ static inline void fz_check_obj_faces(const obj_mesh *m)
     for (i = 0; i < m->ncorners; ++i)
         CHECK(m->corner_vert[i] >= 0 && m->corner_vert[i] < m->nverts, "corner %d vertex %d of %d", i,
               m->corner_vert[i], m->nverts);
+}
+
+/* A failed read leaves the mesh zeroed: no counts, no arrays. */
+static inline void fz_check_obj_zeroed(const obj_mesh *m)
+{
+    CHECK(m->nverts == 0 && m->nfaces == 0 && m->ncorners == 0 && m->nuvs == 0 && m->nnormals == 0 &&
+              m->ngroups == 0 && m->nmaterials == 0,
+          "failed read left counts %d %d %d %d %d %d %d", m->nverts, m->nfaces, m->ncorners, m->nuvs, m->nnormals,
+          m->ngroups, m->nmaterials);
+    CHECK(!m->pos && !m->face_size && !m->corner_vert && !m->uv && !m->corner_uv && !m->normal &&
+              !m->corner_normal && !m->face_group && !m->group_names && !m->face_material && !m->material_names &&
+              !m->mtllib && !m->vert_line && !m->face_line,
+          "failed read left pointers behind");
 }
 
 #endif /* TILEDTEX_FUZZ_OBJ_MESH_H */
