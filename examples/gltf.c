@@ -423,17 +423,12 @@ static int make_tangents(const obj_write_desc *mesh, glb_vertices *v)
             const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[corner[0]];
             const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[corner[1]];
             const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[corner[2]];
-            const float *t0 = mesh->corner_uv + 2 * (size_t)corner[0];
-            const float *t1 = mesh->corner_uv + 2 * (size_t)corner[1];
-            const float *t2 = mesh->corner_uv + 2 * (size_t)corner[2];
-            double du1 = (double)t1[0] - t0[0], dv1 = (double)t1[1] - t0[1];
-            double du2 = (double)t2[0] - t0[0], dv2 = (double)t2[1] - t0[1];
-            double det = du1 * dv2 - du2 * dv1, axes[6], lt = 0.0, lb = 0.0;
-            if (!(fabs(det) > 0.0)) continue;
+            double axes[6], lt = 0.0, lb = 0.0;
+            if (triangle_texture_axes(p0, p1, p2, mesh->corner_uv + 2 * (size_t)corner[0],
+                                      mesh->corner_uv + 2 * (size_t)corner[1], mesh->corner_uv + 2 * (size_t)corner[2],
+                                      axes) != 0)
+                continue;
             for (k = 0; k < 3; k++) {
-                double e1 = (double)p1[k] - p0[k], e2 = (double)p2[k] - p0[k];
-                axes[k] = (e1 * dv2 - e2 * dv1) / det;       /* dP/du */
-                axes[3 + k] = (e2 * du1 - e1 * du2) / det;   /* dP/dv */
                 lt += axes[k] * axes[k];
                 lb += axes[3 + k] * axes[3 + k];
             }

@@ -290,7 +290,8 @@ typedef struct scene {
     float *corner_normal;       /* 3 per OBJ corner, unit length */
     float *screen;              /* 3 per vertex: x and y in samples, then q = 1 / depth */
     const mip_texture *textures; /* the textures faces are drawn with */
-    const mip_texture *normal_map; /* --normal: a tangent-space normal map over the same UVs, or NULL */
+    const mip_texture *normal_map; /* a tangent-space normal map over the same UVs, or NULL */
+    float *triangle_axes;       /* with a normal map: 6 per triangle, its dP/du and dP/dv (zero: none) */
     const int *face_texture;    /* per OBJ face: index into textures, -1: draw grey */
     int wireframe;              /* draw the OBJ faces' edges over the surface */
     vec3 light_key, light_fill; /* unit vectors towards the two lights */
@@ -307,6 +308,7 @@ static void scene_free(scene *s)
     free(s->triangle_shape);
     free(s->triangle_facing);
     free(s->corner_normal);
+    free(s->triangle_axes);
     free(s->screen);
     memset(s, 0, sizeof *s);
 }
@@ -737,31 +739,40 @@ static void texture_color(const scene *s, int t, const surface_point *point, flo
     }
 }
 
+/* Each triangle's texture axes (triangle_texture_axes), once, for
+   mapped_normal; zero for a triangle without texture coordinates. Returns
+   -1 when out of memory. */
+static int scene_texture_axes(scene *s)
+{
+    const obj_mesh *mesh = s->mesh;
+    int t, k;
+    s->triangle_axes = (float *)calloc((size_t)s->ntriangles * 6, sizeof(float));
+    if (!s->triangle_axes) return -1;
+    for (t = 0; t < s->ntriangles && mesh->corner_uv; t++) {
+        const int *corner = s->triangle_corners + 3 * t;
+        const float *p[3], *uv[3];
+        double axes[6];
+        for (k = 0; k < 3; k++) {
+            if (mesh->corner_uv[corner[k]] < 0) break;
+            p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner[k]];
+            uv[k] = mesh->uv + 2 * (size_t)mesh->corner_uv[corner[k]];
+        }
+        if (k < 3 || triangle_texture_axes(p[0], p[1], p[2], uv[0], uv[1], uv[2], axes) != 0) continue;
+        for (k = 0; k < 6; k++) s->triangle_axes[6 * (size_t)t + k] = (float)axes[k];
+    }
+    return 0;
+}
+
 /* The normal a tangent-space normal map gives at a point of triangle t
    whose interpolated normal is n: the map's vector in the frame of the
    triangle's texture axes (tangent along +u, bitangent along +v, each made
    perpendicular to n) - the frame glTF and Blender build from the UVs. */
 static vec3 mapped_normal(const scene *s, int t, const surface_point *point, vec3 n)
 {
-    const obj_mesh *mesh = s->mesh;
-    const int *corner = s->triangle_corners + 3 * t;
-    float uv[6], sample[4], du1, dv1, du2, dv2, det;
-    vec3 p0, e1, e2, tangent, bitangent;
-    const float *a, *b, *c;
-    if (!surface_uv(s, t, point, uv)) return n;
-    a = mesh->uv + 2 * mesh->corner_uv[corner[0]];
-    b = mesh->uv + 2 * mesh->corner_uv[corner[1]];
-    c = mesh->uv + 2 * mesh->corner_uv[corner[2]];
-    p0 = vertex_position(mesh, mesh->corner_vert[corner[0]]);
-    e1 = vec3_sub(vertex_position(mesh, mesh->corner_vert[corner[1]]), p0);
-    e2 = vec3_sub(vertex_position(mesh, mesh->corner_vert[corner[2]]), p0);
-    du1 = b[0] - a[0]; dv1 = b[1] - a[1];
-    du2 = c[0] - a[0]; dv2 = c[1] - a[1];
-    det = du1 * dv2 - du2 * dv1;
-    if (det == 0.0f) return n;
-    /* dP/du and dP/dv of the triangle's linear map */
-    tangent = vec3_scale(vec3_sub(vec3_scale(e1, dv2), vec3_scale(e2, dv1)), 1.0f / det);
-    bitangent = vec3_scale(vec3_sub(vec3_scale(e2, du1), vec3_scale(e1, du2)), 1.0f / det);
+    const float *axes = s->triangle_axes + 6 * (size_t)t;
+    float uv[6], sample[4];
+    vec3 tangent = vec3_make(axes[0], axes[1], axes[2]), bitangent = vec3_make(axes[3], axes[4], axes[5]);
+    if (vec3_dot(tangent, tangent) == 0.0f || !surface_uv(s, t, point, uv)) return n;
     tangent = vec3_normalize(vec3_sub(tangent, vec3_scale(n, vec3_dot(tangent, n))));
     bitangent = vec3_normalize(vec3_sub(bitangent, vec3_scale(n, vec3_dot(bitangent, n))));
     sample_surface(s->normal_map, uv, 1, sample);
@@ -1191,6 +1202,10 @@ int cmd_render(int argc, char **argv)
             goto done;
         }
         s.normal_map = &normal_map;
+    }
+    if (s.normal_map && scene_texture_axes(&s) != 0) {
+        tool_fail("out of memory while rendering %s", positional[0]);
+        goto done;
     }
     s.textures = textures.textures;
     s.face_texture = textures.face_texture;
