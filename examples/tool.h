@@ -670,6 +670,16 @@ int gltf_write(const obj_write_desc *mesh, const tool_material *material, const 
    PATH, and the failure exit status. */
 int output_add_glb(tool_output *output, const char *path, const obj_write_desc *mesh, const tool_material *material);
 
+/* A triangle's texture axes: dP/du into axes[0..2] and dP/dv into
+   axes[3..5], the derivatives of the linear map its corners' texture
+   coordinates t0, t1, t2 (v up, as in OBJ) make from positions p0, p1, p2.
+   The frame a tangent-space normal map is read in (x along +u, y along +v),
+   for the GLB's tangents and render's normal mapping. Returns 0, or -1
+   (axes zeroed) when the coordinates span no area or the axes are not
+   finite. */
+int triangle_texture_axes(const float *p0, const float *p1, const float *p2, const float *t0, const float *t1,
+                          const float *t2, double axes[6]);
+
 /* ---------------------------------------------------------------------- */
 /* Meshes refined and repaired: --subdivide, --smooth, --permissive         */
 /* (cli.c parses them, triangle_mesh.c applies them)                        */
@@ -753,15 +763,6 @@ void triangle_mesh_free(triangle_mesh *m);
    after printing the error. */
 int triangle_mesh_reverse(const char *path, triangle_mesh *m);
 
-/* A triangle's texture axes: dP/du into axes[0..2] and dP/dv into
-   axes[3..5], the derivatives of the linear map its corners' texture
-   coordinates t0, t1, t2 (v up, as in OBJ) make from positions p0, p1, p2.
-   The frame a tangent-space normal map is read in (x along +u, y along +v),
-   for the GLB's tangents and render's normal mapping. Returns 0, or -1
-   (axes zeroed) when the coordinates span no area or the axes are not
-   finite. */
-int triangle_texture_axes(const float *p0, const float *p1, const float *p2, const float *t0, const float *t1,
-                          const float *t2, double axes[6]);
 
 /* A library error about the triangles said the OBJ's way: the library counts
    faces from 0 and means the triangles. rewrite_face writes error->message

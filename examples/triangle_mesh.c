@@ -375,25 +375,3 @@ int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const t
     triangle_mesh_rewrite_face(m, error, message, sizeof message);
     return tool_fail("%s:%d: %s", path, m->obj.face_line[m->face[error->face]], message);
 }
-
-int triangle_texture_axes(const float *p0, const float *p1, const float *p2, const float *t0, const float *t1,
-                          const float *t2, double axes[6])
-{
-    double du1 = (double)t1[0] - t0[0], dv1 = (double)t1[1] - t0[1];
-    double du2 = (double)t2[0] - t0[0], dv2 = (double)t2[1] - t0[1];
-    double det = du1 * dv2 - du2 * dv1;
-    int k;
-    for (k = 0; k < 6; k++) axes[k] = 0.0;
-    if (!(fabs(det) > 0.0)) return -1;
-    for (k = 0; k < 3; k++) {
-        double e1 = (double)p1[k] - p0[k], e2 = (double)p2[k] - p0[k];
-        axes[k] = (e1 * dv2 - e2 * dv1) / det;
-        axes[3 + k] = (e2 * du1 - e1 * du2) / det;
-    }
-    for (k = 0; k < 6; k++)
-        if (!isfinite(axes[k])) {
-            for (k = 0; k < 6; k++) axes[k] = 0.0;
-            return -1;
-        }
-    return 0;
-}
