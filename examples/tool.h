@@ -15,7 +15,8 @@
      image_io.c  images                  image_load, png_encode, output_add_png
      obj.c       OBJ reading, writing    obj_parse, obj_read_text, obj_write
      gltf.c      glTF 2.0 binary (.glb)  gltf_write, output_add_glb,
-                                         gltf_pack_metallic_roughness
+                                         gltf_pack_metallic_roughness,
+                 tangent frames          triangle_texture_axes
      mesh_file.c any mesh file, --weld   mesh_read, mesh_weld
                  MTL writing             mtl_add_material, output_add_mtl
      material.c  a material's maps       material_parse_option, material_load,
