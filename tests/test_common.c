@@ -432,19 +432,33 @@ tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_
 /* main                                                                     */
 /* ------------------------------------------------------------------------ */
 
+/* TT_TEST_ONLY=hpm,polycube runs only those sections (names as below): a
+   quick loop while working on one section; `make test` runs them all. */
+static int section_selected(const char *name)
+{
+    const char *only = getenv("TT_TEST_ONLY"), *p;
+    size_t len = strlen(name);
+    if (!only || !*only) return 1;
+    for (p = only; *p;) {
+        const char *end = strchr(p, ',');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        if (n == len && strncmp(p, name, len) == 0) return 1;
+        p += n;
+        if (*p == ',') p++;
+    }
+    return 0;
+}
+
 int main(void)
 {
-    run_common_tests();
-    run_mesh_tests();
-    run_image_tests();
-    run_numerics_tests();
-    run_fft_tests();
-    run_raster_tests();
-    run_tiled_tests();
-    run_tiled_synthesis_tests();
-    run_lapped_tests();
-    run_hpm_tests();
-    run_polycube_tests();
+    static const struct { const char *name; void (*run)(void); } sections[] = {
+        {"common", run_common_tests}, {"mesh", run_mesh_tests}, {"image", run_image_tests},
+        {"numerics", run_numerics_tests}, {"fft", run_fft_tests}, {"raster", run_raster_tests},
+        {"tiled", run_tiled_tests}, {"synthesis", run_tiled_synthesis_tests},
+        {"lapped", run_lapped_tests}, {"hpm", run_hpm_tests}, {"polycube", run_polycube_tests}};
+    size_t i;
+    for (i = 0; i < sizeof sections / sizeof sections[0]; i++)
+        if (section_selected(sections[i].name)) sections[i].run();
     printf("%d passed, %d failed\n", g_passed, g_failed);
     return g_failed ? 1 : 0;
 }
