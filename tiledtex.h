@@ -253,6 +253,25 @@ typedef struct tt_allocator {
    and returns TT_CANCELLED. */
 typedef int (*tt_progress_fn)(float fraction, void *user_data);
 
+/* Parallel work through the caller's threads (optional). The library never
+   starts a thread: where work splits into independent tasks, a function whose
+   options carry an executor hands the tasks to it, so an engine's job system
+   (or the tool's thread pool) runs them. `run` must call task(task_context,
+   i) exactly once for every i in [0, count), on any threads and in any
+   order, and return only when every call has returned. Tasks write disjoint
+   outputs and the library splits work the same way whatever the executor
+   does, so results are bit-identical with any number of workers (or none).
+   While `run` is active the library may call the allocator from those
+   threads: with an executor, the allocator must be thread-safe (TT_MALLOC /
+   TT_FREE, i.e. malloc and free, are). Progress callbacks are only ever
+   called on the thread that called the library. A NULL executor, or one
+   whose run is NULL, means serial on the calling thread. */
+typedef void (*tt_task_fn)(void *task_context, int index);
+typedef struct tt_executor {
+    void (*run)(int count, tt_task_fn task, void *task_context, void *user_data);
+    void *user_data;
+} tt_executor;
+
 /* The library's version at run time, which may differ from the
    TILEDTEX_VERSION_* macros your code was compiled with when the
    implementation lives in another file: the string, and the numbers through
@@ -1194,11 +1213,14 @@ typedef struct tt_synth_options {
        run from 0 to 1. */
     tt_progress_fn progress;
     void *progress_user_data;
+    /* Runs the tiles in parallel (tt_synth_plan_create copies it into the
+       plan, for tt_synth_apply); NULL: serial. Same tiles either way. */
+    const tt_executor *executor;
 } tt_synth_options;
 
 /* A synthesis plan: everything that decides the tiles except the texels they
    are made of. Read its fields freely; only progress and progress_user_data
-   may be changed (before an apply). Made by tt_synth_plan_create, freed by
+   and executor may be changed (before an apply). Made by tt_synth_plan_create, freed by
    tt_synth_plan_free.
 
    The band of side s (0 bottom, 1 right, 2 top, 3 left: e0..e3) is described
@@ -1232,6 +1254,7 @@ typedef struct tt_synth_plan {
     uint16_t *depth16;
     tt_progress_fn progress;        /* copied from the options; tt_synth_apply reports to it */
     void *progress_user_data;
+    const tt_executor *executor;    /* copied from the options; tt_synth_apply runs its tiles on it */
     tt_allocator allocator;         /* the one it was made with */
 } tt_synth_plan;
 
@@ -1396,6 +1419,7 @@ typedef struct tt_seam_options {
        edge. The same-face and unrelated references are taken as always. */
     const int *edges;
     int nedges;
+    const tt_executor *executor;   /* measures ranges of edges in parallel; NULL: serial; same report */
 } tt_seam_options;
 
 typedef struct tt_seam_report {
@@ -3238,6 +3262,57 @@ static void *tt__alloc_array(const tt_allocator *allocator, size_t count, size_t
 }
 
 #define TT__ALLOC(allocator, type, count) ((type *)tt__alloc_array((allocator), (size_t)(count), sizeof(type)))
+
+/* task(context, i) for every i in [0, count): through the executor when
+   there is one and more than one task, else in order on this thread. */
+static void tt__run_tasks(const tt_executor *executor, int count, tt_task_fn task, void *context)
+{
+    int i;
+    if (count <= 0) return;
+    if (executor && executor->run && count > 1) {
+        executor->run(count, task, context, executor->user_data);
+        return;
+    }
+    for (i = 0; i < count; i++) task(context, i);
+}
+
+/* A loop over [0, n) cut into ranges of `grain` items (the last shorter),
+   each range one task: body(context, begin, end). The cut depends on n and
+   grain only, never on the executor, so per-range results combined in range
+   order are the same with any number of workers. */
+typedef void (*tt__range_fn)(void *context, int begin, int end);
+typedef struct tt__ranges {
+    tt__range_fn body;
+    void *context;
+    int n, grain;
+} tt__ranges;
+
+static void tt__ranges_task(void *context, int index)
+{
+    const tt__ranges *r = (const tt__ranges *)context;
+    int begin = index * r->grain;
+    int end = r->n - begin > r->grain ? begin + r->grain : r->n;
+    r->body(r->context, begin, end);
+}
+
+/* The number of ranges tt__parallel_ranges cuts [0, n) into. */
+static int tt__range_count(int n, int grain)
+{
+    if (n <= 0) return 0;
+    if (grain < 1) grain = 1;
+    return n / grain + (n % grain != 0);
+}
+
+static void tt__parallel_ranges(const tt_executor *executor, int n, int grain, tt__range_fn body, void *context)
+{
+    tt__ranges r;
+    if (n <= 0) return;
+    r.body = body;
+    r.context = context;
+    r.n = n;
+    r.grain = grain < 1 ? 1 : grain;
+    tt__run_tasks(executor, tt__range_count(n, r.grain), tt__ranges_task, &r);
+}
 
 /* Growable array: `array` (holding *capacity elements of `size` bytes)
    grown to hold at least `need`, doubling; NULL when out of memory, the old
@@ -7876,6 +7951,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     else plan->depth16 = (uint16_t *)(void *)((unsigned char *)plan + head + edge_bytes + background_bytes);
     plan->progress = opt->progress;
     plan->progress_user_data = opt->progress_user_data;
+    plan->executor = opt->executor;
     plan->allocator = tt__allocator_copy(allocator);
 
     tt_rng_seed(&rng, opt->seed, 0x74696c6573ull /* "tiles" */);
@@ -8074,6 +8150,37 @@ TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image 
     return TT_OK;
 }
 
+/* Tiles composed per batch of tasks with an executor: enough to keep
+   workers busy, few enough that progress (and cancelling) comes often.
+   Serial runs report every tile. */
+#define TT__SYNTH_BATCH 64
+
+typedef struct tt__compose_job {
+    const tt_synth_plan *plan;
+    const tt_image *source;
+    tt_image *atlas;
+    int first, count;
+} tt__compose_job;
+
+/* Tile job->first + index into its cell of the atlas. */
+static void tt__compose_task(void *context, int index)
+{
+    const tt__compose_job *job = (const tt__compose_job *)context;
+    const tt_synth_plan *plan = job->plan;
+    int t = job->first + index, n = plan->layout.colors, base = 2 * n;
+    int T = tt_tile_layout_tiles_per_side(&plan->layout), C = plan->layout.tile_size + 2 * plan->layout.gutter;
+    int column = t % T, row = t / T, W = job->atlas->width;
+    uint8_t types[4];
+    types[0] = (uint8_t)(column / base);
+    types[1] = (uint8_t)(column % base);
+    types[2] = (uint8_t)(row / base);
+    types[3] = (uint8_t)(row % base);
+    /* Tile row 0 of the formula is at the bottom of the atlas image. */
+    tt__compose_cell(plan, job->source, types, t,
+                     job->atlas->pixels + ((size_t)(T - 1 - row) * C * (size_t)W + (size_t)column * C) * 4,
+                     (size_t)W * 4);
+}
+
 static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *source, const tt_allocator *allocator,
                                  tt_tileset **out, tt_error *error, int check_source, float progress_from,
                                  float progress_to)
@@ -8123,21 +8230,23 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
     set->levels[0].kind = source->kind;
     set->nlevels = 1;
 
-    for (t = 0; t < ntiles; t++) {
-        int column = t % T, row = t / T, base = 2 * n;
-        uint8_t types[4];
-        tt_image *atlas = &set->levels[0];
-        types[0] = (uint8_t)(column / base);
-        types[1] = (uint8_t)(column % base);
-        types[2] = (uint8_t)(row / base);
-        types[3] = (uint8_t)(row % base);
-        /* Tile row 0 of the formula is at the bottom of the atlas image. */
-        tt__compose_cell(plan, source, types, t,
-                         atlas->pixels + ((size_t)(T - 1 - row) * C * (size_t)W + (size_t)column * C) * 4,
-                         (size_t)W * 4);
-        if (tt__synth_report(plan->progress, plan->progress_user_data, progress_from, progress_to, t + 1, ntiles)) {
-            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "tile synthesis was cancelled");
-            goto done;
+    /* The tiles in batches: each cell of the atlas is its own task, and the
+       progress callback is called between batches, on this thread. */
+    {
+        tt__compose_job job;
+        job.plan = plan;
+        job.source = source;
+        job.atlas = &set->levels[0];
+        int batch = plan->executor && plan->executor->run ? TT__SYNTH_BATCH : 1;
+        for (t = 0; t < ntiles; t += batch) {
+            job.first = t;
+            job.count = tt__min_i(batch, ntiles - t);
+            tt__run_tasks(plan->executor, job.count, tt__compose_task, &job);
+            if (tt__synth_report(plan->progress, plan->progress_user_data, progress_from, progress_to,
+                                 t + job.count, ntiles)) {
+                result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "tile synthesis was cancelled");
+                goto done;
+            }
         }
     }
 
@@ -8253,12 +8362,71 @@ static int tt__edge_uv_discontinuous(const tt_mesh *mesh, const float *uv, int a
     return 0;
 }
 
+/* Edges a range of the seam measure holds (see tt_measure_seams). */
+#define TT__SEAM_RANGE 512
+
+typedef struct tt__seam_sums {
+    double seam, same, unrelated;
+    long long samples;
+    int edges;
+} tt__seam_sums;
+
+typedef struct tt__seam_job {
+    const tt_mesh *mesh;
+    const float *corner_uv;
+    const tt_image *atlas;
+    tt_wrap wrap;
+    const int *interior;
+    int ninterior, points_per_edge;
+    uint64_t seed;
+    tt__seam_sums *sums;        /* one per range */
+} tt__seam_job;
+
+/* Measured edges interior[begin .. end-1]: points stratified along each edge
+   (the twin runs the other way), each against the same face a texel deeper
+   and against a random point of another interior edge. */
+static void tt__seam_range(void *context, int begin, int end)
+{
+    const tt__seam_job *job = (const tt__seam_job *)context;
+    const tt_mesh *mesh = job->mesh;
+    tt__seam_sums *sum = &job->sums[begin / TT__SEAM_RANGE];
+    tt_rng rng;
+    int i, j, ppe = job->points_per_edge;
+    memset(sum, 0, sizeof *sum);
+    tt_rng_seed(&rng, job->seed, 0x7365616d73ull /* "seams" */ + 1u + (uint64_t)(begin / TT__SEAM_RANGE));
+    for (i = begin; i < end; i++) {
+        int a = job->interior[i], b = mesh->twin[a], edge_samples = 0;
+        for (j = 0; j < ppe; j++) {
+            float t = ((float)j + tt_rng_float(&rng)) / (float)ppe;
+            int other = job->interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(job->ninterior - 1))) %
+                                      job->ninterior];
+            float t_other = tt_rng_float(&rng);
+            tt__edge_point pa, pb, po;
+            float sa[3], sa_deeper[3], sb[3], so[3];
+            if (!tt__edge_point_at(mesh, job->corner_uv, job->atlas, a, t, &pa) ||
+                !tt__edge_point_at(mesh, job->corner_uv, job->atlas, b, 1.0f - t, &pb) ||
+                !tt__edge_point_at(mesh, job->corner_uv, job->atlas, other, t_other, &po))
+                continue;
+            tt__displayed(job->atlas, job->wrap, &pa, 0.5f, sa);
+            tt__displayed(job->atlas, job->wrap, &pa, 1.5f, sa_deeper);
+            tt__displayed(job->atlas, job->wrap, &pb, 0.5f, sb);
+            tt__displayed(job->atlas, job->wrap, &po, 0.5f, so);
+            sum->seam += tt__texel_difference(sa, sb);
+            sum->same += tt__texel_difference(sa, sa_deeper);
+            sum->unrelated += tt__texel_difference(sa, so);
+            sum->samples++;
+            edge_samples++;
+        }
+        if (edge_samples > 0) sum->edges++;
+    }
+}
+
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  const tt_seam_options *options, const tt_allocator *allocator,
                                  tt_seam_report *report, tt_error *error)
 {
     const unsigned known_flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
-    int *interior, ninterior = 0, npopulation, nmeasured, ndiscontinuous = 0, c, i, j, points_per_edge;
+    int *interior, ninterior = 0, npopulation, nmeasured, ndiscontinuous = 0, c, i, points_per_edge;
     unsigned char *listed;      /* with an edge list: per corner, 1 on the lower corner of a listed edge */
     double seam = 0.0, same = 0.0, unrelated = 0.0;
     long long samples = 0;
@@ -8361,32 +8529,36 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         }
     }
     /* Four points an edge, more on small meshes so that every measure rests
-       on a few thousand samples. */
+       on a few thousand samples. The edges are measured in ranges, each with
+       its own random stream and sums, added in range order: the same score
+       whatever runs the ranges. */
     points_per_edge = nmeasured > 0 ? tt__clamp_i(4096 / nmeasured, 4, 64) : 4;
-    for (i = 0; i < nmeasured && ninterior > 1; i++) {
-        int a = interior[i], b = mesh->twin[a], edge_samples = 0;
-        for (j = 0; j < points_per_edge; j++) {
-            /* Stratified along the edge; the twin runs the other way. */
-            float t = ((float)j + tt_rng_float(&rng)) / (float)points_per_edge;
-            int other = interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(ninterior - 1))) % ninterior];
-            float t_other = tt_rng_float(&rng);
-            tt__edge_point pa, pb, po;
-            float sa[3], sa_deeper[3], sb[3], so[3];
-            if (!tt__edge_point_at(mesh, corner_uv, atlas, a, t, &pa) ||
-                !tt__edge_point_at(mesh, corner_uv, atlas, b, 1.0f - t, &pb) ||
-                !tt__edge_point_at(mesh, corner_uv, atlas, other, t_other, &po))
-                continue;
-            tt__displayed(atlas, wrap, &pa, 0.5f, sa);
-            tt__displayed(atlas, wrap, &pa, 1.5f, sa_deeper);
-            tt__displayed(atlas, wrap, &pb, 0.5f, sb);
-            tt__displayed(atlas, wrap, &po, 0.5f, so);
-            seam += tt__texel_difference(sa, sb);
-            same += tt__texel_difference(sa, sa_deeper);
-            unrelated += tt__texel_difference(sa, so);
-            samples++;
-            edge_samples++;
+    if (ninterior > 1 && nmeasured > 0) {
+        tt__seam_job job;
+        int nranges = tt__range_count(nmeasured, TT__SEAM_RANGE);
+        job.sums = TT__ALLOC(allocator, tt__seam_sums, nranges);
+        if (!job.sums) {
+            tt__free(allocator, interior);
+            return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d edges",
+                            nmeasured);
         }
-        if (edge_samples > 0) report->edges_measured++;
+        job.mesh = mesh;
+        job.corner_uv = corner_uv;
+        job.atlas = atlas;
+        job.wrap = wrap;
+        job.interior = interior;
+        job.ninterior = ninterior;
+        job.points_per_edge = points_per_edge;
+        job.seed = opt.seed;
+        tt__parallel_ranges(opt.executor, nmeasured, TT__SEAM_RANGE, tt__seam_range, &job);
+        for (i = 0; i < nranges; i++) {
+            seam += job.sums[i].seam;
+            same += job.sums[i].same;
+            unrelated += job.sums[i].unrelated;
+            samples += job.sums[i].samples;
+            report->edges_measured += job.sums[i].edges;
+        }
+        tt__free(allocator, job.sums);
     }
     tt__free(allocator, interior);
     if (samples == 0) {

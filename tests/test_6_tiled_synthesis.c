@@ -370,6 +370,45 @@ static void test_plan_wide_depths(void)
 /* The per-tile step                                                        */
 /* ------------------------------------------------------------------------ */
 
+/* The tiles composed through an executor (reverse order, two threads) are
+   the serial ones bit for bit, at every mip level, plain and upright. */
+static void test_synthesis_executor_identical(void)
+{
+    static const int configs[][3] = {{1, 32, 4}, {2, 16, 2}};
+    const tt_executor *executors[2];
+    size_t c, e;
+    executors[0] = &g_reverse_executor;
+    executors[1] = &g_thread_executor;
+    for (c = 0; c < sizeof configs / sizeof configs[0]; c++) {
+        tt_image *src = sy_noise(96, 96, 71u + (unsigned)c);
+        tt_synth_options o = sy_options(configs[c][0], configs[c][1], configs[c][2], 9u + c);
+        tt_tileset *serial = NULL;
+        tt_error err;
+        tt_result r;
+        o.upright = (int)c;
+        r = tt_synthesize_tiles(src, &o, NULL, &serial, &err);
+        CHECK(r == TT_OK, "config %d: serial synthesis: %d (%s)", (int)c, r, err.message);
+        for (e = 0; e < 2 && r == TT_OK; e++) {
+            tt_tileset *par = NULL;
+            int level, differ = 0;
+            o.executor = executors[e];
+            r = tt_synthesize_tiles(src, &o, NULL, &par, &err);
+            CHECK(r == TT_OK && par->nlevels == serial->nlevels, "config %d executor %d: %d (%s)", (int)c, (int)e, r,
+                  err.message);
+            for (level = 0; r == TT_OK && level < serial->nlevels; level++) {
+                const tt_image *a = &serial->levels[level], *b = &par->levels[level];
+                differ += memcmp(a->pixels, b->pixels, (size_t)a->width * (size_t)a->height * 4 * sizeof(float)) != 0;
+            }
+            CHECK(r == TT_OK && differ == 0, "config %d executor %d: %d mip levels differ from the serial run", (int)c,
+                  (int)e, differ);
+            tt_tileset_free(par);
+            o.executor = NULL;
+        }
+        tt_tileset_free(serial);
+        tt_image_free(src);
+    }
+}
+
 static void test_compose_tile_matches_apply(void)
 {
     static const int configs[][3] = {{1, 32, 4}, {2, 16, 0}, {2, 16, 3}};
@@ -1179,6 +1218,7 @@ void run_tiled_synthesis_tests(void)
     RUN(test_plan_fields);
     RUN(test_plan_wide_depths);
     RUN(test_compose_tile_matches_apply);
+    RUN(test_synthesis_executor_identical);
     RUN(test_upright_tiles);
     RUN(test_second_map_same_masks);
     RUN(test_normal_map_turns);

@@ -4,11 +4,13 @@
    program by tests/run.sh (with ASan + UBSan). Prints one line per failed
    check and, last, "N passed, M failed". Does not read any file. */
 #define TILEDTEX_IMPLEMENTATION
+#define _POSIX_C_SOURCE 200809L   /* POSIX threads under -std=c99, for g_thread_executor */
 #include "tiledtex.h"
 
 #include "test_common.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -431,6 +433,53 @@ tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_
 /* ------------------------------------------------------------------------ */
 /* main                                                                     */
 /* ------------------------------------------------------------------------ */
+
+static void reverse_run(int count, tt_task_fn task, void *task_context, void *user_data)
+{
+    int i;
+    (void)user_data;
+    for (i = count - 1; i >= 0; i--) task(task_context, i);
+}
+const tt_executor g_reverse_executor = {reverse_run, NULL};
+
+typedef struct thread_batch {
+    pthread_mutex_t lock;
+    int next, count;
+    tt_task_fn task;
+    void *task_context;
+} thread_batch;
+
+static void *thread_worker(void *arg)
+{
+    thread_batch *b = (thread_batch *)arg;
+    for (;;) {
+        int i;
+        pthread_mutex_lock(&b->lock);
+        i = b->next < b->count ? b->next++ : -1;
+        pthread_mutex_unlock(&b->lock);
+        if (i < 0) return NULL;
+        b->task(b->task_context, i);
+    }
+}
+
+/* A second thread for the batch and this one, both taking indices. */
+static void thread_run(int count, tt_task_fn task, void *task_context, void *user_data)
+{
+    thread_batch b;
+    pthread_t helper;
+    int started;
+    (void)user_data;
+    pthread_mutex_init(&b.lock, NULL);
+    b.next = 0;
+    b.count = count;
+    b.task = task;
+    b.task_context = task_context;
+    started = pthread_create(&helper, NULL, thread_worker, &b) == 0;
+    thread_worker(&b);
+    if (started) pthread_join(helper, NULL);
+    pthread_mutex_destroy(&b.lock);
+}
+const tt_executor g_thread_executor = {thread_run, NULL};
 
 /* TT_TEST_ONLY=hpm,polycube runs only those sections (names as below): a
    quick loop while working on one section; `make test` runs them all. */

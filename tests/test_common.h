@@ -144,6 +144,15 @@ float *px(const tt_image *im, int x, int y);
    fails, if it cannot be created); reseeds the LCG. */
 void make_value_noise(tt_image **im, int w, int h, unsigned seed);
 
+/* Executors for the parallel paths: each runs every task once, so results
+   must equal a serial run's bit for bit. g_reverse_executor runs them on
+   this thread in reverse order (a task reading another's output, or a
+   result that depends on order, shows); g_thread_executor on two POSIX
+   threads taking indices as they come (a data race shows under TSan, and
+   as differences elsewhere). */
+extern const tt_executor g_reverse_executor;
+extern const tt_executor g_thread_executor;
+
 /* ------------------------------------------------------------------------ */
 /* Internal functions of the implementation the tests call                  */
 /* ------------------------------------------------------------------------ */
