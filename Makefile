@@ -1,4 +1,4 @@
-# tiledtex - make / make demo / make test / make bench / make bench-build / make fuzz
+# tiledtex - make / make demo / make test / make bench / make bench-build / make bench-scale / make fuzz
 CC      ?= cc
 CFLAGS  ?= -O2 -g
 WARN    := -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes
@@ -6,7 +6,7 @@ STB_INC := $(shell pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/st
 TOOL_SRC := $(wildcard examples/*.c)
 TOOL_HDR := $(wildcard examples/*.h) tiledtex.h
 
-.PHONY: all demo test bench bench-build fuzz clean deps test-deps
+.PHONY: all demo test bench bench-build bench-scale fuzz clean deps test-deps
 
 all: build/tiledtex
 
@@ -62,14 +62,23 @@ CGAL_INC := $(wildcard /usr/include/CGAL)
 build/bench_build_cgal: bench/bench_build_cgal.cpp bench/bench_build_meshes.h bench/bench_clock.h tiledtex.h | build
 	$(CXX) -O2 -DNDEBUG -I. -Ibench bench/bench_build_cgal.cpp -o $@
 
-bench: deps build/bench build/bench_cg $(if $(EIGEN_INC),build/bench_cg_eigen) $(if $(FFTW_INC),build/bench_fft_fftw,build/bench_fft) build/bench_build $(if $(CGAL_INC),build/bench_build_cgal) build/tiledtex
+build/bench_run: bench/bench_run.c bench/bench_clock.h | build
+	$(CC) -O2 $(WARN) bench/bench_run.c -o $@
+
+# The scale figures (bench/bench_scale.sh): every pipeline on a real scan and
+# on it cut 1-to-4 and 1-to-16, at -j 1 and -j 2, beside v0.3.0 built from its
+# commit. About 25 minutes; BENCH_SCALES="1 4" for a shorter run.
+bench-scale: deps build/bench_run build/tiledtex
+	@bash bench/bench_scale.sh build/tiledtex
+
+bench: deps build/bench build/bench_run build/bench_cg $(if $(EIGEN_INC),build/bench_cg_eigen) $(if $(FFTW_INC),build/bench_fft_fftw,build/bench_fft) build/bench_build $(if $(CGAL_INC),build/bench_build_cgal) build/tiledtex
 	@./build/bench
 	@./build/bench_cg
 	@$(if $(EIGEN_INC),./build/bench_cg_eigen,echo "(no Eigen peer: apt-get install libeigen3-dev)" >&2)
 	@$(if $(FFTW_INC),./build/bench_fft_fftw,./build/bench_fft; echo "(no FFTW peer: apt-get install libfftw3-dev)" >&2)
 	@./build/bench_build
 	@$(if $(CGAL_INC),./build/bench_build_cgal,echo "(no CGAL peer: apt-get install libcgal-dev)" >&2)
-	@bash bench/bench_tool.sh build/tiledtex
+	@bash bench/bench_scale.sh build/tiledtex
 
 # Only the mesh-build figures (a few seconds each).
 bench-build: build/bench_build $(if $(CGAL_INC),build/bench_build_cgal)
