@@ -43,6 +43,10 @@
        cancel (TT_CANCELLED).
      - No global or static mutable state: every function is reentrant and safe
        to call from several threads on distinct outputs.
+     - The library never starts a thread. Options with an `executor` field
+       hand independent work (tiles, ranges of faces, turned copies) to your
+       job system through tt_executor; the result is bit-identical with any
+       number of workers, or none (NULL: serial).
      - The library never touches files.
 
    QUICK START: tile a quad mesh from a photo (Akleman et al.'s tiled textures)
