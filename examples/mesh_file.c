@@ -51,6 +51,33 @@ static int is_binary_stl(const unsigned char *data, size_t size)
     return size >= 84 && (size - 84) % 50 == 0 && (size - 84) / 50 == read_u32_le(data + 80);
 }
 
+/* Bytes no text file holds (NUL and the control codes other than tab, line
+   ends and form feed) among the first 512: a binary file. */
+static int looks_binary(const unsigned char *data, size_t size)
+{
+    size_t i;
+    for (i = 0; i < size && i < 512; i++)
+        if (data[i] < 32 && data[i] != '\t' && data[i] != '\n' && data[i] != '\r' && data[i] != '\f') return 1;
+    return 0;
+}
+
+/* Why a binary file that should be a binary STL is not one: its size and
+   its triangle count disagree (a truncated or padded file). */
+static void refuse_broken_binary_stl(const char *path, const unsigned char *data, size_t size, char *err,
+                                     size_t err_size)
+{
+    if (size < 84) {
+        tool_set_error(err, err_size, "%s: a binary STL of %lu bytes, shorter than its 84-byte header: the file is "
+                       "truncated", path, (unsigned long)size);
+    } else {
+        uint32_t count = read_u32_le(data + 80);
+        double want = 84.0 + 50.0 * (double)count;
+        tool_set_error(err, err_size, "%s: a binary STL whose header counts %lu triangles (%.0f bytes with the "
+                       "84-byte header) is %lu bytes long: the file is %s", path, (unsigned long)count, want,
+                       (unsigned long)size, (double)size < want ? "truncated" : "longer than its triangles, or the count is wrong");
+    }
+}
+
 /* The first word of the text, after blanks, is `word` (case-insensitive),
    followed by a blank, a line end or the end. */
 static int starts_with_word(const unsigned char *data, size_t size, const char *word)
@@ -606,6 +633,8 @@ int mesh_read_data(const char *path, const unsigned char *data, size_t size, obj
         tool_set_error(err, err_size, "%s: out of memory", path);
     } else if (format == MESH_STL_BINARY) {
         status = read_stl_binary(path, data, &builder, err, err_size);
+    } else if (format == MESH_STL_ASCII && looks_binary(data, size)) {
+        refuse_broken_binary_stl(path, data, size, err, err_size);
     } else if (format == MESH_STL_ASCII) {
         status = read_stl_ascii(path, (const char *)data, size, &builder, err, err_size);
     } else {
