@@ -5836,12 +5836,16 @@ static tt_result tt__cg_check_matrix(const tt_sparse_matrix *A, double *inv_diag
     if (A->nnz > 0 && (!A->col || !A->value))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the matrix has %d entries but no col or value array", A->nnz);
+    /* Every row's range checked before any entry is read: with row_start
+       non-decreasing from 0 to nnz, each lies inside the arrays. */
+    for (i = 0; i < n; i++)
+        if (A->row_start[i + 1] < A->row_start[i])
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, i, -1,
+                               "the matrix's row_start decreases at row %d (%d, then %d)", i, A->row_start[i],
+                               A->row_start[i + 1]);
     for (i = 0; i < n; i++) {
         int begin = A->row_start[i], end = A->row_start[i + 1];
         double diagonal = 0.0;
-        if (end < begin)
-            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, i, -1,
-                               "the matrix's row_start decreases at row %d (%d, then %d)", i, begin, end);
         for (k = begin; k < end; k++) {
             int c = A->col[k];
             double v = A->value[k];

@@ -301,12 +301,16 @@ int output_add(tool_output *output, const char *path, void *data, size_t size);
 int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer);
 
 /* First refuse (writing nothing) when an output path names a directory or
-   the same file as an input (see tool_check_output_path). Then write every
-   file to a new temporary file beside it ("PATH.tiledtex-tmp", numbered when
-   that name is taken), and only when all of them were written completely
-   rename each onto its real name. On any failure the temporaries this commit
-   created are removed, as is every file already renamed in this commit, so
-   the command leaves no output at all; no other path is ever removed.
+   the same file as an input (see tool_check_output_path), and remove what
+   killed runs left beside the outputs ("PATH.tiledtex-tmp-PID" and
+   "PATH.tiledtex-old-PID" of processes that are gone). Then write every file
+   to a new temporary file beside it ("PATH.tiledtex-tmp-PID"), and only when
+   all of them were written completely rename each onto its real name: the
+   model files (.obj, .glb, .gltf) last, their previous versions moved aside
+   before anything is replaced, so a model file present on disk always goes
+   with the MTL and textures beside it, even after a kill. On any failure
+   every previous file is put back as it was and every new one removed; no
+   other path is ever touched.
    Returns 0 or -1 with the reason in err. The batch stays valid; free it with
    output_free.
    A batch of one file whose path is "-" goes to the standard output instead

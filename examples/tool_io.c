@@ -15,6 +15,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <dirent.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -474,24 +476,29 @@ int output_add_obj(tool_output *output, const char *path, const obj_write_desc *
     return 0;
 }
 
-#define TEMPORARY_SUFFIX ".tiledtex-tmp"
+/* The names a commit gives its own files beside PATH: PATH.tiledtex-tmp-PID
+   (with -N after it when taken) while a file is written, and
+   PATH.tiledtex-old-PID for the previous run's file while it is being
+   replaced. The process id tells a later run which of these a killed run
+   left behind (its process is gone): those it removes. */
+#define TEMPORARY_MARK ".tiledtex-tmp-"
+#define BACKUP_MARK ".tiledtex-old-"
 #define TEMPORARY_ATTEMPTS 100
 
-/* Create a new temporary file beside `path` ("PATH.tiledtex-tmp", or with a
-   number after it when that name is taken: an existing file or directory of
-   that name is never opened, let alone removed). On success *name is the
+/* Create a new temporary file beside `path` (an existing file or directory
+   of that name is never opened, let alone removed). On success *name is the
    malloc'ed name of a file this call created, open in *file. */
 static int create_temporary(const char *path, char **name, FILE **file)
 {
-    size_t length = strlen(path), size = length + sizeof TEMPORARY_SUFFIX + 8;
+    size_t length = strlen(path), size = length + sizeof TEMPORARY_MARK + 32;
     int attempt;
     *name = (char *)malloc(size);
     *file = NULL;
     if (!*name) { errno = ENOMEM; return -1; }
     for (attempt = 0; attempt < TEMPORARY_ATTEMPTS; attempt++) {
         int fd;
-        if (attempt == 0) snprintf(*name, size, "%s%s", path, TEMPORARY_SUFFIX);
-        else snprintf(*name, size, "%s%s%d", path, TEMPORARY_SUFFIX, attempt);
+        if (attempt == 0) snprintf(*name, size, "%s%s%ld", path, TEMPORARY_MARK, (long)getpid());
+        else snprintf(*name, size, "%s%s%ld-%d", path, TEMPORARY_MARK, (long)getpid(), attempt);
         fd = open(*name, O_WRONLY | O_CREAT | O_EXCL, 0666);
         if (fd >= 0) {
             *file = fdopen(fd, "wb");
@@ -531,11 +538,123 @@ static int write_standard_output(const void *data, size_t size, char *err, size_
     return 0;
 }
 
+/* Whether `entry` (a name in the directory of `path`) is one of the files a
+   commit makes beside path (TEMPORARY_MARK or BACKUP_MARK and a process id,
+   with an optional -N), left by a process that no longer runs. */
+static int left_by_dead_run(const char *path, const char *entry)
+{
+    const char *base = strrchr(path, '/'), *rest, *marks[2];
+    size_t length;
+    int m;
+    base = base ? base + 1 : path;
+    length = strlen(base);
+    if (strncmp(entry, base, length) != 0) return 0;
+    marks[0] = TEMPORARY_MARK;
+    marks[1] = BACKUP_MARK;
+    for (m = 0; m < 2; m++) {
+        char *end;
+        long pid;
+        size_t mark = strlen(marks[m]);
+        if (strncmp(entry + length, marks[m], mark) != 0) continue;
+        rest = entry + length + mark;
+        if (*rest < '0' || *rest > '9') return 0;
+        errno = 0;
+        pid = strtol(rest, &end, 10);
+        if (errno != 0 || pid <= 0 || (long)(pid_t)pid != pid) return 0;
+        if (*end == '-') {
+            if (end[1] < '0' || end[1] > '9') return 0;
+            strtol(end + 1, &end, 10);
+        }
+        if (*end != '\0') return 0;
+        if ((pid_t)pid == getpid()) return 0;
+        return kill((pid_t)pid, 0) != 0 && errno == ESRCH;
+    }
+    return 0;
+}
+
+/* Remove what killed runs left beside `path`: their temporaries (a
+   kill -9 while writing) and the previous files they had moved aside.
+   Only regular files of exactly those names go. */
+static void remove_leftovers(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    size_t dir_length = slash ? (size_t)(slash - path) + 1 : 0;
+    char *directory = (char *)malloc(dir_length + 3);
+    DIR *dir;
+    struct dirent *entry;
+    if (!directory) return;
+    if (slash) {
+        memcpy(directory, path, dir_length);
+        directory[dir_length] = '\0';
+    } else {
+        strcpy(directory, "./");
+    }
+    dir = opendir(directory);
+    while (dir && (entry = readdir(dir)) != NULL) {
+        struct stat info;
+        char *full;
+        if (!left_by_dead_run(path, entry->d_name)) continue;
+        full = (char *)malloc(dir_length + strlen(entry->d_name) + 1);
+        if (!full) break;
+        memcpy(full, path, dir_length);
+        strcpy(full + dir_length, entry->d_name);
+        if (lstat(full, &info) == 0 && S_ISREG(info.st_mode)) remove(full);
+        free(full);
+    }
+    if (dir) closedir(dir);
+    free(directory);
+}
+
+/* The file that says a run is complete: the model (OBJ, GLB, glTF). It is
+   renamed into place last, and its previous version moved aside first, so
+   whenever a model file is present, the files it names are from its run. */
+static int is_model_file(const char *path)
+{
+    static const char *const endings[] = {".obj", ".glb", ".gltf"};
+    size_t length = strlen(path), i;
+    for (i = 0; i < sizeof endings / sizeof endings[0]; i++) {
+        size_t n = strlen(endings[i]);
+        if (length >= n && strcmp(path + length - n, endings[i]) == 0) return 1;
+    }
+    return 0;
+}
+
+/* Per file of a commit: its temporary, the previous file's backup name
+   (when there was one), and whether the new file is in place. */
+typedef struct commit_file {
+    char *temporary;
+    char *backup;
+    int linked;         /* the backup is a second link: the previous file is still at its name too */
+    int placed;
+} commit_file;
+
+/* Move the existing file at `path` (if any) aside to its backup name: a
+   hard link where the file system has them, so the previous file stays at
+   its name until the new one replaces it in one rename; otherwise a rename. */
+static int back_up(const char *path, commit_file *file, int move_aside)
+{
+    struct stat info;
+    size_t size = strlen(path) + sizeof BACKUP_MARK + 24;
+    if (lstat(path, &info) != 0) return errno == ENOENT ? 0 : -1;
+    file->backup = (char *)malloc(size);
+    if (!file->backup) { errno = ENOMEM; return -1; }
+    snprintf(file->backup, size, "%s%s%ld", path, BACKUP_MARK, (long)getpid());
+    remove(file->backup);       /* ours: this process's name */
+    if (!move_aside && link(path, file->backup) == 0) {
+        file->linked = 1;
+        return 0;
+    }
+    if (rename(path, file->backup) == 0) return 0;
+    free(file->backup);
+    file->backup = NULL;
+    return -1;
+}
+
 int output_commit(tool_output *output, char *err, size_t err_size)
 {
-    char **temporaries;     /* the temporaries this commit created (NULL: none for that file) */
-    int renamed = 0, i, failed = 0;
-    if (output->count == 0) return 0;
+    commit_file *files;
+    int *order, i, k, failed = 0;
+    if (output->count <= 0) return 0;
     for (i = 0; i < output->count; i++) {
         if (strcmp(output->files[i].path, "-") != 0) continue;
         /* Commands refuse "-" on their command line when they write several
@@ -558,44 +677,74 @@ int output_commit(tool_output *output, char *err, size_t err_size)
         }
         if (tool_check_output_path(path, err, err_size) != 0) return -1;
     }
-    temporaries = (char **)calloc((size_t)output->count, sizeof *temporaries);
-    if (!temporaries) {
+    for (i = 0; i < output->count; i++) remove_leftovers(output->files[i].path);
+    files = (commit_file *)calloc((unsigned)output->count, sizeof *files);
+    order = (int *)calloc((unsigned)output->count, sizeof *order);
+    if (!files || !order) {
+        free(files);
+        free(order);
         tool_set_error(err, err_size, "out of memory while writing the output files");
         return -1;
     }
+    /* The model files last, the others in the order they were added. */
+    for (i = 0, k = 0; i < output->count; i++)
+        if (!is_model_file(output->files[i].path)) order[k++] = i;
+    for (i = 0; i < output->count; i++)
+        if (is_model_file(output->files[i].path)) order[k++] = i;
     /* Phase 1: every file to a temporary name beside the real one (the same
-       directory, so the rename below cannot cross file systems). */
+       directory, so the renames below cannot cross file systems). */
     for (i = 0; i < output->count && !failed; i++) {
         const tool_output_file *file = &output->files[i];
         FILE *stream;
-        if (create_temporary(file->path, &temporaries[i], &stream) != 0) {
-            tool_set_error(err, err_size, "cannot write '%s': %s", file->path, strerror(errno));
-            failed = 1;
-        } else if (write_whole_file(stream, file->data, file->size) != 0) {
+        if (create_temporary(file->path, &files[i].temporary, &stream) != 0 ||
+            write_whole_file(stream, file->data, file->size) != 0) {
             tool_set_error(err, err_size, "cannot write '%s': %s", file->path, strerror(errno));
             failed = 1;
         }
     }
-    /* Phase 2: only when all are complete, give them their real names. */
-    for (i = 0; i < output->count && !failed; i++) {
-        if (rename(temporaries[i], output->files[i].path) != 0) {
-            tool_set_error(err, err_size, "cannot write '%s': %s", output->files[i].path, strerror(errno));
+    /* Phase 2, only when all are complete: the previous model files move
+       aside first (from here until the end, no model file is present that
+       does not go with the files beside it), then each file takes its name,
+       the previous one kept under its backup name. */
+    for (i = 0; i < output->count && !failed; i++)
+        if (is_model_file(output->files[i].path) && back_up(output->files[i].path, &files[i], 1) != 0) {
+            tool_set_error(err, err_size, "cannot replace '%s': %s", output->files[i].path, strerror(errno));
+            failed = 1;
+        }
+    for (k = 0; k < output->count && !failed; k++) {
+        const char *path = output->files[order[k]].path;
+        commit_file *file = &files[order[k]];
+        if (!file->backup && !is_model_file(path) && back_up(path, file, 0) != 0) {
+            tool_set_error(err, err_size, "cannot replace '%s': %s", path, strerror(errno));
+            failed = 1;
+        } else if (rename(file->temporary, path) != 0) {
+            tool_set_error(err, err_size, "cannot write '%s': %s", path, strerror(errno));
             failed = 1;
         } else {
-            free(temporaries[i]);
-            temporaries[i] = NULL;
-            renamed = i + 1;
+            free(file->temporary);
+            file->temporary = NULL;
+            file->placed = 1;
         }
     }
-    if (failed) {
-        /* Undo: remove the temporaries this commit created, and the files it
-           already renamed into place; nothing else. */
-        for (i = 0; i < output->count; i++)
-            if (temporaries[i]) remove(temporaries[i]);
-        for (i = 0; i < renamed; i++) remove(output->files[i].path);
+    for (i = 0; i < output->count; i++) {
+        commit_file *file = &files[i];
+        const char *path = output->files[i].path;
+        if (file->temporary) remove(file->temporary);
+        if (failed) {
+            /* Undo: the previous file back at its name (over the new one),
+               or, where there was none, the new file removed. A linked
+               backup of a file not yet replaced is only a second name. */
+            if (file->backup && file->linked && !file->placed) remove(file->backup);
+            else if (file->backup) rename(file->backup, path);
+            else if (file->placed) remove(path);
+        } else if (file->backup) {
+            remove(file->backup);
+        }
+        free(file->temporary);
+        free(file->backup);
     }
-    for (i = 0; i < output->count; i++) free(temporaries[i]);
-    free(temporaries);
+    free(files);
+    free(order);
     return failed ? -1 : 0;
 }
 

@@ -1735,6 +1735,17 @@ expect_error "OFF without its header" map ../in/no_header.off m.obj
 err_mentions "OFF without its header: says what it must start with" "no_header\.off:1: an OFF file starts with 'OFF'"
 expect_error "STL facet with 2 vertices" map ../in/two_corners.stl m.obj
 err_mentions "STL facet with 2 vertices: names the line" 'two_corners\.stl:7: a facet with 2 vertices'
+# A binary STL whose triangle count disagrees with its size (a count of 5
+# over 4 triangles; 4 triangles cut short; less than the header): said so.
+{ head -c 80 "$W/in/tetra_binary.stl"; printf '\005\000\000\000'; tail -c +85 "$W/in/tetra_binary.stl"; } >"$W/in/count5.stl"
+head -c 180 "$W/in/tetra_binary.stl" >"$W/in/cut.stl"
+head -c 82 "$W/in/tetra_binary.stl" >"$W/in/header_only.stl"
+expect_error "binary STL counting 5 of 4 triangles" map ../in/count5.stl m.obj
+err_mentions "binary STL counting 5 of 4 triangles: the count and the size" 'count5\.stl: a binary STL whose header counts 5 triangles \(334 bytes .*\) is 284 bytes long: the file is truncated'
+expect_error "binary STL cut short" map ../in/cut.stl m.obj
+err_mentions "binary STL cut short: truncated" 'cut\.stl: a binary STL whose header counts 4 triangles .* is 180 bytes long: the file is truncated'
+expect_error "binary STL shorter than its header" map ../in/header_only.stl m.obj
+err_mentions "binary STL shorter than its header" 'header_only\.stl: a binary STL of 82 bytes, shorter than its 84-byte header'
 
 newdir
 expect_ok "tile torus (for --weld)" tile ../in/torus.obj ../in/tex.png orig --tile 16
@@ -1828,6 +1839,90 @@ check "failed tile: rollback keeps a directory named like a temporary" "fails; o
     "exit $RC, files: $(ls -A | tr '\n' ' ')" \
     "$([ $RC -ne 0 ] && [ "$(ls -A | tr '\n' ' ')" = "out.obj.tiledtex-tmp out.png " ] && [ -d out.obj.tiledtex-tmp ]; echo $?)"
 cd "$W" || exit 1
+
+# What killed runs left beside the outputs (PATH.tiledtex-tmp-PID, a
+# previous file moved aside as PATH.tiledtex-old-PID) goes at the next run,
+# when its process is gone; a live process's, other names and directories
+# stay.
+newdir
+sh -c 'exit 0' &
+dead=$!
+wait "$dead"
+printf 'half' >"out.obj.tiledtex-tmp-$dead"
+printf 'half' >"out.png.tiledtex-tmp-$dead-2"
+printf 'old' >"out.mtl.tiledtex-old-$dead"
+printf 'mine' >"out.obj.tiledtex-tmp-$$"
+printf 'other' >"other.obj.tiledtex-tmp-$dead"
+mkdir "out.png.tiledtex-tmp-$((dead + 1))x"
+expect_ok "tile beside a killed run's leftovers" tile ../in/torus.obj ../in/tex.png out --tile 16
+check "a killed run's temporaries and moved-aside files are removed, nothing else" \
+    "out.obj.tiledtex-tmp-$$, other.obj.tiledtex-tmp-$dead and the directory kept" "$(ls -A | tr '\n' ' ')" \
+    "$([ ! -e "out.obj.tiledtex-tmp-$dead" ] && [ ! -e "out.png.tiledtex-tmp-$dead-2" ] &&
+        [ ! -e "out.mtl.tiledtex-old-$dead" ] && [ -f "out.obj.tiledtex-tmp-$$" ] &&
+        [ -f "other.obj.tiledtex-tmp-$dead" ] && [ -d "out.png.tiledtex-tmp-$((dead + 1))x" ] && [ -s out.obj ]; echo $?)"
+cd "$W" || exit 1
+
+# The commit's renames, watched and failed through a preloaded rename(): the
+# model file (OBJ, GLB) takes its name last, and a rename that fails puts the
+# previous run's files back exactly as they were.
+cat >"$W/rename_shim.c" <<'EOF_C'
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+/* RENAME_LOG: append each rename's new name; RENAME_FAIL: fail (EIO) the
+   first rename onto the path with that ending (the undo's own renames then
+   go through). */
+static int failed_once;
+int rename(const char *from, const char *to)
+{
+    int (*real)(const char *, const char *) = (int (*)(const char *, const char *))dlsym(RTLD_NEXT, "rename");
+    const char *log = getenv("RENAME_LOG"), *failing = getenv("RENAME_FAIL");
+    size_t n = strlen(to);
+    if (log) {
+        FILE *f = fopen(log, "a");
+        if (f) { fprintf(f, "%s\n", to); fclose(f); }
+    }
+    if (failing && !failed_once && n >= strlen(failing) && strcmp(to + n - strlen(failing), failing) == 0) {
+        failed_once = 1;
+        errno = EIO;
+        return -1;
+    }
+    return real(from, to);
+}
+EOF_C
+CMD="$HELPER_CC -shared rename_shim.c (test helper)"
+if $HELPER_CC -shared -fPIC -O1 "$W/rename_shim.c" -o "$W/rename_shim.so" -ldl 2>"$W/err"; then
+    pass
+    newdir
+    expect_ok "tile, the previous run" tile ../in/torus.obj ../in/tex.png out --tile 16 --seed 1
+    before=$(cksum out.obj out.mtl out.png)
+    CMD="RENAME_LOG=renames tiledtex tile ... out --seed 2"
+    RENAME_LOG=$PWD/renames LD_PRELOAD=$W/rename_shim.so ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 \
+        "$TOOL" tile ../in/torus.obj ../in/tex.png out --tile 16 --seed 2 >"$W/out" 2>"$W/err"
+    RC=$?
+    check "the OBJ takes its name last" "exit 0; out.mtl and out.png renamed, then out.obj" \
+        "exit $RC, renames: $(grep -v tiledtex-old renames | tr '\n' ' ')" \
+        "$([ $RC -eq 0 ] && [ "$(grep -v tiledtex-old renames | sed 's|.*/||' | tail -n 1)" = out.obj ] &&
+            [ "$(grep -c . renames)" -ge 3 ]; echo $?)"
+    expect_ok "tile, the previous run again" tile ../in/torus.obj ../in/tex.png out --tile 16 --seed 1
+    for failing in out.png out.obj; do
+        CMD="RENAME_FAIL=$failing tiledtex tile ... out --seed 2"
+        RENAME_FAIL=$failing LD_PRELOAD=$W/rename_shim.so ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 \
+            "$TOOL" tile ../in/torus.obj ../in/tex.png out --tile 16 --seed 2 >"$W/out" 2>"$W/err"
+        RC=$?
+        check "a rename onto $failing fails: the previous run's files as they were" \
+            "non-zero exit, one error line, out.obj/.mtl/.png unchanged, nothing else" \
+            "exit $RC, $(cat "$W/err"), files: $(ls -A | tr '\n' ' ')" \
+            "$([ $RC -ne 0 ] && [ "$(grep -c . "$W/err")" = 1 ] && [ "$(cksum out.obj out.mtl out.png)" = "$before" ] &&
+                [ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out.png renames " ]; echo $?)"
+    done
+    cd "$W" || exit 1
+else
+    fail "rename shim builds" "$CMD" "a shared object" "$(cat "$W/err")"
+fi
 
 # ======================================================================
 # Image size budget (--max-pixels): refused from the header, before decoding

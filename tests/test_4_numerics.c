@@ -760,6 +760,35 @@ static tt_sparse_matrix *cg_small(int rows, int cols, const double *dense)
     return m;
 }
 
+/* A caller-filled matrix whose row_start rises past nnz and then falls
+   ({0, 3, 2}, nnz 2): refused before any entry is read (the arrays hold
+   exactly nnz entries, so ASan sees a read past them). */
+static void test_cg_row_start_past_entries(void)
+{
+    tt_sparse_matrix A;
+    double b[2] = {1, 1}, x[2] = {0, 0};
+    int *row_start = (int *)malloc(3 * sizeof(int)), *col = (int *)malloc(2 * sizeof(int));
+    double *value = (double *)malloc(2 * sizeof(double));
+    tt_error err;
+    tt_result r;
+    if (!row_start || !col || !value) { CHECK(0, "malloc"); free(row_start); free(col); free(value); return; }
+    row_start[0] = 0; row_start[1] = 3; row_start[2] = 2;
+    col[0] = 0; col[1] = 1;
+    value[0] = 2.0; value[1] = 2.0;
+    memset(&A, 0, sizeof A);
+    A.rows = A.cols = 2;
+    A.nnz = 2;
+    A.row_start = row_start;
+    A.col = col;
+    A.value = value;
+    r = tt_cg_solve(&A, b, NULL, NULL, x, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.row == 1 && strstr(err.message, "decreases at row 1"),
+          "row_start {0, 3, 2}: %d at row %d (\"%s\")", r, err.row, err.message);
+    free(row_start);
+    free(col);
+    free(value);
+}
+
 static void test_cg_errors(void)
 {
     static const double spd[9] = {4, 1, 0, 1, 3, 1, 0, 1, 2};
@@ -1143,6 +1172,7 @@ static void test_cg_entry_errors(void)
 void run_numerics_tests(void)
 {
     RUN(test_cg_triplets);
+    RUN(test_cg_row_start_past_entries);
     RUN(test_cg_triplet_errors);
     RUN(test_cg_multiply);
     RUN(test_cg_random_spd);
