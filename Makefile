@@ -5,13 +5,14 @@ WARN    := -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes
 STB_INC := $(shell pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
 TOOL_SRC := $(wildcard examples/*.c)
 TOOL_HDR := $(wildcard examples/*.h) tiledtex.h
+# The tool's thread pool (examples/executor.c, -j N) uses POSIX threads.
 
 .PHONY: all demo test bench bench-build bench-scale fuzz clean deps test-deps
 
 all: build/tiledtex
 
 build/tiledtex: $(TOOL_SRC) $(TOOL_HDR) | build
-	$(CC) $(CFLAGS) $(WARN) -I. $(STB_INC) $(TOOL_SRC) -o $@ -lm
+	$(CC) $(CFLAGS) $(WARN) -pthread -I. $(STB_INC) $(TOOL_SRC) -o $@ -lm
 
 build:
 	mkdir -p build

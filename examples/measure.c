@@ -25,6 +25,7 @@ int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *c
     options.max_edges = all_edges ? 0 : TOOL_REPORT_EDGES;
     options.edges = edges;
     options.nedges = nedges;
+    options.executor = tool_executor();
     result = tt_measure_seams(mesh, corner_uv, atlas, &options, NULL, &out->report, &error);
     if (edges) {
         out->edges = nedges;

@@ -381,6 +381,7 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     synth.layout = options->layout;
     synth.seed = options->seed;
     synth.background = options->background;
+    synth.executor = tool_executor();
     if (options->nedges > 0) {
         int colors = options->layout.colors ? options->layout.colors : 1;
         if (options->nedges != colors)

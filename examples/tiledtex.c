@@ -42,13 +42,15 @@ static void print_help(void)
     int i;
     printf("tiledtex %s - texture any mesh from one example image, without seams or visible repetition\n\n",
            TILEDTEX_VERSION_STRING);
-    printf("usage: tiledtex [--max-pixels N] [--quiet] [--weld] COMMAND [ARGUMENTS]\n"
+    printf("usage: tiledtex [-j N] [--max-pixels N] [--quiet] [--weld] COMMAND [ARGUMENTS]\n"
            "       tiledtex --version\n\ncommands:\n");
     for (i = 0; i < SUBCOMMAND_COUNT; i++) printf("  %-9s %s\n", subcommands[i].name, subcommands[i].summary);
     printf("\nglobal options (before or after the command):\n"
            "  --max-pixels N  refuse images of more than N pixels, checked before decoding them\n"
            "                  (default %d = 4096x4096). Peak memory per input pixel:\n"
            "                  lapped needs about 32 bytes, tile and synth about 17\n"
+           "  -j, --jobs N    run on N threads (default: the %d cores this process may use);\n"
+           "                  -j 1 runs on this thread only. Outputs are the same at any N\n"
            "  -q, --quiet     print nothing but errors: no summary, progress line or warning\n"
            "  -V, --version   print the version and exit\n"
            "  --weld          merge mesh vertices closer than %g of the bounding box diagonal,\n"
@@ -59,7 +61,7 @@ static void print_help(void)
            "synth, map without --atlas, a GLB) may be '-' for the standard output.\n"
            "\nmeshes: Wavefront OBJ, STL (ASCII or binary, always welded) or OFF; other\n"
            "formats are named, with a conversion command (assimp export from assimp-utils)\n",
-           TOOL_DEFAULT_MAX_PIXELS, TOOL_WELD_TOLERANCE);
+           TOOL_DEFAULT_MAX_PIXELS, tool_default_jobs(), TOOL_WELD_TOLERANCE);
     printf("\n'tiledtex help COMMAND' or 'tiledtex COMMAND --help' describes one command.\n"
            "Try it: tiledtex generate mesh torus.obj --shape torus\n"
            "        tiledtex generate texture stones.png\n"
@@ -79,13 +81,22 @@ static void print_help(void)
    status for a bad value. */
 static int take_global_options(int *argc, char **argv)
 {
-    const char *max_pixels = NULL;
+    const char *max_pixels = NULL, *jobs = NULL, *jobs_option = NULL;
     int i, kept = 1, given = 0;
     for (i = 1; i < *argc; i++) {
         const char *value;
         if (tool_option(*argc, argv, &i, "--max-pixels", &value)) {
             max_pixels = value;
             given = 1;
+        } else if (tool_option(*argc, argv, &i, "--jobs", &value)) {
+            jobs_option = "--jobs";
+            jobs = value;
+        } else if (tool_option(*argc, argv, &i, "-j", &value)) {
+            jobs_option = "-j";
+            jobs = value;
+        } else if (strncmp(argv[i], "-j", 2) == 0 && argv[i][2] != '\0') {
+            jobs_option = "-j";                 /* -j4, as make takes it */
+            jobs = argv[i] + 2;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
             tool_set_quiet(1);
         } else if (strcmp(argv[i], "--weld") == 0) {
@@ -101,6 +112,11 @@ static int take_global_options(int *argc, char **argv)
         if (parse_u64("--max-pixels", max_pixels, &n) != 0) return TOOL_EXIT_USAGE;
         if (n == 0) return tool_usage("--max-pixels wants a number of pixels above 0, got '%s'", max_pixels);
         image_set_max_pixels(n);
+    }
+    if (jobs_option) {
+        int n;
+        if (parse_int(jobs_option, jobs, 1, TOOL_MAX_JOBS, &n) != 0) return TOOL_EXIT_USAGE;
+        tool_set_jobs(n);
     }
     return 0;
 }

@@ -26,6 +26,7 @@
                  (parsed in cli.c)       tool_note_cut_edges
      measure.c   quality for summaries   tool_measure_seams, tool_format_seams
      format_number.c  numbers as text   tool_format_float, tool_format_int
+     executor.c  threads for the library  tool_executor, tool_set_jobs (-j N)
 
    Conventions every command follows:
      - Errors are one line on stderr, "tiledtex: <message>" (or
@@ -852,6 +853,23 @@ void tool_progress_begin(tool_progress *progress, const char *activity, const ch
 int tool_show_progress(float fraction, void *user_data);
 /* Ends a line that was shown. */
 void tool_progress_end(tool_progress *progress);
+
+/* ---------------------------------------------------------------------- */
+/* Threads (executor.c)                                                     */
+/* ---------------------------------------------------------------------- */
+
+/* -j N / --jobs N (a global option main takes) runs the library's parallel
+   work (tile synthesis, the seam measure, ...) on N threads: a pool of N - 1
+   threads, started the first time work arrives and kept for every later
+   run, with the calling thread taking part. The outputs are the same at
+   every N. tool_executor() is the pool as the library's options take it,
+   or NULL at -j 1 (serial, no thread started). */
+#define TOOL_MAX_JOBS 256
+void tool_set_jobs(int jobs);
+/* -j as given, or the default: the cores this process may run on. */
+int tool_jobs(void);
+int tool_default_jobs(void);
+const tt_executor *tool_executor(void);
 
 /* ---------------------------------------------------------------------- */
 /* Paths and strings (tool_io.c)                                            */

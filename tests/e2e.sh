@@ -1977,6 +1977,39 @@ check "--help documents --max-pixels" "'--max-pixels' in the usage" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q -- '--max-pixels'; echo $?)"
 
 # ======================================================================
+# Threads (-j N, --jobs N): the same outputs at every N
+# ======================================================================
+# tile and synth at -j 1 (serial) and -j 2 (the thread pool runs the tiles of
+# the synthesis and the ranges of edges of the seam report): byte-identical
+# files, and the same summary line.
+for jobs in 1 2; do
+    mkdir -p "$W/jobs$jobs" && cd "$W/jobs$jobs" || exit 1
+    expect_ok "tile -j $jobs" -j $jobs tile ../in/double-torus.obj ../in/tex.png out --colors 2 --tile 16 --seed 3
+    echo "$OUT" >tile_summary.txt
+    expect_ok "synth --jobs $jobs" synth ../in/tex.png atlas.png --colors 2 --tile 32 --mips --jobs=$jobs
+done
+cd "$W" || exit 1
+for f in out.obj out.mtl out.png atlas.png atlas_mip1.png tile_summary.txt; do
+    CMD="tiledtex tile/synth ... -j 1 and -j 2: $f"
+    check "-j 2 writes the same $f as -j 1" "identical files" "$(cmp "jobs1/$f" "jobs2/$f" 2>&1)" \
+        "$(cmp -s "jobs1/$f" "jobs2/$f"; echo $?)"
+done
+expect_error "-j 0" -j 0 synth ../in/tex.png a.png --tile 32
+err_mentions "-j 0: names the option and the range" "^tiledtex: -j wants an integer from 1 to"
+expect_error "-j -1 (after the command)" synth ../in/tex.png a.png --tile 32 -j -1
+expect_error "--jobs abc" --jobs abc synth ../in/tex.png a.png --tile 32
+err_mentions "--jobs abc: names the option and the value" "^tiledtex: --jobs wants an integer.*'abc'"
+expect_error "-j2x" -j2x synth ../in/tex.png a.png --tile 32
+expect_error "-j without a value" synth ../in/tex.png a.png --tile 32 -j
+newdir
+expect_ok "-j4 (make's form) and -j=1" -j4 synth ../in/tex.png a.png --tile 32
+expect_ok "-j=1" synth ../in/tex.png b.png --tile 32 -j=1
+cd "$W" || exit 1
+run --help
+check "--help documents -j / --jobs" "'-j, --jobs N' in the usage" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q -- '-j, --jobs N'; echo $?)"
+
+# ======================================================================
 # Numbers in written OBJ files: tool_format_float reads back exactly
 # ======================================================================
 cat >"$W/fmt_check.c" <<'EOF_C'

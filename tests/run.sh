@@ -222,8 +222,8 @@ if [ -f tests/e2e.sh ]; then
     mkdir -p build/asan
     STB_INC=$(pkg-config --cflags stb 2>/dev/null || echo -I/usr/include/stb)
     # shellcheck disable=SC2086  # STB_INC is a list of flags
-    if log=$($CC -std=c99 -g -O1 -fsanitize=address,undefined -I. $STB_INC examples/*.c -o build/asan/tiledtex \
-        -lm 2>&1); then
+    if log=$($CC -std=c99 -g -O1 -fsanitize=address,undefined -pthread -I. $STB_INC examples/*.c \
+        -o build/asan/tiledtex -lm 2>&1); then
         run_counted e2e bash tests/e2e.sh build/asan/tiledtex
     else
         fail "e2e: the tool does not build with sanitizers" "$log"
