@@ -330,6 +330,110 @@ static void test_color_bytes_identity(void)
     CHECK(cnt.live == 0, "byte identity: %ld allocations leaked", cnt.live);
 }
 
+/* The byte a value encodes to, the naive way: the number of bounds (the
+   values halfway between neighbouring bytes, in the encoded scale) at or
+   below it, counted one by one; NaN gives 0. The reference for the
+   library's faster encoder. */
+static unsigned char naive_encode(const float bound[255], float value)
+{
+    int b = 0;
+    while (b < 255 && value >= bound[b]) b++;
+    return (unsigned char)b;
+}
+
+static void naive_bounds(tt_color_space space, float bound[255])
+{
+    int b;
+    for (b = 0; b < 255; b++)
+        bound[b] = space == TT_COLOR_SRGB     ? tt_srgb_to_linear(((float)b + 0.5f) / 255.0f)
+                   : space == TT_COLOR_LINEAR ? ((float)b + 0.5f) / 255.0f
+                                              : 2.0f * ((float)b + 0.5f) / 255.0f - 1.0f;
+}
+
+static float float_from_bits(uint32_t bits)
+{
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+static uint32_t bits_of_float(float f)
+{
+    uint32_t bits;
+    memcpy(&bits, &f, sizeof bits);
+    return bits;
+}
+
+/* tt_image_to_rgba8 against naive_encode in every space: on the floats
+   next to every bound (8 on each side, where rounding decides), on a sweep
+   through the bit patterns of all floats from -2 to 2 (every 1021st, both
+   signs), on 0, 1, -0, the infinities and NaN; and every byte through
+   tt_image_from_bytes and back (grey, so the colour channels and alpha each
+   see all 256 values). */
+static void test_color_bytes_against_naive(void)
+{
+    static const tt_color_space spaces[] = {TT_COLOR_SRGB, TT_COLOR_LINEAR, TT_COLOR_NORMAL};
+    const uint32_t top = bits_of_float(2.0f), step = 1021;
+    int nvalues = 255 * 17 + 2 * (int)(top / step + 1) + 6, h = (nvalues + 4 * 1024 - 1) / (4 * 1024), n = 1024 * h;
+    int sp;
+    tt_image *im = NULL;
+    unsigned char *out;
+    if (tt_image_create(1024, h, NULL, &im, NULL) != TT_OK) { CHECK(0, "create 1024 x %d", h); return; }
+    out = (unsigned char *)malloc((size_t)n * 4);
+    for (sp = 0; sp < 3 && out; sp++) {
+        tt_color_space space = spaces[sp];
+        float bound[255], alpha_bound[255];
+        unsigned char bytes[256 * 2], back[256 * 4];
+        uint32_t bits;
+        int i = 0, b, k, bad = 0, first = -1;
+        tt_image *grey = NULL;
+        naive_bounds(space, bound);
+        naive_bounds(TT_COLOR_LINEAR, alpha_bound);
+        for (b = 0; b < 255; b++)
+            for (k = -8; k <= 8; k++) im->pixels[i++] = float_from_bits(bits_of_float(bound[b]) + (uint32_t)k);
+        for (bits = 0; bits <= top; bits += step) {
+            im->pixels[i++] = float_from_bits(bits);
+            im->pixels[i++] = float_from_bits(bits | 0x80000000u);
+        }
+        im->pixels[i++] = 0.0f; im->pixels[i++] = 1.0f; im->pixels[i++] = -0.0f;
+        im->pixels[i++] = (float)INFINITY; im->pixels[i++] = (float)-INFINITY; im->pixels[i++] = (float)NAN;
+        while (i < 4 * n) im->pixels[i++] = 0.5f;
+        tt_image_to_rgba8(im, space, out);
+        for (i = 0; i < 4 * n; i++) {
+            /* The normal spaces renormalise nothing on the way out: each
+               channel encodes alone, as the naive count does. */
+            unsigned char want = naive_encode(i % 4 == 3 ? alpha_bound : bound, im->pixels[i]);
+            if (out[i] != want) {
+                if (first < 0) first = i;
+                bad++;
+            }
+        }
+        if (first >= 0)
+            DETAIL("space %d: %.9g (bits %08lx) encodes to %d, the naive count says %d", (int)space,
+                   im->pixels[first], (unsigned long)bits_of_float(im->pixels[first]), out[first],
+                   naive_encode(first % 4 == 3 ? alpha_bound : bound, im->pixels[first]));
+        CHECK(bad == 0, "space %d: %d of %d values encode to another byte than the naive count", (int)space, bad,
+              4 * n);
+        /* every byte, decoded then encoded */
+        if (space == TT_COLOR_NORMAL) continue;   /* not every byte triple is a unit vector */
+        for (b = 0; b < 256; b++) {
+            bytes[2 * b] = (unsigned char)b;
+            bytes[2 * b + 1] = (unsigned char)(255 - b);
+        }
+        CHECK(tt_image_from_bytes(bytes, 256, 1, 2, 0, space, NULL, &grey, NULL) == TT_OK && grey,
+              "from_bytes, every byte, space %d", (int)space);
+        if (!grey) continue;
+        tt_image_to_rgba8(grey, space, back);
+        for (b = 0, bad = 0; b < 256; b++)
+            bad += back[4 * b] != b || back[4 * b + 1] != b || back[4 * b + 2] != b || back[4 * b + 3] != 255 - b;
+        CHECK(bad == 0, "space %d: %d of the 256 bytes do not come back through from_bytes and to_rgba8",
+              (int)space, bad);
+        tt_image_free(grey);
+    }
+    free(out);
+    tt_image_free(im);
+}
+
 /* The mip of a black and white checkerboard is linear 0.5: sRGB byte 188,
    not the 128 that averaging the encoded bytes would give. */
 static void test_color_mip(void)
@@ -938,6 +1042,7 @@ void run_image_tests(void)
     RUN(test_sample_wrap);
     RUN(test_color_transfer);
     RUN(test_color_bytes_identity);
+    RUN(test_color_bytes_against_naive);
     RUN(test_color_mip);
     RUN(test_color_bytes_in_place);
     RUN(test_color_alpha_nan);
