@@ -3763,6 +3763,8 @@ static double tt__face_area_d(const tt_mesh *mesh, int face)
 static tt_result tt__require_triangles(const tt_mesh *mesh, const char *why, tt_error *error)
 {
     int f;
+    if (mesh->nfaces < 1 || !mesh->face_start)
+        return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces (%d)", mesh->nfaces);
     for (f = 0; f < mesh->nfaces; f++) {
         int count = mesh->face_start[f + 1] - mesh->face_start[f];
         if (count != 3)
@@ -11333,6 +11335,8 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     float shallowest = 0.0f;
     int widest = 1;
     long long total = 0;
+    if (nf < 1 || !mesh->face_start)
+        return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces (%d)", nf);
     if (mesh->min_face_size != 3 || mesh->max_face_size != 3) {
         for (f = 0; f < nf && mesh->face_start[f + 1] - mesh->face_start[f] == 3; f++) {}
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
@@ -11984,6 +11988,7 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
     const double root2 = 1.4142135623730951;
     int f, npairs, per_side, cell;
     double need, m, h, leg;
+    tt_result result;
 
     if (!mesh || !corner_uv)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -11993,8 +11998,7 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
                         TT_MAX_IMAGE_SIZE);
     if (gutter < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
-    if (tt__require_triangles(mesh, "the atlas packs triangles only", error) != TT_OK)
-        return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__require_triangles(mesh, "the atlas packs triangles only", error)) != TT_OK) return result;
 
     npairs = mesh->nfaces / 2 + mesh->nfaces % 2;
     per_side = (int)ceil(sqrt((double)npairs));
@@ -12498,9 +12502,13 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
                         TT_MAX_IMAGE_SIZE);
     if (gutter < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
+    if (gutter > TT_MAX_IMAGE_SIZE)     /* before any 2 * gutter, which could overflow */
+        return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                        "a gutter of %d texels needs charts of %.0f texels each way at least: more than the limit "
+                        "of %d x %d holds; lower the gutter", gutter, 2.0 * gutter + 1.0, TT_MAX_IMAGE_SIZE,
+                        TT_MAX_IMAGE_SIZE);
     nf = mesh->nfaces;
-    if (tt__require_triangles(mesh, "the atlas packs triangles only", error) != TT_OK)
-        return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__require_triangles(mesh, "the atlas packs triangles only", error)) != TT_OK) return result;
 
     memset(&grid, 0, sizeof grid);
     normal = TT__ALLOC(al, double, 3 * (size_t)nf);
@@ -12653,8 +12661,7 @@ TTDEF tt_result tt_uv_check(const tt_mesh *mesh, const float *corner_uv, const t
     report->problem = TT_UV_USABLE;
     report->face = report->other_face = -1;
     nf = mesh->nfaces;
-    if (tt__require_triangles(mesh, "the UV check takes triangles only", error) != TT_OK)
-        return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__require_triangles(mesh, "the UV check takes triangles only", error)) != TT_OK) return result;
     for (f = 0; f < nf && report->problem == TT_UV_USABLE; f++)
         for (k = 0; k < 6; k++)
             if (!tt__is_finite(corner_uv[6 * (size_t)f + k])) {
@@ -12980,8 +12987,10 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     if (atlas->width > TT_MAX_IMAGE_SIZE || atlas->height > TT_MAX_IMAGE_SIZE)
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "the atlas is %d x %d texels, above %d",
                         atlas->width, atlas->height, TT_MAX_IMAGE_SIZE);
-    if (gutter < 0)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "gutter %d is negative", gutter);
+    if (gutter < 0 || gutter > tt__max_i(atlas->width, atlas->height))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "gutter %d is outside 0..%d (the atlas's size)", gutter,
+                        tt__max_i(atlas->width, atlas->height));
     if (npatches < 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "npatches is %d: need at least 1",
                         npatches);
@@ -12994,8 +13003,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1,
                                "patch %d is %sa normal map but patch 0 is %s: bake each map of a material on its "
                                "own", p, normal ? "not " : "", normal ? "one" : "not");
-    if (tt__require_triangles(mesh, "baking needs triangles", error) != TT_OK)
-        return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__require_triangles(mesh, "baking needs triangles", error)) != TT_OK) return result;
     for (c = 0; c < 2 * mesh->ncorners; c++)
         if (!tt__is_finite(corner_uv[c]))
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,

@@ -3235,6 +3235,45 @@ static void test_atlas_pack_errors(void)
     tt_mesh_free(qm);
 }
 
+/* A hand-made mesh with no faces (tt_mesh_build refuses one, a caller's
+   struct need not): every triangle-mesh entry point says so instead of
+   dividing by zero or reading face 0. */
+static void test_zero_face_mesh_refused(void)
+{
+    tt_mesh *built = bake_grid(2, 2, 0.0, NULL), empty;
+    tt_image *patch = NULL, *atlas = NULL;
+    tt_lapped *lapped = NULL;
+    tt_uv_report uv_report;
+    float uv[48], field[24];
+    tt_error err;
+    tt_result r;
+    int i;
+    if (!built) { CHECK(0, "bake_grid"); return; }
+    empty = *built;
+    empty.nfaces = 0;
+    empty.ncorners = 0;
+    empty.min_face_size = empty.max_face_size = 0;
+    for (i = 0; i < 24; i++) field[i] = i % 3 == 0 ? 1.0f : 0.0f;
+    for (i = 0; i < 48; i++) uv[i] = 0.5f;
+    tt_image_create(16, 16, NULL, &patch, NULL);
+    tt_image_create(32, 32, NULL, &atlas, NULL);
+    r = tt_atlas_pack_pairs(&empty, 64, 1, uv, &err);
+    CHECK(r == TT_ERROR_EMPTY_MESH && strstr(err.message, "no faces"), "tt_atlas_pack_pairs: %d (%s)", r, err.message);
+    r = tt_atlas_pack_charts(&empty, 64, 1, NULL, uv, NULL, &err);
+    CHECK(r == TT_ERROR_EMPTY_MESH, "tt_atlas_pack_charts: %d (%s)", r, err.message);
+    r = tt_lapped_paste(&empty, field, &patch, 1, NULL, NULL, &lapped, &err);
+    CHECK(r == TT_ERROR_EMPTY_MESH && lapped == NULL, "tt_lapped_paste: %d (%s)", r, err.message);
+    r = tt_uv_check(&empty, uv, NULL, &uv_report, &err);
+    CHECK(r == TT_ERROR_EMPTY_MESH, "tt_uv_check: %d (%s)", r, err.message);
+    /* A gutter so wide that twice it overflows an int: refused before. */
+    r = tt_atlas_pack_charts(built, 64, 0x7fffffff, NULL, uv, NULL, &err);
+    CHECK(r == TT_ERROR_IMAGE_TOO_SMALL && strstr(err.message, "2147483647") && !strstr(err.message, "-1"),
+          "tt_atlas_pack_charts, gutter INT_MAX: %d (%s)", r, err.message);
+    tt_image_free(patch);
+    tt_image_free(atlas);
+    tt_mesh_free(built);
+}
+
 /* ---- tt_atlas_pack_charts ---- */
 
 /* A torus of nu x nv quads, each split in two, every vertex moved by up to
@@ -4562,6 +4601,7 @@ void run_lapped_tests(void)
     RUN(test_atlas_pack_pairs);
     RUN(test_atlas_pack_odd);
     RUN(test_atlas_pack_errors);
+    RUN(test_zero_face_mesh_refused);
     RUN(test_atlas_pack_charts);
     RUN(test_atlas_pack_charts_uneven);
     RUN(test_atlas_pack_charts_overlap);
