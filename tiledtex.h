@@ -4111,6 +4111,11 @@ static tt_result tt__build_check_counts(tt__builder *b, tt_error *error)
     const tt_mesh_desc *desc = b->desc;
     long long total_corners;
     int f;
+    if (desc->flags & ~(unsigned)(TT_MESH_PERMISSIVE | TT_MESH_BORROW_POSITIONS))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "mesh flags 0x%x include unknown bits 0x%x (known: TT_MESH_PERMISSIVE, "
+                        "TT_MESH_BORROW_POSITIONS)", desc->flags,
+                        desc->flags & ~(unsigned)(TT_MESH_PERMISSIVE | TT_MESH_BORROW_POSITIONS));
     b->permissive = (desc->flags & TT_MESH_PERMISSIVE) != 0;
     b->nverts = desc->nverts;
     b->nfaces = desc->nfaces;
@@ -5374,6 +5379,17 @@ TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int
     *out_y = (int)ry;
 }
 
+/* An image's kind is one of tt_image_kind: a caller's struct may hold
+   anything there, and a step that turns vectors must not guess. */
+static tt_result tt__check_image_kind(const tt_image *image, const char *what, tt_error *error)
+{
+    if (image->kind != TT_IMAGE_COLOR && image->kind != TT_IMAGE_NORMAL)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "%s has kind %d, which is not a tt_image_kind (TT_IMAGE_COLOR 0, TT_IMAGE_NORMAL 1)", what,
+                        (int)image->kind);
+    return TT_OK;
+}
+
 TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const tt_allocator *allocator,
                                   tt_image **out_image, tt_error *error)
 {
@@ -5385,6 +5401,7 @@ TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const 
     *out_image = NULL;
     if (!src || !src->pixels)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
+    if ((result = tt__check_image_kind(src, "the source image", error)) != TT_OK) return result;
     turns = ((quarter_turns % 4) + 4) % 4;
     odd = turns & 1;
     result = tt_image_create(odd ? src->height : src->width, odd ? src->width : src->height, allocator, &dst, error);
@@ -5461,6 +5478,7 @@ TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *al
     *out_image = NULL;
     if (!src || !src->pixels)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
+    if ((result = tt__check_image_kind(src, "the source image", error)) != TT_OK) return result;
     if (src->width % 2 || src->height % 2)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "a %d x %d image cannot be halved: both sides must be even", src->width, src->height);
@@ -7869,6 +7887,7 @@ static tt_result tt__check_plan(const tt_synth_plan *plan, tt_error *error)
 
 static tt_result tt__check_plan_source(const tt_synth_plan *plan, const tt_image *source, tt_error *error)
 {
+    if (tt__check_image_kind(source, "the source image", error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (!source->pixels || source->width != plan->source_width || source->height != plan->source_height)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the source image is %dx%d, but the plan was made for a %dx%d image", source->width,
@@ -12997,6 +13016,10 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     for (p = 0; p < npatches; p++)
         if (!patches[p] || !patches[p]->pixels || patches[p]->width <= 0 || patches[p]->height <= 0)
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1, "patch %d is NULL or empty", p);
+    for (p = 0; p < npatches; p++)
+        if (tt__check_image_kind(patches[p], "a patch", error) != TT_OK)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1,
+                               "patch %d has kind %d, which is not a tt_image_kind", p, (int)patches[p]->kind);
     normal = patches[0]->kind == TT_IMAGE_NORMAL;
     for (p = 1; p < npatches; p++)
         if ((patches[p]->kind == TT_IMAGE_NORMAL) != normal)

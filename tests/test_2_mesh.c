@@ -1865,8 +1865,32 @@ static void test_quadrangulate_sources(void)
     }
 }
 
+/* Flag bits the builder does not know are refused, not ignored: a caller
+   who sets one expects something of it. */
+static void test_builder_unknown_flags(void)
+{
+    tmesh m;
+    tt_mesh_desc d;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    make_tetra(&m, 0);
+    d = tm_desc(&m);
+    d.flags = TT_MESH_PERMISSIVE | (1u << 7);
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && mesh == NULL && strstr(err.message, "0x80"),
+          "flags with bit 7: %d (%s)", r, err.message);
+    d.flags = TT_MESH_PERMISSIVE | TT_MESH_BORROW_POSITIONS;
+    r = tt_mesh_build(&d, NULL, &mesh, &err);
+    CHECK(r == TT_OK, "the known flags: %d (%s)", r, err.message);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
 void run_mesh_tests(void)
 {
+    RUN(test_builder_unknown_flags);
     RUN(test_builder_valid);
     RUN(test_builder_errors);
     RUN(test_builder_oom);

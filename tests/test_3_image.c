@@ -1036,8 +1036,31 @@ done:
     CHECK(cnt.live == 0, "normal maps: %ld blocks left", cnt.live);
 }
 
+/* An image whose kind is not a tt_image_kind (a caller's struct) is refused
+   by the steps that act on the kind, not taken as colour. */
+static void test_image_unknown_kind(void)
+{
+    tt_image *im = NULL, *out = NULL;
+    tt_error err;
+    tt_result r;
+    if (tt_image_create(4, 4, NULL, &im, NULL) != TT_OK) { CHECK(0, "tt_image_create"); return; }
+    im->kind = (tt_image_kind)7;
+    r = tt_image_rotate90(im, 1, NULL, &out, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && out == NULL && strstr(err.message, "kind 7"), "rotate90: %d (%s)", r,
+          err.message);
+    r = tt_image_downsample2(im, NULL, &out, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && out == NULL && strstr(err.message, "kind 7"), "downsample2: %d (%s)", r,
+          err.message);
+    im->kind = TT_IMAGE_NORMAL;
+    r = tt_image_rotate90(im, 1, NULL, &out, &err);
+    CHECK(r == TT_OK && out && out->kind == TT_IMAGE_NORMAL, "rotate90 of a normal map: %d (%s)", r, err.message);
+    tt_image_free(out);
+    tt_image_free(im);
+}
+
 void run_image_tests(void)
 {
+    RUN(test_image_unknown_kind);
     RUN(test_image_basics);
     RUN(test_sample_wrap);
     RUN(test_color_transfer);
