@@ -11898,6 +11898,62 @@ static void tt__entry_map_vector(const tt_mesh *mesh, int face, const float *uv,
    degenerate UVs) counts as the worst case: angle 180 degrees, scale error 1.
    With no entries both errors are 0. Non-finite UVs or field vectors of an
    entry give TT_ERROR_NON_FINITE rather than NaN statistics. */
+/* A tt_lapped from the caller (tt_lapped_measure, tt_lapped_bake): counts
+   and arrays consistent, every entry's face in the mesh and its UVs and
+   fades finite (fades in [0, 1]), every paste's entries inside the list and,
+   when npatches > 0, its patch one of them. *total (when not NULL) is the
+   entries the pastes draw. */
+static tt_result tt__check_lapped(const tt_mesh *mesh, const tt_lapped *lapped, int npatches, size_t *total,
+                                  tt_error *error)
+{
+    size_t drawn = 0;
+    int e, p, f, k;
+    if (lapped->npastes < 0 || lapped->nentries < 0 || (lapped->npastes > 0 && !lapped->pastes) ||
+        (lapped->nentries > 0 && (!lapped->faces || !lapped->uv)))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the pastes are inconsistent: %d pastes, %d entries, some arrays NULL or counts negative",
+                        lapped->npastes, lapped->nentries);
+    for (e = 0; e < lapped->nentries; e++) {
+        f = lapped->faces[e];
+        if (f < 0 || f >= mesh->nfaces)
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, e, -1, -1,
+                               "entry %d names face %d, but the mesh has %d faces", e, f, mesh->nfaces);
+        for (k = 0; k < 6; k++)
+            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k])) {
+                tt__fail_at(error, TT_ERROR_NON_FINITE, e, -1, -1, "entry %d (face %d) has a non-finite paste UV", e,
+                            f);
+                if (error) error->face = f;
+                return TT_ERROR_NON_FINITE;
+            }
+        for (k = 0; lapped->fade && k < 3; k++) {
+            float fade = lapped->fade[3 * (size_t)e + k];
+            if (!tt__is_finite(fade) || fade < 0.0f || fade > 1.0f) {
+                tt__fail_at(error, tt__is_finite(fade) ? TT_ERROR_INVALID_ARGUMENT : TT_ERROR_NON_FINITE, e, -1, -1,
+                            "entry %d (face %d) has fade %g at corner %d: fades run from 0 to 1", e, f, (double)fade,
+                            k);
+                if (error) error->face = f;
+                return error ? error->result : TT_ERROR_INVALID_ARGUMENT;
+            }
+        }
+    }
+    for (p = 0; p < lapped->npastes; p++) {
+        const tt_paste *paste = lapped->pastes + p;
+        if (npatches > 0 && (paste->patch < 0 || paste->patch >= npatches))
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, p, -1, -1,
+                               "paste %d uses patch %d, but there are %d patches", p, paste->patch, npatches);
+        if (paste->first < 0 || paste->nfaces < 0 || paste->first > lapped->nentries - paste->nfaces)
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, p, -1, -1,
+                               "paste %d has entries %d..%lld, but there are %d entries", p, paste->first,
+                               (long long)paste->first + paste->nfaces - 1, lapped->nentries);
+        drawn += (size_t)paste->nfaces;
+        if (drawn > 0x3fffffff)
+            return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                            "the pastes draw more than %d face entries", 0x3fffffff);
+    }
+    if (total) *total = drawn;
+    return TT_OK;
+}
+
 TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
                                   const tt_allocator *allocator, tt_lapped_report *report, tt_error *error)
 {
@@ -11905,6 +11961,7 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
     double *scale_error = NULL, angle_sum = 0.0;
     unsigned char *covered = NULL;
     int n, e, f, k;
+    tt_result result;
 
     tt__ok(error);
     if (report) memset(report, 0, sizeof *report);
@@ -11918,21 +11975,10 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
                         "face %d has %d corners: the alignment measure needs triangles", f,
                         mesh->face_start[f + 1] - mesh->face_start[f]);
     }
+    if ((result = tt__check_lapped(mesh, lapped, 0, NULL, error)) != TT_OK) return result;
     n = lapped->nentries;
-    if (n < 0 || (n > 0 && (!lapped->faces || !lapped->uv)))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the pastes are inconsistent: %d entries with faces or uv NULL", n);
     for (e = 0; e < n; e++) {
         f = lapped->faces[e];
-        if (f < 0 || f >= mesh->nfaces)
-            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, e, -1, -1,
-                               "entry %d names face %d, but the mesh has %d faces", e, f, mesh->nfaces);
-        for (k = 0; k < 6; k++)
-            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k])) {
-                tt__fail_at(error, TT_ERROR_NON_FINITE, e, -1, -1, "entry %d (face %d) has a non-finite UV", e, f);
-                if (error) error->face = f;
-                return TT_ERROR_NON_FINITE;
-            }
         for (k = 0; k < 3; k++)
             if (!tt__is_finite(face_vectors[3 * (size_t)f + k])) {
                 tt__fail_at(error, TT_ERROR_NON_FINITE, e, -1, -1,
@@ -13031,38 +13077,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
         if (!tt__is_finite(corner_uv[c]))
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
                             "corner %d (face %d) has a non-finite atlas UV", c / 2, mesh->corner_face[c / 2]);
-    if (lapped->npastes < 0 || lapped->nentries < 0 || (lapped->npastes > 0 && !lapped->pastes) ||
-        (lapped->nentries > 0 && (!lapped->faces || !lapped->uv)))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the pastes are inconsistent: %d pastes, %d entries, some arrays NULL or counts negative",
-                        lapped->npastes, lapped->nentries);
-    for (e = 0; e < lapped->nentries; e++) {
-        f = lapped->faces[e];
-        if (f < 0 || f >= mesh->nfaces)
-            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, e, -1, -1,
-                               "entry %d names face %d, but the mesh has %d faces", e, f, mesh->nfaces);
-        for (k = 0; k < 6; k++)
-            if (!tt__is_finite(lapped->uv[6 * (size_t)e + k])) {
-                tt__fail_at(error, TT_ERROR_NON_FINITE, e, -1, -1, "entry %d (face %d) has a non-finite paste UV", e,
-                            f);
-                if (error) error->face = f;
-                return TT_ERROR_NON_FINITE;
-            }
-    }
-    for (p = 0; p < lapped->npastes; p++) {
-        const tt_paste *paste = lapped->pastes + p;
-        if (paste->patch < 0 || paste->patch >= npatches)
-            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, p, -1, -1,
-                               "paste %d uses patch %d, but there are %d patches", p, paste->patch, npatches);
-        if (paste->first < 0 || paste->nfaces < 0 || paste->first > lapped->nentries - paste->nfaces)
-            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, p, -1, -1,
-                               "paste %d has entries %d..%lld, but there are %d entries", p, paste->first,
-                               (long long)paste->first + paste->nfaces - 1, lapped->nentries);
-        total += (size_t)paste->nfaces;
-        if (total > 0x3fffffff)
-            return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                            "the pastes draw more than %d face entries", 0x3fffffff);
-    }
+    if ((result = tt__check_lapped(mesh, lapped, npatches, &total, error)) != TT_OK) return result;
 
     width = atlas->width;
     height = atlas->height;

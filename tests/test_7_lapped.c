@@ -2978,6 +2978,25 @@ static void test_lapped_measure_errors(void)
                    "nentries -1");
     b.l.nentries = 4;
     CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "restored input: ok");
+    /* A paste whose entries run past the list: the paste in item. */
+    b.l.pastes[0].nfaces = 9;
+    MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_INDEX_OUT_OF_RANGE, 0, -2,
+                   "paste 0 has 9 entries of 4");
+    b.l.pastes[0].nfaces = 4;
+    /* Fades out of [0, 1] or NaN: the entry in item, its face in face. */
+    {
+        float fade[12];
+        for (i = 0; i < 12; i++) fade[i] = 1.0f;
+        b.l.fade = fade;
+        CHECK(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err) == TT_OK, "fades of 1: ok");
+        fade[3 * 2 + 1] = (float)internal_not_a_number();
+        MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_NON_FINITE, 2, 2,
+                       "NaN fade of entry 2");
+        fade[3 * 2 + 1] = 1.5f;
+        MEASURE_EXPECT(tt_lapped_measure(mesh, fv, &b.l, NULL, &rep, &err), TT_ERROR_INVALID_ARGUMENT, 2, 2,
+                       "fade 1.5 of entry 2");
+        b.l.fade = NULL;
+    }
     lb_free(&b);
 
     /* Not triangles: INVALID_ARGUMENT naming the first face that is not one. */
@@ -4335,6 +4354,15 @@ static void test_lapped_bake_errors(void)
     BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_NON_FINITE, 1, 1,
                 "infinite paste uv of entry 1");
     b.l.uv[6 + 5] = 0.0f;
+    {
+        /* A NaN fade would be drawn as NaN alpha: refused, the entry named. */
+        float fade[6] = {1, 1, 1, 1, 1, 1};
+        b.l.fade = fade;
+        fade[4] = (float)internal_not_a_number();
+        BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_NON_FINITE, 1, 1,
+                    "NaN fade of entry 1");
+        b.l.fade = NULL;
+    }
     uv[7] = internal_infinity();
     BAKE_EXPECT(bake_gutter(mesh, &b.l, &red, 1, uv, 1, atlas, &err), TT_ERROR_NON_FINITE, -2, 1,
                 "infinite atlas uv");
