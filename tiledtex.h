@@ -20913,11 +20913,23 @@ static tt_result tt__polycube_mapping_uvs(const tt_polycube *polycube, const tt_
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, q / 4, q, -1, -1,
                             "corner %d of S has type %d, beyond the layout's %d types (2 per colour)", q,
                             corner_type[q], 2 * resolved.colors);
-    for (i = 0; i < 3 * mapping->ntriangles; i++)
-        if (mapping->corner_points[i].quad < 0 || mapping->corner_points[i].quad >= polycube->surface->nfaces)
+    if (mapping->ntriangles < 0 || (mapping->ntriangles > 0 && !mapping->corner_points))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the mapping has %d triangles%s", mapping->ntriangles,
+                        mapping->ntriangles < 0 ? "" : " but no corner points");
+    for (i = 0; i < 3 * mapping->ntriangles; i++) {
+        const tt_surface_point p = mapping->corner_points[i];
+        if (p.quad < 0 || p.quad >= polycube->surface->nfaces)
             return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, i / 3, i, -1, -1,
-                            "corner %d of the mapping names quad %d; S has %d", i, mapping->corner_points[i].quad,
-                            polycube->surface->nfaces);
+                            "corner %d of the mapping names quad %d; S has %d", i, p.quad, polycube->surface->nfaces);
+        /* A point of a quad is at (s, t) in [0, 1]^2: anything else (NaN
+           included) would be written as a UV outside its tile. */
+        if (!(p.s >= 0.0f && p.s <= 1.0f && p.t >= 0.0f && p.t <= 1.0f))
+            return tt__fail(error, tt__is_finite(p.s) && tt__is_finite(p.t) ? TT_ERROR_INVALID_ARGUMENT
+                                                                             : TT_ERROR_NON_FINITE,
+                            i / 3, i, -1, -1, "corner %d of the mapping is at (%g, %g) in quad %d: a point of a quad "
+                            "has s and t in [0, 1]", i, (double)p.s, (double)p.t, p.quad);
+    }
     for (i = 0; i < 3 * mapping->ntriangles; i++) {
         const tt_surface_point p = mapping->corner_points[i];
         const uint8_t *types = corner_type + polycube->surface->face_start[p.quad];

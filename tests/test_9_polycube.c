@@ -2429,6 +2429,29 @@ static void test_map_determinism_and_errors(void)
                   tt_polycube_mapping_uvs(pc, map, &layout, NULL, uv, &err) == TT_ERROR_INVALID_ARGUMENT,
               "tt_polycube_mapping_uvs with NULL arguments: invalid");
     }
+    if (map && map->ntriangles > 0) {
+        /* A corner point off its quad (NaN, or s > 1): refused, not written
+           as a UV. */
+        tt_tile_layout layout = {1, 32, 4};
+        uint8_t *types = (uint8_t *)calloc((size_t)pc->surface->ncorners, 1);
+        float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
+        tt_surface_point saved = map->corner_points[4];
+        if (types && uv) {
+            map->corner_points[4].s = (float)internal_not_a_number();
+            r = tt_polycube_mapping_uvs(pc, map, &layout, types, uv, &err);
+            CHECK(r == TT_ERROR_NON_FINITE && err.corner == 4 && err.face == 1,
+                  "a NaN corner point: %d, corner %d (%s)", r, err.corner, err.message);
+            map->corner_points[4].s = saved.s;
+            map->corner_points[4].t = 1.5f;
+            r = tt_polycube_mapping_uvs_upright(pc, map, &layout, types, uv, &err);
+            CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.corner == 4, "t = 1.5: %d (%s)", r, err.message);
+            map->corner_points[4] = saved;
+            r = tt_polycube_mapping_uvs(pc, map, &layout, types, uv, &err);
+            CHECK(r == TT_OK, "restored: %d (%s)", r, err.message);
+        }
+        free(types);
+        free(uv);
+    }
     ctx.pc = pc;
     ctx.mesh = mesh;
     oom_reset();
