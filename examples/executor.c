@@ -163,3 +163,38 @@ const tt_executor *tool_executor(void)
     if (tool_jobs() <= 1) return NULL;
     return &executor;
 }
+
+void tool_run_tasks(const tt_executor *executor, int count, tt_task_fn task, void *context)
+{
+    int i;
+    if (executor && executor->run && count > 1) {
+        executor->run(count, task, context, executor->user_data);
+        return;
+    }
+    for (i = 0; i < count; i++) task(context, i);
+}
+
+typedef struct range_job {
+    void (*body)(void *context, int begin, int end);
+    void *context;
+    int n, grain;
+} range_job;
+
+static void range_task(void *context, int index)
+{
+    const range_job *job = (const range_job *)context;
+    int begin = index * job->grain, end = job->n - begin > job->grain ? begin + job->grain : job->n;
+    job->body(job->context, begin, end);
+}
+
+void tool_parallel_ranges(const tt_executor *executor, int n, int grain, void (*body)(void *context, int begin, int end),
+                          void *context)
+{
+    range_job job;
+    if (n <= 0) return;
+    job.body = body;
+    job.context = context;
+    job.n = n;
+    job.grain = grain < 1 ? 1 : grain;
+    tool_run_tasks(executor, n / job.grain + (n % job.grain != 0), range_task, &job);
+}

@@ -1,6 +1,6 @@
 /* image_io.c - images for the `tiledtex` tool: loading any format stb_image
    reads into a float RGBA tt_image (after checking its size), and encoding
-   PNG files. See tool.h for the interface. */
+   PNG files (png_write.c compresses them). See tool.h for the interface. */
 
 #include <limits.h>
 #include <stdio.h>
@@ -9,8 +9,8 @@
 
 #include "tool.h"
 
-/* stb_image and stb_image_write (Debian package libstb-dev) are compiled in
-   this one file. They are not written for -Wextra -pedantic -Wshadow, so their
+/* stb_image (Debian package libstb-dev) is compiled in this one file (PNG
+   files are written by png_write.c). They are not written for -Wextra -pedantic -Wshadow, so their
    own warnings are switched off around them - and only around them. */
 #if defined(__GNUC__) || defined(__clang__)
 #pragma GCC diagnostic push
@@ -32,8 +32,6 @@
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG        /* friendlier texts from stbi_failure_reason() */
 #include "stb_image.h"
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include "stb_image_write.h"
 #if defined(__GNUC__) || defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
@@ -194,7 +192,7 @@ static int drop_opaque_alpha(unsigned char *rgba, size_t npixels)
 int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char **png, size_t *png_size, char *err,
                      size_t err_size)
 {
-    int length = 0, channels;
+    int channels;
     *png = NULL;
     *png_size = 0;
     if (!rgba || width <= 0 || height <= 0 || width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) {
@@ -202,18 +200,40 @@ int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char *
         return -1;
     }
     channels = drop_opaque_alpha(rgba, (size_t)width * (size_t)height);
-    /* stb_image_write's own buffer (malloc'ed) becomes ours: no copy of the
-       encoded file. While it works it holds the filtered rows (one more byte
-       per row than `rgba`) and the compressed stream. */
-    *png = stbi_write_png_to_mem(rgba, width * channels, width, height, channels, &length);
-    if (!*png || length <= 0) {
-        free(*png);
-        *png = NULL;
+    if (png_write_to_memory(rgba, width, height, channels, png, png_size) != 0) {
         tool_set_error(err, err_size, "could not encode a %dx%d PNG (out of memory?)", width, height);
         return -1;
     }
-    *png_size = (size_t)length;
     return 0;
+}
+
+/* Texels per task of image_to_rgba8: a few hundred tasks for an atlas. */
+#define RGBA8_BAND_TEXELS 65536
+
+typedef struct rgba8_job {
+    const tt_image *image;
+    tt_color_space space;
+    unsigned char *out;
+} rgba8_job;
+
+static void rgba8_band(void *context, int begin, int end)
+{
+    const rgba8_job *job = (const rgba8_job *)context;
+    size_t first = (size_t)begin * (size_t)job->image->width;
+    tt_image band = *job->image;   /* a view of rows begin..end */
+    band.height = end - begin;
+    band.pixels = job->image->pixels + 4 * first;
+    tt_image_to_rgba8(&band, job->space, job->out + 4 * first);
+}
+
+void image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out)
+{
+    rgba8_job job;
+    int rows = RGBA8_BAND_TEXELS / image->width;
+    job.image = image;
+    job.space = space;
+    job.out = out;
+    tool_parallel_ranges(tool_executor(), image->height, rows < 1 ? 1 : rows, rgba8_band, &job);
 }
 
 int png_encode(const tt_image *image, tt_color_space space, unsigned char **png, size_t *png_size, char *err,
@@ -233,7 +253,7 @@ int png_encode(const tt_image *image, tt_color_space space, unsigned char **png,
         tool_set_error(err, err_size, "out of memory while encoding a %dx%d PNG", image->width, image->height);
         return -1;
     }
-    tt_image_to_rgba8(image, space, rgba);
+    image_to_rgba8(image, space, rgba);
     status = png_encode_rgba8(rgba, image->width, image->height, png, png_size, err, err_size);
     free(rgba);
     return status;

@@ -840,7 +840,7 @@ static int add_png(tool_output *output, const char *path, tt_image *image)
         tt_image_free(image);
         return tool_fail("out of memory while encoding %s", path);
     }
-    tt_image_to_rgba8(image, TT_COLOR_SRGB, rgba);
+    image_to_rgba8(image, TT_COLOR_SRGB, rgba);
     tt_image_free(image);
     status = output_add_png_rgba8(output, path, rgba, width, height, message, sizeof message);
     free(rgba);

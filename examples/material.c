@@ -127,7 +127,7 @@ int output_add_map_png(tool_output *output, const char *path, int map, const tt_
     unsigned char *rgba = (unsigned char *)malloc(count * 4);
     int status;
     if (!rgba) return tool_fail("out of memory while writing %s", path);
-    tt_image_to_rgba8(image, material_space(map), rgba);
+    image_to_rgba8(image, material_space(map), rgba);
     /* Written opaque: a map has no coverage of its own (a baked one's alpha
        is the colour's coverage, which the colour PNG carries). */
     for (i = 0; i < count; i++) rgba[4 * i + 3] = 255;

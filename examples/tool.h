@@ -12,7 +12,8 @@
                                          memory, then commit them all or none
                  progress, time          tool_progress, tool_seconds_now
      cli.c       command-line helpers    tool_option, parse_int, parse_mesh_option, ...
-     image_io.c  images                  image_load, png_encode, output_add_png
+     image_io.c  images                  image_load, png_encode, output_add_png,
+                                         image_to_rgba8
      obj.c       OBJ reading, writing    obj_parse, obj_read_text, obj_write
      gltf.c      glTF 2.0 binary (.glb)  gltf_write, output_add_glb,
                                          gltf_pack_metallic_roughness,
@@ -26,7 +27,9 @@
                  (parsed in cli.c)       tool_note_cut_edges
      measure.c   quality for summaries   tool_measure_seams, tool_format_seams
      format_number.c  numbers as text   tool_format_float, tool_format_int
-     executor.c  threads for the library  tool_executor, tool_set_jobs (-j N)
+     executor.c  threads for the library  tool_executor, tool_set_jobs (-j N),
+                 and for the tool        tool_run_tasks, tool_parallel_ranges
+     png_write.c PNG files, in parallel  png_write_to_memory
 
    Conventions every command follows:
      - Errors are one line on stderr, "tiledtex: <message>" (or
@@ -349,6 +352,10 @@ void image_free(tt_image *image);
    (free it with image_free). Returns 0, or -1 when out of memory. */
 int image_crop(const tt_image *image, int x, int y, int width, int height, tt_image **out);
 
+/* tt_image_to_rgba8 on the tool's threads (-j), in bands of rows: the same
+   bytes. `out` must not be the image's own pixels (bands would write over
+   floats another band has still to read). */
+void image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out);
 /* Encode an image as an 8-bit PNG in memory (malloc'ed; free it), its
    colours encoded into `space` (TT_COLOR_SRGB for every colour output).
    Opaque images are written as RGB, others as RGBA (straight alpha). */
@@ -358,6 +365,13 @@ int png_encode(const tt_image *image, tt_color_space space, unsigned char **png,
    the encoder may rewrite in place (an opaque image is packed to RGB). */
 int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char **png, size_t *png_size, char *err,
                      size_t err_size);
+/* The PNG file of width x height pixels of `channels` bytes (1 grey, 2
+   grey + alpha, 3 RGB, 4 RGBA), rows packed, in memory (malloc'ed; free
+   it): filtered and compressed on the tool's threads (png_write.c), the
+   same bytes at every -j. Returns 0, or -1 when out of memory or for sizes
+   out of range. */
+int png_write_to_memory(const unsigned char *pixels, int width, int height, int channels, unsigned char **png,
+                        size_t *png_size);
 /* Encode as PNG and add it to an output batch. */
 int output_add_png(tool_output *output, const char *path, const tt_image *image, tt_color_space space, char *err,
                    size_t err_size);
@@ -870,6 +884,13 @@ void tool_set_jobs(int jobs);
 int tool_jobs(void);
 int tool_default_jobs(void);
 const tt_executor *tool_executor(void);
+/* The tool's own parallel loops, as the library runs its (the same rules:
+   tasks write disjoint outputs, the split never depends on the executor):
+   task(context, i) for i in [0, count) on `executor` (NULL: in order, here),
+   and body(context, begin, end) over [0, n) cut into ranges of `grain`. */
+void tool_run_tasks(const tt_executor *executor, int count, tt_task_fn task, void *context);
+void tool_parallel_ranges(const tt_executor *executor, int n, int grain, void (*body)(void *context, int begin, int end),
+                          void *context);
 
 /* ---------------------------------------------------------------------- */
 /* Paths and strings (tool_io.c)                                            */

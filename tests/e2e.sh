@@ -2108,6 +2108,128 @@ check "positions survive writing and reading" "identical v lines" "differ" \
 cd "$W" || exit 1
 
 # ======================================================================
+# PNG files: png_write.c's files decode to their pixels, with valid CRCs and
+# Adler-32, the same bytes at -j 1 and -j 2
+# ======================================================================
+cat >"$W/png_check.c" <<'EOF_C'
+/* Images of every channel count and several shapes (one texel, one row, one
+   column, flat, noise over several compressed pieces, a repeating
+   pattern) through png_write_to_memory at -j 1 and -j 2: each file must be
+   the same at both, decode (stb_image) to the same bytes, have a correct
+   CRC on every chunk and a zlib stream whose Adler-32 matches its data.
+   Prints one line per problem and "checked N images". */
+#define STB_IMAGE_IMPLEMENTATION
+#include "stb_image.h"
+#define TILEDTEX_IMPLEMENTATION
+#include "tool.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static unsigned long be32(const unsigned char *p)
+{
+    return (unsigned long)p[0] << 24 | (unsigned long)p[1] << 16 | (unsigned long)p[2] << 8 | p[3];
+}
+
+static unsigned long crc32_naive(const unsigned char *p, size_t n)
+{
+    unsigned long c = 0xfffffffful;
+    size_t i;
+    int k;
+    for (i = 0; i < n; i++) {
+        c ^= p[i];
+        for (k = 0; k < 8; k++) c = c & 1 ? 0xedb88320ul ^ (c >> 1) : c >> 1;
+    }
+    return c ^ 0xfffffffful;
+}
+
+/* Chunks' CRCs, the IDAT data inflated, its Adler-32; 0 when all good. */
+static int check_file(const unsigned char *png, size_t size, const char *what)
+{
+    unsigned char *idat = malloc(size), *raw;
+    size_t at = 8, nidat = 0, i;
+    unsigned long s1 = 1, s2 = 0;
+    int raw_length, bad = 0;
+    while (at + 12 <= size) {
+        unsigned long n = be32(png + at);
+        if (at + 12 + n > size) { printf("%s: chunk past the end\n", what); return 1; }
+        if (crc32_naive(png + at + 4, 4 + n) != be32(png + at + 8 + n)) { printf("%s: bad CRC\n", what); bad = 1; }
+        if (memcmp(png + at + 4, "IDAT", 4) == 0) { memcpy(idat + nidat, png + at + 8, n); nidat += n; }
+        at += 12 + n;
+    }
+    if (at != size || memcmp(png + size - 8, "IEND", 4) != 0) { printf("%s: does not end with IEND\n", what); bad = 1; }
+    raw = (unsigned char *)stbi_zlib_decode_malloc((const char *)idat, (int)nidat, &raw_length);
+    if (!raw) { printf("%s: the zlib stream does not inflate\n", what); free(idat); return 1; }
+    for (i = 0; i < (size_t)raw_length; i++) { s1 = (s1 + raw[i]) % 65521; s2 = (s2 + s1) % 65521; }
+    if ((s2 << 16 | s1) != be32(idat + nidat - 4)) { printf("%s: wrong Adler-32\n", what); bad = 1; }
+    free(raw);
+    free(idat);
+    return bad;
+}
+
+int main(void)
+{
+    static const int shapes[][2] = {{1, 1}, {300, 1}, {1, 300}, {700, 500}, {1024, 700}, {333, 257}};
+    int s, c, kind, checked = 0, bad = 0;
+    unsigned long state = 12345;
+    for (s = 0; s < 6; s++)
+        for (c = 1; c <= 4; c++)
+            for (kind = 0; kind < 3; kind++) {
+                int w = shapes[s][0], h = shapes[s][1], x, y, k, ww, hh, cc;
+                size_t n = (size_t)w * h * c, sizes[2];
+                unsigned char *pixels = malloc(n), *png[2], *back;
+                char what[96];
+                for (y = 0; y < h; y++)
+                    for (x = 0; x < w; x++)
+                        for (k = 0; k < c; k++) {
+                            size_t i = ((size_t)y * w + x) * c + k;
+                            state = state * 6364136223846793005ul + 1442695040888963407ul;
+                            pixels[i] = kind == 0 ? (unsigned char)(77 + k)                     /* flat */
+                                        : kind == 1 ? (unsigned char)(state >> 33)               /* noise */
+                                                    : (unsigned char)((x * 7 + y * 3 + k * 50) % 23 * 11);
+                        }
+                snprintf(what, sizeof what, "%dx%d, %d channels, %s", w, h, c,
+                         kind == 0 ? "flat" : kind == 1 ? "noise" : "pattern");
+                for (k = 0; k < 2; k++) {
+                    tool_set_jobs(k + 1);
+                    if (png_write_to_memory(pixels, w, h, c, &png[k], &sizes[k]) != 0) {
+                        printf("%s: not encoded\n", what);
+                        return 1;
+                    }
+                }
+                if (sizes[0] != sizes[1] || memcmp(png[0], png[1], sizes[0]) != 0) {
+                    printf("%s: -j 2 wrote other bytes than -j 1\n", what);
+                    bad++;
+                }
+                bad += check_file(png[0], sizes[0], what);
+                back = stbi_load_from_memory(png[0], (int)sizes[0], &ww, &hh, &cc, 0);
+                if (!back || ww != w || hh != h || cc != c || memcmp(back, pixels, n) != 0) {
+                    printf("%s: does not decode to its pixels\n", what);
+                    bad++;
+                }
+                stbi_image_free(back);
+                free(png[0]);
+                free(png[1]);
+                free(pixels);
+                checked++;
+            }
+    printf("checked %d images\n", checked);
+    return bad != 0;
+}
+EOF_C
+CMD="$HELPER_CC png_check.c examples/png_write.c executor.c (test helper)"
+# shellcheck disable=SC2086
+if $HELPER_CC -std=c99 -O1 -w -pthread -I"$ROOT" -I"$ROOT/examples" $STB_INC "$W/png_check.c" \
+    "$ROOT/examples/png_write.c" "$ROOT/examples/executor.c" -o "$W/png_check" -lm 2>"$W/err"; then
+    PNGCHECK=$("$W/png_check" 2>&1)
+    check "PNG files: decode to their pixels, CRCs and Adler-32 right, same at -j 1 and -j 2" \
+        "checked 72 images, no problem" "$PNGCHECK" \
+        "$([ "$PNGCHECK" = "checked 72 images" ]; echo $?)"
+else
+    fail "helper for the PNG writer" "$CMD" "compiles" "$(head -c 300 "$W/err")"
+fi
+
+# ======================================================================
 # Colour: linear light inside, sRGB in the files (converted once each way);
 # the seam report
 # ======================================================================
@@ -2509,10 +2631,10 @@ int main(int argc, char **argv)
 }
 EOF_C
 GLB_PROBE=""
-CMD="$HELPER_CC glb_probe.c examples/gltf.c image_io.c tool_io.c obj.c format_number.c (test helper)"
-if $HELPER_CC -std=c99 -O1 -w -I"$ROOT" -I"$ROOT/examples" $STB_INC "$W/glb_probe.c" "$ROOT/examples/gltf.c" \
-    "$ROOT/examples/image_io.c" "$ROOT/examples/tool_io.c" "$ROOT/examples/obj.c" "$ROOT/examples/format_number.c" \
-    -o "$W/glb_probe" -lm 2>"$W/err"; then
+CMD="$HELPER_CC glb_probe.c examples/gltf.c image_io.c png_write.c executor.c tool_io.c obj.c format_number.c (test helper)"
+if $HELPER_CC -std=c99 -O1 -w -pthread -I"$ROOT" -I"$ROOT/examples" $STB_INC "$W/glb_probe.c" "$ROOT/examples/gltf.c" \
+    "$ROOT/examples/image_io.c" "$ROOT/examples/png_write.c" "$ROOT/examples/executor.c" "$ROOT/examples/tool_io.c" \
+    "$ROOT/examples/obj.c" "$ROOT/examples/format_number.c" -o "$W/glb_probe" -lm 2>"$W/err"; then
     GLB_PROBE=$W/glb_probe
 else
     fail "helper for GLB files" "$CMD" "compiles" "$(head -c 300 "$W/err")"
