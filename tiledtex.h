@@ -10990,6 +10990,9 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 #define TT__LAPPED_FADE_KEEPS 0.1
 /* Vertices of a patch's conservative hull (Sec. 3.3, Fig. 4). */
 #define TT__LAPPED_HULL_VERTICES 32
+/* Cells a side of the grid that answers most of growth's hull tests
+   (tt__hull_grid). */
+#define TT__LAPPED_HULL_GRID 64
 /* Grow-and-solve rounds per paste (Sec. 3.3: "when this occurs, we further
    grow the patch and optimize again"). */
 #define TT__LAPPED_GROW_ROUNDS 3
@@ -11024,6 +11027,8 @@ typedef struct tt__lapper {
     /* per texture patch */
     float **hull;               /* conservative hull, texture space, CCW */
     int *hull_count;
+    unsigned char *hull_cells;  /* per patch: TT__LAPPED_HULL_GRID^2 cells of the hull's box (tt__hull_grid) */
+    float *hull_box;            /* 4 per patch: the box's corner and its cells' width and height */
     float **depth;              /* per texel: distance (texels) to the nearest texel not opaque */
     float *anchor;              /* 2 per patch: where a paste's seed point lands */
     /* per face */
@@ -11296,6 +11301,77 @@ static void tt__map_vertex(tt__lapper *L, int v, int paste)
     L->patch_verts[L->npatch_verts++] = v;
 }
 
+/* Growth asks, for every edge it reaches, whether the edge's image meets
+   the patch's hull (Sec. 3.3), and the exact test walks the hull's 32
+   edges. A grid over the hull's box answers most of the questions at once:
+   a cell whose centre lies inside (or outside) the hull farther from its
+   boundary than half the cell's diagonal lies wholly inside (outside), so
+   an edge with an end in an inside cell meets the hull, and one with both
+   ends in the same outside cell (a convex cell) does not; the rest, near
+   the boundary, take the exact test. The answers are the exact test's. */
+#define TT__HULL_CELL_BOUNDARY 0
+#define TT__HULL_CELL_INSIDE 1
+#define TT__HULL_CELL_OUTSIDE 2
+
+static void tt__hull_grid(tt__lapper *L, int patch)
+{
+    const float *xy = L->hull[patch];
+    const int count = L->hull_count[patch], g = TT__LAPPED_HULL_GRID;
+    unsigned char *cells = L->hull_cells + (size_t)patch * g * g;
+    float *box = L->hull_box + 4 * (size_t)patch;
+    double lo[2], hi[2], half_diagonal;
+    int i, j, k;
+    if (count < 3) {
+        memset(cells, TT__HULL_CELL_BOUNDARY, (size_t)g * g);
+        box[0] = box[1] = box[2] = box[3] = 0.0f;   /* no cell holds a point: the exact test answers */
+        return;
+    }
+    lo[0] = hi[0] = xy[0];
+    lo[1] = hi[1] = xy[1];
+    for (k = 1; k < count; k++)
+        for (j = 0; j < 2; j++) {
+            if (xy[2 * k + j] < lo[j]) lo[j] = xy[2 * k + j];
+            if (xy[2 * k + j] > hi[j]) hi[j] = xy[2 * k + j];
+        }
+    box[0] = (float)lo[0];
+    box[1] = (float)lo[1];
+    box[2] = (float)((hi[0] - lo[0]) / g);
+    box[3] = (float)((hi[1] - lo[1]) / g);
+    half_diagonal = 0.5 * sqrt((double)box[2] * box[2] + (double)box[3] * box[3]);
+    for (j = 0; j < g; j++)
+        for (i = 0; i < g; i++) {
+            double cx = box[0] + (i + 0.5) * box[2], cy = box[1] + (j + 0.5) * box[3], nearest = HUGE_VAL;
+            for (k = 0; k < count; k++) {
+                const float *a = xy + 2 * k, *b = xy + 2 * ((k + 1) % count);
+                double d = tt__point_segment_distance(cx, cy, a[0], a[1], b[0], b[1]);
+                if (d < nearest) nearest = d;
+            }
+            /* A margin for the rounding of the cells' corners (floats). */
+            cells[j * g + i] = !(nearest > 1.01 * half_diagonal + 1e-6) ? TT__HULL_CELL_BOUNDARY
+                             : tt__point_in_polygon(cx, cy, xy, count) ? TT__HULL_CELL_INSIDE
+                                                                       : TT__HULL_CELL_OUTSIDE;
+        }
+}
+
+/* The cell of the hull grid holding (x, y), or -1 outside the box. */
+static int tt__hull_cell(const tt__lapper *L, int patch, const float p[2])
+{
+    const float *box = L->hull_box + 4 * (size_t)patch;
+    double x = (p[0] - box[0]) / box[2], y = (p[1] - box[1]) / box[3];
+    if (!(x >= 0.0 && y >= 0.0 && x < TT__LAPPED_HULL_GRID && y < TT__LAPPED_HULL_GRID)) return -1;
+    return (int)y * TT__LAPPED_HULL_GRID + (int)x;
+}
+
+/* Whether the segment a b meets the hull of texture patch `patch`. */
+static int tt__edge_meets_hull(const tt__lapper *L, int patch, const float a[2], const float b[2])
+{
+    const unsigned char *cells = L->hull_cells + (size_t)patch * TT__LAPPED_HULL_GRID * TT__LAPPED_HULL_GRID;
+    int ca = tt__hull_cell(L, patch, a), cb = tt__hull_cell(L, patch, b);
+    if ((ca >= 0 && cells[ca] == TT__HULL_CELL_INSIDE) || (cb >= 0 && cells[cb] == TT__HULL_CELL_INSIDE)) return 1;
+    if (ca >= 0 && ca == cb && cells[ca] == TT__HULL_CELL_OUTSIDE) return 0;
+    return tt__segment_meets_polygon(a, b, L->hull[patch], L->hull_count[patch]);
+}
+
 /* Queue the half-edges of patch face f whose far side is not in the patch
    and whose image still meets the hull of texture patch `patch` (Sec. 3.3:
    "the patch is only grown over an edge if the edge is still partially
@@ -11315,7 +11391,7 @@ static void tt__queue_edges(tt__lapper *L, int f, int paste, int patch)
         p = L->vert_uv + 2 * (size_t)mesh->corner_vert[c];
         q = L->vert_uv + 2 * (size_t)mesh->corner_vert[3 * f + (k + 1) % 3];
         a[0] = (float)p[0]; a[1] = (float)p[1]; b[0] = (float)q[0]; b[1] = (float)q[1];
-        if (!tt__segment_meets_polygon(a, b, L->hull[patch], L->hull_count[patch])) continue;
+        if (!tt__edge_meets_hull(L, patch, a, b)) continue;
         L->edge_stamp[c] = L->round_stamp;
         mx = 0.5 * (p[0] + q[0]) - anchor[0];
         my = 0.5 * (p[1] + q[1]) - anchor[1];
@@ -11833,6 +11909,8 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->hull);
     tt__free(L->al, L->depth);
     tt__free(L->al, L->hull_count);
+    tt__free(L->al, L->hull_cells);
+    tt__free(L->al, L->hull_box);
     tt__free(L->al, L->anchor);
     tt__free(L->al, L->normal);
     tt__free(L->al, L->tangent);
@@ -11904,6 +11982,8 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         if (L->depth) L->depth[i] = NULL;
     }
     L->hull_count = TT__ALLOC(L->al, int, L->npatches);
+    L->hull_cells = TT__ALLOC(L->al, unsigned char, (size_t)L->npatches * TT__LAPPED_HULL_GRID * TT__LAPPED_HULL_GRID);
+    L->hull_box = TT__ALLOC(L->al, float, 4 * (size_t)L->npatches);
     L->patch_count = TT__ALLOC(L->al, int, L->npatches);
     L->shape_of = TT__ALLOC(L->al, int, L->npatches);
     L->top_patch = TT__ALLOC(L->al, int, nf);
@@ -11935,7 +12015,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->seeded = TT__ALLOC(L->al, unsigned char, nf);
     L->triplets = TT__ALLOC(L->al, tt_triplet, 9 * ((size_t)nf + 1));
     L->solve = TT__ALLOC(L->al, double, 4 * (size_t)nv);
-    if (!L->hull || !L->hull_count || !L->patch_count || !L->shape_of || !L->top_patch || !L->near_stamp || !L->near_queue ||
+    if (!L->hull || !L->hull_count || !L->hull_cells || !L->hull_box || !L->patch_count || !L->shape_of || !L->top_patch || !L->near_stamp || !L->near_queue ||
         !L->anchor || !L->normal || !L->tangent || !L->axis_weights || !L->area || !L->difficulty || !L->sample_res ||
         !L->sample_start || !L->covered_count || !L->uncovered || !L->uncovered_pos || !L->face_stamp ||
         !L->vert_stamp || !L->edge_stamp || !L->vert_local || !L->vert_uv || !L->patch_faces ||
@@ -11965,6 +12045,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         r = tt__patch_hull(p, TT__LAPPED_HULL_VERTICES, L->al, &L->hull[i], &L->hull_count[i]);
         if (r != TT_OK)
             return tt__fail(error, r, -1, -1, -1, -1, "texture patch %d: %s", i, tt_result_string(r));
+        tt__hull_grid(L, i);
         for (j = 0; j < n; j++) opaque += p->pixels[4 * j + 3] >= TT_LAPPED_OPAQUE;
         if (p->width > widest) widest = p->width;
         if (p->height > widest) widest = p->height;
