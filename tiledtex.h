@@ -2017,11 +2017,14 @@ typedef struct tt_bake_options {
     int gutter;             /* texels past each triangle's image filled by extrapolating its
                                composite across its edges; 0 = none (the nearest-texel fill
                                still covers the rest); the tool uses 2 */
-    /* Called before each face with the fraction of faces done (never
-       decreasing), and with 1 when all are baked; non-zero return cancels
-       with TT_CANCELLED. */
+    /* Called between batches of rows of the atlas with the fraction of rows
+       done (never decreasing), and with 1 when all are baked, always from
+       the calling thread; non-zero return cancels with TT_CANCELLED. */
     tt_progress_fn progress;
     void *progress_user_data;
+    /* Bakes bands of rows of the atlas in parallel; NULL: serial. The same
+       atlas either way, bit for bit. */
+    const tt_executor *executor;
 } tt_bake_options;
 
 /* Bake the pastes into `atlas` (yours: its size is the resolution; a view is
@@ -7662,13 +7665,17 @@ TTDEF tt_result tt_xcorr_masked_best(const tt_xcorr_texture *const *textures, in
 #define TT__SUBPIXEL 256
 #define TT__RASTER_LIMIT 2097152.0   /* |coordinate| in pixels; keeps products within 63 bits */
 
-TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raster_fn fn, void *user_data)
+/* tt_raster_triangle over the rows [row_begin, row_end) of the grid only:
+   the same pixels of those rows, with the same weights (the edge functions
+   are exact integers, whichever row they start from), so that bands of rows
+   can be drawn apart, in parallel. */
+static void tt__raster_triangle_rows(const float xy[6], int width, int row_begin, int row_end, tt_raster_fn fn,
+                                     void *user_data)
 {
     long long px[3], py[3], area, bias[3], step_x[3], step_y[3], row[3];
     float min_x, max_x, min_y, max_y, inverse_area;
     int i, x0, x1, y0, y1, x, y, swapped = 0;
-    TT_ASSERT(xy && fn);
-    if (!xy || !fn || width <= 0 || height <= 0) return;
+    if (!xy || !fn || width <= 0 || row_begin >= row_end) return;
     for (i = 0; i < 6; i++)
         if (!(xy[i] > -TT__RASTER_LIMIT && xy[i] < TT__RASTER_LIMIT)) return;
     for (i = 0; i < 3; i++) {
@@ -7693,9 +7700,9 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
         if (xy[2 * i + 1] > max_y) max_y = xy[2 * i + 1];
     }
     x0 = tt__max_i((int)floorf(min_x - 0.5f), 0);
-    y0 = tt__max_i((int)floorf(min_y - 0.5f), 0);
+    y0 = tt__max_i((int)floorf(min_y - 0.5f), row_begin);
     x1 = tt__min_i((int)ceilf(max_x - 0.5f), width - 1);
-    y1 = tt__min_i((int)ceilf(max_y - 0.5f), height - 1);
+    y1 = tt__min_i((int)ceilf(max_y - 0.5f), row_end - 1);
     if (x0 > x1 || y0 > y1) return;
     inverse_area = 1.0f / (float)area;
 
@@ -7729,6 +7736,12 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
         }
         row[0] += step_y[0]; row[1] += step_y[1]; row[2] += step_y[2];
     }
+}
+
+TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raster_fn fn, void *user_data)
+{
+    TT_ASSERT(xy && fn);
+    if (height > 0) tt__raster_triangle_rows(xy, width, 0, height, fn, user_data);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -13413,9 +13426,10 @@ typedef struct tt__bake {
        from its patch's frame to the atlas's; NULL for colour. */
     const float *turns;
     double x[3], y[3];          /* the face's atlas triangle, pixels */
-    double inverse_area2;       /* 1 / twice its signed area */
+    double area2, inverse_area2;    /* twice its signed area, and 1 over it */
     double gutter;              /* texels */
     int inside;                 /* 1: rasterising the triangle itself, 0: its gutter */
+    int row_begin, row_end;     /* the band of atlas rows being baked */
     float *state;               /* per texel: -1 inside a triangle, else distance of the gutter
                                    that wrote it, +infinity for empty */
     tt_image *atlas;
@@ -13573,7 +13587,7 @@ static void tt__bake_gutter(tt__bake *b)
         xy[0] = (float)poly[0]; xy[1] = (float)poly[1];
         xy[2] = (float)poly[2 * k]; xy[3] = (float)poly[2 * k + 1];
         xy[4] = (float)poly[2 * k + 2]; xy[5] = (float)poly[2 * k + 3];
-        tt_raster_triangle(xy, b->atlas->width, b->atlas->height, tt__bake_texel, b);
+        tt__raster_triangle_rows(xy, b->atlas->width, b->row_begin, b->row_end, tt__bake_texel, b);
     }
 }
 
@@ -13620,6 +13634,86 @@ static void tt__bake_turn(const tt__bake *b, const float *uv, const tt_image *pa
    its own: extrapolating g texels across it would multiply its barycentrics,
    and their rounding, by g / height. The final fill covers its surroundings. */
 #define TT__BAKE_MIN_HEIGHT (1.0 / 16.0)
+/* The atlas is baked in bands of this many rows, each a task, and the
+   progress callback is called between batches of this many bands. */
+#define TT__BAKE_BAND_ROWS 16
+#define TT__BAKE_BATCH 32
+
+/* What every band of the bake shares. */
+typedef struct tt__bake_job {
+    const tt_mesh *mesh;
+    const float *corner_uv;
+    const tt_lapped *lapped;
+    tt_image *const *patches;
+    const int *start, *items;   /* per face, its (entry, patch) pairs in paste order */
+    float *turns;               /* normal maps: per item, tt__bake_turn; else NULL */
+    float *state;
+    tt_image *atlas;
+    double gutter;
+    const int *band_start, *band_faces;   /* per band, the faces whose triangle or gutter reaches it */
+    int first_band;             /* the batch running: bands first_band + task */
+} tt__bake_job;
+
+/* Face f's atlas triangle (pixels) in b and xy, and its pastes; 0 when the
+   triangle has no area (nothing to draw: the fill covers it). */
+static int tt__bake_face(tt__bake *b, const tt__bake_job *job, int f, float xy[6])
+{
+    const int width = job->atlas->width, height = job->atlas->height;
+    double area2;
+    int k;
+    for (k = 0; k < 3; k++) {
+        int corner = job->mesh->face_start[f] + k;
+        xy[2 * k] = job->corner_uv[2 * (size_t)corner] * (float)width;
+        xy[2 * k + 1] = (1.0f - job->corner_uv[2 * (size_t)corner + 1]) * (float)height;
+        b->x[k] = xy[2 * k];
+        b->y[k] = xy[2 * k + 1];
+    }
+    area2 = (b->x[1] - b->x[0]) * (b->y[2] - b->y[0]) - (b->x[2] - b->x[0]) * (b->y[1] - b->y[0]);
+    if (!(fabs(area2) > 0.0) || !tt__is_finite_d(area2)) return 0;
+    b->area2 = area2;
+    b->inverse_area2 = 1.0 / area2;
+    b->items = job->items + 2 * (size_t)job->start[f];
+    b->nitems = job->start[f + 1] - job->start[f];
+    b->turns = job->turns ? job->turns + 4 * (size_t)job->start[f] : NULL;
+    return 1;
+}
+
+/* One band of rows: its faces in order, each triangle and then its gutter,
+   as a serial bake draws them - the texels of the band see the same writes
+   in the same order, so the atlas is the same bits whatever runs the bands.
+   Bands write only their own rows (atlas and state). */
+static void tt__bake_band(void *context, int task)
+{
+    const tt__bake_job *job = (const tt__bake_job *)context;
+    const int band = job->first_band + task;
+    tt__bake b;
+    int k;
+    memset(&b, 0, sizeof b);
+    b.lapped = job->lapped;
+    b.patches = job->patches;
+    b.state = job->state;
+    b.atlas = job->atlas;
+    b.gutter = job->gutter;
+    b.row_begin = band * TT__BAKE_BAND_ROWS;
+    b.row_end = tt__min_i(b.row_begin + TT__BAKE_BAND_ROWS, job->atlas->height);
+    for (k = job->band_start[band]; k < job->band_start[band + 1]; k++) {
+        float xy[6];
+        double longest = 0.0;
+        int i;
+        if (!tt__bake_face(&b, job, job->band_faces[k], xy)) continue;
+        b.inside = 1;
+        tt__raster_triangle_rows(xy, job->atlas->width, b.row_begin, b.row_end, tt__bake_texel, &b);
+        if (b.gutter <= 0.0) continue;
+        for (i = 0; i < 3; i++) {
+            double dx = b.x[(i + 1) % 3] - b.x[i], dy = b.y[(i + 1) % 3] - b.y[i];
+            double length = sqrt(dx * dx + dy * dy);
+            if (length > longest) longest = length;
+        }
+        if (fabs(b.area2) / longest < TT__BAKE_MIN_HEIGHT) continue;
+        b.inside = 0;
+        tt__bake_gutter(&b);
+    }
+}
 
 /* Sec. 4 "rendering with a texture atlas": "the texture paste operations are
    composited into the atlas charts". Per face, its entries in paste order
@@ -13639,11 +13733,13 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     int gutter;
     tt_result result;
     tt__bake bake;
-    int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL;
+    tt__bake_job job;
+    int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL, *band_start = NULL, *band_fill = NULL;
+    int *band_faces = NULL;
     float *state = NULL, *turns = NULL;
     size_t texels, t, total = 0, head = 0, tail = 0;
     float empty = tt__infinity();
-    int f, p, e, k, c, width, height, normal;
+    int f, p, e, k, c, width, height, normal, nbands, pass;
 
     tt__ok(error);
     if (!mesh || !lapped || !patches || !corner_uv || !atlas)
@@ -13695,7 +13791,10 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     state = TT__ALLOC(al, float, texels);
     queue = TT__ALLOC(al, int, texels);
     if (normal) turns = TT__ALLOC(al, float, 4 * total + 4);
-    if (!start || !fill || !items || !state || !queue || (normal && !turns)) {
+    nbands = (height + TT__BAKE_BAND_ROWS - 1) / TT__BAKE_BAND_ROWS;
+    band_start = TT__ALLOC(al, int, (size_t)nbands + 1);
+    band_fill = TT__ALLOC(al, int, nbands);
+    if (!start || !fill || !items || !state || !queue || (normal && !turns) || !band_start || !band_fill) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                           "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
         goto done;
@@ -13718,57 +13817,78 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
         }
 
     for (t = 0; t < texels; t++) state[t] = empty;
-    memset(&bake, 0, sizeof bake);
-    bake.lapped = lapped;
-    bake.patches = patches;
-    bake.state = state;
-    bake.atlas = atlas;
+    memset(&job, 0, sizeof job);
+    job.mesh = mesh;
+    job.corner_uv = corner_uv;
+    job.lapped = lapped;
+    job.patches = patches;
+    job.start = start;
+    job.items = items;
+    job.turns = turns;
+    job.state = state;
+    job.atlas = atlas;
     /* A gutter wider than the image reaches every texel anyway. */
-    bake.gutter = gutter < width + height ? (double)gutter : (double)(width + height);
+    job.gutter = gutter < width + height ? (double)gutter : (double)(width + height);
+    memset(&bake, 0, sizeof bake);
 
-    /* Progress before each face, and 1 once every face is baked. */
-    for (f = 0; f <= mesh->nfaces; f++) {
-        float xy[6];
-        double area2, longest = 0.0;
-        if (opt.progress && opt.progress(f < mesh->nfaces ? (float)f / (float)mesh->nfaces : 1.0f,
-                                         opt.progress_user_data)) {
+    /* The bands of rows each face reaches (its triangle and its gutter),
+       counted, then listed with the faces in order; and normal maps' turns
+       per item. */
+    for (k = 0; k <= nbands; k++) band_start[k] = 0;
+    for (pass = 0; pass < 2; pass++) {
+        for (f = 0; f < mesh->nfaces; f++) {
+            float xy[6];
+            double low, high;
+            int first, last;
+            if (!tt__bake_face(&bake, &job, f, xy)) continue;
+            if (pass == 0 && normal)
+                for (k = 0; k < bake.nitems; k++)
+                    tt__bake_turn(&bake, lapped->uv + 6 * (size_t)bake.items[2 * k], patches[bake.items[2 * k + 1]],
+                                  turns + 4 * ((size_t)start[f] + (size_t)k));
+            low = high = bake.y[0];
+            for (k = 1; k < 3; k++) {
+                if (bake.y[k] < low) low = bake.y[k];
+                if (bake.y[k] > high) high = bake.y[k];
+            }
+            low -= job.gutter + 1.0;
+            high += job.gutter + 1.0;
+            if (!(high >= 0.0 && low < height)) continue;
+            first = low <= 0.0 ? 0 : (int)low / TT__BAKE_BAND_ROWS;
+            last = high >= height ? nbands - 1 : (int)high / TT__BAKE_BAND_ROWS;
+            for (k = first; k <= last; k++) {
+                if (pass == 0) band_start[k + 1]++;
+                else band_faces[band_fill[k]++] = f;
+            }
+        }
+        if (pass == 1) break;
+        for (k = 0; k < nbands; k++) band_start[k + 1] += band_start[k];
+        band_faces = TT__ALLOC(al, int, band_start[nbands] > 0 ? band_start[nbands] : 1);
+        if (!band_faces) {
+            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                              "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
+            goto done;
+        }
+        for (k = 0; k < nbands; k++) band_fill[k] = band_start[k];
+    }
+    job.band_start = band_start;
+    job.band_faces = band_faces;
+
+    /* The bands, in batches with the progress between them. */
+    for (job.first_band = 0; job.first_band < nbands; job.first_band += TT__BAKE_BATCH) {
+        if (opt.progress && opt.progress((float)job.first_band / (float)nbands, opt.progress_user_data)) {
             /* The atlas is half-written: clear it, so no caller mistakes it
                for a result. */
             memset(atlas->pixels, 0, texels * 4 * sizeof(float));
-            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at face %d of %d", f,
-                              mesh->nfaces);
+            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at row %d of %d",
+                              job.first_band * TT__BAKE_BAND_ROWS, height);
             goto done;
         }
-        if (f == mesh->nfaces) break;
-        for (k = 0; k < 3; k++) {
-            int corner = mesh->face_start[f] + k;
-            xy[2 * k] = corner_uv[2 * (size_t)corner] * (float)width;
-            xy[2 * k + 1] = (1.0f - corner_uv[2 * (size_t)corner + 1]) * (float)height;
-            bake.x[k] = xy[2 * k];
-            bake.y[k] = xy[2 * k + 1];
-        }
-        area2 = (bake.x[1] - bake.x[0]) * (bake.y[2] - bake.y[0]) - (bake.x[2] - bake.x[0]) * (bake.y[1] - bake.y[0]);
-        if (!(fabs(area2) > 0.0) || !tt__is_finite_d(area2)) continue;   /* no image: the fill covers it */
-        bake.inverse_area2 = 1.0 / area2;
-        bake.items = items + 2 * (size_t)start[f];
-        bake.nitems = start[f + 1] - start[f];
-        if (normal) {
-            bake.turns = turns + 4 * (size_t)start[f];
-            for (k = 0; k < bake.nitems; k++)
-                tt__bake_turn(&bake, lapped->uv + 6 * (size_t)bake.items[2 * k], patches[bake.items[2 * k + 1]],
-                              turns + 4 * ((size_t)start[f] + (size_t)k));
-        }
-        bake.inside = 1;
-        tt_raster_triangle(xy, width, height, tt__bake_texel, &bake);
-        if (bake.gutter <= 0.0) continue;
-        for (k = 0; k < 3; k++) {
-            double dx = bake.x[(k + 1) % 3] - bake.x[k], dy = bake.y[(k + 1) % 3] - bake.y[k];
-            double length = sqrt(dx * dx + dy * dy);
-            if (length > longest) longest = length;
-        }
-        if (fabs(area2) / longest < TT__BAKE_MIN_HEIGHT) continue;
-        bake.inside = 0;
-        tt__bake_gutter(&bake);
+        tt__run_tasks(opt.executor, tt__min_i(TT__BAKE_BATCH, nbands - job.first_band), tt__bake_band, &job);
+    }
+    if (opt.progress && opt.progress(1.0f, opt.progress_user_data)) {
+        memset(atlas->pixels, 0, texels * 4 * sizeof(float));
+        result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at the end");
+        goto done;
     }
 
     /* Straight alpha for the written texels; they seed the fill. */
@@ -13811,6 +13931,9 @@ done:
     tt__free(al, state);
     tt__free(al, queue);
     tt__free(al, turns);
+    tt__free(al, band_start);
+    tt__free(al, band_fill);
+    tt__free(al, band_faces);
     return result;
 }
 

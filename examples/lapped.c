@@ -1006,6 +1006,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     }
     memset(&bake, 0, sizeof bake);
     bake.gutter = LAPPED_BAKE_GUTTER;
+    bake.executor = tool_executor();
     if (tt_lapped_bake(m->mesh, lapped, patches->images, patches->count, corner_uv, &bake, NULL, atlas, &error) !=
         TT_OK) {
         status = triangle_mesh_report_error(options->mesh_path, m, &error);
