@@ -19549,9 +19549,14 @@ failed:
 /* A local chart of S around a quad: the quads within `radius` steps
    across S's edges, found breadth first, each with the map of its frame into the
    centre quad's frame (the first way found: around a cone point of S the
-   chart is cut where the search meets itself). */
+   chart is cut where the search meets itself). It is built when first
+   needed: most points asked for lie in the centre quad or in one of its
+   four neighbours, which the search meets first, so their maps are the
+   half-edges' unfoldings and no search is needed for them. */
 typedef struct tt__relax_chart {
-    int count, radius;  /* quads in it; the reach it was built with (around quad[0]) */
+    const tt_mesh *surface;
+    int centre, radius; /* the chart asked for (tt__relax_chart_at) */
+    int count, built_radius;    /* quads found, around quad[0] within built_radius steps; 0 = none yet */
     int quad[TT__RELAX_CHART];
     tt_quad_map map[TT__RELAX_CHART];
     int cell[TT__RELAX_CHART][2];   /* the unit cell of the chart the quad covers */
@@ -19559,20 +19564,28 @@ typedef struct tt__relax_chart {
     const tt_quad_map *unfold;  /* per half-edge of S: tt_polycube_unfold, made once */
 } tt__relax_chart;
 
-static void tt__relax_chart_build(const tt_polycube *pc, int centre, int radius, tt__relax_chart *c)
+/* The chart around quad `centre` within `radius` steps, from now on. */
+static void tt__relax_chart_at(tt__relax_chart *c, int centre, int radius)
 {
-    const tt_mesh *s = pc->surface;
+    c->centre = centre;
+    c->radius = radius;
+}
+
+/* The breadth-first search of the chart asked for, unless it is built. */
+static void tt__relax_chart_build(tt__relax_chart *c)
+{
+    const tt_mesh *s = c->surface;
     int head = 0, ring_end, ring, i;
     double middle[2];
-    if (c->count > 0 && c->quad[0] == centre && c->radius == radius) return;   /* built already */
+    if (c->count > 0 && c->quad[0] == c->centre && c->built_radius == c->radius) return;
     for (i = 0; i < c->count; i++) c->index_of[c->quad[i]] = -1;
-    c->radius = radius;
+    c->built_radius = c->radius;
     c->count = 1;
-    c->quad[0] = centre;
-    c->index_of[centre] = 0;
+    c->quad[0] = c->centre;
+    c->index_of[c->centre] = 0;
     c->map[0].turns = c->map[0].offset[0] = c->map[0].offset[1] = 0;
     c->cell[0][0] = c->cell[0][1] = 0;
-    for (ring = 0; ring < radius; ring++) {
+    for (ring = 0; ring < c->radius; ring++) {
         ring_end = c->count;
         for (; head < ring_end; head++) {
             int k;
@@ -19592,29 +19605,61 @@ static void tt__relax_chart_build(const tt_polycube *pc, int centre, int radius,
 }
 
 /* Point p of S in the chart; 0 when its quad is not in it. */
-static int tt__relax_chart_place(const tt__relax_chart *c, tt_surface_point p, double at[2])
+static int tt__relax_chart_place(tt__relax_chart *c, tt_surface_point p, double at[2])
 {
-    int i = c->index_of[p.quad];
+    const tt_mesh *s = c->surface;
+    int i, k;
+    if (p.quad == c->centre) {
+        at[0] = p.s;
+        at[1] = p.t;
+        return 1;
+    }
+    for (k = 0; k < 4; k++) {
+        const int h = s->face_start[c->centre] + k;
+        if (s->corner_face[s->twin[h]] == p.quad) {
+            tt_quad_map_apply(c->unfold[h], p.s, p.t, at);
+            return 1;
+        }
+    }
+    tt__relax_chart_build(c);
+    i = c->index_of[p.quad];
     if (i < 0) return 0;
     tt_quad_map_apply(c->map[i], p.s, p.t, at);
     return 1;
 }
 
 /* The point of S at chart place `at`: the first chart quad whose cell holds
-   it. 0 when none does. */
-static int tt__relax_chart_point(const tt__relax_chart *c, const double at[2], tt_surface_point *p)
+   it (the centre's cell is the centre's; the cell below, right of, above,
+   left of it the quad across the centre's half-edge 0, 1, 2, 3). 0 when
+   none does. */
+static int tt__relax_chart_point(tt__relax_chart *c, const double at[2], tt_surface_point *p)
 {
-    int i, x = (int)floor(at[0]), y = (int)floor(at[1]);
-    for (i = 0; i < c->count; i++)
-        if (c->cell[i][0] == x && c->cell[i][1] == y) {
-            double st[2];
-            tt__quad_map_invert_point(c->map[i], at, st);
-            p->quad = c->quad[i];
-            p->s = (float)(st[0] < 0.0 ? 0.0 : (st[0] > 1.0 ? 1.0 : st[0]));
-            p->t = (float)(st[1] < 0.0 ? 0.0 : (st[1] > 1.0 ? 1.0 : st[1]));
-            return 1;
-        }
-    return 0;
+    const tt_mesh *s = c->surface;
+    const int x = (int)floor(at[0]), y = (int)floor(at[1]);
+    tt_quad_map map;
+    double st[2];
+    int i, quad = -1;
+    if (x == 0 && y == 0) {
+        quad = c->centre;
+        map.turns = map.offset[0] = map.offset[1] = 0;
+    } else if (tt__abs_i(x) + tt__abs_i(y) == 1) {
+        const int h = s->face_start[c->centre] + (y < 0 ? 0 : (x > 0 ? 1 : (y > 0 ? 2 : 3)));
+        quad = s->corner_face[s->twin[h]];
+        map = c->unfold[h];
+    } else {
+        tt__relax_chart_build(c);
+        for (i = 0; i < c->count && quad < 0; i++)
+            if (c->cell[i][0] == x && c->cell[i][1] == y) {
+                quad = c->quad[i];
+                map = c->map[i];
+            }
+        if (quad < 0) return 0;
+    }
+    tt__quad_map_invert_point(map, at, st);
+    p->quad = quad;
+    p->s = (float)(st[0] < 0.0 ? 0.0 : (st[0] > 1.0 ? 1.0 : st[0]));
+    p->t = (float)(st[1] < 0.0 ? 0.0 : (st[1] > 1.0 ? 1.0 : st[1]));
+    return 1;
 }
 
 /* What the relaxation, the untangling and the re-seating share: each
@@ -19645,7 +19690,7 @@ static int tt__relax_context_init(const tt_polycube *pc, const tt_mesh *model, c
                                   tt__relax_context *x)
 {
     const int nverts = model->nverts, nquads = pc->surface->nfaces;
-    int v, c, *next;
+    int v, c, k, *next;
     memset(x, 0, sizeof *x);
     x->first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     x->triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
@@ -19661,10 +19706,13 @@ static int tt__relax_context_init(const tt_polycube *pc, const tt_mesh *model, c
     for (c = 0; c < pc->surface->ncorners; c++) x->unfold[c] = tt_polycube_unfold(pc, c);
     x->around = x->chart + 1;
     for (c = 0; c < 2 * nquads; c++) x->index_of[c] = -1;
-    x->chart->count = x->around->count = 0;
-    x->chart->index_of = x->index_of;
-    x->around->index_of = x->index_of + nquads;
-    x->chart->unfold = x->around->unfold = x->unfold;
+    for (k = 0; k < 2; k++) {
+        tt__relax_chart *chart = x->chart + k;
+        chart->surface = pc->surface;
+        chart->centre = chart->radius = chart->count = chart->built_radius = 0;
+        chart->index_of = x->index_of + k * (size_t)nquads;
+        chart->unfold = x->unfold;
+    }
     memset(next, 0, sizeof(int) * (size_t)nverts);
     for (c = 0; c < model->ncorners; c++) next[model->corner_vert[c]]++;
     x->first_triangle[0] = 0;
@@ -19685,7 +19733,8 @@ static tt_surface_point tt__relax_seat(const tt_polycube *pc, const tt_mesh *mod
     double lattice[3], nearest = HUGE_VAL;
     int a, q;
     for (a = 0; a < 3; a++) lattice[a] = ((double)model->pos[3 * v + a] - pc->origin[a]) / pc->h;
-    tt__relax_chart_build(pc, quad, TT__RELAX_SEAT_RADIUS, around);
+    tt__relax_chart_at(around, quad, TT__RELAX_SEAT_RADIUS);
+    tt__relax_chart_build(around);
     best.quad = quad;
     best.s = best.t = 0.5f;
     for (q = 0; q < around->count; q++) {
@@ -19701,27 +19750,11 @@ static tt_surface_point tt__relax_seat(const tt_polycube *pc, const tt_mesh *mod
     return best;
 }
 
-/* Point p of S in the frame of quad `centre`: directly in the same quad,
-   across one edge of S for a quad next to it, else through the local
-   chart around `centre` (built into *scratch). 0 when it lies beyond. */
-static int tt__relax_place_near(const tt_polycube *pc, int centre, tt_surface_point p, double at[2],
-                                tt__relax_chart *scratch)
+/* Point p of S in the frame of quad `centre`, through the local chart
+   around `centre` (*scratch). 0 when it lies beyond. */
+static int tt__relax_place_near(int centre, tt_surface_point p, double at[2], tt__relax_chart *scratch)
 {
-    const tt_mesh *s = pc->surface;
-    int k;
-    if (p.quad == centre) {
-        at[0] = p.s;
-        at[1] = p.t;
-        return 1;
-    }
-    for (k = 0; k < 4; k++) {
-        int h = s->face_start[centre] + k;
-        if (s->corner_face[s->twin[h]] == p.quad) {
-            tt_quad_map_apply(scratch->unfold[h], p.s, p.t, at);
-            return 1;
-        }
-    }
-    tt__relax_chart_build(pc, centre, TT__RELAX_RADIUS, scratch);
+    tt__relax_chart_at(scratch, centre, TT__RELAX_RADIUS);
     return tt__relax_chart_place(scratch, p, at);
 }
 
@@ -19731,7 +19764,7 @@ static int tt__relax_place_near(const tt_polycube *pc, int centre, tt_surface_po
    clockwise on S (a fold) counts 1, and the folded area breaks ties, so a
    move that only shrinks a fold still counts as progress. */
 static double tt__relax_badness(const tt_mesh *model, const tt_surface_point *points, const int *first_triangle,
-                                const int *triangle_corners, int v, const tt__relax_chart *c, const double at[2])
+                                const int *triangle_corners, int v, tt__relax_chart *c, const double at[2])
 {
     int i, bad = 0;
     double folded = 0.0;
@@ -19808,8 +19841,7 @@ static int tt__relax_kernel_centre(const double (*ring)[2], int ntriangles, doub
 /* Whether triangle t turns clockwise in the frames of all three of its
    points' quads. Around a cone of S the chart of one quad may show a
    triangle folded that lies flat on S, but not the charts of all three. */
-static int tt__relax_folded_everywhere(const tt_polycube *pc, const tt_surface_point *points, const int *t,
-                                       tt__relax_chart *scratch)
+static int tt__relax_folded_everywhere(const tt_surface_point *points, const int *t, tt__relax_chart *scratch)
 {
     int first, k;
     for (first = 1; first < 3; first++) {
@@ -19817,23 +19849,23 @@ static int tt__relax_folded_everywhere(const tt_polycube *pc, const tt_surface_p
         at[0][0] = points[t[first]].s;
         at[0][1] = points[t[first]].t;
         for (k = 1; k < 3; k++)
-            if (!tt__relax_place_near(pc, points[t[first]].quad, points[t[(first + k) % 3]], at[k], scratch)) return 0;
+            if (!tt__relax_place_near(points[t[first]].quad, points[t[(first + k) % 3]], at[k], scratch)) return 0;
         if (tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0) return 0;
     }
     return 1;
 }
 
 /* Vertex v tried at `candidate`: its badness there (tt__relax_badness, in
-   a chart around the candidate, built into *chart), which replaces *best
+   a chart around the candidate, into *chart), which replaces *best
    when below *best_bad. points[v] is left as it was. */
-static void tt__relax_try(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                          const int *first_triangle, const int *triangle_corners, int v, tt_surface_point candidate,
-                          tt__relax_chart *chart, double *best_bad, tt_surface_point *best)
+static void tt__relax_try(const tt_mesh *model, tt_surface_point *points, const int *first_triangle,
+                          const int *triangle_corners, int v, tt_surface_point candidate, tt__relax_chart *chart,
+                          double *best_bad, tt_surface_point *best)
 {
     const tt_surface_point kept = points[v];
     double at[2], after;
     points[v] = candidate;
-    tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, chart);
+    tt__relax_chart_at(chart, candidate.quad, TT__RELAX_RADIUS);
     tt__relax_chart_place(chart, candidate, at);
     after = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, at);
     points[v] = kept;
@@ -19841,34 +19873,6 @@ static void tt__relax_try(const tt_polycube *pc, const tt_mesh *model, tt_surfac
         *best_bad = after;
         *best = candidate;
     }
-}
-
-/* Flags the vertices of badly placed triangles in bad[] (cleared first)
-   and returns how many triangles are: a triangle is judged in its first
-   vertex's quad frame, the others' quads mapped in across one edge of S
-   when they are next to it, else through a local chart (x->chart); it is
-   bad when folded (not counter-clockwise) or out of the chart's reach.
-   Only triangles at a vertex in x->focus are judged. */
-static int tt__relax_mark_bad(const tt_polycube *pc, const tt_mesh *model, const tt_surface_point *points,
-                              const tt__relax_context *x, int folds_only, unsigned char *bad)
-{
-    tt__relax_chart *scratch = x->chart;
-    int c, count = 0;
-    memset(bad, 0, (size_t)model->nverts);
-    for (c = 0; c < model->ncorners; c += 3) {
-        const int *t = model->corner_vert + c;
-        double at[3][2];
-        int k, placed = 1;
-        if (x->focus && !x->focus[t[0]] && !x->focus[t[1]] && !x->focus[t[2]]) continue;
-        at[0][0] = points[t[0]].s;
-        at[0][1] = points[t[0]].t;
-        for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(pc, points[t[0]].quad, points[t[k]], at[k], scratch);
-        if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0) continue;
-        if (folds_only && (!placed || !tt__relax_folded_everywhere(pc, points, t, scratch))) continue;
-        bad[t[0]] = bad[t[1]] = bad[t[2]] = 1;
-        count++;
-    }
-    return count;
 }
 
 /* Whether vertex v's point is its own 3D position (the model touches S
@@ -19880,6 +19884,208 @@ static int tt__relax_on_surface(const tt_polycube *pc, const tt_mesh *model, con
     tt_polycube_point_position(pc, points[v], here);
     for (a = 0; a < 3; a++) d2 += (here[a] - model->pos[3 * v + a]) * (here[a] - model->pos[3 * v + a]);
     return d2 <= 1e-18 * pc->h * pc->h;
+}
+
+/* How a triangle stands: fine; badly placed (folded in its first vertex's
+   frame, or its points out of one another's reach: their edge has no
+   short path on S); or folded in every one of its points' frames. */
+enum { TT__TRIANGLE_FINE, TT__TRIANGLE_BAD, TT__TRIANGLE_FOLDED };
+
+/* A point as it was before a move, to go back to. */
+typedef struct tt__relax_saved {
+    int vertex;
+    tt_surface_point point;
+} tt__relax_saved;
+
+/* The relaxation's state. Every move goes through tt__relax_move, which
+   judges again the triangles at the moved vertex, so the counts stay
+   exact without sweeps over the mesh, and the sweeps visit only the
+   vertices that matter: those at triangles that are not fine, and of
+   those only the ones whose star changed since their last step (a step
+   depends on the vertex's star alone, so one that left a vertex in place
+   would again). The results are those of full sweeps in vertex order. */
+typedef struct tt__relax_state {
+    const tt_polycube *pc;
+    const tt_mesh *model;
+    tt_surface_point *points;
+    tt__relax_context x;
+    unsigned char *status;      /* per triangle: TT__TRIANGLE_*; fine where not judged (x.focus) */
+    int *bad_at, *folded_at;    /* per vertex: its triangles not fine; the folded ones of those */
+    int nbad, nfolded;          /* triangles not fine; folded */
+    int *watch, nwatch;         /* the vertices that may have a triangle not fine, each once, in no order */
+    unsigned char *watched;
+    int *still, epoch;          /* still[v] == epoch: v's last step of this pass left it in place, and its star
+                                   has not changed since */
+    int *visit;                 /* the vertices a sweep visits */
+    unsigned char *ring;        /* untangling: per vertex 1 + its distance in edges from a fold, 0 beyond */
+    int journaling;             /* moves are saved in the journal */
+    tt__relax_saved *journal;   /* the points before the moves, in order, each vertex once per segment */
+    int njournal, journal_capacity, segment;
+    int *saved_in;              /* per vertex: the segment in which its point was last saved */
+    const tt_allocator *allocator;
+} tt__relax_state;
+
+static void tt__relax_state_free(tt__relax_state *R)
+{
+    const tt_allocator *allocator = R->allocator;
+    tt__relax_context_free(allocator, &R->x);
+    tt__free(allocator, R->status);
+    tt__free(allocator, R->bad_at);
+    tt__free(allocator, R->folded_at);
+    tt__free(allocator, R->watch);
+    tt__free(allocator, R->watched);
+    tt__free(allocator, R->still);
+    tt__free(allocator, R->visit);
+    tt__free(allocator, R->ring);
+    tt__free(allocator, R->journal);
+    tt__free(allocator, R->saved_in);
+    memset(R, 0, sizeof *R);
+}
+
+/* How triangle f stands with the points as they are: judged in its first
+   vertex's quad frame, the others' quads mapped in through the local
+   chart there (x.chart). Only triangles at a vertex in x.focus are judged. */
+static int tt__relax_judge(tt__relax_state *R, int f)
+{
+    const int *t = R->model->corner_vert + 3 * f;
+    const unsigned char *focus = R->x.focus;
+    double at[3][2];
+    int k, placed = 1;
+    if (focus && !focus[t[0]] && !focus[t[1]] && !focus[t[2]]) return TT__TRIANGLE_FINE;
+    at[0][0] = R->points[t[0]].s;
+    at[0][1] = R->points[t[0]].t;
+    for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(R->points[t[0]].quad, R->points[t[k]], at[k], R->x.chart);
+    if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0)
+        return TT__TRIANGLE_FINE;
+    return placed && tt__relax_folded_everywhere(R->points, t, R->x.chart) ? TT__TRIANGLE_FOLDED : TT__TRIANGLE_BAD;
+}
+
+/* Triangle f judged again, the counts brought up to date. */
+static void tt__relax_rejudge(tt__relax_state *R, int f)
+{
+    const int before = R->status[f], after = tt__relax_judge(R, f);
+    const int bad = (after != TT__TRIANGLE_FINE) - (before != TT__TRIANGLE_FINE);
+    const int folded = (after == TT__TRIANGLE_FOLDED) - (before == TT__TRIANGLE_FOLDED);
+    int k;
+    if (after == before) return;
+    R->status[f] = (unsigned char)after;
+    R->nbad += bad;
+    R->nfolded += folded;
+    for (k = 0; k < 3; k++) {
+        const int v = R->model->corner_vert[3 * f + k];
+        R->bad_at[v] += bad;
+        R->folded_at[v] += folded;
+        if (R->bad_at[v] > 0 && !R->watched[v]) {
+            R->watched[v] = 1;
+            R->watch[R->nwatch++] = v;
+        }
+    }
+}
+
+/* 0 when out of memory (nothing left allocated). */
+static int tt__relax_state_init(tt__relax_state *R, const tt_polycube *pc, const tt_mesh *model,
+                                tt_surface_point *points, const unsigned char *focus, const tt_allocator *allocator)
+{
+    const size_t nverts = model->nverts > 0 ? (size_t)model->nverts : 1;
+    int f;
+    memset(R, 0, sizeof *R);
+    R->allocator = allocator;
+    if (!tt__relax_context_init(pc, model, allocator, &R->x)) return 0;
+    R->pc = pc;
+    R->model = model;
+    R->points = points;
+    R->x.focus = focus;
+    R->status = TT__ALLOC(allocator, unsigned char, model->nfaces > 0 ? model->nfaces : 1);
+    R->bad_at = TT__ALLOC(allocator, int, nverts);
+    R->folded_at = TT__ALLOC(allocator, int, nverts);
+    R->watch = TT__ALLOC(allocator, int, nverts);
+    R->watched = TT__ALLOC(allocator, unsigned char, nverts);
+    R->still = TT__ALLOC(allocator, int, nverts);
+    R->visit = TT__ALLOC(allocator, int, nverts);
+    R->ring = TT__ALLOC(allocator, unsigned char, nverts);
+    R->saved_in = TT__ALLOC(allocator, int, nverts);
+    if (!R->status || !R->bad_at || !R->folded_at || !R->watch || !R->watched || !R->still || !R->visit ||
+        !R->ring || !R->saved_in) {
+        tt__relax_state_free(R);
+        return 0;
+    }
+    memset(R->status, TT__TRIANGLE_FINE, model->nfaces > 0 ? (size_t)model->nfaces : 1);
+    memset(R->bad_at, 0, sizeof(int) * nverts);
+    memset(R->folded_at, 0, sizeof(int) * nverts);
+    memset(R->watched, 0, nverts);
+    memset(R->still, 0, sizeof(int) * nverts);
+    memset(R->ring, 0, nverts);
+    memset(R->saved_in, 0, sizeof(int) * nverts);
+    for (f = 0; f < model->nfaces; f++) tt__relax_rejudge(R, f);
+    return 1;
+}
+
+/* Vertex v's point set to p, its triangles judged again; the stars of v
+   and its neighbours changed. While journaling, v's point before is saved
+   once per segment. 0 when out of memory (the journal could not grow; v
+   stays). */
+static int tt__relax_move(tt__relax_state *R, int v, tt_surface_point p)
+{
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    int i, k;
+    if (R->journaling && R->saved_in[v] != R->segment) {
+        tt__relax_saved *grown = (tt__relax_saved *)tt__grow(R->allocator, R->journal, &R->journal_capacity,
+                                                             R->njournal + 1, sizeof(tt__relax_saved));
+        if (!grown) return 0;
+        R->journal = grown;
+        R->journal[R->njournal].vertex = v;
+        R->journal[R->njournal].point = R->points[v];
+        R->njournal++;
+        R->saved_in[v] = R->segment;
+    }
+    R->points[v] = p;
+    R->still[v] = 0;
+    for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
+        const int f = triangle_corners[i] / 3;
+        tt__relax_rejudge(R, f);
+        for (k = 0; k < 3; k++) R->still[R->model->corner_vert[3 * f + k]] = 0;
+    }
+    return 1;
+}
+
+/* A new segment of the journal; returns where it starts, the mark to go
+   back to with tt__relax_undo. */
+static int tt__relax_journal_mark(tt__relax_state *R)
+{
+    R->segment++;
+    return R->njournal;
+}
+
+/* The points back as they were at `mark`. Starts a new segment. */
+static void tt__relax_undo(tt__relax_state *R, int mark)
+{
+    const int journaling = R->journaling;
+    R->journaling = 0;
+    while (R->njournal > mark) {
+        const tt__relax_saved *saved = &R->journal[--R->njournal];
+        tt__relax_move(R, saved->vertex, saved->point);
+    }
+    R->journaling = journaling;
+    R->segment++;
+}
+
+/* The vertices at a triangle that is not fine (`folded_only`: a folded
+   one), into R->visit in vertex order; returns how many. */
+static int tt__relax_bad_vertices(tt__relax_state *R, int folded_only)
+{
+    int i, n = 0, kept = 0;
+    for (i = 0; i < R->nwatch; i++) {
+        const int v = R->watch[i];
+        if (R->bad_at[v] == 0) {
+            R->watched[v] = 0;
+            continue;
+        }
+        R->watch[kept++] = v;
+        if (!folded_only || R->folded_at[v] > 0) R->visit[n++] = v;
+    }
+    R->nwatch = kept;
+    tt__sort_ints(R->visit, n);
+    return n;
 }
 
 /* A vertex's star for untangling: per triangle (v, a, b), a and b in the
@@ -19946,16 +20152,19 @@ static double tt__untangle_energy(const tt__untangle_star *star, const double x[
 /* One untangling step of vertex v: its star in a chart around its point,
    a few steepest-descent steps of tt__untangle_energy with halving step
    lengths; when `strict`, kept only if no more of its triangles fold than
-   before. Returns 1 when v moved. */
-static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                               const int *first_triangle, const int *triangle_corners, int v, int strict,
-                               tt__relax_chart *chart, tt__untangle_star *star)
+   before. Returns 1 when v moves, to *moved. */
+static int tt__untangle_vertex(tt__relax_state *R, int v, int strict, tt__untangle_star *star,
+                               tt_surface_point *moved)
 {
+    const tt_mesh *model = R->model;
+    const tt_surface_point *points = R->points;
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    tt__relax_chart *chart = R->x.chart;
+    const double h = R->pc->h;
     double x[2], gradient[2], energy, least_det = HUGE_VAL, delta2, reach = 0.0, step_length = 0.0;
     int i, step, folded_before, folded;
-    tt_surface_point moved;
     if (first_triangle[v + 1] - first_triangle[v] > TT__UNTANGLE_STAR) return 0;
-    tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
+    tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
     tt__relax_chart_place(chart, points[v], x);
     star->n = 0;
     for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
@@ -19967,8 +20176,8 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
             !tt__relax_chart_place(chart, points[b], star->ring[star->n][1]))
             return 0;
         for (k = 0; k < 3; k++) {
-            edge_a[k] = ((double)model->pos[3 * a + k] - model->pos[3 * v + k]) / pc->h;
-            edge_b[k] = ((double)model->pos[3 * b + k] - model->pos[3 * v + k]) / pc->h;
+            edge_a[k] = ((double)model->pos[3 * a + k] - model->pos[3 * v + k]) / h;
+            edge_b[k] = ((double)model->pos[3 * b + k] - model->pos[3 * v + k]) / h;
         }
         tt__cross3(edge_a, edge_b, normal);
         if (!((length = tt__length3(edge_a)) > 0.0) || !(tt__normalize3(normal) > 0.0)) return 0;
@@ -20014,10 +20223,8 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
         gradient[1] = trial_gradient[1];
     }
     tt__untangle_energy(star, x, delta2, gradient, &folded);
-    if ((strict && folded > folded_before) || !tt__relax_chart_point(chart, x, &moved)) return 0;
-    if (tt__same_point(moved, points[v])) return 0;
-    points[v] = moved;
-    return 1;
+    if ((strict && folded > folded_before) || !tt__relax_chart_point(chart, x, moved)) return 0;
+    return !tt__same_point(*moved, points[v]);
 }
 
 /* Untangling sweeps over the vertices of folded triangles (those every
@@ -20033,57 +20240,64 @@ static int tt__untangle_vertex(const tt_polycube *pc, const tt_mesh *model, tt_s
    one ring, 11 with up to 16). Strict steps never fold more of a star;
    free ones may, on the way to opening a fold that a strict step cannot
    start on (the horse at 32: 156 folds left strictly, 46 freely), and then
-   the points return to the sweep with the fewest folds (saved in
-   best_sweep, nverts points). `active` holds nverts vertices. Returns the
-   bad triangles left (tt__relax_mark_bad, every kind); the moves made go
-   to *moves. */
-static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                        const tt__relax_context *x, int strict, tt__untangle_star *star, unsigned char *bad,
-                        int *active, tt_surface_point *best_sweep, int *moves)
+   the points return to the sweep with the fewest folds (through the
+   journal, which must be on). Returns the bad triangles left (every
+   kind), -1 when out of memory; the moves made go to *moves. */
+static int tt__untangle(tt__relax_state *R, int strict, tt__untangle_star *star, int *moves)
 {
-    const int *first_triangle = x->first_triangle, *triangle_corners = x->triangle_corners;
-    const size_t size = sizeof *points * (size_t)model->nverts;
-    int sweep, least = INT_MAX, stalled = 0, rings = 1, v, i, region = 0;
+    const tt_mesh *model = R->model;
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    int sweep, least = INT_MAX, stalled = 0, rings = 1, i, region = 0, best = 0;
+    R->epoch++;
     for (sweep = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
-        int moved = 0, nactive = 0, head, folds = tt__relax_mark_bad(pc, model, points, x, 1, bad);
+        int moved = 0, nvisit, head, folds = R->nfolded;
         if (!folds) break;
         if (folds < least) {
             least = folds;
             stalled = 0;
-            if (!strict) memcpy(best_sweep, points, size);
+            if (!strict) best = tt__relax_journal_mark(R);
         } else if (++stalled == TT__UNTANGLE_PATIENCE) {
             if (rings == TT__UNTANGLE_RINGS || region > TT__UNTANGLE_REGION * folds) break;
             rings *= 2;
             stalled = 0;
         }
-        /* The vertices within `rings` edges of a fold, breadth first; bad[v] - 1 is v's distance. */
-        for (v = 0; v < model->nverts; v++)
-            if (bad[v]) active[nactive++] = v;
-        for (head = 0; head < nactive; head++) {
-            const int u = active[head];
-            if (bad[u] > rings) continue;
+        /* The vertices within `rings` edges of a fold, breadth first; ring[v] - 1 is v's distance. */
+        nvisit = tt__relax_bad_vertices(R, 1);
+        for (i = 0; i < nvisit; i++) R->ring[R->visit[i]] = 1;
+        for (head = 0; head < nvisit; head++) {
+            const int u = R->visit[head];
+            if (R->ring[u] > rings) continue;
             for (i = first_triangle[u]; i < first_triangle[u + 1]; i++) {
                 const int corner = triangle_corners[i], f = corner / 3;
                 int k;
                 for (k = 1; k < 3; k++) {
                     const int w = model->corner_vert[3 * f + (corner % 3 + k) % 3];
-                    if (bad[w]) continue;
-                    bad[w] = (unsigned char)(bad[u] + 1);
-                    active[nactive++] = w;
+                    if (R->ring[w]) continue;
+                    R->ring[w] = (unsigned char)(R->ring[u] + 1);
+                    R->visit[nvisit++] = w;
                 }
             }
         }
-        region = nactive;
-        for (v = 0; v < model->nverts; v++)
-            if (bad[v] && !tt__relax_on_surface(pc, model, points, v))
-                moved += tt__untangle_vertex(pc, model, points, first_triangle, triangle_corners, v, strict, x->chart,
-                                             star);
+        region = nvisit;
+        /* In vertex order, as a sweep over the mesh would meet them. */
+        tt__sort_ints(R->visit, nvisit);
+        for (i = 0; i < nvisit; i++) {
+            const int v = R->visit[i];
+            tt_surface_point p;
+            R->ring[v] = 0;
+            if (R->still[v] == R->epoch || tt__relax_on_surface(R->pc, model, R->points, v)) continue;
+            if (!tt__untangle_vertex(R, v, strict, star, &p)) {
+                R->still[v] = R->epoch;
+                continue;
+            }
+            if (!tt__relax_move(R, v, p)) return -1;
+            moved++;
+        }
         *moves += moved;
         if (!moved) break;
     }
-    if (!strict && least < INT_MAX && tt__relax_mark_bad(pc, model, points, x, 1, bad) > least)
-        memcpy(points, best_sweep, size);
-    return tt__relax_mark_bad(pc, model, points, x, 0, bad);
+    if (!strict && least < INT_MAX && R->nfolded > least) tt__relax_undo(R, best);
+    return R->nbad;
 }
 
 /* Spec P11 step 5: points that leave a triangle folded on S or its edge
@@ -20102,51 +20316,50 @@ static int tt__untangle(const tt_polycube *pc, const tt_mesh *model, tt_surface_
    and their neighbours are untangled (tt__untangle), with strict steps
    and with free ones from the same start, keeping the result with fewer
    bad triangles. With `focus` (per vertex), only triangles at a flagged
-   vertex are judged; NULL judges all. Returns the number of moves, -1
+   vertex are judged; NULL judges all. The sweeps visit only the vertices
+   at badly placed triangles whose stars changed (tt__relax_state): the
+   cost follows the folds, not the mesh. Returns the number of moves, -1
    when out of memory. */
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                               const unsigned char *focus, const tt_allocator *allocator)
 {
-    tt__relax_context x;
-    int *first_triangle, *triangle_corners, *active = NULL;
-    unsigned char *bad = NULL;
+    tt__relax_state R;
+    const int *first_triangle, *triangle_corners;
     tt__relax_chart *chart, *around;
     tt__untangle_star *star = NULL;
-    tt_surface_point *initial = NULL, *strict_points = NULL, *best_sweep = NULL;
-    int v, sweep, moves = 0, nverts = model->nverts;
-    if (!tt__relax_context_init(pc, model, allocator, &x)) return -1;
-    x.focus = focus;
-    first_triangle = x.first_triangle;
-    triangle_corners = x.triangle_corners;
-    chart = x.chart;
-    around = x.around;
-    bad = TT__ALLOC(allocator, unsigned char, nverts > 0 ? nverts : 1);
+    tt__relax_saved *strict_points = NULL;
+    int i, sweep, moves = 0;
+    if (!tt__relax_state_init(&R, pc, model, points, focus, allocator)) return -1;
+    first_triangle = R.x.first_triangle;
+    triangle_corners = R.x.triangle_corners;
+    chart = R.x.chart;
+    around = R.x.around;
     star = TT__ALLOC(allocator, tt__untangle_star, 1);
-    initial = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
-    strict_points = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
-    best_sweep = TT__ALLOC(allocator, tt_surface_point, nverts > 0 ? nverts : 1);
-    active = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
-    if (!bad || !star || !initial || !strict_points || !best_sweep || !active) {
+    if (!star) {
         moves = -1;
         goto done;
     }
+    R.epoch++;
     for (sweep = 0; sweep < TT__RELAX_SWEEPS; sweep++) {
-        int moved = 0;
-        tt__relax_mark_bad(pc, model, points, &x, 0, bad);
-        for (v = 0; v < nverts; v++) {
+        int moved = 0, nvisit = tt__relax_bad_vertices(&R, 0);
+        for (i = 0; i < nvisit; i++) {
             /* v's ring in its chart: per triangle, the points of its other two vertices. */
+            const int v = R.visit[i];
             double at[2], mean[2] = {0.0, 0.0}, candidate_at[2], ring[2 * (TT__RELAX_KERNEL_POINTS - 4)][2];
-            int i, n = 0, reachable = 1, step;
+            int j, n = 0, reachable = 1, step;
             double before, best_bad;
             tt_surface_point best, candidate;
-            if (!bad[v] || tt__relax_on_surface(pc, model, points, v)) continue;
-            tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
+            if (R.still[v] == R.epoch || tt__relax_on_surface(pc, model, points, v)) continue;
+            tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
             tt__relax_chart_place(chart, points[v], at);
             before = best_bad = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, at);
-            if (before == 0) continue;
+            if (before == 0) {
+                R.still[v] = R.epoch;
+                continue;
+            }
             best = points[v];
-            for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
-                int corner = triangle_corners[i], f = corner / 3, k;
+            for (j = first_triangle[v]; j < first_triangle[v + 1]; j++) {
+                int corner = triangle_corners[j], f = corner / 3, k;
                 for (k = 1; k < 3; k++) {
                     double pu[2];
                     if (tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], pu)) {
@@ -20162,66 +20375,88 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
             for (step = 1; step <= 2 && reachable && n > 0; step++) {
                 candidate_at[0] = at[0] + 0.5 * step * (mean[0] / n - at[0]);
                 candidate_at[1] = at[1] + 0.5 * step * (mean[1] / n - at[1]);
-                tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
+                tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
                 if (tt__relax_chart_point(chart, candidate_at, &candidate))
-                    tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
+                    tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
                                   &best);
             }
             if (reachable && n > 0 && n <= 2 * (TT__RELAX_KERNEL_POINTS - 4)) {
                 /* Into the kernel of v's star, where none of its triangles folds (when its ring allows). */
-                tt__relax_chart_build(pc, points[v].quad, TT__RELAX_RADIUS, chart);
+                tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
                 if (tt__relax_kernel_centre((const double (*)[2])ring, n / 2, candidate_at) &&
                     tt__relax_chart_point(chart, candidate_at, &candidate))
-                    tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
+                    tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
                                   &best);
             }
             if (!reachable || n == 0) {
                 /* Onto a neighbour's sheet: the closest point to v on the quads around each neighbour's. */
-                for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
-                    int corner = triangle_corners[i], f = corner / 3, k, j;
+                for (j = first_triangle[v]; j < first_triangle[v + 1]; j++) {
+                    int corner = triangle_corners[j], f = corner / 3, k, l;
                     for (k = 1; k < 3; k++) {
                         int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
-                        for (j = first_triangle[v]; j < i; j++) {
-                            int other = triangle_corners[j];
+                        for (l = first_triangle[v]; l < j; l++) {
+                            int other = triangle_corners[l];
                             if (model->corner_vert[3 * (other / 3) + (other % 3 + 1) % 3] == u ||
                                 model->corner_vert[3 * (other / 3) + (other % 3 + 2) % 3] == u)
                                 break;
                         }
-                        if (j < i || (k == 2 && model->corner_vert[3 * f + (corner % 3 + 1) % 3] == u)) continue;
+                        if (l < j || (k == 2 && model->corner_vert[3 * f + (corner % 3 + 1) % 3] == u)) continue;
                         candidate = tt__relax_seat(pc, model, v, points[u].quad, around);
-                        tt__relax_try(pc, model, points, first_triangle, triangle_corners, v, candidate, chart,
+                        tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart,
                                       &best_bad, &best);
                     }
                 }
             }
             if (best_bad < before - 1e-12) {
-                points[v] = best;
+                if (!tt__relax_move(&R, v, best)) {
+                    moves = -1;
+                    goto done;
+                }
                 moved++;
+            } else {
+                R.still[v] = R.epoch;
             }
         }
         moves += moved;
         if (!moved) break;
     }
     /* The folds these moves leave (a vertex whose ring is itself folded has no good place of its own):
-       untangling, both ways (tt__untangle), keeping the one that leaves fewer bad triangles. */
-    if (tt__relax_mark_bad(pc, model, points, &x, 1, bad)) {
-        int strict_left, free_left, strict_moves = 0, free_moves = 0;
-        memcpy(initial, points, sizeof *points * (size_t)nverts);
-        strict_left = tt__untangle(pc, model, points, &x, 1, star, bad, active, NULL, &strict_moves);
-        memcpy(strict_points, points, sizeof *points * (size_t)nverts);
-        memcpy(points, initial, sizeof *points * (size_t)nverts);
-        free_left = tt__untangle(pc, model, points, &x, 0, star, bad, active, best_sweep, &free_moves);
-        if (strict_left <= free_left) memcpy(points, strict_points, sizeof *points * (size_t)nverts);
+       untangling, both ways (tt__untangle), keeping the one that leaves fewer bad triangles. The journal
+       takes the points back to where both start. */
+    if (R.nfolded) {
+        int strict_left, free_left, strict_moves = 0, free_moves = 0, start, nstrict;
+        R.journaling = 1;
+        start = tt__relax_journal_mark(&R);
+        if ((strict_left = tt__untangle(&R, 1, star, &strict_moves)) < 0) {
+            moves = -1;
+            goto done;
+        }
+        /* Strict steps set no mark: each vertex they moved is saved once. */
+        nstrict = R.njournal - start;
+        strict_points = TT__ALLOC(allocator, tt__relax_saved, nstrict > 0 ? nstrict : 1);
+        if (!strict_points) {
+            moves = -1;
+            goto done;
+        }
+        for (i = 0; i < nstrict; i++) {
+            strict_points[i].vertex = R.journal[start + i].vertex;
+            strict_points[i].point = points[strict_points[i].vertex];
+        }
+        tt__relax_undo(&R, start);
+        if ((free_left = tt__untangle(&R, 0, star, &free_moves)) < 0) {
+            moves = -1;
+            goto done;
+        }
+        if (strict_left <= free_left) {
+            tt__relax_undo(&R, start);
+            for (i = 0; i < nstrict; i++) points[strict_points[i].vertex] = strict_points[i].point;
+        }
         moves += strict_left <= free_left ? strict_moves : free_moves;
     }
 done:
-    tt__relax_context_free(allocator, &x);
-    tt__free(allocator, bad);
+    tt__relax_state_free(&R);
     tt__free(allocator, star);
-    tt__free(allocator, initial);
     tt__free(allocator, strict_points);
-    tt__free(allocator, best_sweep);
-    tt__free(allocator, active);
     return moves;
 }
 
@@ -20336,7 +20571,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
         double at[2], best_score;
         int i, k, tried[TT__RESEAT_SEATS], ntried = 0;
         if (!stray[v] || tt__relax_on_surface(pc, model, points, v)) continue;
-        tt__relax_chart_build(pc, kept.quad, TT__RELAX_RADIUS, x.chart);
+        tt__relax_chart_at(x.chart, kept.quad, TT__RELAX_RADIUS);
         tt__relax_chart_place(x.chart, kept, at);
         best_score = 2.0 * tt__reseat_failures(S, model, points, &x, v) +
                      tt__relax_badness(model, points, x.first_triangle, x.triangle_corners, v, x.chart, at);
@@ -20353,7 +20588,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
                 candidate = tt__relax_seat(pc, model, v, points[u].quad, x.around);
                 if (tt__same_point(candidate, kept)) continue;
                 points[v] = candidate;
-                tt__relax_chart_build(pc, candidate.quad, TT__RELAX_RADIUS, x.chart);
+                tt__relax_chart_at(x.chart, candidate.quad, TT__RELAX_RADIUS);
                 tt__relax_chart_place(x.chart, candidate, at);
                 score = 2.0 * tt__reseat_failures(S, model, points, &x, v) +
                         tt__relax_badness(model, points, x.first_triangle, x.triangle_corners, v, x.chart, at);
