@@ -19549,14 +19549,15 @@ failed:
 /* A local chart of S around a quad: the quads within `radius` steps
    across S's edges, found breadth first, each with the map of its frame into the
    centre quad's frame (the first way found: around a cone point of S the
-   chart is cut where the search meets itself). It is built when first
-   needed: most points asked for lie in the centre quad or in one of its
-   four neighbours, which the search meets first, so their maps are the
-   half-edges' unfoldings and no search is needed for them. */
+   chart is cut where the search meets itself). The search goes one ring
+   at a time, only as far as the points asked for need: most lie in the
+   centre quad or next to it. */
 typedef struct tt__relax_chart {
     const tt_mesh *surface;
     int centre, radius; /* the chart asked for (tt__relax_chart_at) */
-    int count, built_radius;    /* quads found, around quad[0] within built_radius steps; 0 = none yet */
+    int count;          /* quads found so far, around quad[0]; 0 = none */
+    int rings, head;    /* rings searched; the next quad whose neighbours the search adds */
+    int built_radius;   /* the radius the quads found were searched for */
     int quad[TT__RELAX_CHART];
     tt_quad_map map[TT__RELAX_CHART];
     int cell[TT__RELAX_CHART][2];   /* the unit cell of the chart the quad covers */
@@ -19571,95 +19572,79 @@ static void tt__relax_chart_at(tt__relax_chart *c, int centre, int radius)
     c->radius = radius;
 }
 
-/* The breadth-first search of the chart asked for, unless it is built. */
-static void tt__relax_chart_build(tt__relax_chart *c)
+/* One more ring of the chart asked for (started anew when the quads found
+   so far belong to another); 0 when it has all its rings. */
+static int tt__relax_chart_grow(tt__relax_chart *c)
 {
     const tt_mesh *s = c->surface;
-    int head = 0, ring_end, ring, i;
+    int ring_end, i;
     double middle[2];
-    if (c->count > 0 && c->quad[0] == c->centre && c->built_radius == c->radius) return;
-    for (i = 0; i < c->count; i++) c->index_of[c->quad[i]] = -1;
-    c->built_radius = c->radius;
-    c->count = 1;
-    c->quad[0] = c->centre;
-    c->index_of[c->centre] = 0;
-    c->map[0].turns = c->map[0].offset[0] = c->map[0].offset[1] = 0;
-    c->cell[0][0] = c->cell[0][1] = 0;
-    for (ring = 0; ring < c->radius; ring++) {
-        ring_end = c->count;
-        for (; head < ring_end; head++) {
-            int k;
-            for (k = 0; k < 4 && c->count < TT__RELAX_CHART; k++) {
-                int h = s->face_start[c->quad[head]] + k, next = s->corner_face[s->twin[h]];
-                if (c->index_of[next] >= 0) continue;
-                c->index_of[next] = c->count;
-                c->quad[c->count] = next;
-                c->map[c->count] = tt_quad_map_compose(c->map[head], c->unfold[h]);
-                tt_quad_map_apply(c->map[c->count], 0.5, 0.5, middle);
-                c->cell[c->count][0] = (int)floor(middle[0]);
-                c->cell[c->count][1] = (int)floor(middle[1]);
-                c->count++;
-            }
+    if (c->count == 0 || c->quad[0] != c->centre || c->built_radius != c->radius) {
+        for (i = 0; i < c->count; i++) c->index_of[c->quad[i]] = -1;
+        c->built_radius = c->radius;
+        c->count = 1;
+        c->rings = c->head = 0;
+        c->quad[0] = c->centre;
+        c->index_of[c->centre] = 0;
+        c->map[0].turns = c->map[0].offset[0] = c->map[0].offset[1] = 0;
+        c->cell[0][0] = c->cell[0][1] = 0;
+        return 1;
+    }
+    if (c->rings == c->radius) return 0;
+    ring_end = c->count;
+    for (; c->head < ring_end; c->head++) {
+        int k;
+        for (k = 0; k < 4 && c->count < TT__RELAX_CHART; k++) {
+            int h = s->face_start[c->quad[c->head]] + k, next = s->corner_face[s->twin[h]];
+            if (c->index_of[next] >= 0) continue;
+            c->index_of[next] = c->count;
+            c->quad[c->count] = next;
+            c->map[c->count] = tt_quad_map_compose(c->map[c->head], c->unfold[h]);
+            tt_quad_map_apply(c->map[c->count], 0.5, 0.5, middle);
+            c->cell[c->count][0] = (int)floor(middle[0]);
+            c->cell[c->count][1] = (int)floor(middle[1]);
+            c->count++;
         }
     }
+    c->rings++;
+    return 1;
+}
+
+/* The whole chart asked for. */
+static void tt__relax_chart_build(tt__relax_chart *c)
+{
+    while (tt__relax_chart_grow(c)) continue;
 }
 
 /* Point p of S in the chart; 0 when its quad is not in it. */
 static int tt__relax_chart_place(tt__relax_chart *c, tt_surface_point p, double at[2])
 {
-    const tt_mesh *s = c->surface;
-    int i, k;
-    if (p.quad == c->centre) {
-        at[0] = p.s;
-        at[1] = p.t;
-        return 1;
-    }
-    for (k = 0; k < 4; k++) {
-        const int h = s->face_start[c->centre] + k;
-        if (s->corner_face[s->twin[h]] == p.quad) {
-            tt_quad_map_apply(c->unfold[h], p.s, p.t, at);
-            return 1;
-        }
-    }
-    tt__relax_chart_build(c);
-    i = c->index_of[p.quad];
-    if (i < 0) return 0;
-    tt_quad_map_apply(c->map[i], p.s, p.t, at);
+    if (c->count == 0 || c->quad[0] != c->centre || c->built_radius != c->radius) tt__relax_chart_grow(c);
+    while (c->index_of[p.quad] < 0)
+        if (!tt__relax_chart_grow(c)) return 0;
+    tt_quad_map_apply(c->map[c->index_of[p.quad]], p.s, p.t, at);
     return 1;
 }
 
 /* The point of S at chart place `at`: the first chart quad whose cell holds
-   it (the centre's cell is the centre's; the cell below, right of, above,
-   left of it the quad across the centre's half-edge 0, 1, 2, 3). 0 when
-   none does. */
+   it. 0 when none does. */
 static int tt__relax_chart_point(tt__relax_chart *c, const double at[2], tt_surface_point *p)
 {
-    const tt_mesh *s = c->surface;
     const int x = (int)floor(at[0]), y = (int)floor(at[1]);
-    tt_quad_map map;
-    double st[2];
-    int i, quad = -1;
-    if (x == 0 && y == 0) {
-        quad = c->centre;
-        map.turns = map.offset[0] = map.offset[1] = 0;
-    } else if (tt__abs_i(x) + tt__abs_i(y) == 1) {
-        const int h = s->face_start[c->centre] + (y < 0 ? 0 : (x > 0 ? 1 : (y > 0 ? 2 : 3)));
-        quad = s->corner_face[s->twin[h]];
-        map = c->unfold[h];
-    } else {
-        tt__relax_chart_build(c);
-        for (i = 0; i < c->count && quad < 0; i++)
+    int i = 0;
+    if (c->count == 0 || c->quad[0] != c->centre || c->built_radius != c->radius) tt__relax_chart_grow(c);
+    for (;;) {
+        for (; i < c->count; i++)
             if (c->cell[i][0] == x && c->cell[i][1] == y) {
-                quad = c->quad[i];
-                map = c->map[i];
+                double st[2];
+                tt__quad_map_invert_point(c->map[i], at, st);
+                p->quad = c->quad[i];
+                p->s = (float)(st[0] < 0.0 ? 0.0 : (st[0] > 1.0 ? 1.0 : st[0]));
+                p->t = (float)(st[1] < 0.0 ? 0.0 : (st[1] > 1.0 ? 1.0 : st[1]));
+                return 1;
             }
-        if (quad < 0) return 0;
+        if (!tt__relax_chart_grow(c)) return 0;
     }
-    tt__quad_map_invert_point(map, at, st);
-    p->quad = quad;
-    p->s = (float)(st[0] < 0.0 ? 0.0 : (st[0] > 1.0 ? 1.0 : st[0]));
-    p->t = (float)(st[1] < 0.0 ? 0.0 : (st[1] > 1.0 ? 1.0 : st[1]));
-    return 1;
 }
 
 /* What the relaxation, the untangling and the re-seating share: each
@@ -19709,7 +19694,7 @@ static int tt__relax_context_init(const tt_polycube *pc, const tt_mesh *model, c
     for (k = 0; k < 2; k++) {
         tt__relax_chart *chart = x->chart + k;
         chart->surface = pc->surface;
-        chart->centre = chart->radius = chart->count = chart->built_radius = 0;
+        chart->centre = chart->radius = chart->count = chart->rings = chart->head = chart->built_radius = 0;
         chart->index_of = x->index_of + k * (size_t)nquads;
         chart->unfold = x->unfold;
     }
