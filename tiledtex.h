@@ -19543,6 +19543,7 @@ failed:
 #define TT__UNTANGLE_EPSILON 0.01   /* Escobar et al.'s epsilon: det J below which delta grows */
 #define TT__UNTANGLE_STEPS 10       /* descent steps per vertex and sweep */
 #define TT__UNTANGLE_HALVINGS 20    /* halvings of a descent step before the vertex stops */
+#define TT__UNTANGLE_CONVERGED 1e-7 /* a descent step this short (quad units) ends a vertex's steps */
 #define TT__RELAX_KERNEL_POINTS 64  /* a star's kernel polygon: its box's 4 corners and one per triangle */
 #define TT__RELAX_KERNEL_MARGIN 1e-9    /* twice the least area (quad units) of a star triangle around a kernel point */
 
@@ -20100,14 +20101,18 @@ static int tt__untangle_star_shape(tt__untangle_star *star, int i, const double 
    costs |J|^2 / (2 h(det J)), h(s) = (s + sqrt(s^2 + delta2)) / 2. With
    delta2 > 0 it is finite for folded triangles and falls steeply toward
    unfolding them; unfolded, it is least where J is a similarity (1 per
-   triangle). The gradient in x goes to gradient[2]; *folded counts the
-   triangles with det J <= 0. */
+   triangle). The gradient in x goes to gradient[2], and when hessian is
+   not NULL the second derivatives (xx, xy, yy) to hessian[3]: J moves
+   with x along a fixed direction per row, so |J|^2 is quadratic in x and
+   det J affine, and the Hessian takes a few products more. *folded counts
+   the triangles with det J <= 0. */
 static double tt__untangle_energy(const tt__untangle_star *star, const double x[2], double delta2,
-                                  double gradient[2], int *folded)
+                                  double gradient[2], double hessian[3], int *folded)
 {
     double energy = 0.0;
     int i;
     gradient[0] = gradient[1] = 0.0;
+    if (hessian) hessian[0] = hessian[1] = hessian[2] = 0.0;
     *folded = 0;
     for (i = 0; i < star->n; i++) {
         const double *a = star->ring[i][0], *b = star->ring[i][1];
@@ -20130,14 +20135,29 @@ static double tt__untangle_energy(const tt__untangle_star *star, const double x[
         ddet[1] = j00 * d1 - j01 * d0;
         energy += frobenius / (2.0 * h);
         for (k = 0; k < 2; k++) gradient[k] += dfrobenius[k] / (2.0 * h) - frobenius * dh * ddet[k] / (2.0 * h * h);
+        if (hessian) {
+            /* f = F u, u = 1 / (2 h): F'' u + F' u'^T + u' F'^T + F u'', with u' = -h' g / (2 h^2) and
+               u'' = (h'^2 / h^3 - h'' / (2 h^2)) g g^T, g = grad det J; F'' = 2 |d|^2 I. */
+            const double ddh = root > 0.0 ? 0.5 * delta2 / (root * root * root) : 0.0;
+            const double u = 1.0 / (2.0 * h), du = -dh / (2.0 * h * h);
+            const double uu = frobenius * (dh * dh / (h * h * h) - ddh / (2.0 * h * h)), dd = 2.0 * (d0 * d0 + d1 * d1) * u;
+            hessian[0] += dd + 2.0 * du * dfrobenius[0] * ddet[0] + uu * ddet[0] * ddet[0];
+            hessian[1] += du * (dfrobenius[0] * ddet[1] + dfrobenius[1] * ddet[0]) + uu * ddet[0] * ddet[1];
+            hessian[2] += dd + 2.0 * du * dfrobenius[1] * ddet[1] + uu * ddet[1] * ddet[1];
+        }
     }
     return energy;
 }
 
 /* One untangling step of vertex v: its star in a chart around its point,
-   a few steepest-descent steps of tt__untangle_energy with halving step
-   lengths; when `strict`, kept only if no more of its triangles fold than
-   before. Returns 1 when v moves, to *moved. */
+   and tt__untangle_energy minimised over v's place by Newton's method
+   (where the energy curves up both ways; else down the gradient), each
+   step halved until the energy falls, until the steps fall below the
+   points' float resolution or TT__UNTANGLE_STEPS are made: the star's
+   own optimum, so that a vertex whose star has not changed has nowhere to
+   go (the sweeps then pass it over). When `strict`, v goes to the last of
+   its steps that folds no more of its triangles than before. Returns 1
+   when v moves, to *moved. */
 static int tt__untangle_vertex(tt__relax_state *R, int v, int strict, tt__untangle_star *star,
                                tt_surface_point *moved)
 {
@@ -20146,7 +20166,7 @@ static int tt__untangle_vertex(tt__relax_state *R, int v, int strict, tt__untang
     const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
     tt__relax_chart *chart = R->x.chart;
     const double h = R->pc->h;
-    double x[2], gradient[2], energy, least_det = HUGE_VAL, delta2, reach = 0.0, step_length = 0.0;
+    double x[2], kept[2], gradient[2], hessian[3], energy, least_det = HUGE_VAL, delta2, reach = 0.0;
     int i, step, folded_before, folded;
     if (first_triangle[v + 1] - first_triangle[v] > TT__UNTANGLE_STAR) return 0;
     tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
@@ -20186,29 +20206,46 @@ static int tt__untangle_vertex(tt__relax_state *R, int v, int strict, tt__untang
     }
     /* Escobar et al.'s delta: 0 once nothing is near folding, else growing with the worst fold. */
     delta2 = least_det < TT__UNTANGLE_EPSILON ? TT__UNTANGLE_EPSILON * (TT__UNTANGLE_EPSILON - least_det) : 0.0;
-    energy = tt__untangle_energy(star, x, delta2, gradient, &folded_before);
+    energy = tt__untangle_energy(star, x, delta2, gradient, hessian, &folded_before);
+    kept[0] = x[0];
+    kept[1] = x[1];
     for (step = 0; step < TT__UNTANGLE_STEPS; step++) {
         const double norm = sqrt(gradient[0] * gradient[0] + gradient[1] * gradient[1]);
-        double trial[2], trial_gradient[2], trial_energy = energy;
+        const double det = hessian[0] * hessian[2] - hessian[1] * hessian[1];
+        double direction[2], length, trial[2], trial_gradient[2], trial_hessian[3], trial_energy = energy, t = 1.0;
         int halvings;
         if (!(norm > 0.0)) break;
-        /* From twice the last step that helped: the first is as long as the star is wide. */
-        step_length = step == 0 ? reach : 2.0 * step_length;
-        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS; halvings++, step_length *= 0.5) {
-            trial[0] = x[0] - step_length * gradient[0] / norm;
-            trial[1] = x[1] - step_length * gradient[1] / norm;
-            trial_energy = tt__untangle_energy(star, trial, delta2, trial_gradient, &folded);
+        /* Newton's step where the energy curves up both ways, else down the gradient; never farther than
+           the star is wide. */
+        if (hessian[0] > 0.0 && det > 0.0) {
+            direction[0] = -(hessian[2] * gradient[0] - hessian[1] * gradient[1]) / det;
+            direction[1] = -(hessian[0] * gradient[1] - hessian[1] * gradient[0]) / det;
+        } else {
+            direction[0] = -reach * gradient[0] / norm;
+            direction[1] = -reach * gradient[1] / norm;
+        }
+        length = sqrt(direction[0] * direction[0] + direction[1] * direction[1]);
+        if (length > reach) t = reach / length;
+        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS; halvings++, t *= 0.5) {
+            trial[0] = x[0] + t * direction[0];
+            trial[1] = x[1] + t * direction[1];
+            trial_energy = tt__untangle_energy(star, trial, delta2, trial_gradient, trial_hessian, &folded);
             if (trial_energy < energy) break;
         }
         if (halvings == TT__UNTANGLE_HALVINGS) break;
         x[0] = trial[0];
         x[1] = trial[1];
         energy = trial_energy;
-        gradient[0] = trial_gradient[0];
-        gradient[1] = trial_gradient[1];
+        memcpy(gradient, trial_gradient, sizeof trial_gradient);
+        memcpy(hessian, trial_hessian, sizeof trial_hessian);
+        if (!strict || folded <= folded_before) {
+            kept[0] = x[0];
+            kept[1] = x[1];
+        }
+        /* Converged: a step below the points' float resolution. */
+        if (t * length < TT__UNTANGLE_CONVERGED) break;
     }
-    tt__untangle_energy(star, x, delta2, gradient, &folded);
-    if ((strict && folded > folded_before) || !tt__relax_chart_point(chart, x, moved)) return 0;
+    if (!tt__relax_chart_point(chart, kept, moved)) return 0;
     return !tt__same_point(*moved, points[v]);
 }
 
@@ -20285,6 +20322,76 @@ static int tt__untangle(tt__relax_state *R, int strict, tt__untangle_star *star,
     return R->nbad;
 }
 
+/* The strict and the free untangling compared region by region: the
+   vertices either run moved fall into groups joined by shared triangles,
+   each group's triangles depend on its points alone, and each group takes
+   the run that leaves fewer of its triangles badly placed (the strict one
+   on a tie), so the result is never worse than the better run as a whole.
+   On entry the points are the free run's, the journal from `start` holds
+   where they started, and strict[] the strict run's points of the
+   vertices it moved. Returns the number of points the untangling moved,
+   -1 when out of memory. */
+static int tt__untangle_choose(tt__relax_state *R, int start, const tt__relax_saved *strict, int nstrict)
+{
+    const tt_mesh *model = R->model;
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    const int nverts = model->nverts, nfree = R->njournal - start;
+    int *strict_of = TT__ALLOC(R->allocator, int, nverts > 0 ? nverts : 1);
+    int *start_of = TT__ALLOC(R->allocator, int, nverts > 0 ? nverts : 1);
+    tt_surface_point *free_points = TT__ALLOC(R->allocator, tt_surface_point, nstrict + nfree > 0 ? nstrict + nfree : 1);
+    int seed, i, j, moved = 0;
+    R->journaling = 0;
+    if (!strict_of || !start_of || !free_points) {
+        moved = -1;
+        goto done;
+    }
+    for (i = 0; i < nverts; i++) strict_of[i] = start_of[i] = -1;
+    for (i = 0; i < nstrict; i++) strict_of[strict[i].vertex] = i;
+    for (i = R->njournal - 1; i >= start; i--) start_of[R->journal[i].vertex] = i;
+    for (seed = 0; seed < nstrict + nfree; seed++) {
+        const int first = seed < nstrict ? strict[seed].vertex : R->journal[start + seed - nstrict].vertex;
+        const int bad_before = R->nbad;
+        int n = 1, head;
+        if (R->ring[first]) continue;
+        /* The group of `first`: breadth first through shared triangles, over the vertices either run moved. */
+        R->ring[first] = 1;
+        R->visit[0] = first;
+        for (head = 0; head < n; head++) {
+            const int u = R->visit[head];
+            for (i = first_triangle[u]; i < first_triangle[u + 1]; i++) {
+                const int f = triangle_corners[i] / 3;
+                int k;
+                for (k = 0; k < 3; k++) {
+                    const int w = model->corner_vert[3 * f + k];
+                    if (R->ring[w] || (strict_of[w] < 0 && start_of[w] < 0)) continue;
+                    R->ring[w] = 1;
+                    R->visit[n++] = w;
+                }
+            }
+        }
+        /* The strict run's points for the group, back to the free run's if they leave more bad triangles. */
+        for (i = 0; i < n; i++) {
+            const int v = R->visit[i];
+            free_points[i] = R->points[v];
+            tt__relax_move(R, v, strict_of[v] >= 0 ? strict[strict_of[v]].point : R->journal[start_of[v]].point);
+        }
+        if (R->nbad > bad_before)
+            for (i = 0; i < n; i++) tt__relax_move(R, R->visit[i], free_points[i]);
+        for (i = 0; i < n; i++) {
+            const int v = R->visit[i];
+            moved += start_of[v] >= 0 ? !tt__same_point(R->points[v], R->journal[start_of[v]].point)
+                                      : !tt__same_point(R->points[v], free_points[i]);
+        }
+    }
+    for (j = 0; j < nstrict + nfree; j++)
+        R->ring[j < nstrict ? strict[j].vertex : R->journal[start + j - nstrict].vertex] = 0;
+done:
+    tt__free(R->allocator, strict_of);
+    tt__free(R->allocator, start_of);
+    tt__free(R->allocator, free_points);
+    return moved;
+}
+
 /* Spec P11 step 5: points that leave a triangle folded on S or its edge
    without a short path (a vertex projected onto the wrong sheet, a fold
    in a concavity) are moved, a few sweeps over the vertices in order:
@@ -20300,11 +20407,12 @@ static int tt__untangle(tt__relax_state *R, int strict, tt__untangle_star *star,
    vertex's ring is folded too), so then the vertices of folded triangles
    and their neighbours are untangled (tt__untangle), with strict steps
    and with free ones from the same start, keeping the result with fewer
-   bad triangles. With `focus` (per vertex), only triangles at a flagged
-   vertex are judged; NULL judges all. The sweeps visit only the vertices
-   at badly placed triangles whose stars changed (tt__relax_state): the
-   cost follows the folds, not the mesh. Returns the number of moves, -1
-   when out of memory. */
+   bad triangles in each region (tt__untangle_choose). With `focus` (per
+   vertex), only triangles at a flagged vertex are judged; NULL judges all.
+   The sweeps visit only the vertices at badly placed triangles whose
+   stars changed (tt__relax_state): the cost follows the folds, not the
+   mesh. Returns the number of moves (each point the untangling moved
+   counts once), -1 when out of memory. */
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                               const unsigned char *focus, const tt_allocator *allocator)
 {
@@ -20406,13 +20514,13 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         if (!moved) break;
     }
     /* The folds these moves leave (a vertex whose ring is itself folded has no good place of its own):
-       untangling, both ways (tt__untangle), keeping the one that leaves fewer bad triangles. The journal
-       takes the points back to where both start. */
+       untangling, both ways (tt__untangle), from the same start (the journal goes back to it), each region
+       keeping the way that leaves it fewer bad triangles. */
     if (R.nfolded) {
-        int strict_left, free_left, strict_moves = 0, free_moves = 0, start, nstrict;
+        int strict_moves = 0, free_moves = 0, start, nstrict, untangled;
         R.journaling = 1;
         start = tt__relax_journal_mark(&R);
-        if ((strict_left = tt__untangle(&R, 1, star, &strict_moves)) < 0) {
+        if (tt__untangle(&R, 1, star, &strict_moves) < 0) {
             moves = -1;
             goto done;
         }
@@ -20428,15 +20536,12 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
             strict_points[i].point = points[strict_points[i].vertex];
         }
         tt__relax_undo(&R, start);
-        if ((free_left = tt__untangle(&R, 0, star, &free_moves)) < 0) {
+        if (tt__untangle(&R, 0, star, &free_moves) < 0 ||
+            (untangled = tt__untangle_choose(&R, start, strict_points, nstrict)) < 0) {
             moves = -1;
             goto done;
         }
-        if (strict_left <= free_left) {
-            tt__relax_undo(&R, start);
-            for (i = 0; i < nstrict; i++) points[strict_points[i].vertex] = strict_points[i].point;
-        }
-        moves += strict_left <= free_left ? strict_moves : free_moves;
+        moves += untangled;
     }
 done:
     tt__relax_state_free(&R);
@@ -20498,6 +20603,25 @@ static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, con
     }
     tt__free(allocator, taken);
     return moved;
+}
+
+/* The vertices at an edge with no path whose points moved since `earlier`
+   go back there; moved[] flags them (cleared first). Returns whether any
+   did. */
+static int tt__polycube_restore_failing(const tt_mesh *model, const tt_polycube_edges *edges,
+                                        const tt_surface_point *earlier, tt_surface_point *points,
+                                        unsigned char *moved)
+{
+    int c, changed = 0;
+    memset(moved, 0, (size_t)model->nverts);
+    for (c = 0; c < model->ncorners; c++) {
+        const int v = model->corner_vert[c];
+        if (!edges->failed[edges->edge_of_halfedge[c]] || tt__same_point(points[v], earlier[v])) continue;
+        points[v] = earlier[v];
+        moved[v] = 1;
+        changed = 1;
+    }
+    return changed;
 }
 
 #define TT__RESEAT_ROUNDS 2     /* rounds of re-seating stray vertices and tracing their edges again */
@@ -21644,25 +21768,23 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=
             TT_OK)
             goto failed;
+        /* A move that left an edge with no path goes back (the folds it opened cost less than the seam). */
+        if (tt__polycube_restore_failing(model, edges, earlier, points, moved) &&
+            (result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=
+                TT_OK)
+            goto failed;
     }
     /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
        vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
     memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
     memset(moved, 0, (size_t)model->nverts);
     for (tracing = 0; tracing < 2; tracing++) {
-        int changed = 0, c;
+        int changed;
         if (tracing == 0) {
             if ((changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator)) < 0)
                 goto out_of_memory;
         } else {
-            memset(moved, 0, (size_t)model->nverts);
-            for (c = 0; c < model->ncorners; c++) {
-                v = model->corner_vert[c];
-                if (!edges->failed[edges->edge_of_halfedge[c]] || tt__same_point(points[v], earlier[v])) continue;
-                points[v] = earlier[v];
-                moved[v] = 1;
-                changed = 1;
-            }
+            changed = tt__polycube_restore_failing(model, edges, earlier, points, moved);
         }
         if (!changed) break;
         if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=

@@ -378,7 +378,7 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
         memcpy(star.ring[i], ring[i], sizeof star.ring[i]);
         if (!tt__untangle_star_shape(&star, i, shape[i])) return -1.0;
     }
-    return tt__untangle_energy(&star, x, delta2, gradient, folded);
+    return tt__untangle_energy(&star, x, delta2, gradient, NULL, folded);
 }
 int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
 float internal_infinity(void) { return tt__infinity(); }
