@@ -2920,6 +2920,9 @@ typedef struct tt_polycube_map_options {
     int max_quads;      /* the longest edge path, as tt_polycube_edge_options; 0 = its default */
     double max_edge;    /* model edges longer than this (mesh units) are halved first, until none is;
                            0 = TT_POLYCUBE_MAP_DEFAULT_EDGE times the cube size h; HUGE_VAL: never */
+    const tt_executor *executor;    /* runs the independent parts in parallel (the vertices' projection, the
+                                       relaxation's groups of vertices, the edges' tracing, the triangles'
+                                       split); NULL: serial. The same mapping either way, bit for bit */
 } tt_polycube_map_options;
 
 #define TT_POLYCUBE_MAP_DEFAULT_EDGE 0.5
@@ -19532,6 +19535,8 @@ failed:
 #define TT__RELAX_RADIUS 4          /* steps across S's edges a vertex's local chart spans */
 #define TT__RELAX_SEAT_RADIUS 2     /* the same around a neighbour's point, where a vertex may be re-seated */
 #define TT__RELAX_CHART 96          /* quads a local chart holds at most */
+#define TT__RELAX_CHART_TABLE 256   /* slots of a chart's hash table: a power of two, over twice the quads */
+#define TT__RELAX_LANES 8           /* tasks a sweep deals its independent groups of vertices to */
 #define TT__RELAX_SWEEPS 12         /* one-vertex sweeps before the untangling */
 #define TT__UNTANGLE_SWEEPS 40      /* untangling sweeps over the vertices near folds */
 #define TT__UNTANGLE_PATIENCE 6     /* sweeps without fewer bad triangles after which the rings double */
@@ -19552,7 +19557,9 @@ failed:
    centre quad's frame (the first way found: around a cone point of S the
    chart is cut where the search meets itself). The search goes one ring
    at a time, only as far as the points asked for need: most lie in the
-   centre quad or next to it. */
+   centre quad or next to it. Its quads are found by a small hash table,
+   so a chart is a few KB whatever the size of S (each task of a sweep
+   has its own). */
 typedef struct tt__relax_chart {
     const tt_mesh *surface;
     int centre, radius; /* the chart asked for (tt__relax_chart_at) */
@@ -19562,9 +19569,18 @@ typedef struct tt__relax_chart {
     int quad[TT__RELAX_CHART];
     tt_quad_map map[TT__RELAX_CHART];
     int cell[TT__RELAX_CHART][2];   /* the unit cell of the chart the quad covers */
-    int *index_of;      /* per quad of S: its place in quad[], or -1 (all -1 outside the chart) */
+    int slot[TT__RELAX_CHART];      /* the quad's slot in the table */
+    int table[TT__RELAX_CHART_TABLE];   /* open addressing: a quad's place in quad[] + 1, 0 = empty */
     const tt_quad_map *unfold;  /* per half-edge of S: tt_polycube_unfold, made once */
 } tt__relax_chart;
+
+/* An empty chart on `surface`. */
+static void tt__relax_chart_init(tt__relax_chart *c, const tt_mesh *surface, const tt_quad_map *unfold)
+{
+    memset(c, 0, sizeof *c);
+    c->surface = surface;
+    c->unfold = unfold;
+}
 
 /* The chart around quad `centre` within `radius` steps, from now on. */
 static void tt__relax_chart_at(tt__relax_chart *c, int centre, int radius)
@@ -19573,22 +19589,52 @@ static void tt__relax_chart_at(tt__relax_chart *c, int centre, int radius)
     c->radius = radius;
 }
 
+/* The first slot of quad q's probe sequence in the table. */
+static int tt__relax_chart_hash(int q)
+{
+    return (int)(((uint32_t)q * 2654435761u) >> 24) & (TT__RELAX_CHART_TABLE - 1);
+}
+
+/* Quad q's place in the chart as found so far, or -1. */
+static int tt__relax_chart_find(const tt__relax_chart *c, int q)
+{
+    int i = tt__relax_chart_hash(q);
+    while (c->table[i]) {
+        if (c->quad[c->table[i] - 1] == q) return c->table[i] - 1;
+        i = (i + 1) & (TT__RELAX_CHART_TABLE - 1);
+    }
+    return -1;
+}
+
+/* Quad q added with its map. */
+static void tt__relax_chart_add(tt__relax_chart *c, int q, tt_quad_map map)
+{
+    int i = tt__relax_chart_hash(q);
+    double middle[2];
+    while (c->table[i]) i = (i + 1) & (TT__RELAX_CHART_TABLE - 1);
+    c->table[i] = c->count + 1;
+    c->slot[c->count] = i;
+    c->quad[c->count] = q;
+    c->map[c->count] = map;
+    tt_quad_map_apply(map, 0.5, 0.5, middle);
+    c->cell[c->count][0] = (int)floor(middle[0]);
+    c->cell[c->count][1] = (int)floor(middle[1]);
+    c->count++;
+}
+
 /* One more ring of the chart asked for (started anew when the quads found
    so far belong to another); 0 when it has all its rings. */
 static int tt__relax_chart_grow(tt__relax_chart *c)
 {
     const tt_mesh *s = c->surface;
     int ring_end, i;
-    double middle[2];
     if (c->count == 0 || c->quad[0] != c->centre || c->built_radius != c->radius) {
-        for (i = 0; i < c->count; i++) c->index_of[c->quad[i]] = -1;
+        tt_quad_map identity;
+        for (i = 0; i < c->count; i++) c->table[c->slot[i]] = 0;
+        identity.turns = identity.offset[0] = identity.offset[1] = 0;
         c->built_radius = c->radius;
-        c->count = 1;
-        c->rings = c->head = 0;
-        c->quad[0] = c->centre;
-        c->index_of[c->centre] = 0;
-        c->map[0].turns = c->map[0].offset[0] = c->map[0].offset[1] = 0;
-        c->cell[0][0] = c->cell[0][1] = 0;
+        c->count = c->rings = c->head = 0;
+        tt__relax_chart_add(c, c->centre, identity);
         return 1;
     }
     if (c->rings == c->radius) return 0;
@@ -19597,14 +19643,8 @@ static int tt__relax_chart_grow(tt__relax_chart *c)
         int k;
         for (k = 0; k < 4 && c->count < TT__RELAX_CHART; k++) {
             int h = s->face_start[c->quad[c->head]] + k, next = s->corner_face[s->twin[h]];
-            if (c->index_of[next] >= 0) continue;
-            c->index_of[next] = c->count;
-            c->quad[c->count] = next;
-            c->map[c->count] = tt_quad_map_compose(c->map[c->head], c->unfold[h]);
-            tt_quad_map_apply(c->map[c->count], 0.5, 0.5, middle);
-            c->cell[c->count][0] = (int)floor(middle[0]);
-            c->cell[c->count][1] = (int)floor(middle[1]);
-            c->count++;
+            if (tt__relax_chart_find(c, next) >= 0) continue;
+            tt__relax_chart_add(c, next, tt_quad_map_compose(c->map[c->head], c->unfold[h]));
         }
     }
     c->rings++;
@@ -19620,10 +19660,11 @@ static void tt__relax_chart_build(tt__relax_chart *c)
 /* Point p of S in the chart; 0 when its quad is not in it. */
 static int tt__relax_chart_place(tt__relax_chart *c, tt_surface_point p, double at[2])
 {
+    int i;
     if (c->count == 0 || c->quad[0] != c->centre || c->built_radius != c->radius) tt__relax_chart_grow(c);
-    while (c->index_of[p.quad] < 0)
+    while ((i = tt__relax_chart_find(c, p.quad)) < 0)
         if (!tt__relax_chart_grow(c)) return 0;
-    tt_quad_map_apply(c->map[c->index_of[p.quad]], p.s, p.t, at);
+    tt_quad_map_apply(c->map[i], p.s, p.t, at);
     return 1;
 }
 
@@ -19656,7 +19697,6 @@ typedef struct tt__relax_context {
     int *first_triangle;        /* per vertex and one more: where its corners start in triangle_corners */
     int *triangle_corners;
     tt__relax_chart *chart, *around;
-    int *index_of;              /* the two charts' quad indices, one after the other */
     tt_quad_map *unfold;        /* per half-edge of S: tt_polycube_unfold */
     const unsigned char *focus; /* per vertex: only triangles at a flagged vertex are judged; NULL = all */
 } tt__relax_context;
@@ -19666,7 +19706,6 @@ static void tt__relax_context_free(const tt_allocator *allocator, tt__relax_cont
     tt__free(allocator, x->first_triangle);
     tt__free(allocator, x->triangle_corners);
     tt__free(allocator, x->chart);
-    tt__free(allocator, x->index_of);
     tt__free(allocator, x->unfold);
     memset(x, 0, sizeof *x);
 }
@@ -19675,30 +19714,23 @@ static void tt__relax_context_free(const tt_allocator *allocator, tt__relax_cont
 static int tt__relax_context_init(const tt_polycube *pc, const tt_mesh *model, const tt_allocator *allocator,
                                   tt__relax_context *x)
 {
-    const int nverts = model->nverts, nquads = pc->surface->nfaces;
-    int v, c, k, *next;
+    const int nverts = model->nverts;
+    int v, c, *next;
     memset(x, 0, sizeof *x);
     x->first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
     x->triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
     x->chart = TT__ALLOC(allocator, tt__relax_chart, 2);
-    x->index_of = TT__ALLOC(allocator, int, 2 * (size_t)nquads);
     x->unfold = TT__ALLOC(allocator, tt_quad_map, pc->surface->ncorners);
     next = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
-    if (!x->first_triangle || !x->triangle_corners || !x->chart || !x->index_of || !x->unfold || !next) {
+    if (!x->first_triangle || !x->triangle_corners || !x->chart || !x->unfold || !next) {
         tt__free(allocator, next);
         tt__relax_context_free(allocator, x);
         return 0;
     }
     for (c = 0; c < pc->surface->ncorners; c++) x->unfold[c] = tt_polycube_unfold(pc, c);
     x->around = x->chart + 1;
-    for (c = 0; c < 2 * nquads; c++) x->index_of[c] = -1;
-    for (k = 0; k < 2; k++) {
-        tt__relax_chart *chart = x->chart + k;
-        chart->surface = pc->surface;
-        chart->centre = chart->radius = chart->count = chart->rings = chart->head = chart->built_radius = 0;
-        chart->index_of = x->index_of + k * (size_t)nquads;
-        chart->unfold = x->unfold;
-    }
+    tt__relax_chart_init(x->chart, pc->surface, x->unfold);
+    tt__relax_chart_init(x->around, pc->surface, x->unfold);
     memset(next, 0, sizeof(int) * (size_t)nverts);
     for (c = 0; c < model->ncorners; c++) next[model->corner_vert[c]]++;
     x->first_triangle[0] = 0;
@@ -19872,208 +19904,6 @@ static int tt__relax_on_surface(const tt_polycube *pc, const tt_mesh *model, con
     return d2 <= 1e-18 * pc->h * pc->h;
 }
 
-/* How a triangle stands: fine; badly placed (folded in its first vertex's
-   frame, or its points out of one another's reach: their edge has no
-   short path on S); or folded in every one of its points' frames. */
-enum { TT__TRIANGLE_FINE, TT__TRIANGLE_BAD, TT__TRIANGLE_FOLDED };
-
-/* A point as it was before a move, to go back to. */
-typedef struct tt__relax_saved {
-    int vertex;
-    tt_surface_point point;
-} tt__relax_saved;
-
-/* The relaxation's state. Every move goes through tt__relax_move, which
-   judges again the triangles at the moved vertex, so the counts stay
-   exact without sweeps over the mesh, and the sweeps visit only the
-   vertices that matter: those at triangles that are not fine, and of
-   those only the ones whose star changed since their last step (a step
-   depends on the vertex's star alone, so one that left a vertex in place
-   would again). The results are those of full sweeps in vertex order. */
-typedef struct tt__relax_state {
-    const tt_polycube *pc;
-    const tt_mesh *model;
-    tt_surface_point *points;
-    tt__relax_context x;
-    unsigned char *status;      /* per triangle: TT__TRIANGLE_*; fine where not judged (x.focus) */
-    int *bad_at, *folded_at;    /* per vertex: its triangles not fine; the folded ones of those */
-    int nbad, nfolded;          /* triangles not fine; folded */
-    int *watch, nwatch;         /* the vertices that may have a triangle not fine, each once, in no order */
-    unsigned char *watched;
-    int *still, epoch;          /* still[v] == epoch: v's last step of this pass left it in place, and its star
-                                   has not changed since */
-    int *visit;                 /* the vertices a sweep visits */
-    unsigned char *ring;        /* untangling: per vertex 1 + its distance in edges from a fold, 0 beyond */
-    int journaling;             /* moves are saved in the journal */
-    tt__relax_saved *journal;   /* the points before the moves, in order, each vertex once per segment */
-    int njournal, journal_capacity, segment;
-    int *saved_in;              /* per vertex: the segment in which its point was last saved */
-    const tt_allocator *allocator;
-} tt__relax_state;
-
-static void tt__relax_state_free(tt__relax_state *R)
-{
-    const tt_allocator *allocator = R->allocator;
-    tt__relax_context_free(allocator, &R->x);
-    tt__free(allocator, R->status);
-    tt__free(allocator, R->bad_at);
-    tt__free(allocator, R->folded_at);
-    tt__free(allocator, R->watch);
-    tt__free(allocator, R->watched);
-    tt__free(allocator, R->still);
-    tt__free(allocator, R->visit);
-    tt__free(allocator, R->ring);
-    tt__free(allocator, R->journal);
-    tt__free(allocator, R->saved_in);
-    memset(R, 0, sizeof *R);
-}
-
-/* How triangle f stands with the points as they are: judged in its first
-   vertex's quad frame, the others' quads mapped in through the local
-   chart there (x.chart). Only triangles at a vertex in x.focus are judged. */
-static int tt__relax_judge(tt__relax_state *R, int f)
-{
-    const int *t = R->model->corner_vert + 3 * f;
-    const unsigned char *focus = R->x.focus;
-    double at[3][2];
-    int k, placed = 1;
-    if (focus && !focus[t[0]] && !focus[t[1]] && !focus[t[2]]) return TT__TRIANGLE_FINE;
-    at[0][0] = R->points[t[0]].s;
-    at[0][1] = R->points[t[0]].t;
-    for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(R->points[t[0]].quad, R->points[t[k]], at[k], R->x.chart);
-    if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0)
-        return TT__TRIANGLE_FINE;
-    return placed && tt__relax_folded_everywhere(R->points, t, R->x.chart) ? TT__TRIANGLE_FOLDED : TT__TRIANGLE_BAD;
-}
-
-/* Triangle f judged again, the counts brought up to date. */
-static void tt__relax_rejudge(tt__relax_state *R, int f)
-{
-    const int before = R->status[f], after = tt__relax_judge(R, f);
-    const int bad = (after != TT__TRIANGLE_FINE) - (before != TT__TRIANGLE_FINE);
-    const int folded = (after == TT__TRIANGLE_FOLDED) - (before == TT__TRIANGLE_FOLDED);
-    int k;
-    if (after == before) return;
-    R->status[f] = (unsigned char)after;
-    R->nbad += bad;
-    R->nfolded += folded;
-    for (k = 0; k < 3; k++) {
-        const int v = R->model->corner_vert[3 * f + k];
-        R->bad_at[v] += bad;
-        R->folded_at[v] += folded;
-        if (R->bad_at[v] > 0 && !R->watched[v]) {
-            R->watched[v] = 1;
-            R->watch[R->nwatch++] = v;
-        }
-    }
-}
-
-/* 0 when out of memory (nothing left allocated). */
-static int tt__relax_state_init(tt__relax_state *R, const tt_polycube *pc, const tt_mesh *model,
-                                tt_surface_point *points, const unsigned char *focus, const tt_allocator *allocator)
-{
-    const size_t nverts = model->nverts > 0 ? (size_t)model->nverts : 1;
-    int f;
-    memset(R, 0, sizeof *R);
-    R->allocator = allocator;
-    if (!tt__relax_context_init(pc, model, allocator, &R->x)) return 0;
-    R->pc = pc;
-    R->model = model;
-    R->points = points;
-    R->x.focus = focus;
-    R->status = TT__ALLOC(allocator, unsigned char, model->nfaces > 0 ? model->nfaces : 1);
-    R->bad_at = TT__ALLOC(allocator, int, nverts);
-    R->folded_at = TT__ALLOC(allocator, int, nverts);
-    R->watch = TT__ALLOC(allocator, int, nverts);
-    R->watched = TT__ALLOC(allocator, unsigned char, nverts);
-    R->still = TT__ALLOC(allocator, int, nverts);
-    R->visit = TT__ALLOC(allocator, int, nverts);
-    R->ring = TT__ALLOC(allocator, unsigned char, nverts);
-    R->saved_in = TT__ALLOC(allocator, int, nverts);
-    if (!R->status || !R->bad_at || !R->folded_at || !R->watch || !R->watched || !R->still || !R->visit ||
-        !R->ring || !R->saved_in) {
-        tt__relax_state_free(R);
-        return 0;
-    }
-    memset(R->status, TT__TRIANGLE_FINE, model->nfaces > 0 ? (size_t)model->nfaces : 1);
-    memset(R->bad_at, 0, sizeof(int) * nverts);
-    memset(R->folded_at, 0, sizeof(int) * nverts);
-    memset(R->watched, 0, nverts);
-    memset(R->still, 0, sizeof(int) * nverts);
-    memset(R->ring, 0, nverts);
-    memset(R->saved_in, 0, sizeof(int) * nverts);
-    for (f = 0; f < model->nfaces; f++) tt__relax_rejudge(R, f);
-    return 1;
-}
-
-/* Vertex v's point set to p, its triangles judged again; the stars of v
-   and its neighbours changed. While journaling, v's point before is saved
-   once per segment. 0 when out of memory (the journal could not grow; v
-   stays). */
-static int tt__relax_move(tt__relax_state *R, int v, tt_surface_point p)
-{
-    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
-    int i, k;
-    if (R->journaling && R->saved_in[v] != R->segment) {
-        tt__relax_saved *grown = (tt__relax_saved *)tt__grow(R->allocator, R->journal, &R->journal_capacity,
-                                                             R->njournal + 1, sizeof(tt__relax_saved));
-        if (!grown) return 0;
-        R->journal = grown;
-        R->journal[R->njournal].vertex = v;
-        R->journal[R->njournal].point = R->points[v];
-        R->njournal++;
-        R->saved_in[v] = R->segment;
-    }
-    R->points[v] = p;
-    R->still[v] = 0;
-    for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
-        const int f = triangle_corners[i] / 3;
-        tt__relax_rejudge(R, f);
-        for (k = 0; k < 3; k++) R->still[R->model->corner_vert[3 * f + k]] = 0;
-    }
-    return 1;
-}
-
-/* A new segment of the journal; returns where it starts, the mark to go
-   back to with tt__relax_undo. */
-static int tt__relax_journal_mark(tt__relax_state *R)
-{
-    R->segment++;
-    return R->njournal;
-}
-
-/* The points back as they were at `mark`. Starts a new segment. */
-static void tt__relax_undo(tt__relax_state *R, int mark)
-{
-    const int journaling = R->journaling;
-    R->journaling = 0;
-    while (R->njournal > mark) {
-        const tt__relax_saved *saved = &R->journal[--R->njournal];
-        tt__relax_move(R, saved->vertex, saved->point);
-    }
-    R->journaling = journaling;
-    R->segment++;
-}
-
-/* The vertices at a triangle that is not fine (`folded_only`: a folded
-   one), into R->visit in vertex order; returns how many. */
-static int tt__relax_bad_vertices(tt__relax_state *R, int folded_only)
-{
-    int i, n = 0, kept = 0;
-    for (i = 0; i < R->nwatch; i++) {
-        const int v = R->watch[i];
-        if (R->bad_at[v] == 0) {
-            R->watched[v] = 0;
-            continue;
-        }
-        R->watch[kept++] = v;
-        if (!folded_only || R->folded_at[v] > 0) R->visit[n++] = v;
-    }
-    R->nwatch = kept;
-    tt__sort_ints(R->visit, n);
-    return n;
-}
-
 /* A vertex's star for untangling: per triangle (v, a, b), a and b in the
    chart, and the inverse of the triangle's own shape (its 3D edges
    v -> a, v -> b laid flat, in cube units), which the map should keep. */
@@ -20149,6 +19979,358 @@ static double tt__untangle_energy(const tt__untangle_star *star, const double x[
     return energy;
 }
 
+/* How a triangle stands: fine; badly placed (folded in its first vertex's
+   frame, or its points out of one another's reach: their edge has no
+   short path on S); or folded in every one of its points' frames. */
+enum { TT__TRIANGLE_FINE, TT__TRIANGLE_BAD, TT__TRIANGLE_FOLDED };
+
+/* A point as it was before a move, to go back to. */
+typedef struct tt__relax_saved {
+    int vertex;
+    tt_surface_point point;
+} tt__relax_saved;
+
+/* A group size and index, to deal the largest groups first. */
+typedef struct tt__relax_group {
+    int size, index;
+} tt__relax_group;
+#define TT__RELAX_GROUP_BEFORE(a, b) ((a).size > (b).size || ((a).size == (b).size && (a).index < (b).index))
+TT__DEFINE_HEAPSORT_BY(tt__sort_relax_groups, tt__relax_group, TT__RELAX_GROUP_BEFORE)
+
+/* One task of a sweep (tt__relax_sweep): the groups of vertices dealt to
+   it, its own charts and star, and what it did, for the sweep to take in
+   afterwards. */
+typedef struct tt__relax_lane {
+    tt__relax_chart chart, around;
+    tt__untangle_star star;
+    int *groups, ngroups, groups_capacity;      /* indices of R->group_start */
+    int *moved, nmoved, moved_capacity;         /* its vertices that moved, in order */
+    tt__relax_saved *journal;                   /* their points before, while journaling */
+    int njournal, journal_capacity;
+    int *judged, njudged, judged_capacity;      /* triangles judged again and their standing before, in pairs */
+    int load, failed;                           /* vertices dealt; out of memory */
+} tt__relax_lane;
+
+/* The relaxation's state. The triangles' standing is kept up to date
+   move by move (tt__relax_move, or a sweep's end), so the counts stay
+   exact without sweeps over the mesh, and the sweeps visit only the
+   vertices that matter: those at triangles that are not fine, and of
+   those only the ones whose star changed since their last step (a step
+   depends on the vertex's star alone, so one that left a vertex in place
+   would again). A sweep's vertices fall into groups joined by shared
+   triangles; a step reads and moves only its own group's points, so the
+   groups are independent and run as tasks (on the executor) with the
+   results of one sweep over all of them in vertex order. */
+typedef struct tt__relax_state {
+    const tt_polycube *pc;
+    const tt_mesh *model;
+    tt_surface_point *points;
+    tt__relax_context x;
+    const tt_executor *executor;
+    unsigned char *status;      /* per triangle: TT__TRIANGLE_*; fine where not judged (x.focus) */
+    int *bad_at, *folded_at;    /* per vertex: its triangles not fine; the folded ones of those */
+    int nbad, nfolded;          /* triangles not fine; folded */
+    int *watch, nwatch;         /* the vertices that may have a triangle not fine, each once, in no order */
+    unsigned char *watched;
+    int *still, epoch;          /* still[v] == epoch: v's last step of this pass left it in place, and its star
+                                   has not changed since */
+    int *visit;                 /* the vertices a sweep visits */
+    unsigned char *ring;        /* per vertex: non-zero while a sweep visits it (untangling: 1 + its distance in
+                                   edges from a fold) */
+    unsigned char *grouped;     /* per vertex: put in a group (while the groups are made) */
+    int *order, *group_start, ngroups;  /* the sweep's vertices group by group, each group in vertex order */
+    tt__relax_group *groups;    /* the groups by size, to deal them */
+    int *moved_in, sweep;       /* moved_in[v] == sweep: v moved in this sweep */
+    tt__relax_lane *lanes;      /* TT__RELAX_LANES */
+    int journaling;             /* moves are saved in the journal */
+    tt__relax_saved *journal;   /* the points before the moves, each vertex once per segment */
+    int njournal, journal_capacity, segment;
+    int *saved_in;              /* per vertex: the segment in which its point was last saved */
+    const tt_allocator *allocator;
+} tt__relax_state;
+
+static void tt__relax_state_free(tt__relax_state *R)
+{
+    const tt_allocator *allocator = R->allocator;
+    int l;
+    tt__relax_context_free(allocator, &R->x);
+    tt__free(allocator, R->status);
+    tt__free(allocator, R->bad_at);
+    tt__free(allocator, R->folded_at);
+    tt__free(allocator, R->watch);
+    tt__free(allocator, R->watched);
+    tt__free(allocator, R->still);
+    tt__free(allocator, R->visit);
+    tt__free(allocator, R->ring);
+    tt__free(allocator, R->grouped);
+    tt__free(allocator, R->order);
+    tt__free(allocator, R->group_start);
+    tt__free(allocator, R->groups);
+    tt__free(allocator, R->moved_in);
+    for (l = 0; R->lanes && l < TT__RELAX_LANES; l++) {
+        tt__free(allocator, R->lanes[l].groups);
+        tt__free(allocator, R->lanes[l].moved);
+        tt__free(allocator, R->lanes[l].journal);
+        tt__free(allocator, R->lanes[l].judged);
+    }
+    tt__free(allocator, R->lanes);
+    tt__free(allocator, R->journal);
+    tt__free(allocator, R->saved_in);
+    memset(R, 0, sizeof *R);
+}
+
+/* How triangle f stands with the points as they are: judged in its first
+   vertex's quad frame, the others' quads mapped in through the local
+   chart there (*chart). Only triangles at a vertex in x.focus are judged. */
+static int tt__relax_judge(const tt__relax_state *R, int f, tt__relax_chart *chart)
+{
+    const int *t = R->model->corner_vert + 3 * f;
+    const unsigned char *focus = R->x.focus;
+    double at[3][2];
+    int k, placed = 1;
+    if (focus && !focus[t[0]] && !focus[t[1]] && !focus[t[2]]) return TT__TRIANGLE_FINE;
+    at[0][0] = R->points[t[0]].s;
+    at[0][1] = R->points[t[0]].t;
+    for (k = 1; k < 3 && placed; k++) placed = tt__relax_place_near(R->points[t[0]].quad, R->points[t[k]], at[k], chart);
+    if (placed && tt__orient2(at[0][0], at[0][1], at[1][0], at[1][1], at[2][0], at[2][1]) > 0.0)
+        return TT__TRIANGLE_FINE;
+    return placed && tt__relax_folded_everywhere(R->points, t, chart) ? TT__TRIANGLE_FOLDED : TT__TRIANGLE_BAD;
+}
+
+/* The counts brought up to date for triangle f, whose standing was
+   `before` and is status[f] now. */
+static void tt__relax_count(tt__relax_state *R, int f, int before)
+{
+    const int after = R->status[f];
+    const int bad = (after != TT__TRIANGLE_FINE) - (before != TT__TRIANGLE_FINE);
+    const int folded = (after == TT__TRIANGLE_FOLDED) - (before == TT__TRIANGLE_FOLDED);
+    int k;
+    if (after == before) return;
+    R->nbad += bad;
+    R->nfolded += folded;
+    for (k = 0; k < 3; k++) {
+        const int v = R->model->corner_vert[3 * f + k];
+        R->bad_at[v] += bad;
+        R->folded_at[v] += folded;
+        if (R->bad_at[v] > 0 && !R->watched[v]) {
+            R->watched[v] = 1;
+            R->watch[R->nwatch++] = v;
+        }
+    }
+}
+
+/* Triangle f judged again, the counts brought up to date. */
+static void tt__relax_rejudge(tt__relax_state *R, int f)
+{
+    const int before = R->status[f];
+    R->status[f] = (unsigned char)tt__relax_judge(R, f, R->x.chart);
+    tt__relax_count(R, f, before);
+}
+
+/* 0 when out of memory (nothing left allocated). */
+static int tt__relax_state_init(tt__relax_state *R, const tt_polycube *pc, const tt_mesh *model,
+                                tt_surface_point *points, const unsigned char *focus, const tt_executor *executor,
+                                const tt_allocator *allocator)
+{
+    const size_t nverts = model->nverts > 0 ? (size_t)model->nverts : 1;
+    int f, l;
+    memset(R, 0, sizeof *R);
+    R->allocator = allocator;
+    if (!tt__relax_context_init(pc, model, allocator, &R->x)) return 0;
+    R->pc = pc;
+    R->model = model;
+    R->points = points;
+    R->executor = executor;
+    R->x.focus = focus;
+    R->status = TT__ALLOC(allocator, unsigned char, model->nfaces > 0 ? model->nfaces : 1);
+    R->bad_at = TT__ALLOC(allocator, int, nverts);
+    R->folded_at = TT__ALLOC(allocator, int, nverts);
+    R->watch = TT__ALLOC(allocator, int, nverts);
+    R->watched = TT__ALLOC(allocator, unsigned char, nverts);
+    R->still = TT__ALLOC(allocator, int, nverts);
+    R->visit = TT__ALLOC(allocator, int, nverts);
+    R->ring = TT__ALLOC(allocator, unsigned char, nverts);
+    R->grouped = TT__ALLOC(allocator, unsigned char, nverts);
+    R->order = TT__ALLOC(allocator, int, nverts);
+    R->group_start = TT__ALLOC(allocator, int, nverts + 1);
+    R->groups = TT__ALLOC(allocator, tt__relax_group, nverts);
+    R->moved_in = TT__ALLOC(allocator, int, nverts);
+    R->saved_in = TT__ALLOC(allocator, int, nverts);
+    R->lanes = TT__ALLOC(allocator, tt__relax_lane, TT__RELAX_LANES);
+    if (R->lanes) memset(R->lanes, 0, sizeof(tt__relax_lane) * TT__RELAX_LANES);
+    if (!R->status || !R->bad_at || !R->folded_at || !R->watch || !R->watched || !R->still || !R->visit ||
+        !R->ring || !R->grouped || !R->order || !R->group_start || !R->groups || !R->moved_in || !R->saved_in ||
+        !R->lanes) {
+        tt__relax_state_free(R);
+        return 0;
+    }
+    memset(R->status, TT__TRIANGLE_FINE, model->nfaces > 0 ? (size_t)model->nfaces : 1);
+    memset(R->bad_at, 0, sizeof(int) * nverts);
+    memset(R->folded_at, 0, sizeof(int) * nverts);
+    memset(R->watched, 0, nverts);
+    memset(R->still, 0, sizeof(int) * nverts);
+    memset(R->ring, 0, nverts);
+    memset(R->grouped, 0, nverts);
+    memset(R->moved_in, 0, sizeof(int) * nverts);
+    memset(R->saved_in, 0, sizeof(int) * nverts);
+    for (l = 0; l < TT__RELAX_LANES; l++) {
+        tt__relax_chart_init(&R->lanes[l].chart, pc->surface, R->x.unfold);
+        tt__relax_chart_init(&R->lanes[l].around, pc->surface, R->x.unfold);
+    }
+    for (f = 0; f < model->nfaces; f++) tt__relax_rejudge(R, f);
+    return 1;
+}
+
+/* Vertex v's point saved in the journal (while journaling, once per
+   segment), into `journal` (grown). 0 when out of memory. */
+static int tt__relax_save(tt__relax_state *R, int v, tt__relax_saved **journal, int *njournal, int *capacity)
+{
+    tt__relax_saved *grown;
+    if (!R->journaling || R->saved_in[v] == R->segment) return 1;
+    grown = (tt__relax_saved *)tt__grow(R->allocator, *journal, capacity, *njournal + 1, sizeof(tt__relax_saved));
+    if (!grown) return 0;
+    *journal = grown;
+    grown[*njournal].vertex = v;
+    grown[*njournal].point = R->points[v];
+    (*njournal)++;
+    R->saved_in[v] = R->segment;
+    return 1;
+}
+
+/* Vertex v's point set to p outside a sweep, its triangles judged again;
+   the stars of v and its neighbours changed. 0 when out of memory (the
+   journal could not grow; v stays). */
+static int tt__relax_move(tt__relax_state *R, int v, tt_surface_point p)
+{
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    int i, k;
+    if (!tt__relax_save(R, v, &R->journal, &R->njournal, &R->journal_capacity)) return 0;
+    R->points[v] = p;
+    R->still[v] = 0;
+    for (i = first_triangle[v]; i < first_triangle[v + 1]; i++) {
+        const int f = triangle_corners[i] / 3;
+        tt__relax_rejudge(R, f);
+        for (k = 0; k < 3; k++) R->still[R->model->corner_vert[3 * f + k]] = 0;
+    }
+    return 1;
+}
+
+/* A new segment of the journal; returns where it starts, the mark to go
+   back to with tt__relax_undo. */
+static int tt__relax_journal_mark(tt__relax_state *R)
+{
+    R->segment++;
+    return R->njournal;
+}
+
+/* The points back as they were at `mark`. Starts a new segment. */
+static void tt__relax_undo(tt__relax_state *R, int mark)
+{
+    const int journaling = R->journaling;
+    R->journaling = 0;
+    while (R->njournal > mark) {
+        const tt__relax_saved *saved = &R->journal[--R->njournal];
+        tt__relax_move(R, saved->vertex, saved->point);
+    }
+    R->journaling = journaling;
+    R->segment++;
+}
+
+/* The vertices at a triangle that is not fine (`folded_only`: a folded
+   one), into R->visit in vertex order; returns how many. */
+static int tt__relax_bad_vertices(tt__relax_state *R, int folded_only)
+{
+    int i, n = 0, kept = 0;
+    for (i = 0; i < R->nwatch; i++) {
+        const int v = R->watch[i];
+        if (R->bad_at[v] == 0) {
+            R->watched[v] = 0;
+            continue;
+        }
+        R->watch[kept++] = v;
+        if (!folded_only || R->folded_at[v] > 0) R->visit[n++] = v;
+    }
+    R->nwatch = kept;
+    tt__sort_ints(R->visit, n);
+    return n;
+}
+
+/* A sweep's vertices (R->visit[0..n), in vertex order, R->ring set) in
+   groups joined by shared triangles, each group in vertex order, dealt to
+   the lanes: the largest group first, each to the least loaded lane.
+   Returns the number of lanes with work. Depends on the vertices alone. */
+static int tt__relax_deal(tt__relax_state *R, int n)
+{
+    const tt_mesh *model = R->model;
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    int i, g, l, end = 0, used = 0;
+    R->ngroups = 0;
+    for (i = 0; i < n; i++) {
+        const int first = R->visit[i];
+        int head;
+        if (R->grouped[first]) continue;
+        R->group_start[R->ngroups++] = head = end;
+        R->order[end++] = first;
+        R->grouped[first] = 1;
+        for (; head < end; head++) {
+            const int u = R->order[head];
+            int j, k;
+            for (j = first_triangle[u]; j < first_triangle[u + 1]; j++)
+                for (k = 0; k < 3; k++) {
+                    const int w = model->corner_vert[3 * (triangle_corners[j] / 3) + k];
+                    if (!R->ring[w] || R->grouped[w]) continue;
+                    R->grouped[w] = 1;
+                    R->order[end++] = w;
+                }
+        }
+        tt__sort_ints(R->order + R->group_start[R->ngroups - 1], end - R->group_start[R->ngroups - 1]);
+    }
+    R->group_start[R->ngroups] = end;
+    for (i = 0; i < n; i++) R->grouped[R->visit[i]] = 0;
+    for (g = 0; g < R->ngroups; g++) {
+        R->groups[g].size = R->group_start[g + 1] - R->group_start[g];
+        R->groups[g].index = g;
+    }
+    tt__sort_relax_groups(R->groups, R->ngroups);
+    for (l = 0; l < TT__RELAX_LANES; l++) R->lanes[l].ngroups = R->lanes[l].load = 0;
+    for (g = 0; g < R->ngroups; g++) {
+        tt__relax_lane *lane = &R->lanes[0];
+        int *grown;
+        for (l = 1; l < TT__RELAX_LANES; l++)
+            if (R->lanes[l].load < lane->load) lane = &R->lanes[l];
+        grown = (int *)tt__grow(R->allocator, lane->groups, &lane->groups_capacity, lane->ngroups + 1, sizeof(int));
+        if (!grown) return -1;
+        lane->groups = grown;
+        lane->groups[lane->ngroups++] = R->groups[g].index;
+        lane->load += R->groups[g].size;
+    }
+    for (l = 0; l < TT__RELAX_LANES; l++) used += R->lanes[l].ngroups > 0;
+    return used;
+}
+
+/* Vertex v's point set to p in a sweep, by its lane: saved, and the stars
+   of the sweep's vertices around it changed (the ones beyond, and the
+   triangles' standing, wait for the sweep's end). 0 when out of memory. */
+static int tt__relax_lane_move(tt__relax_state *R, tt__relax_lane *lane, int v, tt_surface_point p)
+{
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    int *grown, i, k;
+    if (!tt__relax_save(R, v, &lane->journal, &lane->njournal, &lane->journal_capacity)) return 0;
+    grown = (int *)tt__grow(R->allocator, lane->moved, &lane->moved_capacity, lane->nmoved + 1, sizeof(int));
+    if (!grown) return 0;
+    lane->moved = grown;
+    lane->moved[lane->nmoved++] = v;
+    R->points[v] = p;
+    R->moved_in[v] = R->sweep;
+    R->still[v] = 0;
+    for (i = first_triangle[v]; i < first_triangle[v + 1]; i++)
+        for (k = 0; k < 3; k++) {
+            const int u = R->model->corner_vert[3 * (triangle_corners[i] / 3) + k];
+            if (R->ring[u]) R->still[u] = 0;
+        }
+    return 1;
+}
+
 /* One untangling step of vertex v: its star in a chart around its point,
    and tt__untangle_energy minimised over v's place by Newton's method
    (where the energy curves up both ways; else down the gradient), each
@@ -20158,13 +20340,14 @@ static double tt__untangle_energy(const tt__untangle_star *star, const double x[
    go (the sweeps then pass it over). When `strict`, v goes to the last of
    its steps that folds no more of its triangles than before. Returns 1
    when v moves, to *moved. */
-static int tt__untangle_vertex(tt__relax_state *R, int v, int strict, tt__untangle_star *star,
+static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, int v, int strict,
                                tt_surface_point *moved)
 {
     const tt_mesh *model = R->model;
     const tt_surface_point *points = R->points;
     const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
-    tt__relax_chart *chart = R->x.chart;
+    tt__relax_chart *chart = &lane->chart;
+    tt__untangle_star *star = &lane->star;
     const double h = R->pc->h;
     double x[2], kept[2], gradient[2], hessian[3], energy, least_det = HUGE_VAL, delta2, reach = 0.0;
     int i, step, folded_before, folded;
@@ -20249,6 +20432,177 @@ static int tt__untangle_vertex(tt__relax_state *R, int v, int strict, tt__untang
     return !tt__same_point(*moved, points[v]);
 }
 
+/* One relaxation step of vertex v (the moves of tt__polycube_relax), in
+   its lane's charts: 1 when a place is better, into *best. points[v] is
+   left as it was. */
+static int tt__relax_vertex(tt__relax_state *R, tt__relax_lane *lane, int v, tt_surface_point *best)
+{
+    const tt_mesh *model = R->model;
+    tt_surface_point *points = R->points;
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    tt__relax_chart *chart = &lane->chart;
+    /* v's ring in its chart: per triangle, the points of its other two vertices. */
+    double at[2], mean[2] = {0.0, 0.0}, candidate_at[2], ring[2 * (TT__RELAX_KERNEL_POINTS - 4)][2];
+    double before, best_bad;
+    int j, n = 0, reachable = 1, step;
+    tt_surface_point candidate;
+    tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
+    tt__relax_chart_place(chart, points[v], at);
+    before = best_bad = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, at);
+    if (before == 0) return 0;
+    *best = points[v];
+    for (j = first_triangle[v]; j < first_triangle[v + 1]; j++) {
+        int corner = triangle_corners[j], f = corner / 3, k;
+        for (k = 1; k < 3; k++) {
+            double pu[2];
+            if (tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], pu)) {
+                mean[0] += pu[0];
+                mean[1] += pu[1];
+                if (n < 2 * (TT__RELAX_KERNEL_POINTS - 4)) memcpy(ring[n], pu, sizeof pu);
+                n++;
+            } else {
+                reachable = 0;
+            }
+        }
+    }
+    for (step = 1; step <= 2 && reachable && n > 0; step++) {
+        candidate_at[0] = at[0] + 0.5 * step * (mean[0] / n - at[0]);
+        candidate_at[1] = at[1] + 0.5 * step * (mean[1] / n - at[1]);
+        tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
+        if (tt__relax_chart_point(chart, candidate_at, &candidate))
+            tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad, best);
+    }
+    if (reachable && n > 0 && n <= 2 * (TT__RELAX_KERNEL_POINTS - 4)) {
+        /* Into the kernel of v's star, where none of its triangles folds (when its ring allows). */
+        tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
+        if (tt__relax_kernel_centre((const double (*)[2])ring, n / 2, candidate_at) &&
+            tt__relax_chart_point(chart, candidate_at, &candidate))
+            tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad, best);
+    }
+    if (!reachable || n == 0) {
+        /* Onto a neighbour's sheet: the closest point to v on the quads around each neighbour's. */
+        for (j = first_triangle[v]; j < first_triangle[v + 1]; j++) {
+            int corner = triangle_corners[j], f = corner / 3, k, l;
+            for (k = 1; k < 3; k++) {
+                int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
+                for (l = first_triangle[v]; l < j; l++) {
+                    int other = triangle_corners[l];
+                    if (model->corner_vert[3 * (other / 3) + (other % 3 + 1) % 3] == u ||
+                        model->corner_vert[3 * (other / 3) + (other % 3 + 2) % 3] == u)
+                        break;
+                }
+                if (l < j || (k == 2 && model->corner_vert[3 * f + (corner % 3 + 1) % 3] == u)) continue;
+                candidate = tt__relax_seat(R->pc, model, v, points[u].quad, &lane->around);
+                tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad, best);
+            }
+        }
+    }
+    return best_bad < before - 1e-12;
+}
+
+/* The kinds of step a sweep makes. */
+enum { TT__SWEEP_RELAX, TT__SWEEP_STRICT, TT__SWEEP_FREE };
+
+typedef struct tt__relax_sweep_job {
+    tt__relax_state *R;
+    int kind;
+} tt__relax_sweep_job;
+
+/* Lane `index` of a sweep: its groups' vertices in order, each a step
+   (the ones still since their last step passed over), then the triangles
+   at the points it moved judged again (each triangle by its moved vertex
+   of least index), its standing written, the one before kept for the
+   counts. */
+static void tt__relax_lane_task(void *context, int index)
+{
+    const tt__relax_sweep_job *job = (const tt__relax_sweep_job *)context;
+    tt__relax_state *R = job->R;
+    tt__relax_lane *lane = &R->lanes[index];
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    const int *corner_vert = R->model->corner_vert;
+    int g, i, j, k;
+    for (g = 0; g < lane->ngroups; g++) {
+        const int group = lane->groups[g];
+        for (i = R->group_start[group]; i < R->group_start[group + 1]; i++) {
+            const int v = R->order[i];
+            tt_surface_point p;
+            int moves;
+            if (R->still[v] == R->epoch || tt__relax_on_surface(R->pc, R->model, R->points, v)) continue;
+            moves = job->kind == TT__SWEEP_RELAX ? tt__relax_vertex(R, lane, v, &p)
+                                                 : tt__untangle_vertex(R, lane, v, job->kind == TT__SWEEP_STRICT, &p);
+            if (!moves) {
+                R->still[v] = R->epoch;
+                continue;
+            }
+            if (!tt__relax_lane_move(R, lane, v, p)) {
+                lane->failed = 1;
+                return;
+            }
+        }
+    }
+    for (i = 0; i < lane->nmoved; i++) {
+        const int v = lane->moved[i];
+        for (j = first_triangle[v]; j < first_triangle[v + 1]; j++) {
+            const int f = triangle_corners[j] / 3, before = R->status[f];
+            int after, *grown;
+            for (k = 0; k < 3; k++) {
+                const int u = corner_vert[3 * f + k];
+                if (u < v && R->moved_in[u] == R->sweep) break;
+            }
+            if (k < 3 || (after = tt__relax_judge(R, f, &lane->chart)) == before) continue;
+            grown = (int *)tt__grow(R->allocator, lane->judged, &lane->judged_capacity, 2 * lane->njudged + 2,
+                                    sizeof(int));
+            if (!grown) {
+                lane->failed = 1;
+                return;
+            }
+            lane->judged = grown;
+            lane->judged[2 * lane->njudged] = f;
+            lane->judged[2 * lane->njudged + 1] = before;
+            lane->njudged++;
+            R->status[f] = (unsigned char)after;
+        }
+    }
+}
+
+/* One sweep of `kind` over R->visit[0..n) (in vertex order, R->ring set
+   for them): the groups dealt to the lanes (tt__relax_deal), the lanes run
+   as tasks on the executor, then, in lane order, their journals, the
+   stars their moves changed and their triangles' standing taken in.
+   Returns the number of points moved, -1 when out of memory. */
+static int tt__relax_sweep(tt__relax_state *R, int n, int kind)
+{
+    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
+    tt__relax_sweep_job job;
+    int lanes, l, i, j, k, moved = 0, failed = 0;
+    R->sweep++;
+    if ((lanes = tt__relax_deal(R, n)) < 0) return -1;
+    job.R = R;
+    job.kind = kind;
+    tt__run_tasks(R->executor, lanes, tt__relax_lane_task, &job);
+    for (l = 0; l < lanes; l++) {
+        tt__relax_lane *lane = &R->lanes[l];
+        tt__relax_saved *grown = lane->njournal == 0 ? R->journal :
+            (tt__relax_saved *)tt__grow(R->allocator, R->journal, &R->journal_capacity, R->njournal + lane->njournal,
+                                        sizeof(tt__relax_saved));
+        failed |= lane->failed || (lane->njournal > 0 && !grown);
+        if (grown && lane->njournal > 0) {
+            R->journal = grown;
+            memcpy(R->journal + R->njournal, lane->journal, sizeof(tt__relax_saved) * (size_t)lane->njournal);
+            R->njournal += lane->njournal;
+        }
+        for (i = 0; i < lane->nmoved; i++) {
+            const int v = lane->moved[i];
+            for (j = first_triangle[v]; j < first_triangle[v + 1]; j++)
+                for (k = 0; k < 3; k++) R->still[R->model->corner_vert[3 * (triangle_corners[j] / 3) + k]] = 0;
+        }
+        for (i = 0; i < lane->njudged; i++) tt__relax_count(R, lane->judged[2 * i], lane->judged[2 * i + 1]);
+        moved += lane->nmoved;
+        lane->nmoved = lane->njournal = lane->njudged = lane->failed = 0;
+    }
+    return failed ? -1 : moved;
+}
+
 /* Untangling sweeps over the vertices of folded triangles (those every
    one of the triangle's quads sees folded) and the vertices up to `rings`
    edges from them, each vertex a tt__untangle_vertex step, until no fold
@@ -20265,14 +20619,14 @@ static int tt__untangle_vertex(tt__relax_state *R, int v, int strict, tt__untang
    the points return to the sweep with the fewest folds (through the
    journal, which must be on). Returns the bad triangles left (every
    kind), -1 when out of memory; the moves made go to *moves. */
-static int tt__untangle(tt__relax_state *R, int strict, tt__untangle_star *star, int *moves)
+static int tt__untangle(tt__relax_state *R, int strict, int *moves)
 {
     const tt_mesh *model = R->model;
     const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
     int sweep, least = INT_MAX, stalled = 0, rings = 1, i, region = 0, best = 0;
     R->epoch++;
     for (sweep = 0; sweep < TT__UNTANGLE_SWEEPS; sweep++) {
-        int moved = 0, nvisit, head, folds = R->nfolded;
+        int moved, nvisit, head, folds = R->nfolded;
         if (!folds) break;
         if (folds < least) {
             least = folds;
@@ -20301,20 +20655,10 @@ static int tt__untangle(tt__relax_state *R, int strict, tt__untangle_star *star,
             }
         }
         region = nvisit;
-        /* In vertex order, as a sweep over the mesh would meet them. */
         tt__sort_ints(R->visit, nvisit);
-        for (i = 0; i < nvisit; i++) {
-            const int v = R->visit[i];
-            tt_surface_point p;
-            R->ring[v] = 0;
-            if (R->still[v] == R->epoch || tt__relax_on_surface(R->pc, model, R->points, v)) continue;
-            if (!tt__untangle_vertex(R, v, strict, star, &p)) {
-                R->still[v] = R->epoch;
-                continue;
-            }
-            if (!tt__relax_move(R, v, p)) return -1;
-            moved++;
-        }
+        moved = tt__relax_sweep(R, nvisit, strict ? TT__SWEEP_STRICT : TT__SWEEP_FREE);
+        for (i = 0; i < nvisit; i++) R->ring[R->visit[i]] = 0;
+        if (moved < 0) return -1;
         *moves += moved;
         if (!moved) break;
     }
@@ -20414,101 +20758,22 @@ done:
    mesh. Returns the number of moves (each point the untangling moved
    counts once), -1 when out of memory. */
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                              const unsigned char *focus, const tt_allocator *allocator)
+                              const unsigned char *focus, const tt_executor *executor,
+                              const tt_allocator *allocator)
 {
     tt__relax_state R;
-    const int *first_triangle, *triangle_corners;
-    tt__relax_chart *chart, *around;
-    tt__untangle_star *star = NULL;
     tt__relax_saved *strict_points = NULL;
     int i, sweep, moves = 0;
-    if (!tt__relax_state_init(&R, pc, model, points, focus, allocator)) return -1;
-    first_triangle = R.x.first_triangle;
-    triangle_corners = R.x.triangle_corners;
-    chart = R.x.chart;
-    around = R.x.around;
-    star = TT__ALLOC(allocator, tt__untangle_star, 1);
-    if (!star) {
-        moves = -1;
-        goto done;
-    }
+    if (!tt__relax_state_init(&R, pc, model, points, focus, executor, allocator)) return -1;
     R.epoch++;
     for (sweep = 0; sweep < TT__RELAX_SWEEPS; sweep++) {
-        int moved = 0, nvisit = tt__relax_bad_vertices(&R, 0);
-        for (i = 0; i < nvisit; i++) {
-            /* v's ring in its chart: per triangle, the points of its other two vertices. */
-            const int v = R.visit[i];
-            double at[2], mean[2] = {0.0, 0.0}, candidate_at[2], ring[2 * (TT__RELAX_KERNEL_POINTS - 4)][2];
-            int j, n = 0, reachable = 1, step;
-            double before, best_bad;
-            tt_surface_point best, candidate;
-            if (R.still[v] == R.epoch || tt__relax_on_surface(pc, model, points, v)) continue;
-            tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
-            tt__relax_chart_place(chart, points[v], at);
-            before = best_bad = tt__relax_badness(model, points, first_triangle, triangle_corners, v, chart, at);
-            if (before == 0) {
-                R.still[v] = R.epoch;
-                continue;
-            }
-            best = points[v];
-            for (j = first_triangle[v]; j < first_triangle[v + 1]; j++) {
-                int corner = triangle_corners[j], f = corner / 3, k;
-                for (k = 1; k < 3; k++) {
-                    double pu[2];
-                    if (tt__relax_chart_place(chart, points[model->corner_vert[3 * f + (corner % 3 + k) % 3]], pu)) {
-                        mean[0] += pu[0];
-                        mean[1] += pu[1];
-                        if (n < 2 * (TT__RELAX_KERNEL_POINTS - 4)) memcpy(ring[n], pu, sizeof pu);
-                        n++;
-                    } else {
-                        reachable = 0;
-                    }
-                }
-            }
-            for (step = 1; step <= 2 && reachable && n > 0; step++) {
-                candidate_at[0] = at[0] + 0.5 * step * (mean[0] / n - at[0]);
-                candidate_at[1] = at[1] + 0.5 * step * (mean[1] / n - at[1]);
-                tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
-                if (tt__relax_chart_point(chart, candidate_at, &candidate))
-                    tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
-                                  &best);
-            }
-            if (reachable && n > 0 && n <= 2 * (TT__RELAX_KERNEL_POINTS - 4)) {
-                /* Into the kernel of v's star, where none of its triangles folds (when its ring allows). */
-                tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
-                if (tt__relax_kernel_centre((const double (*)[2])ring, n / 2, candidate_at) &&
-                    tt__relax_chart_point(chart, candidate_at, &candidate))
-                    tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart, &best_bad,
-                                  &best);
-            }
-            if (!reachable || n == 0) {
-                /* Onto a neighbour's sheet: the closest point to v on the quads around each neighbour's. */
-                for (j = first_triangle[v]; j < first_triangle[v + 1]; j++) {
-                    int corner = triangle_corners[j], f = corner / 3, k, l;
-                    for (k = 1; k < 3; k++) {
-                        int u = model->corner_vert[3 * f + (corner % 3 + k) % 3];
-                        for (l = first_triangle[v]; l < j; l++) {
-                            int other = triangle_corners[l];
-                            if (model->corner_vert[3 * (other / 3) + (other % 3 + 1) % 3] == u ||
-                                model->corner_vert[3 * (other / 3) + (other % 3 + 2) % 3] == u)
-                                break;
-                        }
-                        if (l < j || (k == 2 && model->corner_vert[3 * f + (corner % 3 + 1) % 3] == u)) continue;
-                        candidate = tt__relax_seat(pc, model, v, points[u].quad, around);
-                        tt__relax_try(model, points, first_triangle, triangle_corners, v, candidate, chart,
-                                      &best_bad, &best);
-                    }
-                }
-            }
-            if (best_bad < before - 1e-12) {
-                if (!tt__relax_move(&R, v, best)) {
-                    moves = -1;
-                    goto done;
-                }
-                moved++;
-            } else {
-                R.still[v] = R.epoch;
-            }
+        int moved, nvisit = tt__relax_bad_vertices(&R, 0);
+        for (i = 0; i < nvisit; i++) R.ring[R.visit[i]] = 1;
+        moved = tt__relax_sweep(&R, nvisit, TT__SWEEP_RELAX);
+        for (i = 0; i < nvisit; i++) R.ring[R.visit[i]] = 0;
+        if (moved < 0) {
+            moves = -1;
+            goto done;
         }
         moves += moved;
         if (!moved) break;
@@ -20520,7 +20785,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         int strict_moves = 0, free_moves = 0, start, nstrict, untangled;
         R.journaling = 1;
         start = tt__relax_journal_mark(&R);
-        if (tt__untangle(&R, 1, star, &strict_moves) < 0) {
+        if (tt__untangle(&R, 1, &strict_moves) < 0) {
             moves = -1;
             goto done;
         }
@@ -20536,7 +20801,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
             strict_points[i].point = points[strict_points[i].vertex];
         }
         tt__relax_undo(&R, start);
-        if (tt__untangle(&R, 0, star, &free_moves) < 0 ||
+        if (tt__untangle(&R, 0, &free_moves) < 0 ||
             (untangled = tt__untangle_choose(&R, start, strict_points, nstrict)) < 0) {
             moves = -1;
             goto done;
@@ -20545,7 +20810,6 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
     }
 done:
     tt__relax_state_free(&R);
-    tt__free(allocator, star);
     tt__free(allocator, strict_points);
     return moves;
 }
@@ -21679,6 +21943,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__refined R;
     tt__split S;
     tt_result result;
+    const tt_executor *executor = options ? options->executor : NULL;
     double longest;
     int f, v, j, tracing, cycle, moves, max_quads;
     tt__ok(error);
@@ -21723,7 +21988,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         points[v].s = points[v].s < TT__MAP_SNAP ? 0.0f : (points[v].s > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].s);
         points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
     }
-    if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, allocator)) < 0) goto out_of_memory;
+    if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator)) < 0)
+        goto out_of_memory;
     if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
                                           error)) != TT_OK)
         goto failed;
@@ -21761,7 +22027,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             for (v = 0; v < model->nverts; v++) focus[v] = focus[v] != 0;
         }
         memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
-        if ((moves = tt__polycube_relax(polycube, model, points, focus, allocator)) < 0) goto out_of_memory;
+        if ((moves = tt__polycube_relax(polycube, model, points, focus, executor, allocator)) < 0) goto out_of_memory;
         report->relaxed += moves;
         for (v = 0; v < model->nverts; v++)
             moved[v] = !tt__same_point(points[v], earlier[v]);

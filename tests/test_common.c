@@ -325,7 +325,7 @@ int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], doub
 int internal_polycube_mask_is_disc(int mask) { return tt__polycube_mask_is_disc(mask); }
 int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points)
 {
-    return tt__polycube_relax(polycube, model, points, NULL, NULL);
+    return tt__polycube_relax(polycube, model, points, NULL, NULL, NULL);
 }
 int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
                              unsigned char *moved, const tt_allocator *allocator)
