@@ -15869,14 +15869,38 @@ static int tt__hpm_allowed_offsets(tt__hpm *S, int cw, int ch, int has_cont, con
                             if (v > mx[d]) mx[d] = v;
                         }
         memset(a, 0, pp);
-        for (ty = 0; ty < P - maxy; ty++)
-            for (tx = 0; tx < P - maxx; tx++) {
-                int ok = 1;
-                if (!S->toroidal)
-                    for (d = 0; d < 4 && ok; d++) ok = nx[d] * tx + ny[d] * ty <= lim[d] - mx[d];
-                a[(size_t)ty * P + tx] = (unsigned char)ok;
-                any |= ok;
-            }
+        for (ty = 0; ty < P - maxy; ty++) {
+            /* Each limit holds on a prefix or a suffix of the row (the
+               rounded nx tx + ny ty is monotone in tx), so the row's
+               allowed offsets are one run, found from the exact bound and
+               nudged to where the rounded test changes. */
+            int lo = 0, hi = P - maxx - 1;
+            if (!S->toroidal)
+                for (d = 0; d < 4 && lo <= hi; d++) {
+                    double row = ny[d] * ty, limit = lim[d] - mx[d], edge;
+                    if (nx[d] == 0) {
+                        if (!(row <= limit)) hi = lo - 1;
+                        continue;
+                    }
+                    edge = (limit - row) / nx[d];
+                    edge = edge < -1.0 ? -1.0 : (edge > P ? P : edge);
+                    if (nx[d] > 0) {
+                        /* the largest tx that holds, searched near floor(edge) */
+                        tx = (int)floor(edge);
+                        while (tx >= 0 && !(nx[d] * tx + row <= limit)) tx--;
+                        while (tx + 1 < P && nx[d] * (tx + 1) + row <= limit) tx++;
+                        if (tx < hi) hi = tx;
+                    } else {
+                        tx = (int)ceil(edge);
+                        while (tx < P && !(nx[d] * tx + row <= limit)) tx++;
+                        while (tx - 1 >= 0 && nx[d] * (tx - 1) + row <= limit) tx--;
+                        if (tx > lo) lo = tx;
+                    }
+                }
+            if (lo > hi) continue;
+            memset(a + (size_t)ty * P + lo, 1, (size_t)(hi - lo + 1));
+            any = 1;
+        }
     }
     /* D8: not the exact continuation of that neighbour (copy 0 at
        the offset that repeats its map), nor anything within the
