@@ -15217,6 +15217,7 @@ typedef struct tt__hpm {
     int *term_at;               /* P x P: the band's pixels in row-major order, for direct sums */
     double *term_weight, *term_values;  /* P x P, nch x P x P: their weights and values */
     double *row;                /* P: one row of E */
+    double *relax_sides;        /* 3 x TT__HPM_RING_MAX x TT__HPM_SIDE_VALUES: the relaxation's edge samples */
     double *xwork, *mask, *values;
     unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band */
     unsigned char *allowed_mem; /* copies x P x P */
@@ -16330,49 +16331,74 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    measure see), weighted TT__HPM_RELAX_ACROSS; plus what each side shows
    against the other side's map continued over the edge to the same place.
    The second part is 0 for an exact continuation, where the first is not
-   (two places a texel apart differ), so a continuation stays one. */
-static double tt__hpm_edge_mismatch(const tt__hpm *S, int h, double *continuation)
+   (two places a texel apart differ), so a continuation stays one.
+
+   In two steps, so that the relaxation, which moves one side at a time,
+   samples the other side once: tt__hpm_edge_side samples one side (side 0
+   is h's face, 1 its twin's), at each point its colour half a texel inside
+   its face ("in") and half a texel outside ("out": its map continued over
+   the edge), TT__HPM_SIDE_VALUES doubles; tt__hpm_edge_compare adds up
+   the differences of two sides. */
+#define TT__HPM_SIDE_VALUES (2 * 3 * TT__HPM_RELAX_SAMPLES)
+
+static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
 {
     const tt_mesh *m = S->mesh;
-    int t = m->twin[h], side, i, c;
-    int ends[2][3];     /* per side: corner at the edge's start, at its end, the apex */
-    double across = 0, cont = 0, n[2][2];
-    ends[0][0] = h;
-    ends[0][1] = tt_mesh_next(m, h);
-    ends[0][2] = tt_mesh_prev(m, h);
-    ends[1][0] = tt_mesh_next(m, t); /* the twin runs the other way */
-    ends[1][1] = t;
-    ends[1][2] = tt_mesh_prev(m, t);
-    for (side = 0; side < 2; side++) {
-        const double *a = S->uv + 2 * ends[side][0], *b = S->uv + 2 * ends[side][1], *x = S->uv + 2 * ends[side][2];
-        double ex = b[0] - a[0], ey = b[1] - a[1], len = sqrt(ex * ex + ey * ey);
-        n[side][0] = n[side][1] = 0;
-        if (len > 0) {
-            n[side][0] = -ey / len;
-            n[side][1] = ex / len;
-            if (n[side][0] * (x[0] - a[0]) + n[side][1] * (x[1] - a[1]) < 0) {
-                n[side][0] = -n[side][0];
-                n[side][1] = -n[side][1];
-            }
+    int t = m->twin[h], e0, e1, apex, i;
+    const double *a, *b, *x;
+    double ex, ey, len, n[2] = {0, 0};
+    if (side == 0) {
+        e0 = h;
+        e1 = tt_mesh_next(m, h);
+        apex = tt_mesh_prev(m, h);
+    } else {
+        e0 = tt_mesh_next(m, t); /* the twin runs the other way */
+        e1 = t;
+        apex = tt_mesh_prev(m, t);
+    }
+    a = S->uv + 2 * e0;
+    b = S->uv + 2 * e1;
+    x = S->uv + 2 * apex;
+    ex = b[0] - a[0];
+    ey = b[1] - a[1];
+    len = sqrt(ex * ex + ey * ey);
+    if (len > 0) {
+        n[0] = -ey / len;
+        n[1] = ex / len;
+        if (n[0] * (x[0] - a[0]) + n[1] * (x[1] - a[1]) < 0) {
+            n[0] = -n[0];
+            n[1] = -n[1];
         }
     }
     for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) {
-        double tt = (i + 0.5) / TT__HPM_RELAX_SAMPLES, in[2][3], out[2][3];
-        for (side = 0; side < 2; side++) {
-            const double *a = S->uv + 2 * ends[side][0], *b = S->uv + 2 * ends[side][1];
-            double ex = a[0] + tt * (b[0] - a[0]), ey = a[1] + tt * (b[1] - a[1]);
-            tt__hpm_sample(S->full, S->W, S->Hh, S->nch, ex + 0.5 * n[side][0], ey + 0.5 * n[side][1], S->toroidal,
-                           in[side]);
-            tt__hpm_sample(S->full, S->W, S->Hh, S->nch, ex - 0.5 * n[side][0], ey - 0.5 * n[side][1], S->toroidal,
-                           out[side]);
-        }
+        double tt = (i + 0.5) / TT__HPM_RELAX_SAMPLES, px = a[0] + tt * (b[0] - a[0]), py = a[1] + tt * (b[1] - a[1]);
+        tt__hpm_sample(S->full, S->W, S->Hh, S->nch, px + 0.5 * n[0], py + 0.5 * n[1], S->toroidal, values + 6 * i);
+        tt__hpm_sample(S->full, S->W, S->Hh, S->nch, px - 0.5 * n[0], py - 0.5 * n[1], S->toroidal,
+                       values + 6 * i + 3);
+    }
+}
+
+static double tt__hpm_edge_compare(const tt__hpm *S, const double *side0, const double *side1, double *continuation)
+{
+    double across = 0, cont = 0;
+    int i, c;
+    for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) {
+        const double *in0 = side0 + 6 * i, *out0 = in0 + 3, *in1 = side1 + 6 * i, *out1 = in1 + 3;
         for (c = 0; c < S->nch; c++) {
-            across += (in[0][c] - in[1][c]) * (in[0][c] - in[1][c]);
-            cont += (in[0][c] - out[1][c]) * (in[0][c] - out[1][c]) + (in[1][c] - out[0][c]) * (in[1][c] - out[0][c]);
+            across += (in0[c] - in1[c]) * (in0[c] - in1[c]);
+            cont += (in0[c] - out1[c]) * (in0[c] - out1[c]) + (in1[c] - out0[c]) * (in1[c] - out0[c]);
         }
     }
     if (continuation) *continuation += cont;
     return TT__HPM_RELAX_ACROSS * across + cont;
+}
+
+static double tt__hpm_edge_mismatch(const tt__hpm *S, int h, double *continuation)
+{
+    double side0[TT__HPM_SIDE_VALUES], side1[TT__HPM_SIDE_VALUES];
+    tt__hpm_edge_side(S, h, 0, side0);
+    tt__hpm_edge_side(S, h, 1, side1);
+    return tt__hpm_edge_compare(S, side0, side1, continuation);
 }
 
 /* 1 when texel positions a and b are the same point of the image (on a
@@ -16400,23 +16426,35 @@ static int tt__hpm_is_border(const tt__hpm *S, int c)
 
 /* Twice the signed area of corner c's triangle in texels, and its stretch:
    the ratio of the singular values of its surface -> texture map (what
-   the stretch measure reads). */
-static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
+   the stretch measure reads).
+   In two parts, so that a loop moving the texture coordinates of a few
+   triangles lays each flat once: tt__hpm_tri_frame (the triangle laid flat
+   in its own plane, e1 along x: 3 numbers) and tt__hpm_tri_map. */
+static void tt__hpm_tri_frame(const tt__hpm *S, int c, double *frame)
 {
     const tt_mesh *m = S->mesh;
-    int k0 = m->face_start[m->corner_face[c]], i;
+    int k0 = m->face_start[m->corner_face[c]];
     const float *p0 = m->pos + 3 * (size_t)m->corner_vert[k0], *p1 = m->pos + 3 * (size_t)m->corner_vert[k0 + 1],
                 *p2 = m->pos + 3 * (size_t)m->corner_vert[k0 + 2];
-    double e1[3], e2[3], cr[3], len, du[2][2], dq[2][2], det, a[2][2], big, small;
+    double e1[3], e2[3], cr[3], len;
     tt__sub3f(p1, p0, e1);
     tt__sub3f(p2, p0, e2);
     tt__cross3(e1, e2, cr);
     len = tt__length3(e1);
-    /* the triangle laid flat in its own plane: e1 along x */
-    dq[0][0] = len;
+    frame[0] = len;
+    frame[1] = len > 0 ? (e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2]) / len : 0;
+    frame[2] = len > 0 ? tt__length3(cr) / len : 0;
+}
+
+static double tt__hpm_tri_map(const tt__hpm *S, int c, const double *frame, double *stretch)
+{
+    const tt_mesh *m = S->mesh;
+    int k0 = m->face_start[m->corner_face[c]], i;
+    double du[2][2], dq[2][2], det, a[2][2], big, small;
+    dq[0][0] = frame[0];
     dq[0][1] = 0;
-    dq[1][0] = len > 0 ? (e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2]) / len : 0;
-    dq[1][1] = len > 0 ? tt__length3(cr) / len : 0;
+    dq[1][0] = frame[1];
+    dq[1][1] = frame[2];
     for (i = 0; i < 2; i++) {
         du[i][0] = S->uv[2 * (k0 + i + 1)] - S->uv[2 * k0];
         du[i][1] = S->uv[2 * (k0 + i + 1) + 1] - S->uv[2 * k0 + 1];
@@ -16434,6 +16472,13 @@ static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
         *stretch = tt__stretch_ratio(big, small);
     }
     return du[0][0] * du[1][1] - du[0][1] * du[1][0];
+}
+
+static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
+{
+    double frame[3];
+    tt__hpm_tri_frame(S, c, frame);
+    return tt__hpm_tri_map(S, c, frame, stretch);
 }
 
 /* Every corner at vertex v (at most `room`), walking round it through the
@@ -16466,28 +16511,12 @@ static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
 
 #define TT__HPM_RING_MAX 64
 
-/* The mismatch of the border edges at v (ring corners[0..n-1]) that touch
-   cluster K's faces; its continuation part in *continuation. */
-static double tt__hpm_vertex_mismatch(const tt__hpm *S, const int *corners, int n, int K, double *continuation)
-{
-    const tt_mesh *m = S->mesh;
-    double sum = 0;
-    int i;
-    for (i = 0; i < n; i++) {
-        int c = corners[i], t = m->twin[c], a, b;
-        if (t < 0) continue;
-        a = S->owner[m->corner_face[c]];
-        b = S->owner[m->corner_face[t]];
-        if (a < 0 || b < 0 || a == b || (a != K && b != K)) continue;
-        sum += tt__hpm_edge_mismatch(S, c, continuation);
-    }
-    return sum;
-}
-
 /* Relax the border between C (its faces already owned by C) and the
    textured faces round it: at each vertex of that border, C's map and
-   then each neighbour's map there is nudged in turn. Returns 0 when out
-   of memory. */
+   then each neighbour's map there is nudged in turn. While one cluster's
+   coordinates at the vertex move, the other sides of its border edges
+   there stay: they are sampled once (tt__hpm_edge_side), and each
+   triangle is laid flat once per vertex. Returns 0 when out of memory. */
 static int tt__hpm_relax(tt__hpm *S, int C)
 {
     const tt_mesh *m = S->mesh;
@@ -16516,7 +16545,9 @@ static int tt__hpm_relax(tt__hpm *S, int C)
         if (radius < 0.25) break;
         for (i = 0; i < nverts; i++) {
             int ring[TT__HPM_RING_MAX], group[TT__HPM_RING_MAX], n, ngroups = 0, g, k;
+            double frame[3 * TT__HPM_RING_MAX];
             n = tt__hpm_ring(m, verts[i], ring, TT__HPM_RING_MAX);
+            for (k = 0; k < n; k++) tt__hpm_tri_frame(S, ring[k], frame + 3 * k);
             /* the clusters meeting at v, C first */
             group[ngroups++] = C;
             for (k = 0; k < n; k++) {
@@ -16525,30 +16556,54 @@ static int tt__hpm_relax(tt__hpm *S, int C)
                 if (K >= 0 && !seen) group[ngroups++] = K;
             }
             for (g = 0; g < ngroups; g++) {
-                int K = group[g], trial, first = -1;
-                double continued = 0, before = tt__hpm_vertex_mismatch(S, ring, n, K, &continued), old[2];
+                /* K's border edges at v (ring corners whose edge parts K from
+                   another textured cluster), K's side of each: 0 when the
+                   ring corner's face is K's */
+                int K = group[g], trial, first = -1, edge[TT__HPM_RING_MAX], side[TT__HPM_RING_MAX], nedges = 0, e;
+                double continued = 0, before = 0, old[2], area0[TT__HPM_RING_MAX], st0[TT__HPM_RING_MAX];
+                double *fixed = S->relax_sides, *moving = fixed + TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES;
+                double *trying = moving + TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES;
+                for (k = 0; k < n; k++) {
+                    int c = ring[k], t = m->twin[c], a, b;
+                    if (t < 0) continue;
+                    a = S->owner[m->corner_face[c]];
+                    b = S->owner[m->corner_face[t]];
+                    if (a < 0 || b < 0 || a == b || (a != K && b != K)) continue;
+                    edge[nedges] = c;
+                    side[nedges] = a == K ? 0 : 1;
+                    tt__hpm_edge_side(S, c, 1 - side[nedges], fixed + TT__HPM_SIDE_VALUES * nedges);
+                    tt__hpm_edge_side(S, c, side[nedges], moving + TT__HPM_SIDE_VALUES * nedges);
+                    nedges++;
+                }
+                for (e = 0; e < nedges; e++) {
+                    const double *mine = moving + TT__HPM_SIDE_VALUES * e, *theirs = fixed + TT__HPM_SIDE_VALUES * e;
+                    before += side[e] == 0 ? tt__hpm_edge_compare(S, mine, theirs, &continued)
+                                           : tt__hpm_edge_compare(S, theirs, mine, &continued);
+                }
                 /* no border here, or the exact continuation of the neighbour */
                 if (continued <= 1e-12) continue;
                 for (k = 0; k < n && first < 0; k++)
                     if (S->owner[m->corner_face[ring[k]]] == K) first = ring[k];
                 old[0] = S->uv[2 * first];
                 old[1] = S->uv[2 * first + 1];
+                for (k = 0; k < n; k++)
+                    if (S->owner[m->corner_face[ring[k]]] == K)
+                        area0[k] = tt__hpm_tri_map(S, ring[k], frame + 3 * k, &st0[k]);
                 for (trial = 0; trial < TT__HPM_RELAX_TRIALS; trial++) {
                     double ang = TT__TWO_PI * tt_rng_float(&S->rng), r = radius * sqrt(tt_rng_float(&S->rng));
-                    double nx = old[0] + r * cos(ang), ny = old[1] + r * sin(ang), after, area0, area1, st0, st;
+                    double nx = old[0] + r * cos(ang), ny = old[1] + r * sin(ang), after = 0, area1, st;
                     int ok = 1;
                     if (!S->toroidal && (nx < 1 || ny < 1 || nx > S->W - 1 || ny > S->Hh - 1)) continue;
                     for (k = 0; k < n && ok; k++) {
                         int c = ring[k];
                         if (S->owner[m->corner_face[c]] != K) continue;
-                        area0 = tt__hpm_tri_area(S, c, &st0);
                         S->uv[2 * c] = nx;
                         S->uv[2 * c + 1] = ny;
-                        area1 = tt__hpm_tri_area(S, c, &st);
+                        area1 = tt__hpm_tri_map(S, c, frame + 3 * k, &st);
                         S->uv[2 * c] = old[0];
                         S->uv[2 * c + 1] = old[1];
-                        ok = area0 * area1 > 0 && fabs(area1) >= 0.25 * fabs(area0) &&
-                             st <= (st0 > TT__HPM_RELAX_MAX_STRETCH ? st0 : TT__HPM_RELAX_MAX_STRETCH);
+                        ok = area0[k] * area1 > 0 && fabs(area1) >= 0.25 * fabs(area0[k]) &&
+                             st <= (st0[k] > TT__HPM_RELAX_MAX_STRETCH ? st0[k] : TT__HPM_RELAX_MAX_STRETCH);
                     }
                     if (!ok) continue;
                     for (k = 0; k < n; k++)
@@ -16556,11 +16611,23 @@ static int tt__hpm_relax(tt__hpm *S, int C)
                             S->uv[2 * ring[k]] = nx;
                             S->uv[2 * ring[k] + 1] = ny;
                         }
-                    after = tt__hpm_vertex_mismatch(S, ring, n, K, NULL);
+                    for (e = 0; e < nedges; e++) {
+                        double *mine = trying + TT__HPM_SIDE_VALUES * e;
+                        const double *theirs = fixed + TT__HPM_SIDE_VALUES * e;
+                        tt__hpm_edge_side(S, edge[e], side[e], mine);
+                        after += side[e] == 0 ? tt__hpm_edge_compare(S, mine, theirs, NULL)
+                                              : tt__hpm_edge_compare(S, theirs, mine, NULL);
+                    }
                     if (after < before) {
+                        double *swap = moving;
+                        moving = trying;
+                        trying = swap;
                         before = after;
                         old[0] = nx;
                         old[1] = ny;
+                        for (k = 0; k < n; k++)
+                            if (S->owner[m->corner_face[ring[k]]] == K)
+                                area0[k] = tt__hpm_tri_map(S, ring[k], frame + 3 * k, &st0[k]);
                     } else {
                         for (k = 0; k < n; k++)
                             if (S->owner[m->corner_face[ring[k]]] == K) {
@@ -17129,6 +17196,7 @@ static void tt__hpm_release(tt__hpm *S)
     tt__free(S->al, S->term_weight);
     tt__free(S->al, S->term_values);
     tt__free(S->al, S->row);
+    tt__free(S->al, S->relax_sides);
     tt__free(S->al, S->flat);
     tt__free(S->al, S->uv);
     tt__free(S->al, S->out);
@@ -17273,9 +17341,10 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.qcap = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
     S.heap = TT__ALLOC(allocator, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
     S.near_faces = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
+    S.relax_sides = TT__ALLOC(allocator, double, 3 * TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES);
     if (!S.flat || !S.uv || ((o.flags & TT_HPM_RANDOM_PLACEMENT) && !S.out) || !S.owner || !S.in_c || !S.seen ||
         !S.placed || !S.vdisp || !S.vmark || !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap ||
-        !S.near_faces) {
+        !S.near_faces || !S.relax_sides) {
         res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
         goto done;
     }
