@@ -7489,67 +7489,106 @@ static uint64_t tt__xcorr_scan(const tt_xcorr_texture *texture, double energy, d
     return found;
 }
 
-/* row[x] += weight (value - src[x])^2 for x < n. Two values a step, so
-   that at -O2 each step is one vector operation. */
-static void tt__xcorr_direct_term(double *TT__RESTRICT row, const double *TT__RESTRICT src, int n, double weight,
-                                  double value)
-{
-    int x;
-    for (x = 0; x + 2 <= n; x += 2) {
-        double d0 = value - src[x], d1 = value - src[x + 1];
-        row[x] += weight * d0 * d0;
-        row[x + 1] += weight * d1 * d1;
-    }
-    if (x < n) {
-        double d = value - src[x];
-        row[x] += weight * d * d;
-    }
-}
-
 /* The direct way to tt_xcorr_masked's E, for a mask with few non-zero
    weights: at each offset (x, y) the sum over the terms i (the mask's
    texels p_i with weight J_i > 0, values I_i) and the channels c of
        J_i (I_ic - T_c(p_i + (x, y)))^2,
-   taken in the order of the terms, wrapping as the correlation does. So E
-   >= 0 without a clamp, an exact continuation gives exactly 0, and the cost
-   is terms x channels operations per offset, where the transforms cost
-   about (channels + 1 + textures) (5/2) log2(width height) per texel
-   whatever the mask - hierarchical pattern mapping's bands at the matching
-   resolution hold tens of texels, and this is then several times cheaper.
-   It agrees with the transforms' E to their rounding (about 1e-13 of sum
-   J I^2), so a near-tie may fall the other way.
-     texture    `channels` planes of height x width (T), laid out as
-                tt_xcorr_texture_create's input.
-     term_at    per term, its texel y * width + x; term_weight its J > 0;
-                term_values its `channels` values, term after term.
-     span       per row y, the run of offsets computed: span[2 y] ..
-                span[2 y + 1] (none when the first is larger); rows
-                y_begin .. y_end - 1 are done.
-     allowed    as tt_xcorr_masked's (NULL: every offset of the runs).
-     row        width doubles of scratch.
-   The smallest allowed E, the first in row-major order on a tie, into
-   *best (y * width + x; -1 when none) and *best_e. Returns non-zero when an
-   E is a NaN or infinity. */
-static uint64_t tt__xcorr_direct(int w, int h, int channels, const double *texture, const int *term_at,
-                                 const double *term_weight, const double *term_values, int nterms, const int *span,
-                                 const unsigned char *allowed, int y_begin, int y_end, double *row, int *best,
+   wrapping as the correlation does. So E >= 0 without a clamp, an exact
+   continuation gives exactly 0, and the cost is terms x channels operations
+   per offset, where the transforms cost about (channels + 1 + textures)
+   (5/2) log2(width height) per texel whatever the mask - hierarchical
+   pattern mapping's bands at the matching resolution hold tens of texels,
+   and this is then several times cheaper. It agrees with the transforms' E
+   to their rounding (about 1e-13 of sum J I^2), so a near-tie may fall the
+   other way.
+
+   Two passes, so that the sums vectorise four wide: every offset's E in
+   float, then the exact E in double (the terms in order, the channels
+   within each) at the offsets whose float E could be the smallest. With u
+   = 2^-24, each float term is within u (2 |a| |I| + 5 a^2) J of the exact
+   one (a = I - T; rounding I, J, the difference and the two products) and
+   a sum of N positive terms within (N - 1) u of their sum, so with
+   2 |a| |I| <= a^2 + I^2 the float E is within u (sum J I^2 + (N + 5) E)
+   of the exact E; the second pass checks every offset whose float E minus
+   that bound (taken 8 times over) is not above the smallest float E plus
+   it. The answer is the one the exact E alone gives. */
+typedef struct tt__xcorr_terms {
+    int count, channels;
+    const int *x, *y;           /* each term's texel */
+    const double *weight;       /* its J > 0 */
+    const double *values;       /* its `channels` values, term after term */
+    double energy;              /* sum of J I^2 over the terms and channels */
+} tt__xcorr_terms;
+
+#define TT__XCORR_FLOAT_SLACK (1.0 / 2097152.0)   /* 8 u = 2^-21 */
+
+/* row[x] += weight (value - src[x])^2 for x < n, in float. Four values a
+   step, so that at -O2 each step is one vector operation. */
+static void tt__xcorr_direct_term(float *TT__RESTRICT row, const float *TT__RESTRICT src, int n, float weight,
+                                  float value)
+{
+    int x;
+    for (x = 0; x + 4 <= n; x += 4) {
+        float d0 = value - src[x], d1 = value - src[x + 1], d2 = value - src[x + 2], d3 = value - src[x + 3];
+        row[x] += weight * d0 * d0;
+        row[x + 1] += weight * d1 * d1;
+        row[x + 2] += weight * d2 * d2;
+        row[x + 3] += weight * d3 * d3;
+    }
+    for (; x < n; x++) {
+        float d = value - src[x];
+        row[x] += weight * d * d;
+    }
+}
+
+/* The exact E at offset (x, y). */
+static double tt__xcorr_direct_exact(int w, int h, const float *texture, const tt__xcorr_terms *terms, int x, int y)
+{
+    size_t plane = (size_t)w * (size_t)h;
+    double e = 0.0;
+    int i, c;
+    for (i = 0; i < terms->count; i++) {
+        int sx = terms->x[i] + x, sy = terms->y[i] + y;
+        if (sx >= w) sx -= w;
+        if (sy >= h) sy -= h;
+        for (c = 0; c < terms->channels; c++) {
+            double d = terms->values[(size_t)i * terms->channels + c] - texture[plane * c + (size_t)w * sy + sx];
+            e += terms->weight[i] * d * d;
+        }
+    }
+    return e;
+}
+
+/* The smallest E over rows y_begin .. y_end - 1 of one texture (`channels`
+   float planes of height x width), each row y over its run of offsets
+   span[2 y] .. span[2 y + 1] (none when the first is larger), of which
+   `allowed` (as tt_xcorr_masked's; NULL: all) says which may be chosen.
+   rows: (y_end - y_begin) x width floats of scratch. The smallest allowed
+   exact E, the first in row-major order on a tie, into *best (y * width + x;
+   -1 when none) and *best_e. Returns non-zero when an E is a NaN or
+   infinity (values too large for the float pass). */
+static uint64_t tt__xcorr_direct(int w, int h, const float *texture, const tt__xcorr_terms *terms, const int *span,
+                                 const unsigned char *allowed, int y_begin, int y_end, float *rows, int *best,
                                  double *best_e)
 {
     size_t plane = (size_t)w * (size_t)h;
-    double low = HUGE_VAL;
-    uint64_t found = 0;
-    int y, x, i, c, at = -1;
+    double low = HUGE_VAL, slack_base = TT__XCORR_FLOAT_SLACK * terms->energy,
+           slack_scale = TT__XCORR_FLOAT_SLACK * (terms->count * terms->channels + 5.0);
+    float low_float = (float)HUGE_VAL, candidate;
+    int y, x, i, c, at = -1, any = 0;
     for (y = y_begin; y < y_end; y++) {
         int lo = span[2 * y], hi = span[2 * y + 1];
         const unsigned char *ok = allowed ? allowed + (size_t)w * y : NULL;
+        float *row = rows + (size_t)w * (y - y_begin);
         if (lo > hi) continue;
-        for (x = lo; x <= hi; x++) row[x] = 0.0;
-        for (i = 0; i < nterms; i++) {
-            int px = term_at[i] % w, sy = term_at[i] / w + y, wrap = w - px; /* offsets x >= wrap wrap round */
+        for (x = lo; x <= hi; x++) row[x] = 0.0f;
+        for (i = 0; i < terms->count; i++) {
+            int px = terms->x[i], sy = terms->y[i] + y, wrap = w - px; /* offsets x >= wrap wrap round */
+            float weight = (float)terms->weight[i];
             if (sy >= h) sy -= h;
-            for (c = 0; c < channels; c++) {
-                const double *src = texture + plane * c + (size_t)w * sy + px;
-                double weight = term_weight[i], value = term_values[(size_t)i * channels + c];
+            for (c = 0; c < terms->channels; c++) {
+                const float *src = texture + plane * c + (size_t)w * sy + px;
+                float value = (float)terms->values[(size_t)i * terms->channels + c];
                 if (lo < wrap)
                     tt__xcorr_direct_term(row + lo, src + lo, (hi < wrap ? hi : wrap - 1) - lo + 1, weight, value);
                 if (hi >= wrap) {
@@ -7558,16 +7597,34 @@ static uint64_t tt__xcorr_direct(int w, int h, int channels, const double *textu
                 }
             }
         }
-        found |= tt__fft_nonfinite(row + lo, (size_t)(hi - lo + 1));
+        /* the sums are >= 0: a float that overflowed is +infinity, no NaN */
         for (x = lo; x <= hi; x++)
-            if (row[x] < low && (!ok || ok[x])) {
+            if (row[x] < low_float && (!ok || ok[x])) low_float = row[x];
+            else any |= !ok || ok[x];
+    }
+    *best = -1;
+    *best_e = 0.0;
+    if (low_float == (float)HUGE_VAL) return (uint64_t)any;
+    /* a candidate: F - (b + s F) <= L + (b + s L) for its float E F and the
+       smallest L, i.e. F <= (L + 2 b + s L) / (1 - s), rounded up */
+    candidate = (float)((low_float + 2 * slack_base + slack_scale * low_float) / (1 - slack_scale) * (1 + 1e-6));
+    for (y = y_begin; y < y_end; y++) {
+        int lo = span[2 * y], hi = span[2 * y + 1];
+        const unsigned char *ok = allowed ? allowed + (size_t)w * y : NULL;
+        const float *row = rows + (size_t)w * (y - y_begin);
+        for (x = lo; x <= hi; x++) {
+            double e;
+            if (!(row[x] <= candidate) || (ok && !ok[x])) continue;
+            e = tt__xcorr_direct_exact(w, h, texture, terms, x, y);
+            if (e < low) {
                 at = w * y + x;
-                low = row[x];
+                low = e;
             }
+        }
     }
     *best = at;
     *best_e = at < 0 ? 0.0 : low;
-    return found;
+    return at >= 0 && !tt__is_finite_d(low);
 }
 
 TTDEF tt_result tt_xcorr_masked(const tt_xcorr_texture *texture, const double *mask, const double *values,
@@ -15212,11 +15269,11 @@ typedef struct tt__hpm {
     int f, ww, wh, P;           /* box factor, matching copy's size, FFT size */
     float *match;               /* nch planes ww x wh */
     tt_xcorr_texture **tex;     /* `copies` turned copies */
-    double *planes;             /* copies x nch planes P x P: the turned copies themselves, for direct sums */
+    float *planes;              /* copies x nch planes P x P: the turned copies themselves, for direct sums */
     int *span;                  /* copies x P x 2: per copy and row, the run of allowed offsets (first, last) */
-    int *term_at;               /* P x P: the band's pixels in row-major order, for direct sums */
+    int *term_x, *term_y;       /* P x P: the band's pixels in row-major order, for direct sums */
     double *term_weight, *term_values;  /* P x P, nch x P x P: their weights and values */
-    double *row;                /* P: one row of E */
+    float *rows;                /* P x P: E of the direct sums in float */
     double *relax_sides;        /* 3 x TT__HPM_RING_MAX x TT__HPM_SIDE_VALUES: the relaxation's edge samples */
     double *xwork, *mask, *values;
     unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band */
@@ -15366,11 +15423,11 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
     S->tex = TT__ALLOC(S->al, tt_xcorr_texture *, (size_t)S->copies);
     if (S->tex)
         for (k = 0; k < S->copies; k++) S->tex[k] = NULL;
-    S->planes = TT__ALLOC(S->al, double, (size_t)S->copies * S->nch * pp);
+    S->planes = TT__ALLOC(S->al, float, (size_t)S->copies * S->nch * pp);
     if (!S->tex || !S->planes)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (turned copies)");
     for (k = 0; k < S->copies; k++) {
-        double *buffer = S->planes + (size_t)k * S->nch * pp;
+        float *buffer = S->planes + (size_t)k * S->nch * pp;
         double th = S->angle[k], ct = cos(th), st = sin(th);
         double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
         for (y = 0; y < S->P; y++)
@@ -15384,7 +15441,7 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
                     continue;
                 }
                 tt__hpm_sample(S->match, S->ww, S->wh, S->nch, wx, wy, S->toroidal, v);
-                for (c = 0; c < S->nch; c++) buffer[c * pp + at] = v[c];
+                for (c = 0; c < S->nch; c++) buffer[c * pp + at] = (float)v[c];
             }
     }
     S->mask = TT__ALLOC(S->al, double, pp);
@@ -15396,12 +15453,14 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
     S->src = TT__ALLOC(S->al, float, 2 * pp);
     S->band_pixels = TT__ALLOC(S->al, int, pp);
     S->span = TT__ALLOC(S->al, int, 2 * (size_t)S->P * S->copies);
-    S->term_at = TT__ALLOC(S->al, int, pp);
+    S->term_x = TT__ALLOC(S->al, int, pp);
+    S->term_y = TT__ALLOC(S->al, int, pp);
     S->term_weight = TT__ALLOC(S->al, double, pp);
     S->term_values = TT__ALLOC(S->al, double, (size_t)S->nch * pp);
-    S->row = TT__ALLOC(S->al, double, (size_t)S->P);
+    S->rows = TT__ALLOC(S->al, float, pp);
     if (!S->mask || !S->values || !S->support || !S->allowed_mem || !S->allowed || !S->dist ||
-        !S->src || !S->band_pixels || !S->span || !S->term_at || !S->term_weight || !S->term_values || !S->row)
+        !S->src || !S->band_pixels || !S->span || !S->term_x || !S->term_y || !S->term_weight ||
+        !S->term_values || !S->rows)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
     for (k = 0; k < S->copies; k++) S->allowed[k] = S->allowed_mem + (size_t)k * pp;
     return TT_OK;
@@ -16060,14 +16119,21 @@ static int tt__hpm_direct_pays(const tt__hpm *S)
    does). */
 static tt_result tt__hpm_spectra(tt__hpm *S, tt_error *error)
 {
-    size_t plane = (size_t)S->nch * S->P * S->P;
+    size_t plane = (size_t)S->nch * S->P * S->P, i;
     int k;
-    tt_result res;
+    tt_result res = TT_OK;
     if (S->xwork) return TT_OK;
-    for (k = 0; k < S->copies; k++)
-        if ((res = tt_xcorr_texture_create(S->P, S->P, S->nch, S->planes + plane * k, S->al, &S->tex[k], error)) !=
-            TT_OK)
-            return res;
+    /* the copy's planes in double, for tt_xcorr_texture_create; then its
+       work space */
+    S->xwork = TT__ALLOC(S->al, double, plane);
+    if (!S->xwork) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
+    for (k = 0; k < S->copies && res == TT_OK; k++) {
+        for (i = 0; i < plane; i++) S->xwork[i] = S->planes[plane * k + i];
+        res = tt_xcorr_texture_create(S->P, S->P, S->nch, S->xwork, S->al, &S->tex[k], error);
+    }
+    tt__free(S->al, S->xwork);
+    S->xwork = NULL;
+    if (res != TT_OK) return res;
     S->xwork = TT__ALLOC(S->al, double, S->tex[0]->best_work_size);
     if (!S->xwork) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
     return TT_OK;
@@ -16078,12 +16144,13 @@ static tt_result tt__hpm_spectra(tt__hpm *S, tt_error *error)
 static tt_result tt__hpm_correlate_direct(tt__hpm *S, tt_xcorr_match *match, int *best_k, tt_error *error)
 {
     size_t pp = (size_t)S->P * S->P;
+    tt__xcorr_terms terms;
     double mask_sum = 0, energy = 0;
-    int i, c, k;
-    memcpy(S->term_at, S->band_pixels, sizeof(int) * (size_t)S->nband);
-    tt__sort_ints(S->term_at, S->nband);
+    int i, c, k, *sorted = S->term_x;
+    memcpy(sorted, S->band_pixels, sizeof(int) * (size_t)S->nband);
+    tt__sort_ints(sorted, S->nband);
     for (i = 0; i < S->nband; i++) {
-        int at = S->term_at[i];
+        int at = sorted[i];
         S->term_weight[i] = S->mask[at];
         mask_sum += S->mask[at];
         for (c = 0; c < S->nch; c++) {
@@ -16091,7 +16158,16 @@ static tt_result tt__hpm_correlate_direct(tt__hpm *S, tt_xcorr_match *match, int
             S->term_values[(size_t)i * S->nch + c] = v;
             energy += S->mask[at] * v * v;
         }
+        S->term_y[i] = at / S->P;
+        S->term_x[i] = at % S->P;
     }
+    terms.count = S->nband;
+    terms.channels = S->nch;
+    terms.x = S->term_x;
+    terms.y = S->term_y;
+    terms.weight = S->term_weight;
+    terms.values = S->term_values;
+    terms.energy = energy;
     match->x = match->y = -1;
     match->e = 0;
     match->mask_sum = mask_sum;
@@ -16100,9 +16176,8 @@ static tt_result tt__hpm_correlate_direct(tt__hpm *S, tt_xcorr_match *match, int
     for (k = 0; k < S->copies; k++) {
         double e;
         int best;
-        if (tt__xcorr_direct(S->P, S->P, S->nch, S->planes + (size_t)k * S->nch * pp, S->term_at, S->term_weight,
-                             S->term_values, S->nband, S->span + 2 * (size_t)S->P * k, S->allowed[k], 0, S->P,
-                             S->row, &best, &e))
+        if (tt__xcorr_direct(S->P, S->P, S->planes + (size_t)k * S->nch * pp, &terms, S->span + 2 * (size_t)S->P * k,
+                             S->allowed[k], 0, S->P, S->rows, &best, &e))
             return tt__fail_at(error, TT_ERROR_NON_FINITE, k, -1, -1,
                                "the band's sum of squared differences with copy %d overflows", k);
         if (best >= 0 && (*best_k < 0 || e < match->e)) {
@@ -17192,10 +17267,11 @@ static void tt__hpm_release(tt__hpm *S)
     tt__free(S->al, S->band_pixels);
     tt__free(S->al, S->planes);
     tt__free(S->al, S->span);
-    tt__free(S->al, S->term_at);
+    tt__free(S->al, S->term_x);
+    tt__free(S->al, S->term_y);
     tt__free(S->al, S->term_weight);
     tt__free(S->al, S->term_values);
-    tt__free(S->al, S->row);
+    tt__free(S->al, S->rows);
     tt__free(S->al, S->relax_sides);
     tt__free(S->al, S->flat);
     tt__free(S->al, S->uv);
