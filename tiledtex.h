@@ -3583,20 +3583,42 @@ TTDEF float tt_rng_float(tt_rng *rng)
 /* 2. Mesh                                                                  */
 /* ------------------------------------------------------------------------ */
 
-TTDEF int tt_mesh_next(const tt_mesh *mesh, int corner)
+/* tt_mesh_next and tt_mesh_prev for the library's own loops, which pass
+   valid corners: no precondition check, small enough to inline. On a mesh
+   of all triangles or all quads (the usual ones) face f's corners are
+   k f .. k f + k - 1, so the answer is arithmetic, with no face lookup. */
+static int tt__next(const tt_mesh *mesh, int c)
 {
     int face;
+    if (mesh->min_face_size == mesh->max_face_size) {
+        if (mesh->min_face_size == 4) return (c & 3) == 3 ? c - 3 : c + 1;
+        if (mesh->min_face_size == 3) return c % 3 == 2 ? c - 2 : c + 1;
+    }
+    face = mesh->corner_face[c];
+    return c + 1 < mesh->face_start[face + 1] ? c + 1 : mesh->face_start[face];
+}
+
+static int tt__prev(const tt_mesh *mesh, int c)
+{
+    int face;
+    if (mesh->min_face_size == mesh->max_face_size) {
+        if (mesh->min_face_size == 4) return (c & 3) == 0 ? c + 3 : c - 1;
+        if (mesh->min_face_size == 3) return c % 3 == 0 ? c + 2 : c - 1;
+    }
+    face = mesh->corner_face[c];
+    return c > mesh->face_start[face] ? c - 1 : mesh->face_start[face + 1] - 1;
+}
+
+TTDEF int tt_mesh_next(const tt_mesh *mesh, int corner)
+{
     TT_ASSERT(mesh && corner >= 0 && corner < mesh->ncorners);
-    face = mesh->corner_face[corner];
-    return corner + 1 < mesh->face_start[face + 1] ? corner + 1 : mesh->face_start[face];
+    return tt__next(mesh, corner);
 }
 
 TTDEF int tt_mesh_prev(const tt_mesh *mesh, int corner)
 {
-    int face;
     TT_ASSERT(mesh && corner >= 0 && corner < mesh->ncorners);
-    face = mesh->corner_face[corner];
-    return corner > mesh->face_start[face] ? corner - 1 : mesh->face_start[face + 1] - 1;
+    return tt__prev(mesh, corner);
 }
 
 TTDEF void tt_mesh_free(tt_mesh *mesh)
@@ -3811,8 +3833,8 @@ TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
 static double tt__corner_angle(const tt_mesh *mesh, int c)
 {
     const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
-    const float *a = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
-    const float *b = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_prev(mesh, c)];
+    const float *a = mesh->pos + 3 * (size_t)mesh->corner_vert[tt__next(mesh, c)];
+    const float *b = mesh->pos + 3 * (size_t)mesh->corner_vert[tt__prev(mesh, c)];
     double u[3], v[3], cross[3];
     tt__sub3f(a, p, u);
     tt__sub3f(b, p, v);
@@ -3823,7 +3845,7 @@ static double tt__corner_angle(const tt_mesh *mesh, int c)
 TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, const tt_allocator *allocator,
                                   float *corner_normal, tt_error *error)
 {
-    double *face_normal, cos_crease;
+    double *face_normal, *angle, cos_crease;
     int *fan, c, f;
     tt__ok(error);
     if (!mesh || !corner_normal)
@@ -3836,9 +3858,11 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     face_normal = TT__ALLOC(allocator, double, 3 * (size_t)(mesh->nfaces > 0 ? mesh->nfaces : 1));
     fan = TT__ALLOC(allocator, int, mesh->ncorners > 0 ? mesh->ncorners : 1);
-    if (!face_normal || !fan) {
+    angle = TT__ALLOC(allocator, double, mesh->ncorners > 0 ? mesh->ncorners : 1);
+    if (!face_normal || !fan || !angle) {
         tt__free(allocator, face_normal);
         tt__free(allocator, fan);
+        tt__free(allocator, angle);
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for the normals of %d faces",
                         mesh->nfaces);
     }
@@ -3859,13 +3883,14 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
         if (corner_normal[3 * (size_t)c] != TT__NOT_WRITTEN) continue;
         while (guard++ < mesh->ncorners) {
             int back = mesh->twin[start];
-            if (back < 0 || (back = tt_mesh_next(mesh, back)) == c) break;
+            if (back < 0 || (back = tt__next(mesh, back)) == c) break;
             start = back;
         }
         h = start;
         while (h >= 0 && count < mesh->ncorners) {
+            angle[count] = tt__corner_angle(mesh, h);   /* each fan member's weight, once */
             fan[count++] = h;
-            h = mesh->twin[tt_mesh_prev(mesh, h)];
+            h = mesh->twin[tt__prev(mesh, h)];
             if (h == start) break;
         }
         for (i = 0; i < count; i++) {
@@ -3874,12 +3899,10 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
             float *out = corner_normal + 3 * (size_t)fan[i];
             for (j = 0; j < count; j++) {
                 const double *other = face_normal + 3 * (size_t)mesh->corner_face[fan[j]];
-                double weight;
                 if (j != i && tt__dot3(own, other) < cos_crease) continue;
-                weight = tt__corner_angle(mesh, fan[j]);
-                sum[0] += weight * other[0];
-                sum[1] += weight * other[1];
-                sum[2] += weight * other[2];
+                sum[0] += angle[j] * other[0];
+                sum[1] += angle[j] * other[1];
+                sum[2] += angle[j] * other[2];
             }
             length = tt__length3(sum);
             out[0] = length > 0.0 ? (float)(sum[0] / length) : 0.0f;
@@ -3889,6 +3912,7 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
     }
     tt__free(allocator, face_normal);
     tt__free(allocator, fan);
+    tt__free(allocator, angle);
     return TT_OK;
 }
 
@@ -3923,16 +3947,10 @@ static tt_result tt__report_edge_problem(const tt__edge_problem *p, tt_error *er
    manifold exactly when this reaches all of its outgoing half-edges. */
 static int tt__fan_size(const tt_mesh *mesh, int v)
 {
-    /* All triangles or all quads (the usual meshes): prev is arithmetic with
-       a constant divisor, no face lookups. */
     int start = mesh->vert_corner[v], h = start, visited = 1;
-    int k = mesh->min_face_size == mesh->max_face_size ? mesh->min_face_size : 0;
     if (start < 0) return 0;
     while (visited <= mesh->ncorners) {
-        int prev = k == 4 ? ((h & 3) == 0 ? h + 3 : h - 1)
-                 : k == 3 ? (h % 3 == 0 ? h + 2 : h - 1)
-                 : tt_mesh_prev(mesh, h);
-        int next = mesh->twin[prev];
+        int next = mesh->twin[tt__prev(mesh, h)];
         if (next < 0 || next == start) break;
         h = next;
         visited++;
@@ -4541,7 +4559,7 @@ static void tt__valences(const tt_mesh *mesh, int *valence)
     memset(valence, 0, (size_t)mesh->nverts * sizeof(int));
     for (c = 0; c < mesh->ncorners; c++) {
         valence[mesh->corner_vert[c]]++;
-        if (mesh->twin[c] < 0) valence[mesh->corner_vert[tt_mesh_next(mesh, c)]]++;
+        if (mesh->twin[c] < 0) valence[mesh->corner_vert[tt__next(mesh, c)]]++;
     }
 }
 
@@ -4615,10 +4633,10 @@ TTDEF tt_result tt_mesh_boundary_loops(const tt_mesh *mesh, int *corner_loop, in
         /* Follow the boundary: from the end of h, turn around its end vertex
            across interior edges until the outgoing boundary half-edge. */
         for (steps = 0; steps <= mesh->ncorners && corner_loop[h] == -2; steps++) {
-            int x = tt_mesh_next(mesh, h), guard;
+            int x = tt__next(mesh, h), guard;
             corner_loop[h] = count;
             for (guard = 0; guard <= mesh->ncorners && mesh->twin[x] >= 0; guard++)
-                x = tt_mesh_next(mesh, mesh->twin[x]);
+                x = tt__next(mesh, mesh->twin[x]);
             if (mesh->twin[x] >= 0) break;
             h = x;
         }
@@ -9032,7 +9050,7 @@ typedef struct tt__edge_point {
 static int tt__edge_point_at(const tt_mesh *mesh, const float *uv, const tt_image *atlas, int c, float t,
                              tt__edge_point *out)
 {
-    int next = tt_mesh_next(mesh, c), face = mesh->corner_face[c], k, count = 0;
+    int next = tt__next(mesh, c), face = mesh->corner_face[c], k, count = 0;
     float ax = uv[2 * c] * atlas->width, ay = (1.0f - uv[2 * c + 1]) * atlas->height;
     float bx = uv[2 * next] * atlas->width, by = (1.0f - uv[2 * next + 1]) * atlas->height;
     float cx = 0.0f, cy = 0.0f, ex = bx - ax, ey = by - ay, len = sqrtf(ex * ex + ey * ey);
@@ -9077,8 +9095,8 @@ static int tt__uv_coordinate_agrees(float x, float y)
 static int tt__edge_uv_discontinuous(const tt_mesh *mesh, const float *uv, int a)
 {
     int b = mesh->twin[a], ends[2][2], k;
-    ends[0][0] = a; ends[0][1] = tt_mesh_next(mesh, b);
-    ends[1][0] = tt_mesh_next(mesh, a); ends[1][1] = b;
+    ends[0][0] = a; ends[0][1] = tt__next(mesh, b);
+    ends[1][0] = tt__next(mesh, a); ends[1][1] = b;
     for (k = 0; k < 2; k++)
         if (!tt__uv_coordinate_agrees(uv[2 * ends[k][0]], uv[2 * ends[k][1]]) ||
             !tt__uv_coordinate_agrees(uv[2 * ends[k][0] + 1], uv[2 * ends[k][1] + 1]))

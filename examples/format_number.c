@@ -65,9 +65,18 @@ int tool_format_float(float value, char *out)
         return (int)(p - out);
     }
     /* 1. log10(2) ~ 78913 / 2^18; the estimate is the true exponent or one
-       below it (floats span about 10^-45 .. 10^38, well inside the table). */
-    frexp(magnitude, &binary_exponent);
-    binary_exponent -= 1;                               /* 2^be <= |x| < 2^(be+1) */
+       below it (floats span about 10^-45 .. 10^38, well inside the table).
+       The binary exponent is read off the float's bits (frexp for the
+       subnormals, whose field is 0). */
+    {
+        uint32_t bits;
+        memcpy(&bits, &value, sizeof bits);
+        binary_exponent = (int)((bits >> 23) & 0xffu) - 127;   /* 2^be <= |x| < 2^(be+1) */
+        if (binary_exponent == -127) {
+            frexp(magnitude, &binary_exponent);
+            binary_exponent -= 1;
+        }
+    }
     e = binary_exponent >= 0 ? (binary_exponent * 78913) >> 18 : -((-binary_exponent * 78913 + 262143) >> 18);
     /* 2. nine digits; a carry past them (999999999.7 -> 10^9) or an estimate
        one too low moves the exponent up, and the digits are made again. */
@@ -121,10 +130,19 @@ int tool_format_int(long value, char *out)
     char reversed[24];
     unsigned long magnitude = value < 0 ? 0ul - (unsigned long)value : (unsigned long)value;
     int n = 0, length = 0;
-    do {
-        reversed[n++] = (char)('0' + magnitude % 10u);
-        magnitude /= 10u;
-    } while (magnitude > 0);
+    /* Two digits at a time from the table, the last first. */
+    while (magnitude >= 100u) {
+        const char *pair = digit_pairs + 2 * (magnitude % 100u);
+        reversed[n++] = pair[1];
+        reversed[n++] = pair[0];
+        magnitude /= 100u;
+    }
+    if (magnitude >= 10u) {
+        reversed[n++] = digit_pairs[2 * magnitude + 1];
+        reversed[n++] = digit_pairs[2 * magnitude];
+    } else {
+        reversed[n++] = (char)('0' + magnitude);
+    }
     if (value < 0) out[length++] = '-';
     while (n > 0) out[length++] = reversed[--n];
     out[length] = '\0';

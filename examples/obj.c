@@ -867,38 +867,204 @@ static void write_floats(tool_buffer *out, const char *keyword, const float *val
     buffer_append(out, line, length);
 }
 
-/* One corner of an "f" line: " v", " v/vt", " v//vn" or " v/vt/vn", where
-   corner c uses vt c + 1 and vn c + 1. */
-static void write_corner(tool_buffer *out, const obj_write_desc *desc, int c)
+/* With desc->share_equal, each distinct vt (or vn) is written once: a
+   corner's row of floats (u, v and w; or x, y, z), compared bit for bit
+   with the rows before it through a hash table. */
+typedef struct distinct_rows {
+    int count;
+    int *of_corner;         /* per corner: the 0-based index of its row among the distinct ones */
+    int *first_corner;      /* per distinct row: the first corner that has it, in corner order */
+} distinct_rows;
+
+typedef void (*row_reader)(const obj_write_desc *desc, int c, float row[3]);
+
+static void texture_row(const obj_write_desc *desc, int c, float row[3])
 {
-    char text[3 * TOOL_NUMBER_TEXT_SIZE + 3];
+    row[0] = desc->corner_uv[2 * (size_t)c];
+    row[1] = desc->corner_uv[2 * (size_t)c + 1];
+    row[2] = desc->corner_uv_w ? desc->corner_uv_w[c] : 0.0f;
+}
+
+static void normal_row(const obj_write_desc *desc, int c, float row[3])
+{
+    memcpy(row, desc->corner_normal + 3 * (size_t)c, 3 * sizeof(float));
+}
+
+static uint32_t row_hash(const float row[3])
+{
+    uint32_t bits[3], hash = 0x2545f491u;
+    int k;
+    memcpy(bits, row, sizeof bits);
+    for (k = 0; k < 3; k++) {
+        hash = (hash ^ bits[k]) * 0x9e3779b1u;
+        hash ^= hash >> 15;
+    }
+    return hash;
+}
+
+static void distinct_rows_free(distinct_rows *rows)
+{
+    free(rows->of_corner);
+    free(rows->first_corner);
+    memset(rows, 0, sizeof *rows);
+}
+
+/* The row a vertex's last corner had (find_distinct_rows' by_vertex). */
+typedef struct vertex_row {
+    float row[3];
+    int index;              /* its distinct row, or -1: no corner yet */
+} vertex_row;
+
+/* A slot of find_distinct_rows' hash table: a distinct row and its hash,
+   so that probing and growing compare hashes, not rows. */
+typedef struct row_slot {
+    int index;              /* distinct row + 1; 0 = empty */
+    uint32_t hash;
+} row_slot;
+
+/* Returns 0, or -1 when out of memory. The table grows to stay at most
+   half full. With by_vertex a corner first tries the row its vertex's last
+   corner had: a smooth normal is one per vertex, so most corners need no
+   look-up in the table, which starts with room for one row per vertex. */
+static int find_distinct_rows(const obj_write_desc *desc, int ncorners, row_reader read_row, int by_vertex,
+                              distinct_rows *rows)
+{
+    size_t size = 1024, mask, slot;
+    row_slot *table;
+    vertex_row *last = NULL;
+    int c, v;
+    memset(rows, 0, sizeof *rows);
+    while (by_vertex && size < 2 * (size_t)desc->nverts) size *= 2;
+    mask = size - 1;
+    table = (row_slot *)calloc(size, sizeof *table);
+    rows->of_corner = (int *)malloc(((size_t)ncorners + 1) * sizeof(int));
+    rows->first_corner = (int *)malloc(((size_t)ncorners + 1) * sizeof(int));
+    if (by_vertex && (last = (vertex_row *)malloc(((size_t)desc->nverts + 1) * sizeof *last)) != NULL)
+        for (v = 0; v < desc->nverts; v++) last[v].index = -1;
+    if (!table || !rows->of_corner || !rows->first_corner || (by_vertex && !last)) goto failed;
+    for (c = 0; c < ncorners; c++) {
+        float row[3], other[3];
+        vertex_row *at = last ? &last[desc->corner_vert[c]] : NULL;
+        uint32_t hash;
+        int index = -1;
+        read_row(desc, c, row);
+        if (at && at->index >= 0 && memcmp(row, at->row, sizeof row) == 0) {
+            rows->of_corner[c] = at->index;
+            continue;
+        }
+        hash = row_hash(row);
+        for (slot = hash & mask; table[slot].index; slot = (slot + 1) & mask) {
+            if (table[slot].hash != hash) continue;
+            read_row(desc, rows->first_corner[table[slot].index - 1], other);
+            if (memcmp(row, other, sizeof row) == 0) {
+                index = table[slot].index - 1;
+                break;
+            }
+        }
+        if (index < 0) {
+            index = rows->count++;
+            rows->first_corner[index] = c;
+            table[slot].index = index + 1;
+            table[slot].hash = hash;
+            if (2 * (size_t)rows->count > size) {
+                row_slot *grown = (row_slot *)calloc(2 * size, sizeof *grown);
+                size_t k;
+                if (!grown) goto failed;
+                for (k = 0; k < size; k++) {
+                    size_t to = table[k].hash & (2 * size - 1);
+                    if (!table[k].index) continue;
+                    while (grown[to].index) to = (to + 1) & (2 * size - 1);
+                    grown[to] = table[k];
+                }
+                free(table);
+                table = grown;
+                size *= 2;
+                mask = size - 1;
+            }
+        }
+        rows->of_corner[c] = index;
+        if (at) {
+            memcpy(at->row, row, sizeof row);
+            at->index = index;
+        }
+    }
+    free(table);
+    free(last);
+    return 0;
+failed:
+    free(table);
+    free(last);
+    distinct_rows_free(rows);
+    return -1;
+}
+
+/* Where each corner's vt and vn are: corner c uses vt c + 1 and vn c + 1,
+   or with shared rows the one of_corner names. */
+typedef struct corner_refs {
+    const obj_write_desc *desc;
+    const int *texture;     /* of_corner of the vt rows, or NULL: one per corner */
+    const int *normal;      /* of_corner of the vn rows, or NULL */
+} corner_refs;
+
+/* One corner of an "f" line into text: " v", " v/vt", " v//vn" or
+   " v/vt/vn"; returns its length (at most CORNER_TEXT_SIZE). */
+#define CORNER_TEXT_SIZE (3 * TOOL_NUMBER_TEXT_SIZE + 3)
+static int format_corner(const corner_refs *refs, int c, char *text)
+{
+    const obj_write_desc *desc = refs->desc;
     int length;
     text[0] = ' ';
     length = 1 + tool_format_int((long)desc->corner_vert[c] + 1, text + 1);
     if (desc->corner_uv || desc->corner_normal) {
         text[length++] = '/';
-        if (desc->corner_uv) length += tool_format_int((long)c + 1, text + length);
+        if (desc->corner_uv)
+            length += tool_format_int((long)(refs->texture ? refs->texture[c] : c) + 1, text + length);
     }
     if (desc->corner_normal) {
         text[length++] = '/';
-        length += tool_format_int((long)c + 1, text + length);
+        length += tool_format_int((long)(refs->normal ? refs->normal[c] : c) + 1, text + length);
     }
-    buffer_append(out, text, (size_t)length);
+    return length;
 }
 
-/* "f" with corner `first`, then `count` corners from `next` on. */
-static void write_face_corners(tool_buffer *out, const obj_write_desc *desc, int first, int next, int count)
+/* "f" with corner `first`, then `count` corners from `next` on, built in
+   one piece (in a line of up to 8 corners, else corner by corner) and
+   appended once. */
+static void write_face_corners(tool_buffer *out, const corner_refs *refs, int first, int next, int count)
 {
-    int i;
-    buffer_append(out, "f", 1);
-    write_corner(out, desc, first);
-    for (i = 0; i < count; i++) write_corner(out, desc, next + i);
-    buffer_append(out, "\n", 1);
+    char line[2 + 8 * CORNER_TEXT_SIZE];
+    int i, length = 1;
+    line[0] = 'f';
+    length += format_corner(refs, first, line + length);
+    for (i = 0; i < count; i++) {
+        if (length + CORNER_TEXT_SIZE + 1 > (int)sizeof line) {
+            buffer_append(out, line, (size_t)length);
+            length = 0;
+        }
+        length += format_corner(refs, next + i, line + length);
+    }
+    line[length++] = '\n';
+    buffer_append(out, line, (size_t)length);
+}
+
+/* The vt lines (`keyword` "vt") or vn lines ("vn") of every corner in
+   order, or of each distinct row once when `rows` is not NULL. */
+static void write_rows(tool_buffer *out, const obj_write_desc *desc, const char *keyword, int width, int ncorners,
+                       row_reader read_row, const distinct_rows *rows)
+{
+    int n = rows ? rows->count : ncorners, k;
+    for (k = 0; k < n; k++) {
+        float row[3];
+        read_row(desc, rows ? rows->first_corner[k] : k, row);
+        write_floats(out, keyword, row, width);
+    }
 }
 
 int obj_write(tool_buffer *out, const obj_write_desc *desc)
 {
-    int v, f, c = 0, ncorners = 0, previous_group = -1;
+    int v, f, c = 0, ncorners = 0, previous_group = -1, status = 0;
+    distinct_rows textures, normals;
+    corner_refs refs;
     if (!desc || desc->nverts < 0 || desc->nfaces < 0 || (desc->nverts > 0 && !desc->pos) ||
         (desc->nfaces > 0 && !desc->corner_vert) || (!desc->face_size && desc->fixed_face_size < 3 && desc->nfaces > 0))
         return -1;
@@ -921,30 +1087,37 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     for (v = 0; v < desc->nverts; v++) write_floats(out, "v", desc->pos + 3 * (size_t)v, 3);
 
     for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
-    if (desc->corner_uv) {
-        /* One vt per face corner, in corner order: corner c uses vt c + 1. */
-        for (c = 0; c < ncorners; c++) {
-            float uvw[3];
-            uvw[0] = desc->corner_uv[2 * (size_t)c];
-            uvw[1] = desc->corner_uv[2 * (size_t)c + 1];
-            uvw[2] = desc->corner_uv_w ? desc->corner_uv_w[c] : 0.0f;
-            write_floats(out, "vt", uvw, desc->corner_uv_w ? 3 : 2);
-        }
-        c = 0;
+    memset(&textures, 0, sizeof textures);
+    memset(&normals, 0, sizeof normals);
+    if (desc->share_equal && ((desc->corner_uv && find_distinct_rows(desc, ncorners, texture_row, 0, &textures) != 0) ||
+                              (desc->corner_normal && find_distinct_rows(desc, ncorners, normal_row, 1, &normals) != 0))) {
+        distinct_rows_free(&textures);
+        return -1;
     }
-    if (desc->corner_normal) {
-        /* One vn per face corner too: corner c uses vn c + 1. */
-        for (c = 0; c < ncorners; c++) write_floats(out, "vn", desc->corner_normal + 3 * (size_t)c, 3);
-        c = 0;
-    }
+    refs.desc = desc;
+    refs.texture = textures.of_corner;
+    refs.normal = normals.of_corner;
+    /* One vt (and vn) per face corner in corner order, corner c using vt
+       c + 1; or each distinct one once, in the order corners first use it. */
+    if (desc->corner_uv)
+        write_rows(out, desc, "vt", desc->corner_uv_w ? 3 : 2, ncorners, texture_row,
+                   desc->share_equal ? &textures : NULL);
+    if (desc->corner_normal)
+        write_rows(out, desc, "vn", 3, ncorners, normal_row, desc->share_equal ? &normals : NULL);
 
     if (desc->material && !(desc->face_group && desc->group_materials)) write_name_line(out, "usemtl", desc->material);
-    for (f = 0; f < desc->nfaces; f++) {
+    for (f = 0; f < desc->nfaces && status == 0; f++) {
         int size = desc->face_size ? desc->face_size[f] : desc->fixed_face_size, i;
-        if (size < 3) return -1;
+        if (size < 3) {
+            status = -1;
+            break;
+        }
         if (desc->face_group) {
             int group = desc->face_group[f];
-            if (group < 0 || group >= desc->ngroups) return -1;
+            if (group < 0 || group >= desc->ngroups) {
+                status = -1;
+                break;
+            }
             if (group != previous_group) {
                 write_name_line(out, "g", desc->group_names[group]);
                 if (desc->group_materials && desc->group_materials[group])
@@ -953,17 +1126,20 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
             }
         }
         for (i = 0; i < size; i++)
-            if (desc->corner_vert[c + i] < 0 || desc->corner_vert[c + i] >= desc->nverts) return -1;
+            if (desc->corner_vert[c + i] < 0 || desc->corner_vert[c + i] >= desc->nverts) status = -1;
+        if (status != 0) break;
         if (desc->triangles) {
             /* The fan from the first corner, as readers split a polygon
                themselves: each triangle keeps the face's winding. */
-            for (i = 1; i + 1 < size; i++) write_face_corners(out, desc, c, c + i, 2);
+            for (i = 1; i + 1 < size; i++) write_face_corners(out, &refs, c, c + i, 2);
         } else {
-            write_face_corners(out, desc, c, c + 1, size - 1);
+            write_face_corners(out, &refs, c, c + 1, size - 1);
         }
         c += size;
     }
-    return out->failed ? -1 : 0;
+    distinct_rows_free(&textures);
+    distinct_rows_free(&normals);
+    return status != 0 || out->failed ? -1 : 0;
 }
 
 void mtl_add_material(tool_buffer *out, const char *name, const char *texture, int texture_alpha,

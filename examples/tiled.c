@@ -199,6 +199,7 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
     desc.mtllib = mtl_name;
     desc.material = mtl_name ? "tiled" : NULL;
     desc.triangles = triangles;
+    desc.share_equal = 1;
     status = output_add_obj(output, obj_path, &desc);
     free(normals);
     return status;

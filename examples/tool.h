@@ -578,6 +578,11 @@ typedef struct obj_write_desc {
     const char *material;           /* "usemtl NAME" before the faces, or NULL */
     int triangles;                  /* --triangles: each face written as the fan of triangles
                                        (c0, ci, ci+1), with its corners' vt and vn */
+    int share_equal;                /* each distinct vt and vn (equal bit for bit) written once, in
+                                       the order corners first use it: tile's UVs take a few values
+                                       and smooth normals one per vertex, so the file is less than
+                                       half as long. 0: one of each per corner, corner c using
+                                       vt c + 1 and vn c + 1 */
     /* Optional groups: face_group[f] indexes group_names (and group_materials,
        when given); "g NAME" (and "usemtl MATERIAL") is written before every
        run of faces whose group differs from the previous face's. */
@@ -589,7 +594,8 @@ typedef struct obj_write_desc {
 
 /* Append the OBJ text to `out`: "v x y z", then one "vt u v" per face corner
    (when corner_uv is given), one "vn x y z" per face corner (when
-   corner_normal is given), then "f v/vt/vn ..." with 1-based indices. Numbers
+   corner_normal is given) - or each distinct one once (share_equal) -
+   then "f v/vt/vn ..." with 1-based indices. Numbers
    use 9 significant digits (tool_format_float), so floats read back exactly. Returns 0, or -1 on
    an invalid description or when the buffer ran out of memory. */
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
