@@ -14104,6 +14104,12 @@ done:
 
 /* ---- The face-cluster hierarchy (Soler et al. Sec. 3.1; spec D12-D14) ---- */
 
+/* tt_mesh_next and tt_mesh_prev for the triangle meshes this section takes
+   (both entry points check it): triangle f's corners are 3 f .. 3 f + 2,
+   so no face lookup. */
+static int tt__tri_next(int c) { return c % 3 == 2 ? c - 2 : c + 1; }
+static int tt__tri_prev(int c) { return c % 3 == 0 ? c + 2 : c - 1; }
+
 TT__DEFINE_HEAPSORT(tt__sort_ints, int)
 
 /* The hierarchy builder's state. `region[f]` is face f's region at the level
@@ -14157,8 +14163,8 @@ static int tt__hier_border(const tt__hier *H, int id, int c)
 static int tt__hier_next_border(const tt__hier *H, int id, int h)
 {
     const tt_mesh *m = H->mesh;
-    int x = tt_mesh_next(m, h), guard;
-    for (guard = 0; guard < m->ncorners && !tt__hier_border(H, id, x); guard++) x = tt_mesh_next(m, m->twin[x]);
+    int x = tt__tri_next(h), guard;
+    for (guard = 0; guard < m->ncorners && !tt__hier_border(H, id, x); guard++) x = tt__tri_next(m->twin[x]);
     return x;
 }
 
@@ -14410,7 +14416,7 @@ static void tt__hier_loop_control(tt__hier *H, int id, int h0, int mark, int sin
     double perimeter = 0.0;
     for (guard = 0; guard <= m->ncorners && H->cstamp[h] != mark; guard++) {
         const float *a = m->pos + 3 * (size_t)m->corner_vert[h];
-        const float *b = m->pos + 3 * (size_t)m->corner_vert[tt_mesh_next(m, h)];
+        const float *b = m->pos + 3 * (size_t)m->corner_vert[tt__tri_next(h)];
         double d[3];
         H->cstamp[h] = mark;
         H->loopv[len] = m->corner_vert[h];
@@ -14666,7 +14672,7 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
         H.cstamp[c] = 0;
         if (mesh->twin[c] < 0) {
             H.vboundary[mesh->corner_vert[c]] = 1;
-            H.vboundary[mesh->corner_vert[tt_mesh_next(mesh, c)]] = 1;
+            H.vboundary[mesh->corner_vert[tt__tri_next(c)]] = 1;
         }
     }
     for (v = 0; v < H.nv; v++) H.vstart[v + 1] += H.vstart[v];
@@ -15332,7 +15338,8 @@ typedef struct tt__hpm {
     float *rows;                /* P x P: E of the direct sums in float */
     double *relax_sides;        /* 3 x TT__HPM_RING_MAX x TT__HPM_SIDE_VALUES: the relaxation's edge samples */
     double *xwork, *mask, *values;
-    unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band */
+    unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band; 0 outside the canvas */
+    int canvas_w, canvas_h;     /* the last fit's canvas */
     unsigned char *allowed_mem; /* copies x P x P */
     const unsigned char **allowed;
     float *dist;                /* P x P distance to the footprint, canvas texels */
@@ -15367,25 +15374,20 @@ typedef struct tt__hpm {
 
 /* Bilinear sample of nch float planes (w x h, texel i covering [i, i+1)),
    clamped to the edge or wrapped. */
-/* The texel index at or left of f (floor, |f| < 1e9: the conversion
-   truncates towards 0) and the one after it, wrapped to [0, n) or clamped
-   to it. */
-static void tt__hpm_sample_pair(double f, int n, int wrap, int *i0, int *i1)
+/* The texel pair around f (f - 0.5 in texel units) on an axis of n texels,
+   wrapped or clamped, when it leaves the axis: i0 holds floor(f) (|f| <
+   1e9) on entry. */
+static void tt__hpm_sample_edge(int n, int wrap, int *i0, int *i1)
 {
-    int a = (int)f, b;
-    if (a > f) a--;
-    b = a + 1;
-    if (a >= 0 && b < n) {
-        *i0 = a;
-        *i1 = b;
-    } else if (wrap) {
+    int a = *i0;
+    if (wrap) {
         a %= n;
         if (a < 0) a += n;
         *i0 = a;
         *i1 = a + 1 == n ? 0 : a + 1;
     } else {
         *i0 = tt__clamp_i(a, 0, n - 1);
-        *i1 = tt__clamp_i(b, 0, n - 1);
+        *i1 = tt__clamp_i(a + 1, 0, n - 1);
     }
 }
 
@@ -15396,11 +15398,17 @@ static void tt__hpm_sample(const float *planes, int w, int h, int nch, double x,
     size_t plane = (size_t)w * h, r0, r1;
     if (!(fx > -1e9 && fx < 1e9)) fx = 0;
     if (!(fy > -1e9 && fy < 1e9)) fy = 0;
-    tt__hpm_sample_pair(fx, w, wrap, &x0, &x1);
-    tt__hpm_sample_pair(fy, h, wrap, &y0, &y1);
-    /* the fractions from the unwrapped floor, as (int)floor would give it */
-    tx = fx - (double)((int)fx - ((int)fx > fx));
-    ty = fy - (double)((int)fy - ((int)fy > fy));
+    /* floor: the conversion truncates towards 0 */
+    x0 = (int)fx;
+    x0 -= x0 > fx;
+    y0 = (int)fy;
+    y0 -= y0 > fy;
+    tx = fx - x0;
+    ty = fy - y0;
+    x1 = x0 + 1;
+    y1 = y0 + 1;
+    if (x0 < 0 || x1 >= w) tt__hpm_sample_edge(w, wrap, &x0, &x1);
+    if (y0 < 0 || y1 >= h) tt__hpm_sample_edge(h, wrap, &y0, &y1);
     r0 = (size_t)y0 * w;
     r1 = (size_t)y1 * w;
     for (c = 0; c < nch; c++) {
@@ -15519,6 +15527,11 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
         !S->term_values || !S->rows)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
     for (k = 0; k < S->copies; k++) S->allowed[k] = S->allowed_mem + (size_t)k * pp;
+    /* cleared once: each fit clears what the previous one drew */
+    memset(S->mask, 0, sizeof(double) * pp);
+    memset(S->support, 0, pp);
+    memset(S->allowed_mem, 0, pp * (size_t)S->copies);
+    for (k = 0; k < 2 * S->P * S->copies; k++) S->span[k] = k % 2 == 0 ? 0 : -1;
     return TT_OK;
 }
 
@@ -15662,7 +15675,7 @@ static int tt__hpm_owners(tt__hpm *S, int C, int stamp)
                         S->pairs[p + 4] = q[1];
                     }
                 }
-                prev = tt_mesh_prev(m, h);
+                prev = tt__tri_prev(h);
                 h = m->twin[prev];
                 if (h == start) break;
             }
@@ -16081,8 +16094,10 @@ static int tt__hpm_allowed_offsets(tt__hpm *S, int cw, int ch, int has_cont, con
                             if (v > mx[d]) mx[d] = v;
                         }
         int *span = S->span + 2 * (size_t)P * k;
-        memset(a, 0, pp);
+        /* the map is 0 outside the runs: clear the previous fit's */
         for (ty = 0; ty < P; ty++) {
+            if (span[2 * ty + 1] >= span[2 * ty])
+                memset(a + (size_t)ty * P + span[2 * ty], 0, (size_t)(span[2 * ty + 1] - span[2 * ty] + 1));
             span[2 * ty] = 0;
             span[2 * ty + 1] = -1;
         }
@@ -16258,7 +16273,6 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     double s_w = S->s / S->f, area_px = cl->area * S->s * S->s, w_full, w_w, phi, cph, sph, box[4], o[2];
     double cont[2] = {0, 0};
     double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
-    size_t pp = (size_t)S->P * S->P;
     int cw, ch, i, j, k, P = S->P, best_k = -1, has_cont;
     tt__hpm_raster r;
     tt_xcorr_match match = {-1, -1, 0, 0, 0};
@@ -16298,8 +16312,13 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     cw = (int)ceil(box[2] + w_w + 2 - o[0]);
     ch = (int)ceil(box[3] + w_w + 2 - o[1]);
     if (cw >= P || ch >= P) return -1;
-    memset(S->support, 0, pp);
-    memset(S->mask, 0, pp * sizeof(double));
+    /* The mask is 0 and the support clear outside what the previous fit
+       drew: clear that. */
+    for (i = 0; i < S->nband; i++) S->mask[S->band_pixels[i]] = 0;
+    for (j = 0; j < S->canvas_h; j++) memset(S->support + (size_t)j * P, 0, (size_t)S->canvas_w);
+    S->nband = 0;
+    S->canvas_w = cw;
+    S->canvas_h = ch;
     r.S = S;
     r.band = w_w;
     for (i = 0; i < cl->nfaces; i++) {
@@ -16311,11 +16330,10 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
             xy[2 * j] = (float)(s_w * (cph * q[0] - sph * q[1]) - o[0]);
             xy[2 * j + 1] = (float)(s_w * (sph * q[0] + cph * q[1]) - o[1]);
         }
-        tt_raster_triangle(xy, P, P, tt__hpm_raster_footprint, &r);
+        tt_raster_triangle(xy, cw, ch, tt__hpm_raster_footprint, &r);
     }
     tt__hpm_distance(S, cw, ch);
     tt__hpm_near_faces(S, C, stamp, 2 * w_full / S->s);
-    S->nband = 0;
     for (i = 0; i < S->nnear; i++) {
         int g = S->near_faces[i];
         const tt__hpm_owner *O = NULL;
@@ -16480,12 +16498,12 @@ static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
     double ex, ey, len, n[2] = {0, 0};
     if (side == 0) {
         e0 = h;
-        e1 = tt_mesh_next(m, h);
-        apex = tt_mesh_prev(m, h);
+        e1 = tt__tri_next(h);
+        apex = tt__tri_prev(h);
     } else {
-        e0 = tt_mesh_next(m, t); /* the twin runs the other way */
+        e0 = tt__tri_next(t); /* the twin runs the other way */
         e1 = t;
-        apex = tt_mesh_prev(m, t);
+        apex = tt__tri_prev(t);
     }
     a = S->uv + 2 * e0;
     b = S->uv + 2 * e1;
@@ -16551,8 +16569,8 @@ static int tt__hpm_is_border(const tt__hpm *S, int c)
     const tt_mesh *m = S->mesh;
     int t = m->twin[c];
     if (t < 0 || S->owner[m->corner_face[c]] < 0 || S->owner[m->corner_face[t]] < 0) return 0;
-    return !tt__hpm_same_place(S, S->uv + 2 * c, S->uv + 2 * tt_mesh_next(m, t)) ||
-           !tt__hpm_same_place(S, S->uv + 2 * tt_mesh_next(m, c), S->uv + 2 * t);
+    return !tt__hpm_same_place(S, S->uv + 2 * c, S->uv + 2 * tt__tri_next(t)) ||
+           !tt__hpm_same_place(S, S->uv + 2 * tt__tri_next(c), S->uv + 2 * t);
 }
 
 /* Twice the signed area of corner c's triangle in texels, and its stretch:
@@ -16622,7 +16640,7 @@ static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
     do {
         int t;
         corners[n++] = c;
-        t = m->twin[tt_mesh_prev(m, c)];
+        t = m->twin[tt__tri_prev(c)];
         if (t < 0) break;
         c = t;
     } while (c != start && n < room);
@@ -16632,7 +16650,7 @@ static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
         while (n < room) {
             int t = m->twin[c];
             if (t < 0) break;
-            c = tt_mesh_next(m, t);
+            c = tt__tri_next(t);
             if (c == start) break;
             corners[n++] = c;
         }
@@ -16663,7 +16681,7 @@ static int tt__hpm_relax(tt__hpm *S, int C)
             int t = m->twin[c];
             if (t >= 0 && S->owner[m->corner_face[t]] >= 0 && S->owner[m->corner_face[t]] != C) {
                 verts[nverts++] = m->corner_vert[c];
-                verts[nverts++] = m->corner_vert[tt_mesh_next(m, c)];
+                verts[nverts++] = m->corner_vert[tt__tri_next(c)];
             }
         }
     }
@@ -16871,13 +16889,13 @@ static void tt__hpm_smooth(tt__hpm *S, int C)
             size_t v = (size_t)m->corner_vert[c];
             int e[2];
             e[0] = c;
-            e[1] = tt_mesh_prev(m, c);
+            e[1] = tt__tri_prev(c);
             /* an edge C does not have on both sides fixes both its ends */
             for (k = 0; k < 2; k++) {
                 int t = m->twin[e[k]];
                 if (t < 0 || S->owner[m->corner_face[t]] != C) {
                     S->vmark[m->corner_vert[e[k]]] = -1;
-                    S->vmark[m->corner_vert[tt_mesh_next(m, e[k])]] = -1;
+                    S->vmark[m->corner_vert[tt__tri_next(e[k])]] = -1;
                 }
             }
             d[5 * v] = S->uv[2 * c] - S->placed[2 * c];
@@ -16891,8 +16909,8 @@ static void tt__hpm_smooth(tt__hpm *S, int C)
             for (i = 0; i < cl->nfaces; i++) {
                 int f = S->H->faces[cl->first_face + i];
                 for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
-                    size_t v = (size_t)m->corner_vert[c], a = (size_t)m->corner_vert[tt_mesh_next(m, c)],
-                           b = (size_t)m->corner_vert[tt_mesh_prev(m, c)];
+                    size_t v = (size_t)m->corner_vert[c], a = (size_t)m->corner_vert[tt__tri_next(c)],
+                           b = (size_t)m->corner_vert[tt__tri_prev(c)];
                     if (S->vmark[v] != inside) continue;
                     if (k == 0) { /* clear the sums */
                         d[5 * v + 2] = d[5 * v + 3] = d[5 * v + 4] = 0;
@@ -17141,13 +17159,13 @@ oom:
 static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, double out[3][2])
 {
     const tt_mesh *m = S->mesh;
-    int t = m->twin[c], nc = tt_mesh_next(m, c), pc = tt_mesh_prev(m, c), K, ring[TT__HPM_RING_MAX], n, k;
+    int t = m->twin[c], nc = tt__tri_next(c), pc = tt__tri_prev(c), K, ring[TT__HPM_RING_MAX], n, k;
     const double *a, *b, *g;
     double e[2], len, ex[3], ey[3], x, y, l3, cr[3], side;
     if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0) return 0;
-    a = uv + 2 * tt_mesh_next(m, t); /* at corner_vert[c] */
+    a = uv + 2 * tt__tri_next(t); /* at corner_vert[c] */
     b = uv + 2 * t;                  /* at corner_vert[nc] */
-    g = uv + 2 * tt_mesh_prev(m, t);
+    g = uv + 2 * tt__tri_prev(t);
     out[0][0] = a[0];
     out[0][1] = a[1];
     out[1][0] = b[0];
@@ -17288,7 +17306,7 @@ static void tt__hpm_leftovers(tt__hpm *S, double *uv)
                     found = 1;
                     break;
                 }
-                h = m->twin[tt_mesh_prev(m, h)];
+                h = m->twin[tt__tri_prev(h)];
                 if (h == start) break;
             }
             if (!found) {
