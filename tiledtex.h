@@ -16451,7 +16451,7 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    turn are nudged by a few texels when that lowers the colour difference
    across the borders at the vertex: the difference is taken at 8 points of
    each such edge, half a texel on either side of it (where the eye and the
-   seam measure look; tt__hpm_edge_mismatch), and moving the vertex moves
+   seam measure look; tt__hpm_edge_side), and moving the vertex moves
    the points of its edges by (1 - t) of the move - the hat weight of D25.
    Moving both sides, not only C's, halves what is left of the seams (0.30
    to 0.21 on cluster borders of a 20k torus); the neighbour's other
@@ -16482,9 +16482,9 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    The second part is 0 for an exact continuation, where the first is not
    (two places a texel apart differ), so a continuation stays one.
 
-   In two steps, so that the relaxation, which moves one side at a time,
-   samples the other side once: tt__hpm_edge_side samples one side (side 0
-   is h's face, 1 its twin's), at each point its colour half a texel inside
+   In two steps, so that the relaxation and the border choice, which move
+   one side at a time, sample the other side once: tt__hpm_edge_side
+   samples one side (side 0 is h's face, 1 its twin's), at each point its colour half a texel inside
    its face ("in") and half a texel outside ("out": its map continued over
    the edge), TT__HPM_SIDE_VALUES doubles; tt__hpm_edge_compare adds up
    the differences of two sides. */
@@ -16540,14 +16540,6 @@ static double tt__hpm_edge_compare(const tt__hpm *S, const double *side0, const 
     }
     if (continuation) *continuation += cont;
     return TT__HPM_RELAX_ACROSS * across + cont;
-}
-
-static double tt__hpm_edge_mismatch(const tt__hpm *S, int h, double *continuation)
-{
-    double side0[TT__HPM_SIDE_VALUES], side1[TT__HPM_SIDE_VALUES];
-    tt__hpm_edge_side(S, h, 0, side0);
-    tt__hpm_edge_side(S, h, 1, side1);
-    return tt__hpm_edge_compare(S, side0, side1, continuation);
 }
 
 /* 1 when texel positions a and b are the same point of the image (on a
@@ -17198,14 +17190,24 @@ static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, 
     return 1;
 }
 
-/* Mismatch over face f's edges to textured faces (0 where continuous). */
-static double tt__hpm_face_mismatch(const tt__hpm *S, int f)
+/* Mismatch over face f's edges to textured faces (0 where continuous).
+   The faces across them keep their coordinates while f tries its
+   candidates: their sides of the edges are sampled once, into
+   theirs[j * TT__HPM_SIDE_VALUES] for f's corner j (known[j] set). */
+static double tt__hpm_face_mismatch(const tt__hpm *S, int f, double *theirs, int *known)
 {
-    const tt_mesh *m = S->mesh;
-    double sum = 0;
-    int c;
-    for (c = m->face_start[f]; c < m->face_start[f + 1]; c++)
-        if (tt__hpm_is_border(S, c)) sum += tt__hpm_edge_mismatch(S, c, NULL);
+    double sum = 0, mine[TT__HPM_SIDE_VALUES];
+    int j;
+    for (j = 0; j < 3; j++) {
+        int c = 3 * f + j;
+        if (!tt__hpm_is_border(S, c)) continue;
+        if (!known[j]) {
+            tt__hpm_edge_side(S, c, 1, theirs + TT__HPM_SIDE_VALUES * j);
+            known[j] = 1;
+        }
+        tt__hpm_edge_side(S, c, 0, mine);
+        sum += tt__hpm_edge_compare(S, mine, theirs + TT__HPM_SIDE_VALUES * j, NULL);
+    }
     return sum;
 }
 
@@ -17218,12 +17220,15 @@ static void tt__hpm_choose_borders(tt__hpm *S)
         for (f = 0; f < m->nfaces; f++) {
             int first = m->face_start[f], best = -1, C = S->owner[f];
             double old[3][2], cand[3][2], keep[3][2], before, best_cost, st_old, st, unused;
+            double theirs[3 * TT__HPM_SIDE_VALUES];
+            int known[3];
             if (C < 0) continue;
             for (k = 0; k < 3; k++) {
                 old[k][0] = S->uv[2 * (first + k)];
                 old[k][1] = S->uv[2 * (first + k) + 1];
             }
-            before = tt__hpm_face_mismatch(S, f);
+            known[0] = known[1] = known[2] = 0;
+            before = tt__hpm_face_mismatch(S, f, theirs, known);
             if (before <= 0) continue;
             best_cost = before * 0.95; /* a clear gain, not noise */
             (void)tt__hpm_tri_area(S, first, &st_old);
@@ -17245,7 +17250,7 @@ static void tt__hpm_choose_borders(tt__hpm *S)
                 area_n = tt__hpm_tri_area(S, t, &unused);
                 ok = ok && area_f * area_n > 0 && (st <= TT__HPM_RELAX_MAX_STRETCH || st <= st_old);
                 if (ok) {
-                    double cost = tt__hpm_face_mismatch(S, f);
+                    double cost = tt__hpm_face_mismatch(S, f, theirs, known);
                     if (cost < best_cost) {
                         best_cost = cost;
                         best = c;
