@@ -4584,38 +4584,47 @@ TTDEF tt_result tt_mesh_valence_histogram(const tt_mesh *mesh, const tt_allocato
     return TT_OK;
 }
 
+/* The root of face f's set in a union-find forest, halving the path on
+   the way; a root is the smallest face of its set. */
+static int tt__find_root(int *parent, int f)
+{
+    while (parent[f] != f) {
+        parent[f] = parent[parent[f]];
+        f = parent[f];
+    }
+    return f;
+}
+
 TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, const tt_allocator *allocator, int *face_component,
                                    int *ncomponents, tt_error *error)
 {
-    int *queue, f, count = 0;
+    int *parent, f, c, count = 0;
     tt__ok(error);
     if (!mesh || !face_component || !ncomponents)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_mesh_components needs a mesh and both outputs (got NULL)");
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    queue = TT__ALLOC(allocator, int, mesh->nfaces);
-    if (!queue)
+    parent = TT__ALLOC(allocator, int, mesh->nfaces);
+    if (!parent)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory finding components");
-    for (f = 0; f < mesh->nfaces; f++) face_component[f] = -1;
+    /* The faces on either side of every interior edge joined, in one pass
+       over the corners in memory order (a search from face to face jumps
+       about memory: three times slower on a 300k-quad scan); then the
+       components numbered in the order of their first faces, the roots. */
+    for (f = 0; f < mesh->nfaces; f++) parent[f] = f;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], a, b;
+        if (t < c) continue;   /* a boundary, or the pair's other half */
+        a = tt__find_root(parent, mesh->corner_face[c]);
+        b = tt__find_root(parent, mesh->corner_face[t]);
+        if (a != b) parent[a > b ? a : b] = a < b ? a : b;
+    }
     for (f = 0; f < mesh->nfaces; f++) {
-        int head = 0, tail = 0;
-        if (face_component[f] >= 0) continue;
-        face_component[f] = count;
-        queue[tail++] = f;
-        while (head < tail) {
-            int g = queue[head++], c;
-            for (c = mesh->face_start[g]; c < mesh->face_start[g + 1]; c++) {
-                int t = mesh->twin[c];
-                if (t >= 0 && face_component[mesh->corner_face[t]] < 0) {
-                    face_component[mesh->corner_face[t]] = count;
-                    queue[tail++] = mesh->corner_face[t];
-                }
-            }
-        }
-        count++;
+        int root = tt__find_root(parent, f);
+        face_component[f] = root == f ? count++ : face_component[root];
     }
     *ncomponents = count;
-    tt__free(allocator, queue);
+    tt__free(allocator, parent);
     return TT_OK;
 }
 
@@ -9044,29 +9053,49 @@ typedef struct tt__edge_point {
     float nx, ny;     /* unit normal into the face, in pixels */
 } tt__edge_point;
 
-/* The point at parameter t along half-edge c, in atlas pixels, with the unit
-   normal pointing into c's face (toward the face's UV centroid, so the answer
-   does not depend on the face's winding in UV space). */
-static int tt__edge_point_at(const tt_mesh *mesh, const float *uv, const tt_image *atlas, int c, float t,
-                             tt__edge_point *out)
+/* Half-edge c in atlas pixels: from (ax, ay) along (ex, ey), its unit
+   normal (nx, ny) one way or the other, and its face's UV centroid (cx,
+   cy). valid is 0 for an edge of (nearly) no length in the atlas. */
+typedef struct tt__edge_frame {
+    float ax, ay, ex, ey, nx, ny, cx, cy;
+    int valid;
+} tt__edge_frame;
+
+static void tt__edge_frame_of(const tt_mesh *mesh, const float *uv, const tt_image *atlas, int c, tt__edge_frame *f)
 {
     int next = tt__next(mesh, c), face = mesh->corner_face[c], k, count = 0;
-    float ax = uv[2 * c] * atlas->width, ay = (1.0f - uv[2 * c + 1]) * atlas->height;
-    float bx = uv[2 * next] * atlas->width, by = (1.0f - uv[2 * next + 1]) * atlas->height;
-    float cx = 0.0f, cy = 0.0f, ex = bx - ax, ey = by - ay, len = sqrtf(ex * ex + ey * ey);
-    if (!(len > 1e-6f)) return 0;
+    float bx, by, len;
+    f->ax = uv[2 * c] * atlas->width;
+    f->ay = (1.0f - uv[2 * c + 1]) * atlas->height;
+    bx = uv[2 * next] * atlas->width;
+    by = (1.0f - uv[2 * next + 1]) * atlas->height;
+    f->ex = bx - f->ax;
+    f->ey = by - f->ay;
+    len = sqrtf(f->ex * f->ex + f->ey * f->ey);
+    f->valid = len > 1e-6f;
+    if (!f->valid) return;
+    f->cx = 0.0f;
+    f->cy = 0.0f;
     for (k = mesh->face_start[face]; k < mesh->face_start[face + 1]; k++, count++) {
-        cx += uv[2 * k] * atlas->width;
-        cy += (1.0f - uv[2 * k + 1]) * atlas->height;
+        f->cx += uv[2 * k] * atlas->width;
+        f->cy += (1.0f - uv[2 * k + 1]) * atlas->height;
     }
-    cx /= (float)count;
-    cy /= (float)count;
-    out->px = ax + ex * t;
-    out->py = ay + ey * t;
-    out->nx = -ey / len;
-    out->ny = ex / len;
-    if (out->nx * (cx - out->px) + out->ny * (cy - out->py) < 0.0f) { out->nx = -out->nx; out->ny = -out->ny; }
-    return 1;
+    f->cx /= (float)count;
+    f->cy /= (float)count;
+    f->nx = -f->ey / len;
+    f->ny = f->ex / len;
+}
+
+/* The point at parameter t along the edge, with the unit normal pointing
+   into its face (toward the face's UV centroid, so the answer does not
+   depend on the face's winding in UV space). */
+static void tt__edge_point_on(const tt__edge_frame *f, float t, tt__edge_point *out)
+{
+    out->px = f->ax + f->ex * t;
+    out->py = f->ay + f->ey * t;
+    out->nx = f->nx;
+    out->ny = f->ny;
+    if (out->nx * (f->cx - out->px) + out->ny * (f->cy - out->py) < 0.0f) { out->nx = -out->nx; out->ny = -out->ny; }
 }
 
 /* A colour as displayed, `depth` pixels inside the face from edge point p:
@@ -9138,6 +9167,10 @@ static void tt__seam_range(void *context, int begin, int end)
     tt_rng_seed(&rng, job->seed, 0x7365616d73ull /* "seams" */ + 1u + (uint64_t)(begin / TT__SEAM_RANGE));
     for (i = begin; i < end; i++) {
         int a = job->interior[i], b = mesh->twin[a], edge_samples = 0;
+        tt__edge_frame fa, fb, fo;
+        /* The edge's two sides once; the other edge changes at every point. */
+        tt__edge_frame_of(mesh, job->corner_uv, job->atlas, a, &fa);
+        tt__edge_frame_of(mesh, job->corner_uv, job->atlas, b, &fb);
         for (j = 0; j < ppe; j++) {
             float t = ((float)j + tt_rng_float(&rng)) / (float)ppe;
             int other = job->interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(job->ninterior - 1))) %
@@ -9145,10 +9178,12 @@ static void tt__seam_range(void *context, int begin, int end)
             float t_other = tt_rng_float(&rng);
             tt__edge_point pa, pb, po;
             float sa[3], sa_deeper[3], sb[3], so[3];
-            if (!tt__edge_point_at(mesh, job->corner_uv, job->atlas, a, t, &pa) ||
-                !tt__edge_point_at(mesh, job->corner_uv, job->atlas, b, 1.0f - t, &pb) ||
-                !tt__edge_point_at(mesh, job->corner_uv, job->atlas, other, t_other, &po))
-                continue;
+            if (!fa.valid || !fb.valid) continue;
+            tt__edge_frame_of(mesh, job->corner_uv, job->atlas, other, &fo);
+            if (!fo.valid) continue;
+            tt__edge_point_on(&fa, t, &pa);
+            tt__edge_point_on(&fb, 1.0f - t, &pb);
+            tt__edge_point_on(&fo, t_other, &po);
             tt__displayed(job->atlas, job->wrap, &pa, 0.5f, sa);
             tt__displayed(job->atlas, job->wrap, &pa, 1.5f, sa_deeper);
             tt__displayed(job->atlas, job->wrap, &pb, 0.5f, sb);
