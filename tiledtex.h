@@ -18947,16 +18947,97 @@ static int tt__polycube_consistent(const tt_polycube *pc)
     return 1;
 }
 
-TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *mesh, const tt_allocator *allocator,
-                                    tt_surface_point *points, tt_polycube_projection_report *report,
-                                    tt_error *error)
+#define TT__PROJECT_RANGE 4096   /* vertices per task of the projection */
+
+/* The projection of a range of vertices (one task), its counts and
+   distances in its own report. */
+typedef struct tt__project_job {
+    const tt_polycube *pc;
+    const tt_mesh *mesh;
+    const double *normals;
+    tt__voxels grid;
+    tt_surface_point *points;
+    tt_polycube_projection_report *reports;     /* per range; mean_distance holds the sum */
+} tt__project_job;
+
+static void tt__project_range(void *context, int begin, int end)
 {
     /* Spec P11 step 2: the rays' reach, and "on S" */
     const double ray_reach = 3.0, on_surface = 1e-9;
+    const tt__project_job *job = (const tt__project_job *)context;
+    const tt_polycube *polycube = job->pc;
+    const tt_mesh *mesh = job->mesh;
+    const tt__voxels *grid = &job->grid;
+    tt_polycube_projection_report *report = &job->reports[begin / TT__PROJECT_RANGE];
+    int v, a;
+    for (v = begin; v < end; v++) {
+        double g[3], normal[3], d[3], gap[3];
+        const double *n = job->normals + 3 * v;
+        tt__facelet_hit chosen, along, against, any, facing, touching;
+        int near_plane = 0, quad;
+        for (a = 0; a < 3; a++) {
+            g[a] = ((double)mesh->pos[3 * v + a] - polycube->origin[a]) / polycube->h;
+            near_plane |= fabs(g[a] - floor(g[a] + 0.5)) < on_surface;
+            normal[a] = n[a];
+        }
+        tt__normalize3(normal);
+        chosen.found = 0;
+        /* On S already: a point within 1e-9 h of a facelet is within 1e-9 h of a lattice plane, and the
+           facelet's cube is at most one ring from g's. Only facelets facing v's side count, as for the
+           rays: the rim of an open sheet lying on the side face of its slab goes to the slab's top. */
+        if (near_plane) {
+            int center[3], ring;
+            any.found = facing.found = touching.found = 0;
+            tt__polycube_center(grid, g, center);
+            for (ring = 0; ring <= 1; ring++)
+                tt__polycube_scan_ring(grid, center, ring, g, normal, on_surface, &any, &facing, &touching);
+            if (touching.found) {
+                chosen = touching;
+                report->on_surface++;
+            }
+        }
+        if (!chosen.found) {
+            /* The rays along the field, or along n_v where the field vanishes. */
+            tt__polycube_field(grid, g, normal, d);
+            if (tt__normalize3(d) < 1e-6)
+                for (a = 0; a < 3; a++) d[a] = normal[a];
+            along.found = against.found = 0;
+            if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) {
+                tt__polycube_ray(grid, g, d, normal, ray_reach, &along);
+                for (a = 0; a < 3; a++) d[a] = -d[a];
+                tt__polycube_ray(grid, g, d, normal, ray_reach, &against);
+            }
+            if (along.found && (!against.found || along.distance <= against.distance)) chosen = along;
+            else if (against.found) chosen = against;
+            if (chosen.found) report->rays++;
+        }
+        if (!chosen.found) {
+            int is_fallback;
+            chosen = tt__polycube_nearest(grid, g, normal, TT_POLYCUBE_PROJECT_SIDE_REACH, &is_fallback);
+            if (is_fallback) report->fallbacks++;
+            else report->nearest++;
+        }
+        quad = tt__polycube_find_quad(polycube, chosen.cube, chosen.side);
+        TT_ASSERT(quad >= 0);   /* tt__polycube_consistent: every exposed face has its quad */
+        job->points[v] = tt__polycube_surface_point(polycube, quad, chosen.point);
+        for (a = 0; a < 3; a++) gap[a] = g[a] - chosen.point[a];
+        chosen.distance = tt__length3(gap);
+        report->mean_distance += chosen.distance;
+        if (chosen.distance > report->max_distance) report->max_distance = chosen.distance;
+    }
+}
+
+/* tt_polycube_project, its vertices in ranges of TT__PROJECT_RANGE, each a
+   task on the executor, the ranges' counts and distances added in range
+   order: the same points and report with any executor. */
+static tt_result tt__polycube_project(const tt_polycube *polycube, const tt_mesh *mesh, const tt_executor *executor,
+                                      const tt_allocator *allocator, tt_surface_point *points,
+                                      tt_polycube_projection_report *report, tt_error *error)
+{
     tt_polycube_projection_report local;
-    tt__voxels grid;
+    tt__project_job job;
     double *normals, distance_sum = 0.0;
-    int v, f, a;
+    int v, f, a, r, nranges;
     tt__ok(error);
     if (!report) report = &local;
     memset(report, 0, sizeof *report);
@@ -18974,9 +19055,14 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
             if (!tt__is_finite(mesh->pos[3 * v + a]))
                 return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, v, -1, "vertex %d has a coordinate %g", v,
                                 (double)mesh->pos[3 * v + a]);
+    nranges = tt__range_count(mesh->nverts, TT__PROJECT_RANGE);
     normals = TT__ALLOC(allocator, double, (size_t)mesh->nverts * 3);
-    if (!normals)
+    job.reports = TT__ALLOC(allocator, tt_polycube_projection_report, nranges > 0 ? nranges : 1);
+    if (!normals || !job.reports) {
+        tt__free(allocator, normals);
+        tt__free(allocator, job.reports);
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory projecting onto the polycube");
+    }
 
     /* n_v: the sum of the Newell vectors (twice the area times the normal) of the faces around v. */
     memset(normals, 0, sizeof(double) * 3 * (size_t)mesh->nverts);
@@ -18988,68 +19074,36 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
             for (a = 0; a < 3; a++) normals[3 * mesh->corner_vert[c] + a] += n[a];
     }
 
-    memset(&grid, 0, sizeof grid);
-    for (a = 0; a < 3; a++) grid.dims[a] = polycube->dims[a];
-    grid.count = grid.dims[0] * grid.dims[1] * grid.dims[2];
-    grid.occupied = polycube->occupied;
-
-    for (v = 0; v < mesh->nverts; v++) {
-        double g[3], normal[3], d[3], *n = normals + 3 * v, gap[3];
-        tt__facelet_hit chosen, along, against, any, facing, touching;
-        int near_plane = 0, quad;
-        for (a = 0; a < 3; a++) {
-            g[a] = ((double)mesh->pos[3 * v + a] - polycube->origin[a]) / polycube->h;
-            near_plane |= fabs(g[a] - floor(g[a] + 0.5)) < on_surface;
-            normal[a] = n[a];
-        }
-        tt__normalize3(normal);
-        chosen.found = 0;
-        /* On S already: a point within 1e-9 h of a facelet is within 1e-9 h of a lattice plane, and the
-           facelet's cube is at most one ring from g's. Only facelets facing v's side count, as for the
-           rays: the rim of an open sheet lying on the side face of its slab goes to the slab's top. */
-        if (near_plane) {
-            int center[3], ring;
-            any.found = facing.found = touching.found = 0;
-            tt__polycube_center(&grid, g, center);
-            for (ring = 0; ring <= 1; ring++)
-                tt__polycube_scan_ring(&grid, center, ring, g, normal, on_surface, &any, &facing, &touching);
-            if (touching.found) {
-                chosen = touching;
-                report->on_surface++;
-            }
-        }
-        if (!chosen.found) {
-            /* The rays along the field, or along n_v where the field vanishes. */
-            tt__polycube_field(&grid, g, normal, d);
-            if (tt__normalize3(d) < 1e-6)
-                for (a = 0; a < 3; a++) d[a] = normal[a];
-            along.found = against.found = 0;
-            if (d[0] != 0.0 || d[1] != 0.0 || d[2] != 0.0) {
-                tt__polycube_ray(&grid, g, d, normal, ray_reach, &along);
-                for (a = 0; a < 3; a++) d[a] = -d[a];
-                tt__polycube_ray(&grid, g, d, normal, ray_reach, &against);
-            }
-            if (along.found && (!against.found || along.distance <= against.distance)) chosen = along;
-            else if (against.found) chosen = against;
-            if (chosen.found) report->rays++;
-        }
-        if (!chosen.found) {
-            int is_fallback;
-            chosen = tt__polycube_nearest(&grid, g, normal, TT_POLYCUBE_PROJECT_SIDE_REACH, &is_fallback);
-            if (is_fallback) report->fallbacks++;
-            else report->nearest++;
-        }
-        quad = tt__polycube_find_quad(polycube, chosen.cube, chosen.side);
-        TT_ASSERT(quad >= 0);   /* tt__polycube_consistent: every exposed face has its quad */
-        points[v] = tt__polycube_surface_point(polycube, quad, chosen.point);
-        for (a = 0; a < 3; a++) gap[a] = g[a] - chosen.point[a];
-        chosen.distance = tt__length3(gap);
-        distance_sum += chosen.distance;
-        if (chosen.distance > report->max_distance) report->max_distance = chosen.distance;
+    memset(&job.grid, 0, sizeof job.grid);
+    for (a = 0; a < 3; a++) job.grid.dims[a] = polycube->dims[a];
+    job.grid.count = job.grid.dims[0] * job.grid.dims[1] * job.grid.dims[2];
+    job.grid.occupied = polycube->occupied;
+    job.pc = polycube;
+    job.mesh = mesh;
+    job.normals = normals;
+    job.points = points;
+    memset(job.reports, 0, sizeof(tt_polycube_projection_report) * (size_t)(nranges > 0 ? nranges : 1));
+    tt__parallel_ranges(executor, mesh->nverts, TT__PROJECT_RANGE, tt__project_range, &job);
+    for (r = 0; r < nranges; r++) {
+        const tt_polycube_projection_report *part = &job.reports[r];
+        report->rays += part->rays;
+        report->nearest += part->nearest;
+        report->fallbacks += part->fallbacks;
+        report->on_surface += part->on_surface;
+        distance_sum += part->mean_distance;
+        if (part->max_distance > report->max_distance) report->max_distance = part->max_distance;
     }
     report->mean_distance = mesh->nverts > 0 ? distance_sum / mesh->nverts : 0.0;
     tt__free(allocator, normals);
+    tt__free(allocator, job.reports);
     return TT_OK;
+}
+
+TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *mesh, const tt_allocator *allocator,
+                                    tt_surface_point *points, tt_polycube_projection_report *report,
+                                    tt_error *error)
+{
+    return tt__polycube_project(polycube, mesh, NULL, allocator, points, report, error);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -19620,106 +19674,78 @@ TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges)
     tt__free(&allocator, edges);
 }
 
-/* tt_polycube_trace_edges, or, given the records `previous` made from the
-   same mesh and the same points except those of the vertices flagged in
-   `moved`, a copy of those records with only the edges at a moved vertex
-   traced again. */
-static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mesh, const tt_surface_point *points,
-                                 int npoints, const tt_polycube_edge_options *options,
-                                 const tt_allocator *allocator, const tt_polycube_edges *previous,
-                                 const unsigned char *moved, tt_polycube_edges **out, tt_error *error)
+#define TT__TRACE_RANGE 2048     /* edges per task of the tracing */
+
+/* The tracing of a range of edges (one task): the edges traced again put
+   their crossings here, their counts in first_crossing[e] (made offsets
+   afterwards). */
+typedef struct tt__trace_range {
+    tt_edge_crossing *crossings;
+    int ncrossings, capacity, nfailed, failed;  /* failed: out of memory */
+} tt__trace_range;
+
+typedef struct tt__trace_job {
+    const tt_polycube *pc;
+    const tt_mesh *mesh;
+    const tt_surface_point *points;
+    const tt_polycube_edges *previous;
+    const unsigned char *moved;
+    const tt_allocator *allocator;
+    int max_quads;
+    tt_polycube_edges *E;
+    tt__trace_range *ranges;
+} tt__trace_job;
+
+/* Whether edge e keeps its record from `previous` (neither end moved). */
+static int tt__trace_kept(const tt__trace_job *job, int e)
 {
-    tt_polycube_edges *E = NULL;
-    tt__edge_search *S = NULL;
-    int max_quads = options && options->max_quads ? options->max_quads : TT_POLYCUBE_EDGE_DEFAULT_QUADS;
-    int c, v, e, capacity = 0;
-    tt__ok(error);
-    if (out) *out = NULL;
-    if (!polycube || !mesh || !points || !out)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_polycube_trace_edges needs a polycube, a mesh, points and out (got NULL)");
-    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (options && (options->max_quads < 0 || options->max_quads > TT_POLYCUBE_EDGE_MAX_QUADS))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_quads %d is outside 0..%d",
-                        options->max_quads, TT_POLYCUBE_EDGE_MAX_QUADS);
-    if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
-    if (npoints != mesh->nverts)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "%d points for a mesh of %d vertices: give one point per vertex", npoints, mesh->nverts);
-    if (!tt__polycube_consistent(polycube))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the polycube's surface has no quads or does not match its cubes: make it with "
-                        "tt_polycube_build and leave it unchanged");
-    for (v = 0; v < npoints; v++)
-        if (points[v].quad < 0 || points[v].quad >= polycube->surface->nfaces || !(points[v].s >= 0.0f) ||
-            !(points[v].s <= 1.0f) || !(points[v].t >= 0.0f) || !(points[v].t <= 1.0f))
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, v, -1,
-                            "the point of vertex %d (quad %d, s %g, t %g) is not on S: the quad must be one of "
-                            "S's %d and s, t in [0, 1]", v, points[v].quad, (double)points[v].s,
-                            (double)points[v].t, polycube->surface->nfaces);
+    return job->previous && !job->moved[job->E->edge_vertices[2 * e]] && !job->moved[job->E->edge_vertices[2 * e + 1]];
+}
 
-    E = TT__ALLOC(allocator, tt_polycube_edges, 1);
-    if (!E) goto out_of_memory;
-    memset(E, 0, sizeof *E);
-    E->allocator = tt__allocator_copy(allocator);
-    S = TT__ALLOC(allocator, tt__edge_search, 1);
-    if (!S) goto out_of_memory;
-    /* One edge per twin pair, numbered in order of its first half-edge. */
-    E->edge_of_halfedge = TT__ALLOC(allocator, int, mesh->ncorners);
-    if (!E->edge_of_halfedge) goto out_of_memory;
-    for (c = 0; c < mesh->ncorners; c++) {
-        int twin = mesh->twin[c];
-        E->edge_of_halfedge[c] = twin >= 0 && twin < c ? E->edge_of_halfedge[twin] : E->nedges++;
+static void tt__trace_range_task(void *context, int begin, int end)
+{
+    const tt__trace_job *job = (const tt__trace_job *)context;
+    const tt_polycube *polycube = job->pc;
+    const tt_mesh *mesh = job->mesh;
+    tt_polycube_edges *E = job->E;
+    tt__trace_range *R = &job->ranges[begin / TT__TRACE_RANGE];
+    tt__edge_search *S = TT__ALLOC(job->allocator, tt__edge_search, 1);
+    int e;
+    if (!S) {
+        R->failed = 1;
+        return;
     }
-    E->edge_vertices = TT__ALLOC(allocator, int, (size_t)E->nedges * 2);
-    E->first_crossing = TT__ALLOC(allocator, int, (size_t)E->nedges + 1);
-    E->failed = TT__ALLOC(allocator, unsigned char, E->nedges);
-    E->end_quads = TT__ALLOC(allocator, int, (size_t)E->nedges * 2);
-    if (!E->edge_vertices || !E->first_crossing || !E->failed || !E->end_quads) goto out_of_memory;
-    for (c = 0; c < mesh->ncorners; c++) {
-        int f = mesh->corner_face[c], next = c + 1 < mesh->face_start[f + 1] ? c + 1 : mesh->face_start[f];
-        int from = mesh->corner_vert[c], to = mesh->corner_vert[next];
-        e = E->edge_of_halfedge[c];
-        E->edge_vertices[2 * e] = from < to ? from : to;
-        E->edge_vertices[2 * e + 1] = from < to ? to : from;
-    }
-
     memset(S, 0, sizeof *S);
     S->pc = polycube;
-    S->max_quads = max_quads;
-    for (e = 0; e < E->nedges; e++) {
-        tt_surface_point qa = points[E->edge_vertices[2 * e]], qb = points[E->edge_vertices[2 * e + 1]];
+    S->max_quads = job->max_quads;
+    for (e = begin; e < end; e++) {
+        tt_surface_point qa = job->points[E->edge_vertices[2 * e]], qb = job->points[E->edge_vertices[2 * e + 1]];
         const tt_edge_crossing *crossing = S->best_crossings;
         int count, i;
-        E->first_crossing[e] = E->ncrossings;
-        if (previous && !moved[E->edge_vertices[2 * e]] && !moved[E->edge_vertices[2 * e + 1]]) {
-            const int first = previous->first_crossing[e];
-            count = previous->first_crossing[e + 1] - first;
-            if (count > 0) {
-                tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(allocator, E->crossings, &capacity,
-                                                                       E->ncrossings + count, sizeof(tt_edge_crossing));
-                if (!grown) goto out_of_memory;
-                E->crossings = grown;
-                memcpy(E->crossings + E->ncrossings, previous->crossings + first, sizeof(tt_edge_crossing) * (size_t)count);
-                E->ncrossings += count;
-            }
+        if (tt__trace_kept(job, e)) {
+            const tt_polycube_edges *previous = job->previous;
+            E->first_crossing[e] = previous->first_crossing[e + 1] - previous->first_crossing[e];
             E->end_quads[2 * e] = previous->end_quads[2 * e];
             E->end_quads[2 * e + 1] = previous->end_quads[2 * e + 1];
             E->failed[e] = previous->failed[e];
-            E->nfailed += E->failed[e];
+            R->nfailed += E->failed[e];
             continue;
         }
+        E->first_crossing[e] = 0;
         E->failed[e] = !tt__edge_find_path(S, qa, qb, E->end_quads + 2 * e);
         if (E->failed[e]) {
-            E->nfailed++;
+            R->nfailed++;
             continue;
         }
-        count = S->best_count - 1;
+        count = E->first_crossing[e] = S->best_count - 1;
         if (count > 0) {
-            tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(allocator, E->crossings, &capacity,
-                                                                   E->ncrossings + count, sizeof(tt_edge_crossing));
-            if (!grown) goto out_of_memory;
-            E->crossings = grown;
+            tt_edge_crossing *grown = (tt_edge_crossing *)tt__grow(job->allocator, R->crossings, &R->capacity,
+                                                                   R->ncrossings + count, sizeof(tt_edge_crossing));
+            if (!grown) {
+                R->failed = 1;
+                break;
+            }
+            R->crossings = grown;
         }
         {
             /* P11 step 4.5, once per edge: no zero-length piece next to a vertex or a quad corner. Besides t
@@ -19751,19 +19777,125 @@ static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mes
                     snapped.t = 1.0;
                 /* Two crossings this close pass one S vertex: one split point (their 3D points would round
                    to one). */
-                if (i > 0 && (snapped.t - E->crossings[E->ncrossings - 1].t) * length3 <= TT__EDGE_SNAP)
-                    snapped.t = E->crossings[E->ncrossings - 1].t;
-                E->crossings[E->ncrossings++] = snapped;
+                if (i > 0 && (snapped.t - R->crossings[R->ncrossings - 1].t) * length3 <= TT__EDGE_SNAP)
+                    snapped.t = R->crossings[R->ncrossings - 1].t;
+                R->crossings[R->ncrossings++] = snapped;
                 map = tt_quad_map_compose(map, tt_polycube_unfold(polycube, crossing[i].halfedge));
             }
         }
     }
+    tt__free(job->allocator, S);
+}
+
+/* tt_polycube_trace_edges, or, given the records `previous` made from the
+   same mesh and the same points except those of the vertices flagged in
+   `moved`, a copy of those records with only the edges at a moved vertex
+   traced again. The edges are traced in ranges of TT__TRACE_RANGE, each a
+   task on the executor; each edge's record depends on its two points
+   alone, so the records are the same with any executor. */
+static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mesh, const tt_surface_point *points,
+                                 int npoints, const tt_polycube_edge_options *options, const tt_executor *executor,
+                                 const tt_allocator *allocator, const tt_polycube_edges *previous,
+                                 const unsigned char *moved, tt_polycube_edges **out, tt_error *error)
+{
+    tt_polycube_edges *E = NULL;
+    tt__trace_job job;
+    int max_quads = options && options->max_quads ? options->max_quads : TT_POLYCUBE_EDGE_DEFAULT_QUADS;
+    int c, v, e, r, nranges = 0, failed = 0;
+    size_t total = 0;
+    tt__ok(error);
+    memset(&job, 0, sizeof job);
+    if (out) *out = NULL;
+    if (!polycube || !mesh || !points || !out)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_trace_edges needs a polycube, a mesh, points and out (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (options && (options->max_quads < 0 || options->max_quads > TT_POLYCUBE_EDGE_MAX_QUADS))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_quads %d is outside 0..%d",
+                        options->max_quads, TT_POLYCUBE_EDGE_MAX_QUADS);
+    if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    if (npoints != mesh->nverts)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "%d points for a mesh of %d vertices: give one point per vertex", npoints, mesh->nverts);
+    if (!tt__polycube_consistent(polycube))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the polycube's surface has no quads or does not match its cubes: make it with "
+                        "tt_polycube_build and leave it unchanged");
+    for (v = 0; v < npoints; v++)
+        if (points[v].quad < 0 || points[v].quad >= polycube->surface->nfaces || !(points[v].s >= 0.0f) ||
+            !(points[v].s <= 1.0f) || !(points[v].t >= 0.0f) || !(points[v].t <= 1.0f))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, v, -1,
+                            "the point of vertex %d (quad %d, s %g, t %g) is not on S: the quad must be one of "
+                            "S's %d and s, t in [0, 1]", v, points[v].quad, (double)points[v].s,
+                            (double)points[v].t, polycube->surface->nfaces);
+
+    E = TT__ALLOC(allocator, tt_polycube_edges, 1);
+    if (!E) goto out_of_memory;
+    memset(E, 0, sizeof *E);
+    E->allocator = tt__allocator_copy(allocator);
+    /* One edge per twin pair, numbered in order of its first half-edge. */
+    E->edge_of_halfedge = TT__ALLOC(allocator, int, mesh->ncorners);
+    if (!E->edge_of_halfedge) goto out_of_memory;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int twin = mesh->twin[c];
+        E->edge_of_halfedge[c] = twin >= 0 && twin < c ? E->edge_of_halfedge[twin] : E->nedges++;
+    }
+    E->edge_vertices = TT__ALLOC(allocator, int, (size_t)E->nedges * 2);
+    E->first_crossing = TT__ALLOC(allocator, int, (size_t)E->nedges + 1);
+    E->failed = TT__ALLOC(allocator, unsigned char, E->nedges);
+    E->end_quads = TT__ALLOC(allocator, int, (size_t)E->nedges * 2);
+    if (!E->edge_vertices || !E->first_crossing || !E->failed || !E->end_quads) goto out_of_memory;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int f = mesh->corner_face[c], next = c + 1 < mesh->face_start[f + 1] ? c + 1 : mesh->face_start[f];
+        int from = mesh->corner_vert[c], to = mesh->corner_vert[next];
+        e = E->edge_of_halfedge[c];
+        E->edge_vertices[2 * e] = from < to ? from : to;
+        E->edge_vertices[2 * e + 1] = from < to ? to : from;
+    }
+
+    nranges = tt__range_count(E->nedges, TT__TRACE_RANGE);
+    job.ranges = TT__ALLOC(allocator, tt__trace_range, nranges > 0 ? nranges : 1);
+    if (!job.ranges) goto out_of_memory;
+    memset(job.ranges, 0, sizeof(tt__trace_range) * (size_t)(nranges > 0 ? nranges : 1));
+    job.pc = polycube;
+    job.mesh = mesh;
+    job.points = points;
+    job.previous = previous;
+    job.moved = moved;
+    job.allocator = allocator;
+    job.max_quads = max_quads;
+    job.E = E;
+    tt__parallel_ranges(executor, E->nedges, TT__TRACE_RANGE, tt__trace_range_task, &job);
+    /* The ranges' crossings, and the ones kept from `previous`, one after the other in edge order. */
+    for (r = 0; r < nranges; r++) failed |= job.ranges[r].failed;
+    for (e = 0; e < E->nedges && !failed; e++) total += (size_t)E->first_crossing[e];
+    if (failed || total > INT_MAX) goto out_of_memory;
+    E->ncrossings = (int)total;
+    E->crossings = TT__ALLOC(allocator, tt_edge_crossing, total > 0 ? total : 1);
+    if (!E->crossings) goto out_of_memory;
+    total = 0;
+    for (r = 0; r < nranges; r++) {
+        const tt__trace_range *R = &job.ranges[r];
+        int taken = 0;
+        E->nfailed += R->nfailed;
+        for (e = r * TT__TRACE_RANGE; e < E->nedges && e < (r + 1) * TT__TRACE_RANGE; e++) {
+            const int count = E->first_crossing[e], kept = tt__trace_kept(&job, e);
+            const tt_edge_crossing *from =
+                kept ? previous->crossings + previous->first_crossing[e] : R->crossings + taken;
+            if (!kept) taken += count;
+            E->first_crossing[e] = (int)total;
+            if (count > 0) memcpy(E->crossings + total, from, sizeof(tt_edge_crossing) * (size_t)count);
+            total += (size_t)count;
+        }
+    }
     E->first_crossing[E->nedges] = E->ncrossings;
-    tt__free(allocator, S);
+    for (r = 0; r < nranges; r++) tt__free(allocator, job.ranges[r].crossings);
+    tt__free(allocator, job.ranges);
     *out = E;
     return TT_OK;
 out_of_memory:
-    tt__free(allocator, S);
+    for (r = 0; job.ranges && r < nranges; r++) tt__free(allocator, job.ranges[r].crossings);
+    tt__free(allocator, job.ranges);
     tt_polycube_edges_free(E);
     return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory tracing the mesh's edges on S");
 }
@@ -19773,18 +19905,19 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
                                         const tt_polycube_edge_options *options, const tt_allocator *allocator,
                                         tt_polycube_edges **out, tt_error *error)
 {
-    return tt__trace_edges(polycube, mesh, points, npoints, options, allocator, NULL, NULL, out, error);
+    return tt__trace_edges(polycube, mesh, points, npoints, options, NULL, allocator, NULL, NULL, out, error);
 }
 
 /* *edges replaced by records whose edges at the points flagged in moved[]
    are traced again (tt__trace_edges); on failure *edges stays. */
 static tt_result tt__retrace_moved(const tt_polycube *polycube, const tt_mesh *mesh, const tt_surface_point *points,
-                                   const tt_polycube_edge_options *options, const tt_allocator *allocator,
-                                   const unsigned char *moved, tt_polycube_edges **edges, tt_error *error)
+                                   const tt_polycube_edge_options *options, const tt_executor *executor,
+                                   const tt_allocator *allocator, const unsigned char *moved,
+                                   tt_polycube_edges **edges, tt_error *error)
 {
     tt_polycube_edges *again = NULL;
-    tt_result result = tt__trace_edges(polycube, mesh, points, mesh->nverts, options, allocator, *edges, moved, &again,
-                                       error);
+    tt_result result = tt__trace_edges(polycube, mesh, points, mesh->nverts, options, executor, allocator, *edges,
+                                       moved, &again, error);
     if (result != TT_OK) return result;
     tt_polycube_edges_free(*edges);
     *edges = again;
@@ -21497,15 +21630,27 @@ typedef struct tt__clip_point {
     double bound;
 } tt__clip_point;
 
+/* The split of a range of triangles (one task of tt_polycube_map's split;
+   see tt__split_range). Output vertices are named by tokens while a task
+   runs: a model vertex by its index, a split point of the records by
+   token_crossing + the index of its crossing (the first at its t), a
+   vertex the task makes by token_local + its index in `out`, the task's
+   own vertices and triangles, which the ranges' merge, in triangle order,
+   turns into the mapping's (tt__split_merge). */
 typedef struct tt__split {
     const tt_polycube *pc;
     const tt_mesh *mesh;
     const tt_polycube_edges *edges;
     const tt_surface_point *points;
+    const int *crossing_edge;   /* per crossing of the records: its edge */
     const tt_allocator *allocator;
-    tt_polycube_mapping *out;
+    int token_crossing, token_local;
+    tt_polycube_mapping *out;   /* the task's vertices and triangles (theirs with tokens) */
     int vertex_capacity, triangle_capacity;
-    int *crossing_vertex;       /* per crossing of the records: its output vertex, -1 until made */
+    int *requests, nrequests, request_capacity; /* the split points the triangles asked for, in order */
+    int *face_ends;             /* per triangle of the range: where its vertices, triangles, requests end in
+                                   the task's arrays, and whether it fell back: 4 each */
+    int failed;                 /* out of memory */
     /* One triangle at a time: */
     int vert[3];
     double corner[3][2];        /* its vertices in the chart */
@@ -21519,96 +21664,154 @@ typedef struct tt__split {
     int ngrid, grid_capacity;
 } tt__split;
 
-/* A new output vertex interpolating up to three input vertices; -1 when out of memory. */
-static int tt__split_vertex(tt__split *S, const int source[3], const double weight[3])
+/* The data of an output vertex interpolating up to three input vertices. */
+static void tt__split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
+                                  float weight_out[3])
 {
-    tt_polycube_mapping *m = S->out;
-    int capacity = S->vertex_capacity, k, a;
     double p[3] = {0.0, 0.0, 0.0};
-    if (m->nverts >= INT_MAX / 3 - 1) return -1;
-    if (m->nverts == capacity) {
-        /* Each array grows from the same old capacity; a failure leaves the arrays as they were, all owned. */
-        float *positions, *weights;
-        int *sources;
-        capacity = S->vertex_capacity;
-        positions = (float *)tt__grow(S->allocator, m->positions, &capacity, m->nverts + 1, 3 * sizeof(float));
-        if (!positions) return -1;
-        m->positions = positions;
-        capacity = S->vertex_capacity;
-        sources = (int *)tt__grow(S->allocator, m->source, &capacity, m->nverts + 1, 3 * sizeof(int));
-        if (!sources) return -1;
-        m->source = sources;
-        capacity = S->vertex_capacity;
-        weights = (float *)tt__grow(S->allocator, m->weights, &capacity, m->nverts + 1, 3 * sizeof(float));
-        if (!weights) return -1;
-        m->weights = weights;
-        S->vertex_capacity = capacity;
-    }
+    int k, a;
     for (k = 0; k < 3; k++) {
-        m->source[3 * m->nverts + k] = source[k];
-        m->weights[3 * m->nverts + k] = (float)weight[k];
-        for (a = 0; a < 3; a++) p[a] += weight[k] * S->mesh->pos[3 * source[k] + a];
+        weight_out[k] = (float)weight[k];
+        for (a = 0; a < 3; a++) p[a] += weight[k] * mesh->pos[3 * source[k] + a];
     }
-    for (a = 0; a < 3; a++) m->positions[3 * m->nverts + a] = (float)p[a];
-    return m->nverts++;
+    for (a = 0; a < 3; a++) position[a] = (float)p[a];
 }
 
-/* A new output triangle in `quad`; 0 when out of memory. */
-static int tt__split_triangle(tt__split *S, int face, int quad, const int vertex[3], double st[3][2])
+/* Vertex (position, source, weight) appended to mapping m, whose vertex
+   arrays hold *capacity; 0 when out of memory (the arrays stay as they
+   were, all owned). */
+static int tt__mapping_add_vertex(const tt_allocator *allocator, tt_polycube_mapping *m, int *capacity,
+                                  const float position[3], const int source[3], const float weight[3])
 {
-    tt_polycube_mapping *m = S->out;
-    int k;
+    if (m->nverts >= INT_MAX / 3 - 1) return 0;
+    if (m->nverts == *capacity) {
+        /* Each array grows from the same old capacity. */
+        float *positions, *weights;
+        int *sources, grown = *capacity;
+        positions = (float *)tt__grow(allocator, m->positions, &grown, m->nverts + 1, 3 * sizeof(float));
+        if (!positions) return 0;
+        m->positions = positions;
+        grown = *capacity;
+        sources = (int *)tt__grow(allocator, m->source, &grown, m->nverts + 1, 3 * sizeof(int));
+        if (!sources) return 0;
+        m->source = sources;
+        grown = *capacity;
+        weights = (float *)tt__grow(allocator, m->weights, &grown, m->nverts + 1, 3 * sizeof(float));
+        if (!weights) return 0;
+        m->weights = weights;
+        *capacity = grown;
+    }
+    memcpy(m->positions + 3 * (size_t)m->nverts, position, 3 * sizeof(float));
+    memcpy(m->source + 3 * (size_t)m->nverts, source, 3 * sizeof(int));
+    memcpy(m->weights + 3 * (size_t)m->nverts, weight, 3 * sizeof(float));
+    m->nverts++;
+    return 1;
+}
+
+/* Triangle (vertex[3], face, points[3]) appended to mapping m, whose
+   triangle arrays hold *capacity; 0 when out of memory. */
+static int tt__mapping_add_triangle(const tt_allocator *allocator, tt_polycube_mapping *m, int *capacity,
+                                    const int vertex[3], int face, const tt_surface_point points[3])
+{
     if (m->ntriangles >= INT_MAX / 6 - 1) return 0;
-    if (m->ntriangles == S->triangle_capacity) {
-        int capacity = S->triangle_capacity, *triangles, *faces;
-        tt_surface_point *points;
-        triangles = (int *)tt__grow(S->allocator, m->triangles, &capacity, m->ntriangles + 1, 3 * sizeof(int));
+    if (m->ntriangles == *capacity) {
+        int grown = *capacity, *triangles, *faces;
+        tt_surface_point *corner_points;
+        triangles = (int *)tt__grow(allocator, m->triangles, &grown, m->ntriangles + 1, 3 * sizeof(int));
         if (!triangles) return 0;
         m->triangles = triangles;
-        capacity = S->triangle_capacity;
-        faces = (int *)tt__grow(S->allocator, m->triangle_face, &capacity, m->ntriangles + 1, sizeof(int));
+        grown = *capacity;
+        faces = (int *)tt__grow(allocator, m->triangle_face, &grown, m->ntriangles + 1, sizeof(int));
         if (!faces) return 0;
         m->triangle_face = faces;
-        capacity = S->triangle_capacity;
-        points = (tt_surface_point *)tt__grow(S->allocator, m->corner_points, &capacity, m->ntriangles + 1,
-                                              3 * sizeof(tt_surface_point));
-        if (!points) return 0;
-        m->corner_points = points;
-        S->triangle_capacity = capacity;
+        grown = *capacity;
+        corner_points = (tt_surface_point *)tt__grow(allocator, m->corner_points, &grown, m->ntriangles + 1,
+                                                     3 * sizeof(tt_surface_point));
+        if (!corner_points) return 0;
+        m->corner_points = corner_points;
+        *capacity = grown;
     }
-    for (k = 0; k < 3; k++) {
-        tt_surface_point *p = &m->corner_points[3 * m->ntriangles + k];
-        m->triangles[3 * m->ntriangles + k] = vertex[k];
-        p->quad = quad;
-        p->s = (float)(st[k][0] < 0.0 ? 0.0 : (st[k][0] > 1.0 ? 1.0 : st[k][0]));
-        p->t = (float)(st[k][1] < 0.0 ? 0.0 : (st[k][1] > 1.0 ? 1.0 : st[k][1]));
-    }
+    memcpy(m->triangles + 3 * (size_t)m->ntriangles, vertex, 3 * sizeof(int));
+    memcpy(m->corner_points + 3 * (size_t)m->ntriangles, points, 3 * sizeof(tt_surface_point));
     m->triangle_face[m->ntriangles++] = face;
     return 1;
 }
 
+/* The source and weights of crossing j's split point (j the first
+   crossing at its t): its edge's ends, by t. */
+static void tt__split_crossing_source(const tt_polycube_edges *E, int e, int j, int source[3], double weight[3])
+{
+    const double t = E->crossings[j].t;
+    source[0] = E->edge_vertices[2 * e];
+    source[1] = source[2] = E->edge_vertices[2 * e + 1];
+    weight[0] = 1.0 - t;
+    weight[1] = t;
+    weight[2] = 0.0;
+}
+
+/* The position, sources and weights of output vertex `token`. */
+static void tt__split_token(const tt__split *S, int token, float position[3], int source[3], float weight[3])
+{
+    double w[3] = {1.0, 0.0, 0.0};
+    if (token >= S->token_local) {
+        const int k = token - S->token_local;
+        memcpy(position, S->out->positions + 3 * (size_t)k, 3 * sizeof(float));
+        memcpy(source, S->out->source + 3 * (size_t)k, 3 * sizeof(int));
+        memcpy(weight, S->out->weights + 3 * (size_t)k, 3 * sizeof(float));
+        return;
+    }
+    if (token >= S->token_crossing) {
+        const int j = token - S->token_crossing;
+        tt__split_crossing_source(S->edges, S->crossing_edge[j], j, source, w);
+    } else {
+        source[0] = source[1] = source[2] = token;
+    }
+    tt__split_vertex_data(S->mesh, source, w, position, weight);
+}
+
+/* A new output vertex of the task interpolating up to three input
+   vertices: its token; -1 when out of memory. */
+static int tt__split_vertex(tt__split *S, const int source[3], const double weight[3])
+{
+    float position[3], w[3];
+    if (S->out->nverts >= INT_MAX - 1 - S->token_local) return -1;
+    tt__split_vertex_data(S->mesh, source, weight, position, w);
+    if (!tt__mapping_add_vertex(S->allocator, S->out, &S->vertex_capacity, position, source, w)) return -1;
+    return S->token_local + S->out->nverts - 1;
+}
+
+/* A new output triangle of the task in `quad` (its vertices' tokens); 0
+   when out of memory. */
+static int tt__split_triangle(tt__split *S, int face, int quad, const int vertex[3], double st[3][2])
+{
+    tt_surface_point points[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        points[k].quad = quad;
+        points[k].s = (float)(st[k][0] < 0.0 ? 0.0 : (st[k][0] > 1.0 ? 1.0 : st[k][0]));
+        points[k].t = (float)(st[k][1] < 0.0 ? 0.0 : (st[k][1] > 1.0 ? 1.0 : st[k][1]));
+    }
+    return tt__mapping_add_triangle(S->allocator, S->out, &S->triangle_capacity, vertex, face, points);
+}
+
 /* The output vertex of crossing j of edge e: the edge's end at t = 0 or 1,
-   else one vertex per t (crossings at one t pass one S vertex), made the
-   first time either triangle asks. -1 when out of memory. */
+   else one vertex per t (crossings at one t pass one S vertex), made by
+   the merge the first time either triangle asks (the request is kept, in
+   order). -1 when out of memory. */
 static int tt__split_crossing_vertex(tt__split *S, int e, int j)
 {
     const tt_polycube_edges *E = S->edges;
     const int *ends = E->edge_vertices + 2 * e;
     double t = E->crossings[j].t;
+    int *grown;
     if (t == 0.0) return ends[0];
     if (t == 1.0) return ends[1];
     while (j > E->first_crossing[e] && E->crossings[j - 1].t == t) j--;
-    if (S->crossing_vertex[j] < 0) {
-        int source[3];
-        double weight[3];
-        source[0] = ends[0];
-        source[1] = source[2] = ends[1];
-        weight[0] = 1.0 - t;
-        weight[1] = t;
-        weight[2] = 0.0;
-        S->crossing_vertex[j] = tt__split_vertex(S, source, weight);
-    }
-    return S->crossing_vertex[j];
+    grown = (int *)tt__grow(S->allocator, S->requests, &S->request_capacity, S->nrequests + 1, sizeof(int));
+    if (!grown) return -1;
+    S->requests = grown;
+    S->requests[S->nrequests++] = j;
+    return S->token_crossing + j;
 }
 
 /* Append boundary point `vertex`, its segment starting in `quad` at st; the
@@ -22180,9 +22383,11 @@ static void tt__split_segment_from(const tt__split *S, int i, const int corner_s
 /* The area of the 3D triangle of output vertices a, b and of point p. */
 static double tt__split_area3(const tt__split *S, int a, int b, const double p[3])
 {
-    const float *x = S->out->positions + 3 * a, *y = S->out->positions + 3 * b;
+    float x[3], y[3], weight[3];
     double u[3], v[3], n[3];
-    int k;
+    int k, source[3];
+    tt__split_token(S, a, x, source, weight);
+    tt__split_token(S, b, y, source, weight);
     for (k = 0; k < 3; k++) {
         u[k] = (double)x[k] - p[k];
         v[k] = (double)y[k] - p[k];
@@ -22227,17 +22432,21 @@ static int tt__split_star(tt__split *S, int f, double area, int *pieces)
             else if (fabs(y[0]) + fabs(y[1]) > TT__SPLIT_MATCH) total += tt__turn_angle(x, y);
         }
         if (on_boundary >= 0) {
+            float at[3], weights[3];
+            int sources[3];
             centre = S->boundary[on_boundary].vertex;
-            for (k = 0; k < 3; k++) position[k] = S->out->positions[3 * centre + k];
+            tt__split_token(S, centre, at, sources, weights);
+            for (k = 0; k < 3; k++) position[k] = at[k];
         } else {
             if (fabs(total - tt__surface_valence(s, s->face_start[S->boundary[0].quad] + c) * 0.5 * TT__PI) > 1e-6)
                 continue;
             /* Mean value coordinates: w_i = (tan(a_(i-1) / 2) + tan(a_i / 2)) / r_i, a_i the angle at V
                from boundary point i to i + 1, r_i the distance from V to point i. */
             for (i = 0; i < n; i++) {
-                const int p = S->boundary[i].vertex;
-                int v[2], j;
+                float at[3], weights[3];
+                int v[2], j, sources[3];
                 double x[2], y[2], w;
+                tt__split_token(S, S->boundary[i].vertex, at, sources, weights);
                 tt__quad_corner_st(tt__quad_corner_of(s, S->boundary[i].quad, apex), v);
                 tt__split_segment_from(S, i, v, x, y);
                 w = tan(0.5 * tt__turn_angle(x, y));
@@ -22247,8 +22456,8 @@ static int tt__split_star(tt__split *S, int f, double area, int *pieces)
                 sum += w;
                 for (j = 0; j < 3; j++)
                     for (k = 0; k < 3; k++)
-                        if (S->out->source[3 * p + j] == S->vert[k]) {
-                            weight[k] += w * S->out->weights[3 * p + j];
+                        if (sources[j] == S->vert[k]) {
+                            weight[k] += w * weights[j];
                             break;
                         }
             }
@@ -22353,7 +22562,10 @@ static int tt__split_fallback(tt__split *S, int f)
         for (a = 0; a < 3; a++) centroid[a] += S->mesh->pos[3 * S->vert[k] + a] / 3.0;
     for (i = 0; i < n; i++) {
         double d[3], x[2];
-        for (a = 0; a < 3; a++) d[a] = ((double)S->out->positions[3 * S->boundary[i].vertex + a] - centroid[a]) / pc->h;
+        float at[3], weights[3];
+        int sources[3];
+        tt__split_token(S, S->boundary[i].vertex, at, sources, weights);
+        for (a = 0; a < 3; a++) d[a] = ((double)at[a] - centroid[a]) / pc->h;
         x[0] = tt__dot3(d, axis_s);
         x[1] = tt__dot3(d, axis_w);
         S->boundary[i].at[0] = x[0];
@@ -22394,6 +22606,196 @@ static int tt__split_fallback(tt__split *S, int f)
     return 1;
 }
 
+#define TT__SPLIT_RANGE 1024        /* triangles per task of the split */
+#define TT__SPLIT_BATCH 32          /* tasks run at once, then merged: their own copies of the output stay small */
+
+typedef struct tt__split_job {
+    tt__split *tasks;           /* TT__SPLIT_BATCH */
+    int first;                  /* the batch's first triangle */
+} tt__split_job;
+
+/* Task `index` of a batch: its range of triangles split (P11 steps 4, 7),
+   into its own vertices and triangles; per triangle where they end, and
+   whether it fell back. */
+static void tt__split_range_task(void *context, int index)
+{
+    const tt__split_job *job = (const tt__split_job *)context;
+    tt__split *S = &job->tasks[index];
+    const tt_mesh *model = S->mesh;
+    const int begin = job->first + index * TT__SPLIT_RANGE;
+    const int end = model->nfaces - begin > TT__SPLIT_RANGE ? begin + TT__SPLIT_RANGE : model->nfaces;
+    int f;
+    S->out->nverts = S->out->ntriangles = S->nrequests = S->failed = 0;
+    for (f = begin; f < end; f++) {
+        int linked = 0, chart = 0, pieces = 0, done = 0, k, kept_vertices, kept_triangles, *ends;
+        for (k = 0; k < 3; k++) S->vert[k] = model->corner_vert[3 * f + k];
+        if (!tt__split_walk(S, f, &linked, &chart)) goto out_of_memory;
+        kept_vertices = S->out->nverts;
+        kept_triangles = S->out->ntriangles;
+        if (chart && (done = tt__split_pieces(S, f, &pieces)) < 0) goto out_of_memory;
+        if (!done && linked) {
+            float at[3], weight[3];
+            double p0[3];
+            int source[3];
+            S->out->nverts = kept_vertices;
+            S->out->ntriangles = kept_triangles;
+            tt__split_token(S, S->vert[0], at, source, weight);
+            for (k = 0; k < 3; k++) p0[k] = at[k];
+            done = tt__split_star(S, f, tt__split_area3(S, S->vert[1], S->vert[2], p0), &pieces);
+            if (done < 0) goto out_of_memory;
+        }
+        if (!done) {
+            S->out->nverts = kept_vertices;
+            S->out->ntriangles = kept_triangles;
+            if (!tt__split_fallback(S, f)) goto out_of_memory;
+        }
+        ends = S->face_ends + 4 * (f - begin);
+        ends[0] = S->out->nverts;
+        ends[1] = S->out->ntriangles;
+        ends[2] = S->nrequests;
+        ends[3] = !done;
+    }
+    return;
+out_of_memory:
+    S->failed = 1;
+}
+
+/* Task S's triangles [begin, end) into mapping m, in order, as a serial
+   split would have made them: per triangle, the split points it asked for
+   (each made the first time any triangle asks: crossing_vertex), then its
+   own vertices, then its triangles, their tokens turned into m's
+   vertices. Adds its fallbacks to *fallbacks. 0 when out of memory. */
+static int tt__split_merge(const tt__split *S, int begin, int end, tt_polycube_mapping *m, int *vertex_capacity,
+                           int *triangle_capacity, int *crossing_vertex, int *fallbacks)
+{
+    int f, v = 0, t = 0, r = 0;
+    for (f = begin; f < end; f++) {
+        const int *ends = S->face_ends + 4 * (f - begin);
+        int local_base, k;
+        for (; r < ends[2]; r++) {
+            const int j = S->requests[r];
+            float position[3], weight[3];
+            int source[3];
+            if (crossing_vertex[j] >= 0) continue;
+            tt__split_token(S, S->token_crossing + j, position, source, weight);
+            if (!tt__mapping_add_vertex(S->allocator, m, vertex_capacity, position, source, weight)) return 0;
+            crossing_vertex[j] = m->nverts - 1;
+        }
+        local_base = m->nverts - v;
+        for (; v < ends[0]; v++)
+            if (!tt__mapping_add_vertex(S->allocator, m, vertex_capacity, S->out->positions + 3 * (size_t)v,
+                                        S->out->source + 3 * (size_t)v, S->out->weights + 3 * (size_t)v))
+                return 0;
+        for (; t < ends[1]; t++) {
+            int vertex[3];
+            for (k = 0; k < 3; k++) {
+                const int token = S->out->triangles[3 * t + k];
+                vertex[k] = token < S->token_crossing ? token
+                          : token < S->token_local ? crossing_vertex[token - S->token_crossing]
+                                                   : local_base + token - S->token_local;
+            }
+            if (!tt__mapping_add_triangle(S->allocator, m, triangle_capacity, vertex, S->out->triangle_face[t],
+                                          S->out->corner_points + 3 * (size_t)t))
+                return 0;
+        }
+        *fallbacks += ends[3];
+    }
+    return 1;
+}
+
+static void tt__split_free(tt__split *S)
+{
+    tt__free(S->allocator, S->requests);
+    tt__free(S->allocator, S->face_ends);
+    tt__free(S->allocator, S->boundary);
+    tt__free(S->allocator, S->cells);
+    tt__free(S->allocator, S->queue);
+    tt__free(S->allocator, S->grid_points);
+    tt_polycube_mapping_free(S->out);
+    memset(S, 0, sizeof *S);
+}
+
+/* P11 steps 4 and 7 for every triangle of `model`: the mapping, its
+   vertices the model's first, then, triangle by triangle, the split
+   points and vertices each makes, and its pieces. The triangles are split
+   in ranges of TT__SPLIT_RANGE, each a task on the executor (a triangle's
+   pieces depend on its vertices' points and its edges' records alone),
+   TT__SPLIT_BATCH at a time, and merged in order: the same mapping with
+   any executor. *fallbacks counts the triangles put whole into one quad.
+   TT_OK or TT_ERROR_OUT_OF_MEMORY (*out NULL, nothing left allocated). */
+static tt_result tt__polycube_split(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
+                                    const tt_surface_point *points, const tt_executor *executor,
+                                    const tt_allocator *allocator, tt_polycube_mapping **out, int *fallbacks)
+{
+    tt_polycube_mapping *m = TT__ALLOC(allocator, tt_polycube_mapping, 1);
+    tt__split *tasks = TT__ALLOC(allocator, tt__split, TT__SPLIT_BATCH);
+    int *crossing_vertex = TT__ALLOC(allocator, int, edges->ncrossings > 0 ? edges->ncrossings : 1);
+    int *crossing_edge = TT__ALLOC(allocator, int, edges->ncrossings > 0 ? edges->ncrossings : 1);
+    int vertex_capacity = 0, triangle_capacity = 0, e, j, i, v, first, failed = 0;
+    *out = NULL;
+    *fallbacks = 0;
+    if (m) {
+        memset(m, 0, sizeof *m);
+        m->allocator = tt__allocator_copy(allocator);
+    }
+    if (tasks) memset(tasks, 0, sizeof(tt__split) * TT__SPLIT_BATCH);
+    failed = !m || !tasks || !crossing_vertex || !crossing_edge;
+    for (i = 0; i < TT__SPLIT_BATCH && !failed; i++) {
+        tt__split *S = &tasks[i];
+        S->pc = pc;
+        S->mesh = model;
+        S->edges = edges;
+        S->points = points;
+        S->crossing_edge = crossing_edge;
+        S->allocator = allocator;
+        S->token_crossing = model->nverts;
+        S->token_local = model->nverts + edges->ncrossings;
+        S->out = TT__ALLOC(allocator, tt_polycube_mapping, 1);
+        S->face_ends = TT__ALLOC(allocator, int, 4 * TT__SPLIT_RANGE);
+        if (S->out) {
+            memset(S->out, 0, sizeof *S->out);
+            S->out->allocator = tt__allocator_copy(allocator);
+        }
+        failed = !S->out || !S->face_ends;
+    }
+    if (!failed && edges->ncrossings > INT_MAX - 1 - model->nverts) failed = 1;
+    if (!failed) {
+        for (j = 0; j < edges->ncrossings; j++) crossing_vertex[j] = -1;
+        for (e = 0; e < edges->nedges; e++)
+            for (j = edges->first_crossing[e]; j < edges->first_crossing[e + 1]; j++) crossing_edge[j] = e;
+        for (v = 0; v < model->nverts && !failed; v++) {
+            float position[3], weight[3];
+            int source[3];
+            tt__split_token(&tasks[0], v, position, source, weight);
+            failed = !tt__mapping_add_vertex(allocator, m, &vertex_capacity, position, source, weight);
+        }
+    }
+    for (first = 0; first < model->nfaces && !failed; first += TT__SPLIT_BATCH * TT__SPLIT_RANGE) {
+        tt__split_job job;
+        int ntasks = tt__range_count(model->nfaces - first, TT__SPLIT_RANGE);
+        if (ntasks > TT__SPLIT_BATCH) ntasks = TT__SPLIT_BATCH;
+        job.tasks = tasks;
+        job.first = first;
+        tt__run_tasks(executor, ntasks, tt__split_range_task, &job);
+        for (i = 0; i < ntasks && !failed; i++) {
+            const int begin = first + i * TT__SPLIT_RANGE;
+            const int end = model->nfaces - begin > TT__SPLIT_RANGE ? begin + TT__SPLIT_RANGE : model->nfaces;
+            failed = tasks[i].failed || !tt__split_merge(&tasks[i], begin, end, m, &vertex_capacity,
+                                                         &triangle_capacity, crossing_vertex, fallbacks);
+        }
+    }
+    for (i = 0; tasks && i < TT__SPLIT_BATCH; i++) tt__split_free(&tasks[i]);
+    tt__free(allocator, tasks);
+    tt__free(allocator, crossing_vertex);
+    tt__free(allocator, crossing_edge);
+    if (failed) {
+        tt_polycube_mapping_free(m);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    *out = m;
+    return TT_OK;
+}
+
 TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping)
 {
     tt_allocator allocator;
@@ -22419,7 +22821,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt_polycube_edges *edges = NULL;
     const tt_mesh *model;
     tt__refined R;
-    tt__split S;
+    tt_polycube_mapping *mapping = NULL;
     tt_result result;
     const tt_executor *executor = options ? options->executor : NULL;
     double longest;
@@ -22428,7 +22830,6 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if (out) *out = NULL;
     if (!report) report = &local;
     memset(report, 0, sizeof *report);
-    memset(&S, 0, sizeof S);
     memset(&R, 0, sizeof R);
     if (!polycube || !mesh || !out)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -22457,7 +22858,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     report->triangles = model->nfaces;
     points = TT__ALLOC(allocator, tt_surface_point, model->nverts > 0 ? model->nverts : 1);
     if (!points) goto out_of_memory;
-    if ((result = tt_polycube_project(polycube, model, allocator, points, &report->projection, error)) != TT_OK)
+    if ((result = tt__polycube_project(polycube, model, executor, allocator, points, &report->projection, error)) !=
+        TT_OK)
         goto failed;
     /* A point within TT__MAP_SNAP of a quad's edge is on it: the points are float (and the projection adds
        its rounding), and a model vertex on a lattice line (a CAD part's edge, a face in a lattice plane) must
@@ -22468,8 +22870,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     }
     if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator)) < 0)
         goto out_of_memory;
-    if ((result = tt_polycube_trace_edges(polycube, model, points, model->nverts, &edge_options, allocator, &edges,
-                                          error)) != TT_OK)
+    if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, executor, allocator, NULL,
+                                  NULL, &edges, error)) != TT_OK)
         goto failed;
     if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
         !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
@@ -22489,7 +22891,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             if (!n) break;
             reseated += n;
             for (v = 0; v < model->nverts; v++) focus[v] |= moved[v];
-            if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges,
+            if ((result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
                                             error)) != TT_OK)
                 goto failed;
             if (edges->nfailed >= failed_before) break;
@@ -22509,13 +22911,13 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         report->relaxed += moves;
         for (v = 0; v < model->nverts; v++)
             moved[v] = !tt__same_point(points[v], earlier[v]);
-        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=
-            TT_OK)
+        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
+                                        error)) != TT_OK)
             goto failed;
         /* A move that left an edge with no path goes back (the folds it opened cost less than the seam). */
         if (tt__polycube_restore_failing(model, edges, earlier, points, moved) &&
-            (result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=
-                TT_OK)
+            (result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
+                                        error)) != TT_OK)
             goto failed;
     }
     /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
@@ -22531,63 +22933,23 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             changed = tt__polycube_restore_failing(model, edges, earlier, points, moved);
         }
         if (!changed) break;
-        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, allocator, moved, &edges, error)) !=
-            TT_OK)
+        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
+                                        error)) != TT_OK)
             goto failed;
     }
     report->failed_edges = edges->nfailed;
 
-    S.pc = polycube;
-    S.mesh = model;
-    S.edges = edges;
-    S.points = points;
-    S.allocator = allocator;
-    S.out = TT__ALLOC(allocator, tt_polycube_mapping, 1);
-    if (!S.out) goto out_of_memory;
-    memset(S.out, 0, sizeof *S.out);
-    S.out->allocator = tt__allocator_copy(allocator);
-    S.crossing_vertex = TT__ALLOC(allocator, int, edges->ncrossings > 0 ? edges->ncrossings : 1);
-    if (!S.crossing_vertex) goto out_of_memory;
-    for (j = 0; j < edges->ncrossings; j++) S.crossing_vertex[j] = -1;
-    for (v = 0; v < model->nverts; v++) {
-        int source[3];
-        double weight[3] = {1.0, 0.0, 0.0};
-        source[0] = source[1] = source[2] = v;
-        if (tt__split_vertex(&S, source, weight) < 0) goto out_of_memory;
-    }
-    for (f = 0; f < model->nfaces; f++) {
-        int linked = 0, chart = 0, pieces = 0, done = 0, k, kept_vertices, kept_triangles;
-        for (k = 0; k < 3; k++) S.vert[k] = model->corner_vert[3 * f + k];
-        if (!tt__split_walk(&S, f, &linked, &chart)) goto out_of_memory;
-        kept_vertices = S.out->nverts;
-        kept_triangles = S.out->ntriangles;
-        if (chart) {
-            done = tt__split_pieces(&S, f, &pieces);
-            if (done < 0) goto out_of_memory;
-        }
-        if (!done && linked) {
-            double p0[3];
-            S.out->nverts = kept_vertices;
-            S.out->ntriangles = kept_triangles;
-            for (k = 0; k < 3; k++) p0[k] = S.out->positions[3 * S.vert[0] + k];
-            done = tt__split_star(&S, f, tt__split_area3(&S, S.vert[1], S.vert[2], p0), &pieces);
-            if (done < 0) goto out_of_memory;
-        }
-        if (!done) {
-            S.out->nverts = kept_vertices;
-            S.out->ntriangles = kept_triangles;
-            if (!tt__split_fallback(&S, f)) goto out_of_memory;
-            report->fallback_triangles++;
-        }
-    }
+    if (tt__polycube_split(polycube, model, edges, points, executor, allocator, &mapping,
+                           &report->fallback_triangles) != TT_OK)
+        goto out_of_memory;
     /* Back to the input: each output vertex's refined sources become input vertices (at most 3, all of one
        input triangle), each output triangle's refined face its input face. */
-    for (v = 0; v < S.out->nverts && R.mesh; v++) {
+    for (v = 0; v < mapping->nverts && R.mesh; v++) {
         int source[3], n = 0, k, i;
         double weight[3] = {0.0, 0.0, 0.0};
         for (k = 0; k < 3; k++) {
-            int r = S.out->source[3 * v + k];
-            double w = S.out->weights[3 * v + k];
+            int r = mapping->source[3 * v + k];
+            double w = mapping->weights[3 * v + k];
             for (i = 0; i < 3 && w != 0.0; i++) {
                 int u = R.source[3 * r + i], m;
                 double wu = w * R.weight[3 * r + i];
@@ -22600,51 +22962,41 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
                 weight[m] += wu;
             }
         }
-        for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * S.out->source[3 * v]];
+        for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * mapping->source[3 * v]];
         for (k = 0; k < 3; k++) {
-            S.out->source[3 * v + k] = source[k];
-            S.out->weights[3 * v + k] = (float)weight[k];
+            mapping->source[3 * v + k] = source[k];
+            mapping->weights[3 * v + k] = (float)weight[k];
         }
     }
     {
         int *outputs_of_face = TT__ALLOC(allocator, int, mesh->nfaces);
         if (!outputs_of_face) goto out_of_memory;
         memset(outputs_of_face, 0, sizeof(int) * (size_t)mesh->nfaces);
-        for (j = 0; j < S.out->ntriangles; j++) {
-            if (R.face) S.out->triangle_face[j] = R.face[S.out->triangle_face[j]];
-            outputs_of_face[S.out->triangle_face[j]]++;
+        for (j = 0; j < mapping->ntriangles; j++) {
+            if (R.face) mapping->triangle_face[j] = R.face[mapping->triangle_face[j]];
+            outputs_of_face[mapping->triangle_face[j]]++;
         }
         for (f = 0; f < mesh->nfaces; f++) report->split_triangles += outputs_of_face[f] > 1;
         tt__free(allocator, outputs_of_face);
     }
-    for (j = 0; j < S.out->ntriangles; j++) {
-        const tt_surface_point *p = S.out->corner_points + 3 * j;
+    for (j = 0; j < mapping->ntriangles; j++) {
+        const tt_surface_point *p = mapping->corner_points + 3 * j;
         double turn = tt__orient2(p[0].s, p[0].t, p[1].s, p[1].t, p[2].s, p[2].t);
         report->flipped += turn < -TT__SPLIT_AREA;
         report->collapsed += fabs(turn) <= TT__SPLIT_AREA;
     }
-    tt__free(allocator, S.crossing_vertex);
-    tt__free(allocator, S.boundary);
-    tt__free(allocator, S.cells);
-    tt__free(allocator, S.queue);
-    tt__free(allocator, S.grid_points);
     tt_polycube_edges_free(edges);
     tt__free(allocator, earlier);
     tt__free(allocator, moved);
     tt__free(allocator, focus);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
-    *out = S.out;
+    *out = mapping;
     return TT_OK;
 out_of_memory:
     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory mapping the mesh onto S");
 failed:
-    tt__free(allocator, S.crossing_vertex);
-    tt__free(allocator, S.boundary);
-    tt__free(allocator, S.cells);
-    tt__free(allocator, S.queue);
-    tt__free(allocator, S.grid_points);
-    tt_polycube_mapping_free(S.out);
+    tt_polycube_mapping_free(mapping);
     tt_polycube_edges_free(edges);
     tt__free(allocator, earlier);
     tt__free(allocator, moved);

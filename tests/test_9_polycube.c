@@ -2999,6 +2999,78 @@ static void test_map_random(void)
           "triangles left to the fallback", flipped, fallbacks);
 }
 
+/* The executor (tt_polycube_map_options::executor) runs the projection,
+   the relaxation's groups of vertices, the tracing and the split as
+   tasks: a bumpy sphere, big enough for several tasks of each (and two
+   batches of the split) and with folds to untangle, maps to the same
+   arrays, bit for bit, and the same report, serially, with the tasks in
+   reverse order and on two threads. */
+static void test_map_executors(void)
+{
+    const double centre[3] = {0.0, 0.0, 0.0};
+    const tt_executor *executors[2];
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_polycube *pc = NULL;
+    tt_polycube_options o;
+    tt_polycube_map_options mo;
+    tt_polycube_map_report serial_report, report;
+    tt_polycube_mapping *serial = NULL, *map = NULL;
+    tt_polycube_report rep;
+    tt_error err;
+    int i, k;
+    executors[0] = &g_reverse_executor;
+    executors[1] = &g_thread_executor;
+    memset(&m, 0, sizeof m);
+    lcg_seed(515);
+    make_sphere(&m, 96, 48, 1.0, centre, 0);
+    for (i = 0; i < m.nv; i++) {
+        /* Bumps a few triangles wide: the projection folds some of them over. */
+        double bump = 1.0 + 0.06 * sin(23.0 * m.pos[3 * i]) * sin(19.0 * m.pos[3 * i + 1]) + 0.02 * lcg_unit();
+        for (k = 0; k < 3; k++) m.pos[3 * i + k] = (float)(bump * m.pos[3 * i + k]);
+    }
+    memset(&o, 0, sizeof o);
+    o.resolution = 12;
+    if (build(&m, 0, &mesh, &err) != TT_OK || tt_polycube_build(mesh, &o, NULL, &pc, &rep, &err) != TT_OK) {
+        CHECK(0, "the bumpy sphere builds: %s", err.message);
+        tt_mesh_free(mesh);
+        tm_free(&m);
+        return;
+    }
+    memset(&mo, 0, sizeof mo);
+    mo.max_edge = 0.25 * pc->h;
+    if (tt_polycube_map(pc, mesh, &mo, NULL, &serial, &serial_report, &err) != TT_OK) {
+        CHECK(0, "the bumpy sphere maps: %s", err.message);
+    } else {
+        for (k = 0; k < 2; k++) {
+            mo.executor = executors[k];
+            CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &map, &report, &err) == TT_OK &&
+                      map->nverts == serial->nverts && map->ntriangles == serial->ntriangles &&
+                      memcmp(map->positions, serial->positions, sizeof(float) * 3 * (size_t)map->nverts) == 0 &&
+                      memcmp(map->source, serial->source, sizeof(int) * 3 * (size_t)map->nverts) == 0 &&
+                      memcmp(map->weights, serial->weights, sizeof(float) * 3 * (size_t)map->nverts) == 0 &&
+                      memcmp(map->triangles, serial->triangles, sizeof(int) * 3 * (size_t)map->ntriangles) == 0 &&
+                      memcmp(map->triangle_face, serial->triangle_face, sizeof(int) * (size_t)map->ntriangles) == 0 &&
+                      memcmp(map->corner_points, serial->corner_points,
+                             sizeof(tt_surface_point) * 3 * (size_t)map->ntriangles) == 0 &&
+                      memcmp(&report, &serial_report, sizeof report) == 0,
+                  "bumpy sphere (%d refined triangles, %d relaxation moves, %d fallbacks) mapped %s: the serial "
+                  "mapping bit for bit, the same report",
+                  serial_report.triangles, serial_report.relaxed, serial_report.fallback_triangles,
+                  k ? "on two threads" : "with the tasks in reverse order");
+            tt_polycube_mapping_free(map);
+            map = NULL;
+        }
+        CHECK(serial_report.triangles > 32 * 1024 && serial_report.relaxed > 100,
+              "the executor test mesh has %d refined triangles (two batches of the split need more than 32768) "
+              "and %d relaxation moves", serial_report.triangles, serial_report.relaxed);
+    }
+    tt_polycube_mapping_free(serial);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -3037,4 +3109,5 @@ void run_polycube_tests(void)
     RUN(test_map_thin_plate);
     RUN(test_map_open_and_messy);
     RUN(test_map_random);
+    RUN(test_map_executors);
 }
