@@ -22,7 +22,7 @@
                               tiles for the tops, upright ones (the same
                               edge windows) for the walls, side by side
      tt_polycube_map          the triangles split along S's quad edges,
-                              each corner's point on S
+                              each corner's point on S (on -j threads)
      tt_polycube_upright_atlas        the two tile sets side by side
      tt_polycube_mapping_uvs_upright  those points as texture coordinates
      tt_measure_uv_distortion, tt_measure_seams   the summary's quality
@@ -273,15 +273,24 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
         job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] +
                                          (float)tt_polycube_quad_upright(job->polycube,
                                                                          job->polycube->surface->corner_face[c]));
+    /* The atlases hold every texel the outputs use (level 0): the tile sets
+       and their mip levels, as large again as the atlases, go now. */
+    tiled_tilesets_free(&job->tiles, job->map_tiles);
+    tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
     return 0;
 }
 
 /* The triangles split along S's quads, with their texture coordinates. */
 static int map_mesh(const polycube_command_options *options, polycube_job *job)
 {
+    tt_polycube_map_options map_options;
     tt_error error;
     double start = tool_seconds_now();
-    if (tt_polycube_map(job->polycube, job->mesh.mesh, NULL, NULL, &job->mapping, &job->map_report, &error) != TT_OK)
+    /* -j: the projection, the relaxation, the tracing and the split on the tool's threads (the same mapping). */
+    memset(&map_options, 0, sizeof map_options);
+    map_options.executor = tool_executor();
+    if (tt_polycube_map(job->polycube, job->mesh.mesh, &map_options, NULL, &job->mapping, &job->map_report, &error) !=
+        TT_OK)
         return triangle_mesh_report_error(options->mesh_path, &job->mesh, &error);
     job->map_seconds = tool_seconds_now() - start;
     /* Above 0.1 % (the target), the cuts show: say why they come and what may help. */
