@@ -127,24 +127,19 @@ int tool_format_float(float value, char *out)
 
 int tool_format_int(long value, char *out)
 {
-    char reversed[24];
-    unsigned long magnitude = value < 0 ? 0ul - (unsigned long)value : (unsigned long)value;
-    int n = 0, length = 0;
-    /* Two digits at a time from the table, the last first. */
-    while (magnitude >= 100u) {
-        const char *pair = digit_pairs + 2 * (magnitude % 100u);
-        reversed[n++] = pair[1];
-        reversed[n++] = pair[0];
-        magnitude /= 100u;
-    }
-    if (magnitude >= 10u) {
-        reversed[n++] = digit_pairs[2 * magnitude + 1];
-        reversed[n++] = digit_pairs[2 * magnitude];
-    } else {
-        reversed[n++] = (char)('0' + magnitude);
-    }
+    unsigned long magnitude = value < 0 ? 0ul - (unsigned long)value : (unsigned long)value, rest;
+    int length = 0, ndigits = 1, i;
     if (value < 0) out[length++] = '-';
-    while (n > 0) out[length++] = reversed[--n];
-    out[length] = '\0';
-    return length;
+    for (rest = magnitude; rest >= 10u; rest /= 10u) ndigits++;
+    /* The digits from the last, two at a time from the table. */
+    i = length + ndigits;
+    out[i] = '\0';
+    while (magnitude >= 100u) {
+        memcpy(out + i - 2, digit_pairs + 2 * (magnitude % 100u), 2);
+        magnitude /= 100u;
+        i -= 2;
+    }
+    if (magnitude >= 10u) memcpy(out + i - 2, digit_pairs + 2 * magnitude, 2);
+    else out[i - 1] = (char)('0' + magnitude);
+    return length + ndigits;
 }

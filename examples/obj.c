@@ -852,19 +852,20 @@ static void write_name_line(tool_buffer *out, const char *keyword, const char *n
     buffer_printf(out, "%s %s%s\n", keyword, name, length > 0 && name[length - 1] == '\\' ? " " : "");
 }
 
-/* "KEYWORD x y z" and a newline, built in one piece and appended once. */
+/* "KEYWORD x y z" and a newline, written in place at the buffer's end. */
 static void write_floats(tool_buffer *out, const char *keyword, const float *values, int count)
 {
-    char line[8 + 3 * (TOOL_NUMBER_TEXT_SIZE + 1)];
     size_t length = strlen(keyword);
+    char *line = buffer_room(out, length + 3 * (TOOL_NUMBER_TEXT_SIZE + 1) + 1);
     int i;
+    if (!line) return;
     memcpy(line, keyword, length);
     for (i = 0; i < count && i < 3; i++) {
         line[length++] = ' ';
         length += (size_t)tool_format_float(values[i], line + length);
     }
     line[length++] = '\n';
-    buffer_append(out, line, length);
+    buffer_wrote(out, length);
 }
 
 /* With desc->share_equal, each distinct vt (or vn) is written once: a
@@ -876,30 +877,26 @@ typedef struct distinct_rows {
     int *first_corner;      /* per distinct row: the first corner that has it, in corner order */
 } distinct_rows;
 
-typedef void (*row_reader)(const obj_write_desc *desc, int c, float row[3]);
+/* The vt rows (u, v and w, 0 without one) or the vn rows (x, y, z). */
+typedef enum row_kind { TEXTURE_ROWS, NORMAL_ROWS } row_kind;
 
-static void texture_row(const obj_write_desc *desc, int c, float row[3])
+static void read_row(const obj_write_desc *desc, row_kind kind, int c, float row[3])
 {
-    row[0] = desc->corner_uv[2 * (size_t)c];
-    row[1] = desc->corner_uv[2 * (size_t)c + 1];
-    row[2] = desc->corner_uv_w ? desc->corner_uv_w[c] : 0.0f;
-}
-
-static void normal_row(const obj_write_desc *desc, int c, float row[3])
-{
-    memcpy(row, desc->corner_normal + 3 * (size_t)c, 3 * sizeof(float));
+    if (kind == NORMAL_ROWS) {
+        memcpy(row, desc->corner_normal + 3 * (size_t)c, 3 * sizeof(float));
+    } else {
+        row[0] = desc->corner_uv[2 * (size_t)c];
+        row[1] = desc->corner_uv[2 * (size_t)c + 1];
+        row[2] = desc->corner_uv_w ? desc->corner_uv_w[c] : 0.0f;
+    }
 }
 
 static uint32_t row_hash(const float row[3])
 {
-    uint32_t bits[3], hash = 0x2545f491u;
-    int k;
+    uint32_t bits[3], hash;
     memcpy(bits, row, sizeof bits);
-    for (k = 0; k < 3; k++) {
-        hash = (hash ^ bits[k]) * 0x9e3779b1u;
-        hash ^= hash >> 15;
-    }
-    return hash;
+    hash = bits[0] * 0x9e3779b1u + bits[1] * 0x85ebca77u + bits[2] * 0xc2b2ae3du;
+    return hash ^ (hash >> 15);
 }
 
 static void distinct_rows_free(distinct_rows *rows)
@@ -909,7 +906,15 @@ static void distinct_rows_free(distinct_rows *rows)
     memset(rows, 0, sizeof *rows);
 }
 
-/* The row a vertex's last corner had (find_distinct_rows' by_vertex). */
+/* A hint to the processor that *address will be read soon. */
+#if defined(__GNUC__) || defined(__clang__)
+#define PREFETCH(address) __builtin_prefetch(address)
+#else
+#define PREFETCH(address) ((void)(address))
+#endif
+#define PREFETCH_AHEAD 16
+
+/* The row a vertex's last corner had (find_distinct_rows, for normals). */
 typedef struct vertex_row {
     float row[3];
     int index;              /* its distinct row, or -1: no corner yet */
@@ -923,16 +928,15 @@ typedef struct row_slot {
 } row_slot;
 
 /* Returns 0, or -1 when out of memory. The table grows to stay at most
-   half full. With by_vertex a corner first tries the row its vertex's last
-   corner had: a smooth normal is one per vertex, so most corners need no
-   look-up in the table, which starts with room for one row per vertex. */
-static int find_distinct_rows(const obj_write_desc *desc, int ncorners, row_reader read_row, int by_vertex,
-                              distinct_rows *rows)
+   half full. A corner's normal is first compared with the one its vertex's
+   last corner had: a smooth normal is one per vertex, so most corners need
+   no look-up in the table, which starts with room for one row per vertex. */
+static int find_distinct_rows(const obj_write_desc *desc, int ncorners, row_kind kind, distinct_rows *rows)
 {
     size_t size = 1024, mask, slot;
     row_slot *table;
     vertex_row *last = NULL;
-    int c, v;
+    int c, v, by_vertex = kind == NORMAL_ROWS;
     memset(rows, 0, sizeof *rows);
     while (by_vertex && size < 2 * (size_t)desc->nverts) size *= 2;
     mask = size - 1;
@@ -947,7 +951,17 @@ static int find_distinct_rows(const obj_write_desc *desc, int ncorners, row_read
         vertex_row *at = last ? &last[desc->corner_vert[c]] : NULL;
         uint32_t hash;
         int index = -1;
-        read_row(desc, c, row);
+        if (last && c + PREFETCH_AHEAD < ncorners) {
+            /* The table is far larger than the cache and is read at random:
+               ask for the slot of a vertex's first corner a few corners
+               ahead, so that the memory works while this one is done. */
+            const vertex_row *ahead = &last[desc->corner_vert[c + PREFETCH_AHEAD]];
+            if (ahead->index < 0) {
+                read_row(desc, kind, c + PREFETCH_AHEAD, other);
+                PREFETCH(&table[row_hash(other) & mask]);
+            }
+        }
+        read_row(desc, kind, c, row);
         if (at && at->index >= 0 && memcmp(row, at->row, sizeof row) == 0) {
             rows->of_corner[c] = at->index;
             continue;
@@ -955,7 +969,7 @@ static int find_distinct_rows(const obj_write_desc *desc, int ncorners, row_read
         hash = row_hash(row);
         for (slot = hash & mask; table[slot].index; slot = (slot + 1) & mask) {
             if (table[slot].hash != hash) continue;
-            read_row(desc, rows->first_corner[table[slot].index - 1], other);
+            read_row(desc, kind, rows->first_corner[table[slot].index - 1], other);
             if (memcmp(row, other, sizeof row) == 0) {
                 index = table[slot].index - 1;
                 break;
@@ -1027,35 +1041,30 @@ static int format_corner(const corner_refs *refs, int c, char *text)
     return length;
 }
 
-/* "f" with corner `first`, then `count` corners from `next` on, built in
-   one piece (in a line of up to 8 corners, else corner by corner) and
-   appended once. */
+/* "f" with corner `first`, then `count` corners from `next` on, written in
+   place at the buffer's end. */
 static void write_face_corners(tool_buffer *out, const corner_refs *refs, int first, int next, int count)
 {
-    char line[2 + 8 * CORNER_TEXT_SIZE];
-    int i, length = 1;
+    char *line = buffer_room(out, 2 + ((size_t)count + 1) * CORNER_TEXT_SIZE);
+    size_t length = 1;
+    int i;
+    if (!line) return;
     line[0] = 'f';
-    length += format_corner(refs, first, line + length);
-    for (i = 0; i < count; i++) {
-        if (length + CORNER_TEXT_SIZE + 1 > (int)sizeof line) {
-            buffer_append(out, line, (size_t)length);
-            length = 0;
-        }
-        length += format_corner(refs, next + i, line + length);
-    }
+    length += (size_t)format_corner(refs, first, line + length);
+    for (i = 0; i < count; i++) length += (size_t)format_corner(refs, next + i, line + length);
     line[length++] = '\n';
-    buffer_append(out, line, (size_t)length);
+    buffer_wrote(out, length);
 }
 
 /* The vt lines (`keyword` "vt") or vn lines ("vn") of every corner in
    order, or of each distinct row once when `rows` is not NULL. */
 static void write_rows(tool_buffer *out, const obj_write_desc *desc, const char *keyword, int width, int ncorners,
-                       row_reader read_row, const distinct_rows *rows)
+                       row_kind kind, const distinct_rows *rows)
 {
     int n = rows ? rows->count : ncorners, k;
     for (k = 0; k < n; k++) {
         float row[3];
-        read_row(desc, rows ? rows->first_corner[k] : k, row);
+        read_row(desc, kind, rows ? rows->first_corner[k] : k, row);
         write_floats(out, keyword, row, width);
     }
 }
@@ -1089,8 +1098,8 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
     memset(&textures, 0, sizeof textures);
     memset(&normals, 0, sizeof normals);
-    if (desc->share_equal && ((desc->corner_uv && find_distinct_rows(desc, ncorners, texture_row, 0, &textures) != 0) ||
-                              (desc->corner_normal && find_distinct_rows(desc, ncorners, normal_row, 1, &normals) != 0))) {
+    if (desc->share_equal && ((desc->corner_uv && find_distinct_rows(desc, ncorners, TEXTURE_ROWS, &textures) != 0) ||
+                              (desc->corner_normal && find_distinct_rows(desc, ncorners, NORMAL_ROWS, &normals) != 0))) {
         distinct_rows_free(&textures);
         return -1;
     }
@@ -1100,10 +1109,10 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     /* One vt (and vn) per face corner in corner order, corner c using vt
        c + 1; or each distinct one once, in the order corners first use it. */
     if (desc->corner_uv)
-        write_rows(out, desc, "vt", desc->corner_uv_w ? 3 : 2, ncorners, texture_row,
+        write_rows(out, desc, "vt", desc->corner_uv_w ? 3 : 2, ncorners, TEXTURE_ROWS,
                    desc->share_equal ? &textures : NULL);
     if (desc->corner_normal)
-        write_rows(out, desc, "vn", 3, ncorners, normal_row, desc->share_equal ? &normals : NULL);
+        write_rows(out, desc, "vn", 3, ncorners, NORMAL_ROWS, desc->share_equal ? &normals : NULL);
 
     if (desc->material && !(desc->face_group && desc->group_materials)) write_name_line(out, "usemtl", desc->material);
     for (f = 0; f < desc->nfaces && status == 0; f++) {

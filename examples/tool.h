@@ -270,6 +270,11 @@ typedef struct tool_buffer {
 #define TOOL_BUFFER_INIT {NULL, 0, 0, 0}
 
 void buffer_append(tool_buffer *buffer, const void *bytes, size_t count);
+/* Room for up to `count` more bytes at the buffer's end, for a writer to
+   fill in place and then count with buffer_wrote (no copy, as an append
+   makes); NULL after a failed allocation. */
+char *buffer_room(tool_buffer *buffer, size_t count);
+void buffer_wrote(tool_buffer *buffer, size_t count);
 void buffer_printf(tool_buffer *buffer, const char *format, ...)
 #if defined(__GNUC__) || defined(__clang__)
     __attribute__((format(printf, 2, 3)))

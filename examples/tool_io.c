@@ -135,12 +135,24 @@ static int buffer_reserve(tool_buffer *buffer, size_t extra)
     return 0;
 }
 
-void buffer_append(tool_buffer *buffer, const void *bytes, size_t count)
+char *buffer_room(tool_buffer *buffer, size_t count)
 {
-    if (buffer_reserve(buffer, count) != 0) return;
-    if (count) memcpy(buffer->data + buffer->size, bytes, count);
+    return buffer_reserve(buffer, count) != 0 ? NULL : buffer->data + buffer->size;
+}
+
+void buffer_wrote(tool_buffer *buffer, size_t count)
+{
+    if (buffer->failed) return;
     buffer->size += count;
     buffer->data[buffer->size] = '\0';
+}
+
+void buffer_append(tool_buffer *buffer, const void *bytes, size_t count)
+{
+    char *room = buffer_room(buffer, count);
+    if (!room) return;
+    if (count) memcpy(room, bytes, count);
+    buffer_wrote(buffer, count);
 }
 
 void buffer_printf(tool_buffer *buffer, const char *format, ...)

@@ -2018,8 +2018,10 @@ check "--help documents -j / --jobs" "'-j, --jobs N' in the usage" "$OUT" \
 # Numbers in written OBJ files: tool_format_float reads back exactly
 # ======================================================================
 cat >"$W/fmt_check.c" <<'EOF_C'
-/* Round trip of tool_format_float on random floats, and its speed against printf. */
+/* Round trip of tool_format_float on random floats, and its speed against printf;
+   tool_format_int against printf. */
 #define _POSIX_C_SOURCE 200112L
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -2076,6 +2078,30 @@ int main(int argc, char **argv)
         if (strcmp(mine, theirs) != 0 && differs++ < 5) printf("differs from printf: '%s' vs '%s'\n", mine, theirs);
     }
     printf("%ld floats: %ld without an exact round trip, %ld differing from printf %%.9g\n", i, bad, differs);
+    {   /* integers: every one from -100000 to 100000, each power of ten and its neighbours, the extremes */
+        static const long extremes[] = {LONG_MAX, LONG_MIN, LONG_MIN + 1, LONG_MAX - 1};
+        long bad_ints = 0, p10 = 1, k;
+        for (k = -100000; k <= 100000; k++) {
+            tool_format_int(k, mine);
+            snprintf(theirs, sizeof theirs, "%ld", k);
+            if (strcmp(mine, theirs) != 0 && bad_ints++ < 5) printf("int %ld written '%s'\n", k, mine);
+        }
+        for (; p10 <= LONG_MAX / 10; p10 *= 10) {
+            long around[6] = {p10 - 1, p10, p10 + 1, -p10 + 1, -p10, -p10 - 1}, j;
+            for (j = 0; j < 6; j++) {
+                tool_format_int(around[j], mine);
+                snprintf(theirs, sizeof theirs, "%ld", around[j]);
+                if (strcmp(mine, theirs) != 0 && bad_ints++ < 5) printf("int %ld written '%s'\n", around[j], mine);
+            }
+        }
+        for (k = 0; k < 4; k++) {
+            tool_format_int(extremes[k], mine);
+            snprintf(theirs, sizeof theirs, "%ld", extremes[k]);
+            if (strcmp(mine, theirs) != 0 && bad_ints++ < 5) printf("int %ld written '%s'\n", extremes[k], mine);
+        }
+        printf("integers: %ld written otherwise than printf %%ld\n", bad_ints);
+        bad += bad_ints;
+    }
     if (argc > 2) {                               /* speed: the same 1M values both ways */
         long m = 1000000, r, rounds = atol(argv[2]);
         float *values = (float *)malloc((size_t)m * sizeof(float));
@@ -2101,6 +2127,8 @@ if $HELPER_CC -std=c99 -O2 -I"$ROOT" -I"$ROOT/examples" "$W/fmt_check.c" "$ROOT/
     FMT=$("$W/fmt_check" 1000000 2>&1)
     check "tool_format_float: 1M random floats read back exactly" "0 without an exact round trip" "$FMT" \
         "$(printf '%s' "$FMT" | grep -q ' 0 without an exact round trip'; echo $?)"
+    check "tool_format_int: written as printf %ld writes them" "integers: 0 written otherwise" "$FMT" \
+        "$(printf '%s' "$FMT" | grep -q '^integers: 0 written otherwise'; echo $?)"
 else
     fail "helper for the float formatter" "$CMD" "compiles" "$(head -c 300 "$W/err")"
 fi
