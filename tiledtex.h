@@ -2332,10 +2332,12 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         box-filtered by 2^k until its larger side is at most match_size.
         Copies of it turned by 2 pi i / rotations, those within max_turn of
         no turn, are laid out on a P x P grid (P a power of two holding a
-        turned copy, or for a toroidal image two periods of it) and their
-        spectra cached once (tt_xcorr_texture): this is the memory of the
-        method, copies * (channels + 1) * P * (P / 2 + 1) * 16 bytes (5
-        copies, 3 channels, P = 256: 10 MB; all 19: 40 MB).
+        turned copy, or for a toroidal image two periods of it), kept as
+        float planes (copies * channels * P^2 * 4 bytes: 5 copies, 3
+        channels, P = 256: 4 MB) and, at the first fit that correlates by
+        transforms (step 3), their spectra cached (tt_xcorr_texture):
+        copies * (channels + 1) * P * (P / 2 + 1) * 16 bytes (10 MB; all
+        19 copies: 40 MB) and a work space per copy.
         Why max_turn: the paper tries all 19 orientations and lets the
         orientation "propagate from the first texture patch" (Sec. 2.2)
         through the fit alone; with a band a few texels wide, a brick or a
@@ -2354,11 +2356,17 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         a random angle (D8), so that the exact continuation of a single
         neighbour is not the answer unless asked for.
      3. The fit (Sec. 4.2, D1, D5-D7, D27, D33): one masked correlation of
-        the band against every turned copy (tt_xcorr_masked_best), offsets
-        restricted so that C's footprint and its band stay inside a bounded
-        image with a margin of one texel (D6; for a toroidal image, inside
-        the copy's grid). The best offset is refined at full resolution by a
-        direct sum over +-2^k texels. Its normalised error (D4)
+        the band against every turned copy, offsets restricted so that C's
+        footprint and its band stay inside a bounded image with a margin of
+        one texel (D6; for a toroidal image, inside the copy's grid): by
+        transforms (as tt_xcorr_masked_best), or, when the band holds few
+        pixels at the matching resolution (tens, on a scan of 100k faces),
+        by sums over them at each allowed offset, whichever costs less; the
+        same smallest sum of squared differences either way (to rounding).
+        With an executor the copies, their allowed offsets and their
+        correlations run as parallel tasks. The best offset is refined at
+        full resolution by a direct sum over +-2^k texels. Its normalised
+        error (D4)
             eps = (sum of squared differences) / (channels * band pixels) / (2 sigma^2)
         with sigma^2 the image's mean per-channel variance: 0 for a perfect
         continuation, about 1 for unrelated pixels.
@@ -2431,6 +2439,8 @@ typedef struct tt_hpm_options {
     double max_flattening_error; /* tt_flatten_options.max_error; 0 = its default (0.10) */
     tt_progress_fn progress;     /* fraction of faces textured; may cancel */
     void *progress_user_data;
+    const tt_executor *executor; /* runs each fit's turned copies (their allowed offsets and correlations) as
+                                    parallel tasks; NULL: serial; the same UVs either way */
 } tt_hpm_options;
 
 typedef struct tt_hpm_report {
@@ -2472,8 +2482,11 @@ typedef struct tt_hpm_report {
      TT_CANCELLED               the progress callback stopped it;
      TT_ERROR_OUT_OF_MEMORY.
    On any error corner_uv and face_cluster are untouched. Time: the
-   hierarchy and flattening (above) plus about 10 ms per fit at P = 256
-   (report->fits), typically a few hundred fits for 20k faces. */
+   hierarchy and flattening (above) plus, per fit (report->fits), about
+   10 ms at P = 256 by transforms or 0.3 ms summing a band of 30 pixels
+   over 5 copies; the border relaxation about as much again. The horse
+   (97k faces, 1170 fits, gravel 512 x 512) takes about 3 s at -O2 on one
+   core (v0.3.0: 9 s). The executor's tasks allocate nothing. */
 TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
                            const tt_allocator *allocator, float *corner_uv, int *face_cluster,
                            tt_hpm_report *report, tt_error *error);
@@ -7722,6 +7735,28 @@ TTDEF tt_result tt_xcorr_masked(const tt_xcorr_texture *texture, const double *m
    time they take in blocks of 1024 and a third less than in blocks of 512. */
 #define TT__XCORR_BLOCK 128
 
+/* One texture's part of tt_xcorr_masked_best: the combined spectrum from
+   the masked planes' scaled spectra (`spectra`: channels + 1 of them, as
+   tt__xcorr_masked_spectrum makes them, plane -1 first) into acc
+   (spectrum_size doubles), its inverse, E and its smallest allowed value,
+   as tt__xcorr_scan. Returns non-zero when an E is a NaN or infinity.
+   Several textures may run at once, each with its own acc. */
+static uint64_t tt__xcorr_texture_best(const tt_xcorr_texture *texture, const double *spectra, double energy,
+                                       const unsigned char *allowed, double *acc, int *best, double *best_e)
+{
+    size_t half = texture->spectrum_size, begin, count;
+    uint64_t found;
+    int c;
+    for (begin = 0; begin < half / 2; begin += count) {
+        count = half / 2 - begin < TT__XCORR_BLOCK ? half / 2 - begin : TT__XCORR_BLOCK;
+        for (c = -1; c < texture->channels; c++)
+            tt__xcorr_add_term(acc, spectra + half * (size_t)(c + 1), texture, c, begin, count);
+    }
+    found = tt__fft_c2r_inplace(texture->plan, acc);
+    found |= tt__xcorr_scan(texture, energy, acc, allowed, NULL, best, best_e);
+    return found;
+}
+
 /* Does texture k have an allowed offset (allowed as tt_xcorr_masked_best's)? */
 static int tt__xcorr_any_allowed(const unsigned char *const *allowed, int k, size_t plane)
 {
@@ -7738,7 +7773,7 @@ TTDEF tt_result tt_xcorr_masked_best(const tt_xcorr_texture *const *textures, in
 {
     const tt_xcorr_texture *first;
     int k, c, any = 0, best_texture = -1;
-    size_t half, plane, begin, count;
+    size_t half, plane;
     double *acc, mask_sum, energy;
     tt_xcorr_match match;
     tt_result result;
@@ -7796,19 +7831,10 @@ TTDEF tt_result tt_xcorr_masked_best(const tt_xcorr_texture *const *textures, in
        a strictly smaller E is needed to displace an earlier texture's. */
     for (k = 0; k < ntextures; k++) {
         const tt_xcorr_texture *texture = textures[k];
-        const unsigned char *allowed_k = allowed ? allowed[k] : NULL;
-        uint64_t found;
         double e;
         int best;
         if (!tt__xcorr_any_allowed(allowed, k, plane)) continue;
-        for (begin = 0; begin < half / 2; begin += count) {
-            count = half / 2 - begin < TT__XCORR_BLOCK ? half / 2 - begin : TT__XCORR_BLOCK;
-            for (c = -1; c < texture->channels; c++)
-                tt__xcorr_add_term(acc, work + half * (size_t)(c + 1), texture, c, begin, count);
-        }
-        found = tt__fft_c2r_inplace(texture->plan, acc);
-        found |= tt__xcorr_scan(texture, energy, acc, allowed_k, NULL, &best, &e);
-        if (found)
+        if (tt__xcorr_texture_best(texture, work, energy, allowed ? allowed[k] : NULL, acc, &best, &e))
             return tt__fail_at(error, TT_ERROR_NON_FINITE, k, -1, -1,
                                "the correlation with texture %d overflows (a NaN or infinity in E): scale the values",
                                k);
@@ -14227,7 +14253,7 @@ typedef struct tt__hier {
     const tt_allocator *al;
     int nf, nv, branching;
     tt_rng rng;
-    double *centroid;           /* 3 per face */
+    double *centroid;           /* 3 per face, until the steps are made from them */
     double *step;               /* per corner: the dual step across its edge (tt__field_step), 0 on a boundary */
     int *across;                /* per corner: the face across its edge, -1 on a boundary */
     double *farea;              /* per face */
@@ -14771,6 +14797,9 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
         H.step[c] = mesh->twin[c] < 0 ? 0.0
                                       : tt__field_step(mesh, H.centroid, mesh->corner_face[c], c,
                                                        mesh->corner_face[mesh->twin[c]]);
+    /* the centroids served the steps only */
+    tt__free(allocator, H.centroid);
+    H.centroid = NULL;
     for (v = 0; v <= H.nv; v++) H.vstart[v] = 0;
     for (v = 0; v < H.nv; v++) H.vboundary[v] = 0, H.vstamp[v] = 0;
     for (c = 0; c < mesh->ncorners; c++) {
@@ -15417,6 +15446,19 @@ typedef struct tt__hpm_owner {
     int valid;                  /* at least two distinct shared vertices */
 } tt__hpm_owner;
 
+/* One task of a fit's correlation: rows y_begin .. y_end - 1 of one copy
+   (direct sums), or a whole copy (transforms), and what it found. */
+typedef struct tt__hpm_task {
+    int copy, y_begin, y_end;
+    int best;                   /* the smallest E's offset, y * P + x; -1 when none */
+    double e;
+    uint64_t found;             /* a NaN or infinity */
+} tt__hpm_task;
+
+/* Rows of one copy per task of the direct sums: about 20 microseconds of
+   work on the horse's bands, long against handing out a task. */
+#define TT__HPM_DIRECT_ROWS 32
+
 typedef struct tt__hpm {
     const tt_mesh *mesh;
     const tt_allocator *al;
@@ -15437,11 +15479,15 @@ typedef struct tt__hpm {
     int f, ww, wh, P;           /* box factor, matching copy's size, FFT size */
     float *match;               /* nch planes ww x wh */
     tt_xcorr_texture **tex;     /* `copies` turned copies */
+    const tt_executor *executor;
+    int *copy_any;              /* copies: the fit's copy has an allowed offset */
+    struct tt__hpm_task *tasks; /* a fit's correlation tasks */
+    int ntasks;
     float *planes;              /* copies x nch planes P x P: the turned copies themselves, for direct sums */
     int *span;                  /* copies x P x 2: per copy and row, the run of allowed offsets (first, last) */
     int *term_x, *term_y;       /* P x P: the band's pixels in row-major order, for direct sums */
     double *term_weight, *term_values;  /* P x P, nch x P x P: their weights and values */
-    float *rows;                /* P x P: E of the direct sums in float */
+    float *rows;                /* copies x P x P: E of the direct sums in float */
     double *relax_sides;        /* 3 x TT__HPM_RING_MAX x TT__HPM_SIDE_VALUES: the relaxation's edge samples */
     double *xwork, *mask, *values;
     unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band; 0 outside the canvas */
@@ -15457,7 +15503,8 @@ typedef struct tt__hpm {
     double *out;                /* the random-placement control's map, or NULL */
     int *owner;                 /* per face: the textured cluster showing it, or -1 */
     int *in_c, *seen;           /* per face stamps */
-    double *placed;             /* 2 * ncorners: each cluster's rigid placement, before its border work */
+    double *placed;             /* 6 per face of the cluster being placed (in its order): its rigid
+                                   placement, before its border work; only the first 6 * its faces touched */
     double *vdisp;              /* 5 * nverts: displacement, its sums, for the interior re-solve */
     int *vmark;                 /* per vertex: stamp of the cluster it is inside (not on its border) */
     int stamp;
@@ -15627,10 +15674,12 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
     S->term_y = TT__ALLOC(S->al, int, pp);
     S->term_weight = TT__ALLOC(S->al, double, pp);
     S->term_values = TT__ALLOC(S->al, double, (size_t)S->nch * pp);
-    S->rows = TT__ALLOC(S->al, float, pp);
+    S->rows = TT__ALLOC(S->al, float, pp * (size_t)S->copies);
+    S->copy_any = TT__ALLOC(S->al, int, (size_t)S->copies);
+    S->tasks = TT__ALLOC(S->al, struct tt__hpm_task, (size_t)S->copies * (S->P / TT__HPM_DIRECT_ROWS + 1) + 4);
     if (!S->mask || !S->values || !S->support || !S->allowed_mem || !S->allowed || !S->dist ||
         !S->src || !S->band_pixels || !S->span || !S->term_x || !S->term_y || !S->term_weight ||
-        !S->term_values || !S->rows)
+        !S->term_values || !S->rows || !S->copy_any || !S->tasks)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
     for (k = 0; k < S->copies; k++) S->allowed[k] = S->allowed_mem + (size_t)k * pp;
     /* cleared once: each fit clears what the previous one drew */
@@ -16165,83 +16214,103 @@ static double tt__hpm_refine_turn(const tt__hpm *S, int C, tt__hpm_place *pl, do
    a margin of one texel (D6). With a main neighbour whose continuation is
    at canvas offset cont (o: the canvas origin), the offsets within
    `exclusion` texels of it in copy 0 are left out (D8). Returns 0 when no
-   offset is allowed. */
+   offset is allowed. The copies are independent tasks (the executor's). */
+typedef struct tt__hpm_allowed_job {
+    tt__hpm *S;
+    int cw, ch, maxx, maxy;     /* the canvas, the support's last column and row */
+} tt__hpm_allowed_job;
+
+/* Copy k's map and runs of allowed offsets; S->copy_any[k] says whether it
+   has one. */
+static void tt__hpm_allowed_copy(void *context, int k)
+{
+    const tt__hpm_allowed_job *job = (const tt__hpm_allowed_job *)context;
+    tt__hpm *S = job->S;
+    double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
+    double m_w = 1.0 / S->f;
+    int i, j, P = S->P, cw = job->cw, ch = job->ch, maxx = job->maxx, maxy = job->maxy, any = 0;
+    unsigned char *a = S->allowed_mem + (size_t)k * P * P;
+    int *span = S->span + 2 * (size_t)P * k;
+    double th = S->angle[k], ct = cos(th), st = sin(th);
+    /* n' = R(theta) n for n = +x, -x, +y, -y; limits L - n.c_T */
+    double nx[4], ny[4], lim[4], mx[4];
+    int d, tx, ty;
+    nx[0] = ct; ny[0] = st; lim[0] = S->ww - m_w - ctx;
+    nx[1] = -ct; ny[1] = -st; lim[1] = -m_w + ctx;
+    nx[2] = -st; ny[2] = ct; lim[2] = S->wh - m_w - cty;
+    nx[3] = st; ny[3] = -ct; lim[3] = -m_w + cty;
+    for (d = 0; d < 4; d++) mx[d] = -1e300;
+    if (!S->toroidal)
+        for (j = 0; j < ch; j++)
+            for (i = 0; i < cw; i++)
+                if (S->support[(size_t)j * P + i])
+                    for (d = 0; d < 4; d++) {
+                        double v = nx[d] * (i - cb) + ny[d] * (j - cb) + (nx[d] > 0 ? nx[d] : 0) +
+                                   (ny[d] > 0 ? ny[d] : 0);
+                        if (v > mx[d]) mx[d] = v;
+                    }
+    /* the map is 0 outside the runs: clear the previous fit's */
+    for (ty = 0; ty < P; ty++) {
+        if (span[2 * ty + 1] >= span[2 * ty])
+            memset(a + (size_t)ty * P + span[2 * ty], 0, (size_t)(span[2 * ty + 1] - span[2 * ty] + 1));
+        span[2 * ty] = 0;
+        span[2 * ty + 1] = -1;
+    }
+    for (ty = 0; ty < P - maxy; ty++) {
+        /* Each limit holds on a prefix or a suffix of the row (the
+           rounded nx tx + ny ty is monotone in tx), so the row's
+           allowed offsets are one run, found from the exact bound and
+           nudged to where the rounded test changes. */
+        int lo = 0, hi = P - maxx - 1;
+        if (!S->toroidal)
+            for (d = 0; d < 4 && lo <= hi; d++) {
+                double row = ny[d] * ty, limit = lim[d] - mx[d], edge;
+                if (nx[d] == 0) {
+                    if (!(row <= limit)) hi = lo - 1;
+                    continue;
+                }
+                edge = (limit - row) / nx[d];
+                edge = edge < -1.0 ? -1.0 : (edge > P ? P : edge);
+                if (nx[d] > 0) {
+                    /* the largest tx that holds, searched near floor(edge) */
+                    tx = (int)floor(edge);
+                    while (tx >= 0 && !(nx[d] * tx + row <= limit)) tx--;
+                    while (tx + 1 < P && nx[d] * (tx + 1) + row <= limit) tx++;
+                    if (tx < hi) hi = tx;
+                } else {
+                    tx = (int)ceil(edge);
+                    while (tx < P && !(nx[d] * tx + row <= limit)) tx++;
+                    while (tx - 1 >= 0 && nx[d] * (tx - 1) + row <= limit) tx--;
+                    if (tx > lo) lo = tx;
+                }
+            }
+        if (lo > hi) continue;
+        memset(a + (size_t)ty * P + lo, 1, (size_t)(hi - lo + 1));
+        span[2 * ty] = lo;
+        span[2 * ty + 1] = hi;
+        any = 1;
+    }
+    S->copy_any[k] = any;
+}
+
 static int tt__hpm_allowed_offsets(tt__hpm *S, int cw, int ch, int has_cont, const double *cont, const double *o,
                                    double exclusion)
 {
     double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
-    double m_w = 1.0 / S->f;
-    size_t pp = (size_t)S->P * S->P;
-    int i, j, k, P = S->P, maxx = 0, maxy = 0, any = 0;
+    int i, j, k, P = S->P, any = 0;
+    tt__hpm_allowed_job job;
+    job.S = S;
+    job.cw = cw;
+    job.ch = ch;
+    job.maxx = job.maxy = 0;
     for (j = 0; j < ch; j++)
         for (i = 0; i < cw; i++)
             if (S->support[(size_t)j * P + i]) {
-                if (i > maxx) maxx = i;
-                if (j > maxy) maxy = j;
+                if (i > job.maxx) job.maxx = i;
+                if (j > job.maxy) job.maxy = j;
             }
-    for (k = 0; k < S->copies; k++) {
-        unsigned char *a = S->allowed_mem + (size_t)k * pp;
-        double th = S->angle[k], ct = cos(th), st = sin(th);
-        /* n' = R(theta) n for n = +x, -x, +y, -y; limits L - n.c_T */
-        double nx[4], ny[4], lim[4], mx[4];
-        int d, tx, ty;
-        nx[0] = ct; ny[0] = st; lim[0] = S->ww - m_w - ctx;
-        nx[1] = -ct; ny[1] = -st; lim[1] = -m_w + ctx;
-        nx[2] = -st; ny[2] = ct; lim[2] = S->wh - m_w - cty;
-        nx[3] = st; ny[3] = -ct; lim[3] = -m_w + cty;
-        for (d = 0; d < 4; d++) mx[d] = -1e300;
-        if (!S->toroidal)
-            for (j = 0; j < ch; j++)
-                for (i = 0; i < cw; i++)
-                    if (S->support[(size_t)j * P + i])
-                        for (d = 0; d < 4; d++) {
-                            double v = nx[d] * (i - cb) + ny[d] * (j - cb) + (nx[d] > 0 ? nx[d] : 0) +
-                                       (ny[d] > 0 ? ny[d] : 0);
-                            if (v > mx[d]) mx[d] = v;
-                        }
-        int *span = S->span + 2 * (size_t)P * k;
-        /* the map is 0 outside the runs: clear the previous fit's */
-        for (ty = 0; ty < P; ty++) {
-            if (span[2 * ty + 1] >= span[2 * ty])
-                memset(a + (size_t)ty * P + span[2 * ty], 0, (size_t)(span[2 * ty + 1] - span[2 * ty] + 1));
-            span[2 * ty] = 0;
-            span[2 * ty + 1] = -1;
-        }
-        for (ty = 0; ty < P - maxy; ty++) {
-            /* Each limit holds on a prefix or a suffix of the row (the
-               rounded nx tx + ny ty is monotone in tx), so the row's
-               allowed offsets are one run, found from the exact bound and
-               nudged to where the rounded test changes. */
-            int lo = 0, hi = P - maxx - 1;
-            if (!S->toroidal)
-                for (d = 0; d < 4 && lo <= hi; d++) {
-                    double row = ny[d] * ty, limit = lim[d] - mx[d], edge;
-                    if (nx[d] == 0) {
-                        if (!(row <= limit)) hi = lo - 1;
-                        continue;
-                    }
-                    edge = (limit - row) / nx[d];
-                    edge = edge < -1.0 ? -1.0 : (edge > P ? P : edge);
-                    if (nx[d] > 0) {
-                        /* the largest tx that holds, searched near floor(edge) */
-                        tx = (int)floor(edge);
-                        while (tx >= 0 && !(nx[d] * tx + row <= limit)) tx--;
-                        while (tx + 1 < P && nx[d] * (tx + 1) + row <= limit) tx++;
-                        if (tx < hi) hi = tx;
-                    } else {
-                        tx = (int)ceil(edge);
-                        while (tx < P && !(nx[d] * tx + row <= limit)) tx++;
-                        while (tx - 1 >= 0 && nx[d] * (tx - 1) + row <= limit) tx--;
-                        if (tx > lo) lo = tx;
-                    }
-                }
-            if (lo > hi) continue;
-            memset(a + (size_t)ty * P + lo, 1, (size_t)(hi - lo + 1));
-            span[2 * ty] = lo;
-            span[2 * ty + 1] = hi;
-            any = 1;
-        }
-    }
+    tt__run_tasks(S->executor, S->copies, tt__hpm_allowed_copy, &job);
+    for (k = 0; k < S->copies; k++) any |= S->copy_any[k];
     /* D8: not the exact continuation of that neighbour (copy 0 at
        the offset that repeats its map), nor anything within the
        cluster's radius of it, which would show the same texels shifted
@@ -16311,19 +16380,64 @@ static tt_result tt__hpm_spectra(tt__hpm *S, tt_error *error)
     tt__free(S->al, S->xwork);
     S->xwork = NULL;
     if (res != TT_OK) return res;
-    S->xwork = TT__ALLOC(S->al, double, S->tex[0]->best_work_size);
+    /* the masked planes' spectra, then one work space per copy */
+    S->xwork = TT__ALLOC(S->al, double, S->tex[0]->spectrum_size * (size_t)(S->nch + 1 + S->copies));
     if (!S->xwork) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (fit buffers)");
     return TT_OK;
 }
 
+/* The fit's correlation tasks: the terms and which half they run. */
+typedef struct tt__hpm_correlate_job {
+    tt__hpm *S;
+    const tt__xcorr_terms *terms;   /* direct sums */
+    double energy;                  /* transforms: sum J I^2 */
+} tt__hpm_correlate_job;
+
+static void tt__hpm_direct_task(void *context, int index)
+{
+    const tt__hpm_correlate_job *job = (const tt__hpm_correlate_job *)context;
+    tt__hpm *S = job->S;
+    tt__hpm_task *t = &S->tasks[index];
+    size_t pp = (size_t)S->P * S->P;
+    t->found = tt__xcorr_direct(S->P, S->P, S->planes + (size_t)t->copy * S->nch * pp, job->terms,
+                                S->span + 2 * (size_t)S->P * t->copy, S->allowed[t->copy], t->y_begin, t->y_end,
+                                S->rows + pp * t->copy + (size_t)S->P * t->y_begin, &t->best, &t->e);
+}
+
+/* The tasks' answers in order (copy, then rows): the first strictly
+   smallest E, so ties go to the first copy, then the first offset in
+   row-major order, as tt_xcorr_masked_best breaks them. */
+static tt_result tt__hpm_correlate_best(tt__hpm *S, tt_xcorr_match *match, int *best_k, tt_error *error)
+{
+    int i;
+    match->x = match->y = -1;
+    match->e = 0;
+    *best_k = -1;
+    for (i = 0; i < S->ntasks; i++) {
+        const tt__hpm_task *t = &S->tasks[i];
+        if (t->found)
+            return tt__fail_at(error, TT_ERROR_NON_FINITE, t->copy, -1, -1,
+                               "the band's sum of squared differences with copy %d overflows", t->copy);
+        if (t->best >= 0 && (*best_k < 0 || t->e < match->e)) {
+            *best_k = t->copy;
+            match->x = t->best % S->P;
+            match->y = t->best / S->P;
+            match->e = t->e;
+        }
+    }
+    return *best_k < 0 ? TT_ERROR_NOT_MEASURED : TT_OK;
+}
+
 /* tt_xcorr_masked_best's answer, summed directly: the band's pixels are
-   the terms, in row-major order (so that |J| adds up as there). */
+   the terms, in row-major order (so that |J| adds up as there); each copy's
+   rows with allowed offsets in tasks of TT__HPM_DIRECT_ROWS rows. */
 static tt_result tt__hpm_correlate_direct(tt__hpm *S, tt_xcorr_match *match, int *best_k, tt_error *error)
 {
     size_t pp = (size_t)S->P * S->P;
     tt__xcorr_terms terms;
+    tt__hpm_correlate_job job;
     double mask_sum = 0, energy = 0;
-    int i, c, k, *sorted = S->term_x;
+    int i, c, k, y, *sorted = S->term_x;
     memcpy(sorted, S->band_pixels, sizeof(int) * (size_t)S->nband);
     tt__sort_ints(sorted, S->nband);
     for (i = 0; i < S->nband; i++) {
@@ -16345,26 +16459,76 @@ static tt_result tt__hpm_correlate_direct(tt__hpm *S, tt_xcorr_match *match, int
     terms.weight = S->term_weight;
     terms.values = S->term_values;
     terms.energy = energy;
-    match->x = match->y = -1;
-    match->e = 0;
-    match->mask_sum = mask_sum;
-    match->masked_energy = energy;
-    *best_k = -1;
+    S->ntasks = 0;
     for (k = 0; k < S->copies; k++) {
-        double e;
-        int best;
-        if (tt__xcorr_direct(S->P, S->P, S->planes + (size_t)k * S->nch * pp, &terms, S->span + 2 * (size_t)S->P * k,
-                             S->allowed[k], 0, S->P, S->rows, &best, &e))
-            return tt__fail_at(error, TT_ERROR_NON_FINITE, k, -1, -1,
-                               "the band's sum of squared differences with copy %d overflows", k);
-        if (best >= 0 && (*best_k < 0 || e < match->e)) {
-            *best_k = k;
-            match->x = best % S->P;
-            match->y = best / S->P;
-            match->e = e;
+        const int *span = S->span + 2 * (size_t)S->P * k;
+        int first = -1, last = -1;
+        for (y = 0; y < S->P; y++)
+            if (span[2 * y + 1] >= span[2 * y]) {
+                if (first < 0) first = y;
+                last = y;
+            }
+        for (y = first; first >= 0 && y <= last; y += TT__HPM_DIRECT_ROWS) {
+            tt__hpm_task *t = &S->tasks[S->ntasks++];
+            t->copy = k;
+            t->y_begin = y;
+            t->y_end = y + TT__HPM_DIRECT_ROWS <= last ? y + TT__HPM_DIRECT_ROWS : last + 1;
         }
     }
-    return *best_k < 0 ? TT_ERROR_NOT_MEASURED : TT_OK;
+    job.S = S;
+    job.terms = &terms;
+    tt__run_tasks(S->executor, S->ntasks, tt__hpm_direct_task, &job);
+    match->mask_sum = mask_sum;
+    match->masked_energy = energy;
+    return tt__hpm_correlate_best(S, match, best_k, error);
+}
+
+/* The masked planes' spectra (plane c - 1 for task c), then each copy's
+   correlation, as tt_xcorr_masked_best makes them, each copy in its own
+   work space. */
+static void tt__hpm_spectrum_task(void *context, int index)
+{
+    const tt__hpm_correlate_job *job = (const tt__hpm_correlate_job *)context;
+    tt__hpm *S = job->S;
+    S->tasks[index].found = tt__xcorr_masked_spectrum(S->tex[0], S->mask, S->values, index - 1,
+                                                      S->xwork + S->tex[0]->spectrum_size * (size_t)index);
+}
+
+static void tt__hpm_transform_task(void *context, int index)
+{
+    const tt__hpm_correlate_job *job = (const tt__hpm_correlate_job *)context;
+    tt__hpm *S = job->S;
+    tt__hpm_task *t = &S->tasks[index];
+    size_t half = S->tex[0]->spectrum_size;
+    t->copy = index;
+    t->best = -1;
+    t->e = 0;
+    t->found = 0;
+    if (!S->copy_any[index]) return;
+    t->found = tt__xcorr_texture_best(S->tex[index], S->xwork, job->energy, S->allowed[index],
+                                      S->xwork + half * (size_t)(S->nch + 1 + index), &t->best, &t->e);
+}
+
+static tt_result tt__hpm_correlate_transforms(tt__hpm *S, tt_xcorr_match *match, int *best_k, tt_error *error)
+{
+    tt__hpm_correlate_job job;
+    double mask_sum, energy;
+    int c;
+    tt_result res = tt__xcorr_masked_sums(S->P, S->P, S->nch, S->mask, S->values, &mask_sum, &energy, error);
+    if (res != TT_OK) return res;
+    job.S = S;
+    job.terms = NULL;
+    job.energy = energy;
+    tt__run_tasks(S->executor, S->nch + 1, tt__hpm_spectrum_task, &job);
+    for (c = 0; c <= S->nch; c++)
+        if (S->tasks[c].found)
+            return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                            "the spectrum of the masked values overflows: scale the values");
+    tt__run_tasks(S->executor, S->copies, tt__hpm_transform_task, &job);
+    S->ntasks = S->copies;
+    match->mask_sum = mask_sum;
+    match->masked_energy = energy;
+    return tt__hpm_correlate_best(S, match, best_k, error);
 }
 
 /* Steps 2 and 3: the band and the fit. Returns 1 with *pl and *eps when
@@ -16466,8 +16630,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     if (tt__hpm_direct_pays(S))
         xr = tt__hpm_correlate_direct(S, &match, &best_k, error);
     else if ((xr = tt__hpm_spectra(S, error)) == TT_OK)
-        xr = tt_xcorr_masked_best((const tt_xcorr_texture *const *)S->tex, S->copies, S->mask, S->values,
-                                  S->allowed, S->xwork, &match, &best_k, error);
+        xr = tt__hpm_correlate_transforms(S, &match, &best_k, error);
     if (xr == TT_ERROR_NOT_MEASURED) return -1;
     if (xr != TT_OK) {
         *res = xr;
@@ -16982,8 +17145,9 @@ static void tt__hpm_smooth(tt__hpm *S, int C)
         for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) S->vmark[m->corner_vert[c]] = inside;
     }
     for (i = 0; i < cl->nfaces; i++) {
-        int f = S->H->faces[cl->first_face + i];
-        for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+        int f = S->H->faces[cl->first_face + i], first = m->face_start[f];
+        const double *p0 = S->placed + 6 * (size_t)i;
+        for (c = first; c < m->face_start[f + 1]; c++) {
             size_t v = (size_t)m->corner_vert[c];
             int e[2];
             e[0] = c;
@@ -16996,8 +17160,8 @@ static void tt__hpm_smooth(tt__hpm *S, int C)
                     S->vmark[m->corner_vert[tt__tri_next(e[k])]] = -1;
                 }
             }
-            d[5 * v] = S->uv[2 * c] - S->placed[2 * c];
-            d[5 * v + 1] = S->uv[2 * c + 1] - S->placed[2 * c + 1];
+            d[5 * v] = S->uv[2 * c] - p0[2 * (c - first)];
+            d[5 * v + 1] = S->uv[2 * c + 1] - p0[2 * (c - first) + 1];
             moved |= d[5 * v] != 0 || d[5 * v + 1] != 0;
         }
     }
@@ -17024,24 +17188,25 @@ static void tt__hpm_smooth(tt__hpm *S, int C)
             }
     for (i = 0; i < cl->nfaces; i++) {
         int f = S->H->faces[cl->first_face + i], first = m->face_start[f];
-        const double *p0 = S->placed + 2 * first, *p1 = p0 + 2, *p2 = p0 + 4;
+        const double *p0 = S->placed + 6 * (size_t)i, *p1 = p0 + 2, *p2 = p0 + 4;
         double before = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]), after, st;
         for (c = first; c < m->face_start[f + 1]; c++) {
             size_t v = (size_t)m->corner_vert[c];
             if (S->vmark[v] != inside) continue;
-            S->uv[2 * c] = S->placed[2 * c] + d[5 * v];
-            S->uv[2 * c + 1] = S->placed[2 * c + 1] + d[5 * v + 1];
+            S->uv[2 * c] = p0[2 * (c - first)] + d[5 * v];
+            S->uv[2 * c + 1] = p0[2 * (c - first) + 1] + d[5 * v + 1];
         }
         after = tt__hpm_tri_area(S, first, &st);
         undo |= !(after * before > 0 && fabs(after) >= 0.25 * fabs(before));
     }
     if (undo)
         for (i = 0; i < cl->nfaces; i++) {
-            int f = S->H->faces[cl->first_face + i];
-            for (c = m->face_start[f]; c < m->face_start[f + 1]; c++)
+            int f = S->H->faces[cl->first_face + i], first = m->face_start[f];
+            const double *p0 = S->placed + 6 * (size_t)i;
+            for (c = first; c < m->face_start[f + 1]; c++)
                 if (S->vmark[m->corner_vert[c]] == inside) {
-                    S->uv[2 * c] = S->placed[2 * c];
-                    S->uv[2 * c + 1] = S->placed[2 * c + 1];
+                    S->uv[2 * c] = p0[2 * (c - first)];
+                    S->uv[2 * c + 1] = p0[2 * (c - first) + 1];
                 }
         }
 }
@@ -17056,7 +17221,7 @@ static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
     for (i = 0; i < cl->nfaces; i++) {
         int f = S->H->faces[cl->first_face + i], c;
         S->owner[f] = C;
-        for (c = 2 * S->mesh->face_start[f]; c < 2 * S->mesh->face_start[f + 1]; c++) S->placed[c] = S->uv[c];
+        for (c = 0; c < 6; c++) S->placed[6 * (size_t)i + c] = S->uv[2 * (size_t)S->mesh->face_start[f] + c];
     }
     if (!(S->flags & TT_HPM_NO_RELAXATION)) {
         tt__hpm_close_cracks(S, C, pl);
@@ -17457,6 +17622,8 @@ static void tt__hpm_release(tt__hpm *S)
     tt__free(S->al, S->term_weight);
     tt__free(S->al, S->term_values);
     tt__free(S->al, S->rows);
+    tt__free(S->al, S->copy_any);
+    tt__free(S->al, S->tasks);
     tt__free(S->al, S->relax_sides);
     tt__free(S->al, S->flat);
     tt__free(S->al, S->uv);
@@ -17570,6 +17737,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.fopt.max_error = o.max_flattening_error;
     S.progress = o.progress;
     S.progress_user_data = o.progress_user_data;
+    S.executor = o.executor;
     tt_rng_seed(&S.rng, o.seed, 0x68706d);
     tt_rng_seed(&S.place_rng, o.seed, 0x706c6163);
     if (!(S.s > 0 && S.s < 1e300))

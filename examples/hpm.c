@@ -169,6 +169,7 @@ static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, 
     tool_progress_begin(&progress, "mapping", "of the faces textured");
     map.progress = tool_show_progress;
     map.progress_user_data = &progress;
+    map.executor = tool_executor();
     result = tt_hpm_map(m->mesh, image, &map, NULL, corner_uv, NULL, report, &error);
     tool_progress_end(&progress);
     if (result == TT_OK) return 0;

@@ -1287,6 +1287,54 @@ done:
     tt_mesh_free(mesh);
 }
 
+/* The executor runs each fit's turned copies as tasks: the same UVs and
+   clusters, bit for bit, whether they run serially, in reverse order or on
+   two threads; with the default bands (summed directly) and with wide ones
+   on a toroidal image (large clusters: their correlations by transforms). */
+static void test_hpm_map_executor(void)
+{
+    tt_mesh *mesh = hpm_mesh(M_SPHERE);
+    tt_image *im = NULL;
+    const tt_executor *executors[3];
+    int config, e;
+    executors[0] = NULL;
+    executors[1] = &g_reverse_executor;
+    executors[2] = &g_thread_executor;
+    make_value_noise(&im, 128, 128, 9);
+    for (config = 0; config < 2 && mesh && im; config++) {
+        float *uv[3] = {NULL, NULL, NULL};
+        int *cl[3] = {NULL, NULL, NULL};
+        tt_hpm_report rep[3];
+        tt_hpm_options o;
+        memset(&o, 0, sizeof o);
+        o.scale = config == 0 ? 6 : 3;
+        if (config == 1) {
+            o.band = 24;
+            o.max_turn = 180;
+            o.flags = TT_HPM_TOROIDAL;
+        }
+        for (e = 0; e < 3; e++) {
+            o.executor = executors[e];
+            if (hpm_run(mesh, im, &o, &uv[e], &cl[e], &rep[e]) != TT_OK) break;
+        }
+        if (e == 3) {
+            CHECK(rep[0].fits > 10, "configuration %d fits %d clusters (more than 10)", config, rep[0].fits);
+            for (e = 1; e < 3; e++)
+                CHECK(memcmp(uv[0], uv[e], sizeof(float) * 2 * (size_t)mesh->ncorners) == 0 &&
+                          memcmp(cl[0], cl[e], sizeof(int) * (size_t)mesh->nfaces) == 0 &&
+                          rep[0].fits == rep[e].fits && rep[0].mean_error == rep[e].mean_error,
+                      "configuration %d: the %s executor gives the serial UVs bit for bit", config,
+                      e == 1 ? "reverse-order" : "two-thread");
+        }
+        for (e = 0; e < 3; e++) {
+            free(uv[e]);
+            free(cl[e]);
+        }
+    }
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
 /* Seams on cluster borders: the fit against random placement of the same
    clusters (the control must score much worse). */
 static void test_hpm_map_seams(void)
@@ -1620,6 +1668,7 @@ void run_hpm_tests(void)
     RUN(test_flatten_errors);
     RUN(test_hpm_map_plane);
     RUN(test_hpm_map_continuation);
+    RUN(test_hpm_map_executor);
     RUN(test_hpm_map_seams);
     RUN(test_hpm_map_orientation);
     RUN(test_hpm_map_budget);
