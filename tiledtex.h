@@ -19384,12 +19384,19 @@ static void tt__quarter_turns(int turns, double x, double y, double out[2])
     }
 }
 
-TTDEF void tt_quad_map_apply(tt_quad_map map, double s, double t, double out[2])
+/* tt_quad_map_apply, for the loops that call it most (the relaxation's
+   charts): small enough to inline. */
+static void tt__quad_map_point(tt_quad_map map, double s, double t, double out[2])
 {
-    TT_ASSERT(out && map.turns >= 0 && map.turns < 4);
     tt__quarter_turns(map.turns, s, t, out);
     out[0] += map.offset[0];
     out[1] += map.offset[1];
+}
+
+TTDEF void tt_quad_map_apply(tt_quad_map map, double s, double t, double out[2])
+{
+    TT_ASSERT(out && map.turns >= 0 && map.turns < 4);
+    tt__quad_map_point(map, s, t, out);
 }
 
 TTDEF tt_quad_map tt_quad_map_compose(tt_quad_map outer, tt_quad_map inner)
@@ -20466,7 +20473,7 @@ static void tt__relax_chart_add(tt__relax_chart *c, int q, tt_quad_map map)
     c->slot[c->count] = i;
     c->quad[c->count] = q;
     c->map[c->count] = map;
-    tt_quad_map_apply(map, 0.5, 0.5, middle);
+    tt__quad_map_point(map, 0.5, 0.5, middle);
     c->cell[c->count][0] = (int)floor(middle[0]);
     c->cell[c->count][1] = (int)floor(middle[1]);
     c->count++;
@@ -20514,7 +20521,7 @@ static int tt__relax_chart_place(tt__relax_chart *c, tt_surface_point p, double 
     if (c->count == 0 || c->quad[0] != c->centre || c->built_radius != c->radius) tt__relax_chart_grow(c);
     while ((i = tt__relax_chart_find(c, p.quad)) < 0)
         if (!tt__relax_chart_grow(c)) return 0;
-    tt_quad_map_apply(c->map[i], p.s, p.t, at);
+    tt__quad_map_point(c->map[i], p.s, p.t, at);
     return 1;
 }
 
@@ -21087,7 +21094,8 @@ static void tt__relax_undo(tt__relax_state *R, int mark)
 }
 
 /* The vertices at a triangle that is not fine (`folded_only`: a folded
-   one), into R->visit in vertex order; returns how many. */
+   one), into R->visit (in no particular order: a sweep orders each group
+   of them); returns how many. */
 static int tt__relax_bad_vertices(tt__relax_state *R, int folded_only)
 {
     int i, n = 0, kept = 0;
@@ -21101,14 +21109,14 @@ static int tt__relax_bad_vertices(tt__relax_state *R, int folded_only)
         if (!folded_only || R->folded_at[v] > 0) R->visit[n++] = v;
     }
     R->nwatch = kept;
-    tt__sort_ints(R->visit, n);
     return n;
 }
 
-/* A sweep's vertices (R->visit[0..n), in vertex order, R->ring set) in
-   groups joined by shared triangles, each group in vertex order, dealt to
-   the lanes: the largest group first, each to the least loaded lane.
-   Returns the number of lanes with work. Depends on the vertices alone. */
+/* A sweep's vertices (R->visit[0..n), R->ring set) in groups joined by
+   shared triangles, each group in vertex order, dealt to the lanes: the
+   largest group first, each to the least loaded lane. Returns the number
+   of lanes with work. Depends on the vertices and their order in visit[]
+   alone (where the groups go does not change the result). */
 static int tt__relax_deal(tt__relax_state *R, int n)
 {
     const tt_mesh *model = R->model;
@@ -21415,8 +21423,8 @@ static void tt__relax_lane_task(void *context, int index)
     }
 }
 
-/* One sweep of `kind` over R->visit[0..n) (in vertex order, R->ring set
-   for them): the groups dealt to the lanes (tt__relax_deal), the lanes run
+/* One sweep of `kind` over R->visit[0..n) (R->ring set for them): the
+   groups dealt to the lanes (tt__relax_deal), the lanes run
    as tasks on the executor, then, in lane order, their journals, the
    stars their moves changed and their triangles' standing taken in.
    Returns the number of points moved, -1 when out of memory. */
@@ -21505,7 +21513,6 @@ static int tt__untangle(tt__relax_state *R, int strict, int *moves)
             }
         }
         region = nvisit;
-        tt__sort_ints(R->visit, nvisit);
         moved = tt__relax_sweep(R, nvisit, strict ? TT__SWEEP_STRICT : TT__SWEEP_FREE);
         for (i = 0; i < nvisit; i++) R->ring[R->visit[i]] = 0;
         if (moved < 0) return -1;
