@@ -2980,13 +2980,20 @@ typedef struct tt_polycube_mapping {
         onto a neighbour's sheet, a move kept only when it leaves the
         vertex's triangles better placed; then the folds left (a whole
         patch folded, where no vertex has a good place of its own) are
-        untangled by Escobar et al.'s energy, from their rims inward;
+        untangled by Escobar et al.'s energy, from their rims inward, each
+        vertex moved to its star's optimum by Newton steps, once with
+        steps that never fold more of a star and once freely, each region
+        keeping the way that leaves it fewer bad triangles. The sweeps
+        visit only the vertices at badly placed triangles (and, while
+        untangling, the rings around them) whose stars changed, so the
+        cost follows the folds, not the mesh;
      4. tt_polycube_trace_edges (max_quads); a vertex with an edge that
         finds no path (the projection seated it on the far side of a part
         about a cube thick) is tried on each neighbour's sheet and kept
         where fewest of its edges fail, then fewest of its triangles fold;
         its edges are traced again, and the relaxation of step 3 runs
-        again around the points so moved; then spikes: a vertex whose
+        again around the points so moved (a point it moves that leaves an
+        edge with no path goes back); then spikes: a vertex whose
         two edges in one triangle leave it through the same corner W of S
         (it lies just behind a saddle) would map part of that triangle
         onto a line; it is moved onto W unless another point is there,
@@ -3034,12 +3041,16 @@ typedef struct tt_polycube_mapping {
    the output's area equals the input's. An inside-out mesh
    (tt_polycube_report::inside_out) must be reversed first: the points go
    to the wrong sides of thin parts and every chart turns clockwise.
-   Measured (-O2, default options, resolution 32): a 100k-triangle torus
-   in about 0.4 s (make bench) with no fallback; the bunny (3.7k
-   triangles, 51k refined) in 0.4 s with 0.01 % fallbacks; a 97k-triangle
-   horse in 1 s with 0.04 %; a CAD flange in 0.6 s with 0.10 %; no
-   flipped triangle on any. Parts about a cube thick cost more time and
-   leave more fallbacks (an elephant's trunk and legs: 2.4 %, 2.5 s).
+   Measured (-O2, one thread, CPU): at resolution 32 the bunny (3.7k
+   triangles, 51k refined) in 0.2 s with 0.02 % fallbacks, a 97k-triangle
+   horse scan in 0.45 s with 0.02 %, a CAD flange in 0.3 s with 0.10 %;
+   parts about a cube thick cost more time and leave more fallbacks (an
+   elephant's trunk and legs: 2.3 %, 1.2 s). At the default 16 the horse
+   takes 1.6 s (0.9 % fallbacks), cut 1-to-4 (388k triangles) 6.5 s and
+   1-to-16 (1.55M) 20 s. No flipped triangle on any. With an executor
+   (options->executor) the projection, the relaxation's independent
+   groups of vertices, the tracing and the split run as tasks; the
+   mapping is the same, bit for bit.
    report may be NULL.
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
@@ -3048,8 +3059,10 @@ typedef struct tt_polycube_mapping {
    TT_ERROR_EMPTY_MESH; TT_ERROR_NON_FINITE; TT_ERROR_TOO_LARGE when the
    refinement would pass INT_MAX / 4 vertices; TT_ERROR_OUT_OF_MEMORY. On
    failure *out is NULL, the report zeroed, and nothing stays allocated.
-   Memory: the refined model and the edge records (about 100 bytes per
-   refined triangle) while it runs, and the result. Free the result with
+   Memory: the refined model, the edge records and the relaxation's
+   state (about 100 bytes per refined triangle) while it runs, and the
+   result. With an executor the allocator must be thread-safe (see
+   tt_executor). Free the result with
    tt_polycube_mapping_free. Same input, same output; thread-safe. */
 TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
                                 const tt_polycube_map_options *options, const tt_allocator *allocator,
@@ -22860,9 +22873,9 @@ typedef struct tt__split_job {
     int first;                  /* the batch's first triangle */
 } tt__split_job;
 
-/* Task `index` of a batch: its range of triangles split (P11 steps 4, 7),
-   into its own vertices and triangles; per triangle where they end, and
-   whether it fell back. */
+/* Task `index` of a batch: its range of triangles split (the pieces, the
+   fan around a cone, or the fallback), into its own vertices and
+   triangles; per triangle where they end, and whether it fell back. */
 static void tt__split_range_task(void *context, int index)
 {
     const tt__split_job *job = (const tt__split_job *)context;
@@ -22961,7 +22974,7 @@ static void tt__split_free(tt__split *S)
     memset(S, 0, sizeof *S);
 }
 
-/* P11 steps 4 and 7 for every triangle of `model`: the mapping, its
+/* The split of every triangle of `model` (Sec. 4.3): the mapping, its
    vertices the model's first, then, triangle by triangle, the split
    points and vertices each makes, and its pieces. The triangles are split
    in ranges of TT__SPLIT_RANGE, each a task on the executor (a triangle's
