@@ -5086,8 +5086,10 @@ static tt_result tt__check_image_size(int width, int height, tt_error *error)
 
 /* Pixels for an image held by value inside a larger object (a tileset's mip
    levels); released with tt__image_release. */
-static tt_result tt__image_init(tt_image *image, int width, int height, const tt_allocator *allocator,
-                                tt_error *error)
+/* An image whose pixels are allocated but not set: for a writer that sets
+   every texel (and then touches the memory first, on its own threads). */
+static tt_result tt__image_alloc(tt_image *image, int width, int height, const tt_allocator *allocator,
+                                 tt_error *error)
 {
     size_t count;
     tt_result result;
@@ -5099,11 +5101,11 @@ static tt_result tt__image_init(tt_image *image, int width, int height, const tt
     if (!image->pixels)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for a %d x %d image", width,
                         height);
-    memset(image->pixels, 0, count * 4 * sizeof(float));
     image->width = width;
     image->height = height;
     return TT_OK;
 }
+
 
 static void tt__image_release(tt_image *image)
 {
@@ -5520,10 +5522,11 @@ TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *erro
 }
 
 /* dst (allocated, half the size of src) = src halved by a 2x2 box. */
-static void tt__downsample_into(const tt_image *src, tt_image *dst)
+/* Rows y0 .. y1-1 of dst, every texel of them. */
+static void tt__downsample_rows(const tt_image *src, tt_image *dst, int y0, int y1)
 {
-    int x, y, k, w = dst->width, h = dst->height;
-    for (y = 0; y < h; y++)
+    int x, y, k, w = dst->width;
+    for (y = y0; y < y1; y++)
         for (x = 0; x < w; x++) {
             const float *a = src->pixels + ((size_t)(2 * y) * src->width + 2 * x) * 4;
             const float *b = a + (size_t)src->width * 4;
@@ -5532,6 +5535,11 @@ static void tt__downsample_into(const tt_image *src, tt_image *dst)
             if (src->kind == TT_IMAGE_NORMAL) tt__normalize_vector_texel(out);
         }
     dst->kind = src->kind;
+}
+
+static void tt__downsample_into(const tt_image *src, tt_image *dst)
+{
+    tt__downsample_rows(src, dst, 0, dst->height);
 }
 
 TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *allocator, tt_image **out_image,
@@ -8632,6 +8640,72 @@ static tt_result tt__check_plan_windows(const tt_synth_plan *plan, const tt_imag
     return TT_OK;
 }
 
+/* Tiles planned or composed per batch of tasks with an executor: enough
+   to keep workers busy, few enough that progress (and cancelling) comes
+   often. Serial runs report every tile. */
+#define TT__SYNTH_BATCH 64
+
+/* Planning's tiles, each its own task (the background windows are drawn
+   before, in tile order, from the one random stream): tile first + index
+   is laid in a scratch tile of its own and its four bands' depths go into
+   the plan. A failure goes into the task's slot, reported afterwards in
+   tile order, as the serial loop would stop at it. */
+typedef struct tt__plan_job {
+    tt_synth_plan *plan;
+    tt__synth base;             /* the guide and windows; each task adds its scratch tile */
+    int first, min_depth, max_depth;
+    const tt_allocator *allocator;
+    tt_result *result;          /* per task of the batch */
+    tt_error *error;            /* per task of the batch */
+} tt__plan_job;
+
+static void tt__plan_task(void *context, int index)
+{
+    const tt__plan_job *job = (const tt__plan_job *)context;
+    tt_synth_plan *plan = job->plan;
+    const int S = plan->layout.tile_size, T = tt_tile_layout_tiles_per_side(&plan->layout), t = job->first + index;
+    const int column = t % T, row = t / T, base = 2 * plan->layout.colors;
+    tt__synth s = job->base;
+    tt_result *result = &job->result[index];
+    tt_error *error = &job->error[index];
+    float *scratch = TT__ALLOC(job->allocator, float, (size_t)S * S * 4);
+    float *cost = TT__ALLOC(job->allocator, float, (size_t)S * (job->max_depth + 1));
+    int *lo = TT__ALLOC(job->allocator, int, S), *hi = TT__ALLOC(job->allocator, int, S);
+    int *cut = TT__ALLOC(job->allocator, int, S), side, x;
+    uint8_t types[4];
+    *result = tt__ok(error);
+    if (!scratch || !cost || !lo || !hi || !cut) {
+        *result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+        goto done;
+    }
+    types[0] = (uint8_t)(column / base);
+    types[1] = (uint8_t)(column % base);
+    types[2] = (uint8_t)(row / base);
+    types[3] = (uint8_t)(row % base);
+    s.tile = scratch;
+    s.stride = (size_t)S * 4;
+    tt__copy_background(&s, &plan->background_windows[t]);
+    /* Each band's cut is against what the bands laid before it left (D
+       first); the last band (A) covers nothing that is cut later. */
+    for (side = 3; side >= 0; side--) {
+        size_t depth_base = (4 * (size_t)t + (size_t)side) * (size_t)S;
+        *result = tt__band_depths(&s, side, types[side], job->min_depth, job->max_depth, cost, lo, hi, cut,
+                                  job->allocator, error);
+        if (*result != TT_OK) goto done;
+        for (x = 0; x < S; x++) {
+            if (plan->depth8) plan->depth8[depth_base + (size_t)x] = (uint8_t)cut[x];
+            else plan->depth16[depth_base + (size_t)x] = (uint16_t)cut[x];
+        }
+        if (side > 0) tt__lay_band(&s, plan, depth_base, side, types[side]);
+    }
+done:
+    tt__free(job->allocator, scratch);
+    tt__free(job->allocator, cost);
+    tt__free(job->allocator, lo);
+    tt__free(job->allocator, hi);
+    tt__free(job->allocator, cut);
+}
+
 static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_options *options,
                                        const tt_allocator *allocator, tt_synth_plan **out_plan, tt_error *error,
                                        const char *what, float progress_from, float progress_to)
@@ -8639,14 +8713,12 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     tt_synth_options defaults;
     const tt_synth_options *opt = options;
     tt_synth_plan *plan = NULL;
-    tt__synth s;
+    tt__plan_job job;
     tt_tile_layout layout;
     tt_rect region;
     tt_rng rng;
     tt_result result;
-    float *scratch = NULL, *cost = NULL;
-    int *lo = NULL, *hi = NULL, *cut = NULL;
-    int S, g, T, n, ntiles, feather, min_depth, max_depth, depth_size, t, k, side;
+    int S, g, T, n, ntiles, feather, min_depth, max_depth, depth_size, t, k, batch;
     unsigned long long head, edge_bytes, background_bytes, depth_count, bytes;
 
     tt__ok(error);
@@ -8718,13 +8790,12 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "a plan of %d tiles of %d texels needs more memory than this machine can address", ntiles,
                         S);
+    batch = opt->executor && opt->executor->run ? TT__SYNTH_BATCH : 1;
     plan = (tt_synth_plan *)tt__alloc(allocator, (size_t)bytes);
-    scratch = TT__ALLOC(allocator, float, (size_t)S * S * 4);
-    cost = TT__ALLOC(allocator, float, (size_t)S * (max_depth + 1));
-    lo = TT__ALLOC(allocator, int, S);
-    hi = TT__ALLOC(allocator, int, S);
-    cut = TT__ALLOC(allocator, int, S);
-    if (!plan || !scratch || !cost || !lo || !hi || !cut) {
+    memset(&job, 0, sizeof job);
+    job.result = TT__ALLOC(allocator, tt_result, batch);
+    job.error = TT__ALLOC(allocator, tt_error, batch);
+    if (!plan || !job.result || !job.error) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
         goto done;
     }
@@ -8772,41 +8843,37 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
         }
     }
 
-    memset(&s, 0, sizeof s);   /* the guide's texels as they are: the cuts compare them */
-    s.source = guide;
-    s.windows = plan->edge_windows;
-    s.vertical = plan->vertical_windows;
-    s.size = S;
-    s.gutter = g;
-    s.feather = feather;
-    s.tile = scratch;
-    s.stride = (size_t)S * 4;
+    /* The background windows, in tile order from the one stream. XXXX: a
+       fresh background window per tile gives the aperiodicity. */
     for (t = 0; t < ntiles; t++) {
-        int column = t % T, row = t / T, base = 2 * n, x;
-        uint8_t types[4];
         tt_rect *bg = &plan->background_windows[t];
-        types[0] = (uint8_t)(column / base);
-        types[1] = (uint8_t)(column % base);
-        types[2] = (uint8_t)(row / base);
-        types[3] = (uint8_t)(row % base);
-        /* XXXX: a fresh background window per tile gives the aperiodicity. */
         bg->x = region.x + (int)tt_rng_below(&rng, (uint32_t)(region.w - S + 1));
         bg->y = region.y + (int)tt_rng_below(&rng, (uint32_t)(region.h - S + 1));
         bg->w = bg->h = S;
-        tt__copy_background(&s, bg);
-        /* Each band's cut is against what the bands laid before it left
-           (D first); the last band (A) covers nothing that is cut later. */
-        for (side = 3; side >= 0; side--) {
-            size_t depth_base = (4 * (size_t)t + (size_t)side) * (size_t)S;
-            result = tt__band_depths(&s, side, types[side], min_depth, max_depth, cost, lo, hi, cut, allocator, error);
-            if (result != TT_OK) goto done;
-            for (x = 0; x < S; x++) {
-                if (plan->depth8) plan->depth8[depth_base + (size_t)x] = (uint8_t)cut[x];
-                else plan->depth16[depth_base + (size_t)x] = (uint16_t)cut[x];
+    }
+    /* The tiles' cuts, in batches through the executor, the progress
+       reported between them on this thread. */
+    job.plan = plan;
+    job.base.source = guide;   /* the guide's texels as they are: the cuts compare them */
+    job.base.windows = plan->edge_windows;
+    job.base.vertical = plan->vertical_windows;
+    job.base.size = S;
+    job.base.gutter = g;
+    job.base.feather = feather;
+    job.min_depth = min_depth;
+    job.max_depth = max_depth;
+    job.allocator = allocator;
+    for (t = 0; t < ntiles; t += batch) {
+        int count = tt__min_i(batch, ntiles - t);
+        job.first = t;
+        tt__run_tasks(opt->executor, count, tt__plan_task, &job);
+        for (k = 0; k < count; k++)
+            if (job.result[k] != TT_OK) {
+                result = job.result[k];
+                if (error) *error = job.error[k];
+                goto done;
             }
-            if (side > 0) tt__lay_band(&s, plan, depth_base, side, types[side]);
-        }
-        if (tt__synth_report(opt->progress, opt->progress_user_data, progress_from, progress_to, t + 1, ntiles)) {
+        if (tt__synth_report(opt->progress, opt->progress_user_data, progress_from, progress_to, t + count, ntiles)) {
             result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "tile synthesis was cancelled");
             goto done;
         }
@@ -8814,11 +8881,8 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     result = TT_OK;
 
 done:
-    tt__free(allocator, scratch);
-    tt__free(allocator, cost);
-    tt__free(allocator, lo);
-    tt__free(allocator, hi);
-    tt__free(allocator, cut);
+    tt__free(allocator, job.result);
+    tt__free(allocator, job.error);
     if (result != TT_OK) {
         tt__free(allocator, plan);
         return result;
@@ -8940,11 +9004,6 @@ TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image 
     return TT_OK;
 }
 
-/* Tiles composed per batch of tasks with an executor: enough to keep
-   workers busy, few enough that progress (and cancelling) comes often.
-   Serial runs report every tile. */
-#define TT__SYNTH_BATCH 64
-
 typedef struct tt__compose_job {
     const tt_synth_plan *plan;
     const tt_image *source;
@@ -8965,10 +9024,27 @@ static void tt__compose_task(void *context, int index)
     types[1] = (uint8_t)(column % base);
     types[2] = (uint8_t)(row / base);
     types[3] = (uint8_t)(row % base);
-    /* Tile row 0 of the formula is at the bottom of the atlas image. */
+    /* Tile row 0 of the formula is at the bottom of the atlas image. The
+       atlas comes unset (tt__image_alloc): composing sets every texel of
+       the cell, and touches its memory first, on the task's thread. */
     tt__compose_cell(plan, job->source, types, t,
                      job->atlas->pixels + ((size_t)(T - 1 - row) * C * (size_t)W + (size_t)column * C) * 4,
                      (size_t)W * 4);
+}
+
+/* Rows of a mip level, TT__MIP_ROWS a task: the level above halved
+   (tt__downsample_rows). */
+#define TT__MIP_ROWS 64
+
+typedef struct tt__mip_job {
+    const tt_image *above;
+    tt_image *level;
+} tt__mip_job;
+
+static void tt__mip_rows(void *context, int begin, int end)
+{
+    const tt__mip_job *job = (const tt__mip_job *)context;
+    tt__downsample_rows(job->above, job->level, begin, end);
 }
 
 static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *source, const tt_allocator *allocator,
@@ -9016,7 +9092,7 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
     memcpy(set->edge_windows, plan->edge_windows, (size_t)n * sizeof(tt_rect));
     if (plan->vertical_windows) memcpy(set->vertical_windows, plan->vertical_windows, (size_t)n * sizeof(tt_rect));
     memcpy(set->background_windows, plan->background_windows, (size_t)ntiles * sizeof(tt_rect));
-    if ((result = tt__image_init(&set->levels[0], W, W, allocator, error)) != TT_OK) goto done;
+    if ((result = tt__image_alloc(&set->levels[0], W, W, allocator, error)) != TT_OK) goto done;
     set->levels[0].kind = source->kind;
     set->nlevels = 1;
 
@@ -9044,10 +9120,13 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
        two cells, so halving the whole atlas halves every tile on its own. A
        level is seamless while its gutter is still at least a texel wide. */
     while (set->nlevels < TT_MAX_MIP_LEVELS && ((C >> (set->nlevels - 1)) % 2) == 0) {
-        const tt_image *above = &set->levels[set->nlevels - 1];
-        result = tt__image_init(&set->levels[set->nlevels], above->width / 2, above->height / 2, allocator, error);
+        tt__mip_job mip;
+        mip.above = &set->levels[set->nlevels - 1];
+        mip.level = &set->levels[set->nlevels];
+        result = tt__image_alloc(mip.level, mip.above->width / 2, mip.above->height / 2, allocator, error);
         if (result != TT_OK) goto done;
-        tt__downsample_into(above, &set->levels[set->nlevels]);
+        tt__parallel_ranges(plan->executor, mip.level->height, TT__MIP_ROWS, tt__mip_rows, &mip);
+        mip.level->kind = mip.above->kind;
         set->nlevels++;
     }
     set->seamless_levels = 0;

@@ -370,11 +370,29 @@ static void test_plan_wide_depths(void)
 /* The per-tile step                                                        */
 /* ------------------------------------------------------------------------ */
 
-/* The tiles composed through an executor (reverse order, two threads) are
-   the serial ones bit for bit, at every mip level, plain and upright. */
+/* An allocator that hands out memory full of 0xFF bytes (NaN floats):
+   synthesis must set every texel of the atlas and its levels itself. */
+static void *garbage_alloc(size_t size, void *user_data)
+{
+    void *p = malloc(size);
+    (void)user_data;
+    if (p) memset(p, 0xff, size);
+    return p;
+}
+
+static void garbage_free(void *p, void *user_data)
+{
+    (void)user_data;
+    free(p);
+}
+
+/* The tiles planned and composed through an executor (reverse order, two
+   threads) are the serial ones bit for bit, at every mip level, plain and
+   upright, from the same plan; and so are they from memory that comes full
+   of garbage. */
 static void test_synthesis_executor_identical(void)
 {
-    static const int configs[][3] = {{1, 32, 4}, {2, 16, 2}};
+    static const int configs[][3] = {{1, 32, 4}, {2, 16, 2}, {2, 16, 0}};
     const tt_executor *executors[2];
     size_t c, e;
     executors[0] = &g_reverse_executor;
@@ -385,7 +403,7 @@ static void test_synthesis_executor_identical(void)
         tt_tileset *serial = NULL;
         tt_error err;
         tt_result r;
-        o.upright = (int)c;
+        o.upright = (int)c % 2;
         r = tt_synthesize_tiles(src, &o, NULL, &serial, &err);
         CHECK(r == TT_OK, "config %d: serial synthesis: %d (%s)", (int)c, r, err.message);
         for (e = 0; e < 2 && r == TT_OK; e++) {
@@ -403,6 +421,43 @@ static void test_synthesis_executor_identical(void)
                   (int)e, differ);
             tt_tileset_free(par);
             o.executor = NULL;
+        }
+        if (r == TT_OK) {
+            tt_allocator garbage = {garbage_alloc, garbage_free, NULL};
+            tt_tileset *dirty = NULL;
+            int level, differ = 0;
+            o.executor = &g_thread_executor;
+            r = tt_synthesize_tiles(src, &o, &garbage, &dirty, &err);
+            o.executor = NULL;
+            CHECK(r == TT_OK && dirty->nlevels == serial->nlevels, "config %d from garbage memory: %d (%s)", (int)c,
+                  r, err.message);
+            for (level = 0; r == TT_OK && level < serial->nlevels; level++) {
+                const tt_image *a = &serial->levels[level], *b = &dirty->levels[level];
+                differ += memcmp(a->pixels, b->pixels, (size_t)a->width * (size_t)a->height * 4 * sizeof(float)) != 0;
+            }
+            CHECK(r == TT_OK && differ == 0, "config %d: %d mip levels made in garbage memory differ", (int)c, differ);
+            tt_tileset_free(dirty);
+        }
+        /* The plan itself (its tiles' cuts are planned in parallel too):
+           the same windows and depths, byte for byte. */
+        for (e = 0; e < 2 && r == TT_OK; e++) {
+            tt_synth_plan *a = NULL, *b = NULL;
+            size_t depths = 4 * (size_t)o.layout.tile_size * (size_t)tt_tile_layout_tile_count(&o.layout);
+            int same;
+            r = tt_synth_plan_create(src, &o, NULL, &a, &err);
+            o.executor = executors[e];
+            if (r == TT_OK) r = tt_synth_plan_create(src, &o, NULL, &b, &err);
+            o.executor = NULL;
+            CHECK(r == TT_OK && a && b, "config %d executor %d: plans: %d (%s)", (int)c, (int)e, r, err.message);
+            if (r != TT_OK || !a || !b) { tt_synth_plan_free(a); tt_synth_plan_free(b); break; }
+            same = memcmp(a->background_windows, b->background_windows,
+                          (size_t)tt_tile_layout_tile_count(&o.layout) * sizeof(tt_rect)) == 0 &&
+                   (a->depth8 ? memcmp(a->depth8, b->depth8, depths) == 0
+                              : memcmp(a->depth16, b->depth16, depths * sizeof(uint16_t)) == 0);
+            CHECK(same, "config %d executor %d: the plan's windows or depths differ from the serial plan's", (int)c,
+                  (int)e);
+            tt_synth_plan_free(a);
+            tt_synth_plan_free(b);
         }
         tt_tileset_free(serial);
         tt_image_free(src);
