@@ -81,7 +81,8 @@ typedef struct tiled_mesh {
 int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out);
 void tiled_mesh_free(tiled_mesh *mesh);
 
-/* Add OBJ_PATH (positions + one vt per corner, using MATERIAL from MTL_NAME
+/* Add OBJ_PATH (positions, then each distinct vt and vn once, the corners
+   sharing them (obj_write_desc::share_equal), using MATERIAL from MTL_NAME
    when mtl_name is not NULL; with `triangles` each quad as two triangles)
    to the output batch. */
 int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name,
