@@ -3635,6 +3635,18 @@ static int tt__prev(const tt_mesh *mesh, int c)
     return c > mesh->face_start[face] ? c - 1 : mesh->face_start[face + 1] - 1;
 }
 
+/* The face of corner c, arithmetic on an all-triangle or all-quad mesh as
+   tt__next is (no look-up in corner_face, which loops over scattered
+   corners would miss in the cache). */
+static int tt__face_of(const tt_mesh *mesh, int c)
+{
+    if (mesh->min_face_size == mesh->max_face_size) {
+        if (mesh->min_face_size == 4) return c >> 2;
+        if (mesh->min_face_size == 3) return c / 3;
+    }
+    return mesh->corner_face[c];
+}
+
 TTDEF int tt_mesh_next(const tt_mesh *mesh, int corner)
 {
     TT_ASSERT(mesh && corner >= 0 && corner < mesh->ncorners);
@@ -3920,11 +3932,11 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
             if (h == start) break;
         }
         for (i = 0; i < count; i++) {
-            const double *own = face_normal + 3 * (size_t)mesh->corner_face[fan[i]];
+            const double *own = face_normal + 3 * (size_t)tt__face_of(mesh, fan[i]);
             double sum[3] = {0.0, 0.0, 0.0}, length;
             float *out = corner_normal + 3 * (size_t)fan[i];
             for (j = 0; j < count; j++) {
-                const double *other = face_normal + 3 * (size_t)mesh->corner_face[fan[j]];
+                const double *other = face_normal + 3 * (size_t)tt__face_of(mesh, fan[j]);
                 if (j != i && tt__dot3(own, other) < cos_crease) continue;
                 sum[0] += angle[j] * other[0];
                 sum[1] += angle[j] * other[1];
@@ -4641,8 +4653,8 @@ TTDEF tt_result tt_mesh_components(const tt_mesh *mesh, const tt_allocator *allo
     for (c = 0; c < mesh->ncorners; c++) {
         int t = mesh->twin[c], a, b;
         if (t < c) continue;   /* a boundary, or the pair's other half */
-        a = tt__find_root(parent, mesh->corner_face[c]);
-        b = tt__find_root(parent, mesh->corner_face[t]);
+        a = tt__find_root(parent, tt__face_of(mesh, c));
+        b = tt__find_root(parent, tt__face_of(mesh, t));
         if (a != b) parent[a > b ? a : b] = a < b ? a : b;
     }
     for (f = 0; f < mesh->nfaces; f++) {
@@ -9181,7 +9193,7 @@ typedef struct tt__edge_frame {
 
 static void tt__edge_frame_of(const tt_mesh *mesh, const float *uv, const tt_image *atlas, int c, tt__edge_frame *f)
 {
-    int next = tt__next(mesh, c), face = mesh->corner_face[c], k, count = 0;
+    int next = tt__next(mesh, c), face = tt__face_of(mesh, c), k, end, count = 0;
     float bx, by, len;
     f->ax = uv[2 * c] * atlas->width;
     f->ay = (1.0f - uv[2 * c + 1]) * atlas->height;
@@ -9194,7 +9206,9 @@ static void tt__edge_frame_of(const tt_mesh *mesh, const float *uv, const tt_ima
     if (!f->valid) return;
     f->cx = 0.0f;
     f->cy = 0.0f;
-    for (k = mesh->face_start[face]; k < mesh->face_start[face + 1]; k++, count++) {
+    k = mesh->min_face_size == mesh->max_face_size ? face * mesh->min_face_size : mesh->face_start[face];
+    end = mesh->min_face_size == mesh->max_face_size ? k + mesh->min_face_size : mesh->face_start[face + 1];
+    for (; k < end; k++, count++) {
         f->cx += uv[2 * k] * atlas->width;
         f->cy += (1.0f - uv[2 * k + 1]) * atlas->height;
     }
