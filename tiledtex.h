@@ -17349,6 +17349,14 @@ static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
     return 1;
 }
 
+/* A split or an acceptance that ran out of memory: *res and *error filled,
+   0 returned (for tt__hpm_process's `done ? 1 : ...` tails). */
+static int tt__hpm_out_of_memory(int C, tt_result *res, tt_error *error)
+{
+    *res = tt__fail_at(error, TT_ERROR_OUT_OF_MEMORY, C, -1, -1, "out of memory texturing cluster %d", C);
+    return 0;
+}
+
 /* One cluster taken from the queues (Sec. 2.2 step 2). Returns 1, or 0 on
    an error in *res. */
 static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res, tt_error *error)
@@ -17360,7 +17368,7 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
     tt_result fr;
     tt_flatten_report frep;
     S->state[C] = 1;
-    if (!(cl->flags & TT_CLUSTER_MAPPABLE)) return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    if (!(cl->flags & TT_CLUSTER_MAPPABLE)) return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
     fr = tt_flatten_cluster(S->mesh, S->H, C, &S->fopt, S->al, S->flat, &frep, NULL);
     if (fr == TT_ERROR_OUT_OF_MEMORY) {
         *res = tt__fail(error, fr, -1, -1, -1, -1, "out of memory flattening cluster %d", C);
@@ -17371,7 +17379,7 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
            cannot be flattened shows its neighbours' texture at the end. */
         S->rep.not_flat++;
         if (cl->nchildren == 0) return 1;
-        return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+        return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     below_floor = area_px < S->floor_px || cl->nfaces < S->min_faces;
     at_floor = cl->nchildren == 0 || area_px / cl->nchildren < S->floor_px ||
@@ -17384,7 +17392,7 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
     fit = 0;
     if (has_neighbours && below_floor && tt__hpm_continue_place(S, C, &pl)) {
         S->rep.continued++;
-        return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+        return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     if (has_neighbours) {
         fit = tt__hpm_fit(S, C, stamp, &pl, &eps, res, error);
@@ -17400,26 +17408,26 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
             }
             S->error_sum += eps;
             if (eps > S->rep.max_error) S->rep.max_error = eps;
-            return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+            return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
         }
         S->rep.rejected_fits++;
-        return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+        return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     if (fit == -1 && !at_floor) {
         S->rep.no_room++;
-        return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+        return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     if (tt__hpm_continue_place(S, C, &pl)) {
         S->rep.continued++;
-        return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+        return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     if (tt__hpm_random_place(S, &S->rng, C, &pl)) {
         S->rep.starts++;
-        return tt__hpm_accept(S, C, &pl) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+        return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     S->rep.no_room++;
     if (cl->nchildren == 0) return 1;
-    return tt__hpm_split(S, C) ? 1 : (*res = TT_ERROR_OUT_OF_MEMORY, 0);
+    return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
 }
 
 /* The traversal (Sec. 2.2, D22). */

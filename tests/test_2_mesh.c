@@ -600,18 +600,17 @@ typedef struct build_ctx {
     unsigned flags;
 } build_ctx;
 
-static tt_result oom_build(void *ctx, const tt_allocator *al)
+static tt_result oom_build(void *ctx, const tt_allocator *al, tt_error *error)
 {
     build_ctx *b = (build_ctx *)ctx;
     tt_mesh_desc d = tm_desc(b->m);
     tt_mesh *mesh = (tt_mesh *)&mesh;
-    tt_error err;
     tt_result r;
     d.flags = b->flags;
-    r = tt_mesh_build(&d, al, &mesh, &err);
+    r = tt_mesh_build(&d, al, &mesh, error);
     if (r == TT_OK) tt_mesh_free(mesh);
     else if (mesh != NULL) return TT_RESULT_MAX_ENUM;   /* must be NULL on failure */
-    if (r != TT_OK && err.result != r) return TT_RESULT_MAX_ENUM;
+    if (r != TT_OK && error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -882,34 +881,33 @@ typedef struct mesh_ctx {
     tt_subdivision scheme;
 } mesh_ctx;
 
-static tt_result oom_stats(void *ctx, const tt_allocator *al)
+static tt_result oom_stats(void *ctx, const tt_allocator *al, tt_error *error)
 {
     tt_mesh_stats st;
-    return tt_mesh_compute_stats(((mesh_ctx *)ctx)->mesh, al, &st, NULL);
+    return tt_mesh_compute_stats(((mesh_ctx *)ctx)->mesh, al, &st, error);
 }
 
-static tt_result oom_histogram(void *ctx, const tt_allocator *al)
+static tt_result oom_histogram(void *ctx, const tt_allocator *al, tt_error *error)
 {
     int hist[6];
-    return tt_mesh_valence_histogram(((mesh_ctx *)ctx)->mesh, al, hist, 6, NULL);
+    return tt_mesh_valence_histogram(((mesh_ctx *)ctx)->mesh, al, hist, 6, error);
 }
 
-static tt_result oom_components(void *ctx, const tt_allocator *al)
+static tt_result oom_components(void *ctx, const tt_allocator *al, tt_error *error)
 {
     mesh_ctx *q = (mesh_ctx *)ctx;
     int *comp = (int *)malloc(sizeof(int) * (size_t)q->mesh->nfaces), n = -1;
-    tt_result r = tt_mesh_components(q->mesh, al, comp, &n, NULL);
+    tt_result r = tt_mesh_components(q->mesh, al, comp, &n, error);
     free(comp);
     if (r == TT_OK && n != 2) return TT_RESULT_MAX_ENUM;   /* the grid part and the torus */
     return r;
 }
 
-static tt_result oom_quad(void *ctx, const tt_allocator *al)
+static tt_result oom_quad(void *ctx, const tt_allocator *al, tt_error *error)
 {
     mesh_ctx *q = (mesh_ctx *)ctx;
     tt_mesh *out = (tt_mesh *)&out;
-    tt_error err;
-    tt_result r = tt_mesh_quadrangulate(q->mesh, q->scheme, al, &out, &err);
+    tt_result r = tt_mesh_quadrangulate(q->mesh, q->scheme, al, &out, error);
     if (r == TT_OK) tt_mesh_free(out);
     else if (out != NULL) return TT_RESULT_MAX_ENUM;
     return r;
@@ -1460,10 +1458,10 @@ typedef struct normals_ctx {
     float *out;
 } normals_ctx;
 
-static tt_result oom_normals(void *ctx, const tt_allocator *al)
+static tt_result oom_normals(void *ctx, const tt_allocator *al, tt_error *error)
 {
     normals_ctx *c = (normals_ctx *)ctx;
-    return tt_corner_normals(c->mesh, 45.0f, al, c->out, NULL);
+    return tt_corner_normals(c->mesh, 45.0f, al, c->out, error);
 }
 
 /* tt_corner_normals against what they must be: a cube keeps its edges at 45
@@ -1711,10 +1709,10 @@ typedef struct sources_ctx {
     const tt_mesh *mesh;
 } sources_ctx;
 
-static tt_result oom_sources(void *ctx, const tt_allocator *al)
+static tt_result oom_sources(void *ctx, const tt_allocator *al, tt_error *error)
 {
     tt_corner_sources *out = (tt_corner_sources *)&out;
-    tt_result r = tt_mesh_quadrangulate_sources(((sources_ctx *)ctx)->mesh, al, &out, NULL);
+    tt_result r = tt_mesh_quadrangulate_sources(((sources_ctx *)ctx)->mesh, al, &out, error);
     if (r == TT_OK) tt_corner_sources_free(out);
     else if (out != NULL) return TT_RESULT_MAX_ENUM;
     return r;

@@ -1067,25 +1067,23 @@ typedef struct fft_oom_ctx {
     const double *t;
 } fft_oom_ctx;
 
-static tt_result fft_oom_plan(void *ctx, const tt_allocator *al)
+static tt_result fft_oom_plan(void *ctx, const tt_allocator *al, tt_error *error)
 {
     fft_oom_ctx *c = (fft_oom_ctx *)ctx;
     tt_fft_plan *plan = (tt_fft_plan *)&plan;
-    tt_error err;
-    tt_result r = tt_fft_plan_create(c->w, c->h, al, &plan, &err);
+    tt_result r = tt_fft_plan_create(c->w, c->h, al, &plan, error);
     if (r == TT_OK) tt_fft_plan_free(plan);
-    else if (plan != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
+    else if (plan != NULL || error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
-static tt_result fft_oom_texture(void *ctx, const tt_allocator *al)
+static tt_result fft_oom_texture(void *ctx, const tt_allocator *al, tt_error *error)
 {
     fft_oom_ctx *c = (fft_oom_ctx *)ctx;
     tt_xcorr_texture *tex = (tt_xcorr_texture *)&tex;
-    tt_error err;
-    tt_result r = tt_xcorr_texture_create(c->w, c->h, c->channels, c->t, al, &tex, &err);
+    tt_result r = tt_xcorr_texture_create(c->w, c->h, c->channels, c->t, al, &tex, error);
     if (r == TT_OK) tt_xcorr_texture_free(tex);
-    else if (tex != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
+    else if (tex != NULL || error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 

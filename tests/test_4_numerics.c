@@ -921,22 +921,20 @@ typedef struct cg_oom_ctx {
     int preconditioner;
 } cg_oom_ctx;
 
-static tt_result cg_oom_triplets(void *ctx, const tt_allocator *al)
+static tt_result cg_oom_triplets(void *ctx, const tt_allocator *al, tt_error *error)
 {
     cg_oom_ctx *c = (cg_oom_ctx *)ctx;
     tt_sparse_matrix *m = (tt_sparse_matrix *)&m;
-    tt_error err;
-    tt_result r = tt_sparse_from_triplets(c->n, c->n, c->t, c->count, al, &m, &err);
+    tt_result r = tt_sparse_from_triplets(c->n, c->n, c->t, c->count, al, &m, error);
     if (r == TT_OK) tt_sparse_matrix_free(m);
-    else if (m != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
+    else if (m != NULL || error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
-static tt_result cg_oom_solve(void *ctx, const tt_allocator *al)
+static tt_result cg_oom_solve(void *ctx, const tt_allocator *al, tt_error *error)
 {
     cg_oom_ctx *c = (cg_oom_ctx *)ctx;
     tt_sparse_matrix *m = NULL;
-    tt_error err;
     tt_result r;
     double x[64];
     memset(x, 0, sizeof x);
@@ -945,9 +943,9 @@ static tt_result cg_oom_solve(void *ctx, const tt_allocator *al)
         tt_cg_options opt;
         memset(&opt, 0, sizeof opt);
         opt.preconditioner = c->preconditioner;
-        r = tt_cg_solve(m, c->b, &opt, al, x, NULL, &err);
+        r = tt_cg_solve(m, c->b, &opt, al, x, NULL, error);
     }
-    if (r != TT_OK && err.result != r) r = TT_RESULT_MAX_ENUM;
+    if (r != TT_OK && error->result != r) r = TT_RESULT_MAX_ENUM;
     tt_sparse_matrix_free(m);
     return r;
 }
@@ -1116,14 +1114,13 @@ typedef struct overflow_ctx {
     int count;
 } overflow_ctx;
 
-static tt_result cg_oom_overflow(void *ctx, const tt_allocator *al)
+static tt_result cg_oom_overflow(void *ctx, const tt_allocator *al, tt_error *error)
 {
     overflow_ctx *c = (overflow_ctx *)ctx;
     tt_sparse_matrix *m = (tt_sparse_matrix *)&m;
-    tt_error err;
-    tt_result r = tt_sparse_from_triplets(3, 3, c->t, c->count, al, &m, &err);
+    tt_result r = tt_sparse_from_triplets(3, 3, c->t, c->count, al, &m, error);
     if (r == TT_OK) tt_sparse_matrix_free(m);
-    else if (m != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
+    else if (m != NULL || error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 

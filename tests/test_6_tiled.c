@@ -1044,15 +1044,14 @@ typedef struct synth_ctx {
     tt_synth_options opt;
 } synth_ctx;
 
-static tt_result oom_synth(void *ctx, const tt_allocator *al)
+static tt_result oom_synth(void *ctx, const tt_allocator *al, tt_error *error)
 {
     synth_ctx *s = (synth_ctx *)ctx;
     tt_tileset *set = (tt_tileset *)&set;
-    tt_error err;
     tt_result r;
-    r = tt_synthesize_tiles(s->src, &s->opt, al, &set, &err);
+    r = tt_synthesize_tiles(s->src, &s->opt, al, &set, error);
     if (r == TT_OK) tt_tileset_free(set);
-    else if (set != NULL || err.result != r) return TT_RESULT_MAX_ENUM;
+    else if (set != NULL || error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -1459,13 +1458,12 @@ typedef struct seams_ctx {
     const tt_seam_options *options;
 } seams_ctx;
 
-static tt_result oom_seams(void *ctx, const tt_allocator *al)
+static tt_result oom_seams(void *ctx, const tt_allocator *al, tt_error *error)
 {
     seams_ctx *s = (seams_ctx *)ctx;
     tt_seam_report rep;
-    tt_error err;
-    tt_result r = tt_measure_seams(s->mesh, s->uv, s->atlas, s->options, al, &rep, &err);
-    if (r != TT_OK && (err.result != r || !isnan(rep.score))) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_measure_seams(s->mesh, s->uv, s->atlas, s->options, al, &rep, error);
+    if (r != TT_OK && (error->result != r || !isnan(rep.score))) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -2334,13 +2332,12 @@ typedef struct distortion_ctx {
     const float *uv;
 } distortion_ctx;
 
-static tt_result oom_distortion(void *ctx, const tt_allocator *al)
+static tt_result oom_distortion(void *ctx, const tt_allocator *al, tt_error *error)
 {
     distortion_ctx *d = (distortion_ctx *)ctx;
     tt_uv_distortion_report rep;
-    tt_error err;
-    tt_result r = tt_measure_uv_distortion(d->mesh, d->uv, 64, 32, NULL, al, &rep, &err);
-    if (r != TT_OK && (err.result != r || !isnan(rep.stretch_median))) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_measure_uv_distortion(d->mesh, d->uv, 64, 32, NULL, al, &rep, error);
+    if (r != TT_OK && (error->result != r || !isnan(rep.stretch_median))) return TT_RESULT_MAX_ENUM;
     return r;
 }
 

@@ -1211,31 +1211,31 @@ typedef struct sy_oom_context {
     tt_synth_options options;
 } sy_oom_context;
 
-static tt_result sy_oom_plan(void *ctx, const tt_allocator *allocator)
+static tt_result sy_oom_plan(void *ctx, const tt_allocator *allocator, tt_error *error)
 {
     sy_oom_context *c = (sy_oom_context *)ctx;
     tt_synth_plan *plan = (tt_synth_plan *)ctx;
-    tt_result r = tt_synth_plan_create(c->source, &c->options, allocator, &plan, NULL);
+    tt_result r = tt_synth_plan_create(c->source, &c->options, allocator, &plan, error);
     if (r != TT_OK && plan != NULL) return TT_RESULT_MAX_ENUM;
     tt_synth_plan_free(plan);
     return r;
 }
 
-static tt_result sy_oom_apply(void *ctx, const tt_allocator *allocator)
+static tt_result sy_oom_apply(void *ctx, const tt_allocator *allocator, tt_error *error)
 {
     sy_oom_context *c = (sy_oom_context *)ctx;
     tt_tileset *set = (tt_tileset *)ctx;
-    tt_result r = tt_synth_apply(c->plan, c->source, allocator, &set, NULL);
+    tt_result r = tt_synth_apply(c->plan, c->source, allocator, &set, error);
     if (r != TT_OK && set != NULL) return TT_RESULT_MAX_ENUM;
     tt_tileset_free(set);
     return r;
 }
 
-static tt_result sy_oom_synthesize(void *ctx, const tt_allocator *allocator)
+static tt_result sy_oom_synthesize(void *ctx, const tt_allocator *allocator, tt_error *error)
 {
     sy_oom_context *c = (sy_oom_context *)ctx;
     tt_tileset *set = (tt_tileset *)ctx;
-    tt_result r = tt_synthesize_tiles(c->source, &c->options, allocator, &set, NULL);
+    tt_result r = tt_synthesize_tiles(c->source, &c->options, allocator, &set, error);
     if (r != TT_OK && set != NULL) return TT_RESULT_MAX_ENUM;
     tt_tileset_free(set);
     return r;

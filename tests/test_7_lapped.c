@@ -849,18 +849,17 @@ typedef struct field_oom_ctx {
     float *out;
 } field_oom_ctx;
 
-static tt_result field_oom_call(void *ctx, const tt_allocator *al)
+static tt_result field_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     field_oom_ctx *c = (field_oom_ctx *)ctx;
     tt_field_options opt;
-    tt_error err;
     tt_result r;
     memset(&opt, 0, sizeof opt);
     memcpy(opt.up, c->up, sizeof opt.up);
     opt.constraints = c->constraints;
     opt.nconstraints = c->nconstraints;
-    r = tt_tangent_field(c->mesh, &opt, al, c->out, &err);
-    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    r = tt_tangent_field(c->mesh, &opt, al, c->out, error);
+    if (error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -1195,17 +1194,16 @@ typedef struct patch_oom_ctx {
     uint64_t seed;
 } patch_oom_ctx;
 
-static tt_result patch_oom_call(void *ctx, const tt_allocator *al)
+static tt_result patch_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     patch_oom_ctx *c = (patch_oom_ctx *)ctx;
     tt_patch_options opt;
     tt_image *patch = (tt_image *)ctx;   /* must be reset to NULL on failure */
-    tt_error err;
     tt_result r;
     memset(&opt, 0, sizeof opt);
     opt.seed = c->seed;
-    r = tt_make_texture_patch(c->source, c->mask, &opt, al, &patch, &err);
-    if (r != TT_OK && (patch != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
+    r = tt_make_texture_patch(c->source, c->mask, &opt, al, &patch, error);
+    if (r != TT_OK && (patch != NULL || error->result != r)) return TT_RESULT_MAX_ENUM;
     tt_image_free(patch);
     return r;
 }
@@ -2035,17 +2033,16 @@ typedef struct lapped_oom_ctx {
     int isotropic;
 } lapped_oom_ctx;
 
-static tt_result lapped_oom_call(void *ctx, const tt_allocator *al)
+static tt_result lapped_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     lapped_oom_ctx *c = (lapped_oom_ctx *)ctx;
     tt_lapped_options lo;
     tt_lapped *out = &g_lapped_sentinel;   /* must be reset to NULL on failure */
-    tt_error err;
     tt_result r;
     memset(&lo, 0, sizeof lo);
     lo.isotropic = c->isotropic;
-    r = tt_lapped_paste(c->mesh, c->field, &c->patch, 1, &lo, al, &out, &err);
-    if (r != TT_OK && (out != NULL || err.result != r)) return TT_RESULT_MAX_ENUM;
+    r = tt_lapped_paste(c->mesh, c->field, &c->patch, 1, &lo, al, &out, error);
+    if (r != TT_OK && (out != NULL || error->result != r)) return TT_RESULT_MAX_ENUM;
     if (r == TT_OK && (!out || out->nentries <= 0)) return TT_RESULT_MAX_ENUM;
     tt_lapped_free(out);
     return r;
@@ -2569,12 +2566,14 @@ typedef struct hull_oom_ctx {
     int max_vertices;
 } hull_oom_ctx;
 
-static tt_result hull_oom_call(void *ctx, const tt_allocator *al)
+static tt_result hull_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     hull_oom_ctx *c = (hull_oom_ctx *)ctx;
     float *xy = (float *)ctx;
     int n = -1;
-    tt_result r = internal_patch_hull(c->img, c->max_vertices, al, &xy, &n);
+    tt_result r;
+    (void)error;   /* a private helper: no tt_error */
+    r = internal_patch_hull(c->img, c->max_vertices, al, &xy, &n);
     if (r != TT_OK) return xy == NULL && n == 0 ? r : TT_RESULT_MAX_ENUM;   /* outputs reset on failure */
     if (!xy || n < 3 || n > c->max_vertices) r = TT_RESULT_MAX_ENUM;
     internal_free(al, xy);
@@ -2592,21 +2591,21 @@ static void test_hull_oom(void)
     hull_blob(img, 900);
     c.img = img;
     c.max_vertices = 32;
-    oom_sweep("tt__patch_hull(blob, contour)", hull_oom_call, &c, TT_OK);
+    oom_sweep_internal("tt__patch_hull(blob, contour)", hull_oom_call, &c, TT_OK);
     tt_image_free(img);
 
     img = hull_image(40, 40);
     hull_disc(img, 10, 10, 6, 1.0f); hull_disc(img, 30, 28, 7, 1.0f);
     c.img = img;
     c.max_vertices = 8;
-    oom_sweep("tt__patch_hull(two blobs, convex)", hull_oom_call, &c, TT_OK);
+    oom_sweep_internal("tt__patch_hull(two blobs, convex)", hull_oom_call, &c, TT_OK);
     tt_image_free(img);
 
     img = hull_image(16, 16);
     hull_rect(img, 2, 2, 14, 14);
     c.img = img;
     c.max_vertices = 3;
-    oom_sweep("tt__patch_hull(square to triangle, bounding)", hull_oom_call, &c, TT_OK);
+    oom_sweep_internal("tt__patch_hull(square to triangle, bounding)", hull_oom_call, &c, TT_OK);
     tt_image_free(img);
 
     img = hull_image(200, 200); /* long straight sides plus fine detail: the edge grid grows */
@@ -2615,7 +2614,7 @@ static void test_hull_oom(void)
     for (s = 12; s < 188; s += 5) hull_set_alpha(img, 190, s, 1.0f);
     c.img = img;
     c.max_vertices = 4;
-    oom_sweep("tt__patch_hull(square with teeth)", hull_oom_call, &c, TT_OK);
+    oom_sweep_internal("tt__patch_hull(square with teeth)", hull_oom_call, &c, TT_OK);
     tt_image_free(img);
 
     img = hull_image(60, 40); /* comb: the edge grid's node pool grows */
@@ -2623,13 +2622,13 @@ static void test_hull_oom(void)
     for (s = 2; s < 58; s += 4) hull_rect(img, s, 3, s + 2, 30);
     c.img = img;
     c.max_vertices = 8;
-    oom_sweep("tt__patch_hull(comb)", hull_oom_call, &c, TT_OK);
+    oom_sweep_internal("tt__patch_hull(comb)", hull_oom_call, &c, TT_OK);
     tt_image_free(img);
 
     img = hull_image(8, 8);   /* transparent: refused before any allocation */
     c.img = img;
     c.max_vertices = 8;
-    CHECK(hull_oom_call(&c, &g_oom_allocator) == TT_ERROR_INVALID_ARGUMENT && g_oom_counter.live == 0,
+    CHECK(hull_oom_call(&c, &g_oom_allocator, NULL) == TT_ERROR_INVALID_ARGUMENT && g_oom_counter.live == 0,
           "transparent patch refused, nothing allocated");
     tt_image_free(img);
     CHECK(g_oom_counter.live == 0 && g_oom_counter.bad_frees == 0, "hull sweeps: %ld blocks live, %ld bad frees",
@@ -3037,13 +3036,12 @@ typedef struct measure_oom_ctx {
     const tt_lapped *lapped;
 } measure_oom_ctx;
 
-static tt_result measure_oom_call(void *ctx, const tt_allocator *al)
+static tt_result measure_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     measure_oom_ctx *c = (measure_oom_ctx *)ctx;
     tt_lapped_report rep;
-    tt_error err;
-    tt_result r = tt_lapped_measure(c->mesh, c->fv, c->lapped, al, &rep, &err);
-    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_lapped_measure(c->mesh, c->fv, c->lapped, al, &rep, error);
+    if (error->result != r) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -3606,13 +3604,12 @@ typedef struct chart_oom_ctx {
     float *uv;
 } chart_oom_ctx;
 
-static tt_result chart_oom_call(void *ctx, const tt_allocator *al)
+static tt_result chart_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     chart_oom_ctx *c = (chart_oom_ctx *)ctx;
     tt_chart_atlas_report report;
-    tt_error err;
-    tt_result r = tt_atlas_pack_charts(c->mesh, 256, 2, al, c->uv, &report, &err);
-    if (err.result != r || (r != TT_OK && report.ncharts != 0)) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_atlas_pack_charts(c->mesh, 256, 2, al, c->uv, &report, error);
+    if (error->result != r || (r != TT_OK && report.ncharts != 0)) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -3724,13 +3721,12 @@ typedef struct uv_check_oom_ctx {
     tt_uv_problem expected;
 } uv_check_oom_ctx;
 
-static tt_result uv_check_oom_call(void *ctx, const tt_allocator *al)
+static tt_result uv_check_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     uv_check_oom_ctx *c = (uv_check_oom_ctx *)ctx;
     tt_uv_report report;
-    tt_error err;
-    tt_result r = tt_uv_check(c->mesh, c->uv, al, &report, &err);
-    if (err.result != r || (r == TT_OK && report.problem != c->expected)) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_uv_check(c->mesh, c->uv, al, &report, error);
+    if (error->result != r || (r == TT_OK && report.problem != c->expected)) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -4567,18 +4563,17 @@ typedef struct bake_oom_ctx {
     tt_image *atlas;
 } bake_oom_ctx;
 
-static tt_result bake_oom_call(void *ctx, const tt_allocator *al)
+static tt_result bake_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     bake_oom_ctx *c = (bake_oom_ctx *)ctx;
     tt_bake_options opt;
-    tt_error err;
     tt_result r;
     int i, n = 4 * c->atlas->width * c->atlas->height;
     memset(&opt, 0, sizeof opt);
     opt.gutter = 1;
     for (i = 0; i < n; i++) c->atlas->pixels[i] = 0.25f;
-    r = tt_lapped_bake(c->mesh, c->lapped, &c->patch, 1, c->uv, &opt, al, c->atlas, &err);
-    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    r = tt_lapped_bake(c->mesh, c->lapped, &c->patch, 1, c->uv, &opt, al, c->atlas, error);
+    if (error->result != r) return TT_RESULT_MAX_ENUM;
     if (r != TT_OK) {
         for (i = 0; i < n; i++)   /* all memory is taken before the atlas is touched */
             if (c->atlas->pixels[i] != 0.25f) return TT_RESULT_MAX_ENUM;

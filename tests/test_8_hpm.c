@@ -556,13 +556,12 @@ typedef struct hpm_oom_ctx {
     const tt_mesh *mesh;
 } hpm_oom_ctx;
 
-static tt_result hpm_oom_call(void *ctx, const tt_allocator *al)
+static tt_result hpm_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     hpm_oom_ctx *c = (hpm_oom_ctx *)ctx;
     tt_cluster_hierarchy *h = (tt_cluster_hierarchy *)&h;
-    tt_error err;
-    tt_result r = tt_cluster_hierarchy_build(c->mesh, NULL, al, &h, &err);
-    if (err.result != r || (r != TT_OK) != (h == NULL)) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_cluster_hierarchy_build(c->mesh, NULL, al, &h, error);
+    if (error->result != r || (r != TT_OK) != (h == NULL)) return TT_RESULT_MAX_ENUM;
     tt_cluster_hierarchy_free(h);
     return r;
 }
@@ -1023,16 +1022,15 @@ typedef struct flat_oom_ctx {
     float *uv;
 } flat_oom_ctx;
 
-static tt_result flat_oom_call(void *ctx, const tt_allocator *al)
+static tt_result flat_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     flat_oom_ctx *c = (flat_oom_ctx *)ctx;
     tt_flatten_report rep;
-    tt_error err;
     int i;
     tt_result r;
     for (i = 0; i < 2 * c->mesh->ncorners; i++) c->uv[i] = FLAT_SENTINEL;
-    r = tt_flatten_cluster(c->mesh, c->h, c->cluster, NULL, al, c->uv, &rep, &err);
-    if (err.result != r) return TT_RESULT_MAX_ENUM;
+    r = tt_flatten_cluster(c->mesh, c->h, c->cluster, NULL, al, c->uv, &rep, error);
+    if (error->result != r) return TT_RESULT_MAX_ENUM;
     if (r != TT_OK)
         for (i = 0; i < 2 * c->mesh->ncorners; i++)
             if (c->uv[i] != FLAT_SENTINEL) return TT_RESULT_MAX_ENUM;
@@ -1586,14 +1584,14 @@ typedef struct hpm_map_ctx {
     float *uv;
 } hpm_map_ctx;
 
-static tt_result hpm_map_oom_call(void *ctx, const tt_allocator *al)
+static tt_result hpm_map_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     hpm_map_ctx *c = (hpm_map_ctx *)ctx;
     tt_hpm_options o;
     memset(&o, 0, sizeof o);
     o.rotations = 3;
     o.match_size = 16;
-    return tt_hpm_map(c->mesh, c->im, &o, al, c->uv, NULL, NULL, NULL);
+    return tt_hpm_map(c->mesh, c->im, &o, al, c->uv, NULL, NULL, error);
 }
 
 static void test_hpm_map_errors(void)

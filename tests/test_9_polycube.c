@@ -733,18 +733,17 @@ typedef struct pc_oom_ctx {
     unsigned flags;
 } pc_oom_ctx;
 
-static tt_result pc_oom_call(void *ctx, const tt_allocator *al)
+static tt_result pc_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     pc_oom_ctx *c = (pc_oom_ctx *)ctx;
     tt_polycube *pc = (tt_polycube *)&pc;
     tt_polycube_options o;
-    tt_error err;
     tt_result r;
     memset(&o, 0, sizeof o);
     o.cube_size = 0.5;
     o.flags = c->flags;
-    r = tt_polycube_build(c->mesh, &o, al, &pc, NULL, &err);
-    if (err.result != r || (r != TT_OK) != (pc == NULL)) return TT_RESULT_MAX_ENUM;
+    r = tt_polycube_build(c->mesh, &o, al, &pc, NULL, error);
+    if (error->result != r || (r != TT_OK) != (pc == NULL)) return TT_RESULT_MAX_ENUM;
     tt_polycube_free(pc);
     return r;
 }
@@ -1233,15 +1232,14 @@ typedef struct project_oom_ctx {
     tt_surface_point *pts;
 } project_oom_ctx;
 
-static tt_result project_oom_call(void *ctx, const tt_allocator *al)
+static tt_result project_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     project_oom_ctx *c = (project_oom_ctx *)ctx;
     tt_polycube_projection_report pr;
-    tt_error err;
     tt_result r;
     pr.rays = -1;
-    r = tt_polycube_project(c->pc, c->mesh, al, c->pts, &pr, &err);
-    if (err.result != r || (r != TT_OK && pr.rays != 0)) return TT_RESULT_MAX_ENUM;
+    r = tt_polycube_project(c->pc, c->mesh, al, c->pts, &pr, error);
+    if (error->result != r || (r != TT_OK && pr.rays != 0)) return TT_RESULT_MAX_ENUM;
     return r;
 }
 
@@ -1649,13 +1647,12 @@ typedef struct edges_oom_ctx {
     const tt_surface_point *pts;
 } edges_oom_ctx;
 
-static tt_result edges_oom_call(void *ctx, const tt_allocator *al)
+static tt_result edges_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     edges_oom_ctx *c = (edges_oom_ctx *)ctx;
     tt_polycube_edges *edges = (tt_polycube_edges *)&edges;
-    tt_error err;
-    tt_result r = tt_polycube_trace_edges(c->pc, c->mesh, c->pts, c->mesh->nverts, NULL, al, &edges, &err);
-    if (err.result != r || (r != TT_OK) != (edges == NULL)) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_polycube_trace_edges(c->pc, c->mesh, c->pts, c->mesh->nverts, NULL, al, &edges, error);
+    if (error->result != r || (r != TT_OK) != (edges == NULL)) return TT_RESULT_MAX_ENUM;
     tt_polycube_edges_free(edges);
     return r;
 }
@@ -2200,13 +2197,12 @@ typedef struct upright_atlas_oom_ctx {
     const tt_tileset *plain, *upright;
 } upright_atlas_oom_ctx;
 
-static tt_result upright_atlas_oom_call(void *ctx, const tt_allocator *al)
+static tt_result upright_atlas_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     upright_atlas_oom_ctx *c = (upright_atlas_oom_ctx *)ctx;
     tt_image *atlas = (tt_image *)&atlas;
-    tt_error err;
-    tt_result r = tt_polycube_upright_atlas(c->plain, c->upright, 0, al, &atlas, &err);
-    if (err.result != r || (r != TT_OK) != (atlas == NULL)) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_polycube_upright_atlas(c->plain, c->upright, 0, al, &atlas, error);
+    if (error->result != r || (r != TT_OK) != (atlas == NULL)) return TT_RESULT_MAX_ENUM;
     tt_image_free(atlas);
     return r;
 }
@@ -2350,13 +2346,12 @@ typedef struct map_oom_ctx {
     const tt_mesh *mesh;
 } map_oom_ctx;
 
-static tt_result map_oom_call(void *ctx, const tt_allocator *al)
+static tt_result map_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     map_oom_ctx *c = (map_oom_ctx *)ctx;
     tt_polycube_mapping *map = (tt_polycube_mapping *)&map;
-    tt_error err;
-    tt_result r = tt_polycube_map(c->pc, c->mesh, NULL, al, &map, NULL, &err);
-    if (err.result != r || (r != TT_OK) != (map == NULL)) return TT_RESULT_MAX_ENUM;
+    tt_result r = tt_polycube_map(c->pc, c->mesh, NULL, al, &map, NULL, error);
+    if (error->result != r || (r != TT_OK) != (map == NULL)) return TT_RESULT_MAX_ENUM;
     tt_polycube_mapping_free(map);
     return r;
 }
@@ -2829,9 +2824,10 @@ typedef struct reseat_oom_ctx {
     unsigned char *moved;
 } reseat_oom_ctx;
 
-static tt_result reseat_oom_call(void *ctx, const tt_allocator *al)
+static tt_result reseat_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     reseat_oom_ctx *c = (reseat_oom_ctx *)ctx;
+    (void)error;   /* a private helper: no tt_error */
     memcpy(c->pts, c->start, sizeof *c->pts * (size_t)c->mesh->nverts);
     memset(c->moved, 0, (size_t)c->mesh->nverts);
     return internal_polycube_reseat(c->pc, c->mesh, c->pts, c->moved, al) == 1 ? TT_OK : TT_ERROR_OUT_OF_MEMORY;
@@ -2880,7 +2876,7 @@ static void test_reseat(void)
     ctx.pts = copy;
     ctx.moved = moved;
     oom_reset();
-    oom_sweep("re-seating (sphere at resolution 6, one vertex across)", reseat_oom_call, &ctx, TT_OK);
+    oom_sweep_internal("re-seating (sphere at resolution 6, one vertex across)", reseat_oom_call, &ctx, TT_OK);
     free(start);
     free(copy);
     free(moved);

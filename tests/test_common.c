@@ -108,30 +108,48 @@ tt_allocator g_oom_allocator;
 
 void oom_reset(void) { g_oom_allocator = make_allocator(&g_oom_counter, -1); }
 
-void oom_sweep(const char *what, oom_call call, void *ctx, tt_result expected_final)
+static void sweep(const char *what, oom_call call, void *ctx, tt_result expected_final, int check_error)
 {
-    int k, bad_result = 0, leaks = 0, bad_frees = 0, nsteps = 0;
+    int k, bad_result = 0, leaks = 0, bad_frees = 0, unfilled = 0, nsteps = 0;
     tt_result r = TT_ERROR_OUT_OF_MEMORY, first_bad = TT_OK;
     counter *cnt = &g_oom_counter;
+    tt_error error;
     for (k = 0; k < 100000; k++) {
         long live0 = cnt->live, bad0 = cnt->bad_frees;
         cnt->calls = 0;
         cnt->failures = 0;
         cnt->fail_at = k;
-        r = call(ctx, &g_oom_allocator);
+        memset(&error, 0x5a, sizeof error);   /* an unfilled error keeps this */
+        r = call(ctx, &g_oom_allocator, &error);
         nsteps++;
         if (cnt->live != live0) leaks++;
         if (cnt->bad_frees != bad0) bad_frees++;
         if (cnt->failures == 0) break;   /* allocation k was never reached: the run is complete */
         if (r != TT_ERROR_OUT_OF_MEMORY) { if (!bad_result) first_bad = r; bad_result++; }
+        else if (check_error && (error.result != r || !memchr(error.message, 0, sizeof error.message) ||
+                                 strlen(error.message) < 8 || error.message[0] == 0x5a)) {
+            if (!unfilled) DETAIL("%s: allocation %d failed, the error was not filled", what, k);
+            unfilled++;
+        }
     }
     cnt->fail_at = -1;
     CHECK(r == expected_final, "%s: after %d allocation-failure runs, expected final result %d, got %d", what, nsteps,
           expected_final, r);
     CHECK(bad_result == 0, "%s: %d runs with a failed allocation did not return TT_ERROR_OUT_OF_MEMORY (first: %d)",
           what, bad_result, first_bad);
+    CHECK(unfilled == 0, "%s: %d runs returned TT_ERROR_OUT_OF_MEMORY with the tt_error unfilled", what, unfilled);
     CHECK(leaks == 0 && bad_frees == 0, "%s: %d runs leaked, %d freed foreign pointers", what, leaks, bad_frees);
     CHECK(nsteps > 1, "%s: expected at least one allocation, got %d runs", what, nsteps);
+}
+
+void oom_sweep(const char *what, oom_call call, void *ctx, tt_result expected_final)
+{
+    sweep(what, call, ctx, expected_final, 1);
+}
+
+void oom_sweep_internal(const char *what, oom_call call, void *ctx, tt_result expected_final)
+{
+    sweep(what, call, ctx, expected_final, 0);
 }
 
 /* ------------------------------------------------------------------------ */

@@ -63,10 +63,11 @@ tt_allocator make_allocator(counter *c, long fail_at);
 /* Allocation-failure sweep                                                 */
 /* ------------------------------------------------------------------------ */
 
-/* The call a sweep repeats: run the function under test with `allocator`,
-   free whatever it made, and return its result (or TT_RESULT_MAX_ENUM when
-   it broke its contract, e.g. an output not reset on failure). */
-typedef tt_result (*oom_call)(void *ctx, const tt_allocator *allocator);
+/* The call a sweep repeats: run the function under test with `allocator`
+   and `error` (pass it on as the function's tt_error), free whatever it
+   made, and return its result (or TT_RESULT_MAX_ENUM when it broke its
+   contract, e.g. an output not reset on failure). */
+typedef tt_result (*oom_call)(void *ctx, const tt_allocator *allocator, tt_error *error);
 
 /* The allocator and counter every OOM sweep uses: the call passes it as the
    allocator parameter of the function under test. Objects built through it
@@ -79,9 +80,15 @@ void oom_reset(void);
 /* Run `call` with allocation k failing for k = 0, 1, ... until a run no
    longer reaches allocation k. Four CHECKs: the last result is
    expected_final, every run with a failed allocation returned
-   TT_ERROR_OUT_OF_MEMORY, no run leaked or freed a foreign pointer, and
-   there was at least one allocation. */
+   TT_ERROR_OUT_OF_MEMORY and filled the tt_error it was given (that
+   result and a sentence: the error is pre-filled with garbage before each
+   run), no run leaked or freed a foreign pointer, and there was at least
+   one allocation. */
 void oom_sweep(const char *what, oom_call call, void *ctx, tt_result expected_final);
+
+/* The same for the private helpers that take no tt_error: the error check
+   is skipped. */
+void oom_sweep_internal(const char *what, oom_call call, void *ctx, tt_result expected_final);
 
 /* ------------------------------------------------------------------------ */
 /* Small helpers                                                            */
