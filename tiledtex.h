@@ -2420,8 +2420,9 @@ enum {
 
 typedef struct tt_hpm_options {
     uint64_t seed;          /* hierarchy seeds, random turns and starts (any value, 0 included) */
-    double scale;           /* world units covered by the image's width (D26); 0 = the bounding box's
-                               diagonal / 4 */
+    double scale;           /* world units covered by the image's width; 0 = the bounding box's
+                               diagonal / 4, or more where the mesh's longest edge would span over 3/4
+                               of the image's smaller side (each face must fit the image) */
     double threshold;       /* the largest accepted eps; 0 = TT_DEFAULT_HPM_THRESHOLD; +infinity
                                accepts every fit (clusters split only when not flat or with no room) */
     int rotations;          /* orientations around the circle, 1..64 (steps of 360 / rotations
@@ -2475,7 +2476,11 @@ typedef struct tt_hpm_report {
      TT_OK;
      TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, a bad
                                 allocator, options out of range, a face
-                                that is not a triangle (error->face);
+                                that is not a triangle (error->face), a
+                                scale at which a face does not fit the
+                                image without TT_HPM_TOROIDAL
+                                (error->face; the message says which
+                                scale would);
      TT_ERROR_EMPTY_MESH        no faces;
      TT_ERROR_ZERO_AREA_FACE    every face has zero area (no scale);
      TT_ERROR_NON_FINITE        a NaN or infinite texel (error->row, column);
@@ -17766,7 +17771,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     tt_cluster_options copt;
     tt_result res;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag, total_area = 0;
-    int i, f, match_size;
+    double longest_edge = 0, scale, fit_texels;
+    int i, f, match_size, longest_face = 0;
 
     memset(&S, 0, sizeof S);
     if (report) memset(report, 0, sizeof *report);
@@ -17807,6 +17813,15 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[0], g);
         tt__cross3(e, g, cr);
         total_area += 0.5 * tt__length3(cr);
+        {
+            double d[3], longest;
+            tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[1], d);
+            longest = fmax(tt__length3(d), fmax(tt__length3(e), tt__length3(g)));
+            if (longest > longest_edge) {
+                longest_edge = longest;
+                longest_face = f;
+            }
+        }
         for (i = 0; i < 3; i++) {
             int k;
             for (k = 0; k < 3; k++) {
@@ -17847,7 +17862,21 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.band = o.band;
     S.floor_px = o.min_footprint > 0 ? o.min_footprint : TT_DEFAULT_HPM_MIN_FOOTPRINT;
     S.min_faces = o.min_faces ? o.min_faces : TT_DEFAULT_HPM_MIN_FACES;
-    S.s = image->width / (o.scale > 0 ? o.scale : diag / 4);
+    /* A face's projection on any axis is no longer than its longest edge,
+       so a face whose longest edge spans fit_texels or fewer fits the image
+       at every turn. Without wrapping, a face that fits nowhere has no map
+       of its own (a mesh of such faces would come out one colour): the
+       default scale makes the longest edge span at most 3/4 of that, and a
+       scale the caller chose is refused, saying which would work. */
+    fit_texels = tt__min_i(image->width, image->height) - 2;
+    if (o.scale > 0)
+        scale = o.scale;
+    else {
+        scale = diag / 4;
+        if (!S.toroidal && longest_edge * image->width / scale > 0.75 * fit_texels)
+            scale = longest_edge * image->width / (0.75 * fit_texels);
+    }
+    S.s = image->width / scale;
     S.fopt.max_error = o.max_flattening_error;
     S.progress = o.progress;
     S.progress_user_data = o.progress_user_data;
@@ -17858,6 +17887,12 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "hpm: scale %g gives no texel density (the mesh's bounding box diagonal is %g)", o.scale,
                         diag);
+    if (!S.toroidal && longest_edge * S.s > fit_texels)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, longest_face, -1, -1, -1,
+                        "hpm: at scale %g the %d x %d image is too small for face %d (its longest edge, %g units, "
+                        "spans %g texels): use a scale of at least %g, or a tileable image with TT_HPM_TOROIDAL",
+                        scale, image->width, image->height, longest_face, longest_edge, longest_edge * S.s,
+                        longest_edge * image->width / fit_texels);
 
     memset(&copt, 0, sizeof copt);
     copt.seed = o.seed;

@@ -1594,6 +1594,62 @@ static tt_result hpm_map_oom_call(void *ctx, const tt_allocator *al, tt_error *e
     return tt_hpm_map(c->mesh, c->im, &o, al, c->uv, NULL, NULL, error);
 }
 
+/* A mesh whose faces are large for the image at the default scale (an
+   octahedron, one triangle): every face still gets a map of its own, with
+   a scale chosen so that each face fits the image; a scale the caller sets
+   that no face fits is refused, naming the face and a scale that works. */
+static void test_hpm_map_coarse(void)
+{
+    static const double octa[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                    {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    tt_image *im = NULL;
+    int which;
+    make_value_noise(&im, 64, 48, 5);
+    for (which = 0; which < 2 && im; which++) {
+        tmesh m;
+        tt_mesh *mesh = NULL;
+        tt_error err;
+        tt_hpm_options o;
+        tt_hpm_report rep;
+        float uv[2 * 24];
+        int cluster[8], i, f, unmapped = 0, still = 0, nf = which == 0 ? 8 : 1;
+        tt_result r;
+        memset(&m, 0, sizeof m);
+        for (i = 0; i < 6; i++) tm_vert(&m, octa[i][0], octa[i][1], octa[i][2]);
+        for (f = 0; f < nf; f++) tm_tri(&m, faces[f][0], faces[f][1], faces[f][2]);
+        if (build(&m, 0, &mesh, &err) != TT_OK) {
+            CHECK(0, "building the coarse mesh: %s", err.message);
+            tm_free(&m);
+            continue;
+        }
+        r = tt_hpm_map(mesh, im, NULL, NULL, uv, cluster, &rep, &err);
+        for (f = 0; f < nf; f++) {
+            const float *a = uv + 2 * mesh->face_start[f];
+            double area = (a[2] - a[0]) * (a[5] - a[1]) - (a[4] - a[0]) * (a[3] - a[1]);
+            if (cluster[f] < 0) unmapped++;
+            if (!(fabs(area) > 1e-4)) still++;
+        }
+        CHECK(r == TT_OK && rep.clusters > 0 && unmapped == 0 && still == 0,
+              "%s at the default scale: result %d, %d clusters textured, %d faces with no map, %d with no UV area",
+              which == 0 ? "octahedron" : "one triangle", r, rep.clusters, unmapped, still);
+        CHECK(r != TT_OK || rep.texels_per_unit * sqrt(2.0) <= 0.75 * (48 - 2) + 1e-9,
+              "the longest edge spans %g texels, more than 3/4 of the image's 46", rep.texels_per_unit * sqrt(2.0));
+        memset(&o, 0, sizeof o);
+        o.scale = 0.5;   /* the image's 64 texels over half a unit: an edge of sqrt 2 spans 181 */
+        r = tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err);
+        CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face >= 0 && err.face < nf && strstr(err.message, "at least 1.9"),
+              "a scale too small for the faces: result %d, face %d, '%s' (1.41421 * 64 / 46 = 1.968 would do)", r,
+              err.face, err.message);
+        o.flags = TT_HPM_TOROIDAL;   /* a tileable image: placements wrap, any scale works */
+        r = tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err);
+        CHECK(r == TT_OK, "the same scale with a tileable image: %d (%s)", r, err.message);
+        tt_mesh_free(mesh);
+        tm_free(&m);
+    }
+    tt_image_free(im);
+}
+
 static void test_hpm_map_errors(void)
 {
     tt_mesh *mesh = hpm_mesh(M_GRID), *quads = NULL;
@@ -1671,5 +1727,6 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_orientation);
     RUN(test_hpm_map_budget);
     RUN(test_hpm_map_topology);
+    RUN(test_hpm_map_coarse);
     RUN(test_hpm_map_errors);
 }
