@@ -16,6 +16,23 @@
                                     off under NDEBUG; checks the preconditions
                                     of the helpers that return no tt_result
 
+   LIMITS (each a constant you may define before including this file, the
+   same in every file that includes it). Work that would pass one is
+   refused with TT_ERROR_TOO_LARGE, the message naming the limit, before the
+   memory it would take is allocated:
+       TT_MAX_IMAGE_SIZE           32768  texels a side of any image, tile
+                                          atlas, bake target or source
+       TT_FFT_MAX_SIZE             32768  values a side of an FFT plan or a
+                                          correlation texture
+       TT_LAPPED_MAX_PASTES       200000  pastes (tt_lapped_options.max_pastes
+                                          sets a lower cap per call)
+       TT_POLYCUBE_MAX_RESOLUTION   1024  cubes along a polycube's longest axis
+       TT_POLYCUBE_MAX_CUBES    (1 << 25) cubes in a polycube's padded grid
+       TT_POLYCUBE_MAX_TRIANGLES (1 << 23) triangles tt_polycube_map's
+                                          refinement (max_edge) may make
+   Mesh and index sizes are capped by int (about 2^30 corners); sizes whose
+   byte counts would overflow size_t are refused the same way.
+
    THE API CONTRACT (true of every public function)
      - Errors. A function that can fail returns tt_result (TT_OK == 0, errors
        negative, tt_result_string() gives a sentence) and takes, as its last
@@ -496,7 +513,9 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
 /* ======================================================================== */
 
 /* Width or height above this is refused with TT_ERROR_TOO_LARGE. */
+#ifndef TT_MAX_IMAGE_SIZE
 #define TT_MAX_IMAGE_SIZE 32768
+#endif
 
 /* What an image's r, g, b hold, which decides how it is turned and blended. */
 typedef enum tt_image_kind {
@@ -836,7 +855,9 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, const tt
 
 #define TT_FFT_FORWARD (-1)   /* e^(-2 pi i ...) */
 #define TT_FFT_INVERSE 1      /* e^(+2 pi i ...), unnormalised */
+#ifndef TT_FFT_MAX_SIZE
 #define TT_FFT_MAX_SIZE 32768 /* the largest width or height of a plan (2^15) */
+#endif
 
 /* The sizes and tables of transforms of height x width values. Read-only
    after creation: several threads may use it at once. The arrays are the
@@ -855,10 +876,10 @@ typedef struct tt_fft_plan {
 /* Make the plan for transforms of height rows by width columns (height 1:
    a 1D transform of width values). Fails, with *out NULL and nothing left
    allocated, on:
-     TT_ERROR_INVALID_ARGUMENT  a size that is not a power of two from 1 to
-                                TT_FFT_MAX_SIZE (the message says the nearest
-                                power of two and the one to pad to), NULL out,
-                                a bad allocator,
+     TT_ERROR_INVALID_ARGUMENT  a size below 1 or not a power of two (the
+                                message says the nearest power of two and
+                                the one to pad to), NULL out, a bad allocator,
+     TT_ERROR_TOO_LARGE         a size above TT_FFT_MAX_SIZE,
      TT_ERROR_OUT_OF_MEMORY.
    Time O(size) cos/sin calls; memory about 40 bytes per value of the larger
    side. Free it with tt_fft_plan_free. Thread-safe. */
@@ -940,9 +961,10 @@ typedef struct tt_xcorr_texture {
    size periodically. Use a Euclidean colour space (the channels' squared
    differences are added). Fails, with *out NULL and nothing left allocated,
    on:
-     TT_ERROR_INVALID_ARGUMENT  sizes that are not powers of two from 1 to
-                                TT_FFT_MAX_SIZE, channels < 1, NULL texture
-                                or out, a bad allocator,
+     TT_ERROR_INVALID_ARGUMENT  sizes below 1 or not powers of two,
+                                channels < 1, NULL texture or out, a bad
+                                allocator,
+     TT_ERROR_TOO_LARGE         a size above TT_FFT_MAX_SIZE,
      TT_ERROR_NON_FINITE        a NaN or infinite value (error->row, column
                                 and item = channel name it), or values whose
                                 squares overflow,
@@ -1809,7 +1831,9 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    alpha there shows a hard edge. */
 #define TT_LAPPED_VISIBLE_CUT 0.25f
 /* options->max_pastes = 0: this cap (a few minutes of work). */
+#ifndef TT_LAPPED_MAX_PASTES
 #define TT_LAPPED_MAX_PASTES 200000
+#endif
 /* Pastes take about this many times the surface area over the patch's
    opaque area (they overlap, and their hulls reach past the opaque part):
    3 to 5 on smooth meshes. tt_lapped_paste refuses up front when the
@@ -2618,8 +2642,12 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    TT_POLYCUBE_MAX_CUBES cubes. */
 
 #define TT_POLYCUBE_DEFAULT_RESOLUTION 16
+#ifndef TT_POLYCUBE_MAX_RESOLUTION
 #define TT_POLYCUBE_MAX_RESOLUTION 1024       /* cubes along any axis, padding excluded */
+#endif
+#ifndef TT_POLYCUBE_MAX_CUBES
 #define TT_POLYCUBE_MAX_CUBES (1 << 25)       /* cubes in the padded grid */
+#endif
 
 enum {
     TT_POLYCUBE_NO_CORRECT = 1u << 0          /* skip the correction step (spec P5) */
@@ -2947,6 +2975,16 @@ typedef struct tt_polycube_map_options {
 
 #define TT_POLYCUBE_MAP_DEFAULT_EDGE 0.5
 
+/* The most triangles tt_polycube_map's refinement (max_edge) may make: a
+   max_edge that needs more is refused with TT_ERROR_TOO_LARGE before the
+   refinement passes this (before any work when the model's area alone
+   says so). The mapping keeps about 100 bytes per triangle, so the
+   default allows about 1 GB. Define it before including the header to
+   change it. */
+#ifndef TT_POLYCUBE_MAX_TRIANGLES
+#define TT_POLYCUBE_MAX_TRIANGLES (1 << 23)
+#endif
+
 typedef struct tt_polycube_map_report {
     int triangles;          /* triangles of the model after refinement (max_edge), the ones mapped */
     tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
@@ -3062,7 +3100,7 @@ typedef struct tt_polycube_mapping {
    max_edge not above 0, a face that is not a triangle (error->face;
    triangulate first), or a polycube not made by tt_polycube_build;
    TT_ERROR_EMPTY_MESH; TT_ERROR_NON_FINITE; TT_ERROR_TOO_LARGE when the
-   refinement would pass INT_MAX / 4 vertices; TT_ERROR_OUT_OF_MEMORY. On
+   refinement would pass TT_POLYCUBE_MAX_TRIANGLES; TT_ERROR_OUT_OF_MEMORY. On
    failure *out is NULL, the report zeroed, and nothing stays allocated.
    Memory: the refined model, the edge records and the relaxation's
    state (about 100 bytes per refined triangle) while it runs, and the
@@ -5096,7 +5134,7 @@ static tt_result tt__check_image_size(int width, int height, tt_error *error)
                         width, height);
     if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE)
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                        "an image of %d x %d texels is above the limit of %d a side", width, height,
+                        "an image of %d x %d texels is above TT_MAX_IMAGE_SIZE, %d a side", width, height,
                         TT_MAX_IMAGE_SIZE);
     return TT_OK;
 }
@@ -6835,7 +6873,8 @@ static int tt__fft_log2(int n)
 }
 
 /* TT_OK when n is a power of two in [1, TT_FFT_MAX_SIZE]; otherwise the
-   error, naming the nearest power of two and the one to pad to. */
+   error (TT_ERROR_TOO_LARGE above the limit), naming the nearest power of
+   two and the one to pad to. */
 static tt_result tt__fft_check_size(const char *what, int n, tt_error *error)
 {
     int below = 1;
@@ -6844,8 +6883,7 @@ static tt_result tt__fft_check_size(const char *what, int n, tt_error *error)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "%s %d: FFT sizes are powers of two from 1 to %d", what, n, TT_FFT_MAX_SIZE);
     if (n > TT_FFT_MAX_SIZE)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "%s %d is above the largest FFT size, %d (the nearest power of two allowed)", what, n,
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "%s %d is above TT_FFT_MAX_SIZE, %d", what, n,
                         TT_FFT_MAX_SIZE);
     while (below * 2 < n) below *= 2;
     return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -6869,13 +6907,14 @@ TTDEF tt_result tt_fft_plan_create(int width, int height, const tt_allocator *al
 {
     tt_fft_plan *plan;
     int size, log2_size, i, L;
+    tt_result result;
     tt__ok(error);
     if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
     *out = NULL;
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (tt__fft_check_size("the width", width, error) != TT_OK ||
-        tt__fft_check_size("the height", height, error) != TT_OK)
-        return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__fft_check_size("the width", width, error)) != TT_OK ||
+        (result = tt__fft_check_size("the height", height, error)) != TT_OK)
+        return result;
     plan = TT__ALLOC(allocator, tt_fft_plan, 1);
     if (!plan) goto out_of_memory;
     memset(plan, 0, sizeof *plan);
@@ -7338,9 +7377,9 @@ TTDEF tt_result tt_xcorr_texture_create(int width, int height, int channels, con
     if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
     *out = NULL;
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (tt__fft_check_size("the texture's width", width, error) != TT_OK ||
-        tt__fft_check_size("the texture's height", height, error) != TT_OK)
-        return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__fft_check_size("the texture's width", width, error)) != TT_OK ||
+        (result = tt__fft_check_size("the texture's height", height, error)) != TT_OK)
+        return result;
     if (channels < 1 || !texture)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "a texture needs 1 or more channels and its values (got %d channels%s)", channels,
@@ -8048,7 +8087,7 @@ TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout 
     if (atlas > TT_MAX_IMAGE_SIZE)
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "%d colors of %d-texel tiles with a %d-texel gutter need an atlas %lld texels wide; "
-                        "the limit is %d (use fewer colors or smaller tiles)",
+                        "TT_MAX_IMAGE_SIZE is %d (use fewer colors or smaller tiles)",
                         layout.colors, layout.tile_size, layout.gutter, atlas, TT_MAX_IMAGE_SIZE);
     *out = layout;
     return TT_OK;
@@ -10463,7 +10502,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     w = source->width;
     h = source->height;
     if (w > TT_MAX_IMAGE_SIZE || h > TT_MAX_IMAGE_SIZE)
-        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "the source is %d x %d texels, above %d", w, h,
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "the source is %d x %d texels, above TT_MAX_IMAGE_SIZE (%d)", w, h,
                         TT_MAX_IMAGE_SIZE);
     if (mask && (!mask->pixels || mask->width != w || mask->height != h))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -12516,7 +12555,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     if (estimate > max_pastes)
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "the texture patches are too small for this mesh: covering it would take about "
-                        "%.3g pastes, more than the limit of %d (use a larger scale)", estimate, max_pastes);
+                        "%.3g pastes, more than max_pastes (%d; 0: TT_LAPPED_MAX_PASTES) (use a larger scale)", estimate, max_pastes);
     for (f = 0; f < nf; f++) {
         const double *t = L->tangent + 3 * (size_t)f;
         double projected = tt__length3(t), longest = 0.0;
@@ -14157,7 +14196,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the atlas is empty: create it with tt_image_create first");
     if (atlas->width > TT_MAX_IMAGE_SIZE || atlas->height > TT_MAX_IMAGE_SIZE)
-        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "the atlas is %d x %d texels, above %d",
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "the atlas is %d x %d texels, above TT_MAX_IMAGE_SIZE (%d)",
                         atlas->width, atlas->height, TT_MAX_IMAGE_SIZE);
     if (gutter < 0 || gutter > tt__max_i(atlas->width, atlas->height))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -18778,7 +18817,7 @@ static tt_result tt__polycube_grid(const tt_mesh *mesh, const tt_polycube_option
         if (cubes < 1.0) cubes = 1.0;
         if (!(cubes <= TT_POLYCUBE_MAX_RESOLUTION))
             return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                            "a cube size of %g makes %g cubes along axis %d, above the limit of %d", vox->h, cubes, a,
+                            "a cube size of %g makes %g cubes along axis %d, above TT_POLYCUBE_MAX_RESOLUTION (%d)", vox->h, cubes, a,
                             TT_POLYCUBE_MAX_RESOLUTION);
         if ((int)cubes > *resolution) *resolution = (int)cubes;
         vox->dims[a] = (int)cubes + 4;
@@ -18787,7 +18826,7 @@ static tt_result tt__polycube_grid(const tt_mesh *mesh, const tt_polycube_option
     }
     if (cells > TT_POLYCUBE_MAX_CUBES)
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                        "the grid of %d x %d x %d cubes (padding included) exceeds the limit of %d cubes",
+                        "the grid of %d x %d x %d cubes (padding included) exceeds TT_POLYCUBE_MAX_CUBES (%d)",
                         vox->dims[0], vox->dims[1], vox->dims[2], TT_POLYCUBE_MAX_CUBES);
     vox->count = (int)cells;
     return TT_OK;
@@ -18803,7 +18842,7 @@ static tt_result tt__polycube_check_options(const tt_polycube_options *o, tt_err
                         "resolution must be 1..%d (0: %d), got %d", TT_POLYCUBE_MAX_RESOLUTION,
                         TT_POLYCUBE_DEFAULT_RESOLUTION, o->resolution);
     if (o->resolution > TT_POLYCUBE_MAX_RESOLUTION)
-        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "resolution %d is above the limit of %d",
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1, "resolution %d is above TT_POLYCUBE_MAX_RESOLUTION (%d)",
                         o->resolution, TT_POLYCUBE_MAX_RESOLUTION);
     if (!tt__is_finite_d(o->cube_size))
         return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1, "cube_size is %g", o->cube_size);
@@ -20370,7 +20409,15 @@ static void tt__refined_midpoint_sources(const int *source, const double *weight
     }
 }
 
-#define TT__REFINE_MAX_TRIANGLES (1 << 24)   /* refining stops short of this many triangles */
+static tt_result tt__polycube_refine_too_large(double longest, double needed, tt_error *error)
+{
+    return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                    "refining the model to edges of at most %g makes %s%.0f triangles, above "
+                    "TT_POLYCUBE_MAX_TRIANGLES (%d): choose a larger max_edge (0: half a cube) or define "
+                    "TT_POLYCUBE_MAX_TRIANGLES higher",
+                    longest, needed > 1e15 ? "over " : "at least ", needed > 1e15 ? 1e15 : needed,
+                    TT_POLYCUBE_MAX_TRIANGLES);
+}
 
 static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
                                      tt__refined *out, tt_error *error)
@@ -20379,6 +20426,7 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
     int *triangles = NULL, *faces = NULL, *source = NULL, *mid = NULL, *next_triangles = NULL, *next_faces = NULL;
     double *weight = NULL;
     int nverts = mesh->nverts, ntriangles = mesh->nfaces, vertex_capacity = 0, pass, c, v, f;
+    double needed = 0, area = 0;
     tt_mesh *current = NULL;
     tt_result result = TT_OK;
     memset(out, 0, sizeof *out);
@@ -20389,6 +20437,18 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
         if (tt__length3(edge) > longest) break;
     }
     if (c == mesh->ncorners) return TT_OK;
+    /* A triangle with no edge above `longest` has at most the area of the
+       equilateral one: the model's area gives a floor on the count. */
+    for (f = 0; f < mesh->nfaces; f++) {
+        const int *corner = mesh->corner_vert + mesh->face_start[f];
+        double e[3], g[3], normal[3];
+        tt__sub3f(mesh->pos + 3 * corner[1], mesh->pos + 3 * corner[0], e);
+        tt__sub3f(mesh->pos + 3 * corner[2], mesh->pos + 3 * corner[0], g);
+        tt__cross3(e, g, normal);
+        area += 0.5 * tt__length3(normal);
+    }
+    needed = area / (0.4330127018922193 * longest * longest);
+    if (!(needed <= TT_POLYCUBE_MAX_TRIANGLES)) return tt__polycube_refine_too_large(longest, needed, error);
     positions = (float *)tt__grow(allocator, NULL, &vertex_capacity, nverts > 0 ? nverts : 1, 3 * sizeof(float));
     source = TT__ALLOC(allocator, int, 3 * (size_t)vertex_capacity);
     weight = TT__ALLOC(allocator, double, 3 * (size_t)vertex_capacity);
@@ -20432,7 +20492,10 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
                 int capacity = vertex_capacity, *grown_source;
                 float *grown_positions;
                 double *grown_weight;
-                if (nverts >= INT_MAX / 4) goto too_large;
+                if (nverts >= INT_MAX / 4) {   /* only with TT_POLYCUBE_MAX_TRIANGLES defined huge */
+                    needed = 2.0 * nverts;
+                    goto too_large;
+                }
                 grown_positions = (float *)tt__grow(allocator, positions, &capacity, nverts + 1, 3 * sizeof(float));
                 if (!grown_positions) goto out_of_memory;
                 positions = grown_positions;
@@ -20451,8 +20514,11 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
             tt__refined_midpoint_sources(source, weight, a, b, source + 3 * nverts, weight + 3 * nverts);
             mid[c] = nverts++;
         }
-        if (!marked || ntriangles > TT__REFINE_MAX_TRIANGLES / 4) break;
-        if (ntriangles > (INT_MAX / 3) / 4) goto too_large;
+        if (!marked) break;
+        needed = 0;
+        for (c = 0; c < current->ncorners; c++) needed += 1 + (mid[c] >= 0);   /* 1 + its split edges per triangle */
+        needed -= 2 * (double)ntriangles;
+        if (needed > TT_POLYCUBE_MAX_TRIANGLES || needed > INT_MAX / 12) goto too_large;
         next_triangles = TT__ALLOC(allocator, int, 12 * (size_t)ntriangles);
         next_faces = TT__ALLOC(allocator, int, 4 * (size_t)ntriangles);
         if (!next_triangles || !next_faces) goto out_of_memory;
@@ -20517,9 +20583,7 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
     out->face = faces;
     return TT_OK;
 too_large:
-    result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                      "refining the model's triangles to edges of at most %g would pass %d vertices or "
-                      "triangles: choose a larger max_edge or a coarser polycube", longest, INT_MAX / 4);
+    result = tt__polycube_refine_too_large(longest, needed, error);
     goto failed;
 out_of_memory:
     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory refining the model");

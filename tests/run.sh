@@ -4,7 +4,8 @@
 #   1. compile checks of tiledtex.h (each counts as one test): gcc C99 with
 #      strict warnings (also at -O3), g++ as C++, clang, tcc, TILEDTEX_STATIC (every function
 #      used, and only one used), user-defined TT_MALLOC/TT_FREE, the helpers'
-#      preconditions caught by TT_ASSERT (tests/assert_check.c), the two
+#      preconditions caught by TT_ASSERT (tests/assert_check.c), the named
+#      limits defined small (tests/limits_check.c), the two
 #      QUICK START blocks compiled and run, every public declaration checked
 #      against the API contract (tests/check_api.sh), and no raw
 #      malloc/free/realloc/calloc outside the TT_MALLOC/TT_FREE defaults;
@@ -92,6 +93,15 @@ for variant in debug ndebug; do
         fail "asserts: a broken precondition is not caught ($variant build)" "$log"
     fi
 done
+
+# The named limits, each defined small before the header (tests/limits_check.c):
+# refused with TT_ERROR_TOO_LARGE naming the limit, and work under it runs.
+if log=$(gcc -std=c99 -g -Wall -Wextra -pedantic -Werror -fsanitize=address,undefined -fno-sanitize-recover=all \
+        -I. tests/limits_check.c -o "$OUT/limits_check" -lm 2>&1) && log=$("$OUT/limits_check" 2>&1); then
+    pass "limits: each named limit, defined small, refuses what passes it (TT_ERROR_TOO_LARGE naming it)"
+else
+    fail "limits: a named limit is not enforced or not named" "$log"
+fi
 
 # TILEDTEX_STATIC in a file that uses one function, as a user would: the
 # functions it does not call must not warn (-Wunused-function) under -Wall.

@@ -2408,6 +2408,22 @@ static void test_map_determinism_and_errors(void)
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && none == NULL &&
               tt_polycube_map(pc, mesh, &mo, NULL, &none, &rep, &err) == TT_ERROR_INVALID_ARGUMENT && none == NULL,
           "max_edge negative or NaN: invalid (%s)", err.message);
+    /* A max_edge whose refinement would pass TT_POLYCUBE_MAX_TRIANGLES is
+       refused before any work, naming the limit (it used to refine until
+       memory ran out). */
+    mo.max_edge = 1e-30;
+    oom_reset();
+    r = tt_polycube_map(pc, mesh, &mo, &g_oom_allocator, &none, &rep, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE && none == NULL && strstr(err.message, "TT_POLYCUBE_MAX_TRIANGLES") != NULL &&
+              g_oom_counter.live == 0,
+          "max_edge 1e-30: too large, naming the limit (%d: %s)", r, err.message);
+    mo.max_edge = 2e-3 * pc->h;   /* the sphere's area over (2e-3 h)^2 passes 2^23 */
+    g_oom_counter.calls = 0;
+    r = tt_polycube_map(pc, mesh, &mo, &g_oom_allocator, &none, &rep, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE && none == NULL && g_oom_counter.calls == 0,
+          "max_edge 2e-3 cubes: too large before any allocation (%d, %ld allocations: %s)", r, g_oom_counter.calls,
+          err.message);
+    mo.max_edge = 0;
     memset(&quads, 0, sizeof quads);
     make_cube_set(&quads, &one, 1, 1, 1, 1.0, 0);
     if (build(&quads, 0, &quad_mesh, &err) == TT_OK) {
