@@ -28,7 +28,7 @@
                                           sets a lower cap per call)
        TT_POLYCUBE_MAX_RESOLUTION   1024  cubes along a polycube's longest axis
        TT_POLYCUBE_MAX_CUBES    (1 << 25) cubes in a polycube's padded grid
-       TT_POLYCUBE_MAX_TRIANGLES (1 << 23) triangles tt_polycube_map's
+       TT_POLYCUBE_MAX_TRIANGLES (1 << 22) triangles tt_polycube_map's
                                           refinement (max_edge) may make
    Mesh and index sizes are capped by int (about 2^30 corners); sizes whose
    byte counts would overflow size_t are refused the same way.
@@ -2979,10 +2979,10 @@ typedef struct tt_polycube_map_options {
    max_edge that needs more is refused with TT_ERROR_TOO_LARGE before the
    refinement passes this (before any work when the model's area alone
    says so). The mapping keeps about 100 bytes per triangle, so the
-   default allows about 1 GB. Define it before including the header to
+   default allows about 400 MB. Define it before including the header to
    change it. */
 #ifndef TT_POLYCUBE_MAX_TRIANGLES
-#define TT_POLYCUBE_MAX_TRIANGLES (1 << 23)
+#define TT_POLYCUBE_MAX_TRIANGLES (1 << 22)
 #endif
 
 typedef struct tt_polycube_map_report {

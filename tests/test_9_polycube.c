@@ -2417,7 +2417,7 @@ static void test_map_determinism_and_errors(void)
     CHECK(r == TT_ERROR_TOO_LARGE && none == NULL && strstr(err.message, "TT_POLYCUBE_MAX_TRIANGLES") != NULL &&
               g_oom_counter.live == 0,
           "max_edge 1e-30: too large, naming the limit (%d: %s)", r, err.message);
-    mo.max_edge = 2e-3 * pc->h;   /* the sphere's area over (2e-3 h)^2 passes 2^23 */
+    mo.max_edge = 2e-3 * pc->h;   /* the sphere's area over (2e-3 h)^2 passes 2^22 */
     g_oom_counter.calls = 0;
     r = tt_polycube_map(pc, mesh, &mo, &g_oom_allocator, &none, &rep, &err);
     CHECK(r == TT_ERROR_TOO_LARGE && none == NULL && g_oom_counter.calls == 0,
