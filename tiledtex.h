@@ -2971,6 +2971,10 @@ typedef struct tt_polycube_map_options {
     const tt_executor *executor;    /* runs the independent parts in parallel (the vertices' projection, the
                                        relaxation's groups of vertices, the edges' tracing, the triangles'
                                        split); NULL: serial. The same mapping either way, bit for bit */
+    tt_progress_fn progress;        /* called between the steps (refinement, projection, relaxation, tracing,
+                                       each repair cycle, the split) with the fraction done, on the calling
+                                       thread; non-zero cancels with TT_CANCELLED */
+    void *progress_user_data;
 } tt_polycube_map_options;
 
 #define TT_POLYCUBE_MAP_DEFAULT_EDGE 0.5
@@ -3100,7 +3104,8 @@ typedef struct tt_polycube_mapping {
    max_edge not above 0, a face that is not a triangle (error->face;
    triangulate first), or a polycube not made by tt_polycube_build;
    TT_ERROR_EMPTY_MESH; TT_ERROR_NON_FINITE; TT_ERROR_TOO_LARGE when the
-   refinement would pass TT_POLYCUBE_MAX_TRIANGLES; TT_ERROR_OUT_OF_MEMORY. On
+   refinement would pass TT_POLYCUBE_MAX_TRIANGLES; TT_CANCELLED by
+   options->progress; TT_ERROR_OUT_OF_MEMORY. On
    failure *out is NULL, the report zeroed, and nothing stays allocated.
    Memory: the refined model, the edge records and the relaxation's
    state (about 100 bytes per refined triangle) while it runs, and the
@@ -23269,6 +23274,11 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping)
     tt__free(&allocator, mapping);
 }
 
+static int tt__polycube_map_cancelled(const tt_polycube_map_options *options, float fraction)
+{
+    return options && options->progress && options->progress(fraction, options->progress_user_data);
+}
+
 TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
                                 const tt_polycube_map_options *options, const tt_allocator *allocator,
                                 tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error)
@@ -23313,6 +23323,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
                         "max_edge %g: give a length above 0 (0 for the default, HUGE_VAL for no refinement)",
                         options->max_edge);
     if ((result = tt__polycube_refine(mesh, longest, allocator, &R, error)) != TT_OK) goto failed;
+    if (tt__polycube_map_cancelled(options, 0.05f)) goto cancelled;
     model = R.mesh ? R.mesh : mesh;
     report->triangles = model->nfaces;
     points = TT__ALLOC(allocator, tt_surface_point, model->nverts > 0 ? model->nverts : 1);
@@ -23320,6 +23331,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if ((result = tt__polycube_project(polycube, model, executor, allocator, points, &report->projection, error)) !=
         TT_OK)
         goto failed;
+    if (tt__polycube_map_cancelled(options, 0.2f)) goto cancelled;
     /* A point within TT__MAP_SNAP of a quad's edge is on it: the points are float (and the projection adds
        its rounding), and a model vertex on a lattice line (a CAD part's edge, a face in a lattice plane) must
        be on S's edge exactly, or the edges through that corner of S split next to it into slivers. */
@@ -23329,9 +23341,11 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     }
     if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator)) < 0)
         goto out_of_memory;
+    if (tt__polycube_map_cancelled(options, 0.45f)) goto cancelled;
     if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, executor, allocator, NULL,
                                   NULL, &edges, error)) != TT_OK)
         goto failed;
+    if (tt__polycube_map_cancelled(options, 0.6f)) goto cancelled;
     if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
         !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
         !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)))
@@ -23341,6 +23355,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
        the edges at the points it moved are traced again. */
     for (cycle = 0; cycle < TT__RESEAT_CYCLES && edges->nfailed > 0; cycle++) {
         int reseated = 0, round, e;
+        if (cycle > 0 && tt__polycube_map_cancelled(options, 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES))
+            goto cancelled;
         memset(focus, 0, (size_t)model->nverts);
         for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
             int n, failed_before = edges->nfailed;
@@ -23397,6 +23413,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             goto failed;
     }
     report->failed_edges = edges->nfailed;
+    if (tt__polycube_map_cancelled(options, 0.85f)) goto cancelled;
 
     if (tt__polycube_split(polycube, model, edges, points, executor, allocator, &mapping,
                            &report->fallback_triangles) != TT_OK)
@@ -23450,8 +23467,16 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, focus);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
+    if (tt__polycube_map_cancelled(options, 1.0f)) {
+        tt_polycube_mapping_free(mapping);
+        memset(report, 0, sizeof *report);
+        return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "polycube mapping cancelled by the progress callback");
+    }
     *out = mapping;
     return TT_OK;
+cancelled:
+    result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "polycube mapping cancelled by the progress callback");
+    goto failed;
 out_of_memory:
     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory mapping the mesh onto S");
 failed:

@@ -989,6 +989,8 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     tt_image *atlas = NULL, **map_patches = NULL, *map_atlases[MATERIAL_MAPS];
     float *normals = NULL;
     tt_bake_options bake;
+    tool_progress progress;
+    tt_result result;
     tt_error error;
     obj_write_desc desc;
     int status = 0, map;
@@ -1007,8 +1009,12 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     memset(&bake, 0, sizeof bake);
     bake.gutter = LAPPED_BAKE_GUTTER;
     bake.executor = tool_executor();
-    if (tt_lapped_bake(m->mesh, lapped, patches->images, patches->count, corner_uv, &bake, NULL, atlas, &error) !=
-        TT_OK) {
+    tool_progress_begin(&progress, "baking", "of the atlas");
+    bake.progress = tool_show_progress;
+    bake.progress_user_data = &progress;
+    result = tt_lapped_bake(m->mesh, lapped, patches->images, patches->count, corner_uv, &bake, NULL, atlas, &error);
+    tool_progress_end(&progress);
+    if (result != TT_OK) {
         status = triangle_mesh_report_error(options->mesh_path, m, &error);
         goto done;
     }

@@ -285,13 +285,19 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
 {
     tt_polycube_map_options map_options;
     tt_error error;
+    tool_progress progress;
+    tt_result result;
     double start = tool_seconds_now();
     /* -j: the projection, the relaxation, the tracing and the split on the tool's threads (the same mapping). */
     memset(&map_options, 0, sizeof map_options);
     map_options.executor = tool_executor();
-    if (tt_polycube_map(job->polycube, job->mesh.mesh, &map_options, NULL, &job->mapping, &job->map_report, &error) !=
-        TT_OK)
-        return triangle_mesh_report_error(options->mesh_path, &job->mesh, &error);
+    tool_progress_begin(&progress, "mapping", "of the steps done");
+    map_options.progress = tool_show_progress;
+    map_options.progress_user_data = &progress;
+    result = tt_polycube_map(job->polycube, job->mesh.mesh, &map_options, NULL, &job->mapping, &job->map_report,
+                             &error);
+    tool_progress_end(&progress);
+    if (result != TT_OK) return triangle_mesh_report_error(options->mesh_path, &job->mesh, &error);
     job->map_seconds = tool_seconds_now() - start;
     /* Above 0.1 % (the target), the cuts show: say why they come and what may help. */
     if (job->map_report.fallback_triangles > 0.001 * job->map_report.triangles)

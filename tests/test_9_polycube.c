@@ -1937,6 +1937,21 @@ static mapping_check check_mapping(const tt_polycube *pc, const tt_mesh *mesh, c
     return c;
 }
 
+/* A progress callback that records the fractions and cancels at call
+   number cancel_at (0-based; -1: never). */
+typedef struct progress_log {
+    int calls, cancel_at, decreasing;
+    float last;
+} progress_log;
+
+static int log_progress(float fraction, void *user_data)
+{
+    progress_log *log = (progress_log *)user_data;
+    if (fraction < log->last || !(fraction >= 0.0f && fraction <= 1.0f)) log->decreasing++;
+    log->last = fraction;
+    return log->calls++ == log->cancel_at;
+}
+
 static tt_polycube_mapping *mapped(const tmesh *m, int resolution, int max_quads, double max_edge,
                                    tt_polycube **pc_out, tt_mesh **mesh_out, tt_polycube_map_report *report)
 {
@@ -2424,6 +2439,36 @@ static void test_map_determinism_and_errors(void)
           "max_edge 2e-3 cubes: too large before any allocation (%d, %ld allocations: %s)", r, g_oom_counter.calls,
           err.message);
     mo.max_edge = 0;
+    /* The progress callback: fractions rising to 1; cancelling at any call
+       stops with TT_CANCELLED, nothing returned and nothing left allocated. */
+    {
+        progress_log log;
+        int k, calls, bad = 0;
+        memset(&log, 0, sizeof log);
+        log.cancel_at = -1;
+        mo.progress = log_progress;
+        mo.progress_user_data = &log;
+        r = tt_polycube_map(pc, mesh, &mo, NULL, &none, NULL, &err);
+        CHECK(r == TT_OK && log.calls >= 6 && log.decreasing == 0 && log.last == 1.0f,
+              "progress: %d calls, %d out of order, last %g (%d)", log.calls, log.decreasing, log.last, r);
+        tt_polycube_mapping_free(none);
+        calls = log.calls;
+        for (k = 0; k < calls; k++) {
+            memset(&log, 0, sizeof log);
+            log.cancel_at = k;
+            oom_reset();
+            none = (tt_polycube_mapping *)&none;
+            r = tt_polycube_map(pc, mesh, &mo, &g_oom_allocator, &none, &rep, &err);
+            if (r != TT_CANCELLED || none != NULL || g_oom_counter.live != 0 || err.result != TT_CANCELLED ||
+                log.calls != k + 1) {
+                if (!bad) DETAIL("cancelled at call %d: result %d, %ld blocks live, %d calls", k, r, g_oom_counter.live,
+                                 log.calls);
+                bad++;
+            }
+        }
+        CHECK(bad == 0, "cancelling at each of the %d progress calls: %d did not stop cleanly", calls, bad);
+        mo.progress = NULL;
+    }
     memset(&quads, 0, sizeof quads);
     make_cube_set(&quads, &one, 1, 1, 1, 1.0, 0);
     if (build(&quads, 0, &quad_mesh, &err) == TT_OK) {
