@@ -66,6 +66,26 @@
        number of workers, or none (NULL: serial).
      - The library never touches files.
 
+   SECURITY: feeding it strangers' files
+     Meshes, images and options from untrusted files may be passed straight
+     in. For any input the library reads only inside the arrays the sizes
+     you give describe, has no undefined behaviour, never writes to an
+     input, and returns a specific error for what it cannot use (NaN and
+     infinite values, indices out of range, sizes that overflow, unknown
+     flags, degenerate geometry) with nothing left allocated. Work and
+     memory are bounded by the input's size and the LIMITS above, checked
+     before the memory is taken; a long run can be cancelled through its
+     progress callback, which every pipeline calls at least every second or
+     so on a 100k-face mesh. What is not bounded is how long a legitimate
+     input near the limits takes: cancel it, or cap the sizes you accept.
+     How it is tested (tests/): every fallible function called with hostile
+     arguments (NULL, zero and negative sizes, NaN, infinities, overflowing
+     sizes, unknown flags and enum values), with and without a tt_error; an
+     allocation-failure sweep of every entry point (each allocation failed
+     in turn: the error filled, nothing leaked); libFuzzer targets for the
+     mesh builder, every pipeline and the example tool's file readers; all
+     under AddressSanitizer and UndefinedBehaviorSanitizer.
+
    QUICK START: tile a quad mesh from a photo (Akleman et al.'s tiled textures)
 
        tt_mesh_desc desc = {0};                                 // your arrays:
