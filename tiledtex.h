@@ -17499,6 +17499,15 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
     return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
 }
 
+/* The progress callback told `fraction` (of the faces textured); 1 with
+   *res and *error filled when it asks to stop. */
+static int tt__hpm_cancelled(const tt__hpm *S, float fraction, tt_result *res, tt_error *error)
+{
+    if (!S->progress || !S->progress(fraction, S->progress_user_data)) return 0;
+    *res = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "hierarchical pattern mapping cancelled");
+    return 1;
+}
+
 /* The traversal (Sec. 2.2, D22). */
 static tt_result tt__hpm_traverse(tt__hpm *S, tt_error *error)
 {
@@ -17571,8 +17580,7 @@ static tt_result tt__hpm_traverse(tt__hpm *S, tt_error *error)
             continue;
         }
         if (!tt__hpm_process(S, C, count > 0, &res, error)) return res;
-        if (S->progress && S->progress((float)S->textured / S->mesh->nfaces, S->progress_user_data))
-            return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "hierarchical pattern mapping cancelled");
+        if (tt__hpm_cancelled(S, (float)S->textured / S->mesh->nfaces, &res, error)) return res;
     }
     return TT_OK;
 oom:
@@ -17963,8 +17971,10 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     copt.branching = o.branching;
     res = tt_cluster_hierarchy_build(mesh, &copt, allocator, &S.H, error);
     if (res != TT_OK) return res;
+    if (tt__hpm_cancelled(&S, 0.0f, &res, error)) goto done;
     res = tt__hpm_prepare_image(&S, image, match_size, error);
     if (res != TT_OK) goto done;
+    if (tt__hpm_cancelled(&S, 0.0f, &res, error)) goto done;
 
     S.flat = TT__ALLOC(allocator, float, 2 * (size_t)mesh->ncorners);
     S.uv = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
@@ -18007,6 +18017,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     res = tt__hpm_traverse(&S, error);
     if (res != TT_OK) goto done;
     if (!(o.flags & TT_HPM_NO_RELAXATION)) tt__hpm_choose_borders(&S);
+    if (tt__hpm_cancelled(&S, 1.0f, &res, error)) goto done;
     tt__hpm_leftovers(&S, S.uv);
     if (S.out) tt__hpm_leftovers(&S, S.out);
     {

@@ -375,6 +375,8 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     tt_synth_options synth;
     tt_synth_plan *plan = NULL;
     tt_error error;
+    tool_progress progress;
+    tt_result result;
     int map;
     *out = NULL;
     for (map = 0; maps && map < MATERIAL_MAPS; map++) map_tiles[map] = NULL;
@@ -397,8 +399,13 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     }
     /* One plan, from the colour image, for every map: the maps' tiles are
        cut where the colour's are, and line up texel for texel. */
-    if (tt_synth_plan_create(image, &synth, NULL, &plan, &error) != TT_OK ||
-        tt_synth_apply(plan, image, NULL, out, &error) != TT_OK) {
+    tool_progress_begin(&progress, "synthesis", "of the tiles");
+    synth.progress = tool_show_progress;
+    synth.progress_user_data = &progress;
+    result = tt_synth_plan_create(image, &synth, NULL, &plan, &error);
+    if (result == TT_OK) result = tt_synth_apply(plan, image, NULL, out, &error);
+    if (result != TT_OK) {
+        tool_progress_end(&progress);
         tt_synth_plan_free(plan);
         if (error.result == TT_ERROR_IMAGE_TOO_SMALL || error.result == TT_ERROR_INVALID_ARGUMENT)
             return tool_fail("%s: %s", image_path, error.message);
@@ -407,12 +414,15 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     for (map = 0; maps && map < MATERIAL_MAPS; map++) {
         if (!maps->images[map]) continue;
         if (tt_synth_apply(plan, maps->images[map], NULL, &map_tiles[map], &error) != TT_OK) {
-            int status = tool_fail("%s: %s", maps->paths[map], error.message);
+            int status;
+            tool_progress_end(&progress);
+            status = tool_fail("%s: %s", maps->paths[map], error.message);
             tt_synth_plan_free(plan);
             tiled_tilesets_free(out, maps ? map_tiles : NULL);
             return status;
         }
     }
+    tool_progress_end(&progress);
     tt_synth_plan_free(plan);
     return 0;
 }

@@ -159,7 +159,9 @@ int main(int argc, char **argv)
         return tool_usage("unknown command '%s' (try 'tiledtex --help')", argv[1]);
     }
     tool_set_command(command->name);
+    tool_catch_interrupts();
     status = command->run(argc - 1, argv + 1);
+    if (status != 0 && tool_interrupted()) status = 130;   /* as a shell reports a command ended by Ctrl-C */
     if (status == 0) tool_print_notes();
     tool_forget_inputs();
     return status;

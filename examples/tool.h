@@ -875,9 +875,17 @@ typedef struct tool_progress {
 } tool_progress;
 
 void tool_progress_begin(tool_progress *progress, const char *activity, const char *what);
+/* Also answers "cancel" once Ctrl-C or SIGTERM came (tool_catch_interrupts). */
 int tool_show_progress(float fraction, void *user_data);
 /* Ends a line that was shown. */
 void tool_progress_end(tool_progress *progress);
+
+/* Between tool_progress_begin and _end, SIGINT and SIGTERM cancel the
+   library call through tool_show_progress instead of killing the tool;
+   outside, they kill it as usual. main installs this once. */
+void tool_catch_interrupts(void);
+/* A signal came: the command was cancelled (exit status 130). */
+int tool_interrupted(void);
 
 /* ---------------------------------------------------------------------- */
 /* Threads (executor.c)                                                     */

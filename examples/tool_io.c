@@ -782,8 +782,38 @@ double tool_seconds_now(void)
     return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
 }
 
+/* Ctrl-C (SIGINT) or SIGTERM during a library call that takes a progress
+   callback cancels it through that callback: the call returns TT_CANCELLED
+   with everything freed, the command fails with one line, and no output
+   is written. Outside such a call the signal does what it always does
+   (the output commit's temporary files are removed by the next run). */
+static volatile sig_atomic_t interrupt_requested, progress_active;
+
+static void on_interrupt(int signal_number)
+{
+    if (!progress_active) {
+        signal(signal_number, SIG_DFL);
+        raise(signal_number);
+        return;
+    }
+    interrupt_requested = 1;
+}
+
+void tool_catch_interrupts(void)
+{
+    struct sigaction action;
+    memset(&action, 0, sizeof action);
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, NULL);
+    sigaction(SIGTERM, &action, NULL);
+}
+
+int tool_interrupted(void) { return interrupt_requested != 0; }
+
 void tool_progress_begin(tool_progress *progress, const char *activity, const char *what)
 {
+    progress_active = 1;
     memset(progress, 0, sizeof *progress);
     progress->activity = activity;
     progress->what = what;
@@ -796,6 +826,7 @@ int tool_show_progress(float fraction, void *user_data)
 {
     tool_progress *progress = (tool_progress *)user_data;
     double now = tool_seconds_now();
+    if (interrupt_requested) return 1;
     if (!progress->terminal || now - progress->start < 1.0 || (progress->shown && now - progress->last < 0.1))
         return 0;
     fprintf(stderr, "\r%s: %s: %5.1f%% %s", TOOL_NAME, progress->activity, 100.0 * (double)fraction,
@@ -808,6 +839,7 @@ int tool_show_progress(float fraction, void *user_data)
 
 void tool_progress_end(tool_progress *progress)
 {
+    progress_active = 0;
     if (progress->shown) fputc('\n', stderr);
     progress->shown = 0;
 }

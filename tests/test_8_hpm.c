@@ -1650,6 +1650,70 @@ static void test_hpm_map_coarse(void)
     tt_image_free(im);
 }
 
+/* A progress callback that records the fractions and cancels at call
+   number cancel_at (0-based; -1: never). */
+typedef struct hpm_progress_log {
+    int calls, cancel_at, decreasing;
+    float last;
+} hpm_progress_log;
+
+static int hpm_log_progress(float fraction, void *user_data)
+{
+    hpm_progress_log *log = (hpm_progress_log *)user_data;
+    if (fraction < log->last || !(fraction >= 0.0f && fraction <= 1.0f)) log->decreasing++;
+    log->last = fraction;
+    return log->calls++ == log->cancel_at;
+}
+
+/* The progress callback: fractions rising to 1 (the hierarchy, the image,
+   every cluster, the borders); cancelling at any call stops the mapping
+   with TT_CANCELLED, the UVs untouched and nothing left allocated. */
+static void test_hpm_map_progress(void)
+{
+    tt_mesh *mesh = hpm_mesh(M_GRID);
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    hpm_progress_log log;
+    tt_error err;
+    float *uv = NULL;
+    int k, calls, bad = 0, n;
+    tt_result r;
+    make_value_noise(&im, 40, 40, 1);
+    if (!mesh || !im) goto done;
+    n = 2 * mesh->ncorners;
+    uv = (float *)malloc(sizeof(float) * (size_t)n);
+    memset(&o, 0, sizeof o);
+    o.rotations = 3;
+    o.match_size = 16;
+    o.progress = hpm_log_progress;
+    o.progress_user_data = &log;
+    memset(&log, 0, sizeof log);
+    log.cancel_at = -1;
+    r = tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err);
+    CHECK(r == TT_OK && log.calls >= 4 && log.decreasing == 0 && log.last == 1.0f,
+          "progress: %d calls, %d out of order, last %g (%d: %s)", log.calls, log.decreasing, log.last, r, err.message);
+    calls = log.calls;
+    for (k = 0; k < calls; k++) {
+        int i, touched = 0;
+        for (i = 0; i < n; i++) uv[i] = -7.0f;
+        memset(&log, 0, sizeof log);
+        log.cancel_at = k;
+        oom_reset();
+        r = tt_hpm_map(mesh, im, &o, &g_oom_allocator, uv, NULL, NULL, &err);
+        for (i = 0; i < n; i++) touched += uv[i] != -7.0f;
+        if (r != TT_CANCELLED || err.result != r || touched || g_oom_counter.live != 0 || log.calls != k + 1) {
+            if (!bad) DETAIL("cancelled at call %d: result %d, %d UVs written, %ld blocks live", k, r, touched,
+                             g_oom_counter.live);
+            bad++;
+        }
+    }
+    CHECK(bad == 0, "cancelling at each of the %d progress calls: %d did not stop cleanly", calls, bad);
+done:
+    free(uv);
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
 static void test_hpm_map_errors(void)
 {
     tt_mesh *mesh = hpm_mesh(M_GRID), *quads = NULL;
@@ -1728,5 +1792,6 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_budget);
     RUN(test_hpm_map_topology);
     RUN(test_hpm_map_coarse);
+    RUN(test_hpm_map_progress);
     RUN(test_hpm_map_errors);
 }
