@@ -1830,6 +1830,26 @@ check "map from standard input onto the same file: refused" "non-zero exit, m.ob
     "$([ $RC -ne 0 ] && cmp -s m.obj ../in/torus.obj; echo $?)"
 cd "$W" || exit 1
 
+# Ctrl-C (SIGINT) or SIGTERM during a long library call cancels it through
+# the progress callback: one line saying so, exit status 130, nothing
+# written. The run (27,000 pastes on the sphere, several seconds even
+# without sanitizers) is well inside its paste loop after 3 s.
+for sig in INT TERM; do
+    newdir
+    CMD="tiledtex lapped sphere.obj lap.png out --scale 0.05, then SIG$sig after 3 s"
+    "$TOOL" lapped ../in/spheretri.obj ../in/lap.png out --scale 0.05 >"$W/out" 2>"$W/err" </dev/null &
+    pid=$!
+    sleep 3
+    kill -s "$sig" "$pid"
+    wait "$pid"
+    RC=$?
+    ERR=$(cat "$W/err")
+    check "SIG$sig during lapped: cancelled cleanly" "exit 130, one line saying it was cancelled, no file" \
+        "exit $RC, stderr: $ERR, files: $(ls -A | tr '\n' ' ')" \
+        "$([ $RC -eq 130 ] && [ "$(wc -l <"$W/err")" -eq 1 ] && grep -qi 'cancel' "$W/err" && [ -z "$(ls -A)" ]; echo $?)"
+    cd "$W" || exit 1
+done
+
 # a directory named like a temporary is never opened nor removed
 newdir
 mkdir out.obj.tiledtex-tmp
