@@ -19,6 +19,9 @@
 #                            on the same input: the figures to beat
 #   scale_P_cpu_growth_4x / _16x
 #                            CPU at 4x (16x) the faces over CPU at 1x
+#   scale_P_97k_cancel_seconds
+#                            Ctrl-C halfway through the 97k run: seconds
+#                            until the tool has exited (target <= 1)
 # Targets (issue 20): growth_4x <= 5; the 16x run finishes; at 97k faces
 # lapped <= 4 s, hpm <= 2.5 s, polycube <= 3 s, tile <= 0.3 s CPU, peak memory
 # no higher than v0.3.0's; -j 2 identical, wall <= 0.65x (tile synthesis, the
@@ -87,6 +90,29 @@ measure() {
         "$tool_" "${jflag[@]}" "$pipeline" "$mesh" "$photo" "$dir/out" "${extra[@]}")
 }
 
+# measure_cancel PIPELINE MESH WALL NAME: Ctrl-C (SIGINT) halfway through a
+# run, by its wall time at -j 1: the seconds until the tool has exited (the
+# library call cancelled through its progress callback). Target: <= 1 s.
+measure_cancel() {
+    local dir=$work/$1-cancel extra=() start end rc
+    rm -rf "$dir" && mkdir -p "$dir"
+    [ "$1" = lapped ] && extra=(--bake 2048)
+    "$tool" -j 1 "$1" "$2" "$photo" "$dir/out" "${extra[@]}" >"$dir/log" 2>&1 &
+    local pid=$!
+    sleep "$(awk -v w="$3" 'BEGIN { printf "%.2f", w / 2 }')"
+    start=$(date +%s.%N)
+    kill -INT "$pid" 2>/dev/null
+    wait "$pid"
+    rc=$?
+    end=$(date +%s.%N)
+    if [ "$rc" = 130 ]; then
+        figure "${4}_cancel_seconds" "$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.3f", b - a }')" s
+    else
+        echo "bench_scale: $1 interrupted halfway: status $rc ($(tail -n 1 "$dir/log"))" >&2
+    fi
+    rm -rf "$dir"
+}
+
 # Tile synthesis alone (the paper's 256 tiles of 128 texels, and the PNG):
 # what a second core gains there.
 measure_synth() {
@@ -151,6 +177,7 @@ for p in tile hpm polycube lapped; do
             fi
         fi
         rm -rf "$work/$p-x$s-j2" "$work/$p-x$s-v030"
+        [ "$s" = 1 ] && measure_cancel "$p" "$mesh" "$wall1" "$name"
     done
     for s in 4 16; do
         if [ -n "${cpu1[1]:-}" ] && [ -n "${cpu1[$s]:-}" ]; then
