@@ -1038,6 +1038,62 @@ done:
 
 /* An image whose kind is not a tt_image_kind (a caller's struct) is refused
    by the steps that act on the kind, not taken as colour. */
+/* The allocation-failure sweep of every image entry point that allocates:
+   each allocation failed in turn gives TT_ERROR_OUT_OF_MEMORY with the
+   error filled, *out NULL, and nothing leaked. */
+typedef struct image_oom_ctx {
+    const tt_image *src;
+    const unsigned char *bytes;
+    const float *cost;
+    int which;
+} image_oom_ctx;
+
+static tt_result image_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
+{
+    image_oom_ctx *c = (image_oom_ctx *)ctx;
+    tt_image *out = (tt_image *)ctx;   /* must be reset to NULL on failure */
+    tt_result r;
+    int path[16], lo[5], hi[5], x;
+    for (x = 0; x < 5; x++) {
+        lo[x] = 2;
+        hi[x] = 13;
+    }
+    switch (c->which) {
+    case 0: r = tt_image_create(24, 16, al, &out, error); break;
+    case 1: r = tt_image_from_bytes(c->bytes, 8, 6, 3, 0, TT_COLOR_SRGB, al, &out, error); break;
+    case 2: r = tt_image_rotate90(c->src, 1, al, &out, error); break;
+    case 3: r = tt_image_downsample2(c->src, al, &out, error); break;
+    default:
+        out = NULL;
+        return tt_min_error_cut(c->cost, 5, 16, lo, hi, al, path, error);
+    }
+    if (r != TT_OK && out != NULL) return TT_RESULT_MAX_ENUM;
+    tt_image_free(out);
+    return r;
+}
+
+static void test_image_oom(void)
+{
+    static const char *const names[5] = {"tt_image_create", "tt_image_from_bytes", "tt_image_rotate90",
+                                         "tt_image_downsample2", "tt_min_error_cut"};
+    image_oom_ctx c;
+    tt_image *src = NULL;
+    unsigned char bytes[8 * 6 * 3];
+    float cost[5 * 16];
+    int i;
+    make_value_noise(&src, 10, 8, 3);
+    for (i = 0; i < (int)sizeof bytes; i++) bytes[i] = (unsigned char)(i * 29);
+    for (i = 0; i < 5 * 16; i++) cost[i] = (float)((i * 7) % 11);
+    c.src = src;
+    c.bytes = bytes;
+    c.cost = cost;
+    for (c.which = 0; c.which < 5 && src; c.which++) {
+        oom_reset();
+        oom_sweep(names[c.which], image_oom_call, &c, TT_OK);
+    }
+    tt_image_free(src);
+}
+
 static void test_image_unknown_kind(void)
 {
     tt_image *im = NULL, *out = NULL;
@@ -1075,4 +1131,5 @@ void run_image_tests(void)
     RUN(test_over_downsample);
     RUN(test_normal_maps);
     RUN(test_min_error_cut);
+    RUN(test_image_oom);
 }
