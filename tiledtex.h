@@ -637,8 +637,10 @@ TTDEF tt_result tt_image_rotate90(const tt_image *src, int quarter_turns, const 
                                   tt_image **out_image, tt_error *error);
 
 /* Porter-Duff `over` on premultiplied RGBA: dst = src + (1 - src.a) * dst.
-   alpha 1 gives src exactly and alpha 0 leaves dst exactly. Same sizes
-   (TT_ERROR_INVALID_ARGUMENT otherwise). */
+   alpha 1 gives src exactly and alpha 0 leaves dst exactly. Errors: NULL
+   images or pixels, sizes that differ or are below 1, a kind that is not a
+   tt_image_kind (TT_ERROR_INVALID_ARGUMENT); above TT_MAX_IMAGE_SIZE
+   (TT_ERROR_TOO_LARGE). */
 TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *error);
 /* The same on one pixel. Preconditions (TT_ASSERT): neither is NULL. */
 TTDEF void tt_rgba_over(float dst[4], const float src_premultiplied[4]);
@@ -5589,6 +5591,7 @@ TTDEF void tt_rgba_over(float dst[4], const float src[4])
 TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *error)
 {
     size_t i, n;
+    tt_result result;
     tt__ok(error);
     if (!dst || !src || !dst->pixels || !src->pixels)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "an image is NULL or empty");
@@ -5596,6 +5599,10 @@ TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *erro
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the images differ in size: %d x %d over %d x %d", src->width, src->height, dst->width,
                         dst->height);
+    if ((result = tt__check_image_size(dst->width, dst->height, error)) != TT_OK ||
+        (result = tt__check_image_kind(src, "the source image", error)) != TT_OK ||
+        (result = tt__check_image_kind(dst, "the destination image", error)) != TT_OK)
+        return result;
     n = (size_t)dst->width * dst->height;
     for (i = 0; i < n; i++) tt_rgba_over(dst->pixels + 4 * i, src->pixels + 4 * i);
     return TT_OK;
