@@ -1309,7 +1309,8 @@ typedef struct tt_synth_plan {
 /* Plan the tile set of options->layout (options may be NULL: all defaults)
    from `guide`, whose texels decide the edge windows (when not given) and the
    cuts; the seed decides the rest. Same guide, options and seed: same plan.
-   Errors: NULL out_plan or an empty guide (TT_ERROR_INVALID_ARGUMENT), a bad
+   Errors: NULL out_plan, an empty guide or one whose kind is not a
+   tt_image_kind (TT_ERROR_INVALID_ARGUMENT), a bad
    allocator, a non-finite guide texel (TT_ERROR_NON_FINITE, error->row /
    column = its y / x), a layout that does not resolve, a guide smaller than S
    x 2S or a background region that cannot hold a tile
@@ -1735,7 +1736,8 @@ typedef struct tt_patch_options {
    seed and size, so every map of a material cut with the same mask (or
    seed) gives patches that line up.
    Errors (*patch is NULL, memory freed on every path):
-     TT_ERROR_INVALID_ARGUMENT  NULL or empty source or patch; a mask of
+     TT_ERROR_INVALID_ARGUMENT  NULL or empty source or patch; a source
+                                whose kind is not a tt_image_kind; a mask of
                                 another size (the message gives both sizes);
                                 "the mask has no opaque pixel" (no texel >=
                                 0.5); a negative falloff, a roughness outside
@@ -2520,7 +2522,8 @@ typedef struct tt_hpm_report {
    tt_cluster_hierarchy_build with the same seed and branching). options and
    report may be NULL. Results:
      TT_OK;
-     TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, a bad
+     TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, an image
+                                whose kind is not a tt_image_kind, a bad
                                 allocator, options out of range, a face
                                 that is not a triangle (error->face), a
                                 scale at which a face does not fit the
@@ -8819,6 +8822,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (!guide || !guide->pixels || guide->width <= 0 || guide->height <= 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the %s is empty", what);
+    if ((result = tt__check_image_kind(guide, what, error)) != TT_OK) return result;
     if ((result = tt__check_finite_texels(guide, what, error)) != TT_OK) return result;
     if ((result = tt_tile_layout_resolve(&opt->layout, &layout, error)) != TT_OK) return result;
     S = layout.tile_size;
@@ -10531,6 +10535,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (!source || !source->pixels || source->width <= 0 || source->height <= 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
+    if (tt__check_image_kind(source, "the source image", error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     w = source->width;
     h = source->height;
     if (w > TT_MAX_IMAGE_SIZE || h > TT_MAX_IMAGE_SIZE)
@@ -17862,6 +17867,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (!image->pixels || image->width < 1 || image->height < 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "tt_hpm_map: the image is empty");
+    if (tt__check_image_kind(image, "the image", error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (mesh->nfaces < 1) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
     if (options)
         o = *options;
