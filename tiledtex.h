@@ -938,9 +938,9 @@ TTDEF tt_result tt_fft_c2c(const tt_fft_plan *plan, double *data, int width, int
    The rows use the N/2 packing: a row of width reals is read as
    width / 2 complex values (x[2m] + i x[2m + 1]), transformed, and split
    into bins 0 .. width / 2 by one pass; about half the work of the complex
-   transform. real and spectrum must not overlap. Errors as tt_fft_c2c
-   (width and height are the real data's; TT_ERROR_NON_FINITE leaves the
-   spectrum unspecified). Allocates nothing; thread-safe for distinct
+   transform. real and spectrum must not overlap (TT_ERROR_INVALID_ARGUMENT).
+   Errors as tt_fft_c2c (width and height are the real data's;
+   TT_ERROR_NON_FINITE leaves the spectrum unspecified). Allocates nothing; thread-safe for distinct
    outputs. */
 TTDEF tt_result tt_fft_r2c(const tt_fft_plan *plan, const double *real, int width, int height, double *spectrum,
                            tt_error *error);
@@ -948,7 +948,7 @@ TTDEF tt_result tt_fft_r2c(const tt_fft_plan *plan, const double *real, int widt
 /* Inverse of tt_fft_r2c, unnormalised like tt_fft_c2c:
    c2r(r2c(x)) = width * height * x. spectrum (the half spectrum, laid out as
    tt_fft_r2c writes it) is used as work space and destroyed; real gets
-   height x width doubles and must not overlap it. The spectrum is taken to
+   height x width doubles and must not overlap it (TT_ERROR_INVALID_ARGUMENT). The spectrum is taken to
    be that of real data (Hermitian), as r2c's output and sums and products of
    such spectra are: the imaginary parts of bins k = 0 and k = width / 2 after
    the column pass are ignored, as FFTW's c2r does. Errors as tt_fft_r2c.
@@ -7337,6 +7337,18 @@ static tt_result tt__fft_check_call(const tt_fft_plan *plan, const void *a, cons
     return TT_OK;
 }
 
+/* The real and spectrum arrays of tt_fft_r2c / tt_fft_c2r must not overlap
+   (one is copied into the other), compared as addresses. */
+static tt_result tt__fft_check_apart(const double *real, const double *spectrum, int width, int height,
+                                     const char *name, tt_error *error)
+{
+    size_t nreal = (size_t)width * (size_t)height, nspectrum = 2 * (size_t)height * (size_t)(width / 2 + 1);
+    if ((uintptr_t)real < (uintptr_t)(spectrum + nspectrum) && (uintptr_t)spectrum < (uintptr_t)(real + nreal))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "%s: the real data and the spectrum overlap",
+                        name);
+    return TT_OK;
+}
+
 static tt_result tt__fft_nonfinite_error(const char *name, tt_error *error)
 {
     return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
@@ -7361,7 +7373,8 @@ TTDEF tt_result tt_fft_r2c(const tt_fft_plan *plan, const double *real, int widt
 {
     int y;
     tt__ok(error);
-    if (tt__fft_check_call(plan, real, spectrum, width, height, "tt_fft_r2c", error) != TT_OK)
+    if (tt__fft_check_call(plan, real, spectrum, width, height, "tt_fft_r2c", error) != TT_OK ||
+        tt__fft_check_apart(real, spectrum, width, height, "tt_fft_r2c", error) != TT_OK)
         return TT_ERROR_INVALID_ARGUMENT;
     /* Each row of reals into its row of the spectrum (width / 2 + 1 complex
        values: room for the bins), transformed there. */
@@ -7378,7 +7391,8 @@ TTDEF tt_result tt_fft_c2r(const tt_fft_plan *plan, double *spectrum, int width,
     int y;
     uint64_t found;
     tt__ok(error);
-    if (tt__fft_check_call(plan, spectrum, real, width, height, "tt_fft_c2r", error) != TT_OK)
+    if (tt__fft_check_call(plan, spectrum, real, width, height, "tt_fft_c2r", error) != TT_OK ||
+        tt__fft_check_apart(real, spectrum, width, height, "tt_fft_c2r", error) != TT_OK)
         return TT_ERROR_INVALID_ARGUMENT;
     found = tt__fft_c2r_inplace(plan, spectrum);
     for (y = 0; y < height; y++)
