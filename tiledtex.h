@@ -1356,7 +1356,8 @@ TTDEF float tt_synth_plan_band_alpha(const tt_synth_plan *plan, int tile, int si
    (TT_ERROR_INVALID_ARGUMENT); a source whose size is not the plan's
    (TT_ERROR_INVALID_ARGUMENT); a type of 2n or more
    (TT_ERROR_INDEX_OUT_OF_RANGE, error->item = the side); a cell that does
-   not lie inside the target (TT_ERROR_INVALID_ARGUMENT). A non-finite source
+   not lie inside the target, a target whose texels overlap the source's
+   (TT_ERROR_INVALID_ARGUMENT). A non-finite source
    texel that reaches the tile is TT_ERROR_NON_FINITE (error->row / column =
    the source texel's y / x); the cell has been written then. */
 TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image *source, const uint8_t types[4],
@@ -9083,6 +9084,12 @@ TTDEF tt_result tt_synth_compose_tile(const tt_synth_plan *plan, const tt_image 
     if ((result = tt__check_plan_source(plan, source, error)) != TT_OK) return result;
     if (!target->pixels || target->width <= 0 || target->height <= 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the target image is empty");
+    /* Compared as addresses: the tile is composed in place in the target while the source is read. */
+    if ((uintptr_t)target->pixels <
+            (uintptr_t)(source->pixels + (size_t)source->width * (size_t)source->height * 4) &&
+        (uintptr_t)source->pixels < (uintptr_t)(target->pixels + (size_t)target->width * (size_t)target->height * 4))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the target shares texels with the source: compose into an image of its own");
     base = 2 * plan->layout.colors;
     for (side = 0; side < 4; side++)
         if (types[side] >= base)
