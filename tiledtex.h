@@ -13049,11 +13049,12 @@ static tt_result tt__check_lapped(const tt_mesh *mesh, const tt_lapped *lapped, 
         for (k = 0; lapped->fade && k < 3; k++) {
             float fade = lapped->fade[3 * (size_t)e + k];
             if (!tt__is_finite(fade) || fade < 0.0f || fade > 1.0f) {
-                tt__fail_at(error, tt__is_finite(fade) ? TT_ERROR_INVALID_ARGUMENT : TT_ERROR_NON_FINITE, e, -1, -1,
+                tt_result result = tt__is_finite(fade) ? TT_ERROR_INVALID_ARGUMENT : TT_ERROR_NON_FINITE;
+                tt__fail_at(error, result, e, -1, -1,
                             "entry %d (face %d) has fade %g at corner %d: fades run from 0 to 1", e, f, (double)fade,
                             k);
                 if (error) error->face = f;
-                return error ? error->result : TT_ERROR_INVALID_ARGUMENT;
+                return result;
             }
         }
     }
