@@ -407,7 +407,8 @@ typedef struct tt_mesh_stats {
 } tt_mesh_stats;
 
 /* Topology summary (temporary memory only). Errors: NULL mesh or stats, a bad
-   allocator (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY. */
+   allocator (TT_ERROR_INVALID_ARGUMENT), a mesh without faces (made by hand:
+   TT_ERROR_EMPTY_MESH), TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, const tt_allocator *allocator, tt_mesh_stats *stats,
                                       tt_error *error);
 
@@ -444,7 +445,8 @@ typedef enum tt_subdivision {
    strict result: where a valid polygon repeats a position at distinct
    vertices, or where float cannot separate the new points (a tiny face far
    from the origin); tt_face_normal gives (0, 0, 0) for such a quad. New
-   points that overflow float are TT_ERROR_NON_FINITE. */
+   points that overflow float are TT_ERROR_NON_FINITE; a mesh without faces
+   (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error);
 
@@ -483,8 +485,9 @@ typedef struct tt_corner_sources {
    interpolates the vertices mesh->corner_vert[source] of any of its corners
    (all of them give the same vertices and weights): old vertex v itself,
    an edge point the edge's two ends, a face point the face's vertices.
-   Errors: NULL mesh or out, a bad allocator (TT_ERROR_INVALID_ARGUMENT);
-   TT_ERROR_TOO_LARGE when the quadrangulation itself would be (as
+   Errors: NULL mesh or out, a bad allocator (TT_ERROR_INVALID_ARGUMENT); a
+   mesh without faces (TT_ERROR_EMPTY_MESH); TT_ERROR_TOO_LARGE when the
+   quadrangulation itself would be (as
    tt_mesh_quadrangulate) or the sources would pass INT_MAX / 2;
    TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL and nothing stays
    allocated. Memory: 8 bytes per source, 5 + |f| sources per input corner
@@ -524,7 +527,8 @@ TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3]);
    vertex; 30 to 60 keeps a CAD part's edges and smooths a scan. Faces of
    zero area weigh nothing; a corner with nothing to average gets (0, 0, 0).
    Errors: NULL mesh or corner_normal, crease_degrees not in [0, 180]
-   (TT_ERROR_INVALID_ARGUMENT); TT_ERROR_OUT_OF_MEMORY. */
+   (TT_ERROR_INVALID_ARGUMENT); a mesh without faces (TT_ERROR_EMPTY_MESH);
+   TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, const tt_allocator *allocator,
                                   float *corner_normal, tt_error *error);
 
@@ -1178,7 +1182,7 @@ TTDEF int tt_tile_layout_tile_count(const tt_tile_layout *layout);
    Errors: NULL mesh, layout or corner_type, colors outside 1..TT_MAX_COLORS
    (TT_ERROR_INVALID_ARGUMENT); a prescribed colour outside -1..n-1
    (TT_ERROR_INDEX_OUT_OF_RANGE) or twins that disagree
-   (TT_ERROR_INVALID_ARGUMENT), naming the corner. */
+   (TT_ERROR_INVALID_ARGUMENT), naming the corner. A mesh without faces (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
                                      const int *edge_colors, uint8_t *corner_type, tt_error *error);
 
@@ -1198,7 +1202,8 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
 
 /* AssignTextureCoordinates: corner_uv gets 2 * mesh->ncorners floats. Every face
    must be a quad (TT_ERROR_NOT_QUAD_MESH names the first that is not). The
-   layout is resolved internally (zeros mean defaults). */
+   layout is resolved internally (zeros mean defaults). A mesh without faces
+   (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                               float *corner_uv, tt_error *error);
 
@@ -1503,7 +1508,7 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
    Errors: NULL pointers, a layout that does not resolve
    (TT_ERROR_INVALID_ARGUMENT), a face that is not a quad
    (TT_ERROR_NOT_QUAD_MESH, naming it), a type of 2n or more
-   (TT_ERROR_INDEX_OUT_OF_RANGE, naming the corner). */
+   (TT_ERROR_INDEX_OUT_OF_RANGE, naming the corner). A mesh without faces (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                                   int *counts, tt_error *error);
 
@@ -1511,7 +1516,7 @@ TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *lay
    surface -> texture map (1 = no stretch), taken at the face's centre; faces
    with a degenerate map get INFINITY. nfaces floats. Errors: NULL pointers
    (TT_ERROR_INVALID_ARGUMENT), a non-finite UV (TT_ERROR_NON_FINITE, naming
-   the corner). */
+   the corner), a mesh without faces (TT_ERROR_EMPTY_MESH). */
 TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, float *stretch, tt_error *error);
 
 /* UV distortion of a charting (the acceptance measure of pipelines that map
@@ -1682,7 +1687,8 @@ typedef struct tt_field_options {
    sigma or weight: TT_ERROR_INVALID_ARGUMENT; a non-finite one:
    TT_ERROR_NON_FINITE; a constraint on a zero-area face:
    TT_ERROR_ZERO_AREA_FACE. Every constraint error names the constraint in
-   error->item (and its face in error->face). Temporary memory only.
+   error->item (and its face in error->face). A mesh without faces (made by
+   hand) is TT_ERROR_EMPTY_MESH. Temporary memory only.
    Deterministic; reentrant and thread-safe on distinct outputs. */
 TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
                                  const tt_allocator *allocator, float *face_vectors, tt_error *error);
@@ -3906,6 +3912,15 @@ static double tt__face_area_d(const tt_mesh *mesh, int face)
 
 /* TT_OK when every face is a triangle; else TT_ERROR_INVALID_ARGUMENT
    naming the first other face: "face F has N corners: <why>". */
+/* A tt_mesh of no faces can only be made by hand (tt_mesh_build refuses
+   it): every function that takes a mesh refuses it too. */
+static tt_result tt__require_faces(const tt_mesh *mesh, tt_error *error)
+{
+    if (mesh->nfaces < 1 || !mesh->face_start)
+        return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces (%d)", mesh->nfaces);
+    return TT_OK;
+}
+
 static tt_result tt__require_triangles(const tt_mesh *mesh, const char *why, tt_error *error)
 {
     int f;
@@ -3963,6 +3978,7 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
     if (!mesh || !corner_normal)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_corner_normals needs a mesh and an output array (got NULL)");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if (!(crease_degrees >= 0.0f && crease_degrees <= 180.0f))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "crease angle %g degrees: it must be from 0 (flat) to 180 (smooth everywhere)",
@@ -4777,6 +4793,7 @@ TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, const tt_allocator *a
     tt_result result = tt__ok(error);
     if (!mesh || !stats)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the mesh or the stats is NULL");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     memset(stats, 0, sizeof *stats);
     valence = TT__ALLOC(allocator, int, mesh->nverts);
@@ -4871,6 +4888,7 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
     if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
     *out_mesh = NULL;
     if (!mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "mesh is NULL");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if (scheme != TT_SUBDIVIDE_LINEAR && scheme != TT_SUBDIVIDE_CATMULL_CLARK)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "unknown subdivision scheme %d",
                         (int)scheme);
@@ -5063,6 +5081,7 @@ TTDEF tt_result tt_mesh_quadrangulate_sources(const tt_mesh *mesh, const tt_allo
     if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
     *out = NULL;
     if (!mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "mesh is NULL");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     for (f = 0; f < mesh->nfaces; f++) {
         long long n = mesh->face_start[f + 1] - mesh->face_start[f];
@@ -8207,6 +8226,7 @@ TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *
     if (!mesh || !layout || !corner_type)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_assign_boundaries needs a mesh, a layout and corner_type (got NULL)");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     n = layout->colors ? layout->colors : 1;
     if (n < 1 || n > TT_MAX_COLORS)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -8250,6 +8270,7 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
     tt__ok(error);
     if (!mesh || !layout || !corner_type || !corner_uv)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "NULL argument to tt_assign_uvs");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
     base = 2 * resolved.colors;
     cell = resolved.tile_size + 2.0 * resolved.gutter;
@@ -9598,6 +9619,7 @@ TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *lay
     if (!mesh || !layout || !corner_type || !counts)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_tile_histogram needs a mesh, a layout, corner types and counts (got NULL)");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
     base = 2 * resolved.colors;
     for (f = 0; f < mesh->nfaces; f++)
@@ -9695,6 +9717,7 @@ TTDEF tt_result tt_face_stretch(const tt_mesh *mesh, const float *corner_uv, flo
     if (!mesh || !corner_uv || !stretch)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_face_stretch needs a mesh, UVs and the stretch array (got NULL)");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     for (c = 0; c < 2 * mesh->ncorners; c++)
         if (!tt__is_finite(corner_uv[c]))
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
@@ -10350,6 +10373,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
     if (!mesh || !face_vectors)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_tangent_field needs a mesh and an output array (got NULL)");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if ((result = tt__field_setup(&F, mesh, options, allocator, error)) != TT_OK) return result;
     if (F.nf <= 0) return tt__ok(error);
 
