@@ -3184,8 +3184,9 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
 /* The atlas is of the tilesets' kind (a normal map when they are).
    Errors: NULL arguments, a bad allocator, tilesets of different layouts
    or kinds, a plain tileset with vertical windows or an upright one
-   without, edge windows that differ (TT_ERROR_INVALID_ARGUMENT); a level
-   that is not in both tilesets (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
+   without, edge windows that differ, a level whose images differ in size or
+   have no pixels (TT_ERROR_INVALID_ARGUMENT); a level that is not in both
+   tilesets or beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
    failure; free it with tt_image_free. */
 TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
                                           const tt_allocator *allocator, tt_image **out_image, tt_error *error);
@@ -23614,12 +23615,18 @@ TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tile
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
                                "edge window %d differs between the tilesets: make the upright tiles with the plain "
                                "ones' edge_windows, or the tops and the walls do not meet", k);
-    if (level < 0 || level >= plain->nlevels || level >= upright->nlevels)
+    if (level < 0 || level >= plain->nlevels || level >= upright->nlevels || level >= TT_MAX_MIP_LEVELS)
         return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
                         "level %d: the tilesets have levels 0 to %d", level,
-                        tt__min_i(plain->nlevels, upright->nlevels) - 1);
+                        tt__min_i(tt__min_i(plain->nlevels, upright->nlevels), TT_MAX_MIP_LEVELS) - 1);
     left = &plain->levels[level];
     right = &upright->levels[level];
+    if (!left->pixels || !right->pixels || left->width < 1 || left->height < 1 || left->width != right->width ||
+        left->height != right->height)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "level %d of the tilesets is %d x %d and %d x %d, or has no pixels: not tilesets of one "
+                        "layout made by tt_synth_apply", level, left->width, left->height, right->width,
+                        right->height);
     if (left->kind != right->kind)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "one tileset is a normal map and the other is not: apply both plans to the same map");
