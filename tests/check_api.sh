@@ -92,3 +92,21 @@ for s in $structs; do
     echo "FAIL api: $s carries a tt_allocator but is not an object the library returns (pass the allocator instead)"
   fi
 done
+
+# The contract test (tests/test_contract.c) calls every fallible function with
+# hostile arguments and checks that each has cases; its list of them must be
+# exactly the header's `TTDEF tt_result` declarations, in order, so that a new
+# function fails here until it has contract cases.
+contract_test=$(dirname "$0")/test_contract.c
+listed=$(sed -n '/CONTRACT FUNCTIONS BEGIN/,/CONTRACT FUNCTIONS END/p' "$contract_test" 2>/dev/null |
+  grep -oE '"tt_[a-z0-9_]+"' | tr -d '"')
+declared=$(printf '%s\n' "$decls" | cut -f2 | grep '^TTDEF tt_result ' |
+  sed -E 's/^TTDEF tt_result (tt_[a-z0-9_]+)\(.*/\1/')
+if [ -n "$declared" ] && [ "$listed" = "$declared" ]; then
+  echo "ok   api: the contract test lists the $(printf '%s\n' "$declared" | wc -l | tr -d ' ') fallible functions the header declares"
+else
+  missing=$(comm -23 <(printf '%s\n' "$declared" | sort) <(printf '%s\n' "$listed" | sort) | tr '\n' ' ')
+  extra=$(comm -13 <(printf '%s\n' "$declared" | sort) <(printf '%s\n' "$listed" | sort) | tr '\n' ' ')
+  echo "FAIL api: the function list of $contract_test is not the header's fallible functions in order" \
+    "(not listed: ${missing:-none}; not declared: ${extra:-none})"
+fi

@@ -522,7 +522,8 @@ int main(void)
         {"common", run_common_tests}, {"mesh", run_mesh_tests}, {"image", run_image_tests},
         {"numerics", run_numerics_tests}, {"fft", run_fft_tests}, {"raster", run_raster_tests},
         {"tiled", run_tiled_tests}, {"synthesis", run_tiled_synthesis_tests},
-        {"lapped", run_lapped_tests}, {"hpm", run_hpm_tests}, {"polycube", run_polycube_tests}};
+        {"lapped", run_lapped_tests}, {"hpm", run_hpm_tests}, {"polycube", run_polycube_tests},
+        {"contract", run_contract_tests}};
     size_t i;
     for (i = 0; i < sizeof sections / sizeof sections[0]; i++)
         if (section_selected(sections[i].name)) sections[i].run();

@@ -41,6 +41,7 @@ void run_tiled_synthesis_tests(void); /* tests/test_6_tiled_synthesis.c */
 void run_lapped_tests(void);     /* tests/test_7_lapped.c */
 void run_hpm_tests(void);        /* tests/test_8_hpm.c */
 void run_polycube_tests(void);   /* tests/test_9_polycube.c */
+void run_contract_tests(void);   /* tests/test_contract.c: THE API CONTRACT, hostile arguments */
 
 /* ------------------------------------------------------------------------ */
 /* Counting and failing allocators                                          */
