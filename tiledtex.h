@@ -11490,10 +11490,14 @@ typedef struct tt__entry {
 } tt__entry;
 
 typedef struct tt__lapper {
-    const tt_mesh *mesh;
+    const tt_mesh *mesh;        /* the loop's copy of the caller's mesh, faces in Morton order (tt__lapper_reorder) */
     tt_image *const *patches;
     int npatches;
-    const float *field;
+    const float *field;         /* the caller's face vectors, in the copy's order */
+    tt_mesh local;              /* the copy's arrays */
+    float *local_field;
+    int *face_of;               /* per face of the copy: the caller's face */
+    int *local_face;            /* per face of the caller's: its face in the copy */
     int isotropic;
     const tt_allocator *al;
     tt_rng rng;
@@ -12431,6 +12435,123 @@ static float tt__face_difficulty(const tt__lapper *L, int f)
     return (float)worst;
 }
 
+/* The paste loop touches, per paste, the per-face and per-vertex data of a
+   patch-sized piece of the mesh, thousands of faces, several times over
+   (growth, solves, recording, fading, coverage). In the caller's order
+   those faces can lie anywhere in the arrays, each touch a cache miss. The
+   loop runs on its own copy of the mesh instead, the faces in Morton
+   (Z-curve) order of their centroids (30-bit codes over the bounding box,
+   sorted by two 15-bit counting passes) and the vertices in order of first
+   use, so that a paste's faces lie in a few runs of the arrays. Measured on
+   the horse cut 1-to-4 (388k faces, its faces in the order of the scan):
+   39 s as given, 33 s in this order, 64 s shuffled. Corners keep their
+   order within a face, so UVs need no mapping; L->face_of gives the
+   caller's face back (results, error messages). 0 when out of memory. */
+static int tt__lapper_reorder(tt__lapper *L, const tt_mesh *mesh, const float *field)
+{
+    const int nf = mesh->nfaces, buckets = 1 << 15;
+    tt_mesh *copy = &L->local;
+    unsigned *key = TT__ALLOC(L->al, unsigned, 2 * (size_t)nf);
+    int *order = TT__ALLOC(L->al, int, 2 * (size_t)nf), *count = TT__ALLOC(L->al, int, (size_t)buckets + 1);
+    int *new_vert = TT__ALLOC(L->al, int, mesh->nverts > 0 ? mesh->nverts : 1), *new_face;
+    double lo[3], hi[3];
+    int f, k, i, pass, nv = 0, ok;
+    float *pos;
+    L->face_of = TT__ALLOC(L->al, int, nf);
+    L->local_face = new_face = TT__ALLOC(L->al, int, nf);
+    L->local_field = TT__ALLOC(L->al, float, 3 * (size_t)nf);
+    copy->face_start = TT__ALLOC(L->al, int, (size_t)nf + 1);
+    copy->corner_vert = TT__ALLOC(L->al, int, 3 * (size_t)nf);
+    copy->corner_face = TT__ALLOC(L->al, int, 3 * (size_t)nf);
+    copy->twin = TT__ALLOC(L->al, int, 3 * (size_t)nf);
+    ok = key && order && count && new_vert && L->face_of && new_face && L->local_field && copy->face_start &&
+         copy->corner_vert && copy->corner_face && copy->twin;
+    if (ok) {
+        for (k = 0; k < 3; k++) lo[k] = hi[k] = mesh->pos[3 * (size_t)mesh->corner_vert[0] + k];
+        for (i = 0; i < 3 * nf; i++)
+            for (k = 0; k < 3; k++) {
+                double x = mesh->pos[3 * (size_t)mesh->corner_vert[i] + k];
+                if (x < lo[k]) lo[k] = x;
+                if (x > hi[k]) hi[k] = x;
+            }
+        for (f = 0; f < nf; f++) {
+            unsigned code = 0, cell[3];
+            for (k = 0; k < 3; k++) {
+                double c = (mesh->pos[3 * (size_t)mesh->corner_vert[3 * f] + k] +
+                            mesh->pos[3 * (size_t)mesh->corner_vert[3 * f + 1] + k] +
+                            mesh->pos[3 * (size_t)mesh->corner_vert[3 * f + 2] + k]) / 3.0;
+                double t = hi[k] > lo[k] ? (c - lo[k]) / (hi[k] - lo[k]) : 0.0;
+                cell[k] = (unsigned)(t * 1023.0 + 0.5);
+            }
+            for (i = 0; i < 10; i++)
+                for (k = 0; k < 3; k++) code |= ((cell[k] >> i) & 1u) << (3 * i + k);
+            key[f] = code;
+            order[f] = f;
+        }
+        /* Stable: faces of one cell keep the caller's order. */
+        for (pass = 0; pass < 2; pass++) {
+            unsigned *key_out = key + nf;
+            int *order_out = order + nf;
+            for (i = 0; i <= buckets; i++) count[i] = 0;
+            for (f = 0; f < nf; f++) count[((key[f] >> (15 * pass)) & (unsigned)(buckets - 1)) + 1]++;
+            for (i = 0; i < buckets; i++) count[i + 1] += count[i];
+            for (f = 0; f < nf; f++) {
+                int at = count[(key[f] >> (15 * pass)) & (unsigned)(buckets - 1)]++;
+                key_out[at] = key[f];
+                order_out[at] = order[f];
+            }
+            memcpy(key, key_out, (size_t)nf * sizeof(unsigned));
+            memcpy(order, order_out, (size_t)nf * sizeof(int));
+        }
+        for (f = 0; f < nf; f++) {
+            L->face_of[f] = order[f];
+            new_face[order[f]] = f;
+        }
+        for (i = 0; i < mesh->nverts; i++) new_vert[i] = -1;
+        for (f = 0; f < nf; f++)
+            for (k = 0; k < 3; k++) {
+                int v = mesh->corner_vert[3 * (size_t)L->face_of[f] + k];
+                if (new_vert[v] < 0) new_vert[v] = nv++;
+            }
+        pos = TT__ALLOC(L->al, float, 3 * (size_t)nv);
+        copy->pos = pos;
+        copy->vert_corner = TT__ALLOC(L->al, int, nv);
+        ok = pos && copy->vert_corner;
+    }
+    if (ok) {
+        for (i = 0; i < mesh->nverts; i++) {
+            int v = new_vert[i], c = mesh->vert_corner[i];
+            if (v < 0) continue;
+            for (k = 0; k < 3; k++) pos[3 * (size_t)v + k] = mesh->pos[3 * (size_t)i + k];
+            copy->vert_corner[v] = c < 0 ? -1 : 3 * new_face[c / 3] + c % 3;
+        }
+        for (f = 0; f < nf; f++) {
+            const int old = L->face_of[f];
+            copy->face_start[f] = 3 * f;
+            for (k = 0; k < 3; k++) {
+                int t = mesh->twin[3 * (size_t)old + k];
+                copy->corner_vert[3 * f + k] = new_vert[mesh->corner_vert[3 * (size_t)old + k]];
+                copy->corner_face[3 * f + k] = f;
+                copy->twin[3 * f + k] = t < 0 ? -1 : 3 * new_face[t / 3] + t % 3;
+                L->local_field[3 * (size_t)f + k] = field[3 * (size_t)old + k];
+            }
+        }
+        copy->face_start[nf] = 3 * nf;
+        copy->nverts = nv;
+        copy->nfaces = nf;
+        copy->ncorners = 3 * nf;
+        copy->min_face_size = copy->max_face_size = 3;
+        copy->flags = mesh->flags;
+        L->mesh = copy;
+        L->field = L->local_field;
+    }
+    tt__free(L->al, key);
+    tt__free(L->al, order);
+    tt__free(L->al, count);
+    tt__free(L->al, new_vert);
+    return ok;
+}
+
 static void tt__lapper_free(tt__lapper *L)
 {
     int i;
@@ -12480,13 +12601,22 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->solve);
     tt__free(L->al, L->paste_patch);
     tt__free(L->al, L->entries);
+    tt__free(L->al, L->face_of);
+    tt__free(L->al, L->local_face);
+    tt__free(L->al, L->local_field);
+    tt__free(L->al, (void *)L->local.pos);
+    tt__free(L->al, L->local.face_start);
+    tt__free(L->al, L->local.corner_vert);
+    tt__free(L->al, L->local.corner_face);
+    tt__free(L->al, L->local.twin);
+    tt__free(L->al, L->local.vert_corner);
 }
 
 /* Check the inputs and prepare the per-face and per-patch data. */
 static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error)
 {
     const tt_mesh *mesh = L->mesh;
-    int nf = mesh->nfaces, nv = mesh->nverts, f, i, k;
+    int nf = mesh->nfaces, nv, f, g, i, k;
     double lo[3], hi[3], diagonal, estimate = 0.0, opaque_fraction = 0.0;
     float shallowest = 0.0f;
     int widest = 1;
@@ -12499,6 +12629,10 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
                         "lapped textures need a triangle mesh: face %d has %d corners (split it into triangles)", f,
                         mesh->face_start[f + 1] - mesh->face_start[f]);
     }
+    if (!tt__lapper_reorder(L, mesh, L->field))
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    mesh = L->mesh;
+    nv = mesh->nverts;
     for (i = 0; i < L->npatches; i++) {
         const tt_image *p = L->patches[i];
         size_t n, j;
@@ -12600,26 +12734,32 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         }
     diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    for (f = 0; f < nf; f++) {
-        const float *fv = L->field + 3 * (size_t)f;
-        double *n = L->normal + 3 * (size_t)f, *t = L->tangent + 3 * (size_t)f, v[3], length, projected;
+    /* The checks run over the caller's faces in the caller's order (g), so
+       that an error names the first face at fault there. */
+    for (g = 0; g < nf; g++) {
+        const float *fv;
+        double *n, *t, v[3], length, projected;
+        f = L->local_face[g];
+        fv = L->field + 3 * (size_t)f;
+        n = L->normal + 3 * (size_t)f;
+        t = L->tangent + 3 * (size_t)f;
         if (!tt__face_normal_d(mesh, f, n))
-            return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, f, -1, -1, -1, "face %d has zero area", f);
+            return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, g, -1, -1, -1, "face %d has zero area", g);
         if (!tt__is_finite(fv[0]) || !tt__is_finite(fv[1]) || !tt__is_finite(fv[2]))
-            return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
-                            "the field vector of face %d is NaN or infinite", f);
+            return tt__fail(error, TT_ERROR_NON_FINITE, g, -1, -1, -1,
+                            "the field vector of face %d is NaN or infinite", g);
         v[0] = fv[0]; v[1] = fv[1]; v[2] = fv[2];
         length = tt__length3(v);
         tt__project3(v, n, t);
         projected = tt__length3(t);
         if (!(length > 0.0) || projected < 1e-3 * length)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, g, -1, -1, -1,
                             length > 0.0 ? "the field vector of face %d is perpendicular to the face"
-                                         : "the field vector of face %d has zero length", f);
+                                         : "the field vector of face %d has zero length", g);
         if (projected > diagonal)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, g, -1, -1, -1,
                             "the texture patch (%g mesh units at face %d) is larger than the mesh "
-                            "(bounding-box diagonal %g): use a smaller scale", projected, f, diagonal);
+                            "(bounding-box diagonal %g): use a smaller scale", projected, g, diagonal);
         /* Pastes needed: the area over the patch's opaque area, |T|^2
            times its opaque fraction, times TT_LAPPED_PASTES_PER_AREA. */
         {
@@ -12639,9 +12779,12 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "the texture patches are too small for this mesh: covering it would take about "
                         "%.3g pastes, more than max_pastes (%d; 0: TT_LAPPED_MAX_PASTES) (use a larger scale)", estimate, max_pastes);
-    for (f = 0; f < nf; f++) {
-        const double *t = L->tangent + 3 * (size_t)f;
-        double projected = tt__length3(t), longest = 0.0;
+    for (g = 0; g < nf; g++) {
+        const double *t;
+        double projected, longest = 0.0;
+        f = L->local_face[g];
+        t = L->tangent + 3 * (size_t)f;
+        projected = tt__length3(t);
         for (k = 0; k < 3; k++) {
             const float *a = tt__corner_pos(mesh, 3 * f + k), *b = tt__corner_pos(mesh, 3 * f + (k + 1) % 3);
             double e[3];
@@ -12659,13 +12802,16 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
                its deepest texel: the samples' reach may use a quarter of the
                depth. */
             if (rho > 0.25 * shallowest || rho + TT__LAPPED_TEXEL_REACH >= shallowest)
-                return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, g, -1, -1, -1,
                                 "face %d is %.3g texture patches long, too coarse for a patch whose opaque part is "
                                 "%.3g texels deep: subdivide the mesh, or use a larger scale or a larger image",
-                                f, longest / projected, (double)shallowest);
+                                g, longest / projected, (double)shallowest);
         }
         if (!tt__sample_table(L, L->sample_res[f]))
             return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    }
+    /* Each face's samples, in the copy's order. */
+    for (f = 0; f < nf; f++) {
         L->sample_start[f] = (int)total;
         total += L->table_count[L->sample_res[f]];
         if (total > INT_MAX)
@@ -12901,7 +13047,7 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
             out->pastes[p].first = n;
             out->pastes[p].nfaces = 0;
         }
-        out->faces[n] = entry->face;
+        out->faces[n] = L->face_of[entry->face];
         for (i = 0; i < 6; i++) out->uv[6 * (size_t)n + i] = entry->uv[i];
         for (i = 0; i < 3; i++) out->fade[3 * (size_t)n + i] = entry->fade[i];
         angle_sum += entry->angle_error;
