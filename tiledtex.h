@@ -11545,6 +11545,7 @@ typedef struct tt__lapper {
     int *row_start, *row_fill, *column_mark;    /* nverts + 1, nverts, nverts */
     int *columns, entry_room;
     double *values;
+    int solve_steps;            /* conjugate gradient steps of the last alignment solve */
     double *solve;              /* 4 per patch vertex: b_s, b_t, x_s, x_t */
     /* recorded pastes (Sec. 3.5) */
     int *paste_patch, npastes, paste_capacity;
@@ -12137,6 +12138,7 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
     r = tt__amg_setup(&hierarchy, &A, L->al);
     if (r == TT_OK) {
         r = tt__amg_solve2(&hierarchy, b, x, TT__LAPPED_CG_TOLERANCE, TT__LAPPED_SOLVE_STEPS, &steps);
+        L->solve_steps = steps;
         tt__amg_free(&hierarchy);
     }
     if (r == TT_ERROR_OUT_OF_MEMORY) return r;
@@ -12749,12 +12751,13 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->row_fill = TT__ALLOC(L->al, int, nv);
     L->column_mark = TT__ALLOC(L->al, int, nv);
     L->solve = TT__ALLOC(L->al, double, 4 * (size_t)nv);
-    if (!L->hull || !L->hull_count || !L->hull_cells || !L->hull_box || !L->patch_count || !L->shape_of || !L->top_patch || !L->near_stamp || !L->near_queue ||
-        !L->anchor || !L->normal || !L->tangent || !L->axis_weights || !L->area || !L->difficulty || !L->sample_res ||
-        !L->sample_start || !L->covered_count || !L->uncovered || !L->uncovered_pos || !L->face_stamp ||
-        !L->vert_stamp || !L->edge_stamp || !L->vert_local || !L->vert_uv || !L->patch_faces ||
-        !L->patch_verts || !L->heap || !L->row_start || !L->row_fill || !L->column_mark || !L->solve || !L->depth || !L->vert_cut_distance ||
-        !L->face_entry || !L->seeded || !L->hidden_below)
+    if (!L->hull || !L->hull_count || !L->hull_cells || !L->hull_box || !L->patch_count || !L->shape_of ||
+        !L->top_patch || !L->near_stamp || !L->near_queue || !L->anchor || !L->normal || !L->tangent ||
+        !L->axis_weights || !L->area || !L->difficulty || !L->sample_res || !L->sample_start || !L->covered_count ||
+        !L->uncovered || !L->uncovered_pos || !L->face_stamp || !L->vert_stamp || !L->edge_stamp || !L->vert_local ||
+        !L->vert_uv || !L->patch_faces || !L->patch_verts || !L->heap || !L->row_start || !L->row_fill ||
+        !L->column_mark || !L->solve || !L->depth || !L->vert_cut_distance || !L->face_entry || !L->seeded ||
+        !L->hidden_below)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     for (i = 0; i < L->npatches; i++) {
         const tt_image *p = L->patches[i];

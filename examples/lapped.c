@@ -1125,8 +1125,80 @@ static void print_patch_use(const lapped_patches *patches, const tt_lapped *lapp
     free(uses);
 }
 
+typedef struct weighted_value {
+    double value, weight;
+} weighted_value;
+
+static int compare_weighted_values(const void *a, const void *b)
+{
+    double x = ((const weighted_value *)a)->value, y = ((const weighted_value *)b)->value;
+    return x < y ? -1 : x > y;
+}
+
+/* How evenly the photo is spread over the surface, as a bake shows it:
+   per triangle, the texel density of the paste on top (the last to draw
+   it: what the bake shows where that paste is opaque), sqrt(patch texels
+   covered / surface area); the area-weighted 95th percentile over the 5th
+   (1 = the same everywhere). 0 when nothing is measured. */
+static double top_density_spread(const triangle_mesh *m, const tt_lapped *lapped, const lapped_patches *patches)
+{
+    int *top = (int *)malloc(2 * (size_t)m->ntriangles * sizeof(int)), *top_patch, p, e, f, n = 0;
+    weighted_value *items = (weighted_value *)malloc((size_t)m->ntriangles * sizeof(weighted_value));
+    double total = 0.0, sum = 0.0, p5 = 0.0, p95 = 0.0;
+    if (!top || !items) {
+        free(top);
+        free(items);
+        return 0.0;
+    }
+    top_patch = top + m->ntriangles;
+    for (f = 0; f < m->ntriangles; f++) top[f] = -1;
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) {
+            top[lapped->faces[e]] = e;
+            top_patch[lapped->faces[e]] = lapped->pastes[p].patch;
+        }
+    for (f = 0; f < m->ntriangles; f++) {
+        const float *uv = lapped->uv + 6 * (size_t)(top[f] > 0 ? top[f] : 0);
+        const float *a = m->pos + 3 * (size_t)m->vert[3 * f], *b = m->pos + 3 * (size_t)m->vert[3 * f + 1];
+        const float *c = m->pos + 3 * (size_t)m->vert[3 * f + 2];
+        const tt_image *patch;
+        double e1[3], e2[3], cross[3], area, texels;
+        int k;
+        if (top[f] < 0) continue;
+        patch = patches->images[top_patch[f]];
+        for (k = 0; k < 3; k++) {
+            e1[k] = (double)b[k] - a[k];
+            e2[k] = (double)c[k] - a[k];
+        }
+        cross[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        cross[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        cross[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        area = 0.5 * sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+        texels = ((double)uv[2] - uv[0]) * ((double)uv[5] - uv[1]) - ((double)uv[4] - uv[0]) * ((double)uv[3] - uv[1]);
+        texels = 0.5 * fabs(texels) * patch->width * patch->height;
+        if (!(area > 0.0)) continue;
+        items[n].value = sqrt(texels / area);
+        items[n].weight = area;
+        total += area;
+        n++;
+    }
+    qsort(items, (size_t)n, sizeof *items, compare_weighted_values);
+    for (e = 0; e < n; e++) {
+        sum += items[e].weight;
+        if (p5 == 0.0 && sum >= 0.05 * total) p5 = items[e].value;
+        if (sum >= 0.95 * total) {
+            p95 = items[e].value;
+            break;
+        }
+    }
+    free(top);
+    free(items);
+    return p5 > 0.0 ? p95 / p5 : 0.0;
+}
+
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
-                          const tt_lapped *lapped, const baked_seams *baked, double seconds)
+                          const tt_lapped *lapped, const lapped_patches *patches, const baked_seams *baked,
+                          double seconds)
 {
     char all[256], top[256];
     tt_lapped_report report;
@@ -1150,6 +1222,8 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
            lapped->mean_overdraw);
     printf("alignment: mean angle error %.1f degrees, median scale error %.1f%%%s\n", angle, 100.0 * scale,
            options->isotropic ? " (isotropic: against each paste's own direction)" : "");
+    printf("texel density of the pastes on top: 95th percentile over 5th %.3f\n",
+           top_density_spread(m, lapped, patches));
     printf("cuts: %d of %d edges where the top paste changes end it at %.0f%% alpha or more\n", lapped->visible_cuts,
            lapped->top_changes, 100.0 * TT_LAPPED_VISIBLE_CUT);
     if (options->bake_size > 0) {
@@ -1250,7 +1324,7 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
-        print_summary(&options, &mesh, field, lapped, &baked, tool_seconds_now() - start);
+        print_summary(&options, &mesh, field, lapped, &patches, &baked, tool_seconds_now() - start);
         print_patch_use(&patches, lapped);
         if (glb) {
             printf("wrote %s (the pastes baked into %dx%d, over ", glb_path, options.bake_size, options.bake_size);

@@ -448,6 +448,88 @@ tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_
     return tt__patch_hull(patch, max_vertices, allocator, out_xy, out_count);
 }
 
+tt_result internal_amg_solve2(const tt_sparse_matrix *A, const double *b, double *x, double tolerance,
+                              int max_iterations, const tt_allocator *allocator, int *levels, int *iterations)
+{
+    tt__amg G;
+    tt_result r = tt__amg_setup(&G, A, allocator);
+    *levels = 0;
+    *iterations = 0;
+    if (r != TT_OK) return r;
+    *levels = G.nlevels;
+    r = tt__amg_solve2(&G, b, x, tolerance, max_iterations, iterations);
+    tt__amg_free(&G);
+    return r;
+}
+
+tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const int *faces, int nfaces, int seed_face,
+                                const double seed_weight[3], const float anchor[2], double *uv, int *unknowns,
+                                int *steps)
+{
+    tt__lapper L;
+    const int nf = mesh->nfaces, nv = mesh->nverts;
+    tt_result r = TT_ERROR_OUT_OF_MEMORY;
+    int i, k;
+    memset(&L, 0, sizeof L);
+    L.mesh = mesh;
+    L.field = field;
+    L.vert_uv = uv;
+    L.normal = (double *)calloc(3 * (size_t)nf, sizeof(double));
+    L.tangent = (double *)calloc(3 * (size_t)nf, sizeof(double));
+    L.axis_weights = (float *)calloc(6 * (size_t)nf, sizeof(float));
+    L.area = (float *)calloc((size_t)nf, sizeof(float));
+    L.patch_faces = (int *)malloc(sizeof(int) * (size_t)nf);
+    L.patch_verts = (int *)malloc(sizeof(int) * (size_t)nv);
+    L.vert_local = (int *)malloc(sizeof(int) * (size_t)nv);
+    L.vert_stamp = (int *)malloc(sizeof(int) * (size_t)nv);
+    L.row_start = (int *)malloc(sizeof(int) * ((size_t)nv + 1));
+    L.row_fill = (int *)malloc(sizeof(int) * (size_t)nv);
+    L.column_mark = (int *)malloc(sizeof(int) * (size_t)nv);
+    L.solve = (double *)malloc(sizeof(double) * 4 * (size_t)nv);
+    if (L.normal && L.tangent && L.axis_weights && L.area && L.patch_faces && L.patch_verts && L.vert_local &&
+        L.vert_stamp && L.row_start && L.row_fill && L.column_mark && L.solve) {
+        for (i = 0; i < nv; i++) L.vert_stamp[i] = -1;
+        for (i = 0; i < nfaces; i++) {
+            const int f = faces[i];
+            double *n = L.normal + 3 * (size_t)f, v[3], e1[3], e2[3], cross[3];
+            tt__face_normal_d(mesh, f, n);
+            for (k = 0; k < 3; k++) v[k] = field[3 * (size_t)f + k];
+            tt__project3(v, n, L.tangent + 3 * (size_t)f);
+            tt__sub3f(tt__corner_pos(mesh, 3 * f + 1), tt__corner_pos(mesh, 3 * f), e1);
+            tt__sub3f(tt__corner_pos(mesh, 3 * f + 2), tt__corner_pos(mesh, 3 * f), e2);
+            tt__cross3(e1, e2, cross);
+            L.area[f] = (float)(0.5 * tt__length3(cross));
+            tt__face_axes(&L, f);
+            L.patch_faces[L.npatch_faces++] = f;
+            for (k = 0; k < 3; k++) {
+                const int vert = mesh->corner_vert[3 * f + k];
+                if (L.vert_stamp[vert] == 0) continue;
+                L.vert_stamp[vert] = 0;
+                L.vert_local[vert] = L.npatch_verts;
+                L.patch_verts[L.npatch_verts++] = vert;
+            }
+        }
+        r = tt__optimize_patch(&L, seed_face, seed_weight, anchor);
+    }
+    *unknowns = L.npatch_verts;
+    *steps = L.solve_steps;
+    free(L.normal);
+    free(L.tangent);
+    free(L.axis_weights);
+    free(L.area);
+    free(L.patch_faces);
+    free(L.patch_verts);
+    free(L.vert_local);
+    free(L.vert_stamp);
+    free(L.row_start);
+    free(L.row_fill);
+    free(L.column_mark);
+    free(L.solve);
+    tt__free(NULL, L.columns);
+    tt__free(NULL, L.values);
+    return r;
+}
+
 /* ------------------------------------------------------------------------ */
 /* main                                                                     */
 /* ------------------------------------------------------------------------ */

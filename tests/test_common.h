@@ -211,5 +211,19 @@ int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
                                 double delta2, double gradient[2], int *folded);
 int internal_polycube_mask_critical(int mask);
+/* Section 4's multigrid-preconditioned conjugate gradients: the hierarchy
+   of A, two solves (b and x interleaved: b[2i + c]) from the x given, the
+   hierarchy freed; *levels and *iterations say how it went. */
+tt_result internal_amg_solve2(const tt_sparse_matrix *A, const double *b, double *x, double tolerance,
+                              int max_iterations, const tt_allocator *allocator, int *levels, int *iterations);
+/* Section 7's alignment of one paste (Praun et al. Sec. 3.4) as the paste
+   loop solves it: the faces listed (a disc of triangles), the field's
+   vectors, the seed point (a face and barycentric weights) held on anchor,
+   from uv (2 per mesh vertex, the listed faces' vertices read and written);
+   *unknowns and *steps give the solve's size and its conjugate gradient
+   steps. */
+tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const int *faces, int nfaces, int seed_face,
+                                const double seed_weight[3], const float anchor[2], double *uv, int *unknowns,
+                                int *steps);
 
 #endif /* TEST_COMMON_H */
