@@ -11460,7 +11460,7 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 #define TT__LAPPED_HULL_VERTICES 32
 /* Cells a side of the grid that answers most of growth's hull tests
    (tt__hull_grid). */
-#define TT__LAPPED_HULL_GRID 64
+#define TT__LAPPED_HULL_GRID 128
 /* Grow-and-solve rounds per paste (Sec. 3.3: "when this occurs, we further
    grow the patch and optimize again"). */
 #define TT__LAPPED_GROW_ROUNDS 3
@@ -11504,7 +11504,7 @@ typedef struct tt__lapper {
     /* per texture patch */
     float **hull;               /* conservative hull, texture space, CCW */
     int *hull_count;
-    unsigned char *hull_cells;  /* per patch: TT__LAPPED_HULL_GRID^2 cells of the hull's box (tt__hull_grid) */
+    float *hull_distance;       /* per patch: TT__LAPPED_HULL_GRID^2 cells of the hull's box (tt__hull_grid) */
     float *hull_box;            /* 4 per patch: the box's corner and its cells' width and height */
     float **depth;              /* per texel: distance (texels) to the nearest texel not opaque */
     float *anchor;              /* 2 per patch: where a paste's seed point lands */
@@ -11788,25 +11788,24 @@ static void tt__map_vertex(tt__lapper *L, int v, int paste)
 /* Growth asks, for every edge it reaches, whether the edge's image meets
    the patch's hull (Sec. 3.3), and the exact test walks the hull's 32
    edges. A grid over the hull's box answers most of the questions at once:
-   a cell whose centre lies inside (or outside) the hull farther from its
-   boundary than half the cell's diagonal lies wholly inside (outside), so
-   an edge with an end in an inside cell meets the hull, and one with both
-   ends in the same outside cell (a convex cell) does not; the rest, near
-   the boundary, take the exact test. The answers are the exact test's. */
-#define TT__HULL_CELL_BOUNDARY 0
-#define TT__HULL_CELL_INSIDE 1
-#define TT__HULL_CELL_OUTSIDE 2
-
+   each cell holds the signed distance from its centre to the hull's
+   boundary (positive inside), and a point's own distance is within half
+   the cell's diagonal of it (a distance changes no faster than the point
+   moves). So an edge with an end surely inside meets the hull, and one
+   with an end surely outside by more than the edge's length does not; the
+   rest, close to the boundary, take the exact test; a point beyond the
+   box is at least its distance from the box away. The answers are the
+   exact test's. */
 static void tt__hull_grid(tt__lapper *L, int patch)
 {
     const float *xy = L->hull[patch];
     const int count = L->hull_count[patch], g = TT__LAPPED_HULL_GRID;
-    unsigned char *cells = L->hull_cells + (size_t)patch * g * g;
+    float *cells = L->hull_distance + (size_t)patch * g * g;
     float *box = L->hull_box + 4 * (size_t)patch;
-    double lo[2], hi[2], half_diagonal;
+    double lo[2], hi[2];
     int i, j, k;
     if (count < 3) {
-        memset(cells, TT__HULL_CELL_BOUNDARY, (size_t)g * g);
+        for (i = 0; i < g * g; i++) cells[i] = 0.0f;
         box[0] = box[1] = box[2] = box[3] = 0.0f;   /* no cell holds a point: the exact test answers */
         return;
     }
@@ -11821,7 +11820,6 @@ static void tt__hull_grid(tt__lapper *L, int patch)
     box[1] = (float)lo[1];
     box[2] = (float)((hi[0] - lo[0]) / g);
     box[3] = (float)((hi[1] - lo[1]) / g);
-    half_diagonal = 0.5 * sqrt((double)box[2] * box[2] + (double)box[3] * box[3]);
     for (j = 0; j < g; j++)
         for (i = 0; i < g; i++) {
             double cx = box[0] + (i + 0.5) * box[2], cy = box[1] + (j + 0.5) * box[3], nearest = HUGE_VAL;
@@ -11830,29 +11828,33 @@ static void tt__hull_grid(tt__lapper *L, int patch)
                 double d = tt__point_segment_distance(cx, cy, a[0], a[1], b[0], b[1]);
                 if (d < nearest) nearest = d;
             }
-            /* A margin for the rounding of the cells' corners (floats). */
-            cells[j * g + i] = !(nearest > 1.01 * half_diagonal + 1e-6) ? TT__HULL_CELL_BOUNDARY
-                             : tt__point_in_polygon(cx, cy, xy, count) ? TT__HULL_CELL_INSIDE
-                                                                       : TT__HULL_CELL_OUTSIDE;
+            cells[j * g + i] = (float)(tt__point_in_polygon(cx, cy, xy, count) ? nearest : -nearest);
         }
-}
-
-/* The cell of the hull grid holding (x, y), or -1 outside the box. */
-static int tt__hull_cell(const tt__lapper *L, int patch, const float p[2])
-{
-    const float *box = L->hull_box + 4 * (size_t)patch;
-    double x = (p[0] - box[0]) / box[2], y = (p[1] - box[1]) / box[3];
-    if (!(x >= 0.0 && y >= 0.0 && x < TT__LAPPED_HULL_GRID && y < TT__LAPPED_HULL_GRID)) return -1;
-    return (int)y * TT__LAPPED_HULL_GRID + (int)x;
 }
 
 /* Whether the segment a b meets the hull of texture patch `patch`. */
 static int tt__edge_meets_hull(const tt__lapper *L, int patch, const float a[2], const float b[2])
 {
-    const unsigned char *cells = L->hull_cells + (size_t)patch * TT__LAPPED_HULL_GRID * TT__LAPPED_HULL_GRID;
-    int ca = tt__hull_cell(L, patch, a), cb = tt__hull_cell(L, patch, b);
-    if ((ca >= 0 && cells[ca] == TT__HULL_CELL_INSIDE) || (cb >= 0 && cells[cb] == TT__HULL_CELL_INSIDE)) return 1;
-    if (ca >= 0 && ca == cb && cells[ca] == TT__HULL_CELL_OUTSIDE) return 0;
+    const int g = TT__LAPPED_HULL_GRID;
+    const float *cells = L->hull_distance + (size_t)patch * g * g, *box = L->hull_box + 4 * (size_t)patch;
+    /* Half a cell's diagonal, and a margin for the rounding of floats. */
+    const double reach = 0.5 * sqrt((double)box[2] * box[2] + (double)box[3] * box[3]) * 1.01 + 1e-6;
+    double length = sqrt(((double)b[0] - a[0]) * ((double)b[0] - a[0]) + ((double)b[1] - a[1]) * ((double)b[1] - a[1]));
+    int end;
+    for (end = 0; end < 2; end++) {
+        const float *p = end ? b : a;
+        double x = (p[0] - box[0]) / box[2], y = (p[1] - box[1]) / box[3], d, dx, dy;
+        if (x >= 0.0 && y >= 0.0 && x < g && y < g) {
+            d = cells[(int)y * g + (int)x];
+            if (d > reach) return 1;
+            if (d < -(reach + length)) return 0;
+            continue;
+        }
+        /* Beyond the box: at least as far from the hull as from the box. */
+        dx = x < 0.0 ? -x * box[2] : x > g ? (x - g) * box[2] : 0.0;
+        dy = y < 0.0 ? -y * box[3] : y > g ? (y - g) * box[3] : 0.0;
+        if (sqrt(dx * dx + dy * dy) > length * 1.01 + 1e-6) return 0;
+    }
     return tt__segment_meets_polygon(a, b, L->hull[patch], L->hull_count[patch]);
 }
 
@@ -12624,7 +12626,7 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->hull);
     tt__free(L->al, L->depth);
     tt__free(L->al, L->hull_count);
-    tt__free(L->al, L->hull_cells);
+    tt__free(L->al, L->hull_distance);
     tt__free(L->al, L->hull_box);
     tt__free(L->al, L->anchor);
     tt__free(L->al, L->normal);
@@ -12715,7 +12717,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         if (L->depth) L->depth[i] = NULL;
     }
     L->hull_count = TT__ALLOC(L->al, int, L->npatches);
-    L->hull_cells = TT__ALLOC(L->al, unsigned char, (size_t)L->npatches * TT__LAPPED_HULL_GRID * TT__LAPPED_HULL_GRID);
+    L->hull_distance = TT__ALLOC(L->al, float, (size_t)L->npatches * TT__LAPPED_HULL_GRID * TT__LAPPED_HULL_GRID);
     L->hull_box = TT__ALLOC(L->al, float, 4 * (size_t)L->npatches);
     L->patch_count = TT__ALLOC(L->al, int, L->npatches);
     L->shape_of = TT__ALLOC(L->al, int, L->npatches);
@@ -12751,7 +12753,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->row_fill = TT__ALLOC(L->al, int, nv);
     L->column_mark = TT__ALLOC(L->al, int, nv);
     L->solve = TT__ALLOC(L->al, double, 4 * (size_t)nv);
-    if (!L->hull || !L->hull_count || !L->hull_cells || !L->hull_box || !L->patch_count || !L->shape_of ||
+    if (!L->hull || !L->hull_count || !L->hull_distance || !L->hull_box || !L->patch_count || !L->shape_of ||
         !L->top_patch || !L->near_stamp || !L->near_queue || !L->anchor || !L->normal || !L->tangent ||
         !L->axis_weights || !L->area || !L->difficulty || !L->sample_res || !L->sample_start || !L->covered_count ||
         !L->uncovered || !L->uncovered_pos || !L->face_stamp || !L->vert_stamp || !L->edge_stamp || !L->vert_local ||
