@@ -5774,12 +5774,54 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
 #endif
 #endif
 
-/* The median of values[0 .. count-1] (sorts them); 0 for none. */
+/* The k-th smallest of values[0 .. count-1] (0-based, 0 <= k < count),
+   which are reordered so that the ones before position k are no larger and
+   the ones after no smaller: Hoare's selection with a middle-of-three
+   pivot, linear time on average where a sort takes n log n; after 2 log2 n
+   rounds without getting there (an input built against the pivot) the
+   range left is heapsorted, so the worst case stays n log n. */
+static double tt__select(double *values, int count, int k)
+{
+    int lo = 0, hi = count - 1, rounds = 0, limit = 2;
+    while ((1 << (limit / 2)) < count && limit < 62) limit += 2;
+    while (lo < hi) {
+        double a = values[lo], b = values[lo + (hi - lo) / 2], c = values[hi], pivot, t;
+        int i = lo, j = hi;
+        if (rounds++ == limit) {
+            tt__sort_doubles(values + lo, hi - lo + 1);
+            break;
+        }
+        pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        while (i <= j) {
+            while (values[i] < pivot) i++;
+            while (values[j] > pivot) j--;
+            if (i <= j) {
+                t = values[i];
+                values[i++] = values[j];
+                values[j--] = t;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+    return values[k];
+}
+
+/* The median of values[0 .. count-1] (reorders them); 0 for none. The
+   values must be comparable (no NaN). */
 static double tt__median(double *values, int count)
 {
+    double upper, lower;
+    int i;
     if (count <= 0) return 0.0;
-    tt__sort_doubles(values, count);
-    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+    upper = tt__select(values, count, count / 2);
+    if (count % 2) return upper;
+    /* The lower middle value: the largest of those before. */
+    lower = values[0];
+    for (i = 1; i < count / 2; i++)
+        if (values[i] > lower) lower = values[i];
+    return 0.5 * (lower + upper);
 }
 
 /* A value and its weight (an area, say), for weighted percentiles. */

@@ -12,6 +12,47 @@
 /* 1. Common (results, errors, allocators, RNG)                             */
 /* ------------------------------------------------------------------------ */
 
+static int median_compare(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* tt__median (a selection, with a heapsort when the pivots keep missing)
+   against the middle of a sorted copy: random values, many repeats, sorted,
+   reversed, all equal and an organ pipe (patterns that defeat naive
+   pivots), odd and even counts from 1 to 3001. */
+static void test_median(void)
+{
+    int pattern, n, i, bad = 0, checked = 0;
+    for (pattern = 0; pattern < 6; pattern++)
+        for (n = 1; n <= 3001; n = n < 20 ? n + 1 : 2 * n + 1) {
+            double *v = (double *)malloc(sizeof(double) * (size_t)n), *sorted, want, got;
+            sorted = (double *)malloc(sizeof(double) * (size_t)n);
+            lcg_seed(17u + (unsigned)n);
+            for (i = 0; i < n; i++) {
+                switch (pattern) {
+                case 0: v[i] = lcg_unit(); break;
+                case 1: v[i] = (double)(int)(4.0 * lcg_unit()); break;
+                case 2: v[i] = i; break;
+                case 3: v[i] = n - i; break;
+                case 4: v[i] = 1.5; break;
+                default: v[i] = i < n / 2 ? i : n - i; break;
+                }
+                sorted[i] = v[i];
+            }
+            qsort(sorted, (size_t)n, sizeof(double), median_compare);
+            want = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+            got = internal_median(v, n);
+            bad += got != want;
+            checked++;
+            free(v);
+            free(sorted);
+        }
+    CHECK(bad == 0, "median: %d of %d arrays off the sorted middle", bad, checked);
+    CHECK(internal_median(NULL, 0) == 0.0, "median of nothing is 0");
+}
+
 static void test_rng(void)
 {
     /* The reference PCG32 demo (pcg32_srandom_r(&rng, 42u, 54u)) prints these. */
@@ -255,6 +296,7 @@ static void test_half_allocators(void)
 void run_common_tests(void)
 {
     RUN(test_rng);
+    RUN(test_median);
     RUN(test_version);
     RUN(test_result_strings);
     RUN(test_half_allocators);

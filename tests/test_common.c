@@ -401,6 +401,8 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
 int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
 float internal_infinity(void) { return tt__infinity(); }
 double internal_not_a_number(void) { return tt__not_a_number(); }
+double internal_median(double *values, int count) { return tt__median(values, count); }
+
 double internal_weighted_percentile(const double *values, const double *weights, int count, double fraction)
 {
     tt__weighted *items = (tt__weighted *)malloc(sizeof(tt__weighted) * (size_t)count);

@@ -173,6 +173,8 @@ double internal_not_a_number(void);
 double internal_orient2(double ax, double ay, double bx, double by, double cx, double cy);
 /* tt__weighted_percentiles of (values[i], weights[i]) at one fraction. */
 double internal_weighted_percentile(const double *values, const double *weights, int count, double fraction);
+/* tt__median (reorders values). */
+double internal_median(double *values, int count);
 double internal_point_segment_distance(double px_, double py_, double ax, double ay, double bx, double by);
 int internal_point_on_segment(double px_, double py_, double ax, double ay, double bx, double by);
 int internal_segments_near(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy,
