@@ -11522,13 +11522,20 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 /* Early seed faces: the most difficult of this many random draws. */
 #define TT__LAPPED_PRIORITY_DRAWS 8
 
+/* The two limits on a face's map, TT_LAPPED_MAX_DISTORTION (a solved map)
+   and TT_LAPPED_GROW_DISTORTION (a predicted one, and the fringe), each as
+   the tangent of the angle and the largest scale (1 + degrees / 90). */
+typedef struct tt__distortion_limit {
+    double tangent, scale;
+} tt__distortion_limit;
+
 /* One face of one paste (Sec. 3.5), with its alignment error (Sec. 3.4). */
 typedef struct tt__entry {
     int face, paste;
     float uv[6];
     float fade[3];              /* per corner: the factor on the patch's alpha (tt__paste_fade) */
     unsigned char covers;       /* the paste may cover samples of the face (not the fringe) */
-    float angle_error, scale_error;
+    float up_image[2];          /* phi(T_f) (tt__face_up_image), for the alignment statistics */
 } tt__entry;
 
 typedef struct tt__lapper {
@@ -11542,6 +11549,7 @@ typedef struct tt__lapper {
     int *local_face;            /* per face of the caller's: its face in the copy */
     int isotropic;
     const tt_allocator *al;
+    tt__distortion_limit solved_limit, grown_limit;   /* TT_LAPPED_MAX_ / TT_LAPPED_GROW_DISTORTION */
     tt_rng rng;
     /* per texture patch */
     float **hull;               /* conservative hull, texture space, CCW */
@@ -11783,13 +11791,24 @@ static float tt__face_alpha_most(const tt_image *patch, const float uv[6])
     return most;
 }
 
-/* Whether an alignment error (tt__alignment_error) turns T_f by at most
-   `most` degrees and scales it within 1 + most / 90 either way
-   (TT_LAPPED_MAX_DISTORTION). */
-static int tt__aligned_within(double angle, double scale, double most)
+static tt__distortion_limit tt__distortion_limit_of(double degrees)
 {
-    double limit = 1.0 + most / 90.0;
-    return angle <= most && scale <= limit && scale * limit >= 1.0;
+    tt__distortion_limit limit;
+    limit.tangent = tan(degrees * (TT__PI / 180.0));
+    limit.scale = 1.0 + degrees / 90.0;
+    return limit;
+}
+
+/* Whether phi(T_f) (tt__face_up_image) is turned from the texture's up by
+   at most the limit's angle and scaled within its scale either way: the
+   test of tt__alignment_error's angle and length, without the arctangent
+   and the root (the paste loop asks it of every face it grows over and
+   records; the angles below 90 degrees). */
+static int tt__aligned_within(const double image_t[2], tt__distortion_limit limit)
+{
+    double squared = image_t[0] * image_t[0] + image_t[1] * image_t[1];
+    return image_t[1] > 0.0 && fabs(image_t[0]) <= limit.tangent * image_t[1] &&
+           squared <= limit.scale * limit.scale && squared * limit.scale * limit.scale >= 1.0;
 }
 
 /* Face f's corner UVs as the current map has them. */
@@ -11809,13 +11828,13 @@ static void tt__face_uv(const tt__lapper *L, int f, float uv[6])
    TT__LAPPED_FRINGE_ALPHA). The fringe keeps the paste's soft border where
    the map drifts from the field toward the paste's rim, so that it need
    not end there with a hard edge; the texture shown there is faint, and
-   covers nothing (Sec. 3.6 counts opaque points only). angle and scale are
-   the face's alignment error (tt__alignment_error). */
-static int tt__paste_may_show(const tt__lapper *L, int f, int patch, double angle, double scale)
+   covers nothing (Sec. 3.6 counts opaque points only). image_t is phi(T_f)
+   (tt__face_up_image). */
+static int tt__paste_may_show(const tt__lapper *L, int f, int patch, const double image_t[2])
 {
     float uv[6];
-    if (tt__aligned_within(angle, scale, TT_LAPPED_MAX_DISTORTION)) return 1;
-    if (!tt__aligned_within(angle, scale, TT_LAPPED_GROW_DISTORTION)) return 0;
+    if (tt__aligned_within(image_t, L->solved_limit)) return 1;
+    if (!tt__aligned_within(image_t, L->grown_limit)) return 0;
     tt__face_uv(L, f, uv);
     return tt__face_alpha_most(L->patches[patch], uv) < TT__LAPPED_FRINGE_ALPHA;
 }
@@ -12014,7 +12033,7 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
 {
     const tt_mesh *mesh = L->mesh;
     int t = mesh->twin[c], g = t / 3, v = mesh->corner_vert[3 * g + (t % 3 + 2) % 3], shared = 0, k, mapped;
-    double uv[2], image_t[2], angle, scale;
+    double uv[2], image_t[2];
     if (L->face_stamp[g] == paste) return 0;
     for (k = 0; k < 3; k++) {
         int u = mesh->twin[3 * g + k];
@@ -12029,8 +12048,7 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
         L->vert_uv[2 * (size_t)v + 1] = uv[1];
     }
     tt__face_up_image(L, g, image_t);
-    tt__alignment_error(image_t, &angle, &scale);
-    if (!tt__aligned_within(angle, scale, TT_LAPPED_GROW_DISTORTION)) return 0;
+    if (!tt__aligned_within(image_t, L->grown_limit)) return 0;
     L->face_stamp[g] = paste;
     L->patch_faces[L->npatch_faces++] = g;
     if (!mapped) tt__map_vertex(L, v, paste);
@@ -12440,24 +12458,23 @@ static long long tt__record_paste(tt__lapper *L, int patch)
     for (i = 0; i < L->npatch_faces; i++) {
         int f = L->patch_faces[i];
         tt__entry *entry;
-        double image_t[2], angle, scale;
+        double image_t[2];
         tt__face_up_image(L, f, image_t);
-        tt__alignment_error(image_t, &angle, &scale);
         /* Sec. 3.3 stops growth where distortion becomes excessive; the
            optimization can still leave faces far off the field (near its
            singularities), and they are left out of the paste too: a cut
            there (faded, tt__paste_fade), and another paste covers them.
            Faces of the fringe stay but cover nothing. The seed face always
            stays, and covers. */
-        if (f != L->seed_face && !tt__paste_may_show(L, f, patch, angle, scale)) continue;
+        if (f != L->seed_face && !tt__paste_may_show(L, f, patch, image_t)) continue;
         entry = &L->entries[L->nentries++];
         tt__face_uv(L, f, entry->uv);
-        entry->covers = f == L->seed_face || tt__aligned_within(angle, scale, TT_LAPPED_MAX_DISTORTION);
+        entry->covers = f == L->seed_face || tt__aligned_within(image_t, L->solved_limit);
         entry->face = f;
         entry->paste = paste;
         L->top_patch[f] = patch;
-        entry->angle_error = (float)angle;
-        entry->scale_error = (float)fabs(scale - 1.0);
+        entry->up_image[0] = (float)image_t[0];
+        entry->up_image[1] = (float)image_t[1];
     }
     tt__paste_fade(L, first);
     /* A paste that its fade would leave covering less than
@@ -13159,8 +13176,14 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
         out->faces[n] = L->face_of[entry->face];
         for (i = 0; i < 6; i++) out->uv[6 * (size_t)n + i] = entry->uv[i];
         for (i = 0; i < 3; i++) out->fade[3 * (size_t)n + i] = entry->fade[i];
-        angle_sum += entry->angle_error;
-        scales[n] = entry->scale_error;
+        {
+            double image_t[2], angle, scale;
+            image_t[0] = entry->up_image[0];
+            image_t[1] = entry->up_image[1];
+            tt__alignment_error(image_t, &angle, &scale);
+            angle_sum += angle;
+            scales[n] = fabs(scale - 1.0);
+        }
         out->pastes[p].nfaces++;
         n++;
     }
@@ -13205,6 +13228,8 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
     L.npatches = npatches;
     L.field = face_vectors;
     L.isotropic = opts.isotropic != 0;
+    L.solved_limit = tt__distortion_limit_of(TT_LAPPED_MAX_DISTORTION);
+    L.grown_limit = tt__distortion_limit_of(TT_LAPPED_GROW_DISTORTION);
     L.al = allocator;
     tt_rng_seed(&L.rng, opts.seed, 0x1a99ed);
     r = tt__lapper_setup(&L, max_pastes, error);
