@@ -12319,6 +12319,10 @@ static void tt__paste_fade(tt__lapper *L, int first)
     const tt_mesh *mesh = L->mesh;
     const tt_image *image = L->patches[L->paste_patch[L->entries[first].paste]];
     double *distance = L->vert_cut_distance, width = TT__LAPPED_FADE_WIDTH;
+    /* Distances matter up to the fade's width, or to where the seed face's
+       corners would shrink it (0.9 of theirs): the walk stops there, so
+       it covers a band along the cuts, not the whole paste. */
+    const double reach = TT__LAPPED_FADE_WIDTH / 0.9;
     int e, k, count = 0;
     for (e = first; e < L->nentries; e++) {
         L->face_entry[L->entries[e].face] = e;
@@ -12364,7 +12368,7 @@ static void tt__paste_fade(tt__lapper *L, int first)
                     double du = L->vert_uv[2 * (size_t)x] - L->vert_uv[2 * (size_t)v];
                     double dv = L->vert_uv[2 * (size_t)x + 1] - L->vert_uv[2 * (size_t)v + 1];
                     double through = distance[v] + sqrt(du * du + dv * dv);
-                    if (through < distance[x]) {
+                    if (through < distance[x] && through <= reach) {
                         distance[x] = through;
                         tt__heap_push(L->heap, &count, through, x);
                     }
