@@ -6491,7 +6491,7 @@ done:
      - the prolongation P: 1 from each unknown to its aggregate (constants
        stay exact, as the Laplacian's near null space asks), smoothed by one
        damped Jacobi step, P = (I - omega D^-1 A) P0, omega = 4 / (3 rho)
-       with rho Gershgorin's bound on the spectral radius of D^-1 A;
+       with rho the spectral radius of D^-1 A (estimated);
      - the smaller matrix is P^T A P (Galerkin), again symmetric positive
        definite, and so on until at most TT__AMG_COARSEST unknowns remain,
        factored densely (Cholesky).
@@ -6508,6 +6508,8 @@ done:
 /* Levels at most; with aggregates of about 7 unknowns this reaches the
    coarsest size from 10^13 unknowns. */
 #define TT__AMG_MAX_LEVELS 16
+/* Power iterations estimating each level's spectral radius. */
+#define TT__AMG_POWER_STEPS 4
 
 typedef struct tt__amg_level {
     int n;
@@ -6638,6 +6640,37 @@ static int tt__amg_multiply(const tt_allocator *al, int rows, const int *a_start
     return 1;
 }
 
+/* The spectral radius of D^-1 A on level V for the prolongation's
+   smoothing step: Gershgorin's bound (`bound`) can be twice the truth on
+   mesh matrices, which damps the step and costs the solves a step or two
+   on fine meshes (the horse cut 1-to-4: 9.3 steps against 7.0). Four power
+   iterations (in D's inner product, where D^-1 A is symmetric) from a fixed
+   start estimate it from below; 10 % more, and never above the bound.
+   Uses the level's x and b as scratch. */
+static double tt__amg_spectral_radius(tt__amg_level *V, double bound)
+{
+    double *u = V->x, *w = V->b, estimate = 0.0;
+    int n = V->n, i, k, step;
+    for (i = 0; i < n; i++) u[i] = 1.0 + (double)(((unsigned)i * 2654435761u) % 1000u) / 2000.0;
+    for (step = 0; step < TT__AMG_POWER_STEPS; step++) {
+        double uAu = 0.0, uDu = 0.0, norm = 0.0;
+        for (i = 0; i < n; i++) {
+            double sum = 0.0;
+            for (k = V->row_start[i]; k < V->row_start[i + 1]; k++) sum += V->value[k] * u[V->col[k]];
+            w[i] = sum * V->inv_diag[i];
+            uAu += sum * u[i];
+            uDu += u[i] * u[i] / V->inv_diag[i];
+            norm += w[i] * w[i];
+        }
+        estimate = uDu > 0.0 ? uAu / uDu : bound;
+        if (!(norm > 0.0)) break;
+        norm = 1.0 / sqrt(norm);
+        for (i = 0; i < n; i++) u[i] = w[i] * norm;
+    }
+    estimate *= 1.1;
+    return estimate > 0.0 && estimate < bound ? estimate : bound;
+}
+
 /* The hierarchy for the symmetric positive definite A (borrowed, kept
    unchanged until tt__amg_free). TT_ERROR_NOT_POSITIVE_DEFINITE when a
    diagonal entry or a pivot of the last level's factor is not positive;
@@ -6709,6 +6742,7 @@ static tt_result tt__amg_setup(tt__amg *G, const tt_sparse_matrix *A, const tt_a
                 for (k = V->row_start[i]; k < V->row_start[i + 1]; k++) s += fabs(V->value[k]);
                 if (s * V->inv_diag[i] > rho) rho = s * V->inv_diag[i];
             }
+            rho = tt__amg_spectral_radius(V, rho);
             omega = 4.0 / (3.0 * rho);
             for (j = 0; j < nagg; j++) mark[j] = -1;
             V->p_start[0] = 0;
