@@ -11621,6 +11621,7 @@ typedef struct tt__lapper {
     int *face_entry;            /* per face: its entry in the paste being recorded */
     unsigned char *seeded;      /* per face: pastes seeded on it (at most 255) */
     int *patch_faces, npatch_faces;
+    int *patch_corners;         /* 3 per patch face: its corners' vertices as the patch numbers them */
     int *patch_verts, npatch_verts;
     tt__heap_item *heap;        /* half-edges to grow across (`value`), or vertices by cut distance */
     int heap_count;
@@ -11880,6 +11881,17 @@ static void tt__map_vertex(tt__lapper *L, int v, int paste)
     L->patch_verts[L->npatch_verts++] = v;
 }
 
+/* Face f joins the patch (its vertices mapped), with its corners' patch
+   numbers kept beside it: the solves read them in the patch's order rather
+   than through the mesh's arrays. */
+static void tt__add_patch_face(tt__lapper *L, int f)
+{
+    int k;
+    for (k = 0; k < 3; k++)
+        L->patch_corners[3 * (size_t)L->npatch_faces + k] = L->vert_local[L->mesh->corner_vert[3 * f + k]];
+    L->patch_faces[L->npatch_faces++] = f;
+}
+
 /* Growth asks, for every edge it reaches, whether the edge's image meets
    the patch's hull (Sec. 3.3), and the exact test walks the hull's 32
    edges. A grid over the hull's box answers most of the questions at once:
@@ -12084,8 +12096,8 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
     tt__face_up_image(L, g, image_t);
     if (!tt__aligned_within(image_t, L->grown_limit)) return 0;
     L->face_stamp[g] = paste;
-    L->patch_faces[L->npatch_faces++] = g;
     if (!mapped) tt__map_vertex(L, v, paste);
+    tt__add_patch_face(L, g);
     return 1;
 }
 
@@ -12127,8 +12139,7 @@ static tt_result tt__alignment_matrix(tt__lapper *L, int seed_face, const double
     void *grown;
     for (i = 0; i < 2 * n; i++) b[i] = 0.0;
     for (i = 0; i <= n; i++) start[i] = 0;
-    for (f = 0; f < L->npatch_faces; f++)
-        for (k = 0; k < 3; k++) start[L->vert_local[mesh->corner_vert[3 * L->patch_faces[f] + k]] + 1] += 3;
+    for (f = 0; f < 3 * L->npatch_faces; f++) start[L->patch_corners[f] + 1] += 3;
     for (k = 0; k < 3; k++) {
         seed_rows[k] = L->vert_local[mesh->corner_vert[3 * seed_face + k]];
         start[seed_rows[k] + 1] += 3;
@@ -12155,10 +12166,9 @@ static tt_result tt__alignment_matrix(tt__lapper *L, int seed_face, const double
     for (f = 0; f < L->npatch_faces; f++) mean_area += L->area[L->patch_faces[f]];
     mean_area /= L->npatch_faces;
     for (f = 0; f < L->npatch_faces; f++) {
-        int face = L->patch_faces[f], local[3];
+        const int face = L->patch_faces[f], *local = L->patch_corners + 3 * (size_t)f;
         const float *wt = L->axis_weights + 6 * (size_t)face, *ws = wt + 3;
         double a = mean_area > 0.0 ? L->area[face] / mean_area : 1.0;
-        for (k = 0; k < 3; k++) local[k] = L->vert_local[mesh->corner_vert[3 * face + k]];
         for (k = 0; k < 3; k++) {
             b[2 * local[k]] += a * ws[k];
             b[2 * local[k] + 1] += a * wt[k];
@@ -12751,6 +12761,7 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->face_entry);
     tt__free(L->al, L->seeded);
     tt__free(L->al, L->patch_faces);
+    tt__free(L->al, L->patch_corners);
     tt__free(L->al, L->patch_verts);
     tt__free(L->al, L->heap);
     tt__free(L->al, L->row_start);
@@ -12838,6 +12849,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->vert_local = TT__ALLOC(L->al, int, nv);
     L->vert_uv = TT__ALLOC(L->al, double, 2 * (size_t)nv);
     L->patch_faces = TT__ALLOC(L->al, int, nf);
+    L->patch_corners = TT__ALLOC(L->al, int, 3 * (size_t)nf);
     L->patch_verts = TT__ALLOC(L->al, int, nv);
     /* growth pushes each half-edge once; the cut distances each vertex and
        each half-edge's relaxation at most once */
@@ -12854,7 +12866,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         !L->top_patch || !L->near_stamp || !L->near_queue || !L->anchor || !L->normal || !L->tangent ||
         !L->axis_weights || !L->area || !L->difficulty || !L->sample_res || !L->sample_start || !L->covered_count ||
         !L->uncovered || !L->uncovered_pos || !L->face_stamp || !L->vert_stamp || !L->edge_stamp || !L->vert_local ||
-        !L->vert_uv || !L->patch_faces || !L->patch_verts || !L->heap || !L->row_start || !L->row_fill ||
+        !L->vert_uv || !L->patch_faces || !L->patch_corners || !L->patch_verts || !L->heap || !L->row_start || !L->row_fill ||
         !L->column_mark || !L->solve || !L->depth || !L->vert_cut_distance || !L->face_entry || !L->seeded ||
         !L->hidden_below)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
@@ -13114,7 +13126,6 @@ static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_
     L->npatch_faces = 0;
     L->npatch_verts = 0;
     L->face_stamp[f] = paste;
-    L->patch_faces[L->npatch_faces++] = f;
     for (k = 0; k < 3; k++) {
         int v = mesh->corner_vert[3 * f + k];
         const float *p = mesh->pos + 3 * (size_t)v;
@@ -13124,6 +13135,7 @@ static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_
         L->vert_uv[2 * (size_t)v + 1] = anchor[1] + tt__dot3(d, t) / tt_;
         tt__map_vertex(L, v, paste);
     }
+    tt__add_patch_face(L, f);
     *seed_face = f;
     L->seed_face = f;
     if (L->seeded[f] < 255) L->seeded[f]++;

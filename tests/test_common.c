@@ -481,6 +481,7 @@ tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const i
     L.axis_weights = (float *)calloc(6 * (size_t)nf, sizeof(float));
     L.area = (float *)calloc((size_t)nf, sizeof(float));
     L.patch_faces = (int *)malloc(sizeof(int) * (size_t)nf);
+    L.patch_corners = (int *)malloc(sizeof(int) * 3 * (size_t)nf);
     L.patch_verts = (int *)malloc(sizeof(int) * (size_t)nv);
     L.vert_local = (int *)malloc(sizeof(int) * (size_t)nv);
     L.vert_stamp = (int *)malloc(sizeof(int) * (size_t)nv);
@@ -488,7 +489,8 @@ tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const i
     L.row_fill = (int *)malloc(sizeof(int) * (size_t)nv);
     L.column_mark = (int *)malloc(sizeof(int) * (size_t)nv);
     L.solve = (double *)malloc(sizeof(double) * 4 * (size_t)nv);
-    if (L.normal && L.tangent && L.axis_weights && L.area && L.patch_faces && L.patch_verts && L.vert_local &&
+    if (L.normal && L.tangent && L.axis_weights && L.area && L.patch_faces && L.patch_corners && L.patch_verts &&
+        L.vert_local &&
         L.vert_stamp && L.row_start && L.row_fill && L.column_mark && L.solve) {
         for (i = 0; i < nv; i++) L.vert_stamp[i] = -1;
         for (i = 0; i < nfaces; i++) {
@@ -502,14 +504,9 @@ tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const i
             tt__cross3(e1, e2, cross);
             L.area[f] = (float)(0.5 * tt__length3(cross));
             tt__face_axes(&L, f);
-            L.patch_faces[L.npatch_faces++] = f;
-            for (k = 0; k < 3; k++) {
-                const int vert = mesh->corner_vert[3 * f + k];
-                if (L.vert_stamp[vert] == 0) continue;
-                L.vert_stamp[vert] = 0;
-                L.vert_local[vert] = L.npatch_verts;
-                L.patch_verts[L.npatch_verts++] = vert;
-            }
+            for (k = 0; k < 3; k++)
+                if (L.vert_stamp[mesh->corner_vert[3 * f + k]] != 0) tt__map_vertex(&L, mesh->corner_vert[3 * f + k], 0);
+            tt__add_patch_face(&L, f);
         }
         r = tt__optimize_patch(&L, seed_face, seed_weight, anchor);
     }
@@ -520,6 +517,7 @@ tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const i
     free(L.axis_weights);
     free(L.area);
     free(L.patch_faces);
+    free(L.patch_corners);
     free(L.patch_verts);
     free(L.vert_local);
     free(L.vert_stamp);
