@@ -916,10 +916,12 @@ static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float
     return 0;
 }
 
-typedef struct baked_seams {
+/* What the summary says of the bake. */
+typedef struct baked_summary {
     tool_seams all;             /* every interior edge */
     tool_seams top_changes;     /* the edges where the paste on top changes */
-} baked_seams;
+    double seconds;             /* wall time of the colour bake itself (tt_lapped_bake) */
+} baked_summary;
 
 /* The interior edges whose two faces show different pastes on top, each
    named by one of its corners (*edges is malloc'd): where pastes end, softly
@@ -951,15 +953,15 @@ static int top_change_edges(const tt_mesh *mesh, const tt_lapped *lapped, int **
    the edges where the paste on top changes: about 0 where pastes fade out
    softly, about 1 where one ends with a hard edge. */
 static int measure_baked(const lapped_options *options, const triangle_mesh *m, const tt_lapped *lapped,
-                         const float *corner_uv, const tt_image *atlas, baked_seams *seams)
+                         const float *corner_uv, const tt_image *atlas, baked_summary *summary)
 {
     int *edges = NULL, nedges = 0;
     int status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, atlas, options->seed, 0, NULL, 0, 0,
-                                    &seams->all);
+                                    &summary->all);
     if (status == 0) status = top_change_edges(m->mesh, lapped, &edges, &nedges);
     if (status == 0)
         status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, atlas, options->seed, 0, edges, nedges, 0,
-                                    &seams->top_changes);
+                                    &summary->top_changes);
     free(edges);
     return status;
 }
@@ -985,7 +987,7 @@ static int bake_map(const lapped_options *options, const triangle_mesh *m, const
    map), or with a glb_path (not NULL) that GLB. */
 static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
                      const tt_lapped *lapped, const lapped_patches *patches, float *corner_uv,
-                     const char *glb_path, baked_seams *seams)
+                     const char *glb_path, baked_summary *summary)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256], map_paths[MATERIAL_MAPS][4200];
     char stem[TOOL_PREFIX_SIZE + 16];
@@ -1016,13 +1018,15 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     tool_progress_begin(&progress, "baking", "of the atlas");
     bake.progress = tool_show_progress;
     bake.progress_user_data = &progress;
+    summary->seconds = tool_seconds_now();
     result = tt_lapped_bake(m->mesh, lapped, patches->images, patches->count, corner_uv, &bake, NULL, atlas, &error);
     tool_progress_end(&progress);
     if (result != TT_OK) {
         status = triangle_mesh_report_error(options->mesh_path, m, &error);
         goto done;
     }
-    if ((status = measure_baked(options, m, lapped, corner_uv, atlas, seams)) != 0) goto done;
+    summary->seconds = tool_seconds_now() - summary->seconds;
+    if ((status = measure_baked(options, m, lapped, corner_uv, atlas, summary)) != 0) goto done;
 
     snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
              tool_basename(png_path));
@@ -1130,79 +1134,42 @@ static void print_patch_use(const lapped_patches *patches, const tt_lapped *lapp
     free(uses);
 }
 
-typedef struct weighted_value {
-    double value, weight;
-} weighted_value;
-
-static int compare_weighted_values(const void *a, const void *b)
-{
-    double x = ((const weighted_value *)a)->value, y = ((const weighted_value *)b)->value;
-    return x < y ? -1 : x > y;
-}
-
-/* How evenly the photo is spread over the surface, as a bake shows it:
-   per triangle, the texel density of the paste on top (the last to draw
-   it: what the bake shows where that paste is opaque), sqrt(patch texels
-   covered / surface area); the area-weighted 95th percentile over the 5th
-   (1 = the same everywhere). 0 when nothing is measured. */
+/* How evenly the photo is spread over the surface, as a bake shows it: the
+   texel density spread (tt_measure_uv_distortion: area-weighted 95th
+   percentile of sqrt(texels / surface area) over its 5th, 1 = the same
+   everywhere) of the map each triangle has from the paste on top, the
+   last to draw it (what the bake shows where that paste is opaque). UVs of
+   a patch of another size than the first are scaled into the first's
+   texels. 0 when it cannot be measured. */
 static double top_density_spread(const triangle_mesh *m, const tt_lapped *lapped, const lapped_patches *patches)
 {
-    int *top = (int *)malloc(2 * (size_t)m->ntriangles * sizeof(int)), *top_patch, p, e, f, n = 0;
-    weighted_value *items = (weighted_value *)malloc((size_t)m->ntriangles * sizeof(weighted_value));
-    double total = 0.0, sum = 0.0, p5 = 0.0, p95 = 0.0;
-    if (!top || !items) {
-        free(top);
-        free(items);
-        return 0.0;
-    }
-    top_patch = top + m->ntriangles;
-    for (f = 0; f < m->ntriangles; f++) top[f] = -1;
-    for (p = 0; p < lapped->npastes; p++)
+    const tt_mesh *mesh = m->mesh;
+    const tt_image *first = patches->images[0];
+    float *uv = (float *)calloc(2 * (size_t)mesh->ncorners, sizeof(float));
+    tt_uv_distortion_report report;
+    tt_error error;
+    double spread = 0.0;
+    int p, e, k;
+    if (!uv) return 0.0;
+    for (p = 0; p < lapped->npastes; p++) {
+        const tt_image *patch = patches->images[lapped->pastes[p].patch];
+        const float su = (float)patch->width / (float)first->width, sv = (float)patch->height / (float)first->height;
         for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) {
-            top[lapped->faces[e]] = e;
-            top_patch[lapped->faces[e]] = lapped->pastes[p].patch;
-        }
-    for (f = 0; f < m->ntriangles; f++) {
-        const float *uv = lapped->uv + 6 * (size_t)(top[f] > 0 ? top[f] : 0);
-        const float *a = m->pos + 3 * (size_t)m->vert[3 * f], *b = m->pos + 3 * (size_t)m->vert[3 * f + 1];
-        const float *c = m->pos + 3 * (size_t)m->vert[3 * f + 2];
-        const tt_image *patch;
-        double e1[3], e2[3], cross[3], area, texels;
-        int k;
-        if (top[f] < 0) continue;
-        patch = patches->images[top_patch[f]];
-        for (k = 0; k < 3; k++) {
-            e1[k] = (double)b[k] - a[k];
-            e2[k] = (double)c[k] - a[k];
-        }
-        cross[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        cross[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        cross[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        area = 0.5 * sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
-        texels = ((double)uv[2] - uv[0]) * ((double)uv[5] - uv[1]) - ((double)uv[4] - uv[0]) * ((double)uv[3] - uv[1]);
-        texels = 0.5 * fabs(texels) * patch->width * patch->height;
-        if (!(area > 0.0)) continue;
-        items[n].value = sqrt(texels / area);
-        items[n].weight = area;
-        total += area;
-        n++;
-    }
-    qsort(items, (size_t)n, sizeof *items, compare_weighted_values);
-    for (e = 0; e < n; e++) {
-        sum += items[e].weight;
-        if (p5 == 0.0 && sum >= 0.05 * total) p5 = items[e].value;
-        if (sum >= 0.95 * total) {
-            p95 = items[e].value;
-            break;
+            float *to = uv + 2 * (size_t)mesh->face_start[lapped->faces[e]];
+            for (k = 0; k < 3; k++) {
+                to[2 * k] = su * lapped->uv[6 * (size_t)e + 2 * k];
+                to[2 * k + 1] = sv * lapped->uv[6 * (size_t)e + 2 * k + 1];
+            }
         }
     }
-    free(top);
-    free(items);
-    return p5 > 0.0 ? p95 / p5 : 0.0;
+    if (tt_measure_uv_distortion(mesh, uv, first->width, first->height, NULL, NULL, &report, &error) == TT_OK)
+        spread = report.density_spread;
+    free(uv);
+    return spread;
 }
 
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
-                          const tt_lapped *lapped, const lapped_patches *patches, const baked_seams *baked,
+                          const tt_lapped *lapped, const lapped_patches *patches, const baked_summary *baked,
                           double seconds)
 {
     char all[256], top[256];
@@ -1235,6 +1202,8 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
         tool_format_seams(&baked->all, "edges", all, sizeof all);
         tool_format_seams(&baked->top_changes, "edges", top, sizeof top);
         printf("baked seam score: all edges %s; where the top paste changes %s\n", all, top);
+        printf("bake: %dx%d texels in %.2f s (wall, %d thread%s)\n", options->bake_size, options->bake_size,
+               baked->seconds, tool_jobs(), tool_jobs() == 1 ? "" : "s");
     }
     printf("removed %d hidden face entries; %.1f s\n", lapped->removed_entries, seconds);
 }
@@ -1274,7 +1243,7 @@ int cmd_lapped(int argc, char **argv)
     patch_windows windows;
     lapped_patches patches;
     float *field = NULL, *bake_uv = NULL;
-    baked_seams baked;
+    baked_summary baked;
     char obj_path[4096], mtl_path[4096], glb_path[4096], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
     int status, charts = 0, glb;

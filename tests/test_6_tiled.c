@@ -2119,9 +2119,10 @@ static void test_uv_distortion_maps(void)
           "degenerate %d (%s)", r, rep.faces_measured, rep.stretch_median, rep.stretch_p95, rep.stretch_max,
           rep.density_median, rep.density_p95, rep.texels_per_unit, rep.flipped, rep.degenerate, err.message);
     r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
-    CHECK(r == TT_OK && near(rep.texels_per_unit, 16, 1e-4) && near(rep.density_p95, 0, 1e-6),
-          "isometric, scale measured: %d, %g texels a unit (want 16), density error p95 %g", r, rep.texels_per_unit,
-          rep.density_p95);
+    CHECK(r == TT_OK && near(rep.texels_per_unit, 16, 1e-4) && near(rep.density_p95, 0, 1e-6) &&
+              near(rep.density_spread, 1, 1e-6),
+          "isometric, scale measured: %d, %g texels a unit (want 16), density error p95 %g, spread %g (want 1)", r,
+          rep.texels_per_unit, rep.density_p95, rep.density_spread);
     /* uniformly twice the intended scale: no stretch, density error exactly 1 */
     linear_uvs(tris, 32, 32, 10, 10, 256, 128, uv);
     r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
@@ -2129,6 +2130,24 @@ static void test_uv_distortion_maps(void)
               near(rep.density_p95, 1, 1e-6),
           "uniform scale 2: %d, stretch max %g, density error %g / %g (want 1)", r, rep.stretch_max,
           rep.density_median, rep.density_p95);
+    CHECK(r == TT_OK && near(rep.density_spread, 1, 1e-6), "uniform scale 2: density spread %g (want 1)",
+          rep.density_spread);
+    /* 8 of the 48 equal triangles (a sixth of the area) at twice the
+       density of the rest, whatever the intended scale: p95 / p5 = 2 */
+    {
+        int f, k, c;
+        for (f = 0; f < 8; f++) {
+            const int first = tris->face_start[f];
+            for (c = first + 1; c < tris->face_start[f + 1]; c++)
+                for (k = 0; k < 2; k++) uv[2 * c + k] = 2.0f * uv[2 * c + k] - uv[2 * first + k];
+        }
+        for (k = 0; k < 2; k++) {
+            r = distortion(tris, uv, 256, 128, k ? 16 : 0, 0, &rep, &err);
+            CHECK(r == TT_OK && near(rep.density_spread, 2, 1e-6),
+                  "a sixth of the area at twice the density (texels_per_unit %d): %d, spread %g (want 2)", k ? 16 : 0,
+                  r, rep.density_spread);
+        }
+    }
     /* 3 : 1 in texels (u three times as fine as v): stretch exactly 3 */
     linear_uvs(tris, 48, 16, 10, 10, 256, 128, uv);
     r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
@@ -2228,7 +2247,7 @@ static void test_uv_distortion_counts(void)
     r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
     CHECK(r == TT_ERROR_NOT_MEASURED && err.result == r && err.message[0] && rep.non_finite == 48 &&
               rep.faces_measured == 0 && isnan(rep.stretch_median) && isnan(rep.density_p95) &&
-              isnan(rep.stretch_max),
+              isnan(rep.density_spread) && isnan(rep.stretch_max),
           "all-NaN UVs: expected TT_ERROR_NOT_MEASURED with 48 non-finite faces and NaN statistics, got %d, %d, "
           "stretch %g (\"%s\")", r, rep.non_finite, rep.stretch_median, err.message);
     for (c = 0; c < 2 * tris->ncorners; c++) uv[c] = 0.25f;
