@@ -14547,10 +14547,25 @@ static int tt__bake_face(tt__bake *b, const tt__bake_job *job, int f, float xy[6
     return 1;
 }
 
+/* The first pass of a band: a texel inside a triangle is marked as such
+   (state -1) before any gutter is drawn. */
+static void tt__bake_mark_inside(int x, int y, const float barycentric[3], void *user_data)
+{
+    tt__bake *b = (tt__bake *)user_data;
+    (void)barycentric;
+    b->state[(size_t)y * (size_t)b->atlas->width + (size_t)x] = -1.0f;
+}
+
 /* One band of rows: its faces in order, each triangle and then its gutter,
    as a serial bake draws them - the texels of the band see the same writes
    in the same order, so the atlas is the same bits whatever runs the bands.
-   Bands write only their own rows (atlas and state). */
+   Bands write only their own rows (atlas and state). A texel inside a
+   triangle ends with that triangle's colour whatever gutters drew on it
+   before (a triangle's texel is composited afresh; after it, gutters pass
+   it by), so the triangles are marked first and the gutters skip their
+   texels from the start: the same atlas, without compositing the gutter of
+   each face over the neighbours drawn after it (in a chart, a face's 2-texel
+   gutter lies mostly on its neighbours). */
 static void tt__bake_band(void *context, int task)
 {
     const tt__bake_job *job = (const tt__bake_job *)context;
@@ -14565,6 +14580,12 @@ static void tt__bake_band(void *context, int task)
     b.gutter = job->gutter;
     b.row_begin = band * TT__BAKE_BAND_ROWS;
     b.row_end = tt__min_i(b.row_begin + TT__BAKE_BAND_ROWS, job->atlas->height);
+    if (b.gutter > 0.0)
+        for (k = job->band_start[band]; k < job->band_start[band + 1]; k++) {
+            float xy[6];
+            if (tt__bake_face(&b, job, job->band_faces[k], xy))
+                tt__raster_triangle_rows(xy, job->atlas->width, b.row_begin, b.row_end, tt__bake_mark_inside, &b);
+        }
     for (k = job->band_start[band]; k < job->band_start[band + 1]; k++) {
         float xy[6];
         double longest = 0.0;

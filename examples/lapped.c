@@ -921,6 +921,7 @@ typedef struct baked_summary {
     tool_seams all;             /* every interior edge */
     tool_seams top_changes;     /* the edges where the paste on top changes */
     double seconds;             /* wall time of the colour bake itself (tt_lapped_bake) */
+    double cpu_seconds;         /* and its CPU time, all threads */
 } baked_summary;
 
 /* The interior edges whose two faces show different pastes on top, each
@@ -1019,6 +1020,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     bake.progress = tool_show_progress;
     bake.progress_user_data = &progress;
     summary->seconds = tool_seconds_now();
+    summary->cpu_seconds = tool_cpu_seconds_now();
     result = tt_lapped_bake(m->mesh, lapped, patches->images, patches->count, corner_uv, &bake, NULL, atlas, &error);
     tool_progress_end(&progress);
     if (result != TT_OK) {
@@ -1026,6 +1028,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
         goto done;
     }
     summary->seconds = tool_seconds_now() - summary->seconds;
+    summary->cpu_seconds = tool_cpu_seconds_now() - summary->cpu_seconds;
     if ((status = measure_baked(options, m, lapped, corner_uv, atlas, summary)) != 0) goto done;
 
     snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
@@ -1202,8 +1205,8 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
         tool_format_seams(&baked->all, "edges", all, sizeof all);
         tool_format_seams(&baked->top_changes, "edges", top, sizeof top);
         printf("baked seam score: all edges %s; where the top paste changes %s\n", all, top);
-        printf("bake: %dx%d texels in %.2f s (wall, %d thread%s)\n", options->bake_size, options->bake_size,
-               baked->seconds, tool_jobs(), tool_jobs() == 1 ? "" : "s");
+        printf("bake: %dx%d texels in %.2f s wall, %.2f s CPU (%d thread%s)\n", options->bake_size,
+               options->bake_size, baked->seconds, baked->cpu_seconds, tool_jobs(), tool_jobs() == 1 ? "" : "s");
     }
     printf("removed %d hidden face entries; %.1f s\n", lapped->removed_entries, seconds);
 }

@@ -10,7 +10,7 @@
                  files, byte buffers     tool_read_file, tool_buffer
                  atomic output           tool_output: build every file in
                                          memory, then commit them all or none
-                 progress, time          tool_progress, tool_seconds_now
+                 progress, time          tool_progress, tool_seconds_now, tool_cpu_seconds_now
      cli.c       command-line helpers    tool_option, parse_int, parse_mesh_option, ...
      image_io.c  images                  image_load, png_encode, output_add_png,
                                          image_to_rgba8
@@ -860,6 +860,10 @@ int tool_format_int(long value, char *out);
 
 /* Seconds on a monotonic clock, for "took 1.2 s". */
 double tool_seconds_now(void);
+/* CPU seconds the process has used so far, all its threads together (user
+   and system): a stage's CPU is the difference, whatever else runs on the
+   machine. */
+double tool_cpu_seconds_now(void);
 
 /* A progress line for a long library call: fill one with
    tool_progress_begin, pass tool_show_progress as the options' tt_progress_fn

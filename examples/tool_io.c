@@ -782,6 +782,13 @@ double tool_seconds_now(void)
     return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
 }
 
+double tool_cpu_seconds_now(void)
+{
+    struct timespec used;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &used);
+    return (double)used.tv_sec + 1e-9 * (double)used.tv_nsec;
+}
+
 /* Ctrl-C (SIGINT) or SIGTERM during a library call that takes a progress
    callback cancels it through that callback: the call returns TT_CANCELLED
    with everything freed, the command fails with one line, and no output
