@@ -2143,13 +2143,14 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
    connected component. A cluster of more than one face is split into n
    children, n = max(2, round(area / (component area / branching^(level+1))))
    (at most its face count): n seed faces by farthest-point sampling (the
-   first drawn from the seeded RNG) and a geodesic Voronoi partition of the
-   parent, a multi-source Dijkstra over the faces of the parent with the
-   step centroid -> shared edge's midpoint -> centroid; then one Lloyd-like
-   round moves each seed to its cell's centre (the face farthest from the
-   cell's border) and partitions again, which halves the spread of sizes
-   (largest / smallest cluster of a level: 4.3 instead of 9.4 on the tests'
-   meshes). A child is a disc
+   first drawn from the parent's own stream of the seeded RNG, so that the
+   parents of a level split independently) and a geodesic Voronoi
+   partition of the parent, a multi-source Dijkstra over the faces of the
+   parent with the step centroid -> shared edge's midpoint -> centroid;
+   then one Lloyd-like round moves each seed to its cell's centre (the face
+   farthest from the cell's border) and partitions again, which halves the
+   spread of sizes (largest / smallest cluster of a level: 4.1 instead of
+   8.3 on the tests' meshes). A child is a disc
    when its faces are edge-connected, its border is one loop that meets no
    vertex twice, and V - E + F = 1 over its faces. When a child is not a
    disc the parent is split again with n + 1 seeds, at most TT_CLUSTER_RESEEDS
@@ -2180,12 +2181,17 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
    children and the leaves are the faces); the face array holds at most
    mesh->nfaces entries per level and the control and neighbour arrays at
    most 3 * faces per level, so O(faces * levels) in all (horse, 97k faces:
-   11 levels, 0.93M face entries). Scratch while building: 184 bytes per
-   face, 33 per corner, 10 per vertex. Time: O(F log F) per level, each
-   split costing about four Dijkstra passes over its parent, more where a
-   split is retried; the passes run on a copy of the parent's adjacency in
-   its own dense numbering (tt__hier_localize), about 3x faster than
-   through the mesh's arrays (horse: 0.3 s at -O2). */
+   11 levels, 0.93M face entries). Scratch while building: about 200 bytes
+   per face of the largest component, 13 per corner, 10 per vertex; with
+   several tasks a level, each task its own for its largest parent. Time:
+   O(F log F) per level, each split costing about four Dijkstra passes over
+   its parent, more where a split is retried; the passes run on a copy of
+   the parent's adjacency in its own dense numbering (tt__hier_localize),
+   about 3x faster than through the mesh's arrays (horse: about 0.4 s at
+   -O2). With an executor (options->executor) the splits of a level run in
+   up to 64 tasks (ranges of parents), and so do the neighbours and control
+   vertices of its clusters: the hierarchy is the same bits with any
+   executor. */
 
 /* Re-splits of a parent with a non-disc child (spec D13). */
 #define TT_CLUSTER_RESEEDS 3
@@ -2204,6 +2210,10 @@ typedef struct tt_cluster_options {
     uint64_t seed;      /* seeds the RNG that draws each split's first seed (any value, 0 included) */
     int branching;      /* average children per split: each level's target cluster area is the
                            level above's divided by this; 0 = TT_DEFAULT_CLUSTER_BRANCHING; 2..64 */
+    const tt_executor *executor;  /* splits a level's clusters, and finds their neighbours and control
+                                     vertices, in parallel tasks; NULL: serial; the same hierarchy either
+                                     way. Tasks allocate their working arrays: with an executor the
+                                     allocator must be thread-safe */
 } tt_cluster_options;
 
 typedef struct tt_cluster {
@@ -14845,33 +14855,61 @@ TT__DEFINE_HEAPSORT(tt__sort_ints, int)
    being processed (see the header: a cluster of that level, or a shallower
    leaf); a split writes its children's ids there once that level's control
    vertices and neighbours are known. */
+/* The parent being split, in its own numbering: local face i is fl[i]
+   (ascending, so comparing local indices compares faces), its three
+   neighbours across its corners (-1 outside the parent) and the dual steps
+   to them, in one record so that a Dijkstra step reads one cache line, and
+   the Dijkstra's arrays indexed the same way: small and dense where the
+   mesh's arrays would be visited at scattered places. One task's working
+   arrays, for parents of up to `capacity` faces. */
+typedef struct tt__hier_adjacent {
+    int face[3];
+    double step[3];
+} tt__hier_adjacent;
+
+typedef struct tt__hier_work {
+    int capacity;
+    tt__hier_adjacent *adjacent;    /* capacity */
+    double *dist;                   /* capacity: Dijkstra distance to the nearest seed */
+    int *cell;                      /* capacity: the seed (child) each face belongs to */
+    int *best;                      /* capacity: the kept split's cells */
+    int *seed;                      /* capacity: chosen as a seed, or a cell's centre (its face) */
+    double *centre;                 /* capacity: per cell, its centre's distance to the cell's border */
+    int *order;                     /* capacity + 2: faces by cell, then the cells' ends */
+    int *origins;                   /* 3 capacity: the border half-edges' first vertices (topology) */
+    tt__heap_item *heap;            /* 4 capacity + 1: a Dijkstra from up to all faces, 3 pushes per face */
+    tt_rng rng;
+} tt__hier_work;
+
 typedef struct tt__hier {
     const tt_mesh *mesh;
     const tt_allocator *al;
+    const tt_executor *executor;
     int nf, nv, branching;
-    tt_rng rng;
+    uint64_t seed;
     double *centroid;           /* 3 per face, until the steps are made from them */
     double *step;               /* per corner: the dual step across its edge (tt__field_step), 0 on a boundary */
     int *across;                /* per corner: the face across its edge, -1 on a boundary */
     double *farea;              /* per face */
     double *comp_area;          /* per component */
-    int *region;                /* per face */
+    int *region;                /* per face: its region at the level being processed */
+    int *local;                 /* per face: its index in its parent's face list, while the parents split */
+    int *cell;                  /* per face: its child in the kept split of its parent */
+    unsigned *child_flags;      /* per face entry of the level being split: its parent's children's flags */
+    int *child_loops;           /*   and border loops, at the parent's first face entry + child */
     int *vstart, *vcorner;      /* corners at vertex v: vcorner[vstart[v] .. vstart[v + 1] - 1] */
     unsigned char *vboundary;   /* per vertex: on a mesh boundary (an edge with one face) */
     unsigned char *vcount;      /* per vertex: regions around it at this level, "outside" included, capped at 3 */
-    int *vstamp, *cstamp, *fstamp;  /* per vertex, corner, face: visited marks, compared with `stamp` */
-    int stamp;
-    double *dist;               /* per face of the parent being split (local numbering): Dijkstra distance
-                                   to the nearest seed */
-    int *label;                 /* per local face: the seed (child) it belongs to */
-    int *local;                 /* per face: its local number in the parent being split */
-    struct tt__hier_adjacent *adjacent;  /* per local face: its neighbours in the parent, the steps to them */
-    int *best;                  /* per face of the parent being split: the kept split's labels */
-    int *scratch;               /* 3 per face */
-    tt__heap_item *heap;        /* 4 per face + 1: a Dijkstra from up to all faces, 3 pushes per face */
-    int *loopv;                 /* per corner: one border loop's vertices */
-    double *loops;              /* per corner: arc length from the loop's first vertex */
-    unsigned char *loopc;       /* per corner: the loop vertex is a control vertex */
+    unsigned char *cmark;       /* per corner: a border loop walked through it (each cluster marks its own) */
+    int *scratch;               /* nf + 1: counts */
+    tt__hier_work work;         /* working arrays for the largest component, kept for the whole build:
+                                   a level that is one task uses them (the largest parents: no block of
+                                   their size allocated and freed at each level); the tasks of a level
+                                   of several allocate their own */
+    int *list;                  /* 6 nf: the level pass's lists, for a level that is one task */
+    int *loopv;                 /* 3 per face of the largest component: its border loops */
+    double *loops;
+    unsigned char *loopc;
     tt_cluster *cl;             /* the output, grown */
     int ncl, cap_cl;
     int *faces, nfe, cap_fe;
@@ -14897,152 +14935,207 @@ static int tt__hier_next_border(const tt__hier *H, int id, int h)
     return x;
 }
 
-/* Topology of cluster `id` (faces fl[0..n-1], region[] == id): its flags
-   (TT_CLUSTER_DISC or 0) and its number of border loops. A disc has one
-   border loop meeting no vertex twice and V - E + F = 1 (the faces are
-   edge-connected by construction: components, and Voronoi cells whose faces
-   each joined through a neighbour of the same cell). */
-static unsigned tt__hier_topology(tt__hier *H, int id, const int *fl, int n, int *nloops)
-{
-    const tt_mesh *m = H->mesh;
-    long v = 0, e2 = 0, border = 0, border_verts = 0;
-    int i, c, loops = 0, vmark, bmark;
-    vmark = ++H->stamp;
-    bmark = ++H->stamp;
-    for (i = 0; i < n; i++) {
-        for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++) {
-            int vert = m->corner_vert[c];
-            if (H->vstamp[vert] != vmark && H->vstamp[vert] != bmark) { H->vstamp[vert] = vmark; v++; }
-            if (tt__hier_border(H, id, c)) {
-                e2 += 2;
-                border++;
-                if (H->vstamp[vert] != bmark) { H->vstamp[vert] = bmark; border_verts++; }
-            } else {
-                e2 += 1;
-            }
-        }
-    }
-    for (i = 0; i < n; i++) {
-        for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++) {
-            int h = c, guard;
-            if (H->cstamp[c] == bmark || !tt__hier_border(H, id, c)) continue;
-            loops++;
-            for (guard = 0; guard <= m->ncorners && H->cstamp[h] != bmark; guard++) {
-                H->cstamp[h] = bmark;
-                h = tt__hier_next_border(H, id, h);
-            }
-        }
-    }
-    *nloops = loops;
-    return (loops == 1 && border == border_verts && v - e2 / 2 + n == 1) ? (unsigned)TT_CLUSTER_DISC : 0u;
-}
-
 /* Relaxation rounds after the farthest-point seeds. */
 #define TT__HIER_RELAX 1
 
-/* The parent being split, in its own numbering: local face i is fl[i]
-   (ascending, so comparing local indices compares faces), its three
-   neighbours across its corners (-1 outside the parent) and the dual steps
-   to them, in one record so that a Dijkstra step reads one cache line, and
-   the Dijkstra's arrays (dist, label) indexed the same way: small and dense
-   where the mesh's arrays would be visited at scattered places. */
-typedef struct tt__hier_adjacent {
-    int face[3];
-    double step[3];
-} tt__hier_adjacent;
+/* Each parent draws its first seeds from its own stream of the seeded RNG
+   (stream TT__HIER_STREAM + its index), so parents split independently. */
+#define TT__HIER_STREAM 0x48504d0000000000ull   /* "HPM" */
 
-static void tt__hier_localize(tt__hier *H, int p, const int *fl, int n)
+static void tt__hier_work_free(const tt_allocator *al, tt__hier_work *W)
 {
-    const tt_mesh *m = H->mesh;
+    tt__free(al, W->adjacent);
+    tt__free(al, W->dist);
+    tt__free(al, W->cell);
+    tt__free(al, W->best);
+    tt__free(al, W->seed);
+    tt__free(al, W->centre);
+    tt__free(al, W->order);
+    tt__free(al, W->origins);
+    tt__free(al, W->heap);
+}
+
+static int tt__hier_work_alloc(const tt_allocator *al, tt__hier_work *W, int capacity)
+{
+    size_t n = (size_t)capacity;
+    memset(W, 0, sizeof *W);
+    W->capacity = capacity;
+    W->adjacent = TT__ALLOC(al, tt__hier_adjacent, n);
+    W->dist = TT__ALLOC(al, double, n);
+    W->cell = TT__ALLOC(al, int, n);
+    W->best = TT__ALLOC(al, int, n);
+    W->seed = TT__ALLOC(al, int, n);
+    W->centre = TT__ALLOC(al, double, n);
+    W->order = TT__ALLOC(al, int, n + 2);
+    W->origins = TT__ALLOC(al, int, 3 * n);
+    W->heap = TT__ALLOC(al, tt__heap_item, 4 * n + 1);
+    if (W->adjacent && W->dist && W->cell && W->best && W->seed && W->centre && W->order && W->origins && W->heap)
+        return 1;
+    tt__hier_work_free(al, W);
+    memset(W, 0, sizeof *W);
+    return 0;
+}
+
+/* Region p's faces fl[0..n-1] in its own numbering (H->local), their
+   neighbours within p and the steps to them. */
+static void tt__hier_localize(tt__hier *H, tt__hier_work *W, int p, const int *fl, int n)
+{
     int i, j;
     for (i = 0; i < n; i++) H->local[fl[i]] = i;
     for (i = 0; i < n; i++) {
-        tt__hier_adjacent *a = &H->adjacent[i];
+        tt__hier_adjacent *a = &W->adjacent[i];
         for (j = 0; j < 3; j++) {
-            int c = m->face_start[fl[i]] + j, g = H->across[c];
+            int c = 3 * fl[i] + j, g = H->across[c];
             a->face[j] = g >= 0 && H->region[g] == p ? H->local[g] : -1;
             a->step[j] = H->step[c];
         }
     }
 }
 
-/* Dijkstra over the parent's faces (local numbering) from the faces
-   already in the heap, staying within one cell when `within_cell` (label[]
-   then fixed), else giving each face it brings closer the label of the face
-   it came from. */
-static void tt__hier_dijkstra(tt__hier *H, int nheap, int within_cell)
+/* Corner c (of local face c's face) and the face across its edge are both
+   in cell `cell` of the localized parent. */
+static int tt__hier_inside(const tt__hier *H, const tt__hier_work *W, int c, int cell)
+{
+    int g = W->adjacent[H->local[c / 3]].face[c % 3];
+    return g >= 0 && W->cell[g] == cell;
+}
+
+/* Topology of cell `cell` of the localized parent (its faces fl[faces[i]],
+   i < n): its flags (TT_CLUSTER_DISC or 0) and its number of border loops.
+   A disc has one border loop meeting no vertex twice and V - E + F = 1
+   (the faces are edge-connected by construction: components, and Voronoi
+   cells whose faces each joined through a neighbour of the same cell).
+   Counted without marks on the vertices, which parents split at the same
+   time share: V as the fans of the cell's faces around each vertex - one
+   per border half-edge (each fan that does not close ends at one) and one
+   per closed fan, counted at its smallest corner - which is the vertex
+   count wherever the border meets no vertex twice, the only case where V
+   decides; that, by the border half-edges' first vertices, sorted. The
+   loops are walked through cmark, cleared first on the cell's corners. */
+static unsigned tt__hier_cell_topology(tt__hier *H, tt__hier_work *W, const int *fl, const int *faces, int n,
+                                       int cell, int *nloops)
+{
+    const tt_mesh *m = H->mesh;
+    long v = 0, e2 = 0, border = 0, border_verts = 0;
+    int i, j, loops = 0;
+    for (i = 0; i < n; i++)
+        for (j = 0; j < 3; j++) {
+            int c = 3 * fl[faces[i]] + j;
+            H->cmark[c] = 0;
+            if (tt__hier_inside(H, W, c, cell)) {
+                int x = c, guard;
+                e2 += 1;
+                /* a closed fan, counted at its smallest corner */
+                for (guard = 0; guard <= m->ncorners; guard++) {
+                    if (!tt__hier_inside(H, W, x, cell)) break;
+                    x = tt__tri_next(m->twin[x]);
+                    if (x <= c) {
+                        v += x == c;
+                        break;
+                    }
+                }
+            } else {
+                e2 += 2;
+                W->origins[border++] = m->corner_vert[c];
+            }
+        }
+    v += border;
+    tt__sort_ints(W->origins, (int)border);
+    for (i = 0; i < border; i++) border_verts += i == 0 || W->origins[i] != W->origins[i - 1];
+    for (i = 0; i < n; i++)
+        for (j = 0; j < 3; j++) {
+            int c = 3 * fl[faces[i]] + j, h = c, guard;
+            if (H->cmark[c] || tt__hier_inside(H, W, c, cell)) continue;
+            loops++;
+            for (guard = 0; guard <= m->ncorners && !H->cmark[h]; guard++) {
+                int x = tt__tri_next(h), turn;
+                H->cmark[h] = 1;
+                for (turn = 0; turn < m->ncorners && tt__hier_inside(H, W, x, cell); turn++)
+                    x = tt__tri_next(m->twin[x]);
+                h = x;
+            }
+        }
+    *nloops = loops;
+    return (loops == 1 && border == border_verts && v - e2 / 2 + n == 1) ? (unsigned)TT_CLUSTER_DISC : 0u;
+}
+
+/* Dijkstra over the localized parent's faces from the faces already in the
+   heap, staying within one cell when `within_cell` (cell[] then fixed),
+   else giving each face it brings closer the cell of the face it came
+   from. */
+static void tt__hier_dijkstra(tt__hier_work *W, int nheap, int within_cell)
 {
     while (nheap > 0) {
-        tt__heap_item top = tt__heap_pop(H->heap, &nheap);
+        tt__heap_item top = tt__heap_pop(W->heap, &nheap);
         const tt__hier_adjacent *a;
         int g = top.value, j;
-        if (top.key > H->dist[g]) continue;
-        a = &H->adjacent[g];
+        if (top.key > W->dist[g]) continue;
+        a = &W->adjacent[g];
         for (j = 0; j < 3; j++) {
             int h = a->face[j];
             double d;
-            if (h < 0 || (within_cell && H->label[h] != H->label[g])) continue;
+            if (h < 0 || (within_cell && W->cell[h] != W->cell[g])) continue;
             d = top.key + a->step[j];
-            if (d < H->dist[h]) {
-                H->dist[h] = d;
-                if (!within_cell) H->label[h] = H->label[g];
-                tt__heap_push(H->heap, &nheap, d, h);
+            if (d < W->dist[h]) {
+                W->dist[h] = d;
+                if (!within_cell) W->cell[h] = W->cell[g];
+                tt__heap_push(W->heap, &nheap, d, h);
             }
         }
     }
 }
 
 /* Geodesic Voronoi split of the localized parent (n faces) into k cells:
-   farthest-point seeds, the first one random, each added by a Dijkstra
-   from it that takes every face it brings closer. label[0..n-1] gets the
-   cells 0..k-1; each cell holds its seed and is edge-connected. */
-static void tt__hier_voronoi(tt__hier *H, int n, int k)
+   farthest-point seeds, the first one drawn from W->rng, each added by a
+   Dijkstra from it that takes every face it brings closer. cell[0..n-1]
+   gets the cells 0..k-1; each cell holds its seed and is edge-connected. */
+static void tt__hier_voronoi(tt__hier_work *W, int n, int k)
 {
-    int i, j, iter, seed = (int)tt_rng_below(&H->rng, (uint32_t)n), smark = ++H->stamp;
+    int i, j, iter, seed = (int)tt_rng_below(&W->rng, (uint32_t)n);
     for (i = 0; i < n; i++) {
-        H->dist[i] = HUGE_VAL;
-        H->label[i] = -1;
+        W->dist[i] = HUGE_VAL;
+        W->cell[i] = -1;
+        W->seed[i] = 0;
     }
     for (j = 0; j < k; j++) {
         int nheap = 0;
         if (j > 0) {
             double far = -1.0;
             for (i = 0; i < n; i++)
-                if (H->fstamp[i] != smark && H->dist[i] > far) { far = H->dist[i]; seed = i; }
+                if (!W->seed[i] && W->dist[i] > far) { far = W->dist[i]; seed = i; }
         }
-        H->fstamp[seed] = smark;
-        H->dist[seed] = 0.0;
-        H->label[seed] = j;
-        tt__heap_push(H->heap, &nheap, 0.0, seed);
-        tt__hier_dijkstra(H, nheap, 0);
+        W->seed[seed] = 1;
+        W->dist[seed] = 0.0;
+        W->cell[seed] = j;
+        tt__heap_push(W->heap, &nheap, 0.0, seed);
+        tt__hier_dijkstra(W, nheap, 0);
     }
     /* Lloyd-like relaxation, for evener sizes (spec 1.1 step 3): move each
        seed to its cell's centre, the face farthest from the cell's border
-       (ties: the smallest face index), and partition again. The seeds live
-       in scratch[0..k-1], the centres' distances in loops[0..k-1]. */
+       (ties: the smallest face index), and partition again. */
     for (iter = 0; iter < TT__HIER_RELAX; iter++) {
         int nheap = 0;
         for (i = 0; i < n; i++) {
-            const tt__hier_adjacent *a = &H->adjacent[i];
+            const tt__hier_adjacent *a = &W->adjacent[i];
             int border = 0;
-            for (j = 0; j < 3; j++) border |= a->face[j] < 0 || H->label[a->face[j]] != H->label[i];
-            H->dist[i] = border ? 0.0 : HUGE_VAL;
-            if (border) tt__heap_push(H->heap, &nheap, 0.0, i);
+            for (j = 0; j < 3; j++) border |= a->face[j] < 0 || W->cell[a->face[j]] != W->cell[i];
+            W->dist[i] = border ? 0.0 : HUGE_VAL;
+            if (border) tt__heap_push(W->heap, &nheap, 0.0, i);
         }
-        tt__hier_dijkstra(H, nheap, 1);
-        for (j = 0; j < k; j++) H->loops[j] = -1.0;
+        tt__hier_dijkstra(W, nheap, 1);
+        for (j = 0; j < k; j++) W->centre[j] = -1.0;
         for (i = 0; i < n; i++) {
-            int cell = H->label[i];
-            if (H->dist[i] > H->loops[cell]) { H->loops[cell] = H->dist[i]; H->scratch[cell] = i; }
+            int c = W->cell[i];
+            if (W->dist[i] > W->centre[c]) { W->centre[c] = W->dist[i]; W->seed[c] = i; }
         }
         nheap = 0;
-        for (i = 0; i < n; i++) H->dist[i] = HUGE_VAL;
+        for (i = 0; i < n; i++) W->dist[i] = HUGE_VAL;
         for (j = 0; j < k; j++) {
-            H->dist[H->scratch[j]] = 0.0;
-            H->label[H->scratch[j]] = j;
-            tt__heap_push(H->heap, &nheap, 0.0, H->scratch[j]);
+            W->dist[W->seed[j]] = 0.0;
+            W->cell[W->seed[j]] = j;
+            tt__heap_push(W->heap, &nheap, 0.0, W->seed[j]);
         }
-        tt__hier_dijkstra(H, nheap, 0);
+        tt__hier_dijkstra(W, nheap, 0);
     }
 }
 
@@ -15065,93 +15158,160 @@ static int tt__hier_reserve(tt__hier *H, int clusters, int faces, int control, i
     return 1;
 }
 
-/* Split cluster p (more than one face) into its children, appended. */
-static int tt__hier_split(tt__hier *H, int p)
+/* The faces of the localized parent (n faces) in order of their cells
+   (cells[i] < k), into W->order; cell j's end into W->seed[j]. Counted in
+   W->origins (k + 1 <= 3 n entries), free until the topology. */
+static void tt__hier_order(tt__hier_work *W, const int *cells, int n, int k)
 {
-    tt_cluster P = H->cl[p];
-    int n = P.nfaces, i, j, k, attempt, best_bad = INT_MAX, best_k = 0, base = H->ncl;
-    double target = H->comp_area[P.component] / pow((double)H->branching, (double)(P.level + 1));
-    double x = target > 0.0 ? P.area / target : 0.0;
-    int *fl, *count;
+    int *count = W->origins, i, j;
+    for (j = 0; j <= k; j++) count[j] = 0;
+    for (i = 0; i < n; i++) count[cells[i] + 1]++;
+    for (j = 0; j < k; j++) count[j + 1] += count[j];
+    for (i = 0; i < n; i++) W->order[count[cells[i]]++] = i;
+    for (j = 0; j < k; j++) W->seed[j] = count[j];
+}
+
+/* Split parent p (more than one face) into cells, with W: its faces get
+   their cell in H->cell, p its child count in nchildren, the cells their
+   flags and loops in H->child_flags / child_loops at entry `at` + cell. */
+static void tt__hier_split(tt__hier *H, tt__hier_work *W, int p, int at)
+{
+    tt_cluster *P = &H->cl[p];
+    const int *fl = H->faces + P->first_face;
+    int n = P->nfaces, i, j, k, attempt, best_bad = INT_MAX, best_k = 0, nloops;
+    double target = H->comp_area[P->component] / pow((double)H->branching, (double)(P->level + 1));
+    double x = target > 0.0 ? P->area / target : 0.0;
     k = x < (double)n ? (int)floor(x + 0.5) : n;     /* NaN and infinity: n */
     k = tt__min_i(tt__max_i(k, 2), n);
-    tt__hier_localize(H, p, H->faces + P.first_face, n);
+    tt_rng_seed(&W->rng, H->seed, TT__HIER_STREAM + (uint64_t)p);
+    tt__hier_localize(H, W, p, fl, n);
     for (attempt = 0; attempt <= TT_CLUSTER_RESEEDS && k + attempt <= n; attempt++) {
-        int bad = 0, nloops;
-        fl = H->faces + P.first_face;
-        tt__hier_voronoi(H, n, k + attempt);
-        for (i = 0; i < n; i++) H->region[fl[i]] = base + H->label[i];
-        /* Each cell's faces, ascending, into scratch; count[j] then ends
-           cell j. */
-        count = H->scratch + n;
-        for (j = 0; j <= k + attempt; j++) count[j] = 0;
-        for (i = 0; i < n; i++) count[H->label[i] + 1]++;
-        for (j = 0; j < k + attempt; j++) count[j + 1] += count[j];
-        for (i = 0; i < n; i++) H->scratch[count[H->label[i]]++] = fl[i];
+        int bad = 0;
+        tt__hier_voronoi(W, n, k + attempt);
+        tt__hier_order(W, W->cell, n, k + attempt);
         for (j = 0; j < k + attempt; j++) {
-            int start = j > 0 ? count[j - 1] : 0;
-            if (!(tt__hier_topology(H, base + j, H->scratch + start, count[j] - start, &nloops) & TT_CLUSTER_DISC))
+            int start = j > 0 ? W->seed[j - 1] : 0;
+            if (!(tt__hier_cell_topology(H, W, fl, W->order + start, W->seed[j] - start, j, &nloops) &
+                  TT_CLUSTER_DISC))
                 bad++;
         }
-        for (i = 0; i < n; i++) H->region[fl[i]] = p;
         if (bad < best_bad) {
             best_bad = bad;
             best_k = k + attempt;
-            for (i = 0; i < n; i++) H->best[i] = H->label[i];
+            for (i = 0; i < n; i++) W->best[i] = W->cell[i];
         }
         if (bad == 0) break;
     }
-    if (!tt__hier_reserve(H, best_k, n, 0, 0)) return 0;
-    fl = H->faces + P.first_face;
-    count = H->scratch;
-    for (j = 0; j <= best_k; j++) count[j] = 0;
-    for (i = 0; i < n; i++) count[H->best[i] + 1]++;
-    for (j = 0; j < best_k; j++) count[j + 1] += count[j];
+    for (i = 0; i < n; i++) W->cell[i] = W->best[i];
+    tt__hier_order(W, W->cell, n, best_k);
     for (j = 0; j < best_k; j++) {
-        tt_cluster *ch = &H->cl[base + j];
-        memset(ch, 0, sizeof *ch);
-        ch->level = P.level + 1;
-        ch->parent = p;
-        ch->first_child = -1;
-        ch->first_face = H->nfe + count[j];
-        ch->nfaces = count[j + 1] - count[j];
-        ch->component = P.component;
+        int start = j > 0 ? W->seed[j - 1] : 0;
+        H->child_flags[at + j] =
+            tt__hier_cell_topology(H, W, fl, W->order + start, W->seed[j] - start, j, &H->child_loops[at + j]);
     }
-    for (i = 0; i < n; i++) {
-        tt_cluster *ch = &H->cl[base + H->best[i]];
-        H->faces[H->nfe + count[H->best[i]]++] = fl[i];
-        H->region[fl[i]] = base + H->best[i];
-        ch->area += H->farea[fl[i]];
+    for (i = 0; i < n; i++) H->cell[fl[i]] = W->cell[i];
+    P->nchildren = best_k;
+}
+
+/* A level's clusters in ranges of `grain`, as tasks: at most 64 ranges
+   (the shared working arrays are sized for that). */
+static int tt__hier_grain(int count)
+{
+    return count > 64 ? (count + 63) / 64 : 1;
+}
+
+/* The splits of one level (clusters ls .. le - 1): ranges of parents as
+   tasks, each with its own working arrays; failed[range] set when they
+   could not be allocated. */
+typedef struct tt__hier_split_job {
+    tt__hier *H;
+    int ls, le, grain, nranges;
+    int *failed;                /* per range: its working arrays could not be allocated */
+} tt__hier_split_job;
+
+/* A range's part: its largest cluster's faces. */
+static int tt__hier_range_largest(const tt__hier *H, int ls, int begin, int end)
+{
+    int id, largest = 0;
+    for (id = ls + begin; id < ls + end; id++) largest = tt__max_i(largest, H->cl[id].nfaces);
+    return largest;
+}
+
+static void tt__hier_split_range(void *context, int begin, int end)
+{
+    const tt__hier_split_job *job = (const tt__hier_split_job *)context;
+    tt__hier *H = job->H;
+    tt__hier_work W;
+    int id, first = H->cl[job->ls].first_face, capacity = tt__hier_range_largest(H, job->ls, begin, end);
+    if (capacity <= 1) return;
+    if (job->nranges == 1) {
+        W = H->work;
+    } else if (!tt__hier_work_alloc(H->al, &W, capacity)) {
+        job->failed[begin / job->grain] = 1;
+        return;
     }
-    H->nfe += n;
-    H->ncl += best_k;
-    H->cl[p].first_child = base;
-    H->cl[p].nchildren = best_k;
-    for (j = 0; j < best_k; j++) {
-        tt_cluster *ch = &H->cl[base + j];
-        ch->flags = tt__hier_topology(H, base + j, H->faces + ch->first_face, ch->nfaces, &ch->nloops);
+    for (id = job->ls + begin; id < job->ls + end; id++)
+        if (H->cl[id].nfaces > 1) tt__hier_split(H, &W, id, H->cl[id].first_face - first);
+    if (job->nranges > 1) tt__hier_work_free(H->al, &W);
+}
+
+/* The children of the split parents ls .. le - 1, appended in order. */
+static int tt__hier_children(tt__hier *H, int ls, int le)
+{
+    int id, i, j, first = H->cl[ls].first_face;
+    for (id = ls; id < le; id++) {
+        int n = H->cl[id].nfaces, k = H->cl[id].nchildren, base = H->ncl, *count = H->scratch;
+        const int *fl;
+        if (n <= 1) continue;
+        if (!tt__hier_reserve(H, k, n, 0, 0)) return 0;
+        fl = H->faces + H->cl[id].first_face;
+        for (j = 0; j <= k; j++) count[j] = 0;
+        for (i = 0; i < n; i++) count[H->cell[fl[i]] + 1]++;
+        for (j = 0; j < k; j++) count[j + 1] += count[j];
+        for (j = 0; j < k; j++) {
+            tt_cluster *ch = &H->cl[base + j];
+            memset(ch, 0, sizeof *ch);
+            ch->level = H->cl[id].level + 1;
+            ch->parent = id;
+            ch->first_child = -1;
+            ch->first_face = H->nfe + count[j];
+            ch->nfaces = count[j + 1] - count[j];
+            ch->component = H->cl[id].component;
+            ch->flags = H->child_flags[H->cl[id].first_face - first + j];
+            ch->nloops = H->child_loops[H->cl[id].first_face - first + j];
+        }
+        for (i = 0; i < n; i++) {
+            int c = H->cell[fl[i]];
+            H->faces[H->nfe + count[c]++] = fl[i];
+            H->region[fl[i]] = base + c;
+            H->cl[base + c].area += H->farea[fl[i]];
+        }
+        H->nfe += n;
+        H->ncl += k;
+        H->cl[id].first_child = base;
     }
     return 1;
 }
 
 /* Control vertices of the border loop through border half-edge h0 of
-   cluster id (spec D12), appended to H->control (room reserved by the
-   caller: at most the loop's length); marks the loop's half-edges with
-   `mark`. */
-static void tt__hier_loop_control(tt__hier *H, int id, int h0, int mark, int single_face)
+   cluster id (spec D12), appended to out[*count..]; marks the loop's
+   half-edges in cmark. loopv, loops and loopc hold the loop (its length at
+   most the cluster's border half-edges). */
+static void tt__hier_loop_control(tt__hier *H, int id, int h0, int single_face, int *loopv, double *loops,
+                                  unsigned char *loopc, int *out, int *nout)
 {
     const tt_mesh *m = H->mesh;
     int len = 0, h = h0, i, j, count = 0, target, first, guard;
     double perimeter = 0.0;
-    for (guard = 0; guard <= m->ncorners && H->cstamp[h] != mark; guard++) {
+    for (guard = 0; guard <= m->ncorners && !H->cmark[h]; guard++) {
         const float *a = m->pos + 3 * (size_t)m->corner_vert[h];
         const float *b = m->pos + 3 * (size_t)m->corner_vert[tt__tri_next(h)];
         double d[3];
-        H->cstamp[h] = mark;
-        H->loopv[len] = m->corner_vert[h];
-        H->loopc[len] = (unsigned char)(single_face || H->vcount[m->corner_vert[h]] >= 3);
-        count += H->loopc[len];
-        H->loops[len] = perimeter;
+        H->cmark[h] = 1;
+        loopv[len] = m->corner_vert[h];
+        loopc[len] = (unsigned char)(single_face || H->vcount[m->corner_vert[h]] >= 3);
+        count += loopc[len];
+        loops[len] = perimeter;
         tt__sub3f(b, a, d);
         perimeter += tt__length3(d);
         len++;
@@ -15165,12 +15325,12 @@ static void tt__hier_loop_control(tt__hier *H, int id, int h0, int mark, int sin
             double want = perimeter * j / target;
             i = 0;
             if (perimeter > 0.0) {
-                while (i < len - 1 && H->loops[i] < want) i++;
+                while (i < len - 1 && loops[i] < want) i++;
             } else {
                 i = (int)((long)len * j / target);
             }
-            while (H->loopc[i]) i = (i + 1) % len;
-            H->loopc[i] = 1;
+            while (loopc[i]) i = (i + 1) % len;
+            loopc[i] = 1;
             count++;
         }
     }
@@ -15181,36 +15341,48 @@ static void tt__hier_loop_control(tt__hier *H, int id, int h0, int mark, int sin
         double barc = -1.0, mid, bdist = HUGE_VAL;
         for (i = 0; i < len; i++) {
             double arc;
-            if (!H->loopc[i]) continue;
+            if (!loopc[i]) continue;
             j = (i + 1) % len;
-            while (!H->loopc[j]) j = (j + 1) % len;
+            while (!loopc[j]) j = (j + 1) % len;
             if (j == (i + 1) % len) continue;
-            arc = H->loops[j] - H->loops[i] + (j <= i ? perimeter : 0.0);
+            arc = loops[j] - loops[i] + (j <= i ? perimeter : 0.0);
             if (arc > barc) { barc = arc; bi = i; bj = j; }
         }
         if (bi < 0) break;
-        mid = H->loops[bi] + 0.5 * barc;
+        mid = loops[bi] + 0.5 * barc;
         for (i = (bi + 1) % len; i != bj; i = (i + 1) % len) {
-            double at = H->loops[i] + (i <= bi ? perimeter : 0.0);
+            double at = loops[i] + (i <= bi ? perimeter : 0.0);
             if (fabs(at - mid) < bdist) { bdist = fabs(at - mid); bk = i; }
         }
-        H->loopc[bk] = 1;
+        loopc[bk] = 1;
         count++;
     }
-    for (first = 0; first < len && !H->loopc[first]; first++) {}
+    for (first = 0; first < len && !loopc[first]; first++) {}
     for (i = 0; i < len; i++) {
         int at = (first + i) % len;
-        if (H->loopc[at]) H->control[H->nctl++] = H->loopv[at];
+        if (loopc[at]) out[(*nout)++] = loopv[at];
     }
 }
 
-/* The neighbours, control vertices and mappable flag of the clusters
-   ls .. le - 1 of one level, from region[] at that level. */
-static int tt__hier_level(tt__hier *H, int ls, int le)
+/* The level pass (clusters ls .. le - 1, from region[] at that level): per
+   vertex, the regions around it; per cluster, its neighbours and control
+   vertices, found by ranges of clusters as tasks into their own lists
+   (lists[range]: per cluster its neighbours then its control vertices, the
+   counts in the cluster, first_neighbour and first_control relative to
+   the list), then appended in order. */
+typedef struct tt__hier_level_job {
+    tt__hier *H;
+    int ls, grain, nranges;
+    int **lists;                /* per range: its list (H->list for a level that is one task), or NULL
+                                   when it could not be allocated */
+} tt__hier_level_job;
+
+static void tt__hier_vcount_range(void *context, int begin, int end)
 {
+    tt__hier *H = (tt__hier *)context;
     const tt_mesh *m = H->mesh;
-    int v, id, i, c;
-    for (v = 0; v < H->nv; v++) {
+    int v, i;
+    for (v = begin; v < end; v++) {
         int r0 = -1, r1 = -1, n = H->vboundary[v];
         for (i = H->vstart[v]; i < H->vstart[v + 1] && n < 3; i++) {
             int r = H->region[m->corner_face[H->vcorner[i]]];
@@ -15220,30 +15392,110 @@ static int tt__hier_level(tt__hier *H, int ls, int le)
         }
         H->vcount[v] = (unsigned char)n;
     }
-    for (id = ls; id < le; id++) {
-        int n = H->cl[id].nfaces, nn = 0, unique = 0, mark;
-        const int *fl = H->faces + H->cl[id].first_face;
-        for (i = 0; i < n; i++)
-            for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++)
-                if (tt__hier_border(H, id, c) && m->twin[c] >= 0)
-                    H->scratch[nn++] = H->region[H->across[c]];
-        tt__sort_ints(H->scratch, nn);
-        for (i = 0; i < nn; i++)
-            if (i == 0 || H->scratch[i] != H->scratch[i - 1]) H->scratch[unique++] = H->scratch[i];
-        if (!tt__hier_reserve(H, 0, 0, 3 * n, unique)) return 0;
-        fl = H->faces + H->cl[id].first_face;
-        H->cl[id].first_neighbour = H->nnb;
-        H->cl[id].nneighbours = unique;
-        for (i = 0; i < unique; i++) H->nb[H->nnb++] = H->scratch[i];
-        mark = ++H->stamp;
-        H->cl[id].first_control = H->nctl;
-        for (i = 0; i < n; i++)
-            for (c = m->face_start[fl[i]]; c < m->face_start[fl[i] + 1]; c++)
-                if (H->cstamp[c] != mark && tt__hier_border(H, id, c)) tt__hier_loop_control(H, id, c, mark, n == 1);
-        H->cl[id].ncontrol = H->nctl - H->cl[id].first_control;
-        if ((H->cl[id].flags & TT_CLUSTER_DISC) && H->cl[id].ncontrol >= 3) H->cl[id].flags |= TT_CLUSTER_MAPPABLE;
+}
+
+static void tt__hier_level_range(void *context, int begin, int end)
+{
+    const tt__hier_level_job *job = (const tt__hier_level_job *)context;
+    tt__hier *H = job->H;
+    int id, i, c, at = 0, r = begin / job->grain, faces = 0;
+    int largest = tt__hier_range_largest(H, job->ls, begin, end);
+    int *list = H->list, *loopv = H->loopv;
+    double *loops = H->loops;
+    unsigned char *loopc = H->loopc;
+    if (job->nranges > 1) {
+        for (id = job->ls + begin; id < job->ls + end; id++) faces += H->cl[id].nfaces;
+        list = TT__ALLOC(H->al, int, 6 * (size_t)faces);
+        loopv = TT__ALLOC(H->al, int, 3 * (size_t)largest);
+        loops = TT__ALLOC(H->al, double, 3 * (size_t)largest);
+        loopc = TT__ALLOC(H->al, unsigned char, 3 * (size_t)largest);
+        if (!list || !loopv || !loops || !loopc) {
+            tt__free(H->al, list);
+            list = NULL;
+        }
     }
-    return 1;
+    job->lists[r] = list;
+    for (id = job->ls + begin; id < job->ls + end && list; id++) {
+        tt_cluster *C = &H->cl[id];
+        const int *fl = H->faces + C->first_face;
+        int n = C->nfaces, nn = 0, unique = 0, ncontrol = 0;
+        for (i = 0; i < n; i++)
+            for (c = 3 * fl[i]; c < 3 * fl[i] + 3; c++) {
+                H->cmark[c] = 0;
+                if (tt__hier_border(H, id, c) && H->across[c] >= 0) list[at + nn++] = H->region[H->across[c]];
+            }
+        tt__sort_ints(list + at, nn);
+        for (i = 0; i < nn; i++)
+            if (i == 0 || list[at + i] != list[at + i - 1]) list[at + unique++] = list[at + i];
+        C->first_neighbour = at;
+        C->nneighbours = unique;
+        at += unique;
+        for (i = 0; i < n; i++)
+            for (c = 3 * fl[i]; c < 3 * fl[i] + 3; c++)
+                if (!H->cmark[c] && tt__hier_border(H, id, c))
+                    tt__hier_loop_control(H, id, c, n == 1, loopv, loops, loopc, list + at, &ncontrol);
+        C->first_control = at;
+        C->ncontrol = ncontrol;
+        at += ncontrol;
+        if ((C->flags & TT_CLUSTER_DISC) && C->ncontrol >= 3) C->flags |= TT_CLUSTER_MAPPABLE;
+    }
+    if (job->nranges > 1) {
+        tt__free(H->al, loopv);
+        tt__free(H->al, loops);
+        tt__free(H->al, loopc);
+    }
+}
+
+static int tt__hier_level(tt__hier *H, int ls, int le)
+{
+    tt__hier_level_job job;
+    int nranges, r, id, i, ok = 1;
+    tt__parallel_ranges(H->executor, H->nv, 4096, tt__hier_vcount_range, H);
+    job.H = H;
+    job.ls = ls;
+    job.grain = tt__hier_grain(le - ls);
+    nranges = job.nranges = tt__range_count(le - ls, job.grain);
+    job.lists = TT__ALLOC(H->al, int *, (size_t)nranges);
+    if (!job.lists) return 0;
+    tt__parallel_ranges(H->executor, le - ls, job.grain, tt__hier_level_range, &job);
+    for (r = 0; r < nranges; r++) ok &= job.lists[r] != NULL;
+    for (id = ls; id < le && ok; id++) {
+        tt_cluster *C = &H->cl[id];
+        const int *list = job.lists[(id - ls) / job.grain];
+        if (!tt__hier_reserve(H, 0, 0, C->ncontrol, C->nneighbours)) {
+            ok = 0;
+            break;
+        }
+        for (i = 0; i < C->nneighbours; i++) H->nb[H->nnb + i] = list[C->first_neighbour + i];
+        for (i = 0; i < C->ncontrol; i++) H->control[H->nctl + i] = list[C->first_control + i];
+        C->first_neighbour = H->nnb;
+        C->first_control = H->nctl;
+        H->nnb += C->nneighbours;
+        H->nctl += C->ncontrol;
+    }
+    if (nranges > 1)
+        for (r = 0; r < nranges; r++) tt__free(H->al, job.lists[r]);
+    tt__free(H->al, job.lists);
+    return ok;
+}
+
+/* The splits of level ls .. le - 1 as tasks, then their children. */
+static int tt__hier_splits(tt__hier *H, int ls, int le)
+{
+    tt__hier_split_job job;
+    int nranges, r, ok = 1;
+    job.H = H;
+    job.ls = ls;
+    job.le = le;
+    job.grain = tt__hier_grain(le - ls);
+    nranges = job.nranges = tt__range_count(le - ls, job.grain);
+    job.failed = TT__ALLOC(H->al, int, (size_t)nranges);
+    if (!job.failed) return 0;
+    for (r = 0; r < nranges; r++) job.failed[r] = 0;
+    tt__parallel_ranges(H->executor, le - ls, job.grain, tt__hier_split_range, &job);
+    for (r = 0; r < nranges; r++) ok &= !job.failed[r];
+    tt__free(H->al, job.failed);
+    return ok && tt__hier_children(H, ls, le);
 }
 
 static void tt__hier_release(tt__hier *H)
@@ -15255,23 +15507,21 @@ static void tt__hier_release(tt__hier *H)
     tt__free(al, H->farea);
     tt__free(al, H->comp_area);
     tt__free(al, H->region);
+    tt__free(al, H->local);
+    tt__free(al, H->cell);
+    tt__free(al, H->child_flags);
+    tt__free(al, H->child_loops);
+    tt__free(al, H->scratch);
+    tt__hier_work_free(al, &H->work);
+    tt__free(al, H->list);
+    tt__free(al, H->loopv);
+    tt__free(al, H->loops);
+    tt__free(al, H->loopc);
     tt__free(al, H->vstart);
     tt__free(al, H->vcorner);
     tt__free(al, H->vboundary);
     tt__free(al, H->vcount);
-    tt__free(al, H->vstamp);
-    tt__free(al, H->cstamp);
-    tt__free(al, H->fstamp);
-    tt__free(al, H->dist);
-    tt__free(al, H->label);
-    tt__free(al, H->local);
-    tt__free(al, H->adjacent);
-    tt__free(al, H->best);
-    tt__free(al, H->scratch);
-    tt__free(al, H->heap);
-    tt__free(al, H->loopv);
-    tt__free(al, H->loops);
-    tt__free(al, H->loopc);
+    tt__free(al, H->cmark);
     tt__free(al, H->cl);
     tt__free(al, H->faces);
     tt__free(al, H->control);
@@ -15280,10 +15530,12 @@ static void tt__hier_release(tt__hier *H)
 }
 
 /* Level 0: one cluster per connected component (region[] holds the
-   component ids), faces ascending. */
+   component ids), faces ascending; each component's topology with one
+   task's working arrays (a component is one cell of itself). */
 static int tt__hier_components(tt__hier *H, int ncomp)
 {
-    int f, j, *count = H->scratch;
+    tt__hier_work *W;
+    int f, j, i, largest = 0, *count = H->scratch;
     if (!tt__hier_reserve(H, ncomp, H->nf, 0, 0)) return 0;
     for (j = 0; j <= ncomp; j++) count[j] = 0;
     for (f = 0; f < H->nf; f++) count[H->region[f] + 1]++;
@@ -15302,10 +15554,26 @@ static int tt__hier_components(tt__hier *H, int ncomp)
     }
     H->nfe = H->nf;
     H->ncl = ncomp;
+    /* the build's own working arrays, for the largest component; each
+       component's topology: one cell of itself */
+    for (j = 0; j < ncomp; j++) largest = tt__max_i(largest, H->cl[j].nfaces);
+    if (!tt__hier_work_alloc(H->al, &H->work, largest)) return 0;
+    H->list = TT__ALLOC(H->al, int, 6 * (size_t)H->nf);
+    H->loopv = TT__ALLOC(H->al, int, 3 * (size_t)largest);
+    H->loops = TT__ALLOC(H->al, double, 3 * (size_t)largest);
+    H->loopc = TT__ALLOC(H->al, unsigned char, 3 * (size_t)largest);
+    if (!H->list || !H->loopv || !H->loops || !H->loopc) return 0;
+    W = &H->work;
     for (j = 0; j < ncomp; j++) {
         tt_cluster *C = &H->cl[j];
+        const int *fl = H->faces + C->first_face;
         H->comp_area[j] = C->area;
-        C->flags = tt__hier_topology(H, j, H->faces + C->first_face, C->nfaces, &C->nloops);
+        tt__hier_localize(H, W, j, fl, C->nfaces);
+        for (i = 0; i < C->nfaces; i++) {
+            W->cell[i] = 0;
+            W->order[i] = i;
+        }
+        C->flags = tt__hier_cell_topology(H, W, fl, W->order, C->nfaces, 0, &C->nloops);
     }
     return 1;
 }
@@ -15344,7 +15612,8 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
     H.nf = mesh->nfaces;
     H.nv = mesh->nverts;
     H.branching = branching;
-    tt_rng_seed(&H.rng, options ? options->seed : 0u, 0x48504du);   /* stream "HPM" */
+    H.seed = options ? options->seed : 0u;
+    H.executor = options ? options->executor : NULL;
     nf = (size_t)H.nf;
     nc = (size_t)mesh->ncorners;
     H.centroid = TT__ALLOC(allocator, double, 3 * nf);
@@ -15357,22 +15626,15 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
     H.vcorner = TT__ALLOC(allocator, int, nc);
     H.vboundary = TT__ALLOC(allocator, unsigned char, (size_t)H.nv);
     H.vcount = TT__ALLOC(allocator, unsigned char, (size_t)H.nv);
-    H.vstamp = TT__ALLOC(allocator, int, (size_t)H.nv);
-    H.cstamp = TT__ALLOC(allocator, int, nc);
-    H.fstamp = TT__ALLOC(allocator, int, nf);
-    H.dist = TT__ALLOC(allocator, double, nf);
-    H.label = TT__ALLOC(allocator, int, nf);
+    H.cmark = TT__ALLOC(allocator, unsigned char, nc);
     H.local = TT__ALLOC(allocator, int, nf);
-    H.adjacent = TT__ALLOC(allocator, struct tt__hier_adjacent, nf);
-    H.best = TT__ALLOC(allocator, int, nf);
-    H.scratch = TT__ALLOC(allocator, int, 3 * nf + 1);
-    H.heap = TT__ALLOC(allocator, tt__heap_item, 4 * nf + 1);
-    H.loopv = TT__ALLOC(allocator, int, nc);
-    H.loops = TT__ALLOC(allocator, double, nc);
-    H.loopc = TT__ALLOC(allocator, unsigned char, nc);
-    if (!H.centroid || !H.step || !H.across || !H.farea || !H.comp_area || !H.region || !H.vstart || !H.vcorner || !H.vboundary ||
-        !H.vcount || !H.vstamp || !H.cstamp || !H.fstamp || !H.dist || !H.label || !H.local || !H.adjacent ||
-        !H.best || !H.scratch || !H.heap || !H.loopv || !H.loops || !H.loopc)
+    H.cell = TT__ALLOC(allocator, int, nf);
+    H.child_flags = TT__ALLOC(allocator, unsigned, nf);
+    H.child_loops = TT__ALLOC(allocator, int, nf);
+    H.scratch = TT__ALLOC(allocator, int, nf + 1);
+    if (!H.centroid || !H.step || !H.across || !H.farea || !H.comp_area || !H.region || !H.vstart || !H.vcorner ||
+        !H.vboundary || !H.vcount || !H.cmark || !H.local || !H.cell || !H.child_flags || !H.child_loops ||
+        !H.scratch)
         goto oom;
     if (tt_mesh_components(mesh, allocator, H.region, &ncomp, NULL) != TT_OK) goto oom;
 
@@ -15387,7 +15649,6 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
         tt__sub3f(p2, p0, e2);
         tt__cross3(e1, e2, n);
         H.farea[f] = 0.5 * tt__length3(n);
-        H.fstamp[f] = 0;
     }
     for (c = 0; c < mesh->ncorners; c++) H.across[c] = mesh->twin[c] < 0 ? -1 : mesh->corner_face[mesh->twin[c]];
     for (c = 0; c < mesh->ncorners; c++)
@@ -15398,10 +15659,9 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
     tt__free(allocator, H.centroid);
     H.centroid = NULL;
     for (v = 0; v <= H.nv; v++) H.vstart[v] = 0;
-    for (v = 0; v < H.nv; v++) H.vboundary[v] = 0, H.vstamp[v] = 0;
+    for (v = 0; v < H.nv; v++) H.vboundary[v] = 0;
     for (c = 0; c < mesh->ncorners; c++) {
         H.vstart[mesh->corner_vert[c] + 1]++;
-        H.cstamp[c] = 0;
         if (mesh->twin[c] < 0) {
             H.vboundary[mesh->corner_vert[c]] = 1;
             H.vboundary[mesh->corner_vert[tt__tri_next(c)]] = 1;
@@ -15414,16 +15674,14 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
 
     if (!tt__hier_components(&H, ncomp)) goto oom;
     for (level = 0;; level++) {
-        int ls, le = H.ncl, id;
+        int ls, le = H.ncl;
         int *g = (int *)tt__grow(allocator, H.level_start, &H.cap_lev, level + 2, sizeof(int));
         if (!g) goto oom;
         H.level_start = g;
         if (level == 0) H.level_start[0] = 0;
         ls = H.level_start[level];
         H.level_start[level + 1] = le;
-        if (!tt__hier_level(&H, ls, le)) goto oom;
-        for (id = ls; id < le; id++)
-            if (H.cl[id].nfaces > 1 && !tt__hier_split(&H, id)) goto oom;
+        if (!tt__hier_level(&H, ls, le) || !tt__hier_splits(&H, ls, le)) goto oom;
         if (H.ncl == le) break;
     }
     H.nlev = level + 1;
@@ -18392,6 +18650,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     memset(&copt, 0, sizeof copt);
     copt.seed = o.seed;
     copt.branching = o.branching;
+    copt.executor = o.executor;
     res = tt_cluster_hierarchy_build(mesh, &copt, allocator, &S.H, error);
     if (res != TT_OK) return res;
     if (tt__hpm_cancelled(&S, 0.0f, &res, error)) goto done;
