@@ -2434,8 +2434,8 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         pixels at the matching resolution (tens, on a scan of 100k faces),
         by sums over them at each allowed offset, whichever costs less; the
         same smallest sum of squared differences either way (to rounding).
-        With an executor the copies, their allowed offsets and their
-        correlations run as parallel tasks. The best offset is refined at
+        With an executor the copies' allowed offsets and correlations run
+        as parallel tasks. The best offset is refined at
         full resolution by a direct sum over +-2^k texels. Its normalised
         error (D4)
             eps = (sum of squared differences) / (channels * band pixels) / (2 sigma^2)
@@ -2511,8 +2511,10 @@ typedef struct tt_hpm_options {
     double max_flattening_error; /* tt_flatten_options.max_error; 0 = its default (0.10) */
     tt_progress_fn progress;     /* fraction of faces textured; may cancel */
     void *progress_user_data;
-    const tt_executor *executor; /* runs each fit's turned copies (their allowed offsets and correlations) as
-                                    parallel tasks; NULL: serial; the same UVs either way */
+    const tt_executor *executor; /* runs the hierarchy's splits (tt_cluster_options.executor) and each fit's
+                                    turned copies (their allowed offsets and correlations) as parallel
+                                    tasks; NULL: serial; the same UVs either way. The hierarchy's tasks
+                                    allocate: the allocator must then be thread-safe */
 } tt_hpm_options;
 
 typedef struct tt_hpm_report {
@@ -2562,8 +2564,9 @@ typedef struct tt_hpm_report {
    hierarchy and flattening (above) plus, per fit (report->fits), about
    10 ms at P = 256 by transforms or 0.3 ms summing a band of 30 pixels
    over 5 copies; the border relaxation about as much again. The horse
-   (97k faces, 1170 fits, gravel 512 x 512) takes about 3 s at -O2 on one
-   core (v0.3.0: 9 s). The executor's tasks allocate nothing. */
+   (97k faces, 1190 fits, gravel 512 x 512) takes about 3 s at -O2 on one
+   core (v0.3.0: 9 s), about half of it in the executor's tasks (the
+   hierarchy's splits, the fits' correlations). */
 TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
                            const tt_allocator *allocator, float *corner_uv, int *face_cluster,
                            tt_hpm_report *report, tt_error *error);
