@@ -2565,7 +2565,7 @@ typedef struct tt_hpm_report {
    10 ms at P = 256 by transforms or 0.3 ms summing a band of 30 pixels
    over 5 copies; the border relaxation about as much again. The horse
    (97k faces, 1190 fits, gravel 512 x 512) takes about 3 s at -O2 on one
-   core (v0.3.0: 9 s), about half of it in the executor's tasks (the
+   core (v0.3.0: 9 s), over 40 % of it in the executor's tasks (the
    hierarchy's splits, the fits' correlations). */
 TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
                            const tt_allocator *allocator, float *corner_uv, int *face_cluster,
