@@ -14846,11 +14846,6 @@ done:
 
 /* ---- The face-cluster hierarchy (Soler et al. Sec. 3.1; spec D12-D14) ---- */
 
-/* tt_mesh_next and tt_mesh_prev for the triangle meshes this section takes
-   (both entry points check it): triangle f's corners are 3 f .. 3 f + 2,
-   so no face lookup. */
-static int tt__tri_next(int c) { return c % 3 == 2 ? c - 2 : c + 1; }
-static int tt__tri_prev(int c) { return c % 3 == 0 ? c + 2 : c - 1; }
 
 TT__DEFINE_HEAPSORT(tt__sort_ints, int)
 
@@ -14933,8 +14928,8 @@ static int tt__hier_border(const tt__hier *H, int id, int c)
 static int tt__hier_next_border(const tt__hier *H, int id, int h)
 {
     const tt_mesh *m = H->mesh;
-    int x = tt__tri_next(h), guard;
-    for (guard = 0; guard < m->ncorners && !tt__hier_border(H, id, x); guard++) x = tt__tri_next(m->twin[x]);
+    int x = tt__next(m, h), guard;
+    for (guard = 0; guard < m->ncorners && !tt__hier_border(H, id, x); guard++) x = tt__next(m, m->twin[x]);
     return x;
 }
 
@@ -15031,7 +15026,7 @@ static unsigned tt__hier_cell_topology(tt__hier *H, tt__hier_work *W, const int 
                 /* a closed fan, counted at its smallest corner */
                 for (guard = 0; guard <= m->ncorners; guard++) {
                     if (!tt__hier_inside(H, W, x, cell)) break;
-                    x = tt__tri_next(m->twin[x]);
+                    x = tt__next(m, m->twin[x]);
                     if (x <= c) {
                         v += x == c;
                         break;
@@ -15051,10 +15046,10 @@ static unsigned tt__hier_cell_topology(tt__hier *H, tt__hier_work *W, const int 
             if (H->cmark[c] || tt__hier_inside(H, W, c, cell)) continue;
             loops++;
             for (guard = 0; guard <= m->ncorners && !H->cmark[h]; guard++) {
-                int x = tt__tri_next(h), turn;
+                int x = tt__next(m, h), turn;
                 H->cmark[h] = 1;
                 for (turn = 0; turn < m->ncorners && tt__hier_inside(H, W, x, cell); turn++)
-                    x = tt__tri_next(m->twin[x]);
+                    x = tt__next(m, m->twin[x]);
                 h = x;
             }
         }
@@ -15308,7 +15303,7 @@ static void tt__hier_loop_control(tt__hier *H, int id, int h0, int single_face, 
     double perimeter = 0.0;
     for (guard = 0; guard <= m->ncorners && !H->cmark[h]; guard++) {
         const float *a = m->pos + 3 * (size_t)m->corner_vert[h];
-        const float *b = m->pos + 3 * (size_t)m->corner_vert[tt__tri_next(h)];
+        const float *b = m->pos + 3 * (size_t)m->corner_vert[tt__next(m, h)];
         double d[3];
         H->cmark[h] = 1;
         loopv[len] = m->corner_vert[h];
@@ -15667,7 +15662,7 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
         H.vstart[mesh->corner_vert[c] + 1]++;
         if (mesh->twin[c] < 0) {
             H.vboundary[mesh->corner_vert[c]] = 1;
-            H.vboundary[mesh->corner_vert[tt__tri_next(c)]] = 1;
+            H.vboundary[mesh->corner_vert[tt__next(mesh, c)]] = 1;
         }
     }
     for (v = 0; v < H.nv; v++) H.vstart[v + 1] += H.vstart[v];
@@ -16688,7 +16683,7 @@ static int tt__hpm_owners(tt__hpm *S, int C, int stamp)
                         S->pairs[p + 4] = q[1];
                     }
                 }
-                prev = tt__tri_prev(h);
+                prev = tt__prev(m, h);
                 h = m->twin[prev];
                 if (h == start) break;
             }
@@ -17625,12 +17620,12 @@ static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
     double ex, ey, len, n[2] = {0, 0};
     if (side == 0) {
         e0 = h;
-        e1 = tt__tri_next(h);
-        apex = tt__tri_prev(h);
+        e1 = tt__next(m, h);
+        apex = tt__prev(m, h);
     } else {
-        e0 = tt__tri_next(t); /* the twin runs the other way */
+        e0 = tt__next(m, t); /* the twin runs the other way */
         e1 = t;
-        apex = tt__tri_prev(t);
+        apex = tt__prev(m, t);
     }
     a = S->uv + 2 * e0;
     b = S->uv + 2 * e1;
@@ -17688,8 +17683,8 @@ static int tt__hpm_is_border(const tt__hpm *S, int c)
     const tt_mesh *m = S->mesh;
     int t = m->twin[c];
     if (t < 0 || S->owner[m->corner_face[c]] < 0 || S->owner[m->corner_face[t]] < 0) return 0;
-    return !tt__hpm_same_place(S, S->uv + 2 * c, S->uv + 2 * tt__tri_next(t)) ||
-           !tt__hpm_same_place(S, S->uv + 2 * tt__tri_next(c), S->uv + 2 * t);
+    return !tt__hpm_same_place(S, S->uv + 2 * c, S->uv + 2 * tt__next(m, t)) ||
+           !tt__hpm_same_place(S, S->uv + 2 * tt__next(m, c), S->uv + 2 * t);
 }
 
 /* Twice the signed area of corner c's triangle in texels, and its stretch:
@@ -17759,7 +17754,7 @@ static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
     do {
         int t;
         corners[n++] = c;
-        t = m->twin[tt__tri_prev(c)];
+        t = m->twin[tt__prev(m, c)];
         if (t < 0) break;
         c = t;
     } while (c != start && n < room);
@@ -17769,7 +17764,7 @@ static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
         while (n < room) {
             int t = m->twin[c];
             if (t < 0) break;
-            c = tt__tri_next(t);
+            c = tt__next(m, t);
             if (c == start) break;
             corners[n++] = c;
         }
@@ -17800,7 +17795,7 @@ static int tt__hpm_relax(tt__hpm *S, int C)
             int t = m->twin[c];
             if (t >= 0 && S->owner[m->corner_face[t]] >= 0 && S->owner[m->corner_face[t]] != C) {
                 verts[nverts++] = m->corner_vert[c];
-                verts[nverts++] = m->corner_vert[tt__tri_next(c)];
+                verts[nverts++] = m->corner_vert[tt__next(m, c)];
             }
         }
     }
@@ -18009,13 +18004,13 @@ static void tt__hpm_smooth(tt__hpm *S, int C)
             size_t v = (size_t)m->corner_vert[c];
             int e[2];
             e[0] = c;
-            e[1] = tt__tri_prev(c);
+            e[1] = tt__prev(m, c);
             /* an edge C does not have on both sides fixes both its ends */
             for (k = 0; k < 2; k++) {
                 int t = m->twin[e[k]];
                 if (t < 0 || S->owner[m->corner_face[t]] != C) {
                     S->vmark[m->corner_vert[e[k]]] = -1;
-                    S->vmark[m->corner_vert[tt__tri_next(e[k])]] = -1;
+                    S->vmark[m->corner_vert[tt__next(m, e[k])]] = -1;
                 }
             }
             d[5 * v] = S->uv[2 * c] - p0[2 * (c - first)];
@@ -18029,8 +18024,8 @@ static void tt__hpm_smooth(tt__hpm *S, int C)
             for (i = 0; i < cl->nfaces; i++) {
                 int f = S->H->faces[cl->first_face + i];
                 for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
-                    size_t v = (size_t)m->corner_vert[c], a = (size_t)m->corner_vert[tt__tri_next(c)],
-                           b = (size_t)m->corner_vert[tt__tri_prev(c)];
+                    size_t v = (size_t)m->corner_vert[c], a = (size_t)m->corner_vert[tt__next(m, c)],
+                           b = (size_t)m->corner_vert[tt__prev(m, c)];
                     if (S->vmark[v] != inside) continue;
                     if (k == 0) { /* clear the sums */
                         d[5 * v + 2] = d[5 * v + 3] = d[5 * v + 4] = 0;
@@ -18296,13 +18291,13 @@ oom:
 static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, double out[3][2])
 {
     const tt_mesh *m = S->mesh;
-    int t = m->twin[c], nc = tt__tri_next(c), pc = tt__tri_prev(c), K, ring[TT__HPM_RING_MAX], n, k;
+    int t = m->twin[c], nc = tt__next(m, c), pc = tt__prev(m, c), K, ring[TT__HPM_RING_MAX], n, k;
     const double *a, *b, *g;
     double e[2], len, ex[3], ey[3], x, y, l3, cr[3], side;
     if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0) return 0;
-    a = uv + 2 * tt__tri_next(t); /* at corner_vert[c] */
+    a = uv + 2 * tt__next(m, t); /* at corner_vert[c] */
     b = uv + 2 * t;                  /* at corner_vert[nc] */
-    g = uv + 2 * tt__tri_prev(t);
+    g = uv + 2 * tt__prev(m, t);
     out[0][0] = a[0];
     out[0][1] = a[1];
     out[1][0] = b[0];
@@ -18456,7 +18451,7 @@ static void tt__hpm_leftovers(tt__hpm *S, double *uv)
                     found = 1;
                     break;
                 }
-                h = m->twin[tt__tri_prev(h)];
+                h = m->twin[tt__prev(m, h)];
                 if (h == start) break;
             }
             if (!found) {
