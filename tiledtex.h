@@ -14846,7 +14846,6 @@ done:
 
 /* ---- The face-cluster hierarchy (Soler et al. Sec. 3.1; spec D12-D14) ---- */
 
-
 TT__DEFINE_HEAPSORT(tt__sort_ints, int)
 
 /* The hierarchy builder's state. `region[f]` is face f's region at the level
@@ -15176,7 +15175,7 @@ static void tt__hier_split(tt__hier *H, tt__hier_work *W, int p, int at)
 {
     tt_cluster *P = &H->cl[p];
     const int *fl = H->faces + P->first_face;
-    int n = P->nfaces, i, j, k, attempt, best_bad = INT_MAX, best_k = 0, nloops;
+    int n = P->nfaces, i, j, k, attempt, best_bad = INT_MAX, best_k = 0, last_k = 0;
     double target = H->comp_area[P->component] / pow((double)H->branching, (double)(P->level + 1));
     double x = target > 0.0 ? P->area / target : 0.0;
     k = x < (double)n ? (int)floor(x + 0.5) : n;     /* NaN and infinity: n */
@@ -15185,27 +15184,32 @@ static void tt__hier_split(tt__hier *H, tt__hier_work *W, int p, int at)
     tt__hier_localize(H, W, p, fl, n);
     for (attempt = 0; attempt <= TT_CLUSTER_RESEEDS && k + attempt <= n; attempt++) {
         int bad = 0;
-        tt__hier_voronoi(W, n, k + attempt);
-        tt__hier_order(W, W->cell, n, k + attempt);
-        for (j = 0; j < k + attempt; j++) {
+        last_k = k + attempt;
+        tt__hier_voronoi(W, n, last_k);
+        tt__hier_order(W, W->cell, n, last_k);
+        for (j = 0; j < last_k; j++) {
             int start = j > 0 ? W->seed[j - 1] : 0;
-            if (!(tt__hier_cell_topology(H, W, fl, W->order + start, W->seed[j] - start, j, &nloops) &
-                  TT_CLUSTER_DISC))
-                bad++;
+            H->child_flags[at + j] =
+                tt__hier_cell_topology(H, W, fl, W->order + start, W->seed[j] - start, j, &H->child_loops[at + j]);
+            bad += !(H->child_flags[at + j] & TT_CLUSTER_DISC);
         }
         if (bad < best_bad) {
             best_bad = bad;
-            best_k = k + attempt;
+            best_k = last_k;
             for (i = 0; i < n; i++) W->best[i] = W->cell[i];
         }
         if (bad == 0) break;
     }
-    for (i = 0; i < n; i++) W->cell[i] = W->best[i];
-    tt__hier_order(W, W->cell, n, best_k);
-    for (j = 0; j < best_k; j++) {
-        int start = j > 0 ? W->seed[j - 1] : 0;
-        H->child_flags[at + j] =
-            tt__hier_cell_topology(H, W, fl, W->order + start, W->seed[j] - start, j, &H->child_loops[at + j]);
+    /* child_flags and child_loops hold the last attempt's cells; when an
+       earlier attempt (fewer cells) is kept, its cells are counted again. */
+    if (best_k != last_k) {
+        for (i = 0; i < n; i++) W->cell[i] = W->best[i];
+        tt__hier_order(W, W->cell, n, best_k);
+        for (j = 0; j < best_k; j++) {
+            int start = j > 0 ? W->seed[j - 1] : 0;
+            H->child_flags[at + j] =
+                tt__hier_cell_topology(H, W, fl, W->order + start, W->seed[j] - start, j, &H->child_loops[at + j]);
+        }
     }
     for (i = 0; i < n; i++) H->cell[fl[i]] = W->cell[i];
     P->nchildren = best_k;
