@@ -2181,9 +2181,10 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
    children and the leaves are the faces); the face array holds at most
    mesh->nfaces entries per level and the control and neighbour arrays at
    most 3 * faces per level, so O(faces * levels) in all (horse, 97k faces:
-   11 levels, 0.93M face entries). Scratch while building: about 200 bytes
-   per face of the largest component, 13 per corner, 10 per vertex; with
-   several tasks a level, each task its own for its largest parent. Time:
+   11 levels, 0.93M face entries), each array of its exact size once
+   built. Scratch while building: about 250 bytes per face, 17 per corner,
+   6 per vertex, whatever the executor (its tasks work in their own parts
+   of the same arrays and allocate nothing). Time:
    O(F log F) per level, each split costing about four Dijkstra passes over
    its parent, more where a split is retried; the passes run on a copy of
    the parent's adjacency in its own dense numbering (tt__hier_localize),
@@ -2212,8 +2213,7 @@ typedef struct tt_cluster_options {
                            level above's divided by this; 0 = TT_DEFAULT_CLUSTER_BRANCHING; 2..64 */
     const tt_executor *executor;  /* splits a level's clusters, and finds their neighbours and control
                                      vertices, in parallel tasks; NULL: serial; the same hierarchy either
-                                     way. Tasks allocate their working arrays: with an executor the
-                                     allocator must be thread-safe */
+                                     way. The tasks allocate nothing */
 } tt_cluster_options;
 
 typedef struct tt_cluster {
@@ -2513,8 +2513,7 @@ typedef struct tt_hpm_options {
     void *progress_user_data;
     const tt_executor *executor; /* runs the hierarchy's splits (tt_cluster_options.executor) and each fit's
                                     turned copies (their allowed offsets and correlations) as parallel
-                                    tasks; NULL: serial; the same UVs either way. The hierarchy's tasks
-                                    allocate: the allocator must then be thread-safe */
+                                    tasks; NULL: serial; the same UVs either way */
 } tt_hpm_options;
 
 typedef struct tt_hpm_report {
@@ -3475,6 +3474,22 @@ static void *tt__grow(const tt_allocator *al, void *array, int *capacity, int ne
     tt__free(al, array);
     *capacity = cap;
     return bigger;
+}
+
+/* A complete array of `count` elements that grew (tt__grow) moved into a
+   block of its exact size (at least one element); 0 when that block cannot
+   be had, the array then left as it was. */
+static int tt__fit_array(const tt_allocator *al, void **array, int count, size_t size)
+{
+    void *exact;
+    size_t n = count > 0 ? (size_t)count : 1;
+    if (!tt__size_fits(n, size)) return 0;
+    exact = tt__alloc(al, n * size);
+    if (!exact) return 0;
+    if (*array && count > 0) memcpy(exact, *array, (size_t)count * size);
+    tt__free(al, *array);
+    *array = exact;
+    return 1;
 }
 
 #define TT__PI 3.14159265358979323846
@@ -14878,6 +14893,10 @@ typedef struct tt__hier_work {
     tt_rng rng;
 } tt__hier_work;
 
+/* A level's clusters are split (and their neighbours found) in at most
+   this many ranges of clusters, the tasks. */
+#define TT__HIER_RANGES 64
+
 typedef struct tt__hier {
     const tt_mesh *mesh;
     const tt_allocator *al;
@@ -14899,12 +14918,12 @@ typedef struct tt__hier {
     unsigned char *vcount;      /* per vertex: regions around it at this level, "outside" included, capped at 3 */
     unsigned char *cmark;       /* per corner: a border loop walked through it (each cluster marks its own) */
     int *scratch;               /* nf + 1: counts */
-    tt__hier_work work;         /* working arrays for the largest component, kept for the whole build:
-                                   a level that is one task uses them (the largest parents: no block of
-                                   their size allocated and freed at each level); the tasks of a level
-                                   of several allocate their own */
-    int *list;                  /* 6 nf: the level pass's lists, for a level that is one task */
-    int *loopv;                 /* 3 per face of the largest component: its border loops */
+    tt__hier_work work;         /* the working arrays, nf + 2 TT__HIER_RANGES faces' worth, kept for the
+                                   whole build: each task of a level works in its own part of them
+                                   (tt__hier_parts), so no task allocates */
+    int part[TT__HIER_RANGES + 1];  /* the level's ranges' parts: range r's starts at face unit part[r] */
+    int *list;                  /* 6 nf: the level pass's lists, range r's from 6 x its first face entry */
+    int *loopv;                 /* 3 per face unit of the working arrays: border loops, in the same parts */
     double *loops;
     unsigned char *loopc;
     tt_cluster *cl;             /* the output, grown */
@@ -15215,46 +15234,63 @@ static void tt__hier_split(tt__hier *H, tt__hier_work *W, int p, int at)
     P->nchildren = best_k;
 }
 
-/* A level's clusters in ranges of `grain`, as tasks: at most 64 ranges
-   (the shared working arrays are sized for that). */
+/* A level's clusters in ranges of `grain`, as tasks: at most
+   TT__HIER_RANGES ranges. */
 static int tt__hier_grain(int count)
 {
-    return count > 64 ? (count + 63) / 64 : 1;
+    return count > TT__HIER_RANGES ? (count + TT__HIER_RANGES - 1) / TT__HIER_RANGES : 1;
+}
+
+/* The parts of the working arrays that the level's ranges (clusters ls ..
+   le - 1, `grain` a range) work in: range r's is its largest cluster's
+   faces + 2 units long, from unit H->part[r]. A cluster's faces are at most
+   the level's in its range, so the parts add up to at most nf + 2
+   TT__HIER_RANGES units, what H->work holds: tasks never allocate, and the
+   memory is the same whatever runs them. */
+static void tt__hier_parts(tt__hier *H, int ls, int le, int grain)
+{
+    int r, id, nranges = tt__range_count(le - ls, grain);
+    H->part[0] = 0;
+    for (r = 0; r < nranges; r++) {
+        int largest = 0, end = tt__min_i(ls + (r + 1) * grain, le);
+        for (id = ls + r * grain; id < end; id++) largest = tt__max_i(largest, H->cl[id].nfaces);
+        H->part[r + 1] = H->part[r] + largest + 2;
+    }
+}
+
+/* Range r's part of the working arrays (units: faces of its parents). */
+static void tt__hier_work_part(const tt__hier *H, int r, tt__hier_work *W)
+{
+    const tt__hier_work *all = &H->work;
+    size_t at = (size_t)H->part[r];
+    W->capacity = H->part[r + 1] - H->part[r] - 2;
+    W->adjacent = all->adjacent + at;
+    W->dist = all->dist + at;
+    W->cell = all->cell + at;
+    W->best = all->best + at;
+    W->seed = all->seed + at;
+    W->centre = all->centre + at;
+    W->order = all->order + at;
+    W->origins = all->origins + 3 * at;
+    W->heap = all->heap + 4 * at;
 }
 
 /* The splits of one level (clusters ls .. le - 1): ranges of parents as
-   tasks, each with its own working arrays; failed[range] set when they
-   could not be allocated. */
+   tasks, each in its part of the working arrays. */
 typedef struct tt__hier_split_job {
     tt__hier *H;
-    int ls, le, grain, nranges;
-    int *failed;                /* per range: its working arrays could not be allocated */
+    int ls, grain;
 } tt__hier_split_job;
-
-/* A range's part: its largest cluster's faces. */
-static int tt__hier_range_largest(const tt__hier *H, int ls, int begin, int end)
-{
-    int id, largest = 0;
-    for (id = ls + begin; id < ls + end; id++) largest = tt__max_i(largest, H->cl[id].nfaces);
-    return largest;
-}
 
 static void tt__hier_split_range(void *context, int begin, int end)
 {
     const tt__hier_split_job *job = (const tt__hier_split_job *)context;
     tt__hier *H = job->H;
     tt__hier_work W;
-    int id, first = H->cl[job->ls].first_face, capacity = tt__hier_range_largest(H, job->ls, begin, end);
-    if (capacity <= 1) return;
-    if (job->nranges == 1) {
-        W = H->work;
-    } else if (!tt__hier_work_alloc(H->al, &W, capacity)) {
-        job->failed[begin / job->grain] = 1;
-        return;
-    }
+    int id, first = H->cl[job->ls].first_face;
+    tt__hier_work_part(H, begin / job->grain, &W);
     for (id = job->ls + begin; id < job->ls + end; id++)
         if (H->cl[id].nfaces > 1) tt__hier_split(H, &W, id, H->cl[id].first_face - first);
-    if (job->nranges > 1) tt__hier_work_free(H->al, &W);
 }
 
 /* The children of the split parents ls .. le - 1, appended in order. */
@@ -15369,15 +15405,21 @@ static void tt__hier_loop_control(tt__hier *H, int id, int h0, int single_face, 
 /* The level pass (clusters ls .. le - 1, from region[] at that level): per
    vertex, the regions around it; per cluster, its neighbours and control
    vertices, found by ranges of clusters as tasks into their own lists
-   (lists[range]: per cluster its neighbours then its control vertices, the
-   counts in the cluster, first_neighbour and first_control relative to
-   the list), then appended in order. */
+   (tt__hier_range_list: per cluster its neighbours then its control
+   vertices, the counts in the cluster, first_neighbour and first_control
+   relative to the list), then appended in order. */
 typedef struct tt__hier_level_job {
     tt__hier *H;
-    int ls, grain, nranges;
-    int **lists;                /* per range: its list (H->list for a level that is one task), or NULL
-                                   when it could not be allocated */
+    int ls, grain;
 } tt__hier_level_job;
+
+/* Range r's list: 6 ints per face entry of its clusters (3 neighbours and
+   3 control vertices at most per face), in H->list from the range's first
+   face entry. */
+static int *tt__hier_range_list(const tt__hier *H, int ls, int grain, int r)
+{
+    return H->list + 6 * (size_t)(H->cl[ls + r * grain].first_face - H->cl[ls].first_face);
+}
 
 static void tt__hier_vcount_range(void *context, int begin, int end)
 {
@@ -15400,24 +15442,11 @@ static void tt__hier_level_range(void *context, int begin, int end)
 {
     const tt__hier_level_job *job = (const tt__hier_level_job *)context;
     tt__hier *H = job->H;
-    int id, i, c, at = 0, r = begin / job->grain, faces = 0;
-    int largest = tt__hier_range_largest(H, job->ls, begin, end);
-    int *list = H->list, *loopv = H->loopv;
-    double *loops = H->loops;
-    unsigned char *loopc = H->loopc;
-    if (job->nranges > 1) {
-        for (id = job->ls + begin; id < job->ls + end; id++) faces += H->cl[id].nfaces;
-        list = TT__ALLOC(H->al, int, 6 * (size_t)faces);
-        loopv = TT__ALLOC(H->al, int, 3 * (size_t)largest);
-        loops = TT__ALLOC(H->al, double, 3 * (size_t)largest);
-        loopc = TT__ALLOC(H->al, unsigned char, 3 * (size_t)largest);
-        if (!list || !loopv || !loops || !loopc) {
-            tt__free(H->al, list);
-            list = NULL;
-        }
-    }
-    job->lists[r] = list;
-    for (id = job->ls + begin; id < job->ls + end && list; id++) {
+    int id, i, c, at = 0, r = begin / job->grain;
+    int *list = tt__hier_range_list(H, job->ls, job->grain, r), *loopv = H->loopv + 3 * (size_t)H->part[r];
+    double *loops = H->loops + 3 * (size_t)H->part[r];
+    unsigned char *loopc = H->loopc + 3 * (size_t)H->part[r];
+    for (id = job->ls + begin; id < job->ls + end; id++) {
         tt_cluster *C = &H->cl[id];
         const int *fl = H->faces + C->first_face;
         int n = C->nfaces, nn = 0, unique = 0, ncontrol = 0;
@@ -15441,33 +15470,22 @@ static void tt__hier_level_range(void *context, int begin, int end)
         at += ncontrol;
         if ((C->flags & TT_CLUSTER_DISC) && C->ncontrol >= 3) C->flags |= TT_CLUSTER_MAPPABLE;
     }
-    if (job->nranges > 1) {
-        tt__free(H->al, loopv);
-        tt__free(H->al, loops);
-        tt__free(H->al, loopc);
-    }
 }
 
+/* The level pass of level ls .. le - 1 (its ranges' parts made). */
 static int tt__hier_level(tt__hier *H, int ls, int le)
 {
     tt__hier_level_job job;
-    int nranges, r, id, i, ok = 1;
+    int id, i;
     tt__parallel_ranges(H->executor, H->nv, 4096, tt__hier_vcount_range, H);
     job.H = H;
     job.ls = ls;
     job.grain = tt__hier_grain(le - ls);
-    nranges = job.nranges = tt__range_count(le - ls, job.grain);
-    job.lists = TT__ALLOC(H->al, int *, (size_t)nranges);
-    if (!job.lists) return 0;
     tt__parallel_ranges(H->executor, le - ls, job.grain, tt__hier_level_range, &job);
-    for (r = 0; r < nranges; r++) ok &= job.lists[r] != NULL;
-    for (id = ls; id < le && ok; id++) {
+    for (id = ls; id < le; id++) {
         tt_cluster *C = &H->cl[id];
-        const int *list = job.lists[(id - ls) / job.grain];
-        if (!tt__hier_reserve(H, 0, 0, C->ncontrol, C->nneighbours)) {
-            ok = 0;
-            break;
-        }
+        const int *list = tt__hier_range_list(H, ls, job.grain, (id - ls) / job.grain);
+        if (!tt__hier_reserve(H, 0, 0, C->ncontrol, C->nneighbours)) return 0;
         for (i = 0; i < C->nneighbours; i++) H->nb[H->nnb + i] = list[C->first_neighbour + i];
         for (i = 0; i < C->ncontrol; i++) H->control[H->nctl + i] = list[C->first_control + i];
         C->first_neighbour = H->nnb;
@@ -15475,29 +15493,19 @@ static int tt__hier_level(tt__hier *H, int ls, int le)
         H->nnb += C->nneighbours;
         H->nctl += C->ncontrol;
     }
-    if (nranges > 1)
-        for (r = 0; r < nranges; r++) tt__free(H->al, job.lists[r]);
-    tt__free(H->al, job.lists);
-    return ok;
+    return 1;
 }
 
-/* The splits of level ls .. le - 1 as tasks, then their children. */
+/* The splits of level ls .. le - 1 as tasks (its ranges' parts made), then
+   their children. */
 static int tt__hier_splits(tt__hier *H, int ls, int le)
 {
     tt__hier_split_job job;
-    int nranges, r, ok = 1;
     job.H = H;
     job.ls = ls;
-    job.le = le;
     job.grain = tt__hier_grain(le - ls);
-    nranges = job.nranges = tt__range_count(le - ls, job.grain);
-    job.failed = TT__ALLOC(H->al, int, (size_t)nranges);
-    if (!job.failed) return 0;
-    for (r = 0; r < nranges; r++) job.failed[r] = 0;
     tt__parallel_ranges(H->executor, le - ls, job.grain, tt__hier_split_range, &job);
-    for (r = 0; r < nranges; r++) ok &= !job.failed[r];
-    tt__free(H->al, job.failed);
-    return ok && tt__hier_children(H, ls, le);
+    return tt__hier_children(H, ls, le);
 }
 
 static void tt__hier_release(tt__hier *H)
@@ -15537,8 +15545,8 @@ static void tt__hier_release(tt__hier *H)
 static int tt__hier_components(tt__hier *H, int ncomp)
 {
     tt__hier_work *W;
-    int f, j, i, largest = 0, *count = H->scratch;
-    if (!tt__hier_reserve(H, ncomp, H->nf, 0, 0)) return 0;
+    int f, j, i, units, *count = H->scratch;
+    if (H->nf > INT_MAX - 2 * TT__HIER_RANGES || !tt__hier_reserve(H, ncomp, H->nf, 0, 0)) return 0;
     for (j = 0; j <= ncomp; j++) count[j] = 0;
     for (f = 0; f < H->nf; f++) count[H->region[f] + 1]++;
     for (j = 0; j < ncomp; j++) count[j + 1] += count[j];
@@ -15556,14 +15564,14 @@ static int tt__hier_components(tt__hier *H, int ncomp)
     }
     H->nfe = H->nf;
     H->ncl = ncomp;
-    /* the build's own working arrays, for the largest component; each
-       component's topology: one cell of itself */
-    for (j = 0; j < ncomp; j++) largest = tt__max_i(largest, H->cl[j].nfaces);
-    if (!tt__hier_work_alloc(H->al, &H->work, largest)) return 0;
+    /* the build's working arrays, for the parts of every level's ranges
+       (tt__hier_parts); each component's topology: one cell of itself */
+    units = H->nf + 2 * TT__HIER_RANGES;
+    if (!tt__hier_work_alloc(H->al, &H->work, units)) return 0;
     H->list = TT__ALLOC(H->al, int, 6 * (size_t)H->nf);
-    H->loopv = TT__ALLOC(H->al, int, 3 * (size_t)largest);
-    H->loops = TT__ALLOC(H->al, double, 3 * (size_t)largest);
-    H->loopc = TT__ALLOC(H->al, unsigned char, 3 * (size_t)largest);
+    H->loopv = TT__ALLOC(H->al, int, 3 * (size_t)units);
+    H->loops = TT__ALLOC(H->al, double, 3 * (size_t)units);
+    H->loopc = TT__ALLOC(H->al, unsigned char, 3 * (size_t)units);
     if (!H->list || !H->loopv || !H->loops || !H->loopc) return 0;
     W = &H->work;
     for (j = 0; j < ncomp; j++) {
@@ -15683,6 +15691,7 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
         if (level == 0) H.level_start[0] = 0;
         ls = H.level_start[level];
         H.level_start[level + 1] = le;
+        tt__hier_parts(&H, ls, le, tt__hier_grain(le - ls));
         if (!tt__hier_level(&H, ls, le) || !tt__hier_splits(&H, ls, le)) goto oom;
         if (H.ncl == le) break;
     }
@@ -15715,6 +15724,17 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
     H.level_start = NULL;
     H.faces = H.control = H.nb = NULL;
     tt__hier_release(&H);
+    /* The arrays grew by doubling: kept at that size, they would hold up to
+       twice the memory (horse: 29 MB instead of 15) while the caller uses
+       the hierarchy; moved once the build's own memory is freed. */
+    if (!tt__fit_array(allocator, (void **)&hier->clusters, hier->nclusters, sizeof *hier->clusters) ||
+        !tt__fit_array(allocator, (void **)&hier->faces, hier->nface_entries, sizeof *hier->faces) ||
+        !tt__fit_array(allocator, (void **)&hier->control, hier->ncontrol, sizeof *hier->control) ||
+        !tt__fit_array(allocator, (void **)&hier->neighbours, hier->nneighbour_entries, sizeof *hier->neighbours)) {
+        tt_cluster_hierarchy_free(hier);
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                        "out of memory building the cluster hierarchy");
+    }
     *out = hier;
     return TT_OK;
 
