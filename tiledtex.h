@@ -2511,9 +2511,10 @@ typedef struct tt_hpm_options {
     double max_flattening_error; /* tt_flatten_options.max_error; 0 = its default (0.10) */
     tt_progress_fn progress;     /* fraction of faces textured; may cancel */
     void *progress_user_data;
-    const tt_executor *executor; /* runs the hierarchy's splits (tt_cluster_options.executor) and each fit's
-                                    turned copies (their allowed offsets and correlations) as parallel
-                                    tasks; NULL: serial; the same UVs either way */
+    const tt_executor *executor; /* runs the hierarchy's splits (tt_cluster_options.executor), each fit's
+                                    turned copies (their allowed offsets and correlations) and the border
+                                    choice's faces as parallel tasks; NULL: serial; the same UVs either
+                                    way */
 } tt_hpm_options;
 
 typedef struct tt_hpm_report {
@@ -2564,8 +2565,8 @@ typedef struct tt_hpm_report {
    10 ms at P = 256 by transforms or 0.3 ms summing a band of 30 pixels
    over 5 copies; the border relaxation about as much again. The horse
    (97k faces, 1190 fits, gravel 512 x 512) takes about 3 s at -O2 on one
-   core (v0.3.0: 9 s), over 40 % of it in the executor's tasks (the
-   hierarchy's splits, the fits' correlations). */
+   core (v0.3.0: 9 s), half of it in the executor's tasks (the
+   hierarchy's splits, the fits' correlations, the border choice). */
 TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
                            const tt_allocator *allocator, float *corner_uv, int *face_cluster,
                            tt_hpm_report *report, tt_error *error);
@@ -16383,7 +16384,9 @@ typedef struct tt__hpm {
     double *placed;             /* 6 per face of the cluster being placed (in its order): its rigid
                                    placement, before its border work; only the first 6 * its faces touched */
     double *vdisp;              /* 5 * nverts: displacement, its sums, for the interior re-solve */
-    int *vmark;                 /* per vertex: stamp of the cluster it is inside (not on its border) */
+    int *vmark;                 /* per vertex: stamp of the cluster it is inside (not on its border), or of
+                                   the border choice's sweep that moved a face there */
+    signed char *border_choice; /* per face: the border choice's pick in a sweep (tt__hpm_border_range) */
     int stamp;
     unsigned char *state;       /* per cluster: 0 new, 1 done, 2 waiting */
     tt__heap_item **queue;
@@ -17636,24 +17639,13 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    the differences of two sides. */
 #define TT__HPM_SIDE_VALUES (2 * 3 * TT__HPM_RELAX_SAMPLES)
 
-static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
+/* One side of an edge from a to b (texel positions) in the triangle whose
+   third corner is at x. */
+static void tt__hpm_edge_samples(const tt__hpm *S, const double *a, const double *b, const double *x,
+                                 double *values)
 {
-    const tt_mesh *m = S->mesh;
-    int t = m->twin[h], e0, e1, apex, i;
-    const double *a, *b, *x;
     double ex, ey, len, n[2] = {0, 0};
-    if (side == 0) {
-        e0 = h;
-        e1 = tt__next(m, h);
-        apex = tt__prev(m, h);
-    } else {
-        e0 = tt__next(m, t); /* the twin runs the other way */
-        e1 = t;
-        apex = tt__prev(m, t);
-    }
-    a = S->uv + 2 * e0;
-    b = S->uv + 2 * e1;
-    x = S->uv + 2 * apex;
+    int i;
     ex = b[0] - a[0];
     ey = b[1] - a[1];
     len = sqrt(ex * ex + ey * ey);
@@ -17671,6 +17663,16 @@ static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
         tt__hpm_sample(S->full, S->W, S->Hh, S->nch, px - 0.5 * n[0], py - 0.5 * n[1], S->toroidal,
                        values + 6 * i + 3);
     }
+}
+
+static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
+{
+    const tt_mesh *m = S->mesh;
+    int t = m->twin[h];
+    if (side == 0)
+        tt__hpm_edge_samples(S, S->uv + 2 * h, S->uv + 2 * tt__next(m, h), S->uv + 2 * tt__prev(m, h), values);
+    else /* the twin runs the other way */
+        tt__hpm_edge_samples(S, S->uv + 2 * tt__next(m, t), S->uv + 2 * t, S->uv + 2 * tt__prev(m, t), values);
 }
 
 static double tt__hpm_edge_compare(const tt__hpm *S, const double *side0, const double *side1, double *continuation)
@@ -17701,14 +17703,13 @@ static int tt__hpm_same_place(const tt__hpm *S, const double *a, const double *b
 }
 
 /* 1 when half-edge c is a border: both faces textured and the map jumps
-   across it. */
-static int tt__hpm_is_border(const tt__hpm *S, int c)
+   across it; c's face mapping its ends to uv_c and uv_next. */
+static int tt__hpm_is_border_at(const tt__hpm *S, int c, const double *uv_c, const double *uv_next)
 {
     const tt_mesh *m = S->mesh;
     int t = m->twin[c];
     if (t < 0 || S->owner[m->corner_face[c]] < 0 || S->owner[m->corner_face[t]] < 0) return 0;
-    return !tt__hpm_same_place(S, S->uv + 2 * c, S->uv + 2 * tt__next(m, t)) ||
-           !tt__hpm_same_place(S, S->uv + 2 * tt__next(m, c), S->uv + 2 * t);
+    return !tt__hpm_same_place(S, uv_c, S->uv + 2 * tt__next(m, t)) || !tt__hpm_same_place(S, uv_next, S->uv + 2 * t);
 }
 
 /* Twice the signed area of corner c's triangle in texels, and its stretch:
@@ -17733,18 +17734,18 @@ static void tt__hpm_tri_frame(const tt__hpm *S, int c, double *frame)
     frame[2] = len > 0 ? tt__length3(cr) / len : 0;
 }
 
-static double tt__hpm_tri_map(const tt__hpm *S, int c, const double *frame, double *stretch)
+/* The triangle whose three corners are at uv[0..5]. */
+static double tt__hpm_tri_map_at(const double *uv, const double *frame, double *stretch)
 {
-    const tt_mesh *m = S->mesh;
-    int k0 = m->face_start[m->corner_face[c]], i;
+    int i;
     double du[2][2], dq[2][2], det, a[2][2], big, small;
     dq[0][0] = frame[0];
     dq[0][1] = 0;
     dq[1][0] = frame[1];
     dq[1][1] = frame[2];
     for (i = 0; i < 2; i++) {
-        du[i][0] = S->uv[2 * (k0 + i + 1)] - S->uv[2 * k0];
-        du[i][1] = S->uv[2 * (k0 + i + 1) + 1] - S->uv[2 * k0 + 1];
+        du[i][0] = uv[2 * (i + 1)] - uv[0];
+        du[i][1] = uv[2 * (i + 1) + 1] - uv[1];
     }
     det = dq[0][0] * dq[1][1] - dq[0][1] * dq[1][0];
     *stretch = tt__infinity();
@@ -17759,6 +17760,11 @@ static double tt__hpm_tri_map(const tt__hpm *S, int c, const double *frame, doub
         *stretch = tt__stretch_ratio(big, small);
     }
     return du[0][0] * du[1][1] - du[0][1] * du[1][0];
+}
+
+static double tt__hpm_tri_map(const tt__hpm *S, int c, const double *frame, double *stretch)
+{
+    return tt__hpm_tri_map_at(S->uv + 2 * (size_t)S->mesh->face_start[S->mesh->corner_face[c]], frame, stretch);
 }
 
 static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
@@ -18354,85 +18360,109 @@ static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, 
     return 1;
 }
 
-/* Mismatch over face f's edges to textured faces (0 where continuous).
-   The faces across them keep their coordinates while f tries its
-   candidates: their sides of the edges are sampled once, into
-   theirs[j * TT__HPM_SIDE_VALUES] for f's corner j (known[j] set). */
-static double tt__hpm_face_mismatch(const tt__hpm *S, int f, double *theirs, int *known)
+/* Mismatch over face f's edges to textured faces (0 where continuous),
+   f's corners at fuv[0..5]. The faces across them keep their coordinates
+   while f tries its candidates: their sides of the edges are sampled once,
+   into theirs[j * TT__HPM_SIDE_VALUES] for f's corner j (known[j] set). */
+static double tt__hpm_face_mismatch(const tt__hpm *S, int f, const double *fuv, double *theirs, int *known)
 {
     double sum = 0, mine[TT__HPM_SIDE_VALUES];
-    int j;
+    int j, first = S->mesh->face_start[f];
     for (j = 0; j < 3; j++) {
-        int c = 3 * f + j;
-        if (!tt__hpm_is_border(S, c)) continue;
+        const double *a = fuv + 2 * j, *b = fuv + 2 * ((j + 1) % 3), *x = fuv + 2 * ((j + 2) % 3);
+        if (!tt__hpm_is_border_at(S, first + j, a, b)) continue;
         if (!known[j]) {
-            tt__hpm_edge_side(S, c, 1, theirs + TT__HPM_SIDE_VALUES * j);
+            tt__hpm_edge_side(S, first + j, 1, theirs + TT__HPM_SIDE_VALUES * j);
             known[j] = 1;
         }
-        tt__hpm_edge_side(S, c, 0, mine);
+        tt__hpm_edge_samples(S, a, b, x, mine);
         sum += tt__hpm_edge_compare(S, mine, theirs + TT__HPM_SIDE_VALUES * j, NULL);
     }
     return sum;
 }
 
+/* Face f's choice in a sweep, on the map as it stands (nothing written):
+   the half-edge of f whose neighbour's map f would rather show, or -1. */
+static int tt__hpm_border_choice(const tt__hpm *S, int f)
+{
+    const tt_mesh *m = S->mesh;
+    int first = m->face_start[f], best = -1, C = S->owner[f], c, j, known[3];
+    double mine[6], cand_uv[6], cand[3][2], frame[3], theirs[3 * TT__HPM_SIDE_VALUES], before, best_cost, st_old,
+        st, unused;
+    if (C < 0) return -1;
+    memcpy(mine, S->uv + 2 * (size_t)first, sizeof mine);
+    known[0] = known[1] = known[2] = 0;
+    before = tt__hpm_face_mismatch(S, f, mine, theirs, known);
+    if (before <= 0) return -1;
+    best_cost = before * 0.95; /* a clear gain, not noise */
+    tt__hpm_tri_frame(S, first, frame);
+    (void)tt__hpm_tri_map_at(mine, frame, &st_old);
+    for (c = first; c < first + 3; c++) {
+        int t = m->twin[c], K, ok = 1;
+        double area_n, area_f;
+        if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0 || K == C) continue;
+        if (!tt__hpm_face_as_neighbour(S, S->uv, c, cand)) continue;
+        /* cand is in the order c, next(c), prev(c) */
+        for (j = 0; j < 3; j++) {
+            int at = (c - first + j) % 3;
+            cand_uv[2 * at] = cand[j][0];
+            cand_uv[2 * at + 1] = cand[j][1];
+            if (!S->toroidal &&
+                (cand[j][0] < 1 || cand[j][1] < 1 || cand[j][0] > S->W - 1 || cand[j][1] > S->Hh - 1))
+                ok = 0;
+        }
+        area_f = tt__hpm_tri_map_at(cand_uv, frame, &st);
+        area_n = tt__hpm_tri_area(S, t, &unused);
+        ok = ok && area_f * area_n > 0 && (st <= TT__HPM_RELAX_MAX_STRETCH || st <= st_old);
+        if (ok) {
+            double cost = tt__hpm_face_mismatch(S, f, cand_uv, theirs, known);
+            if (cost < best_cost) {
+                best_cost = cost;
+                best = c;
+            }
+        }
+    }
+    return best;
+}
+
+/* A sweep's choices are made for every face at once, in ranges of faces
+   as tasks, on the map as the sweep starts; then, in face order, each is
+   taken, or made again where a face before it in the sweep changed sides
+   at one of its vertices (what a choice reads: the faces round its
+   vertices): the sweep of one face after the other, exactly. */
+#define TT__HPM_BORDER_RANGE 256
+
+static void tt__hpm_border_range(void *context, int begin, int end)
+{
+    tt__hpm *S = (tt__hpm *)context;
+    int f;
+    for (f = begin; f < end; f++) {
+        int best = tt__hpm_border_choice(S, f);
+        S->border_choice[f] = (signed char)(best < 0 ? -1 : best - S->mesh->face_start[f]);
+    }
+}
+
 static void tt__hpm_choose_borders(tt__hpm *S)
 {
     const tt_mesh *m = S->mesh;
-    int sweep, f, c, k;
+    int sweep, f, k;
     for (sweep = 0; sweep < TT__HPM_BORDER_SWEEPS; sweep++) {
-        int changed = 0;
+        int changed = 0, moved = ++S->stamp;
+        tt__parallel_ranges(S->executor, m->nfaces, TT__HPM_BORDER_RANGE, tt__hpm_border_range, S);
         for (f = 0; f < m->nfaces; f++) {
-            int first = m->face_start[f], best = -1, C = S->owner[f];
-            double old[3][2], cand[3][2], keep[3][2], before, best_cost, st_old, st, unused;
-            double theirs[3 * TT__HPM_SIDE_VALUES];
-            int known[3];
-            if (C < 0) continue;
+            int first = m->face_start[f], best;
+            double cand[3][2];
+            if (S->owner[f] < 0) continue;
+            if (S->vmark[m->corner_vert[first]] == moved || S->vmark[m->corner_vert[first + 1]] == moved ||
+                S->vmark[m->corner_vert[first + 2]] == moved)
+                best = tt__hpm_border_choice(S, f);
+            else
+                best = S->border_choice[f] < 0 ? -1 : first + S->border_choice[f];
+            if (best < 0 || !tt__hpm_face_as_neighbour(S, S->uv, best, cand)) continue;
             for (k = 0; k < 3; k++) {
-                old[k][0] = S->uv[2 * (first + k)];
-                old[k][1] = S->uv[2 * (first + k) + 1];
-            }
-            known[0] = known[1] = known[2] = 0;
-            before = tt__hpm_face_mismatch(S, f, theirs, known);
-            if (before <= 0) continue;
-            best_cost = before * 0.95; /* a clear gain, not noise */
-            (void)tt__hpm_tri_area(S, first, &st_old);
-            for (c = first; c < first + 3; c++) {
-                int t = m->twin[c], K, ok = 1, j;
-                double area_n, area_f;
-                if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0 || K == C) continue;
-                if (!tt__hpm_face_as_neighbour(S, S->uv, c, cand)) continue;
-                /* cand is in the order c, next(c), prev(c) */
-                for (j = 0; j < 3; j++) {
-                    int at = first + (c - first + j) % 3;
-                    S->uv[2 * at] = cand[j][0];
-                    S->uv[2 * at + 1] = cand[j][1];
-                    if (!S->toroidal && (cand[j][0] < 1 || cand[j][1] < 1 || cand[j][0] > S->W - 1 ||
-                                         cand[j][1] > S->Hh - 1))
-                        ok = 0;
-                }
-                area_f = tt__hpm_tri_area(S, first, &st);
-                area_n = tt__hpm_tri_area(S, t, &unused);
-                ok = ok && area_f * area_n > 0 && (st <= TT__HPM_RELAX_MAX_STRETCH || st <= st_old);
-                if (ok) {
-                    double cost = tt__hpm_face_mismatch(S, f, theirs, known);
-                    if (cost < best_cost) {
-                        best_cost = cost;
-                        best = c;
-                        for (j = 0; j < 3; j++) {
-                            keep[j][0] = S->uv[2 * (first + j)];
-                            keep[j][1] = S->uv[2 * (first + j) + 1];
-                        }
-                    }
-                }
-                for (k = 0; k < 3; k++) {
-                    S->uv[2 * (first + k)] = old[k][0];
-                    S->uv[2 * (first + k) + 1] = old[k][1];
-                }
-            }
-            if (best < 0) continue;
-            for (k = 0; k < 3; k++) {
-                S->uv[2 * (first + k)] = keep[k][0];
-                S->uv[2 * (first + k) + 1] = keep[k][1];
+                int at = first + (best - first + k) % 3;
+                S->uv[2 * at] = cand[k][0];
+                S->uv[2 * at + 1] = cand[k][1];
             }
             if (S->out && tt__hpm_face_as_neighbour(S, S->out, best, cand)) {
                 /* the control follows where it can; where the random map
@@ -18453,6 +18483,7 @@ static void tt__hpm_choose_borders(tt__hpm *S)
                 }
             }
             S->owner[f] = S->owner[m->corner_face[m->twin[best]]];
+            for (k = 0; k < 3; k++) S->vmark[m->corner_vert[first + k]] = moved;
             S->rep.faces_moved++;
             changed = 1;
         }
@@ -18527,6 +18558,7 @@ static void tt__hpm_release(tt__hpm *S)
     tt__free(S->al, S->placed);
     tt__free(S->al, S->vdisp);
     tt__free(S->al, S->vmark);
+    tt__free(S->al, S->border_choice);
     tt__free(S->al, S->state);
     tt__free(S->al, S->waiting);
     tt__free(S->al, S->heap);
@@ -18689,6 +18721,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.placed = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
     S.vdisp = TT__ALLOC(allocator, double, 5 * (size_t)mesh->nverts);
     S.vmark = TT__ALLOC(allocator, int, (size_t)mesh->nverts);
+    S.border_choice = TT__ALLOC(allocator, signed char, (size_t)mesh->nfaces);
     S.state = TT__ALLOC(allocator, unsigned char, (size_t)S.H->nclusters);
     S.queue = TT__ALLOC(allocator, tt__heap_item *, (size_t)S.H->nlevels);
     if (S.queue)
@@ -18699,7 +18732,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.near_faces = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
     S.relax_sides = TT__ALLOC(allocator, double, 3 * TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES);
     if (!S.flat || !S.uv || ((o.flags & TT_HPM_RANDOM_PLACEMENT) && !S.out) || !S.owner || !S.in_c || !S.seen ||
-        !S.placed || !S.vdisp || !S.vmark || !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap ||
+        !S.placed || !S.vdisp || !S.vmark || !S.border_choice || !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap ||
         !S.near_faces || !S.relax_sides) {
         res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
         goto done;

@@ -1299,7 +1299,8 @@ done:
     tt_mesh_free(mesh);
 }
 
-/* The executor runs each fit's turned copies as tasks: the same UVs and
+/* The executor runs the hierarchy's splits, each fit's turned copies and
+   the border choice's sweeps (ranges of faces) as tasks: the same UVs and
    clusters, bit for bit, whether they run serially, in reverse order or on
    two threads; with the default bands (summed directly) and with wide ones
    on a toroidal image (large clusters: their correlations by transforms). */
@@ -1331,6 +1332,9 @@ static void test_hpm_map_executor(void)
         }
         if (e == 3) {
             CHECK(rep[0].fits > 10, "configuration %d fits %d clusters (more than 10)", config, rep[0].fits);
+            CHECK(rep[0].faces_moved > 0 && mesh->nfaces > 2 * 256,
+                  "configuration %d: faces change sides at borders (%d), in several ranges of 256 (%d faces)",
+                  config, rep[0].faces_moved, mesh->nfaces);
             for (e = 1; e < 3; e++)
                 CHECK(memcmp(uv[0], uv[e], sizeof(float) * 2 * (size_t)mesh->ncorners) == 0 &&
                           memcmp(cl[0], cl[e], sizeof(int) * (size_t)mesh->nfaces) == 0 &&
