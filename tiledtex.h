@@ -7804,7 +7804,8 @@ static uint64_t tt__xcorr_scan(const tt_xcorr_texture *texture, double energy, d
    other way.
 
    Two passes, so that the sums vectorise four wide: every offset's E in
-   float, then the exact E in double (the terms in order, the channels
+   float (two terms a pass over the row where neither wraps), then the
+   exact E in double (the terms in order, the channels
    within each) at the offsets whose float E could be the smallest. With u
    = 2^-24, each float term is within u (2 |a| |I| + 5 a^2) J of the exact
    one (a = I - T; rounding I, J, the difference and the two products) and
@@ -7823,22 +7824,28 @@ typedef struct tt__xcorr_terms {
 
 #define TT__XCORR_FLOAT_SLACK (1.0 / 2097152.0)   /* 8 u = 2^-21 */
 
-/* row[x] += weight (value - src[x])^2 for x < n, in float. Four values a
-   step, so that at -O2 each step is one vector operation. */
-static void tt__xcorr_direct_term(float *TT__RESTRICT row, const float *TT__RESTRICT src, int n, float weight,
-                                  float value)
+/* row[x] += weight0 (value0 - src0[x])^2 + weight1 (value1 - src1[x])^2
+   for x < n, in float: two terms in one pass over the row, which is read
+   and written once for both. Four values a step, so that at -O2 each step
+   is a few vector operations. One term alone passes weight1 = 0 (src1 =
+   src0): it adds exactly 0, or a NaN where its own square overflowed,
+   which the callers take as they take the infinity. */
+static void tt__xcorr_direct_terms(float *TT__RESTRICT row, const float *TT__RESTRICT src0,
+                                   const float *TT__RESTRICT src1, int n, float weight0, float value0,
+                                   float weight1, float value1)
 {
     int x;
     for (x = 0; x + 4 <= n; x += 4) {
-        float d0 = value - src[x], d1 = value - src[x + 1], d2 = value - src[x + 2], d3 = value - src[x + 3];
-        row[x] += weight * d0 * d0;
-        row[x + 1] += weight * d1 * d1;
-        row[x + 2] += weight * d2 * d2;
-        row[x + 3] += weight * d3 * d3;
+        float a0 = value0 - src0[x], a1 = value0 - src0[x + 1], a2 = value0 - src0[x + 2], a3 = value0 - src0[x + 3];
+        float b0 = value1 - src1[x], b1 = value1 - src1[x + 1], b2 = value1 - src1[x + 2], b3 = value1 - src1[x + 3];
+        row[x] += weight0 * a0 * a0 + weight1 * b0 * b0;
+        row[x + 1] += weight0 * a1 * a1 + weight1 * b1 * b1;
+        row[x + 2] += weight0 * a2 * a2 + weight1 * b2 * b2;
+        row[x + 3] += weight0 * a3 * a3 + weight1 * b3 * b3;
     }
     for (; x < n; x++) {
-        float d = value - src[x];
-        row[x] += weight * d * d;
+        float a = value0 - src0[x], b = value1 - src1[x];
+        row[x] += weight0 * a * a + weight1 * b * b;
     }
 }
 
@@ -7887,14 +7894,29 @@ static uint64_t tt__xcorr_direct(int w, int h, const float *texture, const tt__x
             int px = terms->x[i], sy = terms->y[i] + y, wrap = w - px; /* offsets x >= wrap wrap round */
             float weight = (float)terms->weight[i];
             if (sy >= h) sy -= h;
+            if (i + 1 < terms->count && hi < wrap && hi < w - terms->x[i + 1]) {
+                /* this term and the next, neither wrapping in the row */
+                int sy1 = terms->y[i + 1] + y;
+                float weight1 = (float)terms->weight[i + 1];
+                if (sy1 >= h) sy1 -= h;
+                for (c = 0; c < terms->channels; c++)
+                    tt__xcorr_direct_terms(row + lo, texture + plane * c + (size_t)w * sy + px + lo,
+                                           texture + plane * c + (size_t)w * sy1 + terms->x[i + 1] + lo, hi - lo + 1,
+                                           weight, (float)terms->values[(size_t)i * terms->channels + c], weight1,
+                                           (float)terms->values[(size_t)(i + 1) * terms->channels + c]);
+                i++;
+                continue;
+            }
             for (c = 0; c < terms->channels; c++) {
                 const float *src = texture + plane * c + (size_t)w * sy + px;
                 float value = (float)terms->values[(size_t)i * terms->channels + c];
                 if (lo < wrap)
-                    tt__xcorr_direct_term(row + lo, src + lo, (hi < wrap ? hi : wrap - 1) - lo + 1, weight, value);
+                    tt__xcorr_direct_terms(row + lo, src + lo, src + lo, (hi < wrap ? hi : wrap - 1) - lo + 1, weight,
+                                           value, 0.0f, value);
                 if (hi >= wrap) {
                     int from = lo > wrap ? lo : wrap;
-                    tt__xcorr_direct_term(row + from, src + from - w, hi - from + 1, weight, value);
+                    tt__xcorr_direct_terms(row + from, src + from - w, src + from - w, hi - from + 1, weight, value,
+                                           0.0f, value);
                 }
             }
         }

@@ -478,6 +478,51 @@ static void test_xcorr_direct(void)
     xc_close(&k);
 }
 
+/* The direct masked sums (hierarchical pattern mapping's small bands):
+   the offset with the smallest exact E, against every offset's E summed in
+   double in the same order, with the terms summed two in one pass over a
+   row (neither wraps there) and one at a time (an odd last term, offsets
+   that wrap round the texture), on 1 and 3 channels. */
+static void test_xcorr_direct_sums(void)
+{
+    enum { W = 48, H = 24, MAXC = 3, TERMS = 10, REACH = 16 };
+    float texture[MAXC * W * H];
+    int config, tx[TERMS], ty[TERMS];
+    double weight[TERMS], values[TERMS * MAXC];
+    lcg_seed(4107);
+    for (config = 0; config < 8; config++) {
+        int channels = (config & 1) ? 3 : 1, count = (config & 2) ? TERMS : TERMS - 1, wraps = config & 4;
+        int lo = wraps ? 0 : 3, hi = wraps ? W - 1 : W - 1 - REACH, i, c, x, y, best = -2, at = -1;
+        double best_e = -1, low = HUGE_VAL;
+        uint64_t found;
+        for (i = 0; i < channels * W * H; i++) texture[i] = (float)lcg_unit();
+        for (i = 0; i < count; i++) {
+            tx[i] = lcg_below(REACH);
+            ty[i] = lcg_below(H);
+            weight[i] = 0.1 + lcg_unit();
+            for (c = 0; c < channels; c++) values[i * channels + c] = lcg_unit();
+        }
+        found = internal_xcorr_direct(W, H, channels, texture, count, tx, ty, weight, values, lo, hi, &best, &best_e);
+        for (y = 0; y < H; y++)
+            for (x = lo; x <= hi; x++) {
+                double e = 0;
+                for (i = 0; i < count; i++)
+                    for (c = 0; c < channels; c++) {
+                        double d = values[i * channels + c] -
+                                   texture[(size_t)W * H * c + (size_t)W * ((ty[i] + y) % H) + (tx[i] + x) % W];
+                        e += weight[i] * d * d;
+                    }
+                if (e < low) {
+                    low = e;
+                    at = W * y + x;
+                }
+            }
+        CHECK(found == 0 && best == at && best_e == low,
+              "%d channel(s), %d terms, offsets %d..%d: the smallest E at %d (%.17g), the exact sums' at %d (%.17g)",
+              channels, count, lo, hi, best, best_e, at, low);
+    }
+}
+
 /* The values are a crop of T at (x0, y0) under a blob of a mask that
    crosses the image border (toroidal): that offset is found, E < 1e-9, and
    the mirrored offset (-x0, -y0), which the paper's printed formula would
@@ -1117,6 +1162,7 @@ void run_fft_tests(void)
     RUN(test_fft_plan_read_only);
     RUN(test_fft_errors);
     RUN(test_xcorr_direct);
+    RUN(test_xcorr_direct_sums);
     RUN(test_xcorr_planted);
     RUN(test_xcorr_planted_bounded);
     RUN(test_xcorr_empty_and_ties);

@@ -399,6 +399,38 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
     return tt__untangle_energy(&star, x, delta2, gradient, NULL, folded);
 }
 int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
+uint64_t internal_xcorr_direct(int w, int h, int channels, const float *texture, int count, const int *x,
+                               const int *y, const double *weight, const double *values, int lo, int hi, int *best,
+                               double *best_e)
+{
+    tt__xcorr_terms terms;
+    int *span = (int *)malloc(sizeof(int) * 2 * (size_t)h), row;
+    float *rows = (float *)malloc(sizeof(float) * (size_t)w * h);
+    double energy = 0;
+    uint64_t found = 1;
+    int i, c;
+    *best = -1;
+    *best_e = 0;
+    for (i = 0; i < count; i++)
+        for (c = 0; c < channels; c++) energy += weight[i] * values[i * channels + c] * values[i * channels + c];
+    terms.count = count;
+    terms.channels = channels;
+    terms.x = x;
+    terms.y = y;
+    terms.weight = weight;
+    terms.values = values;
+    terms.energy = energy;
+    if (span && rows) {
+        for (row = 0; row < h; row++) {
+            span[2 * row] = lo;
+            span[2 * row + 1] = hi;
+        }
+        found = tt__xcorr_direct(w, h, texture, &terms, span, NULL, 0, h, rows, best, best_e);
+    }
+    free(span);
+    free(rows);
+    return found;
+}
 float internal_infinity(void) { return tt__infinity(); }
 double internal_not_a_number(void) { return tt__not_a_number(); }
 double internal_median(double *values, int count) { return tt__median(values, count); }

@@ -227,5 +227,14 @@ tt_result internal_amg_solve2(const tt_sparse_matrix *A, const double *b, double
 tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const int *faces, int nfaces, int seed_face,
                                 const double seed_weight[3], const float anchor[2], double *uv, int *unknowns,
                                 int *steps);
+/* Section 4's direct masked sums (tt__xcorr_direct) over every offset of a
+   texture (`channels` float planes h x w), the terms' texels (x, y),
+   weights and values (channels per term): rows 0 .. h - 1, each over the
+   offsets lo .. hi (wrapping), none excluded. The smallest E's offset (y w
+   + x, the first in row-major order on a tie) and E; returns the
+   non-finite flag. */
+uint64_t internal_xcorr_direct(int w, int h, int channels, const float *texture, int count, const int *x,
+                               const int *y, const double *weight, const double *values, int lo, int hi, int *best,
+                               double *best_e);
 
 #endif /* TEST_COMMON_H */
