@@ -510,9 +510,9 @@ static void test_tile_uv_index(void)
                                           TT_ERROR_INCONSISTENT_ORIENTATION, TT_ERROR_NON_MANIFOLD_VERTEX,
                                           TT_ERROR_NOT_QUAD_MESH, TT_ERROR_IMAGE_TOO_SMALL, TT_ERROR_NOT_CONVERGED,
                                           TT_ERROR_NOT_POSITIVE_DEFINITE, TT_ERROR_NOT_MEASURED};
-        int a, b, bad = 0, n = (int)(sizeof codes / sizeof codes[0]);
+        int a, b, bad = 0, ncodes = (int)(sizeof codes / sizeof codes[0]);
         const char *unknown = tt_result_string((tt_result)-99);
-        for (a = 0; a < n; a++) {
+        for (a = 0; a < ncodes; a++) {
             const char *sa = tt_result_string(codes[a]);
             if (!sa || !sa[0] || strcmp(sa, unknown) == 0) bad++;
             for (b = 0; b < a; b++) if (strcmp(sa, tt_result_string(codes[b])) == 0) bad++;

@@ -458,11 +458,11 @@ static void test_field_constraints(void)
         bad = 0;
         for (f = 9; f < mesh->nfaces; f++) {
             double a[3], b[3], angle;
-            int k;
+            int axis;
             if (!near(fv_len(v + 3 * f), 0.7, 1e-5)) bad++;
-            for (k = 0; k < 3; k++) {
-                a[k] = v[3 * f + k];
-                b[k] = w[3 * (f - 9) + k];
+            for (axis = 0; axis < 3; axis++) {
+                a[axis] = v[3 * f + axis];
+                b[axis] = w[3 * (f - 9) + axis];
             }
             angle = fv_angle(a, b);
             if (angle > worst) worst = angle;

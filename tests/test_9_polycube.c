@@ -1521,11 +1521,11 @@ static edges_check check_edges(const tt_polycube *pc, const tt_mesh *mesh, const
     }
     for (h = 0; h < mesh->ncorners; h++) {
         int f = mesh->corner_face[h], next = h + 1 < mesh->face_start[f + 1] ? h + 1 : mesh->face_start[f];
-        int e = edges->edge_of_halfedge[h], a = mesh->corner_vert[h], b = mesh->corner_vert[next];
-        c.mismatched_halfedges += e < 0 || e >= edges->nedges ||
-                                  (mesh->twin[h] >= 0 && edges->edge_of_halfedge[mesh->twin[h]] != e) ||
-                                  edges->edge_vertices[2 * e] != (a < b ? a : b) ||
-                                  edges->edge_vertices[2 * e + 1] != (a < b ? b : a);
+        int edge = edges->edge_of_halfedge[h], a = mesh->corner_vert[h], b = mesh->corner_vert[next];
+        c.mismatched_halfedges += edge < 0 || edge >= edges->nedges ||
+                                  (mesh->twin[h] >= 0 && edges->edge_of_halfedge[mesh->twin[h]] != edge) ||
+                                  edges->edge_vertices[2 * edge] != (a < b ? a : b) ||
+                                  edges->edge_vertices[2 * edge + 1] != (a < b ? b : a);
     }
     c.out_of_range += failed != edges->nfailed || edges->first_crossing[0] != 0 ||
                       edges->first_crossing[edges->nedges] != edges->ncrossings;
