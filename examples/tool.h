@@ -47,6 +47,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "tiledtex.h"
 
@@ -257,17 +258,25 @@ void tool_forget_inputs(void);
 
 /* A byte buffer that grows as text is appended. A failed allocation sets
    `failed` and makes every later append a no-op, so a writer can append
-   freely and check once at the end. Zero-initialise it before use. */
+   freely and check once at the end. Zero-initialise it before use.
+   With a `sink` (output_stream_begin sets one) the buffer does not grow
+   past TOOL_STREAM_CHUNK: what it holds is written to the sink whenever
+   the next append would not fit, so a file of hundreds of megabytes is
+   made in one small buffer that stays in the cache. A failed write sets
+   `failed` and `sink_error` (its errno). */
 typedef struct tool_buffer {
     char *data;
     size_t size;
     size_t capacity;
     int failed;
+    FILE *sink;
+    int sink_error;
 } tool_buffer;
+#define TOOL_STREAM_CHUNK ((size_t)1 << 18)
 
 /* An empty buffer, for initialising one (plain `= {0}` draws a warning from
    C++ compilers with -Wextra). */
-#define TOOL_BUFFER_INIT {NULL, 0, 0, 0}
+#define TOOL_BUFFER_INIT {NULL, 0, 0, 0, NULL, 0}
 
 void buffer_append(tool_buffer *buffer, const void *bytes, size_t count);
 /* Room for up to `count` more bytes at the buffer's end, for a writer to
@@ -291,6 +300,7 @@ typedef struct tool_output_file {
     char *path;
     unsigned char *data;
     size_t size;
+    char *temporary;    /* a streamed file (output_stream_begin): its contents are in this file, not `data` */
 } tool_output_file;
 
 /* Zero-initialise (tool_output out = TOOL_OUTPUT_INIT;). */
@@ -308,6 +318,20 @@ int output_add(tool_output *output, const char *path, void *data, size_t size);
 /* Add the contents of a tool_buffer (which is emptied). Fails when the
    buffer's `failed` flag is set. */
 int output_add_buffer(tool_output *output, const char *path, tool_buffer *buffer);
+/* A file of the batch written while it is made instead of held whole in
+   memory (an OBJ of a million faces is a hundred MB of text):
+   output_stream_begin makes the checks output_commit makes of PATH, then
+   opens the file's temporary beside it (as the commit names them) as the
+   sink of `buffer` (empty, zero-initialised); append to the buffer as
+   usual; output_stream_end writes the rest, closes the temporary and
+   empties the buffer. The file then commits with the batch, or is removed
+   by output_free. "-" (the standard output) is not streamed: its text
+   stays in the buffer, and output_stream_end adds it as output_add_buffer
+   does. Each returns 0, or -1 with the reason in err (a path refused,
+   "cannot write 'PATH': ...", out of memory); after a failed begin,
+   output_stream_end is not called. */
+int output_stream_begin(tool_output *output, const char *path, tool_buffer *buffer, char *err, size_t err_size);
+int output_stream_end(tool_output *output, const char *path, tool_buffer *buffer, char *err, size_t err_size);
 
 /* First refuse (writing nothing) when an output path names a directory or
    the same file as an input (see tool_check_output_path), and remove what

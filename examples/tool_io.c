@@ -126,7 +126,18 @@ static int buffer_reserve(tool_buffer *buffer, size_t extra)
     if (extra > SIZE_MAX - 1 - buffer->size) { buffer->failed = 1; return -1; }
     needed = buffer->size + extra + 1;
     if (needed <= buffer->capacity) return 0;
-    capacity = buffer->capacity ? buffer->capacity : 4096;
+    if (buffer->sink && buffer->size > 0) {
+        errno = 0;
+        if (fwrite(buffer->data, 1, buffer->size, buffer->sink) != buffer->size) {
+            buffer->sink_error = errno ? errno : EIO;
+            buffer->failed = 1;
+            return -1;
+        }
+        buffer->size = 0;
+        needed = extra + 1;
+        if (needed <= buffer->capacity) return 0;
+    }
+    capacity = buffer->capacity ? buffer->capacity : buffer->sink ? TOOL_STREAM_CHUNK : 4096;
     while (capacity < needed) capacity = capacity > SIZE_MAX / 2 ? needed : capacity * 2;
     grown = (char *)realloc(buffer->data, capacity);
     if (!grown) { buffer->failed = 1; return -1; }
@@ -418,10 +429,14 @@ int output_add(tool_output *output, const char *path, void *data, size_t size)
     int i;
     char *path_copy;
     for (i = 0; i < output->count; i++) {
-        if (strcmp(output->files[i].path, path) == 0) {   /* same file again: the new contents win */
-            free(output->files[i].data);
-            output->files[i].data = (unsigned char *)data;
-            output->files[i].size = size;
+        tool_output_file *file = &output->files[i];
+        if (strcmp(file->path, path) == 0) {   /* same file again: the new contents win */
+            free(file->data);
+            file->data = (unsigned char *)data;
+            file->size = size;
+            if (file->temporary) remove(file->temporary);
+            free(file->temporary);
+            file->temporary = NULL;
             return 0;
         }
     }
@@ -437,6 +452,7 @@ int output_add(tool_output *output, const char *path, void *data, size_t size)
     output->files[output->count].path = path_copy;
     output->files[output->count].data = (unsigned char *)data;
     output->files[output->count].size = size;
+    output->files[output->count].temporary = NULL;
     output->count++;
     return 0;
 }
@@ -481,10 +497,13 @@ float *tool_corner_normals(const char *path, const tt_mesh *mesh, const float *c
 int output_add_obj(tool_output *output, const char *path, const obj_write_desc *desc)
 {
     tool_buffer text = TOOL_BUFFER_INIT;
-    if (obj_write(&text, desc) != 0 || output_add_buffer(output, path, &text) != 0) {
-        buffer_free(&text);
-        return tool_fail("out of memory while writing %s", path);
-    }
+    char err[TOOL_ERROR_SIZE];
+    int written;
+    if (output_stream_begin(output, path, &text, err, sizeof err) != 0) return tool_fail("%s", err);
+    written = obj_write(&text, desc);
+    /* A failed write says why before the writer's own failure does. */
+    if (output_stream_end(output, path, &text, err, sizeof err) != 0) return tool_fail("%s", err);
+    if (written != 0) return tool_fail("out of memory while writing %s", path);
     return 0;
 }
 
@@ -662,6 +681,73 @@ static int back_up(const char *path, commit_file *file, int move_aside)
     return -1;
 }
 
+/* What output_commit refuses before writing anything: a path naming a
+   directory, or the same file as one of the command's inputs. */
+static int check_output(const char *path, char *err, size_t err_size)
+{
+    size_t length = strlen(path);
+    if (length == 0 || path[length - 1] == '/') {
+        tool_set_error(err, err_size, "'%s' names a directory: give a file name", path);
+        return -1;
+    }
+    return tool_check_output_path(path, err, err_size);
+}
+
+int output_stream_begin(tool_output *output, const char *path, tool_buffer *buffer, char *err, size_t err_size)
+{
+    char *temporary;
+    FILE *stream;
+    int i;
+    if (strcmp(path, "-") == 0) return 0;
+    if (check_output(path, err, err_size) != 0) return -1;
+    if (create_temporary(path, &temporary, &stream) != 0) {
+        tool_set_error(err, err_size, "cannot write '%s': %s", path, strerror(errno));
+        return -1;
+    }
+    if (output_add(output, path, NULL, 0) != 0) {
+        fclose(stream);
+        remove(temporary);
+        free(temporary);
+        tool_set_error(err, err_size, "out of memory while writing %s", path);
+        return -1;
+    }
+    for (i = 0; strcmp(output->files[i].path, path) != 0; i++) continue;
+    output->files[i].temporary = temporary;
+    buffer->sink = stream;
+    return 0;
+}
+
+int output_stream_end(tool_output *output, const char *path, tool_buffer *buffer, char *err, size_t err_size)
+{
+    FILE *stream = buffer->sink;
+    int failed, error;
+    if (!stream) {
+        if (output_add_buffer(output, path, buffer) == 0) return 0;
+        tool_set_error(err, err_size, "out of memory while writing %s", path);
+        return -1;
+    }
+    failed = buffer->failed;
+    error = buffer->sink_error;
+    errno = 0;
+    if (!failed && buffer->size > 0 && fwrite(buffer->data, 1, buffer->size, stream) != buffer->size) {
+        failed = 1;
+        error = errno ? errno : EIO;
+    }
+    /* A full disk often shows up only when the file is closed. */
+    if (fflush(stream) != 0 && !failed) {
+        failed = 1;
+        error = errno ? errno : EIO;
+    }
+    if (fclose(stream) != 0 && !failed) {
+        failed = 1;
+        error = errno ? errno : EIO;
+    }
+    buffer_free(buffer);
+    if (failed && error) tool_set_error(err, err_size, "cannot write '%s': %s", path, strerror(error));
+    else if (failed) tool_set_error(err, err_size, "out of memory while writing %s", path);
+    return failed ? -1 : 0;
+}
+
 int output_commit(tool_output *output, char *err, size_t err_size)
 {
     commit_file *files;
@@ -680,15 +766,8 @@ int output_commit(tool_output *output, char *err, size_t err_size)
     }
     /* Before anything is written: no output may name a directory, or the
        same file as one of the command's inputs. */
-    for (i = 0; i < output->count; i++) {
-        const char *path = output->files[i].path;
-        size_t length = strlen(path);
-        if (length == 0 || path[length - 1] == '/') {
-            tool_set_error(err, err_size, "'%s' names a directory: give a file name", path);
-            return -1;
-        }
-        if (tool_check_output_path(path, err, err_size) != 0) return -1;
-    }
+    for (i = 0; i < output->count; i++)
+        if (check_output(output->files[i].path, err, err_size) != 0) return -1;
     for (i = 0; i < output->count; i++) remove_leftovers(output->files[i].path);
     files = (commit_file *)calloc((unsigned)output->count, sizeof *files);
     order = (int *)calloc((unsigned)output->count, sizeof *order);
@@ -706,8 +785,13 @@ int output_commit(tool_output *output, char *err, size_t err_size)
     /* Phase 1: every file to a temporary name beside the real one (the same
        directory, so the renames below cannot cross file systems). */
     for (i = 0; i < output->count && !failed; i++) {
-        const tool_output_file *file = &output->files[i];
+        tool_output_file *file = &output->files[i];
         FILE *stream;
+        if (file->temporary) {      /* streamed: written already */
+            files[i].temporary = file->temporary;
+            file->temporary = NULL;
+            continue;
+        }
         if (create_temporary(file->path, &files[i].temporary, &stream) != 0 ||
             write_whole_file(stream, file->data, file->size) != 0) {
             tool_set_error(err, err_size, "cannot write '%s': %s", file->path, strerror(errno));
@@ -766,6 +850,9 @@ void output_free(tool_output *output)
     for (i = 0; i < output->count; i++) {
         free(output->files[i].path);
         free(output->files[i].data);
+        /* A streamed file never committed. */
+        if (output->files[i].temporary) remove(output->files[i].temporary);
+        free(output->files[i].temporary);
     }
     free(output->files);
     memset(output, 0, sizeof *output);

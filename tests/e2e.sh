@@ -1956,6 +1956,24 @@ else
     fail "rename shim builds" "$CMD" "a shared object" "$(cat "$W/err")"
 fi
 
+# The OBJ is written to its temporary while it is made (streamed, not held
+# whole in memory): a write that fails there (here a file size limit, EFBIG)
+# is one error line naming the OBJ, and leaves no file, temporary or other.
+newdir
+CMD="ulimit -f 64; tiledtex tile ../in/torus.obj ../in/tex.png out --tile 16 --subdivide 3"
+(trap '' XFSZ; ulimit -f 64; exec "$TOOL" tile ../in/torus.obj ../in/tex.png out --tile 16 --subdivide 3) \
+    >"$W/out" 2>"$W/err" </dev/null
+RC=$?
+check "a streamed OBJ that cannot be written: one error, nothing left" \
+    "non-zero exit, one line \"cannot write 'out.obj': ...\", empty directory" \
+    "exit $RC, $(cat "$W/err"), files: $(ls -A | tr '\n' ' ')" \
+    "$([ $RC -ne 0 ] && [ $RC -lt 124 ] && [ "$(grep -c . "$W/err")" = 1 ] &&
+        grep -q "cannot write 'out.obj': " "$W/err" && [ -z "$(ls -A)" ]; echo $?)"
+expect_ok "the same without the limit" tile ../in/torus.obj ../in/tex.png out --tile 16 --subdivide 3
+check "... writes an OBJ over the limit" "out.obj above 64 KB" "$(wc -c <out.obj) bytes" \
+    "$([ "$(wc -c <out.obj)" -gt 65536 ]; echo $?)"
+cd "$W" || exit 1
+
 # ======================================================================
 # Image size budget (--max-pixels): refused from the header, before decoding
 # ======================================================================
