@@ -4036,26 +4036,63 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
     for (f = 0; f < mesh->nfaces; f++)
         if (!tt__face_normal_d(mesh, f, face_normal + 3 * (size_t)f))
             face_normal[3 * (size_t)f] = face_normal[3 * (size_t)f + 1] = face_normal[3 * (size_t)f + 2] = 0.0;
+    /* Each corner's weight, its angle, in corner order: a face's corners
+       and their vertices are read together here, where the fans below
+       meet them scattered. */
+    for (c = 0; c < mesh->ncorners; c++) angle[c] = tt__corner_angle(mesh, c);
     /* Each fan is written once, marked until then by an x no unit normal
        has (a permissive mesh's cut-open vertex has several fans). */
     for (c = 0; c < mesh->ncorners; c++) corner_normal[3 * (size_t)c] = TT__NOT_WRITTEN;
     for (c = 0; c < mesh->ncorners; c++) {
-        /* The fan of corners around c's vertex that c belongs to: back to
-           its start (a boundary, or all the way round), then forward, the
-           turn of tt__fan_size. */
-        int start = c, h, count = 0, guard = 0, i, j;
+        /* The fan of corners around c's vertex that c belongs to, in the
+           turn of tt__fan_size from its start: a boundary, or, all the way
+           round, the corner after c (so the fan ends with c). An interior
+           fan is found in one turn forward from c; only when that meets a
+           boundary is the start looked for backwards and the fan walked
+           again from there. */
+        int start = c, h = c, count = 0, guard = 0, smooth = 1, i, j;
         if (corner_normal[3 * (size_t)c] != TT__NOT_WRITTEN) continue;
-        while (guard++ < mesh->ncorners) {
-            int back = mesh->twin[start];
-            if (back < 0 || (back = tt__next(mesh, back)) == c) break;
-            start = back;
-        }
-        h = start;
-        while (h >= 0 && count < mesh->ncorners) {
-            angle[count] = tt__corner_angle(mesh, h);   /* each fan member's weight, once */
+        while (count < mesh->ncorners && (h = mesh->twin[tt__prev(mesh, h)]) >= 0) {
             fan[count++] = h;
-            h = mesh->twin[tt__prev(mesh, h)];
-            if (h == start) break;
+            if (h == c) break;
+        }
+        if (h < 0) {
+            count = 0;
+            while (guard++ < mesh->ncorners) {
+                int back = mesh->twin[start];
+                if (back < 0 || (back = tt__next(mesh, back)) == c) break;
+                start = back;
+            }
+            h = start;
+            while (h >= 0 && count < mesh->ncorners) {
+                fan[count++] = h;
+                h = mesh->twin[tt__prev(mesh, h)];
+                if (h == start) break;
+            }
+        }
+        /* A smooth fan, every pair of faces within the crease (a scan's
+           usual vertex), gives each of its corners the same sum, taken in
+           the same order: it is taken once. */
+        for (i = 0; i < count && smooth; i++) {
+            const double *own = face_normal + 3 * (size_t)tt__face_of(mesh, fan[i]);
+            for (j = i + 1; j < count && smooth; j++)
+                smooth = tt__dot3(own, face_normal + 3 * (size_t)tt__face_of(mesh, fan[j])) >= cos_crease;
+        }
+        if (smooth) {
+            double sum[3] = {0.0, 0.0, 0.0}, length;
+            float normal[3];
+            for (j = 0; j < count; j++) {
+                const double *other = face_normal + 3 * (size_t)tt__face_of(mesh, fan[j]);
+                sum[0] += angle[fan[j]] * other[0];
+                sum[1] += angle[fan[j]] * other[1];
+                sum[2] += angle[fan[j]] * other[2];
+            }
+            length = tt__length3(sum);
+            normal[0] = length > 0.0 ? (float)(sum[0] / length) : 0.0f;
+            normal[1] = length > 0.0 ? (float)(sum[1] / length) : 0.0f;
+            normal[2] = length > 0.0 ? (float)(sum[2] / length) : 0.0f;
+            for (i = 0; i < count; i++) memcpy(corner_normal + 3 * (size_t)fan[i], normal, sizeof normal);
+            continue;
         }
         for (i = 0; i < count; i++) {
             const double *own = face_normal + 3 * (size_t)tt__face_of(mesh, fan[i]);
@@ -4064,9 +4101,9 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
             for (j = 0; j < count; j++) {
                 const double *other = face_normal + 3 * (size_t)tt__face_of(mesh, fan[j]);
                 if (j != i && tt__dot3(own, other) < cos_crease) continue;
-                sum[0] += angle[j] * other[0];
-                sum[1] += angle[j] * other[1];
-                sum[2] += angle[j] * other[2];
+                sum[0] += angle[fan[j]] * other[0];
+                sum[1] += angle[fan[j]] * other[1];
+                sum[2] += angle[fan[j]] * other[2];
             }
             length = tt__length3(sum);
             out[0] = length > 0.0 ? (float)(sum[0] / length) : 0.0f;
