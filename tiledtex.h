@@ -4886,11 +4886,15 @@ TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, const tt_allocator *a
         if (mesh->twin[c] < 0) stats->boundary_edges++;
         if (mesh->twin[c] < c) stats->edges++;   /* boundary, or the later half of a pair */
     }
-    /* Non-manifold vertices: the fan from vert_corner misses some corners. */
-    memset(valence, 0, (size_t)mesh->nverts * sizeof(int));
-    for (c = 0; c < mesh->ncorners; c++) valence[mesh->corner_vert[c]]++;
-    for (v = 0; v < mesh->nverts; v++)
-        if (mesh->vert_corner[v] >= 0 && tt__fan_size(mesh, v) != valence[v]) stats->nonmanifold_vertices++;
+    /* Non-manifold vertices: the fan from vert_corner misses some corners.
+       A strict build refuses them (and quadrangulating makes none), so only
+       a permissive mesh's fans are walked. */
+    if (mesh->flags & TT_MESH_PERMISSIVE) {
+        memset(valence, 0, (size_t)mesh->nverts * sizeof(int));
+        for (c = 0; c < mesh->ncorners; c++) valence[mesh->corner_vert[c]]++;
+        for (v = 0; v < mesh->nverts; v++)
+            if (mesh->vert_corner[v] >= 0 && tt__fan_size(mesh, v) != valence[v]) stats->nonmanifold_vertices++;
+    }
 
     if ((result = tt_mesh_components(mesh, allocator, face_component, &ncomponents, error)) != TT_OK) goto done;
     if ((result = tt_mesh_boundary_loops(mesh, corner_loop, &nloops, error)) != TT_OK) goto done;
