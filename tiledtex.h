@@ -9563,8 +9563,12 @@ static int tt__edge_uv_discontinuous(const tt_mesh *mesh, const float *uv, int a
     return 0;
 }
 
-/* Edges a range of the seam measure holds (see tt_measure_seams). */
+/* Edges a range of the seam measure holds (see tt_measure_seams), and the
+   most points it samples along one edge. */
 #define TT__SEAM_RANGE 512
+#define TT__SEAM_MAX_POINTS 64
+/* How many corners ahead the count of discontinuous edges asks for a twin's UVs. */
+#define TT__SEAM_PREFETCH 32
 
 typedef struct tt__seam_sums {
     double seam, same, unrelated;
@@ -9597,23 +9601,37 @@ static void tt__seam_range(void *context, int begin, int end)
     tt_rng_seed(&rng, job->seed, 0x7365616d73ull /* "seams" */ + 1u + (uint64_t)(begin / TT__SEAM_RANGE));
     for (i = begin; i < end; i++) {
         int a = job->interior[i], b = mesh->twin[a], edge_samples = 0;
+        float t[TT__SEAM_MAX_POINTS], t_other[TT__SEAM_MAX_POINTS];
+        int other[TT__SEAM_MAX_POINTS];
         tt__edge_frame fa, fb, fo;
+        /* The edge's random draws first, in the stream's order (t, the other
+           edge, t on it, point after point), and the UVs of all its other
+           edges asked for at once: they lie anywhere in memory, and waiting
+           for each in turn was most of the measure's time. The next edge's
+           own UVs are asked for too. */
+        for (j = 0; j < ppe; j++) {
+            t[j] = ((float)j + tt_rng_float(&rng)) / (float)ppe;
+            other[j] = job->interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(job->ninterior - 1))) %
+                                     job->ninterior];
+            t_other[j] = tt_rng_float(&rng);
+        }
+        for (j = 0; j < ppe; j++) TT__PREFETCH(job->corner_uv + 2 * (size_t)other[j]);
+        if (i + 1 < end) {
+            TT__PREFETCH(job->corner_uv + 2 * (size_t)job->interior[i + 1]);
+            TT__PREFETCH(mesh->twin + job->interior[i + 1]);
+        }
         /* The edge's two sides once; the other edge changes at every point. */
         tt__edge_frame_of(mesh, job->corner_uv, job->atlas, a, &fa);
         tt__edge_frame_of(mesh, job->corner_uv, job->atlas, b, &fb);
         for (j = 0; j < ppe; j++) {
-            float t = ((float)j + tt_rng_float(&rng)) / (float)ppe;
-            int other = job->interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(job->ninterior - 1))) %
-                                      job->ninterior];
-            float t_other = tt_rng_float(&rng);
             tt__edge_point pa, pb, po;
             float sa[3], sa_deeper[3], sb[3], so[3];
             if (!fa.valid || !fb.valid) continue;
-            tt__edge_frame_of(mesh, job->corner_uv, job->atlas, other, &fo);
+            tt__edge_frame_of(mesh, job->corner_uv, job->atlas, other[j], &fo);
             if (!fo.valid) continue;
-            tt__edge_point_on(&fa, t, &pa);
-            tt__edge_point_on(&fb, 1.0f - t, &pb);
-            tt__edge_point_on(&fo, t_other, &po);
+            tt__edge_point_on(&fa, t[j], &pa);
+            tt__edge_point_on(&fb, 1.0f - t[j], &pb);
+            tt__edge_point_on(&fo, t_other[j], &po);
             tt__displayed(job->atlas, job->wrap, &pa, 0.5f, sa);
             tt__displayed(job->atlas, job->wrap, &pa, 1.5f, sa_deeper);
             tt__displayed(job->atlas, job->wrap, &pb, 0.5f, sb);
@@ -9691,11 +9709,15 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
             listed[a < b ? a : b] = 1;
         }
     }
-    for (c = 0; c < mesh->ncorners; c++)
+    for (c = 0; c < mesh->ncorners; c++) {
+        /* A twin's UVs are anywhere in memory: asked for some edges ahead. */
+        if (c + TT__SEAM_PREFETCH < mesh->ncorners && mesh->twin[c + TT__SEAM_PREFETCH] > c + TT__SEAM_PREFETCH)
+            TT__PREFETCH(corner_uv + 2 * (size_t)mesh->twin[c + TT__SEAM_PREFETCH]);
         if (mesh->twin[c] > c) {
             interior[ninterior++] = c;
             ndiscontinuous += tt__edge_uv_discontinuous(mesh, corner_uv, c);
         }
+    }
     report->edges_discontinuous = ndiscontinuous;
     /* The measured population is interior[0 .. npopulation-1]: every interior
        edge, or those listed and, in restricted mode, discontinuous, swapped
@@ -9739,7 +9761,7 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
        on a few thousand samples. The edges are measured in ranges, each with
        its own random stream and sums, added in range order: the same score
        whatever runs the ranges. */
-    points_per_edge = nmeasured > 0 ? tt__clamp_i(4096 / nmeasured, 4, 64) : 4;
+    points_per_edge = nmeasured > 0 ? tt__clamp_i(4096 / nmeasured, 4, TT__SEAM_MAX_POINTS) : 4;
     if (ninterior > 1 && nmeasured > 0) {
         tt__seam_job job;
         int nranges = tt__range_count(nmeasured, TT__SEAM_RANGE);
