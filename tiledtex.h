@@ -5350,8 +5350,11 @@ static void tt__turn_vector(const float m[4], const float in[3], float out[3])
    bytes so the pixels keep the allocator's alignment. */
 #define TT__IMAGE_HEADER 64
 
-TTDEF tt_result tt_image_create(int width, int height, const tt_allocator *allocator, tt_image **out_image,
-                                tt_error *error)
+/* tt_image_create, its texels zeroed or, for a caller that sets every one
+   of them, left as the allocator gives them (zeroing a large image first
+   writes all its memory twice). */
+static tt_result tt__image_create(int width, int height, int zeroed, const tt_allocator *allocator,
+                                  tt_image **out_image, tt_error *error)
 {
     size_t count;
     tt_image *image;
@@ -5366,13 +5369,19 @@ TTDEF tt_result tt_image_create(int width, int height, const tt_allocator *alloc
     if (!image)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for a %d x %d image", width,
                         height);
-    memset(image, 0, TT__IMAGE_HEADER + count * 4 * sizeof(float));
+    memset(image, 0, zeroed ? TT__IMAGE_HEADER + count * 4 * sizeof(float) : TT__IMAGE_HEADER);
     image->width = width;
     image->height = height;
     image->pixels = (float *)(void *)((unsigned char *)image + TT__IMAGE_HEADER);
     image->allocator = tt__allocator_copy(allocator);
     *out_image = image;
     return TT_OK;
+}
+
+TTDEF tt_result tt_image_create(int width, int height, const tt_allocator *allocator, tt_image **out_image,
+                                tt_error *error)
+{
+    return tt__image_create(width, height, 1, allocator, out_image, error);
 }
 
 TTDEF void tt_image_free(tt_image *image)
@@ -24396,7 +24405,8 @@ TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tile
     if (left->kind != right->kind)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "one tileset is a normal map and the other is not: apply both plans to the same map");
-    if ((result = tt_image_create(2 * left->width, left->height, allocator, out_image, error)) != TT_OK)
+    /* Every texel is copied in below. */
+    if ((result = tt__image_create(2 * left->width, left->height, 0, allocator, out_image, error)) != TT_OK)
         return result;
     (*out_image)->kind = left->kind;
     for (row = 0; row < left->height; row++) {
