@@ -1056,24 +1056,111 @@ static void write_face_corners(tool_buffer *out, const corner_refs *refs, int fi
     buffer_wrote(out, length);
 }
 
-/* The vt lines (`keyword` "vt") or vn lines ("vn") of every corner in
-   order, or of each distinct row once when `rows` is not NULL. */
-static void write_rows(tool_buffer *out, const obj_write_desc *desc, const char *keyword, int width, int ncorners,
-                       row_kind kind, const distinct_rows *rows)
+/* One section of the file - the v lines, the vt or vn lines (of every
+   corner in order, or of each distinct row once when `rows` is not NULL),
+   or the f lines - whose lines can be made in any order and joined: at -j N
+   runs of them are formatted on the tool's threads, each into its own
+   buffer, and appended in order (the same bytes). */
+typedef enum section_kind { VERTEX_LINES, TEXTURE_LINES, NORMAL_LINES, FACE_LINES } section_kind;
+
+typedef struct section {
+    const obj_write_desc *desc;
+    section_kind kind;
+    const distinct_rows *rows;      /* TEXTURE_LINES, NORMAL_LINES: the distinct rows, or NULL */
+    const corner_refs *refs;        /* FACE_LINES */
+    int count;                      /* lines (faces for FACE_LINES) */
+    int first_piece;                /* the batch's first piece (see write_section) */
+    tool_buffer *pieces;            /* SECTION_BATCH of them */
+    int *invalid;                   /* per piece of the batch: 1 when it has a face obj_write refuses */
+} section;
+
+/* Lines per piece, and pieces made at once (their text held at the same time). */
+#define SECTION_PIECE 8192
+#define SECTION_BATCH 16
+
+/* Items [begin, end) of the section into `out`, the faces' first corner
+   being `corner`. Returns 0, or -1 for a face of fewer than 3 corners or
+   one naming no vertex. */
+static int write_items(tool_buffer *out, const section *sec, int begin, int end, int corner)
 {
-    int n = rows ? rows->count : ncorners, k;
-    for (k = 0; k < n; k++) {
+    const obj_write_desc *desc = sec->desc;
+    int k, i;
+    for (k = begin; k < end; k++) {
         float row[3];
-        read_row(desc, kind, rows ? rows->first_corner[k] : k, row);
-        write_floats(out, keyword, row, width);
+        int size;
+        switch (sec->kind) {
+        case VERTEX_LINES:
+            write_floats(out, "v", desc->pos + 3 * (size_t)k, 3);
+            break;
+        case TEXTURE_LINES:
+            read_row(desc, TEXTURE_ROWS, sec->rows ? sec->rows->first_corner[k] : k, row);
+            write_floats(out, "vt", row, desc->corner_uv_w ? 3 : 2);
+            break;
+        case NORMAL_LINES:
+            read_row(desc, NORMAL_ROWS, sec->rows ? sec->rows->first_corner[k] : k, row);
+            write_floats(out, "vn", row, 3);
+            break;
+        case FACE_LINES:
+            size = desc->face_size ? desc->face_size[k] : desc->fixed_face_size;
+            if (size < 3) return -1;
+            for (i = 0; i < size; i++)
+                if (desc->corner_vert[corner + i] < 0 || desc->corner_vert[corner + i] >= desc->nverts) return -1;
+            if (desc->triangles) {
+                /* The fan from the first corner, as readers split a polygon
+                   themselves: each triangle keeps the face's winding. */
+                for (i = 1; i + 1 < size; i++) write_face_corners(out, sec->refs, corner, corner + i, 2);
+            } else {
+                write_face_corners(out, sec->refs, corner, corner + 1, size - 1);
+            }
+            corner += size;
+            break;
+        }
     }
+    return 0;
+}
+
+static void section_task(void *context, int index)
+{
+    const section *sec = (const section *)context;
+    int piece = sec->first_piece + index, begin = piece * SECTION_PIECE;
+    int end = sec->count - begin > SECTION_PIECE ? begin + SECTION_PIECE : sec->count;
+    int corner = sec->kind == FACE_LINES ? begin * sec->desc->fixed_face_size : 0;
+    sec->invalid[index] = write_items(&sec->pieces[index], sec, begin, end, corner) != 0;
+}
+
+/* The section's lines into `out`: here at -j 1 (and for faces of several
+   sizes, whose pieces would not know their first corners), else piece by
+   piece on the tool's threads. Returns 0, or -1 as write_items (or when out
+   of memory: out->failed). */
+static int write_section(tool_buffer *out, section *sec)
+{
+    const tt_executor *executor = tool_executor();
+    tool_buffer pieces[SECTION_BATCH];
+    int invalid[SECTION_BATCH], npieces = (sec->count + SECTION_PIECE - 1) / SECTION_PIECE, status = 0, p;
+    if (!executor || npieces < 2 || (sec->kind == FACE_LINES && sec->desc->face_size))
+        return write_items(out, sec, 0, sec->count, 0);
+    memset(pieces, 0, sizeof pieces);
+    sec->pieces = pieces;
+    sec->invalid = invalid;
+    for (sec->first_piece = 0; sec->first_piece < npieces && status == 0; sec->first_piece += SECTION_BATCH) {
+        int batch = npieces - sec->first_piece < SECTION_BATCH ? npieces - sec->first_piece : SECTION_BATCH;
+        tool_run_tasks(executor, batch, section_task, sec);
+        for (p = 0; p < batch; p++) {
+            if (invalid[p] || pieces[p].failed) status = -1;
+            if (status == 0) buffer_append(out, pieces[p].data, pieces[p].size);
+            pieces[p].size = 0;
+        }
+    }
+    for (p = 0; p < SECTION_BATCH; p++) buffer_free(&pieces[p]);
+    return status != 0 || out->failed ? -1 : 0;
 }
 
 int obj_write(tool_buffer *out, const obj_write_desc *desc)
 {
-    int v, f, c = 0, ncorners = 0, previous_group = -1, status = 0;
+    int f, c = 0, ncorners = 0, previous_group = -1, status = 0;
     distinct_rows textures, normals;
     corner_refs refs;
+    section sec;
     if (!desc || desc->nverts < 0 || desc->nfaces < 0 || (desc->nverts > 0 && !desc->pos) ||
         (desc->nfaces > 0 && !desc->corner_vert) || (!desc->face_size && desc->fixed_face_size < 3 && desc->nfaces > 0))
         return -1;
@@ -1093,7 +1180,11 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     /* Nine significant digits (tool_format_float) are enough for any float
        to read back exactly, so writing a mesh and reading it again changes
        nothing. */
-    for (v = 0; v < desc->nverts; v++) write_floats(out, "v", desc->pos + 3 * (size_t)v, 3);
+    memset(&sec, 0, sizeof sec);
+    sec.desc = desc;
+    sec.kind = VERTEX_LINES;
+    sec.count = desc->nverts;
+    if (write_section(out, &sec) != 0) return -1;
 
     for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
     memset(&textures, 0, sizeof textures);
@@ -1108,43 +1199,40 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     refs.normal = normals.of_corner;
     /* One vt (and vn) per face corner in corner order, corner c using vt
        c + 1; or each distinct one once, in the order corners first use it. */
-    if (desc->corner_uv)
-        write_rows(out, desc, "vt", desc->corner_uv_w ? 3 : 2, ncorners, TEXTURE_ROWS,
-                   desc->share_equal ? &textures : NULL);
-    if (desc->corner_normal)
-        write_rows(out, desc, "vn", 3, ncorners, NORMAL_ROWS, desc->share_equal ? &normals : NULL);
+    if (desc->corner_uv) {
+        sec.kind = TEXTURE_LINES;
+        sec.rows = desc->share_equal ? &textures : NULL;
+        sec.count = sec.rows ? sec.rows->count : ncorners;
+        status = write_section(out, &sec);
+    }
+    if (desc->corner_normal && status == 0) {
+        sec.kind = NORMAL_LINES;
+        sec.rows = desc->share_equal ? &normals : NULL;
+        sec.count = sec.rows ? sec.rows->count : ncorners;
+        status = write_section(out, &sec);
+    }
 
     if (desc->material && !(desc->face_group && desc->group_materials)) write_name_line(out, "usemtl", desc->material);
-    for (f = 0; f < desc->nfaces && status == 0; f++) {
-        int size = desc->face_size ? desc->face_size[f] : desc->fixed_face_size, i;
-        if (size < 3) {
+    sec.kind = FACE_LINES;
+    sec.rows = NULL;
+    sec.refs = &refs;
+    sec.count = desc->nfaces;
+    if (!desc->face_group && status == 0) status = write_section(out, &sec);
+    /* With groups, a "g" line (and "usemtl") before each run of a group. */
+    for (f = 0; desc->face_group && f < desc->nfaces && status == 0; f++) {
+        int group = desc->face_group[f];
+        if (group < 0 || group >= desc->ngroups) {
             status = -1;
             break;
         }
-        if (desc->face_group) {
-            int group = desc->face_group[f];
-            if (group < 0 || group >= desc->ngroups) {
-                status = -1;
-                break;
-            }
-            if (group != previous_group) {
-                write_name_line(out, "g", desc->group_names[group]);
-                if (desc->group_materials && desc->group_materials[group])
-                    write_name_line(out, "usemtl", desc->group_materials[group]);
-                previous_group = group;
-            }
+        if (group != previous_group) {
+            write_name_line(out, "g", desc->group_names[group]);
+            if (desc->group_materials && desc->group_materials[group])
+                write_name_line(out, "usemtl", desc->group_materials[group]);
+            previous_group = group;
         }
-        for (i = 0; i < size; i++)
-            if (desc->corner_vert[c + i] < 0 || desc->corner_vert[c + i] >= desc->nverts) status = -1;
-        if (status != 0) break;
-        if (desc->triangles) {
-            /* The fan from the first corner, as readers split a polygon
-               themselves: each triangle keeps the face's winding. */
-            for (i = 1; i + 1 < size; i++) write_face_corners(out, &refs, c, c + i, 2);
-        } else {
-            write_face_corners(out, &refs, c, c + 1, size - 1);
-        }
-        c += size;
+        status = write_items(out, &sec, f, f + 1, c);
+        c += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
     }
     distinct_rows_free(&textures);
     distinct_rows_free(&normals);

@@ -625,8 +625,9 @@ typedef struct obj_write_desc {
    (when corner_uv is given), one "vn x y z" per face corner (when
    corner_normal is given) - or each distinct one once (share_equal) -
    then "f v/vt/vn ..." with 1-based indices. Numbers
-   use 9 significant digits (tool_format_float), so floats read back exactly. Returns 0, or -1 on
-   an invalid description or when the buffer ran out of memory. */
+   use 9 significant digits (tool_format_float), so floats read back exactly. At -j N the lines are
+   formatted on the tool's threads (tool_executor), in pieces joined in order: the same text. Returns
+   0, or -1 on an invalid description or when the buffer ran out of memory. */
 int obj_write(tool_buffer *out, const obj_write_desc *desc);
 /* obj_write into a new file of the batch; on failure (out of memory) one
    line "out of memory while writing PATH" and the failure exit status. */

@@ -118,6 +118,18 @@ void tool_set_error(char *err, size_t err_size, const char *format, ...)
 
 /* Make room for `extra` more bytes (plus a NUL we always keep after the data,
    so text in a buffer can be handed to C string functions). */
+/* Bytes to the buffer's sink; a failed write fails the buffer. */
+static int buffer_write_out(tool_buffer *buffer, const void *bytes, size_t count)
+{
+    errno = 0;
+    if (count > 0 && fwrite(bytes, 1, count, buffer->sink) != count) {
+        buffer->sink_error = errno ? errno : EIO;
+        buffer->failed = 1;
+        return -1;
+    }
+    return 0;
+}
+
 static int buffer_reserve(tool_buffer *buffer, size_t extra)
 {
     size_t needed, capacity;
@@ -127,12 +139,7 @@ static int buffer_reserve(tool_buffer *buffer, size_t extra)
     needed = buffer->size + extra + 1;
     if (needed <= buffer->capacity) return 0;
     if (buffer->sink && buffer->size > 0) {
-        errno = 0;
-        if (fwrite(buffer->data, 1, buffer->size, buffer->sink) != buffer->size) {
-            buffer->sink_error = errno ? errno : EIO;
-            buffer->failed = 1;
-            return -1;
-        }
+        if (buffer_write_out(buffer, buffer->data, buffer->size) != 0) return -1;
         buffer->size = 0;
         needed = extra + 1;
         if (needed <= buffer->capacity) return 0;
@@ -160,7 +167,14 @@ void buffer_wrote(tool_buffer *buffer, size_t count)
 
 void buffer_append(tool_buffer *buffer, const void *bytes, size_t count)
 {
-    char *room = buffer_room(buffer, count);
+    char *room;
+    if (buffer->sink && count >= TOOL_STREAM_CHUNK && !buffer->failed) {
+        /* Written as it is, after what the buffer holds: no copy. */
+        if (buffer_write_out(buffer, buffer->data, buffer->size) == 0) buffer_write_out(buffer, bytes, count);
+        buffer->size = 0;
+        return;
+    }
+    room = buffer_room(buffer, count);
     if (!room) return;
     if (count) memcpy(room, bytes, count);
     buffer_wrote(buffer, count);
@@ -726,13 +740,9 @@ int output_stream_end(tool_output *output, const char *path, tool_buffer *buffer
         tool_set_error(err, err_size, "out of memory while writing %s", path);
         return -1;
     }
+    if (!buffer->failed) buffer_write_out(buffer, buffer->data, buffer->size);
     failed = buffer->failed;
     error = buffer->sink_error;
-    errno = 0;
-    if (!failed && buffer->size > 0 && fwrite(buffer->data, 1, buffer->size, stream) != buffer->size) {
-        failed = 1;
-        error = errno ? errno : EIO;
-    }
     /* A full disk often shows up only when the file is closed. */
     if (fflush(stream) != 0 && !failed) {
         failed = 1;
