@@ -431,29 +431,27 @@ static void print_summary(const polycube_command_options *options, const polycub
 /* The files                                                                */
 /* ======================================================================== */
 
-/* The mapped triangles' corner normals: the input mesh's (the file's when
-   every corner has one, else tt_corner_normals, so its creases stay),
-   carried to each output vertex by the mapping's source vertices and
-   weights within the input face the triangle is part of, renormalised.
-   NULL when out of memory (said). */
-static float *mapped_corner_normals(const char *path, const polycube_job *job)
+/* mapped_corner_normals' work, cut in ranges of triangles. */
+typedef struct mapped_normals_job {
+    const tt_mesh *input;
+    const tt_polycube_mapping *mapping;
+    const float *from;          /* the input's corner normals */
+    float *out;                 /* 9 per mapped triangle */
+} mapped_normals_job;
+
+/* Mapped triangles [begin, end): each writes its own three normals. */
+static void mapped_normals_range(void *context, int begin, int end)
 {
-    const tt_mesh *input = job->mesh.mesh;
+    const mapped_normals_job *job = (const mapped_normals_job *)context;
+    const tt_mesh *input = job->input;
     const tt_polycube_mapping *mapping = job->mapping;
-    float *from = tool_corner_normals(path, input, job->mesh.corner_normal);
-    float *out = (float *)malloc(9 * (size_t)(mapping->ntriangles > 0 ? mapping->ntriangles : 1) * sizeof(float));
+    const float *from = job->from;
     int t, k, s, j;
-    if (!from || !out) {
-        if (from && !out) tool_fail("out of memory for the normals of %s", path);
-        free(from);
-        free(out);
-        return NULL;
-    }
-    for (t = 0; t < mapping->ntriangles; t++) {
+    for (t = begin; t < end; t++) {
         int face = mapping->triangle_face[t];
         for (k = 0; k < 3; k++) {
             int v = mapping->triangles[3 * t + k];
-            float *n = out + 9 * (size_t)t + 3 * k;
+            float *n = job->out + 9 * (size_t)t + 3 * k;
             double sum[3] = {0.0, 0.0, 0.0}, length;
             for (s = 0; s < 3; s++) {
                 double w = mapping->weights[3 * (size_t)v + s];
@@ -471,6 +469,31 @@ static float *mapped_corner_normals(const char *path, const polycube_job *job)
             n[2] = length > 0.0 ? (float)(sum[2] / length) : 0.0f;
         }
     }
+}
+
+/* The mapped triangles' corner normals: the input mesh's (the file's when
+   every corner has one, else tt_corner_normals, so its creases stay),
+   carried to each output vertex by the mapping's source vertices and
+   weights within the input face the triangle is part of, renormalised.
+   NULL when out of memory (said). */
+static float *mapped_corner_normals(const char *path, const polycube_job *job)
+{
+    mapped_normals_job normals;
+    float *from = tool_corner_normals(path, job->mesh.mesh, job->mesh.corner_normal);
+    float *out = (float *)malloc(9 * (size_t)(job->mapping->ntriangles > 0 ? job->mapping->ntriangles : 1) *
+                                 sizeof(float));
+    if (!from || !out) {
+        if (from && !out) tool_fail("out of memory for the normals of %s", path);
+        free(from);
+        free(out);
+        return NULL;
+    }
+    normals.input = job->mesh.mesh;
+    normals.mapping = job->mapping;
+    normals.from = from;
+    normals.out = out;
+    /* -j: ranges of triangles on the tool's threads. */
+    tool_parallel_ranges(tool_executor(), job->mapping->ntriangles, 8192, mapped_normals_range, &normals);
     free(from);
     return out;
 }
