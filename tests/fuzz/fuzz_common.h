@@ -135,4 +135,53 @@ static inline int fz_on_progress(float fraction, void *user)
     return ps->cancel_after > 0 && ps->calls >= ps->cancel_after;
 }
 
+/* ---- extreme floats --------------------------------------------------------- */
+
+/* Values that break naive arithmetic, for the targets' extreme-float modes:
+   overflow when subtracted or squared (+-FLT_MAX, +-1e38), underflow and
+   denormals (1e-38, 1e-40, 1e-45), -0.0, the infinities, and NaNs with
+   payloads and either sign (a NaN test that compares bit patterns, or
+   passes a payload through, shows). Built from bits so no constant
+   expression overflows. */
+static inline float fz_extreme_float(uint8_t b)
+{
+    static const uint32_t bits[24] = {
+        0x7f7fffffu, 0xff7fffffu, /* +-FLT_MAX */
+        0x7e967699u, 0xfe967699u, /* +-1e38 */
+        0x006ce3eeu, 0x806ce3eeu, /* +-1e-38 (normal, near FLT_MIN) */
+        0x00011d10u, 0x80011d10u, /* +-1e-40 (denormal) */
+        0x00000001u, 0x80000001u, /* +-1e-45 (the smallest denormal) */
+        0x00800000u, 0x007fffffu, /* FLT_MIN, the largest denormal */
+        0x00000000u, 0x80000000u, /* +0.0, -0.0 */
+        0x7f800000u, 0xff800000u, /* +-infinity */
+        0x7fc00000u, 0xffc00000u, /* quiet NaN, negative quiet NaN */
+        0x7fc00123u, 0xffc4d2e1u, /* quiet NaNs with payloads */
+        0x7f800001u, 0xffbfffffu, /* signalling NaNs (payload 1, all ones) */
+        0x4b800000u, 0x4b800001u  /* 2^24 and the next float: differences collapse */
+    };
+    uint32_t u = bits[b % 24];
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+/* The same for option doubles: +-DBL_MAX, +-1e308, denormals, -0.0,
+   infinities, NaNs with payloads, and the float extremes widened. */
+static inline double fz_extreme_double(uint8_t b)
+{
+    static const uint64_t bits[10] = {
+        0x7fefffffffffffffu, 0xffefffffffffffffu, /* +-DBL_MAX */
+        0x0000000000000001u, 0x8000000000000001u, /* +-4.9e-324 */
+        0x000fffffffffffffu, 0x8000000000000000u, /* the largest denormal, -0.0 */
+        0x7ff8000000000123u, 0xfff4000000000001u, /* NaNs with payloads (quiet, signalling) */
+        0x7ff0000000000000u, 0xfff0000000000000u  /* +-infinity */
+    };
+    double d;
+    if (b % 34 < 10) {
+        memcpy(&d, &bits[b % 34], sizeof d);
+        return d;
+    }
+    return (double)fz_extreme_float((uint8_t)(b % 34 - 10));
+}
+
 #endif /* TILEDTEX_FUZZ_COMMON_H */
