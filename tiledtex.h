@@ -21188,11 +21188,16 @@ static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mes
         E->nfailed += R->nfailed;
         for (e = r * TT__TRACE_RANGE; e < E->nedges && e < (r + 1) * TT__TRACE_RANGE; e++) {
             const int count = E->first_crossing[e], kept = tt__trace_kept(&job, e);
-            const tt_edge_crossing *from =
-                kept ? previous->crossings + previous->first_crossing[e] : R->crossings + taken;
-            if (!kept) taken += count;
             E->first_crossing[e] = (int)total;
-            if (count > 0) memcpy(E->crossings + total, from, sizeof(tt_edge_crossing) * (size_t)count);
+            /* Only an edge with crossings points into its source: a range
+               (or a previous record) with none may hold a NULL array, and
+               NULL + 0 is undefined behaviour (a flat square at resolution 1). */
+            if (count > 0) {
+                const tt_edge_crossing *from =
+                    kept ? previous->crossings + previous->first_crossing[e] : R->crossings + taken;
+                memcpy(E->crossings + total, from, sizeof(tt_edge_crossing) * (size_t)count);
+            }
+            if (!kept) taken += count;
             total += (size_t)count;
         }
     }

@@ -3128,6 +3128,44 @@ static void test_map_executors(void)
     tm_free(&m);
 }
 
+/* A flat square of two triangles at resolution 1: a range of edges whose
+   traces cross nothing keeps a NULL crossing array, and gathering the
+   ranges once computed NULL + 0 (undefined behaviour; clang's UBSan stops
+   there, gcc's does not flag it, so build this with clang to see it fail
+   before the fix). Found by tests/fuzz/fuzz_polycube.c on its empty input. */
+static void test_map_flat_square_coarse(void)
+{
+    float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    int idx[6] = {0, 1, 2, 0, 2, 3};
+    tt_mesh_desc d;
+    tt_mesh *mesh = NULL;
+    tt_polycube *pc = NULL;
+    tt_polycube_options po;
+    tt_polycube_mapping *map = NULL;
+    tt_polycube_map_report report;
+    tt_error err;
+    tt_result r;
+    memset(&d, 0, sizeof d);
+    memset(&po, 0, sizeof po);
+    d.positions = pos;
+    d.nverts = 4;
+    d.indices = idx;
+    d.nfaces = 2;
+    d.fixed_face_size = 3;
+    po.resolution = 1;
+    if (tt_mesh_build(&d, NULL, &mesh, &err) != TT_OK || tt_polycube_build(mesh, &po, NULL, &pc, NULL, &err) != TT_OK) {
+        CHECK(0, "the flat square builds: %s", err.message);
+    } else {
+        r = tt_polycube_map(pc, mesh, NULL, NULL, &map, &report, &err);
+        CHECK(r == TT_OK && map && map->ntriangles >= 2 && report.triangles >= 2,
+              "a flat square at resolution 1 maps (got %d, %d triangles: %s)", (int)r, map ? map->ntriangles : 0,
+              r == TT_OK ? "" : err.message);
+    }
+    tt_polycube_mapping_free(map);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -3165,6 +3203,7 @@ void run_polycube_tests(void)
     RUN(test_map_stretch_floor);
     RUN(test_map_thin_plate);
     RUN(test_map_open_and_messy);
+    RUN(test_map_flat_square_coarse);
     RUN(test_map_random);
     RUN(test_map_executors);
 }
