@@ -124,28 +124,36 @@ static int convert_decoded(unsigned char *pixels, int width, int height, int cha
 
 int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size)
 {
-    unsigned char *file_data, *pixels;
+    unsigned char *file_data;
     size_t file_size;
+    int status;
+    *image = NULL;
+    if (tool_read_file(path, &file_data, &file_size, err, err_size) != 0) return -1;
+    status = image_load_memory(file_data, file_size, path, space, image, err, err_size);
+    free(file_data);
+    return status;
+}
+
+int image_load_memory(const unsigned char *file_data, size_t file_size, const char *path, tt_color_space space,
+                      tt_image **image, char *err, size_t err_size)
+{
+    unsigned char *pixels;
     int width, height, channels;
     tt_error error;
     *image = NULL;
-    if (tool_read_file(path, &file_data, &file_size, err, err_size) != 0) return -1;
     if (file_size > INT_MAX) {
         tool_set_error(err, err_size, "'%s' is too large to be an image this tool can read", path);
-        free(file_data);
         return -1;
     }
     /* Look at the header first: a corrupt or hostile file can claim a huge
        size, and we want to refuse it before anything is allocated for it. */
     if (!stbi_info_from_memory(file_data, (int)file_size, &width, &height, &channels)) {
         tool_set_error(err, err_size, "'%s' is not an image that can be read (%s)", path, stbi_failure_reason());
-        free(file_data);
         return -1;
     }
     if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) {
         tool_set_error(err, err_size, "'%s' is %dx%d; images up to %dx%d are supported", path, width, height,
                   TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
-        free(file_data);
         return -1;
     }
     /* A small file can declare a huge image (a 62 KB PNG of 8000x8000 zeros
@@ -155,11 +163,9 @@ int image_load(const char *path, tt_color_space space, tt_image **image, char *e
                        "'%s' is %dx%d = %llu pixels, over the limit of %llu (raise it with --max-pixels N)", path,
                        width, height, (unsigned long long)width * (unsigned long long)height,
                        (unsigned long long)image_max_pixels);
-        free(file_data);
         return -1;
     }
     pixels = stbi_load_from_memory(file_data, (int)file_size, &width, &height, &channels, 0);
-    free(file_data);    /* the file's bytes are not needed once decoded */
     if (!pixels) {
         tool_set_error(err, err_size, "cannot decode '%s' (%s)", path, stbi_failure_reason());
         return -1;

@@ -375,6 +375,11 @@ void image_set_max_pixels(uint64_t max_pixels);
    the budget (image_set_max_pixels). Sizes are read from the header before
    any pixel is decoded. */
 int image_load(const char *path, tt_color_space space, tt_image **image, char *err, size_t err_size);
+/* image_load on a file's bytes already in memory (`path` only names it in
+   the messages; the bytes are not kept): what image_load does after reading
+   the file, and what tests/fuzz/fuzz_image.c calls. */
+int image_load_memory(const unsigned char *data, size_t size, const char *path, tt_color_space space,
+                      tt_image **image, char *err, size_t err_size);
 void image_free(tt_image *image);
 /* A copy of the width x height rectangle of `image` whose top-left texel is
    (x, y), which must lie inside it; the tool's own memory, like image_load's
