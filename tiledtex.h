@@ -2545,9 +2545,9 @@ typedef struct tt_hpm_report {
    library's UV convention; face_cluster (may be NULL) gets, per face, the
    hierarchy cluster whose map it shows (the numbering of
    tt_cluster_hierarchy_build with the same seed and branching), or -1 for
-   a face no cluster textured: one with no area (tt_face_normal gives the
-   zero vector: degenerate, or so large that its area overflows), whose
-   corners take a textured neighbour's UVs (the image centre without one). options and
+   a face no cluster textured: one with no area (degenerate), or one whose
+   coordinates are so large (near FLT_MAX) that its area overflows a float;
+   its corners take a textured neighbour's UVs (the image centre without one). options and
    report may be NULL. Results:
      TT_OK;
      TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, an image
