@@ -30,7 +30,10 @@
        15     falloff of the second patch (0 = default, else (b % 8) / 2)
        16..23 the second patch's mask: 8 x 8 bits over its 40 x 24 texels
               (5 x 3 texels a bit), row by row
-       then   positions, one byte per coordinate: (b - 128) / 16
+       then   positions, one byte per coordinate: (b - 128) / 16; with
+              byte[15] bit7 (extreme floats) a byte below 24 is
+              fz_extreme_float(b) instead: +-FLT_MAX, +-1e38, denormals,
+              -0.0, infinities, NaNs with payloads
        then   one byte per corner: the vertex index, b % nverts; a triangle cut
               short by the end of the input is dropped
 
@@ -285,7 +288,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (v = 0; v < nverts; ++v) {
         float t = (float)v / 8.0f;
         if (rd.n - rd.at >= 3) {
-            for (k = 0; k < 3; ++k) pos[3 * v + k] = (float)((int)rd_u8(&rd) - 128) / 16.0f;
+            for (k = 0; k < 3; ++k) {
+                uint8_t b = rd_u8(&rd);
+                /* extreme-float mode: a low byte is a value that breaks naive arithmetic */
+                pos[3 * v + k] = (hdr[15] & 128) && b < 24 ? fz_extreme_float(b) : (float)((int)b - 128) / 16.0f;
+            }
         } else {
             pos[3 * v] = t;
             pos[3 * v + 1] = t * t;
@@ -360,7 +367,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (r != TT_OK) {
         check_error("tt_tangent_field", r, &err, &a);
         /* Valid options on a valid mesh: only a constraint can be refused. */
-        CHECK(r == TT_ERROR_OUT_OF_MEMORY || (fo.nconstraints > 0 && !(flags & 128)),
+        /* extreme coordinates: the target's own scale (a fraction of the
+           box's diagonal) may overflow to infinity, which must be refused */
+        CHECK(r == TT_ERROR_OUT_OF_MEMORY || (fo.nconstraints > 0 && !(flags & 128)) ||
+                  (!(flags & 128) && !isfinite(fo.scale)),
               "tt_tangent_field failed without a constraint: %s", err.message);
         goto out;
     }

@@ -30,7 +30,9 @@
               0 -> NaN, 1 -> +inf, 2 -> -inf, 3 -> FLT_MAX, 4 -> a denormal,
               5..36 -> an extreme value (EXTREME[b - 5]: +-FLT_MAX, +-1e38,
               1e-38, denormals, values near 2^24 and 1e10 whose differences
-              collapse, +-0), so that one face mixes huge and tiny coordinates
+              collapse, +-0), 37..42 -> NaNs with payloads, either sign,
+              quiet and signalling (fz_extreme_float), so that one face
+              mixes huge and tiny coordinates
               and zero-area and overflow paths run
 
    The allocator is a parameter of every allocating call: the counting
@@ -72,6 +74,8 @@ static const float EXTREME[32] = {
 static float coord_from_byte(uint8_t b)
 {
     if (b >= 5 && b < 5 + 32) return EXTREME[b - 5];
+    /* NaNs with payloads and either sign, quiet and signalling */
+    if (b >= 37 && b < 43) return fz_extreme_float((uint8_t)(16 + b - 37));
     switch (b) {
     case 0: return NAN;
     case 1: return INFINITY;
