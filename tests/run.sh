@@ -12,7 +12,9 @@
 #   2. the unit tests, tests/test_*.c (test_common.c and one file per section
 #      of the header, built into one program), with ASan + UBSan;
 #   3. if tests/e2e.sh exists: a sanitizer build of the tool and the
-#      end-to-end tests.
+#      end-to-end tests;
+#   4. a short smoke run of each libFuzzer target in tests/fuzz (skipped,
+#      saying why, when clang's libFuzzer is missing).
 # The last line is "N passed, M failed" over everything; the exit status is
 # non-zero when M > 0.
 set -u
@@ -238,6 +240,33 @@ if [ -f tests/e2e.sh ]; then
     else
         fail "e2e: the tool does not build with sanitizers" "$log"
     fi
+fi
+
+# A short smoke run of each libFuzzer target (tests/fuzz/run.sh builds them
+# with clang, ASan and UBSan): its seed corpus, then mutations for
+# FUZZ_SMOKE_SECONDS (default 8), in a scratch copy so the repository's seeds
+# stay as they are. `make fuzz` runs them for longer. Without clang's
+# libFuzzer (run.sh installs it when root) each is skipped, saying why.
+echo "== fuzz smoke runs (tests/fuzz, clang libFuzzer + ASan + UBSan)"
+if fuzz_targets=$(FUZZ_BUILD_ONLY=1 bash tests/fuzz/run.sh 2>"$OUT/fuzz_build.log"); then
+    for t in $fuzz_targets; do
+        scratch=$(mktemp -d)
+        cp tests/fuzz/corpus_"$t"/* "$scratch"/ 2>/dev/null
+        dict=()
+        [ -f tests/fuzz/"$t".dict ] && dict=("-dict=tests/fuzz/$t.dict")
+        if log=$(build/fuzz/fuzz_"$t" -max_total_time="${FUZZ_SMOKE_SECONDS:-8}" -seed=1 -max_len=4096 -timeout=20 \
+            -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="build/fuzz/smoke_$t-" "${dict[@]}" "$scratch" 2>&1); then
+            execs=$(printf '%s\n' "$log" | sed -n 's/^stat::number_of_executed_units: *//p' | tail -1)
+            deep=$(printf '%s\n' "$log" | grep -o '[0-9]* of [0-9]* runs ([0-9.]* %) reached .*' | tail -1)
+            pass "fuzz smoke: fuzz_$t, seeds and ${execs:-?} runs in ${FUZZ_SMOKE_SECONDS:-8} s${deep:+; $deep}"
+        else
+            fail "fuzz smoke: fuzz_$t found a problem (input saved as build/fuzz/smoke_$t-*)" \
+                "$(printf '%s\n' "$log" | grep -E 'contract broken|ERROR: |runtime error|Test unit written' | head -n 6)"
+        fi
+        rm -rf "$scratch"
+    done
+else
+    echo "skip fuzz smoke runs: $(tail -n 1 "$OUT/fuzz_build.log")"
 fi
 
 echo "== done in $(($(date +%s) - START)) s"

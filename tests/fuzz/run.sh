@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # tests/fuzz/run.sh [SECONDS] - build the libFuzzer targets into build/fuzz/ and run
 # each for SECONDS (default 60), FUZZ_JOBS (default 2) at a time: mesh_build,
-# lapped, synth (tiled-texture synthesis, seams, 8-bit images), obj (the
-# tool's OBJ reader, when examples/tool_io.c compiles) and mesh_file (the
-# tool's mesh files: STL, OFF, format detection, welding). Exits non-zero if a target crashed,
+# lapped, synth (tiled-texture synthesis, seams, 8-bit images), hpm (the
+# hierarchy, flattening and tt_hpm_map), polycube (build, colours, mapping,
+# UVs), obj (the tool's OBJ reader, when examples/tool_io.c compiles),
+# mesh_file (the tool's mesh files: STL, OFF, format detection, welding) and
+# image (the tool's image loader through stb_image, and the library's image
+# operations). FUZZ_TARGETS="a b" runs only those. Exits non-zero if a target crashed,
 # leaked, hit undefined behaviour or broke a contract check; the input that did it
 # is saved as build/fuzz/<target>-crash-* (or -leak-, -timeout-, -oom-).
 #
@@ -44,7 +47,7 @@ stb=$(pkg-config --cflags-only-I stb 2>/dev/null | sed "s/-I/-isystem /g")
 [ -n "$stb" ] || stb="-isystem /usr/include/stb"
 
 targets=()
-echo "fuzz: building into $out/"
+echo "fuzz: building into $out/" >&2
 if $cc $flags $warn -I. tests/fuzz/fuzz_mesh_build.c -o "$out/fuzz_mesh_build" -lm; then
   targets+=(mesh_build)
 else
@@ -63,6 +66,16 @@ else
   echo "fuzz: fuzz_synth does not build" >&2
   exit 2
 fi
+# hpm and polycube on small generated meshes (fuzz_shape.h); each prints at
+# exit the share of its runs that reached the deep stage.
+for t in hpm polycube; do
+  if $cc $flags $warn -I. tests/fuzz/fuzz_$t.c -o "$out/fuzz_$t" -lm; then
+    targets+=("$t")
+  else
+    echo "fuzz: fuzz_$t does not build" >&2
+    exit 2
+  fi
+done
 # The tool's OBJ reader (examples/obj.c) with what it uses: tool_io.c (errors,
 # files, buffers) and format_number.c (the writer's numbers).
 obj_sources="examples/obj.c examples/tool_io.c examples/format_number.c"
@@ -88,6 +101,31 @@ if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_mesh_file.c $mesh_file_s
 else
   echo "fuzz: fuzz_mesh_file does not build" >&2
   exit 2
+fi
+
+# The tool's image loader (examples/image_io.c: stb_image, the size checks,
+# the conversion in strips) and the library's image operations.
+image_sources="examples/image_io.c examples/png_write.c examples/tool_io.c examples/executor.c examples/obj.c examples/format_number.c"
+# shellcheck disable=SC2086
+if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources -o "$out/fuzz_image" -lm -pthread; then
+  targets+=(image)
+else
+  echo "fuzz: fuzz_image does not build" >&2
+  exit 2
+fi
+# FUZZ_BUILD_ONLY=1: build, list the targets on stdout, run nothing (the
+# smoke runs of tests/run.sh).
+if [ -n "${FUZZ_BUILD_ONLY:-}" ]; then
+  echo "${targets[@]}"
+  exit 0
+fi
+# FUZZ_TARGETS="hpm image" builds everything but runs only those.
+if [ -n "${FUZZ_TARGETS:-}" ]; then
+  only=()
+  for t in "${targets[@]}"; do
+    case " $FUZZ_TARGETS " in *" $t "*) only+=("$t") ;; esac
+  done
+  targets=("${only[@]}")
 fi
 
 jobs_max=${FUZZ_JOBS:-2}
@@ -117,8 +155,9 @@ for ((i = 0; i < n; i++)); do
   log="$out/fuzz_$t.log"
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   cov=$(grep -o 'cov: [0-9]* ft: [0-9]* corp: [0-9]*/[^ ]*' "$log" | tail -1)
+  deep=$(grep -o '[0-9]* of [0-9]* runs ([0-9.]* %) reached .*' "$log" | tail -1)
   if [ "$rc" = 0 ]; then
-    echo "fuzz_$t: ok, ${execs:-?} execs in ${secs}s, $cov"
+    echo "fuzz_$t: ok, ${execs:-?} execs in ${secs}s, $cov${deep:+; $deep}"
   else
     status=1
     echo "fuzz_$t: FAILED (exit $rc) after ${execs:-?} execs; log: $log"
