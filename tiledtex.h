@@ -2560,7 +2560,9 @@ typedef struct tt_hpm_report {
                                 scale would);
      TT_ERROR_EMPTY_MESH        no faces;
      TT_ERROR_ZERO_AREA_FACE    every face has zero area (no scale);
-     TT_ERROR_NON_FINITE        a NaN or infinite texel (error->row, column);
+     TT_ERROR_NON_FINITE        a NaN or infinite texel (error->row, column),
+                                or coordinates or a scale so extreme that
+                                no cluster could be textured in float;
      TT_CANCELLED               the progress callback stopped it;
      TT_ERROR_OUT_OF_MEMORY.
    On any error corner_uv and face_cluster are untouched. Time: the
@@ -18854,6 +18856,18 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     }
     res = tt__hpm_traverse(&S, error);
     if (res != TT_OK) goto done;
+    /* Faces with area, yet no cluster flattened and placed: the float
+       arithmetic overflowed or underflowed (coordinates near FLT_MAX, or a
+       scale whose texel density is below FLT_MIN). TT_OK would be a
+       one-colour model with every UV at the image centre (issue 21 row 5,
+       reached through extreme floats by fuzz_hpm): refuse it. */
+    if (S.rep.clusters == 0) {
+        res = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                       "hpm: no cluster could be textured: the mesh's coordinates (bounding box diagonal %g) or the "
+                       "texel density (%g per unit) overflow single precision",
+                       diag, S.s);
+        goto done;
+    }
     if (!(o.flags & TT_HPM_NO_RELAXATION)) tt__hpm_choose_borders(&S);
     if (tt__hpm_cancelled(&S, 1.0f, &res, error)) goto done;
     tt__hpm_leftovers(&S, S.uv);

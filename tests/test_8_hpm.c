@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <float.h>
 #include <string.h>
 
 /* ------------------------------------------------------------------------ */
@@ -1790,6 +1791,77 @@ done:
     tt_mesh_free(mesh);
 }
 
+/* fuzz_hpm: a 40-triangle torus with 15 of its 20 vertices at FLT_MAX and
+   a caller's scale of 4.7e39 (texel density below FLT_MIN) textured no
+   cluster and returned TT_OK, every UV at the image centre (a one-colour
+   model, issue 21 row 5). Now TT_ERROR_NON_FINITE, corner_uv untouched. */
+static void test_hpm_extreme_floats_refused(void)
+{
+    static const float pos[60] = {
+        4.2010684, 0.145220593, 0.145220593,
+        1.5710144, 1.47669971, 0.145220593,
+        -1.40792274, 1.43766642, 0.435661763,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX,
+        FLT_MAX, FLT_MAX, FLT_MAX};
+    static const int tris[120] = {
+        0, 6, 1, 0, 5, 6, 1, 7, 2, 1, 6, 7,
+        2, 8, 3, 2, 7, 8, 3, 9, 4, 3, 8, 9,
+        4, 5, 0, 4, 9, 5, 5, 11, 6, 5, 10, 11,
+        6, 12, 7, 6, 11, 12, 7, 13, 8, 7, 12, 13,
+        8, 14, 9, 8, 13, 14, 9, 10, 5, 9, 14, 10,
+        10, 16, 11, 10, 15, 16, 11, 17, 12, 11, 16, 17,
+        12, 18, 13, 12, 17, 18, 13, 19, 14, 13, 18, 19,
+        14, 15, 10, 14, 19, 15, 15, 1, 16, 15, 0, 1,
+        16, 2, 17, 16, 1, 2, 17, 3, 18, 17, 2, 3,
+        18, 4, 19, 18, 3, 4, 19, 0, 15, 19, 4, 0,};
+    tt_mesh_desc d;
+    tt_mesh *mesh = NULL;
+    tt_image *img = NULL;
+    tt_hpm_options o;
+    tt_error err;
+    tt_result r;
+    float uv[240];
+    int k, untouched = 1;
+    memset(&d, 0, sizeof d);
+    d.positions = pos;
+    d.nverts = 20;
+    d.indices = tris;
+    d.nfaces = 40;
+    d.fixed_face_size = 3;
+    d.flags = TT_MESH_PERMISSIVE;
+    if (tt_mesh_build(&d, NULL, &mesh, &err) != TT_OK || tt_image_create(16, 16, NULL, &img, &err) != TT_OK) {
+        CHECK(0, "the extreme torus and its image build: %s", err.message);
+        tt_mesh_free(mesh);
+        return;
+    }
+    for (k = 0; k < 16 * 16 * 4; k++) img->pixels[k] = (float)(k * 7 % 13) / 13.0f;
+    for (k = 0; k < 2 * mesh->ncorners; k++) uv[k] = -7.0f;
+    memset(&o, 0, sizeof o);
+    o.scale = 4.7e39;
+    o.match_size = 16;
+    r = tt_hpm_map(mesh, img, &o, NULL, uv, NULL, NULL, &err);
+    for (k = 0; k < 2 * mesh->ncorners; k++) untouched &= uv[k] == -7.0f;
+    CHECK(r == TT_ERROR_NON_FINITE && untouched, "FLT_MAX coordinates at scale 4.7e39: %d (%s), corner_uv %s",
+          (int)r, r == TT_OK ? "TT_OK" : err.message, untouched ? "untouched" : "written");
+    tt_image_free(img);
+    tt_mesh_free(mesh);
+}
+
 void run_hpm_tests(void)
 {
     RUN(test_hpm_properties);
@@ -1812,4 +1884,5 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_coarse);
     RUN(test_hpm_map_progress);
     RUN(test_hpm_map_errors);
+    RUN(test_hpm_extreme_floats_refused);
 }
