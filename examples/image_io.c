@@ -151,6 +151,12 @@ int image_load_memory(const unsigned char *file_data, size_t file_size, const ch
         tool_set_error(err, err_size, "'%s' is not an image that can be read (%s)", path, stbi_failure_reason());
         return -1;
     }
+    /* stb_image's HDR reader takes a size line such as "-Y 1 +X 0" at its
+       word: no pixels (and a division by zero further on). */
+    if (width < 1 || height < 1) {
+        tool_set_error(err, err_size, "'%s' is an image of %d x %d pixels: nothing to read", path, width, height);
+        return -1;
+    }
     if (width > TT_MAX_IMAGE_SIZE || height > TT_MAX_IMAGE_SIZE) {
         tool_set_error(err, err_size, "'%s' is %dx%d; images up to %dx%d are supported", path, width, height,
                   TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
