@@ -2383,6 +2383,8 @@ typedef struct tt_flatten_report {
                                 (error->item);
      TT_ERROR_NOT_CONVERGED     (and the other tt_cg_solve errors) the
                                 harmonic solve failed;
+     TT_ERROR_NON_FINITE        a (u, v) beyond single precision
+                                (coordinates near FLT_MAX; error->face);
      TT_ERROR_OUT_OF_MEMORY.
    report is zeroed first and filled as far as the work got: with mapped =
    1 for TT_OK and for every TT_ERROR_NOT_FLAT after the solve, so a
@@ -16371,6 +16373,17 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
                           cluster, rep.stretch_p95, max_stretch);
         goto done;
     }
+    /* Coordinates near FLT_MAX flatten to values a float cannot hold (a
+       (u, v) of -inf once came out with TT_OK, found by fuzz_hpm): refuse
+       before writing, so corner_uv stays untouched on the error. */
+    for (i = 0; i < 3 * n; i++)
+        if (!(fabs(uv[2 * cv[i]]) <= FLT_MAX && fabs(uv[2 * cv[i] + 1]) <= FLT_MAX)) {
+            res = tt__fail(error, TT_ERROR_NON_FINITE, faces[i / 3], -1, -1, -1,
+                           "cluster %d: face %d flattens to a (u, v) beyond single precision (coordinates too large)",
+                           cluster, faces[i / 3]);
+            if (error) error->item = cluster;
+            goto done;
+        }
     for (i = 0; i < 3 * n; i++) {
         int c = mesh->face_start[faces[i / 3]] + i % 3;
         corner_uv[2 * c] = (float)uv[2 * cv[i]];
