@@ -134,6 +134,45 @@ int image_load(const char *path, tt_color_space space, tt_image **image, char *e
     return status;
 }
 
+/* Some stb_image versions (Debian's among them) write past a Huffman
+   table's 257 code sizes when a JPEG's DHT segment declares more than 256
+   codes: a hostile file could corrupt the decoder's memory. Such a table
+   is invalid JPEG, so the file is refused before stb_image sees it: walk
+   the segments up to the first scan and check each table's code count. */
+static int jpeg_huffman_tables_overflow(const unsigned char *data, size_t size)
+{
+    size_t at = 2;
+    if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) return 0;
+    while (at + 4 <= size) {
+        size_t length, end, table;
+        unsigned marker;
+        if (data[at] != 0xFF) return 0;   /* not a segment: leave it to the decoder */
+        marker = data[at + 1];
+        if (marker == 0xFF) {             /* fill byte */
+            at++;
+            continue;
+        }
+        if (marker == 0xDA || marker == 0xD9) return 0;   /* the scan (or the end) starts */
+        if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
+            at += 2;
+            continue;
+        }
+        length = ((size_t)data[at + 2] << 8) | data[at + 3];
+        if (length < 2) return 0;
+        end = at + 2 + length;
+        if (end > size) end = size;
+        if (marker == 0xC4)
+            for (table = at + 4; table + 17 <= end;) {
+                size_t codes = 0, k;
+                for (k = 1; k <= 16; k++) codes += data[table + k];
+                if (codes > 256) return 1;
+                table += 17 + codes;
+            }
+        at = at + 2 + length;
+    }
+    return 0;
+}
+
 int image_load_memory(const unsigned char *file_data, size_t file_size, const char *path, tt_color_space space,
                       tt_image **image, char *err, size_t err_size)
 {
@@ -169,6 +208,11 @@ int image_load_memory(const unsigned char *file_data, size_t file_size, const ch
                        "'%s' is %dx%d = %llu pixels, over the limit of %llu (raise it with --max-pixels N)", path,
                        width, height, (unsigned long long)width * (unsigned long long)height,
                        (unsigned long long)image_max_pixels);
+        return -1;
+    }
+    if (jpeg_huffman_tables_overflow(file_data, file_size)) {
+        tool_set_error(err, err_size, "cannot decode '%s' (a corrupt JPEG: a Huffman table of more than 256 codes)",
+                       path);
         return -1;
     }
     pixels = stbi_load_from_memory(file_data, (int)file_size, &width, &height, &channels, 0);
