@@ -8,7 +8,8 @@
 # image (the tool's image loader through stb_image, and the library's image
 # operations). FUZZ_TARGETS="a b" runs only those. Exits non-zero if a target crashed,
 # leaked, hit undefined behaviour or broke a contract check; the input that did it
-# is saved as build/fuzz/<target>-crash-* (or -leak-, -timeout-, -oom-).
+# is saved as build/fuzz/<target>-crash-* (or -leak-, -timeout-, -oom-); exits 2
+# when clang cannot build libFuzzer targets, 3 when a target does not build.
 #
 # The seed corpora in tests/fuzz/corpus_* are copied into build/fuzz/corpus_*
 # (which keeps growing from run to run until `make clean`), so the repository's
@@ -40,7 +41,7 @@ if ! "$cc" -fsanitize=fuzzer "$probe/p.c" -o "$probe/p" >/dev/null 2>&1; then
   fi
 fi
 rm -rf "$probe"
-flags="-std=c99 -g -O1 -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
+flags="-std=c99 -g -O1 -pthread -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
 warn="-Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes"
 # stb as a system header: its own warnings are not ours to fix
 stb=$(pkg-config --cflags-only-I stb 2>/dev/null | sed "s/-I/-isystem /g")
@@ -52,19 +53,19 @@ if $cc $flags $warn -I. tests/fuzz/fuzz_mesh_build.c -o "$out/fuzz_mesh_build" -
   targets+=(mesh_build)
 else
   echo "fuzz: fuzz_mesh_build does not build" >&2
-  exit 2
+  exit 3
 fi
 if $cc $flags $warn -I. tests/fuzz/fuzz_lapped.c -o "$out/fuzz_lapped" -lm; then
   targets+=(lapped)
 else
   echo "fuzz: fuzz_lapped does not build" >&2
-  exit 2
+  exit 3
 fi
 if $cc $flags $warn -I. tests/fuzz/fuzz_synth.c -o "$out/fuzz_synth" -lm; then
   targets+=(synth)
 else
   echo "fuzz: fuzz_synth does not build" >&2
-  exit 2
+  exit 3
 fi
 # hpm and polycube on small generated meshes (fuzz_shape.h); each prints at
 # exit the share of its runs that reached the deep stage.
@@ -73,12 +74,13 @@ for t in hpm polycube; do
     targets+=("$t")
   else
     echo "fuzz: fuzz_$t does not build" >&2
-    exit 2
+    exit 3
   fi
 done
 # The tool's OBJ reader (examples/obj.c) with what it uses: tool_io.c (errors,
-# files, buffers) and format_number.c (the writer's numbers).
-obj_sources="examples/obj.c examples/tool_io.c examples/format_number.c"
+# files, buffers), format_number.c (the writer's numbers) and executor.c
+# (the writer formats its lines on the tool's threads).
+obj_sources="examples/obj.c examples/tool_io.c examples/format_number.c examples/executor.c"
 if [ -f examples/obj.c ] && [ -f examples/tool_io.c ] && [ -f examples/format_number.c ] && [ -f examples/tool.h ]; then
   # These are compiled as they are; fuzz_obj.c is the one TU that defines
   # TILEDTEX_IMPLEMENTATION.
@@ -87,7 +89,7 @@ if [ -f examples/obj.c ] && [ -f examples/tool_io.c ] && [ -f examples/format_nu
     targets+=(obj)
   else
     echo "fuzz: fuzz_obj does not build" >&2
-    exit 2
+    exit 3
   fi
 else
   echo "fuzz: SKIPPED fuzz_obj: one of $obj_sources examples/tool.h is missing" >&2
@@ -100,7 +102,7 @@ if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_mesh_file.c $mesh_file_s
   targets+=(mesh_file)
 else
   echo "fuzz: fuzz_mesh_file does not build" >&2
-  exit 2
+  exit 3
 fi
 
 # The tool's image loader (examples/image_io.c: stb_image, the size checks,
@@ -111,7 +113,7 @@ if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources -
   targets+=(image)
 else
   echo "fuzz: fuzz_image does not build" >&2
-  exit 2
+  exit 3
 fi
 # FUZZ_BUILD_ONLY=1: build, list the targets on stdout, run nothing (the
 # smoke runs of tests/run.sh).
