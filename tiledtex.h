@@ -2157,7 +2157,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
    times; the split with the fewest non-disc children is kept (the first of
    equals), its non-disc children flagged and still split further. Single
    faces are discs and are not split: the tree ends there. Border
-   regularisation and the non-alignment test of the spec (D14) are not done.
+   regularisation and the non-alignment test are not done.
 
    What holds per level. Levels are depths in the tree (a cluster's children
    are at its level + 1). The *regions* of level l are its clusters plus the
@@ -2167,7 +2167,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
    partition its faces. Every face's deepest cluster is a leaf holding just
    that face (hierarchy->face_leaf).
 
-   Control vertices (Sec. 3.1, spec D12). A vertex of a cluster's border is
+   Control vertices (Sec. 3.1). A vertex of a cluster's border is
    a control vertex when the faces around it belong to at least 3 regions
    of the cluster's level, a mesh boundary counting as one more region
    ("outside"). A border loop with fewer than 3 (4 when the loop has at least
@@ -2194,7 +2194,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
    vertices of its clusters: the hierarchy is the same bits with any
    executor. */
 
-/* Re-splits of a parent with a non-disc child (spec D13). */
+/* Re-splits of a parent with a non-disc child. */
 #define TT_CLUSTER_RESEEDS 3
 /* A border loop of at least this many vertices gets at least 4 control
    vertices, a shorter one at least 3. */
@@ -2268,12 +2268,12 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
                                            tt_error *error);
 TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
 
-/* ---- Flattening (Sec. 3.2; spec D9, D10, D18) ----
+/* ---- Flattening (Sec. 3.2) ----
 
    tt_flatten_cluster maps one mappable cluster (a disc with at least 3
    control vertices) into the plane, in world units (a flat cluster keeps
    its lengths), as one continuous map:
-     1. The control polygon (D10): the 3D control vertices projected onto
+     1. The control polygon: the 3D control vertices projected onto
         their least-squares (PCA) plane, whose normal is turned to the side
         of the cluster's area-weighted normal, then TT_FLATTEN_POLYGON_PASSES
         Gauss-Seidel passes of edge-length projection (each edge moved
@@ -2294,7 +2294,7 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
         to at least 1e-3 times the mean |weight| (symmetric positive
         definite, positive weights), solved for u and v by tt_cg_solve
         starting from the border's centroid.
-     4. The measures (D9): r = surface area / sum of the mapped triangles'
+     4. The measures: r = surface area / sum of the mapped triangles'
         signed areas, flattening error E_flat = |r - 1| (infinite when the
         mapped sum is not positive); a triangle with a signed area <= 0 is
         flipped; per triangle stretch = sigma1 / sigma2 of its Jacobian.
@@ -2322,7 +2322,7 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
 /* options->max_error = 0: E_flat above this refuses the cluster (D9: a
    spherical cap of half-angle up to about 35 degrees maps in one piece). */
 #define TT_DEFAULT_FLATTEN_MAX_ERROR 0.10
-/* Edge-length projection passes over the control polygon (D10). */
+/* Edge-length projection passes over the control polygon. */
 #define TT_FLATTEN_POLYGON_PASSES 8
 /* options->cg_tolerance = 0: relative residual of the harmonic solves. */
 #define TT_DEFAULT_FLATTEN_CG_TOLERANCE 1e-10
@@ -2393,13 +2393,13 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
                                    const tt_flatten_options *options, const tt_allocator *allocator,
                                    float *corner_uv, tt_flatten_report *report, tt_error *error);
 
-/* ---- The pipeline: tt_hpm_map (Sec. 2.2, 4; spec D2-D8, D15-D17, D22-D33) ----
+/* ---- The pipeline: tt_hpm_map (Sec. 2.2, 4) ----
 
    tt_hpm_map textures a triangle mesh with texture coordinates into the
    original image: no new texture is made. Coarse to fine, each cluster of
    the hierarchy is flattened (above) and placed on the image where its
    content best continues the already textured neighbours:
-     1. The matching copy of the image (D3, D30): r, g, b as displayed
+     1. The matching copy of the image: r, g, b as displayed
         (sRGB-encoded) turned into Y, Cb, Cr - a Euclidean colour space, so
         squared differences add up; one channel (Y) for a grey image - and
         box-filtered by 2^k until its larger side is at most match_size.
@@ -2419,19 +2419,19 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         the main neighbour's orientation (step 2), so limiting the turn
         keeps the direction coherent and makes each fit 2 to 4 times
         cheaper; max_turn 180 restores the paper's search.
-     2. The band (Sec. 4.1, D15, D16): the textured faces near the cluster
+     2. The band (Sec. 4.1): the textured faces near the cluster
         C are drawn into C's flattened frame, each textured neighbour N
         through the rigid map that best takes N's texture coordinates of the
         vertices it shares with C onto C's flattened positions (a 2D
         Procrustes fit), with the colours of the image at N's coordinates,
         so the mask holds a rigid copy of what N shows; only pixels outside
         C within `band` texels of it are kept. C's frame is first turned by
-        a random angle (D8), so that the exact continuation of a single
+        a random angle, so that the exact continuation of a single
         neighbour is not the answer unless asked for.
-     3. The fit (Sec. 4.2, D1, D5-D7, D27, D33): one masked correlation of
+     3. The fit (Sec. 4.2): one masked correlation of
         the band against every turned copy, offsets restricted so that C's
         footprint and its band stay inside a bounded image with a margin of
-        one texel (D6; for a toroidal image, inside the copy's grid): by
+        one texel (for a toroidal image, inside the copy's grid): by
         transforms (as tt_xcorr_masked_best), or, when the band holds few
         pixels at the matching resolution (tens, on a scan of 100k faces),
         by sums over them at each allowed offset, whichever costs less; the
@@ -2439,11 +2439,11 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         With an executor the copies' allowed offsets and correlations run
         as parallel tasks. The best offset is refined at
         full resolution by a direct sum over +-2^k texels. Its normalised
-        error (D4)
+        error
             eps = (sum of squared differences) / (channels * band pixels) / (2 sigma^2)
         with sigma^2 the image's mean per-channel variance: 0 for a perfect
         continuation, about 1 for unrelated pixels.
-     4. The traversal (Sec. 2.2, D22, D23): one priority queue per level,
+     4. The traversal (Sec. 2.2): one priority queue per level,
         the cluster with most textured neighbouring regions first (then the
         larger share of textured border, then the smaller index). A cluster
         is split (its children queued at the next level) when it is not a
@@ -2457,13 +2457,13 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         nothing else can be done; then it starts a new textured region at
         a random place (the first cluster, each further component, regions
         the queues never reached).
-     5. Texture coordinates (Sec. 4.3, D17, D19-D21): per corner, a
+     5. Texture coordinates (Sec. 4.3): per corner, a
         similarity of the cluster's flattened map - continuous inside a
         cluster, never wrapped per vertex; for a toroidal image each cluster
         is moved by whole periods so its centre lies in [0, 1)^2, the rest
         continues outside (sample with REPEAT). For a bounded image every
         UV lies at least one texel inside the image.
-     6. The borders (Sec. 4.4, D17, D25), after each placement: the cracks
+     6. The borders (Sec. 4.4), after each placement: the cracks
         against the matched band closed, the border vertices of the cluster
         and of its neighbours relaxed to lower the colour difference across
         the border, the interior re-solved. After the traversal, faces on a
@@ -2471,11 +2471,11 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         choice). TT_HPM_NO_RELAXATION leaves all of this out.
    The same mesh, image, options and seed give the same bits. */
 
-#define TT_DEFAULT_HPM_THRESHOLD 0.35   /* eps above which a fit splits the cluster (D4) */
+#define TT_DEFAULT_HPM_THRESHOLD 0.35   /* eps above which a fit splits the cluster */
 #define TT_DEFAULT_HPM_ROTATIONS 19     /* orientations around the circle: the paper's (Sec. 4.2) */
 #define TT_DEFAULT_HPM_MAX_TURN 40.0    /* degrees a patch may turn from its main neighbour: 5 of the 19 */
-#define TT_DEFAULT_HPM_MATCH_SIZE 128   /* larger side of the matching copy of the image (D30) */
-#define TT_DEFAULT_HPM_MIN_FACES 16     /* the floor in faces (D23) */
+#define TT_DEFAULT_HPM_MATCH_SIZE 128   /* larger side of the matching copy of the image */
+#define TT_DEFAULT_HPM_MIN_FACES 16     /* the floor in faces */
 #define TT_DEFAULT_HPM_MIN_FOOTPRINT 576.0  /* the floor in texels^2: a patch 24 texels across */
 #define TT_HPM_MAX_LEVELS 32            /* levels the report counts one by one (deeper ones go to the last) */
 
@@ -2483,12 +2483,12 @@ enum {
     TT_HPM_TOROIDAL = 1u << 0,          /* the image tiles: offsets wrap, UVs may leave [0, 1] */
     TT_HPM_RANDOM_PLACEMENT = 1u << 1,  /* the control: the same traversal and decisions, but every
                                            cluster is output at a random place and orientation */
-    TT_HPM_NO_RANDOM_TURN = 1u << 2,    /* no random turn of the frame before a fit (D8) and
+    TT_HPM_NO_RANDOM_TURN = 1u << 2,    /* no random turn of the frame before a fit and
                                            starts at angle 0: a neighbour's exact continuation
                                            can then be found (tests) */
     TT_HPM_NO_RELAXATION = 1u << 3      /* no work on the borders after each placement: neither
-                                           the crack closing (D17), the relaxation (Sec. 4.4)
-                                           nor the interior re-solve (D25): the fits alone */
+                                           the crack closing, the relaxation (Sec. 4.4)
+                                           nor the interior re-solve: the fits alone */
 };
 
 typedef struct tt_hpm_options {
@@ -2504,7 +2504,7 @@ typedef struct tt_hpm_options {
                                the main textured neighbour's; 0 = TT_DEFAULT_HPM_MAX_TURN; 180 = every
                                one (the paper) */
     double band;            /* band width in image texels; 0 = per cluster clamp(0.2 * r, 3, 24), r the
-                               radius of a disc of the cluster's area (D15) */
+                               radius of a disc of the cluster's area */
     int match_size;         /* 0 = TT_DEFAULT_HPM_MATCH_SIZE; a power of two from 16 to 512 */
     double min_footprint;   /* the floor in texels^2; 0 = TT_DEFAULT_HPM_MIN_FOOTPRINT */
     int min_faces;          /* the floor in faces; 0 = TT_DEFAULT_HPM_MIN_FACES */
@@ -2589,25 +2589,25 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         a. voxelisation: the cubes of a uniform grid over the bounding box
            that the model's surface meets (triangle-cube test);
         b. interior fill, so that a closed part gives one outer sheet of
-           quads, not the paper's hollow shell (spec P4);
+           quads, not the paper's hollow shell;
         c. manifold repair: cubes added where cubes touch along an edge or
-           at a vertex only, so the surface S is a 2-manifold (spec P6);
+           at a vertex only, so the surface S is a 2-manifold;
         d. the paper's correction step, read as in spec P5, undone per
            component where it would change the topology;
         e. extraction of S: one quad per exposed cube face, built as a
            strict half-edge mesh, with each quad's corner 0 fixed by an up
-           direction so anisotropic textures keep their direction (P8, P9).
+           direction so anisotropic textures keep their direction.
      2. tt_polycube_edge_colors: the Wang colouring of S's edges, per axis
         group (Sec. 3.2); tt_assign_boundaries turns it into tile types and
         tt_synthesize_tiles makes the tiles: the paper's rotation rules
         (Figs. 3-5) come out of Akleman's per-side rule on any consistently
-        oriented quad mesh, which S is (spec P9, P10).
+        oriented quad mesh, which S is.
      3. tt_polycube_map: the mapping of the model onto S (Sec. 4, spec
-        P11), in place of the paper's per-cell configurations (P11, P12):
+        P11), in place of the paper's per-cell configurations:
         a. the model refined until no edge is longer than half a cube, so
            a triangle holds about one vertex of S at most;
         b. tt_polycube_project: each vertex gets its point q(v) = (quad,
-           s, t) on S (P11 step 2);
+           s, t) on S;
         c. the relaxation of the points on S where a triangle folds or an
            edge finds no short path (step 5);
         d. tt_polycube_trace_edges: each edge gets its image on S, the
@@ -2623,7 +2623,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
      4. tt_polycube_mapping_uvs: each piece's points on S as texture
         coordinates in its quad's tile (step 6).
 
-   The grid (spec P2). L = the bounding box's longest side; the cube edge is
+   The grid. L = the bounding box's longest side; the cube edge is
    h = L / resolution, or options->cube_size. Each axis has
    max(1, ceil(extent / h)) cubes, centred on the bounding box (a flat mesh
    gets one layer, halfway through it), plus 2 empty cubes of padding on
@@ -2632,7 +2632,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    indices run x fastest: i + dims[0] * (j + dims[1] * k), and lattice
    points likewise with dims + 1 per axis.
 
-   Voxelisation (Sec. 3.1, spec P1, P3). The paper uses Voorhies' gem; this
+   Voxelisation (Sec. 3.1). The paper uses Voorhies' gem; this
    uses the exact separating-axis test of Akenine-Moeller (13 axes), in
    double, relative to the cube centre, over the cubes of each triangle's
    bounding box only (polygons: their fan triangles from corner 0). The
@@ -2646,7 +2646,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    boxes exactly the union. Zero-area triangles are skipped and counted
    (their edges belong to their neighbours).
 
-   Interior (spec P4). The exterior is flooded from the padding through
+   Interior. The exterior is flooded from the padding through
    face-connected empty cubes, and the empty cubes it does not reach are
    filled. A mesh with holes (an open scan, a model missing a few faces)
    lets the flood in, and the spec keeps such a polycube a hollow shell;
@@ -2664,7 +2664,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    A mesh with no hole (every edge shared), or a surface open all around
    (a bowl, a sheet), has nothing to seal.
 
-   Manifold repair (spec P6). Around a lattice point the 8 cubes give an
+   Manifold repair. Around a lattice point the 8 cubes give an
    occupancy mask; S is a disc there for exactly 126 of the 256 masks, and
    a mask is a disc (or empty, or full) exactly when it holds no critical
    configuration: C1, a 2 x 2 checkerboard around a lattice edge; C2, two
@@ -2678,7 +2678,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    order x, y, z of its steps). Adding only ever grows the set, so the
    loop ends and the model stays inside; then the interior is filled again.
 
-   Correction (Sec. 3.1, spec P5). The paper's sentence cannot be meant as
+   Correction (Sec. 3.1). The paper's sentence cannot be meant as
    written; read as: a cube is removed when one of its 8 corner cells (unit
    boxes centred on its corners) holds part of S but does not meet the
    model. One pass over the polycube as it is, then repair and fill. Where
@@ -2708,7 +2708,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
 #endif
 
 enum {
-    TT_POLYCUBE_NO_CORRECT = 1u << 0          /* skip the correction step (spec P5) */
+    TT_POLYCUBE_NO_CORRECT = 1u << 0          /* skip the correction step */
 };
 
 typedef struct tt_polycube_options {
@@ -2716,7 +2716,7 @@ typedef struct tt_polycube_options {
                            at most TT_POLYCUBE_MAX_RESOLUTION */
     double cube_size;   /* the cube edge h in mesh units; > 0 overrides resolution, 0 = use resolution */
     unsigned flags;     /* TT_POLYCUBE_* */
-    double up[3];       /* the up direction for the tiles' orientation (spec P9); zero = +Y. Only its
+    double up[3];       /* the up direction for the tiles' orientation; zero = +Y. Only its
                            axis counts: the lattice axis of its largest component (the first of equals),
                            with that component's sign */
 } tt_polycube_options;
@@ -2728,14 +2728,14 @@ typedef struct tt_polycube_report {
     int cubes;                  /* occupied cubes of the result */
     int quads;                  /* faces of S */
     int components;             /* connected components of S */
-    int filled;                 /* interior cubes added by the fills (P4), sealed ones included */
+    int filled;                 /* interior cubes added by the fills, sealed ones included */
     int sealed;                 /* of those, the cubes inside an open mesh, behind its holes */
-    int repaired;               /* cubes added by the manifold repair (P6) */
-    int removed;                /* cubes the correction removed where it was kept (P5); 0 when skipped */
+    int repaired;               /* cubes added by the manifold repair */
+    int removed;                /* cubes the correction removed where it was kept; 0 when skipped */
     int correction_reverted;    /* components where the correction was undone (it changed the topology) */
     int mesh_genus;             /* the input's genus when every component is closed and manifold, else -1 */
     int polycube_genus;         /* sum over S's components of (2 - chi) / 2 */
-    int genus_differs;          /* mesh_genus >= 0 and differs from polycube_genus: raise the resolution (P8) */
+    int genus_differs;          /* mesh_genus >= 0 and differs from polycube_genus: raise the resolution */
     int zero_area_triangles;    /* fan triangles the voxeliser skipped */
     int inside_out;             /* the mesh is closed and its faces wind inward (negative volume): its normals
                                    point in, and tt_polycube_project's side rule then picks the wrong side;
@@ -2758,7 +2758,7 @@ typedef struct tt_polycube {
 
 /* Build the polycube of `mesh` (any polygon mesh; each face is voxelised as
    its fan of triangles from corner 0) and its surface S.
-   Corner 0 of each quad, i.e. the tile's orientation (spec P9): corner 0 ->
+   Corner 0 of each quad, i.e. the tile's orientation: corner 0 ->
    1 is the tile's u axis, corner 0 -> 3 its v axis, and u x v points out of
    the polycube. With up = +A (a lattice axis A with sign s, see
    tt_polycube_options::up): a quad facing sideways (normal not along A)
@@ -2784,7 +2784,7 @@ TTDEF tt_result tt_polycube_build(const tt_mesh *mesh, const tt_polycube_options
                                   tt_error *error);
 TTDEF void tt_polycube_free(tt_polycube *polycube);
 
-/* The Wang colouring of S (Sec. 3.2, spec P9): every edge of S gets a
+/* The Wang colouring of S (Sec. 3.2): every edge of S gets a
    colour (boundary condition) in 0..colors-1. Edges fall into three groups
    by their direction, x, y and z. With axis_palettes non-zero each group
    first draws its own random 2 of the `colors` colours (all of them when
@@ -2800,7 +2800,7 @@ TTDEF tt_result tt_polycube_edge_colors(const tt_polycube *polycube, int colors,
 
 /* A point of S: a quad and its coordinates in it. s runs along the quad's
    corner 0 -> 1 and t along corner 0 -> 3, both in [0, 1]: the tile's u and
-   v (spec P9), so corners 0..3 are (0,0), (1,0), (1,1), (0,1). */
+   v, so corners 0..3 are (0,0), (1,0), (1,1), (0,1). */
 typedef struct tt_surface_point {
     int quad;           /* face of polycube->surface */
     float s, t;
@@ -2809,14 +2809,14 @@ typedef struct tt_surface_point {
 /* How tt_polycube_project placed the vertices (every vertex counts in
    exactly one of the first four). */
 typedef struct tt_polycube_projection_report {
-    int rays;           /* by a ray along the projection field (P11 step 2, the first choice) */
+    int rays;           /* by a ray along the projection field (the first choice) */
     int nearest;        /* by the closest point among the facelets facing the vertex's side (the second) */
     int fallbacks;      /* by the plain closest point on S, side ignored (target 0) */
     int on_surface;     /* already on S (closer than 1e-9 h to a facelet facing their side): mapped to themselves */
     double mean_distance, max_distance;   /* |p - q(v)| in units of h */
 } tt_polycube_projection_report;
 
-/* Projection of the model's vertices onto S (Sec. 4; spec P11 step 2): for
+/* Projection of the model's vertices onto S (Sec. 4): for
    each vertex v of `mesh` (normally the mesh the polycube was built from)
    its point q(v) on S, into points[v] (mesh->nverts entries).
    Method. n_v is the vertex's area-weighted normal, and a facelet "faces
@@ -2826,7 +2826,7 @@ typedef struct tt_polycube_projection_report {
    or a corner), interpolated trilinearly at the vertex and normalised.
    The spec sums all facelets; on a filled polycube that is the same but
    where the two sides of a thin part meet, and on the hollow shell of an
-   open mesh (spec P4) the inner and outer sheets lie within a cube of each
+   open mesh the inner and outer sheets lie within a cube of each
    other, so their normals cancel and d turns along the surface. In order:
      - a vertex closer than 1e-9 h to a facelet facing its side maps to
        itself (on a quad's edge or corner: the quad facing v's side best,
@@ -2836,8 +2836,8 @@ typedef struct tt_polycube_projection_report {
        DDA; S is where the ray passes from an occupied cube to an empty one
        or back): the nearest crossing of a facelet facing v's side. This
        sends the two sides of a thin part to opposite faces of its slab
-       (spec P4, P14) and works on both sides of S, as the correction
-       leaves the model partly outside (P5);
+       and works on both sides of S, as the correction
+       leaves the model partly outside;
      - else the closest point of S among the facelets facing v's side, by
        a search of the cubes in growing shells around p_v, up to
        TT_POLYCUBE_PROJECT_SIDE_REACH h away;
@@ -2876,7 +2876,7 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    0 <= p.quad < polycube->surface->nfaces, xyz is not NULL. */
 TTDEF void tt_polycube_point_position(const tt_polycube *polycube, tt_surface_point p, double xyz[3]);
 
-/* Unfolding (spec P11 steps 3-4). Each quad of S is the unit square of its
+/* Unfolding. Each quad of S is the unit square of its
    own (s, t) frame; two quads sharing an edge unfold into one plane by a
    rigid map that turns by a multiple of 90 degrees and shifts by whole
    units, so it is exact in floating point and any chain of them composes
@@ -2980,7 +2980,7 @@ typedef struct tt_polycube_edges {
    Snapping (P11 step 4.5): along and t within 1e-6 of 0 or 1 are set to
    0 or 1; the record is made once per edge, so the triangles on both sides
    read the same numbers and split the edge at bitwise identical points
-   (spec Q11): p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
+  : p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
    the half-edge crossed. along and t are double: an edge may cross many
    quads and step 4 rebuilds chart points from them, where float's 6e-8
    would be up to 1e-6 h on an edge 16 h long, the size of the snap.
@@ -3018,7 +3018,7 @@ TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
    triangle lies in one quad, and each output corner gets its point on S.
    The split points of a model edge come from its record of
    tt_polycube_trace_edges, made once per edge, so the two triangles on it
-   share the very same output vertices (no T-junction, no crack; spec Q11).
+   share the very same output vertices (no T-junction, no crack).
    Output vertex v < mesh->nverts is input vertex v; the others lie on the
    model's triangles, each with the (up to 3) input vertices and weights
    it interpolates, so normals, colours or skin weights carry through. */
@@ -3051,10 +3051,10 @@ typedef struct tt_polycube_map_report {
     int triangles;          /* triangles of the model after refinement (max_edge), the ones mapped */
     tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
     int relaxed;            /* moves of points on S that unfolded a fold or joined a vertex to its neighbours'
-                               sheet (P11 step 5) */
+                               sheet */
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
-    int fallback_triangles; /* of `triangles`, those put whole into one quad (P11 step 7): a local seam; target 0 */
+    int fallback_triangles; /* of `triangles`, those put whole into one quad: a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold; none is expected) */
     int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
 } tt_polycube_map_report;
@@ -3079,7 +3079,7 @@ typedef struct tt_polycube_mapping {
      2. tt_polycube_project (points within 1e-5 of a quad's edge are put
         on it, so the model's vertices on lattice lines are on S's edges
         exactly);
-     3. relaxation (P11 step 5): points of folded triangles move toward
+     3. relaxation: points of folded triangles move toward
         their neighbours' in a local chart of S, or into the kernel of
         their star, points cut off from their neighbours (no short path)
         onto a neighbour's sheet, a move kept only when it leaves the
@@ -3104,7 +3104,7 @@ typedef struct tt_polycube_mapping {
         onto a line; it is moved onto W unless another point is there,
         and the edges are traced again (a vertex whose edges then find no
         path goes back, and they are traced once more);
-     5. per triangle, the split (P11 step 4):
+     5. per triangle, the split:
         - its boundary (its vertices and its edges' split points, from
           the records) is unfolded into one chart from its first vertex's
           quad; where an edge runs along an edge of S the quad on the
@@ -3175,7 +3175,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
                                 tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error);
 TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping);
 
-/* Texture coordinates of a mapping (spec P11 step 6): corner i of output
+/* Texture coordinates of a mapping: corner i of output
    triangle f at point (quad, s, t) gets the point (s, t) of that quad's
    tile, u = (column*C + g + s*S) / W, v = (row*C + g + t*S) / W, the tile
    from the quad's four boundary types (corner_type: one per S half-edge,
@@ -14961,7 +14961,7 @@ done:
 /* 8. Hierarchical pattern mapping                                          */
 /* ------------------------------------------------------------------------ */
 
-/* ---- The face-cluster hierarchy (Soler et al. Sec. 3.1; spec D12-D14) ---- */
+/* ---- The face-cluster hierarchy (Soler et al. Sec. 3.1) ---- */
 
 TT__DEFINE_HEAPSORT(tt__sort_ints, int)
 
@@ -15434,7 +15434,7 @@ static int tt__hier_children(tt__hier *H, int ls, int le)
 }
 
 /* Control vertices of the border loop through border half-edge h0 of
-   cluster id (spec D12), appended to out[*count..]; marks the loop's
+   cluster id, appended to out[*count..]; marks the loop's
    half-edges in cmark. loopv, loops and loopc hold the loop (its length at
    most the cluster's border half-edges). */
 static void tt__hier_loop_control(tt__hier *H, int id, int h0, int single_face, int *loopv, double *loops,
@@ -16116,7 +16116,7 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
     rep.nborder = nb;
     rep.ninterior = nv - nb;
 
-    /* The control polygon: PCA plane, oriented by the area vector (D10). */
+    /* The control polygon: PCA plane, oriented by the area vector. */
     for (j = 0; j < k; j++) {
         double P[3];
         tt__flat_point(mesh, ctl[j], P);
@@ -16227,7 +16227,7 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
     }
     rep.polygon_simple = 1;
 
-    /* Cotangent weights, half-edge by half-edge, then per edge (D18). */
+    /* Cotangent weights, half-edge by half-edge, then per edge. */
     for (i = 0; i < n; i++)
         for (j = 0; j < 3; j++) {
             double a[3], b[3], o[3], u[3], v[3], cr[3], len;
@@ -16308,7 +16308,7 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
             }
     }
 
-    /* Measures (D9). */
+    /* Measures. */
     rep.mapped = 1;
     for (i = 0; i < n; i++) {
         double P0[3], P1[3], P2[3], e[3], f[3], cr[3], xa[3], l1, fx, fy, area3;
@@ -16427,7 +16427,7 @@ done:
 /* A textured neighbour of the cluster being placed, and the rigid map
    q = R(angle) (x / s) + shift that best takes its texture coordinates x
    (texels) of the shared vertices onto the cluster's flattened positions q
-   (spec D16). */
+  . */
 typedef struct tt__hpm_owner {
     int cluster;
     int shared;                 /* shared border vertices */
@@ -16462,7 +16462,7 @@ typedef struct tt__hpm {
     double angle[64];           /* their angles, radians: 0 first, then by growing |angle| */
     unsigned flags;
     tt_flatten_options fopt;
-    /* the image in the matching colour space (D3) */
+    /* the image in the matching colour space */
     int W, Hh, nch;
     float *full;                /* nch planes W x Hh */
     double sigma2;              /* mean per-channel variance */
@@ -16586,7 +16586,7 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
             return tt__fail_at(error, TT_ERROR_NON_FINITE, -1, (int)(i / (size_t)image->width),
                                (int)(i % (size_t)image->width), "texel (%d, %d) of the image is not finite",
                                (int)(i % (size_t)image->width), (int)(i / (size_t)image->width));
-        /* As displayed (D3, and as the seam measure compares them). */
+        /* As displayed (and as the seam measure compares them). */
         r = tt_linear_to_srgb(p[0]);
         g = tt_linear_to_srgb(p[1]);
         b = tt_linear_to_srgb(p[2]);
@@ -16604,7 +16604,7 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
     S->sigma2 = var / ((double)n * S->nch);
     if (!(S->sigma2 > 1e-12)) S->sigma2 = 1e-12; /* a flat image: every fit is perfect */
 
-    /* The matching copy: f x f box filter (D30). */
+    /* The matching copy: f x f box filter. */
     big = tt__max_i(S->W, S->Hh);
     S->f = 1;
     while (big > match_size * S->f) S->f *= 2;
@@ -16625,7 +16625,7 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
                 S->match[(size_t)c * S->ww * S->wh + (size_t)y * S->ww + x] = (float)(sum / cnt);
             }
 
-    /* P: a turned copy fits (bounded), or two periods do (toroidal; D5). */
+    /* P: a turned copy fits (bounded), or two periods do (toroidal). */
     {
         double need = S->toroidal ? 2.0 * tt__max_i(S->ww, S->wh)
                                   : sqrt((double)S->ww * S->ww + (double)S->wh * S->wh) + 2;
@@ -16705,7 +16705,7 @@ static int tt__hpm_textured_state(const tt__hpm *S, int C)
     return t == 0 ? 0 : (t == cl->nfaces ? 2 : 1);
 }
 
-/* The queue key of C (D22): textured neighbouring regions (any level),
+/* The queue key of C: textured neighbouring regions (any level),
    then the textured share of its border. Smaller keys pop first. */
 static double tt__hpm_key(tt__hpm *S, int C, int *count)
 {
@@ -16772,7 +16772,7 @@ static void tt__hpm_q(const tt__hpm *S, int c, double *q)
     q[1] = -(double)S->flat[2 * c + 1];
 }
 
-/* The textured neighbours of C and their rigid maps (D16). C's faces are
+/* The textured neighbours of C and their rigid maps. C's faces are
    marked in in_c with `stamp`. */
 static int tt__hpm_owners(tt__hpm *S, int C, int stamp)
 {
@@ -17088,7 +17088,7 @@ static void tt__hpm_near_faces(tt__hpm *S, int C, int stamp, double reach)
     }
 }
 
-/* The band width in image texels for cluster C (D15). */
+/* The band width in image texels for cluster C. */
 static double tt__hpm_band_width(const tt__hpm *S, int C)
 {
     double w;
@@ -17207,9 +17207,9 @@ static double tt__hpm_refine_turn(const tt__hpm *S, int C, tt__hpm_place *pl, do
 /* Step 3's allowed offsets, per turned copy (canvas cw x ch with C's
    support drawn): the support (footprint and band) stays on the grid
    without wrapping, and for a bounded image inside the turned image with
-   a margin of one texel (D6). With a main neighbour whose continuation is
+   a margin of one texel. With a main neighbour whose continuation is
    at canvas offset cont (o: the canvas origin), the offsets within
-   `exclusion` texels of it in copy 0 are left out (D8). Returns 0 when no
+   `exclusion` texels of it in copy 0 are left out. Returns 0 when no
    offset is allowed. The copies are independent tasks (the executor's). */
 typedef struct tt__hpm_allowed_job {
     tt__hpm *S;
@@ -17570,7 +17570,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     if (has_cont) {
         /* Shift the canvas by a fraction of a texel so that the main
            neighbour's texel grid falls on the canvas grid: its continuation
-           is then an integer offset (an exact match, D20), and every
+           is then an integer offset (an exact match), and every
            offset samples the copy where the neighbour's samples were. */
         o[0] -= (cont[0] / S->f + cb - ctx) - floor(cont[0] / S->f + cb - ctx);
         o[1] -= (cont[1] / S->f + cb - cty) - floor(cont[1] / S->f + cb - cty);
@@ -17634,7 +17634,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     }
 
     /* The placement of the best offset, refined at full resolution by a
-       direct sum over +-(f - 1) texels (D30). */
+       direct sum over +-(f - 1) texels. */
     {
         double th = S->angle[best_k], ct = cos(th), st = sin(th);
         double tx = match.x - o[0] - cb, ty = match.y - o[1] - cb, best = -1, vb[3], vc[3];
@@ -17709,7 +17709,7 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
     }
 }
 
-/* ---- The local relaxation along shared borders (Sec. 4.4, D25) ----
+/* ---- The local relaxation along shared borders (Sec. 4.4) ----
 
    After C is placed, at each vertex on its border with textured faces,
    C's texture coordinates there and then each textured neighbour's in
@@ -18053,7 +18053,7 @@ static int tt__hpm_relax(tt__hpm *S, int C)
 }
 
 /* D17: the band that C's place was fitted to shows each textured
-   neighbour N through its rigid map S_N (D16), and C's own flattening
+   neighbour N through its rigid map S_N, and C's own flattening
    puts a shared border vertex a little away from where S_N puts it (the
    two flattenings differ): the image would then be cut at C's border
    texels away from where the matched band ends, a crack. So each shared
@@ -18332,7 +18332,7 @@ static int tt__hpm_cancelled(const tt__hpm *S, float fraction, tt_result *res, t
     return 1;
 }
 
-/* The traversal (Sec. 2.2, D22). */
+/* The traversal (Sec. 2.2). */
 static tt_result tt__hpm_traverse(tt__hpm *S, tt_error *error)
 {
     tt_result res = TT_OK;
@@ -18344,7 +18344,7 @@ static tt_result tt__hpm_traverse(tt__hpm *S, tt_error *error)
         if (level == S->H->nlevels) {
             /* The queues are empty: a waiting cluster that now has a
                textured neighbour, else the first waiting one as a new
-               start, else the first cluster never reached (D22). */
+               start, else the first cluster never reached. */
             int i, pick = -1, kept = 0;
             for (i = 0; i < S->nwaiting; i++) {
                 int w = S->waiting[i];
@@ -18769,7 +18769,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     {
         /* The copies a fit tries: orientation k at 2 pi k / rotations when
            it turns no more than max_turn from the main neighbour (copy 0),
-           in the order 0, +1, -1, +2, -2, ... so that ties (D33) keep the
+           in the order 0, +1, -1, +2, -2, ... so that ties keep the
            smaller turn. */
         double limit = (o.max_turn > 0 ? o.max_turn : TT_DEFAULT_HPM_MAX_TURN) * TT__PI / 180 + 1e-9;
         int step;
@@ -18930,7 +18930,7 @@ typedef struct tt__voxels {
     const tt_allocator *allocator;
 } tt__voxels;
 
-/* The tolerance of the tie rule (spec P3; see the doc comment): boxes are
+/* The tolerance of the tie rule (see the doc comment): boxes are
    shrunk by it and triangles moved inward by twice it. It must exceed the
    rounding of the float input, or a face meant to lie on a lattice plane
    lands a rounding error on the wrong side of it: 1e-6 h, or 8 float ulps
@@ -19073,7 +19073,7 @@ static int tt__polycube_flood(tt__voxels *vox, unsigned char *label, unsigned ch
     return tail;
 }
 
-/* Interior fill (spec P4): flood the exterior from cube 0 (padding, so
+/* Interior fill: flood the exterior from cube 0 (padding, so
    empty, and the padding connects the whole outside) through 6-connected
    empty cubes; the empty cubes it does not reach become occupied. Returns
    how many. Uses vox->queue. */
@@ -19400,7 +19400,7 @@ static int tt__polycube_fix_and_queue(tt__voxels *vox, tt__repair_stack *s, int 
     return n;
 }
 
-/* Manifold repair (spec P6): every lattice point inside the grid is checked
+/* Manifold repair: every lattice point inside the grid is checked
    in order, and after each one the points whose blocks gained a cube are
    checked again (the stack) until none is critical, so at the end no
    critical configuration is left anywhere. Adds to *added. */
@@ -19619,7 +19619,7 @@ static void tt__polycube_quad_corners(int x, int y, int z, int side, int up_axis
     }
 }
 
-/* Extraction of S (spec P8): a quad per occupied cube face whose neighbour
+/* Extraction of S: a quad per occupied cube face whose neighbour
    is empty, cubes in index order and sides in order within a cube, on the
    lattice points they use (numbered in order of first use), built as a
    strict mesh. */
@@ -19938,7 +19938,7 @@ TTDEF tt_result tt_polycube_edge_colors(const tt_polycube *polycube, int colors,
     return TT_OK;
 }
 
-/* ---- Projection of the model's vertices onto S (Sec. 4; spec P11 step 2) ----
+/* ---- Projection of the model's vertices onto S (Sec. 4) ----
    Everything runs in lattice coordinates g = (p - origin) / h, where cube
    (i, j, k) is [i, i+1] x [j, j+1] x [k, k+1] and distances are in units
    of h. A facelet is named by its cube's linear index and its side
@@ -19985,7 +19985,7 @@ static void tt__polycube_field_at(const tt__voxels *grid, int i, int j, int k, c
 }
 
 /* The field for a vertex with this normal, interpolated trilinearly at g
-   (spec P11 step 1): continuous in g, and exactly the lattice values at
+  : continuous in g, and exactly the lattice values at
    lattice points. Zero outside the lattice. Not normalised. */
 static void tt__polycube_field(const tt__voxels *grid, const double g[3], const double normal[3], double d[3])
 {
@@ -20435,7 +20435,7 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
 }
 
 /* ------------------------------------------------------------------------ */
-/* Edge images on S (spec P11 step 3)                                       */
+/* Edge images on S                                       */
 /* ------------------------------------------------------------------------ */
 
 #define TT__EDGE_SNAP 1e-6              /* spec P11 step 4.5 */
@@ -21506,7 +21506,7 @@ failed:
     return result;
 }
 
-/* ---- Relaxation of the points on S (spec P11 step 5) ---- */
+/* ---- Relaxation of the points on S ---- */
 
 #define TT__RELAX_RADIUS 4          /* steps across S's edges a vertex's local chart spans */
 #define TT__RELAX_SEAT_RADIUS 2     /* the same around a neighbour's point, where a vertex may be re-seated */
@@ -22959,7 +22959,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
     return moved;
 }
 
-/* ---- The model split on S and its UVs (spec P11 steps 4, 6, 7) ---- */
+/* ---- The model split on S and its UVs (6, 7) ---- */
 
 #define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
                                        above the records' snap (1e-6), far below any real piece */
@@ -23657,7 +23657,7 @@ static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const 
 }
 
 /* Triangle f cut by the chart's grid into pieces, one per quad, each
-   fanned into output triangles (P11 step 4). 1 when done, 0 when the chart
+   fanned into output triangles. 1 when done, 0 when the chart
    does not allow it (the caller rolls back and takes the fallback), -1
    when out of memory. */
 static int tt__split_pieces(tt__split *S, int f, int *pieces)
