@@ -2288,7 +2288,7 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
         of a spherical cap keeps its circle (E_flat = tan^2(alpha/2) for any
         number of control vertices); the mapped border must then be a simple
         loop. TT_FLATTEN_BORDER_CHORD: placed on polygon edge i at their
-        fraction of the 3D arc length (the spec's D18 wording; a flat
+        fraction of the 3D arc length (a flat
         cluster with a bent border is then distorted).
      3. The interior: the harmonic map with cotangent weights, each clamped
         to at least 1e-3 times the mean |weight| (symmetric positive
@@ -2319,7 +2319,7 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
    because triangles whose corners all lie on one straight polygon edge
    lose their area and count as folds. */
 
-/* options->max_error = 0: E_flat above this refuses the cluster (D9: a
+/* options->max_error = 0: E_flat above this refuses the cluster (a
    spherical cap of half-angle up to about 35 degrees maps in one piece). */
 #define TT_DEFAULT_FLATTEN_MAX_ERROR 0.10
 /* Edge-length projection passes over the control polygon. */
@@ -2336,7 +2336,7 @@ typedef struct tt_flatten_options {
     double max_error;       /* the largest accepted E_flat = |r - 1|; 0 = TT_DEFAULT_FLATTEN_MAX_ERROR;
                                positive, +infinity for no limit */
     double max_stretch;     /* the largest accepted area-weighted 95th percentile of the per-triangle
-                               stretch sigma1 / sigma2; 0 = no shear check (the spec suggests 2); >= 1 */
+                               stretch sigma1 / sigma2; 0 = no shear check (2 is a sound value); >= 1 */
     int border;             /* TT_FLATTEN_BORDER_PROJECTED (0) or TT_FLATTEN_BORDER_CHORD */
     double cg_tolerance;    /* 0 = TT_DEFAULT_FLATTEN_CG_TOLERANCE; in (0, 1) */
     int cg_max_iterations;  /* 0 = tt_cg_solve's default, max(2 n, 100); >= 0 */
@@ -2592,7 +2592,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
            quads, not the paper's hollow shell;
         c. manifold repair: cubes added where cubes touch along an edge or
            at a vertex only, so the surface S is a 2-manifold;
-        d. the paper's correction step, read as in spec P5, undone per
+        d. the paper's correction step, read as explained below, undone per
            component where it would change the topology;
         e. extraction of S: one quad per exposed cube face, built as a
            strict half-edge mesh, with each quad's corner 0 fixed by an up
@@ -2602,8 +2602,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         tt_synthesize_tiles makes the tiles: the paper's rotation rules
         (Figs. 3-5) come out of Akleman's per-side rule on any consistently
         oriented quad mesh, which S is.
-     3. tt_polycube_map: the mapping of the model onto S (Sec. 4, spec
-        P11), in place of the paper's per-cell configurations:
+     3. tt_polycube_map: the mapping of the model onto S (Sec. 4), in place of the paper's per-cell configurations:
         a. the model refined until no edge is longer than half a cube, so
            a triangle holds about one vertex of S at most;
         b. tt_polycube_project: each vertex gets its point q(v) = (quad,
@@ -2914,7 +2913,7 @@ typedef struct tt_edge_crossing {
     double t;           /* the point on the mesh edge from its first vertex, 0..1 */
 } tt_edge_crossing;
 
-#define TT_POLYCUBE_EDGE_DEFAULT_QUADS 4      /* spec P11 step 3 */
+#define TT_POLYCUBE_EDGE_DEFAULT_QUADS 4      /* an edge's image crosses at most this many quads by default */
 #define TT_POLYCUBE_EDGE_MAX_QUADS 64
 
 typedef struct tt_polycube_edge_options {
@@ -2930,7 +2929,7 @@ typedef struct tt_polycube_edge_options {
    crossings at one t at a quad corner (along 0 or 1) pass an S vertex: on
    a flat vertex (4 quads) the path goes straight through it, on a saddle
    (5 or 6) it may bend there, so a chart unfolded across that vertex is
-   not flat (spec P11 step 4.3's cone points, met on an edge). */
+   not flat (cone points, met on an edge). */
 typedef struct tt_polycube_edges {
     int nedges;                 /* the mesh's undirected edges */
     int ncrossings;
@@ -2942,12 +2941,12 @@ typedef struct tt_polycube_edges {
     int *end_quads;             /* 2 * nedges: the quad edge e's image leaves its first vertex's point in, and the
                                    one it reaches the second's in; another than the point's own quad only where
                                    that point is a corner of S (then it lies in every quad around the corner) */
-    unsigned char *failed;      /* per edge: 1 = no consistent path within max_quads (P11 step 7's fallback) */
+    unsigned char *failed;      /* per edge: 1 = no consistent path within max_quads (its triangles fall back to one quad each) */
     int nfailed;
     tt_allocator allocator;     /* the one it was made with */
 } tt_polycube_edges;
 
-/* The image on S of every edge of `mesh` (spec P11 step 3, "edge images
+/* The image on S of every edge of `mesh` ("edge images
    (intrinsic)"), from its vertices' points (tt_polycube_project; npoints
    = mesh->nverts). For edge (a, b) the search runs over the quad paths
    from q_a's quad to q_b's with at most max_quads quads, none twice,
@@ -2975,9 +2974,9 @@ typedef struct tt_polycube_edges {
    crossings are the edges around the vertex the path passes, all at the
    vertex (along 0 or 1) and at one t; t runs in proportion to the length
    along the path. An edge with no consistent path is flagged in `failed`
-   and has no crossing; the triangles around it are for P11 step 7's
+   and has no crossing; the triangles around it are for the
    fallback.
-   Snapping (P11 step 4.5): along and t within 1e-6 of 0 or 1 are set to
+   Snapping: along and t within 1e-6 of 0 or 1 are set to
    0 or 1; the record is made once per edge, so the triangles on both sides
    read the same numbers and split the edge at bitwise identical points
   : p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
@@ -2994,7 +2993,7 @@ typedef struct tt_polycube_edges {
    to 6 takes about 5 times as long and leaves 0, 40 (0.4 %) and 170 (2 %)
    failed at 32: the rest join vertices that the projection sent to
    different sheets (more than 6 quads apart on S though less than 1 h
-   apart in 3D), which the relaxation of P11 step 5 is for.
+   apart in 3D), which the relaxation is for.
    Memory: the result (4 bytes per half-edge, 9 per edge, 24 per crossing)
    and a search state of about 5 KB; the search recurses max_quads deep.
    options and the allocator may be NULL. Results: TT_OK;
@@ -3012,7 +3011,7 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
                                         tt_polycube_edges **out, tt_error *error);
 TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
 
-/* The model mapped onto S (spec P11 steps 4, 6, 7; the paper's Sec. 4.3
+/* The model mapped onto S (the paper's Sec. 4.3
    with its cells replaced by S's quads, P12): every triangle of the model
    is split where its image on S crosses an edge of S, so that each output
    triangle lies in one quad, and each output corner gets its point on S.
@@ -15228,7 +15227,7 @@ static void tt__hier_voronoi(tt__hier_work *W, int n, int k)
         tt__heap_push(W->heap, &nheap, 0.0, seed);
         tt__hier_dijkstra(W, nheap, 0);
     }
-    /* Lloyd-like relaxation, for evener sizes (spec 1.1 step 3): move each
+    /* Lloyd-like relaxation, for evener sizes ): move each
        seed to its cell's centre, the face farthest from the cell's border
        (ties: the smallest face index), and partition again. */
     for (iter = 0; iter < TT__HIER_RELAX; iter++) {
@@ -16595,7 +16594,7 @@ static tt_result tt__hpm_prepare_image(tt__hpm *S, const tt_image *image, int ma
         S->full[2 * n + i] = (float)(0.5 * r - 0.418688 * g - 0.081312 * b);
         if (fabs(S->full[n + i]) > 1e-4 || fabs(S->full[2 * n + i]) > 1e-4) grey = 0;
     }
-    S->nch = grey ? 1 : 3; /* D32: no chroma planes for a grey image */
+    S->nch = grey ? 1 : 3; /* no chroma planes for a grey image */
     for (c = 0; c < S->nch; c++) {
         for (i = 0; i < n; i++) mean[c] += S->full[c * n + i];
         mean[c] /= (double)n;
@@ -17097,7 +17096,7 @@ static double tt__hpm_band_width(const tt__hpm *S, int C)
     return w < 3 ? 3 : (w > 24 ? 24 : w);
 }
 
-/* D28, orientation refinement: the copies are 360 / rotations degrees
+/* Orientation refinement: the copies are 360 / rotations degrees
    apart, so neighbouring patches of an anisotropic texture can disagree by
    up to half a step (9.5 degrees at 19). At the chosen offset the turn is
    refined by a golden-section search of the band's direct sum over +-half a
@@ -17307,7 +17306,7 @@ static int tt__hpm_allowed_offsets(tt__hpm *S, int cw, int ch, int has_cont, con
             }
     tt__run_tasks(S->executor, S->copies, tt__hpm_allowed_copy, &job);
     for (k = 0; k < S->copies; k++) any |= S->copy_any[k];
-    /* D8: not the exact continuation of that neighbour (copy 0 at
+    /* Not the exact continuation of that neighbour (copy 0 at
        the offset that repeats its map), nor anything within the
        cluster's radius of it, which would show the same texels shifted
        a little; unless asked for (TT_HPM_NO_RANDOM_TURN). */
@@ -18052,7 +18051,7 @@ static int tt__hpm_relax(tt__hpm *S, int C)
     return 1;
 }
 
-/* D17: the band that C's place was fitted to shows each textured
+/* The band that C's place was fitted to shows each textured
    neighbour N through its rigid map S_N, and C's own flattening
    puts a shared border vertex a little away from where S_N puts it (the
    two flattenings differ): the image would then be cut at C's border
@@ -19266,7 +19265,7 @@ static int tt__polycube_mask_is_disc(int mask)
     return roots == 1;
 }
 
-/* The critical configurations of spec P6 in a block's mask. *kind gets 1 for
+/* The critical configurations in a block's mask. *kind gets 1 for
    C1 (a checkerboard around spoke `spoke_axis`, its cubes' bit on that axis
    `*side`), 2 for C2 (two antipodal cubes alone), 3 for its complement (two
    antipodal cubes empty); returns 0 when there is none. */
@@ -19329,7 +19328,7 @@ static int tt__polycube_fix_point(tt__voxels *vox, int i, int j, int k, int *add
 {
     int spoke_axis = 0, side = 0, mask = tt__polycube_mask(vox, i, j, k), bit, n = 0, kind;
     /* Most points are outside or inside (mask 0 or 255) or on a disc: nothing to do. Otherwise the
-       critical configuration (there is one: spec P6's equivalence, tested) says what to add. */
+       critical configuration (there is one: their equivalence, tested) says what to add. */
     if (mask == 0 || mask == 255 || tt__polycube_mask_is_disc(mask)) return 0;
     kind = tt__polycube_mask_critical(mask, &spoke_axis, &side);
     if (kind == 1) {
@@ -19509,7 +19508,7 @@ static tt_result tt__polycube_try_correction(tt__voxels *vox, const unsigned cha
     return TT_OK;
 }
 
-/* The correction step (Sec. 3.1 as read in spec P5; see the doc comment). */
+/* The correction step (Sec. 3.1 as read in the doc comment). */
 static tt_result tt__polycube_correct(tt__voxels *vox, tt_polycube_report *report, tt_error *error)
 {
     const int lattice[2] = {vox->dims[0] + 1, vox->dims[1] + 1};
@@ -19685,7 +19684,7 @@ done:
     return result;
 }
 
-/* Options checked, and the grid of spec P2 laid out over the mesh's
+/* Options checked, and the grid laid out over the mesh's
    bounding box (see the doc comment). */
 static tt_result tt__polycube_grid(const tt_mesh *mesh, const tt_polycube_options *options, tt__voxels *vox,
                                    int *resolution, tt_error *error)
@@ -19843,7 +19842,7 @@ TTDEF tt_result tt_polycube_build(const tt_mesh *mesh, const tt_polycube_options
     pc->up_axis = up_axis;
     pc->up_sign = up_sign;
 
-    /* Sec. 3.1 / spec P1-P3: the cubes the surface meets. */
+    /* Sec. 3.1: the cubes the surface meets. */
     memset(vox.hit, 0, (size_t)vox.count);
     report->zero_area_triangles = tt__polycube_voxelize(mesh, vox.origin, vox.h, vox.dims, vox.tie, vox.hit);
     for (c = 0; c < vox.count && !vox.hit[c]; c++) {}
@@ -19853,7 +19852,7 @@ TTDEF tt_result tt_polycube_build(const tt_mesh *mesh, const tt_polycube_options
         goto done;
     }
     memcpy(vox.occupied, vox.hit, (size_t)vox.count);
-    /* Spec P4, P6: filled, made manifold, filled again. */
+    /* Filled, made manifold, filled again. */
     report->filled = tt__polycube_fill(&vox);
     if ((report->sealed = tt__polycube_seal(&vox, mesh, 1 + (report->resolution - 1) / TT__POLYCUBE_SEAL_CUBES)) < 0) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory building the polycube");
@@ -19862,7 +19861,7 @@ TTDEF tt_result tt_polycube_build(const tt_mesh *mesh, const tt_polycube_options
     report->filled += report->sealed;
     if ((result = tt__polycube_repair(&vox, &report->repaired, error)) != TT_OK) goto done;
     report->filled += tt__polycube_fill(&vox);
-    /* Spec P5: the correction needs the unit cells centred on the lattice points that the model meets. */
+    /* The correction needs the unit cells centred on the lattice points that the model meets. */
     if (!(options->flags & TT_POLYCUBE_NO_CORRECT)) {
         double cell_origin[3];
         int cell_dims[3];
@@ -19874,7 +19873,7 @@ TTDEF tt_result tt_polycube_build(const tt_mesh *mesh, const tt_polycube_options
         tt__polycube_voxelize(mesh, cell_origin, vox.h, cell_dims, vox.tie, vox.cell_hit);
         if ((result = tt__polycube_correct(&vox, report, error)) != TT_OK) goto done;
     }
-    /* Spec P8, P9: S. */
+    /* S, with the tiles' orientation. */
     if ((result = tt__polycube_extract(&vox, up_axis, up_sign, pc, error)) != TT_OK) goto done;
     if ((result = tt__polycube_genus(mesh, pc, allocator, report, error)) != TT_OK) goto done;
     for (a = 0; a < 3; a++) {
@@ -20290,7 +20289,7 @@ typedef struct tt__project_job {
 
 static void tt__project_range(void *context, int begin, int end)
 {
-    /* Spec P11 step 2: the rays' reach, and "on S" */
+    /* The rays' reach, and "on S" */
     const double ray_reach = 3.0, on_surface = 1e-9;
     const tt__project_job *job = (const tt__project_job *)context;
     const tt_polycube *polycube = job->pc;
@@ -20438,7 +20437,7 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
 /* Edge images on S                                       */
 /* ------------------------------------------------------------------------ */
 
-#define TT__EDGE_SNAP 1e-6              /* spec P11 step 4.5 */
+#define TT__EDGE_SNAP 1e-6              /* along an edge, t this close to 0 or 1 is snapped */
 #define TT__EDGE_EPS 1e-9               /* lengths in the unfolded plane, in units of h */
 #define TT__EDGE_ANGLE_EPS 1e-9         /* the funnel's directions, radians */
 #define TT__EDGE_SEARCH_BUDGET 200000   /* path steps per edge: a guard for large max_quads */
@@ -21083,7 +21082,7 @@ static void tt__trace_range_task(void *context, int begin, int end)
             R->crossings = grown;
         }
         {
-            /* P11 step 4.5, once per edge: no zero-length piece next to a vertex or a quad corner. Besides t
+            /* Once per edge: no zero-length piece next to a vertex or a quad corner. Besides t
                and along within TT__EDGE_SNAP of their ends, a crossing within TT__EDGE_SNAP h of either
                end of the edge - on S, or in space - is at that end (a vertex's point a float ulp off a quad
                corner gives a crossing there at a t far from 0, and its 3D point would round onto the
@@ -21264,7 +21263,7 @@ static tt_result tt__retrace_moved(const tt_polycube *polycube, const tt_mesh *m
     return TT_OK;
 }
 
-/* ---- The model refined (before spec P11 step 2) ---- */
+/* ---- The model refined (before the projection) ---- */
 
 /* The model refined for the split: its triangles halved along every edge
    longer than a bound until none is, so that a triangle spans few quads of
@@ -22712,7 +22711,7 @@ done:
     return moved;
 }
 
-/* Spec P11 step 5: points that leave a triangle folded on S or its edge
+/* The relaxation: points that leave a triangle folded on S or its edge
    without a short path (a vertex projected onto the wrong sheet, a fold
    in a concavity) are moved, a few sweeps over the vertices in order:
      - toward the mean of its neighbours' points (half way, or all the
@@ -22886,7 +22885,7 @@ static int tt__reseat_failures(tt__edge_search *S, const tt_mesh *model, const t
     return failures;
 }
 
-/* A vertex with an edge that finds no path on S (P11 step 7 would put both
+/* A vertex with an edge that finds no path on S (the fallback would put both
    its triangles whole into one quad, a local seam) sits on another sheet
    of S than its neighbour: the closest point chose the far side of a part
    about a cube thick, or of a fold of S. The relaxation cannot see it
@@ -23761,7 +23760,7 @@ static double tt__split_area3(const tt__split *S, int a, int b, const double p[3
     return 0.5 * tt__length3(n);
 }
 
-/* P11 step 4.3, for a triangle whose chart does not close or is not flat
+/* For a triangle whose chart does not close or is not flat
    (a cone point of S inside it, or a bend at a saddle on an edge): when
    every quad its boundary passes is around one S vertex V, the triangle
    is the fan from V over its boundary, each boundary segment with V a
@@ -23875,7 +23874,7 @@ static int tt__split_star(tt__split *S, int f, double area, int *pieces)
     return 0;
 }
 
-/* P11 step 7: triangle f whole in one quad - of its vertices' quads, the
+/* The fallback: triangle f whole in one quad - of its vertices' quads, the
    one facing most like it - its boundary (vertices and split points, so
    the neighbours meet it) fanned from its centroid. The paper's clamped
    projection onto the quad would fold a triangle that faces away from
