@@ -2612,8 +2612,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         d. tt_polycube_trace_edges: each edge gets its image on S, the
            quads it passes and where it crosses their edges (S half-edge,
            position on it, t on the mesh edge), one record per edge, so
-           the two triangles on an edge split it at the same points (step
-           3, P12, Q11); tt_polycube_unfold lays two quads side by side,
+           the two triangles on an edge split it at the same points;
+           tt_polycube_unfold lays two quads side by side,
            exactly;
         e. the triangle split (step 4): a triangle's boundary unfolded
            into one chart and clipped by the quad grid into pieces inside
@@ -2635,7 +2635,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    uses the exact separating-axis test of Akenine-Moeller (13 axes), in
    double, relative to the cube centre, over the cubes of each triangle's
    bounding box only (polygons: their fan triangles from corner 0). The
-   tie rule of P3, with a tolerance t = 1e-6 h (more for a mesh far from
+   tie rule, with a tolerance t = 1e-6 h (more for a mesh far from
    the origin: 8 float ulps of its largest coordinate, as the input is
    float): each triangle is moved 2t against its normal (into the solid)
    and each cube shrunk by t on every side, so a face on a
@@ -3012,7 +3012,7 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
 TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
 
 /* The model mapped onto S (the paper's Sec. 4.3
-   with its cells replaced by S's quads, P12): every triangle of the model
+   with its cells replaced by S's quads): every triangle of the model
    is split where its image on S crosses an edge of S, so that each output
    triangle lies in one quad, and each output corner gets its point on S.
    The split points of a model edge come from its record of
@@ -3135,8 +3135,8 @@ typedef struct tt_polycube_mapping {
           centroid into one quad - of its vertices' quads, the one facing
           most like it - laid flat in its own plane, turned so that its
           axis nearest the quad's s runs along s, at the model's scale or
-          shrunk to fit the quad, over its centroid's projection (P11 step
-          7, whose clamped projection would fold triangles facing away
+          shrunk to fit the quad, over its centroid's projection (a
+          clamped projection would fold triangles facing away
           from the quad): a local seam, counted in fallback_triangles,
           but no flipped piece.
    Every split point of an edge is one output vertex shared by the two
@@ -17716,20 +17716,20 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    across the borders at the vertex: the difference is taken at 8 points of
    each such edge, half a texel on either side of it (where the eye and the
    seam measure look; tt__hpm_edge_side), and moving the vertex moves
-   the points of its edges by (1 - t) of the move - the hat weight of D25.
+   the points of its edges by (1 - t) of the move - the hat weight of the paper's border relaxation.
    Moving both sides, not only C's, halves what is left of the seams (0.30
    to 0.21 on cluster borders of a 20k torus); the neighbour's other
    borders at the vertex are in the sum, so they do not pay for it. Each
    side gets TT__HPM_RELAX_TRIALS random trials per pass, greedy, in
    TT__HPM_RELAX_PASSES passes of radius w/2, w/4, ... (w the band width):
-   D25's radius w / 2^(depth + 1) is below a texel at the depths where most
+   The relaxation's radius w / 2^(depth + 1) is below a texel at the depths where most
    clusters map, so it would move nothing. A move is refused when a moved
    triangle would flip, shrink below a quarter of its area, or end up
    stretched (surface to texture) more than TT__HPM_RELAX_MAX_STRETCH and
    more than it was - the seams and the stretch measure pull against each
    other here, and 1.2 keeps the median stretch under 1.15 where most
    triangles are on a border - or when it would leave a bounded image's
-   margin. The interior is not re-solved (D25's last step): the moves are a
+   margin. The interior is not re-solved (the relaxation's last step): the moves are a
    few texels and only the border triangles absorb them. Exact
    continuations are left alone. */
 #define TT__HPM_RELAX_TRIALS 16
@@ -17740,7 +17740,7 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
 
 /* Colour mismatch along border half-edge h of C (twin in a textured face),
    summed over its sample points: the squared difference across the border,
-   half a texel inside either face (D25's error, what the eye and the seam
+   half a texel inside either face (the relaxation's error, what the eye and the seam
    measure see), weighted TT__HPM_RELAX_ACROSS; plus what each side shows
    against the other side's map continued over the edge to the same place.
    The second part is 0 for an exact continuation, where the first is not
@@ -18122,7 +18122,7 @@ static void tt__hpm_close_cracks(tt__hpm *S, int C, const tt__hpm_place *pl)
     }
 }
 
-/* D25's last step, the interior re-solve: the crack closing and the
+/* The relaxation's last step, the interior re-solve: the crack closing and the
    relaxation moved C's border vertices; carried by the border triangles
    alone, those moves would stretch them. So the displacement from C's
    rigid placement is spread into C's interior, each interior vertex
@@ -18417,8 +18417,8 @@ oom:
    choose where each cluster's map is placed, but the borders themselves
    stay where the hierarchy cut the mesh, and on a coarse mesh a border
    edge runs tens of texels straight through the pattern. So, as image
-   quilting chooses its cut and not only its placement (spec section 4,
-   "choose the band edges"), a face on a border may change sides: it shows
+   quilting chooses its cut and not only its placement ("choose the band
+   edges"), a face on a border may change sides: it shows
    the map of the neighbouring cluster across one of its edges instead -
    the neighbour's coordinates at the two shared vertices, the third
    unfolded isometrically from the surface (or the neighbour's own there,
@@ -23258,8 +23258,7 @@ static int tt__split_next_map(const tt__split *S, int quad, tt_quad_map map, con
 
 /* Triangle f's boundary: its vertices and the split points of its edges,
    in order, with their output vertices (made when new), and the segments
-   between them in their quads, as the edge records give them (spec P11
-   step 3). Then, for the chart:
+   between them in their quads, as the edge records give them. Then, for the chart:
      - the points one record puts at one place (a path passing a vertex of
        S, or leaving a model vertex that lies on a quad's edge) are one
        point: only the quad after them counts;
