@@ -1790,9 +1790,18 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         (b) the edge's image meets the patch's conservative polygonal hull
         (Sec. 3.3, Fig. 4), (c) the face's predicted map is not too distorted
         (a looser limit than the solved map's, as the prediction drifts from
-        the field: TT_LAPPED_GROW_DISTORTION); each new vertex is placed by similar-
-        triangle prediction from every patch face containing it and a mapped
-        edge, taking the centroid (Sec. 3.3, after Maillot et al.);
+        the field: TT_LAPPED_GROW_DISTORTION) nor folded. Two predictions
+        run side by side, and (c) asks it of both. The paper's unfolding
+        places each new vertex by similar triangles from the faces around
+        it with a mapped edge (Sec. 3.3, after Maillot et al.): it drifts
+        from the field where the field turns against the surface, which is
+        where a solved map would be distorted, so it is what stops growth
+        there. The paste's own map places the vertex where the faces around
+        it best follow the field (one step of the solve below); it decides
+        (b) and starts the solve. The unfolding also drifts in scale, at
+        random and more the finer the mesh, and growth nearest first goes on
+        where it shrank: deciding (b) as well, at a million faces it let a
+        paste take in ten times the surface its patch covers;
      4. solve the least-squares alignment of Sec. 3.4, sum over the patch's
         faces of |phi(S_f) - (1,0)|^2 + |phi(T_f) - (0,1)|^2, with the seed point
         held on the anchor, by conjugate gradients with a multigrid
@@ -11755,7 +11764,8 @@ typedef struct tt__lapper {
     int round_stamp;
     int seed_face, seed_sample;  /* the current paste's seed point */
     double expected_pastes;     /* TT_LAPPED_PASTES_PER_AREA estimate */
-    double *vert_uv;            /* 2 per vertex */
+    double *vert_uv;            /* 2 per vertex: the paste's map (predicted along the field, then solved) */
+    double *vert_unfolded;      /* 2 per vertex: the unfolding that decides where growth stops (tt__try_add_face) */
     double *vert_cut_distance;  /* per vertex: texture-space distance to the current paste's cuts */
     int *face_entry;            /* per face: its entry in the paste being recorded */
     unsigned char *seeded;      /* per face: pastes seeded on it (at most 255) */
@@ -12161,17 +12171,17 @@ static void tt__propagate_direction(tt__lapper *L, int g, int from, int paste)
     tt__face_axes(L, g);
 }
 
-/* Similar-triangle prediction (Sec. 3.3, after Maillot et al.): for every
-   face around vertex v whose other two corners x, y are mapped, place v so
-   the UV triangle is similar to the 3D one; v gets the mean of the
-   predictions, each weighted by 1 / (a^2 + b^2) where (a, b) is v's place
-   in units of the edge x y it comes from (along it and across it): the
-   error of x's and y's UVs reaches v scaled by about that distance, so a
-   short edge (a sliver's) seeing v far away would throw the mean off. The fan
-   walk starts at vert_corner, the outgoing boundary half-edge when v is on
-   a boundary, so one sweep sees every face. Returns 0 when no face
-   predicts v. */
-static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2])
+/* Similar-triangle prediction (Sec. 3.3, after Maillot et al.), in the
+   unfolding `unfolded` (2 per vertex): for every face around vertex v whose
+   other two corners x, y are mapped, place v so the UV triangle is similar
+   to the 3D one; v gets the mean of the predictions, each weighted by
+   1 / (a^2 + b^2) where (a, b) is v's place in units of the edge x y it
+   comes from (along it and across it): the error of x's and y's UVs reaches
+   v scaled by about that distance, so a short edge (a sliver's) seeing v far
+   away would throw the mean off. The fan walk starts at vert_corner, the
+   outgoing boundary half-edge when v is on a boundary, so one sweep sees
+   every face. Returns 0 when no face predicts v. */
+static int tt__unfold_vertex(const tt__lapper *L, const double *unfolded, int v, int paste, double uv[2])
 {
     const tt_mesh *mesh = L->mesh;
     const float *pv = mesh->pos + 3 * (size_t)v;
@@ -12183,7 +12193,7 @@ static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2
         int x = mesh->corner_vert[3 * f + (k + 1) % 3], y = mesh->corner_vert[3 * f + (k + 2) % 3];
         if (L->vert_stamp[x] == paste && L->vert_stamp[y] == paste) {
             const float *px = mesh->pos + 3 * (size_t)x, *py = mesh->pos + 3 * (size_t)y;
-            const double *ux = L->vert_uv + 2 * (size_t)x, *uy = L->vert_uv + 2 * (size_t)y;
+            const double *ux = unfolded + 2 * (size_t)x, *uy = unfolded + 2 * (size_t)y;
             double e[3], q[3], n[3], ee, along, across, w;
             int j;
             for (j = 0; j < 3; j++) { e[j] = (double)py[j] - px[j]; q[j] = (double)pv[j] - px[j]; }
@@ -12209,16 +12219,76 @@ static int tt__predict_vertex(const tt__lapper *L, int v, int paste, double uv[2
     return 1;
 }
 
+/* The paste's map at a new vertex v: where the faces around it whose other
+   two corners are mapped best follow the field, phi(T_f) = (0,1) and
+   phi(S_f) = (1,0) in the least-squares sense of Sec. 3.4 with the faces'
+   areas as weights; that is, one Gauss-Seidel step of the solve at v. It
+   keeps the field's scale and direction at every step, so the map does not
+   drift the way the unfolding does, whatever the density of the triangles.
+   In isotropic mode only face g, just given its direction, has one for this
+   paste. Returns 0 when no face places v. */
+static int tt__predict_vertex(const tt__lapper *L, int v, int g, int paste, double uv[2])
+{
+    const tt_mesh *mesh = L->mesh;
+    int start = mesh->vert_corner[v], c = start, guard = 0;
+    double weight = 0.0;
+    uv[0] = uv[1] = 0.0;
+    while (c >= 0 && guard++ < mesh->ncorners) {
+        int f = c / 3, k = c % 3, kx = (k + 1) % 3, ky = (k + 2) % 3;
+        int x = mesh->corner_vert[3 * f + kx], y = mesh->corner_vert[3 * f + ky];
+        if (L->vert_stamp[x] == paste && L->vert_stamp[y] == paste && (!L->isotropic || f == g)) {
+            const float *w = L->axis_weights + 6 * (size_t)f;   /* T's weights, then S's */
+            const double *ux = L->vert_uv + 2 * (size_t)x, *uy = L->vert_uv + 2 * (size_t)y;
+            double area = L->area[f], wt = w[k], ws = w[3 + k];
+            /* phi(T_f) and phi(S_f) without v's term */
+            double t0 = w[kx] * ux[0] + w[ky] * uy[0], t1 = w[kx] * ux[1] + w[ky] * uy[1];
+            double s0 = w[3 + kx] * ux[0] + w[3 + ky] * uy[0], s1 = w[3 + kx] * ux[1] + w[3 + ky] * uy[1];
+            uv[0] += area * (wt * (0.0 - t0) + ws * (1.0 - s0));
+            uv[1] += area * (wt * (1.0 - t1) + ws * (0.0 - s1));
+            weight += area * (wt * wt + ws * ws);
+        }
+        c = mesh->twin[3 * f + ky];
+        if (c == start) break;
+    }
+    if (!(weight > 0.0)) return 0;
+    uv[0] /= weight;
+    uv[1] /= weight;
+    return 1;
+}
+
+/* Whether face f's map in `uvs` (2 per vertex) takes both of its axes
+   within `limit` (tt__aligned_within): phi(T_f) near (0,1) and phi(S_f),
+   turned a quarter, too. A folded map turns phi(S_f) over while phi(T_f)
+   may still look right. */
+static int tt__face_map_within(const tt__lapper *L, const double *uvs, int f, tt__distortion_limit limit)
+{
+    const float *w = L->axis_weights + 6 * (size_t)f;
+    double image_t[2] = {0.0, 0.0}, image_s[2] = {0.0, 0.0}, turned_s[2];
+    int k;
+    for (k = 0; k < 3; k++) {
+        const double *uv = uvs + 2 * (size_t)L->mesh->corner_vert[3 * f + k];
+        image_t[0] += w[k] * uv[0];
+        image_t[1] += w[k] * uv[1];
+        image_s[0] += w[3 + k] * uv[0];
+        image_s[1] += w[3 + k] * uv[1];
+    }
+    turned_s[0] = -image_s[1];
+    turned_s[1] = image_s[0];
+    return tt__aligned_within(image_t, limit) && tt__aligned_within(turned_s, limit);
+}
+
 /* Add the face across half-edge c (of a patch face) if the three rules of
    Sec. 3.3 allow it: the patch stays a disc (the face meets the patch along
    one edge with a new vertex, or along two edges), and the face's predicted
    map is not too distorted ("patch growth is stopped when distortion
-   becomes excessive"). Returns 1 when it was added. */
+   becomes excessive"): both its unfolding and its map along the field
+   within TT_LAPPED_GROW_DISTORTION, and neither folded. Returns 1 when it
+   was added. */
 static int tt__try_add_face(tt__lapper *L, int c, int paste)
 {
     const tt_mesh *mesh = L->mesh;
     int t = mesh->twin[c], g = t / 3, v = mesh->corner_vert[3 * g + (t % 3 + 2) % 3], shared = 0, k, mapped;
-    double uv[2], image_t[2];
+    double uv[2];
     if (L->face_stamp[g] == paste) return 0;
     for (k = 0; k < 3; k++) {
         int u = mesh->twin[3 * g + k];
@@ -12227,13 +12297,17 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
     mapped = L->vert_stamp[v] == paste;
     if (mapped ? shared != 2 : shared != 1) return 0;
     if (L->isotropic) tt__propagate_direction(L, g, c, paste);
-    if (!mapped) {
-        if (!tt__predict_vertex(L, v, paste, uv)) return 0;
-        L->vert_uv[2 * (size_t)v] = uv[0];        /* provisional until v is stamped */
+    if (!mapped) {   /* both provisional until v is stamped */
+        if (!tt__predict_vertex(L, v, g, paste, uv)) return 0;
+        L->vert_uv[2 * (size_t)v] = uv[0];
         L->vert_uv[2 * (size_t)v + 1] = uv[1];
+        if (!tt__unfold_vertex(L, L->vert_unfolded, v, paste, uv)) return 0;
+        L->vert_unfolded[2 * (size_t)v] = uv[0];
+        L->vert_unfolded[2 * (size_t)v + 1] = uv[1];
     }
-    tt__face_up_image(L, g, image_t);
-    if (!tt__aligned_within(image_t, L->grown_limit)) return 0;
+    if (!tt__face_map_within(L, L->vert_uv, g, L->grown_limit) ||
+        !tt__face_map_within(L, L->vert_unfolded, g, L->grown_limit))
+        return 0;
     L->face_stamp[g] = paste;
     if (!mapped) tt__map_vertex(L, v, paste);
     tt__add_patch_face(L, g);
@@ -12243,6 +12317,13 @@ static int tt__try_add_face(tt__lapper *L, int c, int paste)
 static void tt__grow_patch(tt__lapper *L, int paste, int patch)
 {
     int i, count = L->npatch_faces;
+    /* The unfolding starts afresh from the paste's map (solved, after the
+       first round): drift is measured from there. */
+    for (i = 0; i < L->npatch_verts; i++) {
+        size_t v = (size_t)L->patch_verts[i];
+        L->vert_unfolded[2 * v] = L->vert_uv[2 * v];
+        L->vert_unfolded[2 * v + 1] = L->vert_uv[2 * v + 1];
+    }
     L->round_stamp++;
     L->heap_count = 0;
     for (i = 0; i < count; i++) tt__queue_edges(L, L->patch_faces[i], paste, patch);
@@ -12896,6 +12977,7 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->edge_stamp);
     tt__free(L->al, L->vert_local);
     tt__free(L->al, L->vert_uv);
+    tt__free(L->al, L->vert_unfolded);
     tt__free(L->al, L->vert_cut_distance);
     tt__free(L->al, L->face_entry);
     tt__free(L->al, L->seeded);
@@ -12987,6 +13069,7 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->edge_stamp = TT__ALLOC(L->al, int, mesh->ncorners);
     L->vert_local = TT__ALLOC(L->al, int, nv);
     L->vert_uv = TT__ALLOC(L->al, double, 2 * (size_t)nv);
+    L->vert_unfolded = TT__ALLOC(L->al, double, 2 * (size_t)nv);
     L->patch_faces = TT__ALLOC(L->al, int, nf);
     L->patch_corners = TT__ALLOC(L->al, int, 3 * (size_t)nf);
     L->patch_verts = TT__ALLOC(L->al, int, nv);
@@ -13005,8 +13088,8 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         !L->top_patch || !L->near_stamp || !L->near_queue || !L->anchor || !L->normal || !L->tangent ||
         !L->axis_weights || !L->area || !L->difficulty || !L->sample_res || !L->sample_start || !L->covered_count ||
         !L->uncovered || !L->uncovered_pos || !L->face_stamp || !L->vert_stamp || !L->edge_stamp || !L->vert_local ||
-        !L->vert_uv || !L->patch_faces || !L->patch_corners || !L->patch_verts || !L->heap || !L->row_start || !L->row_fill ||
-        !L->column_mark || !L->solve || !L->depth || !L->vert_cut_distance || !L->face_entry || !L->seeded ||
+        !L->vert_uv || !L->vert_unfolded || !L->patch_faces || !L->patch_corners || !L->patch_verts || !L->heap ||
+        !L->row_start || !L->row_fill || !L->column_mark || !L->solve || !L->depth || !L->vert_cut_distance || !L->face_entry || !L->seeded ||
         !L->hidden_below)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     for (i = 0; i < L->npatches; i++) {
