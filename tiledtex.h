@@ -8757,6 +8757,9 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
                 tt__side_to_tile(&s, side, x, d, &tx, &ty);
                 out = tt__synth_texel(&s, tx, ty);
                 tt__edge_value(&s, side, types[side], x, d, out);
+                /* a source vector that is not a unit one (a map made by
+                   hand) is one here too, as in the tile */
+                if (s.normal) tt__normalize_vector_texel(out);
                 out[3] = 1.0f;
             }
 }

@@ -733,6 +733,52 @@ done:
     tt_image_free(normal);
 }
 
+/* A normal map whose texels are not unit vectors (made by hand: here every
+   one of length 2) still gives an atlas of unit vectors, gutters and mips
+   included: the gutters once copied the source's vectors as they were. */
+static void test_normal_map_not_unit(void)
+{
+    const int W = 96, H = 96;
+    tt_image *normal = NULL;
+    tt_synth_options o = sy_options(1, 24, 3, 7u);
+    tt_tileset *normals = NULL;
+    tt_error err;
+    tt_result r;
+    int x, y, level, not_unit = 0, texels = 0;
+    tt_image_create(W, H, NULL, &normal, NULL);
+    if (!normal) {
+        CHECK(0, "test image");
+        goto done;
+    }
+    normal->kind = TT_IMAGE_NORMAL;
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            float *n = sy_px(normal, x, y);
+            double a = 0.05 * x, b = 0.04 * y;
+            n[0] = (float)(2.0 * 0.5 * cos(a));
+            n[1] = (float)(2.0 * 0.5 * sin(b));
+            n[2] = (float)(2.0 * sqrt(1.0 - 0.25 * cos(a) * cos(a) - 0.25 * sin(b) * sin(b)));
+            n[3] = 1.0f;
+        }
+    r = tt_synthesize_tiles(normal, &o, NULL, &normals, &err);
+    CHECK(r == TT_OK, "normal map of length-2 vectors: %d (%s)", r, err.message);
+    if (r != TT_OK) goto done;
+    for (level = 0; level < normals->nlevels; level++) {
+        const tt_image *im = &normals->levels[level];
+        size_t i, count = (size_t)im->width * (size_t)im->height;
+        for (i = 0; i < count; i++) {
+            const float *p = im->pixels + 4 * i;
+            double length = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+            not_unit += fabs(length - 1.0) > 1e-5;
+            texels++;
+        }
+    }
+    CHECK(not_unit == 0, "%d of %d texels of the atlas and its mips are not unit vectors", not_unit, texels);
+done:
+    tt_tileset_free(normals);
+    tt_image_free(normal);
+}
+
 /* B = s * A + o texel by texel (one s, o per channel): every atlas level of
    B is s * atlas_A + o up to float rounding. The masks do not depend on the
    applied image, and every step (over, corner means, mip averages) is an
@@ -1277,6 +1323,7 @@ void run_tiled_synthesis_tests(void)
     RUN(test_upright_tiles);
     RUN(test_second_map_same_masks);
     RUN(test_normal_map_turns);
+    RUN(test_normal_map_not_unit);
     RUN(test_affine_map);
     RUN(test_plan_create_errors);
     RUN(test_compose_tile_errors);
