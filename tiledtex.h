@@ -10567,7 +10567,10 @@ static tt_result tt__field_smooth(tt__field *F)
     memset(&cg, 0, sizeof cg);
     cg.tolerance = TT__FIELD_TOLERANCE;
     result = tt_cg_solve(A, rhs, &cg, al, x, NULL, NULL);
-    if (result == TT_ERROR_NOT_CONVERGED) result = TT_OK;   /* the last iterate is as smooth a field */
+    /* The last iterate is as smooth a field; on a breakdown (degenerate
+       faces whose rows are all zero make the matrix only semidefinite) it is
+       the start or the last step before it, both fields. */
+    if (result == TT_ERROR_NOT_CONVERGED || result == TT_ERROR_NOT_POSITIVE_DEFINITE) result = TT_OK;
     if (result != TT_OK) goto done;
     for (f = 0; f < F->nf; f++) {
         const int u = unknown[f];
@@ -10596,7 +10599,7 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
 {
     tt__field F;
     tt_result result;
-    int f;
+    int f, smoothing = 0;
 
     if (!mesh || !face_vectors)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -10619,7 +10622,9 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
        default rule, then propagation into what is left. */
     if ((result = tt__field_check_constraints(&F, error)) != TT_OK) goto done;
     if (F.opt.nconstraints > 0 && (result = tt__field_constraints(&F)) != TT_OK) goto done;
+    smoothing = 1;
     if ((result = tt__field_smooth(&F)) != TT_OK) goto done;
+    smoothing = 0;
 
     for (f = 0; f < 3 * F.nf; f++) face_vectors[f] = (float)F.vec[f];
     result = tt__ok(error);
@@ -10627,6 +10632,9 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
 done:
     if (result == TT_ERROR_OUT_OF_MEMORY)
         tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory building the tangent field");
+    else if (result != TT_OK && smoothing)
+        tt__fail(error, result, -1, -1, -1, -1,
+                 "the tangent field's smoothing failed (%s): coordinates too large or small", tt_result_string(result));
     tt__free(F.al, F.normal);
     tt__free(F.al, F.vec);
     tt__free(F.al, F.state);
@@ -12870,10 +12878,12 @@ static int tt__lapper_reorder(tt__lapper *L, const tt_mesh *mesh, const float *f
         for (f = 0; f < nf; f++) {
             unsigned code = 0, cell[3];
             for (k = 0; k < 3; k++) {
-                double c = (mesh->pos[3 * (size_t)mesh->corner_vert[3 * f] + k] +
-                            mesh->pos[3 * (size_t)mesh->corner_vert[3 * f + 1] + k] +
-                            mesh->pos[3 * (size_t)mesh->corner_vert[3 * f + 2] + k]) / 3.0;
+                /* in double: three floats near FLT_MAX add up beyond it */
+                double c = ((double)mesh->pos[3 * (size_t)mesh->corner_vert[3 * f] + k] +
+                            (double)mesh->pos[3 * (size_t)mesh->corner_vert[3 * f + 1] + k] +
+                            (double)mesh->pos[3 * (size_t)mesh->corner_vert[3 * f + 2] + k]) / 3.0;
                 double t = hi[k] > lo[k] ? (c - lo[k]) / (hi[k] - lo[k]) : 0.0;
+                t = t > 0.0 ? (t < 1.0 ? t : 1.0) : 0.0;   /* NaN too */
                 cell[k] = (unsigned)(t * 1023.0 + 0.5);
             }
             for (i = 0; i < 10; i++)

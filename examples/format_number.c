@@ -17,6 +17,7 @@
    The result is the same text as printf("%.9g") except, rarely, in the 9th
    digit when the exact value lies within about 1e-7 of a rounding tie;
    either text reads back as the same float. */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -142,4 +143,16 @@ int tool_format_int(long value, char *out)
     if (magnitude >= 10u) memcpy(out + i - 2, digit_pairs + 2 * magnitude, 2);
     else out[i - 1] = (char)('0' + magnitude);
     return length + ndigits;
+}
+
+float tool_float_of(double value)
+{
+    /* FLT_MAX + half the step between floats there: (2 - 2^-24) 2^127, the
+       tie, which rounds to even (up: FLT_MAX's last bit is odd). */
+    const double overflows = 3.4028235677973366e+38;
+    if (value >= overflows) return (float)INFINITY;
+    if (value <= -overflows) return (float)-INFINITY;
+    if (value > FLT_MAX) return FLT_MAX;
+    if (value < -FLT_MAX) return -FLT_MAX;
+    return (float)value;
 }

@@ -3,6 +3,7 @@
    PNG files (png_write.c compresses them). See tool.h for the interface. */
 
 #include <limits.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -138,22 +139,33 @@ int image_load(const char *path, tt_color_space space, tt_image **image, char *e
    table's 257 code sizes when a JPEG's DHT segment declares more than 256
    codes: a hostile file could corrupt the decoder's memory. Such a table
    is invalid JPEG, so the file is refused before stb_image sees it: walk
-   the segments up to the first scan and check each table's code count. */
+   the segments as the decoder does and check each table's code count. A
+   progressive JPEG defines tables between its scans too, so the walk goes
+   on through each scan's coded data, where 0xFF is followed by 0x00 or a
+   restart marker; like the decoder, it steps over bytes that start no
+   segment until the next 0xFF. */
 static int jpeg_huffman_tables_overflow(const unsigned char *data, size_t size)
 {
-    size_t at = 2;
-    if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) return 0;
+    size_t at = 0;
+    /* the start marker, after as many fill bytes (0xFF) as the file has */
+    if (size < 2 || data[0] != 0xFF) return 0;
+    while (at < size && data[at] == 0xFF) at++;
+    if (at == size || data[at] != 0xD8) return 0;
+    at++;
     while (at + 4 <= size) {
         size_t length, end, table;
         unsigned marker;
-        if (data[at] != 0xFF) return 0;   /* not a segment: leave it to the decoder */
+        if (data[at] != 0xFF) {           /* coded data, or junk the decoder skips too */
+            at++;
+            continue;
+        }
         marker = data[at + 1];
         if (marker == 0xFF) {             /* fill byte */
             at++;
             continue;
         }
-        if (marker == 0xDA || marker == 0xD9) return 0;   /* the scan (or the end) starts */
-        if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
+        if (marker == 0xD9) return 0;     /* the end */
+        if (marker == 0x00 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
             at += 2;
             continue;
         }
@@ -161,14 +173,43 @@ static int jpeg_huffman_tables_overflow(const unsigned char *data, size_t size)
         if (length < 2) return 0;
         end = at + 2 + length;
         if (end > size) end = size;
+        /* As the decoder reads a DHT: table after table while the segment's
+           length lasts, each table's 16 counts read whole even where they run
+           past the segment's end (or, as zeros, past the file's) */
         if (marker == 0xC4)
-            for (table = at + 4; table + 17 <= end;) {
+            for (table = at + 4; table < end;) {
                 size_t codes = 0, k;
-                for (k = 1; k <= 16; k++) codes += data[table + k];
+                for (k = 1; k <= 16; k++) codes += table + k < size ? data[table + k] : 0;
                 if (codes > 256) return 1;
                 table += 17 + codes;
             }
         at = at + 2 + length;
+    }
+    return 0;
+}
+
+/* stb_image reads a binary PNM's width, height and maximum value into an
+   int, digit by digit, without a bound: a longer number is undefined
+   behaviour there. The header is read here as the decoder reads it (its
+   whitespace and # comments) and a number over INT_MAX refused. */
+static int pnm_header_overflows(const unsigned char *data, size_t size)
+{
+    size_t at = 2;
+    int c, number;
+    if (size < 2 || data[0] != 'P' || (data[1] != '5' && data[1] != '6')) return 0;
+    c = at < size ? data[at++] : 0;
+    for (number = 0; number < 3; number++) {
+        uint64_t value = 0;
+        for (;;) {
+            while (at < size && (c == ' ' || (c >= '\t' && c <= '\r'))) c = data[at++];
+            if (at >= size || c != '#') break;
+            while (at < size && c != '\n' && c != '\r') c = data[at++];
+        }
+        while (at < size && c >= '0' && c <= '9') {
+            value = value * 10 + (uint64_t)(c - '0');
+            if (value > INT_MAX) return 1;
+            c = data[at++];
+        }
     }
     return 0;
 }
@@ -182,6 +223,18 @@ int image_load_memory(const unsigned char *file_data, size_t file_size, const ch
     *image = NULL;
     if (file_size > INT_MAX) {
         tool_set_error(err, err_size, "'%s' is too large to be an image this tool can read", path);
+        return -1;
+    }
+    /* Before stb_image reads anything: its header scan already reads the
+       Huffman tables that come before a JPEG's frame header, and a PNM's
+       numbers. */
+    if (jpeg_huffman_tables_overflow(file_data, file_size)) {
+        tool_set_error(err, err_size, "cannot decode '%s' (a corrupt JPEG: a Huffman table of more than 256 codes)",
+                       path);
+        return -1;
+    }
+    if (pnm_header_overflows(file_data, file_size)) {
+        tool_set_error(err, err_size, "cannot decode '%s' (a corrupt PNM header: a number over %d)", path, INT_MAX);
         return -1;
     }
     /* Look at the header first: a corrupt or hostile file can claim a huge
@@ -208,11 +261,6 @@ int image_load_memory(const unsigned char *file_data, size_t file_size, const ch
                        "'%s' is %dx%d = %llu pixels, over the limit of %llu (raise it with --max-pixels N)", path,
                        width, height, (unsigned long long)width * (unsigned long long)height,
                        (unsigned long long)image_max_pixels);
-        return -1;
-    }
-    if (jpeg_huffman_tables_overflow(file_data, file_size)) {
-        tool_set_error(err, err_size, "cannot decode '%s' (a corrupt JPEG: a Huffman table of more than 256 codes)",
-                       path);
         return -1;
     }
     pixels = stbi_load_from_memory(file_data, (int)file_size, &width, &height, &channels, 0);

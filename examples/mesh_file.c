@@ -228,8 +228,7 @@ static int add_vertex(mesh_builder *b, const double xyz[3], int line)
         b->vert_capacity = capacity;
     }
     for (k = 0; k < 3; k++)   /* beyond float range: infinity, which the library names */
-        m->pos[3 * (size_t)m->nverts + k] = fabs(xyz[k]) > FLT_MAX ? (float)(xyz[k] > 0 ? INFINITY : -INFINITY)
-                                                                     : (float)xyz[k];
+        m->pos[3 * (size_t)m->nverts + k] = tool_float_of(xyz[k]);
     m->vert_line[m->nverts++] = line;
     return 0;
 }

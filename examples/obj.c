@@ -218,11 +218,8 @@ static int read_number(obj_parser *P, float *out)
     value = strtod(text, &end);
     if (end != text + length) return -1;
     /* NaN and infinity are passed through (the library rejects them with a
-       message naming the vertex); a finite double beyond float range becomes
-       infinity explicitly, because converting it is undefined behaviour. */
-    if (value > FLT_MAX) *out = (float)INFINITY;
-    else if (value < -FLT_MAX) *out = (float)-INFINITY;
-    else *out = (float)value;
+       message naming the vertex), as is a number beyond float range. */
+    *out = tool_float_of(value);
     return 1;
 }
 

@@ -883,6 +883,13 @@ void tool_format_seams(const tool_seams *seams, const char *edges, char *text, s
 int tool_format_float(float value, char *out);
 /* A decimal integer the same way. */
 int tool_format_int(long value, char *out);
+/* A number read as a double (strtod), as a float: the float nearest to it,
+   as the conversion rounds, and infinity only where that rounding
+   overflows (from FLT_MAX + half its step up). Converting a double beyond
+   FLT_MAX is undefined in C, and calling all of them infinity would read
+   the text printed for FLT_MAX (3.40282347e+38, a little above it) as
+   infinity. NaN stays NaN. */
+float tool_float_of(double value);
 
 /* ---------------------------------------------------------------------- */
 /* Time and progress on a terminal (tool_io.c)                              */

@@ -1850,6 +1850,18 @@ cd "$W" || exit 1
 tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_huffman_257_codes" >"$W/in/huffman257.jpg"
 expect_error "a JPEG with a 257-code Huffman table" synth ../in/huffman257.jpg out.png --tile 16
 err_mentions "the 257-code JPEG: says why" "Huffman table"
+# The same table in a DHT segment between the scans of a progressive JPEG,
+# behind bytes that start no segment (the decoder skips them), is refused
+# too; a valid progressive JPEG and one with restart markers are read.
+tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_dht_after_first_scan" >"$W/in/dht_late.jpg"
+expect_error "a JPEG with a 520-code Huffman table after junk bytes" synth ../in/dht_late.jpg out.png --tile 16
+err_mentions "the late 520-code table: says why" "Huffman table"
+newdir
+for jpeg in jpeg_progressive_64x48 jpeg_restart_markers_64x48; do
+    tail -c +3 "$ROOT/tests/fuzz/corpus_image/$jpeg" >"$W/in/$jpeg.jpg"
+    expect_ok "a valid JPEG is read: $jpeg" synth ../in/$jpeg.jpg "$jpeg.png" --tile 16 --colors 1
+done
+cd "$W" || exit 1
 
 # Ctrl-C (SIGINT) or SIGTERM during a long library call cancels it through
 # the progress callback: one line saying so, exit status 130, nothing

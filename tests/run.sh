@@ -247,23 +247,32 @@ fi
 # FUZZ_SMOKE_SECONDS (default 8), in a scratch copy so the repository's seeds
 # stay as they are. `make fuzz` runs them for longer. Without clang's
 # libFuzzer (run.sh installs it when root) each is skipped, saying why.
-# Off unless FUZZ_SMOKE=1 while two findings are open (issue 21):
-# fuzz_synth's normal-map texel of length 2.19 and stb_image's Huffman
-# table overflow in a DHT segment after a progressive JPEG's first scan.
+# FUZZ_SMOKE=0 skips them (building the targets takes a few minutes).
+# fuzz_image runs its seeds only: mutating JPEGs finds, within minutes, reads
+# out of bounds inside Debian's stb_image (2.27: a Huffman symbol index gone
+# negative in its decoder, checked upstream from 2.28 on) that the tool
+# cannot check for before decoding. `make fuzz` mutates it too.
+seeds_only=" image "
 echo "== fuzz smoke runs (tests/fuzz, clang libFuzzer + ASan + UBSan)"
-if [ "${FUZZ_SMOKE:-0}" != 1 ]; then
-    echo "skip fuzz smoke runs: FUZZ_SMOKE=1 runs them (two findings open: see tests/run.sh)"
+if [ "${FUZZ_SMOKE:-1}" = 0 ]; then
+    echo "skip fuzz smoke runs: FUZZ_SMOKE=0"
 elif fuzz_targets=$(FUZZ_BUILD_ONLY=1 bash tests/fuzz/run.sh 2>"$OUT/fuzz_build.log"); then
     for t in $fuzz_targets; do
         scratch=$(mktemp -d)
         cp tests/fuzz/corpus_"$t"/* "$scratch"/ 2>/dev/null
         dict=()
         [ -f tests/fuzz/"$t".dict ] && dict=("-dict=tests/fuzz/$t.dict")
-        if log=$(build/fuzz/fuzz_"$t" -max_total_time="${FUZZ_SMOKE_SECONDS:-8}" -seed=1 -max_len=4096 -timeout=20 \
+        runs=()
+        [[ "$seeds_only" == *" $t "* ]] && runs=(-runs=0)
+        if log=$(build/fuzz/fuzz_"$t" "${runs[@]}" -max_total_time="${FUZZ_SMOKE_SECONDS:-8}" -seed=1 -max_len=4096 -timeout=20 \
             -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="build/fuzz/smoke_$t-" "${dict[@]}" "$scratch" 2>&1); then
             execs=$(printf '%s\n' "$log" | sed -n 's/^stat::number_of_executed_units: *//p' | tail -1)
             deep=$(printf '%s\n' "$log" | grep -o '[0-9]* of [0-9]* runs ([0-9.]* %) reached .*' | tail -1)
-            pass "fuzz smoke: fuzz_$t, seeds and ${execs:-?} runs in ${FUZZ_SMOKE_SECONDS:-8} s${deep:+; $deep}"
+            if [ ${#runs[@]} -gt 0 ]; then
+                pass "fuzz smoke: fuzz_$t, its seeds (${execs:-?} runs)"
+            else
+                pass "fuzz smoke: fuzz_$t, seeds and ${execs:-?} runs in ${FUZZ_SMOKE_SECONDS:-8} s${deep:+; $deep}"
+            fi
         else
             fail "fuzz smoke: fuzz_$t found a problem (input saved as build/fuzz/smoke_$t-*)" \
                 "$(printf '%s\n' "$log" | grep -E 'contract broken|ERROR: |runtime error|Test unit written' | head -n 6)"

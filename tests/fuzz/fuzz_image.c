@@ -7,9 +7,11 @@
 
    Build (tests/fuzz/run.sh does this; stb_image from libstb-dev):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+             -fno-sanitize=shift (see tests/fuzz/run.sh) \
              -I. -Iexamples -isystem /usr/include/stb tests/fuzz/fuzz_image.c \
              examples/image_io.c examples/png_write.c examples/tool_io.c \
-             examples/executor.c -o build/fuzz/fuzz_image -lm -pthread
+             examples/executor.c examples/obj.c examples/format_number.c \
+             -o build/fuzz/fuzz_image -lm -pthread
 
    Input bytes:
        0      bits 0..1 colour space (sRGB, linear, normal, normal y-down);

@@ -107,9 +107,16 @@ fi
 
 # The tool's image loader (examples/image_io.c: stb_image, the size checks,
 # the conversion in strips) and the library's image operations.
+# Without UBSan's shift checks: Debian's stb_image (2.27) shifts its JPEG
+# bit buffer by 32 or more on corrupt coded data (upstream checks it from
+# 2.28 on). That is in the decoder's arithmetic, not its memory, which ASan
+# and the other checks still watch; the pre-checks of image_io.c keep out
+# what does touch memory (Huffman tables of more than 256 codes, PNM sizes
+# over INT_MAX).
 image_sources="examples/image_io.c examples/png_write.c examples/tool_io.c examples/executor.c examples/obj.c examples/format_number.c"
 # shellcheck disable=SC2086
-if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources -o "$out/fuzz_image" -lm -pthread; then
+if $cc $flags -fno-sanitize=shift $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources \
+    -o "$out/fuzz_image" -lm -pthread; then
   targets+=(image)
 else
   echo "fuzz: fuzz_image does not build" >&2
