@@ -813,7 +813,10 @@ static int xb_agree(xb_set *s, const unsigned char *const *allowed, const char *
     tt_xcorr_match want, got;
     int want_k, got_k;
     tt_error err;
-    tt_result r_want = xb_reference(s, allowed, &want, &want_k);
+    tt_result r_want;
+    memset(&want, 0, sizeof want);
+    memset(&got, 0, sizeof got);
+    r_want = xb_reference(s, allowed, &want, &want_k);
     tt_result r_got;
     long calls = s->cnt.calls;
     r_got = tt_xcorr_masked_best((const tt_xcorr_texture *const *)s->tex, s->n, s->mask, s->values, allowed, s->work,

@@ -200,7 +200,7 @@ static topo topology_of(const tt_mesh *m, const unsigned char *inset, int *deg, 
             if (deg[c] != 2) t.simple = 0;
             if (uf_find(uf, c) == c) t.loops++;
         }
-    memset(seen, 0, (size_t)m->nfaces);
+    if (m->nfaces > 0) memset(seen, 0, (size_t)m->nfaces);
     if (first >= 0) { queue[tail++] = first; seen[first] = 1; }
     while (head < tail) {
         int g = queue[head++];
