@@ -2657,7 +2657,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    Interior. The exterior is flooded from the padding through
    face-connected empty cubes, and the empty cubes it does not reach are
    filled. A mesh with holes (an open scan, a model missing a few faces)
-   lets the flood in, and the spec keeps such a polycube a hollow shell;
+   lets the flood in, and filling only what it misses leaves a hollow shell;
    measured, a shell maps badly (the pig at resolution 32: 1.4 % of the
    triangles to the fallback and stretch p95 6.1, against 0.26 % and 2.7
    sealed), because the two sheets lie one cube apart and neighbouring
@@ -2679,8 +2679,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    antipodal cubes of the 2 x 2 x 2 block alone, or the complement. The
    repair adds cubes until none remains: for C1 one of the two empty cubes,
    for C2 the two cubes of a face-connected staircase between the occupied
-   pair, for its complement one of the two empty cubes. "Nearer to the
-   mesh" (the spec's choice) is judged at the grid's resolution: a cube the
+   pair, for its complement one of the two empty cubes. Which cube is
+   "nearer to the mesh" is judged at the grid's resolution: a cube the
    surface meets first, then the one with more such face neighbours, then
    the smaller index (a staircase by the sum over its two cubes, then the
    order x, y, z of its steps). Adding only ever grows the set, so the
@@ -2832,7 +2832,7 @@ typedef struct tt_polycube_projection_report {
    field d: at each lattice point of S the sum of the normals of its
    facelets facing v's side (the normal on a flat, the diagonal of a fold
    or a corner), interpolated trilinearly at the vertex and normalised.
-   The spec sums all facelets; on a filled polycube that is the same but
+   Summing all facelets instead gives the same on a filled polycube but
    where the two sides of a thin part meet, and on the hollow shell of an
    open mesh the inner and outer sheets lie within a cube of each
    other, so their normals cancel and d turns along the surface. In order:
