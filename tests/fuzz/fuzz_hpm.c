@@ -166,7 +166,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fz_alloc a;
     fz_shape shape;
     fz_progress ps;
-    tt_mesh_desc desc;
     tt_mesh *mesh = NULL;
     tt_image *image = NULL;
     tt_cluster_hierarchy *hier = NULL;
@@ -194,20 +193,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     runs++;
     alloc = fz_alloc_init(&a, (hdr[0] & 3) == 3 ? (long)hdr[1] + 256L * (hdr[2] & 7) + 1 : 0);
 
-    memset(&desc, 0, sizeof desc);
-    desc.positions = shape.pos;
-    desc.nverts = shape.nverts;
-    desc.indices = shape.tri;
-    desc.nfaces = shape.ntris;
-    desc.fixed_face_size = 3;
-    desc.flags = (hdr[3] & 64) ? TT_MESH_PERMISSIVE : 0;
-    memset(&err, 0x55, sizeof err);
-    r = tt_mesh_build(&desc, alloc, &mesh, &err);
-    if (r != TT_OK) {
-        fz_check_null("tt_mesh_build", r, mesh);
-        fz_check_error("tt_mesh_build", r, &err, &a);
-        goto out;
-    }
+    if (fz_shape_build(&shape, hdr[3] & 64, alloc, &a, &mesh) != TT_OK) goto out;
     image = make_image(hdr[4], (uint32_t)hdr[13] | (uint32_t)hdr[14] << 8);
     uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
     uv2 = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);

@@ -152,4 +152,29 @@ static inline void fz_shape_read(reader *rd, fz_shape *s)
         }
 }
 
+/* The shape as a tt_mesh (permissive or not): on failure the output and
+   the error are checked as every failure is (fuzz_common.h) and the result
+   returned, *mesh NULL. */
+static inline tt_result fz_shape_build(const fz_shape *s, int permissive, const tt_allocator *alloc,
+                                       const fz_alloc *a, tt_mesh **mesh)
+{
+    tt_mesh_desc desc;
+    tt_error err;
+    tt_result r;
+    memset(&desc, 0, sizeof desc);
+    desc.positions = s->pos;
+    desc.nverts = s->nverts;
+    desc.indices = s->tri;
+    desc.nfaces = s->ntris;
+    desc.fixed_face_size = 3;
+    desc.flags = permissive ? TT_MESH_PERMISSIVE : 0;
+    memset(&err, 0x55, sizeof err);
+    r = tt_mesh_build(&desc, alloc, mesh, &err);
+    if (r != TT_OK) {
+        fz_check_null("tt_mesh_build", r, *mesh);
+        fz_check_error("tt_mesh_build", r, &err, a);
+    }
+    return r;
+}
+
 #endif /* TILEDTEX_FUZZ_SHAPE_H */
