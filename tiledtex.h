@@ -4023,8 +4023,9 @@ static double tt__corner_angle(const tt_mesh *mesh, int c)
 TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, const tt_allocator *allocator,
                                   float *corner_normal, tt_error *error)
 {
-    double *face_normal, *angle, cos_crease;
-    int *fan, c, f;
+    double *face_normal, *vertex_sum, *fan_angle, cos_crease, cos_half_crease;
+    int *fan, c, f, v;
+    unsigned char *vertex_smooth;
     tt__ok(error);
     if (!mesh || !corner_normal)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -4035,29 +4036,68 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
                         "crease angle %g degrees: it must be from 0 (flat) to 180 (smooth everywhere)",
                         (double)crease_degrees);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    face_normal = TT__ALLOC(allocator, double, 3 * (size_t)(mesh->nfaces > 0 ? mesh->nfaces : 1));
-    fan = TT__ALLOC(allocator, int, mesh->ncorners > 0 ? mesh->ncorners : 1);
-    angle = TT__ALLOC(allocator, double, mesh->ncorners > 0 ? mesh->ncorners : 1);
-    if (!face_normal || !fan || !angle) {
+    face_normal = TT__ALLOC(allocator, double, 3 * (size_t)mesh->nfaces);
+    fan = TT__ALLOC(allocator, int, mesh->ncorners);
+    fan_angle = TT__ALLOC(allocator, double, mesh->ncorners);
+    vertex_sum = TT__ALLOC(allocator, double, 3 * (size_t)(mesh->nverts > 0 ? mesh->nverts : 1));
+    vertex_smooth = TT__ALLOC(allocator, unsigned char, mesh->nverts > 0 ? mesh->nverts : 1);
+    if (!face_normal || !fan || !fan_angle || !vertex_sum || !vertex_smooth) {
         tt__free(allocator, face_normal);
         tt__free(allocator, fan);
-        tt__free(allocator, angle);
+        tt__free(allocator, fan_angle);
+        tt__free(allocator, vertex_sum);
+        tt__free(allocator, vertex_smooth);
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for the normals of %d faces",
                         mesh->nfaces);
     }
     /* Exactly -1 at 180 degrees would still leave out faces turned fully back
        out; the margin takes them in. */
     cos_crease = crease_degrees >= 180.0f ? -2.0 : cos((double)crease_degrees * (TT__PI / 180.0));
+    cos_half_crease = crease_degrees >= 180.0f ? -2.0 : cos((double)crease_degrees * (TT__PI / 360.0));
     for (f = 0; f < mesh->nfaces; f++)
         if (!tt__face_normal_d(mesh, f, face_normal + 3 * (size_t)f))
             face_normal[3 * (size_t)f] = face_normal[3 * (size_t)f + 1] = face_normal[3 * (size_t)f + 2] = 0.0;
-    /* Each corner's weight, its angle, in corner order: a face's corners
-       and their vertices are read together here, where the fans below
-       meet them scattered. */
-    for (c = 0; c < mesh->ncorners; c++) angle[c] = tt__corner_angle(mesh, c);
-    /* Each fan is written once, marked until then by an x no unit normal
-       has (a permissive mesh's cut-open vertex has several fans). */
     for (c = 0; c < mesh->ncorners; c++) corner_normal[3 * (size_t)c] = TT__NOT_WRITTEN;
+    /* A scan's usual vertex is smooth: every pair of faces around it within
+       the crease, so that each of its corners gets the same angle-weighted
+       sum. Where a vertex has one fan (always, unless the mesh was built
+       TT_MESH_PERMISSIVE), that sum is taken in one pass over the corners in
+       memory order, with a vertex taken as smooth when every face is within
+       half the crease of one face of it (then any two are within the
+       crease). The corners around a vertex lie anywhere in memory; walking
+       them fan by fan, one twin after another, waited on memory at each
+       step, where this pass's reads do not wait on each other. */
+    if (!(mesh->flags & TT_MESH_PERMISSIVE)) {
+        memset(vertex_sum, 0, 3 * (size_t)mesh->nverts * sizeof *vertex_sum);
+        for (v = 0; v < mesh->nverts; v++) vertex_smooth[v] = 1;
+        for (c = 0; c < mesh->ncorners; c++) {
+            const int vertex = mesh->corner_vert[c];
+            const double *own = face_normal + 3 * (size_t)tt__face_of(mesh, c);
+            const double *reference = face_normal + 3 * (size_t)tt__face_of(mesh, mesh->vert_corner[vertex]);
+            double angle = tt__corner_angle(mesh, c), *sum = vertex_sum + 3 * (size_t)vertex;
+            if (tt__dot3(own, reference) < cos_half_crease) vertex_smooth[vertex] = 0;
+            sum[0] += angle * own[0];
+            sum[1] += angle * own[1];
+            sum[2] += angle * own[2];
+        }
+        for (v = 0; v < mesh->nverts; v++) {
+            double *sum = vertex_sum + 3 * (size_t)v, length = tt__length3(sum);
+            sum[0] = length > 0.0 ? sum[0] / length : 0.0;
+            sum[1] = length > 0.0 ? sum[1] / length : 0.0;
+            sum[2] = length > 0.0 ? sum[2] / length : 0.0;
+        }
+        for (c = 0; c < mesh->ncorners; c++) {
+            const int vertex = mesh->corner_vert[c];
+            const double *normal = vertex_sum + 3 * (size_t)vertex;
+            if (!vertex_smooth[vertex]) continue;
+            corner_normal[3 * (size_t)c] = (float)normal[0];
+            corner_normal[3 * (size_t)c + 1] = (float)normal[1];
+            corner_normal[3 * (size_t)c + 2] = (float)normal[2];
+        }
+    }
+    /* The corners left, fan by fan: each fan is written once, marked until
+       then by an x no unit normal has (a permissive mesh's cut-open vertex
+       has several fans). */
     for (c = 0; c < mesh->ncorners; c++) {
         /* The fan of corners around c's vertex that c belongs to, in the
            turn of tt__fan_size from its start: a boundary, or, all the way
@@ -4085,40 +4125,28 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
                 if (h == start) break;
             }
         }
-        /* A smooth fan, every pair of faces within the crease (a scan's
-           usual vertex), gives each of its corners the same sum, taken in
-           the same order: it is taken once. */
+        for (i = 0; i < count; i++) fan_angle[i] = tt__corner_angle(mesh, fan[i]);
+        /* A smooth fan gives each of its corners the same sum, taken in the
+           same order: it is taken once. */
         for (i = 0; i < count && smooth; i++) {
             const double *own = face_normal + 3 * (size_t)tt__face_of(mesh, fan[i]);
             for (j = i + 1; j < count && smooth; j++)
                 smooth = tt__dot3(own, face_normal + 3 * (size_t)tt__face_of(mesh, fan[j])) >= cos_crease;
         }
-        if (smooth) {
-            double sum[3] = {0.0, 0.0, 0.0}, length;
-            float normal[3];
-            for (j = 0; j < count; j++) {
-                const double *other = face_normal + 3 * (size_t)tt__face_of(mesh, fan[j]);
-                sum[0] += angle[fan[j]] * other[0];
-                sum[1] += angle[fan[j]] * other[1];
-                sum[2] += angle[fan[j]] * other[2];
-            }
-            length = tt__length3(sum);
-            normal[0] = length > 0.0 ? (float)(sum[0] / length) : 0.0f;
-            normal[1] = length > 0.0 ? (float)(sum[1] / length) : 0.0f;
-            normal[2] = length > 0.0 ? (float)(sum[2] / length) : 0.0f;
-            for (i = 0; i < count; i++) memcpy(corner_normal + 3 * (size_t)fan[i], normal, sizeof normal);
-            continue;
-        }
         for (i = 0; i < count; i++) {
             const double *own = face_normal + 3 * (size_t)tt__face_of(mesh, fan[i]);
             double sum[3] = {0.0, 0.0, 0.0}, length;
             float *out = corner_normal + 3 * (size_t)fan[i];
+            if (smooth && i > 0) {
+                memcpy(out, corner_normal + 3 * (size_t)fan[0], 3 * sizeof *out);
+                continue;
+            }
             for (j = 0; j < count; j++) {
                 const double *other = face_normal + 3 * (size_t)tt__face_of(mesh, fan[j]);
-                if (j != i && tt__dot3(own, other) < cos_crease) continue;
-                sum[0] += angle[fan[j]] * other[0];
-                sum[1] += angle[fan[j]] * other[1];
-                sum[2] += angle[fan[j]] * other[2];
+                if (!smooth && j != i && tt__dot3(own, other) < cos_crease) continue;
+                sum[0] += fan_angle[j] * other[0];
+                sum[1] += fan_angle[j] * other[1];
+                sum[2] += fan_angle[j] * other[2];
             }
             length = tt__length3(sum);
             out[0] = length > 0.0 ? (float)(sum[0] / length) : 0.0f;
@@ -4128,7 +4156,9 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
     }
     tt__free(allocator, face_normal);
     tt__free(allocator, fan);
-    tt__free(allocator, angle);
+    tt__free(allocator, fan_angle);
+    tt__free(allocator, vertex_sum);
+    tt__free(allocator, vertex_smooth);
     return TT_OK;
 }
 
@@ -17851,53 +17881,103 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
 #define TT__HPM_SIDE_VALUES (2 * 3 * TT__HPM_RELAX_SAMPLES)
 
 /* One side of an edge from a to b (texel positions) in the triangle whose
-   third corner is at x. */
-static void tt__hpm_edge_samples(const tt__hpm *S, const double *a, const double *b, const double *x,
-                                 double *values)
+   third corner is at x: where its points are (a, b - a) and its unit normal
+   into that triangle (0 for an edge of no length). */
+typedef struct tt__hpm_edge_line {
+    double a[2], along[2], normal[2];
+} tt__hpm_edge_line;
+
+static void tt__hpm_edge_line_of(const double *a, const double *b, const double *x, tt__hpm_edge_line *line)
 {
-    double ex, ey, len, n[2] = {0, 0};
-    int i;
-    ex = b[0] - a[0];
-    ey = b[1] - a[1];
-    len = sqrt(ex * ex + ey * ey);
+    double len;
+    line->a[0] = a[0];
+    line->a[1] = a[1];
+    line->along[0] = b[0] - a[0];
+    line->along[1] = b[1] - a[1];
+    line->normal[0] = line->normal[1] = 0;
+    len = sqrt(line->along[0] * line->along[0] + line->along[1] * line->along[1]);
     if (len > 0) {
-        n[0] = -ey / len;
-        n[1] = ex / len;
-        if (n[0] * (x[0] - a[0]) + n[1] * (x[1] - a[1]) < 0) {
-            n[0] = -n[0];
-            n[1] = -n[1];
+        line->normal[0] = -line->along[1] / len;
+        line->normal[1] = line->along[0] / len;
+        if (line->normal[0] * (x[0] - a[0]) + line->normal[1] * (x[1] - a[1]) < 0) {
+            line->normal[0] = -line->normal[0];
+            line->normal[1] = -line->normal[1];
         }
-    }
-    for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) {
-        double tt = (i + 0.5) / TT__HPM_RELAX_SAMPLES, px = a[0] + tt * (b[0] - a[0]), py = a[1] + tt * (b[1] - a[1]);
-        tt__hpm_sample(S->full, S->W, S->Hh, S->nch, px + 0.5 * n[0], py + 0.5 * n[1], S->toroidal, values + 6 * i);
-        tt__hpm_sample(S->full, S->W, S->Hh, S->nch, px - 0.5 * n[0], py - 0.5 * n[1], S->toroidal,
-                       values + 6 * i + 3);
     }
 }
 
-static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
+/* Point i of the line: its colour half a texel inside ("in", values[0..2])
+   and half a texel outside ("out", values[3..5]). */
+static void tt__hpm_edge_point(const tt__hpm *S, const tt__hpm_edge_line *line, int i, double *values)
+{
+    double t = (i + 0.5) / TT__HPM_RELAX_SAMPLES, px = line->a[0] + t * line->along[0],
+           py = line->a[1] + t * line->along[1];
+    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, px + 0.5 * line->normal[0], py + 0.5 * line->normal[1], S->toroidal,
+                   values);
+    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, px - 0.5 * line->normal[0], py - 0.5 * line->normal[1], S->toroidal,
+                   values + 3);
+}
+
+/* Side `side` of half-edge h (0 is h's face, 1 its twin's). */
+static void tt__hpm_edge_side_line(const tt__hpm *S, int h, int side, tt__hpm_edge_line *line)
 {
     const tt_mesh *m = S->mesh;
     int t = m->twin[h];
     if (side == 0)
-        tt__hpm_edge_samples(S, S->uv + 2 * h, S->uv + 2 * tt__next(m, h), S->uv + 2 * tt__prev(m, h), values);
+        tt__hpm_edge_line_of(S->uv + 2 * h, S->uv + 2 * tt__next(m, h), S->uv + 2 * tt__prev(m, h), line);
     else /* the twin runs the other way */
-        tt__hpm_edge_samples(S, S->uv + 2 * tt__next(m, t), S->uv + 2 * t, S->uv + 2 * tt__prev(m, t), values);
+        tt__hpm_edge_line_of(S->uv + 2 * tt__next(m, t), S->uv + 2 * t, S->uv + 2 * tt__prev(m, t), line);
 }
 
+static void tt__hpm_edge_side(const tt__hpm *S, int h, int side, double *values)
+{
+    tt__hpm_edge_line line;
+    int i;
+    tt__hpm_edge_side_line(S, h, side, &line);
+    for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) tt__hpm_edge_point(S, &line, i, values + 6 * i);
+}
+
+/* The mismatch of point i's two sides, added to *across and *continued. */
+static void tt__hpm_point_compare(const tt__hpm *S, const double *in0, const double *in1, double *across,
+                                  double *continued)
+{
+    const double *out0 = in0 + 3, *out1 = in1 + 3;
+    int c;
+    for (c = 0; c < S->nch; c++) {
+        *across += (in0[c] - in1[c]) * (in0[c] - in1[c]);
+        *continued += (in0[c] - out1[c]) * (in0[c] - out1[c]) + (in1[c] - out0[c]) * (in1[c] - out0[c]);
+    }
+}
+
+/* The mismatch of two sides of an edge. It is symmetric, bit for bit: each
+   term is a square of a difference or a sum of two such, whose order
+   floating-point addition does not see. */
 static double tt__hpm_edge_compare(const tt__hpm *S, const double *side0, const double *side1, double *continuation)
 {
     double across = 0, cont = 0;
-    int i, c;
-    for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) {
-        const double *in0 = side0 + 6 * i, *out0 = in0 + 3, *in1 = side1 + 6 * i, *out1 = in1 + 3;
-        for (c = 0; c < S->nch; c++) {
-            across += (in0[c] - in1[c]) * (in0[c] - in1[c]);
-            cont += (in0[c] - out1[c]) * (in0[c] - out1[c]) + (in1[c] - out0[c]) * (in1[c] - out0[c]);
-        }
-    }
+    int i;
+    for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) tt__hpm_point_compare(S, side0 + 6 * i, side1 + 6 * i, &across, &cont);
     if (continuation) *continuation += cont;
+    return TT__HPM_RELAX_ACROSS * across + cont;
+}
+
+/* What tt__hpm_edge_compare gives for the side on `line`, sampled into
+   `mine`, against `theirs` - unless `spent` plus the mismatch of the points
+   sampled so far reaches `budget`: then the rest is not sampled and that
+   partial mismatch returned (spent plus it is at least budget). A trial
+   position that cannot beat the best so far is given up after a point or
+   two instead of sampling every edge; the ones that can are summed exactly
+   as tt__hpm_edge_compare sums them, so the choices are the same. */
+static double tt__hpm_edge_cost_within(const tt__hpm *S, const tt__hpm_edge_line *line, const double *theirs,
+                                       double *mine, double spent, double budget)
+{
+    double across = 0, cont = 0;
+    int i;
+    for (i = 0; i < TT__HPM_RELAX_SAMPLES; i++) {
+        tt__hpm_edge_point(S, line, i, mine + 6 * i);
+        tt__hpm_point_compare(S, mine + 6 * i, theirs + 6 * i, &across, &cont);
+        if (spent + (TT__HPM_RELAX_ACROSS * across + cont) >= budget) break;
+    }
     return TT__HPM_RELAX_ACROSS * across + cont;
 }
 
@@ -18079,11 +18159,9 @@ static int tt__hpm_relax(tt__hpm *S, int C)
                     tt__hpm_edge_side(S, c, side[nedges], moving + TT__HPM_SIDE_VALUES * nedges);
                     nedges++;
                 }
-                for (e = 0; e < nedges; e++) {
-                    const double *mine = moving + TT__HPM_SIDE_VALUES * e, *theirs = fixed + TT__HPM_SIDE_VALUES * e;
-                    before += side[e] == 0 ? tt__hpm_edge_compare(S, mine, theirs, &continued)
-                                           : tt__hpm_edge_compare(S, theirs, mine, &continued);
-                }
+                for (e = 0; e < nedges; e++)
+                    before += tt__hpm_edge_compare(S, moving + TT__HPM_SIDE_VALUES * e, fixed + TT__HPM_SIDE_VALUES * e,
+                                                   &continued);
                 /* no border here, or the exact continuation of the neighbour */
                 if (continued <= 1e-12) continue;
                 for (k = 0; k < n && first < 0; k++)
@@ -18115,12 +18193,11 @@ static int tt__hpm_relax(tt__hpm *S, int C)
                             S->uv[2 * ring[k]] = nx;
                             S->uv[2 * ring[k] + 1] = ny;
                         }
-                    for (e = 0; e < nedges; e++) {
-                        double *mine = trying + TT__HPM_SIDE_VALUES * e;
-                        const double *theirs = fixed + TT__HPM_SIDE_VALUES * e;
-                        tt__hpm_edge_side(S, edge[e], side[e], mine);
-                        after += side[e] == 0 ? tt__hpm_edge_compare(S, mine, theirs, NULL)
-                                              : tt__hpm_edge_compare(S, theirs, mine, NULL);
+                    for (e = 0; e < nedges && after < before; e++) {
+                        tt__hpm_edge_line line;
+                        tt__hpm_edge_side_line(S, edge[e], side[e], &line);
+                        after += tt__hpm_edge_cost_within(S, &line, fixed + TT__HPM_SIDE_VALUES * e,
+                                                          trying + TT__HPM_SIDE_VALUES * e, after, before);
                     }
                     if (after < before) {
                         double *swap = moving;
@@ -18575,19 +18652,21 @@ static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, 
    f's corners at fuv[0..5]. The faces across them keep their coordinates
    while f tries its candidates: their sides of the edges are sampled once,
    into theirs[j * TT__HPM_SIDE_VALUES] for f's corner j (known[j] set). */
-static double tt__hpm_face_mismatch(const tt__hpm *S, int f, const double *fuv, double *theirs, int *known)
+static double tt__hpm_face_mismatch(const tt__hpm *S, int f, const double *fuv, double *theirs, int *known,
+                                    double budget)
 {
     double sum = 0, mine[TT__HPM_SIDE_VALUES];
     int j, first = S->mesh->face_start[f];
-    for (j = 0; j < 3; j++) {
+    for (j = 0; j < 3 && sum < budget; j++) {
         const double *a = fuv + 2 * j, *b = fuv + 2 * ((j + 1) % 3), *x = fuv + 2 * ((j + 2) % 3);
+        tt__hpm_edge_line line;
         if (!tt__hpm_is_border_at(S, first + j, a, b)) continue;
         if (!known[j]) {
             tt__hpm_edge_side(S, first + j, 1, theirs + TT__HPM_SIDE_VALUES * j);
             known[j] = 1;
         }
-        tt__hpm_edge_samples(S, a, b, x, mine);
-        sum += tt__hpm_edge_compare(S, mine, theirs + TT__HPM_SIDE_VALUES * j, NULL);
+        tt__hpm_edge_line_of(a, b, x, &line);
+        sum += tt__hpm_edge_cost_within(S, &line, theirs + TT__HPM_SIDE_VALUES * j, mine, sum, budget);
     }
     return sum;
 }
@@ -18603,7 +18682,7 @@ static int tt__hpm_border_choice(const tt__hpm *S, int f)
     if (C < 0) return -1;
     memcpy(mine, S->uv + 2 * (size_t)first, sizeof mine);
     known[0] = known[1] = known[2] = 0;
-    before = tt__hpm_face_mismatch(S, f, mine, theirs, known);
+    before = tt__hpm_face_mismatch(S, f, mine, theirs, known, tt__infinity());
     if (before <= 0) return -1;
     best_cost = before * 0.95; /* a clear gain, not noise */
     tt__hpm_tri_frame(S, first, frame);
@@ -18626,7 +18705,7 @@ static int tt__hpm_border_choice(const tt__hpm *S, int f)
         area_n = tt__hpm_tri_area(S, t, &unused);
         ok = ok && area_f * area_n > 0 && (st <= TT__HPM_RELAX_MAX_STRETCH || st <= st_old);
         if (ok) {
-            double cost = tt__hpm_face_mismatch(S, f, cand_uv, theirs, known);
+            double cost = tt__hpm_face_mismatch(S, f, cand_uv, theirs, known, best_cost);
             if (cost < best_cost) {
                 best_cost = cost;
                 best = c;

@@ -8,6 +8,9 @@
 
 #include <stdio.h>
 #include <string.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "tool.h"
 
@@ -125,6 +128,16 @@ int main(int argc, char **argv)
 {
     const subcommand *command;
     int status;
+#if defined(__GLIBC__)
+    /* A command allocates and frees arrays of tens of megabytes stage after
+       stage. By default glibc gives each back to the kernel when it is
+       freed, and the next stage faults every page of its own in again: a
+       third of the page faults of a 100k-face job and a tenth of its time.
+       Kept in the heap, freed memory is reused, for a peak a few percent
+       higher. */
+    mallopt(M_MMAP_THRESHOLD, 1 << 30);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
     if ((status = take_global_options(&argc, argv)) != 0) return status;
     if (argc < 2)
         return tool_usage("needs a command: tile, lapped, hpm, polycube, synth, map, render or generate (see 'tiledtex --help')");
