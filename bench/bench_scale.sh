@@ -27,7 +27,10 @@
 # no higher than v0.3.0's; -j 2 identical, wall <= 0.65x (tile synthesis, the
 # lapped bake, polycube) or 0.8x (hpm) of -j 1.
 #
-# Environment: BENCH_SCALES="1 4 16" (which sizes), BENCH_V030=0 (skip the
+# The 97k figures and the synthesis are each the median of 5 runs.
+#
+# Environment: BENCH_SCALES="1 4 16" (which sizes), BENCH_RUNS=5 (runs at 97k
+# faces, odd), BENCH_V030=0 (skip the
 # v0.3.0 build), BENCH_TIMEOUT=900 (seconds a run may take),
 # BENCH_V030_TIMEOUT=240 (v0.3.0's lapped grows as n^2: at 16x it is stopped
 # and reported as not finished).
@@ -36,6 +39,7 @@ cd "$(dirname "$0")/.." || exit 1
 tool=${1:-build/tiledtex}
 data=${BENCH_DATA:-../shared/data}
 scales=${BENCH_SCALES:-1 4 16}
+small_runs=${BENCH_RUNS:-5}
 timeout=${BENCH_TIMEOUT:-900}
 old_timeout=${BENCH_V030_TIMEOUT:-240}
 # The last commit of v0.3.0: its tool is built from this commit's files.
@@ -79,16 +83,27 @@ figure() { echo "$1 $2 $3"; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.3f", a / b; else print "nan" }'; }
 mib() { awk -v k="$1" 'BEGIN { printf "%.1f", k / 1024 }'; }
 
-# measure TOOL SECONDS DIR JOBS PIPELINE MESH: runs it in DIR (made afresh),
-# sets cpu wall peak status.
+# measure TOOL SECONDS DIR JOBS PIPELINE MESH [RUNS]: runs it in DIR (made
+# afresh), sets cpu wall peak status. With RUNS (odd) it runs that many times
+# and keeps the median of each figure: a run of a second or less on a shared
+# machine varies by a fifth from one run to the next.
 measure() {
-    local tool_=$1 limit=$2 dir=$3 jobs=$4 pipeline=$5 mesh=$6 extra=() jflag=()
-    rm -rf "$dir" && mkdir -p "$dir"
+    local tool_=$1 limit=$2 dir=$3 jobs=$4 pipeline=$5 mesh=$6 runs=${7:-1} extra=() jflag=() i
+    local cpus=() walls=() peaks=()
     [ "$pipeline" = lapped ] && extra=(--bake 2048)
     [ -n "$jobs" ] && jflag=(-j "$jobs")
-    read -r cpu wall peak status < <("$run" "$limit" sh -c 'exec "$@" >"$0/log" 2>&1' "$dir" \
-        "$tool_" "${jflag[@]}" "$pipeline" "$mesh" "$photo" "$dir/out" "${extra[@]}")
+    for ((i = 0; i < runs; i++)); do
+        rm -rf "$dir" && mkdir -p "$dir"
+        read -r cpu wall peak status < <("$run" "$limit" sh -c 'exec "$@" >"$0/log" 2>&1' "$dir" \
+            "$tool_" "${jflag[@]}" "$pipeline" "$mesh" "$photo" "$dir/out" "${extra[@]}")
+        [ "$status" = 0 ] || return
+        cpus+=("$cpu") walls+=("$wall") peaks+=("$peak")
+    done
+    cpu=$(median "${cpus[@]}") wall=$(median "${walls[@]}") peak=$(median "${peaks[@]}")
 }
+
+# median NUMBER...: the middle one.
+median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 
 # measure_cancel PIPELINE MESH WALL NAME: Ctrl-C (SIGINT) halfway through a
 # run, by its wall time at -j 1: the seconds until the tool has exited (the
@@ -116,10 +131,15 @@ measure_cancel() {
 # Tile synthesis alone (the paper's 256 tiles of 128 texels, and the PNG):
 # what a second core gains there.
 measure_synth() {
-    local dir=$work/synth-j$1
-    rm -rf "$dir" && mkdir -p "$dir"
-    read -r cpu wall peak status < <("$run" "$timeout" sh -c 'exec "$@" >"$0/log" 2>&1' "$dir" \
-        "$tool" -j "$1" synth "$photo" "$dir/atlas.png" --colors 2 --tile 128)
+    local dir=$work/synth-j$1 i cpus=() walls=()
+    for ((i = 0; i < small_runs; i++)); do
+        rm -rf "$dir" && mkdir -p "$dir"
+        read -r cpu wall peak status < <("$run" "$timeout" sh -c 'exec "$@" >"$0/log" 2>&1' "$dir" \
+            "$tool" -j "$1" synth "$photo" "$dir/atlas.png" --colors 2 --tile 128)
+        [ "$status" = 0 ] || return
+        cpus+=("$cpu") walls+=("$wall")
+    done
+    cpu=$(median "${cpus[@]}") wall=$(median "${walls[@]}")
 }
 measure_synth 1
 if [ "$status" = 0 ]; then
@@ -143,7 +163,9 @@ for p in tile hpm polycube lapped; do
         mesh=$work/horse_x$s.obj
         faces=$(grep -c '^f' "$mesh")
         name=scale_${p}_$((faces / 1000))k
-        measure "$tool" "$timeout" "$work/$p-x$s-j1" 1 "$p" "$mesh"
+        runs=1
+        [ "$s" = 1 ] && runs=$small_runs
+        measure "$tool" "$timeout" "$work/$p-x$s-j1" 1 "$p" "$mesh" "$runs"
         if [ "$status" != 0 ]; then
             echo "bench_scale: $p on $faces faces at -j 1: status $status ($(tail -n 1 "$work/$p-x$s-j1/log"))" >&2
             figure "${name}_finished" 0 bool
@@ -154,7 +176,7 @@ for p in tile hpm polycube lapped; do
         figure "${name}_cpu_j1" "$cpu" s
         figure "${name}_wall_j1" "$wall" s
         figure "${name}_peak_j1" "$(mib "$peak")" MiB
-        measure "$tool" "$timeout" "$work/$p-x$s-j2" 2 "$p" "$mesh"
+        measure "$tool" "$timeout" "$work/$p-x$s-j2" 2 "$p" "$mesh" "$runs"
         if [ "$status" = 0 ]; then
             same=1
             for f in "$work/$p-x$s-j1"/out*; do

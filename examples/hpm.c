@@ -194,7 +194,9 @@ static void hpm_write_desc(const triangle_mesh *m, const float *corner_uv, const
     desc->corner_normal = normals;
 }
 
-/* OUT_PREFIX.obj: the vertices, the triangles, one vt per triangle corner. */
+/* OUT_PREFIX.obj: the vertices, the triangles, a vt for each triangle
+   corner (the corners of a vertex inside one cluster share it, as those of
+   a smooth vertex share their vn). */
 static int add_obj(tool_output *output, const char *path, const char *mtl_name, const hpm_command_options *options,
                    const triangle_mesh *m, const float *corner_uv)
 {
@@ -213,6 +215,7 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
     desc.comment = comment;
     desc.mtllib = mtl_name;
     desc.material = "hpm";
+    desc.share_equal = 1;
     status = output_add_obj(output, path, &desc);
     free(normals);
     return status;
