@@ -1846,6 +1846,89 @@ static void test_hpm_extreme_floats_refused(void)
     tt_mesh_free(mesh);
 }
 
+/* A flat strip along the bounding box's diagonal, `reach` x FLT_MAX from
+   its centre on each axis: 2 sqrt(3) reach FLT_MAX long, 0.05 FLT_MAX wide. */
+static tt_mesh *flat_diagonal_strip(double reach)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= 2; j++)
+        for (i = 0; i <= 8; i++) {
+            double s = reach * (i / 4.0 - 1.0), t = 0.05 * (j - 1.0) / sqrt(2.0);
+            tm_vert(&m, (s + t) * FLT_MAX, (s - t) * FLT_MAX, s * FLT_MAX);
+        }
+    for (j = 0; j < 2; j++)
+        for (i = 0; i < 8; i++) {
+            int a = j * 9 + i;
+            tm_tri(&m, a, a + 1, a + 10);
+            tm_tri(&m, a, a + 10, a + 9);
+        }
+    if (build(&m, 0, &mesh, &err) != TT_OK) CHECK(0, "building the diagonal strip failed: %s", err.message);
+    tm_free(&m);
+    return mesh;
+}
+
+/* fuzz_hpm: a cluster whose flat map is longer than single precision
+   holds (centred, more than FLT_MAX from its middle) came out as -inf
+   UVs with TT_OK. Now TT_ERROR_NON_FINITE naming a face of the cluster,
+   corner_uv untouched; the same strip at 0.4 of that reach maps exactly. */
+static void test_flatten_beyond_float(void)
+{
+    static const double reach[2] = {0.95, 0.4};
+    int k;
+    for (k = 0; k < 2; k++) {
+        tt_mesh *m = flat_diagonal_strip(reach[k]);
+        tt_cluster_hierarchy *h = m ? hpm_build(m, 3) : NULL;
+        float *uv = m ? flat_uv(m) : NULL;
+        tt_flatten_report rep;
+        tt_error err;
+        tt_result r;
+        int c, whole = -1, untouched = 1, finite = 1;
+        double length_uv, length_3d;
+        if (!h || !uv) goto next;
+        for (c = 0; c < h->nclusters; c++)
+            if (h->clusters[c].nfaces == m->nfaces && (h->clusters[c].flags & TT_CLUSTER_MAPPABLE)) whole = c;
+        CHECK(whole >= 0, "reach %.2f: a mappable cluster holds the whole strip", reach[k]);
+        if (whole < 0) goto next;
+        memset(&err, 0, sizeof err);
+        r = tt_flatten_cluster(m, h, whole, NULL, NULL, uv, &rep, &err);
+        for (c = 0; c < 2 * m->ncorners; c++) {
+            untouched &= uv[c] == FLAT_SENTINEL;
+            finite &= fabsf(uv[c]) <= FLT_MAX;
+        }
+        if (k == 0) {
+            CHECK(r == TT_ERROR_NON_FINITE && err.result == r && err.item == whole && err.face >= 0 &&
+                      err.face < m->nfaces && strstr(err.message, "beyond single precision") && untouched,
+                  "a strip 3.3 FLT_MAX long: %d (%s), face %d, item %d, corner_uv %s", (int)r, err.message, err.face,
+                  err.item, untouched ? "untouched" : "written");
+        } else {
+            /* vertices 9 and 17 are the strip's two ends on its middle line */
+            const float *p0 = m->pos + 3 * 9, *p1 = m->pos + 3 * 17;
+            int c0 = -1, c1 = -1;
+            for (c = 0; c < m->ncorners; c++) {
+                if (m->corner_vert[c] == 9) c0 = c;
+                if (m->corner_vert[c] == 17) c1 = c;
+            }
+            length_3d = sqrt(((double)p1[0] - p0[0]) * ((double)p1[0] - p0[0]) +
+                             ((double)p1[1] - p0[1]) * ((double)p1[1] - p0[1]) +
+                             ((double)p1[2] - p0[2]) * ((double)p1[2] - p0[2]));
+            length_uv = c0 < 0 || c1 < 0 ? 0 : sqrt(((double)uv[2 * c1] - uv[2 * c0]) * ((double)uv[2 * c1] - uv[2 * c0]) +
+                                                   ((double)uv[2 * c1 + 1] - uv[2 * c0 + 1]) *
+                                                       ((double)uv[2 * c1 + 1] - uv[2 * c0 + 1]));
+            CHECK(r == TT_OK && finite && !untouched && fabs(length_uv / length_3d - 1.0) < 1e-5,
+                  "the strip at 0.4 of that reach: %d (%s), UVs %s, length kept to %.3g", (int)r,
+                  r == TT_OK ? "TT_OK" : err.message, finite ? "finite" : "not finite", length_uv / length_3d - 1.0);
+        }
+    next:
+        free(uv);
+        tt_cluster_hierarchy_free(h);
+        tt_mesh_free(m);
+    }
+}
+
 void run_hpm_tests(void)
 {
     RUN(test_hpm_properties);
@@ -1858,6 +1941,7 @@ void run_hpm_tests(void)
     RUN(test_flatten_folds);
     RUN(test_flatten_clusters);
     RUN(test_flatten_errors);
+    RUN(test_flatten_beyond_float);
     RUN(test_hpm_map_plane);
     RUN(test_hpm_map_continuation);
     RUN(test_hpm_map_executor);
