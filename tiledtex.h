@@ -2542,6 +2542,9 @@ typedef struct tt_hpm_report {
     int rejected_fits;                      /* fits above it: the cluster was split */
     int continued;                          /* small clusters continuing a neighbour's map (no fit) */
     int faces_moved;                        /* faces that changed sides in the border choice */
+    int faces_unflattened;                  /* faces no cluster flattened (on a coarse mesh): each shows a
+                                               textured neighbour's map continued over their edge or, where
+                                               that would leave a bounded image, its leaf's own */
     int starts;                             /* clusters placed at random (no textured neighbour) */
     int not_flat;                           /* clusters split because they did not flatten */
     int no_room;                            /* clusters split because they did not fit in the image */
@@ -2555,10 +2558,15 @@ typedef struct tt_hpm_report {
    corner_uv gets 2 * mesh->ncorners floats, (u, v) per corner in the
    library's UV convention; face_cluster (may be NULL) gets, per face, the
    hierarchy cluster whose map it shows (the numbering of
-   tt_cluster_hierarchy_build with the same seed and branching), or -1 for
-   a face no cluster textured: one with no area (degenerate), or one whose
-   coordinates are so large (near FLT_MAX) that its area overflows a float;
-   its corners take a textured neighbour's UVs (the image centre without one). options and
+   tt_cluster_hierarchy_build with the same seed and branching). A face no
+   cluster could flatten (a coarse mesh, a strict max_flattening_error)
+   shows a textured neighbour's map continued over their shared edge, and
+   that neighbour's cluster; where the continuation would leave a bounded
+   image, its leaf's (the face laid flat on its own beside its neighbours).
+   report->faces_unflattened counts them. -1 is a face no map reaches: one
+   with no area (degenerate), or one whose coordinates are so large (near
+   FLT_MAX) that its area overflows a float; its corners take a textured
+   neighbour's UVs (the image centre without one). options and
    report may be NULL. Results:
      TT_OK;
      TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, an image
@@ -18781,29 +18789,166 @@ static void tt__hpm_choose_borders(tt__hpm *S)
     }
 }
 
-static void tt__hpm_leftovers(tt__hpm *S, double *uv)
+/* Face f's corners in uv take cand (in the order c, next(c), prev(c)), if
+   that is finite, inside a bounded image and turned as the face across c
+   is; returns 1 when written. */
+static int tt__hpm_take_continuation(tt__hpm *S, double *uv, int f, int c, const double *frame)
 {
     const tt_mesh *m = S->mesh;
-    int f, j;
+    int first = m->face_start[f], t = m->twin[c], j;
+    double cand[3][2], cand_uv[6], area_f, area_n, a[2], b[2], g[2], unused;
+    if (!tt__hpm_face_as_neighbour(S, uv, c, cand)) return 0;
+    for (j = 0; j < 3; j++) {
+        int at = (c - first + j) % 3;
+        if (!(fabs(cand[j][0]) < 1e30 && fabs(cand[j][1]) < 1e30)) return 0;
+        if (!S->toroidal && (cand[j][0] < 1 || cand[j][1] < 1 || cand[j][0] > S->W - 1 || cand[j][1] > S->Hh - 1))
+            return 0;
+        cand_uv[2 * at] = cand[j][0];
+        cand_uv[2 * at + 1] = cand[j][1];
+    }
+    area_f = tt__hpm_tri_map_at(cand_uv, frame, &unused);
+    /* the neighbour's signed area in this uv array */
+    for (j = 0; j < 2; j++) {
+        a[j] = uv[2 * (size_t)t + j];
+        b[j] = uv[2 * (size_t)tt__next(m, t) + j];
+        g[j] = uv[2 * (size_t)tt__prev(m, t) + j];
+    }
+    area_n = (b[0] - a[0]) * (g[1] - a[1]) - (b[1] - a[1]) * (g[0] - a[0]);
+    if (!(area_f * area_n > 0)) return 0;
+    memcpy(uv + 2 * (size_t)first, cand_uv, sizeof cand_uv);
+    return 1;
+}
+
+/* Each corner of face f takes, in uv, the coordinates a textured face
+   round its vertex has there (the image centre without one). */
+static void tt__hpm_fill_from_vertices(const tt__hpm *S, double *uv, int f)
+{
+    const tt_mesh *m = S->mesh;
+    int j;
+    for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
+        int v = m->corner_vert[j], h = m->vert_corner[v], start = h, guard = 0, found = 0;
+        while (h >= 0 && guard++ <= m->ncorners) {
+            if (S->owner[m->corner_face[h]] >= 0) {
+                uv[2 * j] = uv[2 * h];
+                uv[2 * j + 1] = uv[2 * h + 1];
+                found = 1;
+                break;
+            }
+            h = m->twin[tt__prev(m, h)];
+            if (h == start) break;
+        }
+        if (!found) {
+            uv[2 * j] = 0.5 * S->W;
+            uv[2 * j + 1] = 0.5 * S->Hh;
+        }
+    }
+}
+
+/* Face f laid flat on its own at the texel density, centred where its
+   corners' coordinates in uv are (its neighbours' at its vertices), turned
+   as the textured faces are, moved inside a bounded image; returns 0 when
+   it does not fit there or its coordinates are not finite. */
+static int tt__hpm_place_alone(const tt__hpm *S, double *uv, int f, const double *frame)
+{
+    const tt_mesh *m = S->mesh;
+    int first = m->face_start[f], g, k, j;
+    double flat[3][2], centre[2] = {0, 0}, mean[2] = {0, 0}, low[2], high[2], size[2], mirror = 1;
+    /* the turn of the first textured face (texel coordinates run y down) */
+    for (g = 0; g < m->nfaces; g++)
+        if (S->owner[g] >= 0) {
+            const double *a = uv + 2 * (size_t)m->face_start[g];
+            if ((a[2] - a[0]) * (a[5] - a[1]) - (a[3] - a[1]) * (a[4] - a[0]) < 0) mirror = -1;
+            break;
+        }
+    flat[0][0] = flat[0][1] = 0;
+    flat[1][0] = frame[0] * S->s;
+    flat[1][1] = 0;
+    flat[2][0] = frame[1] * S->s;
+    flat[2][1] = mirror * frame[2] * S->s;
+    for (k = 0; k < 3; k++)
+        for (j = 0; j < 2; j++) {
+            centre[j] += uv[2 * (size_t)(first + k) + j] / 3;
+            mean[j] += flat[k][j] / 3;
+        }
+    size[0] = S->W;
+    size[1] = S->Hh;
+    for (j = 0; j < 2; j++) {
+        low[j] = high[j] = flat[0][j];
+        for (k = 1; k < 3; k++) {
+            if (flat[k][j] < low[j]) low[j] = flat[k][j];
+            if (flat[k][j] > high[j]) high[j] = flat[k][j];
+        }
+        centre[j] -= mean[j];
+        if (!S->toroidal) {
+            if (high[j] - low[j] > size[j] - 2) return 0;
+            if (centre[j] + low[j] < 1) centre[j] = 1 - low[j];
+            if (centre[j] + high[j] > size[j] - 1) centre[j] = size[j] - 1 - high[j];
+        }
+        if (!(fabs(centre[j]) < 1e30 && high[j] - low[j] < 1e30)) return 0;
+    }
+    for (k = 0; k < 3; k++)
+        for (j = 0; j < 2; j++) uv[2 * (size_t)(first + k) + j] = centre[j] + flat[k][j];
+    return 1;
+}
+
+/* Faces no cluster textured (not flat enough at any level of a coarse
+   mesh, or cut off by the traversal): each shows the map of a textured
+   neighbour continued over their shared edge (tt__hpm_face_as_neighbour,
+   as the border choice moves a face), and that neighbour's cluster - in
+   the order a breadth-first walk from the textured faces meets them, so
+   that a run of such faces continues one map. S->near_faces (the
+   traversal's scratch) holds the walk's queue. A face whose continuation
+   would leave a bounded image (or with no textured face near) is laid flat
+   on its own, its leaf's map, where its neighbours' coordinates at its
+   vertices put it. Only a face of no area shows no cluster (-1): its
+   corners take a textured neighbour's coordinates at the vertex (the
+   image centre without one). */
+static void tt__hpm_leftovers(tt__hpm *S)
+{
+    const tt_mesh *m = S->mesh;
+    int *queue = S->near_faces, head = 0, tail = 0, queued = ++S->stamp, f, j, k;
     for (f = 0; f < m->nfaces; f++) {
         if (S->owner[f] >= 0) continue;
-        for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
-            int v = m->corner_vert[j], h = m->vert_corner[v], start = h, guard = 0, found = 0;
-            while (h >= 0 && guard++ <= m->ncorners) {
-                if (S->owner[m->corner_face[h]] >= 0) {
-                    uv[2 * j] = uv[2 * h];
-                    uv[2 * j + 1] = uv[2 * h + 1];
-                    found = 1;
-                    break;
-                }
-                h = m->twin[tt__prev(m, h)];
-                if (h == start) break;
-            }
-            if (!found) {
-                uv[2 * j] = 0.5 * S->W;
-                uv[2 * j + 1] = 0.5 * S->Hh;
-            }
+        for (j = m->face_start[f]; j < m->face_start[f + 1]; j++)
+            if (m->twin[j] >= 0 && S->owner[m->corner_face[m->twin[j]]] >= 0) break;
+        if (j < m->face_start[f + 1]) {
+            S->seen[f] = queued;
+            queue[tail++] = f;
         }
+    }
+    while (head < tail) {
+        double frame[3];
+        f = queue[head++];
+        tt__hpm_tri_frame(S, m->face_start[f], frame);
+        if (!(frame[0] * frame[2] > 0)) continue; /* no area: nothing to continue onto */
+        for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
+            int t = m->twin[j];
+            if (t < 0 || S->owner[m->corner_face[t]] < 0) continue;
+            if (!tt__hpm_take_continuation(S, S->uv, f, j, frame)) continue;
+            /* the control takes its own neighbours' random maps where it can */
+            if (S->out && !tt__hpm_take_continuation(S, S->out, f, j, frame)) tt__hpm_fill_from_vertices(S, S->out, f);
+            S->owner[f] = S->owner[m->corner_face[t]];
+            S->rep.faces_unflattened++;
+            for (k = m->face_start[f]; k < m->face_start[f + 1]; k++) {
+                int u = m->twin[k];
+                if (u >= 0 && S->owner[m->corner_face[u]] < 0 && S->seen[m->corner_face[u]] != queued) {
+                    S->seen[m->corner_face[u]] = queued;
+                    queue[tail++] = m->corner_face[u];
+                }
+            }
+            break;
+        }
+    }
+    for (f = 0; f < m->nfaces; f++) {
+        double frame[3];
+        if (S->owner[f] >= 0) continue;
+        tt__hpm_fill_from_vertices(S, S->uv, f);
+        if (S->out) tt__hpm_fill_from_vertices(S, S->out, f);
+        tt__hpm_tri_frame(S, m->face_start[f], frame);
+        if (!(frame[0] * frame[2] > 0) || !tt__hpm_place_alone(S, S->uv, f, frame)) continue;
+        if (S->out) (void)tt__hpm_place_alone(S, S->out, f, frame);
+        S->owner[f] = S->H->face_leaf[f];
+        S->rep.faces_unflattened++;
     }
 }
 
@@ -19057,8 +19202,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     }
     if (!(o.flags & TT_HPM_NO_RELAXATION)) tt__hpm_choose_borders(&S);
     if (tt__hpm_cancelled(&S, 1.0f, &res, error)) goto done;
-    tt__hpm_leftovers(&S, S.uv);
-    if (S.out) tt__hpm_leftovers(&S, S.out);
+    tt__hpm_leftovers(&S);
     {
         const double *x = S.out ? S.out : S.uv;
         for (i = 0; i < mesh->ncorners; i++) {
@@ -21492,11 +21636,11 @@ static void tt__refined_midpoint_sources(const int *source, const double *weight
 static tt_result tt__polycube_refine_too_large(double longest, double needed, tt_error *error)
 {
     return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                    "refining the model to edges of at most %g makes %s%.0f triangles, above "
+                    "refining the model to edges of at most %g makes %s%.*g triangles, above "
                     "TT_POLYCUBE_MAX_TRIANGLES (%d): choose a larger max_edge (0: half a cube) or define "
                     "TT_POLYCUBE_MAX_TRIANGLES higher",
-                    longest, needed > 1e15 ? "over " : "at least ", needed > 1e15 ? 1e15 : needed,
-                    TT_POLYCUBE_MAX_TRIANGLES);
+                    longest, needed > 1e15 ? "over " : "at least ", needed < 1e9 ? 9 : 3,
+                    needed > 1e15 ? 1e15 : needed, TT_POLYCUBE_MAX_TRIANGLES);
 }
 
 static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
@@ -24513,9 +24657,13 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             }
         }
         for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * mapping->source[3 * v]];
+        /* Barycentric weights of a point of the input triangle: rounding
+           can leave one a hair below 0 (a fan centre's mean value
+           coordinates on the triangle's edge, found by fuzz_polycube),
+           which clamps to 0 without moving the sum in single precision. */
         for (k = 0; k < 3; k++) {
             mapping->source[3 * v + k] = source[k];
-            mapping->weights[3 * v + k] = (float)weight[k];
+            mapping->weights[3 * v + k] = (float)(weight[k] > 0.0 ? weight[k] : 0.0);
         }
     }
     {

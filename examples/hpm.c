@@ -310,6 +310,9 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
            "split before fitting: %d not flat, %d no room; %d faces changed sides at borders\n",
            report->accepted_fits, report->floor_fits, report->rejected_fits, report->continued, report->starts,
            report->not_flat, report->no_room, report->faces_moved);
+    if (report->faces_unflattened > 0)
+        printf("%d faces no cluster could flatten show a neighbour's map continued over their edge, or their own\n",
+               report->faces_unflattened);
     if (report->accepted_fits + report->floor_fits > 0)
         printf("fit error: mean %.3f, max %.3f (threshold %g)\n", report->mean_error, report->max_error,
                options->map.threshold > 0 ? options->map.threshold : TT_DEFAULT_HPM_THRESHOLD);

@@ -1669,6 +1669,67 @@ static void test_hpm_map_coarse(void)
     tt_image_free(im);
 }
 
+/* fuzz_hpm: with a flattening error bound so strict that no cluster of
+   several faces flattens (a 4 x 3 torus, 24 triangles), 16 to 18 faces
+   were left with no cluster (-1) and corners copied from their neighbours,
+   4 of them collapsing to no UV area. Each now shows a neighbour's map
+   continued over an edge, or its own leaf laid flat; every face has a
+   cluster, UV area and the turn of the others, inside the image. */
+static void test_hpm_map_unflattened(void)
+{
+    static const int branching[2] = {0, 44};
+    tt_image *im = NULL;
+    int which;
+    make_value_noise(&im, 24, 32, 3);
+    for (which = 0; which < 2 && im; which++) {
+        tmesh m;
+        tt_mesh *mesh = NULL;
+        tt_error err;
+        tt_hpm_options o;
+        tt_hpm_report rep;
+        float *uv;
+        int *cluster, f, k, unmapped = 0, collapsed = 0, turned[2] = {0, 0}, outside = 0;
+        tt_result r;
+        tmesh quads;
+        memset(&m, 0, sizeof m);
+        memset(&quads, 0, sizeof quads);
+        make_torus(&quads, 4, 3, 1.0, 0.45);
+        triangulate_into(&m, &quads, 0.0);
+        tm_free(&quads);
+        if (build(&m, 0, &mesh, &err) != TT_OK) {
+            CHECK(0, "building the coarse torus: %s", err.message);
+            tm_free(&m);
+            continue;
+        }
+        uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+        cluster = (int *)malloc(sizeof(int) * (size_t)mesh->nfaces);
+        memset(&o, 0, sizeof o);
+        o.max_flattening_error = 1e-300;
+        o.branching = branching[which];
+        o.match_size = 16;
+        r = tt_hpm_map(mesh, im, &o, NULL, uv, cluster, &rep, &err);
+        for (f = 0; r == TT_OK && f < mesh->nfaces; f++) {
+            const float *a = uv + 2 * mesh->face_start[f];
+            double area = (a[2] - a[0]) * (a[5] - a[1]) - (a[4] - a[0]) * (a[3] - a[1]);
+            if (cluster[f] < 0) unmapped++;
+            if (!(fabs(area) > 1e-6)) collapsed++;
+            else turned[area > 0]++;
+            for (k = 0; k < 6; k++) outside += !(a[k] >= 0.0f && a[k] <= 1.0f);
+        }
+        CHECK(r == TT_OK && rep.faces_unflattened >= 8 && rep.not_flat > 0 && unmapped == 0 && collapsed == 0 &&
+                  (turned[0] == 0 || turned[1] == 0) && outside == 0,
+              "coarse torus, no flattening error allowed, branching %d: result %d (%s), %d faces unflattened, %d "
+              "not flat; %d faces with no cluster, %d with no UV area, turned %d / %d, %d UVs outside",
+              branching[which], r, r == TT_OK ? "TT_OK" : err.message, rep.faces_unflattened, rep.not_flat, unmapped,
+              collapsed, turned[0], turned[1], outside);
+        free(uv);
+        free(cluster);
+        tt_mesh_free(mesh);
+        tm_free(&m);
+    }
+    tt_image_free(im);
+}
+
 /* A progress callback that records the fractions and cancels at call
    number cancel_at (0-based; -1: never). */
 typedef struct hpm_progress_log {
@@ -1950,6 +2011,7 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_budget);
     RUN(test_hpm_map_topology);
     RUN(test_hpm_map_coarse);
+    RUN(test_hpm_map_unflattened);
     RUN(test_hpm_map_progress);
     RUN(test_hpm_map_errors);
     RUN(test_hpm_extreme_floats_refused);
