@@ -16387,6 +16387,13 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         nedges++;
     }
     mean_w = nedges > 0 ? total_w / nedges : 0;
+    /* Every weight 0: faces of no area (a permissive mesh's), whose
+       harmonic map is no system at all (found by fuzz_hpm). */
+    if (!(mean_w > 0)) {
+        res = tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
+                          "cluster %d: its %d faces have no area, so it has no harmonic map", cluster, n);
+        goto done;
+    }
     for (i = 0; i < nv; i++) unk[i] = next[i] < 0 ? nunk++ : -1;
     for (i = 0; i < 2 * nunk; i++) rhs[i] = 0;
     for (i = 0; i < 3 * n; i++) {
@@ -24657,13 +24664,19 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             }
         }
         for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * mapping->source[3 * v]];
-        /* Barycentric weights of a point of the input triangle: rounding
-           can leave one a hair below 0 (a fan centre's mean value
-           coordinates on the triangle's edge, found by fuzz_polycube),
-           which clamps to 0 without moving the sum in single precision. */
+        /* Barycentric weights in the input triangle. A fan centre's mean
+           value coordinates over a boundary that is not convex can put it
+           outside (a weight below 0, from a hair to a tenth, found by
+           fuzz_polycube): it is moved onto the triangle, the weights
+           below 0 set to 0 and the others scaled back to a sum of 1. */
+        if (weight[0] < 0.0 || weight[1] < 0.0 || weight[2] < 0.0) {
+            double sum = 0.0;
+            for (k = 0; k < 3; k++) sum += weight[k] = weight[k] > 0.0 ? weight[k] : 0.0;
+            for (k = 0; k < 3; k++) weight[k] = sum > 0.0 ? weight[k] / sum : (k == 0);
+        }
         for (k = 0; k < 3; k++) {
             mapping->source[3 * v + k] = source[k];
-            mapping->weights[3 * v + k] = (float)(weight[k] > 0.0 ? weight[k] : 0.0);
+            mapping->weights[3 * v + k] = (float)weight[k];
         }
     }
     {
