@@ -20866,6 +20866,7 @@ typedef struct tt__edge_search {
     double a[2];        /* q_a: in the plane, as its quad is the plane's frame */
     double b[2];        /* q_b in its own quad's frame */
     int quad_b, max_quads, steps;
+    double spent;       /* steps of every search so far (the reseating's budget) */
     int quads[TT_POLYCUBE_EDGE_MAX_QUADS];
     int halfedges[TT_POLYCUBE_EDGE_MAX_QUADS];  /* halfedges[i] leaves quads[i] for quads[i + 1] */
     tt_quad_map maps[TT_POLYCUBE_EDGE_MAX_QUADS];
@@ -21306,6 +21307,7 @@ static int tt__edge_find_path(tt__edge_search *S, tt_surface_point qa, tt_surfac
                 best_b = ib;
             }
         }
+    S->spent += S->steps;
     ends[0] = quads_a[best_a];
     ends[1] = quads_b[best_b];
     S->a[0] = st_a[best_a][0];
@@ -23192,6 +23194,14 @@ static int tt__polycube_restore_failing(const tt_mesh *model, const tt_polycube_
 #define TT__RESEAT_ROUNDS 2     /* rounds of re-seating stray vertices and tracing their edges again */
 #define TT__RESEAT_CYCLES 2     /* re-seatings, each followed by the relaxation */
 #define TT__RESEAT_SEATS 16     /* seats (neighbours' quads) tried per vertex at most */
+/* Path-search steps the reseating takes at most in one tt_polycube_map,
+   all its rounds together: this much per model vertex, and 16 searches'
+   budgets besides. With the default max_quads a search takes tens of steps
+   and this is never reached; with one of 60 quads every failing search
+   runs to its budget (200000 steps), and a 1000-vertex model retried seat
+   after seat, round after round, spent 35 s, which this bounds to about a
+   second. */
+#define TT__RESEAT_STEPS_PER_VERTEX 4096.0
 #define TT__RESEAT_FOCUS_RINGS 8    /* rings around the re-seated points the relaxation after them looks at */
 
 /* How many of v's edges, counted once per triangle at v, find no path on
@@ -23221,7 +23231,7 @@ static int tt__reseat_failures(tt__edge_search *S, const tt_mesh *model, const t
    when that is better than where it is. Each point moved is flagged in
    moved_points[]. Returns the number moved, -1 when out of memory. */
 static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
-                               int max_quads, tt_surface_point *points, unsigned char *moved_points,
+                               int max_quads, tt_surface_point *points, unsigned char *moved_points, double *spent,
                                const tt_allocator *allocator)
 {
     tt__relax_context x;
@@ -23236,6 +23246,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
     memset(S, 0, sizeof *S);
     S->pc = pc;
     S->max_quads = max_quads;
+    S->spent = *spent;
     memset(stray, 0, (size_t)model->nverts);
     for (e = 0; e < edges->nedges; e++)
         if (edges->failed[e]) stray[edges->edge_vertices[2 * e]] = stray[edges->edge_vertices[2 * e + 1]] = 1;
@@ -23244,6 +23255,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
         tt_surface_point best = kept;
         double at[2], best_score;
         int i, k, tried[TT__RESEAT_SEATS], ntried = 0;
+        if (S->spent > 16.0 * TT__EDGE_SEARCH_BUDGET + TT__RESEAT_STEPS_PER_VERTEX * model->nverts) break;
         if (!stray[v] || tt__relax_on_surface(pc, model, points, v)) continue;
         tt__relax_chart_at(x.chart, kept.quad, TT__RELAX_RADIUS);
         tt__relax_chart_place(x.chart, kept, at);
@@ -23278,6 +23290,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
             moved++;
         }
     }
+    *spent = S->spent;
     tt__relax_context_free(allocator, &x);
     tt__free(allocator, S);
     tt__free(allocator, stray);
@@ -24520,6 +24533,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     const tt_executor *executor = options ? options->executor : NULL;
     double longest;
     int f, v, j, tracing, cycle, moves, max_quads;
+    double reseat_steps = 0.0;   /* path-search steps of every reseating (TT__RESEAT_STEPS_PER_VERTEX) */
     tt__ok(error);
     if (out) *out = NULL;
     if (!report) report = &local;
@@ -24586,7 +24600,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
             int n, failed_before = edges->nfailed;
             memset(moved, 0, (size_t)model->nverts);
-            if ((n = tt__polycube_reseat(polycube, model, edges, max_quads, points, moved, allocator)) < 0)
+            if ((n = tt__polycube_reseat(polycube, model, edges, max_quads, points, moved, &reseat_steps,
+                                         allocator)) < 0)
                 goto out_of_memory;
             if (!n) break;
             reseated += n;

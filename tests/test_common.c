@@ -349,10 +349,12 @@ int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, 
                              unsigned char *moved, const tt_allocator *allocator)
 {
     tt_polycube_edges *edges = NULL;
+    double spent = 0.0;
     int n;
     if (tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, allocator, &edges, NULL) != TT_OK)
         return -2;
-    n = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, allocator);
+    n = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, &spent,
+                            allocator);
     tt_polycube_edges_free(edges);
     return n;
 }
