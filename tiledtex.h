@@ -2581,7 +2581,9 @@ typedef struct tt_hpm_report {
      TT_ERROR_ZERO_AREA_FACE    every face has zero area (no scale);
      TT_ERROR_NON_FINITE        a NaN or infinite texel (error->row, column),
                                 or coordinates or a scale so extreme that
-                                no cluster could be textured in float;
+                                no cluster could be textured in float, or
+                                that a texture coordinate would overflow
+                                one (error->corner);
      TT_CANCELLED               the progress callback stopped it;
      TT_ERROR_OUT_OF_MEMORY.
    On any error corner_uv and face_cluster are untouched. Time: the
@@ -19212,6 +19214,17 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     tt__hpm_leftovers(&S);
     {
         const double *x = S.out ? S.out : S.uv;
+        /* A tileable image at a scale of almost nothing (1e-40 units
+           across) puts UVs past single precision (found by fuzz_hpm):
+           refused before anything is written. */
+        for (i = 0; i < 2 * mesh->ncorners; i++)
+            if (!(fabs(x[i] / (i % 2 ? S.Hh : S.W)) < 1e30)) {
+                res = tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[i / 2], i / 2, -1, -1,
+                               "hpm: at %g texels per unit corner %d's texture coordinate (%g image widths) "
+                               "overflows single precision: use a larger scale",
+                               S.s, i / 2, x[i] / (i % 2 ? S.Hh : S.W));
+                goto done;
+            }
         for (i = 0; i < mesh->ncorners; i++) {
             corner_uv[2 * i] = (float)(x[2 * i] / S.W);
             corner_uv[2 * i + 1] = (float)(1 - x[2 * i + 1] / S.Hh);
