@@ -17408,7 +17408,7 @@ static void tt__hpm_allowed_copy(void *context, int k)
                     continue;
                 }
                 edge = (limit - row) / nx[d];
-                edge = edge < -1.0 ? -1.0 : (edge > P ? P : edge);
+                edge = edge > -1.0 ? (edge < P ? edge : P) : -1.0;   /* NaN too: -1 */
                 if (nx[d] > 0) {
                     /* the largest tx that holds, searched near floor(edge) */
                     tx = (int)floor(edge);
@@ -17465,10 +17465,13 @@ static int tt__hpm_allowed_offsets(tt__hpm *S, int cw, int ch, int has_cont, con
         for (b = 0; b == 0 || (S->toroidal && tcy + (b - 1) * py - rad < P); b++)
             for (a = 0; a == 0 || (S->toroidal && tcx + (a - 1) * px - rad < P); a++) {
                 double cx = tcx + (S->toroidal ? (a - 1) * px : 0), cy = tcy + (S->toroidal ? (b - 1) * py : 0);
-                for (ty = (int)floor(cy - rad); ty <= (int)ceil(cy + rad); ty++)
-                    for (tx = (int)floor(cx - rad); tx <= (int)ceil(cx + rad); tx++)
-                        if (tx >= 0 && ty >= 0 && tx < P && ty < P &&
-                            (tx - cx) * (tx - cx) + (ty - cy) * (ty - cy) <= rad * rad)
+                /* the disc's rows and columns on the canvas, clipped there in
+                   double: far off it (or not finite), there is nothing to clear */
+                double x0 = floor(cx - rad), x1 = ceil(cx + rad), y0 = floor(cy - rad), y1 = ceil(cy + rad);
+                if (!(x0 < P && x1 >= 0 && y0 < P && y1 >= 0)) continue;
+                for (ty = y0 > 0 ? (int)y0 : 0; ty <= (y1 < P - 1 ? (int)y1 : P - 1); ty++)
+                    for (tx = x0 > 0 ? (int)x0 : 0; tx <= (x1 < P - 1 ? (int)x1 : P - 1); tx++)
+                        if ((tx - cx) * (tx - cx) + (ty - cy) * (ty - cy) <= rad * rad)
                             S->allowed_mem[(size_t)ty * P + tx] = 0;
             }
     }
@@ -17717,9 +17720,14 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         o[0] -= (cont[0] / S->f + cb - ctx) - floor(cont[0] / S->f + cb - ctx);
         o[1] -= (cont[1] / S->f + cb - cty) - floor(cont[1] / S->f + cb - cty);
     }
-    cw = (int)ceil(box[2] + w_w + 2 - o[0]);
-    ch = (int)ceil(box[3] + w_w + 2 - o[1]);
-    if (cw >= P || ch >= P) return -1;
+    {
+        /* Compared before the conversion: a cluster at a texel density
+           of 1e80 spans more texels than an int holds (found by fuzz_hpm). */
+        double width = ceil(box[2] + w_w + 2 - o[0]), height = ceil(box[3] + w_w + 2 - o[1]);
+        if (!(width >= 0 && width < P && height >= 0 && height < P)) return -1;
+        cw = (int)width;
+        ch = (int)height;
+    }
     /* The mask is 0 and the support clear outside what the previous fit
        drew: clear that. */
     for (i = 0; i < S->nband; i++) S->mask[S->band_pixels[i]] = 0;
