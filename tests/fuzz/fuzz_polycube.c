@@ -36,8 +36,8 @@
        5      max_edge: 0 = default (h / 2), 255 = HUGE_VAL (no refinement),
               else h * (16 + b) / 64 (at least h / 4: a finer one refines
               thousands of triangles and takes 0.1 s a run)
-       6      max_quads: b % 70, taken % 9 below 60 (0 = default; 60..64
-              the longest searches; 65..69 out of range)
+       6      max_quads: b % 9 (0 = default) below 245, else 60 + b - 245
+              (60..64 the longest searches, 65..70 out of range)
        7      colors: 1 + b % 8, 250..255 out of range (0, 129, -1, ...)
        8      bit0 axis palettes; bits 1..7 the tile size 4 + 4 * (b >> 5),
               gutter (b >> 1) & 3
@@ -280,7 +280,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     mo.max_edge = hdr[5] == 255 ? HUGE_VAL : hdr[5] == 0 ? 0.0 : pc->h * (16 + hdr[5]) / 64.0;
     /* 0..8 mostly: a long path search (60..64 quads) on a mesh whose edges
        fail spends its whole step budget per edge, seconds a run */
-    mo.max_quads = hdr[6] % 70 < 60 ? hdr[6] % 70 % 9 : hdr[6] % 70;
+    mo.max_quads = hdr[6] < 245 ? hdr[6] % 9 : 60 + (hdr[6] - 245);
     if ((hdr[0] & 128) && hdr[12] % 3 == 2) {
         mo.max_edge = fz_extreme_double(hdr[13]);
         valid_options = 0;
