@@ -21665,12 +21665,16 @@ static void tt__refined_midpoint_sources(const int *source, const double *weight
 
 static tt_result tt__polycube_refine_too_large(double longest, double needed, tt_error *error)
 {
+    /* A whole count up to a billion; beyond, three digits (a message's
+       number is read, not a row of 16 digits). */
+    char count[32];
+    if (needed < 1e9) snprintf(count, sizeof count, "at least %.0f", needed);
+    else snprintf(count, sizeof count, "%s%.3g", needed > 1e15 ? "over " : "at least ", needed > 1e15 ? 1e15 : needed);
     return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
-                    "refining the model to edges of at most %g makes %s%.*g triangles, above "
+                    "refining the model to edges of at most %g makes %s triangles, above "
                     "TT_POLYCUBE_MAX_TRIANGLES (%d): choose a larger max_edge (0: half a cube) or define "
                     "TT_POLYCUBE_MAX_TRIANGLES higher",
-                    longest, needed > 1e15 ? "over " : "at least ", needed < 1e9 ? 9 : 3,
-                    needed > 1e15 ? 1e15 : needed, TT_POLYCUBE_MAX_TRIANGLES);
+                    longest, count, TT_POLYCUBE_MAX_TRIANGLES);
 }
 
 static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
