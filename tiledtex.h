@@ -18863,20 +18863,14 @@ static void tt__hpm_fill_from_vertices(const tt__hpm *S, double *uv, int f)
 
 /* Face f laid flat on its own at the texel density, centred where its
    corners' coordinates in uv are (its neighbours' at its vertices), turned
-   as the textured faces are, moved inside a bounded image; returns 0 when
-   it does not fit there or its coordinates are not finite. */
-static int tt__hpm_place_alone(const tt__hpm *S, double *uv, int f, const double *frame)
+   as the textured faces are (mirror -1: their signed areas are negative),
+   moved inside a bounded image; returns 0 when it does not fit there or
+   its coordinates are not finite. */
+static int tt__hpm_place_alone(const tt__hpm *S, double *uv, int f, const double *frame, double mirror)
 {
     const tt_mesh *m = S->mesh;
-    int first = m->face_start[f], g, k, j;
-    double flat[3][2], centre[2] = {0, 0}, mean[2] = {0, 0}, low[2], high[2], size[2], mirror = 1;
-    /* the turn of the first textured face (texel coordinates run y down) */
-    for (g = 0; g < m->nfaces; g++)
-        if (S->owner[g] >= 0) {
-            const double *a = uv + 2 * (size_t)m->face_start[g];
-            if ((a[2] - a[0]) * (a[5] - a[1]) - (a[3] - a[1]) * (a[4] - a[0]) < 0) mirror = -1;
-            break;
-        }
+    int first = m->face_start[f], k, j;
+    double flat[3][2], centre[2] = {0, 0}, mean[2] = {0, 0}, low[2], high[2], size[2];
     flat[0][0] = flat[0][1] = 0;
     flat[1][0] = frame[0] * S->s;
     flat[1][1] = 0;
@@ -18924,6 +18918,7 @@ static void tt__hpm_leftovers(tt__hpm *S)
 {
     const tt_mesh *m = S->mesh;
     int *queue = S->near_faces, head = 0, tail = 0, queued = ++S->stamp, f, j, k;
+    double mirror = 1;
     for (f = 0; f < m->nfaces; f++) {
         if (S->owner[f] >= 0) continue;
         for (j = m->face_start[f]; j < m->face_start[f + 1]; j++)
@@ -18956,14 +18951,21 @@ static void tt__hpm_leftovers(tt__hpm *S)
             break;
         }
     }
+    /* the turn of the first textured face (texel coordinates run y down) */
+    for (f = 0; f < m->nfaces; f++)
+        if (S->owner[f] >= 0) {
+            const double *a = S->uv + 2 * (size_t)m->face_start[f];
+            if ((a[2] - a[0]) * (a[5] - a[1]) - (a[3] - a[1]) * (a[4] - a[0]) < 0) mirror = -1;
+            break;
+        }
     for (f = 0; f < m->nfaces; f++) {
         double frame[3];
         if (S->owner[f] >= 0) continue;
         tt__hpm_fill_from_vertices(S, S->uv, f);
         if (S->out) tt__hpm_fill_from_vertices(S, S->out, f);
         tt__hpm_tri_frame(S, m->face_start[f], frame);
-        if (!(frame[0] * frame[2] > 0) || !tt__hpm_place_alone(S, S->uv, f, frame)) continue;
-        if (S->out) (void)tt__hpm_place_alone(S, S->out, f, frame);
+        if (!(frame[0] * frame[2] > 0) || !tt__hpm_place_alone(S, S->uv, f, frame, mirror)) continue;
+        if (S->out) (void)tt__hpm_place_alone(S, S->out, f, frame, mirror);
         S->owner[f] = S->H->face_leaf[f];
         S->rep.faces_unflattened++;
     }
