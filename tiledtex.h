@@ -19210,8 +19210,9 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     /* Faces with area, yet no cluster flattened and placed: the float
        arithmetic overflowed or underflowed (coordinates near FLT_MAX, or a
        scale whose texel density is below FLT_MIN). TT_OK would be a
-       one-colour model with every UV at the image centre (issue 21 row 5,
-       reached through extreme floats by fuzz_hpm): refuse it. */
+       one-colour model with every UV at the image centre, which the tool
+       would write and report as done (reached through extreme floats by
+       fuzz_hpm): refuse it. */
     if (S.rep.clusters == 0) {
         res = tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
                        "hpm: no cluster could be textured: the mesh's coordinates (bounding box diagonal %g) or the "
