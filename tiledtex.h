@@ -18673,6 +18673,26 @@ static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, 
     return 1;
 }
 
+/* Face f's corners, in corner order into cand_uv[0..5], where they would
+   be if f showed the map (in uv) of the face across its half-edge c;
+   0 when that face is not usable or the corners are not finite or leave a
+   bounded image. */
+static int tt__hpm_neighbour_corners(const tt__hpm *S, const double *uv, int f, int c, double cand_uv[6])
+{
+    int first = S->mesh->face_start[f], j;
+    double cand[3][2];
+    if (!tt__hpm_face_as_neighbour(S, uv, c, cand)) return 0;
+    for (j = 0; j < 3; j++) {
+        int at = (c - first + j) % 3;   /* cand is in the order c, next(c), prev(c) */
+        if (!(fabs(cand[j][0]) < 1e30 && fabs(cand[j][1]) < 1e30)) return 0;
+        if (!S->toroidal && (cand[j][0] < 1 || cand[j][1] < 1 || cand[j][0] > S->W - 1 || cand[j][1] > S->Hh - 1))
+            return 0;
+        cand_uv[2 * at] = cand[j][0];
+        cand_uv[2 * at + 1] = cand[j][1];
+    }
+    return 1;
+}
+
 /* Mismatch over face f's edges to textured faces (0 where continuous),
    f's corners at fuv[0..5]. The faces across them keep their coordinates
    while f tries its candidates: their sides of the edges are sampled once,
@@ -18701,8 +18721,8 @@ static double tt__hpm_face_mismatch(const tt__hpm *S, int f, const double *fuv, 
 static int tt__hpm_border_choice(const tt__hpm *S, int f)
 {
     const tt_mesh *m = S->mesh;
-    int first = m->face_start[f], best = -1, C = S->owner[f], c, j, known[3];
-    double mine[6], cand_uv[6], cand[3][2], frame[3], theirs[3 * TT__HPM_SIDE_VALUES], before, best_cost, st_old,
+    int first = m->face_start[f], best = -1, C = S->owner[f], c, known[3];
+    double mine[6], cand_uv[6], frame[3], theirs[3 * TT__HPM_SIDE_VALUES], before, best_cost, st_old,
         st, unused;
     if (C < 0) return -1;
     memcpy(mine, S->uv + 2 * (size_t)first, sizeof mine);
@@ -18713,22 +18733,13 @@ static int tt__hpm_border_choice(const tt__hpm *S, int f)
     tt__hpm_tri_frame(S, first, frame);
     (void)tt__hpm_tri_map_at(mine, frame, &st_old);
     for (c = first; c < first + 3; c++) {
-        int t = m->twin[c], K, ok = 1;
+        int t = m->twin[c], K, ok;
         double area_n, area_f;
         if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0 || K == C) continue;
-        if (!tt__hpm_face_as_neighbour(S, S->uv, c, cand)) continue;
-        /* cand is in the order c, next(c), prev(c) */
-        for (j = 0; j < 3; j++) {
-            int at = (c - first + j) % 3;
-            cand_uv[2 * at] = cand[j][0];
-            cand_uv[2 * at + 1] = cand[j][1];
-            if (!S->toroidal &&
-                (cand[j][0] < 1 || cand[j][1] < 1 || cand[j][0] > S->W - 1 || cand[j][1] > S->Hh - 1))
-                ok = 0;
-        }
+        if (!tt__hpm_neighbour_corners(S, S->uv, f, c, cand_uv)) continue;
         area_f = tt__hpm_tri_map_at(cand_uv, frame, &st);
         area_n = tt__hpm_tri_area(S, t, &unused);
-        ok = ok && area_f * area_n > 0 && (st <= TT__HPM_RELAX_MAX_STRETCH || st <= st_old);
+        ok = area_f * area_n > 0 && (st <= TT__HPM_RELAX_MAX_STRETCH || st <= st_old);
         if (ok) {
             double cost = tt__hpm_face_mismatch(S, f, cand_uv, theirs, known, best_cost);
             if (cost < best_cost) {
@@ -18806,33 +18817,19 @@ static void tt__hpm_choose_borders(tt__hpm *S)
     }
 }
 
-/* Face f's corners in uv take cand (in the order c, next(c), prev(c)), if
-   that is finite, inside a bounded image and turned as the face across c
-   is; returns 1 when written. */
-static int tt__hpm_take_continuation(tt__hpm *S, double *uv, int f, int c, const double *frame)
+/* Face f's corners in uv take where they would be if f showed the map of
+   the face across its half-edge c (tt__hpm_neighbour_corners), if that
+   turns as that face does; returns 1 when written. */
+static int tt__hpm_take_continuation(const tt__hpm *S, double *uv, int f, int c)
 {
-    const tt_mesh *m = S->mesh;
-    int first = m->face_start[f], t = m->twin[c], j;
-    double cand[3][2], cand_uv[6], area_f, area_n, a[2], b[2], g[2], unused;
-    if (!tt__hpm_face_as_neighbour(S, uv, c, cand)) return 0;
-    for (j = 0; j < 3; j++) {
-        int at = (c - first + j) % 3;
-        if (!(fabs(cand[j][0]) < 1e30 && fabs(cand[j][1]) < 1e30)) return 0;
-        if (!S->toroidal && (cand[j][0] < 1 || cand[j][1] < 1 || cand[j][0] > S->W - 1 || cand[j][1] > S->Hh - 1))
-            return 0;
-        cand_uv[2 * at] = cand[j][0];
-        cand_uv[2 * at + 1] = cand[j][1];
-    }
-    area_f = tt__hpm_tri_map_at(cand_uv, frame, &unused);
-    /* the neighbour's signed area in this uv array */
-    for (j = 0; j < 2; j++) {
-        a[j] = uv[2 * (size_t)t + j];
-        b[j] = uv[2 * (size_t)tt__next(m, t) + j];
-        g[j] = uv[2 * (size_t)tt__prev(m, t) + j];
-    }
-    area_n = (b[0] - a[0]) * (g[1] - a[1]) - (b[1] - a[1]) * (g[0] - a[0]);
-    if (!(area_f * area_n > 0)) return 0;
-    memcpy(uv + 2 * (size_t)first, cand_uv, sizeof cand_uv);
+    const double *n = uv + 2 * (size_t)S->mesh->face_start[S->mesh->corner_face[S->mesh->twin[c]]];
+    double cand_uv[6];
+    if (!tt__hpm_neighbour_corners(S, uv, f, c, cand_uv) ||
+        !(tt__orient2(cand_uv[0], cand_uv[1], cand_uv[2], cand_uv[3], cand_uv[4], cand_uv[5]) *
+              tt__orient2(n[0], n[1], n[2], n[3], n[4], n[5]) >
+          0))
+        return 0;
+    memcpy(uv + 2 * (size_t)S->mesh->face_start[f], cand_uv, sizeof cand_uv);
     return 1;
 }
 
@@ -18936,9 +18933,9 @@ static void tt__hpm_leftovers(tt__hpm *S)
         for (j = m->face_start[f]; j < m->face_start[f + 1]; j++) {
             int t = m->twin[j];
             if (t < 0 || S->owner[m->corner_face[t]] < 0) continue;
-            if (!tt__hpm_take_continuation(S, S->uv, f, j, frame)) continue;
+            if (!tt__hpm_take_continuation(S, S->uv, f, j)) continue;
             /* the control takes its own neighbours' random maps where it can */
-            if (S->out && !tt__hpm_take_continuation(S, S->out, f, j, frame)) tt__hpm_fill_from_vertices(S, S->out, f);
+            if (S->out && !tt__hpm_take_continuation(S, S->out, f, j)) tt__hpm_fill_from_vertices(S, S->out, f);
             S->owner[f] = S->owner[m->corner_face[t]];
             S->rep.faces_unflattened++;
             for (k = m->face_start[f]; k < m->face_start[f + 1]; k++) {
@@ -18955,7 +18952,7 @@ static void tt__hpm_leftovers(tt__hpm *S)
     for (f = 0; f < m->nfaces; f++)
         if (S->owner[f] >= 0) {
             const double *a = S->uv + 2 * (size_t)m->face_start[f];
-            if ((a[2] - a[0]) * (a[5] - a[1]) - (a[3] - a[1]) * (a[4] - a[0]) < 0) mirror = -1;
+            if (tt__orient2(a[0], a[1], a[2], a[3], a[4], a[5]) < 0) mirror = -1;
             break;
         }
     for (f = 0; f < m->nfaces; f++) {
