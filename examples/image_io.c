@@ -214,6 +214,26 @@ static int pnm_header_overflows(const unsigned char *data, size_t size)
     return 0;
 }
 
+/* stb_image grows its buffer for a PNG's compressed data to what each
+   IDAT chunk's header declares, up to a gigabyte a chunk, before it reads
+   the chunk: a file of a few dozen bytes made it ask for 2 GB. A chunk
+   longer than what is left of the file is corrupt, so the chunks are walked
+   here (length, type, data, CRC) and such a file refused before decoding. */
+static int png_chunk_overruns(const unsigned char *data, size_t size)
+{
+    static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    size_t at = 8;
+    if (size < 8 || memcmp(data, signature, 8) != 0) return 0;
+    while (at + 8 <= size) {
+        uint64_t length = ((uint64_t)data[at] << 24) | ((uint64_t)data[at + 1] << 16) |
+                          ((uint64_t)data[at + 2] << 8) | data[at + 3];
+        if (length > size - at - 8) return 1;
+        if (memcmp(data + at + 4, "IEND", 4) == 0) return 0;
+        at += 8 + (size_t)length + 4;
+    }
+    return 0;
+}
+
 int image_load_memory(const unsigned char *file_data, size_t file_size, const char *path, tt_color_space space,
                       tt_image **image, char *err, size_t err_size)
 {
@@ -226,10 +246,15 @@ int image_load_memory(const unsigned char *file_data, size_t file_size, const ch
         return -1;
     }
     /* Before stb_image reads anything: its header scan already reads the
-       Huffman tables that come before a JPEG's frame header, and a PNM's
-       numbers. */
+       Huffman tables that come before a JPEG's frame header, a PNG's
+       chunks and a PNM's numbers. */
     if (jpeg_huffman_tables_overflow(file_data, file_size)) {
         tool_set_error(err, err_size, "cannot decode '%s' (a corrupt JPEG: a Huffman table of more than 256 codes)",
+                       path);
+        return -1;
+    }
+    if (png_chunk_overruns(file_data, file_size)) {
+        tool_set_error(err, err_size, "cannot decode '%s' (a corrupt PNG: a chunk longer than the rest of the file)",
                        path);
         return -1;
     }

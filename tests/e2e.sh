@@ -1857,6 +1857,12 @@ err_mentions "the 257-code JPEG: says why" "Huffman table"
 tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_dht_after_first_scan" >"$W/in/dht_late.jpg"
 expect_error "a JPEG with a 520-code Huffman table after junk bytes" synth ../in/dht_late.jpg out.png --tile 16
 err_mentions "the late 520-code table: says why" "Huffman table"
+# A 60-byte PNG whose IDAT chunk declares a gigabyte (found by fuzz_image:
+# stb_image grew its buffer to 2 GB before reading the chunk) is refused
+# before decoding, saying why.
+tail -c +3 "$ROOT/tests/fuzz/corpus_image/png_idat_longer_than_file" >"$W/in/idat_overrun.png"
+expect_error "a PNG whose IDAT chunk runs past the end of the file" synth ../in/idat_overrun.png out.png --tile 16
+err_mentions "the overrunning PNG chunk: says why" "chunk longer than the rest of the file"
 newdir
 for jpeg in jpeg_progressive_64x48 jpeg_restart_markers_64x48; do
     tail -c +3 "$ROOT/tests/fuzz/corpus_image/$jpeg" >"$W/in/$jpeg.jpg"
