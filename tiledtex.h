@@ -306,7 +306,11 @@ typedef int (*tt_progress_fn)(float fraction, void *user_data);
    threads: with an executor, the allocator must be thread-safe (TT_MALLOC /
    TT_FREE, i.e. malloc and free, are). Progress callbacks are only ever
    called on the thread that called the library. A NULL executor, or one
-   whose run is NULL, means serial on the calling thread. */
+   whose run is NULL, means serial on the calling thread. Some stages call
+   `run` thousands of times for batches of a fraction of a millisecond
+   (tt_hpm_map fits and relaxes each cluster so): workers that sleep between
+   batches and take tens of microseconds to wake gain little there; the
+   tool's pool spins briefly before it sleeps. */
 typedef void (*tt_task_fn)(void *task_context, int index);
 typedef struct tt_executor {
     void (*run)(int count, tt_task_fn task, void *task_context, void *user_data);
@@ -16620,7 +16624,7 @@ typedef struct tt__hpm {
     int *term_x, *term_y;       /* P x P: the band's pixels in row-major order, for direct sums */
     double *term_weight, *term_values;  /* P x P, nch x P x P: their weights and values */
     float *rows;                /* copies x P x P: E of the direct sums in float */
-    double *relax_sides;        /* 3 x TT__HPM_RING_MAX x TT__HPM_SIDE_VALUES: the relaxation's edge samples */
+    double *relax_sides;        /* TT__HPM_RELAX_TASKS x TT__HPM_RELAX_SIDES: the relaxation's edge samples */
     double *xwork, *mask, *values;
     unsigned char *support;     /* P x P: 1 = the cluster's footprint, 2 = band; 0 outside the canvas */
     int canvas_w, canvas_h;     /* the last fit's canvas */
@@ -16639,7 +16643,8 @@ typedef struct tt__hpm {
                                    placement, before its border work; only the first 6 * its faces touched */
     double *vdisp;              /* 5 * nverts: displacement, its sums, for the interior re-solve */
     int *vmark;                 /* per vertex: stamp of the cluster it is inside (not on its border), or of
-                                   the border choice's sweep that moved a face there */
+                                   the border choice's sweep that moved a face there; while the relaxation
+                                   sorts its vertices into classes, -2 - their index */
     signed char *border_choice; /* per face: the border choice's pick in a sweep (tt__hpm_border_range) */
     int stamp;
     unsigned char *state;       /* per cluster: 0 new, 1 done, 2 waiting */
@@ -18120,20 +18125,227 @@ static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
 
 #define TT__HPM_RING_MAX 64
 
+/* The relaxation's vertices in classes, so that it can run on the
+   executor: two vertices of one class share no face, so nudging one
+   changes nothing the other reads (its triangles, the texture along its
+   edges) or writes (its own corners). The classes run in turn, each pass
+   over all of them, and a class's vertices as tasks of up to
+   TT__HPM_RELAX_TASKS ranges, each range with its own edge samples; each
+   vertex draws its trials from its own random stream (the cluster's seed,
+   the vertex, the pass), so the result does not depend on how the
+   executor runs the ranges, or on whether there is one. */
+#define TT__HPM_RELAX_TASKS 8
+#define TT__HPM_RELAX_SIDES (3 * TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES)
+
+/* One border vertex v of C in one pass: C's map there, then each
+   neighbour's, nudged in turn. While one cluster's coordinates at v move,
+   the other sides of its border edges there stay: they are sampled once
+   (tt__hpm_edge_side), and each triangle is laid flat once. `sides` holds
+   TT__HPM_RELAX_SIDES doubles. */
+static void tt__hpm_relax_vertex(tt__hpm *S, int C, int v, double radius, tt_rng *rng, double *sides)
+{
+    const tt_mesh *m = S->mesh;
+    int ring[TT__HPM_RING_MAX], group[TT__HPM_RING_MAX], n, ngroups = 0, g, k;
+    double frame[3 * TT__HPM_RING_MAX];
+    n = tt__hpm_ring(m, v, ring, TT__HPM_RING_MAX);
+    for (k = 0; k < n; k++) tt__hpm_tri_frame(S, ring[k], frame + 3 * k);
+    /* the clusters meeting at v, C first */
+    group[ngroups++] = C;
+    for (k = 0; k < n; k++) {
+        int K = S->owner[m->corner_face[ring[k]]], seen = 0;
+        for (g = 0; g < ngroups; g++) seen |= group[g] == K;
+        if (K >= 0 && !seen) group[ngroups++] = K;
+    }
+    for (g = 0; g < ngroups; g++) {
+        /* K's border edges at v (ring corners whose edge parts K from
+           another textured cluster), K's side of each: 0 when the ring
+           corner's face is K's */
+        int K = group[g], trial, first = -1, edge[TT__HPM_RING_MAX], side[TT__HPM_RING_MAX], nedges = 0, e;
+        double continued = 0, before = 0, old[2], area0[TT__HPM_RING_MAX], st0[TT__HPM_RING_MAX];
+        double *fixed = sides, *moving = fixed + TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES;
+        double *trying = moving + TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES;
+        for (k = 0; k < n; k++) {
+            int c = ring[k], t = m->twin[c], a, b;
+            if (t < 0) continue;
+            a = S->owner[m->corner_face[c]];
+            b = S->owner[m->corner_face[t]];
+            if (a < 0 || b < 0 || a == b || (a != K && b != K)) continue;
+            edge[nedges] = c;
+            side[nedges] = a == K ? 0 : 1;
+            tt__hpm_edge_side(S, c, 1 - side[nedges], fixed + TT__HPM_SIDE_VALUES * nedges);
+            tt__hpm_edge_side(S, c, side[nedges], moving + TT__HPM_SIDE_VALUES * nedges);
+            nedges++;
+        }
+        for (e = 0; e < nedges; e++)
+            before += tt__hpm_edge_compare(S, moving + TT__HPM_SIDE_VALUES * e, fixed + TT__HPM_SIDE_VALUES * e,
+                                           &continued);
+        /* no border here, or the exact continuation of the neighbour */
+        if (continued <= 1e-12) continue;
+        for (k = 0; k < n && first < 0; k++)
+            if (S->owner[m->corner_face[ring[k]]] == K) first = ring[k];
+        old[0] = S->uv[2 * first];
+        old[1] = S->uv[2 * first + 1];
+        for (k = 0; k < n; k++)
+            if (S->owner[m->corner_face[ring[k]]] == K) area0[k] = tt__hpm_tri_map(S, ring[k], frame + 3 * k, &st0[k]);
+        for (trial = 0; trial < TT__HPM_RELAX_TRIALS; trial++) {
+            double ang = TT__TWO_PI * tt_rng_float(rng), r = radius * sqrt(tt_rng_float(rng));
+            double nx = old[0] + r * cos(ang), ny = old[1] + r * sin(ang), after = 0, area1, st;
+            int ok = 1;
+            if (!S->toroidal && (nx < 1 || ny < 1 || nx > S->W - 1 || ny > S->Hh - 1)) continue;
+            /* whether a moved triangle would flip, collapse or overstretch
+               first: it refuses most trials, for less than their mismatch */
+            for (k = 0; k < n && ok; k++) {
+                int c = ring[k];
+                if (S->owner[m->corner_face[c]] != K) continue;
+                S->uv[2 * c] = nx;
+                S->uv[2 * c + 1] = ny;
+                area1 = tt__hpm_tri_map(S, c, frame + 3 * k, &st);
+                S->uv[2 * c] = old[0];
+                S->uv[2 * c + 1] = old[1];
+                ok = area0[k] * area1 > 0 && fabs(area1) >= 0.25 * fabs(area0[k]) &&
+                     st <= (st0[k] > TT__HPM_RELAX_MAX_STRETCH ? st0[k] : TT__HPM_RELAX_MAX_STRETCH);
+            }
+            if (!ok) continue;
+            for (k = 0; k < n; k++)
+                if (S->owner[m->corner_face[ring[k]]] == K) {
+                    S->uv[2 * ring[k]] = nx;
+                    S->uv[2 * ring[k] + 1] = ny;
+                }
+            for (e = 0; e < nedges && after < before; e++) {
+                tt__hpm_edge_line line;
+                tt__hpm_edge_side_line(S, edge[e], side[e], &line);
+                after += tt__hpm_edge_cost_within(S, &line, fixed + TT__HPM_SIDE_VALUES * e,
+                                                  trying + TT__HPM_SIDE_VALUES * e, after, before);
+            }
+            if (after < before) {
+                double *swap = moving;
+                moving = trying;
+                trying = swap;
+                before = after;
+                old[0] = nx;
+                old[1] = ny;
+                for (k = 0; k < n; k++)
+                    if (S->owner[m->corner_face[ring[k]]] == K)
+                        area0[k] = tt__hpm_tri_map(S, ring[k], frame + 3 * k, &st0[k]);
+            } else {
+                for (k = 0; k < n; k++)
+                    if (S->owner[m->corner_face[ring[k]]] == K) {
+                        S->uv[2 * ring[k]] = old[0];
+                        S->uv[2 * ring[k] + 1] = old[1];
+                    }
+            }
+        }
+    }
+}
+
+/* One class of one pass (tt__hpm_relax), in ranges. */
+typedef struct tt__hpm_relax_job {
+    tt__hpm *S;
+    const int *verts;           /* the class's vertices */
+    int C, pass, grain;
+    uint64_t seed;
+    double radius;
+} tt__hpm_relax_job;
+
+static void tt__hpm_relax_range(void *context, int begin, int end)
+{
+    const tt__hpm_relax_job *job = (const tt__hpm_relax_job *)context;
+    double *sides = job->S->relax_sides + (size_t)TT__HPM_RELAX_SIDES * (size_t)(begin / job->grain);
+    int i;
+    for (i = begin; i < end; i++) {
+        tt_rng rng;
+        tt_rng_seed(&rng, job->seed, (uint64_t)job->verts[i] * TT__HPM_RELAX_PASSES + (uint64_t)job->pass);
+        tt__hpm_relax_vertex(job->S, job->C, job->verts[i], job->radius, &rng, sides);
+    }
+}
+
+/* The border vertices' classes: greedily, in vertex order, each takes the
+   first class none of its face-sharing border vertices has (both ways
+   round: a ring cut at TT__HPM_RING_MAX faces may see a vertex that does
+   not see it). verts[0 .. nverts) is sorted on entry and on return sorted
+   by (class, vertex), class_end[k] the end of class k; returns the number
+   of classes, or 0 when out of memory. S->vmark marks the border vertices
+   with -2 - their index meanwhile (the other uses of vmark leave stamps,
+   all positive, or -1), then 0. */
+static int tt__hpm_relax_classes(tt__hpm *S, int *verts, int nverts, int *class_end)
+{
+    const tt_mesh *m = S->mesh;
+    int *pairs = NULL, *first = NULL, *adjacent = NULL, *cls = NULL, npairs = 0, cap = 0, i, k, j, nclasses = 0;
+    int ok = 0;
+    for (i = 0; i < nverts; i++) S->vmark[verts[i]] = -2 - i;
+    /* every (vertex, border vertex in one of its ring's faces), both ways */
+    for (i = 0; i < nverts; i++) {
+        int ring[TT__HPM_RING_MAX], n = tt__hpm_ring(m, verts[i], ring, TT__HPM_RING_MAX), c;
+        for (k = 0; k < n; k++) {
+            int f = m->corner_face[ring[k]];
+            for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+                int other = -2 - S->vmark[m->corner_vert[c]];
+                int *np;
+                if (other < 0 || other == i) continue;
+                if (npairs + 2 > cap) {
+                    np = (int *)tt__grow(S->al, pairs, &cap, npairs + 2, 2 * sizeof(int));
+                    if (!np) goto done;
+                    pairs = np;
+                }
+                pairs[2 * npairs] = i;
+                pairs[2 * npairs + 1] = other;
+                pairs[2 * npairs + 2] = other;
+                pairs[2 * npairs + 3] = i;
+                npairs += 2;
+            }
+        }
+    }
+    first = TT__ALLOC(S->al, int, (size_t)nverts + 1);
+    adjacent = TT__ALLOC(S->al, int, (size_t)(npairs > nverts ? npairs : nverts)); /* then the vertices' copy */
+    cls = TT__ALLOC(S->al, int, (size_t)nverts);
+    if (!first || !adjacent || !cls) goto done;
+    for (i = 0; i <= nverts; i++) first[i] = 0;
+    for (k = 0; k < npairs; k++) first[pairs[2 * k] + 1]++;
+    for (i = 0; i < nverts; i++) first[i + 1] += first[i];
+    for (k = 0; k < npairs; k++) adjacent[first[pairs[2 * k]]++] = pairs[2 * k + 1];
+    for (i = nverts; i > 0; i--) first[i] = first[i - 1];
+    first[0] = 0;
+    for (i = 0; i < nverts; i++) {
+        int c = 0, taken = 1;
+        while (taken) {
+            taken = 0;
+            for (j = first[i]; j < first[i + 1] && !taken; j++) taken = adjacent[j] < i && cls[adjacent[j]] == c;
+            c += taken;
+        }
+        cls[i] = c;
+        if (c + 1 > nclasses) nclasses = c + 1;
+    }
+    /* sorted by (class, vertex): a counting pass over the classes, the
+       vertices already in order within each */
+    for (k = 0; k < nclasses; k++) class_end[k] = 0;
+    for (i = 0; i < nverts; i++) class_end[cls[i]]++;
+    for (k = 1; k < nclasses; k++) class_end[k] += class_end[k - 1];
+    for (i = 0; i < nverts; i++) adjacent[i] = verts[i];
+    for (k = 0; k < nclasses; k++) first[k] = k == 0 ? 0 : class_end[k - 1];
+    for (i = 0; i < nverts; i++) verts[first[cls[i]]++] = adjacent[i];
+    ok = 1;
+done:
+    for (i = 0; i < nverts; i++) S->vmark[verts[i]] = 0;
+    tt__free(S->al, pairs);
+    tt__free(S->al, first);
+    tt__free(S->al, adjacent);
+    tt__free(S->al, cls);
+    return ok ? nclasses : 0;
+}
+
 /* Relax the border between C (its faces already owned by C) and the
-   textured faces round it: at each vertex of that border, C's map and
-   then each neighbour's map there is nudged in turn. While one cluster's
-   coordinates at the vertex move, the other sides of its border edges
-   there stay: they are sampled once (tt__hpm_edge_side), and each
-   triangle is laid flat once per vertex. Returns 0 when out of memory. */
+   textured faces round it: every vertex of that border in each pass, the
+   radius halving from pass to pass. Returns 0 when out of memory. */
 static int tt__hpm_relax(tt__hpm *S, int C)
 {
     const tt_mesh *m = S->mesh;
     const tt_cluster *cl = &S->H->clusters[C];
-    int *verts, nverts = 0, i, j, pass;
+    int *verts, *class_end, nverts = 0, nclasses, i, j, k, pass;
     double w = tt__hpm_band_width(S, C);
-    verts = TT__ALLOC(S->al, int, 6 * (size_t)cl->nfaces);
+    tt__hpm_relax_job job;
+    verts = TT__ALLOC(S->al, int, 12 * (size_t)cl->nfaces);
     if (!verts) return 0;
+    class_end = verts + 6 * (size_t)cl->nfaces;
     /* both ends of every edge C shares with a textured neighbour */
     for (i = 0; i < cl->nfaces; i++) {
         int f = S->H->faces[cl->first_face + i], c;
@@ -18149,100 +18361,27 @@ static int tt__hpm_relax(tt__hpm *S, int C)
     for (i = j = 0; i < nverts; i++)
         if (j == 0 || verts[i] != verts[j - 1]) verts[j++] = verts[i];
     nverts = j;
-    for (pass = 0; pass < TT__HPM_RELAX_PASSES && nverts > 0; pass++) {
-        double radius = w / (2 << pass);
-        if (radius < 0.25) break;
-        for (i = 0; i < nverts; i++) {
-            int ring[TT__HPM_RING_MAX], group[TT__HPM_RING_MAX], n, ngroups = 0, g, k;
-            double frame[3 * TT__HPM_RING_MAX];
-            n = tt__hpm_ring(m, verts[i], ring, TT__HPM_RING_MAX);
-            for (k = 0; k < n; k++) tt__hpm_tri_frame(S, ring[k], frame + 3 * k);
-            /* the clusters meeting at v, C first */
-            group[ngroups++] = C;
-            for (k = 0; k < n; k++) {
-                int K = S->owner[m->corner_face[ring[k]]], seen = 0;
-                for (g = 0; g < ngroups; g++) seen |= group[g] == K;
-                if (K >= 0 && !seen) group[ngroups++] = K;
-            }
-            for (g = 0; g < ngroups; g++) {
-                /* K's border edges at v (ring corners whose edge parts K from
-                   another textured cluster), K's side of each: 0 when the
-                   ring corner's face is K's */
-                int K = group[g], trial, first = -1, edge[TT__HPM_RING_MAX], side[TT__HPM_RING_MAX], nedges = 0, e;
-                double continued = 0, before = 0, old[2], area0[TT__HPM_RING_MAX], st0[TT__HPM_RING_MAX];
-                double *fixed = S->relax_sides, *moving = fixed + TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES;
-                double *trying = moving + TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES;
-                for (k = 0; k < n; k++) {
-                    int c = ring[k], t = m->twin[c], a, b;
-                    if (t < 0) continue;
-                    a = S->owner[m->corner_face[c]];
-                    b = S->owner[m->corner_face[t]];
-                    if (a < 0 || b < 0 || a == b || (a != K && b != K)) continue;
-                    edge[nedges] = c;
-                    side[nedges] = a == K ? 0 : 1;
-                    tt__hpm_edge_side(S, c, 1 - side[nedges], fixed + TT__HPM_SIDE_VALUES * nedges);
-                    tt__hpm_edge_side(S, c, side[nedges], moving + TT__HPM_SIDE_VALUES * nedges);
-                    nedges++;
-                }
-                for (e = 0; e < nedges; e++)
-                    before += tt__hpm_edge_compare(S, moving + TT__HPM_SIDE_VALUES * e, fixed + TT__HPM_SIDE_VALUES * e,
-                                                   &continued);
-                /* no border here, or the exact continuation of the neighbour */
-                if (continued <= 1e-12) continue;
-                for (k = 0; k < n && first < 0; k++)
-                    if (S->owner[m->corner_face[ring[k]]] == K) first = ring[k];
-                old[0] = S->uv[2 * first];
-                old[1] = S->uv[2 * first + 1];
-                for (k = 0; k < n; k++)
-                    if (S->owner[m->corner_face[ring[k]]] == K)
-                        area0[k] = tt__hpm_tri_map(S, ring[k], frame + 3 * k, &st0[k]);
-                for (trial = 0; trial < TT__HPM_RELAX_TRIALS; trial++) {
-                    double ang = TT__TWO_PI * tt_rng_float(&S->rng), r = radius * sqrt(tt_rng_float(&S->rng));
-                    double nx = old[0] + r * cos(ang), ny = old[1] + r * sin(ang), after = 0, area1, st;
-                    int ok = 1;
-                    if (!S->toroidal && (nx < 1 || ny < 1 || nx > S->W - 1 || ny > S->Hh - 1)) continue;
-                    for (k = 0; k < n && ok; k++) {
-                        int c = ring[k];
-                        if (S->owner[m->corner_face[c]] != K) continue;
-                        S->uv[2 * c] = nx;
-                        S->uv[2 * c + 1] = ny;
-                        area1 = tt__hpm_tri_map(S, c, frame + 3 * k, &st);
-                        S->uv[2 * c] = old[0];
-                        S->uv[2 * c + 1] = old[1];
-                        ok = area0[k] * area1 > 0 && fabs(area1) >= 0.25 * fabs(area0[k]) &&
-                             st <= (st0[k] > TT__HPM_RELAX_MAX_STRETCH ? st0[k] : TT__HPM_RELAX_MAX_STRETCH);
-                    }
-                    if (!ok) continue;
-                    for (k = 0; k < n; k++)
-                        if (S->owner[m->corner_face[ring[k]]] == K) {
-                            S->uv[2 * ring[k]] = nx;
-                            S->uv[2 * ring[k] + 1] = ny;
-                        }
-                    for (e = 0; e < nedges && after < before; e++) {
-                        tt__hpm_edge_line line;
-                        tt__hpm_edge_side_line(S, edge[e], side[e], &line);
-                        after += tt__hpm_edge_cost_within(S, &line, fixed + TT__HPM_SIDE_VALUES * e,
-                                                          trying + TT__HPM_SIDE_VALUES * e, after, before);
-                    }
-                    if (after < before) {
-                        double *swap = moving;
-                        moving = trying;
-                        trying = swap;
-                        before = after;
-                        old[0] = nx;
-                        old[1] = ny;
-                        for (k = 0; k < n; k++)
-                            if (S->owner[m->corner_face[ring[k]]] == K)
-                                area0[k] = tt__hpm_tri_map(S, ring[k], frame + 3 * k, &st0[k]);
-                    } else {
-                        for (k = 0; k < n; k++)
-                            if (S->owner[m->corner_face[ring[k]]] == K) {
-                                S->uv[2 * ring[k]] = old[0];
-                                S->uv[2 * ring[k] + 1] = old[1];
-                            }
-                    }
-                }
-            }
+    if (nverts == 0) {
+        tt__free(S->al, verts);
+        return 1;
+    }
+    nclasses = tt__hpm_relax_classes(S, verts, nverts, class_end);
+    if (nclasses == 0) {
+        tt__free(S->al, verts);
+        return 0;
+    }
+    job.S = S;
+    job.C = C;
+    job.seed = (uint64_t)tt_rng_next(&S->rng) << 32 | (uint32_t)C;
+    for (pass = 0; pass < TT__HPM_RELAX_PASSES; pass++) {
+        job.radius = w / (2 << pass);
+        job.pass = pass;
+        if (job.radius < 0.25) break;
+        for (k = 0; k < nclasses; k++) {
+            int begin = k == 0 ? 0 : class_end[k - 1], count = class_end[k] - begin;
+            job.verts = verts + begin;
+            job.grain = (count + TT__HPM_RELAX_TASKS - 1) / TT__HPM_RELAX_TASKS;
+            tt__parallel_ranges(S->executor, count, job.grain, tt__hpm_relax_range, &job);
         }
     }
     tt__free(S->al, verts);
@@ -19181,7 +19320,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.qcap = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
     S.heap = TT__ALLOC(allocator, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
     S.near_faces = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.relax_sides = TT__ALLOC(allocator, double, 3 * TT__HPM_RING_MAX * TT__HPM_SIDE_VALUES);
+    S.relax_sides = TT__ALLOC(allocator, double, (size_t)TT__HPM_RELAX_TASKS * TT__HPM_RELAX_SIDES);
     if (!S.flat || !S.uv || ((o.flags & TT_HPM_RANDOM_PLACEMENT) && !S.out) || !S.owner || !S.in_c || !S.seen ||
         !S.placed || !S.vdisp || !S.vmark || !S.border_choice || !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap ||
         !S.near_faces || !S.relax_sides) {

@@ -5,9 +5,19 @@
    them for every later run; the thread that calls run works too, so -j N
    runs N tasks at once. Tasks are handed out one index at a time under the
    pool's lock: the library's tasks are coarse (a tile, a range of edges),
-   so the lock is taken a few hundred times per run at most. The library
+   so the lock is taken a few thousand times per run at most. The library
    splits its work the same way whatever the executor does, so the outputs
-   are the same at every -j. */
+   are the same at every -j.
+
+   Some stages hand out thousands of small batches one after another (hpm
+   fits and relaxes each cluster in batches of a fraction of a
+   millisecond), and a thread asleep on a condition variable takes tens of
+   microseconds to wake: the caller would often finish a batch alone before
+   the worker woke, then wait for the worker's last task. So a thread about
+   to sleep (a worker between batches, the caller waiting for the last
+   task) first watches the pool's counters for TOOL_SPIN_NS, without the
+   lock. On the horse, hpm at -j 2 then takes 0.70 of its -j 1 wall time
+   instead of 0.86. */
 
 /* pthreads, sysconf and sched_getaffinity are POSIX / GNU, not C99. */
 #if !defined(_GNU_SOURCE)
@@ -17,6 +27,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <stdlib.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "tool.h"
@@ -35,13 +46,13 @@ typedef struct tool_pool {
     tt_task_fn task;
     void *task_context;
     int count, next, finished, active;
-    unsigned long generation;
+    unsigned long generation, completed; /* batches handed out; the last one whose tasks all returned */
 } tool_pool;
 
 /* -j: 0 until set (tool_jobs then gives the default). */
 static int g_jobs;
 static tool_pool g_pool = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, PTHREAD_COND_INITIALIZER,
-                           NULL, 0, 0, 0, NULL, NULL, 0, 0, 0, 0, 0};
+                           NULL, 0, 0, 0, NULL, NULL, 0, 0, 0, 0, 0, 0};
 
 void tool_set_jobs(int jobs)
 {
@@ -67,6 +78,48 @@ int tool_jobs(void)
     return g_jobs;
 }
 
+/* How long a thread about to sleep first watches for the change it waits
+   for: several wake-ups' worth, short beside any batch worth splitting. */
+#define TOOL_SPIN_NS 200000L
+
+/* The counters the waiting threads watch are written under the lock and,
+   while spinning, read without it: atomically where the compiler has the
+   builtins (gcc, clang); elsewhere the threads sleep at once. */
+#if defined(__GNUC__)
+#define TOOL_CAN_SPIN 1
+#define TOOL_LOAD(x) __atomic_load_n(&(x), __ATOMIC_ACQUIRE)
+#define TOOL_STORE(x, v) __atomic_store_n(&(x), (v), __ATOMIC_RELEASE)
+#else
+#define TOOL_CAN_SPIN 0
+#define TOOL_STORE(x, v) ((x) = (v))
+#endif
+
+/* Called with the lock held, returns with it held: watch, without the
+   lock, for up to TOOL_SPIN_NS until *counter differs from `from` (or the
+   pool is stopping), so that the condition wait after it usually finds the
+   change made and does not sleep. */
+static void spin_until_changed(tool_pool *pool, const unsigned long *counter, unsigned long from)
+{
+#if TOOL_CAN_SPIN
+    struct timespec start, now;
+    int i;
+    pthread_mutex_unlock(&pool->lock);
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    for (i = 1;; i++) {
+        if (TOOL_LOAD(*counter) != from || TOOL_LOAD(pool->stopping)) break;
+        if (i % 64 == 0) {
+            clock_gettime(CLOCK_MONOTONIC, &now);
+            if ((long)(now.tv_sec - start.tv_sec) * 1000000000L + (now.tv_nsec - start.tv_nsec) > TOOL_SPIN_NS) break;
+        }
+    }
+    pthread_mutex_lock(&pool->lock);
+#else
+    (void)pool;
+    (void)counter;
+    (void)from;
+#endif
+}
+
 /* Hand out indices of the current batch until none are left; called with
    the lock held, returns with it held. */
 static void work_on_batch(tool_pool *pool)
@@ -78,7 +131,10 @@ static void work_on_batch(tool_pool *pool)
         pthread_mutex_unlock(&pool->lock);
         task(context, index);
         pthread_mutex_lock(&pool->lock);
-        if (++pool->finished == pool->count) pthread_cond_broadcast(&pool->work_done);
+        if (++pool->finished == pool->count) {
+            TOOL_STORE(pool->completed, pool->generation);
+            pthread_cond_broadcast(&pool->work_done);
+        }
     }
 }
 
@@ -88,6 +144,7 @@ static void *worker_main(void *argument)
     unsigned long seen = 0;
     pthread_mutex_lock(&pool->lock);
     for (;;) {
+        if (!pool->stopping && pool->generation == seen) spin_until_changed(pool, &pool->generation, seen);
         while (!pool->stopping && pool->generation == seen) pthread_cond_wait(&pool->work_ready, &pool->lock);
         if (pool->stopping) break;
         seen = pool->generation;
@@ -103,7 +160,7 @@ static void stop_threads(void)
     tool_pool *pool = &g_pool;
     int i;
     pthread_mutex_lock(&pool->lock);
-    pool->stopping = 1;
+    TOOL_STORE(pool->stopping, 1);
     pthread_cond_broadcast(&pool->work_ready);
     pthread_mutex_unlock(&pool->lock);
     for (i = 0; i < pool->nthreads; i++) pthread_join(pool->threads[i], NULL);
@@ -149,9 +206,10 @@ static void pool_run(int count, tt_task_fn task, void *task_context, void *user_
     pool->next = 0;
     pool->finished = 0;
     pool->active = 1;
-    pool->generation++;
+    TOOL_STORE(pool->generation, pool->generation + 1);
     pthread_cond_broadcast(&pool->work_ready);
     work_on_batch(pool);
+    if (pool->finished < pool->count) spin_until_changed(pool, &pool->completed, pool->generation - 1);
     while (pool->finished < pool->count) pthread_cond_wait(&pool->work_done, &pool->lock);
     pool->active = 0;
     pthread_mutex_unlock(&pool->lock);

@@ -1300,8 +1300,65 @@ done:
     tt_mesh_free(mesh);
 }
 
-/* The executor runs the hierarchy's splits, each fit's turned copies and
-   the border choice's sweeps (ranges of faces) as tasks: the same UVs and
+/* The relaxation's classes, against the pairwise definition: on a torus
+   and a sphere (poles of high valence), with every vertex on the border or
+   every third, no two vertices of a class share a face, every vertex is
+   in exactly one class, the classes come out sorted by (class, vertex),
+   the border vertices' marks are cleared and the others' left alone. */
+static void test_hpm_relax_classes(void)
+{
+    int which;
+    for (which = 0; which < 2; which++) {
+        tt_mesh *mesh = hpm_mesh(which == 0 ? M_TORUS : M_SPHERE);
+        int step;
+        for (step = 1; step <= 3 && mesh; step += 2) {
+            int *vmark = (int *)malloc(sizeof(int) * (size_t)mesh->nverts);
+            int *verts = (int *)malloc(sizeof(int) * (size_t)mesh->nverts);
+            int *class_end = (int *)malloc(sizeof(int) * (size_t)mesh->nverts);
+            int *cls = (int *)malloc(sizeof(int) * (size_t)mesh->nverts);
+            int n = 0, v, k, f, c, d, nclasses, conflicts = 0, misplaced = 0, marks_changed = 0;
+            if (!verts || !class_end || !cls || !vmark) abort();
+            for (v = 0; v < mesh->nverts; v++) {
+                vmark[v] = v % 5 == 0 ? -1 : v; /* what the other uses leave */
+                cls[v] = -1;
+                if (v % step == 0) verts[n++] = v;
+            }
+            nclasses = internal_hpm_relax_classes(mesh, vmark, verts, n, class_end);
+            CHECK(nclasses >= 2 && nclasses <= 16 && class_end[nclasses - 1] == n,
+                  "mesh %d step %d: %d classes ending at %d of %d", which, step, nclasses,
+                  nclasses > 0 ? class_end[nclasses - 1] : -1, n);
+            for (k = 0; k < nclasses; k++)
+                for (c = k == 0 ? 0 : class_end[k - 1]; c < class_end[k]; c++) {
+                    misplaced += cls[verts[c]] != -1 || (c > (k == 0 ? 0 : class_end[k - 1]) && verts[c] <= verts[c - 1]);
+                    cls[verts[c]] = k;
+                }
+            for (v = 0; v < mesh->nverts; v++) {
+                misplaced += (v % step == 0) != (cls[v] >= 0);
+                marks_changed += vmark[v] != (v % step == 0 ? 0 : v % 5 == 0 ? -1 : v);
+            }
+            for (f = 0; f < mesh->nfaces; f++)
+                for (c = mesh->face_start[f]; c < mesh->face_start[f + 1]; c++)
+                    for (d = c + 1; d < mesh->face_start[f + 1]; d++) {
+                        int a = cls[mesh->corner_vert[c]], b = cls[mesh->corner_vert[d]];
+                        conflicts += a >= 0 && a == b;
+                    }
+            CHECK(conflicts == 0 && misplaced == 0,
+                  "mesh %d step %d: %d face-sharing pairs in one class, %d vertices misplaced", which, step, conflicts,
+                  misplaced);
+            CHECK(marks_changed == 0, "mesh %d step %d: %d vertex marks wrong after", which, step,
+                  marks_changed);
+            free(verts);
+            free(class_end);
+            free(cls);
+            free(vmark);
+        }
+        tt_mesh_free(mesh);
+    }
+}
+
+/* The executor runs the hierarchy's splits, each fit's turned copies,
+   the relaxation's classes and the border choice's sweeps (ranges of
+   faces) as tasks: the same UVs and
    clusters, bit for bit, whether they run serially, in reverse order or on
    two threads; with the default bands (summed directly) and with wide ones
    on a toroidal image (large clusters: their correlations by transforms). */
@@ -2005,6 +2062,7 @@ void run_hpm_tests(void)
     RUN(test_flatten_beyond_float);
     RUN(test_hpm_map_plane);
     RUN(test_hpm_map_continuation);
+    RUN(test_hpm_relax_classes);
     RUN(test_hpm_map_executor);
     RUN(test_hpm_map_seams);
     RUN(test_hpm_map_orientation);

@@ -401,6 +401,14 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
     return tt__untangle_energy(&star, x, delta2, gradient, NULL, folded);
 }
 int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
+int internal_hpm_relax_classes(const tt_mesh *mesh, int *vmark, int *verts, int n, int *class_end)
+{
+    tt__hpm S;
+    memset(&S, 0, sizeof S);
+    S.mesh = mesh;
+    S.vmark = vmark;
+    return tt__hpm_relax_classes(&S, verts, n, class_end);
+}
 uint64_t internal_xcorr_direct(int w, int h, int channels, const float *texture, int count, const int *x,
                                const int *y, const double *weight, const double *values, int lo, int hi, int *best,
                                double *best_e)

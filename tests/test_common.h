@@ -227,6 +227,11 @@ tt_result internal_amg_solve2(const tt_sparse_matrix *A, const double *b, double
 tt_result internal_lapped_align(const tt_mesh *mesh, const float *field, const int *faces, int nfaces, int seed_face,
                                 const double seed_weight[3], const float anchor[2], double *uv, int *unknowns,
                                 int *steps);
+/* Section 8's relaxation classes (tt__hpm_relax_classes) of the sorted
+   vertices verts[0 .. n) of mesh, with vmark as the per-vertex marks;
+   returns the number of classes, verts sorted by (class, vertex) and
+   class_end[k] the end of class k. */
+int internal_hpm_relax_classes(const tt_mesh *mesh, int *vmark, int *verts, int n, int *class_end);
 /* Section 4's direct masked sums (tt__xcorr_direct) over every offset of a
    texture (`channels` float planes h x w), the terms' texels (x, y),
    weights and values (channels per term): rows 0 .. h - 1, each over the
