@@ -17885,9 +17885,9 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    more than it was - the seams and the stretch measure pull against each
    other here, and 1.2 keeps the median stretch under 1.15 where most
    triangles are on a border - or when it would leave a bounded image's
-   margin. The interior is not re-solved (the relaxation's last step): the moves are a
-   few texels and only the border triangles absorb them. Exact
-   continuations are left alone. */
+   margin. Exact continuations are left alone. The interior is re-solved
+   after (tt__hpm_smooth), so that the border triangles do not absorb the
+   moves alone. */
 #define TT__HPM_RELAX_TRIALS 16
 #define TT__HPM_RELAX_PASSES 4
 #define TT__HPM_RELAX_SAMPLES 8

@@ -13,6 +13,9 @@
 #   scale_P_Nk_wall_j1/_j2   wall seconds at -j 1 and -j 2
 #   scale_P_Nk_wall_j2_over_j1
 #   scale_P_Nk_identical_j2  1 when every output file of -j 2 equals -j 1's
+#   scale_lapped_Nk_bake_wall_j1/_j2/_j2_over_j1
+#                            the bake stage alone, wall seconds as the tool
+#                            reports them ("bake: ... s wall")
 #   scale_P_Nk_peak_j1       peak resident memory, MiB
 #   scale_P_Nk_v030_cpu / _v030_peak / _cpu_over_v030
 #                            v0.3.0, built in the same run from its commit,
@@ -22,7 +25,7 @@
 #   scale_P_97k_cancel_seconds
 #                            Ctrl-C halfway through the 97k run: seconds
 #                            until the tool has exited (target <= 1)
-# Targets (issue 20): growth_4x <= 5; the 16x run finishes; at 97k faces
+# Targets: growth_4x <= 5; the 16x run finishes; at 97k faces
 # lapped <= 4 s, hpm <= 2.5 s, polycube <= 3 s, tile <= 0.3 s CPU, peak memory
 # no higher than v0.3.0's; -j 2 identical, wall <= 0.65x (tile synthesis, the
 # lapped bake, polycube) or 0.8x (hpm) of -j 1.
@@ -89,7 +92,7 @@ mib() { awk -v k="$1" 'BEGIN { printf "%.1f", k / 1024 }'; }
 # machine varies by a fifth from one run to the next.
 measure() {
     local tool_=$1 limit=$2 dir=$3 jobs=$4 pipeline=$5 mesh=$6 runs=${7:-1} extra=() jflag=() i
-    local cpus=() walls=() peaks=()
+    local cpus=() walls=() peaks=() bakes=()
     [ "$pipeline" = lapped ] && extra=(--bake 2048)
     [ -n "$jobs" ] && jflag=(-j "$jobs")
     for ((i = 0; i < runs; i++)); do
@@ -98,8 +101,12 @@ measure() {
             "$tool_" "${jflag[@]}" "$pipeline" "$mesh" "$photo" "$dir/out" "${extra[@]}")
         [ "$status" = 0 ] || return
         cpus+=("$cpu") walls+=("$wall") peaks+=("$peak")
+        # the bake stage's own wall time, as the tool reports it
+        bakes+=("$(sed -n 's/^bake: .* texels in \([0-9.]*\) s wall.*/\1/p' "$dir/log")")
     done
     cpu=$(median "${cpus[@]}") wall=$(median "${walls[@]}") peak=$(median "${peaks[@]}")
+    bake=
+    [ -n "${bakes[0]}" ] && bake=$(median "${bakes[@]}")
 }
 
 # median NUMBER...: the middle one.
@@ -173,6 +180,7 @@ for p in tile hpm polycube lapped; do
         fi
         cpu1[$s]=$cpu
         wall1=$wall
+        bake1=$bake
         figure "${name}_cpu_j1" "$cpu" s
         figure "${name}_wall_j1" "$wall" s
         figure "${name}_peak_j1" "$(mib "$peak")" MiB
@@ -184,6 +192,11 @@ for p in tile hpm polycube lapped; do
             done
             figure "${name}_wall_j2" "$wall" s
             figure "${name}_wall_j2_over_j1" "$(ratio "$wall" "$wall1")" x
+            if [ -n "$bake1" ] && [ -n "$bake" ]; then
+                figure "${name}_bake_wall_j1" "$bake1" s
+                figure "${name}_bake_wall_j2" "$bake" s
+                figure "${name}_bake_wall_j2_over_j1" "$(ratio "$bake" "$bake1")" x
+            fi
             figure "${name}_identical_j2" "$same" bool
         else
             echo "bench_scale: $p on $faces faces at -j 2: status $status" >&2
