@@ -135,22 +135,32 @@ int image_load(const char *path, tt_color_space space, tt_image **image, char *e
     return status;
 }
 
-/* Some stb_image versions (Debian's among them) write past a Huffman
-   table's 257 code sizes when a JPEG's DHT segment declares more than 256
-   codes: a hostile file could corrupt the decoder's memory. Such a table
-   is invalid JPEG, so the file is refused before stb_image sees it: walk
-   the segments as the decoder does and check each table's code count. A
-   progressive JPEG defines tables between its scans too, so the walk goes
-   on through each scan's coded data, where 0xFF is followed by 0x00 or a
-   restart marker; like the decoder, it steps over bytes that start no
-   segment until the next 0xFF. */
-static int jpeg_huffman_tables_overflow(const unsigned char *data, size_t size)
+/* What stb_image cannot be trusted with in a JPEG's Huffman tables, found
+   by walking the segments as the decoder does, before it sees the file:
+   - JPEG_TABLE_OVERFLOW: a DHT segment declares more than 256 codes for a
+     table; some stb_image versions (Debian's among them) write past the
+     table's 257 code sizes then.
+   - JPEG_TABLE_UNDEFINED: a scan uses a table no DHT segment before it
+     defined; the decoder then reads a table left as it was in memory (it
+     failed its own assertion, and aborted, only when earlier work had left
+     something there: fuzz_image found it after 250,000 runs).
+   Both are invalid JPEG. A progressive JPEG defines tables between its
+   scans too, so the walk goes on through each scan's coded data, where
+   0xFF is followed by 0x00 or a restart marker; like the decoder, it steps
+   over bytes that start no segment until the next 0xFF. A scan needs the
+   DC table of each of its components when it codes DC coefficients for the
+   first time (Ss = 0, Ah = 0: a sequential scan, or a progressive DC scan's
+   first pass) and the AC table when it codes AC ones (Se > 0). */
+enum { JPEG_TABLES_USABLE, JPEG_TABLE_OVERFLOW, JPEG_TABLE_UNDEFINED };
+
+static int jpeg_huffman_tables_check(const unsigned char *data, size_t size)
 {
     size_t at = 0;
+    unsigned char defined[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}}; /* [DC, AC][table id] */
     /* the start marker, after as many fill bytes (0xFF) as the file has */
-    if (size < 2 || data[0] != 0xFF) return 0;
+    if (size < 2 || data[0] != 0xFF) return JPEG_TABLES_USABLE;
     while (at < size && data[at] == 0xFF) at++;
-    if (at == size || data[at] != 0xD8) return 0;
+    if (at == size || data[at] != 0xD8) return JPEG_TABLES_USABLE;
     at++;
     while (at + 4 <= size) {
         size_t length, end, table;
@@ -164,13 +174,13 @@ static int jpeg_huffman_tables_overflow(const unsigned char *data, size_t size)
             at++;
             continue;
         }
-        if (marker == 0xD9) return 0;     /* the end */
+        if (marker == 0xD9) return JPEG_TABLES_USABLE; /* the end */
         if (marker == 0x00 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
             at += 2;
             continue;
         }
         length = ((size_t)data[at + 2] << 8) | data[at + 3];
-        if (length < 2) return 0;
+        if (length < 2) return JPEG_TABLES_USABLE;
         end = at + 2 + length;
         if (end > size) end = size;
         /* As the decoder reads a DHT: table after table while the segment's
@@ -179,13 +189,28 @@ static int jpeg_huffman_tables_overflow(const unsigned char *data, size_t size)
         if (marker == 0xC4)
             for (table = at + 4; table < end;) {
                 size_t codes = 0, k;
+                unsigned kind = data[table] >> 4, id = data[table] & 15;
                 for (k = 1; k <= 16; k++) codes += table + k < size ? data[table + k] : 0;
-                if (codes > 256) return 1;
+                if (codes > 256) return JPEG_TABLE_OVERFLOW;
+                if (kind <= 1 && id <= 3) defined[kind][id] = 1;
                 table += 17 + codes;
             }
+        /* A scan's header: its component count, each component's table
+           ids (DC high, AC low), then Ss, Se and Ah/Al. */
+        if (marker == 0xDA && at + 5 <= size) {
+            size_t count = data[at + 4], spectrum = at + 5 + 2 * count, k;
+            if (spectrum + 2 < end) {
+                int dc = data[spectrum] == 0 && (data[spectrum + 2] >> 4) == 0, ac = data[spectrum + 1] > 0;
+                for (k = 0; k < count; k++) {
+                    unsigned ids = data[at + 6 + 2 * k];
+                    if ((dc && (ids >> 4) <= 3 && !defined[0][ids >> 4]) || (ac && (ids & 15) <= 3 && !defined[1][ids & 15]))
+                        return JPEG_TABLE_UNDEFINED;
+                }
+            }
+        }
         at = at + 2 + length;
     }
-    return 0;
+    return JPEG_TABLES_USABLE;
 }
 
 /* stb_image reads a binary PNM's width, height and maximum value into an
@@ -248,10 +273,17 @@ int image_load_memory(const unsigned char *file_data, size_t file_size, const ch
     /* Before stb_image reads anything: its header scan already reads the
        Huffman tables that come before a JPEG's frame header, a PNG's
        chunks and a PNM's numbers. */
-    if (jpeg_huffman_tables_overflow(file_data, file_size)) {
+    switch (jpeg_huffman_tables_check(file_data, file_size)) {
+    case JPEG_TABLE_OVERFLOW:
         tool_set_error(err, err_size, "cannot decode '%s' (a corrupt JPEG: a Huffman table of more than 256 codes)",
                        path);
         return -1;
+    case JPEG_TABLE_UNDEFINED:
+        tool_set_error(err, err_size, "cannot decode '%s' (a corrupt JPEG: a scan uses a Huffman table never defined)",
+                       path);
+        return -1;
+    default:
+        break;
     }
     if (png_chunk_overruns(file_data, file_size)) {
         tool_set_error(err, err_size, "cannot decode '%s' (a corrupt PNG: a chunk longer than the rest of the file)",

@@ -1857,6 +1857,12 @@ err_mentions "the 257-code JPEG: says why" "Huffman table"
 tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_dht_after_first_scan" >"$W/in/dht_late.jpg"
 expect_error "a JPEG with a 520-code Huffman table after junk bytes" synth ../in/dht_late.jpg out.png --tile 16
 err_mentions "the late 520-code table: says why" "Huffman table"
+# A progressive JPEG whose second scan uses an AC table no DHT segment
+# defined (found by fuzz_image: the decoder read whatever was left in that
+# table's memory and failed its own assertion) is refused before decoding.
+tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_scan_uses_undefined_ac_table" >"$W/in/undefined_table.jpg"
+expect_error "a JPEG scan that uses an undefined Huffman table" synth ../in/undefined_table.jpg out.png --tile 16
+err_mentions "the undefined Huffman table: says why" "Huffman table never defined"
 # A 60-byte PNG whose IDAT chunk declares a gigabyte (found by fuzz_image:
 # stb_image grew its buffer to 2 GB before reading the chunk) is refused
 # before decoding, saying why.
