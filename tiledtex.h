@@ -2689,11 +2689,12 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    Manifold repair. Around a lattice point the 8 cubes give an
    occupancy mask; S is a disc there for exactly 126 of the 256 masks, and
    a mask is a disc (or empty, or full) exactly when it holds no critical
-   configuration: C1, a 2 x 2 checkerboard around a lattice edge; C2, two
-   antipodal cubes of the 2 x 2 x 2 block alone, or the complement. The
-   repair adds cubes until none remains: for C1 one of the two empty cubes,
-   for C2 the two cubes of a face-connected staircase between the occupied
-   pair, for its complement one of the two empty cubes. Which cube is
+   configuration: a checkerboard, 2 x 2 cubes around a lattice edge
+   occupied diagonally; an antipodal pair, two opposite cubes of the
+   2 x 2 x 2 block alone, or its complement. The repair adds cubes until
+   none remains: for a checkerboard one of the two empty cubes, for an
+   antipodal pair the two cubes of a face-connected staircase between them,
+   for its complement one of the two empty cubes. Which cube is
    "nearer to the mesh" is judged at the grid's resolution: a cube the
    surface meets first, then the one with more such face neighbours, then
    the smaller index (a staircase by the sum over its two cubes, then the
@@ -19706,7 +19707,7 @@ static int tt__polycube_mask(const tt__voxels *vox, int i, int j, int k)
 }
 
 /* Is S a disc inside the cell of a lattice point with this mask? Decided
-   from the facelets themselves, independently of the C1/C2 rule: a facelet
+   from the facelets themselves, independently of the critical configurations: a facelet
    is the quarter of a cube face at the point, between two face-adjacent
    cubes of the block that differ; the 6 half-edges (spokes) from the point
    along +-x, +-y, +-z each lie between 4 cubes and 4 facelet slots. S is a
@@ -19752,9 +19753,9 @@ static int tt__polycube_mask_is_disc(int mask)
 }
 
 /* The critical configurations in a block's mask. *kind gets 1 for
-   C1 (a checkerboard around spoke `spoke_axis`, its cubes' bit on that axis
-   `*side`), 2 for C2 (two antipodal cubes alone), 3 for its complement (two
-   antipodal cubes empty); returns 0 when there is none. */
+   a checkerboard (around spoke `spoke_axis`, its cubes' bit on that axis
+   `*side`), 2 for an antipodal pair (two opposite cubes alone), 3 for its
+   complement (two opposite cubes empty); returns 0 when there is none. */
 static int tt__polycube_mask_critical(int mask, int *spoke_axis, int *side)
 {
     int axis, s, pop = 0, bit;

@@ -534,7 +534,7 @@ static void test_hpm_determinism(void)
    whose clusters all have more than 8 faces (measured over seeds 0..9 on
    these meshes: 4.12; 8.31 without the relaxation round). */
 #define HPM_SIZE_RATIO 5.0
-/* Re-seeding (D13) keeps non-disc clusters rare: below level 0, 14 of
+/* Re-seeding keeps non-disc clusters rare: below level 0, 14 of
    53639 clusters over these meshes and seeds (83 without re-seeding). */
 #define HPM_MAX_NONDISC 40
 static void test_hpm_uniform(void)
@@ -740,7 +740,7 @@ static float *flat_uv(const tt_mesh *m)
     return uv;
 }
 
-/* (8) T5: a planar disc maps isometrically at every level, in both border
+/* (8) A planar disc maps isometrically at every level, in both border
    modes where the border between control vertices is straight, and in the
    projected mode whatever the border's shape. */
 static void test_flatten_plane(void)
@@ -809,7 +809,7 @@ end:
     tt_mesh_free(m);
 }
 
-/* (9) T5: spherical caps. E_flat follows tan^2(alpha/2) (the cap's border
+/* (9) Spherical caps. E_flat follows tan^2(alpha/2) (the cap's border
    circle projects onto itself, so this holds whatever the control
    vertices), within 0.5 % + 1e-4 for 32 rings of 128 (measured: 0.01 %;
    the polyhedral cap's area and the 128-gon's fall short of the smooth ones
@@ -1212,7 +1212,7 @@ static double hpm_max_jump(const tt_mesh *mesh, const float *uv, int w, int h, i
     return worst;
 }
 
-/* T6: a plane that fits in a bounded image maps as one undistorted piece. */
+/* A plane that fits in a bounded image maps as one undistorted piece. */
 static void test_hpm_map_plane(void)
 {
     tt_mesh *mesh = hpm_book(30, 20, 0);
@@ -1255,10 +1255,10 @@ done:
     tt_mesh_free(mesh);
 }
 
-/* T7: with no random turn and one orientation, a cluster next to a textured
+/* With no random turn and one orientation, a cluster next to a textured
    one is placed as its exact continuation, so a folded sheet (two planes,
    neither flat across the fold) comes out as one continuous map; with the
-   default exclusion of that continuation (D8) it does not. */
+   default exclusion of that continuation it does not. */
 static void test_hpm_map_continuation(void)
 {
     tt_mesh *mesh = hpm_book(40, 24, 1.2);
@@ -1434,7 +1434,7 @@ static void test_hpm_map_seams(void)
     CHECK(flipped == 0 && bad == 0, "fit: %d flipped, %d corners outside the margin", flipped, bad);
     hpm_uv_checks(mesh, uv_random, 128, 128, 1, &flipped, &bad);
     CHECK(flipped == 0 && bad == 0, "control: %d flipped, %d corners outside the margin", flipped, bad);
-    /* A1: on the cluster borders only (inside a cluster the map is
+    /* On the cluster borders only (inside a cluster the map is
        continuous, which would dilute the score) */
     memset(&so, 0, sizeof so);
     so.flags = TT_SEAM_UV_DISCONTINUOUS;
@@ -1451,7 +1451,7 @@ static void test_hpm_map_seams(void)
            fit.score, rnd.score);
     CHECK(fit.score <= 0.3, "fitted borders score %g (at most 0.3)", fit.score);
     CHECK(rnd.score >= 0.8, "the control's borders score %g (at least 0.8)", rnd.score);
-    /* A3: stretch and texel density */
+    /* Stretch and texel density */
     {
         tt_uv_distortion_options dop;
         tt_uv_distortion_report d;
@@ -1517,7 +1517,7 @@ static double hpm_median_turn(const tt_mesh *mesh, const float *uv, const int *c
     return m;
 }
 
-/* T11: the orientation propagates. Vertical stripes on a plane split into
+/* The orientation propagates. Vertical stripes on a plane split into
    many clusters keep their direction across the borders (median turn at
    most 10 degrees; the fit tries turns of 0, +-19 and +-38 degrees); the
    same clusters placed at random turn by about 45 degrees. */
@@ -1562,7 +1562,7 @@ done:
     tt_mesh_free(mesh);
 }
 
-/* T12, the budget (D23): a 6144-face torus at a scale where clusters of
+/* The budget: a 6144-face torus at a scale where clusters of
    a few dozen faces are needed, with a threshold almost no fit meets, so
    every cluster is split down to the floor. The floor stops it there,
    fitting the clusters at the floor once each: far fewer fits than faces
@@ -1606,7 +1606,7 @@ done:
     tt_mesh_free(mesh);
 }
 
-/* T10 and A10: every face textured, no flip, UVs finite (bounded: inside
+/* Every face textured, no flip, UVs finite (bounded: inside
    the margin) on a torus, a sphere, an open grid, two components and a
    grid with holes, with a non-square, non-power-of-two image; the same seed
    gives the same bits, another seed other bits. */

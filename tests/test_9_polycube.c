@@ -1,8 +1,7 @@
 /* tests/test_9_polycube.c - unit tests for section 9 of tiledtex.h, the
    polycube of Chang and Lin: voxelisation, fill, repair, correction, the
    surface S and its Wang colouring. Run by run_polycube_tests()
-   (tests/test_common.c calls it). The spec's tests Q1-Q5 and Q7
-   (specs/polycube.md Sec. 3.3); occupancy is checked against the shapes'
+   (tests/test_common.c calls it). Occupancy is checked against the shapes'
    own definitions and masks are recomputed from the occupancy array. */
 #include "test_common.h"
 
@@ -141,7 +140,7 @@ static int pc_equals_set(const tt_polycube *pc, const unsigned char *set, int nx
 }
 
 /* ------------------------------------------------------------------------ */
-/* Q5: the configuration table                                              */
+/* The configuration table                                                  */
 /* ------------------------------------------------------------------------ */
 
 static void test_masks(void)
@@ -164,8 +163,8 @@ static void test_masks(void)
             disagree++;
         }
     }
-    CHECK(discs == 126, "masks whose surface is a disc: 126 (spec P6), got %d", discs);
-    CHECK(disagree == 0, "disc <=> no C1/C2 on all non-empty, non-full masks: %d disagree", disagree);
+    CHECK(discs == 126, "masks whose surface is a disc: 126, got %d", discs);
+    CHECK(disagree == 0, "disc <=> no critical configuration on all non-empty, non-full masks: %d disagree", disagree);
     CHECK(!internal_polycube_mask_is_disc(0) && !internal_polycube_mask_is_disc(255) &&
               !internal_polycube_mask_critical(0) && !internal_polycube_mask_critical(255),
           "empty and full masks have no surface and no critical configuration");
@@ -176,11 +175,11 @@ static void test_masks(void)
     CHECK(by_type[6][4] == 32, "tripod 8 + staircase 24 = 32, got %d", by_type[6][4]);
     CHECK(internal_polycube_mask_critical(0x09) == 1 && internal_polycube_mask_critical(0x81) == 2 &&
               internal_polycube_mask_critical(0x7e) == 3,
-          "an edge-only pair is C1, an antipodal pair C2, its complement C2's complement");
+          "an edge-only pair is a checkerboard, an antipodal pair one, its complement the complement");
 }
 
 /* ------------------------------------------------------------------------ */
-/* Q1: voxelisation against an independent computation                     */
+/* Voxelisation against an independent computation                          */
 /* ------------------------------------------------------------------------ */
 
 /* Does the triangle t (9 doubles) meet the box [lo, hi]? Sutherland-Hodgman
@@ -324,7 +323,7 @@ static void test_voxelize(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* Q2, Q3: cubes and unions of boxes give themselves                         */
+/* Cubes and unions of boxes give themselves                                */
 /* ------------------------------------------------------------------------ */
 
 static void test_cube_block(void)
@@ -408,7 +407,7 @@ static void test_unions(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* Q4: contacts along an edge and at a vertex                                */
+/* Contacts along an edge and at a vertex                                   */
 /* ------------------------------------------------------------------------ */
 
 static void check_contact(const char *name, const double lo2[3], const double hi2[3], unsigned flags)
@@ -473,7 +472,7 @@ static void test_contacts(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* Q7: torus genus; open and flat meshes                                     */
+/* Torus genus; open and flat meshes                                        */
 /* ------------------------------------------------------------------------ */
 
 static void test_torus(void)
@@ -540,7 +539,7 @@ static void test_open_and_flat(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* The correction step (spec P5)                                            */
+/* The correction step (Chang and Lin Sec. 3)                               */
 /* ------------------------------------------------------------------------ */
 
 static void test_correction(void)
@@ -605,7 +604,7 @@ static void test_correction(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* Corner 0: the tile's orientation (spec P9)                               */
+/* Corner 0: the tile's orientation                                         */
 /* ------------------------------------------------------------------------ */
 
 static void check_orientation(const tt_polycube *pc, int up_axis, int up_sign, const char *name)
@@ -659,7 +658,7 @@ static void test_orientation(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* The Wang colouring (spec P9)                                             */
+/* The Wang colouring (Chang and Lin Sec. 3)                                */
 /* ------------------------------------------------------------------------ */
 
 static void test_edge_colors(void)
@@ -836,7 +835,7 @@ static void test_errors(void)
     tm_free(&m);
 }
 
-/* Q12 and B5/B6 on S itself: the polycube's Wang tiling through the
+/* On S itself: the polycube's Wang tiling through the
    tiled-textures machinery. The per-axis colours, tt_assign_boundaries,
    tt_assign_uvs and tt_synthesize_tiles texture S seamlessly: the seam
    score over every edge of S is about 0 (at most 0.05), and the same tiles
@@ -844,7 +843,7 @@ static void test_errors(void)
    0.86 - with n = 2 a quarter of the shuffled edges still match by type,
    so it cannot reach 1). The
    paper's rotation rules (Figs. 3-5) need no code: this is the test that
-   they come out of Akleman's per-side rule on S (spec P9). */
+   they come out of Akleman's per-side rule on S. */
 static void test_wang_tiling(void)
 {
     tmesh m;
@@ -916,7 +915,7 @@ static void test_wang_tiling(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* The vertices' points on S (spec P11 step 2)                              */
+/* The vertices' points on S (Chang and Lin Sec. 4)                         */
 /* ------------------------------------------------------------------------ */
 
 /* A latitude-longitude sphere of triangles (closed: one vertex per pole),
@@ -1143,7 +1142,7 @@ static void test_project_sphere(void)
     }
 }
 
-/* Spec Q9, P14: a plate 0.25 h thick is one slab of cubes; its top maps to
+/* A plate 0.25 h thick is one slab of cubes; its top maps to
    the slab's top, its bottom to the slab's bottom. */
 static void test_project_thin_plate(void)
 {
@@ -1192,7 +1191,7 @@ static void test_project_thin_plate(void)
     tm_free(&m);
 }
 
-/* Spec Q10: open meshes stay shells (P4); the side rule picks the sheet. */
+/* Open meshes stay shells; the side rule picks the sheet.                  */
 static void test_project_open(void)
 {
     const double center[3] = {0.05, 0.11, -0.02};
@@ -1310,7 +1309,7 @@ static void test_project_determinism_and_errors(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* The images of the mesh's edges on S (spec P11 step 3)                    */
+/* The images of the mesh's edges on S (Chang and Lin Sec. 4)               */
 /* ------------------------------------------------------------------------ */
 
 /* The 3D point of a crossing: `along` on its S half-edge, between the
@@ -1354,7 +1353,7 @@ static tt_polycube_edges *traced(const tt_polycube *pc, const tt_mesh *mesh, con
     return edges;
 }
 
-/* Spec Q2 for the edges: the cube mesh lies on S, so every edge's image is
+/* For the edges: the cube mesh lies on S, so every edge's image is
    the edge itself. Edges are N or N sqrt 2 cubes long here, so the path
    limit is raised to 2N + 2 quads (a face diagonal passes N - 1 quad
    corners: 2N - 1 quads). */
@@ -1858,7 +1857,7 @@ static void test_edges_determinism_and_errors(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* The model split on S and its UVs (spec P11 steps 4, 6, 7)                */
+/* The model split on S and its UVs (Chang and Lin Sec. 4)                  */
 /* ------------------------------------------------------------------------ */
 
 /* What a mapping must be, whatever the mesh (spec 3.1): output vertices are
@@ -1998,7 +1997,7 @@ static double isometry_error(const tt_polycube *pc, const tt_polycube_mapping *m
     return worst;
 }
 
-/* Q2: the 12-triangle cube on the lattice at N = 1..8 maps onto the N^3
+/* The 12-triangle cube on the lattice at N = 1..8 maps onto the N^3
    block isometrically: every triangle is cut exactly at the lattice lines
    into N^2 pieces (N (N - 1) / 2 squares of 2 triangles and N halves on
    the diagonal), 2 N^2 per cube face, stretch 1, nothing flipped or left
@@ -2041,10 +2040,10 @@ static void test_map_cube(void)
     }
 }
 
-/* The invariants on curved and open meshes (Q6, Q10 in part; B2, B4, B8):
+/* The invariants on curved and open meshes (in part):
    a sphere at resolutions 4 to 32 and a hemisphere (open), each watertight
    after the split (the strict builder accepts the sphere's output closed:
-   the two triangles on an edge split it at the same vertices, Q11), area
+   the two triangles on an edge split it at the same vertices), area
    kept, every vertex on the model, at most 0.1 % of the (refined)
    triangles left to the fallback, none flipped on the sphere (a few at the
    hemisphere's open rim, where the sheet's edge meets the slab: at most
@@ -2117,7 +2116,7 @@ static tt_mesh *mapping_mesh(const tt_polycube_mapping *map)
     return out;
 }
 
-/* Spec P11 step 6 and B3, B5, B6: the UVs of a mapping put each output
+/* The UVs of a mapping put each output
    triangle inside its quad's tile (the three UVs in one tile rectangle),
    the textured model is seamless on the tile borders and over all edges,
    and giving each output triangle another's UVs (shuffled) shows seams. */
@@ -2549,7 +2548,7 @@ static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map)
     return d;
 }
 
-/* Q8, the stretch floor of a voxel polycube (spec P13): a cube turned 45
+/* The stretch floor of a voxel polycube: a cube turned 45
    degrees about z maps its four sides onto staircases sqrt 2 longer across
    the slope, at any resolution, so the area-weighted median stretch (the
    sides are 2/3 of the area) is sqrt 2 at 16 and at 64; a metric that only
@@ -2590,7 +2589,7 @@ static void test_map_stretch_floor(void)
     }
 }
 
-/* Q9, a thin plate (spec P4, P14): a plate a quarter of a cube thick
+/* A thin plate: a plate a quarter of a cube thick
    becomes a one-cube slab, and its two sides go to the slab's opposite
    faces (the side rule of the projection): no part of the top on the
    slab's bottom or the other way round (near the rim both wrap onto the
@@ -2633,7 +2632,7 @@ static void test_map_thin_plate(void)
     tm_free(&m);
 }
 
-/* Q10, open and messy meshes: a flat disc (one layer of cubes, both sides
+/* Open and messy meshes: a flat disc (one layer of cubes, both sides
    of S around it) and a sphere cut into 32 patches that share no vertex
    (an unwelded export): every triangle is mapped, the area kept, every
    vertex on the model. */
@@ -2691,7 +2690,7 @@ static void test_map_open_and_messy(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* P11 step 5: the relaxation's kernel move and its untangling              */
+/* The relaxation's kernel move and its untangling (Chang and Lin Sec. 4)   */
 /* ------------------------------------------------------------------------ */
 
 /* Whether p sees every triangle (p, a, b) of the star turning
@@ -2947,7 +2946,7 @@ static void test_reseat(void)
     tm_free(&m);
 }
 
-/* Spec P4 as the library reads it: an open mesh whose holes are narrower
+/* As the library reads the paper's polycube for an open mesh: an open mesh whose holes are narrower
    than a couple of cubes (a scan missing a few faces) is sealed, its
    polycube solid like the closed mesh's, one sheet instead of a shell;
    a bowl (a hemisphere, its rim a whole side) is not, nor is a closed
@@ -3000,7 +2999,7 @@ static void test_seal(void)
     CHECK(reports[2].sealed == 0, "a hemisphere (a bowl) is not sealed (%d cubes)", reports[2].sealed);
 }
 
-/* Q13 in short: small random closed meshes (bumpy spheres, turned and
+/* In short: small random closed meshes (bumpy spheres, turned and
    scaled at random) at random resolutions map without a crack (closed
    strict output), with their area, every corner in one quad. */
 static void test_map_random(void)

@@ -188,11 +188,11 @@ tt_result internal_patch_hull(const tt_image *patch, int max_vertices, const tt_
 /* Section 9's voxeliser (marks boxes of side h at origin + h * (i + 1/2, ...)
    that the mesh meets under the tie rule; returns the zero-area triangles
    skipped), its disc predicate and its critical-configuration classifier
-   (0 none, 1 C1, 2 C2, 3 C2's complement) on a mask of 8 cubes. */
+   (0 none, 1 a checkerboard, 2 an antipodal pair, 3 its complement) on a mask of 8 cubes. */
 int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], double h, const int dims[3],
                                unsigned char *mark);
 int internal_polycube_mask_is_disc(int mask);
-/* Section 9's relaxation and untangling of points on S (P11 step 5; NULL
+/* Section 9's relaxation and untangling of points on S (Chang and Lin Sec. 4; NULL
    allocator; returns the moves, -1 out of memory), the kernel centre of a
    star (ring: two points per triangle, its far edge counter-clockwise; 0
    when empty) and the untangling energy of a star of n <= 64 triangles. */
