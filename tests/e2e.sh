@@ -1845,30 +1845,32 @@ check "map from standard input onto the same file: refused" "non-zero exit, m.ob
     "$([ $RC -ne 0 ] && cmp -s m.obj ../in/torus.obj; echo $?)"
 cd "$W" || exit 1
 
-# A JPEG whose Huffman table declares 257 codes (found by fuzz_image: some
-# stb_image versions write past their table on it) is refused before the
-# decoder sees it. The fuzz seed holds the file after a 2-byte mode prefix.
-tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_huffman_257_codes" >"$W/in/huffman257.jpg"
-expect_error "a JPEG with a 257-code Huffman table" synth ../in/huffman257.jpg out.png --tile 16
-err_mentions "the 257-code JPEG: says why" "Huffman table"
-# The same table in a DHT segment between the scans of a progressive JPEG,
-# behind bytes that start no segment (the decoder skips them), is refused
-# too; a valid progressive JPEG and one with restart markers are read.
-tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_dht_after_first_scan" >"$W/in/dht_late.jpg"
-expect_error "a JPEG with a 520-code Huffman table after junk bytes" synth ../in/dht_late.jpg out.png --tile 16
-err_mentions "the late 520-code table: says why" "Huffman table"
+# Corrupt images the fuzzer found, each refused before the decoder sees it
+# with a line saying why. A fuzz_image seed holds the file after a 2-byte
+# mode prefix. refused_seed SEED FILE WHAT WHY: the seed as FILE, refused by
+# synth, the message containing WHY.
+refused_seed() {
+    tail -c +3 "$ROOT/tests/fuzz/corpus_image/$1" >"$W/in/$2"
+    expect_error "$3" synth "../in/$2" out.png --tile 16
+    err_mentions "$3: says why" "$4"
+}
+# A Huffman table of 257 codes (some stb_image versions write past their
+# table on it); the same table of 520 codes in a DHT segment between the
+# scans of a progressive JPEG, behind bytes that start no segment (the
+# decoder skips them).
+refused_seed jpeg_huffman_257_codes huffman257.jpg "a JPEG with a 257-code Huffman table" "Huffman table"
+refused_seed jpeg_dht_after_first_scan dht_late.jpg "a JPEG with a 520-code Huffman table after junk bytes" \
+    "Huffman table"
 # A progressive JPEG whose second scan uses an AC table no DHT segment
-# defined (found by fuzz_image: the decoder read whatever was left in that
-# table's memory and failed its own assertion) is refused before decoding.
-tail -c +3 "$ROOT/tests/fuzz/corpus_image/jpeg_scan_uses_undefined_ac_table" >"$W/in/undefined_table.jpg"
-expect_error "a JPEG scan that uses an undefined Huffman table" synth ../in/undefined_table.jpg out.png --tile 16
-err_mentions "the undefined Huffman table: says why" "Huffman table never defined"
-# A 60-byte PNG whose IDAT chunk declares a gigabyte (found by fuzz_image:
-# stb_image grew its buffer to 2 GB before reading the chunk) is refused
-# before decoding, saying why.
-tail -c +3 "$ROOT/tests/fuzz/corpus_image/png_idat_longer_than_file" >"$W/in/idat_overrun.png"
-expect_error "a PNG whose IDAT chunk runs past the end of the file" synth ../in/idat_overrun.png out.png --tile 16
-err_mentions "the overrunning PNG chunk: says why" "chunk longer than the rest of the file"
+# defined (the decoder read whatever was left in that table's memory and
+# failed its own assertion).
+refused_seed jpeg_scan_uses_undefined_ac_table undefined_table.jpg "a JPEG scan that uses an undefined Huffman table" \
+    "Huffman table never defined"
+# A 60-byte PNG whose IDAT chunk declares a gigabyte (stb_image grew its
+# buffer to 2 GB before reading the chunk).
+refused_seed png_idat_longer_than_file idat_overrun.png "a PNG whose IDAT chunk runs past the end of the file" \
+    "chunk longer than the rest of the file"
+# A valid progressive JPEG and one with restart markers are read.
 newdir
 for jpeg in jpeg_progressive_64x48 jpeg_restart_markers_64x48; do
     tail -c +3 "$ROOT/tests/fuzz/corpus_image/$jpeg" >"$W/in/$jpeg.jpg"
