@@ -3183,7 +3183,9 @@ typedef struct tt_polycube_mapping {
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
    max_edge not above 0, a face that is not a triangle (error->face;
-   triangulate first), or a polycube not made by tt_polycube_build;
+   triangulate first), two triangles on the same three corners (a part
+   with no inside: error->face, error->other_face), or a polycube not
+   made by tt_polycube_build;
    TT_ERROR_EMPTY_MESH; TT_ERROR_NON_FINITE; TT_ERROR_TOO_LARGE when the
    refinement would pass TT_POLYCUBE_MAX_TRIANGLES; TT_CANCELLED by
    options->progress; TT_ERROR_OUT_OF_MEMORY. On
@@ -24717,6 +24719,20 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
                             "face %d has %d corners: tt_polycube_map needs triangles (split the faces into fans "
                             "first)", f, mesh->face_start[f + 1] - mesh->face_start[f]);
+    /* Two triangles on the same three corners close on each other: a part
+       with no inside, which no polycube surface maps onto (its refinement
+       would also put four triangles on one edge). */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int c = mesh->face_start[f], g = mesh->twin[c] >= 0 ? mesh->corner_face[mesh->twin[c]] : -1;
+        if (g > f && mesh->twin[c + 1] >= 0 && mesh->twin[c + 2] >= 0 && mesh->corner_face[mesh->twin[c + 1]] == g &&
+            mesh->corner_face[mesh->twin[c + 2]] == g) {
+            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, mesh->corner_vert[c], -1,
+                              "faces %d and %d have the same three corners and enclose nothing: remove the pair "
+                              "(a polycube maps a part with an inside)", f, g);
+            if (error) error->other_face = g;
+            return result;
+        }
+    }
     if (!tt__polycube_consistent(polycube))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the polycube's surface has no quads or does not match its cubes: make it with "

@@ -3165,6 +3165,50 @@ static void test_map_flat_square_coarse(void)
     tt_mesh_free(mesh);
 }
 
+/* A closed pair of triangles on the same three corners (a "pillow") has no
+   inside: refused up front, naming both faces, rather than refined into
+   edges with four triangles. The tetrahedron beside it maps on its own. */
+static void test_map_pillow(void)
+{
+    float pos[21] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 3, 0, 0, 4, 0, 0, 3, 1, 0};
+    int idx[18] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2, 4, 5, 6, 4, 6, 5};
+    int with_pillow;
+    for (with_pillow = 0; with_pillow < 2; with_pillow++) {
+        tt_mesh_desc d;
+        tt_mesh *mesh = NULL;
+        tt_polycube *pc = NULL;
+        tt_polycube_options po;
+        tt_polycube_mapping *map = NULL;
+        tt_error err;
+        tt_result r;
+        memset(&d, 0, sizeof d);
+        memset(&po, 0, sizeof po);
+        d.positions = pos;
+        d.nverts = with_pillow ? 7 : 4;
+        d.indices = idx;
+        d.nfaces = with_pillow ? 6 : 4;
+        d.fixed_face_size = 3;
+        po.resolution = 4;
+        if (tt_mesh_build(&d, NULL, &mesh, &err) != TT_OK ||
+            tt_polycube_build(mesh, &po, NULL, &pc, NULL, &err) != TT_OK) {
+            CHECK(0, "the tetrahedron%s builds: %s", with_pillow ? " and pillow" : "", err.message);
+        } else {
+            r = tt_polycube_map(pc, mesh, NULL, NULL, &map, NULL, &err);
+            if (with_pillow)
+                CHECK(r == TT_ERROR_INVALID_ARGUMENT && map == NULL && err.result == r && err.face == 4 &&
+                          err.other_face == 5 && strstr(err.message, "faces 4 and 5 have the same three corners"),
+                      "a pillow beside a tetrahedron: invalid, naming faces 4 and 5 (got %d, faces %d %d: %s)", (int)r,
+                      err.face, err.other_face, err.message);
+            else
+                CHECK(r == TT_OK && map != NULL, "the tetrahedron alone maps (got %d: %s)", (int)r,
+                      r == TT_OK ? "" : err.message);
+        }
+        tt_polycube_mapping_free(map);
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+    }
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -3203,6 +3247,7 @@ void run_polycube_tests(void)
     RUN(test_map_thin_plate);
     RUN(test_map_open_and_messy);
     RUN(test_map_flat_square_coarse);
+    RUN(test_map_pillow);
     RUN(test_map_random);
     RUN(test_map_executors);
 }
