@@ -22880,13 +22880,17 @@ static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, i
         }
         length = sqrt(direction[0] * direction[0] + direction[1] * direction[1]);
         if (length > reach) t = reach / length;
-        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS; halvings++, t *= 0.5) {
+        /* Steps below the points' float resolution move nothing: at a
+           minimum the Newton step is that short, and halving it further
+           only spends evaluations. */
+        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS && t * length >= TT__UNTANGLE_CONVERGED;
+             halvings++, t *= 0.5) {
             trial[0] = x[0] + t * direction[0];
             trial[1] = x[1] + t * direction[1];
             trial_energy = tt__untangle_energy(star, trial, delta2, trial_gradient, trial_hessian, &folded);
             if (trial_energy < energy) break;
         }
-        if (halvings == TT__UNTANGLE_HALVINGS) break;
+        if (halvings == TT__UNTANGLE_HALVINGS || t * length < TT__UNTANGLE_CONVERGED) break;
         x[0] = trial[0];
         x[1] = trial[1];
         energy = trial_energy;
@@ -22896,8 +22900,6 @@ static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, i
             kept[0] = x[0];
             kept[1] = x[1];
         }
-        /* Converged: a step below the points' float resolution. */
-        if (t * length < TT__UNTANGLE_CONVERGED) break;
     }
     if (!tt__relax_chart_point(chart, kept, moved)) return 0;
     return !tt__same_point(*moved, points[v]);
