@@ -209,7 +209,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     rd.n = size;
     rd.at = 0;
     for (k = 0; k < 14; ++k) hdr[k] = rd_u8(&rd);
-    fz_shape_read(&rd, &shape);
+    fz_shape_read(&rd, &shape, 1);
     runs++;
     alloc = fz_alloc_init(&a, (hdr[0] & 3) == 3 ? (long)hdr[1] + 256L * (hdr[2] & 3) + 1 : 0);
 

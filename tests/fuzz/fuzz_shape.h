@@ -12,8 +12,9 @@
               bit2 extreme floats: each coordinate whose noise byte is
               below 16 becomes fz_extreme_float(noise byte + next byte);
               bit3 reverse every triangle (inside out)
-       1      size: grid nx = 1 + b % 4, ny = 1 + (b / 4) % 4 (up to 32
-              triangles); sphere nu = 3 + b % 4, nv = 2 + (b / 4) % 3 (up to
+       1      size: grid nx = g + b % 4, ny = g + (b / 4) % 4, g the
+              caller's smallest grid side (1: 2 to 32 triangles, 2: 8 to
+              50); sphere nu = 3 + b % 4, nv = 2 + (b / 4) % 3 (up to
               36); torus nu = 3 + b % 4, nv = 3 + (b / 4) % 2 (up to 48);
               raw: nverts = 3 + b % 22, up to 24 triangles. Small, so that
               one run of hpm or polycube takes milliseconds
@@ -53,8 +54,9 @@ static inline void fz_shape_quad(fz_shape *s, int a, int b, int c, int d)
     fz_shape_tri(s, a, c, d);
 }
 
-/* Fill s from the reader (always something, maybe no triangle). */
-static inline void fz_shape_read(reader *rd, fz_shape *s)
+/* Fill s from the reader (always something, maybe no triangle); a grid
+   has at least grid_side x grid_side cells. */
+static inline void fz_shape_read(reader *rd, fz_shape *s, int grid_side)
 {
     uint8_t mode = rd_u8(rd), size = rd_u8(rd), amp_b = rd_u8(rd), stretch_b = rd_u8(rd);
     double amp = amp_b / 255.0, stretch = 0.25 + stretch_b / 64.0;
@@ -63,7 +65,7 @@ static inline void fz_shape_read(reader *rd, fz_shape *s)
     memset(s, 0, sizeof *s);
     switch (mode & 3) {
     case 0: { /* grid in the xy plane, (nx + 1) x (ny + 1) vertices */
-        int nx = 1 + size % 4, ny = 1 + (size / 4) % 4;
+        int nx = grid_side + size % 4, ny = grid_side + (size / 4) % 4;
         for (j = 0; j <= ny; ++j)
             for (i = 0; i <= nx; ++i) {
                 float *p = s->pos + 3 * s->nverts++;
