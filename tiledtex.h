@@ -1694,8 +1694,8 @@ typedef struct tt_field_options {
    nconstraints > 0: TT_ERROR_INVALID_ARGUMENT. A constraint on a face out of
    range: TT_ERROR_INDEX_OUT_OF_RANGE (error->face = that index); a zero,
    perpendicular (projects to under 1e-3 of its length) vector or a negative
-   sigma or weight: TT_ERROR_INVALID_ARGUMENT; a non-finite one:
-   TT_ERROR_NON_FINITE; a constraint on a zero-area face:
+   sigma or weight: TT_ERROR_INVALID_ARGUMENT; a non-finite one, or a
+   vector longer than FLT_MAX: TT_ERROR_NON_FINITE; a constraint on a zero-area face:
    TT_ERROR_ZERO_AREA_FACE. Every constraint error names the constraint in
    error->item (and its face in error->face). A mesh without faces (made by
    hand) is TT_ERROR_EMPTY_MESH. Temporary memory only.
@@ -10279,6 +10279,10 @@ static tt_result tt__field_check_constraints(const tt__field *F, tt_error *error
                                   "constraint %d (face %d): its vector (%g, %g, %g) is %s", i, con->face,
                                   con->vector[0], con->vector[1], con->vector[2],
                                   len > 0.0 ? "perpendicular to the face" : "zero");
+            else if (len > FLT_MAX)   /* turned into another face's plane, it would not fit in the floats */
+                result = tt__fail(error, TT_ERROR_NON_FINITE, con->face, -1, -1, -1,
+                                  "constraint %d (face %d): its vector is %g long, beyond the largest float "
+                                  "(the field's vectors are floats)", i, con->face, len);
         }
         if (result != TT_OK) {
             if (error) error->item = i;
@@ -10673,6 +10677,14 @@ TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *op
     if ((result = tt__field_smooth(&F)) != TT_OK) goto done;
     smoothing = 0;
 
+    /* The vectors are written as floats: one past FLT_MAX would be infinite. */
+    for (f = 0; f < 3 * F.nf; f++)
+        if (!(fabs(F.vec[f]) <= FLT_MAX)) {
+            result = tt__fail(error, TT_ERROR_NON_FINITE, f / 3, -1, -1, -1,
+                              "the field's vector on face %d does not fit in a float (scale %g): scale the "
+                              "mesh or the constraints down", f / 3, F.scale);
+            goto done;
+        }
     for (f = 0; f < 3 * F.nf; f++) face_vectors[f] = (float)F.vec[f];
     result = tt__ok(error);
 

@@ -664,6 +664,7 @@ static void test_field_errors(void)
     tt_error err;
     float v[3 * 64];
     float nan_f;
+    int i;
     {
         uint32_t bits = 0x7fc00000u;   /* a quiet NaN, whatever the compiler flags */
         memcpy(&nan_f, &bits, sizeof nan_f);
@@ -724,6 +725,17 @@ static void test_field_errors(void)
     FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_NON_FINITE, 5, "NaN vector");
     con[1].vector[1] = 1.0f / 0.0f;
     FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_NON_FINITE, 5, "infinite vector");
+    /* Every component finite, the length beyond FLT_MAX: turned into
+       another face's plane it would be infinite as a float. */
+    con[1].vector[0] = 3e38f;
+    con[1].vector[1] = 3e38f;
+    FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_NON_FINITE, 5, "vector longer than FLT_MAX");
+    CHECK(strstr(err.message, "largest float") != NULL, "the message says the length overflows: %s", err.message);
+    con[1].vector[0] = 2e38f;   /* 2.8e38 long: fits */
+    con[1].vector[1] = 2e38f;
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "a vector 2.8e38 long: %s", err.message);
+    for (i = 0; i < 3 * mesh->nfaces; i++) CHECK(isfinite(v[i]), "field component %d is %g", i, (double)v[i]);
+    con[1].vector[0] = 0.0f;
     con[1].vector[1] = 1.0f;
     con[1].weight = -1.0f;
     FIELD_EXPECT(tt_tangent_field(mesh, &opt, NULL, v, &err), TT_ERROR_INVALID_ARGUMENT, 5, "negative weight");
