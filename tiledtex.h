@@ -5979,33 +5979,67 @@ typedef struct tt__weighted {
 #define TT__WEIGHTED_LESS(a, b) ((a).value < (b).value)
 TT__DEFINE_HEAPSORT_BY(tt__sort_weighted, tt__weighted, TT__WEIGHTED_LESS)
 
+/* The smallest value v of items[0 .. count-1] at which the weight of the
+   items with values <= v reaches `goal` (the largest value when rounding
+   keeps the sum below it), in expected linear time: tt__select's
+   partition, going on in the side whose weight holds the goal, and a sort
+   of what is left after 2 log2(count) rounds (so that no order of the
+   values makes it quadratic). Reorders the items. */
+static double tt__weighted_select(tt__weighted *items, int count, double goal)
+{
+    int lo = 0, hi = count - 1, rounds = 0, limit = 2, m;
+    while ((1 << (limit / 2)) < count && limit < 62) limit += 2;
+    while (lo < hi) {
+        double a = items[lo].value, b = items[lo + (hi - lo) / 2].value, c = items[hi].value, pivot;
+        double below = 0.0, at = 0.0;
+        int i = lo, j = hi;
+        if (rounds++ == limit) {
+            tt__sort_weighted(items + lo, hi - lo + 1);
+            for (m = lo; m < hi; m++) {
+                goal -= items[m].weight;
+                if (goal <= 0.0) break;
+            }
+            return items[m].value;
+        }
+        pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        while (i <= j) {
+            while (items[i].value < pivot) i++;
+            while (items[j].value > pivot) j--;
+            if (i <= j) {
+                tt__weighted t = items[i];
+                items[i++] = items[j];
+                items[j--] = t;
+            }
+        }
+        /* [lo, j] <= pivot, (j, i) == pivot, [i, hi] >= pivot. */
+        for (m = lo; m <= j; m++) below += items[m].weight;
+        for (m = j + 1; m < i; m++) at += items[m].weight;
+        if (goal <= below) {
+            hi = j;
+        } else if (goal <= below + at) {
+            return pivot;
+        } else {
+            goal -= below + at;
+            lo = i;
+        }
+    }
+    return items[lo].value;
+}
+
 /* Weighted percentiles: out[k] = the smallest value v of the items at which
    the weight of the items with values <= v reaches fraction[k] of the total
    weight (fraction 0.5: the weighted median, which is always one of the
-   values, never an average of two). Sorts the items by value once for all
-   the fractions. Preconditions (the callers': TT_ASSERT): count >= 1, values
-   not NaN, weights >= 0 with a positive total, fractions in [0, 1]. */
+   values, never an average of two), one tt__weighted_select per fraction.
+   Preconditions (the callers': TT_ASSERT): count >= 1, values not NaN,
+   weights >= 0 with a positive total, fractions in [0, 1]. */
 static void tt__weighted_percentiles(tt__weighted *items, int count, const double *fraction, int nfractions,
                                      double *out)
 {
     double total = 0.0;
     int i, k;
     TT_ASSERT(items && count >= 1);
-    tt__sort_weighted(items, count);
     for (i = 0; i < count; i++) total += items[i].weight;
-    for (k = 0; k < nfractions; k++) {
-        double goal = fraction[k] * total, cumulative = 0.0;
-        /* The last value when rounding keeps the sum just below a goal of
-           the whole total. */
-        out[k] = items[count - 1].value;
-        for (i = 0; i < count; i++) {
-            cumulative += items[i].weight;
-            if (cumulative >= goal) {
-                out[k] = items[i].value;
-                break;
-            }
-        }
-    }
+    for (k = 0; k < nfractions; k++) out[k] = tt__weighted_select(items, count, fraction[k] * total);
 }
 
 TTDEF tt_result tt_sparse_from_triplets(int rows, int cols, const tt_triplet *triplets, int ntriplets,

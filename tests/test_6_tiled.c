@@ -2297,6 +2297,68 @@ static void test_weighted_percentile(void)
     CHECK(bad == 0, "weighted percentiles: %d of 1000 differ from the naive reference", bad);
 }
 
+static int weighted_pair_compare(const void *a, const void *b)
+{
+    const double x = ((const double *)a)[0], y = ((const double *)b)[0];
+    return x < y ? -1 : x > y;
+}
+
+/* The weighted percentile (a weighted selection, with a sort when the
+   pivots keep missing) on long arrays in orders that defeat naive pivots:
+   random, many repeats, sorted, reversed, all equal, an organ pipe; against
+   a sorted copy scanned (integer weights: exact sums). */
+static void test_weighted_percentile_orders(void)
+{
+    static const double fractions[5] = {0.0, 0.05, 0.5, 0.95, 1.0};
+    int pattern, n, i, k, bad = 0, checked = 0;
+    for (pattern = 0; pattern < 6; pattern++)
+        for (n = 1; n <= 3001; n = n < 20 ? n + 1 : 2 * n + 1) {
+            double *values = (double *)malloc(sizeof(double) * (size_t)n);
+            double *weights = (double *)malloc(sizeof(double) * (size_t)n);
+            double *pairs = (double *)malloc(sizeof(double) * 2 * (size_t)n), total = 0.0;
+            if (!values || !weights || !pairs) abort();
+            lcg_seed(23u + (unsigned)n);
+            for (i = 0; i < n; i++) {
+                switch (pattern) {
+                case 0: values[i] = lcg_unit(); break;
+                case 1: values[i] = (double)lcg_below(4); break;
+                case 2: values[i] = i; break;
+                case 3: values[i] = n - i; break;
+                case 4: values[i] = 1.5; break;
+                default: values[i] = i < n / 2 ? i : n - i; break;
+                }
+                weights[i] = (double)lcg_below(5);
+            }
+            weights[n / 2] += 1.0;
+            for (i = 0; i < n; i++) {
+                pairs[2 * i] = values[i];
+                pairs[2 * i + 1] = weights[i];
+                total += weights[i];
+            }
+            qsort(pairs, (size_t)n, 2 * sizeof(double), weighted_pair_compare);
+            for (k = 0; k < 5; k++) {
+                double cumulative = 0.0, want = pairs[2 * (n - 1)];
+                for (i = 0; i < n; i++) {
+                    cumulative += pairs[2 * i + 1];
+                    if (cumulative >= fractions[k] * total) {
+                        want = pairs[2 * i];
+                        break;
+                    }
+                }
+                if (internal_weighted_percentile(values, weights, n, fractions[k]) != want) {
+                    if (!bad) DETAIL("pattern %d, %d items, fraction %g: got %g, want %g", pattern, n, fractions[k],
+                                     internal_weighted_percentile(values, weights, n, fractions[k]), want);
+                    bad++;
+                }
+                checked++;
+            }
+            free(values);
+            free(weights);
+            free(pairs);
+        }
+    CHECK(bad == 0, "weighted percentiles in hostile orders: %d of %d differ from a sorted copy", bad, checked);
+}
+
 static void test_uv_distortion_errors(void)
 {
     tt_mesh *tris = triangle_grid(2, 2);
@@ -2398,6 +2460,7 @@ void run_tiled_tests(void)
     RUN(test_histogram);
     RUN(test_stretch);
     RUN(test_weighted_percentile);
+    RUN(test_weighted_percentile_orders);
     RUN(test_uv_distortion_maps);
     RUN(test_uv_distortion_counts);
     RUN(test_uv_distortion_errors);
