@@ -11821,7 +11821,6 @@ typedef struct tt__entry {
     float uv[6];
     float fade[3];              /* per corner: the factor on the patch's alpha (tt__paste_fade) */
     unsigned char covers;       /* the paste may cover samples of the face (not the fringe) */
-    float up_image[2];          /* phi(T_f) (tt__face_up_image), for the alignment statistics */
 } tt__entry;
 
 typedef struct tt__lapper {
@@ -12037,6 +12036,21 @@ static void tt__face_up_image(const tt__lapper *L, int f, double image_t[2])
         image_t[0] += wt[k] * uv[0];
         image_t[1] += wt[k] * uv[1];
     }
+}
+
+/* phi(v) for one entry: the combination of the face's corners that gives v
+   (tt__face_vector_weights, exact for v in the face's plane, its
+   least-squares projection otherwise) applied to the entry's corner UVs. A
+   face without a map (edges parallel to float precision) gives 0, which the
+   caller reports as the worst alignment. */
+static void tt__entry_map_vector(const tt_mesh *mesh, int face, const float *uv, const float *vector,
+                                 double out[2])
+{
+    double v[3], w[3];
+    v[0] = vector[0]; v[1] = vector[1]; v[2] = vector[2];
+    tt__face_vector_weights(mesh, face, v, w);
+    out[0] = w[0] * uv[0] + w[1] * uv[2] + w[2] * uv[4];
+    out[1] = w[0] * uv[1] + w[1] * uv[3] + w[2] * uv[5];
 }
 
 /* Angle (degrees) between phi(T) and the texture's up axis, and phi(T)'s length. */
@@ -12845,8 +12859,6 @@ static long long tt__record_paste(tt__lapper *L, int patch)
         entry->face = f;
         entry->paste = paste;
         L->top_patch[f] = patch;
-        entry->up_image[0] = (float)image_t[0];
-        entry->up_image[1] = (float)image_t[1];
     }
     tt__paste_fade(L, first);
     /* A paste that its fade would leave covering less than
@@ -13555,9 +13567,10 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
         for (i = 0; i < 6; i++) out->uv[6 * (size_t)n + i] = entry->uv[i];
         for (i = 0; i < 3; i++) out->fade[3 * (size_t)n + i] = entry->fade[i];
         {
+            /* Read back from the UVs as returned (floats), as tt_lapped_measure reads them: a sliver's
+               map turns with their rounding. */
             double image_t[2], angle, scale;
-            image_t[0] = entry->up_image[0];
-            image_t[1] = entry->up_image[1];
+            tt__entry_map_vector(L->mesh, entry->face, entry->uv, L->field + 3 * (size_t)entry->face, image_t);
             tt__alignment_error(image_t, &angle, &scale);
             angle_sum += angle;
             scales[n] = fabs(scale - 1.0);
@@ -13683,21 +13696,6 @@ TTDEF void tt_lapped_free(tt_lapped *lapped)
 }
 
 /* ---- Measuring, packing and baking (Praun et al. Sec. 4) ---------------- */
-
-/* phi(v) for one entry: the combination of the face's corners that gives v
-   (tt__face_vector_weights, exact for v in the face's plane, its
-   least-squares projection otherwise) applied to the entry's corner UVs. A
-   face without a map (edges parallel to float precision) gives 0, which the
-   caller reports as the worst alignment. */
-static void tt__entry_map_vector(const tt_mesh *mesh, int face, const float *uv, const float *vector,
-                                 double out[2])
-{
-    double v[3], w[3];
-    v[0] = vector[0]; v[1] = vector[1]; v[2] = vector[2];
-    tt__face_vector_weights(mesh, face, v, w);
-    out[0] = w[0] * uv[0] + w[1] * uv[2] + w[2] * uv[4];
-    out[1] = w[0] * uv[1] + w[1] * uv[3] + w[2] * uv[5];
-}
 
 /* Alignment of every entry's map with the field (Sec. 3.4's objective, read
    back from the UVs). phi(T_f) = 0 (a zero field vector, a degenerate face or

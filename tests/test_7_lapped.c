@@ -1854,9 +1854,19 @@ static void test_lapped_cover(void)
             CHECK(bad_points <= points / 500, "%s (isotropic %d): %d of %d random points are not opaque (worst alpha %g)",
                   LAPPED_SHAPE_NAMES[shape], iso, bad_points, points, worst_alpha);
             if (!iso && lapped->nentries > 0) {
+                tt_lapped_report measured;
+                tt_error err;
                 CHECK(near(angle_sum / lapped->nentries, lapped->mean_angle_error, 1e-3),
                       "%s: reported mean angle %g, measured from the UVs %g", LAPPED_SHAPE_NAMES[shape],
                       lapped->mean_angle_error, angle_sum / lapped->nentries);
+                /* The paste's statistics are read from the UVs it returns, as tt_lapped_measure reads them:
+                   the same figures to the bit. */
+                CHECK(tt_lapped_measure(mesh, field, lapped, NULL, &measured, &err) == TT_OK &&
+                          measured.mean_angle_error == lapped->mean_angle_error &&
+                          measured.median_scale_error == lapped->median_scale_error,
+                      "%s: paste reports %.17g deg / %.17g, tt_lapped_measure %.17g / %.17g",
+                      LAPPED_SHAPE_NAMES[shape], lapped->mean_angle_error, lapped->median_scale_error,
+                      measured.mean_angle_error, measured.median_scale_error);
                 CHECK(lapped->mean_angle_error <= 8.0, "%s: mean angle error %g deg", LAPPED_SHAPE_NAMES[shape],
                       lapped->mean_angle_error);
             }
