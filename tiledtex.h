@@ -3174,8 +3174,10 @@ typedef struct tt_polycube_mapping {
    horse scan in 0.45 s with 0.02 %, a CAD flange in 0.3 s with 0.10 %;
    parts about a cube thick cost more time and leave more fallbacks (an
    elephant's trunk and legs: 2.3 %, 1.2 s). At the default 16 the horse
-   takes 1.6 s (0.9 % fallbacks), cut 1-to-4 (388k triangles) 6.5 s and
-   1-to-16 (1.55M) 20 s. No flipped triangle on any. With an executor
+   takes 1.1 s (0.9 % fallbacks), cut 1-to-4 (388k triangles) 4.8 s and
+   1-to-16 (1.55M) 14 s. No flipped triangle on the first two; on the
+   1.55M one three slivers of 1e-10 of a quad's area, at a quad's corner,
+   turn over. With an executor
    (options->executor) the projection, the relaxation's independent
    groups of vertices, the tracing and the split run as tasks; the
    mapping is the same, bit for bit.
