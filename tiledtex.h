@@ -1553,14 +1553,18 @@ typedef struct tt_uv_distortion_options {
 } tt_uv_distortion_options;
 
 typedef struct tt_uv_distortion_report {
-    double stretch_median;      /* area-weighted median of the per-face stretch (1 = none) */
+    double stretch_p5;          /* area-weighted 5th percentile of the per-face stretch (1 = none) */
+    double stretch_median;      /* area-weighted median of it */
     double stretch_p95;         /* area-weighted 95th percentile of it */
-    double stretch_max;         /* the largest over measured faces (unweighted) */
+    double stretch_max;         /* the largest over measured faces (unweighted): one sliver decides it */
     double density_median;      /* area-weighted median of the relative density error (0 = as intended) */
     double density_p95;         /* area-weighted 95th percentile of it */
     double texels_per_unit;     /* the scale the density errors are relative to: given or measured */
     double density_spread;      /* area-weighted 95th percentile of the texel density over its 5th (1 = the
                                    same everywhere), whatever the intended scale */
+    double density_p5_over_median;   /* the texel density's area-weighted 5th percentile over its median */
+    double density_p95_over_median;  /* its 95th percentile over its median (with the one above: how far the
+                                        texture's scale strays either way; 1 and 1 = the same everywhere) */
     int faces_measured;         /* faces in the statistics: not degenerate, finite UVs */
     int flipped;                /* measured faces whose UV polygon turns clockwise (negative signed area in
                                    texels, v up) while the face is counter-clockwise on the surface: the
@@ -10073,9 +10077,9 @@ TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corne
     if (report) {
         double not_measured = tt__not_a_number();
         memset(report, 0, sizeof *report);
-        report->stretch_median = report->stretch_p95 = report->stretch_max = not_measured;
+        report->stretch_p5 = report->stretch_median = report->stretch_p95 = report->stretch_max = not_measured;
         report->density_median = report->density_p95 = report->texels_per_unit = not_measured;
-        report->density_spread = not_measured;
+        report->density_spread = report->density_p5_over_median = report->density_p95_over_median = not_measured;
     }
     if (!mesh || !corner_uv || !report)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -10143,12 +10147,15 @@ TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corne
                         "none of the %d faces could be measured: %d have zero surface or UV area, %d a non-finite "
                         "UV", mesh->nfaces, report->degenerate, report->non_finite);
     }
-    tt__weighted_percentiles(stretch, n, median_and_p95, 2, stats);
-    report->stretch_median = stats[0];
-    report->stretch_p95 = stats[1];
-    /* Every face measured has a positive density: the spread is finite. */
+    tt__weighted_percentiles(stretch, n, p5_median_p95, 3, stats);
+    report->stretch_p5 = stats[0];
+    report->stretch_median = stats[1];
+    report->stretch_p95 = stats[2];
+    /* Every face measured has a positive density: the ratios are finite. */
     tt__weighted_percentiles(density, n, p5_median_p95, 3, stats);
     report->density_spread = stats[2] / stats[0];
+    report->density_p5_over_median = stats[0] / stats[1];
+    report->density_p95_over_median = stats[2] / stats[1];
     texels_per_unit = opt.texels_per_unit != 0.0 ? opt.texels_per_unit : stats[1];
     report->texels_per_unit = texels_per_unit;
     for (f = 0; f < n; f++) density[f].value = fabs(density[f].value / texels_per_unit - 1.0);

@@ -82,7 +82,8 @@ static void print_help(void)
            "\n"
            "Prints the polycube (cubes, squares, components, genus against the mesh's), the\n"
            "mapping (triangles split, triangles that fell back to one square: local seams, edges\n"
-           "with no path on the polycube, folds), the stretch of the texture on the triangles, the\n"
+           "with no path on the polycube, folds), the stretch of the texture on the triangles and\n"
+           "the spread of its texel density (5th percentile, median, 95th, by area), the\n"
            "seam score on the tiles' borders and over all edges (about 0: the texture continues,\n"
            "about 1: unrelated) and the time of each stage.\n"
            "\n"
@@ -410,10 +411,12 @@ static void print_summary(const polycube_command_options *options, const polycub
         printf("stretch and seam score: not measured (%s)\n", quality->mesh_reason);
     } else {
         if (quality->distortion_measured) {
-            printf("stretch: median %.3f, p95 %.3f, max %.3f; density error median %.1f%%, p95 %.1f%%; "
-                   "%d flipped UV triangle%s",
-                   d->stretch_median, d->stretch_p95, d->stretch_max, 100.0 * d->density_median,
-                   100.0 * d->density_p95, d->flipped, d->flipped == 1 ? "" : "s");
+            /* Percentiles, area-weighted: a maximum is one sliver's. */
+            printf("stretch: p5 %.3f, median %.3f, p95 %.3f; texel density p5 %.2f, p95 %.2f of its median; "
+                   "density error median %.1f%%, p95 %.1f%%; %d flipped UV triangle%s",
+                   d->stretch_p5, d->stretch_median, d->stretch_p95, d->density_p5_over_median,
+                   d->density_p95_over_median, 100.0 * d->density_median, 100.0 * d->density_p95, d->flipped,
+                   d->flipped == 1 ? "" : "s");
             if (d->degenerate > 0) printf(", %d degenerate", d->degenerate);
             printf("\n");
         } else {

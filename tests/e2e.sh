@@ -1362,10 +1362,10 @@ polycube_case() {
         "$([ "${straddling:-1}" = 0 ]; echo $?)"
     [ -f out_polycube.obj ] && check_obj "polycube $name: out_polycube.obj" out_polycube.obj
     check "polycube $name: summary" "'polycube: N cubes', 'mapping: N triangles, N split, N fallback, N failed edges', \
-'stretch: median X, p95 Y, max Z', 'seam score: tile borders X (...); all edges Y', 'time: build'" "$OUT" \
+'stretch: p5 X, median Y, p95 Z; texel density p5 A, p95 B of its median', 'seam score: tile borders X (...); all edges Y', 'time: build'" "$OUT" \
         "$(printf '%s' "$OUT" | grep -qE '; polycube: [0-9]+ cubes of [0-9.e+-]+ units \(resolution [0-9]+\), [0-9]+ quads, [0-9]+ components?, genus [0-9]+' &&
             printf '%s' "$OUT" | grep -qE '^mapping: [0-9]+ triangles, [0-9]+ split, [0-9]+ fallback, [0-9]+ failed edges, [0-9]+ flipped' &&
-            printf '%s' "$OUT" | grep -qE '^stretch: median [0-9.]+, p95 [0-9.]+, max [0-9.]+' &&
+            printf '%s' "$OUT" | grep -qE '^stretch: p5 [0-9.]+, median [0-9.]+, p95 [0-9.]+; texel density p5 [0-9.]+, p95 [0-9.]+ of its median; ' &&
             printf '%s' "$OUT" | grep -qE '^seam score: tile borders -?[0-9.]+ \([0-9]+ of [0-9]+ border edges( sampled)?\); all edges -?[0-9.]+ ' &&
             printf '%s' "$OUT" | grep -qE '^time: build [0-9.]+ s, synthesis [0-9.]+ s, mapping [0-9.]+ s$'; echo $?)"
     cd "$W" || exit 1

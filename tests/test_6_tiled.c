@@ -2120,7 +2120,8 @@ static void test_uv_distortion_maps(void)
           rep.density_median, rep.density_p95, rep.texels_per_unit, rep.flipped, rep.degenerate, err.message);
     r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
     CHECK(r == TT_OK && near(rep.texels_per_unit, 16, 1e-4) && near(rep.density_p95, 0, 1e-6) &&
-              near(rep.density_spread, 1, 1e-6),
+              near(rep.density_spread, 1, 1e-6) && near(rep.stretch_p5, 1, 1e-9) &&
+              near(rep.density_p5_over_median, 1, 1e-6) && near(rep.density_p95_over_median, 1, 1e-6),
           "isometric, scale measured: %d, %g texels a unit (want 16), density error p95 %g, spread %g (want 1)", r,
           rep.texels_per_unit, rep.density_p95, rep.density_spread);
     /* uniformly twice the intended scale: no stretch, density error exactly 1 */
@@ -2143,15 +2144,18 @@ static void test_uv_distortion_maps(void)
         }
         for (k = 0; k < 2; k++) {
             r = distortion(tris, uv, 256, 128, k ? 16 : 0, 0, &rep, &err);
-            CHECK(r == TT_OK && near(rep.density_spread, 2, 1e-6),
-                  "a sixth of the area at twice the density (texels_per_unit %d): %d, spread %g (want 2)", k ? 16 : 0,
-                  r, rep.density_spread);
+            CHECK(r == TT_OK && near(rep.density_spread, 2, 1e-6) && near(rep.density_p5_over_median, 1, 1e-6) &&
+                      near(rep.density_p95_over_median, 2, 1e-6),
+                  "a sixth of the area at twice the density (texels_per_unit %d): %d, spread %g (want 2), p5 and "
+                  "p95 over the median %g and %g (want 1 and 2)", k ? 16 : 0, r, rep.density_spread,
+                  rep.density_p5_over_median, rep.density_p95_over_median);
         }
     }
     /* 3 : 1 in texels (u three times as fine as v): stretch exactly 3 */
     linear_uvs(tris, 48, 16, 10, 10, 256, 128, uv);
     r = distortion(tris, uv, 256, 128, 16, 0, &rep, &err);
     CHECK(r == TT_OK && near(rep.stretch_median, 3, 1e-6) && near(rep.stretch_max, 3, 1e-6) &&
+              near(rep.stretch_p5, 3, 1e-6) &&
               near(rep.density_median, sqrt(3.0) - 1, 1e-6),
           "anisotropic 3 : 1: %d, stretch %g / %g (want 3), density error %g (want %g)", r, rep.stretch_median,
           rep.stretch_max, rep.density_median, sqrt(3.0) - 1);
@@ -2247,7 +2251,8 @@ static void test_uv_distortion_counts(void)
     r = distortion(tris, uv, 256, 128, 0, 0, &rep, &err);
     CHECK(r == TT_ERROR_NOT_MEASURED && err.result == r && err.message[0] && rep.non_finite == 48 &&
               rep.faces_measured == 0 && isnan(rep.stretch_median) && isnan(rep.density_p95) &&
-              isnan(rep.density_spread) && isnan(rep.stretch_max),
+              isnan(rep.density_spread) && isnan(rep.stretch_max) && isnan(rep.stretch_p5) &&
+              isnan(rep.density_p5_over_median) && isnan(rep.density_p95_over_median),
           "all-NaN UVs: expected TT_ERROR_NOT_MEASURED with 48 non-finite faces and NaN statistics, got %d, %d, "
           "stretch %g (\"%s\")", r, rep.non_finite, rep.stretch_median, err.message);
     for (c = 0; c < 2 * tris->ncorners; c++) uv[c] = 0.25f;
