@@ -325,10 +325,10 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
         printf("UV distortion: not measured (%s)\n", quality->distortion_reason);
         return;
     }
-    printf("UV distortion: stretch median %.3f, p95 %.3f; density error median %.1f%%, p95 %.1f%%; "
-           "%d flipped UV triangle%s",
-           d->stretch_median, d->stretch_p95, 100.0 * d->density_median, 100.0 * d->density_p95, d->flipped,
-           d->flipped == 1 ? "" : "s");
+    printf("UV distortion: stretch p5 %.3f, median %.3f, p95 %.3f; texel density p5 %.2f, p95 %.2f of its "
+           "median; density error median %.1f%%, p95 %.1f%%; %d flipped UV triangle%s",
+           d->stretch_p5, d->stretch_median, d->stretch_p95, d->density_p5_over_median, d->density_p95_over_median,
+           100.0 * d->density_median, 100.0 * d->density_p95, d->flipped, d->flipped == 1 ? "" : "s");
     if (d->degenerate > 0) printf(", %d degenerate", d->degenerate);
     if (d->non_finite > 0) printf(", %d with non-finite coordinates", d->non_finite);
     if (d->outside_margin > 0)

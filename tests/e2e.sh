@@ -1205,9 +1205,9 @@ hpm_case() {
             printf '%s' "$OUT" | grep -qE '^fits: [0-9]+ accepted, [0-9]+ at the floor, [0-9]+ rejected' &&
             printf '%s' "$OUT" | grep -q 'texel density'; echo $?)"
     check "hpm $name: summary measures" "'seam score: cluster borders X (N of M border edges); all edges Y', \
-'UV distortion: stretch median X, p95 Y; density error ...; 0 flipped UV triangles'" "$OUT" \
+'UV distortion: stretch p5 X, median Y, p95 Z; texel density p5 A, p95 B of its median; density error ...; 0 flipped UV triangles'" "$OUT" \
         "$(printf '%s' "$OUT" | grep -qE '^seam score: cluster borders -?[0-9.]+ \([0-9]+ of [0-9]+ border edges\); all edges -?[0-9.]+ ' &&
-            printf '%s' "$OUT" | grep -qE '^UV distortion: stretch median [0-9.]+, p95 [0-9.]+; density error median [0-9.]+%, p95 [0-9.]+%; 0 flipped UV triangles$'; echo $?)"
+            printf '%s' "$OUT" | grep -qE '^UV distortion: stretch p5 [0-9.]+, median [0-9.]+, p95 [0-9.]+; texel density p5 [0-9.]+, p95 [0-9.]+ of its median; density error median [0-9.]+%, p95 [0-9.]+%; 0 flipped UV triangles$'; echo $?)"
     cd "$W" || exit 1
 }
 
