@@ -1699,10 +1699,11 @@ typedef struct tt_field_options {
    range: TT_ERROR_INDEX_OUT_OF_RANGE (error->face = that index); a zero,
    perpendicular (projects to under 1e-3 of its length) vector or a negative
    sigma or weight: TT_ERROR_INVALID_ARGUMENT; a non-finite one, or a
-   vector longer than FLT_MAX: TT_ERROR_NON_FINITE; a constraint on a zero-area face:
-   TT_ERROR_ZERO_AREA_FACE. Every constraint error names the constraint in
-   error->item (and its face in error->face). A mesh without faces (made by
-   hand) is TT_ERROR_EMPTY_MESH. Temporary memory only.
+   vector longer than FLT_MAX: TT_ERROR_NON_FINITE; a constraint on a
+   zero-area face: TT_ERROR_ZERO_AREA_FACE. Every constraint error names
+   the constraint in error->item (and its face in error->face). A mesh
+   without faces (made by hand) is TT_ERROR_EMPTY_MESH. Temporary memory
+   only.
    Deterministic; reentrant and thread-safe on distinct outputs. */
 TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
                                  const tt_allocator *allocator, float *face_vectors, tt_error *error);
