@@ -1701,7 +1701,9 @@ typedef struct tt_field_options {
    sigma or weight: TT_ERROR_INVALID_ARGUMENT; a non-finite one, or a
    vector longer than FLT_MAX: TT_ERROR_NON_FINITE; a constraint on a
    zero-area face: TT_ERROR_ZERO_AREA_FACE. Every constraint error names
-   the constraint in error->item (and its face in error->face). A mesh
+   the constraint in error->item (and its face in error->face).
+   Coordinates so large, or so far apart in magnitude (1e38 beside 1e-40),
+   that the smoothing's sums overflow: TT_ERROR_NON_FINITE. A mesh
    without faces (made by hand) is TT_ERROR_EMPTY_MESH. Temporary memory
    only.
    Deterministic; reentrant and thread-safe on distinct outputs. */

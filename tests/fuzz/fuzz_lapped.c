@@ -265,7 +265,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const tt_allocator *alloc;
     fz_progress ps;
     uint8_t flags, misc, hdr[24];
-    int nverts, ntris, npatches = 1, f, v, k, gutter;
+    int nverts, ntris, npatches = 1, f, v, k, gutter, extreme = 0;   /* extreme: some coordinate is an extreme float */
     int indices[3 * MAX_TRIS];
     float pos[3 * MAX_VERTS + 3], *field = NULL, *corner_uv = NULL;
     double lo3[3], hi3[3], diag, scale;
@@ -291,7 +291,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             for (k = 0; k < 3; ++k) {
                 uint8_t b = rd_u8(&rd);
                 /* extreme-float mode: a low byte is a value that breaks naive arithmetic */
-                pos[3 * v + k] = (hdr[15] & 128) && b < 24 ? fz_extreme_float(b) : (float)((int)b - 128) / 16.0f;
+                const int wild = (hdr[15] & 128) && b < 24;
+                pos[3 * v + k] = wild ? fz_extreme_float(b) : (float)((int)b - 128) / 16.0f;
+                extreme |= wild;
             }
         } else {
             pos[3 * v] = t;
@@ -366,11 +368,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if (r != TT_OK) {
         check_error("tt_tangent_field", r, &err, &a);
-        /* Valid options on a valid mesh: only a constraint can be refused. */
-        /* extreme coordinates: the target's own scale (a fraction of the
-           box's diagonal) may overflow to infinity, which must be refused */
+        /* Valid options on a valid mesh: only a constraint can be refused.
+           Extreme coordinates: the target's own scale (a fraction of the
+           box's diagonal) may overflow to infinity, which must be refused,
+           and the smoothing may overflow (TT_ERROR_NON_FINITE, documented). */
         CHECK(r == TT_ERROR_OUT_OF_MEMORY || (fo.nconstraints > 0 && !(flags & 128)) ||
-                  (!(flags & 128) && !isfinite(fo.scale)),
+                  (!(flags & 128) && !isfinite(fo.scale)) || (r == TT_ERROR_NON_FINITE && extreme),
               "tt_tangent_field failed without a constraint: %s", err.message);
         goto out;
     }
