@@ -3607,6 +3607,17 @@ static void tt__cross3(const double *a, const double *b, double *out)
 static double tt__normalize3(double *v)
 {
     double len = tt__length3(v);
+    if (len > 0.0 && !(len <= DBL_MAX)) {
+        /* The squares overflowed (components beyond 1e154): scaled by the
+           largest first, the direction survives. */
+        const double big = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+        if (big <= DBL_MAX) {
+            v[0] /= big; v[1] /= big; v[2] /= big;
+            len = tt__length3(v);
+            v[0] /= len; v[1] /= len; v[2] /= len;
+            return big * len;
+        }
+    }
     if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
     return len;
 }

@@ -766,6 +766,51 @@ static void test_field_errors(void)
 /* Every constraint error names the constraint in error->item and its face
    in error->face. The bad constraint sits at index 2, after two good ones,
    so item cannot be confused with 0 or with the face. */
+/* Coordinates at FLT_MAX beside ordinary ones and a denormal (what the
+   fuzz target found): the smoothing's solution comes out near 1e198, past
+   what its squares can hold, and used to normalise to a zero vector on
+   faces with a plane. Each such face must still get a vector in its plane,
+   as long as the others. */
+static void test_field_extreme_coordinates(void)
+{
+    float pos[27] = {-4, 7.9375f, 7.5f, 7.9375f, -5.8125f, -2.5f, 1.02261157e-40f, 1.17549435e-38f, 0,
+                     -4.875f, 3.40282347e+38f, -3.40282347e+38f, 3.40282347e+38f, 0, 1, 4, 0, 0, 1, 0, 0,
+                     4.625f, 2.5f, 1.5f, 0, 2.5f, -3.9375f};
+    int idx[9] = {2, 6, 0, 6, 2, 8, 6, 1, 3};
+    tt_mesh_desc d;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    float v[9];
+    double first = 0.0;
+    int f;
+    memset(&d, 0, sizeof d);
+    d.positions = pos;
+    d.nverts = 9;
+    d.indices = idx;
+    d.nfaces = 3;
+    d.fixed_face_size = 3;
+    d.flags = TT_MESH_PERMISSIVE;
+    if (tt_mesh_build(&d, NULL, &mesh, &err) != TT_OK) {
+        CHECK(0, "the mesh builds permissively: %s", err.message);
+        return;
+    }
+    CHECK(tt_tangent_field(mesh, NULL, NULL, v, &err) == TT_OK, "extreme coordinates, default options: %s",
+          err.message);
+    for (f = 0; f < 2; f++) {
+        float n[3];
+        const double len = sqrt((double)v[3 * f] * v[3 * f] + (double)v[3 * f + 1] * v[3 * f + 1] +
+                                (double)v[3 * f + 2] * v[3 * f + 2]);
+        tt_face_normal(mesh, f, n);
+        CHECK(isfinite(len) && len > 0.0, "face %d (it has a plane) has the vector (%g, %g, %g)", f, (double)v[3 * f],
+              (double)v[3 * f + 1], (double)v[3 * f + 2]);
+        CHECK(fabs((double)v[3 * f] * n[0] + (double)v[3 * f + 1] * n[1] + (double)v[3 * f + 2] * n[2]) <= 1e-4 * len,
+              "face %d's vector is off its plane", f);
+        if (f == 0) first = len;
+        else CHECK(fabs(len - first) <= 1e-4 * first, "the vectors are %g and %g long: both the scale", first, len);
+    }
+    tt_mesh_free(mesh);
+}
+
 static void test_field_constraint_items(void)
 {
     tmesh m, md;
@@ -5025,6 +5070,7 @@ void run_lapped_tests(void)
     RUN(test_field_constraints);
     RUN(test_field_errors);
     RUN(test_field_constraint_items);
+    RUN(test_field_extreme_coordinates);
     RUN(test_field_oom);
     RUN(test_patch_splotch);
     RUN(test_patch_seeds);
