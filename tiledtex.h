@@ -2638,19 +2638,20 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         b. tt_polycube_project: each vertex gets its point q(v) = (quad,
            s, t) on S;
         c. the relaxation of the points on S where a triangle folds or an
-           edge finds no short path (step 5);
+           edge finds no short path;
         d. tt_polycube_trace_edges: each edge gets its image on S, the
            quads it passes and where it crosses their edges (S half-edge,
            position on it, t on the mesh edge), one record per edge, so
            the two triangles on an edge split it at the same points;
            tt_polycube_unfold lays two quads side by side,
            exactly;
-        e. the triangle split (step 4): a triangle's boundary unfolded
+        e. the triangle split: a triangle's boundary unfolded
            into one chart and clipped by the quad grid into pieces inside
            one quad each, or fanned around the one vertex of S inside it,
-           or - the fallback (step 7) - put whole into one quad.
+           or - the fallback - put whole into one quad.
      4. tt_polycube_mapping_uvs: each piece's points on S as texture
-        coordinates in its quad's tile (step 6).
+        coordinates in its quad's tile (Sec. 4.3's cell mapping, on
+        Akleman's per-quad layout instead of the paper's per-cell one).
 
    The grid. L = the bounding box's longest side; the cube edge is
    h = L / resolution, or options->cube_size. Each axis has
@@ -3012,8 +3013,9 @@ typedef struct tt_polycube_edges {
    read the same numbers and split the edge at bitwise identical points
   : p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
    the half-edge crossed. along and t are double: an edge may cross many
-   quads and step 4 rebuilds chart points from them, where float's 6e-8
-   would be up to 1e-6 h on an edge 16 h long, the size of the snap.
+   quads and the triangle split rebuilds chart points from them, where
+   float's 6e-8 would be up to 1e-6 h on an edge 16 h long, the size of
+   the snap.
    The search gives up on an edge after 200000 steps (reachable only with
    a large max_quads), keeping the best path found by then.
    Measured (-O2, the default 4 quads; the models of
@@ -23533,7 +23535,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
     return moved;
 }
 
-/* ---- The model split on S and its UVs (6, 7) ---- */
+/* ---- The model split on S and its UVs (Sec. 4.3) ---- */
 
 #define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
                                        above the records' snap (1e-6), far below any real piece */
