@@ -773,25 +773,29 @@ static void test_field_errors(void)
    as long as the others. */
 static void test_field_extreme_coordinates(void)
 {
-    float pos[27] = {-4, 7.9375f, 7.5f, 7.9375f, -5.8125f, -2.5f, 1.02261157e-40f, 1.17549435e-38f, 0,
-                     -4.875f, 3.40282347e+38f, -3.40282347e+38f, 3.40282347e+38f, 0, 1, 4, 0, 0, 1, 0, 0,
-                     4.625f, 2.5f, 1.5f, 0, 2.5f, -3.9375f};
-    int idx[9] = {2, 6, 0, 6, 2, 8, 6, 1, 3};
-    tt_mesh_desc d;
+    static const double pos[9][3] = {{-4, 7.9375, 7.5},
+                                     {7.9375, -5.8125, -2.5},
+                                     {1.02261157e-40, 1.17549435e-38, 0},
+                                     {-4.875, 3.40282347e+38, -3.40282347e+38},
+                                     {3.40282347e+38, 0, 1},
+                                     {4, 0, 0},
+                                     {1, 0, 0},
+                                     {4.625, 2.5, 1.5},
+                                     {0, 2.5, -3.9375}};
+    tmesh m;
     tt_mesh *mesh = NULL;
     tt_error err;
     float v[9];
     double first = 0.0;
     int f;
-    memset(&d, 0, sizeof d);
-    d.positions = pos;
-    d.nverts = 9;
-    d.indices = idx;
-    d.nfaces = 3;
-    d.fixed_face_size = 3;
-    d.flags = TT_MESH_PERMISSIVE;
-    if (tt_mesh_build(&d, NULL, &mesh, &err) != TT_OK) {
+    memset(&m, 0, sizeof m);
+    for (f = 0; f < 9; f++) tm_vert(&m, pos[f][0], pos[f][1], pos[f][2]);
+    tm_tri(&m, 2, 6, 0);
+    tm_tri(&m, 6, 2, 8);
+    tm_tri(&m, 6, 1, 3);   /* a needle 1e38 long and a few units wide: zero area against its size, no vector */
+    if (build(&m, TT_MESH_PERMISSIVE, &mesh, &err) != TT_OK) {
         CHECK(0, "the mesh builds permissively: %s", err.message);
+        tm_free(&m);
         return;
     }
     CHECK(tt_tangent_field(mesh, NULL, NULL, v, &err) == TT_OK, "extreme coordinates, default options: %s",
@@ -809,6 +813,7 @@ static void test_field_extreme_coordinates(void)
         else CHECK(fabs(len - first) <= 1e-4 * first, "the vectors are %g and %g long: both the scale", first, len);
     }
     tt_mesh_free(mesh);
+    tm_free(&m);
 }
 
 static void test_field_constraint_items(void)

@@ -3170,27 +3170,25 @@ static void test_map_flat_square_coarse(void)
    edges with four triangles. The tetrahedron beside it maps on its own. */
 static void test_map_pillow(void)
 {
-    float pos[21] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 3, 0, 0, 4, 0, 0, 3, 1, 0};
-    int idx[18] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2, 4, 5, 6, 4, 6, 5};
     int with_pillow;
     for (with_pillow = 0; with_pillow < 2; with_pillow++) {
-        tt_mesh_desc d;
+        tmesh m;
         tt_mesh *mesh = NULL;
         tt_polycube *pc = NULL;
         tt_polycube_options po;
         tt_polycube_mapping *map = NULL;
         tt_error err;
         tt_result r;
-        memset(&d, 0, sizeof d);
+        memset(&m, 0, sizeof m);
         memset(&po, 0, sizeof po);
-        d.positions = pos;
-        d.nverts = with_pillow ? 7 : 4;
-        d.indices = idx;
-        d.nfaces = with_pillow ? 6 : 4;
-        d.fixed_face_size = 3;
+        make_tetra(&m, 0.0);   /* faces 0..3 */
+        if (with_pillow) {
+            const int a = tm_vert(&m, 3, 0, 0), b = tm_vert(&m, 4, 0, 0), c = tm_vert(&m, 3, 1, 0);
+            tm_tri(&m, a, b, c);   /* faces 4 and 5: the same corners, facing away from each other */
+            tm_tri(&m, a, c, b);
+        }
         po.resolution = 4;
-        if (tt_mesh_build(&d, NULL, &mesh, &err) != TT_OK ||
-            tt_polycube_build(mesh, &po, NULL, &pc, NULL, &err) != TT_OK) {
+        if (build(&m, 0, &mesh, &err) != TT_OK || tt_polycube_build(mesh, &po, NULL, &pc, NULL, &err) != TT_OK) {
             CHECK(0, "the tetrahedron%s builds: %s", with_pillow ? " and pillow" : "", err.message);
         } else {
             r = tt_polycube_map(pc, mesh, NULL, NULL, &map, NULL, &err);
@@ -3206,6 +3204,7 @@ static void test_map_pillow(void)
         tt_polycube_mapping_free(map);
         tt_polycube_free(pc);
         tt_mesh_free(mesh);
+        tm_free(&m);
     }
 }
 
