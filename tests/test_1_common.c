@@ -30,17 +30,8 @@ static void test_median(void)
             double *v = (double *)malloc(sizeof(double) * (size_t)n), *sorted, want, got;
             sorted = (double *)malloc(sizeof(double) * (size_t)n);
             lcg_seed(17u + (unsigned)n);
-            for (i = 0; i < n; i++) {
-                switch (pattern) {
-                case 0: v[i] = lcg_unit(); break;
-                case 1: v[i] = (double)(int)(4.0 * lcg_unit()); break;
-                case 2: v[i] = i; break;
-                case 3: v[i] = n - i; break;
-                case 4: v[i] = 1.5; break;
-                default: v[i] = i < n / 2 ? i : n - i; break;
-                }
-                sorted[i] = v[i];
-            }
+            hostile_order(v, n, pattern);
+            for (i = 0; i < n; i++) sorted[i] = v[i];
             qsort(sorted, (size_t)n, sizeof(double), median_compare);
             want = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
             got = internal_median(v, n);

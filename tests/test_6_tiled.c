@@ -2323,17 +2323,8 @@ static void test_weighted_percentile_orders(void)
             double *pairs = (double *)malloc(sizeof(double) * 2 * (size_t)n), total = 0.0;
             if (!values || !weights || !pairs) abort();
             lcg_seed(23u + (unsigned)n);
-            for (i = 0; i < n; i++) {
-                switch (pattern) {
-                case 0: values[i] = lcg_unit(); break;
-                case 1: values[i] = (double)lcg_below(4); break;
-                case 2: values[i] = i; break;
-                case 3: values[i] = n - i; break;
-                case 4: values[i] = 1.5; break;
-                default: values[i] = i < n / 2 ? i : n - i; break;
-                }
-                weights[i] = (double)lcg_below(5);
-            }
+            hostile_order(values, n, pattern);
+            for (i = 0; i < n; i++) weights[i] = (double)lcg_below(5);
             weights[n / 2] += 1.0;
             for (i = 0; i < n; i++) {
                 pairs[2 * i] = values[i];

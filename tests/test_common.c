@@ -169,6 +169,21 @@ unsigned lcg_next(void)
 int lcg_below(int n) { return (int)(lcg_next() % (unsigned)n); }
 double lcg_unit(void) { return (double)lcg_next() / 2147483648.0; }
 
+void hostile_order(double *values, int n, int pattern)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        switch (pattern) {
+        case 0: values[i] = lcg_unit(); break;
+        case 1: values[i] = (double)(int)(4.0 * lcg_unit()); break;
+        case 2: values[i] = i; break;
+        case 3: values[i] = n - i; break;
+        case 4: values[i] = 1.5; break;
+        default: values[i] = i < n / 2 ? i : n - i; break;
+        }
+    }
+}
+
 int msg_has_number(const char *msg, int n)
 {
     char buf[32];

@@ -102,6 +102,10 @@ void lcg_seed(unsigned long long s);
 unsigned lcg_next(void);
 int lcg_below(int n);     /* in [0, n) */
 double lcg_unit(void);    /* in [0, 1) */
+/* values[i] for i < n in one of the orders that defeat naive selection
+   pivots (pattern 0..5: random, many repeats, sorted, reversed, all equal,
+   an organ pipe); draws from the LCG. */
+void hostile_order(double *values, int n, int pattern);
 
 /* Does `msg` contain the decimal number n as a whole token? */
 int msg_has_number(const char *msg, int n);
