@@ -61,8 +61,9 @@
      - No global or static mutable state: every function is reentrant and safe
        to call from several threads on distinct outputs.
      - The library never starts a thread. Options with an `executor` field
-       hand independent work (tiles, ranges of faces, turned copies) to your
-       job system through tt_executor; the result is bit-identical with any
+       (and tt_polycube_upright_atlas's executor argument) hand independent
+       work (tiles, ranges of faces, turned copies) to your job system
+       through tt_executor; the result is bit-identical with any
        number of workers, or none (NULL: serial).
      - The library never touches files.
 
@@ -3249,9 +3250,13 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
    without, edge windows that differ, a level whose images differ in size or
    have no pixels (TT_ERROR_INVALID_ARGUMENT); a level that is not in both
    tilesets or beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
-   failure; free it with tt_image_free. */
+   failure; free it with tt_image_free. `executor` (NULL: this thread)
+   copies bands of rows in parallel: an atlas of hundreds of megabytes is
+   mostly fresh memory the system must hand out page by page, which one
+   thread alone makes the longest serial stage of a polycube run. */
 TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
-                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error);
+                                          const tt_executor *executor, const tt_allocator *allocator,
+                                          tt_image **out_image, tt_error *error);
 /* Errors and the rest as tt_polycube_mapping_uvs. */
 TTDEF tt_result tt_polycube_mapping_uvs_upright(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                                 const tt_tile_layout *layout, const uint8_t *corner_type,
@@ -24999,12 +25004,35 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad)
     return polycube->quad_side[quad] / 2 != polycube->up_axis;
 }
 
+/* Rows [begin, end) of tt_polycube_upright_atlas: the plain tile row on
+   the left, the upright one on the right. */
+typedef struct tt__atlas_halves {
+    const tt_image *left, *right;
+    tt_image *out;
+} tt__atlas_halves;
+
+static void tt__atlas_halves_rows(void *context, int begin, int end)
+{
+    const tt__atlas_halves *h = (const tt__atlas_halves *)context;
+    const size_t half = (size_t)h->left->width * 4;
+    int row;
+    for (row = begin; row < end; row++) {
+        float *out = h->out->pixels + (size_t)row * 2 * half;
+        memcpy(out, h->left->pixels + (size_t)row * half, half * sizeof(float));
+        memcpy(out + half, h->right->pixels + (size_t)row * half, half * sizeof(float));
+    }
+}
+
+#define TT__ATLAS_BAND_TEXELS 65536   /* texels per task of tt_polycube_upright_atlas: a few hundred tasks */
+
 TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
-                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error)
+                                          const tt_executor *executor, const tt_allocator *allocator,
+                                          tt_image **out_image, tt_error *error)
 {
     const tt_image *left, *right;
+    tt__atlas_halves halves;
     tt_result result;
-    int k, row;
+    int k;
     tt__ok(error);
     if (out_image) *out_image = NULL;
     if (!plain || !upright || !out_image)
@@ -25045,12 +25073,11 @@ TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tile
     if ((result = tt__image_create(2 * left->width, left->height, 0, allocator, out_image, error)) != TT_OK)
         return result;
     (*out_image)->kind = left->kind;
-    for (row = 0; row < left->height; row++) {
-        float *out = (*out_image)->pixels + (size_t)row * 2 * (size_t)left->width * 4;
-        memcpy(out, left->pixels + (size_t)row * left->width * 4, (size_t)left->width * 4 * sizeof(float));
-        memcpy(out + (size_t)left->width * 4, right->pixels + (size_t)row * right->width * 4,
-               (size_t)right->width * 4 * sizeof(float));
-    }
+    halves.left = left;
+    halves.right = right;
+    halves.out = *out_image;
+    tt__parallel_ranges(executor, left->height, tt__max_i(1, TT__ATLAS_BAND_TEXELS / (2 * left->width)),
+                        tt__atlas_halves_rows, &halves);
     return TT_OK;
 }
 

@@ -262,12 +262,13 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
     if ((status = tiled_synthesize(image, options->image_path, &upright, &options->tiles.maps, &job->upright_tiles,
                                    job->map_upright_tiles)) != 0)
         return status;
-    if (tt_polycube_upright_atlas(job->tiles, job->upright_tiles, 0, NULL, &job->atlas, &error) != TT_OK)
+    if (tt_polycube_upright_atlas(job->tiles, job->upright_tiles, 0, tool_executor(), NULL, &job->atlas, &error) !=
+        TT_OK)
         return tool_fail("the %dx%d atlas: %s", 2 * plain->width, plain->height, error.message);
     for (map = 0; map < MATERIAL_MAPS; map++)
         if (job->map_tiles[map] &&
-            tt_polycube_upright_atlas(job->map_tiles[map], job->map_upright_tiles[map], 0, NULL, &job->map_atlas[map],
-                                      &error) != TT_OK)
+            tt_polycube_upright_atlas(job->map_tiles[map], job->map_upright_tiles[map], 0, tool_executor(), NULL,
+                                      &job->map_atlas[map], &error) != TT_OK)
             return tool_fail("the %dx%d %s atlas: %s", 2 * plain->width, plain->height, material_map_names[map],
                              error.message);
     for (c = 0; c < job->polycube->surface->ncorners; c++)

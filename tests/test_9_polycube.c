@@ -2215,7 +2215,7 @@ static tt_result upright_atlas_oom_call(void *ctx, const tt_allocator *al, tt_er
 {
     upright_atlas_oom_ctx *c = (upright_atlas_oom_ctx *)ctx;
     tt_image *atlas = (tt_image *)&atlas;
-    tt_result r = tt_polycube_upright_atlas(c->plain, c->upright, 0, al, &atlas, error);
+    tt_result r = tt_polycube_upright_atlas(c->plain, c->upright, 0, NULL, al, &atlas, error);
     if (error->result != r || (r != TT_OK) != (atlas == NULL)) return TT_RESULT_MAX_ENUM;
     tt_image_free(atlas);
     return r;
@@ -2240,15 +2240,31 @@ static void upright_atlas_checks(const tt_tileset *plain, const tt_tileset *upri
                memcmp(atlas->pixels + ((size_t)row * 2 * W + W) * 4, upright->levels[0].pixels + (size_t)row * W * 4,
                       (size_t)W * 4 * sizeof(float)) == 0;
     CHECK(same, "the atlas is the plain tiles beside the upright ones");
-    CHECK(tt_polycube_upright_atlas(plain, upright, 1, NULL, &level1, &err) == TT_OK && level1 &&
+    {
+        /* Bands of rows through an executor: the same atlas, byte for byte. */
+        const tt_executor *executors[2];
+        int e;
+        executors[0] = &g_reverse_executor;
+        executors[1] = &g_thread_executor;
+        for (e = 0; e < 2; e++) {
+            tt_image *parallel = NULL;
+            CHECK(tt_polycube_upright_atlas(plain, upright, 0, executors[e], NULL, &parallel, &err) == TT_OK &&
+                      parallel && parallel->width == atlas->width && parallel->height == atlas->height &&
+                      memcmp(parallel->pixels, atlas->pixels, (size_t)atlas->width * atlas->height * 4 * sizeof(float)) ==
+                          0,
+                  "executor %d: the atlas differs from the serial one", e);
+            tt_image_free(parallel);
+        }
+    }
+    CHECK(tt_polycube_upright_atlas(plain, upright, 1, NULL, NULL, &level1, &err) == TT_OK && level1 &&
               level1->width == W && level1->height == W / 2 &&
               memcmp(level1->pixels, plain->levels[1].pixels, (size_t)W / 2 * 4 * sizeof(float)) == 0,
           "level 1: %s", err.message);
     tt_image_free(level1);
-    CHECK(tt_polycube_upright_atlas(upright, plain, 0, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
+    CHECK(tt_polycube_upright_atlas(upright, plain, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
           "upright first refused: %s", err.message);
     bad = (tt_image *)&bad;
-    CHECK(tt_polycube_upright_atlas(plain, upright, plain->nlevels, NULL, &bad, &err) ==
+    CHECK(tt_polycube_upright_atlas(plain, upright, plain->nlevels, NULL, NULL, &bad, &err) ==
                   TT_ERROR_INDEX_OUT_OF_RANGE && !bad,
           "level %d refused: %s", plain->nlevels, err.message);
     swapped_windows = *upright;
@@ -2256,7 +2272,7 @@ static void upright_atlas_checks(const tt_tileset *plain, const tt_tileset *upri
     moved[1].x += 1;
     swapped_windows.edge_windows = moved;
     bad = (tt_image *)&bad;
-    CHECK(tt_polycube_upright_atlas(plain, &swapped_windows, 0, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT &&
+    CHECK(tt_polycube_upright_atlas(plain, &swapped_windows, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT &&
               !bad && err.item == 1,
           "other edge windows refused: %s", err.message);
     ctx.plain = plain;
@@ -2289,7 +2305,7 @@ static void test_map_uvs_upright(void)
     so.upright = 1;
     so.edge_windows = plain->edge_windows;
     if (tt_synthesize_tiles(photo, &so, NULL, &upright, &err) != TT_OK ||
-        tt_polycube_upright_atlas(plain, upright, 0, NULL, &atlas, &err) != TT_OK) {
+        tt_polycube_upright_atlas(plain, upright, 0, NULL, NULL, &atlas, &err) != TT_OK) {
         CHECK(0, "upright tiles and their atlas: %s", err.message);
         tt_tileset_free(plain);
         tt_tileset_free(upright);

@@ -1895,36 +1895,36 @@ static void cases_polycube(const baseline *b)
     }
     if (plain && upright) {
         tt_tileset other = *upright, other2;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(NULL, upright, 0, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, NULL, 0, AL, &aout, E));
-        CASE(tt_polycube_upright_atlas(plain, upright, 0, AL, NULL, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, 0, BA1, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, 0, BA2, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, -1, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, plain->nlevels, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, TT_MAX_MIP_LEVELS, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, INT_MAX, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, INT_MIN, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(upright, plain, 0, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, plain, 0, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(NULL, upright, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, NULL, 0, NULL, AL, &aout, E));
+        CASE(tt_polycube_upright_atlas(plain, upright, 0, NULL, AL, NULL, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, 0, NULL, BA1, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, 0, NULL, BA2, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, -1, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, plain->nlevels, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, TT_MAX_MIP_LEVELS, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, INT_MAX, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, INT_MIN, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(upright, plain, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, plain, 0, NULL, AL, &aout, E));
         other.nlevels = -1;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
         other.nlevels = TT_MAX_MIP_LEVELS + 5;   /* both claim levels beyond the array */
         other2 = *plain;
         other2.nlevels = TT_MAX_MIP_LEVELS + 5;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(&other2, &other, TT_MAX_MIP_LEVELS + 1, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(&other2, &other, TT_MAX_MIP_LEVELS + 1, NULL, AL, &aout, E));
         other = *upright;
         other.layout.colors = 2;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
         other = *upright;
         other.levels[0].kind = TT_IMAGE_NORMAL;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
         other = *upright;
         other.levels[0].pixels = NULL;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
         other = *upright;
         other.levels[0].width = 3;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
     }
     tt_tileset_free(plain);
     tt_tileset_free(upright);
