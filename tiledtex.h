@@ -21946,7 +21946,11 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
         desc.indices = triangles;
         desc.nfaces = ntriangles;
         desc.fixed_face_size = 3;
-        desc.flags = mesh->flags & TT_MESH_PERMISSIVE;
+        /* Permissive: the midpoints are rounded to floats, and those of a
+           sliver's two long edges can round to one point, leaving a refined
+           triangle with no area that the input did not have. The mapping
+           takes such triangles as it takes a permissive input's. */
+        desc.flags = TT_MESH_PERMISSIVE;
         if ((result = tt_mesh_build(&desc, allocator, &current, error)) != TT_OK) goto failed;
         mid = TT__ALLOC(allocator, int, current->ncorners);
         if (!mid) goto out_of_memory;

@@ -3224,6 +3224,49 @@ static void test_map_pillow(void)
     }
 }
 
+/* Two vertices 4e-9 apart (a strict build accepts their sliver
+   triangles): the refinement's midpoints of their long edges round to
+   one float, and the refined triangle between them has no area. The
+   mapping goes on (found by fuzz_polycube: it returned
+   TT_ERROR_ZERO_AREA_FACE naming a refined face the caller never had). */
+static void test_map_refined_sliver(void)
+{
+    static const float positions[9][3] = {
+        {-0.0617647059f, -0.247058824f, -0.24509804f}, {0.0622548983f, -0.250980407f, -0.250980407f},
+        {0.205392152f, -0.250980407f, -0.14705883f},   {0.062254902f, 0.249019593f, -0.250980407f},
+        {0.0622548983f, 0.249019593f, -0.250980407f},  {0.187254906f, 0.249019593f, -0.250980407f},
+        {-0.0627451017f, 0.749019623f, -0.250980407f}, {0.0622548983f, 0.749019623f, -0.250980407f},
+        {0.187254906f, 0.749019623f, -0.250980407f}};
+    static const int triangles[8][3] = {{0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4},
+                                        {3, 4, 7}, {3, 7, 6}, {4, 5, 8}, {4, 8, 7}};
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_polycube *pc = NULL;
+    tt_polycube_options po;
+    tt_polycube_mapping *map = NULL;
+    tt_polycube_map_report rep;
+    tt_error err;
+    tt_result r;
+    int i;
+    memset(&m, 0, sizeof m);
+    memset(&po, 0, sizeof po);
+    for (i = 0; i < 9; i++) tm_vert(&m, positions[i][0], positions[i][1], positions[i][2]);
+    for (i = 0; i < 8; i++) tm_tri(&m, triangles[i][0], triangles[i][1], triangles[i][2]);
+    po.cube_size = 1.0;
+    if (build(&m, 0, &mesh, &err) != TT_OK || tt_polycube_build(mesh, &po, NULL, &pc, NULL, &err) != TT_OK) {
+        CHECK(0, "the strip with a sliver builds: %s", err.message);
+    } else {
+        r = tt_polycube_map(pc, mesh, NULL, NULL, &map, &rep, &err);
+        CHECK(r == TT_OK && map != NULL && rep.triangles > mesh->nfaces,
+              "a sliver whose refined triangles lose their area maps (got %d: %s; %d refined triangles)", (int)r,
+              r == TT_OK ? "" : err.message, r == TT_OK ? rep.triangles : 0);
+    }
+    tt_polycube_mapping_free(map);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -3263,6 +3306,7 @@ void run_polycube_tests(void)
     RUN(test_map_open_and_messy);
     RUN(test_map_flat_square_coarse);
     RUN(test_map_pillow);
+    RUN(test_map_refined_sliver);
     RUN(test_map_random);
     RUN(test_map_executors);
 }
