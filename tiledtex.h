@@ -201,7 +201,8 @@
                   tiled-textures boundary assignment (Sec. 3.2)
                 - the mapping, tt_polycube_map: the model refined, each
                   vertex projected to a point of S on the side its normal
-                  faces, the points relaxed, each edge traced on S as a path
+                  faces, the points relaxed and smoothed (stretch and
+                  density evened out), each edge traced on S as a path
                   of quads (exact unfoldings), each triangle split along S's
                   quad edges into pieces inside one quad; the UVs from the
                   tiles (Sec. 4)
@@ -3085,6 +3086,10 @@ typedef struct tt_polycube_map_report {
     tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
     int relaxed;            /* moves of points on S that unfolded a fold or joined a vertex to its neighbours'
                                sheet */
+    int smoothed;           /* moves of points on S that lowered the map's stretch and evened its density */
+    int held;               /* vertices the smoothing left where the projection put them: a triangle of theirs
+                               folded, or their neighbours beyond its reach (their part keeps the projection's
+                               stretch) */
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
     int fallback_triangles; /* of `triangles`, those put whole into one quad: a local seam; target 0 */
@@ -3125,7 +3130,17 @@ typedef struct tt_polycube_mapping {
         visit only the vertices at badly placed triangles (and, while
         untangling, the rings around them) whose stars changed, so the
         cost follows the folds, not the mesh;
-     4. tt_polycube_trace_edges (max_quads); a vertex with an edge that
+     4. smoothing: the projection lays parts oblique to S's faces onto
+        them in thin strips (the texture drawn out into streaks); every
+        point takes Newton steps down an energy of its star that is least
+        where each triangle keeps its angles and the density of the whole
+        map (S's area over the model's), with a barrier that keeps every
+        triangle unfolded, up to TT__SMOOTH_SWEEPS sweeps, a vertex
+        visited again only when it or a neighbour moved; vertices of no
+        common triangle step in parallel (a greedy colouring of the
+        vertices, the same whatever the executor). Vertices at a fold the
+        untangling left stay (report->held);
+     5. tt_polycube_trace_edges (max_quads); a vertex with an edge that
         finds no path (the projection seated it on the far side of a part
         about a cube thick) is tried on each neighbour's sheet and kept
         where fewest of its edges fail, then fewest of its triangles fold;
@@ -3137,7 +3152,7 @@ typedef struct tt_polycube_mapping {
         onto a line; it is moved onto W unless another point is there,
         and the edges are traced again (a vertex whose edges then find no
         path goes back, and they are traced once more);
-     5. per triangle, the split:
+     6. per triangle, the split:
         - its boundary (its vertices and its edges' split points, from
           the records) is unfolded into one chart from its first vertex's
           quad; where an edge runs along an edge of S the quad on the
@@ -3175,8 +3190,11 @@ typedef struct tt_polycube_mapping {
           but no flipped piece.
    Every split point of an edge is one output vertex shared by the two
    triangles on the edge: a closed manifold model gives a closed manifold
-   output. Pieces of zero area (an edge along a lattice line) are dropped;
-   the output's area equals the input's. An inside-out mesh
+   output. Pieces of zero area (an edge along a lattice line) are dropped,
+   but for those whose corners are other pieces' vertices already (edges
+   passing a hair from a corner of S): dropped, they would leave a hole of
+   no area there, so they stay (counted in collapsed). The output's area
+   equals the input's. An inside-out mesh
    (tt_polycube_report::inside_out) must be reversed first: the points go
    to the wrong sides of thin parts and every chart turns clockwise.
    Measured (-O2, one thread, CPU): at resolution 32 the bunny (3.7k
@@ -3187,10 +3205,11 @@ typedef struct tt_polycube_mapping {
    takes 1.1 s (0.9 % fallbacks), cut 1-to-4 (388k triangles) 4.8 s and
    1-to-16 (1.55M) 14 s. No flipped triangle on the first two; on the
    1.55M one three slivers of 1e-10 of a quad's area, at a quad's corner,
-   turn over. With an executor
+   turn over. The smoothing adds 0.3 s on the horse (8 sweeps of about
+   45k vertex steps). With an executor
    (options->executor) the projection, the relaxation's independent
-   groups of vertices, the tracing and the split run as tasks; the
-   mapping is the same, bit for bit.
+   groups of vertices, the smoothing's colours, the tracing and the split
+   run as tasks; the mapping is the same, bit for bit.
    report may be NULL.
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
@@ -22459,6 +22478,7 @@ typedef struct tt__untangle_star {
     int n;
     double ring[TT__UNTANGLE_STAR][2][2];
     double inverse[TT__UNTANGLE_STAR][2][2];
+    double area[TT__UNTANGLE_STAR];     /* the triangle's own area (cube units): its weight when smoothing */
 } tt__untangle_star;
 
 /* Sets triangle i's shape (edge v -> a, edge v -> b, in 2D); 0 when it has no area. */
@@ -22466,6 +22486,7 @@ static int tt__untangle_star_shape(tt__untangle_star *star, int i, const double 
 {
     const double det = shape[0][0] * shape[1][1] - shape[1][0] * shape[0][1];
     if (!(det != 0.0)) return 0;
+    star->area[i] = 0.5 * fabs(det);
     star->inverse[i][0][0] = shape[1][1] / det;
     star->inverse[i][0][1] = -shape[1][0] / det;
     star->inverse[i][1][0] = -shape[0][1] / det;
@@ -22483,8 +22504,17 @@ static int tt__untangle_star_shape(tt__untangle_star *star, int i, const double 
    not NULL the second derivatives (xx, xy, yy) to hessian[3]: J moves
    with x along a fixed direction per row, so |J|^2 is quadratic in x and
    det J affine, and the Hessian takes a few products more. *folded counts
-   the triangles with det J <= 0. */
-static double tt__untangle_energy(const tt__untangle_star *star, const double x[2], double delta2,
+   the triangles with det J <= 0.
+   With `density` > 0 it is the smoothing energy instead (delta2 is then
+   unused): per triangle, weighted by its own area, the same angle term
+   |J|^2 / (2 det J), least at a similarity, plus (det J / density +
+   density / det J) / 2, least where the triangle keeps `density` (the
+   area of S per unit of the model's area): together least where the map
+   neither stretches nor shrinks the texture, the two aims Rabinovich et
+   al.'s scalable locally injective maps (2017) weigh alike. Both grow
+   without bound as a triangle flattens, a barrier that keeps every
+   triangle of the star unfolded: a folded one makes it HUGE_VAL. */
+static double tt__untangle_energy(const tt__untangle_star *star, const double x[2], double delta2, double density,
                                   double gradient[2], double hessian[3], int *folded)
 {
     double energy = 0.0;
@@ -22511,6 +22541,24 @@ static double tt__untangle_energy(const tt__untangle_star *star, const double x[
         dfrobenius[1] = 2.0 * (j10 * d0 + j11 * d1);
         ddet[0] = d0 * j11 - d1 * j10;
         ddet[1] = j00 * d1 - j01 * d0;
+        if (density > 0.0) {
+            const double w = star->area[i], ratio = density / det;
+            if (!(det > 0.0)) return HUGE_VAL;
+            energy += w * (frobenius / (2.0 * det) + 0.5 * (det / density + ratio));
+            for (k = 0; k < 2; k++)
+                gradient[k] += w * (dfrobenius[k] / (2.0 * det) - frobenius * ddet[k] / (2.0 * det * det) +
+                                    0.5 * (1.0 / density - ratio / det) * ddet[k]);
+            if (hessian) {
+                /* As below with h = det (h' = 1, h'' = 0), plus the density term's (density / det^3) g g^T. */
+                const double u = 1.0 / (2.0 * det), du = -1.0 / (2.0 * det * det);
+                const double uu = frobenius / (det * det * det) + ratio / (det * det);
+                const double dd = 2.0 * (d0 * d0 + d1 * d1) * u;
+                hessian[0] += w * (dd + 2.0 * du * dfrobenius[0] * ddet[0] + uu * ddet[0] * ddet[0]);
+                hessian[1] += w * (du * (dfrobenius[0] * ddet[1] + dfrobenius[1] * ddet[0]) + uu * ddet[0] * ddet[1]);
+                hessian[2] += w * (dd + 2.0 * du * dfrobenius[1] * ddet[1] + uu * ddet[1] * ddet[1]);
+            }
+            continue;
+        }
         energy += frobenius / (2.0 * h);
         for (k = 0; k < 2; k++) gradient[k] += dfrobenius[k] / (2.0 * h) - frobenius * dh * ddet[k] / (2.0 * h * h);
         if (hessian) {
@@ -22887,20 +22935,22 @@ static int tt__relax_lane_move(tt__relax_state *R, tt__relax_lane *lane, int v, 
    points' float resolution or TT__UNTANGLE_STEPS are made: the star's
    own optimum, so that a vertex whose star has not changed has nowhere to
    go (the sweeps then pass it over). When `strict`, v goes to the last of
-   its steps that folds no more of its triangles than before. Returns 1
-   when v moves, to *moved. */
-static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, int v, int strict,
-                               tt_surface_point *moved)
+   its steps that folds no more of its triangles than before. With
+   `density` > 0 the step smooths instead (the smoothing energy of
+   tt__untangle_energy): a vertex with a folded triangle stays, and the
+   barrier keeps the others unfolded. Returns 1 when v moves, to *moved;
+   0 when it stays; -1 when its star cannot be stepped (more than
+   TT__UNTANGLE_STAR triangles, a neighbour beyond the chart, a triangle
+   of no area, or, smoothing, a folded triangle). */
+static int tt__star_step(const tt_polycube *pc, const tt_mesh *model, const tt_surface_point *points,
+                         const tt__relax_context *context, tt__relax_chart *chart, tt__untangle_star *star, int v,
+                         int strict, double density, tt_surface_point *moved)
 {
-    const tt_mesh *model = R->model;
-    const tt_surface_point *points = R->points;
-    const int *first_triangle = R->x.first_triangle, *triangle_corners = R->x.triangle_corners;
-    tt__relax_chart *chart = &lane->chart;
-    tt__untangle_star *star = &lane->star;
-    const double h = R->pc->h;
+    const int *first_triangle = context->first_triangle, *triangle_corners = context->triangle_corners;
+    const double h = pc->h;
     double x[2], kept[2], gradient[2], hessian[3], energy, least_det = HUGE_VAL, delta2, reach = 0.0;
     int i, step, folded_before, folded;
-    if (first_triangle[v + 1] - first_triangle[v] > TT__UNTANGLE_STAR) return 0;
+    if (first_triangle[v + 1] - first_triangle[v] > TT__UNTANGLE_STAR) return -1;
     tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
     tt__relax_chart_place(chart, points[v], x);
     star->n = 0;
@@ -22911,20 +22961,20 @@ static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, i
         int k;
         if (!tt__relax_chart_place(chart, points[a], star->ring[star->n][0]) ||
             !tt__relax_chart_place(chart, points[b], star->ring[star->n][1]))
-            return 0;
+            return -1;
         for (k = 0; k < 3; k++) {
             edge_a[k] = ((double)model->pos[3 * a + k] - model->pos[3 * v + k]) / h;
             edge_b[k] = ((double)model->pos[3 * b + k] - model->pos[3 * v + k]) / h;
         }
         tt__cross3(edge_a, edge_b, normal);
-        if (!((length = tt__length3(edge_a)) > 0.0) || !(tt__normalize3(normal) > 0.0)) return 0;
+        if (!((length = tt__length3(edge_a)) > 0.0) || !(tt__normalize3(normal) > 0.0)) return -1;
         for (k = 0; k < 3; k++) along[k] = edge_a[k] / length;
         tt__cross3(normal, along, across);
         shape[0][0] = length;
         shape[0][1] = 0.0;
         shape[1][0] = tt__dot3(edge_b, along);
         shape[1][1] = tt__dot3(edge_b, across);
-        if (!tt__untangle_star_shape(star, star->n, (const double (*)[2])shape)) return 0;
+        if (!tt__untangle_star_shape(star, star->n, (const double (*)[2])shape)) return -1;
         for (k = 0; k < 2; k++)
             reach = fmax(reach, fabs(star->ring[star->n][k][0] - x[0]) + fabs(star->ring[star->n][k][1] - x[1]));
         /* det J of this triangle, for delta below. */
@@ -22938,7 +22988,8 @@ static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, i
     }
     /* Escobar et al.'s delta: 0 once nothing is near folding, else growing with the worst fold. */
     delta2 = least_det < TT__UNTANGLE_EPSILON ? TT__UNTANGLE_EPSILON * (TT__UNTANGLE_EPSILON - least_det) : 0.0;
-    energy = tt__untangle_energy(star, x, delta2, gradient, hessian, &folded_before);
+    if (density > 0.0 && !(least_det > 0.0)) return -1;
+    energy = tt__untangle_energy(star, x, delta2, density, gradient, hessian, &folded_before);
     kept[0] = x[0];
     kept[1] = x[1];
     for (step = 0; step < TT__UNTANGLE_STEPS; step++) {
@@ -22965,7 +23016,7 @@ static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, i
              halvings++, t *= 0.5) {
             trial[0] = x[0] + t * direction[0];
             trial[1] = x[1] + t * direction[1];
-            trial_energy = tt__untangle_energy(star, trial, delta2, trial_gradient, trial_hessian, &folded);
+            trial_energy = tt__untangle_energy(star, trial, delta2, density, trial_gradient, trial_hessian, &folded);
             if (trial_energy < energy) break;
         }
         if (halvings == TT__UNTANGLE_HALVINGS || t * length < TT__UNTANGLE_CONVERGED) break;
@@ -22981,6 +23032,13 @@ static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, i
     }
     if (!tt__relax_chart_point(chart, kept, moved)) return 0;
     return !tt__same_point(*moved, points[v]);
+}
+
+/* One untangling step of vertex v in its lane's chart and star. */
+static int tt__untangle_vertex(const tt__relax_state *R, tt__relax_lane *lane, int v, int strict,
+                               tt_surface_point *moved)
+{
+    return tt__star_step(R->pc, R->model, R->points, &R->x, &lane->chart, &lane->star, v, strict, 0.0, moved) > 0;
 }
 
 /* One relaxation step of vertex v (the moves of tt__polycube_relax), in
@@ -23361,6 +23419,171 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
 done:
     tt__relax_state_free(&R);
     tt__free(allocator, strict_points);
+    return moves;
+}
+
+/* ---- Smoothing of the points on S ---- */
+
+#define TT__SMOOTH_SWEEPS 8         /* smoothing sweeps over the vertices at most */
+#define TT__SMOOTH_STILL 1e-3       /* a step shorter than this (quad units, s + t) leaves the vertex's
+                                       neighbours as they were: they are not visited again for it */
+
+/* One task of a smoothing sweep: its own chart and star. */
+typedef struct tt__smooth_lane {
+    tt__relax_chart chart;
+    tt__untangle_star star;
+    int held;                   /* its vertices whose star could not be stepped in the first sweep */
+} tt__smooth_lane;
+
+typedef struct tt__smooth {
+    const tt_polycube *pc;
+    const tt_mesh *model;
+    tt_surface_point *points;
+    tt__relax_context x;
+    double density;             /* the area of S per unit of the model's area (cube units) */
+    int *order, *colour_start;  /* the vertices colour by colour; where each colour starts in order[] */
+    int ncolours, colour;       /* the colour being swept */
+    int first_sweep;            /* 1 in the first sweep, which visits every vertex */
+    unsigned char *active;      /* per vertex: visited in this sweep */
+    unsigned char *changed;     /* per vertex: moved by at least TT__SMOOTH_STILL in this sweep */
+    tt__smooth_lane *lanes;     /* TT__RELAX_LANES */
+} tt__smooth;
+
+/* Lane `index` of the colour being swept: its share of the colour's
+   vertices, each a smoothing step. No two vertices of a colour share a
+   triangle, so each step reads only points that no other step of the
+   colour writes. */
+static void tt__smooth_task(void *context, int index)
+{
+    tt__smooth *m = (tt__smooth *)context;
+    tt__smooth_lane *lane = &m->lanes[index];
+    const int first = m->colour_start[m->colour], count = m->colour_start[m->colour + 1] - first;
+    const int begin = first + (int)((long long)count * index / TT__RELAX_LANES);
+    const int end = first + (int)((long long)count * (index + 1) / TT__RELAX_LANES);
+    int i;
+    for (i = begin; i < end; i++) {
+        const int v = m->order[i];
+        tt_surface_point p;
+        int step;
+        if (!m->active[v] || tt__relax_on_surface(m->pc, m->model, m->points, v)) continue;
+        step = tt__star_step(m->pc, m->model, m->points, &m->x, &lane->chart, &lane->star, v, 1, m->density, &p);
+        lane->held += step < 0 && m->first_sweep;
+        if (step <= 0) continue;
+        m->changed[v] = p.quad != m->points[v].quad || fabs(p.s - m->points[v].s) + fabs(p.t - m->points[v].t) >=
+                        TT__SMOOTH_STILL;
+        m->points[v] = p;
+    }
+}
+
+/* The points moved on S to lower the distortion of the whole map: the
+   projection lays a part oblique to S's faces onto them in thin strips,
+   drawing the texture out into streaks. Each sweep gives every vertex a
+   step down the smoothing energy of its star (tt__untangle_energy: angles
+   and area kept, triangles never folded), colour by colour so that the
+   steps of a colour are independent and run in parallel, in the same
+   order whatever the executor; a vertex is visited again only when it or
+   a neighbour moved. Vertices with a folded triangle and those on S stay.
+   Returns the number of steps that moved a point, -1 when out of memory;
+   *held: the vertices it could not step (tt__star_step). */
+static int tt__polycube_smooth(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
+                               const tt_executor *executor, const tt_allocator *allocator, int *held)
+{
+    const int nverts = model->nverts;
+    tt__smooth m;
+    int *colour = NULL, *taken = NULL, v, i, k, sweep, moves = 0, l;
+    double model_area = 0.0;
+    memset(&m, 0, sizeof m);
+    *held = 0;
+    if (nverts == 0) return 0;
+    if (!tt__relax_context_init(pc, model, allocator, &m.x)) return -1;
+    m.pc = pc;
+    m.model = model;
+    m.points = points;
+    colour = TT__ALLOC(allocator, int, nverts);
+    taken = TT__ALLOC(allocator, int, (size_t)TT__UNTANGLE_STAR * 2 + 2);
+    m.order = TT__ALLOC(allocator, int, nverts);
+    m.colour_start = TT__ALLOC(allocator, int, (size_t)TT__UNTANGLE_STAR * 2 + 3);
+    m.active = TT__ALLOC(allocator, unsigned char, nverts);
+    m.changed = TT__ALLOC(allocator, unsigned char, nverts);
+    m.lanes = TT__ALLOC(allocator, tt__smooth_lane, TT__RELAX_LANES);
+    if (!colour || !taken || !m.order || !m.colour_start || !m.active || !m.changed || !m.lanes) {
+        moves = -1;
+        goto done;
+    }
+    for (l = 0; l < TT__RELAX_LANES; l++) {
+        tt__relax_chart_init(&m.lanes[l].chart, pc->surface, m.x.unfold);
+        m.lanes[l].held = 0;
+    }
+    /* Greedy colours in vertex order: the least colour no neighbour has.
+       A vertex of more than TT__UNTANGLE_STAR triangles never steps: it
+       gets none (-1). */
+    for (v = 0; v < nverts; v++) colour[v] = -1;
+    for (v = 0; v < nverts; v++) {
+        const int degree = m.x.first_triangle[v + 1] - m.x.first_triangle[v];
+        int c;
+        if (degree > TT__UNTANGLE_STAR) {
+            ++*held;
+            continue;
+        }
+        memset(taken, 0, sizeof(int) * ((size_t)TT__UNTANGLE_STAR * 2 + 2));
+        for (i = m.x.first_triangle[v]; i < m.x.first_triangle[v + 1]; i++)
+            for (k = 0; k < 3; k++) {
+                const int u = model->corner_vert[3 * (m.x.triangle_corners[i] / 3) + k];
+                if (u != v && colour[u] >= 0 && colour[u] <= 2 * TT__UNTANGLE_STAR + 1) taken[colour[u]] = 1;
+            }
+        for (c = 0; taken[c]; c++) continue;
+        colour[v] = c;
+        if (c + 1 > m.ncolours) m.ncolours = c + 1;
+    }
+    memset(m.colour_start, 0, sizeof(int) * ((size_t)m.ncolours + 1));
+    for (v = 0; v < nverts; v++)
+        if (colour[v] >= 0) m.colour_start[colour[v] + 1]++;
+    for (k = 0; k < m.ncolours; k++) m.colour_start[k + 1] += m.colour_start[k];
+    memcpy(taken, m.colour_start, sizeof(int) * (size_t)m.ncolours);
+    for (v = 0; v < nverts; v++)
+        if (colour[v] >= 0) m.order[taken[colour[v]]++] = v;
+    /* The density the map would have everywhere if it kept area: S's
+       quads (each a unit square) over the model's area in cube units. */
+    for (i = 0; i < model->nfaces; i++) {
+        const int *t = model->corner_vert + 3 * i;
+        double e1[3], e2[3], n[3];
+        for (k = 0; k < 3; k++) {
+            e1[k] = ((double)model->pos[3 * t[1] + k] - model->pos[3 * t[0] + k]) / pc->h;
+            e2[k] = ((double)model->pos[3 * t[2] + k] - model->pos[3 * t[0] + k]) / pc->h;
+        }
+        tt__cross3(e1, e2, n);
+        model_area += 0.5 * tt__length3(n);
+    }
+    if (!(model_area > 0.0) || !(model_area < HUGE_VAL)) goto done;
+    m.density = pc->surface->nfaces / model_area;
+    memset(m.active, 1, (size_t)nverts);
+    for (sweep = 0; sweep < TT__SMOOTH_SWEEPS; sweep++) {
+        int changed = 0;
+        memset(m.changed, 0, (size_t)nverts);
+        m.first_sweep = sweep == 0;
+        for (m.colour = 0; m.colour < m.ncolours; m.colour++)
+            tt__run_tasks(executor, TT__RELAX_LANES, tt__smooth_task, &m);
+        if (sweep == 0)
+            for (l = 0; l < TT__RELAX_LANES; l++) *held += m.lanes[l].held;
+        memset(m.active, 0, (size_t)nverts);
+        for (v = 0; v < nverts; v++) {
+            if (!m.changed[v]) continue;
+            changed++;
+            for (i = m.x.first_triangle[v]; i < m.x.first_triangle[v + 1]; i++)
+                for (k = 0; k < 3; k++) m.active[model->corner_vert[3 * (m.x.triangle_corners[i] / 3) + k]] = 1;
+        }
+        moves += changed;
+        if (!changed) break;
+    }
+done:
+    tt__relax_context_free(allocator, &m.x);
+    tt__free(allocator, colour);
+    tt__free(allocator, taken);
+    tt__free(allocator, m.order);
+    tt__free(allocator, m.colour_start);
+    tt__free(allocator, m.active);
+    tt__free(allocator, m.changed);
+    tt__free(allocator, m.lanes);
     return moves;
 }
 
@@ -24125,8 +24348,10 @@ static double tt__split_area(const tt__clip_point *p, int n)
        interpolating the triangle's vertices with its barycentric
        coordinates in the chart; on a side it must be a boundary point.
    Marks the boundary points used. -1 when the records and the chart
-   disagree, -2 when out of memory. */
-static int tt__split_identify(tt__split *S, const tt__clip_point *c, double area2, double at[2])
+   disagree, -2 when out of memory. With `known_only` it only looks: no
+   point is marked, and a grid point that would need a vertex of its own
+   gives -3 (none is made). */
+static int tt__split_identify(tt__split *S, const tt__clip_point *c, double area2, int known_only, double at[2])
 {
     int i, x, y, k, best = -1;
     double weight[3], best_distance = HUGE_VAL;
@@ -24156,6 +24381,7 @@ static int tt__split_identify(tt__split *S, const tt__clip_point *c, double area
         if (i == S->nboundary) {
             for (i = 0; i < S->ngrid; i++)
                 if (S->grid_points[3 * i] == x && S->grid_points[3 * i + 1] == y) return S->grid_points[3 * i + 2];
+            if (known_only) return -3;
             for (k = 0; k < 3; k++) {
                 const double *a = S->corner[(k + 1) % 3], *b = S->corner[(k + 2) % 3];
                 weight[k] = tt__orient2(a[0], a[1], b[0], b[1], at[0], at[1]) / area2;
@@ -24176,7 +24402,7 @@ static int tt__split_identify(tt__split *S, const tt__clip_point *c, double area
             return k;
         }
     }
-    S->boundary[i].used = 1;
+    if (!known_only) S->boundary[i].used = 1;
     at[0] = S->boundary[i].at[0];
     at[1] = S->boundary[i].at[1];
     return S->boundary[i].vertex;
@@ -24247,7 +24473,7 @@ static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const 
 static int tt__split_pieces(tt__split *S, int f, int *pieces)
 {
     double lo[2], hi[2], area2;
-    int k, x, y, ncells, i;
+    int k, x, y, ncells, i, pass;
     area2 = tt__orient2(S->corner[0][0], S->corner[0][1], S->corner[1][0], S->corner[1][1], S->corner[2][0],
                         S->corner[2][1]);
     /* A chart turning clockwise is a fold of the projection the relaxation could not open: its pieces would
@@ -24278,38 +24504,53 @@ static int tt__split_pieces(tt__split *S, int f, int *pieces)
     S->ngrid = 0;
     *pieces = 0;
     for (i = 0; i < S->nboundary; i++) S->boundary[i].used = 0;
-    for (y = 0; y < S->box[3]; y++) {
-        for (x = 0; x < S->box[2]; x++) {
-            const tt__split_cell *cell = &S->cells[x + S->box[2] * y];
-            tt__clip_point poly[8], tmp[8];
-            double X = S->box[0] + x, Y = S->box[1] + y, at[8][2];
-            int n = 3, m = 0, ids[8];
-            for (i = 0; i < 3; i++) {
-                tmp[i].p[0] = S->corner[i][0];
-                tmp[i].p[1] = S->corner[i][1];
-                tmp[i].kind = TT__CLIP_CORNER;
-                tmp[i].index = i;
+    /* Pass 0: the pieces with area. Pass 1: the ones without, kept only
+       when their corners are output vertices already and at least three
+       differ: such a sliver (edges passing a hair from a corner of S)
+       closes the surface between pieces that the neighbours share, and
+       dropped it would leave a hole there; the others are dropped (an
+       edge along a lattice line). */
+    for (pass = 0; pass < 2; pass++)
+        for (y = 0; y < S->box[3]; y++) {
+            for (x = 0; x < S->box[2]; x++) {
+                const tt__split_cell *cell = &S->cells[x + S->box[2] * y];
+                tt__clip_point poly[8], tmp[8];
+                double X = S->box[0] + x, Y = S->box[1] + y, at[8][2];
+                int n = 3, m = 0, ids[8];
+                for (i = 0; i < 3; i++) {
+                    tmp[i].p[0] = S->corner[i][0];
+                    tmp[i].p[1] = S->corner[i][1];
+                    tmp[i].kind = TT__CLIP_CORNER;
+                    tmp[i].index = i;
+                }
+                n = tt__split_clip(tmp, n, 0, X, 1.0, poly);
+                n = tt__split_clip(poly, n, 0, X + 1.0, -1.0, tmp);
+                n = tt__split_clip(tmp, n, 1, Y, 1.0, poly);
+                n = tt__split_clip(poly, n, 1, Y + 1.0, -1.0, tmp);
+                if (n < 3 || (fabs(tt__split_area(tmp, n)) <= TT__SPLIT_AREA) != pass) continue;
+                if (cell->quad < 0) {
+                    if (pass) continue;
+                    return 0;
+                }
+                if (pass) {
+                    /* Only pieces whose corners all exist. */
+                    for (i = 0; i < n && tt__split_identify(S, &tmp[i], area2, 1, at[0]) >= 0; i++) continue;
+                    if (i < n) continue;
+                }
+                for (i = 0; i < n; i++) {
+                    double place[2];
+                    int id = tt__split_identify(S, &tmp[i], area2, 0, place);
+                    if (id == -2) return -1;
+                    if (id < 0) return 0;
+                    if (m > 0 && ids[m - 1] == id) continue;
+                    at[m][0] = place[0];
+                    at[m][1] = place[1];
+                    ids[m++] = id;
+                }
+                if (m > 1 && ids[m - 1] == ids[0]) m--;
+                if (m >= 3 && !tt__split_fan(S, f, cell, ids, at, m, area2, pieces)) return -1;
             }
-            n = tt__split_clip(tmp, n, 0, X, 1.0, poly);
-            n = tt__split_clip(poly, n, 0, X + 1.0, -1.0, tmp);
-            n = tt__split_clip(tmp, n, 1, Y, 1.0, poly);
-            n = tt__split_clip(poly, n, 1, Y + 1.0, -1.0, tmp);
-            if (n < 3 || fabs(tt__split_area(tmp, n)) <= TT__SPLIT_AREA) continue;
-            if (cell->quad < 0) return 0;
-            for (i = 0; i < n; i++) {
-                double place[2];
-                int id = tt__split_identify(S, &tmp[i], area2, place);
-                if (id == -2) return -1;
-                if (id < 0) return 0;
-                if (m > 0 && ids[m - 1] == id) continue;
-                at[m][0] = place[0];
-                at[m][1] = place[1];
-                ids[m++] = id;
-            }
-            if (m > 1 && ids[m - 1] == ids[0]) m--;
-            if (m >= 3 && !tt__split_fan(S, f, cell, ids, at, m, area2, pieces)) return -1;
         }
-    }
     /* Every split point of the records must be a corner of some piece, or the neighbour across would meet
        this triangle at a vertex it does not have. */
     for (i = 0; i < S->nboundary; i++)
@@ -24841,6 +25082,12 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     }
     if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator)) < 0)
         goto out_of_memory;
+    if ((report->smoothed = tt__polycube_smooth(polycube, model, points, executor, allocator, &report->held)) < 0)
+        goto out_of_memory;
+    for (v = 0; v < model->nverts; v++) {
+        points[v].s = points[v].s < TT__MAP_SNAP ? 0.0f : (points[v].s > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].s);
+        points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
+    }
     if (tt__polycube_map_cancelled(options, 0.45f)) goto cancelled;
     if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, executor, allocator, NULL,
                                   NULL, &edges, error)) != TT_OK)

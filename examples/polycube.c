@@ -402,6 +402,7 @@ static void print_summary(const polycube_command_options *options, const polycub
     /* The library halves edges longer than half a cube first, so that no
        triangle holds several corners of the polycube. */
     if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
+    printf("; smoothing: %d moves, %d vertices left as projected", m->smoothed, m->held);
     printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);
     printf("tiles: %s%d (n=%d, %d texels, gutter %d), %dx%d atlas%s; %.4g texels per unit\n", job->atlas ? "2 x " : "",

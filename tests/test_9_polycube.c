@@ -2794,7 +2794,7 @@ static void test_untangle_energy(void)
         }
     }
     similarity = internal_untangle_energy(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.0,
-                                          gradient, &folded);
+                                          0.0, gradient, NULL, &folded);
     CHECK(fabs(similarity - 6.0) < 1e-12 && folded == 0 && fabs(gradient[0]) + fabs(gradient[1]) < 1e-9,
           "a star turned and scaled as a whole costs 1 per triangle (%.15g for 6), none folded (%d), and is "
           "a minimum (gradient %.2g, %.2g)", similarity, folded, gradient[0], gradient[1]);
@@ -2810,8 +2810,8 @@ static void test_untangle_energy(void)
             }
         x[0] = 0.5 * lcg_unit() - 0.25;
         x[1] = 0.5 * lcg_unit() - 0.25;
-        internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, delta2, gradient,
-                                 &folded);
+        internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, delta2, 0.0,
+                                 gradient, NULL, &folded);
         for (i = 0; i < n; i++)
             naive += (ring[i][0][0] - x[0]) * (ring[i][1][1] - x[1]) - (ring[i][0][1] - x[1]) * (ring[i][1][0] - x[0]) <= 0.0;
         bad_folds += naive != folded;
@@ -2822,10 +2822,10 @@ static void test_untangle_energy(void)
             p[1] = x[1];
             p[k] += step;
             plus = internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, p, delta2,
-                                            g, &folded);
+                                            0.0, g, NULL, &folded);
             p[k] -= 2.0 * step;
             minus = internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, p, delta2,
-                                             g, &folded);
+                                             0.0, g, NULL, &folded);
             scale = fabs(gradient[k]) > 1.0 ? fabs(gradient[k]) : 1.0;
             if (fabs((plus - minus) / (2.0 * step) - gradient[k]) / scale > worst)
                 worst = fabs((plus - minus) / (2.0 * step) - gradient[k]) / scale;
@@ -2835,6 +2835,235 @@ static void test_untangle_energy(void)
     CHECK(bad_gradient == 0 && bad_folds == 0,
           "untangling energy on 200 random stars: gradient as central differences (worst relative error %.2g), "
           "folds as orientation (%d stars differ)", worst, bad_folds);
+}
+
+/* The smoothing energy (tt__untangle_energy with a density): a star turned
+   as a whole and scaled to the density costs 2 per unit of its area and is
+   a minimum; on random stars its gradient and Hessian agree with central
+   differences; a folded star costs HUGE_VAL (the barrier). */
+static void test_smooth_energy(void)
+{
+    double ring[8][2][2], shape[8][2][2], x[2] = {0.0, 0.0}, gradient[2], hessian[3], area = 0.0;
+    double worst_gradient = 0.0, worst_hessian = 0.0, energy;
+    int round, i, k, folded, checked = 0, barriers = 0, folded_stars = 0;
+    lcg_seed(11);
+    for (i = 0; i < 6; i++) {
+        double a0 = 6.283185307179586 * i / 6, a1 = 6.283185307179586 * (i + 1) / 6, scale = 0.3, turn = 0.7;
+        shape[i][0][0] = cos(a0);
+        shape[i][0][1] = sin(a0);
+        shape[i][1][0] = cos(a1);
+        shape[i][1][1] = sin(a1);
+        area += 0.5 * sin(a1 - a0);
+        for (k = 0; k < 2; k++) {
+            const double *p = shape[i][k];
+            ring[i][k][0] = scale * (cos(turn) * p[0] - sin(turn) * p[1]);
+            ring[i][k][1] = scale * (sin(turn) * p[0] + cos(turn) * p[1]);
+        }
+    }
+    energy = internal_untangle_energy(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.0, 0.09,
+                                      gradient, hessian, &folded);
+    CHECK(fabs(energy - 2.0 * area) < 1e-12 && folded == 0 && fabs(gradient[0]) + fabs(gradient[1]) < 1e-9 &&
+              hessian[0] > 0.0 && hessian[0] * hessian[2] - hessian[1] * hessian[1] > 0.0,
+          "a star turned and scaled to the density costs 2 per unit area (%.15g for %.15g) and is a minimum "
+          "(gradient %.2g, %.2g; Hessian %.3g %.3g %.3g)", energy, area, gradient[0], gradient[1], hessian[0],
+          hessian[1], hessian[2]);
+    for (round = 0; round < 400; round++) {
+        const double density = 0.2 + 3.0 * lcg_unit(), step = 1e-6;
+        int n = 3 + lcg_below(6), naive = 0;
+        double angle[9];
+        /* A fan around the origin at jittered angles (unfolded at x near the
+           origin), every fourth with two of its points swapped (folded). */
+        for (i = 0; i <= n; i++) angle[i] = 6.283185307179586 * (i + 0.4 * lcg_unit()) / n;
+        for (i = 0; i < n; i++)
+            for (k = 0; k < 2; k++) {
+                const double a = k ? (i + 1 < n ? angle[i + 1] : angle[0]) : angle[i], r = 0.5 + lcg_unit();
+                ring[i][k][0] = r * cos(a);
+                ring[i][k][1] = r * sin(a);
+                shape[i][k][0] = k ? 0.2 + lcg_unit() : 0.5 + lcg_unit();
+                shape[i][k][1] = k ? 0.3 + lcg_unit() : 0.0;
+            }
+        if (round % 4 == 3) {
+            double swap[2][2];
+            memcpy(swap, ring[0], sizeof swap);
+            memcpy(ring[0][0], swap[1], sizeof swap[1]);
+            memcpy(ring[0][1], swap[0], sizeof swap[0]);
+        }
+        x[0] = 0.2 * lcg_unit() - 0.1;
+        x[1] = 0.2 * lcg_unit() - 0.1;
+        for (i = 0; i < n; i++)
+            naive += (ring[i][0][0] - x[0]) * (ring[i][1][1] - x[1]) - (ring[i][0][1] - x[1]) * (ring[i][1][0] - x[0]) <= 0.0;
+        energy = internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.0,
+                                          density, gradient, hessian, &folded);
+        if (naive) {
+            folded_stars++;
+            barriers += energy == HUGE_VAL;
+            continue;
+        }
+        checked++;
+        for (k = 0; k < 2; k++) {
+            double p[2], g_plus[2], g_minus[2], h[3], plus, minus, scale;
+            int j;
+            p[0] = x[0];
+            p[1] = x[1];
+            p[k] += step;
+            plus = internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, p, 0.0,
+                                            density, g_plus, h, &folded);
+            p[k] -= 2.0 * step;
+            minus = internal_untangle_energy(n, (const double (*)[2][2])ring, (const double (*)[2][2])shape, p, 0.0,
+                                             density, g_minus, h, &folded);
+            scale = fmax(1.0, fabs(gradient[k]));
+            worst_gradient = fmax(worst_gradient, fabs((plus - minus) / (2.0 * step) - gradient[k]) / scale);
+            /* Row k of the Hessian: (xx, xy) for k = 0, (xy, yy) for k = 1. */
+            for (j = 0; j < 2; j++) {
+                const double exact = hessian[k + j], numeric = (g_plus[j] - g_minus[j]) / (2.0 * step);
+                worst_hessian = fmax(worst_hessian, fabs(numeric - exact) / fmax(1.0, fabs(exact)));
+            }
+        }
+    }
+    CHECK(checked >= 100 && worst_gradient < 1e-4 && worst_hessian < 1e-4,
+          "smoothing energy on %d unfolded random stars: gradient (worst relative error %.2g) and Hessian (%.2g) "
+          "as central differences", checked, worst_gradient, worst_hessian);
+    CHECK(folded_stars >= 20 && barriers == folded_stars, "%d of %d folded stars cost HUGE_VAL", barriers,
+          folded_stars);
+}
+
+/* The area-weighted 95th percentile of the stretch (sigma1 / sigma2) of the
+   triangles whose three points lie in one quad, and how many of those
+   turn clockwise. */
+static double same_quad_stretch_p95(const tt_mesh *mesh, const tt_surface_point *pts, int *folded, int *counted)
+{
+    double *stretch = (double *)malloc(sizeof(double) * (size_t)mesh->nfaces + 1);
+    double *weight = (double *)malloc(sizeof(double) * (size_t)mesh->nfaces + 1), p95;
+    int f, n = 0;
+    *folded = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        const int *t = mesh->corner_vert + 3 * f;
+        const tt_surface_point *a = &pts[t[0]], *b = &pts[t[1]], *c = &pts[t[2]];
+        double e1[3], e2[3], len, along[3], normal[3], across[3], P[2][2], Q[2][2], J[2][2], det, fro, root;
+        int k;
+        if (a->quad != b->quad || a->quad != c->quad) continue;
+        for (k = 0; k < 3; k++) {
+            e1[k] = (double)mesh->pos[3 * t[1] + k] - mesh->pos[3 * t[0] + k];
+            e2[k] = (double)mesh->pos[3 * t[2] + k] - mesh->pos[3 * t[0] + k];
+        }
+        len = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+        normal[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        normal[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        normal[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        for (k = 0; k < 3; k++) along[k] = e1[k] / len;
+        across[0] = normal[1] * along[2] - normal[2] * along[1];
+        across[1] = normal[2] * along[0] - normal[0] * along[2];
+        across[2] = normal[0] * along[1] - normal[1] * along[0];
+        P[0][0] = len;  /* the triangle's own edges (columns) in its plane */
+        P[1][0] = 0.0;
+        P[0][1] = e2[0] * along[0] + e2[1] * along[1] + e2[2] * along[2];
+        P[1][1] = (e2[0] * across[0] + e2[1] * across[1] + e2[2] * across[2]) /
+                  sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+        Q[0][0] = b->s - a->s;
+        Q[1][0] = b->t - a->t;
+        Q[0][1] = c->s - a->s;
+        Q[1][1] = c->t - a->t;
+        det = P[0][0] * P[1][1] - P[0][1] * P[1][0];
+        /* J = Q P^-1 */
+        J[0][0] = (Q[0][0] * P[1][1] - Q[0][1] * P[1][0]) / det;
+        J[0][1] = (Q[0][1] * P[0][0] - Q[0][0] * P[0][1]) / det;
+        J[1][0] = (Q[1][0] * P[1][1] - Q[1][1] * P[1][0]) / det;
+        J[1][1] = (Q[1][1] * P[0][0] - Q[1][0] * P[0][1]) / det;
+        det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+        if (det <= 0.0) {
+            ++*folded;
+            continue;
+        }
+        fro = J[0][0] * J[0][0] + J[0][1] * J[0][1] + J[1][0] * J[1][0] + J[1][1] * J[1][1];
+        root = sqrt(fmax(0.0, fro * fro - 4.0 * det * det));
+        stretch[n] = sqrt((fro + root) / fmax(fro - root, 1e-300));
+        weight[n] = 0.5 * len * P[1][1];
+        n++;
+    }
+    *counted = n;
+    p95 = n ? internal_weighted_percentile(stretch, weight, n, 0.95) : 0.0;
+    free(stretch);
+    free(weight);
+    return p95;
+}
+
+typedef struct smooth_oom_ctx {
+    const tt_polycube *pc;
+    const tt_mesh *mesh;
+    const tt_surface_point *start;
+    tt_surface_point *pts;
+} smooth_oom_ctx;
+
+static tt_result smooth_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
+{
+    smooth_oom_ctx *c = (smooth_oom_ctx *)ctx;
+    int held;
+    (void)error;   /* a private helper: no tt_error */
+    memcpy(c->pts, c->start, sizeof *c->pts * (size_t)c->mesh->nverts);
+    return internal_polycube_smooth(c->pc, c->mesh, c->pts, NULL, al, &held) >= 0 ? TT_OK : TT_ERROR_OUT_OF_MEMORY;
+}
+
+/* A sphere on a polycube of resolution 4 is oblique to S almost
+   everywhere: the projection lays it on in strips. The smoothing lowers
+   the stretch's tail, folds nothing, holds few vertices (at the cones of
+   S, where a star's chart is cut), and gives the same
+   points whatever the executor; points thrown at random into their
+   quads (the control) score far worse. */
+static void test_polycube_smooth(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_surface_point *pts = NULL, *start, *other;
+    tt_polycube *pc = projected_sphere(96, 48, 4, &m, &mesh, &pts);
+    smooth_oom_ctx ctx;
+    const tt_executor *executors[2];
+    double before, after, shuffled;
+    int moves, held = -1, folded_before, folded_after, folded_shuffled, counted, e, v, same = 1;
+    if (!pc) { tm_free(&m); return; }
+    internal_polycube_relax(pc, mesh, pts);
+    start = (tt_surface_point *)malloc(sizeof *start * (size_t)mesh->nverts);
+    other = (tt_surface_point *)malloc(sizeof *other * (size_t)mesh->nverts);
+    memcpy(start, pts, sizeof *start * (size_t)mesh->nverts);
+    before = same_quad_stretch_p95(mesh, pts, &folded_before, &counted);
+    moves = internal_polycube_smooth(pc, mesh, pts, NULL, NULL, &held);
+    after = same_quad_stretch_p95(mesh, pts, &folded_after, &counted);
+    CHECK(moves > mesh->nverts && held <= mesh->nverts / 100 && folded_before == 0 && folded_after == 0 &&
+              after < 0.95 * before && counted > mesh->nfaces / 2,
+          "sphere at resolution 4: stretch p95 %.3f before smoothing, %.3f after (%d moves, %d held; folded %d, "
+          "then %d, of %d triangles in one quad)", before, after, moves, held, folded_before, folded_after, counted);
+    executors[0] = &g_reverse_executor;
+    executors[1] = &g_thread_executor;
+    for (e = 0; e < 2; e++) {
+        int other_held;
+        memcpy(other, start, sizeof *other * (size_t)mesh->nverts);
+        internal_polycube_smooth(pc, mesh, other, executors[e], NULL, &other_held);
+        for (v = 0; v < mesh->nverts; v++)
+            same &= other[v].quad == pts[v].quad && other[v].s == pts[v].s && other[v].t == pts[v].t;
+        same &= other_held == held;
+    }
+    CHECK(same, "the smoothing's points are the same with the reverse and the threaded executors");
+    lcg_seed(5);
+    for (v = 0; v < mesh->nverts; v++) {
+        other[v] = start[v];
+        other[v].s = (float)lcg_unit();
+        other[v].t = (float)lcg_unit();
+    }
+    shuffled = same_quad_stretch_p95(mesh, other, &folded_shuffled, &counted);
+    CHECK(shuffled > 3.0 * before && folded_shuffled > mesh->nfaces / 10,
+          "control: points thrown at random into their quads score stretch p95 %.3f with %d folded", shuffled,
+          folded_shuffled);
+    ctx.pc = pc;
+    ctx.mesh = mesh;
+    ctx.start = start;
+    ctx.pts = other;
+    oom_reset();
+    oom_sweep_internal("smoothing (sphere at resolution 4)", smooth_oom_call, &ctx, TT_OK);
+    free(start);
+    free(other);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    free(pts);
+    tm_free(&m);
 }
 
 /* A patch of points mirrored inside its quad is folded all through: no
@@ -3293,6 +3522,8 @@ void run_polycube_tests(void)
     RUN(test_relax_kernel);
     RUN(test_untangle_energy);
     RUN(test_relax_untangles);
+    RUN(test_smooth_energy);
+    RUN(test_polycube_smooth);
     RUN(test_reseat);
     RUN(test_seal);
     RUN(test_edges_determinism_and_errors);

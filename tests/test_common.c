@@ -404,7 +404,7 @@ int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double
     return tt__relax_kernel_centre(ring, ntriangles, centre);
 }
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
-                                double delta2, double gradient[2], int *folded)
+                                double delta2, double density, double gradient[2], double hessian[3], int *folded)
 {
     tt__untangle_star star;
     int i;
@@ -413,7 +413,12 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
         memcpy(star.ring[i], ring[i], sizeof star.ring[i]);
         if (!tt__untangle_star_shape(&star, i, shape[i])) return -1.0;
     }
-    return tt__untangle_energy(&star, x, delta2, gradient, NULL, folded);
+    return tt__untangle_energy(&star, x, delta2, density, gradient, hessian, folded);
+}
+int internal_polycube_smooth(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
+                             const tt_executor *executor, const tt_allocator *allocator, int *held)
+{
+    return tt__polycube_smooth(polycube, model, points, executor, allocator, held);
 }
 int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
 int internal_hpm_relax_classes(const tt_mesh *mesh, int *vmark, int *verts, int n, int *class_end)

@@ -214,8 +214,12 @@ int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, t
 int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
                              unsigned char *moved, const tt_allocator *allocator);
 int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2]);
+/* density > 0: the smoothing energy (delta2 unused); hessian (xx, xy, yy) may be NULL. */
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
-                                double delta2, double gradient[2], int *folded);
+                                double delta2, double density, double gradient[2], double hessian[3], int *folded);
+/* Smooths the points (tt__polycube_smooth); returns its moves, -1 when out of memory; *held as it says. */
+int internal_polycube_smooth(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
+                             const tt_executor *executor, const tt_allocator *allocator, int *held);
 int internal_polycube_mask_critical(int mask);
 /* Section 4's multigrid-preconditioned conjugate gradients: the hierarchy
    of A, two solves (b and x interleaved: b[2i + c]) from the x given, the
