@@ -23837,17 +23837,26 @@ typedef struct tt__split {
     int ngrid, grid_capacity;
 } tt__split;
 
-/* The data of an output vertex interpolating up to three input vertices. */
+/* The data of an output vertex interpolating up to three input vertices.
+   The point lies on their triangle, so each coordinate is kept within the
+   sources' own: weights that round past 1 (or a hair below 0) would
+   otherwise carry a coordinate near FLT_MAX past it, to infinity. */
 static void tt__split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
                                   float weight_out[3])
 {
-    double p[3] = {0.0, 0.0, 0.0};
+    double p[3] = {0.0, 0.0, 0.0}, lo[3], hi[3];
     int k, a;
+    for (a = 0; a < 3; a++) lo[a] = hi[a] = mesh->pos[3 * source[0] + a];
     for (k = 0; k < 3; k++) {
         weight_out[k] = (float)weight[k];
-        for (a = 0; a < 3; a++) p[a] += weight[k] * mesh->pos[3 * source[k] + a];
+        for (a = 0; a < 3; a++) {
+            const double x = mesh->pos[3 * source[k] + a];
+            p[a] += weight[k] * x;
+            lo[a] = x < lo[a] ? x : lo[a];
+            hi[a] = x > hi[a] ? x : hi[a];
+        }
     }
-    for (a = 0; a < 3; a++) position[a] = (float)p[a];
+    for (a = 0; a < 3; a++) position[a] = (float)(p[a] < lo[a] ? lo[a] : p[a] > hi[a] ? hi[a] : p[a]);
 }
 
 /* Vertex (position, source, weight) appended to mapping m, whose vertex

@@ -5,6 +5,7 @@
    own definitions and masks are recomputed from the occupancy array. */
 #include "test_common.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -3496,6 +3497,39 @@ static void test_map_refined_sliver(void)
     tm_free(&m);
 }
 
+/* A split vertex lies on its input triangle: interpolating corners at
+   FLT_MAX with weights that round past 1 stays FLT_MAX, not infinity
+   (found by fuzz_polycube: an output position of inf), and an ordinary
+   interpolation is exact. */
+static void test_split_vertex_data(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    const int source[3] = {0, 1, 2};
+    const double past_one[3] = {0.5000001, 0.5, 0.0}, inside[3] = {0.25, 0.25, 0.5};
+    float position[3], weight[3];
+    memset(&m, 0, sizeof m);
+    tm_vert(&m, FLT_MAX, FLT_MAX, 0.0);
+    tm_vert(&m, FLT_MAX, 0.0, FLT_MAX);
+    tm_vert(&m, 0.0, 1.0, 2.0);
+    tm_tri(&m, 0, 1, 2);
+    if (build(&m, 0, &mesh, &err) != TT_OK) {
+        CHECK(0, "the triangle at FLT_MAX builds: %s", err.message);
+        tm_free(&m);
+        return;
+    }
+    internal_split_vertex_data(mesh, source, past_one, position, weight);
+    CHECK(position[0] == FLT_MAX && isfinite(position[1]) && isfinite(position[2]),
+          "weights past 1 between corners at FLT_MAX: (%g, %g, %g)", position[0], position[1], position[2]);
+    internal_split_vertex_data(mesh, source, inside, position, weight);
+    CHECK(position[0] == (float)(0.5 * FLT_MAX) && position[1] == (float)(0.25 * FLT_MAX + 0.5) &&
+              position[2] == (float)(0.25 * FLT_MAX + 1.0) && weight[2] == 0.5f,
+          "an inside point interpolates: (%g, %g, %g)", position[0], position[1], position[2]);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
 void run_polycube_tests(void)
 {
     RUN(test_masks);
@@ -3538,6 +3572,7 @@ void run_polycube_tests(void)
     RUN(test_map_flat_square_coarse);
     RUN(test_map_pillow);
     RUN(test_map_refined_sliver);
+    RUN(test_split_vertex_data);
     RUN(test_map_random);
     RUN(test_map_executors);
 }

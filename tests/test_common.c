@@ -415,6 +415,11 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
     }
     return tt__untangle_energy(&star, x, delta2, density, gradient, hessian, folded);
 }
+void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
+                                float weight_out[3])
+{
+    tt__split_vertex_data(mesh, source, weight, position, weight_out);
+}
 int internal_polycube_smooth(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
                              const tt_executor *executor, const tt_allocator *allocator, int *held)
 {
