@@ -1246,6 +1246,9 @@ typedef struct tt_rect {
    texel of the tile is renormalised; the atlas and its mips are normal maps.
    tt_synthesize_tiles is plan_create + apply + plan_free in one call. */
 
+#define TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES 8
+#define TT_SYNTH_MAX_BACKGROUND_CANDIDATES 64
+
 typedef struct tt_synth_options {
     tt_tile_layout layout;
     uint64_t seed;
@@ -1270,6 +1273,13 @@ typedef struct tt_synth_options {
     /* Region from which each tile's S x S background window is drawn; all zero =
        the whole image. */
     tt_rect background;
+    /* Random windows of the region each tile's background is chosen from:
+       the one whose mean tone is nearest the region's. With a photo whose
+       tone changes slowly (rust, a forest floor), tiles of one random window
+       each differ in tone, and a flat face of many tiles reads as a grid.
+       0 = TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES; 1 = the paper's single
+       random window (most variety); at most TT_SYNTH_MAX_BACKGROUND_CANDIDATES. */
+    int background_candidates;
     int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16); negative is refused */
     /* Called by tt_synth_plan_create (which copies it into the plan) and by
        tt_synth_apply with that plan; tt_synthesize_tiles reports both as one
@@ -8427,7 +8437,12 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
                 1. edge windows: one S x 2S window per condition, chosen
                    from the seed as the least conspicuous of 128 candidates
                    (or given)                             -> tt__choose_edge_windows
-                2. per tile, its S x S background window XXXX from the seed
+                2. per tile, its S x S background window XXXX: of
+                   options.background_candidates drawn from the seed, the one
+                   whose mean tone is nearest the region's (beyond the
+                   paper: tiles of a photo with slow changes of tone would
+                   each show their own, and a flat face would read as a
+                   grid of tiles)                         -> tt__choose_background
                 3. per tile and side (D, C, B, A in that order), the band
                    depth per column: a minimum-error cut of the band against
                    what lies beneath (f4), kept inside the side's wedge
@@ -9030,6 +9045,47 @@ static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int siz
     }
 }
 
+/* The mean grey of a w x h window at (x, y), from every fourth texel of
+   every fourth row: enough to tell its tone, at 1/16 of the reads. */
+static double tt__window_tone(const tt_image *source, int x, int y, int w, int h)
+{
+    double sum = 0.0;
+    int r, i, count = 0;
+    for (r = y; r < y + h; r += 4)
+        for (i = x; i < x + w; i += 4) {
+            const float *p = source->pixels + ((size_t)r * source->width + i) * 4;
+            sum += ((double)p[0] + p[1] + p[2]) / 3.0;
+            count++;
+        }
+    return sum / count;
+}
+
+/* A tile's background window in `region`: of `candidates` random ones, the
+   one whose tone is nearest `tone` (the region's). Each tile draws the same
+   number of times, so every tile's candidates depend on the seed and its
+   index alone; one candidate is the paper's random window. */
+static tt_rect tt__choose_background(tt_rng *rng, const tt_image *source, const tt_rect *region, int size,
+                                     int candidates, double tone)
+{
+    tt_rect best;
+    double nearest = HUGE_VAL;
+    int k;
+    best.x = region->x;
+    best.y = region->y;
+    best.w = best.h = size;
+    for (k = 0; k < candidates; k++) {
+        const int x = region->x + (int)tt_rng_below(rng, (uint32_t)(region->w - size + 1));
+        const int y = region->y + (int)tt_rng_below(rng, (uint32_t)(region->h - size + 1));
+        const double off = candidates > 1 ? fabs(tt__window_tone(source, x, y, size, size) - tone) : 0.0;
+        if (off < nearest) {
+            nearest = off;
+            best.x = x;
+            best.y = y;
+        }
+    }
+    return best;
+}
+
 /* Progress of step `done` of `total` within [from, to] of the caller's
    0..1; non-zero when the callback asks to stop. */
 static int tt__synth_report(tt_progress_fn progress, void *user_data, float from, float to, int done, int total)
@@ -9217,6 +9273,10 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     max_depth = tt__max_i(1, S / 4);
     min_depth = tt__min_i(tt__max_i(2, g + feather / 2 + 1), max_depth);
 
+    if (opt->background_candidates < 0 || opt->background_candidates > TT_SYNTH_MAX_BACKGROUND_CANDIDATES)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "background_candidates %d: give 1 to %d (0 for the default, %d)", opt->background_candidates,
+                        TT_SYNTH_MAX_BACKGROUND_CANDIDATES, TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES);
     region = opt->background;
     if (region.x == 0 && region.y == 0 && region.w == 0 && region.h == 0) {
         region.w = guide->width;
@@ -9302,12 +9362,14 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     }
 
     /* The background windows, in tile order from the one stream. XXXX: a
-       fresh background window per tile gives the aperiodicity. */
-    for (t = 0; t < ntiles; t++) {
-        tt_rect *bg = &plan->background_windows[t];
-        bg->x = region.x + (int)tt_rng_below(&rng, (uint32_t)(region.w - S + 1));
-        bg->y = region.y + (int)tt_rng_below(&rng, (uint32_t)(region.h - S + 1));
-        bg->w = bg->h = S;
+       fresh background window per tile gives the aperiodicity; of a few, the
+       one nearest the region's tone keeps the tiles alike in tone. */
+    {
+        const int candidates =
+            opt->background_candidates > 0 ? opt->background_candidates : TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES;
+        const double tone = candidates > 1 ? tt__window_tone(guide, region.x, region.y, region.w, region.h) : 0.0;
+        for (t = 0; t < ntiles; t++)
+            plan->background_windows[t] = tt__choose_background(&rng, guide, &region, S, candidates, tone);
     }
     /* The tiles' cuts, in batches through the executor, the progress
        reported between them on this thread. */

@@ -349,6 +349,10 @@ static int measure_quality(const polycube_command_options *options, const polycu
     desc.indices = job->mapping->triangles;
     desc.nfaces = job->mapping->ntriangles;
     desc.fixed_face_size = 3;
+    /* Permissive: a triangle of no area (a sliver the split kept to close
+       the surface) must not switch the whole report off; the measures
+       count it as degenerate. */
+    desc.flags = TT_MESH_PERMISSIVE;
     if (tt_mesh_build(&desc, NULL, &mapped, &error) != TT_OK) {
         /* A report, not the job: the files are still right. */
         snprintf(quality->mesh_reason, sizeof quality->mesh_reason, "the mapped triangles: %s", error.message);

@@ -1388,6 +1388,20 @@ check "polycube torus: says it split the quads into triangles" "'1024 triangles 
 polycube_case "sphere --cube-size" spheretri.obj 1 --cube-size 0.5
 check "polycube --cube-size 0.5: cubes of 0.5 units" "'cubes of 0.5 units'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'cubes of 0.5 units'; echo $?)"
+# Two vertices 4e-9 apart: their refined triangles include ones of no area,
+# and the mapped triangles with them; the quality report is still computed
+# (it was switched off: "not measured").
+newdir
+printf '%s\n' 'v -0.0617647059 -0.247058824 -0.24509804' 'v 0.0622548983 -0.250980407 -0.250980407' \
+    'v 0.205392152 -0.250980407 -0.14705883' 'v 0.062254902 0.249019593 -0.250980407' \
+    'v 0.0622548983 0.249019593 -0.250980407' 'v 0.187254906 0.249019593 -0.250980407' \
+    'v -0.0627451017 0.749019623 -0.250980407' 'v 0.0622548983 0.749019623 -0.250980407' \
+    'v 0.187254906 0.749019623 -0.250980407' 'f 1 2 5' 'f 1 5 4' 'f 2 3 6' 'f 2 6 5' 'f 4 5 8' 'f 4 8 7' \
+    'f 5 6 9' 'f 5 9 8' >sliver_strip.obj
+expect_ok "polycube on a strip with a sliver" polycube sliver_strip.obj ../in/tex.png out --tile 16 --cube-size 1
+check "polycube sliver strip: the stretch and seams are measured" "'stretch: p5 ...' and 'seam score: ...', no 'not measured'" \
+    "$OUT" "$(printf '%s' "$OUT" | grep -q '^stretch: p5 ' && printf '%s' "$OUT" | grep -q '^seam score: ' &&
+        ! printf '%s' "$OUT" | grep -q 'not measured'; echo $?)"
 newdir
 expect_ok "polycube torus at resolution 2" polycube ../in/torus.obj ../in/tex.png out --tile 16 --colors 1 --resolution 2
 check "polycube torus at resolution 2: warns that the genus differs" \

@@ -162,7 +162,8 @@ static void sy_tile_types(const tt_tile_layout *layout, int t, uint8_t types[4],
    of branch `api` (commit e9e89f0, before synthesis became a plan and its
    application), with gcc -O0/-O2, clang -O2 and tcc: level 0 alone, then
    every level. Configurations: n, S, g, feather, seed, given edge windows,
-   background region, source size. */
+   background region, source size. That algorithm drew one random
+   background window per tile: background_candidates = 1. */
 typedef struct sy_reference {
     int colors, size, gutter, feather;
     unsigned seed;
@@ -182,6 +183,7 @@ static void sy_reference_options(const sy_reference *ref, tt_rect windows[2], tt
 {
     *o = sy_options(ref->colors, ref->size, ref->gutter, ref->seed);
     o->feather = ref->feather;
+    o->background_candidates = 1;
     memset(windows, 0, 2 * sizeof *windows);
     windows[0].x = 5;
     windows[0].y = 9;
@@ -194,6 +196,81 @@ static void sy_reference_options(const sy_reference *ref, tt_rect windows[2], tt
         o->background.w = 50;
         o->background.h = 40;
     }
+}
+
+/* The mean grey of window r of `image`, every texel. */
+static double sy_window_tone(const tt_image *image, const tt_rect *r)
+{
+    double sum = 0.0;
+    int x, y;
+    for (y = r->y; y < r->y + r->h; y++)
+        for (x = r->x; x < r->x + r->w; x++) {
+            const float *p = image->pixels + ((size_t)y * image->width + x) * 4;
+            sum += ((double)p[0] + p[1] + p[2]) / 3.0;
+        }
+    return sum / ((double)r->w * r->h);
+}
+
+/* The spread (standard deviation) of the tiles' background tones. */
+static double sy_background_spread(const tt_image *image, const tt_rect *windows, int n)
+{
+    double sum = 0.0, sum2 = 0.0;
+    int t;
+    for (t = 0; t < n; t++) {
+        const double tone = sy_window_tone(image, &windows[t]);
+        sum += tone;
+        sum2 += tone * tone;
+    }
+    return sqrt(fmax(0.0, sum2 / n - (sum / n) * (sum / n)));
+}
+
+/* On a photo whose tone drifts slowly (a dark-to-bright ramp under the
+   noise), the backgrounds chosen nearest the image's tone spread far less
+   in tone than the paper's single random window per tile (the control,
+   background_candidates = 1, must spread widely), and stay within the
+   region; a count past the limit is refused. */
+static void test_background_tone(void)
+{
+    tt_image *src = sy_noise(160, 160, 77u);
+    tt_synth_options o = sy_options(2, 16, 2, 9u);
+    tt_synth_plan *matched = NULL, *random = NULL, *bad = NULL;
+    tt_error err;
+    int x, y, k, t, ntiles, inside = 1;
+    double spread_matched, spread_random;
+    for (y = 0; y < 160; y++)
+        for (x = 0; x < 160; x++)
+            for (k = 0; k < 3; k++) src->pixels[((size_t)y * 160 + x) * 4 + k] += 1.5f * (float)x / 159.0f;
+    o.background.x = 8;
+    o.background.y = 4;
+    o.background.w = 150;
+    o.background.h = 150;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &matched, &err) == TT_OK, "default plan: %s", err.message);
+    o.background_candidates = 1;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &random, &err) == TT_OK, "one-candidate plan: %s", err.message);
+    if (matched && random) {
+        ntiles = tt_tile_layout_tile_count(&matched->layout);
+        spread_matched = sy_background_spread(src, matched->background_windows, ntiles);
+        spread_random = sy_background_spread(src, random->background_windows, ntiles);
+        for (t = 0; t < ntiles; t++) {
+            const tt_rect *r = &matched->background_windows[t];
+            inside &= r->x >= 8 && r->y >= 4 && r->x + r->w <= 158 && r->y + r->h <= 154 && r->w == 16 && r->h == 16;
+        }
+        printf("     background tone spread: %.4f nearest the image's tone, %.4f one random window each\n",
+               spread_matched, spread_random);
+        CHECK(spread_random > 0.3 && spread_matched < 0.3 * spread_random && inside,
+              "background tones over %d tiles spread %.4f nearest the image's tone, %.4f one random window each "
+              "(the control); inside the region: %d", ntiles, spread_matched, spread_random, inside);
+    }
+    o.background_candidates = TT_SYNTH_MAX_BACKGROUND_CANDIDATES + 1;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad &&
+              strstr(err.message, "background_candidates"),
+          "too many background candidates refused: %s", err.message);
+    o.background_candidates = -1;
+    CHECK(tt_synth_plan_create(src, &o, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
+          "negative background candidates refused: %s", err.message);
+    tt_synth_plan_free(matched);
+    tt_synth_plan_free(random);
+    tt_image_free(src);
 }
 
 static void test_synthesize_matches_old_algorithm(void)
@@ -1316,6 +1393,7 @@ static void test_allocation_failures(void)
 void run_tiled_synthesis_tests(void)
 {
     RUN(test_synthesize_matches_old_algorithm);
+    RUN(test_background_tone);
     RUN(test_plan_fields);
     RUN(test_plan_wide_depths);
     RUN(test_compose_tile_matches_apply);

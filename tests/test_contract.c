@@ -1010,6 +1010,12 @@ static void cases_tiled(const baseline *b)
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
     sb = so; sb.feather = INT_MAX;
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
+    sb = so; sb.background_candidates = -1;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
+    sb = so; sb.background_candidates = INT_MAX;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
+    sb = so; sb.background_candidates = INT_MIN;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
     sb = so; sb.background.x = 30; sb.background.y = 0; sb.background.w = 16; sb.background.h = 16;
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
     sb = so; sb.background.x = -4; sb.background.y = 0; sb.background.w = 16; sb.background.h = 16;
