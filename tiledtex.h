@@ -3213,10 +3213,10 @@ typedef struct tt_polycube_mapping {
    parts about a cube thick cost more time and leave more fallbacks (an
    elephant's trunk and legs: 2.3 %, 1.2 s). At the default 16 the horse
    takes 1.1 s (0.9 % fallbacks), cut 1-to-4 (388k triangles) 4.8 s and
-   1-to-16 (1.55M) 14 s. No flipped triangle on the first two; on the
-   1.55M one three slivers of 1e-10 of a quad's area, at a quad's corner,
-   turn over. The smoothing adds 0.3 s on the horse (8 sweeps of about
-   45k vertex steps). With an executor
+   1-to-16 (1.55M) 14 s, the smoothing included (0.3 s of the horse's:
+   8 sweeps of about 45k vertex steps). No flipped triangle on the three;
+   with their UVs rounded to floats, 3 slivers of the 388k one and 6 of
+   the 1.55M one turn over. With an executor
    (options->executor) the projection, the relaxation's independent
    groups of vertices, the smoothing's colours, the tracing and the split
    run as tasks; the mapping is the same, bit for bit.
