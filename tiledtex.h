@@ -683,7 +683,7 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
    (diagonal) preconditioned conjugate gradient method, with the formulas of
    Shewchuk, "An Introduction to the Conjugate Gradient Method Without the
    Agonizing Pain" (edition 1 1/4, 1994), Sec. 12 and the preconditioned
-   algorithm of its Appendix B3 (M = diag(A)):
+   algorithm in the third part of its appendix B (M = diag(A)):
 
        r0 = b - A x0,   z0 = M^-1 r0,   p0 = z0
        alpha_k = (r_k . z_k) / (p_k . A p_k)
@@ -6725,10 +6725,11 @@ done:
      - aggregates: an unknown whose strong neighbours are all free starts one
        with them; the unknowns left join the aggregate of their strongest
        neighbour in one, and what remains starts aggregates of its own;
-     - the prolongation P: 1 from each unknown to its aggregate (constants
-       stay exact, as the Laplacian's near null space asks), smoothed by one
-       damped Jacobi step, P = (I - omega D^-1 A) P0, omega = 4 / (3 rho)
-       with rho the spectral radius of D^-1 A (estimated);
+     - the prolongation P: the tentative one, T, is 1 from each unknown to
+       its aggregate (constants stay exact, as the Laplacian's near null
+       space asks), smoothed by one damped Jacobi step,
+       P = (I - omega diag(A)^-1 A) T, omega = 4 / (3 rho) with rho the
+       spectral radius of diag(A)^-1 A (estimated);
      - the smaller matrix is P^T A P (Galerkin), again symmetric positive
        definite, and so on until at most TT__AMG_COARSEST unknowns remain,
        factored densely (Cholesky).
@@ -6974,7 +6975,7 @@ static tt_result tt__amg_setup(tt__amg *G, const tt_sparse_matrix *A, const tt_a
                 r = TT_ERROR_OUT_OF_MEMORY;
         }
         if (r == TT_OK) {
-            /* P = (I - omega D^-1 A) P0, each row merged per aggregate. */
+            /* P = (I - omega diag(A)^-1 A) T, each row merged per aggregate. */
             for (i = 0; i < n; i++) {
                 double s = 0.0;
                 for (k = V->row_start[i]; k < V->row_start[i + 1]; k++) s += fabs(V->value[k]);
