@@ -23485,6 +23485,21 @@ done:
     return moves;
 }
 
+#define TT__MAP_SNAP 1e-5f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
+
+/* Points within TT__MAP_SNAP of a quad's edge put on it: the points are
+   float, and a model vertex on a lattice line (a CAD part's edge, a face in
+   a lattice plane) must be on S's edge exactly, or the edges through that
+   corner of S split next to it into slivers. */
+static void tt__polycube_snap_points(tt_surface_point *points, int n)
+{
+    int v;
+    for (v = 0; v < n; v++) {
+        points[v].s = points[v].s < TT__MAP_SNAP ? 0.0f : (points[v].s > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].s);
+        points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
+    }
+}
+
 /* ---- Smoothing of the points on S ---- */
 
 #define TT__SMOOTH_SWEEPS 8         /* smoothing sweeps over the vertices at most */
@@ -23607,16 +23622,8 @@ static int tt__polycube_smooth(const tt_polycube *pc, const tt_mesh *model, tt_s
         if (colour[v] >= 0) m.order[taken[colour[v]]++] = v;
     /* The density the map would have everywhere if it kept area: S's
        quads (each a unit square) over the model's area in cube units. */
-    for (i = 0; i < model->nfaces; i++) {
-        const int *t = model->corner_vert + 3 * i;
-        double e1[3], e2[3], n[3];
-        for (k = 0; k < 3; k++) {
-            e1[k] = ((double)model->pos[3 * t[1] + k] - model->pos[3 * t[0] + k]) / pc->h;
-            e2[k] = ((double)model->pos[3 * t[2] + k] - model->pos[3 * t[0] + k]) / pc->h;
-        }
-        tt__cross3(e1, e2, n);
-        model_area += 0.5 * tt__length3(n);
-    }
+    for (i = 0; i < model->nfaces; i++) model_area += tt__face_area_d(model, i);
+    model_area /= pc->h * pc->h;
     if (!(model_area > 0.0) || !(model_area < HUGE_VAL)) goto done;
     m.density = pc->surface->nfaces / model_area;
     memset(m.active, 1, (size_t)nverts);
@@ -23835,7 +23842,6 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
 #define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
                                        above the records' snap (1e-6), far below any real piece */
 #define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
-#define TT__MAP_SNAP 1e-5f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
 #define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
 
 /* A point on a triangle's boundary (a model vertex or a split point of an
@@ -24538,6 +24544,25 @@ static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const 
     return 1;
 }
 
+/* The triangle's chart clipped to grid cell (x, y) of its box, into
+   out[]; returns its number of points (below 3: nothing in the cell). */
+static int tt__split_clip_cell(const tt__split *S, int x, int y, tt__clip_point out[8])
+{
+    tt__clip_point poly[8];
+    const double X = S->box[0] + x, Y = S->box[1] + y;
+    int i, n = 3;
+    for (i = 0; i < 3; i++) {
+        out[i].p[0] = S->corner[i][0];
+        out[i].p[1] = S->corner[i][1];
+        out[i].kind = TT__CLIP_CORNER;
+        out[i].index = i;
+    }
+    n = tt__split_clip(out, n, 0, X, 1.0, poly);
+    n = tt__split_clip(poly, n, 0, X + 1.0, -1.0, out);
+    n = tt__split_clip(out, n, 1, Y, 1.0, poly);
+    return tt__split_clip(poly, n, 1, Y + 1.0, -1.0, out);
+}
+
 /* Triangle f cut by the chart's grid into pieces, one per quad, each
    fanned into output triangles. 1 when done, 0 when the chart
    does not allow it (the caller rolls back and takes the fallback), -1
@@ -24545,7 +24570,7 @@ static int tt__split_fan(tt__split *S, int f, const tt__split_cell *cell, const 
 static int tt__split_pieces(tt__split *S, int f, int *pieces)
 {
     double lo[2], hi[2], area2;
-    int k, x, y, ncells, i, pass;
+    int k, ncells, i, pass, nempty;
     area2 = tt__orient2(S->corner[0][0], S->corner[0][1], S->corner[1][0], S->corner[1][1], S->corner[2][0],
                         S->corner[2][1]);
     /* A chart turning clockwise is a fold of the projection the relaxation could not open: its pieces would
@@ -24576,53 +24601,50 @@ static int tt__split_pieces(tt__split *S, int f, int *pieces)
     S->ngrid = 0;
     *pieces = 0;
     for (i = 0; i < S->nboundary; i++) S->boundary[i].used = 0;
-    /* Pass 0: the pieces with area. Pass 1: the ones without, kept only
-       when their corners are output vertices already and at least three
-       differ: such a sliver (edges passing a hair from a corner of S)
-       closes the surface between pieces that the neighbours share, and
-       dropped it would leave a hole there; the others are dropped (an
-       edge along a lattice line). */
-    for (pass = 0; pass < 2; pass++)
-        for (y = 0; y < S->box[3]; y++) {
-            for (x = 0; x < S->box[2]; x++) {
-                const tt__split_cell *cell = &S->cells[x + S->box[2] * y];
-                tt__clip_point poly[8], tmp[8];
-                double X = S->box[0] + x, Y = S->box[1] + y, at[8][2];
-                int n = 3, m = 0, ids[8];
-                for (i = 0; i < 3; i++) {
-                    tmp[i].p[0] = S->corner[i][0];
-                    tmp[i].p[1] = S->corner[i][1];
-                    tmp[i].kind = TT__CLIP_CORNER;
-                    tmp[i].index = i;
-                }
-                n = tt__split_clip(tmp, n, 0, X, 1.0, poly);
-                n = tt__split_clip(poly, n, 0, X + 1.0, -1.0, tmp);
-                n = tt__split_clip(tmp, n, 1, Y, 1.0, poly);
-                n = tt__split_clip(poly, n, 1, Y + 1.0, -1.0, tmp);
-                if (n < 3 || (fabs(tt__split_area(tmp, n)) <= TT__SPLIT_AREA) != pass) continue;
-                if (cell->quad < 0) {
-                    if (pass) continue;
-                    return 0;
-                }
-                if (pass) {
-                    /* Only pieces whose corners all exist. */
-                    for (i = 0; i < n && tt__split_identify(S, &tmp[i], area2, 1, at[0]) >= 0; i++) continue;
-                    if (i < n) continue;
-                }
-                for (i = 0; i < n; i++) {
-                    double place[2];
-                    int id = tt__split_identify(S, &tmp[i], area2, 0, place);
-                    if (id == -2) return -1;
-                    if (id < 0) return 0;
-                    if (m > 0 && ids[m - 1] == id) continue;
-                    at[m][0] = place[0];
-                    at[m][1] = place[1];
-                    ids[m++] = id;
-                }
-                if (m > 1 && ids[m - 1] == ids[0]) m--;
-                if (m >= 3 && !tt__split_fan(S, f, cell, ids, at, m, area2, pieces)) return -1;
+    /* The pieces with area first. The ones without are kept only when
+       their corners are output vertices already and at least three differ:
+       such a sliver (edges passing a hair from a corner of S) closes the
+       surface between pieces that the neighbours share, and dropped it
+       would leave a hole there; the others are dropped (an edge along a
+       lattice line). Their cells wait in S->queue (free once the cells are
+       found) for the second round. */
+    nempty = 0;
+    for (pass = 0; pass < 2; pass++) {
+        const int count = pass ? nempty : ncells;
+        for (k = 0; k < count; k++) {
+            const int index = pass ? S->queue[k] : k;
+            const tt__split_cell *cell = &S->cells[index];
+            tt__clip_point tmp[8];
+            double at[8][2];
+            int n = tt__split_clip_cell(S, index % S->box[2], index / S->box[2], tmp), m = 0, ids[8];
+            if (n < 3) continue;
+            if (!pass && fabs(tt__split_area(tmp, n)) <= TT__SPLIT_AREA) {
+                S->queue[nempty++] = index;
+                continue;
             }
+            if (cell->quad < 0) {
+                if (pass) continue;
+                return 0;
+            }
+            if (pass) {
+                /* Only pieces whose corners all exist. */
+                for (i = 0; i < n && tt__split_identify(S, &tmp[i], area2, 1, at[0]) >= 0; i++) continue;
+                if (i < n) continue;
+            }
+            for (i = 0; i < n; i++) {
+                double place[2];
+                int id = tt__split_identify(S, &tmp[i], area2, 0, place);
+                if (id == -2) return -1;
+                if (id < 0) return 0;
+                if (m > 0 && ids[m - 1] == id) continue;
+                at[m][0] = place[0];
+                at[m][1] = place[1];
+                ids[m++] = id;
+            }
+            if (m > 1 && ids[m - 1] == ids[0]) m--;
+            if (m >= 3 && !tt__split_fan(S, f, cell, ids, at, m, area2, pieces)) return -1;
         }
+    }
     /* Every split point of the records must be a corner of some piece, or the neighbour across would meet
        this triangle at a vertex it does not have. */
     for (i = 0; i < S->nboundary; i++)
@@ -25145,21 +25167,12 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         TT_OK)
         goto failed;
     if (tt__polycube_map_cancelled(options, 0.2f)) goto cancelled;
-    /* A point within TT__MAP_SNAP of a quad's edge is on it: the points are float (and the projection adds
-       its rounding), and a model vertex on a lattice line (a CAD part's edge, a face in a lattice plane) must
-       be on S's edge exactly, or the edges through that corner of S split next to it into slivers. */
-    for (v = 0; v < model->nverts; v++) {
-        points[v].s = points[v].s < TT__MAP_SNAP ? 0.0f : (points[v].s > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].s);
-        points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
-    }
+    tt__polycube_snap_points(points, model->nverts);
     if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator)) < 0)
         goto out_of_memory;
     if ((report->smoothed = tt__polycube_smooth(polycube, model, points, executor, allocator, &report->held)) < 0)
         goto out_of_memory;
-    for (v = 0; v < model->nverts; v++) {
-        points[v].s = points[v].s < TT__MAP_SNAP ? 0.0f : (points[v].s > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].s);
-        points[v].t = points[v].t < TT__MAP_SNAP ? 0.0f : (points[v].t > 1.0f - TT__MAP_SNAP ? 1.0f : points[v].t);
-    }
+    tt__polycube_snap_points(points, model->nverts);   /* again: the smoothing moves points near edges too */
     if (tt__polycube_map_cancelled(options, 0.45f)) goto cancelled;
     if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, executor, allocator, NULL,
                                   NULL, &edges, error)) != TT_OK)
