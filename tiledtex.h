@@ -22991,17 +22991,72 @@ static int tt__relax_lane_move(tt__relax_state *R, tt__relax_lane *lane, int v, 
     return 1;
 }
 
+/* The descent of one star's centre from x, within `reach` of it (the
+   star's width): tt__untangle_energy minimised by Newton's method where
+   the energy curves up both ways, else down the gradient, each step
+   halved until the energy falls, until the steps fall below the points'
+   float resolution or TT__UNTANGLE_STEPS are made. The place reached goes
+   to kept; when `strict`, the last place that folds no more of the star's
+   triangles than x does. A gradient or step that overflows (a triangle
+   within rounding of flat) ends the descent where it is. */
+static void tt__untangle_descend(const tt__untangle_star *star, const double x0[2], double reach, double delta2,
+                                 double density, int strict, double kept[2])
+{
+    double x[2], gradient[2], hessian[3], energy;
+    int step, folded_before;
+    energy = tt__untangle_energy(star, x0, delta2, density, gradient, hessian, &folded_before);
+    x[0] = kept[0] = x0[0];
+    x[1] = kept[1] = x0[1];
+    for (step = 0; step < TT__UNTANGLE_STEPS; step++) {
+        const double norm = sqrt(gradient[0] * gradient[0] + gradient[1] * gradient[1]);
+        const double det = hessian[0] * hessian[2] - hessian[1] * hessian[1];
+        double direction[2], length, trial[2], trial_gradient[2], trial_hessian[3], trial_energy = energy, t = 1.0;
+        int halvings, folded = folded_before, improved = 0;
+        if (!(norm > 0.0 && norm < HUGE_VAL)) break;
+        if (hessian[0] > 0.0 && det > 0.0) {
+            direction[0] = -(hessian[2] * gradient[0] - hessian[1] * gradient[1]) / det;
+            direction[1] = -(hessian[0] * gradient[1] - hessian[1] * gradient[0]) / det;
+        } else {
+            direction[0] = -reach * gradient[0] / norm;
+            direction[1] = -reach * gradient[1] / norm;
+        }
+        length = sqrt(direction[0] * direction[0] + direction[1] * direction[1]);
+        if (!(length < HUGE_VAL)) break;
+        if (length > reach) t = reach / length;
+        /* Steps below the points' float resolution move nothing: at a
+           minimum the Newton step is that short, and halving it further
+           only spends evaluations. */
+        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS && t * length >= TT__UNTANGLE_CONVERGED;
+             halvings++, t *= 0.5) {
+            trial[0] = x[0] + t * direction[0];
+            trial[1] = x[1] + t * direction[1];
+            trial_energy = tt__untangle_energy(star, trial, delta2, density, trial_gradient, trial_hessian, &folded);
+            if (trial_energy < energy) {
+                improved = 1;
+                break;
+            }
+        }
+        if (!improved) break;
+        x[0] = trial[0];
+        x[1] = trial[1];
+        energy = trial_energy;
+        memcpy(gradient, trial_gradient, sizeof trial_gradient);
+        memcpy(hessian, trial_hessian, sizeof trial_hessian);
+        if (!strict || folded <= folded_before) {
+            kept[0] = x[0];
+            kept[1] = x[1];
+        }
+    }
+}
+
 /* One untangling step of vertex v: its star in a chart around its point,
-   and tt__untangle_energy minimised over v's place by Newton's method
-   (where the energy curves up both ways; else down the gradient), each
-   step halved until the energy falls, until the steps fall below the
-   points' float resolution or TT__UNTANGLE_STEPS are made: the star's
-   own optimum, so that a vertex whose star has not changed has nowhere to
-   go (the sweeps then pass it over). When `strict`, v goes to the last of
-   its steps that folds no more of its triangles than before. With
-   `density` > 0 the step smooths instead (the smoothing energy of
-   tt__untangle_energy): a vertex with a folded triangle stays, and the
-   barrier keeps the others unfolded. Returns 1 when v moves, to *moved;
+   and v's place descended to the star's own optimum
+   (tt__untangle_descend), so that a vertex whose star has not changed
+   has nowhere to go (the sweeps then pass it over). When `strict`, v goes
+   to the last of its steps that folds no more of its triangles than
+   before. With `density` > 0 the step smooths instead (the smoothing
+   energy of tt__untangle_energy): a vertex with a folded triangle stays,
+   and the barrier keeps the others unfolded. Returns 1 when v moves, to *moved;
    0 when it stays; -1 when its star cannot be stepped (more than
    TT__UNTANGLE_STAR triangles, a neighbour beyond the chart, a triangle
    of no area, or, smoothing, a folded triangle). */
@@ -23011,8 +23066,8 @@ static int tt__star_step(const tt_polycube *pc, const tt_mesh *model, const tt_s
 {
     const int *first_triangle = context->first_triangle, *triangle_corners = context->triangle_corners;
     const double h = pc->h;
-    double x[2], kept[2], gradient[2], hessian[3], energy, least_det = HUGE_VAL, delta2, reach = 0.0;
-    int i, step, folded_before, folded;
+    double x[2], kept[2], least_det = HUGE_VAL, delta2, reach = 0.0;
+    int i;
     if (first_triangle[v + 1] - first_triangle[v] > TT__UNTANGLE_STAR) return -1;
     tt__relax_chart_at(chart, points[v].quad, TT__RELAX_RADIUS);
     tt__relax_chart_place(chart, points[v], x);
@@ -23052,47 +23107,7 @@ static int tt__star_step(const tt_polycube *pc, const tt_mesh *model, const tt_s
     /* Escobar et al.'s delta: 0 once nothing is near folding, else growing with the worst fold. */
     delta2 = least_det < TT__UNTANGLE_EPSILON ? TT__UNTANGLE_EPSILON * (TT__UNTANGLE_EPSILON - least_det) : 0.0;
     if (density > 0.0 && !(least_det > 0.0)) return -1;
-    energy = tt__untangle_energy(star, x, delta2, density, gradient, hessian, &folded_before);
-    kept[0] = x[0];
-    kept[1] = x[1];
-    for (step = 0; step < TT__UNTANGLE_STEPS; step++) {
-        const double norm = sqrt(gradient[0] * gradient[0] + gradient[1] * gradient[1]);
-        const double det = hessian[0] * hessian[2] - hessian[1] * hessian[1];
-        double direction[2], length, trial[2], trial_gradient[2], trial_hessian[3], trial_energy = energy, t = 1.0;
-        int halvings;
-        if (!(norm > 0.0)) break;
-        /* Newton's step where the energy curves up both ways, else down the gradient; never farther than
-           the star is wide. */
-        if (hessian[0] > 0.0 && det > 0.0) {
-            direction[0] = -(hessian[2] * gradient[0] - hessian[1] * gradient[1]) / det;
-            direction[1] = -(hessian[0] * gradient[1] - hessian[1] * gradient[0]) / det;
-        } else {
-            direction[0] = -reach * gradient[0] / norm;
-            direction[1] = -reach * gradient[1] / norm;
-        }
-        length = sqrt(direction[0] * direction[0] + direction[1] * direction[1]);
-        if (length > reach) t = reach / length;
-        /* Steps below the points' float resolution move nothing: at a
-           minimum the Newton step is that short, and halving it further
-           only spends evaluations. */
-        for (halvings = 0; halvings < TT__UNTANGLE_HALVINGS && t * length >= TT__UNTANGLE_CONVERGED;
-             halvings++, t *= 0.5) {
-            trial[0] = x[0] + t * direction[0];
-            trial[1] = x[1] + t * direction[1];
-            trial_energy = tt__untangle_energy(star, trial, delta2, density, trial_gradient, trial_hessian, &folded);
-            if (trial_energy < energy) break;
-        }
-        if (halvings == TT__UNTANGLE_HALVINGS || t * length < TT__UNTANGLE_CONVERGED) break;
-        x[0] = trial[0];
-        x[1] = trial[1];
-        energy = trial_energy;
-        memcpy(gradient, trial_gradient, sizeof trial_gradient);
-        memcpy(hessian, trial_hessian, sizeof trial_hessian);
-        if (!strict || folded <= folded_before) {
-            kept[0] = x[0];
-            kept[1] = x[1];
-        }
-    }
+    tt__untangle_descend(star, x, reach, delta2, density, strict, kept);
     if (!tt__relax_chart_point(chart, kept, moved)) return 0;
     return !tt__same_point(*moved, points[v]);
 }

@@ -2928,6 +2928,65 @@ static void test_smooth_energy(void)
           folded_stars);
 }
 
+/* The descent of a star's centre: to the centre of a regular star from
+   off it, lower in energy each time (untangling and smoothing), and
+   nowhere, with every number finite, when one triangle is within rounding
+   of flat: its gradient overflows (1 / det^2 with det near 1e-170), and
+   the step it would give is no number at all. Before, such a star sent
+   the vertex to a place never computed (found by fuzzing: the same input
+   mapped twice came out two ways). */
+static void test_untangle_descend(void)
+{
+    double ring[8][2][2], shape[8][2][2], x[2], kept[2], gradient[2];
+    double start_energy, end_energy;
+    int i, k, mode, folded;
+    for (i = 0; i < 6; i++) {
+        double a0 = 6.283185307179586 * i / 6, a1 = 6.283185307179586 * (i + 1) / 6;
+        shape[i][0][0] = cos(a0);
+        shape[i][0][1] = sin(a0);
+        shape[i][1][0] = cos(a1);
+        shape[i][1][1] = sin(a1);
+        for (k = 0; k < 2; k++) {
+            ring[i][k][0] = 0.4 * shape[i][k][0];
+            ring[i][k][1] = 0.4 * shape[i][k][1];
+        }
+    }
+    for (mode = 0; mode < 2; mode++) {
+        const double density = mode ? 0.16 : 0.0;
+        x[0] = 0.11;
+        x[1] = -0.07;
+        internal_untangle_descend(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.4, 0.0, density,
+                                  1, kept);
+        start_energy = internal_untangle_energy(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.0,
+                                                density, gradient, NULL, &folded);
+        end_energy = internal_untangle_energy(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, kept,
+                                              0.0, density, gradient, NULL, &folded);
+        CHECK(fabs(kept[0]) + fabs(kept[1]) < 1e-5 && end_energy < start_energy,
+              "%s: a regular star's centre descends from (0.11, -0.07) to (%.3g, %.3g), energy %.6g -> %.6g",
+              mode ? "smoothing" : "untangling", kept[0], kept[1], start_energy, end_energy);
+    }
+    /* The first triangle nearly flat at x: (x, a, b) with b a hair off the line x a. */
+    x[0] = 0.0;
+    x[1] = 0.0;
+    ring[0][0][0] = 0.4;
+    ring[0][0][1] = 0.0;
+    ring[0][1][0] = 0.4;
+    ring[0][1][1] = 1e-170;
+    for (mode = 0; mode < 2; mode++) {
+        const double density = mode ? 0.16 : 0.0;
+        kept[0] = kept[1] = 12345.0;
+        internal_untangle_energy(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.0, density,
+                                 gradient, NULL, &folded);
+        internal_untangle_descend(6, (const double (*)[2][2])ring, (const double (*)[2][2])shape, x, 0.4, 0.0, density,
+                                  mode == 0, kept);
+        CHECK(!isfinite(gradient[0]) || !isfinite(gradient[1]),
+              "%s: the flat triangle's gradient overflows (%g, %g), the case this test is for",
+              mode ? "smoothing" : "untangling", gradient[0], gradient[1]);
+        CHECK(kept[0] == x[0] && kept[1] == x[1], "%s: a star with a flat triangle keeps its centre (%g, %g)",
+              mode ? "smoothing" : "untangling", kept[0], kept[1]);
+    }
+}
+
 /* The area-weighted 95th percentile of the stretch (sigma1 / sigma2) of the
    triangles whose three points lie in one quad, and how many of those
    turn clockwise. */
@@ -3557,6 +3616,7 @@ void run_polycube_tests(void)
     RUN(test_untangle_energy);
     RUN(test_relax_untangles);
     RUN(test_smooth_energy);
+    RUN(test_untangle_descend);
     RUN(test_polycube_smooth);
     RUN(test_reseat);
     RUN(test_seal);

@@ -415,6 +415,21 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
     }
     return tt__untangle_energy(&star, x, delta2, density, gradient, hessian, folded);
 }
+void internal_untangle_descend(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
+                               double reach, double delta2, double density, int strict, double kept[2])
+{
+    tt__untangle_star star;
+    int i;
+    star.n = n;
+    for (i = 0; i < n; i++) {
+        memcpy(star.ring[i], ring[i], sizeof star.ring[i]);
+        if (!tt__untangle_star_shape(&star, i, shape[i])) {
+            kept[0] = kept[1] = -1.0;
+            return;
+        }
+    }
+    tt__untangle_descend(&star, x, reach, delta2, density, strict, kept);
+}
 void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
                                 float weight_out[3])
 {

@@ -217,6 +217,9 @@ int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double
 /* density > 0: the smoothing energy (delta2 unused); hessian (xx, xy, yy) may be NULL. */
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
                                 double delta2, double density, double gradient[2], double hessian[3], int *folded);
+/* Where a star's centre descends from x (tt__untangle_descend). */
+void internal_untangle_descend(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
+                               double reach, double delta2, double density, int strict, double kept[2]);
 /* The position and weights of a split vertex interpolating three of mesh's vertices (tt__split_vertex_data). */
 void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
                                 float weight_out[3]);
