@@ -27,12 +27,17 @@
    Input bytes, read front to back (missing bytes read as 0):
        0      bits 0..1 both set: allocation number byte[1] + 256 * (byte[2]
               & 3) + 1 fails; bit2 a progress callback on the mapping,
-              cancelling after byte[3] % 8 calls (0 = never); bit3
-              TT_POLYCUBE_NO_CORRECT; bit4 cube_size instead of resolution:
-              the box's longest side / (1 + byte[4] % 6); bit5 the mapping
-              twice and compare (determinism); bit6 NULL options to
-              tt_polycube_build; bit7 an extreme option double (byte[12]
-              picks the field, byte[13] the value: fz_extreme_double)
+              cancelling after byte[3] % 8 calls (0 = never) when byte[9]
+              has bit7 set, else never; bit3 TT_POLYCUBE_NO_CORRECT; bit4
+              cube_size instead of resolution: the box's longest side /
+              (1 + byte[4] % 6); bit5 the mapping twice and compare
+              (determinism); bit6 with byte[4] >= 240 NULL options to
+              tt_polycube_build; bit7 with byte[12] >= 192 an extreme
+              option double (byte[12] % 3 picks the field, byte[13] the
+              value: fz_extreme_double). The second conditions keep the
+              runs that stop early (resolution 16 is not mapped here, an
+              extreme option or a cancel mostly stops the mapping) rare
+              enough that most runs reach the triangle split.
        1, 2   which allocation fails (see above)
        3      cancel after (% 8); bit3 TT_MESH_PERMISSIVE; bits 4..7 up:
               0 default, else one of +-x, +-y, +-z, or a skew vector
@@ -196,7 +201,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     tt_result r;
     const tt_allocator *alloc;
     uint8_t hdr[14];
-    int *colors = NULL, ncolors, k, valid_options = 1;
+    int *colors = NULL, ncolors, k, valid_options = 1, null_options;
     uint8_t *types = NULL;
     float *uv = NULL;
     double lo3[3] = {1e300, 1e300, 1e300}, hi3[3] = {-1e300, -1e300, -1e300}, longest;
@@ -211,6 +216,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (k = 0; k < 14; ++k) hdr[k] = rd_u8(&rd);
     fz_shape_read(&rd, &shape, 1);
     runs++;
+    null_options = (hdr[0] & 64) && hdr[4] >= 240;
     alloc = fz_alloc_init(&a, (hdr[0] & 3) == 3 ? (long)hdr[1] + 256L * (hdr[2] & 3) + 1 : 0);
 
     if (fz_shape_build(&shape, hdr[3] & 8, alloc, &a, &mesh) != TT_OK) goto out;
@@ -239,7 +245,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     case 5: po.up[2] = -1; break;
     default: po.up[0] = 0.3; po.up[1] = -0.2; po.up[2] = (hdr[3] >> 4) - 10.0; break;
     }
-    if ((hdr[0] & 128) && (hdr[12] % 3) < 2) {
+    if ((hdr[0] & 128) && hdr[12] >= 192 && (hdr[12] % 3) < 2) {
         double v = fz_extreme_double(hdr[13]);
         if (hdr[12] % 3 == 0) po.cube_size = v;
         else po.up[hdr[13] % 3] = v;
@@ -248,7 +254,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memset(&err, 0x55, sizeof err);
     memset(&prep, 0x55, sizeof prep);
     pc = (tt_polycube *)&rd;
-    r = tt_polycube_build(mesh, (hdr[0] & 64) ? NULL : &po, alloc, &pc, &prep, &err);
+    r = tt_polycube_build(mesh, null_options ? NULL : &po, alloc, &pc, &prep, &err);
     if (r != TT_OK) {
         fz_check_null("tt_polycube_build", r, pc);
         fz_check_error("tt_polycube_build", r, &err, &a);
@@ -259,7 +265,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         goto out;
     }
     check_polycube(pc, &prep);
-    if (hdr[0] & 64) goto out; /* resolution 16: too slow to map here */
+    if (null_options) goto out; /* resolution 16: too slow to map here */
     /* An inside-out mesh must be reversed before mapping (the header says
        so; the tool does it): every triangle folds, and the untangling then
        spends its whole budget (0.7 s for a 36-triangle sphere). */
@@ -297,13 +303,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* 0..8 mostly: a long path search (60..64 quads) on a mesh whose edges
        fail spends its whole step budget per edge, seconds a run */
     mo.max_quads = hdr[6] < 245 ? hdr[6] % 9 : 60 + (hdr[6] - 245);
-    if ((hdr[0] & 128) && hdr[12] % 3 == 2) {
+    if ((hdr[0] & 128) && hdr[12] >= 192 && hdr[12] % 3 == 2) {
         mo.max_edge = fz_extreme_double(hdr[13]);
         valid_options = 0;
     }
     memset(&ps, 0, sizeof ps);
     if (hdr[0] & 4) {
-        ps.cancel_after = hdr[3] % 8;
+        ps.cancel_after = (hdr[9] & 128) ? hdr[3] % 8 : 0;
         mo.progress = fz_on_progress;
         mo.progress_user_data = &ps;
     }
