@@ -23776,6 +23776,29 @@ static int tt__reseat_failures(tt__edge_search *S, const tt_mesh *model, const t
     return failures;
 }
 
+/* What the re-seatings of one tt_polycube_map remember from one to the
+   next: which vertices were tried and kept their seat, the points as the
+   last re-seating left them, and the path-search steps spent. */
+typedef struct tt__reseat_memory {
+    unsigned char *stayed;      /* per vertex: tried, kept its seat, and nothing in its star has moved since */
+    tt_surface_point *seen;     /* per vertex: its point when the last re-seating ended */
+    double spent;               /* path-search steps of every re-seating (TT__RESEAT_STEPS_PER_VERTEX) */
+} tt__reseat_memory;
+
+/* Whether v or a vertex of its triangles has moved since the last
+   re-seating (the points it judges v's seats by). */
+static int tt__reseat_star_moved(const tt_mesh *model, const tt_surface_point *points, const tt__relax_context *x,
+                                 const tt__reseat_memory *memory, int v)
+{
+    int i, k;
+    for (i = x->first_triangle[v]; i < x->first_triangle[v + 1]; i++)
+        for (k = 0; k < 3; k++) {
+            const int u = model->corner_vert[3 * (x->triangle_corners[i] / 3) + k];
+            if (!tt__same_point(points[u], memory->seen[u])) return 1;
+        }
+    return 0;
+}
+
 /* A vertex with an edge that finds no path on S (the fallback would put both
    its triangles whole into one quad, a local seam) sits on another sheet
    of S than its neighbour: the closest point chose the far side of a part
@@ -23783,11 +23806,15 @@ static int tt__reseat_failures(tt__edge_search *S, const tt_mesh *model, const t
    (both points lie within its chart), so each such vertex is tried seated
    on the sheet of each neighbour (tt__relax_seat) and kept where fewest of
    its edges fail, then fewest of its triangles fold (tt__relax_badness),
-   when that is better than where it is. Each point moved is flagged in
-   moved_points[]. Returns the number moved, -1 when out of memory. */
+   when that is better than where it is. Its seats depend on its star's
+   points only, so a vertex that kept its seat before is not tried again
+   until its star moves (*memory; the later re-seatings of a map found
+   1 move in 100 tries, each a few path searches that fail). Each point
+   moved is flagged in moved_points[]. Returns the number moved, -1 when
+   out of memory. */
 static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
-                               int max_quads, tt_surface_point *points, unsigned char *moved_points, double *spent,
-                               const tt_allocator *allocator)
+                               int max_quads, tt_surface_point *points, unsigned char *moved_points,
+                               tt__reseat_memory *memory, const tt_allocator *allocator)
 {
     tt__relax_context x;
     tt__edge_search *S = TT__ALLOC(allocator, tt__edge_search, 1);
@@ -23801,17 +23828,19 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
     memset(S, 0, sizeof *S);
     S->pc = pc;
     S->max_quads = max_quads;
-    S->spent = *spent;
+    S->spent = memory->spent;
     memset(stray, 0, (size_t)model->nverts);
     for (e = 0; e < edges->nedges; e++)
         if (edges->failed[e]) stray[edges->edge_vertices[2 * e]] = stray[edges->edge_vertices[2 * e + 1]] = 1;
+    for (v = 0; v < model->nverts; v++)
+        if (memory->stayed[v] && tt__reseat_star_moved(model, points, &x, memory, v)) memory->stayed[v] = 0;
     for (v = 0; v < model->nverts; v++) {
         const tt_surface_point kept = points[v];
         tt_surface_point best = kept;
         double at[2], best_score;
         int i, k, tried[TT__RESEAT_SEATS], ntried = 0;
         if (S->spent > 16.0 * TT__EDGE_SEARCH_BUDGET + TT__RESEAT_STEPS_PER_VERTEX * model->nverts) break;
-        if (!stray[v] || tt__relax_on_surface(pc, model, points, v)) continue;
+        if (!stray[v] || memory->stayed[v] || tt__relax_on_surface(pc, model, points, v)) continue;
         tt__relax_chart_at(x.chart, kept.quad, TT__RELAX_RADIUS);
         tt__relax_chart_place(x.chart, kept, at);
         best_score = 2.0 * tt__reseat_failures(S, model, points, &x, v) +
@@ -23840,12 +23869,17 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
             }
         }
         points[v] = best;
-        if (!tt__same_point(best, kept)) {
+        memory->stayed[v] = tt__same_point(best, kept);
+        if (!memory->stayed[v]) {
+            /* The stars v is in have changed: their centres are tried again. */
+            for (i = x.first_triangle[v]; i < x.first_triangle[v + 1]; i++)
+                for (k = 0; k < 3; k++) memory->stayed[model->corner_vert[3 * (x.triangle_corners[i] / 3) + k]] = 0;
             moved_points[v] = 1;
             moved++;
         }
     }
-    *spent = S->spent;
+    memcpy(memory->seen, points, sizeof *points * (size_t)model->nverts);
+    memory->spent = S->spent;
     tt__relax_context_free(allocator, &x);
     tt__free(allocator, S);
     tt__free(allocator, stray);
@@ -25130,12 +25164,13 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     const tt_executor *executor = options ? options->executor : NULL;
     double longest;
     int f, v, j, tracing, cycle, moves, max_quads;
-    double reseat_steps = 0.0;   /* path-search steps of every reseating (TT__RESEAT_STEPS_PER_VERTEX) */
+    tt__reseat_memory reseat;
     tt__ok(error);
     if (out) *out = NULL;
     if (!report) report = &local;
     memset(report, 0, sizeof *report);
     memset(&R, 0, sizeof R);
+    memset(&reseat, 0, sizeof reseat);
     if (!polycube || !mesh || !out)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_polycube_map needs a polycube, a mesh and out (got NULL)");
@@ -25195,8 +25230,11 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if (tt__polycube_map_cancelled(options, 0.6f)) goto cancelled;
     if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
         !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
-        !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)))
+        !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
+        !(reseat.stayed = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
+        !(reseat.seen = TT__ALLOC(allocator, tt_surface_point, model->nverts)))
         goto out_of_memory;
+    memset(reseat.stayed, 0, (size_t)model->nverts);
     /* Vertices with an edge that finds no path are re-seated (tt__polycube_reseat) and their edges traced
        again, up to TT__RESEAT_ROUNDS times; the relaxation then opens the folds that leaves near them, and
        the edges at the points it moved are traced again. */
@@ -25208,8 +25246,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
             int n, failed_before = edges->nfailed;
             memset(moved, 0, (size_t)model->nverts);
-            if ((n = tt__polycube_reseat(polycube, model, edges, max_quads, points, moved, &reseat_steps,
-                                         allocator)) < 0)
+            if ((n = tt__polycube_reseat(polycube, model, edges, max_quads, points, moved, &reseat, allocator)) < 0)
                 goto out_of_memory;
             if (!n) break;
             reseated += n;
@@ -25323,6 +25360,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, earlier);
     tt__free(allocator, moved);
     tt__free(allocator, focus);
+    tt__free(allocator, reseat.stayed);
+    tt__free(allocator, reseat.seen);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     if (tt__polycube_map_cancelled(options, 1.0f)) {
@@ -25343,6 +25382,8 @@ failed:
     tt__free(allocator, earlier);
     tt__free(allocator, moved);
     tt__free(allocator, focus);
+    tt__free(allocator, reseat.stayed);
+    tt__free(allocator, reseat.seen);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     memset(report, 0, sizeof *report);

@@ -3242,6 +3242,23 @@ static void test_reseat(void)
     ctx.moved = moved;
     oom_reset();
     oom_sweep_internal("re-seating (sphere at resolution 6, one vertex across)", reseat_oom_call, &ctx, TT_OK);
+    /* The re-seatings of one mapping remember who stayed: with the edges as
+       first traced, the moved vertex is tried again (it moved) and stays;
+       a third call then tries nothing, unless a neighbour of it moved. */
+    {
+        double spent[3];
+        int neighbour = -1, f, k, calls, nudge;
+        for (f = 0; f < mesh->nfaces && neighbour < 0; f++)
+            for (k = 0; k < 3; k++)
+                if (mesh->corner_vert[3 * f + k] == near) neighbour = mesh->corner_vert[3 * f + (k + 1) % 3];
+        for (nudge = 0; nudge < 2; nudge++) {
+            memcpy(copy, start, sizeof *copy * (size_t)mesh->nverts);
+            calls = internal_polycube_reseat_calls(pc, mesh, copy, 3, nudge ? neighbour : -1, spent);
+            CHECK(calls == 1 && spent[0] > 0.0 && spent[1] > 0.0 && (nudge ? spent[2] > 0.0 : spent[2] == 0.0),
+                  "re-seating three times%s: %d moves, path-search steps %g, %g, %g", nudge ?
+                  " with a neighbour nudged before the third" : "", calls, spent[0], spent[1], spent[2]);
+        }
+    }
     free(start);
     free(copy);
     free(moved);

@@ -364,13 +364,49 @@ int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, 
                              unsigned char *moved, const tt_allocator *allocator)
 {
     tt_polycube_edges *edges = NULL;
-    double spent = 0.0;
-    int n;
-    if (tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, allocator, &edges, NULL) != TT_OK)
-        return -2;
-    n = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, &spent,
-                            allocator);
+    tt__reseat_memory memory;
+    int n = -1;
+    memset(&memory, 0, sizeof memory);
+    memory.stayed = (unsigned char *)calloc((size_t)model->nverts, 1);
+    memory.seen = (tt_surface_point *)malloc(sizeof(tt_surface_point) * (size_t)model->nverts);
+    if (memory.stayed && memory.seen &&
+        tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, allocator, &edges, NULL) != TT_OK)
+        n = -2;
+    else if (memory.stayed && memory.seen)
+        n = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, &memory,
+                                allocator);
     tt_polycube_edges_free(edges);
+    free(memory.stayed);
+    free(memory.seen);
+    return n;
+}
+int internal_polycube_reseat_calls(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
+                                   int ncalls, int nudged, double *spent)
+{
+    tt_polycube_edges *edges = NULL;
+    tt__reseat_memory memory;
+    unsigned char *moved = (unsigned char *)calloc((size_t)model->nverts, 1);
+    int n = 0, call;
+    memset(&memory, 0, sizeof memory);
+    memory.stayed = (unsigned char *)calloc((size_t)model->nverts, 1);
+    memory.seen = (tt_surface_point *)malloc(sizeof(tt_surface_point) * (size_t)model->nverts);
+    if (!moved || !memory.stayed || !memory.seen ||
+        tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, NULL, &edges, NULL) != TT_OK)
+        n = -2;
+    for (call = 0; call < ncalls && n >= 0; call++) {
+        const double before = memory.spent;
+        int moves;
+        if (call == ncalls - 1 && nudged >= 0)
+            points[nudged].s = points[nudged].s < 0.5f ? points[nudged].s + 0.001f : points[nudged].s - 0.001f;
+        moves = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, &memory,
+                                    NULL);
+        n = moves < 0 ? -1 : n + moves;
+        spent[call] = memory.spent - before;
+    }
+    tt_polycube_edges_free(edges);
+    free(moved);
+    free(memory.stayed);
+    free(memory.seen);
     return n;
 }
 ic0_check_result internal_ic0_check(const tt_sparse_matrix *A)

@@ -213,6 +213,11 @@ int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, t
    returns how many moved, -1 when out of memory re-seating, -2 tracing. */
 int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
                              unsigned char *moved, const tt_allocator *allocator);
+/* Traces the edges once, then re-seats ncalls times with one memory (the later calls see the edges as
+   traced first); before the last call, vertex `nudged` (-1: none) moves a hair. The path-search steps of
+   each call go to spent[]; returns the moves of all calls, -1 when out of memory, -2 tracing. */
+int internal_polycube_reseat_calls(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
+                                   int ncalls, int nudged, double *spent);
 int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2]);
 /* density > 0: the smoothing energy (delta2 unused); hessian (xx, xy, yy) may be NULL. */
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
