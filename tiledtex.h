@@ -9784,8 +9784,33 @@ static int tt__edge_uv_discontinuous(const tt_mesh *mesh, const float *uv, int a
    most points it samples along one edge. */
 #define TT__SEAM_RANGE 512
 #define TT__SEAM_MAX_POINTS 64
-/* How many corners ahead the count of discontinuous edges asks for a twin's UVs. */
+/* How many corners ahead the classification of edges asks for a twin's UVs,
+   and corners a task of it takes. */
 #define TT__SEAM_PREFETCH 32
+#define TT__SEAM_CLASS_RANGE 16384
+
+/* Each edge of the mesh classified on its lower corner: 0 for a boundary
+   edge or the upper corner, 1 for an interior edge with continuous UVs, 2
+   for a discontinuous one. The twins' UVs lie anywhere in memory (a
+   cache miss an edge), so ranges of corners run as tasks. */
+typedef struct tt__seam_class_job {
+    const tt_mesh *mesh;
+    const float *corner_uv;
+    unsigned char *edge_class;
+} tt__seam_class_job;
+
+static void tt__seam_class_range(void *context, int begin, int end)
+{
+    const tt__seam_class_job *job = (const tt__seam_class_job *)context;
+    const tt_mesh *mesh = job->mesh;
+    int c;
+    for (c = begin; c < end; c++) {
+        if (c + TT__SEAM_PREFETCH < end && mesh->twin[c + TT__SEAM_PREFETCH] > c + TT__SEAM_PREFETCH)
+            TT__PREFETCH(job->corner_uv + 2 * (size_t)mesh->twin[c + TT__SEAM_PREFETCH]);
+        job->edge_class[c] = (unsigned char)(mesh->twin[c] > c ? 1 + tt__edge_uv_discontinuous(mesh, job->corner_uv, c)
+                                                               : 0);
+    }
+}
 
 typedef struct tt__seam_sums {
     double seam, same, unrelated;
@@ -9870,6 +9895,8 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
     const unsigned known_flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
     int *interior, ninterior = 0, npopulation, nmeasured, ndiscontinuous = 0, c, i, points_per_edge;
     unsigned char *listed;      /* with an edge list: per corner, 1 on the lower corner of a listed edge */
+    unsigned char *edge_class;  /* per corner: tt__seam_class_range */
+    tt__seam_class_job class_job;
     double seam = 0.0, same = 0.0, unrelated = 0.0;
     long long samples = 0;
     tt_seam_options opt;
@@ -9912,9 +9939,11 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
     wrap = (opt.flags & TT_SEAM_WRAP) ? TT_WRAP_REPEAT : TT_WRAP_CLAMP;
     interior = TT__ALLOC(allocator, int, mesh->ncorners);
     listed = opt.edges ? TT__ALLOC(allocator, unsigned char, mesh->ncorners) : NULL;
-    if (!interior || (opt.edges && !listed)) {
+    edge_class = TT__ALLOC(allocator, unsigned char, mesh->ncorners);
+    if (!interior || (opt.edges && !listed) || !edge_class) {
         tt__free(allocator, interior);
         tt__free(allocator, listed);
+        tt__free(allocator, edge_class);
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d corners",
                         mesh->ncorners);
     }
@@ -9926,14 +9955,13 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
             listed[a < b ? a : b] = 1;
         }
     }
+    class_job.mesh = mesh;
+    class_job.corner_uv = corner_uv;
+    class_job.edge_class = edge_class;
+    tt__parallel_ranges(opt.executor, mesh->ncorners, TT__SEAM_CLASS_RANGE, tt__seam_class_range, &class_job);
     for (c = 0; c < mesh->ncorners; c++) {
-        /* A twin's UVs are anywhere in memory: asked for some edges ahead. */
-        if (c + TT__SEAM_PREFETCH < mesh->ncorners && mesh->twin[c + TT__SEAM_PREFETCH] > c + TT__SEAM_PREFETCH)
-            TT__PREFETCH(corner_uv + 2 * (size_t)mesh->twin[c + TT__SEAM_PREFETCH]);
-        if (mesh->twin[c] > c) {
-            interior[ninterior++] = c;
-            ndiscontinuous += tt__edge_uv_discontinuous(mesh, corner_uv, c);
-        }
+        if (edge_class[c]) interior[ninterior++] = c;
+        ndiscontinuous += edge_class[c] == 2;
     }
     report->edges_discontinuous = ndiscontinuous;
     /* The measured population is interior[0 .. npopulation-1]: every interior
@@ -9945,13 +9973,14 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         npopulation = 0;
         for (i = 0; i < ninterior; i++)
             if ((!listed || listed[interior[i]]) &&
-                (!(opt.flags & TT_SEAM_UV_DISCONTINUOUS) || tt__edge_uv_discontinuous(mesh, corner_uv, interior[i]))) {
+                (!(opt.flags & TT_SEAM_UV_DISCONTINUOUS) || edge_class[interior[i]] == 2)) {
                 int edge = interior[i];
                 interior[i] = interior[npopulation];
                 interior[npopulation++] = edge;
             }
     }
     tt__free(allocator, listed);
+    tt__free(allocator, edge_class);
     if (npopulation == 0 && ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) || listed)) {
         tt__free(allocator, interior);
         if ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) && ndiscontinuous == 0)

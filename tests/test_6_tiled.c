@@ -1749,7 +1749,9 @@ done:
 }
 
 /* The seam measure through an executor (reverse order, two threads): the
-   serial report, bit for bit, on a mesh with several ranges of edges. */
+   serial report, bit for bit, on a mesh with several ranges of edges and
+   of corners, measuring every edge, then only the discontinuous ones
+   (some faces' UVs shifted apart from their neighbours'). */
 static void test_seams_executor_identical(void)
 {
     tmesh m;
@@ -1758,31 +1760,39 @@ static void test_seams_executor_identical(void)
     float *uv = NULL;
     int c;
     memset(&m, 0, sizeof m);
-    make_grid(&m, 40, 40);
+    make_grid(&m, 100, 100);
     make_value_noise(&atlas, 128, 128, 11);
     if (build(&m, 0, &mesh, NULL) == TT_OK && atlas) uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
     if (uv) {
         tt_seam_options so;
         tt_seam_report serial, got;
         tt_result r0, r1, r2;
-        for (c = 0; c < mesh->ncorners; c++) {
-            const float *p = mesh->pos + 3 * mesh->corner_vert[c];
-            uv[2 * c] = p[0] / 40.0f * 0.9f + 0.05f;
-            uv[2 * c + 1] = p[1] / 40.0f * 0.9f + 0.05f;
+        int mode;
+        for (mode = 0; mode < 2; mode++) {
+            for (c = 0; c < mesh->ncorners; c++) {
+                const float *p = mesh->pos + 3 * mesh->corner_vert[c];
+                const float shift = mode && (mesh->corner_face[c] / 7) % 3 == 0 ? 0.01f : 0.0f;
+                uv[2 * c] = p[0] / 100.0f * 0.9f + 0.04f + shift;
+                uv[2 * c + 1] = p[1] / 100.0f * 0.9f + 0.04f;
+            }
+            memset(&so, 0, sizeof so);
+            so.seed = 5;
+            so.flags = mode ? TT_SEAM_UV_DISCONTINUOUS : 0;
+            r0 = tt_measure_seams(mesh, uv, atlas, &so, NULL, &serial, NULL);
+            CHECK(mesh->ncorners > 2 * 16384 &&
+                      (mode ? serial.edges_discontinuous > 1000 : serial.edges_discontinuous == 0),
+                  "%d corners, %d discontinuous edges", mesh->ncorners, serial.edges_discontinuous);
+            so.executor = &g_reverse_executor;
+            r1 = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, NULL);
+            CHECK(r0 == TT_OK && serial.edges_measured > 2 * 512 && r1 == TT_OK &&
+                      memcmp(&serial, &got, sizeof serial) == 0,
+                  "reverse-order executor: %d/%d, %d edges, score %.17g against %.17g", r0, r1, serial.edges_measured,
+                  got.score, serial.score);
+            so.executor = &g_thread_executor;
+            r2 = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, NULL);
+            CHECK(r2 == TT_OK && memcmp(&serial, &got, sizeof serial) == 0,
+                  "two-thread executor: %d, score %.17g against %.17g", r2, got.score, serial.score);
         }
-        memset(&so, 0, sizeof so);
-        so.seed = 5;
-        r0 = tt_measure_seams(mesh, uv, atlas, &so, NULL, &serial, NULL);
-        so.executor = &g_reverse_executor;
-        r1 = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, NULL);
-        CHECK(r0 == TT_OK && serial.edges_measured > 2 * 512 && r1 == TT_OK &&
-                  memcmp(&serial, &got, sizeof serial) == 0,
-              "reverse-order executor: %d/%d, %d edges, score %.17g against %.17g", r0, r1, serial.edges_measured,
-              got.score, serial.score);
-        so.executor = &g_thread_executor;
-        r2 = tt_measure_seams(mesh, uv, atlas, &so, NULL, &got, NULL);
-        CHECK(r2 == TT_OK && memcmp(&serial, &got, sizeof serial) == 0,
-              "two-thread executor: %d, score %.17g against %.17g", r2, got.score, serial.score);
     }
     CHECK(uv != NULL, "setup");
     free(uv);
