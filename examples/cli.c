@@ -37,11 +37,110 @@ int tool_is_option(const char *arg)
     return arg[0] == '-' && arg[1] != '\0' && !isdigit((unsigned char)arg[1]) && arg[1] != '.';
 }
 
+/* The option names a command's parser has compared the argument being
+   read with (tool_option and tool_flag record them), so that an unknown
+   option can be answered with the nearest one the command takes. A
+   different argument starts the list again. */
+#define OFFERED_MAX 128
+static struct {
+    const char *arg;
+    const char *names[OFFERED_MAX];
+    int count;
+} offered;
+
+static void offer(const char *arg, const char *name)
+{
+    if (offered.arg != arg) {
+        offered.arg = arg;
+        offered.count = 0;
+    }
+    if (offered.count < OFFERED_MAX) offered.names[offered.count++] = name;
+}
+
+int tool_flag(const char *arg, const char *name)
+{
+    offer(arg, name);
+    return strcmp(arg, name) == 0;
+}
+
+/* The options the tool takes before or after any command (tiledtex.c's
+   take_global_options): a typo of one reaches the command's parser. */
+static const char *const global_options[] = {"--max-pixels", "--jobs", "--quiet", "--weld"};
+
+/* Edits (insertions, deletions, changes, swaps of two neighbours) that make
+   a[0..na) into b[0..nb); anything above `most` is reported as most + 1. */
+static int edit_distance(const char *a, size_t na, const char *b, size_t nb, int most)
+{
+    int row[3][64], *before = row[0], *previous = row[1], *current = row[2];
+    size_t i, j;
+    if (na >= 63 || nb >= 63) return most + 1;
+    for (j = 0; j <= nb; j++) previous[j] = (int)j;
+    for (i = 1; i <= na; i++) {
+        int least = INT_MAX, *spare;
+        current[0] = (int)i;
+        for (j = 1; j <= nb; j++) {
+            int d = previous[j - 1] + (a[i - 1] != b[j - 1]);
+            if (previous[j] + 1 < d) d = previous[j] + 1;
+            if (current[j - 1] + 1 < d) d = current[j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && before[j - 2] + 1 < d)
+                d = before[j - 2] + 1;
+            current[j] = d;
+            if (d < least) least = d;
+        }
+        if (least > most) return most + 1;
+        spare = before;
+        before = previous;
+        previous = current;
+        current = spare;
+    }
+    return previous[nb] <= most ? previous[nb] : most + 1;
+}
+
+/* The option nearest `arg` among those offered for it and the global ones:
+   within two edits (one for a short name), or the only one `arg` begins
+   (at least three letters after the dashes); NULL when none is near or two
+   are equally near. */
+static const char *nearest_option(const char *arg)
+{
+    const char *equals = strchr(arg, '='), *best = NULL, *candidates[OFFERED_MAX + 4];
+    size_t length = equals ? (size_t)(equals - arg) : strlen(arg);
+    int ncandidates = 0, best_distance = INT_MAX, ties = 0, prefixed = 0, k;
+    const char *prefix_of = NULL;
+    if (offered.arg == arg)
+        for (k = 0; k < offered.count; k++) candidates[ncandidates++] = offered.names[k];
+    for (k = 0; k < (int)(sizeof global_options / sizeof global_options[0]); k++)
+        candidates[ncandidates++] = global_options[k];
+    for (k = 0; k < ncandidates; k++) {
+        const char *name = candidates[k];
+        size_t name_length = strlen(name);
+        int most = name_length > 5 ? 2 : 1, d;
+        if (strlen(name) == length && strncmp(name, arg, length) == 0) continue;   /* the same option twice */
+        if (length >= 5 && name_length > length && strncmp(name, arg, length) == 0) {
+            if (!prefix_of || strcmp(prefix_of, name) != 0) prefixed++;
+            prefix_of = name;
+        }
+        d = edit_distance(arg, length, name, name_length, most);
+        if (d > most) continue;
+        if (d < best_distance) {
+            best_distance = d;
+            best = name;
+            ties = 0;
+        } else if (d == best_distance && strcmp(best, name) != 0) {
+            ties++;
+        }
+    }
+    if (best && !ties) return best;
+    return prefixed == 1 ? prefix_of : NULL;
+}
+
 int tool_unknown_option(const char *arg)
 {
+    const char *nearest = nearest_option(arg);
+    char hint[160] = "";
+    if (nearest) snprintf(hint, sizeof hint, ": did you mean '%s'?", nearest);
     if (tool_command())
-        return tool_usage("unknown option '%s' (see '%s %s --help')", arg, TOOL_NAME, tool_command());
-    return tool_usage("unknown option '%s' (see '%s --help')", arg, TOOL_NAME);
+        return tool_usage("unknown option '%s'%s (see '%s %s --help')", arg, hint, TOOL_NAME, tool_command());
+    return tool_usage("unknown option '%s'%s (see '%s --help')", arg, hint, TOOL_NAME);
 }
 
 /* Extensions an output prefix may end with by mistake: the files the
@@ -72,7 +171,7 @@ int parse_mesh_output_option(int argc, char **argv, int *index, int accept_forma
             return -1;
         }
         output->format_given = 1;
-    } else if (strcmp(argv[*index], "--triangles") == 0) {
+    } else if (tool_flag(argv[*index], "--triangles")) {
         output->triangles = 1;
     } else {
         return 0;
@@ -167,6 +266,7 @@ int tool_option(int argc, char **argv, int *index, const char *name, const char 
 {
     const char *arg = argv[*index];
     size_t name_length = strlen(name);
+    offer(arg, name);
     if (strncmp(arg, name, name_length) != 0) return 0;
     if (arg[name_length] == '=') {              /* --size=800x600 */
         *value = arg + name_length + 1;
@@ -348,9 +448,9 @@ int parse_mesh_option(int argc, char **argv, int *index, tool_mesh_options *opti
     const char *value;
     if (tool_option(argc, argv, index, "--subdivide", &value)) {
         if (parse_int("--subdivide", value, 0, 8, &options->subdivide) != 0) return -1;
-    } else if (strcmp(argv[*index], "--smooth") == 0) {
+    } else if (tool_flag(argv[*index], "--smooth")) {
         options->smooth = 1;
-    } else if (strcmp(argv[*index], "--permissive") == 0) {
+    } else if (tool_flag(argv[*index], "--permissive")) {
         options->permissive = 1;
     } else {
         return 0;

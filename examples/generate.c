@@ -339,7 +339,7 @@ static int generate_texture(int argc, char **argv)
             if (parse_int("--size", value, 16, TEXTURE_MAX_SIZE, &size) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--seed", &value)) {
             if (parse_u64("--seed", value, &seed) != 0) return TOOL_EXIT_USAGE;
-        } else if (strcmp(argv[i], "--material") == 0) {
+        } else if (tool_flag(argv[i], "--material")) {
             material = 1;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
@@ -1022,7 +1022,7 @@ static int generate_mesh(int argc, char **argv)
         } else if (tool_option(argc, argv, &i, "--shape", &value)) {
             if (!value) return tool_usage("--shape needs a value");
             shape = value;
-        } else if (strcmp(argv[i], "--triangles") == 0) {
+        } else if (tool_flag(argv[i], "--triangles")) {
             triangles = 1;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);

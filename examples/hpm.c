@@ -134,9 +134,9 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
             if (parse_float("--max-turn", value, 0.01, 180.0, &options->map.max_turn) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--band", &value)) {
             if (parse_float("--band", value, 1.0, 1e6, &options->map.band) != 0) return TOOL_EXIT_USAGE;
-        } else if (strcmp(argv[i], "--toroidal") == 0) {
+        } else if (tool_flag(argv[i], "--toroidal")) {
             options->map.flags |= TT_HPM_TOROIDAL;
-        } else if (strcmp(argv[i], "--no-fit") == 0) {
+        } else if (tool_flag(argv[i], "--no-fit")) {
             options->map.flags |= TT_HPM_RANDOM_PLACEMENT;
         } else if ((taken = material_parse_option(argc, argv, &i, &options->maps)) != 0) {
             if (taken < 0) return TOOL_EXIT_USAGE;

@@ -232,7 +232,7 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             else if (strcmp(value, "mesh") == 0) options->bake_uv = BAKE_UV_MESH;
             else if (strcmp(value, "atlas") == 0) options->bake_uv = BAKE_UV_ATLAS;
             else return tool_usage("--bake-uv wants auto, mesh or atlas, got '%s'", value);
-        } else if (strcmp(argv[i], "--isotropic") == 0) {
+        } else if (tool_flag(argv[i], "--isotropic")) {
             options->isotropic = 1;
         } else if ((taken = material_parse_option(argc, argv, &i, &options->maps)) != 0) {
             if (taken < 0) return TOOL_EXIT_USAGE;
@@ -315,7 +315,8 @@ static int read_constraints(const char *path, const triangle_mesh *m, constraint
     char message[TOOL_ERROR_SIZE], where[4096], *line, *next;
     int capacity = 0, number = 0, status = 0;
     memset(list, 0, sizeof *list);
-    if (tool_read_file(path, &data, &size, message, sizeof message) != 0) return tool_fail("%s", message);
+    if (tool_read_file(path, &data, &size, message, sizeof message) != 0)
+        return tool_fail("--constraints: %s", message);
     for (line = (char *)data; line && status == 0; line = next) {
         char *comment;
         number++;
@@ -509,12 +510,12 @@ static int load_mask(const lapped_options *options, int width, int height, const
     /* A mask is data, not colour: its bytes are read as they are
        (TT_COLOR_LINEAR), so grey 128 and up is inside, as the help says. */
     if (image_load(options->mask_path, TT_COLOR_LINEAR, mask, message, sizeof message) != 0)
-        return tool_fail("%s", message);
+        return tool_fail("--mask: %s", message);
     /* The whole image as the patch: tt_make_texture_patch says it when the
        sizes differ, as it always did. */
     if (size == 0 || ((*mask)->width == size && (*mask)->height == size)) return 0;
     if ((*mask)->width != width || (*mask)->height != height) {
-        int status = tool_fail("%s is %dx%d: a mask must be the size of a patch (%dx%d) or of %s (%dx%d)",
+        int status = tool_fail("--mask %s is %dx%d: a mask must be the size of a patch (%dx%d) or of %s (%dx%d)",
                                options->mask_path, (*mask)->width, (*mask)->height, size, size,
                                options->image_path, width, height);
         image_free(*mask);

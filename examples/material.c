@@ -17,19 +17,21 @@
 
 const char *const material_map_names[MATERIAL_MAPS] = {"normal", "roughness", "metallic", "ao", "height"};
 
+/* The option that gives each map, named in its messages. */
+static const char *const map_options[MATERIAL_MAPS] = {"--normal", "--roughness", "--metallic", "--ao", "--height"};
+
 int material_parse_option(int argc, char **argv, int *index, material_maps *maps)
 {
-    static const char *const options[MATERIAL_MAPS] = {"--normal", "--roughness", "--metallic", "--ao", "--height"};
     const char *value;
     int map;
-    if (strcmp(argv[*index], "--normal-y-down") == 0) {
+    if (tool_flag(argv[*index], "--normal-y-down")) {
         maps->normal_y_down = 1;
         return 1;
     }
     for (map = 0; map < MATERIAL_MAPS; map++)
-        if (tool_option(argc, argv, index, options[map], &value)) {
+        if (tool_option(argc, argv, index, map_options[map], &value)) {
             if (!value || !*value) {
-                tool_usage("%s needs an image", options[map]);
+                tool_usage("%s needs an image", map_options[map]);
                 return -1;
             }
             maps->paths[map] = value;
@@ -59,13 +61,14 @@ int material_load(material_maps *maps, const char *image_path, int width, int he
         if (map == MATERIAL_NORMAL) space = maps->normal_y_down ? TT_COLOR_NORMAL_Y_DOWN : TT_COLOR_NORMAL;
         if (image_load(maps->paths[map], space, &maps->images[map], message, sizeof message) != 0) {
             material_free(maps);
-            return tool_fail("%s", message);
+            return tool_fail("%s: %s", map_options[map], message);
         }
         image = maps->images[map];
         if (image->width != width || image->height != height) {
-            int status = tool_fail("%s is %dx%d but %s is %dx%d: every map of a material must have the colour "
+            int status = tool_fail("%s %s is %dx%d but %s is %dx%d: every map of a material must have the colour "
                                    "image's size, texel for texel",
-                                   maps->paths[map], image->width, image->height, image_path, width, height);
+                                   map_options[map], maps->paths[map], image->width, image->height, image_path, width,
+                                   height);
             material_free(maps);
             return status;
         }

@@ -134,9 +134,9 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
                 return tool_usage("--cube-size wants the cubes' edge in mesh units, above 0, got '%s'", value);
             options->build.cube_size = size;
             cube_size_given = 1;
-        } else if (strcmp(argv[i], "--no-upright") == 0) {
+        } else if (tool_flag(argv[i], "--no-upright")) {
             options->plain = 1;
-        } else if (strcmp(argv[i], "--no-correct") == 0) {
+        } else if (tool_flag(argv[i], "--no-correct")) {
             options->build.flags |= TT_POLYCUBE_NO_CORRECT;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
             if (parse_up("--up", value, options->build.up) != 0) return TOOL_EXIT_USAGE;

@@ -1132,14 +1132,14 @@ int cmd_render(int argc, char **argv)
             if (parse_float("--pitch", value, -89.0, 89.0, &pitch) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--zoom", &value)) {
             if (parse_float("--zoom", value, 0.1, 100.0, &zoom) != 0) return TOOL_EXIT_USAGE;
-        } else if (strcmp(argv[i], "--wireframe") == 0) {
+        } else if (tool_flag(argv[i], "--wireframe")) {
             wireframe = 1;
-        } else if (strcmp(argv[i], "--no-materials") == 0) {
+        } else if (tool_flag(argv[i], "--no-materials")) {
             use_materials = 0;
         } else if (tool_option(argc, argv, &i, "--normal", &value)) {
             if (!value || !*value) return tool_usage("--normal needs an image");
             normal_path = value;
-        } else if (strcmp(argv[i], "--normal-y-down") == 0) {
+        } else if (tool_flag(argv[i], "--normal-y-down")) {
             normal_y_down = 1;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
             if (parse_up("--up", value, up) != 0) return TOOL_EXIT_USAGE;

@@ -55,9 +55,9 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         options->background.y = r[1];
         options->background.w = r[2];
         options->background.h = r[3];
-    } else if ((accept & TILED_SYNTH_OPTIONS) && strcmp(argv[*index], "--mips") == 0) {
+    } else if ((accept & TILED_SYNTH_OPTIONS) && tool_flag(argv[*index], "--mips")) {
         options->mips = 1;
-    } else if ((accept & TILED_REPORT_OPTION) && strcmp(argv[*index], "--report") == 0) {
+    } else if ((accept & TILED_REPORT_OPTION) && tool_flag(argv[*index], "--report")) {
         options->report = 1;
     } else if ((accept & TILED_MATERIAL_OPTIONS) && (taken = material_parse_option(argc, argv, index, &options->maps))) {
         if (taken < 0) return -1;

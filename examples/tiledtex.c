@@ -100,9 +100,9 @@ static int take_global_options(int *argc, char **argv)
         } else if (strncmp(argv[i], "-j", 2) == 0 && argv[i][2] != '\0') {
             jobs_option = "-j";                 /* -j4, as make takes it */
             jobs = argv[i] + 2;
-        } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
+        } else if (tool_flag(argv[i], "--quiet") || strcmp(argv[i], "-q") == 0) {
             tool_set_quiet(1);
-        } else if (strcmp(argv[i], "--weld") == 0) {
+        } else if (tool_flag(argv[i], "--weld")) {
             mesh_set_weld(1);
         } else {
             argv[kept++] = argv[i];

@@ -156,8 +156,14 @@ int tool_is_help(const char *arg);
 void tool_print_mesh_help(int writes_obj);
 /* Looks like an option: starts with '-' and is not just "-" or a number. */
 int tool_is_option(const char *arg);
-/* Report "unknown option '--foo' (see 'tiledtex CMD --help')"; returns TOOL_EXIT_USAGE. */
+/* Report "unknown option '--colours': did you mean '--colors'? (see
+   'tiledtex CMD --help')": the suggestion is the nearest of the options the
+   command's parser compared `arg` with (through tool_option and tool_flag)
+   and the global ones, when one is near; returns TOOL_EXIT_USAGE. */
 int tool_unknown_option(const char *arg);
+/* Whether `arg` is the flag `name` ("--smooth"): strcmp, and `name` is
+   remembered as an option of the command for tool_unknown_option. */
+int tool_flag(const char *arg, const char *name);
 /* Room for an OUT_PREFIX: tool_output_prefix refuses longer ones, leaving
    room for the longest name a command adds ("_polycube.obj", "_patch_12.png"). */
 #define TOOL_PREFIX_SIZE 4000

@@ -1553,7 +1553,40 @@ for sub in synth map tile lapped hpm render generate; do
     # shellcheck disable=SC2086
     expect_error "unknown option ($sub)" $sub $args --frobnicate
     err_mentions "unknown option ($sub): message names it" 'frobnicate'
+    check "unknown option ($sub): nothing near it to suggest" "no 'did you mean'" "$ERR" \
+        "$(printf '%s' "$ERR" | grep -q 'did you mean'; [ $? -ne 0 ]; echo $?)"
 done
+# A typo of an option the command takes is answered with that option (the
+# nearest within two edits, a swap of two letters being one, or the only
+# option a long enough start begins); one of an option another command
+# takes is not, nor is a start that two options share.
+typo_suggests() {
+    local what=$1 expected=$2
+    shift 2
+    expect_error "typo $what" "$@"
+    check "typo $what: suggestion" "did you mean '$expected'" "$ERR" \
+        "$(printf '%s' "$ERR" | grep -qF "did you mean '$expected'?"; echo $?)"
+}
+typo_suggests "--colours (synth)" --colors synth ../in/tex.png a.png --colours 2
+typo_suggests "--colours=2 (tile)" --colors tile ../in/torus.obj ../in/tex.png out --colours=2
+typo_suggests "--resoluton (polycube)" --resolution polycube ../in/spheretri.obj ../in/tex.png out --resoluton 4
+typo_suggests "--cube_size (polycube)" --cube-size polycube ../in/spheretri.obj ../in/tex.png out --cube_size 1
+typo_suggests "--isotorpic (lapped)" --isotropic lapped ../in/torus.obj ../in/tex.png out --isotorpic
+typo_suggests "--scal (hpm)" --scale hpm ../in/torus.obj ../in/tex.png out --scal 2
+typo_suggests "--wirefame (render)" --wireframe render ../in/torus.obj ../in/tex.png r.png --wirefame
+typo_suggests "--normall (tile)" --normal tile ../in/torus.obj ../in/tex.png out --normall n.png
+typo_suggests "--quite (global)" --quiet tile ../in/torus.obj ../in/tex.png out --quite
+typo_suggests "--resol (a start, polycube)" --resolution polycube ../in/spheretri.obj ../in/tex.png out --resol 4
+expect_error "typo of another command's option" polycube ../in/spheretri.obj ../in/tex.png out --smoth
+check "typo of another command's option: no suggestion" "no 'did you mean'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -q 'did you mean'; [ $? -ne 0 ]; echo $?)"
+# A file given by an option that cannot be read is named with its option.
+expect_error "--normal file missing" tile ../in/torus.obj ../in/tex.png out --normal nothere.png
+err_mentions "--normal file missing: message names the option" "[-]-normal: cannot open 'nothere.png'"
+expect_error "--mask file missing" lapped ../in/torus.obj ../in/tex.png out --mask nothere.png
+err_mentions "--mask file missing: message names the option" "[-]-mask: cannot open 'nothere.png'"
+expect_error "--constraints file missing" lapped ../in/torus.obj ../in/tex.png out --constraints nothere.txt
+err_mentions "--constraints file missing: message names the option" "[-]-constraints: cannot open 'nothere.txt'"
 expect_error "unknown command" frobnicate
 expect_error "missing positional args (synth)" synth ../in/tex.png
 expect_error "missing positional args (map)" map ../in/torus.obj
