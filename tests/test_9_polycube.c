@@ -3195,7 +3195,8 @@ static tt_result reseat_oom_call(void *ctx, const tt_allocator *al, tt_error *er
     (void)error;   /* a private helper: no tt_error */
     memcpy(c->pts, c->start, sizeof *c->pts * (size_t)c->mesh->nverts);
     memset(c->moved, 0, (size_t)c->mesh->nverts);
-    return internal_polycube_reseat(c->pc, c->mesh, c->pts, c->moved, al) == 1 ? TT_OK : TT_ERROR_OUT_OF_MEMORY;
+    return internal_polycube_reseat_calls(c->pc, c->mesh, c->pts, c->moved, al, 1, -1, NULL) == 1
+               ? TT_OK : TT_ERROR_OUT_OF_MEMORY;
 }
 
 /* A vertex seated on the far side of S (as the closest point does across a
@@ -3227,7 +3228,7 @@ static void test_reseat(void)
     start = (tt_surface_point *)malloc(sizeof *start * (size_t)mesh->nverts);
     copy = (tt_surface_point *)malloc(sizeof *copy * (size_t)mesh->nverts);
     memcpy(start, pts, sizeof *start * (size_t)mesh->nverts);
-    reseated = internal_polycube_reseat(pc, mesh, pts, moved, NULL);
+    reseated = internal_polycube_reseat_calls(pc, mesh, pts, moved, NULL, 1, -1, NULL);
     after = failed_edges(pc, mesh, pts);
     for (v = 0; v < mesh->nverts; v++) others += moved[v] && v != near;
     tt_polycube_point_position(pc, pts[near], at);
@@ -3253,7 +3254,8 @@ static void test_reseat(void)
                 if (mesh->corner_vert[3 * f + k] == near) neighbour = mesh->corner_vert[3 * f + (k + 1) % 3];
         for (nudge = 0; nudge < 2; nudge++) {
             memcpy(copy, start, sizeof *copy * (size_t)mesh->nverts);
-            calls = internal_polycube_reseat_calls(pc, mesh, copy, 3, nudge ? neighbour : -1, spent);
+            memset(moved, 0, (size_t)mesh->nverts);
+            calls = internal_polycube_reseat_calls(pc, mesh, copy, moved, NULL, 3, nudge ? neighbour : -1, spent);
             CHECK(calls == 1 && spent[0] > 0.0 && spent[1] > 0.0 && (nudge ? spent[2] > 0.0 : spent[2] == 0.0),
                   "re-seating three times%s: %d moves, path-search steps %g, %g, %g", nudge ?
                   " with a neighbour nudged before the third" : "", calls, spent[0], spent[1], spent[2]);

@@ -360,38 +360,18 @@ int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, t
 {
     return tt__polycube_relax(polycube, model, points, NULL, NULL, NULL);
 }
-int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
-                             unsigned char *moved, const tt_allocator *allocator)
-{
-    tt_polycube_edges *edges = NULL;
-    tt__reseat_memory memory;
-    int n = -1;
-    memset(&memory, 0, sizeof memory);
-    memory.stayed = (unsigned char *)calloc((size_t)model->nverts, 1);
-    memory.seen = (tt_surface_point *)malloc(sizeof(tt_surface_point) * (size_t)model->nverts);
-    if (memory.stayed && memory.seen &&
-        tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, allocator, &edges, NULL) != TT_OK)
-        n = -2;
-    else if (memory.stayed && memory.seen)
-        n = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, &memory,
-                                allocator);
-    tt_polycube_edges_free(edges);
-    free(memory.stayed);
-    free(memory.seen);
-    return n;
-}
 int internal_polycube_reseat_calls(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
-                                   int ncalls, int nudged, double *spent)
+                                   unsigned char *moved, const tt_allocator *allocator, int ncalls, int nudged,
+                                   double *spent)
 {
     tt_polycube_edges *edges = NULL;
     tt__reseat_memory memory;
-    unsigned char *moved = (unsigned char *)calloc((size_t)model->nverts, 1);
     int n = 0, call;
     memset(&memory, 0, sizeof memory);
     memory.stayed = (unsigned char *)calloc((size_t)model->nverts, 1);
     memory.seen = (tt_surface_point *)malloc(sizeof(tt_surface_point) * (size_t)model->nverts);
-    if (!moved || !memory.stayed || !memory.seen ||
-        tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, NULL, &edges, NULL) != TT_OK)
+    if (!memory.stayed || !memory.seen) n = -1;
+    else if (tt_polycube_trace_edges(polycube, model, points, model->nverts, NULL, allocator, &edges, NULL) != TT_OK)
         n = -2;
     for (call = 0; call < ncalls && n >= 0; call++) {
         const double before = memory.spent;
@@ -399,12 +379,11 @@ int internal_polycube_reseat_calls(const tt_polycube *polycube, const tt_mesh *m
         if (call == ncalls - 1 && nudged >= 0)
             points[nudged].s = points[nudged].s < 0.5f ? points[nudged].s + 0.001f : points[nudged].s - 0.001f;
         moves = tt__polycube_reseat(polycube, model, edges, TT_POLYCUBE_EDGE_DEFAULT_QUADS, points, moved, &memory,
-                                    NULL);
+                                    allocator);
         n = moves < 0 ? -1 : n + moves;
-        spent[call] = memory.spent - before;
+        if (spent) spent[call] = memory.spent - before;
     }
     tt_polycube_edges_free(edges);
-    free(moved);
     free(memory.stayed);
     free(memory.seen);
     return n;

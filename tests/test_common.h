@@ -209,15 +209,13 @@ typedef struct ic0_check_result {
 } ic0_check_result;
 ic0_check_result internal_ic0_check(const tt_sparse_matrix *A);
 int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points);
-/* Traces the edges and re-seats the vertices with a failed one (flagged in moved[], cleared by the caller);
-   returns how many moved, -1 when out of memory re-seating, -2 tracing. */
-int internal_polycube_reseat(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
-                             unsigned char *moved, const tt_allocator *allocator);
-/* Traces the edges once, then re-seats ncalls times with one memory (the later calls see the edges as
-   traced first); before the last call, vertex `nudged` (-1: none) moves a hair. The path-search steps of
-   each call go to spent[]; returns the moves of all calls, -1 when out of memory, -2 tracing. */
+/* Traces the edges once, then re-seats the vertices with a failed one ncalls times with one memory (the
+   later calls see the edges as first traced), flagging those moved in moved[] (cleared by the caller);
+   before the last call, vertex `nudged` (-1: none) moves a hair. The path-search steps of each call go to
+   spent[] (may be NULL); returns the moves of all calls, -1 when out of memory, -2 tracing. */
 int internal_polycube_reseat_calls(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
-                                   int ncalls, int nudged, double *spent);
+                                   unsigned char *moved, const tt_allocator *allocator, int ncalls, int nudged,
+                                   double *spent);
 int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double centre[2]);
 /* density > 0: the smoothing energy (delta2 unused); hessian (xx, xy, yy) may be NULL. */
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
