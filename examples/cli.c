@@ -147,13 +147,13 @@ int tool_unknown_option(const char *arg)
    commands write, and the glTF a user may expect from a mesh tool. */
 static const char *const output_extensions[] = {".obj", ".mtl", ".png", ".glb", ".gltf"};
 
-static int ends_with_ignoring_case(const char *text, size_t length, const char *ending)
+const char *tool_model_extension(const tool_mesh_output *output)
 {
-    size_t n = strlen(ending), i;
-    if (length < n) return 0;
-    for (i = 0; i < n; i++)
-        if (tolower((unsigned char)text[length - n + i]) != tolower((unsigned char)ending[i])) return 0;
-    return 1;
+    switch (output->format) {
+    case TOOL_FORMAT_GLB: return ".glb";
+    case TOOL_FORMAT_GLTF: return ".gltf";
+    default: return ".obj";
+    }
 }
 
 int parse_mesh_output_option(int argc, char **argv, int *index, int accept_format, tool_mesh_output *output)
@@ -161,13 +161,14 @@ int parse_mesh_output_option(int argc, char **argv, int *index, int accept_forma
     const char *value;
     if (accept_format && tool_option(argc, argv, index, "--format", &value)) {
         if (!value) {
-            tool_usage("--format needs a value: obj or glb");
+            tool_usage("--format needs a value: obj, glb or gltf");
             return -1;
         }
         if (strcmp(value, "obj") == 0) output->format = TOOL_FORMAT_OBJ;
         else if (strcmp(value, "glb") == 0) output->format = TOOL_FORMAT_GLB;
+        else if (strcmp(value, "gltf") == 0) output->format = TOOL_FORMAT_GLTF;
         else {
-            tool_usage("--format wants obj or glb, got '%s'", value);
+            tool_usage("--format wants obj, glb or gltf, got '%s'", value);
             return -1;
         }
         output->format_given = 1;
@@ -185,7 +186,7 @@ static const char *output_extension(const char *text)
 {
     size_t length = strlen(text), k;
     for (k = 0; k < sizeof output_extensions / sizeof output_extensions[0]; k++)
-        if (ends_with_ignoring_case(text, length, output_extensions[k]) &&
+        if (tool_has_extension(text, output_extensions[k]) &&
             length - strlen(output_extensions[k]) > (size_t)(tool_basename(text) - text))
             return text + length - strlen(output_extensions[k]);
     return NULL;
@@ -193,16 +194,27 @@ static const char *output_extension(const char *text)
 
 int tool_output_prefix(const char *text, tool_mesh_output *output, char *prefix)
 {
+    static const char *const format_names[] = {"obj", "glb", "gltf"};
     const char *extension = output_extension(text);
     size_t length = extension ? (size_t)(extension - text) : strlen(text);
-    int glb_name = extension && ends_with_ignoring_case(extension, strlen(extension), ".glb");
-    if (output && glb_name && output->format_given && output->format != TOOL_FORMAT_GLB)
-        return tool_usage("OUT_PREFIX '%s' names a GLB file, but --format obj asks for OBJ files: drop one of them",
-                          text);
-    if (output && extension && !glb_name && output->format == TOOL_FORMAT_GLB)
-        return tool_usage("OUT_PREFIX '%s' ends in %s, but --format glb writes one .glb file: name it '%.*s.glb'",
-                          text, extension, (int)length, text);
-    if (output && glb_name) output->format = TOOL_FORMAT_GLB;
+    int named = TOOL_FORMAT_OBJ;   /* the format the name's extension says */
+    if (extension && tool_has_extension(extension, ".glb")) named = TOOL_FORMAT_GLB;
+    if (extension && tool_has_extension(extension, ".gltf")) named = TOOL_FORMAT_GLTF;
+    if (output && output->format_given && named != TOOL_FORMAT_OBJ && (int)output->format != named)
+        return tool_usage("OUT_PREFIX '%s' names a %s file, but --format %s asks for %s: drop one of them", text,
+                          named == TOOL_FORMAT_GLB ? "GLB" : "glTF", format_names[output->format],
+                          output->format == TOOL_FORMAT_OBJ ? "OBJ files" : output->format == TOOL_FORMAT_GLB
+                                                                              ? "one GLB file" : "a glTF file");
+    if (output && extension && named == TOOL_FORMAT_OBJ && output->format != TOOL_FORMAT_OBJ)
+        return tool_usage("OUT_PREFIX '%s' ends in %s, but --format %s writes %s: name it '%.*s%s'", text, extension,
+                          format_names[output->format],
+                          output->format == TOOL_FORMAT_GLB ? "one .glb file" : "a .gltf file with its .bin and "
+                                                                                "PNGs",
+                          (int)length, text, tool_model_extension(output));
+    if (output && named != TOOL_FORMAT_OBJ) output->format = (tool_mesh_format)named;
+    if (!output && named != TOOL_FORMAT_OBJ)
+        return tool_usage("OUT_PREFIX '%s' names a %s file, but this command writes OBJ and PNG files only", text,
+                          named == TOOL_FORMAT_GLB ? "GLB" : "glTF");
     if (strcmp(text, "-") == 0 && output && output->format == TOOL_FORMAT_GLB) {
         strcpy(prefix, "-");
         return 0;

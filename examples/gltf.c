@@ -1,14 +1,19 @@
-/* gltf.c - glTF 2.0 binary (.glb) writing for the `tiledtex` tool: the
-   textured mesh a command made, its material and the material's images in
-   one file that other programs open (Blender, game engines, web viewers).
-   See tool.h for the interface.
+/* gltf.c - glTF 2.0 writing for the `tiledtex` tool: the textured mesh a
+   command made, its material and the material's images, in the forms
+   other programs open (Blender, game engines, web viewers). See tool.h for
+   the interface.
 
-   A GLB is a 12-byte header, a JSON chunk describing the scene and a BIN
-   chunk holding the data the JSON points into. Here the BIN chunk holds,
-   each from a 4-byte boundary: the vertices' positions, normals, tangents
-   (with a normal map) and texture coordinates (one array each), the
-   triangles' indices, and the material's PNG files. Every number in the file is little-endian, whatever
-   the machine writing it.
+   A GLB (.glb) is one file: a 12-byte header, a JSON chunk describing the
+   scene and a BIN chunk holding the data the JSON points into. Here the
+   BIN chunk holds, each from a 4-byte boundary: the vertices' positions,
+   normals, tangents (with a normal map) and texture coordinates (one array
+   each), the triangles' indices, and the material's PNG files. Every number
+   in the file is little-endian, whatever the machine writing it.
+
+   The separate form (.gltf) is the same scene as text: the JSON in the
+   .gltf file, the same arrays in a .bin file beside it, and each PNG a file
+   of its own, which the JSON names by relative URIs. An editor can open
+   the JSON, and a PNG can be changed without rewriting the rest.
 
    glTF keeps one texture coordinate and one normal per vertex, where the
    tool's meshes have them per face corner: a glTF vertex is made for each
@@ -52,6 +57,13 @@
 /* The texture slots of a material, in the order the file lists them. */
 enum { SLOT_BASE_COLOR, SLOT_NORMAL, SLOT_METALLIC_ROUGHNESS, SLOT_OCCLUSION, SLOT_COUNT };
 static const char *const slot_names[SLOT_COUNT] = {"baseColor", "normal", "metallicRoughness", "occlusion"};
+
+/* The separate form's URIs, relative to the .gltf (percent-encoded): its
+   buffer and each slot's PNG. The GLB form has none (a NULL gltf_uris). */
+typedef struct gltf_uris {
+    char buffer[1024];
+    char image[SLOT_COUNT][1024];
+} gltf_uris;
 
 static size_t padded4(size_t size)
 {
@@ -557,8 +569,10 @@ typedef struct glb_layout {
     int short_indices;
 } glb_layout;
 
+/* The BIN chunk's (or the .bin file's) arrays; the images go into it in
+   the GLB form only (embed_images). */
 static void plan_layout(const glb_vertices *v, int has_normals, int has_uvs, const glb_images *images,
-                        glb_layout *layout)
+                        int embed_images, glb_layout *layout)
 {
     size_t lengths[VIEW_IMAGE + SLOT_COUNT];
     int i;
@@ -569,7 +583,7 @@ static void plan_layout(const glb_vertices *v, int has_normals, int has_uvs, con
     lengths[VIEW_TANGENT] = v->tangent ? 16 * (size_t)v->count : 0;
     lengths[VIEW_UV] = has_uvs ? 8 * (size_t)v->count : 0;
     lengths[VIEW_INDEX] = 3 * (size_t)v->ntriangles * (layout->short_indices ? 2 : 4);
-    for (i = 0; i < SLOT_COUNT; i++) lengths[VIEW_IMAGE + i] = images->png[i] ? images->size[i] : 0;
+    for (i = 0; i < SLOT_COUNT; i++) lengths[VIEW_IMAGE + i] = embed_images && images->png[i] ? images->size[i] : 0;
     for (i = 0; i < VIEW_IMAGE + SLOT_COUNT; i++) {
         layout->view[i] = lengths[i] > 0 ? layout->nviews++ : -1;
         layout->offset[i] = layout->bin_size;
@@ -586,12 +600,14 @@ static void json_view(tool_buffer *out, const glb_layout *layout, int i, int tar
     buffer_append(out, "}", 1);
 }
 
+/* The scene's JSON; `uris` NULL for the GLB form (images in the BIN
+   chunk), else the separate form's files. */
 static void write_json(tool_buffer *out, const tool_material *material, const char *name, const glb_vertices *v,
-                       const glb_layout *layout)
+                       const glb_images *images, const glb_layout *layout, const gltf_uris *uris)
 {
     int texture[SLOT_COUNT], ntextures = 0, s, accessor = 0;
     int normal_accessor = -1, tangent_accessor = -1, uv_accessor = -1, index_accessor;
-    for (s = 0; s < SLOT_COUNT; s++) texture[s] = layout->view[VIEW_IMAGE + s] >= 0 ? ntextures++ : -1;
+    for (s = 0; s < SLOT_COUNT; s++) texture[s] = images->png[s] ? ntextures++ : -1;
 
     buffer_printf(out, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"tiledtex %s\"},", TILEDTEX_VERSION_STRING);
     buffer_printf(out, "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":");
@@ -669,8 +685,13 @@ static void write_json(tool_buffer *out, const tool_material *material, const ch
         first = 1;
         for (s = 0; s < SLOT_COUNT; s++)
             if (texture[s] >= 0) {
-                buffer_printf(out, "%s{\"bufferView\":%d,\"mimeType\":\"image/png\",\"name\":\"%s\"}", first ? "" : ",",
-                              layout->view[VIEW_IMAGE + s], slot_names[s]);
+                if (uris) {
+                    buffer_printf(out, "%s{\"uri\":", first ? "" : ",");
+                    json_string(out, uris->image[s]);
+                } else {
+                    buffer_printf(out, "%s{\"bufferView\":%d", first ? "" : ",", layout->view[VIEW_IMAGE + s]);
+                }
+                buffer_printf(out, ",\"mimeType\":\"image/png\",\"name\":\"%s\"}", slot_names[s]);
                 first = 0;
             }
         buffer_printf(out, "],");
@@ -684,7 +705,13 @@ static void write_json(tool_buffer *out, const tool_material *material, const ch
     json_view(out, layout, VIEW_INDEX, GL_ELEMENT_ARRAY_BUFFER);
     for (s = 0; s < SLOT_COUNT; s++)
         if (layout->view[VIEW_IMAGE + s] >= 0) json_view(out, layout, VIEW_IMAGE + s, 0);
-    buffer_printf(out, "],\"buffers\":[{\"byteLength\":%lu}]}", (unsigned long)layout->bin_size);
+    buffer_printf(out, "],\"buffers\":[{");
+    if (uris) {
+        buffer_printf(out, "\"uri\":");
+        json_string(out, uris->buffer);
+        buffer_append(out, ",", 1);
+    }
+    buffer_printf(out, "\"byteLength\":%lu}]}", (unsigned long)layout->bin_size);
 }
 
 /* ======================================================================== */
@@ -741,93 +768,193 @@ static void write_bin(unsigned char *bin, const obj_write_desc *mesh, const glb_
             }
         }
     for (s = 0; s < SLOT_COUNT; s++)
-        if (images->png[s]) memcpy(bin + layout->offset[VIEW_IMAGE + s], images->png[s], images->size[s]);
+        if (layout->view[VIEW_IMAGE + s] >= 0)
+            memcpy(bin + layout->offset[VIEW_IMAGE + s], images->png[s], images->size[s]);
+}
+
+/* What both forms are made of: the vertices, the material's PNGs, where
+   the arrays go and the JSON (padded with spaces to 4 bytes, which JSON
+   ignores). */
+typedef struct gltf_parts {
+    glb_vertices v;
+    glb_images images;
+    glb_layout layout;
+    tool_buffer json;
+} gltf_parts;
+
+static void gltf_parts_free(gltf_parts *parts)
+{
+    buffer_free(&parts->json);
+    glb_vertices_free(&parts->v);
+    glb_images_free(&parts->images);
+}
+
+/* The parts of the scene (uris NULL: the GLB form). Returns 0, or -1 with
+   the reason in err and nothing left allocated. */
+static int gltf_prepare(const obj_write_desc *mesh, const tool_material *material, const char *name,
+                        const gltf_uris *uris, gltf_parts *parts, char *err, size_t err_size)
+{
+    int s, textured = 0;
+    memset(parts, 0, sizeof *parts);
+    if (!mesh || !material || !name || mesh->nverts < 0 || mesh->nfaces < 0 || (mesh->nverts > 0 && !mesh->pos) ||
+        (mesh->nfaces > 0 && !mesh->corner_vert) || (!mesh->face_size && mesh->fixed_face_size < 3)) {
+        tool_set_error(err, err_size, "an invalid mesh for glTF");
+        return -1;
+    }
+    if (encode_material(material, &parts->images, err, err_size) != 0) return -1;
+    for (s = 0; s < SLOT_COUNT; s++) textured |= parts->images.png[s] != NULL;
+    if (textured && !mesh->corner_uv) {
+        tool_set_error(err, err_size, "a textured glTF needs texture coordinates");
+        goto fail;
+    }
+    if (make_vertices(mesh, &parts->v, err, err_size) != 0) goto fail;
+    if (parts->images.png[SLOT_NORMAL] && parts->v.unit_normal && make_tangents(mesh, &parts->v) != 0) {
+        tool_set_error(err, err_size, "out of memory for the tangents of %d vertices", parts->v.count);
+        goto fail;
+    }
+    plan_layout(&parts->v, mesh->corner_normal != NULL, mesh->corner_uv != NULL, &parts->images, uris == NULL,
+                &parts->layout);
+    write_json(&parts->json, material, name, &parts->v, &parts->images, &parts->layout, uris);
+    while (parts->json.size % 4) buffer_append(&parts->json, " ", 1);
+    if (parts->json.failed) {
+        tool_set_error(err, err_size, "out of memory while writing the glTF");
+        goto fail;
+    }
+    return 0;
+fail:
+    gltf_parts_free(parts);
+    return -1;
 }
 
 int gltf_write(const obj_write_desc *mesh, const tool_material *material, const char *name, unsigned char **glb,
                size_t *glb_size, char *err, size_t err_size)
 {
-    glb_vertices v;
-    glb_images images;
-    glb_layout layout;
-    tool_buffer json = TOOL_BUFFER_INIT;
-    size_t json_size, total;
+    gltf_parts parts;
+    size_t total;
     unsigned char *p;
-    int s, textured = 0;
-
     *glb = NULL;
     *glb_size = 0;
-    if (!mesh || !material || !name || mesh->nverts < 0 || mesh->nfaces < 0 || (mesh->nverts > 0 && !mesh->pos) ||
-        (mesh->nfaces > 0 && !mesh->corner_vert) || (!mesh->face_size && mesh->fixed_face_size < 3)) {
-        tool_set_error(err, err_size, "an invalid mesh for a GLB");
+    if (gltf_prepare(mesh, material, name, NULL, &parts, err, err_size) != 0) return -1;
+    total = GLB_HEADER_SIZE + 2 * GLB_CHUNK_HEADER_SIZE + parts.json.size + parts.layout.bin_size;
+    if (total > UINT32_MAX || total < parts.layout.bin_size) {
+        tool_set_error(err, err_size, "the GLB would be over 4 GB, more than the format holds");
+        gltf_parts_free(&parts);
         return -1;
-    }
-    if (encode_material(material, &images, err, err_size) != 0) return -1;
-    for (s = 0; s < SLOT_COUNT; s++) textured |= images.png[s] != NULL;
-    if (textured && !mesh->corner_uv) {
-        glb_images_free(&images);
-        tool_set_error(err, err_size, "a textured GLB needs texture coordinates");
-        return -1;
-    }
-    if (make_vertices(mesh, &v, err, err_size) != 0) {
-        glb_images_free(&images);
-        return -1;
-    }
-    if (images.png[SLOT_NORMAL] && v.unit_normal && make_tangents(mesh, &v) != 0) {
-        tool_set_error(err, err_size, "out of memory for the tangents of %d vertices", v.count);
-        goto fail;
-    }
-    plan_layout(&v, mesh->corner_normal != NULL, mesh->corner_uv != NULL, &images, &layout);
-    write_json(&json, material, name, &v, &layout);
-    /* The JSON chunk is padded with spaces, which JSON ignores. */
-    while (json.size % 4) buffer_append(&json, " ", 1);
-    json_size = json.size;
-    total = GLB_HEADER_SIZE + 2 * GLB_CHUNK_HEADER_SIZE + json_size + layout.bin_size;
-    if (json.failed || total > UINT32_MAX || total < layout.bin_size) {
-        tool_set_error(err, err_size, json.failed ? "out of memory while writing the GLB"
-                                                  : "the GLB would be over 4 GB, more than the format holds");
-        goto fail;
     }
     *glb = (unsigned char *)calloc(total, 1);
     if (!*glb) {
         tool_set_error(err, err_size, "out of memory for a GLB of %lu bytes", (unsigned long)total);
-        goto fail;
+        gltf_parts_free(&parts);
+        return -1;
     }
     p = put_u32(*glb, GLB_MAGIC);
     p = put_u32(p, GLB_VERSION);
     p = put_u32(p, (uint32_t)total);
-    p = put_u32(p, (uint32_t)json_size);
+    p = put_u32(p, (uint32_t)parts.json.size);
     p = put_u32(p, GLB_CHUNK_JSON);
-    memcpy(p, json.data, json_size);
-    p += json_size;
-    p = put_u32(p, (uint32_t)layout.bin_size);
+    memcpy(p, parts.json.data, parts.json.size);
+    p += parts.json.size;
+    p = put_u32(p, (uint32_t)parts.layout.bin_size);
     p = put_u32(p, GLB_CHUNK_BIN);
-    write_bin(p, mesh, &v, &images, &layout);
+    write_bin(p, mesh, &parts.v, &parts.images, &parts.layout);
     *glb_size = total;
-    buffer_free(&json);
-    glb_vertices_free(&v);
-    glb_images_free(&images);
+    gltf_parts_free(&parts);
     return 0;
-fail:
-    buffer_free(&json);
-    glb_vertices_free(&v);
-    glb_images_free(&images);
-    return -1;
 }
 
-int output_add_glb(tool_output *output, const char *path, const obj_write_desc *mesh, const tool_material *material)
+/* `name` as a relative URI: the bytes of RFC 3986's unreserved characters
+   as they are, every other byte (spaces, UTF-8 beyond ASCII) as %XX. 0, or
+   -1 when it does not fit in `size` bytes. */
+static int uri_encode(const char *name, char *uri, size_t size)
+{
+    static const char hex[] = "0123456789ABCDEF";
+    size_t n = 0;
+    for (; *name; name++) {
+        const unsigned char c = (unsigned char)*name;
+        if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '.' ||
+            c == '_' || c == '~') {
+            if (n + 1 >= size) return -1;
+            uri[n++] = (char)c;
+        } else {
+            if (n + 3 >= size) return -1;
+            uri[n++] = '%';
+            uri[n++] = hex[c >> 4];
+            uri[n++] = hex[c & 15];
+        }
+    }
+    uri[n] = '\0';
+    return 0;
+}
+
+/* The separate form into the batch: PATH (the JSON), PATH less ".gltf"
+   plus ".bin", and a PNG per image, PATH less ".gltf" plus "_baseColor.png"
+   and the like. */
+static int output_add_gltf_separate(tool_output *output, const char *path, const char *name,
+                                    const obj_write_desc *mesh, const tool_material *material)
+{
+    char message[TOOL_ERROR_SIZE], bin_path[4200], image_path[SLOT_COUNT][4200];
+    gltf_uris uris;
+    gltf_parts parts;
+    size_t stem = strlen(path) - strlen(".gltf");
+    unsigned char *bin;
+    int s, status = 0;
+    memset(&uris, 0, sizeof uris);
+    snprintf(bin_path, sizeof bin_path, "%.*s.bin", (int)stem, path);
+    for (s = 0; s < SLOT_COUNT; s++)
+        snprintf(image_path[s], sizeof image_path[s], "%.*s_%s.png", (int)stem, path, slot_names[s]);
+    if (stem + 32 > 4096 || uri_encode(tool_basename(bin_path), uris.buffer, sizeof uris.buffer) != 0)
+        return tool_fail("%s: the name is too long for the files beside it", path);
+    for (s = 0; s < SLOT_COUNT; s++)
+        if (uri_encode(tool_basename(image_path[s]), uris.image[s], sizeof uris.image[s]) != 0)
+            return tool_fail("%s: the name is too long for the files beside it", path);
+    if (gltf_prepare(mesh, material, name, &uris, &parts, message, sizeof message) != 0)
+        return tool_fail("%s: %s", path, message);
+    bin = (unsigned char *)calloc(parts.layout.bin_size > 0 ? parts.layout.bin_size : 1, 1);
+    if (!bin) {
+        gltf_parts_free(&parts);
+        return tool_fail("out of memory for %s (%lu bytes)", bin_path, (unsigned long)parts.layout.bin_size);
+    }
+    write_bin(bin, mesh, &parts.v, &parts.images, &parts.layout);
+    /* The batch owns what it is given, whether or not it takes it. */
+    if (output_add(output, bin_path, bin, parts.layout.bin_size) != 0) status = -1;
+    for (s = 0; s < SLOT_COUNT; s++)
+        if (parts.images.png[s]) {
+            if (output_add(output, image_path[s], parts.images.png[s], parts.images.size[s]) != 0) status = -1;
+            parts.images.png[s] = NULL;
+        }
+    if (status == 0) {
+        status = output_add(output, path, parts.json.data, parts.json.size);
+        parts.json.data = NULL;
+    }
+    gltf_parts_free(&parts);
+    if (status != 0) return tool_fail("out of memory while writing %s", path);
+    return 0;
+}
+
+int output_add_gltf(tool_output *output, const char *path, const obj_write_desc *mesh, const tool_material *material)
 {
     char message[TOOL_ERROR_SIZE], name[256];
     const char *base = strcmp(path, "-") == 0 ? "tiledtex" : tool_basename(path);
     size_t length = strlen(base);
+    int separate = tool_has_extension(path, ".gltf");
     unsigned char *glb;
     size_t size;
     /* The scene's object is named after the file, as an importer would
        name it ("bunny_tiled" from bunny_tiled.glb). */
-    if (length > 4 && strcmp(base + length - 4, ".glb") == 0) length -= 4;
+    if (separate) length -= strlen(".gltf");
+    else if (tool_has_extension(base, ".glb")) length -= strlen(".glb");
     snprintf(name, sizeof name, "%.*s", (int)(length < sizeof name ? length : sizeof name - 1), base);
+    if (separate) return output_add_gltf_separate(output, path, name, mesh, material);
     if (gltf_write(mesh, material, name, &glb, &size, message, sizeof message) != 0)
         return tool_fail("%s: %s", path, message);
     if (output_add(output, path, glb, size) != 0) return tool_fail("out of memory while writing %s", path);
     return 0;
+}
+
+const char *gltf_written(const char *path, char *text, size_t size)
+{
+    size_t stem = strlen(path) - strlen(".gltf");
+    if (!tool_has_extension(path, ".gltf")) return path;
+    snprintf(text, size, "%s, %.*s.bin, %.*s_*.png", path, (int)stem, path, (int)stem, path);
+    return text;
 }

@@ -38,9 +38,10 @@ static void print_help(void)
            "Faces with more than 3 corners are split into triangle fans first. The mesh must be\n"
            "manifold and consistently oriented.\n");
     tool_print_mesh_help(1);
-    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl or .png loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
-           "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
+           "(--format glb), one ending in .gltf OUT_PREFIX.gltf (--format gltf). It may be '-' (the\n"
+           "standard output) only for a GLB, one file.\n"
            "\n"
            "options:\n"
            "  --scale X        mesh units covered by the image's width (default: a quarter of the\n"
@@ -60,8 +61,10 @@ static void print_help(void)
            "                   coordinates leave [0,1] (render with repeat, as 'tiledtex render'\n"
            "                   does); without it every coordinate stays inside the image\n"
            "  --no-fit         the control: the same clusters, each placed at random\n"
-           "  --format obj|glb obj (default): the OBJ and MTL above; glb: one binary glTF file,\n"
-           "                   OUT_PREFIX.glb, with IMAGE in it (as a PNG; repeated under --toroidal)\n"
+           "  --format F       obj (default): the OBJ and MTL above; glb: one binary glTF file,\n"
+           "                   OUT_PREFIX.glb, with IMAGE in it (as a PNG; repeated under --toroidal);\n"
+           "                   gltf: the same as glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and\n"
+           "                   OUT_PREFIX_baseColor.png (and a PNG per map) beside it\n"
            "  --triangles      accepted for the OBJ, whose faces are triangles already\n"
            MATERIAL_OPTIONS_HELP("                   ")
            "                   (here the MTL names each map where it is, as it names IMAGE: the\n"
@@ -223,7 +226,7 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
 
 /* OUT_PREFIX.glb: the same triangles, IMAGE embedded as the material's
    colour; repeated when --toroidal lets the coordinates leave [0,1]. */
-static int add_glb(tool_output *output, const char *path, const hpm_command_options *options, const triangle_mesh *m,
+static int add_gltf(tool_output *output, const char *path, const hpm_command_options *options, const triangle_mesh *m,
                    const float *corner_uv, const tt_image *image)
 {
     obj_write_desc desc;
@@ -237,7 +240,7 @@ static int add_glb(tool_output *output, const char *path, const hpm_command_opti
     material.base_color = image;
     material_for_glb(&material, &options->maps, (const tt_image *const *)options->maps.images);
     material.repeat = (options->map.flags & TT_HPM_TOROIDAL) != 0;
-    status = output_add_glb(output, path, &desc, &material);
+    status = output_add_gltf(output, path, &desc, &material);
     free(normals);
     return status;
 }
@@ -350,17 +353,17 @@ int cmd_hpm(int argc, char **argv)
     hpm_quality quality;
     tool_output output = TOOL_OUTPUT_INIT;
     float *corner_uv = NULL;
-    char obj_path[4096], mtl_path[4096], glb_path[4096], message[TOOL_ERROR_SIZE], normal_path[4200];
+    char obj_path[4096], mtl_path[4096], gltf_path[4096], written[8400], message[TOOL_ERROR_SIZE], normal_path[4200];
     const char *map_paths[MATERIAL_MAPS];
     double start = tool_seconds_now();
-    int status, map, glb;
+    int status, map, gltf;
 
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
-    tool_output_path(options.prefix, ".glb", glb_path, sizeof glb_path);
-    glb = options.output.format == TOOL_FORMAT_GLB;
+    tool_output_path(options.prefix, tool_model_extension(&options.output), gltf_path, sizeof gltf_path);
+    gltf = options.output.format != TOOL_FORMAT_OBJ;
     /* The UVs are into IMAGE itself, so they serve every map of its size as
        it is; a Y-down normal map alone is rewritten, +Y up. */
     material_path(normal_path, sizeof normal_path, options.prefix, MATERIAL_NORMAL);
@@ -375,10 +378,10 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again, but only after mapping). */
-    if (status == 0 && glb) status = tool_refuse_input_overwrite(glb_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(obj_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(mtl_path);
-    if (status == 0 && !glb && options.maps.normal_y_down) status = tool_refuse_input_overwrite(normal_path);
+    if (status == 0 && gltf) status = tool_refuse_input_overwrite(gltf_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0 && !gltf && options.maps.normal_y_down) status = tool_refuse_input_overwrite(normal_path);
     if (status == 0) {
         corner_uv = (float *)malloc((size_t)mesh.ntriangles * 6 * sizeof(float));
         if (!corner_uv) status = tool_fail("out of memory for the texture coordinates of %s", options.mesh_path);
@@ -386,16 +389,19 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0) status = map_mesh(&options, &mesh, image, corner_uv, &report);
     if (status == 0) status = measure_quality(&options, &mesh, image, corner_uv, &report, &quality);
 
-    if (status == 0 && glb) status = add_glb(&output, glb_path, &options, &mesh, corner_uv, image);
-    if (status == 0 && !glb) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
-    if (status == 0 && !glb) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0, map_paths);
-    if (status == 0 && !glb && options.maps.normal_y_down)
+    if (status == 0 && gltf) status = add_gltf(&output, gltf_path, &options, &mesh, corner_uv, image);
+    if (status == 0 && !gltf) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
+    if (status == 0 && !gltf) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0, map_paths);
+    if (status == 0 && !gltf && options.maps.normal_y_down)
         status = output_add_map_png(&output, normal_path, MATERIAL_NORMAL, options.maps.images[MATERIAL_NORMAL]);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, image, &report, &quality, tool_seconds_now() - start);
-        if (glb) printf("wrote %s (with %s in it)\n", glb_path, options.image_path);
+        if (gltf && options.output.format == TOOL_FORMAT_GLTF)
+            printf("wrote %s\n", gltf_written(gltf_path, written, sizeof written));
+        else if (gltf)
+            printf("wrote %s (with %s in it)\n", gltf_path, options.image_path);
         else
             printf("wrote %s, %s%s%s\n", obj_path, mtl_path, options.maps.normal_y_down ? ", " : "",
                    options.maps.normal_y_down ? normal_path : "");

@@ -76,15 +76,16 @@ static void print_help(void)
            "its material names.\n"
            "That OBJ is for this tool's renderer and for engines that draw the faces in file order\n"
            "with blending; Blender's importer cannot stack copies of a triangle. To take the\n"
-           "result to other programs, use --bake (one texture on the mesh) or write a GLB, which\n"
-           "holds the pastes baked (--format glb, or OUT_PREFIX.glb).\n"
+           "result to other programs, use --bake (one texture on the mesh) or write glTF, which\n"
+           "holds the pastes baked (--format glb or gltf, or OUT_PREFIX.glb or .gltf).\n"
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
            "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
            "--permissive.\n");
     tool_print_mesh_help(1);
-    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl or .png loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
-           "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
+           "(--format glb), one ending in .gltf OUT_PREFIX.gltf (--format gltf). It may be '-' (the\n"
+           "standard output) only for a GLB, one file.\n"
            "\n");
     /* Two pieces: C99 compilers need only take string literals of 4095 bytes. */
     printf("options:\n"
@@ -127,11 +128,12 @@ static void print_help(void)
            "                       (pieces of the surface flattened, one texel density, 2 texels\n"
            "                       apart); 'auto' (default) the OBJ's own when they are fit, else an\n"
            "                       atlas, with a warning saying why when the OBJ has some\n"
-           "  --format obj|glb     obj (default): the files above; glb: one binary glTF file,\n"
+           "  --format F           obj (default): the files above; glb: one binary glTF file,\n"
            "                       OUT_PREFIX.glb, holding the pastes baked into one texture (--bake\n"
            "                       SIZE, default %d, and --bake-uv apply): a glTF renderer does not\n"
            "                       draw stacked copies of a triangle in order, so the pasting OBJ stays\n"
-           "                       the way to composite at run time\n"
+           "                       the way to composite at run time; gltf: the same as glTF text,\n"
+           "                       OUT_PREFIX.gltf, with OUT_PREFIX.bin and PNGs beside it\n"
            "  --triangles          accepted for the OBJ, whose faces are triangles already\n",
            TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
            LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
@@ -249,7 +251,7 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
         return TOOL_EXIT_USAGE;
     /* A glTF renderer does not draw stacked blended copies of a triangle in
        their order, so a GLB holds the pastes baked into one texture. */
-    if (options->output.format == TOOL_FORMAT_GLB && options->bake_size == 0)
+    if (options->output.format != TOOL_FORMAT_OBJ && options->bake_size == 0)
         options->bake_size = LAPPED_GLB_BAKE_SIZE;
     return -1;
 }
@@ -986,10 +988,10 @@ static int bake_map(const lapped_options *options, const triangle_mesh *m, const
 
 /* --bake: the pastes composited into a size x size texture over corner_uv
    (from bake_uvs; freed here); an ordinary OBJ + MTL + PNG (and a PNG per
-   map), or with a glb_path (not NULL) that GLB. */
+   map), or with a gltf_path (not NULL) that GLB. */
 static int add_baked(tool_output *output, const lapped_options *options, const triangle_mesh *m,
                      const tt_lapped *lapped, const lapped_patches *patches, float *corner_uv,
-                     const char *glb_path, baked_summary *summary)
+                     const char *gltf_path, baked_summary *summary)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256], map_paths[MATERIAL_MAPS][4200];
     char stem[TOOL_PREFIX_SIZE + 16];
@@ -1034,7 +1036,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
 
     snprintf(comment, sizeof comment, "lapped texture by tiledtex %s, baked into %s", TILEDTEX_VERSION_STRING,
              tool_basename(png_path));
-    if (!(normals = tool_corner_normals(glb_path ? glb_path : obj_path, m->mesh, m->corner_normal))) {
+    if (!(normals = tool_corner_normals(gltf_path ? gltf_path : obj_path, m->mesh, m->corner_normal))) {
         status = TOOL_EXIT_FAILURE;
         goto done;
     }
@@ -1047,7 +1049,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     desc.corner_uv = corner_uv;
     desc.corner_normal = normals;
     desc.share_equal = 1;   /* a chart's corners at one vertex share a vt */
-    if (glb_path) {
+    if (gltf_path) {
         /* The GLB is written at once: every map baked into an atlas of its own. */
         tool_material material;
         for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
@@ -1062,7 +1064,7 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
         material.name = "lapped_baked";
         material.base_color = atlas;
         material_for_glb(&material, &options->maps, (const tt_image *const *)map_atlases);
-        status = output_add_glb(output, glb_path, &desc, &material);
+        status = output_add_gltf(output, gltf_path, &desc, &material);
         goto done;
     }
     desc.comment = comment;
@@ -1215,12 +1217,12 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
 /* Refuse, before the long part, outputs that would replace an input (the
    commit checks again, but only after pasting). */
 static int refuse_overwriting_inputs(const lapped_options *options, const char *obj_path, const char *mtl_path,
-                                     const char *glb_path, const lapped_patches *patches)
+                                     const char *gltf_path, const lapped_patches *patches)
 {
     static const char *const baked[] = {"_baked.obj", "_baked.mtl", "_baked.png"};
     char path[4096 + 16];
     int status, k;
-    if (options->output.format == TOOL_FORMAT_GLB) return tool_refuse_input_overwrite(glb_path);
+    if (options->output.format != TOOL_FORMAT_OBJ) return tool_refuse_input_overwrite(gltf_path);
     status = tool_refuse_input_overwrite(obj_path);
     if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
     for (k = 0; k < patches->count && status == 0; k++) status = tool_refuse_input_overwrite(patches->png_paths[k]);
@@ -1248,16 +1250,16 @@ int cmd_lapped(int argc, char **argv)
     lapped_patches patches;
     float *field = NULL, *bake_uv = NULL;
     baked_summary baked;
-    char obj_path[4096], mtl_path[4096], glb_path[4096], message[TOOL_ERROR_SIZE];
+    char obj_path[4096], mtl_path[4096], gltf_path[4096], written[8400], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
-    int status, charts = 0, glb;
+    int status, charts = 0, gltf;
 
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
-    tool_output_path(options.prefix, ".glb", glb_path, sizeof glb_path);
-    glb = options.output.format == TOOL_FORMAT_GLB;
+    tool_output_path(options.prefix, tool_model_extension(&options.output), gltf_path, sizeof gltf_path);
+    gltf = options.output.format != TOOL_FORMAT_OBJ;
     memset(&output, 0, sizeof output);
     memset(&baked, 0, sizeof baked);
     memset(&patches, 0, sizeof patches);
@@ -1273,15 +1275,15 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     if (status == 0) status = choose_windows(&options, image->width, image->height, &windows);
     if (status == 0) status = lapped_patches_name(options.prefix, &windows, &options.maps, &patches);
-    if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, glb_path, &patches);
+    if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, gltf_path, &patches);
     if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &charts);
     if (status == 0) status = load_mask(&options, image->width, image->height, &windows, &mask);
     /* Memory: the image is needed only to make the patches and their PNGs,
        so the PNGs are encoded now and the image freed before the paste
        loop; from here on the command holds the patches and the compressed
        PNGs. */
-    if (status == 0) status = make_patches(&options, &image, &windows, mask, glb ? NULL : &output, &patches);
-    if (status == 0) status = make_map_patches(&options, &options.maps, &windows, glb ? NULL : &output, &patches);
+    if (status == 0) status = make_patches(&options, &image, &windows, mask, gltf ? NULL : &output, &patches);
+    if (status == 0) status = make_map_patches(&options, &options.maps, &windows, gltf ? NULL : &output, &patches);
     material_free(&options.maps);
     image_free(image);
     image = NULL;
@@ -1289,14 +1291,14 @@ int cmd_lapped(int argc, char **argv)
     mask = NULL;
     if (status == 0) status = paste(&options, &mesh, field, &patches, &lapped);
 
-    if (status == 0 && !glb)
+    if (status == 0 && !gltf)
         status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped, &patches);
-    if (status == 0 && !glb)
+    if (status == 0 && !gltf)
         status = output_add_mtl_materials(&output, mtl_path, patches.count, (const char *const *)patches.materials,
                                           (const char *const *)patches.png_paths, 1,
                                           (const char *const *)patches.map_png_paths);
     if (status == 0 && options.bake_size > 0) {
-        status = add_baked(&output, &options, &mesh, lapped, &patches, bake_uv, glb ? glb_path : NULL, &baked);
+        status = add_baked(&output, &options, &mesh, lapped, &patches, bake_uv, gltf ? gltf_path : NULL, &baked);
         bake_uv = NULL;   /* add_baked freed it */
     }
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
@@ -1304,8 +1306,9 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, field, lapped, &patches, &baked, tool_seconds_now() - start);
         print_patch_use(&patches, lapped);
-        if (glb) {
-            printf("wrote %s (the pastes baked into %dx%d, over ", glb_path, options.bake_size, options.bake_size);
+        if (gltf) {
+            printf("wrote %s (the pastes baked into %dx%d, over ", gltf_written(gltf_path, written, sizeof written),
+                   options.bake_size, options.bake_size);
             if (charts == 0) printf("the OBJ's texture coordinates)\n");
             else printf("an atlas of %d chart%s)\n", charts, charts == 1 ? "" : "s");
         } else {

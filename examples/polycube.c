@@ -52,9 +52,10 @@ static void print_help(void)
            "surface with its tiles). Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX.png\n"
            "view.png'.\n");
     tool_print_mesh_help(1);
-    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl or .png loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
-           "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
+           "(--format glb), one ending in .gltf OUT_PREFIX.gltf (--format gltf). It may be '-' (the\n"
+           "standard output) only for a GLB, one file.\n"
            "\n"
            "options:\n"
            "  --resolution N   cubes along the mesh's longest side, 1 to %d (default %d)\n"
@@ -73,9 +74,11 @@ static void print_help(void)
            "                   right quarter of each tile turns a quarter (bricks, planks and grain\n"
            "                   run crosswise there); by default the walls' tiles keep IMAGE's up\n"
            "                   throughout, from a second set of tiles beside the first\n"
-           "  --format obj|glb obj (default): the files above; glb: one binary glTF file,\n"
-           "                   OUT_PREFIX.glb: the textured mesh with the atlas in it (the\n"
-           "                   polycube's surface is left out: write the OBJ files to see it)\n"
+           "  --format F       obj (default): the files above; glb: one binary glTF file,\n"
+           "                   OUT_PREFIX.glb: the textured mesh with the atlas in it; gltf: the\n"
+           "                   same as glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and\n"
+           "                   OUT_PREFIX_baseColor.png (and a PNG per map) beside it (either way\n"
+           "                   the polycube's surface is left out: write the OBJ files to see it)\n"
            "  --triangles      write the polycube surface's squares as two triangles each (the\n"
            "                   mesh is triangles already)\n"
            MATERIAL_OPTIONS_HELP("                   ")
@@ -550,14 +553,14 @@ static int add_obj(tool_output *output, const char *path, const char *mtl_name, 
    surface, a look at what the mesh was mapped onto, stays out of it: a GLB
    is the textured mesh to take to other programs, and the surface would
    enclose it. */
-static int add_glb(tool_output *output, const char *path, const polycube_job *job, const tool_material *material)
+static int add_gltf(tool_output *output, const char *path, const polycube_job *job, const tool_material *material)
 {
     obj_write_desc desc;
     float *normals = mapped_corner_normals(path, job);
     int status;
     if (!normals) return TOOL_EXIT_FAILURE;
     mapped_write_desc(job, normals, &desc);
-    status = output_add_glb(output, path, &desc, material);
+    status = output_add_gltf(output, path, &desc, material);
     free(normals);
     return status;
 }
@@ -587,11 +590,11 @@ int cmd_polycube(int argc, char **argv)
     tt_image *image = NULL;
     tool_output output = TOOL_OUTPUT_INIT;
     tt_error error;
-    char obj_path[4096], mtl_path[4096], png_path[4096], surface_path[4096], glb_path[4096],
+    char obj_path[4096], mtl_path[4096], png_path[4096], surface_path[4096], gltf_path[4096], written[8400],
         message[TOOL_ERROR_SIZE];
     char map_paths[MATERIAL_MAPS][4200];
     const char *map_names[MATERIAL_MAPS];
-    int status, map, glb;
+    int status, map, gltf;
     double start;
 
     memset(&job, 0, sizeof job);
@@ -601,8 +604,8 @@ int cmd_polycube(int argc, char **argv)
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options.prefix);
     snprintf(png_path, sizeof png_path, "%s.png", options.prefix);
     snprintf(surface_path, sizeof surface_path, "%s_polycube.obj", options.prefix);
-    tool_output_path(options.prefix, ".glb", glb_path, sizeof glb_path);
-    glb = options.tiles.output.format == TOOL_FORMAT_GLB;
+    tool_output_path(options.prefix, tool_model_extension(&options.tiles.output), gltf_path, sizeof gltf_path);
+    gltf = options.tiles.output.format != TOOL_FORMAT_OBJ;
     for (map = 0; map < MATERIAL_MAPS; map++) {
         material_path(map_paths[map], sizeof map_paths[map], options.prefix, map);
         map_names[map] = options.tiles.maps.paths[map] ? tool_basename(map_paths[map]) : NULL;
@@ -619,12 +622,12 @@ int cmd_polycube(int argc, char **argv)
         status = tool_fail("%s", error.message);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again). */
-    if (status == 0 && glb) status = tool_refuse_input_overwrite(glb_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(obj_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(mtl_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(png_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(surface_path);
-    if (status == 0 && !glb) status = material_refuse_overwrite(&options.tiles.maps, options.prefix);
+    if (status == 0 && gltf) status = tool_refuse_input_overwrite(gltf_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(png_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(surface_path);
+    if (status == 0 && !gltf) status = material_refuse_overwrite(&options.tiles.maps, options.prefix);
 
     if (status == 0) status = build_polycube(&options, &job);
     if (status == 0) {
@@ -642,7 +645,7 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = map_mesh(&options, &job);
     if (status == 0) status = measure_quality(&options, &job, &quality);
 
-    if (status == 0 && glb) {
+    if (status == 0 && gltf) {
         tool_material material;
         const tt_image *map_images[MATERIAL_MAPS];
         memset(&material, 0, sizeof material);
@@ -652,27 +655,27 @@ int cmd_polycube(int argc, char **argv)
             map_images[map] = job.map_atlas[map] ? job.map_atlas[map]
                               : job.map_tiles[map] ? &job.map_tiles[map]->levels[0] : NULL;
         material_for_glb(&material, &options.tiles.maps, map_images);
-        status = add_glb(&output, glb_path, &job, &material);
+        status = add_gltf(&output, gltf_path, &job, &material);
     }
-    if (status == 0 && !glb && job.atlas &&
+    if (status == 0 && !gltf && job.atlas &&
         output_add_png(&output, png_path, job.atlas, TT_COLOR_SRGB, message, sizeof message) != 0)
         status = tool_fail("%s", message);
-    if (status == 0 && !glb && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0, TT_COLOR_SRGB);
-    for (map = 0; map < MATERIAL_MAPS && status == 0 && !glb; map++) {
+    if (status == 0 && !gltf && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0, TT_COLOR_SRGB);
+    for (map = 0; map < MATERIAL_MAPS && status == 0 && !gltf; map++) {
         if (job.map_atlas[map]) status = output_add_map_png(&output, map_paths[map], map, job.map_atlas[map]);
         else if (job.map_tiles[map])
             status = tiled_add_atlas(&output, map_paths[map], job.map_tiles[map], 0, material_space(map));
     }
-    if (status == 0 && !glb) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
-    if (status == 0 && !glb) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
-    if (status == 0 && !glb)
+    if (status == 0 && !gltf) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
+    if (status == 0 && !gltf) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
+    if (status == 0 && !gltf)
         status = add_surface_obj(&output, surface_path, tool_basename(mtl_path), &job, options.tiles.output.triangles);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &job, &quality);
-        if (glb) {
-            printf("wrote %s\n", glb_path);
+        if (gltf) {
+            printf("wrote %s\n", gltf_written(gltf_path, written, sizeof written));
         } else {
             printf("wrote %s, %s, %s, %s", obj_path, mtl_path, png_path, surface_path);
             for (map = 0; map < MATERIAL_MAPS; map++)

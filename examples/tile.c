@@ -20,9 +20,10 @@ static void print_help(void)
            "first; each quad shows one tile, so --subdivide makes the texture smaller on the\n"
            "surface.\n");
     tool_print_mesh_help(1);
-    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl, .png or .gltf loses it\n"
+    printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl or .png loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
-           "(--format glb). It may be '-' (the standard output) only for a GLB, one file.\n"
+           "(--format glb), one ending in .gltf OUT_PREFIX.gltf (--format gltf). It may be '-' (the\n"
+           "standard output) only for a GLB, one file.\n"
            "\n"
            "options:\n"
            "  --colors N             edge conditions n; (2n)^4 tiles (default 1)\n"
@@ -38,8 +39,11 @@ static void print_help(void)
            "  --report               also print tile usage and face stretch, and measure the\n"
            "                         seams on every edge (default: a sample of %d edges)\n"
            MATERIAL_OPTIONS_HELP("                         ")
-           "  --format obj|glb       obj (default): the OBJ, MTL and PNG above; glb: one binary glTF\n"
-           "                         file, OUT_PREFIX.glb, with the atlas in it (not with --mips)\n"
+           "  --format F             obj (default): the OBJ, MTL and PNG above; glb: one binary glTF\n"
+           "                         file, OUT_PREFIX.glb, with the atlas in it; gltf: the same as\n"
+           "                         glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and\n"
+           "                         OUT_PREFIX_baseColor.png (and a PNG per map) beside it (neither\n"
+           "                         with --mips)\n"
            "  --triangles            write each quad of the OBJ as two triangles, for programs that\n"
            "                         read only triangles (a GLB holds triangles anyway)\n"
            "\n"
@@ -59,10 +63,10 @@ int cmd_tile(int argc, char **argv)
     tool_seams seams;
     tool_output output;
     char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096],
-        glb_path[4096];
+        gltf_path[4096], written[8400];
     char map_paths[MATERIAL_MAPS][4200];
     const char *map_names[MATERIAL_MAPS];
-    int map, glb;
+    int map, gltf;
 
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
@@ -74,14 +78,14 @@ int cmd_tile(int argc, char **argv)
                                       &options, positional, 3, "MESH, IMAGE and OUT_PREFIX", print_help);
     if (status >= 0) return status;
     if (tool_output_prefix(positional[2], &options.output, prefix) != 0) return TOOL_EXIT_USAGE;
-    glb = options.output.format == TOOL_FORMAT_GLB;
+    gltf = options.output.format != TOOL_FORMAT_OBJ;
     /* The per-tile mip levels keep coarse levels from blending neighbouring
        tiles; a GLB has no place for them (its viewer makes its own). */
-    if (glb && options.mips) return tool_usage("--mips writes PNG files beside an OBJ: not with a GLB");
+    if (gltf && options.mips) return tool_usage("--mips writes PNG files beside an OBJ: not with glTF (--format obj)");
     snprintf(obj_path, sizeof obj_path, "%s.obj", prefix);
     snprintf(mtl_path, sizeof mtl_path, "%s.mtl", prefix);
     snprintf(png_path, sizeof png_path, "%s.png", prefix);
-    tool_output_path(prefix, ".glb", glb_path, sizeof glb_path);
+    tool_output_path(prefix, tool_model_extension(&options.output), gltf_path, sizeof gltf_path);
     for (map = 0; map < MATERIAL_MAPS; map++) {
         material_path(map_paths[map], sizeof map_paths[map], prefix, map);
         map_names[map] = options.maps.paths[map] ? tool_basename(map_paths[map]) : NULL;
@@ -99,11 +103,11 @@ int cmd_tile(int argc, char **argv)
     status = tiled_check_atlas_size(&options);
     if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
     /* Before the synthesis: no output may replace an input (checked again at the commit). */
-    if (status == 0 && glb) status = tool_refuse_input_overwrite(glb_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(obj_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(mtl_path);
-    if (status == 0 && !glb) status = tool_refuse_input_overwrite(png_path);
-    if (status == 0 && !glb) status = material_refuse_overwrite(&options.maps, prefix);
+    if (status == 0 && gltf) status = tool_refuse_input_overwrite(gltf_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(obj_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(mtl_path);
+    if (status == 0 && !gltf) status = tool_refuse_input_overwrite(png_path);
+    if (status == 0 && !gltf) status = material_refuse_overwrite(&options.maps, prefix);
     if (status == 0) status = tiled_synthesize(image, positional[1], &options, &options.maps, &tiles, map_tiles);
     /* The photo and the maps are not needed past the synthesis: free them
        before the PNGs are encoded (they are the largest things the command
@@ -114,7 +118,7 @@ int cmd_tile(int argc, char **argv)
     if (status == 0)
         status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, 0,
                                     NULL, 0, options.report, &seams);
-    if (status == 0 && glb) {
+    if (status == 0 && gltf) {
         tool_material material;
         const tt_image *map_atlases[MATERIAL_MAPS];
         for (map = 0; map < MATERIAL_MAPS; map++) map_atlases[map] = map_tiles[map] ? &map_tiles[map]->levels[0] : NULL;
@@ -122,14 +126,14 @@ int cmd_tile(int argc, char **argv)
         material.name = "tiled";
         material.base_color = &tiles->levels[0];
         material_for_glb(&material, &options.maps, map_atlases);
-        status = tiled_add_glb(&output, glb_path, &mesh, &material);
+        status = tiled_add_gltf(&output, gltf_path, &mesh, &material);
     }
-    if (status == 0 && !glb) status = tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
-    for (map = 0; map < MATERIAL_MAPS && status == 0 && !glb; map++)
+    if (status == 0 && !gltf) status = tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
+    for (map = 0; map < MATERIAL_MAPS && status == 0 && !gltf; map++)
         if (map_tiles[map])
             status = tiled_add_atlas(&output, map_paths[map], map_tiles[map], options.mips, material_space(map));
-    if (status == 0 && !glb) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
-    if (status == 0 && !glb)
+    if (status == 0 && !gltf) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
+    if (status == 0 && !gltf)
         status = tiled_add_obj(&output, obj_path, &mesh, tool_basename(mtl_path), options.output.triangles);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
     if (status == 0) {
@@ -137,8 +141,9 @@ int cmd_tile(int argc, char **argv)
         tiled_print_notes(positional[0], &mesh);
         if (!tool_quiet()) {
             tiled_print_summary(positional[0], &mesh, &seams, options.report);
-            if (glb) {
-                printf("wrote %s (%dx%d atlas)\n", glb_path, tiles->levels[0].width, tiles->levels[0].height);
+            if (gltf) {
+                printf("wrote %s (%dx%d atlas)\n", gltf_written(gltf_path, written, sizeof written),
+                       tiles->levels[0].width, tiles->levels[0].height);
             } else {
                 printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
                 for (map = 0; map < MATERIAL_MAPS; map++)

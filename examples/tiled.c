@@ -205,14 +205,14 @@ int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *m
     return status;
 }
 
-int tiled_add_glb(tool_output *output, const char *glb_path, const tiled_mesh *mesh, const tool_material *material)
+int tiled_add_gltf(tool_output *output, const char *gltf_path, const tiled_mesh *mesh, const tool_material *material)
 {
     obj_write_desc desc;
-    float *normals = tool_corner_normals(glb_path, mesh->mesh, mesh->corner_normal);
+    float *normals = tool_corner_normals(gltf_path, mesh->mesh, mesh->corner_normal);
     int status;
     if (!normals) return TOOL_EXIT_FAILURE;
     tiled_write_desc(mesh, normals, &desc);
-    status = output_add_glb(output, glb_path, &desc, material);
+    status = output_add_gltf(output, gltf_path, &desc, material);
     free(normals);
     return status;
 }

@@ -20,7 +20,7 @@ enum {
     TILED_REPORT_OPTION = 1 << 4,    /* --report: quality line, seams measured on every edge */
     TILED_MATERIAL_OPTIONS = 1 << 5, /* --normal --roughness --metallic --ao --height --normal-y-down */
     TILED_TRIANGLES_OPTION = 1 << 6, /* --triangles */
-    TILED_FORMAT_OPTION = 1 << 7     /* --format obj|glb */
+    TILED_FORMAT_OPTION = 1 << 7     /* --format obj|gltf */
 };
 
 /* From this many triangles on, a mesh counts as a dense triangle mesh, for
@@ -88,7 +88,7 @@ void tiled_mesh_free(tiled_mesh *mesh);
 int tiled_add_obj(tool_output *output, const char *obj_path, const tiled_mesh *mesh, const char *mtl_name,
                   int triangles);
 /* Add GLB_PATH: the same mesh with `material` (its base colour the atlas). */
-int tiled_add_glb(tool_output *output, const char *glb_path, const tiled_mesh *mesh, const tool_material *material);
+int tiled_add_gltf(tool_output *output, const char *gltf_path, const tiled_mesh *mesh, const tool_material *material);
 /* Add an MTL file with one material, "tiled", whose texture is TEXTURE_NAME
    and whose other maps are map_names (as mtl_add_material's maps). */
 int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture_name, const char *const *map_names);

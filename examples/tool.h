@@ -15,7 +15,7 @@
      image_io.c  images                  image_load, png_encode, output_add_png,
                                          image_to_rgba8
      obj.c       OBJ reading, writing    obj_parse, obj_read_text, obj_write
-     gltf.c      glTF 2.0 binary (.glb)  gltf_write, output_add_glb,
+     gltf.c      glTF 2.0 (.glb, .gltf)  gltf_write, output_add_gltf,
                                          gltf_pack_metallic_roughness,
                  tangent frames          triangle_texture_axes
      mesh_file.c any mesh file, --weld   mesh_read, mesh_weld
@@ -169,15 +169,16 @@ int tool_flag(const char *arg, const char *name);
 #define TOOL_PREFIX_SIZE 4000
 
 /* What the commands that write a textured mesh (tile, lapped, hpm,
-   polycube) write it as: an OBJ with its MTL and PNGs, or one binary glTF
-   file. Zero-initialised: OBJ, faces as they are. */
-typedef enum tool_mesh_format { TOOL_FORMAT_OBJ = 0, TOOL_FORMAT_GLB = 1 } tool_mesh_format;
+   polycube) write it as: an OBJ with its MTL and PNGs, one binary glTF
+   file (.glb), or a glTF as text (.gltf) with its .bin and PNGs beside it.
+   Zero-initialised: OBJ, faces as they are. */
+typedef enum tool_mesh_format { TOOL_FORMAT_OBJ = 0, TOOL_FORMAT_GLB = 1, TOOL_FORMAT_GLTF = 2 } tool_mesh_format;
 typedef struct tool_mesh_output {
-    tool_mesh_format format;    /* --format obj|glb, or an OUT_PREFIX ending in .glb */
+    tool_mesh_format format;    /* --format obj|glb|gltf, or an OUT_PREFIX ending in .glb or .gltf */
     int format_given;           /* --format was given */
     int triangles;              /* --triangles: OBJ faces written as triangle fans */
 } tool_mesh_output;
-/* If argv[*index] is --format obj|glb (only when accept_format) or
+/* If argv[*index] is --format obj|glb|gltf (only when accept_format) or
    --triangles, consume it and return 1; 0 for any other argument; -1 after
    printing a bad value. */
 int parse_mesh_output_option(int argc, char **argv, int *index, int accept_format, tool_mesh_output *output);
@@ -185,13 +186,15 @@ int parse_mesh_output_option(int argc, char **argv, int *index, int accept_forma
 /* OUT_PREFIX as given into `prefix` (TOOL_PREFIX_SIZE bytes), less a known
    extension (.obj, .mtl, .png, .glb, .gltf, any case): "out.obj" means
    out.obj + out.mtl + out.png, not out.obj.obj. With `output` (NULL for a
-   command without --format) an OUT_PREFIX ending in .glb also sets
-   output->format to GLB, and one that names the other format than --format
-   asks for is refused ("out.glb --format obj", "out.obj --format glb"). A GLB is
-   one file, so for GLB "-" (the standard output) is kept as the prefix;
-   otherwise "-" is refused (the prefix names several files, standard
-   output takes one), as are a directory and a too long prefix: prints the
-   error and returns TOOL_EXIT_USAGE; 0 otherwise. */
+   command without --format) an OUT_PREFIX ending in .glb or .gltf also
+   sets output->format to GLB or GLTF, and one that names another format
+   than --format asks for is refused ("out.glb --format obj", "out.obj
+   --format glb"); without `output` a .glb or .gltf name is refused (the
+   command writes no glTF). A GLB is one file, so for GLB "-" (the standard
+   output) is kept as the prefix; otherwise "-" is refused (the prefix
+   names several files, standard output takes one), as are a directory and
+   a too long prefix: prints the error and returns TOOL_EXIT_USAGE; 0
+   otherwise. */
 int tool_output_prefix(const char *text, tool_mesh_output *output, char *prefix);
 /* The file PREFIX + SUFFIX ("out" + ".glb"), or "-" when the prefix is "-". */
 void tool_output_path(const char *prefix, const char *suffix, char *path, size_t size);
@@ -212,6 +215,8 @@ int tool_refuse_stdout(const char *path, int several, const char *what);
    function below reports as "--size needs a value". Returns 0 when argv[*index]
    is some other argument. */
 int tool_option(int argc, char **argv, int *index, const char *name, const char **value);
+/* The extension of the model file of `output`'s format: ".obj", ".glb" or ".gltf". */
+const char *tool_model_extension(const tool_mesh_output *output);
 
 /* An axis name: x, y or z (either case), with an optional sign: "-z",
    "+y". *axis gets 0, 1 or 2 and *sign +1 or -1; returns 0, or -1 without
@@ -681,7 +686,7 @@ int output_add_mtl_materials(tool_output *output, const char *mtl_path, int coun
                              const char *const *texture_paths, int texture_alpha, const char *const *map_paths);
 
 /* ---------------------------------------------------------------------- */
-/* glTF 2.0 binary, .glb (gltf.c)                                           */
+/* glTF 2.0, .glb and .gltf (gltf.c)                                      */
 /* ---------------------------------------------------------------------- */
 
 /* The material of a GLB, as a command holds it: its images, each NULL when
@@ -732,10 +737,17 @@ int gltf_pack_metallic_roughness(const tt_image *roughness, const tt_image *meta
    coordinate, a file over 4 GB, out of memory. */
 int gltf_write(const obj_write_desc *mesh, const tool_material *material, const char *name, unsigned char **glb,
                size_t *glb_size, char *err, size_t err_size);
-/* gltf_write into a new file of the batch, its object named after the
-   file ("out" for out.glb; "tiledtex" for "-"). On failure one line naming
-   PATH, and the failure exit status. */
-int output_add_glb(tool_output *output, const char *path, const obj_write_desc *mesh, const tool_material *material);
+/* The scene of gltf_write into the batch, its object named after the file
+   ("out" for out.glb or out.gltf; "tiledtex" for "-"): for a PATH ending
+   in .gltf (any case) the separate form, PATH holding the JSON, PATH less
+   .gltf plus ".bin" the arrays and PATH less .gltf plus "_baseColor.png",
+   "_normal.png", "_metallicRoughness.png" and "_occlusion.png" the images
+   it has, each named from the JSON by a relative URI; otherwise one GLB
+   file. On failure one line naming PATH, and the failure exit status. */
+int output_add_gltf(tool_output *output, const char *path, const obj_write_desc *mesh, const tool_material *material);
+/* PATH as a summary names what was written: a .gltf with the files beside
+   it ("p.gltf, p.bin, p_*.png", into `text`), a GLB alone (PATH itself). */
+const char *gltf_written(const char *path, char *text, size_t size);
 
 /* A triangle's texture axes: dP/du into axes[0..2] and dP/dv into
    axes[3..5], the derivatives of the linear map its corners' texture
@@ -966,6 +978,8 @@ void tool_parallel_ranges(const tt_executor *executor, int n, int grain, void (*
    of memory. */
 char *tool_copy_string(const char *text, size_t length);
 
+/* Whether `path` ends with `extension` (".gltf"), in any case. */
+int tool_has_extension(const char *path, const char *extension);
 /* The file name part of a path ("out/a.png" -> "a.png"), for mtllib / map_Kd
    lines that must be relative to the OBJ / MTL file. */
 const char *tool_basename(const char *path);

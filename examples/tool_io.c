@@ -6,6 +6,7 @@
 
 #define _XOPEN_SOURCE 700          /* open, fdopen, fileno, stat, isatty, clock_gettime, realpath */
 
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -423,6 +424,15 @@ const char *tool_basename(const char *path)
     for (p = path; *p; p++)
         if (*p == '/' || *p == '\\') base = p + 1;
     return base;
+}
+
+int tool_has_extension(const char *path, const char *extension)
+{
+    size_t length = strlen(path), n = strlen(extension), i;
+    if (length < n) return 0;
+    for (i = 0; i < n; i++)
+        if (tolower((unsigned char)path[length - n + i]) != tolower((unsigned char)extension[i])) return 0;
+    return 1;
 }
 
 char *tool_copy_string(const char *text, size_t length)

@@ -2465,7 +2465,8 @@ cd "$W" || exit 1
 # Command-line conventions (issue 11, item 5)
 # ======================================================================
 # An OUT_PREFIX ending in a known extension loses it: "out.obj" writes
-# out.obj + out.mtl, never out.obj.obj, in every command that takes a prefix.
+# out.obj + out.mtl, never out.obj.obj, in every command that takes a prefix
+# (.glb and .gltf choose those formats: below).
 prefix_case() {
     local what=$1 expect=$2
     shift 2
@@ -2481,7 +2482,7 @@ check "tile OUT_PREFIX out.obj: mtllib names out.mtl" "mtllib out.mtl" "$(grep m
     "$(grep -qx 'mtllib out.mtl' "$W/d$NEWDIR_N/out.obj" 2>/dev/null; echo $?)"
 prefix_case "tile OUT_PREFIX out.PNG" "out.obj out.mtl out.png" tile ../in/torus.obj ../in/tex.png out.PNG
 prefix_case "lapped OUT_PREFIX l.mtl" "l.obj l.mtl l_patch.png" lapped ../in/torus.obj ../in/lap.png l.mtl --scale 1.5
-prefix_case "hpm OUT_PREFIX h.gltf" "h.obj h.mtl" hpm ../in/torus.obj ../in/lap.png h.gltf
+prefix_case "hpm OUT_PREFIX h.Obj" "h.obj h.mtl" hpm ../in/torus.obj ../in/lap.png h.Obj
 prefix_case "polycube OUT_PREFIX p.OBJ" "p.obj p.mtl p.png p_polycube.obj" polycube ../in/spheretri.obj ../in/tex.png \
     p.OBJ --resolution 4
 
@@ -3057,6 +3058,75 @@ fi
 validate "polycube GLB" p.glb
 cd "$W" || exit 1
 
+# --- .gltf: the GLB's scene as text, with its arrays and images beside it -----
+# gltf_same_as_glb WHAT STEM: STEM.gltf, STEM.bin and STEM_*.png hold what
+# STEM.glb holds: the .bin is the BIN chunk's arrays (the GLB's images come
+# after them), each PNG the embedded image of its name, and the JSON names
+# the .bin with its length; then the validator (which reads the files the
+# URIs name)
+gltf_same_as_glb() {
+    local what=$1 stem=$2 bin_size json slot
+    glb_check "$what (its GLB)" "$stem.glb"
+    [ -n "$GLB_JSON" ] || return
+    bin_size=$(stat -c %s "$stem.bin" 2>/dev/null || echo 0)
+    CMD="glb_probe bytes $stem.glb 0 $bin_size | cmp - $stem.bin"
+    check "$what: $stem.bin is the GLB's arrays" "identical" "$bin_size bytes" \
+        "$([ "$bin_size" -gt 0 ] && "$GLB_PROBE" bytes "$stem.glb" 0 "$bin_size" | cmp -s - "$stem.bin"; echo $?)"
+    for slot in $(json_items images | grep -oE '"name":"[A-Za-z]+"' | cut -d'"' -f4); do
+        glb_image "$stem.glb" "$slot" "glb_$slot.png"
+        CMD="cmp glb_$slot.png ${stem}_$slot.png"
+        check "$what: ${stem}_$slot.png is the GLB's $slot image" "identical" "$(ls -l "${stem}_$slot.png" 2>&1)" \
+            "$(cmp -s "glb_$slot.png" "${stem}_$slot.png"; echo $?)"
+        rm -f "glb_$slot.png"
+    done
+    json=$(tr -d '\n' <"$stem.gltf")
+    CMD="$stem.gltf"
+    check "$what: the JSON names $stem.bin and its length" "\"buffers\":[{\"uri\":\"$stem.bin\",\"byteLength\":$bin_size}]" \
+        "$(printf '%s' "$json" | grep -oE '"buffers":\[[^]]*\]')" \
+        "$(printf '%s' "$json" | grep -qF "\"buffers\":[{\"uri\":\"$stem.bin\",\"byteLength\":$bin_size}]"; echo $?)"
+    validate "$what" "$stem.gltf"
+}
+# gltf_case WHAT STEM EXPECTED_FILES ARGS...: the command run twice in a
+# fresh folder, OUT_PREFIX STEM.glb then STEM.gltf; exactly the GLB and
+# EXPECTED_FILES are left, and the .gltf holds what the GLB does
+gltf_case() {
+    local what=$1 stem=$2 expected=$3
+    shift 3
+    newdir
+    expect_ok "$what OUT.glb" "$@" "$stem.glb"
+    expect_ok "$what OUT.gltf" "$@" "$stem.gltf"
+    check "$what OUT.gltf: the summary names the files" "wrote $stem.gltf, $stem.bin, ${stem}_*.png" "$OUT" \
+        "$(printf '%s' "$OUT" | grep -qF "wrote $stem.gltf, $stem.bin, ${stem}_*.png"; echo $?)"
+    CMD="ls after tiledtex $* $stem.gltf"
+    check "$what OUT.gltf: its files and nothing else" "$expected $stem.glb" "$(ls | tr '\n' ' ')" \
+        "$([ "$(ls | sort | tr '\n' ' ')" = "$(printf '%s\n' $expected "$stem.glb" | sort | tr '\n' ' ')" ]; echo $?)"
+    gltf_same_as_glb "$what glTF" "$stem"
+    cd "$W" || exit 1
+}
+gltf_case "tile" t "t.gltf t.bin t_baseColor.png" tile ../in/torus.obj ../in/tex.png
+gltf_case "hpm" h "h.gltf h.bin h_baseColor.png" hpm ../in/torus.obj ../in/lap.png
+gltf_case "polycube" p "p.gltf p.bin p_baseColor.png" polycube ../in/spheretri.obj ../in/tex.png --resolution 4
+gltf_case "lapped" l "l.gltf l.bin l_baseColor.png" lapped ../in/torus.obj ../in/lap.png --bake 128
+# --format gltf is the same as a name ending in .gltf; a name with a space
+# and a letter beyond ASCII is written as it is, and the JSON's URIs are
+# percent-encoded (the validator reads the files through them)
+newdir
+expect_ok "tile --format gltf" tile ../in/torus.obj ../in/tex.png t --format gltf
+mkdir f
+expect_ok "tile OUT.gltf in another folder" tile ../in/torus.obj ../in/tex.png f/t.gltf
+CMD="cmp t.gltf f/t.gltf; cmp t.bin f/t.bin"
+check "tile: --format gltf and OUT_PREFIX.gltf write the same files" "identical" "$(ls . f | tr '\n' ' ')" \
+    "$(cmp -s t.gltf f/t.gltf && cmp -s t.bin f/t.bin && cmp -s t_baseColor.png f/t_baseColor.png; echo $?)"
+name=$'m \303\251'   # "m é", the é in UTF-8
+expect_ok "tile OUT.gltf with a space and a non-ASCII letter" tile ../in/torus.obj ../in/tex.png "$name.gltf"
+CMD="grep uri '$name.gltf'"
+check "tile OUT.gltf '$name': percent-encoded URIs" "\"uri\":\"m%20%C3%A9.bin\" and m%20%C3%A9_baseColor.png" \
+    "$(grep -oE '"uri":"[^"]*"' "$name.gltf" 2>&1 | tr '\n' ' ')" \
+    "$(grep -qF '"uri":"m%20%C3%A9.bin"' "$name.gltf" && grep -qF '"uri":"m%20%C3%A9_baseColor.png"' "$name.gltf" &&
+       [ -s "$name.bin" ] && [ -s "${name}_baseColor.png" ]; echo $?)"
+validate "tile OUT.gltf '$name'" "$name.gltf"
+cd "$W" || exit 1
+
 # --- what a GLB is refused with ----------------------------------------------
 expect_usage_error "tile OUT.glb --format obj (they disagree)" tile ../in/torus.obj ../in/tex.png o.glb --format obj
 err_mentions "tile OUT.glb --format obj: says why" "names a GLB.*format obj"
@@ -3064,8 +3134,14 @@ expect_usage_error "hpm OUT.obj --format glb (they disagree)" hpm ../in/torus.ob
 err_mentions "hpm OUT.obj --format glb: names o.glb" "o\.glb"
 expect_usage_error "polycube OUT.gltf --format glb (a GLB is not .gltf)" polycube ../in/spheretri.obj ../in/tex.png o.gltf \
     --format glb
-expect_usage_error "lapped --format gltf" lapped ../in/torus.obj ../in/lap.png o --format gltf
-err_mentions "lapped --format gltf: names the formats" "obj or glb"
+expect_usage_error "lapped --format fbx" lapped ../in/torus.obj ../in/lap.png o --format fbx
+err_mentions "lapped --format fbx: names the formats" "obj, glb or gltf"
+expect_usage_error "tile OUT.gltf --format obj (they disagree)" tile ../in/torus.obj ../in/tex.png o.gltf --format obj
+err_mentions "tile OUT.gltf --format obj: says why" "names a glTF.*format obj"
+expect_usage_error "hpm OUT.obj --format gltf (they disagree)" hpm ../in/torus.obj ../in/lap.png o.obj --format gltf
+err_mentions "hpm OUT.obj --format gltf: names o.gltf" "o\.gltf"
+expect_usage_error "hpm - --format gltf (several files)" hpm ../in/torus.obj ../in/lap.png - --format gltf
+expect_usage_error "tile --mips with a .gltf" tile ../in/torus.obj ../in/tex.png o.gltf --mips
 expect_usage_error "tile --format without a value" tile ../in/torus.obj ../in/tex.png o --format
 expect_usage_error "tile --mips with a GLB" tile ../in/torus.obj ../in/tex.png o.glb --mips
 expect_usage_error "hpm - (OBJ: several files)" hpm ../in/torus.obj ../in/lap.png -
@@ -3457,6 +3533,18 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
             "$most" "$([ "$most" = 0 ]; echo $?)"
     fi
     validate "tile GLB with a material" t.glb
+    # the same material as a .gltf: a PNG per texture beside it, the GLB's images
+    mkdir g && cp t.glb g/ && cd g || exit 1
+    expect_ok "tile a material into a .gltf" tile ../../in/torus.obj ../../in/tex.png t.gltf --tile 48 \
+        --normal ../m_normal.png --roughness ../m_roughness.png --height ../m_height.png --metallic ../coords.png \
+        --ao ../m_height.png
+    CMD="ls g after tiledtex tile ... t.gltf with a material"
+    check "tile .gltf with a material: a PNG per texture" \
+        "t.bin t.glb t.gltf t_baseColor.png t_metallicRoughness.png t_normal.png t_occlusion.png" "$(ls | tr '\n' ' ')" \
+        "$([ "$(ls | tr '\n' ' ')" = "t.bin t.glb t.gltf t_baseColor.png t_metallicRoughness.png t_normal.png t_occlusion.png " ]
+           echo $?)"
+    gltf_same_as_glb "tile .gltf with a material" t
+    cd .. || exit 1
     # with a normal map, a tangent per vertex: unit, across the normal, w = +-1, and along
     # +u (the first triangle's texture axis)
     if [ -n "$GLB_PROBE" ]; then

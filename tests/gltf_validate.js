@@ -1,7 +1,8 @@
-// tests/gltf_validate.js - check GLB files with the Khronos glTF validator
-// (the npm package gltf-validator).
+// tests/gltf_validate.js - check glTF files (.glb, or .gltf with the files
+// its URIs name beside it) with the Khronos glTF validator (the npm package
+// gltf-validator).
 //
-//   node tests/gltf_validate.js FILE.glb...
+//   node tests/gltf_validate.js FILE.glb|FILE.gltf...
 //   node tests/gltf_validate.js --version     (is it installed? exit 0 or 2)
 //
 // The package is looked for in build/gltf-validator (where
@@ -29,7 +30,7 @@ function loadValidator() {
 async function main() {
     const files = process.argv.slice(2);
     if (files.length === 0) {
-        console.error('usage: node tests/gltf_validate.js FILE.glb...');
+        console.error('usage: node tests/gltf_validate.js FILE.glb|FILE.gltf...');
         return 2;
     }
     const validator = loadValidator();
@@ -50,9 +51,19 @@ async function main() {
             console.error(`${file}: ${e.message}`);
             return 2;
         }
-        // Unlimited issues: a count cut short would hide errors.
+        // Unlimited issues: a count cut short would hide errors. A .gltf's
+        // buffers and images are read from the files its relative URIs name
+        // (a missing one is the validator's error to report).
+        const directory = path.dirname(file);
+        const external = (uri) => new Promise((resolve, reject) => {
+            fs.readFile(path.join(directory, decodeURIComponent(uri)), (error, data) => {
+                if (error) reject(error);
+                else resolve(new Uint8Array(data));
+            });
+        });
         const report = await validator.validateBytes(bytes, { uri: path.basename(file), maxIssues: 0,
-                                                             writeTimestamp: false });
+                                                             writeTimestamp: false,
+                                                             externalResourceFunction: external });
         const issues = report.issues;
         console.log(`${file}: ${issues.numErrors} errors, ${issues.numWarnings} warnings, ` +
                     `${issues.numInfos} infos, ${issues.numHints} hints (gltf-validator ${validator.version()})`);
