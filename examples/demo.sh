@@ -13,7 +13,7 @@
 #                                           build/demo/lapped.obj/.mtl, lapped_patch_1..4.png, lapped_baked.*,
 #                                           pictures build/demo/lapped_front.png, lapped_baked_front.png
 #   6. hierarchical pattern mapping (Soler et al.): texture coordinates into the texture itself:
-#                                           build/demo/hpm.obj/.mtl, picture build/demo/hpm_front.png
+#                                           build/demo/hpm.obj/.mtl/.png, picture build/demo/hpm_front.png
 #   7. polycube + Wang tiles (Chang and Lin): the triangles split along a polycube's squares:
 #                                           build/demo/polycube.obj/.mtl/.png, polycube_polycube.obj,
 #                                           pictures build/demo/polycube_front.png, polycube_cubes.png

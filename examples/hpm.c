@@ -33,8 +33,10 @@ static void print_help(void)
            "each is flattened and placed on the image where its content best continues the\n"
            "clusters already textured around it, and split into smaller ones when no place fits\n"
            "well enough. Writes OUT_PREFIX.obj (the triangles with one texture coordinate per\n"
-           "face corner) and OUT_PREFIX.mtl, which names IMAGE relative to itself: keep IMAGE\n"
-           "where it is. Look at it with 'tiledtex render OUT_PREFIX.obj IMAGE view.png'.\n"
+           "face corner), OUT_PREFIX.mtl and a copy of IMAGE beside them, OUT_PREFIX.png (or .jpg:\n"
+           "a PNG or JPEG is copied byte for byte, another format written as a PNG), so that the\n"
+           "folder can move. Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX.png\n"
+           "view.png'.\n"
            "Faces with more than 3 corners are split into triangle fans first. The mesh must be\n"
            "manifold and consistently oriented.\n");
     tool_print_mesh_help(1);
@@ -66,10 +68,12 @@ static void print_help(void)
            "                   gltf: the same as glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and\n"
            "                   OUT_PREFIX_baseColor.png (and a PNG per map) beside it\n"
            "  --triangles      accepted for the OBJ, whose faces are triangles already\n"
+           "  --reference-image  no copies: the MTL names IMAGE (and the maps) where they are,\n"
+           "                   relative to itself; keep them there\n"
            MATERIAL_OPTIONS_HELP("                   ")
-           "                   (here the MTL names each map where it is, as it names IMAGE: the\n"
-           "                   UVs serve every map; only a --normal-y-down map is written, turned\n"
-           "                   +Y up, as OUT_PREFIX_normal.png)\n"
+           "                   (the UVs serve every map as they serve IMAGE: each is copied beside\n"
+           "                   the OBJ as IMAGE is, OUT_PREFIX_normal.png and so on; a\n"
+           "                   --normal-y-down map is written turned +Y up)\n"
            "\n"
            "Prints the clusters textured per level of the hierarchy, the fits (accepted, accepted\n"
            "at the smallest cluster size, rejected: split), clusters that continue a neighbour's\n"
@@ -91,6 +95,7 @@ typedef struct hpm_command_options {
     tt_hpm_options map;     /* zero fields: the library's defaults */
     material_maps maps;     /* --normal ...: the material's other maps, on the same UVs */
     tool_mesh_output output;        /* --format, --triangles */
+    int reference_image;            /* --reference-image: the MTL names IMAGE and the maps where they are */
 } hpm_command_options;
 
 /* --threshold: a number above 0, or "inf" (every fit accepted). */
@@ -141,6 +146,8 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
             options->map.flags |= TT_HPM_TOROIDAL;
         } else if (tool_flag(argv[i], "--no-fit")) {
             options->map.flags |= TT_HPM_RANDOM_PLACEMENT;
+        } else if (tool_flag(argv[i], "--reference-image")) {
+            options->reference_image = 1;
         } else if ((taken = material_parse_option(argc, argv, &i, &options->maps)) != 0) {
             if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_is_option(argv[i])) {
@@ -340,6 +347,39 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
     printf("\n");
 }
 
+/* An image file beside the OBJ, so that the folder can move: `source`'s
+   bytes as they are when it is a PNG or a JPEG (which every program
+   reads), into STEM.png or STEM.jpg; any other format as a PNG of the
+   image as loaded (`map` a material map, or -1 for the colour image,
+   sRGB). A source that is that file already is named, not copied. The
+   path the MTL is to name goes to `path`. */
+static int add_image_copy(tool_output *output, const char *source, const tt_image *loaded, int map, const char *stem,
+                          char *path, size_t size)
+{
+    static const unsigned char png_signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    char message[TOOL_ERROR_SIZE];
+    unsigned char *data;
+    size_t length;
+    int png, jpeg;
+    if (tool_read_file(source, &data, &length, message, sizeof message) != 0) return tool_fail("%s", message);
+    png = length >= 8 && memcmp(data, png_signature, 8) == 0;
+    jpeg = length >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF;
+    snprintf(path, size, "%s%s", stem, jpeg ? ".jpg" : ".png");
+    if (tool_same_file(source, path)) {
+        free(data);
+        return 0;
+    }
+    if (png || jpeg) {
+        if (output_add(output, path, data, length) != 0) return tool_fail("out of memory while writing %s", path);
+        return 0;
+    }
+    free(data);
+    if (map >= 0) return output_add_map_png(output, path, map, loaded);
+    if (output_add_png(output, path, loaded, TT_COLOR_SRGB, message, sizeof message) != 0)
+        return tool_fail("%s: %s", path, message);
+    return 0;
+}
+
 /* ======================================================================== */
 /* The command                                                              */
 /* ======================================================================== */
@@ -354,7 +394,8 @@ int cmd_hpm(int argc, char **argv)
     tool_output output = TOOL_OUTPUT_INIT;
     float *corner_uv = NULL;
     char obj_path[4096], mtl_path[4096], gltf_path[4096], written[8400], message[TOOL_ERROR_SIZE], normal_path[4200];
-    const char *map_paths[MATERIAL_MAPS];
+    char texture_path[4200], copy_paths[MATERIAL_MAPS][4200], stem[4200];
+    const char *map_paths[MATERIAL_MAPS], *texture = NULL;
     double start = tool_seconds_now();
     int status, map, gltf;
 
@@ -391,7 +432,21 @@ int cmd_hpm(int argc, char **argv)
 
     if (status == 0 && gltf) status = add_gltf(&output, gltf_path, &options, &mesh, corner_uv, image);
     if (status == 0 && !gltf) status = add_obj(&output, obj_path, tool_basename(mtl_path), &options, &mesh, corner_uv);
-    if (status == 0 && !gltf) status = output_add_mtl(&output, mtl_path, "hpm", options.image_path, 0, map_paths);
+    /* IMAGE and the maps copied beside the OBJ (--reference-image: named where they are). */
+    texture = options.image_path;
+    if (status == 0 && !gltf && !options.reference_image) {
+        status = add_image_copy(&output, options.image_path, image, -1, options.prefix, texture_path,
+                                sizeof texture_path);
+        texture = texture_path;
+        for (map = 0; map < MATERIAL_MAPS && status == 0; map++) {
+            if (!options.maps.paths[map] || (map == MATERIAL_NORMAL && options.maps.normal_y_down)) continue;
+            snprintf(stem, sizeof stem, "%s_%s", options.prefix, material_map_names[map]);
+            status = add_image_copy(&output, options.maps.paths[map], options.maps.images[map], map, stem,
+                                    copy_paths[map], sizeof copy_paths[map]);
+            map_paths[map] = copy_paths[map];
+        }
+    }
+    if (status == 0 && !gltf) status = output_add_mtl(&output, mtl_path, "hpm", texture, 0, map_paths);
     if (status == 0 && !gltf && options.maps.normal_y_down)
         status = output_add_map_png(&output, normal_path, MATERIAL_NORMAL, options.maps.images[MATERIAL_NORMAL]);
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
@@ -402,9 +457,15 @@ int cmd_hpm(int argc, char **argv)
             printf("wrote %s\n", gltf_written(gltf_path, written, sizeof written));
         else if (gltf)
             printf("wrote %s (with %s in it)\n", gltf_path, options.image_path);
-        else
-            printf("wrote %s, %s%s%s\n", obj_path, mtl_path, options.maps.normal_y_down ? ", " : "",
-                   options.maps.normal_y_down ? normal_path : "");
+        else {
+            printf("wrote %s, %s", obj_path, mtl_path);
+            if (!options.reference_image && !tool_same_file(options.image_path, texture)) printf(", %s", texture);
+            for (map = 0; map < MATERIAL_MAPS; map++)
+                if (map_paths[map] && map_paths[map] != options.maps.paths[map] &&
+                    !tool_same_file(options.maps.paths[map], map_paths[map]))
+                    printf(", %s", map_paths[map]);
+            printf("\n");
+        }
     }
     output_free(&output);
     image_free(image);

@@ -264,6 +264,8 @@ int tool_read_file(const char *path, unsigned char **data, size_t *size, char *e
    TOOL_EXIT_FAILURE, or 0 when the path is fine). */
 int tool_check_output_path(const char *path, char *err, size_t err_size);
 int tool_refuse_input_overwrite(const char *path);
+/* Whether paths a and b name one existing file (device and inode). */
+int tool_same_file(const char *a, const char *b);
 /* Forget the inputs remembered so far (frees their list). */
 void tool_forget_inputs(void);
 

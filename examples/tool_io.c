@@ -264,6 +264,13 @@ int tool_check_output_path(const char *path, char *err, size_t err_size)
     return 0;
 }
 
+int tool_same_file(const char *a, const char *b)
+{
+    struct stat info_a, info_b;
+    return stat(a, &info_a) == 0 && stat(b, &info_b) == 0 && info_a.st_dev == info_b.st_dev &&
+           info_a.st_ino == info_b.st_ino;
+}
+
 int tool_refuse_input_overwrite(const char *path)
 {
     char message[TOOL_ERROR_SIZE];

@@ -1172,20 +1172,22 @@ hpm_obj_report() {
 fan_triangles() { awk '$1 == "f" { n += NF - 3 } END { print n + 0 }' "$1" 2>/dev/null; }
 
 # hpm_case NAME MESH BOUNDED ARGS... : in a fresh directory, hpm writes
-# exactly out.obj and out.mtl; the OBJ holds the mesh's triangle fans with a
-# vt for each corner (equal ones shared), finite (and in [0,1] when BOUNDED is "bounded");
-# the MTL names the input image from out.mtl's directory; the summary has its lines.
+# exactly out.obj, out.mtl and out.png, a copy of the input image byte for
+# byte, which the MTL names (the folder can move); the OBJ holds the mesh's
+# triangle fans with a vt for each corner (equal ones shared), finite (and
+# in [0,1] when BOUNDED is "bounded"); the summary has its lines.
 hpm_case() {
     local name=$1 mesh=$2 bounded=$3 faces nontri corners nvt badc unused nonfinite outside want
     shift 3
     newdir
     run hpm "../in/$mesh" ../in/lap.png out "$@"
     check "hpm $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
-    check "hpm $name: exactly out.mtl, out.obj" "out.mtl out.obj" "$(ls -A | tr '\n' ' ')" \
-        "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj " ]; echo $?)"
-    check "hpm $name: mtl names the input image, no copy" "map_Kd ../in/lap.png, mtllib out.mtl" \
+    check "hpm $name: exactly out.mtl, out.obj, out.png" "out.mtl out.obj out.png" "$(ls -A | tr '\n' ' ')" \
+        "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out.png " ]; echo $?)"
+    check "hpm $name: mtl names out.png, the input image's copy" "map_Kd out.png, mtllib out.mtl, out.png = lap.png" \
         "$(grep -h -E 'map_|mtllib' out.mtl out.obj 2>&1)" \
-        "$(grep -qE '^map_Kd +\.\./in/lap\.png$' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl' out.obj 2>/dev/null; echo $?)"
+        "$(grep -qE '^map_Kd +out\.png$' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl' out.obj 2>/dev/null &&
+           cmp -s out.png ../in/lap.png; echo $?)"
     read -r faces nontri corners nvt badc unused nonfinite outside <<<"$(hpm_obj_report out.obj)"
     want=$(fan_triangles "$W/in/$mesh")
     check "hpm $name: the mesh's $want triangles" "$want triangle f lines" "$faces f lines, $nontri not triangles" \
@@ -1254,15 +1256,36 @@ check "hpm into a subdirectory: map_Kd finds the image from sub/" "sub/<map_Kd> 
     "$(cmp -s "sub/$(awk '$1 == "map_Kd" { print $2 }' sub/out.mtl 2>/dev/null)" images/stones.png; echo $?)"
 cd run || exit 1
 expect_ok "hpm into ../sub from another directory" hpm ../../in/torus.obj ../images/stones.png ../sub/up --rotations 3
-check "hpm into ../sub: map_Kd finds the image from sub/" "map_Kd ../images/stones.png" "$(grep map_Kd ../sub/up.mtl 2>&1)" \
-    "$(grep -qE '^map_Kd +\.\./images/stones\.png$' ../sub/up.mtl 2>/dev/null; echo $?)"
+check "hpm into ../sub: map_Kd names the copy beside it" "map_Kd up.png" "$(grep map_Kd ../sub/up.mtl 2>&1)" \
+    "$(grep -qE '^map_Kd +up\.png$' ../sub/up.mtl 2>/dev/null && cmp -s ../sub/up.png ../images/stones.png; echo $?)"
+# --reference-image: no copy, the MTL names IMAGE relative to itself, from a directory reached with ".."
+expect_ok "hpm --reference-image into ../sub" hpm ../../in/torus.obj ../images/stones.png ../sub/ref --rotations 3 \
+    --reference-image
+check "hpm --reference-image: map_Kd ../images/stones.png, no copy" "map_Kd ../images/stones.png" \
+    "$(grep map_Kd ../sub/ref.mtl 2>&1)" \
+    "$(grep -qE '^map_Kd +\.\./images/stones\.png$' ../sub/ref.mtl 2>/dev/null && [ ! -e ../sub/ref.png ]; echo $?)"
 cd .. || exit 1
 # absolute paths too: relative to the MTL, so sub/ and images/ can move together
-expect_ok "hpm with an absolute IMAGE and OUT_PREFIX" hpm ../in/torus.obj "$PWD/images/stones.png" "$PWD/sub/abs" \
-    --rotations 3
+expect_ok "hpm --reference-image with an absolute IMAGE and OUT_PREFIX" hpm ../in/torus.obj "$PWD/images/stones.png" \
+    "$PWD/sub/abs" --rotations 3 --reference-image
 check "hpm absolute paths: map_Kd ../images/stones.png, mtllib abs.mtl" "map_Kd ../images/stones.png, mtllib abs.mtl" \
     "$(grep -h -E '^(map_Kd|mtllib)' sub/abs.mtl sub/abs.obj 2>&1)" \
     "$(grep -qx 'map_Kd ../images/stones.png' sub/abs.mtl 2>/dev/null && grep -qx 'mtllib abs.mtl' sub/abs.obj; echo $?)"
+# IMAGE that is the copy's own name already (OUT_PREFIX.png beside the OBJ) is named, not copied over
+cp images/stones.png sub/same.png
+expect_ok "hpm with IMAGE at OUT_PREFIX.png" hpm ../in/torus.obj sub/same.png sub/same --rotations 3
+check "hpm IMAGE at OUT_PREFIX.png: named as it is" "map_Kd same.png, the file unchanged" "$(grep map_Kd sub/same.mtl 2>&1)" \
+    "$(grep -qx 'map_Kd same.png' sub/same.mtl && cmp -s sub/same.png images/stones.png; echo $?)"
+# a JPEG is copied as a JPEG, byte for byte
+if command -v convert >/dev/null 2>&1 && convert images/stones.png images/stones.jpg 2>/dev/null; then
+    expect_ok "hpm with a JPEG IMAGE" hpm ../in/torus.obj images/stones.jpg sub/jp --rotations 3
+    check "hpm JPEG IMAGE: copied as sub/jp.jpg" "map_Kd jp.jpg, the same bytes" "$(grep map_Kd sub/jp.mtl 2>&1)" \
+        "$(grep -qx 'map_Kd jp.jpg' sub/jp.mtl && cmp -s sub/jp.jpg images/stones.jpg; echo $?)"
+fi
+# the folder moved: the MTL still finds its texture
+mv sub moved
+check "hpm output folder moved: map_Kd still names a file beside the MTL" "moved/up.png" "$(ls moved)" \
+    "$([ -s "moved/$(awk '$1 == "map_Kd" { print $2 }' moved/up.mtl)" ]; echo $?)"
 cd "$W" || exit 1
 
 # bad inputs: one line, non-zero exit, no files
@@ -3585,10 +3608,18 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
         --tile 48 --normal m_normal.png --metallic m_roughness.png
     validate "polycube GLB with a material" pg.glb
 
-    # hpm: the UVs serve every map where it is; a y-down normal map is rewritten +Y up
+    # hpm: the UVs serve every map as they are; each is copied beside the OBJ as IMAGE is
+    # (--reference-image: named where it is); a y-down normal map is rewritten +Y up
     expect_ok "hpm with a material" hpm ../in/torus.obj ../in/tex.png h --normal m_normal.png --roughness m_roughness.png
-    check "hpm: the MTL names the maps where they are" "norm m_normal.png, map_Pr m_roughness.png" "$(cat h.mtl)" \
-        "$(grep -qx 'norm m_normal.png' h.mtl && grep -qx 'map_Pr m_roughness.png' h.mtl && [ ! -e h_normal.png ]; echo $?)"
+    check "hpm: the MTL names the maps' copies" "norm h_normal.png, map_Pr h_roughness.png" "$(cat h.mtl)" \
+        "$(grep -qx 'norm h_normal.png' h.mtl && grep -qx 'map_Pr h_roughness.png' h.mtl &&
+           cmp -s h_normal.png m_normal.png && cmp -s h_roughness.png m_roughness.png; echo $?)"
+    expect_ok "hpm with a material, --reference-image" hpm ../in/torus.obj ../in/tex.png hr --normal m_normal.png \
+        --roughness m_roughness.png --reference-image
+    check "hpm --reference-image: the MTL names the maps where they are" "norm m_normal.png, map_Pr m_roughness.png" \
+        "$(cat hr.mtl)" \
+        "$(grep -qx 'norm m_normal.png' hr.mtl && grep -qx 'map_Pr m_roughness.png' hr.mtl && [ ! -e hr_normal.png ]
+           echo $?)"
     expect_ok "hpm --normal-y-down" hpm ../in/torus.obj ../in/tex.png hd --normal dx_normal.png --normal-y-down
     check "hpm --normal-y-down: writes hd_normal.png +Y up and names it" "norm hd_normal.png" "$(cat hd.mtl)" \
         "$(grep -qx 'norm hd_normal.png' hd.mtl && [ -s hd_normal.png ]; echo $?)"
