@@ -23988,11 +23988,27 @@ typedef struct tt__split {
    The point lies on their triangle, so each coordinate is kept within the
    sources' own: weights that round past 1 (or a hair below 0) would
    otherwise carry a coordinate near FLT_MAX past it, to infinity. */
-static void tt__split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
-                                  float weight_out[3])
+/* Barycentric weights moved onto their triangle: those below 0 (a point a
+   rounding outside it, -4.6e-17 on a split edge found by fuzz_polycube,
+   or a fan centre's mean value coordinates past a boundary that is not
+   convex, a hair to a tenth) set to 0 and the others scaled back to a sum
+   of 1, so that the mapping's weights stay in [0, 1] as documented. */
+static void tt__barycentric_onto_triangle(double weight[3])
 {
-    double p[3] = {0.0, 0.0, 0.0}, lo[3], hi[3];
+    double sum = 0.0;
+    int k;
+    if (!(weight[0] < 0.0 || weight[1] < 0.0 || weight[2] < 0.0)) return;
+    for (k = 0; k < 3; k++) sum += weight[k] = weight[k] > 0.0 ? weight[k] : 0.0;
+    for (k = 0; k < 3; k++) weight[k] = sum > 0.0 ? weight[k] / sum : (k == 0);
+}
+
+static void tt__split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight_in[3],
+                                  float position[3], float weight_out[3])
+{
+    double p[3] = {0.0, 0.0, 0.0}, lo[3], hi[3], weight[3];
     int k, a;
+    memcpy(weight, weight_in, sizeof weight);
+    tt__barycentric_onto_triangle(weight);
     for (a = 0; a < 3; a++) lo[a] = hi[a] = mesh->pos[3 * source[0] + a];
     for (k = 0; k < 3; k++) {
         weight_out[k] = (float)weight[k];
@@ -25353,16 +25369,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             }
         }
         for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * mapping->source[3 * v]];
-        /* Barycentric weights in the input triangle. A fan centre's mean
-           value coordinates over a boundary that is not convex can put it
-           outside (a weight below 0, from a hair to a tenth, found by
-           fuzz_polycube): it is moved onto the triangle, the weights
-           below 0 set to 0 and the others scaled back to a sum of 1. */
-        if (weight[0] < 0.0 || weight[1] < 0.0 || weight[2] < 0.0) {
-            double sum = 0.0;
-            for (k = 0; k < 3; k++) sum += weight[k] = weight[k] > 0.0 ? weight[k] : 0.0;
-            for (k = 0; k < 3; k++) weight[k] = sum > 0.0 ? weight[k] / sum : (k == 0);
-        }
+        tt__barycentric_onto_triangle(weight);   /* barycentric weights in the input triangle */
         for (k = 0; k < 3; k++) {
             mapping->source[3 * v + k] = source[k];
             mapping->weights[3 * v + k] = (float)weight[k];

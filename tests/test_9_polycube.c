@@ -3604,6 +3604,19 @@ static void test_split_vertex_data(void)
     CHECK(position[0] == (float)(0.5 * FLT_MAX) && position[1] == (float)(0.25 * FLT_MAX + 0.5) &&
               position[2] == (float)(0.25 * FLT_MAX + 1.0) && weight[2] == 0.5f,
           "an inside point interpolates: (%g, %g, %g)", position[0], position[1], position[2]);
+    /* A weight a rounding below 0 (found by fuzz_polycube on a split edge)
+       is 0, the others summing to 1: the mapping's weights stay in [0, 1]. */
+    {
+        const double below[3] = {1.0 + 4.55e-17, -4.55e-17, 0.0}, outside[3] = {0.6, 0.5, -0.1};
+        internal_split_vertex_data(mesh, source, below, position, weight);
+        CHECK(weight[0] == 1.0f && weight[1] == 0.0f && !signbit(weight[1]) && weight[2] == 0.0f,
+              "weights (1 + 4.55e-17, -4.55e-17, 0) give (%.9g, %.9g, %.9g)", (double)weight[0], (double)weight[1],
+              (double)weight[2]);
+        internal_split_vertex_data(mesh, source, outside, position, weight);
+        CHECK(fabs(weight[0] - 0.6f / 1.1f) < 1e-7 && fabs(weight[1] - 0.5f / 1.1f) < 1e-7 && weight[2] == 0.0f,
+              "weights (0.6, 0.5, -0.1) give (%.9g, %.9g, %.9g): onto the triangle, summing to 1", (double)weight[0],
+              (double)weight[1], (double)weight[2]);
+    }
     tt_mesh_free(mesh);
     tm_free(&m);
 }
