@@ -9981,7 +9981,7 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
     }
     tt__free(allocator, listed);
     tt__free(allocator, edge_class);
-    if (npopulation == 0 && ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) || listed)) {
+    if (npopulation == 0 && ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) || opt.edges)) {
         tt__free(allocator, interior);
         if ((opt.flags & TT_SEAM_UV_DISCONTINUOUS) && ndiscontinuous == 0)
             return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
