@@ -102,7 +102,8 @@ static int edit_distance(const char *a, size_t na, const char *b, size_t nb, int
    are equally near. */
 static const char *nearest_option(const char *arg)
 {
-    const char *equals = strchr(arg, '='), *best = NULL, *candidates[OFFERED_MAX + 4];
+    const char *equals = strchr(arg, '='), *best = NULL;
+    const char *candidates[OFFERED_MAX + sizeof global_options / sizeof global_options[0]];
     size_t length = equals ? (size_t)(equals - arg) : strlen(arg);
     int ncandidates = 0, best_distance = INT_MAX, ties = 0, prefixed = 0, k;
     const char *prefix_of = NULL;
