@@ -418,30 +418,31 @@ int internal_relax_kernel_centre(const double (*ring)[2], int ntriangles, double
 {
     return tt__relax_kernel_centre(ring, ntriangles, centre);
 }
+/* A star of n triangles (x, ring[i][0], ring[i][1]) with the given shapes; 0 when a shape has no area. */
+static int make_untangle_star(int n, const double (*ring)[2][2], const double (*shape)[2][2], tt__untangle_star *star)
+{
+    int i;
+    star->n = n;
+    for (i = 0; i < n; i++) {
+        memcpy(star->ring[i], ring[i], sizeof star->ring[i]);
+        if (!tt__untangle_star_shape(star, i, shape[i])) return 0;
+    }
+    return 1;
+}
 double internal_untangle_energy(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
                                 double delta2, double density, double gradient[2], double hessian[3], int *folded)
 {
     tt__untangle_star star;
-    int i;
-    star.n = n;
-    for (i = 0; i < n; i++) {
-        memcpy(star.ring[i], ring[i], sizeof star.ring[i]);
-        if (!tt__untangle_star_shape(&star, i, shape[i])) return -1.0;
-    }
+    if (!make_untangle_star(n, ring, shape, &star)) return -1.0;
     return tt__untangle_energy(&star, x, delta2, density, gradient, hessian, folded);
 }
 void internal_untangle_descend(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
                                double reach, double delta2, double density, int strict, double kept[2])
 {
     tt__untangle_star star;
-    int i;
-    star.n = n;
-    for (i = 0; i < n; i++) {
-        memcpy(star.ring[i], ring[i], sizeof star.ring[i]);
-        if (!tt__untangle_star_shape(&star, i, shape[i])) {
-            kept[0] = kept[1] = -1.0;
-            return;
-        }
+    if (!make_untangle_star(n, ring, shape, &star)) {
+        kept[0] = kept[1] = -1.0;
+        return;
     }
     tt__untangle_descend(&star, x, reach, delta2, density, strict, kept);
 }
