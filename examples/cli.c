@@ -195,27 +195,26 @@ static const char *output_extension(const char *text)
 
 int tool_output_prefix(const char *text, tool_mesh_output *output, char *prefix)
 {
+    /* By tool_mesh_format: its --format value, the file's kind, what it writes. */
     static const char *const format_names[] = {"obj", "glb", "gltf"};
+    static const char *const kinds[] = {"OBJ", "GLB", "glTF"};
+    static const char *const writes[] = {"OBJ files", "one .glb file", "a .gltf file with its .bin and PNGs"};
     const char *extension = output_extension(text);
     size_t length = extension ? (size_t)(extension - text) : strlen(text);
     int named = TOOL_FORMAT_OBJ;   /* the format the name's extension says */
     if (extension && tool_has_extension(extension, ".glb")) named = TOOL_FORMAT_GLB;
     if (extension && tool_has_extension(extension, ".gltf")) named = TOOL_FORMAT_GLTF;
-    if (output && output->format_given && named != TOOL_FORMAT_OBJ && (int)output->format != named)
-        return tool_usage("OUT_PREFIX '%s' names a %s file, but --format %s asks for %s: drop one of them", text,
-                          named == TOOL_FORMAT_GLB ? "GLB" : "glTF", format_names[output->format],
-                          output->format == TOOL_FORMAT_OBJ ? "OBJ files" : output->format == TOOL_FORMAT_GLB
-                                                                              ? "one GLB file" : "a glTF file");
-    if (output && extension && named == TOOL_FORMAT_OBJ && output->format != TOOL_FORMAT_OBJ)
-        return tool_usage("OUT_PREFIX '%s' ends in %s, but --format %s writes %s: name it '%.*s%s'", text, extension,
-                          format_names[output->format],
-                          output->format == TOOL_FORMAT_GLB ? "one .glb file" : "a .gltf file with its .bin and "
-                                                                                "PNGs",
-                          (int)length, text, tool_model_extension(output));
-    if (output && named != TOOL_FORMAT_OBJ) output->format = (tool_mesh_format)named;
     if (!output && named != TOOL_FORMAT_OBJ)
         return tool_usage("OUT_PREFIX '%s' names a %s file, but this command writes OBJ and PNG files only", text,
-                          named == TOOL_FORMAT_GLB ? "GLB" : "glTF");
+                          kinds[named]);
+    if (output && output->format_given && named != TOOL_FORMAT_OBJ && (int)output->format != named)
+        return tool_usage("OUT_PREFIX '%s' names a %s file, but --format %s asks for %s: drop one of them", text,
+                          kinds[named], format_names[output->format], writes[output->format]);
+    if (output && extension && named == TOOL_FORMAT_OBJ && output->format != TOOL_FORMAT_OBJ)
+        return tool_usage("OUT_PREFIX '%s' ends in %s, but --format %s writes %s: name it '%.*s%s'", text, extension,
+                          format_names[output->format], writes[output->format], (int)length, text,
+                          tool_model_extension(output));
+    if (output && named != TOOL_FORMAT_OBJ) output->format = (tool_mesh_format)named;
     if (strcmp(text, "-") == 0 && output && output->format == TOOL_FORMAT_GLB) {
         strcpy(prefix, "-");
         return 0;
