@@ -25,20 +25,23 @@
    it at 180-250 inputs a second.
 
    Input bytes, read front to back (missing bytes read as 0):
-       0      bits 0..1 both set: allocation number byte[1] + 256 * (byte[2]
-              & 3) + 1 fails; bit2 a progress callback on the mapping,
-              cancelling after byte[3] % 8 calls (0 = never) when byte[9]
-              has bit7 set, else never; bit3 TT_POLYCUBE_NO_CORRECT; bit4
-              cube_size instead of resolution: the box's longest side /
-              (1 + byte[4] % 6); bit5 the mapping twice and compare
-              (determinism); bit6 with byte[4] >= 240 NULL options to
+       0      bits 0..1 both set, with byte[2] bit7: allocation number
+              byte[1] + 256 * (byte[2] & 3) + 1 fails; bit2 a progress
+              callback on the mapping, cancelling after byte[3] % 8 calls
+              (0 = never) when byte[9] has bit7 set, else never; bit3
+              TT_POLYCUBE_NO_CORRECT; bit4 cube_size instead of
+              resolution: the box's longest side / (1 + byte[4] % 6); bit5
+              the mapping twice and compare (determinism); bit6 with
+              byte[4] >= 240 and byte[2] bit6 NULL options to
               tt_polycube_build; bit7 with byte[12] >= 192 an extreme
               option double (byte[12] % 3 picks the field, byte[13] the
               value: fz_extreme_double). The second conditions keep the
-              runs that stop early (resolution 16 is not mapped here, an
-              extreme option or a cancel mostly stops the mapping) rare
-              enough that most runs reach the triangle split.
-       1, 2   which allocation fails (see above)
+              runs that stop early (a failed allocation, resolution 16,
+              which is not mapped here, an extreme option or a cancel
+              mostly stops the mapping) rare enough that most runs reach
+              the triangle split.
+       1, 2   which allocation fails (see above); byte[2] bits 6, 7 gate
+              NULL options and the failing allocation
        3      cancel after (% 8); bit3 TT_MESH_PERMISSIVE; bits 4..7 up:
               0 default, else one of +-x, +-y, +-z, or a skew vector
        4      resolution 1 + b % 6
@@ -216,8 +219,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (k = 0; k < 14; ++k) hdr[k] = rd_u8(&rd);
     fz_shape_read(&rd, &shape, 1);
     runs++;
-    null_options = (hdr[0] & 64) && hdr[4] >= 240;
-    alloc = fz_alloc_init(&a, (hdr[0] & 3) == 3 ? (long)hdr[1] + 256L * (hdr[2] & 3) + 1 : 0);
+    null_options = (hdr[0] & 64) && hdr[4] >= 240 && (hdr[2] & 64);
+    alloc = fz_alloc_init(&a, (hdr[0] & 3) == 3 && (hdr[2] & 128) ? (long)hdr[1] + 256L * (hdr[2] & 3) + 1 : 0);
 
     if (fz_shape_build(&shape, hdr[3] & 8, alloc, &a, &mesh) != TT_OK) goto out;
 
