@@ -41,7 +41,7 @@ maps=(--normal "$out/texture_normal.png" --height "$out/texture_height.png"
     --yaw 10 --pitch 30 --zoom 3 --size 900x600 --wireframe
 "$tool" render "$out/double_torus.obj" "$out/double_torus.png" "$out/double_torus_relief.png" \
     --yaw 10 --pitch 30 --zoom 3 --size 900x600 --normal "$out/double_torus_normal.png"
-"$tool" lapped "$out/double_torus_mesh.obj" "$out/texture.png" "$out/lapped" --scale 1.2 --seed 1 --bake 2048
+"$tool" lapped "$out/double_torus_mesh.obj" "$out/texture.png" "$out/lapped" --scale 1.2 --seed 1 --pasting --bake 2048
 # Four patches (windows of the 512x512 texture): render takes each paste's from its material.
 "$tool" render "$out/lapped.obj" "$out/lapped_patch_1.png" "$out/lapped_front.png" --yaw 20 --pitch 15
 "$tool" render "$out/lapped_baked.obj" "$out/lapped_baked.png" "$out/lapped_baked_front.png" --yaw 20 --pitch 15

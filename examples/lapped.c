@@ -1,18 +1,23 @@
 /* lapped.c - `tiledtex lapped`: texture a mesh with Praun et al.'s lapped textures.
 
-   MESH + IMAGE -> OUT_PREFIX.obj, whose faces are the pastes in order
-   (group paste_N: the triangles paste N covers, with that paste's texture
+   MESH + IMAGE -> OUT_PREFIX.obj + .mtl + .png: the pastes composited
+   into one texture over the mesh's own texture coordinates or a new atlas
+   (Praun et al. Sec. 4, "rendering with a texture atlas"), an ordinary
+   textured mesh that every program opens; or the same as glTF.
+
+   --pasting writes the pastes themselves instead (Sec. 4, "runtime
+   pasting"): OUT_PREFIX.obj, whose faces are the pastes in order (group
+   paste_N: the triangles paste N covers, with that paste's texture
    coordinates, and the material of its patch), OUT_PREFIX.mtl and the
-   texture patches (straight alpha): OUT_PREFIX_patch.png when there is one,
-   OUT_PREFIX_patch_K.png when there are several (--patches: windows of the
-   image, so that the pastes do not all show the same part of the photo).
-   Drawn in file order with alpha blending, the pastes cover
-   the surface (Praun et al. Sec. 4, "runtime pasting"); `tiledtex render`
-   draws such a file that way, as do engines that composite in order; an
-   importer that merges the copies of a triangle (Blender's) cannot, so
-   --bake also writes an ordinary textured mesh to exchange (Sec. 4,
-   "rendering with a texture atlas"). The MTL files name the textures beside
-   them by file name, so the folder can move.
+   texture patches (straight alpha): OUT_PREFIX_patch.png when there is
+   one, OUT_PREFIX_patch_K.png when there are several (--patches: windows
+   of the image, so that the pastes do not all show the same part of the
+   photo). Drawn in file order with alpha blending, the pastes cover the
+   surface; `tiledtex render` draws such a file that way, as do engines
+   that composite in order; an importer that merges or reorders the copies
+   of a triangle (Blender's, assimp's) cannot, which is why the bake is
+   the default. The MTL files name the textures beside them by file name,
+   so the folder can move.
 
    The library calls, as a user of tiledtex.h makes them:
 
@@ -27,7 +32,7 @@
                             --mask) alpha (Sec. 3.1)
      tt_lapped_paste        the paste loop over all the patches (Sec. 3.3 - 3.6, 4)
      tt_lapped_measure      alignment measured from the written UVs alone
-     tt_uv_check,           --bake: the OBJ's own texture coordinates when they
+     tt_uv_check,           the bake: the OBJ's own texture coordinates when they
      tt_atlas_pack_charts,  can take a bake (--bake-uv), else an atlas of
      tt_lapped_bake         charts, and the pastes composited into it
 */
@@ -54,9 +59,9 @@
    the whole image stays the one patch. */
 #define LAPPED_DEFAULT_PATCHES 4
 #define LAPPED_DEFAULT_MIN_WINDOW 64
-/* A GLB holds the pastes baked (see cmd_lapped); without --bake, into a
-   texture of this size. */
-#define LAPPED_GLB_BAKE_SIZE 2048
+/* The side of the baked texture unless --bake says: the default output
+   (and every glTF) holds the pastes baked, see parse_command_line. */
+#define LAPPED_DEFAULT_BAKE_SIZE 2048
 
 static void print_help(void)
 {
@@ -64,23 +69,25 @@ static void print_help(void)
            "\n"
            "Cover MESH with overlapping pastes of texture patches cut from IMAGE (Praun et\n"
            "al., Lapped Textures): no seams show, because every paste fades out over the ones\n"
-           "beneath it. Writes OUT_PREFIX.obj (group paste_N holds the triangles of paste N with\n"
-           "its texture coordinates and its patch's material; draw the groups in order with alpha\n"
-           "blending and clamped texture coordinates, the alpha times each vt's third number, the\n"
-           "paste's fade: 0 where it had to stop short of its soft edge), OUT_PREFIX.mtl and the\n"
-           "patches (straight alpha): OUT_PREFIX_patch.png when there is one, OUT_PREFIX_patch_1.png,\n"
-           "_2, ... when there are several (the MTL has a material lapped_K for each, naming its PNG\n"
-           "as map_Kd and map_d by file name: the folder can move).\n"
-           "Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX_patch_1.png view.png' (or\n"
-           "OUT_PREFIX_patch.png when there is one patch): render draws each paste with the patch\n"
-           "its material names.\n"
-           "That OBJ is for this tool's renderer and for engines that draw the faces in file order\n"
-           "with blending; Blender's importer cannot stack copies of a triangle. To take the\n"
-           "result to other programs, use --bake (one texture on the mesh) or write glTF, which\n"
-           "holds the pastes baked (--format glb or gltf, or OUT_PREFIX.glb or .gltf).\n"
+           "beneath it. Writes the pastes baked into one texture on the mesh, which every\n"
+           "program opens: OUT_PREFIX.obj, OUT_PREFIX.mtl and OUT_PREFIX.png (--bake SIZE, default\n"
+           "%d; the OBJ's texture coordinates or a new atlas, see --bake-uv), or with --format glb\n"
+           "or gltf (or OUT_PREFIX.glb or .gltf) the same as glTF.\n"
+           "--pasting writes instead the pastes themselves, to composite at run time:\n"
+           "OUT_PREFIX.obj (group paste_N holds the triangles of paste N with its texture\n"
+           "coordinates and its patch's material; draw the groups in order with alpha blending and\n"
+           "clamped texture coordinates, the alpha times each vt's third number, the paste's fade:\n"
+           "0 where it had to stop short of its soft edge), OUT_PREFIX.mtl and the patches\n"
+           "(straight alpha): OUT_PREFIX_patch.png when there is one, OUT_PREFIX_patch_1.png, _2,\n"
+           "... when there are several (the MTL has a material lapped_K for each, naming its PNG as\n"
+           "map_Kd and map_d by file name: the folder can move). 'tiledtex render OUT_PREFIX.obj\n"
+           "OUT_PREFIX_patch_1.png view.png' draws each paste with the patch its material names, as\n"
+           "do engines that draw the faces in file order with blending; Blender's and assimp's\n"
+           "importers cannot stack copies of a triangle and show it shredded.\n"
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
            "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
-           "--permissive.\n");
+           "--permissive.\n",
+           LAPPED_DEFAULT_BAKE_SIZE);
     tool_print_mesh_help(1);
     printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl or .png loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
@@ -117,31 +124,29 @@ static void print_help(void)
            "                       (white = inside); one shape for every patch: MASK is the size of a\n"
            "                       patch, or of IMAGE and then scaled to the patch's (default: a random\n"
            "                       splotch, or the window's own alpha when IMAGE has one)\n"
-           "  --bake SIZE          also write OUT_PREFIX_baked.obj/.mtl/.png: the pastes baked into a\n"
-           "                       SIZE x SIZE texture (16 to %d) over texture coordinates that\n"
-           "                       --bake-uv chooses\n"
+           "  --bake SIZE          the baked texture's side, 16 to %d (default %d); with --pasting,\n"
+           "                       also write the bake, as OUT_PREFIX_baked.obj/.mtl/.png\n"
            "  --bake-uv auto|mesh|atlas\n"
-           "                       where --bake bakes: 'mesh' over the OBJ's own texture coordinates,\n"
+           "                       where the bake goes: 'mesh' over the OBJ's own texture coordinates,\n"
            "                       refused unless every corner has one, all in [0,1], no triangle\n"
            "                       flipped, none overlapping another (two triangles drawing the same\n"
            "                       texels would bake scrambled); 'atlas' over a new atlas of charts\n"
            "                       (pieces of the surface flattened, one texel density, 2 texels\n"
            "                       apart); 'auto' (default) the OBJ's own when they are fit, else an\n"
            "                       atlas, with a warning saying why when the OBJ has some\n"
-           "  --format F           obj (default): the files above; glb: one binary glTF file,\n"
-           "                       OUT_PREFIX.glb, holding the pastes baked into one texture (--bake\n"
-           "                       SIZE, default %d, and --bake-uv apply): a glTF renderer does not\n"
-           "                       draw stacked copies of a triangle in order, so the pasting OBJ stays\n"
-           "                       the way to composite at run time; gltf: the same as glTF text,\n"
-           "                       OUT_PREFIX.gltf, with OUT_PREFIX.bin and PNGs beside it\n"
+           "  --pasting            write the pastes, not their bake (see above); OBJ only\n"
+           "  --format F           obj (default), glb (one binary glTF file, OUT_PREFIX.glb) or gltf\n"
+           "                       (glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and PNGs beside\n"
+           "                       it): the pastes baked, with the material's maps\n"
            "  --triangles          accepted for the OBJ, whose faces are triangles already\n",
            TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
            LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
-           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS, LAPPED_GLB_BAKE_SIZE);
+           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS, LAPPED_DEFAULT_BAKE_SIZE);
     printf(MATERIAL_OPTIONS_HELP("                       ")
-           "                       (here each patch's window of each map: OUT_PREFIX_patch_1_normal.png,\n"
-           "                       ...; with --bake the maps baked with the same pastes as IMAGE,\n"
-           "                       OUT_PREFIX_baked_normal.png, ..., normals turned into the atlas)\n");
+           "                       (here baked with the same pastes as IMAGE: OUT_PREFIX_normal.png,\n"
+           "                       ..., normals turned into the atlas; with --pasting each patch's\n"
+           "                       window of each map, OUT_PREFIX_patch_1_normal.png, ..., and with\n"
+           "                       --bake too OUT_PREFIX_baked_normal.png, ...)\n");
     printf("  --subdivide L        make the triangles smaller before pasting, L from 0 to 8 (default\n"
            "                       0): quadrangulate them L times, as 'tiledtex tile' does, and split\n"
            "                       every quad into two triangles, so a triangle becomes 6, 24, 96, ...\n"
@@ -154,17 +159,17 @@ static void print_help(void)
            "Prints the number of pastes, the coverage, how often a face is drawn (overdraw), how\n"
            "well the texture follows the field (angle and scale error), the hard edges (where the\n"
            "paste on top stops while still at least 25%% opaque), how many face entries hidden\n"
-           "by later pastes were dropped, and how many pastes each patch got. With --bake, also the\n"
+           "by later pastes were dropped, and how many pastes each patch got; of the bake, the\n"
            "baked texture's seam score (about 0: the texture continues across edges; about 1: it\n"
            "jumps) over every edge and over the edges where the paste on top changes.\n"
            "\n"
            "example: tiledtex generate mesh torus.obj --shape torus\n"
            "         tiledtex generate texture stones.png --size 128\n"
            "         tiledtex lapped torus.obj stones.png torus_lapped --scale 1.5\n"
-           "         tiledtex render torus_lapped.obj torus_lapped_patch_1.png view.png\n");
+           "         tiledtex render torus_lapped.obj torus_lapped.png view.png\n");
 }
 
-/* --bake-uv: where --bake bakes. */
+/* --bake-uv: where the bake goes. */
 typedef enum bake_uv_choice { BAKE_UV_AUTO = 0, BAKE_UV_MESH, BAKE_UV_ATLAS } bake_uv_choice;
 
 typedef struct lapped_options {
@@ -178,7 +183,9 @@ typedef struct lapped_options {
     const char *mask_path;          /* or NULL */
     int npatches;                   /* --patches N; 0 = the default (choose_windows) */
     int patch_size;                 /* --patch-size S in texels; 0 = the default */
-    int bake_size;                  /* 0 = no --bake */
+    int pasting;                    /* --pasting: the pasting OBJ and its patches */
+    int bake_size;                  /* 0 = no bake (only with --pasting) */
+    char baked_stem[TOOL_PREFIX_SIZE + 8]; /* the baked files' names without extension */
     bake_uv_choice bake_uv;         /* --bake-uv */
     tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
     material_maps maps;             /* --normal ...: the material's other maps, pasted alike */
@@ -236,6 +243,8 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             else return tool_usage("--bake-uv wants auto, mesh or atlas, got '%s'", value);
         } else if (tool_flag(argv[i], "--isotropic")) {
             options->isotropic = 1;
+        } else if (tool_flag(argv[i], "--pasting")) {
+            options->pasting = 1;
         } else if ((taken = material_parse_option(argc, argv, &i, &options->maps)) != 0) {
             if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_is_option(argv[i])) {
@@ -249,10 +258,17 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
     if (tool_mesh_image_prefix(positional, npositional, &options->mesh_path, &options->image_path,
                                &options->output, options->prefix) != 0)
         return TOOL_EXIT_USAGE;
-    /* A glTF renderer does not draw stacked blended copies of a triangle in
-       their order, so a GLB holds the pastes baked into one texture. */
-    if (options->output.format != TOOL_FORMAT_OBJ && options->bake_size == 0)
-        options->bake_size = LAPPED_GLB_BAKE_SIZE;
+    /* Only this tool's renderer and engines that draw the faces in file
+       order with blending show the pasting OBJ right (Blender's and
+       assimp's importers merge or shred the stacked copies of a triangle),
+       so what is written unless --pasting asks, and every glTF, holds the
+       pastes baked into one texture. */
+    if (options->pasting && options->output.format != TOOL_FORMAT_OBJ)
+        return tool_usage("--pasting writes the pasting OBJ; a glTF file holds the pastes baked (leave out --pasting, "
+                          "or write OUT_PREFIX.obj)");
+    if (!options->pasting && options->bake_size == 0) options->bake_size = LAPPED_DEFAULT_BAKE_SIZE;
+    snprintf(options->baked_stem, sizeof options->baked_stem, "%s%s", options->prefix,
+             options->pasting ? "_baked" : "");
     return -1;
 }
 
@@ -994,7 +1010,6 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
                      const char *gltf_path, baked_summary *summary)
 {
     char obj_path[4096], mtl_path[4096], png_path[4096], comment[256], map_paths[MATERIAL_MAPS][4200];
-    char stem[TOOL_PREFIX_SIZE + 16];
     const char *map_names[MATERIAL_MAPS];
     tt_image *atlas = NULL, **map_patches = NULL, *map_atlases[MATERIAL_MAPS];
     float *normals = NULL;
@@ -1009,9 +1024,9 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     map_patches = (tt_image **)malloc((size_t)patches->count * sizeof(tt_image *));
     if (!map_patches) return tool_fail("out of memory for the baked maps");
 
-    snprintf(obj_path, sizeof obj_path, "%s_baked.obj", options->prefix);
-    snprintf(mtl_path, sizeof mtl_path, "%s_baked.mtl", options->prefix);
-    snprintf(png_path, sizeof png_path, "%s_baked.png", options->prefix);
+    snprintf(obj_path, sizeof obj_path, "%s.obj", options->baked_stem);
+    snprintf(mtl_path, sizeof mtl_path, "%s.mtl", options->baked_stem);
+    snprintf(png_path, sizeof png_path, "%s.png", options->baked_stem);
     if (tt_image_create(options->bake_size, options->bake_size, NULL, &atlas, &error) != TT_OK) {
         status = tool_fail("--bake %d: %s", options->bake_size, error.message);
         goto done;
@@ -1071,9 +1086,8 @@ static int add_baked(tool_output *output, const lapped_options *options, const t
     desc.mtllib = tool_basename(mtl_path);
     desc.material = "lapped_baked";
     if ((status = output_add_obj(output, obj_path, &desc)) != 0) goto done;
-    snprintf(stem, sizeof stem, "%s_baked", options->prefix);
     for (map = 0; map < MATERIAL_MAPS; map++) {
-        material_path(map_paths[map], sizeof map_paths[map], stem, map);
+        material_path(map_paths[map], sizeof map_paths[map], options->baked_stem, map);
         map_names[map] = options->maps.paths[map] ? map_paths[map] : NULL;
     }
     status = output_add_mtl(output, mtl_path, "lapped_baked", png_path, 0, map_names);
@@ -1219,21 +1233,22 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
 static int refuse_overwriting_inputs(const lapped_options *options, const char *obj_path, const char *mtl_path,
                                      const char *gltf_path, const lapped_patches *patches)
 {
-    static const char *const baked[] = {"_baked.obj", "_baked.mtl", "_baked.png"};
-    char path[4096 + 16];
-    int status, k;
+    static const char *const baked[] = {".obj", ".mtl", ".png"};
+    char path[TOOL_PREFIX_SIZE + 16];
+    int status = 0, k;
     if (options->output.format != TOOL_FORMAT_OBJ) return tool_refuse_input_overwrite(gltf_path);
-    status = tool_refuse_input_overwrite(obj_path);
-    if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
-    for (k = 0; k < patches->count && status == 0; k++) status = tool_refuse_input_overwrite(patches->png_paths[k]);
-    for (k = 0; k < patches->count * MATERIAL_MAPS && status == 0; k++)
-        if (patches->map_png_paths[k]) status = tool_refuse_input_overwrite(patches->map_png_paths[k]);
-    if (status == 0 && options->bake_size > 0) {
-        snprintf(path, sizeof path, "%s_baked", options->prefix);
-        status = material_refuse_overwrite(&options->maps, path);
+    if (options->pasting) {
+        status = tool_refuse_input_overwrite(obj_path);
+        if (status == 0) status = tool_refuse_input_overwrite(mtl_path);
+        for (k = 0; k < patches->count && status == 0; k++)
+            status = tool_refuse_input_overwrite(patches->png_paths[k]);
+        for (k = 0; k < patches->count * MATERIAL_MAPS && status == 0; k++)
+            if (patches->map_png_paths[k]) status = tool_refuse_input_overwrite(patches->map_png_paths[k]);
     }
-    for (k = 0; k < 3 && status == 0 && options->bake_size > 0; k++) {
-        snprintf(path, sizeof path, "%s%s", options->prefix, baked[k]);
+    if (options->bake_size == 0) return status;
+    if (status == 0) status = material_refuse_overwrite(&options->maps, options->baked_stem);
+    for (k = 0; k < 3 && status == 0; k++) {
+        snprintf(path, sizeof path, "%s%s", options->baked_stem, baked[k]);
         status = tool_refuse_input_overwrite(path);
     }
     return status;
@@ -1282,8 +1297,10 @@ int cmd_lapped(int argc, char **argv)
        so the PNGs are encoded now and the image freed before the paste
        loop; from here on the command holds the patches and the compressed
        PNGs. */
-    if (status == 0) status = make_patches(&options, &image, &windows, mask, gltf ? NULL : &output, &patches);
-    if (status == 0) status = make_map_patches(&options, &options.maps, &windows, gltf ? NULL : &output, &patches);
+    if (status == 0)
+        status = make_patches(&options, &image, &windows, mask, options.pasting ? &output : NULL, &patches);
+    if (status == 0)
+        status = make_map_patches(&options, &options.maps, &windows, options.pasting ? &output : NULL, &patches);
     material_free(&options.maps);
     image_free(image);
     image = NULL;
@@ -1291,9 +1308,9 @@ int cmd_lapped(int argc, char **argv)
     mask = NULL;
     if (status == 0) status = paste(&options, &mesh, field, &patches, &lapped);
 
-    if (status == 0 && !gltf)
+    if (status == 0 && options.pasting)
         status = add_pasting_obj(&output, obj_path, tool_basename(mtl_path), &mesh, lapped, &patches);
-    if (status == 0 && !gltf)
+    if (status == 0 && options.pasting)
         status = output_add_mtl_materials(&output, mtl_path, patches.count, (const char *const *)patches.materials,
                                           (const char *const *)patches.png_paths, 1,
                                           (const char *const *)patches.map_png_paths);
@@ -1306,22 +1323,27 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && !tool_quiet()) {
         print_summary(&options, &mesh, field, lapped, &patches, &baked, tool_seconds_now() - start);
         print_patch_use(&patches, lapped);
-        if (gltf) {
-            printf("wrote %s (the pastes baked into %dx%d, over ", gltf_written(gltf_path, written, sizeof written),
-                   options.bake_size, options.bake_size);
-            if (charts == 0) printf("the OBJ's texture coordinates)\n");
-            else printf("an atlas of %d chart%s)\n", charts, charts == 1 ? "" : "s");
-        } else {
+        if (options.pasting) {
             printf("wrote %s, %s, %s", obj_path, mtl_path, patches.png_paths[0]);
             if (patches.count > 1) printf(" to %s", patches.png_paths[patches.count - 1]);
-            if (options.bake_size > 0 && charts == 0)
-                printf("; %s_baked.obj/.mtl/.png (%dx%d, over the OBJ's texture coordinates)", options.prefix,
-                       options.bake_size, options.bake_size);
-            else if (options.bake_size > 0)
-                printf("; %s_baked.obj/.mtl/.png (%dx%d, over an atlas of %d chart%s)", options.prefix,
-                       options.bake_size, options.bake_size, charts, charts == 1 ? "" : "s");
-            printf("\n");
+            if (options.bake_size > 0) printf("; %s.obj/.mtl/.png", options.baked_stem);
+        } else {
+            printf("wrote %s", gltf ? gltf_written(gltf_path, written, sizeof written) : obj_path);
+            if (!gltf) printf(", %s, %s.png", mtl_path, options.baked_stem);
         }
+        if (options.bake_size > 0) {
+            printf(" (the pastes baked into %dx%d, over ", options.bake_size, options.bake_size);
+            if (charts == 0) printf("the OBJ's texture coordinates)");
+            else printf("an atlas of %d chart%s)", charts, charts == 1 ? "" : "s");
+        }
+        printf("\n");
+        if (options.pasting)
+            printf("%s holds the pastes: 'tiledtex render' and engines that draw its faces in file order with "
+                   "blending show it right; Blender and assimp do not (the stacked copies of a triangle come out "
+                   "dropped or shredded): %s\n",
+                   obj_path,
+                   options.bake_size > 0 ? "the baked files are for them"
+                                         : "leave out --pasting for a bake that they show right");
     }
     output_free(&output);
     tt_lapped_free(lapped);

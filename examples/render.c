@@ -1090,7 +1090,7 @@ static void print_render_help(void)
            "  --normal N.png  light the surface through a tangent-space normal map over the same\n"
            "                texture coordinates (+Y up, as the tool writes them; the frame is the\n"
            "                texture's u and v axes on each triangle, as glTF and Blender take it);\n"
-           "                not for pasting meshes: render their --bake output\n"
+           "                not for pasting meshes: render the bake (lapped without --pasting)\n"
            "  --normal-y-down  N.png is DirectX style (y down)\n",
            RENDER_MAX_SIZE, RENDER_DEFAULT_WIDTH, RENDER_DEFAULT_HEIGHT);
 }
@@ -1188,7 +1188,8 @@ int cmd_render(int argc, char **argv)
     } else if (normal_path) {
         tt_image *image;
         if (s.pasting) {
-            tool_fail("%s is a pasting mesh: --normal needs one texture over the surface (render its --bake output)",
+            tool_fail("%s is a pasting mesh: --normal needs one texture over the surface (render the bake, which "
+                      "lapped writes without --pasting)",
                       positional[0]);
             goto done;
         }

@@ -641,14 +641,14 @@ lapped_groups() {
 }
 summary_pastes() { printf '%s\n' "$OUT" | grep -oE '[0-9]+ pastes' | head -1 | awk '{print $1}'; }
 
-# lapped_case NAME MESH ARGS... : in a fresh directory, lapped writes out.obj,
-# out.mtl and out_patch.png; every triangle of MESH is in a paste, the
-# groups are the pastes in order, coverage 100.0%.
+# lapped_case NAME MESH ARGS... : in a fresh directory, lapped --pasting
+# writes out.obj, out.mtl and out_patch.png; every triangle of MESH is in a
+# paste, the groups are the pastes in order, coverage 100.0%.
 lapped_case() {
     local name=$1 mesh=$2 r total missing foreign groups bad pastes
     shift 2
     newdir
-    run lapped "../in/$mesh" ../in/lap.png out "$@"
+    run lapped "../in/$mesh" ../in/lap.png out --pasting "$@"
     check "lapped $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
     check "lapped $name: exactly out.mtl, out.obj, out_patch.png" "out.mtl out.obj out_patch.png" \
         "$(ls -A | tr '\n' ' ')" "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_patch.png " ]; echo $?)"
@@ -679,20 +679,43 @@ check "lapped torus: says it split the quads into triangles" "'1024 triangles (f
     "$(printf '%s' "$OUT" | grep -q '1024 triangles (fans of 512 faces)'; echo $?)"
 check "lapped torus: reports alignment" "'mean angle error X degrees, median scale error Y%'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE 'mean angle error [0-9.]+ degrees, median scale error [0-9.]+%'; echo $?)"
+check "lapped --pasting: says which programs draw the pasting OBJ and which do not" \
+    "'out.obj holds the pastes: 'tiledtex render' and engines ... Blender and assimp do not ...'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE "^out\.obj holds the pastes: 'tiledtex render' and engines .*; Blender and assimp do not .*leave out --pasting"; echo $?)"
+
+# the default: the pastes baked into one texture, an ordinary textured mesh
+# that every program opens; no pasting OBJ, no patch, no word of --pasting
+newdir
+expect_ok "lapped default (the bake)" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3
+check "lapped default: exactly out.mtl, out.obj, out.png" "out.mtl out.obj out.png" "$(ls -A | tr '\n' ' ')" \
+    "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out.png " ]; echo $?)"
+check "lapped default: a 2048x2048 texture" "2048 2048" "$(png_size out.png)" \
+    "$(is_png out.png && [ "$(png_size out.png)" = "2048 2048" ]; echo $?)"
+check "lapped default: one material naming out.png, no paste groups" "map_Kd out.png, no 'g paste_'" \
+    "$(grep -h -E '^(map_Kd|mtllib|usemtl|g) ' out.mtl out.obj 2>&1 | sort | uniq -c | head -5)" \
+    "$(grep -qx 'map_Kd out.png' out.mtl && grep -qx 'mtllib out.mtl' out.obj && ! grep -q '^g paste_' out.obj; echo $?)"
+check "lapped default: says it wrote the bake, not the pastes" \
+    "'wrote out.obj, out.mtl, out.png (the pastes baked into 2048x2048, over an atlas of N charts)', no 'holds the pastes'" \
+    "$OUT" "$(printf '%s\n' "$OUT" | grep -qxE 'wrote out\.obj, out\.mtl, out\.png \(the pastes baked into 2048x2048, over an atlas of [0-9]+ charts?\)' &&
+        ! printf '%s' "$OUT" | grep -q 'holds the pastes'; echo $?)"
+check_normals "lapped default: the baked OBJ" out.obj
+expect_ok "render the default lapped OBJ with its texture" render out.obj out.png view.png --size 64x48
+cd "$W" || exit 1
+
 lapped_case sphere-triangles spheretri.obj --scale 0.9 --isotropic
 lapped_case "grid (open)" grid.obj --scale 2 --up 0,0,1
 lapped_case "pair (two components)" pair.obj --scale 1.5 --constraints ../in/constraints.txt
 
 # the same seed twice: the same files; another seed: another result
 newdir
-expect_ok "lapped seed 3 again" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3
-CMD="tiledtex lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3 (twice)"
+expect_ok "lapped seed 3 again" lapped ../in/torus.obj ../in/lap.png out --pasting --scale 1.5 --seed 3
+CMD="tiledtex lapped ../in/torus.obj ../in/lap.png out --pasting --scale 1.5 --seed 3 (twice)"
 check "lapped same seed twice: identical .obj" "cmp equal" "$(cmp out.obj "$LAPPED_TORUS/out.obj" 2>&1)" \
     "$(cmp -s out.obj "$LAPPED_TORUS/out.obj"; echo $?)"
 check "lapped same seed twice: identical patch" "cmp equal" "$(cmp out_patch.png "$LAPPED_TORUS/out_patch.png" 2>&1)" \
     "$(cmp -s out_patch.png "$LAPPED_TORUS/out_patch.png"; echo $?)"
-expect_ok "lapped seed 4" lapped ../in/torus.obj ../in/lap.png other --scale 1.5 --seed 4
-CMD="tiledtex lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3 / --seed 4"
+expect_ok "lapped seed 4" lapped ../in/torus.obj ../in/lap.png other --pasting --scale 1.5 --seed 4
+CMD="tiledtex lapped ../in/torus.obj ../in/lap.png out --pasting --scale 1.5 --seed 3 / --seed 4"
 check "lapped different seed: different .obj" "files differ" "identical" "$(! cmp -s out.obj other.obj; echo $?)"
 
 # the pasting OBJ renders (blended pastes)
@@ -716,9 +739,9 @@ check "render: fades of 1 draw as no fade" "cmp equal" "$(cmp ones.png nofade.pn
     "$(cmp -s ones.png nofade.png; echo $?)"
 cd "$W" || exit 1
 
-# --bake: over an atlas of charts (no vt in the OBJ) ...
+# --pasting --bake: over an atlas of charts (no vt in the OBJ) ...
 newdir
-expect_ok "lapped --bake 256" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --bake 256
+expect_ok "lapped --pasting --bake 256" lapped ../in/torus.obj ../in/lap.png out --pasting --scale 1.5 --bake 256
 seams_line=$(printf '%s\n' "$OUT" | grep '^baked seam score: ')
 check "lapped --bake: the summary gives the baked seam score over every edge and where the top paste changes" \
     "'baked seam score: all edges S (1536 of 1536 edges); where the top paste changes S (N of N edges)'" \
@@ -752,7 +775,7 @@ expect_ok "lapped --bake over the OBJ's own vt" lapped out_baked.obj ../in/lap.p
 check "lapped --bake over own vt: says so, no warning" "'over the OBJ's texture coordinates', empty stderr" \
     "$OUT | $ERR" "$(printf '%s' "$OUT" | grep -q "over the OBJ's texture coordinates" && [ -z "$ERR" ]; echo $?)"
 check "lapped --bake over own vt: same vt values as the OBJ" "identical sorted vt lines" "differ" \
-    "$(diff -q <(grep '^vt' out_baked.obj | sort -u) <(grep '^vt' own_baked.obj | sort -u) >/dev/null; echo $?)"
+    "$(diff -q <(grep '^vt' out_baked.obj | sort -u) <(grep '^vt' own.obj | sort -u) >/dev/null; echo $?)"
 expect_ok "lapped --bake-uv atlas: a new atlas even over fit vt" lapped out_baked.obj ../in/lap.png new --scale 1.5 \
     --bake 128 --bake-uv atlas
 check "lapped --bake-uv atlas: says so, no warning" "'over an atlas of N charts', empty stderr" "$OUT | $ERR" \
@@ -875,9 +898,9 @@ expect_error "lapped --subdivide 1 --constraints face out of range" lapped ../in
 err_mentions "lapped --subdivide constraint out of range: counts the OBJ's faces" 'constraints_range\.txt:2:.*1 to 512'
 newdir
 expect_ok "an atlas OBJ for lapped --subdivide --bake" lapped ../in/torus.obj ../in/lap.png a --scale 1.5 --bake 256
-mv a_baked.obj t.obj
+mv a.obj t.obj
 expect_ok "lapped --subdivide 1 --bake over the OBJ's own vt" lapped t.obj ../in/lap.png own --scale 1.5 --subdivide 1 \
-    --bake 256 --bake-uv mesh
+    --bake 256 --bake-uv mesh --pasting
 check "lapped --subdivide --bake over own vt: says so" "'over the OBJ's texture coordinates'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q "over the OBJ's texture coordinates"; echo $?)"
 read -r corners nvt nonquad badc baduv nf <<<"$(obj_report own_baked.obj)"
@@ -895,7 +918,7 @@ cd "$W" || exit 1
 newdir
 mkdir -p assets elsewhere pc
 expect_ok "lapped into an absolute OUT_PREFIX" lapped ../in/torus.obj ../in/lap.png "$PWD/assets/out" --scale 1.5 \
-    --bake 256
+    --bake 256 --pasting
 check "lapped absolute OUT_PREFIX: mtllib lines name the MTL files by name" "mtllib out.mtl, mtllib out_baked.mtl" \
     "$(grep -h '^mtllib' assets/out.obj assets/out_baked.obj 2>&1)" \
     "$(grep -qx 'mtllib out.mtl' assets/out.obj && grep -qx 'mtllib out_baked.mtl' assets/out_baked.obj; echo $?)"
@@ -941,7 +964,7 @@ patch_summary() {
 }
 
 newdir
-expect_ok "lapped default on a 256x256 image" lapped ../in/torus.obj ../in/lap256.png out --scale 1.5
+expect_ok "lapped default on a 256x256 image" lapped ../in/torus.obj ../in/lap256.png out --pasting --scale 1.5
 check "lapped default, 256x256 image: 4 patches of 128x128" "out.mtl out.obj out_patch_1.png ... out_patch_4.png" \
     "$(ls -A | tr '\n' ' ')" \
     "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out_patch_1.png out_patch_2.png out_patch_3.png out_patch_4.png " ] &&
@@ -961,7 +984,7 @@ check "lapped 4 patches: the summary counts each patch's pastes, adding up to th
     "'patches: 4 of 4 used (128x128 windows), a/b/c/d pastes', a+b+c+d = $pastes" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE '^patches: 4 of 4 used \(128x128 windows\), [0-9]+/[0-9]+/[0-9]+/[0-9]+ pastes$' &&
         [ "${used:-0}" = 4 ] && [ "${sum:-0}" = "${pastes:-x}" ]; echo $?)"
-expect_ok "lapped 4 patches again" lapped ../in/torus.obj ../in/lap256.png again --scale 1.5
+expect_ok "lapped 4 patches again" lapped ../in/torus.obj ../in/lap256.png again --pasting --scale 1.5
 CMD="tiledtex lapped ../in/torus.obj ../in/lap256.png out / again (same seed)"
 check "lapped 4 patches: same seed, same windows and pastes" "identical patches and OBJ bodies" "differ" \
     "$(for k in 1 2 3 4; do cmp -s out_patch_$k.png again_patch_$k.png || exit 1; done
@@ -980,36 +1003,36 @@ cd "$W" || exit 1
 
 # a small image keeps the whole image as the one patch; --patches 1 is that
 newdir
-expect_ok "lapped default on a 64x64 image" lapped ../in/torus.obj ../in/lap.png out --scale 1.5
+expect_ok "lapped default on a 64x64 image" lapped ../in/torus.obj ../in/lap.png out --pasting --scale 1.5
 check "lapped default, 64x64 image: one patch, the whole image" "out_patch.png 64x64, 'patches: 1 of 1 used (the whole image)'" \
     "$(ls -A | tr '\n' ' '); $OUT" \
     "$([ "$(png_size out_patch.png)" = "64 64" ] && [ ! -e out_patch_1.png ] &&
         printf '%s' "$OUT" | grep -qE '^patches: 1 of 1 used \(the whole image\), [0-9]+ pastes$'; echo $?)"
 mkdir one && cd one || exit 1
-expect_ok "lapped --patches 1 on a 64x64 image" lapped ../../in/torus.obj ../../in/lap.png out --scale 1.5 --patches 1
+expect_ok "lapped --patches 1 on a 64x64 image" lapped ../../in/torus.obj ../../in/lap.png out --pasting --scale 1.5 --patches 1
 CMD="tiledtex lapped torus.obj lap.png out --scale 1.5 (default / --patches 1)"
 check "lapped --patches 1 = the default on a small image" "identical out.obj, out.mtl, out_patch.png" "differ" \
     "$(cmp -s out.obj ../out.obj && cmp -s out.mtl ../out.mtl && cmp -s out_patch.png ../out_patch.png; echo $?)"
 cd "$W" || exit 1
 newdir
-expect_ok "lapped --patches 1 on a 256x256 image" lapped ../in/torus.obj ../in/lap256.png out --scale 1.5 --patches 1
+expect_ok "lapped --patches 1 on a 256x256 image" lapped ../in/torus.obj ../in/lap256.png out --pasting --scale 1.5 --patches 1
 check "lapped --patches 1: the whole image, one material for the file" "out_patch.png 256x256, one usemtl lapped" \
     "$(png_size out_patch.png); $(grep -c '^usemtl' out.obj) usemtl" \
     "$([ "$(png_size out_patch.png)" = "256 256" ] && [ "$(grep -c '^usemtl' out.obj)" = 1 ] &&
         grep -qx 'usemtl lapped' out.obj && [ "$(grep -c '^newmtl' out.mtl)" = 1 ]; echo $?)"
-expect_ok "lapped --patches 9" lapped ../in/torus.obj ../in/lap256.png nine --scale 1.5 --patches 9
+expect_ok "lapped --patches 9" lapped ../in/torus.obj ../in/lap256.png nine --pasting --scale 1.5 --patches 9
 check "lapped --patches 9: 9 windows of 85x85 (the largest that fit 3 x 3)" "nine_patch_1..9.png, 85x85" \
     "$(ls nine_patch_* | tr '\n' ' '); $(png_size nine_patch_9.png)" \
     "$([ "$(ls nine_patch_*.png | wc -l)" = 9 ] && [ "$(png_size nine_patch_9.png)" = "85 85" ]; echo $?)"
-expect_ok "lapped --patch-size 64 (default count 4)" lapped ../in/torus.obj ../in/lap256.png sized --scale 1.5 \
+expect_ok "lapped --patch-size 64 (default count 4)" lapped ../in/torus.obj ../in/lap256.png sized --pasting --scale 1.5 \
     --patch-size 64 --isotropic --bake 256
 check "lapped --patch-size 64 --isotropic --bake: 4 patches of 64x64, a baked texture" "sized_patch_4.png 64x64, sized_baked.png" \
     "$(ls sized* | tr '\n' ' ')" "$([ "$(png_size sized_patch_4.png)" = "64 64" ] && is_png sized_baked.png; echo $?)"
 # one --mask for every patch: the image's size (scaled to the patch's) or a patch's
 { printf 'P5\n256 256\n255\n'; head -c 65536 /dev/zero | tr '\0' '\377'; } >mask256.pgm
 { printf 'P5\n128 128\n255\n'; head -c 16384 /dev/zero | tr '\0' '\377'; } >mask128.pgm
-expect_ok "lapped 4 patches, --mask the image's size" lapped ../in/torus.obj ../in/lap256.png m1 --scale 1.5 --mask mask256.pgm
-expect_ok "lapped 4 patches, --mask a patch's size" lapped ../in/torus.obj ../in/lap256.png m2 --scale 1.5 --mask mask128.pgm
+expect_ok "lapped 4 patches, --mask the image's size" lapped ../in/torus.obj ../in/lap256.png m1 --pasting --scale 1.5 --mask mask256.pgm
+expect_ok "lapped 4 patches, --mask a patch's size" lapped ../in/torus.obj ../in/lap256.png m2 --pasting --scale 1.5 --mask mask128.pgm
 CMD="tiledtex lapped ... --mask mask256.pgm / mask128.pgm (both all white)"
 check "lapped --mask: the image-sized mask scaled to the patch is the patch-sized one" "identical patches" "differ" \
     "$(for k in 1 2 3 4; do cmp -s m1_patch_$k.png m2_patch_$k.png || exit 1; done; echo $?)"
@@ -1121,9 +1144,9 @@ if $HELPER_CC -O2 -w $STB_INC "$W/repeats.c" -o "$W/repeats" -lm 2>"$W/err"; the
     # Two seeds each: one run's count moves by a third with the paste order.
     for seed in 0 1; do
         expect_ok "lapped a plane, --patches 1, baked, seed $seed" lapped plane.obj ../in/lap128.png p1s$seed \
-            --scale 1 --patches 1 --bake 256 --seed $seed
+            --scale 1 --patches 1 --bake 256 --seed $seed --pasting
         expect_ok "lapped a plane, --patches 4, baked, seed $seed" lapped plane.obj ../in/lap128.png p4s$seed \
-            --scale 1 --patches 4 --bake 256 --seed $seed
+            --scale 1 --patches 4 --bake 256 --seed $seed --pasting
     done
     r1=$(awk -v a="$("$W/repeats" p1s0_baked.png 2>&1)" -v b="$("$W/repeats" p1s1_baked.png 2>&1)" \
         'BEGIN { printf "%.2f", (a + b) / 2 }')
@@ -1894,9 +1917,12 @@ ln m.obj link.obj
 expect_refused "map onto a hard link of the input" map m.obj link.obj
 expect_refused "map onto the input" map m.obj m.obj
 cp img.png x_patch.png
-expect_refused "lapped IMAGE that is OUT_PREFIX_patch.png" lapped m.obj x_patch.png x --scale 1.5
+expect_refused "lapped --pasting IMAGE that is OUT_PREFIX_patch.png" lapped m.obj x_patch.png x --scale 1.5 --pasting
 cp img.png y_baked.png
-expect_refused "lapped --bake output that is the IMAGE" lapped m.obj y_baked.png y --scale 1.5 --bake 64
+expect_refused "lapped --pasting --bake output that is the IMAGE" lapped m.obj y_baked.png y --scale 1.5 --bake 64 \
+    --pasting
+cp img.png z.png
+expect_refused "lapped baked texture that is the IMAGE" lapped m.obj z.png z --scale 1.5 --bake 64
 expect_refused "hpm with OUT_PREFIX naming the mesh" hpm m.obj img.png m --rotations 3
 cp m.obj z.mtl
 expect_refused "hpm with OUT_PREFIX.mtl an input (the mesh)" hpm z.mtl img.png z --rotations 3
@@ -2504,7 +2530,7 @@ prefix_case "tile OUT_PREFIX out.obj" "out.obj out.mtl out.png" tile ../in/torus
 check "tile OUT_PREFIX out.obj: mtllib names out.mtl" "mtllib out.mtl" "$(grep mtllib "$W/d$NEWDIR_N/out.obj" 2>&1)" \
     "$(grep -qx 'mtllib out.mtl' "$W/d$NEWDIR_N/out.obj" 2>/dev/null; echo $?)"
 prefix_case "tile OUT_PREFIX out.PNG" "out.obj out.mtl out.png" tile ../in/torus.obj ../in/tex.png out.PNG
-prefix_case "lapped OUT_PREFIX l.mtl" "l.obj l.mtl l_patch.png" lapped ../in/torus.obj ../in/lap.png l.mtl --scale 1.5
+prefix_case "lapped OUT_PREFIX l.mtl" "l.obj l.mtl l.png" lapped ../in/torus.obj ../in/lap.png l.mtl --scale 1.5
 prefix_case "hpm OUT_PREFIX h.Obj" "h.obj h.mtl" hpm ../in/torus.obj ../in/lap.png h.Obj
 prefix_case "polycube OUT_PREFIX p.OBJ" "p.obj p.mtl p.png p_polycube.obj" polycube ../in/spheretri.obj ../in/tex.png \
     p.OBJ --resolution 4
@@ -2542,8 +2568,8 @@ CMD="cmp z.png zv.png"
 check "render --up 0,0,3 draws what --up z does" "identical PNGs" "$(cmp z.png zv.png 2>&1)" \
     "$(cmp -s z.png zv.png; echo $?)"
 expect_ok "render --up 1,1,0 (a slanted up)" render ../in/torus.obj ../in/tex.png s.png --size 48x48 --up 1,1,0
-expect_ok "lapped --up z" lapped ../in/torus.obj ../in/lap.png a --scale 1.5 --up z
-expect_ok "lapped --up 0,0,1" lapped ../in/torus.obj ../in/lap.png b --scale 1.5 --up 0,0,1
+expect_ok "lapped --up z" lapped ../in/torus.obj ../in/lap.png a --pasting --scale 1.5 --up z
+expect_ok "lapped --up 0,0,1" lapped ../in/torus.obj ../in/lap.png b --pasting --scale 1.5 --up 0,0,1
 CMD="cmp a.obj b.obj (but the mtllib line)"
 check "lapped --up z pastes as --up 0,0,1" "identical OBJs" "$(diff <(grep -v mtllib a.obj 2>&1) <(grep -v mtllib b.obj 2>&1) | head -3)" \
     "$(cmp -s <(grep -v mtllib a.obj 2>/dev/null) <(grep -v mtllib b.obj 2>/dev/null) && [ -s a.obj ]; echo $?)"
@@ -2641,7 +2667,7 @@ check_turned "tile (quadrangulated, --subdivide 1)" t.obj
 expect_ok "map --subdivide 2, normals from the file" map ../in/sphere_turned.obj m.obj --subdivide 2
 check_turned "map --subdivide 2" m.obj
 expect_ok "lapped --subdivide 1 --bake, normals from the file" lapped ../in/sphere_turned.obj ../in/lap.png l \
-    --subdivide 1 --bake 128 --patches 1
+    --subdivide 1 --bake 128 --patches 1 --pasting
 check_turned "lapped --subdivide 1: the pasting OBJ" l.obj
 check_turned "lapped --subdivide 1: the baked OBJ" l_baked.obj
 expect_ok "hpm, normals from the file" hpm ../in/sphere_turned.obj ../in/lap.png h
@@ -3001,6 +3027,7 @@ cd "$W" || exit 1
 # --- lapped: the GLB holds the pastes baked ---------------------------------
 newdir
 expect_ok "lapped OUT.glb (bakes by itself)" lapped ../in/torus.obj ../in/lap.png l.glb --scale 1.5
+
 CMD="ls after tiledtex lapped ../in/torus.obj ../in/lap.png l.glb"
 check "lapped OUT.glb: writes l.glb alone (no pasting OBJ, no patch PNG)" "l.glb" "$(ls | tr '\n' ' ')" \
     "$([ "$(ls)" = l.glb ]; echo $?)"
@@ -3019,11 +3046,11 @@ expect_ok "lapped --bake 256, as OBJ" lapped ../in/torus.obj ../in/lap.png l2 --
 glb_check "lapped --bake 256 GLB" l2.glb
 if [ -n "$GLB_JSON" ]; then
     glb_image l2.glb baseColor baked256.png
-    CMD="cmp baked256.png l2_baked.png"
-    check "lapped GLB --bake 256: the baked texture of the OBJ's --bake" "identical PNGs" "$(cmp baked256.png l2_baked.png 2>&1)" \
-        "$(cmp -s baked256.png l2_baked.png; echo $?)"
-    read -r found total extra <<<"$(glb_uvs_match_obj l2.glb l2_baked.obj)"
-    CMD="GLB TEXCOORD_0 against l2_baked.obj's vt"
+    CMD="cmp baked256.png l2.png"
+    check "lapped GLB --bake 256: the baked texture of the OBJ's" "identical PNGs" "$(cmp baked256.png l2.png 2>&1)" \
+        "$(cmp -s baked256.png l2.png; echo $?)"
+    read -r found total extra <<<"$(glb_uvs_match_obj l2.glb l2.obj)"
+    CMD="GLB TEXCOORD_0 against l2.obj's vt"
     check "lapped GLB: the baked OBJ's texture coordinates, v flipped" "all, no other" "$found of $total, $extra others" \
         "$([ "${total:-0}" -gt 0 ] && [ "$found" = "$total" ] && [ "$extra" = 0 ]; echo $?)"
 fi
@@ -3157,6 +3184,8 @@ expect_usage_error "hpm OUT.obj --format glb (they disagree)" hpm ../in/torus.ob
 err_mentions "hpm OUT.obj --format glb: names o.glb" "o\.glb"
 expect_usage_error "polycube OUT.gltf --format glb (a GLB is not .gltf)" polycube ../in/spheretri.obj ../in/tex.png o.gltf \
     --format glb
+expect_usage_error "lapped --pasting into a GLB" lapped ../in/torus.obj ../in/lap.png p.glb --scale 1.5 --pasting
+err_mentions "lapped --pasting into a GLB: says a glTF file holds the bake" 'pasting writes the pasting OBJ; a glTF file holds the pastes baked'
 expect_usage_error "lapped --format fbx" lapped ../in/torus.obj ../in/lap.png o --format fbx
 err_mentions "lapped --format fbx: names the formats" "obj, glb or gltf"
 expect_usage_error "tile OUT.gltf --format obj (they disagree)" tile ../in/torus.obj ../in/tex.png o.gltf --format obj
@@ -3521,7 +3550,7 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
       for j in $(seq 0 11); do for i in $(seq 0 11); do a=$((j * 13 + i + 1)); b=$((a + 1)); c=$((a + 14)); d=$((a + 13))
           echo "f $a/$a $b/$b $c/$c"; echo "f $a/$a $c/$c $d/$d"; done; done; } >plane.obj
     expect_ok "lapped with a material" lapped plane.obj ../in/tex.png l --isotropic --scale 8 --patches 1 \
-        --bake 512 --bake-uv mesh --normal m_normal.png --height m_height.png
+        --bake 512 --bake-uv mesh --normal m_normal.png --height m_height.png --pasting
     check "lapped: the patch's maps and the baked maps" "l_patch_normal.png, l_patch_height.png, l_baked_normal.png, ..." \
         "$(ls l_*)" \
         "$([ -s l_patch_normal.png ] && [ -s l_patch_height.png ] && [ -s l_baked_normal.png ] && [ -s l_baked_height.png ]; echo $?)"
@@ -3533,7 +3562,7 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
     check "lapped --bake: the baked normals follow the baked height's slopes" "median <= 15 deg" "$slope" \
         "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 <= 15)}'; echo $?)"
     expect_ok "lapped: y-down read of a +Y-up map (control)" lapped plane.obj ../in/tex.png lc --isotropic --scale 8 \
-        --patches 1 --bake 512 --bake-uv mesh --normal m_normal.png --normal-y-down --height m_height.png
+        --patches 1 --bake 512 --bake-uv mesh --normal m_normal.png --normal-y-down --height m_height.png --pasting
     slope=$("$MAPS" slope lc_baked_height.png lc_baked_normal.png 2>&1)
     check "lapped: the control's baked normals disagree" "median above 30 deg" "$slope" \
         "$(printf '%s\n' "$slope" | awk '{exit !(NF == 3 && $1 > 30)}'; echo $?)"
