@@ -289,6 +289,7 @@ static int measure_quality(const hpm_command_options *options, const triangle_me
     memset(&distortion, 0, sizeof distortion);
     distortion.texels_per_unit = report->texels_per_unit;
     distortion.margin_texels = (options->map.flags & TT_HPM_TOROIDAL) ? 0.0 : HPM_MARGIN_TEXELS;
+    tool_stage("measuring the texture's stretch");
     result = tt_measure_uv_distortion(m->mesh, corner_uv, image->width, image->height, &distortion, NULL,
                                       &quality->distortion, &error);
     if (result == TT_ERROR_NOT_MEASURED) {

@@ -129,6 +129,7 @@ int image_load(const char *path, tt_color_space space, tt_image **image, char *e
     size_t file_size;
     int status;
     *image = NULL;
+    tool_stage("reading %s", tool_basename(path));
     if (tool_read_file(path, &file_data, &file_size, err, err_size) != 0) return -1;
     status = image_load_memory(file_data, file_size, path, space, image, err, err_size);
     free(file_data);
@@ -360,6 +361,7 @@ int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char *
         tool_set_error(err, err_size, "cannot save an empty or oversized image");
         return -1;
     }
+    tool_stage("compressing a %dx%d PNG", width, height);
     channels = drop_opaque_alpha(rgba, (size_t)width * (size_t)height);
     if (png_write_to_memory(rgba, width, height, channels, png, png_size) != 0) {
         tool_set_error(err, err_size, "could not encode a %dx%d PNG (out of memory?)", width, height);

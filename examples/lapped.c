@@ -378,6 +378,7 @@ static int make_field(const lapped_options *options, const triangle_mesh *m, flo
     field.scale = options->scale;
     field.constraints = constraints.items;
     field.nconstraints = constraints.count;
+    tool_stage("computing the direction field");
     if (tt_tangent_field(m->mesh, &field, NULL, face_vectors, &error) != TT_OK) {
         /* An error about a constraint names it in error.item: say it at its
            line of the file (what reading the file could not see, such as a
@@ -922,6 +923,7 @@ static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float
         memcpy(*corner_uv, m->corner_uv, ncorners * 2 * sizeof(float));
         return 0;
     }
+    tool_stage("packing the bake's atlas");
     if (tt_atlas_pack_charts(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, NULL, *corner_uv, &atlas, &error) !=
         TT_OK) {
         free(*corner_uv);

@@ -26,6 +26,7 @@ int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *c
     options.edges = edges;
     options.nedges = nedges;
     options.executor = tool_executor();
+    tool_stage("measuring the seams");
     result = tt_measure_seams(mesh, corner_uv, atlas, &options, NULL, &out->report, &error);
     if (edges) {
         out->edges = nedges;

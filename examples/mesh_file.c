@@ -609,6 +609,7 @@ int mesh_read(const char *path, obj_mesh *out, char *err, size_t err_size)
     size_t size;
     int status;
     memset(out, 0, sizeof *out);
+    tool_stage("reading %s", tool_basename(path));
     if (tool_read_file(path, &data, &size, err, err_size) != 0) return -1;
     status = mesh_read_data(path, data, size, out, err, err_size);
     free(data);

@@ -1182,6 +1182,9 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
     sec.kind = VERTEX_LINES;
     sec.count = desc->nverts;
     if (write_section(out, &sec) != 0) return -1;
+    /* The progress line (a scan's OBJ takes a second): after each section,
+       the faces, the largest, last. */
+    tool_stage_fraction(0.2, NULL);
 
     for (f = 0; f < desc->nfaces; f++) ncorners += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
     memset(&textures, 0, sizeof textures);
@@ -1191,6 +1194,7 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         distinct_rows_free(&textures);
         return -1;
     }
+    tool_stage_fraction(0.35, NULL);
     refs.desc = desc;
     refs.texture = textures.of_corner;
     refs.normal = normals.of_corner;
@@ -1201,12 +1205,14 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         sec.rows = desc->share_equal ? &textures : NULL;
         sec.count = sec.rows ? sec.rows->count : ncorners;
         status = write_section(out, &sec);
+        tool_stage_fraction(0.5, NULL);
     }
     if (desc->corner_normal && status == 0) {
         sec.kind = NORMAL_LINES;
         sec.rows = desc->share_equal ? &normals : NULL;
         sec.count = sec.rows ? sec.rows->count : ncorners;
         status = write_section(out, &sec);
+        tool_stage_fraction(0.65, NULL);
     }
 
     if (desc->material && !(desc->face_group && desc->group_materials)) write_name_line(out, "usemtl", desc->material);
@@ -1230,6 +1236,7 @@ int obj_write(tool_buffer *out, const obj_write_desc *desc)
         }
         status = write_items(out, &sec, f, f + 1, c);
         c += desc->face_size ? desc->face_size[f] : desc->fixed_face_size;
+        if (f % 65536 == 65535) tool_stage_fraction(0.65 + 0.35 * f / desc->nfaces, NULL);
     }
     distinct_rows_free(&textures);
     distinct_rows_free(&normals);

@@ -209,6 +209,7 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
     tt_error error;
     double start = tool_seconds_now();
     int ncorners;
+    tool_stage("building the polycube");
     if (tt_polycube_build(job->mesh.mesh, &options->build, NULL, &job->polycube, &job->build_report, &error) != TT_OK)
         return triangle_mesh_report_error(path, &job->mesh, &error);
     job->build_seconds = tool_seconds_now() - start;
@@ -265,6 +266,7 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
     if ((status = tiled_synthesize(image, options->image_path, &upright, &options->tiles.maps, &job->upright_tiles,
                                    job->map_upright_tiles)) != 0)
         return status;
+    tool_stage("turning the tiles upright");
     if (tt_polycube_upright_atlas(job->tiles, job->upright_tiles, 0, tool_executor(), NULL, &job->atlas, &error) !=
         TT_OK)
         return tool_fail("the %dx%d atlas: %s", 2 * plain->width, plain->height, error.message);
@@ -356,6 +358,7 @@ static int measure_quality(const polycube_command_options *options, const polycu
        the surface) must not switch the whole report off; the measures
        count it as degenerate. */
     desc.flags = TT_MESH_PERMISSIVE;
+    tool_stage("measuring the texture's stretch");
     if (tt_mesh_build(&desc, NULL, &mapped, &error) != TT_OK) {
         /* A report, not the job: the files are still right. */
         snprintf(quality->mesh_reason, sizeof quality->mesh_reason, "the mapped triangles: %s", error.message);

@@ -120,6 +120,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
 
     desc = obj_mesh_desc(&obj, options->mesh.permissive ? TT_MESH_PERMISSIVE : 0);
     out->input_faces = obj.nfaces;
+    tool_stage("checking the mesh");
     if (tt_mesh_build(&desc, NULL, &out->mesh, &error) != TT_OK) {
         status = obj_report_mesh_error(obj_path, &obj, &error, 1);
         obj_free(&obj);
@@ -300,6 +301,7 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
                       mesh->input_max_face_size);
         /* Like the notes: nothing but errors under --quiet. */
         if (tool_quiet()) return;
+        tool_progress_clear();
         fprintf(stderr, "tiledtex: %s has %s: quadrangulated %d face%s into %d quads\n", obj_path, sizes,
                 mesh->input_faces, mesh->input_faces == 1 ? "" : "s", mesh->quadrangulated);
         /* Each triangle becomes three kite-shaped quads, each showing a

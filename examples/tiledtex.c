@@ -173,7 +173,9 @@ int main(int argc, char **argv)
     }
     tool_set_command(command->name);
     tool_catch_interrupts();
+    tool_progress_start();
     status = command->run(argc - 1, argv + 1);
+    tool_progress_clear();
     if (status != 0 && tool_interrupted()) status = 130;   /* as a shell reports a command ended by Ctrl-C */
     if (status == 0) tool_print_notes();
     tool_forget_inputs();

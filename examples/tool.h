@@ -922,23 +922,37 @@ double tool_seconds_now(void);
    machine. */
 double tool_cpu_seconds_now(void);
 
-/* A progress line for a long library call: fill one with
-   tool_progress_begin, pass tool_show_progress as the options' tt_progress_fn
-   and the state as its user data, and call tool_progress_end afterwards.
-   The line, "tiledtex: ACTIVITY: 42.0% WHAT", is redrawn in place at most
-   ten times a second, only after the first second (most runs are shorter)
-   and only when stderr is a terminal (a log would fill with "\r" lines). */
+/* The progress line. On a terminal (stderr), one line redrawn in place
+   says what the command is doing, "tiledtex: reading horse.obj: 42.0%" or
+   "tiledtex: building the polycube", from half a second after the command
+   started (most runs end sooner) until it writes its summary: the line is
+   erased before any other output (the summary, a note, an error). Nothing
+   with -q or when stderr is not a terminal (a log would fill with "\r"
+   lines). A fraction is shown below 100 % (a stage that is done gives way
+   to the next one, it does not sit at 100 %), and redrawn at most ten
+   times a second. main calls tool_progress_start when the command begins. */
+void tool_progress_start(void);
+/* A stage begins, named like printf ("writing %s", path); its fraction is
+   unknown until tool_stage_fraction says. */
+void tool_stage(const char *format, ...);
+/* How far the current stage is, 0 to 1, with what the fraction counts
+   (NULL, or "of the faces textured"). */
+void tool_stage_fraction(double done, const char *what);
+/* Erase the line, so that the next output starts on a clean line. */
+void tool_progress_clear(void);
+
+/* A long library call's progress callback, on the progress line: fill one
+   with tool_progress_begin (which begins a stage named ACTIVITY), pass
+   tool_show_progress as the options' tt_progress_fn and the state as its
+   user data, and call tool_progress_end afterwards. */
 typedef struct tool_progress {
     const char *activity, *what;    /* "pasting", "of the surface covered" */
-    double start, last;             /* seconds */
-    int terminal;                   /* stderr is a terminal: a "\r" line can be redrawn */
-    int shown;
 } tool_progress;
 
 void tool_progress_begin(tool_progress *progress, const char *activity, const char *what);
 /* Also answers "cancel" once Ctrl-C or SIGTERM came (tool_catch_interrupts). */
 int tool_show_progress(float fraction, void *user_data);
-/* Ends a line that was shown. */
+/* The library call returned: Ctrl-C kills the tool again. */
 void tool_progress_end(tool_progress *progress);
 
 /* Between tool_progress_begin and _end, SIGINT and SIGTERM cancel the

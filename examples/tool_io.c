@@ -17,6 +17,7 @@
 #include <time.h>
 
 #include <dirent.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -50,6 +51,7 @@ static void print_error_line(const char *prefix_command, const char *format, va_
        so a newline inside the message cannot split it into several lines. */
     char message[1024];
     char *c;
+    tool_progress_clear();
     vsnprintf(message, sizeof message, format, args);
     for (c = message; *c; c++)
         if (*c == '\n' || *c == '\r') *c = ' ';
@@ -94,6 +96,7 @@ void tool_note(const char *format, ...)
 void tool_print_notes(void)
 {
     int i;
+    tool_progress_clear();
     for (i = 0; i < tool_note_count && !tool_quiet_flag; i++) {
         char *c;
         for (c = tool_notes[i]; *c; c++)
@@ -530,6 +533,7 @@ int output_add_obj(tool_output *output, const char *path, const obj_write_desc *
     tool_buffer text = TOOL_BUFFER_INIT;
     char err[TOOL_ERROR_SIZE];
     int written;
+    tool_stage("writing %s", tool_basename(path));
     if (output_stream_begin(output, path, &text, err, sizeof err) != 0) return tool_fail("%s", err);
     written = obj_write(&text, desc);
     /* A failed write says why before the writer's own failure does. */
@@ -775,7 +779,7 @@ int output_stream_end(tool_output *output, const char *path, tool_buffer *buffer
     return failed ? -1 : 0;
 }
 
-int output_commit(tool_output *output, char *err, size_t err_size)
+static int commit_files(tool_output *output, char *err, size_t err_size)
 {
     commit_file *files;
     int *order, i, k, failed = 0;
@@ -871,6 +875,16 @@ int output_commit(tool_output *output, char *err, size_t err_size)
     return failed ? -1 : 0;
 }
 
+int output_commit(tool_output *output, char *err, size_t err_size)
+{
+    int status;
+    tool_stage("saving %d file%s", output->count, output->count == 1 ? "" : "s");
+    status = commit_files(output, err, err_size);
+    /* the summary comes next, on a clean line */
+    tool_progress_clear();
+    return status;
+}
+
 void output_free(tool_output *output)
 {
     int i;
@@ -932,35 +946,143 @@ void tool_catch_interrupts(void)
 
 int tool_interrupted(void) { return interrupt_requested != 0; }
 
+/* The progress line (see tool.h): one per command, so a static like the
+   command name above. A library call may run for seconds between two of
+   its progress callbacks (a polycube's smoothing, hpm's hierarchy), so on
+   a terminal a thread of the tool redraws the line once a second with the
+   seconds the stage has taken; the lock keeps its redraws and the
+   command's own (which library callbacks may make from any thread) from
+   mixing, and from drawing over an erased line. */
+#define PROGRESS_DELAY 0.5     /* seconds before the first line */
+#define PROGRESS_INTERVAL 0.1  /* seconds between redraws of one stage */
+#define PROGRESS_HEARTBEAT 0.8 /* seconds: redrawn at least once a second while a stage lasts */
+static pthread_mutex_t progress_lock = PTHREAD_MUTEX_INITIALIZER;
+static struct {
+    double start, last;     /* seconds: the command's start, the last redraw */
+    double stage_start;
+    int terminal;           /* stderr is a terminal and not -q */
+    int width;              /* characters of the line on screen, 0 = none */
+    int drawn;              /* this stage was drawn */
+    char stage[160];        /* "" between stages: nothing to draw */
+    double done;            /* the stage's fraction, or -1: unknown */
+    const char *what;
+} progress_line;
+
+/* Under progress_lock. */
+static void progress_draw(int heartbeat)
+{
+    char text[256];
+    int n, pad, seconds;
+    double now = tool_seconds_now();
+    if (!progress_line.terminal || !progress_line.stage[0] || now - progress_line.start < PROGRESS_DELAY) return;
+    if (progress_line.drawn && now - progress_line.last < (heartbeat ? PROGRESS_HEARTBEAT : PROGRESS_INTERVAL))
+        return;
+    if (progress_line.done >= 0.0)
+        n = snprintf(text, sizeof text, "%s: %s: %5.1f%%%s%s", TOOL_NAME, progress_line.stage,
+                     100.0 * fmin(progress_line.done, 0.999), progress_line.what ? " " : "",
+                     progress_line.what ? progress_line.what : "");
+    else
+        n = snprintf(text, sizeof text, "%s: %s", TOOL_NAME, progress_line.stage);
+    seconds = (int)(now - progress_line.stage_start);
+    if (n >= 0 && n < (int)sizeof text && seconds >= 1)
+        n += snprintf(text + n, sizeof text - (size_t)n, " (%d s)", seconds);
+    if (n < 0) return;
+    if (n >= (int)sizeof text) n = (int)sizeof text - 1;
+    /* spaces over what is left of a longer line before */
+    pad = progress_line.width > n ? progress_line.width - n : 0;
+    fprintf(stderr, "\r%s%*s", text, pad, "");
+    if (pad > 0) fprintf(stderr, "\r%s", text);
+    fflush(stderr);
+    progress_line.width = n;
+    progress_line.drawn = 1;
+    progress_line.last = now;
+}
+
+static void *progress_heartbeat(void *unused)
+{
+    struct timespec pause = {0, 200000000};
+    (void)unused;
+    for (;;) {
+        nanosleep(&pause, NULL);
+        pthread_mutex_lock(&progress_lock);
+        progress_draw(1);
+        pthread_mutex_unlock(&progress_lock);
+    }
+    return NULL;
+}
+
+void tool_progress_start(void)
+{
+    pthread_t thread;
+    pthread_attr_t attributes;
+    memset(&progress_line, 0, sizeof progress_line);
+    progress_line.start = progress_line.stage_start = tool_seconds_now();
+    progress_line.terminal = !tool_quiet() && isatty(STDERR_FILENO);
+    progress_line.done = -1.0;
+    if (!progress_line.terminal) return;
+    /* Detached: it sleeps until the process ends. Without it (no thread to
+       be had) the line is drawn only by the command's own calls. */
+    if (pthread_attr_init(&attributes) != 0) return;
+    pthread_attr_setdetachstate(&attributes, PTHREAD_CREATE_DETACHED);
+    pthread_create(&thread, &attributes, progress_heartbeat, NULL);
+    pthread_attr_destroy(&attributes);
+}
+
+void tool_stage(const char *format, ...)
+{
+    va_list args;
+    pthread_mutex_lock(&progress_lock);
+    va_start(args, format);
+    vsnprintf(progress_line.stage, sizeof progress_line.stage, format, args);
+    va_end(args);
+    progress_line.stage_start = tool_seconds_now();
+    progress_line.done = -1.0;
+    progress_line.what = NULL;
+    progress_line.drawn = 0;
+    progress_draw(0);
+    pthread_mutex_unlock(&progress_lock);
+}
+
+void tool_stage_fraction(double done, const char *what)
+{
+    pthread_mutex_lock(&progress_lock);
+    progress_line.done = done > 0.0 ? done : 0.0;
+    progress_line.what = what;
+    progress_draw(0);
+    pthread_mutex_unlock(&progress_lock);
+}
+
+void tool_progress_clear(void)
+{
+    pthread_mutex_lock(&progress_lock);
+    progress_line.stage[0] = '\0';
+    if (progress_line.width > 0) {
+        fprintf(stderr, "\r%*s\r", progress_line.width, "");
+        fflush(stderr);
+    }
+    progress_line.width = 0;
+    progress_line.drawn = 0;
+    pthread_mutex_unlock(&progress_lock);
+}
+
 void tool_progress_begin(tool_progress *progress, const char *activity, const char *what)
 {
     progress_active = 1;
-    memset(progress, 0, sizeof *progress);
     progress->activity = activity;
     progress->what = what;
-    progress->start = tool_seconds_now();
-    /* --quiet: never a progress line, whatever stderr is. */
-    progress->terminal = !tool_quiet() && isatty(STDERR_FILENO);
+    tool_stage("%s", activity);
 }
 
 int tool_show_progress(float fraction, void *user_data)
 {
     tool_progress *progress = (tool_progress *)user_data;
-    double now = tool_seconds_now();
     if (interrupt_requested) return 1;
-    if (!progress->terminal || now - progress->start < 1.0 || (progress->shown && now - progress->last < 0.1))
-        return 0;
-    fprintf(stderr, "\r%s: %s: %5.1f%% %s", TOOL_NAME, progress->activity, 100.0 * (double)fraction,
-            progress->what);
-    fflush(stderr);
-    progress->shown = 1;
-    progress->last = now;
+    tool_stage_fraction((double)fraction, progress->what);
     return 0;
 }
 
 void tool_progress_end(tool_progress *progress)
 {
+    (void)progress;
     progress_active = 0;
-    if (progress->shown) fputc('\n', stderr);
-    progress->shown = 0;
 }

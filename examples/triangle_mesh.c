@@ -44,6 +44,7 @@ int tool_quadrangulate(const char *obj_path, tt_mesh **mesh, int smooth, float *
     int carry_uv = corner_uv && *corner_uv, carry_normal = corner_normal && *corner_normal;
     if ((carry_uv || carry_normal) && tt_mesh_quadrangulate_sources(*mesh, NULL, &sources, &error) != TT_OK)
         return tool_fail("%s: cannot quadrangulate: %s", obj_path, error.message);
+    tool_stage("subdividing");
     if (tt_mesh_quadrangulate(*mesh, smooth ? TT_SUBDIVIDE_CATMULL_CLARK : TT_SUBDIVIDE_LINEAR, NULL, &quads,
                               &error) != TT_OK) {
         tt_corner_sources_free(sources);
@@ -125,6 +126,7 @@ static int triangle_mesh_build(const char *path, triangle_mesh *m, int offer_per
     desc.nfaces = m->ntriangles;
     desc.fixed_face_size = 3;
     desc.flags = m->flags;
+    tool_stage("checking the mesh");
     if (tt_mesh_build(&desc, NULL, &m->mesh, &error) != TT_OK) {
         /* Say it about the OBJ's faces, which the user can find. */
         if (error.face >= 0 && error.face < m->ntriangles) error.face = m->face[error.face];

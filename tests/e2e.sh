@@ -3712,6 +3712,125 @@ fi
 cd "$W" || exit 1
 
 # ======================================================================
+# Progress on a terminal
+# ======================================================================
+# pty_watch runs the tool on a pseudo-terminal and notes when each piece of
+# text between carriage returns arrives: a progress line comes within a
+# second, is redrawn at least once a second, never shows 100 %, and is gone
+# before the summary; nothing of it with -q or without a terminal.
+cat >"$W/pty_watch.c" <<'EOF_C'
+/* pty_watch FRAMES CMD ARGS...: run CMD with its standard output and error
+   on a new pseudo-terminal, as a user's shell would, and write FRAMES: one
+   line "SECONDS TEXT" for each piece of text between carriage returns and
+   newlines, SECONDS when it arrived, then "end SECONDS". Exits with CMD's
+   status. */
+#define _XOPEN_SOURCE 700
+#include <fcntl.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+int main(int argc, char **argv)
+{
+    char text[4096], piece[65536];
+    size_t length = 0;
+    int master, status;
+    double start;
+    pid_t child;
+    FILE *frames;
+    if (argc < 3 || !(frames = fopen(argv[1], "w"))) return 125;
+    master = posix_openpt(O_RDWR | O_NOCTTY);
+    if (master < 0 || grantpt(master) != 0 || unlockpt(master) != 0) return 125;
+    start = now();
+    child = fork();
+    if (child < 0) return 125;
+    if (child == 0) {
+        int slave;
+        setsid();
+        slave = open(ptsname(master), O_RDWR);
+        if (slave < 0) _exit(125);
+        dup2(slave, 1);
+        dup2(slave, 2);
+        execv(argv[2], argv + 2);
+        _exit(126);
+    }
+    for (;;) {
+        struct pollfd p;
+        ssize_t n, i;
+        p.fd = master;
+        p.events = POLLIN;
+        if (poll(&p, 1, 100) <= 0) {
+            if (waitpid(child, &status, WNOHANG) == child) break;
+            continue;
+        }
+        n = read(master, piece, sizeof piece);
+        if (n <= 0) break;  /* EIO: the child closed the terminal */
+        for (i = 0; i < n; i++) {
+            if (piece[i] == '\r' || piece[i] == '\n') {
+                while (length > 0 && text[length - 1] == ' ') length--;
+                if (length > 0) fprintf(frames, "%.3f %.*s\n", now() - start, (int)length, text);
+                length = 0;
+            } else if (length < sizeof text - 1) {
+                text[length++] = piece[i];
+            }
+        }
+    }
+    if (length > 0) fprintf(frames, "%.3f %.*s\n", now() - start, (int)length, text);
+    if (waitpid(child, &status, 0) != child && !WIFEXITED(status)) status = 0;
+    fprintf(frames, "end %.3f\n", now() - start);
+    fclose(frames);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+EOF_C
+CMD="$HELPER_CC pty_watch.c (test helper)"
+if $HELPER_CC -O1 -w "$W/pty_watch.c" -o "$W/pty_watch" 2>"$W/err"; then
+    newdir
+    "$TOOL" generate mesh t.obj --shape torus >/dev/null 2>&1
+    # 24576 triangles and a 2048x2048 bake: about a second at -O2, a few under the sanitizers
+    CMD="pty_watch frames.txt tiledtex lapped t.obj ../in/lap.png out --scale 0.6 --subdivide 2"
+    "$W/pty_watch" frames.txt "$TOOL" lapped t.obj ../in/lap.png out --scale 0.6 --subdivide 2 >/dev/null 2>&1
+    RC=$?
+    check "progress: the run on a terminal" "exit 0" "exit $RC" "$([ $RC -eq 0 ]; echo $?)"
+    # the frames before the summary (which starts with the mesh's name)
+    awk '$2 == "t.obj:" { exit } $1 != "end" { print }' frames.txt >progress.txt
+    stages=$(sed -n 's/^[0-9.]* tiledtex: \([a-z][^:(]*\).*/\1/p' progress.txt | sed 's/ *$//' | sort -u | tr '\n' ',')
+    check "progress: a line naming each stage (pasting, baking, writing, ...)" "at least 3 stages" "$stages" \
+        "$([ "$(printf '%s' "$stages" | tr ',' '\n' | grep -c .)" -ge 3 ]; echo $?)"
+    check "progress: never at 100 % while work goes on" "no '100.0%' before the summary" \
+        "$(grep '100\.0%' progress.txt | head -2)" "$(! grep -q '100\.0%' progress.txt; echo $?)"
+    timing=$(awk '$1 == "end" { end = $2 } $2 == "t.obj:" && !summary { summary = $1 }
+                  $2 == "tiledtex:" && !summary { if (!first) first = $1; if ($1 - last > gap && first) gap = $1 - last; last = $1 }
+                  END { if (summary - last > gap) gap = summary - last; printf "%.2f %.2f %.2f", first, gap, end }' frames.txt)
+    read -r first gap end <<<"$timing"
+    check "progress: the first line within a second, then at least one a second (2 s allowed on a loaded machine)" \
+        "first <= 1.5 s, gaps <= 2 s" "first $first s, largest gap $gap s, run $end s" \
+        "$(awk -v f="$first" -v g="$gap" 'BEGIN { exit !(f > 0 && f <= 1.5 && g <= 2) }'; echo $?)"
+    check "progress: erased before the summary, which starts a line of its own" \
+        "'t.obj: 24576 triangles' and 'wrote out.obj' as whole lines" "$(grep -E 't\.obj: |wrote ' frames.txt | head -3)" \
+        "$(grep -qE '^[0-9.]+ t\.obj: 24576 triangles' frames.txt && grep -qE '^[0-9.]+ wrote out\.obj' frames.txt; echo $?)"
+    "$W/pty_watch" quiet.txt "$TOOL" -q lapped t.obj ../in/lap.png q --scale 0.6 --subdivide 2 >/dev/null 2>&1
+    check "progress: nothing with -q" "no line but 'end'" "$(head -3 quiet.txt)" \
+        "$([ "$(grep -vc '^end ' quiet.txt)" = 0 ]; echo $?)"
+    run lapped t.obj ../in/lap.png p --scale 0.6 --subdivide 2
+    check "progress: nothing when stderr is not a terminal" "stderr without a carriage return" "$(od -c "$W/err" | head -3)" \
+        "$([ $RC -eq 0 ] && ! grep -q $'\r' "$W/err"; echo $?)"
+    cd "$W" || exit 1
+else
+    fail "helper for the progress line" "$CMD" "compiles" "$(head -c 300 "$W/err")"
+fi
+
+# ======================================================================
 # Sanitizers
 # ======================================================================
 CMD="all $RUNS runs"
