@@ -36,8 +36,8 @@
    `polycube_100k_faces_res32_*` time the polycube's construction and the
    vertices' projection onto it on a 100k-triangle torus;
    `polycube_100k_faces_res32` the whole mapping of that torus, voxelisation
-   to UVs (spec B10), with the triangles it made and the ones left to the
-   fallback; its atlas (spec P17: timed apart) is `synth_n2_tile64`, the
+   to UVs, with the triangles it made and the ones left to the
+   fallback; its atlas (timed apart) is `synth_n2_tile64`, the
    paper's 256 tiles at 64 texels. `atlas_charts_100k_faces` times
    tt_atlas_pack_charts on that torus at 2048 x 2048 (gutter 2, the tool's
    --bake), with the charts it made and the fraction of the atlas they fill.
@@ -564,7 +564,7 @@ static double run_polycube_project(void *p)
     return t1 - t0;
 }
 
-/* The whole mapping, voxelisation to UVs (spec B10): the polycube, its
+/* The whole mapping, voxelisation to UVs: the polycube, its
    Wang colouring and tile types, the model split on S, the UVs. The
    atlas's synthesis is timed apart: synth_n2_tile64, the paper's 256-tile
    layout. */
@@ -783,7 +783,7 @@ int main(int argc, char **argv)
     }
     if (wanted("hpm_20k_faces")) {
         /* 20000 triangles of a torus and a 256 x 256 three-channel photo-like
-           image (the paper's sizes, spec A11: at most 5 s) */
+           image (the paper's sizes; the target is at most 5 s) */
         hpm_ctx hc;
         hc.mesh = make_triangle_torus(100, 0.0);
         hc.image = make_source(256);
@@ -813,7 +813,7 @@ int main(int argc, char **argv)
     if (wanted("polycube_100k_faces_res32")) {
         /* the polycube on a 100k-triangle torus: its construction and the
            projection alone, then the whole mapping, voxelisation to UVs
-           (spec B10: <= 1 s); its atlas is synth_n2_tile64 (P17) */
+           (the target is at most 1 s); its atlas is synth_n2_tile64 */
         polycube_ctx pc;
         memset(&pc, 0, sizeof pc);
         pc.mesh = make_triangle_torus(224, 0.0);

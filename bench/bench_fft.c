@@ -1,4 +1,5 @@
-/* bench_fft.c - FFT figures for tiledtex.h (section 4), hpm.md 5.4.
+/* bench_fft.c - FFT figures for tiledtex.h (section 4): the transforms and
+   the masked correlation that hierarchical pattern mapping fits with.
 
    Prints, as bench/bench.c does (`name value unit`, nothing else on stdout):
        fft2d_512 <ms> ms               tt_fft_c2c forward + inverse, in place, complex

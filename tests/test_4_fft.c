@@ -1,7 +1,9 @@
 /* tests/test_4_fft.c - unit tests for section 4 of tiledtex.h, second part:
    the radix-2 FFTs (complex, real, 1D and 2D) and the masked
-   cross-correlation (hpm.md 3.3, T1, T2 and the planted offset of T3). Run
-   by run_fft_tests() (tests/test_common.c calls it). */
+   cross-correlation that hierarchical pattern mapping fits clusters with
+   (transforms against a naive DFT, the correlation against a direct sum,
+   and a planted offset it must find). Run by run_fft_tests()
+   (tests/test_common.c calls it). */
 #include "test_common.h"
 
 #include <math.h>
@@ -64,7 +66,7 @@ static tt_fft_plan *fft_plan(int w, int h)
 }
 
 /* ------------------------------------------------------------------------ */
-/* T1: transforms                                                           */
+/* Transforms                                                               */
 /* ------------------------------------------------------------------------ */
 
 /* 1D sizes 1 .. 1024, both directions, against the definition. */
@@ -382,7 +384,7 @@ static void test_fft_errors(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* T2, T3: masked correlation                                               */
+/* Masked correlation                                                       */
 /* ------------------------------------------------------------------------ */
 
 /* E(ox, oy) by its definition. */

@@ -1861,11 +1861,12 @@ static void test_edges_determinism_and_errors(void)
 /* The model split on S and its UVs (Chang and Lin Sec. 4)                  */
 /* ------------------------------------------------------------------------ */
 
-/* What a mapping must be, whatever the mesh (spec 3.1): output vertices are
-   the weighted input vertices they name (on the model's triangles), input
-   vertex v stays output vertex v, the areas add up to the input's, corner
-   points lie in [0, 1]^2 of a quad of S, and the output is a closed
-   manifold (strict build) when the input is: no crack, no T-junction. */
+/* What a mapping must be, whatever the mesh (the header's contract of
+   tt_polycube_map): output vertices are the weighted input vertices they
+   name (on the model's triangles), input vertex v stays output vertex v,
+   the areas add up to the input's, corner points lie in [0, 1]^2 of a
+   quad of S, and the output is a closed manifold (strict build) when the
+   input is: no crack, no T-junction. */
 typedef struct mapping_check {
     int off_surface, moved_inputs, bad_points, bad_faces;
     double area_error;      /* relative */
