@@ -2457,9 +2457,11 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         vertices it shares with C onto C's flattened positions (a 2D
         Procrustes fit), with the colours of the image at N's coordinates,
         so the mask holds a rigid copy of what N shows; only pixels outside
-        C within `band` texels of it are kept. C's frame is first turned by
-        a random angle, so that the exact continuation of a single
-        neighbour is not the answer unless asked for.
+        C within `band` texels of it are kept. The fit leaves out the
+        offsets that would continue the main neighbour's map exactly or
+        nearly (copy 0 within the cluster's radius of the offset that
+        repeats its texels), so that a patch shows other texels than the
+        one beside it; TT_HPM_EXACT_CONTINUATION lets it continue.
      3. The fit (Sec. 4.2): one masked correlation of
         the band against every turned copy, offsets restricted so that C's
         footprint and its band stay inside a bounded image with a margin of
@@ -2515,16 +2517,20 @@ enum {
     TT_HPM_TOROIDAL = 1u << 0,          /* the image tiles: offsets wrap, UVs may leave [0, 1] */
     TT_HPM_RANDOM_PLACEMENT = 1u << 1,  /* the control: the same traversal and decisions, but every
                                            cluster is output at a random place and orientation */
-    TT_HPM_NO_RANDOM_TURN = 1u << 2,    /* no random turn of the frame before a fit and
-                                           starts at angle 0: a neighbour's exact continuation
-                                           can then be found (tests) */
+    TT_HPM_EXACT_CONTINUATION = 1u << 2, /* a fit may continue a neighbour's map exactly (the
+                                           offsets near its continuation are not left out) and
+                                           new starts are at angle 0: a cluster beside a
+                                           textured one can then repeat it seamlessly (tests) */
+    TT_HPM_NO_RANDOM_TURN = TT_HPM_EXACT_CONTINUATION, /* deprecated: the old name of
+                                           TT_HPM_EXACT_CONTINUATION, for what it did not do */
     TT_HPM_NO_RELAXATION = 1u << 3      /* no work on the borders after each placement: neither
                                            the crack closing, the relaxation (Sec. 4.4)
                                            nor the interior re-solve: the fits alone */
 };
 
 typedef struct tt_hpm_options {
-    uint64_t seed;          /* hierarchy seeds, random turns and starts (any value, 0 included) */
+    uint64_t seed;          /* hierarchy seeds, and the angle and place of each start (any value,
+                               0 included) */
     double scale;           /* world units covered by the image's width; 0 = the bounding box's
                                diagonal / 4, or more where the mesh's longest edge would span over 3/4
                                of the image's smaller side (each face must fit the image) */
@@ -17240,12 +17246,12 @@ static void tt__hpm_bbox(const tt__hpm *S, int C, double cos_a, double sin_a, do
 }
 
 /* A random place (a start, or the control's output): a random angle (0
-   with TT_HPM_NO_RANDOM_TURN) and a random shift keeping the cluster one
+   with TT_HPM_EXACT_CONTINUATION) and a random shift keeping the cluster one
    texel inside a bounded image, trying the other rotations' angles when it
    does not fit. Returns 0 when it fits at no angle. */
 static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, tt__hpm_place *pl)
 {
-    double a0 = (S->flags & TT_HPM_NO_RANDOM_TURN) ? 0 : TT__TWO_PI * tt_rng_float(rng);
+    double a0 = (S->flags & TT_HPM_EXACT_CONTINUATION) ? 0 : TT__TWO_PI * tt_rng_float(rng);
     double ux = tt_rng_float(rng), uy = tt_rng_float(rng);
     int k;
     for (k = 0; k < S->rotations; k++) {
@@ -17645,8 +17651,8 @@ static int tt__hpm_allowed_offsets(tt__hpm *S, int cw, int ch, int has_cont, con
     /* Not the exact continuation of that neighbour (copy 0 at
        the offset that repeats its map), nor anything within the
        cluster's radius of it, which would show the same texels shifted
-       a little; unless asked for (TT_HPM_NO_RANDOM_TURN). */
-    if (has_cont && !(S->flags & TT_HPM_NO_RANDOM_TURN)) {
+       a little; unless asked for (TT_HPM_EXACT_CONTINUATION). */
+    if (has_cont && !(S->flags & TT_HPM_EXACT_CONTINUATION)) {
         double tcx = cont[0] / S->f + o[0] + cb - ctx, tcy = cont[1] / S->f + o[1] + cb - cty;
         double rad = exclusion, px = S->toroidal ? S->ww : 1e300, py = S->toroidal ? S->wh : 1e300;
         int tx, ty, a, b;

@@ -1255,10 +1255,10 @@ done:
     tt_mesh_free(mesh);
 }
 
-/* With no random turn and one orientation, a cluster next to a textured
-   one is placed as its exact continuation, so a folded sheet (two planes,
-   neither flat across the fold) comes out as one continuous map; with the
-   default exclusion of that continuation it does not. */
+/* With TT_HPM_EXACT_CONTINUATION and one orientation, a cluster next to a
+   textured one is placed as its exact continuation, so a folded sheet (two
+   planes, neither flat across the fold) comes out as one continuous map;
+   with the default exclusion of that continuation it does not. */
 static void test_hpm_map_continuation(void)
 {
     tt_mesh *mesh = hpm_book(40, 24, 1.2);
@@ -1271,7 +1271,7 @@ static void test_hpm_map_continuation(void)
     memset(&o, 0, sizeof o);
     o.scale = 20;
     o.rotations = 1;
-    o.flags = TT_HPM_TOROIDAL | TT_HPM_NO_RANDOM_TURN;
+    o.flags = TT_HPM_TOROIDAL | TT_HPM_EXACT_CONTINUATION;
     o.min_faces = 4;
     o.min_footprint = 16;
     /* only exactly planar clusters: a cluster across the fold flattens

@@ -12,7 +12,7 @@
               callback (checked), cancelling after byte[3] % 8 calls (0 =
               never); bit3 tt_hpm_map with NULL options; bit4 map twice
               and compare (determinism); bit5 TT_HPM_TOROIDAL; bit6
-              TT_HPM_RANDOM_PLACEMENT; bit7 TT_HPM_NO_RANDOM_TURN
+              TT_HPM_RANDOM_PLACEMENT; bit7 TT_HPM_EXACT_CONTINUATION
        1, 2   which allocation fails (see above)
        3      cancel after (% 8); bit3 TT_HPM_NO_RELAXATION; bit4 the
               flattening's chord border; bit5 a max_stretch of 2;
@@ -280,7 +280,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ho.min_faces = hdr[10] % 24;
     ho.min_footprint = hdr[11] * 3.0;
     ho.flags = ((hdr[0] & 32) ? TT_HPM_TOROIDAL : 0) | ((hdr[0] & 64) ? TT_HPM_RANDOM_PLACEMENT : 0) |
-               ((hdr[0] & 128) ? TT_HPM_NO_RANDOM_TURN : 0) | ((hdr[3] & 8) ? TT_HPM_NO_RELAXATION : 0);
+               ((hdr[0] & 128) ? TT_HPM_EXACT_CONTINUATION : 0) | ((hdr[3] & 8) ? TT_HPM_NO_RELAXATION : 0);
     ho.branching = co.branching;
     ho.max_flattening_error = hdr[15] / 100.0;
     if (!(ho.scale >= 0.0 && isfinite(ho.scale))) ho.scale = 0.0; /* a mesh with extreme floats */
