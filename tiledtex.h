@@ -848,6 +848,23 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, const tt
    at every offset at once, with the FFT. This part gives the transforms and
    that masked correlation.
 
+   What a transform computes is the textbook radix-2 recursion (Cooley and
+   Tukey's decimation in time), for n a power of two and w = e^(sign 2 pi i / n):
+
+       X = fft(x, n):
+           if n == 1, X = x
+           E = fft(x[0], x[2], ..., x[n - 2], n / 2)      the even-indexed values
+           O = fft(x[1], x[3], ..., x[n - 1], n / 2)      the odd-indexed values
+           for k = 0 .. n / 2 - 1:
+               X[k]         = E[k] + w^k O[k]
+               X[k + n / 2] = E[k] - w^k O[k]
+
+   Unrolled, the recursion reads its leaves in bit-reversed index order and
+   does each of its log2 n levels as one pass of such butterflies over the
+   whole array, which is how the code below runs it, without recursion or
+   temporary arrays (tests/test_4_fft.c holds the naive DFT it is checked
+   against).
+
    Transforms. Complex double, in place, radix-2 family (sizes are powers of
    two, pad the data to them), iterative: a bit-reversal permutation, one
    radix-2 stage when log2 n is odd, then radix-4 stages (each does the work of
