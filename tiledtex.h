@@ -22722,6 +22722,37 @@ typedef struct tt__relax_lane {
     int load, failed;                           /* vertices dealt; out of memory */
 } tt__relax_lane;
 
+/* tt_polycube_map's progress: each phase reports fractions of its own
+   share [lo, hi] of the call, so that a long phase (the smoothing of a
+   100k-face scan takes a second) still reports several times a second. A
+   cancel the callback asks for in a phase is remembered and acted on at
+   the next phase boundary, where the call frees what it holds. */
+typedef struct tt__map_progress {
+    const tt_polycube_map_options *options;
+    float lo, hi;
+    int cancelled;
+} tt__map_progress;
+
+/* Within the phase: done of it, 0 to 1. NULL: no progress to report. */
+static void tt__map_progress_report(tt__map_progress *progress, double done)
+{
+    const tt_polycube_map_options *o = progress ? progress->options : NULL;
+    if (!o || !o->progress || progress->cancelled) return;
+    if (o->progress(progress->lo + (progress->hi - progress->lo) * (float)(done < 1.0 ? done : 1.0),
+                    o->progress_user_data))
+        progress->cancelled = 1;
+}
+
+/* A phase boundary: reports lo, gives the next phase [lo, hi]; non-zero
+   when the callback has asked to stop. */
+static int tt__map_progress_phase(tt__map_progress *progress, float lo, float hi)
+{
+    progress->lo = progress->hi = lo;
+    tt__map_progress_report(progress, 0.0);
+    progress->hi = hi;
+    return progress->cancelled;
+}
+
 /* The relaxation's state. The triangles' standing is kept up to date
    move by move (tt__relax_move, or a sweep's end), so the counts stay
    exact without sweeps over the mesh, and the sweeps visit only the
@@ -22758,6 +22789,8 @@ typedef struct tt__relax_state {
     int njournal, journal_capacity, segment;
     int *saved_in;              /* per vertex: the segment in which its point was last saved */
     const tt_allocator *allocator;
+    tt__map_progress *progress; /* or NULL; the untangling's sweeps report [progress_base, + progress_span] */
+    double progress_base, progress_span;
 } tt__relax_state;
 
 static void tt__relax_state_free(tt__relax_state *R)
@@ -23399,6 +23432,8 @@ static int tt__untangle(tt__relax_state *R, int strict, int *moves)
         if (moved < 0) return -1;
         *moves += moved;
         if (!moved) break;
+        tt__map_progress_report(R->progress, R->progress_base + R->progress_span * (sweep + 1) / TT__UNTANGLE_SWEEPS);
+        if (R->progress && R->progress->cancelled) break;   /* the call stops at its next phase */
     }
     if (!strict && least < INT_MAX && R->nfolded > least) tt__relax_undo(R, best);
     return R->nbad;
@@ -23497,12 +23532,13 @@ done:
    counts once), -1 when out of memory. */
 static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                               const unsigned char *focus, const tt_executor *executor,
-                              const tt_allocator *allocator)
+                              const tt_allocator *allocator, tt__map_progress *progress)
 {
     tt__relax_state R;
     tt__relax_saved *strict_points = NULL;
     int i, sweep, moves = 0;
     if (!tt__relax_state_init(&R, pc, model, points, focus, executor, allocator)) return -1;
+    R.progress = progress;
     R.epoch++;
     for (sweep = 0; sweep < TT__RELAX_SWEEPS; sweep++) {
         int moved, nvisit = tt__relax_bad_vertices(&R, 0);
@@ -23515,7 +23551,10 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         }
         moves += moved;
         if (!moved) break;
+        tt__map_progress_report(progress, 0.5 * (sweep + 1) / TT__RELAX_SWEEPS);
+        if (progress && progress->cancelled) goto done;
     }
+    tt__map_progress_report(progress, 0.5);
     /* The folds these moves leave (a vertex whose ring is itself folded has no good place of its own):
        untangling, both ways (tt__untangle), from the same start (the journal goes back to it), each region
        keeping the way that leaves it fewer bad triangles. */
@@ -23523,10 +23562,13 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
         int strict_moves = 0, free_moves = 0, start, nstrict, untangled;
         R.journaling = 1;
         start = tt__relax_journal_mark(&R);
+        R.progress_base = 0.5;
+        R.progress_span = 0.25;
         if (tt__untangle(&R, 1, &strict_moves) < 0) {
             moves = -1;
             goto done;
         }
+        if (progress && progress->cancelled) goto done;
         /* Strict steps set no mark: each vertex they moved is saved once. */
         nstrict = R.njournal - start;
         strict_points = TT__ALLOC(allocator, tt__relax_saved, nstrict > 0 ? nstrict : 1);
@@ -23539,6 +23581,7 @@ static int tt__polycube_relax(const tt_polycube *pc, const tt_mesh *model, tt_su
             strict_points[i].point = points[strict_points[i].vertex];
         }
         tt__relax_undo(&R, start);
+        R.progress_base = 0.75;
         if (tt__untangle(&R, 0, &free_moves) < 0 ||
             (untangled = tt__untangle_choose(&R, start, strict_points, nstrict)) < 0) {
             moves = -1;
@@ -23631,7 +23674,8 @@ static void tt__smooth_task(void *context, int index)
    Returns the number of steps that moved a point, -1 when out of memory;
    *held: the vertices it could not step (tt__star_step). */
 static int tt__polycube_smooth(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
-                               const tt_executor *executor, const tt_allocator *allocator, int *held)
+                               const tt_executor *executor, const tt_allocator *allocator, int *held,
+                               tt__map_progress *progress)
 {
     const int nverts = model->nverts;
     tt__smooth m;
@@ -23711,6 +23755,8 @@ static int tt__polycube_smooth(const tt_polycube *pc, const tt_mesh *model, tt_s
         }
         moves += changed;
         if (!changed) break;
+        tt__map_progress_report(progress, (double)(sweep + 1) / TT__SMOOTH_SWEEPS);
+        if (progress && progress->cancelled) break;
     }
 done:
     tt__relax_context_free(allocator, &m.x);
@@ -25211,11 +25257,6 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping)
     tt__free(&allocator, mapping);
 }
 
-static int tt__polycube_map_cancelled(const tt_polycube_map_options *options, float fraction)
-{
-    return options && options->progress && options->progress(fraction, options->progress_user_data);
-}
-
 TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
                                 const tt_polycube_map_options *options, const tt_allocator *allocator,
                                 tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error)
@@ -25233,12 +25274,15 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     double longest;
     int f, v, j, tracing, cycle, moves, max_quads;
     tt__reseat_memory reseat;
+    tt__map_progress progress;
     tt__ok(error);
     if (out) *out = NULL;
     if (!report) report = &local;
     memset(report, 0, sizeof *report);
     memset(&R, 0, sizeof R);
     memset(&reseat, 0, sizeof reseat);
+    memset(&progress, 0, sizeof progress);
+    progress.options = options;
     if (!polycube || !mesh || !out)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_polycube_map needs a polycube, a mesh and out (got NULL)");
@@ -25276,7 +25320,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
                         "max_edge %g: give a length above 0 (0 for the default, HUGE_VAL for no refinement)",
                         options->max_edge);
     if ((result = tt__polycube_refine(mesh, longest, allocator, &R, error)) != TT_OK) goto failed;
-    if (tt__polycube_map_cancelled(options, 0.05f)) goto cancelled;
+    if (tt__map_progress_phase(&progress, 0.05f, 0.2f)) goto cancelled;
     model = R.mesh ? R.mesh : mesh;
     report->triangles = model->nfaces;
     points = TT__ALLOC(allocator, tt_surface_point, model->nverts > 0 ? model->nverts : 1);
@@ -25284,18 +25328,20 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if ((result = tt__polycube_project(polycube, model, executor, allocator, points, &report->projection, error)) !=
         TT_OK)
         goto failed;
-    if (tt__polycube_map_cancelled(options, 0.2f)) goto cancelled;
+    if (tt__map_progress_phase(&progress, 0.2f, 0.3f)) goto cancelled;
     tt__polycube_snap_points(points, model->nverts);
-    if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator)) < 0)
+    if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator, &progress)) < 0)
         goto out_of_memory;
-    if ((report->smoothed = tt__polycube_smooth(polycube, model, points, executor, allocator, &report->held)) < 0)
+    if (tt__map_progress_phase(&progress, 0.3f, 0.45f)) goto cancelled;
+    if ((report->smoothed =
+             tt__polycube_smooth(polycube, model, points, executor, allocator, &report->held, &progress)) < 0)
         goto out_of_memory;
     tt__polycube_snap_points(points, model->nverts);   /* again: the smoothing moves points near edges too */
-    if (tt__polycube_map_cancelled(options, 0.45f)) goto cancelled;
+    if (tt__map_progress_phase(&progress, 0.45f, 0.6f)) goto cancelled;
     if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, executor, allocator, NULL,
                                   NULL, &edges, error)) != TT_OK)
         goto failed;
-    if (tt__polycube_map_cancelled(options, 0.6f)) goto cancelled;
+    if (tt__map_progress_phase(&progress, 0.6f, 0.6f)) goto cancelled;
     if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
         !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
         !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
@@ -25308,7 +25354,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
        the edges at the points it moved are traced again. */
     for (cycle = 0; cycle < TT__RESEAT_CYCLES && edges->nfailed > 0; cycle++) {
         int reseated = 0, round, e;
-        if (cycle > 0 && tt__polycube_map_cancelled(options, 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES))
+        if (cycle > 0 && tt__map_progress_phase(&progress, 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES,
+                                                0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES))
             goto cancelled;
         memset(focus, 0, (size_t)model->nverts);
         for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
@@ -25335,7 +25382,8 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             for (v = 0; v < model->nverts; v++) focus[v] = focus[v] != 0;
         }
         memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
-        if ((moves = tt__polycube_relax(polycube, model, points, focus, executor, allocator)) < 0) goto out_of_memory;
+        if ((moves = tt__polycube_relax(polycube, model, points, focus, executor, allocator, NULL)) < 0)
+            goto out_of_memory;
         report->relaxed += moves;
         for (v = 0; v < model->nverts; v++)
             moved[v] = !tt__same_point(points[v], earlier[v]);
@@ -25366,7 +25414,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             goto failed;
     }
     report->failed_edges = edges->nfailed;
-    if (tt__polycube_map_cancelled(options, 0.85f)) goto cancelled;
+    if (tt__map_progress_phase(&progress, 0.85f, 0.85f)) goto cancelled;
 
     if (tt__polycube_split(polycube, model, edges, points, executor, allocator, &mapping,
                            &report->fallback_triangles) != TT_OK)
@@ -25423,7 +25471,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, reseat.seen);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
-    if (tt__polycube_map_cancelled(options, 1.0f)) {
+    if (tt__map_progress_phase(&progress, 1.0f, 1.0f)) {
         tt_polycube_mapping_free(mapping);
         memset(report, 0, sizeof *report);
         return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "polycube mapping cancelled by the progress callback");

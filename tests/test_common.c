@@ -358,7 +358,7 @@ int internal_polycube_voxelize(const tt_mesh *mesh, const double origin[3], doub
 int internal_polycube_mask_is_disc(int mask) { return tt__polycube_mask_is_disc(mask); }
 int internal_polycube_relax(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points)
 {
-    return tt__polycube_relax(polycube, model, points, NULL, NULL, NULL);
+    return tt__polycube_relax(polycube, model, points, NULL, NULL, NULL, NULL);
 }
 int internal_polycube_reseat_calls(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
                                    unsigned char *moved, const tt_allocator *allocator, int ncalls, int nudged,
@@ -454,7 +454,7 @@ void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const 
 int internal_polycube_smooth(const tt_polycube *polycube, const tt_mesh *model, tt_surface_point *points,
                              const tt_executor *executor, const tt_allocator *allocator, int *held)
 {
-    return tt__polycube_smooth(polycube, model, points, executor, allocator, held);
+    return tt__polycube_smooth(polycube, model, points, executor, allocator, held, NULL);
 }
 int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critical(mask, NULL, NULL); }
 int internal_hpm_relax_classes(const tt_mesh *mesh, int *vmark, int *verts, int n, int *class_end)
