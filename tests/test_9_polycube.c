@@ -1942,6 +1942,7 @@ static mapping_check check_mapping(const tt_polycube *pc, const tt_mesh *mesh, c
    number cancel_at (0-based; -1: never). */
 typedef struct progress_log {
     int calls, cancel_at, decreasing;
+    int within_smoothing;   /* fractions strictly between the projection's end (0.2) and the tracing's start (0.45) */
     float last;
 } progress_log;
 
@@ -1949,6 +1950,7 @@ static int log_progress(float fraction, void *user_data)
 {
     progress_log *log = (progress_log *)user_data;
     if (fraction < log->last || !(fraction >= 0.0f && fraction <= 1.0f)) log->decreasing++;
+    log->within_smoothing += fraction > 0.2f && fraction < 0.45f;
     log->last = fraction;
     return log->calls++ == log->cancel_at;
 }
@@ -2468,6 +2470,10 @@ static void test_map_determinism_and_errors(void)
         r = tt_polycube_map(pc, mesh, &mo, NULL, &none, NULL, &err);
         CHECK(r == TT_OK && log.calls >= 6 && log.decreasing == 0 && log.last == 1.0f,
               "progress: %d calls, %d out of order, last %g (%d)", log.calls, log.decreasing, log.last, r);
+        /* The relaxation and the smoothing, which take seconds on a scan,
+           report from inside their sweeps, not only where they end. */
+        CHECK(log.within_smoothing >= 3, "progress: %d calls from inside the relaxation and the smoothing",
+              log.within_smoothing);
         tt_polycube_mapping_free(none);
         calls = log.calls;
         for (k = 0; k < calls; k++) {
