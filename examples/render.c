@@ -294,6 +294,7 @@ typedef struct scene {
     float *triangle_axes;       /* with a normal map: 6 per triangle, its dP/du and dP/dv (zero: none) */
     const int *face_texture;    /* per OBJ face: index into textures, -1: draw grey */
     int wireframe;              /* draw the OBJ faces' edges over the surface */
+    int unlit;                  /* the texture's colour as it is: no lighting (--unlit) */
     vec3 light_key, light_fill; /* unit vectors towards the two lights */
     int width, height;          /* of the sample grid */
     float untextured_grey;      /* linear light */
@@ -780,7 +781,8 @@ static vec3 mapped_normal(const scene *s, int t, const surface_point *point, vec
                                    vec3_scale(n, sample[2])));
 }
 
-/* Light an RGB colour on triangle t at a point, and draw the wireframe. */
+/* Light an RGB colour on triangle t at a point (unless unlit), and draw the
+   wireframe. */
 static void light_sample(const scene *s, int t, const surface_point *point, float rgb[3])
 {
     const int *corner = s->triangle_corners + 3 * t;
@@ -799,6 +801,9 @@ static void light_sample(const scene *s, int t, const surface_point *point, floa
     normal = vec3_scale(normal, (float)s->triangle_facing[t]);
     light = 0.32f + 0.72f * fmaxf(0.0f, vec3_dot(normal, s->light_key)) +
             0.22f * fmaxf(0.0f, vec3_dot(normal, s->light_fill));
+    /* Unlit: the colour an emission shader shows, so that another renderer's
+       picture can be compared with this one whatever its lights. */
+    if (s->unlit) light = 1.0f;
     for (k = 0; k < 3; k++) rgb[k] *= light;
 
     /* Wireframe: b[k] / |grad b[k]| is the distance in samples to the edge
@@ -1055,7 +1060,7 @@ done:
 static void print_render_help(void)
 {
     printf("usage: tiledtex render MESH TEXTURE OUT.png [--size WxH] [--yaw DEG] [--pitch DEG] [--up AXIS]\n"
-           "                       [--zoom F] [--wireframe] [--no-materials]\n"
+           "                       [--zoom F] [--wireframe] [--no-materials] [--unlit]\n"
            "OUT.png may be '-': the PNG goes to the standard output.\n"
            "\n"
            "Draw MESH with TEXTURE (PNG, JPEG, TGA, BMP, ...) applied through the mesh's per-corner\n"
@@ -1086,6 +1091,8 @@ static void print_render_help(void)
            "                and scans), x, -y, -z or -x, or a direction X,Y,Z\n"
            "  --zoom F      magnify the view F times, 0.1 to 100 (default 1: the whole model)\n"
            "  --wireframe   draw the edges of the mesh's faces over the surface\n"
+           "  --unlit       draw the texture's colours as they are, without lighting (as an\n"
+           "                emission shader shows them): for comparing with other renderers\n"
            "  --no-materials  draw every face with TEXTURE, whatever its material names\n"
            "  --normal N.png  light the surface through a tangent-space normal map over the same\n"
            "                texture coordinates (+Y up, as the tool writes them; the frame is the\n"
@@ -1100,7 +1107,7 @@ int cmd_render(int argc, char **argv)
     const char *positional[3];
     int npositional = 0, width = RENDER_DEFAULT_WIDTH, height = RENDER_DEFAULT_HEIGHT, i, status = TOOL_EXIT_FAILURE;
     double yaw = 30.0, pitch = 20.0, zoom = 1.0;
-    int wireframe = 0, use_materials = 1, normal_y_down = 0;
+    int wireframe = 0, use_materials = 1, normal_y_down = 0, unlit = 0;
     const char *normal_path = NULL;
     float *file_normals = NULL;
     mip_texture normal_map;
@@ -1134,6 +1141,8 @@ int cmd_render(int argc, char **argv)
             if (parse_float("--zoom", value, 0.1, 100.0, &zoom) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_flag(argv[i], "--wireframe")) {
             wireframe = 1;
+        } else if (tool_flag(argv[i], "--unlit")) {
+            unlit = 1;
         } else if (tool_flag(argv[i], "--no-materials")) {
             use_materials = 0;
         } else if (tool_option(argc, argv, &i, "--normal", &value)) {
@@ -1157,6 +1166,8 @@ int cmd_render(int argc, char **argv)
 
     if (normal_y_down && !normal_path)
         return tool_usage("--normal-y-down says how --normal N.png is encoded, but no --normal was given");
+    if (unlit && normal_path)
+        return tool_usage("--unlit draws no lighting, which is all --normal %s changes: give one of them", normal_path);
     memset(&textures, 0, sizeof textures);
     memset(&normal_map, 0, sizeof normal_map);
     memset(&s, 0, sizeof s);
@@ -1175,8 +1186,8 @@ int cmd_render(int argc, char **argv)
     if (load_textures(positional[0], positional[1], &mesh, s.pasting, use_materials, &textures) != 0) goto done;
     /* The materials' normal map lights the surface unless --normal names
        another (a pasting mesh's per-patch maps are for engines that
-       composite in order). */
-    if (!normal_path && textures.normal_map && !s.pasting) {
+       composite in order); unlit, nothing would show it. */
+    if (!normal_path && textures.normal_map && !s.pasting && !unlit) {
         tt_image *image;
         /* as a material texture that cannot be read: a note, and drawn without */
         if (image_load(textures.normal_map, TT_COLOR_NORMAL, &image, err, sizeof err) != 0)
@@ -1213,6 +1224,7 @@ int cmd_render(int argc, char **argv)
     s.width = width * SUPERSAMPLING;
     s.height = height * SUPERSAMPLING;
     s.wireframe = wireframe;
+    s.unlit = unlit;
     s.untextured_grey = tt_srgb_to_linear(UNTEXTURED_GREY_SRGB);
     s.wireframe_ink = tt_srgb_to_linear(WIREFRAME_INK_SRGB);
     camera_orbit(&cam, centre, radius, &axis, (float)yaw, (float)pitch, (float)zoom, s.width, s.height);

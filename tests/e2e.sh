@@ -2497,9 +2497,32 @@ if $HELPER_CC -O2 -w $STB_INC "$W/pixstat.c" -o "$W/pixstat" -lm 2>"$W/err"; the
     px=$("$W/pixstat" view.png 32 32 2>/dev/null)
     check "render: mid-grey stays mid-grey (no double gamma)" "r g b each 124 +- 4" "$px" \
         "$(printf '%s\n' "$px" | awk '{exit !(NF == 3 && $1 >= 120 && $1 <= 128 && $2 == $1 && $3 == $1)}'; echo $?)"
+    # --unlit draws the texture's colour as it is (what tests/import_check.sh
+    # compares Blender's emission render with): a flat colour comes out as
+    # exactly that colour, where the lit picture above is darker.
+    expect_ok "render a flat mid-grey texture --unlit" render square_uv.obj grey.pgm unlit.png --size 64x64 \
+        --yaw 0 --pitch 0 --unlit
+    CMD="pixstat unlit.png 32 32"
+    check "render --unlit: flat grey 128 is drawn as 128 (no lighting)" "128 128 128" \
+        "$("$W/pixstat" unlit.png 32 32 2>&1)" "$([ "$("$W/pixstat" unlit.png 32 32 2>/dev/null)" = "128 128 128" ]; echo $?)"
+    { printf 'P6\n4 4\n255\n'; for k in $(seq 16); do printf '\310\144\062'; done; } >orange.ppm
+    expect_ok "render a flat orange texture --unlit" render square_uv.obj orange.ppm orange.png --size 64x64 \
+        --yaw 20 --pitch 10 --unlit
+    CMD="pixstat orange.png 32 32"
+    check "render --unlit: flat (200, 100, 50) is drawn as exactly that colour" "200 100 50" \
+        "$("$W/pixstat" orange.png 32 32 2>&1)" "$([ "$("$W/pixstat" orange.png 32 32 2>/dev/null)" = "200 100 50" ]; echo $?)"
+    expect_ok "render the flat orange texture lit" render square_uv.obj orange.ppm orange_lit.png --size 64x64 \
+        --yaw 20 --pitch 10
+    CMD="pixstat orange_lit.png 32 32"
+    check "render: lit, the flat orange is not its texture's colour (so --unlit changed something)" \
+        "not 200 100 50" "$("$W/pixstat" orange_lit.png 32 32 2>&1)" \
+        "$([ "$("$W/pixstat" orange_lit.png 32 32 2>/dev/null)" != "200 100 50" ]; echo $?)"
 else
     fail "helper for reading pixels" "$CMD" "compiles" "$(head -c 300 "$W/err")"
 fi
+expect_usage_error "render --unlit with --normal" render ../in/torus.obj ../in/tex.png view.png --unlit \
+    --normal ../in/tex.png
+err_mentions "render --unlit with --normal: names both" 'unlit.*normal'
 # one quad has no interior edge: the summary says the seams were not measured
 expect_ok "tile a one-quad mesh" tile square_uv.obj ../in/tex.png one
 check "tile one quad: seam score not measured" "'seam score: not measured (reason)'" "$OUT" \
