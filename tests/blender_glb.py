@@ -12,8 +12,10 @@
 # layer or no base-colour image. With --obj (the OBJ the same command wrote
 # for the same result) it also checks that Blender reads the OBJ's texture
 # coordinates at the OBJ's positions, corner for corner: v flipped right.
-# Not part of `make test` (Blender is large and slow to start); see
-# README.md, "glTF output".
+# Not part of `make test` itself (Blender is large and slow to start); see
+# README.md, "glTF output". tests/import_check.py, which is, imports its
+# helpers: the numpy fix, the image feeding a material input and the camera
+# of `tiledtex render`.
 import math
 import struct
 import sys
@@ -41,18 +43,24 @@ def parse_arguments(argv):
     return positional[0], positional[1] if len(positional) > 1 else None, options
 
 
-def linked_image(socket):
-    """The image feeding a material input, through a Normal Map or Separate
-    RGB/Color node if there is one, or None."""
+def linked_image_node(socket):
+    """The Image Texture node feeding a material input, through a Normal Map
+    or Separate RGB/Color node if there is one, or None."""
     for link in socket.links:
         node = link.from_node
         if node.type == 'TEX_IMAGE' and node.image:
-            return node.image
+            return node
         for inner in node.inputs:
-            image = linked_image(inner)
-            if image:
-                return image
+            found = linked_image_node(inner)
+            if found:
+                return found
     return None
+
+
+def linked_image(socket):
+    """The image feeding a material input, or None."""
+    node = linked_image_node(socket)
+    return node.image if node else None
 
 
 def describe(objects):
@@ -132,10 +140,12 @@ def compare_with_obj(meshes, path):
     return found == len(obj_corners)
 
 
-def render(meshes, out, options):
-    """Cycles, CPU, from where `tiledtex render` puts its camera: around the
-    bounding box's centre, yaw about the up axis and pitch above it, far
-    enough that the bounding sphere fits a 35-degree view with 10 % room."""
+def add_camera_like_render(meshes, options, width, height):
+    """A camera where `tiledtex render` puts its own: around the bounding
+    box's centre, yaw about the up axis and pitch above it, far enough that
+    the bounding sphere fits a 35-degree view (along the picture's shorter
+    side) with 10 % room. Returns the camera object and the picture's up and
+    right as Blender vectors."""
     scene = bpy.context.scene
     corners = [o.matrix_world @ v.co for o in meshes for v in o.data.vertices]
     lo = Vector([min(c[k] for c in corners) for k in range(3)])
@@ -154,6 +164,9 @@ def render(meshes, out, options):
     toward_eye = side * (math.cos(pitch) * math.sin(yaw)) + up * math.sin(pitch) + front * (math.cos(pitch) * math.cos(yaw))
     half_fov = math.radians(35.0) / 2
     camera_data = bpy.data.cameras.new('camera')
+    # The tool's field of view is along the shorter side; Blender's angle is
+    # along the side sensor_fit names.
+    camera_data.sensor_fit = 'HORIZONTAL' if width <= height else 'VERTICAL'
     camera_data.angle = 2 * half_fov
     camera = bpy.data.objects.new('camera', camera_data)
     scene.collection.objects.link(camera)
@@ -168,6 +181,13 @@ def render(meshes, out, options):
     right = forward.cross(up).normalized()
     camera.rotation_euler = Matrix((right, right.cross(forward), -forward)).transposed().to_euler()
     scene.camera = camera
+    return camera, toward_eye, up, right
+
+
+def render(meshes, out, options):
+    """Cycles, CPU, lit by a sun, from `tiledtex render`'s viewpoint."""
+    scene = bpy.context.scene
+    camera, toward_eye, up, right = add_camera_like_render(meshes, options, options['size'], options['size'])
     sun_data = bpy.data.lights.new('key', 'SUN')
     sun_data.energy = 3.0
     sun = bpy.data.objects.new('key', sun_data)
@@ -190,13 +210,22 @@ def render(meshes, out, options):
     print(f"blender: rendered {out}")
 
 
+def restore_numpy_bool():
+    """Debian 12's Blender 3.4 glTF importer still says numpy.bool, which
+    numpy 1.24 removed (it was the builtin bool all along): give it back."""
+    import warnings
+    import numpy
+    # Asking numpy 1.24 about the name warns that it may come back one day.
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', FutureWarning)
+        missing = not hasattr(numpy, 'bool')
+    if missing:
+        numpy.bool = bool
+
+
 def main():
     path, out, options = parse_arguments(sys.argv)
-    # Debian 12's Blender 3.4 importer still says numpy.bool, which numpy
-    # 1.24 removed (it was the builtin bool all along): give it back.
-    import numpy
-    if not hasattr(numpy, 'bool'):
-        numpy.bool = bool
+    restore_numpy_bool()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     result = bpy.ops.import_scene.gltf(filepath=path)
     if 'FINISHED' not in result:
@@ -209,4 +238,6 @@ def main():
     sys.exit(0 if ok else 1)
 
 
-main()
+# Blender runs a --python script as __main__; tests/import_check.py imports it.
+if __name__ == '__main__':
+    main()
