@@ -13,7 +13,10 @@
 #      of the header, built into one program), with ASan + UBSan;
 #   3. if tests/e2e.sh exists: a sanitizer build of the tool and the
 #      end-to-end tests;
-#   4. a short smoke run of each libFuzzer target in tests/fuzz (skipped,
+#   4. the import test (tests/import_check.sh, that build): each pipeline's
+#      default OBJ and GLB opened in assimp and Blender, each skipped with
+#      one line when not installed;
+#   5. a short smoke run of each libFuzzer target in tests/fuzz (skipped,
 #      saying why, when clang's libFuzzer is missing).
 # The last line is "N passed, M failed" over everything; the exit status is
 # non-zero when M > 0.
@@ -237,9 +240,18 @@ if [ -f tests/e2e.sh ]; then
     if log=$($CC -std=c99 -g -O1 -fsanitize=address,undefined -pthread -I. $STB_INC examples/*.c \
         -o build/asan/tiledtex -lm 2>&1); then
         run_counted e2e bash tests/e2e.sh build/asan/tiledtex
+        SANITIZED_TOOL=build/asan/tiledtex
     else
         fail "e2e: the tool does not build with sanitizers" "$log"
     fi
+fi
+
+# Other programs open what the tool writes: assimp and Blender, when
+# installed (a CI machine without them prints one "skip" line and counts
+# nothing). About 30 s with both.
+if [ -n "${SANITIZED_TOOL:-}" ]; then
+    echo "== import test (tests/import_check.sh: assimp and Blender open each pipeline's output)"
+    run_counted import bash tests/import_check.sh "$SANITIZED_TOOL"
 fi
 
 # A short smoke run of each libFuzzer target (tests/fuzz/run.sh builds them
