@@ -2520,9 +2520,6 @@ if $HELPER_CC -O2 -w $STB_INC "$W/pixstat.c" -o "$W/pixstat" -lm 2>"$W/err"; the
 else
     fail "helper for reading pixels" "$CMD" "compiles" "$(head -c 300 "$W/err")"
 fi
-expect_usage_error "render --unlit with --normal" render ../in/torus.obj ../in/tex.png view.png --unlit \
-    --normal ../in/tex.png
-err_mentions "render --unlit with --normal: names both" 'unlit.*normal'
 # one quad has no interior edge: the summary says the seams were not measured
 expect_ok "tile a one-quad mesh" tile square_uv.obj ../in/tex.png one
 check "tile one quad: seam score not measured" "'seam score: not measured (reason)'" "$OUT" \
@@ -2532,6 +2529,10 @@ expect_ok "tile the torus for the seam report" tile ../in/torus.obj ../in/tex.pn
 check "tile: seam score names the edges measured" "'seam score X (N of M edges'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE 'seam score -?[0-9.]+ \([0-9]+ of [0-9]+ edges'; echo $?)"
 cd "$W" || exit 1
+# --unlit draws no lighting, which is all --normal would change
+expect_usage_error "render --unlit with --normal" render ../in/torus.obj ../in/tex.png view.png --unlit \
+    --normal ../in/tex.png
+err_mentions "render --unlit with --normal: names both" 'unlit.*normal'
 
 # ======================================================================
 # Command-line conventions (issue 11, item 5)
