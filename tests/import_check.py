@@ -30,7 +30,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import blender_glb  # noqa: E402  (found through the path set just above)
 import mesh_counts  # noqa: E402
 
-CHECKS_PER_FILE = 4
 # `tiledtex render`'s background (examples/render.c, background_color): a
 # vertical gradient of displayed greys, blue a little higher, drawn with 2x2
 # supersampling. Pixels within this many bytes of it are background.

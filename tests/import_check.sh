@@ -141,7 +141,7 @@ if [ -n "$ASSIMP" ]; then
 fi
 
 # Blender: one run for every file (it takes seconds to start); each file
-# (4 arguments) is tests/import_check.py's CHECKS_PER_FILE = 4 checks.
+# (4 arguments) is the 4 checks tests/import_check.py prints for it.
 if [ -n "$BLENDER" ] && [ -n "$ready" ]; then
     jobs=()
     for p in $ready; do
