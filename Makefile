@@ -1,4 +1,4 @@
-# tiledtex - make / make demo / make test / make bench / make bench-build / make bench-scale / make fuzz
+# tiledtex - make / make demo / make test / make learn / make bench / make bench-build / make bench-scale / make fuzz
 CC      ?= cc
 CFLAGS  ?= -O2 -g
 WARN    := -std=c99 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes
@@ -7,7 +7,7 @@ TOOL_SRC := $(wildcard examples/*.c)
 TOOL_HDR := $(wildcard examples/*.h) tiledtex.h
 # The tool's thread pool (examples/executor.c, -j N) uses POSIX threads.
 
-.PHONY: all demo test bench bench-build bench-scale fuzz clean deps test-deps
+.PHONY: all demo test learn bench bench-build bench-scale fuzz clean deps test-deps
 
 all: build/tiledtex
 
@@ -30,6 +30,11 @@ demo: deps build/tiledtex
 
 test: test-deps
 	@bash tests/run.sh
+
+# The learner's programs (examples/learn/): each built as its README says, run
+# on generated inputs, and its OBJ rendered to build/learn/NAME_view.png.
+learn: deps build/tiledtex
+	@bash tests/learn.sh build/tiledtex
 
 build/bench: bench/bench.c bench/bench_clock.h tiledtex.h | build
 	$(CC) -O2 -g $(WARN) -I. bench/bench.c -o $@ -lm

@@ -16,7 +16,9 @@
 #   4. the import test (tests/import_check.sh, that build): each pipeline's
 #      default OBJ and GLB opened in assimp and Blender, each skipped with
 #      one line when not installed;
-#   5. a short smoke run of each libFuzzer target in tests/fuzz (skipped,
+#   5. the learner's programs, examples/learn/*.c, built with the command
+#      their README gives, run and rendered (tests/learn.sh);
+#   6. a short smoke run of each libFuzzer target in tests/fuzz (skipped,
 #      saying why, when clang's libFuzzer is missing).
 # The last line is "N passed, M failed" over everything; the exit status is
 # non-zero when M > 0.
@@ -252,6 +254,15 @@ fi
 if [ -n "${SANITIZED_TOOL:-}" ]; then
     echo "== import test (tests/import_check.sh: assimp and Blender open each pipeline's output)"
     run_counted import bash tests/import_check.sh "$SANITIZED_TOOL"
+fi
+
+# The learner's programs: each built as examples/learn/README.md says (with
+# -Werror), run on inputs the tool generates, and drawn by its render command.
+echo "== the learner's programs (tests/learn.sh, examples/learn/)"
+if [ -n "${SANITIZED_TOOL:-}" ]; then
+    run_counted learn bash tests/learn.sh "$SANITIZED_TOOL"
+else
+    fail "learn: not run, as the tool that makes its inputs and draws its outputs did not build"
 fi
 
 # A short smoke run of each libFuzzer target (tests/fuzz/run.sh builds them
