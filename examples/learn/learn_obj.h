@@ -34,32 +34,43 @@ static void learn_obj_free(learn_mesh *mesh)
     memset(mesh, 0, sizeof *mesh);
 }
 
-/* One pass over the file: counts the vertices, faces and corners, and
-   stores them too when the arrays are there (the second pass). */
-static int learn_obj_pass(FILE *file, int triangulate, learn_mesh *mesh)
+/* One pass over the file: counts the vertices, faces and corners into
+   `mesh`, and stores them too on the second pass, when `room` (the first
+   pass's counts) says how much the arrays hold. */
+static int learn_obj_pass(FILE *file, int triangulate, learn_mesh *mesh, const learn_mesh *room)
 {
     char line[4096];
     mesh->nverts = mesh->nfaces = mesh->ncorners = 0;
     while (fgets(line, sizeof line, file)) {
-        if (line[0] == 'v' && line[1] == ' ') {
-            float *xyz = mesh->positions ? mesh->positions + 3 * mesh->nverts : NULL;
-            if (xyz && sscanf(line + 2, "%f %f %f", &xyz[0], &xyz[1], &xyz[2]) != 3) return 1;
-            mesh->nverts++;
-        } else if (line[0] == 'f' && line[1] == ' ') {
-            int corners[256], n = 0, used, i;
-            const char *cursor = line + 2;
-            while (n < 256 && sscanf(cursor, "%d%n", &corners[n], &used) == 1) {
-                corners[n] = corners[n] < 0 ? mesh->nverts + corners[n] : corners[n] - 1;
-                n++;
-                cursor += used;
-                while (*cursor && *cursor != ' ' && *cursor != '\t') cursor++;   /* past /t/n */
+        char *cursor = line + 1, *end;
+        if (!strchr(line, '\n') && !feof(file)) return 1;                /* a line too long to read */
+        if (line[0] == 'v' && (line[1] == ' ' || line[1] == '\t')) {
+            int k;
+            if (room && mesh->nverts >= room->nverts) return 1;           /* the file grew meanwhile */
+            for (k = 0; k < 3; k++) {
+                float value = strtof(cursor, &end);
+                if (end == cursor) return 1;
+                if (room) mesh->positions[3 * mesh->nverts + k] = value;
+                cursor = end;
             }
-            if (n < 3 || n == 256) return 1;
+            mesh->nverts++;
+        } else if (line[0] == 'f' && (line[1] == ' ' || line[1] == '\t')) {
+            int corners[256], n = 0, i;
+            long index;
+            while (n < 256 && (index = strtol(cursor, &end, 10), end != cursor)) {
+                if (index > 1000000000L || index < -1000000000L) return 1;   /* keeps int sums exact */
+                corners[n++] = index < 0 ? mesh->nverts + (int)index : (int)index - 1;   /* OBJ counts from 1 */
+                cursor = end;
+                while (*cursor && *cursor != ' ' && *cursor != '\t' && *cursor != '\n') cursor++;   /* past /t/n */
+            }
+            if (n < 3 || n == 256 || mesh->ncorners > 1000000000 - 3 * n) return 1;
             for (i = 1; i + 1 < n; i++) {           /* the fan's triangle (0, i, i + 1) */
                 int size = triangulate ? 3 : n, k;
-                if (mesh->face_sizes) {
+                if (room && (mesh->nfaces >= room->nfaces || mesh->ncorners + size > room->ncorners))
+                    return 1;                       /* the file grew meanwhile */
+                if (room) {
                     mesh->face_sizes[mesh->nfaces] = size;
-                    for (k = 0; k < size; k++)      /* triangle: corners 0, i, i + 1 */
+                    for (k = 0; k < size; k++)
                         mesh->indices[mesh->ncorners + k] = corners[triangulate && k > 0 ? i + k - 1 : k];
                 }
                 mesh->nfaces++;
@@ -77,18 +88,19 @@ static int learn_obj_pass(FILE *file, int triangulate, learn_mesh *mesh)
    indices and the geometry itself (tt_mesh_build). */
 static int learn_obj_read(const char *path, int triangulate, learn_mesh *mesh)
 {
+    learn_mesh counted;
     FILE *file = fopen(path, "r");
     int failed;
     memset(mesh, 0, sizeof *mesh);
     if (!file) { fprintf(stderr, "cannot open %s\n", path); return 1; }
-    failed = learn_obj_pass(file, triangulate, mesh);
+    failed = learn_obj_pass(file, triangulate, &counted, NULL);
     if (!failed) {
-        mesh->positions = (float *)malloc(3 * sizeof(float) * (size_t)(mesh->nverts + 1));
-        mesh->indices = (int *)malloc(sizeof(int) * (size_t)(mesh->ncorners + 1));
-        mesh->face_sizes = (int *)malloc(sizeof(int) * (size_t)(mesh->nfaces + 1));
+        mesh->positions = (float *)malloc(3 * sizeof(float) * (size_t)(counted.nverts + 1));
+        mesh->indices = (int *)malloc(sizeof(int) * (size_t)(counted.ncorners + 1));
+        mesh->face_sizes = (int *)malloc(sizeof(int) * (size_t)(counted.nfaces + 1));
         failed = !mesh->positions || !mesh->indices || !mesh->face_sizes;
         rewind(file);
-        if (!failed) failed = learn_obj_pass(file, triangulate, mesh);
+        if (!failed) failed = learn_obj_pass(file, triangulate, mesh, &counted);
     }
     fclose(file);
     if (failed) { fprintf(stderr, "cannot read %s: a bad v or f line, or out of memory\n", path); learn_obj_free(mesh); }
