@@ -63,10 +63,11 @@ int main(int argc, char **argv)
     stbi_image_free(bytes);
     if (decoded != TT_OK) goto failed;
 
-    /* Sec. 3.1: the automatic polycube. The cubes of a 16-cube grid the
-       surface meets, the inside filled, cubes added where S would not be a
-       manifold; S gets one quad per exposed cube face, each turned so that
-       its tile's up follows +Y on the walls. */
+    /* Sec. 3.1: the automatic polycube. The cubes of a grid (16 along the
+       model's longest side) that its surface meets, the inside filled,
+       cubes added where S would not be a manifold; S gets one quad per
+       exposed cube face, each turned so that its tile's up follows +Y on
+       the walls. */
     if (tt_polycube_build(mesh, NULL, NULL, &polycube, &cubes, &error) != TT_OK) goto failed;
 
     edge_colors = (int *)malloc(sizeof(int) * (size_t)polycube->surface->ncorners);
@@ -75,10 +76,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "out of memory\n");
         goto done;
     }
-    /* Sec. 3.2: the Wang colouring of S's edges, the edges along each axis
-       drawing from their own two colours; then, as in tile.c, each
+    /* Sec. 3.2: the Wang colouring of S's edges. The edges fall into three
+       groups by their axis, each group draws two of the colours (here n = 2:
+       both) and each edge one of its group's. Then, as in tile.c, each
        half-edge's boundary type from its edge's colour and a random side. */
-    if (tt_polycube_edge_colors(polycube, layout.colors, 1, 1, edge_colors, &error) != TT_OK) goto failed;
+    if (tt_polycube_edge_colors(polycube, layout.colors, 1 /* per-axis groups */, 1 /* seed */, edge_colors,
+                                &error) != TT_OK)
+        goto failed;
     if (tt_assign_boundaries(polycube->surface, &layout, 1, edge_colors, types, &error) != TT_OK) goto failed;
     /* The tiles themselves, from the photo, as tile.c makes them. */
     synth.layout = layout;

@@ -48,8 +48,9 @@ int main(int argc, char **argv)
     desc.nfaces = obj.nfaces;
     if (tt_mesh_build(&desc, NULL, &mesh, &error) != TT_OK) goto failed;
 
-    /* The method needs quads (Sec. 2). Any other mesh becomes one by a
-       subdivision step: each n-gon into n quads, the shape kept. */
+    /* The method textures quadrilateral meshes, one tile per quad (Sec. 3).
+       Any other mesh becomes one by a subdivision step: each n-gon into n
+       quads, the shape kept. */
     if (mesh->min_face_size != 4 || mesh->max_face_size != 4) {
         if (tt_mesh_quadrangulate(mesh, TT_SUBDIVIDE_LINEAR, NULL, &quads, &error) != TT_OK) goto failed;
         tt_mesh_free(mesh);
@@ -75,7 +76,7 @@ int main(int argc, char **argv)
     }
     /* Sec. 3, AssignBoundaries: every edge a random condition k and side i;
        one half-edge gets type 2k + i, its twin 2k + 1 - i. */
-    if (tt_assign_boundaries(mesh, &layout, 1, NULL, types, &error) != TT_OK) goto failed;
+    if (tt_assign_boundaries(mesh, &layout, 1 /* seed */, NULL, types, &error) != TT_OK) goto failed;
     /* Sec. 3, AssignTextureCoordinates: a quad's four types name its tile,
        and so its place in the atlas. */
     if (tt_assign_uvs(mesh, &layout, types, uv, &error) != TT_OK) goto failed;
