@@ -1153,7 +1153,7 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
 /* ======================================================================== */
 
 /* Based on: E. Akleman, J. Chen, V. Meenakshisundaram, V. Srinivasan, "Tiled
-   Textures: A Simple and Practical Technique for Seamless Texturing".
+   Textures: A Simple and Practical Technique for Seamless Texturing". Design note: docs/tiled.md.
    The steps, for a quad mesh (tt_mesh_quadrangulate any other first):
      1. tt_assign_boundaries: a boundary type per half-edge (Sec. 3, 6);
      2. tt_assign_uvs: each quad's UVs from its four types alone (Sec. 3);
@@ -1624,7 +1624,7 @@ TTDEF tt_result tt_measure_uv_distortion(const tt_mesh *mesh, const float *corne
 /* 7. Lapped textures                                                       */
 /* ======================================================================== */
 
-/* Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000).
+/* Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000). Design note: docs/lapped.md.
    The steps, for a triangle mesh:
      1. tt_tangent_field: the texture's up and scale per face (Sec. 3.2);
      2. tt_make_texture_patch: the photo with a soft-edged alpha (Sec. 3.1);
@@ -1879,7 +1879,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    random, and each face added gets the average direction of its neighbours
    already in the patch, projected on its plane; only |T_f| is used.
 
-   Hard edges: where growth stops (a disc would close, or distortion), the
+   Hard edges (docs/lapped.md): where growth stops (a disc would close, or distortion), the
    paste would end at a mesh edge without its soft falloff (Sec. 3.3 finds
    them "less objectionable than distorted texture"); step 5 fades it
    there instead. What stays hard is a cut along the seed face itself (a
@@ -2177,7 +2177,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
 /* ======================================================================== */
 
 /* Based on: Soler, Cani, Angelidis, "Hierarchical Pattern Mapping"
-   (SIGGRAPH 2002). The steps, for a triangle mesh:
+   (SIGGRAPH 2002); design note: docs/hpm.md. The steps, for a triangle mesh:
      1. tt_cluster_hierarchy_build: the face-cluster hierarchy, from whole
         components down to single faces, with control vertices (Sec. 2.1,
         3.1) - this block;
@@ -2460,7 +2460,7 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         transforms (step 3), their spectra cached (tt_xcorr_texture):
         copies * (channels + 1) * P * (P / 2 + 1) * 16 bytes (10 MB; all
         19 copies: 40 MB) and a work space per copy.
-        Why max_turn: the paper tries all 19 orientations and lets the
+        Why max_turn (docs/hpm.md): the paper tries all 19 orientations and lets the
         orientation "propagate from the first texture patch" (Sec. 2.2)
         through the fit alone; with a band a few texels wide, a brick or a
         plank turned by 60 or 120 degrees often matches about as well, and
@@ -2649,7 +2649,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
 
 /* Based on: C.-C. Chang and C.-Y. Lin, "Texture Tiling on 3D Models Using
    Automatic Polycube-maps and Wang Tiles" (Journal of Information Science
-   and Engineering 25, 2009). The steps of the whole pipeline:
+   and Engineering 25, 2009); design note: docs/polycube.md. The steps:
      1. tt_polycube_build: the automatic polycube (Sec. 3.1) - this block:
         a. voxelisation: the cubes of a uniform grid over the bounding box
            that the model's surface meets (triangle-cube test);
@@ -2744,7 +2744,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    order x, y, z of its steps). Adding only ever grows the set, so the
    loop ends and the model stays inside; then the interior is filled again.
 
-   Correction (Sec. 3.1). The paper's sentence cannot be meant as
+   Correction (Sec. 3.1; docs/polycube.md). The paper's sentence cannot be meant as
    written; read as: a cube is removed when one of its 8 corner cells (unit
    boxes centred on its corners) holds part of S but does not meet the
    model. One pass over the polycube as it is, then repair and fill. Where
@@ -8562,7 +8562,7 @@ TTDEF int tt_tile_index(const tt_tile_layout *layout, const uint8_t types[4])
 
 TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4], int corner, float uv[2])
 {
-    /* The paper prints floor(j/2) in the u equation (Figure 6); with
+    /* The paper prints floor(j/2) in the u equation (Figure 6; docs/tiled.md); with
        j = floor(((i+1) mod 4)/2) already 0 or 1 that would pin u to the
        tile's left side. j itself is the corner's column within the tile. */
     tt_tile_layout L;
@@ -18075,7 +18075,7 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
     }
 }
 
-/* ---- The local relaxation along shared borders (Sec. 4.4) ----
+/* ---- The local relaxation along shared borders (Sec. 4.4; docs/hpm.md) ----
 
    After C is placed, at each vertex on its border with textured faces,
    C's texture coordinates there and then each textured neighbour's in
