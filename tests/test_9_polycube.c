@@ -840,7 +840,7 @@ static void test_errors(void)
    tiled-textures machinery. The per-axis colours, tt_assign_boundaries,
    tt_assign_uvs and tt_synthesize_tiles texture S seamlessly: the seam
    score over every edge of S is about 0 (at most 0.05), and the same tiles
-   with the quads' coordinates shuffled score at least 0.8 (B6; measured
+   with the quads' coordinates shuffled score at least 0.8 (measured
    0.86 - with n = 2 a quarter of the shuffled edges still match by type,
    so it cannot reach 1). The
    paper's rotation rules (Figs. 3-5) need no code: this is the test that
@@ -2390,7 +2390,7 @@ static tt_result map_oom_call(void *ctx, const tt_allocator *al, tt_error *error
     return r;
 }
 
-/* B9 and the errors: the same input gives bitwise the same mapping; bad
+/* Determinism and the errors: the same input gives bitwise the same mapping; bad
    arguments and polygons are refused with *out NULL; every allocation
    failure is reported and leaks nothing. */
 static void test_map_determinism_and_errors(void)
@@ -3381,7 +3381,7 @@ static void test_map_random(void)
            fallbacks, triangles, collapsed);
     CHECK(bad == 0, "24 random bumpy spheres at resolutions 1-14: %d not watertight, area-true and in one quad "
                     "per triangle", bad);
-    /* B4: the fallback's pieces too keep their turn (a clamped projection folds some of these). */
+    /* No flipped triangle: the fallback's pieces too keep their turn (a clamped projection folds some of these). */
     CHECK(fallbacks > 0 && flipped == 0, "24 random bumpy spheres: %d flipped output triangles (0 expected), with %d "
           "triangles left to the fallback", flipped, fallbacks);
 }
