@@ -214,7 +214,10 @@ static int make_stone_texture(int size, uint64_t seed, tt_image **out_image, tt_
     }
 
     /* Pass 1: albedo into RGB, height into alpha (a free scratch channel). */
+    tool_stage("generating the stones");
     for (y = 0; y < size; y++) {
+        /* the first pass is most of the time (a 4096 texture takes seconds) */
+        if (y % 64 == 0) tool_stage_fraction(0.8 * y / size, "of the rows");
         for (x = 0; x < size; x++) {
             float *pixel = image->pixels + 4 * ((size_t)y * (size_t)size + (size_t)x);
             float fx = (float)x, fy = (float)y, sx, sy, stone, dome, height, mottle, grit, albedo[3];
@@ -258,6 +261,7 @@ static int make_stone_texture(int size, uint64_t seed, tt_image **out_image, tt_
        the surface normal; the light comes from the upper left. Mortar and the
        foot of each stone are darkened as if little light reached them. */
     for (y = 0; y < size; y++) {
+        if (y % 64 == 0) tool_stage_fraction(0.8 + 0.2 * y / size, "of the rows");
         for (x = 0; x < size; x++) {
             float *pixel = image->pixels + 4 * ((size_t)y * (size_t)size + (size_t)x);
             int xl = x > 0 ? x - 1 : x, xr = x + 1 < size ? x + 1 : x;

@@ -1239,6 +1239,7 @@ int cmd_render(int argc, char **argv)
     }
     if (file_normals) scene_use_file_normals(&s, file_normals);
 
+    tool_stage("drawing %d triangles", s.ntriangles);
     draw_visibility(&s, &samples);
     if (s.pasting) draw_pastes(&s, &samples);
     shade_samples(&s, &samples);
