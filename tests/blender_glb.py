@@ -140,6 +140,17 @@ def compare_with_obj(meshes, path):
     return found == len(obj_corners)
 
 
+def use_cycles_on_cpu(scene, samples, world_grey):
+    """Cycles on the CPU, no denoising, `samples` per pixel, over a plain grey world."""
+    world = bpy.data.worlds.new('world')
+    world.color = (world_grey, world_grey, world_grey)
+    scene.world = world
+    scene.render.engine = 'CYCLES'
+    scene.cycles.device = 'CPU'
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+
+
 def add_camera_like_render(meshes, options, width, height):
     """A camera where `tiledtex render` puts its own: around the bounding
     box's centre, yaw about the up axis and pitch above it, far enough that
@@ -194,13 +205,7 @@ def render(meshes, out, options):
     # From above the camera, a little to its right.
     sun.rotation_euler = (-(toward_eye + up * 0.8 + right * 0.5)).to_track_quat('-Z', 'Y').to_euler()
     scene.collection.objects.link(sun)
-    world = bpy.data.worlds.new('world')
-    world.color = (0.35, 0.35, 0.35)
-    scene.world = world
-    scene.render.engine = 'CYCLES'
-    scene.cycles.device = 'CPU'
-    scene.cycles.samples = options['samples']
-    scene.cycles.use_denoising = False
+    use_cycles_on_cpu(scene, options['samples'], 0.35)
     scene.render.resolution_x = scene.render.resolution_y = options['size']
     scene.render.resolution_percentage = 100
     # Plain sRGB, as the tool writes its pictures (Blender's default, Filmic, flattens them).

@@ -173,14 +173,8 @@ def setup_render(meshes, options):
     scene = bpy.context.scene
     blender_glb.add_camera_like_render(meshes, {'yaw': 30.0, 'pitch': 20.0, 'up': 'y'}, options['size'],
                                        options['size'])
-    world = bpy.data.worlds.new('world')
-    world.color = (0.0, 0.0, 0.0)
-    scene.world = world
-    scene.render.engine = 'CYCLES'
-    scene.cycles.device = 'CPU'
-    scene.cycles.samples = options['samples']
+    blender_glb.use_cycles_on_cpu(scene, options['samples'], 0.0)
     scene.cycles.use_adaptive_sampling = False
-    scene.cycles.use_denoising = False
     scene.cycles.seed = 1
     # Emission seen straight from the camera: no bounce changes a pixel.
     scene.cycles.max_bounces = 0
