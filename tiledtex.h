@@ -1161,7 +1161,9 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
         several maps of one material: the (2n)^4 tiles composited from
         windows of the photo (Sec. 4), with gutters and mips;
      4. tt_measure_seams, tt_tile_histogram, tt_face_stretch: the report
-        (tt_measure_uv_distortion measures any charting, tiled or not).
+        (tt_measure_uv_distortion measures any charting, tiled or not);
+     5. optionally tt_compact_atlas_create: an atlas of only the tiles the
+        mesh shows, a power of two a side.
    Memory: nothing per photo pixel beyond the photo itself (16 bytes a
    pixel, yours): synthesis reads windows of it. The atlas and its mips take
    about 4/3 * W * W * 16 bytes, the plan about 4 * S bytes per tile, and
@@ -1454,6 +1456,74 @@ TTDEF tt_result tt_synth_apply(const tt_synth_plan *plan, const tt_image *source
 TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_options *options,
                                     const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error);
 TTDEF void tt_tileset_free(tt_tileset *tileset);
+
+/* --- The compact atlas: only the tiles a mesh shows ---
+
+   The layout's atlas holds every one of the (2n)^4 tiles whether the mesh
+   shows it or not: 2176 x 2176 texels at the defaults (twice as wide with a
+   polycube's upright tiles), a size no engine asks for and, beside upright
+   tiles, above the 4096 texels a side many take. A compact atlas holds only
+   the cells the faces use, each whole with its gutter (so bilinear
+   filtering and the mip levels a gutter keeps seamless read what the full
+   atlas had there), in a power-of-two rectangle: the smallest of W x W and
+   2W x W that holds them, cells filled row by row from the top left.
+     1. tt_compact_atlas_create: which cells the faces use, from their UVs
+        in the full atlas (tt_assign_uvs, tt_polycube_mapping_uvs...), and
+        the compact atlas's size;
+     2. tt_compact_atlas_image: those cells of a full atlas image, for each
+        map of a material alike (colour, normal, roughness...);
+     3. tt_compact_atlas_uv: a face's UV in the full atlas moved to its
+        cell in the compact one (a translation per face: what the UVs
+        interpolate inside the face stays as it was). */
+
+#define TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE 4096   /* texels a side: what many engines and GPUs take */
+
+typedef struct tt_compact_atlas {
+    int full_width, full_height;    /* the atlas the UVs were made for, texels */
+    int cell_size;                  /* C = S + 2g of the layout */
+    int width, height;              /* the compact atlas: powers of two, width = height or 2 * height */
+    int columns;                    /* cells per row of the compact atlas */
+    int ncells;                     /* the cells kept: in the full atlas's order (by tile row, then column) */
+    int *cell_source;               /* 2 * ncells: each kept cell's column and row in the full atlas,
+                                       row 0 at the bottom as tt_tile_index counts */
+    int nfaces;
+    int *face_cell;                 /* nfaces: the kept cell of each face */
+    tt_allocator allocator;         /* the one it was made with */
+} tt_compact_atlas;
+
+/* The cells of a full atlas (full_width x full_height texels, cells of the
+   layout's C = S + 2g texels, row 0 at the bottom: a layout's W x W, or a
+   polycube's 2W x W upright atlas) that mesh's faces use, each face's cell
+   being the one its corners' UVs lie in, and the smallest power-of-two
+   atlas that holds them with at most max_size texels a side (0 =
+   TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE; at most TT_MAX_IMAGE_SIZE).
+   corner_uv: 2 * mesh->ncorners floats, (0, 0) the full atlas's bottom left.
+   Errors: NULL mesh, corner_uv or out, a bad allocator, a layout that does
+   not resolve, full sizes that are not whole numbers of cells or max_size
+   outside 0..TT_MAX_IMAGE_SIZE (TT_ERROR_INVALID_ARGUMENT); a face whose
+   UVs are not finite or do not lie in one cell of the full atlas
+   (TT_ERROR_INVALID_ARGUMENT, error->face and error->corner say which: UVs
+   of another layout or atlas); a mesh without faces (TT_ERROR_EMPTY_MESH);
+   more cells than max_size x max_size holds (TT_ERROR_TOO_LARGE, saying
+   what size would hold them); TT_ERROR_OUT_OF_MEMORY. *out is NULL on
+   failure. Free with tt_compact_atlas_free. Thread-safe. */
+TTDEF tt_result tt_compact_atlas_create(const tt_mesh *mesh, const float *corner_uv, const tt_tile_layout *layout,
+                                        int full_width, int full_height, int max_size,
+                                        const tt_allocator *allocator, tt_compact_atlas **out, tt_error *error);
+/* The compact atlas's image: every kept cell copied from `full` (an image
+   of the full atlas's size: the colour atlas or any map applied with the
+   same plan), of full's kind; texels outside the cells hold the cells' mean
+   (a normal map's renormalised). Errors: NULL arguments, a bad allocator, a `full` of
+   another size or without pixels (TT_ERROR_INVALID_ARGUMENT),
+   TT_ERROR_OUT_OF_MEMORY. *out_image is NULL on failure; free it with
+   tt_image_free. */
+TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_image *full,
+                                       const tt_allocator *allocator, tt_image **out_image, tt_error *error);
+/* uv = full_uv (a UV of `face` in the full atlas) moved into the face's
+   cell of the compact atlas; uv may be full_uv.
+   Preconditions (TT_ASSERT): atlas not NULL, 0 <= face < atlas->nfaces. */
+TTDEF void tt_compact_atlas_uv(const tt_compact_atlas *atlas, int face, const float full_uv[2], float uv[2]);
+TTDEF void tt_compact_atlas_free(tt_compact_atlas *atlas);
 
 /* Seam measure across every interior edge (the project's acceptance measure):
    at points along the edge, sample the atlas just inside each of the two faces,
@@ -3291,7 +3361,13 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
      2. tt_polycube_upright_atlas: the two side by side, 2W x W, plain on
         the left (per mip level, as you need them);
      3. tt_polycube_mapping_uvs_upright: as tt_polycube_mapping_uvs, u
-        halved, and moved to the right half for a wall.
+        halved, and moved to the right half for a wall;
+     4. optionally tt_compact_atlas_create on S with its UVs (those of
+        tt_assign_uvs, halved and moved the same way), then
+        tt_compact_atlas_image and tt_compact_atlas_uv with each corner's
+        quad: an atlas of only the tiles S shows (about 400 of the 512 on
+        a model at resolution 16), 4096 x 2048 instead of 4352 x 2176 with
+        128-texel tiles.
    tt_polycube_quad_upright is 1 for a wall, 0 for a top or bottom.
    Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad <
    its surface's nfaces. */
@@ -9712,6 +9788,235 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
     result = tt__synth_apply(plan, source, allocator, out_tileset, error, 0, TT__PLAN_SHARE, 1.0f);
     tt_synth_plan_free(plan);
     return result;
+}
+
+/* --- The compact atlas ---------------------------------------------------- */
+
+/* The smallest power-of-two W x W or 2W x W, W <= max_size on its larger
+   side, whose C-texel cells number at least `cells`; 0 when none does. */
+static int tt__compact_atlas_fit(int cells, int cell_size, int max_size, int *width, int *height)
+{
+    long long side;
+    for (side = 1; side <= max_size; side *= 2) {
+        long long across = side / cell_size;
+        if (across * across >= cells) {
+            *width = *height = (int)side;
+            return 1;
+        }
+        if (2 * side <= max_size && (2 * side / cell_size) * across >= cells) {
+            *width = (int)(2 * side);
+            *height = (int)side;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+TTDEF tt_result tt_compact_atlas_create(const tt_mesh *mesh, const float *corner_uv, const tt_tile_layout *layout,
+                                        int full_width, int full_height, int max_size,
+                                        const tt_allocator *allocator, tt_compact_atlas **out, tt_error *error)
+{
+    tt_tile_layout resolved;
+    tt_compact_atlas *atlas;
+    int *slot = NULL, full_columns, full_rows, C, f, c, n = 0, width, height;
+    tt_result result;
+    tt__ok(error);
+    if (out) *out = NULL;
+    if (!mesh || !corner_uv || !layout || !out)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_compact_atlas_create needs a mesh, corner_uv, a layout and out (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
+    C = resolved.tile_size + 2 * resolved.gutter;
+    if (max_size == 0) max_size = TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE;
+    if (max_size < 0 || max_size > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "max_size must be 0 (%d) or 1..%d (TT_MAX_IMAGE_SIZE), got %d",
+                        TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE, TT_MAX_IMAGE_SIZE, max_size);
+    if (full_width < C || full_height < C || full_width % C || full_height % C ||
+        full_width > TT_MAX_IMAGE_SIZE || full_height > TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "a full atlas of %d x %d texels is not a whole number of the layout's %d-texel cells "
+                        "(tile %d, gutter %d) within %d texels a side",
+                        full_width, full_height, C, resolved.tile_size, resolved.gutter, TT_MAX_IMAGE_SIZE);
+    if (mesh->nfaces < 1)
+        return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces: it shows no tile");
+    full_columns = full_width / C;
+    full_rows = full_height / C;
+    atlas = TT__ALLOC(allocator, tt_compact_atlas, 1);
+    if (atlas) {
+        memset(atlas, 0, sizeof *atlas);
+        atlas->allocator = tt__allocator_copy(allocator);
+        atlas->face_cell = TT__ALLOC(allocator, int, mesh->nfaces);
+    }
+    /* slot[cell of the full atlas]: 1 when a face uses it, then its kept index. */
+    slot = TT__ALLOC(allocator, int, (size_t)full_columns * (size_t)full_rows);
+    if (!atlas || !atlas->face_cell || !slot) {
+        tt__free(allocator, slot);
+        tt_compact_atlas_free(atlas);
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                        "out of memory for the cells of a %d x %d atlas", full_width, full_height);
+    }
+    memset(slot, 0, sizeof(int) * (size_t)full_columns * (size_t)full_rows);
+    for (f = 0; f < mesh->nfaces; f++) {
+        const int begin = mesh->face_start[f], end = mesh->face_start[f + 1];
+        double mean[2] = {0.0, 0.0};
+        long long column, row;
+        for (c = begin; c < end; c++) {
+            if (!tt__is_finite(corner_uv[2 * c]) || !tt__is_finite(corner_uv[2 * c + 1])) {
+                tt__free(allocator, slot);
+                tt_compact_atlas_free(atlas);
+                return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, c, -1, -1, "corner %d's UV is not finite", c);
+            }
+            mean[0] += corner_uv[2 * c];
+            mean[1] += corner_uv[2 * c + 1];
+        }
+        /* The centre of the face's UVs lies inside its cell, away from the
+           borders its corners may touch; every corner must then lie in that
+           cell, within a hundredth of a texel. */
+        column = (long long)floor(mean[0] / (end - begin) * full_width / C);
+        row = (long long)floor(mean[1] / (end - begin) * full_height / C);
+        if (column < 0 || column >= full_columns || row < 0 || row >= full_rows) {
+            tt__free(allocator, slot);
+            tt_compact_atlas_free(atlas);
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, begin, -1, -1,
+                            "face %d's UVs lie outside the %d x %d atlas", f, full_width, full_height);
+        }
+        for (c = begin; c < end; c++) {
+            double x = (double)corner_uv[2 * c] * full_width - (double)column * C;
+            double y = (double)corner_uv[2 * c + 1] * full_height - (double)row * C;
+            if (x < -0.01 || x > C + 0.01 || y < -0.01 || y > C + 0.01) {
+                tt__free(allocator, slot);
+                tt_compact_atlas_free(atlas);
+                return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, c, -1, -1,
+                                "face %d's UVs do not lie in one %d-texel cell of the %d x %d atlas (corner %d): "
+                                "UVs of another layout or atlas", f, C, full_width, full_height, c);
+            }
+        }
+        atlas->face_cell[f] = (int)(row * full_columns + column);
+        slot[atlas->face_cell[f]] = 1;
+    }
+    for (c = 0; c < full_columns * full_rows; c++) n += slot[c];
+    if (!tt__compact_atlas_fit(n, C, max_size, &width, &height)) {
+        int wanted_width = 0, wanted_height = 0;
+        tt__compact_atlas_fit(n, C, TT_MAX_IMAGE_SIZE, &wanted_width, &wanted_height);
+        tt__free(allocator, slot);
+        tt_compact_atlas_free(atlas);
+        if (wanted_width)
+            return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                            "the %d tiles the mesh shows (%d-texel cells) need a %d x %d atlas, above max_size %d: "
+                            "fewer colors, smaller tiles or a larger max_size", n, C, wanted_width, wanted_height,
+                            max_size);
+        return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                        "the %d tiles the mesh shows (%d-texel cells) do not fit %d texels a side "
+                        "(TT_MAX_IMAGE_SIZE): fewer colors or smaller tiles", n, C, TT_MAX_IMAGE_SIZE);
+    }
+    atlas->cell_source = TT__ALLOC(allocator, int, 2 * (size_t)n);
+    if (!atlas->cell_source) {
+        tt__free(allocator, slot);
+        tt_compact_atlas_free(atlas);
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for %d cells", n);
+    }
+    atlas->full_width = full_width;
+    atlas->full_height = full_height;
+    atlas->cell_size = C;
+    atlas->width = width;
+    atlas->height = height;
+    atlas->columns = width / C;
+    atlas->nfaces = mesh->nfaces;
+    for (c = 0; c < full_columns * full_rows; c++)
+        if (slot[c]) {
+            atlas->cell_source[2 * atlas->ncells] = c % full_columns;
+            atlas->cell_source[2 * atlas->ncells + 1] = c / full_columns;
+            slot[c] = atlas->ncells++;
+        }
+    for (f = 0; f < mesh->nfaces; f++) atlas->face_cell[f] = slot[atlas->face_cell[f]];
+    tt__free(allocator, slot);
+    *out = atlas;
+    return TT_OK;
+}
+
+/* Kept cell `cell`'s bottom-left texel in the compact atlas, counting y from
+   the bottom as UVs do; cells fill rows from the top. */
+static void tt__compact_atlas_origin(const tt_compact_atlas *atlas, int cell, int origin[2])
+{
+    origin[0] = (cell % atlas->columns) * atlas->cell_size;
+    origin[1] = atlas->height - (cell / atlas->columns + 1) * atlas->cell_size;
+}
+
+TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_image *full,
+                                       const tt_allocator *allocator, tt_image **out_image, tt_error *error)
+{
+    tt_image *image;
+    tt_result result;
+    double mean[4] = {0.0, 0.0, 0.0, 0.0};
+    size_t i;
+    int cell, y, k, pass;
+    tt__ok(error);
+    if (out_image) *out_image = NULL;
+    if (!atlas || !full || !out_image)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_compact_atlas_image needs an atlas, a full image and out_image (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (!full->pixels || full->width != atlas->full_width || full->height != atlas->full_height)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the full atlas image is %d x %d%s; the UVs were made for %d x %d", full->width,
+                        full->height, full->pixels ? "" : " without pixels", atlas->full_width, atlas->full_height);
+    if ((result = tt__image_create(atlas->width, atlas->height, 0, allocator, &image, error)) != TT_OK) return result;
+    image->kind = full->kind;
+    /* Texels between and beside the cells hold the cells' mean, so that the
+       coarse mip levels an engine makes blend toward it rather than black. */
+    for (pass = 0; pass < 2; pass++) {
+        if (pass == 1) {
+            if (full->kind == TT_IMAGE_NORMAL) tt__normalize3(mean);
+            for (i = 0; i < (size_t)atlas->width * (size_t)atlas->height; i++)
+                for (k = 0; k < 4; k++) image->pixels[4 * i + k] = (float)mean[k];
+        }
+        for (cell = 0; cell < atlas->ncells; cell++) {
+            const int C = atlas->cell_size;
+            int to[2], x;
+            /* Image rows count from the top; cell rows from the bottom. */
+            const int from_x = atlas->cell_source[2 * cell] * C;
+            const int from_y = full->height - (atlas->cell_source[2 * cell + 1] + 1) * C;
+            tt__compact_atlas_origin(atlas, cell, to);
+            for (y = 0; y < C; y++) {
+                const float *from = full->pixels + 4 * ((size_t)(from_y + y) * (size_t)full->width + (size_t)from_x);
+                if (pass == 1)
+                    memcpy(image->pixels +
+                               4 * ((size_t)(atlas->height - to[1] - C + y) * (size_t)atlas->width + (size_t)to[0]),
+                           from, 4 * sizeof(float) * (size_t)C);
+                else
+                    for (x = 0; x < C; x++)
+                        for (k = 0; k < 4; k++)
+                            mean[k] += from[4 * x + k] / ((double)atlas->ncells * C * C);
+            }
+        }
+    }
+    *out_image = image;
+    return TT_OK;
+}
+
+TTDEF void tt_compact_atlas_uv(const tt_compact_atlas *atlas, int face, const float full_uv[2], float uv[2])
+{
+    int to[2], cell;
+    double x, y;
+    TT_ASSERT(atlas && face >= 0 && face < atlas->nfaces);
+    cell = atlas->face_cell[face];
+    tt__compact_atlas_origin(atlas, cell, to);
+    x = (double)full_uv[0] * atlas->full_width - (double)atlas->cell_source[2 * cell] * atlas->cell_size + to[0];
+    y = (double)full_uv[1] * atlas->full_height - (double)atlas->cell_source[2 * cell + 1] * atlas->cell_size + to[1];
+    uv[0] = (float)(x / atlas->width);
+    uv[1] = (float)(y / atlas->height);
+}
+
+TTDEF void tt_compact_atlas_free(tt_compact_atlas *atlas)
+{
+    tt_allocator allocator;
+    if (!atlas) return;
+    allocator = atlas->allocator;
+    tt__free(&allocator, atlas->cell_source);
+    tt__free(&allocator, atlas->face_cell);
+    tt__free(&allocator, atlas);
 }
 
 /* --- quality report ------------------------------------------------------ */

@@ -81,6 +81,8 @@ static void print_help(void)
            "                   the polycube's surface is left out: write the OBJ files to see it)\n"
            "  --triangles      write the polycube surface's squares as two triangles each (the\n"
            "                   mesh is triangles already)\n"
+           "  --max-atlas N    the atlas's larger side at most N texels (default %d): it holds\n"
+           "                   only the tiles the polycube shows, in a power-of-two rectangle\n"
            MATERIAL_OPTIONS_HELP("                   ")
            "\n"
            "Prints the polycube (cubes, squares, components, genus against the mesh's), the\n"
@@ -95,7 +97,7 @@ static void print_help(void)
            "         tiledtex polycube sphere.obj stones.png sphere_pc --resolution 8\n"
            "         tiledtex render sphere_pc.obj sphere_pc.png view.png\n",
            TT_POLYCUBE_MAX_RESOLUTION, TT_POLYCUBE_DEFAULT_RESOLUTION, POLYCUBE_DEFAULT_COLORS,
-           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE);
 }
 
 typedef struct polycube_command_options {
@@ -104,6 +106,7 @@ typedef struct polycube_command_options {
     tiled_options tiles;            /* --colors --tile --gutter --seed, as `tile` takes them */
     tt_polycube_options build;      /* zero fields: the library's defaults */
     int plain;                      /* --no-upright */
+    int max_atlas;                  /* --max-atlas; 0 = the library's default */
 } polycube_command_options;
 
 /* Returns -1 to go on, or the exit status to return now. */
@@ -137,6 +140,9 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
                 return tool_usage("--cube-size wants the cubes' edge in mesh units, above 0, got '%s'", value);
             options->build.cube_size = size;
             cube_size_given = 1;
+        } else if (tool_option(argc, argv, &i, "--max-atlas", &value)) {
+            if (parse_int("--max-atlas", value, 1, TT_MAX_IMAGE_SIZE, &options->max_atlas) != 0)
+                return TOOL_EXIT_USAGE;
         } else if (tool_flag(argv[i], "--no-upright")) {
             options->plain = 1;
         } else if (tool_flag(argv[i], "--no-correct")) {
@@ -175,10 +181,13 @@ typedef struct polycube_job {
     float *surface_uv;              /* per S corner: S's own texture coordinates */
     tt_tileset *tiles;              /* plain: the tops and bottoms (all of S with --no-upright) */
     tt_tileset *upright_tiles;      /* the walls; NULL with --no-upright */
-    tt_image *atlas;                /* the two side by side; NULL with --no-upright (then tiles->levels[0]) */
+    tt_image *atlas;                /* the two side by side (NULL with --no-upright), then the compact atlas */
     /* The same for each map of the material (NULL for the maps not given). */
     tt_tileset *map_tiles[MATERIAL_MAPS], *map_upright_tiles[MATERIAL_MAPS];
     tt_image *map_atlas[MATERIAL_MAPS];
+    int upright;                    /* the walls have upright tiles (IMAGE was large enough) */
+    tt_compact_atlas *compact;      /* the cells S shows, and where they went */
+    int full_width, full_height;    /* the atlas of every tile, which the compact one replaced */
     tt_polycube_mapping *mapping;
     tt_polycube_map_report map_report;
     float *corner_uv;               /* 6 per mapped triangle */
@@ -197,6 +206,7 @@ static void polycube_job_free(polycube_job *job)
     tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
     tt_image_free(job->atlas);
     for (map = 0; map < MATERIAL_MAPS; map++) tt_image_free(job->map_atlas[map]);
+    tt_compact_atlas_free(job->compact);
     tt_polycube_mapping_free(job->mapping);
     free(job->corner_uv);
     memset(job, 0, sizeof *job);
@@ -267,6 +277,7 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
                                    job->map_upright_tiles)) != 0)
         return status;
     tool_stage("turning the tiles upright");
+    job->upright = 1;
     if (tt_polycube_upright_atlas(job->tiles, job->upright_tiles, 0, tool_executor(), NULL, &job->atlas, &error) !=
         TT_OK)
         return tool_fail("the %dx%d atlas: %s", 2 * plain->width, plain->height, error.message);
@@ -287,6 +298,45 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
     return 0;
 }
 
+/* The atlas of the tiles S shows (tt_compact_atlas_create): it replaces the
+   atlas of every tile, and S's texture coordinates move into it. */
+static int compact_atlas(const polycube_command_options *options, polycube_job *job)
+{
+    const tt_mesh *surface = job->polycube->surface;
+    const tt_image *full = job->atlas ? job->atlas : &job->tiles->levels[0];
+    tt_image *compact = NULL;
+    tt_error error;
+    int c, map;
+    tool_stage("packing the tiles S shows");
+    job->full_width = full->width;
+    job->full_height = full->height;
+    if (tt_compact_atlas_create(surface, job->surface_uv, &job->layout, full->width, full->height, options->max_atlas,
+                                NULL, &job->compact, &error) != TT_OK)
+        return tool_fail("%s: the atlas: %s%s", options->mesh_path, error.message,
+                         error.result == TT_ERROR_TOO_LARGE ? " (--colors 1, a smaller --tile or --max-atlas)" : "");
+    if (tt_compact_atlas_image(job->compact, full, NULL, &compact, &error) != TT_OK)
+        return tool_fail("the %dx%d atlas: %s", job->compact->width, job->compact->height, error.message);
+    tt_image_free(job->atlas);
+    job->atlas = compact;
+    for (map = 0; map < MATERIAL_MAPS; map++) {
+        const tt_image *map_full = job->map_atlas[map]   ? job->map_atlas[map]
+                                   : job->map_tiles[map] ? &job->map_tiles[map]->levels[0]
+                                                         : NULL;
+        if (!map_full) continue;
+        if (tt_compact_atlas_image(job->compact, map_full, NULL, &compact, &error) != TT_OK)
+            return tool_fail("the %dx%d %s atlas: %s", job->compact->width, job->compact->height,
+                             material_map_names[map], error.message);
+        tt_image_free(job->map_atlas[map]);
+        job->map_atlas[map] = compact;
+    }
+    for (c = 0; c < surface->ncorners; c++)
+        tt_compact_atlas_uv(job->compact, surface->corner_face[c], &job->surface_uv[2 * c], &job->surface_uv[2 * c]);
+    /* The compact atlases hold every texel the outputs use. */
+    tiled_tilesets_free(&job->tiles, job->map_tiles);
+    tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
+    return 0;
+}
+
 /* The triangles split along S's quads, with their texture coordinates. */
 static int map_mesh(const polycube_command_options *options, polycube_job *job)
 {
@@ -295,6 +345,7 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
     tool_progress progress;
     tt_result result;
     double start = tool_seconds_now();
+    int i;
     /* -j: the projection, the relaxation, the tracing and the split on the tool's threads (the same mapping). */
     memset(&map_options, 0, sizeof map_options);
     map_options.executor = tool_executor();
@@ -315,9 +366,12 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
     job->corner_uv = (float *)malloc((size_t)job->mapping->ntriangles * 6 * sizeof(float));
     if (!job->corner_uv)
         return tool_fail("out of memory for the texture coordinates of %d triangles", job->mapping->ntriangles);
-    if ((job->atlas ? tt_polycube_mapping_uvs_upright : tt_polycube_mapping_uvs)(
+    if ((job->upright ? tt_polycube_mapping_uvs_upright : tt_polycube_mapping_uvs)(
             job->polycube, job->mapping, &job->layout, job->surface_type, job->corner_uv, &error) != TT_OK)
         return tool_fail("%s: the texture coordinates: %s", options->mesh_path, error.message);
+    for (i = 0; i < 3 * job->mapping->ntriangles; i++)
+        tt_compact_atlas_uv(job->compact, job->mapping->corner_points[i].quad, &job->corner_uv[2 * i],
+                            &job->corner_uv[2 * i]);
     return 0;
 }
 
@@ -340,7 +394,7 @@ typedef struct polycube_quality {
 static int measure_quality(const polycube_command_options *options, const polycube_job *job,
                            polycube_quality *quality)
 {
-    const tt_image *atlas = job->atlas ? job->atlas : &job->tiles->levels[0];
+    const tt_image *atlas = job->atlas;
     tt_mesh_desc desc;
     tt_mesh *mapped = NULL;
     tt_uv_distortion_options distortion;
@@ -396,7 +450,6 @@ static void print_summary(const polycube_command_options *options, const polycub
     const tt_polycube_projection_report *p = &m->projection;
     const tt_uv_distortion_report *d = &quality->distortion;
     char borders[320], all[320];
-    int atlas = tt_tile_layout_atlas_size(&job->layout);
 
     printf("%s: %d triangles", options->mesh_path, job->mesh.ntriangles);
     if (job->mesh.ntriangles != job->mesh.obj.nfaces) printf(" (fans of %d faces)", job->mesh.obj.nfaces);
@@ -415,10 +468,11 @@ static void print_summary(const polycube_command_options *options, const polycub
     printf("; smoothing: %d moves, %d vertices left as projected", m->smoothed, m->held);
     printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);
-    printf("tiles: %s%d (n=%d, %d texels, gutter %d), %dx%d atlas%s; %.4g texels per unit\n", job->atlas ? "2 x " : "",
+    printf("tiles: %d of the %s%d shown (n=%d, %d texels, gutter %d%s), in a %dx%d atlas (all would take %dx%d); "
+           "%.4g texels per unit\n", job->compact->ncells, job->upright ? "2 x " : "",
            tt_tile_layout_tile_count(&job->layout), job->layout.colors, job->layout.tile_size, job->layout.gutter,
-           job->atlas ? 2 * atlas : atlas, atlas, job->atlas ? " (plain for the tops, upright for the walls)" : "",
-           job->layout.tile_size / job->polycube->h);
+           job->upright ? "; plain for the tops, upright for the walls" : "", job->compact->width,
+           job->compact->height, job->full_width, job->full_height, job->layout.tile_size / job->polycube->h);
     if (!quality->mesh_built) {
         printf("stretch and seam score: not measured (%s)\n", quality->mesh_reason);
     } else {
@@ -638,6 +692,7 @@ int cmd_polycube(int argc, char **argv)
         status = tiled_synthesize(image, options.image_path, &options.tiles, &options.tiles.maps, &job.tiles,
                                   job.map_tiles);
         if (status == 0 && !options.plain) status = synthesize_upright(&options, image, &job);
+        if (status == 0) status = compact_atlas(&options, &job);
         job.synth_seconds = tool_seconds_now() - start;
     }
     /* The photo and the maps are not needed past the synthesis; they are
@@ -653,22 +708,15 @@ int cmd_polycube(int argc, char **argv)
         const tt_image *map_images[MATERIAL_MAPS];
         memset(&material, 0, sizeof material);
         material.name = "tiled";
-        material.base_color = job.atlas ? job.atlas : &job.tiles->levels[0];
-        for (map = 0; map < MATERIAL_MAPS; map++)
-            map_images[map] = job.map_atlas[map] ? job.map_atlas[map]
-                              : job.map_tiles[map] ? &job.map_tiles[map]->levels[0] : NULL;
+        material.base_color = job.atlas;
+        for (map = 0; map < MATERIAL_MAPS; map++) map_images[map] = job.map_atlas[map];
         material_for_glb(&material, &options.tiles.maps, map_images);
         status = add_gltf(&output, gltf_path, &job, &material);
     }
-    if (status == 0 && !gltf && job.atlas &&
-        output_add_png(&output, png_path, job.atlas, TT_COLOR_SRGB, message, sizeof message) != 0)
+    if (status == 0 && !gltf && output_add_png(&output, png_path, job.atlas, TT_COLOR_SRGB, message, sizeof message) != 0)
         status = tool_fail("%s", message);
-    if (status == 0 && !gltf && !job.atlas) status = tiled_add_atlas(&output, png_path, job.tiles, 0, TT_COLOR_SRGB);
-    for (map = 0; map < MATERIAL_MAPS && status == 0 && !gltf; map++) {
+    for (map = 0; map < MATERIAL_MAPS && status == 0 && !gltf; map++)
         if (job.map_atlas[map]) status = output_add_map_png(&output, map_paths[map], map, job.map_atlas[map]);
-        else if (job.map_tiles[map])
-            status = tiled_add_atlas(&output, map_paths[map], job.map_tiles[map], 0, material_space(map));
-    }
     if (status == 0 && !gltf) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
     if (status == 0 && !gltf) status = add_obj(&output, obj_path, tool_basename(mtl_path), &job);
     if (status == 0 && !gltf)
@@ -682,7 +730,7 @@ int cmd_polycube(int argc, char **argv)
         } else {
             printf("wrote %s, %s, %s, %s", obj_path, mtl_path, png_path, surface_path);
             for (map = 0; map < MATERIAL_MAPS; map++)
-                if (job.map_tiles[map]) printf(", %s", map_paths[map]);
+                if (job.map_atlas[map]) printf(", %s", map_paths[map]);
             printf("\n");
         }
     }

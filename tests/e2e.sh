@@ -1338,16 +1338,16 @@ expect_error "hpm OBJ truncated mid face line" hpm ../in/truncated_face.obj ../i
 # ======================================================================
 # Polycube + Wang tiles
 # ======================================================================
-# polycube_obj_report OBJ COLORS TILE GUTTER WIDE ->
+# polycube_obj_report OBJ TILE GUTTER ATLAS_WIDTH ATLAS_HEIGHT ->
 #   "faces nontri corners nvt badc unused outside straddling":
 #   f lines, f lines without 3 corners, corners, vt lines, corners whose v or
 #   vt index is missing or out of range, vt lines no corner uses, vt values that are not numbers in [0,1], and triangles whose three vt
-#   do not fall in one tile's cell of the atlas ((2n)^2 cells of S + 2G texels a side, WIDE
-#   times as many across: 2 for the plain and upright tiles side by side).
+#   do not fall in one tile of the atlas (cells of TILE + 2 GUTTER texels from its top left, the
+#   corners within the TILE x TILE square inside the gutter).
 polycube_obj_report() {
-    awk -v n="$2" -v s="$3" -v g="$4" -v wide="$5" '
+    awk -v s="$2" -v g="$3" -v aw="$4" -v ah="$5" '
         function isnum(x) { return x ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?$/ }
-        BEGIN { cell = s + 2 * g; side = 4 * n * n * cell }
+        BEGIN { cell = s + 2 * g }
         $1 == "v"  { nv++ }
         $1 == "vt" { nvt++; u[nvt] = $2; v[nvt] = $3
                      for (i = 2; i <= 3; i++)
@@ -1362,7 +1362,12 @@ polycube_obj_report() {
                     p[1] + 0 < 1 || p[1] + 0 > nv || p[2] + 0 < 1 || p[2] + 0 > nvt) { badc++; continue }
                 t = p[2] + 0
                 uses[t]++
-                key = int(u[t] * wide * side / cell) "," int(v[t] * side / cell)
+                x = u[t] * aw; y = (1 - v[t]) * ah
+                key = int(x / cell) "," int(y / cell)
+                # Inside the tile proper: the gutter is for filtering only.
+                if (x - int(x / cell) * cell < g - 0.01 || x - int(x / cell) * cell > g + s + 0.01 ||
+                    y - int(y / cell) * cell < g - 0.01 || y - int(y / cell) * cell > g + s + 0.01)
+                    if (!(cf[k] in straddles)) { straddles[cf[k]] = 1; straddling++ }
                 if (!(cf[k] in tile)) tile[cf[k]] = key
                 else if (tile[cf[k]] != key && !(cf[k] in straddles)) { straddles[cf[k]] = 1; straddling++ }
             }
@@ -1376,9 +1381,8 @@ polycube_obj_report() {
 # the OBJ holds at least the mesh's triangle fans, each corner's vt inside its
 # triangle's tile; the polycube's surface is quads with tile UVs; the summary has its lines.
 polycube_case() {
-    local name=$1 mesh=$2 colors=$3 faces nontri corners nvt badc unused outside straddling want side wide=2
+    local name=$1 mesh=$2 colors=$3 faces nontri corners nvt badc unused outside straddling want shown aw ah
     shift 3
-    case " $* " in *" --no-upright "*) wide=1 ;; esac
     newdir
     run polycube "../in/$mesh" ../in/tex.png out --tile 16 --colors "$colors" "$@"
     check "polycube $name: exit status" "0" "exit $RC, stderr: $ERR" "$([ $RC -eq 0 ]; echo $?)"
@@ -1389,11 +1393,19 @@ polycube_case() {
         "$(grep -h -E 'map_|mtllib' out.mtl out.obj out_polycube.obj 2>&1)" \
         "$(grep -qE '^map_Kd +out\.png$' out.mtl 2>/dev/null && grep -qE '^mtllib +out\.mtl$' out.obj 2>/dev/null &&
             grep -qE '^mtllib +out\.mtl$' out_polycube.obj 2>/dev/null; echo $?)"
-    side=$((4 * colors * colors * (16 + 2 * 4)))
-    check "polycube $name: the atlas is $((wide * side))x$side" "$((wide * side)) $side" "$(png_size out.png)" \
-        "$(is_png out.png && [ "$(png_size out.png)" = "$((wide * side)) $side" ]; echo $?)"
+    # The compact atlas: the smallest power-of-two square or 2:1 rectangle
+    # of 24-texel cells holding the tiles the summary says S shows.
+    shown=$(printf '%s' "$OUT" | sed -nE 's/^tiles: ([0-9]+) of the .*/\1/p')
+    read -r aw ah <<<"$(png_size out.png)"
+    check "polycube $name: a power-of-two atlas just holding the $shown tiles shown" \
+        "WxW or 2WxW, W a power of two, the half size too small" "${aw}x$ah, $shown tiles" \
+        "$(is_png out.png && [ -n "$shown" ] && [ $((aw & (aw - 1))) = 0 ] && [ $((ah & (ah - 1))) = 0 ] &&
+            { [ "$aw" = "$ah" ] || [ "$aw" = $((2 * ah)) ]; } &&
+            [ $(((aw / 24) * (ah / 24))) -ge "$shown" ] &&
+            if [ "$aw" = "$ah" ]; then [ $(((aw / 24) * (aw / 48))) -lt "$shown" ];
+            else [ $(((ah / 24) * (ah / 24))) -lt "$shown" ]; fi; echo $?)"
     read -r faces nontri corners nvt badc unused outside straddling \
-        <<<"$(polycube_obj_report out.obj "$colors" 16 4 "$wide")"
+        <<<"$(polycube_obj_report out.obj 16 4 $(png_size out.png))"
     want=$(fan_triangles "$W/in/$mesh")
     check "polycube $name: triangles, at least the mesh's $want" ">= $want triangle f lines" \
         "$faces f lines, $nontri not triangles" \
@@ -1423,11 +1435,16 @@ check "polycube sphere: genus 0 as the mesh" "'genus 0 (as the mesh)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'genus 0 (as the mesh)'; echo $?)"
 check "polycube sphere: no note about cuts (none beyond 0.1 %)" "no 'no seamless place' on stderr" "$ERR" \
     "$(printf '%s' "$ERR" | grep -q 'no seamless place'; [ $? -ne 0 ]; echo $?)"
-check "polycube sphere: the paper's 256 tiles, plain and upright" "'tiles: 2 x 256 (n=2 ... (plain for the tops, upright for the walls)'" "$OUT" \
-    "$(printf '%s' "$OUT" | grep -q '^tiles: 2 x 256 (n=2, 16 texels, gutter 4), 768x384 atlas (plain for the tops, upright for the walls)'; echo $?)"
+check "polycube sphere: of the paper's 256 tiles, plain and upright, those shown" "'tiles: N of the 2 x 256 shown (n=2, 16 texels, gutter 4; plain for the tops, upright for the walls), in a WxH atlas (all would take 768x384)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE '^tiles: [0-9]+ of the 2 x 256 shown \(n=2, 16 texels, gutter 4; plain for the tops, upright for the walls\), in a [0-9]+x[0-9]+ atlas \(all would take 768x384\)'; echo $?)"
+expect_error "polycube --max-atlas below the tiles shown" polycube ../in/spheretri.obj ../in/tex.png out --tile 16 \
+    --resolution 8 --max-atlas 64
+check "polycube --max-atlas 64: says the size the tiles need and what helps" \
+    "'need a WxH atlas, above max_size 64 ... --max-atlas)'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -qE 'need a [0-9]+ x [0-9]+ atlas, above max_size 64.*--max-atlas\)$'; echo $?)"
 polycube_case "sphere --no-upright" spheretri.obj 2 --resolution 8 --no-upright
-check "polycube --no-upright: one set of 256 tiles" "'tiles: 256 (n=2, 16 texels, gutter 4), 384x384 atlas;'" "$OUT" \
-    "$(printf '%s' "$OUT" | grep -q '^tiles: 256 (n=2, 16 texels, gutter 4), 384x384 atlas;'; echo $?)"
+check "polycube --no-upright: of one set of 256 tiles, those shown" "'tiles: N of the 256 shown (n=2, 16 texels, gutter 4), in a WxH atlas (all would take 384x384);'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE '^tiles: [0-9]+ of the 256 shown \(n=2, 16 texels, gutter 4\), in a [0-9]+x[0-9]+ atlas \(all would take 384x384\);'; echo $?)"
 polycube_case "torus (quads as fans)" torus.obj 1 --seed 3
 check "polycube torus: says it split the quads into triangles" "'1024 triangles (fans of 512 faces)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q '1024 triangles (fans of 512 faces)'; echo $?)"

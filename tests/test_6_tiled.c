@@ -1073,7 +1073,229 @@ static void test_synth_oom(void)
 }
 
 /* ------------------------------------------------------------------------ */
-/* 6c. Quality measures                                                     */
+/* 6c. The compact atlas                                                     */
+/* ------------------------------------------------------------------------ */
+
+/* The full atlas's texel (x, y), y counted from the bottom as UVs are. */
+static const float *texel_from_bottom(const tt_image *im, int x, int y)
+{
+    return im->pixels + 4 * ((size_t)(im->height - 1 - y) * (size_t)im->width + (size_t)x);
+}
+
+/* Check a compact atlas against the naive reference: the cells are the
+   distinct tiles of the faces (tt_tile_index, the walls' half moved right
+   when `wide`), the size is the smallest power-of-two rectangle that holds
+   them, and every texel of every face's full cell reads the same through
+   tt_compact_atlas_uv in the compact image. */
+static void check_compact(const char *what, const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *types,
+                          const float *uv, const int *wall, const tt_image *full, const tt_compact_atlas *ca,
+                          const tt_image *image)
+{
+    const int T = tt_tile_layout_tiles_per_side(layout), W = tt_tile_layout_atlas_size(layout);
+    const int C = layout->tile_size + 2 * layout->gutter, columns = full->width / C;
+    int *seen = (int *)calloc((size_t)columns * (size_t)T, sizeof(int));
+    int f, distinct = 0, wrong_texels = 0, fits, smaller_fits;
+    (void)uv;
+    if (!seen) return;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int index = tt_tile_index(layout, types + mesh->face_start[f]);
+        int column = index % T + (wall && wall[f] ? T : 0), row = index / T, x, y;
+        if (!seen[row * columns + column]++) distinct++;
+        for (y = 0; y < C; y++)
+            for (x = 0; x < C; x++) {
+                float in[2], out[2];
+                const float *a = texel_from_bottom(full, column * C + x, row * C + y), *b;
+                int cx, cy;
+                in[0] = (float)((column * C + x + 0.5) / full->width);
+                in[1] = (float)((row * C + y + 0.5) / full->height);
+                tt_compact_atlas_uv(ca, f, in, out);
+                cx = (int)floor(out[0] * ca->width);
+                cy = (int)floor(out[1] * ca->height);
+                if (cx < 0 || cy < 0 || cx >= image->width || cy >= image->height) {
+                    wrong_texels++;
+                    continue;
+                }
+                b = texel_from_bottom(image, cx, cy);
+                if (memcmp(a, b, 4 * sizeof(float)) != 0) wrong_texels++;
+            }
+    }
+    fits = (ca->width / C) * (ca->height / C) >= distinct;
+    /* The next smaller candidate: W/2 x W/2 before a W x W/2... */
+    smaller_fits = ca->width == ca->height ? (ca->width / C) * (ca->width / 2 / C) >= distinct
+                                           : (ca->height / C) * (ca->height / C) >= distinct;
+    CHECK(ca->ncells == distinct && fits && !smaller_fits && (ca->width & (ca->width - 1)) == 0 &&
+              (ca->height & (ca->height - 1)) == 0 && (ca->width == ca->height || ca->width == 2 * ca->height) &&
+              image->width == ca->width && image->height == ca->height && ca->columns == ca->width / C,
+          "%s: %d cells in %d x %d (columns %d) for %d distinct tiles of %d-texel cells (full %d x %d, W %d)", what,
+          ca->ncells, ca->width, ca->height, ca->columns, distinct, C, full->width, full->height, W);
+    CHECK(wrong_texels == 0, "%s: %d texels of the faces' cells read differently in the compact atlas", what,
+          wrong_texels);
+    free(seen);
+}
+
+typedef struct compact_ctx {
+    const tt_mesh *mesh;
+    const float *uv;
+    tt_tile_layout layout;
+    int full_width, full_height;
+    const tt_image *full;
+} compact_ctx;
+
+static tt_result oom_compact(void *ctx, const tt_allocator *al, tt_error *error)
+{
+    compact_ctx *c = (compact_ctx *)ctx;
+    tt_compact_atlas *ca = (tt_compact_atlas *)&ca;
+    tt_image *image = (tt_image *)&image;
+    tt_result r = tt_compact_atlas_create(c->mesh, c->uv, &c->layout, c->full_width, c->full_height, 0, al, &ca,
+                                          error);
+    if (r != TT_OK) return ca != NULL || error->result != r ? TT_RESULT_MAX_ENUM : r;
+    r = tt_compact_atlas_image(ca, c->full, al, &image, error);
+    tt_compact_atlas_free(ca);
+    if (r != TT_OK) return image != NULL || error->result != r ? TT_RESULT_MAX_ENUM : r;
+    tt_image_free(image);
+    return r;
+}
+
+static void test_compact_atlas(void)
+{
+    tmesh m;
+    tt_mesh *grid = NULL, *torus = NULL;
+    tt_tile_layout layout = make_layout(2, 8, 2);   /* T 16, C 12, W 192 */
+    tt_error err;
+    uint8_t *types = NULL;
+    float *uv = NULL, *wide_uv = NULL;
+    int *wall = NULL, f, c;
+    tt_image *full = NULL, *wide = NULL, *image = NULL;
+    tt_compact_atlas *ca = NULL;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 6, 5);
+    CHECK(build(&m, 0, &grid, &err) == TT_OK, "grid build");
+    tm_free(&m);
+    make_torus(&m, 32, 24, 3, 1);
+    CHECK(build(&m, 0, &torus, &err) == TT_OK, "torus build");
+    tm_free(&m);
+    full = make_noise(192, 192, 5);
+    wide = make_noise(384, 192, 6);
+    types = (uint8_t *)malloc((size_t)torus->ncorners);
+    uv = (float *)malloc(2 * sizeof(float) * (size_t)torus->ncorners);
+    wide_uv = (float *)malloc(2 * sizeof(float) * (size_t)torus->ncorners);
+    wall = (int *)malloc(sizeof(int) * (size_t)torus->nfaces);
+    if (!grid || !torus || !full || !wide || !types || !uv || !wide_uv || !wall) goto done;
+
+    /* A few faces, a few tiles: a small square or 2:1 atlas. */
+    CHECK(tt_assign_boundaries(grid, &layout, 7, NULL, types, &err) == TT_OK &&
+              tt_assign_uvs(grid, &layout, types, uv, &err) == TT_OK, "grid tiles: %s", err.message);
+    CHECK(tt_compact_atlas_create(grid, uv, &layout, 192, 192, 0, NULL, &ca, &err) == TT_OK && ca,
+          "compact atlas of the grid: %s", err.message);
+    if (ca && tt_compact_atlas_image(ca, full, NULL, &image, &err) == TT_OK) {
+        check_compact("grid", grid, &layout, types, uv, NULL, full, ca, image);
+        /* The UVs inside a face keep their differences: a translation. */
+        {
+            int bad = 0;
+            for (f = 0; f < grid->nfaces; f++)
+                for (c = grid->face_start[f] + 1; c < grid->face_start[f + 1]; c++) {
+                    float a[2], b[2];
+                    const float *p = uv + 2 * grid->face_start[f], *q = uv + 2 * c;
+                    tt_compact_atlas_uv(ca, f, p, a);
+                    tt_compact_atlas_uv(ca, f, q, b);
+                    if (fabs((b[0] - a[0]) * ca->width - (q[0] - p[0]) * 192.0) > 1e-3 ||
+                        fabs((b[1] - a[1]) * ca->height - (q[1] - p[1]) * 192.0) > 1e-3)
+                        bad++;
+                }
+            CHECK(bad == 0, "compact UVs: %d corners moved against their face's first", bad);
+        }
+        /* Texels outside every cell hold the cells' mean (the noise's, about 0.5). */
+        {
+            const float *corner = texel_from_bottom(image, image->width - 1, 0);
+            CHECK(ca->ncells < ca->columns * (ca->height / 12) && near(corner[0], 0.5, 0.05) && corner[3] == 1.0f,
+                  "the space beside the cells: %g %g (%d cells, %d a row)", corner[0], corner[3], ca->ncells,
+                  ca->columns);
+        }
+        tt_image_free(image);
+        image = NULL;
+    }
+    tt_compact_atlas_free(ca);
+    ca = NULL;
+
+    /* Upright-style: a 2W x W atlas, every third face a wall in the right half. */
+    CHECK(tt_assign_boundaries(torus, &layout, 3, NULL, types, &err) == TT_OK &&
+              tt_assign_uvs(torus, &layout, types, uv, &err) == TT_OK, "torus tiles: %s", err.message);
+    for (f = 0; f < torus->nfaces; f++) {
+        wall[f] = f % 3 == 0;
+        for (c = torus->face_start[f]; c < torus->face_start[f + 1]; c++) {
+            wide_uv[2 * c] = 0.5f * (uv[2 * c] + (float)wall[f]);
+            wide_uv[2 * c + 1] = uv[2 * c + 1];
+        }
+    }
+    CHECK(tt_compact_atlas_create(torus, wide_uv, &layout, 384, 192, 0, NULL, &ca, &err) == TT_OK && ca,
+          "compact atlas of the torus: %s", err.message);
+    if (ca && tt_compact_atlas_image(ca, wide, NULL, &image, &err) == TT_OK)
+        check_compact("torus, walls", torus, &layout, types, wide_uv, wall, wide, ca, image);
+    tt_image_free(image);
+    image = NULL;
+    /* A limit the cells do not fit: TOO_LARGE, saying the size that would. */
+    if (ca) {
+        char needed[64];
+        tt_compact_atlas *small = (tt_compact_atlas *)&small;
+        snprintf(needed, sizeof needed, "%d x %d", ca->width, ca->height);
+        CHECK(tt_compact_atlas_create(torus, wide_uv, &layout, 384, 192, ca->width / 2, NULL, &small, &err) ==
+                      TT_ERROR_TOO_LARGE &&
+                  small == NULL && strstr(err.message, needed),
+              "max_size %d below the %s needed: %s", ca->width / 2, needed, err.message);
+    }
+    tt_compact_atlas_free(ca);
+    ca = NULL;
+    /* A normal map's unused texels are a unit vector. */
+    {
+        tt_image *normals = make_noise(384, 192, 8);
+        if (normals) {
+            int i;
+            normals->kind = TT_IMAGE_NORMAL;
+            for (i = 0; i < 384 * 192; i++) normals->pixels[4 * i + 2] += 1.0f;
+            if (tt_compact_atlas_create(grid, uv, &layout, 192, 192, 0, NULL, &ca, NULL) == TT_OK) {
+                tt_image *small = NULL;
+                normals->width = 192;   /* the first half of each row: any 192 x 192 image of the kind */
+                normals->height = 192;
+                if (tt_compact_atlas_image(ca, normals, NULL, &small, &err) == TT_OK) {
+                    const float *p = texel_from_bottom(small, small->width - 1, 0);
+                    CHECK(small->kind == TT_IMAGE_NORMAL && near(p[0] * p[0] + p[1] * p[1] + p[2] * p[2], 1.0, 1e-5),
+                          "a normal map's fill: kind %d, length %g", (int)small->kind,
+                          sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]));
+                }
+                tt_image_free(small);
+                normals->width = 384;
+                normals->height = 192;
+            }
+            tt_compact_atlas_free(ca);
+            ca = NULL;
+            tt_image_free(normals);
+        }
+    }
+    /* Every allocation may fail. */
+    {
+        compact_ctx ctx;
+        ctx.mesh = torus;
+        ctx.uv = wide_uv;
+        ctx.layout = layout;
+        ctx.full_width = 384;
+        ctx.full_height = 192;
+        ctx.full = wide;
+        oom_reset();
+        oom_sweep("tt_compact_atlas_create + image", oom_compact, &ctx, TT_OK);
+    }
+done:
+    tt_image_free(full);
+    tt_image_free(wide);
+    free(types);
+    free(uv);
+    free(wide_uv);
+    free(wall);
+    tt_mesh_free(grid);
+    tt_mesh_free(torus);
+}
+
+/* ------------------------------------------------------------------------ */
+/* 6d. Quality measures                                                     */
 /* ------------------------------------------------------------------------ */
 
 /* UVs of one random tile per face: four types drawn independently, so the
@@ -2452,6 +2674,7 @@ void run_tiled_tests(void)
     RUN(test_synth_errors);
     RUN(test_synth_non_finite);
     RUN(test_synth_oom);
+    RUN(test_compact_atlas);
     RUN(test_seams);
     RUN(test_seams_control);
     RUN(test_seams_displayed);

@@ -61,6 +61,8 @@ static const char *const k_functions[] = {
     "tt_synth_compose_tile",
     "tt_synth_apply",
     "tt_synthesize_tiles",
+    "tt_compact_atlas_create",
+    "tt_compact_atlas_image",
     "tt_measure_seams",
     "tt_tile_histogram",
     "tt_face_stretch",
@@ -1146,6 +1148,64 @@ static void cases_tiled(const baseline *b)
     CASE(tt_measure_seams(m, uv, img, &seo, AL, &srep, E));
     seo.flags = 0;
     CASE(tt_measure_seams(&b->empty, uv, img, &seo, AL, &srep, E));
+
+    /* The compact atlas of the quads' tiles (the full atlas: 4 x 4 cells of 12 texels). */
+    {
+        tt_compact_atlas *ca = NULL, *cout = NULL;
+        tt_image *iout = NULL;
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(NULL, uv, &L, 48, 48, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, NULL, &L, 48, 48, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, NULL, 48, 48, 0, AL, &cout, E));
+        CASE(tt_compact_atlas_create(m, uv, &L, 48, 48, 0, AL, NULL, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 48, 48, 0, BA1, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 48, 48, 0, BA2, &cout, E));
+        bad = L; bad.tile_size = -8;
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &bad, 48, 48, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 47, 48, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 48, 0, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, -48, 48, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, INT_MAX, 48, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 48, INT_MIN, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 48, 48, -1, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free,
+                 tt_compact_atlas_create(m, uv, &L, 48, 48, TT_MAX_IMAGE_SIZE + 1, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 48, 48, INT_MIN, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, uv, &L, 48, 48, 8, AL, &cout, E));
+        memcpy(bad_uv, uv, sizeof bad_uv);
+        bad_uv[5] = b->nan_t;
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, bad_uv, &L, 48, 48, 0, AL, &cout, E));
+        bad_uv[5] = b->inf_t;
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, bad_uv, &L, 48, 48, 0, AL, &cout, E));
+        bad_uv[5] = 1e30f;
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, bad_uv, &L, 48, 48, 0, AL, &cout, E));
+        bad_uv[5] = uv[5] + 0.5f;   /* one corner in another cell */
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, bad_uv, &L, 48, 48, 0, AL, &cout, E));
+        for (i = 0; i < 48; i++) bad_uv[i] = -1.0f;   /* every face outside */
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(m, bad_uv, &L, 48, 48, 0, AL, &cout, E));
+        OUT_CASE(cout, tt_compact_atlas_free, tt_compact_atlas_create(&b->empty, uv, &L, 48, 48, 0, AL, &cout, E));
+
+        CHECK(tt_compact_atlas_create(m, uv, &L, 48, 48, 0, AL, &ca, NULL) == TT_OK && ca, "baseline compact atlas");
+        if (!ca) return;
+        v = image_view(48, 48, 0.5f);
+        OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(NULL, &v, AL, &iout, E));
+        OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(ca, NULL, AL, &iout, E));
+        CASE(tt_compact_atlas_image(ca, &v, AL, NULL, E));
+        OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(ca, &v, BA1, &iout, E));
+        OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(ca, &v, BA2, &iout, E));
+        v.width = 47;
+        OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(ca, &v, AL, &iout, E));
+        v.width = -48;
+        OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(ca, &v, AL, &iout, E));
+        v.width = 48;
+        {
+            float *keep = v.pixels;
+            v.pixels = NULL;
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(ca, &v, AL, &iout, E));
+            v.pixels = keep;
+        }
+        free(v.pixels);
+        tt_compact_atlas_free(ca);
+    }
 }
 
 static void cases_lapped(const baseline *b)
