@@ -1236,6 +1236,39 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
 TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                               float *corner_uv, tt_error *error);
 
+/* Fewer distinct tiles, for a smaller compact atlas (tt_compact_atlas_create):
+   boundary types from tt_assign_boundaries are changed edge by edge until
+   the faces show at most max_tiles distinct tiles. An edge's new type keeps
+   its twin's the other half of the same condition (type ^ 1), so every edge
+   still matches, and keeps a prescribed colour (edge_colors as
+   tt_assign_boundaries; only the side changes then). A change is kept when
+   the two faces of the edge then show fewer distinct tiles, or as many but
+   tiles more of the faces already show; edges are visited in an order
+   drawn from the seed, pass after pass, until max_tiles is reached or a
+   pass changes nothing. Then the max_tiles tiles most faces show are kept
+   and the other faces walk into them, an edge change at a time (with some
+   random steps, at most 200 passes); a face that finds no way keeps its
+   tile, so a few more than max_tiles may stay (*out_tiles says how many:
+   on a polycube's 800 to 7,000 squares with 2 colours, 225 asked, 225 to
+   about 240).
+     face_group  NULL, or per face a group 0..255 whose tiles count apart
+                 from the other groups' (a polycube's walls take upright
+                 tiles and its tops plain ones: one tile index, two cells);
+     out_tiles   NULL, or the distinct (group, tile) pairs shown after.
+   Every face must be a quad. Same input and seed, same result. Memory:
+   about 24 bytes per face, from `allocator`, freed before it returns.
+   Errors: NULL mesh, layout or corner_type, a bad allocator, colors
+   outside 1..TT_MAX_COLORS, max_tiles below 1 (TT_ERROR_INVALID_ARGUMENT);
+   a face that is not a quad (TT_ERROR_NOT_QUAD_MESH); a type of 2n or more,
+   twins that are not the two halves of one condition, or a type against a
+   prescribed colour (TT_ERROR_INVALID_ARGUMENT, naming the corner); a mesh
+   without faces (TT_ERROR_EMPTY_MESH); TT_ERROR_OUT_OF_MEMORY. On failure
+   corner_type is as it was. */
+TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
+                                const int *edge_colors, const uint8_t *face_group, int max_tiles,
+                                const tt_allocator *allocator, uint8_t *corner_type, int *out_tiles,
+                                tt_error *error);
+
 typedef struct tt_rect {
     int x, y, w, h;         /* pixels; (x, y) is the top-left corner, row 0 at the top */
 } tt_rect;
@@ -8742,6 +8775,351 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
         uv[4] = u1; uv[5] = v1;   /* corner 2: top-right    */
         uv[6] = u0; uv[7] = v1;   /* corner 3: top-left     */
     }
+    return TT_OK;
+}
+
+/* ---- Fewer tiles (tt_reduce_tiles) ----
+   Counts of the (group, tile) pairs the faces show, in an open-addressing
+   table: a tile index needs up to 32 bits (n = 128), the group 8 more, so
+   no flat array would do for every layout. A pair whose count falls to 0
+   keeps its slot until the table is rebuilt. */
+typedef struct tt__tile_counts {
+    uint64_t *keys;         /* 0 = empty; a key is pair + 1 */
+    int *counts;
+    size_t capacity;        /* a power of two */
+    size_t used;            /* slots with a key */
+    int distinct;           /* pairs with a count above 0 */
+    double squares;         /* the sum of the counts' squares */
+} tt__tile_counts;
+
+static size_t tt__tile_counts_slot(const tt__tile_counts *t, uint64_t key)
+{
+    size_t i = (size_t)((key * 0x9e3779b97f4a7c15ull) >> 17) & (t->capacity - 1);
+    while (t->keys[i] && t->keys[i] != key) i = (i + 1) & (t->capacity - 1);
+    return i;
+}
+
+static int tt__tile_counts_get(const tt__tile_counts *t, uint64_t key)
+{
+    size_t i = tt__tile_counts_slot(t, key + 1);
+    return t->keys[i] ? t->counts[i] : 0;
+}
+
+/* Add `change` (+1 or -1) to key's count; the table has room (see
+   tt__tile_counts_room). */
+static void tt__tile_counts_add(tt__tile_counts *t, uint64_t key, int change)
+{
+    size_t i = tt__tile_counts_slot(t, key + 1);
+    int before;
+    if (!t->keys[i]) {
+        t->keys[i] = key + 1;
+        t->counts[i] = 0;
+        t->used++;
+    }
+    before = t->counts[i];
+    t->counts[i] += change;
+    t->distinct += (t->counts[i] > 0) - (before > 0);
+    t->squares += (double)t->counts[i] * t->counts[i] - (double)before * before;
+}
+
+/* Keep at least two free slots in three: drop the keys whose count is 0. */
+static void tt__tile_counts_room(tt__tile_counts *t, uint64_t *spare_keys, int *spare_counts)
+{
+    size_t i, n = t->capacity;
+    if (3 * (t->used + 2) < n) return;
+    memcpy(spare_keys, t->keys, n * sizeof(uint64_t));
+    memcpy(spare_counts, t->counts, n * sizeof(int));
+    memset(t->keys, 0, n * sizeof(uint64_t));
+    t->used = 0;
+    for (i = 0; i < n; i++)
+        if (spare_keys[i] && spare_counts[i] > 0) {
+            size_t j = tt__tile_counts_slot(t, spare_keys[i]);
+            t->keys[j] = spare_keys[i];
+            t->counts[j] = spare_counts[i];
+            t->used++;
+        }
+}
+
+/* The (group, tile) pair of face f: the tile index as tt_tile_index
+   computes it, in 64 bits. */
+static uint64_t tt__face_tile_key(const tt_mesh *mesh, const uint8_t *corner_type, const uint8_t *face_group,
+                                  uint64_t base, int f)
+{
+    const uint8_t *e = corner_type + mesh->face_start[f];
+    const uint64_t tile = (base * e[2] + e[3]) * base * base + base * e[0] + e[1];
+    return ((uint64_t)(face_group ? face_group[f] : 0) << 40) | tile;
+}
+
+/* The second phase of tt_reduce_tiles, when the descent stalls above
+   max_tiles (every change that would drop a tile brings another in):
+   `kept` = the max_tiles pairs most faces show (ties by pair), and the
+   faces whose pair is not kept walk into them. Each pass tries every type
+   of every edge of each such face and takes the change that puts most of
+   its two faces among the kept pairs; when none gains, one time in four a
+   change that loses nothing (off a plateau), one in sixteen any change
+   (out of a local minimum), for TT__REDUCE_WALK_PASSES passes at most.
+   Faces still out keep their pairs. The kept table reuses `counts`' arrays
+   (its counts are no longer needed); `spare` (the table's capacity, at
+   least twice the pairs) holds the pairs and their counts while they are
+   sorted. */
+#define TT__REDUCE_WALK_PASSES 200
+
+typedef struct tt__reduce_walker {
+    const tt_mesh *mesh;
+    uint64_t base;
+    const int *edge_colors;
+    const uint8_t *face_group;
+    const tt__tile_counts *kept;
+    uint8_t *corner_type;
+} tt__reduce_walker;
+
+static int tt__face_kept(const tt__reduce_walker *r, int f)
+{
+    return tt__tile_counts_get(r->kept, tt__face_tile_key(r->mesh, r->corner_type, r->face_group, r->base, f)) > 0;
+}
+
+/* (count, pair) entries: higher counts first, then smaller pairs. */
+static int tt__compare_pair_counts(const void *a, const void *b)
+{
+    const uint64_t *x = (const uint64_t *)a, *y = (const uint64_t *)b;
+    if (x[0] != y[0]) return x[0] > y[0] ? -1 : 1;
+    return x[1] < y[1] ? -1 : x[1] > y[1];
+}
+
+/* One pass of the walk over the faces not kept; returns how many there were. */
+static int tt__reduce_walk(const tt__reduce_walker *r, tt_rng *rng)
+{
+    const tt_mesh *mesh = r->mesh;
+    int f, k, left = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int best_h = -1, best_type = 0, best_gain = 0, plateau_h = -1, plateau_type = 0, nplateau = 0;
+        int any_h = -1, any_type = 0, nany = 0;
+        if (tt__face_kept(r, f)) continue;
+        left++;
+        for (k = 0; k < 4; k++) {
+            const int h = mesh->face_start[f] + k, t = mesh->twin[h];
+            const int g = t >= 0 && mesh->corner_face[t] != f ? mesh->corner_face[t] : -1;
+            const uint8_t current = r->corner_type[h];
+            const int first = r->edge_colors && r->edge_colors[h] >= 0 ? 2 * r->edge_colors[h] : 0;
+            const int last = r->edge_colors && r->edge_colors[h] >= 0 ? first + 1 : (int)r->base - 1;
+            const int g_in = g >= 0 && tt__face_kept(r, g);
+            int type;
+            for (type = first; type <= last; type++) {
+                int gain;
+                if (type == current) continue;
+                r->corner_type[h] = (uint8_t)type;
+                if (t >= 0) r->corner_type[t] = (uint8_t)(type ^ 1);
+                gain = tt__face_kept(r, f) + (g >= 0 ? tt__face_kept(r, g) - g_in : 0);
+                r->corner_type[h] = current;
+                if (t >= 0) r->corner_type[t] = (uint8_t)(current ^ 1);
+                if (gain > best_gain) {
+                    best_gain = gain;
+                    best_h = h;
+                    best_type = type;
+                } else if (gain == 0 && tt_rng_below(rng, (uint32_t)++nplateau) == 0) {
+                    plateau_h = h;   /* each change that loses nothing as likely */
+                    plateau_type = type;
+                }
+                if (tt_rng_below(rng, (uint32_t)++nany) == 0) {
+                    any_h = h;
+                    any_type = type;
+                }
+            }
+        }
+        if (best_h < 0 && plateau_h >= 0 && tt_rng_below(rng, 4u) == 0) {
+            best_h = plateau_h;
+            best_type = plateau_type;
+        } else if (best_h < 0 && tt_rng_below(rng, 16u) == 0) {
+            best_h = any_h;
+            best_type = any_type;
+        }
+        if (best_h >= 0) {
+            r->corner_type[best_h] = (uint8_t)best_type;
+            if (mesh->twin[best_h] >= 0) r->corner_type[mesh->twin[best_h]] = (uint8_t)(best_type ^ 1);
+        }
+    }
+    return left;
+}
+
+static void tt__reduce_into_most_shown(const tt_mesh *mesh, uint64_t base, const int *edge_colors,
+                                       const uint8_t *face_group, int max_tiles, tt_rng *rng,
+                                       tt__tile_counts *counts, uint64_t *spare, uint8_t *corner_type)
+{
+    tt__reduce_walker walker;
+    size_t i, npairs = 0;
+    int pass, left = 1;
+    for (i = 0; i < counts->capacity; i++)
+        if (counts->keys[i] && counts->counts[i] > 0) {
+            spare[2 * npairs] = (uint64_t)counts->counts[i];
+            spare[2 * npairs + 1] = counts->keys[i] - 1;
+            npairs++;
+        }
+    qsort(spare, npairs, 2 * sizeof(uint64_t), tt__compare_pair_counts);
+    memset(counts->keys, 0, counts->capacity * sizeof(uint64_t));
+    counts->used = 0;
+    counts->distinct = 0;
+    counts->squares = 0.0;
+    for (i = 0; i < npairs && (int)i < max_tiles; i++) tt__tile_counts_add(counts, spare[2 * i + 1], 1);
+    walker.mesh = mesh;
+    walker.base = base;
+    walker.edge_colors = edge_colors;
+    walker.face_group = face_group;
+    walker.kept = counts;
+    walker.corner_type = corner_type;
+    for (pass = 0; pass < TT__REDUCE_WALK_PASSES && left; pass++) left = tt__reduce_walk(&walker, rng);
+}
+
+TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
+                                const int *edge_colors, const uint8_t *face_group, int max_tiles,
+                                const tt_allocator *allocator, uint8_t *corner_type, int *out_tiles,
+                                tt_error *error)
+{
+    tt__tile_counts table;
+    uint64_t *spare_keys = NULL, base;
+    int *spare_counts = NULL, *order = NULL, n, f, c, i, nedges = 0, pass, moved;
+    tt_rng rng;
+    tt__ok(error);
+    if (out_tiles) *out_tiles = 0;
+    if (!mesh || !layout || !corner_type)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_reduce_tiles needs a mesh, a layout and corner_type (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
+    n = layout->colors ? layout->colors : 1;
+    if (n < 1 || n > TT_MAX_COLORS)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "colors (boundary conditions) must be 1..%d, got %d", TT_MAX_COLORS, layout->colors);
+    if (max_tiles < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_tiles must be 1 or more, got %d",
+                        max_tiles);
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4)
+            return tt__fail(error, TT_ERROR_NOT_QUAD_MESH, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners; tiles are for quads (quadrangulate the mesh first)", f,
+                            mesh->face_start[f + 1] - mesh->face_start[f]);
+    for (c = 0; c < mesh->ncorners; c++) {
+        const int t = mesh->twin[c];
+        if (corner_type[c] >= 2 * n)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                            "corner %d has boundary type %d, but %d colors allow 0..%d", c, corner_type[c], n,
+                            2 * n - 1);
+        if (t >= 0 && corner_type[t] != (corner_type[c] ^ 1))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                            "corners %d and %d are the two sides of one edge but have types %d and %d, not the "
+                            "two halves of one condition (tt_assign_boundaries makes them so)", c, t,
+                            corner_type[c], corner_type[t]);
+        if (edge_colors && (edge_colors[c] < -1 || edge_colors[c] >= n || (t >= 0 && edge_colors[t] != edge_colors[c])))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                            "corner %d prescribes colour %d (its twin %d), but %d colors allow 0..%d or -1 on both "
+                            "sides alike", c, edge_colors[c], t >= 0 ? edge_colors[t] : -1, n, n - 1);
+        if (edge_colors && edge_colors[c] >= 0 && corner_type[c] / 2 != edge_colors[c])
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                            "corner %d has type %d, of colour %d, but prescribes colour %d", c, corner_type[c],
+                            corner_type[c] / 2, edge_colors[c]);
+        if (t < 0 || c < t) nedges++;
+    }
+    base = 2u * (uint64_t)n;
+    memset(&table, 0, sizeof table);
+    table.capacity = 16;
+    while (table.capacity < 4 * (size_t)mesh->nfaces + 8) table.capacity *= 2;
+    table.keys = TT__ALLOC(allocator, uint64_t, table.capacity);
+    table.counts = TT__ALLOC(allocator, int, table.capacity);
+    spare_keys = TT__ALLOC(allocator, uint64_t, table.capacity);
+    spare_counts = TT__ALLOC(allocator, int, table.capacity);
+    order = TT__ALLOC(allocator, int, nedges);
+    if (!table.keys || !table.counts || !spare_keys || !spare_counts || !order) {
+        tt__free(allocator, table.keys);
+        tt__free(allocator, table.counts);
+        tt__free(allocator, spare_keys);
+        tt__free(allocator, spare_counts);
+        tt__free(allocator, order);
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory for the tiles of %d faces",
+                        mesh->nfaces);
+    }
+    memset(table.keys, 0, table.capacity * sizeof(uint64_t));
+    for (f = 0; f < mesh->nfaces; f++)
+        tt__tile_counts_add(&table, tt__face_tile_key(mesh, corner_type, face_group, base, f), 1);
+    /* One half-edge per edge, in an order drawn from the seed. */
+    for (c = 0, i = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] < 0 || c < mesh->twin[c]) order[i++] = c;
+    tt_rng_seed(&rng, seed, 0x66657765ull /* "fewe" */);
+    for (i = nedges - 1; i > 0; i--) {
+        int j = (int)tt_rng_below(&rng, (uint32_t)i + 1u), keep = order[i];
+        order[i] = order[j];
+        order[j] = keep;
+    }
+    for (pass = 0, moved = 1; table.distinct > max_tiles && moved; pass++) {
+        moved = 0;
+        for (i = 0; i < nedges && table.distinct > max_tiles; i++) {
+            const int h = order[i], t = mesh->twin[h], fa = mesh->corner_face[h];
+            /* A face on both sides of the edge counts once. */
+            const int fb = t >= 0 && mesh->corner_face[t] != fa ? mesh->corner_face[t] : -1;
+            const uint8_t current = corner_type[h];
+            const int first = edge_colors && edge_colors[h] >= 0 ? 2 * edge_colors[h] : 0;
+            const int last = edge_colors && edge_colors[h] >= 0 ? first + 1 : 2 * n - 1;
+            uint64_t old_a = tt__face_tile_key(mesh, corner_type, face_group, base, fa), old_b = 0;
+            int type, best = current, best_distinct = table.distinct;
+            double best_squares = table.squares;
+            if (fb >= 0) old_b = tt__face_tile_key(mesh, corner_type, face_group, base, fb);
+            /* Each candidate type tried in the table and taken back: four
+               changes of count, whatever keys coincide. */
+            for (type = first; type <= last; type++) {
+                uint64_t new_a, new_b = 0;
+                int distinct;
+                double squares;
+                if (type == current) continue;
+                corner_type[h] = (uint8_t)type;
+                if (t >= 0) corner_type[t] = (uint8_t)(type ^ 1);
+                new_a = tt__face_tile_key(mesh, corner_type, face_group, base, fa);
+                if (fb >= 0) new_b = tt__face_tile_key(mesh, corner_type, face_group, base, fb);
+                tt__tile_counts_room(&table, spare_keys, spare_counts);
+                tt__tile_counts_add(&table, old_a, -1);
+                if (fb >= 0) tt__tile_counts_add(&table, old_b, -1);
+                tt__tile_counts_add(&table, new_a, 1);
+                if (fb >= 0) tt__tile_counts_add(&table, new_b, 1);
+                distinct = table.distinct;
+                squares = table.squares;
+                tt__tile_counts_add(&table, new_a, -1);
+                if (fb >= 0) tt__tile_counts_add(&table, new_b, -1);
+                tt__tile_counts_add(&table, old_a, 1);
+                if (fb >= 0) tt__tile_counts_add(&table, old_b, 1);
+                if (distinct < best_distinct || (distinct == best_distinct && squares > best_squares + 0.5)) {
+                    best = type;
+                    best_distinct = distinct;
+                    best_squares = squares;
+                }
+            }
+            corner_type[h] = (uint8_t)best;
+            if (t >= 0) corner_type[t] = (uint8_t)(best ^ 1);
+            if (best != current) {
+                tt__tile_counts_room(&table, spare_keys, spare_counts);
+                tt__tile_counts_add(&table, old_a, -1);
+                if (fb >= 0) tt__tile_counts_add(&table, old_b, -1);
+                tt__tile_counts_add(&table, tt__face_tile_key(mesh, corner_type, face_group, base, fa), 1);
+                if (fb >= 0) tt__tile_counts_add(&table, tt__face_tile_key(mesh, corner_type, face_group, base, fb), 1);
+                moved = 1;
+            }
+        }
+    }
+    if (table.distinct > max_tiles) {
+        /* The descent stalled above max_tiles (every change that would drop
+           a tile brings another in): keep the max_tiles pairs most faces
+           show and move the rest into them. */
+        tt__reduce_into_most_shown(mesh, base, edge_colors, face_group, max_tiles, &rng, &table, spare_keys,
+                                   corner_type);
+        memset(table.keys, 0, table.capacity * sizeof(uint64_t));
+        table.used = 0;
+        table.distinct = 0;
+        table.squares = 0.0;
+        for (f = 0; f < mesh->nfaces; f++)
+            tt__tile_counts_add(&table, tt__face_tile_key(mesh, corner_type, face_group, base, f), 1);
+    }
+    if (out_tiles) *out_tiles = table.distinct;
+    tt__free(allocator, table.keys);
+    tt__free(allocator, table.counts);
+    tt__free(allocator, spare_keys);
+    tt__free(allocator, spare_counts);
+    tt__free(allocator, order);
     return TT_OK;
 }
 

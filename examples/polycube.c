@@ -36,6 +36,11 @@
 
 /* The paper's colours: two per axis, drawn from a palette of this many. */
 #define POLYCUBE_DEFAULT_COLORS 2
+/* The atlas's side the tiles' count aims at by default: 2048 x 2048 holds
+   225 tiles of 128 texels with their gutters, and keeps a GLB with a four-map
+   material of a scan under about 16 MB; up to TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE
+   when the tiles cannot be fewer. */
+#define POLYCUBE_DEFAULT_MAX_ATLAS 2048
 
 static void print_help(void)
 {
@@ -81,8 +86,10 @@ static void print_help(void)
            "                   the polycube's surface is left out: write the OBJ files to see it)\n"
            "  --triangles      write the polycube surface's squares as two triangles each (the\n"
            "                   mesh is triangles already)\n"
-           "  --max-atlas N    the atlas's larger side at most N texels (default %d): it holds\n"
-           "                   only the tiles the polycube shows, in a power-of-two rectangle\n"
+           "  --max-atlas N    the atlas's larger side at most N texels (default %d, or up to %d\n"
+           "                   when the tiles cannot be fewer): it holds only the tiles the\n"
+           "                   polycube shows, as few as the squares' colours allow, in a\n"
+           "                   power-of-two square or 2:1 rectangle\n"
            MATERIAL_OPTIONS_HELP("                   ")
            "\n"
            "Prints the polycube (cubes, squares, components, genus against the mesh's), the\n"
@@ -97,7 +104,7 @@ static void print_help(void)
            "         tiledtex polycube sphere.obj stones.png sphere_pc --resolution 8\n"
            "         tiledtex render sphere_pc.obj sphere_pc.png view.png\n",
            TT_POLYCUBE_MAX_RESOLUTION, TT_POLYCUBE_DEFAULT_RESOLUTION, POLYCUBE_DEFAULT_COLORS,
-           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE);
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, POLYCUBE_DEFAULT_MAX_ATLAS, TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE);
 }
 
 typedef struct polycube_command_options {
@@ -178,6 +185,8 @@ typedef struct polycube_job {
     tt_tile_layout layout;          /* resolved */
     int *edge_colors;               /* per S half-edge */
     uint8_t *surface_type;          /* per S half-edge: its boundary type */
+    uint8_t *surface_group;         /* per S quad: 1 for a wall with upright tiles, else 0 */
+    int tiles_shown;                /* distinct tiles S shows, walls' and tops' apart */
     float *surface_uv;              /* per S corner: S's own texture coordinates */
     tt_tileset *tiles;              /* plain: the tops and bottoms (all of S with --no-upright) */
     tt_tileset *upright_tiles;      /* the walls; NULL with --no-upright */
@@ -201,6 +210,7 @@ static void polycube_job_free(polycube_job *job)
     tt_polycube_free(job->polycube);
     free(job->edge_colors);
     free(job->surface_type);
+    free(job->surface_group);
     free(job->surface_uv);
     tiled_tilesets_free(&job->tiles, job->map_tiles);
     tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
@@ -212,13 +222,22 @@ static void polycube_job_free(polycube_job *job)
     memset(job, 0, sizeof *job);
 }
 
+/* The tiles the atlas holds within --max-atlas on a side: a square of
+   whole cells. */
+static int polycube_tile_budget(const polycube_command_options *options, const tt_tile_layout *layout)
+{
+    const int side = options->max_atlas ? options->max_atlas : POLYCUBE_DEFAULT_MAX_ATLAS;
+    const int across = side / (layout->tile_size + 2 * layout->gutter);
+    return across > 0 ? across * across : 1;
+}
+
 /* The polycube and the tiles of its surface S. */
 static int build_polycube(const polycube_command_options *options, polycube_job *job)
 {
     const char *path = options->mesh_path;
     tt_error error;
     double start = tool_seconds_now();
-    int ncorners;
+    int ncorners, q;
     tool_stage("building the polycube");
     if (tt_polycube_build(job->mesh.mesh, &options->build, NULL, &job->polycube, &job->build_report, &error) != TT_OK)
         return triangle_mesh_report_error(path, &job->mesh, &error);
@@ -241,14 +260,23 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
     job->edge_colors = (int *)malloc((size_t)ncorners * sizeof(int));
     job->surface_type = (uint8_t *)malloc((size_t)ncorners);
     job->surface_uv = (float *)malloc((size_t)ncorners * 2 * sizeof(float));
-    if (!job->edge_colors || !job->surface_type || !job->surface_uv)
+    job->surface_group = (uint8_t *)malloc((size_t)job->polycube->surface->nfaces);
+    if (!job->edge_colors || !job->surface_type || !job->surface_uv || !job->surface_group)
         return tool_fail("out of memory for the %d quads of the polycube", job->polycube->surface->nfaces);
     /* axis_palettes = 1: the edges along each axis draw from two colours
        of the palette picked for that axis, the paper's scheme. */
     if (tt_polycube_edge_colors(job->polycube, job->layout.colors, 1, options->tiles.seed, job->edge_colors,
                                 &error) != TT_OK ||
         tt_assign_boundaries(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
-                             job->surface_type, &error) != TT_OK ||
+                             job->surface_type, &error) != TT_OK)
+        return tool_fail("%s: the polycube's tiles: %s", path, error.message);
+    /* As few tiles as fit the atlas's limit: the walls' (upright) and the
+       tops' (plain) count apart, each its own cell. */
+    for (q = 0; q < job->polycube->surface->nfaces; q++)
+        job->surface_group[q] = (uint8_t)(!options->plain && tt_polycube_quad_upright(job->polycube, q));
+    if (tt_reduce_tiles(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
+                        job->surface_group, polycube_tile_budget(options, &job->layout), NULL, job->surface_type,
+                        &job->tiles_shown, &error) != TT_OK ||
         tt_assign_uvs(job->polycube->surface, &job->layout, job->surface_type, job->surface_uv, &error) != TT_OK)
         return tool_fail("%s: the polycube's tiles: %s", path, error.message);
     return 0;

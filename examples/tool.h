@@ -405,11 +405,12 @@ int image_crop(const tt_image *image, int x, int y, int width, int height, tt_im
 void image_to_rgba8(const tt_image *image, tt_color_space space, unsigned char *out);
 /* Encode an image as an 8-bit PNG in memory (malloc'ed; free it), its
    colours encoded into `space` (TT_COLOR_SRGB for every colour output).
-   Opaque images are written as RGB, others as RGBA (straight alpha). */
+   Written with the fewest channels that hold them: no alpha when opaque
+   (else straight alpha), one grey channel when r = g = b everywhere. */
 int png_encode(const tt_image *image, tt_color_space space, unsigned char **png, size_t *png_size, char *err,
                size_t err_size);
 /* The same from 8-bit RGBA already encoded (width * height * 4 bytes), which
-   the encoder may rewrite in place (an opaque image is packed to RGB). */
+   the encoder may rewrite in place (packed to fewer channels). */
 int png_encode_rgba8(unsigned char *rgba, int width, int height, unsigned char **png, size_t *png_size, char *err,
                      size_t err_size);
 /* The PNG file of width x height pixels of `channels` bytes (1 grey, 2

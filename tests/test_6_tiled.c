@@ -556,6 +556,157 @@ static void test_tile_uv_index(void)
     }
 }
 
+/* Distinct (group, tile) pairs the faces show, counted naively. */
+static int count_tiles(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *types, const uint8_t *group)
+{
+    int f, g, distinct = 0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int index = tt_tile_index(layout, types + mesh->face_start[f]), seen = 0;
+        for (g = 0; g < f && !seen; g++)
+            seen = tt_tile_index(layout, types + mesh->face_start[g]) == index && (!group || group[g] == group[f]);
+        distinct += !seen;
+    }
+    return distinct;
+}
+
+/* Twins are the two halves of one condition, types below 2n, prescribed colours kept. */
+static int reduced_types_valid(const tt_mesh *mesh, int n, const uint8_t *types, const int *colors)
+{
+    int c, bad = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        if (types[c] >= 2 * n) bad++;
+        if (mesh->twin[c] >= 0 && types[mesh->twin[c]] != (types[c] ^ 1)) bad++;
+        if (colors && colors[c] >= 0 && types[c] / 2 != colors[c]) bad++;
+    }
+    return bad;
+}
+
+typedef struct reduce_ctx {
+    const tt_mesh *mesh;
+    const uint8_t *types;
+    uint8_t *work;
+} reduce_ctx;
+
+static tt_result oom_reduce(void *ctx, const tt_allocator *al, tt_error *error)
+{
+    reduce_ctx *r = (reduce_ctx *)ctx;
+    tt_tile_layout layout = make_layout(2, 8, 0);
+    tt_result result;
+    memcpy(r->work, r->types, (size_t)r->mesh->ncorners);
+    result = tt_reduce_tiles(r->mesh, &layout, 1, NULL, NULL, 40, al, r->work, NULL, error);
+    if (result != TT_OK && memcmp(r->work, r->types, (size_t)r->mesh->ncorners) != 0) return TT_RESULT_MAX_ENUM;
+    return result;
+}
+
+static void test_reduce_tiles(void)
+{
+    tmesh m;
+    tt_mesh *torus = NULL, *mixed = NULL;
+    tt_tile_layout layout = make_layout(2, 8, 0);
+    tt_error err;
+    uint8_t *types = NULL, *work = NULL, *again = NULL, *group = NULL;
+    int *colors = NULL, before, after = -1, f, c;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 32, 24, 3, 1);
+    CHECK(build(&m, 0, &torus, &err) == TT_OK, "torus build");
+    tm_free(&m);
+    make_grid(&m, 3, 2);
+    tm_tri(&m, 1, 0, tm_vert(&m, 0.5, -1, 0));
+    CHECK(build(&m, 0, &mixed, &err) == TT_OK, "grid+triangle build");
+    tm_free(&m);
+    if (!torus || !mixed) goto done;
+    types = (uint8_t *)malloc((size_t)torus->ncorners);
+    work = (uint8_t *)malloc((size_t)torus->ncorners);
+    again = (uint8_t *)malloc((size_t)torus->ncorners);
+    group = (uint8_t *)malloc((size_t)torus->nfaces);
+    colors = (int *)malloc(sizeof(int) * (size_t)torus->ncorners);
+    if (!types || !work || !again || !group || !colors) goto done;
+    CHECK(tt_assign_boundaries(torus, &layout, 11, NULL, types, &err) == TT_OK, "boundaries: %s", err.message);
+    before = count_tiles(torus, &layout, types, NULL);
+
+    /* Already within the limit: nothing changes. */
+    memcpy(work, types, (size_t)torus->ncorners);
+    CHECK(tt_reduce_tiles(torus, &layout, 1, NULL, NULL, before, NULL, work, &after, &err) == TT_OK &&
+              after == before && memcmp(work, types, (size_t)torus->ncorners) == 0,
+          "max_tiles = the %d shown: unchanged (reports %d)", before, after);
+    /* To a fifth of the tiles random types show (the control: `before`);
+       a few more may stay, as documented. */
+    memcpy(work, types, (size_t)torus->ncorners);
+    CHECK(tt_reduce_tiles(torus, &layout, 1, NULL, NULL, before / 5, NULL, work, &after, &err) == TT_OK,
+          "reduce: %s", err.message);
+    {
+        const int counted = count_tiles(torus, &layout, work, NULL), invalid = reduced_types_valid(torus, 2, work, NULL);
+        CHECK(after <= before / 5 + before / 50 && after == counted && invalid == 0,
+              "768 quads from %d tiles to %d, at most %d and a tenth: %d (counted %d), %d invalid types", before,
+              before / 5, before / 5 + before / 50, after, counted, invalid);
+    }
+    /* Same seed, same result; another seed, another. */
+    memcpy(again, types, (size_t)torus->ncorners);
+    tt_reduce_tiles(torus, &layout, 1, NULL, NULL, before / 5, NULL, again, NULL, NULL);
+    CHECK(memcmp(again, work, (size_t)torus->ncorners) == 0, "tt_reduce_tiles: same seed, same types");
+    memcpy(again, types, (size_t)torus->ncorners);
+    tt_reduce_tiles(torus, &layout, 2, NULL, NULL, before / 5, NULL, again, NULL, NULL);
+    CHECK(memcmp(again, work, (size_t)torus->ncorners) != 0, "tt_reduce_tiles: another seed, other types");
+
+    /* Prescribed colours stay; groups count apart. */
+    lcg_seed(5);
+    for (c = 0; c < torus->ncorners; c++)
+        if (torus->twin[c] < 0 || c < torus->twin[c]) {
+            colors[c] = lcg_below(3) - 1;   /* -1: free */
+            if (torus->twin[c] >= 0) colors[torus->twin[c]] = colors[c];
+        }
+    for (f = 0; f < torus->nfaces; f++) group[f] = (uint8_t)(f % 3 == 0);
+    CHECK(tt_assign_boundaries(torus, &layout, 12, colors, types, &err) == TT_OK, "boundaries: %s", err.message);
+    before = count_tiles(torus, &layout, types, group);
+    CHECK(tt_reduce_tiles(torus, &layout, 3, colors, group, before / 3, NULL, types, &after, &err) == TT_OK,
+          "reduce with colours and groups: %s", err.message);
+    {
+        const int counted = count_tiles(torus, &layout, types, group);
+        const int invalid = reduced_types_valid(torus, 2, types, colors);
+        CHECK(after <= before / 3 + before / 30 && after == counted && invalid == 0,
+              "with colours and groups: %d to %d and a tenth: %d (counted %d), %d invalid", before, before / 3, after,
+              counted, invalid);
+    }
+
+    /* Bad input: a specific result, the types as they were. */
+    memcpy(work, types, (size_t)torus->ncorners);
+    CHECK(tt_reduce_tiles(torus, &layout, 1, NULL, NULL, 0, NULL, work, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+          "max_tiles 0: %s", err.message);
+    work[7] ^= 1;   /* its twin no longer the other half */
+    CHECK(tt_reduce_tiles(torus, &layout, 1, NULL, NULL, 10, NULL, work, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              (err.corner == 7 || err.corner == torus->twin[7]) && work[7] == (types[7] ^ 1),
+          "twins that disagree: %s (corner %d)", err.message, err.corner);
+    work[7] ^= 1;
+    for (c = 0; c < torus->ncorners && colors[c] < 0; c++) continue;
+    if (c < torus->ncorners) {
+        colors[c] = 1 - colors[c];
+        if (torus->twin[c] >= 0) colors[torus->twin[c]] = colors[c];
+        CHECK(tt_reduce_tiles(torus, &layout, 1, colors, NULL, 10, NULL, work, NULL, &err) ==
+                  TT_ERROR_INVALID_ARGUMENT && memcmp(work, types, (size_t)torus->ncorners) == 0,
+              "a type against its prescribed colour: %s", err.message);
+    }
+    CHECK(tt_reduce_tiles(mixed, &layout, 1, NULL, NULL, 10, NULL, work, NULL, &err) == TT_ERROR_NOT_QUAD_MESH &&
+              err.face == 6,
+          "a triangle: %s (face %d)", err.message, err.face);
+    {
+        reduce_ctx ctx;
+        tt_assign_boundaries(torus, &layout, 11, NULL, types, NULL);
+        ctx.mesh = torus;
+        ctx.types = types;
+        ctx.work = work;
+        oom_reset();
+        oom_sweep("tt_reduce_tiles", oom_reduce, &ctx, TT_OK);
+    }
+done:
+    free(types);
+    free(work);
+    free(again);
+    free(group);
+    free(colors);
+    tt_mesh_free(torus);
+    tt_mesh_free(mixed);
+}
+
 /* ------------------------------------------------------------------------ */
 /* 6b. Tile-set synthesis                                                   */
 /* ------------------------------------------------------------------------ */
@@ -2670,6 +2821,7 @@ void run_tiled_tests(void)
     RUN(test_boundaries_uvs);
     RUN(test_prescribed_colors);
     RUN(test_tile_uv_index);
+    RUN(test_reduce_tiles);
     RUN(test_synthesis);
     RUN(test_synth_errors);
     RUN(test_synth_non_finite);

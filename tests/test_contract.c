@@ -57,6 +57,7 @@ static const char *const k_functions[] = {
     "tt_tile_layout_resolve",
     "tt_assign_boundaries",
     "tt_assign_uvs",
+    "tt_reduce_tiles",
     "tt_synth_plan_create",
     "tt_synth_compose_tile",
     "tt_synth_apply",
@@ -929,6 +930,40 @@ static void cases_tiled(const baseline *b)
     CASE(tt_assign_uvs(m, &L, bt, uv, E));
     CASE(tt_assign_uvs(&b->empty, &L, types, uv, E));
     CHECK(tt_assign_uvs(m, &L, types, uv, NULL) == TT_OK, "baseline UVs");
+
+    {
+        uint8_t rt[24];
+        memcpy(rt, types, sizeof rt);
+        CASE(tt_reduce_tiles(NULL, &L, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        CASE(tt_reduce_tiles(m, NULL, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, 4, AL, NULL, NULL, E));
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, 4, BA1, rt, NULL, E));
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, 4, BA2, rt, NULL, E));
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, 0, AL, rt, NULL, E));
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, -1, AL, rt, NULL, E));
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, INT_MIN, AL, rt, NULL, E));
+        bad = L; bad.colors = -1;
+        CASE(tt_reduce_tiles(m, &bad, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        bad = L; bad.colors = TT_MAX_COLORS + 1;
+        CASE(tt_reduce_tiles(m, &bad, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        CASE(tt_reduce_tiles(b->tris, &L, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        CASE(tt_reduce_tiles(&b->empty, &L, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        rt[3] = 2;   /* 2n with n = 1 */
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        rt[3] = 255;
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        memcpy(rt, types, sizeof rt);
+        rt[3] ^= 1;   /* its twin no longer the other half */
+        CASE(tt_reduce_tiles(m, &L, 1, NULL, NULL, 4, AL, rt, NULL, E));
+        memcpy(rt, types, sizeof rt);
+        for (i = 0; i < 24; i++) ec[i] = 0;
+        ec[5] = 1;   /* colour 1 of 1 */
+        CASE(tt_reduce_tiles(m, &L, 1, ec, NULL, 4, AL, rt, NULL, E));
+        ec[5] = INT_MIN;
+        CASE(tt_reduce_tiles(m, &L, 1, ec, NULL, 4, AL, rt, NULL, E));
+        ec[5] = 0;
+        CHECK(tt_reduce_tiles(m, &L, 1, ec, NULL, 1, AL, rt, NULL, NULL) == TT_OK, "baseline fewer tiles");
+    }
 
     CASE(tt_tile_histogram(NULL, &L, types, counts, E));
     CASE(tt_tile_histogram(m, NULL, types, counts, E));
