@@ -176,7 +176,7 @@ static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, 
     tool_progress progress;
     tt_error error;
     tt_result result;
-    tool_progress_begin(&progress, "mapping", "of the faces textured");
+    tool_progress_begin(&progress, "mapping", "done");
     map.progress = tool_show_progress;
     map.progress_user_data = &progress;
     map.executor = tool_executor();

@@ -937,7 +937,7 @@ void tool_progress_start(void);
    unknown until tool_stage_fraction says. */
 void tool_stage(const char *format, ...);
 /* How far the current stage is, 0 to 1, with what the fraction counts
-   (NULL, or "of the faces textured"). */
+   (NULL, or "of the surface covered"). */
 void tool_stage_fraction(double done, const char *what);
 /* Erase the line, so that the next output starts on a clean line. */
 void tool_progress_clear(void);

@@ -1791,6 +1791,7 @@ static void test_hpm_map_unflattened(void)
    number cancel_at (0-based; -1: never). */
 typedef struct hpm_progress_log {
     int calls, cancel_at, decreasing;
+    int below_traversal;    /* fractions strictly between 0 and the traversal's start (0.2): the hierarchy's */
     float last;
 } hpm_progress_log;
 
@@ -1798,8 +1799,44 @@ static int hpm_log_progress(float fraction, void *user_data)
 {
     hpm_progress_log *log = (hpm_progress_log *)user_data;
     if (fraction < log->last || !(fraction >= 0.0f && fraction <= 1.0f)) log->decreasing++;
+    log->below_traversal += fraction > 0.0f && fraction < 0.2f;
     log->last = fraction;
     return log->calls++ == log->cancel_at;
+}
+
+/* tt_cluster_hierarchy_build's progress: after each level, rising, below
+   1; cancelling at any call returns TT_CANCELLED with nothing allocated. */
+static void test_cluster_hierarchy_progress(void)
+{
+    tt_mesh *mesh = hpm_mesh(M_GRID);
+    tt_cluster_options opt;
+    tt_cluster_hierarchy *h = NULL;
+    hpm_progress_log log;
+    tt_error err;
+    tt_result r;
+    int k, calls, bad = 0;
+    if (!mesh) return;
+    memset(&opt, 0, sizeof opt);
+    opt.progress = hpm_log_progress;
+    opt.progress_user_data = &log;
+    memset(&log, 0, sizeof log);
+    log.cancel_at = -1;
+    r = tt_cluster_hierarchy_build(mesh, &opt, NULL, &h, &err);
+    CHECK(r == TT_OK && h && log.calls >= 2 && log.calls >= h->nlevels - 1 && log.decreasing == 0 && log.last < 1.0f,
+          "hierarchy progress: %d calls over %d levels, %d out of order, last %g (%d: %s)", log.calls,
+          h ? h->nlevels : -1, log.decreasing, log.last, r, err.message);
+    tt_cluster_hierarchy_free(h);
+    calls = log.calls;
+    for (k = 0; k < calls; k++) {
+        memset(&log, 0, sizeof log);
+        log.cancel_at = k;
+        oom_reset();
+        h = (tt_cluster_hierarchy *)&log;
+        r = tt_cluster_hierarchy_build(mesh, &opt, &g_oom_allocator, &h, &err);
+        if (r != TT_CANCELLED || err.result != r || h != NULL || g_oom_counter.live != 0 || log.calls != k + 1) bad++;
+    }
+    CHECK(bad == 0, "hierarchy: cancelling at each of the %d progress calls: %d did not stop cleanly", calls, bad);
+    tt_mesh_free(mesh);
 }
 
 /* The progress callback: fractions rising to 1 (the hierarchy, the image,
@@ -1829,6 +1866,8 @@ static void test_hpm_map_progress(void)
     r = tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err);
     CHECK(r == TT_OK && log.calls >= 4 && log.decreasing == 0 && log.last == 1.0f,
           "progress: %d calls, %d out of order, last %g (%d: %s)", log.calls, log.decreasing, log.last, r, err.message);
+    /* The hierarchy, a second of a scan's run, reports level by level. */
+    CHECK(log.below_traversal >= 2, "progress: %d calls from the hierarchy", log.below_traversal);
     calls = log.calls;
     for (k = 0; k < calls; k++) {
         int i, touched = 0;
@@ -2070,6 +2109,7 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_topology);
     RUN(test_hpm_map_coarse);
     RUN(test_hpm_map_unflattened);
+    RUN(test_cluster_hierarchy_progress);
     RUN(test_hpm_map_progress);
     RUN(test_hpm_map_errors);
     RUN(test_hpm_extreme_floats_refused);
