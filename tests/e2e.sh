@@ -3579,6 +3579,10 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
         --normal m_normal.png --height m_height.png
     check "polycube: the maps have the atlas's size" "$(png_size p.png)" "$(png_size p_normal.png), $(png_size p_height.png)" \
         "$([ "$(png_size p_normal.png)" = "$(png_size p.png)" ] && [ "$(png_size p_height.png)" = "$(png_size p.png)" ]; echo $?)"
+    # A data map is grey (r = g = b): one channel, PNG colour type 0; the colour atlas RGB (type 2).
+    check "polycube: the height map is a grey PNG, the colour atlas RGB" "colour types 0 and 2" \
+        "$(od -An -tu1 -j25 -N1 p_height.png | tr -d ' ') and $(od -An -tu1 -j25 -N1 p.png | tr -d ' ')" \
+        "$([ "$(od -An -tu1 -j25 -N1 p_height.png | tr -d ' ')" = 0 ] && [ "$(od -An -tu1 -j25 -N1 p.png | tr -d ' ')" = 2 ]; echo $?)"
     slope=$("$MAPS" slope p_height.png p_normal.png 2>&1)
     CMD="maps slope p_height.png p_normal.png"
     check "polycube: the normal atlas follows the height atlas's slopes" "median <= 5 deg" "$slope" \
