@@ -151,11 +151,15 @@ int gltf_pack_metallic_roughness(const tt_image *roughness, const tt_image *meta
         if (metallic) row_to_rgba8(metallic, y, TT_COLOR_LINEAR, metal_row);
         for (x = 0; x < sized->width; x++) {
             /* glTF reads roughness from G and metalness from B and multiplies
-               each by its factor; R is not read. An absent map's channel is
-               1, so that its factor alone gives the value. */
-            out[4 * x] = 255;
-            out[4 * x + 1] = roughness ? rough_row[4 * x] : 255;
-            out[4 * x + 2] = metallic ? metal_row[4 * x] : 255;
+               each by its factor; R is not read. An absent roughness map's
+               channel is 1, so that its factor alone gives the value. An
+               absent metallic map's factor is 0 (the material JSON), which
+               makes B unread too: then R and B repeat the roughness and the
+               PNG is a grey one, a third of the bytes. */
+            const unsigned char rough = roughness ? rough_row[4 * x] : 255;
+            out[4 * x] = metallic ? 255 : rough;
+            out[4 * x + 1] = rough;
+            out[4 * x + 2] = metallic ? metal_row[4 * x] : rough;
             out[4 * x + 3] = 255;
         }
     }

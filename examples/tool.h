@@ -716,9 +716,11 @@ typedef struct tool_material {
 
 /* glTF's metallicRoughness texture from separate maps, either of which may
    be NULL (not both): G = roughness's R, B = metallic's R, each rounded to
-   a byte; an absent map's channel is 255, so that the material's factor
-   alone gives its value (gltf_write writes metallicFactor 0 without a
-   metallic map, roughnessFactor 1); R and alpha are 255 (glTF reads neither).
+   a byte; an absent roughness map's channel is 255, so that the material's
+   factor alone gives its value (roughnessFactor 1); without a metallic map
+   gltf_write writes metallicFactor 0, B is then unread and R and B repeat
+   G (a grey image, which the PNG writer stores in one channel); otherwise R
+   is 255. Alpha is 255 (glTF reads neither R nor alpha).
    *rgba gets width * height * 4 bytes, malloc'ed. Returns 0, or -1 with the
    reason in err: both NULL, sizes that differ, out of memory. */
 int gltf_pack_metallic_roughness(const tt_image *roughness, const tt_image *metallic, unsigned char **rgba,
