@@ -19003,7 +19003,9 @@ static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
 }
 
 /* Every corner at vertex v (at most `room`), walking round it through the
-   twins; returns the count. */
+   twins; returns the count. A count of `room` may be a ring cut short: a
+   step that moves the vertex must then leave it alone, or the corners
+   past the cut would keep the old UV, a tear inside the cluster. */
 static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
 {
     int start = m->vert_corner[v], c = start, n = 0;
@@ -19032,6 +19034,34 @@ static int tt__hpm_ring(const tt_mesh *m, int v, int *corners, int room)
 
 #define TT__HPM_RING_MAX 64
 
+/* A corner at vertex v of a face of cluster K other than face `other`, or
+   -1: walking round v as tt__hpm_ring does, however many corners it has. */
+static int tt__hpm_corner_of_cluster(const tt__hpm *S, int v, int K, int other)
+{
+    const tt_mesh *m = S->mesh;
+    int start = m->vert_corner[v], c = start, steps = 0;
+    if (start < 0) return -1;
+    do {
+        int t;
+        if (m->corner_face[c] != other && S->owner[m->corner_face[c]] == K) return c;
+        t = m->twin[tt__prev(m, c)];
+        if (t < 0) break;
+        c = t;
+    } while (c != start && ++steps < m->ncorners);
+    if (c != start || steps == 0) {
+        /* a boundary: the other way from the start */
+        c = start;
+        while (++steps < m->ncorners) {
+            int t = m->twin[c];
+            if (t < 0) break;
+            c = tt__next(m, t);
+            if (c == start) break;
+            if (m->corner_face[c] != other && S->owner[m->corner_face[c]] == K) return c;
+        }
+    }
+    return -1;
+}
+
 /* The relaxation's vertices in classes, so that it can run on the
    executor: two vertices of one class share no face, so nudging one
    changes nothing the other reads (its triangles, the texture along its
@@ -19055,6 +19085,7 @@ static void tt__hpm_relax_vertex(tt__hpm *S, int C, int v, double radius, tt_rng
     int ring[TT__HPM_RING_MAX], group[TT__HPM_RING_MAX], n, ngroups = 0, g, k;
     double frame[3 * TT__HPM_RING_MAX];
     n = tt__hpm_ring(m, v, ring, TT__HPM_RING_MAX);
+    if (n >= TT__HPM_RING_MAX) return;   /* maybe more corners than the ring holds: stays */
     for (k = 0; k < n; k++) tt__hpm_tri_frame(S, ring[k], frame + 3 * k);
     /* the clusters meeting at v, C first */
     group[ngroups++] = C;
@@ -19317,6 +19348,7 @@ static void tt__hpm_close_cracks(tt__hpm *S, int C, const tt__hpm_place *pl)
             const tt__hpm_owner *N = NULL;
             double target[2], old[2], q[2], area0[TT__HPM_RING_MAX], st0[TT__HPM_RING_MAX], st;
             n = tt__hpm_ring(m, m->corner_vert[c], ring, TT__HPM_RING_MAX);
+            if (n >= TT__HPM_RING_MAX) continue;   /* maybe more corners than the ring holds: stays */
             for (k = 0; k < n; k++) {
                 int K = S->owner[m->corner_face[ring[k]]];
                 if (K < 0 || K == C) continue;
@@ -19693,7 +19725,7 @@ oom:
 static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, double out[3][2])
 {
     const tt_mesh *m = S->mesh;
-    int t = m->twin[c], nc = tt__next(m, c), pc = tt__prev(m, c), K, ring[TT__HPM_RING_MAX], n, k;
+    int t = m->twin[c], nc = tt__next(m, c), pc = tt__prev(m, c), K, own;
     const double *a, *b, *g;
     double e[2], len, ex[3], ey[3], x, y, l3, cr[3], side;
     if (t < 0 || (K = S->owner[m->corner_face[t]]) < 0) return 0;
@@ -19704,14 +19736,14 @@ static int tt__hpm_face_as_neighbour(const tt__hpm *S, const double *uv, int c, 
     out[0][1] = a[1];
     out[1][0] = b[0];
     out[1][1] = b[1];
-    /* the neighbour's own coordinates at the third vertex, when it has some */
-    n = tt__hpm_ring(m, m->corner_vert[pc], ring, TT__HPM_RING_MAX);
-    for (k = 0; k < n; k++)
-        if (m->corner_face[ring[k]] != m->corner_face[c] && S->owner[m->corner_face[ring[k]]] == K) {
-            out[2][0] = uv[2 * ring[k]];
-            out[2][1] = uv[2 * ring[k] + 1];
-            return 1;
-        }
+    /* the neighbour's own coordinates at the third vertex, when it has some
+       (from any of the vertex's corners: one UV per vertex in a cluster) */
+    own = tt__hpm_corner_of_cluster(S, m->corner_vert[pc], K, m->corner_face[c]);
+    if (own >= 0) {
+        out[2][0] = uv[2 * own];
+        out[2][1] = uv[2 * own + 1];
+        return 1;
+    }
     /* else unfolded across the edge, on the side away from the neighbour's
        third corner, at the scale of the neighbour's edge */
     e[0] = b[0] - a[0];

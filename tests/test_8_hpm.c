@@ -1654,6 +1654,58 @@ static void test_hpm_map_topology(void)
     tt_image_free(im);
 }
 
+/* A vertex with more corners than hpm walks round at once (a lat-long
+   sphere's pole: 96): within each cluster its corners keep one UV (a tear
+   would cut the texture there), and the map has no flipped triangle. */
+static void test_hpm_map_high_valence(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_image *im = NULL;
+    tt_error err;
+    float *uv = NULL;
+    int *cl = NULL, *pole_corners, npole = 0, torn = 0, flipped, bad, c, k, t;
+    tt_hpm_options o;
+    tt_hpm_report rep;
+    memset(&m, 0, sizeof m);
+    hpm_sphere(&m, 24, 96);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "lat-long sphere: %s", err.message);
+    tm_free(&m);
+    make_value_noise(&im, 160, 120, 4);
+    if (!mesh || !im) goto done;
+    pole_corners = (int *)malloc(sizeof(int) * (size_t)mesh->ncorners);
+    for (t = 0; t < 2 && pole_corners; t++) {
+        memset(&o, 0, sizeof o);
+        o.seed = 3 + t;
+        o.scale = 0.5 + t;
+        if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) break;
+        /* vertex 0 is the north pole */
+        npole = 0;
+        for (c = 0; c < mesh->ncorners; c++)
+            if (mesh->corner_vert[c] == 0) pole_corners[npole++] = c;
+        for (c = 0; c < npole; c++)
+            for (k = 0; k < c; k++) {
+                const int a = pole_corners[c], b = pole_corners[k];
+                if (cl[mesh->corner_face[a]] >= 0 && cl[mesh->corner_face[a]] == cl[mesh->corner_face[b]] &&
+                    (uv[2 * a] != uv[2 * b] || uv[2 * a + 1] != uv[2 * b + 1]))
+                    torn++;
+            }
+        hpm_uv_checks(mesh, uv, 160, 120, 1, &flipped, &bad);
+        CHECK(npole == 96 && torn == 0 && flipped == 0 && bad == 0,
+              "pole of valence %d, scale %g: %d corner pairs of one cluster with different UVs, %d flipped, %d bad",
+              npole, o.scale, torn, flipped, bad);
+        free(uv);
+        free(cl);
+        uv = NULL;
+        cl = NULL;
+        torn = 0;
+    }
+    free(pole_corners);
+done:
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
 typedef struct hpm_map_ctx {
     const tt_mesh *mesh;
     const tt_image *im;
@@ -2107,6 +2159,7 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_orientation);
     RUN(test_hpm_map_budget);
     RUN(test_hpm_map_topology);
+    RUN(test_hpm_map_high_valence);
     RUN(test_hpm_map_coarse);
     RUN(test_hpm_map_unflattened);
     RUN(test_cluster_hierarchy_progress);
