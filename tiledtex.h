@@ -8868,6 +8868,7 @@ static uint64_t tt__face_tile_key(const tt_mesh *mesh, const uint8_t *corner_typ
    least twice the pairs) holds the pairs and their counts while they are
    sorted. */
 #define TT__REDUCE_WALK_PASSES 200
+#define TT__REDUCE_DESCENT_PASSES 100   /* a bound on the time: it stalls after 2 to 12 on polycubes */
 #define TT__REDUCE_ROUNDS 3
 
 typedef struct tt__reduce_walker {
@@ -9054,7 +9055,7 @@ TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layou
         order[i] = order[j];
         order[j] = keep;
     }
-    for (pass = 0, moved = 1; table.distinct > max_tiles && moved; pass++) {
+    for (pass = 0, moved = 1; pass < TT__REDUCE_DESCENT_PASSES && table.distinct > max_tiles && moved; pass++) {
         moved = 0;
         for (i = 0; i < nedges && table.distinct > max_tiles; i++) {
             const int h = order[i], t = mesh->twin[h], fa = mesh->corner_face[h];
