@@ -222,12 +222,15 @@ static void polycube_job_free(polycube_job *job)
     memset(job, 0, sizeof *job);
 }
 
-/* The tiles the atlas holds within --max-atlas on a side: a square of
-   whole cells. */
+/* The tiles an atlas within --max-atlas holds: the whole cells of the
+   largest power-of-two square within it (the compact atlas's sides are
+   powers of two). */
 static int polycube_tile_budget(const polycube_command_options *options, const tt_tile_layout *layout)
 {
-    const int side = options->max_atlas ? options->max_atlas : POLYCUBE_DEFAULT_MAX_ATLAS;
-    const int across = side / (layout->tile_size + 2 * layout->gutter);
+    const int limit = options->max_atlas ? options->max_atlas : POLYCUBE_DEFAULT_MAX_ATLAS;
+    int side = 1, across;
+    while (2 * side <= limit) side *= 2;
+    across = side / (layout->tile_size + 2 * layout->gutter);
     return across > 0 ? across * across : 1;
 }
 
@@ -341,7 +344,8 @@ static int compact_atlas(const polycube_command_options *options, polycube_job *
     if (tt_compact_atlas_create(surface, job->surface_uv, &job->layout, full->width, full->height, options->max_atlas,
                                 NULL, &job->compact, &error) != TT_OK)
         return tool_fail("%s: the atlas: %s%s", options->mesh_path, error.message,
-                         error.result == TT_ERROR_TOO_LARGE ? " (--colors 1, a smaller --tile or --max-atlas)" : "");
+                         error.result == TT_ERROR_TOO_LARGE ? "; here: a larger --max-atlas, --colors 1 or a smaller --tile"
+                                                            : "");
     if (tt_compact_atlas_image(job->compact, full, NULL, &compact, &error) != TT_OK)
         return tool_fail("the %dx%d atlas: %s", job->compact->width, job->compact->height, error.message);
     tt_image_free(job->atlas);

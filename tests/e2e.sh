@@ -1440,8 +1440,17 @@ check "polycube sphere: of the paper's 256 tiles, plain and upright, those shown
 expect_error "polycube --max-atlas below the tiles shown" polycube ../in/spheretri.obj ../in/tex.png out --tile 16 \
     --resolution 8 --max-atlas 64
 check "polycube --max-atlas 64: says the size the tiles need and what helps" \
-    "'need a WxH atlas, above max_size 64 ... --max-atlas)'" "$ERR" \
-    "$(printf '%s' "$ERR" | grep -qE 'need a [0-9]+ x [0-9]+ atlas, above max_size 64.*--max-atlas\)$'; echo $?)"
+    "'need a WxH atlas, above max_size 64 ...; here: a larger --max-atlas, ...'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -qE 'need a [0-9]+ x [0-9]+ atlas, above max_size 64.*; here: a larger --max-atlas, --colors 1 or a smaller --tile$'; echo $?)"
+# --max-atlas 300: the largest power-of-two square within it, 256, holds 10 x 10 cells of 24 texels; the squares
+# (167 tiles shown without the limit) are given as few tiles as that, and the atlas stays within 300.
+newdir
+run polycube ../in/spheretri.obj ../in/tex.png out --tile 16 --resolution 8 --no-upright --max-atlas 300
+check "polycube --max-atlas 300: at most 100 tiles, in an atlas within 300 texels a side" \
+    "exit 0, 'tiles: N of', N <= 100, PNG sides <= 300" "exit $RC, $(printf '%s' "$OUT" | grep '^tiles:'), $(png_size out.png)" \
+    "$([ $RC -eq 0 ] && n=$(printf '%s' "$OUT" | sed -nE 's/^tiles: ([0-9]+) of the .*/\1/p') && [ -n "$n" ] &&
+        [ "$n" -le 100 ] && read -r aw ah <<<"$(png_size out.png)" && [ "$aw" -le 300 ] && [ "$ah" -le 300 ]; echo $?)"
+cd "$W" || exit 1
 polycube_case "sphere --no-upright" spheretri.obj 2 --resolution 8 --no-upright
 check "polycube --no-upright: of one set of 256 tiles, those shown" "'tiles: N of the 256 shown (n=2, 16 texels, gutter 4), in a WxH atlas (all would take 384x384);'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE '^tiles: [0-9]+ of the 256 shown \(n=2, 16 texels, gutter 4\), in a [0-9]+x[0-9]+ atlas \(all would take 384x384\);'; echo $?)"
