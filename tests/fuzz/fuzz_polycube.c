@@ -25,21 +25,25 @@
    it at 180-250 inputs a second.
 
    Input bytes, read front to back (missing bytes read as 0):
-       0      bits 0..1 both set, with byte[2] bit7: allocation number
-              byte[1] + 256 * (byte[2] & 3) + 1 fails; bit2 a progress
+       0      bits 0..1 both set, with byte[2] bit7 and byte[10] bit7:
+              allocation number byte[1] + 256 * (byte[2] & 3) + 1 fails;
+              bit2 a progress
               callback on the mapping, cancelling after byte[3] % 8 calls
               (0 = never) when byte[9] has bit7 set, else never; bit3
               TT_POLYCUBE_NO_CORRECT; bit4 cube_size instead of
               resolution: the box's longest side / (1 + byte[4] % 6); bit5
               the mapping twice and compare (determinism); bit6 with
-              byte[4] >= 240 and byte[2] bit6 NULL options to
-              tt_polycube_build; bit7 with byte[12] >= 192 an extreme
+              byte[4] >= 252 and byte[2] bit6 NULL options to
+              tt_polycube_build; bit7 with byte[12] >= 232 an extreme
               option double (byte[12] % 3 picks the field, byte[13] the
               value: fz_extreme_double). The second conditions keep the
               runs that stop early (a failed allocation, resolution 16,
               which is not mapped here, an extreme option or a cancel
               mostly stops the mapping) rare enough that most runs reach
-              the triangle split.
+              the triangle split: the fuzzer, drawn to the paths these
+              open, made them 16 % of its runs under looser gates (a
+              failed allocation 5 %, NULL options 11 %), and half the
+              runs fell short of the split.
        1, 2   which allocation fails (see above); byte[2] bits 6, 7 gate
               NULL options and the failing allocation
        3      cancel after (% 8); bit3 TT_MESH_PERMISSIVE; bits 4..7 up:
@@ -53,7 +57,8 @@
        7      colors: 1 + b % 8, 250..255 out of range (0, 129, -1, ...)
        8      bit0 axis palettes; bits 1..7 the tile size 4 + 4 * (b >> 5),
               gutter (b >> 1) & 3
-       9..11  edge colour seed, boundary seed
+       9..11  edge colour seed (byte[10] bit7 also gates the failing
+              allocation), boundary seed
        12, 13 the extreme option
        then   the mesh (fuzz_shape.h)
 
@@ -219,8 +224,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (k = 0; k < 14; ++k) hdr[k] = rd_u8(&rd);
     fz_shape_read(&rd, &shape, 1);
     runs++;
-    null_options = (hdr[0] & 64) && hdr[4] >= 240 && (hdr[2] & 64);
-    alloc = fz_alloc_init(&a, (hdr[0] & 3) == 3 && (hdr[2] & 128) ? (long)hdr[1] + 256L * (hdr[2] & 3) + 1 : 0);
+    null_options = (hdr[0] & 64) && hdr[4] >= 252 && (hdr[2] & 64);
+    alloc = fz_alloc_init(&a, (hdr[0] & 3) == 3 && (hdr[2] & 128) && (hdr[10] & 128)
+                                  ? (long)hdr[1] + 256L * (hdr[2] & 3) + 1
+                                  : 0);
 
     if (fz_shape_build(&shape, hdr[3] & 8, alloc, &a, &mesh) != TT_OK) goto out;
 
@@ -248,7 +255,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     case 5: po.up[2] = -1; break;
     default: po.up[0] = 0.3; po.up[1] = -0.2; po.up[2] = (hdr[3] >> 4) - 10.0; break;
     }
-    if ((hdr[0] & 128) && hdr[12] >= 192 && (hdr[12] % 3) < 2) {
+    if ((hdr[0] & 128) && hdr[12] >= 232 && (hdr[12] % 3) < 2) {
         double v = fz_extreme_double(hdr[13]);
         if (hdr[12] % 3 == 0) po.cube_size = v;
         else po.up[hdr[13] % 3] = v;
@@ -306,7 +313,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* 0..8 mostly: a long path search (60..64 quads) on a mesh whose edges
        fail spends its whole step budget per edge, seconds a run */
     mo.max_quads = hdr[6] < 245 ? hdr[6] % 9 : 60 + (hdr[6] - 245);
-    if ((hdr[0] & 128) && hdr[12] >= 192 && hdr[12] % 3 == 2) {
+    if ((hdr[0] & 128) && hdr[12] >= 232 && hdr[12] % 3 == 2) {
         mo.max_edge = fz_extreme_double(hdr[13]);
         valid_options = 0;
     }
