@@ -3405,7 +3405,9 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
         tt_compact_atlas_image and tt_compact_atlas_uv with each corner's
         quad: an atlas of only the tiles S shows (about 400 of the 512 on
         a model at resolution 16), 4096 x 2048 instead of 4352 x 2176 with
-        128-texel tiles.
+        128-texel tiles; tt_reduce_tiles on S's types before the UVs, its
+        groups tt_polycube_quad_upright, makes them as few as 2048 x 2048
+        holds (225).
    tt_polycube_quad_upright is 1 for a wall, 0 for a top or bottom.
    Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad <
    its surface's nfaces. */
