@@ -189,13 +189,20 @@ static const unsigned short length_base[29] = {3,  4,  5,  6,  7,  8,  9,  10, 1
 static const unsigned char length_extra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2,
                                                2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
 
-/* The length code (0..28) of a match length 3..258. */
-static int length_code(int length)
+/* The length code (0..28) of each match length 3..258, looked up once per
+   match rather than searched: made once per file. */
+typedef struct length_codes {
+    unsigned char of[MAX_MATCH + 1];
+} length_codes;
+
+static void length_codes_init(length_codes *table)
 {
-    int code = 0;
-    if (length == MAX_MATCH) return 28;
-    while (code < 27 && length_base[code + 1] <= length) code++;
-    return code;
+    int code, length;
+    memset(table, 0, sizeof *table);
+    for (code = 0; code < 29; code++) {
+        int last = code == 28 ? MAX_MATCH : length_base[code + 1] - 1;   /* 258 has a code of its own */
+        for (length = length_base[code]; length <= last; length++) table->of[length] = (unsigned char)code;
+    }
 }
 
 /* The distance code (0..29) of a distance 1..32768, and its extra bits. */
@@ -446,8 +453,8 @@ static size_t deflate_stored(const unsigned char *data, int n, int final, unsign
     return size;
 }
 
-static size_t deflate_piece(matcher *m, lz_symbol *symbols, const unsigned char *data, int n, int final,
-                            unsigned char *out)
+static size_t deflate_piece(matcher *m, const length_codes *lengths, lz_symbol *symbols, const unsigned char *data,
+                            int n, int final, unsigned char *out)
 {
     uint32_t literal_counts[286] = {0}, distance_counts[30] = {0}, header_counts[19] = {0};
     uint32_t literal_codes[286], distance_codes[30], header_codes[19];
@@ -463,7 +470,7 @@ static size_t deflate_piece(matcher *m, lz_symbol *symbols, const unsigned char 
         if (symbols[i].distance == 0) {
             literal_counts[symbols[i].value]++;
         } else {
-            const int code = length_code(symbols[i].value);
+            const int code = lengths->of[symbols[i].value];
             literal_counts[257 + code]++;
             distance_counts[distance_code(symbols[i].distance, &extra_bits, &extra)]++;
             bits += (uint64_t)length_extra[code] + (uint64_t)extra_bits;
@@ -523,7 +530,7 @@ static size_t deflate_piece(matcher *m, lz_symbol *symbols, const unsigned char 
         if (symbols[i].distance == 0) {
             put_bits(&w, literal_codes[symbols[i].value], literal_lengths[symbols[i].value]);
         } else {
-            const int length = symbols[i].value, code = length_code(length);
+            const int length = symbols[i].value, code = lengths->of[length];
             int extra_bits, distance;
             uint32_t extra;
             put_bits(&w, literal_codes[257 + code], literal_lengths[257 + code]);
@@ -554,6 +561,7 @@ typedef struct piece_job {
     size_t size;                 /* filtered bytes in all */
     int npieces;
     const crc_table *crc;
+    const length_codes *lengths;
     unsigned char **chunk;       /* per piece: a whole IDAT chunk (length, type, data, CRC), or NULL */
     size_t *chunk_size;
     uint32_t *adler;             /* per piece: the Adler-32 of its filtered bytes */
@@ -582,7 +590,7 @@ static void compress_piece(void *context, int index)
         chunk[9] = 0x5e;   /* no dictionary; the header's check bits */
         data = 2;
     }
-    data += deflate_piece(m, symbols, job->filtered + begin, n, final, chunk + 8 + data);
+    data += deflate_piece(m, job->lengths, symbols, job->filtered + begin, n, final, chunk + 8 + data);
     free(m);
     free(symbols);
     put_u32_be(chunk, (uint32_t)data);
@@ -599,6 +607,7 @@ int png_write_to_memory(const unsigned char *pixels, int width, int height, int 
     static const unsigned char color_type[5] = {0, 0, 4, 2, 6};   /* by channels: grey, grey+alpha, RGB, RGBA */
     const tt_executor *executor = tool_executor();
     crc_table crc;
+    length_codes lengths;
     filter_job filter;
     piece_job pieces;
     unsigned char *filtered, *file = NULL, tail[12 + 4 + 12], *p;
@@ -626,9 +635,11 @@ int png_write_to_memory(const unsigned char *pixels, int width, int height, int 
     tool_parallel_ranges(executor, height, PNG_BAND_ROWS, filter_band, &filter);
 
     crc_table_init(&crc);
+    length_codes_init(&lengths);
     pieces.filtered = filtered;
     pieces.size = size;
     pieces.crc = &crc;
+    pieces.lengths = &lengths;
     tool_run_tasks(executor, pieces.npieces, compress_piece, &pieces);
     total = sizeof signature + 25;
     for (i = 0; i < pieces.npieces; i++) {

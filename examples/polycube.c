@@ -186,7 +186,6 @@ typedef struct polycube_job {
     int *edge_colors;               /* per S half-edge */
     uint8_t *surface_type;          /* per S half-edge: its boundary type */
     uint8_t *surface_group;         /* per S quad: 1 for a wall with upright tiles, else 0 */
-    int tiles_shown;                /* distinct tiles S shows, walls' and tops' apart */
     float *surface_uv;              /* per S corner: S's own texture coordinates */
     tt_tileset *tiles;              /* plain: the tops and bottoms (all of S with --no-upright) */
     tt_tileset *upright_tiles;      /* the walls; NULL with --no-upright */
@@ -279,7 +278,7 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
         job->surface_group[q] = (uint8_t)(!options->plain && tt_polycube_quad_upright(job->polycube, q));
     if (tt_reduce_tiles(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
                         job->surface_group, polycube_tile_budget(options, &job->layout), NULL, job->surface_type,
-                        &job->tiles_shown, &error) != TT_OK ||
+                        NULL, &error) != TT_OK ||
         tt_assign_uvs(job->polycube->surface, &job->layout, job->surface_type, job->surface_uv, &error) != TT_OK)
         return tool_fail("%s: the polycube's tiles: %s", path, error.message);
     return 0;
