@@ -1260,9 +1260,10 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
    about 24 bytes per face, from `allocator`, freed before it returns.
    Errors: NULL mesh, layout or corner_type, a bad allocator, colors
    outside 1..TT_MAX_COLORS, max_tiles below 1 (TT_ERROR_INVALID_ARGUMENT);
-   a face that is not a quad (TT_ERROR_NOT_QUAD_MESH); a type of 2n or more,
-   twins that are not the two halves of one condition, or a type against a
-   prescribed colour (TT_ERROR_INVALID_ARGUMENT, naming the corner); a mesh
+   a face that is not a quad (TT_ERROR_NOT_QUAD_MESH); edge_colors as
+   tt_assign_boundaries refuses them; a type of 2n or more, twins that are
+   not the two halves of one condition, or a type against a prescribed
+   colour (TT_ERROR_INVALID_ARGUMENT, naming the corner); a mesh
    without faces (TT_ERROR_EMPTY_MESH); TT_ERROR_OUT_OF_MEMORY. On failure
    corner_type is as it was. */
 TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
@@ -8699,10 +8700,42 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
     uv[1] = (float)(((double)row * cell + L.gutter + (double)k * L.tile_size) / atlas);
 }
 
+/* Prescribed edge colours (tt_assign_boundaries' edge_colors): each -1 or
+   0..n-1, the two half-edges of an edge alike. */
+static tt_result tt__check_edge_colors(const tt_mesh *mesh, int n, const int *edge_colors, tt_error *error)
+{
+    int c;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c];
+        if (edge_colors[c] < -1 || edge_colors[c] >= n)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, mesh->corner_face[c], c, -1, -1,
+                            "corner %d prescribes colour %d, but %d colors allow 0..%d (or -1: random)", c,
+                            edge_colors[c], n, n - 1);
+        if (t >= 0 && edge_colors[t] != edge_colors[c])
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                            "corners %d and %d are the two sides of one edge but prescribe colours %d and %d",
+                            c, t, edge_colors[c], edge_colors[t]);
+    }
+    return TT_OK;
+}
+
+/* Every face a quad (TT_ERROR_NOT_QUAD_MESH names the first that is not). */
+static tt_result tt__require_quads(const tt_mesh *mesh, tt_error *error)
+{
+    int f;
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4)
+            return tt__fail(error, TT_ERROR_NOT_QUAD_MESH, f, mesh->face_start[f], -1, -1,
+                            "face %d has %d corners; tiled textures need quads (quadrangulate the mesh first)",
+                            f, mesh->face_start[f + 1] - mesh->face_start[f]);
+    return TT_OK;
+}
+
 TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *layout, uint64_t seed,
                                      const int *edge_colors, uint8_t *corner_type, tt_error *error)
 {
     tt_rng rng;
+    tt_result result;
     int n, c;
     tt__ok(error);
     if (!mesh || !layout || !corner_type)
@@ -8713,18 +8746,7 @@ TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *
     if (n < 1 || n > TT_MAX_COLORS)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "colors (boundary conditions) must be 1..%d, got %d", TT_MAX_COLORS, layout->colors);
-    if (edge_colors)
-        for (c = 0; c < mesh->ncorners; c++) {
-            int t = mesh->twin[c];
-            if (edge_colors[c] < -1 || edge_colors[c] >= n)
-                return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, mesh->corner_face[c], c, -1, -1,
-                                "corner %d prescribes colour %d, but %d colors allow 0..%d (or -1: random)", c,
-                                edge_colors[c], n, n - 1);
-            if (t >= 0 && edge_colors[t] != edge_colors[c])
-                return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
-                                "corners %d and %d are the two sides of one edge but prescribe colours %d and %d",
-                                c, t, edge_colors[c], edge_colors[t]);
-        }
+    if (edge_colors && (result = tt__check_edge_colors(mesh, n, edge_colors, error)) != TT_OK) return result;
     tt_rng_seed(&rng, seed, 0x6564676573ull /* "edges" */);
     /* Edges are visited in order of their first half-edge, so the result
        depends only on the mesh and the seed. A prescribed colour draws no
@@ -8757,11 +8779,7 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
     base = 2 * resolved.colors;
     cell = resolved.tile_size + 2.0 * resolved.gutter;
     atlas = (double)base * base * cell;
-    for (f = 0; f < mesh->nfaces; f++)
-        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4)
-            return tt__fail(error, TT_ERROR_NOT_QUAD_MESH, f, mesh->face_start[f], -1, -1,
-                            "face %d has %d corners; tiled textures need quads (quadrangulate the mesh first)",
-                            f, mesh->face_start[f + 1] - mesh->face_start[f]);
+    if (tt__require_quads(mesh, error) != TT_OK) return TT_ERROR_NOT_QUAD_MESH;
     for (c = 0; c < mesh->ncorners; c++)
         if (corner_type[c] >= base)
             return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, mesh->corner_face[c], c, -1, -1,
@@ -8986,6 +9004,7 @@ TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layou
     tt__tile_counts table;
     uint64_t *spare_keys = NULL, base;
     int *spare_counts = NULL, *order = NULL, n, f, c, i, nedges = 0, pass, moved, kept;
+    tt_result result;
     tt_rng rng;
     tt__ok(error);
     if (out_tiles) *out_tiles = 0;
@@ -9001,11 +9020,8 @@ TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layou
     if (max_tiles < 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_tiles must be 1 or more, got %d",
                         max_tiles);
-    for (f = 0; f < mesh->nfaces; f++)
-        if (mesh->face_start[f + 1] - mesh->face_start[f] != 4)
-            return tt__fail(error, TT_ERROR_NOT_QUAD_MESH, f, mesh->face_start[f], -1, -1,
-                            "face %d has %d corners; tiles are for quads (quadrangulate the mesh first)", f,
-                            mesh->face_start[f + 1] - mesh->face_start[f]);
+    if (tt__require_quads(mesh, error) != TT_OK) return TT_ERROR_NOT_QUAD_MESH;
+    if (edge_colors && (result = tt__check_edge_colors(mesh, n, edge_colors, error)) != TT_OK) return result;
     for (c = 0; c < mesh->ncorners; c++) {
         const int t = mesh->twin[c];
         if (corner_type[c] >= 2 * n)
@@ -9017,10 +9033,6 @@ TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layou
                             "corners %d and %d are the two sides of one edge but have types %d and %d, not the "
                             "two halves of one condition (tt_assign_boundaries makes them so)", c, t,
                             corner_type[c], corner_type[t]);
-        if (edge_colors && (edge_colors[c] < -1 || edge_colors[c] >= n || (t >= 0 && edge_colors[t] != edge_colors[c])))
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
-                            "corner %d prescribes colour %d (its twin %d), but %d colors allow 0..%d or -1 on both "
-                            "sides alike", c, edge_colors[c], t >= 0 ? edge_colors[t] : -1, n, n - 1);
         if (edge_colors && edge_colors[c] >= 0 && corner_type[c] / 2 != edge_colors[c])
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
                             "corner %d has type %d, of colour %d, but prescribes colour %d", c, corner_type[c],
