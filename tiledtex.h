@@ -23156,20 +23156,46 @@ static void tt__relax_context_free(const tt_allocator *allocator, tt__relax_cont
     memset(x, 0, sizeof *x);
 }
 
+/* The corners at each vertex of `model`, in corner order: vertex v's are
+   corners[first[v]] up to corners[first[v + 1]]. 0 when out of memory
+   (nothing left allocated). */
+static int tt__vertex_corner_lists(const tt_mesh *model, const tt_allocator *allocator, int **first_out,
+                                   int **corners_out)
+{
+    const int nverts = model->nverts;
+    int *first = TT__ALLOC(allocator, int, (size_t)nverts + 1);
+    int *corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
+    int *next = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
+    int v, c;
+    *first_out = *corners_out = NULL;
+    if (!first || !corners || !next) {
+        tt__free(allocator, first);
+        tt__free(allocator, corners);
+        tt__free(allocator, next);
+        return 0;
+    }
+    memset(next, 0, sizeof(int) * (size_t)nverts);
+    for (c = 0; c < model->ncorners; c++) next[model->corner_vert[c]]++;
+    first[0] = 0;
+    for (v = 0; v < nverts; v++) first[v + 1] = first[v] + next[v];
+    for (v = 0; v < nverts; v++) next[v] = first[v];
+    for (c = 0; c < model->ncorners; c++) corners[next[model->corner_vert[c]]++] = c;
+    tt__free(allocator, next);
+    *first_out = first;
+    *corners_out = corners;
+    return 1;
+}
+
 /* 0 when out of memory (nothing left allocated). */
 static int tt__relax_context_init(const tt_polycube *pc, const tt_mesh *model, const tt_allocator *allocator,
                                   tt__relax_context *x)
 {
-    const int nverts = model->nverts;
-    int v, c, *next;
+    int c;
     memset(x, 0, sizeof *x);
-    x->first_triangle = TT__ALLOC(allocator, int, (size_t)nverts + 1);
-    x->triangle_corners = TT__ALLOC(allocator, int, model->ncorners > 0 ? model->ncorners : 1);
     x->chart = TT__ALLOC(allocator, tt__relax_chart, 2);
     x->unfold = TT__ALLOC(allocator, tt_quad_map, pc->surface->ncorners);
-    next = TT__ALLOC(allocator, int, nverts > 0 ? nverts : 1);
-    if (!x->first_triangle || !x->triangle_corners || !x->chart || !x->unfold || !next) {
-        tt__free(allocator, next);
+    if (!x->chart || !x->unfold ||
+        !tt__vertex_corner_lists(model, allocator, &x->first_triangle, &x->triangle_corners)) {
         tt__relax_context_free(allocator, x);
         return 0;
     }
@@ -23177,13 +23203,6 @@ static int tt__relax_context_init(const tt_polycube *pc, const tt_mesh *model, c
     x->around = x->chart + 1;
     tt__relax_chart_init(x->chart, pc->surface, x->unfold);
     tt__relax_chart_init(x->around, pc->surface, x->unfold);
-    memset(next, 0, sizeof(int) * (size_t)nverts);
-    for (c = 0; c < model->ncorners; c++) next[model->corner_vert[c]]++;
-    x->first_triangle[0] = 0;
-    for (v = 0; v < nverts; v++) x->first_triangle[v + 1] = x->first_triangle[v] + next[v];
-    for (v = 0; v < nverts; v++) next[v] = x->first_triangle[v];
-    for (c = 0; c < model->ncorners; c++) x->triangle_corners[next[model->corner_vert[c]]++] = c;
-    tt__free(allocator, next);
     return 1;
 }
 
@@ -25825,6 +25844,37 @@ typedef struct tt__split_job {
     int first;                  /* the batch's first triangle */
 } tt__split_job;
 
+/* Triangle f split onto S, its vertices and triangles appended to S->out:
+   the pieces, the fan around a cone, or else the fallback. 1 when split,
+   0 when it fell back, -1 when out of memory. */
+static int tt__split_face(tt__split *S, int f)
+{
+    const tt_mesh *model = S->mesh;
+    int linked = 0, chart = 0, pieces = 0, done = 0, k, kept_vertices, kept_triangles;
+    for (k = 0; k < 3; k++) S->vert[k] = model->corner_vert[3 * f + k];
+    if (!tt__split_walk(S, f, &linked, &chart)) return -1;
+    kept_vertices = S->out->nverts;
+    kept_triangles = S->out->ntriangles;
+    if (chart && (done = tt__split_pieces(S, f, &pieces)) < 0) return -1;
+    if (!done && linked) {
+        float at[3], weight[3];
+        double p0[3];
+        int source[3];
+        S->out->nverts = kept_vertices;
+        S->out->ntriangles = kept_triangles;
+        tt__split_token(S, S->vert[0], at, source, weight);
+        for (k = 0; k < 3; k++) p0[k] = at[k];
+        done = tt__split_star(S, f, tt__split_area3(S, S->vert[1], S->vert[2], p0), &pieces);
+        if (done < 0) return -1;
+    }
+    if (!done) {
+        S->out->nverts = kept_vertices;
+        S->out->ntriangles = kept_triangles;
+        if (!tt__split_fallback(S, f)) return -1;
+    }
+    return done;
+}
+
 /* Task `index` of a batch: its range of triangles split (the pieces, the
    fan around a cone, or the fallback), into its own vertices and
    triangles; per triangle where they end, and whether it fell back. */
@@ -25838,28 +25888,9 @@ static void tt__split_range_task(void *context, int index)
     int f;
     S->out->nverts = S->out->ntriangles = S->nrequests = S->failed = 0;
     for (f = begin; f < end; f++) {
-        int linked = 0, chart = 0, pieces = 0, done = 0, k, kept_vertices, kept_triangles, *ends;
-        for (k = 0; k < 3; k++) S->vert[k] = model->corner_vert[3 * f + k];
-        if (!tt__split_walk(S, f, &linked, &chart)) goto out_of_memory;
-        kept_vertices = S->out->nverts;
-        kept_triangles = S->out->ntriangles;
-        if (chart && (done = tt__split_pieces(S, f, &pieces)) < 0) goto out_of_memory;
-        if (!done && linked) {
-            float at[3], weight[3];
-            double p0[3];
-            int source[3];
-            S->out->nverts = kept_vertices;
-            S->out->ntriangles = kept_triangles;
-            tt__split_token(S, S->vert[0], at, source, weight);
-            for (k = 0; k < 3; k++) p0[k] = at[k];
-            done = tt__split_star(S, f, tt__split_area3(S, S->vert[1], S->vert[2], p0), &pieces);
-            if (done < 0) goto out_of_memory;
-        }
-        if (!done) {
-            S->out->nverts = kept_vertices;
-            S->out->ntriangles = kept_triangles;
-            if (!tt__split_fallback(S, f)) goto out_of_memory;
-        }
+        const int done = tt__split_face(S, f);
+        int *ends;
+        if (done < 0) goto out_of_memory;
         ends = S->face_ends + 4 * (f - begin);
         ends[0] = S->out->nverts;
         ends[1] = S->out->ntriangles;
@@ -25914,6 +25945,35 @@ static int tt__split_merge(const tt__split *S, int begin, int end, tt_polycube_m
     return 1;
 }
 
+/* A split of model's triangles from `points` and the edge records, its
+   output empty; crossing_edge: per crossing of the records, its edge
+   (tt__crossing_edges). 0 when out of memory. */
+static int tt__split_setup(tt__split *S, const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
+                           const tt_surface_point *points, const int *crossing_edge, const tt_allocator *allocator)
+{
+    S->pc = pc;
+    S->mesh = model;
+    S->edges = edges;
+    S->points = points;
+    S->crossing_edge = crossing_edge;
+    S->allocator = allocator;
+    S->token_crossing = model->nverts;
+    S->token_local = model->nverts + edges->ncrossings;
+    S->out = TT__ALLOC(allocator, tt_polycube_mapping, 1);
+    if (!S->out) return 0;
+    memset(S->out, 0, sizeof *S->out);
+    S->out->allocator = tt__allocator_copy(allocator);
+    return 1;
+}
+
+/* Per crossing of the records, the edge it belongs to. */
+static void tt__crossing_edges(const tt_polycube_edges *edges, int *crossing_edge)
+{
+    int e, j;
+    for (e = 0; e < edges->nedges; e++)
+        for (j = edges->first_crossing[e]; j < edges->first_crossing[e + 1]; j++) crossing_edge[j] = e;
+}
+
 static void tt__split_free(tt__split *S)
 {
     tt__free(S->allocator, S->requests);
@@ -25942,7 +26002,7 @@ static tt_result tt__polycube_split(const tt_polycube *pc, const tt_mesh *model,
     tt__split *tasks = TT__ALLOC(allocator, tt__split, TT__SPLIT_BATCH);
     int *crossing_vertex = TT__ALLOC(allocator, int, edges->ncrossings > 0 ? edges->ncrossings : 1);
     int *crossing_edge = TT__ALLOC(allocator, int, edges->ncrossings > 0 ? edges->ncrossings : 1);
-    int vertex_capacity = 0, triangle_capacity = 0, e, j, i, v, first, failed = 0;
+    int vertex_capacity = 0, triangle_capacity = 0, j, i, v, first, failed = 0;
     *out = NULL;
     *fallbacks = 0;
     if (m) {
@@ -25952,28 +26012,13 @@ static tt_result tt__polycube_split(const tt_polycube *pc, const tt_mesh *model,
     if (tasks) memset(tasks, 0, sizeof(tt__split) * TT__SPLIT_BATCH);
     failed = !m || !tasks || !crossing_vertex || !crossing_edge;
     for (i = 0; i < TT__SPLIT_BATCH && !failed; i++) {
-        tt__split *S = &tasks[i];
-        S->pc = pc;
-        S->mesh = model;
-        S->edges = edges;
-        S->points = points;
-        S->crossing_edge = crossing_edge;
-        S->allocator = allocator;
-        S->token_crossing = model->nverts;
-        S->token_local = model->nverts + edges->ncrossings;
-        S->out = TT__ALLOC(allocator, tt_polycube_mapping, 1);
-        S->face_ends = TT__ALLOC(allocator, int, 4 * TT__SPLIT_RANGE);
-        if (S->out) {
-            memset(S->out, 0, sizeof *S->out);
-            S->out->allocator = tt__allocator_copy(allocator);
-        }
-        failed = !S->out || !S->face_ends;
+        failed = !tt__split_setup(&tasks[i], pc, model, edges, points, crossing_edge, allocator) ||
+                 !(tasks[i].face_ends = TT__ALLOC(allocator, int, 4 * TT__SPLIT_RANGE));
     }
     if (!failed && edges->ncrossings > INT_MAX - 1 - model->nverts) failed = 1;
     if (!failed) {
         for (j = 0; j < edges->ncrossings; j++) crossing_vertex[j] = -1;
-        for (e = 0; e < edges->nedges; e++)
-            for (j = edges->first_crossing[e]; j < edges->first_crossing[e + 1]; j++) crossing_edge[j] = e;
+        tt__crossing_edges(edges, crossing_edge);
         for (v = 0; v < model->nverts && !failed; v++) {
             float position[3], weight[3];
             int source[3];
