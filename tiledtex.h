@@ -3046,6 +3046,47 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
                                     tt_surface_point *points, tt_polycube_projection_report *report,
                                     tt_error *error);
 
+/* The polycube at the resolution the mesh needs: tt_polycube_build at
+   16, 24, 32, 48 and 64 cubes in turn (never above max_resolution; 0 =
+   TT_POLYCUBE_AUTO_MAX_RESOLUTION) until S has the mesh's genus (when the
+   mesh has one: closed and manifold) and the mesh's vertices lie within
+   TT_POLYCUBE_AUTO_NEAR cubes of S on average (tt_polycube_project's
+   mean_distance). The second test finds parts thinner than about two
+   cubes, which a coarse polycube cannot follow: their projections land a
+   cube or more away, and their triangles are drawn out into streaks or
+   fall back. A larger resolution's grid of more than TT_POLYCUBE_MAX_CUBES
+   or more than TT_POLYCUBE_AUTO_MAX_QUADS quads stops the search. When no
+   resolution passes both, the result is the one nearest the mesh among
+   those with the mesh's genus, else the lowest of those with the genus
+   closest to it (report->genus_differs then says so).
+   With options->resolution or options->cube_size set, this is
+   tt_polycube_build at that size. The mesh must face outward: when the
+   first build finds it inside out (report->inside_out), the search stops
+   there; reverse the mesh's faces and call again.
+   chosen (may be NULL) gets what the search did. The texture's scale is
+   not the polycube's business: a caller that keeps one tile per square
+   at a larger resolution gets smaller tiles on the surface, so the tool
+   cuts each square's tile from fewer texels of the photo (its
+   --texture-size). Cost: up to five builds and projections of the mesh
+   (the horse scan, 97k triangles: ... ). Results as
+   tt_polycube_build's, and TT_ERROR_INVALID_ARGUMENT for max_resolution
+   outside 0..TT_POLYCUBE_MAX_RESOLUTION. */
+#define TT_POLYCUBE_AUTO_MAX_RESOLUTION 64
+#define TT_POLYCUBE_AUTO_MAX_QUADS 200000
+#define TT_POLYCUBE_AUTO_NEAR 0.4
+typedef struct tt_polycube_resolution_report {
+    int tries;                  /* builds made */
+    int resolution[5];          /* the resolutions tried, in order */
+    int genus[5];               /* S's genus at each */
+    double mean_distance[5];    /* the mesh's vertices from S at each, in cubes (-1: not measured, the genus
+                                   already differed) */
+    int chosen;                 /* the index of the result in those */
+    int capped;                 /* 1 when the next resolution was not tried for the size limits */
+} tt_polycube_resolution_report;
+TTDEF tt_result tt_polycube_build_auto(const tt_mesh *mesh, const tt_polycube_options *options, int max_resolution,
+                                       const tt_allocator *allocator, tt_polycube **out, tt_polycube_report *report,
+                                       tt_polycube_resolution_report *chosen, tt_error *error);
+
 /* The 3D position of a point of S, into xyz.
    Preconditions (TT_ASSERT): polycube and its surface are not NULL,
    0 <= p.quad < polycube->surface->nfaces, xyz is not NULL. */
@@ -21892,6 +21933,111 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
                                     tt_error *error)
 {
     return tt__polycube_project(polycube, mesh, NULL, allocator, points, report, error);
+}
+
+/* ---- The resolution chosen for the mesh ---- */
+
+TTDEF tt_result tt_polycube_build_auto(const tt_mesh *mesh, const tt_polycube_options *options, int max_resolution,
+                                       const tt_allocator *allocator, tt_polycube **out, tt_polycube_report *report,
+                                       tt_polycube_resolution_report *chosen, tt_error *error)
+{
+    static const int ladder[5] = {16, 24, 32, 48, 64};
+    tt_polycube_options tried;
+    tt_polycube_resolution_report local;
+    tt_polycube_report local_report, best_report;
+    tt_polycube *best = NULL;
+    tt_surface_point *points = NULL;
+    tt_result result;
+    int i, best_index = -1, last_quads = 0;
+    double best_distance = HUGE_VAL;
+    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
+    if (!chosen) chosen = &local;
+    memset(chosen, 0, sizeof *chosen);
+    if (!report) report = &local_report;
+    *out = NULL;
+    if (max_resolution < 0 || max_resolution > TT_POLYCUBE_MAX_RESOLUTION) {
+        if (report) memset(report, 0, sizeof *report);
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_resolution %d is outside 0..%d",
+                        max_resolution, TT_POLYCUBE_MAX_RESOLUTION);
+    }
+    if (!max_resolution) max_resolution = TT_POLYCUBE_AUTO_MAX_RESOLUTION;
+    if (options && (options->resolution != 0 || options->cube_size != 0.0)) {
+        result = tt_polycube_build(mesh, options, allocator, out, report, error);
+        if (result == TT_OK) {
+            chosen->tries = 1;
+            chosen->resolution[0] = report->resolution;
+            chosen->genus[0] = report->polycube_genus;
+            chosen->mean_distance[0] = -1.0;
+        }
+        return result;
+    }
+    if (options) tried = *options;
+    else memset(&tried, 0, sizeof tried);
+    for (i = 0; i < 5 && (i == 0 || ladder[i] <= max_resolution); i++) {
+        tt_polycube *pc = NULL;
+        tt_polycube_report r;
+        tt_polycube_projection_report projection;
+        int better, genus_gap, best_gap;
+        tried.resolution = ladder[i] < max_resolution ? ladder[i] : max_resolution;
+        if (i > 0 && last_quads * (double)tried.resolution * tried.resolution /
+                         ((double)ladder[i - 1] * ladder[i - 1]) > TT_POLYCUBE_AUTO_MAX_QUADS) {
+            chosen->capped = 1;
+            break;
+        }
+        result = tt_polycube_build(mesh, &tried, allocator, &pc, &r, error);
+        if (result == TT_ERROR_TOO_LARGE && i > 0) {
+            tt__ok(error);
+            chosen->capped = 1;
+            break;
+        }
+        if (result != TT_OK) goto failed;
+        last_quads = r.quads;
+        chosen->resolution[i] = r.resolution;
+        chosen->genus[i] = r.polycube_genus;
+        chosen->mean_distance[i] = -1.0;
+        chosen->tries = i + 1;
+        if (!r.genus_differs && !r.inside_out) {
+            if (!points && !(points = TT__ALLOC(allocator, tt_surface_point, mesh->nverts > 0 ? mesh->nverts : 1))) {
+                tt_polycube_free(pc);
+                result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                                  "out of memory choosing the polycube's resolution");
+                goto failed;
+            }
+            if ((result = tt_polycube_project(pc, mesh, allocator, points, &projection, error)) != TT_OK) {
+                tt_polycube_free(pc);
+                goto failed;
+            }
+            chosen->mean_distance[i] = projection.mean_distance;
+        }
+        /* The best so far: the genus nearest the mesh's, then the mesh nearest S. */
+        genus_gap = r.mesh_genus >= 0 ? abs(r.polycube_genus - r.mesh_genus) : 0;
+        best_gap = best ? (best_report.mesh_genus >= 0 ? abs(best_report.polycube_genus - best_report.mesh_genus) : 0)
+                        : INT_MAX;
+        better = genus_gap < best_gap ||
+                 (genus_gap == best_gap && chosen->mean_distance[i] >= 0.0 && chosen->mean_distance[i] < best_distance);
+        if (better) {
+            tt_polycube_free(best);
+            best = pc;
+            best_report = r;
+            best_index = i;
+            best_distance = chosen->mean_distance[i] >= 0.0 ? chosen->mean_distance[i] : HUGE_VAL;
+        } else {
+            tt_polycube_free(pc);
+        }
+        if (r.inside_out || (!r.genus_differs && chosen->mean_distance[i] <= TT_POLYCUBE_AUTO_NEAR)) break;
+        if (tried.resolution >= max_resolution) break;
+    }
+    tt__free(allocator, points);
+    chosen->chosen = best_index;
+    *report = best_report;
+    *out = best;
+    return TT_OK;
+failed:
+    tt__free(allocator, points);
+    tt_polycube_free(best);
+    memset(report, 0, sizeof *report);
+    memset(chosen, 0, sizeof *chosen);
+    return result;
 }
 
 /* ------------------------------------------------------------------------ */

@@ -63,9 +63,17 @@ static void print_help(void)
            "standard output) only for a GLB, one file.\n"
            "\n"
            "options:\n"
-           "  --resolution N   cubes along the mesh's longest side, 1 to %d (default %d)\n"
-           "  --cube-size X    the cubes' edge in mesh units instead: one tile covers X x X of the\n"
-           "                   surface (not with --resolution)\n"
+           "  --resolution N   cubes along the mesh's longest side, 1 to %d (default: the first of\n"
+           "                   16, 24, 32, 48, 64 at which the polycube has the mesh's genus and\n"
+           "                   the mesh lies near it, so thin parts are two cubes thick or more)\n"
+           "  --cube-size X    the cubes' edge in mesh units instead (not with --resolution)\n"
+           "  --texture-size X how much of the surface, in mesh units, one tile of IMAGE's texels\n"
+           "                   (--tile) covers; each square of the polycube shows a tile of as many\n"
+           "                   texels as its share of that. Default: the mesh's longest side / 16,\n"
+           "                   whatever resolution is chosen; with --resolution or --cube-size,\n"
+           "                   the cube size (one tile of --tile texels per square)\n",
+           TT_POLYCUBE_MAX_RESOLUTION);
+    printf(
            "  --colors N       edge colours of the palette each axis draws 2 from (default %d:\n"
            "                   the paper's 256 tiles); 1 gives 16 tiles\n"
            "  --seed K         random seed: colours, tiles, synthesis (default 0)\n"
@@ -101,9 +109,9 @@ static void print_help(void)
            "\n"
            "example: tiledtex generate mesh sphere.obj --shape sphere --triangles\n"
            "         tiledtex generate texture stones.png --size 256\n"
-           "         tiledtex polycube sphere.obj stones.png sphere_pc --resolution 8\n"
+           "         tiledtex polycube sphere.obj stones.png sphere_pc\n"
            "         tiledtex render sphere_pc.obj sphere_pc.png view.png\n",
-           TT_POLYCUBE_MAX_RESOLUTION, TT_POLYCUBE_DEFAULT_RESOLUTION, POLYCUBE_DEFAULT_COLORS,
+           POLYCUBE_DEFAULT_COLORS,
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, POLYCUBE_DEFAULT_MAX_ATLAS, TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE);
 }
 
@@ -114,6 +122,8 @@ typedef struct polycube_command_options {
     tt_polycube_options build;      /* zero fields: the library's defaults */
     int plain;                      /* --no-upright */
     int max_atlas;                  /* --max-atlas; 0 = the library's default */
+    double texture_size;            /* --texture-size; 0 = the mesh's longest side / 16, or the cube size when
+                                       --resolution or --cube-size chose it */
 } polycube_command_options;
 
 /* Returns -1 to go on, or the exit status to return now. */
@@ -147,6 +157,12 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
                 return tool_usage("--cube-size wants the cubes' edge in mesh units, above 0, got '%s'", value);
             options->build.cube_size = size;
             cube_size_given = 1;
+        } else if (tool_option(argc, argv, &i, "--texture-size", &value)) {
+            if (!value) return tool_usage("--texture-size needs a value");
+            if (parse_whole_double(value, &options->texture_size) != 0 || !(options->texture_size > 0.0) ||
+                options->texture_size > 1e30)
+                return tool_usage("--texture-size wants the surface one tile covers in mesh units, above 0, got "
+                                  "'%s'", value);
         } else if (tool_option(argc, argv, &i, "--max-atlas", &value)) {
             if (parse_int("--max-atlas", value, 1, TT_MAX_IMAGE_SIZE, &options->max_atlas) != 0)
                 return TOOL_EXIT_USAGE;
@@ -182,6 +198,8 @@ typedef struct polycube_job {
     triangle_mesh mesh;
     tt_polycube *polycube;
     tt_polycube_report build_report;
+    tt_polycube_resolution_report resolution_report;   /* the resolutions tried */
+    int photo_tile;                 /* texels of IMAGE one tile of --texture-size takes (--tile) */
     tt_tile_layout layout;          /* resolved */
     int *edge_colors;               /* per S half-edge */
     uint8_t *surface_type;          /* per S half-edge: its boundary type */
@@ -233,31 +251,104 @@ static int polycube_tile_budget(const polycube_command_options *options, const t
     return across > 0 ? across * across : 1;
 }
 
-/* The polycube and the tiles of its surface S. */
+/* The polycube: at the resolution the mesh needs, unless --resolution or
+   --cube-size chose it. */
 static int build_polycube(const polycube_command_options *options, polycube_job *job)
 {
     const char *path = options->mesh_path;
+    const tt_polycube_resolution_report *tried = &job->resolution_report;
     tt_error error;
     double start = tool_seconds_now();
-    int ncorners, q;
     tool_stage("building the polycube");
-    if (tt_polycube_build(job->mesh.mesh, &options->build, NULL, &job->polycube, &job->build_report, &error) != TT_OK)
+    if (tt_polycube_build_auto(job->mesh.mesh, &options->build, 0, NULL, &job->polycube, &job->build_report,
+                               &job->resolution_report, &error) != TT_OK)
         return triangle_mesh_report_error(path, &job->mesh, &error);
-    job->build_seconds = tool_seconds_now() - start;
-    if (job->build_report.genus_differs)
-        tool_note("%s: the polycube has genus %d, the mesh %d: handles are closed or opened where the cubes are "
-                  "too coarse (raise --resolution)",
-                  path, job->build_report.polycube_genus, job->build_report.mesh_genus);
     if (job->build_report.inside_out) {
         /* The mapping needs outward faces (its projection tells the sides of a thin part by the normals, and
            the polycube's squares turn counter-clockwise seen from outside): map the faces reversed, and write
-           them so. */
+           them so. The resolution is chosen again on the faces turned out. */
         int status = triangle_mesh_reverse(path, &job->mesh);
         if (status != 0) return status;
         tool_note("%s: the faces wind inward (the mesh is inside out): mapped them reversed, and the output's "
                   "faces wind outward", path);
+        tt_polycube_free(job->polycube);
+        job->polycube = NULL;
+        if (tt_polycube_build_auto(job->mesh.mesh, &options->build, 0, NULL, &job->polycube, &job->build_report,
+                                   &job->resolution_report, &error) != TT_OK)
+            return triangle_mesh_report_error(path, &job->mesh, &error);
     }
+    job->build_seconds = tool_seconds_now() - start;
+    if (job->build_report.genus_differs)
+        tool_note("%s: the polycube has genus %d, the mesh %d: handles are closed or opened where the cubes are "
+                  "too coarse (%s)", path, job->build_report.polycube_genus, job->build_report.mesh_genus,
+                  tried->tries > 1 ? "the same up to the largest resolution tried; a larger --resolution may close "
+                                     "them, with many more triangles"
+                                   : "raise --resolution");
+    else if (tried->tries > 1 && tried->mean_distance[tried->chosen] > TT_POLYCUBE_AUTO_NEAR)
+        tool_note("%s: parts of the mesh are thinner than two cubes even at resolution %d (the largest tried): "
+                  "their texture is drawn out there (a larger --resolution follows them, with many more "
+                  "triangles)", path, job->build_report.resolution);
+    return 0;
+}
 
+/* Each square's tile in texels: --tile texels cover --texture-size of the
+   surface, and a square covers the cube size h of it. Multiples of 8
+   (the tiles' mip levels), 16 at least. Without --texture-size the
+   texture keeps the size the default resolution (16) gives it, however
+   fine the polycube the mesh needed; a resolution the user chose keeps a
+   tile per square, the size --cube-size always promised. */
+static int scale_tiles(polycube_command_options *options, polycube_job *job, const tt_image *image)
+{
+    const tt_mesh *mesh = job->mesh.mesh;
+    double low[3], high[3], longest = 0.0, extent, texels;
+    int v, a, size;
+    job->photo_tile = options->tiles.layout.tile_size;
+    extent = options->texture_size;
+    if (!(extent > 0.0) && (options->build.resolution || options->build.cube_size > 0.0))
+        extent = job->polycube->h;
+    if (!(extent > 0.0)) {
+        for (a = 0; a < 3; a++) low[a] = high[a] = mesh->pos[a];
+        for (v = 1; v < mesh->nverts; v++)
+            for (a = 0; a < 3; a++) {
+                if (mesh->pos[3 * v + a] < low[a]) low[a] = mesh->pos[3 * v + a];
+                if (mesh->pos[3 * v + a] > high[a]) high[a] = mesh->pos[3 * v + a];
+            }
+        for (a = 0; a < 3; a++)
+            if (high[a] - low[a] > longest) longest = high[a] - low[a];
+        extent = longest / TT_POLYCUBE_DEFAULT_RESOLUTION;
+    }
+    texels = job->photo_tile * job->polycube->h / extent;
+    if (extent == job->polycube->h) return 0;   /* one --tile per square, as given */
+    size = (int)(texels / 8.0 + 0.5) * 8;
+    if (size < 16) {
+        tool_note("%s: a square of the polycube (%.4g units) would show %.3g texels of %s; shows 16 (the texture "
+                  "is larger on the surface than --texture-size %.4g asks)", options->mesh_path, job->polycube->h,
+                  texels, options->image_path, extent);
+        size = 16;
+    }
+    if (size > job->photo_tile) {
+        /* More texels than --tile: as many as IMAGE can feed (an edge window is S x 2S, at most 2/5 of its
+           smaller side, as tiled_fit_tile_size allows). */
+        const int side = image->width < image->height ? image->width : image->height;
+        int feed = 2 * side / 5 - (2 * side / 5) % 8;
+        if (feed < job->photo_tile) feed = job->photo_tile;
+        if (size > feed) {
+            tool_note("%s: a square of the polycube (%.4g units) would show %d texels of %s, more than it can "
+                      "feed; shows %d (the texture is smaller on the surface than --texture-size %.4g asks)",
+                      options->mesh_path, job->polycube->h, size, options->image_path, feed, extent);
+            size = feed;
+        }
+    }
+    options->tiles.layout.tile_size = size;
+    return 0;
+}
+
+/* The tiles of the polycube's surface S. */
+static int tile_polycube(const polycube_command_options *options, polycube_job *job)
+{
+    const char *path = options->mesh_path;
+    tt_error error;
+    int ncorners, q;
     ncorners = job->polycube->surface->ncorners;
     job->edge_colors = (int *)malloc((size_t)ncorners * sizeof(int));
     job->surface_type = (uint8_t *)malloc((size_t)ncorners);
@@ -486,6 +577,18 @@ static void print_summary(const polycube_command_options *options, const polycub
     if (job->mesh.ntriangles != job->mesh.obj.nfaces) printf(" (fans of %d faces)", job->mesh.obj.nfaces);
     printf("; polycube: %d cubes of %.4g units (resolution %d), %d quads, %d component%s, genus %d", b->cubes,
            b->cube_size, b->resolution, b->quads, b->components, b->components == 1 ? "" : "s", b->polycube_genus);
+    if (job->resolution_report.tries > 1) {
+        /* How the resolution was chosen: per try, the genus where it differed, else how far the mesh lay. */
+        const tt_polycube_resolution_report *r = &job->resolution_report;
+        int i;
+        printf(" (resolution chosen of");
+        for (i = 0; i < r->tries; i++) {
+            printf("%s %d: ", i ? "," : "", r->resolution[i]);
+            if (r->mean_distance[i] < 0.0) printf("genus %d", r->genus[i]);
+            else printf("%.2f cubes away", r->mean_distance[i]);
+        }
+        printf(")");
+    }
     if (b->mesh_genus < 0 && b->sealed > 0) printf(" (the mesh's: not closed; %d cubes sealed behind its holes)\n", b->sealed);
     else if (b->mesh_genus < 0) printf(" (the mesh's: not closed)\n");
     else if (b->genus_differs) printf(" (the mesh's %d: they differ)\n", b->mesh_genus);
@@ -705,9 +808,6 @@ int cmd_polycube(int argc, char **argv)
         status = tool_fail("%s", message);
     if (status == 0) status = tiled_pick_tile_size(options.image_path, image->width, image->height, &options.tiles);
     if (status == 0) status = material_load(&options.tiles.maps, options.image_path, image->width, image->height);
-    if (status == 0) status = tiled_check_atlas_size(&options.tiles);
-    if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
-        status = tool_fail("%s", error.message);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again). */
     if (status == 0 && gltf) status = tool_refuse_input_overwrite(gltf_path);
@@ -718,6 +818,11 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0 && !gltf) status = material_refuse_overwrite(&options.tiles.maps, options.prefix);
 
     if (status == 0) status = build_polycube(&options, &job);
+    if (status == 0) status = scale_tiles(&options, &job, image);
+    if (status == 0) status = tiled_check_atlas_size(&options.tiles);
+    if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
+        status = tool_fail("%s", error.message);
+    if (status == 0) status = tile_polycube(&options, &job);
     if (status == 0) {
         start = tool_seconds_now();
         status = tiled_synthesize(image, options.image_path, &options.tiles, &options.tiles.maps, &job.tiles,

@@ -1243,6 +1243,124 @@ static tt_result project_oom_call(void *ctx, const tt_allocator *al, tt_error *e
     return r;
 }
 
+/* tt_polycube_build_auto: a mesh the default resolution fits stays there;
+   a thin part or a handle the default misses raises it, and a control
+   built at the default shows what the search saw (a mesh far from S, a
+   genus that differs); an explicit resolution is tt_polycube_build. */
+static void test_polycube_auto_resolution(void)
+{
+    const double centre[3] = {0.0, 0.0, 0.0};
+    tmesh sphere, needle, ring;
+    tt_mesh *mesh = NULL;
+    tt_polycube *pc = NULL, *plain = NULL;
+    tt_polycube_report rep, plain_rep;
+    tt_polycube_resolution_report tried;
+    tt_polycube_projection_report projection;
+    tt_polycube_options o;
+    tt_surface_point *points = NULL;
+    tt_error err;
+    int i;
+    memset(&sphere, 0, sizeof sphere);
+    memset(&needle, 0, sizeof needle);
+    memset(&ring, 0, sizeof ring);
+    memset(&o, 0, sizeof o);
+
+    /* A sphere: the default resolution, one build. */
+    make_sphere(&sphere, 32, 16, 1.0, centre, 0);
+    CHECK(build(&sphere, 0, &mesh, &err) == TT_OK, "sphere builds");
+    if (mesh && tt_polycube_build_auto(mesh, NULL, 0, NULL, &pc, &rep, &tried, &err) == TT_OK) {
+        CHECK(tried.tries == 1 && rep.resolution == TT_POLYCUBE_DEFAULT_RESOLUTION && tried.chosen == 0,
+              "a sphere keeps the default resolution (%d tries, resolution %d)", tried.tries, rep.resolution);
+        CHECK(tried.mean_distance[0] >= 0.0 && tried.mean_distance[0] <= TT_POLYCUBE_AUTO_NEAR,
+              "the sphere lies near S (%g cubes)", tried.mean_distance[0]);
+    } else {
+        CHECK(0, "auto build of a sphere: %s", err.message);
+    }
+    tt_polycube_free(pc);
+    pc = NULL;
+    tt_mesh_free(mesh);
+    mesh = NULL;
+
+    /* A needle (an ellipsoid 1.4 across, 16 long): at 16 it is about one cube thick. */
+    make_sphere(&needle, 24, 64, 1.0, centre, 0);
+    for (i = 0; i < needle.nv; i++) {
+        needle.pos[3 * i] *= 0.7f;
+        needle.pos[3 * i + 1] *= 0.7f;
+        needle.pos[3 * i + 2] *= 8.0f;
+    }
+    CHECK(build(&needle, 0, &mesh, &err) == TT_OK, "needle builds");
+    if (mesh && tt_polycube_build_auto(mesh, NULL, 0, NULL, &pc, &rep, &tried, &err) == TT_OK) {
+        CHECK(rep.resolution > TT_POLYCUBE_DEFAULT_RESOLUTION && tried.tries >= 2,
+              "a needle raises the resolution (%d after %d tries)", rep.resolution, tried.tries);
+        CHECK(tried.mean_distance[tried.chosen] <= TT_POLYCUBE_AUTO_NEAR,
+              "the needle lies near the chosen S (%g cubes)", tried.mean_distance[tried.chosen]);
+        CHECK(tried.resolution[tried.chosen] == rep.resolution, "the report names the chosen resolution");
+        /* The control: at the default the needle's vertices land far from it. */
+        o.resolution = TT_POLYCUBE_DEFAULT_RESOLUTION;
+        points = (tt_surface_point *)malloc(sizeof *points * (size_t)mesh->nverts);
+        if (points && tt_polycube_build(mesh, &o, NULL, &plain, NULL, &err) == TT_OK &&
+            tt_polycube_project(plain, mesh, NULL, points, &projection, &err) == TT_OK)
+            CHECK(projection.mean_distance > TT_POLYCUBE_AUTO_NEAR,
+                  "control: at the default the needle lies %g cubes from S", projection.mean_distance);
+        else
+            CHECK(0, "control build: %s", err.message);
+        free(points);
+        points = NULL;
+        tt_polycube_free(plain);
+        plain = NULL;
+        /* max_resolution holds the search: the default only, with the report of that one try. */
+        tt_polycube_free(pc);
+        pc = NULL;
+        CHECK(tt_polycube_build_auto(mesh, NULL, TT_POLYCUBE_DEFAULT_RESOLUTION, NULL, &pc, &rep, &tried, &err) ==
+                      TT_OK &&
+                  tried.tries == 1 && rep.resolution == TT_POLYCUBE_DEFAULT_RESOLUTION,
+              "max_resolution stops the search (%d tries, resolution %d)", tried.tries, rep.resolution);
+    } else {
+        CHECK(0, "auto build of a needle: %s", err.message);
+    }
+    tt_polycube_free(pc);
+    pc = NULL;
+
+    /* An explicit resolution is that build, bit for bit. */
+    o.resolution = 12;
+    if (mesh && tt_polycube_build_auto(mesh, &o, 0, NULL, &pc, &rep, &tried, &err) == TT_OK &&
+        tt_polycube_build(mesh, &o, NULL, &plain, &plain_rep, &err) == TT_OK) {
+        CHECK(tried.tries == 1 && rep.resolution == plain_rep.resolution && pc->surface->nfaces == plain->surface->nfaces &&
+                  memcmp(pc->occupied, plain->occupied, (size_t)pc->dims[0] * pc->dims[1] * pc->dims[2]) == 0,
+              "an explicit resolution builds as tt_polycube_build");
+    } else {
+        CHECK(0, "explicit resolution: %s", err.message);
+    }
+    tt_polycube_free(pc);
+    tt_polycube_free(plain);
+    pc = plain = NULL;
+    tt_mesh_free(mesh);
+    mesh = NULL;
+
+    /* A ring whose hole (0.4 across, 4.4 outside) closes at 16: the search goes on until S has the handle. */
+    make_torus(&ring, 64, 32, 1.2, 1.0);
+    CHECK(build(&ring, 0, &mesh, &err) == TT_OK, "ring builds");
+    memset(&o, 0, sizeof o);
+    o.resolution = TT_POLYCUBE_DEFAULT_RESOLUTION;
+    if (mesh && tt_polycube_build(mesh, &o, NULL, &plain, &plain_rep, &err) == TT_OK)
+        CHECK(plain_rep.mesh_genus == 1 && plain_rep.genus_differs,
+              "control: at the default the ring's hole closes (genus %d)", plain_rep.polycube_genus);
+    if (mesh && tt_polycube_build_auto(mesh, NULL, 0, NULL, &pc, &rep, &tried, &err) == TT_OK)
+        CHECK(!rep.genus_differs && rep.polycube_genus == 1 && rep.resolution > TT_POLYCUBE_DEFAULT_RESOLUTION &&
+                  tried.genus[0] != 1 && tried.mean_distance[0] < 0.0,
+              "the search keeps the ring's handle (genus %d at %d)", rep.polycube_genus, rep.resolution);
+    if (pc) printf("     auto resolution: a ring with a small hole gets genus 1 at %d (genus %d at 16)\n", rep.resolution,
+                   plain_rep.polycube_genus);
+    if (!pc)
+        CHECK(0, "auto build of a ring: %s", err.message);
+    tt_polycube_free(pc);
+    tt_polycube_free(plain);
+    tt_mesh_free(mesh);
+    tm_free(&sphere);
+    tm_free(&needle);
+    tm_free(&ring);
+}
+
 static void test_project_determinism_and_errors(void)
 {
     const double center[3] = {0.31, 0.02, -0.17};
@@ -3646,6 +3764,7 @@ void run_polycube_tests(void)
     RUN(test_project_sphere);
     RUN(test_project_thin_plate);
     RUN(test_project_open);
+    RUN(test_polycube_auto_resolution);
     RUN(test_project_determinism_and_errors);
     RUN(test_unfold);
     RUN(test_edges_cube);

@@ -82,6 +82,7 @@ static const char *const k_functions[] = {
     "tt_polycube_build",
     "tt_polycube_edge_colors",
     "tt_polycube_project",
+    "tt_polycube_build_auto",
     "tt_polycube_trace_edges",
     "tt_polycube_map",
     "tt_polycube_mapping_uvs",
@@ -1854,6 +1855,24 @@ static void cases_polycube(const baseline *b)
     hand = *pc;
     hand.quad_cube = NULL;
     CASE(tt_polycube_project(&hand, m, AL, pts, &jrep, E));
+    {
+        tt_polycube_resolution_report rr;
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(NULL, NULL, 0, AL, &pout, &prep, &rr, E));
+        CASE(tt_polycube_build_auto(m, NULL, 0, AL, NULL, &prep, &rr, E));
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(m, NULL, 0, BA1, &pout, &prep, &rr, E));
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(m, NULL, 0, BA2, &pout, NULL, NULL, E));
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(&b->empty, NULL, 0, AL, &pout, &prep, &rr, E));
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(b->nan_tris, NULL, 0, AL, &pout, &prep, &rr, E));
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(m, NULL, -1, AL, &pout, &prep, &rr, E));
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(m, NULL, INT_MIN, AL, &pout, &prep, &rr, E));
+        OUT_CASE(pout, tt_polycube_free,
+                 tt_polycube_build_auto(m, NULL, TT_POLYCUBE_MAX_RESOLUTION + 1, AL, &pout, &prep, &rr, E));
+        memset(&pb, 0x5a, sizeof pb);
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(m, &pb, 0, AL, &pout, &prep, &rr, E));
+        pb = po;
+        pb.resolution = -1;
+        OUT_CASE(pout, tt_polycube_free, tt_polycube_build_auto(m, &pb, 0, AL, &pout, &prep, &rr, E));
+    }
     hand = *pc;
     hand.occupied = NULL;
     CASE(tt_polycube_project(&hand, m, AL, pts, &jrep, E));
