@@ -2703,7 +2703,8 @@ typedef struct tt_hpm_options {
                                degrees); 0 = TT_DEFAULT_HPM_ROTATIONS */
     double max_turn;        /* degrees, 0..180: a fit tries only the orientations within this turn of
                                the main textured neighbour's (of the field's, with face_vectors); 0 =
-                               TT_DEFAULT_HPM_MAX_TURN; 180 = every one (the paper) */
+                               TT_DEFAULT_HPM_MAX_TURN (TT_DEFAULT_HPM_FIELD_MAX_TURN with face_vectors);
+                               180 = every one (the paper) */
     double band;            /* band width in image texels; 0 = per cluster clamp(0.2 * r, 3, 24), r the
                                radius of a disc of the cluster's area */
     int match_size;         /* 0 = TT_DEFAULT_HPM_MATCH_SIZE; a power of two from 16 to 512 */
@@ -2724,8 +2725,9 @@ typedef struct tt_hpm_options {
                                     tt_tangent_field: --up, constraints): each cluster's texture is turned
                                     so that its up (+v) follows the field averaged over the cluster's faces,
                                     at starts and in the fits, whose max_turn then counts from the field's
-                                    direction instead of the main neighbour's. Only directions count; a
-                                    zero vector has no say */
+                                    direction instead of the main neighbour's (default then
+                                    TT_DEFAULT_HPM_FIELD_MAX_TURN), and a continuation turned further from
+                                    it is turned back. Only directions count; a zero vector has no say */
 } tt_hpm_options;
 
 typedef struct tt_hpm_report {
@@ -18109,16 +18111,20 @@ static void tt__hpm_bbox(const tt__hpm *S, int C, double cos_a, double sin_a, do
 /* A random place (a start, or the control's output): a random angle (0
    with TT_HPM_EXACT_CONTINUATION, *angle when given: the field's) and a
    random shift keeping the cluster one texel inside a bounded image, trying
-   the other rotations' angles when it does not fit. Returns 0 when it fits
-   at no angle. */
+   the other rotations' angles when it does not fit (with *angle, only the
+   half turn). Returns 0 when it fits at no angle. */
 static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, const double *angle, tt__hpm_place *pl)
 {
     double a0 = (S->flags & TT_HPM_EXACT_CONTINUATION) ? 0 : TT__TWO_PI * tt_rng_float(rng);
     double ux = tt_rng_float(rng), uy = tt_rng_float(rng);
-    int k;
-    if (angle) a0 = *angle;
-    for (k = 0; k < S->rotations; k++) {
-        double a = a0 + TT__TWO_PI * k / S->rotations, box[4];
+    int k, turns = S->rotations;
+    if (angle) {
+        /* the field's angle, or upside down (courses lie level either way) */
+        a0 = *angle;
+        turns = 2;
+    }
+    for (k = 0; k < turns; k++) {
+        double a = a0 + TT__TWO_PI * k / turns, box[4];
         pl->cos_a = cos(a);
         pl->sin_a = sin(a);
         tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, box);

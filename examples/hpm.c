@@ -60,10 +60,11 @@ static void print_help(void)
            "                   degrees)\n"
            "  --max-turn DEG   a fit tries only the orientations within DEG degrees of its main\n"
            "                   textured neighbour's, so the pattern keeps its direction (default\n"
-           "                   %g; 180: every orientation, as in the paper)\n"
+           "                   %g; with --up, within DEG of it, default %g; 180: every orientation,\n"
+           "                   as in the paper)\n"
            "  --band W         width in texels of the textured border a fit matches (default:\n"
            "                   per cluster, a fifth of its radius, 3 to 24)\n",
-           TT_DEFAULT_HPM_THRESHOLD, TT_DEFAULT_HPM_ROTATIONS, TT_DEFAULT_HPM_MAX_TURN);
+           TT_DEFAULT_HPM_THRESHOLD, TT_DEFAULT_HPM_ROTATIONS, TT_DEFAULT_HPM_MAX_TURN, TT_DEFAULT_HPM_FIELD_MAX_TURN);
     printf("  --up DIR         the image's up direction, projected on each face: x, y, z, -x, -y,\n"
            "                   -z or X,Y,Z. Each cluster is turned so that the image's up follows\n"
            "                   it, and --max-turn counts from it: bricks lie level. Without it\n"
