@@ -2137,6 +2137,37 @@ typedef struct tt_lapped_report {
 TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
                                   const tt_allocator *allocator, tt_lapped_report *report, tt_error *error);
 
+/* How level a texture lies on the walls of a model, from any per-corner UVs
+   (tt_hpm_map's, a tiling's, a bake's): courses of bricks should run level,
+   across the up direction. Per wall face f - one whose projected up P_f(up)
+   = up - (up.N_f) N_f (|up| = 1) is at least min_projected long, a face
+   tilted at least acos(min_projected) from facing up or down - the angle
+   between phi(P_f(up)), the projected up pushed through the face's UV map
+   into texels (u * width, v * height), and the texture's up (0, 1), taken
+   between lines: 0 to 90 degrees, a texture upside down lying level (the
+   courses of a wall do). A face whose UV map is singular or not finite
+   counts as 90. No wall face: TT_ERROR_NOT_MEASURED (the statistics NaN).
+   Errors: NULL pointers, width or height below 1, a face that is not a
+   triangle (error->face), a zero or non-finite up, options out of range
+   (TT_ERROR_INVALID_ARGUMENT); TT_ERROR_OUT_OF_MEMORY. Temporary memory: 8
+   bytes a face. Only reads its inputs. */
+typedef struct tt_uv_direction_options {
+    float up[3];            /* the world's up; 0,0,0 = (0,1,0), as tt_field_options */
+    double min_projected;   /* wall faces: |P_f(up)| at least this; 0 = 0.7, about 45 degrees from level */
+    double tolerance;       /* degrees: report->within counts faces at most this far from level; 0 = 10 */
+} tt_uv_direction_options;
+
+typedef struct tt_uv_direction_report {
+    int faces;              /* wall faces measured */
+    int singular;           /* of them, faces whose UV map is singular or not finite (counted at 90) */
+    double mean, p90;       /* degrees from level over the wall faces: the mean, the 90th percentile */
+    double within;          /* the share of wall faces within options->tolerance of level */
+} tt_uv_direction_report;
+
+TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                                        const tt_uv_direction_options *options, const tt_allocator *allocator,
+                                        tt_uv_direction_report *report, tt_error *error);
+
 /* A simple atlas for meshes without UVs (Sec. 4 "rendering with a texture
    atlas"; the paper's charts were arranged by hand, this is automatic):
    triangles in pairs, each pair in one square cell of a grid over a size x
@@ -2575,7 +2606,12 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         the pattern's direction then wanders from patch to patch. Copy 0 is
         the main neighbour's orientation (step 2), so limiting the turn
         keeps the direction coherent and makes each fit 2 to 4 times
-        cheaper; max_turn 180 restores the paper's search.
+        cheaper; max_turn 180 restores the paper's search. Carried from
+        neighbour to neighbour, the direction still wanders over a large
+        surface (bricks climbing 30 to 45 degrees across a scan): with a
+        direction field (face_vectors) copy 0 is the field's direction
+        averaged over the cluster instead, so each fit turns at most
+        max_turn from it and nothing accumulates, and starts take it too.
      2. The band (Sec. 4.1): the textured faces near the cluster
         C are drawn into C's flattened frame, each textured neighbour N
         through the rigid map that best takes N's texture coordinates of the
@@ -2633,6 +2669,8 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
 #define TT_DEFAULT_HPM_THRESHOLD 0.35   /* eps above which a fit splits the cluster */
 #define TT_DEFAULT_HPM_ROTATIONS 19     /* orientations around the circle: the paper's (Sec. 4.2) */
 #define TT_DEFAULT_HPM_MAX_TURN 40.0    /* degrees a patch may turn from its main neighbour: 5 of the 19 */
+#define TT_DEFAULT_HPM_FIELD_MAX_TURN 5.0 /* with a direction field, degrees a patch may turn from it: copy 0 alone,
+                                           refined by up to 5 degrees either way */
 #define TT_DEFAULT_HPM_MATCH_SIZE 128   /* larger side of the matching copy of the image */
 #define TT_DEFAULT_HPM_MIN_FACES 16     /* the floor in faces */
 #define TT_DEFAULT_HPM_MIN_FOOTPRINT 576.0  /* the floor in texels^2: a patch 24 texels across */
@@ -2664,8 +2702,9 @@ typedef struct tt_hpm_options {
     int rotations;          /* orientations around the circle, 1..64 (steps of 360 / rotations
                                degrees); 0 = TT_DEFAULT_HPM_ROTATIONS */
     double max_turn;        /* degrees, 0..180: a fit tries only the orientations within this turn of
-                               the main textured neighbour's; 0 = TT_DEFAULT_HPM_MAX_TURN; 180 = every
-                               one (the paper) */
+                               the main textured neighbour's (of the field's, with face_vectors); 0 =
+                               TT_DEFAULT_HPM_MAX_TURN (TT_DEFAULT_HPM_FIELD_MAX_TURN with face_vectors);
+                               180 = every one (the paper) */
     double band;            /* band width in image texels; 0 = per cluster clamp(0.2 * r, 3, 24), r the
                                radius of a disc of the cluster's area */
     int match_size;         /* 0 = TT_DEFAULT_HPM_MATCH_SIZE; a power of two from 16 to 512 */
@@ -2681,6 +2720,14 @@ typedef struct tt_hpm_options {
                                     turned copies (their allowed offsets and correlations) and the border
                                     choice's faces as parallel tasks; NULL: serial; the same UVs either
                                     way */
+    const float *face_vectors;   /* NULL: the orientation spreads from patch to patch (Sec. 2.2). Else a
+                                    direction per face, 3 floats each in the face's plane (from
+                                    tt_tangent_field: --up, constraints): each cluster's texture is turned
+                                    so that its up (+v) follows the field averaged over the cluster's faces,
+                                    at starts and in the fits, whose max_turn then counts from the field's
+                                    direction instead of the main neighbour's (default then
+                                    TT_DEFAULT_HPM_FIELD_MAX_TURN), and a continuation turned further from
+                                    it is turned back. Only directions count; a zero vector has no say */
 } tt_hpm_options;
 
 typedef struct tt_hpm_report {
@@ -2734,7 +2781,8 @@ typedef struct tt_hpm_report {
                                 scale would);
      TT_ERROR_EMPTY_MESH        no faces;
      TT_ERROR_ZERO_AREA_FACE    every face has zero area (no scale);
-     TT_ERROR_NON_FINITE        a NaN or infinite texel (error->row, column),
+     TT_ERROR_NON_FINITE        a NaN or infinite texel (error->row, column)
+                                or face vector (error->face),
                                 or coordinates or a scale so extreme that
                                 no cluster could be textured in float, or
                                 that a texture coordinate would overflow
@@ -14734,6 +14782,85 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
     return TT_OK;
 }
 
+TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                                        const tt_uv_direction_options *options, const tt_allocator *allocator,
+                                        tt_uv_direction_report *report, tt_error *error)
+{
+    double up[3] = {0.0, 1.0, 0.0}, min_projected = 0.7, tolerance = 10.0, length, sum = 0.0, *angles;
+    int f, k, n = 0, within = 0;
+
+    tt__ok(error);
+    if (report) {
+        memset(report, 0, sizeof *report);
+        report->mean = report->p90 = report->within = tt__not_a_number();
+    }
+    if (!mesh || !corner_uv || !report || width < 1 || height < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_measure_uv_direction needs a mesh, UVs, a report and an image size of at least 1 x 1");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (options) {
+        if (options->up[0] != 0.0f || options->up[1] != 0.0f || options->up[2] != 0.0f)
+            for (k = 0; k < 3; k++) up[k] = options->up[k];
+        if (options->min_projected != 0.0) min_projected = options->min_projected;
+        if (options->tolerance != 0.0) tolerance = options->tolerance;
+    }
+    length = tt__length3(up);
+    if (!(length > 0.0 && length < 1e300) || !(min_projected > 0.0 && min_projected <= 1.0) ||
+        !(tolerance > 0.0 && tolerance <= 90.0))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_measure_uv_direction: up must be finite and not zero, min_projected in (0, 1], "
+                        "tolerance in (0, 90] degrees (got %g, %g)", min_projected, tolerance);
+    for (k = 0; k < 3; k++) up[k] /= length;
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d has %d corners: the direction measure needs triangles", f,
+                            mesh->face_start[f + 1] - mesh->face_start[f]);
+    angles = TT__ALLOC(allocator, double, (size_t)mesh->nfaces + 1);
+    if (!angles)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d faces",
+                        mesh->nfaces);
+    for (f = 0; f < mesh->nfaces; f++) {
+        double a[3], b[3], normal[3], projected[3], w[3], image[2] = {0.0, 0.0}, angle, scale, along;
+        const float *uv = corner_uv + 6 * (size_t)f;
+        tt__sub3f(tt__corner_pos(mesh, 3 * f + 1), tt__corner_pos(mesh, 3 * f), a);
+        tt__sub3f(tt__corner_pos(mesh, 3 * f + 2), tt__corner_pos(mesh, 3 * f), b);
+        tt__cross3(a, b, normal);
+        length = tt__length3(normal);
+        if (!(length > 0.0 && length < 1e300)) continue;   /* no plane: not a wall */
+        along = tt__dot3(up, normal) / length;
+        for (k = 0; k < 3; k++) projected[k] = up[k] - along * normal[k] / length;
+        if (!(tt__length3(projected) >= min_projected)) continue;
+        tt__face_vector_weights(mesh, f, projected, w);
+        for (k = 0; k < 3; k++) {
+            image[0] += w[k] * uv[2 * k] * width;
+            image[1] += w[k] * uv[2 * k + 1] * height;
+        }
+        tt__alignment_error(image, &angle, &scale);
+        if (!(scale > 0.0 && scale < 1e300)) {
+            angle = 90.0;
+            report->singular++;
+        } else if (angle > 90.0) {
+            angle = 180.0 - angle;  /* between lines: upside down is level */
+        }
+        angles[n++] = angle;
+        sum += angle;
+        within += angle <= tolerance;
+    }
+    report->faces = n;
+    if (n == 0) {
+        tt__free(allocator, angles);
+        return tt__fail(error, TT_ERROR_NOT_MEASURED, -1, -1, -1, -1,
+                        "no wall face: no face's projected up is %g long or more", min_projected);
+    }
+    tt__sort_doubles(angles, n);
+    report->mean = sum / n;
+    report->p90 = angles[(int)ceil(0.9 * n) - 1];
+    report->within = (double)within / n;
+    tt__free(allocator, angles);
+    return TT_OK;
+}
+
 /* The corner opposite a triangle's longest edge: its largest angle, which
    becomes the right angle of the atlas image (the least change of shape a
    right isosceles image can give). The first such corner on ties. */
@@ -17573,7 +17700,11 @@ typedef struct tt__hpm {
     int rotations, min_faces, toroidal;
     int copies;                 /* turned copies matched per fit (those within max_turn) */
     double angle[64];           /* their angles, radians: 0 first, then by growing |angle| */
+    double refine_turn;         /* radians a fit's turn is refined by, either way: half a step, or with a
+                                   field at most max_turn */
+    double turn_limit;          /* max_turn, radians */
     unsigned flags;
+    const float *field;         /* options->face_vectors, or NULL */
     tt_flatten_options fopt;
     /* the image in the matching colour space */
     int W, Hh, nch;
@@ -18019,16 +18150,22 @@ static void tt__hpm_bbox(const tt__hpm *S, int C, double cos_a, double sin_a, do
 }
 
 /* A random place (a start, or the control's output): a random angle (0
-   with TT_HPM_EXACT_CONTINUATION) and a random shift keeping the cluster one
-   texel inside a bounded image, trying the other rotations' angles when it
-   does not fit. Returns 0 when it fits at no angle. */
-static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, tt__hpm_place *pl)
+   with TT_HPM_EXACT_CONTINUATION, *angle when given: the field's) and a
+   random shift keeping the cluster one texel inside a bounded image, trying
+   the other rotations' angles when it does not fit (with *angle, only the
+   half turn). Returns 0 when it fits at no angle. */
+static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, const double *angle, tt__hpm_place *pl)
 {
     double a0 = (S->flags & TT_HPM_EXACT_CONTINUATION) ? 0 : TT__TWO_PI * tt_rng_float(rng);
     double ux = tt_rng_float(rng), uy = tt_rng_float(rng);
-    int k;
-    for (k = 0; k < S->rotations; k++) {
-        double a = a0 + TT__TWO_PI * k / S->rotations, box[4];
+    int k, turns = S->rotations;
+    if (angle) {
+        /* the field's angle, or upside down (courses lie level either way) */
+        a0 = *angle;
+        turns = 2;
+    }
+    for (k = 0; k < turns; k++) {
+        double a = a0 + TT__TWO_PI * k / turns, box[4];
         pl->cos_a = cos(a);
         pl->sin_a = sin(a);
         tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, box);
@@ -18044,6 +18181,43 @@ static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, tt__hpm_place *p
         }
     }
     return 0;
+}
+
+/* The angle of a placement (tt__hpm_place) that turns C's texture up -
+   texel -y, +v - along the direction field averaged over C's faces: each
+   face's vector carried into C's flattened frame by the face's linear map
+   (tt__face_vector_weights), as a unit direction weighted by the face's
+   flattened area. centre gets the mean of C's corners in that frame.
+   Returns 0 without a field, or where the directions cancel. */
+static int tt__hpm_field_angle(const tt__hpm *S, int C, double *angle, double *centre)
+{
+    const tt_cluster *cl = &S->H->clusters[C];
+    double sum[2] = {0, 0};
+    int i, j, k;
+    if (!S->field) return 0;
+    centre[0] = centre[1] = 0;
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        double t[3], w[3], q[3][2], d[2] = {0, 0}, length, area;
+        for (k = 0; k < 3; k++) t[k] = S->field[3 * (size_t)f + k];
+        tt__face_vector_weights(S->mesh, f, t, w);
+        for (j = 0; j < 3; j++) {
+            tt__hpm_q(S, 3 * f + j, q[j]);
+            d[0] += w[j] * q[j][0];
+            d[1] += w[j] * q[j][1];
+            centre[0] += q[j][0] / (3.0 * cl->nfaces);
+            centre[1] += q[j][1] / (3.0 * cl->nfaces);
+        }
+        length = sqrt(d[0] * d[0] + d[1] * d[1]);
+        area = 0.5 * fabs((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]));
+        if (!(length > 0)) continue;
+        sum[0] += area * d[0] / length;
+        sum[1] += area * d[1] / length;
+    }
+    if (!(sum[0] * sum[0] + sum[1] * sum[1] > 0)) return 0;
+    /* s R(angle) sum points along -y: angle + atan2(sum) = -pi / 2 */
+    *angle = -0.5 * TT__PI - atan2(sum[1], sum[0]);
+    return 1;
 }
 
 /* Continue the map of C's best textured neighbour (most shared vertices,
@@ -18064,12 +18238,43 @@ static const tt__hpm_owner *tt__hpm_best_owner(const tt__hpm *S)
 static int tt__hpm_continue_place(const tt__hpm *S, int C, tt__hpm_place *pl)
 {
     const tt__hpm_owner *best = tt__hpm_best_owner(S);
+    double field_angle, centre[2];
     if (!best) return 0;
     /* q = R(b) x / s + d  =>  x = s R(-b) (q - d) */
     pl->cos_a = best->cos_a;
     pl->sin_a = -best->sin_a;
     pl->shift[0] = -S->s * (pl->cos_a * best->shift[0] - pl->sin_a * best->shift[1]);
     pl->shift[1] = -S->s * (pl->sin_a * best->shift[0] + pl->cos_a * best->shift[1]);
+    if (tt__hpm_field_angle(S, C, &field_angle, centre)) {
+        /* On a curved surface each continuation turns a little from the
+           field, and chains of them (most clusters of a dense scan are
+           below the floor) would carry the direction away: one turned
+           more than max_turn from the field is turned back to it about
+           the vertices it shares with the neighbour, where the seam
+           then opens least. */
+        double delta = field_angle - atan2(pl->sin_a, pl->cos_a), mid[2] = {0, 0}, pivot[2], cd, sd, x, y;
+        int p, n = 0;
+        delta -= TT__TWO_PI * floor((delta + TT__PI) / TT__TWO_PI);
+        if (fabs(delta) > S->turn_limit) {
+            for (p = 0; p < S->npairs; p++)
+                if ((int)S->pairs[5 * p] == (int)(best - S->owners)) {
+                    mid[0] += S->pairs[5 * p + 3];
+                    mid[1] += S->pairs[5 * p + 4];
+                    n++;
+                }
+            mid[0] /= n;
+            mid[1] /= n;
+            tt__hpm_apply(S, pl, mid, pivot);
+            cd = cos(delta);
+            sd = sin(delta);
+            x = pl->shift[0] - pivot[0];
+            y = pl->shift[1] - pivot[1];
+            pl->cos_a = cos(field_angle);
+            pl->sin_a = sin(field_angle);
+            pl->shift[0] = cd * x - sd * y + pivot[0];
+            pl->shift[1] = sd * x + cd * y + pivot[1];
+        }
+    }
     if (!S->toroidal) {
         /* a bounded image: only when the cluster stays a texel inside */
         double box[4];
@@ -18218,7 +18423,9 @@ static double tt__hpm_band_width(const tt__hpm *S, int C)
    step, turning the placement about the band's centre; a turn is kept only
    when it lowers the sum (an exact continuation stays exact) and keeps a
    bounded image's margin. Skipped with fewer than 4 orientations, where
-   half a step is no small correction. Returns the band sum at the result.
+   half a step is no small correction. With a direction field the search
+   spans at most max_turn (S->refine_turn), so that a placement stays
+   within max_turn of the field. Returns the band sum at the result.
    The band pixel at canvas index `at` shows, at the unrefined turn, the
    image at f (R(theta) (canvas + (mx, my)) + (ctx, cty)) + (dx, dy). */
 #define TT__HPM_TURN_STEPS 10
@@ -18260,7 +18467,7 @@ static double tt__hpm_refine_turn(const tt__hpm *S, int C, tt__hpm_place *pl, do
                                   double ct, double st, double ctx, double cty, int dx, int dy)
 {
     const double golden = 0.6180339887498949;
-    double half = TT__PI / S->rotations, pivot[2] = {0, 0}, weight = 0, lo, hi, a, b, fa, fb, best_delta = 0,
+    double half = S->refine_turn, pivot[2] = {0, 0}, weight = 0, lo, hi, a, b, fa, fb, best_delta = 0,
            best = sum0;
     int i, step, P = S->P;
     tt__hpm_place turned;
@@ -18667,17 +18874,33 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     /* The canvas is turned so that the texture of the neighbour sharing
        most vertices keeps its orientation in the turned copy 0: the
        orientation then propagates from patch to patch (Sec. 2.2) without
-       the drift that a random turn of the frame would add at every fit. */
+       the drift that a random turn of the frame would add at every fit.
+       With a direction field copy 0 is the field's direction instead, so
+       that the small turns of the fits do not add up over the surface. */
     {
         const tt__hpm_owner *best = tt__hpm_best_owner(S);
+        double field_angle, centre[2];
         cph = best ? best->cos_a : 1;
         sph = best ? -best->sin_a : 0;
-        phi = atan2(sph, cph);
         if (best) {
             cont[0] = -S->s * (cph * best->shift[0] - sph * best->shift[1]);
             cont[1] = -S->s * (sph * best->shift[0] + cph * best->shift[1]);
         }
         has_cont = best != NULL;
+        if (tt__hpm_field_angle(S, C, &field_angle, centre)) {
+            /* The neighbour's continuation, turned a little from copy 0
+               now, is taken as the copy-0 offset that agrees with it at
+               C's centre: the offsets left out stay those that would
+               repeat its texels. */
+            double cf = cos(field_angle), sf = sin(field_angle);
+            if (best) {
+                cont[0] += S->s * ((cph - cf) * centre[0] - (sph - sf) * centre[1]);
+                cont[1] += S->s * ((sph - sf) * centre[0] + (cph - cf) * centre[1]);
+            }
+            cph = cf;
+            sph = sf;
+        }
+        phi = atan2(sph, cph);
     }
     /* The canvas: c = s_w R(phi) q - o. */
     tt__hpm_bbox(S, C, cph, sph, box);
@@ -19564,7 +19787,7 @@ static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
     }
     if (S->out) {
         tt__hpm_place rp;
-        if (!tt__hpm_random_place(S, &S->place_rng, C, &rp)) rp = *pl;
+        if (!tt__hpm_random_place(S, &S->place_rng, C, NULL, &rp)) rp = *pl;
         tt__hpm_write(S, C, &rp, S->out);
     }
     S->textured += cl->nfaces;
@@ -19649,9 +19872,14 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
         S->rep.continued++;
         return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
-    if (tt__hpm_random_place(S, &S->rng, C, &pl)) {
-        S->rep.starts++;
-        return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
+    {
+        /* a start turns to the field when there is one */
+        double angle, centre[2];
+        int field = tt__hpm_field_angle(S, C, &angle, centre);
+        if (tt__hpm_random_place(S, &S->rng, C, field ? &angle : NULL, &pl)) {
+            S->rep.starts++;
+            return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
+        }
     }
     S->rep.no_room++;
     if (cl->nchildren == 0) return 1;
@@ -20243,12 +20471,19 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     if (!(total_area > 0))
         return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, -1, -1, -1, -1,
                         "every face of the mesh has zero area: nothing to texture");
+    if (o.face_vectors)
+        for (f = 0; f < mesh->nfaces; f++)
+            for (i = 0; i < 3; i++)
+                if (!tt__is_finite(o.face_vectors[3 * (size_t)f + i]))
+                    return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
+                                    "hpm: the direction of face %d (face_vectors) is not finite", f);
     diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
     S.mesh = mesh;
     S.al = allocator;
     S.flags = o.flags;
+    S.field = o.face_vectors;
     S.toroidal = (o.flags & TT_HPM_TOROIDAL) != 0;
     S.threshold = o.threshold > 0 ? o.threshold : TT_DEFAULT_HPM_THRESHOLD;
     S.rotations = o.rotations ? o.rotations : TT_DEFAULT_HPM_ROTATIONS;
@@ -20257,8 +20492,13 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
            it turns no more than max_turn from the main neighbour (copy 0),
            in the order 0, +1, -1, +2, -2, ... so that ties keep the
            smaller turn. */
-        double limit = (o.max_turn > 0 ? o.max_turn : TT_DEFAULT_HPM_MAX_TURN) * TT__PI / 180 + 1e-9;
+        double max_turn = o.max_turn > 0 ? o.max_turn
+                          : o.face_vectors ? TT_DEFAULT_HPM_FIELD_MAX_TURN : TT_DEFAULT_HPM_MAX_TURN;
+        double limit = max_turn * TT__PI / 180 + 1e-9;
         int step;
+        S.turn_limit = limit;
+        S.refine_turn = TT__PI / S.rotations;
+        if (o.face_vectors && max_turn * TT__PI / 180 < S.refine_turn) S.refine_turn = max_turn * TT__PI / 180;
         S.copies = 0;
         S.angle[S.copies++] = 0;
         for (step = 1; 2 * step <= S.rotations; step++) {

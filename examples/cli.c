@@ -490,3 +490,24 @@ int parse_up(const char *option, const char *text, double up[3])
     }
     return 0;
 }
+
+int parse_field_option(int argc, char **argv, int *index, tool_field *field)
+{
+    const char *value;
+    double up[3];
+    int k;
+    if (tool_option(argc, argv, index, "--up", &value)) {
+        if (parse_up("--up", value, up) != 0) return -1;
+        for (k = 0; k < 3; k++) field->up[k] = (float)up[k];
+    } else if (tool_option(argc, argv, index, "--constraints", &value)) {
+        if (!value) {
+            tool_usage("--constraints needs a value");
+            return -1;
+        }
+        field->constraints_path = value;
+    } else {
+        return 0;
+    }
+    field->given = 1;
+    return 1;
+}

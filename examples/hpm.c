@@ -11,11 +11,15 @@
 
      tt_mesh_build       validate the OBJ's faces, split into triangle fans
                          first: the method works on triangles
+     tt_tangent_field    with --up or --constraints, the direction the
+                         image's up follows on each face
      tt_hpm_map          the whole pipeline: cluster hierarchy, flattening,
                          band fits, traversal, per-corner UVs
      tt_measure_seams    how well the texture continues across the cluster
                          borders (and across every edge)
      tt_measure_uv_distortion  stretch, texel density, flipped triangles
+     tt_measure_uv_direction   with a direction, how level the image lies on
+                         the walls
 */
 #include <math.h>
 #include <stdio.h>
@@ -56,9 +60,21 @@ static void print_help(void)
            "                   degrees)\n"
            "  --max-turn DEG   a fit tries only the orientations within DEG degrees of its main\n"
            "                   textured neighbour's, so the pattern keeps its direction (default\n"
-           "                   %g; 180: every orientation, as in the paper)\n"
+           "                   %g; with --up, within DEG of it, default %g; 180: every orientation,\n"
+           "                   as in the paper)\n"
            "  --band W         width in texels of the textured border a fit matches (default:\n"
-           "                   per cluster, a fifth of its radius, 3 to 24)\n"
+           "                   per cluster, a fifth of its radius, 3 to 24)\n",
+           TT_DEFAULT_HPM_THRESHOLD, TT_DEFAULT_HPM_ROTATIONS, TT_DEFAULT_HPM_MAX_TURN, TT_DEFAULT_HPM_FIELD_MAX_TURN);
+    printf("  --up DIR         the image's up direction, projected on each face: x, y, z, -x, -y,\n"
+           "                   -z or X,Y,Z. Each cluster is turned so that the image's up follows\n"
+           "                   it, and --max-turn counts from it: bricks lie level. Without it\n"
+           "                   (and --constraints) the direction spreads from patch to patch and\n"
+           "                   wanders over a large mesh\n"
+           "  --constraints FILE  the direction at chosen faces instead, one per line:\n"
+           "                   FACE X Y Z [SIGMA [WEIGHT]] (FACE counts the OBJ's faces from 1, X Y Z\n"
+           "                   points up along the face, SIGMA in mesh units is how far it reaches,\n"
+           "                   WEIGHT its weight; '#' starts a comment); elsewhere the directions\n"
+           "                   blend the constraints\n"
            "  --toroidal       IMAGE tiles: placements wrap around its edges, and texture\n"
            "                   coordinates leave [0,1] (render with repeat, as 'tiledtex render'\n"
            "                   does); without it every coordinate stays inside the image\n"
@@ -80,19 +96,21 @@ static void print_help(void)
            "map without a fit, new starts, the fit error, the texel density and the time; then the\n"
            "seam score on the cluster borders and over all edges (about 0: the texture continues,\n"
            "about 1: unrelated), the faces' stretch, the texel density's error and the number of\n"
-           "mirrored triangles.\n"
+           "mirrored triangles; with --up or --constraints, how far the image's up turns from --up\n"
+           "(y by default) projected on the walls (faces at least 45 degrees from level): how\n"
+           "level courses of bricks lie.\n"
            "\n"
            "example: tiledtex generate mesh torus.obj --shape torus\n"
            "         tiledtex generate texture stones.png --size 256\n"
            "         tiledtex hpm torus.obj stones.png torus_hpm --scale 3\n"
-           "         tiledtex render torus_hpm.obj stones.png view.png\n",
-           TT_DEFAULT_HPM_THRESHOLD, TT_DEFAULT_HPM_ROTATIONS, TT_DEFAULT_HPM_MAX_TURN);
+           "         tiledtex render torus_hpm.obj stones.png view.png\n");
 }
 
 typedef struct hpm_command_options {
     const char *mesh_path, *image_path;
     char prefix[TOOL_PREFIX_SIZE];  /* OUT_PREFIX without a known extension */
     tt_hpm_options map;     /* zero fields: the library's defaults */
+    tool_field field;       /* --up, --constraints: the direction the image's up follows */
     material_maps maps;     /* --normal ...: the material's other maps, on the same UVs */
     tool_mesh_output output;        /* --format, --triangles */
     int reference_image;            /* --reference-image: the MTL names IMAGE and the maps where they are */
@@ -142,6 +160,8 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
             if (parse_float("--max-turn", value, 0.01, 180.0, &options->map.max_turn) != 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--band", &value)) {
             if (parse_float("--band", value, 1.0, 1e6, &options->map.band) != 0) return TOOL_EXIT_USAGE;
+        } else if ((taken = parse_field_option(argc, argv, &i, &options->field)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_flag(argv[i], "--toroidal")) {
             options->map.flags |= TT_HPM_TOROIDAL;
         } else if (tool_flag(argv[i], "--no-fit")) {
@@ -168,9 +188,10 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
 /* The mapping                                                              */
 /* ======================================================================== */
 
-/* corner_uv gets 2 floats per triangle corner. */
+/* corner_uv gets 2 floats per triangle corner; face_vectors is the
+   direction field, or NULL. */
 static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, const tt_image *image,
-                    float *corner_uv, tt_hpm_report *report)
+                    const float *face_vectors, float *corner_uv, tt_hpm_report *report)
 {
     tt_hpm_options map = options->map;
     tool_progress progress;
@@ -180,6 +201,7 @@ static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, 
     map.progress = tool_show_progress;
     map.progress_user_data = &progress;
     map.executor = tool_executor();
+    map.face_vectors = face_vectors;
     result = tt_hpm_map(m->mesh, image, &map, NULL, corner_uv, NULL, report, &error);
     tool_progress_end(&progress);
     if (result == TT_OK) return 0;
@@ -267,6 +289,8 @@ typedef struct hpm_quality {
     tt_uv_distortion_report distortion;
     int distortion_measured;
     char distortion_reason[224];
+    tt_uv_direction_report direction; /* with --up or --constraints */
+    int direction_measured;
 } hpm_quality;
 
 /* The seams are measured on the image itself, the texture the OBJ uses;
@@ -298,6 +322,16 @@ static int measure_quality(const hpm_command_options *options, const triangle_me
     }
     if (result != TT_OK) return tool_fail("%s: cannot measure the distortion: %s", options->mesh_path, error.message);
     quality->distortion_measured = 1;
+    if (options->field.given) {
+        tt_uv_direction_options direction;
+        memset(&direction, 0, sizeof direction);
+        memcpy(direction.up, options->field.up, sizeof direction.up);
+        result = tt_measure_uv_direction(m->mesh, corner_uv, image->width, image->height, &direction, NULL,
+                                         &quality->direction, &error);
+        if (result != TT_OK && result != TT_ERROR_NOT_MEASURED)
+            return tool_fail("%s: cannot measure the texture's direction: %s", options->mesh_path, error.message);
+        quality->direction_measured = result == TT_OK;
+    }
     return 0;
 }
 
@@ -306,6 +340,7 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
 {
     const tt_uv_distortion_report *d = &quality->distortion;
     char borders[320], all[320];
+    const tt_uv_direction_report *up = &quality->direction;
     int level, last = -1, counted = report->levels < TT_HPM_MAX_LEVELS ? report->levels : TT_HPM_MAX_LEVELS;
     for (level = 0; level < counted; level++)
         if (report->mapped_per_level[level] > 0) last = level;
@@ -332,6 +367,11 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
     tool_format_seams(&quality->borders, "border edges", borders, sizeof borders);
     tool_format_seams(&quality->all, "edges", all, sizeof all);
     printf("seam score: cluster borders %s; all edges %s\n", borders, all);
+    if (quality->direction_measured)
+        printf("level: the image's up %.1f%% of %d wall faces within 10 degrees of --up, mean %.1f, p90 %.1f "
+               "degrees\n", 100.0 * up->within, up->faces, up->mean, up->p90);
+    else if (options->field.given)
+        printf("level: not measured (no face at least 45 degrees from level)\n");
     if (!quality->distortion_measured) {
         printf("UV distortion: not measured (%s)\n", quality->distortion_reason);
         return;
@@ -393,7 +433,7 @@ int cmd_hpm(int argc, char **argv)
     tt_hpm_report report;
     hpm_quality quality;
     tool_output output = TOOL_OUTPUT_INIT;
-    float *corner_uv = NULL;
+    float *corner_uv = NULL, *field = NULL;
     char obj_path[4096], mtl_path[4096], gltf_path[4096], written[8400], message[TOOL_ERROR_SIZE], normal_path[4200];
     char texture_path[4200], copy_paths[MATERIAL_MAPS][4200], stem[4200];
     const char *map_paths[MATERIAL_MAPS], *texture = NULL;
@@ -428,7 +468,12 @@ int cmd_hpm(int argc, char **argv)
         corner_uv = (float *)malloc((size_t)mesh.ntriangles * 6 * sizeof(float));
         if (!corner_uv) status = tool_fail("out of memory for the texture coordinates of %s", options.mesh_path);
     }
-    if (status == 0) status = map_mesh(&options, &mesh, image, corner_uv, &report);
+    if (status == 0 && options.field.given) {
+        field = (float *)malloc((size_t)mesh.ntriangles * 3 * sizeof(float));
+        status = field ? tool_make_field(options.mesh_path, &mesh, &options.field, 0.0f, field)
+                       : tool_fail("out of memory for the direction field of %s", options.mesh_path);
+    }
+    if (status == 0) status = map_mesh(&options, &mesh, image, field, corner_uv, &report);
     if (status == 0) status = measure_quality(&options, &mesh, image, corner_uv, &report, &quality);
 
     if (status == 0 && gltf) status = add_gltf(&output, gltf_path, &options, &mesh, corner_uv, image);
@@ -472,6 +517,7 @@ int cmd_hpm(int argc, char **argv)
     image_free(image);
     material_free(&options.maps);
     free(corner_uv);
+    free(field);
     triangle_mesh_free(&mesh);
     return status;
 }

@@ -36,7 +36,6 @@
      tt_atlas_pack_charts,  can take a bake (--bake-uv), else an atlas of
      tt_lapped_bake         charts, and the pastes composited into it
 */
-#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -177,8 +176,7 @@ typedef struct lapped_options {
     char prefix[TOOL_PREFIX_SIZE];  /* OUT_PREFIX without a known extension */
     float scale;                    /* 0 = the library's default */
     uint64_t seed;
-    float up[3];
-    const char *constraints_path;   /* or NULL */
+    tool_field field;               /* --up, --constraints */
     int isotropic;
     const char *mask_path;          /* or NULL */
     int npatches;                   /* --patches N; 0 = the default (choose_windows) */
@@ -198,10 +196,9 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
     const char *positional[3];
     int npositional = 0, i;
     memset(options, 0, sizeof *options);
-    options->up[1] = 1.0f;
     for (i = 1; i < argc; i++) {
         const char *value;
-        double number, xyz[3];
+        double number;
         int taken;
         if (tool_is_help(argv[i])) {
             print_help();
@@ -217,14 +214,8 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             options->scale = (float)number;
         } else if (tool_option(argc, argv, &i, "--seed", &value)) {
             if (parse_u64("--seed", value, &options->seed) != 0) return TOOL_EXIT_USAGE;
-        } else if (tool_option(argc, argv, &i, "--up", &value)) {
-            if (parse_up("--up", value, xyz) != 0) return TOOL_EXIT_USAGE;
-            options->up[0] = (float)xyz[0];
-            options->up[1] = (float)xyz[1];
-            options->up[2] = (float)xyz[2];
-        } else if (tool_option(argc, argv, &i, "--constraints", &value)) {
-            if (!value) return tool_usage("--constraints needs a value");
-            options->constraints_path = value;
+        } else if ((taken = parse_field_option(argc, argv, &i, &options->field)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_option(argc, argv, &i, "--mask", &value)) {
             if (!value) return tool_usage("--mask needs a value");
             options->mask_path = value;
@@ -270,141 +261,6 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
     snprintf(options->baked_stem, sizeof options->baked_stem, "%s%s", options->prefix,
              options->pasting ? "_baked" : "");
     return -1;
-}
-
-/* ======================================================================== */
-/* The tangent field and its constraints file                               */
-/* ======================================================================== */
-
-typedef struct constraint_list {
-    tt_field_constraint *items;
-    int *line;              /* the file line of each */
-    int count;
-} constraint_list;
-
-static void constraint_list_free(constraint_list *list)
-{
-    free(list->items);
-    free(list->line);
-    memset(list, 0, sizeof *list);
-}
-
-/* One line "FACE X Y Z [SIGMA [WEIGHT]]" ('#' comments and blank lines are
-   skipped by the caller). FACE counts the OBJ's faces from 1; a polygon's
-   constraint goes on the first triangle of its fan (they share its plane).
-   Returns 0, or the exit status after printing "FILE:LINE: ...". */
-static int parse_constraint(char *text, const char *where, const triangle_mesh *m, tt_field_constraint *out)
-{
-    char *token[6];
-    double value[6];
-    long face;
-    int ntokens = 0, k;
-    char *p;
-    for (p = strtok(text, " \t\r\v\f"); p; p = strtok(NULL, " \t\r\v\f")) {
-        if (ntokens < 6) token[ntokens] = p;
-        ntokens++;
-    }
-    if (ntokens < 4 || ntokens > 6)
-        return tool_fail("%s: wants FACE X Y Z [SIGMA [WEIGHT]], got %d value%s", where, ntokens,
-                         ntokens == 1 ? "" : "s");
-    if (parse_whole_long(token[0], &face) != 0)
-        return tool_fail("%s: FACE wants a face number, got '%s'", where, token[0]);
-    if (face < 1 || face > m->obj.nfaces)
-        return tool_fail("%s: face %s is out of range: the mesh has faces 1 to %d", where, token[0], m->obj.nfaces);
-    for (k = 1; k < ntokens; k++)
-        if (parse_whole_double(token[k], &value[k]) != 0)
-            return tool_fail("%s: '%s' is not a finite number", where, token[k]);
-    if (value[1] == 0.0 && value[2] == 0.0 && value[3] == 0.0)
-        return tool_fail("%s: the vector 0 0 0 has no direction", where);
-    if ((ntokens > 4 && !(value[4] > 0.0)) || (ntokens > 5 && !(value[5] > 0.0)))
-        return tool_fail("%s: SIGMA and WEIGHT must be above 0", where);
-    memset(out, 0, sizeof *out);
-    out->face = m->first_triangle[face - 1];
-    for (k = 0; k < 3; k++) out->vector[k] = (float)value[k + 1];
-    out->sigma = ntokens > 4 ? (float)value[4] : 0.0f;
-    out->weight = ntokens > 5 ? (float)value[5] : 0.0f;
-    return 0;
-}
-
-static int read_constraints(const char *path, const triangle_mesh *m, constraint_list *list)
-{
-    unsigned char *data;
-    size_t size;
-    char message[TOOL_ERROR_SIZE], where[4096], *line, *next;
-    int capacity = 0, number = 0, status = 0;
-    memset(list, 0, sizeof *list);
-    if (tool_read_file(path, &data, &size, message, sizeof message) != 0)
-        return tool_fail("--constraints: %s", message);
-    for (line = (char *)data; line && status == 0; line = next) {
-        char *comment;
-        number++;
-        next = strchr(line, '\n');
-        if (next) *next++ = '\0';
-        if ((comment = strchr(line, '#')) != NULL) *comment = '\0';
-        if (strspn(line, " \t\r\v\f") == strlen(line)) continue;
-        if (list->count == capacity) {
-            int grown = capacity ? 2 * capacity : 16;
-            tt_field_constraint *items = (tt_field_constraint *)realloc(list->items, (size_t)grown * sizeof *items);
-            int *lines = items ? (int *)realloc(list->line, (size_t)grown * sizeof(int)) : NULL;
-            if (items) list->items = items;
-            if (lines) list->line = lines;
-            if (!items || !lines) {
-                status = tool_fail("out of memory reading %s", path);
-                break;
-            }
-            capacity = grown;
-        }
-        snprintf(where, sizeof where, "%s:%d", path, number);
-        status = parse_constraint(line, where, m, &list->items[list->count]);
-        list->line[list->count++] = number;
-    }
-    free(data);
-    if (status != 0) constraint_list_free(list);
-    return status;
-}
-
-/* face_vectors gets 3 floats per triangle. */
-static int make_field(const lapped_options *options, const triangle_mesh *m, float *face_vectors)
-{
-    constraint_list constraints;
-    tt_field_options field;
-    tt_error error;
-    int status = 0;
-    memset(&constraints, 0, sizeof constraints);
-    if (options->constraints_path && (status = read_constraints(options->constraints_path, m, &constraints)) != 0)
-        return status;
-    memset(&field, 0, sizeof field);
-    memcpy(field.up, options->up, sizeof field.up);
-    field.scale = options->scale;
-    field.constraints = constraints.items;
-    field.nconstraints = constraints.count;
-    tool_stage("computing the direction field");
-    if (tt_tangent_field(m->mesh, &field, NULL, face_vectors, &error) != TT_OK) {
-        /* An error about a constraint names it in error.item: say it at its
-           line of the file (what reading the file could not see, such as a
-           vector that the face's plane reduces to nothing). The library's
-           sentence counts constraints and triangles from 0; its face is
-           rewritten as the OBJ's face. */
-        if (error.item >= 0 && error.item < constraints.count) {
-            char message[sizeof error.message + 32], prefix[32];
-            size_t length = (size_t)snprintf(prefix, sizeof prefix, "constraint %d", error.item);
-            const char *text = message;
-            triangle_mesh_rewrite_face(m, &error, message, sizeof message);
-            /* "constraint 0 (face 7): ..." counts from 0; the line says which. */
-            if (strncmp(message, prefix, length) == 0 && !isdigit((unsigned char)message[length])) {
-                text = message + length;
-                while (*text == ' ') text++;
-                status = tool_fail("%s:%d: the constraint %s", options->constraints_path,
-                                   constraints.line[error.item], text);
-            } else {
-                status = tool_fail("%s:%d: %s", options->constraints_path, constraints.line[error.item], text);
-            }
-        } else {
-            status = triangle_mesh_report_error(options->mesh_path, m, &error);
-        }
-    }
-    constraint_list_free(&constraints);
-    return status;
 }
 
 /* ======================================================================== */
@@ -1285,7 +1141,7 @@ int cmd_lapped(int argc, char **argv)
     if ((status = triangle_mesh_read(options.mesh_path, &options.mesh, &mesh)) != 0) return status;
     field = (float *)malloc((size_t)mesh.ntriangles * 3 * sizeof(float));
     if (!field) status = tool_fail("out of memory for the field of %s", options.mesh_path);
-    if (status == 0) status = make_field(&options, &mesh, field);
+    if (status == 0) status = tool_make_field(options.mesh_path, &mesh, &options.field, options.scale, field);
     /* A photo: sRGB bytes in the file, linear light in the library. */
     if (status == 0 && image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);

@@ -227,6 +227,17 @@ int parse_axis_name(const char *text, int *axis, int *sign);
    X,Y,Z, into up[3] (an axis becomes a unit vector, a direction is kept as
    given). Prints the error and returns -1 otherwise. */
 int parse_up(const char *option, const char *text, double up[3]);
+/* The texture's direction (lapped, hpm): --up DIR (parse_up) and
+   --constraints FILE, turned into a field by tool_make_field.
+   Zero-initialised: no option given, up the library's default (+y). */
+typedef struct tool_field {
+    float up[3];                    /* --up; 0,0,0 = the library's default */
+    const char *constraints_path;   /* --constraints FILE, or NULL */
+    int given;                      /* --up or --constraints was given */
+} tool_field;
+/* If argv[*index] is --up or --constraints, consume it and return 1; 0 for
+   any other argument; -1 after printing a bad value. */
+int parse_field_option(int argc, char **argv, int *index, tool_field *field);
 /* An integer in [min, max]: "tiledtex CMD: --seed wants an integer from 0 to 9, got 'x'". */
 int parse_int(const char *option, const char *text, int min, int max, int *out);
 /* An unsigned 64-bit integer (seeds), decimal or 0x hexadecimal. */
@@ -856,6 +867,15 @@ int triangle_mesh_reverse(const char *path, triangle_mesh *m);
    TOOL_EXIT_FAILURE. */
 void triangle_mesh_rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size);
 int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const tt_error *error);
+
+/* tt_tangent_field from --up and --constraints (tool_field): face_vectors
+   gets 3 floats per triangle, `scale` (mesh units, 0 = the library's
+   default) their length. A constraints file's line is "FACE X Y Z [SIGMA
+   [WEIGHT]]", FACE counting the OBJ's faces from 1 ('#' comments). Returns
+   0, or the exit status after printing the error, a constraint's at its
+   line of the file. */
+int tool_make_field(const char *mesh_path, const triangle_mesh *m, const tool_field *field, float scale,
+                    float *face_vectors);
 
 /* ---------------------------------------------------------------------- */
 /* Quality measures for the summaries (measure.c)                          */

@@ -377,3 +377,138 @@ int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const t
     triangle_mesh_rewrite_face(m, error, message, sizeof message);
     return tool_fail("%s:%d: %s", path, m->obj.face_line[m->face[error->face]], message);
 }
+
+/* ======================================================================== */
+/* The direction field: --up and --constraints (lapped, hpm)                */
+/* ======================================================================== */
+
+typedef struct constraint_list {
+    tt_field_constraint *items;
+    int *line;              /* the file line of each */
+    int count;
+} constraint_list;
+
+static void constraint_list_free(constraint_list *list)
+{
+    free(list->items);
+    free(list->line);
+    memset(list, 0, sizeof *list);
+}
+
+/* One line "FACE X Y Z [SIGMA [WEIGHT]]" ('#' comments and blank lines are
+   skipped by the caller). FACE counts the OBJ's faces from 1; a polygon's
+   constraint goes on the first triangle of its fan (they share its plane).
+   Returns 0, or the exit status after printing "FILE:LINE: ...". */
+static int parse_constraint(char *text, const char *where, const triangle_mesh *m, tt_field_constraint *out)
+{
+    char *token[6];
+    double value[6];
+    long face;
+    int ntokens = 0, k;
+    char *p;
+    for (p = strtok(text, " \t\r\v\f"); p; p = strtok(NULL, " \t\r\v\f")) {
+        if (ntokens < 6) token[ntokens] = p;
+        ntokens++;
+    }
+    if (ntokens < 4 || ntokens > 6)
+        return tool_fail("%s: wants FACE X Y Z [SIGMA [WEIGHT]], got %d value%s", where, ntokens,
+                         ntokens == 1 ? "" : "s");
+    if (parse_whole_long(token[0], &face) != 0)
+        return tool_fail("%s: FACE wants a face number, got '%s'", where, token[0]);
+    if (face < 1 || face > m->obj.nfaces)
+        return tool_fail("%s: face %s is out of range: the mesh has faces 1 to %d", where, token[0], m->obj.nfaces);
+    for (k = 1; k < ntokens; k++)
+        if (parse_whole_double(token[k], &value[k]) != 0)
+            return tool_fail("%s: '%s' is not a finite number", where, token[k]);
+    if (value[1] == 0.0 && value[2] == 0.0 && value[3] == 0.0)
+        return tool_fail("%s: the vector 0 0 0 has no direction", where);
+    if ((ntokens > 4 && !(value[4] > 0.0)) || (ntokens > 5 && !(value[5] > 0.0)))
+        return tool_fail("%s: SIGMA and WEIGHT must be above 0", where);
+    memset(out, 0, sizeof *out);
+    out->face = m->first_triangle[face - 1];
+    for (k = 0; k < 3; k++) out->vector[k] = (float)value[k + 1];
+    out->sigma = ntokens > 4 ? (float)value[4] : 0.0f;
+    out->weight = ntokens > 5 ? (float)value[5] : 0.0f;
+    return 0;
+}
+
+static int read_constraints(const char *path, const triangle_mesh *m, constraint_list *list)
+{
+    unsigned char *data;
+    size_t size;
+    char message[TOOL_ERROR_SIZE], where[4096], *line, *next;
+    int capacity = 0, number = 0, status = 0;
+    memset(list, 0, sizeof *list);
+    if (tool_read_file(path, &data, &size, message, sizeof message) != 0)
+        return tool_fail("--constraints: %s", message);
+    for (line = (char *)data; line && status == 0; line = next) {
+        char *comment;
+        number++;
+        next = strchr(line, '\n');
+        if (next) *next++ = '\0';
+        if ((comment = strchr(line, '#')) != NULL) *comment = '\0';
+        if (strspn(line, " \t\r\v\f") == strlen(line)) continue;
+        if (list->count == capacity) {
+            int grown = capacity ? 2 * capacity : 16;
+            tt_field_constraint *items = (tt_field_constraint *)realloc(list->items, (size_t)grown * sizeof *items);
+            int *lines = items ? (int *)realloc(list->line, (size_t)grown * sizeof(int)) : NULL;
+            if (items) list->items = items;
+            if (lines) list->line = lines;
+            if (!items || !lines) {
+                status = tool_fail("out of memory reading %s", path);
+                break;
+            }
+            capacity = grown;
+        }
+        snprintf(where, sizeof where, "%s:%d", path, number);
+        status = parse_constraint(line, where, m, &list->items[list->count]);
+        list->line[list->count++] = number;
+    }
+    free(data);
+    if (status != 0) constraint_list_free(list);
+    return status;
+}
+
+int tool_make_field(const char *mesh_path, const triangle_mesh *m, const tool_field *options, float scale,
+                    float *face_vectors)
+{
+    constraint_list constraints;
+    tt_field_options field;
+    tt_error error;
+    int status = 0;
+    memset(&constraints, 0, sizeof constraints);
+    if (options->constraints_path && (status = read_constraints(options->constraints_path, m, &constraints)) != 0)
+        return status;
+    memset(&field, 0, sizeof field);
+    memcpy(field.up, options->up, sizeof field.up);
+    field.scale = scale;
+    field.constraints = constraints.items;
+    field.nconstraints = constraints.count;
+    tool_stage("computing the direction field");
+    if (tt_tangent_field(m->mesh, &field, NULL, face_vectors, &error) != TT_OK) {
+        /* An error about a constraint names it in error.item: say it at its
+           line of the file (what reading the file could not see, such as a
+           vector that the face's plane reduces to nothing). The library's
+           sentence counts constraints and triangles from 0; its face is
+           rewritten as the OBJ's face. */
+        if (error.item >= 0 && error.item < constraints.count) {
+            char message[sizeof error.message + 32], prefix[32];
+            size_t length = (size_t)snprintf(prefix, sizeof prefix, "constraint %d", error.item);
+            const char *text = message;
+            triangle_mesh_rewrite_face(m, &error, message, sizeof message);
+            /* "constraint 0 (face 7): ..." counts from 0; the line says which. */
+            if (strncmp(message, prefix, length) == 0 && !isdigit((unsigned char)message[length])) {
+                text = message + length;
+                while (*text == ' ') text++;
+                status = tool_fail("%s:%d: the constraint %s", options->constraints_path,
+                                   constraints.line[error.item], text);
+            } else {
+                status = tool_fail("%s:%d: %s", options->constraints_path, constraints.line[error.item], text);
+            }
+        } else {
+            status = triangle_mesh_report_error(mesh_path, m, &error);
+        }
+    }
+    constraint_list_free(&constraints);
+    return status;
+}

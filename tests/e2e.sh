@@ -1238,6 +1238,7 @@ hpm_case() {
 
 hpm_case torus torus.obj bounded --rotations 3 --seed 2
 HPM_TORUS=$W/d$NEWDIR_N
+HPM_TORUS_OUT=$OUT
 check "hpm torus: says it split the quads into triangles" "'1024 triangles (fans of 512 faces)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q '1024 triangles (fans of 512 faces)'; echo $?)"
 hpm_case sphere-triangles spheretri.obj bounded --rotations 3
@@ -1255,6 +1256,28 @@ check "hpm --no-fit: says the clusters were placed at random" "'placed at random
 CMD="tiledtex hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 [--no-fit]"
 check "hpm --no-fit: other coordinates than the fitted ones" "files differ" "identical" \
     "$(! cmp -s "$HPM_TORUS/out.obj" "$HPM_RANDOM/out.obj"; echo $?)"
+
+# --up: each cluster turned so that the image's up follows the direction field;
+# the summary says how level it lies on the walls (the torus's axis is z; on this
+# coarse torus and a bounded 64x64 image about 60 % of the wall faces lie within
+# 10 degrees, against about 1 in 9 for random turns)
+newdir
+expect_ok "hpm --up z" hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 --up z
+LEVEL=$(printf '%s\n' "$OUT" | sed -nE "s/^level: the image's up ([0-9.]+)% of ([0-9]+) wall faces within 10 degrees of --up, mean [0-9.]+, p90 [0-9.]+ degrees$/\1 \2/p")
+check "hpm --up z: summary 'level: the image's up P% of N wall faces ...', P >= 40, N > 0" "P >= 40, N > 0" \
+    "${LEVEL:-no level line}: $OUT" "$(read -r p n <<<"$LEVEL"; awk -v p="${p:-0}" -v n="${n:-0}" 'BEGIN { exit !(p >= 40 && n > 0) }'; echo $?)"
+check "hpm --up z: other coordinates than without" "files differ" "identical" \
+    "$(! cmp -s out.obj "$HPM_TORUS/out.obj"; echo $?)"
+check "hpm without --up: no level line" "no 'level:' in the summary of the run without --up" "$HPM_TORUS_OUT" \
+    "$(! printf '%s\n' "$HPM_TORUS_OUT" | grep -q '^level:'; echo $?)"
+expect_ok "hpm --constraints" hpm ../in/torus.obj ../in/lap.png cons --rotations 3 --constraints ../in/constraints.txt
+check "hpm --constraints: says how level, against y" "'level: ...'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -q '^level: the image'"'"'s up'; echo $?)"
+expect_error "hpm --constraints face out of range" hpm ../in/torus.obj ../in/lap.png out --rotations 3 \
+    --constraints ../in/constraints_range.txt
+err_mentions "hpm constraint out of range: FILE:LINE" 'constraints_range\.txt:2:'
+expect_error "hpm --constraints missing file" hpm ../in/torus.obj ../in/lap.png out --constraints ../in/nope.txt
+expect_error "hpm --up 0,0,0" hpm ../in/torus.obj ../in/lap.png out --up 0,0,0
 
 # the same seed twice: the same file; another seed: another result
 newdir

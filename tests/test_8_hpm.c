@@ -1562,6 +1562,197 @@ done:
     tt_mesh_free(mesh);
 }
 
+/* Bricks in running bond, courses along x: level when the image's up is
+   the surface's up. Tiles with period w (a multiple of 16). */
+static void hpm_bricks(tt_image *im)
+{
+    int x, y;
+    for (y = 0; y < im->height; y++)
+        for (x = 0; x < im->width; x++) {
+            float *p = im->pixels + 4 * ((size_t)y * im->width + x);
+            int course = y / 8, mortar = y % 8 < 2 || (x + 8 * (course % 2)) % 16 < 2;
+            float v = mortar ? 0.85f : 0.25f + 0.1f * (float)((x / 16 + 3 * course) % 4);
+            p[0] = v;
+            p[1] = 0.6f * v;
+            p[2] = 0.5f * v;
+            p[3] = 1;
+        }
+}
+
+/* tt_measure_uv_direction against maps whose answer is known: a wall (the
+   plane x-z, up z) mapped with v along z lies level, turned by 30 degrees
+   it does not, upside down it lies level again (between lines); a floor
+   has no wall face. */
+static void test_uv_direction_measure(void)
+{
+    tmesh m;
+    tt_mesh *wall = NULL, *floor_mesh = NULL;
+    tt_uv_direction_options o;
+    tt_uv_direction_report r;
+    tt_error err;
+    float *uv = NULL;
+    int f, k;
+    const int turns[3] = {0, 30, 180};
+    for (k = 0; k < 2; k++) {
+        /* 6 x 4 squares, two triangles each: a floor (z = 0), then a wall (y = 0) */
+        int i, j;
+        memset(&m, 0, sizeof m);
+        for (j = 0; j <= 4; j++)
+            for (i = 0; i <= 6; i++) tm_vert(&m, i, k ? 0 : j, k ? j : 0);
+        for (j = 0; j < 4; j++)
+            for (i = 0; i < 6; i++) {
+                int a = j * 7 + i;
+                tm_tri(&m, a, a + 1, a + 8);
+                tm_tri(&m, a, a + 8, a + 7);
+            }
+        CHECK(build(&m, 0, k ? &wall : &floor_mesh, NULL) == TT_OK, "mesh %d", k);
+        tm_free(&m);
+    }
+    if (!wall || !floor_mesh) goto done;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)wall->ncorners);
+    memset(&o, 0, sizeof o);
+    o.up[2] = 1;
+    for (k = 0; k < 3; k++) {
+        double a = turns[k] * 3.14159265358979323846 / 180;
+        for (f = 0; f < wall->ncorners; f++) {
+            const float *p = wall->pos + 3 * wall->corner_vert[f];
+            uv[2 * f] = (float)(0.1 * (cos(a) * p[0] - sin(a) * p[2]));
+            uv[2 * f + 1] = (float)(0.1 * (sin(a) * p[0] + cos(a) * p[2]));
+        }
+        CHECK(tt_measure_uv_direction(wall, uv, 64, 64, &o, NULL, &r, &err) == TT_OK, "measured: %s",
+              err.message);
+        CHECK(r.faces == wall->nfaces && near(r.mean, turns[k] == 30 ? 30 : 0, 1e-3) &&
+                  near(r.p90, r.mean, 1e-3) && r.within == (turns[k] == 30 ? 0.0 : 1.0) && r.singular == 0,
+              "turned %d degrees: %d faces, mean %g, p90 %g, within %g", turns[k], r.faces, r.mean, r.p90, r.within);
+    }
+    /* a non-square image weighs its axes: turned 45 degrees in (u, v), the
+       map is turned atan(1/2) = 26.6 degrees in texels of a 64 x 128 image */
+    for (f = 0; f < wall->ncorners; f++) {
+        const float *p = wall->pos + 3 * wall->corner_vert[f];
+        uv[2 * f] = (float)(0.1 * (p[0] + p[2]));
+        uv[2 * f + 1] = (float)(0.1 * (p[2] - p[0]));
+    }
+    CHECK(tt_measure_uv_direction(wall, uv, 64, 128, &o, NULL, &r, NULL) == TT_OK &&
+              near(r.mean, 26.565, 0.01),
+          "64 x 128 texels: %g degrees (26.57)", r.mean);
+    for (f = 0; f < wall->ncorners; f++) uv[2 * f] = uv[2 * f + 1] = 0.5f;
+    CHECK(tt_measure_uv_direction(wall, uv, 64, 64, &o, NULL, &r, NULL) == TT_OK && r.singular == wall->nfaces &&
+              r.mean == 90 && r.within == 0,
+          "a collapsed map counts as 90 degrees: %d singular, mean %g", r.singular, r.mean);
+    CHECK(tt_measure_uv_direction(floor_mesh, uv, 64, 64, &o, NULL, &r, &err) == TT_ERROR_NOT_MEASURED &&
+              r.faces == 0 && r.mean != r.mean,
+          "a floor has no wall: %s", err.message);
+    o.up[2] = 0;
+    o.tolerance = -1;
+    CHECK(tt_measure_uv_direction(wall, uv, 64, 64, &o, NULL, &r, NULL) == TT_ERROR_INVALID_ARGUMENT,
+          "a negative tolerance is refused");
+    CHECK(tt_measure_uv_direction(wall, NULL, 64, 64, NULL, NULL, &r, NULL) == TT_ERROR_INVALID_ARGUMENT &&
+              tt_measure_uv_direction(wall, uv, 0, 64, NULL, NULL, &r, NULL) == TT_ERROR_INVALID_ARGUMENT,
+          "NULL UVs and an empty image are refused");
+done:
+    free(uv);
+    tt_mesh_free(wall);
+    tt_mesh_free(floor_mesh);
+}
+
+/* An open tower around the z axis, its wall bulging in and out: radius 2
+   + 0.4 sin(3 phi) sin(z), z from 0 to 6, nu x nv squares split in two. */
+static tt_mesh *hpm_tower(int nu, int nv)
+{
+    const double pi = 3.14159265358979323846;
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= nv; j++)
+        for (i = 0; i < nu; i++) {
+            double p = 2 * pi * i / nu, z = 6.0 * j / nv, r = 2 + 0.4 * sin(3 * p) * sin(z);
+            tm_vert(&m, r * cos(p), r * sin(p), z);
+        }
+    for (j = 0; j < nv; j++)
+        for (i = 0; i < nu; i++) {
+            int a = j * nu + i, b = j * nu + (i + 1) % nu;
+            tm_tri(&m, a, b, b + nu);
+            tm_tri(&m, a, b + nu, a + nu);
+        }
+    CHECK(build(&m, 0, &mesh, NULL) == TT_OK, "tower");
+    tm_free(&m);
+    return mesh;
+}
+
+/* With a direction field the courses lie level. Bricks on a bulging
+   tower (up z): carried from neighbour to neighbour the direction of the
+   courses turns over the curved wall; turned to the field at every
+   cluster it stays level on nearly every face. Controls: the same
+   without a field, and with a field pointing every which way. */
+static void test_hpm_map_level(void)
+{
+    tt_mesh *mesh = hpm_tower(64, 32);
+    tt_image *im = NULL;
+    tt_hpm_options o;
+    tt_hpm_report rep;
+    tt_field_options fo;
+    tt_uv_direction_options mo;
+    tt_uv_direction_report with, without, random_field;
+    tt_error err;
+    float *field = NULL, *uv = NULL;
+    int *cl = NULL, f, k;
+    CHECK(tt_image_create(64, 64, NULL, &im, NULL) == TT_OK, "image");
+    if (!mesh || !im) goto done;
+    hpm_bricks(im);
+    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&fo, 0, sizeof fo);
+    fo.up[2] = 1;
+    CHECK(tt_tangent_field(mesh, &fo, NULL, field, NULL) == TT_OK, "field");
+    memset(&mo, 0, sizeof mo);
+    mo.up[2] = 1;
+    memset(&o, 0, sizeof o);
+    o.scale = 2;
+    o.seed = 5;
+    o.flags = TT_HPM_TOROIDAL;
+    o.face_vectors = field;
+    if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    CHECK(tt_measure_uv_direction(mesh, uv, 64, 64, &mo, NULL, &with, NULL) == TT_OK, "measured");
+    CHECK(rep.clusters >= 8, "%d clusters", rep.clusters);
+    free(uv);
+    free(cl);
+    /* without a field, started level (TT_HPM_EXACT_CONTINUATION starts at
+       angle 0), so that what is lost is the drift alone */
+    o.face_vectors = NULL;
+    o.flags |= TT_HPM_EXACT_CONTINUATION;
+    if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    CHECK(tt_measure_uv_direction(mesh, uv, 64, 64, &mo, NULL, &without, NULL) == TT_OK, "measured");
+    o.flags &= ~(unsigned)TT_HPM_EXACT_CONTINUATION;
+    free(uv);
+    free(cl);
+    lcg_seed(11);
+    for (f = 0; f < mesh->nfaces; f++) {
+        /* a random direction, left in the face's plane by the library's
+           own weights (only its projection counts) */
+        for (k = 0; k < 3; k++) field[3 * f + k] = (float)(2 * lcg_unit() - 1);
+    }
+    o.face_vectors = field;
+    if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) goto done;
+    CHECK(tt_measure_uv_direction(mesh, uv, 64, 64, &mo, NULL, &random_field, NULL) == TT_OK, "measured");
+    printf("     courses within 10 degrees of level on %d wall faces: %.0f%% with the field (mean %.1f), "
+           "%.0f%% without, started level (mean %.1f), %.0f%% with a random field\n",
+           with.faces, 100 * with.within, with.mean, 100 * without.within, without.mean, 100 * random_field.within);
+    CHECK(with.within >= 0.9, "with the field %g of the wall faces lie within 10 degrees of level (at least 0.9)",
+          with.within);
+    CHECK(without.within < 0.8, "without it, started level, %g do (the control: under 0.8)", without.within);
+    CHECK(random_field.within < 0.6, "with a random field %g do (the control: under 0.6)", random_field.within);
+    /* a field that is not finite is refused, naming the face */
+    field[3 * 7 + 1] = internal_not_a_number();
+    CHECK(tt_hpm_map(mesh, im, &o, NULL, uv, NULL, NULL, &err) == TT_ERROR_NON_FINITE && err.face == 7,
+          "a NaN direction: %s", err.message);
+done:
+    free(field);
+    free(uv);
+    free(cl);
+    tt_image_free(im);
+    tt_mesh_free(mesh);
+}
+
 /* The budget: a 6144-face torus at a scale where clusters of
    a few dozen faces are needed, with a threshold almost no fit meets, so
    every cluster is split down to the floor. The floor stops it there,
@@ -2157,6 +2348,8 @@ void run_hpm_tests(void)
     RUN(test_hpm_map_executor);
     RUN(test_hpm_map_seams);
     RUN(test_hpm_map_orientation);
+    RUN(test_uv_direction_measure);
+    RUN(test_hpm_map_level);
     RUN(test_hpm_map_budget);
     RUN(test_hpm_map_topology);
     RUN(test_hpm_map_high_valence);

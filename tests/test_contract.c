@@ -72,6 +72,7 @@ static const char *const k_functions[] = {
     "tt_make_texture_patch",
     "tt_lapped_paste",
     "tt_lapped_measure",
+    "tt_measure_uv_direction",
     "tt_atlas_pack_pairs",
     "tt_atlas_pack_charts",
     "tt_uv_check",
@@ -1437,6 +1438,39 @@ static void cases_lapped(const baseline *b)
     }
     patches[1] = NULL;
 
+    {
+        /* how level a map lies: hostile arguments */
+        float duv[72];
+        tt_uv_direction_options dopt;
+        tt_uv_direction_report drep;
+        memset(duv, 0, sizeof duv);
+        memset(&dopt, 0, sizeof dopt);
+        CASE(tt_measure_uv_direction(NULL, duv, 64, 64, &dopt, AL, &drep, E));
+        CASE(tt_measure_uv_direction(m, NULL, 64, 64, &dopt, AL, &drep, E));
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, AL, NULL, E));
+        CASE(tt_measure_uv_direction(m, duv, 0, 64, &dopt, AL, &drep, E));
+        CASE(tt_measure_uv_direction(m, duv, 64, INT_MIN, &dopt, AL, &drep, E));
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, BA1, &drep, E));
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, BA2, &drep, E));
+        CASE(tt_measure_uv_direction(b->quads, duv, 64, 64, &dopt, AL, &drep, E));
+        /* a collapsed or non-finite map is measured, not refused: 90 degrees */
+        duv[3] = b->nan_t;
+        CHECK(tt_measure_uv_direction(m, duv, 64, 64, NULL, AL, &drep, NULL) == TT_OK && drep.faces > 0 &&
+                  drep.singular == drep.faces && drep.mean == 90,
+              "collapsed and NaN UVs: %d of %d faces singular", drep.singular, drep.faces);
+        dopt.up[1] = b->inf_t;
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, AL, &drep, E));
+        dopt.up[1] = b->nan_t;
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, AL, &drep, E));
+        dopt.up[1] = 1;
+        dopt.min_projected = 2;
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, AL, &drep, E));
+        dopt.min_projected = b->nan_t;
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, AL, &drep, E));
+        dopt.min_projected = 0;
+        dopt.tolerance = -b->inf_t;
+        CASE(tt_measure_uv_direction(m, duv, 64, 64, &dopt, AL, &drep, E));
+    }
     CHECK(tt_lapped_paste(m, field, patches, 1, &lo, AL, &lapped, NULL) == TT_OK && lapped, "baseline pastes");
     if (lapped) {
         CASE(tt_lapped_measure(NULL, field, lapped, AL, &lrep, E));
@@ -1760,6 +1794,15 @@ static void cases_hpm(const baseline *b)
     HPM_BAD(max_turn, 181);
     HPM_BAD(max_turn, b->nan_d);
     HPM_BAD(max_turn, b->inf_d);
+    {
+        float bad_field[36];
+        int k;
+        for (k = 0; k < 36; k++) bad_field[k] = k % 3 == 0 ? 1.0f : 0.0f;
+        bad_field[13] = b->nan_t;
+        HPM_BAD(face_vectors, bad_field);
+        bad_field[13] = -b->inf_t;
+        HPM_BAD(face_vectors, bad_field);
+    }
     HPM_BAD(band, -1);
     HPM_BAD(band, b->nan_d);
     HPM_BAD(band, b->inf_d);
