@@ -14554,8 +14554,8 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
    moved within its patch by the shift that best matches what lies beneath
    it: the colour of the top entry of each of its faces, drawn into the
    paste's texture space on a grid of cells of about TT__LAPPED_REGISTER_TEXELS texels and compared
-   with the patch at every shift at once (tt_xcorr_masked, as tile synthesis
-   fits its pieces), weighted by both alphas. The shift is at most
+   with the patch at every shift at once (tt_xcorr_masked, as hpm fits its
+   bands), weighted by both alphas. The shift is at most
    TT__LAPPED_REGISTER_REACH of a patch side, and keeps the seed point at
    least TT__LAPPED_REGISTER_DEPTH of the anchor's depth inside the opaque
    part, so that it is still covered. The paste is then grown again where
@@ -14696,8 +14696,8 @@ static tt_result tt__register_paste(tt__lapper *L, int patch, double shift[2])
 }
 
 /* Move the paste's map by `shift` and grow it where the moved patch now
-   reaches past its faces; solve again if it grew, with the seed point on
-   the moved anchor. */
+   reaches past its faces; solve again if it grew by more than a few faces,
+   with the seed point on the moved anchor. */
 static tt_result tt__move_paste(tt__lapper *L, int patch, int seed_face, const double seed_weight[3],
                                 const double shift[2])
 {
@@ -14710,7 +14710,8 @@ static tt_result tt__move_paste(tt__lapper *L, int patch, int seed_face, const d
         L->vert_uv[2 * (size_t)L->patch_verts[i] + 1] += shift[1];
     }
     tt__grow_patch(L, L->npastes, patch);
-    if (L->npatch_faces == before) return TT_OK;
+    /* A few faces more keep their predicted map, as in the loop's rounds. */
+    if (L->npatch_faces - before <= before / TT__LAPPED_RESOLVE_FRACTION) return TT_OK;
     moved[0] = (float)(anchor[0] + shift[0]);
     moved[1] = (float)(anchor[1] + shift[1]);
     return tt__optimize_patch(L, seed_face, seed_weight, moved);
