@@ -1793,13 +1793,17 @@ typedef struct tt_field_options {
    right angle nothing is carried: a box's walls point up, their vectors
    say nothing of its top) is constant, along the world axis least along up
    (x for the default up). The field is smoothed over the field scale or 8
-   mean edge lengths, whichever is less. Measured: on a closed box the walls
-   follow up and the top is constant to 0.001 degrees; the mean turn across
-   edges (after parallel transport) against the earlier rule (projected up,
-   breadth-first from neighbours within 11.5 degrees of facing up): the
-   bunny 7.6 to 3.2 degrees, the horse 2.1 to 1.1, a mannequin 4.4 to 2.4,
-   the elephant 9.1 to 5.6; a CAD flange 6.2 to 6.2 (its turns are at its
-   creases).
+   mean edge lengths, whichever is less. Where up is strong the smoothing
+   gains nothing and turns the texture away from up on a scan's bumps: the
+   smoothed direction is turned toward P_f(up) from |P_f(up)| = 0.6 and is
+   P_f(up) itself from 0.7 (walls, 45 degrees or more from facing up).
+   Measured: on a closed box the walls follow up and the top is constant to
+   0.001 degrees; the mean turn across edges (after parallel transport)
+   against the earlier rule (projected up, breadth-first from neighbours
+   within 11.5 degrees of facing up): the bunny 7.6 to 3.2 degrees, the
+   horse 2.1 to 1.1, a mannequin 4.4 to 2.4, the elephant 9.1 to 5.6; a CAD
+   flange 6.2 to 6.2 (its turns are at its creases), measured before walls
+   took the projected up (docs/lapped.md has both).
 
    With constraints (Sec. 3.2 "Gaussian radial basis functions, where radius
    is defined as distance over the mesh, as computed using Dijkstra's
@@ -1955,7 +1959,12 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         triangles under the paste, so the loop's time grows with the mesh
         size, not its square); if the new map
         moved an edge of the patch back over the hull, grow and solve again;
-        faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
+        then (not isotropic) move the map within the patch by the shift, up
+        to a quarter of a patch side, whose colours best match those of the
+        pastes beneath (a masked correlation, tt_xcorr_masked), so that a
+        structured photo's courses run on through the overlap instead of
+        breaking or doubling, and grow and solve again where the moved
+        patch reaches past the faces; faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
         are dropped from the paste, except the seed face and the fringe:
         faces up to TT_LAPPED_GROW_DISTORTION off where the patch's alpha
         over them stays below one half, kept for the paste's soft border
@@ -11165,6 +11174,8 @@ static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a,
 #define TT__FIELD_DECIDES_FROM 0.1     /* |P(up)| below which up says nothing of a face's direction (6 degrees
                                           from facing up: a scan's noise turns it at random there)... */
 #define TT__FIELD_DECIDES_AT 0.5       /* ...and from which it decides it (30 degrees) */
+#define TT__FIELD_LEVEL_FROM 0.6       /* |P(up)| from which the smoothed field is turned toward the projected up... */
+#define TT__FIELD_LEVEL_AT 0.7         /* ...until it is the projected up (walls: 45 degrees or more from facing up) */
 #define TT__FIELD_SMOOTHING_EDGES 4.0  /* the smoothing length in mean edge lengths at most */
 #define TT__FIELD_TIE 0.01             /* the tie axis's pull where up says nothing, against up's where it does */
 #define TT__FIELD_TOLERANCE 1e-2       /* CG's relative residual: at 3e-2 faces where up decides stray past 1 degree */
@@ -11471,6 +11482,33 @@ static double tt__field_decided(double projected)
     return t * t * (3.0 - 2.0 * t);
 }
 
+/* Phase 3, last: the unit smoothed direction o of a face turned toward the
+   projected up, fully where |P_f(up)| >= TT__FIELD_LEVEL_AT (walls),
+   not at all below TT__FIELD_LEVEL_FROM, smoothly in between. The smoothing
+   pays off where up is weak; on walls it turned the texture away from up
+   (mean 8 to 14 degrees on a bunny, an elephant and a mannequin scan),
+   following a scan's bumps and noise less than the walls' level courses
+   should. Turning by an angle keeps the direction a unit vector in the
+   face's plane. */
+static void tt__field_level(const double *up, const double *normal, double *o)
+{
+    double p[3], side[3], angle, t, c, s;
+    int k;
+    tt__project3(up, normal, p);
+    t = (tt__normalize3(p) - TT__FIELD_LEVEL_FROM) / (TT__FIELD_LEVEL_AT - TT__FIELD_LEVEL_FROM);
+    if (!(t > 0.0)) return;
+    if (t >= 1.0) {
+        for (k = 0; k < 3; k++) o[k] = p[k];
+        return;
+    }
+    tt__cross3(o, p, side);
+    angle = atan2(tt__dot3(side, normal), tt__dot3(o, p)) * t * t * (3.0 - 2.0 * t);
+    c = cos(angle);
+    s = sin(angle);
+    tt__cross3(normal, o, side);
+    for (k = 0; k < 3; k++) o[k] = c * o[k] + s * side[k];
+}
+
 /* Face f's vector in its own frame (e1 = first edge, e2 = N x e1) as unit
    coordinates. */
 static void tt__field_coordinates(const double *frame, const double *v, double xy[2])
@@ -11624,6 +11662,7 @@ static tt_result tt__field_smooth(tt__field *F)
         for (k = 0; k < 3; k++) o[k] = x[2 * u] * e1[k] + x[2 * u + 1] * e2[k];
         if (!(tt__normalize3(o) > 0.0))
             for (k = 0; k < 3; k++) o[k] = e1[k];
+        tt__field_level(F->up, F->normal + 3 * (size_t)f, o);
         for (k = 0; k < 3; k++) o[k] *= F->scale;
         F->state[f] = 1;
     }
@@ -12766,6 +12805,16 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 #define TT__LAPPED_SOLVE_STEPS 100
 /* Early seed faces: the most difficult of this many random draws. */
 #define TT__LAPPED_PRIORITY_DRAWS 8
+/* Registration (tt__register_paste): the patch and what lies beneath are
+   compared on cells of about this many texels (a power-of-two grid of 16
+   to 64 cells a side; 64 cells take 4 times the time of 32)... */
+#define TT__LAPPED_REGISTER_TEXELS 4
+/* ...the paste moves by at most this fraction of a patch side either way... */
+#define TT__LAPPED_REGISTER_REACH 0.25
+/* ...where its seed point keeps at least this fraction of the anchor's depth... */
+#define TT__LAPPED_REGISTER_DEPTH 0.5
+/* ...and only over at least this many cells of overlap. */
+#define TT__LAPPED_REGISTER_CELLS 16.0
 
 /* The two limits on a face's map, TT_LAPPED_MAX_DISTORTION (a solved map)
    and TT_LAPPED_GROW_DISTORTION (a predicted one, and the fringe), each as
@@ -12849,6 +12898,13 @@ typedef struct tt__lapper {
     int nentries, entry_capacity;
     int *hidden_below;          /* per face: its entries of earlier pastes are hidden (tt__entry_hides_face) */
     int dropped;                /* entries dropped as hidden while pasting (tt__drop_hidden) */
+    /* registration (tt__register_paste) */
+    int *top_entry;             /* per face: its entry of the last paste over it, or -1 */
+    tt_xcorr_texture **register_texture;    /* per patch, made when first used: its colour on the grid */
+    unsigned char **register_allowed;       /* per patch: the shifts that keep the seed point deep */
+    float **register_alpha;     /* per patch: its alpha on the grid */
+    double *register_mask, *register_values, *register_work;
+    int register_grid;          /* cells a side */
 } tt__lapper;
 
 /* Sec. 3.6 counts a face point as covered where a paste is opaque. Here a
@@ -13774,6 +13830,8 @@ static void tt__drop_hidden(tt__lapper *L)
         if (L->entries[e].paste >= L->hidden_below[L->entries[e].face]) L->entries[kept++] = L->entries[e];
     L->dropped += L->nentries - kept;
     L->nentries = kept;
+    for (e = 0; e < L->mesh->nfaces; e++) L->top_entry[e] = -1;
+    for (e = 0; e < L->nentries; e++) L->top_entry[L->entries[e].face] = e;
 }
 
 /* Sec. 3.5 and 3.6: record the paste (one entry per patch face, with its
@@ -13818,6 +13876,7 @@ static long long tt__record_paste(tt__lapper *L, int patch)
         entry->face = f;
         entry->paste = paste;
         L->top_patch[f] = patch;
+        L->top_entry[f] = L->nentries - 1;
     }
     tt__paste_fade(L, first);
     /* A paste that its fade would leave covering less than
@@ -14072,6 +14131,18 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->entries);
     tt__free(L->al, L->face_of);
     tt__free(L->al, L->hidden_below);
+    for (i = 0; i < L->npatches; i++) {
+        if (L->register_texture) tt_xcorr_texture_free(L->register_texture[i]);
+        if (L->register_allowed) tt__free(L->al, L->register_allowed[i]);
+        if (L->register_alpha) tt__free(L->al, L->register_alpha[i]);
+    }
+    tt__free(L->al, L->register_texture);
+    tt__free(L->al, L->register_allowed);
+    tt__free(L->al, L->register_alpha);
+    tt__free(L->al, L->register_mask);
+    tt__free(L->al, L->register_values);
+    tt__free(L->al, L->register_work);
+    tt__free(L->al, L->top_entry);
     tt__free(L->al, L->local_face);
     tt__free(L->al, L->local_field);
     tt__free(L->al, (void *)L->local.pos);
@@ -14157,6 +14228,15 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     L->face_entry = TT__ALLOC(L->al, int, nf);
     L->seeded = TT__ALLOC(L->al, unsigned char, nf);
     L->hidden_below = TT__ALLOC(L->al, int, nf);
+    L->top_entry = TT__ALLOC(L->al, int, nf);
+    L->register_texture = TT__ALLOC(L->al, tt_xcorr_texture *, L->npatches);
+    L->register_allowed = TT__ALLOC(L->al, unsigned char *, L->npatches);
+    L->register_alpha = TT__ALLOC(L->al, float *, L->npatches);
+    for (i = 0; i < L->npatches; i++) {   /* made when first used; tt__lapper_free frees what is there */
+        if (L->register_texture) L->register_texture[i] = NULL;
+        if (L->register_allowed) L->register_allowed[i] = NULL;
+        if (L->register_alpha) L->register_alpha[i] = NULL;
+    }
     L->row_start = TT__ALLOC(L->al, int, (size_t)nv + 1);
     L->row_fill = TT__ALLOC(L->al, int, nv);
     L->column_mark = TT__ALLOC(L->al, int, nv);
@@ -14167,8 +14247,16 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         !L->uncovered || !L->uncovered_pos || !L->face_stamp || !L->vert_stamp || !L->edge_stamp || !L->vert_local ||
         !L->vert_uv || !L->vert_unfolded || !L->patch_faces || !L->patch_corners || !L->patch_verts || !L->heap ||
         !L->row_start || !L->row_fill || !L->column_mark || !L->solve || !L->depth || !L->vert_cut_distance || !L->face_entry || !L->seeded ||
-        !L->hidden_below)
+        !L->hidden_below || !L->top_entry || !L->register_texture || !L->register_allowed || !L->register_alpha)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    for (f = 0; f < nf; f++) L->top_entry[f] = -1;
+    for (L->register_grid = 16; L->register_grid < 64; L->register_grid *= 2) {
+        for (i = 0; i < L->npatches; i++)
+            if (L->patches[i]->width >= 2 * TT__LAPPED_REGISTER_TEXELS * L->register_grid ||
+                L->patches[i]->height >= 2 * TT__LAPPED_REGISTER_TEXELS * L->register_grid)
+                break;
+        if (i == L->npatches) break;
+    }
     for (i = 0; i < L->npatches; i++) {
         const tt_image *p = L->patches[i];
         size_t j, n = (size_t)p->width * p->height, opaque = 0;
@@ -14548,6 +14636,176 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
     return tt__lapped_count_cuts(L, out) ? TT_OK : TT_ERROR_OUT_OF_MEMORY;
 }
 
+/* Registration. A paste lands where its seed point falls, so with a
+   structured photo (bricks, tiles, planks) its courses sit at a random
+   height against those of the pastes beneath, and along its soft edge the
+   two show broken or doubled courses. Before it is recorded, the paste is
+   moved within its patch by the shift that best matches what lies beneath
+   it: the colour of the top entry of each of its faces, drawn into the
+   paste's texture space on a grid of cells of about TT__LAPPED_REGISTER_TEXELS texels and compared
+   with the patch at every shift at once (tt_xcorr_masked, as hpm fits its
+   bands), weighted by both alphas. The shift is at most
+   TT__LAPPED_REGISTER_REACH of a patch side, and keeps the seed point at
+   least TT__LAPPED_REGISTER_DEPTH of the anchor's depth inside the opaque
+   part, so that it is still covered. The paste is then grown again where
+   the moved patch reaches past its faces. A stochastic photo matches
+   about as well at every shift, and is moved at random, as its seed point
+   already was. */
+typedef struct tt__register_raster {
+    const tt__entry *below;     /* the entry on top of the face so far */
+    const tt_image *below_patch;
+    const float *alpha;         /* the paste's patch's alpha on the grid */
+    double *mask, *values;      /* the correlation's planes, size x size */
+    int grid, size;
+} tt__register_raster;
+
+static void tt__register_cell(int x, int y, const float b[3], void *user_data)
+{
+    const tt__register_raster *R = (const tt__register_raster *)user_data;
+    const float *uv = R->below->uv, *fade = R->below->fade;
+    const float u = b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4], v = b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5];
+    const float alpha = R->alpha[y * R->grid + x];
+    const size_t at = (size_t)y * R->size + x, plane = (size_t)R->size * R->size;
+    float rgba[4], below;
+    int c;
+    if (alpha < 0.5f) return;
+    tt_image_sample_bilinear(R->below_patch, u * R->below_patch->width, (1.0f - v) * R->below_patch->height, rgba);
+    below = rgba[3] * (b[0] * fade[0] + b[1] * fade[1] + b[2] * fade[2]);
+    if (!(below >= 0.5f)) return;
+    R->mask[at] = below * alpha;
+    for (c = 0; c < 3; c++) R->values[c * plane + at] = rgba[c] / rgba[3];
+}
+
+/* The patch's colour (straight, its cells' mean) and alpha on the grid,
+   cached for the correlation, and the shifts it allows. */
+static tt_result tt__register_prepare(tt__lapper *L, int patch)
+{
+    const tt_image *image = L->patches[patch];
+    const int grid = L->register_grid, size = 2 * grid, w = image->width, h = image->height;
+    const int reach = (int)(TT__LAPPED_REGISTER_REACH * grid);
+    const size_t plane = (size_t)size * size;
+    const float *depth = L->depth[patch], *anchor = L->anchor + 2 * (size_t)patch;
+    float *alpha, deepest;
+    unsigned char *allowed;
+    double *planes;
+    int cx, cy, dx, dy, x, y, c;
+    if (!L->register_mask) {
+        L->register_mask = TT__ALLOC(L->al, double, plane);
+        L->register_values = TT__ALLOC(L->al, double, 3 * plane);
+        if (!L->register_mask || !L->register_values) return TT_ERROR_OUT_OF_MEMORY;
+    }
+    planes = L->register_values;
+    alpha = TT__ALLOC(L->al, float, (size_t)grid * grid);
+    allowed = TT__ALLOC(L->al, unsigned char, plane);
+    if (!alpha || !allowed) {
+        tt__free(L->al, alpha);
+        tt__free(L->al, allowed);
+        return TT_ERROR_OUT_OF_MEMORY;
+    }
+    L->register_alpha[patch] = alpha;
+    L->register_allowed[patch] = allowed;
+    memset(planes, 0, 3 * plane * sizeof *planes);
+    for (cy = 0; cy < grid; cy++)
+        for (cx = 0; cx < grid; cx++) {
+            const int x0 = (int)((long long)cx * w / grid), y0 = (int)((long long)cy * h / grid);
+            const int x1 = (int)((long long)(cx + 1) * w / grid) > x0 ? (int)((long long)(cx + 1) * w / grid) : x0 + 1;
+            const int y1 = (int)((long long)(cy + 1) * h / grid) > y0 ? (int)((long long)(cy + 1) * h / grid) : y0 + 1;
+            double sum[4] = {0.0, 0.0, 0.0, 0.0};
+            for (y = y0; y < y1 && y < h; y++)
+                for (x = x0; x < x1 && x < w; x++)
+                    for (c = 0; c < 4; c++) sum[c] += image->pixels[4 * ((size_t)y * w + x) + c];
+            alpha[cy * grid + cx] = (float)(sum[3] / ((double)(y1 - y0) * (x1 - x0)));
+            if (sum[3] > 1e-6)
+                for (c = 0; c < 3; c++) planes[c * plane + (size_t)cy * size + cx] = sum[c] / sum[3];
+        }
+    /* The planes are finite (the patches were checked): only memory can fail. */
+    if (tt_xcorr_texture_create(size, size, 3, planes, L->al, &L->register_texture[patch], NULL) != TT_OK)
+        return TT_ERROR_OUT_OF_MEMORY;
+    memset(allowed, 0, plane);
+    x = (int)(anchor[0] * w);
+    y = (int)((1.0f - anchor[1]) * h);
+    deepest = depth[(size_t)(y < h ? y : h - 1) * w + (x < w ? x : w - 1)];
+    for (dy = -reach; dy <= reach; dy++)
+        for (dx = -reach; dx <= reach; dx++) {
+            const double u = anchor[0] + (double)dx / grid, v = anchor[1] - (double)dy / grid;
+            x = (int)floor(u * w);
+            y = (int)floor((1.0 - v) * h);
+            if (x < 0 || y < 0 || x >= w || y >= h || depth[(size_t)y * w + x] < TT__LAPPED_REGISTER_DEPTH * deepest)
+                continue;
+            allowed[(size_t)((dy + size) % size) * size + (dx + size) % size] = 1;
+        }
+    return TT_OK;
+}
+
+/* The shift (texture space) that best matches the paste of `patch`, under
+   its current map, with what lies beneath it; (0, 0) where too little
+   lies beneath. */
+static tt_result tt__register_paste(tt__lapper *L, int patch, double shift[2])
+{
+    const int grid = L->register_grid, size = 2 * grid;
+    const size_t plane = (size_t)size * size;
+    tt__register_raster R;
+    tt_xcorr_match match;
+    int i, k;
+    shift[0] = shift[1] = 0.0;
+    if (!L->register_texture[patch]) {
+        tt_result r = tt__register_prepare(L, patch);
+        if (r != TT_OK) return r;
+    }
+    if (!L->register_work) {
+        L->register_work = TT__ALLOC(L->al, double, L->register_texture[patch]->work_size);
+        if (!L->register_work) return TT_ERROR_OUT_OF_MEMORY;
+    }
+    memset(L->register_mask, 0, plane * sizeof *L->register_mask);
+    R.alpha = L->register_alpha[patch];
+    R.mask = L->register_mask;
+    R.values = L->register_values;
+    R.grid = grid;
+    R.size = size;
+    for (i = 0; i < L->npatch_faces; i++) {
+        const int f = L->patch_faces[i], e = L->top_entry[f];
+        float xy[6];
+        if (e < 0) continue;
+        R.below = &L->entries[e];
+        R.below_patch = L->patches[L->paste_patch[R.below->paste]];
+        for (k = 0; k < 3; k++) {
+            const double *p = L->vert_uv + 2 * (size_t)L->mesh->corner_vert[3 * f + k];
+            xy[2 * k] = (float)(p[0] * grid);
+            xy[2 * k + 1] = (float)((1.0 - p[1]) * grid);
+        }
+        tt_raster_triangle(xy, grid, grid, tt__register_cell, &R);
+    }
+    if (tt_xcorr_masked(L->register_texture[patch], L->register_mask, L->register_values,
+                        L->register_allowed[patch], L->register_work, NULL, &match, NULL) != TT_OK ||
+        match.mask_sum < TT__LAPPED_REGISTER_CELLS || match.x < 0)
+        return TT_OK;
+    shift[0] = (double)(match.x < grid ? match.x : match.x - size) / grid;
+    shift[1] = -(double)(match.y < grid ? match.y : match.y - size) / grid;
+    return TT_OK;
+}
+
+/* Move the paste's map by `shift` and grow it where the moved patch now
+   reaches past its faces; solve again if it grew by more than a few faces,
+   with the seed point on the moved anchor. */
+static tt_result tt__move_paste(tt__lapper *L, int patch, int seed_face, const double seed_weight[3],
+                                const double shift[2])
+{
+    const float *anchor = L->anchor + 2 * (size_t)patch;
+    float moved[2];
+    int i, before = L->npatch_faces;
+    if (shift[0] == 0.0 && shift[1] == 0.0) return TT_OK;
+    for (i = 0; i < L->npatch_verts; i++) {
+        L->vert_uv[2 * (size_t)L->patch_verts[i]] += shift[0];
+        L->vert_uv[2 * (size_t)L->patch_verts[i] + 1] += shift[1];
+    }
+    tt__grow_patch(L, L->npastes, patch);
+    /* A few faces more keep their predicted map, as in the loop's rounds. */
+    if (L->npatch_faces - before <= before / TT__LAPPED_RESOLVE_FRACTION) return TT_OK;
+    moved[0] = (float)(anchor[0] + shift[0]);
+    moved[1] = (float)(anchor[1] + shift[1]);
+    return tt__optimize_patch(L, seed_face, seed_weight, moved);
+}
+
 TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, tt_image *const *patches,
                                 int npatches, const tt_lapped_options *options, const tt_allocator *allocator,
                                 tt_lapped **out_lapped, tt_error *error)
@@ -14611,6 +14869,15 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
             break;
         }
         patch = tt__least_overlapping_twin(&L, patch);
+        if (!L.isotropic) {
+            double shift[2];
+            r = tt__register_paste(&L, patch, shift);
+            if (r == TT_OK) r = tt__move_paste(&L, patch, seed_face, seed_weight, shift);
+            if (r != TT_OK) {
+                r = tt__fail(error, r, -1, -1, -1, -1, "out of memory");
+                break;
+            }
+        }
         added = tt__record_paste(&L, patch);
         if (added < 0) {
             r = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
