@@ -2166,12 +2166,12 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
    chart, less after each chart is scaled to keep its total area. Each
    chart is turned to its smallest bounding box (16 angles tried) and laid
    with its long side across. Packing works on the charts' outlines, not
-   their boxes: each row of a chart is the span of texels its triangles
-   touch, widened by `gutter` texels every way (2 * gutter between charts);
-   by decreasing box height, each chart goes, in whichever of four quarter
-   turns sits lowest, to the lowest then leftmost place of a bitmap of the
-   atlas where none of its texels is taken, so small charts fill the room
-   between large ones. The largest scale that fits size x size is found by
+   their boxes: a chart is the texels its triangles touch, widened by
+   `gutter` texels every way (2 * gutter between charts); by decreasing box
+   area, each chart goes, in whichever of four quarter turns sits lowest,
+   to the lowest then leftmost place of a bitmap of the atlas where none of
+   its texels is taken, so small charts fill the room between and inside
+   large ones. The largest scale that fits size x size is found by
    bisection. Faces of zero area (permissive meshes) join a neighbouring
    chart. */
 
@@ -2193,7 +2193,7 @@ typedef struct tt_chart_atlas_report {
    not fit even when shrunk to nothing - each needs 2 * gutter + 1 texels a
    side (TT_ERROR_IMAGE_TOO_SMALL; the message gives the smallest size that
    holds them); TT_ERROR_OUT_OF_MEMORY. corner_uv is written only on
-   success. Temporary memory only: about 200 bytes per face and a bit per
+   success. Temporary memory only: about 200 bytes per face and two bits per
    atlas texel. Time O(faces) for the charts (with the faces of a chart in
    a bounded number of grid cells each); the packing, about ten times over
    for the bisection, scans the bitmap for each chart, skipping rows
@@ -15036,15 +15036,16 @@ typedef struct tt__chart {
     double width, height;
 } tt__chart;
 
-/* Packing order: taller first, then wider, then by index (deterministic). */
+/* Packing order: larger boxes first (small charts then fill the gaps
+   between large ones), then wider, then by index (deterministic). */
 typedef struct tt__chart_order {
-    double height, width;
+    double area, width;
     int chart;
 } tt__chart_order;
 
 #define TT__CHART_BEFORE(a, b)                                                                                 \
-    ((a).height > (b).height ||                                                                               \
-     ((a).height == (b).height && ((a).width > (b).width || ((a).width == (b).width && (a).chart < (b).chart))))
+    ((a).area > (b).area ||                                                                                   \
+     ((a).area == (b).area && ((a).width > (b).width || ((a).width == (b).width && (a).chart < (b).chart))))
 TT__DEFINE_HEAPSORT_BY(tt__sort_chart_order, tt__chart_order, TT__CHART_BEFORE)
 
 /* Face `face`'s corners projected on the plane (origin, u, v): 6 doubles. */
@@ -15154,83 +15155,105 @@ static void tt__chart_texel(const double *xy, int face, int k, double s, int gut
     }
 }
 
-/* A chart's profile at scale s in turn `turn`: for each of its `width`
-   columns the lowest (lo) and highest (hi) row of the cells its triangles
-   touch, widened by `gutter` cells every way (lo > hi: an empty column).
-   Every texel whose centre lies within `gutter` of a triangle is inside the
-   profile, so charts whose profiles do not meet share no texel of their
-   triangles or gutters. Returns the width, or 0 when wider than `limit`. */
-static int tt__chart_profile(const tt__chart *chart, const int *members, const double *xy, double s, int gutter,
-                             int turn, int by_rows, int limit, int *lo, int *hi, int *scratch_lo, int *scratch_hi)
+/* Scratch of the bitmap packing: one bit per atlas texel, taken or free
+   (rows of `words` 64-bit words), the longest free run of each row, and
+   the mask of the chart being placed (same layout). */
+typedef struct tt__packing {
+    uint64_t *bits, *mask;
+    int words;
+    int *run;
+} tt__packing;
+
+/* Sets bits [a, b] of a row of words. */
+static void tt__bits_set(uint64_t *line, int a, int b)
+{
+    int w;
+    for (w = a >> 6; w <= b >> 6; w++) {
+        uint64_t word = ~(uint64_t)0;
+        if (w == a >> 6) word &= ~(uint64_t)0 << (a & 63);
+        if (w == b >> 6 && (b & 63) != 63) word &= ((uint64_t)1 << ((b & 63) + 1)) - 1;
+        line[w] |= word;
+    }
+}
+
+/* The mask of a chart at scale s in turn `turn` (p->mask, `*width` x
+   `*height` cells, row 0 at the bottom): the cells its triangles touch,
+   widened by `gutter` cells every way. Every texel whose centre lies
+   within `gutter` of a triangle is in the mask, so charts whose masks do
+   not meet share no texel of their triangles or gutters. 0 when the chart
+   does not fit `limit`. */
+static int tt__chart_mask(const tt__chart *chart, const int *members, const double *xy, double s, int gutter,
+                          int turn, int limit, tt__packing *p, int *width, int *height)
 {
     int cols = tt__chart_cells(chart->width, s, gutter), rows = tt__chart_cells(chart->height, s, gutter);
-    int width = (turn & 1) != by_rows ? rows : cols, height = (turn & 1) != by_rows ? cols : rows, i, c, k, d;
+    int w = turn & 1 ? rows : cols, h = turn & 1 ? cols : rows, i, k, r, d;
     if (cols > limit || rows > limit) return 0;
-    for (c = 0; c < width; c++) {
-        scratch_lo[c] = INT_MAX;
-        scratch_hi[c] = INT_MIN;
-    }
+    memset(p->mask, 0, sizeof *p->mask * (size_t)h * p->words);
     for (i = 0; i < chart->count; i++) {
-        double t[3][2], x0 = 1e300, x1 = -1e300;
+        double t[3][2], y0 = 1e300, y1 = -1e300;
         int face = members[chart->first + i];
         for (k = 0; k < 3; k++) {
             tt__chart_texel(xy, face, k, s, gutter, turn, cols, rows, t[k]);
-            if (by_rows) {
-                double swap = t[k][0];
-                t[k][0] = t[k][1];
-                t[k][1] = swap;
-            }
-            if (t[k][0] < x0) x0 = t[k][0];
-            if (t[k][0] > x1) x1 = t[k][0];
+            if (t[k][1] < y0) y0 = t[k][1];
+            if (t[k][1] > y1) y1 = t[k][1];
         }
-        /* Column c's slab [c, c + 1] cuts the triangle in a convex piece
-           whose lowest and highest points lie on the triangle's edges. */
-        for (c = x0 > 0.0 ? (int)floor(x0) : 0; c <= (int)floor(x1) && c < width; c++) {
-            double y0 = 1e300, y1 = -1e300;
+        /* Row r's slab [r, r + 1] cuts the triangle in a convex piece
+           whose leftmost and rightmost points lie on the triangle's edges. */
+        for (r = y0 > 0.0 ? (int)floor(y0) : 0; r <= (int)floor(y1) && r < h; r++) {
+            double x0 = 1e300, x1 = -1e300;
             for (k = 0; k < 3; k++) {
-                const double *p = t[k], *q = t[(k + 1) % 3];
-                double a = p[0] < q[0] ? p[0] : q[0], b = p[0] < q[0] ? q[0] : p[0], ends[2];
+                const double *a = t[k], *b = t[(k + 1) % 3];
+                double lo = a[1] < b[1] ? a[1] : b[1], hi = a[1] < b[1] ? b[1] : a[1], ends[2];
                 int e;
-                if (b < c || a > c + 1) continue;
-                ends[0] = a > c ? a : c;
-                ends[1] = b < c + 1 ? b : c + 1;
+                if (hi < r || lo > r + 1) continue;
+                ends[0] = lo > r ? lo : r;
+                ends[1] = hi < r + 1 ? hi : r + 1;
                 for (e = 0; e < 2; e++) {
-                    double y = q[0] != p[0] ? p[1] + (q[1] - p[1]) * (ends[e] - p[0]) / (q[0] - p[0])
-                                            : (e ? (p[1] > q[1] ? p[1] : q[1]) : (p[1] < q[1] ? p[1] : q[1]));
-                    if (y < y0) y0 = y;
-                    if (y > y1) y1 = y;
+                    double x = b[1] != a[1] ? a[0] + (b[0] - a[0]) * (ends[e] - a[1]) / (b[1] - a[1])
+                                            : (e ? (a[0] > b[0] ? a[0] : b[0]) : (a[0] < b[0] ? a[0] : b[0]));
+                    if (x < x0) x0 = x;
+                    if (x > x1) x1 = x;
                 }
             }
-            if (y0 > y1) continue;
+            if (x0 > x1) continue;
             /* Rounding may put a corner a hair outside the cells. */
-            y0 = y0 > 0.0 ? floor(y0) : 0.0;
-            y1 = y1 < height - 1 ? floor(y1) : height - 1;
-            if ((int)y0 < scratch_lo[c]) scratch_lo[c] = (int)y0;
-            if ((int)y1 > scratch_hi[c]) scratch_hi[c] = (int)y1;
+            x0 = x0 > 0.0 ? floor(x0) : 0.0;
+            x1 = x1 < w - 1 ? floor(x1) : w - 1;
+            if (x0 <= x1) tt__bits_set(p->mask + (size_t)r * p->words, (int)x0, (int)x1);
         }
     }
-    for (c = 0; c < width; c++) {
-        lo[c] = INT_MAX;
-        hi[c] = INT_MIN;
-        for (d = c - gutter < 0 ? 0 : c - gutter; d <= c + gutter && d < width; d++)
-            if (scratch_lo[d] <= scratch_hi[d]) {
-                if (scratch_lo[d] - gutter < lo[c]) lo[c] = scratch_lo[d] - gutter;
-                if (scratch_hi[d] + gutter > hi[c]) hi[c] = scratch_hi[d] + gutter;
+    if (gutter > 0) {
+        /* Widened along rows, then across them (each row takes the rows
+           within `gutter` below it, then above it). */
+        int nw = (w + 63) / 64, j;
+        for (r = 0; r < h; r++) {
+            uint64_t *line = p->mask + (size_t)r * p->words;
+            for (d = 0; d < gutter; d++) {
+                uint64_t carry_up = 0, carry_down = 0;
+                for (j = 0; j < nw; j++) {   /* one cell left: bit c from c + 1 */
+                    uint64_t next = j + 1 < nw ? line[j + 1] : 0;
+                    carry_down = line[j] | line[j] >> 1 | next << 63;
+                    line[j] = carry_down;
+                }
+                for (j = nw - 1; j >= 0; j--) {   /* one cell right: bit c from c - 1 */
+                    uint64_t prev = j > 0 ? line[j - 1] : 0;
+                    carry_up = line[j] | line[j] << 1 | prev >> 63;
+                    line[j] = carry_up;
+                }
             }
-        if (lo[c] < 0) lo[c] = 0;
-        if (hi[c] > height - 1) hi[c] = height - 1;
+            if (w & 63) line[nw - 1] &= ((uint64_t)1 << (w & 63)) - 1;
+        }
+        for (d = 0; d < gutter; d++) {
+            for (r = h - 1; r > 0; r--)
+                for (j = 0; j < nw; j++) p->mask[(size_t)r * p->words + j] |= p->mask[(size_t)(r - 1) * p->words + j];
+            for (r = 0; r + 1 < h; r++)
+                for (j = 0; j < nw; j++) p->mask[(size_t)r * p->words + j] |= p->mask[(size_t)(r + 1) * p->words + j];
+        }
     }
-    return width;
+    *width = w;
+    *height = h;
+    return 1;
 }
-
-/* Scratch of the bitmap packing: one bit per atlas texel, taken or free
-   (rows of `words` 64-bit words), and a chart's rows. */
-typedef struct tt__packing {
-    uint64_t *bits;
-    int words;
-    int *run;                                 /* the longest run of free texels of each row */
-    int *lo, *hi, *scratch_lo, *scratch_hi;   /* size + 1 each */
-} tt__packing;
 
 /* The longest run of free texels of row `row`. */
 static int tt__packing_longest_run(const tt__packing *p, int row, int size)
@@ -15277,52 +15300,69 @@ static int tt__packing_next_run(const tt__packing *p, int row, int from, int len
     return size;
 }
 
-/* The highest taken column of row `row` in [a, b], or -1. */
-static int tt__packing_last_taken(const tt__packing *p, int row, int a, int b)
+/* 64 bits of a row from column `at` on (0 past its end). */
+static uint64_t tt__bits_at(const uint64_t *line, int words, int at)
 {
-    const uint64_t *line = p->bits + (size_t)row * p->words;
-    int w;
-    for (w = b >> 6; w >= a >> 6; w--) {
-        uint64_t word = line[w];
-        int bit;
-        if (w == b >> 6 && (b & 63) != 63) word &= ((uint64_t)1 << ((b & 63) + 1)) - 1;
-        if (w == a >> 6) word &= ~(((uint64_t)1 << (a & 63)) - 1);
-        if (!word) continue;
-        for (bit = 63; !(word >> bit & 1); bit--) {}
-        return 64 * w + bit;
+    int w = at >> 6, shift = at & 63;
+    uint64_t low = w < words ? line[w] : 0;
+    if (shift == 0) return low;
+    return low >> shift | (w + 1 < words ? line[w + 1] << (64 - shift) : 0);
+}
+
+/* Mask row `r` shifted to column x on atlas row `row`: -1 when none of its
+   texels is taken, else the shift to try next. The clash found is the
+   highest, in a run of the mask row from column a to b; a shift that
+   keeps the run over a taken texel clashes again, so the run must move
+   onto the next free stretch of its length past the clash. */
+static int tt__packing_clash(const tt__packing *p, int r, int width, int row, int x, int size)
+{
+    const uint64_t *mask = p->mask + (size_t)r * p->words, *line = p->bits + (size_t)row * p->words;
+    int j, nw = (width + 63) / 64;
+    for (j = nw - 1; j >= 0; j--) {
+        uint64_t both = mask[j] & tt__bits_at(line, p->words, x + 64 * j);
+        int bit, a, b;
+        if (!both) continue;
+        for (bit = 63; !(both >> bit & 1); bit--) {}
+        a = b = 64 * j + bit;
+        while (a > 0 && (mask[(a - 1) >> 6] >> ((a - 1) & 63) & 1)) a--;
+        while (b + 1 < width && (mask[(b + 1) >> 6] >> ((b + 1) & 63) & 1)) b++;
+        return tt__packing_next_run(p, row, x + 64 * j + bit + 1, b - a + 1, size) - a;
     }
     return -1;
 }
 
-/* Bottom-left placement of a chart's rows (lo[r]..hi[r] at row r, `rows`
-   of them, `cols` wide) at the lowest row below `below`, then leftmost,
-   where none of its texels is taken. A row whose longest free run is
-   shorter than the chart's row that would lie on it rules out the whole
-   shift (the widest chart row is asked first); a clash
-   at column X of row r rules out every shift that still covers X with
-   that row, so the next shift tried puts that row on the next free run
-   past X long enough for it, and that row is asked first from then on. 1 and (x, y) when it fits. */
-static int tt__packing_find(const tt__packing *p, int size, const int *lo, const int *hi, int cols, int rows, int below,
-                            int *x, int *y)
+/* Bottom-left placement of the chart mask (width x height cells; need[r]
+   the longest run of row r) at the lowest row below `below`, then
+   leftmost, where none of its texels is taken. An atlas row whose longest
+   free run is shorter than the mask row that would lie on it rules out
+   the whole shift (the longest mask row is asked first). Rows far apart
+   are tried first (every 16th, then the 8th between, ...: what is in the
+   way is usually several rows tall), and the row that clashed last first
+   of all. 1 and (x, y) when it fits. */
+static int tt__packing_find(const tt__packing *p, int size, int width, int height, const int *need, int *order,
+                            int below, int *x, int *y)
 {
-    int at_y, at_x, r, widest = 0, hint = 0;
-    for (r = 1; r < rows; r++)
-        if (hi[r] - lo[r] > hi[widest] - lo[widest]) widest = r;
-    for (at_y = 0; at_y + rows <= size && at_y < below; at_y++) {
-        if (p->run[at_y + widest] < hi[widest] - lo[widest] + 1) continue;
-        for (r = 0; r < rows; r++)
-            if (lo[r] <= hi[r] && p->run[at_y + r] < hi[r] - lo[r] + 1) break;
-        if (r < rows) continue;
-        for (at_x = 0; at_x + cols <= size;) {
-            int clash = -1, i;
-            for (i = 0; i < rows && clash < 0; i++) {
-                r = i == 0 ? hint : i == hint ? 0 : i;
-                if (lo[r] <= hi[r] && (clash = tt__packing_last_taken(p, at_y + r, at_x + lo[r], at_x + hi[r])) >= 0) {
-                    at_x = tt__packing_next_run(p, at_y + r, clash + 1, hi[r] - lo[r] + 1, size) - lo[r];
+    int at_y, at_x, r, widest = 0, hint = 0, stride, n = 0, i;
+    for (r = 1; r < height; r++)
+        if (need[r] > need[widest]) widest = r;
+    for (stride = 16; stride >= 1; stride /= 2)
+        for (r = 0; r < height; r += stride)
+            if (stride == 16 || r % (2 * stride) != 0) order[n++] = r;
+    for (at_y = 0; at_y + height <= size && at_y < below; at_y++) {
+        if (p->run[at_y + widest] < need[widest]) continue;
+        for (r = 0; r < height; r++)
+            if (p->run[at_y + r] < need[r]) break;
+        if (r < height) continue;
+        for (at_x = 0; at_x + width <= size;) {
+            int next = -1;
+            for (i = 0; i < height && next < 0; i++) {
+                r = i == 0 ? hint : order[i] == hint ? order[0] : order[i];
+                if ((next = tt__packing_clash(p, r, width, at_y + r, at_x, size)) >= 0) {
+                    at_x = next;
                     hint = r;
                 }
             }
-            if (clash < 0) {
+            if (next < 0) {
                 *x = at_x;
                 *y = at_y;
                 return 1;
@@ -15332,28 +15372,42 @@ static int tt__packing_find(const tt__packing *p, int size, const int *lo, const
     return 0;
 }
 
+/* The longest run of each of the mask's rows. */
+static void tt__mask_runs(const tt__packing *p, int width, int height, int *need)
+{
+    int r, c;
+    for (r = 0; r < height; r++) {
+        const uint64_t *line = p->mask + (size_t)r * p->words;
+        int run = 0;
+        need[r] = 0;
+        for (c = 0; c < width; c++) {
+            run = line[c >> 6] >> (c & 63) & 1 ? run + 1 : 0;
+            if (run > need[r]) need[r] = run;
+        }
+    }
+}
+
 /* Packing of the charts' outlines in a bitmap: the charts in `order`, each
    in the turn that lets it sit lowest (then leftmost), at the lowest free
    place (then leftmost): small charts fill the room that larger ones left
-   between them, where boxes or a skyline would leave it empty. Each chart
-   row is its span of cells (gaps within a row count as taken). 1 when all
-   fit in size x size; then x, y, turn, if given, get each chart's offset
-   in texels from the bottom-left corner and its turn. */
+   between and inside them, where boxes or a skyline would leave it empty.
+   1 when all fit in size x size; then x, y, turn, if given, get each
+   chart's offset in texels from the bottom-left corner and its turn.
+   need and rows_order: size ints each. */
 static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order, int n, const int *members,
-                           const double *xy, double s, int gutter, int size, tt__packing *p, int *x, int *y, int *turn)
+                           const double *xy, double s, int gutter, int size, tt__packing *p, int *need,
+                           int *rows_order, int *x, int *y, int *turn)
 {
-    int i, r, c;
+    int i, r, j;
     memset(p->bits, 0, sizeof *p->bits * (size_t)size * p->words);
     for (r = 0; r < size; r++) p->run[r] = size;
     for (i = 0; i < n; i++) {
         const tt__chart *chart = charts + order[i].chart;
-        int best_x = 0, best_y = size, best_turn = -1, rows = 0, at_x, at_y;
+        int best_x = 0, best_y = size, best_turn = -1, at_x, at_y, width, height;
         for (r = 0; r < 4; r++) {
-            int cols = (r & 1 ? tt__chart_cells(chart->height, s, gutter) : tt__chart_cells(chart->width, s, gutter));
-            int height = tt__chart_profile(chart, members, xy, s, gutter, r, 1, size, p->lo, p->hi, p->scratch_lo,
-                                           p->scratch_hi);
-            if (height == 0) continue;
-            if (tt__packing_find(p, size, p->lo, p->hi, cols, height, best_y, &at_x, &at_y) &&
+            if (!tt__chart_mask(chart, members, xy, s, gutter, r, size, p, &width, &height)) continue;
+            tt__mask_runs(p, width, height, need);
+            if (tt__packing_find(p, size, width, height, need, rows_order, best_y, &at_x, &at_y) &&
                 (at_y < best_y || (at_y == best_y && at_x < best_x))) {
                 best_x = at_x;
                 best_y = at_y;
@@ -15361,12 +15415,17 @@ static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order
             }
         }
         if (best_turn < 0) return 0;
-        rows = tt__chart_profile(chart, members, xy, s, gutter, best_turn, 1, size, p->lo, p->hi, p->scratch_lo,
-                                 p->scratch_hi);
-        for (r = 0; r < rows; r++) {
-            for (c = best_x + p->lo[r]; c <= best_x + p->hi[r]; c++)
-                p->bits[(size_t)(best_y + r) * p->words + (c >> 6)] |= (uint64_t)1 << (c & 63);
-            if (p->lo[r] <= p->hi[r]) p->run[best_y + r] = tt__packing_longest_run(p, best_y + r, size);
+        tt__chart_mask(chart, members, xy, s, gutter, best_turn, size, p, &width, &height);
+        for (r = 0; r < height; r++) {
+            const uint64_t *mask = p->mask + (size_t)r * p->words;
+            uint64_t *line = p->bits + (size_t)(best_y + r) * p->words;
+            int shift = best_x & 63, w0 = best_x >> 6;
+            for (j = 0; j < (width + 63) / 64; j++) {
+                if (!mask[j]) continue;
+                line[w0 + j] |= mask[j] << shift;
+                if (shift && w0 + j + 1 < p->words) line[w0 + j + 1] |= mask[j] >> (64 - shift);
+            }
+            p->run[best_y + r] = tt__packing_longest_run(p, best_y + r, size);
         }
         if (x) {
             x[order[i].chart] = best_x;
@@ -15442,6 +15501,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     const tt_allocator *al = allocator;
     double *normal = NULL, *area = NULL, *xy = NULL;
     int *chart = NULL, *tried = NULL, *members = NULL, *box_x = NULL, *box_y = NULL, *box_turn = NULL;
+    int *need = NULL, *rows_order = NULL;
     tt__chart *charts = NULL;
     tt__chart_order *order = NULL;
     tt__tri_grid grid;
@@ -15485,13 +15545,12 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     box_turn = TT__ALLOC(al, int, nf);
     pack.words = (size + 63) / 64;
     pack.bits = TT__ALLOC(al, uint64_t, (size_t)size * pack.words);
+    pack.mask = TT__ALLOC(al, uint64_t, (size_t)size * pack.words);
     pack.run = TT__ALLOC(al, int, size);
-    pack.lo = TT__ALLOC(al, int, (size_t)size + 1);
-    pack.hi = TT__ALLOC(al, int, (size_t)size + 1);
-    pack.scratch_lo = TT__ALLOC(al, int, (size_t)size + 1);
-    pack.scratch_hi = TT__ALLOC(al, int, (size_t)size + 1);
+    need = TT__ALLOC(al, int, size);
+    rows_order = TT__ALLOC(al, int, size);
     if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !box_x || !box_y || !box_turn ||
-        !pack.bits || !pack.run || !pack.lo || !pack.hi || !pack.scratch_lo || !pack.scratch_hi || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
+        !pack.bits || !pack.mask || !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
         goto out_of_memory;
 
     /* The grid's cells: the mean edge, but no face across more than 32 of
@@ -15531,7 +15590,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
 
     for (c = 0; c < ncharts; c++) {
         tt__chart_shape(area, members, xy, charts + c);
-        order[c].height = charts[c].height;
+        order[c].area = charts[c].width * charts[c].height;
         order[c].width = charts[c].width;
         order[c].chart = c;
         if (charts[c].width > largest) largest = charts[c].width;
@@ -15539,7 +15598,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     tt__sort_chart_order(order, ncharts);
 
     tiny = largest > 0.0 ? 1e-6 / largest : 1.0;
-    if (!tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, gutter, size, &pack, NULL, NULL, NULL)) {
+    if (!tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, gutter, size, &pack, need, rows_order, NULL, NULL, NULL)) {
         /* Shrunk to nothing, each chart is a square of 2 gutter + 1 cells,
            and the skyline lays equal squares in a grid. */
         double side = ceil(sqrt((double)ncharts)) * (2.0 * gutter + 1.0);
@@ -15558,17 +15617,17 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     s_lo = tiny;
     s_hi = surface > 0.0 ? size / sqrt(surface) : tiny;
     if (s_hi < s_lo) s_hi = s_lo;
-    if (tt__pack_bitmap(charts, order, ncharts, members, xy, s_hi, gutter, size, &pack, NULL, NULL, NULL)) s_lo = s_hi;
+    if (tt__pack_bitmap(charts, order, ncharts, members, xy, s_hi, gutter, size, &pack, need, rows_order, NULL, NULL, NULL)) s_lo = s_hi;
     /* Each packing costs about as much as a bake of the atlas: the first
        guess is a fill of 0.72, then halving down to 0.2 % of the scale. */
     for (i = 0; i < 100 && s_hi - s_lo > 2e-3 * s_hi; i++) {
         double mid = i == 0 && 0.85 * s_hi > s_lo ? 0.85 * s_hi : 0.5 * (s_lo + s_hi);
-        if (tt__pack_bitmap(charts, order, ncharts, members, xy, mid, gutter, size, &pack, NULL, NULL, NULL))
+        if (tt__pack_bitmap(charts, order, ncharts, members, xy, mid, gutter, size, &pack, need, rows_order, NULL, NULL, NULL))
             s_lo = mid;
         else
             s_hi = mid;
     }
-    tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, gutter, size, &pack, box_x, box_y, box_turn);
+    tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, gutter, size, &pack, need, rows_order, box_x, box_y, box_turn);
 
     for (c = 0; c < ncharts; c++) {
         int cols = tt__chart_cells(charts[c].width, s_lo, gutter), rows = tt__chart_cells(charts[c].height, s_lo, gutter);
@@ -15608,11 +15667,10 @@ done:
     tt__free(al, box_y);
     tt__free(al, box_turn);
     tt__free(al, pack.bits);
+    tt__free(al, pack.mask);
     tt__free(al, pack.run);
-    tt__free(al, pack.lo);
-    tt__free(al, pack.hi);
-    tt__free(al, pack.scratch_lo);
-    tt__free(al, pack.scratch_hi);
+    tt__free(al, need);
+    tt__free(al, rows_order);
     return result;
 }
 
