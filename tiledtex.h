@@ -15278,24 +15278,42 @@ static int tt__packing_longest_run(const tt__packing *p, int row, int size)
     return run > longest ? run : longest;
 }
 
-/* The first column c >= from with `length` free texels from c on in row
-   `row`, or `size` when there is none. Whole words, taken or free, are
-   stepped over at once. */
-static int tt__packing_next_run(const tt__packing *p, int row, int from, int length, int size)
+/* The index of the lowest set bit of a non-zero word (de Bruijn). */
+static int tt__lowest_bit(uint64_t word)
+{
+    static const unsigned char table[64] = {
+        0,  1,  48, 2,  57, 49, 28, 3,  61, 58, 50, 42, 38, 29, 17, 4,  62, 55, 59, 36, 53, 51,
+        43, 22, 45, 39, 33, 30, 24, 18, 12, 5,  63, 47, 56, 27, 60, 41, 37, 16, 54, 35, 52, 21,
+        44, 32, 23, 11, 46, 26, 40, 15, 34, 20, 31, 10, 25, 14, 19, 9,  13, 8,  7,  6};
+    return table[((word & (~word + 1)) * (uint64_t)0x03f79d71b4cb0a89u) >> 58];
+}
+
+/* The first column >= from of row `row` whose bit is `taken` (0 or 1), or
+   `size`. */
+static int tt__packing_next_bit(const tt__packing *p, int row, int from, int taken, int size)
 {
     const uint64_t *line = p->bits + (size_t)row * p->words;
-    int c = from, start = from;
-    while (c < size) {
-        uint64_t word = line[c >> 6];
-        if ((c & 63) == 0 && c + 64 <= size && (word == 0 || word == ~(uint64_t)0)) {
-            if (word) start = c + 64;
-            else if (c + 64 - start >= length) return start;
-            c += 64;
-            continue;
-        }
-        if (word >> (c & 63) & 1) start = c + 1;
-        else if (c + 1 - start >= length) return start;
-        c++;
+    int w = from >> 6;
+    uint64_t word;
+    if (from >= size) return size;
+    word = (taken ? line[w] : ~line[w]) & (~(uint64_t)0 << (from & 63));
+    while (!word) {
+        if (++w >= p->words) return size;
+        word = taken ? line[w] : ~line[w];
+    }
+    w = 64 * w + tt__lowest_bit(word);
+    return w < size ? w : size;
+}
+
+/* The first column c >= from with `length` free texels from c on in row
+   `row`, or `size` when there is none: free runs found a word at a time. */
+static int tt__packing_next_run(const tt__packing *p, int row, int from, int length, int size)
+{
+    int start = tt__packing_next_bit(p, row, from, 0, size);
+    while (start < size) {
+        int end = tt__packing_next_bit(p, row, start, 1, size);
+        if (end - start >= length) return start;
+        start = tt__packing_next_bit(p, row, end, 0, size);
     }
     return size;
 }
@@ -15619,8 +15637,8 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     if (s_hi < s_lo) s_hi = s_lo;
     if (tt__pack_bitmap(charts, order, ncharts, members, xy, s_hi, gutter, size, &pack, need, rows_order, NULL, NULL, NULL)) s_lo = s_hi;
     /* Each packing costs about as much as a bake of the atlas: the first
-       guess is a fill of 0.72, then halving down to 0.2 % of the scale. */
-    for (i = 0; i < 100 && s_hi - s_lo > 2e-3 * s_hi; i++) {
+       guess is a fill of 0.72, then halving down to 0.5 % of the scale. */
+    for (i = 0; i < 100 && s_hi - s_lo > 5e-3 * s_hi; i++) {
         double mid = i == 0 && 0.85 * s_hi > s_lo ? 0.85 * s_hi : 0.5 * (s_lo + s_hi);
         if (tt__pack_bitmap(charts, order, ncharts, members, xy, mid, gutter, size, &pack, need, rows_order, NULL, NULL, NULL))
             s_lo = mid;
