@@ -15255,20 +15255,21 @@ static int tt__chart_mask(const tt__chart *chart, const int *members, const doub
     return 1;
 }
 
-/* The longest run of free texels of row `row`. */
-static int tt__packing_longest_run(const tt__packing *p, int row, int size)
+/* The longest run of bits equal to `taken` among the first `width` of a
+   row of words. */
+static int tt__longest_run(const uint64_t *line, int width, int taken)
 {
-    const uint64_t *line = p->bits + (size_t)row * p->words;
+    const uint64_t same = taken ? ~(uint64_t)0 : 0;
     int w, bit, run = 0, longest = 0;
-    for (w = 0; w < p->words; w++) {
+    for (w = 0; 64 * w < width; w++) {
         uint64_t word = line[w];
-        int bits = size - 64 * w < 64 ? size - 64 * w : 64;
-        if (word == 0 && bits == 64) {
+        int bits = width - 64 * w < 64 ? width - 64 * w : 64;
+        if (word == same && bits == 64) {
             run += 64;
             continue;
         }
         for (bit = 0; bit < bits; bit++)
-            if (word >> bit & 1) {
+            if ((word >> bit & 1) != (uint64_t)taken) {
                 if (run > longest) longest = run;
                 run = 0;
             } else {
@@ -15390,21 +15391,6 @@ static int tt__packing_find(const tt__packing *p, int size, int width, int heigh
     return 0;
 }
 
-/* The longest run of each of the mask's rows. */
-static void tt__mask_runs(const tt__packing *p, int width, int height, int *need)
-{
-    int r, c;
-    for (r = 0; r < height; r++) {
-        const uint64_t *line = p->mask + (size_t)r * p->words;
-        int run = 0;
-        need[r] = 0;
-        for (c = 0; c < width; c++) {
-            run = line[c >> 6] >> (c & 63) & 1 ? run + 1 : 0;
-            if (run > need[r]) need[r] = run;
-        }
-    }
-}
-
 /* Packing of the charts' outlines in a bitmap: the charts in `order`, each
    in the turn that lets it sit lowest (then leftmost), at the lowest free
    place (then leftmost): small charts fill the room that larger ones left
@@ -15424,7 +15410,7 @@ static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order
         int best_x = 0, best_y = size, best_turn = -1, at_x, at_y, width, height;
         for (r = 0; r < 4; r++) {
             if (!tt__chart_mask(chart, members, xy, s, gutter, r, size, p, &width, &height)) continue;
-            tt__mask_runs(p, width, height, need);
+            for (j = 0; j < height; j++) need[j] = tt__longest_run(p->mask + (size_t)j * p->words, width, 1);
             if (tt__packing_find(p, size, width, height, need, rows_order, best_y, &at_x, &at_y) &&
                 (at_y < best_y || (at_y == best_y && at_x < best_x))) {
                 best_x = at_x;
@@ -15443,7 +15429,7 @@ static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order
                 line[w0 + j] |= mask[j] << shift;
                 if (shift && w0 + j + 1 < p->words) line[w0 + j + 1] |= mask[j] >> (64 - shift);
             }
-            p->run[best_y + r] = tt__packing_longest_run(p, best_y + r, size);
+            p->run[best_y + r] = tt__longest_run(line, size, 0);
         }
         if (x) {
             x[order[i].chart] = best_x;
