@@ -15155,6 +15155,9 @@ static void tt__chart_texel(const double *xy, int face, int k, double s, int gut
     }
 }
 
+/* Atlas sides above this many texels are packed in blocks of texels. */
+#define TT__PACK_GRID 2048
+
 /* Scratch of the bitmap packing: one bit per atlas texel, taken or free
    (rows of `words` 64-bit words), the longest free run of each row, and
    the mask of the chart being placed (same layout). */
@@ -15505,7 +15508,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     const tt_allocator *al = allocator;
     double *normal = NULL, *area = NULL, *xy = NULL;
     int *chart = NULL, *tried = NULL, *members = NULL, *box_x = NULL, *box_y = NULL, *box_turn = NULL;
-    int *need = NULL, *rows_order = NULL;
+    int *need = NULL, *rows_order = NULL, block, side, block_gutter;
     tt__chart *charts = NULL;
     tt__chart_order *order = NULL;
     tt__tri_grid grid;
@@ -15547,12 +15550,18 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     box_x = TT__ALLOC(al, int, nf);
     box_y = TT__ALLOC(al, int, nf);
     box_turn = TT__ALLOC(al, int, nf);
-    pack.words = (size + 63) / 64;
-    pack.bits = TT__ALLOC(al, uint64_t, (size_t)size * pack.words);
-    pack.mask = TT__ALLOC(al, uint64_t, (size_t)size * pack.words);
-    pack.run = TT__ALLOC(al, int, size);
-    need = TT__ALLOC(al, int, size);
-    rows_order = TT__ALLOC(al, int, size);
+    /* Above TT__PACK_GRID texels a side, the packing works in blocks of
+       texels (the gutter rounded up to whole blocks): its time grows with
+       the bitmap, and a chart's outline then costs at most a block more. */
+    block = (size + TT__PACK_GRID - 1) / TT__PACK_GRID;
+    side = size / block;
+    block_gutter = (gutter + block - 1) / block;
+    pack.words = (side + 63) / 64;
+    pack.bits = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
+    pack.mask = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
+    pack.run = TT__ALLOC(al, int, side);
+    need = TT__ALLOC(al, int, side);
+    rows_order = TT__ALLOC(al, int, side);
     if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !box_x || !box_y || !box_turn ||
         !pack.bits || !pack.mask || !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
         goto out_of_memory;
@@ -15601,16 +15610,18 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     }
     tt__sort_chart_order(order, ncharts);
 
+    /* Scales from here on are in blocks per mesh unit. */
     tiny = largest > 0.0 ? 1e-6 / largest : 1.0;
-    if (!tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, gutter, size, &pack, need, rows_order, NULL, NULL, NULL)) {
-        /* Shrunk to nothing, each chart is a square of 2 gutter + 1 cells,
-           and the skyline lays equal squares in a grid. */
-        double side = ceil(sqrt((double)ncharts)) * (2.0 * gutter + 1.0);
-        if (side <= TT_MAX_IMAGE_SIZE)
+    if (!tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, block_gutter, side, &pack, need, rows_order, NULL,
+                         NULL, NULL)) {
+        /* Shrunk to nothing, each chart is a square of 2 gutter + 1 texels,
+           and the packing lays equal squares in a grid. */
+        double needed = ceil(sqrt((double)ncharts)) * (2.0 * gutter + 1.0);
+        if (needed <= TT_MAX_IMAGE_SIZE)
             result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
                               "%d charts need at least %d x %d texels each for gutter %d: they do not fit %d x %d, "
                               "the smallest size that works is %.0f (with the charts shrunk to nothing)",
-                              ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, size, size, side);
+                              ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, size, size, needed);
         else
             result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
                               "%d charts need at least %d x %d texels each for gutter %d: more than the limit of %d "
@@ -15619,37 +15630,44 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
         goto done;
     }
     s_lo = tiny;
-    s_hi = surface > 0.0 ? size / sqrt(surface) : tiny;
+    s_hi = surface > 0.0 ? side / sqrt(surface) : tiny;
     if (s_hi < s_lo) s_hi = s_lo;
-    if (tt__pack_bitmap(charts, order, ncharts, members, xy, s_hi, gutter, size, &pack, need, rows_order, NULL, NULL, NULL)) s_lo = s_hi;
+    if (tt__pack_bitmap(charts, order, ncharts, members, xy, s_hi, block_gutter, side, &pack, need, rows_order, NULL,
+                        NULL, NULL))
+        s_lo = s_hi;
     /* Each packing costs about as much as a bake of the atlas: the first
        guess is a fill of 0.72, then halving down to 0.5 % of the scale. */
     for (i = 0; i < 100 && s_hi - s_lo > 5e-3 * s_hi; i++) {
         double mid = i == 0 && 0.85 * s_hi > s_lo ? 0.85 * s_hi : 0.5 * (s_lo + s_hi);
-        if (tt__pack_bitmap(charts, order, ncharts, members, xy, mid, gutter, size, &pack, need, rows_order, NULL, NULL, NULL))
+        if (tt__pack_bitmap(charts, order, ncharts, members, xy, mid, block_gutter, side, &pack, need, rows_order, NULL,
+                            NULL, NULL))
             s_lo = mid;
         else
             s_hi = mid;
     }
-    tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, gutter, size, &pack, need, rows_order, box_x, box_y, box_turn);
+    tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, &pack, need, rows_order, box_x,
+                    box_y, box_turn);
 
     for (c = 0; c < ncharts; c++) {
-        int cols = tt__chart_cells(charts[c].width, s_lo, gutter), rows = tt__chart_cells(charts[c].height, s_lo, gutter);
+        int cols = tt__chart_cells(charts[c].width, s_lo, block_gutter);
+        int rows = tt__chart_cells(charts[c].height, s_lo, block_gutter);
         for (i = 0; i < charts[c].count; i++) {
             int face = members[charts[c].first + i];
             for (k = 0; k < 3; k++) {
                 int corner = mesh->face_start[face] + k;
                 double t[2];
-                tt__chart_texel(xy, face, k, s_lo, gutter, box_turn[c], cols, rows, t);
-                corner_uv[2 * (size_t)corner] = tt__clamp_f((float)((box_x[c] + t[0]) / size), 0.0f, 1.0f);
-                corner_uv[2 * (size_t)corner + 1] = tt__clamp_f((float)((box_y[c] + t[1]) / size), 0.0f, 1.0f);
+                tt__chart_texel(xy, face, k, s_lo, block_gutter, box_turn[c], cols, rows, t);
+                corner_uv[2 * (size_t)corner] =
+                    tt__clamp_f((float)((double)block * (box_x[c] + t[0]) / size), 0.0f, 1.0f);
+                corner_uv[2 * (size_t)corner + 1] =
+                    tt__clamp_f((float)((double)block * (box_y[c] + t[1]) / size), 0.0f, 1.0f);
             }
         }
     }
     if (report) {
         report->ncharts = ncharts;
-        report->texels_per_unit = s_lo;
-        report->fill = s_lo * s_lo * surface / ((double)size * size);
+        report->texels_per_unit = s_lo * block;
+        report->fill = report->texels_per_unit * report->texels_per_unit * surface / ((double)size * size);
     }
     result = tt__ok(error);
     goto done;
