@@ -694,6 +694,10 @@ check "lapped default: the bake's side chosen and said: a power of two whose atl
     "'bake size N: the smallest power of two ...', N a power of two, an N x N texture" "$(png_size out.png) | $OUT" \
     "$(is_png out.png && [ -n "$bake_side" ] && [ "$(png_size out.png)" = "$bake_side $bake_side" ] &&
         [ $((bake_side & (bake_side - 1))) -eq 0 ]; echo $?)"
+check "lapped default: the summary gives the atlas's fill and texel density spread" \
+    "'bake atlas: N charts fill F% of it; texel density D texels per unit, 95th percentile over 5th S', S <= 1.2" \
+    "$OUT" "$(printf '%s\n' "$OUT" | grep -E '^bake atlas: [0-9]+ charts? fill [0-9.]+% of it; texel density [0-9.e+]+ texels per unit, 95th percentile over 5th [0-9.]+$' |
+        awk '{ exit !($NF + 0 >= 1 && $NF + 0 <= 1.2) }'; echo $?)"
 check "lapped default: one material naming out.png, no paste groups" "map_Kd out.png, no 'g paste_'" \
     "$(grep -h -E '^(map_Kd|mtllib|usemtl|g) ' out.mtl out.obj 2>&1 | sort | uniq -c | head -5)" \
     "$(grep -qx 'map_Kd out.png' out.mtl && grep -qx 'mtllib out.mtl' out.obj && ! grep -q '^g paste_' out.obj; echo $?)"
