@@ -58,9 +58,14 @@
    the whole image stays the one patch. */
 #define LAPPED_DEFAULT_PATCHES 4
 #define LAPPED_DEFAULT_MIN_WINDOW 64
-/* The side of the baked texture unless --bake says: the default output
-   (and every glTF) holds the pastes baked, see parse_command_line. */
-#define LAPPED_DEFAULT_BAKE_SIZE 2048
+/* The default output (and every glTF) holds the pastes baked, see
+   parse_command_line. Unless --bake says, the bake's side is the power of
+   two whose atlas gives at least the texels per unit length that the
+   pastes show (bake_uvs), from LAPPED_MIN_BAKE_SIZE up to TOOL_MAX_ATLAS;
+   the atlas is expected to fill about LAPPED_EXPECTED_FILL of its square
+   (a first guess: the size doubles while the atlas falls short). */
+#define LAPPED_MIN_BAKE_SIZE 256
+#define LAPPED_EXPECTED_FILL 0.65
 
 static void print_help(void)
 {
@@ -69,9 +74,10 @@ static void print_help(void)
            "Cover MESH with overlapping pastes of texture patches cut from IMAGE (Praun et\n"
            "al., Lapped Textures): no seams show, because every paste fades out over the ones\n"
            "beneath it. Writes the pastes baked into one texture on the mesh, which every\n"
-           "program opens: OUT_PREFIX.obj, OUT_PREFIX.mtl and OUT_PREFIX.png (--bake SIZE, default\n"
-           "%d; the OBJ's texture coordinates or a new atlas, see --bake-uv), or with --format glb\n"
-           "or gltf (or OUT_PREFIX.glb or .gltf) the same as glTF.\n"
+           "program opens: OUT_PREFIX.obj, OUT_PREFIX.mtl and OUT_PREFIX.png (--bake SIZE, by\n"
+           "default as sharp as the pastes; the OBJ's texture coordinates or a new atlas, see\n"
+           "--bake-uv), or with --format glb or gltf (or OUT_PREFIX.glb or .gltf) the same as\n"
+           "glTF.\n"
            "--pasting writes instead the pastes themselves, to composite at run time:\n"
            "OUT_PREFIX.obj (group paste_N holds the triangles of paste N with its texture\n"
            "coordinates and its patch's material; draw the groups in order with alpha blending and\n"
@@ -85,8 +91,7 @@ static void print_help(void)
            "importers cannot stack copies of a triangle and show it shredded.\n"
            "Lapped textures work on triangles: faces with more than 3 corners are split into\n"
            "triangle fans first. The mesh must be manifold and consistently oriented, or use\n"
-           "--permissive.\n",
-           LAPPED_DEFAULT_BAKE_SIZE);
+           "--permissive.\n");
     tool_print_mesh_help(1);
     printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl or .png loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
@@ -123,8 +128,10 @@ static void print_help(void)
            "                       (white = inside); one shape for every patch: MASK is the size of a\n"
            "                       patch, or of IMAGE and then scaled to the patch's (default: a random\n"
            "                       splotch, or the window's own alpha when IMAGE has one)\n"
-           "  --bake SIZE          the baked texture's side, 16 to %d (default %d); with --pasting,\n"
-           "                       also write the bake, as OUT_PREFIX_baked.obj/.mtl/.png\n"
+           "  --bake SIZE          the baked texture's side, 16 to %d (default: the power of two, %d\n"
+           "                       to %d, whose texels per unit length on the surface are at least\n"
+           "                       the pastes' (patch texels over --scale), said in the summary);\n"
+           "                       with --pasting, also write the bake, as OUT_PREFIX_baked.obj/.mtl/.png\n"
            "  --bake-uv auto|mesh|atlas\n"
            "                       where the bake goes: 'mesh' over the OBJ's own texture coordinates,\n"
            "                       refused unless every corner has one, all in [0,1], no triangle\n"
@@ -140,7 +147,7 @@ static void print_help(void)
            "  --triangles          accepted for the OBJ, whose faces are triangles already\n",
            TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
            LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
-           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS, LAPPED_DEFAULT_BAKE_SIZE);
+           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS, LAPPED_MIN_BAKE_SIZE, TOOL_MAX_ATLAS);
     printf(MATERIAL_OPTIONS_HELP("                       ")
            "                       (here baked with the same pastes as IMAGE: OUT_PREFIX_normal.png,\n"
            "                       ..., normals turned into the atlas; with --pasting each patch's\n"
@@ -183,6 +190,7 @@ typedef struct lapped_options {
     int patch_size;                 /* --patch-size S in texels; 0 = the default */
     int pasting;                    /* --pasting: the pasting OBJ and its patches */
     int bake_size;                  /* 0 = no bake (only with --pasting) */
+    int bake_auto;                  /* no --bake: bake_uvs chooses bake_size */
     char baked_stem[TOOL_PREFIX_SIZE + 8]; /* the baked files' names without extension */
     bake_uv_choice bake_uv;         /* --bake-uv */
     tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
@@ -257,7 +265,10 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
     if (options->pasting && options->output.format != TOOL_FORMAT_OBJ)
         return tool_usage("--pasting writes the pasting OBJ; a glTF file holds the pastes baked (leave out --pasting, "
                           "or write OUT_PREFIX.obj)");
-    if (!options->pasting && options->bake_size == 0) options->bake_size = LAPPED_DEFAULT_BAKE_SIZE;
+    if (!options->pasting && options->bake_size == 0) {
+        options->bake_size = LAPPED_MIN_BAKE_SIZE;
+        options->bake_auto = 1;
+    }
     snprintf(options->baked_stem, sizeof options->baked_stem, "%s%s", options->prefix,
              options->pasting ? "_baked" : "");
     return -1;
@@ -751,19 +762,64 @@ static void describe_uv_problem(const triangle_mesh *m, const tt_uv_report *repo
     }
 }
 
+/* What the summary says of the bake's atlas. */
+typedef struct bake_atlas {
+    int charts;                 /* charts of the new atlas; 0 over the OBJ's own texture coordinates */
+    double fill;                /* the share of the atlas the triangles cover */
+    double density_spread;      /* texel density, area-weighted 95th percentile over 5th */
+    double texels_per_unit;     /* the atlas's texels per mesh unit of length */
+    double paste_texels;        /* the pastes': patch texels over the patch's side on the surface */
+} bake_atlas;
+
+/* The texels per mesh unit of length that the pastes show: the patch's
+   side in texels over the patch's side on the surface (the field's
+   length), as the root mean square over the surface, so that an atlas at
+   this density holds as many texels as the pastes spread over it.
+   *surface gets the mesh's area. 0 for a mesh without area. */
+static double paste_texel_density(const triangle_mesh *m, const float *field, int patch_texels, double *surface)
+{
+    const tt_mesh *mesh = m->mesh;
+    double texels = 0.0;
+    int f, k;
+    *surface = 0.0;
+    for (f = 0; f < mesh->nfaces; f++) {
+        const float *v = field + 3 * (size_t)f;
+        const float *p[3];
+        double e1[3], e2[3], area, length2 = (double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2];
+        for (k = 0; k < 3; k++) p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + k];
+        for (k = 0; k < 3; k++) {
+            e1[k] = (double)p[1][k] - p[0][k];
+            e2[k] = (double)p[2][k] - p[0][k];
+        }
+        area = 0.5 * sqrt((e1[1] * e2[2] - e1[2] * e2[1]) * (e1[1] * e2[2] - e1[2] * e2[1]) +
+                          (e1[2] * e2[0] - e1[0] * e2[2]) * (e1[2] * e2[0] - e1[0] * e2[2]) +
+                          (e1[0] * e2[1] - e1[1] * e2[0]) * (e1[0] * e2[1] - e1[1] * e2[0]));
+        *surface += area;
+        if (length2 > 0.0) texels += area * (double)patch_texels * patch_texels / length2;
+    }
+    return *surface > 0.0 ? sqrt(texels / *surface) : 0.0;
+}
+
 /* --bake's texture coordinates per triangle corner, as --bake-uv chooses:
    the OBJ's own when they can take a bake (tt_uv_check), else an atlas of
-   charts; *charts gets the number of charts, 0 for the OBJ's own. Made
-   before anything is pasted, so a size too small for the mesh, or UVs
-   --bake-uv mesh refuses, are said at once. */
-static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float **corner_uv, int *charts)
+   charts; *atlas says which and how well it fills. Without --bake the
+   atlas's side is chosen here: the smallest power of two whose atlas
+   gives at least the pastes' texels per unit length, up to TOOL_MAX_ATLAS
+   (said when it falls short there). Made before anything is pasted, so a
+   size too small for the mesh, or UVs --bake-uv mesh refuses, are said at
+   once. */
+static int bake_uvs(lapped_options *options, const triangle_mesh *m, const float *field, int patch_texels,
+                    float **corner_uv, bake_atlas *atlas)
 {
     const size_t ncorners = 3 * (size_t)m->ntriangles;
     char problem[160] = "have none at some corners";
-    tt_chart_atlas_report atlas;
+    tt_chart_atlas_report report;
+    tt_uv_distortion_report distortion;
     tt_uv_report check;
     tt_error error;
-    *charts = 0;
+    double surface;
+    memset(atlas, 0, sizeof *atlas);
+    atlas->paste_texels = paste_texel_density(m, field, patch_texels, &surface);
     if (options->bake_uv != BAKE_UV_ATLAS && m->corner_uv) {
         if (tt_uv_check(m->mesh, m->corner_uv, NULL, &check, &error) != TT_OK)
             return tool_fail("%s: cannot check its texture coordinates: %s", options->mesh_path, error.message);
@@ -777,19 +833,50 @@ static int bake_uvs(const lapped_options *options, const triangle_mesh *m, float
     if (!*corner_uv) return tool_fail("out of memory for the texture coordinates of %s", options->mesh_path);
     if (options->bake_uv != BAKE_UV_ATLAS && !problem[0]) {
         memcpy(*corner_uv, m->corner_uv, ncorners * 2 * sizeof(float));
-        return 0;
+    } else {
+        if (options->bake_auto) {
+            /* A first guess from the surface's area, then doubled while the
+               packed atlas falls short of the pastes' density. */
+            double side = atlas->paste_texels * sqrt(surface / LAPPED_EXPECTED_FILL);
+            while (options->bake_size < TOOL_MAX_ATLAS && options->bake_size < side) options->bake_size *= 2;
+        }
+        tool_stage("packing the bake's atlas");
+        for (;;) {
+            if (tt_atlas_pack_charts(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, NULL, *corner_uv, &report,
+                                     &error) != TT_OK) {
+                if (options->bake_auto && error.result == TT_ERROR_IMAGE_TOO_SMALL &&
+                    options->bake_size < TOOL_MAX_ATLAS) {
+                    options->bake_size *= 2;
+                    continue;
+                }
+                free(*corner_uv);
+                *corner_uv = NULL;
+                return tool_fail("--bake %d: %s", options->bake_size, error.message);
+            }
+            if (!options->bake_auto || report.texels_per_unit >= atlas->paste_texels ||
+                options->bake_size >= TOOL_MAX_ATLAS)
+                break;
+            options->bake_size *= 2;
+        }
+        atlas->charts = report.ncharts;
+        atlas->fill = report.fill;
+        /* Only an OBJ that has texture coordinates was asked for them. */
+        if (options->bake_uv == BAKE_UV_AUTO && m->corner_uv)
+            tool_note("%s: its texture coordinates %s; baking over a new atlas", options->mesh_path, problem);
     }
-    tool_stage("packing the bake's atlas");
-    if (tt_atlas_pack_charts(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, NULL, *corner_uv, &atlas, &error) !=
-        TT_OK) {
-        free(*corner_uv);
-        *corner_uv = NULL;
-        return tool_fail("--bake %d: %s", options->bake_size, error.message);
+    if (tt_measure_uv_distortion(m->mesh, *corner_uv, options->bake_size, options->bake_size, NULL, NULL,
+                                 &distortion, &error) == TT_OK) {
+        atlas->density_spread = distortion.density_spread;
+        atlas->texels_per_unit = distortion.texels_per_unit;
     }
-    /* Only an OBJ that has texture coordinates was asked for them. */
-    if (options->bake_uv == BAKE_UV_AUTO && m->corner_uv)
-        tool_note("%s: its texture coordinates %s; baking over a new atlas", options->mesh_path, problem);
-    *charts = atlas.ncharts;
+    /* The OBJ's own coordinates: their density grows with the side. */
+    if (options->bake_auto && atlas->charts == 0 && atlas->texels_per_unit > 0.0) {
+        double side = options->bake_size * atlas->paste_texels / atlas->texels_per_unit;
+        int size = options->bake_size;
+        while (size < TOOL_MAX_ATLAS && size < side) size *= 2;
+        atlas->texels_per_unit *= (double)size / options->bake_size;
+        options->bake_size = size;
+    }
     return 0;
 }
 
@@ -1047,8 +1134,8 @@ static double top_density_spread(const triangle_mesh *m, const tt_lapped *lapped
 }
 
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
-                          const tt_lapped *lapped, const lapped_patches *patches, const baked_summary *baked,
-                          double seconds)
+                          const tt_lapped *lapped, const lapped_patches *patches, const bake_atlas *atlas,
+                          const baked_summary *baked, double seconds)
 {
     char all[256], top[256];
     tt_lapped_report report;
@@ -1082,6 +1169,18 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
         printf("baked seam score: all edges %s; where the top paste changes %s\n", all, top);
         printf("bake: %dx%d texels in %.2f s wall, %.2f s CPU (%d thread%s)\n", options->bake_size,
                options->bake_size, baked->seconds, baked->cpu_seconds, tool_jobs(), tool_jobs() == 1 ? "" : "s");
+        if (atlas->charts > 0)
+            printf("bake atlas: %d charts fill %.1f%% of it; texel density %.3g texels per unit, 95th percentile "
+                   "over 5th %.3f\n",
+                   atlas->charts, 100.0 * atlas->fill, atlas->texels_per_unit, atlas->density_spread);
+        if (options->bake_auto && atlas->texels_per_unit >= atlas->paste_texels)
+            printf("bake size %d: the smallest power of two whose texels per unit (%.3g) reach the pastes' (%.3g; "
+                   "--bake to choose)\n",
+                   options->bake_size, atlas->texels_per_unit, atlas->paste_texels);
+        else if (options->bake_auto)
+            printf("bake size %d: capped there; its %.3g texels per unit fall short of the pastes' %.3g, so the bake "
+                   "is softer than the pasting (a larger --scale or smaller --patch-size lowers theirs)\n",
+                   options->bake_size, atlas->texels_per_unit, atlas->paste_texels);
     }
     printf("removed %d hidden face entries; %.1f s\n", lapped->removed_entries, seconds);
 }
@@ -1125,7 +1224,8 @@ int cmd_lapped(int argc, char **argv)
     baked_summary baked;
     char obj_path[4096], mtl_path[4096], gltf_path[4096], written[8400], message[TOOL_ERROR_SIZE];
     double start = tool_seconds_now();
-    int status, charts = 0, gltf;
+    int status, gltf;
+    bake_atlas atlas;
 
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
@@ -1149,7 +1249,11 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0) status = choose_windows(&options, image->width, image->height, &windows);
     if (status == 0) status = lapped_patches_name(options.prefix, &windows, &options.maps, &patches);
     if (status == 0) status = refuse_overwriting_inputs(&options, obj_path, mtl_path, gltf_path, &patches);
-    if (status == 0 && options.bake_size > 0) status = bake_uvs(&options, &mesh, &bake_uv, &charts);
+    memset(&atlas, 0, sizeof atlas);
+    if (status == 0 && options.bake_size > 0)
+        status = bake_uvs(&options, &mesh, field,
+                          windows.size > 0 ? windows.size : image->width > image->height ? image->width : image->height,
+                          &bake_uv, &atlas);
     if (status == 0) status = load_mask(&options, image->width, image->height, &windows, &mask);
     /* Memory: the image is needed only to make the patches and their PNGs,
        so the PNGs are encoded now and the image freed before the paste
@@ -1179,7 +1283,7 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && output_commit(&output, message, sizeof message) != 0) status = tool_fail("%s", message);
 
     if (status == 0 && !tool_quiet()) {
-        print_summary(&options, &mesh, field, lapped, &patches, &baked, tool_seconds_now() - start);
+        print_summary(&options, &mesh, field, lapped, &patches, &atlas, &baked, tool_seconds_now() - start);
         print_patch_use(&patches, lapped);
         if (options.pasting) {
             printf("wrote %s, %s, %s", obj_path, mtl_path, patches.png_paths[0]);
@@ -1191,8 +1295,8 @@ int cmd_lapped(int argc, char **argv)
         }
         if (options.bake_size > 0) {
             printf(" (the pastes baked into %dx%d, over ", options.bake_size, options.bake_size);
-            if (charts == 0) printf("the OBJ's texture coordinates)");
-            else printf("an atlas of %d chart%s)", charts, charts == 1 ? "" : "s");
+            if (atlas.charts == 0) printf("the OBJ's texture coordinates)");
+            else printf("an atlas of %d chart%s)", atlas.charts, atlas.charts == 1 ? "" : "s");
         }
         printf("\n");
         if (options.pasting)

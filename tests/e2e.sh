@@ -689,14 +689,21 @@ newdir
 expect_ok "lapped default (the bake)" lapped ../in/torus.obj ../in/lap.png out --scale 1.5 --seed 3
 check "lapped default: exactly out.mtl, out.obj, out.png" "out.mtl out.obj out.png" "$(ls -A | tr '\n' ' ')" \
     "$([ "$(ls -A | tr '\n' ' ')" = "out.mtl out.obj out.png " ]; echo $?)"
-check "lapped default: a 2048x2048 texture" "2048 2048" "$(png_size out.png)" \
-    "$(is_png out.png && [ "$(png_size out.png)" = "2048 2048" ]; echo $?)"
+bake_side=$(printf '%s\n' "$OUT" | sed -n 's/^bake size \([0-9]*\): the smallest power of two whose texels per unit .* reach .*/\1/p')
+check "lapped default: the bake's side chosen and said: a power of two whose atlas reaches the pastes' texel density" \
+    "'bake size N: the smallest power of two ...', N a power of two, an N x N texture" "$(png_size out.png) | $OUT" \
+    "$(is_png out.png && [ -n "$bake_side" ] && [ "$(png_size out.png)" = "$bake_side $bake_side" ] &&
+        [ $((bake_side & (bake_side - 1))) -eq 0 ]; echo $?)"
+check "lapped default: the summary gives the atlas's fill and texel density spread" \
+    "'bake atlas: N charts fill F% of it; texel density D texels per unit, 95th percentile over 5th S', S <= 1.2" \
+    "$OUT" "$(printf '%s\n' "$OUT" | grep -E '^bake atlas: [0-9]+ charts? fill [0-9.]+% of it; texel density [0-9.e+]+ texels per unit, 95th percentile over 5th [0-9.]+$' |
+        awk '{ exit !($NF + 0 >= 1 && $NF + 0 <= 1.2) }'; echo $?)"
 check "lapped default: one material naming out.png, no paste groups" "map_Kd out.png, no 'g paste_'" \
     "$(grep -h -E '^(map_Kd|mtllib|usemtl|g) ' out.mtl out.obj 2>&1 | sort | uniq -c | head -5)" \
     "$(grep -qx 'map_Kd out.png' out.mtl && grep -qx 'mtllib out.mtl' out.obj && ! grep -q '^g paste_' out.obj; echo $?)"
 check "lapped default: says it wrote the bake, not the pastes" \
-    "'wrote out.obj, out.mtl, out.png (the pastes baked into 2048x2048, over an atlas of N charts)', no 'holds the pastes'" \
-    "$OUT" "$(printf '%s\n' "$OUT" | grep -qxE 'wrote out\.obj, out\.mtl, out\.png \(the pastes baked into 2048x2048, over an atlas of [0-9]+ charts?\)' &&
+    "'wrote out.obj, out.mtl, out.png (the pastes baked into NxN, over an atlas of N charts)', no 'holds the pastes'" \
+    "$OUT" "$(printf '%s\n' "$OUT" | grep -qxE "wrote out\.obj, out\.mtl, out\.png \(the pastes baked into ${bake_side}x${bake_side}, over an atlas of [0-9]+ charts?\)" &&
         ! printf '%s' "$OUT" | grep -q 'holds the pastes'; echo $?)"
 check_normals "lapped default: the baked OBJ" out.obj
 expect_ok "render the default lapped OBJ with its texture" render out.obj out.png view.png --size 64x48
@@ -2026,11 +2033,13 @@ cd "$W" || exit 1
 # Ctrl-C (SIGINT) or SIGTERM during a long library call cancels it through
 # the progress callback: one line saying so, exit status 130, nothing
 # written. The run (27,000 pastes on the sphere, several seconds even
-# without sanitizers) is well inside its paste loop after 3 s.
+# without sanitizers) is well inside its paste loop after 3 s (--bake 2048:
+# the atlas for the default side, 8192 here, is packed before the paste
+# loop, and the packing takes no progress callback).
 for sig in INT TERM; do
     newdir
-    CMD="tiledtex lapped sphere.obj lap.png out --scale 0.05, then SIG$sig after 3 s"
-    "$TOOL" lapped ../in/spheretri.obj ../in/lap.png out --scale 0.05 >"$W/out" 2>"$W/err" </dev/null &
+    CMD="tiledtex lapped sphere.obj lap.png out --scale 0.05 --bake 2048, then SIG$sig after 3 s"
+    "$TOOL" lapped ../in/spheretri.obj ../in/lap.png out --scale 0.05 --bake 2048 >"$W/out" 2>"$W/err" </dev/null &
     pid=$!
     sleep 3
     kill -s "$sig" "$pid"
@@ -3104,14 +3113,15 @@ expect_ok "lapped OUT.glb (bakes by itself)" lapped ../in/torus.obj ../in/lap.pn
 CMD="ls after tiledtex lapped ../in/torus.obj ../in/lap.png l.glb"
 check "lapped OUT.glb: writes l.glb alone (no pasting OBJ, no patch PNG)" "l.glb" "$(ls | tr '\n' ' ')" \
     "$([ "$(ls)" = l.glb ]; echo $?)"
-check "lapped OUT.glb: says it baked at 2048 (the default)" "'wrote l.glb (the pastes baked into 2048x2048'" "$OUT" \
-    "$(printf '%s' "$OUT" | grep -q '^wrote l\.glb (the pastes baked into 2048x2048'; echo $?)"
+glb_side=$(printf '%s\n' "$OUT" | sed -n 's/^bake size \([0-9]*\): .*/\1/p')
+check "lapped OUT.glb: says the side it chose and baked at it" "'bake size N: ...', 'wrote l.glb (the pastes baked into NxN'" \
+    "$OUT" "$([ -n "$glb_side" ] && printf '%s' "$OUT" | grep -q "^wrote l\.glb (the pastes baked into ${glb_side}x${glb_side}"; echo $?)"
 glb_check "lapped GLB" l.glb
 if [ -n "$GLB_JSON" ]; then
-    check "lapped GLB: one material, lapped_baked, with the baked texture" "material lapped_baked, one 2048x2048 image" \
+    check "lapped GLB: one material, lapped_baked, with the baked texture" "material lapped_baked, one ${glb_side}x${glb_side} image" \
         "$GLB_JSON" "$(printf '%s' "$GLB_JSON" | grep -q '"name":"lapped_baked","pbrMetallicRoughness":{"baseColorTexture"' &&
                       [ "$(json_items materials | wc -l)" -eq 1 ] && glb_image l.glb baseColor baked.png &&
-                      [ "$(png_size baked.png)" = "2048 2048" ]; echo $?)"
+                      [ "$(png_size baked.png)" = "$glb_side $glb_side" ]; echo $?)"
 fi
 validate "lapped GLB" l.glb
 expect_ok "lapped --format glb --bake 256" lapped ../in/torus.obj ../in/lap.png l2 --scale 1.5 --format glb --bake 256
@@ -3877,7 +3887,7 @@ CMD="$HELPER_CC pty_watch.c (test helper)"
 if $HELPER_CC -O1 -w "$W/pty_watch.c" -o "$W/pty_watch" 2>"$W/err"; then
     newdir
     "$TOOL" generate mesh t.obj --shape torus >/dev/null 2>&1
-    # 24576 triangles and a 2048x2048 bake: about a second at -O2, a few under the sanitizers
+    # 24576 triangles and their bake: about a second at -O2, a few under the sanitizers
     CMD="pty_watch frames.txt tiledtex lapped t.obj ../in/lap.png out --scale 0.6 --subdivide 2"
     "$W/pty_watch" frames.txt "$TOOL" lapped t.obj ../in/lap.png out --scale 0.6 --subdivide 2 >/dev/null 2>&1
     RC=$?
