@@ -22780,7 +22780,7 @@ TTDEF tt_result tt_polycube_build_auto(const tt_mesh *mesh, const tt_polycube_op
     if (!report) report = &local_report;
     *out = NULL;
     if (max_resolution < 0 || max_resolution > TT_POLYCUBE_MAX_RESOLUTION) {
-        if (report) memset(report, 0, sizeof *report);
+        memset(report, 0, sizeof *report);
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_resolution %d is outside 0..%d",
                         max_resolution, TT_POLYCUBE_MAX_RESOLUTION);
     }

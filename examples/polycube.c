@@ -299,24 +299,15 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
    tile per square, the size --cube-size always promised. */
 static int scale_tiles(polycube_command_options *options, polycube_job *job, const tt_image *image)
 {
-    const tt_mesh *mesh = job->mesh.mesh;
-    double low[3], high[3], longest = 0.0, extent, texels;
-    int v, a, size;
+    double extent, texels;
+    int size;
     job->photo_tile = options->tiles.layout.tile_size;
     extent = options->texture_size;
     if (!(extent > 0.0) && (options->build.resolution || options->build.cube_size > 0.0))
         extent = job->polycube->h;
-    if (!(extent > 0.0)) {
-        for (a = 0; a < 3; a++) low[a] = high[a] = mesh->pos[a];
-        for (v = 1; v < mesh->nverts; v++)
-            for (a = 0; a < 3; a++) {
-                if (mesh->pos[3 * v + a] < low[a]) low[a] = mesh->pos[3 * v + a];
-                if (mesh->pos[3 * v + a] > high[a]) high[a] = mesh->pos[3 * v + a];
-            }
-        for (a = 0; a < 3; a++)
-            if (high[a] - low[a] > longest) longest = high[a] - low[a];
-        extent = longest / TT_POLYCUBE_DEFAULT_RESOLUTION;
-    }
+    /* The chosen polycube's cube is the mesh's longest side over its
+       resolution: the default is the cube of resolution 16. */
+    if (!(extent > 0.0)) extent = job->polycube->h * job->build_report.resolution / TT_POLYCUBE_DEFAULT_RESOLUTION;
     texels = job->photo_tile * job->polycube->h / extent;
     if (extent == job->polycube->h) return 0;   /* one --tile per square, as given */
     size = (int)(texels / 8.0 + 0.5) * 8;
