@@ -2843,8 +2843,9 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
         (Figs. 3-5) come out of Akleman's per-side rule on any consistently
         oriented quad mesh, which S is.
      3. tt_polycube_map: the mapping of the model onto S (Sec. 4), in place of the paper's per-cell configurations:
-        a. the model refined until no edge is longer than half a cube, so
-           a triangle holds about one vertex of S at most;
+        a. the model refined until no edge is longer than a cube, so a
+           triangle holds about one vertex of S at most, and to half a
+           cube where the mapping then falls short (mapped again);
         b. tt_polycube_project: each vertex gets its point q(v) = (quad,
            s, t) on S;
         c. the relaxation of the points on S where a triangle folds or an
@@ -3310,7 +3311,10 @@ TTDEF void tt_polycube_edges_free(tt_polycube_edges *edges);
 typedef struct tt_polycube_map_options {
     int max_quads;      /* the longest edge path, as tt_polycube_edge_options; 0 = its default */
     double max_edge;    /* model edges longer than this (mesh units) are halved first, until none is;
-                           0 = TT_POLYCUBE_MAP_DEFAULT_EDGE times the cube size h; HUGE_VAL: never */
+                           HUGE_VAL: never. 0 = TT_POLYCUBE_MAP_DEFAULT_EDGE times the cube size h, and
+                           where that mapping falls short (a triangle put whole into a quad, or a piece
+                           of no area on S), TT_POLYCUBE_MAP_FINER_EDGE times h on those faces for a
+                           second mapping (report->refined_again) */
     const tt_executor *executor;    /* runs the independent parts in parallel (the vertices' projection, the
                                        relaxation's groups of vertices, the edges' tracing, the triangles'
                                        split); NULL: serial. The same mapping either way, bit for bit */
@@ -3320,7 +3324,8 @@ typedef struct tt_polycube_map_options {
     void *progress_user_data;
 } tt_polycube_map_options;
 
-#define TT_POLYCUBE_MAP_DEFAULT_EDGE 0.5
+#define TT_POLYCUBE_MAP_DEFAULT_EDGE 1.0  /* cubes; see max_edge */
+#define TT_POLYCUBE_MAP_FINER_EDGE 0.5    /* cubes */
 
 /* The most triangles tt_polycube_map's refinement (max_edge) may make: a
    max_edge that needs more is refused with TT_ERROR_TOO_LARGE before the
@@ -3346,6 +3351,8 @@ typedef struct tt_polycube_map_report {
     int fallback_triangles; /* of `triangles`, those put whole into one quad: a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold; none is expected) */
     int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
+    int refined_again;      /* input faces refined to the finer bound for a second mapping, where the first
+                               fell short (default max_edge only); 0 when the first mapping stands */
 } tt_polycube_map_report;
 
 typedef struct tt_polycube_mapping {
@@ -3362,9 +3369,12 @@ typedef struct tt_polycube_mapping {
 
 /* Map `mesh` (triangles, outward facing; the mesh the polycube was built
    from, or any other near its surface) onto S:
-     1. refinement: edges longer than max_edge (half a cube by default)
-        are halved until none is, so a triangle spans few quads and holds
-        about one vertex of S at most;
+     1. refinement: edges longer than max_edge (a cube by default) are
+        halved until none is, so a triangle spans few quads and holds
+        about one vertex of S at most; by default, the faces where the
+        mapping then falls short (step 6 puts them whole into a quad, or
+        leaves a piece of no area) are refined to half a cube and the
+        model is mapped again from step 2, the better mapping kept;
      2. tt_polycube_project (points within 1e-5 of a quad's edge are put
         on it, so the model's vertices on lattice lines are on S's edges
         exactly);
@@ -4281,6 +4291,19 @@ static double tt__face_area_d(const tt_mesh *mesh, int face)
     double n[3], scale;
     tt__polygon_newell(mesh->pos, mesh->corner_vert + begin, mesh->face_start[face + 1] - begin, n, &scale);
     return 0.5 * tt__length3(n);
+}
+
+/* The length of a face's longest edge. */
+static double tt__face_longest_edge(const tt_mesh *mesh, int face)
+{
+    double longest = 0.0;
+    int c;
+    for (c = mesh->face_start[face]; c < mesh->face_start[face + 1]; c++) {
+        double edge[3], length;
+        tt__sub3f(mesh->pos + 3 * mesh->corner_vert[tt_mesh_next(mesh, c)], mesh->pos + 3 * mesh->corner_vert[c], edge);
+        if ((length = tt__length3(edge)) > longest) longest = length;
+    }
+    return longest;
 }
 
 /* TT_OK when every face is a triangle; else TT_ERROR_INVALID_ARGUMENT
@@ -23706,7 +23729,9 @@ static tt_result tt__retrace_moved(const tt_polycube *polycube, const tt_mesh *m
    refined vertex interpolates at most 3 vertices of one input triangle
    (the midpoint of a midpoint stays on its triangle), and each refined
    triangle knows its input face. When no edge is too long, all four stay
-   NULL: the model is the input. */
+   NULL: the model is the input. The bound may be finer on some input
+   faces (where a first mapping failed): an edge is halved while it is
+   longer than the bound of either face it borders. */
 typedef struct tt__refined {
     tt_mesh *mesh;
     int *source;                /* 3 per vertex: input vertices... */
@@ -23756,12 +23781,22 @@ static tt_result tt__polycube_refine_too_large(double longest, double needed, tt
     else snprintf(count, sizeof count, "%s%.3g", needed > 1e15 ? "over " : "at least ", needed > 1e15 ? 1e15 : needed);
     return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                     "refining the model to edges of at most %g makes %s triangles, above "
-                    "TT_POLYCUBE_MAX_TRIANGLES (%d): choose a larger max_edge (0: half a cube) or define "
+                    "TT_POLYCUBE_MAX_TRIANGLES (%d): choose a larger max_edge (0: the default) or define "
                     "TT_POLYCUBE_MAX_TRIANGLES higher",
                     longest, count, TT_POLYCUBE_MAX_TRIANGLES);
 }
 
-static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const tt_allocator *allocator,
+/* The bound on an edge between input faces `face` and `other` (-1 at a
+   border): the finer one where either is flagged in fine_faces. */
+static double tt__refine_bound(double longest, double fine_longest, const unsigned char *fine_faces, int face,
+                               int other)
+{
+    if (fine_faces && (fine_faces[face] || (other >= 0 && fine_faces[other]))) return fine_longest;
+    return longest;
+}
+
+static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double fine_longest,
+                                     const unsigned char *fine_faces, const tt_allocator *allocator,
                                      tt__refined *out, tt_error *error)
 {
     float *positions = NULL;
@@ -23776,21 +23811,24 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
     for (c = 0; c < mesh->ncorners; c++) {
         double edge[3];
         tt__sub3f(mesh->pos + 3 * mesh->corner_vert[tt_mesh_next(mesh, c)], mesh->pos + 3 * mesh->corner_vert[c], edge);
-        if (tt__length3(edge) > longest) break;
+        if (tt__length3(edge) > tt__refine_bound(longest, fine_longest, fine_faces, mesh->corner_face[c],
+                                                 mesh->twin[c] >= 0 ? mesh->corner_face[mesh->twin[c]] : -1))
+            break;
     }
     if (c == mesh->ncorners) return TT_OK;
     /* A triangle with no edge above `longest` has at most the area of the
        equilateral one: the model's area gives a floor on the count. */
     for (f = 0; f < mesh->nfaces; f++) {
         const int *corner = mesh->corner_vert + mesh->face_start[f];
+        const double bound = tt__refine_bound(longest, fine_longest, fine_faces, f, -1);
         double e[3], g[3], normal[3];
         tt__sub3f(mesh->pos + 3 * corner[1], mesh->pos + 3 * corner[0], e);
         tt__sub3f(mesh->pos + 3 * corner[2], mesh->pos + 3 * corner[0], g);
         tt__cross3(e, g, normal);
-        area += 0.5 * tt__length3(normal);
+        area += 0.5 * tt__length3(normal) / (bound * bound);
     }
-    needed = area / (0.4330127018922193 * longest * longest);
-    if (!(needed <= TT_POLYCUBE_MAX_TRIANGLES)) return tt__polycube_refine_too_large(longest, needed, error);
+    needed = area / 0.4330127018922193;
+    if (!(needed <= TT_POLYCUBE_MAX_TRIANGLES)) return tt__polycube_refine_too_large(fine_faces ? fine_longest : longest, needed, error);
     positions = (float *)tt__grow(allocator, NULL, &vertex_capacity, nverts > 0 ? nverts : 1, 3 * sizeof(float));
     source = TT__ALLOC(allocator, int, 3 * (size_t)vertex_capacity);
     weight = TT__ALLOC(allocator, double, 3 * (size_t)vertex_capacity);
@@ -23828,7 +23866,9 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
             int k;
             tt__sub3f(positions + 3 * b, positions + 3 * a, edge);
             mid[c] = -1;
-            if (tt__length3(edge) <= longest) continue;
+            if (tt__length3(edge) <= tt__refine_bound(longest, fine_longest, fine_faces, faces[current->corner_face[c]],
+                                                      twin >= 0 ? faces[current->corner_face[twin]] : -1))
+                continue;
             marked++;
             if (twin >= 0 && twin < c) {
                 mid[c] = mid[twin];
@@ -23929,7 +23969,7 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, const 
     out->face = faces;
     return TT_OK;
 too_large:
-    result = tt__polycube_refine_too_large(longest, needed, error);
+    result = tt__polycube_refine_too_large(fine_faces ? fine_longest : longest, needed, error);
     goto failed;
 out_of_memory:
     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory refining the model");
@@ -24483,6 +24523,7 @@ typedef struct tt__relax_lane {
 typedef struct tt__map_progress {
     const tt_polycube_map_options *options;
     float lo, hi;
+    float base, scale;  /* a mapping pass's share of the whole: its phases' [lo, hi] times scale, plus base */
     int cancelled;
 } tt__map_progress;
 
@@ -24500,9 +24541,9 @@ static void tt__map_progress_report(tt__map_progress *progress, double done)
    when the callback has asked to stop. */
 static int tt__map_progress_phase(tt__map_progress *progress, float lo, float hi)
 {
-    progress->lo = progress->hi = lo;
+    progress->lo = progress->hi = progress->base + progress->scale * lo;
     tt__map_progress_report(progress, 0.0);
-    progress->hi = hi;
+    progress->hi = progress->base + progress->scale * hi;
     return progress->cancelled;
 }
 
@@ -26876,9 +26917,10 @@ out_of_memory:
    split would have made them: per triangle, the split points it asked for
    (each made the first time any triangle asks: crossing_vertex), then its
    own vertices, then its triangles, their tokens turned into m's
-   vertices. Adds its fallbacks to *fallbacks. 0 when out of memory. */
+   vertices. Adds its fallbacks to *fallbacks and flags them in fell_back
+   (per model triangle; NULL: not wanted). 0 when out of memory. */
 static int tt__split_merge(const tt__split *S, int begin, int end, tt_polycube_mapping *m, int *vertex_capacity,
-                           int *triangle_capacity, int *crossing_vertex, int *fallbacks)
+                           int *triangle_capacity, int *crossing_vertex, int *fallbacks, unsigned char *fell_back)
 {
     int f, v = 0, t = 0, r = 0;
     for (f = begin; f < end; f++) {
@@ -26911,6 +26953,7 @@ static int tt__split_merge(const tt__split *S, int begin, int end, tt_polycube_m
                 return 0;
         }
         *fallbacks += ends[3];
+        if (fell_back) fell_back[f] = (unsigned char)ends[3];
     }
     return 1;
 }
@@ -26966,7 +27009,8 @@ static void tt__split_free(tt__split *S)
    TT_OK or TT_ERROR_OUT_OF_MEMORY (*out NULL, nothing left allocated). */
 static tt_result tt__polycube_split(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
                                     const tt_surface_point *points, const tt_executor *executor,
-                                    const tt_allocator *allocator, tt_polycube_mapping **out, int *fallbacks)
+                                    const tt_allocator *allocator, tt_polycube_mapping **out, int *fallbacks,
+                                    unsigned char *fell_back)
 {
     tt_polycube_mapping *m = TT__ALLOC(allocator, tt_polycube_mapping, 1);
     tt__split *tasks = TT__ALLOC(allocator, tt__split, TT__SPLIT_BATCH);
@@ -27007,7 +27051,8 @@ static tt_result tt__polycube_split(const tt_polycube *pc, const tt_mesh *model,
             const int begin = first + i * TT__SPLIT_RANGE;
             const int end = model->nfaces - begin > TT__SPLIT_RANGE ? begin + TT__SPLIT_RANGE : model->nfaces;
             failed = tasks[i].failed || !tt__split_merge(&tasks[i], begin, end, m, &vertex_capacity,
-                                                         &triangle_capacity, crossing_vertex, fallbacks);
+                                                         &triangle_capacity, crossing_vertex, fallbacks,
+                                                         fell_back);
         }
     }
     for (i = 0; tasks && i < TT__SPLIT_BATCH; i++) tt__split_free(&tasks[i]);
@@ -27036,70 +27081,44 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping)
     tt__free(&allocator, mapping);
 }
 
-TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
-                                const tt_polycube_map_options *options, const tt_allocator *allocator,
-                                tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error)
+#define TT__MAP_ROUNDS 3             /* mappings tt_polycube_map makes at most by default, each finer where
+                                       the ones before fell short */
+
+/* One mapping of `mesh` (checked by tt_polycube_map) refined to edges of
+   at most `longest`, or fine_longest next to the input faces flagged in
+   fine_faces (NULL: none): steps 1 to 6 of tt_polycube_map. troubled
+   (per input face; NULL: not wanted) gets a flag on each input face the
+   mapping fell short on: a part put whole into one quad (a local seam),
+   or an output triangle folded or of no area on S (a sliver of smeared
+   texture). On failure nothing stays allocated and the report is
+   zeroed. */
+static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mesh *mesh, double longest,
+                                       double fine_longest, const unsigned char *fine_faces,
+                                       const tt_polycube_map_options *options, const tt_allocator *allocator,
+                                       tt__map_progress *progress, unsigned char *troubled,
+                                       tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error)
 {
-    tt_polycube_map_report local;
     tt_polycube_edge_options edge_options;
     tt_surface_point *points = NULL, *earlier = NULL;
-    unsigned char *moved = NULL, *focus = NULL;
+    unsigned char *moved = NULL, *focus = NULL, *fell_back = NULL;
     tt_polycube_edges *edges = NULL;
     const tt_mesh *model;
     tt__refined R;
     tt_polycube_mapping *mapping = NULL;
     tt_result result;
     const tt_executor *executor = options ? options->executor : NULL;
-    double longest;
     int f, v, j, tracing, cycle, moves, max_quads;
     tt__reseat_memory reseat;
-    tt__map_progress progress;
-    tt__ok(error);
-    if (out) *out = NULL;
-    if (!report) report = &local;
+    *out = NULL;
     memset(report, 0, sizeof *report);
     memset(&R, 0, sizeof R);
     memset(&reseat, 0, sizeof reseat);
-    memset(&progress, 0, sizeof progress);
-    progress.options = options;
-    if (!polycube || !mesh || !out)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_polycube_map needs a polycube, a mesh and out (got NULL)");
-    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     memset(&edge_options, 0, sizeof edge_options);
     if (options) edge_options.max_quads = options->max_quads;
     max_quads = edge_options.max_quads ? edge_options.max_quads : TT_POLYCUBE_EDGE_DEFAULT_QUADS;
-    if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
-    for (f = 0; f < mesh->nfaces; f++)
-        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
-                            "face %d has %d corners: tt_polycube_map needs triangles (split the faces into fans "
-                            "first)", f, mesh->face_start[f + 1] - mesh->face_start[f]);
-    /* Two triangles on the same three corners close on each other: a part
-       with no inside, which no polycube surface maps onto (its refinement
-       would also put four triangles on one edge). */
-    for (f = 0; f < mesh->nfaces; f++) {
-        int c = mesh->face_start[f], g = mesh->twin[c] >= 0 ? mesh->corner_face[mesh->twin[c]] : -1;
-        if (g > f && mesh->twin[c + 1] >= 0 && mesh->twin[c + 2] >= 0 && mesh->corner_face[mesh->twin[c + 1]] == g &&
-            mesh->corner_face[mesh->twin[c + 2]] == g) {
-            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, mesh->corner_vert[c], -1,
-                              "faces %d and %d have the same three corners and enclose nothing: remove the pair "
-                              "(a polycube maps a part with an inside)", f, g);
-            if (error) error->other_face = g;
-            return result;
-        }
-    }
-    if (!tt__polycube_consistent(polycube))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the polycube's surface has no quads or does not match its cubes: make it with "
-                        "tt_polycube_build and leave it unchanged");
-    longest = options && options->max_edge != 0.0 ? options->max_edge : TT_POLYCUBE_MAP_DEFAULT_EDGE * polycube->h;
-    if (!(longest > 0.0))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "max_edge %g: give a length above 0 (0 for the default, HUGE_VAL for no refinement)",
-                        options->max_edge);
-    if ((result = tt__polycube_refine(mesh, longest, allocator, &R, error)) != TT_OK) goto failed;
-    if (tt__map_progress_phase(&progress, 0.05f, 0.2f)) goto cancelled;
+    if ((result = tt__polycube_refine(mesh, longest, fine_longest, fine_faces, allocator, &R, error)) != TT_OK)
+        goto failed;
+    if (tt__map_progress_phase(progress, 0.05f, 0.2f)) goto cancelled;
     model = R.mesh ? R.mesh : mesh;
     report->triangles = model->nfaces;
     points = TT__ALLOC(allocator, tt_surface_point, model->nverts > 0 ? model->nverts : 1);
@@ -27107,20 +27126,20 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if ((result = tt__polycube_project(polycube, model, executor, allocator, points, &report->projection, error)) !=
         TT_OK)
         goto failed;
-    if (tt__map_progress_phase(&progress, 0.2f, 0.3f)) goto cancelled;
+    if (tt__map_progress_phase(progress, 0.2f, 0.3f)) goto cancelled;
     tt__polycube_snap_points(points, model->nverts);
-    if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator, &progress)) < 0)
+    if ((report->relaxed = tt__polycube_relax(polycube, model, points, NULL, executor, allocator, progress)) < 0)
         goto out_of_memory;
-    if (tt__map_progress_phase(&progress, 0.3f, 0.45f)) goto cancelled;
+    if (tt__map_progress_phase(progress, 0.3f, 0.45f)) goto cancelled;
     if ((report->smoothed =
-             tt__polycube_smooth(polycube, model, points, executor, allocator, &report->held, &progress)) < 0)
+             tt__polycube_smooth(polycube, model, points, executor, allocator, &report->held, progress)) < 0)
         goto out_of_memory;
     tt__polycube_snap_points(points, model->nverts);   /* again: the smoothing moves points near edges too */
-    if (tt__map_progress_phase(&progress, 0.45f, 0.6f)) goto cancelled;
+    if (tt__map_progress_phase(progress, 0.45f, 0.6f)) goto cancelled;
     if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, executor, allocator, NULL,
                                   NULL, &edges, error)) != TT_OK)
         goto failed;
-    if (tt__map_progress_phase(&progress, 0.6f, 0.6f)) goto cancelled;
+    if (tt__map_progress_phase(progress, 0.6f, 0.6f)) goto cancelled;
     if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
         !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
         !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
@@ -27133,7 +27152,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
        the edges at the points it moved are traced again. */
     for (cycle = 0; cycle < TT__RESEAT_CYCLES && edges->nfailed > 0; cycle++) {
         int reseated = 0, round, e;
-        if (cycle > 0 && tt__map_progress_phase(&progress, 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES,
+        if (cycle > 0 && tt__map_progress_phase(progress, 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES,
                                                 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES))
             goto cancelled;
         memset(focus, 0, (size_t)model->nverts);
@@ -27193,10 +27212,11 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
             goto failed;
     }
     report->failed_edges = edges->nfailed;
-    if (tt__map_progress_phase(&progress, 0.85f, 0.85f)) goto cancelled;
+    if (tt__map_progress_phase(progress, 0.85f, 0.85f)) goto cancelled;
 
+    if (troubled && !(fell_back = TT__ALLOC(allocator, unsigned char, model->nfaces))) goto out_of_memory;
     if (tt__polycube_split(polycube, model, edges, points, executor, allocator, &mapping,
-                           &report->fallback_triangles) != TT_OK)
+                           &report->fallback_triangles, fell_back) != TT_OK)
         goto out_of_memory;
     /* Back to the input: each output vertex's refined sources become input vertices (at most 3, all of one
        input triangle), each output triangle's refined face its input face. */
@@ -27241,7 +27261,11 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         double turn = tt__orient2(p[0].s, p[0].t, p[1].s, p[1].t, p[2].s, p[2].t);
         report->flipped += turn < -TT__SPLIT_AREA;
         report->collapsed += fabs(turn) <= TT__SPLIT_AREA;
+        if (troubled && turn <= TT__SPLIT_AREA) troubled[mapping->triangle_face[j]] = 1;
     }
+    for (f = 0; fell_back && f < model->nfaces; f++)
+        if (fell_back[f]) troubled[R.face ? R.face[f] : f] = 1;
+    tt__free(allocator, fell_back);
     tt_polycube_edges_free(edges);
     tt__free(allocator, earlier);
     tt__free(allocator, moved);
@@ -27250,11 +27274,6 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     tt__free(allocator, reseat.seen);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
-    if (tt__map_progress_phase(&progress, 1.0f, 1.0f)) {
-        tt_polycube_mapping_free(mapping);
-        memset(report, 0, sizeof *report);
-        return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "polycube mapping cancelled by the progress callback");
-    }
     *out = mapping;
     return TT_OK;
 cancelled:
@@ -27264,6 +27283,7 @@ out_of_memory:
     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory mapping the mesh onto S");
 failed:
     tt_polycube_mapping_free(mapping);
+    tt__free(allocator, fell_back);
     tt_polycube_edges_free(edges);
     tt__free(allocator, earlier);
     tt__free(allocator, moved);
@@ -27274,6 +27294,122 @@ failed:
     tt__refined_free(allocator, &R);
     memset(report, 0, sizeof *report);
     return result;
+}
+
+TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh,
+                                const tt_polycube_map_options *options, const tt_allocator *allocator,
+                                tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error)
+{
+    tt_polycube_map_report local, again;
+    tt_polycube_mapping *mapping = NULL, *finer = NULL;
+    unsigned char *troubled = NULL, *fine;
+    tt_result result;
+    double longest;
+    int f, ntroubled = 0;
+    tt__map_progress progress;
+    tt__ok(error);
+    if (out) *out = NULL;
+    if (!report) report = &local;
+    memset(report, 0, sizeof *report);
+    memset(&progress, 0, sizeof progress);
+    progress.options = options;
+    progress.scale = 1.0f;
+    if (!polycube || !mesh || !out)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_map needs a polycube, a mesh and out (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (mesh->nfaces <= 0) return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces");
+    for (f = 0; f < mesh->nfaces; f++)
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d has %d corners: tt_polycube_map needs triangles (split the faces into fans "
+                            "first)", f, mesh->face_start[f + 1] - mesh->face_start[f]);
+    /* Two triangles on the same three corners close on each other: a part
+       with no inside, which no polycube surface maps onto (its refinement
+       would also put four triangles on one edge). */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int c = mesh->face_start[f], g = mesh->twin[c] >= 0 ? mesh->corner_face[mesh->twin[c]] : -1;
+        if (g > f && mesh->twin[c + 1] >= 0 && mesh->twin[c + 2] >= 0 && mesh->corner_face[mesh->twin[c + 1]] == g &&
+            mesh->corner_face[mesh->twin[c + 2]] == g) {
+            result = tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, mesh->corner_vert[c], -1,
+                              "faces %d and %d have the same three corners and enclose nothing: remove the pair "
+                              "(a polycube maps a part with an inside)", f, g);
+            if (error) error->other_face = g;
+            return result;
+        }
+    }
+    if (!tt__polycube_consistent(polycube))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the polycube's surface has no quads or does not match its cubes: make it with "
+                        "tt_polycube_build and leave it unchanged");
+    longest = options && options->max_edge != 0.0 ? options->max_edge : TT_POLYCUBE_MAP_DEFAULT_EDGE * polycube->h;
+    if (!(longest > 0.0))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "max_edge %g: give a length above 0 (0 for the default, HUGE_VAL for no refinement)",
+                        options->max_edge);
+    if (options && options->max_edge != 0.0) {
+        result = tt__polycube_map_pass(polycube, mesh, longest, longest, NULL, options, allocator, &progress, NULL,
+                                       &mapping, report, error);
+    } else {
+        /* A first mapping with the coarser bound; where it falls short (a
+           large triangle holding two cone points of S, or bending round a
+           saddle), those faces are refined to the finer bound and the
+           whole is mapped again, up to TT__MAP_ROUNDS times while new
+           faces fall short; the best mapping stays. The output grows with
+           the squares the model crosses, not by a fixed factor (a finer
+           bound everywhere doubles a coarse model's output for the few
+           triangles that need it). */
+        const double fine_longest = TT_POLYCUBE_MAP_FINER_EDGE * polycube->h;
+        int round, bad = 0;
+        if (!(troubled = TT__ALLOC(allocator, unsigned char, 2 * (size_t)mesh->nfaces)))
+            return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory mapping the mesh onto S");
+        fine = troubled + mesh->nfaces;
+        memset(fine, 0, (size_t)mesh->nfaces);
+        progress.scale = 1.0f / TT__MAP_ROUNDS;
+        for (round = 0; round < TT__MAP_ROUNDS; round++) {
+            int added = 0;
+            memset(troubled, 0, (size_t)mesh->nfaces);
+            progress.base = (float)round / TT__MAP_ROUNDS;
+            if ((result = tt__polycube_map_pass(polycube, mesh, longest, fine_longest, round ? fine : NULL, options,
+                                                allocator, &progress, troubled, &finer, &again, error)) != TT_OK)
+                break;
+            again.refined_again = ntroubled;
+            if (!mapping || again.fallback_triangles + again.flipped + again.collapsed < bad) {
+                tt_polycube_mapping_free(mapping);
+                mapping = finer;
+                *report = again;
+                bad = again.fallback_triangles + again.flipped + again.collapsed;
+            } else {
+                tt_polycube_mapping_free(finer);
+            }
+            finer = NULL;
+            /* A face whose edges are all within the finer bound would map the same: it is left. */
+            for (f = 0; f < mesh->nfaces; f++)
+                if (troubled[f] && !fine[f] && tt__face_longest_edge(mesh, f) > fine_longest) {
+                    fine[f] = 1;
+                    added++;
+                }
+            if (!bad || !added) break;
+            ntroubled += added;
+        }
+        /* A finer mapping too large to make leaves the ones before it. */
+        if (result == TT_ERROR_TOO_LARGE && mapping) {
+            tt__ok(error);
+            result = TT_OK;
+        }
+        tt__free(allocator, troubled);
+    }
+    progress.base = 0.0f;
+    progress.scale = 1.0f;
+    if (result == TT_OK && tt__map_progress_phase(&progress, 1.0f, 1.0f))
+        result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "polycube mapping cancelled by the progress callback");
+    if (result != TT_OK) {
+        tt_polycube_mapping_free(mapping);
+        memset(report, 0, sizeof *report);
+        return result;
+    }
+    *out = mapping;
+    return TT_OK;
 }
 
 TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad)

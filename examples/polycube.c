@@ -587,9 +587,11 @@ static void print_summary(const polycube_command_options *options, const polycub
     printf("mapping: %d triangles, %d split, %d fallback, %d failed edges, %d flipped, %d collapsed",
            job->mapping->ntriangles, m->split_triangles, m->fallback_triangles, m->failed_edges, m->flipped,
            m->collapsed);
-    /* The library halves edges longer than half a cube first, so that no
-       triangle holds several corners of the polycube. */
+    /* The library halves edges longer than a cube first, so that no
+       triangle holds several corners of the polycube, and to half a cube
+       where that mapping fell short. */
     if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
+    if (m->refined_again) printf(" (%d input faces refined further, where a first mapping fell short)", m->refined_again);
     printf("; smoothing: %d moves, %d vertices left as projected", m->smoothed, m->held);
     printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);

@@ -2207,6 +2207,57 @@ static void test_map_sphere(void)
         }
 }
 
+/* The default refinement maps once with edges up to a cube, then refines
+   to half a cube only the faces that mapping fell short on and maps again.
+   The control, one mapping at a cube, must fall short somewhere (a
+   triangle put whole into a quad, or a piece of no area); the default
+   must fall short less, and make far fewer triangles than half a cube
+   everywhere, with no more fallbacks than the sphere test allows. */
+static void test_map_refine_where_needed(void)
+{
+    const double centre[3] = {0.13, -0.21, 0.05};
+    tmesh m;
+    tt_mesh *mesh;
+    tt_polycube *pc;
+    tt_polycube_map_report rep, coarse_rep, fine_rep;
+    tt_polycube_map_options mo;
+    tt_polycube_mapping *map, *coarse = NULL, *fine = NULL;
+    tt_error err;
+    memset(&m, 0, sizeof m);
+    memset(&mo, 0, sizeof mo);
+    make_sphere(&m, 48, 24, 1.0, centre, 0);
+    map = mapped(&m, 32, 0, 0.0, &pc, &mesh, &rep);
+    if (map) {
+        mo.max_edge = pc->h;
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &coarse, &coarse_rep, &err) == TT_OK, "coarse: %s", err.message);
+        mo.max_edge = 0.5 * pc->h;
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &fine, &fine_rep, &err) == TT_OK, "fine: %s", err.message);
+    }
+    if (map && coarse && fine) {
+        printf("     sphere at 32: one mapping at a cube %d triangles, %d fallbacks, %d empty; half a cube %d, %d, %d; "
+               "default %d, %d, %d (%d faces refined again)\n", coarse->ntriangles, coarse_rep.fallback_triangles,
+               coarse_rep.collapsed, fine->ntriangles, fine_rep.fallback_triangles, fine_rep.collapsed,
+               map->ntriangles, rep.fallback_triangles, rep.collapsed, rep.refined_again);
+        CHECK(coarse_rep.fallback_triangles + coarse_rep.collapsed > 0 && coarse_rep.refined_again == 0,
+              "control: one mapping at a cube falls short (%d fallbacks, %d empty)", coarse_rep.fallback_triangles,
+              coarse_rep.collapsed);
+        CHECK(rep.refined_again > 0 && rep.fallback_triangles + rep.collapsed <
+                                           coarse_rep.fallback_triangles + coarse_rep.collapsed,
+              "the default refines again (%d faces) and falls short less (%d + %d against %d + %d)",
+              rep.refined_again, rep.fallback_triangles, rep.collapsed, coarse_rep.fallback_triangles,
+              coarse_rep.collapsed);
+        CHECK(map->ntriangles <= 0.7 * fine->ntriangles && rep.fallback_triangles <= rep.triangles / 1000,
+              "the default makes %d triangles (at most 70 %% of half a cube's %d) with %d fallbacks (at most 0.1 "
+              "%% of %d)", map->ntriangles, fine->ntriangles, rep.fallback_triangles, rep.triangles);
+    }
+    tt_polycube_mapping_free(map);
+    tt_polycube_mapping_free(coarse);
+    tt_polycube_mapping_free(fine);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
 /* The seam tests' tiles: n = 2, 32-texel tiles with a 4-texel gutter, seed 3,
    from a 160 x 256 value noise (*photo, to free); NULL on failure. */
 static tt_tileset *seam_test_tiles(tt_synth_options *so, tt_image **photo)
@@ -2692,9 +2743,12 @@ static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map)
 
 /* The stretch floor of a voxel polycube: a cube turned 45
    degrees about z maps its four sides onto staircases sqrt 2 longer across
-   the slope, at any resolution, so the area-weighted median stretch (the
-   sides are 2/3 of the area) is sqrt 2 at 16 and at 64; a metric that only
-   measured area would not see it. */
+   the slope, at any resolution. A uniform map of a side has stretch sqrt 2
+   everywhere; a map may trade some of it for density (stretching less in
+   one place, more in another), so the area-weighted median may fall below
+   sqrt 2 but the 95th percentile may not (the sides are 2/3 of the area),
+   and nothing is far above it; a metric that only measured area would see
+   1. */
 static void test_map_stretch_floor(void)
 {
     const double lo[3] = {-0.5, -0.5, -0.5}, hi[3] = {0.5, 0.5, 0.5}, c = cos(0.25 * 3.14159265358979323846),
@@ -2720,9 +2774,9 @@ static void test_map_stretch_floor(void)
             printf("     cube turned 45 degrees at resolution %d: stretch median %.3f, p95 %.3f; %d fallbacks of %d, "
                    "%d flipped\n", resolution, d.stretch_median, d.stretch_p95, rep.fallback_triangles,
                    rep.triangles, rep.flipped);
-            CHECK(fabs(d.stretch_median - sqrt(2.0)) <= 0.1 * sqrt(2.0),
-                  "cube turned 45 degrees at resolution %d: median stretch %.3f, sqrt 2 within 10 %%", resolution,
-                  d.stretch_median);
+            CHECK(d.stretch_median >= 1.15 && d.stretch_p95 >= 0.95 * sqrt(2.0) && d.stretch_p95 <= 1.15 * sqrt(2.0),
+                  "cube turned 45 degrees at resolution %d: median stretch %.3f (1.15 or more), p95 %.3f (sqrt 2 "
+                  "within -5 %% and +15 %%)", resolution, d.stretch_median, d.stretch_p95);
         }
         tt_polycube_mapping_free(map);
         tt_polycube_free(pc);
@@ -3676,6 +3730,7 @@ static void test_map_refined_sliver(void)
     tt_mesh *mesh = NULL;
     tt_polycube *pc = NULL;
     tt_polycube_options po;
+    tt_polycube_map_options mo;
     tt_polycube_mapping *map = NULL;
     tt_polycube_map_report rep;
     tt_error err;
@@ -3686,10 +3741,12 @@ static void test_map_refined_sliver(void)
     for (i = 0; i < 9; i++) tm_vert(&m, positions[i][0], positions[i][1], positions[i][2]);
     for (i = 0; i < 8; i++) tm_tri(&m, triangles[i][0], triangles[i][1], triangles[i][2]);
     po.cube_size = 1.0;
+    memset(&mo, 0, sizeof mo);
+    mo.max_edge = 0.5;  /* halves the long edges whatever the default */
     if (build(&m, 0, &mesh, &err) != TT_OK || tt_polycube_build(mesh, &po, NULL, &pc, NULL, &err) != TT_OK) {
         CHECK(0, "the strip with a sliver builds: %s", err.message);
     } else {
-        r = tt_polycube_map(pc, mesh, NULL, NULL, &map, &rep, &err);
+        r = tt_polycube_map(pc, mesh, &mo, NULL, &map, &rep, &err);
         CHECK(r == TT_OK && map != NULL && rep.triangles > mesh->nfaces,
               "a sliver whose refined triangles lose their area maps (got %d: %s; %d refined triangles)", (int)r,
               r == TT_OK ? "" : err.message, r == TT_OK ? rep.triangles : 0);
@@ -3781,6 +3838,7 @@ void run_polycube_tests(void)
     RUN(test_edges_determinism_and_errors);
     RUN(test_map_cube);
     RUN(test_map_sphere);
+    RUN(test_map_refine_where_needed);
     RUN(test_map_uvs_and_seams);
     RUN(test_map_uvs_upright);
     RUN(test_map_determinism_and_errors);
