@@ -23795,6 +23795,77 @@ static double tt__refine_bound(double longest, double fine_longest, const unsign
     return longest;
 }
 
+/* Room for one more refined vertex past nverts: the three per-vertex
+   arrays grown together (each kept when its growth fails). 0 when out of
+   memory. */
+static int tt__refined_grow(const tt_allocator *allocator, int nverts, int *vertex_capacity, float **positions,
+                            int **source, double **weight)
+{
+    int capacity = *vertex_capacity, *grown_source;
+    float *grown_positions;
+    double *grown_weight;
+    grown_positions = (float *)tt__grow(allocator, *positions, &capacity, nverts + 1, 3 * sizeof(float));
+    if (!grown_positions) return 0;
+    *positions = grown_positions;
+    capacity = *vertex_capacity;
+    grown_source = (int *)tt__grow(allocator, *source, &capacity, nverts + 1, 3 * sizeof(int));
+    if (!grown_source) return 0;
+    *source = grown_source;
+    capacity = *vertex_capacity;
+    grown_weight = (double *)tt__grow(allocator, *weight, &capacity, nverts + 1, 3 * sizeof(double));
+    if (!grown_weight) return 0;
+    *weight = grown_weight;
+    *vertex_capacity = capacity;
+    return 1;
+}
+
+/* The refined triangles of triangle `corner` (3 vertices) whose edges
+   (corner[r], corner[r + 1]) have midpoints mid[r] (-1: not split): 1 to
+   4 triangles into add (3 vertices each), wound as the input. Returns the
+   count of vertices written. */
+static int tt__refine_triangle(const float *positions, const int *corner, const int *m, int add[12])
+{
+    int r, split = 0, n = 0;
+    int a, b, cc, ab, bc, ca;
+    for (r = 0; r < 3; r++) split += m[r] >= 0;
+    /* Turn the triangle so its split edges come first: (a, b) always split when any is. */
+    for (r = 0; r < 3 && split > 0 && split < 3; r++)
+        if (m[r] >= 0 && m[(r + 2) % 3] < 0) break;
+    if (split == 0 || split == 3) r = 0;
+    a = corner[r];
+    b = corner[(r + 1) % 3];
+    cc = corner[(r + 2) % 3];
+    ab = m[r];
+    bc = m[(r + 1) % 3];
+    ca = m[(r + 2) % 3];
+    if (split == 0) {
+        add[n++] = a; add[n++] = b; add[n++] = cc;
+    } else if (split == 1) {
+        add[n++] = a; add[n++] = ab; add[n++] = cc;
+        add[n++] = ab; add[n++] = b; add[n++] = cc;
+    } else if (split == 2) {
+        /* (a, b) and (b, c) split: the corner at b, then the quad a, ab, bc, c by its shorter
+           diagonal. */
+        double diagonal_a[3], diagonal_c[3];
+        tt__sub3f(positions + 3 * a, positions + 3 * bc, diagonal_a);
+        tt__sub3f(positions + 3 * cc, positions + 3 * ab, diagonal_c);
+        add[n++] = ab; add[n++] = b; add[n++] = bc;
+        if (tt__length3(diagonal_a) <= tt__length3(diagonal_c)) {
+            add[n++] = a; add[n++] = ab; add[n++] = bc;
+            add[n++] = a; add[n++] = bc; add[n++] = cc;
+        } else {
+            add[n++] = a; add[n++] = ab; add[n++] = cc;
+            add[n++] = ab; add[n++] = bc; add[n++] = cc;
+        }
+    } else {
+        add[n++] = a; add[n++] = ab; add[n++] = ca;
+        add[n++] = ab; add[n++] = b; add[n++] = bc;
+        add[n++] = ca; add[n++] = bc; add[n++] = cc;
+        add[n++] = ab; add[n++] = bc; add[n++] = ca;
+    }
+    return n;
+}
+
 static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double fine_longest,
                                      const unsigned char *fine_faces, const tt_allocator *allocator,
                                      tt__refined *out, tt_error *error)
@@ -23875,25 +23946,12 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double
                 continue;
             }
             if (nverts == vertex_capacity) {
-                int capacity = vertex_capacity, *grown_source;
-                float *grown_positions;
-                double *grown_weight;
                 if (nverts >= INT_MAX / 4) {   /* only with TT_POLYCUBE_MAX_TRIANGLES defined huge */
                     needed = 2.0 * nverts;
                     goto too_large;
                 }
-                grown_positions = (float *)tt__grow(allocator, positions, &capacity, nverts + 1, 3 * sizeof(float));
-                if (!grown_positions) goto out_of_memory;
-                positions = grown_positions;
-                capacity = vertex_capacity;
-                grown_source = (int *)tt__grow(allocator, source, &capacity, nverts + 1, 3 * sizeof(int));
-                if (!grown_source) goto out_of_memory;
-                source = grown_source;
-                capacity = vertex_capacity;
-                grown_weight = (double *)tt__grow(allocator, weight, &capacity, nverts + 1, 3 * sizeof(double));
-                if (!grown_weight) goto out_of_memory;
-                weight = grown_weight;
-                vertex_capacity = capacity;
+                if (!tt__refined_grow(allocator, nverts, &vertex_capacity, &positions, &source, &weight))
+                    goto out_of_memory;
             }
             for (k = 0; k < 3; k++)
                 positions[3 * nverts + k] = (float)(0.5 * ((double)positions[3 * a + k] + positions[3 * b + k]));
@@ -23909,45 +23967,9 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double
         next_faces = TT__ALLOC(allocator, int, 4 * (size_t)ntriangles);
         if (!next_triangles || !next_faces) goto out_of_memory;
         for (f = 0; f < ntriangles; f++) {
-            int r, split = 0, *t;
-            const int *corner = triangles + 3 * f, *m = mid + 3 * f;
-            for (r = 0; r < 3; r++) split += m[r] >= 0;
-            /* Turn the triangle so its split edges come first: (a, b) always split when any is. */
-            for (r = 0; r < 3 && split > 0 && split < 3; r++)
-                if (m[r] >= 0 && m[(r + 2) % 3] < 0) break;
-            if (split == 0 || split == 3) r = 0;
-            {
-                int a = corner[r], b = corner[(r + 1) % 3], cc = corner[(r + 2) % 3];
-                int ab = m[r], bc = m[(r + 1) % 3], ca = m[(r + 2) % 3], add[12], n = 0, k;
-                if (split == 0) {
-                    add[n++] = a; add[n++] = b; add[n++] = cc;
-                } else if (split == 1) {
-                    add[n++] = a; add[n++] = ab; add[n++] = cc;
-                    add[n++] = ab; add[n++] = b; add[n++] = cc;
-                } else if (split == 2) {
-                    /* (a, b) and (b, c) split: the corner at b, then the quad a, ab, bc, c by its shorter
-                       diagonal. */
-                    double diagonal_a[3], diagonal_c[3];
-                    tt__sub3f(positions + 3 * a, positions + 3 * bc, diagonal_a);
-                    tt__sub3f(positions + 3 * cc, positions + 3 * ab, diagonal_c);
-                    add[n++] = ab; add[n++] = b; add[n++] = bc;
-                    if (tt__length3(diagonal_a) <= tt__length3(diagonal_c)) {
-                        add[n++] = a; add[n++] = ab; add[n++] = bc;
-                        add[n++] = a; add[n++] = bc; add[n++] = cc;
-                    } else {
-                        add[n++] = a; add[n++] = ab; add[n++] = cc;
-                        add[n++] = ab; add[n++] = bc; add[n++] = cc;
-                    }
-                } else {
-                    add[n++] = a; add[n++] = ab; add[n++] = ca;
-                    add[n++] = ab; add[n++] = b; add[n++] = bc;
-                    add[n++] = ca; add[n++] = bc; add[n++] = cc;
-                    add[n++] = ab; add[n++] = bc; add[n++] = ca;
-                }
-                t = next_triangles + 3 * next_count;
-                memcpy(t, add, sizeof(int) * (size_t)n);
-                for (k = 0; k < n / 3; k++) next_faces[next_count++] = faces[f];
-            }
+            int add[12], n = tt__refine_triangle(positions, triangles + 3 * f, mid + 3 * f, add), k;
+            memcpy(next_triangles + 3 * next_count, add, sizeof(int) * (size_t)n);
+            for (k = 0; k < n / 3; k++) next_faces[next_count++] = faces[f];
         }
         tt__free(allocator, triangles);
         tt__free(allocator, faces);
@@ -27081,6 +27103,159 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping)
     tt__free(&allocator, mapping);
 }
 
+/* Step 5's repairs (see tt_polycube_map): the vertices with an edge that
+   finds no path re-seated and the relaxation run around them, in up to
+   TT__RESEAT_CYCLES cycles, then the spikes taken off; the edges at every
+   point moved are traced again (*edges_io replaced). *relaxed counts the
+   relaxation's moves. */
+static tt_result tt__polycube_repair_edges(const tt_polycube *polycube, const tt_mesh *model,
+                                           const tt_polycube_edge_options *edge_options, int max_quads,
+                                           const tt_executor *executor, const tt_allocator *allocator,
+                                           tt__map_progress *progress, tt_surface_point *points,
+                                           tt_polycube_edges **edges_io, int *relaxed, tt_error *error)
+{
+    tt_polycube_edges *edges = *edges_io;
+    tt_surface_point *earlier = NULL;
+    unsigned char *moved = NULL, *focus = NULL;
+    tt__reseat_memory reseat;
+    tt_result result = TT_OK;
+    int v, tracing, cycle, moves;
+    memset(&reseat, 0, sizeof reseat);
+    if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
+        !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
+        !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
+        !(reseat.stayed = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
+        !(reseat.seen = TT__ALLOC(allocator, tt_surface_point, model->nverts)))
+        goto out_of_memory;
+    memset(reseat.stayed, 0, (size_t)model->nverts);
+    /* Vertices with an edge that finds no path are re-seated (tt__polycube_reseat) and their edges traced
+       again, up to TT__RESEAT_ROUNDS times; the relaxation then opens the folds that leaves near them, and
+       the edges at the points it moved are traced again. */
+    for (cycle = 0; cycle < TT__RESEAT_CYCLES && edges->nfailed > 0; cycle++) {
+        int reseated = 0, round, e;
+        if (cycle > 0 && tt__map_progress_phase(progress, 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES,
+                                                0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES))
+            goto cancelled;
+        memset(focus, 0, (size_t)model->nverts);
+        for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
+            int n, failed_before = edges->nfailed;
+            memset(moved, 0, (size_t)model->nverts);
+            if ((n = tt__polycube_reseat(polycube, model, edges, max_quads, points, moved, &reseat, allocator)) < 0)
+                goto out_of_memory;
+            if (!n) break;
+            reseated += n;
+            for (v = 0; v < model->nverts; v++) focus[v] |= moved[v];
+            if ((result = tt__retrace_moved(polycube, model, points, edge_options, executor, allocator, moved, &edges,
+                                            error)) != TT_OK)
+                goto done;
+            if (edges->nfailed >= failed_before) break;
+        }
+        if (!reseated) break;
+        /* The relaxation looks only near the re-seated points: elsewhere it has done what it can. */
+        for (round = 0; round < TT__RESEAT_FOCUS_RINGS; round++) {
+            for (e = 0; e < edges->nedges; e++) {
+                const int a = edges->edge_vertices[2 * e], b = edges->edge_vertices[2 * e + 1];
+                if (focus[a] == 1 && !focus[b]) focus[b] = 2;
+                if (focus[b] == 1 && !focus[a]) focus[a] = 2;
+            }
+            for (v = 0; v < model->nverts; v++) focus[v] = focus[v] != 0;
+        }
+        memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
+        if ((moves = tt__polycube_relax(polycube, model, points, focus, executor, allocator, NULL)) < 0)
+            goto out_of_memory;
+        *relaxed += moves;
+        for (v = 0; v < model->nverts; v++)
+            moved[v] = !tt__same_point(points[v], earlier[v]);
+        if ((result = tt__retrace_moved(polycube, model, points, edge_options, executor, allocator, moved, &edges,
+                                        error)) != TT_OK)
+            goto done;
+        /* A move that left an edge with no path goes back (the folds it opened cost less than the seam). */
+        if (tt__polycube_restore_failing(model, edges, earlier, points, moved) &&
+            (result = tt__retrace_moved(polycube, model, points, edge_options, executor, allocator, moved, &edges,
+                                        error)) != TT_OK)
+            goto done;
+    }
+    /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
+       vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
+    memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
+    memset(moved, 0, (size_t)model->nverts);
+    for (tracing = 0; tracing < 2; tracing++) {
+        int changed;
+        if (tracing == 0) {
+            if ((changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator)) < 0)
+                goto out_of_memory;
+        } else {
+            changed = tt__polycube_restore_failing(model, edges, earlier, points, moved);
+        }
+        if (!changed) break;
+        if ((result = tt__retrace_moved(polycube, model, points, edge_options, executor, allocator, moved, &edges,
+                                        error)) != TT_OK)
+            goto done;
+    }
+    goto done;
+cancelled:
+    result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "polycube mapping cancelled by the progress callback");
+    goto done;
+out_of_memory:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory mapping the mesh onto S");
+done:
+    *edges_io = edges;
+    tt__free(allocator, earlier);
+    tt__free(allocator, moved);
+    tt__free(allocator, focus);
+    tt__free(allocator, reseat.stayed);
+    tt__free(allocator, reseat.seen);
+    return result;
+}
+
+/* A mapping of the refined model R turned into one of the input mesh:
+   each output vertex's refined sources become input vertices (at most 3,
+   all of one input triangle), each output triangle's refined face its
+   input face; *split_triangles counts the input faces cut into two or
+   more. 0 when out of memory. */
+static int tt__mapping_to_input(tt_polycube_mapping *mapping, const tt__refined *R, const tt_mesh *mesh,
+                                const tt_allocator *allocator, int *split_triangles)
+{
+    int v, j, f;
+    for (v = 0; v < mapping->nverts && R->mesh; v++) {
+        int source[3], n = 0, k, i;
+        double weight[3] = {0.0, 0.0, 0.0};
+        for (k = 0; k < 3; k++) {
+            int r = mapping->source[3 * v + k];
+            double w = mapping->weights[3 * v + k];
+            for (i = 0; i < 3 && w != 0.0; i++) {
+                int u = R->source[3 * r + i], m;
+                double wu = w * R->weight[3 * r + i];
+                if (wu == 0.0) continue;
+                for (m = 0; m < n && source[m] != u; m++) continue;
+                if (m == n) {
+                    if (n == 3) continue;
+                    source[n++] = u;
+                }
+                weight[m] += wu;
+            }
+        }
+        for (k = n; k < 3; k++) source[k] = n ? source[0] : R->source[3 * mapping->source[3 * v]];
+        tt__barycentric_onto_triangle(weight);   /* barycentric weights in the input triangle */
+        for (k = 0; k < 3; k++) {
+            mapping->source[3 * v + k] = source[k];
+            mapping->weights[3 * v + k] = (float)weight[k];
+        }
+    }
+    {
+        int *outputs_of_face = TT__ALLOC(allocator, int, mesh->nfaces);
+        if (!outputs_of_face) return 0;
+        memset(outputs_of_face, 0, sizeof(int) * (size_t)mesh->nfaces);
+        for (j = 0; j < mapping->ntriangles; j++) {
+            if (R->face) mapping->triangle_face[j] = R->face[mapping->triangle_face[j]];
+            outputs_of_face[mapping->triangle_face[j]]++;
+        }
+        for (f = 0; f < mesh->nfaces; f++) *split_triangles += outputs_of_face[f] > 1;
+        tt__free(allocator, outputs_of_face);
+    }
+    return 1;
+}
+
 #define TT__MAP_ROUNDS 3             /* mappings tt_polycube_map makes at most by default, each finer where
                                        the ones before fell short */
 
@@ -27099,20 +27274,18 @@ static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mes
                                        tt_polycube_mapping **out, tt_polycube_map_report *report, tt_error *error)
 {
     tt_polycube_edge_options edge_options;
-    tt_surface_point *points = NULL, *earlier = NULL;
-    unsigned char *moved = NULL, *focus = NULL, *fell_back = NULL;
+    tt_surface_point *points = NULL;
+    unsigned char *fell_back = NULL;
     tt_polycube_edges *edges = NULL;
     const tt_mesh *model;
     tt__refined R;
     tt_polycube_mapping *mapping = NULL;
     tt_result result;
     const tt_executor *executor = options ? options->executor : NULL;
-    int f, v, j, tracing, cycle, moves, max_quads;
-    tt__reseat_memory reseat;
+    int f, j, max_quads;
     *out = NULL;
     memset(report, 0, sizeof *report);
     memset(&R, 0, sizeof R);
-    memset(&reseat, 0, sizeof reseat);
     memset(&edge_options, 0, sizeof edge_options);
     if (options) edge_options.max_quads = options->max_quads;
     max_quads = edge_options.max_quads ? edge_options.max_quads : TT_POLYCUBE_EDGE_DEFAULT_QUADS;
@@ -27140,77 +27313,9 @@ static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mes
                                   NULL, &edges, error)) != TT_OK)
         goto failed;
     if (tt__map_progress_phase(progress, 0.6f, 0.6f)) goto cancelled;
-    if (!(earlier = TT__ALLOC(allocator, tt_surface_point, model->nverts)) ||
-        !(moved = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
-        !(focus = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
-        !(reseat.stayed = TT__ALLOC(allocator, unsigned char, model->nverts)) ||
-        !(reseat.seen = TT__ALLOC(allocator, tt_surface_point, model->nverts)))
-        goto out_of_memory;
-    memset(reseat.stayed, 0, (size_t)model->nverts);
-    /* Vertices with an edge that finds no path are re-seated (tt__polycube_reseat) and their edges traced
-       again, up to TT__RESEAT_ROUNDS times; the relaxation then opens the folds that leaves near them, and
-       the edges at the points it moved are traced again. */
-    for (cycle = 0; cycle < TT__RESEAT_CYCLES && edges->nfailed > 0; cycle++) {
-        int reseated = 0, round, e;
-        if (cycle > 0 && tt__map_progress_phase(progress, 0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES,
-                                                0.6f + 0.2f * (float)cycle / TT__RESEAT_CYCLES))
-            goto cancelled;
-        memset(focus, 0, (size_t)model->nverts);
-        for (round = 0; round < TT__RESEAT_ROUNDS && edges->nfailed > 0; round++) {
-            int n, failed_before = edges->nfailed;
-            memset(moved, 0, (size_t)model->nverts);
-            if ((n = tt__polycube_reseat(polycube, model, edges, max_quads, points, moved, &reseat, allocator)) < 0)
-                goto out_of_memory;
-            if (!n) break;
-            reseated += n;
-            for (v = 0; v < model->nverts; v++) focus[v] |= moved[v];
-            if ((result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
-                                            error)) != TT_OK)
-                goto failed;
-            if (edges->nfailed >= failed_before) break;
-        }
-        if (!reseated) break;
-        /* The relaxation looks only near the re-seated points: elsewhere it has done what it can. */
-        for (round = 0; round < TT__RESEAT_FOCUS_RINGS; round++) {
-            for (e = 0; e < edges->nedges; e++) {
-                const int a = edges->edge_vertices[2 * e], b = edges->edge_vertices[2 * e + 1];
-                if (focus[a] == 1 && !focus[b]) focus[b] = 2;
-                if (focus[b] == 1 && !focus[a]) focus[a] = 2;
-            }
-            for (v = 0; v < model->nverts; v++) focus[v] = focus[v] != 0;
-        }
-        memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
-        if ((moves = tt__polycube_relax(polycube, model, points, focus, executor, allocator, NULL)) < 0)
-            goto out_of_memory;
-        report->relaxed += moves;
-        for (v = 0; v < model->nverts; v++)
-            moved[v] = !tt__same_point(points[v], earlier[v]);
-        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
-                                        error)) != TT_OK)
-            goto failed;
-        /* A move that left an edge with no path goes back (the folds it opened cost less than the seam). */
-        if (tt__polycube_restore_failing(model, edges, earlier, points, moved) &&
-            (result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
-                                        error)) != TT_OK)
-            goto failed;
-    }
-    /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
-       vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
-    memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
-    memset(moved, 0, (size_t)model->nverts);
-    for (tracing = 0; tracing < 2; tracing++) {
-        int changed;
-        if (tracing == 0) {
-            if ((changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator)) < 0)
-                goto out_of_memory;
-        } else {
-            changed = tt__polycube_restore_failing(model, edges, earlier, points, moved);
-        }
-        if (!changed) break;
-        if ((result = tt__retrace_moved(polycube, model, points, &edge_options, executor, allocator, moved, &edges,
-                                        error)) != TT_OK)
-            goto failed;
-    }
+    if ((result = tt__polycube_repair_edges(polycube, model, &edge_options, max_quads, executor, allocator, progress,
+                                            points, &edges, &report->relaxed, error)) != TT_OK)
+        goto failed;
     report->failed_edges = edges->nfailed;
     if (tt__map_progress_phase(progress, 0.85f, 0.85f)) goto cancelled;
 
@@ -27218,44 +27323,7 @@ static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mes
     if (tt__polycube_split(polycube, model, edges, points, executor, allocator, &mapping,
                            &report->fallback_triangles, fell_back) != TT_OK)
         goto out_of_memory;
-    /* Back to the input: each output vertex's refined sources become input vertices (at most 3, all of one
-       input triangle), each output triangle's refined face its input face. */
-    for (v = 0; v < mapping->nverts && R.mesh; v++) {
-        int source[3], n = 0, k, i;
-        double weight[3] = {0.0, 0.0, 0.0};
-        for (k = 0; k < 3; k++) {
-            int r = mapping->source[3 * v + k];
-            double w = mapping->weights[3 * v + k];
-            for (i = 0; i < 3 && w != 0.0; i++) {
-                int u = R.source[3 * r + i], m;
-                double wu = w * R.weight[3 * r + i];
-                if (wu == 0.0) continue;
-                for (m = 0; m < n && source[m] != u; m++) continue;
-                if (m == n) {
-                    if (n == 3) continue;
-                    source[n++] = u;
-                }
-                weight[m] += wu;
-            }
-        }
-        for (k = n; k < 3; k++) source[k] = n ? source[0] : R.source[3 * mapping->source[3 * v]];
-        tt__barycentric_onto_triangle(weight);   /* barycentric weights in the input triangle */
-        for (k = 0; k < 3; k++) {
-            mapping->source[3 * v + k] = source[k];
-            mapping->weights[3 * v + k] = (float)weight[k];
-        }
-    }
-    {
-        int *outputs_of_face = TT__ALLOC(allocator, int, mesh->nfaces);
-        if (!outputs_of_face) goto out_of_memory;
-        memset(outputs_of_face, 0, sizeof(int) * (size_t)mesh->nfaces);
-        for (j = 0; j < mapping->ntriangles; j++) {
-            if (R.face) mapping->triangle_face[j] = R.face[mapping->triangle_face[j]];
-            outputs_of_face[mapping->triangle_face[j]]++;
-        }
-        for (f = 0; f < mesh->nfaces; f++) report->split_triangles += outputs_of_face[f] > 1;
-        tt__free(allocator, outputs_of_face);
-    }
+    if (!tt__mapping_to_input(mapping, &R, mesh, allocator, &report->split_triangles)) goto out_of_memory;
     for (j = 0; j < mapping->ntriangles; j++) {
         const tt_surface_point *p = mapping->corner_points + 3 * j;
         double turn = tt__orient2(p[0].s, p[0].t, p[1].s, p[1].t, p[2].s, p[2].t);
@@ -27267,11 +27335,6 @@ static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mes
         if (fell_back[f]) troubled[R.face ? R.face[f] : f] = 1;
     tt__free(allocator, fell_back);
     tt_polycube_edges_free(edges);
-    tt__free(allocator, earlier);
-    tt__free(allocator, moved);
-    tt__free(allocator, focus);
-    tt__free(allocator, reseat.stayed);
-    tt__free(allocator, reseat.seen);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     *out = mapping;
@@ -27285,11 +27348,6 @@ failed:
     tt_polycube_mapping_free(mapping);
     tt__free(allocator, fell_back);
     tt_polycube_edges_free(edges);
-    tt__free(allocator, earlier);
-    tt__free(allocator, moved);
-    tt__free(allocator, focus);
-    tt__free(allocator, reseat.stayed);
-    tt__free(allocator, reseat.seen);
     tt__free(allocator, points);
     tt__refined_free(allocator, &R);
     memset(report, 0, sizeof *report);
