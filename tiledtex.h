@@ -5337,13 +5337,139 @@ done:
     return result;
 }
 
+/* The quads' topology, straight from the input's: no search, and a
+   valid mesh gives a valid result. edge_of: per input half-edge, its
+   edge's id (nedges of them). */
+static void tt__quadrangulate_topology(const tt_mesh *mesh, const int *edge_of, int nedges, tt_mesh *quads)
+{
+    int c, f, v;
+    /* Quad c (one per input corner c of face f, with next n,
+       previous p) is (v_c, E(c), F(f), E(p)); its half-edges are
+         4c   v_c -> E(c)   first half of old c:  twin is the second half of
+                            twin(c), i.e. half-edge 4 next(twin c) + 3
+         4c+1 E(c) -> F     inside f:             twin 4n + 2
+         4c+2 F -> E(p)     inside f:             twin 4p + 1
+         4c+3 E(p) -> v_c   second half of old p: twin 4 twin(p) */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
+        int face_point = mesh->nverts + nedges + f;
+        for (c = first; c < end; c++) {
+            int n = c + 1 < end ? c + 1 : first, p = c > first ? c - 1 : end - 1, t = mesh->twin[c], k;
+            int *q = quads->corner_vert + 4 * (size_t)c, *tw = quads->twin + 4 * (size_t)c;
+            q[0] = mesh->corner_vert[c];
+            q[1] = mesh->nverts + edge_of[c];
+            q[2] = face_point;
+            q[3] = mesh->nverts + edge_of[p];
+            tw[0] = t >= 0 ? 4 * tt_mesh_next(mesh, t) + 3 : -1;
+            tw[1] = 4 * n + 2;
+            tw[2] = 4 * p + 1;
+            tw[3] = mesh->twin[p] >= 0 ? 4 * mesh->twin[p] : -1;
+            quads->face_start[c] = 4 * c;
+            for (k = 0; k < 4; k++) quads->corner_face[4 * c + k] = c;
+        }
+        quads->vert_corner[face_point] = 4 * first + 2;
+    }
+    quads->face_start[mesh->ncorners] = 4 * mesh->ncorners;
+    /* Outgoing half-edges, a boundary one where there is one: an old vertex
+       keeps its own (first half of it); an edge point takes the second half of
+       its edge (a boundary exactly when the edge is). */
+    for (v = 0; v < mesh->nverts; v++) quads->vert_corner[v] = mesh->vert_corner[v] >= 0 ? 4 * mesh->vert_corner[v] : -1;
+    for (c = 0; c < mesh->ncorners; c++)
+        if (mesh->twin[c] < 0 || c < mesh->twin[c])
+            quads->vert_corner[mesh->nverts + edge_of[c]] = 4 * tt_mesh_next(mesh, c) + 3;
+    quads->min_face_size = quads->max_face_size = 4;
+    quads->repaired_edges = 2 * mesh->repaired_edges;   /* each cut edge is now two */
+}
+
+/* The new vertices' positions into pos, past the input's: edge points,
+   then face points. */
+static void tt__quadrangulate_points(const tt_mesh *mesh, tt_subdivision scheme, const int *edge_of, int nedges,
+                                     float *pos)
+{
+    int c, f;
+    /* Face points: centroids. Edge points: midpoints (linear, and CC on a
+       boundary) or the average of the two ends and the two face points (CC). */
+    for (f = 0; f < mesh->nfaces; f++) {
+        int first = mesh->face_start[f], end = mesh->face_start[f + 1], k;
+        double centre[3] = {0, 0, 0};
+        float *out = pos + 3 * ((size_t)mesh->nverts + nedges + f);
+        for (c = first; c < end; c++)
+            for (k = 0; k < 3; k++) centre[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
+        for (k = 0; k < 3; k++) out[k] = (float)(centre[k] / (end - first));
+    }
+    for (c = 0; c < mesh->ncorners; c++) {
+        int t = mesh->twin[c], k;
+        const float *a, *b;
+        float *out;
+        if (!(t < 0 || c < t)) continue;
+        a = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
+        b = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
+        out = pos + 3 * ((size_t)mesh->nverts + edge_of[c]);
+        if (scheme == TT_SUBDIVIDE_CATMULL_CLARK && t >= 0) {
+            const float *f0 = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[c]);
+            const float *f1 = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[t]);
+            for (k = 0; k < 3; k++) out[k] = (float)(((double)a[k] + b[k] + f0[k] + f1[k]) * 0.25);
+        } else {
+            for (k = 0; k < 3; k++) out[k] = (float)(((double)a[k] + b[k]) * 0.5);
+        }
+    }
+}
+
+/* The input's vertices moved by the Catmull-Clark rules (see
+   tt_mesh_quadrangulate) into pos, from the face points already there;
+   sum (9 per vertex) and count (3 per vertex) zeroed, for the rules'
+   sums. */
+static void tt__catmull_clark_vertices(const tt_mesh *mesh, int nedges, float *pos, double *sum, int *count)
+{
+    int c, v;
+    for (c = 0; c < mesh->ncorners; c++) {
+        int a = mesh->corner_vert[c], b = mesh->corner_vert[tt_mesh_next(mesh, c)], t = mesh->twin[c], k;
+        const float *fp = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[c]);
+        for (k = 0; k < 3; k++) sum[9 * (size_t)a + k] += fp[k];
+        count[3 * (size_t)a]++;
+        if (t < 0 || c < t) {
+            for (k = 0; k < 3; k++) {
+                double mid = 0.5 * ((double)mesh->pos[3 * (size_t)a + k] + mesh->pos[3 * (size_t)b + k]);
+                sum[9 * (size_t)a + 3 + k] += mid;
+                sum[9 * (size_t)b + 3 + k] += mid;
+            }
+            count[3 * (size_t)a + 1]++;
+            count[3 * (size_t)b + 1]++;
+        }
+        if (t < 0) {
+            /* Boundary neighbours of a and b: the other end of this edge. */
+            for (k = 0; k < 3; k++) {
+                sum[9 * (size_t)a + 6 + k] += mesh->pos[3 * (size_t)b + k];
+                sum[9 * (size_t)b + 6 + k] += mesh->pos[3 * (size_t)a + k];
+            }
+            count[3 * (size_t)a + 2]++;
+            count[3 * (size_t)b + 2]++;
+        }
+    }
+    for (v = 0; v < mesh->nverts; v++) {
+        const double *sv = sum + 9 * (size_t)v;
+        const int *n = count + 3 * (size_t)v;
+        const float *old = mesh->pos + 3 * (size_t)v;
+        float *out = pos + 3 * (size_t)v;
+        int k;
+        if (n[0] == 0) continue;
+        if (n[2] == 2) {
+            for (k = 0; k < 3; k++) out[k] = (float)(0.75 * old[k] + 0.125 * sv[6 + k]);
+        } else if (n[2] == 0) {
+            double faces = n[0];
+            for (k = 0; k < 3; k++)
+                out[k] = (float)((sv[k] / faces + 2.0 * sv[3 + k] / n[1] + (faces - 3.0) * old[k]) / faces);
+        }
+    }
+}
+
 /* Quadrangulation: one Catmull-Clark step's topology. Based on: Catmull and
    Clark 1978 (the paper's reference [3]); Akleman Sec. 6 uses it to turn any
    mesh into quads. Edge ids follow the first half-edge of each edge. */
 TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error)
 {
-    int *edge_of = NULL, nedges = 0, c, f, v, nverts_new;
+    int *edge_of = NULL, nedges = 0, c, v, nverts_new;
     double *sum = NULL;       /* CC vertex rule accumulators: 3 face sums, 3 edge-midpoint sums, 3 boundary sums */
     int *count = NULL;        /* per vertex: faces, edges, boundary edges */
     float *pos = NULL;
@@ -5384,70 +5510,10 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
     }
 
     /* Topology, straight from the input's: no search, and a valid mesh gives
-       a valid result. Quad c (one per input corner c of face f, with next n,
-       previous p) is (v_c, E(c), F(f), E(p)); its half-edges are
-         4c   v_c -> E(c)   first half of old c:  twin is the second half of
-                            twin(c), i.e. half-edge 4 next(twin c) + 3
-         4c+1 E(c) -> F     inside f:             twin 4n + 2
-         4c+2 F -> E(p)     inside f:             twin 4p + 1
-         4c+3 E(p) -> v_c   second half of old p: twin 4 twin(p) */
-    for (f = 0; f < mesh->nfaces; f++) {
-        int first = mesh->face_start[f], end = mesh->face_start[f + 1];
-        int face_point = mesh->nverts + nedges + f;
-        for (c = first; c < end; c++) {
-            int n = c + 1 < end ? c + 1 : first, p = c > first ? c - 1 : end - 1, t = mesh->twin[c], k;
-            int *q = quads->corner_vert + 4 * (size_t)c, *tw = quads->twin + 4 * (size_t)c;
-            q[0] = mesh->corner_vert[c];
-            q[1] = mesh->nverts + edge_of[c];
-            q[2] = face_point;
-            q[3] = mesh->nverts + edge_of[p];
-            tw[0] = t >= 0 ? 4 * tt_mesh_next(mesh, t) + 3 : -1;
-            tw[1] = 4 * n + 2;
-            tw[2] = 4 * p + 1;
-            tw[3] = mesh->twin[p] >= 0 ? 4 * mesh->twin[p] : -1;
-            quads->face_start[c] = 4 * c;
-            for (k = 0; k < 4; k++) quads->corner_face[4 * c + k] = c;
-        }
-        quads->vert_corner[face_point] = 4 * first + 2;
-    }
-    quads->face_start[mesh->ncorners] = 4 * mesh->ncorners;
-    /* Outgoing half-edges, a boundary one where there is one: an old vertex
-       keeps its own (first half of it); an edge point takes the second half of
-       its edge (a boundary exactly when the edge is). */
-    for (v = 0; v < mesh->nverts; v++) quads->vert_corner[v] = mesh->vert_corner[v] >= 0 ? 4 * mesh->vert_corner[v] : -1;
-    for (c = 0; c < mesh->ncorners; c++)
-        if (mesh->twin[c] < 0 || c < mesh->twin[c])
-            quads->vert_corner[mesh->nverts + edge_of[c]] = 4 * tt_mesh_next(mesh, c) + 3;
-    quads->min_face_size = quads->max_face_size = 4;
-    quads->repaired_edges = 2 * mesh->repaired_edges;   /* each cut edge is now two */
+       a valid result. */
+    tt__quadrangulate_topology(mesh, edge_of, nedges, quads);
 
-    /* Face points: centroids. Edge points: midpoints (linear, and CC on a
-       boundary) or the average of the two ends and the two face points (CC). */
-    for (f = 0; f < mesh->nfaces; f++) {
-        int first = mesh->face_start[f], end = mesh->face_start[f + 1], k;
-        double centre[3] = {0, 0, 0};
-        float *out = pos + 3 * ((size_t)mesh->nverts + nedges + f);
-        for (c = first; c < end; c++)
-            for (k = 0; k < 3; k++) centre[k] += mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
-        for (k = 0; k < 3; k++) out[k] = (float)(centre[k] / (end - first));
-    }
-    for (c = 0; c < mesh->ncorners; c++) {
-        int t = mesh->twin[c], k;
-        const float *a, *b;
-        float *out;
-        if (!(t < 0 || c < t)) continue;
-        a = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
-        b = mesh->pos + 3 * (size_t)mesh->corner_vert[tt_mesh_next(mesh, c)];
-        out = pos + 3 * ((size_t)mesh->nverts + edge_of[c]);
-        if (scheme == TT_SUBDIVIDE_CATMULL_CLARK && t >= 0) {
-            const float *f0 = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[c]);
-            const float *f1 = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[t]);
-            for (k = 0; k < 3; k++) out[k] = (float)(((double)a[k] + b[k] + f0[k] + f1[k]) * 0.25);
-        } else {
-            for (k = 0; k < 3; k++) out[k] = (float)(((double)a[k] + b[k]) * 0.5);
-        }
-    }
-
+    tt__quadrangulate_points(mesh, scheme, edge_of, nedges, pos);
     /* Old vertices: kept (linear), or moved by the Catmull-Clark rules:
        interior  (Q + 2R + (n-3) S) / n  with Q the average face point, R the
        average edge midpoint, n the number of faces; boundary  3/4 S + 1/8 of
@@ -5463,45 +5529,7 @@ TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme
         }
         memset(sum, 0, (size_t)mesh->nverts * 9 * sizeof(double));
         memset(count, 0, (size_t)mesh->nverts * 3 * sizeof(int));
-        for (c = 0; c < mesh->ncorners; c++) {
-            int a = mesh->corner_vert[c], b = mesh->corner_vert[tt_mesh_next(mesh, c)], t = mesh->twin[c], k;
-            const float *fp = pos + 3 * ((size_t)mesh->nverts + nedges + mesh->corner_face[c]);
-            for (k = 0; k < 3; k++) sum[9 * (size_t)a + k] += fp[k];
-            count[3 * (size_t)a]++;
-            if (t < 0 || c < t) {
-                for (k = 0; k < 3; k++) {
-                    double mid = 0.5 * ((double)mesh->pos[3 * (size_t)a + k] + mesh->pos[3 * (size_t)b + k]);
-                    sum[9 * (size_t)a + 3 + k] += mid;
-                    sum[9 * (size_t)b + 3 + k] += mid;
-                }
-                count[3 * (size_t)a + 1]++;
-                count[3 * (size_t)b + 1]++;
-            }
-            if (t < 0) {
-                /* Boundary neighbours of a and b: the other end of this edge. */
-                for (k = 0; k < 3; k++) {
-                    sum[9 * (size_t)a + 6 + k] += mesh->pos[3 * (size_t)b + k];
-                    sum[9 * (size_t)b + 6 + k] += mesh->pos[3 * (size_t)a + k];
-                }
-                count[3 * (size_t)a + 2]++;
-                count[3 * (size_t)b + 2]++;
-            }
-        }
-        for (v = 0; v < mesh->nverts; v++) {
-            const double *sv = sum + 9 * (size_t)v;
-            const int *n = count + 3 * (size_t)v;
-            const float *old = mesh->pos + 3 * (size_t)v;
-            float *out = pos + 3 * (size_t)v;
-            int k;
-            if (n[0] == 0) continue;
-            if (n[2] == 2) {
-                for (k = 0; k < 3; k++) out[k] = (float)(0.75 * old[k] + 0.125 * sv[6 + k]);
-            } else if (n[2] == 0) {
-                double faces = n[0];
-                for (k = 0; k < 3; k++)
-                    out[k] = (float)((sv[k] / faces + 2.0 * sv[3 + k] / n[1] + (faces - 3.0) * old[k]) / faces);
-            }
-        }
+        tt__catmull_clark_vertices(mesh, nedges, pos, sum, count);
     }
     /* Averages of finite numbers can still overflow float. */
     for (v = 0; v < nverts_new; v++)
@@ -6794,6 +6822,60 @@ static double tt__ic0_restart(const tt__ic0 *F, int n, const double *TT__RESTRIC
     return rz;
 }
 
+/* The incomplete Cholesky factor of A; *ic = 0 when a pivot is not
+   positive (the solve then falls back to Jacobi). */
+static tt_result tt__cg_factor(const tt_sparse_matrix *A, const tt_allocator *allocator, tt__ic0 *factor, int *ic,
+                               tt_error *error)
+{
+    int bad_row = -1, made = tt__ic0_factor(A, allocator, factor, &bad_row);
+    if (made == -1)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                        "out of memory for the incomplete Cholesky factor of %d unknowns", A->rows);
+    if (made == -2)
+        return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, bad_row, -1,
+                           "row %d's columns do not increase: incomplete Cholesky needs them strictly increasing "
+                           "(as tt_sparse_from_triplets makes them)", bad_row);
+    *ic = made == 1;
+    return TT_OK;
+}
+
+/* tt_cg_solve's arguments checked (opt: the options, zero when none). */
+static tt_result tt__cg_check_arguments(const tt_sparse_matrix *A, const double *b_in, const double *x,
+                                        const tt_cg_options *opt, tt_error *error)
+{
+    if (!A || !b_in || !x)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_cg_solve needs a matrix, a right-hand side and a solution vector; one is NULL");
+    if (b_in == x)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the right-hand side b and the solution x must be different arrays");
+    if (opt->max_iterations < 0 || !(opt->tolerance >= 0.0) || !tt__is_finite_d(opt->tolerance))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "max_iterations %d and tolerance %g: neither may be negative (0 = default)", opt->max_iterations,
+                        opt->tolerance);
+    if (opt->preconditioner != TT_CG_JACOBI && opt->preconditioner != TT_CG_INCOMPLETE_CHOLESKY)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "preconditioner %d: use TT_CG_JACOBI (0) or TT_CG_INCOMPLETE_CHOLESKY (1)", opt->preconditioner);
+    if (A->rows != A->cols || A->rows < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the matrix is %d x %d; conjugate gradients need a square matrix", A->rows, A->cols);
+    return TT_OK;
+}
+
+/* The progress callback told how far a solve is, by steps or by the
+   residual's fall toward the tolerance (whichever is further, never
+   going back: *shown); non-zero when it asks to stop. */
+static int tt__cg_progress(const tt_cg_options *opt, double rr, double norm_b, int iterations, int max_iterations,
+                           double *shown)
+{
+    double rel = sqrt(rr) / norm_b, fraction = (double)iterations / max_iterations;
+    if (opt->tolerance < 1.0 && rel < 1.0 && log(rel) / log(opt->tolerance) > fraction)
+        fraction = log(rel) / log(opt->tolerance);
+    if (fraction > 1.0) fraction = 1.0;
+    if (fraction > *shown) *shown = fraction;
+    return opt->progress((float)*shown, opt->progress_user_data);
+}
+
 TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const tt_cg_options *options,
                             const tt_allocator *allocator, double *x, tt_cg_report *report, tt_error *error)
 {
@@ -6814,22 +6896,7 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
     if (options) opt = *options;
     else memset(&opt, 0, sizeof opt);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (!A || !b_in || !x)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_cg_solve needs a matrix, a right-hand side and a solution vector; one is NULL");
-    if (b_in == x)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the right-hand side b and the solution x must be different arrays");
-    if (opt.max_iterations < 0 || !(opt.tolerance >= 0.0) || !tt__is_finite_d(opt.tolerance))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "max_iterations %d and tolerance %g: neither may be negative (0 = default)", opt.max_iterations,
-                        opt.tolerance);
-    if (opt.preconditioner != TT_CG_JACOBI && opt.preconditioner != TT_CG_INCOMPLETE_CHOLESKY)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "preconditioner %d: use TT_CG_JACOBI (0) or TT_CG_INCOMPLETE_CHOLESKY (1)", opt.preconditioner);
-    if (A->rows != A->cols || A->rows < 0)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the matrix is %d x %d; conjugate gradients need a square matrix", A->rows, A->cols);
+    if ((result = tt__cg_check_arguments(A, b_in, x, &opt, error)) != TT_OK) return result;
     n = A->rows;
     if (opt.tolerance == 0.0) opt.tolerance = 1e-8;
     max_iterations = opt.max_iterations;
@@ -6851,19 +6918,7 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
 
     if ((result = tt__cg_check_matrix(A, inv_diag, error)) != TT_OK) goto done;
     if (opt.preconditioner == TT_CG_INCOMPLETE_CHOLESKY) {
-        int bad_row = -1, made = tt__ic0_factor(A, allocator, &factor, &bad_row);
-        if (made == -1) {
-            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                              "out of memory for the incomplete Cholesky factor of %d unknowns", n);
-            goto done;
-        }
-        if (made == -2) {
-            result = tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, -1, bad_row, -1,
-                                 "row %d's columns do not increase: incomplete Cholesky needs them strictly "
-                                 "increasing (as tt_sparse_from_triplets makes them)", bad_row);
-            goto done;
-        }
-        ic = made == 1;
+        if ((result = tt__cg_factor(A, allocator, &factor, &ic, error)) != TT_OK) goto done;
         z = b + n;
         rep.preconditioner = ic ? TT_CG_INCOMPLETE_CHOLESKY : TT_CG_JACOBI;   /* a pivot <= 0: Jacobi */
     }
@@ -6920,18 +6975,10 @@ TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b_in, const
             result = TT_ERROR_NOT_CONVERGED;   /* the message, with the final residual, below */
             break;
         }
-        if (opt.progress) {
-            double rel = sqrt(rr) / norm_b, fraction = (double)rep.iterations / max_iterations;
-            if (opt.tolerance < 1.0 && rel < 1.0 && log(rel) / log(opt.tolerance) > fraction)
-                fraction = log(rel) / log(opt.tolerance);
-            if (fraction > 1.0) fraction = 1.0;
-            if (fraction > shown) shown = fraction;
-            if (opt.progress((float)shown, opt.progress_user_data)) {
-                result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1,
-                                  "cancelled by the progress callback after %d conjugate gradient steps",
-                                  rep.iterations);
-                break;
-            }
+        if (opt.progress && tt__cg_progress(&opt, rr, norm_b, rep.iterations, max_iterations, &shown)) {
+            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1,
+                              "cancelled by the progress callback after %d conjugate gradient steps", rep.iterations);
+            break;
         }
         pAp = tt__spmv_dot(n, A->row_start, A->col, A->value, p, Ap);
         if (!tt__is_finite_d(pAp)) {
@@ -7182,6 +7229,34 @@ static double tt__amg_spectral_radius(tt__amg_level *V, double bound)
     return estimate > 0.0 && estimate < bound ? estimate : bound;
 }
 
+/* The hierarchy's last level factored densely, F F^T = A_last, into
+   G->factor. TT_ERROR_NOT_POSITIVE_DEFINITE at a pivot that is not
+   positive; TT_ERROR_OUT_OF_MEMORY. */
+static tt_result tt__amg_factor_last(tt__amg *G)
+{
+    const tt__amg_level *V = &G->level[G->nlevels - 1];
+    int n = V->n, i, j, k;
+    double *F = TT__ALLOC(G->al, double, (size_t)n * n > 0 ? (size_t)n * n : 1);
+    G->factor = F;
+    if (!F) return TT_ERROR_OUT_OF_MEMORY;
+    for (i = 0; i < n * n; i++) F[i] = 0.0;
+    for (i = 0; i < n; i++)
+        for (k = V->row_start[i]; k < V->row_start[i + 1]; k++) F[(size_t)i * n + V->col[k]] += V->value[k];
+    for (j = 0; j < n; j++) {
+        double pivot = F[(size_t)j * n + j];
+        for (k = 0; k < j; k++) pivot -= F[(size_t)j * n + k] * F[(size_t)j * n + k];
+        if (!(pivot > 0.0)) return TT_ERROR_NOT_POSITIVE_DEFINITE;
+        pivot = sqrt(pivot);
+        F[(size_t)j * n + j] = pivot;
+        for (i = j + 1; i < n; i++) {
+            double s = F[(size_t)i * n + j];
+            for (k = 0; k < j; k++) s -= F[(size_t)i * n + k] * F[(size_t)j * n + k];
+            F[(size_t)i * n + j] = s / pivot;
+        }
+    }
+    return TT_OK;
+}
+
 /* The hierarchy for the symmetric positive definite A (borrowed, kept
    unchanged until tt__amg_free). TT_ERROR_NOT_POSITIVE_DEFINITE when a
    diagonal entry or a pivot of the last level's factor is not positive;
@@ -7317,32 +7392,7 @@ static tt_result tt__amg_setup(tt__amg *G, const tt_sparse_matrix *A, const tt_a
         tt__free(al, ap_value);
         if (r != TT_OK && l + 1 < TT__AMG_MAX_LEVELS) G->nlevels = l + 2;   /* the next level's arrays, freed below */
     }
-    if (r == TT_OK) {
-        /* The last level, factored densely: F F^T = A_last. */
-        const tt__amg_level *V = &G->level[G->nlevels - 1];
-        int n = V->n;
-        double *F = TT__ALLOC(al, double, (size_t)n * n > 0 ? (size_t)n * n : 1);
-        G->factor = F;
-        if (!F) r = TT_ERROR_OUT_OF_MEMORY;
-        for (i = 0; r == TT_OK && i < n * n; i++) F[i] = 0.0;
-        for (i = 0; r == TT_OK && i < n; i++)
-            for (k = V->row_start[i]; k < V->row_start[i + 1]; k++) F[(size_t)i * n + V->col[k]] += V->value[k];
-        for (j = 0; r == TT_OK && j < n; j++) {
-            double pivot = F[(size_t)j * n + j];
-            for (k = 0; k < j; k++) pivot -= F[(size_t)j * n + k] * F[(size_t)j * n + k];
-            if (!(pivot > 0.0)) {
-                r = TT_ERROR_NOT_POSITIVE_DEFINITE;
-                break;
-            }
-            pivot = sqrt(pivot);
-            F[(size_t)j * n + j] = pivot;
-            for (i = j + 1; i < n; i++) {
-                double s = F[(size_t)i * n + j];
-                for (k = 0; k < j; k++) s -= F[(size_t)i * n + k] * F[(size_t)j * n + k];
-                F[(size_t)i * n + j] = s / pivot;
-            }
-        }
-    }
+    if (r == TT_OK) r = tt__amg_factor_last(G);
     if (r != TT_OK) tt__amg_free(G);
     return r;
 }
