@@ -9902,6 +9902,101 @@ done:
     tt__free(job->allocator, cut);
 }
 
+/* The options of a plan of S-texel tiles of n colours checked against
+   the guide: the feather (*feather, its
+   default filled in), the background region (*region: the whole guide
+   when none is given) and the edge windows given. */
+static tt_result tt__synth_check_windows(const tt_image *guide, const tt_synth_options *opt, int S, int n,
+                                         int *feather_out, tt_rect *region_out, tt_error *error)
+{
+    tt_rect region;
+    int feather, k;
+    *feather_out = 0;
+    memset(region_out, 0, sizeof *region_out);
+    if (opt->feather < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "feather %d is negative", opt->feather);
+    feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
+    if (feather > S / 4 + 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "feather %d is too wide for %d-texel tiles (at most %d)", feather, S, S / 4 + 1);
+    if (opt->background_candidates < 0 || opt->background_candidates > TT_SYNTH_MAX_BACKGROUND_CANDIDATES)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "background_candidates %d: give 1 to %d (0 for the default, %d)", opt->background_candidates,
+                        TT_SYNTH_MAX_BACKGROUND_CANDIDATES, TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES);
+    region = opt->background;
+    if (region.x == 0 && region.y == 0 && region.w == 0 && region.h == 0) {
+        region.w = guide->width;
+        region.h = guide->height;
+    }
+    if (region.x < 0 || region.y < 0 || region.w < S || region.h < S ||
+        region.x > guide->width - region.w || region.y > guide->height - region.h)
+        return tt__fail(error, region.w < S || region.h < S ? TT_ERROR_IMAGE_TOO_SMALL : TT_ERROR_INVALID_ARGUMENT,
+                        -1, -1, -1, -1,
+                        "the background region %d,%d %dx%d must lie inside the %dx%d image and hold a %dx%d tile",
+                        region.x, region.y, region.w, region.h, guide->width, guide->height, S, S);
+    if (opt->edge_windows)
+        for (k = 0; k < n; k++)
+            if (!tt__rect_fits(&opt->edge_windows[k], S, 2 * S, guide->width, guide->height))
+                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                                   "edge window %d at %d,%d does not fit: it needs %dx%d texels inside the %dx%d "
+                                   "image", k, opt->edge_windows[k].x, opt->edge_windows[k].y, S, 2 * S,
+                                   guide->width, guide->height);
+    *feather_out = feather;
+    *region_out = region;
+    return TT_OK;
+}
+
+/* A plan's windows on the guide, all from one random stream seeded by
+   opt->seed: the edge windows (given, or chosen), the vertical ones of
+   upright tiles, and a background window per tile. */
+static tt_result tt__synth_choose_windows(tt_synth_plan *plan, const tt_image *guide, const tt_synth_options *opt,
+                                          const tt_rect *region, int S, int n, int ntiles,
+                                          const tt_allocator *allocator, tt_error *error)
+{
+    tt_rng rng;
+    tt_result result;
+    int t, k;
+    tt_rng_seed(&rng, opt->seed, 0x74696c6573ull /* "tiles" */);
+    if (opt->edge_windows) {
+        for (k = 0; k < n; k++) {
+            plan->edge_windows[k] = opt->edge_windows[k];
+            plan->edge_windows[k].w = S;
+            plan->edge_windows[k].h = 2 * S;
+        }
+    } else {
+        tt__choose_edge_windows(&rng, guide, S, n, plan->edge_windows);
+    }
+    if (opt->upright) {
+        /* The vertical windows: edge windows chosen on the guide turned a
+           quarter, whose lines then run down the guide. Texel (x, y) of the
+           guide is (y, W-1-x) of the turned image, so the turned window at
+           (x, y) covers guide columns W-y-2S .. W-y-1 and rows x .. x+S-1. */
+        tt_image *turned = NULL;
+        if ((result = tt_image_rotate90(guide, 1, allocator, &turned, error)) != TT_OK) return result;
+        tt__choose_edge_windows(&rng, turned, S, n, plan->vertical_windows);
+        tt_image_free(turned);
+        for (k = 0; k < n; k++) {
+            tt_rect r = plan->vertical_windows[k];
+            plan->vertical_windows[k].x = guide->width - r.y - 2 * S;
+            plan->vertical_windows[k].y = r.x;
+            plan->vertical_windows[k].w = 2 * S;
+            plan->vertical_windows[k].h = S;
+        }
+    }
+
+    /* The background windows, in tile order from the one stream: a fresh
+       background window per tile gives the aperiodicity; of a few, the one
+       nearest the region's tone keeps the tiles alike in tone. */
+    {
+        const int candidates =
+            opt->background_candidates > 0 ? opt->background_candidates : TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES;
+        const double tone = candidates > 1 ? tt__window_tone(guide, region->x, region->y, region->w, region->h) : 0.0;
+        for (t = 0; t < ntiles; t++)
+            plan->background_windows[t] = tt__choose_background(&rng, guide, region, S, candidates, tone);
+    }
+    return TT_OK;
+}
+
 static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_options *options,
                                        const tt_allocator *allocator, tt_synth_plan **out_plan, tt_error *error,
                                        const char *what, float progress_from, float progress_to)
@@ -9912,7 +10007,6 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     tt__plan_job job;
     tt_tile_layout layout;
     tt_rect region;
-    tt_rng rng;
     tt_result result;
     int S, g, T, n, ntiles, feather, min_depth, max_depth, depth_size, t, k, batch;
     unsigned long long head, edge_bytes, background_bytes, depth_count, bytes;
@@ -9942,12 +10036,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
                         what, guide->width, guide->height, S, opt->upright ? "upright " : "",
                         opt->upright ? 2 * S : S, 2 * S,
                         tt__min_i(opt->upright ? guide->width / 2 : guide->width, guide->height / 2));
-    if (opt->feather < 0)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "feather %d is negative", opt->feather);
-    feather = opt->feather > 0 ? opt->feather : tt__max_i(2, S / 16);
-    if (feather > S / 4 + 1)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "feather %d is too wide for %d-texel tiles (at most %d)", feather, S, S / 4 + 1);
+    if ((result = tt__synth_check_windows(guide, opt, S, n, &feather, &region, error)) != TT_OK) return result;
     /* Every edge of a type shows the same band, so a deep band repeats
        visibly across the surface: bands go no deeper than the cut needs. At
        least past the gutter's depth plus half the feather (so the rows a
@@ -9955,29 +10044,6 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
        of each tile is its own background). */
     max_depth = tt__max_i(1, S / 4);
     min_depth = tt__min_i(tt__max_i(2, g + feather / 2 + 1), max_depth);
-
-    if (opt->background_candidates < 0 || opt->background_candidates > TT_SYNTH_MAX_BACKGROUND_CANDIDATES)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "background_candidates %d: give 1 to %d (0 for the default, %d)", opt->background_candidates,
-                        TT_SYNTH_MAX_BACKGROUND_CANDIDATES, TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES);
-    region = opt->background;
-    if (region.x == 0 && region.y == 0 && region.w == 0 && region.h == 0) {
-        region.w = guide->width;
-        region.h = guide->height;
-    }
-    if (region.x < 0 || region.y < 0 || region.w < S || region.h < S ||
-        region.x > guide->width - region.w || region.y > guide->height - region.h)
-        return tt__fail(error, region.w < S || region.h < S ? TT_ERROR_IMAGE_TOO_SMALL : TT_ERROR_INVALID_ARGUMENT,
-                        -1, -1, -1, -1,
-                        "the background region %d,%d %dx%d must lie inside the %dx%d image and hold a %dx%d tile",
-                        region.x, region.y, region.w, region.h, guide->width, guide->height, S, S);
-    if (opt->edge_windows)
-        for (k = 0; k < n; k++)
-            if (!tt__rect_fits(&opt->edge_windows[k], S, 2 * S, guide->width, guide->height))
-                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
-                                   "edge window %d at %d,%d does not fit: it needs %dx%d texels inside the %dx%d "
-                                   "image", k, opt->edge_windows[k].x, opt->edge_windows[k].y, S, 2 * S,
-                                   guide->width, guide->height);
 
     /* One block: the struct, the edge windows, the background windows, the
        depths (each part a multiple of 16 bytes long but the last). */
@@ -10016,44 +10082,8 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     plan->executor = opt->executor;
     plan->allocator = tt__allocator_copy(allocator);
 
-    tt_rng_seed(&rng, opt->seed, 0x74696c6573ull /* "tiles" */);
-    if (opt->edge_windows) {
-        for (k = 0; k < n; k++) {
-            plan->edge_windows[k] = opt->edge_windows[k];
-            plan->edge_windows[k].w = S;
-            plan->edge_windows[k].h = 2 * S;
-        }
-    } else {
-        tt__choose_edge_windows(&rng, guide, S, n, plan->edge_windows);
-    }
-    if (opt->upright) {
-        /* The vertical windows: edge windows chosen on the guide turned a
-           quarter, whose lines then run down the guide. Texel (x, y) of the
-           guide is (y, W-1-x) of the turned image, so the turned window at
-           (x, y) covers guide columns W-y-2S .. W-y-1 and rows x .. x+S-1. */
-        tt_image *turned = NULL;
-        if ((result = tt_image_rotate90(guide, 1, allocator, &turned, error)) != TT_OK) goto done;
-        tt__choose_edge_windows(&rng, turned, S, n, plan->vertical_windows);
-        tt_image_free(turned);
-        for (k = 0; k < n; k++) {
-            tt_rect r = plan->vertical_windows[k];
-            plan->vertical_windows[k].x = guide->width - r.y - 2 * S;
-            plan->vertical_windows[k].y = r.x;
-            plan->vertical_windows[k].w = 2 * S;
-            plan->vertical_windows[k].h = S;
-        }
-    }
-
-    /* The background windows, in tile order from the one stream. XXXX: a
-       fresh background window per tile gives the aperiodicity; of a few, the
-       one nearest the region's tone keeps the tiles alike in tone. */
-    {
-        const int candidates =
-            opt->background_candidates > 0 ? opt->background_candidates : TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES;
-        const double tone = candidates > 1 ? tt__window_tone(guide, region.x, region.y, region.w, region.h) : 0.0;
-        for (t = 0; t < ntiles; t++)
-            plan->background_windows[t] = tt__choose_background(&rng, guide, &region, S, candidates, tone);
-    }
+    if ((result = tt__synth_choose_windows(plan, guide, opt, &region, S, n, ntiles, allocator, error)) != TT_OK)
+        goto done;
     /* The tiles' cuts, in batches through the executor, the progress
        reported between them on this thread. */
     job.plan = plan;
