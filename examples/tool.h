@@ -227,7 +227,7 @@ int parse_axis_name(const char *text, int *axis, int *sign);
    X,Y,Z, into up[3] (an axis becomes a unit vector, a direction is kept as
    given). Prints the error and returns -1 otherwise. */
 int parse_up(const char *option, const char *text, double up[3]);
-/* The texture's direction (lapped, hpm): --up DIR (parse_up) and
+/* The texture's direction (lapped, hpm, tile): --up DIR (parse_up) and
    --constraints FILE, turned into a field by tool_make_field.
    Zero-initialised: no option given, up the library's default (+y). */
 typedef struct tool_field {
