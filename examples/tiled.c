@@ -144,7 +144,7 @@ static int orient_tiles(const char *obj_path, const tiled_options *options, cons
 {
     const int nfaces = out->mesh->nfaces;
     float *vectors = (float *)malloc((size_t)nfaces * 3 * sizeof(float));
-    int *first = (int *)malloc((size_t)nsources * sizeof(int));
+    int *first = (int *)calloc((size_t)nsources, sizeof(int));
     tool_face_source faces;
     tt_error error;
     int f, status;
