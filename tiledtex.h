@@ -1236,6 +1236,48 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
 TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                               float *corner_uv, tt_error *error);
 
+/* Tiles that follow a direction field, for a texture with an up (bricks,
+   planks, grain). tt_assign_uvs puts each tile's bottom side on the face's
+   first half-edge, wherever that runs; on a mesh of any shape the courses
+   of a brick wall then turn from quad to quad. face_turn[f] (0..3) instead
+   names the half-edge face_start[f] + face_turn[f] as the tile's bottom
+   side: the turn whose tile up - from the middle of the bottom side to the
+   middle of the top side - lies nearest face_vectors[f] in angle
+   (tt_tangent_field's T_f, or your own; only the direction counts; a zero
+   vector keeps turn 0).
+   Upright tiles (tt_synth_options::upright) keep the source's up on all
+   four sides, but their left and right sides match only left and right
+   sides of upright tiles. face_upright (NULL: not wanted) gets 1 for the
+   faces that can show one: a face starts upright when its vector is not
+   zero, and stops being upright while one of its left or right sides meets
+   a face that is not upright or that sees the edge as its bottom or top
+   (where the field turns past the diagonal of the quads, around the mesh's
+   irregular vertices); those faces show plain tiles, which match anything
+   across their sides but turn the texture of their left and right quarters
+   a quarter turn. Every edge then matches with tt_assign_uvs_oriented's
+   atlas. *out_upright (NULL: not wanted) gets the number of upright faces.
+   Errors: NULL mesh, face_vectors or face_turn, a bad allocator
+   (TT_ERROR_INVALID_ARGUMENT); a face that is not a quad
+   (TT_ERROR_NOT_QUAD_MESH); a non-finite vector (TT_ERROR_NON_FINITE,
+   naming the face); a mesh without faces (TT_ERROR_EMPTY_MESH);
+   TT_ERROR_OUT_OF_MEMORY. Memory: 5 bytes a face, from `allocator`, freed
+   before it returns. Deterministic. */
+TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, const tt_allocator *allocator,
+                                uint8_t *face_turn, uint8_t *face_upright, int *out_upright, tt_error *error);
+
+/* tt_assign_uvs with each quad's tile turned by face_turn (NULL: no turn,
+   tt_assign_uvs's UVs to the bit): the tile is named by the types e0..e3
+   read from the half-edge face_turn[f] on, and its corner k lies at the
+   face's corner face_turn[f] + k. With face_upright (NULL: one tile set)
+   the UVs address an atlas twice as wide, plain tiles on the left and
+   upright ones on the right (tt_polycube_upright_atlas makes it): u
+   becomes (u + face_upright[f]) / 2. Errors: as tt_assign_uvs, and a turn
+   above 3 or an upright flag other than 0 or 1 (TT_ERROR_INVALID_ARGUMENT,
+   naming the face). */
+TTDEF tt_result tt_assign_uvs_oriented(const tt_mesh *mesh, const tt_tile_layout *layout,
+                                       const uint8_t *corner_type, const uint8_t *face_turn,
+                                       const uint8_t *face_upright, float *corner_uv, tt_error *error);
+
 /* Fewer distinct tiles, for a smaller compact atlas (tt_compact_atlas_create):
    boundary types from tt_assign_boundaries are changed edge by edge until
    the faces show at most max_tiles distinct tiles. An edge's new type keeps
@@ -8946,8 +8988,11 @@ TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *
     return TT_OK;
 }
 
-TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
-                              float *corner_uv, tt_error *error)
+/* tt_assign_uvs and tt_assign_uvs_oriented: face_turn and face_upright
+   NULL give tt_assign_uvs's UVs. */
+static tt_result tt__assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
+                                const uint8_t *face_turn, const uint8_t *face_upright, float *corner_uv,
+                                const char *name, tt_error *error)
 {
     tt_tile_layout resolved = {0, 0, 0}; /* written by tt_tile_layout_resolve; set so no compiler sees it unset */
     tt_result result;
@@ -8955,7 +9000,7 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
     int f, base, c;
     tt__ok(error);
     if (!mesh || !layout || !corner_type || !corner_uv)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "NULL argument to tt_assign_uvs");
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "NULL argument to %s", name);
     if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if ((result = tt_tile_layout_resolve(layout, &resolved, error)) != TT_OK) return result;
     base = 2 * resolved.colors;
@@ -8967,21 +9012,153 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
             return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, mesh->corner_face[c], c, -1, -1,
                             "corner %d has boundary type %d, but %d colors allow 0..%d", c, corner_type[c],
                             resolved.colors, base - 1);
+    for (f = 0; f < mesh->nfaces; f++)
+        if ((face_turn && face_turn[f] > 3) || (face_upright && face_upright[f] > 1))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d has turn %d and upright flag %d: turns are 0..3, flags 0 or 1", f,
+                            face_turn ? face_turn[f] : 0, face_upright ? face_upright[f] : 0);
     for (f = 0; f < mesh->nfaces; f++) {
         /* tt_tile_corner_uv's formula, term for term, so the two agree to
            the bit. */
-        const uint8_t *e = corner_type + 4 * (size_t)f;
-        float *uv = corner_uv + 8 * (size_t)f;
-        int column = base * e[0] + e[1], row = base * e[2] + e[3];
-        float u0 = (float)(((double)column * cell + resolved.gutter) / atlas);
-        float u1 = (float)(((double)column * cell + resolved.gutter + (double)resolved.tile_size) / atlas);
-        float v0 = (float)(((double)row * cell + resolved.gutter) / atlas);
-        float v1 = (float)(((double)row * cell + resolved.gutter + (double)resolved.tile_size) / atlas);
-        uv[0] = u0; uv[1] = v0;   /* corner 0: bottom-left  */
-        uv[2] = u1; uv[3] = v0;   /* corner 1: bottom-right */
-        uv[4] = u1; uv[5] = v1;   /* corner 2: top-right    */
-        uv[6] = u0; uv[7] = v1;   /* corner 3: top-left     */
+        const int turn = face_turn ? face_turn[f] : 0;
+        const uint8_t *face = corner_type + 4 * (size_t)f;
+        float *uv = corner_uv + 8 * (size_t)f, tile[8];
+        uint8_t e[4];
+        int column, row, k;
+        float u0, u1, v0, v1;
+        for (k = 0; k < 4; k++) e[k] = face[(k + turn) & 3];
+        column = base * e[0] + e[1];
+        row = base * e[2] + e[3];
+        u0 = (float)(((double)column * cell + resolved.gutter) / atlas);
+        u1 = (float)(((double)column * cell + resolved.gutter + (double)resolved.tile_size) / atlas);
+        v0 = (float)(((double)row * cell + resolved.gutter) / atlas);
+        v1 = (float)(((double)row * cell + resolved.gutter + (double)resolved.tile_size) / atlas);
+        tile[0] = u0; tile[1] = v0;   /* corner 0: bottom-left  */
+        tile[2] = u1; tile[3] = v0;   /* corner 1: bottom-right */
+        tile[4] = u1; tile[5] = v1;   /* corner 2: top-right    */
+        tile[6] = u0; tile[7] = v1;   /* corner 3: top-left     */
+        for (k = 0; k < 4; k++) {
+            const int at = (k + turn) & 3;
+            /* tt_polycube_mapping_uvs_upright's halves, the same arithmetic. */
+            uv[2 * at] = face_upright ? 0.5f * (tile[2 * k] + (float)face_upright[f]) : tile[2 * k];
+            uv[2 * at + 1] = tile[2 * k + 1];
+        }
     }
+    return TT_OK;
+}
+
+TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
+                              float *corner_uv, tt_error *error)
+{
+    return tt__assign_uvs(mesh, layout, corner_type, NULL, NULL, corner_uv, "tt_assign_uvs", error);
+}
+
+TTDEF tt_result tt_assign_uvs_oriented(const tt_mesh *mesh, const tt_tile_layout *layout,
+                                       const uint8_t *corner_type, const uint8_t *face_turn,
+                                       const uint8_t *face_upright, float *corner_uv, tt_error *error)
+{
+    return tt__assign_uvs(mesh, layout, corner_type, face_turn, face_upright, corner_uv, "tt_assign_uvs_oriented",
+                          error);
+}
+
+/* Whether face f (turned by turn[f]) sees its corner c's half-edge as its
+   left or right side. */
+static int tt__tile_side_is_vertical(const tt_mesh *mesh, const uint8_t *turn, int f, int c)
+{
+    return ((c - mesh->face_start[f] - turn[f]) & 1) != 0;
+}
+
+TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, const tt_allocator *allocator,
+                                uint8_t *face_turn, uint8_t *face_upright, int *out_upright, tt_error *error)
+{
+    int *stack = NULL;
+    uint8_t *stacked = NULL;
+    int f, k, top = 0, upright = 0;
+    tt__ok(error);
+    if (out_upright) *out_upright = 0;
+    if (!mesh || !face_vectors || !face_turn)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_orient_tiles needs a mesh, face_vectors and face_turn (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
+    if (tt__require_quads(mesh, error) != TT_OK) return TT_ERROR_NOT_QUAD_MESH;
+    for (f = 0; f < mesh->nfaces; f++)
+        for (k = 0; k < 3; k++)
+            if (!tt__is_finite(face_vectors[3 * (size_t)f + k]))
+                return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1, "face %d's vector is not finite", f);
+    if (face_upright) {
+        stack = TT__ALLOC(allocator, int, mesh->nfaces);
+        stacked = TT__ALLOC(allocator, uint8_t, mesh->nfaces);
+        if (!stack || !stacked) {
+            tt__free(allocator, stack);
+            tt__free(allocator, stacked);
+            return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                            "out of memory for the %d faces' orientation", mesh->nfaces);
+        }
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        const float *t = face_vectors + 3 * (size_t)f;
+        double p[4][3], best = -2.0;
+        const double length_t = sqrt((double)t[0] * t[0] + (double)t[1] * t[1] + (double)t[2] * t[2]);
+        int turn;
+        for (k = 0; k < 4; k++) {
+            const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[4 * (size_t)f + k];
+            p[k][0] = q[0]; p[k][1] = q[1]; p[k][2] = q[2];
+        }
+        face_turn[f] = 0;
+        for (turn = 0; turn < 4 && length_t > 0.0; turn++) {
+            /* The tile's up: from its bottom side's middle (half-edge turn)
+               to its top side's (half-edge turn + 2). */
+            const double *a = p[turn], *b = p[(turn + 1) & 3], *c = p[(turn + 2) & 3], *d = p[(turn + 3) & 3];
+            double up[3], length, cosine;
+            for (k = 0; k < 3; k++) up[k] = c[k] + d[k] - a[k] - b[k];
+            length = tt__length3(up);
+            if (!(length > 0.0)) continue;
+            cosine = (up[0] * t[0] + up[1] * t[1] + up[2] * t[2]) / (length * length_t);
+            if (cosine > best) {
+                best = cosine;
+                face_turn[f] = (uint8_t)turn;
+            }
+        }
+        if (face_upright) {
+            face_upright[f] = (uint8_t)(length_t > 0.0);
+            stack[top++] = f;
+            stacked[f] = 1;
+        }
+    }
+    /* A face stops being upright while one of its left or right sides
+       meets a face that is not upright or sees the edge as bottom or top;
+       its upright neighbours are checked again. Faces only ever stop, so
+       the order does not matter: what stays is the largest set of faces
+       that satisfies the rule. */
+    while (top > 0) {
+        int c, demote = 0;
+        f = stack[--top];
+        stacked[f] = 0;
+        if (!face_upright[f]) continue;
+        for (c = 4 * f; c < 4 * f + 4 && !demote; c++) {
+            const int t = mesh->twin[c];
+            int g;
+            if (t < 0 || !tt__tile_side_is_vertical(mesh, face_turn, f, c)) continue;
+            g = mesh->corner_face[t];
+            demote = !face_upright[g] || !tt__tile_side_is_vertical(mesh, face_turn, g, t);
+        }
+        if (!demote) continue;
+        face_upright[f] = 0;
+        for (c = 4 * f; c < 4 * f + 4; c++) {
+            const int t = mesh->twin[c];
+            const int g = t >= 0 ? mesh->corner_face[t] : -1;
+            if (g >= 0 && face_upright[g] && !stacked[g]) {
+                stack[top++] = g;
+                stacked[g] = 1;
+            }
+        }
+    }
+    if (face_upright)
+        for (f = 0; f < mesh->nfaces; f++) upright += face_upright[f];
+    tt__free(allocator, stack);
+    tt__free(allocator, stacked);
+    if (out_upright) *out_upright = upright;
     return TT_OK;
 }
 

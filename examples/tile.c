@@ -4,6 +4,9 @@
    OUT_PREFIX.png (the atlas): `tiledtex map` and `tiledtex synth` together,
    with the seam score measured on the result. Open the OBJ in Blender, or
    look at it with `tiledtex render OUT_PREFIX.obj OUT_PREFIX.png view.png`.
+   With --up or --constraints the quads' tiles turn along the direction
+   field (tiled_map_mesh), and the atlas is a plain and an upright tile set
+   side by side (tt_polycube_upright_atlas), as the polycube's.
 */
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,6 +39,14 @@ static void print_help(void)
            "  --edge X,Y             condition k's S x 2S edge window, once per condition\n"
            "  --background X,Y,W,H   region the background windows come from\n"
            "  --mips                 also write the per-tile mip levels, OUT_PREFIX_mip1.png ...\n"
+           "  --up AXIS              turn each quad's tile so that its up follows AXIS (x, y, z, -x,\n"
+           "                         -y, -z or X,Y,Z) along the surface, and give the quads upright\n"
+           "                         tiles, which keep IMAGE's up on all four sides (bricks, planks\n"
+           "                         and grain run level): the atlas is twice as wide, plain tiles\n"
+           "                         on the left for the quads where the field turns past a quad's\n"
+           "                         diagonal, upright ones on the right\n"
+           "  --constraints FILE     the same, up given by lines FACE X Y Z [SIGMA [WEIGHT]] (FACE\n"
+           "                         counts the OBJ's faces from 1), as 'tiledtex lapped' takes them\n"
            "  --report               also print tile usage and face stretch, and measure the\n"
            "                         seams on every edge (default: a sample of %d edges)\n"
            MATERIAL_OPTIONS_HELP("                         ")
@@ -52,6 +63,48 @@ static void print_help(void)
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
 }
 
+/* The upright tiles, on the plain tiles' edge windows, for the quads
+   tiled_map_mesh gave upright tiles, and for each map. */
+static int synthesize_upright(const tt_image *image, const char *image_path, const tiled_options *options,
+                              const tt_tileset *tiles, tt_tileset **upright, tt_tileset **map_upright)
+{
+    tiled_options over = *options;
+    over.upright_over = tiles->edge_windows;
+    return tiled_synthesize(image, image_path, &over, &options->maps, upright, map_upright);
+}
+
+/* Level `level` of the plain | upright atlas; prints the error. */
+static int upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level, tt_image **out)
+{
+    tt_error error;
+    if (tt_polycube_upright_atlas(plain, upright, level, tool_executor(), NULL, out, &error) != TT_OK)
+        return tool_fail("the %dx%d atlas: %s", 2 * plain->levels[level].width, plain->levels[level].height,
+                         error.message);
+    return 0;
+}
+
+/* tiled_add_atlas for the plain | upright atlas: level 0 is made already,
+   the mip levels (--mips) side by side as level 0's. */
+static int add_upright_atlas(tool_output *output, const char *png_path, const tt_image *atlas,
+                             const tt_tileset *plain, const tt_tileset *upright, int mips, tt_color_space space)
+{
+    char message[TOOL_ERROR_SIZE], path[4096];
+    size_t stem = strlen(png_path);
+    int level, status = 0;
+    if (output_add_png(output, png_path, atlas, space, message, sizeof message) != 0)
+        return tool_fail("%s", message);
+    if (stem > 4 && strcmp(png_path + stem - 4, ".png") == 0) stem -= 4;
+    for (level = 1; mips && status == 0 && level < plain->nlevels && level < upright->nlevels; level++) {
+        tt_image *image = NULL;
+        snprintf(path, sizeof path, "%.*s_mip%d.png", (int)stem, png_path, level);
+        if ((status = upright_atlas(plain, upright, level, &image)) == 0 &&
+            output_add_png(output, path, image, space, message, sizeof message) != 0)
+            status = tool_fail("%s", message);
+        tt_image_free(image);
+    }
+    return status;
+}
+
 int cmd_tile(int argc, char **argv)
 {
     const char *positional[3];
@@ -59,7 +112,8 @@ int cmd_tile(int argc, char **argv)
     tiled_options options;
     tiled_mesh mesh;
     tt_image *image = NULL;
-    tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS];
+    tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS], *upright = NULL, *map_upright[MATERIAL_MAPS];
+    tt_image *atlas = NULL, *map_atlas[MATERIAL_MAPS];
     tool_seams seams;
     tool_output output;
     char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096],
@@ -71,10 +125,12 @@ int cmd_tile(int argc, char **argv)
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
     memset(map_tiles, 0, sizeof map_tiles);
+    memset(map_upright, 0, sizeof map_upright);
+    memset(map_atlas, 0, sizeof map_atlas);
     status = tiled_parse_command_line(argc, argv,
                                       TILED_LAYOUT_OPTIONS | TILED_MESH_OPTIONS | TILED_SYNTH_OPTIONS |
                                           TILED_REPORT_OPTION | TILED_MATERIAL_OPTIONS | TILED_TRIANGLES_OPTION |
-                                          TILED_FORMAT_OPTION,
+                                          TILED_FORMAT_OPTION | TILED_FIELD_OPTIONS,
                                       &options, positional, 3, "MESH, IMAGE and OUT_PREFIX", print_help);
     if (status >= 0) return status;
     if (tool_output_prefix(positional[2], &options.output, prefix) != 0) return TOOL_EXIT_USAGE;
@@ -101,6 +157,25 @@ int cmd_tile(int argc, char **argv)
         return status;
     }
     status = tiled_check_atlas_size(&options);
+    if (status == 0 && options.field.given) {
+        /* Upright tiles cut their left and right bands from 2S x S windows
+           beside the plain ones' S x 2S; the atlas of both is twice as wide. */
+        const int S = options.layout.tile_size ? options.layout.tile_size : TT_DEFAULT_TILE_SIZE;
+        int side = 0;
+        tt_tile_layout layout;
+        tt_error error;
+        if (tt_tile_layout_resolve(&options.layout, &layout, &error) == TT_OK)
+            side = tt_tile_layout_atlas_size(&layout);
+        options.upright = image->width >= 2 * S && image->height >= 2 * S;
+        if (!options.upright)
+            tool_note("%s is %dx%d: too small for upright %d-texel tiles (they need %dx%d): the tiles are turned "
+                      "along --up, but plain, their left and right quarters turned a quarter (use a smaller --tile)",
+                      positional[1], image->width, image->height, S, 2 * S, 2 * S);
+        else if (2 * side > TOOL_MAX_ATLAS)
+            status = tool_fail("--up makes a %dx%d atlas of plain and upright tiles; the tool writes at most %d "
+                               "texels a side (use fewer --colors or a smaller --tile)", 2 * side, side,
+                               TOOL_MAX_ATLAS);
+    }
     if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
     /* Before the synthesis: no output may replace an input (checked again at the commit). */
     if (status == 0 && gltf) status = tool_refuse_input_overwrite(gltf_path);
@@ -109,6 +184,12 @@ int cmd_tile(int argc, char **argv)
     if (status == 0 && !gltf) status = tool_refuse_input_overwrite(png_path);
     if (status == 0 && !gltf) status = material_refuse_overwrite(&options.maps, prefix);
     if (status == 0) status = tiled_synthesize(image, positional[1], &options, &options.maps, &tiles, map_tiles);
+    if (status == 0 && mesh.face_upright) {
+        status = synthesize_upright(image, positional[1], &options, tiles, &upright, map_upright);
+        if (status == 0) status = upright_atlas(tiles, upright, 0, &atlas);
+        for (map = 0; map < MATERIAL_MAPS && status == 0; map++)
+            if (map_tiles[map]) status = upright_atlas(map_tiles[map], map_upright[map], 0, &map_atlas[map]);
+    }
     /* The photo and the maps are not needed past the synthesis: free them
        before the PNGs are encoded (they are the largest things the command
        holds). */
@@ -116,21 +197,28 @@ int cmd_tile(int argc, char **argv)
     image = NULL;
     material_free(&options.maps);
     if (status == 0)
-        status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, &tiles->levels[0], options.seed, 0,
+        status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas ? atlas : &tiles->levels[0],
+                                    options.seed, 0,
                                     NULL, 0, options.report, &seams);
     if (status == 0 && gltf) {
         tool_material material;
         const tt_image *map_atlases[MATERIAL_MAPS];
-        for (map = 0; map < MATERIAL_MAPS; map++) map_atlases[map] = map_tiles[map] ? &map_tiles[map]->levels[0] : NULL;
+        for (map = 0; map < MATERIAL_MAPS; map++)
+            map_atlases[map] = map_atlas[map] ? map_atlas[map] : map_tiles[map] ? &map_tiles[map]->levels[0] : NULL;
         memset(&material, 0, sizeof material);
         material.name = "tiled";
-        material.base_color = &tiles->levels[0];
+        material.base_color = atlas ? atlas : &tiles->levels[0];
         material_for_glb(&material, &options.maps, map_atlases);
         status = tiled_add_gltf(&output, gltf_path, &mesh, &material);
     }
-    if (status == 0 && !gltf) status = tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
+    if (status == 0 && !gltf)
+        status = atlas ? add_upright_atlas(&output, png_path, atlas, tiles, upright, options.mips, TT_COLOR_SRGB)
+                       : tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
     for (map = 0; map < MATERIAL_MAPS && status == 0 && !gltf; map++)
-        if (map_tiles[map])
+        if (map_atlas[map])
+            status = add_upright_atlas(&output, map_paths[map], map_atlas[map], map_tiles[map], map_upright[map],
+                                       options.mips, material_space(map));
+        else if (map_tiles[map])
             status = tiled_add_atlas(&output, map_paths[map], map_tiles[map], options.mips, material_space(map));
     if (status == 0 && !gltf) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
     if (status == 0 && !gltf)
@@ -141,20 +229,28 @@ int cmd_tile(int argc, char **argv)
         tiled_print_notes(positional[0], &mesh);
         if (!tool_quiet()) {
             tiled_print_summary(positional[0], &mesh, &seams, options.report);
+            if (mesh.face_turn)
+                printf("up: %d quads' tiles turned along the field, %d upright and %d plain (where the field turns "
+                       "past a quad's diagonal, or next to such a quad along a course)\n", mesh.mesh->nfaces,
+                       mesh.upright_faces, mesh.mesh->nfaces - mesh.upright_faces);
             if (gltf) {
                 printf("wrote %s (%dx%d atlas)\n", gltf_written(gltf_path, written, sizeof written),
-                       tiles->levels[0].width, tiles->levels[0].height);
+                       atlas ? atlas->width : tiles->levels[0].width, atlas ? atlas->height : tiles->levels[0].height);
             } else {
                 printf("wrote %s, %s, %s", obj_path, mtl_path, png_path);
                 for (map = 0; map < MATERIAL_MAPS; map++)
                     if (map_tiles[map]) printf(", %s", map_paths[map]);
-                printf(" (%dx%d atlas)\n", tiles->levels[0].width, tiles->levels[0].height);
+                printf(" (%dx%d atlas)\n", atlas ? atlas->width : tiles->levels[0].width,
+                       atlas ? atlas->height : tiles->levels[0].height);
             }
         }
     }
     output_free(&output);
     tiled_mesh_free(&mesh);
     tiled_tilesets_free(&tiles, map_tiles);
+    tiled_tilesets_free(&upright, map_upright);
+    tt_image_free(atlas);
+    for (map = 0; map < MATERIAL_MAPS; map++) tt_image_free(map_atlas[map]);
     material_free(&options.maps);
     image_free(image);
     return status;

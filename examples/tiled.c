@@ -11,6 +11,12 @@
                             complementary (seeded: same seed, same result)
      tt_assign_uvs          one UV per corner: the tile named by its four
                             boundary types, at its place in the atlas
+   With --up or --constraints, instead of tt_assign_uvs:
+     tt_tangent_field       the texture's up per quad (tool_make_face_field)
+     tt_orient_tiles        each quad's tile turned to it, and the quads that
+                            can show upright tiles
+     tt_assign_uvs_oriented the UVs of the turned tiles, upright ones in the
+                            right half of a plain | upright atlas
 */
 #include <stdio.h>
 #include <stdlib.h>
@@ -65,6 +71,8 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
                (taken = parse_mesh_output_option(argc, argv, index, accept & TILED_FORMAT_OPTION,
                                                  &options->output)) != 0) {
         if (taken < 0) return -1;
+    } else if ((accept & TILED_FIELD_OPTIONS) && (taken = parse_field_option(argc, argv, index, &options->field))) {
+        if (taken < 0) return -1;
     } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
         if (!value) { tool_usage("--atlas needs a value"); return -1; }
         options->atlas_path = value;
@@ -102,7 +110,67 @@ void tiled_mesh_free(tiled_mesh *mesh)
     free(mesh->corner_normal);
     free(mesh->corner_type);
     free(mesh->corner_uv);
+    free(mesh->face_turn);
+    free(mesh->face_upright);
     memset(mesh, 0, sizeof *mesh);
+}
+
+/* tool_quadrangulate, keeping each quad's OBJ face in *source (when not
+   NULL): quad q of the result comes from corner q's face. */
+static int quadrangulate_traced(const char *obj_path, tiled_mesh *out, int smooth, int **source)
+{
+    int *traced = NULL, q, status;
+    if (*source) {
+        traced = (int *)malloc((size_t)out->mesh->ncorners * sizeof(int));
+        if (!traced) return tool_fail("out of memory for the %d quads of %s", out->mesh->ncorners, obj_path);
+        for (q = 0; q < out->mesh->ncorners; q++) traced[q] = (*source)[out->mesh->corner_face[q]];
+    }
+    status = tool_quadrangulate(obj_path, &out->mesh, smooth, NULL, &out->corner_normal);
+    if (status != 0) {
+        free(traced);
+        return status;
+    }
+    if (traced) {
+        free(*source);
+        *source = traced;
+    }
+    return 0;
+}
+
+/* The direction field on the quads, each quad's tile turned to it, and
+   the UVs of those tiles. */
+static int orient_tiles(const char *obj_path, const tiled_options *options, const int *source, const int *lines,
+                        int nsources, tiled_mesh *out)
+{
+    const int nfaces = out->mesh->nfaces;
+    float *vectors = (float *)malloc((size_t)nfaces * 3 * sizeof(float));
+    int *first = (int *)calloc((size_t)nsources, sizeof(int));
+    tool_face_source faces;
+    tt_error error;
+    int f, status;
+    out->face_turn = (uint8_t *)malloc((size_t)nfaces);
+    out->face_upright = options->upright ? (uint8_t *)malloc((size_t)nfaces) : NULL;
+    if (!vectors || !first || !out->face_turn || (options->upright && !out->face_upright)) {
+        free(vectors);
+        free(first);
+        return tool_fail("out of memory for the direction field of %d quads", nfaces);
+    }
+    for (f = nfaces - 1; f >= 0; f--) first[source[f]] = f;
+    faces.mesh = out->mesh;
+    faces.nfaces = nfaces;
+    faces.nsources = nsources;
+    faces.source = source;
+    faces.first = first;
+    faces.source_line = lines;
+    status = tool_make_face_field(obj_path, &faces, &options->field, 0.0f, vectors);
+    free(first);
+    if (status == 0 && (tt_orient_tiles(out->mesh, vectors, NULL, out->face_turn, out->face_upright,
+                                        &out->upright_faces, &error) != TT_OK ||
+                        tt_assign_uvs_oriented(out->mesh, &out->layout, out->corner_type, out->face_turn,
+                                               out->face_upright, out->corner_uv, &error) != TT_OK))
+        status = tool_fail("%s: %s", obj_path, error.message);
+    free(vectors);
+    return status;
 }
 
 int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out)
@@ -111,7 +179,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
     tt_mesh_desc desc;
     tt_error error;
     char message[TOOL_ERROR_SIZE];
-    int status, step;
+    int status, step, f, *source = NULL, *lines = NULL;
 
     memset(out, 0, sizeof *out);
     if (tt_tile_layout_resolve(&options->layout, &out->layout, &error) != TT_OK)
@@ -120,10 +188,25 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
 
     desc = obj_mesh_desc(&obj, options->mesh.permissive ? TT_MESH_PERMISSIVE : 0);
     out->input_faces = obj.nfaces;
+    if (options->field.given) {
+        /* Each quad's OBJ face and the faces' lines, for --constraints. */
+        source = (int *)malloc((size_t)obj.nfaces * sizeof(int));
+        lines = (int *)malloc((size_t)obj.nfaces * sizeof(int));
+        if (!source || !lines) {
+            free(source);
+            free(lines);
+            obj_free(&obj);
+            return tool_fail("out of memory for the %d faces of %s", obj.nfaces, obj_path);
+        }
+        for (f = 0; f < obj.nfaces; f++) source[f] = f;
+        memcpy(lines, obj.face_line, (size_t)obj.nfaces * sizeof(int));
+    }
     tool_stage("checking the mesh");
     if (tt_mesh_build(&desc, NULL, &out->mesh, &error) != TT_OK) {
         status = obj_report_mesh_error(obj_path, &obj, &error, 1);
         obj_free(&obj);
+        free(source);
+        free(lines);
         return status;
     }
     /* The mesh's corners are the OBJ's, in order. */
@@ -131,6 +214,8 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
     obj_free(&obj);
     if (status != 0) {
         tiled_mesh_free(out);
+        free(source);
+        free(lines);
         return tool_fail("out of memory for the normals of %s", obj_path);
     }
     out->repaired_edges = out->mesh->repaired_edges;
@@ -139,14 +224,12 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
 
     /* Tiles are square: every face must be a quad. */
     if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
-        if ((status = tool_quadrangulate(obj_path, &out->mesh, 0, NULL, &out->corner_normal)) != 0) goto fail;
+        if ((status = quadrangulate_traced(obj_path, out, 0, &source)) != 0) goto fail;
         out->quadrangulated = out->mesh->nfaces;
     }
     if ((status = tool_check_subdivide(obj_path, out->mesh, options->mesh.subdivide)) != 0) goto fail;
     for (step = 0; step < options->mesh.subdivide; step++)
-        if ((status = tool_quadrangulate(obj_path, &out->mesh, options->mesh.smooth, NULL, &out->corner_normal)) !=
-            0)
-            goto fail;
+        if ((status = quadrangulate_traced(obj_path, out, options->mesh.smooth, &source)) != 0) goto fail;
 
     out->corner_type = (uint8_t *)malloc((size_t)out->mesh->ncorners);
     out->corner_uv = (float *)malloc((size_t)out->mesh->ncorners * 2 * sizeof(float));
@@ -160,12 +243,17 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         status = tool_fail("%s: %s", obj_path, error.message);
         goto fail;
     }
+    if (source && (status = orient_tiles(obj_path, options, source, lines, out->input_faces, out)) != 0) goto fail;
     if (tt_mesh_compute_stats(out->mesh, NULL, &out->stats, &error) != TT_OK) {
         status = tool_fail("%s: %s", obj_path, error.message);
         goto fail;
     }
+    free(source);
+    free(lines);
     return 0;
 fail:
+    free(source);
+    free(lines);
     tiled_mesh_free(out);
     return status;
 }
@@ -238,13 +326,15 @@ static int compare_floats(const void *a, const void *b)
 
 /* The rest of the quality report: how evenly the tiles are used (every tile
    equally often is what keeps repetition invisible) and how much each face
-   stretches its tile (the ratio of the singular values of its map). */
+   stretches its tile (the ratio of the singular values of its map). With
+   --up a tile counts once whether plain or upright. */
 static void print_quality(const tiled_mesh *mesh)
 {
     int ntiles = tt_tile_layout_tile_count(&mesh->layout), nfaces = mesh->mesh->nfaces, used = 0, least = -1,
         most = 0, t, f, degenerate = 0;
     int *counts = (int *)malloc((size_t)ntiles * sizeof(int));
-    float *stretch = (float *)malloc((size_t)nfaces * sizeof(float));
+    float *stretch = (float *)malloc((size_t)nfaces * sizeof(float)), *uv = NULL;
+    uint8_t *types = NULL;
     tt_error error;
     if (!counts || !stretch) {
         printf("quality: not measured (out of memory)\n");
@@ -252,13 +342,37 @@ static void print_quality(const tiled_mesh *mesh)
         free(stretch);
         return;
     }
-    if (tt_tile_histogram(mesh->mesh, &mesh->layout, mesh->corner_type, counts, &error) != TT_OK ||
-        tt_face_stretch(mesh->mesh, mesh->corner_uv, stretch, &error) != TT_OK) {
+    if (mesh->face_turn) {
+        /* Turned tiles: each quad's types from its tile's bottom side on,
+           and the UVs of an atlas twice as wide measured in its texels. */
+        types = (uint8_t *)malloc((size_t)mesh->mesh->ncorners);
+        uv = (float *)malloc((size_t)mesh->mesh->ncorners * 2 * sizeof(float));
+        if (!types || !uv) {
+            printf("quality: not measured (out of memory)\n");
+            free(counts);
+            free(stretch);
+            free(types);
+            free(uv);
+            return;
+        }
+        for (f = 0; f < nfaces; f++)
+            for (t = 0; t < 4; t++) types[4 * f + t] = mesh->corner_type[4 * f + ((t + mesh->face_turn[f]) & 3)];
+        for (t = 0; t < mesh->mesh->ncorners; t++) {
+            uv[2 * t] = mesh->face_upright ? 2.0f * mesh->corner_uv[2 * t] : mesh->corner_uv[2 * t];
+            uv[2 * t + 1] = mesh->corner_uv[2 * t + 1];
+        }
+    }
+    if (tt_tile_histogram(mesh->mesh, &mesh->layout, types ? types : mesh->corner_type, counts, &error) != TT_OK ||
+        tt_face_stretch(mesh->mesh, uv ? uv : mesh->corner_uv, stretch, &error) != TT_OK) {
         printf("quality: not measured (%s)\n", error.message);
         free(counts);
         free(stretch);
+        free(types);
+        free(uv);
         return;
     }
+    free(types);
+    free(uv);
     for (t = 0; t < ntiles; t++) {
         if (counts[t] > 0) used++;
         if (least < 0 || counts[t] < least) least = counts[t];

@@ -20,7 +20,8 @@ enum {
     TILED_REPORT_OPTION = 1 << 4,    /* --report: quality line, seams measured on every edge */
     TILED_MATERIAL_OPTIONS = 1 << 5, /* --normal --roughness --metallic --ao --height --normal-y-down */
     TILED_TRIANGLES_OPTION = 1 << 6, /* --triangles */
-    TILED_FORMAT_OPTION = 1 << 7     /* --format obj|gltf */
+    TILED_FORMAT_OPTION = 1 << 7,    /* --format obj|gltf */
+    TILED_FIELD_OPTIONS = 1 << 8     /* --up --constraints: tiles turned along the direction field */
 };
 
 /* From this many triangles on, a mesh counts as a dense triangle mesh, for
@@ -40,6 +41,8 @@ typedef struct tiled_options {
     int report;                  /* --report: tile usage and stretch under the summary */
     tool_mesh_output output;     /* --format, --triangles */
     const tt_rect *upright_over; /* not NULL: upright tiles (tt_synth_options::upright) on these edge windows */
+    tool_field field;            /* --up, --constraints: each quad's tile turned along the field */
+    int upright;                 /* with the field: faces may take upright tiles (the image feeds them) */
     material_maps maps;          /* the material's other maps (their paths; material_load loads them) */
 } tiled_options;
 
@@ -72,11 +75,17 @@ typedef struct tiled_mesh {
     int quadrangulated;          /* quads made from the OBJ's triangles or n-gons; 0 if all quads */
     int input_min_face_size, input_max_face_size;
     int repaired_edges;          /* edges --permissive cut open */
+    /* With --up or --constraints (else NULL and 0): */
+    uint8_t *face_turn;          /* per quad: the half-edge its tile's bottom side lies on (tt_orient_tiles) */
+    uint8_t *face_upright;       /* per quad: 1 for an upright tile (the atlas's right half); NULL without */
+    int upright_faces;           /* quads with upright tiles */
 } tiled_mesh;
 
 /* Read an OBJ, build and validate it, quadrangulate when it is not all quads
    (said on stderr), subdivide (the file's normals carried along when every
-   corner has one), assign boundaries and UVs. Prints the error and returns
+   corner has one), assign boundaries and UVs; with options->field given,
+   each quad's tile turned along the direction field, and with
+   options->upright the UVs of a plain | upright atlas (tt_assign_uvs_oriented). Prints the error and returns
    an exit status on failure, 0 on success. */
 int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out);
 void tiled_mesh_free(tiled_mesh *mesh);

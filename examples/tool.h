@@ -227,7 +227,7 @@ int parse_axis_name(const char *text, int *axis, int *sign);
    X,Y,Z, into up[3] (an axis becomes a unit vector, a direction is kept as
    given). Prints the error and returns -1 otherwise. */
 int parse_up(const char *option, const char *text, double up[3]);
-/* The texture's direction (lapped, hpm): --up DIR (parse_up) and
+/* The texture's direction (lapped, hpm, tile): --up DIR (parse_up) and
    --constraints FILE, turned into a field by tool_make_field.
    Zero-initialised: no option given, up the library's default (+y). */
 typedef struct tool_field {
@@ -868,6 +868,18 @@ int triangle_mesh_reverse(const char *path, triangle_mesh *m);
 void triangle_mesh_rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size);
 int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const tt_error *error);
 
+/* The faces of a mesh made from an OBJ's (triangle fans, quads), traced
+   back to them for constraints and error messages. */
+typedef struct tool_face_source {
+    const tt_mesh *mesh;
+    int nfaces;                 /* the mesh's faces */
+    int nsources;               /* the OBJ's faces */
+    const int *source;          /* per mesh face: its OBJ face */
+    const int *first;           /* per OBJ face: the first mesh face made from it */
+    const int *source_line;     /* per OBJ face: its line in the file */
+} tool_face_source;
+tool_face_source triangle_mesh_faces(const triangle_mesh *m);
+
 /* tt_tangent_field from --up and --constraints (tool_field): face_vectors
    gets 3 floats per triangle, `scale` (mesh units, 0 = the library's
    default) their length. A constraints file's line is "FACE X Y Z [SIGMA
@@ -876,6 +888,11 @@ int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const t
    line of the file. */
 int tool_make_field(const char *mesh_path, const triangle_mesh *m, const tool_field *field, float scale,
                     float *face_vectors);
+/* The same on any mesh whose faces trace back to the OBJ's (a constraint
+   goes on the first face made from its OBJ face); face_vectors gets 3
+   floats per face. */
+int tool_make_face_field(const char *mesh_path, const tool_face_source *faces, const tool_field *field,
+                         float scale, float *face_vectors);
 
 /* ---------------------------------------------------------------------- */
 /* Quality measures for the summaries (measure.c)                          */

@@ -349,15 +349,27 @@ int triangle_mesh_reverse(const char *path, triangle_mesh *m)
     return status;
 }
 
-/* The library's "face N" is the Nth triangle counted from 0: replace the
-   first such mention (not "face N0...") by the OBJ face it came from, counted
-   from 1. */
-void triangle_mesh_rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size)
+tool_face_source triangle_mesh_faces(const triangle_mesh *m)
+{
+    tool_face_source faces;
+    faces.mesh = m->mesh;
+    faces.nfaces = m->ntriangles;
+    faces.nsources = m->obj.nfaces;
+    faces.source = m->face;
+    faces.first = m->first_triangle;
+    faces.source_line = m->obj.face_line;
+    return faces;
+}
+
+/* The library's "face N" is the Nth face of the mesh counted from 0: replace
+   the first such mention (not "face N0...") by the OBJ face it came from,
+   counted from 1. */
+static void face_source_rewrite(const tool_face_source *faces, const tt_error *error, char *message, size_t size)
 {
     char pattern[32];
     const char *at = NULL;
     size_t length = 0;
-    if (error->face >= 0 && error->face < m->ntriangles) {
+    if (error->face >= 0 && error->face < faces->nfaces) {
         length = (size_t)snprintf(pattern, sizeof pattern, "face %d", error->face);
         for (at = strstr(error->message, pattern); at && isdigit((unsigned char)at[length]);
              at = strstr(at + 1, pattern))
@@ -365,21 +377,33 @@ void triangle_mesh_rewrite_face(const triangle_mesh *m, const tt_error *error, c
     }
     if (at)
         snprintf(message, size, "%.*sface %d%s", (int)(at - error->message), error->message,
-                 m->face[error->face] + 1, at + length);
+                 faces->source[error->face] + 1, at + length);
     else
         snprintf(message, size, "%s", error->message);
 }
 
-int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const tt_error *error)
+static int face_source_report_error(const char *path, const tool_face_source *faces, const tt_error *error)
 {
     char message[sizeof error->message + 32];
-    if (error->face < 0 || error->face >= m->ntriangles) return tool_fail("%s: %s", path, error->message);
-    triangle_mesh_rewrite_face(m, error, message, sizeof message);
-    return tool_fail("%s:%d: %s", path, m->obj.face_line[m->face[error->face]], message);
+    if (error->face < 0 || error->face >= faces->nfaces) return tool_fail("%s: %s", path, error->message);
+    face_source_rewrite(faces, error, message, sizeof message);
+    return tool_fail("%s:%d: %s", path, faces->source_line[faces->source[error->face]], message);
+}
+
+void triangle_mesh_rewrite_face(const triangle_mesh *m, const tt_error *error, char *message, size_t size)
+{
+    tool_face_source faces = triangle_mesh_faces(m);
+    face_source_rewrite(&faces, error, message, size);
+}
+
+int triangle_mesh_report_error(const char *path, const triangle_mesh *m, const tt_error *error)
+{
+    tool_face_source faces = triangle_mesh_faces(m);
+    return face_source_report_error(path, &faces, error);
 }
 
 /* ======================================================================== */
-/* The direction field: --up and --constraints (lapped, hpm)                */
+/* The direction field: --up and --constraints (lapped, hpm, tile)          */
 /* ======================================================================== */
 
 typedef struct constraint_list {
@@ -397,9 +421,10 @@ static void constraint_list_free(constraint_list *list)
 
 /* One line "FACE X Y Z [SIGMA [WEIGHT]]" ('#' comments and blank lines are
    skipped by the caller). FACE counts the OBJ's faces from 1; a polygon's
-   constraint goes on the first triangle of its fan (they share its plane).
+   constraint goes on the first face made from it (the first triangle of its
+   fan, the first of its quads: they share its plane, or nearly).
    Returns 0, or the exit status after printing "FILE:LINE: ...". */
-static int parse_constraint(char *text, const char *where, const triangle_mesh *m, tt_field_constraint *out)
+static int parse_constraint(char *text, const char *where, const tool_face_source *faces, tt_field_constraint *out)
 {
     char *token[6];
     double value[6];
@@ -415,8 +440,9 @@ static int parse_constraint(char *text, const char *where, const triangle_mesh *
                          ntokens == 1 ? "" : "s");
     if (parse_whole_long(token[0], &face) != 0)
         return tool_fail("%s: FACE wants a face number, got '%s'", where, token[0]);
-    if (face < 1 || face > m->obj.nfaces)
-        return tool_fail("%s: face %s is out of range: the mesh has faces 1 to %d", where, token[0], m->obj.nfaces);
+    if (face < 1 || face > faces->nsources)
+        return tool_fail("%s: face %s is out of range: the mesh has faces 1 to %d", where, token[0],
+                         faces->nsources);
     for (k = 1; k < ntokens; k++)
         if (parse_whole_double(token[k], &value[k]) != 0)
             return tool_fail("%s: '%s' is not a finite number", where, token[k]);
@@ -425,14 +451,14 @@ static int parse_constraint(char *text, const char *where, const triangle_mesh *
     if ((ntokens > 4 && !(value[4] > 0.0)) || (ntokens > 5 && !(value[5] > 0.0)))
         return tool_fail("%s: SIGMA and WEIGHT must be above 0", where);
     memset(out, 0, sizeof *out);
-    out->face = m->first_triangle[face - 1];
+    out->face = faces->first[face - 1];
     for (k = 0; k < 3; k++) out->vector[k] = (float)value[k + 1];
     out->sigma = ntokens > 4 ? (float)value[4] : 0.0f;
     out->weight = ntokens > 5 ? (float)value[5] : 0.0f;
     return 0;
 }
 
-static int read_constraints(const char *path, const triangle_mesh *m, constraint_list *list)
+static int read_constraints(const char *path, const tool_face_source *faces, constraint_list *list)
 {
     unsigned char *data;
     size_t size;
@@ -461,7 +487,7 @@ static int read_constraints(const char *path, const triangle_mesh *m, constraint
             capacity = grown;
         }
         snprintf(where, sizeof where, "%s:%d", path, number);
-        status = parse_constraint(line, where, m, &list->items[list->count]);
+        status = parse_constraint(line, where, faces, &list->items[list->count]);
         list->line[list->count++] = number;
     }
     free(data);
@@ -472,12 +498,20 @@ static int read_constraints(const char *path, const triangle_mesh *m, constraint
 int tool_make_field(const char *mesh_path, const triangle_mesh *m, const tool_field *options, float scale,
                     float *face_vectors)
 {
+    tool_face_source faces = triangle_mesh_faces(m);
+    return tool_make_face_field(mesh_path, &faces, options, scale, face_vectors);
+}
+
+int tool_make_face_field(const char *mesh_path, const tool_face_source *faces, const tool_field *options,
+                         float scale, float *face_vectors)
+{
     constraint_list constraints;
     tt_field_options field;
     tt_error error;
     int status = 0;
     memset(&constraints, 0, sizeof constraints);
-    if (options->constraints_path && (status = read_constraints(options->constraints_path, m, &constraints)) != 0)
+    if (options->constraints_path &&
+        (status = read_constraints(options->constraints_path, faces, &constraints)) != 0)
         return status;
     memset(&field, 0, sizeof field);
     memcpy(field.up, options->up, sizeof field.up);
@@ -485,7 +519,7 @@ int tool_make_field(const char *mesh_path, const triangle_mesh *m, const tool_fi
     field.constraints = constraints.items;
     field.nconstraints = constraints.count;
     tool_stage("computing the direction field");
-    if (tt_tangent_field(m->mesh, &field, NULL, face_vectors, &error) != TT_OK) {
+    if (tt_tangent_field(faces->mesh, &field, NULL, face_vectors, &error) != TT_OK) {
         /* An error about a constraint names it in error.item: say it at its
            line of the file (what reading the file could not see, such as a
            vector that the face's plane reduces to nothing). The library's
@@ -495,7 +529,7 @@ int tool_make_field(const char *mesh_path, const triangle_mesh *m, const tool_fi
             char message[sizeof error.message + 32], prefix[32];
             size_t length = (size_t)snprintf(prefix, sizeof prefix, "constraint %d", error.item);
             const char *text = message;
-            triangle_mesh_rewrite_face(m, &error, message, sizeof message);
+            face_source_rewrite(faces, &error, message, sizeof message);
             /* "constraint 0 (face 7): ..." counts from 0; the line says which. */
             if (strncmp(message, prefix, length) == 0 && !isdigit((unsigned char)message[length])) {
                 text = message + length;
@@ -506,7 +540,7 @@ int tool_make_field(const char *mesh_path, const triangle_mesh *m, const tool_fi
                 status = tool_fail("%s:%d: %s", options->constraints_path, constraints.line[error.item], text);
             }
         } else {
-            status = triangle_mesh_report_error(mesh_path, m, &error);
+            status = face_source_report_error(mesh_path, faces, &error);
         }
     }
     constraint_list_free(&constraints);

@@ -1283,6 +1283,50 @@ check "hpm --constraints: says how level, against y" "'level: ...'" "$OUT" \
 expect_error "hpm --constraints face out of range" hpm ../in/torus.obj ../in/lap.png out --rotations 3 \
     --constraints ../in/constraints_range.txt
 err_mentions "hpm constraint out of range: FILE:LINE" 'constraints_range\.txt:2:'
+
+# tile --up: each quad's tile turned along the field, upright tiles where every
+# left and right side meets an upright left or right side, in an atlas twice as
+# wide (plain | upright). The torus's axis is y: with --up y its grid runs along
+# the field and every quad is upright; the double torus's vertices of valence 3,
+# 5 and 6 turn the field past quads' diagonals: some plain.
+newdir
+expect_ok "tile (no --up) for --up" tile ../in/torus.obj ../in/lap256.png flat --colors 2 --tile 32
+TILE_FLAT_OUT=$OUT
+expect_ok "tile --up y" tile ../in/torus.obj ../in/lap256.png out --colors 2 --tile 32 --up y
+check "tile --up y: every quad of the torus upright" "'up: 512 quads' tiles turned ..., 512 upright and 0 plain'" \
+    "$OUT" "$(printf '%s\n' "$OUT" | grep -q "^up: 512 quads' tiles turned along the field, 512 upright and 0 plain"; echo $?)"
+check "tile --up y: the atlas twice as wide" "$(($(png_size flat.png | cut -d' ' -f1) * 2)) $(png_size flat.png | cut -d' ' -f2)" \
+    "$(png_size out.png)" \
+    "$([ "$(png_size out.png)" = "$(($(png_size flat.png | cut -d' ' -f1) * 2)) $(png_size flat.png | cut -d' ' -f2)" ]; echo $?)"
+check "tile --up y: other coordinates than without" "files differ" "identical" \
+    "$(! cmp -s out.obj flat.obj; echo $?)"
+check "tile without --up: no up line" "no 'up:' in the summary" "$TILE_FLAT_OUT" \
+    "$(! printf '%s\n' "$TILE_FLAT_OUT" | grep -q '^up:'; echo $?)"
+SEAM_UP=$(printf '%s\n' "$OUT" | sed -nE 's/.*seam score (-?[0-9.]+) .*/\1/p')
+check "tile --up y: seams still match (score below 0.1)" "below 0.1" "${SEAM_UP:-none}: $OUT" \
+    "$(awk -v s="${SEAM_UP:-9}" 'BEGIN { exit !(s < 0.1) }'; echo $?)"
+expect_ok "tile --up z on the double torus" tile ../in/double-torus.obj ../in/lap256.png dt --colors 2 --tile 32 --up z
+UPRIGHT=$(printf '%s\n' "$OUT" | sed -nE "s/^up: [0-9]+ quads' tiles turned along the field, ([0-9]+) upright and ([0-9]+) plain.*/\1 \2/p")
+check "tile --up z on the double torus: some quads upright, some plain" "both above 0" "${UPRIGHT:-no up line}" \
+    "$(read -r u p <<<"$UPRIGHT"; [ "${u:-0}" -gt 0 ] && [ "${p:-0}" -gt 0 ]; echo $?)"
+expect_ok "tile --up z --format glb" tile ../in/torus.obj ../in/lap256.png g.glb --colors 2 --tile 32 --up z
+expect_ok "tile --up z --mips" tile ../in/torus.obj ../in/lap256.png m --tile 32 --up z --mips
+check "tile --up z --mips: mip levels twice as wide" "$(($(png_size m.png | cut -d' ' -f1) / 2)) ..." \
+    "$(png_size m_mip1.png)" "$([ "$(png_size m_mip1.png | cut -d' ' -f1)" = "$(($(png_size m.png | cut -d' ' -f1) / 2))" ]; echo $?)"
+expect_ok "tile --constraints" tile ../in/torus.obj ../in/lap256.png cons --tile 32 --constraints ../in/constraints.txt
+check "tile --constraints: an up line" "'up: ...'" "$OUT" "$(printf '%s\n' "$OUT" | grep -q '^up: '; echo $?)"
+expect_ok "tile --constraints on triangles (faces of the OBJ, before quadrangulation)" tile ../in/spheretri.obj \
+    ../in/lap256.png tri --tile 32 --constraints ../in/constraints.txt
+check "tile --constraints on triangles: 3840 quads turned" "'up: 3840 quads' ...'" "$OUT" \
+    "$(printf '%s\n' "$OUT" | grep -q "^up: 3840 quads' tiles turned"; echo $?)"
+expect_error "tile --constraints face out of range" tile ../in/torus.obj ../in/lap256.png out --tile 32 \
+    --constraints ../in/constraints_range.txt
+err_mentions "tile constraint out of range: FILE:LINE" 'constraints_range\.txt:2:'
+expect_error "tile --up 0,0,0" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up 0,0,0
+expect_error "tile --up without a value" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up
+expect_error "tile --up with an atlas too wide for two sets" tile ../in/torus.obj ../in/lap256.png out --colors 4 \
+    --tile 72 --gutter 0 --up z
+err_mentions "tile --up atlas too wide: says why" 'plain and upright'
 expect_error "hpm --constraints missing file" hpm ../in/torus.obj ../in/lap.png out --constraints ../in/nope.txt
 expect_error "hpm --up 0,0,0" hpm ../in/torus.obj ../in/lap.png out --up 0,0,0
 

@@ -1652,6 +1652,199 @@ static void test_seams_control(void)
     seam_fixture_free(&fx);
 }
 
+/* ---- Tiles turned along a field (tt_orient_tiles, tt_assign_uvs_oriented) ---- */
+
+/* Whether upright face f's left and right sides all meet upright faces that
+   see them as left or right: the rule every upright face must keep. */
+static int upright_rule_holds(const tt_mesh *mesh, const uint8_t *turn, const uint8_t *upright, int f)
+{
+    int c;
+    for (c = 4 * f; c < 4 * f + 4; c++) {
+        const int t = mesh->twin[c], g = t >= 0 ? mesh->corner_face[t] : -1;
+        if (t < 0 || !((c - 4 * f - turn[f]) & 1)) continue;
+        if (!upright[g] || !((t - 4 * g - turn[g]) & 1)) return 0;
+    }
+    return 1;
+}
+
+/* On a plane grid whose quads start at random corners, a field along +y
+   turns every tile upright: its bottom side (half-edge turn) runs along +x.
+   Turn 0 (tt_assign_uvs) does so only where the corners happen to start
+   there: the control. One quad whose field runs along +x makes its row
+   plain (its left and right sides meet the bottom and top sides of the
+   rows beside, and the plain quads' neighbours along the row follow), and
+   no other quad. */
+static void test_orient_tiles(void)
+{
+    const int nx = 7, ny = 5;
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    float vectors[3 * 35];
+    uint8_t turn[35], upright[35];
+    int f, k, along = 0, along_unturned = 0, count = -1, rule = 1, row_plain = 1, others_upright = 1;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, nx, ny);
+    lcg_seed(77);
+    for (f = 0; f < m.nf; f++) {
+        int q[4], r = lcg_below(4);
+        for (k = 0; k < 4; k++) q[k] = m.idx[4 * f + (k + r) % 4];
+        for (k = 0; k < 4; k++) m.idx[4 * f + k] = q[k];
+    }
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid build: %s", err.message);
+    if (!mesh) { tm_free(&m); return; }
+    for (f = 0; f < mesh->nfaces; f++) {
+        vectors[3 * f] = 0.0f; vectors[3 * f + 1] = 2.0f; vectors[3 * f + 2] = 0.0f;
+    }
+    CHECK(tt_orient_tiles(mesh, vectors, NULL, turn, upright, &count, &err) == TT_OK, "orient: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++) {
+        const float *a = mesh->pos + 3 * mesh->corner_vert[4 * f + turn[f]];
+        const float *b = mesh->pos + 3 * mesh->corner_vert[4 * f + ((turn[f] + 1) & 3)];
+        const float *a0 = mesh->pos + 3 * mesh->corner_vert[4 * f], *b0 = mesh->pos + 3 * mesh->corner_vert[4 * f + 1];
+        along += b[0] - a[0] > 0.5f && fabsf(b[1] - a[1]) < 1e-6f;
+        along_unturned += b0[0] - a0[0] > 0.5f && fabsf(b0[1] - a0[1]) < 1e-6f;
+    }
+    CHECK(along == nx * ny, "every tile's bottom runs along +x: %d of %d", along, nx * ny);
+    CHECK(along_unturned < nx * ny / 2, "control: unturned, %d of %d run along +x (want few)", along_unturned,
+          nx * ny);
+    CHECK(count == nx * ny, "a grid along the field: every quad upright (%d of %d)", count, nx * ny);
+
+    /* Quad (3, 2) turned a quarter by its field. */
+    vectors[3 * (2 * nx + 3)] = 1.0f;
+    vectors[3 * (2 * nx + 3) + 1] = 0.0f;
+    CHECK(tt_orient_tiles(mesh, vectors, NULL, turn, upright, &count, &err) == TT_OK, "orient: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++) {
+        if (upright[f]) rule &= upright_rule_holds(mesh, turn, upright, f);
+        if (f / nx == 2) row_plain &= !upright[f];
+        else others_upright &= upright[f];
+    }
+    CHECK(rule, "every upright quad's left and right sides meet upright left and right sides");
+    CHECK(row_plain && others_upright && count == nx * (ny - 1),
+          "one quad across the field makes its row plain and nothing else: %d upright (want %d)", count,
+          nx * (ny - 1));
+    /* Without face_upright only the turns are made. */
+    CHECK(tt_orient_tiles(mesh, vectors, NULL, turn, NULL, &count, &err) == TT_OK && count == 0,
+          "no face_upright: count 0, got %d", count);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* tt_assign_uvs_oriented: without turns and flags tt_assign_uvs's UVs to the
+   bit; with them, corner turn + k of a quad gets corner k of the tile named
+   by the types read from half-edge turn on (tt_tile_corner_uv), its u halved
+   and moved to the right half for an upright quad. */
+static void test_assign_uvs_oriented(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    tt_tile_layout layout = make_layout(2, 16, 2);
+    uint8_t types[4 * 12], turn[12], upright[12];
+    float plain_uv[8 * 12], uv[8 * 12];
+    int f, k, agree = 1;
+    memset(&m, 0, sizeof m);
+    make_grid(&m, 4, 3);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "grid build");
+    if (!mesh) { tm_free(&m); return; }
+    CHECK(tt_assign_boundaries(mesh, &layout, 5, NULL, types, &err) == TT_OK, "boundaries");
+    CHECK(tt_assign_uvs(mesh, &layout, types, plain_uv, &err) == TT_OK, "uvs");
+    CHECK(tt_assign_uvs_oriented(mesh, &layout, types, NULL, NULL, uv, &err) == TT_OK &&
+              memcmp(uv, plain_uv, sizeof uv) == 0,
+          "no turns, no flags: tt_assign_uvs's UVs to the bit");
+    for (f = 0; f < 12; f++) {
+        turn[f] = (uint8_t)(f % 4);
+        upright[f] = (uint8_t)(f % 3 == 0);
+    }
+    CHECK(tt_assign_uvs_oriented(mesh, &layout, types, turn, upright, uv, &err) == TT_OK, "oriented: %s",
+          err.message);
+    for (f = 0; f < 12; f++) {
+        uint8_t e[4];
+        for (k = 0; k < 4; k++) e[k] = types[4 * f + ((k + turn[f]) & 3)];
+        for (k = 0; k < 4; k++) {
+            float want[2];
+            const float *got = uv + 2 * (4 * f + ((k + turn[f]) & 3));
+            tt_tile_corner_uv(&layout, e, k, want);
+            want[0] = 0.5f * (want[0] + (float)upright[f]);
+            agree &= fabsf(got[0] - want[0]) < 1e-6f && fabsf(got[1] - want[1]) < 1e-6f;
+        }
+    }
+    CHECK(agree, "each quad's corners are its turned tile's, plain ones in the left half, upright ones in the "
+                 "right");
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
+/* Every edge matches with turned tiles, plain and upright: on a torus whose
+   field runs along the meridians on one half and along the parallels on the
+   other, or one or the other at random per quad, either way at random, the
+   seam score of tt_orient_tiles's choice stays near 0. The control forces
+   every quad upright with the random field's turns: left and right sides
+   then meet bottom and top sides, and the score rises. */
+static void test_orient_tiles_seams(void)
+{
+    seam_fixture fx;
+    tt_synth_options opt;
+    tt_tileset *upright_set = NULL;
+    tt_image *atlas = NULL;
+    tt_seam_report kept, forced;
+    tt_error err;
+    float *vectors;
+    uint8_t *turn, *upright;
+    int f, count = 0, field;
+    tt_result r;
+    if (!seam_fixture_make(&fx, 40, 24, 160, 21, 2, 4, "oriented")) return;
+    memset(&opt, 0, sizeof opt);
+    opt.layout = fx.layout;
+    opt.seed = 4;
+    opt.upright = 1;
+    opt.edge_windows = fx.set->edge_windows;
+    vectors = (float *)malloc(sizeof(float) * 3 * (size_t)fx.mesh->nfaces);
+    turn = (uint8_t *)malloc((size_t)fx.mesh->nfaces);
+    upright = (uint8_t *)malloc((size_t)fx.mesh->nfaces);
+    if (!vectors || !turn || !upright ||
+        tt_synthesize_tiles(fx.src, &opt, NULL, &upright_set, &err) != TT_OK ||
+        tt_polycube_upright_atlas(fx.set, upright_set, 0, NULL, NULL, &atlas, &err) != TT_OK) {
+        CHECK(0, "oriented: upright tiles and atlas");
+        goto done;
+    }
+    tt_assign_boundaries(fx.mesh, &fx.layout, 8, NULL, fx.types, NULL);
+    lcg_seed(31);
+    for (field = 0; field < 2; field++) {
+        for (f = 0; f < fx.mesh->nfaces; f++) {
+            /* Face (i, j) of make_torus: half-edge 0 along the parallel, 3 (reversed) along the meridian. */
+            const int meridian = field == 0 ? f / 40 < 12 : lcg_below(2);
+            const float *a = fx.mesh->pos + 3 * fx.mesh->corner_vert[4 * f];
+            const float *b = fx.mesh->pos + 3 * fx.mesh->corner_vert[4 * f + (meridian ? 3 : 1)];
+            const float sign = lcg_below(2) ? 1.0f : -1.0f;
+            int k;
+            for (k = 0; k < 3; k++) vectors[3 * f + k] = sign * (b[k] - a[k]);
+        }
+        CHECK(tt_orient_tiles(fx.mesh, vectors, NULL, turn, upright, &count, &err) == TT_OK, "orient: %s",
+              err.message);
+        CHECK(field == 1 || (count > 0 && count < fx.mesh->nfaces),
+              "half along the meridians, half along the parallels: some quads upright, some plain (%d of %d)",
+              count, fx.mesh->nfaces);
+        tt_assign_uvs_oriented(fx.mesh, &fx.layout, fx.types, turn, upright, fx.uv, NULL);
+        r = tt_measure_seams(fx.mesh, fx.uv, atlas, NULL, NULL, &kept, &err);
+        CHECK(r == TT_OK && kept.score < 0.1, "field %d: turned tiles, upright where the rule allows: score %.4f "
+              "(want < 0.1)", field, kept.score);
+    }
+    /* The control, on the random field's turns. */
+    memset(upright, 1, (size_t)fx.mesh->nfaces);
+    tt_assign_uvs_oriented(fx.mesh, &fx.layout, fx.types, turn, upright, fx.uv, NULL);
+    r = tt_measure_seams(fx.mesh, fx.uv, atlas, NULL, NULL, &forced, &err);
+    CHECK(r == TT_OK && forced.score > kept.score + 0.2,
+          "control, every quad upright whatever the turns: score %.4f (want above %.4f + 0.2)", forced.score,
+          kept.score);
+done:
+    free(vectors);
+    free(turn);
+    free(upright);
+    tt_image_free(atlas);
+    tt_tileset_free(upright_set);
+    seam_fixture_free(&fx);
+}
+
 /* The seam measure compares colours as displayed: three unit quads in a row,
    each mapped onto its own flat 8 x 8 block of an atlas made from sRGB bytes
    100, 200, 100. Both interior edges then differ by exactly 100/255 as
@@ -2828,6 +3021,9 @@ void run_tiled_tests(void)
     RUN(test_compact_atlas);
     RUN(test_seams);
     RUN(test_seams_control);
+    RUN(test_orient_tiles);
+    RUN(test_assign_uvs_oriented);
+    RUN(test_orient_tiles_seams);
     RUN(test_seams_displayed);
     RUN(test_seams_not_measured);
     RUN(test_seams_sampled);

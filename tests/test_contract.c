@@ -57,6 +57,8 @@ static const char *const k_functions[] = {
     "tt_tile_layout_resolve",
     "tt_assign_boundaries",
     "tt_assign_uvs",
+    "tt_orient_tiles",
+    "tt_assign_uvs_oriented",
     "tt_reduce_tiles",
     "tt_synth_plan_create",
     "tt_synth_compose_tile",
@@ -932,6 +934,42 @@ static void cases_tiled(const baseline *b)
     CASE(tt_assign_uvs(m, &L, bt, uv, E));
     CASE(tt_assign_uvs(&b->empty, &L, types, uv, E));
     CHECK(tt_assign_uvs(m, &L, types, uv, NULL) == TT_OK, "baseline UVs");
+
+    {
+        /* 12 faces' worth: b->tris (12 triangles) reads that many. */
+        float fv[36];
+        uint8_t turn[12], up[12];
+        volatile float zero = 0.0f;
+        for (i = 0; i < 36; i++) fv[i] = i % 3 == 1 ? 1.0f : 0.0f;
+        CASE(tt_orient_tiles(NULL, fv, AL, turn, up, NULL, E));
+        CASE(tt_orient_tiles(m, NULL, AL, turn, up, NULL, E));
+        CASE(tt_orient_tiles(m, fv, AL, NULL, up, NULL, E));
+        CASE(tt_orient_tiles(m, fv, BA1, turn, up, NULL, E));
+        CASE(tt_orient_tiles(m, fv, BA2, turn, up, NULL, E));
+        CASE(tt_orient_tiles(b->tris, fv, AL, turn, up, NULL, E));
+        CASE(tt_orient_tiles(&b->empty, fv, AL, turn, up, NULL, E));
+        fv[4] = zero / zero;
+        CASE(tt_orient_tiles(m, fv, AL, turn, up, NULL, E));
+        fv[4] = 1.0f / zero;
+        CASE(tt_orient_tiles(m, fv, AL, turn, up, NULL, E));
+        fv[4] = 1.0f;
+        CHECK(tt_orient_tiles(m, fv, AL, turn, up, NULL, NULL) == TT_OK, "baseline orientation");
+        CASE(tt_assign_uvs_oriented(NULL, &L, types, turn, up, uv, E));
+        CASE(tt_assign_uvs_oriented(m, NULL, types, turn, up, uv, E));
+        CASE(tt_assign_uvs_oriented(m, &L, NULL, turn, up, uv, E));
+        CASE(tt_assign_uvs_oriented(m, &L, types, turn, up, NULL, E));
+        CASE(tt_assign_uvs_oriented(b->tris, &L, types, turn, up, uv, E));
+        CASE(tt_assign_uvs_oriented(&b->empty, &L, types, turn, up, uv, E));
+        turn[2] = 4;
+        CASE(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, E));
+        turn[2] = 255;
+        CASE(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, E));
+        turn[2] = 0;
+        up[1] = 2;
+        CASE(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, E));
+        up[1] = 0;
+        CHECK(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, NULL) == TT_OK, "baseline oriented UVs");
+    }
 
     {
         uint8_t rt[24];
