@@ -11006,11 +11006,40 @@ static void tt__seam_range(void *context, int begin, int end)
     }
 }
 
+/* tt_measure_seams' options checked against the mesh. */
+static tt_result tt__seam_check_options(const tt_mesh *mesh, const tt_seam_options *opt, tt_error *error)
+{
+    const unsigned known_flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
+    int i;
+    if (opt->max_edges < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_edges is %d: 0 (all) or more",
+                        opt->max_edges);
+    if (opt->flags & ~known_flags)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "seam option flags 0x%x include unknown bits 0x%x (known: TT_SEAM_UV_DISCONTINUOUS, "
+                        "TT_SEAM_WRAP)", opt->flags, opt->flags & ~known_flags);
+    if (opt->nedges < 0 || (!opt->edges && opt->nedges > 0))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the edge list has %d entries at %s: give a list and its length, or NULL for every edge",
+                        opt->nedges, opt->edges ? "an address" : "NULL");
+    for (i = 0; opt->edges && i < opt->nedges; i++) {
+        if (opt->edges[i] < 0 || opt->edges[i] >= mesh->ncorners)
+            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, i, -1, -1,
+                               "listed edge %d is corner %d, outside the mesh's %d corners", i, opt->edges[i],
+                               mesh->ncorners);
+        if (mesh->twin[opt->edges[i]] < 0)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
+                               "listed edge %d (corner %d) is on the boundary: a seam needs a face on each side", i,
+                               opt->edges[i]);
+    }
+    return TT_OK;
+}
+
 TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
                                  const tt_seam_options *options, const tt_allocator *allocator,
                                  tt_seam_report *report, tt_error *error)
 {
-    const unsigned known_flags = TT_SEAM_UV_DISCONTINUOUS | TT_SEAM_WRAP;
+    tt_result result;
     int *interior, ninterior = 0, npopulation, nmeasured, ndiscontinuous = 0, c, i, points_per_edge;
     unsigned char *listed;      /* with an edge list: per corner, 1 on the lower corner of a listed edge */
     unsigned char *edge_class;  /* per corner: tt__seam_class_range */
@@ -11032,27 +11061,7 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the atlas is empty");
     if (options) opt = *options;
     else memset(&opt, 0, sizeof opt);
-    if (opt.max_edges < 0)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "max_edges is %d: 0 (all) or more",
-                        opt.max_edges);
-    if (opt.flags & ~known_flags)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "seam option flags 0x%x include unknown bits 0x%x (known: TT_SEAM_UV_DISCONTINUOUS, "
-                        "TT_SEAM_WRAP)", opt.flags, opt.flags & ~known_flags);
-    if (opt.nedges < 0 || (!opt.edges && opt.nedges > 0))
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the edge list has %d entries at %s: give a list and its length, or NULL for every edge",
-                        opt.nedges, opt.edges ? "an address" : "NULL");
-    for (i = 0; opt.edges && i < opt.nedges; i++) {
-        if (opt.edges[i] < 0 || opt.edges[i] >= mesh->ncorners)
-            return tt__fail_at(error, TT_ERROR_INDEX_OUT_OF_RANGE, i, -1, -1,
-                               "listed edge %d is corner %d, outside the mesh's %d corners", i, opt.edges[i],
-                               mesh->ncorners);
-        if (mesh->twin[opt.edges[i]] < 0)
-            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
-                               "listed edge %d (corner %d) is on the boundary: a seam needs a face on each side", i,
-                               opt.edges[i]);
-    }
+    if ((result = tt__seam_check_options(mesh, &opt, error)) != TT_OK) return result;
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     wrap = (opt.flags & TT_SEAM_WRAP) ? TT_WRAP_REPEAT : TT_WRAP_CLAMP;
     interior = TT__ALLOC(allocator, int, mesh->ncorners);
