@@ -27524,6 +27524,7 @@ static int tt__mapping_to_input(tt_polycube_mapping *mapping, const tt__refined 
 
 #define TT__MAP_ROUNDS 3             /* mappings tt_polycube_map makes at most by default, each finer where
                                        the ones before fell short */
+#define TT__MAP_REFINE_SHARE 10000   /* one face in this many to refine makes another mapping worth its cost */
 
 /* One mapping of `mesh` (checked by tt_polycube_map) refined to edges of
    at most `longest`, or fine_longest next to the input faces flagged in
@@ -27713,7 +27714,9 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
                     fine[f] = 1;
                     added++;
                 }
-            if (!bad || !added) break;
+            /* Another mapping costs as much as the first: it is made when it can mend at least one face in
+               TT__MAP_REFINE_SHARE (a 100k-triangle scan with 3 such faces keeps its first mapping). */
+            if (!bad || !added || (long long)added * TT__MAP_REFINE_SHARE < mesh->nfaces) break;
             ntroubled += added;
         }
         /* A finer mapping too large to make leaves the ones before it. */
