@@ -2660,7 +2660,9 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         the cluster with most textured neighbouring regions first (then the
         larger share of textured border, then the smaller index). A cluster
         is split (its children queued at the next level) when it is not a
-        disc, not flat enough, has no room in a bounded image, or fits worse
+        disc, not flat enough (E_flat above max_flattening_error, or a
+        triangle stretched past 2: sigma1 / sigma2 of its flattening), has
+        no room in a bounded image, or fits worse
         than `threshold` - unless its children would be smaller than the
         floor (min_footprint texels^2 or min_faces faces), where the best
         fit is taken whatever its error. A cluster smaller than the floor
@@ -2740,12 +2742,15 @@ typedef struct tt_hpm_options {
                                     way */
     const float *face_vectors;   /* NULL: the orientation spreads from patch to patch (Sec. 2.2). Else a
                                     direction per face, 3 floats each in the face's plane (from
-                                    tt_tangent_field: --up, constraints): each cluster's texture is turned
-                                    so that its up (+v) follows the field averaged over the cluster's faces,
-                                    at starts and in the fits, whose max_turn then counts from the field's
-                                    direction instead of the main neighbour's (default then
-                                    TT_DEFAULT_HPM_FIELD_MAX_TURN), and a continuation turned further from
-                                    it is turned back. Only directions count; a zero vector has no say */
+                                    tt_tangent_field: --up, constraints): each cluster's flattening is
+                                    combed along the field (each triangle turned toward it, the cluster
+                                    re-fitted by least squares), and its texture is turned so that its up
+                                    (+v) follows the field averaged over the cluster's faces, at starts and
+                                    in the fits, whose max_turn then counts from the field's direction
+                                    instead of the main neighbour's (default then
+                                    TT_DEFAULT_HPM_FIELD_MAX_TURN); a continuation turned further from it
+                                    is turned back, and the border work turns no triangle far from it.
+                                    Only directions count; a zero vector has no say */
 } tt_hpm_options;
 
 typedef struct tt_hpm_report {
@@ -20590,11 +20595,15 @@ static int tt__hpm_comb(tt__hpm *S, int C)
     {
         tt_cg_options co;
         tt_cg_report cr;
+        tt_result r;
         int d;
         memset(&co, 0, sizeof co);
         for (d = 0; d < 2 && ok; d++) {
             for (k = 0; k < nv; k++) x[d * nv + k] = q[2 * k + d];
-            ok = tt_cg_solve(A, rhs + d * nv, &co, S->al, x + d * nv, &cr, NULL) == TT_OK;
+            r = tt_cg_solve(A, rhs + d * nv, &co, S->al, x + d * nv, &cr, NULL);
+            if (r == TT_ERROR_OUT_OF_MEMORY) goto out;
+            /* a solve that fails for a numerical reason keeps the harmonic map */
+            ok = r == TT_OK;
         }
     }
     done = 1;
@@ -20634,6 +20643,8 @@ static int tt__hpm_out_of_memory(int C, tt_result *res, tt_error *error)
     return 0;
 }
 
+#define TT__HPM_MAX_FLAT_STRETCH 2.0  /* the largest sigma1 / sigma2 of a flattened triangle */
+
 /* One cluster taken from the queues (Sec. 2.2 step 2). Returns 1, or 0 on
    an error in *res. */
 static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res, tt_error *error)
@@ -20651,6 +20662,12 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
         *res = tt__fail(error, fr, -1, -1, -1, -1, "out of memory flattening cluster %d", C);
         return 0;
     }
+    /* E_flat weighs areas only: a cluster folded over a crease keeps its
+       area while the triangles its border projection squashes shear, and
+       show the image smeared - shards along the creases of a CAD part
+       (the flange: 64 triangles stretched past 2, nearly all on cluster
+       borders). Such a cluster is split like one that is not flat. */
+    if (fr == TT_OK && frep.max_stretch > TT__HPM_MAX_FLAT_STRETCH) fr = TT_ERROR_NOT_FLAT;
     if (fr != TT_OK) {
         /* Not flat (or a degenerate single face): split; a face that
            cannot be flattened shows its neighbours' texture at the end. */
