@@ -460,10 +460,16 @@ int internal_polycube_mask_critical(int mask) { return tt__polycube_mask_critica
 int internal_hpm_relax_classes(const tt_mesh *mesh, int *vmark, int *verts, int n, int *class_end)
 {
     tt__hpm S;
+    int largest, *count = (int *)malloc(sizeof(int) * (size_t)mesh->nverts), nclasses;
     memset(&S, 0, sizeof S);
     S.mesh = mesh;
     S.vmark = vmark;
-    return tt__hpm_relax_classes(&S, verts, n, class_end);
+    S.ring_room = count ? tt__hpm_ring_room(mesh, count) : 0;
+    S.ring = (int *)malloc(sizeof(int) * (size_t)S.ring_room);
+    nclasses = S.ring ? tt__hpm_relax_classes(&S, verts, n, class_end, &largest) : 0;
+    free(count);
+    free(S.ring);
+    return nclasses;
 }
 uint64_t internal_xcorr_direct(int w, int h, int channels, const float *texture, int count, const int *x,
                                const int *y, const double *weight, const double *values, int lo, int hi, int *best,
