@@ -2080,9 +2080,10 @@ typedef struct tt_lapped {
     /* The cut of each paste's edge (tt_lapped_options.keep_edges), or NULL (and 0): paste p's anchor
        (u, v in its patch's texture space) at cut[(2 + cut_columns) p], then at cut_columns even angles
        (column j at 2 pi j / cut_columns, counter-clockwise from +u, linear between columns) the distance
-       from the anchor (texture units) beyond which tt_lapped_bake fades the paste out over cut_feather
-       where what lies beneath is opaque: paste alpha * (1 - (1 - c) * alpha beneath), c from 1 at the
-       distance to 0 at the distance + cut_feather (smoothstep). The runtime pasting (Sec. 4) ignores it */
+       from the anchor (texture units) beyond which tt_lapped_bake fades the paste's colour into that of
+       what lies beneath over cut_feather, as far as that is opaque (the paste's colour weighs
+       1 - (1 - c) * alpha beneath, c from 1 at the distance to 0 at the distance + cut_feather,
+       smoothstep), its alpha unchanged. The runtime pasting (Sec. 4) ignores it */
     int cut_columns;
     float *cut;
     float cut_feather;
@@ -2329,7 +2330,10 @@ typedef struct tt_bake_options {
    pastes of that face composited in paste order ("over" of the
    premultiplied patches, each sampled bilinearly with clamping at the UVs
    interpolated from the entry's corners, times the entry's fade when
-   lapped->fade is given). Texels within `gutter` texels
+   lapped->fade is given; beyond its paste's cut, when lapped->cut is
+   given, its colour gives way to the colour composited beneath, weighing
+   1 - (1 - c) * the alpha beneath, its alpha unchanged). Texels within
+   `gutter` texels
    outside a triangle get the same composite extrapolated across its edges
    (the face's maps extended linearly), and every texel still empty is then
    filled from the nearest filled texel, so bilinear filtering and mipmaps
@@ -2348,7 +2352,8 @@ typedef struct tt_bake_options {
    covers read (0, 0, 1). The atlas takes the patches' kind.
    Errors: NULL pointers, an empty atlas, non-triangles,
    npatches < 1, a negative gutter, patches of which some are normal maps
-   and some not (TT_ERROR_INVALID_ARGUMENT); an entry
+   and some not, a cut with no columns or no feather
+   (TT_ERROR_INVALID_ARGUMENT); a non-finite cut (TT_ERROR_NON_FINITE); an entry
    naming a patch or face out of range (TT_ERROR_INDEX_OUT_OF_RANGE,
    error->item names the paste or entry); non-finite corner_uv
    (TT_ERROR_NON_FINITE); TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch
@@ -12969,7 +12974,22 @@ typedef struct tt__lapper {
     int *cut_lo, *cut_hi, *cut_path;
     float *paste_cut;           /* per paste: its anchor and cut, as tt_lapped.cut; NULL when not cutting */
     int paste_cut_capacity;
+    double cut_inner;           /* the current paste's nearest cut distance (TT__LAPPED_NO_CUT: none) */
 } tt__lapper;
+
+/* A paste's cut (as tt_lapped.cut: its anchor, then K distances) at (u, v)
+   of its texture space: how far from the anchor the cut lies in that
+   direction (linear between columns), and in *r how far (u, v) lies. */
+static double tt__cut_reach(const float *cut, int K, double u, double v, double *r)
+{
+    const double du = u - cut[0], dv = v - cut[1];
+    double at = atan2(dv, du) / 6.283185307179586 * K;
+    int j;
+    *r = sqrt(du * du + dv * dv);
+    if (at < 0.0) at += K;
+    j = (int)at < K ? (int)at : K - 1;
+    return cut[2 + j] + (at - j) * (cut[2 + (j + 1) % K] - cut[2 + j]);
+}
 
 /* Sec. 3.6 counts a face point as covered where a paste is opaque. Here a
    sample point counts only when every texel a bilinear lookup could read
@@ -13686,9 +13706,12 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
    `unfaded` it marks nothing, counts them, and adds to *unfaded how many
    there would be with no fade. Any point of the face lies within
    TT__LAPPED_SAMPLE_REACH raster cells of a sample; the face's map
-   stretches a cell to at most rho texels. */
+   stretches a cell to at most rho texels. With `cut` (the entry's paste's,
+   as tt_lapped.cut), only points that far within the cut count: beyond it
+   the paste shows what lies beneath (tt_lapped_bake), so it hides nothing
+   there. */
 static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, const float *fade, int patch,
-                                   unsigned char *marks, int *unfaded)
+                                   const float *cut, unsigned char *marks, int *unfaded)
 {
     const tt_image *image = L->patches[patch];
     const float *depth = L->depth[patch];
@@ -13704,6 +13727,11 @@ static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, 
         x = (w0 * uv[0] + w1 * uv[2] + w2 * uv[4]) * w;
         y = (1.0 - (w0 * uv[1] + w1 * uv[3] + w2 * uv[5])) * h;
         if (!(x >= 0.0 && y >= 0.0 && x < w && y < h) || !(depth[(size_t)(int)y * w + (int)x] > need)) continue;
+        if (cut) {
+            double from, reach = tt__cut_reach(cut, TT__LAPPED_CUT_COLUMNS_PER_CELL * L->register_grid, x / w,
+                                               1.0 - y / h, &from);
+            if (!(from + need / (w < h ? w : h) <= reach)) continue;
+        }
         if (unfaded) {
             (*unfaded)++;
             if (w0 * fade[0] + w1 * fade[1] + w2 * fade[2] >= TT_LAPPED_OPAQUE) added++;
@@ -13881,6 +13909,21 @@ static int tt__entry_hides_face(const tt__lapper *L, const tt__entry *entry, int
     return deepest > need + longest + 1.4142135623730951;
 }
 
+/* Whether the entry lies wholly within its paste's cut: its corners within
+   the nearest cut distance (a disc about the anchor holds the triangle). */
+static int tt__entry_within_cut(const tt__lapper *L, const tt__entry *entry, int paste)
+{
+    const float *anchor;
+    int k;
+    if (!L->paste_cut) return 1;
+    anchor = L->paste_cut + (2 + (size_t)TT__LAPPED_CUT_COLUMNS_PER_CELL * L->register_grid) * paste;
+    for (k = 0; k < 3; k++) {
+        const double du = entry->uv[2 * k] - anchor[0], dv = entry->uv[2 * k + 1] - anchor[1];
+        if (!(sqrt(du * du + dv * dv) <= L->cut_inner)) return 0;
+    }
+    return 1;
+}
+
 /* Drop the entries hidden by a later entry of their face that alone covers
    it (tt__entry_hides_face): the walk of tt__remove_hidden would drop them
    at the end anyway (their face is covered by the time it reaches them, and
@@ -13954,15 +13997,17 @@ static long long tt__record_paste(tt__lapper *L, int patch)
             const tt__entry *entry = &L->entries[i];
             int f = entry->face, got, none = 0;
             if (!entry->covers) continue;
-            if (pass == 1 && tt__entry_hides_face(L, entry, patch)) L->hidden_below[f] = paste;
+            if (pass == 1 && tt__entry_hides_face(L, entry, patch) && tt__entry_within_cut(L, entry, paste))
+                L->hidden_below[f] = paste;
             if (L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) continue;
             if (pass == 0) {
-                faded += tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, L->covered + L->sample_start[f],
+                faded += tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, NULL, L->covered + L->sample_start[f],
                                                  &none);
                 unfaded += none;
                 continue;
             }
-            got = tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, L->covered + L->sample_start[f], NULL);
+            got = tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, NULL, L->covered + L->sample_start[f],
+                                          NULL);
             added += tt__count_covered(L, f, got);
         }
         if (pass == 0 && (double)faded < TT__LAPPED_FADE_KEEPS * (double)unfaded)
@@ -14616,8 +14661,11 @@ static int tt__remove_hidden(tt__lapper *L)
             removed++;
             continue;
         }
-        L->covered_count[face] += tt__mark_opaque_samples(L, face, entry->uv, entry->fade, L->paste_patch[entry->paste],
-                                                          L->covered + L->sample_start[face], NULL);
+        L->covered_count[face] += tt__mark_opaque_samples(
+            L, face, entry->uv, entry->fade, L->paste_patch[entry->paste],
+            L->paste_cut ? L->paste_cut + (2 + (size_t)TT__LAPPED_CUT_COLUMNS_PER_CELL * L->register_grid) * entry->paste
+                         : NULL,
+            L->covered + L->sample_start[face], NULL);
     }
     return removed;
 }
@@ -14920,10 +14968,9 @@ static tt_result tt__move_paste(tt__lapper *L, int patch, int seed_face, const d
    is the edge's (cutting there changes nothing). The path is closed by
    cutting again with its first column held (left open when that cannot
    join). The distances go into L->paste_cut for the paste being recorded;
-   tt_lapped_bake fades the paste out beyond them over what is opaque
-   beneath (tt_lapped.cut). The loop's coverage does not use the cut: it
-   only ever shows what lies beneath where that is opaque, and every part of
-   the paste stays. */
+   beyond them tt_lapped_bake gives the paste the colour of what is opaque
+   beneath (tt_lapped.cut), its alpha unchanged. So the loop's coverage
+   does not use the cut, and every part of the paste stays. */
 static tt_result tt__cut_paste(tt__lapper *L, int patch, const double center[2])
 {
     const float *alpha = L->register_alpha[patch];
@@ -14943,6 +14990,7 @@ static tt_result tt__cut_paste(tt__lapper *L, int patch, const double center[2])
     out[0] = (float)center[0];
     out[1] = (float)center[1];
     for (j = 0; j < K; j++) out[2 + j] = TT__LAPPED_NO_CUT;
+    L->cut_inner = TT__LAPPED_NO_CUT;
     if (!L->cut_cost) {
         L->cut_cost = TT__ALLOC(L->al, float, (size_t)W * R);
         L->cut_lo = TT__ALLOC(L->al, int, W);
@@ -14993,7 +15041,10 @@ static tt_result tt__cut_paste(tt__lapper *L, int patch, const double center[2])
     r = tt_min_error_cut(cost, W, R, lo, hi, L->al, path + W, NULL);
     if (r == TT_ERROR_OUT_OF_MEMORY) return r;
     if (r == TT_OK) path += W;
-    for (j = 0; j < K; j++) out[2 + j] = (float)path[j] / grid;
+    for (j = 0; j < K; j++) {
+        out[2 + j] = (float)path[j] / grid;
+        if (out[2 + j] < L->cut_inner) L->cut_inner = out[2 + j];
+    }
     return TT_OK;
 }
 
@@ -16468,13 +16519,7 @@ typedef struct tt__bake {
 static float tt__paste_cut_at(const tt_lapped *lapped, int p, double u, double v)
 {
     const int K = lapped->cut_columns;
-    const float *cut = lapped->cut + (2 + (size_t)K) * (size_t)p;
-    const double du = u - cut[0], dv = v - cut[1], r = sqrt(du * du + dv * dv);
-    double at = atan2(dv, du) / 6.283185307179586 * K, reach, x;
-    int j;
-    if (at < 0.0) at += K;
-    j = (int)at < K ? (int)at : K - 1;
-    reach = cut[2 + j] + (at - j) * (cut[2 + (j + 1) % K] - cut[2 + j]);
+    double r, x, reach = tt__cut_reach(lapped->cut + (2 + (size_t)K) * (size_t)p, K, u, v, &r);
     if (r <= reach) return 1.0f;
     x = (reach + lapped->cut_feather - r) / lapped->cut_feather;
     if (!(x > 0.0)) return 0.0f;
@@ -16516,15 +16561,16 @@ static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float s
 /* Pastes sampled from the top down before compositing, at most. */
 #define TT__BAKE_CACHE 32
 
-/* "over" of a paste's sample cut to c: beyond its cut the paste gives way
-   to what lies beneath as far as that is opaque, so a cut never uncovers
-   anything. */
+/* "over" of a paste's sample cut to c: beyond its cut the paste takes the
+   colour of what lies beneath as far as that is opaque (its colour weighs
+   1 - (1 - c) * the alpha beneath), its alpha unchanged, so a cut changes
+   no coverage and never uncovers anything. */
 static void tt__bake_over(float out[4], float sample[4], float cut)
 {
     int i;
     if (cut < 1.0f) {
-        const float keep = 1.0f - (1.0f - cut) * out[3];
-        for (i = 0; i < 4; i++) sample[i] *= keep;
+        const float keep = 1.0f - (1.0f - cut) * out[3], beneath = (1.0f - cut) * sample[3];
+        for (i = 0; i < 3; i++) sample[i] = keep * sample[i] + beneath * out[i];
     }
     tt_rgba_over(out, sample);
 }
