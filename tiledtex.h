@@ -1837,8 +1837,9 @@ typedef struct tt_field_options {
    (x for the default up). The field is smoothed over the field scale or 8
    mean edge lengths, whichever is less. Where up is strong the smoothing
    gains nothing and turns the texture away from up on a scan's bumps: the
-   smoothed direction is turned toward P_f(up) from |P_f(up)| = 0.6 and is
-   P_f(up) itself from 0.7 (walls, 45 degrees or more from facing up).
+   smoothed direction is turned toward P_f(up) from |P_f(up)| = 0.65 and is
+   P_f(up) itself from 0.8 (walls 53 degrees or more from facing up; within
+   a degree of it on average from 0.7, 45 degrees).
    Measured: on a closed box the walls follow up and the top is constant to
    0.001 degrees; the mean turn across edges (after parallel transport)
    against the earlier rule (projected up, breadth-first from neighbours
@@ -2088,6 +2089,9 @@ typedef struct tt_lapped_options {
     uint64_t seed;              /* random seed: same seed, same result */
     int isotropic;              /* 1: orientation by propagation per paste (only |T_f| counts) */
     int max_pastes;             /* cap on pastes; 0 = TT_LAPPED_MAX_PASTES */
+    int keep_edges;             /* 1: each paste keeps its patch's whole edge; 0: where it lies over what is
+                                   opaque, its edge is cut where it best matches what lies beneath (a
+                                   minimum-error cut, as tile synthesis cuts its bands; not when isotropic) */
     /* Called after every paste with the fraction of sample points covered
        (never decreasing); non-zero return cancels with TT_CANCELLED. */
     tt_progress_fn progress;
@@ -2115,6 +2119,16 @@ typedef struct tt_lapped {
                                    fade[3e .. 3e+2], linear over the face: 1 inside the paste, 0 where
                                    it had to stop while its patch still showed (a cut). Draw alpha *
                                    fade. NULL (in a tt_lapped made by hand) means 1 everywhere */
+    /* The cut of each paste's edge (tt_lapped_options.keep_edges), or NULL (and 0): paste p's anchor
+       (u, v in its patch's texture space) at cut[(2 + cut_columns) p], then at cut_columns even angles
+       (column j at 2 pi j / cut_columns, counter-clockwise from +u, linear between columns) the distance
+       from the anchor (texture units) beyond which tt_lapped_bake fades the paste's colour into that of
+       what lies beneath over cut_feather, as far as that is opaque (the paste's colour weighs
+       1 - (1 - c) * alpha beneath, c from 1 at the distance to 0 at the distance + cut_feather,
+       smoothstep), its alpha unchanged. The runtime pasting (Sec. 4) ignores it */
+    int cut_columns;
+    float *cut;
+    float cut_feather;
     /* Statistics (also available from tt_lapped_measure for any UVs). */
     double coverage;            /* fraction of faces whose samples are all covered: 1 on success */
     double mean_overdraw;       /* nentries / faces: how often a face is drawn */
@@ -2262,6 +2276,22 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
 /* Degrees: the normals of a chart's faces stay within this of its seed face's normal. */
 #define TT_ATLAS_CHART_CONE 40.0
 
+typedef struct tt_chart_pack_options {
+    /* The fill to try first, e.g. the report's fill from a packing of the same
+       mesh at another size (the fill changes little with the size); 0 =
+       TT_ATLAS_FILL_GUESS. From the first try the scale is bracketed in steps
+       of 6 %, then bisected: a good guess saves tries. */
+    double fill_guess;
+    /* Called after each packing tried with the share of the search done (an
+       estimate, never decreasing), and with 1 at the end; non-zero return
+       cancels with TT_CANCELLED. */
+    tt_progress_fn progress;
+    void *progress_user_data;
+} tt_chart_pack_options;
+
+/* The fill tried first when the options give none. */
+#define TT_ATLAS_FILL_GUESS 0.72
+
 typedef struct tt_chart_atlas_report {
     int ncharts;
     double texels_per_unit;     /* atlas texels per mesh unit of length, the same on every chart */
@@ -2280,12 +2310,14 @@ typedef struct tt_chart_atlas_report {
    success. Temporary memory only: about 200 bytes per face and two bits
    per texel (per block above 2048 a side). Time O(faces) for the charts
    (with the faces of a chart in a bounded number of grid cells each); the
-   packing, about ten times over for the bisection, scans the bitmap for
-   each chart, skipping rows without a long enough free run: 1 s on a
-   26k-face scan at 2048, 5 s on a 97k-face one. Deterministic; reentrant
+   packing, five to eight times over for the search of the scale (fewer
+   with a good options->fill_guess), scans the bitmap for each chart,
+   skipping rows without a long enough free run. options may be NULL
+   (defaults); TT_CANCELLED by options->progress. Deterministic; reentrant
    and thread-safe on distinct outputs. */
-TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_allocator *allocator,
-                                     float *corner_uv, tt_chart_atlas_report *report, tt_error *error);
+TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_chart_pack_options *options,
+                                     const tt_allocator *allocator, float *corner_uv, tt_chart_atlas_report *report,
+                                     tt_error *error);
 
 /* What tt_uv_check finds first, in this order of kinds (each the lowest face). */
 typedef enum tt_uv_problem {
@@ -2340,7 +2372,10 @@ typedef struct tt_bake_options {
    pastes of that face composited in paste order ("over" of the
    premultiplied patches, each sampled bilinearly with clamping at the UVs
    interpolated from the entry's corners, times the entry's fade when
-   lapped->fade is given). Texels within `gutter` texels
+   lapped->fade is given; beyond its paste's cut, when lapped->cut is
+   given, its colour gives way to the colour composited beneath, weighing
+   1 - (1 - c) * the alpha beneath, its alpha unchanged). Texels within
+   `gutter` texels
    outside a triangle get the same composite extrapolated across its edges
    (the face's maps extended linearly), and every texel still empty is then
    filled from the nearest filled texel, so bilinear filtering and mipmaps
@@ -2359,7 +2394,8 @@ typedef struct tt_bake_options {
    covers read (0, 0, 1). The atlas takes the patches' kind.
    Errors: NULL pointers, an empty atlas, non-triangles,
    npatches < 1, a negative gutter, patches of which some are normal maps
-   and some not (TT_ERROR_INVALID_ARGUMENT); an entry
+   and some not, a cut with no columns or no feather
+   (TT_ERROR_INVALID_ARGUMENT); a non-finite cut (TT_ERROR_NON_FINITE); an entry
    naming a patch or face out of range (TT_ERROR_INDEX_OUT_OF_RANGE,
    error->item names the paste or entry); non-finite corner_uv
    (TT_ERROR_NON_FINITE); TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch
@@ -11479,8 +11515,10 @@ static double tt__field_step(const tt_mesh *mesh, const double *centroid, int a,
 #define TT__FIELD_DECIDES_FROM 0.1     /* |P(up)| below which up says nothing of a face's direction (6 degrees
                                           from facing up: a scan's noise turns it at random there)... */
 #define TT__FIELD_DECIDES_AT 0.5       /* ...and from which it decides it (30 degrees) */
-#define TT__FIELD_LEVEL_FROM 0.6       /* |P(up)| from which the smoothed field is turned toward the projected up... */
-#define TT__FIELD_LEVEL_AT 0.7         /* ...until it is the projected up (walls: 45 degrees or more from facing up) */
+#define TT__FIELD_LEVEL_FROM 0.65      /* |P(up)| from which the smoothed field is turned toward the projected up... */
+#define TT__FIELD_LEVEL_AT 0.8         /* ...until it is the projected up (walls: 53 degrees or more from facing up;
+                                          turning from 0.6 to 0.7 cost the tops 1.2 to 1.7 degrees of mean turn
+                                          across edges on the bunny and the elephant, this 0.1) */
 #define TT__FIELD_SMOOTHING_EDGES 4.0  /* the smoothing length in mean edge lengths at most */
 #define TT__FIELD_TIE 0.01             /* the tie axis's pull where up says nothing, against up's where it does */
 #define TT__FIELD_TOLERANCE 1e-2       /* CG's relative residual: at 3e-2 faces where up decides stray past 1 degree */
@@ -13120,6 +13158,21 @@ static int tt__segment_meets_polygon(const float a[2], const float b[2], const f
 #define TT__LAPPED_REGISTER_DEPTH 0.5
 /* ...and only over at least this many cells of overlap. */
 #define TT__LAPPED_REGISTER_CELLS 16.0
+/* The cut of a paste's edge (tt__cut_paste): columns (angles) per
+   registration cell of the patch's side. A third of a side from the
+   anchor a column spans half a cell, so the cut, a row (a cell) at most
+   from column to column, can run up to about 60 degrees off the circle
+   about the anchor, enough to follow a course; with 1 column per cell
+   (about 30 degrees) it kept to the patch's edge (bunny, brick_red: seam
+   mismatch 0.067 -> 0.065; 0.062 with 4, 0.061 with 8 at twice the cost)... */
+#define TT__LAPPED_CUT_COLUMNS_PER_CELL 4
+/* ...the distance of a column the cut leaves alone (beyond any patch)... */
+#define TT__LAPPED_NO_CUT 4.0f
+/* ...the fade beyond the cut, in cells... */
+#define TT__LAPPED_CUT_FEATHER 1.0
+/* ...and the opacity beneath that a cut may lie over (the bake cuts only
+   as far as what lies beneath is opaque, so no cut uncovers anything). */
+#define TT__LAPPED_CUT_OVER 0.5
 
 /* The two limits on a face's map, TT_LAPPED_MAX_DISTORTION (a solved map)
    and TT_LAPPED_GROW_DISTORTION (a predicted one, and the fringe), each as
@@ -13207,10 +13260,30 @@ typedef struct tt__lapper {
     int *top_entry;             /* per face: its entry of the last paste over it, or -1 */
     tt_xcorr_texture **register_texture;    /* per patch, made when first used: its colour on the grid */
     unsigned char **register_allowed;       /* per patch: the shifts that keep the seed point deep */
-    float **register_alpha;     /* per patch: its alpha on the grid */
+    float **register_alpha;     /* per patch: its alpha on the grid, then its straight colour (3 planes) */
     double *register_mask, *register_values, *register_work;
     int register_grid;          /* cells a side */
+    /* the cut of the paste's edge (tt__cut_paste) */
+    float *cut_cost;
+    int *cut_lo, *cut_hi, *cut_path;
+    float *paste_cut;           /* per paste: its anchor and cut, as tt_lapped.cut; NULL when not cutting */
+    int paste_cut_capacity;
+    double cut_inner;           /* the current paste's nearest cut distance (TT__LAPPED_NO_CUT: none) */
 } tt__lapper;
+
+/* A paste's cut (as tt_lapped.cut: its anchor, then K distances) at (u, v)
+   of its texture space: how far from the anchor the cut lies in that
+   direction (linear between columns), and in *r how far (u, v) lies. */
+static double tt__cut_reach(const float *cut, int K, double u, double v, double *r)
+{
+    const double du = u - cut[0], dv = v - cut[1];
+    double at = atan2(dv, du) / 6.283185307179586 * K;
+    int j;
+    *r = sqrt(du * du + dv * dv);
+    if (at < 0.0) at += K;
+    j = (int)at < K ? (int)at : K - 1;
+    return cut[2 + j] + (at - j) * (cut[2 + (j + 1) % K] - cut[2 + j]);
+}
 
 /* Sec. 3.6 counts a face point as covered where a paste is opaque. Here a
    sample point counts only when every texel a bilinear lookup could read
@@ -13927,9 +14000,12 @@ static tt_result tt__optimize_patch(tt__lapper *L, int seed_face, const double s
    `unfaded` it marks nothing, counts them, and adds to *unfaded how many
    there would be with no fade. Any point of the face lies within
    TT__LAPPED_SAMPLE_REACH raster cells of a sample; the face's map
-   stretches a cell to at most rho texels. */
+   stretches a cell to at most rho texels. With `cut` (the entry's paste's,
+   as tt_lapped.cut), only points that far within the cut count: beyond it
+   the paste shows what lies beneath (tt_lapped_bake), so it hides nothing
+   there. */
 static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, const float *fade, int patch,
-                                   unsigned char *marks, int *unfaded)
+                                   const float *cut, unsigned char *marks, int *unfaded)
 {
     const tt_image *image = L->patches[patch];
     const float *depth = L->depth[patch];
@@ -13945,6 +14021,11 @@ static int tt__mark_opaque_samples(const tt__lapper *L, int f, const float *uv, 
         x = (w0 * uv[0] + w1 * uv[2] + w2 * uv[4]) * w;
         y = (1.0 - (w0 * uv[1] + w1 * uv[3] + w2 * uv[5])) * h;
         if (!(x >= 0.0 && y >= 0.0 && x < w && y < h) || !(depth[(size_t)(int)y * w + (int)x] > need)) continue;
+        if (cut) {
+            double from, reach = tt__cut_reach(cut, TT__LAPPED_CUT_COLUMNS_PER_CELL * L->register_grid, x / w,
+                                               1.0 - y / h, &from);
+            if (!(from + need / (w < h ? w : h) <= reach)) continue;
+        }
         if (unfaded) {
             (*unfaded)++;
             if (w0 * fade[0] + w1 * fade[1] + w2 * fade[2] >= TT_LAPPED_OPAQUE) added++;
@@ -14122,6 +14203,21 @@ static int tt__entry_hides_face(const tt__lapper *L, const tt__entry *entry, int
     return deepest > need + longest + 1.4142135623730951;
 }
 
+/* Whether the entry lies wholly within its paste's cut: its corners within
+   the nearest cut distance (a disc about the anchor holds the triangle). */
+static int tt__entry_within_cut(const tt__lapper *L, const tt__entry *entry, int paste)
+{
+    const float *anchor;
+    int k;
+    if (!L->paste_cut) return 1;
+    anchor = L->paste_cut + (2 + (size_t)TT__LAPPED_CUT_COLUMNS_PER_CELL * L->register_grid) * paste;
+    for (k = 0; k < 3; k++) {
+        const double du = entry->uv[2 * k] - anchor[0], dv = entry->uv[2 * k + 1] - anchor[1];
+        if (!(sqrt(du * du + dv * dv) <= L->cut_inner)) return 0;
+    }
+    return 1;
+}
+
 /* Drop the entries hidden by a later entry of their face that alone covers
    it (tt__entry_hides_face): the walk of tt__remove_hidden would drop them
    at the end anyway (their face is covered by the time it reaches them, and
@@ -14195,15 +14291,17 @@ static long long tt__record_paste(tt__lapper *L, int patch)
             const tt__entry *entry = &L->entries[i];
             int f = entry->face, got, none = 0;
             if (!entry->covers) continue;
-            if (pass == 1 && tt__entry_hides_face(L, entry, patch)) L->hidden_below[f] = paste;
+            if (pass == 1 && tt__entry_hides_face(L, entry, patch) && tt__entry_within_cut(L, entry, paste))
+                L->hidden_below[f] = paste;
             if (L->covered_count[f] == L->sample_start[f + 1] - L->sample_start[f]) continue;
             if (pass == 0) {
-                faded += tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, L->covered + L->sample_start[f],
+                faded += tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, NULL, L->covered + L->sample_start[f],
                                                  &none);
                 unfaded += none;
                 continue;
             }
-            got = tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, L->covered + L->sample_start[f], NULL);
+            got = tt__mark_opaque_samples(L, f, entry->uv, entry->fade, patch, NULL, L->covered + L->sample_start[f],
+                                          NULL);
             added += tt__count_covered(L, f, got);
         }
         if (pass == 0 && (double)faded < TT__LAPPED_FADE_KEEPS * (double)unfaded)
@@ -14447,6 +14545,11 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->register_mask);
     tt__free(L->al, L->register_values);
     tt__free(L->al, L->register_work);
+    tt__free(L->al, L->cut_cost);
+    tt__free(L->al, L->cut_lo);
+    tt__free(L->al, L->cut_hi);
+    tt__free(L->al, L->cut_path);
+    tt__free(L->al, L->paste_cut);
     tt__free(L->al, L->top_entry);
     tt__free(L->al, L->local_face);
     tt__free(L->al, L->local_field);
@@ -14852,8 +14955,11 @@ static int tt__remove_hidden(tt__lapper *L)
             removed++;
             continue;
         }
-        L->covered_count[face] += tt__mark_opaque_samples(L, face, entry->uv, entry->fade, L->paste_patch[entry->paste],
-                                                          L->covered + L->sample_start[face], NULL);
+        L->covered_count[face] += tt__mark_opaque_samples(
+            L, face, entry->uv, entry->fade, L->paste_patch[entry->paste],
+            L->paste_cut ? L->paste_cut + (2 + (size_t)TT__LAPPED_CUT_COLUMNS_PER_CELL * L->register_grid) * entry->paste
+                         : NULL,
+            L->covered + L->sample_start[face], NULL);
     }
     return removed;
 }
@@ -14901,6 +15007,15 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
     out->fade = TT__ALLOC(L->al, float, 3 * (size_t)(kept > 0 ? kept : 1));
     out->pastes = TT__ALLOC(L->al, tt_paste, L->npastes > 0 ? L->npastes : 1);
     scales = TT__ALLOC(L->al, double, kept > 0 ? kept : 1);
+    if (L->paste_cut) {
+        out->cut_columns = TT__LAPPED_CUT_COLUMNS_PER_CELL * L->register_grid;
+        out->cut_feather = (float)(TT__LAPPED_CUT_FEATHER / L->register_grid);
+        out->cut = TT__ALLOC(L->al, float, (2 + (size_t)out->cut_columns) * (size_t)(L->npastes > 0 ? L->npastes : 1));
+        if (!out->cut) {
+            tt__free(L->al, scales);
+            return TT_ERROR_OUT_OF_MEMORY;
+        }
+    }
     if (!out->faces || !out->uv || !out->fade || !out->pastes || !scales) {
         tt__free(L->al, scales);
         return TT_ERROR_OUT_OF_MEMORY;
@@ -14914,6 +15029,10 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
             out->pastes[p].patch = L->paste_patch[entry->paste];
             out->pastes[p].first = n;
             out->pastes[p].nfaces = 0;
+            if (out->cut) {
+                const size_t stride = 2 + (size_t)out->cut_columns;
+                memcpy(out->cut + stride * p, L->paste_cut + stride * entry->paste, stride * sizeof(float));
+            }
         }
         out->faces[n] = L->face_of[entry->face];
         for (i = 0; i < 6; i++) out->uv[6 * (size_t)n + i] = entry->uv[i];
@@ -14959,7 +15078,8 @@ static tt_result tt__lapped_output(tt__lapper *L, int removed, tt_lapped *out)
 typedef struct tt__register_raster {
     const tt__entry *below;     /* the entry on top of the face so far */
     const tt_image *below_patch;
-    const float *alpha;         /* the paste's patch's alpha on the grid */
+    const float *alpha;         /* the paste's patch's alpha on the grid; NULL for the cut (tt__cut_paste):
+                                   the mask is then the opacity beneath */
     double *mask, *values;      /* the correlation's planes, size x size */
     int grid, size;
 } tt__register_raster;
@@ -14969,14 +15089,15 @@ static void tt__register_cell(int x, int y, const float b[3], void *user_data)
     const tt__register_raster *R = (const tt__register_raster *)user_data;
     const float *uv = R->below->uv, *fade = R->below->fade;
     const float u = b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4], v = b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5];
-    const float alpha = R->alpha[y * R->grid + x];
+    const float alpha = R->alpha ? R->alpha[y * R->grid + x] : 1.0f;
     const size_t at = (size_t)y * R->size + x, plane = (size_t)R->size * R->size;
     float rgba[4], below;
     int c;
     if (alpha < 0.5f) return;
     tt_image_sample_bilinear(R->below_patch, u * R->below_patch->width, (1.0f - v) * R->below_patch->height, rgba);
     below = rgba[3] * (b[0] * fade[0] + b[1] * fade[1] + b[2] * fade[2]);
-    if (!(below >= 0.5f)) return;
+    /* Without the paste's alpha (the cut), every cell gets what lies beneath. */
+    if (!(below >= (R->alpha ? 0.5f : 1e-6f)) || !(rgba[3] > 0.0f)) return;
     R->mask[at] = below * alpha;
     for (c = 0; c < 3; c++) R->values[c * plane + at] = rgba[c] / rgba[3];
 }
@@ -15000,7 +15121,8 @@ static tt_result tt__register_prepare(tt__lapper *L, int patch)
         if (!L->register_mask || !L->register_values) return TT_ERROR_OUT_OF_MEMORY;
     }
     planes = L->register_values;
-    alpha = TT__ALLOC(L->al, float, (size_t)grid * grid);
+    /* Its alpha, then its straight colour's three planes (for the cut). */
+    alpha = TT__ALLOC(L->al, float, 4 * (size_t)grid * grid);
     allowed = TT__ALLOC(L->al, unsigned char, plane);
     if (!alpha || !allowed) {
         tt__free(L->al, alpha);
@@ -15020,8 +15142,11 @@ static tt_result tt__register_prepare(tt__lapper *L, int patch)
                 for (x = x0; x < x1 && x < w; x++)
                     for (c = 0; c < 4; c++) sum[c] += image->pixels[4 * ((size_t)y * w + x) + c];
             alpha[cy * grid + cx] = (float)(sum[3] / ((double)(y1 - y0) * (x1 - x0)));
-            if (sum[3] > 1e-6)
-                for (c = 0; c < 3; c++) planes[c * plane + (size_t)cy * size + cx] = sum[c] / sum[3];
+            for (c = 0; c < 3; c++) {
+                if (sum[3] > 1e-6) planes[c * plane + (size_t)cy * size + cx] = sum[c] / sum[3];
+                alpha[(size_t)(c + 1) * grid * grid + (size_t)cy * grid + cx] =
+                    (float)planes[c * plane + (size_t)cy * size + cx];
+            }
         }
     /* The planes are finite (the patches were checked): only memory can fail. */
     if (tt_xcorr_texture_create(size, size, 3, planes, L->al, &L->register_texture[patch], NULL) != TT_OK)
@@ -15042,27 +15167,17 @@ static tt_result tt__register_prepare(tt__lapper *L, int patch)
     return TT_OK;
 }
 
-/* The shift (texture space) that best matches the paste of `patch`, under
-   its current map, with what lies beneath it; (0, 0) where too little
-   lies beneath. */
-static tt_result tt__register_paste(tt__lapper *L, int patch, double shift[2])
+/* What lies beneath the current paste (the top entry of each of its faces),
+   drawn into its texture space on the registration's grid: into L->register_mask (alpha NULL: the
+   opacity beneath; else times alpha, where both are at least half) and
+   L->register_values (straight colour). */
+static void tt__register_raster_below(tt__lapper *L, const float *alpha)
 {
     const int grid = L->register_grid, size = 2 * grid;
-    const size_t plane = (size_t)size * size;
     tt__register_raster R;
-    tt_xcorr_match match;
     int i, k;
-    shift[0] = shift[1] = 0.0;
-    if (!L->register_texture[patch]) {
-        tt_result r = tt__register_prepare(L, patch);
-        if (r != TT_OK) return r;
-    }
-    if (!L->register_work) {
-        L->register_work = TT__ALLOC(L->al, double, L->register_texture[patch]->work_size);
-        if (!L->register_work) return TT_ERROR_OUT_OF_MEMORY;
-    }
-    memset(L->register_mask, 0, plane * sizeof *L->register_mask);
-    R.alpha = L->register_alpha[patch];
+    memset(L->register_mask, 0, (size_t)size * size * sizeof *L->register_mask);
+    R.alpha = alpha;
     R.mask = L->register_mask;
     R.values = L->register_values;
     R.grid = grid;
@@ -15080,6 +15195,25 @@ static tt_result tt__register_paste(tt__lapper *L, int patch, double shift[2])
         }
         tt_raster_triangle(xy, grid, grid, tt__register_cell, &R);
     }
+}
+
+/* The shift (texture space) that best matches the paste of `patch`, under
+   its current map, with what lies beneath it; (0, 0) where too little
+   lies beneath. */
+static tt_result tt__register_paste(tt__lapper *L, int patch, double shift[2])
+{
+    const int grid = L->register_grid, size = 2 * grid;
+    tt_xcorr_match match;
+    shift[0] = shift[1] = 0.0;
+    if (!L->register_texture[patch]) {
+        tt_result r = tt__register_prepare(L, patch);
+        if (r != TT_OK) return r;
+    }
+    if (!L->register_work) {
+        L->register_work = TT__ALLOC(L->al, double, L->register_texture[patch]->work_size);
+        if (!L->register_work) return TT_ERROR_OUT_OF_MEMORY;
+    }
+    tt__register_raster_below(L, L->register_alpha[patch]);
     if (tt_xcorr_masked(L->register_texture[patch], L->register_mask, L->register_values,
                         L->register_allowed[patch], L->register_work, NULL, &match, NULL) != TT_OK ||
         match.mask_sum < TT__LAPPED_REGISTER_CELLS || match.x < 0)
@@ -15109,6 +15243,103 @@ static tt_result tt__move_paste(tt__lapper *L, int patch, int seed_face, const d
     moved[0] = (float)(anchor[0] + shift[0]);
     moved[1] = (float)(anchor[1] + shift[1]);
     return tt__optimize_patch(L, seed_face, seed_weight, moved);
+}
+
+/* The cut (image quilting's minimum-error boundary, as tile synthesis cuts
+   its bands). Registration lines the paste's courses up with those beneath
+   on the whole, but along its edge the two still disagree here and there
+   (a paste over two that disagree with each other, maps a few degrees
+   apart on a curved surface), and its soft edge shows every such break.
+   So where the paste lies over what is opaque, its edge moves to where the
+   two agree best: in polar coordinates about the paste's anchor (angle:
+   TT__LAPPED_CUT_COLUMNS_PER_CELL columns per grid cell a side; distance:
+   rows of one grid cell) the cost of a place is the squared difference
+   between the patch's straight colour and what lies beneath, both on the
+   registration's grid, and
+   tt_min_error_cut finds the path of least total cost around the anchor.
+   A row is allowed in a column only when everything the patch shows
+   beyond it lies over what is opaque; beyond the patch's own edge the cost
+   is the edge's (cutting there changes nothing). The path is closed by
+   cutting again with its first column held (left open when that cannot
+   join). The distances go into L->paste_cut for the paste being recorded;
+   beyond them tt_lapped_bake gives the paste the colour of what is opaque
+   beneath (tt_lapped.cut), its alpha unchanged. So the loop's coverage
+   does not use the cut, and every part of the paste stays. */
+static tt_result tt__cut_paste(tt__lapper *L, int patch, const double center[2])
+{
+    const float *alpha = L->register_alpha[patch];
+    const int grid = L->register_grid, size = 2 * grid, K = TT__LAPPED_CUT_COLUMNS_PER_CELL * grid, W = K + 1;
+    const int R = (int)(1.4143 * grid) + 2;
+    const double two_pi = 6.283185307179586;
+    const size_t plane = (size_t)size * size, stride = 2 + (size_t)K;
+    const double *below = L->register_mask, *colour = L->register_values;
+    float *cost, *out;
+    int *lo, *hi, *path, i, j, k;
+    tt_result r;
+    void *grown = tt__grow(L->al, L->paste_cut, &L->paste_cut_capacity, (int)((L->npastes + 1) * stride),
+                           sizeof(float));
+    if (!grown) return TT_ERROR_OUT_OF_MEMORY;
+    L->paste_cut = (float *)grown;
+    out = L->paste_cut + L->npastes * stride;
+    out[0] = (float)center[0];
+    out[1] = (float)center[1];
+    for (j = 0; j < K; j++) out[2 + j] = TT__LAPPED_NO_CUT;
+    L->cut_inner = TT__LAPPED_NO_CUT;
+    if (!L->cut_cost) {
+        L->cut_cost = TT__ALLOC(L->al, float, (size_t)W * R);
+        L->cut_lo = TT__ALLOC(L->al, int, W);
+        L->cut_hi = TT__ALLOC(L->al, int, W);
+        L->cut_path = TT__ALLOC(L->al, int, 2 * (size_t)W);
+        if (!L->cut_cost || !L->cut_lo || !L->cut_hi || !L->cut_path) return TT_ERROR_OUT_OF_MEMORY;
+    }
+    if (!L->register_mask || !alpha) return TT_OK;
+    cost = L->cut_cost;
+    lo = L->cut_lo;
+    hi = L->cut_hi;
+    path = L->cut_path;
+    tt__register_raster_below(L, NULL);
+    for (j = 0; j < K; j++) {
+        const double angle = two_pi * j / K, du = cos(angle) / grid, dv = sin(angle) / grid;
+        int last_shown = -1, last_open = -1;
+        for (i = 0; i < R; i++) {
+            const double u = center[0] + i * du, v = center[1] + i * dv;
+            const int cx = (int)floor(u * grid), cy = (int)floor((1.0 - v) * grid);
+            const size_t at = (size_t)cy * grid + cx, under = (size_t)cy * size + cx;
+            double err = 3.0;
+            if (cx >= 0 && cy >= 0 && cx < grid && cy < grid && alpha[at] > 0.0f) {
+                last_shown = i;
+                if (!(below[under] >= TT__LAPPED_CUT_OVER)) last_open = i;
+                if (below[under] > 0.0) {
+                    err = 0.0;
+                    for (k = 0; k < 3; k++) {
+                        double d = alpha[(size_t)(k + 1) * grid * grid + at] - colour[k * plane + under];
+                        err += d * d;
+                    }
+                }
+            }
+            cost[(size_t)i * W + j] = (float)err;
+        }
+        /* Beyond the patch's edge a cut changes nothing: the edge's cost. */
+        for (i = last_shown + 1; i < R; i++)
+            cost[(size_t)i * W + j] = last_shown >= 0 ? cost[(size_t)last_shown * W + j] : 0.0f;
+        /* One row more than the open ones: the open cell's far side. */
+        lo[j] = last_open + 2 < R - 1 ? last_open + 2 : R - 1;
+        hi[j] = R - 1;
+    }
+    for (i = 0; i < R; i++) cost[(size_t)i * W + K] = cost[(size_t)i * W];
+    lo[K] = lo[0];
+    hi[K] = hi[0];
+    r = tt_min_error_cut(cost, W, R, lo, hi, L->al, path, NULL);
+    if (r != TT_OK) return r == TT_ERROR_OUT_OF_MEMORY ? r : TT_OK;
+    lo[0] = hi[0] = lo[K] = hi[K] = path[0];
+    r = tt_min_error_cut(cost, W, R, lo, hi, L->al, path + W, NULL);
+    if (r == TT_ERROR_OUT_OF_MEMORY) return r;
+    if (r == TT_OK) path += W;
+    for (j = 0; j < K; j++) {
+        out[2 + j] = (float)path[j] / grid;
+        if (out[2 + j] < L->cut_inner) L->cut_inner = out[2 + j];
+    }
+    return TT_OK;
 }
 
 TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, tt_image *const *patches,
@@ -15178,6 +15409,10 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
             double shift[2];
             r = tt__register_paste(&L, patch, shift);
             if (r == TT_OK) r = tt__move_paste(&L, patch, seed_face, seed_weight, shift);
+            if (r == TT_OK && !opts.keep_edges) {
+                const double center[2] = {L.anchor[2 * patch] + shift[0], L.anchor[2 * patch + 1] + shift[1]};
+                r = tt__cut_paste(&L, patch, center);
+            }
             if (r != TT_OK) {
                 r = tt__fail(error, r, -1, -1, -1, -1, "out of memory");
                 break;
@@ -15223,6 +15458,7 @@ TTDEF void tt_lapped_free(tt_lapped *lapped)
     tt__free(&allocator, lapped->faces);
     tt__free(&allocator, lapped->uv);
     tt__free(&allocator, lapped->fade);
+    tt__free(&allocator, lapped->cut);
     tt__free(&allocator, lapped);
 }
 
@@ -15890,6 +16126,10 @@ static void tt__chart_texel(const double *xy, int face, int k, double s, int gut
 
 /* Atlas sides above this many texels are packed in blocks of texels. */
 #define TT__PACK_GRID 2048
+/* The search of the scale (tt_atlas_pack_charts) steps from its first guess
+   by this factor until it brackets the scale that fits: the fills of real
+   meshes lie within a step or two of TT_ATLAS_FILL_GUESS. */
+#define TT__PACK_BRACKET 1.06
 
 /* Scratch of the bitmap packing: one bit per atlas texel, taken or free
    (rows of `words` 64-bit words), the longest free run of each row, and
@@ -16235,12 +16475,15 @@ static int tt__grow_charts(const tt_mesh *mesh, const double *normal, const doub
    at which every chart is under a millionth of a texel (when even that does
    not fit, nothing does) and the one at which the charts' boxes alone would
    fill the atlas. */
-TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_allocator *allocator,
-                                     float *corner_uv, tt_chart_atlas_report *report, tt_error *error)
+TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_chart_pack_options *options,
+                                     const tt_allocator *allocator, float *corner_uv, tt_chart_atlas_report *report,
+                                     tt_error *error)
 {
     const tt_allocator *al = allocator;
     double *normal = NULL, *area = NULL, *xy = NULL;
     int *chart = NULL, *tried = NULL, *members = NULL, *box_x = NULL, *box_y = NULL, *box_turn = NULL;
+    int *try_box = NULL, packed = 0, tries = 0, failed = 0, fitted = 0;
+    tt_chart_pack_options opt;
     int *need = NULL, *rows_order = NULL, block, side, block_gutter;
     tt__chart *charts = NULL;
     tt__chart_order *order = NULL;
@@ -16267,6 +16510,9 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
                         "a gutter of %d texels needs charts of %.0f texels each way at least: more than the limit "
                         "of %d x %d holds; lower the gutter", gutter, 2.0 * gutter + 1.0, TT_MAX_IMAGE_SIZE,
                         TT_MAX_IMAGE_SIZE);
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    if (!(opt.fill_guess > 0.0 && opt.fill_guess < 1.0)) opt.fill_guess = TT_ATLAS_FILL_GUESS;
     nf = mesh->nfaces;
     if ((result = tt__require_triangles(mesh, "the atlas packs triangles only", error)) != TT_OK) return result;
 
@@ -16283,6 +16529,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     box_x = TT__ALLOC(al, int, nf);
     box_y = TT__ALLOC(al, int, nf);
     box_turn = TT__ALLOC(al, int, nf);
+    try_box = TT__ALLOC(al, int, 3 * (size_t)nf);
     /* Above TT__PACK_GRID texels a side, the packing works in blocks of
        texels (the gutter rounded up to whole blocks): its time grows with
        the bitmap, and a chart's outline then costs at most a block more. */
@@ -16296,7 +16543,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     need = TT__ALLOC(al, int, side);
     rows_order = TT__ALLOC(al, int, side);
     if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !box_x || !box_y || !box_turn ||
-        !pack.bits || !pack.mask || !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
+        !try_box || !pack.bits || !pack.mask || !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
         goto out_of_memory;
 
     /* The grid's cells: the mean edge, but no face across more than 32 of
@@ -16362,24 +16609,48 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
                               ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
         goto done;
     }
+    /* The triangles cannot fill more than the atlas: s_hi never fits. From
+       the guess, steps of TT__PACK_BRACKET up while it fits or down while
+       it does not bracket the scale; then halving, down to 0.5 % of it. The
+       layout of the last packing that fitted is kept. */
     s_lo = tiny;
-    s_hi = surface > 0.0 ? side / sqrt(surface) : tiny;
+    s_hi = surface > 0.0 ? 1.0001 * side / sqrt(surface) : tiny;
     if (s_hi < s_lo) s_hi = s_lo;
-    if (tt__pack_bitmap(charts, order, ncharts, members, xy, s_hi, block_gutter, side, &pack, need, rows_order, NULL,
-                        NULL, NULL))
-        s_lo = s_hi;
-    /* Each packing costs about as much as a bake of the atlas: the first
-       guess is a fill of 0.72, then halving down to 0.5 % of the scale. */
-    for (i = 0; i < 100 && s_hi - s_lo > 5e-3 * s_hi; i++) {
-        double mid = i == 0 && 0.85 * s_hi > s_lo ? 0.85 * s_hi : 0.5 * (s_lo + s_hi);
-        if (tt__pack_bitmap(charts, order, ncharts, members, xy, mid, block_gutter, side, &pack, need, rows_order, NULL,
-                            NULL, NULL))
-            s_lo = mid;
-        else
-            s_hi = mid;
+    {
+        double mid = s_hi * sqrt(opt.fill_guess);
+        while (tries < 100 && s_hi - s_lo > 5e-3 * s_hi) {
+            int fits;
+            if (!(mid > s_lo && mid < s_hi)) mid = 0.5 * (s_lo + s_hi);
+            fits = tt__pack_bitmap(charts, order, ncharts, members, xy, mid, block_gutter, side, &pack, need, rows_order,
+                                   try_box, try_box + nf, try_box + 2 * (size_t)nf);
+            tries++;
+            if (fits) {
+                s_lo = mid;
+                fitted = 1;
+                packed = 1;
+                memcpy(box_x, try_box, (size_t)ncharts * sizeof(int));
+                memcpy(box_y, try_box + nf, (size_t)ncharts * sizeof(int));
+                memcpy(box_turn, try_box + 2 * (size_t)nf, (size_t)ncharts * sizeof(int));
+            } else {
+                s_hi = mid;
+                failed = 1;
+            }
+            /* About 6 tries in all; the estimate only grows. */
+            if (opt.progress && opt.progress((float)(1.0 - 1.0 / (1.0 + tries / 3.0)), opt.progress_user_data)) {
+                result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
+                goto done;
+            }
+            if (fitted && failed) mid = 0.5 * (s_lo + s_hi);
+            else mid = fitted ? mid * TT__PACK_BRACKET : mid / TT__PACK_BRACKET;
+        }
     }
-    tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, &pack, need, rows_order, box_x,
-                    box_y, box_turn);
+    if (!packed)
+        tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, &pack, need, rows_order, box_x,
+                        box_y, box_turn);
+    if (opt.progress && opt.progress(1.0f, opt.progress_user_data)) {
+        result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
+        goto done;
+    }
 
     for (c = 0; c < ncharts; c++) {
         int cols = tt__chart_cells(charts[c].width, s_lo, block_gutter);
@@ -16421,6 +16692,7 @@ done:
     tt__free(al, box_x);
     tt__free(al, box_y);
     tt__free(al, box_turn);
+    tt__free(al, try_box);
     tt__free(al, pack.bits);
     tt__free(al, pack.mask);
     tt__free(al, pack.run);
@@ -16521,7 +16793,7 @@ done:
 typedef struct tt__bake {
     const tt_lapped *lapped;
     tt_image *const *patches;
-    const int *items;           /* pairs (entry, patch) of this face, in paste order */
+    const int *items;           /* pairs (entry, paste) of this face, in paste order */
     int nitems;
     /* Normal-map patches: per item, the turn (row-major 2 x 2, image axes)
        from its patch's frame to the atlas's; NULL for colour. */
@@ -16536,12 +16808,25 @@ typedef struct tt__bake {
     tt_image *atlas;
 } tt__bake;
 
+/* Paste p's cut (tt_lapped.cut) at (u, v) of its texture space: 1 within
+   the cut, falling to 0 over the feather beyond it. */
+static float tt__paste_cut_at(const tt_lapped *lapped, int p, double u, double v)
+{
+    const int K = lapped->cut_columns;
+    double r, x, reach = tt__cut_reach(lapped->cut + (2 + (size_t)K) * (size_t)p, K, u, v, &r);
+    if (r <= reach) return 1.0f;
+    x = (reach + lapped->cut_feather - r) / lapped->cut_feather;
+    if (!(x > 0.0)) return 0.0f;
+    return (float)(x * x * (3.0 - 2.0 * x));
+}
+
 /* Paste item k of the face sampled at barycentric weights w (weights outside
-   [0, 1] extend the paste's linear map across the face's edges). */
-static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float sample[4])
+   [0, 1] extend the paste's linear map across the face's edges), and its
+   cut there (1 without). */
+static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float sample[4], float *cut)
 {
     const float *uv = b->lapped->uv + 6 * (size_t)b->items[2 * k];
-    const tt_image *patch = b->patches[b->items[2 * k + 1]];
+    const tt_image *patch = b->patches[b->lapped->pastes[b->items[2 * k + 1]].patch];
     double u = 0.0, v = 0.0, px, py;
     int i;
     for (i = 0; i < 3; i++) {
@@ -16550,6 +16835,7 @@ static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float s
     }
     /* The sampler clamps; clamping here first keeps the float conversion
        defined for far extrapolations. */
+    *cut = b->lapped->cut ? tt__paste_cut_at(b->lapped, b->items[2 * k + 1], u, v) : 1.0f;
     px = u * patch->width;
     py = (1.0 - v) * patch->height;
     px = px < -1.0 ? -1.0 : (px > patch->width + 1.0 ? patch->width + 1.0 : px);
@@ -16569,31 +16855,48 @@ static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float s
 /* Pastes sampled from the top down before compositing, at most. */
 #define TT__BAKE_CACHE 32
 
+/* "over" of a paste's sample cut to c: beyond its cut the paste takes the
+   colour of what lies beneath as far as that is opaque (its colour weighs
+   1 - (1 - c) * the alpha beneath), its alpha unchanged, so a cut changes
+   no coverage and never uncovers anything. */
+static void tt__bake_over(float out[4], float sample[4], float cut)
+{
+    int i;
+    if (cut < 1.0f) {
+        const float keep = 1.0f - (1.0f - cut) * out[3], beneath = (1.0f - cut) * sample[3];
+        for (i = 0; i < 3; i++) sample[i] = keep * sample[i] + beneath * out[i];
+    }
+    tt_rgba_over(out, sample);
+}
+
 /* Composite the face's pastes at barycentric weights w (Sec. 4: the pastes
    drawn in order with "over"), premultiplied. A paste that is opaque here
-   (alpha exactly 1) hides everything beneath it - "over" then gives the
-   paste itself, exactly - so the walk goes down from the topmost paste and
-   composites upward from the first opaque one: the same bits as drawing
-   every paste, at the cost of the one or two on top instead of the face's
-   whole overdraw. */
+   (alpha exactly 1, not cut) hides everything beneath it - "over" then gives
+   the paste itself, exactly - so the walk goes down from the topmost paste
+   and composites upward from the first opaque one: the same bits as
+   drawing every paste, at the cost of the one or two on top instead of the
+   face's whole overdraw. */
 static void tt__bake_composite(const tt__bake *b, const double w[3], float out[4])
 {
-    float cache[TT__BAKE_CACHE][4];
+    float cache[TT__BAKE_CACHE][4], cuts[TT__BAKE_CACHE];
     int n = b->nitems, k, cached = 0, opaque = 0;
     out[0] = out[1] = out[2] = out[3] = 0.0f;
     for (k = n - 1; k >= 0 && cached < TT__BAKE_CACHE && !opaque; k--) {
-        tt__bake_sample(b, k, w, cache[cached]);
-        opaque = cache[cached][3] == 1.0f;
+        tt__bake_sample(b, k, w, cache[cached], &cuts[cached]);
+        opaque = cache[cached][3] == 1.0f && cuts[cached] == 1.0f;
         cached++;
     }
     if (opaque || cached == n) {
-        while (cached > 0) tt_rgba_over(out, cache[--cached]);
+        while (cached > 0) {
+            cached--;
+            tt__bake_over(out, cache[cached], cuts[cached]);
+        }
         return;
     }
     for (k = 0; k < n; k++) {
-        float sample[4];
-        tt__bake_sample(b, k, w, sample);
-        tt_rgba_over(out, sample);
+        float sample[4], cut;
+        tt__bake_sample(b, k, w, sample, &cut);
+        tt__bake_over(out, sample, cut);
     }
 }
 
@@ -16903,6 +17206,17 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
                             "corner %d (face %d) has a non-finite atlas UV", c / 2, mesh->corner_face[c / 2]);
     if ((result = tt__check_lapped(mesh, lapped, npatches, &total, error)) != TT_OK) return result;
+    if (lapped->cut) {
+        if (lapped->cut_columns < 1 || lapped->cut_columns > (1 << 16) || !(lapped->cut_feather > 0.0f) ||
+            !tt__is_finite(lapped->cut_feather))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "the pastes' cut has %d columns and a feather of %g: need 1 to 65536 columns and a "
+                            "positive feather", lapped->cut_columns, (double)lapped->cut_feather);
+        for (t = 0; t < (2 + (size_t)lapped->cut_columns) * (size_t)lapped->npastes; t++)
+            if (!tt__is_finite(lapped->cut[t]))
+                return tt__fail_at(error, TT_ERROR_NON_FINITE, (int)(t / (2 + (size_t)lapped->cut_columns)), -1, -1,
+                                   "the cut of paste %d is not finite", (int)(t / (2 + (size_t)lapped->cut_columns)));
+    }
 
     width = atlas->width;
     height = atlas->height;
@@ -16935,7 +17249,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
         for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) {
             int slot = fill[lapped->faces[e]]++;
             items[2 * slot] = e;
-            items[2 * slot + 1] = lapped->pastes[p].patch;
+            items[2 * slot + 1] = p;
         }
 
     for (t = 0; t < texels; t++) state[t] = empty;
@@ -16965,7 +17279,8 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
             if (!tt__bake_face(&bake, &job, f, xy)) continue;
             if (pass == 0 && normal)
                 for (k = 0; k < bake.nitems; k++)
-                    tt__bake_turn(&bake, lapped->uv + 6 * (size_t)bake.items[2 * k], patches[bake.items[2 * k + 1]],
+                    tt__bake_turn(&bake, lapped->uv + 6 * (size_t)bake.items[2 * k],
+                                  patches[lapped->pastes[bake.items[2 * k + 1]].patch],
                                   turns + 4 * ((size_t)start[f] + (size_t)k));
             low = high = bake.y[0];
             for (k = 1; k < 3; k++) {

@@ -124,6 +124,9 @@ static void print_help(void)
            "                       reaches, WEIGHT its weight (default 1); '#' starts a comment.\n"
            "                       Directions elsewhere blend the constraints; --up is unused\n"
            "  --isotropic          the texture has no direction: each paste turns its patch at random\n"
+           "  --keep-edges         each paste keeps its patch's whole soft edge (default: where it lies\n"
+           "                       over what is opaque, its edge is cut where it best matches what lies\n"
+           "                       beneath, so bricks or planks run on through the overlaps)\n"
            "  --mask MASK.png      the patches' shape: MASK's alpha, or its grey when opaque\n"
            "                       (white = inside); one shape for every patch: MASK is the size of a\n"
            "                       patch, or of IMAGE and then scaled to the patch's (default: a random\n"
@@ -185,6 +188,7 @@ typedef struct lapped_options {
     uint64_t seed;
     tool_field field;               /* --up, --constraints */
     int isotropic;
+    int keep_edges;
     const char *mask_path;          /* or NULL */
     int npatches;                   /* --patches N; 0 = the default (choose_windows) */
     int patch_size;                 /* --patch-size S in texels; 0 = the default */
@@ -242,6 +246,8 @@ static int parse_command_line(int argc, char **argv, lapped_options *options)
             else return tool_usage("--bake-uv wants auto, mesh or atlas, got '%s'", value);
         } else if (tool_flag(argv[i], "--isotropic")) {
             options->isotropic = 1;
+        } else if (tool_flag(argv[i], "--keep-edges")) {
+            options->keep_edges = 1;
         } else if (tool_flag(argv[i], "--pasting")) {
             options->pasting = 1;
         } else if ((taken = material_parse_option(argc, argv, &i, &options->maps)) != 0) {
@@ -814,6 +820,8 @@ static int bake_uvs(lapped_options *options, const triangle_mesh *m, const float
     const size_t ncorners = 3 * (size_t)m->ntriangles;
     char problem[160] = "have none at some corners";
     tt_chart_atlas_report report;
+    tt_chart_pack_options pack;
+    tool_progress progress;
     tt_uv_distortion_report distortion;
     tt_uv_report check;
     tt_error error;
@@ -840,15 +848,23 @@ static int bake_uvs(lapped_options *options, const triangle_mesh *m, const float
             double side = atlas->paste_texels * sqrt(surface / LAPPED_EXPECTED_FILL);
             while (options->bake_size < TOOL_MAX_ATLAS && options->bake_size < side) options->bake_size *= 2;
         }
-        tool_stage("packing the bake's atlas");
+        /* Cancellable (Ctrl-C); a doubled side starts from the fill the
+           last packing reached, which changes little with the side. */
+        tool_progress_begin(&progress, "packing the bake's atlas", "of the search");
+        memset(&pack, 0, sizeof pack);
+        pack.progress = tool_show_progress;
+        pack.progress_user_data = &progress;
         for (;;) {
-            if (tt_atlas_pack_charts(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, NULL, *corner_uv, &report,
-                                     &error) != TT_OK) {
+            tt_result packed = tt_atlas_pack_charts(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, &pack, NULL,
+                                                    *corner_uv, &report, &error);
+            if (packed == TT_OK) pack.fill_guess = report.fill;
+            if (packed != TT_OK) {
                 if (options->bake_auto && error.result == TT_ERROR_IMAGE_TOO_SMALL &&
                     options->bake_size < TOOL_MAX_ATLAS) {
                     options->bake_size *= 2;
                     continue;
                 }
+                tool_progress_end(&progress);
                 free(*corner_uv);
                 *corner_uv = NULL;
                 return tool_fail("--bake %d: %s", options->bake_size, error.message);
@@ -858,6 +874,7 @@ static int bake_uvs(lapped_options *options, const triangle_mesh *m, const float
                 break;
             options->bake_size *= 2;
         }
+        tool_progress_end(&progress);
         atlas->charts = report.ncharts;
         atlas->fill = report.fill;
         /* Only an OBJ that has texture coordinates was asked for them. */
@@ -1075,6 +1092,7 @@ static int paste(const lapped_options *options, const triangle_mesh *m, const fl
     memset(&paste_options, 0, sizeof paste_options);
     paste_options.seed = options->seed;
     paste_options.isotropic = options->isotropic;
+    paste_options.keep_edges = options->keep_edges;
     paste_options.progress = tool_show_progress;
     paste_options.progress_user_data = &progress;
     result = tt_lapped_paste(m->mesh, field, patches->images, patches->count, &paste_options, NULL, lapped, &error);

@@ -238,7 +238,7 @@ int main(void)
                     {
                         tt_chart_atlas_report ar;
                         tt_uv_report ur;
-                        EXPECT(tt_atlas_pack_charts(tris, 64, 2, NULL, corner_uv, &ar, &err) == TT_OK &&
+                        EXPECT(tt_atlas_pack_charts(tris, 64, 2, NULL, NULL, corner_uv, &ar, &err) == TT_OK &&
                                ar.ncharts >= 1);
                         EXPECT(tt_uv_check(tris, corner_uv, NULL, &ur, &err) == TT_OK && ur.problem == TT_UV_USABLE);
                     }

@@ -1672,19 +1672,19 @@ static void cases_lapped(const baseline *b)
     CASE(tt_atlas_pack_pairs(b->quads, 64, 2, cuv, E));
     CASE(tt_atlas_pack_pairs(&b->empty, 64, 2, cuv, E));
 
-    CASE(tt_atlas_pack_charts(NULL, 64, 2, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 64, 2, AL, NULL, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 0, 2, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, INT_MIN, 2, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, INT_MAX, 2, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 64, -2, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 64, INT_MAX, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 64, INT_MAX / 2 + 1, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 4, 2, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 64, 2, BA1, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(m, 64, 2, BA2, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(b->quads, 64, 2, AL, cuv, &crep, E));
-    CASE(tt_atlas_pack_charts(&b->empty, 64, 2, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(NULL, 64, 2, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 64, 2, NULL, AL, NULL, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 0, 2, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, INT_MIN, 2, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, INT_MAX, 2, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 64, -2, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 64, INT_MAX, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 64, INT_MAX / 2 + 1, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 4, 2, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 64, 2, NULL, BA1, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(m, 64, 2, NULL, BA2, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(b->quads, 64, 2, NULL, AL, cuv, &crep, E));
+    CASE(tt_atlas_pack_charts(&b->empty, 64, 2, NULL, AL, cuv, &crep, E));
 
     CASE(tt_uv_check(NULL, cuv, AL, &urep, E));
     CASE(tt_uv_check(m, NULL, AL, &urep, E));

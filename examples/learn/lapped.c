@@ -82,7 +82,7 @@ int main(int argc, char **argv)
     /* Sec. 4, "rendering with a texture atlas": cut the mesh into charts of
        faces that face about the same way, lay them flat side by side in one
        square, and composite every paste of each face into its place. */
-    if (tt_atlas_pack_charts(mesh, ATLAS_SIZE, ATLAS_GUTTER, NULL, uv, &charts, &error) != TT_OK) goto failed;
+    if (tt_atlas_pack_charts(mesh, ATLAS_SIZE, ATLAS_GUTTER, NULL, NULL, uv, &charts, &error) != TT_OK) goto failed;
     if (tt_image_create(ATLAS_SIZE, ATLAS_SIZE, NULL, &atlas, &error) != TT_OK) goto failed;
     bake.gutter = ATLAS_GUTTER;     /* fill the charts' margins, so filtering at their borders reads them */
     if (tt_lapped_bake(mesh, pastes, &patch, 1, uv, &bake, NULL, atlas, &error) != TT_OK) goto failed;
