@@ -14561,27 +14561,11 @@ static void tt__lapper_free(tt__lapper *L)
     tt__free(L->al, L->local.vert_corner);
 }
 
-/* Check the inputs and prepare the per-face and per-patch data. */
-static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error)
+/* Every texture patch non-empty and finite, before anything is measured on
+   it. */
+static tt_result tt__lapper_check_patches(const tt__lapper *L, tt_error *error)
 {
-    const tt_mesh *mesh = L->mesh;
-    int nf = mesh->nfaces, nv, f, g, i, k;
-    double lo[3], hi[3], diagonal, estimate = 0.0, opaque_fraction = 0.0;
-    float shallowest = 0.0f;
-    int widest = 1;
-    long long total = 0;
-    if (nf < 1 || !mesh->face_start)
-        return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces (%d)", nf);
-    if (mesh->min_face_size != 3 || mesh->max_face_size != 3) {
-        for (f = 0; f < nf && mesh->face_start[f + 1] - mesh->face_start[f] == 3; f++) {}
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
-                        "lapped textures need a triangle mesh: face %d has %d corners (split it into triangles)", f,
-                        mesh->face_start[f + 1] - mesh->face_start[f]);
-    }
-    if (!tt__lapper_reorder(L, mesh, L->field))
-        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
-    mesh = L->mesh;
-    nv = mesh->nverts;
+    int i;
     for (i = 0; i < L->npatches; i++) {
         const tt_image *p = L->patches[i];
         size_t n, j;
@@ -14595,6 +14579,16 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
                                    "texture patch %d has a NaN or infinite value at texel (%d, %d)", i,
                                    (int)(j / 4 % (size_t)p->width), (int)(j / 4 / (size_t)p->width));
     }
+    return TT_OK;
+}
+
+/* The per-patch, per-face and per-vertex arrays of the paste loop, all
+   allocated at once over the reordered copy of the mesh; when one fails,
+   tt__lapper_free frees those that were made. */
+static tt_result tt__lapper_alloc(tt__lapper *L, tt_error *error)
+{
+    const tt_mesh *mesh = L->mesh;
+    int nf = mesh->nfaces, nv = mesh->nverts, f, i;
     L->hull = TT__ALLOC(L->al, float *, L->npatches);
     L->depth = TT__ALLOC(L->al, float *, L->npatches);
     for (i = 0; i < L->npatches; i++) {
@@ -14658,6 +14652,17 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         !L->hidden_below || !L->top_entry || !L->register_texture || !L->register_allowed || !L->register_alpha)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     for (f = 0; f < nf; f++) L->top_entry[f] = -1;
+    return TT_OK;
+}
+
+/* The registration's grid, and per patch its shape (which earlier patch it
+   is interchangeable with), depth, hull and opaque texels. Gives what the
+   face checks measure against: the shallowest patch's deepest texel, the
+   widest patch side and the patches' mean opaque fraction. */
+static tt_result tt__lapper_patch_shapes(tt__lapper *L, float *shallowest, int *widest, double *opaque_fraction,
+                                         tt_error *error)
+{
+    int i;
     for (L->register_grid = 16; L->register_grid < 64; L->register_grid *= 2) {
         for (i = 0; i < L->npatches; i++)
             if (L->patches[i]->width >= 2 * TT__LAPPED_REGISTER_TEXELS * L->register_grid ||
@@ -14684,17 +14689,28 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         if (deepest == 0.0f)
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
                                "texture patch %d has no opaque texel (alpha >= %g)", i, TT_LAPPED_OPAQUE);
-        if (i == 0 || deepest < shallowest) shallowest = deepest;
+        if (i == 0 || deepest < *shallowest) *shallowest = deepest;
         r = tt__patch_hull(p, TT__LAPPED_HULL_VERTICES, L->al, &L->hull[i], &L->hull_count[i]);
         if (r != TT_OK)
             return tt__fail(error, r, -1, -1, -1, -1, "texture patch %d: %s", i, tt_result_string(r));
         tt__hull_grid(L, i);
         for (j = 0; j < n; j++) opaque += p->pixels[4 * j + 3] >= TT_LAPPED_OPAQUE;
-        if (p->width > widest) widest = p->width;
-        if (p->height > widest) widest = p->height;
-        opaque_fraction += (double)opaque / (double)n / L->npatches;
+        if (p->width > *widest) *widest = p->width;
+        if (p->height > *widest) *widest = p->height;
+        *opaque_fraction += (double)opaque / (double)n / L->npatches;
     }
+    return TT_OK;
+}
 
+/* Per face: its normal, the field projected into its plane (the texture's
+   up and scale there), its area and axes; the field checked to be usable.
+   Then the pastes the mesh needs, refused above max_pastes before any work
+   is done. */
+static tt_result tt__lapper_face_frames(tt__lapper *L, double opaque_fraction, int max_pastes, tt_error *error)
+{
+    const tt_mesh *mesh = L->mesh;
+    int nf = mesh->nfaces, nv = mesh->nverts, f, g, i, k;
+    double lo[3], hi[3], diagonal, estimate = 0.0;
     for (k = 0; k < 3; k++) lo[k] = hi[k] = mesh->pos[k];
     for (i = 0; i < nv; i++)
         for (k = 0; k < 3; k++) {
@@ -14749,6 +14765,16 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         return tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                         "the texture patches are too small for this mesh: covering it would take about "
                         "%.3g pastes, more than max_pastes (%d; 0: TT_LAPPED_MAX_PASTES) (use a larger scale)", estimate, max_pastes);
+    return TT_OK;
+}
+
+/* Per face, how finely coverage is sampled: enough samples per side that
+   each reaches a bounded part of a patch; a face too coarse for the patch is
+   refused, as no paste could cover it. */
+static tt_result tt__lapper_sample_resolution(tt__lapper *L, float shallowest, int widest, tt_error *error)
+{
+    const tt_mesh *mesh = L->mesh;
+    int nf = mesh->nfaces, f, g, k;
     for (g = 0; g < nf; g++) {
         const double *t;
         double projected, longest = 0.0;
@@ -14780,6 +14806,16 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
         if (!tt__sample_table(L, L->sample_res[f]))
             return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
     }
+    return TT_OK;
+}
+
+/* The coverage samples of every face, none covered yet, and the paste
+   loop's per-face, per-vertex and per-edge state at its start. */
+static tt_result tt__lapper_coverage_start(tt__lapper *L, tt_error *error)
+{
+    const tt_mesh *mesh = L->mesh;
+    int nf = mesh->nfaces, nv = mesh->nverts, f, i;
+    long long total = 0;
     /* Each face's samples, in the copy's order. */
     for (f = 0; f < nf; f++) {
         L->sample_start[f] = (int)total;
@@ -14809,6 +14845,35 @@ static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error
     for (i = 0; i < mesh->ncorners; i++) L->edge_stamp[i] = -1;
     L->round_stamp = 0;
     return TT_OK;
+}
+
+/* Check the inputs and prepare the per-face and per-patch data: the mesh
+   reordered into a local copy, the patches checked and measured, the faces'
+   frames and sample resolutions, then the coverage samples. */
+static tt_result tt__lapper_setup(tt__lapper *L, int max_pastes, tt_error *error)
+{
+    const tt_mesh *mesh = L->mesh;
+    int nf = mesh->nfaces, f;
+    double opaque_fraction = 0.0;
+    float shallowest = 0.0f;
+    int widest = 1;
+    tt_result r;
+    if (nf < 1 || !mesh->face_start)
+        return tt__fail(error, TT_ERROR_EMPTY_MESH, -1, -1, -1, -1, "the mesh has no faces (%d)", nf);
+    if (mesh->min_face_size != 3 || mesh->max_face_size != 3) {
+        for (f = 0; f < nf && mesh->face_start[f + 1] - mesh->face_start[f] == 3; f++) {}
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                        "lapped textures need a triangle mesh: face %d has %d corners (split it into triangles)", f,
+                        mesh->face_start[f + 1] - mesh->face_start[f]);
+    }
+    if (!tt__lapper_reorder(L, mesh, L->field))
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    if ((r = tt__lapper_check_patches(L, error)) != TT_OK) return r;
+    if ((r = tt__lapper_alloc(L, error)) != TT_OK) return r;
+    if ((r = tt__lapper_patch_shapes(L, &shallowest, &widest, &opaque_fraction, error)) != TT_OK) return r;
+    if ((r = tt__lapper_face_frames(L, opaque_fraction, max_pastes, error)) != TT_OK) return r;
+    if ((r = tt__lapper_sample_resolution(L, shallowest, widest, error)) != TT_OK) return r;
+    return tt__lapper_coverage_start(L, error);
 }
 
 /* The texture patch for a paste seeded on face f: one of those that the
