@@ -16535,32 +16535,10 @@ static int tt__grow_charts(const tt_mesh *mesh, const double *normal, const doub
     return ncharts;
 }
 
-/* Sec. 4 "rendering with a texture atlas", the charts made automatically;
-   see the declaration for the method. The scale is bisected between a size
-   at which every chart is under a millionth of a texel (when even that does
-   not fit, nothing does) and the one at which the charts' boxes alone would
-   fill the atlas. */
-TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_chart_pack_options *options,
-                                     const tt_allocator *allocator, float *corner_uv, tt_chart_atlas_report *report,
-                                     tt_error *error)
+/* The arguments of tt_atlas_pack_charts that need no allocation to check. */
+static tt_result tt__atlas_check_arguments(const tt_mesh *mesh, int size, int gutter, const tt_allocator *allocator,
+                                           const float *corner_uv, tt_error *error)
 {
-    const tt_allocator *al = allocator;
-    double *normal = NULL, *area = NULL, *xy = NULL;
-    int *chart = NULL, *tried = NULL, *members = NULL, *box_x = NULL, *box_y = NULL, *box_turn = NULL;
-    int *try_box = NULL, packed = 0, tries = 0, failed = 0, fitted = 0;
-    tt_chart_pack_options opt;
-    int *need = NULL, *rows_order = NULL, block, side, block_gutter;
-    tt__chart *charts = NULL;
-    tt__chart_order *order = NULL;
-    tt__tri_grid grid;
-    tt__packing pack;
-    double lo[3], hi[3], edges = 0.0, longest = 0.0, surface = 0.0, largest = 0.0;
-    double cell, diagonal, tiny, s_lo, s_hi;
-    int nf, f, k, c, i, ncharts;
-    tt_result result;
-
-    tt__ok(error);
-    if (report) memset(report, 0, sizeof *report);
     if (!mesh || !corner_uv)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_atlas_pack_charts needs a mesh and an output array (got NULL)");
@@ -16575,6 +16553,166 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
                         "a gutter of %d texels needs charts of %.0f texels each way at least: more than the limit "
                         "of %d x %d holds; lower the gutter", gutter, 2.0 * gutter + 1.0, TT_MAX_IMAGE_SIZE,
                         TT_MAX_IMAGE_SIZE);
+    return TT_OK;
+}
+
+/* Each face's normal and area (0 when it has none), and the mesh's surface,
+   bounding-box diagonal and the chart grid's cell: the mean edge, but no
+   face across more than 32 cells (very uneven meshes), so every face meets
+   a bounded number. */
+static void tt__atlas_measure(const tt_mesh *mesh, double *normal, double *area, double *surface, double *diagonal,
+                              double *cell)
+{
+    double lo[3], hi[3], edges = 0.0, longest = 0.0;
+    int nf = mesh->nfaces, f, k;
+    lo[0] = lo[1] = lo[2] = 1e300;
+    hi[0] = hi[1] = hi[2] = -1e300;
+    for (f = 0; f < nf; f++) {
+        if (tt__face_normal_d(mesh, f, normal + 3 * (size_t)f)) area[f] = tt__face_area_d(mesh, f);
+        else area[f] = 0.0;
+        *surface += area[f];
+        for (k = 0; k < 3; k++) {
+            const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + k];
+            const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + (k + 1) % 3];
+            double d[3], length;
+            int j;
+            tt__sub3f(q, p, d);
+            length = tt__length3(d);
+            edges += length;
+            if (length > longest) longest = length;
+            for (j = 0; j < 3; j++) {
+                if (p[j] < lo[j]) lo[j] = p[j];
+                if (p[j] > hi[j]) hi[j] = p[j];
+            }
+        }
+    }
+    *cell = nf > 0 ? edges / (3.0 * nf) : 1.0;
+    if (*cell < longest / 32.0) *cell = longest / 32.0;
+    if (!(*cell > 0.0)) *cell = 1.0;
+    *diagonal = nf > 0 ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                              (hi[2] - lo[2]) * (hi[2] - lo[2]))
+                       : 1.0;
+}
+
+/* The error when even the charts shrunk to nothing do not fit: each is then
+   a square of 2 gutter + 1 texels, and the packing lays equal squares in a
+   grid, which says the smallest size that would work. */
+static tt_result tt__atlas_too_small(int ncharts, int gutter, int size, tt_error *error)
+{
+    double needed = ceil(sqrt((double)ncharts)) * (2.0 * gutter + 1.0);
+    if (needed <= TT_MAX_IMAGE_SIZE)
+        return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                        "%d charts need at least %d x %d texels each for gutter %d: they do not fit %d x %d, "
+                        "the smallest size that works is %.0f (with the charts shrunk to nothing)",
+                        ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, size, size, needed);
+    return tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
+                    "%d charts need at least %d x %d texels each for gutter %d: more than the limit of %d "
+                    "x %d holds; lower the gutter",
+                    ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
+}
+
+/* The largest scale (blocks per mesh unit) found at which the charts fit, in
+   *scale, and their layout at it in box_x, box_y, box_turn. The triangles
+   cannot fill more than the atlas: s_hi never fits, tiny always does. From
+   the guess, steps of TT__PACK_BRACKET up while it fits or down while it
+   does not bracket the scale; then halving, down to 0.5 % of it. The layout
+   of the last packing that fitted is kept. try_box holds 3 nf ints. */
+static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart_order *order, int ncharts,
+                                        const int *members, const double *xy, int block_gutter, int side,
+                                        tt__packing *pack, int *need, int *rows_order, int *try_box, int nf,
+                                        const tt_chart_pack_options *opt, double surface, double tiny, int *box_x,
+                                        int *box_y, int *box_turn, double *scale, tt_error *error)
+{
+    int packed = 0, tries = 0, failed = 0, fitted = 0;
+    double s_lo = tiny, s_hi = surface > 0.0 ? 1.0001 * side / sqrt(surface) : tiny;
+    if (s_hi < s_lo) s_hi = s_lo;
+    {
+        double mid = s_hi * sqrt(opt->fill_guess);
+        while (tries < 100 && s_hi - s_lo > 5e-3 * s_hi) {
+            int fits;
+            if (!(mid > s_lo && mid < s_hi)) mid = 0.5 * (s_lo + s_hi);
+            fits = tt__pack_bitmap(charts, order, ncharts, members, xy, mid, block_gutter, side, pack, need, rows_order,
+                                   try_box, try_box + nf, try_box + 2 * (size_t)nf);
+            tries++;
+            if (fits) {
+                s_lo = mid;
+                fitted = 1;
+                packed = 1;
+                memcpy(box_x, try_box, (size_t)ncharts * sizeof(int));
+                memcpy(box_y, try_box + nf, (size_t)ncharts * sizeof(int));
+                memcpy(box_turn, try_box + 2 * (size_t)nf, (size_t)ncharts * sizeof(int));
+            } else {
+                s_hi = mid;
+                failed = 1;
+            }
+            /* About 6 tries in all; the estimate only grows. */
+            if (opt->progress && opt->progress((float)(1.0 - 1.0 / (1.0 + tries / 3.0)), opt->progress_user_data))
+                return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
+            if (fitted && failed) mid = 0.5 * (s_lo + s_hi);
+            else mid = fitted ? mid * TT__PACK_BRACKET : mid / TT__PACK_BRACKET;
+        }
+    }
+    if (!packed)
+        tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, pack, need, rows_order, box_x,
+                        box_y, box_turn);
+    if (opt->progress && opt->progress(1.0f, opt->progress_user_data))
+        return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
+    *scale = s_lo;
+    return TT_OK;
+}
+
+/* Every corner's UV from its chart's place in the atlas (in blocks of
+   block texels), clamped to [0, 1]. */
+static void tt__atlas_write_uv(const tt_mesh *mesh, const tt__chart *charts, int ncharts, const int *members,
+                               const double *xy, double s, int block, int block_gutter, const int *box_x,
+                               const int *box_y, const int *box_turn, int size, float *corner_uv)
+{
+    int c, i, k;
+    for (c = 0; c < ncharts; c++) {
+        int cols = tt__chart_cells(charts[c].width, s, block_gutter);
+        int rows = tt__chart_cells(charts[c].height, s, block_gutter);
+        for (i = 0; i < charts[c].count; i++) {
+            int face = members[charts[c].first + i];
+            for (k = 0; k < 3; k++) {
+                int corner = mesh->face_start[face] + k;
+                double t[2];
+                tt__chart_texel(xy, face, k, s, block_gutter, box_turn[c], cols, rows, t);
+                corner_uv[2 * (size_t)corner] =
+                    tt__clamp_f((float)((double)block * (box_x[c] + t[0]) / size), 0.0f, 1.0f);
+                corner_uv[2 * (size_t)corner + 1] =
+                    tt__clamp_f((float)((double)block * (box_y[c] + t[1]) / size), 0.0f, 1.0f);
+            }
+        }
+    }
+}
+
+/* Sec. 4 "rendering with a texture atlas", the charts made automatically;
+   see the declaration for the method. The scale is bisected between a size
+   at which every chart is under a millionth of a texel (when even that does
+   not fit, nothing does) and the one at which the charts' boxes alone would
+   fill the atlas. */
+TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_chart_pack_options *options,
+                                     const tt_allocator *allocator, float *corner_uv, tt_chart_atlas_report *report,
+                                     tt_error *error)
+{
+    const tt_allocator *al = allocator;
+    double *normal = NULL, *area = NULL, *xy = NULL;
+    int *chart = NULL, *tried = NULL, *members = NULL, *box_x = NULL, *box_y = NULL, *box_turn = NULL;
+    int *try_box = NULL;
+    tt_chart_pack_options opt;
+    int *need = NULL, *rows_order = NULL, block, side, block_gutter;
+    tt__chart *charts = NULL;
+    tt__chart_order *order = NULL;
+    tt__tri_grid grid;
+    tt__packing pack;
+    double surface = 0.0, largest = 0.0;
+    double cell, diagonal, tiny, s_lo = 0.0;   /* set by tt__atlas_search_scale */
+    int nf, c, ncharts;
+    tt_result result;
+
+    tt__ok(error);
+    if (report) memset(report, 0, sizeof *report);
+    if ((result = tt__atlas_check_arguments(mesh, size, gutter, allocator, corner_uv, error)) != TT_OK) return result;
     if (options) opt = *options;
     else memset(&opt, 0, sizeof opt);
     if (!(opt.fill_guess > 0.0 && opt.fill_guess < 1.0)) opt.fill_guess = TT_ATLAS_FILL_GUESS;
@@ -16611,36 +16749,8 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
         !try_box || !pack.bits || !pack.mask || !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
         goto out_of_memory;
 
-    /* The grid's cells: the mean edge, but no face across more than 32 of
-       them (very uneven meshes), so every face meets a bounded number. */
-    lo[0] = lo[1] = lo[2] = 1e300;
-    hi[0] = hi[1] = hi[2] = -1e300;
-    for (f = 0; f < nf; f++) {
-        if (tt__face_normal_d(mesh, f, normal + 3 * (size_t)f)) area[f] = tt__face_area_d(mesh, f);
-        else area[f] = 0.0;
-        surface += area[f];
-        for (k = 0; k < 3; k++) {
-            const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + k];
-            const float *q = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + (k + 1) % 3];
-            double d[3], length;
-            int j;
-            tt__sub3f(q, p, d);
-            length = tt__length3(d);
-            edges += length;
-            if (length > longest) longest = length;
-            for (j = 0; j < 3; j++) {
-                if (p[j] < lo[j]) lo[j] = p[j];
-                if (p[j] > hi[j]) hi[j] = p[j];
-            }
-        }
-    }
-    cell = nf > 0 ? edges / (3.0 * nf) : 1.0;
-    if (cell < longest / 32.0) cell = longest / 32.0;
-    if (!(cell > 0.0)) cell = 1.0;
+    tt__atlas_measure(mesh, normal, area, &surface, &diagonal, &cell);
     grid.cell = cell;
-    diagonal = nf > 0 ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                             (hi[2] - lo[2]) * (hi[2] - lo[2]))
-                      : 1.0;
     /* Overlaps smaller than this are rounding (neighbours share an edge). */
     ncharts = tt__grow_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), chart, tried,
                               members, charts, xy);
@@ -16659,80 +16769,15 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     tiny = largest > 0.0 ? 1e-6 / largest : 1.0;
     if (!tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, block_gutter, side, &pack, need, rows_order, NULL,
                          NULL, NULL)) {
-        /* Shrunk to nothing, each chart is a square of 2 gutter + 1 texels,
-           and the packing lays equal squares in a grid. */
-        double needed = ceil(sqrt((double)ncharts)) * (2.0 * gutter + 1.0);
-        if (needed <= TT_MAX_IMAGE_SIZE)
-            result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
-                              "%d charts need at least %d x %d texels each for gutter %d: they do not fit %d x %d, "
-                              "the smallest size that works is %.0f (with the charts shrunk to nothing)",
-                              ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, size, size, needed);
-        else
-            result = tt__fail(error, TT_ERROR_IMAGE_TOO_SMALL, -1, -1, -1, -1,
-                              "%d charts need at least %d x %d texels each for gutter %d: more than the limit of %d "
-                              "x %d holds; lower the gutter",
-                              ncharts, 2 * gutter + 1, 2 * gutter + 1, gutter, TT_MAX_IMAGE_SIZE, TT_MAX_IMAGE_SIZE);
+        result = tt__atlas_too_small(ncharts, gutter, size, error);
         goto done;
     }
-    /* The triangles cannot fill more than the atlas: s_hi never fits. From
-       the guess, steps of TT__PACK_BRACKET up while it fits or down while
-       it does not bracket the scale; then halving, down to 0.5 % of it. The
-       layout of the last packing that fitted is kept. */
-    s_lo = tiny;
-    s_hi = surface > 0.0 ? 1.0001 * side / sqrt(surface) : tiny;
-    if (s_hi < s_lo) s_hi = s_lo;
-    {
-        double mid = s_hi * sqrt(opt.fill_guess);
-        while (tries < 100 && s_hi - s_lo > 5e-3 * s_hi) {
-            int fits;
-            if (!(mid > s_lo && mid < s_hi)) mid = 0.5 * (s_lo + s_hi);
-            fits = tt__pack_bitmap(charts, order, ncharts, members, xy, mid, block_gutter, side, &pack, need, rows_order,
-                                   try_box, try_box + nf, try_box + 2 * (size_t)nf);
-            tries++;
-            if (fits) {
-                s_lo = mid;
-                fitted = 1;
-                packed = 1;
-                memcpy(box_x, try_box, (size_t)ncharts * sizeof(int));
-                memcpy(box_y, try_box + nf, (size_t)ncharts * sizeof(int));
-                memcpy(box_turn, try_box + 2 * (size_t)nf, (size_t)ncharts * sizeof(int));
-            } else {
-                s_hi = mid;
-                failed = 1;
-            }
-            /* About 6 tries in all; the estimate only grows. */
-            if (opt.progress && opt.progress((float)(1.0 - 1.0 / (1.0 + tries / 3.0)), opt.progress_user_data)) {
-                result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
-                goto done;
-            }
-            if (fitted && failed) mid = 0.5 * (s_lo + s_hi);
-            else mid = fitted ? mid * TT__PACK_BRACKET : mid / TT__PACK_BRACKET;
-        }
-    }
-    if (!packed)
-        tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, &pack, need, rows_order, box_x,
-                        box_y, box_turn);
-    if (opt.progress && opt.progress(1.0f, opt.progress_user_data)) {
-        result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
-        goto done;
-    }
+    result = tt__atlas_search_scale(charts, order, ncharts, members, xy, block_gutter, side, &pack, need, rows_order,
+                                    try_box, nf, &opt, surface, tiny, box_x, box_y, box_turn, &s_lo, error);
+    if (result != TT_OK) goto done;
 
-    for (c = 0; c < ncharts; c++) {
-        int cols = tt__chart_cells(charts[c].width, s_lo, block_gutter);
-        int rows = tt__chart_cells(charts[c].height, s_lo, block_gutter);
-        for (i = 0; i < charts[c].count; i++) {
-            int face = members[charts[c].first + i];
-            for (k = 0; k < 3; k++) {
-                int corner = mesh->face_start[face] + k;
-                double t[2];
-                tt__chart_texel(xy, face, k, s_lo, block_gutter, box_turn[c], cols, rows, t);
-                corner_uv[2 * (size_t)corner] =
-                    tt__clamp_f((float)((double)block * (box_x[c] + t[0]) / size), 0.0f, 1.0f);
-                corner_uv[2 * (size_t)corner + 1] =
-                    tt__clamp_f((float)((double)block * (box_y[c] + t[1]) / size), 0.0f, 1.0f);
-            }
-        }
-    }
+    tt__atlas_write_uv(mesh, charts, ncharts, members, xy, s_lo, block, block_gutter, box_x, box_y, box_turn, size,
+                       corner_uv);
     if (report) {
         report->ncharts = ncharts;
         report->texels_per_unit = s_lo * block;
