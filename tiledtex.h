@@ -17250,40 +17250,17 @@ static void tt__bake_band(void *context, int task)
     }
 }
 
-/* Sec. 4 "rendering with a texture atlas": "the texture paste operations are
-   composited into the atlas charts". Per face, its entries in paste order
-   (a CSR list built once), composited at every texel of its atlas triangle
-   and, extrapolated, of its gutter; then un-premultiplied, and every texel
-   still empty takes the colour of the nearest written one (breadth-first over
-   4-neighbours from all written texels at once, O(texels)) so that bilinear
-   filtering and mipmaps at chart borders read chart colours (the sampling
-   problems Sec. 4 lists for atlases). Temporary memory comes from the mesh's
-   allocator, all of it before the atlas is touched. */
-TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
-                               int npatches, const float *corner_uv, const tt_bake_options *options,
-                               const tt_allocator *allocator, tt_image *atlas, tt_error *error)
+/* The arguments of tt_lapped_bake after the NULL and allocator checks: the
+   atlas, the gutter, the patches (all normal maps or none; *normal says
+   which), the UVs and the pastes with their cut. *total is the number of
+   face entries of the pastes. */
+static tt_result tt__bake_check_inputs(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
+                                       int npatches, const float *corner_uv, const tt_image *atlas, int gutter,
+                                       int *normal, size_t *total, tt_error *error)
 {
-    const tt_allocator *al = allocator;
-    tt_bake_options opt;
-    int gutter;
     tt_result result;
-    tt__bake bake;
-    tt__bake_job job;
-    int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL, *band_start = NULL, *band_fill = NULL;
-    int *band_faces = NULL;
-    float *state = NULL, *turns = NULL;
-    size_t texels, t, total = 0, head = 0, tail = 0;
-    float empty = tt__infinity();
-    int f, p, e, k, c, width, height, normal, nbands, pass;
-
-    tt__ok(error);
-    if (!mesh || !lapped || !patches || !corner_uv || !atlas)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_lapped_bake needs a mesh, pastes, patches, UVs and an atlas (got NULL)");
-    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (options) opt = *options;
-    else memset(&opt, 0, sizeof opt);
-    gutter = opt.gutter;
+    size_t t;
+    int p, c;
     if (!atlas->pixels || atlas->width <= 0 || atlas->height <= 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the atlas is empty: create it with tt_image_create first");
@@ -17304,18 +17281,18 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
         if (tt__check_image_kind(patches[p], "a patch", error) != TT_OK)
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1,
                                "patch %d has kind %d, which is not a tt_image_kind", p, (int)patches[p]->kind);
-    normal = patches[0]->kind == TT_IMAGE_NORMAL;
+    *normal = patches[0]->kind == TT_IMAGE_NORMAL;
     for (p = 1; p < npatches; p++)
-        if ((patches[p]->kind == TT_IMAGE_NORMAL) != normal)
+        if ((patches[p]->kind == TT_IMAGE_NORMAL) != *normal)
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, p, -1, -1,
                                "patch %d is %sa normal map but patch 0 is %s: bake each map of a material on its "
-                               "own", p, normal ? "not " : "", normal ? "one" : "not");
+                               "own", p, *normal ? "not " : "", *normal ? "one" : "not");
     if ((result = tt__require_triangles(mesh, "baking needs triangles", error)) != TT_OK) return result;
     for (c = 0; c < 2 * mesh->ncorners; c++)
         if (!tt__is_finite(corner_uv[c]))
             return tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[c / 2], c / 2, -1, -1,
                             "corner %d (face %d) has a non-finite atlas UV", c / 2, mesh->corner_face[c / 2]);
-    if ((result = tt__check_lapped(mesh, lapped, npatches, &total, error)) != TT_OK) return result;
+    if ((result = tt__check_lapped(mesh, lapped, npatches, total, error)) != TT_OK) return result;
     if (lapped->cut) {
         if (lapped->cut_columns < 1 || lapped->cut_columns > (1 << 16) || !(lapped->cut_feather > 0.0f) ||
             !tt__is_finite(lapped->cut_feather))
@@ -17327,26 +17304,15 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
                 return tt__fail_at(error, TT_ERROR_NON_FINITE, (int)(t / (2 + (size_t)lapped->cut_columns)), -1, -1,
                                    "the cut of paste %d is not finite", (int)(t / (2 + (size_t)lapped->cut_columns)));
     }
+    return TT_OK;
+}
 
-    width = atlas->width;
-    height = atlas->height;
-    texels = (size_t)width * (size_t)height;   /* <= 2^30 */
-    start = TT__ALLOC(al, int, (size_t)mesh->nfaces + 1);
-    fill = TT__ALLOC(al, int, mesh->nfaces);
-    items = TT__ALLOC(al, int, 2 * total);
-    state = TT__ALLOC(al, float, texels);
-    queue = TT__ALLOC(al, int, texels);
-    if (normal) turns = TT__ALLOC(al, float, 4 * total + 4);
-    nbands = (height + TT__BAKE_BAND_ROWS - 1) / TT__BAKE_BAND_ROWS;
-    band_start = TT__ALLOC(al, int, (size_t)nbands + 1);
-    band_fill = TT__ALLOC(al, int, nbands);
-    if (!start || !fill || !items || !state || !queue || (normal && !turns) || !band_start || !band_fill) {
-        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                          "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
-        goto done;
-    }
-
-    /* Entries by face, in paste order (bucket by face, stable). */
+/* The pastes' entries by face, in paste order (bucket by face, stable):
+   face f's (entry, paste) pairs are items[2 start[f]] up to
+   items[2 start[f + 1]]; fill is scratch, one int per face. */
+static void tt__bake_entries_by_face(const tt_mesh *mesh, const tt_lapped *lapped, int *start, int *fill, int *items)
+{
+    int p, e, f;
     memset(start, 0, ((size_t)mesh->nfaces + 1) * sizeof(int));
     for (p = 0; p < lapped->npastes; p++)
         for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++)
@@ -17361,84 +17327,68 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
             items[2 * slot] = e;
             items[2 * slot + 1] = p;
         }
+}
 
-    for (t = 0; t < texels; t++) state[t] = empty;
-    memset(&job, 0, sizeof job);
-    job.mesh = mesh;
-    job.corner_uv = corner_uv;
-    job.lapped = lapped;
-    job.patches = patches;
-    job.start = start;
-    job.items = items;
-    job.turns = turns;
-    job.state = state;
-    job.atlas = atlas;
-    /* A gutter wider than the image reaches every texel anyway. */
-    job.gutter = gutter < width + height ? (double)gutter : (double)(width + height);
+/* The bands of rows each face reaches (its triangle and its gutter),
+   counted, then listed with the faces in order, into job->band_start and a
+   new job->band_faces (band_fill is scratch, one int per band); and normal
+   maps' turns per item (into job->turns). 0 when out of memory. */
+static int tt__bake_list_bands(tt__bake_job *job, int nbands, int *band_start, int *band_fill,
+                               const tt_allocator *al, int **band_faces)
+{
+    const tt_mesh *mesh = job->mesh;
+    const tt_lapped *lapped = job->lapped;
+    const int height = job->atlas->height;
+    tt__bake bake;
+    int f, k, pass;
     memset(&bake, 0, sizeof bake);
-
-    /* The bands of rows each face reaches (its triangle and its gutter),
-       counted, then listed with the faces in order; and normal maps' turns
-       per item. */
     for (k = 0; k <= nbands; k++) band_start[k] = 0;
     for (pass = 0; pass < 2; pass++) {
         for (f = 0; f < mesh->nfaces; f++) {
             float xy[6];
             double low, high;
             int first, last;
-            if (!tt__bake_face(&bake, &job, f, xy)) continue;
-            if (pass == 0 && normal)
+            if (!tt__bake_face(&bake, job, f, xy)) continue;
+            if (pass == 0 && job->turns)
                 for (k = 0; k < bake.nitems; k++)
                     tt__bake_turn(&bake, lapped->uv + 6 * (size_t)bake.items[2 * k],
-                                  patches[lapped->pastes[bake.items[2 * k + 1]].patch],
-                                  turns + 4 * ((size_t)start[f] + (size_t)k));
+                                  job->patches[lapped->pastes[bake.items[2 * k + 1]].patch],
+                                  job->turns + 4 * ((size_t)job->start[f] + (size_t)k));
             low = high = bake.y[0];
             for (k = 1; k < 3; k++) {
                 if (bake.y[k] < low) low = bake.y[k];
                 if (bake.y[k] > high) high = bake.y[k];
             }
-            low -= job.gutter + 1.0;
-            high += job.gutter + 1.0;
+            low -= job->gutter + 1.0;
+            high += job->gutter + 1.0;
             if (!(high >= 0.0 && low < height)) continue;
             first = low <= 0.0 ? 0 : (int)low / TT__BAKE_BAND_ROWS;
             last = high >= height ? nbands - 1 : (int)high / TT__BAKE_BAND_ROWS;
             for (k = first; k <= last; k++) {
                 if (pass == 0) band_start[k + 1]++;
-                else band_faces[band_fill[k]++] = f;
+                else (*band_faces)[band_fill[k]++] = f;
             }
         }
         if (pass == 1) break;
         for (k = 0; k < nbands; k++) band_start[k + 1] += band_start[k];
-        band_faces = TT__ALLOC(al, int, band_start[nbands] > 0 ? band_start[nbands] : 1);
-        if (!band_faces) {
-            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                              "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
-            goto done;
-        }
+        *band_faces = TT__ALLOC(al, int, band_start[nbands] > 0 ? band_start[nbands] : 1);
+        if (!*band_faces) return 0;
         for (k = 0; k < nbands; k++) band_fill[k] = band_start[k];
     }
-    job.band_start = band_start;
-    job.band_faces = band_faces;
+    job->band_start = band_start;
+    job->band_faces = *band_faces;
+    return 1;
+}
 
-    /* The bands, in batches with the progress between them. */
-    for (job.first_band = 0; job.first_band < nbands; job.first_band += TT__BAKE_BATCH) {
-        if (opt.progress && opt.progress((float)job.first_band / (float)nbands, opt.progress_user_data)) {
-            /* The atlas is half-written: clear it, so no caller mistakes it
-               for a result. */
-            memset(atlas->pixels, 0, texels * 4 * sizeof(float));
-            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at row %d of %d",
-                              job.first_band * TT__BAKE_BAND_ROWS, height);
-            goto done;
-        }
-        tt__run_tasks(opt.executor, tt__min_i(TT__BAKE_BATCH, nbands - job.first_band), tt__bake_band, &job);
-    }
-    if (opt.progress && opt.progress(1.0f, opt.progress_user_data)) {
-        memset(atlas->pixels, 0, texels * 4 * sizeof(float));
-        result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at the end");
-        goto done;
-    }
-
-    /* Straight alpha for the written texels; they seed the fill. */
+/* After the bands: straight alpha for the written texels (state below
+   empty), which seed the fill; every texel still empty then takes the colour
+   of the nearest written one (breadth-first over 4-neighbours from all of
+   them at once, O(texels); queue holds one int per texel). */
+static void tt__bake_finish(tt_image *atlas, float *state, int *queue, float empty, int normal)
+{
+    const int width = atlas->width, height = atlas->height;
+    const size_t texels = (size_t)width * (size_t)height;
+    size_t t, head = 0, tail = 0;
     for (t = 0; t < texels; t++) {
         float *px = atlas->pixels + 4 * t;
         if (!(state[t] < empty)) continue;
@@ -17469,6 +17419,100 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
             queue[tail++] = to;
         }
     }
+}
+
+/* Sec. 4 "rendering with a texture atlas": "the texture paste operations are
+   composited into the atlas charts". Per face, its entries in paste order
+   (a CSR list built once), composited at every texel of its atlas triangle
+   and, extrapolated, of its gutter; then un-premultiplied, and every texel
+   still empty takes the colour of the nearest written one (breadth-first over
+   4-neighbours from all written texels at once, O(texels)) so that bilinear
+   filtering and mipmaps at chart borders read chart colours (the sampling
+   problems Sec. 4 lists for atlases). Temporary memory comes from the mesh's
+   allocator, all of it before the atlas is touched. */
+TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
+                               int npatches, const float *corner_uv, const tt_bake_options *options,
+                               const tt_allocator *allocator, tt_image *atlas, tt_error *error)
+{
+    const tt_allocator *al = allocator;
+    tt_bake_options opt;
+    int gutter;
+    tt_result result;
+    tt__bake_job job;
+    int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL, *band_start = NULL, *band_fill = NULL;
+    int *band_faces = NULL;
+    float *state = NULL, *turns = NULL;
+    size_t texels, t, total = 0;
+    float empty = tt__infinity();
+    int width, height, normal = 0, nbands;
+
+    tt__ok(error);
+    if (!mesh || !lapped || !patches || !corner_uv || !atlas)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_lapped_bake needs a mesh, pastes, patches, UVs and an atlas (got NULL)");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (options) opt = *options;
+    else memset(&opt, 0, sizeof opt);
+    gutter = opt.gutter;
+    result = tt__bake_check_inputs(mesh, lapped, patches, npatches, corner_uv, atlas, gutter, &normal, &total, error);
+    if (result != TT_OK) return result;
+
+    width = atlas->width;
+    height = atlas->height;
+    texels = (size_t)width * (size_t)height;   /* <= 2^30 */
+    start = TT__ALLOC(al, int, (size_t)mesh->nfaces + 1);
+    fill = TT__ALLOC(al, int, mesh->nfaces);
+    items = TT__ALLOC(al, int, 2 * total);
+    state = TT__ALLOC(al, float, texels);
+    queue = TT__ALLOC(al, int, texels);
+    if (normal) turns = TT__ALLOC(al, float, 4 * total + 4);
+    nbands = (height + TT__BAKE_BAND_ROWS - 1) / TT__BAKE_BAND_ROWS;
+    band_start = TT__ALLOC(al, int, (size_t)nbands + 1);
+    band_fill = TT__ALLOC(al, int, nbands);
+    if (!start || !fill || !items || !state || !queue || (normal && !turns) || !band_start || !band_fill) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                          "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
+        goto done;
+    }
+    tt__bake_entries_by_face(mesh, lapped, start, fill, items);
+
+    for (t = 0; t < texels; t++) state[t] = empty;
+    memset(&job, 0, sizeof job);
+    job.mesh = mesh;
+    job.corner_uv = corner_uv;
+    job.lapped = lapped;
+    job.patches = patches;
+    job.start = start;
+    job.items = items;
+    job.turns = turns;
+    job.state = state;
+    job.atlas = atlas;
+    /* A gutter wider than the image reaches every texel anyway. */
+    job.gutter = gutter < width + height ? (double)gutter : (double)(width + height);
+    if (!tt__bake_list_bands(&job, nbands, band_start, band_fill, al, &band_faces)) {
+        result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
+                          "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
+        goto done;
+    }
+
+    /* The bands, in batches with the progress between them. */
+    for (job.first_band = 0; job.first_band < nbands; job.first_band += TT__BAKE_BATCH) {
+        if (opt.progress && opt.progress((float)job.first_band / (float)nbands, opt.progress_user_data)) {
+            /* The atlas is half-written: clear it, so no caller mistakes it
+               for a result. */
+            memset(atlas->pixels, 0, texels * 4 * sizeof(float));
+            result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at row %d of %d",
+                              job.first_band * TT__BAKE_BAND_ROWS, height);
+            goto done;
+        }
+        tt__run_tasks(opt.executor, tt__min_i(TT__BAKE_BATCH, nbands - job.first_band), tt__bake_band, &job);
+    }
+    if (opt.progress && opt.progress(1.0f, opt.progress_user_data)) {
+        memset(atlas->pixels, 0, texels * 4 * sizeof(float));
+        result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "baking was cancelled at the end");
+        goto done;
+    }
+    tt__bake_finish(atlas, state, queue, empty, normal);
     result = tt__ok(error);
 
 done:
