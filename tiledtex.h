@@ -17792,13 +17792,57 @@ static int tt__hier_components(tt__hier *H, int ncomp)
     return 1;
 }
 
+/* What every level's splits read of the mesh: each face's area, the face
+   across each corner's edge and the step between the two faces' centroids
+   (the centroids serve the steps only and are freed here), and each
+   vertex's corners (vstart / vcorner) and whether it lies on the mesh's
+   border. */
+static void tt__hier_geometry(tt__hier *H)
+{
+    const tt_mesh *mesh = H->mesh;
+    int f, c, v;
+    for (f = 0; f < H->nf; f++) {
+        const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f];
+        const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 1];
+        const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 2];
+        double e1[3], e2[3], n[3];
+        int k;
+        for (k = 0; k < 3; k++) H->centroid[3 * (size_t)f + k] = ((double)p0[k] + p1[k] + p2[k]) / 3.0;
+        tt__sub3f(p1, p0, e1);
+        tt__sub3f(p2, p0, e2);
+        tt__cross3(e1, e2, n);
+        H->farea[f] = 0.5 * tt__length3(n);
+    }
+    for (c = 0; c < mesh->ncorners; c++) H->across[c] = mesh->twin[c] < 0 ? -1 : mesh->corner_face[mesh->twin[c]];
+    for (c = 0; c < mesh->ncorners; c++)
+        H->step[c] = mesh->twin[c] < 0 ? 0.0
+                                       : tt__field_step(mesh, H->centroid, mesh->corner_face[c], c,
+                                                        mesh->corner_face[mesh->twin[c]]);
+    /* the centroids served the steps only */
+    tt__free(H->al, H->centroid);
+    H->centroid = NULL;
+    for (v = 0; v <= H->nv; v++) H->vstart[v] = 0;
+    for (v = 0; v < H->nv; v++) H->vboundary[v] = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        H->vstart[mesh->corner_vert[c] + 1]++;
+        if (mesh->twin[c] < 0) {
+            H->vboundary[mesh->corner_vert[c]] = 1;
+            H->vboundary[mesh->corner_vert[tt__next(mesh, c)]] = 1;
+        }
+    }
+    for (v = 0; v < H->nv; v++) H->vstart[v + 1] += H->vstart[v];
+    for (c = 0; c < mesh->ncorners; c++) H->vcorner[H->vstart[mesh->corner_vert[c]]++] = c;
+    for (v = H->nv; v > 0; v--) H->vstart[v] = H->vstart[v - 1];
+    H->vstart[0] = 0;
+}
+
 TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster_options *options,
                                            const tt_allocator *allocator, tt_cluster_hierarchy **out,
                                            tt_error *error)
 {
     tt__hier H;
     tt_cluster_hierarchy *hier;
-    int f, c, v, ncomp = 0, level, branching;
+    int f, c, ncomp = 0, level, branching;
     size_t nf, nc;
 
     if (out) *out = NULL;
@@ -17851,41 +17895,7 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
         !H.scratch)
         goto oom;
     if (tt_mesh_components(mesh, allocator, H.region, &ncomp, NULL) != TT_OK) goto oom;
-
-    for (f = 0; f < H.nf; f++) {
-        const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f];
-        const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 1];
-        const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 2];
-        double e1[3], e2[3], n[3];
-        int k;
-        for (k = 0; k < 3; k++) H.centroid[3 * (size_t)f + k] = ((double)p0[k] + p1[k] + p2[k]) / 3.0;
-        tt__sub3f(p1, p0, e1);
-        tt__sub3f(p2, p0, e2);
-        tt__cross3(e1, e2, n);
-        H.farea[f] = 0.5 * tt__length3(n);
-    }
-    for (c = 0; c < mesh->ncorners; c++) H.across[c] = mesh->twin[c] < 0 ? -1 : mesh->corner_face[mesh->twin[c]];
-    for (c = 0; c < mesh->ncorners; c++)
-        H.step[c] = mesh->twin[c] < 0 ? 0.0
-                                      : tt__field_step(mesh, H.centroid, mesh->corner_face[c], c,
-                                                       mesh->corner_face[mesh->twin[c]]);
-    /* the centroids served the steps only */
-    tt__free(allocator, H.centroid);
-    H.centroid = NULL;
-    for (v = 0; v <= H.nv; v++) H.vstart[v] = 0;
-    for (v = 0; v < H.nv; v++) H.vboundary[v] = 0;
-    for (c = 0; c < mesh->ncorners; c++) {
-        H.vstart[mesh->corner_vert[c] + 1]++;
-        if (mesh->twin[c] < 0) {
-            H.vboundary[mesh->corner_vert[c]] = 1;
-            H.vboundary[mesh->corner_vert[tt__next(mesh, c)]] = 1;
-        }
-    }
-    for (v = 0; v < H.nv; v++) H.vstart[v + 1] += H.vstart[v];
-    for (c = 0; c < mesh->ncorners; c++) H.vcorner[H.vstart[mesh->corner_vert[c]]++] = c;
-    for (v = H.nv; v > 0; v--) H.vstart[v] = H.vstart[v - 1];
-    H.vstart[0] = 0;
-
+    tt__hier_geometry(&H);
     if (!tt__hier_components(&H, ncomp)) goto oom;
     for (level = 0;; level++) {
         int ls, le = H.ncl;
