@@ -19893,6 +19893,88 @@ static tt_result tt__hpm_correlate_transforms(tt__hpm *S, tt_xcorr_match *match,
     return tt__hpm_correlate_best(S, match, best_k, error);
 }
 
+/* The canvas's turn (cos, sin of phi) and the main neighbour's
+   continuation cont (the copy-0 offset that repeats its texels); 0 when
+   C has no textured neighbour (cont stays 0). The canvas is turned so
+   that the texture of the neighbour sharing most vertices keeps its
+   orientation in the turned copy 0: the orientation then propagates from
+   patch to patch (Sec. 2.2) without the drift that a random turn of the
+   frame would add at every fit. With a direction field copy 0 is the
+   field's direction instead, so that the small turns of the fits do not
+   add up over the surface. */
+static int tt__hpm_canvas_turn(tt__hpm *S, int C, double *cph, double *sph, double cont[2])
+{
+    const tt__hpm_owner *best = tt__hpm_best_owner(S);
+    double field_angle, centre[2];
+    *cph = best ? best->cos_a : 1;
+    *sph = best ? -best->sin_a : 0;
+    if (best) {
+        cont[0] = -S->s * (*cph * best->shift[0] - *sph * best->shift[1]);
+        cont[1] = -S->s * (*sph * best->shift[0] + *cph * best->shift[1]);
+    }
+    if (tt__hpm_field_angle(S, C, &field_angle, centre)) {
+        /* The neighbour's continuation, turned a little from copy 0
+           now, is taken as the copy-0 offset that agrees with it at
+           C's centre: the offsets left out stay those that would
+           repeat its texels. */
+        double cf = cos(field_angle), sf = sin(field_angle);
+        if (best) {
+            cont[0] += S->s * ((*cph - cf) * centre[0] - (*sph - sf) * centre[1]);
+            cont[1] += S->s * ((*sph - sf) * centre[0] + (*cph - cf) * centre[1]);
+        }
+        *cph = cf;
+        *sph = sf;
+    }
+    return best != NULL;
+}
+
+/* The placement of the best offset (copy best_k at match's offset on the
+   canvas c = s_w R(phi) q - o), refined at full resolution by a direct
+   sum over +-(f - 1) texels, then by a turn: *pl and its fit error *eps.
+   0 when no refined offset keeps the cluster inside a non-toroidal image. */
+static int tt__hpm_refine_offset(tt__hpm *S, int C, double phi, int best_k, const tt_xcorr_match *match,
+                                 const double o[2], tt__hpm_place *pl, double *eps)
+{
+    double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
+    double th = S->angle[best_k], ct = cos(th), st = sin(th);
+    double tx = match->x - o[0] - cb, ty = match->y - o[1] - cb, best = -1, vb[3], vc[3];
+    double pbox[4];
+    int dx, dy, bdx = 0, bdy = 0, reach = S->f - 1, c, i, P = S->P;
+    pl->cos_a = cos(phi - th);
+    pl->sin_a = sin(phi - th);
+    pl->shift[0] = S->f * (ct * tx + st * ty + ctx);
+    pl->shift[1] = S->f * (-st * tx + ct * ty + cty);
+    tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, pbox);
+    for (dy = -reach; dy <= reach; dy++)
+        for (dx = -reach; dx <= reach; dx++) {
+            double sum = 0;
+            if (!S->toroidal && (pbox[0] + pl->shift[0] + dx < 1 || pbox[1] + pl->shift[1] + dy < 1 ||
+                                 pbox[2] + pl->shift[0] + dx > S->W - 1 ||
+                                 pbox[3] + pl->shift[1] + dy > S->Hh - 1))
+                continue;
+            for (i = 0; i < S->nband; i++) {
+                int at = S->band_pixels[i];
+                double cx = at % P + 0.5 + match->x - cb, cy = at / P + 0.5 + match->y - cb;
+                double xcx = S->f * (ct * cx + st * cy + ctx) + dx, xcy = S->f * (-st * cx + ct * cy + cty) + dy;
+                tt__hpm_sample(S->full, S->W, S->Hh, S->nch, S->src[2 * at], S->src[2 * at + 1], S->toroidal,
+                               vb);
+                tt__hpm_sample(S->full, S->W, S->Hh, S->nch, xcx, xcy, S->toroidal, vc);
+                for (c = 0; c < S->nch; c++) sum += S->mask[at] * (vb[c] - vc[c]) * (vb[c] - vc[c]);
+            }
+            if (best < 0 || sum < best) {
+                best = sum;
+                bdx = dx;
+                bdy = dy;
+            }
+        }
+    if (best < 0) return 0;
+    pl->shift[0] += bdx;
+    pl->shift[1] += bdy;
+    best = tt__hpm_refine_turn(S, C, pl, best, match->x - cb, match->y - cb, ct, st, ctx, cty, bdx, bdy);
+    *eps = best / ((double)S->nch * match->mask_sum) / (2 * S->sigma2);
+    return 1;
+}
+
 /* Steps 2 and 3: the band and the fit. Returns 1 with *pl and *eps when
    a fit was made, 0 when there is no band to fit (continue or start
    instead), -1 when there is no room for C in the image, -2 on
@@ -19913,37 +19995,9 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     w_full = tt__hpm_band_width(S, C);
     w_w = w_full / S->f;
     if (w_w < 1.5) w_w = 1.5;
-    /* The canvas is turned so that the texture of the neighbour sharing
-       most vertices keeps its orientation in the turned copy 0: the
-       orientation then propagates from patch to patch (Sec. 2.2) without
-       the drift that a random turn of the frame would add at every fit.
-       With a direction field copy 0 is the field's direction instead, so
-       that the small turns of the fits do not add up over the surface. */
-    {
-        const tt__hpm_owner *best = tt__hpm_best_owner(S);
-        double field_angle, centre[2];
-        cph = best ? best->cos_a : 1;
-        sph = best ? -best->sin_a : 0;
-        if (best) {
-            cont[0] = -S->s * (cph * best->shift[0] - sph * best->shift[1]);
-            cont[1] = -S->s * (sph * best->shift[0] + cph * best->shift[1]);
-        }
-        has_cont = best != NULL;
-        if (tt__hpm_field_angle(S, C, &field_angle, centre)) {
-            /* The neighbour's continuation, turned a little from copy 0
-               now, is taken as the copy-0 offset that agrees with it at
-               C's centre: the offsets left out stay those that would
-               repeat its texels. */
-            double cf = cos(field_angle), sf = sin(field_angle);
-            if (best) {
-                cont[0] += S->s * ((cph - cf) * centre[0] - (sph - sf) * centre[1]);
-                cont[1] += S->s * ((sph - sf) * centre[0] + (cph - cf) * centre[1]);
-            }
-            cph = cf;
-            sph = sf;
-        }
-        phi = atan2(sph, cph);
-    }
+    /* the canvas turned to the main neighbour's texture or the field */
+    has_cont = tt__hpm_canvas_turn(S, C, &cph, &sph, cont);
+    phi = atan2(sph, cph);
     /* The canvas: c = s_w R(phi) q - o. */
     tt__hpm_bbox(S, C, cph, sph, box);
     for (i = 0; i < 4; i++) box[i] /= S->f;
@@ -20020,46 +20074,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         return -2;
     }
 
-    /* The placement of the best offset, refined at full resolution by a
-       direct sum over +-(f - 1) texels. */
-    {
-        double th = S->angle[best_k], ct = cos(th), st = sin(th);
-        double tx = match.x - o[0] - cb, ty = match.y - o[1] - cb, best = -1, vb[3], vc[3];
-        double pbox[4];
-        int dx, dy, bdx = 0, bdy = 0, reach = S->f - 1, c;
-        pl->cos_a = cos(phi - th);
-        pl->sin_a = sin(phi - th);
-        pl->shift[0] = S->f * (ct * tx + st * ty + ctx);
-        pl->shift[1] = S->f * (-st * tx + ct * ty + cty);
-        tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, pbox);
-        for (dy = -reach; dy <= reach; dy++)
-            for (dx = -reach; dx <= reach; dx++) {
-                double sum = 0;
-                if (!S->toroidal && (pbox[0] + pl->shift[0] + dx < 1 || pbox[1] + pl->shift[1] + dy < 1 ||
-                                     pbox[2] + pl->shift[0] + dx > S->W - 1 ||
-                                     pbox[3] + pl->shift[1] + dy > S->Hh - 1))
-                    continue;
-                for (i = 0; i < S->nband; i++) {
-                    int at = S->band_pixels[i];
-                    double cx = at % P + 0.5 + match.x - cb, cy = at / P + 0.5 + match.y - cb;
-                    double xcx = S->f * (ct * cx + st * cy + ctx) + dx, xcy = S->f * (-st * cx + ct * cy + cty) + dy;
-                    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, S->src[2 * at], S->src[2 * at + 1], S->toroidal,
-                                   vb);
-                    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, xcx, xcy, S->toroidal, vc);
-                    for (c = 0; c < S->nch; c++) sum += S->mask[at] * (vb[c] - vc[c]) * (vb[c] - vc[c]);
-                }
-                if (best < 0 || sum < best) {
-                    best = sum;
-                    bdx = dx;
-                    bdy = dy;
-                }
-            }
-        if (best < 0) return -1;
-        pl->shift[0] += bdx;
-        pl->shift[1] += bdy;
-        best = tt__hpm_refine_turn(S, C, pl, best, match.x - cb, match.y - cb, ct, st, ctx, cty, bdx, bdy);
-        *eps = best / ((double)S->nch * match.mask_sum) / (2 * S->sigma2);
-    }
+    if (!tt__hpm_refine_offset(S, C, phi, best_k, &match, o, pl, eps)) return -1;
     S->rep.fits++;
     S->rep.fits_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
     return 1;
