@@ -21707,6 +21707,161 @@ static void tt__hpm_release(tt__hpm *S)
     tt_cluster_hierarchy_free(S->H);
 }
 
+/* The mesh's size for the default scale: its area, bounding box and
+   longest edge (with its face). Every face must be a triangle. */
+static tt_result tt__hpm_mesh_extent(const tt_mesh *mesh, double *total_area, double lo[3], double hi[3],
+                                     double *longest_edge, int *longest_face, tt_error *error)
+{
+    int i, f;
+    for (f = 0; f < mesh->nfaces; f++) {
+        const int *c = mesh->corner_vert + mesh->face_start[f];
+        double e[3], g[3], cr[3];
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d has %d corners: hierarchical pattern mapping needs triangles", f,
+                            mesh->face_start[f + 1] - mesh->face_start[f]);
+        tt__sub3f(mesh->pos + 3 * c[1], mesh->pos + 3 * c[0], e);
+        tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[0], g);
+        tt__cross3(e, g, cr);
+        *total_area += 0.5 * tt__length3(cr);
+        {
+            double d[3], longest;
+            tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[1], d);
+            longest = fmax(tt__length3(d), fmax(tt__length3(e), tt__length3(g)));
+            if (longest > *longest_edge) {
+                *longest_edge = longest;
+                *longest_face = f;
+            }
+        }
+        for (i = 0; i < 3; i++) {
+            int k;
+            for (k = 0; k < 3; k++) {
+                double v = mesh->pos[3 * c[i] + k];
+                if (v < lo[k]) lo[k] = v;
+                if (v > hi[k]) hi[k] = v;
+            }
+        }
+    }
+    return TT_OK;
+}
+
+/* The turned copies a fit tries: orientation k at 2 pi k / rotations when
+   it turns no more than max_turn from the main neighbour (copy 0),
+   in the order 0, +1, -1, +2, -2, ... so that ties keep the
+   smaller turn. */
+static void tt__hpm_turned_copies(tt__hpm *S, const tt_hpm_options *o)
+{
+    double max_turn = o->max_turn > 0 ? o->max_turn
+                      : o->face_vectors ? TT_DEFAULT_HPM_FIELD_MAX_TURN : TT_DEFAULT_HPM_MAX_TURN;
+    double limit = max_turn * TT__PI / 180 + 1e-9;
+    int step;
+    S->turn_limit = limit;
+    S->refine_turn = TT__PI / S->rotations;
+    if (o->face_vectors && max_turn * TT__PI / 180 < S->refine_turn) S->refine_turn = max_turn * TT__PI / 180;
+    S->copies = 0;
+    S->angle[S->copies++] = 0;
+    for (step = 1; 2 * step <= S->rotations; step++) {
+        double a = TT__TWO_PI * step / S->rotations;
+        if (a > limit) break;
+        S->angle[S->copies++] = a;
+        if (2 * step < S->rotations) S->angle[S->copies++] = -a;
+    }
+}
+
+/* The traversal's state, sized by the mesh and the hierarchy, cleared:
+   no face owned, no cluster queued or textured. What is allocated before
+   a failure is freed by tt__hpm_release. */
+static tt_result tt__hpm_alloc_state(tt__hpm *S, tt_error *error)
+{
+    const tt_mesh *mesh = S->mesh;
+    int i, f;
+    S->flat = TT__ALLOC(S->al, float, 2 * (size_t)mesh->ncorners);
+    S->uv = TT__ALLOC(S->al, double, 2 * (size_t)mesh->ncorners);
+    if (S->flags & TT_HPM_RANDOM_PLACEMENT) S->out = TT__ALLOC(S->al, double, 2 * (size_t)mesh->ncorners);
+    S->owner = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->in_c = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->seen = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->placed = TT__ALLOC(S->al, double, 2 * (size_t)mesh->ncorners);
+    S->vdisp = TT__ALLOC(S->al, double, 5 * (size_t)mesh->nverts);
+    S->vmark = TT__ALLOC(S->al, int, (size_t)mesh->nverts);
+    S->border_choice = TT__ALLOC(S->al, signed char, (size_t)mesh->nfaces);
+    S->state = TT__ALLOC(S->al, unsigned char, (size_t)S->H->nclusters);
+    S->queue = TT__ALLOC(S->al, tt__heap_item *, (size_t)S->H->nlevels);
+    if (S->queue)
+        for (i = 0; i < S->H->nlevels; i++) S->queue[i] = NULL;
+    S->qcount = TT__ALLOC(S->al, int, (size_t)S->H->nlevels);
+    S->qcap = TT__ALLOC(S->al, int, (size_t)S->H->nlevels);
+    S->heap = TT__ALLOC(S->al, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
+    S->near_faces = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->cmark = TT__ALLOC(S->al, unsigned, (size_t)S->H->nclusters);
+    if (S->vmark) {
+        S->ring_room = tt__hpm_ring_room(mesh, S->vmark);
+        S->ring = TT__ALLOC(S->al, int, (size_t)S->ring_room);
+        S->ring_values = TT__ALLOC(S->al, double, 3 * (size_t)S->ring_room);
+    }
+    if (!S->flat || !S->uv || ((S->flags & TT_HPM_RANDOM_PLACEMENT) && !S->out) || !S->owner || !S->in_c ||
+        !S->seen || !S->placed || !S->vdisp || !S->vmark || !S->border_choice || !S->state || !S->queue ||
+        !S->qcount || !S->qcap || !S->heap || !S->near_faces || !S->cmark || !S->ring || !S->ring_values)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
+    memset(S->cmark, 0, sizeof(unsigned) * (size_t)S->H->nclusters);
+    if (S->field) {
+        S->vlocal = TT__ALLOC(S->al, int, (size_t)mesh->nverts);
+        if (!S->vlocal)
+            return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
+        for (i = 0; i < mesh->nverts; i++) S->vlocal[i] = -1;
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        S->owner[f] = -1;
+        S->in_c[f] = S->seen[f] = 0;
+    }
+    for (i = 0; i < mesh->nverts; i++) S->vmark[i] = 0;
+    memset(S->state, 0, (size_t)S->H->nclusters);
+    for (i = 0; i < S->H->nlevels; i++) {
+        S->queue[i] = NULL;
+        S->qcount[i] = S->qcap[i] = 0;
+    }
+    for (i = 0; i < 2 * mesh->ncorners; i++) {
+        S->uv[i] = 0;
+        if (S->out) S->out[i] = 0;
+    }
+    return TT_OK;
+}
+
+/* corner_uv from the texel positions (the random placement's when asked
+   for), as fractions of the image with v up. */
+static tt_result tt__hpm_output_uv(const tt__hpm *S, float *corner_uv, tt_error *error)
+{
+    int i;
+    const double *x = S->out ? S->out : S->uv;
+    /* A tileable image at a scale of almost nothing (1e-40 units
+       across) puts UVs past single precision (found by fuzz_hpm):
+       refused before anything is written. */
+    for (i = 0; i < 2 * S->mesh->ncorners; i++)
+        if (!(fabs(x[i] / (i % 2 ? S->Hh : S->W)) < 1e30))
+            return tt__fail(error, TT_ERROR_NON_FINITE, S->mesh->corner_face[i / 2], i / 2, -1, -1,
+                            "hpm: at %g texels per unit corner %d's texture coordinate (%g image widths) "
+                            "overflows single precision: use a larger scale",
+                            S->s, i / 2, x[i] / (i % 2 ? S->Hh : S->W));
+    for (i = 0; i < S->mesh->ncorners; i++) {
+        corner_uv[2 * i] = (float)(x[2 * i] / S->W);
+        corner_uv[2 * i + 1] = (float)(1 - x[2 * i + 1] / S->Hh);
+    }
+    return TT_OK;
+}
+
+/* The report's totals, once the mesh is textured. */
+static void tt__hpm_finish_report(tt__hpm *S)
+{
+    int accepted = S->rep.accepted_fits + S->rep.floor_fits;
+    S->rep.levels = S->H->nlevels;
+    S->rep.texels_per_unit = S->s;
+    S->rep.match_width = S->ww;
+    S->rep.match_height = S->wh;
+    S->rep.fft_size = S->P;
+    S->rep.copies = S->copies;
+    S->rep.mean_error = accepted > 0 ? S->error_sum / accepted : 0;
+}
+
 TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
                            const tt_allocator *allocator, float *corner_uv, int *face_cluster,
                            tt_hpm_report *report, tt_error *error)
@@ -21748,35 +21903,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
                         "max_flattening_error %g (>= 0)",
                         o.scale, o.threshold, o.rotations, o.max_turn, o.band, match_size, o.min_footprint, o.min_faces,
                         o.flags, o.branching, o.max_flattening_error);
-    for (f = 0; f < mesh->nfaces; f++) {
-        const int *c = mesh->corner_vert + mesh->face_start[f];
-        double e[3], g[3], cr[3];
-        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
-                            "face %d has %d corners: hierarchical pattern mapping needs triangles", f,
-                            mesh->face_start[f + 1] - mesh->face_start[f]);
-        tt__sub3f(mesh->pos + 3 * c[1], mesh->pos + 3 * c[0], e);
-        tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[0], g);
-        tt__cross3(e, g, cr);
-        total_area += 0.5 * tt__length3(cr);
-        {
-            double d[3], longest;
-            tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[1], d);
-            longest = fmax(tt__length3(d), fmax(tt__length3(e), tt__length3(g)));
-            if (longest > longest_edge) {
-                longest_edge = longest;
-                longest_face = f;
-            }
-        }
-        for (i = 0; i < 3; i++) {
-            int k;
-            for (k = 0; k < 3; k++) {
-                double v = mesh->pos[3 * c[i] + k];
-                if (v < lo[k]) lo[k] = v;
-                if (v > hi[k]) hi[k] = v;
-            }
-        }
-    }
+    res = tt__hpm_mesh_extent(mesh, &total_area, lo, hi, &longest_edge, &longest_face, error);
+    if (res != TT_OK) return res;
     if (!(total_area > 0))
         return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, -1, -1, -1, -1,
                         "every face of the mesh has zero area: nothing to texture");
@@ -21796,27 +21924,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.toroidal = (o.flags & TT_HPM_TOROIDAL) != 0;
     S.threshold = o.threshold > 0 ? o.threshold : TT_DEFAULT_HPM_THRESHOLD;
     S.rotations = o.rotations ? o.rotations : TT_DEFAULT_HPM_ROTATIONS;
-    {
-        /* The copies a fit tries: orientation k at 2 pi k / rotations when
-           it turns no more than max_turn from the main neighbour (copy 0),
-           in the order 0, +1, -1, +2, -2, ... so that ties keep the
-           smaller turn. */
-        double max_turn = o.max_turn > 0 ? o.max_turn
-                          : o.face_vectors ? TT_DEFAULT_HPM_FIELD_MAX_TURN : TT_DEFAULT_HPM_MAX_TURN;
-        double limit = max_turn * TT__PI / 180 + 1e-9;
-        int step;
-        S.turn_limit = limit;
-        S.refine_turn = TT__PI / S.rotations;
-        if (o.face_vectors && max_turn * TT__PI / 180 < S.refine_turn) S.refine_turn = max_turn * TT__PI / 180;
-        S.copies = 0;
-        S.angle[S.copies++] = 0;
-        for (step = 1; 2 * step <= S.rotations; step++) {
-            double a = TT__TWO_PI * step / S.rotations;
-            if (a > limit) break;
-            S.angle[S.copies++] = a;
-            if (2 * step < S.rotations) S.angle[S.copies++] = -a;
-        }
-    }
+    tt__hpm_turned_copies(&S, &o);
     S.band = o.band;
     S.floor_px = o.min_footprint > 0 ? o.min_footprint : TT_DEFAULT_HPM_MIN_FOOTPRINT;
     S.min_faces = o.min_faces ? o.min_faces : TT_DEFAULT_HPM_MIN_FACES;
@@ -21867,59 +21975,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     if (res != TT_OK) goto done;
     if (tt__hpm_cancelled(&S, 0.0f, &res, error)) goto done;
 
-    S.flat = TT__ALLOC(allocator, float, 2 * (size_t)mesh->ncorners);
-    S.uv = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
-    if (o.flags & TT_HPM_RANDOM_PLACEMENT) S.out = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
-    S.owner = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.in_c = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.seen = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.placed = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
-    S.vdisp = TT__ALLOC(allocator, double, 5 * (size_t)mesh->nverts);
-    S.vmark = TT__ALLOC(allocator, int, (size_t)mesh->nverts);
-    S.border_choice = TT__ALLOC(allocator, signed char, (size_t)mesh->nfaces);
-    S.state = TT__ALLOC(allocator, unsigned char, (size_t)S.H->nclusters);
-    S.queue = TT__ALLOC(allocator, tt__heap_item *, (size_t)S.H->nlevels);
-    if (S.queue)
-        for (i = 0; i < S.H->nlevels; i++) S.queue[i] = NULL;
-    S.qcount = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
-    S.qcap = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
-    S.heap = TT__ALLOC(allocator, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
-    S.near_faces = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.cmark = TT__ALLOC(allocator, unsigned, (size_t)S.H->nclusters);
-    if (S.vmark) {
-        S.ring_room = tt__hpm_ring_room(mesh, S.vmark);
-        S.ring = TT__ALLOC(allocator, int, (size_t)S.ring_room);
-        S.ring_values = TT__ALLOC(allocator, double, 3 * (size_t)S.ring_room);
-    }
-    if (!S.flat || !S.uv || ((o.flags & TT_HPM_RANDOM_PLACEMENT) && !S.out) || !S.owner || !S.in_c || !S.seen ||
-        !S.placed || !S.vdisp || !S.vmark || !S.border_choice || !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap ||
-        !S.near_faces || !S.cmark || !S.ring || !S.ring_values) {
-        res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
-        goto done;
-    }
-    memset(S.cmark, 0, sizeof(unsigned) * (size_t)S.H->nclusters);
-    if (S.field) {
-        S.vlocal = TT__ALLOC(allocator, int, (size_t)mesh->nverts);
-        if (!S.vlocal) {
-            res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
-            goto done;
-        }
-        for (i = 0; i < mesh->nverts; i++) S.vlocal[i] = -1;
-    }
-    for (f = 0; f < mesh->nfaces; f++) {
-        S.owner[f] = -1;
-        S.in_c[f] = S.seen[f] = 0;
-    }
-    for (i = 0; i < mesh->nverts; i++) S.vmark[i] = 0;
-    memset(S.state, 0, (size_t)S.H->nclusters);
-    for (i = 0; i < S.H->nlevels; i++) {
-        S.queue[i] = NULL;
-        S.qcount[i] = S.qcap[i] = 0;
-    }
-    for (i = 0; i < 2 * mesh->ncorners; i++) {
-        S.uv[i] = 0;
-        if (S.out) S.out[i] = 0;
-    }
+    res = tt__hpm_alloc_state(&S, error);
+    if (res != TT_OK) goto done;
     res = tt__hpm_traverse(&S, error);
     if (res != TT_OK) goto done;
     /* Faces with area, yet no cluster flattened and placed: the float
@@ -21938,36 +21995,11 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     if (!(o.flags & TT_HPM_NO_RELAXATION)) tt__hpm_choose_borders(&S);
     if (tt__hpm_cancelled(&S, 1.0f, &res, error)) goto done;
     tt__hpm_leftovers(&S);
-    {
-        const double *x = S.out ? S.out : S.uv;
-        /* A tileable image at a scale of almost nothing (1e-40 units
-           across) puts UVs past single precision (found by fuzz_hpm):
-           refused before anything is written. */
-        for (i = 0; i < 2 * mesh->ncorners; i++)
-            if (!(fabs(x[i] / (i % 2 ? S.Hh : S.W)) < 1e30)) {
-                res = tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[i / 2], i / 2, -1, -1,
-                               "hpm: at %g texels per unit corner %d's texture coordinate (%g image widths) "
-                               "overflows single precision: use a larger scale",
-                               S.s, i / 2, x[i] / (i % 2 ? S.Hh : S.W));
-                goto done;
-            }
-        for (i = 0; i < mesh->ncorners; i++) {
-            corner_uv[2 * i] = (float)(x[2 * i] / S.W);
-            corner_uv[2 * i + 1] = (float)(1 - x[2 * i + 1] / S.Hh);
-        }
-    }
+    res = tt__hpm_output_uv(&S, corner_uv, error);
+    if (res != TT_OK) goto done;
     if (face_cluster)
         for (f = 0; f < mesh->nfaces; f++) face_cluster[f] = S.owner[f];
-    S.rep.levels = S.H->nlevels;
-    S.rep.texels_per_unit = S.s;
-    S.rep.match_width = S.ww;
-    S.rep.match_height = S.wh;
-    S.rep.fft_size = S.P;
-    S.rep.copies = S.copies;
-    {
-        int accepted = S.rep.accepted_fits + S.rep.floor_fits;
-        S.rep.mean_error = accepted > 0 ? S.error_sum / accepted : 0;
-    }
+    tt__hpm_finish_report(&S);
     if (report) *report = S.rep;
 done:
     tt__hpm_release(&S);
