@@ -18261,13 +18261,57 @@ static int tt__hier_components(tt__hier *H, int ncomp)
     return 1;
 }
 
+/* What every level's splits read of the mesh: each face's area, the face
+   across each corner's edge and the step between the two faces' centroids
+   (the centroids serve the steps only and are freed here), and each
+   vertex's corners (vstart / vcorner) and whether it lies on the mesh's
+   border. */
+static void tt__hier_geometry(tt__hier *H)
+{
+    const tt_mesh *mesh = H->mesh;
+    int f, c, v;
+    for (f = 0; f < H->nf; f++) {
+        const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f];
+        const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 1];
+        const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 2];
+        double e1[3], e2[3], n[3];
+        int k;
+        for (k = 0; k < 3; k++) H->centroid[3 * (size_t)f + k] = ((double)p0[k] + p1[k] + p2[k]) / 3.0;
+        tt__sub3f(p1, p0, e1);
+        tt__sub3f(p2, p0, e2);
+        tt__cross3(e1, e2, n);
+        H->farea[f] = 0.5 * tt__length3(n);
+    }
+    for (c = 0; c < mesh->ncorners; c++) H->across[c] = mesh->twin[c] < 0 ? -1 : mesh->corner_face[mesh->twin[c]];
+    for (c = 0; c < mesh->ncorners; c++)
+        H->step[c] = mesh->twin[c] < 0 ? 0.0
+                                       : tt__field_step(mesh, H->centroid, mesh->corner_face[c], c,
+                                                        mesh->corner_face[mesh->twin[c]]);
+    /* the centroids served the steps only */
+    tt__free(H->al, H->centroid);
+    H->centroid = NULL;
+    for (v = 0; v <= H->nv; v++) H->vstart[v] = 0;
+    for (v = 0; v < H->nv; v++) H->vboundary[v] = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        H->vstart[mesh->corner_vert[c] + 1]++;
+        if (mesh->twin[c] < 0) {
+            H->vboundary[mesh->corner_vert[c]] = 1;
+            H->vboundary[mesh->corner_vert[tt__next(mesh, c)]] = 1;
+        }
+    }
+    for (v = 0; v < H->nv; v++) H->vstart[v + 1] += H->vstart[v];
+    for (c = 0; c < mesh->ncorners; c++) H->vcorner[H->vstart[mesh->corner_vert[c]]++] = c;
+    for (v = H->nv; v > 0; v--) H->vstart[v] = H->vstart[v - 1];
+    H->vstart[0] = 0;
+}
+
 TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster_options *options,
                                            const tt_allocator *allocator, tt_cluster_hierarchy **out,
                                            tt_error *error)
 {
     tt__hier H;
     tt_cluster_hierarchy *hier;
-    int f, c, v, ncomp = 0, level, branching;
+    int f, c, ncomp = 0, level, branching;
     size_t nf, nc;
 
     if (out) *out = NULL;
@@ -18320,41 +18364,7 @@ TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster
         !H.scratch)
         goto oom;
     if (tt_mesh_components(mesh, allocator, H.region, &ncomp, NULL) != TT_OK) goto oom;
-
-    for (f = 0; f < H.nf; f++) {
-        const float *p0 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f];
-        const float *p1 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 1];
-        const float *p2 = mesh->pos + 3 * (size_t)mesh->corner_vert[3 * (size_t)f + 2];
-        double e1[3], e2[3], n[3];
-        int k;
-        for (k = 0; k < 3; k++) H.centroid[3 * (size_t)f + k] = ((double)p0[k] + p1[k] + p2[k]) / 3.0;
-        tt__sub3f(p1, p0, e1);
-        tt__sub3f(p2, p0, e2);
-        tt__cross3(e1, e2, n);
-        H.farea[f] = 0.5 * tt__length3(n);
-    }
-    for (c = 0; c < mesh->ncorners; c++) H.across[c] = mesh->twin[c] < 0 ? -1 : mesh->corner_face[mesh->twin[c]];
-    for (c = 0; c < mesh->ncorners; c++)
-        H.step[c] = mesh->twin[c] < 0 ? 0.0
-                                      : tt__field_step(mesh, H.centroid, mesh->corner_face[c], c,
-                                                       mesh->corner_face[mesh->twin[c]]);
-    /* the centroids served the steps only */
-    tt__free(allocator, H.centroid);
-    H.centroid = NULL;
-    for (v = 0; v <= H.nv; v++) H.vstart[v] = 0;
-    for (v = 0; v < H.nv; v++) H.vboundary[v] = 0;
-    for (c = 0; c < mesh->ncorners; c++) {
-        H.vstart[mesh->corner_vert[c] + 1]++;
-        if (mesh->twin[c] < 0) {
-            H.vboundary[mesh->corner_vert[c]] = 1;
-            H.vboundary[mesh->corner_vert[tt__next(mesh, c)]] = 1;
-        }
-    }
-    for (v = 0; v < H.nv; v++) H.vstart[v + 1] += H.vstart[v];
-    for (c = 0; c < mesh->ncorners; c++) H.vcorner[H.vstart[mesh->corner_vert[c]]++] = c;
-    for (v = H.nv; v > 0; v--) H.vstart[v] = H.vstart[v - 1];
-    H.vstart[0] = 0;
-
+    tt__hier_geometry(&H);
     if (!tt__hier_components(&H, ncomp)) goto oom;
     for (level = 0;; level++) {
         int ls, le = H.ncl;
@@ -18548,6 +18558,503 @@ static void tt__flat_point(const tt_mesh *mesh, int v, double *out)
     out[2] = mesh->pos[3 * v + 2];
 }
 
+/* One cluster's flattening (tt_flatten_cluster) as it goes: the cluster's
+   local vertices and border loop, the control polygon's plane, the
+   harmonic map's system, and the report filled as far as the work got. */
+typedef struct tt__flat {
+    const tt_mesh *mesh;
+    const tt_allocator *al;
+    int cluster;
+    const int *faces, *ctl;     /* the cluster's n faces (ascending) and k control vertices */
+    int n, k;
+    int nv, nb, nunk, nt;       /* local vertices, border vertices, unknowns, triplets */
+    int first_flip;             /* the first flipped face, or -1 */
+    int *lv, *cv, *next, *loop, *at, *unk;
+    double *uv, *w, *q, *arc, *rhs, *x, *bxy;
+    tt__weighted *keys;
+    tt_triplet *trip;
+    tt_sparse_matrix *A;
+    double area_vec[3], centre[3], e1[3], e2[3];   /* the control polygon's plane */
+    double surface, mapped;     /* the cluster's area and its mapped signed area */
+    tt_flatten_report rep;
+} tt__flat;
+
+/* Every working array at once, each O(n) for n faces: the memory of one
+   cluster, never of the whole mesh. 0 when one is missing. */
+static int tt__flat_alloc(tt__flat *F)
+{
+    const tt_allocator *allocator = F->al;
+    const int n = F->n, k = F->k;
+    F->lv = TT__ALLOC(allocator, int, 6 * (size_t)n);
+    F->cv = TT__ALLOC(allocator, int, 3 * (size_t)n);
+    F->next = TT__ALLOC(allocator, int, 3 * (size_t)n);
+    F->loop = TT__ALLOC(allocator, int, 3 * (size_t)n + 1);
+    F->at = TT__ALLOC(allocator, int, 3 * (size_t)n);
+    F->unk = TT__ALLOC(allocator, int, 3 * (size_t)n);
+    F->uv = TT__ALLOC(allocator, double, 6 * (size_t)n);
+    F->w = TT__ALLOC(allocator, double, 3 * (size_t)n);
+    F->q = TT__ALLOC(allocator, double, 2 * (size_t)k);
+    F->arc = TT__ALLOC(allocator, double, 3 * (size_t)n + 1);
+    F->rhs = TT__ALLOC(allocator, double, 6 * (size_t)n);
+    F->x = TT__ALLOC(allocator, double, 6 * (size_t)n);
+    F->bxy = TT__ALLOC(allocator, double, 6 * (size_t)n);
+    F->keys = TT__ALLOC(allocator, tt__weighted, (size_t)n);
+    F->trip = TT__ALLOC(allocator, tt_triplet, 12 * (size_t)n);
+    return F->lv && F->cv && F->next && F->loop && F->at && F->unk && F->uv && F->w && F->q && F->arc && F->rhs &&
+           F->x && F->bxy && F->keys && F->trip;
+}
+
+static void tt__flat_free(tt__flat *F)
+{
+    const tt_allocator *allocator = F->al;
+    tt_sparse_matrix_free(F->A);
+    tt__free(allocator, F->lv);
+    tt__free(allocator, F->cv);
+    tt__free(allocator, F->next);
+    tt__free(allocator, F->loop);
+    tt__free(allocator, F->at);
+    tt__free(allocator, F->unk);
+    tt__free(allocator, F->uv);
+    tt__free(allocator, F->w);
+    tt__free(allocator, F->q);
+    tt__free(allocator, F->arc);
+    tt__free(allocator, F->rhs);
+    tt__free(allocator, F->x);
+    tt__free(allocator, F->bxy);
+    tt__free(allocator, F->keys);
+    tt__free(allocator, F->trip);
+}
+
+/* The local vertices (the cluster's mesh vertices, ascending, so a corner
+   finds its own by binary search), then the border: half-edges whose twin
+   lies outside the cluster chain into one loop, which must pass the
+   control vertices in order. 0 when it does not (a hierarchy not made by
+   tt_cluster_hierarchy_build). */
+static int tt__flat_border_loop(tt__flat *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    const int *faces = F->faces, *ctl = F->ctl;
+    const int n = F->n, k = F->k;
+    int *lv = F->lv, *cv = F->cv, *next = F->next, *loop = F->loop, *at = F->at;
+    int i, j, p, nv = 0, nb = 0;
+
+    /* Local vertices: the cluster's mesh vertices, ascending. */
+    for (i = 0; i < n; i++)
+        for (j = 0; j < 3; j++) lv[3 * i + j] = mesh->corner_vert[mesh->face_start[faces[i]] + j];
+    qsort(lv, 3 * (size_t)n, sizeof(int), tt__int_compare);
+    for (i = 0; i < 3 * n; i++)
+        if (i == 0 || lv[i] != lv[nv - 1]) lv[nv++] = lv[i];
+    F->nv = nv;
+    for (i = 0; i < 3 * n; i++) cv[i] = tt__find_sorted(lv, nv, mesh->corner_vert[mesh->face_start[faces[i / 3]] + i % 3]);
+    for (i = 0; i < nv; i++) next[i] = at[i] = -1;
+
+    /* Border half-edges (twin outside the cluster) chain into the loop. */
+    for (i = 0; i < 3 * n; i++) {
+        int c = mesh->face_start[faces[i / 3]] + i % 3, t = mesh->twin[c];
+        if (t >= 0 && tt__find_sorted(faces, n, mesh->corner_face[t]) >= 0) continue;
+        if (next[cv[i]] >= 0) return 0;
+        next[cv[i]] = cv[3 * (i / 3) + (i % 3 + 1) % 3];
+        nb++;
+    }
+    F->nb = nb;
+    p = tt__find_sorted(lv, nv, ctl[0]);
+    if (p < 0 || next[p] < 0) return 0;
+    for (i = 0; i < nb; i++) {
+        if (at[p] >= 0) return 0;
+        at[p] = i;
+        loop[i] = p;
+        p = next[p];
+        if (p < 0) return 0;
+    }
+    if (p != loop[0]) return 0;
+    loop[nb] = loop[0];
+    for (j = 0; j < k; j++) {
+        int lj = tt__find_sorted(lv, nv, ctl[j]);
+        if (lj < 0 || at[lj] < 0 || (j > 0 && at[lj] <= at[tt__find_sorted(lv, nv, ctl[j - 1])])) return 0;
+    }
+    return 1;
+}
+
+/* The cluster's surface area and area vector (which side the plane's
+   normal faces), and the border's 3D arc lengths (the chord border's
+   parameter). */
+static void tt__flat_surface(tt__flat *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    const int *lv = F->lv, *cv = F->cv, *loop = F->loop;
+    int i, j;
+    for (i = 0; i < F->n; i++) {
+        double a[3], b[3], c3[3], e[3], f[3], cr[3];
+        tt__flat_point(mesh, lv[cv[3 * i]], a);
+        tt__flat_point(mesh, lv[cv[3 * i + 1]], b);
+        tt__flat_point(mesh, lv[cv[3 * i + 2]], c3);
+        for (j = 0; j < 3; j++) {
+            e[j] = b[j] - a[j];
+            f[j] = c3[j] - a[j];
+        }
+        tt__cross3(e, f, cr);
+        F->surface += 0.5 * tt__length3(cr);
+        for (j = 0; j < 3; j++) F->area_vec[j] += 0.5 * cr[j];
+    }
+    F->arc[0] = 0;
+    for (i = 0; i < F->nb; i++) {
+        double a[3], b[3], d[3];
+        tt__flat_point(mesh, lv[loop[i]], a);
+        tt__flat_point(mesh, lv[loop[i + 1]], b);
+        for (j = 0; j < 3; j++) d[j] = b[j] - a[j];
+        F->arc[i + 1] = F->arc[i] + tt__length3(d);
+    }
+    F->rep.surface_area = F->surface;
+    F->rep.nborder = F->nb;
+    F->rep.ninterior = F->nv - F->nb;
+}
+
+/* The control polygon (step 1 of the declaration's list): the control
+   vertices on their PCA plane, its normal on the side of the area vector,
+   then edge-length passes towards the 3D chords. 0 when the polygon is not
+   simple and counter-clockwise (the cluster is not flat). */
+static int tt__flat_control_polygon(tt__flat *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    const int *ctl = F->ctl;
+    const int k = F->k;
+    double *q = F->q, *centre = F->centre, *e1 = F->e1, *e2 = F->e2;
+    double cov[3][3], nrm[3];
+    int i, j, p;
+    for (j = 0; j < k; j++) {
+        double P[3];
+        tt__flat_point(mesh, ctl[j], P);
+        for (i = 0; i < 3; i++) centre[i] += P[i] / k;
+    }
+    memset(cov, 0, sizeof cov);
+    for (j = 0; j < k; j++) {
+        double P[3];
+        int r, s;
+        tt__flat_point(mesh, ctl[j], P);
+        for (i = 0; i < 3; i++) P[i] -= centre[i];
+        for (r = 0; r < 3; r++)
+            for (s = 0; s < 3; s++) cov[r][s] += P[r] * P[s];
+    }
+    tt__sym3_min_vector(cov, nrm);
+    if (tt__dot3(nrm, F->area_vec) < 0)
+        for (i = 0; i < 3; i++) nrm[i] = -nrm[i];
+    {
+        int axis = 0;
+        for (i = 1; i < 3; i++)
+            if (fabs(nrm[i]) < fabs(nrm[axis])) axis = i;
+        for (i = 0; i < 3; i++) e1[i] = (i == axis) - nrm[axis] * nrm[i];
+        tt__normalize3(e1);
+        tt__cross3(nrm, e1, e2);
+    }
+    for (j = 0; j < k; j++) {
+        double P[3];
+        tt__flat_point(mesh, ctl[j], P);
+        for (i = 0; i < 3; i++) P[i] -= centre[i];
+        q[2 * j] = tt__dot3(P, e1);
+        q[2 * j + 1] = tt__dot3(P, e2);
+    }
+    for (p = 0; p < TT_FLATTEN_POLYGON_PASSES; p++)
+        for (j = 0; j < k; j++) {
+            int j2 = (j + 1) % k;
+            double P[3], R[3], d[3], L3, L2, dx = q[2 * j2] - q[2 * j], dy = q[2 * j2 + 1] - q[2 * j + 1], corr;
+            tt__flat_point(mesh, ctl[j], P);
+            tt__flat_point(mesh, ctl[j2], R);
+            for (i = 0; i < 3; i++) d[i] = R[i] - P[i];
+            L3 = tt__length3(d);
+            L2 = sqrt(dx * dx + dy * dy);
+            if (!(L2 > 0)) continue;
+            corr = (L2 - L3) / (2 * L2);
+            q[2 * j] += corr * dx;
+            q[2 * j + 1] += corr * dy;
+            q[2 * j2] -= corr * dx;
+            q[2 * j2 + 1] -= corr * dy;
+        }
+    return tt__polygon_simple_ccw(q, k);
+}
+
+/* The border (step 2 of the declaration's list, options->border): the
+   border vertices between two control vertices placed along the polygon's
+   edge between them, projected and carried by a similarity, or by arc
+   length. 0 when the projected border is not a simple counter-clockwise
+   loop. */
+static int tt__flat_place_border(tt__flat *F, int border_mode)
+{
+    const tt_mesh *mesh = F->mesh;
+    const int *lv = F->lv, *ctl = F->ctl, *loop = F->loop, *at = F->at;
+    const int k = F->k, nv = F->nv, nb = F->nb;
+    const double *q = F->q, *arc = F->arc, *centre = F->centre, *e1 = F->e1, *e2 = F->e2;
+    double *uv = F->uv, *bxy = F->bxy;
+    int i, j, p;
+    for (j = 0; j < k; j++) {
+        int pa = at[tt__find_sorted(lv, nv, ctl[j])];
+        int pb = j + 1 < k ? at[tt__find_sorted(lv, nv, ctl[j + 1])] : nb;
+        int j2 = (j + 1) % k;
+        double qax = q[2 * j], qay = q[2 * j + 1], qbx = q[2 * j2], qby = q[2 * j2 + 1];
+        double pax, pay, pbx, pby, den, P[3];
+        tt__flat_point(mesh, lv[loop[pa]], P);
+        for (i = 0; i < 3; i++) P[i] -= centre[i];
+        pax = tt__dot3(P, e1);
+        pay = tt__dot3(P, e2);
+        tt__flat_point(mesh, lv[loop[pb]], P);
+        for (i = 0; i < 3; i++) P[i] -= centre[i];
+        pbx = tt__dot3(P, e1);
+        pby = tt__dot3(P, e2);
+        den = (pbx - pax) * (pbx - pax) + (pby - pay) * (pby - pay);
+        for (p = pa; p < pb; p++) {
+            double *o = uv + 2 * loop[p];
+            if (p == pa) {
+                o[0] = qax;
+                o[1] = qay;
+            } else if (border_mode == TT_FLATTEN_BORDER_PROJECTED && den > 0) {
+                /* z = (proj - pa) * (qb - qa) / (pb - pa) + qa, complex */
+                double zx, zy, sx = qbx - qax, sy = qby - qay, tx = pbx - pax, ty = pby - pay, rx, ry;
+                tt__flat_point(mesh, lv[loop[p]], P);
+                for (i = 0; i < 3; i++) P[i] -= centre[i];
+                zx = tt__dot3(P, e1) - pax;
+                zy = tt__dot3(P, e2) - pay;
+                rx = (sx * tx + sy * ty) / den;     /* (qb - qa) / (pb - pa) */
+                ry = (sy * tx - sx * ty) / den;
+                o[0] = qax + zx * rx - zy * ry;
+                o[1] = qay + zx * ry + zy * rx;
+            } else {
+                double t = arc[pb] > arc[pa] ? (arc[p] - arc[pa]) / (arc[pb] - arc[pa]) : 0;
+                o[0] = qax + t * (qbx - qax);
+                o[1] = qay + t * (qby - qay);
+            }
+        }
+    }
+    if (border_mode == TT_FLATTEN_BORDER_PROJECTED) {
+        for (p = 0; p < nb; p++) {
+            bxy[2 * p] = uv[2 * loop[p]];
+            bxy[2 * p + 1] = uv[2 * loop[p] + 1];
+        }
+        if (!tt__polygon_simple_ccw(bxy, nb)) return 0;
+    }
+    return 1;
+}
+
+/* The cotangent weights, half-edge by half-edge (w), and the mean |weight|
+   per edge, an edge inside the cluster counting its two halves together:
+   the floor that keeps the harmonic system positive definite. */
+static double tt__flat_cotangents(tt__flat *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    const int *faces = F->faces, *lv = F->lv, *cv = F->cv;
+    const int n = F->n;
+    double *w = F->w, total_w = 0;
+    int i, j, nedges = 0;
+    for (i = 0; i < n; i++)
+        for (j = 0; j < 3; j++) {
+            double a[3], b[3], o[3], u[3], v[3], cr[3], len;
+            int l;
+            tt__flat_point(mesh, lv[cv[3 * i + j]], a);
+            tt__flat_point(mesh, lv[cv[3 * i + (j + 1) % 3]], b);
+            tt__flat_point(mesh, lv[cv[3 * i + (j + 2) % 3]], o);
+            for (l = 0; l < 3; l++) {
+                u[l] = a[l] - o[l];
+                v[l] = b[l] - o[l];
+            }
+            tt__cross3(u, v, cr);
+            len = tt__length3(cr);
+            w[3 * i + j] = len > 0 ? 0.5 * tt__dot3(u, v) / len : 0;
+        }
+    for (i = 0; i < 3 * n; i++) {
+        int c = mesh->face_start[faces[i / 3]] + i % 3, t = mesh->twin[c], tf;
+        double W = w[i];
+        if (t >= 0 && (tf = tt__find_sorted(faces, n, mesh->corner_face[t])) >= 0) {
+            if (t < c) continue;
+            W += w[3 * tf + (t - mesh->face_start[mesh->corner_face[t]])];
+        }
+        total_w += fabs(W);
+        nedges++;
+    }
+    return nedges > 0 ? total_w / nedges : 0;
+}
+
+/* The interior (step 3 of the declaration's list): the harmonic map with
+   the border fixed, each weight at least 1e-3 of the mean, solved for u
+   and v by CG from the border's centroid. */
+static tt_result tt__flat_harmonic(tt__flat *F, double mean_w, double tol, int maxit, tt_error *error)
+{
+    const tt_mesh *mesh = F->mesh;
+    const int *faces = F->faces, *cv = F->cv, *loop = F->loop, *next = F->next;
+    const int n = F->n, nv = F->nv, nb = F->nb;
+    const double *w = F->w;
+    int *unk = F->unk;
+    double *uv = F->uv, *rhs = F->rhs, *x = F->x;
+    tt_triplet *trip = F->trip;
+    tt_result res = TT_OK;
+    int i, p, nunk = 0, nt = 0;
+    /* Every weight 0: faces of no area (a permissive mesh's), whose
+       harmonic map is no system at all (found by fuzz_hpm). */
+    if (!(mean_w > 0))
+        return tt__fail_at(error, TT_ERROR_NOT_FLAT, F->cluster, -1, -1,
+                           "cluster %d: its %d faces have no area, so it has no harmonic map", F->cluster, n);
+    for (i = 0; i < nv; i++) unk[i] = next[i] < 0 ? nunk++ : -1;
+    for (i = 0; i < 2 * nunk; i++) rhs[i] = 0;
+    for (i = 0; i < 3 * n; i++) {
+        int c = mesh->face_start[faces[i / 3]] + i % 3, t = mesh->twin[c], tf, a = cv[i], b, side;
+        double W = w[i];
+        b = cv[3 * (i / 3) + (i % 3 + 1) % 3];
+        if (t >= 0 && (tf = tt__find_sorted(faces, n, mesh->corner_face[t])) >= 0) {
+            if (t < c) continue;
+            W += w[3 * tf + (t - mesh->face_start[mesh->corner_face[t]])];
+        }
+        if (W < 1e-3 * mean_w) W = 1e-3 * mean_w;
+        for (side = 0; side < 2; side++) {
+            int s = side ? b : a, o = side ? a : b;
+            if (unk[s] < 0) continue;
+            trip[nt].row = trip[nt].col = unk[s];
+            trip[nt++].value = W;
+            if (unk[o] >= 0) {
+                trip[nt].row = unk[s];
+                trip[nt].col = unk[o];
+                trip[nt++].value = -W;
+            } else {
+                rhs[unk[s]] += W * uv[2 * o];
+                rhs[nunk + unk[s]] += W * uv[2 * o + 1];
+            }
+        }
+    }
+    F->nunk = nunk;
+    F->nt = nt;
+    if (nunk > 0) {
+        tt_cg_options co;
+        tt_cg_report cr;
+        double mx = 0, my = 0;
+        int d;
+        for (p = 0; p < nb; p++) {
+            mx += uv[2 * loop[p]] / nb;
+            my += uv[2 * loop[p] + 1] / nb;
+        }
+        res = tt_sparse_from_triplets(nunk, nunk, trip, nt, F->al, &F->A, error);
+        if (res != TT_OK) return res;
+        memset(&co, 0, sizeof co);
+        co.tolerance = tol;
+        co.max_iterations = maxit;
+        for (d = 0; d < 2; d++) {
+            double *xd = x + d * nunk;
+            for (i = 0; i < nunk; i++) xd[i] = d ? my : mx;
+            res = tt_cg_solve(F->A, rhs + d * nunk, &co, F->al, xd, &cr, error);
+            F->rep.cg_iterations += cr.iterations;
+            if (res != TT_OK) return res;
+        }
+        for (i = 0; i < nv; i++)
+            if (unk[i] >= 0) {
+                uv[2 * i] = x[unk[i]];
+                uv[2 * i + 1] = x[nunk + unk[i]];
+            }
+    }
+    return res;
+}
+
+/* The measures (step 4 of the declaration's list): flipped triangles, the
+   per-triangle stretch sigma1 / sigma2 of the Jacobian and its
+   area-weighted 95th percentile, r and E_flat. */
+static void tt__flat_measures(tt__flat *F)
+{
+    const tt_mesh *mesh = F->mesh;
+    const int *faces = F->faces, *lv = F->lv, *cv = F->cv;
+    const int n = F->n;
+    const double *uv = F->uv;
+    tt__weighted *keys = F->keys;
+    tt_flatten_report *rep = &F->rep;
+    double p95 = 0.95;
+    int i, j;
+    rep->mapped = 1;
+    for (i = 0; i < n; i++) {
+        double P0[3], P1[3], P2[3], e[3], f[3], cr[3], xa[3], l1, fx, fy, area3;
+        const double *u0 = uv + 2 * cv[3 * i], *u1 = uv + 2 * cv[3 * i + 1], *u2 = uv + 2 * cv[3 * i + 2];
+        double a2 = 0.5 * tt__orient2(u0[0], u0[1], u1[0], u1[1], u2[0], u2[1]);
+        double J00, J01, J10, J11, E, Fs, G, H, Q, R, s1, s2;
+        F->mapped += a2;
+        if (!(a2 > 0)) {
+            rep->flipped++;
+            if (F->first_flip < 0) F->first_flip = faces[i];
+        }
+        tt__flat_point(mesh, lv[cv[3 * i]], P0);
+        tt__flat_point(mesh, lv[cv[3 * i + 1]], P1);
+        tt__flat_point(mesh, lv[cv[3 * i + 2]], P2);
+        for (j = 0; j < 3; j++) {
+            e[j] = P1[j] - P0[j];
+            f[j] = P2[j] - P0[j];
+        }
+        tt__cross3(e, f, cr);
+        area3 = 0.5 * tt__length3(cr);
+        l1 = tt__length3(e);
+        for (j = 0; j < 3; j++) xa[j] = e[j] / l1;
+        fx = tt__dot3(f, xa);
+        fy = 2 * area3 / l1;
+        /* J = U P^-1, P = [[l1, fx], [0, fy]] */
+        J00 = (u1[0] - u0[0]) / l1;
+        J10 = (u1[1] - u0[1]) / l1;
+        J01 = ((u2[0] - u0[0]) - J00 * fx) / fy;
+        J11 = ((u2[1] - u0[1]) - J10 * fx) / fy;
+        E = 0.5 * (J00 + J11);
+        Fs = 0.5 * (J00 - J11);
+        G = 0.5 * (J10 + J01);
+        H = 0.5 * (J10 - J01);
+        Q = sqrt(E * E + H * H);
+        R = sqrt(Fs * Fs + G * G);
+        s1 = Q + R;
+        s2 = fabs(Q - R);
+        keys[i].value = s2 > 1e-300 ? s1 / s2 : (double)tt__infinity();
+        keys[i].weight = area3;
+        if (keys[i].value > rep->max_stretch) rep->max_stretch = keys[i].value;
+    }
+    tt__weighted_percentiles(keys, n, &p95, 1, &rep->stretch_p95);
+    rep->mapped_area = F->mapped;
+    rep->r = F->mapped > 0 ? F->surface / F->mapped : (double)tt__infinity();
+    rep->flattening_error = fabs(rep->r - 1);
+}
+
+/* Accepted (no flipped triangle, E_flat and the stretch within their
+   limits, every (u, v) a float can hold): the cluster's corners get their
+   (u, v); refused, corner_uv stays untouched. */
+static tt_result tt__flat_accept(tt__flat *F, double max_error, double max_stretch, float *corner_uv,
+                                 tt_error *error)
+{
+    const tt_mesh *mesh = F->mesh;
+    const tt_flatten_report *rep = &F->rep;
+    const int *faces = F->faces, *cv = F->cv;
+    const int n = F->n, cluster = F->cluster;
+    const double *uv = F->uv;
+    int i;
+    if (rep->flipped > 0) {
+        tt_result res = tt__fail(error, TT_ERROR_NOT_FLAT, F->first_flip, -1, -1, -1,
+                                 "cluster %d folds: %d of its %d triangles flip, face %d first", cluster,
+                                 rep->flipped, n, F->first_flip);
+        if (error) error->item = cluster;
+        return res;
+    }
+    if (rep->flattening_error > max_error)
+        return tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
+                           "cluster %d has flattening error %.4g, above the allowed %.4g: split it", cluster,
+                           rep->flattening_error, max_error);
+    if (max_stretch > 0 && rep->stretch_p95 > max_stretch)
+        return tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
+                           "cluster %d has a 95th percentile stretch of %.4g, above the allowed %.4g: split it",
+                           cluster, rep->stretch_p95, max_stretch);
+    /* Coordinates near FLT_MAX flatten to values a float cannot hold (a
+       (u, v) of -inf once came out with TT_OK, found by fuzz_hpm): refuse
+       before writing, so corner_uv stays untouched on the error. */
+    for (i = 0; i < 3 * n; i++)
+        if (!(fabs(uv[2 * cv[i]]) <= FLT_MAX && fabs(uv[2 * cv[i] + 1]) <= FLT_MAX)) {
+            tt_result res = tt__fail(error, TT_ERROR_NON_FINITE, faces[i / 3], -1, -1, -1,
+                                     "cluster %d: face %d flattens to a (u, v) beyond single precision "
+                                     "(coordinates too large)",
+                                     cluster, faces[i / 3]);
+            if (error) error->item = cluster;
+            return res;
+        }
+    for (i = 0; i < 3 * n; i++) {
+        int c = mesh->face_start[faces[i / 3]] + i % 3;
+        corner_uv[2 * c] = (float)uv[2 * cv[i]];
+        corner_uv[2 * c + 1] = (float)uv[2 * cv[i] + 1];
+    }
+    return TT_OK;
+}
+
 TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarchy *hierarchy, int cluster,
                                    const tt_flatten_options *options, const tt_allocator *allocator,
                                    float *corner_uv, tt_flatten_report *report, tt_error *error)
@@ -18556,20 +19063,12 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
     const int *faces, *ctl;
     double max_error = TT_DEFAULT_FLATTEN_MAX_ERROR, max_stretch = 0, tol = TT_DEFAULT_FLATTEN_CG_TOLERANCE;
     int border_mode = TT_FLATTEN_BORDER_PROJECTED, maxit = 0;
-    int n, k, nv = 0, nb = 0, nunk = 0, nt = 0, i, j, p, first_flip = -1;
-    int *lv = NULL, *cv = NULL, *next = NULL, *loop = NULL, *at = NULL, *unk = NULL;
-    double *uv = NULL, *w = NULL, *q = NULL, *arc = NULL, *rhs = NULL, *x = NULL, *bxy = NULL;
-    tt__weighted *keys = NULL;
-    tt_triplet *trip = NULL;
-    tt_sparse_matrix *A = NULL;
-    tt_flatten_report rep;
+    int n, k, i;
+    tt__flat F;
     tt_result res = TT_OK;
-    double area_vec[3] = {0, 0, 0}, centre[3] = {0, 0, 0}, cov[3][3], nrm[3], e1[3], e2[3];
-    double surface = 0, mapped = 0, mean_w = 0, total_w = 0, p95 = 0.95;
-    int nedges = 0;
 
-    memset(&rep, 0, sizeof rep);
-    if (report) *report = rep;
+    memset(&F, 0, sizeof F);
+    if (report) *report = F.rep;
     tt__ok(error);
     if (!mesh || !hierarchy || !corner_uv)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -18618,364 +19117,36 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
                                "cluster %d lists face %d, which is out of range, out of order or not a triangle",
                                cluster, faces[i]);
 
-    lv = TT__ALLOC(allocator, int, 6 * (size_t)n);
-    cv = TT__ALLOC(allocator, int, 3 * (size_t)n);
-    next = TT__ALLOC(allocator, int, 3 * (size_t)n);
-    loop = TT__ALLOC(allocator, int, 3 * (size_t)n + 1);
-    at = TT__ALLOC(allocator, int, 3 * (size_t)n);
-    unk = TT__ALLOC(allocator, int, 3 * (size_t)n);
-    uv = TT__ALLOC(allocator, double, 6 * (size_t)n);
-    w = TT__ALLOC(allocator, double, 3 * (size_t)n);
-    q = TT__ALLOC(allocator, double, 2 * (size_t)k);
-    arc = TT__ALLOC(allocator, double, 3 * (size_t)n + 1);
-    rhs = TT__ALLOC(allocator, double, 6 * (size_t)n);
-    x = TT__ALLOC(allocator, double, 6 * (size_t)n);
-    bxy = TT__ALLOC(allocator, double, 6 * (size_t)n);
-    keys = TT__ALLOC(allocator, tt__weighted, (size_t)n);
-    trip = TT__ALLOC(allocator, tt_triplet, 12 * (size_t)n);
-    if (!lv || !cv || !next || !loop || !at || !unk || !uv || !w || !q || !arc || !rhs || !x || !bxy || !keys ||
-        !trip)
-        goto oom;
-
-    /* Local vertices: the cluster's mesh vertices, ascending. */
-    for (i = 0; i < n; i++)
-        for (j = 0; j < 3; j++) lv[3 * i + j] = mesh->corner_vert[mesh->face_start[faces[i]] + j];
-    qsort(lv, 3 * (size_t)n, sizeof(int), tt__int_compare);
-    for (i = 0; i < 3 * n; i++)
-        if (i == 0 || lv[i] != lv[nv - 1]) lv[nv++] = lv[i];
-    for (i = 0; i < 3 * n; i++) cv[i] = tt__find_sorted(lv, nv, mesh->corner_vert[mesh->face_start[faces[i / 3]] + i % 3]);
-    for (i = 0; i < nv; i++) next[i] = at[i] = -1;
-
-    /* Border half-edges (twin outside the cluster) chain into the loop. */
-    for (i = 0; i < 3 * n; i++) {
-        int c = mesh->face_start[faces[i / 3]] + i % 3, t = mesh->twin[c];
-        if (t >= 0 && tt__find_sorted(faces, n, mesh->corner_face[t]) >= 0) continue;
-        if (next[cv[i]] >= 0) goto bad_border;
-        next[cv[i]] = cv[3 * (i / 3) + (i % 3 + 1) % 3];
-        nb++;
-    }
-    p = tt__find_sorted(lv, nv, ctl[0]);
-    if (p < 0 || next[p] < 0) goto bad_border;
-    for (i = 0; i < nb; i++) {
-        if (at[p] >= 0) goto bad_border;
-        at[p] = i;
-        loop[i] = p;
-        p = next[p];
-        if (p < 0) goto bad_border;
-    }
-    if (p != loop[0]) goto bad_border;
-    loop[nb] = loop[0];
-    for (j = 0; j < k; j++) {
-        int lj = tt__find_sorted(lv, nv, ctl[j]);
-        if (lj < 0 || at[lj] < 0 || (j > 0 && at[lj] <= at[tt__find_sorted(lv, nv, ctl[j - 1])])) goto bad_border;
-    }
-
-    /* Surface area, area vector, arc lengths. */
-    for (i = 0; i < n; i++) {
-        double a[3], b[3], c3[3], e[3], f[3], cr[3];
-        tt__flat_point(mesh, lv[cv[3 * i]], a);
-        tt__flat_point(mesh, lv[cv[3 * i + 1]], b);
-        tt__flat_point(mesh, lv[cv[3 * i + 2]], c3);
-        for (j = 0; j < 3; j++) {
-            e[j] = b[j] - a[j];
-            f[j] = c3[j] - a[j];
-        }
-        tt__cross3(e, f, cr);
-        surface += 0.5 * tt__length3(cr);
-        for (j = 0; j < 3; j++) area_vec[j] += 0.5 * cr[j];
-    }
-    arc[0] = 0;
-    for (i = 0; i < nb; i++) {
-        double a[3], b[3], d[3];
-        tt__flat_point(mesh, lv[loop[i]], a);
-        tt__flat_point(mesh, lv[loop[i + 1]], b);
-        for (j = 0; j < 3; j++) d[j] = b[j] - a[j];
-        arc[i + 1] = arc[i] + tt__length3(d);
-    }
-    rep.surface_area = surface;
-    rep.nborder = nb;
-    rep.ninterior = nv - nb;
-
-    /* The control polygon: PCA plane, oriented by the area vector. */
-    for (j = 0; j < k; j++) {
-        double P[3];
-        tt__flat_point(mesh, ctl[j], P);
-        for (i = 0; i < 3; i++) centre[i] += P[i] / k;
-    }
-    memset(cov, 0, sizeof cov);
-    for (j = 0; j < k; j++) {
-        double P[3];
-        int r, s;
-        tt__flat_point(mesh, ctl[j], P);
-        for (i = 0; i < 3; i++) P[i] -= centre[i];
-        for (r = 0; r < 3; r++)
-            for (s = 0; s < 3; s++) cov[r][s] += P[r] * P[s];
-    }
-    tt__sym3_min_vector(cov, nrm);
-    if (tt__dot3(nrm, area_vec) < 0)
-        for (i = 0; i < 3; i++) nrm[i] = -nrm[i];
-    {
-        int axis = 0;
-        for (i = 1; i < 3; i++)
-            if (fabs(nrm[i]) < fabs(nrm[axis])) axis = i;
-        for (i = 0; i < 3; i++) e1[i] = (i == axis) - nrm[axis] * nrm[i];
-        tt__normalize3(e1);
-        tt__cross3(nrm, e1, e2);
-    }
-    for (j = 0; j < k; j++) {
-        double P[3];
-        tt__flat_point(mesh, ctl[j], P);
-        for (i = 0; i < 3; i++) P[i] -= centre[i];
-        q[2 * j] = tt__dot3(P, e1);
-        q[2 * j + 1] = tt__dot3(P, e2);
-    }
-    for (p = 0; p < TT_FLATTEN_POLYGON_PASSES; p++)
-        for (j = 0; j < k; j++) {
-            int j2 = (j + 1) % k;
-            double P[3], R[3], d[3], L3, L2, dx = q[2 * j2] - q[2 * j], dy = q[2 * j2 + 1] - q[2 * j + 1], corr;
-            tt__flat_point(mesh, ctl[j], P);
-            tt__flat_point(mesh, ctl[j2], R);
-            for (i = 0; i < 3; i++) d[i] = R[i] - P[i];
-            L3 = tt__length3(d);
-            L2 = sqrt(dx * dx + dy * dy);
-            if (!(L2 > 0)) continue;
-            corr = (L2 - L3) / (2 * L2);
-            q[2 * j] += corr * dx;
-            q[2 * j + 1] += corr * dy;
-            q[2 * j2] -= corr * dx;
-            q[2 * j2 + 1] -= corr * dy;
-        }
-    if (!tt__polygon_simple_ccw(q, k)) {
+    F.mesh = mesh;
+    F.al = allocator;
+    F.cluster = cluster;
+    F.faces = faces;
+    F.ctl = ctl;
+    F.n = n;
+    F.k = k;
+    F.first_flip = -1;
+    if (!tt__flat_alloc(&F)) goto oom;
+    if (!tt__flat_border_loop(&F)) goto bad_border;
+    tt__flat_surface(&F);
+    if (!tt__flat_control_polygon(&F)) {
         res = tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
                           "cluster %d: its control polygon (%d vertices) flattens to a polygon that is not simple "
                           "and counter-clockwise",
                           cluster, k);
         goto done;
     }
-
-    /* The border (options->border). */
-    for (j = 0; j < k; j++) {
-        int pa = at[tt__find_sorted(lv, nv, ctl[j])];
-        int pb = j + 1 < k ? at[tt__find_sorted(lv, nv, ctl[j + 1])] : nb;
-        int j2 = (j + 1) % k;
-        double qax = q[2 * j], qay = q[2 * j + 1], qbx = q[2 * j2], qby = q[2 * j2 + 1];
-        double pax, pay, pbx, pby, den, P[3];
-        tt__flat_point(mesh, lv[loop[pa]], P);
-        for (i = 0; i < 3; i++) P[i] -= centre[i];
-        pax = tt__dot3(P, e1);
-        pay = tt__dot3(P, e2);
-        tt__flat_point(mesh, lv[loop[pb]], P);
-        for (i = 0; i < 3; i++) P[i] -= centre[i];
-        pbx = tt__dot3(P, e1);
-        pby = tt__dot3(P, e2);
-        den = (pbx - pax) * (pbx - pax) + (pby - pay) * (pby - pay);
-        for (p = pa; p < pb; p++) {
-            double *o = uv + 2 * loop[p];
-            if (p == pa) {
-                o[0] = qax;
-                o[1] = qay;
-            } else if (border_mode == TT_FLATTEN_BORDER_PROJECTED && den > 0) {
-                /* z = (proj - pa) * (qb - qa) / (pb - pa) + qa, complex */
-                double zx, zy, sx = qbx - qax, sy = qby - qay, tx = pbx - pax, ty = pby - pay, rx, ry;
-                tt__flat_point(mesh, lv[loop[p]], P);
-                for (i = 0; i < 3; i++) P[i] -= centre[i];
-                zx = tt__dot3(P, e1) - pax;
-                zy = tt__dot3(P, e2) - pay;
-                rx = (sx * tx + sy * ty) / den;     /* (qb - qa) / (pb - pa) */
-                ry = (sy * tx - sx * ty) / den;
-                o[0] = qax + zx * rx - zy * ry;
-                o[1] = qay + zx * ry + zy * rx;
-            } else {
-                double t = arc[pb] > arc[pa] ? (arc[p] - arc[pa]) / (arc[pb] - arc[pa]) : 0;
-                o[0] = qax + t * (qbx - qax);
-                o[1] = qay + t * (qby - qay);
-            }
-        }
-    }
-    if (border_mode == TT_FLATTEN_BORDER_PROJECTED) {
-        for (p = 0; p < nb; p++) {
-            bxy[2 * p] = uv[2 * loop[p]];
-            bxy[2 * p + 1] = uv[2 * loop[p] + 1];
-        }
-        if (!tt__polygon_simple_ccw(bxy, nb)) {
-            res = tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
-                              "cluster %d: its border (%d vertices) projects to a loop that is not simple and "
-                              "counter-clockwise",
-                              cluster, nb);
-            goto done;
-        }
-    }
-    rep.polygon_simple = 1;
-
-    /* Cotangent weights, half-edge by half-edge, then per edge. */
-    for (i = 0; i < n; i++)
-        for (j = 0; j < 3; j++) {
-            double a[3], b[3], o[3], u[3], v[3], cr[3], len;
-            int l;
-            tt__flat_point(mesh, lv[cv[3 * i + j]], a);
-            tt__flat_point(mesh, lv[cv[3 * i + (j + 1) % 3]], b);
-            tt__flat_point(mesh, lv[cv[3 * i + (j + 2) % 3]], o);
-            for (l = 0; l < 3; l++) {
-                u[l] = a[l] - o[l];
-                v[l] = b[l] - o[l];
-            }
-            tt__cross3(u, v, cr);
-            len = tt__length3(cr);
-            w[3 * i + j] = len > 0 ? 0.5 * tt__dot3(u, v) / len : 0;
-        }
-    for (i = 0; i < 3 * n; i++) {
-        int c = mesh->face_start[faces[i / 3]] + i % 3, t = mesh->twin[c], tf;
-        double W = w[i];
-        if (t >= 0 && (tf = tt__find_sorted(faces, n, mesh->corner_face[t])) >= 0) {
-            if (t < c) continue;
-            W += w[3 * tf + (t - mesh->face_start[mesh->corner_face[t]])];
-        }
-        total_w += fabs(W);
-        nedges++;
-    }
-    mean_w = nedges > 0 ? total_w / nedges : 0;
-    /* Every weight 0: faces of no area (a permissive mesh's), whose
-       harmonic map is no system at all (found by fuzz_hpm). */
-    if (!(mean_w > 0)) {
+    if (!tt__flat_place_border(&F, border_mode)) {
         res = tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
-                          "cluster %d: its %d faces have no area, so it has no harmonic map", cluster, n);
+                          "cluster %d: its border (%d vertices) projects to a loop that is not simple and "
+                          "counter-clockwise",
+                          cluster, F.nb);
         goto done;
     }
-    for (i = 0; i < nv; i++) unk[i] = next[i] < 0 ? nunk++ : -1;
-    for (i = 0; i < 2 * nunk; i++) rhs[i] = 0;
-    for (i = 0; i < 3 * n; i++) {
-        int c = mesh->face_start[faces[i / 3]] + i % 3, t = mesh->twin[c], tf, a = cv[i], b, side;
-        double W = w[i];
-        b = cv[3 * (i / 3) + (i % 3 + 1) % 3];
-        if (t >= 0 && (tf = tt__find_sorted(faces, n, mesh->corner_face[t])) >= 0) {
-            if (t < c) continue;
-            W += w[3 * tf + (t - mesh->face_start[mesh->corner_face[t]])];
-        }
-        if (W < 1e-3 * mean_w) W = 1e-3 * mean_w;
-        for (side = 0; side < 2; side++) {
-            int s = side ? b : a, o = side ? a : b;
-            if (unk[s] < 0) continue;
-            trip[nt].row = trip[nt].col = unk[s];
-            trip[nt++].value = W;
-            if (unk[o] >= 0) {
-                trip[nt].row = unk[s];
-                trip[nt].col = unk[o];
-                trip[nt++].value = -W;
-            } else {
-                rhs[unk[s]] += W * uv[2 * o];
-                rhs[nunk + unk[s]] += W * uv[2 * o + 1];
-            }
-        }
-    }
-    if (nunk > 0) {
-        tt_cg_options co;
-        tt_cg_report cr;
-        double mx = 0, my = 0;
-        int d;
-        for (p = 0; p < nb; p++) {
-            mx += uv[2 * loop[p]] / nb;
-            my += uv[2 * loop[p] + 1] / nb;
-        }
-        res = tt_sparse_from_triplets(nunk, nunk, trip, nt, allocator, &A, error);
-        if (res != TT_OK) goto done;
-        memset(&co, 0, sizeof co);
-        co.tolerance = tol;
-        co.max_iterations = maxit;
-        for (d = 0; d < 2; d++) {
-            double *xd = x + d * nunk;
-            for (i = 0; i < nunk; i++) xd[i] = d ? my : mx;
-            res = tt_cg_solve(A, rhs + d * nunk, &co, allocator, xd, &cr, error);
-            rep.cg_iterations += cr.iterations;
-            if (res != TT_OK) goto done;
-        }
-        for (i = 0; i < nv; i++)
-            if (unk[i] >= 0) {
-                uv[2 * i] = x[unk[i]];
-                uv[2 * i + 1] = x[nunk + unk[i]];
-            }
-    }
-
-    /* Measures. */
-    rep.mapped = 1;
-    for (i = 0; i < n; i++) {
-        double P0[3], P1[3], P2[3], e[3], f[3], cr[3], xa[3], l1, fx, fy, area3;
-        const double *u0 = uv + 2 * cv[3 * i], *u1 = uv + 2 * cv[3 * i + 1], *u2 = uv + 2 * cv[3 * i + 2];
-        double a2 = 0.5 * tt__orient2(u0[0], u0[1], u1[0], u1[1], u2[0], u2[1]);
-        double J00, J01, J10, J11, E, F, G, H, Q, R, s1, s2;
-        mapped += a2;
-        if (!(a2 > 0)) {
-            rep.flipped++;
-            if (first_flip < 0) first_flip = faces[i];
-        }
-        tt__flat_point(mesh, lv[cv[3 * i]], P0);
-        tt__flat_point(mesh, lv[cv[3 * i + 1]], P1);
-        tt__flat_point(mesh, lv[cv[3 * i + 2]], P2);
-        for (j = 0; j < 3; j++) {
-            e[j] = P1[j] - P0[j];
-            f[j] = P2[j] - P0[j];
-        }
-        tt__cross3(e, f, cr);
-        area3 = 0.5 * tt__length3(cr);
-        l1 = tt__length3(e);
-        for (j = 0; j < 3; j++) xa[j] = e[j] / l1;
-        fx = tt__dot3(f, xa);
-        fy = 2 * area3 / l1;
-        /* J = U P^-1, P = [[l1, fx], [0, fy]] */
-        J00 = (u1[0] - u0[0]) / l1;
-        J10 = (u1[1] - u0[1]) / l1;
-        J01 = ((u2[0] - u0[0]) - J00 * fx) / fy;
-        J11 = ((u2[1] - u0[1]) - J10 * fx) / fy;
-        E = 0.5 * (J00 + J11);
-        F = 0.5 * (J00 - J11);
-        G = 0.5 * (J10 + J01);
-        H = 0.5 * (J10 - J01);
-        Q = sqrt(E * E + H * H);
-        R = sqrt(F * F + G * G);
-        s1 = Q + R;
-        s2 = fabs(Q - R);
-        keys[i].value = s2 > 1e-300 ? s1 / s2 : (double)tt__infinity();
-        keys[i].weight = area3;
-        if (keys[i].value > rep.max_stretch) rep.max_stretch = keys[i].value;
-    }
-    tt__weighted_percentiles(keys, n, &p95, 1, &rep.stretch_p95);
-    rep.mapped_area = mapped;
-    rep.r = mapped > 0 ? surface / mapped : (double)tt__infinity();
-    rep.flattening_error = fabs(rep.r - 1);
-    if (rep.flipped > 0) {
-        res = tt__fail(error, TT_ERROR_NOT_FLAT, first_flip, -1, -1, -1,
-                       "cluster %d folds: %d of its %d triangles flip, face %d first", cluster, rep.flipped, n,
-                       first_flip);
-        if (error) error->item = cluster;
-        goto done;
-    }
-    if (rep.flattening_error > max_error) {
-        res = tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
-                          "cluster %d has flattening error %.4g, above the allowed %.4g: split it", cluster,
-                          rep.flattening_error, max_error);
-        goto done;
-    }
-    if (max_stretch > 0 && rep.stretch_p95 > max_stretch) {
-        res = tt__fail_at(error, TT_ERROR_NOT_FLAT, cluster, -1, -1,
-                          "cluster %d has a 95th percentile stretch of %.4g, above the allowed %.4g: split it",
-                          cluster, rep.stretch_p95, max_stretch);
-        goto done;
-    }
-    /* Coordinates near FLT_MAX flatten to values a float cannot hold (a
-       (u, v) of -inf once came out with TT_OK, found by fuzz_hpm): refuse
-       before writing, so corner_uv stays untouched on the error. */
-    for (i = 0; i < 3 * n; i++)
-        if (!(fabs(uv[2 * cv[i]]) <= FLT_MAX && fabs(uv[2 * cv[i] + 1]) <= FLT_MAX)) {
-            res = tt__fail(error, TT_ERROR_NON_FINITE, faces[i / 3], -1, -1, -1,
-                           "cluster %d: face %d flattens to a (u, v) beyond single precision (coordinates too large)",
-                           cluster, faces[i / 3]);
-            if (error) error->item = cluster;
-            goto done;
-        }
-    for (i = 0; i < 3 * n; i++) {
-        int c = mesh->face_start[faces[i / 3]] + i % 3;
-        corner_uv[2 * c] = (float)uv[2 * cv[i]];
-        corner_uv[2 * c + 1] = (float)uv[2 * cv[i] + 1];
-    }
+    F.rep.polygon_simple = 1;
+    res = tt__flat_harmonic(&F, tt__flat_cotangents(&F), tol, maxit, error);
+    if (res != TT_OK) goto done;
+    tt__flat_measures(&F);
+    res = tt__flat_accept(&F, max_error, max_stretch, corner_uv, error);
     goto done;
 
 bad_border:
@@ -18988,23 +19159,8 @@ oom:
     res = tt__fail_at(error, TT_ERROR_OUT_OF_MEMORY, cluster, -1, -1, "out of memory flattening cluster %d",
                       cluster);
 done:
-    if (report) *report = rep;
-    tt_sparse_matrix_free(A);
-    tt__free(allocator, lv);
-    tt__free(allocator, cv);
-    tt__free(allocator, next);
-    tt__free(allocator, loop);
-    tt__free(allocator, at);
-    tt__free(allocator, unk);
-    tt__free(allocator, uv);
-    tt__free(allocator, w);
-    tt__free(allocator, q);
-    tt__free(allocator, arc);
-    tt__free(allocator, rhs);
-    tt__free(allocator, x);
-    tt__free(allocator, bxy);
-    tt__free(allocator, keys);
-    tt__free(allocator, trip);
+    if (report) *report = F.rep;
+    tt__flat_free(&F);
     return res;
 }
 
@@ -20206,6 +20362,88 @@ static tt_result tt__hpm_correlate_transforms(tt__hpm *S, tt_xcorr_match *match,
     return tt__hpm_correlate_best(S, match, best_k, error);
 }
 
+/* The canvas's turn (cos, sin of phi) and the main neighbour's
+   continuation cont (the copy-0 offset that repeats its texels); 0 when
+   C has no textured neighbour (cont stays 0). The canvas is turned so
+   that the texture of the neighbour sharing most vertices keeps its
+   orientation in the turned copy 0: the orientation then propagates from
+   patch to patch (Sec. 2.2) without the drift that a random turn of the
+   frame would add at every fit. With a direction field copy 0 is the
+   field's direction instead, so that the small turns of the fits do not
+   add up over the surface. */
+static int tt__hpm_canvas_turn(tt__hpm *S, int C, double *cph, double *sph, double cont[2])
+{
+    const tt__hpm_owner *best = tt__hpm_best_owner(S);
+    double field_angle, centre[2];
+    *cph = best ? best->cos_a : 1;
+    *sph = best ? -best->sin_a : 0;
+    if (best) {
+        cont[0] = -S->s * (*cph * best->shift[0] - *sph * best->shift[1]);
+        cont[1] = -S->s * (*sph * best->shift[0] + *cph * best->shift[1]);
+    }
+    if (tt__hpm_field_angle(S, C, &field_angle, centre)) {
+        /* The neighbour's continuation, turned a little from copy 0
+           now, is taken as the copy-0 offset that agrees with it at
+           C's centre: the offsets left out stay those that would
+           repeat its texels. */
+        double cf = cos(field_angle), sf = sin(field_angle);
+        if (best) {
+            cont[0] += S->s * ((*cph - cf) * centre[0] - (*sph - sf) * centre[1]);
+            cont[1] += S->s * ((*sph - sf) * centre[0] + (*cph - cf) * centre[1]);
+        }
+        *cph = cf;
+        *sph = sf;
+    }
+    return best != NULL;
+}
+
+/* The placement of the best offset (copy best_k at match's offset on the
+   canvas c = s_w R(phi) q - o), refined at full resolution by a direct
+   sum over +-(f - 1) texels, then by a turn: *pl and its fit error *eps.
+   0 when no refined offset keeps the cluster inside a non-toroidal image. */
+static int tt__hpm_refine_offset(tt__hpm *S, int C, double phi, int best_k, const tt_xcorr_match *match,
+                                 const double o[2], tt__hpm_place *pl, double *eps)
+{
+    double cb = 0.5 * S->P, ctx = 0.5 * S->ww, cty = 0.5 * S->wh;
+    double th = S->angle[best_k], ct = cos(th), st = sin(th);
+    double tx = match->x - o[0] - cb, ty = match->y - o[1] - cb, best = -1, vb[3], vc[3];
+    double pbox[4];
+    int dx, dy, bdx = 0, bdy = 0, reach = S->f - 1, c, i, P = S->P;
+    pl->cos_a = cos(phi - th);
+    pl->sin_a = sin(phi - th);
+    pl->shift[0] = S->f * (ct * tx + st * ty + ctx);
+    pl->shift[1] = S->f * (-st * tx + ct * ty + cty);
+    tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, pbox);
+    for (dy = -reach; dy <= reach; dy++)
+        for (dx = -reach; dx <= reach; dx++) {
+            double sum = 0;
+            if (!S->toroidal && (pbox[0] + pl->shift[0] + dx < 1 || pbox[1] + pl->shift[1] + dy < 1 ||
+                                 pbox[2] + pl->shift[0] + dx > S->W - 1 ||
+                                 pbox[3] + pl->shift[1] + dy > S->Hh - 1))
+                continue;
+            for (i = 0; i < S->nband; i++) {
+                int at = S->band_pixels[i];
+                double cx = at % P + 0.5 + match->x - cb, cy = at / P + 0.5 + match->y - cb;
+                double xcx = S->f * (ct * cx + st * cy + ctx) + dx, xcy = S->f * (-st * cx + ct * cy + cty) + dy;
+                tt__hpm_sample(S->full, S->W, S->Hh, S->nch, S->src[2 * at], S->src[2 * at + 1], S->toroidal,
+                               vb);
+                tt__hpm_sample(S->full, S->W, S->Hh, S->nch, xcx, xcy, S->toroidal, vc);
+                for (c = 0; c < S->nch; c++) sum += S->mask[at] * (vb[c] - vc[c]) * (vb[c] - vc[c]);
+            }
+            if (best < 0 || sum < best) {
+                best = sum;
+                bdx = dx;
+                bdy = dy;
+            }
+        }
+    if (best < 0) return 0;
+    pl->shift[0] += bdx;
+    pl->shift[1] += bdy;
+    best = tt__hpm_refine_turn(S, C, pl, best, match->x - cb, match->y - cb, ct, st, ctx, cty, bdx, bdy);
+    *eps = best / ((double)S->nch * match->mask_sum) / (2 * S->sigma2);
+    return 1;
+}
+
 /* Steps 2 and 3: the band and the fit. Returns 1 with *pl and *eps when
    a fit was made, 0 when there is no band to fit (continue or start
    instead), -1 when there is no room for C in the image, -2 on
@@ -20226,37 +20464,9 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
     w_full = tt__hpm_band_width(S, C);
     w_w = w_full / S->f;
     if (w_w < 1.5) w_w = 1.5;
-    /* The canvas is turned so that the texture of the neighbour sharing
-       most vertices keeps its orientation in the turned copy 0: the
-       orientation then propagates from patch to patch (Sec. 2.2) without
-       the drift that a random turn of the frame would add at every fit.
-       With a direction field copy 0 is the field's direction instead, so
-       that the small turns of the fits do not add up over the surface. */
-    {
-        const tt__hpm_owner *best = tt__hpm_best_owner(S);
-        double field_angle, centre[2];
-        cph = best ? best->cos_a : 1;
-        sph = best ? -best->sin_a : 0;
-        if (best) {
-            cont[0] = -S->s * (cph * best->shift[0] - sph * best->shift[1]);
-            cont[1] = -S->s * (sph * best->shift[0] + cph * best->shift[1]);
-        }
-        has_cont = best != NULL;
-        if (tt__hpm_field_angle(S, C, &field_angle, centre)) {
-            /* The neighbour's continuation, turned a little from copy 0
-               now, is taken as the copy-0 offset that agrees with it at
-               C's centre: the offsets left out stay those that would
-               repeat its texels. */
-            double cf = cos(field_angle), sf = sin(field_angle);
-            if (best) {
-                cont[0] += S->s * ((cph - cf) * centre[0] - (sph - sf) * centre[1]);
-                cont[1] += S->s * ((sph - sf) * centre[0] + (cph - cf) * centre[1]);
-            }
-            cph = cf;
-            sph = sf;
-        }
-        phi = atan2(sph, cph);
-    }
+    /* the canvas turned to the main neighbour's texture or the field */
+    has_cont = tt__hpm_canvas_turn(S, C, &cph, &sph, cont);
+    phi = atan2(sph, cph);
     /* The canvas: c = s_w R(phi) q - o. */
     tt__hpm_bbox(S, C, cph, sph, box);
     for (i = 0; i < 4; i++) box[i] /= S->f;
@@ -20333,46 +20543,7 @@ static int tt__hpm_fit(tt__hpm *S, int C, int stamp, tt__hpm_place *pl, double *
         return -2;
     }
 
-    /* The placement of the best offset, refined at full resolution by a
-       direct sum over +-(f - 1) texels. */
-    {
-        double th = S->angle[best_k], ct = cos(th), st = sin(th);
-        double tx = match.x - o[0] - cb, ty = match.y - o[1] - cb, best = -1, vb[3], vc[3];
-        double pbox[4];
-        int dx, dy, bdx = 0, bdy = 0, reach = S->f - 1, c;
-        pl->cos_a = cos(phi - th);
-        pl->sin_a = sin(phi - th);
-        pl->shift[0] = S->f * (ct * tx + st * ty + ctx);
-        pl->shift[1] = S->f * (-st * tx + ct * ty + cty);
-        tt__hpm_bbox(S, C, pl->cos_a, pl->sin_a, pbox);
-        for (dy = -reach; dy <= reach; dy++)
-            for (dx = -reach; dx <= reach; dx++) {
-                double sum = 0;
-                if (!S->toroidal && (pbox[0] + pl->shift[0] + dx < 1 || pbox[1] + pl->shift[1] + dy < 1 ||
-                                     pbox[2] + pl->shift[0] + dx > S->W - 1 ||
-                                     pbox[3] + pl->shift[1] + dy > S->Hh - 1))
-                    continue;
-                for (i = 0; i < S->nband; i++) {
-                    int at = S->band_pixels[i];
-                    double cx = at % P + 0.5 + match.x - cb, cy = at / P + 0.5 + match.y - cb;
-                    double xcx = S->f * (ct * cx + st * cy + ctx) + dx, xcy = S->f * (-st * cx + ct * cy + cty) + dy;
-                    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, S->src[2 * at], S->src[2 * at + 1], S->toroidal,
-                                   vb);
-                    tt__hpm_sample(S->full, S->W, S->Hh, S->nch, xcx, xcy, S->toroidal, vc);
-                    for (c = 0; c < S->nch; c++) sum += S->mask[at] * (vb[c] - vc[c]) * (vb[c] - vc[c]);
-                }
-                if (best < 0 || sum < best) {
-                    best = sum;
-                    bdx = dx;
-                    bdy = dy;
-                }
-            }
-        if (best < 0) return -1;
-        pl->shift[0] += bdx;
-        pl->shift[1] += bdy;
-        best = tt__hpm_refine_turn(S, C, pl, best, match.x - cb, match.y - cb, ct, st, ctx, cty, bdx, bdy);
-        *eps = best / ((double)S->nch * match.mask_sum) / (2 * S->sigma2);
-    }
+    if (!tt__hpm_refine_offset(S, C, phi, best_k, &match, o, pl, eps)) return -1;
     S->rep.fits++;
     S->rep.fits_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
     return 1;
@@ -22005,6 +22176,161 @@ static void tt__hpm_release(tt__hpm *S)
     tt_cluster_hierarchy_free(S->H);
 }
 
+/* The mesh's size for the default scale: its area, bounding box and
+   longest edge (with its face). Every face must be a triangle. */
+static tt_result tt__hpm_mesh_extent(const tt_mesh *mesh, double *total_area, double lo[3], double hi[3],
+                                     double *longest_edge, int *longest_face, tt_error *error)
+{
+    int i, f;
+    for (f = 0; f < mesh->nfaces; f++) {
+        const int *c = mesh->corner_vert + mesh->face_start[f];
+        double e[3], g[3], cr[3];
+        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d has %d corners: hierarchical pattern mapping needs triangles", f,
+                            mesh->face_start[f + 1] - mesh->face_start[f]);
+        tt__sub3f(mesh->pos + 3 * c[1], mesh->pos + 3 * c[0], e);
+        tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[0], g);
+        tt__cross3(e, g, cr);
+        *total_area += 0.5 * tt__length3(cr);
+        {
+            double d[3], longest;
+            tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[1], d);
+            longest = fmax(tt__length3(d), fmax(tt__length3(e), tt__length3(g)));
+            if (longest > *longest_edge) {
+                *longest_edge = longest;
+                *longest_face = f;
+            }
+        }
+        for (i = 0; i < 3; i++) {
+            int k;
+            for (k = 0; k < 3; k++) {
+                double v = mesh->pos[3 * c[i] + k];
+                if (v < lo[k]) lo[k] = v;
+                if (v > hi[k]) hi[k] = v;
+            }
+        }
+    }
+    return TT_OK;
+}
+
+/* The turned copies a fit tries: orientation k at 2 pi k / rotations when
+   it turns no more than max_turn from the main neighbour (copy 0),
+   in the order 0, +1, -1, +2, -2, ... so that ties keep the
+   smaller turn. */
+static void tt__hpm_turned_copies(tt__hpm *S, const tt_hpm_options *o)
+{
+    double max_turn = o->max_turn > 0 ? o->max_turn
+                      : o->face_vectors ? TT_DEFAULT_HPM_FIELD_MAX_TURN : TT_DEFAULT_HPM_MAX_TURN;
+    double limit = max_turn * TT__PI / 180 + 1e-9;
+    int step;
+    S->turn_limit = limit;
+    S->refine_turn = TT__PI / S->rotations;
+    if (o->face_vectors && max_turn * TT__PI / 180 < S->refine_turn) S->refine_turn = max_turn * TT__PI / 180;
+    S->copies = 0;
+    S->angle[S->copies++] = 0;
+    for (step = 1; 2 * step <= S->rotations; step++) {
+        double a = TT__TWO_PI * step / S->rotations;
+        if (a > limit) break;
+        S->angle[S->copies++] = a;
+        if (2 * step < S->rotations) S->angle[S->copies++] = -a;
+    }
+}
+
+/* The traversal's state, sized by the mesh and the hierarchy, cleared:
+   no face owned, no cluster queued or textured. What is allocated before
+   a failure is freed by tt__hpm_release. */
+static tt_result tt__hpm_alloc_state(tt__hpm *S, tt_error *error)
+{
+    const tt_mesh *mesh = S->mesh;
+    int i, f;
+    S->flat = TT__ALLOC(S->al, float, 2 * (size_t)mesh->ncorners);
+    S->uv = TT__ALLOC(S->al, double, 2 * (size_t)mesh->ncorners);
+    if (S->flags & TT_HPM_RANDOM_PLACEMENT) S->out = TT__ALLOC(S->al, double, 2 * (size_t)mesh->ncorners);
+    S->owner = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->in_c = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->seen = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->placed = TT__ALLOC(S->al, double, 2 * (size_t)mesh->ncorners);
+    S->vdisp = TT__ALLOC(S->al, double, 5 * (size_t)mesh->nverts);
+    S->vmark = TT__ALLOC(S->al, int, (size_t)mesh->nverts);
+    S->border_choice = TT__ALLOC(S->al, signed char, (size_t)mesh->nfaces);
+    S->state = TT__ALLOC(S->al, unsigned char, (size_t)S->H->nclusters);
+    S->queue = TT__ALLOC(S->al, tt__heap_item *, (size_t)S->H->nlevels);
+    if (S->queue)
+        for (i = 0; i < S->H->nlevels; i++) S->queue[i] = NULL;
+    S->qcount = TT__ALLOC(S->al, int, (size_t)S->H->nlevels);
+    S->qcap = TT__ALLOC(S->al, int, (size_t)S->H->nlevels);
+    S->heap = TT__ALLOC(S->al, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
+    S->near_faces = TT__ALLOC(S->al, int, (size_t)mesh->nfaces);
+    S->cmark = TT__ALLOC(S->al, unsigned, (size_t)S->H->nclusters);
+    if (S->vmark) {
+        S->ring_room = tt__hpm_ring_room(mesh, S->vmark);
+        S->ring = TT__ALLOC(S->al, int, (size_t)S->ring_room);
+        S->ring_values = TT__ALLOC(S->al, double, 3 * (size_t)S->ring_room);
+    }
+    if (!S->flat || !S->uv || ((S->flags & TT_HPM_RANDOM_PLACEMENT) && !S->out) || !S->owner || !S->in_c ||
+        !S->seen || !S->placed || !S->vdisp || !S->vmark || !S->border_choice || !S->state || !S->queue ||
+        !S->qcount || !S->qcap || !S->heap || !S->near_faces || !S->cmark || !S->ring || !S->ring_values)
+        return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
+    memset(S->cmark, 0, sizeof(unsigned) * (size_t)S->H->nclusters);
+    if (S->field) {
+        S->vlocal = TT__ALLOC(S->al, int, (size_t)mesh->nverts);
+        if (!S->vlocal)
+            return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
+        for (i = 0; i < mesh->nverts; i++) S->vlocal[i] = -1;
+    }
+    for (f = 0; f < mesh->nfaces; f++) {
+        S->owner[f] = -1;
+        S->in_c[f] = S->seen[f] = 0;
+    }
+    for (i = 0; i < mesh->nverts; i++) S->vmark[i] = 0;
+    memset(S->state, 0, (size_t)S->H->nclusters);
+    for (i = 0; i < S->H->nlevels; i++) {
+        S->queue[i] = NULL;
+        S->qcount[i] = S->qcap[i] = 0;
+    }
+    for (i = 0; i < 2 * mesh->ncorners; i++) {
+        S->uv[i] = 0;
+        if (S->out) S->out[i] = 0;
+    }
+    return TT_OK;
+}
+
+/* corner_uv from the texel positions (the random placement's when asked
+   for), as fractions of the image with v up. */
+static tt_result tt__hpm_output_uv(const tt__hpm *S, float *corner_uv, tt_error *error)
+{
+    int i;
+    const double *x = S->out ? S->out : S->uv;
+    /* A tileable image at a scale of almost nothing (1e-40 units
+       across) puts UVs past single precision (found by fuzz_hpm):
+       refused before anything is written. */
+    for (i = 0; i < 2 * S->mesh->ncorners; i++)
+        if (!(fabs(x[i] / (i % 2 ? S->Hh : S->W)) < 1e30))
+            return tt__fail(error, TT_ERROR_NON_FINITE, S->mesh->corner_face[i / 2], i / 2, -1, -1,
+                            "hpm: at %g texels per unit corner %d's texture coordinate (%g image widths) "
+                            "overflows single precision: use a larger scale",
+                            S->s, i / 2, x[i] / (i % 2 ? S->Hh : S->W));
+    for (i = 0; i < S->mesh->ncorners; i++) {
+        corner_uv[2 * i] = (float)(x[2 * i] / S->W);
+        corner_uv[2 * i + 1] = (float)(1 - x[2 * i + 1] / S->Hh);
+    }
+    return TT_OK;
+}
+
+/* The report's totals, once the mesh is textured. */
+static void tt__hpm_finish_report(tt__hpm *S)
+{
+    int accepted = S->rep.accepted_fits + S->rep.floor_fits;
+    S->rep.levels = S->H->nlevels;
+    S->rep.texels_per_unit = S->s;
+    S->rep.match_width = S->ww;
+    S->rep.match_height = S->wh;
+    S->rep.fft_size = S->P;
+    S->rep.copies = S->copies;
+    S->rep.mean_error = accepted > 0 ? S->error_sum / accepted : 0;
+}
+
 TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
                            const tt_allocator *allocator, float *corner_uv, int *face_cluster,
                            tt_hpm_report *report, tt_error *error)
@@ -22046,35 +22372,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
                         "max_flattening_error %g (>= 0)",
                         o.scale, o.threshold, o.rotations, o.max_turn, o.band, match_size, o.min_footprint, o.min_faces,
                         o.flags, o.branching, o.max_flattening_error);
-    for (f = 0; f < mesh->nfaces; f++) {
-        const int *c = mesh->corner_vert + mesh->face_start[f];
-        double e[3], g[3], cr[3];
-        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
-                            "face %d has %d corners: hierarchical pattern mapping needs triangles", f,
-                            mesh->face_start[f + 1] - mesh->face_start[f]);
-        tt__sub3f(mesh->pos + 3 * c[1], mesh->pos + 3 * c[0], e);
-        tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[0], g);
-        tt__cross3(e, g, cr);
-        total_area += 0.5 * tt__length3(cr);
-        {
-            double d[3], longest;
-            tt__sub3f(mesh->pos + 3 * c[2], mesh->pos + 3 * c[1], d);
-            longest = fmax(tt__length3(d), fmax(tt__length3(e), tt__length3(g)));
-            if (longest > longest_edge) {
-                longest_edge = longest;
-                longest_face = f;
-            }
-        }
-        for (i = 0; i < 3; i++) {
-            int k;
-            for (k = 0; k < 3; k++) {
-                double v = mesh->pos[3 * c[i] + k];
-                if (v < lo[k]) lo[k] = v;
-                if (v > hi[k]) hi[k] = v;
-            }
-        }
-    }
+    res = tt__hpm_mesh_extent(mesh, &total_area, lo, hi, &longest_edge, &longest_face, error);
+    if (res != TT_OK) return res;
     if (!(total_area > 0))
         return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, -1, -1, -1, -1,
                         "every face of the mesh has zero area: nothing to texture");
@@ -22094,27 +22393,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     S.toroidal = (o.flags & TT_HPM_TOROIDAL) != 0;
     S.threshold = o.threshold > 0 ? o.threshold : TT_DEFAULT_HPM_THRESHOLD;
     S.rotations = o.rotations ? o.rotations : TT_DEFAULT_HPM_ROTATIONS;
-    {
-        /* The copies a fit tries: orientation k at 2 pi k / rotations when
-           it turns no more than max_turn from the main neighbour (copy 0),
-           in the order 0, +1, -1, +2, -2, ... so that ties keep the
-           smaller turn. */
-        double max_turn = o.max_turn > 0 ? o.max_turn
-                          : o.face_vectors ? TT_DEFAULT_HPM_FIELD_MAX_TURN : TT_DEFAULT_HPM_MAX_TURN;
-        double limit = max_turn * TT__PI / 180 + 1e-9;
-        int step;
-        S.turn_limit = limit;
-        S.refine_turn = TT__PI / S.rotations;
-        if (o.face_vectors && max_turn * TT__PI / 180 < S.refine_turn) S.refine_turn = max_turn * TT__PI / 180;
-        S.copies = 0;
-        S.angle[S.copies++] = 0;
-        for (step = 1; 2 * step <= S.rotations; step++) {
-            double a = TT__TWO_PI * step / S.rotations;
-            if (a > limit) break;
-            S.angle[S.copies++] = a;
-            if (2 * step < S.rotations) S.angle[S.copies++] = -a;
-        }
-    }
+    tt__hpm_turned_copies(&S, &o);
     S.band = o.band;
     S.floor_px = o.min_footprint > 0 ? o.min_footprint : TT_DEFAULT_HPM_MIN_FOOTPRINT;
     S.min_faces = o.min_faces ? o.min_faces : TT_DEFAULT_HPM_MIN_FACES;
@@ -22165,59 +22444,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     if (res != TT_OK) goto done;
     if (tt__hpm_cancelled(&S, 0.0f, &res, error)) goto done;
 
-    S.flat = TT__ALLOC(allocator, float, 2 * (size_t)mesh->ncorners);
-    S.uv = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
-    if (o.flags & TT_HPM_RANDOM_PLACEMENT) S.out = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
-    S.owner = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.in_c = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.seen = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.placed = TT__ALLOC(allocator, double, 2 * (size_t)mesh->ncorners);
-    S.vdisp = TT__ALLOC(allocator, double, 5 * (size_t)mesh->nverts);
-    S.vmark = TT__ALLOC(allocator, int, (size_t)mesh->nverts);
-    S.border_choice = TT__ALLOC(allocator, signed char, (size_t)mesh->nfaces);
-    S.state = TT__ALLOC(allocator, unsigned char, (size_t)S.H->nclusters);
-    S.queue = TT__ALLOC(allocator, tt__heap_item *, (size_t)S.H->nlevels);
-    if (S.queue)
-        for (i = 0; i < S.H->nlevels; i++) S.queue[i] = NULL;
-    S.qcount = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
-    S.qcap = TT__ALLOC(allocator, int, (size_t)S.H->nlevels);
-    S.heap = TT__ALLOC(allocator, tt__heap_item, 3 * (size_t)mesh->nfaces + 3);
-    S.near_faces = TT__ALLOC(allocator, int, (size_t)mesh->nfaces);
-    S.cmark = TT__ALLOC(allocator, unsigned, (size_t)S.H->nclusters);
-    if (S.vmark) {
-        S.ring_room = tt__hpm_ring_room(mesh, S.vmark);
-        S.ring = TT__ALLOC(allocator, int, (size_t)S.ring_room);
-        S.ring_values = TT__ALLOC(allocator, double, 3 * (size_t)S.ring_room);
-    }
-    if (!S.flat || !S.uv || ((o.flags & TT_HPM_RANDOM_PLACEMENT) && !S.out) || !S.owner || !S.in_c || !S.seen ||
-        !S.placed || !S.vdisp || !S.vmark || !S.border_choice || !S.state || !S.queue || !S.qcount || !S.qcap || !S.heap ||
-        !S.near_faces || !S.cmark || !S.ring || !S.ring_values) {
-        res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
-        goto done;
-    }
-    memset(S.cmark, 0, sizeof(unsigned) * (size_t)S.H->nclusters);
-    if (S.field) {
-        S.vlocal = TT__ALLOC(allocator, int, (size_t)mesh->nverts);
-        if (!S.vlocal) {
-            res = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory (hpm state)");
-            goto done;
-        }
-        for (i = 0; i < mesh->nverts; i++) S.vlocal[i] = -1;
-    }
-    for (f = 0; f < mesh->nfaces; f++) {
-        S.owner[f] = -1;
-        S.in_c[f] = S.seen[f] = 0;
-    }
-    for (i = 0; i < mesh->nverts; i++) S.vmark[i] = 0;
-    memset(S.state, 0, (size_t)S.H->nclusters);
-    for (i = 0; i < S.H->nlevels; i++) {
-        S.queue[i] = NULL;
-        S.qcount[i] = S.qcap[i] = 0;
-    }
-    for (i = 0; i < 2 * mesh->ncorners; i++) {
-        S.uv[i] = 0;
-        if (S.out) S.out[i] = 0;
-    }
+    res = tt__hpm_alloc_state(&S, error);
+    if (res != TT_OK) goto done;
     res = tt__hpm_traverse(&S, error);
     if (res != TT_OK) goto done;
     /* Faces with area, yet no cluster flattened and placed: the float
@@ -22236,36 +22464,11 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
     if (!(o.flags & TT_HPM_NO_RELAXATION)) tt__hpm_choose_borders(&S);
     if (tt__hpm_cancelled(&S, 1.0f, &res, error)) goto done;
     tt__hpm_leftovers(&S);
-    {
-        const double *x = S.out ? S.out : S.uv;
-        /* A tileable image at a scale of almost nothing (1e-40 units
-           across) puts UVs past single precision (found by fuzz_hpm):
-           refused before anything is written. */
-        for (i = 0; i < 2 * mesh->ncorners; i++)
-            if (!(fabs(x[i] / (i % 2 ? S.Hh : S.W)) < 1e30)) {
-                res = tt__fail(error, TT_ERROR_NON_FINITE, mesh->corner_face[i / 2], i / 2, -1, -1,
-                               "hpm: at %g texels per unit corner %d's texture coordinate (%g image widths) "
-                               "overflows single precision: use a larger scale",
-                               S.s, i / 2, x[i] / (i % 2 ? S.Hh : S.W));
-                goto done;
-            }
-        for (i = 0; i < mesh->ncorners; i++) {
-            corner_uv[2 * i] = (float)(x[2 * i] / S.W);
-            corner_uv[2 * i + 1] = (float)(1 - x[2 * i + 1] / S.Hh);
-        }
-    }
+    res = tt__hpm_output_uv(&S, corner_uv, error);
+    if (res != TT_OK) goto done;
     if (face_cluster)
         for (f = 0; f < mesh->nfaces; f++) face_cluster[f] = S.owner[f];
-    S.rep.levels = S.H->nlevels;
-    S.rep.texels_per_unit = S.s;
-    S.rep.match_width = S.ww;
-    S.rep.match_height = S.wh;
-    S.rep.fft_size = S.P;
-    S.rep.copies = S.copies;
-    {
-        int accepted = S.rep.accepted_fits + S.rep.floor_fits;
-        S.rep.mean_error = accepted > 0 ? S.error_sum / accepted : 0;
-    }
+    tt__hpm_finish_report(&S);
     if (report) *report = S.rep;
 done:
     tt__hpm_release(&S);
