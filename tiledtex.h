@@ -3436,6 +3436,8 @@ typedef struct tt_polycube_map_report {
     int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
     int refined_again;      /* input faces refined to the finer bound for a second mapping, where the first
                                fell short (default max_edge only); 0 when the first mapping stands */
+    int unpinched;          /* edges split where a triangle at a saddle of S would collapse onto a line
+                               (tt_polycube_map, step 5) */
 } tt_polycube_map_report;
 
 typedef struct tt_polycube_mapping {
@@ -24697,16 +24699,19 @@ typedef struct tt__trace_job {
     const tt_surface_point *points;
     const tt_polycube_edges *previous;
     const unsigned char *moved;
+    int *previous_edge;         /* per edge, its number in `previous` (-1: none); NULL: the same number */
     const tt_allocator *allocator;
     int max_quads;
     tt_polycube_edges *E;
     tt__trace_range *ranges;
 } tt__trace_job;
 
-/* Whether edge e keeps its record from `previous` (neither end moved). */
+/* The record of `previous` edge e keeps (neither end moved), or -1. */
 static int tt__trace_kept(const tt__trace_job *job, int e)
 {
-    return job->previous && !job->moved[job->E->edge_vertices[2 * e]] && !job->moved[job->E->edge_vertices[2 * e + 1]];
+    if (!job->previous || job->moved[job->E->edge_vertices[2 * e]] || job->moved[job->E->edge_vertices[2 * e + 1]])
+        return -1;
+    return job->previous_edge ? job->previous_edge[e] : e;
 }
 
 static void tt__trace_range_task(void *context, int begin, int end)
@@ -24729,12 +24734,13 @@ static void tt__trace_range_task(void *context, int begin, int end)
         tt_surface_point qa = job->points[E->edge_vertices[2 * e]], qb = job->points[E->edge_vertices[2 * e + 1]];
         const tt_edge_crossing *crossing = S->best_crossings;
         int count, i;
-        if (tt__trace_kept(job, e)) {
+        const int kept = tt__trace_kept(job, e);
+        if (kept >= 0) {
             const tt_polycube_edges *previous = job->previous;
-            E->first_crossing[e] = previous->first_crossing[e + 1] - previous->first_crossing[e];
-            E->end_quads[2 * e] = previous->end_quads[2 * e];
-            E->end_quads[2 * e + 1] = previous->end_quads[2 * e + 1];
-            E->failed[e] = previous->failed[e];
+            E->first_crossing[e] = previous->first_crossing[kept + 1] - previous->first_crossing[kept];
+            E->end_quads[2 * e] = previous->end_quads[2 * kept];
+            E->end_quads[2 * e + 1] = previous->end_quads[2 * kept + 1];
+            E->failed[e] = previous->failed[kept];
             R->nfailed += E->failed[e];
             continue;
         }
@@ -24797,13 +24803,17 @@ static void tt__trace_range_task(void *context, int begin, int end)
 /* tt_polycube_trace_edges, or, given the records `previous` made from the
    same mesh and the same points except those of the vertices flagged in
    `moved`, a copy of those records with only the edges at a moved vertex
-   traced again. The edges are traced in ranges of TT__TRACE_RANGE, each a
-   task on the executor; each edge's record depends on its two points
-   alone, so the records are the same with any executor. */
+   traced again. previous_corner (NULL: the same mesh) gives per corner of
+   `mesh` the corner of previous's mesh on the same edge (the same two
+   vertices), or -1 for an edge new to it: a mesh with some edges split.
+   The edges are traced in ranges of TT__TRACE_RANGE, each a task on the
+   executor; each edge's record depends on its two points alone, so the
+   records are the same with any executor. */
 static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mesh, const tt_surface_point *points,
                                  int npoints, const tt_polycube_edge_options *options, const tt_executor *executor,
                                  const tt_allocator *allocator, const tt_polycube_edges *previous,
-                                 const unsigned char *moved, tt_polycube_edges **out, tt_error *error)
+                                 const unsigned char *moved, const int *previous_corner, tt_polycube_edges **out,
+                                 tt_error *error)
 {
     tt_polycube_edges *E = NULL;
     tt__trace_job job;
@@ -24860,6 +24870,13 @@ static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mes
         E->edge_vertices[2 * e + 1] = from < to ? to : from;
     }
 
+    if (previous && previous_corner) {
+        if (!(job.previous_edge = TT__ALLOC(allocator, int, E->nedges > 0 ? E->nedges : 1))) goto out_of_memory;
+        for (e = 0; e < E->nedges; e++) job.previous_edge[e] = -1;
+        for (c = 0; c < mesh->ncorners; c++)
+            if (previous_corner[c] >= 0)
+                job.previous_edge[E->edge_of_halfedge[c]] = previous->edge_of_halfedge[previous_corner[c]];
+    }
     nranges = tt__range_count(E->nedges, TT__TRACE_RANGE);
     job.ranges = TT__ALLOC(allocator, tt__trace_range, nranges > 0 ? nranges : 1);
     if (!job.ranges) goto out_of_memory;
@@ -24893,21 +24910,23 @@ static tt_result tt__trace_edges(const tt_polycube *polycube, const tt_mesh *mes
                NULL + 0 is undefined behaviour (a flat square at resolution 1). */
             if (count > 0) {
                 const tt_edge_crossing *from =
-                    kept ? previous->crossings + previous->first_crossing[e] : R->crossings + taken;
+                    kept >= 0 ? previous->crossings + previous->first_crossing[kept] : R->crossings + taken;
                 memcpy(E->crossings + total, from, sizeof(tt_edge_crossing) * (size_t)count);
             }
-            if (!kept) taken += count;
+            if (kept < 0) taken += count;
             total += (size_t)count;
         }
     }
     E->first_crossing[E->nedges] = E->ncrossings;
     for (r = 0; r < nranges; r++) tt__free(allocator, job.ranges[r].crossings);
     tt__free(allocator, job.ranges);
+    tt__free(allocator, job.previous_edge);
     *out = E;
     return TT_OK;
 out_of_memory:
     for (r = 0; job.ranges && r < nranges; r++) tt__free(allocator, job.ranges[r].crossings);
     tt__free(allocator, job.ranges);
+    tt__free(allocator, job.previous_edge);
     tt_polycube_edges_free(E);
     return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory tracing the mesh's edges on S");
 }
@@ -24917,7 +24936,7 @@ TTDEF tt_result tt_polycube_trace_edges(const tt_polycube *polycube, const tt_me
                                         const tt_polycube_edge_options *options, const tt_allocator *allocator,
                                         tt_polycube_edges **out, tt_error *error)
 {
-    return tt__trace_edges(polycube, mesh, points, npoints, options, NULL, allocator, NULL, NULL, out, error);
+    return tt__trace_edges(polycube, mesh, points, npoints, options, NULL, allocator, NULL, NULL, NULL, out, error);
 }
 
 /* *edges replaced by records whose edges at the points flagged in moved[]
@@ -24929,7 +24948,7 @@ static tt_result tt__retrace_moved(const tt_polycube *polycube, const tt_mesh *m
 {
     tt_polycube_edges *again = NULL;
     tt_result result = tt__trace_edges(polycube, mesh, points, mesh->nverts, options, executor, allocator, *edges,
-                                       moved, &again, error);
+                                       moved, NULL, &again, error);
     if (result != TT_OK) return result;
     tt_polycube_edges_free(*edges);
     *edges = again;
@@ -25083,6 +25102,42 @@ static int tt__refine_triangle(const float *positions, const int *corner, const 
     return n;
 }
 
+/* The refined triangles of `ntriangles` triangles (3 vertices each, of
+   input faces `faces`) whose edges are split at the vertices in mid (per
+   corner, -1: not split), wound as the input, into next_triangles and
+   next_faces (one triangle per triangle and per split edge). Returns
+   their count. */
+static int tt__refine_faces(const float *positions, const int *triangles, const int *faces, int ntriangles,
+                            const int *mid, int *next_triangles, int *next_faces)
+{
+    int f, k, count = 0;
+    for (f = 0; f < ntriangles; f++) {
+        int add[12], n = tt__refine_triangle(positions, triangles + 3 * f, mid + 3 * f, add);
+        memcpy(next_triangles + 3 * count, add, sizeof(int) * (size_t)n);
+        for (k = 0; k < n / 3; k++) next_faces[count++] = faces[f];
+    }
+    return count;
+}
+
+/* The mesh of refined triangles. Permissive: the midpoints are rounded
+   to floats, and those of a sliver's two long edges can round to one
+   point, leaving a refined triangle with no area that the input did not
+   have. The mapping takes such triangles as it takes a permissive
+   input's. */
+static tt_result tt__refined_build(const float *positions, int nverts, const int *triangles, int ntriangles,
+                                   const tt_allocator *allocator, tt_mesh **out, tt_error *error)
+{
+    tt_mesh_desc desc;
+    memset(&desc, 0, sizeof desc);
+    desc.positions = positions;
+    desc.nverts = nverts;
+    desc.indices = triangles;
+    desc.nfaces = ntriangles;
+    desc.fixed_face_size = 3;
+    desc.flags = TT_MESH_PERMISSIVE;
+    return tt_mesh_build(&desc, allocator, out, error);
+}
+
 static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double fine_longest,
                                      const unsigned char *fine_faces, const tt_allocator *allocator,
                                      tt__refined *out, tt_error *error)
@@ -25090,7 +25145,7 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double
     float *positions = NULL;
     int *triangles = NULL, *faces = NULL, *source = NULL, *mid = NULL, *next_triangles = NULL, *next_faces = NULL;
     double *weight = NULL;
-    int nverts = mesh->nverts, ntriangles = mesh->nfaces, vertex_capacity = 0, pass, c, v, f;
+    int nverts = mesh->nverts, ntriangles = mesh->nfaces, vertex_capacity = 0, pass, c, v, f, next_count;
     double needed = 0, area = 0;
     tt_mesh *current = NULL;
     tt_result result = TT_OK;
@@ -25132,20 +25187,10 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double
     memcpy(triangles, mesh->corner_vert, sizeof(int) * 3 * (size_t)ntriangles);
     for (f = 0; f < ntriangles; f++) faces[f] = f;
     for (pass = 0;; pass++) {
-        tt_mesh_desc desc;
-        int marked = 0, next_count = 0;
-        memset(&desc, 0, sizeof desc);
-        desc.positions = positions;
-        desc.nverts = nverts;
-        desc.indices = triangles;
-        desc.nfaces = ntriangles;
-        desc.fixed_face_size = 3;
-        /* Permissive: the midpoints are rounded to floats, and those of a
-           sliver's two long edges can round to one point, leaving a refined
-           triangle with no area that the input did not have. The mapping
-           takes such triangles as it takes a permissive input's. */
-        desc.flags = TT_MESH_PERMISSIVE;
-        if ((result = tt_mesh_build(&desc, allocator, &current, error)) != TT_OK) goto failed;
+        int marked = 0;
+        if ((result = tt__refined_build(positions, nverts, triangles, ntriangles, allocator, &current, error)) !=
+            TT_OK)
+            goto failed;
         mid = TT__ALLOC(allocator, int, current->ncorners);
         if (!mid) goto out_of_memory;
         for (c = 0; c < current->ncorners; c++) {
@@ -25183,11 +25228,7 @@ static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double
         next_triangles = TT__ALLOC(allocator, int, 12 * (size_t)ntriangles);
         next_faces = TT__ALLOC(allocator, int, 4 * (size_t)ntriangles);
         if (!next_triangles || !next_faces) goto out_of_memory;
-        for (f = 0; f < ntriangles; f++) {
-            int add[12], n = tt__refine_triangle(positions, triangles + 3 * f, mid + 3 * f, add), k;
-            memcpy(next_triangles + 3 * next_count, add, sizeof(int) * (size_t)n);
-            for (k = 0; k < n / 3; k++) next_faces[next_count++] = faces[f];
-        }
+        next_count = tt__refine_faces(positions, triangles, faces, ntriangles, mid, next_triangles, next_faces);
         tt__free(allocator, triangles);
         tt__free(allocator, faces);
         tt__free(allocator, mid);
@@ -28425,6 +28466,264 @@ done:
     return result;
 }
 
+/* ---- Pinches at the saddles of S ---- */
+
+/* A triangle T = (v, b, c) whose vertex v lies on a saddle W of S (a
+   vertex of five or six quads, where the unspiking puts points) with a
+   corner there of more than half a turn of S has no straight image: the
+   shortest path from b to c runs through W as well, and T collapses onto
+   the segments W-b and W-c, a streak of stretched texture. The triangle
+   N = (c, b, d) across b-c reaches W with that corner instead. Splitting
+   b-c at its midpoint m (on the model, whose shape stays) with m's point
+   on the straight segment from W to d gives the quadrilateral W, b, d, c
+   the diagonal its reflex corner at W needs: T's halves meet at W, N's
+   halves at m. m divides W-d in the ratio of T's area to T's and N's
+   together, so that both keep their density. */
+#define TT__UNPINCH_ROUNDS 2        /* splits of the pinched edges, each followed by tracing the model again */
+
+typedef struct tt__pinch {
+    int corner;                 /* T's corner whose edge b-c is split */
+    tt_surface_point point;     /* the point of b-c's midpoint on S */
+} tt__pinch;
+
+/* Whether the image of edge e passes S vertex w between its ends. */
+static int tt__edge_passes_vertex(const tt_mesh *s, const tt_polycube_edges *edges, int e, int w)
+{
+    int j;
+    for (j = edges->first_crossing[e]; j < edges->first_crossing[e + 1]; j++) {
+        const tt_edge_crossing *x = &edges->crossings[j];
+        if ((x->along == 0.0 || x->along == 1.0) && x->t > 0.0 && x->t < 1.0 &&
+            s->corner_vert[x->along == 0.0 ? x->halfedge : tt_mesh_next(s, x->halfedge)] == w)
+            return 1;
+    }
+    return 0;
+}
+
+/* The point a fraction `share` of the way along the shortest path on S
+   from qa to qb (tt__edge_find_path): in each quad the path passes, the
+   straight segment between the points where it enters and leaves. 0 when
+   there is no path. */
+static int tt__edge_point_along(tt__edge_search *S, tt_surface_point qa, tt_surface_point qb, double share,
+                                tt_surface_point *out)
+{
+    const tt_mesh *s = S->pc->surface;
+    double from[2], to[2], t0 = 0.0, t1, u;
+    int ends[2], j, count, quad, k, st0[2], st1[2];
+    if (!tt__edge_find_path(S, qa, qb, ends)) return 0;
+    count = S->best_count - 1;
+    quad = ends[0];
+    from[0] = S->a[0];
+    from[1] = S->a[1];
+    for (j = 0;; j++) {
+        const tt_edge_crossing *x = j < count ? &S->best_crossings[j] : NULL;
+        if (x) {
+            k = x->halfedge - s->face_start[quad];
+            tt__quad_corner_st(k, st0);
+            tt__quad_corner_st(k + 1, st1);
+            to[0] = st0[0] + x->along * (st1[0] - st0[0]);
+            to[1] = st0[1] + x->along * (st1[1] - st0[1]);
+            t1 = x->t;
+        } else {
+            to[0] = S->b[0];
+            to[1] = S->b[1];
+            t1 = 1.0;
+        }
+        if (!x || share <= t1) {
+            u = t1 > t0 ? (share - t0) / (t1 - t0) : 0.0;
+            u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+            out->quad = quad;
+            out->s = (float)(from[0] + u * (to[0] - from[0]));
+            out->t = (float)(from[1] + u * (to[1] - from[1]));
+            return 1;
+        }
+        /* Across the crossing: the same point in the next quad's frame. */
+        quad = s->corner_face[s->twin[x->halfedge]];
+        k = s->twin[x->halfedge] - s->face_start[quad];
+        tt__quad_corner_st(k, st0);
+        tt__quad_corner_st(k + 1, st1);
+        from[0] = st1[0] + x->along * (st0[0] - st1[0]);
+        from[1] = st1[1] + x->along * (st0[1] - st1[1]);
+        t0 = t1;
+    }
+}
+
+/* The pinched triangles of the model (see above) whose split can be
+   placed: a path on S from W to N's third vertex d. *pinches grows
+   (capacity *capacity); returns their count, -1 when out of memory. */
+static int tt__polycube_find_pinches(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
+                                     const tt_surface_point *points, int max_quads, const tt_allocator *allocator,
+                                     tt__pinch **pinches, int *capacity)
+{
+    const tt_mesh *s = pc->surface;
+    tt__edge_search *search = NULL;
+    int count = 0, c;
+    for (c = 0; c < model->ncorners; c++) {
+        const int v = model->corner_vert[c], w = tt__point_vertex(s, points[v]);
+        const int opposite = tt_mesh_next(model, c), twin = model->twin[opposite];
+        double share, area, other;
+        tt_surface_point point;
+        int d;
+        if (w < 0 || twin < 0 || !tt__edge_passes_vertex(s, edges, edges->edge_of_halfedge[opposite], w)) continue;
+        d = model->corner_vert[tt_mesh_prev(model, twin)];
+        if (tt__point_vertex(s, points[d]) == w) continue;
+        if (!search) {
+            if (!(search = TT__ALLOC(allocator, tt__edge_search, 1))) return -1;
+            memset(search, 0, sizeof *search);
+            search->pc = pc;
+            search->max_quads = max_quads;
+        }
+        area = tt__face_area_d(model, model->corner_face[c]);
+        other = tt__face_area_d(model, model->corner_face[twin]);
+        share = area + other > 0.0 ? area / (area + other) : 0.5;
+        share = share < 0.2 ? 0.2 : (share > 0.8 ? 0.8 : share);
+        if (!tt__edge_point_along(search, points[v], points[d], share, &point)) continue;
+        if (count == *capacity) {
+            tt__pinch *grown = (tt__pinch *)tt__grow(allocator, *pinches, capacity, count + 1, sizeof(tt__pinch));
+            if (!grown) {
+                tt__free(allocator, search);
+                return -1;
+            }
+            *pinches = grown;
+        }
+        (*pinches)[count].corner = opposite;
+        (*pinches)[count].point = point;
+        count++;
+    }
+    tt__free(allocator, search);
+    return count;
+}
+
+/* The refined model R (the input mesh itself while R->mesh is NULL) with
+   the pinched edges split at their midpoints, *points_io grown by their
+   points; per corner of the new model, the corner of the old one on the
+   same edge (-1 at a midpoint) in *previous_corner, and per vertex whether
+   it is new in *added_vertices, for tracing again only their edges. On
+   failure R and the points stay as they were. */
+static tt_result tt__polycube_split_pinches(const tt_mesh *mesh, tt__refined *R, const tt__pinch *pinches,
+                                            int npinches, tt_surface_point **points_io, int **previous_corner,
+                                            unsigned char **added_vertices, const tt_allocator *allocator,
+                                            tt_error *error)
+{
+    const tt_mesh *model = R->mesh ? R->mesh : mesh;
+    const int nverts = model->nverts + npinches, nsplit = model->nfaces + 2 * npinches;
+    float *positions = TT__ALLOC(allocator, float, 3 * (size_t)nverts);
+    int *source = TT__ALLOC(allocator, int, 3 * (size_t)nverts);
+    double *weight = TT__ALLOC(allocator, double, 3 * (size_t)nverts);
+    int *mid = TT__ALLOC(allocator, int, model->ncorners);
+    int *faces = TT__ALLOC(allocator, int, model->nfaces);
+    int *triangles = TT__ALLOC(allocator, int, 3 * (size_t)nsplit);
+    int *triangle_faces = TT__ALLOC(allocator, int, nsplit);
+    int *corners = TT__ALLOC(allocator, int, 3 * (size_t)nsplit);
+    unsigned char *added = TT__ALLOC(allocator, unsigned char, nverts);
+    tt_surface_point *points = TT__ALLOC(allocator, tt_surface_point, nverts);
+    tt_mesh *split = NULL;
+    tt_result result = TT_ERROR_OUT_OF_MEMORY;
+    int v, c, f, k, i, count = model->nverts, ntriangles;
+    if (!positions || !source || !weight || !mid || !faces || !triangles || !triangle_faces || !corners || !added ||
+        !points)
+        goto done;
+    memcpy(positions, model->pos, sizeof(float) * 3 * (size_t)model->nverts);
+    memcpy(points, *points_io, sizeof(tt_surface_point) * (size_t)model->nverts);
+    memset(added, 0, (size_t)nverts);
+    for (v = 0; v < model->nverts; v++)
+        for (k = 0; k < 3; k++) {
+            source[3 * v + k] = R->mesh ? R->source[3 * v + k] : v;
+            weight[3 * v + k] = R->mesh ? R->weight[3 * v + k] : (double)(k == 0);
+        }
+    for (f = 0; f < model->nfaces; f++) faces[f] = f;
+    for (c = 0; c < model->ncorners; c++) mid[c] = -1;
+    for (i = 0; i < npinches; i++) {
+        const int corner = pinches[i].corner, twin = model->twin[corner];
+        const int a = model->corner_vert[corner], b = model->corner_vert[tt_mesh_next(model, corner)];
+        if (mid[corner] >= 0) continue;
+        for (k = 0; k < 3; k++)
+            positions[3 * count + k] = (float)(0.5 * ((double)positions[3 * a + k] + positions[3 * b + k]));
+        tt__refined_midpoint_sources(source, weight, a, b, source + 3 * count, weight + 3 * count);
+        points[count] = pinches[i].point;
+        added[count] = 1;
+        mid[corner] = mid[twin] = count++;
+    }
+    ntriangles = tt__refine_faces(positions, model->corner_vert, faces, model->nfaces, mid, triangles, triangle_faces);
+    /* Each new triangle's edges found among its old triangle's (none at a midpoint). */
+    for (c = 0; c < 3 * ntriangles; c++) {
+        const int from = triangles[c], to = triangles[c - c % 3 + (c + 1) % 3], old = 3 * triangle_faces[c / 3];
+        corners[c] = -1;
+        for (k = 0; k < 3; k++)
+            if (model->corner_vert[old + k] == from && model->corner_vert[old + (k + 1) % 3] == to) corners[c] = old + k;
+    }
+    for (f = 0; f < ntriangles && R->mesh; f++) triangle_faces[f] = R->face[triangle_faces[f]];
+    if ((result = tt__refined_build(positions, count, triangles, ntriangles, allocator, &split, error)) != TT_OK)
+        goto done;
+    tt__refined_free(allocator, R);
+    R->mesh = split;
+    R->source = source;
+    R->weight = weight;
+    R->face = triangle_faces;
+    tt__free(allocator, *points_io);
+    *points_io = points;
+    *previous_corner = corners;
+    *added_vertices = added;
+    source = corners = NULL;
+    weight = NULL;
+    triangle_faces = NULL;
+    added = NULL;
+    points = NULL;
+done:
+    if (result == TT_ERROR_OUT_OF_MEMORY)
+        tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory splitting the model's pinched edges");
+    tt__free(allocator, positions);
+    tt__free(allocator, source);
+    tt__free(allocator, weight);
+    tt__free(allocator, mid);
+    tt__free(allocator, faces);
+    tt__free(allocator, triangles);
+    tt__free(allocator, triangle_faces);
+    tt__free(allocator, corners);
+    tt__free(allocator, added);
+    tt__free(allocator, points);
+    return result;
+}
+
+/* The pinches taken off (see above): up to TT__UNPINCH_ROUNDS times the
+   pinched edges are split and the edges at their midpoints traced
+   (*edges_io replaced). *unpinched counts the edges split. */
+static tt_result tt__polycube_unpinch(const tt_polycube *pc, const tt_mesh *mesh, tt__refined *R,
+                                      const tt_polycube_edge_options *edge_options, int max_quads,
+                                      const tt_executor *executor,
+                                      const tt_allocator *allocator, tt_surface_point **points_io,
+                                      tt_polycube_edges **edges_io, int *unpinched, tt_error *error)
+{
+    tt__pinch *pinches = NULL;
+    tt_result result = TT_OK;
+    int capacity = 0, round, n;
+    for (round = 0; round < TT__UNPINCH_ROUNDS; round++) {
+        const tt_mesh *model = R->mesh ? R->mesh : mesh;
+        tt_polycube_edges *edges = NULL;
+        int *previous_corner = NULL;
+        unsigned char *added = NULL;
+        if ((n = tt__polycube_find_pinches(pc, model, *edges_io, *points_io, max_quads, allocator, &pinches,
+                                           &capacity)) < 0) {
+            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory finding pinches");
+            break;
+        }
+        if (!n) break;
+        if ((result = tt__polycube_split_pinches(mesh, R, pinches, n, points_io, &previous_corner, &added, allocator,
+                                                 error)) != TT_OK)
+            break;
+        *unpinched += n;
+        model = R->mesh;
+        result = tt__trace_edges(pc, model, *points_io, model->nverts, edge_options, executor, allocator, *edges_io,
+                                 added, previous_corner, &edges, error);
+        tt__free(allocator, previous_corner);
+        tt__free(allocator, added);
+        if (result != TT_OK) break;
+        tt_polycube_edges_free(*edges_io);
+        *edges_io = edges;
+    }
+    tt__free(allocator, pinches);
+    return result;
+}
+
 /* A mapping of the refined model R turned into one of the input mesh:
    each output vertex's refined sources become input vertices (at most 3,
    all of one input triangle), each output triangle's refined face its
@@ -28528,12 +28827,17 @@ static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mes
     tt__polycube_snap_points(points, model->nverts);   /* again: the smoothing moves points near edges too */
     if (tt__map_progress_phase(progress, 0.45f, 0.6f)) goto cancelled;
     if ((result = tt__trace_edges(polycube, model, points, model->nverts, &edge_options, executor, allocator, NULL,
-                                  NULL, &edges, error)) != TT_OK)
+                                  NULL, NULL, &edges, error)) != TT_OK)
         goto failed;
     if (tt__map_progress_phase(progress, 0.6f, 0.6f)) goto cancelled;
     if ((result = tt__polycube_repair_edges(polycube, model, &edge_options, max_quads, executor, allocator, progress,
                                             points, &edges, &report->relaxed, error)) != TT_OK)
         goto failed;
+    if ((result = tt__polycube_unpinch(polycube, mesh, &R, &edge_options, max_quads, executor, allocator, &points,
+                                       &edges, &report->unpinched, error)) != TT_OK)
+        goto failed;
+    model = R.mesh ? R.mesh : mesh;
+    report->triangles = model->nfaces;
     report->failed_edges = edges->nfailed;
     if (tt__map_progress_phase(progress, 0.85f, 0.85f)) goto cancelled;
 
