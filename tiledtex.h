@@ -498,7 +498,7 @@ typedef struct tt_corner_sources {
    TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL and nothing stays
    allocated. Memory: 8 bytes per source, 5 + |f| sources per input corner
    of face f (a face point lists its face's corners in each of its quads,
-   so an n-gon costs n * n; 9 per corner of a triangle, 9 per quad corner),
+   so an n-gon costs n * n; 8 per corner of a triangle, 9 per quad corner),
    plus 4 bytes per new corner. Free the result with
    tt_corner_sources_free. Thread-safe. */
 TTDEF tt_result tt_mesh_quadrangulate_sources(const tt_mesh *mesh, const tt_allocator *allocator,
@@ -4389,8 +4389,6 @@ static double tt__face_longest_edge(const tt_mesh *mesh, int face)
     return longest;
 }
 
-/* TT_OK when every face is a triangle; else TT_ERROR_INVALID_ARGUMENT
-   naming the first other face: "face F has N corners: <why>". */
 /* A tt_mesh of no faces can only be made by hand (tt_mesh_build refuses
    it): every function that takes a mesh refuses it too. */
 static tt_result tt__require_faces(const tt_mesh *mesh, tt_error *error)
@@ -4400,6 +4398,9 @@ static tt_result tt__require_faces(const tt_mesh *mesh, tt_error *error)
     return TT_OK;
 }
 
+/* TT_OK when every face is a triangle; else TT_ERROR_INVALID_ARGUMENT
+   naming the first other face: "face F has N corners: <why>"
+   (TT_ERROR_EMPTY_MESH for a mesh without faces, as tt__require_faces). */
 static tt_result tt__require_triangles(const tt_mesh *mesh, const char *why, tt_error *error)
 {
     int f;
