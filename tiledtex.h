@@ -664,9 +664,11 @@ TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *al
 /* Minimum-error cut (as in image quilting): in a width x height cost map, find
    the path path[x] (one row per column) with path[x] in [lo[x], hi[x]] and
    |path[x] - path[x-1]| <= 1 that minimises the sum of cost[path[x]*width + x].
-   Ties go to the smaller row. Needs lo[x] <= hi[x] and consecutive ranges
-   that a path can follow (TT_ERROR_INVALID_ARGUMENT otherwise, naming the
-   column); a NaN cost is TT_ERROR_NON_FINITE. path has width entries. */
+   Ties go to the smaller row. Needs 0 <= lo[x] <= hi[x] < height
+   (TT_ERROR_INVALID_ARGUMENT otherwise, naming the column) and consecutive
+   ranges that a path can follow (TT_ERROR_INVALID_ARGUMENT); a NaN or
+   infinite cost is TT_ERROR_NON_FINITE (naming its row and column); a map
+   of more than 2^28 entries is TT_ERROR_TOO_LARGE. path has width entries. */
 TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
                                  const tt_allocator *allocator, int *path, tt_error *error);
 
