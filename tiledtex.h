@@ -166,8 +166,9 @@
      3. Image   - float RGBA images, colour spaces, bilinear sampling, 90-degree
                   rotations, premultiplied `over`, box downsampling,
                   minimum-error cut
-     4. Numerics - triplets to CSR sparse matrices, Jacobi-preconditioned
-                  conjugate gradients (symmetric positive definite systems),
+     4. Numerics - triplets to CSR sparse matrices, conjugate gradients
+                  preconditioned by Jacobi or incomplete Cholesky (symmetric
+                  positive definite systems),
                   radix-2 FFTs (1D, 2D, real input), masked cross-correlation
      5. Raster  - 2D triangle rasterisation with barycentrics
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
@@ -682,7 +683,8 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
    tangent field (Praun et al. Sec. 3.4), hierarchical pattern mapping
    flattens each face cluster (Soler et al. Sec. 3.2). Such a system is
    assembled as triplets, compressed into rows (CSR) and solved by the Jacobi
-   (diagonal) preconditioned conjugate gradient method, with the formulas of
+   (diagonal) preconditioned conjugate gradient method (or, as an option,
+   incomplete Cholesky: TT_CG_INCOMPLETE_CHOLESKY), with the formulas of
    Shewchuk, "An Introduction to the Conjugate Gradient Method Without the
    Agonizing Pain" (edition 1 1/4, 1994), Sec. 12 and the preconditioned
    algorithm in the third part of its appendix B (M = diag(A)):
@@ -824,7 +826,8 @@ typedef struct tt_cg_report {
                                     iteration;
      TT_ERROR_INVALID_ARGUMENT      NULL pointers, b == x, A not square or its
                                     row_start array inconsistent, negative
-                                    max_iterations or tolerance, an unknown
+                                    max_iterations, a negative or non-finite
+                                    tolerance, a bad allocator, an unknown
                                     preconditioner, or incomplete Cholesky on
                                     a row whose columns do not increase
                                     (error->row);
@@ -835,8 +838,8 @@ typedef struct tt_cg_report {
      TT_ERROR_OUT_OF_MEMORY.
    b = 0 gives x = 0 at once. Symmetry is assumed, not checked (checking
    costs more than several steps): a non-symmetric A may stall or break down.
-   Memory: one scratch block of 5 n doubles for the whole solve, nothing per
-   step. A step costs one product with A (with p . A p in the same pass) and
+   Memory: one scratch block of 5 n doubles (6 n and the factor with
+   incomplete Cholesky) for the whole solve, nothing per step. A step costs one product with A (with p . A p in the same pass) and
    two fused passes over the vectors; one more product confirms the result.
    Thread-safe: several threads may solve with the same A and b into
    distinct x. */
