@@ -1192,8 +1192,9 @@ typedef struct tt_tile_layout {
 
 /* Replace zeros by defaults and check ranges: colors 1..TT_MAX_COLORS, tile
    size 4..TT_MAX_IMAGE_SIZE, gutter 0..tile size, and an atlas side within
-   TT_MAX_IMAGE_SIZE (TT_ERROR_TOO_LARGE otherwise; TT_ERROR_INVALID_ARGUMENT
-   for the others). Resolving a resolved layout changes nothing. */
+   TT_MAX_IMAGE_SIZE (a tile size or an atlas side above it is
+   TT_ERROR_TOO_LARGE; anything else out of range, or a NULL in or out, is
+   TT_ERROR_INVALID_ARGUMENT). Resolving a resolved layout changes nothing. */
 TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error);
 /* Tiles per atlas side T, atlas side W, total tiles (2n)^4; zeros in the
    layout mean defaults, as everywhere.
@@ -1236,7 +1237,10 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
 
 /* AssignTextureCoordinates: corner_uv gets 2 * mesh->ncorners floats. Every face
    must be a quad (TT_ERROR_NOT_QUAD_MESH names the first that is not). The
-   layout is resolved internally (zeros mean defaults). A mesh without faces
+   layout is resolved internally (zeros mean defaults; one that does not
+   resolve gives tt_tile_layout_resolve's error). Other errors: NULL
+   arguments (TT_ERROR_INVALID_ARGUMENT), a type of 2n or more
+   (TT_ERROR_INDEX_OUT_OF_RANGE, naming the corner). A mesh without faces
    (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                               float *corner_uv, tt_error *error);
@@ -1304,7 +1308,8 @@ TTDEF tt_result tt_assign_uvs_oriented(const tt_mesh *mesh, const tt_tile_layout
                  tiles and its tops plain ones: one tile index, two cells);
      out_tiles   NULL, or the distinct (group, tile) pairs shown after.
    Every face must be a quad. Same input and seed, same result. Memory:
-   about 24 bytes per face, from `allocator`, freed before it returns.
+   about 100 to 200 bytes per face (a table of 4 to 8 slots a face, 24 bytes
+   a slot) and 4 per edge, from `allocator`, freed before it returns.
    Errors: NULL mesh, layout or corner_type, a bad allocator, colors
    outside 1..TT_MAX_COLORS, max_tiles below 1 (TT_ERROR_INVALID_ARGUMENT);
    a face that is not a quad (TT_ERROR_NOT_QUAD_MESH); edge_colors as
@@ -1439,10 +1444,12 @@ typedef struct tt_synth_plan {
    tt_image_kind (TT_ERROR_INVALID_ARGUMENT), a bad
    allocator, a non-finite guide texel (TT_ERROR_NON_FINITE, error->row /
    column = its y / x), a layout that does not resolve, a guide smaller than S
-   x 2S or a background region that cannot hold a tile
-   (TT_ERROR_IMAGE_TOO_SMALL), a background region outside the guide, a given
-   edge window that does not fit, a feather wider than S/4 + 1
-   (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by the
+   x 2S (2S x 2S for upright tiles) or a background region that cannot hold
+   a tile (TT_ERROR_IMAGE_TOO_SMALL), a background region outside the guide,
+   a given edge window that does not fit, a negative feather or one wider
+   than S/4 + 1, background_candidates outside
+   0..TT_SYNTH_MAX_BACKGROUND_CANDIDATES (TT_ERROR_INVALID_ARGUMENT),
+   TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by the
    progress callback. *out_plan is NULL on failure and nothing is left
    allocated. Temporary memory, freed before it returns: about 20 * S * S
    bytes (a scratch tile and the cut's cost tables). Time: about that of
@@ -1542,9 +1549,10 @@ TTDEF void tt_tileset_free(tt_tileset *tileset);
 /* --- The compact atlas: only the tiles a mesh shows ---
 
    The layout's atlas holds every one of the (2n)^4 tiles whether the mesh
-   shows it or not: 2176 x 2176 texels at the defaults (twice as wide with a
-   polycube's upright tiles), a size no engine asks for and, beside upright
-   tiles, above the 4096 texels a side many take. A compact atlas holds only
+   shows it or not: 2176 x 2176 texels with 2 colours, 128-texel tiles and
+   gutter 4 (the tiledtex tool's polycube defaults; twice as wide with its
+   upright tiles), a size no engine asks for and, beside upright tiles,
+   above the 4096 texels a side many take. A compact atlas holds only
    the cells the faces use, each whole with its gutter (so bilinear
    filtering and the mip levels a gutter keeps seamless read what the full
    atlas had there), in a power-of-two rectangle: the smallest of W x W and
@@ -1694,8 +1702,8 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
                                  tt_seam_report *report, tt_error *error);
 
 /* counts[t] = number of quads using tile t (tt_tile_layout_tile_count entries).
-   Errors: NULL pointers, a layout that does not resolve
-   (TT_ERROR_INVALID_ARGUMENT), a face that is not a quad
+   Errors: NULL pointers (TT_ERROR_INVALID_ARGUMENT), a layout that does not
+   resolve (tt_tile_layout_resolve's error), a face that is not a quad
    (TT_ERROR_NOT_QUAD_MESH, naming it), a type of 2n or more
    (TT_ERROR_INDEX_OUT_OF_RANGE, naming the corner). A mesh without faces (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
@@ -11272,13 +11280,6 @@ static void tt__face_tangents(const float *const point[4], int dims, int size, d
     }
 }
 
-/* The map from texture to surface of `face` at its centre, M (3x2, columns
-   dP/du and dP/dv), through the face's own parametrisation (s, t): for a
-   quad the bilinear patch's derivatives, otherwise the first triangle.
-   A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2) with texture coordinates
-   (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
-   M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
-   M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
 /* Eigenvalues big >= small of the symmetric 2x2 matrix [g11 g12; g12 g22]:
    a map's metric, whose square roots are its singular values. */
 static void tt__metric_eigenvalues(double g11, double g12, double g22, double *big, double *small)
@@ -11288,6 +11289,13 @@ static void tt__metric_eigenvalues(double g11, double g12, double g22, double *b
     *small = 0.5 * (tr - disc);
 }
 
+/* The map from texture to surface of `face` at its centre, M (3x2, columns
+   dP/du and dP/dv), through the face's own parametrisation (s, t): for a
+   quad the bilinear patch's derivatives, otherwise the first triangle.
+   A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2) with texture coordinates
+   (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
+   M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
+   M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
 static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
                                        double v_scale, double *big, double *small)
 {
