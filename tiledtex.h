@@ -121,7 +121,8 @@
        tt_make_texture_patch(photo, NULL, NULL, NULL, &patch, &err);
        tt_lapped_paste(mesh, field, &patch, 1, NULL, NULL, &pastes, &err);
        // draw pastes->pastes[p] in order, alpha-blended: faces pastes->faces[first..],
-       // corner UVs pastes->uv[6 * entry ..] into the patch; or bake them:
+       // corner UVs pastes->uv[6 * entry ..] into the patch, the patch's alpha times
+       // pastes->fade[3 * entry ..] (0 where a paste stops); or bake them:
        tt_atlas_pack_pairs(mesh, 2048, 2, corner_uv, &err);      // float corner_uv[6 * ntris]
        tt_lapped_bake(mesh, pastes, &patch, 1, corner_uv, NULL, NULL, atlas, &err);
        tt_lapped_free(pastes); tt_image_free(patch);             // atlas: your 2048 x 2048 tt_image
@@ -174,7 +175,9 @@
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
                 - boundary assignment (random or prescribed), UV formula,
-                  tile-set synthesis as a plan applied to one or more images,
+                  tiles turned to follow a direction field (upright tiles),
+                  fewer distinct tiles, tile-set synthesis as a plan applied
+                  to one or more images, a compact atlas of the tiles shown,
                   quality report
      7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures")
                 - tangent field: texture up and scale per face (Sec. 3.2)
