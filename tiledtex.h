@@ -422,7 +422,10 @@ typedef struct tt_mesh_stats {
 TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, const tt_allocator *allocator, tt_mesh_stats *stats,
                                       tt_error *error);
 
-/* Number of edges at vertex v (0 for an unused vertex).
+/* Number of edges at vertex v (0 for an unused vertex). It walks the fan of
+   vert_corner[v]: at a non-manifold vertex (TT_MESH_PERMISSIVE) the edges
+   of the other fans are not counted (tt_mesh_valence_histogram and
+   tt_mesh_stats count them all).
    Preconditions (TT_ASSERT): mesh is not NULL, 0 <= vertex < mesh->nverts. */
 TTDEF int tt_mesh_valence(const tt_mesh *mesh, int vertex);
 
