@@ -845,8 +845,9 @@ typedef struct tt_cg_report {
    b = 0 gives x = 0 at once. Symmetry is assumed, not checked (checking
    costs more than several steps): a non-symmetric A may stall or break down.
    Memory: one scratch block of 5 n doubles (6 n and the factor with
-   incomplete Cholesky) for the whole solve, nothing per step. A step costs one product with A (with p . A p in the same pass) and
-   two fused passes over the vectors; one more product confirms the result.
+   incomplete Cholesky) for the whole solve, nothing per step. A step
+   costs one product with A (with p . A p in the same pass) and two fused
+   passes over the vectors; one more product confirms the result.
    Thread-safe: several threads may solve with the same A and b into
    distinct x. */
 TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, const tt_cg_options *options,
