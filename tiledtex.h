@@ -459,7 +459,9 @@ typedef enum tt_subdivision {
    vertices, or where float cannot separate the new points (a tiny face far
    from the origin); tt_face_normal gives (0, 0, 0) for such a quad. New
    points that overflow float are TT_ERROR_NON_FINITE; a mesh without faces
-   (made by hand) is TT_ERROR_EMPTY_MESH. */
+   (made by hand) is TT_ERROR_EMPTY_MESH; a result of more than 2^30 - 1
+   corners or vertices is TT_ERROR_TOO_LARGE; NULL arguments, an unknown
+   scheme or a bad allocator are TT_ERROR_INVALID_ARGUMENT. */
 TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error);
 
