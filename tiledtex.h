@@ -3742,10 +3742,11 @@ static void tt__clear_places(tt_error *error)
 }
 
 /* Fill *error (if given) and return `result`. Every error path goes through
-   here, so every error carries a sentence and the place it refers to; places
-   other than a face, corner or vertex are set after it (tt__fail_at). Numbers
-   in messages use %g-style formats, never %f, so a huge value cannot push
-   the sentence past the buffer. */
+   here or tt__fail_at, so every error carries a sentence and the place it
+   refers to: here a face, corner, vertex and other vertex; tt__fail_at an
+   input item, row and column; a caller sets other_face after the call.
+   Numbers in messages use %g-style formats (%.0f only for values bounded
+   first), so a huge value cannot push the sentence past the buffer. */
 static tt_result tt__fail(tt_error *error, tt_result result, int face, int corner, int vertex,
                           int other_vertex, const char *format, ...)
 {
