@@ -121,7 +121,8 @@
        tt_make_texture_patch(photo, NULL, NULL, NULL, &patch, &err);
        tt_lapped_paste(mesh, field, &patch, 1, NULL, NULL, &pastes, &err);
        // draw pastes->pastes[p] in order, alpha-blended: faces pastes->faces[first..],
-       // corner UVs pastes->uv[6 * entry ..] into the patch; or bake them:
+       // corner UVs pastes->uv[6 * entry ..] into the patch, the patch's alpha times
+       // pastes->fade[3 * entry ..] (0 where a paste stops); or bake them:
        tt_atlas_pack_pairs(mesh, 2048, 2, corner_uv, &err);      // float corner_uv[6 * ntris]
        tt_lapped_bake(mesh, pastes, &patch, 1, corner_uv, NULL, NULL, atlas, &err);
        tt_lapped_free(pastes); tt_image_free(patch);             // atlas: your 2048 x 2048 tt_image
@@ -166,14 +167,17 @@
      3. Image   - float RGBA images, colour spaces, bilinear sampling, 90-degree
                   rotations, premultiplied `over`, box downsampling,
                   minimum-error cut
-     4. Numerics - triplets to CSR sparse matrices, Jacobi-preconditioned
-                  conjugate gradients (symmetric positive definite systems),
+     4. Numerics - triplets to CSR sparse matrices, conjugate gradients
+                  preconditioned by Jacobi or incomplete Cholesky (symmetric
+                  positive definite systems),
                   radix-2 FFTs (1D, 2D, real input), masked cross-correlation
      5. Raster  - 2D triangle rasterisation with barycentrics
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
                 - boundary assignment (random or prescribed), UV formula,
-                  tile-set synthesis as a plan applied to one or more images,
+                  tiles turned to follow a direction field (upright tiles),
+                  fewer distinct tiles, tile-set synthesis as a plan applied
+                  to one or more images, a compact atlas of the tiles shown,
                   quality report
      7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures")
                 - tangent field: texture up and scale per face (Sec. 3.2)
@@ -418,7 +422,10 @@ typedef struct tt_mesh_stats {
 TTDEF tt_result tt_mesh_compute_stats(const tt_mesh *mesh, const tt_allocator *allocator, tt_mesh_stats *stats,
                                       tt_error *error);
 
-/* Number of edges at vertex v (0 for an unused vertex).
+/* Number of edges at vertex v (0 for an unused vertex). It walks the fan of
+   vert_corner[v]: at a non-manifold vertex (TT_MESH_PERMISSIVE) the edges
+   of the other fans are not counted (tt_mesh_valence_histogram and
+   tt_mesh_stats count them all).
    Preconditions (TT_ASSERT): mesh is not NULL, 0 <= vertex < mesh->nverts. */
 TTDEF int tt_mesh_valence(const tt_mesh *mesh, int vertex);
 
@@ -452,7 +459,9 @@ typedef enum tt_subdivision {
    vertices, or where float cannot separate the new points (a tiny face far
    from the origin); tt_face_normal gives (0, 0, 0) for such a quad. New
    points that overflow float are TT_ERROR_NON_FINITE; a mesh without faces
-   (made by hand) is TT_ERROR_EMPTY_MESH. */
+   (made by hand) is TT_ERROR_EMPTY_MESH; a result of more than 2^30 - 1
+   corners or vertices is TT_ERROR_TOO_LARGE; NULL arguments, an unknown
+   scheme or a bad allocator are TT_ERROR_INVALID_ARGUMENT. */
 TTDEF tt_result tt_mesh_quadrangulate(const tt_mesh *mesh, tt_subdivision scheme, const tt_allocator *allocator,
                                       tt_mesh **out_mesh, tt_error *error);
 
@@ -498,7 +507,7 @@ typedef struct tt_corner_sources {
    TT_ERROR_OUT_OF_MEMORY. On failure *out is NULL and nothing stays
    allocated. Memory: 8 bytes per source, 5 + |f| sources per input corner
    of face f (a face point lists its face's corners in each of its quads,
-   so an n-gon costs n * n; 9 per corner of a triangle, 9 per quad corner),
+   so an n-gon costs n * n; 8 per corner of a triangle, 9 per quad corner),
    plus 4 bytes per new corner. Free the result with
    tt_corner_sources_free. Thread-safe. */
 TTDEF tt_result tt_mesh_quadrangulate_sources(const tt_mesh *mesh, const tt_allocator *allocator,
@@ -664,9 +673,11 @@ TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *al
 /* Minimum-error cut (as in image quilting): in a width x height cost map, find
    the path path[x] (one row per column) with path[x] in [lo[x], hi[x]] and
    |path[x] - path[x-1]| <= 1 that minimises the sum of cost[path[x]*width + x].
-   Ties go to the smaller row. Needs lo[x] <= hi[x] and consecutive ranges
-   that a path can follow (TT_ERROR_INVALID_ARGUMENT otherwise, naming the
-   column); a NaN cost is TT_ERROR_NON_FINITE. path has width entries. */
+   Ties go to the smaller row. Needs 0 <= lo[x] <= hi[x] < height
+   (TT_ERROR_INVALID_ARGUMENT otherwise, naming the column) and consecutive
+   ranges that a path can follow (TT_ERROR_INVALID_ARGUMENT); a NaN or
+   infinite cost is TT_ERROR_NON_FINITE (naming its row and column); a map
+   of more than 2^28 entries is TT_ERROR_TOO_LARGE. path has width entries. */
 TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
                                  const tt_allocator *allocator, int *path, tt_error *error);
 
@@ -680,7 +691,8 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
    tangent field (Praun et al. Sec. 3.4), hierarchical pattern mapping
    flattens each face cluster (Soler et al. Sec. 3.2). Such a system is
    assembled as triplets, compressed into rows (CSR) and solved by the Jacobi
-   (diagonal) preconditioned conjugate gradient method, with the formulas of
+   (diagonal) preconditioned conjugate gradient method (or, as an option,
+   incomplete Cholesky: TT_CG_INCOMPLETE_CHOLESKY), with the formulas of
    Shewchuk, "An Introduction to the Conjugate Gradient Method Without the
    Agonizing Pain" (edition 1 1/4, 1994), Sec. 12 and the preconditioned
    algorithm in the third part of its appendix B (M = diag(A)):
@@ -822,7 +834,8 @@ typedef struct tt_cg_report {
                                     iteration;
      TT_ERROR_INVALID_ARGUMENT      NULL pointers, b == x, A not square or its
                                     row_start array inconsistent, negative
-                                    max_iterations or tolerance, an unknown
+                                    max_iterations, a negative or non-finite
+                                    tolerance, a bad allocator, an unknown
                                     preconditioner, or incomplete Cholesky on
                                     a row whose columns do not increase
                                     (error->row);
@@ -833,9 +846,10 @@ typedef struct tt_cg_report {
      TT_ERROR_OUT_OF_MEMORY.
    b = 0 gives x = 0 at once. Symmetry is assumed, not checked (checking
    costs more than several steps): a non-symmetric A may stall or break down.
-   Memory: one scratch block of 5 n doubles for the whole solve, nothing per
-   step. A step costs one product with A (with p . A p in the same pass) and
-   two fused passes over the vectors; one more product confirms the result.
+   Memory: one scratch block of 5 n doubles (6 n and the factor with
+   incomplete Cholesky) for the whole solve, nothing per step. A step
+   costs one product with A (with p . A p in the same pass) and two fused
+   passes over the vectors; one more product confirms the result.
    Thread-safe: several threads may solve with the same A and b into
    distinct x. */
 TTDEF tt_result tt_cg_solve(const tt_sparse_matrix *A, const double *b, const tt_cg_options *options,
@@ -1187,8 +1201,9 @@ typedef struct tt_tile_layout {
 
 /* Replace zeros by defaults and check ranges: colors 1..TT_MAX_COLORS, tile
    size 4..TT_MAX_IMAGE_SIZE, gutter 0..tile size, and an atlas side within
-   TT_MAX_IMAGE_SIZE (TT_ERROR_TOO_LARGE otherwise; TT_ERROR_INVALID_ARGUMENT
-   for the others). Resolving a resolved layout changes nothing. */
+   TT_MAX_IMAGE_SIZE (a tile size or an atlas side above it is
+   TT_ERROR_TOO_LARGE; anything else out of range, or a NULL in or out, is
+   TT_ERROR_INVALID_ARGUMENT). Resolving a resolved layout changes nothing. */
 TTDEF tt_result tt_tile_layout_resolve(const tt_tile_layout *in, tt_tile_layout *out, tt_error *error);
 /* Tiles per atlas side T, atlas side W, total tiles (2n)^4; zeros in the
    layout mean defaults, as everywhere.
@@ -1231,7 +1246,10 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
 
 /* AssignTextureCoordinates: corner_uv gets 2 * mesh->ncorners floats. Every face
    must be a quad (TT_ERROR_NOT_QUAD_MESH names the first that is not). The
-   layout is resolved internally (zeros mean defaults). A mesh without faces
+   layout is resolved internally (zeros mean defaults; one that does not
+   resolve gives tt_tile_layout_resolve's error). Other errors: NULL
+   arguments (TT_ERROR_INVALID_ARGUMENT), a type of 2n or more
+   (TT_ERROR_INDEX_OUT_OF_RANGE, naming the corner). A mesh without faces
    (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                               float *corner_uv, tt_error *error);
@@ -1299,7 +1317,8 @@ TTDEF tt_result tt_assign_uvs_oriented(const tt_mesh *mesh, const tt_tile_layout
                  tiles and its tops plain ones: one tile index, two cells);
      out_tiles   NULL, or the distinct (group, tile) pairs shown after.
    Every face must be a quad. Same input and seed, same result. Memory:
-   about 24 bytes per face, from `allocator`, freed before it returns.
+   about 100 to 200 bytes per face (a table of 4 to 8 slots a face, 24 bytes
+   a slot) and 4 per edge, from `allocator`, freed before it returns.
    Errors: NULL mesh, layout or corner_type, a bad allocator, colors
    outside 1..TT_MAX_COLORS, max_tiles below 1 (TT_ERROR_INVALID_ARGUMENT);
    a face that is not a quad (TT_ERROR_NOT_QUAD_MESH); edge_colors as
@@ -1434,10 +1453,12 @@ typedef struct tt_synth_plan {
    tt_image_kind (TT_ERROR_INVALID_ARGUMENT), a bad
    allocator, a non-finite guide texel (TT_ERROR_NON_FINITE, error->row /
    column = its y / x), a layout that does not resolve, a guide smaller than S
-   x 2S or a background region that cannot hold a tile
-   (TT_ERROR_IMAGE_TOO_SMALL), a background region outside the guide, a given
-   edge window that does not fit, a feather wider than S/4 + 1
-   (TT_ERROR_INVALID_ARGUMENT), TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by the
+   x 2S (2S x 2S for upright tiles) or a background region that cannot hold
+   a tile (TT_ERROR_IMAGE_TOO_SMALL), a background region outside the guide,
+   a given edge window that does not fit, a negative feather or one wider
+   than S/4 + 1, background_candidates outside
+   0..TT_SYNTH_MAX_BACKGROUND_CANDIDATES (TT_ERROR_INVALID_ARGUMENT),
+   TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by the
    progress callback. *out_plan is NULL on failure and nothing is left
    allocated. Temporary memory, freed before it returns: about 20 * S * S
    bytes (a scratch tile and the cut's cost tables). Time: about that of
@@ -1537,9 +1558,10 @@ TTDEF void tt_tileset_free(tt_tileset *tileset);
 /* --- The compact atlas: only the tiles a mesh shows ---
 
    The layout's atlas holds every one of the (2n)^4 tiles whether the mesh
-   shows it or not: 2176 x 2176 texels at the defaults (twice as wide with a
-   polycube's upright tiles), a size no engine asks for and, beside upright
-   tiles, above the 4096 texels a side many take. A compact atlas holds only
+   shows it or not: 2176 x 2176 texels with 2 colours, 128-texel tiles and
+   gutter 4 (the tiledtex tool's polycube defaults; twice as wide with its
+   upright tiles), a size no engine asks for and, beside upright tiles,
+   above the 4096 texels a side many take. A compact atlas holds only
    the cells the faces use, each whole with its gutter (so bilinear
    filtering and the mip levels a gutter keeps seamless read what the full
    atlas had there), in a power-of-two rectangle: the smallest of W x W and
@@ -1689,8 +1711,8 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
                                  tt_seam_report *report, tt_error *error);
 
 /* counts[t] = number of quads using tile t (tt_tile_layout_tile_count entries).
-   Errors: NULL pointers, a layout that does not resolve
-   (TT_ERROR_INVALID_ARGUMENT), a face that is not a quad
+   Errors: NULL pointers (TT_ERROR_INVALID_ARGUMENT), a layout that does not
+   resolve (tt_tile_layout_resolve's error), a face that is not a quad
    (TT_ERROR_NOT_QUAD_MESH, naming it), a type of 2n or more
    (TT_ERROR_INDEX_OUT_OF_RANGE, naming the corner). A mesh without faces (made by hand) is TT_ERROR_EMPTY_MESH. */
 TTDEF tt_result tt_tile_histogram(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
@@ -3722,10 +3744,11 @@ static void tt__clear_places(tt_error *error)
 }
 
 /* Fill *error (if given) and return `result`. Every error path goes through
-   here, so every error carries a sentence and the place it refers to; places
-   other than a face, corner or vertex are set after it (tt__fail_at). Numbers
-   in messages use %g-style formats, never %f, so a huge value cannot push
-   the sentence past the buffer. */
+   here or tt__fail_at, so every error carries a sentence and the place it
+   refers to: here a face, corner, vertex and other vertex; tt__fail_at an
+   input item, row and column; a caller sets other_face after the call.
+   Numbers in messages use %g-style formats (%.0f only for values bounded
+   first), so a huge value cannot push the sentence past the buffer. */
 static tt_result tt__fail(tt_error *error, tt_result result, int face, int corner, int vertex,
                           int other_vertex, const char *format, ...)
 {
@@ -4391,8 +4414,6 @@ static double tt__face_longest_edge(const tt_mesh *mesh, int face)
     return longest;
 }
 
-/* TT_OK when every face is a triangle; else TT_ERROR_INVALID_ARGUMENT
-   naming the first other face: "face F has N corners: <why>". */
 /* A tt_mesh of no faces can only be made by hand (tt_mesh_build refuses
    it): every function that takes a mesh refuses it too. */
 static tt_result tt__require_faces(const tt_mesh *mesh, tt_error *error)
@@ -4402,6 +4423,9 @@ static tt_result tt__require_faces(const tt_mesh *mesh, tt_error *error)
     return TT_OK;
 }
 
+/* TT_OK when every face is a triangle; else TT_ERROR_INVALID_ARGUMENT
+   naming the first other face: "face F has N corners: <why>"
+   (TT_ERROR_EMPTY_MESH for a mesh without faces, as tt__require_faces). */
 static tt_result tt__require_triangles(const tt_mesh *mesh, const char *why, tt_error *error)
 {
     int f;
@@ -11268,13 +11292,6 @@ static void tt__face_tangents(const float *const point[4], int dims, int size, d
     }
 }
 
-/* The map from texture to surface of `face` at its centre, M (3x2, columns
-   dP/du and dP/dv), through the face's own parametrisation (s, t): for a
-   quad the bilinear patch's derivatives, otherwise the first triangle.
-   A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2) with texture coordinates
-   (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
-   M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
-   M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
 /* Eigenvalues big >= small of the symmetric 2x2 matrix [g11 g12; g12 g22]:
    a map's metric, whose square roots are its singular values. */
 static void tt__metric_eigenvalues(double g11, double g12, double g22, double *big, double *small)
@@ -11284,6 +11301,13 @@ static void tt__metric_eigenvalues(double g11, double g12, double g22, double *b
     *small = 0.5 * (tr - disc);
 }
 
+/* The map from texture to surface of `face` at its centre, M (3x2, columns
+   dP/du and dP/dv), through the face's own parametrisation (s, t): for a
+   quad the bilinear patch's derivatives, otherwise the first triangle.
+   A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2) with texture coordinates
+   (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
+   M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
+   M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
 static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
                                        double v_scale, double *big, double *small)
 {
