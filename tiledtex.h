@@ -5793,10 +5793,10 @@ static tt_result tt__check_image_size(int width, int height, tt_error *error)
     return TT_OK;
 }
 
-/* Pixels for an image held by value inside a larger object (a tileset's mip
-   levels); released with tt__image_release. */
-/* An image whose pixels are allocated but not set: for a writer that sets
-   every texel (and then touches the memory first, on its own threads). */
+/* An image held by value (inside a larger object, such as a tileset's mip
+   levels) whose pixels are allocated but not set: for a writer that sets
+   every texel (and then touches the memory first, on its own threads).
+   Released with tt__image_release. */
 static tt_result tt__image_alloc(tt_image *image, int width, int height, const tt_allocator *allocator,
                                  tt_error *error)
 {
@@ -6244,8 +6244,8 @@ TTDEF tt_result tt_image_over(tt_image *dst, const tt_image *src, tt_error *erro
     return TT_OK;
 }
 
-/* dst (allocated, half the size of src) = src halved by a 2x2 box. */
-/* Rows y0 .. y1-1 of dst, every texel of them. */
+/* Rows y0 .. y1-1 of dst (allocated, half the size of src): src halved by
+   a 2x2 box. */
 static void tt__downsample_rows(const tt_image *src, tt_image *dst, int y0, int y1)
 {
     int x, y, k, w = dst->width;
@@ -27118,7 +27118,7 @@ typedef struct tt__clip_point {
 } tt__clip_point;
 
 /* The split of a range of triangles (one task of tt_polycube_map's split;
-   see tt__split_range). Output vertices are named by tokens while a task
+   see tt__split_range_task). Output vertices are named by tokens while a task
    runs: a model vertex by its index, a split point of the records by
    token_crossing + the index of its crossing (the first at its t), a
    vertex the task makes by token_local + its index in `out`, the task's

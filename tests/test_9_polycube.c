@@ -2207,6 +2207,62 @@ static void test_map_sphere(void)
         }
 }
 
+/* A triangle with a vertex on a saddle of S whose corner there spans more
+   than half a turn has no straight image: the path across from that vertex
+   runs through the saddle too, and the triangle collapses onto two
+   segments. The mapping splits that edge (unpinched). On triangulated tori
+   (whose polycubes have saddles around the hole) at several resolutions:
+   pinches occur (the control: each one split was a collapsed triangle),
+   the output stays closed, area-true and one quad per triangle, and fewer
+   collapsed triangles are left than pinches were split. */
+static void test_map_unpinch(void)
+{
+    int round, unpinched = 0, collapsed = 0, bad = 0;
+    for (round = 0; round < 3; round++) {
+        const double pi = 3.14159265358979323846, R = 1.0, r = 0.3 + 0.05 * round;
+        const int nu = 64, nv = 24;
+        tmesh m;
+        tt_mesh *mesh;
+        tt_polycube *pc;
+        tt_polycube_map_report rep;
+        tt_polycube_mapping *map;
+        int i, j;
+        memset(&m, 0, sizeof m);
+        for (j = 0; j < nv; j++)
+            for (i = 0; i < nu; i++) {
+                double a = 2 * pi * (i + 0.5 * j) / nu, b = 2 * pi * j / nv;
+                tm_vert(&m, (R + r * cos(b)) * cos(a), (R + r * cos(b)) * sin(a), r * sin(b) + 0.1 * sin(3 * a));
+            }
+        for (j = 0; j < nv; j++)
+            for (i = 0; i < nu; i++) {
+                /* Row nv is row 0 turned by half nv columns (the rows are sheared). */
+                int i1 = (i + 1) % nu, j1 = (j + 1) % nv, wrap = j1 == 0 ? nv / 2 : 0;
+                int a = j * nu + i, b = j * nu + i1, c = j1 * nu + (i1 + wrap) % nu, d = j1 * nu + (i + wrap) % nu;
+                tm_tri(&m, a, b, c);
+                tm_tri(&m, a, c, d);
+            }
+        map = mapped(&m, 16 + 8 * round, 0, 0.0, &pc, &mesh, &rep);
+        if (map) {
+            mapping_check c = check_mapping(pc, mesh, map);
+            if (c.off_surface || c.bad_points || c.bad_faces || c.area_error > 1e-6 || c.strict_fails || c.open_edges)
+                bad++;
+            printf("     torus r %.2f at %d: %d unpinched, %d collapsed, %d fallbacks of %d\n", r, 16 + 8 * round,
+                   rep.unpinched, rep.collapsed, rep.fallback_triangles, rep.triangles);
+            unpinched += rep.unpinched;
+            collapsed += rep.collapsed;
+        } else {
+            bad++;
+        }
+        tt_polycube_mapping_free(map);
+        tt_polycube_free(pc);
+        tt_mesh_free(mesh);
+        tm_free(&m);
+    }
+    CHECK(bad == 0, "tori with pinches: %d mappings not closed, area-true and one quad per triangle", bad);
+    CHECK(unpinched > 0 && collapsed < unpinched, "tori: %d pinches split (some expected), %d collapsed triangles "
+          "left (fewer expected)", unpinched, collapsed);
+}
+
 /* The default refinement maps once with edges up to a cube, then refines
    to half a cube only the faces that mapping fell short on and maps again.
    The control, one mapping at a cube, must fall short somewhere (a
@@ -3839,6 +3895,7 @@ void run_polycube_tests(void)
     RUN(test_map_cube);
     RUN(test_map_sphere);
     RUN(test_map_refine_where_needed);
+    RUN(test_map_unpinch);
     RUN(test_map_uvs_and_seams);
     RUN(test_map_uvs_upright);
     RUN(test_map_determinism_and_errors);
