@@ -3519,7 +3519,13 @@ typedef struct tt_polycube_mapping {
         (it lies just behind a saddle) would map part of that triangle
         onto a line; it is moved onto W unless another point is there,
         and the edges are traced again (a vertex whose edges then find no
-        path goes back, and they are traced once more);
+        path goes back, and they are traced once more); then pinches: a
+        triangle whose vertex lies on a saddle W of S and whose corner
+        there spans more than half a turn of S would collapse onto two
+        segments (the path across runs through W as well); that edge is
+        split at its midpoint, the new point on the path from W to the
+        next triangle's third vertex, and the new edges traced
+        (report->unpinched);
      6. per triangle, the split:
         - its boundary (its vertices and its edges' split points, from
           the records) is unfolded into one chart from its first vertex's

@@ -592,6 +592,7 @@ static void print_summary(const polycube_command_options *options, const polycub
        where that mapping fell short. */
     if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
     if (m->refined_again) printf(" (%d input faces refined further, where a first mapping fell short)", m->refined_again);
+    if (m->unpinched) printf(" (%d edges split where a triangle wrapped a saddle of the polycube)", m->unpinched);
     printf("; smoothing: %d moves, %d vertices left as projected", m->smoothed, m->held);
     printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);
