@@ -2110,7 +2110,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
 typedef struct tt_lapped_options {
     uint64_t seed;              /* random seed: same seed, same result */
     int isotropic;              /* 1: orientation by propagation per paste (only |T_f| counts) */
-    int max_pastes;             /* cap on pastes; 0 = TT_LAPPED_MAX_PASTES */
+    int max_pastes;             /* cap on pastes; 0 (or above TT_LAPPED_MAX_PASTES) = TT_LAPPED_MAX_PASTES */
     int keep_edges;             /* 1: each paste keeps its patch's whole edge; 0: where it lies over what is
                                    opaque, its edge is cut where it best matches what lies beneath (a
                                    minimum-error cut, as tile synthesis cuts its bands; not when isotropic) */
@@ -15462,7 +15462,8 @@ TTDEF tt_result tt_lapped_paste(const tt_mesh *mesh, const float *face_vectors, 
     if (opts.max_pastes < 0)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_lapped_paste: max_pastes is %d, it must be 0 (default) or more", opts.max_pastes);
-    max_pastes = opts.max_pastes ? opts.max_pastes : TT_LAPPED_MAX_PASTES;
+    /* The compile-time limit holds whatever the option asks: it only lowers it. */
+    max_pastes = opts.max_pastes && opts.max_pastes < TT_LAPPED_MAX_PASTES ? opts.max_pastes : TT_LAPPED_MAX_PASTES;
     memset(&L, 0, sizeof L);
     L.mesh = mesh;
     L.patches = patches;

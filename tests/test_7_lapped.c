@@ -4,6 +4,7 @@
    */
 #include "test_common.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -2823,6 +2824,14 @@ static void test_lapped_errors(void)
         r = tt_lapped_paste(mesh, big, &patch, 1, NULL, NULL, &out, &err);
         LAPPED_EXPECT(r, out, TT_ERROR_TOO_LARGE, "tiny patches");
         CHECK(strstr(err.message, "pastes") != NULL, "tiny patches: %s", err.message);
+        /* max_pastes only lowers the compile-time limit: asking for more is held to it. */
+        lo.max_pastes = INT_MAX;
+        out = &g_lapped_sentinel;
+        r = tt_lapped_paste(mesh, big, &patch, 1, &lo, NULL, &out, &err);
+        LAPPED_EXPECT(r, out, TT_ERROR_TOO_LARGE, "tiny patches with max_pastes INT_MAX");
+        CHECK(msg_has_number(err.message, TT_LAPPED_MAX_PASTES), "max_pastes INT_MAX: the limit %d holds: %s",
+              TT_LAPPED_MAX_PASTES, err.message);
+        lo.max_pastes = 0;
         /* Astronomically many pastes (about 1e60): the message stays short
            and gives the estimate in %g form, not 61 digits. */
         fo.scale = 1e-30f;
