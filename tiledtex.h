@@ -2233,11 +2233,13 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
    into texels (u * width, v * height), and the texture's up (0, 1), taken
    between lines: 0 to 90 degrees, a texture upside down lying level (the
    courses of a wall do). A face whose UV map is singular or not finite
-   counts as 90. No wall face: TT_ERROR_NOT_MEASURED (the statistics NaN).
-   Errors: NULL pointers, width or height below 1, a face that is not a
-   triangle (error->face), a zero or non-finite up, options out of range
-   (TT_ERROR_INVALID_ARGUMENT); TT_ERROR_OUT_OF_MEMORY. Temporary memory: 8
-   bytes a face. Only reads its inputs. */
+   counts as 90. A face of more corners (a tiling's quads) is measured as
+   the fan of triangles from its first corner, phi(P_f(up)) their mean, its
+   normal theirs added up. No wall face: TT_ERROR_NOT_MEASURED (the
+   statistics NaN). Errors: NULL pointers, width or height below 1, a zero
+   or non-finite up, options out of range (TT_ERROR_INVALID_ARGUMENT);
+   TT_ERROR_OUT_OF_MEMORY. Temporary memory: 8 bytes a face. Only reads its
+   inputs. */
 typedef struct tt_uv_direction_options {
     float up[3];            /* the world's up; 0,0,0 = (0,1,0), as tt_field_options */
     double min_projected;   /* wall faces: |P_f(up)| at least this; 0 = 0.7, about 45 degrees from level */
@@ -13411,12 +13413,12 @@ static const float *tt__corner_pos(const tt_mesh *mesh, int corner)
 }
 
 /* The weights (w0, w1, w2), summing to 0, with which a vector t in the plane
-   of triangle f is a combination of its corners: t = sum w_i P_i (Sec. 3.4,
-   footnote 1). Then phi(t) = sum w_i phi(P_i) for the linear map phi. */
-static void tt__face_vector_weights(const tt_mesh *mesh, int f, const double *t, double w[3])
+   of the triangle of corners c0, c1, c2 is a combination of its corners:
+   t = sum w_i P_i (Sec. 3.4, footnote 1). Then phi(t) = sum w_i phi(P_i)
+   for the linear map phi. */
+static void tt__corners_vector_weights(const tt_mesh *mesh, int c0, int c1, int c2, const double *t, double w[3])
 {
-    const float *a = tt__corner_pos(mesh, 3 * f), *b = tt__corner_pos(mesh, 3 * f + 1);
-    const float *c = tt__corner_pos(mesh, 3 * f + 2);
+    const float *a = tt__corner_pos(mesh, c0), *b = tt__corner_pos(mesh, c1), *c = tt__corner_pos(mesh, c2);
     double e1[3], e2[3], g11, g12, g22, r1, r2, det;
     tt__sub3f(b, a, e1);
     tt__sub3f(c, a, e2);
@@ -13427,6 +13429,12 @@ static void tt__face_vector_weights(const tt_mesh *mesh, int f, const double *t,
     w[1] = (g22 * r1 - g12 * r2) / det;
     w[2] = (g11 * r2 - g12 * r1) / det;
     w[0] = -w[1] - w[2];
+}
+
+/* The same for triangle f of a triangle mesh. */
+static void tt__face_vector_weights(const tt_mesh *mesh, int f, const double *t, double w[3])
+{
+    tt__corners_vector_weights(mesh, 3 * f, 3 * f + 1, 3 * f + 2, t, w);
 }
 
 /* The weights of face f's axes T_f and S_f = T_f x N_f over its corners
@@ -15717,30 +15725,34 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
                         "tt_measure_uv_direction: up must be finite and not zero, min_projected in (0, 1], "
                         "tolerance in (0, 90] degrees (got %g, %g)", min_projected, tolerance);
     for (k = 0; k < 3; k++) up[k] /= length;
-    for (f = 0; f < mesh->nfaces; f++)
-        if (mesh->face_start[f + 1] - mesh->face_start[f] != 3)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
-                            "face %d has %d corners: the direction measure needs triangles", f,
-                            mesh->face_start[f + 1] - mesh->face_start[f]);
     angles = TT__ALLOC(allocator, double, (size_t)mesh->nfaces + 1);
     if (!angles)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d faces",
                         mesh->nfaces);
     for (f = 0; f < mesh->nfaces; f++) {
-        double a[3], b[3], normal[3], projected[3], w[3], image[2] = {0.0, 0.0}, angle, scale, along;
-        const float *uv = corner_uv + 6 * (size_t)f;
-        tt__sub3f(tt__corner_pos(mesh, 3 * f + 1), tt__corner_pos(mesh, 3 * f), a);
-        tt__sub3f(tt__corner_pos(mesh, 3 * f + 2), tt__corner_pos(mesh, 3 * f), b);
-        tt__cross3(a, b, normal);
+        const int first = mesh->face_start[f], fan = mesh->face_start[f + 1] - first - 2;
+        const float *uv = corner_uv + 2 * (size_t)first;
+        double a[3], b[3], cross[3], normal[3] = {0.0, 0.0, 0.0}, projected[3], w[3], image[2] = {0.0, 0.0};
+        double angle, scale, along;
+        int i;
+        for (i = 1; i <= fan; i++) {
+            tt__sub3f(tt__corner_pos(mesh, first + i), tt__corner_pos(mesh, first), a);
+            tt__sub3f(tt__corner_pos(mesh, first + i + 1), tt__corner_pos(mesh, first), b);
+            tt__cross3(a, b, cross);
+            for (k = 0; k < 3; k++) normal[k] += cross[k];
+        }
         length = tt__length3(normal);
         if (!(length > 0.0 && length < 1e300)) continue;   /* no plane: not a wall */
         along = tt__dot3(up, normal) / length;
         for (k = 0; k < 3; k++) projected[k] = up[k] - along * normal[k] / length;
         if (!(tt__length3(projected) >= min_projected)) continue;
-        tt__face_vector_weights(mesh, f, projected, w);
-        for (k = 0; k < 3; k++) {
-            image[0] += w[k] * uv[2 * k] * width;
-            image[1] += w[k] * uv[2 * k + 1] * height;
+        for (i = 1; i <= fan; i++) {
+            const int corners[3] = {0, i, i + 1};
+            tt__corners_vector_weights(mesh, first, first + i, first + i + 1, projected, w);
+            for (k = 0; k < 3; k++) {
+                image[0] += w[k] * uv[2 * corners[k]] * width / fan;
+                image[1] += w[k] * uv[2 * corners[k] + 1] * height / fan;
+            }
         }
         tt__alignment_error(image, &angle, &scale);
         if (!(scale > 0.0 && scale < 1e300)) {

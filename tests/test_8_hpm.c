@@ -1713,6 +1713,37 @@ static void test_uv_direction_measure(void)
                   near(r.p90, r.mean, 1e-3) && r.within == (turns[k] == 30 ? 0.0 : 1.0) && r.singular == 0,
               "turned %d degrees: %d faces, mean %g, p90 %g, within %g", turns[k], r.faces, r.mean, r.p90, r.within);
     }
+    /* Quads (a tiling's faces) are measured as their fans: the same wall in
+       quads reads 30 degrees turned; each quad's corners' UVs passed on by
+       one (its tile turned a quarter) read 90. */
+    {
+        tt_mesh *quads = NULL;
+        float *quad_uv;
+        int i, j;
+        memset(&m, 0, sizeof m);
+        for (j = 0; j <= 4; j++)
+            for (i = 0; i <= 6; i++) tm_vert(&m, i, 0, j);
+        for (j = 0; j < 4; j++)
+            for (i = 0; i < 6; i++) tm_quad(&m, j * 7 + i, j * 7 + i + 1, j * 7 + i + 8, j * 7 + i + 7);
+        CHECK(build(&m, 0, &quads, NULL) == TT_OK, "quad wall");
+        tm_free(&m);
+        quad_uv = quads ? (float *)malloc(sizeof(float) * 2 * (size_t)quads->ncorners) : NULL;
+        for (k = 0; quad_uv && k < 2; k++) {
+            double a = 30 * 3.14159265358979323846 / 180;
+            for (f = 0; f < quads->ncorners; f++) {
+                const int c = k ? quads->face_start[f / 4] + (f % 4 + 1) % 4 : f;
+                const float *p = quads->pos + 3 * quads->corner_vert[c];
+                quad_uv[2 * f] = (float)(0.1 * (cos(a) * p[0] - sin(a) * p[2]));
+                quad_uv[2 * f + 1] = (float)(0.1 * (sin(a) * p[0] + cos(a) * p[2]));
+            }
+            CHECK(tt_measure_uv_direction(quads, quad_uv, 64, 64, &o, NULL, &r, &err) == TT_OK &&
+                      r.faces == quads->nfaces && near(r.mean, k ? 60 : 30, 1e-3) && r.within == 0.0,
+                  "quads turned 30 degrees%s: %d faces, mean %g (%d expected)", k ? " and a quarter" : "", r.faces,
+                  r.mean, k ? 60 : 30);
+        }
+        free(quad_uv);
+        tt_mesh_free(quads);
+    }
     /* a non-square image weighs its axes: turned 45 degrees in (u, v), the
        map is turned atan(1/2) = 26.6 degrees in texels of a 64 x 128 image */
     for (f = 0; f < wall->ncorners; f++) {
