@@ -2865,7 +2865,8 @@ typedef struct tt_hpm_report {
                                                (each a masked correlation over every copy) */
     int copies;                             /* turned copies of the image each fit tries */
     int accepted_fits;                      /* fits at or below the threshold */
-    int floor_fits;                         /* fits above it, accepted at the floor */
+    int floor_fits;                         /* fits at the floor: above the threshold, accepted, or
+                                               floor_continued */
     int rejected_fits;                      /* fits above it: the cluster was split */
     int continued;                          /* small clusters continuing a neighbour's map (no fit) */
     int faces_moved;                        /* faces that changed sides in the border choice */
@@ -2879,6 +2880,9 @@ typedef struct tt_hpm_report {
     double texels_per_unit;                 /* the texel density: image width / scale */
     int match_width, match_height;          /* the matching copy's size */
     int fft_size;                           /* P */
+    int floor_continued;                    /* of floor_fits, those whose place gave way to a textured
+                                               neighbour's continuation, which matched the cluster's
+                                               borders better (at full resolution) */
 } tt_hpm_report;
 
 /* Texture `mesh` (triangles) from `image` (linear RGBA; alpha ignored).
@@ -19776,8 +19780,8 @@ static int tt__hpm_field_angle(const tt__hpm *S, int C, double *angle, double *c
     return 1;
 }
 
-/* Continue the map of C's best textured neighbour (most shared vertices,
-   then the smaller cluster index): the inverse of its rigid map. */
+/* C's main textured neighbour: the most shared vertices, then the smaller
+   cluster index. */
 static const tt__hpm_owner *tt__hpm_best_owner(const tt__hpm *S)
 {
     const tt__hpm_owner *best = NULL;
@@ -19791,9 +19795,10 @@ static const tt__hpm_owner *tt__hpm_best_owner(const tt__hpm *S)
     return best;
 }
 
-static int tt__hpm_continue_place(const tt__hpm *S, int C, tt__hpm_place *pl)
+/* Continue the map of textured neighbour `best`: the inverse of its rigid
+   map; 0 when that leaves a bounded image. */
+static int tt__hpm_continue_owner(const tt__hpm *S, int C, const tt__hpm_owner *best, tt__hpm_place *pl)
 {
-    const tt__hpm_owner *best = tt__hpm_best_owner(S);
     double field_angle, centre[2];
     if (!best) return 0;
     /* q = R(b) x / s + d  =>  x = s R(-b) (q - d) */
@@ -20784,6 +20789,61 @@ static int tt__hpm_same_place(const tt__hpm *S, const double *a, const double *b
     return fabs(dx) <= 1e-9 * (1 + fabs(a[0])) && fabs(dy) <= 1e-9 * (1 + fabs(a[1]));
 }
 
+/* The colour mismatch across C's edges with textured faces were C placed
+   rigidly by pl: tt__hpm_edge_compare per such edge, their mean (-1 when
+   C has none). It writes C's corners into S->uv. */
+static double tt__hpm_border_cost(tt__hpm *S, int C, const tt__hpm_place *pl)
+{
+    const tt_mesh *m = S->mesh;
+    const tt_cluster *cl = &S->H->clusters[C];
+    double sum = 0, mine[TT__HPM_SIDE_VALUES], theirs[TT__HPM_SIDE_VALUES];
+    int i, c, n = 0;
+    tt__hpm_write(S, C, pl, S->uv);
+    for (i = 0; i < cl->nfaces; i++) {
+        int f = S->H->faces[cl->first_face + i];
+        for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) {
+            int t = m->twin[c], K = t < 0 ? -1 : S->owner[m->corner_face[t]];
+            if (K < 0 || K == C) continue;
+            tt__hpm_edge_side(S, c, 0, mine);
+            tt__hpm_edge_side(S, c, 1, theirs);
+            sum += tt__hpm_edge_compare(S, mine, theirs, NULL);
+            n++;
+        }
+    }
+    return n ? sum / n : -1;
+}
+
+/* A continuation: C continues the map of one textured neighbour. Which
+   one is chosen where the seams are seen, at full resolution along C's
+   borders: the neighbour whose continuation gives the least mismatch
+   (tt__hpm_border_cost; the main neighbour when none has a border edge
+   with C). The main neighbour (the most shared vertices) left C's
+   borders with the others to chance; choosing by the mismatch lowered
+   the border seams with gravel on the flange from 0.168 to 0.128, on a
+   14k-face knot tube from 0.115 to 0.105. *cost is the chosen one's
+   mismatch (-1 when unknown); 0 when no continuation stays inside a
+   bounded image. */
+static int tt__hpm_continue_place(tt__hpm *S, int C, tt__hpm_place *pl, double *cost)
+{
+    const tt__hpm_owner *main_owner = tt__hpm_best_owner(S);
+    tt__hpm_place cand;
+    int k, found = 0;
+    *cost = -1;
+    for (k = 0; k < S->nowners; k++) {
+        const tt__hpm_owner *O = &S->owners[k];
+        double c;
+        if (!O->valid || !tt__hpm_continue_owner(S, C, O, &cand)) continue;
+        c = tt__hpm_border_cost(S, C, &cand);
+        if (c < 0 && O != main_owner) continue;
+        if (!found || (c >= 0 && (*cost < 0 || c < *cost))) {
+            *pl = cand;
+            *cost = c;
+            found = 1;
+        }
+    }
+    return found;
+}
+
 /* 1 when half-edge c is a border: both faces textured and the map jumps
    across it; c's face mapping its ends to uv_c and uv_next. */
 static int tt__hpm_is_border_at(const tt__hpm *S, int c, const double *uv_c, const double *uv_next)
@@ -21624,9 +21684,9 @@ static int tt__hpm_out_of_memory(int C, tt_result *res, tt_error *error)
 static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res, tt_error *error)
 {
     const tt_cluster *cl = &S->H->clusters[C];
-    double area_px = cl->area * S->s * S->s, eps = 0;
+    double area_px = cl->area * S->s * S->s, eps = 0, cont_cost;
     int below_floor, at_floor, stamp, fit;
-    tt__hpm_place pl;
+    tt__hpm_place pl, cont;
     tt_result fr;
     tt_flatten_report frep;
     S->state[C] = 1;
@@ -21659,13 +21719,31 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
         return 0;
     }
     fit = 0;
-    if (has_neighbours && below_floor && tt__hpm_continue_place(S, C, &pl)) {
+    if (has_neighbours && below_floor && tt__hpm_continue_place(S, C, &pl, &cont_cost)) {
         S->rep.continued++;
         return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     if (has_neighbours) {
         fit = tt__hpm_fit(S, C, stamp, &pl, &eps, res, error);
         if (fit == -2) return 0;
+    }
+    /* At the floor a fit is accepted whatever its error; there it competes
+       with the continuations, judged where the seam is seen. The fit
+       matches the band on the image box-filtered to match_size and may
+       not continue its main neighbour, so on a fine stochastic photo
+       (gravel: grains of a few texels) its borders are unrelated texel
+       for texel - its place only shares the band's blurred brightness - and
+       those borders made most of the seam score on a knot tube. A
+       continuation is exact along the neighbour it continues. */
+    if (fit == 1 && at_floor && tt__hpm_continue_place(S, C, &cont, &cont_cost) && cont_cost >= 0) {
+        double fit_cost = tt__hpm_border_cost(S, C, &pl);
+        if (fit_cost >= 0 && cont_cost < fit_cost) {
+            S->rep.floor_fits++;
+            S->rep.floor_continued++;
+            S->error_sum += eps;
+            if (eps > S->rep.max_error) S->rep.max_error = eps;
+            return tt__hpm_accept(S, C, &cont) ? 1 : tt__hpm_out_of_memory(C, res, error);
+        }
     }
     if (fit == 1) {
         if (eps <= S->threshold || at_floor) {
@@ -21686,7 +21764,7 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
         S->rep.no_room++;
         return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
-    if (tt__hpm_continue_place(S, C, &pl)) {
+    if (tt__hpm_continue_place(S, C, &pl, &cont_cost)) {
         S->rep.continued++;
         return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
