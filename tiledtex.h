@@ -2952,17 +2952,21 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
      3. tt_polycube_map: the mapping of the model onto S (Sec. 4), in place of the paper's per-cell configurations:
         a. the model refined until no edge is longer than a cube, so a
            triangle holds about one vertex of S at most, and to half a
-           cube where the mapping then falls short (mapped again);
+           cube where the mapping then falls short (mapped again, up to
+           three mappings in all);
         b. tt_polycube_project: each vertex gets its point q(v) = (quad,
            s, t) on S;
         c. the relaxation of the points on S where a triangle folds or an
-           edge finds no short path;
+           edge finds no short path, then the smoothing of all points
+           (angles and density kept, no triangle folded);
         d. tt_polycube_trace_edges: each edge gets its image on S, the
            quads it passes and where it crosses their edges (S half-edge,
            position on it, t on the mesh edge), one record per edge, so
            the two triangles on an edge split it at the same points;
-           tt_polycube_unfold lays two quads side by side,
-           exactly;
+           tt_polycube_unfold lays two quads side by side, exactly; then
+           the repairs: vertices with an edge that finds no path re-seated,
+           points behind a saddle moved onto it, and edges split where a
+           triangle at a saddle would collapse (pinches);
         e. the triangle split: a triangle's boundary unfolded
            into one chart and clipped by the quad grid into pieces inside
            one quad each, or fanned around the one vertex of S inside it,
@@ -2973,9 +2977,10 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
 
    The grid. L = the bounding box's longest side; the cube edge is
    h = L / resolution, or options->cube_size. Each axis has
-   max(1, ceil(extent / h)) cubes, centred on the bounding box (a flat mesh
-   gets one layer, halfway through it), plus 2 empty cubes of padding on
-   every side. Cube (i, j, k) spans origin + h * [i, i+1] x [j, j+1] x
+   max(1, ceil((extent - t) / h)) cubes (t the tie rule's tolerance below,
+   so an extent of N cubes up to rounding gives N), centred on the
+   bounding box (a flat mesh gets one layer, halfway through it), plus 2
+   empty cubes of padding on every side. Cube (i, j, k) spans origin + h * [i, i+1] x [j, j+1] x
    [k, k+1]; lattice point (i, j, k) is at origin + h * (i, j, k); linear
    indices run x fastest: i + dims[0] * (j + dims[1] * k), and lattice
    points likewise with dims + 1 per axis.
