@@ -3234,7 +3234,9 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    cubes, which a coarse polycube cannot follow: their projections land a
    cube or more away, and their triangles are drawn out into streaks or
    fall back. A larger resolution's grid of more than TT_POLYCUBE_MAX_CUBES
-   or more than TT_POLYCUBE_AUTO_MAX_QUADS quads stops the search. When no
+   cubes, or an S estimated at more than TT_POLYCUBE_AUTO_MAX_QUADS quads
+   (the last S's quads times the square of the resolutions' ratio), stops
+   the search (chosen->capped). When no
    resolution passes both, the result is the one nearest the mesh among
    those with the mesh's genus, else the lowest of those with the genus
    closest to it (report->genus_differs then says so).
@@ -3249,7 +3251,9 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    --texture-size). Cost: up to five builds and projections of the mesh
    (the horse scan, 97k triangles: three, 0.22 s of the tool's 1.2 s end
    to end at 32, where it used to spend 2.6 s CPU at 16 for a worse map:
-   stretch p95 1.9 against 6, 0.01 % fallbacks against 1 %). Results as
+   stretch p95 1.9 against 6, 0.01 % fallbacks against 1 %, measured
+   before tt_polycube_map's refinement to a cube; now 0.03 % against
+   0.85 %). Results as
    tt_polycube_build's, and TT_ERROR_INVALID_ARGUMENT for max_resolution
    outside 0..TT_POLYCUBE_MAX_RESOLUTION. */
 #define TT_POLYCUBE_AUTO_MAX_RESOLUTION 64
@@ -3344,8 +3348,7 @@ typedef struct tt_polycube_edges {
     tt_allocator allocator;     /* the one it was made with */
 } tt_polycube_edges;
 
-/* The image on S of every edge of `mesh` ("edge images
-   (intrinsic)"), from its vertices' points (tt_polycube_project; npoints
+/* The image on S of every edge of `mesh`, from its vertices' points (tt_polycube_project; npoints
    = mesh->nverts). For edge (a, b) the search runs over the quad paths
    from q_a's quad to q_b's with at most max_quads quads, none twice,
    depth first, a quad's half-edges in corner order; each path is unfolded
@@ -3376,8 +3379,8 @@ typedef struct tt_polycube_edges {
    fallback.
    Snapping: along and t within 1e-6 of 0 or 1 are set to
    0 or 1; the record is made once per edge, so the triangles on both sides
-   read the same numbers and split the edge at bitwise identical points
-  : p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
+   read the same numbers and split the edge at bitwise identical points:
+   p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
    the half-edge crossed. along and t are double: an edge may cross many
    quads and the triangle split rebuilds chart points from them, where
    float's 6e-8 would be up to 1e-6 h on an edge 16 h long, the size of
@@ -3393,7 +3396,7 @@ typedef struct tt_polycube_edges {
    failed at 32: the rest join vertices that the projection sent to
    different sheets (more than 6 quads apart on S though less than 1 h
    apart in 3D), which the relaxation is for.
-   Memory: the result (4 bytes per half-edge, 9 per edge, 24 per crossing)
+   Memory: the result (4 bytes per half-edge, 21 per edge, 24 per crossing)
    and a search state of about 5 KB; the search recurses max_quads deep.
    options and the allocator may be NULL. Results: TT_OK;
    TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh, points or out, a
@@ -3425,14 +3428,15 @@ typedef struct tt_polycube_map_options {
     double max_edge;    /* model edges longer than this (mesh units) are halved first, until none is;
                            HUGE_VAL: never. 0 = TT_POLYCUBE_MAP_DEFAULT_EDGE times the cube size h, and
                            where that mapping falls short (a triangle put whole into a quad, or a piece
-                           of no area on S), TT_POLYCUBE_MAP_FINER_EDGE times h on those faces for a
-                           second mapping (report->refined_again) */
+                           folded or of no area on S), TT_POLYCUBE_MAP_FINER_EDGE times h on those faces
+                           for another mapping, up to three in all (report->refined_again) */
     const tt_executor *executor;    /* runs the independent parts in parallel (the vertices' projection, the
                                        relaxation's groups of vertices, the edges' tracing, the triangles'
                                        split); NULL: serial. The same mapping either way, bit for bit */
-    tt_progress_fn progress;        /* called between the steps (refinement, projection, relaxation, tracing,
-                                       each repair cycle, the split) with the fraction done, on the calling
-                                       thread; non-zero cancels with TT_CANCELLED */
+    tt_progress_fn progress;        /* called between the steps (refinement, projection, relaxation, smoothing,
+                                       tracing, each repair cycle, the split) and during the relaxation's and
+                                       the smoothing's sweeps, with the fraction done, on the calling thread;
+                                       non-zero cancels with TT_CANCELLED */
     void *progress_user_data;
 } tt_polycube_map_options;
 
@@ -3463,8 +3467,8 @@ typedef struct tt_polycube_map_report {
     int fallback_triangles; /* of `triangles`, those put whole into one quad: a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold; none is expected) */
     int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
-    int refined_again;      /* input faces refined to the finer bound for a second mapping, where the first
-                               fell short (default max_edge only); 0 when the first mapping stands */
+    int refined_again;      /* input faces refined to the finer bound for the mapping kept, where the ones
+                               before fell short (default max_edge only); 0 when the first mapping stands */
     int unpinched;          /* edges split where a triangle at a saddle of S would collapse onto a line
                                (tt_polycube_map, step 5) */
 } tt_polycube_map_report;
@@ -3487,8 +3491,12 @@ typedef struct tt_polycube_mapping {
         halved until none is, so a triangle spans few quads and holds
         about one vertex of S at most; by default, the faces where the
         mapping then falls short (step 6 puts them whole into a quad, or
-        leaves a piece of no area) are refined to half a cube and the
-        model is mapped again from step 2, the better mapping kept;
+        leaves a piece folded or of no area) are refined to half a cube
+        and the model is mapped again from this step, up to three
+        mappings in all, another one made only while new faces fall short
+        and they are at least one input face in 10000; the mapping with
+        the fewest such triangles is kept (a later one refused with
+        TT_ERROR_TOO_LARGE leaves it);
      2. tt_polycube_project (points within 1e-5 of a quad's edge are put
         on it, so the model's vertices on lattice lines are on S's edges
         exactly);
@@ -3531,8 +3539,9 @@ typedef struct tt_polycube_mapping {
         there spans more than half a turn of S would collapse onto two
         segments (the path across runs through W as well); that edge is
         split at its midpoint, the new point on the path from W to the
-        next triangle's third vertex, and the new edges traced
-        (report->unpinched);
+        next triangle's third vertex (at the share of the two triangles'
+        area the pinched one holds, kept within 0.2..0.8), and the new
+        edges traced, in up to two rounds (report->unpinched);
      6. per triangle, the split:
         - its boundary (its vertices and its edges' split points, from
           the records) is unfolded into one chart from its first vertex's
@@ -3578,16 +3587,22 @@ typedef struct tt_polycube_mapping {
    equals the input's. An inside-out mesh
    (tt_polycube_report::inside_out) must be reversed first: the points go
    to the wrong sides of thin parts and every chart turns clockwise.
-   Measured (-O2, one thread, CPU): at resolution 32 the bunny (3.7k
-   triangles, 51k refined) in 0.2 s with 0.02 % fallbacks, a 97k-triangle
-   horse scan in 0.45 s with 0.02 %, a CAD flange in 0.3 s with 0.10 %;
-   parts about a cube thick cost more time and leave more fallbacks (an
-   elephant's trunk and legs: 2.3 %, 1.2 s). At the default 16 the horse
-   takes 1.1 s (0.9 % fallbacks), cut 1-to-4 (388k triangles) 4.8 s and
-   1-to-16 (1.55M) 14 s, the smoothing included (0.3 s of the horse's:
-   8 sweeps of about 45k vertex steps). No flipped triangle on the three;
-   with their UVs rounded to floats, 3 slivers of the 388k one and 6 of
-   the 1.55M one turn over. With an executor
+   Measured (-O2, one thread, CPU) when every edge was still halved to
+   half a cube: at resolution 32 the bunny (3.7k triangles, 51k refined)
+   in 0.2 s with 0.02 % fallbacks, a 97k-triangle horse scan in 0.45 s
+   with 0.02 %, a CAD flange in 0.3 s with 0.10 %; parts about a cube
+   thick cost more time and leave more fallbacks (an elephant's trunk and
+   legs: 2.3 %, 1.2 s). At the default 16 the horse took 1.1 s (0.9 %
+   fallbacks), cut 1-to-4 (388k triangles) 4.8 s and 1-to-16 (1.55M)
+   14 s, the smoothing included (0.3 s of the horse's: 8 sweeps of about
+   45k vertex steps). No flipped triangle on the three; with their UVs
+   rounded to floats, 3 slivers of the 388k one and 6 of the 1.55M one
+   turned over. With the refinement as it is (a cube, half a cube where
+   needed), counted in the fewer refined triangles, at resolution 32:
+   the bunny 14 fallbacks of 15.2k (0.09 %), the horse 25 of 97k
+   (0.03 %), the flange 50 of 17.3k (0.29 %; its S has genus 3, the
+   mesh 4), the elephant 561 of 8.3k (6.8 %); the horse at 16 829 of
+   97k (0.85 %); none flipped (times not measured again). With an executor
    (options->executor) the projection, the relaxation's independent
    groups of vertices, the smoothing's colours, the tracing and the split
    run as tasks; the mapping is the same, bit for bit.
@@ -3619,9 +3634,12 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping);
    from tt_assign_boundaries on polycube->surface with this layout), as
    tt_tile_corner_uv gives at s, t in {0, 1}. corner_uv gets
    6 * mapping->ntriangles floats. Errors: NULL arguments, a layout that
-   does not resolve, a type of 2n or more (TT_ERROR_INVALID_ARGUMENT,
-   TT_ERROR_TOO_LARGE as tt_tile_layout_resolve), a corner point outside S
-   (TT_ERROR_INDEX_OUT_OF_RANGE). Allocates nothing; thread-safe. */
+   does not resolve, a type of 2n or more, a mapping with a negative count
+   or without corner points, a corner point with s or t outside [0, 1]
+   (TT_ERROR_INVALID_ARGUMENT, TT_ERROR_TOO_LARGE as tt_tile_layout_resolve;
+   TT_ERROR_NON_FINITE for a NaN or infinite s or t), a corner point whose
+   quad is outside S (TT_ERROR_INDEX_OUT_OF_RANGE). Allocates nothing;
+   thread-safe. */
 TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                         const tt_tile_layout *layout, const uint8_t *corner_type,
                                         float *corner_uv, tt_error *error);
@@ -3657,8 +3675,8 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
    or kinds, a plain tileset with vertical windows or an upright one
    without, edge windows that differ, a level whose images differ in size or
    have no pixels (TT_ERROR_INVALID_ARGUMENT); a level that is not in both
-   tilesets or beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
-   failure; free it with tt_image_free. `executor` (NULL: this thread)
+   tilesets or beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE);
+   TT_ERROR_OUT_OF_MEMORY. *out_image is NULL on failure; free it with tt_image_free. `executor` (NULL: this thread)
    copies bands of rows in parallel: an atlas of hundreds of megabytes is
    mostly fresh memory the system must hand out page by page, which one
    thread alone makes the longest serial stage of a polycube run. */
@@ -28333,7 +28351,8 @@ static void tt__split_free(tt__split *S)
    in ranges of TT__SPLIT_RANGE, each a task on the executor (a triangle's
    pieces depend on its vertices' points and its edges' records alone),
    TT__SPLIT_BATCH at a time, and merged in order: the same mapping with
-   any executor. *fallbacks counts the triangles put whole into one quad.
+   any executor. *fallbacks counts the triangles put whole into one quad,
+   and fell_back (per model face; NULL: not wanted) flags them.
    TT_OK or TT_ERROR_OUT_OF_MEMORY (*out NULL, nothing left allocated). */
 static tt_result tt__polycube_split(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
                                     const tt_surface_point *points, const tt_executor *executor,
@@ -28526,7 +28545,8 @@ done:
    on the straight segment from W to d gives the quadrilateral W, b, d, c
    the diagonal its reflex corner at W needs: T's halves meet at W, N's
    halves at m. m divides W-d in the ratio of T's area to T's and N's
-   together, so that both keep their density. */
+   together (kept within 0.2..0.8, so neither side is squeezed to a
+   sliver), so that both keep their density. */
 #define TT__UNPINCH_ROUNDS 2        /* splits of the pinched edges, each followed by tracing the model again */
 
 typedef struct tt__pinch {
