@@ -3458,10 +3458,12 @@ typedef struct tt_polycube_map_report {
     tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
     int relaxed;            /* moves of points on S that unfolded a fold or joined a vertex to its neighbours'
                                sheet */
-    int smoothed;           /* moves of points on S that lowered the map's stretch and evened its density */
-    int held;               /* vertices the smoothing left where the projection put them: a triangle of theirs
-                               folded, or their neighbours beyond its reach (their part keeps the projection's
-                               stretch) */
+    int smoothed;           /* moves of points on S (of 1e-3 of a quad or more) that lowered the map's stretch
+                               and evened its density */
+    int held;               /* vertices the smoothing could not step in its first sweep, left where the
+                               projection and relaxation put them: a triangle of theirs folded or of no area,
+                               more than 64 triangles around them, or their neighbours beyond its chart (their
+                               part keeps the projection's stretch) */
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
     int fallback_triangles; /* of `triangles`, those put whole into one quad: a local seam; target 0 */
@@ -3518,8 +3520,9 @@ typedef struct tt_polycube_mapping {
         point takes Newton steps down an energy of its star that is least
         where each triangle keeps its angles and the density of the whole
         map (S's area over the model's), with a barrier that keeps every
-        triangle unfolded, up to TT__SMOOTH_SWEEPS sweeps, a vertex
-        visited again only when it or a neighbour moved; vertices of no
+        triangle unfolded, up to 8 sweeps (TT__SMOOTH_SWEEPS), a vertex
+        visited again only when it or a neighbour moved by 1e-3 of a quad
+        or more; vertices of no
         common triangle step in parallel (a greedy colouring of the
         vertices, the same whatever the executor). Vertices at a fold the
         untangling left stay (report->held);
@@ -26811,8 +26814,9 @@ static void tt__smooth_task(void *context, int index)
    steps of a colour are independent and run in parallel, in the same
    order whatever the executor; a vertex is visited again only when it or
    a neighbour moved. Vertices with a folded triangle and those on S stay.
-   Returns the number of steps that moved a point, -1 when out of memory;
-   *held: the vertices it could not step (tt__star_step). */
+   Returns the number of steps that moved a point by TT__SMOOTH_STILL or
+   more (or into another quad), -1 when out of memory; *held: the vertices
+   it could not step in the first sweep (tt__star_step). */
 static int tt__polycube_smooth(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                                const tt_executor *executor, const tt_allocator *allocator, int *held,
                                tt__map_progress *progress)
