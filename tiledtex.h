@@ -23369,6 +23369,10 @@ static tt_result tt__polycube_grid(const tt_mesh *mesh, const tt_polycube_option
     return TT_OK;
 }
 
+/* tt_polycube_build's options checked: TT_OK, or TT_ERROR_INVALID_ARGUMENT
+   (unknown flags, a negative resolution or cube_size), TT_ERROR_TOO_LARGE
+   (a resolution above TT_POLYCUBE_MAX_RESOLUTION), TT_ERROR_NON_FINITE (a
+   NaN or infinite cube_size or up). */
 static tt_result tt__polycube_check_options(const tt_polycube_options *o, tt_error *error)
 {
     int a;
@@ -23620,9 +23624,9 @@ static void tt__polycube_field_at(const tt__voxels *grid, int i, int j, int k, c
     }
 }
 
-/* The field for a vertex with this normal, interpolated trilinearly at g
-  : continuous in g, and exactly the lattice values at
-   lattice points. Zero outside the lattice. Not normalised. */
+/* The field for a vertex with this normal, interpolated trilinearly at g:
+   continuous in g, and exactly the lattice values at lattice points. Zero
+   outside the lattice. Not normalised. */
 static void tt__polycube_field(const tt__voxels *grid, const double g[3], const double normal[3], double d[3])
 {
     int base[3], corner, a;
@@ -24264,6 +24268,7 @@ TTDEF tt_quad_map tt_polycube_unfold(const tt_polycube *polycube, int halfedge)
     return m;
 }
 
+/* Whether two quad maps are the same map (1) or not (0). */
 static int tt__quad_map_equal(tt_quad_map a, tt_quad_map b)
 {
     return a.turns == b.turns && a.offset[0] == b.offset[0] && a.offset[1] == b.offset[1];
@@ -24436,6 +24441,8 @@ static int tt__edge_bend_holds(const tt__edge_bends *B, int m, const double from
     return run >= TT__PI - TT__EDGE_ANGLE_EPS && valence * 0.5 * TT__PI - run >= TT__PI - TT__EDGE_ANGLE_EPS;
 }
 
+/* The distance from p to q in the plane (not squared: the 2 is the
+   dimension). */
 static double tt__distance2(const double p[2], const double q[2])
 {
     return sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]));
@@ -24733,6 +24740,7 @@ static int tt__edge_find_path(tt__edge_search *S, tt_surface_point qa, tt_surfac
     return S->best_count > 0;
 }
 
+/* x snapped to 0 or 1 when within TT__EDGE_SNAP of it, else x. */
 static double tt__edge_snap(double x)
 {
     return x < TT__EDGE_SNAP ? 0.0 : (x > 1.0 - TT__EDGE_SNAP ? 1.0 : x);
@@ -25077,6 +25085,8 @@ static void tt__refined_midpoint_sources(const int *source, const double *weight
     }
 }
 
+/* The TT_ERROR_TOO_LARGE of a refinement to edges of at most `longest`
+   that needs `needed` triangles or more; returns TT_ERROR_TOO_LARGE. */
 static tt_result tt__polycube_refine_too_large(double longest, double needed, tt_error *error)
 {
     /* A whole count up to a billion; beyond, three digits (a message's
@@ -25207,6 +25217,12 @@ static tt_result tt__refined_build(const float *positions, int nverts, const int
     return tt_mesh_build(&desc, allocator, out, error);
 }
 
+/* The model refined (see tt__refined) to edges of at most `longest`, and
+   of at most fine_longest on the faces flagged in fine_faces (NULL: none),
+   into *out (all NULL when no edge is too long). TT_OK; TT_ERROR_TOO_LARGE when the refinement would
+   pass TT_POLYCUBE_MAX_TRIANGLES (refused from the model's area before any
+   work when that alone says so); TT_ERROR_OUT_OF_MEMORY. On failure *out
+   is left empty. */
 static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double fine_longest,
                                      const unsigned char *fine_faces, const tt_allocator *allocator,
                                      tt__refined *out, tt_error *error)
@@ -27619,6 +27635,8 @@ static double tt__split_inside_length(const tt__split *S, const double e0[2], co
     return hi - lo;
 }
 
+/* The cell of the chart's box that `map` takes the unit square onto, or
+   NULL when it lies outside the box. */
 static tt__split_cell *tt__split_cell_at(tt__split *S, tt_quad_map map)
 {
     double centre[2];
@@ -27713,6 +27731,8 @@ static int tt__split_clip(const tt__clip_point *in, int n, int axis, double boun
     return m;
 }
 
+/* The signed area of the chart polygon p[0..n-1], positive when it turns
+   counter-clockwise. */
 static double tt__split_area(const tt__clip_point *p, int n)
 {
     double area = 0.0;
