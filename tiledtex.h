@@ -3003,7 +3003,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    face-connected empty cubes, and the empty cubes it does not reach are
    filled. A mesh with holes (an open scan, a model missing a few faces)
    lets the flood in, and filling only what it misses leaves a hollow shell;
-   measured, a shell maps badly (the pig at resolution 32: 1.4 % of the
+   measured when the sealing was added (before the smoothing and today's
+   refinement), a shell maps badly (the pig at resolution 32: 1.4 % of the
    triangles to the fallback and stretch p95 6.1, against 0.26 % and 2.7
    sealed), because the two sheets lie one cube apart and neighbouring
    vertices land on different ones. So for an open mesh the holes are
