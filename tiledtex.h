@@ -3264,8 +3264,8 @@ typedef struct tt_polycube_resolution_report {
     int tries;                  /* builds made */
     int resolution[5];          /* the resolutions tried, in order */
     int genus[5];               /* S's genus at each */
-    double mean_distance[5];    /* the mesh's vertices from S at each, in cubes (-1: not measured, the genus
-                                   already differed) */
+    double mean_distance[5];    /* the mesh's vertices from S at each, in cubes (-1: not measured: the genus
+                                   differed, the mesh is inside out, or options gave the size) */
     int chosen;                 /* the index of the result in those */
     int capped;                 /* 1 when the next resolution was not tried for the size limits */
 } tt_polycube_resolution_report;
