@@ -3046,7 +3046,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    for the voxelisation (twice: cubes and corner cells), O(cubes) per
    repair, fill and topology count, with the correction's retries
    O(components * cubes) at worst (many separate parts whose correction
-   changes the topology). Bunny, flange, elephant (4-6k faces): 2-10 ms at
+   changes the topology). Bunny, flange, elephant (3.7-6.5k faces): 2-10 ms at
    resolution 16-32, 30-45 ms at 64 (-O2). Memory while building: up to
    about 14 bytes per grid cube (occupancy, the cubes and cells the surface
    meets, a queue, the correction's copy and labels), 4 bytes per lattice
@@ -3212,7 +3212,7 @@ typedef struct tt_polycube_projection_report {
    vertices the rays miss, the cubes of the shells searched ((2 reach +
    1)^3 = 2197 at most, farther only for a fallback); a ray grazing a
    lattice plane (a rim lying on one) may miss and go to the shells.
-   Measured at -O2: 2-3 ms for the bunny, flange and elephant (2-3k
+   Measured at -O2: 1-3 ms for the bunny, flange and elephant (1.8-3.2k
    vertices) at resolution 16-64, 23 ms for the horse (48k) at 16-64.
    The side rule needs outward normals: on an inside-out closed mesh no
    facelet near a vertex faces its side, most vertices go to the shells and
