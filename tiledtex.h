@@ -3047,7 +3047,7 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    repair, fill and topology count, with the correction's retries
    O(components * cubes) at worst (many separate parts whose correction
    changes the topology). Bunny, flange, elephant (3.7-6.5k faces): 2-10 ms at
-   resolution 16-32, 30-45 ms at 64 (-O2). Memory while building: up to
+   resolution 16-32, 25-45 ms at 64 (-O2). Memory while building: up to
    about 14 bytes per grid cube (occupancy, the cubes and cells the surface
    meets, a queue, the correction's copy and labels), 4 bytes per lattice
    point while extracting, and the result: 1 byte per cube plus the
