@@ -3391,9 +3391,9 @@ typedef struct tt_polycube_edges {
    Measured (-O2, the default 4 quads; the models of
    tt_polycube_project's cost note): bunny (5.5k edges) 12 ms at
    resolution 16 with none failed, 22 ms at 32 with 72 failed (1.3 %);
-   flange (9.7k) 17 ms and 408 (4.2 %), 29 ms and 110 (1.1 %); elephant
-   (8.3k) 13 ms and 116 (1.4 %), 25 ms and 317 (3.8 %). Raising max_quads
-   to 6 takes about 5 times as long and leaves 0, 40 (0.4 %) and 170 (2 %)
+   flange (9.7k) 17 ms and 385 (4.0 %), 29 ms and 110 (1.1 %); elephant
+   (8.3k) 13 ms and 115 (1.4 %), 25 ms and 313 (3.8 %). Raising max_quads
+   to 6 takes about 5 times as long and leaves 0, 40 (0.4 %) and 163 (2 %)
    failed at 32: the rest join vertices that the projection sent to
    different sheets (more than 6 quads apart on S though less than 1 h
    apart in 3D), which the relaxation is for.
