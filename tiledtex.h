@@ -3455,7 +3455,8 @@ typedef struct tt_polycube_map_options {
 #endif
 
 typedef struct tt_polycube_map_report {
-    int triangles;          /* triangles of the model after refinement (max_edge), the ones mapped */
+    int triangles;          /* triangles of the model after refinement (max_edge) and the pinch splits, the
+                               ones mapped */
     tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
     int relaxed;            /* moves of points on S that unfolded a fold or joined a vertex to its neighbours'
                                sheet */
