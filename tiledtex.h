@@ -2956,17 +2956,21 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
      3. tt_polycube_map: the mapping of the model onto S (Sec. 4), in place of the paper's per-cell configurations:
         a. the model refined until no edge is longer than a cube, so a
            triangle holds about one vertex of S at most, and to half a
-           cube where the mapping then falls short (mapped again);
+           cube where the mapping then falls short (mapped again, up to
+           three mappings in all);
         b. tt_polycube_project: each vertex gets its point q(v) = (quad,
            s, t) on S;
         c. the relaxation of the points on S where a triangle folds or an
-           edge finds no short path;
+           edge finds no short path, then the smoothing of all points
+           (angles and density kept, no triangle folded);
         d. tt_polycube_trace_edges: each edge gets its image on S, the
            quads it passes and where it crosses their edges (S half-edge,
            position on it, t on the mesh edge), one record per edge, so
            the two triangles on an edge split it at the same points;
-           tt_polycube_unfold lays two quads side by side,
-           exactly;
+           tt_polycube_unfold lays two quads side by side, exactly; then
+           the repairs: vertices with an edge that finds no path re-seated,
+           points behind a saddle moved onto it, and edges split where a
+           triangle at a saddle would collapse (pinches);
         e. the triangle split: a triangle's boundary unfolded
            into one chart and clipped by the quad grid into pieces inside
            one quad each, or fanned around the one vertex of S inside it,
@@ -2977,9 +2981,10 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
 
    The grid. L = the bounding box's longest side; the cube edge is
    h = L / resolution, or options->cube_size. Each axis has
-   max(1, ceil(extent / h)) cubes, centred on the bounding box (a flat mesh
-   gets one layer, halfway through it), plus 2 empty cubes of padding on
-   every side. Cube (i, j, k) spans origin + h * [i, i+1] x [j, j+1] x
+   max(1, ceil((extent - t) / h)) cubes (t the tie rule's tolerance below,
+   so an extent of N cubes up to rounding gives N), centred on the
+   bounding box (a flat mesh gets one layer, halfway through it), plus 2
+   empty cubes of padding on every side. Cube (i, j, k) spans origin + h * [i, i+1] x [j, j+1] x
    [k, k+1]; lattice point (i, j, k) is at origin + h * (i, j, k); linear
    indices run x fastest: i + dims[0] * (j + dims[1] * k), and lattice
    points likewise with dims + 1 per axis.
@@ -3002,7 +3007,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    face-connected empty cubes, and the empty cubes it does not reach are
    filled. A mesh with holes (an open scan, a model missing a few faces)
    lets the flood in, and filling only what it misses leaves a hollow shell;
-   measured, a shell maps badly (the pig at resolution 32: 1.4 % of the
+   measured when the sealing was added (before the smoothing and today's
+   refinement), a shell maps badly (the pig at resolution 32: 1.4 % of the
    triangles to the fallback and stretch p95 6.1, against 0.26 % and 2.7
    sealed), because the two sheets lie one cube apart and neighbouring
    vertices land on different ones. So for an open mesh the holes are
@@ -3044,8 +3050,8 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
    for the voxelisation (twice: cubes and corner cells), O(cubes) per
    repair, fill and topology count, with the correction's retries
    O(components * cubes) at worst (many separate parts whose correction
-   changes the topology). Bunny, flange, elephant (4-6k faces): 2-10 ms at
-   resolution 16-32, 30-45 ms at 64 (-O2). Memory while building: up to
+   changes the topology). Bunny, flange, elephant (3.7-6.5k faces): 2-10 ms at
+   resolution 16-32, 25-45 ms at 64 (-O2). Memory while building: up to
    about 14 bytes per grid cube (occupancy, the cubes and cells the surface
    meets, a queue, the correction's copy and labels), 4 bytes per lattice
    point while extracting, and the result: 1 byte per cube plus the
@@ -3210,7 +3216,7 @@ typedef struct tt_polycube_projection_report {
    vertices the rays miss, the cubes of the shells searched ((2 reach +
    1)^3 = 2197 at most, farther only for a fallback); a ray grazing a
    lattice plane (a rim lying on one) may miss and go to the shells.
-   Measured at -O2: 2-3 ms for the bunny, flange and elephant (2-3k
+   Measured at -O2: 1-3 ms for the bunny, flange and elephant (1.8-3.2k
    vertices) at resolution 16-64, 23 ms for the horse (48k) at 16-64.
    The side rule needs outward normals: on an inside-out closed mesh no
    facelet near a vertex faces its side, most vertices go to the shells and
@@ -3233,7 +3239,9 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    cubes, which a coarse polycube cannot follow: their projections land a
    cube or more away, and their triangles are drawn out into streaks or
    fall back. A larger resolution's grid of more than TT_POLYCUBE_MAX_CUBES
-   or more than TT_POLYCUBE_AUTO_MAX_QUADS quads stops the search. When no
+   cubes, or an S estimated at more than TT_POLYCUBE_AUTO_MAX_QUADS quads
+   (the last S's quads times the square of the resolutions' ratio), stops
+   the search (chosen->capped). When no
    resolution passes both, the result is the one nearest the mesh among
    those with the mesh's genus, else the lowest of those with the genus
    closest to it (report->genus_differs then says so).
@@ -3248,7 +3256,9 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    --texture-size). Cost: up to five builds and projections of the mesh
    (the horse scan, 97k triangles: three, 0.22 s of the tool's 1.2 s end
    to end at 32, where it used to spend 2.6 s CPU at 16 for a worse map:
-   stretch p95 1.9 against 6, 0.01 % fallbacks against 1 %). Results as
+   stretch p95 1.9 against 6, 0.01 % fallbacks against 1 %, measured
+   before tt_polycube_map's refinement to a cube; now 0.03 % against
+   0.85 %). Results as
    tt_polycube_build's, and TT_ERROR_INVALID_ARGUMENT for max_resolution
    outside 0..TT_POLYCUBE_MAX_RESOLUTION. */
 #define TT_POLYCUBE_AUTO_MAX_RESOLUTION 64
@@ -3258,8 +3268,8 @@ typedef struct tt_polycube_resolution_report {
     int tries;                  /* builds made */
     int resolution[5];          /* the resolutions tried, in order */
     int genus[5];               /* S's genus at each */
-    double mean_distance[5];    /* the mesh's vertices from S at each, in cubes (-1: not measured, the genus
-                                   already differed) */
+    double mean_distance[5];    /* the mesh's vertices from S at each, in cubes (-1: not measured: the genus
+                                   differed, the mesh is inside out, or options gave the size) */
     int chosen;                 /* the index of the result in those */
     int capped;                 /* 1 when the next resolution was not tried for the size limits */
 } tt_polycube_resolution_report;
@@ -3343,8 +3353,7 @@ typedef struct tt_polycube_edges {
     tt_allocator allocator;     /* the one it was made with */
 } tt_polycube_edges;
 
-/* The image on S of every edge of `mesh` ("edge images
-   (intrinsic)"), from its vertices' points (tt_polycube_project; npoints
+/* The image on S of every edge of `mesh`, from its vertices' points (tt_polycube_project; npoints
    = mesh->nverts). For edge (a, b) the search runs over the quad paths
    from q_a's quad to q_b's with at most max_quads quads, none twice,
    depth first, a quad's half-edges in corner order; each path is unfolded
@@ -3375,8 +3384,8 @@ typedef struct tt_polycube_edges {
    fallback.
    Snapping: along and t within 1e-6 of 0 or 1 are set to
    0 or 1; the record is made once per edge, so the triangles on both sides
-   read the same numbers and split the edge at bitwise identical points
-  : p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
+   read the same numbers and split the edge at bitwise identical points:
+   p_a + t * (p_b - p_a) in 3D, and on S the point `along` on
    the half-edge crossed. along and t are double: an edge may cross many
    quads and the triangle split rebuilds chart points from them, where
    float's 6e-8 would be up to 1e-6 h on an edge 16 h long, the size of
@@ -3386,13 +3395,13 @@ typedef struct tt_polycube_edges {
    Measured (-O2, the default 4 quads; the models of
    tt_polycube_project's cost note): bunny (5.5k edges) 12 ms at
    resolution 16 with none failed, 22 ms at 32 with 72 failed (1.3 %);
-   flange (9.7k) 17 ms and 408 (4.2 %), 29 ms and 110 (1.1 %); elephant
-   (8.3k) 13 ms and 116 (1.4 %), 25 ms and 317 (3.8 %). Raising max_quads
-   to 6 takes about 5 times as long and leaves 0, 40 (0.4 %) and 170 (2 %)
+   flange (9.7k) 17 ms and 385 (4.0 %), 29 ms and 110 (1.1 %); elephant
+   (8.3k) 13 ms and 115 (1.4 %), 25 ms and 313 (3.8 %). Raising max_quads
+   to 6 takes about 5 times as long and leaves 0, 40 (0.4 %) and 163 (2 %)
    failed at 32: the rest join vertices that the projection sent to
    different sheets (more than 6 quads apart on S though less than 1 h
    apart in 3D), which the relaxation is for.
-   Memory: the result (4 bytes per half-edge, 9 per edge, 24 per crossing)
+   Memory: the result (4 bytes per half-edge, 21 per edge, 24 per crossing)
    and a search state of about 5 KB; the search recurses max_quads deep.
    options and the allocator may be NULL. Results: TT_OK;
    TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh, points or out, a
@@ -3424,14 +3433,15 @@ typedef struct tt_polycube_map_options {
     double max_edge;    /* model edges longer than this (mesh units) are halved first, until none is;
                            HUGE_VAL: never. 0 = TT_POLYCUBE_MAP_DEFAULT_EDGE times the cube size h, and
                            where that mapping falls short (a triangle put whole into a quad, or a piece
-                           of no area on S), TT_POLYCUBE_MAP_FINER_EDGE times h on those faces for a
-                           second mapping (report->refined_again) */
+                           folded or of no area on S), TT_POLYCUBE_MAP_FINER_EDGE times h on those faces
+                           for another mapping, up to three in all (report->refined_again) */
     const tt_executor *executor;    /* runs the independent parts in parallel (the vertices' projection, the
                                        relaxation's groups of vertices, the edges' tracing, the triangles'
                                        split); NULL: serial. The same mapping either way, bit for bit */
-    tt_progress_fn progress;        /* called between the steps (refinement, projection, relaxation, tracing,
-                                       each repair cycle, the split) with the fraction done, on the calling
-                                       thread; non-zero cancels with TT_CANCELLED */
+    tt_progress_fn progress;        /* called between the steps (refinement, projection, relaxation, smoothing,
+                                       tracing, each repair cycle, the split) and during the relaxation's and
+                                       the smoothing's sweeps, with the fraction done, on the calling thread;
+                                       non-zero cancels with TT_CANCELLED */
     void *progress_user_data;
 } tt_polycube_map_options;
 
@@ -3449,21 +3459,24 @@ typedef struct tt_polycube_map_options {
 #endif
 
 typedef struct tt_polycube_map_report {
-    int triangles;          /* triangles of the model after refinement (max_edge), the ones mapped */
+    int triangles;          /* triangles of the model after refinement (max_edge) and the pinch splits, the
+                               ones mapped */
     tt_polycube_projection_report projection;   /* how the (refined) model's vertices went onto S */
     int relaxed;            /* moves of points on S that unfolded a fold or joined a vertex to its neighbours'
                                sheet */
-    int smoothed;           /* moves of points on S that lowered the map's stretch and evened its density */
-    int held;               /* vertices the smoothing left where the projection put them: a triangle of theirs
-                               folded, or their neighbours beyond its reach (their part keeps the projection's
-                               stretch) */
+    int smoothed;           /* moves of points on S (of 1e-3 of a quad or more) that lowered the map's stretch
+                               and evened its density */
+    int held;               /* vertices the smoothing could not step in its first sweep, left where the
+                               projection and relaxation put them: a triangle of theirs folded or of no area,
+                               more than 64 triangles around them, or their neighbours beyond its chart (their
+                               part keeps the projection's stretch) */
     int failed_edges;       /* model edges with no path on S within max_quads */
     int split_triangles;    /* input triangles cut into two or more output triangles */
     int fallback_triangles; /* of `triangles`, those put whole into one quad: a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold; none is expected) */
     int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
-    int refined_again;      /* input faces refined to the finer bound for a second mapping, where the first
-                               fell short (default max_edge only); 0 when the first mapping stands */
+    int refined_again;      /* input faces refined to the finer bound for the mapping kept, where the ones
+                               before fell short (default max_edge only); 0 when the first mapping stands */
     int unpinched;          /* edges split where a triangle at a saddle of S would collapse onto a line
                                (tt_polycube_map, step 5) */
 } tt_polycube_map_report;
@@ -3486,8 +3499,12 @@ typedef struct tt_polycube_mapping {
         halved until none is, so a triangle spans few quads and holds
         about one vertex of S at most; by default, the faces where the
         mapping then falls short (step 6 puts them whole into a quad, or
-        leaves a piece of no area) are refined to half a cube and the
-        model is mapped again from step 2, the better mapping kept;
+        leaves a piece folded or of no area) are refined to half a cube
+        and the model is mapped again from this step, up to three
+        mappings in all, another one made only while new faces fall short
+        and they are at least one input face in 10000; the mapping with
+        the fewest such triangles is kept (a later one refused with
+        TT_ERROR_TOO_LARGE leaves it);
      2. tt_polycube_project (points within 1e-5 of a quad's edge are put
         on it, so the model's vertices on lattice lines are on S's edges
         exactly);
@@ -3509,8 +3526,9 @@ typedef struct tt_polycube_mapping {
         point takes Newton steps down an energy of its star that is least
         where each triangle keeps its angles and the density of the whole
         map (S's area over the model's), with a barrier that keeps every
-        triangle unfolded, up to TT__SMOOTH_SWEEPS sweeps, a vertex
-        visited again only when it or a neighbour moved; vertices of no
+        triangle unfolded, up to 8 sweeps (TT__SMOOTH_SWEEPS), a vertex
+        visited again only when it or a neighbour moved by 1e-3 of a quad
+        or more; vertices of no
         common triangle step in parallel (a greedy colouring of the
         vertices, the same whatever the executor). Vertices at a fold the
         untangling left stay (report->held);
@@ -3530,8 +3548,9 @@ typedef struct tt_polycube_mapping {
         there spans more than half a turn of S would collapse onto two
         segments (the path across runs through W as well); that edge is
         split at its midpoint, the new point on the path from W to the
-        next triangle's third vertex, and the new edges traced
-        (report->unpinched);
+        next triangle's third vertex (at the share of the two triangles'
+        area the pinched one holds, kept within 0.2..0.8), and the new
+        edges traced, in up to two rounds (report->unpinched);
      6. per triangle, the split:
         - its boundary (its vertices and its edges' split points, from
           the records) is unfolded into one chart from its first vertex's
@@ -3577,16 +3596,22 @@ typedef struct tt_polycube_mapping {
    equals the input's. An inside-out mesh
    (tt_polycube_report::inside_out) must be reversed first: the points go
    to the wrong sides of thin parts and every chart turns clockwise.
-   Measured (-O2, one thread, CPU): at resolution 32 the bunny (3.7k
-   triangles, 51k refined) in 0.2 s with 0.02 % fallbacks, a 97k-triangle
-   horse scan in 0.45 s with 0.02 %, a CAD flange in 0.3 s with 0.10 %;
-   parts about a cube thick cost more time and leave more fallbacks (an
-   elephant's trunk and legs: 2.3 %, 1.2 s). At the default 16 the horse
-   takes 1.1 s (0.9 % fallbacks), cut 1-to-4 (388k triangles) 4.8 s and
-   1-to-16 (1.55M) 14 s, the smoothing included (0.3 s of the horse's:
-   8 sweeps of about 45k vertex steps). No flipped triangle on the three;
-   with their UVs rounded to floats, 3 slivers of the 388k one and 6 of
-   the 1.55M one turn over. With an executor
+   Measured (-O2, one thread, CPU) when every edge was still halved to
+   half a cube: at resolution 32 the bunny (3.7k triangles, 51k refined)
+   in 0.2 s with 0.02 % fallbacks, a 97k-triangle horse scan in 0.45 s
+   with 0.02 %, a CAD flange in 0.3 s with 0.10 %; parts about a cube
+   thick cost more time and leave more fallbacks (an elephant's trunk and
+   legs: 2.3 %, 1.2 s). At the default 16 the horse took 1.1 s (0.9 %
+   fallbacks), cut 1-to-4 (388k triangles) 4.8 s and 1-to-16 (1.55M)
+   14 s, the smoothing included (0.3 s of the horse's: 8 sweeps of about
+   45k vertex steps). No flipped triangle on the three; with their UVs
+   rounded to floats, 3 slivers of the 388k one and 6 of the 1.55M one
+   turned over. With the refinement as it is (a cube, half a cube where
+   needed), counted in the fewer refined triangles, at resolution 32:
+   the bunny 14 fallbacks of 15.2k (0.09 %), the horse 25 of 97k
+   (0.03 %), the flange 50 of 17.3k (0.29 %; its S has genus 3, the
+   mesh 4), the elephant 561 of 8.3k (6.8 %); the horse at 16 829 of
+   97k (0.85 %); none flipped (times not measured again). With an executor
    (options->executor) the projection, the relaxation's independent
    groups of vertices, the smoothing's colours, the tracing and the split
    run as tasks; the mapping is the same, bit for bit.
@@ -3618,9 +3643,12 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping);
    from tt_assign_boundaries on polycube->surface with this layout), as
    tt_tile_corner_uv gives at s, t in {0, 1}. corner_uv gets
    6 * mapping->ntriangles floats. Errors: NULL arguments, a layout that
-   does not resolve, a type of 2n or more (TT_ERROR_INVALID_ARGUMENT,
-   TT_ERROR_TOO_LARGE as tt_tile_layout_resolve), a corner point outside S
-   (TT_ERROR_INDEX_OUT_OF_RANGE). Allocates nothing; thread-safe. */
+   does not resolve, a type of 2n or more, a mapping with a negative count
+   or without corner points, a corner point with s or t outside [0, 1]
+   (TT_ERROR_INVALID_ARGUMENT, TT_ERROR_TOO_LARGE as tt_tile_layout_resolve;
+   TT_ERROR_NON_FINITE for a NaN or infinite s or t), a corner point whose
+   quad is outside S (TT_ERROR_INDEX_OUT_OF_RANGE). Allocates nothing;
+   thread-safe. */
 TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                         const tt_tile_layout *layout, const uint8_t *corner_type,
                                         float *corner_uv, tt_error *error);
@@ -3656,8 +3684,8 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
    or kinds, a plain tileset with vertical windows or an upright one
    without, edge windows that differ, a level whose images differ in size or
    have no pixels (TT_ERROR_INVALID_ARGUMENT); a level that is not in both
-   tilesets or beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE). *out_image is NULL on
-   failure; free it with tt_image_free. `executor` (NULL: this thread)
+   tilesets or beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE);
+   TT_ERROR_OUT_OF_MEMORY. *out_image is NULL on failure; free it with tt_image_free. `executor` (NULL: this thread)
    copies bands of rows in parallel: an atlas of hundreds of megabytes is
    mostly fresh memory the system must hand out page by page, which one
    thread alone makes the longest serial stage of a polycube run. */
@@ -23421,6 +23449,10 @@ static tt_result tt__polycube_grid(const tt_mesh *mesh, const tt_polycube_option
     return TT_OK;
 }
 
+/* tt_polycube_build's options checked: TT_OK, or TT_ERROR_INVALID_ARGUMENT
+   (unknown flags, a negative resolution or cube_size), TT_ERROR_TOO_LARGE
+   (a resolution above TT_POLYCUBE_MAX_RESOLUTION), TT_ERROR_NON_FINITE (a
+   NaN or infinite cube_size or up). */
 static tt_result tt__polycube_check_options(const tt_polycube_options *o, tt_error *error)
 {
     int a;
@@ -23672,9 +23704,9 @@ static void tt__polycube_field_at(const tt__voxels *grid, int i, int j, int k, c
     }
 }
 
-/* The field for a vertex with this normal, interpolated trilinearly at g
-  : continuous in g, and exactly the lattice values at
-   lattice points. Zero outside the lattice. Not normalised. */
+/* The field for a vertex with this normal, interpolated trilinearly at g:
+   continuous in g, and exactly the lattice values at lattice points. Zero
+   outside the lattice. Not normalised. */
 static void tt__polycube_field(const tt__voxels *grid, const double g[3], const double normal[3], double d[3])
 {
     int base[3], corner, a;
@@ -24316,6 +24348,7 @@ TTDEF tt_quad_map tt_polycube_unfold(const tt_polycube *polycube, int halfedge)
     return m;
 }
 
+/* Whether two quad maps are the same map (1) or not (0). */
 static int tt__quad_map_equal(tt_quad_map a, tt_quad_map b)
 {
     return a.turns == b.turns && a.offset[0] == b.offset[0] && a.offset[1] == b.offset[1];
@@ -24488,6 +24521,8 @@ static int tt__edge_bend_holds(const tt__edge_bends *B, int m, const double from
     return run >= TT__PI - TT__EDGE_ANGLE_EPS && valence * 0.5 * TT__PI - run >= TT__PI - TT__EDGE_ANGLE_EPS;
 }
 
+/* The distance from p to q in the plane (not squared: the 2 is the
+   dimension). */
 static double tt__distance2(const double p[2], const double q[2])
 {
     return sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]));
@@ -24785,6 +24820,7 @@ static int tt__edge_find_path(tt__edge_search *S, tt_surface_point qa, tt_surfac
     return S->best_count > 0;
 }
 
+/* x snapped to 0 or 1 when within TT__EDGE_SNAP of it, else x. */
 static double tt__edge_snap(double x)
 {
     return x < TT__EDGE_SNAP ? 0.0 : (x > 1.0 - TT__EDGE_SNAP ? 1.0 : x);
@@ -25129,6 +25165,8 @@ static void tt__refined_midpoint_sources(const int *source, const double *weight
     }
 }
 
+/* The TT_ERROR_TOO_LARGE of a refinement to edges of at most `longest`
+   that needs `needed` triangles or more; returns TT_ERROR_TOO_LARGE. */
 static tt_result tt__polycube_refine_too_large(double longest, double needed, tt_error *error)
 {
     /* A whole count up to a billion; beyond, three digits (a message's
@@ -25259,6 +25297,12 @@ static tt_result tt__refined_build(const float *positions, int nverts, const int
     return tt_mesh_build(&desc, allocator, out, error);
 }
 
+/* The model refined (see tt__refined) to edges of at most `longest`, and
+   of at most fine_longest on the faces flagged in fine_faces (NULL: none),
+   into *out (all NULL when no edge is too long). TT_OK; TT_ERROR_TOO_LARGE when the refinement would
+   pass TT_POLYCUBE_MAX_TRIANGLES (refused from the model's area before any
+   work when that alone says so); TT_ERROR_OUT_OF_MEMORY. On failure *out
+   is left empty. */
 static tt_result tt__polycube_refine(const tt_mesh *mesh, double longest, double fine_longest,
                                      const unsigned char *fine_faces, const tt_allocator *allocator,
                                      tt__refined *out, tt_error *error)
@@ -26866,8 +26910,9 @@ static void tt__smooth_task(void *context, int index)
    steps of a colour are independent and run in parallel, in the same
    order whatever the executor; a vertex is visited again only when it or
    a neighbour moved. Vertices with a folded triangle and those on S stay.
-   Returns the number of steps that moved a point, -1 when out of memory;
-   *held: the vertices it could not step (tt__star_step). */
+   Returns the number of steps that moved a point by TT__SMOOTH_STILL or
+   more (or into another quad), -1 when out of memory; *held: the vertices
+   it could not step in the first sweep (tt__star_step). */
 static int tt__polycube_smooth(const tt_polycube *pc, const tt_mesh *model, tt_surface_point *points,
                                const tt_executor *executor, const tt_allocator *allocator, int *held,
                                tt__map_progress *progress)
@@ -27670,6 +27715,8 @@ static double tt__split_inside_length(const tt__split *S, const double e0[2], co
     return hi - lo;
 }
 
+/* The cell of the chart's box that `map` takes the unit square onto, or
+   NULL when it lies outside the box. */
 static tt__split_cell *tt__split_cell_at(tt__split *S, tt_quad_map map)
 {
     double centre[2];
@@ -27764,6 +27811,8 @@ static int tt__split_clip(const tt__clip_point *in, int n, int axis, double boun
     return m;
 }
 
+/* The signed area of the chart polygon p[0..n-1], positive when it turns
+   counter-clockwise. */
 static double tt__split_area(const tt__clip_point *p, int n)
 {
     double area = 0.0;
@@ -28406,7 +28455,8 @@ static void tt__split_free(tt__split *S)
    in ranges of TT__SPLIT_RANGE, each a task on the executor (a triangle's
    pieces depend on its vertices' points and its edges' records alone),
    TT__SPLIT_BATCH at a time, and merged in order: the same mapping with
-   any executor. *fallbacks counts the triangles put whole into one quad.
+   any executor. *fallbacks counts the triangles put whole into one quad,
+   and fell_back (per model face; NULL: not wanted) flags them.
    TT_OK or TT_ERROR_OUT_OF_MEMORY (*out NULL, nothing left allocated). */
 static tt_result tt__polycube_split(const tt_polycube *pc, const tt_mesh *model, const tt_polycube_edges *edges,
                                     const tt_surface_point *points, const tt_executor *executor,
@@ -28599,7 +28649,8 @@ done:
    on the straight segment from W to d gives the quadrilateral W, b, d, c
    the diagonal its reflex corner at W needs: T's halves meet at W, N's
    halves at m. m divides W-d in the ratio of T's area to T's and N's
-   together, so that both keep their density. */
+   together (kept within 0.2..0.8, so neither side is squeezed to a
+   sliver), so that both keep their density. */
 #define TT__UNPINCH_ROUNDS 2        /* splits of the pinched edges, each followed by tracing the model again */
 
 typedef struct tt__pinch {
