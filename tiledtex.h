@@ -2280,14 +2280,19 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
    TT_ATLAS_CHART_CONE degrees of the seed face's and its image, projected
    on the plane perpendicular to the seed's normal, overlaps none of the
    chart's faces already taken (tested in a hashed grid); a face refused
-   starts or joins a later chart. Within the cone every face keeps its
-   winding (no flips), and the projection shrinks a face's area by at most
+   starts or joins a later chart. Then a face with two of its three
+   neighbours in another chart moves to it when it passes that chart's
+   tests (straighter borders). Two sets of charts are made and packed, one
+   with every face also within 0.15 sqrt(surface) of its seed
+   (round charts: long branching ones leave hollows no packing fills, but
+   the rings of a smooth tube nest whole), and the one that fills more is
+   kept. Within the cone every face keeps its winding (no flips), and the projection shrinks a face's area by at most
    cos(cone), so density varies by at most sqrt(1 / cos(cone)) across a
    chart, less after each chart is scaled to keep its total area. Each
    chart is turned to its smallest bounding box (16 angles tried) and laid
    with its long side across. Packing works on the charts' outlines, not
-   their boxes: a chart is the texels its triangles touch, widened by
-   `gutter` texels every way (2 * gutter between charts); by decreasing box
+   their boxes: a chart is the texels whose centres lie within `gutter` of
+   its triangles (what tt_lapped_bake draws for it); by decreasing box
    area, each chart goes, in whichever of four quarter turns sits lowest,
    to the lowest then leftmost place of a bitmap of the atlas where none of
    its texels is taken, so small charts fill the room between and inside
@@ -2331,11 +2336,13 @@ typedef struct tt_chart_atlas_report {
    not fit even when shrunk to nothing - each needs 2 * gutter + 1 texels a
    side (TT_ERROR_IMAGE_TOO_SMALL; the message gives the smallest size that
    holds them); TT_ERROR_OUT_OF_MEMORY. corner_uv is written only on
-   success. Temporary memory only: about 200 bytes per face and two bits
+   success. Temporary memory only: about 210 bytes per face and three bits
    per texel (per block above 2048 a side). Time O(faces) for the charts
    (with the faces of a chart in a bounded number of grid cells each); the
    packing, five to eight times over for the search of the scale (fewer
-   with a good options->fill_guess), scans the bitmap for each chart,
+   with a good options->fill_guess) for each of the two sets of charts
+   (progress reports the first set's search up to 0.5), scans the bitmap
+   for each chart,
    skipping rows without a long enough free run. options may be NULL
    (defaults); TT_CANCELLED by options->progress. Deterministic; reentrant
    and thread-safe on distinct outputs. */
@@ -16275,11 +16282,14 @@ static void tt__chart_texel(const double *xy, int face, int k, double s, int gut
 
 /* Scratch of the bitmap packing: one bit per atlas texel, taken or free
    (rows of `words` 64-bit words), the longest free run of each row, and
-   the mask of the chart being placed (same layout). */
+   the outline of the chart being placed and its mask in the turn tried
+   (same layout). */
 typedef struct tt__packing {
-    uint64_t *bits, *mask;
+    uint64_t *bits, *mask, *outline;
     int words;
     int *run;
+    double reach;   /* cells: a cell whose centre lies this near a triangle is the chart's */
+    const unsigned char *border;   /* per face, bit k: its edge from corner k borders another chart */
 } tt__packing;
 
 /* Sets bits [a, b] of a row of words. */
@@ -16294,83 +16304,163 @@ static void tt__bits_set(uint64_t *line, int a, int b)
     }
 }
 
-/* The mask of a chart at scale s in turn `turn` (p->mask, `*width` x
-   `*height` cells, row 0 at the bottom): the cells its triangles touch,
-   widened by `gutter` cells every way. Every texel whose centre lies
-   within `gutter` of a triangle is in the mask, so charts whose masks do
-   not meet share no texel of their triangles or gutters. 0 when the chart
-   does not fit `limit`. */
-static int tt__chart_mask(const tt__chart *chart, const int *members, const double *xy, double s, int gutter,
-                          int turn, int limit, tt__packing *p, int *width, int *height)
+/* The index of the lowest set bit of a non-zero word (de Bruijn). */
+static int tt__lowest_bit(uint64_t word)
 {
-    int cols = tt__chart_cells(chart->width, s, gutter), rows = tt__chart_cells(chart->height, s, gutter);
-    int w = turn & 1 ? rows : cols, h = turn & 1 ? cols : rows, i, k, r, d;
-    if (cols > limit || rows > limit) return 0;
-    memset(p->mask, 0, sizeof *p->mask * (size_t)h * p->words);
+    static const unsigned char table[64] = {
+        0,  1,  48, 2,  57, 49, 28, 3,  61, 58, 50, 42, 38, 29, 17, 4,  62, 55, 59, 36, 53, 51,
+        43, 22, 45, 39, 33, 30, 24, 18, 12, 5,  63, 47, 56, 27, 60, 41, 37, 16, 54, 35, 52, 21,
+        44, 32, 23, 11, 46, 26, 40, 15, 34, 20, 31, 10, 25, 14, 19, 9,  13, 8,  7,  6};
+    return table[((word & (~word + 1)) * (uint64_t)0x03f79d71b4cb0a89u) >> 58];
+}
+
+/* The x interval (lo, hi) where the line y = c meets the points within
+   `reach` of segment ab; 0 when it misses them. The capsule is the band
+   along the segment and the discs at its ends, each met in an interval. */
+static int tt__capsule_span(const double *a, const double *b, double reach, double c, double *lo, double *hi)
+{
+    double dx = b[0] - a[0], dy = b[1] - a[1], length, l = 1e300, h = -1e300;
+    int e;
+    if (reach == 0.0) {
+        /* The segment itself (edges inside a chart): where it crosses. */
+        if ((c < a[1] && c < b[1]) || (c > a[1] && c > b[1])) return 0;
+        if (dy == 0.0) {
+            *lo = a[0] < b[0] ? a[0] : b[0];
+            *hi = a[0] < b[0] ? b[0] : a[0];
+        } else {
+            *lo = *hi = a[0] + dx * (c - a[1]) / dy;
+        }
+        return 1;
+    }
+    length = sqrt(dx * dx + dy * dy);
+    for (e = 0; e < 2; e++) {
+        const double *q = e ? b : a;
+        double off = c - q[1];
+        if (fabs(off) <= reach) {
+            double half = sqrt(reach * reach - off * off);
+            if (q[0] - half < l) l = q[0] - half;
+            if (q[0] + half > h) h = q[0] + half;
+        }
+    }
+    if (length > 0.0) {
+        /* Along the segment t = (x - a.x) dx + (c - a.y) dy in [0, length],
+           across it u = (c - a.y) dx - (x - a.x) dy in [-reach, reach]
+           (dx, dy made unit): each bounds x, or holds or fails for all x. */
+        double x0 = -1e300, x1 = 1e300, slope[2], base[2], bound[2][2];
+        int j;
+        dx /= length;
+        dy /= length;
+        slope[0] = dx;
+        base[0] = (c - a[1]) * dy - a[0] * dx;
+        bound[0][0] = 0.0;
+        bound[0][1] = length;
+        slope[1] = -dy;
+        base[1] = (c - a[1]) * dx + a[0] * dy;
+        bound[1][0] = -reach;
+        bound[1][1] = reach;
+        for (j = 0; j < 2; j++) {
+            if (fabs(slope[j]) < 1e-12) {
+                if (base[j] < bound[j][0] || base[j] > bound[j][1]) x1 = -1e300;
+            } else {
+                double p = (bound[j][0] - base[j]) / slope[j], q = (bound[j][1] - base[j]) / slope[j];
+                if (p > q) { double t = p; p = q; q = t; }
+                if (p > x0) x0 = p;
+                if (q < x1) x1 = q;
+            }
+        }
+        if (x0 <= x1) {
+            if (x0 < l) l = x0;
+            if (x1 > h) h = x1;
+        }
+    }
+    *lo = l;
+    *hi = h;
+    return l <= h;
+}
+
+/* The outline of a chart at scale s, unturned (p->outline, `*cols` x
+   `*rows` cells, row 0 at the bottom): the cells whose centres lie within
+   p->reach of a triangle. A triangle and the points within reach of it
+   make a convex set, so each row meets it in one interval, bounded by the
+   capsules around the three edges. With reach the bake's gutter this is
+   exactly the texels tt_lapped_bake draws for the chart (the triangles'
+   own texels have their centres inside), so charts whose masks do not meet
+   share no texel of their triangles or gutters; the texels a triangle
+   merely touches, widened by the gutter every way, would hold up to a
+   texel and a half more along each border. Cells beyond the `gutter`
+   cells framing the chart lie too far to need marking. 0 when the chart
+   does not fit `limit`. */
+static int tt__chart_outline(const tt__chart *chart, const int *members, const double *xy, double s, int gutter,
+                             int limit, tt__packing *p, int *cols, int *rows)
+{
+    int w = tt__chart_cells(chart->width, s, gutter), h = tt__chart_cells(chart->height, s, gutter), i, k, r;
+    double reach = p->reach;
+    if (w > limit || h > limit) return 0;
+    memset(p->outline, 0, sizeof *p->outline * (size_t)h * p->words);
     for (i = 0; i < chart->count; i++) {
-        double t[3][2], y0 = 1e300, y1 = -1e300;
-        int face = members[chart->first + i];
+        double t[3][2], y0 = 1e300, y1 = -1e300, r0, r1, grow;
+        int face = members[chart->first + i], edges = p->border[face];
         for (k = 0; k < 3; k++) {
-            tt__chart_texel(xy, face, k, s, gutter, turn, cols, rows, t[k]);
+            tt__chart_texel(xy, face, k, s, gutter, 0, w, h, t[k]);
             if (t[k][1] < y0) y0 = t[k][1];
             if (t[k][1] > y1) y1 = t[k][1];
         }
-        /* Row r's slab [r, r + 1] cuts the triangle in a convex piece
-           whose leftmost and rightmost points lie on the triangle's edges. */
-        for (r = y0 > 0.0 ? (int)floor(y0) : 0; r <= (int)floor(y1) && r < h; r++) {
-            double x0 = 1e300, x1 = -1e300;
-            for (k = 0; k < 3; k++) {
-                const double *a = t[k], *b = t[(k + 1) % 3];
-                double lo = a[1] < b[1] ? a[1] : b[1], hi = a[1] < b[1] ? b[1] : a[1], ends[2];
-                int e;
-                if (hi < r || lo > r + 1) continue;
-                ends[0] = lo > r ? lo : r;
-                ends[1] = hi < r + 1 ? hi : r + 1;
-                for (e = 0; e < 2; e++) {
-                    double x = b[1] != a[1] ? a[0] + (b[0] - a[0]) * (ends[e] - a[1]) / (b[1] - a[1])
-                                            : (e ? (a[0] > b[0] ? a[0] : b[0]) : (a[0] < b[0] ? a[0] : b[0]));
-                    if (x < x0) x0 = x;
-                    if (x > x1) x1 = x;
+        /* Rows whose centres r + 0.5 lie within reach of [y0, y1]. A point
+           outside the chart is nearest to a border edge: the others only
+           bound the triangle (reach 0). */
+        grow = edges ? reach : 0.0;
+        r0 = ceil(y0 - grow - 0.5);
+        r1 = floor(y1 + grow - 0.5);
+        if (r0 < 0.0) r0 = 0.0;
+        if (r1 > h - 1) r1 = h - 1;
+        for (r = (int)r0; r <= (int)r1; r++) {
+            double x0 = 1e300, x1 = -1e300, lo, hi;
+            for (k = 0; k < 3; k++)
+                if (tt__capsule_span(t[k], t[(k + 1) % 3], edges >> k & 1 ? reach : 0.0, r + 0.5, &lo, &hi)) {
+                    if (lo < x0) x0 = lo;
+                    if (hi > x1) x1 = hi;
                 }
-            }
             if (x0 > x1) continue;
-            /* Rounding may put a corner a hair outside the cells. */
-            x0 = x0 > 0.0 ? floor(x0) : 0.0;
-            x1 = x1 < w - 1 ? floor(x1) : w - 1;
-            if (x0 <= x1) tt__bits_set(p->mask + (size_t)r * p->words, (int)x0, (int)x1);
+            x0 = ceil(x0 - 0.5);
+            x1 = floor(x1 - 0.5);
+            if (x0 < 0.0) x0 = 0.0;
+            if (x1 > w - 1) x1 = w - 1;
+            if (x0 <= x1) tt__bits_set(p->outline + (size_t)r * p->words, (int)x0, (int)x1);
         }
     }
-    if (gutter > 0) {
-        /* Widened along rows, then across them (each row takes the rows
-           within `gutter` below it, then above it). */
-        int nw = (w + 63) / 64, j;
-        for (r = 0; r < h; r++) {
-            uint64_t *line = p->mask + (size_t)r * p->words;
-            for (d = 0; d < gutter; d++) {
-                uint64_t carry_up = 0, carry_down = 0;
-                for (j = 0; j < nw; j++) {   /* one cell left: bit c from c + 1 */
-                    uint64_t next = j + 1 < nw ? line[j + 1] : 0;
-                    carry_down = line[j] | line[j] >> 1 | next << 63;
-                    line[j] = carry_down;
-                }
-                for (j = nw - 1; j >= 0; j--) {   /* one cell right: bit c from c - 1 */
-                    uint64_t prev = j > 0 ? line[j - 1] : 0;
-                    carry_up = line[j] | line[j] << 1 | prev >> 63;
-                    line[j] = carry_up;
+    *cols = w;
+    *rows = h;
+    return 1;
+}
+
+/* p->mask: the outline (cols x rows) turned by `turn` quarter turns as
+   tt__chart_texel turns the chart (cell (i, j) goes where its square
+   goes), `*width` x `*height` cells. Turning the cells, not the triangles,
+   costs a pass over the outline's cells instead of three more outlines. */
+static void tt__mask_turn(tt__packing *p, int cols, int rows, int turn, int *width, int *height)
+{
+    int w = turn & 1 ? rows : cols, h = turn & 1 ? cols : rows, j, word;
+    if (turn == 0) {
+        memcpy(p->mask, p->outline, sizeof *p->mask * (size_t)rows * p->words);
+    } else {
+        memset(p->mask, 0, sizeof *p->mask * (size_t)h * p->words);
+        for (j = 0; j < rows; j++)
+            for (word = 0; word < (cols + 63) / 64; word++) {
+                uint64_t bits = p->outline[(size_t)j * p->words + word];
+                while (bits) {
+                    int i = 64 * word + tt__lowest_bit(bits), x, y;
+                    bits &= bits - 1;
+                    switch (turn) {
+                    case 1: x = rows - 1 - j; y = i; break;
+                    case 2: x = cols - 1 - i; y = rows - 1 - j; break;
+                    default: x = j; y = cols - 1 - i; break;
+                    }
+                    p->mask[(size_t)y * p->words + (x >> 6)] |= (uint64_t)1 << (x & 63);
                 }
             }
-            if (w & 63) line[nw - 1] &= ((uint64_t)1 << (w & 63)) - 1;
-        }
-        for (d = 0; d < gutter; d++) {
-            for (r = h - 1; r > 0; r--)
-                for (j = 0; j < nw; j++) p->mask[(size_t)r * p->words + j] |= p->mask[(size_t)(r - 1) * p->words + j];
-            for (r = 0; r + 1 < h; r++)
-                for (j = 0; j < nw; j++) p->mask[(size_t)r * p->words + j] |= p->mask[(size_t)(r + 1) * p->words + j];
-        }
     }
     *width = w;
     *height = h;
-    return 1;
 }
 
 /* The longest run of bits equal to `taken` among the first `width` of a
@@ -16395,16 +16485,6 @@ static int tt__longest_run(const uint64_t *line, int width, int taken)
             }
     }
     return run > longest ? run : longest;
-}
-
-/* The index of the lowest set bit of a non-zero word (de Bruijn). */
-static int tt__lowest_bit(uint64_t word)
-{
-    static const unsigned char table[64] = {
-        0,  1,  48, 2,  57, 49, 28, 3,  61, 58, 50, 42, 38, 29, 17, 4,  62, 55, 59, 36, 53, 51,
-        43, 22, 45, 39, 33, 30, 24, 18, 12, 5,  63, 47, 56, 27, 60, 41, 37, 16, 54, 35, 52, 21,
-        44, 32, 23, 11, 46, 26, 40, 15, 34, 20, 31, 10, 25, 14, 19, 9,  13, 8,  7,  6};
-    return table[((word & (~word + 1)) * (uint64_t)0x03f79d71b4cb0a89u) >> 58];
 }
 
 /* The first column >= from of row `row` whose bit is `taken` (0 or 1), or
@@ -16525,9 +16605,10 @@ static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order
     for (r = 0; r < size; r++) p->run[r] = size;
     for (i = 0; i < n; i++) {
         const tt__chart *chart = charts + order[i].chart;
-        int best_x = 0, best_y = size, best_turn = -1, at_x, at_y, width, height;
+        int best_x = 0, best_y = size, best_turn = -1, at_x, at_y, width, height, cols, rows;
+        if (!tt__chart_outline(chart, members, xy, s, gutter, size, p, &cols, &rows)) return 0;
         for (r = 0; r < 4; r++) {
-            if (!tt__chart_mask(chart, members, xy, s, gutter, r, size, p, &width, &height)) continue;
+            tt__mask_turn(p, cols, rows, r, &width, &height);
             for (j = 0; j < height; j++) need[j] = tt__longest_run(p->mask + (size_t)j * p->words, width, 1);
             if (tt__packing_find(p, size, width, height, need, rows_order, best_y, &at_x, &at_y) &&
                 (at_y < best_y || (at_y == best_y && at_x < best_x))) {
@@ -16537,7 +16618,7 @@ static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order
             }
         }
         if (best_turn < 0) return 0;
-        tt__chart_mask(chart, members, xy, s, gutter, best_turn, size, p, &width, &height);
+        tt__mask_turn(p, cols, rows, best_turn, &width, &height);
         for (r = 0; r < height; r++) {
             const uint64_t *mask = p->mask + (size_t)r * p->words;
             uint64_t *line = p->bits + (size_t)(best_y + r) * p->words;
@@ -16558,12 +16639,32 @@ static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order
     return 1;
 }
 
+/* How far a chart's faces may lie from its seed's centre, over the square
+   root of the mesh's surface. The cone alone lets a chart run on along
+   anything facing its way (a horse's flank takes in its legs, a plate's
+   rim bends round a corner): long, branching outlines whose hollows the
+   packing cannot fill. Held within a disc, charts stay round; more of
+   them cost more borders, which this radius keeps in balance (the fill
+   of scans and generated meshes peaks between 0.1 and 0.2). */
+#define TT__CHART_REACH 0.15
+
+/* Whether a projected face (6 doubles about its seed's centre) has a corner
+   farther than reach from it. */
+static int tt__beyond_reach(const double *t, double reach)
+{
+    int k;
+    for (k = 0; k < 3; k++)
+        if (t[2 * k] * t[2 * k] + t[2 * k + 1] * t[2 * k + 1] > reach * reach) return 1;
+    return 0;
+}
+
 /* The charts of the mesh (see tt_atlas_pack_charts): chart[f] for every
    face, members listing each chart's faces in the order they joined, xy
    their projections (6 per face). Returns the number of charts, or -1 when
    out of memory. */
 static int tt__grow_charts(const tt_mesh *mesh, const double *normal, const double *area, tt__tri_grid *grid,
-                           double eps, int *chart, int *tried, int *members, tt__chart *charts, double *xy)
+                           double eps, double reach, int *chart, int *tried, int *members, tt__chart *charts,
+                           double *xy)
 {
     const double cos_cone = cos(TT_ATLAS_CHART_CONE * TT__PI / 180.0), up[3] = {0.0, 0.0, 1.0};
     int nf = mesh->nfaces, ncharts = 0, placed = 0, zero_area, seed, f, k;
@@ -16601,6 +16702,7 @@ static int tt__grow_charts(const tt_mesh *mesh, const double *normal, const doub
                     if (area[face] > 0.0 && tt__dot3(normal + 3 * (size_t)face, axis) < cos_cone) continue;
                     tt__chart_project(mesh, face, origin, u, v, xy + 6 * (size_t)face);
                     if (area[face] > 0.0 && tt__tri_grid_overlap(grid, face, eps) >= 0) continue;
+                    if (area[face] > 0.0 && tt__beyond_reach(xy + 6 * (size_t)face, reach)) continue;
                     if (!tt__tri_grid_insert(grid, face)) return -1;
                     chart[face] = c;
                     members[placed++] = face;
@@ -16610,6 +16712,103 @@ static int tt__grow_charts(const tt_mesh *mesh, const double *normal, const doub
             tt__tri_grid_clear(grid);
         }
     return ncharts;
+}
+
+/* members and charts[0 .. n - 1] from chart[] (each chart's faces in index
+   order), the charts left empty dropped and the others renumbered in
+   order, seed[] with them; map: ncharts ints of scratch. Returns n. */
+static int tt__charts_regroup(int nf, int ncharts, int *chart, int *members, tt__chart *charts, int *seed, int *map)
+{
+    int f, c, n = 0, at = 0;
+    for (c = 0; c < ncharts; c++) charts[c].count = 0;
+    for (f = 0; f < nf; f++) charts[chart[f]].count++;
+    for (c = 0; c < ncharts; c++) {
+        int count = charts[c].count;
+        map[c] = n;
+        if (count == 0) continue;
+        charts[n].first = at;
+        charts[n].count = 0;
+        seed[n] = seed[c];
+        at += count;
+        n++;
+    }
+    for (f = 0; f < nf; f++) {
+        tt__chart *ch = charts + (chart[f] = map[chart[f]]);
+        members[ch->first + ch->count++] = f;
+    }
+    return n;
+}
+
+/* Straighter chart borders: a face with two of its three neighbours in
+   another chart is a tooth of its own chart and a notch of the other; it
+   moves over when it passes the other chart's tests (the cone about its
+   seed's normal, the reach, no overlap in its plane), and a pass repeats
+   while faces move (at most TT__CHART_SMOOTHING). A face that leaves a
+   chart had at most one neighbour in it, so no chart is torn; every chart
+   keeps the guarantees of its growth, and its border only shortens. Each
+   border tooth costs its gutter on both sides, and the hollows between
+   teeth are room the packing cannot use. seed[c]: chart c's seed; stamp:
+   nf ints, scratch: 2 nf ints. Returns the number of charts (some may
+   empty), or -1 when out of memory. */
+#define TT__CHART_SMOOTHING 4
+
+static int tt__smooth_charts(const tt_mesh *mesh, const double *normal, const double *area, tt__tri_grid *grid,
+                             double eps, double reach, int *chart, int *members, tt__chart *charts, int ncharts,
+                             int *seed, double *xy, int *stamp, int *scratch)
+{
+    const double cos_cone = cos(TT_ATLAS_CHART_CONE * TT__PI / 180.0);
+    int nf = mesh->nfaces, pass, c, f, k, moved = 1, now = 0, *queue = scratch, *map = scratch + nf;
+    for (f = 0; f < nf; f++) stamp[f] = 0;
+    for (pass = 0; pass < TT__CHART_SMOOTHING && moved; pass++) {
+        moved = 0;
+        ncharts = tt__charts_regroup(nf, ncharts, chart, members, charts, seed, map);
+        for (c = 0; c < ncharts; c++) {
+            const double *axis = normal + 3 * (size_t)seed[c];
+            double u[3], v[3], origin[3];
+            int n = 0, head, i;
+            if (area[seed[c]] == 0.0) continue;   /* no normal: its faces join other charts only */
+            tt__plane_frame(axis, u, v);
+            tt__face_centroid(mesh, seed[c], origin);
+            now++;
+            for (i = 0; i < charts[c].count; i++) {
+                f = members[charts[c].first + i];
+                if (chart[f] != c) continue;   /* moved out earlier in this pass */
+                queue[n++] = f;
+                stamp[f] = now;
+                if (!tt__tri_grid_insert(grid, f)) return -1;
+            }
+            /* A face taken in may make its neighbours teeth in turn. */
+            for (head = 0; head < n; head++) {
+                int from = queue[head];
+                for (k = 0; k < 3; k++) {
+                    int twin = mesh->twin[mesh->face_start[from] + k], face, j, inside = 0;
+                    double saved[6];
+                    if (twin < 0) continue;
+                    face = mesh->corner_face[twin];
+                    if (stamp[face] == now || area[face] == 0.0) continue;
+                    for (j = 0; j < 3; j++) {
+                        int t = mesh->twin[mesh->face_start[face] + j];
+                        if (t >= 0 && chart[mesh->corner_face[t]] == c) inside++;
+                    }
+                    if (inside < 2) continue;
+                    stamp[face] = now;
+                    if (tt__dot3(normal + 3 * (size_t)face, axis) < cos_cone) continue;
+                    memcpy(saved, xy + 6 * (size_t)face, sizeof saved);
+                    tt__chart_project(mesh, face, origin, u, v, xy + 6 * (size_t)face);
+                    if (tt__beyond_reach(xy + 6 * (size_t)face, reach) || tt__tri_grid_overlap(grid, face, eps) >= 0) {
+                        memcpy(xy + 6 * (size_t)face, saved, sizeof saved);
+                        continue;
+                    }
+                    if (!tt__tri_grid_insert(grid, face)) return -1;
+                    chart[face] = c;
+                    queue[n++] = face;
+                    moved++;
+                }
+            }
+            tt__tri_grid_clear(grid);
+        }
+    }
+    return tt__charts_regroup(nf, ncharts, chart, members, charts, seed, map);
 }
 
 /* The arguments of tt_atlas_pack_charts that need no allocation to check. */
@@ -16697,7 +16896,8 @@ static tt_result tt__atlas_too_small(int ncharts, int gutter, int size, tt_error
 static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart_order *order, int ncharts,
                                         const int *members, const double *xy, int block_gutter, int side,
                                         tt__packing *pack, int *need, int *rows_order, int *try_box, int nf,
-                                        const tt_chart_pack_options *opt, double surface, double tiny, int *box_x,
+                                        const tt_chart_pack_options *opt, float base, float span, double surface,
+                                        double tiny, int *box_x,
                                         int *box_y, int *box_turn, double *scale, tt_error *error)
 {
     int packed = 0, tries = 0, failed = 0, fitted = 0;
@@ -16723,7 +16923,8 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
                 failed = 1;
             }
             /* About 6 tries in all; the estimate only grows. */
-            if (opt->progress && opt->progress((float)(1.0 - 1.0 / (1.0 + tries / 3.0)), opt->progress_user_data))
+            if (opt->progress &&
+                opt->progress(base + span * (float)(1.0 - 1.0 / (1.0 + tries / 3.0)), opt->progress_user_data))
                 return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
             if (fitted && failed) mid = 0.5 * (s_lo + s_hi);
             else mid = fitted ? mid * TT__PACK_BRACKET : mid / TT__PACK_BRACKET;
@@ -16732,7 +16933,7 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
     if (!packed)
         tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, pack, need, rows_order, box_x,
                         box_y, box_turn);
-    if (opt->progress && opt->progress(1.0f, opt->progress_user_data))
+    if (opt->progress && opt->progress(base + span, opt->progress_user_data))
         return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
     *scale = s_lo;
     return TT_OK;
@@ -16775,16 +16976,17 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     const tt_allocator *al = allocator;
     double *normal = NULL, *area = NULL, *xy = NULL;
     int *chart = NULL, *tried = NULL, *members = NULL, *box_x = NULL, *box_y = NULL, *box_turn = NULL;
-    int *try_box = NULL;
+    int *try_box = NULL, *seed = NULL;
+    unsigned char *border = NULL;
     tt_chart_pack_options opt;
     int *need = NULL, *rows_order = NULL, block, side, block_gutter;
     tt__chart *charts = NULL;
     tt__chart_order *order = NULL;
     tt__tri_grid grid;
     tt__packing pack;
-    double surface = 0.0, largest = 0.0;
-    double cell, diagonal, tiny, s_lo = 0.0;   /* set by tt__atlas_search_scale */
-    int nf, c, ncharts;
+    double surface = 0.0, cell, diagonal, reach_cells, best_scale = 0.0;
+    float *best_uv = NULL;
+    int nf, c, ncharts, f, k, attempt, best_charts = 0, fewest = -1;
     tt_result result;
 
     tt__ok(error);
@@ -16810,54 +17012,104 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     box_y = TT__ALLOC(al, int, nf);
     box_turn = TT__ALLOC(al, int, nf);
     try_box = TT__ALLOC(al, int, 3 * (size_t)nf);
+    seed = TT__ALLOC(al, int, nf);
+    border = TT__ALLOC(al, unsigned char, nf);
+    best_uv = TT__ALLOC(al, float, 2 * (size_t)mesh->ncorners);
     /* Above TT__PACK_GRID texels a side, the packing works in blocks of
        texels (the gutter rounded up to whole blocks): its time grows with
        the bitmap, and a chart's outline then costs at most a block more. */
     block = (size + TT__PACK_GRID - 1) / TT__PACK_GRID;
     side = size / block;
     block_gutter = (gutter + block - 1) / block;
+    /* A texel's centre within `gutter` of a triangle is the bake's; in
+       blocks, the centres of a block's texels lie within half its diagonal
+       of its own. Every point lies within half a diagonal of a cell's
+       centre, so with at least that much two charts' triangles cannot
+       overlap (gutter 0). The margin covers the rounding of the UVs to
+       floats. */
+    reach_cells = (double)gutter / block + (block > 1 ? 0.5 * sqrt(2.0) : 0.0);
+    if (reach_cells < 0.5 * sqrt(2.0)) reach_cells = 0.5 * sqrt(2.0);
+    reach_cells += 1.0 / 64.0;
     pack.words = (side + 63) / 64;
     pack.bits = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
     pack.mask = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
+    pack.outline = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
     pack.run = TT__ALLOC(al, int, side);
     need = TT__ALLOC(al, int, side);
     rows_order = TT__ALLOC(al, int, side);
     if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !box_x || !box_y || !box_turn ||
-        !try_box || !pack.bits || !pack.mask || !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
+        !try_box || !seed || !border || !best_uv || !pack.bits || !pack.mask || !pack.outline || !pack.run || !need ||
+        !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
         goto out_of_memory;
 
     tt__atlas_measure(mesh, normal, area, &surface, &diagonal, &cell);
     grid.cell = cell;
-    /* Overlaps smaller than this are rounding (neighbours share an edge). */
-    ncharts = tt__grow_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), chart, tried,
-                              members, charts, xy);
-    if (ncharts < 0) goto out_of_memory;
+    /* Two sets of charts, each packed: round ones (held within
+       TT__CHART_REACH) and ones held by the cone alone; the atlas that
+       fills more wins. Round charts pack better where the cone lets charts
+       branch (scans, plates with rims); bands and rings, the charts of a
+       smooth tube, nest in each other's holes whole and lose fill when cut. */
+    for (attempt = 0; attempt < 2; attempt++) {
+        double reach = attempt == 0 ? TT__CHART_REACH * sqrt(surface) : 1e300, largest = 0.0, tiny, s_lo = 0.0;
+        int fits;
+        /* Overlaps smaller than this are rounding (neighbours share an edge). */
+        ncharts = tt__grow_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), reach, chart,
+                                  tried, members, charts, xy);
+        if (ncharts < 0) goto out_of_memory;
+        /* The seeds (each chart's first member) and scratch for the smoothing. */
+        for (c = 0; c < ncharts; c++) seed[c] = members[charts[c].first];
+        ncharts = tt__smooth_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), reach, chart,
+                                    members, charts, ncharts, seed, xy, tried, try_box);
+        if (ncharts < 0) goto out_of_memory;
+        for (f = 0; f < nf; f++) {
+            border[f] = 0;
+            for (k = 0; k < 3; k++) {
+                int twin = mesh->twin[mesh->face_start[f] + k];
+                if (twin < 0 || chart[mesh->corner_face[twin]] != chart[f]) border[f] |= (unsigned char)(1u << k);
+            }
+        }
+        pack.border = border;
+        for (c = 0; c < ncharts; c++) {
+            tt__chart_shape(area, members, xy, charts + c);
+            order[c].area = charts[c].width * charts[c].height;
+            order[c].width = charts[c].width;
+            order[c].chart = c;
+            if (charts[c].width > largest) largest = charts[c].width;
+        }
+        tt__sort_chart_order(order, ncharts);
 
-    for (c = 0; c < ncharts; c++) {
-        tt__chart_shape(area, members, xy, charts + c);
-        order[c].area = charts[c].width * charts[c].height;
-        order[c].width = charts[c].width;
-        order[c].chart = c;
-        if (charts[c].width > largest) largest = charts[c].width;
+        /* Scales from here on are in blocks per mesh unit. Whether they fit
+           at all asks for each chart's whole frame of 2 gutter + 1 cells a
+           side, which makes the size the error names exact; any mask lies
+           within its frame. */
+        tiny = largest > 0.0 ? 1e-6 / largest : 1.0;
+        pack.reach = 2.0 * (block_gutter + 1);
+        fits = tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, block_gutter, side, &pack, need, rows_order,
+                               NULL, NULL, NULL);
+        pack.reach = reach_cells;
+        if (!fits) {
+            if (fewest < 0 || ncharts < fewest) fewest = ncharts;
+            continue;
+        }
+        result = tt__atlas_search_scale(charts, order, ncharts, members, xy, block_gutter, side, &pack, need,
+                                        rows_order, try_box, nf, &opt, 0.5f * attempt, 0.5f, surface, tiny, box_x,
+                                        box_y, box_turn, &s_lo, error);
+        if (result != TT_OK) goto done;
+        if (best_charts == 0 || s_lo > best_scale) {
+            best_charts = ncharts;
+            best_scale = s_lo;
+            tt__atlas_write_uv(mesh, charts, ncharts, members, xy, s_lo, block, block_gutter, box_x, box_y, box_turn,
+                               size, best_uv);
+        }
     }
-    tt__sort_chart_order(order, ncharts);
-
-    /* Scales from here on are in blocks per mesh unit. */
-    tiny = largest > 0.0 ? 1e-6 / largest : 1.0;
-    if (!tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, block_gutter, side, &pack, need, rows_order, NULL,
-                         NULL, NULL)) {
-        result = tt__atlas_too_small(ncharts, gutter, size, error);
+    if (best_charts == 0) {
+        result = tt__atlas_too_small(fewest, gutter, size, error);
         goto done;
     }
-    result = tt__atlas_search_scale(charts, order, ncharts, members, xy, block_gutter, side, &pack, need, rows_order,
-                                    try_box, nf, &opt, surface, tiny, box_x, box_y, box_turn, &s_lo, error);
-    if (result != TT_OK) goto done;
-
-    tt__atlas_write_uv(mesh, charts, ncharts, members, xy, s_lo, block, block_gutter, box_x, box_y, box_turn, size,
-                       corner_uv);
+    memcpy(corner_uv, best_uv, sizeof(float) * 2 * (size_t)mesh->ncorners);
     if (report) {
-        report->ncharts = ncharts;
-        report->texels_per_unit = s_lo * block;
+        report->ncharts = best_charts;
+        report->texels_per_unit = best_scale * block;
         report->fill = report->texels_per_unit * report->texels_per_unit * surface / ((double)size * size);
     }
     result = tt__ok(error);
@@ -16880,8 +17132,12 @@ done:
     tt__free(al, box_y);
     tt__free(al, box_turn);
     tt__free(al, try_box);
+    tt__free(al, seed);
+    tt__free(al, border);
+    tt__free(al, best_uv);
     tt__free(al, pack.bits);
     tt__free(al, pack.mask);
+    tt__free(al, pack.outline);
     tt__free(al, pack.run);
     tt__free(al, need);
     tt__free(al, rows_order);

@@ -4435,7 +4435,7 @@ static double chart_box_fill(const tt_mesh *mesh, const float *uv, int size, int
    0.15 in lumps, +-0.0015 of noise per vertex). The triangles fill at
    least 60 % of the atlas at one texel density (p95 / p5 within 1.2); the
    control, the same charts' bounding boxes in shelves (how the atlas was
-   packed before), must stay below 50 %. */
+   packed before), must stay below 55 % (rounder charts box better than ragged ones). */
 static void test_atlas_pack_charts_fill(void)
 {
     tt_mesh *mesh;
@@ -4470,7 +4470,7 @@ static void test_atlas_pack_charts_fill(void)
     CHECK(spread[2] / spread[0] <= 1.2, "texel density p95 / p5 %.3f", spread[2] / spread[0]);
     boxes = chart_box_fill(mesh, uv, 2048, 2);
     CHECK(report.fill >= 0.6, "%d charts fill %.3f of the atlas", report.ncharts, report.fill);
-    CHECK(boxes < 0.5, "control: their boxes in shelves would fill %.3f", boxes);
+    CHECK(boxes < 0.55, "control: their boxes in shelves would fill %.3f", boxes);
     /* Above 2048 texels a side the packing works in blocks of texels
        (here 2, the gutter of 3 rounded up to 2 blocks): every promise still
        holds, at the same or a better fill. */
@@ -4569,6 +4569,33 @@ static void test_atlas_pack_charts_overlap(void)
     CHECK(result == TT_OK && check.problem == TT_UV_USABLE,
           "the ramp's atlas passes the UV check (problem %d at faces %d, %d)", (int)check.problem, check.face,
           check.other_face);
+    free(uv);
+    tt_mesh_free(mesh);
+}
+
+
+/* A coarse torus (32 x 16 quads, each split in two) at 512, gutter 2: with
+   round charts, straightened borders and outlines of the texels the bake
+   fills, the triangles fill 0.58 or more (0.60); charts by the cone alone
+   as outlines of touched texels widened square filled 0.54. Control: the
+   same mesh with gutter 6 fills less (0.43), so the bound tells the
+   outlines' size apart. */
+static void test_atlas_pack_charts_coarse(void)
+{
+    tt_mesh *mesh;
+    float *uv;
+    tt_chart_atlas_report report, wide;
+    tt_error err;
+    double spread[3];
+    mesh = chart_torus(32, 16, 0.0);
+    if (!mesh) return;
+    uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+    CHECK(tt_atlas_pack_charts(mesh, 512, 2, NULL, NULL, uv, &report, &err) == TT_OK, "512: %s", err.message);
+    chart_check_atlas("coarse torus at 512", mesh, uv, &report, 512, 2, spread);
+    CHECK(report.fill >= 0.58, "%d charts fill %.3f of the atlas", report.ncharts, report.fill);
+    CHECK(tt_atlas_pack_charts(mesh, 512, 6, NULL, NULL, uv, &wide, &err) == TT_OK, "gutter 6: %s", err.message);
+    chart_check_atlas("coarse torus at 512, gutter 6", mesh, uv, &wide, 512, 6, spread);
+    CHECK(wide.fill < 0.58, "control: gutter 6 fills %.3f", wide.fill);
     free(uv);
     tt_mesh_free(mesh);
 }
@@ -5728,6 +5755,7 @@ void run_lapped_tests(void)
     RUN(test_atlas_pack_charts_uneven);
     RUN(test_atlas_pack_charts_overlap);
     RUN(test_atlas_pack_charts_small);
+    RUN(test_atlas_pack_charts_coarse);
     RUN(test_atlas_pack_charts_errors);
     RUN(test_atlas_pack_charts_oom);
     RUN(test_uv_check);
