@@ -141,7 +141,7 @@ static void print_help(void)
            "                       flipped, none overlapping another (two triangles drawing the same\n"
            "                       texels would bake scrambled); 'atlas' over a new atlas of charts\n"
            "                       (pieces of the surface flattened, one texel density, 2 texels\n"
-           "                       apart); 'auto' (default) the OBJ's own when they are fit, else an\n"
+           "                       of gutter each); 'auto' (default) the OBJ's own when they are fit, else an\n"
            "                       atlas, with a warning saying why when the OBJ has some\n"
            "  --pasting            write the pastes, not their bake (see above); OBJ only\n"
            "  --format F           obj (default), glb (one binary glTF file, OUT_PREFIX.glb) or gltf\n"
