@@ -2095,6 +2095,14 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
 /* tt_lapped.visible_cuts: a paste that stops at an edge with at least this
    alpha there shows a hard edge. */
 #define TT_LAPPED_VISIBLE_CUT 0.25f
+/* With a cut (tt_lapped.cut), tt_lapped_bake narrows each paste's soft
+   edge over what is opaque: the paste's share s of the colour (alpha times
+   fade over the alpha composited) becomes smoothstep of
+   (s - 0.5) / TT_LAPPED_CUT_BLEND + 0.5, so the ramp of the patch's alpha
+   and of the fade is this fraction as wide. A wide ramp shows both pastes
+   at once, a structured photo's courses doubled (bunny, brick_red: at 10 %
+   of the sample points with the full ramp, 2 % at 0.25). */
+#define TT_LAPPED_CUT_BLEND 0.25f
 /* options->max_pastes = 0: this cap (a few minutes of work). */
 #ifndef TT_LAPPED_MAX_PASTES
 #define TT_LAPPED_MAX_PASTES 200000
@@ -2147,7 +2155,8 @@ typedef struct tt_lapped {
        from the anchor (texture units) beyond which tt_lapped_bake fades the paste's colour into that of
        what lies beneath over cut_feather, as far as that is opaque (the paste's colour weighs
        1 - (1 - c) * alpha beneath, c from 1 at the distance to 0 at the distance + cut_feather,
-       smoothstep), its alpha unchanged. The runtime pasting (Sec. 4) ignores it */
+       smoothstep), its alpha unchanged; with a cut the bake also narrows each paste's soft edge over what
+       is opaque (TT_LAPPED_CUT_BLEND). The runtime pasting (Sec. 4) ignores both */
     int cut_columns;
     float *cut;
     float cut_feather;
@@ -17301,10 +17310,21 @@ static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float s
 /* "over" of a paste's sample cut to c: beyond its cut the paste takes the
    colour of what lies beneath as far as that is opaque (its colour weighs
    1 - (1 - c) * the alpha beneath), its alpha unchanged, so a cut changes
-   no coverage and never uncovers anything. */
-static void tt__bake_over(float out[4], float sample[4], float cut)
+   no coverage and never uncovers anything. narrow (pastes with a cut):
+   first its soft edge is narrowed (TT_LAPPED_CUT_BLEND), its alpha
+   unchanged as well. */
+static void tt__bake_over(float out[4], float sample[4], float cut, int narrow)
 {
     int i;
+    if (narrow && out[3] > 0.0f && sample[3] > 0.0f && sample[3] < 1.0f) {
+        /* TT_LAPPED_CUT_BLEND: the paste's share of the straight colour,
+           a / A, narrowed to g; the colour then is A (g S + (1 - g) B),
+           with B the straight colour beneath, and the alpha stays A. */
+        const double a = sample[3], A = a + (1.0 - a) * out[3], x0 = (a / A - 0.5) / TT_LAPPED_CUT_BLEND + 0.5;
+        const double x = x0 < 0.0 ? 0.0 : (x0 > 1.0 ? 1.0 : x0), g = x * x * (3.0 - 2.0 * x);
+        const double own = g * A / a, beneath = (1.0 - g) * A / out[3] - (1.0 - a);
+        for (i = 0; i < 3; i++) sample[i] = (float)(own * sample[i] + beneath * out[i]);
+    }
     if (cut < 1.0f) {
         const float keep = 1.0f - (1.0f - cut) * out[3], beneath = (1.0f - cut) * sample[3];
         for (i = 0; i < 3; i++) sample[i] = keep * sample[i] + beneath * out[i];
@@ -17332,14 +17352,14 @@ static void tt__bake_composite(const tt__bake *b, const double w[3], float out[4
     if (opaque || cached == n) {
         while (cached > 0) {
             cached--;
-            tt__bake_over(out, cache[cached], cuts[cached]);
+            tt__bake_over(out, cache[cached], cuts[cached], b->lapped->cut != NULL);
         }
         return;
     }
     for (k = 0; k < n; k++) {
         float sample[4], cut;
         tt__bake_sample(b, k, w, sample, &cut);
-        tt__bake_over(out, sample, cut);
+        tt__bake_over(out, sample, cut, b->lapped->cut != NULL);
     }
 }
 

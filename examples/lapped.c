@@ -126,7 +126,8 @@ static void print_help(void)
            "  --isotropic          the texture has no direction: each paste turns its patch at random\n"
            "  --keep-edges         each paste keeps its patch's whole soft edge (default: where it lies\n"
            "                       over what is opaque, its edge is cut where it best matches what lies\n"
-           "                       beneath, so bricks or planks run on through the overlaps)\n"
+           "                       beneath, and the bake blends it over a quarter of the soft edge's\n"
+           "                       width, so bricks or planks run on through the overlaps, not doubled)\n"
            "  --mask MASK.png      the patches' shape: MASK's alpha, or its grey when opaque\n"
            "                       (white = inside); one shape for every patch: MASK is the size of a\n"
            "                       patch, or of IMAGE and then scaled to the patch's (default: a random\n"
@@ -167,7 +168,9 @@ static void print_help(void)
            "\n"
            "Prints the number of pastes, the coverage, how often a face is drawn (overdraw), how\n"
            "well the texture follows the field (angle and scale error), the hard edges (where the\n"
-           "paste on top stops while still at least 25%% opaque), how many face entries hidden\n"
+           "paste on top stops while still at least 25%% opaque), the ghosting (the share of points\n"
+           "where two pastes that differ each make at least 20%% of the colour: courses seen through\n"
+           "each other), how many face entries hidden\n"
            "by later pastes were dropped, and how many pastes each patch got; of the bake, the\n"
            "baked texture's seam score (about 0: the texture continues across edges; about 1: it\n"
            "jumps) over every edge and over the edges where the paste on top changes.\n"
@@ -1151,6 +1154,133 @@ static double top_density_spread(const triangle_mesh *m, const tt_lapped *lapped
     return spread;
 }
 
+/* Paste `paste`'s cut at (u, v) of its texture space, as tt_lapped.cut
+   describes it: 1 within, smoothstep down to 0 over the feather beyond. */
+static double paste_cut_factor(const tt_lapped *lapped, int paste, double u, double v)
+{
+    const int K = lapped->cut_columns;
+    const float *cut = lapped->cut + (size_t)(2 + K) * (size_t)paste;
+    const double du = u - cut[0], dv = v - cut[1], r = sqrt(du * du + dv * dv);
+    double at = atan2(dv, du) / (2.0 * 3.14159265358979323846) * K, reach, x;
+    int j;
+    if (at < 0.0) at += K;
+    j = (int)at < K ? (int)at : K - 1;
+    reach = cut[2 + j] + (at - j) * (cut[2 + (j + 1) % K] - cut[2 + j]);
+    if (r <= reach) return 1.0;
+    x = (reach + lapped->cut_feather - r) / lapped->cut_feather;
+    return x <= 0.0 ? 0.0 : x * x * (3.0 - 2.0 * x);
+}
+
+/* Pastes composited at one point, at most (beneath them the rest is hidden
+   in practice: the walk stops below 0.001 of light left). */
+#define GHOST_DEPTH 64
+
+/* One paste (straight colour S, alpha a = patch alpha times fade, cut c)
+   composited over out[4] as tt_lapped_bake does it (narrowed with a cut,
+   TT_LAPPED_CUT_BLEND, then cut), also on share[0 .. n - 1], out's
+   premultiplied colour split by the pastes beneath (share[n] is this
+   one's). */
+static void ghost_over(double out[4], double *share, int n, const double S[3], double a, double c, int narrow)
+{
+    double own = a, beneath = 0.0;   /* the sample's colour: own S + beneath out */
+    int i, k;
+    if (narrow && out[3] > 0.0 && a > 0.0 && a < 1.0) {
+        const double A = a + (1.0 - a) * out[3], x0 = (a / A - 0.5) / TT_LAPPED_CUT_BLEND + 0.5;
+        const double x = x0 < 0.0 ? 0.0 : (x0 > 1.0 ? 1.0 : x0), g = x * x * (3.0 - 2.0 * x);
+        own = g * A;
+        beneath = (1.0 - g) * A / out[3] - (1.0 - a);
+    }
+    if (c < 1.0) {
+        const double keep = 1.0 - (1.0 - c) * out[3];
+        own *= keep;
+        beneath = keep * beneath + (1.0 - c) * a;
+    }
+    for (k = 0; k < n; k++) share[k] *= beneath + 1.0 - a;
+    share[n] = own;
+    for (i = 0; i < 3; i++) out[i] = own * S[i] + (beneath + 1.0 - a) * out[i];
+    out[3] = a + (1.0 - a) * out[3];
+}
+
+/* Ghosting: the share of sample points (21 per face) whose composited
+   colour mixes two pastes, each at least GHOST_SHARE of it, whose colours
+   differ by at least GHOST_DIFFERENCE (mean square over RGB): two courses
+   of a structured photo seen through each other. *mixed gets the share of
+   points that mix two pastes at all. -1 when out of memory. */
+#define GHOST_SHARE 0.2
+#define GHOST_DIFFERENCE 0.02
+static double ghosting(const tt_mesh *mesh, const tt_lapped *lapped, const lapped_patches *patches, double *mixed)
+{
+    int *paste_of = (int *)malloc(sizeof(int) * (size_t)(lapped->nentries + 1));
+    int *head = (int *)malloc(sizeof(int) * (size_t)(mesh->nfaces + 1));
+    int *below = (int *)malloc(sizeof(int) * (size_t)(lapped->nentries + 1));
+    long points = 0, mixing = 0, ghosts = 0;
+    int p, e, f, j;
+    *mixed = 0.0;
+    if (!paste_of || !head || !below) {
+        free(paste_of);
+        free(head);
+        free(below);
+        return -1.0;
+    }
+    for (p = 0; p < lapped->npastes; p++)
+        for (e = lapped->pastes[p].first; e < lapped->pastes[p].first + lapped->pastes[p].nfaces; e++) paste_of[e] = p;
+    for (f = 0; f < mesh->nfaces; f++) head[f] = -1;
+    for (e = 0; e < lapped->nentries; e++) {
+        below[e] = head[lapped->faces[e]];
+        head[lapped->faces[e]] = e;
+    }
+    for (f = 0; f < mesh->nfaces; f++)
+        for (j = 0; j < 36; j++) {
+            const int wa = j % 6, wb = j / 6;
+            double w[3], S[GHOST_DEPTH][3], alpha[GHOST_DEPTH], cut[GHOST_DEPTH], share[GHOST_DEPTH];
+            double light = 1.0, out[4] = {0.0, 0.0, 0.0, 0.0}, first = 0.0, second = 0.0, d = 0.0;
+            int n = 0, c, k, i1 = 0, i2 = 0;
+            if (wa + wb > 5 || head[f] < 0) continue;
+            w[0] = (wa + 0.5) / 7.0;
+            w[1] = (wb + 0.5) / 7.0;
+            w[2] = 1.0 - w[0] - w[1];
+            /* From the top down while light gets through, then composited upward. */
+            for (e = head[f]; e >= 0 && light > 0.001 && n < GHOST_DEPTH; e = below[e], n++) {
+                const float *uv = lapped->uv + 6 * (size_t)e, *fd = lapped->fade ? lapped->fade + 3 * (size_t)e : NULL;
+                const tt_image *patch = patches->images[lapped->pastes[paste_of[e]].patch];
+                const double u = w[0] * uv[0] + w[1] * uv[2] + w[2] * uv[4], v = w[0] * uv[1] + w[1] * uv[3] + w[2] * uv[5];
+                double fade = fd ? w[0] * fd[0] + w[1] * fd[1] + w[2] * fd[2] : 1.0;
+                float rgba[4];
+                tt_image_sample_bilinear(patch, (float)(u * patch->width), (float)((1.0 - v) * patch->height), rgba);
+                fade = fade < 0.0 ? 0.0 : (fade > 1.0 ? 1.0 : fade);
+                alpha[n] = rgba[3] * fade;
+                cut[n] = lapped->cut ? paste_cut_factor(lapped, paste_of[e], u, v) : 1.0;
+                for (c = 0; c < 3; c++) S[n][c] = rgba[3] > 0.0f ? rgba[c] / rgba[3] : 0.0;
+                light *= 1.0 - alpha[n];
+            }
+            for (k = 0; k < n; k++)
+                ghost_over(out, share, k, S[n - 1 - k], alpha[n - 1 - k], cut[n - 1 - k], lapped->cut != NULL);
+            points++;
+            if (!(out[3] > 0.0)) continue;
+            for (k = 0; k < n; k++) {
+                const double s = share[k] / out[3];
+                if (s > first) {
+                    second = first;
+                    i2 = i1;
+                    first = s;
+                    i1 = k;
+                } else if (s > second) {
+                    second = s;
+                    i2 = k;
+                }
+            }
+            if (second < GHOST_SHARE) continue;
+            mixing++;
+            for (c = 0; c < 3; c++) d += (S[n - 1 - i1][c] - S[n - 1 - i2][c]) * (S[n - 1 - i1][c] - S[n - 1 - i2][c]);
+            ghosts += d / 3.0 >= GHOST_DIFFERENCE;
+        }
+    free(paste_of);
+    free(head);
+    free(below);
+    *mixed = points ? (double)mixing / (double)points : 0.0;
+    return points ? (double)ghosts / (double)points : 0.0;
+}
+
 static void print_summary(const lapped_options *options, const triangle_mesh *m, const float *field,
                           const tt_lapped *lapped, const lapped_patches *patches, const bake_atlas *atlas,
                           const baked_summary *baked, double seconds)
@@ -1179,6 +1309,12 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
            options->isotropic ? " (isotropic: against each paste's own direction)" : "");
     printf("texel density of the pastes on top: 95th percentile over 5th %.3f\n",
            top_density_spread(m, lapped, patches));
+    {
+        double mixed, ghosts = ghosting(m->mesh, lapped, patches, &mixed);
+        if (ghosts >= 0.0)
+            printf("ghosting: %.1f%% of the sample points show two pastes that differ, each at least %.0f%% of the colour "
+                   "(%.1f%% mixes two)\n", 100.0 * ghosts, 100.0 * GHOST_SHARE, 100.0 * mixed);
+    }
     printf("cuts: %d of %d edges where the top paste changes end it at %.0f%% alpha or more\n", lapped->visible_cuts,
            lapped->top_changes, 100.0 * TT_LAPPED_VISIBLE_CUT);
     if (options->bake_size > 0) {

@@ -2225,6 +2225,33 @@ static double lapped_seam_mismatch(const tt_mesh *mesh, const tt_lapped *lapped,
     return *points ? sum / *points : 0.0;
 }
 
+/* Pastes of the photo src (its patch, seed 5) over the sheet m, along a
+   field of scale 8 (seed 7): *cut with the cut of each paste's edge, *kept
+   with keep_edges. */
+static void lapped_sheet_pair(const tmesh *m, const tt_image *src, tt_mesh **mesh, float **field, tt_image **patch,
+                              tt_lapped **cut, tt_lapped **kept)
+{
+    tt_patch_options po;
+    tt_field_options fo;
+    tt_lapped_options lo;
+    tt_error err;
+    memset(&po, 0, sizeof po);
+    po.seed = 5;
+    CHECK(tt_make_texture_patch(src, NULL, &po, NULL, patch, NULL) == TT_OK, "sheet's patch");
+    CHECK(build(m, 0, mesh, &err) == TT_OK, "sheet");
+    if (*mesh && *patch) {
+        *field = (float *)malloc(sizeof(float) * 3 * (size_t)(*mesh)->nfaces);
+        memset(&fo, 0, sizeof fo);
+        fo.scale = 8.0f;
+        CHECK(tt_tangent_field(*mesh, &fo, NULL, *field, &err) == TT_OK, "field: %s", err.message);
+        memset(&lo, 0, sizeof lo);
+        lo.seed = 7;
+        CHECK(tt_lapped_paste(*mesh, *field, patch, 1, &lo, NULL, cut, &err) == TT_OK, "cut: %s", err.message);
+        lo.keep_edges = 1;
+        CHECK(tt_lapped_paste(*mesh, *field, patch, 1, &lo, NULL, kept, &err) == TT_OK, "kept: %s", err.message);
+    }
+}
+
 /* The cut of each paste's edge: on a flat sheet, pastes of blotchy noise
    (which registration cannot line up everywhere) blend into those beneath
    where the two agree better than along the patch's own edge
@@ -2239,9 +2266,6 @@ static void test_lapped_cut(void)
     float *field = NULL;
     tt_image *src = NULL, *patch = NULL;
     tt_lapped *cut = NULL, *kept = NULL;
-    tt_patch_options po;
-    tt_field_options fo;
-    tt_lapped_options lo;
     tt_error err;
     double lattice[17][17][3], with_cut, without, turned;
     int x, y, k, points[3];
@@ -2263,21 +2287,7 @@ static void test_lapped_cut(void)
                                            ty * ((1 - tx) * lattice[iy + 1][ix][k] + tx * lattice[iy + 1][ix + 1][k]));
             px(src, x, y)[3] = 1.0f;
         }
-    memset(&po, 0, sizeof po);
-    po.seed = 5;
-    CHECK(tt_make_texture_patch(src, NULL, &po, NULL, &patch, NULL) == TT_OK, "noise patch");
-    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sheet");
-    if (mesh && patch) {
-        field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-        memset(&fo, 0, sizeof fo);
-        fo.scale = 8.0f;
-        CHECK(tt_tangent_field(mesh, &fo, NULL, field, &err) == TT_OK, "field: %s", err.message);
-        memset(&lo, 0, sizeof lo);
-        lo.seed = 7;
-        CHECK(tt_lapped_paste(mesh, field, &patch, 1, &lo, NULL, &cut, &err) == TT_OK, "cut: %s", err.message);
-        lo.keep_edges = 1;
-        CHECK(tt_lapped_paste(mesh, field, &patch, 1, &lo, NULL, &kept, &err) == TT_OK, "kept: %s", err.message);
-    }
+    lapped_sheet_pair(&m, src, &mesh, &field, &patch, &cut, &kept);
     if (cut && kept) {
         CHECK(cut->cut && cut->cut_columns > 0 && cut->cut_feather > 0.0f, "the pastes carry their cut");
         CHECK(!kept->cut && kept->cut_columns == 0, "keep_edges: no cut");
@@ -2328,6 +2338,113 @@ static void test_lapped_cut(void)
             free(uv);
         }
     }
+    tt_lapped_free(cut);
+    tt_lapped_free(kept);
+    tt_mesh_free(mesh);
+    free(field);
+    tm_free(&m);
+    tm_free(&g);
+    tt_image_free(patch);
+    tt_image_free(src);
+}
+
+/* Share of the opaque texels of a bake of a black-and-white photo that are
+   grey (0.25 to 0.75) with no step of 0.25 or more to a 4-neighbour: a
+   course and the mortar of another pasted over it blend to a smooth grey,
+   while the bilinear edges of the bricks within one paste step sharply. */
+static double lapped_grey_share(const tt_image *baked)
+{
+    const int w = baked->width, h = baked->height;
+    long opaque = 0, grey = 0;
+    int x, y, k;
+    for (y = 1; y < h - 1; y++)
+        for (x = 1; x < w - 1; x++) {
+            const float *p = baked->pixels + 4 * ((size_t)y * (size_t)w + (size_t)x);
+            const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+            int smooth = 1;
+            if (p[3] < 0.99f) continue;
+            opaque++;
+            if (p[0] < 0.25f || p[0] > 0.75f) continue;
+            for (k = 0; k < 4; k++) {
+                const float *q = baked->pixels + 4 * ((size_t)(y + dy[k]) * (size_t)w + (size_t)(x + dx[k]));
+                smooth &= q[3] >= 0.99f && fabsf(q[0] - p[0]) < 0.25f;
+            }
+            grey += smooth;
+        }
+    return opaque ? (double)grey / (double)opaque : 0.0;
+}
+
+/* Ghosting: a brick photo (white bricks 13 texels high in black mortar,
+   each course's bricks of its own length, 20 to 43 texels, so that no
+   shift lines up every course of two pastes) pasted over a flat sheet and
+   baked. With the cut, the pastes' soft edges are narrowed
+   (TT_LAPPED_CUT_BLEND), so the bake shows one course where pastes
+   overlap; the control, keep_edges, blends the whole soft edge (the
+   patch's alpha and the fade) and must show clearly more smooth grey
+   (measured: 0.0044 against 0.0082). The photo itself, resampled at the
+   bake's density, is the floor. */
+static void test_lapped_ghosting(void)
+{
+    tmesh g, m;
+    tt_mesh *mesh = NULL;
+    float *field = NULL, *uv = NULL;
+    tt_image *src = NULL, *patch = NULL, *baked = NULL;
+    tt_lapped *cut = NULL, *kept = NULL;
+    tt_error err;
+    double narrow = 1.0, wide = 0.0, floor_share;
+    int x, y, k, period[8], joint[8];
+    memset(&g, 0, sizeof g);
+    make_grid(&g, 40, 40);
+    tm_triangulate(&g, &m);
+    lcg_seed(9);
+    for (k = 0; k < 8; k++) {
+        period[k] = 20 + (int)(lcg_unit() * 24.0);
+        joint[k] = (int)(lcg_unit() * period[k]);
+    }
+    CHECK(tt_image_create(128, 128, NULL, &src, NULL) == TT_OK, "brick image");
+    for (y = 0; y < 128; y++)
+        for (x = 0; x < 128; x++) {
+            const int course = y / 16, along = (x + joint[course]) % period[course];
+            const float value = y % 16 < 3 || along < 3 ? 0.0f : 1.0f;
+            for (k = 0; k < 3; k++) px(src, x, y)[k] = value;
+            px(src, x, y)[3] = 1.0f;
+        }
+    lapped_sheet_pair(&m, src, &mesh, &field, &patch, &cut, &kept);
+    /* The floor: the photo itself resampled at the bake's density (the
+       sheet is 40 units, 5 patches of 8, on 1024 texels: about 1.6 texels
+       per patch texel). */
+    {
+        tt_image *resampled = NULL;
+        CHECK(tt_image_create(205, 205, NULL, &resampled, NULL) == TT_OK, "resampled photo");
+        for (y = 0; resampled && y < 205; y++)
+            for (x = 0; x < 205; x++)
+                tt_image_sample_bilinear(src, (float)((x + 0.5) * 128.0 / 205.0), (float)((y + 0.5) * 128.0 / 205.0),
+                                         resampled->pixels + 4 * ((size_t)y * 205 + (size_t)x));
+        floor_share = resampled ? lapped_grey_share(resampled) : 1.0;
+        tt_image_free(resampled);
+    }
+    if (cut && kept) {
+        uv = (float *)malloc(sizeof(float) * 2 * (size_t)mesh->ncorners);
+        CHECK(tt_atlas_pack_pairs(mesh, 1024, 2, uv, &err) == TT_OK &&
+                  tt_image_create(1024, 1024, NULL, &baked, NULL) == TT_OK,
+              "atlas for the bakes: %s", err.message);
+        if (baked) {
+            CHECK(tt_lapped_bake(mesh, cut, &patch, 1, uv, NULL, NULL, baked, &err) == TT_OK, "bake, cut: %s",
+                  err.message);
+            narrow = lapped_grey_share(baked);
+            CHECK(tt_lapped_bake(mesh, kept, &patch, 1, uv, NULL, NULL, baked, &err) == TT_OK, "bake, kept: %s",
+                  err.message);
+            wide = lapped_grey_share(baked);
+        }
+        printf("     ghosting on a brick sheet: %.4f of the baked texels smooth grey with the cut's narrow edges, %.4f "
+               "with the whole soft edge (keep_edges); %.4f in the photo itself\n", narrow, wide, floor_share);
+        CHECK(wide >= 0.004 && narrow - floor_share <= 0.65 * (wide - floor_share),
+              "brick sheet: %.4f of the baked texels smooth grey with the cut, %.4f with keep_edges, %.4f in the "
+              "photo: keep_edges at least 0.004, and the cut's excess over the photo at most 0.65 of keep_edges's "
+              "wanted", narrow, wide, floor_share);
+    }
+    tt_image_free(baked);
+    free(uv);
     tt_lapped_free(cut);
     tt_lapped_free(kept);
     tt_mesh_free(mesh);
@@ -5727,6 +5844,7 @@ void run_lapped_tests(void)
     RUN(test_lapped_plane);
     RUN(test_lapped_register);
     RUN(test_lapped_cut);
+    RUN(test_lapped_ghosting);
     RUN(test_lapped_walls);
     RUN(test_lapped_cover);
     RUN(test_lapped_density);
