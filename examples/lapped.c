@@ -127,8 +127,11 @@ static void print_help(void)
            "  --keep-edges         each paste keeps its patch's whole soft edge (default: where it lies\n"
            "                       over what is opaque, its edge is cut where it best matches what lies\n"
            "                       beneath, and the bake blends it over a quarter of the soft edge's\n"
-           "                       width, so bricks or planks run on through the overlaps, not doubled)\n"
-           "  --mask MASK.png      the patches' shape: MASK's alpha, or its grey when opaque\n"
+           "                       width, so bricks or planks run on through the overlaps, not doubled)\n",
+           TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
+           LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
+           TT_DEFAULT_FIELD_SIGMA);
+    printf("  --mask MASK.png      the patches' shape: MASK's alpha, or its grey when opaque\n"
            "                       (white = inside); one shape for every patch: MASK is the size of a\n"
            "                       patch, or of IMAGE and then scaled to the patch's (default: a random\n"
            "                       splotch, or the window's own alpha when IMAGE has one)\n"
@@ -149,9 +152,7 @@ static void print_help(void)
            "                       (glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and PNGs beside\n"
            "                       it): the pastes baked, with the material's maps\n"
            "  --triangles          accepted for the OBJ, whose faces are triangles already\n",
-           TT_DEFAULT_FIELD_SCALE, LAPPED_MAX_PATCHES, LAPPED_DEFAULT_PATCHES, LAPPED_DEFAULT_PATCHES,
-           LAPPED_DEFAULT_MIN_WINDOW, LAPPED_DEFAULT_MIN_WINDOW, 2 * LAPPED_DEFAULT_MIN_WINDOW, LAPPED_MIN_WINDOW,
-           TT_DEFAULT_FIELD_SIGMA, TOOL_MAX_ATLAS, LAPPED_MIN_BAKE_SIZE, TOOL_MAX_ATLAS);
+           TOOL_MAX_ATLAS, LAPPED_MIN_BAKE_SIZE, TOOL_MAX_ATLAS);
     printf(MATERIAL_OPTIONS_HELP("                       ")
            "                       (here baked with the same pastes as IMAGE: OUT_PREFIX_normal.png,\n"
            "                       ..., normals turned into the atlas; with --pasting each patch's\n"
