@@ -16973,6 +16973,57 @@ static void tt__atlas_write_uv(const tt_mesh *mesh, const tt__chart *charts, int
     }
 }
 
+/* How far from a chart's triangles, in cells of `block` texels, the
+   texels it reserves reach. A texel's centre within `gutter` of a triangle
+   is the bake's; in blocks, the centres of a block's texels lie within
+   half its diagonal of its own. Every point lies within half a diagonal of
+   a cell's centre, so with at least that much two charts' triangles cannot
+   overlap (gutter 0). The margin covers the rounding of the UVs to
+   floats. */
+static double tt__atlas_reach_cells(int gutter, int block)
+{
+    double reach = (double)gutter / block + (block > 1 ? 0.5 * sqrt(2.0) : 0.0);
+    if (reach < 0.5 * sqrt(2.0)) reach = 0.5 * sqrt(2.0);
+    return reach + 1.0 / 64.0;
+}
+
+/* One set of charts for tt_atlas_pack_charts: grown from seeds (faces
+   within `reach` of their seed, 1e300: the cone alone), smoothed, with per
+   face a bit per edge that leaves its chart (border), each chart's shape,
+   and the packing order, largest first; *largest the widest chart. seed,
+   tried and scratch are scratch of nfaces. Returns the count of charts,
+   -1 when out of memory. */
+static int tt__atlas_make_charts(const tt_mesh *mesh, const double *normal, const double *area, tt__tri_grid *grid,
+                                 double eps, double reach, int *chart, int *tried, int *members, tt__chart *charts,
+                                 double *xy, int *seed, int *scratch, unsigned char *border, tt__chart_order *order,
+                                 double *largest)
+{
+    int ncharts = tt__grow_charts(mesh, normal, area, grid, eps, reach, chart, tried, members, charts, xy), c, f, k;
+    if (ncharts < 0) return -1;
+    /* The seeds: each chart's first member. */
+    for (c = 0; c < ncharts; c++) seed[c] = members[charts[c].first];
+    ncharts = tt__smooth_charts(mesh, normal, area, grid, eps, reach, chart, members, charts, ncharts, seed, xy, tried,
+                                scratch);
+    if (ncharts < 0) return -1;
+    for (f = 0; f < mesh->nfaces; f++) {
+        border[f] = 0;
+        for (k = 0; k < 3; k++) {
+            int twin = mesh->twin[mesh->face_start[f] + k];
+            if (twin < 0 || chart[mesh->corner_face[twin]] != chart[f]) border[f] |= (unsigned char)(1u << k);
+        }
+    }
+    *largest = 0.0;
+    for (c = 0; c < ncharts; c++) {
+        tt__chart_shape(area, members, xy, charts + c);
+        order[c].area = charts[c].width * charts[c].height;
+        order[c].width = charts[c].width;
+        order[c].chart = c;
+        if (charts[c].width > *largest) *largest = charts[c].width;
+    }
+    tt__sort_chart_order(order, ncharts);
+    return ncharts;
+}
+
 /* Sec. 4 "rendering with a texture atlas", the charts made automatically;
    see the declaration for the method. The scale is bisected between a size
    at which every chart is under a millionth of a texel (when even that does
@@ -16995,7 +17046,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     tt__packing pack;
     double surface = 0.0, cell, diagonal, reach_cells, best_scale = 0.0;
     float *best_uv = NULL;
-    int nf, c, ncharts, f, k, attempt, best_charts = 0, fewest = -1;
+    int nf, ncharts, attempt, best_charts = 0, fewest = -1;
     tt_result result;
 
     tt__ok(error);
@@ -17030,15 +17081,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     block = (size + TT__PACK_GRID - 1) / TT__PACK_GRID;
     side = size / block;
     block_gutter = (gutter + block - 1) / block;
-    /* A texel's centre within `gutter` of a triangle is the bake's; in
-       blocks, the centres of a block's texels lie within half its diagonal
-       of its own. Every point lies within half a diagonal of a cell's
-       centre, so with at least that much two charts' triangles cannot
-       overlap (gutter 0). The margin covers the rounding of the UVs to
-       floats. */
-    reach_cells = (double)gutter / block + (block > 1 ? 0.5 * sqrt(2.0) : 0.0);
-    if (reach_cells < 0.5 * sqrt(2.0)) reach_cells = 0.5 * sqrt(2.0);
-    reach_cells += 1.0 / 64.0;
+    reach_cells = tt__atlas_reach_cells(gutter, block);
     pack.words = (side + 63) / 64;
     pack.bits = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
     pack.mask = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
@@ -17061,31 +17104,11 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     for (attempt = 0; attempt < 2; attempt++) {
         double reach = attempt == 0 ? TT__CHART_REACH * sqrt(surface) : 1e300, largest = 0.0, tiny, s_lo = 0.0;
         int fits;
-        /* Overlaps smaller than this are rounding (neighbours share an edge). */
-        ncharts = tt__grow_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), reach, chart,
-                                  tried, members, charts, xy);
+        /* Overlaps smaller than 1e-9 of the diagonal are rounding (neighbours share an edge). */
+        ncharts = tt__atlas_make_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), reach,
+                                        chart, tried, members, charts, xy, seed, try_box, border, order, &largest);
         if (ncharts < 0) goto out_of_memory;
-        /* The seeds (each chart's first member) and scratch for the smoothing. */
-        for (c = 0; c < ncharts; c++) seed[c] = members[charts[c].first];
-        ncharts = tt__smooth_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), reach, chart,
-                                    members, charts, ncharts, seed, xy, tried, try_box);
-        if (ncharts < 0) goto out_of_memory;
-        for (f = 0; f < nf; f++) {
-            border[f] = 0;
-            for (k = 0; k < 3; k++) {
-                int twin = mesh->twin[mesh->face_start[f] + k];
-                if (twin < 0 || chart[mesh->corner_face[twin]] != chart[f]) border[f] |= (unsigned char)(1u << k);
-            }
-        }
         pack.border = border;
-        for (c = 0; c < ncharts; c++) {
-            tt__chart_shape(area, members, xy, charts + c);
-            order[c].area = charts[c].width * charts[c].height;
-            order[c].width = charts[c].width;
-            order[c].chart = c;
-            if (charts[c].width > largest) largest = charts[c].width;
-        }
-        tt__sort_chart_order(order, ncharts);
 
         /* Scales from here on are in blocks per mesh unit. Whether they fit
            at all asks for each chart's whole frame of 2 gutter + 1 cells a
