@@ -1991,6 +1991,15 @@ typedef struct mapping_check {
     int strict_fails, open_edges;
 } mapping_check;
 
+/* Whether a mapping's check found it sound: every output vertex on the
+   model, every corner's point in its triangle's quad, the area kept, a
+   closed strict mesh. */
+static int mapping_sound(const mapping_check *c)
+{
+    return !(c->off_surface || c->bad_points || c->bad_faces || c->area_error > 1e-6 || c->strict_fails ||
+             c->open_edges);
+}
+
 static double triangle_area3(const float *a, const float *b, const float *c)
 {
     double u[3], v[3], n[3];
@@ -2244,8 +2253,7 @@ static void test_map_unpinch(void)
         map = mapped(&m, 16 + 8 * round, 0, 0.0, &pc, &mesh, &rep);
         if (map) {
             mapping_check c = check_mapping(pc, mesh, map);
-            if (c.off_surface || c.bad_points || c.bad_faces || c.area_error > 1e-6 || c.strict_fails || c.open_edges)
-                bad++;
+            if (!mapping_sound(&c)) bad++;
             printf("     torus r %.2f at %d: %d unpinched, %d collapsed, %d fallbacks of %d\n", r, 16 + 8 * round,
                    rep.unpinched, rep.collapsed, rep.fallback_triangles, rep.triangles);
             unpinched += rep.unpinched;
@@ -3587,7 +3595,7 @@ static void test_map_random(void)
         map = mapped(&m, resolution, 0, 0.0, &pc, &mesh, &rep);
         if (map) {
             mapping_check c = check_mapping(pc, mesh, map);
-            if (c.off_surface || c.bad_points || c.bad_faces || c.area_error > 1e-6 || c.strict_fails || c.open_edges) {
+            if (!mapping_sound(&c)) {
                 bad++;
                 printf("     random mesh %d (resolution %d): %d off, %d points, area error %.2g, strict %s, %d open\n",
                        round, resolution, c.off_surface, c.bad_points, c.area_error, c.strict_fails ? "fails" : "holds",
