@@ -20969,10 +20969,11 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    Moving both sides, not only C's, halves what is left of the seams (0.30
    to 0.21 on cluster borders of a 20k torus); the neighbour's other
    borders at the vertex are in the sum, so they do not pay for it. Each
-   side gets TT__HPM_RELAX_TRIALS random trials per pass, greedy, in
-   TT__HPM_RELAX_PASSES passes of radius w/2, w/4, ... (w the band width):
-   The relaxation's radius w / 2^(depth + 1) is below a texel at the depths where most
-   clusters map, so it would move nothing. A move is refused when a moved
+   side gets TT__HPM_RELAX_TRIALS random trials per pass, greedy, in up to
+   TT__HPM_RELAX_PASSES passes of radius w/2, w/4, ... (w the band width),
+   ending below a quarter of a texel. The radius halves from the band width
+   and not from the paper's w / 2^(depth + 1), which is below a texel at the
+   depths where most clusters map and would move nothing. A move is refused when a moved
    triangle would flip, shrink below a quarter of its area, or end up
    stretched (surface to texture) more than TT__HPM_RELAX_MAX_STRETCH and
    more than it was - the seams and the stretch measure pull against each
