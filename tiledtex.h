@@ -2502,15 +2502,15 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
    children and the leaves are the faces); the face array holds at most
    mesh->nfaces entries per level and the control and neighbour arrays at
    most 3 * faces per level, so O(faces * levels) in all (horse, 97k faces:
-   11 levels, 0.93M face entries), each array of its exact size once
+   12 levels, 0.93M face entries), each array of its exact size once
    built. Scratch while building: about 250 bytes per face, 17 per corner,
    6 per vertex, whatever the executor (its tasks work in their own parts
    of the same arrays and allocate nothing). Time:
    O(F log F) per level, each split costing about four Dijkstra passes over
    its parent, more where a split is retried; the passes run on a copy of
    the parent's adjacency in its own dense numbering (tt__hier_localize),
-   about 3x faster than through the mesh's arrays (horse: about 0.4 s at
-   -O2). With an executor (options->executor) the splits of a level run in
+   about 3x faster than through the mesh's arrays (horse: 0.6 s at -O2
+   on a shared machine; 0.4 s measured earlier). With an executor (options->executor) the splits of a level run in
    up to 64 tasks (ranges of parents), and so do the neighbours and control
    vertices of its clusters: the hierarchy is the same bits with any
    executor. */
@@ -2586,7 +2586,8 @@ typedef struct tt_cluster_hierarchy {
    hierarchy. *out gets it (free it with tt_cluster_hierarchy_free), NULL on
    failure. Errors: NULL mesh or out, a bad allocator, a face that is not a
    triangle (error->face), branching outside 2..64 (TT_ERROR_INVALID_ARGUMENT);
-   no faces (TT_ERROR_EMPTY_MESH); TT_ERROR_OUT_OF_MEMORY. */
+   no faces (TT_ERROR_EMPTY_MESH); the progress callback stopped it
+   (TT_CANCELLED); TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_cluster_hierarchy_build(const tt_mesh *mesh, const tt_cluster_options *options,
                                            const tt_allocator *allocator, tt_cluster_hierarchy **out,
                                            tt_error *error);
@@ -2633,13 +2634,15 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy);
    sqrt(n) steps of O(n) each for a disc), plus an O(k^2) polygon test for
    k control vertices and, in the projected border mode, an O(b^2) border
    test for b border vertices. Every mappable
-   cluster of every level, at -O2: bunny (3.7k faces) 15 ms; horse (97k
-   faces) 1.0 s, 0.45 s of it for level 1's four 24k-face clusters.
+   cluster of every level, at -O2 on a shared machine: bunny (3.7k faces)
+   30 ms; horse (97k faces) 1.2 to 1.4 s, 0.3 s of it for level 1's four
+   24k-face clusters.
 
-   What it accepts at the default 0.10 (projected border): bunny levels 1-6
-   0 %, 5 %, 66 %, 86 %, 97 %, 98 % of the mappable clusters; horse levels
-   1-9 0 %, 7 %, 44 %, 68 %, 88 %, 98 %, 99.3 %, 99.8 %, 97 %. The chord
-   border accepts far fewer (bunny level 4: 19 % against 86 %), mostly
+   What it accepts at the default 0.10 (projected border, hierarchy of
+   seed 0): bunny levels 1-7 0 %, 26 %, 70 %, 88 %, 97 %, 99.9 %, 100 % of
+   the mappable clusters; horse levels 1-9 0 %, 0 %, 48 %, 65 %, 88 %, 98 %,
+   99.3 %, 99.9 %, 100 %. The chord border accepts far fewer (bunny level
+   4: 24 % against 88 %), mostly
    because triangles whose corners all lie on one straight polygon edge
    lose their area and count as folds. */
 
@@ -2769,7 +2772,7 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         same smallest sum of squared differences either way (to rounding).
         With an executor the copies' allowed offsets and correlations run
         as parallel tasks. The best offset is refined at
-        full resolution by a direct sum over +-2^k texels. Its normalised
+        full resolution by a direct sum over +-(2^k - 1) texels. Its normalised
         error
             eps = (sum of squared differences) / (channels * band pixels) / (2 sigma^2)
         with sigma^2 the image's mean per-channel variance: 0 for a perfect
@@ -2785,8 +2788,10 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         floor (min_footprint texels^2 or min_faces faces), where the best
         fit is taken whatever its error. A cluster smaller than the floor
         (reached only below a cluster that could not be flattened) is not
-        fitted: it continues the map of the neighbour it shares most
-        vertices with. A cluster with no textured neighbour waits until
+        fitted: it continues the map of the textured neighbour whose
+        continuation matches its borders best (the one it shares most
+        vertices with when none has a border edge with it). A cluster
+        with no textured neighbour waits until
         nothing else can be done; then it starts a new textured region at
         a random place (the first cluster, each further component, regions
         the queues never reached).
@@ -2834,7 +2839,8 @@ typedef struct tt_hpm_options {
                                0 included) */
     double scale;           /* world units covered by the image's width; 0 = the bounding box's
                                diagonal / 4, or more where the mesh's longest edge would span over 3/4
-                               of the image's smaller side (each face must fit the image) */
+                               of the image's smaller side less 2 texels (each face must fit a bounded
+                               image; not with TT_HPM_TOROIDAL) */
     double threshold;       /* the largest accepted eps; 0 = TT_DEFAULT_HPM_THRESHOLD; +infinity
                                accepts every fit (clusters split only when not flat or with no room) */
     int rotations;          /* orientations around the circle, 1..64 (steps of 360 / rotations
@@ -2916,8 +2922,9 @@ typedef struct tt_hpm_report {
    neighbour's UVs (the image centre without one). options and
    report may be NULL. Results:
      TT_OK;
-     TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, an image
-                                whose kind is not a tt_image_kind, a bad
+     TT_ERROR_INVALID_ARGUMENT  NULL mesh, image or corner_uv, an empty
+                                image (no pixels, or a side below 1), an
+                                image whose kind is not a tt_image_kind, a bad
                                 allocator, options out of range, a face
                                 that is not a triangle (error->face), a
                                 scale at which a face does not fit the
@@ -2938,8 +2945,9 @@ typedef struct tt_hpm_report {
    hierarchy and flattening (above) plus, per fit (report->fits), about
    10 ms at P = 256 by transforms or 0.3 ms summing a band of 30 pixels
    over 5 copies; the border relaxation about as much again. The horse
-   (97k faces, 1190 fits, gravel 512 x 512) takes about 3 s at -O2 on one
-   core (v0.3.0: 9 s), half of it in the executor's tasks (the
+   (97k faces, 1222 fits, gravel 512 x 512) takes about 4 s at -O2 on one
+   core of a shared machine, the tool's whole process (3 s measured
+   earlier; v0.3.0: 9 s), half of it in the executor's tasks (the
    hierarchy's splits, the fits' correlations, the border choice). */
 TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_hpm_options *options,
                            const tt_allocator *allocator, float *corner_uv, int *face_cluster,
@@ -20966,8 +20974,8 @@ static void tt__hpm_write(tt__hpm *S, int C, const tt__hpm_place *pl, double *uv
    each such edge, half a texel on either side of it (where the eye and the
    seam measure look; tt__hpm_edge_side), and moving the vertex moves
    the points of its edges by (1 - t) of the move - the hat weight of the paper's border relaxation.
-   Moving both sides, not only C's, halves what is left of the seams (0.30
-   to 0.21 on cluster borders of a 20k torus); the neighbour's other
+   Moving both sides, not only C's, lowered what was left of the seams
+   (0.30 to 0.21 on cluster borders of a 20k torus); the neighbour's other
    borders at the vertex are in the sum, so they do not pay for it. Each
    side gets TT__HPM_RELAX_TRIALS random trials per pass, greedy, in up to
    TT__HPM_RELAX_PASSES passes of radius w/2, w/4, ... (w the band width),
@@ -22211,9 +22219,6 @@ oom:
     return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory in the traversal");
 }
 
-/* Faces that could not be flattened (degenerate single faces): each
-   corner takes the texture coordinate a textured face around its vertex
-   gives it. */
 /* The border choice, after the traversal: the fits and the relaxation
    choose where each cluster's map is placed, but the borders themselves
    stay where the hierarchy cut the mesh, and on a coarse mesh a border
