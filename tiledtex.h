@@ -22015,8 +22015,9 @@ static int tt__hpm_out_of_memory(int C, tt_result *res, tt_error *error)
 
 #define TT__HPM_MAX_FLAT_STRETCH 2.0  /* the largest sigma1 / sigma2 of a flattened triangle */
 
-/* One cluster taken from the queues (Sec. 2.2 step 2). Returns 1, or 0 on
-   an error in *res. */
+/* One cluster taken from the queues (Sec. 2.2, steps 2 to 4: flatten,
+   fit, map or split; step 5 is tt__hpm_accept's). Returns 1, or 0 on an
+   error in *res. */
 static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res, tt_error *error)
 {
     const tt_cluster *cl = &S->H->clusters[C];
@@ -22229,9 +22230,10 @@ oom:
    the neighbour's coordinates at the two shared vertices, the third
    unfolded isometrically from the surface (or the neighbour's own there,
    when it has one) - when that lowers the colour mismatch over the face's
-   three edges (the edge it crosses becomes continuous, the others may
-   become borders), without flipping, overstretching or leaving a bounded
-   image. TT__HPM_BORDER_SWEEPS passes over the faces, in index order. The
+   three edges by at least 5 % (the edge it crosses becomes continuous, the
+   others may become borders), without flipping, overstretching or leaving
+   a bounded image. Up to TT__HPM_BORDER_SWEEPS passes over the faces, in
+   index order, ending early after a pass that moves no face. The
    random-placement control gets the same partition, each moved face
    unfolded into its new cluster's random map, so both show the same
    clusters. */
