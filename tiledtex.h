@@ -2457,8 +2457,10 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
      3. fitting: the band of textured neighbours matched against the image
         by FFT over several orientations (Sec. 4.1-4.2);
      4. the coarse-to-fine traversal with one priority queue per level
-        (Sec. 2.2);
-     5. texture coordinates, crack removal and relaxation (Sec. 4.3-4.4).
+        (Sec. 2.2), which runs 2, 3 and 5 for each cluster it takes;
+     5. texture coordinates, crack removal and relaxation (Sec. 4.3-4.4)
+        after each placement; after the traversal, the border choice and
+        the faces no cluster textured (tt_hpm_map's list below).
 
    The face-cluster hierarchy (Sec. 3.1). Level 0 holds one cluster per
    connected component. A cluster of more than one face is split into n
@@ -2896,8 +2898,10 @@ typedef struct tt_hpm_report {
                                                textured neighbour's map continued over their edge or, where
                                                that would leave a bounded image, its leaf's own */
     int starts;                             /* clusters placed at random (no textured neighbour) */
-    int not_flat;                           /* clusters split because they did not flatten */
-    int no_room;                            /* clusters split because they did not fit in the image */
+    int not_flat;                           /* clusters that did not flatten: split, or a single face
+                                               left to faces_unflattened */
+    int no_room;                            /* clusters that did not fit in the image: split, or a
+                                               single face left to faces_unflattened */
     double mean_error, max_error;           /* eps over the accepted fits (floor ones included) */
     double texels_per_unit;                 /* the texel density: image width / scale */
     int match_width, match_height;          /* the matching copy's size */
