@@ -19557,8 +19557,8 @@ done:
 
 /* A textured neighbour of the cluster being placed, and the rigid map
    q = R(angle) (x / s) + shift that best takes its texture coordinates x
-   (texels) of the shared vertices onto the cluster's flattened positions q
-  . */
+   (texels) of the shared vertices onto the cluster's flattened positions
+   q. */
 typedef struct tt__hpm_owner {
     int cluster;
     int shared;                 /* shared border vertices */
