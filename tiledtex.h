@@ -2863,9 +2863,9 @@ typedef struct tt_hpm_options {
                                     then the faces textured; may cancel */
     void *progress_user_data;
     const tt_executor *executor; /* runs the hierarchy's splits (tt_cluster_options.executor), each fit's
-                                    turned copies (their allowed offsets and correlations) and the border
-                                    choice's faces as parallel tasks; NULL: serial; the same UVs either
-                                    way */
+                                    turned copies (their allowed offsets and correlations), the
+                                    relaxation's border vertices and the border choice's faces as
+                                    parallel tasks; NULL: serial; the same UVs either way */
     const float *face_vectors;   /* NULL: the orientation spreads from patch to patch (Sec. 2.2). Else a
                                     direction per face, 3 floats each in the face's plane (from
                                     tt_tangent_field: --up, constraints): each cluster's flattening is
