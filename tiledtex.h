@@ -1856,7 +1856,7 @@ typedef struct tt_field_options {
    parallel transport, and a region cut off from them by creases (across a
    right angle nothing is carried: a box's walls point up, their vectors
    say nothing of its top) is constant, along the world axis least along up
-   (x for the default up). The field is smoothed over the field scale or 8
+   (x for the default up). The field is smoothed over the field scale or 4
    mean edge lengths, whichever is less. Where up is strong the smoothing
    gains nothing and turns the texture away from up on a scan's bumps: the
    smoothed direction is turned toward P_f(up) from |P_f(up)| = 0.65 and is
