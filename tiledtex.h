@@ -1994,8 +1994,11 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    meant to be clamped (the patches are transparent at their border).
 
    The loop, until every face is covered:
-     1. pick a face not yet covered at random (seeded) and a point of it not
-        yet covered; pick a texture patch at random;
+     1. pick a face not yet covered at random (seeded; until half the
+        samples are covered, the most difficult of a few such draws, Sec.
+        3.3) and a point of it not yet covered; pick a texture patch (the
+        one the faces around the seed show least on top, at random among
+        equals; with one patch, that one);
      2. map the seed face so that point lands on the patch's anchor (its
         deepest opaque texel, the "center" for any mask shape) with (S, T)
         along the axes;
@@ -2029,7 +2032,10 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         pastes beneath (a masked correlation, tt_xcorr_masked), so that a
         structured photo's courses run on through the overlap instead of
         breaking or doubling, and grow and solve again where the moved
-        patch reaches past the faces; faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
+        patch reaches past the faces; unless keep_edges (or isotropic), cut
+        the paste's edge where it lies over what is opaque along the path
+        that best matches what lies beneath (tt_lapped.cut, used by the
+        bake); faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
         are dropped from the paste, except the seed face and the fringe:
         faces up to TT_LAPPED_GROW_DISTORTION off where the patch's alpha
         over them stays below one half, kept for the paste's soft border
@@ -2038,7 +2044,10 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         an edge to a face left out, whatever the reason): a factor on its
         alpha per vertex, 0 at the cut and rising with the distance from it
         in texture space to 1 within 0.05 patch sides, never on the seed
-        face (tt_lapped.fade). The paper accepts such "hard edges" (Sec.
+        face (tt_lapped.fade); a paste is not faded at all when its seed
+        face was seeded more than twice, or when the fade would leave it
+        covering under a tenth of what it covers unfaded (parts thinner
+        than a patch). The paper accepts such "hard edges" (Sec.
         3.3); faded, a paste ends softly everywhere, and what it fades is
         left for later pastes to cover;
      6. mark coverage (Sec. 3.6): each face carries a fixed set of sample
