@@ -2208,10 +2208,12 @@ typedef struct tt_lapped {
      TT_ERROR_NON_FINITE        a NaN or infinite field vector (error->face)
                                 or patch texel;
      TT_ERROR_ZERO_AREA_FACE    a face of zero area (permissive meshes);
+     TT_ERROR_EMPTY_MESH        a mesh without faces (made by hand);
      TT_ERROR_TOO_LARGE         the patches are so small next to the mesh that
                                 more than max_pastes would be needed (the
                                 message gives the estimate, see
-                                TT_LAPPED_PASTES_PER_AREA);
+                                TT_LAPPED_PASTES_PER_AREA), or the coverage
+                                samples of all faces do not fit an int;
      TT_ERROR_NOT_CONVERGED     max_pastes pastes, or 16 times the estimate,
                                 did not cover the mesh;
      TT_CANCELLED, TT_ERROR_OUT_OF_MEMORY.
@@ -2234,11 +2236,13 @@ typedef struct tt_lapped_report {
    the statistics tt_lapped_paste reports (anisotropic mode), or of UVs from
    anywhere. phi(T_f) = 0 (a degenerate face or UV triangle) counts as the
    worst case, 180 degrees and scale error 1; no entries give 0 errors.
-   Errors: NULL pointers, a mesh of non-triangles (error->face) or
-   inconsistent counts: TT_ERROR_INVALID_ARGUMENT; an entry's face out of
-   range: TT_ERROR_INDEX_OUT_OF_RANGE; a non-finite UV or field vector of an
-   entry: TT_ERROR_NON_FINITE; each naming the entry in error->item and its
-   face; TT_ERROR_OUT_OF_MEMORY. */
+   Errors: NULL pointers, a mesh of non-triangles (error->face),
+   inconsistent counts or a fade outside [0, 1]: TT_ERROR_INVALID_ARGUMENT;
+   an entry's face, or a paste's entries, out of range:
+   TT_ERROR_INDEX_OUT_OF_RANGE; a non-finite UV, fade or field vector of an
+   entry: TT_ERROR_NON_FINITE; each naming the entry (or paste) in
+   error->item, and a bad UV, fade or vector its face; pastes drawing more than 2^30 entries:
+   TT_ERROR_TOO_LARGE; TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
                                   const tt_allocator *allocator, tt_lapped_report *report, tt_error *error);
 
