@@ -2321,7 +2321,8 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
    large ones. Above 2048 texels a side the bitmap holds blocks of texels
    (size / 2048 rounded up a side, the gutter rounded up to whole blocks),
    so that a larger atlas costs no more to pack. The largest scale that
-   fits size x size is found by bisection. Faces of zero area (permissive
+   fits size x size is searched from the guessed fill (options->fill_guess)
+   in steps of 6 % until bracketed, then by bisection to 0.5 %. Faces of zero area (permissive
    meshes) join a neighbouring chart. */
 
 /* Degrees: the normals of a chart's faces stay within this of its seed face's normal. */
