@@ -2421,7 +2421,8 @@ typedef struct tt_bake_options {
 
 /* Bake the pastes into `atlas` (yours: its size is the resolution; a view is
    fine) over the texture coordinates corner_uv (2 floats per corner, origin
-   bottom-left: the mesh's own, or from tt_atlas_pack_pairs). Every texel
+   bottom-left: the mesh's own, or from tt_atlas_pack_charts or
+   tt_atlas_pack_pairs). Every texel
    whose centre lies in a triangle's image (tt_raster_triangle) gets the
    pastes of that face composited in paste order ("over" of the
    premultiplied patches, each sampled bilinearly with clamping at the UVs
@@ -2447,13 +2448,17 @@ typedef struct tt_bake_options {
    map between the two), composited, and renormalised; texels nothing
    covers read (0, 0, 1). The atlas takes the patches' kind.
    Errors: NULL pointers, an empty atlas, non-triangles,
-   npatches < 1, a negative gutter, patches of which some are normal maps
-   and some not, a cut with no columns or no feather
-   (TT_ERROR_INVALID_ARGUMENT); a non-finite cut (TT_ERROR_NON_FINITE); an entry
-   naming a patch or face out of range (TT_ERROR_INDEX_OUT_OF_RANGE,
-   error->item names the paste or entry); non-finite corner_uv
-   (TT_ERROR_NON_FINITE); TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch
-   is allocated before the atlas is touched). */
+   npatches < 1, a gutter negative or above the atlas's size, a patch whose
+   kind is no tt_image_kind, patches of which some are normal maps and some
+   not, inconsistent counts of the pastes, a fade outside [0, 1], a cut
+   with no columns (or more than 65536) or no feather
+   (TT_ERROR_INVALID_ARGUMENT); an atlas above TT_MAX_IMAGE_SIZE, pastes
+   drawing more than 2^30 entries (TT_ERROR_TOO_LARGE); a paste naming a
+   patch or entries out of range, an entry naming a face out of range
+   (TT_ERROR_INDEX_OUT_OF_RANGE, error->item names the paste or entry);
+   non-finite corner_uv, entry UVs, fades or cut (TT_ERROR_NON_FINITE);
+   TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch is allocated before
+   the atlas is touched). */
 TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
                                int npatches, const float *corner_uv, const tt_bake_options *options,
                                const tt_allocator *allocator, tt_image *atlas, tt_error *error);
