@@ -15051,8 +15051,9 @@ static int tt__least_overlapping_twin(tt__lapper *L, int patch)
     return best;
 }
 
-/* Start paste number `paste` (Sec. 3.3): a random face not yet covered, a
-   random uncovered sample point of it, and a random texture patch; the face
+/* Start paste number `paste` (Sec. 3.3): a face not yet covered
+   (tt__pick_seed_face), a random uncovered sample point of it, and a texture
+   patch (tt__pick_patch); the face
    is mapped so that the point lands on the patch's anchor with (S, T) along
    the texture axes. Returns the patch; fills the seed point's weights. */
 static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_weight[3])
