@@ -2173,8 +2173,9 @@ typedef struct tt_lapped {
     double coverage;            /* fraction of faces whose samples are all covered: 1 on success */
     double mean_overdraw;       /* nentries / faces: how often a face is drawn */
     int removed_entries;        /* face entries dropped because later pastes hide them */
-    double mean_angle_error;    /* degrees, mean over entries of the angle between phi(T_f) and (0,1)
-                                   (isotropic: against each paste's propagated direction) */
+    double mean_angle_error;    /* degrees, mean over entries of the angle between phi(T_f) and (0,1),
+                                   T_f the given field's (isotropic too, where the pastes turn at
+                                   random: about 90, saying nothing) */
     double median_scale_error;  /* median over entries of | |phi(T_f)| - 1 | */
     int top_changes;            /* interior edges whose two faces show different pastes on top */
     int visible_cuts;           /* of those, the ones where the upper paste stops while still at least
