@@ -2072,9 +2072,11 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    them "less objectionable than distorted texture"); step 5 fades it
    there instead. What stays hard is a cut along the seed face itself (a
    crease or a part thinner than a patch that no paste crosses).
-   tt_lapped.visible_cuts counts the cuts left on top: 4 % of the edges
-   where the paste on top changes on a sphere, 6 % on the bunny, 11 % on
-   the elephant (without the fade: 5 %, 17 % and 49 %). The fade costs
+   tt_lapped.visible_cuts counts the cuts left on top: measured when the
+   fade came in, 4 % of the edges where the paste on top changes on a
+   sphere, 6 % on the bunny, 11 % on the elephant (without the fade: 5 %,
+   17 % and 49 %); with today's cut and patch windows (brick_red, seed 0)
+   the bunny has 9 % and the elephant 11 %. The fade costs
    pastes: faded rims cover nothing, so 1.5 to 2.5 times as many pastes
    are needed on meshes with many cuts. A patch may fold over itself in
    texture space (allowed by the paper); coverage is still counted per
