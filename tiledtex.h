@@ -2122,7 +2122,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    opaque area (they overlap, and their hulls reach past the opaque part):
    3 to 5 on smooth meshes. tt_lapped_paste refuses up front when the
    estimate exceeds max_pastes, and gives up when the loop runs past 16
-   times the estimate (a mesh with parts thinner than a patch, whose pastes
+   times the estimate plus 100 (a mesh with parts thinner than a patch, whose pastes
    fade at many cuts, took up to 6 times: the horse's legs). */
 #define TT_LAPPED_PASTES_PER_AREA 4.0
 
@@ -2217,8 +2217,8 @@ typedef struct tt_lapped {
                                 message gives the estimate, see
                                 TT_LAPPED_PASTES_PER_AREA), or the coverage
                                 samples of all faces do not fit an int;
-     TT_ERROR_NOT_CONVERGED     max_pastes pastes, or 16 times the estimate,
-                                did not cover the mesh;
+     TT_ERROR_NOT_CONVERGED     max_pastes pastes, or 16 times the estimate
+                                plus 100, did not cover the mesh;
      TT_CANCELLED, TT_ERROR_OUT_OF_MEMORY.
    Deterministic for a seed; time about O(faces * overdraw): the alignment
    solve takes about the same number of steps at any density. */
