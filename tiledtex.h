@@ -2035,8 +2035,8 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         patch reaches past the faces; unless keep_edges (or isotropic), cut
         the paste's edge where it lies over what is opaque along the path
         that best matches what lies beneath (tt_lapped.cut, used by the
-        bake); faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
-        are dropped from the paste, except the seed face and the fringe:
+        bake); faces the solved map leaves too distorted
+        (TT_LAPPED_MAX_DISTORTION) are dropped from the paste, except the seed face and the fringe:
         faces up to TT_LAPPED_GROW_DISTORTION off where the patch's alpha
         over them stays below one half, kept for the paste's soft border
         (faint there) and covering nothing;
@@ -2067,8 +2067,8 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    random, and each face added gets the average direction of its neighbours
    already in the patch, projected on its plane; only |T_f| is used.
 
-   Hard edges (docs/lapped.md): where growth stops (a disc would close, or distortion), the
-   paste would end at a mesh edge without its soft falloff (Sec. 3.3 finds
+   Hard edges (docs/lapped.md): where growth stops (a disc would close,
+   or distortion), the paste would end at a mesh edge without its soft falloff (Sec. 3.3 finds
    them "less objectionable than distorted texture"); step 5 fades it
    there instead. What stays hard is a cut along the seed face itself (a
    crease or a part thinner than a patch that no paste crosses).
@@ -2368,8 +2368,7 @@ typedef struct tt_chart_atlas_report {
    packing, five to eight times over for the search of the scale (fewer
    with a good options->fill_guess) for each of the two sets of charts
    (progress reports the first set's search up to 0.5), scans the bitmap
-   for each chart,
-   skipping rows without a long enough free run. options may be NULL
+   for each chart, skipping rows without a long enough free run. options may be NULL
    (defaults); TT_CANCELLED by options->progress. Deterministic; reentrant
    and thread-safe on distinct outputs. */
 TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_chart_pack_options *options,
@@ -2433,8 +2432,7 @@ typedef struct tt_bake_options {
    lapped->fade is given; beyond its paste's cut, when lapped->cut is
    given, its colour gives way to the colour composited beneath, weighing
    1 - (1 - c) * the alpha beneath, its alpha unchanged). Texels within
-   `gutter` texels
-   outside a triangle get the same composite extrapolated across its edges
+   `gutter` texels outside a triangle get the same composite extrapolated across its edges
    (the face's maps extended linearly), and every texel still empty is then
    filled from the nearest filled texel, so bilinear filtering and mipmaps
    near chart borders read chart colours, not background. The atlas holds
@@ -2445,8 +2443,8 @@ typedef struct tt_bake_options {
    (no gutter).
    Material maps: bake each map with the same pastes, UVs and options, from
    patches cut from that map with the same mask or seed
-   (tt_make_texture_patch), and the maps line up texel for texel. Normal-map patches (kind
-   TT_IMAGE_NORMAL, all of them) have their vectors turned, per face and
+   (tt_make_texture_patch), and the maps line up texel for texel.
+   Normal-map patches (kind TT_IMAGE_NORMAL, all of them) have their vectors turned, per face and
    paste, from the patch's frame into the atlas's (the rotation nearest the
    map between the two), composited, and renormalised; texels nothing
    covers read (0, 0, 1). The atlas takes the patches' kind.
