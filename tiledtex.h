@@ -16240,7 +16240,8 @@ static void tt__chart_bounds(const double *xy, const int *faces, int count, doub
    each face by the cosine of its tilt: scaled back, the chart's density is
    its faces' mean), turn it to its smallest bounding box among
    TT__CHART_ANGLES angles (a quarter turn more when it is then taller than
-   wide: shelves of flat boxes waste less), and move it to start at (0, 0).
+   wide: the turn the packer tries first, of all four, and keeps on ties),
+   and move it to start at (0, 0).
    Turns and a positive scale keep every face's winding. */
 static void tt__chart_shape(const double *area, const int *members, double *xy, tt__chart *chart)
 {
@@ -16782,7 +16783,7 @@ static int tt__charts_regroup(int nf, int ncharts, int *chart, int *members, tt_
    border tooth costs its gutter on both sides, and the hollows between
    teeth are room the packing cannot use. seed[c]: chart c's seed; stamp:
    nf ints, scratch: 2 nf ints. Returns the number of charts (some may
-   empty), or -1 when out of memory. */
+   be empty), or -1 when out of memory. */
 #define TT__CHART_SMOOTHING 4
 
 static int tt__smooth_charts(const tt_mesh *mesh, const double *normal, const double *area, tt__tri_grid *grid,
