@@ -1906,7 +1906,8 @@ typedef struct tt_field_options {
    zero-area face: TT_ERROR_ZERO_AREA_FACE. Every constraint error names
    the constraint in error->item (and its face in error->face).
    Coordinates so large, or so far apart in magnitude (1e38 beside 1e-40),
-   that the smoothing's sums overflow: TT_ERROR_NON_FINITE. A mesh
+   that the smoothing's sums overflow, or a resulting vector longer than
+   FLT_MAX (error->face): TT_ERROR_NON_FINITE. A mesh
    without faces (made by hand) is TT_ERROR_EMPTY_MESH. Temporary memory
    only.
    Deterministic; reentrant and thread-safe on distinct outputs. */
