@@ -1856,7 +1856,7 @@ typedef struct tt_field_options {
    parallel transport, and a region cut off from them by creases (across a
    right angle nothing is carried: a box's walls point up, their vectors
    say nothing of its top) is constant, along the world axis least along up
-   (x for the default up). The field is smoothed over the field scale or 8
+   (x for the default up). The field is smoothed over the field scale or 4
    mean edge lengths, whichever is less. Where up is strong the smoothing
    gains nothing and turns the texture away from up on a scan's bumps: the
    smoothed direction is turned toward P_f(up) from |P_f(up)| = 0.65 and is
@@ -1906,7 +1906,8 @@ typedef struct tt_field_options {
    zero-area face: TT_ERROR_ZERO_AREA_FACE. Every constraint error names
    the constraint in error->item (and its face in error->face).
    Coordinates so large, or so far apart in magnitude (1e38 beside 1e-40),
-   that the smoothing's sums overflow: TT_ERROR_NON_FINITE. A mesh
+   that the smoothing's sums overflow, or a resulting vector longer than
+   FLT_MAX (error->face): TT_ERROR_NON_FINITE. A mesh
    without faces (made by hand) is TT_ERROR_EMPTY_MESH. Temporary memory
    only.
    Deterministic; reentrant and thread-safe on distinct outputs. */
@@ -1994,8 +1995,11 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    meant to be clamped (the patches are transparent at their border).
 
    The loop, until every face is covered:
-     1. pick a face not yet covered at random (seeded) and a point of it not
-        yet covered; pick a texture patch at random;
+     1. pick a face not yet covered at random (seeded; until half the
+        samples are covered, the most difficult of a few such draws, Sec.
+        3.3) and a point of it not yet covered; pick a texture patch (the
+        one the faces around the seed show least on top, at random among
+        equals; with one patch, that one);
      2. map the seed face so that point lands on the patch's anchor (its
         deepest opaque texel, the "center" for any mask shape) with (S, T)
         along the axes;
@@ -2017,7 +2021,8 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         where it shrank: deciding (b) as well, at a million faces it let a
         paste take in ten times the surface its patch covers;
      4. solve the least-squares alignment of Sec. 3.4, sum over the patch's
-        faces of |phi(S_f) - (1,0)|^2 + |phi(T_f) - (0,1)|^2, with the seed point
+        faces, each weighted by its area (the paper's sum has no weights),
+        of |phi(S_f) - (1,0)|^2 + |phi(T_f) - (0,1)|^2, with the seed point
         held on the anchor, by conjugate gradients with a multigrid
         preconditioner warm-started from the prediction (s and t decouple:
         one matrix, two right-hand sides; about 6 steps however dense the
@@ -2029,8 +2034,11 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         pastes beneath (a masked correlation, tt_xcorr_masked), so that a
         structured photo's courses run on through the overlap instead of
         breaking or doubling, and grow and solve again where the moved
-        patch reaches past the faces; faces the solved map leaves too distorted (TT_LAPPED_MAX_DISTORTION)
-        are dropped from the paste, except the seed face and the fringe:
+        patch reaches past the faces; unless keep_edges (or isotropic), cut
+        the paste's edge where it lies over what is opaque along the path
+        that best matches what lies beneath (tt_lapped.cut, used by the
+        bake); faces the solved map leaves too distorted
+        (TT_LAPPED_MAX_DISTORTION) are dropped from the paste, except the seed face and the fringe:
         faces up to TT_LAPPED_GROW_DISTORTION off where the patch's alpha
         over them stays below one half, kept for the paste's soft border
         (faint there) and covering nothing;
@@ -2038,7 +2046,10 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
         an edge to a face left out, whatever the reason): a factor on its
         alpha per vertex, 0 at the cut and rising with the distance from it
         in texture space to 1 within 0.05 patch sides, never on the seed
-        face (tt_lapped.fade). The paper accepts such "hard edges" (Sec.
+        face (tt_lapped.fade); a paste is not faded at all when its seed
+        face was seeded more than twice, or when the fade would leave it
+        covering under a tenth of what it covers unfaded (parts thinner
+        than a patch). The paper accepts such "hard edges" (Sec.
         3.3); faded, a paste ends softly everywhere, and what it fades is
         left for later pastes to cover;
      6. mark coverage (Sec. 3.6): each face carries a fixed set of sample
@@ -2058,14 +2069,16 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    random, and each face added gets the average direction of its neighbours
    already in the patch, projected on its plane; only |T_f| is used.
 
-   Hard edges (docs/lapped.md): where growth stops (a disc would close, or distortion), the
-   paste would end at a mesh edge without its soft falloff (Sec. 3.3 finds
+   Hard edges (docs/lapped.md): where growth stops (a disc would close,
+   or distortion), the paste would end at a mesh edge without its soft falloff (Sec. 3.3 finds
    them "less objectionable than distorted texture"); step 5 fades it
    there instead. What stays hard is a cut along the seed face itself (a
    crease or a part thinner than a patch that no paste crosses).
-   tt_lapped.visible_cuts counts the cuts left on top: 4 % of the edges
-   where the paste on top changes on a sphere, 6 % on the bunny, 11 % on
-   the elephant (without the fade: 5 %, 17 % and 49 %). The fade costs
+   tt_lapped.visible_cuts counts the cuts left on top: measured when the
+   fade came in, 4 % of the edges where the paste on top changes on a
+   sphere, 6 % on the bunny, 11 % on the elephant (without the fade: 5 %,
+   17 % and 49 %); with today's cut and patch windows (brick_red, seed 0)
+   the bunny has 9 % and the elephant 11 %. The fade costs
    pastes: faded rims cover nothing, so 1.5 to 2.5 times as many pastes
    are needed on meshes with many cuts. A patch may fold over itself in
    texture space (allowed by the paper); coverage is still counted per
@@ -2111,7 +2124,7 @@ TTDEF tt_result tt_make_texture_patch(const tt_image *source, const tt_image *ma
    opaque area (they overlap, and their hulls reach past the opaque part):
    3 to 5 on smooth meshes. tt_lapped_paste refuses up front when the
    estimate exceeds max_pastes, and gives up when the loop runs past 16
-   times the estimate (a mesh with parts thinner than a patch, whose pastes
+   times the estimate plus 100 (a mesh with parts thinner than a patch, whose pastes
    fade at many cuts, took up to 6 times: the horse's legs). */
 #define TT_LAPPED_PASTES_PER_AREA 4.0
 
@@ -2164,8 +2177,9 @@ typedef struct tt_lapped {
     double coverage;            /* fraction of faces whose samples are all covered: 1 on success */
     double mean_overdraw;       /* nentries / faces: how often a face is drawn */
     int removed_entries;        /* face entries dropped because later pastes hide them */
-    double mean_angle_error;    /* degrees, mean over entries of the angle between phi(T_f) and (0,1)
-                                   (isotropic: against each paste's propagated direction) */
+    double mean_angle_error;    /* degrees, mean over entries of the angle between phi(T_f) and (0,1),
+                                   T_f the given field's (isotropic too, where the pastes turn at
+                                   random: about 90, saying nothing) */
     double median_scale_error;  /* median over entries of | |phi(T_f)| - 1 | */
     int top_changes;            /* interior edges whose two faces show different pastes on top */
     int visible_cuts;           /* of those, the ones where the upper paste stops while still at least
@@ -2199,12 +2213,14 @@ typedef struct tt_lapped {
      TT_ERROR_NON_FINITE        a NaN or infinite field vector (error->face)
                                 or patch texel;
      TT_ERROR_ZERO_AREA_FACE    a face of zero area (permissive meshes);
+     TT_ERROR_EMPTY_MESH        a mesh without faces (made by hand);
      TT_ERROR_TOO_LARGE         the patches are so small next to the mesh that
                                 more than max_pastes would be needed (the
                                 message gives the estimate, see
-                                TT_LAPPED_PASTES_PER_AREA);
-     TT_ERROR_NOT_CONVERGED     max_pastes pastes, or 16 times the estimate,
-                                did not cover the mesh;
+                                TT_LAPPED_PASTES_PER_AREA), or the coverage
+                                samples of all faces do not fit an int;
+     TT_ERROR_NOT_CONVERGED     max_pastes pastes, or 16 times the estimate
+                                plus 100, did not cover the mesh;
      TT_CANCELLED, TT_ERROR_OUT_OF_MEMORY.
    Deterministic for a seed; time about O(faces * overdraw): the alignment
    solve takes about the same number of steps at any density. */
@@ -2225,11 +2241,13 @@ typedef struct tt_lapped_report {
    the statistics tt_lapped_paste reports (anisotropic mode), or of UVs from
    anywhere. phi(T_f) = 0 (a degenerate face or UV triangle) counts as the
    worst case, 180 degrees and scale error 1; no entries give 0 errors.
-   Errors: NULL pointers, a mesh of non-triangles (error->face) or
-   inconsistent counts: TT_ERROR_INVALID_ARGUMENT; an entry's face out of
-   range: TT_ERROR_INDEX_OUT_OF_RANGE; a non-finite UV or field vector of an
-   entry: TT_ERROR_NON_FINITE; each naming the entry in error->item and its
-   face; TT_ERROR_OUT_OF_MEMORY. */
+   Errors: NULL pointers, a mesh of non-triangles (error->face),
+   inconsistent counts or a fade outside [0, 1]: TT_ERROR_INVALID_ARGUMENT;
+   an entry's face, or a paste's entries, out of range:
+   TT_ERROR_INDEX_OUT_OF_RANGE; a non-finite UV, fade or field vector of an
+   entry: TT_ERROR_NON_FINITE; each naming the entry (or paste) in
+   error->item, and a bad UV, fade or vector its face; pastes drawing more than 2^30 entries:
+   TT_ERROR_TOO_LARGE; TT_ERROR_OUT_OF_MEMORY. */
 TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors, const tt_lapped *lapped,
                                   const tt_allocator *allocator, tt_lapped_report *report, tt_error *error);
 
@@ -2308,7 +2326,8 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
    large ones. Above 2048 texels a side the bitmap holds blocks of texels
    (size / 2048 rounded up a side, the gutter rounded up to whole blocks),
    so that a larger atlas costs no more to pack. The largest scale that
-   fits size x size is found by bisection. Faces of zero area (permissive
+   fits size x size is searched from the guessed fill (options->fill_guess)
+   in steps of 6 % until bracketed, then by bisection to 0.5 %. Faces of zero area (permissive
    meshes) join a neighbouring chart. */
 
 /* Degrees: the normals of a chart's faces stay within this of its seed face's normal. */
@@ -2351,8 +2370,7 @@ typedef struct tt_chart_atlas_report {
    packing, five to eight times over for the search of the scale (fewer
    with a good options->fill_guess) for each of the two sets of charts
    (progress reports the first set's search up to 0.5), scans the bitmap
-   for each chart,
-   skipping rows without a long enough free run. options may be NULL
+   for each chart, skipping rows without a long enough free run. options may be NULL
    (defaults); TT_CANCELLED by options->progress. Deterministic; reentrant
    and thread-safe on distinct outputs. */
 TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, const tt_chart_pack_options *options,
@@ -2407,7 +2425,8 @@ typedef struct tt_bake_options {
 
 /* Bake the pastes into `atlas` (yours: its size is the resolution; a view is
    fine) over the texture coordinates corner_uv (2 floats per corner, origin
-   bottom-left: the mesh's own, or from tt_atlas_pack_pairs). Every texel
+   bottom-left: the mesh's own, or from tt_atlas_pack_charts or
+   tt_atlas_pack_pairs). Every texel
    whose centre lies in a triangle's image (tt_raster_triangle) gets the
    pastes of that face composited in paste order ("over" of the
    premultiplied patches, each sampled bilinearly with clamping at the UVs
@@ -2415,8 +2434,7 @@ typedef struct tt_bake_options {
    lapped->fade is given; beyond its paste's cut, when lapped->cut is
    given, its colour gives way to the colour composited beneath, weighing
    1 - (1 - c) * the alpha beneath, its alpha unchanged). Texels within
-   `gutter` texels
-   outside a triangle get the same composite extrapolated across its edges
+   `gutter` texels outside a triangle get the same composite extrapolated across its edges
    (the face's maps extended linearly), and every texel still empty is then
    filled from the nearest filled texel, so bilinear filtering and mipmaps
    near chart borders read chart colours, not background. The atlas holds
@@ -2427,19 +2445,23 @@ typedef struct tt_bake_options {
    (no gutter).
    Material maps: bake each map with the same pastes, UVs and options, from
    patches cut from that map with the same mask or seed
-   (tt_make_texture_patch), and the maps line up texel for texel. Normal-map patches (kind
-   TT_IMAGE_NORMAL, all of them) have their vectors turned, per face and
+   (tt_make_texture_patch), and the maps line up texel for texel.
+   Normal-map patches (kind TT_IMAGE_NORMAL, all of them) have their vectors turned, per face and
    paste, from the patch's frame into the atlas's (the rotation nearest the
    map between the two), composited, and renormalised; texels nothing
    covers read (0, 0, 1). The atlas takes the patches' kind.
    Errors: NULL pointers, an empty atlas, non-triangles,
-   npatches < 1, a negative gutter, patches of which some are normal maps
-   and some not, a cut with no columns or no feather
-   (TT_ERROR_INVALID_ARGUMENT); a non-finite cut (TT_ERROR_NON_FINITE); an entry
-   naming a patch or face out of range (TT_ERROR_INDEX_OUT_OF_RANGE,
-   error->item names the paste or entry); non-finite corner_uv
-   (TT_ERROR_NON_FINITE); TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch
-   is allocated before the atlas is touched). */
+   npatches < 1, a gutter negative or above the atlas's size, a patch whose
+   kind is no tt_image_kind, patches of which some are normal maps and some
+   not, inconsistent counts of the pastes, a fade outside [0, 1], a cut
+   with no columns (or more than 65536) or no feather
+   (TT_ERROR_INVALID_ARGUMENT); an atlas above TT_MAX_IMAGE_SIZE, pastes
+   drawing more than 2^30 entries (TT_ERROR_TOO_LARGE); a paste naming a
+   patch or entries out of range, an entry naming a face out of range
+   (TT_ERROR_INDEX_OUT_OF_RANGE, error->item names the paste or entry);
+   non-finite corner_uv, entry UVs, fades or cut (TT_ERROR_NON_FINITE);
+   TT_CANCELLED; TT_ERROR_OUT_OF_MEMORY (all scratch is allocated before
+   the atlas is touched). */
 TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_image *const *patches,
                                int npatches, const float *corner_uv, const tt_bake_options *options,
                                const tt_allocator *allocator, tt_image *atlas, tt_error *error);
@@ -13992,8 +14014,10 @@ static tt_result tt__alignment_matrix(tt__lapper *L, int seed_face, const double
        the paper's plain sum over faces lets a sliver weigh as much as a
        large face, and its huge gradient weights make the matrix so
        ill-conditioned that CG crawls (a torus with half its triangles
-       slivers took 2.2 times as long to paste; 1.55 weighted). Weighted, it
-       is the integral over the surface. */
+       slivers took 2.2 times as long to paste; 1.55 weighted, measured then;
+       1.19 now that growth's predictions are weighted too, make bench's
+       lapped_slivers_over_regular). Weighted, it is the integral over the
+       surface. */
     for (f = 0; f < L->npatch_faces; f++) mean_area += L->area[L->patch_faces[f]];
     mean_area /= L->npatch_faces;
     for (f = 0; f < L->npatch_faces; f++) {
@@ -15044,8 +15068,9 @@ static int tt__least_overlapping_twin(tt__lapper *L, int patch)
     return best;
 }
 
-/* Start paste number `paste` (Sec. 3.3): a random face not yet covered, a
-   random uncovered sample point of it, and a random texture patch; the face
+/* Start paste number `paste` (Sec. 3.3): a face not yet covered
+   (tt__pick_seed_face), a random uncovered sample point of it, and a texture
+   patch (tt__pick_patch); the face
    is mapped so that the point lands on the patch's anchor with (S, T) along
    the texture axes. Returns the patch; fills the seed point's weights. */
 static int tt__seed_paste(tt__lapper *L, int paste, int *seed_face, double seed_weight[3])
@@ -16228,7 +16253,8 @@ static void tt__chart_bounds(const double *xy, const int *faces, int count, doub
    each face by the cosine of its tilt: scaled back, the chart's density is
    its faces' mean), turn it to its smallest bounding box among
    TT__CHART_ANGLES angles (a quarter turn more when it is then taller than
-   wide: shelves of flat boxes waste less), and move it to start at (0, 0).
+   wide: the turn the packer tries first, of all four, and keeps on ties),
+   and move it to start at (0, 0).
    Turns and a positive scale keep every face's winding. */
 static void tt__chart_shape(const double *area, const int *members, double *xy, tt__chart *chart)
 {
@@ -16770,7 +16796,7 @@ static int tt__charts_regroup(int nf, int ncharts, int *chart, int *members, tt_
    border tooth costs its gutter on both sides, and the hollows between
    teeth are room the packing cannot use. seed[c]: chart c's seed; stamp:
    nf ints, scratch: 2 nf ints. Returns the number of charts (some may
-   empty), or -1 when out of memory. */
+   be empty), or -1 when out of memory. */
 #define TT__CHART_SMOOTHING 4
 
 static int tt__smooth_charts(const tt_mesh *mesh, const double *normal, const double *area, tt__tri_grid *grid,
