@@ -1307,7 +1307,8 @@ static void print_summary(const lapped_options *options, const triangle_mesh *m,
     printf(", %d pastes, coverage %.1f%%, mean overdraw %.2f\n", lapped->npastes, 100.0 * lapped->coverage,
            lapped->mean_overdraw);
     printf("alignment: mean angle error %.1f degrees, median scale error %.1f%%%s\n", angle, 100.0 * scale,
-           options->isotropic ? " (isotropic: against each paste's own direction)" : "");
+           options->isotropic ? " (isotropic: the angle is against the field, which the pastes do not follow; "
+                                "only the scale error counts)" : "");
     printf("texel density of the pastes on top: 95th percentile over 5th %.3f\n",
            top_density_spread(m, lapped, patches));
     {
