@@ -289,8 +289,7 @@ typedef struct hpm_quality {
     tt_uv_distortion_report distortion;
     int distortion_measured;
     char distortion_reason[224];
-    tt_uv_direction_report direction; /* with --up or --constraints */
-    int direction_measured;
+    tool_level level;               /* with --up or --constraints */
 } hpm_quality;
 
 /* The seams are measured on the image itself, the texture the OBJ uses;
@@ -322,16 +321,9 @@ static int measure_quality(const hpm_command_options *options, const triangle_me
     }
     if (result != TT_OK) return tool_fail("%s: cannot measure the distortion: %s", options->mesh_path, error.message);
     quality->distortion_measured = 1;
-    if (options->field.given) {
-        tt_uv_direction_options direction;
-        memset(&direction, 0, sizeof direction);
-        memcpy(direction.up, options->field.up, sizeof direction.up);
-        result = tt_measure_uv_direction(m->mesh, corner_uv, image->width, image->height, &direction, NULL,
-                                         &quality->direction, &error);
-        if (result != TT_OK && result != TT_ERROR_NOT_MEASURED)
-            return tool_fail("%s: cannot measure the texture's direction: %s", options->mesh_path, error.message);
-        quality->direction_measured = result == TT_OK;
-    }
+    if (options->field.given)
+        return tool_measure_level(options->mesh_path, m->mesh, corner_uv, image->width, image->height,
+                                  options->field.up, &quality->level);
     return 0;
 }
 
@@ -340,7 +332,6 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
 {
     const tt_uv_distortion_report *d = &quality->distortion;
     char borders[320], all[320];
-    const tt_uv_direction_report *up = &quality->direction;
     int level, last = -1, counted = report->levels < TT_HPM_MAX_LEVELS ? report->levels : TT_HPM_MAX_LEVELS;
     for (level = 0; level < counted; level++)
         if (report->mapped_per_level[level] > 0) last = level;
@@ -367,11 +358,7 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
     tool_format_seams(&quality->borders, "border edges", borders, sizeof borders);
     tool_format_seams(&quality->all, "edges", all, sizeof all);
     printf("seam score: cluster borders %s; all edges %s\n", borders, all);
-    if (quality->direction_measured)
-        printf("level: the image's up %.1f%% of %d wall faces within 10 degrees of --up, mean %.1f, p90 %.1f "
-               "degrees\n", 100.0 * up->within, up->faces, up->mean, up->p90);
-    else if (options->field.given)
-        printf("level: not measured (no face at least 45 degrees from level)\n");
+    if (options->field.given) tool_print_level(&quality->level);
     if (!quality->distortion_measured) {
         printf("UV distortion: not measured (%s)\n", quality->distortion_reason);
         return;

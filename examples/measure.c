@@ -61,3 +61,35 @@ void tool_format_seams(const tool_seams *seams, const char *edges, char *text, s
         snprintf(text, size, "n/a: unrelated places differ no more than neighbours (%d %s; seam - same-face %.4f)",
                  r->edges_measured, edges, r->seam - r->same_face);
 }
+
+int tool_measure_level(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                       const float up[3], tool_level *level)
+{
+    tt_uv_direction_options options;
+    tt_error error;
+    tt_result result;
+    memset(level, 0, sizeof *level);
+    memset(&options, 0, sizeof options);
+    memcpy(options.up, up, sizeof options.up);
+    result = tt_measure_uv_direction(mesh, corner_uv, width, height, &options, NULL, &level->report, &error);
+    if (result == TT_ERROR_NOT_MEASURED) {
+        size_t length;
+        snprintf(level->reason, sizeof level->reason, "%s", error.message);
+        length = strlen(level->reason);
+        if (length > 0 && level->reason[length - 1] == '.') level->reason[length - 1] = '\0';
+        return 0;
+    }
+    if (result != TT_OK) return tool_fail("%s: cannot measure the texture's direction: %s", obj_path, error.message);
+    level->measured = 1;
+    return 0;
+}
+
+void tool_print_level(const tool_level *level)
+{
+    const tt_uv_direction_report *r = &level->report;
+    if (level->measured)
+        printf("level: the image's up %.1f%% of %d wall faces within 10 degrees of --up, mean %.1f, p90 %.1f "
+               "degrees\n", 100.0 * r->within, r->faces, r->mean, r->p90);
+    else
+        printf("level: not measured (%s)\n", level->reason);
+}

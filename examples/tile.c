@@ -105,25 +105,6 @@ static int add_upright_atlas(tool_output *output, const char *png_path, const tt
     return status;
 }
 
-/* With --up: how level the texture lies on the walls, as hpm and lapped
-   report it. Each quad's tile turns by quarter turns only, so on a mesh
-   whose quads do not follow the field the courses tilt up to 45 degrees. */
-static void print_level(const tiled_options *options, const tiled_mesh *mesh, int width, int height)
-{
-    tt_uv_direction_options direction;
-    tt_uv_direction_report level;
-    tt_error error;
-    tt_result result;
-    memset(&direction, 0, sizeof direction);
-    memcpy(direction.up, options->field.up, sizeof direction.up);
-    result = tt_measure_uv_direction(mesh->mesh, mesh->corner_uv, width, height, &direction, NULL, &level, &error);
-    if (result == TT_OK)
-        printf("level: the image's up %.1f%% of %d wall faces within 10 degrees of --up, mean %.1f, p90 %.1f "
-               "degrees\n", 100.0 * level.within, level.faces, level.mean, level.p90);
-    else
-        printf("level: not measured (%s)\n", error.message);
-}
-
 int cmd_tile(int argc, char **argv)
 {
     const char *positional[3];
@@ -134,6 +115,7 @@ int cmd_tile(int argc, char **argv)
     tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS], *upright = NULL, *map_upright[MATERIAL_MAPS];
     tt_image *atlas = NULL, *map_atlas[MATERIAL_MAPS];
     tool_seams seams;
+    tool_level level;
     tool_output output;
     char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096],
         gltf_path[4096], written[8400];
@@ -252,9 +234,13 @@ int cmd_tile(int argc, char **argv)
                 printf("up: %d quads' tiles turned along the field, %d upright and %d plain (where the field turns "
                        "past a quad's diagonal, or next to such a quad along a course)\n", mesh.mesh->nfaces,
                        mesh.upright_faces, mesh.mesh->nfaces - mesh.upright_faces);
-            if (options.field.given)
-                print_level(&options, &mesh, atlas ? atlas->width : tiles->levels[0].width,
-                            atlas ? atlas->height : tiles->levels[0].height);
+            /* Each quad's tile turns by quarter turns only: on a mesh whose quads do not follow the field
+               the courses tilt up to 45 degrees, which this line shows. */
+            if (options.field.given && tool_measure_level(positional[0], mesh.mesh, mesh.corner_uv,
+                                                          atlas ? atlas->width : tiles->levels[0].width,
+                                                          atlas ? atlas->height : tiles->levels[0].height,
+                                                          options.field.up, &level) == 0)
+                tool_print_level(&level);
             if (gltf) {
                 printf("wrote %s (%dx%d atlas)\n", gltf_written(gltf_path, written, sizeof written),
                        atlas ? atlas->width : tiles->levels[0].width, atlas ? atlas->height : tiles->levels[0].height);

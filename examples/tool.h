@@ -928,6 +928,22 @@ int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *c
    (reason)". */
 void tool_format_seams(const tool_seams *seams, const char *edges, char *text, size_t size);
 
+typedef struct tool_level {
+    int measured;               /* 0: TT_ERROR_NOT_MEASURED (no wall face), `reason` says why */
+    tt_uv_direction_report report;
+    char reason[224];           /* the library's sentence, without its full stop */
+} tool_level;
+
+/* How level the image lies on the walls with up `up` (--up; 0,0,0 the
+   library's default), for a summary's `level:` line. No wall face is not
+   an error: level->measured is 0. Other library errors are printed as one
+   line naming obj_path; returns the exit status. */
+int tool_measure_level(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, int width, int height,
+                       const float up[3], tool_level *level);
+/* The summary's line: "level: the image's up 95.1% of 812 wall faces
+   within 10 degrees of --up, ...", or "level: not measured (reason)". */
+void tool_print_level(const tool_level *level);
+
 /* ---------------------------------------------------------------------- */
 /* Numbers as text without printf (format_number.c)                        */
 /* ---------------------------------------------------------------------- */
