@@ -24615,6 +24615,23 @@ static void tt__quad_corner_st(int k, int st[2])
     st[1] = k >= 2;
 }
 
+/* The point `along` of the way along half-edge h of S, in its quad's
+   frame: from h's start corner, or with from_end from its end corner (the
+   twin's point of a crossing, exactly as it is written there). */
+static void tt__halfedge_point(const tt_mesh *s, int h, double along, int from_end, double st[2])
+{
+    int k = h - s->face_start[s->corner_face[h]], st0[2], st1[2];
+    tt__quad_corner_st(k, st0);
+    tt__quad_corner_st(k + 1, st1);
+    if (from_end) {
+        st[0] = st1[0] + along * (st0[0] - st1[0]);
+        st[1] = st1[1] + along * (st0[1] - st1[1]);
+    } else {
+        st[0] = st0[0] + along * (st1[0] - st0[0]);
+        st[1] = st0[1] + along * (st1[1] - st0[1]);
+    }
+}
+
 /* The corner of `quad` at S vertex `vertex`, or -1. */
 static int tt__quad_corner_of(const tt_mesh *s, int quad, int vertex)
 {
@@ -27926,24 +27943,16 @@ static int tt__split_walk(tt__split *S, int f, int *linked, int *chart)
             quad = leaves;
         }
         for (i = 0; i < count; i++) {
-            int j = forward ? first + i : first + count - 1 - i, vertex, kh, st0[2], st1[2];
+            int j = forward ? first + i : first + count - 1 - i, vertex;
             tt_edge_crossing x = E->crossings[j];
             int h = forward ? x.halfedge : s->twin[x.halfedge];
             double along = forward ? x.along : 1.0 - x.along, st_in[2];
             vertex = tt__split_crossing_vertex(S, e, j);
             if (vertex < 0) return 0;
             holds = holds && s->corner_face[h] == quad;
-            kh = h - s->face_start[s->corner_face[h]];
-            tt__quad_corner_st(kh, st0);
-            tt__quad_corner_st(kh + 1, st1);
-            st_in[0] = st0[0] + along * (st1[0] - st0[0]);
-            st_in[1] = st0[1] + along * (st1[1] - st0[1]);
+            tt__halfedge_point(s, h, along, 0, st_in);
             quad = s->corner_face[s->twin[h]];
-            kh = s->twin[h] - s->face_start[quad];
-            tt__quad_corner_st(kh, st0);
-            tt__quad_corner_st(kh + 1, st1);
-            st[0] = st1[0] + along * (st0[0] - st1[0]);
-            st[1] = st1[1] + along * (st0[1] - st1[1]);
+            tt__halfedge_point(s, s->twin[h], along, 1, st);
             if (!tt__split_push(S, vertex, quad, st_in, st)) return 0;
         }
     }
@@ -29017,7 +29026,7 @@ static int tt__edge_point_along(tt__edge_search *S, tt_surface_point qa, tt_surf
 {
     const tt_mesh *s = S->pc->surface;
     double from[2], to[2], t0 = 0.0, t1, u;
-    int ends[2], j, count, quad, k, st0[2], st1[2];
+    int ends[2], j, count, quad;
     if (!tt__edge_find_path(S, qa, qb, ends)) return 0;
     count = S->best_count - 1;
     quad = ends[0];
@@ -29026,11 +29035,7 @@ static int tt__edge_point_along(tt__edge_search *S, tt_surface_point qa, tt_surf
     for (j = 0;; j++) {
         const tt_edge_crossing *x = j < count ? &S->best_crossings[j] : NULL;
         if (x) {
-            k = x->halfedge - s->face_start[quad];
-            tt__quad_corner_st(k, st0);
-            tt__quad_corner_st(k + 1, st1);
-            to[0] = st0[0] + x->along * (st1[0] - st0[0]);
-            to[1] = st0[1] + x->along * (st1[1] - st0[1]);
+            tt__halfedge_point(s, x->halfedge, x->along, 0, to);
             t1 = x->t;
         } else {
             to[0] = S->b[0];
@@ -29047,11 +29052,7 @@ static int tt__edge_point_along(tt__edge_search *S, tt_surface_point qa, tt_surf
         }
         /* Across the crossing: the same point in the next quad's frame. */
         quad = s->corner_face[s->twin[x->halfedge]];
-        k = s->twin[x->halfedge] - s->face_start[quad];
-        tt__quad_corner_st(k, st0);
-        tt__quad_corner_st(k + 1, st1);
-        from[0] = st1[0] + x->along * (st0[0] - st1[0]);
-        from[1] = st1[1] + x->along * (st0[1] - st1[1]);
+        tt__halfedge_point(s, s->twin[x->halfedge], x->along, 1, from);
         t0 = t1;
     }
 }
