@@ -36,8 +36,8 @@
    `polycube_100k_faces_res32_*` time the polycube's construction and the
    vertices' projection onto it on a 100k-triangle torus;
    `polycube_100k_faces_res32` the whole mapping of that torus, voxelisation
-   to UVs, with the triangles it made and the ones left to the
-   fallback; its atlas (timed apart) is `synth_n2_tile64`, the
+   to UVs, with the triangles it made, the ones left to the fallback
+   and the collapsed pieces (no area on S); its atlas (timed apart) is `synth_n2_tile64`, the
    paper's 256 tiles at 64 texels. `atlas_charts_100k_faces` times
    tt_atlas_pack_charts on that torus at 2048 x 2048 (gutter 2, the tool's
    --bake), with the charts it made and the fraction of the atlas they fill.
@@ -826,6 +826,7 @@ int main(int argc, char **argv)
         report("polycube_100k_faces_res32_output_triangles", pc.output_triangles, "triangles");
         report("polycube_100k_faces_res32_fallback_triangles", pc.map_report.fallback_triangles, "triangles");
         report("polycube_100k_faces_res32_flipped", pc.map_report.flipped, "triangles");
+        report("polycube_100k_faces_res32_collapsed", pc.map_report.collapsed, "triangles");
         free(pc.points);
         tt_polycube_free(pc.polycube);
         tt_mesh_free(pc.mesh);
