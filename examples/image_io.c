@@ -42,8 +42,18 @@
 /* ======================================================================== */
 
 static uint64_t image_max_pixels = TOOL_DEFAULT_MAX_PIXELS;
+static int image_max_pixels_given = 0;
 
-void image_set_max_pixels(uint64_t max_pixels) { image_max_pixels = max_pixels; }
+void image_set_max_pixels(uint64_t max_pixels)
+{
+    image_max_pixels = max_pixels;
+    image_max_pixels_given = 1;
+}
+
+void image_set_default_max_pixels(uint64_t max_pixels)
+{
+    if (!image_max_pixels_given) image_max_pixels = max_pixels;
+}
 
 void image_free(tt_image *image)
 {

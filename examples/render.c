@@ -1126,6 +1126,9 @@ int cmd_render(int argc, char **argv)
     up_axis axis;
     double up[3] = {0.0, 1.0, 0.0};   /* y up, usual for OBJ */
 
+    /* The tool's own outputs must open here without a flag: a lapped bake
+       may be 8192 x 8192 (see TOOL_RENDER_MAX_PIXELS). */
+    image_set_default_max_pixels(TOOL_RENDER_MAX_PIXELS);
     for (i = 1; i < argc; i++) {
         const char *value;
         if (tool_is_help(argv[i])) {

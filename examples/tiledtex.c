@@ -50,8 +50,9 @@ static void print_help(void)
     for (i = 0; i < SUBCOMMAND_COUNT; i++) printf("  %-9s %s\n", subcommands[i].name, subcommands[i].summary);
     printf("\nglobal options (before or after the command):\n"
            "  --max-pixels N  refuse images of more than N pixels, checked before decoding them\n"
-           "                  (default %d = 4096x4096). Peak memory per input pixel:\n"
-           "                  lapped needs about 32 bytes, tile and synth about 17\n"
+           "                  (default %d = 4096x4096; render: 8192x8192, the largest\n"
+           "                  texture the tool writes). Peak memory per input pixel:\n"
+           "                  lapped needs about 32 bytes, render 21, tile and synth 17\n"
            "  -j, --jobs N    run on N threads (default: the %d cores this process may use);\n"
            "                  -j 1 runs on this thread only. Outputs are the same at any N\n"
            "  -q, --quiet     print nothing but errors: no summary, progress line or warning\n"

@@ -381,9 +381,17 @@ void output_free(tool_output *output);
 /* ---------------------------------------------------------------------- */
 
 /* The pixel budget for the images the tool reads (the global option
-   --max-pixels): 4096 x 4096, which take 256 MB as float RGBA. */
+   --max-pixels): 4096 x 4096, which take 256 MB as float RGBA.
+   image_set_max_pixels is the user's --max-pixels; a command whose own
+   inputs may be larger raises its default with image_set_default_max_pixels,
+   which leaves a budget the user gave alone. render takes the largest
+   texture the tool writes (TOOL_MAX_ATLAS on a side, a lapped bake at its
+   cap): its textures cost about 21 bytes a pixel with their mip levels, so
+   1.4 GB at 8192 x 8192. */
 #define TOOL_DEFAULT_MAX_PIXELS 16777216
+#define TOOL_RENDER_MAX_PIXELS ((uint64_t)TOOL_MAX_ATLAS * (uint64_t)TOOL_MAX_ATLAS)
 void image_set_max_pixels(uint64_t max_pixels);
+void image_set_default_max_pixels(uint64_t max_pixels);
 
 /* Load a PNG / JPEG / TGA / BMP / PSD / GIF / HDR / PIC / PNM file as a float
    RGBA tt_image in linear light (grey and grey+alpha become RGB(A); no alpha

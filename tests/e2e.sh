@@ -2223,9 +2223,8 @@ cat >"$W/bigpng.c" <<'EOF_C'
 #include <stdlib.h>
 int main(int argc, char **argv)
 {
-    int width = 8000, height = 8000;
+    int width = argc > 2 ? atoi(argv[2]) : 8000, height = width;
     unsigned char *pixels = (unsigned char *)calloc((size_t)width * height, 1);
-    (void)argc;
     return !(pixels && stbi_write_png(argv[1], width, height, 1, pixels, width));
 }
 EOF_C
@@ -2240,7 +2239,7 @@ if $HELPER_CC -O2 -w $STB_INC "$W/bigpng.c" -o "$W/bigpng" -lm 2>"$W/err" && "$W
             synth) args="../in/big.png a.png" ;;
             tile) args="../in/torus.obj ../in/big.png out" ;;
             lapped | hpm) args="../in/torus.obj ../in/big.png out" ;;
-            render) args="../in/torus.obj ../in/big.png r.png" ;;
+            render) args="../in/torus.obj ../in/big.png r.png --max-pixels 16777216" ;;
         esac
         # shellcheck disable=SC2086
         expect_error "8000x8000 PNG ($sub)" $sub $args
@@ -2248,6 +2247,18 @@ if $HELPER_CC -O2 -w $STB_INC "$W/bigpng.c" -o "$W/bigpng" -lm 2>"$W/err" && "$W
     done
     expect_error "8000x8000 PNG as map --atlas" map ../in/torus.obj m.obj --atlas ../in/big.png
     err_mentions "8000x8000 PNG as map --atlas: names --max-pixels" 'with --max-pixels'
+    # render opens what the tool writes (a lapped bake may be 8192x8192)
+    # without the option: its default budget is 8192x8192, not 4096x4096.
+    if "$W/bigpng" "$W/in/big4100.png" 4100 && "$W/bigpng" "$W/in/big8200.png" 8200; then
+        expect_error "4100x4100 PNG (tile, default budget 4096x4096)" tile ../in/torus.obj ../in/big4100.png out
+        newdir
+        expect_ok "4100x4100 PNG (render, default budget 8192x8192)" render ../in/torus.obj ../in/big4100.png r.png --size 64x48
+        cd "$W" || exit 1
+        expect_error "8200x8200 PNG (render, over 8192x8192)" render ../in/torus.obj ../in/big8200.png r.png
+        err_mentions "8200x8200 PNG (render): names the size and --max-pixels" '8200x8200.*67108864.*--max-pixels'
+    else
+        fail "helper for the 4100 and 8200 PNGs" "$CMD" "writes big4100.png and big8200.png" ""
+    fi
 else
     fail "helper for the big PNG" "$CMD" "compiles and writes big.png" "$(head -c 300 "$W/err")"
 fi
