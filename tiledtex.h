@@ -3524,7 +3524,9 @@ typedef struct tt_polycube_map_report {
     int split_triangles;    /* input triangles cut into two or more output triangles */
     int fallback_triangles; /* of `triangles`, those put whole into one quad: a local seam; target 0 */
     int flipped;            /* output triangles whose points on S turn clockwise (a fold; none is expected) */
-    int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture) */
+    int collapsed;          /* output triangles whose points on S have no area (a sliver of stretched texture);
+                               a piece with no area on S but some on the model makes its triangle fall back,
+                               so only slivers thin in both spaces are left here */
     int refined_again;      /* input faces refined to the finer bound for the mapping kept, where the ones
                                before fell short (default max_edge only); 0 when the first mapping stands */
     int unpinched;          /* edges split where a triangle at a saddle of S would collapse onto a line
@@ -3624,7 +3626,7 @@ typedef struct tt_polycube_mapping {
           vertex V of S and the boundary winds once around V (a cone point
           inside) or passes through it (a bend), the triangle is the fan
           from V over its boundary, each fan triangle in its segment's
-          quad (one may collapse to a line on S: counted in collapsed); a
+          quad; a
           V inside becomes a vertex at the boundary's mean value
           coordinates seen from V, which lie on the triangle;
         - otherwise (an edge with no path, a fold the relaxation could not
@@ -3642,7 +3644,11 @@ typedef struct tt_polycube_mapping {
    output. Pieces of zero area (an edge along a lattice line) are dropped,
    but for those whose corners are other pieces' vertices already (edges
    passing a hair from a corner of S): dropped, they would leave a hole of
-   no area there, so they stay (counted in collapsed). The output's area
+   no area there, so they stay (counted in collapsed). A triangle with a
+   piece that turns over on S, or whose area on S is below a thousandth of
+   its area on the model (a streak: a fan triangle at a saddle, a vertex
+   behind a corner another vertex holds), takes the fallback instead: a
+   local seam shows less than a streak. The output's area
    equals the input's. An inside-out mesh
    (tt_polycube_report::inside_out) must be reversed first: the points go
    to the wrong sides of thin parts and every chart turns clockwise.
@@ -27583,6 +27589,7 @@ static int tt__polycube_reseat(const tt_polycube *pc, const tt_mesh *model, cons
 #define TT__SPLIT_MATCH 1e-5        /* chart distance, in units of h, within which a clipped point is a known one:
                                        above the records' snap (1e-6), far below any real piece */
 #define TT__SPLIT_AREA 1e-12        /* chart area below which a piece is empty */
+#define TT__SPLIT_STREAK 1e-3      /* a piece's area on S, in cube faces, below this share of its area on the model is a streak */
 #define TT__SPLIT_MAX_CELLS 4096    /* grid cells of a chart's box beyond which a triangle takes the fallback */
 
 /* A point on a triangle's boundary (a model vertex or a split point of an
@@ -28441,10 +28448,11 @@ static double tt__split_area3(const tt__split *S, int a, int b, const double p[3
    up to V's full angle (a quarter turn per quad: V inside) or V is on the
    boundary, and no fan triangle of non-zero area on the model turns
    clockwise on S (the projection folds there). One of zero area on S is
-   kept: where two edges of the triangle pass through V (a point next to a
+   made: where two edges of the triangle pass through V (a point next to a
    saddle of S, whose shortest paths to both sides run through it), the
-   corner between them collapses onto a line, a sliver of stretched
-   texture rather than the seam of the fallback. A V inside
+   corner between them collapses onto a line; tt__split_face then takes
+   the fallback for the triangle, as that sliver would draw the texture
+   out into a streak, which shows more than a local seam. A V inside
    becomes a new output vertex at the boundary's mean value coordinates
    seen from V (exact where S is flat), so it lies on the triangle and the
    fan covers it exactly. 1 when done, 0 when no V works, -1 when out of
@@ -28651,6 +28659,31 @@ typedef struct tt__split_job {
     int first;                  /* the batch's first triangle */
 } tt__split_job;
 
+/* Whether a triangle of S->out from `first` on turns over on S, or has
+   (next to) no area there while it has some on the model: a streak of
+   texture drawn out along a line, as when a triangle wraps a saddle of S
+   or its vertex lies behind a corner another vertex holds. The fallback's
+   local seam shows less than the streak. A sliver thin in both spaces (an
+   edge passing a hair from a grid line) is no streak and stays. */
+static int tt__split_has_empty_piece(tt__split *S, int first)
+{
+    const double h2 = (double)S->pc->h * (double)S->pc->h;
+    int j, k, source[3];
+    for (j = first; j < S->out->ntriangles; j++) {
+        const tt_surface_point *p = S->out->corner_points + 3 * j;
+        const int *v = S->out->triangles + 3 * j;
+        const double area_on_s = 0.5 * tt__orient2(p[0].s, p[0].t, p[1].s, p[1].t, p[2].s, p[2].t);
+        float at[3], weight[3];
+        double p0[3];
+        if (area_on_s < -TT__SPLIT_AREA) return 1;
+        if (area_on_s >= TT__SPLIT_STREAK) continue;
+        tt__split_token(S, v[0], at, source, weight);
+        for (k = 0; k < 3; k++) p0[k] = at[k];
+        if (area_on_s < TT__SPLIT_STREAK * tt__split_area3(S, v[1], v[2], p0) / h2) return 1;
+    }
+    return 0;
+}
+
 /* Triangle f split onto S, its vertices and triangles appended to S->out:
    the pieces, the fan around a cone, or else the fallback. 1 when split,
    0 when it fell back, -1 when out of memory. */
@@ -28674,6 +28707,7 @@ static int tt__split_face(tt__split *S, int f)
         done = tt__split_star(S, f, tt__split_area3(S, S->vert[1], S->vert[2], p0), &pieces);
         if (done < 0) return -1;
     }
+    if (done && tt__split_has_empty_piece(S, kept_triangles)) done = 0;
     if (!done) {
         S->out->nverts = kept_vertices;
         S->out->ntriangles = kept_triangles;
