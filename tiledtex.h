@@ -1672,6 +1672,12 @@ typedef struct tt_seam_options {
        reports (with 20000 edges it stays within about 0.01 of the full score). */
     int max_edges;
     unsigned flags;         /* TT_SEAM_*; 0 = every interior edge, clamped sampling */
+    /* 0: points spread along each whole edge. In (0, 0.5]: only points within
+       this fraction of the edge's length of either end, where the faces
+       around a vertex meet (0.05 on a tile mesh: the tiles' corners, where
+       three to six tiles must match at once). The references are taken as
+       always. */
+    float ends;
     /* NULL: every interior edge (with TT_SEAM_UV_DISCONTINUOUS, every
        discontinuous one). Otherwise only the interior edges listed, each named
        by either of its two corners (half-edges); a list naming nothing
@@ -1702,7 +1708,8 @@ typedef struct tt_seam_report {
    TT_ERROR_NOT_MEASURED and the report is zero with score NaN, except
    edges_discontinuous, which is counted before any sampling. Other errors: NULL pointers or an empty atlas
    (TT_ERROR_INVALID_ARGUMENT), a negative max_edges or nedges, edges NULL with
-   nedges > 0, an unknown flag bit (TT_ERROR_INVALID_ARGUMENT); a listed edge
+   nedges > 0, an unknown flag bit, ends outside [0, 0.5] or NaN
+   (TT_ERROR_INVALID_ARGUMENT); a listed edge
    that is not a corner of the mesh (TT_ERROR_INDEX_OUT_OF_RANGE) or lies on
    the boundary (TT_ERROR_INVALID_ARGUMENT), error->item naming its place in
    the list; TT_ERROR_OUT_OF_MEMORY. */
@@ -11106,6 +11113,7 @@ typedef struct tt__seam_job {
     tt_wrap wrap;
     const int *interior;
     int ninterior, points_per_edge;
+    float ends;                 /* tt_seam_options::ends */
     uint64_t seed;
     tt__seam_sums *sums;        /* one per range */
 } tt__seam_job;
@@ -11134,6 +11142,10 @@ static void tt__seam_range(void *context, int begin, int end)
            own UVs are asked for too. */
         for (j = 0; j < ppe; j++) {
             t[j] = ((float)j + tt_rng_float(&rng)) / (float)ppe;
+            /* Near the ends only: the first half of the strata folded onto
+               [0, ends], the second onto [1 - ends, 1]. */
+            if (job->ends > 0.0f)
+                t[j] = t[j] < 0.5f ? 2.0f * t[j] * job->ends : 1.0f - 2.0f * (1.0f - t[j]) * job->ends;
             other[j] = job->interior[(i + 1 + (int)tt_rng_below(&rng, (uint32_t)(job->ninterior - 1))) %
                                      job->ninterior];
             t_other[j] = tt_rng_float(&rng);
@@ -11181,6 +11193,9 @@ static tt_result tt__seam_check_options(const tt_mesh *mesh, const tt_seam_optio
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "seam option flags 0x%x include unknown bits 0x%x (known: TT_SEAM_UV_DISCONTINUOUS, "
                         "TT_SEAM_WRAP)", opt->flags, opt->flags & ~known_flags);
+    if (!(opt->ends >= 0.0f && opt->ends <= 0.5f))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "ends is %g: 0 (whole edges) or a fraction of an edge up to 0.5", (double)opt->ends);
     if (opt->nedges < 0 || (!opt->edges && opt->nedges > 0))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the edge list has %d entries at %s: give a list and its length, or NULL for every edge",
@@ -11314,6 +11329,7 @@ TTDEF tt_result tt_measure_seams(const tt_mesh *mesh, const float *corner_uv, co
         job.interior = interior;
         job.ninterior = ninterior;
         job.points_per_edge = points_per_edge;
+        job.ends = opt.ends;
         job.seed = opt.seed;
         tt__parallel_ranges(opt.executor, nmeasured, TT__SEAM_RANGE, tt__seam_range, &job);
         for (i = 0; i < nranges; i++) {

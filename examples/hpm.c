@@ -304,10 +304,10 @@ static int measure_quality(const hpm_command_options *options, const triangle_me
     int status;
     memset(quality, 0, sizeof *quality);
     status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, image, options->map.seed,
-                                TT_SEAM_UV_DISCONTINUOUS | wrap, NULL, 0, 0, &quality->borders);
+                                TT_SEAM_UV_DISCONTINUOUS | wrap, NULL, 0, 0, 0.0f, &quality->borders);
     if (status == 0)
         status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, image, options->map.seed, wrap, NULL,
-                                    0, 0, &quality->all);
+                                    0, 0, 0.0f, &quality->all);
     if (status != 0) return status;
     memset(&distortion, 0, sizeof distortion);
     distortion.texels_per_unit = report->texels_per_unit;

@@ -943,11 +943,11 @@ static int measure_baked(const lapped_options *options, const triangle_mesh *m, 
 {
     int *edges = NULL, nedges = 0;
     int status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, atlas, options->seed, 0, NULL, 0, 0,
-                                    &summary->all);
+                                    0.0f, &summary->all);
     if (status == 0) status = top_change_edges(m->mesh, lapped, &edges, &nedges);
     if (status == 0)
         status = tool_measure_seams(options->mesh_path, m->mesh, corner_uv, atlas, options->seed, 0, edges, nedges, 0,
-                                    &summary->top_changes);
+                                    0.0f, &summary->top_changes);
     free(edges);
     return status;
 }

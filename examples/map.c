@@ -86,7 +86,7 @@ int cmd_map(int argc, char **argv)
     tiled_options options;
     tiled_mesh mesh;
     tt_image *atlas = NULL;
-    tool_seams seams;
+    tool_seams seams, corners;
     tool_output output;
     char message[TOOL_ERROR_SIZE], mtl_path[4096];
 
@@ -109,7 +109,10 @@ int cmd_map(int argc, char **argv)
     if (options.atlas_path) {
         char texture[4096];
         status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas, options.seed, 0, NULL, 0,
-                                    options.report, &seams);
+                                    options.report, 0.0f, &seams);
+        if (status == 0)
+            status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas, options.seed, 0, NULL, 0,
+                                        options.report, TOOL_CORNER_ENDS, &corners);
         if (status != 0) goto done;
         /* The MTL sits beside the OBJ, and names the atlas relative to itself. */
         snprintf(mtl_path, sizeof mtl_path, "%.*s.mtl",
@@ -127,7 +130,8 @@ int cmd_map(int argc, char **argv)
     if (status == 0) {
         tiled_print_notes(positional[0], &mesh);
         if (!tool_quiet())
-            tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL, options.report);
+            tiled_print_summary(positional[0], &mesh, options.atlas_path ? &seams : NULL,
+                                options.atlas_path ? &corners : NULL, options.report);
     }
 done:
     output_free(&output);

@@ -7,7 +7,7 @@
 #include "tool.h"
 
 int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
-                       uint64_t seed, unsigned flags, const int *edges, int nedges, int all_edges,
+                       uint64_t seed, unsigned flags, const int *edges, int nedges, int all_edges, float ends,
                        tool_seams *out)
 {
     tt_seam_options options;
@@ -25,6 +25,7 @@ int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *c
     options.max_edges = all_edges ? 0 : TOOL_REPORT_EDGES;
     options.edges = edges;
     options.nedges = nedges;
+    options.ends = ends;
     options.executor = tool_executor();
     tool_stage("measuring the seams");
     result = tt_measure_seams(mesh, corner_uv, atlas, &options, NULL, &out->report, &error);

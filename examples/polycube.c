@@ -104,8 +104,9 @@ static void print_help(void)
            "mapping (triangles split, triangles that fell back to one square: local seams, edges\n"
            "with no path on the polycube, folds), the stretch of the texture on the triangles and\n"
            "the spread of its texel density (5th percentile, median, 95th, by area), the\n"
-           "seam score on the tiles' borders and over all edges (about 0: the texture continues,\n"
-           "about 1: unrelated) and the time of each stage.\n"
+           "seam score on the tiles' borders, over all edges, and on the polycube's squares near\n"
+           "their corners, within 5 %% of each edge's ends, where three to six tiles meet (about 0:\n"
+           "the texture continues, about 1: unrelated) and the time of each stage.\n"
            "\n"
            "example: tiledtex generate mesh sphere.obj --shape sphere --triangles\n"
            "         tiledtex generate texture stones.png --size 256\n"
@@ -495,6 +496,7 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
 typedef struct polycube_quality {
     tool_seams borders;             /* UV-discontinuous edges: the tiles' borders */
     tool_seams all;                 /* every interior edge */
+    tool_seams corners;             /* S's squares near their corners, where 3 to 6 tiles meet */
     tt_uv_distortion_report distortion;
     int distortion_measured;
     char distortion_reason[224];    /* why the distortion was not measured */
@@ -533,10 +535,16 @@ static int measure_quality(const polycube_command_options *options, const polycu
     }
     quality->mesh_built = 1;
     status = tool_measure_seams(options->mesh_path, mapped, job->corner_uv, atlas, options->tiles.seed,
-                                TT_SEAM_UV_DISCONTINUOUS, NULL, 0, 0, &quality->borders);
+                                TT_SEAM_UV_DISCONTINUOUS, NULL, 0, 0, 0.0f, &quality->borders);
     if (status == 0)
         status = tool_measure_seams(options->mesh_path, mapped, job->corner_uv, atlas, options->tiles.seed, 0, NULL,
-                                    0, 0, &quality->all);
+                                    0, 0, 0.0f, &quality->all);
+    /* The tiles' corners, on S's own squares: near the mapped triangles'
+       corners the samples would mostly fall where a model edge crosses a
+       square's edge, not at the square's corner. */
+    if (status == 0)
+        status = tool_measure_seams(options->mesh_path, job->polycube->surface, job->surface_uv, atlas,
+                                    options->tiles.seed, 0, NULL, 0, 0, TOOL_CORNER_ENDS, &quality->corners);
     if (status == 0) {
         /* One tile covers one cube face: the intended density is the tile's
            texels over the cube's edge. */
@@ -562,7 +570,7 @@ static void print_summary(const polycube_command_options *options, const polycub
     const tt_polycube_map_report *m = &job->map_report;
     const tt_polycube_projection_report *p = &m->projection;
     const tt_uv_distortion_report *d = &quality->distortion;
-    char borders[320], all[320];
+    char borders[320], all[320], corners[320];
 
     printf("%s: %d triangles", options->mesh_path, job->mesh.ntriangles);
     if (job->mesh.ntriangles != job->mesh.obj.nfaces) printf(" (fans of %d faces)", job->mesh.obj.nfaces);
@@ -618,7 +626,9 @@ static void print_summary(const polycube_command_options *options, const polycub
         }
         tool_format_seams(&quality->borders, "border edges", borders, sizeof borders);
         tool_format_seams(&quality->all, "edges", all, sizeof all);
-        printf("seam score: tile borders %s; all edges %s\n", borders, all);
+        tool_format_seams(&quality->corners, "square edges", corners, sizeof corners);
+        printf("seam score: tile borders %s; all edges %s; near the squares' corners (within %.0f %% of an edge's "
+               "ends) %s\n", borders, all, 100.0 * TOOL_CORNER_ENDS, corners);
     }
     printf("time: build %.2f s, synthesis %.2f s, mapping %.2f s\n", job->build_seconds, job->synth_seconds,
            job->map_seconds);

@@ -59,7 +59,11 @@ static void print_help(void)
            "                         read only triangles (a GLB holds triangles anyway)\n"
            "\n"
            "A material's maps share IMAGE's tiles: the cuts are decided once, from IMAGE, and\n"
-           "every map is cut and blended the same way, so the atlases line up texel for texel.\n",
+           "every map is cut and blended the same way, so the atlases line up texel for texel.\n"
+           "\n"
+           "Prints the mesh, the tiles and the seam score over every edge and near the tiles'\n"
+           "corners, within 5 %% of each edge's ends, where three to six tiles meet (about 0: the\n"
+           "texture continues, about 1: unrelated).\n",
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
 }
 
@@ -114,7 +118,7 @@ int cmd_tile(int argc, char **argv)
     tt_image *image = NULL;
     tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS], *upright = NULL, *map_upright[MATERIAL_MAPS];
     tt_image *atlas = NULL, *map_atlas[MATERIAL_MAPS];
-    tool_seams seams;
+    tool_seams seams, corners;
     tool_level level;
     tool_output output;
     char message[TOOL_ERROR_SIZE], prefix[TOOL_PREFIX_SIZE], obj_path[4096], mtl_path[4096], png_path[4096],
@@ -200,7 +204,10 @@ int cmd_tile(int argc, char **argv)
     if (status == 0)
         status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas ? atlas : &tiles->levels[0],
                                     options.seed, 0,
-                                    NULL, 0, options.report, &seams);
+                                    NULL, 0, options.report, 0.0f, &seams);
+    if (status == 0)
+        status = tool_measure_seams(positional[0], mesh.mesh, mesh.corner_uv, atlas ? atlas : &tiles->levels[0],
+                                    options.seed, 0, NULL, 0, options.report, TOOL_CORNER_ENDS, &corners);
     if (status == 0 && gltf) {
         tool_material material;
         const tt_image *map_atlases[MATERIAL_MAPS];
@@ -229,7 +236,7 @@ int cmd_tile(int argc, char **argv)
         /* Said only on success: a failing command prints its one error line. */
         tiled_print_notes(positional[0], &mesh);
         if (!tool_quiet()) {
-            tiled_print_summary(positional[0], &mesh, &seams, options.report);
+            tiled_print_summary(positional[0], &mesh, &seams, &corners, options.report);
             if (mesh.face_turn)
                 printf("up: %d quads' tiles turned along the field, %d upright and %d plain (where the field turns "
                        "past a quad's diagonal, or next to such a quad along a course)\n", mesh.mesh->nfaces,

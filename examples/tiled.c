@@ -428,7 +428,8 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
     }
 }
 
-void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tool_seams *seams, int report)
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tool_seams *seams,
+                         const tool_seams *corners, int report)
 {
     const tt_mesh_stats *s = &mesh->stats;
     printf("%s: %d quads, %d vertices, genus %d, %d component%s, %d boundary loop%s, valence %d..%d, "
@@ -450,6 +451,11 @@ void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const too
         else
             printf(", seam score n/a: unrelated places differ no more than neighbours (%s; seam %.4f, "
                    "same-face %.4f, unrelated %.4f)", edges, r->seam, r->same_face, r->unrelated);
+    }
+    if (corners) {
+        char text[320];
+        tool_format_seams(corners, "edges", text, sizeof text);
+        printf("; near the tiles' corners (within %.0f %% of an edge's ends) %s", 100.0 * TOOL_CORNER_ENDS, text);
     }
     printf("\n");
     if (report) print_quality(mesh);

@@ -137,6 +137,7 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh);
 
 /* The one-line summary map and tile print; seams may be NULL. With `report`
    a second line gives tile usage and face stretch. */
-void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tool_seams *seams, int report);
+void tiled_print_summary(const char *obj_path, const tiled_mesh *mesh, const tool_seams *seams,
+                         const tool_seams *corners, int report);
 
 #endif /* TILEDTEX_TILED_H */

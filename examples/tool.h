@@ -924,11 +924,16 @@ typedef struct tool_seams {
 /* Measure the seams of per-corner UVs on `atlas` for a summary: flags are
    tt_seam_options.flags; edges (nedges of them, each named by a corner) the
    edges to measure, or NULL for every one the flags allow; a sample of
-   TOOL_REPORT_EDGES edges, or with all_edges every one. Nothing measurable (a one-face mesh, say) is not an
+   TOOL_REPORT_EDGES edges, or with all_edges every one; ends as
+   tt_seam_options.ends (0: whole edges; TOOL_CORNER_ENDS: near the
+   corners where the tiles meet). Nothing measurable (a one-face mesh, say) is not an
    error: seams->measured is 0. Other library errors are printed as one line
    naming obj_path; returns the exit status. */
+/* How near an edge's ends the corner seam score samples: within 5 % of
+   the edge at either end, where three to six tiles meet. */
+#define TOOL_CORNER_ENDS 0.05f
 int tool_measure_seams(const char *obj_path, const tt_mesh *mesh, const float *corner_uv, const tt_image *atlas,
-                       uint64_t seed, unsigned flags, const int *edges, int nedges, int all_edges,
+                       uint64_t seed, unsigned flags, const int *edges, int nedges, int all_edges, float ends,
                        tool_seams *seams);
 /* The score as a summary says it, `edges` naming what was measured
    ("border edges"): "0.123 (456 of 789 border edges sampled)", "n/a: ..."

@@ -1652,6 +1652,68 @@ static void test_seams_control(void)
     seam_fixture_free(&fx);
 }
 
+/* tt_seam_options::ends measures only near the edges' ends, where the
+   tiles' corners meet. On matching tiles it stays low; with a disc around
+   every face corner's UV painted a flat colour of its own (the middles
+   untouched), it
+   rises well above the whole-edge score, which the middles dilute; and
+   bad fractions are refused. */
+static void test_seams_ends(void)
+{
+    seam_fixture fx;
+    tt_seam_options so;
+    tt_seam_report whole, ends, whole_spoilt, ends_spoilt;
+    tt_error err;
+    tt_result r1, r2;
+    tt_image *atlas;
+    const float bad[3] = {-0.1f, 0.6f, 0.0f};
+    int x, y, k, c, corner = 5;
+    uint32_t state = 12345u;
+    if (!seam_fixture_make(&fx, 40, 24, 160, 21, 2, 4, "ends")) return;
+    tt_assign_boundaries(fx.mesh, &fx.layout, 8, NULL, fx.types, NULL);
+    tt_assign_uvs(fx.mesh, &fx.layout, fx.types, fx.uv, NULL);
+    atlas = &fx.set->levels[0];
+    memset(&so, 0, sizeof so);
+    so.ends = 0.1f;
+    r1 = tt_measure_seams(fx.mesh, fx.uv, atlas, NULL, NULL, &whole, &err);
+    r2 = tt_measure_seams(fx.mesh, fx.uv, atlas, &so, NULL, &ends, &err);
+    CHECK(r1 == TT_OK && r2 == TT_OK && whole.score < 0.1 && ends.score < 0.2,
+          "ends, matching tiles: %d %d, whole-edge score %.4f (want < 0.1), near the ends %.4f (want < 0.2)", r1, r2,
+          whole.score, ends.score);
+    /* Spoil a disc of `corner` texels around every face corner's UV, each
+       with a flat colour of its own (flat, so the same-face reference stays
+       what it was). */
+    for (c = 0; c < fx.mesh->ncorners; c++) {
+        const int u = (int)(fx.uv[2 * c] * (float)atlas->width), v = (int)((1.0f - fx.uv[2 * c + 1]) * (float)atlas->height);
+        float colour[3];
+        for (k = 0; k < 3; k++) {
+            state = state * 1664525u + 1013904223u;
+            colour[k] = (float)(state >> 8) / 16777216.0f;
+        }
+        for (y = v - corner; y <= v + corner; y++)
+            for (x = u - corner; x <= u + corner; x++) {
+                if (x < 0 || y < 0 || x >= atlas->width || y >= atlas->height ||
+                    (x - u) * (x - u) + (y - v) * (y - v) > corner * corner)
+                    continue;
+                for (k = 0; k < 3; k++) atlas->pixels[4 * ((size_t)y * atlas->width + x) + k] = colour[k];
+            }
+    }
+    r1 = tt_measure_seams(fx.mesh, fx.uv, atlas, NULL, NULL, &whole_spoilt, &err);
+    r2 = tt_measure_seams(fx.mesh, fx.uv, atlas, &so, NULL, &ends_spoilt, &err);
+    CHECK(r1 == TT_OK && r2 == TT_OK && ends_spoilt.score > 0.5 && ends_spoilt.score > whole_spoilt.score + 0.25,
+          "ends, corners spoilt: %d %d, near the ends %.4f (want > 0.5 and > whole-edge %.4f + 0.25)", r1, r2,
+          ends_spoilt.score, whole_spoilt.score);
+    printf("     seams near the ends: matching %.3f (whole %.3f), corners spoilt %.3f (whole %.3f)\n", ends.score,
+           whole.score, ends_spoilt.score, whole_spoilt.score);
+    for (k = 0; k < 3; k++) {
+        so.ends = k < 2 ? bad[k] : (float)NAN;
+        r1 = tt_measure_seams(fx.mesh, fx.uv, atlas, &so, NULL, &ends, &err);
+        CHECK(r1 == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "ends") != NULL,
+              "ends %g: expected TT_ERROR_INVALID_ARGUMENT naming ends, got %d (%s)", (double)so.ends, r1, err.message);
+    }
+    seam_fixture_free(&fx);
+}
+
 /* ---- Tiles turned along a field (tt_orient_tiles, tt_assign_uvs_oriented) ---- */
 
 /* Whether upright face f's left and right sides all meet upright faces that
@@ -3021,6 +3083,7 @@ void run_tiled_tests(void)
     RUN(test_compact_atlas);
     RUN(test_seams);
     RUN(test_seams_control);
+    RUN(test_seams_ends);
     RUN(test_orient_tiles);
     RUN(test_assign_uvs_oriented);
     RUN(test_orient_tiles_seams);
