@@ -3633,8 +3633,7 @@ typedef struct tt_polycube_mapping {
           vertex V of S and the boundary winds once around V (a cone point
           inside) or passes through it (a bend), the triangle is the fan
           from V over its boundary, each fan triangle in its segment's
-          quad; a
-          V inside becomes a vertex at the boundary's mean value
+          quad; a V inside becomes a vertex at the boundary's mean value
           coordinates seen from V, which lie on the triangle;
         - otherwise (an edge with no path, a fold the relaxation could not
           open, several cones) the triangle keeps its boundary, so its
@@ -28681,7 +28680,7 @@ typedef struct tt__split_job {
    or its vertex lies behind a corner another vertex holds. The fallback's
    local seam shows less than the streak. A sliver thin in both spaces (an
    edge passing a hair from a grid line) is no streak and stays. */
-static int tt__split_has_empty_piece(tt__split *S, int first)
+static int tt__split_has_empty_piece(const tt__split *S, int first)
 {
     const double h2 = (double)S->pc->h * (double)S->pc->h;
     int j, k, source[3];
