@@ -16362,6 +16362,19 @@ static int tt__lowest_bit(uint64_t word)
     return table[((word & (~word + 1)) * (uint64_t)0x03f79d71b4cb0a89u) >> 58];
 }
 
+/* The index of the highest set bit of a non-zero word: the bits below it
+   set, the highest is the one its right neighbour lacks. */
+static int tt__highest_bit(uint64_t word)
+{
+    word |= word >> 1;
+    word |= word >> 2;
+    word |= word >> 4;
+    word |= word >> 8;
+    word |= word >> 16;
+    word |= word >> 32;
+    return tt__lowest_bit(word ^ (word >> 1));
+}
+
 /* The x interval (lo, hi) where the line y = c meets the points within
    `reach` of segment ab; 0 when it misses them. The capsule is the band
    along the segment and the discs at its ends, each met in an interval. */
@@ -16512,25 +16525,25 @@ static void tt__mask_turn(tt__packing *p, int cols, int rows, int turn, int *wid
 }
 
 /* The longest run of bits equal to `taken` among the first `width` of a
-   row of words. */
+   row of words, a word at a time: the run carried in from below ends at
+   the word's lowest other bit, the longest run inside it is the number of
+   times x &= x >> 1 leaves bits, and the run at its top carries on. */
 static int tt__longest_run(const uint64_t *line, int width, int taken)
 {
-    const uint64_t same = taken ? ~(uint64_t)0 : 0;
-    int w, bit, run = 0, longest = 0;
+    int w, run = 0, longest = 0;
     for (w = 0; 64 * w < width; w++) {
-        uint64_t word = line[w];
-        int bits = width - 64 * w < 64 ? width - 64 * w : 64;
-        if (word == same && bits == 64) {
-            run += 64;
+        int bits = width - 64 * w < 64 ? width - 64 * w : 64, inner = 0;
+        uint64_t valid = bits == 64 ? ~(uint64_t)0 : ((uint64_t)1 << bits) - 1;
+        uint64_t same = (taken ? line[w] : ~line[w]) & valid, other = ~same & valid, x;
+        if (!other) {
+            run += bits;
             continue;
         }
-        for (bit = 0; bit < bits; bit++)
-            if ((word >> bit & 1) != (uint64_t)taken) {
-                if (run > longest) longest = run;
-                run = 0;
-            } else {
-                run++;
-            }
+        run += tt__lowest_bit(other);
+        if (run > longest) longest = run;
+        for (x = same; x; x &= x >> 1) inner++;
+        if (inner > longest) longest = inner;
+        run = bits - 1 - tt__highest_bit(other);
     }
     return run > longest ? run : longest;
 }
@@ -16584,13 +16597,26 @@ static int tt__packing_clash(const tt__packing *p, int r, int width, int row, in
     const uint64_t *mask = p->mask + (size_t)r * p->words, *line = p->bits + (size_t)row * p->words;
     int j, nw = (width + 63) / 64;
     for (j = nw - 1; j >= 0; j--) {
-        uint64_t both = mask[j] & tt__bits_at(line, p->words, x + 64 * j);
-        int bit, a, b;
+        uint64_t both = mask[j] & tt__bits_at(line, p->words, x + 64 * j), gap;
+        int bit, a, b, k;
         if (!both) continue;
-        for (bit = 63; !(both >> bit & 1); bit--) {}
-        a = b = 64 * j + bit;
-        while (a > 0 && (mask[(a - 1) >> 6] >> ((a - 1) & 63) & 1)) a--;
-        while (b + 1 < width && (mask[(b + 1) >> 6] >> ((b + 1) & 63) & 1)) b++;
+        bit = tt__highest_bit(both);
+        /* The run's ends: the nearest unset mask bits below and above. */
+        a = 0;
+        gap = ~mask[j] & (((uint64_t)1 << bit) - 1);
+        for (k = j; k >= 0; gap = --k >= 0 ? ~mask[k] : 0)
+            if (gap) {
+                a = 64 * k + tt__highest_bit(gap) + 1;
+                break;
+            }
+        b = width - 1;
+        gap = ~mask[j] & (~(uint64_t)0 << bit);
+        for (k = j; k < nw; gap = ++k < nw ? ~mask[k] : 0)
+            if (gap) {
+                b = 64 * k + tt__lowest_bit(gap) - 1;
+                break;
+            }
+        if (b > width - 1) b = width - 1;
         return tt__packing_next_run(p, row, x + 64 * j + bit + 1, b - a + 1, size) - a;
     }
     return -1;
