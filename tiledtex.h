@@ -16352,20 +16352,28 @@ static void tt__bits_set(uint64_t *line, int a, int b)
     }
 }
 
-/* The index of the lowest set bit of a non-zero word (de Bruijn). */
+/* The index of the lowest set bit of a non-zero word (de Bruijn, or the
+   compiler's instruction). */
 static int tt__lowest_bit(uint64_t word)
 {
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctzll(word);
+#else
     static const unsigned char table[64] = {
         0,  1,  48, 2,  57, 49, 28, 3,  61, 58, 50, 42, 38, 29, 17, 4,  62, 55, 59, 36, 53, 51,
         43, 22, 45, 39, 33, 30, 24, 18, 12, 5,  63, 47, 56, 27, 60, 41, 37, 16, 54, 35, 52, 21,
         44, 32, 23, 11, 46, 26, 40, 15, 34, 20, 31, 10, 25, 14, 19, 9,  13, 8,  7,  6};
     return table[((word & (~word + 1)) * (uint64_t)0x03f79d71b4cb0a89u) >> 58];
+#endif
 }
 
-/* The index of the highest set bit of a non-zero word: the bits below it
-   set, the highest is the one its right neighbour lacks. */
+/* The index of the highest set bit of a non-zero word: with the bits below
+   it set, the highest is the one its right neighbour lacks. */
 static int tt__highest_bit(uint64_t word)
 {
+#if defined(__GNUC__) || defined(__clang__)
+    return 63 - __builtin_clzll(word);
+#else
     word |= word >> 1;
     word |= word >> 2;
     word |= word >> 4;
@@ -16373,6 +16381,7 @@ static int tt__highest_bit(uint64_t word)
     word |= word >> 16;
     word |= word >> 32;
     return tt__lowest_bit(word ^ (word >> 1));
+#endif
 }
 
 /* The x interval (lo, hi) where the line y = c meets the points within
