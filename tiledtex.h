@@ -2310,8 +2310,8 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
    starts or joins a later chart. Then a face with two of its three
    neighbours in another chart moves to it when it passes that chart's
    tests (straighter borders). Two sets of charts are made and packed, one
-   with every face also within 0.15 sqrt(surface) of its seed and within
-   30 degrees of its normal (round, flat charts: long branching ones leave
+   with every face also within 0.15 sqrt(surface) of its seed and grown
+   within 30 degrees of its normal (round, flat charts: long branching ones leave
    hollows no packing fills, but the rings of a smooth tube nest whole),
    and the one that fills more is kept. Within the cone every face keeps its winding (no flips), and the projection shrinks a face's area by at most
    cos(cone), so density varies by at most sqrt(1 / cos(cone)) across a
@@ -2331,7 +2331,7 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
    meshes) join a neighbouring chart. */
 
 /* Degrees: the normals of a chart's faces stay within this of its seed face's normal (the
-   round charts tried first keep within 30). */
+   round charts tried first grow within 30). */
 #define TT_ATLAS_CHART_CONE 40.0
 
 typedef struct tt_chart_pack_options {
@@ -16832,11 +16832,12 @@ static int tt__charts_regroup(int nf, int ncharts, int *chart, int *members, tt_
 
 /* Straighter chart borders: a face with two of its three neighbours in
    another chart is a tooth of its own chart and a notch of the other; it
-   moves over when it passes the other chart's tests (the cone about its
-   seed's normal, the reach, no overlap in its plane), and a pass repeats
-   while faces move (at most TT__CHART_SMOOTHING). A face that leaves a
-   chart had at most one neighbour in it, so no chart is torn; every chart
-   keeps the guarantees of its growth, and its border only shortens. Each
+   moves over when it passes the other chart's tests (cos_cone about its
+   seed's normal, which may be wider than the cone the chart grew in, the
+   reach, no overlap in its plane), and a pass repeats while faces move
+   (at most TT__CHART_SMOOTHING). A face that leaves a chart had at most
+   one neighbour in it, so no chart is torn; every chart keeps within
+   cos_cone, the reach and without overlaps, and its border only shortens. Each
    border tooth costs its gutter on both sides, and the hollows between
    teeth are room the packing cannot use. seed[c]: chart c's seed; stamp:
    nf ints, scratch: 2 nf ints. Returns the number of charts (some may
@@ -17070,7 +17071,7 @@ static double tt__atlas_reach_cells(int gutter, int block)
 
 /* One set of charts for tt_atlas_pack_charts: grown from seeds (faces
    within `cone` degrees of their seed's normal and within `reach` of it,
-   1e300: the cone alone), smoothed, with per
+   1e300: the cone alone), smoothed (in TT_ATLAS_CHART_CONE), with per
    face a bit per edge that leaves its chart (border), each chart's shape,
    and the packing order, largest first; *largest the widest chart. seed,
    tried and scratch are scratch of nfaces. Returns the count of charts,
@@ -17080,14 +17081,15 @@ static int tt__atlas_make_charts(const tt_mesh *mesh, const double *normal, cons
                                  tt__chart *charts, double *xy, int *seed, int *scratch, unsigned char *border,
                                  tt__chart_order *order, double *largest)
 {
-    const double cos_cone = cos(cone * TT__PI / 180.0);
-    int ncharts = tt__grow_charts(mesh, normal, area, grid, eps, cos_cone, reach, chart, tried, members, charts, xy), c,
-        f, k;
+    int ncharts = tt__grow_charts(mesh, normal, area, grid, eps, cos(cone * TT__PI / 180.0), reach, chart, tried,
+                                  members, charts, xy), c, f, k;
     if (ncharts < 0) return -1;
     /* The seeds: each chart's first member. */
     for (c = 0; c < ncharts; c++) seed[c] = members[charts[c].first];
-    ncharts = tt__smooth_charts(mesh, normal, area, grid, eps, cos_cone, reach, chart, members, charts, ncharts, seed,
-                                xy, tried, scratch);
+    /* Teeth move in the wider cone: a face whose noisy normal kept it out
+       of a narrow-cone chart, and alone, joins it. */
+    ncharts = tt__smooth_charts(mesh, normal, area, grid, eps, cos(TT_ATLAS_CHART_CONE * TT__PI / 180.0), reach, chart,
+                                members, charts, ncharts, seed, xy, tried, scratch);
     if (ncharts < 0) return -1;
     for (f = 0; f < mesh->nfaces; f++) {
         border[f] = 0;

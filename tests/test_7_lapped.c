@@ -4720,9 +4720,10 @@ static void test_atlas_pack_charts_coarse(void)
 /* A coarse, noisy scan: a lumpy sphere of 3120 triangles with +-0.015 of
    noise per vertex, so that its normals scatter as a decimated scan's do
    and a chart is only a few triangles across. At 1024, gutter 2, the
-   atlas fills 0.68 at one density (round charts in a 30 degree cone, the
-   cone alone in 40); round charts in the 40 degree cone filled 0.66, with
-   ragged borders along the cone's limit. */
+   atlas fills 0.70 at one density (round charts grown in a 30 degree
+   cone, their teeth moved in 40; the cone alone in 40); round charts grown
+   in the 40 degree cone filled 0.66, with ragged borders along the cone's
+   limit. */
 static void test_atlas_pack_charts_noisy(void)
 {
     tt_mesh *mesh;
@@ -4755,7 +4756,7 @@ static void test_atlas_pack_charts_noisy(void)
     CHECK(tt_atlas_pack_charts(mesh, 1024, 2, NULL, NULL, uv, &report, &err) == TT_OK, "1024: %s", err.message);
     chart_check_atlas("noisy lumpy sphere at 1024", mesh, uv, &report, 1024, 2, spread);
     CHECK(spread[2] / spread[0] <= 1.2, "texel density p95 / p5 %.3f", spread[2] / spread[0]);
-    CHECK(report.fill >= 0.67, "%d charts fill %.3f of the atlas", report.ncharts, report.fill);
+    CHECK(report.fill >= 0.68, "%d charts fill %.3f of the atlas", report.ncharts, report.fill);
     printf("     atlas fill on a noisy lumpy sphere: %d charts fill %.3f at 1024, density p95/p5 %.3f\n",
            report.ncharts, report.fill, spread[2] / spread[0]);
     free(uv);
