@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # tests/fuzz/run.sh [SECONDS] - build the libFuzzer targets into build/fuzz/ and run
-# each for SECONDS (default 60), FUZZ_JOBS (default 2) at a time: mesh_build,
+# each for SECONDS (default 60), FUZZ_JOBS (default 2) at a time, builds and runs alike: mesh_build,
 # lapped, synth (tiled-texture synthesis, seams, 8-bit images), hpm (the
 # hierarchy, flattening and tt_hpm_map), polycube (build, colours, mapping,
 # UVs), obj (the tool's OBJ reader, when examples/tool_io.c compiles),
@@ -54,70 +54,46 @@ warn="-Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes"
 stb=$(pkg-config --cflags-only-I stb 2>/dev/null | sed "s/-I/-isystem /g")
 [ -n "$stb" ] || stb="-isystem /usr/include/stb"
 
-targets=()
-echo "fuzz: building into $out/" >&2
-if $cc $flags $warn -I. tests/fuzz/fuzz_mesh_build.c -o "$out/fuzz_mesh_build" -lm; then
-  targets+=(mesh_build)
-else
-  echo "fuzz: fuzz_mesh_build does not build" >&2
-  exit 3
-fi
-if $cc $flags $warn -I. tests/fuzz/fuzz_lapped.c -o "$out/fuzz_lapped" -lm; then
-  targets+=(lapped)
-else
-  echo "fuzz: fuzz_lapped does not build" >&2
-  exit 3
-fi
-if $cc $flags $warn -I. tests/fuzz/fuzz_synth.c -o "$out/fuzz_synth" -lm; then
-  targets+=(synth)
-else
-  echo "fuzz: fuzz_synth does not build" >&2
-  exit 3
-fi
-# hpm and polycube on small generated meshes (fuzz_shape.h); each prints at
-# exit the share of its runs that reached the deep stage. polycube is built
-# without libFuzzer's comparison tracing: its decisions are on floats, which
-# the tracing does not see, while tracing the integer comparisons of its
-# inner loops (sorts, chart and quad indices) halved its runs a second.
-for t in hpm polycube; do
-  extra=""
-  [ "$t" = polycube ] && extra="-fno-sanitize-coverage=trace-cmp"
-  # shellcheck disable=SC2086
-  if $cc $flags $extra $warn -I. tests/fuzz/fuzz_$t.c -o "$out/fuzz_$t" -lm; then
-    targets+=("$t")
-  else
-    echo "fuzz: fuzz_$t does not build" >&2
-    exit 3
-  fi
-done
+# The targets build FUZZ_JOBS (default 2) at a time, each compiling the whole
+# header with the sanitizers (over a minute on one core), into its own log;
+# they are checked in order once every build is done.
+build_jobs=${FUZZ_JOBS:-2}
+[ "$build_jobs" -ge 1 ] 2>/dev/null || build_jobs=2
+building=()
+build_start() {
+  local name=$1
+  shift
+  while [ "$(jobs -rp | wc -l)" -ge "$build_jobs" ]; do wait -n; done
+  rm -f "$out/build_$name.rc"
+  ( "$@" >"$out/build_$name.log" 2>&1; echo $? >"$out/build_$name.rc" ) &
+  building+=("$name")
+}
+build_plain() {   # mesh_build, lapped, synth, hpm: the target alone
+  $cc $flags $warn -I. "tests/fuzz/fuzz_$1.c" -o "$out/fuzz_$1" -lm
+}
+# polycube is built without libFuzzer's comparison tracing: its decisions
+# are on floats, which the tracing does not see, while tracing the integer
+# comparisons of its inner loops (sorts, chart and quad indices) halved its
+# runs a second.
+build_polycube() {
+  $cc $flags -fno-sanitize-coverage=trace-cmp $warn -I. tests/fuzz/fuzz_polycube.c -o "$out/fuzz_polycube" -lm
+}
 # The tool's OBJ reader (examples/obj.c) with what it uses: tool_io.c (errors,
 # files, buffers), format_number.c (the writer's numbers) and executor.c
-# (the writer formats its lines on the tool's threads).
+# (the writer formats its lines on the tool's threads). These are compiled
+# as they are; fuzz_obj.c is the one TU that defines TILEDTEX_IMPLEMENTATION.
 obj_sources="examples/obj.c examples/tool_io.c examples/format_number.c examples/executor.c"
-if [ -f examples/obj.c ] && [ -f examples/tool_io.c ] && [ -f examples/format_number.c ] && [ -f examples/tool.h ]; then
-  # These are compiled as they are; fuzz_obj.c is the one TU that defines
-  # TILEDTEX_IMPLEMENTATION.
+build_obj() {
   # shellcheck disable=SC2086
-  if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_obj.c $obj_sources -o "$out/fuzz_obj" -lm; then
-    targets+=(obj)
-  else
-    echo "fuzz: fuzz_obj does not build" >&2
-    exit 3
-  fi
-else
-  echo "fuzz: SKIPPED fuzz_obj: one of $obj_sources examples/tool.h is missing" >&2
-fi
+  $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_obj.c $obj_sources -o "$out/fuzz_obj" -lm
+}
 # The tool's mesh files (examples/mesh_file.c), with the OBJ reader it hands
 # OBJs to and cli.c for its number parsing.
 mesh_file_sources="examples/mesh_file.c $obj_sources examples/cli.c"
-# shellcheck disable=SC2086
-if $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_mesh_file.c $mesh_file_sources -o "$out/fuzz_mesh_file" -lm; then
-  targets+=(mesh_file)
-else
-  echo "fuzz: fuzz_mesh_file does not build" >&2
-  exit 3
-fi
-
+build_mesh_file() {
+  # shellcheck disable=SC2086
+  $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_mesh_file.c $mesh_file_sources -o "$out/fuzz_mesh_file" -lm
+}
 # The tool's image loader (examples/image_io.c: stb_image, the size checks,
 # the conversion in strips) and the library's image operations.
 # image_io.c, which compiles Debian's stb_image (2.27), is built without
@@ -130,16 +106,35 @@ fi
 # the end of the file, PNM sizes over INT_MAX). Every other file keeps every
 # check.
 image_sources="examples/png_write.c examples/tool_io.c examples/executor.c examples/obj.c examples/format_number.c"
-# shellcheck disable=SC2086
-if $cc $flags -fno-sanitize=shift,signed-integer-overflow $warn -I. -Iexamples $stb -c examples/image_io.c \
+build_image() {
+  # shellcheck disable=SC2086
+  $cc $flags -fno-sanitize=shift,signed-integer-overflow $warn -I. -Iexamples $stb -c examples/image_io.c \
     -o "$out/image_io.o" &&
-  $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources "$out/image_io.o" \
-    -o "$out/fuzz_image" -lm -pthread; then
-  targets+=(image)
+    $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources "$out/image_io.o" \
+      -o "$out/fuzz_image" -lm -pthread
+}
+
+echo "fuzz: building into $out/" >&2
+for t in mesh_build lapped synth hpm; do build_start "$t" build_plain "$t"; done
+build_start polycube build_polycube
+if [ -f examples/obj.c ] && [ -f examples/tool_io.c ] && [ -f examples/format_number.c ] && [ -f examples/tool.h ]; then
+  build_start obj build_obj
 else
-  echo "fuzz: fuzz_image does not build" >&2
-  exit 3
+  echo "fuzz: SKIPPED fuzz_obj: one of $obj_sources examples/tool.h is missing" >&2
 fi
+build_start mesh_file build_mesh_file
+build_start image build_image
+wait
+targets=()
+for t in "${building[@]}"; do
+  cat "$out/build_$t.log" >&2
+  if [ "$(cat "$out/build_$t.rc" 2>/dev/null)" = 0 ]; then
+    targets+=("$t")
+  else
+    echo "fuzz: fuzz_$t does not build" >&2
+    exit 3
+  fi
+done
 # FUZZ_BUILD_ONLY=1: build, list the targets on stdout, run nothing (the
 # smoke runs of tests/run.sh).
 if [ -n "${FUZZ_BUILD_ONLY:-}" ]; then
