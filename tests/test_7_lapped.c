@@ -4548,6 +4548,31 @@ static double chart_box_fill(const tt_mesh *mesh, const float *uv, int size, int
     return texels / ((double)size * fmax(y, size));
 }
 
+/* A lumpy sphere of n x n latitude-longitude cells as triangles: radius
+   1 + 0.15 sin(3 theta) cos(4 phi), each vertex pushed in or out by up to
+   noise / 2 (seeded, so the same every run). */
+static void make_lumpy_sphere(tmesh *m, int n, double noise)
+{
+    tmesh quads;
+    int i, f, k, corner = 0;
+    memset(&quads, 0, sizeof quads);
+    memset(m, 0, sizeof *m);
+    make_field_sphere(&quads, n, n, 1.0);
+    lcg_seed(43);
+    for (i = 0; i < quads.nv; i++) {
+        const float *p = quads.pos + 3 * i;
+        double t = acos(fmax(-1.0, fmin(1.0, p[2]))), phi = atan2(p[1], p[0]);
+        double r = 1.0 + 0.15 * sin(3.0 * t) * cos(4.0 * phi) + noise * (lcg_unit() - 0.5);
+        tm_vert(m, p[0] * r, p[1] * r, p[2] * r);
+    }
+    for (f = 0; f < quads.nf; f++) {
+        for (k = 2; k < quads.sizes[f]; k++)
+            tm_tri(m, quads.idx[corner], quads.idx[corner + k - 1], quads.idx[corner + k]);
+        corner += quads.sizes[f];
+    }
+    tm_free(&quads);
+}
+
 /* A scan-like chart set: a lumpy sphere of 19800 triangles (radius 1 +-
    0.15 in lumps, +-0.0015 of noise per vertex). The triangles fill at
    least 60 % of the atlas at one texel density (p95 / p5 within 1.2); the
@@ -4560,24 +4585,9 @@ static void test_atlas_pack_charts_fill(void)
     tt_chart_atlas_report report;
     tt_error err;
     double spread[3], boxes;
-    tmesh quads, m;
-    int i, f, k, corner = 0;
-    memset(&quads, 0, sizeof quads);
-    memset(&m, 0, sizeof m);
-    make_field_sphere(&quads, 100, 100, 1.0);
-    lcg_seed(43);
-    for (i = 0; i < quads.nv; i++) {
-        const float *p = quads.pos + 3 * i;
-        double t = acos(fmax(-1.0, fmin(1.0, p[2]))), phi = atan2(p[1], p[0]);
-        double r = 1.0 + 0.15 * sin(3.0 * t) * cos(4.0 * phi) + 0.003 * (lcg_unit() - 0.5);
-        tm_vert(&m, p[0] * r, p[1] * r, p[2] * r);
-    }
-    for (f = 0; f < quads.nf; f++) {
-        for (k = 2; k < quads.sizes[f]; k++)
-            tm_tri(&m, quads.idx[corner], quads.idx[corner + k - 1], quads.idx[corner + k]);
-        corner += quads.sizes[f];
-    }
-    tm_free(&quads);
+    tmesh m;
+    int i;
+    make_lumpy_sphere(&m, 100, 0.003);
     mesh = bake_build(&m, NULL);
     tm_free(&m);
     if (!mesh) return;
@@ -4731,24 +4741,8 @@ static void test_atlas_pack_charts_noisy(void)
     tt_chart_atlas_report report;
     tt_error err;
     double spread[3];
-    tmesh quads, m;
-    int i, f, k, corner = 0;
-    memset(&quads, 0, sizeof quads);
-    memset(&m, 0, sizeof m);
-    make_field_sphere(&quads, 40, 40, 1.0);
-    lcg_seed(43);
-    for (i = 0; i < quads.nv; i++) {
-        const float *p = quads.pos + 3 * i;
-        double t = acos(fmax(-1.0, fmin(1.0, p[2]))), phi = atan2(p[1], p[0]);
-        double r = 1.0 + 0.15 * sin(3.0 * t) * cos(4.0 * phi) + 0.03 * (lcg_unit() - 0.5);
-        tm_vert(&m, p[0] * r, p[1] * r, p[2] * r);
-    }
-    for (f = 0; f < quads.nf; f++) {
-        for (k = 2; k < quads.sizes[f]; k++)
-            tm_tri(&m, quads.idx[corner], quads.idx[corner + k - 1], quads.idx[corner + k]);
-        corner += quads.sizes[f];
-    }
-    tm_free(&quads);
+    tmesh m;
+    make_lumpy_sphere(&m, 40, 0.03);
     mesh = bake_build(&m, NULL);
     tm_free(&m);
     if (!mesh) return;
