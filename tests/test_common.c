@@ -685,14 +685,12 @@ static void thread_run(int count, tt_task_fn task, void *task_context, void *use
 }
 const tt_executor g_thread_executor = {thread_run, NULL};
 
-/* TT_TEST_ONLY=hpm,polycube runs only those sections (names as below): a
-   quick loop while working on one section; `make test` runs them all. */
-static int section_selected(const char *name)
+/* Whether a comma-separated list of section names holds this one. */
+static int section_listed(const char *list, const char *name)
 {
-    const char *only = getenv("TT_TEST_ONLY"), *p;
+    const char *p;
     size_t len = strlen(name);
-    if (!only || !*only) return 1;
-    for (p = only; *p;) {
+    for (p = list; *p;) {
         const char *end = strchr(p, ',');
         size_t n = end ? (size_t)(end - p) : strlen(p);
         if (n == len && strncmp(p, name, len) == 0) return 1;
@@ -700,6 +698,17 @@ static int section_selected(const char *name)
         if (*p == ',') p++;
     }
     return 0;
+}
+
+/* TT_TEST_ONLY=hpm,polycube runs only those sections (names as below): a
+   quick loop while working on one section. TT_TEST_SKIP=lapped runs all but
+   those: tests/run.sh runs the program twice at once, one of each, so that
+   every section runs exactly once. `make test` runs them all. */
+static int section_selected(const char *name)
+{
+    const char *only = getenv("TT_TEST_ONLY"), *skip = getenv("TT_TEST_SKIP");
+    if (skip && *skip && section_listed(skip, name)) return 0;
+    return !only || !*only || section_listed(only, name);
 }
 
 int main(void)
@@ -710,8 +719,24 @@ int main(void)
         {"tiled", run_tiled_tests}, {"synthesis", run_tiled_synthesis_tests},
         {"lapped", run_lapped_tests}, {"hpm", run_hpm_tests}, {"polycube", run_polycube_tests},
         {"contract", run_contract_tests}};
-    size_t i;
-    for (i = 0; i < sizeof sections / sizeof sections[0]; i++)
+    static const char *const lists[] = {"TT_TEST_ONLY", "TT_TEST_SKIP"};
+    size_t i, k, n = sizeof sections / sizeof sections[0];
+    /* A misspelt name would quietly run nothing, or everything. */
+    for (k = 0; k < 2; k++) {
+        const char *list = getenv(lists[k]), *p;
+        for (p = list ? list : ""; *p;) {
+            size_t len = strcspn(p, ",");
+            for (i = 0; i < n; i++)
+                if (strlen(sections[i].name) == len && strncmp(p, sections[i].name, len) == 0) break;
+            if (i == n) {
+                printf("%s names no section '%.*s'\n0 passed, 1 failed\n", lists[k], (int)len, p);
+                return 1;
+            }
+            p += len;
+            if (*p == ',') p++;
+        }
+    }
+    for (i = 0; i < n; i++)
         if (section_selected(sections[i].name)) sections[i].run();
     printf("%d passed, %d failed\n", g_passed, g_failed);
     return g_failed ? 1 : 0;

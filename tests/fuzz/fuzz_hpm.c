@@ -2,9 +2,10 @@
    face-cluster hierarchy, the flattening of its clusters and tt_hpm_map, on
    small meshes and images so that one input takes milliseconds.
 
-   Build (tests/fuzz/run.sh does this):
+   Build (tests/fuzz/run.sh does this, with the library compiled once from
+   tests/fuzz/fuzz_library.c):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-             -I. tests/fuzz/fuzz_hpm.c -o build/fuzz/fuzz_hpm -lm
+             -I. tests/fuzz/fuzz_hpm.c tests/fuzz/fuzz_library.c -o build/fuzz/fuzz_hpm -lm
 
    Input bytes, read front to back (missing bytes read as 0):
        0      bits 0..1 both set: allocation number byte[1] + 256 * (byte[2]
@@ -54,7 +55,6 @@
 
    It counts the runs whose tt_hpm_map reached a fit or a split (report fits
    + not_flat + no_room > 0: the deep stage) and prints the share at exit. */
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_hpm"
 #include "fuzz_common.h"

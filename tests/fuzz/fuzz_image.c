@@ -5,10 +5,11 @@
    tt_image_downsample2 and tt_image_over; and tt_image_from_bytes directly
    on raw bytes with fuzzed sizes, channels, stride and colour space.
 
-   Build (tests/fuzz/run.sh does this; stb_image from libstb-dev):
+   Build (tests/fuzz/run.sh does this, with the library compiled once from
+   tests/fuzz/fuzz_library.c; stb_image from libstb-dev):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
              -fno-sanitize=shift (see tests/fuzz/run.sh) \
-             -I. -Iexamples -isystem /usr/include/stb tests/fuzz/fuzz_image.c \
+             -I. -Iexamples -isystem /usr/include/stb tests/fuzz/fuzz_image.c tests/fuzz/fuzz_library.c \
              examples/image_io.c examples/png_write.c examples/tool_io.c \
              examples/executor.c examples/obj.c examples/format_number.c \
              -o build/fuzz/fuzz_image -lm -pthread
@@ -38,7 +39,6 @@
    size is not half; `over` of an image with itself turned by 180 degrees
    failing, or with a non-finite result; an error without a sentence or out
    of memory with no failed allocation; an allocation not given back. */
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_image"
 #include "fuzz_common.h"

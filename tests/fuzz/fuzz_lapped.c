@@ -2,9 +2,10 @@
    field, texture patches, the paste loop, the alignment measure, the pair
    atlas and baking.
 
-   Build (tests/fuzz/run.sh does this):
+   Build (tests/fuzz/run.sh does this, with the library compiled once from
+   tests/fuzz/fuzz_library.c):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-             -I. tests/fuzz/fuzz_lapped.c -o build/fuzz/fuzz_lapped -lm
+             -I. tests/fuzz/fuzz_lapped.c tests/fuzz/fuzz_library.c -o build/fuzz/fuzz_lapped -lm
 
    Input bytes, read front to back (missing bytes read as 0; missing positions
    get distinct points on the twisted cubic (t, t^2, t^3), no three collinear):
@@ -60,7 +61,6 @@
    `T **out` is not NULL, or whose message is empty, unterminated or holds a
    run of more than 12 digits (fz_check_error in fuzz_common.h). Every
    allocating call gets the counting allocator as its parameter. */
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_lapped"
 #include "fuzz_common.h"

@@ -1,9 +1,10 @@
 /* fuzz_mesh_build.c - libFuzzer target for the half-edge builder and everything
    that runs on a built mesh.
 
-   Build (tests/fuzz/run.sh does this):
+   Build (tests/fuzz/run.sh does this, with the library compiled once from
+   tests/fuzz/fuzz_library.c):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-             -I. tests/fuzz/fuzz_mesh_build.c -o build/fuzz/fuzz_mesh_build -lm
+             -I. tests/fuzz/fuzz_mesh_build.c tests/fuzz/fuzz_library.c -o build/fuzz/fuzz_mesh_build -lm
 
    Input bytes, read front to back (missing bytes read as 0; missing positions
    get distinct points on the twisted cubic (t, t^2, t^3), no three collinear):
@@ -49,7 +50,6 @@
    a sentence, or TT_ERROR_OUT_OF_MEMORY when no allocation failed; with any
    coordinates, a build result outside the documented codes, or a built mesh
    whose face normal is not a finite unit vector (or, permissive only, zero). */
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_mesh_build"
 #include "fuzz_common.h"

@@ -2,10 +2,10 @@
    (examples/mesh_file.c): format detection, ASCII and binary STL, OFF, the
    refused formats, welding; fed on into the library when the file reads.
 
-   Build (tests/fuzz/run.sh does this; this file is the one translation unit
-   that defines TILEDTEX_IMPLEMENTATION):
+   Build (tests/fuzz/run.sh does this, with the library
+   compiled from tests/fuzz/fuzz_library.c):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-             -I. -Iexamples -isystem /usr/include/stb tests/fuzz/fuzz_mesh_file.c \
+             -I. -Iexamples -isystem /usr/include/stb tests/fuzz/fuzz_mesh_file.c tests/fuzz/fuzz_library.c \
              examples/mesh_file.c examples/obj.c examples/cli.c examples/tool_io.c \
              examples/format_number.c -o build/fuzz/fuzz_mesh_file -lm
 
@@ -22,7 +22,6 @@
         when it builds, one quadrangulation step with its corner sources,
         the positions carried by them equal to the linear step's. Every
         allocation must be given back. */
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #include "tool.h"
 #define FUZZ_NAME "fuzz_mesh_file"

@@ -1,11 +1,11 @@
 /* fuzz_obj.c - libFuzzer target for the tool's OBJ reader (examples/obj.c),
    fed on into the library when the text parses.
 
-   Build (tests/fuzz/run.sh does this; this file is the one translation unit
-   that defines TILEDTEX_IMPLEMENTATION):
+   Build (tests/fuzz/run.sh does this, with the library
+   compiled from tests/fuzz/fuzz_library.c):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
              -I. -Iexamples -isystem /usr/include/stb \
-             tests/fuzz/fuzz_obj.c examples/obj.c examples/tool_io.c examples/format_number.c -o build/fuzz/fuzz_obj -lm
+             tests/fuzz/fuzz_obj.c tests/fuzz/fuzz_library.c examples/obj.c examples/tool_io.c examples/format_number.c -o build/fuzz/fuzz_obj -lm
 
    The input is the OBJ text itself, exactly `size` bytes with no terminating
    NUL, so AddressSanitizer catches any read past the end. Each input:
@@ -23,7 +23,6 @@
         NaN), faces, UVs, normals, group names per face and mtllib must come
         back; obj_corner_normals gives unit normals exactly when every corner
         has a finite non-zero one. */
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #include "tool.h"
 #define FUZZ_NAME "fuzz_obj"

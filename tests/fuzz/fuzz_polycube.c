@@ -3,9 +3,10 @@
    projection, relaxation, tracing, the triangle split) and the texture
    coordinates, plain and upright, on small meshes at resolutions 1..6.
 
-   Build (tests/fuzz/run.sh does this):
+   Build (tests/fuzz/run.sh does this, with the library compiled once from
+   tests/fuzz/fuzz_library.c):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-             -I. tests/fuzz/fuzz_polycube.c -o build/fuzz/fuzz_polycube -lm
+             -I. tests/fuzz/fuzz_polycube.c tests/fuzz/fuzz_library.c -o build/fuzz/fuzz_polycube -lm
 
    Why so small: the time of tt_polycube_map follows the refined triangles
    and, above all, the folds the projection leaves (a random tetrahedron at
@@ -77,7 +78,6 @@
    It counts the runs that reach the triangle split (tt_polycube_map's
    report.triangles > 0 and a mapping) and prints the share at exit. */
 #define TT_POLYCUBE_MAX_TRIANGLES 1024
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_polycube"
 #include "fuzz_common.h"

@@ -3,9 +3,10 @@
    edge colours), tt_assign_uvs, tt_measure_seams; and the 8-bit image
    conversions tt_image_from_bytes / tt_image_to_rgba8.
 
-   Build (tests/fuzz/run.sh does this):
+   Build (tests/fuzz/run.sh does this, with the library compiled once from
+   tests/fuzz/fuzz_library.c):
        clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-             -I. tests/fuzz/fuzz_synth.c -o build/fuzz/fuzz_synth -lm
+             -I. tests/fuzz/fuzz_synth.c tests/fuzz/fuzz_library.c -o build/fuzz/fuzz_synth -lm
 
    Input bytes, read front to back (missing bytes read as 0):
        0      flags: bit0 non-finite texels (NaN, +inf, -inf) at byte 21..23,
@@ -68,7 +69,6 @@
        unit vectors (alpha still exact both ways);
      - every failure: fz_check_error and fz_check_null (fuzz_common.h); the
        counting allocator's live count back to zero at the end. */
-#define TILEDTEX_IMPLEMENTATION
 #include "tiledtex.h"
 #define FUZZ_NAME "fuzz_synth"
 #include "fuzz_common.h"

@@ -54,9 +54,11 @@ warn="-Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes"
 stb=$(pkg-config --cflags-only-I stb 2>/dev/null | sed "s/-I/-isystem /g")
 [ -n "$stb" ] || stb="-isystem /usr/include/stb"
 
-# The targets build FUZZ_JOBS (default 2) at a time, each compiling the whole
-# header with the sanitizers (over a minute on one core), into its own log;
-# they are checked in order once every build is done.
+# The library is compiled once with the sanitizers and libFuzzer's coverage
+# (tests/fuzz/fuzz_library.c, over a minute on one core), then each target,
+# only its own file and the tool's files it tests, is linked against it.
+# Builds run FUZZ_JOBS (default 2) at a time, each into its own log, and are
+# checked in order once every build is done.
 build_jobs=${FUZZ_JOBS:-2}
 [ "$build_jobs" -ge 1 ] 2>/dev/null || build_jobs=2
 building=()
@@ -68,31 +70,38 @@ build_start() {
   ( "$@" >"$out/build_$name.log" 2>&1; echo $? >"$out/build_$name.rc" ) &
   building+=("$name")
 }
-build_plain() {   # mesh_build, lapped, synth, hpm: the target alone
-  $cc $flags $warn -I. "tests/fuzz/fuzz_$1.c" -o "$out/fuzz_$1" -lm
+# polycube links a copy of the library built without libFuzzer's comparison
+# tracing: its decisions are on floats, which the tracing does not see, while
+# tracing the integer comparisons of its inner loops (sorts, chart and quad
+# indices) halved its runs a second.
+nocmp="-fno-sanitize-coverage=trace-cmp"
+build_library() {   # the object's name, then its extra flags
+  local name=$1
+  shift
+  # shellcheck disable=SC2086  # flags are lists
+  $cc $flags "$@" $warn -I. -c tests/fuzz/fuzz_library.c -o "$out/$name.o"
 }
-# polycube is built without libFuzzer's comparison tracing: its decisions
-# are on floats, which the tracing does not see, while tracing the integer
-# comparisons of its inner loops (sorts, chart and quad indices) halved its
-# runs a second.
+build_plain() {   # mesh_build, lapped, synth, hpm: the target alone
+  $cc $flags $warn -I. "tests/fuzz/fuzz_$1.c" "$out/fuzz_library.o" -o "$out/fuzz_$1" -lm
+}
 build_polycube() {
-  $cc $flags -fno-sanitize-coverage=trace-cmp $warn -I. tests/fuzz/fuzz_polycube.c -o "$out/fuzz_polycube" -lm
+  $cc $flags $nocmp $warn -I. tests/fuzz/fuzz_polycube.c "$out/fuzz_library_nocmp.o" -o "$out/fuzz_polycube" -lm
 }
 # The tool's OBJ reader (examples/obj.c) with what it uses: tool_io.c (errors,
 # files, buffers), format_number.c (the writer's numbers) and executor.c
 # (the writer formats its lines on the tool's threads). These are compiled
-# as they are; fuzz_obj.c is the one TU that defines TILEDTEX_IMPLEMENTATION.
+# as they are.
 obj_sources="examples/obj.c examples/tool_io.c examples/format_number.c examples/executor.c"
 build_obj() {
   # shellcheck disable=SC2086
-  $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_obj.c $obj_sources -o "$out/fuzz_obj" -lm
+  $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_obj.c $obj_sources "$out/fuzz_library.o" -o "$out/fuzz_obj" -lm
 }
 # The tool's mesh files (examples/mesh_file.c), with the OBJ reader it hands
 # OBJs to and cli.c for its number parsing.
 mesh_file_sources="examples/mesh_file.c $obj_sources examples/cli.c"
 build_mesh_file() {
   # shellcheck disable=SC2086
-  $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_mesh_file.c $mesh_file_sources -o "$out/fuzz_mesh_file" -lm
+  $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_mesh_file.c $mesh_file_sources "$out/fuzz_library.o" -o "$out/fuzz_mesh_file" -lm
 }
 # The tool's image loader (examples/image_io.c: stb_image, the size checks,
 # the conversion in strips) and the library's image operations.
@@ -110,11 +119,24 @@ build_image() {
   # shellcheck disable=SC2086
   $cc $flags -fno-sanitize=shift,signed-integer-overflow $warn -I. -Iexamples $stb -c examples/image_io.c \
     -o "$out/image_io.o" &&
-    $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources "$out/image_io.o" \
+    $cc $flags $warn -I. -Iexamples $stb tests/fuzz/fuzz_image.c $image_sources "$out/image_io.o" "$out/fuzz_library.o" \
       -o "$out/fuzz_image" -lm -pthread
 }
 
+# A build that failed: its log and exit 3.
+build_failed() {
+  cat "$out/build_$1.log" >&2
+  echo "fuzz: fuzz_$1 does not build" >&2
+  exit 3
+}
 echo "fuzz: building into $out/" >&2
+build_start library build_library fuzz_library
+build_start library_nocmp build_library fuzz_library_nocmp "$nocmp"
+wait
+for t in library library_nocmp; do
+  [ "$(cat "$out/build_$t.rc" 2>/dev/null)" = 0 ] || build_failed "$t"
+done
+building=()
 for t in mesh_build lapped synth hpm; do build_start "$t" build_plain "$t"; done
 build_start polycube build_polycube
 if [ -f examples/obj.c ] && [ -f examples/tool_io.c ] && [ -f examples/format_number.c ] && [ -f examples/tool.h ]; then
@@ -127,12 +149,11 @@ build_start image build_image
 wait
 targets=()
 for t in "${building[@]}"; do
-  cat "$out/build_$t.log" >&2
   if [ "$(cat "$out/build_$t.rc" 2>/dev/null)" = 0 ]; then
+    cat "$out/build_$t.log" >&2
     targets+=("$t")
   else
-    echo "fuzz: fuzz_$t does not build" >&2
-    exit 3
+    build_failed "$t"
   fi
 done
 # FUZZ_BUILD_ONLY=1: build, list the targets on stdout, run nothing (the
