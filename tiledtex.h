@@ -669,6 +669,14 @@ TTDEF void tt_rgba_over(float dst[4], const float src_premultiplied[4]);
    A normal map's averaged vectors are renormalised. */
 TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *allocator, tt_image **out_image,
                                      tt_error *error);
+/* *dst = src resampled to width x height, each axis on its own: a tent
+   filter as wide as one texel of the larger grid (linear interpolation when
+   enlarging, an average over the footprint when shrinking), in linear light,
+   clamped at the borders. A normal map's vectors are renormalised. Errors:
+   as tt_image_downsample2, and sizes below 1 (TT_ERROR_INVALID_ARGUMENT) or
+   above TT_MAX_IMAGE_SIZE (TT_ERROR_TOO_LARGE). */
+TTDEF tt_result tt_image_resize(const tt_image *src, int width, int height, const tt_allocator *allocator,
+                                tt_image **out_image, tt_error *error);
 
 /* Minimum-error cut (as in image quilting): in a width x height cost map, find
    the path path[x] (one row per column) with path[x] in [lo[x], hi[x]] and
@@ -1361,6 +1369,37 @@ typedef struct tt_rect {
    texel of the tile is renormalised; the atlas and its mips are normal maps.
    tt_synthesize_tiles is plan_create + apply + plan_free in one call. */
 
+/* The courses of a structured photo: bricks, blocks, planks or tiles laid
+   in rows, whose horizontal joints repeat down the image. */
+typedef struct tt_courses {
+    float period;       /* texels from one course to the next; 0: none found (or none wanted) */
+    float phase;        /* in [0, period): a height (texel y covers [y, y + 1)) about which the rows
+                           mirror, such as a joint's middle; so does every phase + k * period */
+    float strength;     /* how alike the courses are: the row profile's correlation with itself
+                           one period down, 0..1 */
+    float coherence;    /* how far the joints run across the width: the correlation of the row
+                           profiles of neighbouring quarters of the photo, -1..1 */
+} tt_courses;
+
+/* Find the courses of `image` from its row profile (the mean luminance of
+   each row): the period is the first strong peak of the profile's
+   correlation with itself, refined over as many periods as the image holds;
+   the phase is where the profile, folded over one period, is most mirror-
+   symmetric. A photo without rows (gravel, rust, a forest floor), or with
+   fewer than three courses in its height or courses under 4 texels tall,
+   gives period 0, and so does one
+   whose strength is below TT_COURSES_MIN_STRENGTH, or whose rows repeat
+   without joints across the width (stones of about one size, whose row
+   profile alone can look periodic over a few courses): coherence below
+   TT_COURSES_MIN_COHERENCE, or a photo under 16 texels wide. Errors: a NULL or
+   empty image, a kind that is not a tt_image_kind, a NULL out, a bad
+   allocator (TT_ERROR_INVALID_ARGUMENT); a texel that is not finite
+   (TT_ERROR_NON_FINITE); TT_ERROR_OUT_OF_MEMORY. */
+#define TT_COURSES_MIN_STRENGTH 0.4f
+#define TT_COURSES_MIN_COHERENCE 0.4f
+TTDEF tt_result tt_find_courses(const tt_image *image, const tt_allocator *allocator, tt_courses *out,
+                                tt_error *error);
+
 #define TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES 8
 #define TT_SYNTH_MAX_BACKGROUND_CANDIDATES 64
 
@@ -1372,6 +1411,16 @@ typedef struct tt_synth_options {
        2k, the lower one (turned 180 degrees) edges of type 2k+1. NULL: chosen
        from the seed. Otherwise `colors` rects; only x and y are read. */
     const tt_rect *edge_windows;
+    /* Courses to keep whole (tt_find_courses; all zero: none). Every window
+       the plan chooses (not edge_windows given above) then starts at a row
+       round(phase + k * period), so each band and background of an upright
+       tile shows the joints at the same heights, mirrored or not, and the
+       courses run level through the tile; with S a multiple of the period
+       (resample the image by S / (m * period) first, m = the nearest whole
+       number of courses: tt_image_resize) they run on into the tiles above
+       and below. A period must be finite and at least 2, or 0; the phase
+       finite. */
+    tt_courses courses;
     /* Nonzero: upright tiles. Plain tiles turn each edge's band to its side,
        so on the left and right sides an anisotropic texture (bricks, planks,
        grain) runs a quarter turn off: walls come out a maze. Upright tiles
@@ -6387,6 +6436,67 @@ TTDEF tt_result tt_image_downsample2(const tt_image *src, const tt_allocator *al
     return TT_OK;
 }
 
+/* One axis of tt_image_resize: n_out samples of a line of n_in, each read
+   `step` floats apart (4 for a row, 4 * width for a column), written
+   `out_step` apart. Output texel i's centre lands at c = (i + 0.5) n_in /
+   n_out - 0.5 in input texels; the tent has radius max(1, n_in / n_out). */
+static void tt__resample_line(const float *in, int n_in, size_t step, float *out, int n_out, size_t out_step)
+{
+    const double ratio = (double)n_in / n_out, radius = ratio > 1.0 ? ratio : 1.0;
+    int i, j, k;
+    for (i = 0; i < n_out; i++) {
+        const double c = (i + 0.5) * ratio - 0.5;
+        double sum[4] = {0.0, 0.0, 0.0, 0.0}, total = 0.0;
+        const int first = (int)ceil(c - radius), last = (int)floor(c + radius);
+        for (j = first; j <= last; j++) {
+            const double w = 1.0 - fabs(j - c) / radius;
+            const float *p = in + (size_t)tt__clamp_i(j, 0, n_in - 1) * step;
+            if (w <= 0.0) continue;
+            for (k = 0; k < 4; k++) sum[k] += w * p[k];
+            total += w;
+        }
+        for (k = 0; k < 4; k++) out[(size_t)i * out_step + k] = (float)(sum[k] / total);
+    }
+}
+
+TTDEF tt_result tt_image_resize(const tt_image *src, int width, int height, const tt_allocator *allocator,
+                                tt_image **out_image, tt_error *error)
+{
+    tt_image *across = NULL, *dst;
+    tt_result result;
+    int x, y;
+    size_t i, n;
+    tt__ok(error);
+    if (!out_image) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_image is NULL");
+    *out_image = NULL;
+    if (!src || !src->pixels || src->width < 1 || src->height < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the source image is NULL or empty");
+    if ((result = tt__check_image_kind(src, "the source image", error)) != TT_OK ||
+        (result = tt__check_image_size(src->width, src->height, error)) != TT_OK)
+        return result;
+    /* Rows first, into an image as wide as the result and as tall as the
+       source; then its columns. */
+    if ((result = tt_image_create(width, src->height, allocator, &across, error)) != TT_OK) return result;
+    if ((result = tt_image_create(width, height, allocator, &dst, error)) != TT_OK) {
+        tt_image_free(across);
+        return result;
+    }
+    for (y = 0; y < src->height; y++)
+        tt__resample_line(src->pixels + (size_t)y * src->width * 4, src->width, 4,
+                          across->pixels + (size_t)y * width * 4, width, 4);
+    for (x = 0; x < width; x++)
+        tt__resample_line(across->pixels + (size_t)x * 4, src->height, (size_t)width * 4, dst->pixels + (size_t)x * 4,
+                          height, (size_t)width * 4);
+    tt_image_free(across);
+    dst->kind = src->kind;
+    if (dst->kind == TT_IMAGE_NORMAL) {
+        n = (size_t)width * height;
+        for (i = 0; i < n; i++) tt__normalize_vector_texel(dst->pixels + 4 * i);
+    }
+    *out_image = dst;
+    return TT_OK;
+}
+
 TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const int *lo, const int *hi,
                                  const tt_allocator *allocator, int *path, tt_error *error)
 {
@@ -8971,7 +9081,9 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
               plan (tt_synth_plan_create), from a guide image:
                 1. edge windows: one S x 2S window per condition, chosen
                    from the seed as the least conspicuous of 128 candidates
-                   (or given)                             -> tt__choose_edge_windows
+                   (or given); beyond the paper, with a photo's courses
+                   (tt_find_courses) every window starts on them, so upright
+                   tiles show them whole                   -> tt__choose_edge_windows
                 2. per tile, its S x S background window XXXX: of
                    options.background_candidates drawn from the seed, the one
                    whose mean tone is nearest the region's (beyond the
@@ -10043,11 +10155,265 @@ static double tt__edge_window_score(const tt_image *source, int x, int y, int si
     }
 }
 
+/* The correlation of a zero-mean profile with itself `lag` rows down, over
+   the rows both ends cover. */
+static double tt__profile_correlation(const double *a, int n, int lag)
+{
+    double ab = 0.0, aa = 0.0, bb = 0.0;
+    int y;
+    for (y = 0; y + lag < n; y++) {
+        ab += a[y] * a[y + lag];
+        aa += a[y] * a[y];
+        bb += a[y + lag] * a[y + lag];
+    }
+    return aa > 0.0 && bb > 0.0 ? ab / sqrt(aa * bb) : 0.0;
+}
+
+/* Where the parabola through (-1, left), (0, middle), (1, right) peaks, in
+   [-0.5, 0.5]; 0 when it does not bend down. */
+static double tt__parabola_peak(double left, double middle, double right)
+{
+    const double bend = left - 2.0 * middle + right;
+    double offset;
+    if (!(bend < 0.0)) return 0.0;
+    offset = 0.5 * (left - right) / bend;
+    return offset < -0.5 ? -0.5 : (offset > 0.5 ? 0.5 : offset);
+}
+
+/* A periodic profile folded into `bins` bins (bin b centred at (b + 0.5)
+   period / bins), read at height u by linear interpolation. */
+static double tt__fold_at(const double *fold, int bins, double period, double u)
+{
+    double v = u / period * bins - 0.5, t;
+    int b;
+    v -= floor(v / bins) * bins;
+    b = (int)floor(v);
+    t = v - b;
+    return (1.0 - t) * fold[b % bins] + t * fold[(b + 1) % bins];
+}
+
+/* The shortest courses tt_find_courses looks for, in texels: rows that
+   repeat more often are grain, not courses. */
+#define TT__COURSES_MIN_PERIOD 4
+
+/* tt_find_courses's coherence: the photo cut into four vertical strips,
+   each strip's row profile with what changes over more than 8 rows taken
+   off (the joints are sharp, the light is not), and each strip against the
+   next, allowed to slide 3 rows either way (a photo a little askew); the
+   mean of the three best correlations. `strips` holds 5 * H doubles. */
+static double tt__courses_coherence(const tt_image *image, double *strips)
+{
+    const int W = image->width, H = image->height, radius = 8, slide = 3;
+    double *box = strips + 4 * (size_t)H, total = 0.0;
+    int k, x, y, s;
+    if (W < 16 || H <= 2 * slide + 2) return 0.0;
+    for (k = 0; k < 4; k++) {
+        double *a = strips + (size_t)k * H;
+        const int x0 = k * W / 4, x1 = (k + 1) * W / 4;
+        for (y = 0; y < H; y++) {
+            const float *p = image->pixels + ((size_t)y * W + x0) * 4;
+            double sum = 0.0;
+            for (x = x0; x < x1; x++, p += 4) sum += ((double)p[0] + p[1] + p[2]) / 3.0;
+            a[y] = sum / (x1 - x0);
+        }
+        for (y = 0; y < H; y++) {
+            const int lo = tt__max_i(0, y - radius), hi = tt__min_i(H - 1, y + radius);
+            double sum = 0.0;
+            int z;
+            for (z = lo; z <= hi; z++) sum += a[z];
+            box[y] = sum / (hi - lo + 1);
+        }
+        for (y = 0; y < H; y++) a[y] -= box[y];
+    }
+    for (k = 0; k < 3; k++) {
+        const double *a = strips + (size_t)k * H, *b = a + H;
+        double best = -1.0;
+        for (s = -slide; s <= slide; s++) {
+            double ma = 0.0, mb = 0.0, ab = 0.0, aa = 0.0, bb = 0.0;
+            const int n = H - 2 * slide;
+            for (y = slide; y < H - slide; y++) {
+                ma += a[y];
+                mb += b[y + s];
+            }
+            ma /= n;
+            mb /= n;
+            for (y = slide; y < H - slide; y++) {
+                ab += (a[y] - ma) * (b[y + s] - mb);
+                aa += (a[y] - ma) * (a[y] - ma);
+                bb += (b[y + s] - mb) * (b[y + s] - mb);
+            }
+            if (aa > 0.0 && bb > 0.0 && ab / sqrt(aa * bb) > best) best = ab / sqrt(aa * bb);
+        }
+        total += best;
+    }
+    return total / 3.0;
+}
+
+/* Bins of tt_find_courses's fold, one per texel of the period: the longest
+   period it looks for is two less. */
+#define TT__COURSES_MAX_BINS 1024
+
+/* tt_find_courses's phase: the height in [0, period) about which the folded
+   profile is most mirror-symmetric, tried every half bin. */
+static double tt__courses_phase(const double *profile, int n, double period, double *fold)
+{
+    const int bins = tt__max_i(8, (int)ceil(period));
+    int count[TT__COURSES_MAX_BINS], b, k, y;
+    double best = -HUGE_VAL, phase = 0.0;
+    for (b = 0; b < bins; b++) {
+        fold[b] = 0.0;
+        count[b] = 0;
+    }
+    for (y = 0; y < n; y++) {
+        double u = (y + 0.5) / period;
+        b = tt__clamp_i((int)((u - floor(u)) * bins), 0, bins - 1);
+        fold[b] += profile[y];
+        count[b]++;
+    }
+    for (b = 0; b < bins; b++) fold[b] = count[b] ? fold[b] / count[b] : 0.0;
+    for (k = 0; k < 2 * bins; k++) {
+        const double c = k * period / (2.0 * bins);
+        double cross = 0.0, up = 0.0, down = 0.0, score;
+        for (b = 0; b < bins; b++) {
+            const double t = (b + 0.5) * period / (2.0 * bins);
+            const double above = tt__fold_at(fold, bins, period, c - t), below = tt__fold_at(fold, bins, period, c + t);
+            cross += above * below;
+            up += above * above;
+            down += below * below;
+        }
+        score = up > 0.0 && down > 0.0 ? cross / sqrt(up * down) : 0.0;
+        if (score > best) {
+            best = score;
+            phase = c;
+        }
+    }
+    return phase;
+}
+
+TTDEF tt_result tt_find_courses(const tt_image *image, const tt_allocator *allocator, tt_courses *out,
+                                tt_error *error)
+{
+    double *profile, *corr, period, best = 0.0, tilt = 0.0, spread = 0.0, mean = 0.0;
+    tt_result result;
+    int W, H, x, y, lag, first, max_lag, periods;
+    tt__ok(error);
+    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
+    memset(out, 0, sizeof *out);
+    if (!image || !image->pixels || image->width < 1 || image->height < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the image is NULL or empty");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__check_image_kind(image, "the image", error)) != TT_OK ||
+        (result = tt__check_image_size(image->width, image->height, error)) != TT_OK ||
+        (result = tt__check_finite_texels(image, "the image", error)) != TT_OK)
+        return result;
+    W = image->width;
+    H = image->height;
+    /* Three courses at least, and no more bins to a period than fit the fold. */
+    max_lag = tt__min_i(H / 3, TT__COURSES_MAX_BINS - 2);
+    if (max_lag < 4) return TT_OK;
+    /* The profile, then the correlations by lag, which the fold (at most
+       one bin per texel of the period, at least 8) and the coherence's
+       strips later reuse. */
+    profile = TT__ALLOC(allocator, double, (size_t)H + (size_t)tt__max_i(tt__max_i(max_lag + 2, 9), 5 * H));
+    if (!profile) return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+    corr = profile + H;
+    for (y = 0; y < H; y++) {
+        const float *p = image->pixels + (size_t)y * W * 4;
+        double sum = 0.0;
+        for (x = 0; x < W; x++) sum += ((double)p[4 * x] + p[4 * x + 1] + p[4 * x + 2]) / 3.0;
+        profile[y] = sum / W;
+        mean += profile[y] / H;
+    }
+    /* A straight line taken off: a photo lit from above, darker at the
+       bottom, must not read as one long course. */
+    for (y = 0; y < H; y++) {
+        const double t = y - 0.5 * (H - 1);
+        tilt += t * (profile[y] - mean);
+        spread += t * t;
+    }
+    tilt = spread > 0.0 ? tilt / spread : 0.0;
+    for (y = 0; y < H; y++) profile[y] -= mean + tilt * (y - 0.5 * (H - 1));
+    /* Past the central peak (where the correlation first drops below zero),
+       the strongest correlation, then the first peak within 0.8 of it: the
+       period itself rather than a multiple of it. */
+    for (first = 1; first <= max_lag; first++)
+        if ((corr[first] = tt__profile_correlation(profile, H, first)) < 0.0) break;
+    if (first > max_lag) goto done;
+    for (lag = first + 1; lag <= max_lag + 1; lag++) {
+        corr[lag] = tt__profile_correlation(profile, H, lag);
+        if (lag >= TT__COURSES_MIN_PERIOD && lag <= max_lag && corr[lag] > best) best = corr[lag];
+    }
+    if (best < TT_COURSES_MIN_STRENGTH) goto done;
+    for (lag = tt__max_i(first + 1, TT__COURSES_MIN_PERIOD); lag <= max_lag; lag++)
+        if (corr[lag] >= 0.8 * best && corr[lag] >= corr[lag - 1] && corr[lag] >= corr[lag + 1]) break;
+    /* Still rising at the last lag (no period inside the range), or a
+       period weaker than the threshold however strong its multiples. */
+    if (lag > max_lag || corr[lag] < TT_COURSES_MIN_STRENGTH) goto done;
+    period = lag + tt__parabola_peak(corr[lag - 1], corr[lag], corr[lag + 1]);
+    out->strength = (float)corr[lag];
+    /* Refined at the peak near as many periods as fit half the image: its
+       place, divided by that many, is as many times as exact. */
+    periods = (int)(0.5 * H / period);
+    if (periods >= 2) {
+        const int centre = (int)floor(periods * period + 0.5);
+        int at = centre, k;
+        double peak = -HUGE_VAL;
+        for (k = centre - periods; k <= centre + periods; k++)
+            if (k >= 2 && k < H - 2) {
+                const double c = tt__profile_correlation(profile, H, k);
+                if (c > peak) {
+                    peak = c;
+                    at = k;
+                }
+            }
+        /* Kept only near the first estimate (within a texel or 5 %, inside
+           the lags searched): a stray peak of a short profile is not a
+           period. */
+        if (peak > -HUGE_VAL) {
+            const double refined = (at + tt__parabola_peak(tt__profile_correlation(profile, H, at - 1), peak,
+                                                           tt__profile_correlation(profile, H, at + 1))) /
+                                   periods;
+            if (fabs(refined - period) < (period > 20.0 ? 0.05 * period : 1.0) && refined <= max_lag + 0.5)
+                period = refined;
+        }
+    }
+    out->coherence = (float)tt__courses_coherence(image, corr);
+    if (out->coherence < TT_COURSES_MIN_COHERENCE) goto done;
+    out->period = (float)period;
+    out->phase = (float)tt__courses_phase(profile, H, period, corr);
+    if (!(out->phase < out->period)) out->phase = 0.0f;
+done:
+    if (out->period == 0.0f) out->strength = out->coherence = 0.0f;
+    tt__free(allocator, profile);
+    return TT_OK;
+}
+
+/* The start nearest v in [lo, hi] that lies on the courses, round(phase +
+   k * period); v itself without courses or when none fits. */
+static int tt__snap_to_courses(int v, int lo, int hi, const tt_courses *courses)
+{
+    const double period = courses ? courses->period : 0.0;
+    int best = v, found = 0, k, k0;
+    if (!(period > 0.0)) return v;
+    k0 = (int)floor((v - courses->phase) / period);
+    for (k = k0 - 1; k <= k0 + 2; k++) {
+        const int start = (int)floor(courses->phase + k * period + 0.5);
+        if (start >= lo && start <= hi && (!found || tt__abs_i(start - v) < tt__abs_i(best - v))) {
+            best = start;
+            found = 1;
+        }
+    }
+    return best;
+}
+
 /* Condition windows from the seed: the least conspicuous of 128 random
    candidates, among those at least S away from the windows already chosen
    (so several conditions use different parts of the image) when there are
-   any. */
-static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int size, int n, tt_rect *windows)
+   any. With courses, each candidate's top (its left, `courses_across`: the
+   image is the guide turned a quarter) moves onto the nearest course start
+   first. */
+static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int size, int n, const tt_courses *courses,
+                                    int courses_across, tt_rect *windows)
 {
     const int candidates = 128;
     tt__image_statistics st = tt__measure_image(source);
@@ -10061,6 +10427,8 @@ static void tt__choose_edge_windows(tt_rng *rng, const tt_image *source, int siz
             int j, far = 1;
             r.x = (int)tt_rng_below(rng, (uint32_t)(source->width - size + 1));
             r.y = (int)tt_rng_below(rng, (uint32_t)(source->height - 2 * size + 1));
+            if (courses_across) r.x = tt__snap_to_courses(r.x, 0, source->width - size, courses);
+            else r.y = tt__snap_to_courses(r.y, 0, source->height - 2 * size, courses);
             r.w = size;
             r.h = 2 * size;
             for (j = 0; j < k; j++)
@@ -10093,9 +10461,10 @@ static double tt__window_tone(const tt_image *source, int x, int y, int w, int h
 /* A tile's background window in `region`: of `candidates` random ones, the
    one whose tone is nearest `tone` (the region's). Each tile draws the same
    number of times, so every tile's candidates depend on the seed and its
-   index alone; one candidate is the paper's random window. */
+   index alone; one candidate is the paper's random window. With courses,
+   each candidate's top moves onto the nearest course start. */
 static tt_rect tt__choose_background(tt_rng *rng, const tt_image *source, const tt_rect *region, int size,
-                                     int candidates, double tone)
+                                     int candidates, double tone, const tt_courses *courses)
 {
     tt_rect best;
     double nearest = HUGE_VAL;
@@ -10105,7 +10474,8 @@ static tt_rect tt__choose_background(tt_rng *rng, const tt_image *source, const 
     best.w = best.h = size;
     for (k = 0; k < candidates; k++) {
         const int x = region->x + (int)tt_rng_below(rng, (uint32_t)(region->w - size + 1));
-        const int y = region->y + (int)tt_rng_below(rng, (uint32_t)(region->h - size + 1));
+        const int y = tt__snap_to_courses(region->y + (int)tt_rng_below(rng, (uint32_t)(region->h - size + 1)),
+                                          region->y, region->y + region->h - size, courses);
         const double off = candidates > 1 ? fabs(tt__window_tone(source, x, y, size, size) - tone) : 0.0;
         if (off < nearest) {
             nearest = off;
@@ -10270,6 +10640,12 @@ static tt_result tt__synth_check_windows(const tt_image *guide, const tt_synth_o
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "background_candidates %d: give 1 to %d (0 for the default, %d)", opt->background_candidates,
                         TT_SYNTH_MAX_BACKGROUND_CANDIDATES, TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES);
+    if (!tt__is_finite(opt->courses.period) || !tt__is_finite(opt->courses.phase) ||
+        (opt->courses.period != 0.0f && !(opt->courses.period >= 2.0f)))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "courses of period %g and phase %g: the period must be 0 (none) or at least 2 texels, "
+                        "and both finite",
+                        (double)opt->courses.period, (double)opt->courses.phase);
     region = opt->background;
     if (region.x == 0 && region.y == 0 && region.w == 0 && region.h == 0) {
         region.w = guide->width;
@@ -10311,7 +10687,7 @@ static tt_result tt__synth_choose_windows(tt_synth_plan *plan, const tt_image *g
             plan->edge_windows[k].h = 2 * S;
         }
     } else {
-        tt__choose_edge_windows(&rng, guide, S, n, plan->edge_windows);
+        tt__choose_edge_windows(&rng, guide, S, n, &opt->courses, 0, plan->edge_windows);
     }
     if (opt->upright) {
         /* The vertical windows: edge windows chosen on the guide turned a
@@ -10320,7 +10696,7 @@ static tt_result tt__synth_choose_windows(tt_synth_plan *plan, const tt_image *g
            (x, y) covers guide columns W-y-2S .. W-y-1 and rows x .. x+S-1. */
         tt_image *turned = NULL;
         if ((result = tt_image_rotate90(guide, 1, allocator, &turned, error)) != TT_OK) return result;
-        tt__choose_edge_windows(&rng, turned, S, n, plan->vertical_windows);
+        tt__choose_edge_windows(&rng, turned, S, n, &opt->courses, 1, plan->vertical_windows);
         tt_image_free(turned);
         for (k = 0; k < n; k++) {
             tt_rect r = plan->vertical_windows[k];
@@ -10339,7 +10715,8 @@ static tt_result tt__synth_choose_windows(tt_synth_plan *plan, const tt_image *g
             opt->background_candidates > 0 ? opt->background_candidates : TT_SYNTH_DEFAULT_BACKGROUND_CANDIDATES;
         const double tone = candidates > 1 ? tt__window_tone(guide, region->x, region->y, region->w, region->h) : 0.0;
         for (t = 0; t < ntiles; t++)
-            plan->background_windows[t] = tt__choose_background(&rng, guide, region, S, candidates, tone);
+            plan->background_windows[t] =
+                tt__choose_background(&rng, guide, region, S, candidates, tone, &opt->courses);
     }
     return TT_OK;
 }

@@ -83,6 +83,26 @@ int image_crop(const tt_image *image, int x, int y, int width, int height, tt_im
     return 0;
 }
 
+int image_resize(const tt_image *image, int width, int height, tt_image **out)
+{
+    tt_image *resized = NULL, *copy = (tt_image *)calloc(1, sizeof *copy);
+    *out = NULL;
+    if (copy && tt_image_resize(image, width, height, NULL, &resized, NULL) == TT_OK)
+        copy->pixels = (float *)malloc((size_t)width * (size_t)height * 4 * sizeof(float));
+    if (!copy || !copy->pixels) {
+        tt_image_free(resized);
+        free(copy);
+        return -1;
+    }
+    copy->width = width;
+    copy->height = height;
+    copy->kind = resized->kind;
+    memcpy(copy->pixels, resized->pixels, (size_t)width * (size_t)height * 4 * sizeof(float));
+    tt_image_free(resized);
+    *out = copy;
+    return 0;
+}
+
 /* Rows converted at a time: the 8-bit decode shrinks by this much per step. */
 #define LOAD_STRIP_BYTES (1u << 20)
 

@@ -87,6 +87,9 @@ static void print_help(void)
            "                   right quarter of each tile turns a quarter (bricks, planks and grain\n"
            "                   run crosswise there); by default the walls' tiles keep IMAGE's up\n"
            "                   throughout, from a second set of tiles beside the first\n"
+           "  --no-courses     take IMAGE as it is: by default a photo laid in courses (bricks,\n"
+           "                   blocks) is resampled so that a tile holds a whole number of them,\n"
+           "                   and every tile is cut on them, so they run level through the walls\n"
            "  --format F       obj (default): the files above; glb: one binary glTF file,\n"
            "                   OUT_PREFIX.glb: the textured mesh with the atlas in it; gltf: the\n"
            "                   same as glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and\n"
@@ -167,6 +170,8 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
         } else if (tool_option(argc, argv, &i, "--max-atlas", &value)) {
             if (parse_int("--max-atlas", value, 1, TT_MAX_IMAGE_SIZE, &options->max_atlas) != 0)
                 return TOOL_EXIT_USAGE;
+        } else if (tool_flag(argv[i], "--no-courses")) {
+            options->tiles.no_courses = 1;
         } else if (tool_flag(argv[i], "--no-upright")) {
             options->plain = 1;
         } else if (tool_flag(argv[i], "--no-correct")) {
@@ -827,6 +832,7 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
         status = tool_fail("%s", error.message);
     if (status == 0) status = tile_polycube(&options, &job);
+    if (status == 0 && !options.plain) status = tiled_fit_courses(&image, options.image_path, &options.tiles);
     if (status == 0) {
         start = tool_seconds_now();
         status = tiled_synthesize(image, options.image_path, &options.tiles, &options.tiles.maps, &job.tiles,

@@ -47,6 +47,9 @@ static void print_help(void)
            "                         diagonal, upright ones on the right\n"
            "  --constraints FILE     the same, up given by lines FACE X Y Z [SIGMA [WEIGHT]] (FACE\n"
            "                         counts the OBJ's faces from 1), as 'tiledtex lapped' takes them\n"
+           "  --no-courses           with --up, take IMAGE as it is: by default a photo laid in\n"
+           "                         courses (bricks, blocks) is resampled so that a tile holds a\n"
+           "                         whole number of them, and every tile is cut on them\n"
            "  --report               also print tile usage and face stretch, and measure the\n"
            "                         seams on every edge (default: a sample of %d edges)\n"
            MATERIAL_OPTIONS_HELP("                         ")
@@ -180,6 +183,9 @@ int cmd_tile(int argc, char **argv)
             status = tool_fail("--up makes a %dx%d atlas of plain and upright tiles; the tool writes at most %d "
                                "texels a side (use fewer --colors or a smaller --tile)", 2 * side, side,
                                TOOL_MAX_ATLAS);
+    }
+    if (status == 0 && options.upright) {
+        status = tiled_fit_courses(&image, positional[1], &options);
     }
     if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
     /* Before the synthesis: no output may replace an input (checked again at the commit). */

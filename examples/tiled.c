@@ -18,6 +18,7 @@
      tt_assign_uvs_oriented the UVs of the turned tiles, upright ones in the
                             right half of a plain | upright atlas
 */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -73,6 +74,8 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         if (taken < 0) return -1;
     } else if ((accept & TILED_FIELD_OPTIONS) && (taken = parse_field_option(argc, argv, index, &options->field))) {
         if (taken < 0) return -1;
+    } else if ((accept & TILED_FIELD_OPTIONS) && tool_flag(argv[*index], "--no-courses")) {
+        options->no_courses = 1;
     } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
         if (!value) { tool_usage("--atlas needs a value"); return -1; }
         options->atlas_path = value;
@@ -491,6 +494,63 @@ int tiled_pick_tile_size(const char *image_path, int width, int height, tiled_op
     return 0;
 }
 
+int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *options)
+{
+    const int S = options->layout.tile_size ? options->layout.tile_size : TT_DEFAULT_TILE_SIZE;
+    tt_image *resized[1 + MATERIAL_MAPS] = {NULL};
+    tt_courses courses;
+    tt_error error;
+    double scale, row_scale = 1.0;
+    int courses_per_tile, width, height, map;
+    memset(&options->courses, 0, sizeof options->courses);
+    if (options->no_courses) return 0;
+    if (tt_find_courses(*image, NULL, &courses, &error) != TT_OK) return tool_fail("%s: %s", image_path, error.message);
+    if (courses.period == 0.0f) return 0;
+    /* The nearest whole number of courses to a tile: every band of an
+       upright tile then starts where the tile above or below ends. */
+    courses_per_tile = (int)floor(S / courses.period + 0.5);
+    if (courses_per_tile < 1) courses_per_tile = 1;
+    scale = S / (courses_per_tile * (double)courses.period);
+    width = (int)floor((*image)->width * scale + 0.5);
+    height = (int)floor((*image)->height * scale + 0.5);
+    if (width < 2 * S || height < 2 * S) {
+        tool_note("%s: courses every %.1f texels, but resampled to hold %d in a %d-texel tile it would be too small "
+                  "for the tiles; its courses are not kept level (use a smaller --tile)",
+                  image_path, (double)courses.period, courses_per_tile, S);
+        return 0;
+    }
+    if (fabs(scale - 1.0) > 1e-3) {
+        row_scale = (double)height / (*image)->height;
+        if (image_resize(*image, width, height, &resized[0]) != 0) return tool_fail("out of memory");
+        for (map = 0; map < MATERIAL_MAPS; map++)
+            if (options->maps.images[map] && image_resize(options->maps.images[map], width, height,
+                                                          &resized[1 + map]) != 0) {
+                for (map = 0; map <= MATERIAL_MAPS; map++) image_free(resized[map]);
+                return tool_fail("out of memory");
+            }
+        image_free(*image);
+        *image = resized[0];
+        for (map = 0; map < MATERIAL_MAPS; map++)
+            if (resized[1 + map]) {
+                image_free(options->maps.images[map]);
+                options->maps.images[map] = resized[1 + map];
+            }
+    }
+    /* Where the courses now lie: scaled with the rows. */
+    options->courses = courses;
+    options->courses.period = (float)(courses.period * row_scale);
+    options->courses.phase = (float)(courses.phase * row_scale);
+    if (row_scale != 1.0)
+        tool_note("%s has courses every %.1f texels: resampled by %.3g so that a %d-texel tile holds %d, and every "
+                  "tile cut on them, so they run level from tile to tile (--no-courses: as it is)",
+                  image_path, (double)courses.period, scale, S, courses_per_tile);
+    else
+        tool_note("%s has courses every %.1f texels, %d to a %d-texel tile: every tile cut on them, so they run "
+                  "level from tile to tile (--no-courses: anywhere)",
+                  image_path, (double)courses.period, courses_per_tile, S);
+    return 0;
+}
+
 int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_options *options,
                      const material_maps *maps, tt_tileset **out, tt_tileset **map_tiles)
 {
@@ -506,6 +566,7 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     synth.layout = options->layout;
     synth.seed = options->seed;
     synth.background = options->background;
+    synth.courses = options->courses;
     synth.executor = tool_executor();
     if (options->nedges > 0) {
         int colors = options->layout.colors ? options->layout.colors : 1;

@@ -44,6 +44,8 @@ typedef struct tiled_options {
     tool_field field;            /* --up, --constraints: each quad's tile turned along the field */
     int upright;                 /* with the field: faces may take upright tiles (the image feeds them) */
     material_maps maps;          /* the material's other maps (their paths; material_load loads them) */
+    int no_courses;              /* --no-courses: upright tiles ignore the photo's courses */
+    tt_courses courses;          /* tiled_fit_courses's: the windows stay on them (period 0: none) */
 } tiled_options;
 
 /* The tool's defaults: the library's, with a gutter of TT_RECOMMENDED_GUTTER
@@ -61,6 +63,15 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
    OUT.obj"). Returns -1 to go on, or the exit status to return now. */
 int tiled_parse_command_line(int argc, char **argv, unsigned accept, tiled_options *options,
                              const char **positional, int count, const char *names, void (*help)(void));
+
+/* Before upright tiles are synthesised from *image (tile size chosen): a
+   photo with courses (tt_find_courses: bricks, blocks laid in rows) is
+   resampled, with its maps, so that a tile holds a whole number of them,
+   and options->courses keeps every window on them; a note says so. Nothing
+   changes for a photo without courses, with --no-courses, or when the
+   resampled photo would be too small for the tiles. *image is replaced
+   (the old one freed) when resampled. Returns 0 or the exit status. */
+int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *options);
 
 /* A quad mesh with its tiled-texture UVs, ready to write. */
 typedef struct tiled_mesh {

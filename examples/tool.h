@@ -417,6 +417,9 @@ void image_free(tt_image *image);
    (x, y), which must lie inside it; the tool's own memory, like image_load's
    (free it with image_free). Returns 0, or -1 when out of memory. */
 int image_crop(const tt_image *image, int x, int y, int width, int height, tt_image **out);
+/* `image` resampled to width x height (tt_image_resize), in the tool's own
+   memory like image_load's. Returns 0, or -1 when out of memory. */
+int image_resize(const tt_image *image, int width, int height, tt_image **out);
 
 /* tt_image_to_rgba8 on the tool's threads (-j), in bands of rows: the same
    bytes. `out` must not be the image's own pixels (bands would write over

@@ -111,6 +111,13 @@ int main(void)
     EXPECT(rx == 0 && ry == 15);
     EXPECT(tt_image_rotate90(image, 1, NULL, &rotated, &err) == TT_OK && rotated->width == 32);
     EXPECT(tt_image_downsample2(image, NULL, &half, &err) == TT_OK && half->width == 8);
+    {
+        tt_image *resized = NULL;
+        tt_courses courses;
+        EXPECT(tt_image_resize(image, 5, 7, NULL, &resized, &err) == TT_OK && resized->height == 7);
+        EXPECT(tt_find_courses(image, NULL, &courses, &err) == TT_OK && courses.period >= 0.0f);
+        tt_image_free(resized);
+    }
     EXPECT(tt_image_create(8, 16, NULL, &atlas_copy, &err) == TT_OK);
     if (!rotated || !half || !atlas_copy) return 1;
     EXPECT(tt_image_over(atlas_copy, half, &err) == TT_OK);

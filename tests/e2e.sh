@@ -1326,6 +1326,41 @@ check "tile --constraints on triangles: 3840 quads turned" "'up: 3840 quads' ...
 expect_error "tile --constraints face out of range" tile ../in/torus.obj ../in/lap256.png out --tile 32 \
     --constraints ../in/constraints_range.txt
 err_mentions "tile constraint out of range: FILE:LINE" 'constraints_range\.txt:2:'
+# A photo laid in courses (bricks 15 rows apart, each course's head joints at
+# their own offset, grain from an LCG): with --up, tile and polycube resample
+# it so that a tile holds a whole number of courses and cut every tile on
+# them, and say so; --no-courses, plain tiles and a photo without courses
+# leave it as it is.
+newdir
+awk 'BEGIN { w = 192; h = 192; p = 15; seed = 7; printf "P5\n%d %d\n255\n", w, h
+    for (y = 0; y < h; y++) {
+        c = int((y + 0.5 - 5) / p + 0.5); m = (y + 0.5 - 5) / p - c; if (m < 0) m = -m
+        off = ((c * 7919 + 13) % 97) / 97
+        for (x = 0; x < w; x++) {
+            a = x / 33 + off; b = int(a); seed = (seed * 1103515245 + 12345) % 2147483648
+            v = (m * p < 1.5 || (a - b) * 33 < 2.5) ? 215 : 80 + (b * 31 + c * 17) % 60
+            printf "%c", v + int(seed / 2147483648 * 30) } } }' >bricks.pgm
+expect_ok "tile --up y on bricks" tile ../in/torus.obj bricks.pgm courses --colors 2 --tile 32 --up y
+err_mentions "tile --up on bricks: the courses found, the photo resampled" \
+    'bricks\.pgm has courses every 1[45]\.[0-9] texels: resampled by 1\.0[0-9]* so that a 32-texel tile holds 2'
+expect_ok "tile --up y --no-courses on bricks" tile ../in/torus.obj bricks.pgm asis --colors 2 --tile 32 --up y \
+    --no-courses
+check "tile --no-courses: no word of courses" "no 'courses' on stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q courses; echo $?)"
+check "tile --up on bricks: --no-courses makes another atlas" "files differ" "identical" \
+    "$(! cmp -s courses.png asis.png; echo $?)"
+expect_ok "tile (no --up) on bricks" tile ../in/torus.obj bricks.pgm plain --colors 2 --tile 32
+check "tile without --up: the photo as it is" "no 'courses' on stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q courses; echo $?)"
+expect_ok "tile --up y on stones" tile ../in/torus.obj ../in/lap256.png stones --colors 2 --tile 32 --up y
+check "tile --up on a photo without courses: none found" "no 'courses' on stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q courses; echo $?)"
+expect_ok "polycube on bricks" polycube ../in/spheretri.obj bricks.pgm pc --resolution 6 --tile 32
+err_mentions "polycube on bricks: the walls' courses kept" 'bricks\.pgm has courses every'
+expect_ok "polycube --no-courses on bricks" polycube ../in/spheretri.obj bricks.pgm pcn --resolution 6 --tile 32 \
+    --no-courses
+check "polycube --no-courses: no word of courses" "no 'courses' on stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q courses; echo $?)"
 expect_error "tile --up 0,0,0" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up 0,0,0
 expect_error "tile --up without a value" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up
 expect_error "tile --up with an atlas too wide for two sets" tile ../in/torus.obj ../in/lap256.png out --colors 4 \

@@ -851,6 +851,108 @@ static int brute_cut(const float *cost, int w, int h, const int *lo, const int *
     return found;
 }
 
+/* tt_image_resize against a naive reference: the tent filter written out
+   for one texel at a time, in two dimensions at once. */
+static void resize_reference(const tt_image *src, int w, int h, int x, int y, float out[4])
+{
+    const double rx = (double)src->width / w, ry = (double)src->height / h;
+    const double ax = rx > 1.0 ? rx : 1.0, ay = ry > 1.0 ? ry : 1.0;
+    const double cx = (x + 0.5) * rx - 0.5, cy = (y + 0.5) * ry - 0.5;
+    double sum[4] = {0, 0, 0, 0}, total = 0.0;
+    int i, j, k;
+    for (j = (int)floor(cy - ay) - 1; j <= (int)ceil(cy + ay) + 1; j++)
+        for (i = (int)floor(cx - ax) - 1; i <= (int)ceil(cx + ax) + 1; i++) {
+            const double wx = 1.0 - fabs(i - cx) / ax, wy = 1.0 - fabs(j - cy) / ay;
+            const float *p;
+            if (wx <= 0.0 || wy <= 0.0) continue;
+            p = px(src, i < 0 ? 0 : (i >= src->width ? src->width - 1 : i),
+                   j < 0 ? 0 : (j >= src->height ? src->height - 1 : j));
+            for (k = 0; k < 4; k++) sum[k] += wx * wy * p[k];
+            total += wx * wy;
+        }
+    for (k = 0; k < 4; k++) out[k] = (float)(sum[k] / total);
+}
+
+static void test_resize(void)
+{
+    static const int sizes[][2] = {{23, 17}, {40, 9}, {5, 31}, {1, 1}, {48, 32}};
+    tt_image *src = NULL, *out = NULL;
+    tt_error err;
+    tt_result r;
+    int s, x, y, k, bad;
+    double worst;
+    make_value_noise(&src, 24, 16, 9);
+    if (!src) return;
+    for (s = 0; s < (int)(sizeof sizes / sizeof sizes[0]); s++) {
+        const int w = sizes[s][0], h = sizes[s][1];
+        r = tt_image_resize(src, w, h, NULL, &out, &err);
+        CHECK(r == TT_OK && out && out->width == w && out->height == h, "resize 24x16 to %dx%d: %s", w, h,
+              err.message);
+        if (!out) continue;
+        worst = 0.0;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float ref[4];
+                resize_reference(src, w, h, x, y, ref);
+                for (k = 0; k < 4; k++)
+                    if (fabs(ref[k] - px(out, x, y)[k]) > worst) worst = fabs(ref[k] - px(out, x, y)[k]);
+            }
+        CHECK(worst < 1e-5, "resize to %dx%d agrees with the naive tent filter (worst %g)", w, h, worst);
+        tt_image_free(out);
+        out = NULL;
+    }
+    /* The same size is the image itself; a linear ramp stays linear inside
+       when enlarged (the tent is linear interpolation there). */
+    r = tt_image_resize(src, 24, 16, NULL, &out, &err);
+    CHECK(r == TT_OK && out && memcmp(out->pixels, src->pixels, sizeof(float) * 4 * 24 * 16) == 0,
+          "resize to its own size is exact");
+    tt_image_free(out);
+    for (y = 0; y < 16; y++)
+        for (x = 0; x < 24; x++)
+            for (k = 0; k < 4; k++) px(src, x, y)[k] = 0.01f * x + 0.02f * y;
+    r = tt_image_resize(src, 60, 40, NULL, &out, &err);
+    bad = 0;
+    for (y = 3; out && y < 37; y++)
+        for (x = 3; x < 57; x++) {
+            const double sx = (x + 0.5) * 24.0 / 60.0 - 0.5, sy = (y + 0.5) * 16.0 / 40.0 - 0.5;
+            bad += fabs(px(out, x, y)[0] - (0.01 * sx + 0.02 * sy)) > 1e-5;
+        }
+    CHECK(r == TT_OK && bad == 0, "a ramp enlarged 2.5x stays the ramp: %d texels off", bad);
+    tt_image_free(out);
+    out = NULL;
+    /* A normal map stays unit vectors. */
+    src->kind = TT_IMAGE_NORMAL;
+    for (y = 0; y < 16; y++)
+        for (x = 0; x < 24; x++) {
+            float *p = px(src, x, y);
+            const double a = 0.3 * x, z = 0.8;
+            p[0] = (float)(0.6 * cos(a));
+            p[1] = (float)(0.6 * sin(a));
+            p[2] = (float)z;
+        }
+    r = tt_image_resize(src, 10, 7, NULL, &out, &err);
+    bad = 0;
+    for (y = 0; out && y < 7; y++)
+        for (x = 0; x < 10; x++) {
+            const float *p = px(out, x, y);
+            bad += fabs(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - 1.0) > 1e-4;
+        }
+    CHECK(r == TT_OK && out && out->kind == TT_IMAGE_NORMAL && bad == 0, "a resized normal map: %d not unit", bad);
+    tt_image_free(out);
+    /* Errors. */
+    r = tt_image_resize(src, 0, 5, NULL, &out, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && !out, "width 0: %d (%s)", r, err.message);
+    r = tt_image_resize(src, 5, TT_MAX_IMAGE_SIZE + 1, NULL, &out, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE && !out, "height above TT_MAX_IMAGE_SIZE: %d (%s)", r, err.message);
+    r = tt_image_resize(NULL, 5, 5, NULL, &out, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && !out, "NULL source: %d (%s)", r, err.message);
+    CHECK(tt_image_resize(src, 5, 5, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL out: %s", err.message);
+    src->kind = (tt_image_kind)7;
+    r = tt_image_resize(src, 5, 5, NULL, &out, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && !out && strstr(err.message, "kind 7"), "kind 7: %s", err.message);
+    tt_image_free(src);
+}
+
 static void test_min_error_cut(void)
 {
     int trial, bad_cost = 0, bad_path = 0, bad_valid = 0, bad_result = 0, nvalid = 0, ninvalid = 0;
@@ -1063,6 +1165,12 @@ static tt_result image_oom_call(void *ctx, const tt_allocator *al, tt_error *err
     case 1: r = tt_image_from_bytes(c->bytes, 8, 6, 3, 0, TT_COLOR_SRGB, al, &out, error); break;
     case 2: r = tt_image_rotate90(c->src, 1, al, &out, error); break;
     case 3: r = tt_image_downsample2(c->src, al, &out, error); break;
+    case 4: r = tt_image_resize(c->src, 7, 13, al, &out, error); break;
+    case 5: {
+        tt_courses courses;
+        out = NULL;
+        return tt_find_courses(c->src, al, &courses, error);
+    }
     default:
         out = NULL;
         return tt_min_error_cut(c->cost, 5, 16, lo, hi, al, path, error);
@@ -1074,20 +1182,21 @@ static tt_result image_oom_call(void *ctx, const tt_allocator *al, tt_error *err
 
 static void test_image_oom(void)
 {
-    static const char *const names[5] = {"tt_image_create", "tt_image_from_bytes", "tt_image_rotate90",
-                                         "tt_image_downsample2", "tt_min_error_cut"};
+    static const char *const names[7] = {"tt_image_create", "tt_image_from_bytes", "tt_image_rotate90",
+                                         "tt_image_downsample2", "tt_image_resize", "tt_find_courses",
+                                         "tt_min_error_cut"};
     image_oom_ctx c;
     tt_image *src = NULL;
     unsigned char bytes[8 * 6 * 3];
     float cost[5 * 16];
     int i;
-    make_value_noise(&src, 10, 8, 3);
+    make_value_noise(&src, 10, 16, 3);
     for (i = 0; i < (int)sizeof bytes; i++) bytes[i] = (unsigned char)(i * 29);
     for (i = 0; i < 5 * 16; i++) cost[i] = (float)((i * 7) % 11);
     c.src = src;
     c.bytes = bytes;
     c.cost = cost;
-    for (c.which = 0; c.which < 5 && src; c.which++) {
+    for (c.which = 0; c.which < 7 && src; c.which++) {
         oom_reset();
         oom_sweep(names[c.which], image_oom_call, &c, TT_OK);
     }
@@ -1129,6 +1238,7 @@ void run_image_tests(void)
     RUN(test_rotate);
     RUN(test_rotate_coords_large);
     RUN(test_over_downsample);
+    RUN(test_resize);
     RUN(test_normal_maps);
     RUN(test_min_error_cut);
     RUN(test_image_oom);

@@ -981,6 +981,211 @@ static void test_upright_tiles(void)
     tt_image_free(noise);
 }
 
+/* Bricks: courses `period` texels tall (any real number) whose mortar, 3
+   texels thick, is centred on the heights phase + k * period; head joints
+   every 2.2 courses, each course's at its own offset (so nothing repeats
+   across the image); each brick its own grey, with grain. */
+static tt_image *sy_bricks(int w, int h, double period, double phase, uint32_t seed)
+{
+    const double brick = 2.2 * period;
+    tt_image *im = NULL;
+    int x, y, k;
+    if (tt_image_create(w, h, NULL, &im, NULL) != TT_OK) return NULL;
+    for (y = 0; y < h; y++) {
+        const double course = (y + 0.5 - phase) / period;
+        const int c = (int)floor(course + 0.5);
+        const int mortar_row = fabs(course - c) * period < 1.5;
+        for (x = 0; x < w; x++) {
+            const double along = (x + 0.5) / brick + (double)(sy_hash((uint32_t)c + 99u, 5u, seed) % 1000u) / 1000.0;
+            const int b = (int)floor(along);
+            const int joint = (along - b) * brick < 2.5;
+            const float grain = (float)(sy_hash((uint32_t)x, (uint32_t)y, seed) % 1000u) / 1000.0f * 0.06f;
+            const float face = 0.35f + (float)(sy_hash((uint32_t)b, (uint32_t)c + 7u, seed) % 100u) / 400.0f;
+            const float tone = mortar_row || joint ? 0.85f : face;
+            for (k = 0; k < 3; k++) sy_px(im, x, y)[k] = tone + grain;
+            sy_px(im, x, y)[3] = 1.0f;
+        }
+    }
+    return im;
+}
+
+/* The distance from v to the nearest phase + k * period. */
+static double sy_off_courses(double v, const tt_courses *c)
+{
+    double r = fmod(v - c->phase, c->period);
+    if (r < 0.0) r += c->period;
+    return r < c->period - r ? r : c->period - r;
+}
+
+/* Correlation of two series of n values (0 when one is flat). */
+static double sy_correlation(const double *a, const double *b, int n)
+{
+    double ma = 0.0, mb = 0.0, ab = 0.0, aa = 0.0, bb = 0.0;
+    int i;
+    for (i = 0; i < n; i++) {
+        ma += a[i] / n;
+        mb += b[i] / n;
+    }
+    for (i = 0; i < n; i++) {
+        ab += (a[i] - ma) * (b[i] - mb);
+        aa += (a[i] - ma) * (a[i] - ma);
+        bb += (b[i] - mb) * (b[i] - mb);
+    }
+    return aa > 0.0 && bb > 0.0 ? ab / sqrt(aa * bb) : 0.0;
+}
+
+static void test_find_courses(void)
+{
+    const double period = 23.5, phase = 7.25;
+    tt_image *bricks = sy_bricks(240, 240, period, phase, 3u), *turned = NULL, *noise = sy_noise(240, 240, 8u);
+    tt_courses c;
+    tt_error err;
+    int x, y, shifted;
+    if (!bricks || !noise || tt_image_rotate90(bricks, 1, NULL, &turned, NULL) != TT_OK) {
+        CHECK(0, "images");
+        tt_image_free(bricks);
+        tt_image_free(noise);
+        return;
+    }
+    CHECK(tt_find_courses(bricks, NULL, &c, &err) == TT_OK && fabs(c.period - period) < 0.15 &&
+              c.strength >= TT_COURSES_MIN_STRENGTH && c.coherence >= TT_COURSES_MIN_COHERENCE && c.phase >= 0.0f &&
+              c.phase < c.period,
+          "bricks of courses %.2f texels tall: period %.3f, strength %.3f, coherence %.3f", period, c.period,
+          c.strength, c.coherence);
+    /* The mortar's middle, or a course's: the rows mirror about both. */
+    {
+        tt_courses half = c;
+        half.period = c.period / 2.0f;
+        CHECK(sy_off_courses(phase, &half) < 0.75, "phase %.3f: the mortar is centred at %.2f (mod %.2f)", c.phase,
+              phase, c.period / 2.0f);
+    }
+    /* Light falling off down the photo does not hide the courses or add one. */
+    for (y = 0; y < bricks->height; y++)
+        for (x = 0; x < bricks->width; x++) {
+            float *p = sy_px(bricks, x, y);
+            p[0] *= 1.0f - 0.5f * y / bricks->height;
+            p[1] *= 1.0f - 0.5f * y / bricks->height;
+            p[2] *= 1.0f - 0.5f * y / bricks->height;
+        }
+    CHECK(tt_find_courses(bricks, NULL, &c, &err) == TT_OK && fabs(c.period - period) < 0.15,
+          "bricks darkening downward: period %.3f", c.period);
+    /* Controls: courses running up the image, and a photo without rows. */
+    CHECK(tt_find_courses(turned, NULL, &c, &err) == TT_OK && c.period == 0.0f && c.strength == 0.0f,
+          "bricks turned a quarter: no courses across the rows (period %.3f)", c.period);
+    CHECK(tt_find_courses(noise, NULL, &c, &err) == TT_OK && c.period == 0.0f && c.coherence == 0.0f,
+          "noise: no courses (period %.3f)", c.period);
+    /* The courses move with the rows. */
+    tt_image_free(turned);
+    turned = sy_bricks(240, 240, period, phase + 5.0, 3u);
+    shifted = turned && tt_find_courses(turned, NULL, &c, &err) == TT_OK;
+    c.period /= 2.0f;   /* either of the two mirror lines of a course */
+    CHECK(shifted && sy_off_courses(phase + 5.0, &c) < 0.75, "bricks moved down 5 rows: phase %.3f", c.phase);
+    /* Too short for three courses of any height: none, and no error. */
+    {
+        tt_image *flat = sy_bricks(64, 11, 3.0, 0.0, 1u);
+        CHECK(flat && tt_find_courses(flat, NULL, &c, &err) == TT_OK && c.period == 0.0f, "an 11-row photo");
+        tt_image_free(flat);
+    }
+    /* Errors. */
+    CHECK(tt_find_courses(bricks, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "NULL out: %s", err.message);
+    CHECK(tt_find_courses(NULL, NULL, &c, &err) == TT_ERROR_INVALID_ARGUMENT && c.period == 0.0f, "NULL image: %s",
+          err.message);
+    sy_px(bricks, 3, 100)[1] = (float)internal_not_a_number();
+    CHECK(tt_find_courses(bricks, NULL, &c, &err) == TT_ERROR_NON_FINITE && c.period == 0.0f, "a NaN texel: %s",
+          err.message);
+    tt_image_free(bricks);
+    tt_image_free(turned);
+    tt_image_free(noise);
+}
+
+/* Upright tiles cut on the courses: every window starts on them, and in
+   every tile the courses run level, band and background alike. The control
+   is the same plan without courses. The measure: per tile, each 4-texel
+   column strip's row profile against the tile's background's, the worst
+   strip of the tile, averaged over the tiles. */
+static void test_synthesis_keeps_courses(void)
+{
+    const int S = 32, g = 4;
+    tt_image *bricks = sy_bricks(200, 200, 16.0, 5.0, 11u);
+    tt_courses found;
+    double score[2] = {0.0, 0.0};
+    int with, on_courses[2] = {0, 0}, windows[2] = {0, 0};
+    tt_error err;
+    if (!bricks || tt_find_courses(bricks, NULL, &found, &err) != TT_OK || found.period == 0.0f) {
+        CHECK(0, "bricks and their courses: %s", bricks ? err.message : "no image");
+        tt_image_free(bricks);
+        return;
+    }
+    for (with = 0; with < 2; with++) {
+        tt_synth_options o = sy_options(2, S, g, 21u);
+        tt_synth_plan *plan = NULL;
+        tt_tileset *set = NULL;
+        int tiles, t, k;
+        o.upright = 1;
+        if (with) o.courses = found;
+        if (tt_synth_plan_create(bricks, &o, NULL, &plan, &err) != TT_OK ||
+            tt_synth_apply(plan, bricks, NULL, &set, &err) != TT_OK) {
+            CHECK(0, "upright tiles of bricks: %s", err.message);
+            tt_synth_plan_free(plan);
+            continue;
+        }
+        tiles = tt_tile_layout_tile_count(&plan->layout);
+        for (k = 0; k < 2; k++) {
+            on_courses[with] += sy_off_courses(plan->edge_windows[k].y, &found) <= 0.51;
+            on_courses[with] += sy_off_courses(plan->vertical_windows[k].y, &found) <= 0.51;
+            windows[with] += 2;
+        }
+        for (t = 0; t < tiles; t++) {
+            double profile[32], background[32], worst = 1.0;
+            uint8_t types[4];
+            int cx, cy, x0, x, y;
+            on_courses[with] += sy_off_courses(plan->background_windows[t].y, &found) <= 0.51;
+            windows[with]++;
+            sy_tile_types(&plan->layout, t, types, &cx, &cy);
+            for (y = 0; y < S; y++) {
+                const tt_rect *r = &plan->background_windows[t];
+                background[y] = 0.0;
+                for (x = 0; x < S; x++) background[y] += sy_px(bricks, r->x + x, r->y + y)[0];
+            }
+            for (x0 = 0; x0 < S; x0 += 4) {
+                double c;
+                for (y = 0; y < S; y++) {
+                    profile[y] = 0.0;
+                    for (x = x0; x < x0 + 4; x++) profile[y] += sy_px(&set->levels[0], cx + g + x, cy + g + y)[0];
+                }
+                c = sy_correlation(profile, background, S);
+                if (c < worst) worst = c;
+            }
+            score[with] += worst / tiles;
+        }
+        tt_tileset_free(set);
+        tt_synth_plan_free(plan);
+    }
+    printf("     upright tiles of bricks, worst column strip against the background: %.3f on the courses, "
+           "%.3f without (windows on the courses: %d of %d, %d of %d)\n",
+           score[1], score[0], on_courses[1], windows[1], on_courses[0], windows[0]);
+    CHECK(on_courses[1] == windows[1], "with courses every window starts on them: %d of %d", on_courses[1],
+          windows[1]);
+    CHECK(on_courses[0] < windows[0] / 2, "the control's windows fall anywhere: %d of %d on the courses",
+          on_courses[0], windows[0]);
+    CHECK(score[1] >= 0.6, "on the courses every strip of a tile follows its background's rows: %.3f", score[1]);
+    CHECK(score[0] <= 0.3, "the control's bands show other rows: %.3f", score[0]);
+    /* Bad courses are refused. */
+    {
+        tt_synth_options o = sy_options(2, S, g, 21u);
+        tt_synth_plan *plan = NULL;
+        o.courses.period = 1.0f;
+        CHECK(tt_synth_plan_create(bricks, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT && !plan &&
+                  strstr(err.message, "period"),
+              "a period of 1: %s", err.message);
+        o.courses.period = 16.0f;
+        o.courses.phase = (float)internal_not_a_number();
+        CHECK(tt_synth_plan_create(bricks, &o, NULL, &plan, &err) == TT_ERROR_INVALID_ARGUMENT && !plan,
+              "a NaN phase: %s", err.message);
+    }
+    tt_image_free(bricks);
+}
+
 static void test_affine_map(void)
 {
     static const float scale[3] = {0.5f, -0.7f, 2.0f}, offset[3] = {0.25f, 0.9f, -0.5f};
@@ -1399,6 +1604,8 @@ void run_tiled_synthesis_tests(void)
     RUN(test_compose_tile_matches_apply);
     RUN(test_synthesis_executor_identical);
     RUN(test_upright_tiles);
+    RUN(test_find_courses);
+    RUN(test_synthesis_keeps_courses);
     RUN(test_second_map_same_masks);
     RUN(test_normal_map_turns);
     RUN(test_normal_map_not_unit);

@@ -43,6 +43,7 @@ static const char *const k_functions[] = {
     "tt_image_rotate90",
     "tt_image_over",
     "tt_image_downsample2",
+    "tt_image_resize",
     "tt_min_error_cut",
     "tt_sparse_from_triplets",
     "tt_sparse_multiply",
@@ -60,6 +61,7 @@ static const char *const k_functions[] = {
     "tt_orient_tiles",
     "tt_assign_uvs_oriented",
     "tt_reduce_tiles",
+    "tt_find_courses",
     "tt_synth_plan_create",
     "tt_synth_compose_tile",
     "tt_synth_apply",
@@ -522,6 +524,24 @@ static void cases_image(const baseline *b)
     OUT_CASE(out, tt_image_free, tt_image_downsample2(img, BA1, &out, E));
     OUT_CASE(out, tt_image_free, tt_image_downsample2(img, BA2, &out, E));
     free(odd.pixels);
+
+    OUT_CASE(out, tt_image_free, tt_image_resize(NULL, 4, 4, AL, &out, E));
+    CASE(tt_image_resize(img, 4, 4, AL, NULL, E));
+    OUT_CASE(out, tt_image_free, tt_image_resize(img, 0, 4, AL, &out, E));
+    OUT_CASE(out, tt_image_free, tt_image_resize(img, 4, -3, AL, &out, E));
+    OUT_CASE(out, tt_image_free, tt_image_resize(img, TT_MAX_IMAGE_SIZE + 1, 4, AL, &out, E));
+    OUT_CASE(out, tt_image_free, tt_image_resize(img, 65536, 65536, AL, &out, E));
+    v = *img;
+    v.pixels = NULL;
+    OUT_CASE(out, tt_image_free, tt_image_resize(&v, 4, 4, AL, &out, E));
+    v = *img;
+    v.width = -32;
+    OUT_CASE(out, tt_image_free, tt_image_resize(&v, 4, 4, AL, &out, E));
+    v = *img;
+    v.kind = (tt_image_kind)7;
+    OUT_CASE(out, tt_image_free, tt_image_resize(&v, 4, 4, AL, &out, E));
+    OUT_CASE(out, tt_image_free, tt_image_resize(img, 4, 4, BA1, &out, E));
+    OUT_CASE(out, tt_image_free, tt_image_resize(img, 4, 4, BA2, &out, E));
 
     for (i = 0; i < 32; i++) cost[i] = (float)(i % 5);
     for (i = 0; i < 8; i++) {
@@ -1050,12 +1070,42 @@ static void cases_tiled(const baseline *b)
     dop.margin_texels = 0;
     CASE(tt_measure_uv_distortion(&b->empty, uv, 64, 64, &dop, AL, &drep, E));
 
+    {
+        tt_courses courses;
+        CASE(tt_find_courses(NULL, AL, &courses, E));
+        CASE(tt_find_courses(img, AL, NULL, E));
+        CASE(tt_find_courses(img, BA1, &courses, E));
+        CASE(tt_find_courses(img, BA2, &courses, E));
+        v = *img;
+        v.pixels = NULL;
+        CASE(tt_find_courses(&v, AL, &courses, E));
+        v = *img;
+        v.height = 0;
+        CASE(tt_find_courses(&v, AL, &courses, E));
+        v = *img;
+        v.kind = (tt_image_kind)6;
+        CASE(tt_find_courses(&v, AL, &courses, E));
+        v = image_view(32, 32, 0.5f);
+        v.pixels[4 * 40 + 2] = b->nan_t;
+        CASE(tt_find_courses(&v, AL, &courses, E));
+        free(v.pixels);
+    }
     memset(&so, 0, sizeof so);
     so.layout = L;
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(NULL, &so, AL, &pout, E));
     CASE(tt_synth_plan_create(img, &so, AL, NULL, E));
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &so, BA1, &pout, E));
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &so, BA2, &pout, E));
+    so.courses.period = 1.5f;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &so, AL, &pout, E));
+    so.courses.period = -4.0f;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &so, AL, &pout, E));
+    so.courses.period = b->inf_t;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &so, AL, &pout, E));
+    so.courses.period = 8.0f;
+    so.courses.phase = b->nan_t;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &so, AL, &pout, E));
+    memset(&so.courses, 0, sizeof so.courses);
     v = *img;
     v.pixels = NULL;
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(&v, &so, AL, &pout, E));

@@ -2,8 +2,9 @@
    (examples/image_io.c: stb_image's PNG, JPEG, BMP, TGA, GIF, PSD, HDR, PIC
    and PNM decoders behind the size checks, then tt_image_from_bytes in
    strips) and, on whatever decodes, tt_image_rotate90,
-   tt_image_downsample2 and tt_image_over; and tt_image_from_bytes directly
-   on raw bytes with fuzzed sizes, channels, stride and colour space.
+   tt_image_downsample2, tt_image_resize, tt_find_courses and
+   tt_image_over; and tt_image_from_bytes directly on raw bytes with fuzzed
+   sizes, channels, stride and colour space.
 
    Build (tests/fuzz/run.sh does this, with the library compiled once from
    tests/fuzz/fuzz_library.c; stb_image from libstb-dev):
@@ -121,6 +122,44 @@ static void operate(const tt_image *img, tt_color_space space, int turns, fz_all
         CHECK(half->width == img->width / 2 && half->height == img->height / 2, "half of %d x %d is %d x %d",
               img->width, img->height, half->width, half->height);
         check_image("downsampled", half, space);
+    }
+
+    /* resized to a size from the turns (shrunk, kept or grown on each axis):
+       within the source's range of values (the filter's weights are
+       non-negative), a normal map's vectors unit; and its courses, if any,
+       inside its height */
+    {
+        static const int factors[4] = {1, 2, 3, 5};
+        const int rw = img->width * factors[(turns + 8) & 3] / 3 + 1;
+        const int rh = img->height * factors[((turns + 8) >> 2) & 3] / 3 + 1;
+        tt_image *resized = NULL;
+        tt_courses courses;
+        memset(&err, 0x55, sizeof err);
+        r = tt_image_resize(img, rw, rh, &a->tt, &resized, &err);
+        if (r != TT_OK) {
+            fz_check_error("tt_image_resize", r, &err, a);
+            fz_check_null("tt_image_resize", r, resized);
+            CHECK(r == TT_ERROR_OUT_OF_MEMORY, "tt_image_resize of %d x %d to %d x %d: %s", img->width, img->height,
+                  rw, rh, err.message);
+        } else {
+            CHECK(resized->width == rw && resized->height == rh && resized->kind == img->kind,
+                  "resized to %d x %d (kind %d) when asked %d x %d", resized->width, resized->height,
+                  (int)resized->kind, rw, rh);
+            check_image("resized", resized, space);
+        }
+        tt_image_free(resized);
+        memset(&err, 0x55, sizeof err);
+        r = tt_find_courses(img, &a->tt, &courses, &err);
+        if (r != TT_OK) {
+            fz_check_error("tt_find_courses", r, &err, a);
+            CHECK(r == TT_ERROR_OUT_OF_MEMORY, "tt_find_courses of %d x %d: %s", img->width, img->height,
+                  err.message);
+        } else {
+            CHECK(courses.period == 0.0f || (courses.period >= 2.0f && courses.period <= img->height / 3.0f + 1.0f &&
+                                             courses.phase >= 0.0f && courses.phase < courses.period),
+                  "courses of a %d x %d image: period %g, phase %g", img->width, img->height, (double)courses.period,
+                  (double)courses.phase);
+        }
     }
 
     /* over: a copy of the image (premultiplied where it is colour) under itself turned by 180 degrees */

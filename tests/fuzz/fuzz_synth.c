@@ -24,7 +24,10 @@
        7      feather: (int8_t)b % 12 (-11..11: negative and too wide included)
        8, 9   synthesis seed
        10     background: b & 3 = 0 whole image, 1 a rect that fits, 2 raw bytes
-              11..14 (x, y, w, h, may not fit), 3 negative or huge values
+              11..14 (x, y, w, h, may not fit), 3 negative or huge values;
+              courses: b & 4 those tt_find_courses finds in the source (a
+              finite one), b & 8 raw ones, period (int8_t)byte 11 / 4 (0, too
+              short or negative included) and phase byte 12 / 3
        11..14 background rect bytes
        15..20 edge windows: x = b - 8, y = b' - 8 for colours 0..2 (out of range
               ones included)
@@ -397,7 +400,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fz_alloc a;
     uint8_t hdr[36], flags;
     int w, h, k, raw, S, g, n, T, feather, in_unit = 1, nonfinite = 0, first_bad = -1, layout_ok;
-    int bg_ok = 1, windows_ok = 1, big_enough;
+    int bg_ok = 1, windows_ok = 1, courses_ok, big_enough;
     tt_image *src = NULL;
     tt_tileset *set = NULL;
     tt_mesh *mesh = NULL;
@@ -527,6 +530,28 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 windows_ok = 0;
         if (n > 3) goto out;    /* only 3 windows given: a larger raw n would read past them */
     }
+    if ((hdr[10] & 4) && !nonfinite) {
+        tt_courses found;
+        memset(&err, 0x55, sizeof err);
+        r = tt_find_courses(src, &a.tt, &found, &err);
+        if (r != TT_OK) {
+            fz_check_error("tt_find_courses", r, &err, &a);
+            CHECK(r == TT_ERROR_OUT_OF_MEMORY && a.failed, "tt_find_courses on a finite source: %d: %s", (int)r,
+                  err.message);
+            goto out;
+        }
+        CHECK(found.period == 0.0f ? found.phase == 0.0f && found.strength == 0.0f
+                                   : found.period >= 2.0f && found.period <= h / 3.0f + 1.0f && found.phase >= 0.0f &&
+                                         found.phase < found.period && found.strength >= TT_COURSES_MIN_STRENGTH &&
+                                         found.strength <= 1.0f,
+              "courses of a %dx%d source: period %g, phase %g, strength %g", w, h, (double)found.period,
+              (double)found.phase, (double)found.strength);
+        opt.courses = found;
+    } else if (hdr[10] & 8) {
+        opt.courses.period = (float)(int8_t)hdr[11] / 4.0f;
+        opt.courses.phase = (float)hdr[12] / 3.0f;
+    }
+    courses_ok = opt.courses.period == 0.0f || opt.courses.period >= 2.0f;
     memset(&ps, 0, sizeof ps);
     if (flags & 128) {
         ps.cancel_after = hdr[28] & 7;
@@ -561,7 +586,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         /* huge texels may overflow a cut's cost: a specific NON_FINITE */
         if (r == TT_ERROR_NON_FINITE && !in_unit) goto out;
-        CHECK(!layout_ok || !big_enough || !bg_ok || !windows_ok || opt.feather < 0 || feather > S / 4 + 1,
+        CHECK(!layout_ok || !big_enough || !bg_ok || !windows_ok || !courses_ok || opt.feather < 0 ||
+                  feather > S / 4 + 1,
               "valid synthesis refused (layout %d/%d/%d, feather %d, source %dx%d): %s", opt.layout.colors,
               opt.layout.tile_size, opt.layout.gutter, opt.feather, w, h, err.message);
         if (!layout_ok)
@@ -575,8 +601,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         goto out;
     }
     CHECK(!nonfinite, "synthesis accepted a non-finite texel (first at %d)", first_bad);
-    CHECK(layout_ok && big_enough && bg_ok && windows_ok, "synthesis accepted bad input: layout %d, source %d, "
-          "background %d, windows %d", layout_ok, big_enough, bg_ok, windows_ok);
+    CHECK(layout_ok && big_enough && bg_ok && windows_ok && courses_ok, "synthesis accepted bad input: layout %d, "
+          "source %d, background %d, windows %d, courses %d", layout_ok, big_enough, bg_ok, windows_ok, courses_ok);
     CHECK(opt.feather >= 0, "synthesis accepted feather %d", opt.feather);
     CHECK(feather <= S / 4 + 1, "synthesis accepted feather %d for %d-texel tiles", feather, S);
     CHECK(ps.cancel_after == 0 || ps.calls < ps.cancel_after, "not cancelled after %d calls", ps.calls);
