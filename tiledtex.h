@@ -1386,7 +1386,9 @@ typedef struct tt_courses {
    correlation with itself, refined over as many periods as the image holds;
    the phase is where the profile, folded over one period, is most mirror-
    symmetric. A photo without rows (gravel, rust, a forest floor), or with
-   fewer than three courses in its height or courses under 4 texels tall,
+   fewer than three courses in its height or courses under 4 texels tall
+   (a photo taller than 256 rows is looked at reduced to 256: under 4 of
+   those),
    gives period 0, and so does one
    whose strength is below TT_COURSES_MIN_STRENGTH, or whose rows repeat
    without joints across the width (stones of about one size, whose row
@@ -10192,9 +10194,13 @@ static double tt__fold_at(const double *fold, int bins, double period, double u)
     return (1.0 - t) * fold[b % bins] + t * fold[(b + 1) % bins];
 }
 
-/* The shortest courses tt_find_courses looks for, in texels: rows that
-   repeat more often are grain, not courses. */
+/* The shortest courses tt_find_courses looks for, in texels of the
+   photo as it looks at them: rows that repeat more often are grain, not
+   courses. */
 #define TT__COURSES_MIN_PERIOD 4
+/* The most rows tt_find_courses looks at: a taller photo is reduced to
+   this height first (its thresholds are set at this scale). */
+#define TT__COURSES_ROWS 256
 
 /* tt_find_courses's coherence: the photo cut into four vertical strips,
    each strip's row profile with what changes over more than 8 rows taken
@@ -10290,22 +10296,12 @@ static double tt__courses_phase(const double *profile, int n, double period, dou
     return phase;
 }
 
-TTDEF tt_result tt_find_courses(const tt_image *image, const tt_allocator *allocator, tt_courses *out,
-                                tt_error *error)
+/* tt_find_courses on a checked image at most TT__COURSES_ROWS tall. */
+static tt_result tt__find_courses_in(const tt_image *image, const tt_allocator *allocator, tt_courses *out,
+                                     tt_error *error)
 {
     double *profile, *corr, period, best = 0.0, tilt = 0.0, spread = 0.0, mean = 0.0;
-    tt_result result;
     int W, H, x, y, lag, first, max_lag, periods;
-    tt__ok(error);
-    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
-    memset(out, 0, sizeof *out);
-    if (!image || !image->pixels || image->width < 1 || image->height < 1)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the image is NULL or empty");
-    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if ((result = tt__check_image_kind(image, "the image", error)) != TT_OK ||
-        (result = tt__check_image_size(image->width, image->height, error)) != TT_OK ||
-        (result = tt__check_finite_texels(image, "the image", error)) != TT_OK)
-        return result;
     W = image->width;
     H = image->height;
     /* Three courses at least, and no more bins to a period than fit the fold. */
@@ -10386,6 +10382,39 @@ done:
     if (out->period == 0.0f) out->strength = out->coherence = 0.0f;
     tt__free(allocator, profile);
     return TT_OK;
+}
+
+TTDEF tt_result tt_find_courses(const tt_image *image, const tt_allocator *allocator, tt_courses *out,
+                                tt_error *error)
+{
+    tt_image *reduced = NULL;
+    tt_result result;
+    double scale;
+    tt__ok(error);
+    if (!out) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out is NULL");
+    memset(out, 0, sizeof *out);
+    if (!image || !image->pixels || image->width < 1 || image->height < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "the image is NULL or empty");
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if ((result = tt__check_image_kind(image, "the image", error)) != TT_OK ||
+        (result = tt__check_image_size(image->width, image->height, error)) != TT_OK ||
+        (result = tt__check_finite_texels(image, "the image", error)) != TT_OK)
+        return result;
+    if (image->height <= TT__COURSES_ROWS) return tt__find_courses_in(image, allocator, out, error);
+    /* A taller photo is looked at reduced to TT__COURSES_ROWS rows (its
+       width in proportion): the joints' thickness and the coherence's
+       high-pass are then measured at the one scale the thresholds were set
+       at, and what is found is scaled back. */
+    scale = (double)image->height / TT__COURSES_ROWS;
+    if ((result = tt_image_resize(image, tt__max_i(1, (int)(image->width / scale + 0.5)), TT__COURSES_ROWS, allocator,
+                                  &reduced, error)) != TT_OK)
+        return result;
+    result = tt__find_courses_in(reduced, allocator, out, error);
+    tt_image_free(reduced);
+    out->period = (float)(out->period * scale);
+    out->phase = (float)(out->phase * scale);
+    if (!(out->phase < out->period)) out->phase = 0.0f;
+    return result;
 }
 
 /* The start nearest v in [lo, hi] that lies on the courses, round(phase +

@@ -1080,6 +1080,19 @@ static void test_find_courses(void)
     shifted = turned && tt_find_courses(turned, NULL, &c, &err) == TT_OK;
     c.period /= 2.0f;   /* either of the two mirror lines of a course */
     CHECK(shifted && sy_off_courses(phase + 5.0, &c) < 0.75, "bricks moved down 5 rows: phase %.3f", c.phase);
+    /* A photo taller than the rows looked at is reduced first; what is
+       found is scaled back. */
+    {
+        tt_image *tall = sy_bricks(500, 700, 61.25, 20.0, 4u);
+        tt_courses half;
+        CHECK(tall && tt_find_courses(tall, NULL, &c, &err) == TT_OK && fabs(c.period - 61.25) < 0.6,
+              "bricks 700 rows tall, courses 61.25: period %.3f", c.period);
+        half = c;
+        half.period = c.period / 2.0f;
+        CHECK(c.period > 0.0f && sy_off_courses(20.0, &half) < 2.5, "700 rows tall: phase %.3f, mortar at 20 (mod %.2f)",
+              c.phase, half.period);
+        tt_image_free(tall);
+    }
     /* Too short for three courses of any height: none, and no error. */
     {
         tt_image *flat = sy_bricks(64, 11, 3.0, 0.0, 1u);
