@@ -270,37 +270,29 @@ stage_tool_build() {
         fail "e2e: the tool does not build with sanitizers" "$log"
     fi
 }
-stage_e2e() {
-    echo "== end-to-end tests (tests/e2e.sh, tool built with ASan + UBSan)"
+# tool_stage NAME TITLE SCRIPT: a script that takes the sanitized tool,
+# counted; not run (the tool's build has failed already) without it.
+tool_stage() {
+    echo "== $2"
     if [ -x "$SANITIZED_TOOL" ]; then
-        run_counted e2e bash tests/e2e.sh "$SANITIZED_TOOL"
+        run_counted "$1" bash "$3" "$SANITIZED_TOOL"
     else
         echo "not run: the tool did not build"
     fi
 }
+stage_e2e() { tool_stage e2e "end-to-end tests (tests/e2e.sh, tool built with ASan + UBSan)" tests/e2e.sh; }
 
 # 4. Other programs open what the tool writes: assimp and Blender, when
 # installed (a CI machine without them prints one "skip" line and counts
 # nothing). About 30 s with both.
 stage_import() {
-    echo "== import test (tests/import_check.sh: assimp and Blender open each pipeline's output)"
-    if [ -x "$SANITIZED_TOOL" ]; then
-        run_counted import bash tests/import_check.sh "$SANITIZED_TOOL"
-    else
-        echo "not run: the tool did not build"
-    fi
+    tool_stage import "import test (tests/import_check.sh: assimp and Blender open each pipeline's output)" \
+        tests/import_check.sh
 }
 
 # 5. The learner's programs: each built as examples/learn/README.md says (with
 # -Werror), run on inputs the tool generates, and drawn by its render command.
-stage_learn() {
-    echo "== the learner's programs (tests/learn.sh, examples/learn/)"
-    if [ -x "$SANITIZED_TOOL" ]; then
-        run_counted learn bash tests/learn.sh "$SANITIZED_TOOL"
-    else
-        fail "learn: not run, as the tool that makes its inputs and draws its outputs did not build"
-    fi
-}
+stage_learn() { tool_stage learn "the learner's programs (tests/learn.sh, examples/learn/)" tests/learn.sh; }
 
 # 6. A short smoke run of each libFuzzer target (tests/fuzz/run.sh builds them
 # with clang, ASan and UBSan): its seed corpus, then mutations for
