@@ -4607,6 +4607,18 @@ static void test_atlas_pack_charts_fill(void)
         CHECK(tt_atlas_pack_charts(mesh, 4096, 3, NULL, NULL, uv_large, &large, &err) == TT_OK, "4096: %s", err.message);
         chart_check_atlas("lumpy sphere at 4096, gutter 3", mesh, uv_large, &large, 4096, 3, spread);
         CHECK(large.fill >= 0.6, "at 4096 the charts fill %.3f", large.fill);
+        /* Gutter 4 at 4096 is gutter 2 at 2048 drawn twice as large: a
+           block's texels lie within a quarter of its diagonal of its
+           centre, so the blocks reserve at most 0.7 texel more round each
+           chart than texels would (half the diagonal, 1.4 more, lost 3
+           points of fill here). */
+        CHECK(tt_atlas_pack_charts(mesh, 4096, 4, NULL, NULL, uv_large, &large, &err) == TT_OK, "4096, gutter 4: %s",
+              err.message);
+        chart_check_atlas("lumpy sphere at 4096, gutter 4", mesh, uv_large, &large, 4096, 4, spread);
+        printf("     in blocks of 2 texels: %d charts fill %.3f at 4096 with gutter 4, %.3f at 2048 with gutter 2\n",
+               large.ncharts, large.fill, report.fill);
+        CHECK(large.fill >= report.fill - 0.015, "at 4096 with gutter 4 the charts fill %.3f, at 2048 with gutter 2 %.3f",
+              large.fill, report.fill);
         free(uv_large);
     }
     printf("     atlas fill on a lumpy sphere: %d charts fill %.3f at 2048 (their boxes in shelves: %.3f), density "
