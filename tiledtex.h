@@ -2385,8 +2385,11 @@ TTDEF tt_result tt_atlas_pack_pairs(const tt_mesh *mesh, int size, int gutter, f
    (size / 2048 rounded up a side, the gutter rounded up to whole blocks),
    so that a larger atlas costs no more to pack. The largest scale that
    fits size x size is searched from the guessed fill (options->fill_guess)
-   in steps of 6 % until bracketed, then by bisection to 0.5 %. Faces of zero area (permissive
-   meshes) join a neighbouring chart. */
+   in steps of 6 % until bracketed, then by bisection to 0.5 %; then two
+   other packings of the same charts (each chart in the turn that leaves
+   least free room beneath it, in the order above, then by decreasing
+   surface area) try scales 0.4 % larger while they fit, and what fits is
+   kept. Faces of zero area (permissive meshes) join a neighbouring chart. */
 
 /* Degrees: the normals of a chart's faces stay within this of its seed face's normal (the
    round charts tried first grow within 30). */
@@ -2423,12 +2426,14 @@ typedef struct tt_chart_atlas_report {
    not fit even when shrunk to nothing - each needs 2 * gutter + 1 texels a
    side (TT_ERROR_IMAGE_TOO_SMALL; the message gives the smallest size that
    holds them); TT_ERROR_OUT_OF_MEMORY. corner_uv is written only on
-   success. Temporary memory only: about 210 bytes per face and three bits
+   success. Temporary memory only: about 235 bytes per face and three bits
    per texel (per block above 2048 a side). Time O(faces) for the charts
    (with the faces of a chart in a bounded number of grid cells each); the
    packing, five to eight times over for the search of the scale (fewer
-   with a good options->fill_guess) for each of the two sets of charts
-   (progress reports the first set's search up to 0.5), scans the bitmap
+   with a good options->fill_guess) and two to ten times more to refine it
+   for each of the two sets of charts (the second set's refinement skipped
+   when it cannot catch up with the first; progress reports the first
+   set's search up to 0.5), scans the bitmap
    for each chart, skipping rows without a long enough free run. options may be NULL
    (defaults); TT_CANCELLED by options->progress. Deterministic; reentrant
    and thread-safe on distinct outputs. */
@@ -16754,6 +16759,10 @@ static void tt__chart_texel(const double *xy, int face, int k, double s, int gut
    by this factor until it brackets the scale that fits: the fills of real
    meshes lie within a step or two of TT_ATLAS_FILL_GUESS. */
 #define TT__PACK_BRACKET 1.06
+/* The refinement (tt__atlas_search_scale) steps the scale up by this factor
+   (0.8 % of fill), at most this many times for each other way of packing. */
+#define TT__PACK_REFINE 1.004
+#define TT__PACK_REFINE_STEPS 4
 
 /* Scratch of the bitmap packing: one bit per atlas texel, taken or free
    (rows of `words` 64-bit words), the longest free run of each row, and
@@ -16765,6 +16774,7 @@ typedef struct tt__packing {
     int *run;
     double reach;   /* cells: a cell whose centre lies this near a triangle is the chart's */
     const unsigned char *border;   /* per face, bit k: its edge from corner k borders another chart */
+    int waste;   /* 0: each chart in the turn that sits lowest; 1: the one that leaves least room beneath */
 } tt__packing;
 
 /* Sets bits [a, b] of a row of words. */
@@ -17099,11 +17109,34 @@ static int tt__packing_find(const tt__packing *p, int size, int width, int heigh
     return 0;
 }
 
+/* The free cells beneath the mask (p->mask, width x height) placed at (x,
+   y): in each of its columns, those between its lowest cell and the first
+   taken cell below (or the atlas's bottom), at most `height` deep. Room a
+   chart leaves there is a hollow that only a smaller chart can still use. */
+static long tt__packing_waste(const tt__packing *p, int width, int height, int x, int y)
+{
+    long waste = 0;
+    int col;
+    for (col = 0; col < width; col++) {
+        int low, row, depth;
+        for (low = 0; low < height; low++)
+            if (p->mask[(size_t)low * p->words + (col >> 6)] >> (col & 63) & 1) break;
+        if (low == height) continue;
+        for (row = y + low - 1, depth = 0; row >= 0 && depth < height; row--, depth++)
+            if (p->bits[(size_t)row * p->words + ((x + col) >> 6)] >> ((x + col) & 63) & 1) break;
+        waste += depth;
+    }
+    return waste;
+}
+
 /* Packing of the charts' outlines in a bitmap: the charts in `order`, each
    in the turn that lets it sit lowest (then leftmost), at the lowest free
    place (then leftmost): small charts fill the room that larger ones left
    between and inside them, where boxes or a skyline would leave it empty.
-   1 when all fit in size x size; then x, y, turn, if given, get each
+   With p->waste, each turn still goes to its lowest place, but the turn
+   kept is the one whose free cells beneath plus its width times its row
+   are fewest (a chart that sits a little higher but fits the ground below
+   it). 1 when all fit in size x size; then x, y, turn, if given, get each
    chart's offset in texels from the bottom-left corner and its turn.
    need and rows_order: size ints each. */
 static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order, int n, const int *members,
@@ -17116,12 +17149,21 @@ static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order
     for (i = 0; i < n; i++) {
         const tt__chart *chart = charts + order[i].chart;
         int best_x = 0, best_y = size, best_turn = -1, at_x, at_y, width, height, cols, rows;
+        double best_key = 0.0;
         if (!tt__chart_outline(chart, members, xy, s, gutter, size, p, &cols, &rows)) return 0;
         for (r = 0; r < 4; r++) {
+            int below = best_y;
+            double key;
             tt__mask_turn(p, cols, rows, r, &width, &height);
             for (j = 0; j < height; j++) need[j] = tt__longest_run(p->mask + (size_t)j * p->words, width, 1);
-            if (tt__packing_find(p, size, width, height, need, rows_order, best_y, &at_x, &at_y) &&
-                (at_y < best_y || (at_y == best_y && at_x < best_x))) {
+            /* The waste is never negative: rows from best_key / width up cannot win. */
+            if (p->waste) below = best_turn < 0 ? size : (int)(best_key / width) + 1;
+            if (below > size) below = size;
+            if (!tt__packing_find(p, size, width, height, need, rows_order, below, &at_x, &at_y)) continue;
+            key = p->waste ? (double)tt__packing_waste(p, width, height, at_x, at_y) + (double)width * at_y : at_y;
+            if (best_turn < 0 || key < best_key ||
+                (key == best_key && (at_y < best_y || (at_y == best_y && at_x < best_x)))) {
+                best_key = key;
                 best_x = at_x;
                 best_y = at_y;
                 best_turn = r;
@@ -17410,15 +17452,22 @@ static tt_result tt__atlas_too_small(int ncharts, int gutter, int size, tt_error
    cannot fill more than the atlas: s_hi never fits, tiny always does. From
    the guess, steps of TT__PACK_BRACKET up while it fits or down while it
    does not bracket the scale; then halving, down to 0.5 % of it. The layout
-   of the last packing that fitted is kept. try_box holds 3 nf ints. */
-static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart_order *order, int ncharts,
-                                        const int *members, const double *xy, int block_gutter, int side,
-                                        tt__packing *pack, int *need, int *rows_order, int *try_box, int nf,
-                                        const tt_chart_pack_options *opt, float base, float span, double surface,
-                                        double tiny, int *box_x,
+   of the last packing that fitted is kept. Then, unless even
+   TT__PACK_REFINE_STEPS steps up would leave the scale below `rival` (the
+   best of another set of charts), each other way of packing the same charts
+   (tt__pack_bitmap with pack->waste, in order then in order_area) tries
+   the scale TT__PACK_REFINE times larger while it fits: packings differ
+   by a step or two from chart set to chart set, none best on all, and
+   what fits is kept, so the fill never falls below the first way's.
+   try_box holds 3 nf ints. */
+static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart_order *order,
+                                        const tt__chart_order *order_area, int ncharts, const int *members,
+                                        const double *xy, int block_gutter, int side, tt__packing *pack, int *need,
+                                        int *rows_order, int *try_box, int nf, const tt_chart_pack_options *opt,
+                                        float base, float span, double surface, double tiny, double rival, int *box_x,
                                         int *box_y, int *box_turn, double *scale, tt_error *error)
 {
-    int packed = 0, tries = 0, failed = 0, fitted = 0;
+    int packed = 0, tries = 0, failed = 0, fitted = 0, way, step;
     double s_lo = tiny, s_hi = surface > 0.0 ? 1.0001 * side / sqrt(surface) : tiny;
     if (s_hi < s_lo) s_hi = s_lo;
     {
@@ -17451,6 +17500,28 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
     if (!packed)
         tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, pack, need, rows_order, box_x,
                         box_y, box_turn);
+    if (packed && s_lo * pow(TT__PACK_REFINE, TT__PACK_REFINE_STEPS) >= rival)
+        for (way = 0; way < 2; way++) {
+            pack->waste = 1;
+            for (step = 0; step < TT__PACK_REFINE_STEPS; step++) {
+                double s = s_lo * TT__PACK_REFINE;
+                int fits = tt__pack_bitmap(charts, way ? order_area : order, ncharts, members, xy, s, block_gutter,
+                                           side, pack, need, rows_order, try_box, try_box + nf,
+                                           try_box + 2 * (size_t)nf);
+                tries++;
+                if (opt->progress &&
+                    opt->progress(base + span * (float)(1.0 - 1.0 / (1.0 + tries / 3.0)), opt->progress_user_data)) {
+                    pack->waste = 0;
+                    return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
+                }
+                if (!fits) break;
+                s_lo = s;
+                memcpy(box_x, try_box, (size_t)ncharts * sizeof(int));
+                memcpy(box_y, try_box + nf, (size_t)ncharts * sizeof(int));
+                memcpy(box_turn, try_box + 2 * (size_t)nf, (size_t)ncharts * sizeof(int));
+            }
+            pack->waste = 0;
+        }
     if (opt->progress && opt->progress(base + span, opt->progress_user_data))
         return tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "cancelled while packing the atlas");
     *scale = s_lo;
@@ -17503,13 +17574,14 @@ static double tt__atlas_reach_cells(int gutter, int block)
    within `cone` degrees of their seed's normal and within `reach` of it,
    1e300: the cone alone), smoothed (in TT_ATLAS_CHART_CONE), with per
    face a bit per edge that leaves its chart (border), each chart's shape,
-   and the packing order, largest first; *largest the widest chart. seed,
+   and the packing orders, largest first (order by box, order_area by
+   surface area); *largest the widest chart. seed,
    tried and scratch are scratch of nfaces. Returns the count of charts,
    -1 when out of memory. */
 static int tt__atlas_make_charts(const tt_mesh *mesh, const double *normal, const double *area, tt__tri_grid *grid,
                                  double eps, double cone, double reach, int *chart, int *tried, int *members,
                                  tt__chart *charts, double *xy, int *seed, int *scratch, unsigned char *border,
-                                 tt__chart_order *order, double *largest)
+                                 tt__chart_order *order, tt__chart_order *order_area, double *largest)
 {
     int ncharts = tt__grow_charts(mesh, normal, area, grid, eps, cos(cone * TT__PI / 180.0), reach, chart, tried,
                                   members, charts, xy), c, f, k;
@@ -17534,9 +17606,13 @@ static int tt__atlas_make_charts(const tt_mesh *mesh, const double *normal, cons
         order[c].area = charts[c].width * charts[c].height;
         order[c].width = charts[c].width;
         order[c].chart = c;
+        order_area[c] = order[c];
+        order_area[c].area = 0.0;
+        for (k = 0; k < charts[c].count; k++) order_area[c].area += area[members[charts[c].first + k]];
         if (charts[c].width > *largest) *largest = charts[c].width;
     }
     tt__sort_chart_order(order, ncharts);
+    tt__sort_chart_order(order_area, ncharts);
     return ncharts;
 }
 
@@ -17557,7 +17633,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     tt_chart_pack_options opt;
     int *need = NULL, *rows_order = NULL, block, side, block_gutter;
     tt__chart *charts = NULL;
-    tt__chart_order *order = NULL;
+    tt__chart_order *order = NULL, *order_area = NULL;
     tt__tri_grid grid;
     tt__packing pack;
     double surface = 0.0, cell, diagonal, reach_cells, best_scale = 0.0;
@@ -17584,6 +17660,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     members = TT__ALLOC(al, int, nf);
     charts = TT__ALLOC(al, tt__chart, nf);
     order = TT__ALLOC(al, tt__chart_order, nf);
+    order_area = TT__ALLOC(al, tt__chart_order, nf);
     box_x = TT__ALLOC(al, int, nf);
     box_y = TT__ALLOC(al, int, nf);
     box_turn = TT__ALLOC(al, int, nf);
@@ -17605,9 +17682,9 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     pack.run = TT__ALLOC(al, int, side);
     need = TT__ALLOC(al, int, side);
     rows_order = TT__ALLOC(al, int, side);
-    if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !box_x || !box_y || !box_turn ||
-        !try_box || !seed || !border || !best_uv || !pack.bits || !pack.mask || !pack.outline || !pack.run || !need ||
-        !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
+    if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !order_area || !box_x ||
+        !box_y || !box_turn || !try_box || !seed || !border || !best_uv || !pack.bits || !pack.mask || !pack.outline ||
+        !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
         goto out_of_memory;
 
     tt__atlas_measure(mesh, normal, area, &surface, &diagonal, &cell);
@@ -17625,7 +17702,7 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
         /* Overlaps smaller than 1e-9 of the diagonal are rounding (neighbours share an edge). */
         ncharts = tt__atlas_make_charts(mesh, normal, area, &grid, 1e-9 * (diagonal > 0.0 ? diagonal : 1.0), cone,
                                         reach, chart, tried, members, charts, xy, seed, try_box, border, order,
-                                        &largest);
+                                        order_area, &largest);
         if (ncharts < 0) goto out_of_memory;
         pack.border = border;
 
@@ -17642,9 +17719,9 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
             if (fewest < 0 || ncharts < fewest) fewest = ncharts;
             continue;
         }
-        result = tt__atlas_search_scale(charts, order, ncharts, members, xy, block_gutter, side, &pack, need,
-                                        rows_order, try_box, nf, &opt, 0.5f * attempt, 0.5f, surface, tiny, box_x,
-                                        box_y, box_turn, &s_lo, error);
+        result = tt__atlas_search_scale(charts, order, order_area, ncharts, members, xy, block_gutter, side, &pack,
+                                        need, rows_order, try_box, nf, &opt, 0.5f * attempt, 0.5f, surface, tiny,
+                                        best_charts ? best_scale : 0.0, box_x, box_y, box_turn, &s_lo, error);
         if (result != TT_OK) goto done;
         if (best_charts == 0 || s_lo > best_scale) {
             best_charts = ncharts;
@@ -17679,6 +17756,7 @@ done:
     tt__free(al, members);
     tt__free(al, charts);
     tt__free(al, order);
+    tt__free(al, order_area);
     tt__free(al, box_x);
     tt__free(al, box_y);
     tt__free(al, box_turn);
