@@ -2430,7 +2430,7 @@ typedef struct tt_chart_atlas_report {
    per texel (per block above 2048 a side). Time O(faces) for the charts
    (with the faces of a chart in a bounded number of grid cells each); the
    packing, five to eight times over for the search of the scale (fewer
-   with a good options->fill_guess) and two to ten times more to refine it
+   with a good options->fill_guess) and two to four times more to refine it
    for each of the two sets of charts (the second set's refinement skipped
    when it cannot catch up with the first; progress reports the first
    set's search up to 0.5), scans the bitmap
@@ -16760,9 +16760,10 @@ static void tt__chart_texel(const double *xy, int face, int k, double s, int gut
    meshes lie within a step or two of TT_ATLAS_FILL_GUESS. */
 #define TT__PACK_BRACKET 1.06
 /* The refinement (tt__atlas_search_scale) steps the scale up by this factor
-   (0.8 % of fill), at most this many times for each other way of packing. */
+   (0.8 % of fill), at most this many times for each other way of packing
+   (on scans and CAD meshes each way gained at most two steps). */
 #define TT__PACK_REFINE 1.004
-#define TT__PACK_REFINE_STEPS 4
+#define TT__PACK_REFINE_STEPS 2
 
 /* Scratch of the bitmap packing: one bit per atlas texel, taken or free
    (rows of `words` 64-bit words), the longest free run of each row, and
@@ -17116,15 +17117,21 @@ static int tt__packing_find(const tt__packing *p, int size, int width, int heigh
 static long tt__packing_waste(const tt__packing *p, int width, int height, int x, int y)
 {
     long waste = 0;
-    int col;
-    for (col = 0; col < width; col++) {
-        int low, row, depth;
-        for (low = 0; low < height; low++)
-            if (p->mask[(size_t)low * p->words + (col >> 6)] >> (col & 63) & 1) break;
-        if (low == height) continue;
-        for (row = y + low - 1, depth = 0; row >= 0 && depth < height; row--, depth++)
-            if (p->bits[(size_t)row * p->words + ((x + col) >> 6)] >> ((x + col) & 63) & 1) break;
-        waste += depth;
+    int nw = (width + 63) / 64, w, low;
+    /* Row by row from the bottom, the columns whose lowest cell it holds. */
+    for (w = 0; w < nw; w++) {
+        uint64_t seen = 0, all = 64 * w + 64 <= width ? ~(uint64_t)0 : ((uint64_t)1 << (width - 64 * w)) - 1;
+        for (low = 0; low < height && seen != all; low++) {
+            uint64_t fresh = p->mask[(size_t)low * p->words + w] & ~seen;
+            seen |= fresh;
+            while (fresh) {
+                int col = x + 64 * w + tt__lowest_bit(fresh), row, depth;
+                fresh &= fresh - 1;
+                for (row = y + low - 1, depth = 0; row >= 0 && depth < height; row--, depth++)
+                    if (p->bits[(size_t)row * p->words + (col >> 6)] >> (col & 63) & 1) break;
+                waste += depth;
+            }
+        }
     }
     return waste;
 }
@@ -17452,9 +17459,9 @@ static tt_result tt__atlas_too_small(int ncharts, int gutter, int size, tt_error
    cannot fill more than the atlas: s_hi never fits, tiny always does. From
    the guess, steps of TT__PACK_BRACKET up while it fits or down while it
    does not bracket the scale; then halving, down to 0.5 % of it. The layout
-   of the last packing that fitted is kept. Then, unless even
-   TT__PACK_REFINE_STEPS steps up would leave the scale below `rival` (the
-   best of another set of charts), each other way of packing the same charts
+   of the last packing that fitted is kept. Then, unless even every step
+   of both ways would leave the scale below `rival` (the best of another
+   set of charts), each other way of packing the same charts
    (tt__pack_bitmap with pack->waste, in order then in order_area) tries
    the scale TT__PACK_REFINE times larger while it fits: packings differ
    by a step or two from chart set to chart set, none best on all, and
@@ -17500,7 +17507,7 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
     if (!packed)
         tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, pack, need, rows_order, box_x,
                         box_y, box_turn);
-    if (packed && s_lo * pow(TT__PACK_REFINE, TT__PACK_REFINE_STEPS) >= rival)
+    if (packed && s_lo * pow(TT__PACK_REFINE, 2 * TT__PACK_REFINE_STEPS) >= rival)
         for (way = 0; way < 2; way++) {
             pack->waste = 1;
             for (step = 0; step < TT__PACK_REFINE_STEPS; step++) {
