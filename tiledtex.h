@@ -3557,10 +3557,14 @@ typedef struct tt_polycube_map_options {
                                        the smoothing's sweeps, with the fraction done, on the calling thread;
                                        non-zero cancels with TT_CANCELLED */
     void *progress_user_data;
+    double max_map_error;   /* how far (in quads: a tile's side) merging the output's pieces may move the
+                               texture; 0 = TT_POLYCUBE_MAP_DEFAULT_ERROR; below 0: no merging (every piece of
+                               the split kept) */
 } tt_polycube_map_options;
 
 #define TT_POLYCUBE_MAP_DEFAULT_EDGE 1.0  /* cubes; see max_edge */
 #define TT_POLYCUBE_MAP_FINER_EDGE 0.5    /* cubes */
+#define TT_POLYCUBE_MAP_DEFAULT_ERROR (1.0 / 256)   /* quads: half a texel of a 128-texel tile */
 
 /* The most triangles tt_polycube_map's refinement (max_edge) may make: a
    max_edge that needs more is refused with TT_ERROR_TOO_LARGE before the
@@ -3595,6 +3599,7 @@ typedef struct tt_polycube_map_report {
                                before fell short (default max_edge only); 0 when the first mapping stands */
     int unpinched;          /* edges split where a triangle at a saddle of S would collapse onto a line
                                (tt_polycube_map, step 5) */
+    int merged;             /* output triangles merged away (step 7) */
 } tt_polycube_map_report;
 
 typedef struct tt_polycube_mapping {
@@ -3701,7 +3706,19 @@ typedef struct tt_polycube_mapping {
           shrunk to fit the quad, over its centroid's projection (a
           clamped projection would fold triangles facing away
           from the quad): a local seam, counted in fallback_triangles,
-          but no flipped piece.
+          but no flipped piece;
+     7. merging: an output vertex the split made is merged into a
+        neighbour (an edge collapse) where the texture moves by at most
+        max_map_error and every triangle around keeps its input face, its
+        quad, and some area turning the same way in both spaces; the move
+        is measured where it is largest (at the two ends and where the old
+        and new edges cross) and adds up within each triangle, so the
+        whole stays within max_map_error. Where the refinement put more
+        vertices than the map needs (a model coarser than the squares) the
+        output loses a sixth to a quarter of its triangles at half a texel,
+        and the slivers a model edge passing a hair from a corner of S
+        cuts off go too. Input vertices and a fallback's vertices stay
+        (report->merged).
    Every split point of an edge is one output vertex shared by the two
    triangles on the edge: a closed manifold model gives a closed manifold
    output. Pieces of zero area (an edge along a lattice line) are dropped,
@@ -3737,7 +3754,7 @@ typedef struct tt_polycube_mapping {
    report may be NULL.
    Results: TT_OK; TT_ERROR_INVALID_ARGUMENT for a NULL polycube, mesh or
    out, a bad allocator, max_quads outside 0..TT_POLYCUBE_EDGE_MAX_QUADS,
-   max_edge not above 0, a face that is not a triangle (error->face;
+   max_edge not above 0, a NaN max_map_error, a face that is not a triangle (error->face;
    triangulate first), two triangles on the same three corners (a part
    with no inside: error->face, error->other_face), or a polycube not
    made by tt_polycube_build;
@@ -29882,6 +29899,714 @@ static int tt__mapping_to_input(tt_polycube_mapping *mapping, const tt__refined 
     return 1;
 }
 
+/* ---- The mapping's pieces merged ---- */
+
+/* The split cuts every refined triangle at each edge of S it crosses, so
+   the output holds a vertex wherever a refined edge meets an edge of S: on
+   a model coarser than the squares, 18 to 26 output triangles per square,
+   most of them there only because the refinement put an edge there. Where
+   the map is near affine such a vertex adds nothing, and merging it into a
+   neighbour (an edge collapse) makes the output smaller without a visible
+   change. The same step takes away the pieces a model edge passing a hair
+   from a corner of S cuts off: slivers thin in both spaces.
+
+   A merge keeps every triangle on its input face and in its quad: the
+   vertex that stays takes the model point of one of the two ends and the
+   point on S of one of them (they may differ: a corner of S a hair off an
+   input edge keeps its place on S and moves onto the edge), each allowed
+   only where it lies on the face, or in the quad, of every triangle
+   around. So the output covers the same surface and the same squares,
+   closed and without T-junctions, as before. A merge is made when every
+   triangle around keeps turning the same way, with some area, in both
+   spaces, and the texture moves by at most the tolerance at the two ends
+   (the map's value at each end's model point against its point on S); a
+   triangle's bound carries what merges before it moved (their sum), so
+   the whole stays within the tolerance. Vertices whose triangles put
+   them at more than one place of S (a fallback's local seam) and input
+   vertices (they keep their index and place) stay. */
+
+#define TT__MERGE_STAR 64       /* triangles around an edge's two ends beyond which it is left */
+#define TT__MERGE_PASSES 12     /* passes over the vertices, each merging an independent set */
+#define TT__MERGE_QUADS 8       /* quads around a vertex beyond which it is left (a corner of S has 3 to 6) */
+#define TT__MERGE_AREA 1e-10    /* twice a triangle's area on S, in quads, below which a merge may not take it */
+
+enum { TT__MERGE_FREE, TT__MERGE_STAYS, TT__MERGE_TOUCHED, TT__MERGE_GONE };
+
+typedef struct tt__merge {
+    tt_polycube_mapping *m;
+    const tt_mesh *mesh;
+    int *start, *items;         /* each vertex's live triangles at the pass's start */
+    unsigned char *state;       /* per vertex: TT__MERGE_* */
+    unsigned char *dead;        /* per triangle: merged away */
+    float *moved;               /* per triangle: how far the texture moved within it so far, in quads */
+    unsigned char *dirty;       /* per vertex: its star changed since it was last tried with the whole tolerance */
+    double *position;           /* per vertex: its model point (3) */
+    double *normal;             /* per input face: its unit normal (3), 0 when it has no area */
+} tt__merge;
+
+/* One candidate merge: a goes, b stays with the model point of `keep_model`
+   and the point on S of `keep_s` (each a or b). */
+typedef struct tt__merge_try {
+    int a, b, keep_model, keep_s;
+    int n, tris[TT__MERGE_STAR];    /* the live triangles around a or b */
+    int na;                         /* the first na of them a's */
+    int nring[2], ring[2][TT__MERGE_STAR], ring_count[TT__MERGE_STAR];  /* a's and b's neighbours */
+    int nquads[2], quad[2][TT__MERGE_QUADS];    /* a's and b's quads among them... */
+    float quad_st[2][TT__MERGE_QUADS][2];      /* ...and their points there */
+    float st[TT__MERGE_STAR][2];    /* the kept point on S in each one's quad (triangles with a or b) */
+    double before[TT__MERGE_STAR][3][3], st_before[TT__MERGE_STAR][3][2];  /* each one's corners now... */
+    double after[TT__MERGE_STAR][3][3], st_after[TT__MERGE_STAR][3][2];    /* ...and after the merge */
+    double moved;
+} tt__merge_try;
+
+/* The model point of output vertex x: its input vertices' weighted sum. */
+static void tt__merge_position(const tt__merge *G, int x, double p[3])
+{
+    memcpy(p, G->position + 3 * (size_t)x, 3 * sizeof(double));
+}
+
+/* 1 when every input vertex that x interpolates lies on input face f. */
+static int tt__merge_on_face(const tt__merge *G, int x, int f)
+{
+    int k, c;
+    for (k = 0; k < 3; k++) {
+        if (!(G->m->weights[3 * x + k] > 0.0f)) continue;
+        for (c = G->mesh->face_start[f]; c < G->mesh->face_start[f + 1]; c++)
+            if (G->mesh->corner_vert[c] == G->m->source[3 * x + k]) break;
+        if (c == G->mesh->face_start[f + 1]) return 0;
+    }
+    return 1;
+}
+
+/* End x's (a or b) point on S in `quad`; 0 when none of its triangles
+   lies in that quad. */
+static int tt__merge_point(const tt__merge_try *T, int x, int quad, float st[2])
+{
+    const int end = x == T->b;
+    int i;
+    for (i = 0; i < T->nquads[end]; i++)
+        if (T->quad[end][i] == quad) {
+            st[0] = T->quad_st[end][i][0];
+            st[1] = T->quad_st[end][i][1];
+            return 1;
+        }
+    return 0;
+}
+
+/* 1 when the triangles around vertex x put it at one place of S: the same
+   (s, t) wherever they share a quad, and a single quad when that place is
+   inside one. A fallback's triangles lay its vertices into a quad of their
+   own, apart from the places their neighbours give them. */
+static int tt__merge_one_place(const tt__merge *G, int x)
+{
+    const tt_surface_point *first = NULL;
+    int i, k, inside = 0, quads = 0;
+    for (i = G->start[x]; i < G->start[x + 1]; i++) {
+        const int t = G->items[i];
+        for (k = 0; k < 3; k++) {
+            const tt_surface_point *p = G->m->corner_points + 3 * (size_t)t + k;
+            if (G->m->triangles[3 * t + k] != x) continue;
+            inside |= p->s > 0.0f && p->s < 1.0f && p->t > 0.0f && p->t < 1.0f;
+            if (!first) {
+                first = p;
+                quads = 1;
+            } else if (p->quad == first->quad) {
+                if (p->s != first->s || p->t != first->t) return 0;
+            } else {
+                quads = 2;
+            }
+        }
+    }
+    return !(inside && quads > 1);
+}
+
+/* 1 when every quad of one end (0: a, 1: b) is a quad of the other: the
+   other's point on S can stand for it in all its triangles. */
+static int tt__merge_quads_within(const tt__merge_try *T, int end)
+{
+    int i, j;
+    for (i = 0; i < T->nquads[end]; i++) {
+        for (j = 0; j < T->nquads[!end] && T->quad[!end][j] != T->quad[end][i]; j++) continue;
+        if (j == T->nquads[!end]) return 0;
+    }
+    return 1;
+}
+
+/* End `end` (0: a, 1: b) of T: its quads and points there, its
+   neighbours (ring[end]) and, for a, how many of its triangles each is on;
+   its live triangles appended to T's (b's without those on a-b, listed
+   from a already), with their corners now. 0 when they pass
+   TT__MERGE_STAR or TT__MERGE_QUADS. */
+static int tt__merge_star_end(const tt__merge *G, tt__merge_try *T, int end)
+{
+    const int x = end ? T->b : T->a;
+    int i, j, k;
+    T->nquads[end] = T->nring[end] = 0;
+    for (i = G->start[x]; i < G->start[x + 1]; i++) {
+        const int t = G->items[i], *v = G->m->triangles + 3 * t;
+        if (G->dead[t]) continue;
+        for (k = 0; k < 3; k++) {
+            const tt_surface_point *p = G->m->corner_points + 3 * (size_t)t + k;
+            if (v[k] != x) continue;
+            for (j = 0; j < T->nquads[end] && T->quad[end][j] != p->quad; j++) continue;
+            if (j < T->nquads[end]) continue;
+            if (j == TT__MERGE_QUADS) return 0;
+            T->quad[end][j] = p->quad;
+            T->quad_st[end][j][0] = p->s;
+            T->quad_st[end][j][1] = p->t;
+            T->nquads[end]++;
+        }
+        if (end && (v[0] == T->a || v[1] == T->a || v[2] == T->a)) continue;   /* listed from a already */
+        if (T->n == TT__MERGE_STAR) return 0;
+        for (k = 0; k < 3; k++) {
+            const tt_surface_point *p = G->m->corner_points + 3 * (size_t)t + k;
+            tt__merge_position(G, v[k], T->before[T->n][k]);
+            T->st_before[T->n][k][0] = p->s;
+            T->st_before[T->n][k][1] = p->t;
+        }
+        T->tris[T->n++] = t;
+        for (k = 0; k < 3; k++) {
+            if (v[k] == x) continue;
+            for (j = 0; j < T->nring[end] && T->ring[end][j] != v[k]; j++) continue;
+            if (j == T->nring[end]) {
+                if (T->nring[end] == TT__MERGE_STAR) return 0;
+                T->ring[end][T->nring[end]++] = v[k];
+                if (!end) T->ring_count[j] = 0;
+            }
+            if (!end) T->ring_count[j]++;
+        }
+    }
+    return 1;
+}
+
+/* a's part of T's star (T->a set): 0 when a is on a boundary (a neighbour
+   on one of its triangles only) or has too many triangles. */
+static int tt__merge_star_a(const tt__merge *G, tt__merge_try *T)
+{
+    int j;
+    T->n = 0;
+    if (!tt__merge_star_end(G, T, 0)) return 0;
+    for (j = 0; j < T->nring[0]; j++)
+        if (T->ring_count[j] != 2) return 0;
+    T->na = T->n;
+    return 1;
+}
+
+/* b's part of T's star (T->b set, a's made): 1 when the edge a-b can
+   close: two triangles on it, and no neighbour shared by a and b but
+   those two triangles' third corners (the link condition: the merge
+   leaves a manifold). */
+static int tt__merge_star_b(const tt__merge *G, tt__merge_try *T)
+{
+    int i, j, on_edge = 0, shared = 0;
+    T->n = T->na;
+    for (i = 0; i < T->na; i++) {
+        const int *v = G->m->triangles + 3 * T->tris[i];
+        on_edge += v[0] == T->b || v[1] == T->b || v[2] == T->b;
+    }
+    if (on_edge != 2 || !tt__merge_star_end(G, T, 1)) return 0;
+    for (j = 0; j < T->nring[0]; j++)
+        for (i = 0; i < T->nring[1]; i++) shared += T->ring[0][j] == T->ring[1][i] && T->ring[0][j] != T->b;
+    return shared == 2;
+}
+
+/* Barycentric coordinates of p in the triangle q (its plane), in l. */
+static void tt__merge_barycentric(const double q[3][3], const double p[3], double l[3])
+{
+    double e1[3], e2[3], n[3], d1[3], d2[3], c[3], nn;
+    int k;
+    for (k = 0; k < 3; k++) {
+        e1[k] = q[1][k] - q[0][k];
+        e2[k] = q[2][k] - q[0][k];
+    }
+    tt__cross3(e1, e2, n);
+    nn = tt__dot3(n, n);
+    for (k = 0; k < 3; k++) {
+        d1[k] = q[2][k] - q[1][k];
+        d2[k] = p[k] - q[1][k];
+    }
+    tt__cross3(d1, d2, c);
+    l[0] = nn > 0.0 ? tt__dot3(c, n) / nn : -1.0;
+    for (k = 0; k < 3; k++) {
+        d1[k] = q[0][k] - q[2][k];
+        d2[k] = p[k] - q[2][k];
+    }
+    tt__cross3(d1, d2, c);
+    l[1] = nn > 0.0 ? tt__dot3(c, n) / nn : -1.0;
+    l[2] = 1.0 - l[0] - l[1];
+}
+
+/* How far the texture moves at end x's model point: the merged star's
+   map there against x's point on S, in quads; -1 when no triangle after
+   the merge holds the point. */
+static double tt__merge_moved_at(const tt__merge *G, const tt__merge_try *T, int x)
+{
+    double p[3], best = -HUGE_VAL, moved = -1.0;
+    int i;
+    if (x == T->keep_model && x == T->keep_s) return 0.0;
+    tt__merge_position(G, x, p);
+    for (i = 0; i < T->n; i++) {
+        const int t = T->tris[i], *v = G->m->triangles + 3 * t;
+        const double (*st_after)[2] = T->st_after[i];
+        double l[3], low;
+        float own[2];
+        if ((v[0] == T->a || v[1] == T->a || v[2] == T->a) && (v[0] == T->b || v[1] == T->b || v[2] == T->b))
+            continue;   /* merged away */
+        if (!tt__merge_on_face(G, x, G->m->triangle_face[t]) ||
+            !tt__merge_point(T, x, G->m->corner_points[3 * t].quad, own))
+            continue;
+        tt__merge_barycentric(T->after[i], p, l);
+        low = fmin(l[0], fmin(l[1], l[2]));
+        if (low > best) {
+            const double s = l[0] * st_after[0][0] + l[1] * st_after[1][0] + l[2] * st_after[2][0] - own[0];
+            const double u = l[0] * st_after[0][1] + l[1] * st_after[1][1] + l[2] * st_after[2][1] - own[1];
+            best = low;
+            moved = sqrt(s * s + u * u);
+        }
+    }
+    return best >= -1e-6 ? moved : -1.0;
+}
+
+/* Where the model edge from p0 to p1 crosses the one from q0 to q1 (both
+   on the plane of unit normal n), strictly inside both: their parameters
+   u and w; 0 when they do not cross so (parallel ones do not). */
+static int tt__merge_crossing(const double p0[3], const double p1[3], const double q0[3], const double q1[3],
+                              const double n[3], double *u, double *w)
+{
+    /* In the plane of the two axes the normal leans least on. */
+    const int drop = fabs(n[0]) >= fabs(n[1]) && fabs(n[0]) >= fabs(n[2]) ? 0 : (fabs(n[1]) >= fabs(n[2]) ? 1 : 2);
+    const int x = (drop + 1) % 3, y = (drop + 2) % 3;
+    const double ex = p1[x] - p0[x], ey = p1[y] - p0[y], fx = q1[x] - q0[x], fy = q1[y] - q0[y];
+    const double gx = q0[x] - p0[x], gy = q0[y] - p0[y], denominator = ex * fy - ey * fx;
+    const double scale = sqrt((ex * ex + ey * ey) * (fx * fx + fy * fy));
+    if (!(fabs(denominator) > 1e-12 * scale)) return 0;
+    *u = (gx * fy - gy * fx) / denominator;
+    *w = (gx * ey - gy * ex) / denominator;
+    return *u > 1e-9 && *u < 1.0 - 1e-9 && *w > 1e-9 && *w < 1.0 - 1e-9;
+}
+
+/* The most merge T moves the texture at the crossings of the edges the
+   dropped model point had with the merged vertex's new ones: with the two
+   ends, the corners of the pieces both triangulations cut the star into,
+   on each of which the move is affine, so its largest is at one of them.
+   A crossing of edges in different quads is measured through another
+   pair of triangles on the same two edges that share a quad; -1 when no
+   pair does (the merge moves texture from one square into another). */
+static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try *T)
+{
+    const int dropped = T->keep_model == T->a ? T->b : T->a, kept = T->keep_model;
+    int need[TT__MERGE_STAR][2], done[TT__MERGE_STAR][2], nneed = 0, ndone = 0, i, j, k, l, q;
+    double moved = 0.0;
+    for (i = 0; i < T->n; i++) {
+        const int ti = T->tris[i], *vi = G->m->triangles + 3 * ti;
+        const double (*before_i)[3] = T->before[i], (*st_before_i)[2] = T->st_before[i];
+        int di;
+        for (di = 0; di < 3 && vi[di] != dropped; di++) continue;
+        if (di == 3) continue;
+        for (k = 1; k < 3; k++) {
+            const int ri = (di + k) % 3;
+            if (vi[ri] == kept) continue;
+            for (j = 0; j < T->n; j++) {
+                const int tj = T->tris[j], *vj = G->m->triangles + 3 * tj;
+                const int has_a = vj[0] == T->a || vj[1] == T->a || vj[2] == T->a;
+                const int has_b = vj[0] == T->b || vj[1] == T->b || vj[2] == T->b;
+                const double (*after)[3] = T->after[j], (*st_after)[2] = T->st_after[j];
+                int mj;
+                if ((has_a && has_b) || G->m->triangle_face[tj] != G->m->triangle_face[ti]) continue;
+                for (mj = 0; mj < 3 && vj[mj] != T->a && vj[mj] != T->b; mj++) continue;
+                for (l = 1; l < 3; l++) {
+                    const int rj = (mj + l) % 3;
+                    const int same = G->m->corner_points[3 * ti].quad == G->m->corner_points[3 * tj].quad;
+                    double u, w;
+                    if (!tt__merge_crossing(before_i[di], before_i[ri], after[mj], after[rj],
+                                            G->normal + 3 * (size_t)G->m->triangle_face[ti], &u, &w))
+                        continue;
+                    if (same) {
+                        const double ds = (1 - u) * st_before_i[di][0] + u * st_before_i[ri][0] -
+                                          (1 - w) * st_after[mj][0] - w * st_after[rj][0];
+                        const double dt = (1 - u) * st_before_i[di][1] + u * st_before_i[ri][1] -
+                                          (1 - w) * st_after[mj][1] - w * st_after[rj][1];
+                        moved = fmax(moved, sqrt(ds * ds + dt * dt));
+                        for (q = 0; q < ndone && (done[q][0] != vi[ri] || done[q][1] != vj[rj]); q++) continue;
+                        if (q == ndone && ndone < TT__MERGE_STAR) {
+                            done[ndone][0] = vi[ri];
+                            done[ndone++][1] = vj[rj];
+                        }
+                    } else {
+                        if (nneed == TT__MERGE_STAR) return -1.0;
+                        need[nneed][0] = vi[ri];
+                        need[nneed++][1] = vj[rj];
+                    }
+                }
+            }
+        }
+    }
+    for (i = 0; i < nneed; i++) {
+        for (q = 0; q < ndone && (done[q][0] != need[i][0] || done[q][1] != need[i][1]); q++) continue;
+        if (q == ndone) return -1.0;
+    }
+    return moved;
+}
+
+/* 1 when merge T is allowed with the texture moving by at most `tolerance`
+   (T->moved gets the new bound of its triangles); without `crossings`,
+   judged at the two ends only (a lower bound, and a quicker one). */
+static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double tolerance, int crossings)
+{
+    double largest = 0.0, moved_before = 0.0, ma, mb, mc;
+    double area[TT__MERGE_STAR];
+    int i, k;
+    /* The places first (cheap, and where most choices fail), the movement
+       at the ends (where most others fail), then the shapes. */
+    for (i = 0; i < T->n; i++) {
+        const int t = T->tris[i], *v = G->m->triangles + 3 * t;
+        moved_before = fmax(moved_before, G->moved[t]);
+        if ((v[0] == T->a || v[1] == T->a || v[2] == T->a) && (v[0] == T->b || v[1] == T->b || v[2] == T->b))
+            continue;   /* merged away */
+        if (v[0] != T->keep_model && v[1] != T->keep_model && v[2] != T->keep_model &&
+            !tt__merge_on_face(G, T->keep_model, G->m->triangle_face[t]))
+            return 0;
+        if (!tt__merge_point(T, T->keep_s, G->m->corner_points[3 * t].quad, T->st[i])) return 0;
+        for (k = 0; k < 3; k++) {
+            if (v[k] == T->a || v[k] == T->b) {
+                tt__merge_position(G, T->keep_model, T->after[i][k]);
+                T->st_after[i][k][0] = T->st[i][0];
+                T->st_after[i][k][1] = T->st[i][1];
+            } else {
+                memcpy(T->after[i][k], T->before[i][k], sizeof T->after[i][k]);
+                T->st_after[i][k][0] = T->st_before[i][k][0];
+                T->st_after[i][k][1] = T->st_before[i][k][1];
+            }
+        }
+    }
+    ma = tt__merge_moved_at(G, T, T->a);
+    mb = tt__merge_moved_at(G, T, T->b);
+    if (ma < 0.0 || mb < 0.0 || moved_before + fmax(ma, mb) > tolerance) return 0;
+    for (i = 0; i < T->n; i++) {
+        const int t = T->tris[i], *v = G->m->triangles + 3 * t;
+        double (*after)[3] = T->after[i], (*before)[3] = T->before[i];
+        double (*st_after)[2] = T->st_after[i], (*st_before)[2] = T->st_before[i];
+        double e1[3], e2[3], n[3], s_after;
+        const int has_a = v[0] == T->a || v[1] == T->a || v[2] == T->a;
+        const int has_b = v[0] == T->b || v[1] == T->b || v[2] == T->b;
+        area[i] = 0.0;
+        if (has_a && has_b) continue;   /* merged away */
+        s_after = tt__orient2(st_after[0][0], st_after[0][1], st_after[1][0], st_after[1][1], st_after[2][0],
+                              st_after[2][1]);
+        if (!(s_after > 0.0) ||
+            (s_after < TT__MERGE_AREA && s_after < tt__orient2(st_before[0][0], st_before[0][1], st_before[1][0],
+                                                               st_before[1][1], st_before[2][0], st_before[2][1])))
+            return 0;
+        for (k = 0; k < 3; k++) {
+            e1[k] = after[1][k] - after[0][k];
+            e2[k] = after[2][k] - after[0][k];
+        }
+        tt__cross3(e1, e2, n);
+        area[i] = tt__dot3(n, G->normal + 3 * (size_t)G->m->triangle_face[t]);
+        if (!(area[i] > 0.0)) return 0;
+        for (k = 0; k < 3; k++) {
+            e1[k] = before[1][k] - before[0][k];
+            e2[k] = before[2][k] - before[0][k];
+        }
+        tt__cross3(e1, e2, n);
+        largest = fmax(largest, tt__length3(n));
+    }
+    /* No triangle made thinner on the model than a millionth of the star's largest. */
+    for (i = 0; i < T->n; i++)
+        if (area[i] != 0.0 && area[i] < 1e-6 * largest) return 0;
+    mc = crossings ? tt__merge_moved_crossings(G, T) : 0.0;
+    if (mc < 0.0) return 0;
+    T->moved = moved_before + fmax(fmax(ma, mb), mc);
+    return T->moved <= tolerance;
+}
+
+/* Make merge T: the triangles on a-b go, the others around a or b take b
+   with the kept model point and point on S. */
+static void tt__merge_apply(tt__merge *G, const tt__merge_try *T)
+{
+    tt_polycube_mapping *m = G->m;
+    int i, k;
+    for (i = 0; i < T->n; i++) {
+        const int t = T->tris[i];
+        int *v = m->triangles + 3 * t;
+        const int has_a = v[0] == T->a || v[1] == T->a || v[2] == T->a;
+        const int has_b = v[0] == T->b || v[1] == T->b || v[2] == T->b;
+        if (has_a && has_b) {
+            G->dead[t] = 1;
+            continue;
+        }
+        for (k = 0; k < 3; k++) {
+            if (v[k] != T->a && v[k] != T->b) continue;
+            v[k] = T->b;
+            m->corner_points[3 * t + k].s = T->st[i][0];
+            m->corner_points[3 * t + k].t = T->st[i][1];
+        }
+        G->moved[t] = (float)T->moved;
+    }
+    if (T->keep_model == T->a) {
+        memcpy(G->position + 3 * (size_t)T->b, G->position + 3 * (size_t)T->a, 3 * sizeof(double));
+        memcpy(m->positions + 3 * (size_t)T->b, m->positions + 3 * (size_t)T->a, 3 * sizeof(float));
+        memcpy(m->source + 3 * (size_t)T->b, m->source + 3 * (size_t)T->a, 3 * sizeof(int));
+        memcpy(m->weights + 3 * (size_t)T->b, m->weights + 3 * (size_t)T->a, 3 * sizeof(float));
+    }
+    G->state[T->a] = TT__MERGE_GONE;
+    /* b's list and its neighbours' stars are stale until the next pass. */
+    for (i = 0; i < T->n; i++)
+        for (k = 0; k < 3; k++) {
+            const int v = m->triangles[3 * T->tris[i] + k];
+            if (G->state[v] != TT__MERGE_GONE) G->state[v] = TT__MERGE_TOUCHED;
+            G->dirty[v] = 1;
+        }
+}
+
+/* A merge judged at its ends: the neighbour, which end keeps what, and
+   the movement there. */
+typedef struct tt__merge_candidate {
+    int b, choice;
+    double moved;
+} tt__merge_candidate;
+
+#define TT__MERGE_CANDIDATES 32   /* of one vertex: its edges times the 4 choices of what stays, at most */
+
+/* The input vertices output vertex x interpolates with some weight: their
+   count, and them in `sources`. */
+static int tt__merge_sources(const tt__merge *G, int x, int sources[3])
+{
+    int k, n = 0;
+    for (k = 0; k < 3; k++)
+        if (G->m->weights[3 * x + k] > 0.0f) sources[n++] = G->m->source[3 * x + k];
+    return n;
+}
+
+/* 1 when every input vertex `from` interpolates is one `onto` does: a
+   point of an input edge or face stays on it at the other's place. */
+static int tt__merge_within(const tt__merge *G, int from, int onto)
+{
+    int a[3], b[3], na = tt__merge_sources(G, from, a), nb = tt__merge_sources(G, onto, b), i, j;
+    for (i = 0; i < na; i++) {
+        for (j = 0; j < nb && b[j] != a[i]; j++) continue;
+        if (j == nb) return 0;
+    }
+    return 1;
+}
+
+/* The choices (bits 1 << choice) of merging a into b worth judging, from
+   triangle t on both: a model point kept must be on the input edge the
+   other lies on (inside an input face, it is on every face around); an
+   input vertex keeps its place; a point on S taken from the other end at
+   the other model point moves the texture there by their distance. */
+static int tt__merge_choices(const tt__merge *G, int t, int a, int b, double tolerance)
+{
+    const tt_surface_point *p = G->m->corner_points + 3 * (size_t)t;
+    int sources[3], choices = 15, k, ka = 0, kb = 0;
+    double ds, dt;
+    for (k = 0; k < 3; k++) {
+        if (G->m->triangles[3 * t + k] == a) ka = k;
+        if (G->m->triangles[3 * t + k] == b) kb = k;
+    }
+    if (tt__merge_sources(G, a, sources) < 3 && !tt__merge_within(G, b, a)) choices &= ~(1 | 4);
+    if (b < G->mesh->nverts || (tt__merge_sources(G, b, sources) < 3 && !tt__merge_within(G, a, b)))
+        choices &= ~(2 | 8);
+    ds = (double)p[ka].s - p[kb].s;
+    dt = (double)p[ka].t - p[kb].t;
+    if (ds * ds + dt * dt > tolerance * tolerance) choices &= ~(2 | 4);
+    return choices;
+}
+
+/* The merge T of a into b with `choice` (bit 0: the model point a's, bit
+   1: the point on S a's), judged at its ends or (crossings) in full. */
+static int tt__merge_try_choice(const tt__merge *G, tt__merge_try *T, int a, int b, int choice, double tolerance,
+                                int crossings)
+{
+    T->a = a;
+    T->b = b;
+    T->keep_model = choice & 1 ? a : b;
+    T->keep_s = choice & 2 ? a : b;
+    return tt__merge_check(G, T, tolerance, crossings);
+}
+
+/* The merge of vertex a into a neighbour that moves the texture least, in
+   best; 0 when none is allowed. The merges are judged at their ends
+   first, then in full from the least moving one until one holds (most
+   vertices have none that holds even at the ends). */
+static int tt__merge_vertex(const tt__merge *G, int a, double tolerance, tt__merge_try *best, tt__merge_try *T)
+{
+    tt__merge_candidate candidate[TT__MERGE_CANDIDATES];
+    int i, j, k, n = 0;
+    T->a = a;
+    if (!tt__merge_star_a(G, T)) return 0;
+    for (i = G->start[a]; i < G->start[a + 1]; i++) {
+        const int t = G->items[i];
+        if (G->dead[t]) continue;
+        for (k = 0; k < 3; k++) {
+            const int b = G->m->triangles[3 * t + k];
+            int choice, allowed;
+            if (b == a || G->state[b] != TT__MERGE_FREE) continue;
+            /* each edge a-b is seen from both its triangles: try it once, from the one where b follows a */
+            if (G->m->triangles[3 * t + (k + 2) % 3] != a) continue;
+            allowed = tt__merge_choices(G, t, a, b, tolerance);
+            if (!allowed) continue;
+            T->b = b;
+            if (!tt__merge_star_b(G, T)) continue;
+            for (choice = 0; choice < 4 && n < TT__MERGE_CANDIDATES; choice++) {
+                if (!(allowed & 1 << choice)) continue;
+                if (!tt__merge_quads_within(T, choice & 2 ? 1 : 0)) continue;
+                if (!tt__merge_try_choice(G, T, a, b, choice, tolerance, 0)) continue;
+                candidate[n].b = b;
+                candidate[n].choice = choice;
+                candidate[n++].moved = T->moved;
+            }
+        }
+    }
+    while (n > 0) {
+        for (i = 1, j = 0; i < n; i++)
+            if (candidate[i].moved < candidate[j].moved) j = i;
+        T->b = candidate[j].b;
+        if (tt__merge_star_b(G, T) &&
+            tt__merge_try_choice(G, T, a, candidate[j].b, candidate[j].choice, tolerance, 1)) {
+            *best = *T;
+            return 1;
+        }
+        candidate[j] = candidate[--n];
+    }
+    return 0;
+}
+
+/* Vertex -> live triangles, and the states for a pass. */
+static void tt__merge_lists(tt__merge *G)
+{
+    const tt_polycube_mapping *m = G->m;
+    int v, t, k;
+    memset(G->start, 0, sizeof(int) * ((size_t)m->nverts + 1));
+    for (t = 0; t < m->ntriangles; t++)
+        for (k = 0; k < 3 && !G->dead[t]; k++) G->start[m->triangles[3 * t + k] + 1]++;
+    for (v = 0; v < m->nverts; v++) G->start[v + 1] += G->start[v];
+    for (t = 0; t < m->ntriangles; t++)
+        for (k = 0; k < 3 && !G->dead[t]; k++) G->items[G->start[m->triangles[3 * t + k]]++] = t;
+    for (v = m->nverts; v > 0; v--) G->start[v] = G->start[v - 1];
+    G->start[0] = 0;
+    for (v = 0; v < m->nverts; v++)
+        if (G->state[v] != TT__MERGE_GONE)
+            G->state[v] = tt__merge_one_place(G, v) ? TT__MERGE_FREE : TT__MERGE_STAYS;
+}
+
+/* Drop the merged triangles and vertices, keeping the input vertices'
+   indices. */
+static void tt__merge_compact(tt__merge *G)
+{
+    tt_polycube_mapping *m = G->m;
+    int *index = G->start, v, t, nv = 0, nt = 0;
+    for (v = 0; v < m->nverts; v++) {
+        index[v] = G->state[v] == TT__MERGE_GONE ? -1 : nv;
+        if (index[v] < 0) continue;
+        if (nv != v) {
+            memcpy(m->positions + 3 * (size_t)nv, m->positions + 3 * (size_t)v, 3 * sizeof(float));
+            memcpy(m->source + 3 * (size_t)nv, m->source + 3 * (size_t)v, 3 * sizeof(int));
+            memcpy(m->weights + 3 * (size_t)nv, m->weights + 3 * (size_t)v, 3 * sizeof(float));
+        }
+        nv++;
+    }
+    for (t = 0; t < m->ntriangles; t++) {
+        int k;
+        if (G->dead[t]) continue;
+        for (k = 0; k < 3; k++) {
+            m->triangles[3 * nt + k] = index[m->triangles[3 * t + k]];
+            m->corner_points[3 * nt + k] = m->corner_points[3 * t + k];
+        }
+        m->triangle_face[nt] = m->triangle_face[t];
+        nt++;
+    }
+    m->nverts = nv;
+    m->ntriangles = nt;
+}
+
+/* Merge the mapping's needless vertices (see above) with the texture
+   moving by at most `tolerance` quads; returns the triangles removed, -1
+   when out of memory (the mapping unchanged). */
+static int tt__mapping_merge(tt_polycube_mapping *m, const tt_mesh *mesh, double tolerance,
+                             const tt_allocator *allocator)
+{
+    tt__merge G;
+    tt__merge_try *tries;
+    int before = m->ntriangles, pass, a;
+    memset(&G, 0, sizeof G);
+    G.m = m;
+    G.mesh = mesh;
+    G.start = TT__ALLOC(allocator, int, (size_t)m->nverts + 1);
+    G.items = TT__ALLOC(allocator, int, 3 * (size_t)m->ntriangles);
+    G.state = TT__ALLOC(allocator, unsigned char, m->nverts);
+    G.dead = TT__ALLOC(allocator, unsigned char, m->ntriangles);
+    G.moved = TT__ALLOC(allocator, float, m->ntriangles);
+    G.dirty = TT__ALLOC(allocator, unsigned char, m->nverts);
+    G.position = TT__ALLOC(allocator, double, 3 * (size_t)m->nverts);
+    G.normal = TT__ALLOC(allocator, double, 3 * (size_t)mesh->nfaces);
+    tries = TT__ALLOC(allocator, tt__merge_try, 2);
+    if (!G.start || !G.items || !G.state || !G.dead || !G.moved || !G.dirty || !G.position || !G.normal || !tries) {
+        before = -1;
+        goto done;
+    }
+    memset(G.state, TT__MERGE_FREE, (size_t)m->nverts);
+    memset(G.dirty, 1, (size_t)m->nverts);
+    memset(G.dead, 0, (size_t)m->ntriangles);
+    memset(G.moved, 0, sizeof(float) * (size_t)m->ntriangles);
+    for (a = 0; a < m->nverts; a++) {
+        double *p = G.position + 3 * (size_t)a;
+        int k;
+        p[0] = p[1] = p[2] = 0.0;
+        for (k = 0; k < 3; k++) {
+            const float *q = mesh->pos + 3 * (size_t)m->source[3 * a + k];
+            const double w = m->weights[3 * a + k];
+            p[0] += w * q[0]; p[1] += w * q[1]; p[2] += w * q[2];
+        }
+    }
+    for (a = 0; a < mesh->nfaces; a++) tt__face_normal_d(mesh, a, G.normal + 3 * (size_t)a);
+    for (pass = 0; pass < TT__MERGE_PASSES; pass++) {
+        /* A vertex is tried again only when its star changed. */
+        int merged = 0;
+        tt__merge_lists(&G);
+        for (a = mesh->nverts; a < m->nverts; a++) {
+            if (G.state[a] != TT__MERGE_FREE || !G.dirty[a]) continue;
+            if (tt__merge_vertex(&G, a, tolerance, &tries[0], &tries[1])) {
+                tt__merge_apply(&G, &tries[0]);
+                merged++;
+            } else {
+                G.dirty[a] = 0;
+            }
+        }
+        if (!merged) break;
+    }
+    tt__merge_compact(&G);
+    before -= m->ntriangles;
+done:
+    tt__free(allocator, G.start);
+    tt__free(allocator, G.items);
+    tt__free(allocator, G.state);
+    tt__free(allocator, G.dead);
+    tt__free(allocator, G.moved);
+    tt__free(allocator, G.dirty);
+    tt__free(allocator, G.position);
+    tt__free(allocator, G.normal);
+    tt__free(allocator, tries);
+    return before;
+}
+
+/* The mapping's output triangles that turn clockwise on S (report->flipped)
+   or have no area there (report->collapsed); troubled (per input face, may
+   be NULL) gets a flag on the faces of both. */
+static void tt__mapping_count_turns(const tt_polycube_mapping *mapping, tt_polycube_map_report *report,
+                                    unsigned char *troubled)
+{
+    int j;
+    report->flipped = report->collapsed = 0;
+    for (j = 0; j < mapping->ntriangles; j++) {
+        const tt_surface_point *p = mapping->corner_points + 3 * j;
+        const double turn = tt__orient2(p[0].s, p[0].t, p[1].s, p[1].t, p[2].s, p[2].t);
+        report->flipped += turn < -TT__SPLIT_AREA;
+        report->collapsed += fabs(turn) <= TT__SPLIT_AREA;
+        if (troubled && turn <= TT__SPLIT_AREA) troubled[mapping->triangle_face[j]] = 1;
+    }
+}
+
 #define TT__MAP_ROUNDS 3             /* mappings tt_polycube_map makes at most by default, each finer where
                                        the ones before fell short */
 #define TT__MAP_REFINE_SHARE 10000   /* one face in this many to refine makes another mapping worth its cost */
@@ -29909,7 +30634,7 @@ static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mes
     tt_polycube_mapping *mapping = NULL;
     tt_result result;
     const tt_executor *executor = options ? options->executor : NULL;
-    int f, j, max_quads;
+    int f, max_quads;
     *out = NULL;
     memset(report, 0, sizeof *report);
     memset(&R, 0, sizeof R);
@@ -29956,13 +30681,7 @@ static tt_result tt__polycube_map_pass(const tt_polycube *polycube, const tt_mes
                            &report->fallback_triangles, fell_back) != TT_OK)
         goto out_of_memory;
     if (!tt__mapping_to_input(mapping, &R, mesh, allocator, &report->split_triangles)) goto out_of_memory;
-    for (j = 0; j < mapping->ntriangles; j++) {
-        const tt_surface_point *p = mapping->corner_points + 3 * j;
-        double turn = tt__orient2(p[0].s, p[0].t, p[1].s, p[1].t, p[2].s, p[2].t);
-        report->flipped += turn < -TT__SPLIT_AREA;
-        report->collapsed += fabs(turn) <= TT__SPLIT_AREA;
-        if (troubled && turn <= TT__SPLIT_AREA) troubled[mapping->triangle_face[j]] = 1;
-    }
+    tt__mapping_count_turns(mapping, report, troubled);
     for (f = 0; fell_back && f < model->nfaces; f++)
         if (fell_back[f]) troubled[R.face ? R.face[f] : f] = 1;
     tt__free(allocator, fell_back);
@@ -30032,6 +30751,9 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "the polycube's surface has no quads or does not match its cubes: make it with "
                         "tt_polycube_build and leave it unchanged");
+    if (options && options->max_map_error != options->max_map_error)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "max_map_error is NaN: give quads (0 for the default, below 0 for no merging)");
     longest = options && options->max_edge != 0.0 ? options->max_edge : TT_POLYCUBE_MAP_DEFAULT_EDGE * polycube->h;
     if (!(longest > 0.0))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -30093,6 +30815,15 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     }
     progress.base = 0.0f;
     progress.scale = 1.0f;
+    if (result == TT_OK && !(options && options->max_map_error < 0.0)) {
+        const double tolerance =
+            options && options->max_map_error > 0.0 ? options->max_map_error : TT_POLYCUBE_MAP_DEFAULT_ERROR;
+        if ((report->merged = tt__mapping_merge(mapping, mesh, tolerance, allocator)) < 0) {
+            report->merged = 0;
+            result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory merging the mapping's pieces");
+        }
+        if (result == TT_OK) tt__mapping_count_turns(mapping, report, NULL);
+    }
     if (result == TT_OK && tt__map_progress_phase(&progress, 1.0f, 1.0f))
         result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "polycube mapping cancelled by the progress callback");
     if (result != TT_OK) {

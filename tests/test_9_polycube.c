@@ -2351,6 +2351,146 @@ static void test_map_refine_where_needed(void)
     tm_free(&m);
 }
 
+/* How far a merged mapping moves the texture from the unmerged one: each
+   unmerged piece's centroid, found in a merged triangle of the same input
+   face and quad, gets a point on S there; the largest distance from the
+   centroid's own point, in quads. *unfound counts centroids no merged
+   triangle of their face holds in their quad (a grid line's preimage
+   straightened by a merge can move a piece's centroid across it). */
+static double merge_moved(const tt_polycube_mapping *ref, const tt_polycube_mapping *merged, int nfaces,
+                          int *unfound)
+{
+    int *start = (int *)calloc((size_t)nfaces + 1, sizeof(int)), *items = (int *)malloc(sizeof(int) * (size_t)merged->ntriangles);
+    double worst = 0.0;
+    int f, j, i;
+    *unfound = 0;
+    if (!start || !items) {
+        free(start);
+        free(items);
+        *unfound = ref->ntriangles;
+        return HUGE_VAL;
+    }
+    for (j = 0; j < merged->ntriangles; j++) start[merged->triangle_face[j] + 1]++;
+    for (f = 0; f < nfaces; f++) start[f + 1] += start[f];
+    for (j = 0; j < merged->ntriangles; j++) items[start[merged->triangle_face[j]]++] = j;
+    for (f = nfaces; f > 0; f--) start[f] = start[f - 1];
+    start[0] = 0;
+    for (j = 0; j < ref->ntriangles; j++) {
+        const int face = ref->triangle_face[j], quad = ref->corner_points[3 * j].quad;
+        double p[3] = {0, 0, 0}, s = 0, t = 0, best = -HUGE_VAL, moved = 0;
+        int k, a;
+        for (k = 0; k < 3; k++) {
+            for (a = 0; a < 3; a++) p[a] += ref->positions[3 * ref->triangles[3 * j + k] + a] / 3.0;
+            s += ref->corner_points[3 * j + k].s / 3.0;
+            t += ref->corner_points[3 * j + k].t / 3.0;
+        }
+        for (i = start[face]; i < start[face + 1]; i++) {
+            const int g = items[i];
+            double q[3][3], e1[3], e2[3], d[3], n[3], c[3], nn, l[3];
+            if (merged->corner_points[3 * g].quad != quad) continue;
+            for (k = 0; k < 3; k++)
+                for (a = 0; a < 3; a++) q[k][a] = merged->positions[3 * merged->triangles[3 * g + k] + a];
+            for (a = 0; a < 3; a++) {
+                e1[a] = q[1][a] - q[0][a];
+                e2[a] = q[2][a] - q[0][a];
+            }
+            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+            if (!(nn > 0.0)) continue;
+            for (k = 0; k < 3; k++) {
+                const double *u = q[(k + 1) % 3], *w = q[(k + 2) % 3];
+                for (a = 0; a < 3; a++) {
+                    e1[a] = w[a] - u[a];
+                    d[a] = p[a] - u[a];
+                }
+                c[0] = e1[1] * d[2] - e1[2] * d[1];
+                c[1] = e1[2] * d[0] - e1[0] * d[2];
+                c[2] = e1[0] * d[1] - e1[1] * d[0];
+                l[k] = (c[0] * n[0] + c[1] * n[1] + c[2] * n[2]) / nn;
+            }
+            if (fmin(l[0], fmin(l[1], l[2])) > best) {
+                double ds = -s, dt = -t;
+                for (k = 0; k < 3; k++) {
+                    ds += l[k] * merged->corner_points[3 * g + k].s;
+                    dt += l[k] * merged->corner_points[3 * g + k].t;
+                }
+                best = fmin(l[0], fmin(l[1], l[2]));
+                moved = sqrt(ds * ds + dt * dt);
+            }
+        }
+        if (best < -1e-4) (*unfound)++;
+        else worst = fmax(worst, moved);
+    }
+    free(start);
+    free(items);
+    return worst;
+}
+
+/* Step 7, the pieces merged: on a coarse sphere (its triangles span
+   several squares, so the split leaves many vertices inside them) the
+   default mapping has fewer triangles than with merging off
+   (max_map_error below 0), is as sound (on the model, the area kept,
+   closed, each triangle in one quad, none flipped), and its texture stays
+   within max_map_error of the unmerged one. Control: merged with 0.05
+   quads, the same measure finds it moved past the default's bound. */
+static void test_map_merge(void)
+{
+    const double centre[3] = {0.02, -0.03, 0.01};
+    tmesh m;
+    tt_mesh *mesh;
+    tt_polycube *pc;
+    tt_polycube_map_report rep, ref_rep, loose_rep;
+    tt_polycube_map_options mo;
+    tt_polycube_mapping *map, *ref = NULL, *loose = NULL;
+    tt_error err;
+    memset(&m, 0, sizeof m);
+    memset(&mo, 0, sizeof mo);
+    make_sphere(&m, 16, 8, 1.0, centre, 0);
+    map = mapped(&m, 24, 0, 0.0, &pc, &mesh, &rep);
+    if (map) {
+        mo.max_map_error = -1.0;
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &ref, &ref_rep, &err) == TT_OK, "unmerged: %s", err.message);
+        mo.max_map_error = NAN;
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &loose, &loose_rep, &err) == TT_ERROR_INVALID_ARGUMENT && !loose,
+              "a NaN max_map_error is refused");
+        mo.max_map_error = 0.05;
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &loose, &loose_rep, &err) == TT_OK, "loose: %s", err.message);
+    }
+    if (map && ref && loose) {
+        const mapping_check c = check_mapping(pc, mesh, map);
+        int unfound, loose_unfound;
+        const double moved = merge_moved(ref, map, mesh->nfaces, &unfound);
+        const double loose_moved = merge_moved(ref, loose, mesh->nfaces, &loose_unfound);
+        printf("     coarse sphere at 24: %d triangles unmerged, %d merged by default (texture moved %.2g quads, "
+               "%d centroids across a line), %d at 0.05 quads (moved %.2g)\n", ref->ntriangles, map->ntriangles,
+               moved, unfound, loose->ntriangles, loose_moved);
+        CHECK(ref_rep.merged == 0 && rep.merged == ref->ntriangles - map->ntriangles &&
+                  map->ntriangles <= 0.95 * ref->ntriangles && loose->ntriangles < map->ntriangles,
+              "merging: %d triangles unmerged, %d by default (report %d), %d at 0.05", ref->ntriangles,
+              map->ntriangles, rep.merged, loose->ntriangles);
+        CHECK(mapping_sound(&c) && c.moved_inputs == 0 && rep.flipped == 0 &&
+                  rep.fallback_triangles == ref_rep.fallback_triangles,
+              "the merged mapping is sound (%d off the model, %d inputs moved, %d bad points, area error %.2g, "
+              "strict build %s, %d open edges), %d flipped, %d fallbacks (unmerged %d)", c.off_surface,
+              c.moved_inputs, c.bad_points, c.area_error, c.strict_fails ? "fails" : "holds", c.open_edges,
+              rep.flipped, rep.fallback_triangles, ref_rep.fallback_triangles);
+        CHECK(moved <= TT_POLYCUBE_MAP_DEFAULT_ERROR + 1e-5 && unfound <= ref->ntriangles / 100,
+              "the texture moved %.3g quads (at most %.3g), %d of %d centroids not found", moved,
+              TT_POLYCUBE_MAP_DEFAULT_ERROR, unfound, ref->ntriangles);
+        CHECK(loose_moved > TT_POLYCUBE_MAP_DEFAULT_ERROR + 1e-5 && loose_moved <= 0.05 + 1e-5,
+              "control: merged within 0.05 quads the texture moved %.3g (above the default's %.3g)", loose_moved,
+              TT_POLYCUBE_MAP_DEFAULT_ERROR);
+    }
+    tt_polycube_mapping_free(map);
+    tt_polycube_mapping_free(ref);
+    tt_polycube_mapping_free(loose);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
+    tm_free(&m);
+}
+
 /* The seam tests' tiles: n = 2, 32-texel tiles with a 4-texel gutter, seed 3,
    from a 160 x 256 value noise (*photo, to free); NULL on failure. */
 static tt_tileset *seam_test_tiles(tt_synth_options *so, tt_image **photo)
@@ -3932,6 +4072,7 @@ void run_polycube_tests(void)
     RUN(test_map_cube);
     RUN(test_map_sphere);
     RUN(test_map_refine_where_needed);
+    RUN(test_map_merge);
     RUN(test_map_unpinch);
     RUN(test_map_uvs_and_seams);
     RUN(test_map_uvs_upright);
