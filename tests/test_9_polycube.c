@@ -1356,6 +1356,28 @@ static void test_polycube_auto_resolution(void)
     tt_polycube_free(pc);
     tt_polycube_free(plain);
     tt_mesh_free(mesh);
+    pc = plain = NULL;
+    mesh = NULL;
+    tm_free(&ring);
+
+    /* A hole 0.2 across (4.6 outside) closes up to 64: past it, only the genus goes on (72 here); with
+       max_resolution 64 the search stops short, at the lowest of the closest genus. */
+    memset(&ring, 0, sizeof ring);
+    make_torus(&ring, 96, 48, 1.2, 1.1);
+    CHECK(build(&ring, 0, &mesh, &err) == TT_OK, "narrow ring builds");
+    if (mesh && tt_polycube_build_auto(mesh, NULL, 0, NULL, &pc, &rep, &tried, &err) == TT_OK)
+        CHECK(!rep.genus_differs && rep.polycube_genus == 1 &&
+                  rep.resolution > 64 && tried.genus[4] == 0 && tried.resolution[4] == 64,
+              "past 64 for the genus: genus %d at %d (at 64: genus %d)", rep.polycube_genus, rep.resolution,
+              tried.genus[4]);
+    tt_polycube_free(pc);
+    pc = NULL;
+    if (mesh && tt_polycube_build_auto(mesh, NULL, 64, NULL, &pc, &rep, &tried, &err) == TT_OK)
+        CHECK(rep.genus_differs && rep.polycube_genus == 0 && tried.tries == 5 && rep.resolution == 16,
+              "control: up to 64 the hole stays closed (genus %d at %d after %d tries)", rep.polycube_genus,
+              rep.resolution, tried.tries);
+    tt_polycube_free(pc);
+    tt_mesh_free(mesh);
     tm_free(&sphere);
     tm_free(&needle);
     tm_free(&ring);
