@@ -29958,6 +29958,7 @@ typedef struct tt__merge_try {
     int a, b, keep_model, keep_s;
     int n, tris[TT__MERGE_STAR];    /* the live triangles around a or b */
     int na;                         /* the first na of them a's */
+    unsigned char gone[TT__MERGE_STAR]; /* 1 for the two on the edge a-b, which the merge removes */
     int nring[2], ring[2][TT__MERGE_STAR], ring_count[TT__MERGE_STAR];  /* a's and b's neighbours */
     int nquads[2], quad[2][TT__MERGE_QUADS];    /* a's and b's quads among them... */
     float quad_st[2][TT__MERGE_QUADS][2];      /* ...and their points there */
@@ -29973,17 +29974,24 @@ static void tt__merge_position(const tt__merge *G, int x, double p[3])
     memcpy(p, G->position + 3 * (size_t)x, 3 * sizeof(double));
 }
 
-/* 1 when every input vertex that x interpolates lies on input face f. */
-static int tt__merge_on_face(const tt__merge *G, int x, int f)
+/* 1 when every input vertex that x interpolates (with some weight) is
+   one of the n in `set`. */
+static int tt__merge_sources_in(const tt__merge *G, int x, const int *set, int n)
 {
-    int k, c;
+    int k, i;
     for (k = 0; k < 3; k++) {
         if (!(G->m->weights[3 * x + k] > 0.0f)) continue;
-        for (c = G->mesh->face_start[f]; c < G->mesh->face_start[f + 1]; c++)
-            if (G->mesh->corner_vert[c] == G->m->source[3 * x + k]) break;
-        if (c == G->mesh->face_start[f + 1]) return 0;
+        for (i = 0; i < n && set[i] != G->m->source[3 * x + k]; i++) continue;
+        if (i == n) return 0;
     }
     return 1;
+}
+
+/* 1 when x lies on input face f: every input vertex it interpolates is a corner of f. */
+static int tt__merge_on_face(const tt__merge *G, int x, int f)
+{
+    const int begin = G->mesh->face_start[f];
+    return tt__merge_sources_in(G, x, G->mesh->corner_vert + begin, G->mesh->face_start[f + 1] - begin);
 }
 
 /* End x's (a or b) point on S in `quad`; 0 when none of its triangles
@@ -30110,9 +30118,10 @@ static int tt__merge_star_b(const tt__merge *G, tt__merge_try *T)
     T->n = T->na;
     for (i = 0; i < T->na; i++) {
         const int *v = G->m->triangles + 3 * T->tris[i];
-        on_edge += v[0] == T->b || v[1] == T->b || v[2] == T->b;
+        on_edge += T->gone[i] = v[0] == T->b || v[1] == T->b || v[2] == T->b;
     }
     if (on_edge != 2 || !tt__merge_star_end(G, T, 1)) return 0;
+    memset(T->gone + T->na, 0, (size_t)(T->n - T->na));   /* b's own list leaves out those on a-b */
     for (j = 0; j < T->nring[0]; j++)
         for (i = 0; i < T->nring[1]; i++) shared += T->ring[0][j] == T->ring[1][i] && T->ring[0][j] != T->b;
     return shared == 2;
@@ -30154,12 +30163,11 @@ static double tt__merge_moved_at(const tt__merge *G, const tt__merge_try *T, int
     if (x == T->keep_model && x == T->keep_s) return 0.0;
     tt__merge_position(G, x, p);
     for (i = 0; i < T->n; i++) {
-        const int t = T->tris[i], *v = G->m->triangles + 3 * t;
+        const int t = T->tris[i];
         const double (*st_after)[2] = T->st_after[i];
         double l[3], low;
         float own[2];
-        if ((v[0] == T->a || v[1] == T->a || v[2] == T->a) && (v[0] == T->b || v[1] == T->b || v[2] == T->b))
-            continue;   /* merged away */
+        if (T->gone[i]) continue;
         if (!tt__merge_on_face(G, x, G->m->triangle_face[t]) ||
             !tt__merge_point(T, x, G->m->corner_points[3 * t].quad, own))
             continue;
@@ -30216,11 +30224,9 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
             if (vi[ri] == kept) continue;
             for (j = 0; j < T->n; j++) {
                 const int tj = T->tris[j], *vj = G->m->triangles + 3 * tj;
-                const int has_a = vj[0] == T->a || vj[1] == T->a || vj[2] == T->a;
-                const int has_b = vj[0] == T->b || vj[1] == T->b || vj[2] == T->b;
                 const double (*after)[3] = T->after[j], (*st_after)[2] = T->st_after[j];
                 int mj;
-                if ((has_a && has_b) || G->m->triangle_face[tj] != G->m->triangle_face[ti]) continue;
+                if (T->gone[j] || G->m->triangle_face[tj] != G->m->triangle_face[ti]) continue;
                 for (mj = 0; mj < 3 && vj[mj] != T->a && vj[mj] != T->b; mj++) continue;
                 for (l = 1; l < 3; l++) {
                     const int rj = (mj + l) % 3;
@@ -30269,8 +30275,7 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
     for (i = 0; i < T->n; i++) {
         const int t = T->tris[i], *v = G->m->triangles + 3 * t;
         moved_before = fmax(moved_before, G->moved[t]);
-        if ((v[0] == T->a || v[1] == T->a || v[2] == T->a) && (v[0] == T->b || v[1] == T->b || v[2] == T->b))
-            continue;   /* merged away */
+        if (T->gone[i]) continue;
         if (v[0] != T->keep_model && v[1] != T->keep_model && v[2] != T->keep_model &&
             !tt__merge_on_face(G, T->keep_model, G->m->triangle_face[t]))
             return 0;
@@ -30291,14 +30296,12 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
     mb = tt__merge_moved_at(G, T, T->b);
     if (ma < 0.0 || mb < 0.0 || moved_before + fmax(ma, mb) > tolerance) return 0;
     for (i = 0; i < T->n; i++) {
-        const int t = T->tris[i], *v = G->m->triangles + 3 * t;
+        const int t = T->tris[i];
         double (*after)[3] = T->after[i], (*before)[3] = T->before[i];
         double (*st_after)[2] = T->st_after[i], (*st_before)[2] = T->st_before[i];
         double e1[3], e2[3], n[3], s_after;
-        const int has_a = v[0] == T->a || v[1] == T->a || v[2] == T->a;
-        const int has_b = v[0] == T->b || v[1] == T->b || v[2] == T->b;
         area[i] = 0.0;
-        if (has_a && has_b) continue;   /* merged away */
+        if (T->gone[i]) continue;
         s_after = tt__orient2(st_after[0][0], st_after[0][1], st_after[1][0], st_after[1][1], st_after[2][0],
                               st_after[2][1]);
         if (!(s_after > 0.0) ||
@@ -30337,9 +30340,7 @@ static void tt__merge_apply(tt__merge *G, const tt__merge_try *T)
     for (i = 0; i < T->n; i++) {
         const int t = T->tris[i];
         int *v = m->triangles + 3 * t;
-        const int has_a = v[0] == T->a || v[1] == T->a || v[2] == T->a;
-        const int has_b = v[0] == T->b || v[1] == T->b || v[2] == T->b;
-        if (has_a && has_b) {
+        if (T->gone[i]) {
             G->dead[t] = 1;
             continue;
         }
@@ -30390,12 +30391,8 @@ static int tt__merge_sources(const tt__merge *G, int x, int sources[3])
    point of an input edge or face stays on it at the other's place. */
 static int tt__merge_within(const tt__merge *G, int from, int onto)
 {
-    int a[3], b[3], na = tt__merge_sources(G, from, a), nb = tt__merge_sources(G, onto, b), i, j;
-    for (i = 0; i < na; i++) {
-        for (j = 0; j < nb && b[j] != a[i]; j++) continue;
-        if (j == nb) return 0;
-    }
-    return 1;
+    int sources[3];
+    return tt__merge_sources_in(G, from, sources, tt__merge_sources(G, onto, sources));
 }
 
 /* The choices (bits 1 << choice) of merging a into b worth judging, from
