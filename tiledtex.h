@@ -30201,18 +30201,33 @@ static int tt__merge_crossing(const double p0[3], const double p1[3], const doub
     return *u > 1e-9 && *u < 1.0 - 1e-9 && *w > 1e-9 && *w < 1.0 - 1e-9;
 }
 
+/* The distance in `quad` from the point at u along the segment p0-p1 to
+   the merged vertex's point on S there; -1 when that quad has none. */
+static double tt__merge_to_kept(const tt__merge_try *T, int quad, const double p0[2], const double p1[2], double u)
+{
+    float kept[2];
+    double ds, dt;
+    if (!tt__merge_point(T, T->keep_s, quad, kept)) return -1.0;
+    ds = (1 - u) * p0[0] + u * p1[0] - kept[0];
+    dt = (1 - u) * p0[1] + u * p1[1] - kept[1];
+    return sqrt(ds * ds + dt * dt);
+}
+
 /* The most merge T moves the texture at the crossings of the edges the
    dropped model point had with the merged vertex's new ones: with the two
    ends, the corners of the pieces both triangulations cut the star into,
    on each of which the move is affine, so its largest is at one of them.
    A crossing of edges in different quads is measured through another
-   pair of triangles on the same two edges that share a quad; -1 when no
-   pair does (the merge moves texture from one square into another). */
+   pair of triangles on the same two edges that share a quad; where no
+   pair does, by the way through the merged vertex's point on S, which
+   both quads hold: the two points' distances to it, added (near a corner
+   of S that the merge keeps, a hair's move from one square into the
+   next; far from it, more than any tolerance). */
 static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try *T)
 {
     const int dropped = T->keep_model == T->a ? T->b : T->a, kept = T->keep_model;
     int need[TT__MERGE_STAR][2], done[TT__MERGE_STAR][2], nneed = 0, ndone = 0, i, j, k, l, q;
-    double moved = 0.0;
+    double moved = 0.0, around[TT__MERGE_STAR];
     for (i = 0; i < T->n; i++) {
         const int ti = T->tris[i], *vi = G->m->triangles + 3 * ti;
         const double (*before_i)[3] = T->before[i], (*st_before_i)[2] = T->st_before[i];
@@ -30247,7 +30262,12 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
                             done[ndone++][1] = vj[rj];
                         }
                     } else {
-                        if (nneed == TT__MERGE_STAR) return -1.0;
+                        const double old_way = tt__merge_to_kept(T, G->m->corner_points[3 * ti].quad,
+                                                                 st_before_i[di], st_before_i[ri], u);
+                        const double new_way = tt__merge_to_kept(T, G->m->corner_points[3 * tj].quad,
+                                                                 st_after[mj], st_after[rj], w);
+                        if (nneed == TT__MERGE_STAR || old_way < 0.0 || new_way < 0.0) return -1.0;
+                        around[nneed] = old_way + new_way;
                         need[nneed][0] = vi[ri];
                         need[nneed++][1] = vj[rj];
                     }
@@ -30257,7 +30277,7 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
     }
     for (i = 0; i < nneed; i++) {
         for (q = 0; q < ndone && (done[q][0] != need[i][0] || done[q][1] != need[i][1]); q++) continue;
-        if (q == ndone) return -1.0;
+        if (q == ndone) moved = fmax(moved, around[i]);
     }
     return moved;
 }
