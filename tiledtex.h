@@ -30288,8 +30288,8 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
 static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double tolerance, int crossings)
 {
     double largest = 0.0, moved_before = 0.0, ma, mb, mc;
-    double area[TT__MERGE_STAR];
-    int i, k;
+    double area[TT__MERGE_STAR], area_before[TT__MERGE_STAR];
+    int i, k, slivers;
     /* The places first (cheap, and where most choices fail), the movement
        at the ends (where most others fail), then the shapes. */
     for (i = 0; i < T->n; i++) {
@@ -30320,6 +30320,13 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
         double (*after)[3] = T->after[i], (*before)[3] = T->before[i];
         double (*st_after)[2] = T->st_after[i], (*st_before)[2] = T->st_before[i];
         double e1[3], e2[3], n[3], s_after;
+        for (k = 0; k < 3; k++) {
+            e1[k] = before[1][k] - before[0][k];
+            e2[k] = before[2][k] - before[0][k];
+        }
+        tt__cross3(e1, e2, n);
+        area_before[i] = tt__length3(n);
+        largest = fmax(largest, area_before[i]);
         area[i] = 0.0;
         if (T->gone[i]) continue;
         s_after = tt__orient2(st_after[0][0], st_after[0][1], st_after[1][0], st_after[1][1], st_after[2][0],
@@ -30335,16 +30342,16 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
         tt__cross3(e1, e2, n);
         area[i] = tt__dot3(n, G->normal + 3 * (size_t)G->m->triangle_face[t]);
         if (!(area[i] > 0.0)) return 0;
-        for (k = 0; k < 3; k++) {
-            e1[k] = before[1][k] - before[0][k];
-            e2[k] = before[2][k] - before[0][k];
-        }
-        tt__cross3(e1, e2, n);
-        largest = fmax(largest, tt__length3(n));
     }
-    /* No triangle made thinner on the model than a millionth of the star's largest. */
-    for (i = 0; i < T->n; i++)
-        if (area[i] != 0.0 && area[i] < 1e-6 * largest) return 0;
+    /* No more slivers on the model (under 1e-4 of the star's largest) than before, none made under a
+       millionth: a sliver with its area on S would draw a square's texture into a speck of the model. */
+    for (i = 0, slivers = 0; i < T->n; i++) {
+        slivers += area_before[i] < 1e-4 * largest;
+        if (T->gone[i]) continue;
+        if (area[i] < 1e-6 * largest && area[i] < area_before[i]) return 0;
+        slivers -= area[i] < 1e-4 * largest;
+    }
+    if (slivers < 0) return 0;
     mc = crossings ? tt__merge_moved_crossings(G, T) : 0.0;
     if (mc < 0.0) return 0;
     T->moved = moved_before + fmax(fmax(ma, mb), mc);

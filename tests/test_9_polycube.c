@@ -2450,12 +2450,39 @@ static double merge_moved(const tt_polycube_mapping *ref, const tt_polycube_mapp
     return worst;
 }
 
+/* A mapping's triangles with less area on the model than `share` of the
+   mean (slivers). */
+static int mapping_slivers(const tt_polycube_mapping *map, double share)
+{
+    double mean = 0.0, *area = (double *)malloc(sizeof(double) * (size_t)map->ntriangles);
+    int j, a, count = 0;
+    if (!area) return map->ntriangles;
+    for (j = 0; j < map->ntriangles; j++) {
+        const float *p = map->positions + 3 * map->triangles[3 * j], *q = map->positions + 3 * map->triangles[3 * j + 1],
+                    *r = map->positions + 3 * map->triangles[3 * j + 2];
+        double e1[3], e2[3], n[3];
+        for (a = 0; a < 3; a++) {
+            e1[a] = (double)q[a] - p[a];
+            e2[a] = (double)r[a] - p[a];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        area[j] = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        mean += area[j] / map->ntriangles;
+    }
+    for (j = 0; j < map->ntriangles; j++) count += area[j] < share * mean;
+    free(area);
+    return count;
+}
+
 /* Step 7, the pieces merged: on a coarse sphere (its triangles span
    several squares, so the split leaves many vertices inside them) the
    default mapping has fewer triangles than with merging off
    (max_map_error below 0), is as sound (on the model, the area kept,
    closed, each triangle in one quad, none flipped), and its texture stays
-   within max_map_error of the unmerged one. Control: merged with 0.05
+   within max_map_error of the unmerged one; the split's slivers on the
+   model are mostly gone, and none is made. Control: merged with 0.05
    quads, the same measure finds it moved past the default's bound. */
 static void test_map_merge(void)
 {
@@ -2485,9 +2512,10 @@ static void test_map_merge(void)
         int unfound, loose_unfound;
         const double moved = merge_moved(ref, map, mesh->nfaces, &unfound);
         const double loose_moved = merge_moved(ref, loose, mesh->nfaces, &loose_unfound);
+        const int slivers = mapping_slivers(map, 1e-4), ref_slivers = mapping_slivers(ref, 1e-4);
         printf("     coarse sphere at 24: %d triangles unmerged, %d merged by default (texture moved %.2g quads, "
-               "%d centroids across a line), %d at 0.05 quads (moved %.2g)\n", ref->ntriangles, map->ntriangles,
-               moved, unfound, loose->ntriangles, loose_moved);
+               "%d centroids across a line), %d at 0.05 quads (moved %.2g); slivers %d unmerged, %d merged\n",
+               ref->ntriangles, map->ntriangles, moved, unfound, loose->ntriangles, loose_moved, ref_slivers, slivers);
         CHECK(ref_rep.merged == 0 && rep.merged == ref->ntriangles - map->ntriangles &&
                   map->ntriangles <= 0.95 * ref->ntriangles && loose->ntriangles < map->ntriangles,
               "merging: %d triangles unmerged, %d by default (report %d), %d at 0.05", ref->ntriangles,
@@ -2501,6 +2529,10 @@ static void test_map_merge(void)
         CHECK(moved <= TT_POLYCUBE_MAP_DEFAULT_ERROR + 1e-5 && unfound <= ref->ntriangles / 100,
               "the texture moved %.3g quads (at most %.3g), %d of %d centroids not found", moved,
               TT_POLYCUBE_MAP_DEFAULT_ERROR, unfound, ref->ntriangles);
+        CHECK(4 * slivers <= ref_slivers && mapping_slivers(map, 1e-6) == 0,
+              "merging takes the split's slivers away and makes none: %d under 1e-4 of the mean area (unmerged %d), "
+              "%d under 1e-6 (unmerged %d)", slivers, ref_slivers, mapping_slivers(map, 1e-6),
+              mapping_slivers(ref, 1e-6));
         CHECK(loose_moved > TT_POLYCUBE_MAP_DEFAULT_ERROR + 1e-5 && loose_moved <= 0.05 + 1e-5,
               "control: merged within 0.05 quads the texture moved %.3g (above the default's %.3g)", loose_moved,
               TT_POLYCUBE_MAP_DEFAULT_ERROR);
