@@ -3671,7 +3671,13 @@ typedef struct tt_polycube_mapping {
         (it lies just behind a saddle) would map part of that triangle
         onto a line; it is moved onto W unless another point is there,
         and the edges are traced again (a vertex whose edges then find no
-        path goes back, and they are traced once more); then pinches: a
+        path goes back, and they are traced once more); then corners
+        passed a hair away: an edge whose image passes within 1e-3 of a
+        quad of a corner W of S would cut a sliver off there; its end
+        nearer W moves (by a few thousandths of a quad) so that the image
+        passes through W where four quads meet, or 0.01 quads from it at
+        a cone point, and the edges are traced again (the same going
+        back); then pinches: a
         triangle whose vertex lies on a saddle W of S and whose corner
         there spans more than half a turn of S would collapse onto two
         segments (the path across runs through W as well); that edge is
@@ -28016,6 +28022,108 @@ static int tt__polycube_unspike(const tt_polycube *pc, const tt_mesh *model, con
     return moved;
 }
 
+/* Edge e's image seen from its end `from_end` (0: its first vertex): 1
+   when it passes within TT__MAP_SNAP of a vertex W of S without going
+   through it (two crossings in a row that near W, at different t), with
+   that end's point (in its quad's frame, the chart's), W and the other
+   end's point in the chart, and *flat 1 when four quads meet at W. */
+static int tt__edge_corner_pass(const tt_polycube *pc, const tt_polycube_edges *edges,
+                                const tt_surface_point *points, int e, int from_end, double x[2], double w[2],
+                                double y[2], int *flat)
+{
+    const tt_mesh *s = pc->surface;
+    const int first = edges->first_crossing[e], count = edges->first_crossing[e + 1] - first;
+    tt_quad_map map;
+    double previous[2] = {0.0, 0.0}, previous_t = 0.0;
+    int k, near_previous = 0, found = 0;
+    if (count < 2 || edges->failed[e] ||
+        !tt__point_in_quad(s, points[edges->edge_vertices[2 * e + from_end]], edges->end_quads[2 * e + from_end], x))
+        return 0;
+    map.turns = map.offset[0] = map.offset[1] = 0;
+    for (k = 0; k < count; k++) {
+        const tt_edge_crossing *c = &edges->crossings[from_end ? first + count - 1 - k : first + k];
+        const int h = from_end ? s->twin[c->halfedge] : c->halfedge;
+        const double along = from_end ? 1.0 - c->along : c->along;
+        double e0[2], e1[2];
+        const int near = along < TT__MAP_SNAP || along > 1.0 - TT__MAP_SNAP;
+        tt__edge_in_plane(s, h, map, e0, e1);
+        if (near) {
+            const double *corner = along < 0.5 ? e0 : e1;
+            const int quad = s->corner_face[h];
+            const int at = along < 0.5 ? h : s->face_start[quad] + ((h - s->face_start[quad] + 1) & 3);
+            if (!found && near_previous && c->t != previous_t && corner[0] == previous[0] &&
+                corner[1] == previous[1]) {
+                w[0] = corner[0];
+                w[1] = corner[1];
+                found = 1;
+                *flat = tt__surface_valence(s, at) == 4;
+            }
+            previous[0] = corner[0];
+            previous[1] = corner[1];
+        }
+        near_previous = near;
+        previous_t = c->t;
+        map = tt_quad_map_compose(map, tt_polycube_unfold(pc, h));
+    }
+    if (!found ||
+        !tt__point_in_quad(s, points[edges->edge_vertices[2 * e + !from_end]], edges->end_quads[2 * e + !from_end], y))
+        return 0;
+    tt_quad_map_apply(map, y[0], y[1], y);
+    return 1;
+}
+
+/* An edge whose image passes a hair from a vertex W of S cuts a piece a
+   hair across off the quad there, a sliver in both spaces that no merge
+   of step 7 can take (its corner of S would have to move onto the edge,
+   flattening the triangles it makes with the edge's other split points).
+   The end of the edge nearer W moves, turning the image about the other
+   end: where four quads meet at W, onto the line through W, so the image
+   passes through it; at a cone point of S (three, five or six quads),
+   where an image through W would bend and the triangles beside it fall
+   back, away from W until the image passes TT__CORNER_CLEARANCE from it.
+   An end on an edge of S, near one, moved already in this round, or that
+   would move by more than 4 TT__CORNER_CLEARANCE stays. Each point moved
+   is flagged in moved_points[]. Returns the number of points moved. */
+#define TT__CORNER_CLEARANCE 1e-2   /* quads between a cone point of S and an image passing it, at least */
+
+static int tt__polycube_clear_corners(const tt_polycube *pc, const tt_polycube_edges *edges,
+                                      tt_surface_point *points, unsigned char *moved_points)
+{
+    int e, moved = 0;
+    for (e = 0; e < edges->nedges; e++) {
+        double x[2], w[2], y[2], u[2], length, along, to[2], across, shift;
+        int from_end, v, flat;
+        if (!tt__edge_corner_pass(pc, edges, points, e, 0, x, w, y, &flat)) continue;
+        from_end = tt__distance2(x, w) > tt__distance2(y, w);
+        if (from_end && !tt__edge_corner_pass(pc, edges, points, e, 1, x, w, y, &flat)) continue;
+        v = edges->edge_vertices[2 * e + from_end];
+        /* u: from the end that stays to the one that moves; W's distance along and across it */
+        u[0] = x[0] - y[0];
+        u[1] = x[1] - y[1];
+        length = sqrt(u[0] * u[0] + u[1] * u[1]);
+        if (moved_points[v] || !(length > 0.0)) continue;
+        u[0] /= length;
+        u[1] /= length;
+        along = (w[0] - y[0]) * u[0] + (w[1] - y[1]) * u[1];
+        across = (w[1] - y[1]) * u[0] - (w[0] - y[0]) * u[1];
+        if (!(along > 0.0 && along < length)) continue;
+        /* Turned about y, the image's distance from W changes by the move of x times along / length. */
+        shift = (flat ? across : (across > 0.0 ? across - TT__CORNER_CLEARANCE : across + TT__CORNER_CLEARANCE)) *
+                length / along;
+        to[0] = x[0] - shift * u[1];
+        to[1] = x[1] + shift * u[0];
+        if (x[0] < TT__MAP_SNAP || x[0] > 1.0 - TT__MAP_SNAP || x[1] < TT__MAP_SNAP || x[1] > 1.0 - TT__MAP_SNAP ||
+            to[0] < TT__MAP_SNAP || to[0] > 1.0 - TT__MAP_SNAP || to[1] < TT__MAP_SNAP ||
+            to[1] > 1.0 - TT__MAP_SNAP || fabs(shift) > 4.0 * TT__CORNER_CLEARANCE)
+            continue;
+        points[v].s = (float)to[0];
+        points[v].t = (float)to[1];
+        moved_points[v] = 1;
+        moved++;
+    }
+    return moved;
+}
+
 /* The vertices at an edge with no path whose points moved since `earlier`
    go back there; moved[] flags them (cleared first). Returns whether any
    did. */
@@ -29575,19 +29683,25 @@ static tt_result tt__polycube_repair_edges(const tt_polycube *polycube, const tt
                                         error)) != TT_OK)
             goto done;
     }
-    /* Spikes (tt__polycube_unspike) are taken off and the edges at the moved points traced again; a
+    /* Spikes (tt__polycube_unspike), then edges passing a hair from a corner of S
+       (tt__polycube_clear_corners), are taken off and the edges at the moved points traced again; a
        vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
-    memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
-    memset(moved, 0, (size_t)model->nverts);
-    for (tracing = 0; tracing < 2; tracing++) {
+    for (tracing = 0; tracing < 4; tracing++) {
         int changed;
-        if (tracing == 0) {
-            if ((changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator)) < 0)
-                goto out_of_memory;
+        if (tracing % 2 == 0) {
+            memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
+            memset(moved, 0, (size_t)model->nverts);
+            if (tracing == 0) changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator);
+            else changed = tt__polycube_clear_corners(polycube, edges, points, moved);
+            if (changed < 0) goto out_of_memory;
+            if (!changed) {
+                tracing++;
+                continue;
+            }
         } else {
             changed = tt__polycube_restore_failing(model, edges, earlier, points, moved);
+            if (!changed) continue;
         }
-        if (!changed) break;
         if ((result = tt__retrace_moved(polycube, model, points, edge_options, executor, allocator, moved, &edges,
                                         error)) != TT_OK)
             goto done;
