@@ -2455,20 +2455,11 @@ static double merge_moved(const tt_polycube_mapping *ref, const tt_polycube_mapp
 static int mapping_slivers(const tt_polycube_mapping *map, double share)
 {
     double mean = 0.0, *area = (double *)malloc(sizeof(double) * (size_t)map->ntriangles);
-    int j, a, count = 0;
+    int j, count = 0;
     if (!area) return map->ntriangles;
     for (j = 0; j < map->ntriangles; j++) {
-        const float *p = map->positions + 3 * map->triangles[3 * j], *q = map->positions + 3 * map->triangles[3 * j + 1],
-                    *r = map->positions + 3 * map->triangles[3 * j + 2];
-        double e1[3], e2[3], n[3];
-        for (a = 0; a < 3; a++) {
-            e1[a] = (double)q[a] - p[a];
-            e2[a] = (double)r[a] - p[a];
-        }
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        area[j] = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const int *v = map->triangles + 3 * j;
+        area[j] = triangle_area3(map->positions + 3 * v[0], map->positions + 3 * v[1], map->positions + 3 * v[2]);
         mean += area[j] / map->ntriangles;
     }
     for (j = 0; j < map->ntriangles; j++) count += area[j] < share * mean;
