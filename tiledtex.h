@@ -30078,6 +30078,7 @@ typedef struct tt__merge_try {
     float quad_st[2][TT__MERGE_QUADS][2];      /* ...and their points there */
     float st[TT__MERGE_STAR][2];    /* the kept point on S in each one's quad (triangles with a or b) */
     double before[TT__MERGE_STAR][3][3], st_before[TT__MERGE_STAR][3][2];  /* each one's corners now... */
+    double area_before[TT__MERGE_STAR];  /* ...its area on the model now (twice it)... */
     double after[TT__MERGE_STAR][3][3], st_after[TT__MERGE_STAR][3][2];    /* ...and after the merge */
     double moved;
 } tt__merge_try;
@@ -30193,6 +30194,16 @@ static int tt__merge_star_end(const tt__merge *G, tt__merge_try *T, int end)
             tt__merge_position(G, v[k], T->before[T->n][k]);
             T->st_before[T->n][k][0] = p->s;
             T->st_before[T->n][k][1] = p->t;
+        }
+        {
+            double(*corners)[3] = T->before[T->n];
+            double e1[3], e2[3], n[3];
+            for (k = 0; k < 3; k++) {
+                e1[k] = corners[1][k] - corners[0][k];
+                e2[k] = corners[2][k] - corners[0][k];
+            }
+            tt__cross3(e1, e2, n);
+            T->area_before[T->n] = tt__length3(n);
         }
         T->tris[T->n++] = t;
         for (k = 0; k < 3; k++) {
@@ -30354,12 +30365,12 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
             for (j = 0; j < T->n; j++) {
                 const int tj = T->tris[j], *vj = G->m->triangles + 3 * tj;
                 const double (*after)[3] = T->after[j], (*st_after)[2] = T->st_after[j];
+                const int same = G->m->corner_points[3 * ti].quad == G->m->corner_points[3 * tj].quad;
                 int mj;
                 if (T->gone[j] || G->m->triangle_face[tj] != G->m->triangle_face[ti]) continue;
                 for (mj = 0; mj < 3 && vj[mj] != T->a && vj[mj] != T->b; mj++) continue;
                 for (l = 1; l < 3; l++) {
                     const int rj = (mj + l) % 3;
-                    const int same = G->m->corner_points[3 * ti].quad == G->m->corner_points[3 * tj].quad;
                     double u, w;
                     if (!tt__merge_crossing(before_i[di], before_i[ri], after[mj], after[rj],
                                             G->normal + 3 * (size_t)G->m->triangle_face[ti], &u, &w))
@@ -30402,7 +30413,7 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
 static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double tolerance, int crossings)
 {
     double largest = 0.0, moved_before = 0.0, ma, mb, mc;
-    double area[TT__MERGE_STAR], area_before[TT__MERGE_STAR];
+    double area[TT__MERGE_STAR];
     int i, k, slivers;
     /* The places first (cheap, and where most choices fail), the movement
        at the ends (where most others fail), then the shapes. */
@@ -30431,16 +30442,10 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
     if (ma < 0.0 || mb < 0.0 || moved_before + fmax(ma, mb) > tolerance) return 0;
     for (i = 0; i < T->n; i++) {
         const int t = T->tris[i];
-        double (*after)[3] = T->after[i], (*before)[3] = T->before[i];
+        double (*after)[3] = T->after[i];
         double (*st_after)[2] = T->st_after[i], (*st_before)[2] = T->st_before[i];
         double e1[3], e2[3], n[3], s_after;
-        for (k = 0; k < 3; k++) {
-            e1[k] = before[1][k] - before[0][k];
-            e2[k] = before[2][k] - before[0][k];
-        }
-        tt__cross3(e1, e2, n);
-        area_before[i] = tt__length3(n);
-        largest = fmax(largest, area_before[i]);
+        largest = fmax(largest, T->area_before[i]);
         area[i] = 0.0;
         if (T->gone[i]) continue;
         s_after = tt__orient2(st_after[0][0], st_after[0][1], st_after[1][0], st_after[1][1], st_after[2][0],
@@ -30460,9 +30465,9 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
     /* No more slivers on the model (under 1e-4 of the star's largest) than before, none made under a
        millionth: a sliver with its area on S would draw a square's texture into a speck of the model. */
     for (i = 0, slivers = 0; i < T->n; i++) {
-        slivers += area_before[i] < 1e-4 * largest;
+        slivers += T->area_before[i] < 1e-4 * largest;
         if (T->gone[i]) continue;
-        if (area[i] < 1e-6 * largest && area[i] < area_before[i]) return 0;
+        if (area[i] < 1e-6 * largest && area[i] < T->area_before[i]) return 0;
         slivers -= area[i] < 1e-4 * largest;
     }
     if (slivers < 0) return 0;
