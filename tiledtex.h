@@ -3729,9 +3729,8 @@ typedef struct tt_polycube_mapping {
         whole stays within max_map_error. Where the refinement put more
         vertices than the map needs (a model coarser than the squares) the
         output loses a sixth to a quarter of its triangles at half a texel,
-        and the slivers a model edge passing a hair from a corner of S
-        cuts off go too. Input vertices and a fallback's vertices stay
-        (report->merged).
+        and slivers of the split go too, no merge making a new one. Input
+        vertices and a fallback's vertices stay (report->merged).
    Every split point of an edge is one output vertex shared by the two
    triangles on the edge: a closed manifold model gives a closed manifold
    output. Pieces of zero area (an edge along a lattice line) are dropped,
@@ -29686,24 +29685,19 @@ static tt_result tt__polycube_repair_edges(const tt_polycube *polycube, const tt
     /* Spikes (tt__polycube_unspike), then edges passing a hair from a corner of S
        (tt__polycube_clear_corners), are taken off and the edges at the moved points traced again; a
        vertex whose edges then find no path goes back where it was, and its edges are traced once more. */
-    for (tracing = 0; tracing < 4; tracing++) {
+    for (tracing = 0; tracing < 2; tracing++) {
         int changed;
-        if (tracing % 2 == 0) {
-            memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
-            memset(moved, 0, (size_t)model->nverts);
-            if (tracing == 0) changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator);
-            else changed = tt__polycube_clear_corners(polycube, edges, points, moved);
-            if (changed < 0) goto out_of_memory;
-            if (!changed) {
-                tracing++;
-                continue;
-            }
-        } else {
-            changed = tt__polycube_restore_failing(model, edges, earlier, points, moved);
-            if (!changed) continue;
-        }
+        memcpy(earlier, points, sizeof *points * (size_t)model->nverts);
+        memset(moved, 0, (size_t)model->nverts);
+        if (tracing == 0) changed = tt__polycube_unspike(polycube, model, edges, points, moved, allocator);
+        else changed = tt__polycube_clear_corners(polycube, edges, points, moved);
+        if (changed < 0) goto out_of_memory;
+        if (!changed) continue;
         if ((result = tt__retrace_moved(polycube, model, points, edge_options, executor, allocator, moved, &edges,
-                                        error)) != TT_OK)
+                                        error)) != TT_OK ||
+            (tt__polycube_restore_failing(model, edges, earlier, points, moved) &&
+             (result = tt__retrace_moved(polycube, model, points, edge_options, executor, allocator, moved, &edges,
+                                         error)) != TT_OK))
             goto done;
     }
     goto done;
@@ -30029,8 +30023,9 @@ static int tt__mapping_to_input(tt_polycube_mapping *mapping, const tt__refined 
    most of them there only because the refinement put an edge there. Where
    the map is near affine such a vertex adds nothing, and merging it into a
    neighbour (an edge collapse) makes the output smaller without a visible
-   change. The same step takes away the pieces a model edge passing a hair
-   from a corner of S cuts off: slivers thin in both spaces.
+   change. The same step takes away slivers of the split where a merge
+   can (the pieces a model edge passing a hair from a corner of S would cut
+   off are mostly not made: tt__polycube_clear_corners).
 
    A merge keeps every triangle on its input face and in its quad: the
    vertex that stays takes the model point of one of the two ends and the
