@@ -3345,11 +3345,17 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
                                     tt_error *error);
 
 /* The polycube at the resolution the mesh needs: tt_polycube_build at
-   16, 24, 32, 48 and 64 cubes in turn (never above max_resolution; 0 =
-   TT_POLYCUBE_AUTO_MAX_RESOLUTION) until S has the mesh's genus (when the
-   mesh has one: closed and manifold) and the mesh's vertices lie within
-   TT_POLYCUBE_AUTO_NEAR cubes of S on average (tt_polycube_project's
-   mean_distance); then, while the genus still differs, at 72, 80 and 96. The
+   16, 20, 24, 28, 32, 36, 40, 48, 56 and 64 cubes in turn (never above
+   max_resolution; 0 = TT_POLYCUBE_AUTO_MAX_RESOLUTION) until S has the
+   mesh's genus (when the mesh has one: closed and manifold) and the mesh's
+   vertices lie within TT_POLYCUBE_AUTO_NEAR cubes of S on average
+   (tt_polycube_project's mean_distance); then, while the genus still
+   differs, at 72, 80 and 96. The steps are at most a quarter apart below
+   64 because every step up shrinks the squares: a brick photo shown one
+   course per square shrinks with them, and a mesh coarser than the squares
+   is cut into more pieces (a trefoil tube that has its genus from 36 on
+   got 48 when 36 and 40 were not tried: bricks 0.81 of the asked size
+   against 1.02, and 1.6 times the output triangles). The
    second test finds parts thinner than about two cubes, which a coarse
    polycube cannot follow: their projections land a cube or more away,
    and their triangles are drawn out into streaks or fall back. A handle
@@ -3372,18 +3378,19 @@ TTDEF tt_result tt_polycube_project(const tt_polycube *polycube, const tt_mesh *
    not the polycube's business: a caller that keeps one tile per square
    at a larger resolution gets smaller tiles on the surface, so the tool
    cuts each square's tile from fewer texels of the photo (its
-   --texture-size). Cost: up to eight builds and projections of the mesh
-   (the horse scan, 97k triangles: three, 0.22 s of the tool's 1.2 s end
-   to end at 32, where it used to spend 2.6 s CPU at 16 for a worse map:
+   --texture-size). Cost: up to thirteen builds and projections of the mesh
+   (the horse scan, 97k triangles: five, 0.34 s of the tool's 1.1 s
+   to map at 32, where it used to spend 2.6 s CPU at 16 for a worse map:
    stretch p95 1.9 against 6, 0.01 % fallbacks against 1 %, measured
    before tt_polycube_map's refinement to a cube; now 0.03 % against
-   0.85 %). Results as
+   0.85 %; a mesh that never passes tries every step: a 26k-triangle
+   mannequin open at the neck, ten in 2.7 s). Results as
    tt_polycube_build's, and TT_ERROR_INVALID_ARGUMENT for max_resolution
    outside 0..TT_POLYCUBE_MAX_RESOLUTION. */
 #define TT_POLYCUBE_AUTO_MAX_RESOLUTION 96
 #define TT_POLYCUBE_AUTO_MAX_QUADS 200000
 #define TT_POLYCUBE_AUTO_NEAR 0.4
-#define TT_POLYCUBE_AUTO_TRIES 8    /* the resolutions tt_polycube_build_auto may try */
+#define TT_POLYCUBE_AUTO_TRIES 13   /* the resolutions tt_polycube_build_auto may try */
 typedef struct tt_polycube_resolution_report {
     int tries;                  /* builds made */
     int resolution[TT_POLYCUBE_AUTO_TRIES];         /* the resolutions tried, in order */
@@ -25092,8 +25099,8 @@ TTDEF tt_result tt_polycube_build_auto(const tt_mesh *mesh, const tt_polycube_op
                                        const tt_allocator *allocator, tt_polycube **out, tt_polycube_report *report,
                                        tt_polycube_resolution_report *chosen, tt_error *error)
 {
-    static const int ladder[TT_POLYCUBE_AUTO_TRIES] = {16, 24, 32, 48, 64, 72, 80, 96};
-    const int genus_only = 5;   /* from ladder[5] on, only a genus that differs goes on */
+    static const int ladder[TT_POLYCUBE_AUTO_TRIES] = {16, 20, 24, 28, 32, 36, 40, 48, 56, 64, 72, 80, 96};
+    const int genus_only = 10;  /* from ladder[10] (72) on, only a genus that differs goes on */
     tt_polycube_options tried;
     tt_polycube_resolution_report local;
     tt_polycube_report local_report, best_report;
