@@ -3815,6 +3815,9 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
    are left/right sides of both their quads (upright tiles both), and every
    other edge is a bottom/top side of each wall it borders, alike in both
    sets when they share their edge windows.
+     0. with a photo laid in courses (bricks, planks), tt_polycube_orient_upright
+        on S's types (after tt_reduce_tiles, before tt_assign_uvs), so every
+        wall shows its bands upright;
      1. tt_synthesize_tiles (or plan and apply) the plain tiles, then the
         upright ones with the same layout and seed, options.upright = 1 and
         options.edge_windows = the plain tileset's edge_windows;
@@ -3834,6 +3837,29 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
    Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad <
    its surface's nfaces. */
 TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
+/* An upright tile shows a side's band upright only on one of the two types
+   of its condition (tt_synth_options::upright): the even type on its
+   bottom and right sides, the odd one on its top and left; on the other
+   type the band and its neighbour's across the edge are turned half a turn
+   together. They still meet, but a course turned about a tile's edge has
+   its joints mirrored about that edge, which puts them at the wrong height
+   unless the edge runs exactly mid-joint: a photo with a gradient through
+   each course shows the turned bands as reversed patches, and bricks look
+   jumbled. tt_assign_boundaries draws the side at random, so half the
+   bands of the walls were turned. This turns the types of whole edges
+   (both halves: type ^ 1, the condition kept) so that every wall quad
+   (tt_polycube_quad_upright) has the even type on its sides 0 and 1 and
+   the odd type on 2 and 3; walls meet walls only bottom to top and right
+   to left, so no edge is asked both ways. Tops and bottoms keep theirs
+   where no wall borders them. The cost is variety: the walls' tiles are
+   then set by the colours alone (16 per group with two colours an axis,
+   as in the paper, against up to 256 with sides drawn). *out_turned (may
+   be NULL) gets the edges turned. Errors: NULL polycube or corner_type
+   (TT_ERROR_INVALID_ARGUMENT); twins that are not the two halves of one
+   condition (TT_ERROR_INVALID_ARGUMENT, naming the corner): corner_type
+   is then as it was. Allocates nothing; thread-safe. */
+TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t *corner_type, int *out_turned,
+                                           tt_error *error);
 /* The atlas is of the tilesets' kind (a normal map when they are).
    Errors: NULL arguments, a bad allocator, tilesets of different layouts
    or kinds, a plain tileset with vertical windows or an upright one
@@ -30992,6 +31018,40 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad)
 {
     TT_ASSERT(polycube && polycube->surface && quad >= 0 && quad < polycube->surface->nfaces);
     return polycube->quad_side[quad] / 2 != polycube->up_axis;
+}
+
+TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t *corner_type, int *out_turned,
+                                           tt_error *error)
+{
+    const tt_mesh *s;
+    int q, k, c, turned = 0;
+    tt__ok(error);
+    if (out_turned) *out_turned = 0;
+    if (!polycube || !polycube->surface || !corner_type)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_polycube_orient_upright needs a polycube and corner_type (got NULL)");
+    s = polycube->surface;
+    for (c = 0; c < s->ncorners; c++) {
+        int t = s->twin[c];
+        if (t >= 0 && corner_type[t] != (corner_type[c] ^ 1))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, s->corner_face[c], c, -1, -1,
+                            "corner %d has type %d and its twin %d type %d: not the two halves of one condition",
+                            c, corner_type[c], t, corner_type[t]);
+    }
+    for (q = 0; q < s->nfaces; q++) {
+        if (!tt_polycube_quad_upright(polycube, q)) continue;
+        for (k = 0; k < 4; k++) {
+            int t;
+            c = s->face_start[q] + k;
+            t = s->twin[c];
+            if ((corner_type[c] & 1) == (k >= 2)) continue;
+            corner_type[c] ^= 1;
+            if (t >= 0) corner_type[t] ^= 1;
+            turned++;
+        }
+    }
+    if (out_turned) *out_turned = turned;
+    return TT_OK;
 }
 
 /* Rows [begin, end) of tt_polycube_upright_atlas: the plain tile row on

@@ -365,9 +365,13 @@ static int tile_polycube(const polycube_command_options *options, polycube_job *
        tops' (plain) count apart, each its own cell. */
     for (q = 0; q < job->polycube->surface->nfaces; q++)
         job->surface_group[q] = (uint8_t)(!options->plain && tt_polycube_quad_upright(job->polycube, q));
+    /* A photo laid in courses: every band of the walls upright, so no
+       course shows mirrored about a tile's edge. */
     if (tt_reduce_tiles(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
                         job->surface_group, polycube_tile_budget(options, &job->layout), NULL, job->surface_type,
                         NULL, &error) != TT_OK ||
+        (!options->plain && options->tiles.courses.period > 0.0f &&
+         tt_polycube_orient_upright(job->polycube, job->surface_type, NULL, &error) != TT_OK) ||
         tt_assign_uvs(job->polycube->surface, &job->layout, job->surface_type, job->surface_uv, &error) != TT_OK)
         return tool_fail("%s: the polycube's tiles: %s", path, error.message);
     return 0;
@@ -835,8 +839,8 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = tiled_check_atlas_size(&options.tiles);
     if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
         status = tool_fail("%s", error.message);
-    if (status == 0) status = tile_polycube(&options, &job);
     if (status == 0 && !options.plain) status = tiled_fit_courses(&image, options.image_path, &options.tiles);
+    if (status == 0) status = tile_polycube(&options, &job);
     if (status == 0) {
         start = tool_seconds_now();
         status = tiled_synthesize(image, options.image_path, &options.tiles, &options.tiles.maps, &job.tiles,

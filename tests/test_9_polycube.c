@@ -2745,6 +2745,153 @@ static void upright_atlas_checks(const tt_tileset *plain, const tt_tileset *upri
     oom_sweep("tt_polycube_upright_atlas", upright_atlas_oom_call, &ctx, TT_OK);
 }
 
+/* Rows of a wall tile that darken going down, beyond the noise: the
+   courses photo brightens down every course, so an upright tile (one
+   course, cut on it) brightens down everywhere and a band turned half a
+   turn shows up as rows that darken. */
+static int darkening_rows(const tt_image *cell, int g, int S)
+{
+    int x, y, count = 0;
+    for (x = 1; x < S - 1; x++)
+        for (y = 0; y + 1 < S; y++) {
+            const float *a = cell->pixels + 4 * ((size_t)(g + y) * cell->width + g + x), *b = a + 4 * cell->width;
+            if ((b[0] + b[1] + b[2]) - (a[0] + a[1] + a[2]) < -0.05f) count++;
+        }
+    return count;
+}
+
+/* tt_polycube_orient_upright: every wall's bottom and right sides take the
+   even type, its top and left the odd one, whole edges turning (the
+   conditions kept, twins still the two halves of one); nothing else
+   changes, and a second call turns nothing. The effect: wall tiles
+   composed from a photo that brightens down every course (courses one tile
+   tall, windows cut on them) brighten down everywhere; with the sides
+   tt_assign_boundaries drew, turned bands darken down somewhere. */
+static void test_orient_upright(void)
+{
+    const double centre[3] = {0.02, 0.11, -0.07};
+    const int S = 16, g = 2;
+    tt_polycube_options o;
+    tt_polycube_report rep;
+    tt_polycube *pc;
+    tt_result r;
+    tt_error err;
+    tmesh m;
+    memset(&m, 0, sizeof m);
+    make_sphere(&m, 48, 24, 1.0, centre, 0);
+    memset(&o, 0, sizeof o);
+    o.resolution = 8;
+    pc = polycube_of(&m, &o, &rep, &r);
+    CHECK(pc != NULL, "sphere polycube: %d", r);
+    if (pc) {
+        const tt_mesh *s = pc->surface;
+        tt_tile_layout layout;
+        tt_synth_options so;
+        tt_synth_plan *plain_plan = NULL, *upright_plan = NULL;
+        tt_image *photo = NULL, *cell = NULL;
+        int *colors = (int *)malloc(sizeof(int) * (size_t)s->ncorners);
+        uint8_t *drawn = (uint8_t *)malloc((size_t)s->ncorners), *types = (uint8_t *)malloc((size_t)s->ncorners);
+        int c, q, k, x, y, turned = -1, again = -1, wrong_before = 0, wrong_after = 0, kept = 0, paired = 0;
+        int untouched = 0, walls = 0, dark_before = 0, dark_after = 0, tiles_before = 0, tiles_after = 0;
+        memset(&layout, 0, sizeof layout);
+        layout.colors = 2;
+        layout.tile_size = S;
+        layout.gutter = g;
+        CHECK(colors && drawn && types && tt_polycube_edge_colors(pc, 2, 1, 7, colors, &err) == TT_OK &&
+                  tt_assign_boundaries(s, &layout, 7, colors, drawn, &err) == TT_OK,
+              "types: %s", err.message);
+        memcpy(types, drawn, (size_t)s->ncorners);
+        for (q = 0; q < s->nfaces; q++)
+            if (tt_polycube_quad_upright(pc, q))
+                for (k = 0; k < 4; k++) wrong_before += (drawn[s->face_start[q] + k] & 1) != (k >= 2);
+        CHECK(tt_polycube_orient_upright(pc, types, &turned, &err) == TT_OK && turned > 0, "oriented (%d turned): %s",
+              turned, err.message);
+        CHECK(tt_polycube_orient_upright(pc, types, &again, &err) == TT_OK && again == 0,
+              "a second call turns nothing (%d)", again);
+        for (c = 0; c < s->ncorners; c++) {
+            int t = s->twin[c], wall = tt_polycube_quad_upright(pc, s->corner_face[c]) ||
+                                       tt_polycube_quad_upright(pc, s->corner_face[t]);
+            kept += types[c] / 2 == drawn[c] / 2;
+            paired += types[t] == (types[c] ^ 1);
+            untouched += wall || types[c] == drawn[c];
+        }
+        for (q = 0; q < s->nfaces; q++)
+            if (tt_polycube_quad_upright(pc, q)) {
+                walls++;
+                for (k = 0; k < 4; k++) wrong_after += (types[s->face_start[q] + k] & 1) != (k >= 2);
+            }
+        CHECK(wrong_before > 0 && wrong_after == 0 && walls > 0,
+              "walls' sides of the wrong type: %d of %d drawn, %d after", wrong_before, 4 * walls, wrong_after);
+        CHECK(kept == s->ncorners && paired == s->ncorners && untouched == s->ncorners,
+              "conditions kept (%d), twins paired (%d), edges without a wall untouched (%d) of %d", kept, paired,
+              untouched, s->ncorners);
+
+        /* The photo: 8 courses of 16 rows brightening down, a trace of noise across. */
+        if (tt_image_create(96, 128, NULL, &photo, &err) == TT_OK)
+            for (y = 0; y < 128; y++)
+                for (x = 0; x < 96; x++) {
+                    float v = 0.1f + 0.8f * (float)(y % S) / (float)S + 0.01f * (float)((x * 7 + y * 13) % 5);
+                    float *p = photo->pixels + 4 * ((size_t)y * 96 + x);
+                    p[0] = p[1] = p[2] = v;
+                    p[3] = 1.0f;
+                }
+        memset(&so, 0, sizeof so);
+        so.layout = layout;
+        so.seed = 5;
+        so.courses.period = (float)S;
+        so.courses.phase = 0.0f;
+        CHECK(photo && tt_synth_plan_create(photo, &so, NULL, &plain_plan, &err) == TT_OK, "plain plan: %s",
+              err.message);
+        if (plain_plan) {
+            so.upright = 1;
+            so.edge_windows = plain_plan->edge_windows;
+            CHECK(tt_synth_plan_create(photo, &so, NULL, &upright_plan, &err) == TT_OK, "upright plan: %s",
+                  err.message);
+        }
+        if (upright_plan && tt_image_create(S + 2 * g, S + 2 * g, NULL, &cell, &err) == TT_OK)
+            for (q = 0; q < s->nfaces; q++) {
+                uint8_t before[4], after[4];
+                if (!tt_polycube_quad_upright(pc, q)) continue;
+                for (k = 0; k < 4; k++) {
+                    before[k] = drawn[s->face_start[q] + k];
+                    after[k] = types[s->face_start[q] + k];
+                }
+                if (tt_synth_compose_tile(upright_plan, photo, before, cell, 0, 0, &err) == TT_OK) {
+                    int n = darkening_rows(cell, g, S);
+                    dark_before += n;
+                    tiles_before += n > 0;
+                }
+                if (tt_synth_compose_tile(upright_plan, photo, after, cell, 0, 0, &err) == TT_OK) {
+                    int n = darkening_rows(cell, g, S);
+                    dark_after += n;
+                    tiles_after += n > 0;
+                }
+            }
+        CHECK(upright_plan && cell && tiles_before > walls / 4 && dark_after == 0,
+              "wall tiles with rows darkening down: %d of %d as drawn (%d rows), %d after (%d rows)", tiles_before,
+              walls, dark_before, tiles_after, dark_after);
+        printf("     orient upright: %d of %d wall sides turned; wall tiles with a turned band %d -> %d of %d\n",
+               wrong_before, 4 * walls, tiles_before, tiles_after, walls);
+        CHECK(tt_polycube_orient_upright(NULL, types, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
+                  tt_polycube_orient_upright(pc, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
+              "NULL polycube or types refused");
+        memcpy(drawn, types, (size_t)s->ncorners);
+        types[s->twin[0]] = types[0];
+        CHECK(tt_polycube_orient_upright(pc, types, &turned, &err) == TT_ERROR_INVALID_ARGUMENT && turned == 0 &&
+                  (err.corner == 0 || err.corner == s->twin[0]) && types[s->twin[0]] == types[0],
+              "twins of one type refused, naming the corner (%d), types as they were: %s", err.corner, err.message);
+        tt_image_free(cell);
+        tt_image_free(photo);
+        tt_synth_plan_free(plain_plan);
+        tt_synth_plan_free(upright_plan);
+        free(colors);
+        free(drawn);
+        free(types);
+    }
+    tt_polycube_free(pc);
+    tm_free(&m);
+}
+
 /* Upright tiles on the walls (tt_polycube_mapping_uvs_upright): a sphere
    textured from a plain and an upright tile set side by side is seamless
    on the tile borders; the walls' UVs lie in the right half, the tops' in
@@ -4140,6 +4287,7 @@ void run_polycube_tests(void)
     RUN(test_map_unpinch);
     RUN(test_map_uvs_and_seams);
     RUN(test_map_uvs_upright);
+    RUN(test_orient_upright);
     RUN(test_map_determinism_and_errors);
     RUN(test_map_stretch_floor);
     RUN(test_map_thin_plate);

@@ -91,6 +91,7 @@ static const char *const k_functions[] = {
     "tt_polycube_trace_edges",
     "tt_polycube_map",
     "tt_polycube_mapping_uvs",
+    "tt_polycube_orient_upright",
     "tt_polycube_upright_atlas",
     "tt_polycube_mapping_uvs_upright",
 };
@@ -2094,12 +2095,15 @@ static void cases_polycube(const baseline *b)
     L.tile_size = 8;
     L.gutter = 2;
     CHECK(tt_assign_boundaries(pc->surface, &L, 9, ec, types, NULL) == TT_OK, "baseline polycube types");
+    CASE(tt_polycube_orient_upright(NULL, types, NULL, E));
+    CASE(tt_polycube_orient_upright(pc, NULL, NULL, E));
     if (pm) {
         tt_surface_point *cp = (tt_surface_point *)malloc(sizeof *cp * 3 * (size_t)pm->ntriangles);
         muv = (float *)malloc(sizeof(float) * 6 * (size_t)pm->ntriangles);
         memcpy(cp, pm->corner_points, sizeof *cp * 3 * (size_t)pm->ntriangles);
         memcpy(bt, types, sizeof bt);
         bt[7] = 2;
+        CASE(tt_polycube_orient_upright(pc, bt, NULL, E));
 #define UV_CASES(fn)                                                                                          \
     CASE(fn(NULL, pm, &L, types, muv, E));                                                                     \
     CASE(fn(pc, NULL, &L, types, muv, E));                                                                     \
