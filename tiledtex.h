@@ -9296,6 +9296,18 @@ static tt_result tt__check_edge_colors(const tt_mesh *mesh, int n, const int *ed
     return TT_OK;
 }
 
+/* Corner c's boundary type and its twin's the two halves of one
+   condition (type and type ^ 1), as tt_assign_boundaries makes them;
+   TT_ERROR_INVALID_ARGUMENT naming c when not. */
+static tt_result tt__check_twin_types(const tt_mesh *mesh, const uint8_t *corner_type, int c, tt_error *error)
+{
+    const int t = mesh->twin[c];
+    if (t < 0 || corner_type[t] == (corner_type[c] ^ 1)) return TT_OK;
+    return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
+                    "corners %d and %d are the two sides of one edge but have types %d and %d, not the two halves "
+                    "of one condition (tt_assign_boundaries makes them so)", c, t, corner_type[c], corner_type[t]);
+}
+
 /* Every face a quad (TT_ERROR_NOT_QUAD_MESH names the first that is not). */
 static tt_result tt__require_quads(const tt_mesh *mesh, tt_error *error)
 {
@@ -9740,11 +9752,7 @@ TTDEF tt_result tt_reduce_tiles(const tt_mesh *mesh, const tt_tile_layout *layou
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
                             "corner %d has boundary type %d, but %d colors allow 0..%d", c, corner_type[c], n,
                             2 * n - 1);
-        if (t >= 0 && corner_type[t] != (corner_type[c] ^ 1))
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
-                            "corners %d and %d are the two sides of one edge but have types %d and %d, not the "
-                            "two halves of one condition (tt_assign_boundaries makes them so)", c, t,
-                            corner_type[c], corner_type[t]);
+        if ((result = tt__check_twin_types(mesh, corner_type, c, error)) != TT_OK) return result;
         if (edge_colors && edge_colors[c] >= 0 && corner_type[c] / 2 != edge_colors[c])
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, mesh->corner_face[c], c, -1, -1,
                             "corner %d has type %d, of colour %d, but prescribes colour %d", c, corner_type[c],
@@ -27832,6 +27840,12 @@ done:
 
 #define TT__MAP_SNAP 1e-3f          /* a vertex's point this near a quad's edge (in quad units) is put on it */
 
+/* A coordinate in a quad (or along an edge of S) within TT__MAP_SNAP of 0 or 1. */
+static int tt__near_quad_edge(double v)
+{
+    return v < TT__MAP_SNAP || v > 1.0 - TT__MAP_SNAP;
+}
+
 /* Points within TT__MAP_SNAP of a quad's edge put on it: the points are
    float, and a model vertex on a lattice line (a CAD part's edge, a face in
    a lattice plane) must be on S's edge exactly, or the edges through that
@@ -28090,7 +28104,7 @@ static int tt__edge_corner_pass(const tt_polycube *pc, const tt_polycube_edges *
         const int h = from_end ? s->twin[c->halfedge] : c->halfedge;
         const double along = from_end ? 1.0 - c->along : c->along;
         double e0[2], e1[2];
-        const int near = along < TT__MAP_SNAP || along > 1.0 - TT__MAP_SNAP;
+        const int near = tt__near_quad_edge(along);
         tt__edge_in_plane(s, h, map, e0, e1);
         if (near) {
             const double *corner = along < 0.5 ? e0 : e1;
@@ -28157,9 +28171,8 @@ static int tt__polycube_clear_corners(const tt_polycube *pc, const tt_polycube_e
                 length / along;
         to[0] = x[0] - shift * u[1];
         to[1] = x[1] + shift * u[0];
-        if (x[0] < TT__MAP_SNAP || x[0] > 1.0 - TT__MAP_SNAP || x[1] < TT__MAP_SNAP || x[1] > 1.0 - TT__MAP_SNAP ||
-            to[0] < TT__MAP_SNAP || to[0] > 1.0 - TT__MAP_SNAP || to[1] < TT__MAP_SNAP ||
-            to[1] > 1.0 - TT__MAP_SNAP || fabs(shift) > 4.0 * TT__CORNER_CLEARANCE)
+        if (tt__near_quad_edge(x[0]) || tt__near_quad_edge(x[1]) || tt__near_quad_edge(to[0]) ||
+            tt__near_quad_edge(to[1]) || fabs(shift) > 4.0 * TT__CORNER_CLEARANCE)
             continue;
         points[v].s = (float)to[0];
         points[v].t = (float)to[1];
@@ -30204,6 +30217,18 @@ static int tt__merge_quads_within(const tt__merge_try *T, int end)
     return 1;
 }
 
+/* (q1 - q0) x (q2 - q0): twice triangle q's area, along its normal. */
+static void tt__merge_normal(const double q[3][3], double n[3])
+{
+    double e1[3], e2[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        e1[k] = q[1][k] - q[0][k];
+        e2[k] = q[2][k] - q[0][k];
+    }
+    tt__cross3(e1, e2, n);
+}
+
 /* End `end` (0: a, 1: b) of T: its quads and points there, its
    neighbours (ring[end]) and, for a, how many of its triangles each is on;
    its live triangles appended to T's (b's without those on a-b, listed
@@ -30237,13 +30262,8 @@ static int tt__merge_star_end(const tt__merge *G, tt__merge_try *T, int end)
             T->st_before[T->n][k][1] = p->t;
         }
         {
-            double(*corners)[3] = T->before[T->n];
-            double e1[3], e2[3], n[3];
-            for (k = 0; k < 3; k++) {
-                e1[k] = corners[1][k] - corners[0][k];
-                e2[k] = corners[2][k] - corners[0][k];
-            }
-            tt__cross3(e1, e2, n);
+            double n[3];
+            tt__merge_normal((const double(*)[3])T->before[T->n], n);
             T->area_before[T->n] = tt__length3(n);
         }
         T->tris[T->n++] = t;
@@ -30296,13 +30316,9 @@ static int tt__merge_star_b(const tt__merge *G, tt__merge_try *T)
 /* Barycentric coordinates of p in the triangle q (its plane), in l. */
 static void tt__merge_barycentric(const double q[3][3], const double p[3], double l[3])
 {
-    double e1[3], e2[3], n[3], d1[3], d2[3], c[3], nn;
+    double n[3], d1[3], d2[3], c[3], nn;
     int k;
-    for (k = 0; k < 3; k++) {
-        e1[k] = q[1][k] - q[0][k];
-        e2[k] = q[2][k] - q[0][k];
-    }
-    tt__cross3(e1, e2, n);
+    tt__merge_normal(q, n);
     nn = tt__dot3(n, n);
     for (k = 0; k < 3; k++) {
         d1[k] = q[2][k] - q[1][k];
@@ -30485,7 +30501,7 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
         const int t = T->tris[i];
         double (*after)[3] = T->after[i];
         double (*st_after)[2] = T->st_after[i], (*st_before)[2] = T->st_before[i];
-        double e1[3], e2[3], n[3], s_after;
+        double n[3], s_after;
         largest = fmax(largest, T->area_before[i]);
         area[i] = 0.0;
         if (T->gone[i]) continue;
@@ -30495,11 +30511,7 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
             (s_after < TT__MERGE_AREA && s_after < tt__orient2(st_before[0][0], st_before[0][1], st_before[1][0],
                                                                st_before[1][1], st_before[2][0], st_before[2][1])))
             return 0;
-        for (k = 0; k < 3; k++) {
-            e1[k] = after[1][k] - after[0][k];
-            e2[k] = after[2][k] - after[0][k];
-        }
-        tt__cross3(e1, e2, n);
+        tt__merge_normal((const double(*)[3])after, n);
         area[i] = tt__dot3(n, G->normal + 3 * (size_t)G->m->triangle_face[t]);
         if (!(area[i] > 0.0)) return 0;
     }
@@ -31045,11 +31057,8 @@ TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t 
                         "tt_polycube_orient_upright needs a polycube and corner_type (got NULL)");
     s = polycube->surface;
     for (c = 0; c < s->ncorners; c++) {
-        int t = s->twin[c];
-        if (t >= 0 && corner_type[t] != (corner_type[c] ^ 1))
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, s->corner_face[c], c, -1, -1,
-                            "corner %d has type %d and its twin %d type %d: not the two halves of one condition",
-                            c, corner_type[c], t, corner_type[t]);
+        tt_result result = tt__check_twin_types(s, corner_type, c, error);
+        if (result != TT_OK) return result;
     }
     for (q = 0; q < s->nfaces; q++) {
         if (!tt_polycube_quad_upright(polycube, q)) continue;
