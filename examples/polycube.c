@@ -486,8 +486,9 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
     /* Above 0.1 % (the target), the cuts show: say why they come and what may help. */
     if (job->map_report.fallback_triangles > 0.001 * job->map_report.triangles)
         tool_note("%s: %d of the %d triangles mapped (%.2g %%) have no seamless place on the polycube and show a cut each: "
-                  "parts thinner than about two cubes, handles the polycube lacks, or wide holes; try another "
-                  "--resolution", options->mesh_path, job->map_report.fallback_triangles, job->map_report.triangles,
+                  "parts thinner than about two cubes, parts less than a cube apart (joined on the polycube), "
+                  "handles the polycube lacks, or wide holes; try another --resolution, or hpm or lapped, which "
+                  "need no polycube", options->mesh_path, job->map_report.fallback_triangles, job->map_report.triangles,
                   100.0 * job->map_report.fallback_triangles / job->map_report.triangles);
     job->corner_uv = (float *)malloc((size_t)job->mapping->ntriangles * 6 * sizeof(float));
     if (!job->corner_uv)
