@@ -72,7 +72,8 @@ static void print_help(void)
            "                   (--tile) covers; each square of the polycube shows a tile of as many\n"
            "                   texels as its share of that. Default: the mesh's longest side / 16,\n"
            "                   whatever resolution is chosen; with --resolution or --cube-size,\n"
-           "                   the cube size (one tile of --tile texels per square)\n",
+           "                   the cube size (one tile of --tile texels per square). A photo laid in\n"
+           "                   courses shows one course per square at the least, at its own texels\n",
            TT_POLYCUBE_MAX_RESOLUTION);
     printf(
            "  --colors N       edge colours of the palette each axis draws 2 from (default %d:\n"
@@ -303,8 +304,12 @@ static int build_polycube(const polycube_command_options *options, polycube_job 
    (the tiles' mip levels), 16 at least. Without --texture-size the
    texture keeps the size the default resolution (16) gives it, however
    fine the polycube the mesh needed; a resolution the user chose keeps a
-   tile per square, the size --cube-size always promised. */
-static int scale_tiles(polycube_command_options *options, polycube_job *job, const tt_image *image)
+   tile per square, the size --cube-size always promised. A photo laid in
+   courses (course_period texels apart; 0: none) shows one course per
+   square at the least (tiled_fit_courses), so a square shows at least a
+   course's texels. */
+static int scale_tiles(polycube_command_options *options, polycube_job *job, const tt_image *image,
+                       double course_period)
 {
     double extent, texels;
     int size;
@@ -318,7 +323,19 @@ static int scale_tiles(polycube_command_options *options, polycube_job *job, con
     texels = job->photo_tile * job->polycube->h / extent;
     if (extent == job->polycube->h) return 0;   /* one --tile per square, as given */
     size = (int)(texels / 8.0 + 0.5) * 8;
-    if (size < 16) {
+    if (size < course_period) {
+        /* Fewer texels than a course would shrink the photo to fit one
+           (brick_red on the elephant at 72: to 0.61, 24 texels a course, its
+           bricks blurred). The bricks are a square tall on the surface
+           either way; with the course's own texels (half a texel less at
+           most) they keep their detail, at a higher texel density. */
+        size = (int)ceil((course_period - 0.5) / 8.0) * 8;
+        if (size < 16) size = 16;
+        tool_note("%s: a square of the polycube (%.4g units) would show %.3g texels of %s, fewer than one of its "
+                  "courses (%.1f); shows %d, a course per square (the bricks are smaller on the surface than "
+                  "--texture-size %.4g asks)", options->mesh_path, job->polycube->h, texels, options->image_path,
+                  course_period, size, extent);
+    } else if (size < 16) {
         tool_note("%s: a square of the polycube (%.4g units) would show %.3g texels of %s; shows 16 (the texture "
                   "is larger on the surface than --texture-size %.4g asks)", options->mesh_path, job->polycube->h,
                   texels, options->image_path, extent);
@@ -798,6 +815,7 @@ int cmd_polycube(int argc, char **argv)
     polycube_quality quality;
     tt_image *image = NULL;
     tool_output output = TOOL_OUTPUT_INIT;
+    tt_courses photo_courses;
     tt_error error;
     char obj_path[4096], mtl_path[4096], png_path[4096], surface_path[4096], gltf_path[4096], written[8400],
         message[TOOL_ERROR_SIZE];
@@ -807,6 +825,7 @@ int cmd_polycube(int argc, char **argv)
     double start;
 
     memset(&job, 0, sizeof job);
+    memset(&photo_courses, 0, sizeof photo_courses);
     status = parse_command_line(argc, argv, &options);
     if (status >= 0) return status;
     snprintf(obj_path, sizeof obj_path, "%s.obj", options.prefix);
@@ -836,7 +855,9 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0 && !gltf) status = material_refuse_overwrite(&options.tiles.maps, options.prefix);
 
     if (status == 0) status = build_polycube(&options, &job);
-    if (status == 0) status = scale_tiles(&options, &job, image);
+    if (status == 0 && !options.plain)
+        status = tiled_find_courses(image, options.image_path, &options.tiles, &photo_courses);
+    if (status == 0) status = scale_tiles(&options, &job, image, photo_courses.period);
     if (status == 0) status = tiled_check_atlas_size(&options.tiles);
     if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
         status = tool_fail("%s", error.message);

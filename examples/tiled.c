@@ -494,17 +494,25 @@ int tiled_pick_tile_size(const char *image_path, int width, int height, tiled_op
     return 0;
 }
 
+int tiled_find_courses(const tt_image *image, const char *image_path, const tiled_options *options,
+                       tt_courses *courses)
+{
+    tt_error error;
+    memset(courses, 0, sizeof *courses);
+    if (options->no_courses) return 0;
+    if (tt_find_courses(image, NULL, courses, &error) != TT_OK) return tool_fail("%s: %s", image_path, error.message);
+    return 0;
+}
+
 int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *options)
 {
     const int S = options->layout.tile_size ? options->layout.tile_size : TT_DEFAULT_TILE_SIZE;
     tt_image *resized[1 + MATERIAL_MAPS] = {NULL};
     tt_courses courses;
-    tt_error error;
     double scale, row_scale = 1.0;
-    int courses_per_tile, width, height, map;
+    int courses_per_tile, width, height, map, status;
     memset(&options->courses, 0, sizeof options->courses);
-    if (options->no_courses) return 0;
-    if (tt_find_courses(*image, NULL, &courses, &error) != TT_OK) return tool_fail("%s: %s", image_path, error.message);
+    if ((status = tiled_find_courses(*image, image_path, options, &courses)) != 0) return status;
     if (courses.period == 0.0f) return 0;
     /* The nearest whole number of courses to a tile: every band of an
        upright tile then starts where the tile above or below ends. */

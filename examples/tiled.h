@@ -64,6 +64,11 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
 int tiled_parse_command_line(int argc, char **argv, unsigned accept, tiled_options *options,
                              const char **positional, int count, const char *names, void (*help)(void));
 
+/* IMAGE's courses (tt_find_courses) into *courses, period 0 when it has
+   none or options->no_courses is set. Returns 0 or the exit status. */
+int tiled_find_courses(const tt_image *image, const char *image_path, const tiled_options *options,
+                       tt_courses *courses);
+
 /* Before upright tiles are synthesised from *image (tile size chosen): a
    photo with courses (tt_find_courses: bricks, blocks laid in rows) is
    resampled, with its maps, so that a tile holds a whole number of them,

@@ -1361,6 +1361,20 @@ expect_ok "polycube --no-courses on bricks" polycube ../in/spheretri.obj bricks.
     --no-courses
 check "polycube --no-courses: no word of courses" "no 'courses' on stderr" "$ERR" \
     "$(! printf '%s' "$ERR" | grep -q courses; echo $?)"
+# Courses 40 texels apart, and squares that would show 16 texels of the
+# photo: each square shows a course's texels instead of the photo shrunk.
+awk 'BEGIN { w = 256; h = 256; p = 40; printf "P5\n%d %d\n255\n", w, h
+    for (y = 0; y < h; y++) {
+        c = int(y / p); m = y - c * p
+        for (x = 0; x < w; x++) {
+            a = int((x + 37 * c) / 64); v = (m < 4 || (x + 37 * c) % 64 < 4) ? 220 : 70 + (a * 29 + c * 13) % 70
+            printf "%c", v } } }' >bricks40.pgm
+expect_ok "polycube on 40-texel courses, squares of 16 texels" polycube ../in/spheretri.obj bricks40.pgm big \
+    --tile 32 --texture-size 100
+err_mentions "polycube, squares smaller than a course: shows a course's texels, and says so" \
+    'would show [0-9.e+-]+ texels of bricks40\.pgm, fewer than one of its courses \(40\.0\); shows 40, a course'
+err_mentions "polycube, squares smaller than a course: the photo is not shrunk" \
+    'courses every 40\.0 texels(: resampled by 1(\.00[0-9]*)? so that a|, 1 to a) 40-texel tile'
 expect_error "tile --up 0,0,0" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up 0,0,0
 expect_error "tile --up without a value" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up
 expect_error "tile --up with an atlas too wide for two sets" tile ../in/torus.obj ../in/lap256.png out --colors 4 \
