@@ -42,7 +42,7 @@ static void print_help(void)
            "folder can move. Look at it with 'tiledtex render OUT_PREFIX.obj OUT_PREFIX.png\n"
            "view.png'.\n"
            "Faces with more than 3 corners are split into triangle fans first. The mesh must be\n"
-           "manifold and consistently oriented.\n");
+           "manifold and consistently oriented (--permissive cuts bad edges open).\n");
     tool_print_mesh_help(1);
     printf("OUT_PREFIX is a name without extension; one ending in .obj, .mtl or .png loses it\n"
            "('out.obj' writes out.obj, not out.obj.obj); one ending in .glb writes OUT_PREFIX.glb\n"
@@ -83,7 +83,17 @@ static void print_help(void)
            "                   OUT_PREFIX.glb, with IMAGE in it (as a PNG; repeated under --toroidal);\n"
            "                   gltf: the same as glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and\n"
            "                   OUT_PREFIX_baseColor.png (and a PNG per map) beside it\n"
-           "  --triangles      accepted for the OBJ, whose faces are triangles already\n"
+           "  --triangles      accepted for the OBJ, whose faces are triangles already\n");
+    printf("  --subdivide L    make the triangles smaller first, L from 0 to 8 (default 0):\n"
+           "                   quadrangulate them L times, as 'tiledtex tile' does, and split every\n"
+           "                   quad into two triangles, so a triangle becomes 6, 24, 96, ... (the\n"
+           "                   outputs have these). Clusters are made of whole triangles, so on a\n"
+           "                   coarse mesh (edges spanning a hundred texels) their borders are few,\n"
+           "                   long and visible; on smaller triangles they find better places (a\n"
+           "                   mesh whose edges span 30 texels or fewer gains nothing)\n"
+           "  --smooth         Catmull-Clark positions when subdividing (rounder, a little smaller)\n"
+           "  --permissive     accept non-manifold or mis-oriented edges (an edge shared by three\n"
+           "                   faces, as some exports have): they are cut open into boundaries\n"
            "  --reference-image  no copies: the MTL names IMAGE (and the maps) where they are,\n"
            "                   relative to itself; keep them there\n"
            MATERIAL_OPTIONS_HELP("                   ")
@@ -113,6 +123,7 @@ typedef struct hpm_command_options {
     tool_field field;       /* --up, --constraints: the direction the image's up follows */
     material_maps maps;     /* --normal ...: the material's other maps, on the same UVs */
     tool_mesh_output output;        /* --format, --triangles */
+    tool_mesh_options mesh;         /* --subdivide, --smooth, --permissive */
     int reference_image;            /* --reference-image: the MTL names IMAGE and the maps where they are */
 } hpm_command_options;
 
@@ -161,6 +172,8 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
         } else if (tool_option(argc, argv, &i, "--band", &value)) {
             if (parse_float("--band", value, 1.0, 1e6, &options->map.band) != 0) return TOOL_EXIT_USAGE;
         } else if ((taken = parse_field_option(argc, argv, &i, &options->field)) != 0) {
+            if (taken < 0) return TOOL_EXIT_USAGE;
+        } else if ((taken = parse_mesh_option(argc, argv, &i, &options->mesh)) != 0) {
             if (taken < 0) return TOOL_EXIT_USAGE;
         } else if (tool_flag(argv[i], "--toroidal")) {
             options->map.flags |= TT_HPM_TOROIDAL;
@@ -336,7 +349,8 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
     for (level = 0; level < counted; level++)
         if (report->mapped_per_level[level] > 0) last = level;
     printf("%s: %d triangles", options->mesh_path, m->ntriangles);
-    if (m->ntriangles != m->obj.nfaces) printf(" (fans of %d faces)", m->obj.nfaces);
+    if (m->subdivided > 0) printf(" (%d faces, --subdivide %d)", m->obj.nfaces, m->subdivided);
+    else if (m->ntriangles != m->obj.nfaces) printf(" (fans of %d faces)", m->obj.nfaces);
     printf(", %d levels, %d clusters textured%s\n", report->levels, report->clusters,
            (options->map.flags & TT_HPM_RANDOM_PLACEMENT) ? " (--no-fit: each placed at random)" : "");
     printf("clusters per level:");
@@ -439,7 +453,7 @@ int cmd_hpm(int argc, char **argv)
     for (map = 0; map < MATERIAL_MAPS; map++) map_paths[map] = options.maps.paths[map];
     if (options.maps.normal_y_down) map_paths[MATERIAL_NORMAL] = normal_path;
 
-    if ((status = triangle_mesh_read(options.mesh_path, NULL, &mesh)) != 0) return status;
+    if ((status = triangle_mesh_read(options.mesh_path, &options.mesh, &mesh)) != 0) return status;
     /* A photo: sRGB bytes in the file, linear light in the library (which
        matches colours as displayed again, by itself). */
     if (image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)

@@ -1268,6 +1268,21 @@ CMD="tiledtex hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 [--no
 check "hpm --no-fit: other coordinates than the fitted ones" "files differ" "identical" \
     "$(! cmp -s "$HPM_TORUS/out.obj" "$HPM_RANDOM/out.obj"; echo $?)"
 
+# The mesh options: --subdivide makes six triangles of each before the
+# clusters are made, and the OBJ has them; --permissive cuts a bad edge open.
+newdir
+expect_ok "hpm --subdivide 1" hpm ../in/spheretri.obj ../in/lap.png out --rotations 3 --subdivide 1
+check "hpm --subdivide 1: the summary counts 6 triangles for each" "'7680 triangles (1280 faces, --subdivide 1)'" \
+    "$OUT" "$(printf '%s' "$OUT" | grep -q 'spheretri.obj: 7680 triangles (1280 faces, --subdivide 1)'; echo $?)"
+check "hpm --subdivide 1: the OBJ has them" "7680 f lines" "$(grep -c '^f ' out.obj 2>&1) f lines" \
+    "$([ "$(grep -c '^f ' out.obj 2>/dev/null)" = 7680 ]; echo $?)"
+cd "$W" || exit 1
+expect_error "hpm non-manifold edge" hpm ../in/nonmanifold.obj ../in/lap.png out --rotations 3
+err_mentions "hpm non-manifold: says --permissive would help" 'permissive'
+newdir
+expect_ok "hpm non-manifold --permissive" hpm ../in/nonmanifold.obj ../in/lap.png out --rotations 3 --permissive
+cd "$W" || exit 1
+
 # --up: each cluster turned so that the image's up follows the direction field;
 # the summary says how level it lies on the walls (the torus's axis is z; on this
 # coarse torus and a bounded 64x64 image about 60 % of the wall faces lie within
