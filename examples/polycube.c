@@ -73,7 +73,8 @@ static void print_help(void)
            "                   texels as its share of that. Default: the mesh's longest side / 16,\n"
            "                   whatever resolution is chosen; with --resolution or --cube-size,\n"
            "                   the cube size (one tile of --tile texels per square). A photo laid in\n"
-           "                   courses shows one course per square at the least, at its own texels\n",
+           "                   courses shows one course per square at the least, at its own texels\n"
+           "                   (its bricks then smaller than X asks; a note says so)\n",
            TT_POLYCUBE_MAX_RESOLUTION);
     printf(
            "  --colors N       edge colours of the palette each axis draws 2 from (default %d:\n"
