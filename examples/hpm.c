@@ -225,33 +225,6 @@ static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, 
     return triangle_mesh_report_error(options->mesh_path, m, &error);
 }
 
-/* Clusters are made of whole triangles, so on a mesh whose edges span many
-   texels their borders are few and long, and their seams show: the
-   891-triangle pig, edges of 100 texels at the default scale, scores 0.50
-   on its borders with gravel and 0.04 subdivided twice, where the mismatch
-   one sees (the score times the borders' length) is 0.29 of what it was;
-   the bunny, 48 texels, 0.37 and 0.10 subdivided once (0.60 of it). Below
-   about 40 texels a step only adds borders (a 9.6k-triangle knotted tube
-   at 33: 0.31 and 0.17, the same mismatch), so the note stays quiet
-   there. It names the steps that bring the median edge to 32 texels. */
-#define HPM_COARSE_EDGE_TEXELS 40.0
-#define HPM_FINE_EDGE_TEXELS 32.0
-#define HPM_MAX_SUGGESTED_STEPS 3
-
-static void note_coarse_mesh(const hpm_command_options *options, const triangle_mesh *m, double texels_per_unit)
-{
-    double edge = triangle_mesh_median_edge(m) * texels_per_unit;
-    int steps = 0, times = 1;
-    if (options->mesh.subdivide > 0 || !(edge > HPM_COARSE_EDGE_TEXELS)) return;
-    while (steps < HPM_MAX_SUGGESTED_STEPS && edge / (1 << steps) > HPM_FINE_EDGE_TEXELS) {
-        steps++;
-        times *= steps == 1 ? 6 : 4;
-    }
-    tool_note("%s: its edges span %.0f texels of %s (the median), so the clusters, made of whole triangles, have "
-              "few and long borders, and their seams show; --subdivide %d cuts each triangle into %d first",
-              options->mesh_path, edge, options->image_path, steps, times);
-}
-
 /* The triangles with one texture coordinate and one normal per corner, for
    either file. */
 static void hpm_write_desc(const triangle_mesh *m, const float *corner_uv, const float *normals, obj_write_desc *desc)
@@ -502,7 +475,6 @@ int cmd_hpm(int argc, char **argv)
                        : tool_fail("out of memory for the direction field of %s", options.mesh_path);
     }
     if (status == 0) status = map_mesh(&options, &mesh, image, field, corner_uv, &report);
-    if (status == 0) note_coarse_mesh(&options, &mesh, report.texels_per_unit);
     if (status == 0) status = measure_quality(&options, &mesh, image, corner_uv, &report, &quality);
 
     if (status == 0 && gltf) status = add_gltf(&output, gltf_path, &options, &mesh, corner_uv, image);

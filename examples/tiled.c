@@ -321,6 +321,12 @@ int tiled_add_mtl(tool_output *output, const char *mtl_path, const char *texture
     return 0;
 }
 
+static int compare_floats(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
 /* The rest of the quality report: how evenly the tiles are used (every tile
    equally often is what keeps repetition invisible) and how much each face
    stretches its tile (the ratio of the singular values of its map). With
@@ -375,7 +381,7 @@ static void print_quality(const tiled_mesh *mesh)
         if (least < 0 || counts[t] < least) least = counts[t];
         if (counts[t] > most) most = counts[t];
     }
-    qsort(stretch, (size_t)nfaces, sizeof(float), tool_compare_floats);
+    qsort(stretch, (size_t)nfaces, sizeof(float), compare_floats);
     for (f = nfaces; f > 0 && !(stretch[f - 1] < 1e30f); f--) degenerate++;
     printf("quality: %d of %d tiles used (%d to %d faces each, %.1f on average)", used, ntiles, least, most,
            (double)nfaces / ntiles);

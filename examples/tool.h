@@ -11,7 +11,6 @@
                  atomic output           tool_output: build every file in
                                          memory, then commit them all or none
                  progress, time          tool_progress, tool_seconds_now, tool_cpu_seconds_now
-                 sorting                 tool_compare_floats
      cli.c       command-line helpers    tool_option, parse_int, parse_mesh_option, ...
      image_io.c  images                  image_load, png_encode, output_add_png,
                                          image_to_rgba8
@@ -864,9 +863,6 @@ typedef struct triangle_mesh {
    empty). */
 int triangle_mesh_read(const char *path, const tool_mesh_options *options, triangle_mesh *m);
 void triangle_mesh_free(triangle_mesh *m);
-/* The median length of the triangles' edges in mesh units (an edge between
-   two triangles counted twice); -1 when out of memory. */
-double triangle_mesh_median_edge(const triangle_mesh *m);
 /* Reverse every triangle's corners (an inside-out mesh turned outward) and
    build the mesh again; the file's normals, if any, are turned round too
    unless they already faced the new way. Returns 0, or the exit status
@@ -990,9 +986,6 @@ float tool_float_of(double value);
 /* ---------------------------------------------------------------------- */
 /* Time and progress on a terminal (tool_io.c)                              */
 /* ---------------------------------------------------------------------- */
-
-/* qsort's comparison of two floats, ascending. */
-int tool_compare_floats(const void *a, const void *b);
 
 /* Seconds on a monotonic clock, for "took 1.2 s". */
 double tool_seconds_now(void);

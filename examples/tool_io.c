@@ -903,12 +903,6 @@ void output_free(tool_output *output)
 /* Time and progress on a terminal                                          */
 /* ======================================================================== */
 
-int tool_compare_floats(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return x < y ? -1 : x > y;
-}
-
 double tool_seconds_now(void)
 {
     struct timespec now;

@@ -107,25 +107,6 @@ void triangle_mesh_free(triangle_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
-double triangle_mesh_median_edge(const triangle_mesh *m)
-{
-    const int corners = 3 * m->ntriangles;
-    float *length = (float *)malloc((size_t)(corners > 0 ? corners : 1) * sizeof(float));
-    double median;
-    int c, k;
-    if (!length) return -1.0;
-    for (c = 0; c < corners; c++) {
-        const float *a = m->pos + 3 * (size_t)m->vert[c], *b = m->pos + 3 * (size_t)m->vert[c % 3 == 2 ? c - 2 : c + 1];
-        double sum = 0.0;
-        for (k = 0; k < 3; k++) sum += ((double)b[k] - a[k]) * ((double)b[k] - a[k]);
-        length[c] = (float)sqrt(sum);
-    }
-    qsort(length, (size_t)corners, sizeof(float), tool_compare_floats);
-    median = corners > 0 ? length[corners / 2] : 0.0;
-    free(length);
-    return median;
-}
-
 /* (Re)build m->mesh from m->pos and m->vert; a build error is said about the
    OBJ's face, suggesting --permissive when offer_permissive and it would
    help. It would not for a face of zero area (or one repeating a vertex,

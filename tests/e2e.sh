@@ -1277,21 +1277,6 @@ check "hpm --subdivide 1: the summary counts 6 triangles for each" "'7680 triang
 check "hpm --subdivide 1: the OBJ has them" "7680 f lines" "$(grep -c '^f ' out.obj 2>&1) f lines" \
     "$([ "$(grep -c '^f ' out.obj 2>/dev/null)" = 7680 ]; echo $?)"
 cd "$W" || exit 1
-# A coarse mesh for the image (the torus's edges span about 50 texels of a
-# 256-texel image at the default scale): a note names the --subdivide that
-# brings them to 32; none on the 64-texel image, or once subdivided.
-newdir
-expect_ok "hpm torus on a 256-texel image" hpm ../in/torus.obj ../in/lap256.png out --rotations 3
-err_mentions "hpm, edges of 50 texels: says which --subdivide helps" \
-    'torus\.obj: its edges span [0-9]+ texels of \.\./in/lap256\.png \(the median\).*--subdivide 1 cuts each triangle into 6'
-expect_ok "hpm torus --subdivide 1 on a 256-texel image" hpm ../in/torus.obj ../in/lap256.png out --rotations 3 \
-    --subdivide 1
-check "hpm --subdivide 1: no note about the edges" "no 'edges span' on stderr" "$ERR" \
-    "$(! printf '%s' "$ERR" | grep -q 'edges span'; echo $?)"
-expect_ok "hpm torus on a 64-texel image" hpm ../in/torus.obj ../in/lap.png out --rotations 3
-check "hpm, edges of 12 texels: no note about the edges" "no 'edges span' on stderr" "$ERR" \
-    "$(! printf '%s' "$ERR" | grep -q 'edges span'; echo $?)"
-cd "$W" || exit 1
 expect_error "hpm non-manifold edge" hpm ../in/nonmanifold.obj ../in/lap.png out --rotations 3
 err_mentions "hpm non-manifold: says --permissive would help" 'permissive'
 newdir
