@@ -3031,15 +3031,15 @@ typedef struct tt_hpm_report {
                                 one (error->corner);
      TT_CANCELLED               the progress callback stopped it;
      TT_ERROR_OUT_OF_MEMORY.
-   Clusters are made of whole faces, so on a mesh whose edges span many
-   texels (more than about 40 at report->texels_per_unit) their borders
-   are few and long, and their seams show; subdivide such a mesh first
+   Clusters are made of whole faces, so on a coarse mesh their borders
+   are few and long, and their seams show. Subdividing it first
    (tt_mesh_quadrangulate with TT_SUBDIVIDE_LINEAR, each quad split into
-   two triangles): an 891-triangle pig with a gravel photo, edges of 100
-   texels, scores 0.50 on its borders and 0.04 subdivided twice, the
-   mismatch times the borders' length 0.29 of what it was. On finer
-   meshes a step only adds borders: the mean score falls, the mismatch
-   does not.
+   two triangles) can help: an 891-triangle pig with a gravel photo,
+   edges of 100 texels, scores 0.50 on its borders and 0.04 subdivided
+   twice, the score times the borders' length 0.29 of what it was. It is
+   not a rule (a generated double torus with edges of 98 texels gains
+   nothing), and on a mesh whose edges span about 30 texels a step only
+   adds borders: the mean score falls, the mismatch does not.
    On any error corner_uv and face_cluster are untouched. Time: the
    hierarchy and flattening (above) plus, per fit (report->fits), about
    10 ms at P = 256 by transforms or 0.3 ms summing a band of 30 pixels
