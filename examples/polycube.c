@@ -862,7 +862,8 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = tiled_check_atlas_size(&options.tiles);
     if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)
         status = tool_fail("%s", error.message);
-    if (status == 0 && !options.plain) status = tiled_fit_courses(&image, options.image_path, &options.tiles);
+    if (status == 0 && !options.plain)
+        status = tiled_fit_courses(&image, options.image_path, &options.tiles, &photo_courses);
     if (status == 0) status = tile_polycube(&options, &job);
     if (status == 0) {
         start = tool_seconds_now();

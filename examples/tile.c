@@ -185,7 +185,7 @@ int cmd_tile(int argc, char **argv)
                                TOOL_MAX_ATLAS);
     }
     if (status == 0 && options.upright) {
-        status = tiled_fit_courses(&image, positional[1], &options);
+        status = tiled_fit_courses(&image, positional[1], &options, NULL);
     }
     if (status == 0) status = tiled_map_mesh(positional[0], &options, &mesh);
     /* Before the synthesis: no output may replace an input (checked again at the commit). */

@@ -504,7 +504,7 @@ int tiled_find_courses(const tt_image *image, const char *image_path, const tile
     return 0;
 }
 
-int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *options)
+int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *options, const tt_courses *found)
 {
     const int S = options->layout.tile_size ? options->layout.tile_size : TT_DEFAULT_TILE_SIZE;
     tt_image *resized[1 + MATERIAL_MAPS] = {NULL};
@@ -512,7 +512,10 @@ int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *o
     double scale, row_scale = 1.0;
     int courses_per_tile, width, height, map, status;
     memset(&options->courses, 0, sizeof options->courses);
-    if ((status = tiled_find_courses(*image, image_path, options, &courses)) != 0) return status;
+    if (found)
+        courses = *found;
+    else if ((status = tiled_find_courses(*image, image_path, options, &courses)) != 0)
+        return status;
     if (courses.period == 0.0f) return 0;
     /* The nearest whole number of courses to a tile: every band of an
        upright tile then starts where the tile above or below ends. */

@@ -74,9 +74,11 @@ int tiled_find_courses(const tt_image *image, const char *image_path, const tile
    resampled, with its maps, so that a tile holds a whole number of them,
    and options->courses keeps every window on them; a note says so. Nothing
    changes for a photo without courses, with --no-courses, or when the
-   resampled photo would be too small for the tiles. *image is replaced
-   (the old one freed) when resampled. Returns 0 or the exit status. */
-int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *options);
+   resampled photo would be too small for the tiles. found: the courses
+   tiled_find_courses already found in *image, or NULL to find them here.
+   *image is replaced (the old one freed) when resampled. Returns 0 or the
+   exit status. */
+int tiled_fit_courses(tt_image **image, const char *image_path, tiled_options *options, const tt_courses *found);
 
 /* A quad mesh with its tiled-texture UVs, ready to write. */
 typedef struct tiled_mesh {
