@@ -1436,6 +1436,15 @@ typedef struct tt_synth_options {
        the tops of a polycube, tt_polycube_upright_atlas). Needs a
        source of at least 2S x 2S. */
     int upright;
+    /* Upright tiles only: a bit per side, 1 << 1 (right) and 1 << 3 (left),
+       whose band is a plain tile's instead - the edge window turned to that
+       side - so that it meets a tile that sees the edge as its bottom or top
+       (a polycube's top beside a wall: tt_polycube_quad_kind). 0: both sides
+       upright. The vertical windows, the backgrounds and the cuts' random
+       choices do not depend on it: upright plans that differ only here
+       share their windows, and each such side meets a plain tile of a plan
+       with the same edge_windows seamlessly. */
+    int plain_sides;
     /* Region from which each tile's S x S background window is drawn; all zero =
        the whole image. */
     tt_rect background;
@@ -1484,6 +1493,7 @@ typedef struct tt_synth_plan {
     int max_depth;                  /* max(1, S/4): no band goes deeper (before its feather) */
     tt_rect *edge_windows;          /* n rects (w = S, h = 2S), one per condition */
     tt_rect *vertical_windows;      /* upright plans: n rects (w = 2S, h = S) for sides 1 and 3; else NULL */
+    int plain_sides;                /* upright plans: tt_synth_options::plain_sides; else 0 */
     tt_rect *background_windows;    /* one S x S rect per tile, indexed like tt_tile_index */
     /* The band depth (0..max_depth) of tile t, side s, column x at entry
        (4 * t + s) * S + x of the one of these that is not NULL: depth8 when
@@ -1507,7 +1517,8 @@ typedef struct tt_synth_plan {
    x 2S (2S x 2S for upright tiles) or a background region that cannot hold
    a tile (TT_ERROR_IMAGE_TOO_SMALL), a background region outside the guide,
    a given edge window that does not fit, a negative feather or one wider
-   than S/4 + 1, background_candidates outside
+   than S/4 + 1, plain_sides with other bits than 1 << 1 and 1 << 3 or
+   without upright, background_candidates outside
    0..TT_SYNTH_MAX_BACKGROUND_CANDIDATES (TT_ERROR_INVALID_ARGUMENT),
    TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by the
    progress callback. *out_plan is NULL on failure and nothing is left
@@ -1570,6 +1581,7 @@ typedef struct tt_tileset {
     tt_image levels[TT_MAX_MIP_LEVELS];
     tt_rect *edge_windows;          /* colors rects actually used (w = S, h = 2S) */
     tt_rect *vertical_windows;      /* upright tiles: colors rects (w = 2S, h = S) for sides 1 and 3; else NULL */
+    int plain_sides;                /* upright tiles: the sides with a plain band (tt_synth_options::plain_sides) */
     tt_rect *background_windows;    /* one per tile, indexed like tt_tile_index */
     tt_allocator allocator;         /* the one it was made with */
 } tt_tileset;
@@ -1610,9 +1622,10 @@ TTDEF void tt_tileset_free(tt_tileset *tileset);
 
    The layout's atlas holds every one of the (2n)^4 tiles whether the mesh
    shows it or not: 2176 x 2176 texels with 2 colours, 128-texel tiles and
-   gutter 4 (the tiledtex tool's polycube defaults; twice as wide with its
-   upright tiles), a size no engine asks for and, beside upright tiles,
-   above the 4096 texels a side many take. A compact atlas holds only
+   gutter 4 (the tiledtex tool's polycube defaults; twice as wide and
+   twice as tall with its four sets of upright and plain tiles), a size no
+   engine asks for and, with upright tiles, above the 4096 texels a side
+   many take. A compact atlas holds only
    the cells the faces use, each whole with its gutter (so bilinear
    filtering and the mip levels a gutter keeps seamless read what the full
    atlas had there), in a power-of-two rectangle: the smallest of W x W and
@@ -1642,8 +1655,8 @@ typedef struct tt_compact_atlas {
 } tt_compact_atlas;
 
 /* The cells of a full atlas (full_width x full_height texels, cells of the
-   layout's C = S + 2g texels, row 0 at the bottom: a layout's W x W, or a
-   polycube's 2W x W upright atlas) that mesh's faces use, each face's cell
+   layout's C = S + 2g texels, row 0 at the bottom: a layout's W x W, or
+   tt_polycube_upright_atlas's 2W x W or 2W x 2W) that mesh's faces use, each face's cell
    being the one its corners' UVs lie in, and the smallest power-of-two
    atlas that holds them with at most max_size texels a side (0 =
    TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE; at most TT_MAX_IMAGE_SIZE).
@@ -1669,6 +1682,16 @@ TTDEF tt_result tt_compact_atlas_create(const tt_mesh *mesh, const float *corner
    tt_image_free. */
 TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_image *full,
                                        const tt_allocator *allocator, tt_image **out_image, tt_error *error);
+/* The same from a full atlas in parts, never put together: columns x rows
+   (1 or 2 each) images of one size and kind, part k = row * columns +
+   column, row 0 at the bottom as cells count - a polycube's four tile sets
+   in the order of tt_polycube_tiles (tt_polycube_upright_atlas's layout),
+   without the memory of the whole. Errors: as tt_compact_atlas_image, a
+   NULL part, parts of different sizes or kinds, or columns or rows outside
+   1..2 (TT_ERROR_INVALID_ARGUMENT). */
+TTDEF tt_result tt_compact_atlas_image_parts(const tt_compact_atlas *atlas, const tt_image *const *parts, int columns,
+                                             int rows, const tt_allocator *allocator, tt_image **out_image,
+                                             tt_error *error);
 /* uv = full_uv (a UV of `face` in the full atlas) moved into the face's
    cell of the compact atlas; uv may be full_uv.
    Preconditions (TT_ASSERT): atlas not NULL, 0 <= face < atlas->nfaces. */
@@ -3818,36 +3841,53 @@ TTDEF void tt_polycube_mapping_free(tt_polycube_mapping *mapping);
 TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                         const tt_tile_layout *layout, const uint8_t *corner_type,
                                         float *corner_uv, tt_error *error);
-/* Upright tiles on the walls, so bricks, planks and grain keep their
-   direction all round the model (tt_synth_options::upright). The walls -
-   quads facing sideways, their normal not along polycube->up_axis: 1 from
-   tt_polycube_quad_upright - take upright tiles, the tops and bottoms plain
-   ones. Every edge of S then meets seamlessly: the edges along the up axis
-   are left/right sides of both their quads (upright tiles both), and every
-   other edge is a bottom/top side of each wall it borders, alike in both
-   sets when they share their edge windows.
+/* Upright tiles, so bricks, planks and grain keep their direction all
+   round the model (tt_synth_options::upright), on the walls and on the
+   tops alike. The walls - quads facing sideways, their normal not along
+   polycube->up_axis - take upright tiles: the edges along the up axis are
+   left/right sides of both their quads, every other edge a bottom/top side
+   of each wall it borders. The tops and bottoms all share one frame
+   (tt_polycube_build's up rule: u along one lattice axis, v along the
+   other), so their courses run one way over every top, as a pavement's
+   do: an edge between two of them is bottom/top to both or left/right to
+   both. Only where a top's left or right side meets a wall (which sees the
+   edge as its top or bottom) must that side be plain: the edge window
+   turned to the side, a course along the edge on the top beside the
+   wall's last course. So S takes four tile sets (tt_polycube_quad_tileset):
+   TT_POLYCUBE_TILES_UPRIGHT for the walls and the tops among tops,
+   TT_POLYCUBE_TILES_RIGHT_PLAIN or _LEFT_PLAIN for a top with a wall on
+   that side (tt_synth_options::plain_sides 1 << 1 or 1 << 3), and
+   TT_POLYCUBE_TILES_PLAIN for one with walls on both. Every edge of S then
+   meets seamlessly.
      0. with a photo laid in courses (bricks, planks), tt_polycube_orient_upright
         on S's types (after tt_reduce_tiles, before tt_assign_uvs), so every
-        wall shows its bands upright;
+        band shows upright;
      1. tt_synthesize_tiles (or plan and apply) the plain tiles, then the
-        upright ones with the same layout and seed, options.upright = 1 and
-        options.edge_windows = the plain tileset's edge_windows;
-     2. tt_polycube_upright_atlas: the two side by side, 2W x W, plain on
-        the left (per mip level, as you need them);
-     3. tt_polycube_mapping_uvs_upright: as tt_polycube_mapping_uvs, u
-        halved, and moved to the right half for a wall;
+        three upright sets with the same layout and seed, options.upright =
+        1, options.edge_windows = the plain tileset's edge_windows and
+        options.plain_sides 0, 1 << 1 and 1 << 3;
+     2. tt_polycube_upright_atlas with the four, in the order of the
+        TT_POLYCUBE_TILES_ values: a 2W x 2W atlas (per mip level, as you
+        need them);
+     3. tt_polycube_mapping_uvs_upright: as tt_polycube_mapping_uvs, each
+        quad's tile moved into its set's quarter;
      4. optionally tt_compact_atlas_create on S with its UVs (those of
-        tt_assign_uvs, halved and moved the same way), then
-        tt_compact_atlas_image and tt_compact_atlas_uv with each corner's
-        quad: an atlas of only the tiles S shows (about 400 of the 512 on
-        a model at resolution 16), 4096 x 2048 instead of 4352 x 2176 with
-        128-texel tiles; tt_reduce_tiles on S's types before the UVs, its
-        groups tt_polycube_quad_upright, makes them as few as 2048 x 2048
-        holds (225).
-   tt_polycube_quad_upright is 1 for a wall, 0 for a top or bottom.
-   Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad <
-   its surface's nfaces. */
-TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
+        tt_assign_uvs, moved the same way), then tt_compact_atlas_image and
+        tt_compact_atlas_uv with each corner's quad: an atlas of only the
+        tiles S shows (a few hundred of the 1024); tt_reduce_tiles on S's
+        types before the UVs, its groups the quads' tilesets, makes them as
+        few as 2048 x 2048 holds.
+   tt_polycube_quad_tileset gives the quad's set.
+   Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad
+   < its surface's nfaces. */
+typedef enum tt_polycube_tiles {
+    TT_POLYCUBE_TILES_PLAIN = 0,        /* a top with walls on its left and right */
+    TT_POLYCUBE_TILES_UPRIGHT = 1,      /* every wall; a top among tops */
+    TT_POLYCUBE_TILES_RIGHT_PLAIN = 2,  /* a top with a wall on its right side (1) only */
+    TT_POLYCUBE_TILES_LEFT_PLAIN = 3    /* a top with a wall on its left side (3) only */
+} tt_polycube_tiles;
+#define TT_POLYCUBE_TILESETS 4
+TTDEF tt_polycube_tiles tt_polycube_quad_tileset(const tt_polycube *polycube, int quad);
 /* An upright tile shows a side's band upright only on one of the two types
    of its condition (tt_synth_options::upright): the even type on its
    bottom and right sides, the odd one on its top and left; on the other
@@ -3857,31 +3897,41 @@ TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad);
    unless the edge runs exactly mid-joint: a photo with a gradient through
    each course shows the turned bands as reversed patches, and bricks look
    jumbled. tt_assign_boundaries draws the side at random, so half the
-   bands of the walls were turned. This turns the types of whole edges
-   (both halves: type ^ 1, the condition kept) so that every wall quad
-   (tt_polycube_quad_upright) has the even type on its sides 0 and 1 and
-   the odd type on 2 and 3; walls meet walls only bottom to top and right
-   to left, so no edge is asked both ways. Tops and bottoms keep theirs
-   where no wall borders them. The cost is variety: the walls' tiles are
-   then set by the colours alone (16 per group with two colours an axis,
-   as in the paper, against up to 256 with sides drawn). *out_turned (may
-   be NULL) gets the edges turned. Errors: NULL polycube or corner_type
-   (TT_ERROR_INVALID_ARGUMENT); twins that are not the two halves of one
-   condition (TT_ERROR_INVALID_ARGUMENT, naming the corner): corner_type
-   is then as it was. Allocates nothing; thread-safe. */
+   bands were turned. This turns the types of whole edges (both halves:
+   type ^ 1, the condition kept) so that every quad has the even type on
+   its sides 0 and 1 and the odd type on 2 and 3: first every edge of a
+   wall (walls meet walls only bottom to top and right to left, so no edge
+   is asked both ways), then every edge between two tops or bottoms (in
+   their shared frame again bottom to top or right to left; where a top
+   meets a bottom, a part one cube thin, the quad first in S's order
+   decides). An edge between a top and a wall is the wall's. The cost is
+   variety: the tiles are then set by the colours alone (16 per set with
+   two colours an axis, as in the paper, against up to 256 with sides
+   drawn). *out_turned (may be NULL) gets the edges turned. Errors: NULL
+   polycube or corner_type (TT_ERROR_INVALID_ARGUMENT); twins that are not
+   the two halves of one condition (TT_ERROR_INVALID_ARGUMENT, naming the
+   corner): corner_type is then as it was. Allocates nothing; thread-safe. */
 TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t *corner_type, int *out_turned,
                                            tt_error *error);
-/* The atlas is of the tilesets' kind (a normal map when they are).
-   Errors: NULL arguments, a bad allocator, tilesets of different layouts
-   or kinds, a plain tileset with vertical windows or an upright one
-   without, edge windows that differ, a level whose images differ in size or
-   have no pixels (TT_ERROR_INVALID_ARGUMENT); a level that is not in both
-   tilesets or beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE);
-   TT_ERROR_OUT_OF_MEMORY. *out_image is NULL on failure; free it with tt_image_free. `executor` (NULL: this thread)
-   copies bands of rows in parallel: an atlas of hundreds of megabytes is
-   mostly fresh memory the system must hand out page by page, which one
-   thread alone makes the longest serial stage of a polycube run. */
-TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
+/* sets[i] at level `level` into the atlas: two sets (a plain and an
+   upright one: tt_assign_uvs_oriented's, `tiled --up`) side by side, 2W x
+   W, or four (TT_POLYCUBE_TILESETS, in the order of tt_polycube_tiles)
+   2W x 2W; set i at column i % 2, tile-row block i / 2 from the bottom,
+   so u becomes (u + i % 2) / 2 and, with four, v (v + i / 2) / 2. The
+   atlas is of the tilesets' kind (a normal map when they are). Errors:
+   NULL arguments, nsets other than 2 or 4, a bad allocator, tilesets of
+   different layouts or kinds, a set that is not the kind its place asks
+   for (set 0 plain, the others upright, set 2 with plain_sides 1 << 1
+   and set 3 with 1 << 3), edge windows or vertical windows that differ,
+   a level whose images differ in size or have no pixels
+   (TT_ERROR_INVALID_ARGUMENT); a level that is not in every tileset or
+   beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE);
+   TT_ERROR_OUT_OF_MEMORY. *out_image is NULL on failure; free it with
+   tt_image_free. `executor` (NULL: this thread) copies bands of rows in
+   parallel: an atlas of hundreds of megabytes is mostly fresh memory the
+   system must hand out page by page, which one thread alone makes the
+   longest serial stage of a polycube run. */
+TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int nsets, int level,
                                           const tt_executor *executor, const tt_allocator *allocator,
                                           tt_image **out_image, tt_error *error);
 /* Errors and the rest as tt_polycube_mapping_uvs. */
@@ -9889,6 +9939,7 @@ typedef struct tt__synth {
     const tt_image *source;
     const tt_rect *windows;   /* per condition: S x 2S, top-left (x, y) */
     const tt_rect *vertical;  /* upright tiles: per condition, 2S x S, for sides 1 and 3; else NULL */
+    int plain_sides;          /* upright tiles: the sides of 1 and 3 that read `windows` instead */
     int size, gutter, feather;
     float *tile;              /* RGBA, premultiplied (opaque) */
     size_t stride;            /* floats per row of `tile` */
@@ -9915,11 +9966,12 @@ static float *tt__synth_texel(const tt__synth *s, int tx, int ty)
    turned back by the side's quarter turn: type 2k lines side 1 with the left
    square as it is (the band's tile texels are the window's, shifted), type
    2k+1 with the right square turned 180 degrees, and across the line each
-   continues into the other as before. */
+   continues into the other as before. A side in plain_sides reads the
+   edge window as a plain tile does. */
 static void tt__edge_source_texel(const tt__synth *s, int side, int type, int x, int d, int *sx, int *sy)
 {
     const int S = s->size;
-    if (s->vertical && (side & 1)) {
+    if (s->vertical && (side & 1) && !((s->plain_sides >> side) & 1)) {
         const tt_rect *w = &s->vertical[type >> 1];
         if ((type & 1) == 0) { *sx = w->x + S - 1 - d; *sy = w->y + S - 1 - x; }
         else { *sx = w->x + S + d; *sy = w->y + x; }
@@ -10082,6 +10134,7 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
     s.source = source;
     s.windows = plan->edge_windows;
     s.vertical = plan->vertical_windows;
+    s.plain_sides = plan->plain_sides;
     s.size = S;
     s.gutter = g;
     s.feather = plan->feather;
@@ -10875,6 +10928,10 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
                         what, guide->width, guide->height, S, opt->upright ? "upright " : "",
                         opt->upright ? 2 * S : S, 2 * S,
                         tt__min_i(opt->upright ? guide->width / 2 : guide->width, guide->height / 2));
+    if (opt->plain_sides & ~((1 << 1) | (1 << 3)) || (opt->plain_sides && !opt->upright))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "plain_sides is %d: it takes the bits 1 << 1 and 1 << 3 (2, 8 or 10), and only with upright",
+                        opt->plain_sides);
     if ((result = tt__synth_check_windows(guide, opt, S, n, &feather, &region, error)) != TT_OK) return result;
     /* Every edge of a type shows the same band, so a deep band repeats
        visibly across the surface: bands go no deeper than the cut needs. At
@@ -10912,7 +10969,10 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     plan->feather = feather;
     plan->max_depth = max_depth;
     plan->edge_windows = (tt_rect *)(void *)((unsigned char *)plan + head);
-    if (opt->upright) plan->vertical_windows = plan->edge_windows + n;
+    if (opt->upright) {
+        plan->vertical_windows = plan->edge_windows + n;
+        plan->plain_sides = opt->plain_sides;
+    }
     plan->background_windows = (tt_rect *)(void *)((unsigned char *)plan + head + edge_bytes);
     if (depth_size == 1) plan->depth8 = (uint8_t *)plan + head + edge_bytes + background_bytes;
     else plan->depth16 = (uint16_t *)(void *)((unsigned char *)plan + head + edge_bytes + background_bytes);
@@ -10929,6 +10989,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     job.base.source = guide;   /* the guide's texels as they are: the cuts compare them */
     job.base.windows = plan->edge_windows;
     job.base.vertical = plan->vertical_windows;
+    job.base.plain_sides = plan->plain_sides;
     job.base.size = S;
     job.base.gutter = g;
     job.base.feather = feather;
@@ -11013,6 +11074,7 @@ static tt_result tt__compose_non_finite(const tt_synth_plan *plan, const tt_imag
     s.source = source;
     s.windows = plan->edge_windows;
     s.vertical = plan->vertical_windows;
+    s.plain_sides = plan->plain_sides;
     s.size = S;
     for (y = 0; y < S && !bad; y++)
         for (x = 0; x < S && !bad; x++) {
@@ -11169,6 +11231,7 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
     }
     memcpy(set->edge_windows, plan->edge_windows, (size_t)n * sizeof(tt_rect));
     if (plan->vertical_windows) memcpy(set->vertical_windows, plan->vertical_windows, (size_t)n * sizeof(tt_rect));
+    set->plain_sides = plan->plain_sides;
     memcpy(set->background_windows, plan->background_windows, (size_t)ntiles * sizeof(tt_rect));
     if ((result = tt__image_alloc(&set->levels[0], W, W, allocator, error)) != TT_OK) goto done;
     set->levels[0].kind = source->kind;
@@ -11396,43 +11459,65 @@ static void tt__compact_atlas_origin(const tt_compact_atlas *atlas, int cell, in
     origin[1] = atlas->height - (cell / atlas->columns + 1) * atlas->cell_size;
 }
 
-TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_image *full,
-                                       const tt_allocator *allocator, tt_image **out_image, tt_error *error)
+TTDEF tt_result tt_compact_atlas_image_parts(const tt_compact_atlas *atlas, const tt_image *const *parts, int columns,
+                                             int rows, const tt_allocator *allocator, tt_image **out_image,
+                                             tt_error *error)
 {
     tt_image *image;
     tt_result result;
     double mean[4] = {0.0, 0.0, 0.0, 0.0};
     size_t i;
-    int cell, y, k, pass;
+    int cell, y, k, pass, part_width, part_height;
     tt__ok(error);
     if (out_image) *out_image = NULL;
-    if (!atlas || !full || !out_image)
+    if (!atlas || !parts || !out_image)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_compact_atlas_image needs an atlas, a full image and out_image (got NULL)");
+                        "tt_compact_atlas_image needs an atlas, the full image and out_image (got NULL)");
+    if (columns < 1 || rows < 1 || columns > 2 || rows > 2)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "the full atlas is %d x %d parts: 1 or 2 each way", columns, rows);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (!full->pixels || full->width != atlas->full_width || full->height != atlas->full_height)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the full atlas image is %d x %d%s; the UVs were made for %d x %d", full->width,
-                        full->height, full->pixels ? "" : " without pixels", atlas->full_width, atlas->full_height);
+    for (k = 0; k < columns * rows; k++)
+        if (!parts[k])
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1, "part %d of the full atlas is NULL", k);
+    part_width = parts[0]->width;
+    part_height = parts[0]->height;
+    for (k = 0; k < columns * rows; k++)
+        if (!parts[k]->pixels || parts[k]->width != part_width || parts[k]->height != part_height ||
+            parts[k]->kind != parts[0]->kind || (long long)part_width * columns != atlas->full_width ||
+            (long long)part_height * rows != atlas->full_height)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                               "the full atlas image%s is %d x %d%s%s; the UVs were made for %d x %d",
+                               columns * rows > 1 ? "'s parts" : "", part_width * columns, part_height * rows,
+                               parts[k]->pixels ? "" : " without pixels",
+                               parts[k]->width != part_width || parts[k]->height != part_height ||
+                                       parts[k]->kind != parts[0]->kind
+                                   ? " (parts of different sizes or kinds)"
+                                   : "",
+                               atlas->full_width, atlas->full_height);
     if ((result = tt__image_create(atlas->width, atlas->height, 0, allocator, &image, error)) != TT_OK) return result;
-    image->kind = full->kind;
+    image->kind = parts[0]->kind;
     /* Texels between and beside the cells hold the cells' mean, so that the
        coarse mip levels an engine makes blend toward it rather than black. */
     for (pass = 0; pass < 2; pass++) {
         if (pass == 1) {
-            if (full->kind == TT_IMAGE_NORMAL) tt__normalize3(mean);
+            if (image->kind == TT_IMAGE_NORMAL) tt__normalize3(mean);
             for (i = 0; i < (size_t)atlas->width * (size_t)atlas->height; i++)
                 for (k = 0; k < 4; k++) image->pixels[4 * i + k] = (float)mean[k];
         }
         for (cell = 0; cell < atlas->ncells; cell++) {
             const int C = atlas->cell_size;
+            /* The cell's texels in the full atlas, then in its part. Image
+               rows count from the top; cell and part rows from the bottom. */
+            const int full_x = atlas->cell_source[2 * cell] * C, full_row = atlas->cell_source[2 * cell + 1] * C;
+            const int column = full_x / part_width, row = full_row / part_height;
+            const tt_image *part = parts[row * columns + column];
+            const int from_x = full_x - column * part_width;
+            const int from_y = part_height - (full_row - row * part_height) - C;
             int to[2], x;
-            /* Image rows count from the top; cell rows from the bottom. */
-            const int from_x = atlas->cell_source[2 * cell] * C;
-            const int from_y = full->height - (atlas->cell_source[2 * cell + 1] + 1) * C;
             tt__compact_atlas_origin(atlas, cell, to);
             for (y = 0; y < C; y++) {
-                const float *from = full->pixels + 4 * ((size_t)(from_y + y) * (size_t)full->width + (size_t)from_x);
+                const float *from = part->pixels + 4 * ((size_t)(from_y + y) * (size_t)part_width + (size_t)from_x);
                 if (pass == 1)
                     memcpy(image->pixels +
                                4 * ((size_t)(atlas->height - to[1] - C + y) * (size_t)atlas->width + (size_t)to[0]),
@@ -11446,6 +11531,12 @@ TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_i
     }
     *out_image = image;
     return TT_OK;
+}
+
+TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_image *full,
+                                       const tt_allocator *allocator, tt_image **out_image, tt_error *error)
+{
+    return tt_compact_atlas_image_parts(atlas, &full, 1, 1, allocator, out_image, error);
 }
 
 TTDEF void tt_compact_atlas_uv(const tt_compact_atlas *atlas, int face, const float full_uv[2], float uv[2])
@@ -31048,17 +31139,50 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     return TT_OK;
 }
 
-TTDEF int tt_polycube_quad_upright(const tt_polycube *polycube, int quad)
+/* 1 for a wall: a quad facing sideways. */
+static int tt__polycube_wall(const tt_polycube *polycube, int quad)
 {
-    TT_ASSERT(polycube && polycube->surface && quad >= 0 && quad < polycube->surface->nfaces);
     return polycube->quad_side[quad] / 2 != polycube->up_axis;
+}
+
+/* 1 when the quad across side k of top or bottom `quad` is a wall (or
+   there is none: a side with nothing across it keeps the plain band). */
+static int tt__polycube_wall_across(const tt_polycube *polycube, int quad, int k)
+{
+    const tt_mesh *s = polycube->surface;
+    const int t = s->twin[s->face_start[quad] + k];
+    return t < 0 || tt__polycube_wall(polycube, s->corner_face[t]);
+}
+
+TTDEF tt_polycube_tiles tt_polycube_quad_tileset(const tt_polycube *polycube, int quad)
+{
+    int right, left;
+    TT_ASSERT(polycube && polycube->surface && quad >= 0 && quad < polycube->surface->nfaces);
+    if (tt__polycube_wall(polycube, quad)) return TT_POLYCUBE_TILES_UPRIGHT;
+    right = tt__polycube_wall_across(polycube, quad, 1);
+    left = tt__polycube_wall_across(polycube, quad, 3);
+    if (right && left) return TT_POLYCUBE_TILES_PLAIN;
+    if (right) return TT_POLYCUBE_TILES_RIGHT_PLAIN;
+    if (left) return TT_POLYCUBE_TILES_LEFT_PLAIN;
+    return TT_POLYCUBE_TILES_UPRIGHT;
+}
+
+/* Corner c (side k of its quad) and its twin t turned, when needed, so
+   that side k has the even type for k = 0, 1 and the odd one for 2, 3.
+   Returns 1 when it turned them. */
+static int tt__polycube_orient_edge(uint8_t *corner_type, int c, int t, int k)
+{
+    if ((corner_type[c] & 1) == (k >= 2)) return 0;
+    corner_type[c] ^= 1;
+    if (t >= 0) corner_type[t] ^= 1;
+    return 1;
 }
 
 TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t *corner_type, int *out_turned,
                                            tt_error *error)
 {
     const tt_mesh *s;
-    int q, k, c, turned = 0;
+    int q, k, c, pass, turned = 0;
     tt__ok(error);
     if (out_turned) *out_turned = 0;
     if (!polycube || !polycube->surface || !corner_type)
@@ -31069,101 +31193,139 @@ TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t 
         tt_result result = tt__check_twin_types(s, corner_type, c, error);
         if (result != TT_OK) return result;
     }
-    for (q = 0; q < s->nfaces; q++) {
-        if (!tt_polycube_quad_upright(polycube, q)) continue;
-        for (k = 0; k < 4; k++) {
-            int t;
-            c = s->face_start[q] + k;
-            t = s->twin[c];
-            if ((corner_type[c] & 1) == (k >= 2)) continue;
-            corner_type[c] ^= 1;
-            if (t >= 0) corner_type[t] ^= 1;
-            turned++;
+    /* The walls' edges first, then those between tops and bottoms, each
+       once: from the quad first in S's order. */
+    for (pass = 0; pass < 2; pass++)
+        for (q = 0; q < s->nfaces; q++) {
+            if (tt__polycube_wall(polycube, q) != (pass == 0)) continue;
+            for (k = 0; k < 4; k++) {
+                int t;
+                c = s->face_start[q] + k;
+                t = s->twin[c];
+                if (pass == 1 && t >= 0 && (tt__polycube_wall(polycube, s->corner_face[t]) || s->corner_face[t] < q))
+                    continue;
+                turned += tt__polycube_orient_edge(corner_type, c, t, k);
+            }
         }
-    }
     if (out_turned) *out_turned = turned;
     return TT_OK;
 }
 
-/* Rows [begin, end) of tt_polycube_upright_atlas: the plain tile row on
-   the left, the upright one on the right. */
-typedef struct tt__atlas_halves {
-    const tt_image *left, *right;
+/* Rows [begin, end) of tt_polycube_upright_atlas: a row of tile rows, each
+   from its set, two sets side by side. */
+typedef struct tt__atlas_quarters {
+    const tt_image *part[TT_POLYCUBE_TILESETS];
+    int nsets;
     tt_image *out;
-} tt__atlas_halves;
+} tt__atlas_quarters;
 
-static void tt__atlas_halves_rows(void *context, int begin, int end)
+static void tt__atlas_quarters_rows(void *context, int begin, int end)
 {
-    const tt__atlas_halves *h = (const tt__atlas_halves *)context;
-    const size_t half = (size_t)h->left->width * 4;
+    const tt__atlas_quarters *h = (const tt__atlas_quarters *)context;
+    const int height = h->part[0]->height, blocks = h->nsets / 2;
+    const size_t half = (size_t)h->part[0]->width * 4;
     int row;
     for (row = begin; row < end; row++) {
+        /* image rows count from the top: the last block of sets lies there */
+        const int block = blocks - 1 - row / height, in_part = row % height;
         float *out = h->out->pixels + (size_t)row * 2 * half;
-        memcpy(out, h->left->pixels + (size_t)row * half, half * sizeof(float));
-        memcpy(out + half, h->right->pixels + (size_t)row * half, half * sizeof(float));
+        memcpy(out, h->part[2 * block]->pixels + (size_t)in_part * half, half * sizeof(float));
+        memcpy(out + half, h->part[2 * block + 1]->pixels + (size_t)in_part * half, half * sizeof(float));
     }
 }
 
 #define TT__ATLAS_BAND_TEXELS 65536   /* texels per task of tt_polycube_upright_atlas: a few hundred tasks */
 
-TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level,
+/* The plain_sides set i of tt_polycube_upright_atlas must have (-1: none,
+   a plain set). */
+static int tt__upright_set_sides(int i)
+{
+    static const int sides[TT_POLYCUBE_TILESETS] = {-1, 0, 1 << 1, 1 << 3};
+    return sides[i];
+}
+
+TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int nsets, int level,
                                           const tt_executor *executor, const tt_allocator *allocator,
                                           tt_image **out_image, tt_error *error)
 {
-    const tt_image *left, *right;
-    tt__atlas_halves halves;
+    tt__atlas_quarters quarters;
     tt_result result;
-    int k;
+    const tt_tileset *first;
+    int i, k, width, height;
     tt__ok(error);
     if (out_image) *out_image = NULL;
-    if (!plain || !upright || !out_image)
+    if (!sets || !out_image)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_polycube_upright_atlas needs a plain and an upright tileset and out_image (got NULL)");
+                        "tt_polycube_upright_atlas needs the tilesets and out_image (got NULL)");
+    if (nsets != 2 && nsets != TT_POLYCUBE_TILESETS)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "nsets is %d: 2 (plain, upright) or %d (tt_polycube_tiles' order)", nsets, TT_POLYCUBE_TILESETS);
+    for (i = 0; i < nsets; i++)
+        if (!sets[i])
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1, "tileset %d of %d is NULL", i, nsets);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    if (plain->vertical_windows || !upright->vertical_windows)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the first tileset must be plain and the second upright (tt_synth_options.upright)");
-    if (plain->layout.colors != upright->layout.colors || plain->layout.tile_size != upright->layout.tile_size ||
-        plain->layout.gutter != upright->layout.gutter)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "the tilesets' layouts differ (%d colors, %d texels, gutter %d against %d, %d, %d)",
-                        plain->layout.colors, plain->layout.tile_size, plain->layout.gutter, upright->layout.colors,
-                        upright->layout.tile_size, upright->layout.gutter);
-    for (k = 0; k < plain->layout.colors; k++)
-        if (plain->edge_windows[k].x != upright->edge_windows[k].x ||
-            plain->edge_windows[k].y != upright->edge_windows[k].y)
-            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
-                               "edge window %d differs between the tilesets: make the upright tiles with the plain "
-                               "ones' edge_windows, or the tops and the walls do not meet", k);
-    if (level < 0 || level >= plain->nlevels || level >= upright->nlevels || level >= TT_MAX_MIP_LEVELS)
-        return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
-                        "level %d: the tilesets have levels 0 to %d", level,
-                        tt__min_i(tt__min_i(plain->nlevels, upright->nlevels), TT_MAX_MIP_LEVELS) - 1);
-    left = &plain->levels[level];
-    right = &upright->levels[level];
-    if (!left->pixels || !right->pixels || left->width < 1 || left->height < 1 || left->width != right->width ||
-        left->height != right->height)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "level %d of the tilesets is %d x %d and %d x %d, or has no pixels: not tilesets of one "
-                        "layout made by tt_synth_apply", level, left->width, left->height, right->width,
-                        right->height);
-    if (left->kind != right->kind)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "one tileset is a normal map and the other is not: apply both plans to the same map");
+    first = sets[0];
+    for (i = 0; i < nsets; i++) {
+        const tt_tileset *set = sets[i];
+        const int want = tt__upright_set_sides(i);
+        static const char *const names[TT_POLYCUBE_TILESETS] = {
+            "plain", "upright (plain_sides 0)", "upright with its right side plain (plain_sides 1 << 1)",
+            "upright with its left side plain (plain_sides 1 << 3)"};
+        if ((want < 0) != !set->vertical_windows || (want >= 0 && set->plain_sides != want))
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
+                               "tileset %d must be %s (tt_synth_options.upright, plain_sides), in the order of "
+                               "tt_polycube_tiles", i, names[i]);
+        if (set->layout.colors != first->layout.colors || set->layout.tile_size != first->layout.tile_size ||
+            set->layout.gutter != first->layout.gutter)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
+                               "the tilesets' layouts differ (%d colors, %d texels, gutter %d against %d, %d, %d "
+                               "in tileset %d)", first->layout.colors, first->layout.tile_size, first->layout.gutter,
+                               set->layout.colors, set->layout.tile_size, set->layout.gutter, i);
+        for (k = 0; k < first->layout.colors; k++) {
+            if (set->edge_windows[k].x != first->edge_windows[k].x || set->edge_windows[k].y != first->edge_windows[k].y)
+                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                                   "edge window %d differs between tilesets 0 and %d: make the upright tiles with the "
+                                   "plain ones' edge_windows, or the tops and the walls do not meet", k, i);
+            if (i > 1 && (set->vertical_windows[k].x != sets[1]->vertical_windows[k].x ||
+                          set->vertical_windows[k].y != sets[1]->vertical_windows[k].y))
+                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                                   "vertical window %d differs between tilesets 1 and %d: make the upright sets with "
+                                   "one seed and guide, or their left and right sides do not meet", k, i);
+        }
+        if (level < 0 || level >= set->nlevels || level >= TT_MAX_MIP_LEVELS)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
+                            "level %d: tileset %d has levels 0 to %d", level, i,
+                            tt__min_i(set->nlevels, TT_MAX_MIP_LEVELS) - 1);
+    }
+    width = first->levels[level].width;
+    height = first->levels[level].height;
+    for (i = 0; i < nsets; i++) {
+        const tt_image *part = &sets[i]->levels[level];
+        if (!part->pixels || width < 1 || height < 1 || part->width != width || part->height != height)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "level %d of the tilesets is %d x %d and %d x %d (tileset %d), or has no pixels: not "
+                            "tilesets of one layout made by tt_synth_apply", level, width, height, part->width,
+                            part->height, i);
+        if (part->kind != first->levels[level].kind)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "tileset %d is %sa normal map and tileset 0 is %s: apply every plan to the same map", i,
+                            part->kind == TT_IMAGE_NORMAL ? "" : "not ",
+                            part->kind == TT_IMAGE_NORMAL ? "not" : "one");
+        quarters.part[i] = part;
+    }
     /* Every texel is copied in below. */
-    if ((result = tt__image_create(2 * left->width, left->height, 0, allocator, out_image, error)) != TT_OK)
+    if ((result = tt__image_create(2 * width, height * (nsets / 2), 0, allocator, out_image, error)) != TT_OK)
         return result;
-    (*out_image)->kind = left->kind;
-    halves.left = left;
-    halves.right = right;
-    halves.out = *out_image;
-    tt__parallel_ranges(executor, left->height, tt__max_i(1, TT__ATLAS_BAND_TEXELS / (2 * left->width)),
-                        tt__atlas_halves_rows, &halves);
+    (*out_image)->kind = first->levels[level].kind;
+    quarters.nsets = nsets;
+    quarters.out = *out_image;
+    tt__parallel_ranges(executor, (*out_image)->height, tt__max_i(1, TT__ATLAS_BAND_TEXELS / (2 * width)),
+                        tt__atlas_quarters_rows, &quarters);
     return TT_OK;
 }
 
-/* tt_polycube_mapping_uvs and its upright form: `upright` puts the walls'
-   tiles in the right half of a 2W x W atlas. */
+/* tt_polycube_mapping_uvs and its upright form: `upright` puts each
+   quad's tile in its set's quarter of a 2W x 2W atlas. */
 static tt_result tt__polycube_mapping_uvs(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                           const tt_tile_layout *layout, const uint8_t *corner_type, int upright,
                                           float *corner_uv, tt_error *error)
@@ -31207,7 +31369,11 @@ static tt_result tt__polycube_mapping_uvs(const tt_polycube *polycube, const tt_
         tt_tile_corner_uv(&resolved, types, 2, high);
         corner_uv[2 * i] = low[0] + p.s * (high[0] - low[0]);
         corner_uv[2 * i + 1] = low[1] + p.t * (high[1] - low[1]);
-        if (upright) corner_uv[2 * i] = 0.5f * (corner_uv[2 * i] + (float)tt_polycube_quad_upright(polycube, p.quad));
+        if (upright) {
+            const int set = (int)tt_polycube_quad_tileset(polycube, p.quad);
+            corner_uv[2 * i] = 0.5f * (corner_uv[2 * i] + (float)(set % 2));
+            corner_uv[2 * i + 1] = 0.5f * (corner_uv[2 * i + 1] + (float)(set / 2));
+        }
     }
     return TT_OK;
 }

@@ -19,11 +19,13 @@
      tt_assign_boundaries     tile types from those colours; tt_assign_uvs
                               gives S its own texture coordinates
      tt_synthesize_tiles      the atlas (shared with `tile`: tiled.c): plain
-                              tiles for the tops, upright ones (the same
-                              edge windows) for the walls, side by side
+                              tiles, and upright ones (the same edge
+                              windows) for the walls and the tops, with
+                              a plain side where a top meets a wall
      tt_polycube_map          the triangles split along S's quad edges,
                               each corner's point on S (on -j threads)
-     tt_polycube_upright_atlas        the two tile sets side by side
+     tt_compact_atlas_create, tt_compact_atlas_image_parts
+                              the tiles S shows, cut from the four sets
      tt_polycube_mapping_uvs_upright  those points as texture coordinates
      tt_measure_uv_distortion, tt_measure_seams   the summary's quality
 */
@@ -86,10 +88,12 @@ static void print_help(void)
            "                   meets)\n"
            "  --up AXIS        the direction the tiles' up follows: x, y, z, -x, -y, -z or X,Y,Z\n"
            "                   (its largest component counts; default y)\n"
-           "  --no-upright     one set of plain tiles: half the atlas, but on the walls the left and\n"
+           "  --no-upright     one set of plain tiles: a quarter of the atlas, but the left and\n"
            "                   right quarter of each tile turns a quarter (bricks, planks and grain\n"
-           "                   run crosswise there); by default the walls' tiles keep IMAGE's up\n"
-           "                   throughout, from a second set of tiles beside the first\n"
+           "                   run crosswise there); by default the tiles keep IMAGE's up throughout\n"
+           "                   (on the walls) or one direction over every top, from three more sets\n"
+           "                   of tiles: upright ones, and two with one plain side, for the tops'\n"
+           "                   sides beside a wall\n"
            "  --no-courses     take IMAGE as it is: by default a photo laid in courses (bricks,\n"
            "                   blocks) is resampled so that a tile holds a whole number of them,\n"
            "                   and every tile is cut on them, so they run level through the walls\n"
@@ -202,6 +206,9 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
 /* The pipeline                                                             */
 /* ======================================================================== */
 
+/* The upright tile sets: TT_POLYCUBE_TILES_UPRIGHT and the two after it. */
+#define POLYCUBE_UPRIGHT_SETS (TT_POLYCUBE_TILESETS - TT_POLYCUBE_TILES_UPRIGHT)
+
 /* Everything the command makes, freed by polycube_job_free. */
 typedef struct polycube_job {
     triangle_mesh mesh;
@@ -212,15 +219,18 @@ typedef struct polycube_job {
     tt_tile_layout layout;          /* resolved */
     int *edge_colors;               /* per S half-edge */
     uint8_t *surface_type;          /* per S half-edge: its boundary type */
-    uint8_t *surface_group;         /* per S quad: 1 for a wall with upright tiles, else 0 */
+    uint8_t *surface_group;         /* per S quad: its tile set (tt_polycube_quad_tileset), 0 with --no-upright */
     float *surface_uv;              /* per S corner: S's own texture coordinates */
-    tt_tileset *tiles;              /* plain: the tops and bottoms (all of S with --no-upright) */
-    tt_tileset *upright_tiles;      /* the walls; NULL with --no-upright */
-    tt_image *atlas;                /* the two side by side (NULL with --no-upright), then the compact atlas */
+    tt_tileset *tiles;              /* plain: tops with walls on both sides (all of S with --no-upright) */
+    /* Upright, TT_POLYCUBE_TILES_UPRIGHT + k: the walls and the tops among
+       tops, then the tops with a wall on the right or the left; NULL with
+       --no-upright. */
+    tt_tileset *upright_tiles[POLYCUBE_UPRIGHT_SETS];
+    tt_image *atlas;                /* the compact atlas: the tiles S shows */
     /* The same for each map of the material (NULL for the maps not given). */
-    tt_tileset *map_tiles[MATERIAL_MAPS], *map_upright_tiles[MATERIAL_MAPS];
+    tt_tileset *map_tiles[MATERIAL_MAPS], *map_upright_tiles[POLYCUBE_UPRIGHT_SETS][MATERIAL_MAPS];
     tt_image *map_atlas[MATERIAL_MAPS];
-    int upright;                    /* the walls have upright tiles (IMAGE was large enough) */
+    int upright;                    /* upright tiles (IMAGE was large enough) */
     tt_compact_atlas *compact;      /* the cells S shows, and where they went */
     int full_width, full_height;    /* the atlas of every tile, which the compact one replaced */
     tt_polycube_mapping *mapping;
@@ -228,6 +238,14 @@ typedef struct polycube_job {
     float *corner_uv;               /* 6 per mapped triangle */
     double build_seconds, synth_seconds, map_seconds;
 } polycube_job;
+
+/* Every tile set and its maps' (the atlases hold what the outputs use). */
+static void polycube_tilesets_free(polycube_job *job)
+{
+    int k;
+    tiled_tilesets_free(&job->tiles, job->map_tiles);
+    for (k = 0; k < POLYCUBE_UPRIGHT_SETS; k++) tiled_tilesets_free(&job->upright_tiles[k], job->map_upright_tiles[k]);
+}
 
 static void polycube_job_free(polycube_job *job)
 {
@@ -238,8 +256,7 @@ static void polycube_job_free(polycube_job *job)
     free(job->surface_type);
     free(job->surface_group);
     free(job->surface_uv);
-    tiled_tilesets_free(&job->tiles, job->map_tiles);
-    tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
+    polycube_tilesets_free(job);
     tt_image_free(job->atlas);
     for (map = 0; map < MATERIAL_MAPS; map++) tt_image_free(job->map_atlas[map]);
     tt_compact_atlas_free(job->compact);
@@ -379,12 +396,12 @@ static int tile_polycube(const polycube_command_options *options, polycube_job *
         tt_assign_boundaries(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
                              job->surface_type, &error) != TT_OK)
         return tool_fail("%s: the polycube's tiles: %s", path, error.message);
-    /* As few tiles as fit the atlas's limit: the walls' (upright) and the
-       tops' (plain) count apart, each its own cell. */
+    /* As few tiles as fit the atlas's limit: each set's count apart, each
+       tile its own cell. */
     for (q = 0; q < job->polycube->surface->nfaces; q++)
-        job->surface_group[q] = (uint8_t)(!options->plain && tt_polycube_quad_upright(job->polycube, q));
-    /* A photo laid in courses: every band of the walls upright, so no
-       course shows mirrored about a tile's edge. */
+        job->surface_group[q] = (uint8_t)(options->plain ? 0 : tt_polycube_quad_tileset(job->polycube, q));
+    /* A photo laid in courses: every band upright, so no course shows
+       mirrored about a tile's edge. */
     if (tt_reduce_tiles(job->polycube->surface, &job->layout, options->tiles.seed, job->edge_colors,
                         job->surface_group, polycube_tile_budget(options, &job->layout), NULL, job->surface_type,
                         NULL, &error) != TT_OK ||
@@ -395,87 +412,83 @@ static int tile_polycube(const polycube_command_options *options, polycube_job *
     return 0;
 }
 
-/* The walls' upright tiles, on the plain tiles' edge windows, and the
-   atlas of both: plain on the left, upright on the right, as
+/* The upright tiles, on the plain tiles' edge windows: the atlas of every
+   tile is the four sets, 2 x 2 in the order of tt_polycube_tiles, as
    tt_polycube_mapping_uvs_upright reads it; S's own texture coordinates
-   move into their halves. An image too narrow for upright tiles (they need
-   2S x 2S) keeps the plain ones, with a note. */
+   move into their quarters. An image too narrow for upright tiles (they
+   need 2S x 2S) keeps the plain ones, with a note. */
 static int synthesize_upright(const polycube_command_options *options, const tt_image *image, polycube_job *job)
 {
-    const tt_image *plain = &job->tiles->levels[0];
-    tiled_options upright = options->tiles;
-    tt_error error;
-    int c, status, map;
+    static const int plain_sides[POLYCUBE_UPRIGHT_SETS] = {0, 1 << 1, 1 << 3};
+    int c, k, status;
     if (image->width < 2 * job->layout.tile_size || image->height < 2 * job->layout.tile_size) {
-        tool_note("%s: %dx%d is too small for upright %d-texel tiles (they need %dx%d): the walls' tiles are "
-                  "plain, turned a quarter on their left and right sides (use a smaller --tile)",
+        tool_note("%s: %dx%d is too small for upright %d-texel tiles (they need %dx%d): the tiles are plain, "
+                  "turned a quarter on their left and right sides (use a smaller --tile)",
                   options->image_path, image->width, image->height, job->layout.tile_size,
                   2 * job->layout.tile_size, 2 * job->layout.tile_size);
         return 0;
     }
-    upright.upright_over = job->tiles->edge_windows;
-    if ((status = tiled_synthesize(image, options->image_path, &upright, &options->tiles.maps, &job->upright_tiles,
-                                   job->map_upright_tiles)) != 0)
-        return status;
-    tool_stage("turning the tiles upright");
+    for (k = 0; k < POLYCUBE_UPRIGHT_SETS; k++) {
+        tiled_options upright = options->tiles;
+        upright.upright_over = job->tiles->edge_windows;
+        upright.plain_sides = plain_sides[k];
+        if ((status = tiled_synthesize(image, options->image_path, &upright, &options->tiles.maps,
+                                       &job->upright_tiles[k], job->map_upright_tiles[k])) != 0)
+            return status;
+    }
     job->upright = 1;
-    if (tt_polycube_upright_atlas(job->tiles, job->upright_tiles, 0, tool_executor(), NULL, &job->atlas, &error) !=
-        TT_OK)
-        return tool_fail("the %dx%d atlas: %s", 2 * plain->width, plain->height, error.message);
-    for (map = 0; map < MATERIAL_MAPS; map++)
-        if (job->map_tiles[map] &&
-            tt_polycube_upright_atlas(job->map_tiles[map], job->map_upright_tiles[map], 0, tool_executor(), NULL,
-                                      &job->map_atlas[map], &error) != TT_OK)
-            return tool_fail("the %dx%d %s atlas: %s", 2 * plain->width, plain->height, material_map_names[map],
-                             error.message);
-    for (c = 0; c < job->polycube->surface->ncorners; c++)
-        job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] +
-                                         (float)tt_polycube_quad_upright(job->polycube,
-                                                                         job->polycube->surface->corner_face[c]));
-    /* The atlases hold every texel the outputs use (level 0): the tile sets
-       and their mip levels, as large again as the atlases, go now. */
-    tiled_tilesets_free(&job->tiles, job->map_tiles);
-    tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
+    for (c = 0; c < job->polycube->surface->ncorners; c++) {
+        const int set = (int)tt_polycube_quad_tileset(job->polycube, job->polycube->surface->corner_face[c]);
+        job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] + (float)(set % 2));
+        job->surface_uv[2 * c + 1] = 0.5f * (job->surface_uv[2 * c + 1] + (float)(set / 2));
+    }
     return 0;
 }
 
-/* The atlas of the tiles S shows (tt_compact_atlas_create): it replaces the
-   atlas of every tile, and S's texture coordinates move into it. */
+/* The atlas of one map (-1: the colour) in parts: level 0 of each set, or
+   of the plain set alone. Returns the parts each way (2, or 1). */
+static int atlas_parts(const polycube_job *job, int map, const tt_image *parts[TT_POLYCUBE_TILESETS])
+{
+    int k;
+    parts[TT_POLYCUBE_TILES_PLAIN] = map < 0 ? &job->tiles->levels[0] : &job->map_tiles[map]->levels[0];
+    if (!job->upright) return 1;
+    for (k = 0; k < POLYCUBE_UPRIGHT_SETS; k++)
+        parts[TT_POLYCUBE_TILES_UPRIGHT + k] =
+            map < 0 ? &job->upright_tiles[k]->levels[0] : &job->map_upright_tiles[k][map]->levels[0];
+    return 2;
+}
+
+/* The atlas of the tiles S shows (tt_compact_atlas_create), cut from the
+   tile sets (the atlas of every tile is never put together): S's texture
+   coordinates move into it. */
 static int compact_atlas(const polycube_command_options *options, polycube_job *job)
 {
     const tt_mesh *surface = job->polycube->surface;
-    const tt_image *full = job->atlas ? job->atlas : &job->tiles->levels[0];
-    tt_image *compact = NULL;
+    const tt_image *parts[TT_POLYCUBE_TILESETS];
     tt_error error;
-    int c, map;
+    int c, map, each_way = atlas_parts(job, -1, parts);
     tool_stage("packing the tiles S shows");
-    job->full_width = full->width;
-    job->full_height = full->height;
-    if (tt_compact_atlas_create(surface, job->surface_uv, &job->layout, full->width, full->height, options->max_atlas,
-                                NULL, &job->compact, &error) != TT_OK)
+    job->full_width = each_way * parts[0]->width;
+    job->full_height = each_way * parts[0]->height;
+    if (tt_compact_atlas_create(surface, job->surface_uv, &job->layout, job->full_width, job->full_height,
+                                options->max_atlas, NULL, &job->compact, &error) != TT_OK)
         return tool_fail("%s: the atlas: %s%s", options->mesh_path, error.message,
                          error.result == TT_ERROR_TOO_LARGE ? "; here: a larger --max-atlas, --colors 1 or a smaller --tile"
                                                             : "");
-    if (tt_compact_atlas_image(job->compact, full, NULL, &compact, &error) != TT_OK)
+    if (tt_compact_atlas_image_parts(job->compact, parts, each_way, each_way, NULL, &job->atlas, &error) != TT_OK)
         return tool_fail("the %dx%d atlas: %s", job->compact->width, job->compact->height, error.message);
-    tt_image_free(job->atlas);
-    job->atlas = compact;
     for (map = 0; map < MATERIAL_MAPS; map++) {
-        const tt_image *map_full = job->map_atlas[map]   ? job->map_atlas[map]
-                                   : job->map_tiles[map] ? &job->map_tiles[map]->levels[0]
-                                                         : NULL;
-        if (!map_full) continue;
-        if (tt_compact_atlas_image(job->compact, map_full, NULL, &compact, &error) != TT_OK)
+        if (!job->map_tiles[map]) continue;
+        atlas_parts(job, map, parts);
+        if (tt_compact_atlas_image_parts(job->compact, parts, each_way, each_way, NULL, &job->map_atlas[map],
+                                         &error) != TT_OK)
             return tool_fail("the %dx%d %s atlas: %s", job->compact->width, job->compact->height,
                              material_map_names[map], error.message);
-        tt_image_free(job->map_atlas[map]);
-        job->map_atlas[map] = compact;
     }
     for (c = 0; c < surface->ncorners; c++)
         tt_compact_atlas_uv(job->compact, surface->corner_face[c], &job->surface_uv[2 * c], &job->surface_uv[2 * c]);
     /* The compact atlases hold every texel the outputs use. */
-    tiled_tilesets_free(&job->tiles, job->map_tiles);
-    tiled_tilesets_free(&job->upright_tiles, job->map_upright_tiles);
+    polycube_tilesets_free(job);
     return 0;
 }
 
@@ -637,9 +650,9 @@ static void print_summary(const polycube_command_options *options, const polycub
     printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);
     printf("tiles: %d of the %s%d shown (n=%d, %d texels, gutter %d%s), in a %dx%d atlas (all would take %dx%d); "
-           "%.4g texels per unit\n", job->compact->ncells, job->upright ? "2 x " : "",
+           "%.4g texels per unit\n", job->compact->ncells, job->upright ? "4 x " : "",
            tt_tile_layout_tile_count(&job->layout), job->layout.colors, job->layout.tile_size, job->layout.gutter,
-           job->upright ? "; plain for the tops, upright for the walls" : "", job->compact->width,
+           job->upright ? "; upright, plain on a top's side beside a wall" : "", job->compact->width,
            job->compact->height, job->full_width, job->full_height, job->layout.tile_size / job->polycube->h);
     if (!quality->mesh_built) {
         printf("stretch and seam score: not measured (%s)\n", quality->mesh_reason);

@@ -83,8 +83,11 @@ static int synthesize_upright(const tt_image *image, const char *image_path, con
 /* Level `level` of the plain | upright atlas; prints the error. */
 static int upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level, tt_image **out)
 {
+    const tt_tileset *sets[2];
     tt_error error;
-    if (tt_polycube_upright_atlas(plain, upright, level, tool_executor(), NULL, out, &error) != TT_OK)
+    sets[0] = plain;
+    sets[1] = upright;
+    if (tt_polycube_upright_atlas(sets, 2, level, tool_executor(), NULL, out, &error) != TT_OK)
         return tool_fail("the %dx%d atlas: %s", 2 * plain->levels[level].width, plain->levels[level].height,
                          error.message);
     return 0;

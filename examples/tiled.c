@@ -590,6 +590,7 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     if (options->upright_over) {
         synth.edge_windows = options->upright_over;
         synth.upright = 1;
+        synth.plain_sides = options->plain_sides;
     }
     /* One plan, from the colour image, for every map: the maps' tiles are
        cut where the colour's are, and line up texel for texel. */

@@ -41,6 +41,7 @@ typedef struct tiled_options {
     int report;                  /* --report: tile usage and stretch under the summary */
     tool_mesh_output output;     /* --format, --triangles */
     const tt_rect *upright_over; /* not NULL: upright tiles (tt_synth_options::upright) on these edge windows */
+    int plain_sides;             /* with upright_over: tt_synth_options::plain_sides */
     tool_field field;            /* --up, --constraints: each quad's tile turned along the field */
     int upright;                 /* with the field: faces may take upright tiles (the image feeds them) */
     material_maps maps;          /* the material's other maps (their paths; material_load loads them) */

@@ -1582,8 +1582,8 @@ check "polycube sphere: genus 0 as the mesh" "'genus 0 (as the mesh)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -q 'genus 0 (as the mesh)'; echo $?)"
 check "polycube sphere: no note about cuts (none beyond 0.1 %)" "no 'no seamless place' on stderr" "$ERR" \
     "$(printf '%s' "$ERR" | grep -q 'no seamless place'; [ $? -ne 0 ]; echo $?)"
-check "polycube sphere: of the paper's 256 tiles, plain and upright, those shown" "'tiles: N of the 2 x 256 shown (n=2, 16 texels, gutter 4; plain for the tops, upright for the walls), in a WxH atlas (all would take 768x384)'" "$OUT" \
-    "$(printf '%s' "$OUT" | grep -qE '^tiles: [0-9]+ of the 2 x 256 shown \(n=2, 16 texels, gutter 4; plain for the tops, upright for the walls\), in a [0-9]+x[0-9]+ atlas \(all would take 768x384\)'; echo $?)"
+check "polycube sphere: of the paper's 256 tiles in four sets, those shown" "'tiles: N of the 4 x 256 shown (n=2, 16 texels, gutter 4; upright, plain on a top's side beside a wall), in a WxH atlas (all would take 768x768)'" "$OUT" \
+    "$(printf '%s' "$OUT" | grep -qE "^tiles: [0-9]+ of the 4 x 256 shown \(n=2, 16 texels, gutter 4; upright, plain on a top's side beside a wall\), in a [0-9]+x[0-9]+ atlas \(all would take 768x768\)"; echo $?)"
 expect_error "polycube --max-atlas below the tiles shown" polycube ../in/spheretri.obj ../in/tex.png out --tile 16 \
     --resolution 8 --max-atlas 64
 check "polycube --max-atlas 64: says the size the tiles need and what helps" \
@@ -3747,7 +3747,7 @@ if $HELPER_CC -O2 -w $STB_INC "$W/maps.c" -o "$W/maps" -lm 2>"$W/err"; then
         "$(printf '%s\n' "$turns" | awk '{exit !(NF == 4 && $1 >= 0.05 && $2 >= 0.05 && $3 >= 0.05 && $4 >= 0.05 &&
             $1 + $2 + $3 + $4 >= 0.9)}'; echo $?)"
 
-    # polycube: plain and upright tiles, each map in both halves of the atlas
+    # polycube: plain and upright tiles, each map in every quarter of the atlas
     expect_ok "polycube with a material" polycube ../in/spheretri.obj ../in/tex.png p --resolution 4 --tile 48 \
         --normal m_normal.png --height m_height.png
     check "polycube: the maps have the atlas's size" "$(png_size p.png)" "$(png_size p_normal.png), $(png_size p_height.png)" \

@@ -1791,6 +1791,14 @@ static void test_orient_tiles(void)
     tm_free(&m);
 }
 
+/* sets[] = {plain, upright}, for tt_polycube_upright_atlas. */
+static const tt_tileset *const *pair_of(const tt_tileset *plain, const tt_tileset *upright, const tt_tileset *sets[2])
+{
+    sets[0] = plain;
+    sets[1] = upright;
+    return sets;
+}
+
 /* tt_assign_uvs_oriented: without turns and flags tt_assign_uvs's UVs to the
    bit; with them, corner turn + k of a quad gets corner k of the tile named
    by the types read from half-edge turn on (tt_tile_corner_uv), its u halved
@@ -1847,6 +1855,7 @@ static void test_orient_tiles_seams(void)
     seam_fixture fx;
     tt_synth_options opt;
     tt_tileset *upright_set = NULL;
+    const tt_tileset *sets[2];
     tt_image *atlas = NULL;
     tt_seam_report kept, forced;
     tt_error err;
@@ -1865,7 +1874,7 @@ static void test_orient_tiles_seams(void)
     upright = (uint8_t *)malloc((size_t)fx.mesh->nfaces);
     if (!vectors || !turn || !upright ||
         tt_synthesize_tiles(fx.src, &opt, NULL, &upright_set, &err) != TT_OK ||
-        tt_polycube_upright_atlas(fx.set, upright_set, 0, NULL, NULL, &atlas, &err) != TT_OK) {
+        tt_polycube_upright_atlas(pair_of(fx.set, upright_set, sets), 2, 0, NULL, NULL, &atlas, &err) != TT_OK) {
         CHECK(0, "oriented: upright tiles and atlas");
         goto done;
     }

@@ -981,6 +981,109 @@ static void test_upright_tiles(void)
     tt_image_free(noise);
 }
 
+/* tt_synth_options::plain_sides: an upright tile whose right (left) side
+   is plain meets a plain tile across that side and an upright one across
+   the other, texel for texel in the gutters; the same side of a fully
+   upright tile (the control) does not meet the plain tile. Plans that
+   differ only in plain_sides share their windows. */
+static int sy_gutter_matches(const tt_image *a, int a_side, const tt_image *b, int S, int g)
+{
+    /* a_side 1: a's gutter beyond its right side against b's first g
+       columns (b lies to the right); a_side 3: a's gutter before its left
+       side against b's last g columns (b lies to the left). */
+    int y, j, same = 1;
+    for (y = g + 2; y < S - g - 2; y++)
+        for (j = 0; j < g; j++)
+            same &= memcmp(sy_px(a, a_side == 1 ? g + S + j : j, g + y), sy_px(b, a_side == 1 ? g + j : S + j, g + y),
+                           3 * sizeof(float)) == 0;
+    return same;
+}
+
+static void test_upright_plain_sides(void)
+{
+    const int S = 32, g = 4;
+    tt_image *noise = sy_noise(96, 80, 43u), *a = NULL, *b = NULL;
+    tt_synth_plan *plain = NULL, *upright = NULL, *mixed[2] = {NULL, NULL};
+    tt_synth_options o = sy_options(2, S, g, 21u);
+    tt_error err;
+    int m, type;
+    tt_image_create(S + 2 * g, S + 2 * g, NULL, &a, NULL);
+    tt_image_create(S + 2 * g, S + 2 * g, NULL, &b, NULL);
+    if (!noise || !a || !b || tt_synth_plan_create(noise, &o, NULL, &plain, &err) != TT_OK) {
+        CHECK(0, "plain plan of noise");
+        goto done;
+    }
+    o.edge_windows = plain->edge_windows;
+    o.upright = 1;
+    if (tt_synth_plan_create(noise, &o, NULL, &upright, &err) != TT_OK) {
+        CHECK(0, "upright plan: %s", err.message);
+        goto done;
+    }
+    for (m = 0; m < 2; m++) {
+        int n = plain->layout.colors, tiles = tt_tile_layout_tile_count(&plain->layout);
+        o.plain_sides = m == 0 ? 1 << 1 : 1 << 3;
+        if (tt_synth_plan_create(noise, &o, NULL, &mixed[m], &err) != TT_OK) {
+            CHECK(0, "plain_sides %d: %s", o.plain_sides, err.message);
+            goto done;
+        }
+        CHECK(mixed[m]->plain_sides == o.plain_sides &&
+                  memcmp(mixed[m]->vertical_windows, upright->vertical_windows, (size_t)n * sizeof(tt_rect)) == 0 &&
+                  memcmp(mixed[m]->background_windows, upright->background_windows,
+                         (size_t)tiles * sizeof(tt_rect)) == 0,
+              "plain_sides %d: the plan keeps it, and the upright plan's vertical and background windows",
+              o.plain_sides);
+    }
+    for (type = 0; type < 4; type++) {
+        /* The mixed tile in the middle: its side 1 (plain_sides 2) or 3
+           (plain_sides 8) has type `type`; the tile across shows type ^ 1. */
+        const uint8_t right_plain[4] = {1, (uint8_t)type, 2, 0}, left_plain[4] = {1, 0, 2, (uint8_t)type};
+        const uint8_t across_right[4] = {3, 0, 0, (uint8_t)(type ^ 1)}, across_left[4] = {3, (uint8_t)(type ^ 1), 0, 0};
+        const uint8_t left_of_type0[4] = {3, 1, 0, 0}, right_of_type0[4] = {3, 0, 0, 1};   /* across a side of type 0 */
+        /* the right side plain (plain_sides 2): a plain tile across it, an upright one across the left */
+        int ok = tt_synth_compose_tile(mixed[0], noise, right_plain, a, 0, 0, &err) == TT_OK &&
+                 tt_synth_compose_tile(plain, noise, across_right, b, 0, 0, &err) == TT_OK;
+        CHECK(ok && sy_gutter_matches(a, 1, b, S, g), "type %d: a plain right side meets a plain tile", type);
+        ok = tt_synth_compose_tile(upright, noise, left_of_type0, b, 0, 0, &err) == TT_OK;
+        CHECK(ok && sy_gutter_matches(a, 3, b, S, g), "type %d: its upright left side meets an upright tile", type);
+        /* the left side plain (plain_sides 8) */
+        ok = tt_synth_compose_tile(mixed[1], noise, left_plain, a, 0, 0, &err) == TT_OK &&
+             tt_synth_compose_tile(plain, noise, across_left, b, 0, 0, &err) == TT_OK;
+        CHECK(ok && sy_gutter_matches(a, 3, b, S, g), "type %d: a plain left side meets a plain tile", type);
+        ok = tt_synth_compose_tile(upright, noise, right_of_type0, b, 0, 0, &err) == TT_OK;
+        CHECK(ok && sy_gutter_matches(a, 1, b, S, g), "type %d: its upright right side meets an upright tile", type);
+        /* controls: an upright side does not meet a plain tile */
+        ok = tt_synth_compose_tile(upright, noise, right_plain, a, 0, 0, &err) == TT_OK &&
+             tt_synth_compose_tile(plain, noise, across_right, b, 0, 0, &err) == TT_OK;
+        CHECK(ok && !sy_gutter_matches(a, 1, b, S, g),
+              "type %d: (control) an upright right side does not meet a plain tile", type);
+        ok = tt_synth_compose_tile(upright, noise, left_plain, a, 0, 0, &err) == TT_OK &&
+             tt_synth_compose_tile(plain, noise, across_left, b, 0, 0, &err) == TT_OK;
+        CHECK(ok && !sy_gutter_matches(a, 3, b, S, g),
+              "type %d: (control) an upright left side does not meet a plain tile", type);
+    }
+    {
+        tt_synth_plan *bad = NULL;
+        o.plain_sides = 1 << 2;
+        CHECK(tt_synth_plan_create(noise, &o, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad &&
+                  strstr(err.message, "plain_sides"),
+              "plain_sides 4 (a bottom or top side) is refused: %s", err.message);
+        o.plain_sides = 1 << 1;
+        o.upright = 0;
+        CHECK(tt_synth_plan_create(noise, &o, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad &&
+                  strstr(err.message, "upright"),
+              "plain_sides without upright is refused: %s", err.message);
+        tt_synth_plan_free(bad);
+    }
+done:
+    tt_synth_plan_free(plain);
+    tt_synth_plan_free(upright);
+    tt_synth_plan_free(mixed[0]);
+    tt_synth_plan_free(mixed[1]);
+    tt_image_free(noise);
+    tt_image_free(a);
+    tt_image_free(b);
+}
+
 /* Bricks: courses `period` texels tall (any real number) whose mortar, 3
    texels thick, is centred on the heights phase + k * period; head joints
    every 2.2 courses, each course's at its own offset (so nothing repeats
@@ -1617,6 +1720,7 @@ void run_tiled_synthesis_tests(void)
     RUN(test_compose_tile_matches_apply);
     RUN(test_synthesis_executor_identical);
     RUN(test_upright_tiles);
+    RUN(test_upright_plain_sides);
     RUN(test_find_courses);
     RUN(test_synthesis_keeps_courses);
     RUN(test_second_map_same_masks);

@@ -2699,38 +2699,66 @@ static void test_map_uvs_and_seams(void)
 }
 
 typedef struct upright_atlas_oom_ctx {
-    const tt_tileset *plain, *upright;
+    const tt_tileset *const *sets;
 } upright_atlas_oom_ctx;
 
 static tt_result upright_atlas_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
 {
     upright_atlas_oom_ctx *c = (upright_atlas_oom_ctx *)ctx;
     tt_image *atlas = (tt_image *)&atlas;
-    tt_result r = tt_polycube_upright_atlas(c->plain, c->upright, 0, NULL, al, &atlas, error);
+    tt_result r = tt_polycube_upright_atlas(c->sets, TT_POLYCUBE_TILESETS, 0, NULL, al, &atlas, error);
     if (error->result != r || (r != TT_OK) != (atlas == NULL)) return TT_RESULT_MAX_ENUM;
     tt_image_free(atlas);
     return r;
 }
 
-/* tt_polycube_upright_atlas: level L of both tilesets side by side, plain
-   on the left, texel for texel; tilesets that do not go together are
-   refused. */
-static void upright_atlas_checks(const tt_tileset *plain, const tt_tileset *upright, const tt_image *atlas)
+/* 1 when rows [0, rows) of `part` are the block of `atlas` at texel
+   column x0, image row y0. */
+static int atlas_block_is(const tt_image *atlas, int x0, int y0, const tt_image *part, int rows)
 {
-    tt_tileset swapped_windows;
+    int row;
+    for (row = 0; row < rows; row++)
+        if (memcmp(atlas->pixels + ((size_t)(y0 + row) * atlas->width + x0) * 4,
+                   part->pixels + (size_t)row * part->width * 4, (size_t)part->width * 4 * sizeof(float)) != 0)
+            return 0;
+    return 1;
+}
+
+/* The four tile sets of a polycube (tt_polycube_tiles' order) on the
+   plain set's edge windows: upright, then the right or the left side
+   plain. NULL in sets[1..3] on failure. */
+static void upright_sets(const tt_image *photo, tt_synth_options so, tt_tileset *sets[TT_POLYCUBE_TILESETS])
+{
+    static const int plain_sides[3] = {0, 1 << 1, 1 << 3};
+    int k;
+    so.upright = 1;
+    so.edge_windows = sets[0]->edge_windows;
+    for (k = 1; k < TT_POLYCUBE_TILESETS; k++) {
+        so.plain_sides = plain_sides[k - 1];
+        sets[k] = NULL;
+        if (tt_synthesize_tiles(photo, &so, NULL, &sets[k], NULL) != TT_OK) sets[k] = NULL;
+    }
+}
+
+/* tt_polycube_upright_atlas: level L of the four tilesets, set i in
+   column i % 2 and tile-row block i / 2 from the bottom, texel for
+   texel; two sets side by side; sets that do not go together, or in
+   another order, are refused. */
+static void upright_atlas_checks(const tt_tileset *const *sets, const tt_image *atlas)
+{
+    const tt_tileset *plain = sets[0], *upright = sets[1];
+    const tt_tileset *reordered[TT_POLYCUBE_TILESETS], *pair[2];
+    tt_tileset moved_set;
     tt_rect moved[TT_MAX_COLORS];
-    tt_image *level1 = NULL, *bad = (tt_image *)&bad;
+    tt_image *level1 = NULL, *two = NULL, *bad = (tt_image *)&bad;
     upright_atlas_oom_ctx ctx;
     tt_error err;
-    int row, same = 1, W = plain->levels[0].width;
-    CHECK(atlas->width == 2 * W && atlas->height == W, "the atlas is %dx%d (want %dx%d)", atlas->width,
-          atlas->height, 2 * W, W);
-    for (row = 0; row < W && same; row++)
-        same = memcmp(atlas->pixels + (size_t)row * 2 * W * 4, plain->levels[0].pixels + (size_t)row * W * 4,
-                      (size_t)W * 4 * sizeof(float)) == 0 &&
-               memcmp(atlas->pixels + ((size_t)row * 2 * W + W) * 4, upright->levels[0].pixels + (size_t)row * W * 4,
-                      (size_t)W * 4 * sizeof(float)) == 0;
-    CHECK(same, "the atlas is the plain tiles beside the upright ones");
+    int i, i2, same = 1, W = plain->levels[0].width;
+    CHECK(atlas->width == 2 * W && atlas->height == 2 * W, "the atlas is %dx%d (want %dx%d)", atlas->width,
+          atlas->height, 2 * W, 2 * W);
+    for (i = 0; i < TT_POLYCUBE_TILESETS; i++)
+        same &= atlas_block_is(atlas, (i % 2) * W, (1 - i / 2) * W, &sets[i]->levels[0], W);
+    CHECK(same, "the atlas is the four sets, 2 x 2, the first two at the bottom");
     {
         /* Bands of rows through an executor: the same atlas, byte for byte. */
         const tt_executor *executors[2];
@@ -2739,7 +2767,8 @@ static void upright_atlas_checks(const tt_tileset *plain, const tt_tileset *upri
         executors[1] = &g_thread_executor;
         for (e = 0; e < 2; e++) {
             tt_image *parallel = NULL;
-            CHECK(tt_polycube_upright_atlas(plain, upright, 0, executors[e], NULL, &parallel, &err) == TT_OK &&
+            CHECK(tt_polycube_upright_atlas(sets, TT_POLYCUBE_TILESETS, 0, executors[e], NULL, &parallel, &err) ==
+                          TT_OK &&
                       parallel && parallel->width == atlas->width && parallel->height == atlas->height &&
                       memcmp(parallel->pixels, atlas->pixels, (size_t)atlas->width * atlas->height * 4 * sizeof(float)) ==
                           0,
@@ -2747,27 +2776,52 @@ static void upright_atlas_checks(const tt_tileset *plain, const tt_tileset *upri
             tt_image_free(parallel);
         }
     }
-    CHECK(tt_polycube_upright_atlas(plain, upright, 1, NULL, NULL, &level1, &err) == TT_OK && level1 &&
-              level1->width == W && level1->height == W / 2 &&
-              memcmp(level1->pixels, plain->levels[1].pixels, (size_t)W / 2 * 4 * sizeof(float)) == 0,
+    CHECK(tt_polycube_upright_atlas(sets, TT_POLYCUBE_TILESETS, 1, NULL, NULL, &level1, &err) == TT_OK && level1 &&
+              level1->width == W && level1->height == W && atlas_block_is(level1, 0, W / 2, &plain->levels[1], W / 2),
           "level 1: %s", err.message);
     tt_image_free(level1);
-    CHECK(tt_polycube_upright_atlas(upright, plain, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
+    pair[0] = plain;
+    pair[1] = upright;
+    CHECK(tt_polycube_upright_atlas(pair, 2, 0, NULL, NULL, &two, &err) == TT_OK && two && two->width == 2 * W &&
+              two->height == W && atlas_block_is(two, 0, 0, &plain->levels[0], W) &&
+              atlas_block_is(two, W, 0, &upright->levels[0], W),
+          "two sets: the plain tiles beside the upright ones: %s", err.message);
+    tt_image_free(two);
+    for (i = 0; i < TT_POLYCUBE_TILESETS; i++) reordered[i] = sets[i];
+    reordered[2] = sets[3];
+    reordered[3] = sets[2];
+    CHECK(tt_polycube_upright_atlas(reordered, TT_POLYCUBE_TILESETS, 0, NULL, NULL, &bad, &err) ==
+                  TT_ERROR_INVALID_ARGUMENT && !bad && err.item == 2,
+          "the left- and right-plain sets swapped refused, naming set 2: %s", err.message);
+    bad = (tt_image *)&bad;
+    pair[0] = upright;
+    pair[1] = plain;
+    CHECK(tt_polycube_upright_atlas(pair, 2, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
           "upright first refused: %s", err.message);
     bad = (tt_image *)&bad;
-    CHECK(tt_polycube_upright_atlas(plain, upright, plain->nlevels, NULL, NULL, &bad, &err) ==
+    CHECK(tt_polycube_upright_atlas(sets, 3, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
+          "three sets refused: %s", err.message);
+    bad = (tt_image *)&bad;
+    CHECK(tt_polycube_upright_atlas(sets, TT_POLYCUBE_TILESETS, plain->nlevels, NULL, NULL, &bad, &err) ==
                   TT_ERROR_INDEX_OUT_OF_RANGE && !bad,
           "level %d refused: %s", plain->nlevels, err.message);
-    swapped_windows = *upright;
-    memcpy(moved, upright->edge_windows, sizeof(tt_rect) * (size_t)upright->layout.colors);
-    moved[1].x += 1;
-    swapped_windows.edge_windows = moved;
-    bad = (tt_image *)&bad;
-    CHECK(tt_polycube_upright_atlas(plain, &swapped_windows, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT &&
-              !bad && err.item == 1,
-          "other edge windows refused: %s", err.message);
-    ctx.plain = plain;
-    ctx.upright = upright;
+    for (i = 0; i < 2; i++) {
+        /* another edge window, then another vertical window, in set 2 */
+        moved_set = *sets[2];
+        memcpy(moved, i == 0 ? sets[2]->edge_windows : sets[2]->vertical_windows,
+               sizeof(tt_rect) * (size_t)plain->layout.colors);
+        moved[1].x += 1;
+        if (i == 0) moved_set.edge_windows = moved;
+        else moved_set.vertical_windows = moved;
+        for (i2 = 0; i2 < TT_POLYCUBE_TILESETS; i2++) reordered[i2] = sets[i2];
+        reordered[2] = &moved_set;
+        bad = (tt_image *)&bad;
+        CHECK(tt_polycube_upright_atlas(reordered, TT_POLYCUBE_TILESETS, 0, NULL, NULL, &bad, &err) ==
+                      TT_ERROR_INVALID_ARGUMENT &&
+                  !bad && err.item == 1 && strstr(err.message, i == 0 ? "edge window" : "vertical window"),
+              "another %s window in set 2 refused: %s", i == 0 ? "edge" : "vertical", err.message);
+    }
+    ctx.sets = sets;
     oom_sweep("tt_polycube_upright_atlas", upright_atlas_oom_call, &ctx, TT_OK);
 }
 
@@ -2786,13 +2840,20 @@ static int darkening_rows(const tt_image *cell, int g, int S)
     return count;
 }
 
+/* A wall of S: a quad facing sideways. */
+static int is_wall(const tt_polycube *pc, int q)
+{
+    return pc->quad_side[q] / 2 != pc->up_axis;
+}
+
 /* tt_polycube_orient_upright: every wall's bottom and right sides take the
-   even type, its top and left the odd one, whole edges turning (the
-   conditions kept, twins still the two halves of one); nothing else
-   changes, and a second call turns nothing. The effect: wall tiles
-   composed from a photo that brightens down every course (courses one tile
-   tall, windows cut on them) brighten down everywhere; with the sides
-   tt_assign_boundaries drew, turned bands darken down somewhere. */
+   even type, its top and left the odd one, and so do a top's sides that
+   meet another top, whole edges turning (the conditions kept, twins still
+   the two halves of one); a second call turns nothing. The effect: upright
+   tiles of walls and of tops among tops, composed from a photo that
+   brightens down every course (courses one tile tall, windows cut on
+   them), brighten down everywhere; with the sides tt_assign_boundaries
+   drew, turned bands darken down somewhere. */
 static void test_orient_upright(void)
 {
     const double centre[3] = {0.02, 0.11, -0.07};
@@ -2818,7 +2879,8 @@ static void test_orient_upright(void)
         int *colors = (int *)malloc(sizeof(int) * (size_t)s->ncorners);
         uint8_t *drawn = (uint8_t *)malloc((size_t)s->ncorners), *types = (uint8_t *)malloc((size_t)s->ncorners);
         int c, q, k, x, y, turned = -1, again = -1, wrong_before = 0, wrong_after = 0, kept = 0, paired = 0;
-        int untouched = 0, walls = 0, dark_before = 0, dark_after = 0, tiles_before = 0, tiles_after = 0;
+        int walls = 0, dark_before = 0, dark_after = 0, tiles_before = 0, tiles_after = 0;
+        int top_sides = 0, top_wrong_before = 0, top_wrong_after = 0, tops = 0;
         memset(&layout, 0, sizeof layout);
         layout.colors = 2;
         layout.tile_size = S;
@@ -2828,29 +2890,39 @@ static void test_orient_upright(void)
               "types: %s", err.message);
         memcpy(types, drawn, (size_t)s->ncorners);
         for (q = 0; q < s->nfaces; q++)
-            if (tt_polycube_quad_upright(pc, q))
+            if (is_wall(pc, q))
                 for (k = 0; k < 4; k++) wrong_before += (drawn[s->face_start[q] + k] & 1) != (k >= 2);
         CHECK(tt_polycube_orient_upright(pc, types, &turned, &err) == TT_OK && turned > 0, "oriented (%d turned): %s",
               turned, err.message);
         CHECK(tt_polycube_orient_upright(pc, types, &again, &err) == TT_OK && again == 0,
               "a second call turns nothing (%d)", again);
         for (c = 0; c < s->ncorners; c++) {
-            int t = s->twin[c], wall = tt_polycube_quad_upright(pc, s->corner_face[c]) ||
-                                       tt_polycube_quad_upright(pc, s->corner_face[t]);
+            int t = s->twin[c];
             kept += types[c] / 2 == drawn[c] / 2;
             paired += types[t] == (types[c] ^ 1);
-            untouched += wall || types[c] == drawn[c];
         }
-        for (q = 0; q < s->nfaces; q++)
-            if (tt_polycube_quad_upright(pc, q)) {
+        for (q = 0; q < s->nfaces; q++) {
+            if (is_wall(pc, q)) {
                 walls++;
                 for (k = 0; k < 4; k++) wrong_after += (types[s->face_start[q] + k] & 1) != (k >= 2);
+                continue;
             }
+            for (k = 0; k < 4; k++) {
+                /* a top's side across which lies a quad facing the same way */
+                const int corner = s->face_start[q] + k, across = s->corner_face[s->twin[corner]];
+                if (pc->quad_side[across] != pc->quad_side[q]) continue;
+                top_sides++;
+                top_wrong_before += (drawn[corner] & 1) != (k >= 2);
+                top_wrong_after += (types[corner] & 1) != (k >= 2);
+            }
+        }
         CHECK(wrong_before > 0 && wrong_after == 0 && walls > 0,
               "walls' sides of the wrong type: %d of %d drawn, %d after", wrong_before, 4 * walls, wrong_after);
-        CHECK(kept == s->ncorners && paired == s->ncorners && untouched == s->ncorners,
-              "conditions kept (%d), twins paired (%d), edges without a wall untouched (%d) of %d", kept, paired,
-              untouched, s->ncorners);
+        CHECK(top_wrong_before > 0 && top_wrong_after == 0,
+              "tops' sides meeting tops of the wrong type: %d of %d drawn, %d after", top_wrong_before, top_sides,
+              top_wrong_after);
+        CHECK(kept == s->ncorners && paired == s->ncorners, "conditions kept (%d), twins paired (%d) of %d", kept,
+              paired, s->ncorners);
 
         /* The photo: 8 courses of 16 rows brightening down, a trace of noise across. */
         if (tt_image_create(96, 128, NULL, &photo, &err) == TT_OK)
@@ -2877,7 +2949,15 @@ static void test_orient_upright(void)
         if (upright_plan && tt_image_create(S + 2 * g, S + 2 * g, NULL, &cell, &err) == TT_OK)
             for (q = 0; q < s->nfaces; q++) {
                 uint8_t before[4], after[4];
-                if (!tt_polycube_quad_upright(pc, q)) continue;
+                if (!is_wall(pc, q)) {
+                    /* a top all of whose sides meet tops: a wall decides the edges it shares with
+                       a top, and one whose top side meets the top's top side turns that band */
+                    int among = 1;
+                    for (k = 0; k < 4; k++)
+                        among &= pc->quad_side[s->corner_face[s->twin[s->face_start[q] + k]]] == pc->quad_side[q];
+                    if (!among) continue;
+                    tops++;
+                }
                 for (k = 0; k < 4; k++) {
                     before[k] = drawn[s->face_start[q] + k];
                     after[k] = types[s->face_start[q] + k];
@@ -2893,11 +2973,12 @@ static void test_orient_upright(void)
                     tiles_after += n > 0;
                 }
             }
-        CHECK(upright_plan && cell && tiles_before > walls / 4 && dark_after == 0,
-              "wall tiles with rows darkening down: %d of %d as drawn (%d rows), %d after (%d rows)", tiles_before,
-              walls, dark_before, tiles_after, dark_after);
-        printf("     orient upright: %d of %d wall sides turned; wall tiles with a turned band %d -> %d of %d\n",
-               wrong_before, 4 * walls, tiles_before, tiles_after, walls);
+        CHECK(upright_plan && cell && tops > 0 && tiles_before > (walls + tops) / 4 && dark_after == 0,
+              "upright tiles (%d walls, %d tops) with rows darkening down: %d as drawn (%d rows), %d after (%d rows)",
+              walls, tops, tiles_before, dark_before, tiles_after, dark_after);
+        printf("     orient upright: %d of %d wall sides turned, %d of %d tops' sides between tops; upright tiles "
+               "with a turned band %d -> %d of %d\n",
+               wrong_before, 4 * walls, top_wrong_before, top_sides, tiles_before, tiles_after, walls + tops);
         CHECK(tt_polycube_orient_upright(NULL, types, NULL, &err) == TT_ERROR_INVALID_ARGUMENT &&
                   tt_polycube_orient_upright(pc, NULL, NULL, &err) == TT_ERROR_INVALID_ARGUMENT,
               "NULL polycube or types refused");
@@ -2918,16 +2999,17 @@ static void test_orient_upright(void)
     tm_free(&m);
 }
 
-/* Upright tiles on the walls (tt_polycube_mapping_uvs_upright): a sphere
-   textured from a plain and an upright tile set side by side is seamless
-   on the tile borders; the walls' UVs lie in the right half, the tops' in
-   the left. Upright tiles on every quad instead (the tops too) break the
-   edges where a top's left or right side meets a wall's top side. */
+/* Upright tiles (tt_polycube_mapping_uvs_upright): a sphere textured from
+   the four tile sets, 2 x 2, is seamless on the tile borders; every
+   corner's UV lies in its quad's set's quarter, and the tops take all four
+   sets (among tops, and beside a wall on the right, the left or both).
+   Upright tiles on every quad instead (the control) break the edges where
+   a top's left or right side meets a wall's top side. */
 static void test_map_uvs_upright(void)
 {
     const double centre[3] = {0.02, 0.11, -0.07};
     tt_image *photo = NULL, *atlas = NULL;
-    tt_tileset *plain = NULL, *upright = NULL;
+    tt_tileset *sets[TT_POLYCUBE_TILESETS] = {NULL, NULL, NULL, NULL};
     tt_synth_options so;
     tt_polycube *pc = NULL;
     tt_mesh *mesh = NULL, *out = NULL;
@@ -2935,22 +3017,22 @@ static void test_map_uvs_upright(void)
     tt_polycube_mapping *map;
     tt_error err;
     tmesh m;
-    if (!(plain = seam_test_tiles(&so, &photo))) {
+    int k;
+    if (!(sets[0] = seam_test_tiles(&so, &photo))) {
         CHECK(0, "plain tiles");
         tt_image_free(photo);
         return;
     }
-    so.upright = 1;
-    so.edge_windows = plain->edge_windows;
-    if (tt_synthesize_tiles(photo, &so, NULL, &upright, &err) != TT_OK ||
-        tt_polycube_upright_atlas(plain, upright, 0, NULL, NULL, &atlas, &err) != TT_OK) {
+    upright_sets(photo, so, sets);
+    if (!sets[1] || !sets[2] || !sets[3] ||
+        tt_polycube_upright_atlas((const tt_tileset *const *)sets, TT_POLYCUBE_TILESETS, 0, NULL, NULL, &atlas,
+                                  &err) != TT_OK) {
         CHECK(0, "upright tiles and their atlas: %s", err.message);
-        tt_tileset_free(plain);
-        tt_tileset_free(upright);
+        for (k = 0; k < TT_POLYCUBE_TILESETS; k++) tt_tileset_free(sets[k]);
         tt_image_free(photo);
         return;
     }
-    upright_atlas_checks(plain, upright, atlas);
+    upright_atlas_checks((const tt_tileset *const *)sets, atlas);
     memset(&m, 0, sizeof m);
     make_sphere(&m, 48, 24, 1.0, centre, 0);
     map = mapped(&m, 8, 0, 0.0, &pc, &mesh, &rep);
@@ -2960,7 +3042,7 @@ static void test_map_uvs_upright(void)
         uint8_t *types = (uint8_t *)malloc((size_t)s->ncorners);
         float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
         float *everywhere = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
-        int i, wrong_half = 0, walls = 0;
+        int i, q, wrong_quarter = 0, walls = 0, top_sets[TT_POLYCUBE_TILESETS] = {0, 0, 0, 0};
         tt_seam_options border;
         tt_seam_report fit, control;
         CHECK(colors && types && uv && everywhere && tt_polycube_edge_colors(pc, 2, 1, 7, colors, &err) == TT_OK &&
@@ -2970,25 +3052,38 @@ static void test_map_uvs_upright(void)
               "the upright UVs: %s", err.message);
         CHECK(pc->up_axis == 1 && pc->up_sign == 1, "the default up is +y: axis %d, sign %d", pc->up_axis,
               pc->up_sign);
-        for (i = 0; i < 3 * map->ntriangles; i++) {
-            const int wall = tt_polycube_quad_upright(pc, map->corner_points[i].quad);
-            walls += wall;
-            wrong_half += wall ? uv[2 * i] < 0.5f : uv[2 * i] > 0.5f;
-            everywhere[2 * i] = 0.5f * (everywhere[2 * i] + 1.0f);
+        for (q = 0; q < s->nfaces; q++) {
+            const int set = (int)tt_polycube_quad_tileset(pc, q);
+            if (is_wall(pc, q)) {
+                walls++;
+                wrong_quarter += set != TT_POLYCUBE_TILES_UPRIGHT;
+            } else {
+                top_sets[set]++;
+            }
         }
-        CHECK(wrong_half == 0 && walls > 0 && walls < 3 * map->ntriangles,
-              "walls in the right half, tops and bottoms in the left: %d corners not", wrong_half);
+        for (i = 0; i < 3 * map->ntriangles; i++) {
+            const int set = (int)tt_polycube_quad_tileset(pc, map->corner_points[i].quad);
+            wrong_quarter += uv[2 * i] < 0.5f * (float)(set % 2) || uv[2 * i] > 0.5f * (float)(set % 2 + 1) ||
+                             uv[2 * i + 1] < 0.5f * (float)(set / 2) || uv[2 * i + 1] > 0.5f * (float)(set / 2 + 1);
+            everywhere[2 * i] = 0.5f * (everywhere[2 * i] + 1.0f);
+            everywhere[2 * i + 1] = 0.5f * everywhere[2 * i + 1];
+        }
+        CHECK(wrong_quarter == 0 && walls > 0, "every wall upright, every corner in its set's quarter: %d not",
+              wrong_quarter);
+        CHECK(top_sets[0] > 0 && top_sets[1] > 0 && top_sets[2] > 0 && top_sets[3] > 0,
+              "tops and bottoms in every set: plain %d, upright %d, right side plain %d, left side plain %d",
+              top_sets[0], top_sets[1], top_sets[2], top_sets[3]);
         memset(&border, 0, sizeof border);
         border.flags = TT_SEAM_UV_DISCONTINUOUS;
         if ((out = mapping_mesh(map)) != NULL &&
             tt_measure_seams(out, uv, atlas, &border, NULL, &fit, &err) == TT_OK &&
             tt_measure_seams(out, everywhere, atlas, &border, NULL, &control, &err) == TT_OK) {
-            printf("     sphere with upright tiles on its walls: seam %.3f on tile borders; upright tiles on the "
-                   "tops too: %.3f\n", fit.score, control.score);
-            CHECK(fit.score <= 0.05, "upright walls seamless: %.3f on the tile borders", fit.score);
+            printf("     sphere with upright tiles, plain sides beside the walls: seam %.3f on tile borders; "
+                   "upright tiles everywhere: %.3f\n", fit.score, control.score);
+            CHECK(fit.score <= 0.05, "upright tiles seamless: %.3f on the tile borders", fit.score);
             /* Only the edges where a top's left or right side meets a wall break (a tenth of the borders),
                so the control's score rises by less than a seam's full 1. */
-            CHECK(control.score >= fit.score + 0.08, "upright tops show seams at the walls: %.3f against %.3f",
+            CHECK(control.score >= fit.score + 0.08, "upright tops beside walls show seams: %.3f against %.3f",
                   control.score, fit.score);
         } else {
             CHECK(0, "seams measured: %s", err.message);
@@ -3004,8 +3099,7 @@ static void test_map_uvs_upright(void)
     tt_mesh_free(mesh);
     tm_free(&m);
     tt_image_free(atlas);
-    tt_tileset_free(plain);
-    tt_tileset_free(upright);
+    for (k = 0; k < TT_POLYCUBE_TILESETS; k++) tt_tileset_free(sets[k]);
     tt_image_free(photo);
 }
 

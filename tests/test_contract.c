@@ -68,6 +68,7 @@ static const char *const k_functions[] = {
     "tt_synthesize_tiles",
     "tt_compact_atlas_create",
     "tt_compact_atlas_image",
+    "tt_compact_atlas_image_parts",
     "tt_measure_seams",
     "tt_tile_histogram",
     "tt_face_stretch",
@@ -1329,6 +1330,32 @@ static void cases_tiled(const baseline *b)
             OUT_CASE(iout, tt_image_free, tt_compact_atlas_image(ca, &v, AL, &iout, E));
             v.pixels = keep;
         }
+        {
+            /* The full atlas in parts: 2 x 1 of 24 x 48 is its size. */
+            tt_image left = image_view(24, 48, 0.5f), right = image_view(24, 48, 0.25f);
+            const tt_image *two[2], *with_null[2];
+            two[0] = &left;
+            two[1] = &right;
+            with_null[0] = &left;
+            with_null[1] = NULL;
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(NULL, two, 2, 1, AL, &iout, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, NULL, 2, 1, AL, &iout, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, with_null, 2, 1, AL, &iout, E));
+            CASE(tt_compact_atlas_image_parts(ca, two, 2, 1, AL, NULL, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, 2, 1, BA1, &iout, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, 0, 1, AL, &iout, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, 2, 0, AL, &iout, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, 3, 1, AL, &iout, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, -1, -2, AL, &iout, E));
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, 1, 2, AL, &iout, E));
+            right.width = 23;
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, 2, 1, AL, &iout, E));
+            right.width = 24;
+            right.kind = TT_IMAGE_NORMAL;
+            OUT_CASE(iout, tt_image_free, tt_compact_atlas_image_parts(ca, two, 2, 1, AL, &iout, E));
+            free(left.pixels);
+            free(right.pixels);
+        }
         free(v.pixels);
         tt_compact_atlas_free(ca);
     }
@@ -2157,36 +2184,60 @@ static void cases_polycube(const baseline *b)
     }
     if (plain && upright) {
         tt_tileset other = *upright, other2;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(NULL, upright, 0, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, NULL, 0, NULL, AL, &aout, E));
-        CASE(tt_polycube_upright_atlas(plain, upright, 0, NULL, AL, NULL, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, 0, NULL, BA1, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, 0, NULL, BA2, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, -1, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, plain->nlevels, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, TT_MAX_MIP_LEVELS, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, INT_MAX, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, upright, INT_MIN, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(upright, plain, 0, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, plain, 0, NULL, AL, &aout, E));
+        const tt_tileset *pair[2], *four[4];
+        tt_rect moved[TT_MAX_COLORS];
+#define ATLAS_CASE(a, b, level, al) \
+        do { pair[0] = (a); pair[1] = (b); \
+             OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 2, level, NULL, al, &aout, E)); } while (0)
+        ATLAS_CASE(NULL, upright, 0, AL);
+        ATLAS_CASE(plain, NULL, 0, AL);
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(NULL, 2, 0, NULL, AL, &aout, E));
+        pair[0] = plain;
+        pair[1] = upright;
+        CASE(tt_polycube_upright_atlas(pair, 2, 0, NULL, AL, NULL, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 0, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 1, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 3, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, -4, 0, NULL, AL, &aout, E));
+        four[0] = plain;
+        four[1] = four[2] = four[3] = upright;   /* sets 2 and 3 need plain_sides */
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 4, 0, NULL, AL, &aout, E));
+        ATLAS_CASE(plain, upright, 0, BA1);
+        ATLAS_CASE(plain, upright, 0, BA2);
+        ATLAS_CASE(plain, upright, -1, AL);
+        ATLAS_CASE(plain, upright, plain->nlevels, AL);
+        ATLAS_CASE(plain, upright, TT_MAX_MIP_LEVELS, AL);
+        ATLAS_CASE(plain, upright, INT_MAX, AL);
+        ATLAS_CASE(plain, upright, INT_MIN, AL);
+        ATLAS_CASE(upright, plain, 0, AL);
+        ATLAS_CASE(plain, plain, 0, AL);
         other.nlevels = -1;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
+        ATLAS_CASE(plain, &other, 0, AL);
         other.nlevels = TT_MAX_MIP_LEVELS + 5;   /* both claim levels beyond the array */
         other2 = *plain;
         other2.nlevels = TT_MAX_MIP_LEVELS + 5;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(&other2, &other, TT_MAX_MIP_LEVELS + 1, NULL, AL, &aout, E));
+        ATLAS_CASE(&other2, &other, TT_MAX_MIP_LEVELS + 1, AL);
         other = *upright;
         other.layout.colors = 2;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
+        ATLAS_CASE(plain, &other, 0, AL);
         other = *upright;
         other.levels[0].kind = TT_IMAGE_NORMAL;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
+        ATLAS_CASE(plain, &other, 0, AL);
         other = *upright;
         other.levels[0].pixels = NULL;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
+        ATLAS_CASE(plain, &other, 0, AL);
         other = *upright;
         other.levels[0].width = 3;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(plain, &other, 0, NULL, AL, &aout, E));
+        ATLAS_CASE(plain, &other, 0, AL);
+        other = *upright;
+        other.plain_sides = 1 << 1;
+        ATLAS_CASE(plain, &other, 0, AL);
+        other = *upright;
+        memcpy(moved, upright->edge_windows, sizeof(tt_rect) * (size_t)upright->layout.colors);
+        moved[0].y += 1;
+        other.edge_windows = moved;
+        ATLAS_CASE(plain, &other, 0, AL);
+#undef ATLAS_CASE
     }
     tt_tileset_free(plain);
     tt_tileset_free(upright);
