@@ -1262,6 +1262,22 @@ TTDEF void tt_tile_corner_uv(const tt_tile_layout *layout, const uint8_t types[4
 TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
                               float *corner_uv, tt_error *error);
 
+/* The four sets of tiles a face may take when the tiles follow a direction
+   (tt_orient_tiles, a polycube's tops: tt_polycube_quad_tileset), in the
+   order of tt_polycube_upright_atlas's quarters. Upright tiles
+   (tt_synth_options::upright) keep the source's up on all four sides, but
+   their left and right sides match only the left and right sides of
+   upright tiles; a side that meets anything else is plain, the edge window
+   turned to it (tt_synth_options::plain_sides), as all four sides of a
+   plain tile are. */
+typedef enum tt_tileset_kind {
+    TT_TILESET_PLAIN = 0,        /* plain: both left and right sides plain, or no direction */
+    TT_TILESET_UPRIGHT = 1,      /* upright on all four sides */
+    TT_TILESET_RIGHT_PLAIN = 2,  /* upright, its right side (1) plain: plain_sides 1 << 1 */
+    TT_TILESET_LEFT_PLAIN = 3    /* upright, its left side (3) plain: plain_sides 1 << 3 */
+} tt_tileset_kind;
+#define TT_TILESET_KINDS 4
+
 /* Tiles that follow a direction field, for a texture with an up (bricks,
    planks, grain). tt_assign_uvs puts each tile's bottom side on the face's
    first half-edge, wherever that runs; on a mesh of any shape the courses
@@ -1271,35 +1287,31 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
    middle of the top side - lies nearest face_vectors[f] in angle
    (tt_tangent_field's T_f, or your own; only the direction counts; a zero
    vector keeps turn 0).
-   Upright tiles (tt_synth_options::upright) keep the source's up on all
-   four sides, but their left and right sides match only left and right
-   sides of upright tiles. face_upright (NULL: not wanted) gets 1 for the
-   faces that can show one: a face starts upright when its vector is not
-   zero, and stops being upright while one of its left or right sides meets
-   a face that is not upright or that sees the edge as its bottom or top
-   (where the field turns past the diagonal of the quads, around the mesh's
-   irregular vertices); those faces show plain tiles, which match anything
-   across their sides but turn the texture of their left and right quarters
-   a quarter turn. Every edge then matches with tt_assign_uvs_oriented's
-   atlas. *out_upright (NULL: not wanted) gets the number of upright faces.
-   Errors: NULL mesh, face_vectors or face_turn, a bad allocator
-   (TT_ERROR_INVALID_ARGUMENT); a face that is not a quad
-   (TT_ERROR_NOT_QUAD_MESH); a non-finite vector (TT_ERROR_NON_FINITE,
-   naming the face); a mesh without faces (TT_ERROR_EMPTY_MESH);
-   TT_ERROR_OUT_OF_MEMORY. Memory: 5 bytes a face, from `allocator`, freed
-   before it returns. Deterministic. */
-TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, const tt_allocator *allocator,
-                                uint8_t *face_turn, uint8_t *face_upright, int *out_upright, tt_error *error);
+   face_upright (NULL: not wanted) gets each face's tile set
+   (tt_tileset_kind): a face with a vector is upright, but for each of its
+   left and right sides that meets a face without one, or one that sees the
+   edge as its bottom or top (where the field turns past the diagonal of
+   the quads, around the mesh's irregular vertices, on kites made from
+   triangles): that side is plain. Both faces of an edge decide it alike,
+   so every edge matches with tt_assign_uvs_oriented's atlas, and only the
+   sides where the field turns show the texture a quarter turn off. A face
+   without a vector is plain. *out_upright (NULL: not wanted) gets the
+   number of faces upright on all four sides.
+   Errors: NULL mesh, face_vectors or face_turn (TT_ERROR_INVALID_ARGUMENT);
+   a face that is not a quad (TT_ERROR_NOT_QUAD_MESH); a non-finite vector
+   (TT_ERROR_NON_FINITE, naming the face); a mesh without faces
+   (TT_ERROR_EMPTY_MESH). Allocates nothing; deterministic. */
+TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, uint8_t *face_turn,
+                                uint8_t *face_upright, int *out_upright, tt_error *error);
 
 /* tt_assign_uvs with each quad's tile turned by face_turn (NULL: no turn,
    tt_assign_uvs's UVs to the bit): the tile is named by the types e0..e3
    read from the half-edge face_turn[f] on, and its corner k lies at the
-   face's corner face_turn[f] + k. With face_upright (NULL: one tile set)
-   the UVs address an atlas twice as wide, plain tiles on the left and
-   upright ones on the right (tt_polycube_upright_atlas makes it): u
-   becomes (u + face_upright[f]) / 2. Errors: as tt_assign_uvs, and a turn
-   above 3 or an upright flag other than 0 or 1 (TT_ERROR_INVALID_ARGUMENT,
-   naming the face). */
+   face's corner face_turn[f] + k. With face_upright (NULL: one tile set;
+   else each face's tt_tileset_kind) the UVs address the atlas of the four
+   sets (tt_polycube_upright_atlas makes it): u becomes (u + k % 2) / 2 and
+   v (v + k / 2) / 2 for kind k. Errors: as tt_assign_uvs, and a turn above
+   3 or a kind above 3 (TT_ERROR_INVALID_ARGUMENT, naming the face). */
 TTDEF tt_result tt_assign_uvs_oriented(const tt_mesh *mesh, const tt_tile_layout *layout,
                                        const uint8_t *corner_type, const uint8_t *face_turn,
                                        const uint8_t *face_upright, float *corner_uv, tt_error *error);
@@ -1656,7 +1668,7 @@ typedef struct tt_compact_atlas {
 
 /* The cells of a full atlas (full_width x full_height texels, cells of the
    layout's C = S + 2g texels, row 0 at the bottom: a layout's W x W, or
-   tt_polycube_upright_atlas's 2W x W or 2W x 2W) that mesh's faces use, each face's cell
+   tt_polycube_upright_atlas's 2W x 2W) that mesh's faces use, each face's cell
    being the one its corners' UVs lie in, and the smallest power-of-two
    atlas that holds them with at most max_size texels a side (0 =
    TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE; at most TT_MAX_IMAGE_SIZE).
@@ -1685,7 +1697,7 @@ TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_i
 /* The same from a full atlas in parts, never put together: columns x rows
    (1 or 2 each) images of one size and kind, part k = row * columns +
    column, row 0 at the bottom as cells count - a polycube's four tile sets
-   in the order of tt_polycube_tiles (tt_polycube_upright_atlas's layout),
+   in the order of tt_tileset_kind (tt_polycube_upright_atlas's layout),
    without the memory of the whole. Errors: as tt_compact_atlas_image, a
    NULL part, parts of different sizes or kinds, or columns or rows outside
    1..2 (TT_ERROR_INVALID_ARGUMENT). */
@@ -3854,10 +3866,10 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
    edge as its top or bottom) must that side be plain: the edge window
    turned to the side, a course along the edge on the top beside the
    wall's last course. So S takes four tile sets (tt_polycube_quad_tileset):
-   TT_POLYCUBE_TILES_UPRIGHT for the walls and the tops among tops,
-   TT_POLYCUBE_TILES_RIGHT_PLAIN or _LEFT_PLAIN for a top with a wall on
+   TT_TILESET_UPRIGHT for the walls and the tops among tops,
+   TT_TILESET_RIGHT_PLAIN or _LEFT_PLAIN for a top with a wall on
    that side (tt_synth_options::plain_sides 1 << 1 or 1 << 3), and
-   TT_POLYCUBE_TILES_PLAIN for one with walls on both. Every edge of S then
+   TT_TILESET_PLAIN for one with walls on both. Every edge of S then
    meets seamlessly.
      0. with a photo laid in courses (bricks, planks), tt_polycube_orient_upright
         on S's types (after tt_reduce_tiles, before tt_assign_uvs), so every
@@ -3867,7 +3879,7 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
         1, options.edge_windows = the plain tileset's edge_windows and
         options.plain_sides 0, 1 << 1 and 1 << 3;
      2. tt_polycube_upright_atlas with the four, in the order of the
-        TT_POLYCUBE_TILES_ values: a 2W x 2W atlas (per mip level, as you
+        TT_TILESET_ values: a 2W x 2W atlas (per mip level, as you
         need them);
      3. tt_polycube_mapping_uvs_upright: as tt_polycube_mapping_uvs, each
         quad's tile moved into its set's quarter;
@@ -3880,14 +3892,7 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
    tt_polycube_quad_tileset gives the quad's set.
    Preconditions (TT_ASSERT): a polycube from tt_polycube_build, 0 <= quad
    < its surface's nfaces. */
-typedef enum tt_polycube_tiles {
-    TT_POLYCUBE_TILES_PLAIN = 0,        /* a top with walls on its left and right */
-    TT_POLYCUBE_TILES_UPRIGHT = 1,      /* every wall; a top among tops */
-    TT_POLYCUBE_TILES_RIGHT_PLAIN = 2,  /* a top with a wall on its right side (1) only */
-    TT_POLYCUBE_TILES_LEFT_PLAIN = 3    /* a top with a wall on its left side (3) only */
-} tt_polycube_tiles;
-#define TT_POLYCUBE_TILESETS 4
-TTDEF tt_polycube_tiles tt_polycube_quad_tileset(const tt_polycube *polycube, int quad);
+TTDEF tt_tileset_kind tt_polycube_quad_tileset(const tt_polycube *polycube, int quad);
 /* An upright tile shows a side's band upright only on one of the two types
    of its condition (tt_synth_options::upright): the even type on its
    bottom and right sides, the odd one on its top and left; on the other
@@ -3913,16 +3918,15 @@ TTDEF tt_polycube_tiles tt_polycube_quad_tileset(const tt_polycube *polycube, in
    corner): corner_type is then as it was. Allocates nothing; thread-safe. */
 TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t *corner_type, int *out_turned,
                                            tt_error *error);
-/* sets[i] at level `level` into the atlas: two sets (a plain and an
-   upright one: tt_assign_uvs_oriented's, `tiled --up`) side by side, 2W x
-   W, or four (TT_POLYCUBE_TILESETS, in the order of tt_polycube_tiles)
-   2W x 2W; set i at column i % 2, tile-row block i / 2 from the bottom,
-   so u becomes (u + i % 2) / 2 and, with four, v (v + i / 2) / 2. The
-   atlas is of the tilesets' kind (a normal map when they are). Errors:
-   NULL arguments, nsets other than 2 or 4, a bad allocator, tilesets of
-   different layouts or kinds, a set that is not the kind its place asks
-   for (set 0 plain, the others upright, set 2 with plain_sides 1 << 1
-   and set 3 with 1 << 3), edge windows or vertical windows that differ,
+/* The TT_TILESET_KINDS sets (sets[k] of tt_tileset_kind k) at level
+   `level` in one 2W x 2W atlas, set k at column k % 2 and tile-row block
+   k / 2 from the bottom, so u becomes (u + k % 2) / 2 and v (v + k / 2) /
+   2 (tt_assign_uvs_oriented, tt_polycube_mapping_uvs_upright). The atlas
+   is of the tilesets' kind (a normal map when they are). Errors: NULL
+   arguments, a bad allocator, tilesets of different layouts or kinds, a
+   set that is not the kind its place asks for (set 0 plain, the others
+   upright, set 2 with plain_sides 1 << 1 and set 3 with 1 << 3), edge
+   windows or vertical windows that differ,
    a level whose images differ in size or have no pixels
    (TT_ERROR_INVALID_ARGUMENT); a level that is not in every tileset or
    beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE);
@@ -3931,9 +3935,8 @@ TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t 
    parallel: an atlas of hundreds of megabytes is mostly fresh memory the
    system must hand out page by page, which one thread alone makes the
    longest serial stage of a polycube run. */
-TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int nsets, int level,
-                                          const tt_executor *executor, const tt_allocator *allocator,
-                                          tt_image **out_image, tt_error *error);
+TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int level, const tt_executor *executor,
+                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error);
 /* Errors and the rest as tt_polycube_mapping_uvs. */
 TTDEF tt_result tt_polycube_mapping_uvs_upright(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                                 const tt_tile_layout *layout, const uint8_t *corner_type,
@@ -9437,9 +9440,9 @@ static tt_result tt__assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layou
                             "corner %d has boundary type %d, but %d colors allow 0..%d", c, corner_type[c],
                             resolved.colors, base - 1);
     for (f = 0; f < mesh->nfaces; f++)
-        if ((face_turn && face_turn[f] > 3) || (face_upright && face_upright[f] > 1))
+        if ((face_turn && face_turn[f] > 3) || (face_upright && face_upright[f] >= TT_TILESET_KINDS))
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
-                            "face %d has turn %d and upright flag %d: turns are 0..3, flags 0 or 1", f,
+                            "face %d has turn %d and tile set %d: turns are 0..3, sets 0..3 (tt_tileset_kind)", f,
                             face_turn ? face_turn[f] : 0, face_upright ? face_upright[f] : 0);
     for (f = 0; f < mesh->nfaces; f++) {
         /* tt_tile_corner_uv's formula, term for term, so the two agree to
@@ -9463,9 +9466,9 @@ static tt_result tt__assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layou
         tile[6] = u0; tile[7] = v1;   /* corner 3: top-left     */
         for (k = 0; k < 4; k++) {
             const int at = (k + turn) & 3;
-            /* tt_polycube_mapping_uvs_upright's halves, the same arithmetic. */
-            uv[2 * at] = face_upright ? 0.5f * (tile[2 * k] + (float)face_upright[f]) : tile[2 * k];
-            uv[2 * at + 1] = tile[2 * k + 1];
+            /* tt_polycube_mapping_uvs_upright's quarters, the same arithmetic. */
+            uv[2 * at] = face_upright ? 0.5f * (tile[2 * k] + (float)(face_upright[f] % 2)) : tile[2 * k];
+            uv[2 * at + 1] = face_upright ? 0.5f * (tile[2 * k + 1] + (float)(face_upright[f] / 2)) : tile[2 * k + 1];
         }
     }
     return TT_OK;
@@ -9492,34 +9495,41 @@ static int tt__tile_side_is_vertical(const tt_mesh *mesh, const uint8_t *turn, i
     return ((c - mesh->face_start[f] - turn[f]) & 1) != 0;
 }
 
-TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, const tt_allocator *allocator,
-                                uint8_t *face_turn, uint8_t *face_upright, int *out_upright, tt_error *error)
+/* Whether face f has a direction: a vector of some length (only its
+   direction counts). */
+static int tt__face_has_direction(const float *face_vectors, int f)
 {
-    int *stack = NULL;
-    uint8_t *stacked = NULL;
-    int f, k, top = 0, upright = 0;
+    const float *t = face_vectors + 3 * (size_t)f;
+    return (double)t[0] * t[0] + (double)t[1] * t[1] + (double)t[2] * t[2] > 0.0;
+}
+
+/* Whether face f sees half-edge c's edge as a plain side: its left or
+   right side (tt__tile_side_is_vertical) across which lies a face without
+   a direction, or one that sees the edge as its bottom or top. */
+static int tt__tile_side_is_plain(const tt_mesh *mesh, const float *face_vectors, const uint8_t *turn, int f, int c)
+{
+    const int t = mesh->twin[c];
+    int g;
+    if (t < 0 || !tt__tile_side_is_vertical(mesh, turn, f, c)) return 0;
+    g = mesh->corner_face[t];
+    return !tt__face_has_direction(face_vectors, g) || !tt__tile_side_is_vertical(mesh, turn, g, t);
+}
+
+TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, uint8_t *face_turn,
+                                uint8_t *face_upright, int *out_upright, tt_error *error)
+{
+    int f, k, upright = 0;
     tt__ok(error);
     if (out_upright) *out_upright = 0;
     if (!mesh || !face_vectors || !face_turn)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_orient_tiles needs a mesh, face_vectors and face_turn (got NULL)");
-    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
     if (tt__require_quads(mesh, error) != TT_OK) return TT_ERROR_NOT_QUAD_MESH;
     for (f = 0; f < mesh->nfaces; f++)
         for (k = 0; k < 3; k++)
             if (!tt__is_finite(face_vectors[3 * (size_t)f + k]))
                 return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1, "face %d's vector is not finite", f);
-    if (face_upright) {
-        stack = TT__ALLOC(allocator, int, mesh->nfaces);
-        stacked = TT__ALLOC(allocator, uint8_t, mesh->nfaces);
-        if (!stack || !stacked) {
-            tt__free(allocator, stack);
-            tt__free(allocator, stacked);
-            return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
-                            "out of memory for the %d faces' orientation", mesh->nfaces);
-        }
-    }
     for (f = 0; f < mesh->nfaces; f++) {
         const float *t = face_vectors + 3 * (size_t)f;
         double p[4][3], best = -2.0;
@@ -9544,44 +9554,24 @@ TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, 
                 face_turn[f] = (uint8_t)turn;
             }
         }
-        if (face_upright) {
-            face_upright[f] = (uint8_t)(length_t > 0.0);
-            stack[top++] = f;
-            stacked[f] = 1;
-        }
     }
-    /* A face stops being upright while one of its left or right sides
-       meets a face that is not upright or sees the edge as bottom or top;
-       its upright neighbours are checked again. Faces only ever stop, so
-       the order does not matter: what stays is the largest set of faces
-       that satisfies the rule. */
-    while (top > 0) {
-        int c, demote = 0;
-        f = stack[--top];
-        stacked[f] = 0;
-        if (!face_upright[f]) continue;
-        for (c = 4 * f; c < 4 * f + 4 && !demote; c++) {
-            const int t = mesh->twin[c];
-            int g;
-            if (t < 0 || !tt__tile_side_is_vertical(mesh, face_turn, f, c)) continue;
-            g = mesh->corner_face[t];
-            demote = !face_upright[g] || !tt__tile_side_is_vertical(mesh, face_turn, g, t);
+    /* Each face's left and right sides, once every face is turned: the two
+       faces of an edge see it alike, so both make it plain or neither. */
+    for (f = 0; f < mesh->nfaces && face_upright; f++) {
+        const int right = 4 * f + ((face_turn[f] + 1) & 3), left = 4 * f + ((face_turn[f] + 3) & 3);
+        int plain_right, plain_left;
+        if (!tt__face_has_direction(face_vectors, f)) {
+            face_upright[f] = TT_TILESET_PLAIN;
+            continue;
         }
-        if (!demote) continue;
-        face_upright[f] = 0;
-        for (c = 4 * f; c < 4 * f + 4; c++) {
-            const int t = mesh->twin[c];
-            const int g = t >= 0 ? mesh->corner_face[t] : -1;
-            if (g >= 0 && face_upright[g] && !stacked[g]) {
-                stack[top++] = g;
-                stacked[g] = 1;
-            }
-        }
+        plain_right = tt__tile_side_is_plain(mesh, face_vectors, face_turn, f, right);
+        plain_left = tt__tile_side_is_plain(mesh, face_vectors, face_turn, f, left);
+        face_upright[f] = (uint8_t)(plain_right && plain_left ? TT_TILESET_PLAIN
+                                    : plain_right             ? TT_TILESET_RIGHT_PLAIN
+                                    : plain_left              ? TT_TILESET_LEFT_PLAIN
+                                                              : TT_TILESET_UPRIGHT);
+        upright += face_upright[f] == TT_TILESET_UPRIGHT;
     }
-    if (face_upright)
-        for (f = 0; f < mesh->nfaces; f++) upright += face_upright[f];
-    tt__free(allocator, stack);
-    tt__free(allocator, stacked);
     if (out_upright) *out_upright = upright;
     return TT_OK;
 }
@@ -31154,17 +31144,17 @@ static int tt__polycube_wall_across(const tt_polycube *polycube, int quad, int k
     return t < 0 || tt__polycube_wall(polycube, s->corner_face[t]);
 }
 
-TTDEF tt_polycube_tiles tt_polycube_quad_tileset(const tt_polycube *polycube, int quad)
+TTDEF tt_tileset_kind tt_polycube_quad_tileset(const tt_polycube *polycube, int quad)
 {
     int right, left;
     TT_ASSERT(polycube && polycube->surface && quad >= 0 && quad < polycube->surface->nfaces);
-    if (tt__polycube_wall(polycube, quad)) return TT_POLYCUBE_TILES_UPRIGHT;
+    if (tt__polycube_wall(polycube, quad)) return TT_TILESET_UPRIGHT;
     right = tt__polycube_wall_across(polycube, quad, 1);
     left = tt__polycube_wall_across(polycube, quad, 3);
-    if (right && left) return TT_POLYCUBE_TILES_PLAIN;
-    if (right) return TT_POLYCUBE_TILES_RIGHT_PLAIN;
-    if (left) return TT_POLYCUBE_TILES_LEFT_PLAIN;
-    return TT_POLYCUBE_TILES_UPRIGHT;
+    if (right && left) return TT_TILESET_PLAIN;
+    if (right) return TT_TILESET_RIGHT_PLAIN;
+    if (left) return TT_TILESET_LEFT_PLAIN;
+    return TT_TILESET_UPRIGHT;
 }
 
 /* Corner c (side k of its quad) and its twin t turned, when needed, so
@@ -31211,23 +31201,22 @@ TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t 
     return TT_OK;
 }
 
-/* Rows [begin, end) of tt_polycube_upright_atlas: a row of tile rows, each
-   from its set, two sets side by side. */
+/* Rows [begin, end) of tt_polycube_upright_atlas: each from the two sets
+   side by side in its half. */
 typedef struct tt__atlas_quarters {
-    const tt_image *part[TT_POLYCUBE_TILESETS];
-    int nsets;
+    const tt_image *part[TT_TILESET_KINDS];
     tt_image *out;
 } tt__atlas_quarters;
 
 static void tt__atlas_quarters_rows(void *context, int begin, int end)
 {
     const tt__atlas_quarters *h = (const tt__atlas_quarters *)context;
-    const int height = h->part[0]->height, blocks = h->nsets / 2;
+    const int height = h->part[0]->height;
     const size_t half = (size_t)h->part[0]->width * 4;
     int row;
     for (row = begin; row < end; row++) {
-        /* image rows count from the top: the last block of sets lies there */
-        const int block = blocks - 1 - row / height, in_part = row % height;
+        /* image rows count from the top: sets 2 and 3 lie there */
+        const int block = 1 - row / height, in_part = row % height;
         float *out = h->out->pixels + (size_t)row * 2 * half;
         memcpy(out, h->part[2 * block]->pixels + (size_t)in_part * half, half * sizeof(float));
         memcpy(out + half, h->part[2 * block + 1]->pixels + (size_t)in_part * half, half * sizeof(float));
@@ -31240,13 +31229,12 @@ static void tt__atlas_quarters_rows(void *context, int begin, int end)
    a plain set). */
 static int tt__upright_set_sides(int i)
 {
-    static const int sides[TT_POLYCUBE_TILESETS] = {-1, 0, 1 << 1, 1 << 3};
+    static const int sides[TT_TILESET_KINDS] = {-1, 0, 1 << 1, 1 << 3};
     return sides[i];
 }
 
-TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int nsets, int level,
-                                          const tt_executor *executor, const tt_allocator *allocator,
-                                          tt_image **out_image, tt_error *error)
+TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int level, const tt_executor *executor,
+                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error)
 {
     tt__atlas_quarters quarters;
     tt_result result;
@@ -31257,24 +31245,22 @@ TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int nse
     if (!sets || !out_image)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "tt_polycube_upright_atlas needs the tilesets and out_image (got NULL)");
-    if (nsets != 2 && nsets != TT_POLYCUBE_TILESETS)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "nsets is %d: 2 (plain, upright) or %d (tt_polycube_tiles' order)", nsets, TT_POLYCUBE_TILESETS);
-    for (i = 0; i < nsets; i++)
+    for (i = 0; i < TT_TILESET_KINDS; i++)
         if (!sets[i])
-            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1, "tileset %d of %d is NULL", i, nsets);
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1, "tileset %d of %d is NULL", i,
+                               TT_TILESET_KINDS);
     if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
     first = sets[0];
-    for (i = 0; i < nsets; i++) {
+    for (i = 0; i < TT_TILESET_KINDS; i++) {
         const tt_tileset *set = sets[i];
         const int want = tt__upright_set_sides(i);
-        static const char *const names[TT_POLYCUBE_TILESETS] = {
+        static const char *const names[TT_TILESET_KINDS] = {
             "plain", "upright (plain_sides 0)", "upright with its right side plain (plain_sides 1 << 1)",
             "upright with its left side plain (plain_sides 1 << 3)"};
         if ((want < 0) != !set->vertical_windows || (want >= 0 && set->plain_sides != want))
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
                                "tileset %d must be %s (tt_synth_options.upright, plain_sides), in the order of "
-                               "tt_polycube_tiles", i, names[i]);
+                               "tt_tileset_kind", i, names[i]);
         if (set->layout.colors != first->layout.colors || set->layout.tile_size != first->layout.tile_size ||
             set->layout.gutter != first->layout.gutter)
             return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
@@ -31299,7 +31285,7 @@ TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int nse
     }
     width = first->levels[level].width;
     height = first->levels[level].height;
-    for (i = 0; i < nsets; i++) {
+    for (i = 0; i < TT_TILESET_KINDS; i++) {
         const tt_image *part = &sets[i]->levels[level];
         if (!part->pixels || width < 1 || height < 1 || part->width != width || part->height != height)
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -31314,10 +31300,8 @@ TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int nse
         quarters.part[i] = part;
     }
     /* Every texel is copied in below. */
-    if ((result = tt__image_create(2 * width, height * (nsets / 2), 0, allocator, out_image, error)) != TT_OK)
-        return result;
+    if ((result = tt__image_create(2 * width, 2 * height, 0, allocator, out_image, error)) != TT_OK) return result;
     (*out_image)->kind = first->levels[level].kind;
-    quarters.nsets = nsets;
     quarters.out = *out_image;
     tt__parallel_ranges(executor, (*out_image)->height, tt__max_i(1, TT__ATLAS_BAND_TEXELS / (2 * width)),
                         tt__atlas_quarters_rows, &quarters);

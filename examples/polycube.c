@@ -206,9 +206,6 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
 /* The pipeline                                                             */
 /* ======================================================================== */
 
-/* The upright tile sets: TT_POLYCUBE_TILES_UPRIGHT and the two after it. */
-#define POLYCUBE_UPRIGHT_SETS (TT_POLYCUBE_TILESETS - TT_POLYCUBE_TILES_UPRIGHT)
-
 /* Everything the command makes, freed by polycube_job_free. */
 typedef struct polycube_job {
     triangle_mesh mesh;
@@ -222,13 +219,13 @@ typedef struct polycube_job {
     uint8_t *surface_group;         /* per S quad: its tile set (tt_polycube_quad_tileset), 0 with --no-upright */
     float *surface_uv;              /* per S corner: S's own texture coordinates */
     tt_tileset *tiles;              /* plain: tops with walls on both sides (all of S with --no-upright) */
-    /* Upright, TT_POLYCUBE_TILES_UPRIGHT + k: the walls and the tops among
+    /* Upright, TT_TILESET_UPRIGHT + k: the walls and the tops among
        tops, then the tops with a wall on the right or the left; NULL with
        --no-upright. */
-    tt_tileset *upright_tiles[POLYCUBE_UPRIGHT_SETS];
+    tt_tileset *upright_tiles[TILED_UPRIGHT_SETS];
     tt_image *atlas;                /* the compact atlas: the tiles S shows */
     /* The same for each map of the material (NULL for the maps not given). */
-    tt_tileset *map_tiles[MATERIAL_MAPS], *map_upright_tiles[POLYCUBE_UPRIGHT_SETS][MATERIAL_MAPS];
+    tt_tileset *map_tiles[MATERIAL_MAPS], *map_upright_tiles[TILED_UPRIGHT_SETS][MATERIAL_MAPS];
     tt_image *map_atlas[MATERIAL_MAPS];
     int upright;                    /* upright tiles (IMAGE was large enough) */
     tt_compact_atlas *compact;      /* the cells S shows, and where they went */
@@ -242,9 +239,8 @@ typedef struct polycube_job {
 /* Every tile set and its maps' (the atlases hold what the outputs use). */
 static void polycube_tilesets_free(polycube_job *job)
 {
-    int k;
     tiled_tilesets_free(&job->tiles, job->map_tiles);
-    for (k = 0; k < POLYCUBE_UPRIGHT_SETS; k++) tiled_tilesets_free(&job->upright_tiles[k], job->map_upright_tiles[k]);
+    tiled_upright_free(job->upright_tiles, job->map_upright_tiles);
 }
 
 static void polycube_job_free(polycube_job *job)
@@ -413,14 +409,13 @@ static int tile_polycube(const polycube_command_options *options, polycube_job *
 }
 
 /* The upright tiles, on the plain tiles' edge windows: the atlas of every
-   tile is the four sets, 2 x 2 in the order of tt_polycube_tiles, as
+   tile is the four sets, 2 x 2 in the order of tt_tileset_kind, as
    tt_polycube_mapping_uvs_upright reads it; S's own texture coordinates
    move into their quarters. An image too narrow for upright tiles (they
    need 2S x 2S) keeps the plain ones, with a note. */
 static int synthesize_upright(const polycube_command_options *options, const tt_image *image, polycube_job *job)
 {
-    static const int plain_sides[POLYCUBE_UPRIGHT_SETS] = {0, 1 << 1, 1 << 3};
-    int c, k, status;
+    int c, status;
     if (image->width < 2 * job->layout.tile_size || image->height < 2 * job->layout.tile_size) {
         tool_note("%s: %dx%d is too small for upright %d-texel tiles (they need %dx%d): the tiles are plain, "
                   "turned a quarter on their left and right sides (use a smaller --tile)",
@@ -428,14 +423,9 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
                   2 * job->layout.tile_size, 2 * job->layout.tile_size);
         return 0;
     }
-    for (k = 0; k < POLYCUBE_UPRIGHT_SETS; k++) {
-        tiled_options upright = options->tiles;
-        upright.upright_over = job->tiles->edge_windows;
-        upright.plain_sides = plain_sides[k];
-        if ((status = tiled_synthesize(image, options->image_path, &upright, &options->tiles.maps,
-                                       &job->upright_tiles[k], job->map_upright_tiles[k])) != 0)
-            return status;
-    }
+    if ((status = tiled_synthesize_upright(image, options->image_path, &options->tiles, job->tiles,
+                                           job->upright_tiles, job->map_upright_tiles)) != 0)
+        return status;
     job->upright = 1;
     for (c = 0; c < job->polycube->surface->ncorners; c++) {
         const int set = (int)tt_polycube_quad_tileset(job->polycube, job->polycube->surface->corner_face[c]);
@@ -447,13 +437,13 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
 
 /* The atlas of one map (-1: the colour) in parts: level 0 of each set, or
    of the plain set alone. Returns the parts each way (2, or 1). */
-static int atlas_parts(const polycube_job *job, int map, const tt_image *parts[TT_POLYCUBE_TILESETS])
+static int atlas_parts(const polycube_job *job, int map, const tt_image *parts[TT_TILESET_KINDS])
 {
     int k;
-    parts[TT_POLYCUBE_TILES_PLAIN] = map < 0 ? &job->tiles->levels[0] : &job->map_tiles[map]->levels[0];
+    parts[TT_TILESET_PLAIN] = map < 0 ? &job->tiles->levels[0] : &job->map_tiles[map]->levels[0];
     if (!job->upright) return 1;
-    for (k = 0; k < POLYCUBE_UPRIGHT_SETS; k++)
-        parts[TT_POLYCUBE_TILES_UPRIGHT + k] =
+    for (k = 0; k < TILED_UPRIGHT_SETS; k++)
+        parts[TT_TILESET_UPRIGHT + k] =
             map < 0 ? &job->upright_tiles[k]->levels[0] : &job->map_upright_tiles[k][map]->levels[0];
     return 2;
 }
@@ -464,7 +454,7 @@ static int atlas_parts(const polycube_job *job, int map, const tt_image *parts[T
 static int compact_atlas(const polycube_command_options *options, polycube_job *job)
 {
     const tt_mesh *surface = job->polycube->surface;
-    const tt_image *parts[TT_POLYCUBE_TILESETS];
+    const tt_image *parts[TT_TILESET_KINDS];
     tt_error error;
     int c, map, each_way = atlas_parts(job, -1, parts);
     tool_stage("packing the tiles S shows");

@@ -5,8 +5,8 @@
    with the seam score measured on the result. Open the OBJ in Blender, or
    look at it with `tiledtex render OUT_PREFIX.obj OUT_PREFIX.png view.png`.
    With --up or --constraints the quads' tiles turn along the direction
-   field (tiled_map_mesh), and the atlas is a plain and an upright tile set
-   side by side (tt_polycube_upright_atlas), as the polycube's.
+   field (tiled_map_mesh), and the atlas holds four tile sets, plain and
+   upright (tt_polycube_upright_atlas), as the polycube's.
 */
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,9 +42,9 @@ static void print_help(void)
            "  --up AXIS              turn each quad's tile so that its up follows AXIS (x, y, z, -x,\n"
            "                         -y, -z or X,Y,Z) along the surface, and give the quads upright\n"
            "                         tiles, which keep IMAGE's up on all four sides (bricks, planks\n"
-           "                         and grain run level): the atlas is twice as wide, plain tiles\n"
-           "                         on the left for the quads where the field turns past a quad's\n"
-           "                         diagonal, upright ones on the right\n"
+           "                         and grain run level); a left or right side is plain where the\n"
+           "                         field turns past a quad's diagonal: the atlas holds four sets,\n"
+           "                         twice as wide and tall\n"
            "  --constraints FILE     the same, up given by lines FACE X Y Z [SIGMA [WEIGHT]] (FACE\n"
            "                         counts the OBJ's faces from 1), as 'tiledtex lapped' takes them\n"
            "  --no-courses           with --up, take IMAGE as it is: by default a photo laid in\n"
@@ -70,41 +70,34 @@ static void print_help(void)
            TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
 }
 
-/* The upright tiles, on the plain tiles' edge windows, for the quads
-   tiled_map_mesh gave upright tiles, and for each map. */
-static int synthesize_upright(const tt_image *image, const char *image_path, const tiled_options *options,
-                              const tt_tileset *tiles, tt_tileset **upright, tt_tileset **map_upright)
+/* Level `level` of the four sets' atlas (tt_tileset_kind's quarters);
+   prints the error. */
+static int upright_atlas(const tt_tileset *plain, tt_tileset *const upright[TILED_UPRIGHT_SETS], int level,
+                         tt_image **out)
 {
-    tiled_options over = *options;
-    over.upright_over = tiles->edge_windows;
-    return tiled_synthesize(image, image_path, &over, &options->maps, upright, map_upright);
-}
-
-/* Level `level` of the plain | upright atlas; prints the error. */
-static int upright_atlas(const tt_tileset *plain, const tt_tileset *upright, int level, tt_image **out)
-{
-    const tt_tileset *sets[2];
+    const tt_tileset *sets[TT_TILESET_KINDS];
     tt_error error;
-    sets[0] = plain;
-    sets[1] = upright;
-    if (tt_polycube_upright_atlas(sets, 2, level, tool_executor(), NULL, out, &error) != TT_OK)
-        return tool_fail("the %dx%d atlas: %s", 2 * plain->levels[level].width, plain->levels[level].height,
+    tiled_tileset_kinds(plain, upright, sets);
+    if (tt_polycube_upright_atlas(sets, level, tool_executor(), NULL, out, &error) != TT_OK)
+        return tool_fail("the %dx%d atlas: %s", 2 * plain->levels[level].width, 2 * plain->levels[level].height,
                          error.message);
     return 0;
 }
 
-/* tiled_add_atlas for the plain | upright atlas: level 0 is made already,
-   the mip levels (--mips) side by side as level 0's. */
+/* tiled_add_atlas for the four sets' atlas: level 0 is made already, the
+   mip levels (--mips) laid out as level 0's. */
 static int add_upright_atlas(tool_output *output, const char *png_path, const tt_image *atlas,
-                             const tt_tileset *plain, const tt_tileset *upright, int mips, tt_color_space space)
+                             const tt_tileset *plain, tt_tileset *const upright[TILED_UPRIGHT_SETS], int mips,
+                             tt_color_space space)
 {
     char message[TOOL_ERROR_SIZE], path[4096];
     size_t stem = strlen(png_path);
-    int level, status = 0;
+    int level, k, levels = plain->nlevels, status = 0;
+    for (k = 0; k < TILED_UPRIGHT_SETS; k++) levels = upright[k]->nlevels < levels ? upright[k]->nlevels : levels;
     if (output_add_png(output, png_path, atlas, space, message, sizeof message) != 0)
         return tool_fail("%s", message);
     if (stem > 4 && strcmp(png_path + stem - 4, ".png") == 0) stem -= 4;
-    for (level = 1; mips && status == 0 && level < plain->nlevels && level < upright->nlevels; level++) {
+    for (level = 1; mips && status == 0 && level < levels; level++) {
         tt_image *image = NULL;
         snprintf(path, sizeof path, "%.*s_mip%d.png", (int)stem, png_path, level);
         if ((status = upright_atlas(plain, upright, level, &image)) == 0 &&
@@ -122,7 +115,8 @@ int cmd_tile(int argc, char **argv)
     tiled_options options;
     tiled_mesh mesh;
     tt_image *image = NULL;
-    tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS], *upright = NULL, *map_upright[MATERIAL_MAPS];
+    tt_tileset *tiles = NULL, *map_tiles[MATERIAL_MAPS], *upright[TILED_UPRIGHT_SETS],
+        *map_upright[TILED_UPRIGHT_SETS][MATERIAL_MAPS];
     tt_image *atlas = NULL, *map_atlas[MATERIAL_MAPS];
     tool_seams seams, corners;
     tool_level level;
@@ -136,6 +130,7 @@ int cmd_tile(int argc, char **argv)
     memset(&output, 0, sizeof output);
     memset(&mesh, 0, sizeof mesh);
     memset(map_tiles, 0, sizeof map_tiles);
+    memset(upright, 0, sizeof upright);
     memset(map_upright, 0, sizeof map_upright);
     memset(map_atlas, 0, sizeof map_atlas);
     status = tiled_parse_command_line(argc, argv,
@@ -170,7 +165,8 @@ int cmd_tile(int argc, char **argv)
     status = tiled_check_atlas_size(&options);
     if (status == 0 && options.field.given) {
         /* Upright tiles cut their left and right bands from 2S x S windows
-           beside the plain ones' S x 2S; the atlas of both is twice as wide. */
+           beside the plain ones' S x 2S; the atlas of the four sets is twice
+           as wide and twice as tall. */
         const int S = options.layout.tile_size ? options.layout.tile_size : TT_DEFAULT_TILE_SIZE;
         int side = 0;
         tt_tile_layout layout;
@@ -184,7 +180,7 @@ int cmd_tile(int argc, char **argv)
                       positional[1], image->width, image->height, S, 2 * S, 2 * S);
         else if (2 * side > TOOL_MAX_ATLAS)
             status = tool_fail("--up makes a %dx%d atlas of plain and upright tiles; the tool writes at most %d "
-                               "texels a side (use fewer --colors or a smaller --tile)", 2 * side, side,
+                               "texels a side (use fewer --colors or a smaller --tile)", 2 * side, 2 * side,
                                TOOL_MAX_ATLAS);
     }
     if (status == 0 && options.upright) {
@@ -199,10 +195,15 @@ int cmd_tile(int argc, char **argv)
     if (status == 0 && !gltf) status = material_refuse_overwrite(&options.maps, prefix);
     if (status == 0) status = tiled_synthesize(image, positional[1], &options, &options.maps, &tiles, map_tiles);
     if (status == 0 && mesh.face_upright) {
-        status = synthesize_upright(image, positional[1], &options, tiles, &upright, map_upright);
+        status = tiled_synthesize_upright(image, positional[1], &options, tiles, upright, map_upright);
         if (status == 0) status = upright_atlas(tiles, upright, 0, &atlas);
         for (map = 0; map < MATERIAL_MAPS && status == 0; map++)
-            if (map_tiles[map]) status = upright_atlas(map_tiles[map], map_upright[map], 0, &map_atlas[map]);
+            if (map_tiles[map]) {
+                tt_tileset *map_sets[TILED_UPRIGHT_SETS];
+                int k;
+                for (k = 0; k < TILED_UPRIGHT_SETS; k++) map_sets[k] = map_upright[k][map];
+                status = upright_atlas(map_tiles[map], map_sets, 0, &map_atlas[map]);
+            }
     }
     /* The photo and the maps are not needed past the synthesis: free them
        before the PNGs are encoded (they are the largest things the command
@@ -232,10 +233,13 @@ int cmd_tile(int argc, char **argv)
         status = atlas ? add_upright_atlas(&output, png_path, atlas, tiles, upright, options.mips, TT_COLOR_SRGB)
                        : tiled_add_atlas(&output, png_path, tiles, options.mips, TT_COLOR_SRGB);
     for (map = 0; map < MATERIAL_MAPS && status == 0 && !gltf; map++)
-        if (map_atlas[map])
-            status = add_upright_atlas(&output, map_paths[map], map_atlas[map], map_tiles[map], map_upright[map],
+        if (map_atlas[map]) {
+            tt_tileset *map_sets[TILED_UPRIGHT_SETS];
+            int k;
+            for (k = 0; k < TILED_UPRIGHT_SETS; k++) map_sets[k] = map_upright[k][map];
+            status = add_upright_atlas(&output, map_paths[map], map_atlas[map], map_tiles[map], map_sets,
                                        options.mips, material_space(map));
-        else if (map_tiles[map])
+        } else if (map_tiles[map])
             status = tiled_add_atlas(&output, map_paths[map], map_tiles[map], options.mips, material_space(map));
     if (status == 0 && !gltf) status = tiled_add_mtl(&output, mtl_path, tool_basename(png_path), map_names);
     if (status == 0 && !gltf)
@@ -246,10 +250,15 @@ int cmd_tile(int argc, char **argv)
         tiled_print_notes(positional[0], &mesh);
         if (!tool_quiet()) {
             tiled_print_summary(positional[0], &mesh, &seams, &corners, options.report);
-            if (mesh.face_turn)
-                printf("up: %d quads' tiles turned along the field, %d upright and %d plain (where the field turns "
-                       "past a quad's diagonal, or next to such a quad along a course)\n", mesh.mesh->nfaces,
-                       mesh.upright_faces, mesh.mesh->nfaces - mesh.upright_faces);
+            if (mesh.face_turn) {
+                /* Kinds 2 and 3 have one plain side, 0 two (or no direction). */
+                int f, one_side = 0;
+                for (f = 0; mesh.face_upright && f < mesh.mesh->nfaces; f++)
+                    one_side += mesh.face_upright[f] >= TT_TILESET_RIGHT_PLAIN;
+                printf("up: %d quads' tiles turned along the field, %d upright, %d with one side plain and %d plain "
+                       "(a side is plain where the field turns past a quad's diagonal)\n", mesh.mesh->nfaces,
+                       mesh.upright_faces, one_side, mesh.mesh->nfaces - mesh.upright_faces - one_side);
+            }
             /* Each quad's tile turns by quarter turns only: on a mesh whose quads do not follow the field
                the courses tilt up to 45 degrees, which this line shows. */
             if (options.field.given && tool_measure_level(positional[0], mesh.mesh, mesh.corner_uv,
@@ -272,7 +281,7 @@ int cmd_tile(int argc, char **argv)
     output_free(&output);
     tiled_mesh_free(&mesh);
     tiled_tilesets_free(&tiles, map_tiles);
-    tiled_tilesets_free(&upright, map_upright);
+    tiled_upright_free(upright, map_upright);
     tt_image_free(atlas);
     for (map = 0; map < MATERIAL_MAPS; map++) tt_image_free(map_atlas[map]);
     material_free(&options.maps);

@@ -167,8 +167,8 @@ static int orient_tiles(const char *obj_path, const tiled_options *options, cons
     faces.source_line = lines;
     status = tool_make_face_field(obj_path, &faces, &options->field, 0.0f, vectors);
     free(first);
-    if (status == 0 && (tt_orient_tiles(out->mesh, vectors, NULL, out->face_turn, out->face_upright,
-                                        &out->upright_faces, &error) != TT_OK ||
+    if (status == 0 && (tt_orient_tiles(out->mesh, vectors, out->face_turn, out->face_upright, &out->upright_faces,
+                                        &error) != TT_OK ||
                         tt_assign_uvs_oriented(out->mesh, &out->layout, out->corner_type, out->face_turn,
                                                out->face_upright, out->corner_uv, &error) != TT_OK))
         status = tool_fail("%s: %s", obj_path, error.message);
@@ -347,7 +347,7 @@ static void print_quality(const tiled_mesh *mesh)
     }
     if (mesh->face_turn) {
         /* Turned tiles: each quad's types from its tile's bottom side on,
-           and the UVs of an atlas twice as wide measured in its texels. */
+           and the UVs of the four sets' atlas measured in a set's texels. */
         types = (uint8_t *)malloc((size_t)mesh->mesh->ncorners);
         uv = (float *)malloc((size_t)mesh->mesh->ncorners * 2 * sizeof(float));
         if (!types || !uv) {
@@ -362,7 +362,7 @@ static void print_quality(const tiled_mesh *mesh)
             for (t = 0; t < 4; t++) types[4 * f + t] = mesh->corner_type[4 * f + ((t + mesh->face_turn[f]) & 3)];
         for (t = 0; t < mesh->mesh->ncorners; t++) {
             uv[2 * t] = mesh->face_upright ? 2.0f * mesh->corner_uv[2 * t] : mesh->corner_uv[2 * t];
-            uv[2 * t + 1] = mesh->corner_uv[2 * t + 1];
+            uv[2 * t + 1] = mesh->face_upright ? 2.0f * mesh->corner_uv[2 * t + 1] : mesh->corner_uv[2 * t + 1];
         }
     }
     if (tt_tile_histogram(mesh->mesh, &mesh->layout, types ? types : mesh->corner_type, counts, &error) != TT_OK ||
@@ -631,6 +631,37 @@ void tiled_tilesets_free(tt_tileset **tiles, tt_tileset **map_tiles)
         tt_tileset_free(map_tiles[map]);
         map_tiles[map] = NULL;
     }
+}
+
+int tiled_synthesize_upright(const tt_image *image, const char *image_path, const tiled_options *options,
+                             const tt_tileset *plain, tt_tileset *upright[TILED_UPRIGHT_SETS],
+                             tt_tileset *map_upright[TILED_UPRIGHT_SETS][MATERIAL_MAPS])
+{
+    static const int plain_sides[TILED_UPRIGHT_SETS] = {0, 1 << 1, 1 << 3};
+    int k, status;
+    for (k = 0; k < TILED_UPRIGHT_SETS; k++) {
+        tiled_options over = *options;
+        over.upright_over = plain->edge_windows;
+        over.plain_sides = plain_sides[k];
+        if ((status = tiled_synthesize(image, image_path, &over, &options->maps, &upright[k], map_upright[k])) != 0)
+            return status;
+    }
+    return 0;
+}
+
+void tiled_upright_free(tt_tileset *upright[TILED_UPRIGHT_SETS],
+                        tt_tileset *map_upright[TILED_UPRIGHT_SETS][MATERIAL_MAPS])
+{
+    int k;
+    for (k = 0; k < TILED_UPRIGHT_SETS; k++) tiled_tilesets_free(&upright[k], map_upright[k]);
+}
+
+void tiled_tileset_kinds(const tt_tileset *plain, tt_tileset *const upright[TILED_UPRIGHT_SETS],
+                         const tt_tileset *sets[TT_TILESET_KINDS])
+{
+    int k;
+    sets[TT_TILESET_PLAIN] = plain;
+    for (k = 0; k < TILED_UPRIGHT_SETS; k++) sets[TT_TILESET_UPRIGHT + k] = upright[k];
 }
 
 int tiled_add_atlas(tool_output *output, const char *png_path, const tt_tileset *tiles, int mips,

@@ -96,8 +96,8 @@ typedef struct tiled_mesh {
     int repaired_edges;          /* edges --permissive cut open */
     /* With --up or --constraints (else NULL and 0): */
     uint8_t *face_turn;          /* per quad: the half-edge its tile's bottom side lies on (tt_orient_tiles) */
-    uint8_t *face_upright;       /* per quad: 1 for an upright tile (the atlas's right half); NULL without */
-    int upright_faces;           /* quads with upright tiles */
+    uint8_t *face_upright;       /* per quad: its tile set (tt_tileset_kind), the atlas's quarter; NULL without */
+    int upright_faces;           /* quads with upright tiles on all four sides */
 } tiled_mesh;
 
 /* Read an OBJ, build and validate it, quadrangulate when it is not all quads
@@ -141,6 +141,24 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
                      const material_maps *maps, tt_tileset **out, tt_tileset **map_tiles);
 /* Free what tiled_synthesize made (map_tiles may be NULL) and set it NULL. */
 void tiled_tilesets_free(tt_tileset **tiles, tt_tileset **map_tiles);
+
+/* The upright tile sets, TT_TILESET_UPRIGHT and the two after it. */
+#define TILED_UPRIGHT_SETS (TT_TILESET_KINDS - TT_TILESET_UPRIGHT)
+/* The upright sets on the plain tiles' edge windows, upright[k] of
+   tt_tileset_kind TT_TILESET_UPRIGHT + k (tt_synth_options::plain_sides 0,
+   then the right side, then the left side plain), each with its maps'
+   (map_upright[k], as tiled_synthesize's map_tiles). Prints the error and
+   returns an exit status on failure (what was made stays, for
+   tiled_upright_free). */
+int tiled_synthesize_upright(const tt_image *image, const char *image_path, const tiled_options *options,
+                             const tt_tileset *plain, tt_tileset *upright[TILED_UPRIGHT_SETS],
+                             tt_tileset *map_upright[TILED_UPRIGHT_SETS][MATERIAL_MAPS]);
+/* Free what tiled_synthesize_upright made. */
+void tiled_upright_free(tt_tileset *upright[TILED_UPRIGHT_SETS],
+                        tt_tileset *map_upright[TILED_UPRIGHT_SETS][MATERIAL_MAPS]);
+/* sets[k] = the set of tt_tileset_kind k: plain, then upright[0..2]. */
+void tiled_tileset_kinds(const tt_tileset *plain, tt_tileset *const upright[TILED_UPRIGHT_SETS],
+                         const tt_tileset *sets[TT_TILESET_KINDS]);
 /* Add the atlas (and with --mips its levels as PREFIX_mipL.png) to the
    batch, encoded into `space` (TT_COLOR_SRGB for colour, material_space's
    for a map). */

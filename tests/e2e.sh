@@ -1303,20 +1303,21 @@ expect_error "hpm --constraints face out of range" hpm ../in/torus.obj ../in/lap
     --constraints ../in/constraints_range.txt
 err_mentions "hpm constraint out of range: FILE:LINE" 'constraints_range\.txt:2:'
 
-# tile --up: each quad's tile turned along the field, upright tiles where every
-# left and right side meets an upright left or right side, in an atlas twice as
-# wide (plain | upright). The torus's axis is y: with --up y its grid runs along
-# the field and every quad is upright; the double torus's vertices of valence 3,
-# 5 and 6 turn the field past quads' diagonals: some plain.
+# tile --up: each quad's tile turned along the field, upright, with a left or
+# right side plain where it meets a quad that sees the edge as its bottom or
+# top, in an atlas of four sets twice as wide and twice as tall. The torus's axis
+# is y: with --up y its grid runs along the field and every quad is upright; the
+# double torus's vertices of valence 3, 5 and 6 turn the field past quads'
+# diagonals: there sides are plain, and most quads keep upright tiles.
 newdir
 expect_ok "tile (no --up) for --up" tile ../in/torus.obj ../in/lap256.png flat --colors 2 --tile 32
 TILE_FLAT_OUT=$OUT
 expect_ok "tile --up y" tile ../in/torus.obj ../in/lap256.png out --colors 2 --tile 32 --up y
-check "tile --up y: every quad of the torus upright" "'up: 512 quads' tiles turned ..., 512 upright and 0 plain'" \
-    "$OUT" "$(printf '%s\n' "$OUT" | grep -q "^up: 512 quads' tiles turned along the field, 512 upright and 0 plain"; echo $?)"
-check "tile --up y: the atlas twice as wide" "$(($(png_size flat.png | cut -d' ' -f1) * 2)) $(png_size flat.png | cut -d' ' -f2)" \
+check "tile --up y: every quad of the torus upright" "'up: 512 quads' tiles turned ..., 512 upright, 0 with one side plain and 0 plain'" \
+    "$OUT" "$(printf '%s\n' "$OUT" | grep -q "^up: 512 quads' tiles turned along the field, 512 upright, 0 with one side plain and 0 plain"; echo $?)"
+check "tile --up y: the atlas twice as wide and twice as tall" "$(($(png_size flat.png | cut -d' ' -f1) * 2)) $(($(png_size flat.png | cut -d' ' -f2) * 2))" \
     "$(png_size out.png)" \
-    "$([ "$(png_size out.png)" = "$(($(png_size flat.png | cut -d' ' -f1) * 2)) $(png_size flat.png | cut -d' ' -f2)" ]; echo $?)"
+    "$([ "$(png_size out.png)" = "$(($(png_size flat.png | cut -d' ' -f1) * 2)) $(($(png_size flat.png | cut -d' ' -f2) * 2))" ]; echo $?)"
 check "tile --up y: other coordinates than without" "files differ" "identical" \
     "$(! cmp -s out.obj flat.obj; echo $?)"
 check "tile without --up: no up line" "no 'up:' in the summary" "$TILE_FLAT_OUT" \
@@ -1325,9 +1326,10 @@ SEAM_UP=$(printf '%s\n' "$OUT" | sed -nE 's/.*seam score (-?[0-9.]+) .*/\1/p')
 check "tile --up y: seams still match (score below 0.1)" "below 0.1" "${SEAM_UP:-none}: $OUT" \
     "$(awk -v s="${SEAM_UP:-9}" 'BEGIN { exit !(s < 0.1) }'; echo $?)"
 expect_ok "tile --up z on the double torus" tile ../in/double-torus.obj ../in/lap256.png dt --colors 2 --tile 32 --up z
-UPRIGHT=$(printf '%s\n' "$OUT" | sed -nE "s/^up: [0-9]+ quads' tiles turned along the field, ([0-9]+) upright and ([0-9]+) plain.*/\1 \2/p")
-check "tile --up z on the double torus: some quads upright, some plain" "both above 0" "${UPRIGHT:-no up line}" \
-    "$(read -r u p <<<"$UPRIGHT"; [ "${u:-0}" -gt 0 ] && [ "${p:-0}" -gt 0 ]; echo $?)"
+UPRIGHT=$(printf '%s\n' "$OUT" | sed -nE "s/^up: [0-9]+ quads' tiles turned along the field, ([0-9]+) upright, ([0-9]+) with one side plain and ([0-9]+) plain.*/\1 \2 \3/p")
+check "tile --up z on the double torus: quads upright, some with a side plain, fewer plain" \
+    "upright and one-side-plain above 0, their sum above the plain" "${UPRIGHT:-no up line}" \
+    "$(read -r u o p <<<"$UPRIGHT"; [ "${u:-0}" -gt 0 ] && [ "${o:-0}" -gt 0 ] && [ $((${u:-0} + ${o:-0})) -gt "${p:-0}" ]; echo $?)"
 expect_ok "tile --up z --format glb" tile ../in/torus.obj ../in/lap256.png g.glb --colors 2 --tile 32 --up z
 expect_ok "tile --up z --mips" tile ../in/torus.obj ../in/lap256.png m --tile 32 --up z --mips
 check "tile --up z --mips: mip levels twice as wide" "$(($(png_size m.png | cut -d' ' -f1) / 2)) ..." \
@@ -1392,7 +1394,7 @@ err_mentions "polycube, squares smaller than a course: the photo is not shrunk" 
     'courses every 40\.0 texels(: resampled by 1(\.00[0-9]*)? so that a|, 1 to a) 40-texel tile'
 expect_error "tile --up 0,0,0" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up 0,0,0
 expect_error "tile --up without a value" tile ../in/torus.obj ../in/lap256.png out --tile 32 --up
-expect_error "tile --up with an atlas too wide for two sets" tile ../in/torus.obj ../in/lap256.png out --colors 4 \
+expect_error "tile --up with an atlas too wide for four sets" tile ../in/torus.obj ../in/lap256.png out --colors 4 \
     --tile 72 --gutter 0 --up z
 err_mentions "tile --up atlas too wide: says why" 'plain and upright'
 expect_error "hpm --constraints missing file" hpm ../in/torus.obj ../in/lap.png out --constraints ../in/nope.txt

@@ -1716,26 +1716,38 @@ static void test_seams_ends(void)
 
 /* ---- Tiles turned along a field (tt_orient_tiles, tt_assign_uvs_oriented) ---- */
 
-/* Whether upright face f's left and right sides all meet upright faces that
-   see them as left or right: the rule every upright face must keep. */
-static int upright_rule_holds(const tt_mesh *mesh, const uint8_t *turn, const uint8_t *upright, int f)
+/* Whether face f (of tt_tileset_kind kind[f]) shows an upright band on
+   half-edge c's side: a left or right side its kind keeps upright. */
+static int side_is_upright(const uint8_t *turn, const uint8_t *kind, int f, int c)
 {
-    int c;
-    for (c = 4 * f; c < 4 * f + 4; c++) {
-        const int t = mesh->twin[c], g = t >= 0 ? mesh->corner_face[t] : -1;
-        if (t < 0 || !((c - 4 * f - turn[f]) & 1)) continue;
-        if (!upright[g] || !((t - 4 * g - turn[g]) & 1)) return 0;
+    const int side = (c - 4 * f - turn[f]) & 3;
+    if (side == 1) return kind[f] == TT_TILESET_UPRIGHT || kind[f] == TT_TILESET_LEFT_PLAIN;
+    if (side == 3) return kind[f] == TT_TILESET_UPRIGHT || kind[f] == TT_TILESET_RIGHT_PLAIN;
+    return 0;
+}
+
+/* Edges whose two faces show different bands (one upright, one plain or a
+   bottom or top side): each must be 0 for every edge to match. */
+static int mismatched_edges(const tt_mesh *mesh, const uint8_t *turn, const uint8_t *kind)
+{
+    int c, bad = 0;
+    for (c = 0; c < mesh->ncorners; c++) {
+        const int t = mesh->twin[c];
+        if (t > c && side_is_upright(turn, kind, mesh->corner_face[c], c) !=
+                         side_is_upright(turn, kind, mesh->corner_face[t], t))
+            bad++;
     }
-    return 1;
+    return bad;
 }
 
 /* On a plane grid whose quads start at random corners, a field along +y
    turns every tile upright: its bottom side (half-edge turn) runs along +x.
    Turn 0 (tt_assign_uvs) does so only where the corners happen to start
-   there: the control. One quad whose field runs along +x makes its row
-   plain (its left and right sides meet the bottom and top sides of the
-   rows beside, and the plain quads' neighbours along the row follow), and
-   no other quad. */
+   there: the control. One quad whose field runs along +x is plain (its
+   left and right sides meet the bottom and top sides of the rows beside),
+   its neighbours along its row keep upright tiles with the side that meets
+   it plain, and every other quad stays upright; every edge's two faces
+   show the same band. */
 static void test_orient_tiles(void)
 {
     const int nx = 7, ny = 5;
@@ -1744,7 +1756,7 @@ static void test_orient_tiles(void)
     tt_error err;
     float vectors[3 * 35];
     uint8_t turn[35], upright[35];
-    int f, k, along = 0, along_unturned = 0, count = -1, rule = 1, row_plain = 1, others_upright = 1;
+    int f, k, along = 0, along_unturned = 0, count = -1, as_expected = 1;
     memset(&m, 0, sizeof m);
     make_grid(&m, nx, ny);
     lcg_seed(77);
@@ -1758,7 +1770,7 @@ static void test_orient_tiles(void)
     for (f = 0; f < mesh->nfaces; f++) {
         vectors[3 * f] = 0.0f; vectors[3 * f + 1] = 2.0f; vectors[3 * f + 2] = 0.0f;
     }
-    CHECK(tt_orient_tiles(mesh, vectors, NULL, turn, upright, &count, &err) == TT_OK, "orient: %s", err.message);
+    CHECK(tt_orient_tiles(mesh, vectors, turn, upright, &count, &err) == TT_OK, "orient: %s", err.message);
     for (f = 0; f < mesh->nfaces; f++) {
         const float *a = mesh->pos + 3 * mesh->corner_vert[4 * f + turn[f]];
         const float *b = mesh->pos + 3 * mesh->corner_vert[4 * f + ((turn[f] + 1) & 3)];
@@ -1774,29 +1786,28 @@ static void test_orient_tiles(void)
     /* Quad (3, 2) turned a quarter by its field. */
     vectors[3 * (2 * nx + 3)] = 1.0f;
     vectors[3 * (2 * nx + 3) + 1] = 0.0f;
-    CHECK(tt_orient_tiles(mesh, vectors, NULL, turn, upright, &count, &err) == TT_OK, "orient: %s", err.message);
+    CHECK(tt_orient_tiles(mesh, vectors, turn, upright, &count, &err) == TT_OK, "orient: %s", err.message);
     for (f = 0; f < mesh->nfaces; f++) {
-        if (upright[f]) rule &= upright_rule_holds(mesh, turn, upright, f);
-        if (f / nx == 2) row_plain &= !upright[f];
-        else others_upright &= upright[f];
+        const int want = f == 2 * nx + 3   ? TT_TILESET_PLAIN
+                         : f == 2 * nx + 2 ? TT_TILESET_RIGHT_PLAIN
+                         : f == 2 * nx + 4 ? TT_TILESET_LEFT_PLAIN
+                                           : TT_TILESET_UPRIGHT;
+        as_expected &= upright[f] == want;
     }
-    CHECK(rule, "every upright quad's left and right sides meet upright left and right sides");
-    CHECK(row_plain && others_upright && count == nx * (ny - 1),
-          "one quad across the field makes its row plain and nothing else: %d upright (want %d)", count,
-          nx * (ny - 1));
+    CHECK(mismatched_edges(mesh, turn, upright) == 0, "every edge's two faces show the same band: %d do not",
+          mismatched_edges(mesh, turn, upright));
+    CHECK(as_expected && count == nx * ny - 3,
+          "one quad across the field is plain, its neighbours along the row have that side plain, the rest "
+          "upright: %d upright (want %d)", count, nx * ny - 3);
+    /* The control: upright everywhere leaves the quad's four edges mismatched. */
+    memset(upright, TT_TILESET_UPRIGHT, sizeof upright);
+    CHECK(mismatched_edges(mesh, turn, upright) == 4, "control: upright everywhere, %d edges mismatched (want 4)",
+          mismatched_edges(mesh, turn, upright));
     /* Without face_upright only the turns are made. */
-    CHECK(tt_orient_tiles(mesh, vectors, NULL, turn, NULL, &count, &err) == TT_OK && count == 0,
+    CHECK(tt_orient_tiles(mesh, vectors, turn, NULL, &count, &err) == TT_OK && count == 0,
           "no face_upright: count 0, got %d", count);
     tt_mesh_free(mesh);
     tm_free(&m);
-}
-
-/* sets[] = {plain, upright}, for tt_polycube_upright_atlas. */
-static const tt_tileset *const *pair_of(const tt_tileset *plain, const tt_tileset *upright, const tt_tileset *sets[2])
-{
-    sets[0] = plain;
-    sets[1] = upright;
-    return sets;
 }
 
 /* tt_assign_uvs_oriented: without turns and flags tt_assign_uvs's UVs to the
@@ -1823,7 +1834,7 @@ static void test_assign_uvs_oriented(void)
           "no turns, no flags: tt_assign_uvs's UVs to the bit");
     for (f = 0; f < 12; f++) {
         turn[f] = (uint8_t)(f % 4);
-        upright[f] = (uint8_t)(f % 3 == 0);
+        upright[f] = (uint8_t)(f % TT_TILESET_KINDS);
     }
     CHECK(tt_assign_uvs_oriented(mesh, &layout, types, turn, upright, uv, &err) == TT_OK, "oriented: %s",
           err.message);
@@ -1834,12 +1845,16 @@ static void test_assign_uvs_oriented(void)
             float want[2];
             const float *got = uv + 2 * (4 * f + ((k + turn[f]) & 3));
             tt_tile_corner_uv(&layout, e, k, want);
-            want[0] = 0.5f * (want[0] + (float)upright[f]);
+            want[0] = 0.5f * (want[0] + (float)(upright[f] % 2));
+            want[1] = 0.5f * (want[1] + (float)(upright[f] / 2));
             agree &= fabsf(got[0] - want[0]) < 1e-6f && fabsf(got[1] - want[1]) < 1e-6f;
         }
     }
-    CHECK(agree, "each quad's corners are its turned tile's, plain ones in the left half, upright ones in the "
-                 "right");
+    CHECK(agree, "each quad's corners are its turned tile's, in its set's quarter of the atlas");
+    upright[5] = TT_TILESET_KINDS;
+    CHECK(tt_assign_uvs_oriented(mesh, &layout, types, turn, upright, uv, &err) == TT_ERROR_INVALID_ARGUMENT &&
+              err.face == 5,
+          "a set beyond the four refused, naming the face: %s", err.message);
     tt_mesh_free(mesh);
     tm_free(&m);
 }
@@ -1848,20 +1863,20 @@ static void test_assign_uvs_oriented(void)
    field runs along the meridians on one half and along the parallels on the
    other, or one or the other at random per quad, either way at random, the
    seam score of tt_orient_tiles's choice stays near 0. The control forces
-   every quad upright with the random field's turns: left and right sides
-   then meet bottom and top sides, and the score rises. */
+   every quad upright on all four sides with the random field's turns: left
+   and right sides then meet bottom and top sides, and the score rises. */
 static void test_orient_tiles_seams(void)
 {
     seam_fixture fx;
     tt_synth_options opt;
-    tt_tileset *upright_set = NULL;
-    const tt_tileset *sets[2];
+    tt_tileset *upright_sets[3] = {NULL, NULL, NULL};
+    const tt_tileset *sets[TT_TILESET_KINDS];
     tt_image *atlas = NULL;
     tt_seam_report kept, forced;
     tt_error err;
     float *vectors;
     uint8_t *turn, *upright;
-    int f, count = 0, field;
+    int f, k, count = 0, field, made = 1;
     tt_result r;
     if (!seam_fixture_make(&fx, 40, 24, 160, 21, 2, 4, "oriented")) return;
     memset(&opt, 0, sizeof opt);
@@ -1872,9 +1887,14 @@ static void test_orient_tiles_seams(void)
     vectors = (float *)malloc(sizeof(float) * 3 * (size_t)fx.mesh->nfaces);
     turn = (uint8_t *)malloc((size_t)fx.mesh->nfaces);
     upright = (uint8_t *)malloc((size_t)fx.mesh->nfaces);
-    if (!vectors || !turn || !upright ||
-        tt_synthesize_tiles(fx.src, &opt, NULL, &upright_set, &err) != TT_OK ||
-        tt_polycube_upright_atlas(pair_of(fx.set, upright_set, sets), 2, 0, NULL, NULL, &atlas, &err) != TT_OK) {
+    sets[TT_TILESET_PLAIN] = fx.set;
+    for (k = 0; k < 3; k++) {
+        opt.plain_sides = k == 0 ? 0 : k == 1 ? 1 << 1 : 1 << 3;
+        made &= tt_synthesize_tiles(fx.src, &opt, NULL, &upright_sets[k], &err) == TT_OK;
+        sets[TT_TILESET_UPRIGHT + k] = upright_sets[k];
+    }
+    if (!vectors || !turn || !upright || !made ||
+        tt_polycube_upright_atlas(sets, 0, NULL, NULL, &atlas, &err) != TT_OK) {
         CHECK(0, "oriented: upright tiles and atlas");
         goto done;
     }
@@ -1887,10 +1907,10 @@ static void test_orient_tiles_seams(void)
             const float *a = fx.mesh->pos + 3 * fx.mesh->corner_vert[4 * f];
             const float *b = fx.mesh->pos + 3 * fx.mesh->corner_vert[4 * f + (meridian ? 3 : 1)];
             const float sign = lcg_below(2) ? 1.0f : -1.0f;
-            int k;
-            for (k = 0; k < 3; k++) vectors[3 * f + k] = sign * (b[k] - a[k]);
+            int axis;
+            for (axis = 0; axis < 3; axis++) vectors[3 * f + axis] = sign * (b[axis] - a[axis]);
         }
-        CHECK(tt_orient_tiles(fx.mesh, vectors, NULL, turn, upright, &count, &err) == TT_OK, "orient: %s",
+        CHECK(tt_orient_tiles(fx.mesh, vectors, turn, upright, &count, &err) == TT_OK, "orient: %s",
               err.message);
         CHECK(field == 1 || (count > 0 && count < fx.mesh->nfaces),
               "half along the meridians, half along the parallels: some quads upright, some plain (%d of %d)",
@@ -1901,7 +1921,7 @@ static void test_orient_tiles_seams(void)
               "(want < 0.1)", field, kept.score);
     }
     /* The control, on the random field's turns. */
-    memset(upright, 1, (size_t)fx.mesh->nfaces);
+    memset(upright, TT_TILESET_UPRIGHT, (size_t)fx.mesh->nfaces);
     tt_assign_uvs_oriented(fx.mesh, &fx.layout, fx.types, turn, upright, fx.uv, NULL);
     r = tt_measure_seams(fx.mesh, fx.uv, atlas, NULL, NULL, &forced, &err);
     CHECK(r == TT_OK && forced.score > kept.score + 0.2,
@@ -1912,7 +1932,7 @@ done:
     free(turn);
     free(upright);
     tt_image_free(atlas);
-    tt_tileset_free(upright_set);
+    for (k = 0; k < 3; k++) tt_tileset_free(upright_sets[k]);
     seam_fixture_free(&fx);
 }
 

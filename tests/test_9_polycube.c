@@ -2706,7 +2706,7 @@ static tt_result upright_atlas_oom_call(void *ctx, const tt_allocator *al, tt_er
 {
     upright_atlas_oom_ctx *c = (upright_atlas_oom_ctx *)ctx;
     tt_image *atlas = (tt_image *)&atlas;
-    tt_result r = tt_polycube_upright_atlas(c->sets, TT_POLYCUBE_TILESETS, 0, NULL, al, &atlas, error);
+    tt_result r = tt_polycube_upright_atlas(c->sets, 0, NULL, al, &atlas, error);
     if (error->result != r || (r != TT_OK) != (atlas == NULL)) return TT_RESULT_MAX_ENUM;
     tt_image_free(atlas);
     return r;
@@ -2724,16 +2724,16 @@ static int atlas_block_is(const tt_image *atlas, int x0, int y0, const tt_image 
     return 1;
 }
 
-/* The four tile sets of a polycube (tt_polycube_tiles' order) on the
+/* The four tile sets of a polycube (tt_tileset_kind' order) on the
    plain set's edge windows: upright, then the right or the left side
    plain. NULL in sets[1..3] on failure. */
-static void upright_sets(const tt_image *photo, tt_synth_options so, tt_tileset *sets[TT_POLYCUBE_TILESETS])
+static void upright_sets(const tt_image *photo, tt_synth_options so, tt_tileset *sets[TT_TILESET_KINDS])
 {
     static const int plain_sides[3] = {0, 1 << 1, 1 << 3};
     int k;
     so.upright = 1;
     so.edge_windows = sets[0]->edge_windows;
-    for (k = 1; k < TT_POLYCUBE_TILESETS; k++) {
+    for (k = 1; k < TT_TILESET_KINDS; k++) {
         so.plain_sides = plain_sides[k - 1];
         sets[k] = NULL;
         if (tt_synthesize_tiles(photo, &so, NULL, &sets[k], NULL) != TT_OK) sets[k] = NULL;
@@ -2742,21 +2742,21 @@ static void upright_sets(const tt_image *photo, tt_synth_options so, tt_tileset 
 
 /* tt_polycube_upright_atlas: level L of the four tilesets, set i in
    column i % 2 and tile-row block i / 2 from the bottom, texel for
-   texel; two sets side by side; sets that do not go together, or in
-   another order, are refused. */
+   texel; sets that do not go together, or in another order, are
+   refused. */
 static void upright_atlas_checks(const tt_tileset *const *sets, const tt_image *atlas)
 {
     const tt_tileset *plain = sets[0], *upright = sets[1];
-    const tt_tileset *reordered[TT_POLYCUBE_TILESETS], *pair[2];
+    const tt_tileset *reordered[TT_TILESET_KINDS];
     tt_tileset moved_set;
     tt_rect moved[TT_MAX_COLORS];
-    tt_image *level1 = NULL, *two = NULL, *bad = (tt_image *)&bad;
+    tt_image *level1 = NULL, *bad = (tt_image *)&bad;
     upright_atlas_oom_ctx ctx;
     tt_error err;
     int i, i2, same = 1, W = plain->levels[0].width;
     CHECK(atlas->width == 2 * W && atlas->height == 2 * W, "the atlas is %dx%d (want %dx%d)", atlas->width,
           atlas->height, 2 * W, 2 * W);
-    for (i = 0; i < TT_POLYCUBE_TILESETS; i++)
+    for (i = 0; i < TT_TILESET_KINDS; i++)
         same &= atlas_block_is(atlas, (i % 2) * W, (1 - i / 2) * W, &sets[i]->levels[0], W);
     CHECK(same, "the atlas is the four sets, 2 x 2, the first two at the bottom");
     {
@@ -2767,7 +2767,7 @@ static void upright_atlas_checks(const tt_tileset *const *sets, const tt_image *
         executors[1] = &g_thread_executor;
         for (e = 0; e < 2; e++) {
             tt_image *parallel = NULL;
-            CHECK(tt_polycube_upright_atlas(sets, TT_POLYCUBE_TILESETS, 0, executors[e], NULL, &parallel, &err) ==
+            CHECK(tt_polycube_upright_atlas(sets, 0, executors[e], NULL, &parallel, &err) ==
                           TT_OK &&
                       parallel && parallel->width == atlas->width && parallel->height == atlas->height &&
                       memcmp(parallel->pixels, atlas->pixels, (size_t)atlas->width * atlas->height * 4 * sizeof(float)) ==
@@ -2776,33 +2776,24 @@ static void upright_atlas_checks(const tt_tileset *const *sets, const tt_image *
             tt_image_free(parallel);
         }
     }
-    CHECK(tt_polycube_upright_atlas(sets, TT_POLYCUBE_TILESETS, 1, NULL, NULL, &level1, &err) == TT_OK && level1 &&
+    CHECK(tt_polycube_upright_atlas(sets, 1, NULL, NULL, &level1, &err) == TT_OK && level1 &&
               level1->width == W && level1->height == W && atlas_block_is(level1, 0, W / 2, &plain->levels[1], W / 2),
           "level 1: %s", err.message);
     tt_image_free(level1);
-    pair[0] = plain;
-    pair[1] = upright;
-    CHECK(tt_polycube_upright_atlas(pair, 2, 0, NULL, NULL, &two, &err) == TT_OK && two && two->width == 2 * W &&
-              two->height == W && atlas_block_is(two, 0, 0, &plain->levels[0], W) &&
-              atlas_block_is(two, W, 0, &upright->levels[0], W),
-          "two sets: the plain tiles beside the upright ones: %s", err.message);
-    tt_image_free(two);
-    for (i = 0; i < TT_POLYCUBE_TILESETS; i++) reordered[i] = sets[i];
+    for (i = 0; i < TT_TILESET_KINDS; i++) reordered[i] = sets[i];
     reordered[2] = sets[3];
     reordered[3] = sets[2];
-    CHECK(tt_polycube_upright_atlas(reordered, TT_POLYCUBE_TILESETS, 0, NULL, NULL, &bad, &err) ==
+    CHECK(tt_polycube_upright_atlas(reordered, 0, NULL, NULL, &bad, &err) ==
                   TT_ERROR_INVALID_ARGUMENT && !bad && err.item == 2,
           "the left- and right-plain sets swapped refused, naming set 2: %s", err.message);
     bad = (tt_image *)&bad;
-    pair[0] = upright;
-    pair[1] = plain;
-    CHECK(tt_polycube_upright_atlas(pair, 2, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
+    for (i = 0; i < TT_TILESET_KINDS; i++) reordered[i] = sets[i];
+    reordered[0] = upright;
+    reordered[1] = plain;
+    CHECK(tt_polycube_upright_atlas(reordered, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
           "upright first refused: %s", err.message);
     bad = (tt_image *)&bad;
-    CHECK(tt_polycube_upright_atlas(sets, 3, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
-          "three sets refused: %s", err.message);
-    bad = (tt_image *)&bad;
-    CHECK(tt_polycube_upright_atlas(sets, TT_POLYCUBE_TILESETS, plain->nlevels, NULL, NULL, &bad, &err) ==
+    CHECK(tt_polycube_upright_atlas(sets, plain->nlevels, NULL, NULL, &bad, &err) ==
                   TT_ERROR_INDEX_OUT_OF_RANGE && !bad,
           "level %d refused: %s", plain->nlevels, err.message);
     for (i = 0; i < 2; i++) {
@@ -2813,10 +2804,10 @@ static void upright_atlas_checks(const tt_tileset *const *sets, const tt_image *
         moved[1].x += 1;
         if (i == 0) moved_set.edge_windows = moved;
         else moved_set.vertical_windows = moved;
-        for (i2 = 0; i2 < TT_POLYCUBE_TILESETS; i2++) reordered[i2] = sets[i2];
+        for (i2 = 0; i2 < TT_TILESET_KINDS; i2++) reordered[i2] = sets[i2];
         reordered[2] = &moved_set;
         bad = (tt_image *)&bad;
-        CHECK(tt_polycube_upright_atlas(reordered, TT_POLYCUBE_TILESETS, 0, NULL, NULL, &bad, &err) ==
+        CHECK(tt_polycube_upright_atlas(reordered, 0, NULL, NULL, &bad, &err) ==
                       TT_ERROR_INVALID_ARGUMENT &&
                   !bad && err.item == 1 && strstr(err.message, i == 0 ? "edge window" : "vertical window"),
               "another %s window in set 2 refused: %s", i == 0 ? "edge" : "vertical", err.message);
@@ -3009,7 +3000,7 @@ static void test_map_uvs_upright(void)
 {
     const double centre[3] = {0.02, 0.11, -0.07};
     tt_image *photo = NULL, *atlas = NULL;
-    tt_tileset *sets[TT_POLYCUBE_TILESETS] = {NULL, NULL, NULL, NULL};
+    tt_tileset *sets[TT_TILESET_KINDS] = {NULL, NULL, NULL, NULL};
     tt_synth_options so;
     tt_polycube *pc = NULL;
     tt_mesh *mesh = NULL, *out = NULL;
@@ -3025,10 +3016,9 @@ static void test_map_uvs_upright(void)
     }
     upright_sets(photo, so, sets);
     if (!sets[1] || !sets[2] || !sets[3] ||
-        tt_polycube_upright_atlas((const tt_tileset *const *)sets, TT_POLYCUBE_TILESETS, 0, NULL, NULL, &atlas,
-                                  &err) != TT_OK) {
+        tt_polycube_upright_atlas((const tt_tileset *const *)sets, 0, NULL, NULL, &atlas, &err) != TT_OK) {
         CHECK(0, "upright tiles and their atlas: %s", err.message);
-        for (k = 0; k < TT_POLYCUBE_TILESETS; k++) tt_tileset_free(sets[k]);
+        for (k = 0; k < TT_TILESET_KINDS; k++) tt_tileset_free(sets[k]);
         tt_image_free(photo);
         return;
     }
@@ -3042,7 +3032,7 @@ static void test_map_uvs_upright(void)
         uint8_t *types = (uint8_t *)malloc((size_t)s->ncorners);
         float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
         float *everywhere = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
-        int i, q, wrong_quarter = 0, walls = 0, top_sets[TT_POLYCUBE_TILESETS] = {0, 0, 0, 0};
+        int i, q, wrong_quarter = 0, walls = 0, top_sets[TT_TILESET_KINDS] = {0, 0, 0, 0};
         tt_seam_options border;
         tt_seam_report fit, control;
         CHECK(colors && types && uv && everywhere && tt_polycube_edge_colors(pc, 2, 1, 7, colors, &err) == TT_OK &&
@@ -3056,7 +3046,7 @@ static void test_map_uvs_upright(void)
             const int set = (int)tt_polycube_quad_tileset(pc, q);
             if (is_wall(pc, q)) {
                 walls++;
-                wrong_quarter += set != TT_POLYCUBE_TILES_UPRIGHT;
+                wrong_quarter += set != TT_TILESET_UPRIGHT;
             } else {
                 top_sets[set]++;
             }
@@ -3099,7 +3089,7 @@ static void test_map_uvs_upright(void)
     tt_mesh_free(mesh);
     tm_free(&m);
     tt_image_free(atlas);
-    for (k = 0; k < TT_POLYCUBE_TILESETS; k++) tt_tileset_free(sets[k]);
+    for (k = 0; k < TT_TILESET_KINDS; k++) tt_tileset_free(sets[k]);
     tt_image_free(photo);
 }
 

@@ -963,19 +963,17 @@ static void cases_tiled(const baseline *b)
         uint8_t turn[12], up[12];
         volatile float zero = 0.0f;
         for (i = 0; i < 36; i++) fv[i] = i % 3 == 1 ? 1.0f : 0.0f;
-        CASE(tt_orient_tiles(NULL, fv, AL, turn, up, NULL, E));
-        CASE(tt_orient_tiles(m, NULL, AL, turn, up, NULL, E));
-        CASE(tt_orient_tiles(m, fv, AL, NULL, up, NULL, E));
-        CASE(tt_orient_tiles(m, fv, BA1, turn, up, NULL, E));
-        CASE(tt_orient_tiles(m, fv, BA2, turn, up, NULL, E));
-        CASE(tt_orient_tiles(b->tris, fv, AL, turn, up, NULL, E));
-        CASE(tt_orient_tiles(&b->empty, fv, AL, turn, up, NULL, E));
+        CASE(tt_orient_tiles(NULL, fv, turn, up, NULL, E));
+        CASE(tt_orient_tiles(m, NULL, turn, up, NULL, E));
+        CASE(tt_orient_tiles(m, fv, NULL, up, NULL, E));
+        CASE(tt_orient_tiles(b->tris, fv, turn, up, NULL, E));
+        CASE(tt_orient_tiles(&b->empty, fv, turn, up, NULL, E));
         fv[4] = zero / zero;
-        CASE(tt_orient_tiles(m, fv, AL, turn, up, NULL, E));
+        CASE(tt_orient_tiles(m, fv, turn, up, NULL, E));
         fv[4] = 1.0f / zero;
-        CASE(tt_orient_tiles(m, fv, AL, turn, up, NULL, E));
+        CASE(tt_orient_tiles(m, fv, turn, up, NULL, E));
         fv[4] = 1.0f;
-        CHECK(tt_orient_tiles(m, fv, AL, turn, up, NULL, NULL) == TT_OK, "baseline orientation");
+        CHECK(tt_orient_tiles(m, fv, turn, up, NULL, NULL) == TT_OK, "baseline orientation");
         CASE(tt_assign_uvs_oriented(NULL, &L, types, turn, up, uv, E));
         CASE(tt_assign_uvs_oriented(m, NULL, types, turn, up, uv, E));
         CASE(tt_assign_uvs_oriented(m, &L, NULL, turn, up, uv, E));
@@ -987,7 +985,9 @@ static void cases_tiled(const baseline *b)
         turn[2] = 255;
         CASE(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, E));
         turn[2] = 0;
-        up[1] = 2;
+        up[1] = TT_TILESET_KINDS;
+        CASE(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, E));
+        up[1] = 255;
         CASE(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, E));
         up[1] = 0;
         CHECK(tt_assign_uvs_oriented(m, &L, types, turn, up, uv, NULL) == TT_OK, "baseline oriented UVs");
@@ -2183,25 +2183,30 @@ static void cases_polycube(const baseline *b)
         CHECK(tt_synthesize_tiles(b->image, &so, AL, &upright, NULL) == TT_OK && upright, "baseline upright tiles");
     }
     if (plain && upright) {
-        tt_tileset other = *upright, other2;
-        const tt_tileset *pair[2], *four[4];
+        tt_tileset other = *upright, other2, right = *upright, left = *upright;
+        const tt_tileset *four[TT_TILESET_KINDS];
         tt_rect moved[TT_MAX_COLORS];
+        /* The same texels serve the upright sets with a plain side: only
+           their kind is checked before the texels are copied. */
+        right.plain_sides = 1 << 1;
+        left.plain_sides = 1 << 3;
 #define ATLAS_CASE(a, b, level, al) \
-        do { pair[0] = (a); pair[1] = (b); \
-             OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 2, level, NULL, al, &aout, E)); } while (0)
+        do { four[0] = (a); four[1] = (b); four[2] = &right; four[3] = &left; \
+             OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, level, NULL, al, &aout, E)); } while (0)
         ATLAS_CASE(NULL, upright, 0, AL);
         ATLAS_CASE(plain, NULL, 0, AL);
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(NULL, 2, 0, NULL, AL, &aout, E));
-        pair[0] = plain;
-        pair[1] = upright;
-        CASE(tt_polycube_upright_atlas(pair, 2, 0, NULL, AL, NULL, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 0, 0, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 1, 0, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, 3, 0, NULL, AL, &aout, E));
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(pair, -4, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(NULL, 0, NULL, AL, &aout, E));
         four[0] = plain;
-        four[1] = four[2] = four[3] = upright;   /* sets 2 and 3 need plain_sides */
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 4, 0, NULL, AL, &aout, E));
+        four[1] = upright;
+        four[2] = &right;
+        four[3] = &left;
+        CASE(tt_polycube_upright_atlas(four, 0, NULL, AL, NULL, E));
+        four[3] = &right;   /* both with the right side plain */
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 0, NULL, AL, &aout, E));
+        four[2] = four[3] = upright;   /* sets 2 and 3 need plain_sides */
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 0, NULL, AL, &aout, E));
+        four[3] = NULL;
+        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 0, NULL, AL, &aout, E));
         ATLAS_CASE(plain, upright, 0, BA1);
         ATLAS_CASE(plain, upright, 0, BA2);
         ATLAS_CASE(plain, upright, -1, AL);
@@ -2213,10 +2218,12 @@ static void cases_polycube(const baseline *b)
         ATLAS_CASE(plain, plain, 0, AL);
         other.nlevels = -1;
         ATLAS_CASE(plain, &other, 0, AL);
-        other.nlevels = TT_MAX_MIP_LEVELS + 5;   /* both claim levels beyond the array */
+        other.nlevels = TT_MAX_MIP_LEVELS + 5;   /* every set claims levels beyond the array */
         other2 = *plain;
         other2.nlevels = TT_MAX_MIP_LEVELS + 5;
+        right.nlevels = left.nlevels = TT_MAX_MIP_LEVELS + 5;
         ATLAS_CASE(&other2, &other, TT_MAX_MIP_LEVELS + 1, AL);
+        right.nlevels = left.nlevels = upright->nlevels;
         other = *upright;
         other.layout.colors = 2;
         ATLAS_CASE(plain, &other, 0, AL);
