@@ -61,7 +61,7 @@
      - No global or static mutable state: every function is reentrant and safe
        to call from several threads on distinct outputs.
      - The library never starts a thread. Options with an `executor` field
-       (and tt_polycube_upright_atlas's executor argument) hand independent
+       (and tt_upright_atlas's executor argument) hand independent
        work (tiles, ranges of faces, turned copies) to your job system
        through tt_executor; the result is bit-identical with any
        number of workers, or none (NULL: serial).
@@ -1264,7 +1264,7 @@ TTDEF tt_result tt_assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout,
 
 /* The four sets of tiles a face may take when the tiles follow a direction
    (tt_orient_tiles, a polycube's tops: tt_polycube_quad_tileset), in the
-   order of tt_polycube_upright_atlas's quarters. Upright tiles
+   order of tt_upright_atlas's quarters. Upright tiles
    (tt_synth_options::upright) keep the source's up on all four sides, but
    their left and right sides match only the left and right sides of
    upright tiles; a side that meets anything else is plain, the edge window
@@ -1309,7 +1309,7 @@ TTDEF tt_result tt_orient_tiles(const tt_mesh *mesh, const float *face_vectors, 
    read from the half-edge face_turn[f] on, and its corner k lies at the
    face's corner face_turn[f] + k. With face_upright (NULL: one tile set;
    else each face's tt_tileset_kind) the UVs address the atlas of the four
-   sets (tt_polycube_upright_atlas makes it): u becomes (u + k % 2) / 2 and
+   sets (tt_upright_atlas makes it): u becomes (u + k % 2) / 2 and
    v (v + k / 2) / 2 for kind k. Errors: as tt_assign_uvs, and a turn above
    3 or a kind above 3 (TT_ERROR_INVALID_ARGUMENT, naming the face). */
 TTDEF tt_result tt_assign_uvs_oriented(const tt_mesh *mesh, const tt_tile_layout *layout,
@@ -1445,7 +1445,7 @@ typedef struct tt_synth_options {
        across an edge that both see as a left/right side or both as a
        bottom/top side; an edge that is bottom/top to both also meets a plain
        tile of a plan with the same edge_windows seamlessly (the walls and
-       the tops of a polycube, tt_polycube_upright_atlas). Needs a
+       the tops of a polycube, tt_upright_atlas). Needs a
        source of at least 2S x 2S. */
     int upright;
     /* Upright tiles only: a bit per side, 1 << 1 (right) and 1 << 3 (left),
@@ -1630,6 +1630,26 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
                                     const tt_allocator *allocator, tt_tileset **out_tileset, tt_error *error);
 TTDEF void tt_tileset_free(tt_tileset *tileset);
 
+/* The atlas of turned tiles: the TT_TILESET_KINDS sets (sets[k] of
+   tt_tileset_kind k, made with the plain set's edge windows) at level
+   `level` in one 2W x 2W atlas, set k at column k % 2 and tile-row block
+   k / 2 from the bottom, so u becomes (u + k % 2) / 2 and v (v + k / 2) /
+   2 (tt_assign_uvs_oriented, tt_polycube_mapping_uvs_upright). The atlas
+   is of the tilesets' kind (a normal map when they are). Errors: NULL
+   arguments, a bad allocator, tilesets of different layouts or kinds, a
+   set that is not the kind its place asks for (set 0 plain, the others
+   upright, set 2 with plain_sides 1 << 1 and set 3 with 1 << 3), edge
+   windows or vertical windows that differ, a level whose images differ in
+   size or have no pixels (TT_ERROR_INVALID_ARGUMENT); a level that is not
+   in every tileset or beyond TT_MAX_MIP_LEVELS
+   (TT_ERROR_INDEX_OUT_OF_RANGE); TT_ERROR_OUT_OF_MEMORY. *out_image is
+   NULL on failure; free it with tt_image_free. `executor` (NULL: this
+   thread) copies bands of rows in parallel: an atlas of hundreds of
+   megabytes is mostly fresh memory the system must hand out page by
+   page, which one thread alone would make the longest serial stage. */
+TTDEF tt_result tt_upright_atlas(const tt_tileset *const *sets, int level, const tt_executor *executor,
+                                 const tt_allocator *allocator, tt_image **out_image, tt_error *error);
+
 /* --- The compact atlas: only the tiles a mesh shows ---
 
    The layout's atlas holds every one of the (2n)^4 tiles whether the mesh
@@ -1668,7 +1688,7 @@ typedef struct tt_compact_atlas {
 
 /* The cells of a full atlas (full_width x full_height texels, cells of the
    layout's C = S + 2g texels, row 0 at the bottom: a layout's W x W, or
-   tt_polycube_upright_atlas's 2W x 2W) that mesh's faces use, each face's cell
+   tt_upright_atlas's 2W x 2W) that mesh's faces use, each face's cell
    being the one its corners' UVs lie in, and the smallest power-of-two
    atlas that holds them with at most max_size texels a side (0 =
    TT_COMPACT_ATLAS_DEFAULT_MAX_SIZE; at most TT_MAX_IMAGE_SIZE).
@@ -1697,7 +1717,7 @@ TTDEF tt_result tt_compact_atlas_image(const tt_compact_atlas *atlas, const tt_i
 /* The same from a full atlas in parts, never put together: columns x rows
    (1 or 2 each) images of one size and kind, part k = row * columns +
    column, row 0 at the bottom as cells count - a polycube's four tile sets
-   in the order of tt_tileset_kind (tt_polycube_upright_atlas's layout),
+   in the order of tt_tileset_kind (tt_upright_atlas's layout),
    without the memory of the whole. Errors: as tt_compact_atlas_image, a
    NULL part, parts of different sizes or kinds, or columns or rows outside
    1..2 (TT_ERROR_INVALID_ARGUMENT). */
@@ -3878,7 +3898,7 @@ TTDEF tt_result tt_polycube_mapping_uvs(const tt_polycube *polycube, const tt_po
         three upright sets with the same layout and seed, options.upright =
         1, options.edge_windows = the plain tileset's edge_windows and
         options.plain_sides 0, 1 << 1 and 1 << 3;
-     2. tt_polycube_upright_atlas with the four, in the order of the
+     2. tt_upright_atlas with the four, in the order of the
         TT_TILESET_ values: a 2W x 2W atlas (per mip level, as you
         need them);
      3. tt_polycube_mapping_uvs_upright: as tt_polycube_mapping_uvs, each
@@ -3918,25 +3938,6 @@ TTDEF tt_tileset_kind tt_polycube_quad_tileset(const tt_polycube *polycube, int 
    corner): corner_type is then as it was. Allocates nothing; thread-safe. */
 TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t *corner_type, int *out_turned,
                                            tt_error *error);
-/* The TT_TILESET_KINDS sets (sets[k] of tt_tileset_kind k) at level
-   `level` in one 2W x 2W atlas, set k at column k % 2 and tile-row block
-   k / 2 from the bottom, so u becomes (u + k % 2) / 2 and v (v + k / 2) /
-   2 (tt_assign_uvs_oriented, tt_polycube_mapping_uvs_upright). The atlas
-   is of the tilesets' kind (a normal map when they are). Errors: NULL
-   arguments, a bad allocator, tilesets of different layouts or kinds, a
-   set that is not the kind its place asks for (set 0 plain, the others
-   upright, set 2 with plain_sides 1 << 1 and set 3 with 1 << 3), edge
-   windows or vertical windows that differ,
-   a level whose images differ in size or have no pixels
-   (TT_ERROR_INVALID_ARGUMENT); a level that is not in every tileset or
-   beyond TT_MAX_MIP_LEVELS (TT_ERROR_INDEX_OUT_OF_RANGE);
-   TT_ERROR_OUT_OF_MEMORY. *out_image is NULL on failure; free it with
-   tt_image_free. `executor` (NULL: this thread) copies bands of rows in
-   parallel: an atlas of hundreds of megabytes is mostly fresh memory the
-   system must hand out page by page, which one thread alone makes the
-   longest serial stage of a polycube run. */
-TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int level, const tt_executor *executor,
-                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error);
 /* Errors and the rest as tt_polycube_mapping_uvs. */
 TTDEF tt_result tt_polycube_mapping_uvs_upright(const tt_polycube *polycube, const tt_polycube_mapping *mapping,
                                                 const tt_tile_layout *layout, const uint8_t *corner_type,
@@ -11293,6 +11294,113 @@ TTDEF tt_result tt_synthesize_tiles(const tt_image *source, const tt_synth_optio
     result = tt__synth_apply(plan, source, allocator, out_tileset, error, 0, TT__PLAN_SHARE, 1.0f);
     tt_synth_plan_free(plan);
     return result;
+}
+
+/* Rows [begin, end) of tt_upright_atlas: each from the two sets
+   side by side in its half. */
+typedef struct tt__atlas_quarters {
+    const tt_image *part[TT_TILESET_KINDS];
+    tt_image *out;
+} tt__atlas_quarters;
+
+static void tt__atlas_quarters_rows(void *context, int begin, int end)
+{
+    const tt__atlas_quarters *h = (const tt__atlas_quarters *)context;
+    const int height = h->part[0]->height;
+    const size_t half = (size_t)h->part[0]->width * 4;
+    int row;
+    for (row = begin; row < end; row++) {
+        /* image rows count from the top: sets 2 and 3 lie there */
+        const int block = 1 - row / height, in_part = row % height;
+        float *out = h->out->pixels + (size_t)row * 2 * half;
+        memcpy(out, h->part[2 * block]->pixels + (size_t)in_part * half, half * sizeof(float));
+        memcpy(out + half, h->part[2 * block + 1]->pixels + (size_t)in_part * half, half * sizeof(float));
+    }
+}
+
+#define TT__ATLAS_BAND_TEXELS 65536   /* texels per task of tt_upright_atlas: a few hundred tasks */
+
+/* The plain_sides set i of tt_upright_atlas must have (-1: none,
+   a plain set). */
+static int tt__upright_set_sides(int i)
+{
+    static const int sides[TT_TILESET_KINDS] = {-1, 0, 1 << 1, 1 << 3};
+    return sides[i];
+}
+
+TTDEF tt_result tt_upright_atlas(const tt_tileset *const *sets, int level, const tt_executor *executor,
+                                 const tt_allocator *allocator, tt_image **out_image, tt_error *error)
+{
+    tt__atlas_quarters quarters;
+    tt_result result;
+    const tt_tileset *first;
+    int i, k, width, height;
+    tt__ok(error);
+    if (out_image) *out_image = NULL;
+    if (!sets || !out_image)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_upright_atlas needs the tilesets and out_image (got NULL)");
+    for (i = 0; i < TT_TILESET_KINDS; i++)
+        if (!sets[i])
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1, "tileset %d of %d is NULL", i,
+                               TT_TILESET_KINDS);
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    first = sets[0];
+    for (i = 0; i < TT_TILESET_KINDS; i++) {
+        const tt_tileset *set = sets[i];
+        const int want = tt__upright_set_sides(i);
+        static const char *const names[TT_TILESET_KINDS] = {
+            "plain", "upright (plain_sides 0)", "upright with its right side plain (plain_sides 1 << 1)",
+            "upright with its left side plain (plain_sides 1 << 3)"};
+        if ((want < 0) != !set->vertical_windows || (want >= 0 && set->plain_sides != want))
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
+                               "tileset %d must be %s (tt_synth_options.upright, plain_sides), in the order of "
+                               "tt_tileset_kind", i, names[i]);
+        if (set->layout.colors != first->layout.colors || set->layout.tile_size != first->layout.tile_size ||
+            set->layout.gutter != first->layout.gutter)
+            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
+                               "the tilesets' layouts differ (%d colors, %d texels, gutter %d against %d, %d, %d "
+                               "in tileset %d)", first->layout.colors, first->layout.tile_size, first->layout.gutter,
+                               set->layout.colors, set->layout.tile_size, set->layout.gutter, i);
+        for (k = 0; k < first->layout.colors; k++) {
+            if (set->edge_windows[k].x != first->edge_windows[k].x || set->edge_windows[k].y != first->edge_windows[k].y)
+                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                                   "edge window %d differs between tilesets 0 and %d: make the upright tiles with the "
+                                   "plain ones' edge_windows, or the tops and the walls do not meet", k, i);
+            if (i > 1 && (set->vertical_windows[k].x != sets[1]->vertical_windows[k].x ||
+                          set->vertical_windows[k].y != sets[1]->vertical_windows[k].y))
+                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
+                                   "vertical window %d differs between tilesets 1 and %d: make the upright sets with "
+                                   "one seed and guide, or their left and right sides do not meet", k, i);
+        }
+        if (level < 0 || level >= set->nlevels || level >= TT_MAX_MIP_LEVELS)
+            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
+                            "level %d: tileset %d has levels 0 to %d", level, i,
+                            tt__min_i(set->nlevels, TT_MAX_MIP_LEVELS) - 1);
+    }
+    width = first->levels[level].width;
+    height = first->levels[level].height;
+    for (i = 0; i < TT_TILESET_KINDS; i++) {
+        const tt_image *part = &sets[i]->levels[level];
+        if (!part->pixels || width < 1 || height < 1 || part->width != width || part->height != height)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "level %d of the tilesets is %d x %d and %d x %d (tileset %d), or has no pixels: not "
+                            "tilesets of one layout made by tt_synth_apply", level, width, height, part->width,
+                            part->height, i);
+        if (part->kind != first->levels[level].kind)
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                            "tileset %d is %sa normal map and tileset 0 is %s: apply every plan to the same map", i,
+                            part->kind == TT_IMAGE_NORMAL ? "" : "not ",
+                            part->kind == TT_IMAGE_NORMAL ? "not" : "one");
+        quarters.part[i] = part;
+    }
+    /* Every texel is copied in below. */
+    if ((result = tt__image_create(2 * width, 2 * height, 0, allocator, out_image, error)) != TT_OK) return result;
+    (*out_image)->kind = first->levels[level].kind;
+    quarters.out = *out_image;
+    tt__parallel_ranges(executor, (*out_image)->height, tt__max_i(1, TT__ATLAS_BAND_TEXELS / (2 * width)),
+                        tt__atlas_quarters_rows, &quarters);
+    return TT_OK;
 }
 
 /* --- The compact atlas ---------------------------------------------------- */
@@ -31201,112 +31309,6 @@ TTDEF tt_result tt_polycube_orient_upright(const tt_polycube *polycube, uint8_t 
     return TT_OK;
 }
 
-/* Rows [begin, end) of tt_polycube_upright_atlas: each from the two sets
-   side by side in its half. */
-typedef struct tt__atlas_quarters {
-    const tt_image *part[TT_TILESET_KINDS];
-    tt_image *out;
-} tt__atlas_quarters;
-
-static void tt__atlas_quarters_rows(void *context, int begin, int end)
-{
-    const tt__atlas_quarters *h = (const tt__atlas_quarters *)context;
-    const int height = h->part[0]->height;
-    const size_t half = (size_t)h->part[0]->width * 4;
-    int row;
-    for (row = begin; row < end; row++) {
-        /* image rows count from the top: sets 2 and 3 lie there */
-        const int block = 1 - row / height, in_part = row % height;
-        float *out = h->out->pixels + (size_t)row * 2 * half;
-        memcpy(out, h->part[2 * block]->pixels + (size_t)in_part * half, half * sizeof(float));
-        memcpy(out + half, h->part[2 * block + 1]->pixels + (size_t)in_part * half, half * sizeof(float));
-    }
-}
-
-#define TT__ATLAS_BAND_TEXELS 65536   /* texels per task of tt_polycube_upright_atlas: a few hundred tasks */
-
-/* The plain_sides set i of tt_polycube_upright_atlas must have (-1: none,
-   a plain set). */
-static int tt__upright_set_sides(int i)
-{
-    static const int sides[TT_TILESET_KINDS] = {-1, 0, 1 << 1, 1 << 3};
-    return sides[i];
-}
-
-TTDEF tt_result tt_polycube_upright_atlas(const tt_tileset *const *sets, int level, const tt_executor *executor,
-                                          const tt_allocator *allocator, tt_image **out_image, tt_error *error)
-{
-    tt__atlas_quarters quarters;
-    tt_result result;
-    const tt_tileset *first;
-    int i, k, width, height;
-    tt__ok(error);
-    if (out_image) *out_image = NULL;
-    if (!sets || !out_image)
-        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "tt_polycube_upright_atlas needs the tilesets and out_image (got NULL)");
-    for (i = 0; i < TT_TILESET_KINDS; i++)
-        if (!sets[i])
-            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1, "tileset %d of %d is NULL", i,
-                               TT_TILESET_KINDS);
-    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
-    first = sets[0];
-    for (i = 0; i < TT_TILESET_KINDS; i++) {
-        const tt_tileset *set = sets[i];
-        const int want = tt__upright_set_sides(i);
-        static const char *const names[TT_TILESET_KINDS] = {
-            "plain", "upright (plain_sides 0)", "upright with its right side plain (plain_sides 1 << 1)",
-            "upright with its left side plain (plain_sides 1 << 3)"};
-        if ((want < 0) != !set->vertical_windows || (want >= 0 && set->plain_sides != want))
-            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
-                               "tileset %d must be %s (tt_synth_options.upright, plain_sides), in the order of "
-                               "tt_tileset_kind", i, names[i]);
-        if (set->layout.colors != first->layout.colors || set->layout.tile_size != first->layout.tile_size ||
-            set->layout.gutter != first->layout.gutter)
-            return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, i, -1, -1,
-                               "the tilesets' layouts differ (%d colors, %d texels, gutter %d against %d, %d, %d "
-                               "in tileset %d)", first->layout.colors, first->layout.tile_size, first->layout.gutter,
-                               set->layout.colors, set->layout.tile_size, set->layout.gutter, i);
-        for (k = 0; k < first->layout.colors; k++) {
-            if (set->edge_windows[k].x != first->edge_windows[k].x || set->edge_windows[k].y != first->edge_windows[k].y)
-                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
-                                   "edge window %d differs between tilesets 0 and %d: make the upright tiles with the "
-                                   "plain ones' edge_windows, or the tops and the walls do not meet", k, i);
-            if (i > 1 && (set->vertical_windows[k].x != sets[1]->vertical_windows[k].x ||
-                          set->vertical_windows[k].y != sets[1]->vertical_windows[k].y))
-                return tt__fail_at(error, TT_ERROR_INVALID_ARGUMENT, k, -1, -1,
-                                   "vertical window %d differs between tilesets 1 and %d: make the upright sets with "
-                                   "one seed and guide, or their left and right sides do not meet", k, i);
-        }
-        if (level < 0 || level >= set->nlevels || level >= TT_MAX_MIP_LEVELS)
-            return tt__fail(error, TT_ERROR_INDEX_OUT_OF_RANGE, -1, -1, -1, -1,
-                            "level %d: tileset %d has levels 0 to %d", level, i,
-                            tt__min_i(set->nlevels, TT_MAX_MIP_LEVELS) - 1);
-    }
-    width = first->levels[level].width;
-    height = first->levels[level].height;
-    for (i = 0; i < TT_TILESET_KINDS; i++) {
-        const tt_image *part = &sets[i]->levels[level];
-        if (!part->pixels || width < 1 || height < 1 || part->width != width || part->height != height)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                            "level %d of the tilesets is %d x %d and %d x %d (tileset %d), or has no pixels: not "
-                            "tilesets of one layout made by tt_synth_apply", level, width, height, part->width,
-                            part->height, i);
-        if (part->kind != first->levels[level].kind)
-            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                            "tileset %d is %sa normal map and tileset 0 is %s: apply every plan to the same map", i,
-                            part->kind == TT_IMAGE_NORMAL ? "" : "not ",
-                            part->kind == TT_IMAGE_NORMAL ? "not" : "one");
-        quarters.part[i] = part;
-    }
-    /* Every texel is copied in below. */
-    if ((result = tt__image_create(2 * width, 2 * height, 0, allocator, out_image, error)) != TT_OK) return result;
-    (*out_image)->kind = first->levels[level].kind;
-    quarters.out = *out_image;
-    tt__parallel_ranges(executor, (*out_image)->height, tt__max_i(1, TT__ATLAS_BAND_TEXELS / (2 * width)),
-                        tt__atlas_quarters_rows, &quarters);
-    return TT_OK;
-}
 
 /* tt_polycube_mapping_uvs and its upright form: `upright` puts each
    quad's tile in its set's quarter of a 2W x 2W atlas. */

@@ -6,7 +6,7 @@
    look at it with `tiledtex render OUT_PREFIX.obj OUT_PREFIX.png view.png`.
    With --up or --constraints the quads' tiles turn along the direction
    field (tiled_map_mesh), and the atlas holds four tile sets, plain and
-   upright (tt_polycube_upright_atlas), as the polycube's.
+   upright (tt_upright_atlas), as the polycube's.
 */
 #include <stdio.h>
 #include <stdlib.h>
@@ -78,7 +78,7 @@ static int upright_atlas(const tt_tileset *plain, tt_tileset *const upright[TILE
     const tt_tileset *sets[TT_TILESET_KINDS];
     tt_error error;
     tiled_tileset_kinds(plain, upright, sets);
-    if (tt_polycube_upright_atlas(sets, level, tool_executor(), NULL, out, &error) != TT_OK)
+    if (tt_upright_atlas(sets, level, tool_executor(), NULL, out, &error) != TT_OK)
         return tool_fail("the %dx%d atlas: %s", 2 * plain->levels[level].width, 2 * plain->levels[level].height,
                          error.message);
     return 0;

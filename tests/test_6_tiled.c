@@ -1869,8 +1869,7 @@ static void test_orient_tiles_seams(void)
 {
     seam_fixture fx;
     tt_synth_options opt;
-    tt_tileset *upright_sets[3] = {NULL, NULL, NULL};
-    const tt_tileset *sets[TT_TILESET_KINDS];
+    tt_tileset *upright_sets[3] = {NULL, NULL, NULL}, *sets[TT_TILESET_KINDS];
     tt_image *atlas = NULL;
     tt_seam_report kept, forced;
     tt_error err;
@@ -1882,19 +1881,14 @@ static void test_orient_tiles_seams(void)
     memset(&opt, 0, sizeof opt);
     opt.layout = fx.layout;
     opt.seed = 4;
-    opt.upright = 1;
-    opt.edge_windows = fx.set->edge_windows;
     vectors = (float *)malloc(sizeof(float) * 3 * (size_t)fx.mesh->nfaces);
     turn = (uint8_t *)malloc((size_t)fx.mesh->nfaces);
     upright = (uint8_t *)malloc((size_t)fx.mesh->nfaces);
     sets[TT_TILESET_PLAIN] = fx.set;
-    for (k = 0; k < 3; k++) {
-        opt.plain_sides = k == 0 ? 0 : k == 1 ? 1 << 1 : 1 << 3;
-        made &= tt_synthesize_tiles(fx.src, &opt, NULL, &upright_sets[k], &err) == TT_OK;
-        sets[TT_TILESET_UPRIGHT + k] = upright_sets[k];
-    }
+    make_upright_sets(fx.src, opt, sets);
+    for (k = 0; k < 3; k++) made &= (upright_sets[k] = sets[TT_TILESET_UPRIGHT + k]) != NULL;
     if (!vectors || !turn || !upright || !made ||
-        tt_polycube_upright_atlas(sets, 0, NULL, NULL, &atlas, &err) != TT_OK) {
+        tt_upright_atlas((const tt_tileset *const *)sets, 0, NULL, NULL, &atlas, &err) != TT_OK) {
         CHECK(0, "oriented: upright tiles and atlas");
         goto done;
     }

@@ -2698,124 +2698,6 @@ static void test_map_uvs_and_seams(void)
     tt_image_free(photo);
 }
 
-typedef struct upright_atlas_oom_ctx {
-    const tt_tileset *const *sets;
-} upright_atlas_oom_ctx;
-
-static tt_result upright_atlas_oom_call(void *ctx, const tt_allocator *al, tt_error *error)
-{
-    upright_atlas_oom_ctx *c = (upright_atlas_oom_ctx *)ctx;
-    tt_image *atlas = (tt_image *)&atlas;
-    tt_result r = tt_polycube_upright_atlas(c->sets, 0, NULL, al, &atlas, error);
-    if (error->result != r || (r != TT_OK) != (atlas == NULL)) return TT_RESULT_MAX_ENUM;
-    tt_image_free(atlas);
-    return r;
-}
-
-/* 1 when rows [0, rows) of `part` are the block of `atlas` at texel
-   column x0, image row y0. */
-static int atlas_block_is(const tt_image *atlas, int x0, int y0, const tt_image *part, int rows)
-{
-    int row;
-    for (row = 0; row < rows; row++)
-        if (memcmp(atlas->pixels + ((size_t)(y0 + row) * atlas->width + x0) * 4,
-                   part->pixels + (size_t)row * part->width * 4, (size_t)part->width * 4 * sizeof(float)) != 0)
-            return 0;
-    return 1;
-}
-
-/* The four tile sets of a polycube (tt_tileset_kind' order) on the
-   plain set's edge windows: upright, then the right or the left side
-   plain. NULL in sets[1..3] on failure. */
-static void upright_sets(const tt_image *photo, tt_synth_options so, tt_tileset *sets[TT_TILESET_KINDS])
-{
-    static const int plain_sides[3] = {0, 1 << 1, 1 << 3};
-    int k;
-    so.upright = 1;
-    so.edge_windows = sets[0]->edge_windows;
-    for (k = 1; k < TT_TILESET_KINDS; k++) {
-        so.plain_sides = plain_sides[k - 1];
-        sets[k] = NULL;
-        if (tt_synthesize_tiles(photo, &so, NULL, &sets[k], NULL) != TT_OK) sets[k] = NULL;
-    }
-}
-
-/* tt_polycube_upright_atlas: level L of the four tilesets, set i in
-   column i % 2 and tile-row block i / 2 from the bottom, texel for
-   texel; sets that do not go together, or in another order, are
-   refused. */
-static void upright_atlas_checks(const tt_tileset *const *sets, const tt_image *atlas)
-{
-    const tt_tileset *plain = sets[0], *upright = sets[1];
-    const tt_tileset *reordered[TT_TILESET_KINDS];
-    tt_tileset moved_set;
-    tt_rect moved[TT_MAX_COLORS];
-    tt_image *level1 = NULL, *bad = (tt_image *)&bad;
-    upright_atlas_oom_ctx ctx;
-    tt_error err;
-    int i, i2, same = 1, W = plain->levels[0].width;
-    CHECK(atlas->width == 2 * W && atlas->height == 2 * W, "the atlas is %dx%d (want %dx%d)", atlas->width,
-          atlas->height, 2 * W, 2 * W);
-    for (i = 0; i < TT_TILESET_KINDS; i++)
-        same &= atlas_block_is(atlas, (i % 2) * W, (1 - i / 2) * W, &sets[i]->levels[0], W);
-    CHECK(same, "the atlas is the four sets, 2 x 2, the first two at the bottom");
-    {
-        /* Bands of rows through an executor: the same atlas, byte for byte. */
-        const tt_executor *executors[2];
-        int e;
-        executors[0] = &g_reverse_executor;
-        executors[1] = &g_thread_executor;
-        for (e = 0; e < 2; e++) {
-            tt_image *parallel = NULL;
-            CHECK(tt_polycube_upright_atlas(sets, 0, executors[e], NULL, &parallel, &err) ==
-                          TT_OK &&
-                      parallel && parallel->width == atlas->width && parallel->height == atlas->height &&
-                      memcmp(parallel->pixels, atlas->pixels, (size_t)atlas->width * atlas->height * 4 * sizeof(float)) ==
-                          0,
-                  "executor %d: the atlas differs from the serial one", e);
-            tt_image_free(parallel);
-        }
-    }
-    CHECK(tt_polycube_upright_atlas(sets, 1, NULL, NULL, &level1, &err) == TT_OK && level1 &&
-              level1->width == W && level1->height == W && atlas_block_is(level1, 0, W / 2, &plain->levels[1], W / 2),
-          "level 1: %s", err.message);
-    tt_image_free(level1);
-    for (i = 0; i < TT_TILESET_KINDS; i++) reordered[i] = sets[i];
-    reordered[2] = sets[3];
-    reordered[3] = sets[2];
-    CHECK(tt_polycube_upright_atlas(reordered, 0, NULL, NULL, &bad, &err) ==
-                  TT_ERROR_INVALID_ARGUMENT && !bad && err.item == 2,
-          "the left- and right-plain sets swapped refused, naming set 2: %s", err.message);
-    bad = (tt_image *)&bad;
-    for (i = 0; i < TT_TILESET_KINDS; i++) reordered[i] = sets[i];
-    reordered[0] = upright;
-    reordered[1] = plain;
-    CHECK(tt_polycube_upright_atlas(reordered, 0, NULL, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad,
-          "upright first refused: %s", err.message);
-    bad = (tt_image *)&bad;
-    CHECK(tt_polycube_upright_atlas(sets, plain->nlevels, NULL, NULL, &bad, &err) ==
-                  TT_ERROR_INDEX_OUT_OF_RANGE && !bad,
-          "level %d refused: %s", plain->nlevels, err.message);
-    for (i = 0; i < 2; i++) {
-        /* another edge window, then another vertical window, in set 2 */
-        moved_set = *sets[2];
-        memcpy(moved, i == 0 ? sets[2]->edge_windows : sets[2]->vertical_windows,
-               sizeof(tt_rect) * (size_t)plain->layout.colors);
-        moved[1].x += 1;
-        if (i == 0) moved_set.edge_windows = moved;
-        else moved_set.vertical_windows = moved;
-        for (i2 = 0; i2 < TT_TILESET_KINDS; i2++) reordered[i2] = sets[i2];
-        reordered[2] = &moved_set;
-        bad = (tt_image *)&bad;
-        CHECK(tt_polycube_upright_atlas(reordered, 0, NULL, NULL, &bad, &err) ==
-                      TT_ERROR_INVALID_ARGUMENT &&
-                  !bad && err.item == 1 && strstr(err.message, i == 0 ? "edge window" : "vertical window"),
-              "another %s window in set 2 refused: %s", i == 0 ? "edge" : "vertical", err.message);
-    }
-    ctx.sets = sets;
-    oom_sweep("tt_polycube_upright_atlas", upright_atlas_oom_call, &ctx, TT_OK);
-}
-
 /* Rows of a wall tile that darken going down, beyond the noise: the
    courses photo brightens down every course, so an upright tile (one
    course, cut on it) brightens down everywhere and a band turned half a
@@ -3014,15 +2896,14 @@ static void test_map_uvs_upright(void)
         tt_image_free(photo);
         return;
     }
-    upright_sets(photo, so, sets);
+    make_upright_sets(photo, so, sets);
     if (!sets[1] || !sets[2] || !sets[3] ||
-        tt_polycube_upright_atlas((const tt_tileset *const *)sets, 0, NULL, NULL, &atlas, &err) != TT_OK) {
+        tt_upright_atlas((const tt_tileset *const *)sets, 0, NULL, NULL, &atlas, &err) != TT_OK) {
         CHECK(0, "upright tiles and their atlas: %s", err.message);
         for (k = 0; k < TT_TILESET_KINDS; k++) tt_tileset_free(sets[k]);
         tt_image_free(photo);
         return;
     }
-    upright_atlas_checks((const tt_tileset *const *)sets, atlas);
     memset(&m, 0, sizeof m);
     make_sphere(&m, 48, 24, 1.0, centre, 0);
     map = mapped(&m, 8, 0, 0.0, &pc, &mesh, &rep);

@@ -685,6 +685,20 @@ static void thread_run(int count, tt_task_fn task, void *task_context, void *use
 }
 const tt_executor g_thread_executor = {thread_run, NULL};
 
+/* Tile sets for the tests of turned tiles (tt_upright_atlas). */
+void make_upright_sets(const tt_image *photo, tt_synth_options so, tt_tileset *sets[TT_TILESET_KINDS])
+{
+    static const int plain_sides[TT_TILESET_KINDS - 1] = {0, 1 << 1, 1 << 3};
+    int k;
+    so.upright = 1;
+    so.edge_windows = sets[TT_TILESET_PLAIN]->edge_windows;
+    for (k = TT_TILESET_UPRIGHT; k < TT_TILESET_KINDS; k++) {
+        so.plain_sides = plain_sides[k - TT_TILESET_UPRIGHT];
+        sets[k] = NULL;
+        if (tt_synthesize_tiles(photo, &so, NULL, &sets[k], NULL) != TT_OK) sets[k] = NULL;
+    }
+}
+
 /* Whether a comma-separated list of section names holds this one. */
 static int section_listed(const char *list, const char *name)
 {

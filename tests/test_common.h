@@ -165,6 +165,11 @@ void make_value_noise(tt_image **im, int w, int h, unsigned seed);
 extern const tt_executor g_reverse_executor;
 extern const tt_executor g_thread_executor;
 
+/* sets[1..3] (tt_tileset_kind's upright, right side plain, left side
+   plain) made from `photo` with `so` on the edge windows of sets[0], the
+   plain set; NULL where one fails. */
+void make_upright_sets(const tt_image *photo, tt_synth_options so, tt_tileset *sets[TT_TILESET_KINDS]);
+
 /* ------------------------------------------------------------------------ */
 /* Internal functions of the implementation the tests call                  */
 /* ------------------------------------------------------------------------ */

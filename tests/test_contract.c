@@ -66,6 +66,7 @@ static const char *const k_functions[] = {
     "tt_synth_compose_tile",
     "tt_synth_apply",
     "tt_synthesize_tiles",
+    "tt_upright_atlas",
     "tt_compact_atlas_create",
     "tt_compact_atlas_image",
     "tt_compact_atlas_image_parts",
@@ -93,7 +94,6 @@ static const char *const k_functions[] = {
     "tt_polycube_map",
     "tt_polycube_mapping_uvs",
     "tt_polycube_orient_upright",
-    "tt_polycube_upright_atlas",
     "tt_polycube_mapping_uvs_upright",
 };
 /* CONTRACT FUNCTIONS END */
@@ -2192,21 +2192,21 @@ static void cases_polycube(const baseline *b)
         left.plain_sides = 1 << 3;
 #define ATLAS_CASE(a, b, level, al) \
         do { four[0] = (a); four[1] = (b); four[2] = &right; four[3] = &left; \
-             OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, level, NULL, al, &aout, E)); } while (0)
+             OUT_CASE(aout, tt_image_free, tt_upright_atlas(four, level, NULL, al, &aout, E)); } while (0)
         ATLAS_CASE(NULL, upright, 0, AL);
         ATLAS_CASE(plain, NULL, 0, AL);
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(NULL, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_upright_atlas(NULL, 0, NULL, AL, &aout, E));
         four[0] = plain;
         four[1] = upright;
         four[2] = &right;
         four[3] = &left;
-        CASE(tt_polycube_upright_atlas(four, 0, NULL, AL, NULL, E));
+        CASE(tt_upright_atlas(four, 0, NULL, AL, NULL, E));
         four[3] = &right;   /* both with the right side plain */
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_upright_atlas(four, 0, NULL, AL, &aout, E));
         four[2] = four[3] = upright;   /* sets 2 and 3 need plain_sides */
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_upright_atlas(four, 0, NULL, AL, &aout, E));
         four[3] = NULL;
-        OUT_CASE(aout, tt_image_free, tt_polycube_upright_atlas(four, 0, NULL, AL, &aout, E));
+        OUT_CASE(aout, tt_image_free, tt_upright_atlas(four, 0, NULL, AL, &aout, E));
         ATLAS_CASE(plain, upright, 0, BA1);
         ATLAS_CASE(plain, upright, 0, BA2);
         ATLAS_CASE(plain, upright, -1, AL);
