@@ -112,7 +112,8 @@ static void print_help(void)
            "\n"
            "Prints the polycube (cubes, squares, components, genus against the mesh's), the\n"
            "mapping (triangles split, triangles that fell back to one square: local seams, edges\n"
-           "with no path on the polycube, folds), the stretch of the texture on the triangles and\n"
+           "with no path on the polycube, folds), the tiles (how many, and which squares take\n"
+           "upright ones), the stretch of the texture on the triangles and\n"
            "the spread of its texel density (5th percentile, median, 95th, by area), the\n"
            "seam score on the tiles' borders, over all edges, and on the polycube's squares near\n"
            "their corners, within 5 %% of each edge's ends, where three to six tiles meet (about 0:\n"
@@ -644,6 +645,20 @@ static void print_summary(const polycube_command_options *options, const polycub
            tt_tile_layout_tile_count(&job->layout), job->layout.colors, job->layout.tile_size, job->layout.gutter,
            job->upright ? "; upright, plain on a top's side beside a wall" : "", job->compact->width,
            job->compact->height, job->full_width, job->full_height, job->layout.tile_size / job->polycube->h);
+    if (job->upright) {
+        /* How the squares' tiles split among the four sets. */
+        const tt_polycube *pc = job->polycube;
+        int q, walls = 0, tops = 0, one_side = 0, plain = 0;
+        for (q = 0; q < pc->surface->nfaces; q++) {
+            const tt_tileset_kind kind = tt_polycube_quad_tileset(pc, q);
+            if (pc->quad_side[q] / 2 != pc->up_axis) walls++;
+            else if (kind == TT_TILESET_UPRIGHT) tops++;
+            else if (kind == TT_TILESET_PLAIN) plain++;
+            else one_side++;
+        }
+        printf("squares: %d walls upright; %d tops and bottoms: %d upright, %d with one side plain (beside a wall), "
+               "%d plain\n", walls, tops + one_side + plain, tops, one_side, plain);
+    }
     if (!quality->mesh_built) {
         printf("stretch and seam score: not measured (%s)\n", quality->mesh_reason);
     } else {

@@ -1586,6 +1586,13 @@ check "polycube sphere: no note about cuts (none beyond 0.1 %)" "no 'no seamless
     "$(printf '%s' "$ERR" | grep -q 'no seamless place'; [ $? -ne 0 ]; echo $?)"
 check "polycube sphere: of the paper's 256 tiles in four sets, those shown" "'tiles: N of the 4 x 256 shown (n=2, 16 texels, gutter 4; upright, plain on a top's side beside a wall), in a WxH atlas (all would take 768x768)'" "$OUT" \
     "$(printf '%s' "$OUT" | grep -qE "^tiles: [0-9]+ of the 4 x 256 shown \(n=2, 16 texels, gutter 4; upright, plain on a top's side beside a wall\), in a [0-9]+x[0-9]+ atlas \(all would take 768x768\)"; echo $?)"
+SQUARES=$(printf '%s\n' "$OUT" | sed -nE 's/^squares: ([0-9]+) walls upright; ([0-9]+) tops and bottoms: ([0-9]+) upright, ([0-9]+) with one side plain \(beside a wall\), ([0-9]+) plain$/\1 \2 \3 \4 \5/p')
+QUADS=$(printf '%s\n' "$OUT" | sed -nE 's/.* ([0-9]+) quads, 1 component.*/\1/p')
+check "polycube sphere: the squares' tiles, walls and tops, add up to the quads" \
+    "'squares: W walls upright; T tops and bottoms: U upright, O with one side plain (beside a wall), P plain', W + T = $QUADS, U + O + P = T, U > 0, O > 0" \
+    "${SQUARES:-no squares line}" \
+    "$(read -r w t u o p <<<"$SQUARES"; [ -n "$p" ] && [ $((w + t)) -eq "${QUADS:-0}" ] && [ $((u + o + p)) -eq "$t" ] &&
+        [ "$u" -gt 0 ] && [ "$o" -gt 0 ]; echo $?)"
 expect_error "polycube --max-atlas below the tiles shown" polycube ../in/spheretri.obj ../in/tex.png out --tile 16 \
     --resolution 8 --max-atlas 64
 check "polycube --max-atlas 64: says the size the tiles need and what helps" \
