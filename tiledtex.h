@@ -175,10 +175,11 @@
      6. Tiled textures (Akleman, Chen, Meenakshisundaram, Srinivasan, "Tiled
                   Textures: A Simple and Practical Technique for Seamless Texturing")
                 - boundary assignment (random or prescribed), UV formula,
-                  tiles turned to follow a direction field (upright tiles),
-                  fewer distinct tiles, tile-set synthesis as a plan applied
-                  to one or more images, a compact atlas of the tiles shown,
-                  quality report
+                  tiles turned to follow a direction field (upright tiles,
+                  a side plain where the field turns), fewer distinct
+                  tiles, tile-set synthesis as a plan applied to one or
+                  more images, the atlas of the four sets of turned tiles,
+                  a compact atlas of the tiles shown, quality report
      7. Lapped textures (Praun, Finkelstein, Hoppe, "Lapped Textures")
                 - tangent field: texture up and scale per face (Sec. 3.2)
                 - texture patches with soft splotch masks (Sec. 3.1)
@@ -209,7 +210,7 @@
                   density evened out), each edge traced on S as a path
                   of quads (exact unfoldings), each triangle split along S's
                   quad edges into pieces inside one quad; the UVs from the
-                  tiles (Sec. 4)
+                  tiles (Sec. 4), upright on the walls and over the tops
 */
 #ifndef TILEDTEX_H
 #define TILEDTEX_H
