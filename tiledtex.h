@@ -1469,6 +1469,11 @@ typedef struct tt_synth_options {
        random window (most variety); at most TT_SYNTH_MAX_BACKGROUND_CANDIDATES. */
     int background_candidates;
     int feather;            /* texels of soft blend across each cut; 0 = max(2, S/16); negative is refused */
+    /* Mip levels tt_synth_apply makes: 0 = as many as the cells allow
+       (while their size halves evenly), n > 0 at most n; 1 = level 0 alone,
+       for an atlas cut up or filtered later (a compact atlas: a quarter less
+       memory). Negative is refused. */
+    int levels;
     /* Called by tt_synth_plan_create (which copies it into the plan) and by
        tt_synth_apply with that plan; tt_synthesize_tiles reports both as one
        run from 0 to 1. */
@@ -1504,6 +1509,7 @@ typedef struct tt_synth_plan {
     int source_width, source_height;/* the guide's size: every applied image must have it */
     int feather;                    /* resolved (options.feather or max(2, S/16)) */
     int max_depth;                  /* max(1, S/4): no band goes deeper (before its feather) */
+    int levels;                     /* copied from the options: the most mip levels tt_synth_apply makes (0: all) */
     tt_rect *edge_windows;          /* n rects (w = S, h = 2S), one per condition */
     tt_rect *vertical_windows;      /* upright plans: n rects (w = 2S, h = S) for sides 1 and 3; else NULL */
     int plain_sides;                /* upright plans: tt_synth_options::plain_sides; else 0 */
@@ -1531,7 +1537,7 @@ typedef struct tt_synth_plan {
    a tile (TT_ERROR_IMAGE_TOO_SMALL), a background region outside the guide,
    a given edge window that does not fit, a negative feather or one wider
    than S/4 + 1, plain_sides with other bits than 1 << 1 and 1 << 3 or
-   without upright, background_candidates outside
+   without upright, a negative levels, background_candidates outside
    0..TT_SYNTH_MAX_BACKGROUND_CANDIDATES (TT_ERROR_INVALID_ARGUMENT),
    TT_ERROR_OUT_OF_MEMORY, TT_CANCELLED by the
    progress callback. *out_plan is NULL on failure and nothing is left
@@ -10920,6 +10926,9 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
                         what, guide->width, guide->height, S, opt->upright ? "upright " : "",
                         opt->upright ? 2 * S : S, 2 * S,
                         tt__min_i(opt->upright ? guide->width / 2 : guide->width, guide->height / 2));
+    if (opt->levels < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "levels is %d: 0 (every mip level) or the most to make", opt->levels);
     if (opt->plain_sides & ~((1 << 1) | (1 << 3)) || (opt->plain_sides && !opt->upright))
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "plain_sides is %d: it takes the bits 1 << 1 and 1 << 3 (2, 8 or 10), and only with upright",
@@ -10960,6 +10969,7 @@ static tt_result tt__synth_plan_create(const tt_image *guide, const tt_synth_opt
     plan->source_height = guide->height;
     plan->feather = feather;
     plan->max_depth = max_depth;
+    plan->levels = opt->levels;
     plan->edge_windows = (tt_rect *)(void *)((unsigned char *)plan + head);
     if (opt->upright) {
         plan->vertical_windows = plan->edge_windows + n;
@@ -11252,7 +11262,8 @@ static tt_result tt__synth_apply(const tt_synth_plan *plan, const tt_image *sour
     /* Mip levels: while the cell size stays even, 2x2 blocks never straddle
        two cells, so halving the whole atlas halves every tile on its own. A
        level is seamless while its gutter is still at least a texel wide. */
-    while (set->nlevels < TT_MAX_MIP_LEVELS && ((C >> (set->nlevels - 1)) % 2) == 0) {
+    while (set->nlevels < TT_MAX_MIP_LEVELS && ((C >> (set->nlevels - 1)) % 2) == 0 &&
+           (plan->levels == 0 || set->nlevels < plan->levels)) {
         tt__mip_job mip;
         mip.above = &set->levels[set->nlevels - 1];
         mip.level = &set->levels[set->nlevels];

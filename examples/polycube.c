@@ -885,6 +885,8 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = tile_polycube(&options, &job);
     if (status == 0) {
         start = tool_seconds_now();
+        /* The compact atlas is cut from level 0; the mip levels would only take memory. */
+        options.tiles.levels = 1;
         status = tiled_synthesize(image, options.image_path, &options.tiles, &options.tiles.maps, &job.tiles,
                                   job.map_tiles);
         if (status == 0 && !options.plain) status = synthesize_upright(&options, image, &job);

@@ -578,6 +578,7 @@ int tiled_synthesize(const tt_image *image, const char *image_path, const tiled_
     synth.seed = options->seed;
     synth.background = options->background;
     synth.courses = options->courses;
+    synth.levels = options->levels;
     synth.executor = tool_executor();
     if (options->nedges > 0) {
         int colors = options->layout.colors ? options->layout.colors : 1;

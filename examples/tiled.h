@@ -42,6 +42,7 @@ typedef struct tiled_options {
     tool_mesh_output output;     /* --format, --triangles */
     const tt_rect *upright_over; /* not NULL: upright tiles (tt_synth_options::upright) on these edge windows */
     int plain_sides;             /* with upright_over: tt_synth_options::plain_sides */
+    int levels;                  /* tt_synth_options::levels: 1 when only level 0 is used */
     tool_field field;            /* --up, --constraints: each quad's tile turned along the field */
     int upright;                 /* with the field: faces may take upright tiles (the image feeds them) */
     material_maps maps;          /* the material's other maps (their paths; material_load loads them) */

@@ -1183,6 +1183,7 @@ static void upright_atlas_checks(const tt_tileset *const *sets, const tt_image *
               "another %s window in set 2 refused: %s", i == 0 ? "edge" : "vertical", err.message);
     }
     ctx.sets = sets;
+    oom_reset();
     oom_sweep("tt_upright_atlas", upright_atlas_oom_call, &ctx, TT_OK);
 }
 
@@ -1207,6 +1208,37 @@ static void test_upright_atlas(void)
         upright_atlas_checks((const tt_tileset *const *)sets, atlas);
     tt_image_free(atlas);
     for (k = 0; k < TT_TILESET_KINDS; k++) tt_tileset_free(sets[k]);
+    tt_image_free(noise);
+}
+
+/* tt_synth_options::levels: 1 makes level 0 alone, 2 two levels, 0 every
+   level the cells allow (the control: more than 2), the same level 0 each
+   time; a negative count is refused. */
+static void test_synth_levels(void)
+{
+    tt_image *noise = sy_noise(96, 96, 53u);
+    tt_tileset *sets[3] = {NULL, NULL, NULL};
+    tt_synth_options o = sy_options(1, 32, 4, 17u);
+    tt_synth_plan *bad = NULL;
+    tt_error err;
+    int k, same = 1;
+    for (k = 0; k < 3 && noise; k++) {
+        o.levels = k == 0 ? 0 : k;
+        if (tt_synthesize_tiles(noise, &o, NULL, &sets[k], &err) != TT_OK) sets[k] = NULL;
+    }
+    for (k = 1; k < 3; k++)
+        same &= sets[0] && sets[k] &&
+                memcmp(sets[0]->levels[0].pixels, sets[k]->levels[0].pixels,
+                       (size_t)sets[0]->levels[0].width * sets[0]->levels[0].height * 4 * sizeof(float)) == 0;
+    CHECK(sets[0] && sets[1] && sets[2] && sets[0]->nlevels > 2 && sets[1]->nlevels == 1 && sets[2]->nlevels == 2 &&
+              same,
+          "levels 0, 1, 2: %d, %d, %d mip levels, level 0 the same", sets[0] ? sets[0]->nlevels : -1,
+          sets[1] ? sets[1]->nlevels : -1, sets[2] ? sets[2]->nlevels : -1);
+    o.levels = -1;
+    CHECK(noise && tt_synth_plan_create(noise, &o, NULL, &bad, &err) == TT_ERROR_INVALID_ARGUMENT && !bad &&
+              strstr(err.message, "levels"),
+          "levels -1 refused: %s", err.message);
+    for (k = 0; k < 3; k++) tt_tileset_free(sets[k]);
     tt_image_free(noise);
 }
 
@@ -1848,6 +1880,7 @@ void run_tiled_synthesis_tests(void)
     RUN(test_upright_tiles);
     RUN(test_upright_plain_sides);
     RUN(test_upright_atlas);
+    RUN(test_synth_levels);
     RUN(test_find_courses);
     RUN(test_synthesis_keeps_courses);
     RUN(test_second_map_same_masks);

@@ -1139,6 +1139,14 @@ static void cases_tiled(const baseline *b)
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
     sb = so; sb.feather = INT_MAX;
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
+    sb = so; sb.levels = -1;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
+    sb = so; sb.levels = INT_MIN;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
+    sb = so; sb.plain_sides = 1 << 1;   /* without upright */
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
+    sb = so; sb.upright = 1; sb.plain_sides = -1;
+    OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
     sb = so; sb.background_candidates = -1;
     OUT_CASE(pout, tt_synth_plan_free, tt_synth_plan_create(img, &sb, AL, &pout, E));
     sb = so; sb.background_candidates = INT_MAX;
