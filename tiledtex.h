@@ -9423,6 +9423,15 @@ TTDEF tt_result tt_assign_boundaries(const tt_mesh *mesh, const tt_tile_layout *
     return TT_OK;
 }
 
+/* A UV of one tile set's atlas moved into set `kind`'s quarter of
+   tt_upright_atlas's: tt_assign_uvs_oriented's and
+   tt_polycube_mapping_uvs_upright's arithmetic, the one place it lives. */
+static void tt__upright_atlas_uv(int kind, float uv[2])
+{
+    uv[0] = 0.5f * (uv[0] + (float)(kind % 2));
+    uv[1] = 0.5f * (uv[1] + (float)(kind / 2));
+}
+
 /* tt_assign_uvs and tt_assign_uvs_oriented: face_turn and face_upright
    NULL give tt_assign_uvs's UVs. */
 static tt_result tt__assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layout, const uint8_t *corner_type,
@@ -9474,9 +9483,9 @@ static tt_result tt__assign_uvs(const tt_mesh *mesh, const tt_tile_layout *layou
         tile[6] = u0; tile[7] = v1;   /* corner 3: top-left     */
         for (k = 0; k < 4; k++) {
             const int at = (k + turn) & 3;
-            /* tt_polycube_mapping_uvs_upright's quarters, the same arithmetic. */
-            uv[2 * at] = face_upright ? 0.5f * (tile[2 * k] + (float)(face_upright[f] % 2)) : tile[2 * k];
-            uv[2 * at + 1] = face_upright ? 0.5f * (tile[2 * k + 1] + (float)(face_upright[f] / 2)) : tile[2 * k + 1];
+            uv[2 * at] = tile[2 * k];
+            uv[2 * at + 1] = tile[2 * k + 1];
+            if (face_upright) tt__upright_atlas_uv(face_upright[f], uv + 2 * at);
         }
     }
     return TT_OK;
@@ -31367,11 +31376,7 @@ static tt_result tt__polycube_mapping_uvs(const tt_polycube *polycube, const tt_
         tt_tile_corner_uv(&resolved, types, 2, high);
         corner_uv[2 * i] = low[0] + p.s * (high[0] - low[0]);
         corner_uv[2 * i + 1] = low[1] + p.t * (high[1] - low[1]);
-        if (upright) {
-            const int set = (int)tt_polycube_quad_tileset(polycube, p.quad);
-            corner_uv[2 * i] = 0.5f * (corner_uv[2 * i] + (float)(set % 2));
-            corner_uv[2 * i + 1] = 0.5f * (corner_uv[2 * i + 1] + (float)(set / 2));
-        }
+        if (upright) tt__upright_atlas_uv((int)tt_polycube_quad_tileset(polycube, p.quad), corner_uv + 2 * i);
     }
     return TT_OK;
 }

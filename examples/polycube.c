@@ -416,7 +416,8 @@ static int tile_polycube(const polycube_command_options *options, polycube_job *
    need 2S x 2S) keeps the plain ones, with a note. */
 static int synthesize_upright(const polycube_command_options *options, const tt_image *image, polycube_job *job)
 {
-    int c, status;
+    tt_error error;
+    int status;
     if (image->width < 2 * job->layout.tile_size || image->height < 2 * job->layout.tile_size) {
         tool_note("%s: %dx%d is too small for upright %d-texel tiles (they need %dx%d): the tiles are plain, "
                   "turned a quarter on their left and right sides (use a smaller --tile)",
@@ -428,11 +429,11 @@ static int synthesize_upright(const polycube_command_options *options, const tt_
                                            job->upright_tiles, job->map_upright_tiles)) != 0)
         return status;
     job->upright = 1;
-    for (c = 0; c < job->polycube->surface->ncorners; c++) {
-        const int set = (int)tt_polycube_quad_tileset(job->polycube, job->polycube->surface->corner_face[c]);
-        job->surface_uv[2 * c] = 0.5f * (job->surface_uv[2 * c] + (float)(set % 2));
-        job->surface_uv[2 * c + 1] = 0.5f * (job->surface_uv[2 * c + 1] + (float)(set / 2));
-    }
+    /* surface_group holds each square's set (tile_polycube): S's own UVs in
+       its set's quarter, as tt_polycube_mapping_uvs_upright puts the mesh's. */
+    if (tt_assign_uvs_oriented(job->polycube->surface, &job->layout, job->surface_type, NULL, job->surface_group,
+                               job->surface_uv, &error) != TT_OK)
+        return tool_fail("%s: the polycube's tiles: %s", options->mesh_path, error.message);
     return 0;
 }
 
