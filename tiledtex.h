@@ -548,6 +548,90 @@ TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3]);
 TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, const tt_allocator *allocator,
                                   float *corner_normal, tt_error *error);
 
+/* ---- A new quad mesh along a direction field ----
+   Based on: W. Jakob, M. Tarini, D. Panozzo, O. Sorkine-Hornung, "Instant
+   Field-Aligned Meshes" (SIGGRAPH Asia 2015):
+     Sec. 3   an orientation field, smoothed as a 4-fold symmetric field
+              (a direction counts as its quarter turns), here anchored to
+              your face_vectors where face_weights say they matter;
+     Sec. 4   a position field: at each vertex the nearest point of a local
+              square lattice of spacing edge_length, smoothed so that
+              neighbours' lattices agree up to whole lattice steps;
+     Sec. 3.3 both smoothed coarse to fine over a hierarchy of vertex pairs;
+     Sec. 5   extraction: vertices whose lattices agree on the same point
+              become one output vertex, neighbours one lattice step apart
+              an output edge, and the faces are traced around them.
+   Beyond the paper: the input is first refined (linear quadrangulation)
+   until nine edges in ten are at most 0.7 edge_length, which extraction
+   needs; the faces are traced from the edges' order around
+   each vertex, so the result is always a valid mesh (see below); output
+   vertices are moved onto the input's surface.
+
+   What it is for: tiles (section 6) follow a quad's edges, so on a triangle
+   scan quadrangulated in place, where each triangle makes three kites, a
+   brick photo's courses run every way. Here the quads' edges follow the
+   field: with tt_tangent_field's, walls get rows of quads with level edges.
+   Run tt_mesh_quadrangulate on the result for quads only (each face into
+   quads of half the size: pass twice the edge length you want). */
+
+typedef struct tt_remesh_options {
+    float edge_length;          /* the output's edge length in mesh units; 0 = TT_DEFAULT_REMESH_EDGE
+                                   times the bounding-box diagonal */
+    const float *face_weights;  /* mesh->nfaces weights in [0, 1]: how firmly each face's vector holds
+                                   the direction (1: exactly; 0: free, the field is smoothed there).
+                                   NULL: 1 everywhere. Give 0 where the vector is a guess, e.g. where
+                                   a surface faces up and "up" decides nothing */
+    int sweeps;                 /* smoothing sweeps per hierarchy level; 0 = TT_DEFAULT_REMESH_SWEEPS */
+} tt_remesh_options;
+
+#define TT_DEFAULT_REMESH_EDGE 0.025f    /* 1/40 of the bounding-box diagonal */
+#define TT_DEFAULT_REMESH_SWEEPS 10
+#define TT_MAX_REMESH_VERTICES (1 << 24) /* the refined input's vertices at most */
+
+typedef struct tt_remesh_report {
+    int refinements;            /* linear quadrangulations of the input before remeshing */
+    int working_vertices;       /* vertices of that refined input */
+    int levels;                 /* levels of the hierarchy */
+    int triangles, quads, pentagons, larger_faces;  /* the output's faces by sides */
+    int folded_faces;           /* output faces turned against the surface's normal (kept) */
+    int split_faces;            /* traced faces that met themselves at a vertex, split there */
+    int split_vertices;         /* output vertices duplicated so that each has one fan of faces */
+    int dropped_faces;          /* traced faces across the input's holes, and stray pieces */
+} tt_remesh_report;
+
+/* A new polygon mesh of mostly quads with edges of about edge_length whose
+   edges follow face_vectors (3 * mesh->nfaces floats, each in its face's
+   plane, as tt_tangent_field makes them; only directions count, and a
+   direction and its quarter turns are the same). Its vertices lie on the
+   input's faces; it has the input's holes larger than about an edge, and
+   its faces are mostly quads, with triangles and pentagons where a row of
+   quads ends and at the field's singularities.
+
+   The result is always a mesh tt_mesh_build accepts (strict): each vertex
+   has one fan of faces (duplicated otherwise), no face repeats a vertex.
+   Its genus can differ from the input's where the surface is thinner than
+   about an edge (a handle closes) and the report counts faces turned
+   against the surface (folds where the field could not be followed); a
+   smaller edge_length follows the shape more closely.
+
+   options may be NULL (all defaults); report may be NULL.
+   Cost: O(V log V) in the refined input's vertices V (refinement makes
+   V about area / (edge_length / 2)^2 or more); about 2 s for 50k vertices
+   at -O2, serial. Temporary memory about 400 bytes per refined vertex.
+   Errors: NULL mesh, face_vectors or out_mesh, a negative, non-finite or
+   too large edge_length (more than a quarter of the bounding-box
+   diagonal), sweeps < 0, a face weight outside [0, 1] (error->face):
+   TT_ERROR_INVALID_ARGUMENT; a non-finite face vector (error->face):
+   TT_ERROR_NON_FINITE; a mesh without faces: TT_ERROR_EMPTY_MESH; a mesh
+   with no extent: TT_ERROR_ZERO_AREA_FACE; an edge_length so small that
+   the refined input would pass TT_MAX_REMESH_VERTICES: TT_ERROR_TOO_LARGE;
+   a field so inconsistent that no face could be traced:
+   TT_ERROR_NOT_CONVERGED; TT_ERROR_OUT_OF_MEMORY. Deterministic; the
+   result is built with `allocator` and freed with tt_mesh_free. */
+TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, const tt_remesh_options *options,
+                                const tt_allocator *allocator, tt_mesh **out_mesh, tt_remesh_report *report,
+                                tt_error *error);
+
 /* ======================================================================== */
 /* 3. Image                                                                 */
 /* ======================================================================== */
@@ -2033,6 +2117,18 @@ typedef struct tt_field_options {
    Deterministic; reentrant and thread-safe on distinct outputs. */
 TTDEF tt_result tt_tangent_field(const tt_mesh *mesh, const tt_field_options *options,
                                  const tt_allocator *allocator, float *face_vectors, tt_error *error);
+
+/* How firmly tt_tangent_field's field holds each face's direction, in
+   [0, 1], e.g. for tt_remesh_quads' face_weights. Without constraints:
+   how much up decides the face (0 within 6 degrees of facing up or down,
+   where the field only continues its surroundings; 1 from 30 degrees on;
+   smooth between); with constraints, 1 on every face. face_weights gets
+   mesh->nfaces floats; a face of zero area gets 0. Errors: those of
+   tt_tangent_field's options (up, scale, sigma, nconstraints), NULL mesh or
+   face_weights (TT_ERROR_INVALID_ARGUMENT), a mesh without faces
+   (TT_ERROR_EMPTY_MESH). Allocates nothing. */
+TTDEF tt_result tt_field_face_weights(const tt_mesh *mesh, const tt_field_options *options, float *face_weights,
+                                      tt_error *error);
 
 /* Texture patches.
    Based on: Praun, Finkelstein, Hoppe, "Lapped Textures" (SIGGRAPH 2000),
@@ -4429,6 +4525,40 @@ static tt__heap_item tt__heap_pop(tt__heap_item *heap, int *count)
 
 TT__DEFINE_HEAPSORT(tt__sort_doubles, double)
 
+/* The k-th smallest of values[0 .. count-1] (0-based, 0 <= k < count),
+   which are reordered so that the ones before position k are no larger and
+   the ones after no smaller: Hoare's selection with a middle-of-three
+   pivot, linear time on average where a sort takes n log n; after 2 log2 n
+   rounds without getting there (an input built against the pivot) the
+   range left is heapsorted, so the worst case stays n log n. */
+static double tt__select(double *values, int count, int k)
+{
+    int lo = 0, hi = count - 1, rounds = 0, limit = 2;
+    while ((1 << (limit / 2)) < count && limit < 62) limit += 2;
+    while (lo < hi) {
+        double a = values[lo], b = values[lo + (hi - lo) / 2], c = values[hi], pivot, t;
+        int i = lo, j = hi;
+        if (rounds++ == limit) {
+            tt__sort_doubles(values + lo, hi - lo + 1);
+            break;
+        }
+        pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        while (i <= j) {
+            while (values[i] < pivot) i++;
+            while (values[j] > pivot) j--;
+            if (i <= j) {
+                t = values[i];
+                values[i++] = values[j];
+                values[j--] = t;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+    return values[k];
+}
+
 /* PCG32 (O'Neill 2014): a 64-bit LCG whose output is a permuted 32-bit word. */
 TTDEF uint32_t tt_rng_next(tt_rng *rng)
 {
@@ -6069,6 +6199,1208 @@ TTDEF tt_result tt_corner_sources_apply(const tt_corner_sources *sources, int co
     return TT_OK;
 }
 
+/* ---- A new quad mesh along a direction field (Jakob et al. 2015) ---- */
+
+/* An anchored vertex's own direction weighs as much as this many
+   neighbours (the paper smooths freely; here the caller's field decides
+   where its weight says so). */
+#define TT__REMESH_ANCHOR 4.0
+/* The hierarchy stops at this many vertices, or when pairing stops
+   shrinking a level by a tenth. */
+#define TT__REMESH_COARSEST 64
+#define TT__REMESH_MAX_LEVELS 40
+
+typedef struct tt__remesh_level {
+    int n;
+    double *x, *normal, *area;      /* 3n, 3n, n: position, unit normal, area */
+    double *anchor, *weight;        /* 3n, n: the caller's direction and its weight */
+    double *orient, *lattice;       /* 3n, 3n: the smoothed direction, the nearest lattice point */
+    int *adj_start, *adj;           /* neighbours: adj[adj_start[i] .. adj_start[i + 1]) */
+    int *parent;                    /* n: the vertex of the next coarser level; NULL on the coarsest */
+} tt__remesh_level;
+
+static int tt__int_compare(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+static int tt__u64_compare(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+/* A pair of vertices and its score, sorted by score, then by the pair
+   (the order is total, so the result does not depend on qsort). */
+typedef struct tt__scored_edge {
+    double score;
+    int a, b;
+} tt__scored_edge;
+
+static int tt__scored_edge_compare(const void *x, const void *y)
+{
+    const tt__scored_edge *p = (const tt__scored_edge *)x, *q = (const tt__scored_edge *)y;
+    if (p->score != q->score) return p->score < q->score ? -1 : 1;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    return p->b < q->b ? -1 : (p->b > q->b ? 1 : 0);
+}
+
+static void tt__remesh_level_free(const tt_allocator *al, tt__remesh_level *l)
+{
+    tt__free(al, l->x); tt__free(al, l->normal); tt__free(al, l->area);
+    tt__free(al, l->anchor); tt__free(al, l->weight);
+    tt__free(al, l->orient); tt__free(al, l->lattice);
+    tt__free(al, l->adj_start); tt__free(al, l->adj); tt__free(al, l->parent);
+    memset(l, 0, sizeof *l);
+}
+
+static int tt__remesh_level_alloc(const tt_allocator *al, tt__remesh_level *l, int n)
+{
+    memset(l, 0, sizeof *l);
+    l->n = n;
+    l->x = TT__ALLOC(al, double, 3 * (size_t)n);
+    l->normal = TT__ALLOC(al, double, 3 * (size_t)n);
+    l->area = TT__ALLOC(al, double, n);
+    l->anchor = TT__ALLOC(al, double, 3 * (size_t)n);
+    l->weight = TT__ALLOC(al, double, n);
+    l->orient = TT__ALLOC(al, double, 3 * (size_t)n);
+    l->lattice = TT__ALLOC(al, double, 3 * (size_t)n);
+    l->adj_start = TT__ALLOC(al, int, (size_t)n + 1);
+    return l->x && l->normal && l->area && l->anchor && l->weight && l->orient && l->lattice && l->adj_start;
+}
+
+/* Of the four quarter turns of o about n, the one closest to target. */
+static void tt__rosy4_nearest(const double *target, const double *o, const double *n, double *out)
+{
+    double t[3], a, b;
+    int k;
+    tt__cross3(n, o, t);
+    a = tt__dot3(target, o);
+    b = tt__dot3(target, t);
+    if (fabs(a) >= fabs(b)) {
+        for (k = 0; k < 3; k++) out[k] = a >= 0.0 ? o[k] : -o[k];
+    } else {
+        for (k = 0; k < 3; k++) out[k] = b >= 0.0 ? t[k] : -t[k];
+    }
+}
+
+/* A unit tangent at normal n: d projected, or any tangent if that is zero. */
+static void tt__tangent_or_any(const double *d, const double *n, double *out)
+{
+    double axis[3] = {1.0, 0.0, 0.0};
+    tt__project3(d, n, out);
+    if (tt__normalize3(out) > 0.0) return;
+    if (fabs(n[0]) > 0.9) { axis[0] = 0.0; axis[1] = 1.0; }
+    tt__cross3(n, axis, out);
+    if (tt__normalize3(out) == 0.0) { out[0] = 1.0; out[1] = 0.0; out[2] = 0.0; }
+}
+
+/* Point p + rho (a o + b (n x o)). */
+static void tt__lattice_point(const double *p, const double *o, const double *n, double rho, int a, int b,
+                              double *out)
+{
+    double t[3];
+    int k;
+    tt__cross3(n, o, t);
+    for (k = 0; k < 3; k++) out[k] = p[k] + rho * ((double)a * o[k] + (double)b * t[k]);
+}
+
+/* The points of lattices i and j (origins pi, pj, directions oi and oj
+   already matched by tt__rosy4_nearest) closest to each other near the
+   middle of xi and xj: their integer coordinates ci, cj in their own
+   lattices; returns the distance between the two points. Of the four
+   lattice points around the middle on each side, the closest pair wins
+   (the paper's compat_position, extrinsic form). */
+static double tt__lattice_pair(const double *xi, const double *ni, const double *oi, const double *pi,
+                               const double *xj, const double *nj, const double *oj, const double *pj, double rho,
+                               int ci[2], int cj[2])
+{
+    double ti[3], tj[3], mi[3], mj[3], base[3], best = HUGE_VAL;
+    int k, fi[2], fj[2], q, r;
+    tt__cross3(ni, oi, ti);
+    tt__cross3(nj, oj, tj);
+    for (k = 0; k < 3; k++) {
+        double m = 0.5 * (xi[k] + xj[k]);
+        mi[k] = m - pi[k];
+        mj[k] = m - pj[k];
+    }
+    fi[0] = (int)floor(tt__dot3(mi, oi) / rho); fi[1] = (int)floor(tt__dot3(mi, ti) / rho);
+    fj[0] = (int)floor(tt__dot3(mj, oj) / rho); fj[1] = (int)floor(tt__dot3(mj, tj) / rho);
+    ci[0] = fi[0]; ci[1] = fi[1]; cj[0] = fj[0]; cj[1] = fj[1];
+    /* The lower-left points' difference; each candidate adds whole steps. */
+    for (k = 0; k < 3; k++)
+        base[k] = pi[k] - pj[k] + rho * (fi[0] * oi[k] + fi[1] * ti[k] - fj[0] * oj[k] - fj[1] * tj[k]);
+    for (q = 0; q < 4; q++) {
+        double dq[3];
+        for (k = 0; k < 3; k++) dq[k] = base[k] + rho * ((q & 1) * oi[k] + (q >> 1) * ti[k]);
+        for (r = 0; r < 4; r++) {
+            double d[3], dd;
+            for (k = 0; k < 3; k++) d[k] = dq[k] - rho * ((r & 1) * oj[k] + (r >> 1) * tj[k]);
+            dd = tt__dot3(d, d);
+            if (dd < best) {
+                best = dd;
+                ci[0] = fi[0] + (q & 1); ci[1] = fi[1] + (q >> 1);
+                cj[0] = fj[0] + (r & 1); cj[1] = fj[1] + (r >> 1);
+            }
+        }
+    }
+    return sqrt(best);
+}
+
+/* One Gauss-Seidel sweep of the orientation field, forwards or backwards:
+   each direction becomes the mean of its neighbours' (each turned by the
+   quarter turn nearest it) and its anchor, weighted. */
+static void tt__remesh_orient_sweep(tt__remesh_level *l, int backwards)
+{
+    int s;
+    for (s = 0; s < l->n; s++) {
+        int i = backwards ? l->n - 1 - s : s, e, k;
+        const double *n = l->normal + 3 * (size_t)i;
+        double *o = l->orient + 3 * (size_t)i, sum[3], w = 0.0, cur[3];
+        if (l->adj_start[i] == l->adj_start[i + 1] && l->weight[i] <= 0.0) continue;
+        if (l->weight[i] > 0.0) {
+            double a[3];
+            tt__rosy4_nearest(o, l->anchor + 3 * (size_t)i, n, a);
+            w = TT__REMESH_ANCHOR * l->weight[i];
+            for (k = 0; k < 3; k++) sum[k] = a[k];
+        } else {
+            for (k = 0; k < 3; k++) sum[k] = o[k];
+        }
+        for (e = l->adj_start[i]; e < l->adj_start[i + 1]; e++) {
+            int j = l->adj[e];
+            double oj[3], pj[3];
+            for (k = 0; k < 3; k++) cur[k] = sum[k];
+            if (tt__normalize3(cur) == 0.0) for (k = 0; k < 3; k++) cur[k] = o[k];
+            tt__rosy4_nearest(cur, l->orient + 3 * (size_t)j, l->normal + 3 * (size_t)j, oj);
+            tt__project3(oj, n, pj);
+            for (k = 0; k < 3; k++) sum[k] = (sum[k] * w + pj[k]) / (w + 1.0);
+            w += 1.0;
+        }
+        tt__project3(sum, n, cur);
+        if (tt__normalize3(cur) > 0.0) for (k = 0; k < 3; k++) o[k] = cur[k];
+    }
+}
+
+/* One Gauss-Seidel sweep of the position field: each lattice moves to the
+   running mean of its neighbours' nearest points, stays in its tangent
+   plane, and is stored as its point nearest the vertex. */
+static void tt__remesh_position_sweep(tt__remesh_level *l, double rho, int backwards)
+{
+    int s;
+    for (s = 0; s < l->n; s++) {
+        int i = backwards ? l->n - 1 - s : s, e, k;
+        const double *x = l->x + 3 * (size_t)i, *n = l->normal + 3 * (size_t)i, *o = l->orient + 3 * (size_t)i;
+        double q[3], w = 0.0, t[3], d[3], a, b;
+        for (k = 0; k < 3; k++) q[k] = l->lattice[3 * (size_t)i + k];
+        for (e = l->adj_start[i]; e < l->adj_start[i + 1]; e++) {
+            int j = l->adj[e], ci[2], cj[2];
+            double oj[3], li[3], lj[3];
+            const double *nj = l->normal + 3 * (size_t)j;
+            tt__rosy4_nearest(o, l->orient + 3 * (size_t)j, nj, oj);
+            tt__lattice_pair(x, n, o, q, l->x + 3 * (size_t)j, nj, oj, l->lattice + 3 * (size_t)j, rho, ci, cj);
+            tt__lattice_point(q, o, n, rho, ci[0], ci[1], li);
+            tt__lattice_point(l->lattice + 3 * (size_t)j, oj, nj, rho, cj[0], cj[1], lj);
+            w += 1.0;
+            for (k = 0; k < 3; k++) q[k] += (lj[k] - li[k]) / w;
+        }
+        for (k = 0; k < 3; k++) d[k] = q[k] - x[k];
+        a = tt__dot3(d, n);
+        for (k = 0; k < 3; k++) q[k] -= a * n[k];
+        tt__cross3(n, o, t);
+        for (k = 0; k < 3; k++) d[k] = x[k] - q[k];
+        a = floor(tt__dot3(d, o) / rho + 0.5);
+        b = floor(tt__dot3(d, t) / rho + 0.5);
+        for (k = 0; k < 3; k++) l->lattice[3 * (size_t)i + k] = q[k] + rho * (a * o[k] + b * t[k]);
+    }
+}
+
+/* The next coarser level: vertices paired along edges, the pairs of most
+   similar normals first (scaled by their areas' ratio, as the paper
+   does), every vertex in at most one pair. Returns 0 on allocation
+   failure, else 1 (c->n == f->n when nothing paired). */
+static int tt__remesh_coarsen(const tt_allocator *al, tt__remesh_level *f, tt__remesh_level *c)
+{
+    int n = f->n, i, e, pairs = 0, cn = 0, ok = 0, total;
+    tt__scored_edge *order = NULL;
+    int *fill = NULL;
+    memset(c, 0, sizeof *c);
+    f->parent = TT__ALLOC(al, int, n);
+    order = TT__ALLOC(al, tt__scored_edge, (size_t)f->adj_start[n] / 2 + 1);
+    if (!f->parent || !order) goto done;
+    for (i = 0; i < n; i++) {
+        for (e = f->adj_start[i]; e < f->adj_start[i + 1]; e++) {
+            int j = f->adj[e];
+            double ratio;
+            if (j <= i) continue;
+            ratio = f->area[i] > f->area[j] ? f->area[i] / fmax(f->area[j], DBL_MIN)
+                                            : f->area[j] / fmax(f->area[i], DBL_MIN);
+            /* Sorted ascending: the best pair first. */
+            order[pairs].score = -tt__dot3(f->normal + 3 * (size_t)i, f->normal + 3 * (size_t)j) * fmin(ratio, 1e6);
+            order[pairs].a = i;
+            order[pairs].b = j;
+            pairs++;
+        }
+    }
+    qsort(order, (size_t)pairs, sizeof *order, tt__scored_edge_compare);
+    for (i = 0; i < n; i++) f->parent[i] = -1;
+    for (e = 0; e < pairs; e++) {
+        int a = order[e].a, b = order[e].b;
+        if (f->parent[a] < 0 && f->parent[b] < 0) f->parent[a] = f->parent[b] = cn++;
+    }
+    for (i = 0; i < n; i++) if (f->parent[i] < 0) f->parent[i] = cn++;
+    if (!tt__remesh_level_alloc(al, c, cn)) goto done;
+    memset(c->x, 0, 3 * (size_t)cn * sizeof(double));
+    memset(c->normal, 0, 3 * (size_t)cn * sizeof(double));
+    memset(c->area, 0, (size_t)cn * sizeof(double));
+    memset(c->anchor, 0, 3 * (size_t)cn * sizeof(double));
+    memset(c->weight, 0, (size_t)cn * sizeof(double));
+    for (i = 0; i < n; i++) {
+        int p = f->parent[i], k;
+        double a = f->area[i];
+        for (k = 0; k < 3; k++) {
+            c->x[3 * (size_t)p + k] += a * f->x[3 * (size_t)i + k];
+            c->normal[3 * (size_t)p + k] += a * f->normal[3 * (size_t)i + k];
+        }
+        c->area[p] += a;
+    }
+    for (i = 0; i < cn; i++) {
+        int k;
+        double *cx = c->x + 3 * (size_t)i;
+        if (c->area[i] > 0.0) for (k = 0; k < 3; k++) cx[k] /= c->area[i];
+        if (tt__normalize3(c->normal + 3 * (size_t)i) == 0.0) { c->normal[3 * (size_t)i + 2] = 1.0; }
+    }
+    /* positions of zero-area pairs: their members' mean */
+    for (i = 0; i < n; i++) {
+        int p = f->parent[i], k;
+        if (c->area[p] > 0.0) continue;
+        for (k = 0; k < 3; k++) c->x[3 * (size_t)p + k] = f->x[3 * (size_t)i + k];
+    }
+    for (i = 0; i < n; i++) {
+        int p = f->parent[i], k;
+        double a[3], w = f->weight[i] * f->area[i];
+        double *ca = c->anchor + 3 * (size_t)p;
+        if (w <= 0.0) continue;
+        if (c->weight[p] > 0.0) {
+            double cur[3];
+            for (k = 0; k < 3; k++) cur[k] = ca[k];
+            tt__normalize3(cur);
+            tt__rosy4_nearest(cur, f->anchor + 3 * (size_t)i, f->normal + 3 * (size_t)i, a);
+        } else {
+            for (k = 0; k < 3; k++) a[k] = f->anchor[3 * (size_t)i + k];
+        }
+        for (k = 0; k < 3; k++) ca[k] += w * a[k];
+        c->weight[p] += w;
+    }
+    for (i = 0; i < cn; i++) {
+        double t[3];
+        if (c->weight[i] > 0.0) {
+            tt__tangent_or_any(c->anchor + 3 * (size_t)i, c->normal + 3 * (size_t)i, t);
+            memcpy(c->anchor + 3 * (size_t)i, t, sizeof t);
+            c->weight[i] = c->area[i] > 0.0 ? fmin(1.0, c->weight[i] / c->area[i]) : 0.0;
+        }
+    }
+    /* Neighbours: the fine level's, through parent, without repeats. */
+    fill = TT__ALLOC(al, int, (size_t)cn + 1);
+    if (!fill) goto done;
+    memset(c->adj_start, 0, ((size_t)cn + 1) * sizeof(int));
+    for (i = 0; i < n; i++)
+        for (e = f->adj_start[i]; e < f->adj_start[i + 1]; e++)
+            if (f->parent[f->adj[e]] != f->parent[i]) c->adj_start[f->parent[i] + 1]++;
+    for (i = 0; i < cn; i++) c->adj_start[i + 1] += c->adj_start[i];
+    total = c->adj_start[cn];
+    c->adj = TT__ALLOC(al, int, (size_t)total + 1);
+    if (!c->adj) goto done;
+    for (i = 0; i < cn; i++) fill[i] = c->adj_start[i];
+    for (i = 0; i < n; i++)
+        for (e = f->adj_start[i]; e < f->adj_start[i + 1]; e++) {
+            int p = f->parent[i], q = f->parent[f->adj[e]];
+            if (q != p) c->adj[fill[p]++] = q;
+        }
+    {
+        int w = 0, p;
+        for (p = 0; p < cn; p++) {
+            int begin = c->adj_start[p], end = c->adj_start[p + 1], k;
+            qsort(c->adj + begin, (size_t)(end - begin), sizeof(int), tt__int_compare);
+            c->adj_start[p] = w;
+            for (k = begin; k < end; k++)
+                if (k == begin || c->adj[k] != c->adj[k - 1]) c->adj[w++] = c->adj[k];
+        }
+        c->adj_start[cn] = w;
+    }
+    ok = 1;
+done:
+    tt__free(al, order);
+    tt__free(al, fill);
+    return ok;
+}
+
+/* Level 0, from the refined input: per vertex its position, normal (its
+   faces' Newell vectors summed), area (a share of each face), anchor (the
+   4-fold mean of its faces' vectors, turned to agree, by area times
+   weight) and weight (the faces' weights by area); neighbours: every other
+   vertex of its faces, a quad's diagonal too. */
+static int tt__remesh_base_level(const tt_allocator *al, const tt_mesh *m, const float *face_vectors,
+                                 const float *face_weights, const int *face_source, tt__remesh_level *l)
+{
+    int n = m->nverts, f, i, c, total, *fill = NULL, ok = 0;
+    if (!tt__remesh_level_alloc(al, l, n)) return 0;
+    memset(l->normal, 0, 3 * (size_t)n * sizeof(double));
+    memset(l->area, 0, (size_t)n * sizeof(double));
+    memset(l->anchor, 0, 3 * (size_t)n * sizeof(double));
+    memset(l->weight, 0, (size_t)n * sizeof(double));
+    for (i = 0; i < n; i++) {
+        int k;
+        for (k = 0; k < 3; k++) l->x[3 * (size_t)i + k] = m->pos[3 * (size_t)i + k];
+    }
+    for (f = 0; f < m->nfaces; f++) {
+        int begin = m->face_start[f], end = m->face_start[f + 1], k;
+        double nv[3], scale, area, share;
+        tt__polygon_newell(m->pos, m->corner_vert + begin, end - begin, nv, &scale);
+        area = 0.5 * tt__length3(nv);
+        share = area / (end - begin);
+        for (c = begin; c < end; c++) {
+            int v = m->corner_vert[c];
+            for (k = 0; k < 3; k++) l->normal[3 * (size_t)v + k] += nv[k];
+            l->area[v] += share;
+        }
+    }
+    for (i = 0; i < n; i++)
+        if (tt__normalize3(l->normal + 3 * (size_t)i) == 0.0) l->normal[3 * (size_t)i + 2] = 1.0;
+    for (f = 0; f < m->nfaces; f++) {
+        int begin = m->face_start[f], end = m->face_start[f + 1], src = face_source[f], k;
+        double w = face_weights ? face_weights[src] : 1.0, share = tt__face_area_d(m, f) / (end - begin);
+        double d[3];
+        for (k = 0; k < 3; k++) d[k] = face_vectors[3 * (size_t)src + k];
+        if (w <= 0.0 || share <= 0.0 || tt__length3(d) == 0.0) continue;
+        for (c = begin; c < end; c++) {
+            int v = m->corner_vert[c];
+            double *a = l->anchor + 3 * (size_t)v, t[3], turned[3], cur[3];
+            tt__project3(d, l->normal + 3 * (size_t)v, t);
+            if (tt__normalize3(t) == 0.0) continue;
+            if (l->weight[v] > 0.0) {
+                for (k = 0; k < 3; k++) cur[k] = a[k];
+                tt__normalize3(cur);
+                tt__rosy4_nearest(cur, t, l->normal + 3 * (size_t)v, turned);
+            } else {
+                for (k = 0; k < 3; k++) turned[k] = t[k];
+            }
+            for (k = 0; k < 3; k++) a[k] += share * w * turned[k];
+            l->weight[v] += share * w;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        double t[3];
+        if (l->weight[i] <= 0.0) continue;
+        tt__tangent_or_any(l->anchor + 3 * (size_t)i, l->normal + 3 * (size_t)i, t);
+        memcpy(l->anchor + 3 * (size_t)i, t, sizeof t);
+        l->weight[i] = l->area[i] > 0.0 ? fmin(1.0, l->weight[i] / l->area[i]) : 0.0;
+    }
+    memset(l->adj_start, 0, ((size_t)n + 1) * sizeof(int));
+    for (f = 0; f < m->nfaces; f++) {
+        int size = m->face_start[f + 1] - m->face_start[f];
+        for (c = m->face_start[f]; c < m->face_start[f + 1]; c++) l->adj_start[m->corner_vert[c] + 1] += size - 1;
+    }
+    for (i = 0; i < n; i++) l->adj_start[i + 1] += l->adj_start[i];
+    total = l->adj_start[n];
+    l->adj = TT__ALLOC(al, int, (size_t)total + 1);
+    fill = TT__ALLOC(al, int, (size_t)n + 1);
+    if (!l->adj || !fill) goto done;
+    for (i = 0; i < n; i++) fill[i] = l->adj_start[i];
+    for (f = 0; f < m->nfaces; f++) {
+        int begin = m->face_start[f], end = m->face_start[f + 1], a, b;
+        for (a = begin; a < end; a++)
+            for (b = begin; b < end; b++)
+                if (a != b) l->adj[fill[m->corner_vert[a]]++] = m->corner_vert[b];
+    }
+    {
+        int w = 0;
+        for (i = 0; i < n; i++) {
+            int begin = l->adj_start[i], end = l->adj_start[i + 1], k;
+            qsort(l->adj + begin, (size_t)(end - begin), sizeof(int), tt__int_compare);
+            l->adj_start[i] = w;
+            for (k = begin; k < end; k++)
+                if (k == begin || l->adj[k] != l->adj[k - 1]) l->adj[w++] = l->adj[k];
+        }
+        l->adj_start[n] = w;
+    }
+    ok = 1;
+done:
+    tt__free(al, fill);
+    return ok;
+}
+
+/* The closest point to p on triangle abc (by the regions of its
+   vertices, edges and interior). */
+static void tt__closest_on_triangle(const double *p, const double *a, const double *b, const double *c,
+                                    double *out)
+{
+    double ab[3], ac[3], ap[3], bp[3], cp[3], d1, d2, d3, d4, d5, d6, va, vb, vc, t, den;
+    int k;
+    for (k = 0; k < 3; k++) {
+        ab[k] = b[k] - a[k]; ac[k] = c[k] - a[k]; ap[k] = p[k] - a[k];
+        bp[k] = p[k] - b[k]; cp[k] = p[k] - c[k];
+    }
+    d1 = tt__dot3(ab, ap); d2 = tt__dot3(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) { memcpy(out, a, 3 * sizeof(double)); return; }
+    d3 = tt__dot3(ab, bp); d4 = tt__dot3(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) { memcpy(out, b, 3 * sizeof(double)); return; }
+    vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        t = d1 / (d1 - d3);
+        for (k = 0; k < 3; k++) out[k] = a[k] + t * ab[k];
+        return;
+    }
+    d5 = tt__dot3(ab, cp); d6 = tt__dot3(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) { memcpy(out, c, 3 * sizeof(double)); return; }
+    vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        t = d2 / (d2 - d6);
+        for (k = 0; k < 3; k++) out[k] = a[k] + t * ac[k];
+        return;
+    }
+    va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+        t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (k = 0; k < 3; k++) out[k] = b[k] + t * (c[k] - b[k]);
+        return;
+    }
+    den = va + vb + vc;
+    if (!(den > 0.0)) { memcpy(out, a, 3 * sizeof(double)); return; }
+    for (k = 0; k < 3; k++) out[k] = a[k] + (vb * ab[k] + vc * ac[k]) / den;
+}
+
+/* Extraction's state: the clusters (output vertices), the graph between
+   them, and the faces traced from it. */
+typedef struct tt__remesh_graph {
+    int nclusters;
+    int *cluster;           /* per level-0 vertex: its cluster */
+    double *pos, *normal;   /* 3 per cluster */
+    unsigned char *on_boundary;     /* per cluster: holds a vertex of the input's boundary */
+    uint64_t *edges;        /* (low << 32 | high) cluster pairs, sorted, unique */
+    int nedges;
+    unsigned char *dead;    /* per edge */
+    int *start, *nbr, *nbr_edge;    /* neighbours of each cluster in counter-clockwise order */
+    int *face_of;           /* per entry of nbr: the traced face left of cluster -> nbr */
+    int *face_start, *face_vert, nfaces;
+} tt__remesh_graph;
+
+static void tt__remesh_graph_free(const tt_allocator *al, tt__remesh_graph *g)
+{
+    tt__free(al, g->cluster); tt__free(al, g->pos); tt__free(al, g->normal); tt__free(al, g->on_boundary);
+    tt__free(al, g->edges); tt__free(al, g->dead); tt__free(al, g->start); tt__free(al, g->nbr);
+    tt__free(al, g->nbr_edge); tt__free(al, g->face_of); tt__free(al, g->face_start); tt__free(al, g->face_vert);
+    memset(g, 0, sizeof *g);
+}
+
+/* Sec. 5: edges of level 0 whose ends' lattices agree on one point are
+   collapsed (the most certain first, and never two vertices a lattice
+   edge already joins); those one lattice step apart become the graph's
+   edges. Returns 0 on allocation failure. */
+static int tt__remesh_clusters(const tt_allocator *al, const tt__remesh_level *l, const tt_mesh *m, double rho,
+                               tt__remesh_graph *g)
+{
+    int n = l->n, i, e, nunit = 0, cap_unit = 0, ncollapse = 0, cap_collapse = 0, ok = 0, k;
+    int *unit = NULL, *collapse = NULL, *parent = NULL, *head = NULL, *tail = NULL, *next = NULL, *root_id = NULL;
+    uint64_t *keys = NULL;
+    double *wsum = NULL;
+    for (i = 0; i < n; i++) {
+        const double *xi = l->x + 3 * (size_t)i, *ni = l->normal + 3 * (size_t)i, *oi = l->orient + 3 * (size_t)i;
+        for (e = l->adj_start[i]; e < l->adj_start[i + 1]; e++) {
+            int j = l->adj[e], ci[2], cj[2], da, db;
+            double oj[3], d;
+            if (j <= i) continue;
+            tt__rosy4_nearest(oi, l->orient + 3 * (size_t)j, l->normal + 3 * (size_t)j, oj);
+            d = tt__lattice_pair(xi, ni, oi, l->lattice + 3 * (size_t)i, l->x + 3 * (size_t)j,
+                                 l->normal + 3 * (size_t)j, oj, l->lattice + 3 * (size_t)j, rho, ci, cj);
+            if (d > 0.5 * rho) continue;       /* the two lattices disagree here */
+            da = abs(ci[0] - cj[0]);
+            db = abs(ci[1] - cj[1]);
+            if (da > 1 || db > 1 || (da == 1 && db == 1)) continue;   /* far or diagonal */
+            if (da + db == 0) {
+                int *grown = (int *)tt__grow(al, collapse, &cap_collapse, 2 * ncollapse + 2, sizeof(int));
+                if (!grown) goto done;
+                collapse = grown;
+                collapse[2 * ncollapse] = i;
+                collapse[2 * ncollapse + 1] = j;
+                ncollapse++;
+            } else {
+                int *grown = (int *)tt__grow(al, unit, &cap_unit, 2 * nunit + 2, sizeof(int));
+                if (!grown) goto done;
+                unit = grown;
+                unit[2 * nunit] = i;
+                unit[2 * nunit + 1] = j;
+                nunit++;
+            }
+        }
+    }
+    /* The collapses in order of their lattice points' distance. */
+    keys = TT__ALLOC(al, uint64_t, (size_t)ncollapse + 1);
+    parent = TT__ALLOC(al, int, (size_t)n + 1);
+    head = TT__ALLOC(al, int, (size_t)n + 1);
+    tail = TT__ALLOC(al, int, (size_t)n + 1);
+    next = TT__ALLOC(al, int, 2 * (size_t)nunit + 1);
+    if (!keys || !parent || !head || !tail || !next) goto done;
+    for (k = 0; k < ncollapse; k++) {
+        int a = collapse[2 * k], b = collapse[2 * k + 1], ci[2], cj[2];
+        double oj[3], d;
+        tt__rosy4_nearest(l->orient + 3 * (size_t)a, l->orient + 3 * (size_t)b, l->normal + 3 * (size_t)b, oj);
+        d = tt__lattice_pair(l->x + 3 * (size_t)a, l->normal + 3 * (size_t)a, l->orient + 3 * (size_t)a,
+                             l->lattice + 3 * (size_t)a, l->x + 3 * (size_t)b, l->normal + 3 * (size_t)b, oj,
+                             l->lattice + 3 * (size_t)b, rho, ci, cj);
+        keys[k] = ((uint64_t)(uint32_t)fmin(4294967295.0, d / rho * 1e9) << 32) | (uint32_t)k;
+    }
+    qsort(keys, (size_t)ncollapse, sizeof *keys, tt__u64_compare);
+    /* Each root keeps a list of the lattice edges of its members (entry 2u
+       at unit edge u's first end names its second, 2u + 1 the reverse). */
+    for (i = 0; i < n; i++) { parent[i] = i; head[i] = tail[i] = -1; }
+    for (k = 0; k < 2 * nunit; k++) {
+        int at = unit[k];
+        next[k] = -1;
+        if (head[at] < 0) head[at] = k; else next[tail[at]] = k;
+        tail[at] = k;
+    }
+    for (k = 0; k < ncollapse; k++) {
+        int pair = (int)(keys[k] & 0xffffffffu), a = tt__find_root(parent, collapse[2 * pair]);
+        int b = tt__find_root(parent, collapse[2 * pair + 1]), entry, joined = 0;
+        if (a == b) continue;
+        for (entry = head[a]; entry >= 0 && !joined; entry = next[entry])
+            if (tt__find_root(parent, unit[entry ^ 1]) == b) joined = 1;
+        if (joined) continue;
+        parent[a] = b;
+        if (head[a] >= 0) {
+            if (head[b] < 0) head[b] = head[a]; else next[tail[b]] = head[a];
+            tail[b] = tail[a];
+        }
+    }
+    /* Clusters: their lattice points' mean, weighted by closeness to the
+       vertex (a point far from its vertex is less sure), and normals. */
+    root_id = head;     /* reused: no longer needed */
+    for (i = 0; i < n; i++) root_id[i] = -1;
+    g->cluster = TT__ALLOC(al, int, (size_t)n + 1);
+    if (!g->cluster) goto done;
+    g->nclusters = 0;
+    for (i = 0; i < n; i++) {
+        int r = tt__find_root(parent, i);
+        if (root_id[r] < 0) root_id[r] = g->nclusters++;
+        g->cluster[i] = root_id[r];
+    }
+    g->pos = TT__ALLOC(al, double, 3 * (size_t)g->nclusters + 1);
+    g->normal = TT__ALLOC(al, double, 3 * (size_t)g->nclusters + 1);
+    g->on_boundary = TT__ALLOC(al, unsigned char, (size_t)g->nclusters + 1);
+    wsum = TT__ALLOC(al, double, (size_t)g->nclusters + 1);
+    if (!g->pos || !g->normal || !g->on_boundary || !wsum) goto done;
+    memset(g->pos, 0, 3 * (size_t)g->nclusters * sizeof(double));
+    memset(g->normal, 0, 3 * (size_t)g->nclusters * sizeof(double));
+    memset(g->on_boundary, 0, (size_t)g->nclusters);
+    memset(wsum, 0, (size_t)g->nclusters * sizeof(double));
+    for (i = 0; i < n; i++) {
+        int c = g->cluster[i];
+        double d[3], w;
+        for (k = 0; k < 3; k++) d[k] = l->lattice[3 * (size_t)i + k] - l->x[3 * (size_t)i + k];
+        w = exp(-9.0 * tt__dot3(d, d) / (rho * rho)) + 1e-12;
+        for (k = 0; k < 3; k++) {
+            g->pos[3 * (size_t)c + k] += w * l->lattice[3 * (size_t)i + k];
+            g->normal[3 * (size_t)c + k] += w * l->normal[3 * (size_t)i + k];
+        }
+        wsum[c] += w;
+    }
+    for (i = 0; i < g->nclusters; i++) {
+        for (k = 0; k < 3; k++) g->pos[3 * (size_t)i + k] /= wsum[i];
+        if (tt__normalize3(g->normal + 3 * (size_t)i) == 0.0) g->normal[3 * (size_t)i + 2] = 1.0;
+    }
+    for (k = 0; k < m->ncorners; k++)
+        if (m->twin[k] < 0) {
+            g->on_boundary[g->cluster[m->corner_vert[k]]] = 1;
+            g->on_boundary[g->cluster[m->corner_vert[tt_mesh_next(m, k)]]] = 1;
+        }
+    /* The graph's edges: lattice edges between distinct clusters, once. */
+    g->edges = TT__ALLOC(al, uint64_t, (size_t)nunit + 1);
+    if (!g->edges) goto done;
+    g->nedges = 0;
+    for (k = 0; k < nunit; k++) {
+        int a = g->cluster[unit[2 * k]], b = g->cluster[unit[2 * k + 1]];
+        if (a == b) continue;
+        if (a > b) { int t = a; a = b; b = t; }
+        g->edges[g->nedges++] = ((uint64_t)(uint32_t)a << 32) | (uint32_t)b;
+    }
+    qsort(g->edges, (size_t)g->nedges, sizeof *g->edges, tt__u64_compare);
+    {
+        int w = 0;
+        for (k = 0; k < g->nedges; k++)
+            if (w == 0 || g->edges[k] != g->edges[w - 1]) g->edges[w++] = g->edges[k];
+        g->nedges = w;
+    }
+    g->dead = TT__ALLOC(al, unsigned char, (size_t)g->nedges + 1);
+    if (!g->dead) goto done;
+    memset(g->dead, 0, (size_t)g->nedges + 1);
+    ok = 1;
+done:
+    tt__free(al, unit); tt__free(al, collapse); tt__free(al, keys); tt__free(al, parent);
+    tt__free(al, head); tt__free(al, tail); tt__free(al, next); tt__free(al, wsum);
+    return ok;
+}
+
+/* Faces from the graph: around each cluster its edges in counter-clockwise
+   order about its normal; the face left of the half-edge u -> v goes on
+   with the edge just clockwise of v -> u at v. Every half-edge lies in one
+   face, and the faces make an oriented surface (each vertex's corners one
+   cycle) whatever the graph. First, and again whenever some are found,
+   edges that end nowhere and edges with one face on both sides (bridges:
+   a face would pass them twice) are removed. Returns 0 on allocation
+   failure. */
+static int tt__remesh_trace(const tt_allocator *al, tt__remesh_graph *g)
+{
+    int nc = g->nclusters, round, e, c, k, ok = 0, *degree = NULL, *fill = NULL, *stack = NULL;
+    double *angle = NULL;
+    degree = TT__ALLOC(al, int, (size_t)nc + 1);
+    fill = TT__ALLOC(al, int, (size_t)nc + 1);
+    stack = TT__ALLOC(al, int, (size_t)nc + 1);
+    g->start = TT__ALLOC(al, int, (size_t)nc + 1);
+    g->nbr = TT__ALLOC(al, int, 2 * (size_t)g->nedges + 1);
+    g->nbr_edge = TT__ALLOC(al, int, 2 * (size_t)g->nedges + 1);
+    g->face_of = TT__ALLOC(al, int, 2 * (size_t)g->nedges + 1);
+    g->face_start = TT__ALLOC(al, int, 2 * (size_t)g->nedges + 2);
+    g->face_vert = TT__ALLOC(al, int, 2 * (size_t)g->nedges + 1);
+    angle = TT__ALLOC(al, double, 2 * (size_t)g->nedges + 1);
+    if (!degree || !fill || !stack || !g->start || !g->nbr || !g->nbr_edge || !g->face_of || !g->face_start ||
+        !g->face_vert || !angle)
+        goto done;
+    for (round = 0;; round++) {
+        int top = 0, entries, nfc = 0, bridges = 0;
+        /* Neighbour lists of the live edges; then edges that end nowhere,
+           repeatedly; then the lists again without them. */
+        for (k = 0; k < 2; k++) {
+            memset(g->start, 0, ((size_t)nc + 1) * sizeof(int));
+            for (e = 0; e < g->nedges; e++)
+                if (!g->dead[e]) { g->start[(g->edges[e] >> 32) + 1]++; g->start[(g->edges[e] & 0xffffffffu) + 1]++; }
+            for (c = 0; c < nc; c++) g->start[c + 1] += g->start[c];
+            entries = g->start[nc];
+            for (c = 0; c < nc; c++) fill[c] = g->start[c];
+            for (e = 0; e < g->nedges; e++) {
+                int a = (int)(g->edges[e] >> 32), b = (int)(g->edges[e] & 0xffffffffu);
+                if (g->dead[e]) continue;
+                g->nbr_edge[fill[a]] = e; g->nbr[fill[a]++] = b;
+                g->nbr_edge[fill[b]] = e; g->nbr[fill[b]++] = a;
+            }
+            if (k == 1) break;
+            for (c = 0; c < nc; c++) {
+                degree[c] = g->start[c + 1] - g->start[c];
+                if (degree[c] == 1) stack[top++] = c;
+            }
+            while (top > 0) {
+                int v = stack[--top], q;
+                if (degree[v] != 1) continue;
+                for (q = g->start[v]; q < g->start[v + 1]; q++) {
+                    int w = g->nbr[q];
+                    if (g->dead[g->nbr_edge[q]]) continue;
+                    g->dead[g->nbr_edge[q]] = 1;
+                    degree[v]--;
+                    if (--degree[w] == 1) stack[top++] = w;
+                    break;
+                }
+            }
+        }
+        for (c = 0; c < nc; c++) {
+            const double *n = g->normal + 3 * (size_t)c, *p = g->pos + 3 * (size_t)c;
+            double u[3], v[3], any[3] = {1.0, 0.0, 0.0};
+            int a, b;
+            tt__tangent_or_any(any, n, u);
+            tt__cross3(n, u, v);
+            for (a = g->start[c]; a < g->start[c + 1]; a++) {
+                const double *q = g->pos + 3 * (size_t)g->nbr[a];
+                double d[3];
+                d[0] = q[0] - p[0]; d[1] = q[1] - p[1]; d[2] = q[2] - p[2];
+                angle[a] = atan2(tt__dot3(d, v), tt__dot3(d, u));
+            }
+            for (a = g->start[c] + 1; a < g->start[c + 1]; a++)
+                for (b = a; b > g->start[c] && angle[b - 1] > angle[b]; b--) {
+                    double t = angle[b]; int s;
+                    angle[b] = angle[b - 1]; angle[b - 1] = t;
+                    s = g->nbr[b]; g->nbr[b] = g->nbr[b - 1]; g->nbr[b - 1] = s;
+                    s = g->nbr_edge[b]; g->nbr_edge[b] = g->nbr_edge[b - 1]; g->nbr_edge[b - 1] = s;
+                }
+        }
+        /* Trace. */
+        for (k = 0; k < entries; k++) g->face_of[k] = -1;
+        g->nfaces = 0;
+        g->face_start[0] = 0;
+        for (c = 0; c < nc; c++)
+            for (k = g->start[c]; k < g->start[c + 1]; k++) {
+                int u = c, at = k;
+                if (g->face_of[k] >= 0) continue;
+                while (g->face_of[at] < 0) {
+                    int v = g->nbr[at], back = -1, q;
+                    g->face_of[at] = g->nfaces;
+                    g->face_vert[nfc++] = u;
+                    for (q = g->start[v]; q < g->start[v + 1]; q++)
+                        if (g->nbr[q] == u) { back = q; break; }
+                    at = back > g->start[v] ? back - 1 : g->start[v + 1] - 1;
+                    u = v;
+                }
+                g->face_start[++g->nfaces] = nfc;
+            }
+        /* Bridges. */
+        for (c = 0; c < nc; c++)
+            for (k = g->start[c]; k < g->start[c + 1]; k++) {
+                int v = g->nbr[k], q;
+                if (v < c) continue;
+                for (q = g->start[v]; q < g->start[v + 1]; q++)
+                    if (g->nbr[q] == c) break;
+                if (q < g->start[v + 1] && g->face_of[q] == g->face_of[k]) {
+                    g->dead[g->nbr_edge[k]] = 1;
+                    bridges++;
+                }
+            }
+        if (bridges == 0 || round >= 64) break;
+    }
+    ok = 1;
+done:
+    tt__free(al, degree); tt__free(al, fill); tt__free(al, stack); tt__free(al, angle);
+    return ok;
+}
+
+/* The output from the traced faces: a face that meets itself at a vertex
+   is split there into simple loops; a loop facing against the surface
+   with most of its vertices on the input's boundary, or one entirely on
+   it, spans a hole and is dropped; each vertex whose faces form several
+   fans becomes one vertex per fan; with more pieces than the input,
+   pieces of fewer than 8 faces (pockets a pinch closed off) are dropped;
+   each vertex moves to the closest point of the faces around its
+   cluster's members (level-0 vertices). */
+static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, const tt__remesh_graph *g,
+                                   int input_components, tt_mesh **out_mesh, tt_remesh_report *rep,
+                                   tt_error *error)
+{
+    int nc = g->nclusters, total = g->face_start[g->nfaces], f, k, q, nloops = 0, ncorners = 0, nhalf = 0;
+    int nverts = nc, npieces = 0, nkept = 0, nindices = 0;
+    int *loop_start = NULL, *loop_vert = NULL, *where = NULL, *path = NULL, *corner_loop = NULL;
+    int *corner_root = NULL, *loop_root = NULL, *vertex_root = NULL, *vertex_of = NULL, *piece_size = NULL;
+    int *member_head = NULL, *member_next = NULL, *out_id = NULL, *indices = NULL, *sizes = NULL;
+    unsigned char *keep = NULL;
+    uint64_t *half = NULL;      /* pairs: (a << 32 | b, the corner at b of the loop running a -> b) */
+    float *positions = NULL;
+    tt_mesh_desc desc;
+    tt_result result = TT_ERROR_OUT_OF_MEMORY;
+
+    loop_start = TT__ALLOC(al, int, (size_t)total + 2);
+    loop_vert = TT__ALLOC(al, int, (size_t)total + 1);
+    corner_loop = TT__ALLOC(al, int, (size_t)total + 1);
+    where = TT__ALLOC(al, int, (size_t)nc + 1);
+    path = TT__ALLOC(al, int, (size_t)total + 1);
+    keep = TT__ALLOC(al, unsigned char, (size_t)total + 1);
+    if (!loop_start || !loop_vert || !corner_loop || !where || !path || !keep) goto fail;
+    for (k = 0; k < nc; k++) where[k] = -1;
+    loop_start[0] = 0;
+    for (f = 0; f < g->nfaces; f++) {
+        int begin = g->face_start[f], size = g->face_start[f + 1] - begin, depth = 0, split = 0, first = nloops;
+        for (k = 0; k <= size; k++) {
+            int v = k < size ? g->face_vert[begin + k] : -1, from = k < size ? where[v] : 0;
+            if (k < size && from < 0) {
+                where[v] = depth;
+                path[depth++] = v;
+                continue;
+            }
+            /* The loop from v's first visit to here (or what is left, at
+               the end); a bridge-free face leaves none shorter than 3. */
+            if (k < size) split = 1;
+            if (depth - from >= 3) {
+                for (q = from; q < depth; q++) { corner_loop[ncorners] = nloops; loop_vert[ncorners++] = path[q]; }
+                loop_start[++nloops] = ncorners;
+            }
+            for (q = k < size ? from + 1 : 0; q < depth; q++) where[path[q]] = -1;
+            depth = k < size ? from + 1 : 0;
+        }
+        rep->split_faces += split;
+        for (q = first; q < nloops; q++) {
+            int b = loop_start[q], s = loop_start[q + 1] - b, on = 0, j;
+            double newell[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 0.0}, turn;
+            for (k = 0; k < s; k++) {
+                const double *p0 = g->pos + 3 * (size_t)loop_vert[b + k];
+                const double *p1 = g->pos + 3 * (size_t)loop_vert[b + (k + 1) % s];
+                double cr[3];
+                tt__cross3(p0, p1, cr);
+                for (j = 0; j < 3; j++) {
+                    newell[j] += cr[j];
+                    normal[j] += g->normal[3 * (size_t)loop_vert[b + k] + j];
+                }
+                on += g->on_boundary[loop_vert[b + k]];
+            }
+            turn = tt__dot3(newell, normal);
+            keep[q] = !(on == s || (turn <= 0.0 && 2 * on >= s));
+            if (!keep[q]) rep->dropped_faces++;
+            else if (turn <= 0.0) rep->folded_faces++;
+        }
+    }
+    /* Corners at one vertex are one fan where their loops share an edge
+       there: the corner leaving v towards w joins the corner its twin
+       w -> v arrives at. Loops sharing an edge make one piece. */
+    half = TT__ALLOC(al, uint64_t, 2 * (size_t)ncorners + 2);
+    corner_root = TT__ALLOC(al, int, (size_t)ncorners + 1);
+    loop_root = TT__ALLOC(al, int, (size_t)nloops + 1);
+    if (!half || !corner_root || !loop_root) goto fail;
+    for (q = 0; q < nloops; q++) {
+        int b = loop_start[q], s = loop_start[q + 1] - b;
+        loop_root[q] = q;
+        if (!keep[q]) continue;
+        for (k = 0; k < s; k++) {
+            half[2 * (size_t)nhalf] = ((uint64_t)(uint32_t)loop_vert[b + k] << 32) | (uint32_t)loop_vert[b + (k + 1) % s];
+            half[2 * (size_t)nhalf + 1] = (uint64_t)(b + (k + 1) % s);
+            nhalf++;
+        }
+    }
+    qsort(half, (size_t)nhalf, 2 * sizeof *half, tt__u64_compare);
+    for (k = 0; k < ncorners; k++) corner_root[k] = k;
+    for (q = 0; q < nloops; q++) {
+        int b = loop_start[q], s = loop_start[q + 1] - b;
+        if (!keep[q]) continue;
+        for (k = 0; k < s; k++) {
+            int v = loop_vert[b + k], w = loop_vert[b + (k + 1) % s], lo = 0, hi = nhalf;
+            uint64_t twin = ((uint64_t)(uint32_t)w << 32) | (uint32_t)v;
+            while (lo < hi) {
+                int mid = lo + (hi - lo) / 2;
+                if (half[2 * (size_t)mid] < twin) lo = mid + 1; else hi = mid;
+            }
+            if (lo < nhalf && half[2 * (size_t)lo] == twin) {
+                int other = (int)half[2 * (size_t)lo + 1], x, y;
+                x = tt__find_root(corner_root, b + k);
+                y = tt__find_root(corner_root, other);
+                if (x != y) corner_root[x] = y;
+                x = tt__find_root(loop_root, q);
+                y = tt__find_root(loop_root, corner_loop[other]);
+                if (x != y) loop_root[x] = y;
+            }
+        }
+    }
+    /* Pieces: drop small ones only when there are more than the input has. */
+    piece_size = TT__ALLOC(al, int, (size_t)nloops + 1);
+    if (!piece_size) goto fail;
+    memset(piece_size, 0, ((size_t)nloops + 1) * sizeof(int));
+    for (q = 0; q < nloops; q++)
+        if (keep[q] && piece_size[tt__find_root(loop_root, q)]++ == 0) npieces++;
+    if (npieces > input_components)
+        for (q = 0; q < nloops; q++)
+            if (keep[q] && piece_size[tt__find_root(loop_root, q)] < 8) {
+                keep[q] = 0;
+                rep->dropped_faces++;
+            }
+    /* Vertices: the first fan at a cluster keeps its number. */
+    vertex_root = TT__ALLOC(al, int, (size_t)nc + 1);
+    vertex_of = TT__ALLOC(al, int, (size_t)ncorners + 1);
+    if (!vertex_root || !vertex_of) goto fail;
+    for (k = 0; k < nc; k++) vertex_root[k] = -1;
+    for (k = 0; k < ncorners; k++) vertex_of[k] = -1;
+    for (q = 0; q < nloops; q++) {
+        int b = loop_start[q], s = loop_start[q + 1] - b;
+        if (!keep[q]) continue;
+        for (k = b; k < b + s; k++) {
+            int r = tt__find_root(corner_root, k), v = loop_vert[k];
+            if (vertex_of[r] < 0) {
+                if (vertex_root[v] < 0) { vertex_root[v] = r; vertex_of[r] = v; }
+                else { vertex_of[r] = nverts++; rep->split_vertices++; }
+            }
+            vertex_of[k] = vertex_of[r];
+        }
+    }
+    /* Positions: each output vertex at the closest point of the input near
+       its cluster; numbered in order of first use. */
+    member_head = TT__ALLOC(al, int, (size_t)nc + 1);
+    member_next = TT__ALLOC(al, int, (size_t)m->nverts + 1);
+    out_id = TT__ALLOC(al, int, (size_t)nverts + 1);
+    positions = TT__ALLOC(al, float, 3 * (size_t)nverts + 3);
+    indices = TT__ALLOC(al, int, (size_t)ncorners + 1);
+    sizes = TT__ALLOC(al, int, (size_t)nloops + 1);
+    if (!member_head || !member_next || !out_id || !positions || !indices || !sizes) goto fail;
+    for (k = 0; k < nc; k++) member_head[k] = -1;
+    for (k = m->nverts - 1; k >= 0; k--) {
+        member_next[k] = member_head[g->cluster[k]];
+        member_head[g->cluster[k]] = k;
+    }
+    for (k = 0; k < nverts; k++) out_id[k] = -1;
+    {
+        int nout = 0;
+        for (q = 0; q < nloops; q++) {
+            int b = loop_start[q], s = loop_start[q + 1] - b;
+            if (!keep[q]) continue;
+            sizes[nkept++] = s;
+            for (k = b; k < b + s; k++) {
+                int v = vertex_of[k], cl = loop_vert[k];
+                if (out_id[v] < 0) {
+                    const double *p = g->pos + 3 * (size_t)cl;
+                    double best[3], best_d = HUGE_VAL;
+                    int i, j;
+                    memcpy(best, p, sizeof best);
+                    for (i = member_head[cl]; i >= 0; i = member_next[i]) {
+                        int c0 = m->vert_corner[i], c = c0, steps = 0;
+                        if (c0 < 0) continue;
+                        do {
+                            int face = m->corner_face[c], fb = m->face_start[face], fe = m->face_start[face + 1];
+                            int t;
+                            for (t = fb + 1; t + 1 < fe; t++) {
+                                double a[3], bb[3], cc[3], near_point[3], d[3], dd;
+                                for (j = 0; j < 3; j++) {
+                                    a[j] = m->pos[3 * (size_t)m->corner_vert[fb] + j];
+                                    bb[j] = m->pos[3 * (size_t)m->corner_vert[t] + j];
+                                    cc[j] = m->pos[3 * (size_t)m->corner_vert[t + 1] + j];
+                                }
+                                tt__closest_on_triangle(p, a, bb, cc, near_point);
+                                for (j = 0; j < 3; j++) d[j] = near_point[j] - p[j];
+                                dd = tt__dot3(d, d);
+                                if (dd < best_d) { best_d = dd; memcpy(best, near_point, sizeof best); }
+                            }
+                            c = m->twin[tt_mesh_prev(m, c)];
+                        } while (c >= 0 && c != c0 && ++steps < m->ncorners);
+                    }
+                    out_id[v] = nout;
+                    for (j = 0; j < 3; j++) positions[3 * (size_t)nout + j] = (float)best[j];
+                    nout++;
+                }
+                indices[nindices++] = out_id[v];
+            }
+        }
+        nverts = nout;
+    }
+    for (q = 0; q < nloops; q++) {
+        int s = loop_start[q + 1] - loop_start[q];
+        if (!keep[q]) continue;
+        if (s == 3) rep->triangles++;
+        else if (s == 4) rep->quads++;
+        else if (s == 5) rep->pentagons++;
+        else rep->larger_faces++;
+    }
+    if (nkept == 0) {
+        result = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
+                          "remeshing traced no faces: the field or edge_length gives no consistent lattice");
+        goto done;
+    }
+    memset(&desc, 0, sizeof desc);
+    desc.positions = positions;
+    desc.nverts = nverts;
+    desc.indices = indices;
+    desc.face_sizes = sizes;
+    desc.nfaces = nkept;
+    result = tt_mesh_build(&desc, al, out_mesh, error);
+    if (result != TT_OK && result != TT_ERROR_OUT_OF_MEMORY) {
+        char why[sizeof error->message];
+        strcpy(why, error ? error->message : tt_result_string(result));
+        result = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
+                          "remeshing made an invalid mesh (%s): try another edge_length", why);
+    }
+    goto done;
+fail:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+done:
+    tt__free(al, loop_start); tt__free(al, loop_vert); tt__free(al, corner_loop); tt__free(al, where);
+    tt__free(al, path); tt__free(al, keep); tt__free(al, half); tt__free(al, corner_root);
+    tt__free(al, loop_root); tt__free(al, piece_size); tt__free(al, vertex_root); tt__free(al, vertex_of);
+    tt__free(al, member_head); tt__free(al, member_next); tt__free(al, out_id); tt__free(al, positions);
+    tt__free(al, indices); tt__free(al, sizes);
+    return result;
+}
+
+TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, const tt_remesh_options *options,
+                                const tt_allocator *allocator, tt_mesh **out_mesh, tt_remesh_report *report,
+                                tt_error *error)
+{
+    tt_remesh_options opt;
+    tt_remesh_report rep;
+    tt__remesh_level levels[TT__REMESH_MAX_LEVELS];
+    tt__remesh_graph graph;
+    const tt_mesh *work = mesh;
+    tt_mesh *refined = NULL;
+    int *face_source = NULL, nlevels = 0, f, i, l, sweeps, components = 1;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, diag, rho;
+    double *lengths = NULL;
+    tt_result result = TT_OK;
+
+    tt__ok(error);
+    memset(levels, 0, sizeof levels);
+    memset(&graph, 0, sizeof graph);
+    memset(&rep, 0, sizeof rep);
+    if (report) memset(report, 0, sizeof *report);
+    if (!out_mesh) return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1, "out_mesh is NULL");
+    *out_mesh = NULL;
+    if (!mesh || !face_vectors)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_remesh_quads needs a mesh and its face vectors (got NULL)");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
+    if (tt__check_allocator(allocator, error) != TT_OK) return TT_ERROR_INVALID_ARGUMENT;
+    if (options) opt = *options; else memset(&opt, 0, sizeof opt);
+    if (!(opt.edge_length >= 0.0f) || !tt__is_finite(opt.edge_length))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "edge_length must be 0 (the default) or positive and finite, got %g", (double)opt.edge_length);
+    if (opt.sweeps < 0)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "sweeps must be 0 (the default) or positive, got %d", opt.sweeps);
+    sweeps = opt.sweeps ? opt.sweeps : TT_DEFAULT_REMESH_SWEEPS;
+    for (f = 0; f < mesh->nfaces; f++) {
+        int k;
+        for (k = 0; k < 3; k++)
+            if (!tt__is_finite(face_vectors[3 * (size_t)f + k]))
+                return tt__fail(error, TT_ERROR_NON_FINITE, f, -1, -1, -1,
+                                "face %d's vector is not finite", f);
+        if (opt.face_weights && !(opt.face_weights[f] >= 0.0f && opt.face_weights[f] <= 1.0f))
+            return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
+                            "face %d's weight %g is not in [0, 1]", f, (double)opt.face_weights[f]);
+    }
+    for (f = 0; f < mesh->ncorners; f++) {
+        int v = mesh->corner_vert[f], k;
+        for (k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], mesh->pos[3 * (size_t)v + k]);
+            hi[k] = fmax(hi[k], mesh->pos[3 * (size_t)v + k]);
+        }
+    }
+    diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (!tt__is_finite_d(diag))
+        return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
+                        "the mesh's bounding box is not finite (diagonal %g): a NaN or infinite position", diag);
+    if (!(diag > 0.0))
+        return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, -1, -1, -1, -1,
+                        "the mesh's faces all lie at one point: nothing to remesh");
+    rho = opt.edge_length > 0.0f ? (double)opt.edge_length : TT_DEFAULT_REMESH_EDGE * diag;
+    if (rho > 0.25 * diag)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "edge_length %g is more than a quarter of the mesh's bounding-box diagonal %g",
+                        rho, diag);
+
+    /* Refine until nine edges in ten are at most 0.7 edge_length: a
+       lattice edge is found only where input edges join its ends' lattice
+       points (half an edge doubled the time and gave no better faces on
+       the test scans; a whole edge left more faces of 6 or more sides). */
+    face_source = TT__ALLOC(allocator, int, mesh->nfaces);
+    if (!face_source) goto oom;
+    for (f = 0; f < mesh->nfaces; f++) face_source[f] = f;
+    for (;;) {
+        int c, *finer;
+        double p90;
+        tt_mesh *next = NULL;
+        tt_error ignored;
+        lengths = TT__ALLOC(allocator, double, work->ncorners);
+        if (!lengths) goto oom;
+        for (c = 0; c < work->ncorners; c++) {
+            double d[3];
+            tt__sub3f(work->pos + 3 * (size_t)work->corner_vert[c],
+                      work->pos + 3 * (size_t)work->corner_vert[tt_mesh_next(work, c)], d);
+            lengths[c] = tt__length3(d);
+        }
+        p90 = tt__select(lengths, work->ncorners, (int)(0.9 * (work->ncorners - 1)));
+        tt__free(allocator, lengths);
+        lengths = NULL;
+        if (p90 <= 0.7 * rho) break;
+        if ((long long)work->nverts + work->ncorners / 2 + work->nfaces > TT_MAX_REMESH_VERTICES) {
+            result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
+                              "edge_length %g needs the mesh refined past %d vertices (its edges are up to %g "
+                              "long): choose a larger edge_length", rho, TT_MAX_REMESH_VERTICES, p90);
+            goto done;
+        }
+        result = tt_mesh_quadrangulate(work, TT_SUBDIVIDE_LINEAR, allocator, &next, &ignored);
+        if (result != TT_OK) {
+            result = result == TT_ERROR_OUT_OF_MEMORY
+                         ? tt__fail(error, result, -1, -1, -1, -1, "out of memory")
+                         : tt__fail(error, result, -1, -1, -1, -1, "refining the mesh to remesh it: %s",
+                                    ignored.message);
+            goto done;
+        }
+        finer = TT__ALLOC(allocator, int, next->nfaces);
+        if (!finer) { tt_mesh_free(next); goto oom; }
+        for (c = 0; c < next->nfaces; c++) finer[c] = face_source[work->corner_face[c]];
+        tt__free(allocator, face_source);
+        face_source = finer;
+        tt_mesh_free(refined);
+        refined = next;
+        work = next;
+        rep.refinements++;
+    }
+    rep.working_vertices = work->nverts;
+
+    /* The hierarchy. */
+    nlevels = 1;
+    if (!tt__remesh_base_level(allocator, work, face_vectors, opt.face_weights, face_source, &levels[0])) goto oom;
+    while (levels[nlevels - 1].n > TT__REMESH_COARSEST && nlevels < TT__REMESH_MAX_LEVELS) {
+        tt__remesh_level *fine = &levels[nlevels - 1], *coarse = &levels[nlevels];
+        if (!tt__remesh_coarsen(allocator, fine, coarse)) { nlevels++; goto oom; }
+        if (coarse->n > fine->n - fine->n / 10) {
+            tt__remesh_level_free(allocator, coarse);
+            tt__free(allocator, fine->parent);
+            fine->parent = NULL;
+            break;
+        }
+        nlevels++;
+    }
+    rep.levels = nlevels;
+
+    /* Sec. 3: the orientation field, coarse to fine. */
+    for (l = nlevels - 1; l >= 0; l--) {
+        tt__remesh_level *lv = &levels[l];
+        for (i = 0; i < lv->n; i++) {
+            const double *from = l == nlevels - 1 ? lv->anchor + 3 * (size_t)i
+                                                  : levels[l + 1].orient + 3 * (size_t)lv->parent[i];
+            double any[3] = {1.0, 0.0, 0.0};
+            tt__tangent_or_any(l == nlevels - 1 && lv->weight[i] <= 0.0 ? any : from, lv->normal + 3 * (size_t)i,
+                               lv->orient + 3 * (size_t)i);
+        }
+        for (i = 0; i < sweeps; i++) tt__remesh_orient_sweep(lv, i & 1);
+    }
+    /* Every coarser level takes the finest directions (its members' 4-fold
+       mean), so that each level's lattice follows the final field. */
+    for (l = 1; l < nlevels; l++) {
+        tt__remesh_level *fine = &levels[l - 1], *lv = &levels[l];
+        memset(lv->orient, 0, 3 * (size_t)lv->n * sizeof(double));
+        for (i = 0; i < fine->n; i++) {
+            double *o = lv->orient + 3 * (size_t)fine->parent[i], t[3], cur[3];
+            int k;
+            for (k = 0; k < 3; k++) cur[k] = o[k];
+            if (tt__normalize3(cur) > 0.0) tt__rosy4_nearest(cur, fine->orient + 3 * (size_t)i, fine->normal + 3 * (size_t)i, t);
+            else for (k = 0; k < 3; k++) t[k] = fine->orient[3 * (size_t)i + k];
+            for (k = 0; k < 3; k++) o[k] += t[k];
+        }
+        for (i = 0; i < lv->n; i++) {
+            double t[3];
+            tt__tangent_or_any(lv->orient + 3 * (size_t)i, lv->normal + 3 * (size_t)i, t);
+            memcpy(lv->orient + 3 * (size_t)i, t, sizeof t);
+        }
+    }
+    /* Sec. 4: the position field, coarse to fine. */
+    for (l = nlevels - 1; l >= 0; l--) {
+        tt__remesh_level *lv = &levels[l];
+        for (i = 0; i < lv->n; i++) {
+            const double *from = l == nlevels - 1 ? lv->x + 3 * (size_t)i
+                                                  : levels[l + 1].lattice + 3 * (size_t)lv->parent[i];
+            const double *x = lv->x + 3 * (size_t)i, *n = lv->normal + 3 * (size_t)i;
+            double d[3], a;
+            int k;
+            for (k = 0; k < 3; k++) d[k] = from[k] - x[k];
+            a = tt__dot3(d, n);
+            for (k = 0; k < 3; k++) lv->lattice[3 * (size_t)i + k] = from[k] - a * n[k];
+        }
+        for (i = 0; i < sweeps; i++) tt__remesh_position_sweep(lv, rho, i & 1);
+    }
+
+    /* Sec. 5: extraction. */
+    if (!tt__remesh_clusters(allocator, &levels[0], work, rho, &graph)) goto oom;
+    if (!tt__remesh_trace(allocator, &graph)) goto oom;
+    {
+        int *face_component = TT__ALLOC(allocator, int, mesh->nfaces);
+        if (!face_component) goto oom;
+        result = tt_mesh_components(mesh, allocator, face_component, &components, error);
+        tt__free(allocator, face_component);
+        if (result != TT_OK) goto done;
+    }
+    result = tt__remesh_output(allocator, work, &graph, components, out_mesh, &rep, error);
+    goto done;
+oom:
+    result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
+done:
+    for (l = 0; l < nlevels; l++) tt__remesh_level_free(allocator, &levels[l]);
+    tt__remesh_graph_free(allocator, &graph);
+    tt__free(allocator, face_source);
+    tt__free(allocator, lengths);
+    tt_mesh_free(refined);
+    if (report) *report = rep;
+    return result;
+}
+
 /* ------------------------------------------------------------------------ */
 /* 3. Image                                                                 */
 /* ------------------------------------------------------------------------ */
@@ -6739,40 +8071,6 @@ TTDEF tt_result tt_min_error_cut(const float *cost, int width, int height, const
 #define TT__RESTRICT
 #endif
 #endif
-
-/* The k-th smallest of values[0 .. count-1] (0-based, 0 <= k < count),
-   which are reordered so that the ones before position k are no larger and
-   the ones after no smaller: Hoare's selection with a middle-of-three
-   pivot, linear time on average where a sort takes n log n; after 2 log2 n
-   rounds without getting there (an input built against the pivot) the
-   range left is heapsorted, so the worst case stays n log n. */
-static double tt__select(double *values, int count, int k)
-{
-    int lo = 0, hi = count - 1, rounds = 0, limit = 2;
-    while ((1 << (limit / 2)) < count && limit < 62) limit += 2;
-    while (lo < hi) {
-        double a = values[lo], b = values[lo + (hi - lo) / 2], c = values[hi], pivot, t;
-        int i = lo, j = hi;
-        if (rounds++ == limit) {
-            tt__sort_doubles(values + lo, hi - lo + 1);
-            break;
-        }
-        pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        while (i <= j) {
-            while (values[i] < pivot) i++;
-            while (values[j] > pivot) j--;
-            if (i <= j) {
-                t = values[i];
-                values[i++] = values[j];
-                values[j--] = t;
-            }
-        }
-        if (k <= j) hi = j;
-        else if (k >= i) lo = i;
-        else break;
-    }
-    return values[k];
-}
 
 /* The median of values[0 .. count-1] (reorders them); 0 for none. The
    values must be comparable (no NaN). */
@@ -12914,6 +14212,29 @@ done:
     tt__free(F.al, F.state);
     tt__free(F.al, F.queue);
     return result;
+}
+
+TTDEF tt_result tt_field_face_weights(const tt_mesh *mesh, const tt_field_options *options, float *face_weights,
+                                      tt_error *error)
+{
+    tt__field F;
+    tt_result result;
+    int f;
+    if (!mesh || !face_weights)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "tt_field_face_weights needs a mesh and an output array (got NULL)");
+    if (tt__require_faces(mesh, error) != TT_OK) return TT_ERROR_EMPTY_MESH;
+    if ((result = tt__field_setup(&F, mesh, options, NULL, error)) != TT_OK) return result;
+    for (f = 0; f < mesh->nfaces; f++) {
+        double normal[3], p[3];
+        if (!tt__face_normal_d(mesh, f, normal)) {
+            face_weights[f] = 0.0f;
+            continue;
+        }
+        tt__project3(F.up, normal, p);
+        face_weights[f] = F.opt.nconstraints > 0 ? 1.0f : (float)tt__field_decided(tt__length3(p));
+    }
+    return tt__ok(error);
 }
 
 /* ---- Texture patches (Praun et al. Sec. 3.1) ---------------------------- */
@@ -19721,12 +21042,6 @@ TTDEF void tt_cluster_hierarchy_free(tt_cluster_hierarchy *hierarchy)
 }
 
 /* ---- Flattening (Sec. 3.2) ---- */
-
-static int tt__int_compare(const void *a, const void *b)
-{
-    int x = *(const int *)a, y = *(const int *)b;
-    return x < y ? -1 : (x > y ? 1 : 0);
-}
 
 /* Position of key in the ascending array a[0..n-1], or -1. */
 static int tt__find_sorted(const int *a, int n, int key)

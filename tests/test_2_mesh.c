@@ -1863,6 +1863,342 @@ static void test_quadrangulate_sources(void)
     }
 }
 
+/* ---- tt_remesh_quads ---- */
+
+/* An icosphere of radius r: an icosahedron with each triangle split into
+   4^level and pushed onto the sphere. Its edges follow no direction. */
+static void make_icosphere(tmesh *m, int level, double r)
+{
+    static const double t = 1.6180339887498949;
+    static const int faces[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9},
+                                     {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2},
+                                     {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10},
+                                     {8, 6, 7}, {9, 8, 1}};
+    double v[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                       {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    int f, n = 1 << level, i, j;
+    for (f = 0; f < 20; f++) {
+        const double *a = v[faces[f][0]], *b = v[faces[f][1]], *c = v[faces[f][2]];
+        int row[65][65];
+        for (i = 0; i <= n; i++)
+            for (j = 0; i + j <= n; j++) {
+                double p[3], len;
+                int k;
+                for (k = 0; k < 3; k++) p[k] = a[k] + (b[k] - a[k]) * i / n + (c[k] - a[k]) * j / n;
+                len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+                row[i][j] = tm_vert(m, r * p[0] / len, r * p[1] / len, r * p[2] / len);
+            }
+        for (i = 0; i < n; i++)
+            for (j = 0; i + j < n; j++) {
+                tm_tri(m, row[i][j], row[i + 1][j], row[i][j + 1]);
+                if (i + j + 1 < n) tm_tri(m, row[i + 1][j], row[i + 1][j + 1], row[i][j + 1]);
+            }
+    }
+}
+
+/* The icosphere above with shared vertices welded (the per-face grids
+   repeat the edges' points). */
+static tt_result build_welded(const tmesh *m, tt_mesh **out, tt_error *err)
+{
+    tmesh w;
+    int *map = (int *)malloc(sizeof(int) * (size_t)(m->nv + 1)), i, j, c;
+    tt_result r;
+    memset(&w, 0, sizeof w);
+    for (i = 0; map && i < m->nv; i++) {
+        map[i] = -1;
+        for (j = 0; j < w.nv && map[i] < 0; j++)
+            if (fabs(w.pos[3 * j] - m->pos[3 * i]) < 1e-5f && fabs(w.pos[3 * j + 1] - m->pos[3 * i + 1]) < 1e-5f &&
+                fabs(w.pos[3 * j + 2] - m->pos[3 * i + 2]) < 1e-5f)
+                map[i] = j;
+        if (map[i] < 0) map[i] = tm_vert(&w, m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]);
+    }
+    for (c = 0; map && c < m->nc; c += 3) tm_tri(&w, map[m->idx[c]], map[m->idx[c + 1]], map[m->idx[c + 2]]);
+    r = build(&w, 0, out, err);
+    tm_free(&w);
+    free(map);
+    return r;
+}
+
+/* The projected up (0, 1, 0) on every face, and how firmly it holds: 0
+   facing up or down, 1 on walls (tt_field_face_weights' rule, written
+   out). With `random_field`, a random tangent direction of weight 1 on
+   every face instead: the control. */
+static void remesh_field(const tt_mesh *mesh, int random_field, float *vectors, float *weights)
+{
+    int f;
+    lcg_seed(7);
+    for (f = 0; f < mesh->nfaces; f++) {
+        float n[3];
+        double up[3] = {0.0, 1.0, 0.0}, p[3], len, t;
+        int k;
+        tt_face_normal(mesh, f, n);
+        if (random_field) {
+            double a[3] = {lcg_unit() - 0.5, lcg_unit() - 0.5, lcg_unit() - 0.5};
+            for (k = 0; k < 3; k++) up[k] = a[k];
+        }
+        for (k = 0; k < 3; k++) p[k] = up[k] - (up[0] * n[0] + up[1] * n[1] + up[2] * n[2]) * n[k];
+        len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        for (k = 0; k < 3; k++) vectors[3 * f + k] = len > 0 ? (float)(p[k] / len) : 0.0f;
+        t = (len - 0.1) / 0.4;
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        weights[f] = random_field ? 1.0f : (float)(t * t * (3 - 2 * t));
+    }
+}
+
+/* Of the edges of output faces on walls (normal within 45 degrees of
+   horizontal), the share within 10 degrees of the projected up or across
+   it; *median_edge gets the median edge length. */
+static double remesh_aligned_share(const tt_mesh *q, double *median_edge)
+{
+    int f, c, aligned = 0, counted = 0, nlen = 0;
+    double *len = (double *)malloc(sizeof(double) * (size_t)q->ncorners);
+    for (f = 0; f < q->nfaces; f++) {
+        float n[3];
+        double up[3] = {0.0, 1.0, 0.0}, p[3], pl;
+        int k;
+        tt_face_normal(q, f, n);
+        for (k = 0; k < 3; k++) p[k] = up[k] - n[1] * n[k];
+        pl = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        for (c = q->face_start[f]; c < q->face_start[f + 1]; c++) {
+            const float *a = q->pos + 3 * q->corner_vert[c], *b = q->pos + 3 * q->corner_vert[tt_mesh_next(q, c)];
+            double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, el, cosine, angle;
+            el = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            if (len) len[nlen++] = el;
+            if (fabs(n[1]) > 0.7071 || el <= 0) continue;
+            cosine = fabs(e[0] * p[0] + e[1] * p[1] + e[2] * p[2]) / (el * pl);
+            angle = acos(cosine > 1 ? 1 : cosine) * 57.29577951308232;
+            if (angle > 45) angle = 90 - angle;
+            counted++;
+            aligned += angle <= 10;
+        }
+    }
+    *median_edge = len && nlen ? internal_median(len, nlen) : 0.0;
+    free(len);
+    return counted ? (double)aligned / counted : 0.0;
+}
+
+static void test_remesh_sphere(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *q = NULL, *q2 = NULL;
+    tt_error err;
+    tt_remesh_options o;
+    tt_remesh_report rep;
+    tt_mesh_stats st;
+    float *vec, *w;
+    double median, share, control;
+    int v, off = 0;
+    memset(&m, 0, sizeof m);
+    make_icosphere(&m, 4, 1.0);
+    CHECK(build_welded(&m, &mesh, &err) == TT_OK, "icosphere: %s", err.message);
+    tm_free(&m);
+    if (!mesh) return;
+    vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
+    remesh_field(mesh, 0, vec, w);
+    memset(&o, 0, sizeof o);
+    o.edge_length = 0.15f;
+    o.face_weights = w;
+    CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "remesh: %s", err.message);
+    if (q) {
+        CHECK(tt_mesh_compute_stats(q, NULL, &st, &err) == TT_OK && st.genus == 0 && st.components == 1 &&
+              st.boundary_loops == 0, "a sphere stays a closed sphere: genus %d, %d components, %d loops", st.genus,
+              st.components, st.boundary_loops);
+        CHECK(rep.quads >= 4 * (rep.triangles + rep.pentagons + rep.larger_faces),
+              "mostly quads: %d quads, %d triangles, %d pentagons, %d larger", rep.quads, rep.triangles,
+              rep.pentagons, rep.larger_faces);
+        CHECK(rep.triangles + rep.quads + rep.pentagons + rep.larger_faces == q->nfaces,
+              "the report counts every face: %d of %d", rep.triangles + rep.quads + rep.pentagons + rep.larger_faces,
+              q->nfaces);
+        /* area 4 pi over 0.15^2: about 560 quads */
+        CHECK(q->nfaces > 400 && q->nfaces < 750, "faces of about 0.15: %d", q->nfaces);
+        share = remesh_aligned_share(q, &median);
+        CHECK(median > 0.11 && median < 0.19, "median edge %.3f, asked 0.15", median);
+        CHECK(share >= 0.85, "wall edges along or across up: %.3f", share);
+        /* On the input's faces: between the icosphere's flattest point and the sphere. */
+        for (v = 0; v < q->nverts; v++) {
+            const float *p = q->pos + 3 * v;
+            double r = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+            off += r < 0.99 || r > 1.0 + 1e-5;
+        }
+        CHECK(off == 0, "vertices on the input's surface: %d of %d off", off, q->nverts);
+        /* Deterministic. */
+        CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q2, NULL, &err) == TT_OK, "again: %s", err.message);
+        if (q2)
+            CHECK(q2->nverts == q->nverts && q2->ncorners == q->ncorners &&
+                  memcmp(q2->pos, q->pos, sizeof(float) * 3 * (size_t)q->nverts) == 0 &&
+                  memcmp(q2->corner_vert, q->corner_vert, sizeof(int) * (size_t)q->ncorners) == 0,
+                  "the same result twice");
+        tt_mesh_free(q2);
+        tt_mesh_free(q);
+        q = NULL;
+    }
+    /* The control: a random direction on every face, held firmly. */
+    remesh_field(mesh, 1, vec, w);
+    CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "random field: %s", err.message);
+    if (q) {
+        control = remesh_aligned_share(q, &median);
+        CHECK(control < 0.5, "a random field's edges do not follow up: %.3f", control);
+    }
+    tt_mesh_free(q);
+    free(vec);
+    free(w);
+    tt_mesh_free(mesh);
+}
+
+/* A torus keeps its handle; an open tube its two boundary loops, with no
+   face across its ends. */
+static void test_remesh_topology(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *q = NULL;
+    tt_error err;
+    tt_remesh_options o;
+    tt_mesh_stats st;
+    float *vec, *w;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    make_torus(&m, 48, 24, 2.0, 0.7);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus: %s", err.message);
+    tm_free(&m);
+    if (mesh) {
+        vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+        w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
+        remesh_field(mesh, 0, vec, w);
+        memset(&o, 0, sizeof o);
+        o.edge_length = 0.25f;
+        o.face_weights = w;
+        CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err) == TT_OK, "torus: %s", err.message);
+        if (q)
+            CHECK(tt_mesh_compute_stats(q, NULL, &st, &err) == TT_OK && st.genus == 1 && st.components == 1 &&
+                  st.boundary_loops == 0, "a torus: genus %d, %d components, %d loops", st.genus, st.components,
+                  st.boundary_loops);
+        tt_mesh_free(q);
+        q = NULL;
+        free(vec);
+        free(w);
+        tt_mesh_free(mesh);
+        mesh = NULL;
+    }
+    /* A tube of radius 1 and length 4 along y, 40 x 20 quads. */
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= 20; j++)
+        for (i = 0; i < 40; i++) {
+            double a = 6.283185307179586 * i / 40;
+            tm_vert(&m, cos(a), 0.2 * j, sin(a));
+        }
+    for (j = 0; j < 20; j++)
+        for (i = 0; i < 40; i++)
+            tm_quad(&m, j * 40 + i, (j + 1) * 40 + i, (j + 1) * 40 + (i + 1) % 40, j * 40 + (i + 1) % 40);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "tube: %s", err.message);
+    tm_free(&m);
+    if (mesh) {
+        tt_remesh_report rep;
+        vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+        w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
+        remesh_field(mesh, 0, vec, w);
+        memset(&o, 0, sizeof o);
+        o.edge_length = 0.3f;
+        o.face_weights = w;
+        CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "tube: %s", err.message);
+        if (q) {
+            double median, share = remesh_aligned_share(q, &median);
+            CHECK(tt_mesh_compute_stats(q, NULL, &st, &err) == TT_OK && st.genus == 0 && st.components == 1 &&
+                  st.boundary_loops == 2, "an open tube: genus %d, %d components, %d loops", st.genus,
+                  st.components, st.boundary_loops);
+            /* A cylinder's field has no singularity: rows of quads all round. */
+            CHECK(rep.quads >= 9 * (rep.triangles + rep.pentagons + rep.larger_faces) && share >= 0.95,
+                  "a tube: %d quads, %d others, %.3f of its edges along or across up", rep.quads,
+                  rep.triangles + rep.pentagons + rep.larger_faces, share);
+        }
+        tt_mesh_free(q);
+        free(vec);
+        free(w);
+        tt_mesh_free(mesh);
+    }
+}
+
+typedef struct remesh_ctx {
+    const tt_mesh *mesh;
+    const float *vectors;
+    tt_remesh_options options;
+} remesh_ctx;
+
+static tt_result oom_remesh(void *ctx, const tt_allocator *al, tt_error *error)
+{
+    remesh_ctx *r = (remesh_ctx *)ctx;
+    tt_mesh *out = (tt_mesh *)&out;
+    tt_result result = tt_remesh_quads(r->mesh, r->vectors, &r->options, al, &out, NULL, error);
+    if (result == TT_OK) tt_mesh_free(out);
+    else if (out != NULL) return TT_RESULT_MAX_ENUM;
+    return result;
+}
+
+static void test_remesh_errors(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *q = (tt_mesh *)&q;
+    tt_error err;
+    tt_remesh_options o;
+    tt_remesh_report rep;
+    float *vec, *w;
+    remesh_ctx ctx;
+    tt_result r;
+    memset(&m, 0, sizeof m);
+    make_icosphere(&m, 2, 1.0);
+    CHECK(build_welded(&m, &mesh, &err) == TT_OK, "icosphere: %s", err.message);
+    tm_free(&m);
+    if (!mesh) return;
+    vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
+    remesh_field(mesh, 0, vec, w);
+    memset(&o, 0, sizeof o);
+    r = tt_remesh_quads(NULL, vec, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && q == NULL, "NULL mesh: %d", r);
+    r = tt_remesh_quads(mesh, NULL, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "NULL vectors: %d", r);
+    r = tt_remesh_quads(mesh, vec, &o, NULL, NULL, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "NULL out_mesh: %d", r);
+    o.edge_length = -1.0f;
+    r = tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "edge_length"), "negative edge: %s", err.message);
+    o.edge_length = internal_infinity();
+    r = tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "infinite edge: %s", err.message);
+    o.edge_length = 1.0f;   /* the bounding box's diagonal is 2 sqrt(3) / 1.05 or so: past a quarter of it */
+    r = tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "quarter"), "edge too large: %s", err.message);
+    o.edge_length = 1e-4f;
+    r = tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err);
+    CHECK(r == TT_ERROR_TOO_LARGE && q == NULL, "edge too small: %d %s", r, err.message);
+    o.edge_length = 0.0f;
+    o.sweeps = -1;
+    r = tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT, "negative sweeps: %d", r);
+    o.sweeps = 0;
+    w[17] = 1.5f;
+    o.face_weights = w;
+    r = tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_INVALID_ARGUMENT && err.face == 17, "weight 1.5 on face 17: face %d, %s", err.face,
+          err.message);
+    w[17] = 1.0f;
+    vec[3 * 5 + 1] = (float)internal_not_a_number();
+    r = tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err);
+    CHECK(r == TT_ERROR_NON_FINITE && err.face == 5, "NaN vector on face 5: face %d, %s", err.face, err.message);
+    remesh_field(mesh, 0, vec, w);
+    /* Every allocation failing in turn. */
+    ctx.mesh = mesh;
+    ctx.vectors = vec;
+    memset(&ctx.options, 0, sizeof ctx.options);
+    ctx.options.edge_length = 0.4f;
+    ctx.options.face_weights = w;
+    oom_reset();
+    oom_sweep("tt_remesh_quads", oom_remesh, &ctx, TT_OK);
+    free(vec);
+    free(w);
+    tt_mesh_free(mesh);
+}
+
 /* Flag bits the builder does not know are refused, not ignored: a caller
    who sets one expects something of it. */
 static void test_builder_unknown_flags(void)
@@ -1900,4 +2236,7 @@ void run_mesh_tests(void)
     RUN(test_corner_normals);
     RUN(test_mesh_null_errors);
     RUN(test_mesh_query_allocators);
+    RUN(test_remesh_sphere);
+    RUN(test_remesh_topology);
+    RUN(test_remesh_errors);
 }

@@ -1007,6 +1007,70 @@ static tt_result field_oom_call(void *ctx, const tt_allocator *al, tt_error *err
     return r;
 }
 
+/* tt_field_face_weights: 0 where up decides nothing, 1 on walls, the
+   smooth step between (|P(up)| from 0.1 to 0.5), 1 everywhere with
+   constraints; and the field holds the projected up exactly where the
+   weight is 1 and the face is a wall. */
+static void test_field_face_weights(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_field_options opt;
+    tt_field_constraint con;
+    tt_error err;
+    float *w, *v;
+    int f, wrong = 0, ones = 0, zeros = 0, level_wrong = 0;
+    memset(&m, 0, sizeof m);
+    make_field_sphere(&m, 24, 32, 2.0);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "sphere builds: %s", err.message);
+    tm_free(&m);
+    if (!mesh) return;
+    w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
+    v = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    memset(&opt, 0, sizeof opt);
+    CHECK(tt_field_face_weights(mesh, &opt, w, &err) == TT_OK, "weights: %s", err.message);
+    CHECK(tt_tangent_field(mesh, &opt, NULL, v, &err) == TT_OK, "field: %s", err.message);
+    for (f = 0; f < mesh->nfaces; f++) {
+        float n[3];
+        double p = 0, t, expect, dot, len;
+        tt_face_normal(mesh, f, n);
+        p = sqrt(1.0 - (double)n[1] * n[1] > 0 ? 1.0 - (double)n[1] * n[1] : 0);
+        t = (p - 0.1) / 0.4;
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        expect = t * t * (3 - 2 * t);
+        if (fabs(w[f] - expect) > 1e-5) {
+            if (!wrong++) DETAIL("face %d: |P(up)| %.4f, weight %.6f, expected %.6f", f, p, w[f], expect);
+        }
+        ones += w[f] == 1.0f;
+        zeros += w[f] == 0.0f;
+        /* Walls (|P(up)| >= 0.8): the field is the projected up there. */
+        len = sqrt((double)v[3 * f] * v[3 * f] + (double)v[3 * f + 1] * v[3 * f + 1] + (double)v[3 * f + 2] * v[3 * f + 2]);
+        dot = len > 0 ? v[3 * f + 1] / len : 0;
+        if (p >= 0.8 && w[f] == 1.0f && fabs(dot - p) > 1e-3) {
+            if (!level_wrong++) DETAIL("face %d: field . up %.4f, |P(up)| %.4f", f, dot, p);
+        }
+    }
+    CHECK(wrong == 0 && ones > 0 && ones + zeros < mesh->nfaces, "weights by the rule: %d wrong, %d ones, %d zeros of %d",
+          wrong, ones, zeros, mesh->nfaces);
+    CHECK(level_wrong == 0, "weight-1 walls carry the projected up: %d do not", level_wrong);
+    memset(&con, 0, sizeof con);
+    con.face = 3;
+    {
+        float n[3];
+        tt_face_normal(mesh, 3, n);
+        con.vector[0] = -n[1]; con.vector[1] = n[0]; con.vector[2] = 0.0f;
+        if (fabsf(con.vector[0]) + fabsf(con.vector[1]) < 1e-3f) { con.vector[0] = 0; con.vector[1] = -n[2]; con.vector[2] = n[1]; }
+    }
+    opt.constraints = &con;
+    opt.nconstraints = 1;
+    CHECK(tt_field_face_weights(mesh, &opt, w, &err) == TT_OK, "constraints: %s", err.message);
+    for (f = 0, wrong = 0; f < mesh->nfaces; f++) wrong += w[f] != 1.0f;
+    CHECK(wrong == 0, "with constraints every weight is 1: %d are not", wrong);
+    free(w);
+    free(v);
+    tt_mesh_free(mesh);
+}
+
 static void test_field_oom(void)
 {
     tmesh m;
@@ -5886,6 +5950,7 @@ void run_lapped_tests(void)
     RUN(test_field_errors);
     RUN(test_field_constraint_items);
     RUN(test_field_extreme_coordinates);
+    RUN(test_field_face_weights);
     RUN(test_field_oom);
     RUN(test_patch_splotch);
     RUN(test_patch_seeds);

@@ -38,6 +38,7 @@ static const char *const k_functions[] = {
     "tt_mesh_quadrangulate_sources",
     "tt_corner_sources_apply",
     "tt_corner_normals",
+    "tt_remesh_quads",
     "tt_image_create",
     "tt_image_from_bytes",
     "tt_image_rotate90",
@@ -75,6 +76,7 @@ static const char *const k_functions[] = {
     "tt_face_stretch",
     "tt_measure_uv_distortion",
     "tt_tangent_field",
+    "tt_field_face_weights",
     "tt_make_texture_patch",
     "tt_lapped_paste",
     "tt_lapped_measure",
@@ -419,6 +421,61 @@ static void cases_mesh(const baseline *b)
     CASE(tt_corner_normals(m, 30, BA1, normals, E));
     CASE(tt_corner_normals(m, 30, BA2, normals, E));
     CASE(tt_corner_normals(&b->empty, 30, AL, normals, E));
+
+    {
+        /* The cube's 12 triangles with a tangent of each (x, or z on the
+           faces facing x); its diagonal is sqrt(3). */
+        float vectors[12 * 3], weights[12];
+        tt_remesh_options ro;
+        tt_mesh *rm = NULL;
+        const tt_mesh *t = b->tris;
+        int f;
+        for (f = 0; f < 12; f++) {
+            float n[3];
+            tt_face_normal(t, f, n);
+            vectors[3 * f] = fabsf(n[0]) > 0.5f ? 0.0f : 1.0f;
+            vectors[3 * f + 1] = 0.0f;
+            vectors[3 * f + 2] = fabsf(n[0]) > 0.5f ? 1.0f : 0.0f;
+            weights[f] = 1.0f;
+        }
+        memset(&ro, 0, sizeof ro);
+        ro.edge_length = 0.2f;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(NULL, vectors, &ro, AL, &rm, NULL, E));
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, NULL, &ro, AL, &rm, NULL, E));
+        CASE(tt_remesh_quads(t, vectors, &ro, AL, NULL, NULL, E));
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, BA1, &rm, NULL, E));
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, BA2, &rm, NULL, E));
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(&b->empty, vectors, &ro, AL, &rm, NULL, E));
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(b->nan_tris, vectors, &ro, AL, &rm, NULL, E));
+        ro.edge_length = -1.0f;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.edge_length = b->nan_t;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.edge_length = b->inf_t;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.edge_length = 1.0f;      /* more than a quarter of the diagonal */
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.edge_length = 1e-30f;    /* the refinement would pass TT_MAX_REMESH_VERTICES */
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.edge_length = 0.2f;
+        ro.sweeps = -1;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.sweeps = INT_MIN;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.sweeps = 0;
+        ro.face_weights = weights;
+        weights[3] = -0.5f;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        weights[3] = b->nan_t;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        weights[3] = 2.0f;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        weights[3] = 1.0f;
+        vectors[7] = b->nan_t;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        vectors[7] = -b->inf_t;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+    }
 }
 
 static void cases_image(const baseline *b)
@@ -1391,6 +1448,18 @@ static void cases_lapped(const baseline *b)
     memset(&fc, 0, sizeof fc);
     fc.face = 0;
     fc.vector[0] = 1;
+    CASE(tt_field_face_weights(NULL, &fo, field, E));
+    CASE(tt_field_face_weights(m, &fo, NULL, E));
+    CASE(tt_field_face_weights(&b->empty, &fo, field, E));
+    fb = fo; fb.up[0] = b->nan_t;
+    CASE(tt_field_face_weights(m, &fb, field, E));
+    fb = fo; fb.up[1] = b->inf_t;
+    CASE(tt_field_face_weights(m, &fb, field, E));
+    fb = fo; fb.sigma = -1;
+    CASE(tt_field_face_weights(m, &fb, field, E));
+    fb = fo; fb.nconstraints = 1; fb.constraints = NULL;
+    CASE(tt_field_face_weights(m, &fb, field, E));
+
     CASE(tt_tangent_field(NULL, &fo, AL, field, E));
     CASE(tt_tangent_field(m, &fo, AL, NULL, E));
     CASE(tt_tangent_field(m, &fo, BA1, field, E));
