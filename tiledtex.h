@@ -6960,14 +6960,47 @@ done:
     return ok;
 }
 
+/* The closest point to p (cluster's position) on the faces around the
+   cluster's members (level-0 vertices, listed by head / next). */
+static void tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *next, int cluster, const double *p,
+                                  float *out)
+{
+    double best[3], best_d = HUGE_VAL;
+    int i, j;
+    memcpy(best, p, sizeof best);
+    for (i = head[cluster]; i >= 0; i = next[i]) {
+        int c0 = m->vert_corner[i], c = c0, steps = 0;
+        if (c0 < 0) continue;
+        do {
+            int face = m->corner_face[c], fb = m->face_start[face], fe = m->face_start[face + 1], t;
+            for (t = fb + 1; t + 1 < fe; t++) {
+                double a[3], b[3], cc[3], near_point[3], d[3], dd;
+                for (j = 0; j < 3; j++) {
+                    a[j] = m->pos[3 * (size_t)m->corner_vert[fb] + j];
+                    b[j] = m->pos[3 * (size_t)m->corner_vert[t] + j];
+                    cc[j] = m->pos[3 * (size_t)m->corner_vert[t + 1] + j];
+                }
+                tt__closest_on_triangle(p, a, b, cc, near_point);
+                for (j = 0; j < 3; j++) d[j] = near_point[j] - p[j];
+                dd = tt__dot3(d, d);
+                if (dd < best_d) {
+                    best_d = dd;
+                    memcpy(best, near_point, sizeof best);
+                }
+            }
+            c = m->twin[tt_mesh_prev(m, c)];
+        } while (c >= 0 && c != c0 && ++steps < m->ncorners);
+    }
+    for (j = 0; j < 3; j++) out[j] = (float)best[j];
+}
+
 /* The output from the traced faces: a face that meets itself at a vertex
    is split there into simple loops; a loop facing against the surface
    with most of its vertices on the input's boundary, or one entirely on
    it, spans a hole and is dropped; each vertex whose faces form several
    fans becomes one vertex per fan; with more pieces than the input,
-   pieces of fewer than 8 faces (pockets a pinch closed off) are dropped;
-   each vertex moves to the closest point of the faces around its
-   cluster's members (level-0 vertices). */
+   pieces of fewer than 8 faces (pockets a pinch closed off) are dropped.
+   Vertices lie on the input (tt__remesh_onto_input). */
 static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, const tt__remesh_graph *g,
                                    int input_components, tt_mesh **out_mesh, tt_remesh_report *rep,
                                    tt_error *error)
@@ -6979,7 +7012,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     int *member_head = NULL, *member_next = NULL, *out_id = NULL, *indices = NULL, *sizes = NULL;
     unsigned char *keep = NULL;
     uint64_t *half = NULL;      /* pairs: (a << 32 | b, the corner at b of the loop running a -> b) */
-    float *positions = NULL;
+    float *positions = NULL, *surface = NULL;
     tt_mesh_desc desc;
     tt_result result = TT_ERROR_OUT_OF_MEMORY;
 
@@ -7032,6 +7065,29 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             else if (turn <= 0.0) rep->folded_faces++;
         }
     }
+    /* Each cluster a loop uses moves to the closest point of the input's
+       faces around its members; a loop those points make flat (two
+       clusters onto one point, or three onto a line) is dropped. */
+    member_head = TT__ALLOC(al, int, (size_t)nc + 1);
+    member_next = TT__ALLOC(al, int, (size_t)m->nverts + 1);
+    surface = TT__ALLOC(al, float, 3 * (size_t)nc + 3);
+    if (!member_head || !member_next || !surface) goto fail;
+    for (k = 0; k < nc; k++) member_head[k] = -1;
+    for (k = m->nverts - 1; k >= 0; k--) {
+        member_next[k] = member_head[g->cluster[k]];
+        member_head[g->cluster[k]] = k;
+    }
+    for (k = 0; k < nc; k++) where[k] = 0;
+    for (q = 0; q < nloops; q++)
+        if (keep[q])
+            for (k = loop_start[q]; k < loop_start[q + 1]; k++) where[loop_vert[k]] = 1;
+    for (k = 0; k < nc; k++)
+        if (where[k]) tt__remesh_onto_input(m, member_head, member_next, k, g->pos + 3 * (size_t)k, surface + 3 * (size_t)k);
+    for (q = 0; q < nloops; q++)
+        if (keep[q] && tt__face_has_zero_area(surface, loop_vert + loop_start[q], loop_start[q + 1] - loop_start[q])) {
+            keep[q] = 0;
+            rep->dropped_faces++;
+        }
     /* Corners at one vertex are one fan where their loops share an edge
        there: the corner leaving v towards w joins the corner its twin
        w -> v arrives at. Loops sharing an edge make one piece. */
@@ -7102,20 +7158,12 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             vertex_of[k] = vertex_of[r];
         }
     }
-    /* Positions: each output vertex at the closest point of the input near
-       its cluster; numbered in order of first use. */
-    member_head = TT__ALLOC(al, int, (size_t)nc + 1);
-    member_next = TT__ALLOC(al, int, (size_t)m->nverts + 1);
+    /* Numbered in order of first use. */
     out_id = TT__ALLOC(al, int, (size_t)nverts + 1);
     positions = TT__ALLOC(al, float, 3 * (size_t)nverts + 3);
     indices = TT__ALLOC(al, int, (size_t)ncorners + 1);
     sizes = TT__ALLOC(al, int, (size_t)nloops + 1);
-    if (!member_head || !member_next || !out_id || !positions || !indices || !sizes) goto fail;
-    for (k = 0; k < nc; k++) member_head[k] = -1;
-    for (k = m->nverts - 1; k >= 0; k--) {
-        member_next[k] = member_head[g->cluster[k]];
-        member_head[g->cluster[k]] = k;
-    }
+    if (!out_id || !positions || !indices || !sizes) goto fail;
     for (k = 0; k < nverts; k++) out_id[k] = -1;
     {
         int nout = 0;
@@ -7126,33 +7174,8 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             for (k = b; k < b + s; k++) {
                 int v = vertex_of[k], cl = loop_vert[k];
                 if (out_id[v] < 0) {
-                    const double *p = g->pos + 3 * (size_t)cl;
-                    double best[3], best_d = HUGE_VAL;
-                    int i, j;
-                    memcpy(best, p, sizeof best);
-                    for (i = member_head[cl]; i >= 0; i = member_next[i]) {
-                        int c0 = m->vert_corner[i], c = c0, steps = 0;
-                        if (c0 < 0) continue;
-                        do {
-                            int face = m->corner_face[c], fb = m->face_start[face], fe = m->face_start[face + 1];
-                            int t;
-                            for (t = fb + 1; t + 1 < fe; t++) {
-                                double a[3], bb[3], cc[3], near_point[3], d[3], dd;
-                                for (j = 0; j < 3; j++) {
-                                    a[j] = m->pos[3 * (size_t)m->corner_vert[fb] + j];
-                                    bb[j] = m->pos[3 * (size_t)m->corner_vert[t] + j];
-                                    cc[j] = m->pos[3 * (size_t)m->corner_vert[t + 1] + j];
-                                }
-                                tt__closest_on_triangle(p, a, bb, cc, near_point);
-                                for (j = 0; j < 3; j++) d[j] = near_point[j] - p[j];
-                                dd = tt__dot3(d, d);
-                                if (dd < best_d) { best_d = dd; memcpy(best, near_point, sizeof best); }
-                            }
-                            c = m->twin[tt_mesh_prev(m, c)];
-                        } while (c >= 0 && c != c0 && ++steps < m->ncorners);
-                    }
                     out_id[v] = nout;
-                    for (j = 0; j < 3; j++) positions[3 * (size_t)nout + j] = (float)best[j];
+                    memcpy(positions + 3 * (size_t)nout, surface + 3 * (size_t)cl, 3 * sizeof(float));
                     nout++;
                 }
                 indices[nindices++] = out_id[v];
@@ -7194,7 +7217,7 @@ done:
     tt__free(al, path); tt__free(al, keep); tt__free(al, half); tt__free(al, corner_root);
     tt__free(al, loop_root); tt__free(al, piece_size); tt__free(al, vertex_root); tt__free(al, vertex_of);
     tt__free(al, member_head); tt__free(al, member_next); tt__free(al, out_id); tt__free(al, positions);
-    tt__free(al, indices); tt__free(al, sizes);
+    tt__free(al, indices); tt__free(al, sizes); tt__free(al, surface);
     return result;
 }
 

@@ -38,8 +38,9 @@ static void print_help(void)
            "  --permissive           accept non-manifold or mis-oriented edges\n"
            "  --edge X,Y             condition k's S x 2S edge window, once per condition\n"
            "  --background X,Y,W,H   region the background windows come from\n"
-           "  --mips                 also write the per-tile mip levels, OUT_PREFIX_mip1.png ...\n"
-           "  --up AXIS              turn each quad's tile so that its up follows AXIS (x, y, z, -x,\n"
+           "  --mips                 also write the per-tile mip levels, OUT_PREFIX_mip1.png ...\n",
+           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER);
+    printf("  --up AXIS              turn each quad's tile so that its up follows AXIS (x, y, z, -x,\n"
            "                         -y, -z or X,Y,Z) along the surface, and give the quads upright\n"
            "                         tiles, which keep IMAGE's up on all four sides (bricks, planks\n"
            "                         and grain run level); a left or right side is plain where the\n"
@@ -47,6 +48,11 @@ static void print_help(void)
            "                         twice as wide and tall\n"
            "  --constraints FILE     the same, up given by lines FACE X Y Z [SIGMA [WEIGHT]] (FACE\n"
            "                         counts the OBJ's faces from 1), as 'tiledtex lapped' takes them\n"
+           "  --remesh L             first remesh MESH into quads of side about L (mesh units, or\n"
+           "                         'auto': 1/80 of its bounding-box diagonal) whose edges follow\n"
+           "                         the field: with --up, rows of level quads on every wall, so a\n"
+           "                         triangle scan shows courses level at the size you choose (the\n"
+           "                         OBJ written is the new mesh; its vertices lie on MESH's faces)\n"
            "  --no-courses           with --up, take IMAGE as it is: by default a photo laid in\n"
            "                         courses (bricks, blocks) is resampled so that a tile holds a\n"
            "                         whole number of them, and every tile is cut on them\n"
@@ -67,7 +73,7 @@ static void print_help(void)
            "Prints the mesh, the tiles and the seam score over every edge and near the tiles'\n"
            "corners, within 5 %% of each edge's ends, where three to six tiles meet (about 0: the\n"
            "texture continues, about 1: unrelated).\n",
-           TT_DEFAULT_TILE_SIZE, TT_RECOMMENDED_GUTTER, TOOL_REPORT_EDGES);
+           TOOL_REPORT_EDGES);
 }
 
 /* Level `level` of the four sets' atlas (tt_tileset_kind's quarters);
@@ -139,6 +145,8 @@ int cmd_tile(int argc, char **argv)
                                           TILED_FORMAT_OPTION | TILED_FIELD_OPTIONS,
                                       &options, positional, 3, "MESH, IMAGE and OUT_PREFIX", print_help);
     if (status >= 0) return status;
+    if (options.remesh && options.field.constraints_path)
+        return tool_usage("--remesh follows --up: not with --constraints, whose face numbers are the OBJ's");
     if (tool_output_prefix(positional[2], &options.output, prefix) != 0) return TOOL_EXIT_USAGE;
     gltf = options.output.format != TOOL_FORMAT_OBJ;
     /* The per-tile mip levels keep coarse levels from blending neighbouring

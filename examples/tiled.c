@@ -76,6 +76,15 @@ int tiled_parse_option(int argc, char **argv, int *index, unsigned accept, tiled
         if (taken < 0) return -1;
     } else if ((accept & TILED_FIELD_OPTIONS) && tool_flag(argv[*index], "--no-courses")) {
         options->no_courses = 1;
+    } else if ((accept & TILED_FIELD_OPTIONS) && tool_option(argc, argv, index, "--remesh", &value)) {
+        options->remesh = 1;
+        options->remesh_size = 0.0;
+        if (!value || (strcmp(value, "auto") != 0 &&
+                       (parse_whole_double(value, &options->remesh_size) != 0 || !(options->remesh_size > 0.0)))) {
+            tool_usage("--remesh wants the quads' side in mesh units (above 0) or 'auto', got '%s'",
+                       value ? value : "nothing");
+            return -1;
+        }
     } else if ((accept & TILED_ATLAS_OPTION) && tool_option(argc, argv, index, "--atlas", &value)) {
         if (!value) { tool_usage("--atlas needs a value"); return -1; }
         options->atlas_path = value;
@@ -176,13 +185,84 @@ static int orient_tiles(const char *obj_path, const tiled_options *options, cons
     return status;
 }
 
+/* --remesh: the OBJ's mesh replaced by one whose quads follow the field
+   (tt_remesh_quads), with up from --up (the library's +y without it) held
+   as firmly as tt_field_face_weights says; its edges twice the quads'
+   asked side, since the quadrangulation after halves them. The OBJ's
+   normals do not carry over (the new mesh gets computed ones). With the
+   field given, *source and *nsources then name the new faces themselves:
+   the field is made again on the quads. */
+static int remesh_along_field(const char *obj_path, const tiled_options *options, int **source, int *nsources,
+                              tiled_mesh *out)
+{
+    const int nfaces = out->mesh->nfaces;
+    float *vectors = (float *)malloc((size_t)nfaces * 3 * sizeof(float));
+    float *weights = (float *)malloc((size_t)nfaces * sizeof(float));
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    tt_field_options field;
+    tt_remesh_options remesh;
+    tt_mesh *remeshed = NULL;
+    tt_error error;
+    int f, c, k, status = 0;
+    if (!vectors || !weights) {
+        free(vectors);
+        free(weights);
+        return tool_fail("out of memory for the direction field of %d faces", nfaces);
+    }
+    for (c = 0; c < out->mesh->ncorners; c++)
+        for (k = 0; k < 3; k++) {
+            double x = out->mesh->pos[3 * (size_t)out->mesh->corner_vert[c] + k];
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
+        }
+    memset(&field, 0, sizeof field);
+    memcpy(field.up, options->field.up, sizeof field.up);
+    memset(&remesh, 0, sizeof remesh);
+    remesh.edge_length = (float)(2.0 * options->remesh_size);
+    remesh.face_weights = weights;
+    out->remesh_edge = remesh.edge_length > 0.0f
+                           ? remesh.edge_length
+                           : (float)(TT_DEFAULT_REMESH_EDGE * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                                                   (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                                                   (hi[2] - lo[2]) * (hi[2] - lo[2])));
+    tool_stage("computing the direction field");
+    if (tt_mesh_compute_stats(out->mesh, NULL, &out->input_stats, &error) != TT_OK ||
+        tt_tangent_field(out->mesh, &field, NULL, vectors, &error) != TT_OK ||
+        tt_field_face_weights(out->mesh, &field, weights, &error) != TT_OK)
+        status = tool_fail("%s: %s", obj_path, error.message);
+    tool_stage("remeshing along the field");
+    if (status == 0 && tt_remesh_quads(out->mesh, vectors, &remesh, NULL, &remeshed, &out->remesh, &error) != TT_OK)
+        status = tool_fail("%s: --remesh %g (a remesh with edges of %g, each face then split): %s", obj_path,
+                           0.5 * out->remesh_edge, out->remesh_edge, error.message);
+    free(vectors);
+    free(weights);
+    if (status != 0) return status;
+    if (*source) {
+        int *own = (int *)malloc((size_t)remeshed->nfaces * sizeof(int));
+        if (!own) {
+            tt_mesh_free(remeshed);
+            return tool_fail("out of memory for the %d faces remeshed from %s", remeshed->nfaces, obj_path);
+        }
+        for (f = 0; f < remeshed->nfaces; f++) own[f] = f;
+        free(*source);
+        *source = own;
+        *nsources = remeshed->nfaces;
+    }
+    tt_mesh_free(out->mesh);
+    out->mesh = remeshed;
+    free(out->corner_normal);
+    out->corner_normal = NULL;
+    out->remeshed = remeshed->nfaces;
+    return 0;
+}
+
 int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mesh *out)
 {
     obj_mesh obj;
     tt_mesh_desc desc;
     tt_error error;
     char message[TOOL_ERROR_SIZE];
-    int status, step, f, *source = NULL, *lines = NULL;
+    int status, step, f, *source = NULL, *lines = NULL, nsources;
 
     memset(out, 0, sizeof *out);
     if (tt_tile_layout_resolve(&options->layout, &out->layout, &error) != TT_OK)
@@ -224,9 +304,17 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
     out->repaired_edges = out->mesh->repaired_edges;
     out->input_min_face_size = out->mesh->min_face_size;
     out->input_max_face_size = out->mesh->max_face_size;
+    nsources = out->input_faces;
+    if (options->remesh) {
+        if ((status = remesh_along_field(obj_path, options, &source, &nsources, out)) != 0) goto fail;
+        /* The constraints' lines name the OBJ's faces; the new ones have none. */
+        free(lines);
+        lines = NULL;
+    }
 
-    /* Tiles are square: every face must be a quad. */
-    if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
+    /* Tiles are square: every face must be a quad. A remeshed mesh is
+       always split, so that its quads have the side asked for. */
+    if (out->remeshed || out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
         if ((status = quadrangulate_traced(obj_path, out, 0, &source)) != 0) goto fail;
         out->quadrangulated = out->mesh->nfaces;
     }
@@ -246,7 +334,7 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         status = tool_fail("%s: %s", obj_path, error.message);
         goto fail;
     }
-    if (source && (status = orient_tiles(obj_path, options, source, lines, out->input_faces, out)) != 0) goto fail;
+    if (source && (status = orient_tiles(obj_path, options, source, lines, nsources, out)) != 0) goto fail;
     if (tt_mesh_compute_stats(out->mesh, NULL, &out->stats, &error) != TT_OK) {
         status = tool_fail("%s: %s", obj_path, error.message);
         goto fail;
@@ -411,6 +499,26 @@ int tiled_check_atlas_size(const tiled_options *options)
 void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
 {
     tool_note_cut_edges(obj_path, mesh->repaired_edges);
+    if (mesh->remeshed) {
+        const tt_remesh_report *r = &mesh->remesh;
+        const tt_mesh_stats *in = &mesh->input_stats, *s = &mesh->stats;
+        if (tool_quiet()) return;
+        tool_progress_clear();
+        fprintf(stderr, "tiledtex: %s remeshed along the field into %d faces with edges of about %g (%d quads, %d "
+                        "triangles, %d pentagons, %d larger", obj_path, mesh->remeshed, mesh->remesh_edge, r->quads,
+                r->triangles, r->pentagons, r->larger_faces);
+        if (r->folded_faces) fprintf(stderr, "; %d folded", r->folded_faces);
+        fprintf(stderr, "), then split into %d quads of about %g\n", mesh->quadrangulated, 0.5 * mesh->remesh_edge);
+        /* Where the surface is thinner than an edge, the new mesh closes a
+           handle or a hole, or loses a piece smaller than a face. */
+        if (in->genus != s->genus || in->components != s->components || in->boundary_loops != s->boundary_loops)
+            fprintf(stderr, "tiledtex: the remeshed surface has genus %d, %d component%s and %d boundary loop%s; "
+                            "%s has %d, %d and %d: parts of it are thinner than an edge (a smaller --remesh "
+                            "follows them)\n", s->genus, s->components, s->components == 1 ? "" : "s",
+                    s->boundary_loops, s->boundary_loops == 1 ? "" : "s", obj_path, in->genus, in->components,
+                    in->boundary_loops);
+        return;
+    }
     if (mesh->quadrangulated) {
         char sizes[64];
         if (mesh->input_max_face_size == 3) snprintf(sizes, sizeof sizes, "triangles");
@@ -426,8 +534,9 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
            the part's size, with stars at the vertices, whatever --tile. */
         if (mesh->input_max_face_size == 3 && mesh->input_faces >= TILED_DENSE_TRIANGLES)
             fprintf(stderr, "tiledtex: %d triangles make %d tiny tiles with stars at the vertices: for a dense "
-                            "triangle mesh use 'tiledtex polycube', 'tiledtex hpm' or 'tiledtex lapped', which "
-                            "texture it at the scale you choose\n", mesh->input_faces, mesh->quadrangulated);
+                            "triangle mesh use --remesh (quads of the size you choose, along the field), or "
+                            "'tiledtex polycube', 'tiledtex hpm' or 'tiledtex lapped'\n", mesh->input_faces,
+                    mesh->quadrangulated);
     }
 }
 

@@ -21,7 +21,8 @@ enum {
     TILED_MATERIAL_OPTIONS = 1 << 5, /* --normal --roughness --metallic --ao --height --normal-y-down */
     TILED_TRIANGLES_OPTION = 1 << 6, /* --triangles */
     TILED_FORMAT_OPTION = 1 << 7,    /* --format obj|gltf */
-    TILED_FIELD_OPTIONS = 1 << 8     /* --up --constraints: tiles turned along the direction field */
+    TILED_FIELD_OPTIONS = 1 << 8     /* --up --constraints --no-courses --remesh: tiles turned along the direction
+                                        field, and quads made to follow it */
 };
 
 /* From this many triangles on, a mesh counts as a dense triangle mesh, for
@@ -48,6 +49,8 @@ typedef struct tiled_options {
     material_maps maps;          /* the material's other maps (their paths; material_load loads them) */
     int no_courses;              /* --no-courses: upright tiles ignore the photo's courses */
     tt_courses courses;          /* tiled_fit_courses's: the windows stay on them (period 0: none) */
+    int remesh;                  /* --remesh: a new quad mesh along the field first (tt_remesh_quads) */
+    double remesh_size;          /* its quads' side in mesh units after the quadrangulation; 0 = auto */
 } tiled_options;
 
 /* The tool's defaults: the library's, with a gutter of TT_RECOMMENDED_GUTTER
@@ -95,6 +98,10 @@ typedef struct tiled_mesh {
     int quadrangulated;          /* quads made from the OBJ's triangles or n-gons; 0 if all quads */
     int input_min_face_size, input_max_face_size;
     int repaired_edges;          /* edges --permissive cut open */
+    int remeshed;                /* --remesh: the faces tt_remesh_quads made, before the quadrangulation */
+    tt_remesh_report remesh;     /* ...and its report */
+    float remesh_edge;           /* ...and the edge length it was asked for (mesh units) */
+    tt_mesh_stats input_stats;   /* --remesh: the OBJ's topology, to say where the new mesh differs */
     /* With --up or --constraints (else NULL and 0): */
     uint8_t *face_turn;          /* per quad: the half-edge its tile's bottom side lies on (tt_orient_tiles) */
     uint8_t *face_upright;       /* per quad: its tile set (tt_tileset_kind), the atlas's quarter; NULL without */

@@ -887,7 +887,7 @@ typedef struct tool_face_source {
     int nsources;               /* the OBJ's faces */
     const int *source;          /* per mesh face: its OBJ face */
     const int *first;           /* per OBJ face: the first mesh face made from it */
-    const int *source_line;     /* per OBJ face: its line in the file */
+    const int *source_line;     /* per OBJ face: its line in the file; NULL for faces made anew (--remesh) */
 } tool_face_source;
 tool_face_source triangle_mesh_faces(const triangle_mesh *m);
 

@@ -386,6 +386,8 @@ static int face_source_report_error(const char *path, const tool_face_source *fa
 {
     char message[sizeof error->message + 32];
     if (error->face < 0 || error->face >= faces->nfaces) return tool_fail("%s: %s", path, error->message);
+    /* Faces made anew (--remesh) trace back to no line of the file. */
+    if (!faces->source_line) return tool_fail("%s: %s", path, error->message);
     face_source_rewrite(faces, error, message, sizeof message);
     return tool_fail("%s:%d: %s", path, faces->source_line[faces->source[error->face]], message);
 }

@@ -1355,6 +1355,41 @@ check "tile --constraints on triangles: 3840 quads turned" "'up: 3840 quads' ...
 expect_error "tile --constraints face out of range" tile ../in/torus.obj ../in/lap256.png out --tile 32 \
     --constraints ../in/constraints_range.txt
 err_mentions "tile constraint out of range: FILE:LINE" 'constraints_range\.txt:2:'
+# tile --remesh: the icosphere's triangles would make kites whose tiles turn
+# every way; remeshed along the field its walls get rows of level quads.
+newdir
+expect_ok "tile --up y on the icosphere's triangles, no remesh" tile ../in/spheretri.obj ../in/lap256.png kites \
+    --tile 32 --up y
+LEVEL_KITES=$(printf '%s\n' "$OUT" | sed -nE 's/^level: the image.s up ([0-9.]+)% .*/\1/p')
+expect_ok "tile --up y --remesh auto" tile ../in/spheretri.obj ../in/lap256.png rm --tile 32 --up y --remesh auto
+LEVEL_REMESH=$(printf '%s\n' "$OUT" | sed -nE 's/^level: the image.s up ([0-9.]+)% .*/\1/p')
+check "tile --remesh: walls level (90 % within 10 degrees), the kites far from it" \
+    "remesh >= 90, kites < 60" "remesh ${LEVEL_REMESH:-none}, kites ${LEVEL_KITES:-none}" \
+    "$(awk -v r="${LEVEL_REMESH:-0}" -v k="${LEVEL_KITES:-100}" 'BEGIN { exit !(r >= 90 && k < 60) }'; echo $?)"
+err_mentions "tile --remesh: the note says what the remesh made" \
+    'remeshed along the field into [0-9]+ faces with edges of about [0-9.]+ \([0-9]+ quads, [0-9]+ triangles'
+check "tile --remesh: a closed genus-0 surface of quads" "genus 0, 1 component, 0 boundary loops" "$OUT" \
+    "$(printf '%s\n' "$OUT" | grep -q '^\.\./in/spheretri\.obj: [0-9]* quads, [0-9]* vertices, genus 0, 1 component, 0 boundary loops'; echo $?)"
+check "tile --remesh: the OBJ holds quads only" "every f line 4 corners" "$(awk '/^f /{print NF-1}' rm.obj | sort -u | tr '\n' ' ')" \
+    "$([ "$(awk '/^f /{print NF-1}' rm.obj | sort -u)" = "4" ]; echo $?)"
+ON_SPHERE=$(awk '/^v /{ r = sqrt($2*$2 + $3*$3 + $4*$4); if (r < lo || NR == 1 || lo == "") lo = r; if (r > hi) hi = r }
+    END { printf "%.4f %.4f", lo, hi }' rm.obj)
+check "tile --remesh: vertices on or just inside the icosphere (radius 1 at its vertices)" "0.97 .. 1.0001" \
+    "$ON_SPHERE" "$(read -r lo hi <<<"$ON_SPHERE"; awk -v a="$lo" -v b="$hi" 'BEGIN { exit !(a >= 0.97 && b <= 1.0001) }'; echo $?)"
+expect_ok "tile --remesh 0.1: smaller quads" tile ../in/spheretri.obj ../in/lap256.png rm2 --tile 32 --up y --remesh 0.1
+check "tile --remesh 0.1: larger quads than auto's (0.043), so fewer" "fewer quads than auto's" \
+    "$(grep -c '^f ' rm2.obj) vs $(grep -c '^f ' rm.obj)" "$([ "$(grep -c '^f ' rm2.obj)" -lt "$(grep -c '^f ' rm.obj)" ]; echo $?)"
+expect_ok "tile --remesh without --up (the library's +y)" tile ../in/spheretri.obj ../in/lap256.png rm3 --tile 32 \
+    --remesh auto
+expect_ok "tile --remesh --format glb" tile ../in/spheretri.obj ../in/lap256.png rm4.glb --tile 32 --up y --remesh auto
+expect_error "tile --remesh 0" tile ../in/spheretri.obj ../in/lap256.png bad --tile 32 --remesh 0
+err_mentions "tile --remesh 0: what it wants" "remesh wants the quads' side in mesh units \\(above 0\\) or 'auto'"
+expect_error "tile --remesh with no value" tile ../in/spheretri.obj ../in/lap256.png bad --tile 32 --remesh
+expect_error "tile --remesh larger than the mesh" tile ../in/spheretri.obj ../in/lap256.png bad --tile 32 --remesh 5
+err_mentions "tile --remesh 5: too large, said in the tool's terms" 'remesh 5 \(a remesh with edges of 10'
+expect_error "tile --remesh --constraints" tile ../in/spheretri.obj ../in/lap256.png bad --tile 32 --remesh auto \
+    --constraints ../in/constraints.txt
+err_mentions "tile --remesh --constraints: refused" "remesh follows --up: not with --constraints"
 # A photo laid in courses (bricks 15 rows apart, each course's head joints at
 # their own offset, grain from an LCG): with --up, tile and polycube resample
 # it so that a tile holds a whole number of courses and cut every tile on
