@@ -1897,25 +1897,48 @@ static void make_icosphere(tmesh *m, int level, double r)
 }
 
 /* The icosphere above with shared vertices welded (the per-face grids
-   repeat the edges' points). */
+   repeat the edges' points): points sorted by their coordinates rounded to
+   1e-5, equal neighbours merged. */
+typedef struct weld_key {
+    long long x, y, z;
+    int index;
+} weld_key;
+
+static int weld_compare(const void *a, const void *b)
+{
+    const weld_key *p = (const weld_key *)a, *q = (const weld_key *)b;
+    if (p->x != q->x) return p->x < q->x ? -1 : 1;
+    if (p->y != q->y) return p->y < q->y ? -1 : 1;
+    if (p->z != q->z) return p->z < q->z ? -1 : 1;
+    return p->index - q->index;
+}
+
 static tt_result build_welded(const tmesh *m, tt_mesh **out, tt_error *err)
 {
     tmesh w;
-    int *map = (int *)malloc(sizeof(int) * (size_t)(m->nv + 1)), i, j, c;
+    int *map = (int *)malloc(sizeof(int) * (size_t)(m->nv + 1)), i, c;
+    weld_key *keys = (weld_key *)malloc(sizeof(weld_key) * (size_t)(m->nv + 1));
     tt_result r;
     memset(&w, 0, sizeof w);
-    for (i = 0; map && i < m->nv; i++) {
-        map[i] = -1;
-        for (j = 0; j < w.nv && map[i] < 0; j++)
-            if (fabs(w.pos[3 * j] - m->pos[3 * i]) < 1e-5f && fabs(w.pos[3 * j + 1] - m->pos[3 * i + 1]) < 1e-5f &&
-                fabs(w.pos[3 * j + 2] - m->pos[3 * i + 2]) < 1e-5f)
-                map[i] = j;
-        if (map[i] < 0) map[i] = tm_vert(&w, m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]);
+    for (i = 0; keys && i < m->nv; i++) {
+        keys[i].x = llround(m->pos[3 * i] * 1e5);
+        keys[i].y = llround(m->pos[3 * i + 1] * 1e5);
+        keys[i].z = llround(m->pos[3 * i + 2] * 1e5);
+        keys[i].index = i;
     }
-    for (c = 0; map && c < m->nc; c += 3) tm_tri(&w, map[m->idx[c]], map[m->idx[c + 1]], map[m->idx[c + 2]]);
+    if (keys) qsort(keys, (size_t)m->nv, sizeof *keys, weld_compare);
+    for (i = 0; keys && map && i < m->nv; i++) {
+        const weld_key *k = &keys[i];
+        if (i > 0 && k->x == keys[i - 1].x && k->y == keys[i - 1].y && k->z == keys[i - 1].z)
+            map[k->index] = map[keys[i - 1].index];
+        else
+            map[k->index] = tm_vert(&w, m->pos[3 * k->index], m->pos[3 * k->index + 1], m->pos[3 * k->index + 2]);
+    }
+    for (c = 0; keys && map && c < m->nc; c += 3) tm_tri(&w, map[m->idx[c]], map[m->idx[c + 1]], map[m->idx[c + 2]]);
     r = build(&w, 0, out, err);
     tm_free(&w);
     free(map);
+    free(keys);
     return r;
 }
 
@@ -1989,7 +2012,7 @@ static void test_remesh_sphere(void)
     double median, share, control;
     int v, off = 0;
     memset(&m, 0, sizeof m);
-    make_icosphere(&m, 4, 1.0);
+    make_icosphere(&m, 5, 1.0);
     CHECK(build_welded(&m, &mesh, &err) == TT_OK, "icosphere: %s", err.message);
     tm_free(&m);
     if (!mesh) return;
@@ -2010,6 +2033,11 @@ static void test_remesh_sphere(void)
         CHECK(rep.triangles + rep.quads + rep.pentagons + rep.larger_faces == q->nfaces,
               "the report counts every face: %d of %d", rep.triangles + rep.quads + rep.pentagons + rep.larger_faces,
               q->nfaces);
+        /* The icosphere's edges (about 0.04) are far below the 0.105 that
+           extraction needs: it ran on a coarser level of the hierarchy. */
+        CHECK(rep.refinements == 0 && rep.extracted_vertices < rep.working_vertices,
+              "extracted from a coarser level: %d of %d vertices, %d refinements", rep.extracted_vertices,
+              rep.working_vertices, rep.refinements);
         /* area 4 pi over 0.15^2: about 560 quads */
         CHECK(q->nfaces > 400 && q->nfaces < 750, "faces of about 0.15: %d", q->nfaces);
         share = remesh_aligned_share(q, &median);
