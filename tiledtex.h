@@ -130,7 +130,10 @@
    Triangles or n-gons? tt_mesh_quadrangulate() turns every n-gon into n quads first
    (the per-corner outputs then line up with the quadrangulated mesh's corners:
    mesh->corner_vert is its index buffer). Your normals, colours and UVs follow
-   through tt_mesh_quadrangulate_sources() and tt_corner_sources_apply().
+   through tt_mesh_quadrangulate_sources() and tt_corner_sources_apply(). A dense
+   scan? tt_remesh_quads() makes a new mesh of quads of the size you choose whose
+   edges follow a direction field (tt_tangent_field's, weighted by
+   tt_field_face_weights), so tiles keep a photo's up: then quadrangulate that.
 
    CONVENTIONS
      - Half-edges are corners: the half-edges of face f are stored contiguously in
@@ -1267,7 +1270,8 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
 
 /* Based on: E. Akleman, J. Chen, V. Meenakshisundaram, V. Srinivasan, "Tiled
    Textures: A Simple and Practical Technique for Seamless Texturing". Design note: docs/tiled.md.
-   The steps, for a quad mesh (tt_mesh_quadrangulate any other first):
+   The steps, for a quad mesh (tt_mesh_quadrangulate any other first, or for a
+   scan tt_remesh_quads then tt_mesh_quadrangulate: quads along a field):
      1. tt_assign_boundaries: a boundary type per half-edge (Sec. 3, 6);
      2. tt_assign_uvs: each quad's UVs from its four types alone (Sec. 3);
      3. tt_synthesize_tiles, or tt_synth_plan_create + tt_synth_apply for
