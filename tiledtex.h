@@ -585,6 +585,8 @@ typedef struct tt_remesh_options {
                                    NULL: 1 everywhere. Give 0 where the vector is a guess, e.g. where
                                    a surface faces up and "up" decides nothing */
     int sweeps;                 /* smoothing sweeps per hierarchy level; 0 = TT_DEFAULT_REMESH_SWEEPS */
+    tt_progress_fn progress;    /* optional; called at each step and level; non-zero cancels */
+    void *progress_user_data;
 } tt_remesh_options;
 
 #define TT_DEFAULT_REMESH_EDGE 0.025f    /* 1/40 of the bounding-box diagonal */
@@ -635,7 +637,8 @@ typedef struct tt_remesh_report {
    with no extent: TT_ERROR_ZERO_AREA_FACE; an edge_length so small that
    the refined input would pass TT_MAX_REMESH_VERTICES: TT_ERROR_TOO_LARGE;
    a field so inconsistent that no face could be traced:
-   TT_ERROR_NOT_CONVERGED; TT_ERROR_OUT_OF_MEMORY. Deterministic; the
+   TT_ERROR_NOT_CONVERGED; TT_CANCELLED by options->progress;
+   TT_ERROR_OUT_OF_MEMORY. Deterministic; the
    result is built with `allocator` and freed with tt_mesh_free. */
 TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, const tt_remesh_options *options,
                                 const tt_allocator *allocator, tt_mesh **out_mesh, tt_remesh_report *report,
@@ -7243,6 +7246,15 @@ done:
     return result;
 }
 
+/* The share of the work done, to the caller's progress callback: non-zero
+   when it asks to stop. Refining takes the first tenth, the hierarchy the
+   next, the fields (smoothed level by level, by vertices) up to 0.85,
+   extraction the rest. */
+static int tt__remesh_cancelled(const tt_remesh_options *o, double fraction)
+{
+    return o->progress && o->progress((float)fmin(1.0, fraction), o->progress_user_data);
+}
+
 TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, const tt_remesh_options *options,
                                 const tt_allocator *allocator, tt_mesh **out_mesh, tt_remesh_report *report,
                                 tt_error *error)
@@ -7255,7 +7267,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     tt_mesh *refined = NULL;
     int *face_source = NULL, *ancestor = NULL, nlevels = 0, finest = 0, f, i, l, sweeps, components = 1;
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, diag, rho;
-    double *lengths = NULL;
+    double *lengths = NULL, smoothed = 0.0, smoothed_total = 0.0;
     tt_result result = TT_OK;
 
     tt__ok(error);
@@ -7318,6 +7330,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         double p90;
         tt_mesh *next = NULL;
         tt_error ignored;
+        if (tt__remesh_cancelled(&opt, 0.1 * (1.0 - 1.0 / (1.0 + rep.refinements)))) goto cancelled;
         lengths = TT__ALLOC(allocator, double, work->ncorners);
         if (!lengths) goto oom;
         for (c = 0; c < work->ncorners; c++) {
@@ -7361,6 +7374,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     if (!tt__remesh_base_level(allocator, work, face_vectors, opt.face_weights, face_source, &levels[0])) goto oom;
     while (levels[nlevels - 1].n > TT__REMESH_COARSEST && nlevels < TT__REMESH_MAX_LEVELS) {
         tt__remesh_level *fine = &levels[nlevels - 1], *coarse = &levels[nlevels];
+        if (tt__remesh_cancelled(&opt, 0.2 - 0.1 * (double)fine->n / levels[0].n)) goto cancelled;
         if (!tt__remesh_coarsen(allocator, fine, coarse)) { nlevels++; goto oom; }
         if (coarse->n > fine->n - fine->n / 10) {
             tt__remesh_level_free(allocator, coarse);
@@ -7399,9 +7413,13 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         if (!levels[l].orient || !levels[l].lattice) goto oom;
     }
 
+    for (l = finest; l < nlevels; l++) smoothed_total += 2.0 * levels[l].n;
+
     /* Sec. 3: the orientation field, coarse to fine. */
     for (l = nlevels - 1; l >= finest; l--) {
         tt__remesh_level *lv = &levels[l];
+        if (tt__remesh_cancelled(&opt, 0.2 + 0.65 * smoothed / smoothed_total)) goto cancelled;
+        smoothed += lv->n;
         for (i = 0; i < lv->n; i++) {
             const double *from = l == nlevels - 1 ? lv->anchor + 3 * (size_t)i
                                                   : levels[l + 1].orient + 3 * (size_t)lv->parent[i];
@@ -7433,6 +7451,8 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     /* Sec. 4: the position field, coarse to fine. */
     for (l = nlevels - 1; l >= finest; l--) {
         tt__remesh_level *lv = &levels[l];
+        if (tt__remesh_cancelled(&opt, 0.2 + 0.65 * smoothed / smoothed_total)) goto cancelled;
+        smoothed += lv->n;
         for (i = 0; i < lv->n; i++) {
             const double *from = l == nlevels - 1 ? lv->x + 3 * (size_t)i
                                                   : levels[l + 1].lattice + 3 * (size_t)lv->parent[i];
@@ -7457,8 +7477,11 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
             ancestor[i] = a;
         }
     }
+    if (tt__remesh_cancelled(&opt, 0.85)) goto cancelled;
     if (!tt__remesh_clusters(allocator, &levels[finest], work, ancestor, rho, &graph)) goto oom;
+    if (tt__remesh_cancelled(&opt, 0.9)) goto cancelled;
     if (!tt__remesh_trace(allocator, &graph)) goto oom;
+    if (tt__remesh_cancelled(&opt, 0.95)) goto cancelled;
     {
         int *face_component = TT__ALLOC(allocator, int, mesh->nfaces);
         if (!face_component) goto oom;
@@ -7467,6 +7490,14 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         if (result != TT_OK) goto done;
     }
     result = tt__remesh_output(allocator, work, &graph, components, out_mesh, &rep, error);
+    if (result == TT_OK && tt__remesh_cancelled(&opt, 1.0)) {
+        tt_mesh_free(*out_mesh);
+        *out_mesh = NULL;
+        goto cancelled;
+    }
+    goto done;
+cancelled:
+    result = tt__fail(error, TT_CANCELLED, -1, -1, -1, -1, "remeshing was cancelled");
     goto done;
 oom:
     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");

@@ -230,10 +230,18 @@ static int remesh_along_field(const char *obj_path, const tiled_options *options
         tt_tangent_field(out->mesh, &field, NULL, vectors, &error) != TT_OK ||
         tt_field_face_weights(out->mesh, &field, weights, &error) != TT_OK)
         status = tool_fail("%s: %s", obj_path, error.message);
-    tool_stage("remeshing along the field");
-    if (status == 0 && tt_remesh_quads(out->mesh, vectors, &remesh, NULL, &remeshed, &out->remesh, &error) != TT_OK)
-        status = tool_fail("%s: --remesh %g (a remesh with edges of %g, each face then split): %s", obj_path,
-                           0.5 * out->remesh_edge, out->remesh_edge, error.message);
+    if (status == 0) {
+        tool_progress progress;
+        tt_result result;
+        tool_progress_begin(&progress, "remeshing", "along the field");
+        remesh.progress = tool_show_progress;
+        remesh.progress_user_data = &progress;
+        result = tt_remesh_quads(out->mesh, vectors, &remesh, NULL, &remeshed, &out->remesh, &error);
+        tool_progress_end(&progress);
+        if (result != TT_OK)
+            status = tool_fail("%s: --remesh %g (a remesh with edges of %g, each face then split): %s", obj_path,
+                               0.5 * out->remesh_edge, out->remesh_edge, error.message);
+    }
     free(vectors);
     free(weights);
     if (status != 0) return status;

@@ -2146,6 +2146,20 @@ static void test_remesh_topology(void)
     }
 }
 
+/* Records the fractions; asks to stop at call `stop_at` (-1: never). */
+typedef struct remesh_progress {
+    int calls, stop_at, decreasing;
+    float last;
+} remesh_progress;
+
+static int remesh_progress_fn(float fraction, void *user_data)
+{
+    remesh_progress *p = (remesh_progress *)user_data;
+    if (p->calls > 0 && fraction < p->last) p->decreasing++;
+    p->last = fraction;
+    return p->calls++ == p->stop_at;
+}
+
 typedef struct remesh_ctx {
     const tt_mesh *mesh;
     const float *vectors;
@@ -2214,6 +2228,36 @@ static void test_remesh_errors(void)
     r = tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err);
     CHECK(r == TT_ERROR_NON_FINITE && err.face == 5, "NaN vector on face 5: face %d, %s", err.face, err.message);
     remesh_field(mesh, 0, vec, w);
+    /* Progress: never decreasing, ending at 1; cancelling at any call
+       leaves nothing allocated and no mesh. */
+    {
+        remesh_progress p;
+        counter cnt;
+        tt_allocator al = make_allocator(&cnt, -1);
+        int calls, k, bad = 0;
+        memset(&o, 0, sizeof o);
+        o.edge_length = 0.3f;
+        o.face_weights = w;
+        o.progress = remesh_progress_fn;
+        o.progress_user_data = &p;
+        memset(&p, 0, sizeof p);
+        p.stop_at = -1;
+        r = tt_remesh_quads(mesh, vec, &o, &al, &q, NULL, &err);
+        CHECK(r == TT_OK && p.calls >= 8 && p.decreasing == 0 && p.last == 1.0f,
+              "progress: %d, %d calls, %d decreasing, last %g", r, p.calls, p.decreasing, p.last);
+        tt_mesh_free(q);
+        calls = p.calls;
+        for (k = 0; k < calls; k++) {
+            memset(&p, 0, sizeof p);
+            p.stop_at = k;
+            q = (tt_mesh *)&q;
+            r = tt_remesh_quads(mesh, vec, &o, &al, &q, NULL, &err);
+            if (r != TT_CANCELLED || q != NULL || cnt.live != 0 || err.result != TT_CANCELLED) {
+                if (!bad++) DETAIL("cancelled at call %d: %d, out %p, %ld live", k, r, (void *)q, cnt.live);
+            }
+        }
+        CHECK(bad == 0, "cancelling at each of %d calls: %d went wrong", calls, bad);
+    }
     /* Every allocation failing in turn. */
     ctx.mesh = mesh;
     ctx.vectors = vec;
