@@ -6,8 +6,10 @@
 # Meshes: a real scan, the 96,966-triangle horse of ../shared/data (or
 # $BENCH_DATA/meshes/horse.obj), and the same scan cut 1-to-4 once and twice
 # (387,864 and 1,551,456 triangles: bench/bench_subdivide.awk), with the
-# 512 x 512 gravel photo. Each of tile, hpm, polycube and lapped (--bake 2048)
-# runs as a user runs it, files in and out, at -j 1 and -j 2:
+# 512 x 512 gravel photo. Each of tile, tile-remesh (tile --up z --remesh
+# auto: the scan remeshed into quads along the field first), hpm, polycube
+# and lapped (--bake 2048) runs as a user runs it, files in and out, at -j 1
+# and -j 2:
 #   scale_P_Nk_cpu_j1        CPU seconds (user + system) at -j 1, what the
 #                            targets compare: other jobs' load does not count
 #   scale_P_Nk_wall_j1/_j2   wall seconds at -j 1 and -j 2
@@ -26,7 +28,7 @@
 #                            Ctrl-C halfway through the 97k run: seconds
 #                            until the tool has exited (target <= 1)
 # Targets: growth_4x <= 5; the 16x run finishes; at 97k faces
-# lapped <= 4 s, hpm <= 2.5 s, polycube <= 3 s, tile <= 0.3 s CPU, peak memory
+# lapped <= 4 s, hpm <= 2.5 s, polycube <= 3 s, tile <= 0.3 s, tile-remesh <= 1.5 s CPU, peak memory
 # no higher than v0.3.0's; -j 2 identical, wall <= 0.65x (tile synthesis, the
 # lapped bake, polycube) or 0.8x (hpm) of -j 1.
 #
@@ -90,15 +92,25 @@ mib() { awk -v k="$1" 'BEGIN { printf "%.1f", k / 1024 }'; }
 # afresh), sets cpu wall peak status. With RUNS (odd) it runs that many times
 # and keeps the median of each figure: a run of a second or less on a shared
 # machine varies by a fifth from one run to the next.
+# pipeline_args PIPELINE: sets sub (the command) and extra (its options):
+# tile-remesh is tile remeshing the scan along --up z first.
+pipeline_args() {
+    sub=$1 extra=()
+    case $1 in
+        lapped) extra=(--bake 2048) ;;
+        tile-remesh) sub=tile extra=(--up z --remesh auto) ;;
+    esac
+}
+
 measure() {
-    local tool_=$1 limit=$2 dir=$3 jobs=$4 pipeline=$5 mesh=$6 runs=${7:-1} extra=() jflag=() i
+    local tool_=$1 limit=$2 dir=$3 jobs=$4 pipeline=$5 mesh=$6 runs=${7:-1} extra=() jflag=() i sub
     local cpus=() walls=() peaks=() bakes=()
-    [ "$pipeline" = lapped ] && extra=(--bake 2048)
+    pipeline_args "$pipeline"
     [ -n "$jobs" ] && jflag=(-j "$jobs")
     for ((i = 0; i < runs; i++)); do
         rm -rf "$dir" && mkdir -p "$dir"
         read -r cpu wall peak status < <("$run" "$limit" sh -c 'exec "$@" >"$0/log" 2>&1' "$dir" \
-            "$tool_" "${jflag[@]}" "$pipeline" "$mesh" "$photo" "$dir/out" "${extra[@]}")
+            "$tool_" "${jflag[@]}" "$sub" "$mesh" "$photo" "$dir/out" "${extra[@]}")
         [ "$status" = 0 ] || return
         cpus+=("$cpu") walls+=("$wall") peaks+=("$peak")
         # the bake stage's own wall time, as the tool reports it
@@ -116,10 +128,10 @@ median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int(
 # run, by its wall time at -j 1: the seconds until the tool has exited (the
 # library call cancelled through its progress callback). Target: <= 1 s.
 measure_cancel() {
-    local dir=$work/$1-cancel extra=() start end rc
+    local dir=$work/$1-cancel extra=() start end rc sub
     rm -rf "$dir" && mkdir -p "$dir"
-    [ "$1" = lapped ] && extra=(--bake 2048)
-    "$tool" -j 1 "$1" "$2" "$photo" "$dir/out" "${extra[@]}" >"$dir/log" 2>&1 &
+    pipeline_args "$1"
+    "$tool" -j 1 "$sub" "$2" "$photo" "$dir/out" "${extra[@]}" >"$dir/log" 2>&1 &
     local pid=$!
     sleep "$(awk -v w="$3" 'BEGIN { printf "%.2f", w / 2 }')"
     start=$(date +%s.%N)
@@ -164,7 +176,7 @@ else
     echo "bench_scale: synth: status $status ($(tail -n 1 "$work/synth-j1/log"))" >&2
 fi
 
-for p in tile hpm polycube lapped; do
+for p in tile tile-remesh hpm polycube lapped; do
     declare -A cpu1=()
     for s in $scales; do
         mesh=$work/horse_x$s.obj
@@ -201,7 +213,7 @@ for p in tile hpm polycube lapped; do
         else
             echo "bench_scale: $p on $faces faces at -j 2: status $status" >&2
         fi
-        if [ -n "$old" ]; then
+        if [ -n "$old" ] && [ "$p" != tile-remesh ]; then    # v0.3.0 had no --remesh
             measure "$old" "$old_timeout" "$work/$p-x$s-v030" "" "$p" "$mesh"
             if [ "$status" = 0 ]; then
                 figure "${name}_v030_cpu" "$cpu" s
