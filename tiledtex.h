@@ -133,7 +133,7 @@
    through tt_mesh_quadrangulate_sources() and tt_corner_sources_apply(). A dense
    scan? tt_remesh_quads() makes a new mesh of quads of the size you choose whose
    edges follow a direction field (tt_tangent_field's, weighted by
-   tt_field_face_weights), so tiles keep a photo's up: then quadrangulate that.
+   tt_field_face_weights), so tiles keep a photo's up.
 
    CONVENTIONS
      - Half-edges are corners: the half-edges of face f are stored contiguously in
@@ -558,38 +558,37 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
               (a direction counts as its quarter turns), here anchored to
               your face_vectors where face_weights say they matter;
      Sec. 4   a position field: at each vertex the nearest point of a local
-              square lattice of spacing edge_length, smoothed so that
-              neighbours' lattices agree up to whole lattice steps;
+              square lattice, smoothed so that neighbours' lattices agree
+              up to whole lattice steps;
      Sec. 3.3 both smoothed coarse to fine over a hierarchy of vertex pairs;
      Sec. 5   extraction: vertices whose lattices agree on the same point
-              become one output vertex, neighbours one lattice step apart
-              an output edge, and the faces are traced around them.
+              become one vertex, neighbours one lattice step apart an edge,
+              and the faces are traced around them.
    Beyond the paper: the input is first refined (linear quadrangulation)
-   until nine edges in ten are at most 0.7 edge_length, which extraction
-   needs; the faces are traced from the edges' order around
-   each vertex, so the result is always a valid mesh (see below); output
-   vertices are moved onto the input's surface.
+   until its edges are short enough for extraction; the faces are traced
+   from the edges' order around each vertex, so the result is always a
+   valid mesh (see below); the lattice is twice edge_length, and each of
+   its faces is split into quads (the paper's pure-quad output); every
+   vertex is moved onto the input's surface.
 
    What it is for: tiles (section 6) follow a quad's edges, so on a triangle
    scan quadrangulated in place, where each triangle makes three kites, a
    brick photo's courses run every way. Here the quads' edges follow the
-   field: with tt_tangent_field's, walls get rows of quads with level edges.
-   Run tt_mesh_quadrangulate on the result for quads only (each face into
-   quads of half the size: pass twice the edge length you want). */
+   field: with tt_tangent_field's, walls get rows of quads with level edges. */
 
 typedef struct tt_remesh_options {
-    float edge_length;          /* the output's edge length in mesh units; 0 = TT_DEFAULT_REMESH_EDGE
+    float edge_length;          /* the output quads' side in mesh units; 0 = TT_DEFAULT_REMESH_EDGE
                                    times the bounding-box diagonal */
     const float *face_weights;  /* mesh->nfaces weights in [0, 1]: how firmly each face's vector holds
                                    the direction (1: exactly; 0: free, the field is smoothed there).
                                    NULL: 1 everywhere. Give 0 where the vector is a guess, e.g. where
-                                   a surface faces up and "up" decides nothing */
+                                   a surface faces up and "up" decides nothing (tt_field_face_weights) */
     int sweeps;                 /* smoothing sweeps per hierarchy level; 0 = TT_DEFAULT_REMESH_SWEEPS */
     tt_progress_fn progress;    /* optional; called at each step and level; non-zero cancels */
     void *progress_user_data;
 } tt_remesh_options;
 
-#define TT_DEFAULT_REMESH_EDGE 0.025f    /* 1/40 of the bounding-box diagonal */
+#define TT_DEFAULT_REMESH_EDGE 0.0125f   /* 1/80 of the bounding-box diagonal */
 #define TT_DEFAULT_REMESH_SWEEPS 10
 #define TT_MAX_REMESH_VERTICES (1 << 24) /* the refined input's vertices at most */
 
@@ -599,38 +598,40 @@ typedef struct tt_remesh_report {
     int levels;                 /* levels of the hierarchy */
     int extracted_vertices;     /* vertices of the hierarchy's level the lattice was smoothed to and
                                    extracted from: the coarsest whose neighbours are, nine pairs in ten,
-                                   at most 0.7 edge_length apart */
-    int triangles, quads, pentagons, larger_faces;  /* the output's faces by sides */
-    int folded_faces;           /* output faces turned against the surface's normal (kept) */
+                                   at most 1.4 edge_length (0.7 lattice steps) apart */
+    int triangles, quads, pentagons, larger_faces;  /* the lattice's faces by sides, before the split:
+                                                       each n-gon gave n quads */
+    int folded_faces;           /* lattice faces turned against the surface's normal (kept) */
     int split_faces;            /* traced faces that met themselves at a vertex, split there */
-    int split_vertices;         /* output vertices duplicated so that each has one fan of faces */
+    int split_vertices;         /* vertices duplicated so that each has one fan of faces */
     int dropped_faces;          /* traced faces across the input's holes, and stray pieces */
 } tt_remesh_report;
 
-/* A new polygon mesh of mostly quads with edges of about edge_length whose
-   edges follow face_vectors (3 * mesh->nfaces floats, each in its face's
-   plane, as tt_tangent_field makes them; only directions count, and a
-   direction and its quarter turns are the same). Its vertices lie on the
-   input's faces; it has the input's holes larger than about an edge, and
-   its faces are mostly quads, with triangles and pentagons where a row of
-   quads ends and at the field's singularities.
+/* A new mesh of quads of side about edge_length whose edges follow
+   face_vectors (3 * mesh->nfaces floats, each in its face's plane, as
+   tt_tangent_field makes them; only directions count, and a direction and
+   its quarter turns are the same). Every vertex lies on the input's faces;
+   it has the input's holes larger than about two edges. The quads come in
+   rows along the field; where a row ends and at the field's singularities
+   the lattice has a triangle or a pentagon, split into three or five quads
+   around its centre (vertices of valence 3 or 5).
 
    The result is always a mesh tt_mesh_build accepts (strict): each vertex
    has one fan of faces (duplicated otherwise), no face repeats a vertex.
    Its genus can differ from the input's where the surface is thinner than
-   about an edge (a handle closes) and the report counts faces turned
-   against the surface (folds where the field could not be followed); a
-   smaller edge_length follows the shape more closely.
+   about two edges (a handle closes), and the report counts lattice faces
+   turned against the surface (folds where the field could not be
+   followed); a smaller edge_length follows the shape more closely.
 
    options may be NULL (all defaults); report may be NULL.
    Cost: O(V log V) in the refined input's vertices V, serial; the
-   smoothing and extraction run on about area / (0.35 edge_length)^2
+   smoothing and extraction run on about area / (0.7 edge_length)^2
    vertices whatever V (a coarser level of the hierarchy when the input is
    denser). At -O2: 0.4 s for the 48k-vertex horse at the default edge,
    0.9 s for it split to 194k vertices, 2.9 s at 776k. Temporary memory
    about 250 bytes per vertex of the (refined) input.
    Errors: NULL mesh, face_vectors or out_mesh, a negative, non-finite or
-   too large edge_length (more than a quarter of the bounding-box
+   too large edge_length (more than an eighth of the bounding-box
    diagonal), sweeps < 0, a face weight outside [0, 1] (error->face):
    TT_ERROR_INVALID_ARGUMENT; a non-finite face vector (error->face):
    TT_ERROR_NON_FINITE; a mesh without faces: TT_ERROR_EMPTY_MESH; a mesh
@@ -638,8 +639,8 @@ typedef struct tt_remesh_report {
    the refined input would pass TT_MAX_REMESH_VERTICES: TT_ERROR_TOO_LARGE;
    a field so inconsistent that no face could be traced:
    TT_ERROR_NOT_CONVERGED; TT_CANCELLED by options->progress;
-   TT_ERROR_OUT_OF_MEMORY. Deterministic; the
-   result is built with `allocator` and freed with tt_mesh_free. */
+   TT_ERROR_OUT_OF_MEMORY. Deterministic; the result is built with
+   `allocator` and freed with tt_mesh_free. */
 TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, const tt_remesh_options *options,
                                 const tt_allocator *allocator, tt_mesh **out_mesh, tt_remesh_report *report,
                                 tt_error *error);
@@ -1274,7 +1275,7 @@ TTDEF void tt_raster_triangle(const float xy[6], int width, int height, tt_raste
 /* Based on: E. Akleman, J. Chen, V. Meenakshisundaram, V. Srinivasan, "Tiled
    Textures: A Simple and Practical Technique for Seamless Texturing". Design note: docs/tiled.md.
    The steps, for a quad mesh (tt_mesh_quadrangulate any other first, or for a
-   scan tt_remesh_quads then tt_mesh_quadrangulate: quads along a field):
+   scan tt_remesh_quads: quads along a field):
      1. tt_assign_boundaries: a boundary type per half-edge (Sec. 3, 6);
      2. tt_assign_uvs: each quad's UVs from its four types alone (Sec. 3);
      3. tt_synthesize_tiles, or tt_synth_plan_create + tt_synth_apply for
@@ -6985,15 +6986,16 @@ done:
     return ok;
 }
 
-/* The closest point to p (cluster's position) on the faces around the
-   cluster's members (level-0 vertices, listed by head / next). */
-static void tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *next, int cluster, const double *p,
-                                  float *out)
+/* The closest point to p on the faces around the members (level-0
+   vertices, listed by head / next) of `count` clusters. */
+static void tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *next, const int *clusters, int count,
+                                  const double *p, float *out)
 {
     double best[3], best_d = HUGE_VAL;
-    int i, j;
+    int i, j, n;
     memcpy(best, p, sizeof best);
-    for (i = head[cluster]; i >= 0; i = next[i]) {
+    for (n = 0; n < count; n++)
+    for (i = head[clusters[n]]; i >= 0; i = next[i]) {
         int c0 = m->vert_corner[i], c = c0, steps = 0;
         if (c0 < 0) continue;
         do {
@@ -7038,6 +7040,8 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     unsigned char *keep = NULL;
     uint64_t *half = NULL;      /* pairs: (a << 32 | b, the corner at b of the loop running a -> b) */
     float *positions = NULL, *surface = NULL;
+    int *out_cluster = NULL;    /* per output vertex of the lattice mesh: its cluster */
+    tt_mesh *lattice = NULL;    /* the traced faces, before the split */
     tt_mesh_desc desc;
     tt_result result = TT_ERROR_OUT_OF_MEMORY;
 
@@ -7107,7 +7111,8 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         if (keep[q])
             for (k = loop_start[q]; k < loop_start[q + 1]; k++) where[loop_vert[k]] = 1;
     for (k = 0; k < nc; k++)
-        if (where[k]) tt__remesh_onto_input(m, member_head, member_next, k, g->pos + 3 * (size_t)k, surface + 3 * (size_t)k);
+        if (where[k]) tt__remesh_onto_input(m, member_head, member_next, &k, 1, g->pos + 3 * (size_t)k,
+                                            surface + 3 * (size_t)k);
     for (q = 0; q < nloops; q++)
         if (keep[q] && tt__face_has_zero_area(surface, loop_vert + loop_start[q], loop_start[q + 1] - loop_start[q])) {
             keep[q] = 0;
@@ -7185,10 +7190,11 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     }
     /* Numbered in order of first use. */
     out_id = TT__ALLOC(al, int, (size_t)nverts + 1);
+    out_cluster = TT__ALLOC(al, int, (size_t)nverts + 1);
     positions = TT__ALLOC(al, float, 3 * (size_t)nverts + 3);
     indices = TT__ALLOC(al, int, (size_t)ncorners + 1);
     sizes = TT__ALLOC(al, int, (size_t)nloops + 1);
-    if (!out_id || !positions || !indices || !sizes) goto fail;
+    if (!out_id || !out_cluster || !positions || !indices || !sizes) goto fail;
     for (k = 0; k < nverts; k++) out_id[k] = -1;
     {
         int nout = 0;
@@ -7200,6 +7206,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
                 int v = vertex_of[k], cl = loop_vert[k];
                 if (out_id[v] < 0) {
                     out_id[v] = nout;
+                    out_cluster[nout] = cl;
                     memcpy(positions + 3 * (size_t)nout, surface + 3 * (size_t)cl, 3 * sizeof(float));
                     nout++;
                 }
@@ -7227,12 +7234,42 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     desc.indices = indices;
     desc.face_sizes = sizes;
     desc.nfaces = nkept;
-    result = tt_mesh_build(&desc, al, out_mesh, error);
+    result = tt_mesh_build(&desc, al, &lattice, error);
     if (result != TT_OK && result != TT_ERROR_OUT_OF_MEMORY) {
         char why[sizeof error->message];
         strcpy(why, error ? error->message : tt_result_string(result));
         result = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
                           "remeshing made an invalid mesh (%s): try another edge_length", why);
+    }
+    if (result != TT_OK) goto done;
+    /* Every face split into quads (tt_mesh_quadrangulate: its vertices, its
+       edges' points in order of their first half-edge, its faces' points),
+       the new points also moved onto the input, near their clusters. */
+    result = tt_mesh_quadrangulate(lattice, TT_SUBDIVIDE_LINEAR, al, out_mesh, error);
+    if (result != TT_OK) goto done;
+    {
+        float *pos = (float *)(*out_mesh)->pos;
+        int c, edge = 0, face, around[3 * 64];
+        for (c = 0; c < lattice->ncorners; c++) {
+            int t = lattice->twin[c], j;
+            double mid[3];
+            if (t >= 0 && t < c) continue;
+            around[0] = out_cluster[lattice->corner_vert[c]];
+            around[1] = out_cluster[lattice->corner_vert[tt_mesh_next(lattice, c)]];
+            for (j = 0; j < 3; j++) mid[j] = pos[3 * ((size_t)lattice->nverts + edge) + j];
+            tt__remesh_onto_input(m, member_head, member_next, around, 2, mid,
+                                  pos + 3 * ((size_t)lattice->nverts + edge));
+            edge++;
+        }
+        for (face = 0; face < lattice->nfaces; face++) {
+            int count = 0, j;
+            double centre[3];
+            float *at = pos + 3 * ((size_t)lattice->nverts + edge + face);
+            for (c = lattice->face_start[face]; c < lattice->face_start[face + 1] && count < 3 * 64; c++)
+                around[count++] = out_cluster[lattice->corner_vert[c]];
+            for (j = 0; j < 3; j++) centre[j] = at[j];
+            tt__remesh_onto_input(m, member_head, member_next, around, count, centre, at);
+        }
     }
     goto done;
 fail:
@@ -7242,7 +7279,12 @@ done:
     tt__free(al, path); tt__free(al, keep); tt__free(al, half); tt__free(al, corner_root);
     tt__free(al, loop_root); tt__free(al, piece_size); tt__free(al, vertex_root); tt__free(al, vertex_of);
     tt__free(al, member_head); tt__free(al, member_next); tt__free(al, out_id); tt__free(al, positions);
-    tt__free(al, indices); tt__free(al, sizes); tt__free(al, surface);
+    tt__free(al, indices); tt__free(al, sizes); tt__free(al, surface); tt__free(al, out_cluster);
+    tt_mesh_free(lattice);
+    if (result != TT_OK && *out_mesh) {
+        tt_mesh_free(*out_mesh);
+        *out_mesh = NULL;
+    }
     return result;
 }
 
@@ -7315,11 +7357,12 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     if (!(diag > 0.0))
         return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, -1, -1, -1, -1,
                         "the mesh's faces all lie at one point: nothing to remesh");
-    rho = opt.edge_length > 0.0f ? (double)opt.edge_length : TT_DEFAULT_REMESH_EDGE * diag;
+    /* The lattice is twice the output's edge: each of its faces is split. */
+    rho = 2.0 * (opt.edge_length > 0.0f ? (double)opt.edge_length : TT_DEFAULT_REMESH_EDGE * diag);
     if (rho > 0.25 * diag)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
-                        "edge_length %g is more than a quarter of the mesh's bounding-box diagonal %g",
-                        rho, diag);
+                        "edge_length %g is more than an eighth of the mesh's bounding-box diagonal %g",
+                        0.5 * rho, diag);
 
     /* Refine until nine edges in ten are short enough (TT__REMESH_SPACING). */
     face_source = TT__ALLOC(allocator, int, mesh->nfaces);

@@ -187,11 +187,10 @@ static int orient_tiles(const char *obj_path, const tiled_options *options, cons
 
 /* --remesh: the OBJ's mesh replaced by one whose quads follow the field
    (tt_remesh_quads), with up from --up (the library's +y without it) held
-   as firmly as tt_field_face_weights says; its edges twice the quads'
-   asked side, since the quadrangulation after halves them. The OBJ's
-   normals do not carry over (the new mesh gets computed ones). With the
-   field given, *source and *nsources then name the new faces themselves:
-   the field is made again on the quads. */
+   as firmly as tt_field_face_weights says. The OBJ's normals do not carry
+   over (the new mesh gets computed ones). With the field given, *source
+   and *nsources then name the new faces themselves: the field is made
+   again on the quads. */
 static int remesh_along_field(const char *obj_path, const tiled_options *options, int **source, int *nsources,
                               tiled_mesh *out)
 {
@@ -218,7 +217,7 @@ static int remesh_along_field(const char *obj_path, const tiled_options *options
     memset(&field, 0, sizeof field);
     memcpy(field.up, options->field.up, sizeof field.up);
     memset(&remesh, 0, sizeof remesh);
-    remesh.edge_length = (float)(2.0 * options->remesh_size);
+    remesh.edge_length = (float)options->remesh_size;
     remesh.face_weights = weights;
     out->remesh_edge = remesh.edge_length > 0.0f
                            ? remesh.edge_length
@@ -238,9 +237,7 @@ static int remesh_along_field(const char *obj_path, const tiled_options *options
         remesh.progress_user_data = &progress;
         result = tt_remesh_quads(out->mesh, vectors, &remesh, NULL, &remeshed, &out->remesh, &error);
         tool_progress_end(&progress);
-        if (result != TT_OK)
-            status = tool_fail("%s: --remesh %g (a remesh with edges of %g, each face then split): %s", obj_path,
-                               0.5 * out->remesh_edge, out->remesh_edge, error.message);
+        if (result != TT_OK) status = tool_fail("%s: --remesh %g: %s", obj_path, out->remesh_edge, error.message);
     }
     free(vectors);
     free(weights);
@@ -320,9 +317,8 @@ int tiled_map_mesh(const char *obj_path, const tiled_options *options, tiled_mes
         lines = NULL;
     }
 
-    /* Tiles are square: every face must be a quad. A remeshed mesh is
-       always split, so that its quads have the side asked for. */
-    if (out->remeshed || out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
+    /* Tiles are square: every face must be a quad. */
+    if (out->mesh->min_face_size != 4 || out->mesh->max_face_size != 4) {
         if ((status = quadrangulate_traced(obj_path, out, 0, &source)) != 0) goto fail;
         out->quadrangulated = out->mesh->nfaces;
     }
@@ -512,11 +508,12 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
         const tt_mesh_stats *in = &mesh->input_stats, *s = &mesh->stats;
         if (tool_quiet()) return;
         tool_progress_clear();
-        fprintf(stderr, "tiledtex: %s remeshed along the field into %d faces with edges of about %g (%d quads, %d "
-                        "triangles, %d pentagons, %d larger", obj_path, mesh->remeshed, mesh->remesh_edge, r->quads,
-                r->triangles, r->pentagons, r->larger_faces);
+        fprintf(stderr, "tiledtex: %s remeshed along the field into %d quads of side about %g (from a lattice of "
+                        "%d quads, %d triangles, %d pentagons and %d larger faces, each n-gon split into n quads",
+                obj_path, mesh->remeshed, mesh->remesh_edge, r->quads, r->triangles, r->pentagons,
+                r->larger_faces);
         if (r->folded_faces) fprintf(stderr, "; %d folded", r->folded_faces);
-        fprintf(stderr, "), then split into %d quads of about %g\n", mesh->quadrangulated, 0.5 * mesh->remesh_edge);
+        fprintf(stderr, ")\n");
         /* Where the surface is thinner than an edge, the new mesh closes a
            handle or a hole, or loses a piece smaller than a face. */
         if (in->genus != s->genus || in->components != s->components || in->boundary_loops != s->boundary_loops)

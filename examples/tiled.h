@@ -50,7 +50,7 @@ typedef struct tiled_options {
     int no_courses;              /* --no-courses: upright tiles ignore the photo's courses */
     tt_courses courses;          /* tiled_fit_courses's: the windows stay on them (period 0: none) */
     int remesh;                  /* --remesh: a new quad mesh along the field first (tt_remesh_quads) */
-    double remesh_size;          /* its quads' side in mesh units after the quadrangulation; 0 = auto */
+    double remesh_size;          /* its quads' side in mesh units; 0 = auto (tt_remesh_quads' default) */
 } tiled_options;
 
 /* The tool's defaults: the library's, with a gutter of TT_RECOMMENDED_GUTTER
@@ -98,7 +98,7 @@ typedef struct tiled_mesh {
     int quadrangulated;          /* quads made from the OBJ's triangles or n-gons; 0 if all quads */
     int input_min_face_size, input_max_face_size;
     int repaired_edges;          /* edges --permissive cut open */
-    int remeshed;                /* --remesh: the faces tt_remesh_quads made, before the quadrangulation */
+    int remeshed;                /* --remesh: the quads tt_remesh_quads made */
     tt_remesh_report remesh;     /* ...and its report */
     float remesh_edge;           /* ...and the edge length it was asked for (mesh units) */
     tt_mesh_stats input_stats;   /* --remesh: the OBJ's topology, to say where the new mesh differs */
