@@ -1968,6 +1968,29 @@ static void remesh_field(const tt_mesh *mesh, int random_field, float *vectors, 
     }
 }
 
+/* remesh_field's up field on new arrays (malloc): *vectors 3 floats per
+   face, *weights one. */
+static void remesh_field_new(const tt_mesh *mesh, float **vectors, float **weights)
+{
+    *vectors = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+    *weights = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
+    remesh_field(mesh, 0, *vectors, *weights);
+}
+
+/* The welded icosphere of radius 1 at `level` (make_icosphere), or NULL
+   after a failed CHECK. */
+static tt_mesh *remesh_icosphere(int level)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL;
+    tt_error err;
+    memset(&m, 0, sizeof m);
+    make_icosphere(&m, level, 1.0);
+    CHECK(build_welded(&m, &mesh, &err) == TT_OK, "icosphere: %s", err.message);
+    tm_free(&m);
+    return mesh;
+}
+
 /* Of the edges of output faces on walls (normal within 45 degrees of
    horizontal), the share within 10 degrees of the projected up or across
    it; *median_edge gets the median edge length. */
@@ -2002,7 +2025,6 @@ static double remesh_aligned_share(const tt_mesh *q, double *median_edge)
 
 static void test_remesh_sphere(void)
 {
-    tmesh m;
     tt_mesh *mesh = NULL, *q = NULL, *q2 = NULL;
     tt_error err;
     tt_remesh_options o;
@@ -2011,14 +2033,9 @@ static void test_remesh_sphere(void)
     float *vec, *w;
     double median, share, control;
     int v, off = 0;
-    memset(&m, 0, sizeof m);
-    make_icosphere(&m, 5, 1.0);
-    CHECK(build_welded(&m, &mesh, &err) == TT_OK, "icosphere: %s", err.message);
-    tm_free(&m);
+    mesh = remesh_icosphere(5);
     if (!mesh) return;
-    vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
-    remesh_field(mesh, 0, vec, w);
+    remesh_field_new(mesh, &vec, &w);
     memset(&o, 0, sizeof o);
     o.edge_length = 0.15f;
     o.face_weights = w;
@@ -2095,9 +2112,7 @@ static void test_remesh_topology(void)
     CHECK(build(&m, 0, &mesh, &err) == TT_OK, "torus: %s", err.message);
     tm_free(&m);
     if (mesh) {
-        vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-        w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
-        remesh_field(mesh, 0, vec, w);
+        remesh_field_new(mesh, &vec, &w);
         memset(&o, 0, sizeof o);
         o.edge_length = 0.25f;
         o.face_weights = w;
@@ -2127,9 +2142,7 @@ static void test_remesh_topology(void)
     tm_free(&m);
     if (mesh) {
         tt_remesh_report rep;
-        vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-        w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
-        remesh_field(mesh, 0, vec, w);
+        remesh_field_new(mesh, &vec, &w);
         memset(&o, 0, sizeof o);
         o.edge_length = 0.3f;
         o.face_weights = w;
@@ -2183,7 +2196,6 @@ static tt_result oom_remesh(void *ctx, const tt_allocator *al, tt_error *error)
 
 static void test_remesh_errors(void)
 {
-    tmesh m;
     tt_mesh *mesh = NULL, *q = (tt_mesh *)&q;
     tt_error err;
     tt_remesh_options o;
@@ -2191,14 +2203,9 @@ static void test_remesh_errors(void)
     float *vec, *w;
     remesh_ctx ctx;
     tt_result r;
-    memset(&m, 0, sizeof m);
-    make_icosphere(&m, 2, 1.0);
-    CHECK(build_welded(&m, &mesh, &err) == TT_OK, "icosphere: %s", err.message);
-    tm_free(&m);
+    mesh = remesh_icosphere(2);
     if (!mesh) return;
-    vec = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    w = (float *)malloc(sizeof(float) * (size_t)mesh->nfaces);
-    remesh_field(mesh, 0, vec, w);
+    remesh_field_new(mesh, &vec, &w);
     memset(&o, 0, sizeof o);
     r = tt_remesh_quads(NULL, vec, &o, NULL, &q, NULL, &err);
     CHECK(r == TT_ERROR_INVALID_ARGUMENT && q == NULL, "NULL mesh: %d", r);
