@@ -7021,8 +7021,25 @@ static void tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *
     for (j = 0; j < 3; j++) out[j] = (float)best[j];
 }
 
-/* The output from the traced faces: a face that meets itself at a vertex
-   is split there into simple loops; a loop facing against the surface
+/* A vertex with two edges only lies in the middle of a side of both its
+   faces (a quad there would have a straight corner, and its split a vertex
+   of valence 2): the faces skip it, unless its two neighbours are joined
+   already (the faces are then a triangle and its neighbour, and dropping
+   it would join them twice). */
+static int tt__remesh_passes_through(const tt__remesh_graph *g, int v)
+{
+    int a, b, q;
+    if (g->start[v + 1] - g->start[v] != 2) return 0;
+    a = g->nbr[g->start[v]];
+    b = g->nbr[g->start[v] + 1];
+    for (q = g->start[a]; q < g->start[a + 1]; q++)
+        if (g->nbr[q] == b) return 0;
+    return 1;
+}
+
+/* The output from the traced faces: vertices a face only passes through
+   are left out (tt__remesh_passes_through); a face that meets itself at a
+   vertex is split there into simple loops; a loop facing against the surface
    with most of its vertices on the input's boundary, or one entirely on
    it, spans a hole and is dropped; each vertex whose faces form several
    fans becomes one vertex per fan; with more pieces than the input,
@@ -7058,6 +7075,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         int begin = g->face_start[f], size = g->face_start[f + 1] - begin, depth = 0, split = 0, first = nloops;
         for (k = 0; k <= size; k++) {
             int v = k < size ? g->face_vert[begin + k] : -1, from = k < size ? where[v] : 0;
+            if (k < size && tt__remesh_passes_through(g, v)) continue;
             if (k < size && from < 0) {
                 where[v] = depth;
                 path[depth++] = v;
