@@ -6223,11 +6223,11 @@ TTDEF tt_result tt_corner_sources_apply(const tt_corner_sources *sources, int co
    shrinking a level by a tenth. */
 #define TT__REMESH_COARSEST 64
 #define TT__REMESH_MAX_LEVELS 40
-/* Extraction needs vertices at most this many edge lengths apart, nine
+/* Extraction needs vertices at most this many lattice steps apart, nine
    pairs of neighbours in ten: a lattice edge is found only where
    neighbours join its ends' lattice points. The input is refined until
-   its edges are (half an edge doubled the time and gave no better faces
-   on the test scans; a whole edge left more faces of 6 or more sides),
+   its edges are (half a step doubled the time and gave no better faces
+   on the test scans; a whole step left more faces of 6 or more sides),
    and the lattice is smoothed and extracted on the coarsest level of the
    hierarchy whose neighbours still are (a dense scan's finer levels add
    time, not faces: the horse's 48k vertices, 0.4 s instead of 1.8 s). */
