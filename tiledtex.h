@@ -584,12 +584,17 @@ typedef struct tt_remesh_options {
                                    NULL: 1 everywhere. Give 0 where the vector is a guess, e.g. where
                                    a surface faces up and "up" decides nothing (tt_field_face_weights) */
     int sweeps;                 /* smoothing sweeps per hierarchy level; 0 = TT_DEFAULT_REMESH_SWEEPS */
+    float crease_degrees;       /* edges where the input's faces meet at more than this angle, and its
+                                   boundary edges, are creases: a vertex within half an edge of one moves
+                                   onto it, so sharp edges stay sharp; 0 = TT_DEFAULT_REMESH_CREASE,
+                                   180 = no creases */
     tt_progress_fn progress;    /* optional; called at each step and level; non-zero cancels */
     void *progress_user_data;
 } tt_remesh_options;
 
 #define TT_DEFAULT_REMESH_EDGE 0.0125f   /* 1/80 of the bounding-box diagonal */
 #define TT_DEFAULT_REMESH_SWEEPS 10
+#define TT_DEFAULT_REMESH_CREASE 60.0f
 #define TT_MAX_REMESH_VERTICES (1 << 24) /* the refined input's vertices at most */
 
 typedef struct tt_remesh_report {
@@ -605,6 +610,7 @@ typedef struct tt_remesh_report {
     int split_faces;            /* traced faces that met themselves at a vertex, split there */
     int split_vertices;         /* vertices duplicated so that each has one fan of faces */
     int dropped_faces;          /* traced faces across the input's holes, and stray pieces */
+    int snapped_vertices;       /* output vertices moved onto a crease or the boundary */
 } tt_remesh_report;
 
 /* A new mesh of quads of side about edge_length whose edges follow
@@ -632,7 +638,8 @@ typedef struct tt_remesh_report {
    about 250 bytes per vertex of the (refined) input.
    Errors: NULL mesh, face_vectors or out_mesh, a negative, non-finite or
    too large edge_length (more than an eighth of the bounding-box
-   diagonal), sweeps < 0, a face weight outside [0, 1] (error->face):
+   diagonal), sweeps < 0, crease_degrees outside [0, 180], a face weight
+   outside [0, 1] (error->face):
    TT_ERROR_INVALID_ARGUMENT; a non-finite face vector (error->face):
    TT_ERROR_NON_FINITE; a mesh without faces: TT_ERROR_EMPTY_MESH; a mesh
    with no extent: TT_ERROR_ZERO_AREA_FACE; an edge_length so small that
@@ -6987,11 +6994,14 @@ done:
 }
 
 /* The closest point to p on the faces around the members (level-0
-   vertices, listed by head / next) of `count` clusters. */
-static void tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *next, const int *clusters, int count,
-                                  const double *p, float *out)
+   vertices, listed by head / next) of `count` clusters; or, with creases
+   (per half-edge of m, NULL for none), the closest point on a crease edge
+   of those faces when one lies within `snap` of p. Returns whether it
+   snapped. */
+static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *next, const int *clusters, int count,
+                                 const unsigned char *creases, double snap, const double *p, float *out)
 {
-    double best[3], best_d = HUGE_VAL;
+    double best[3], best_d = HUGE_VAL, on_crease[3], crease_d = HUGE_VAL;
     int i, j, n;
     memcpy(best, p, sizeof best);
     for (n = 0; n < count; n++)
@@ -7015,10 +7025,32 @@ static void tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *
                     memcpy(best, near_point, sizeof best);
                 }
             }
+            for (t = fb; creases && t < fe; t++) {
+                double a[3], ab[3], ap[3], q[3], d[3], along, dd, len2;
+                if (!creases[t]) continue;
+                for (j = 0; j < 3; j++) {
+                    a[j] = m->pos[3 * (size_t)m->corner_vert[t] + j];
+                    ab[j] = m->pos[3 * (size_t)m->corner_vert[t + 1 < fe ? t + 1 : fb] + j] - a[j];
+                    ap[j] = p[j] - a[j];
+                }
+                len2 = tt__dot3(ab, ab);
+                along = len2 > 0.0 ? fmin(1.0, fmax(0.0, tt__dot3(ap, ab) / len2)) : 0.0;
+                for (j = 0; j < 3; j++) {
+                    q[j] = a[j] + along * ab[j];
+                    d[j] = q[j] - p[j];
+                }
+                dd = tt__dot3(d, d);
+                if (dd < crease_d) {
+                    crease_d = dd;
+                    memcpy(on_crease, q, sizeof on_crease);
+                }
+            }
             c = m->twin[tt_mesh_prev(m, c)];
         } while (c >= 0 && c != c0 && ++steps < m->ncorners);
     }
+    if (crease_d <= snap * snap) memcpy(best, on_crease, sizeof best);
     for (j = 0; j < 3; j++) out[j] = (float)best[j];
+    return crease_d <= snap * snap;
 }
 
 /* A vertex with two edges only lies in the middle of a side of both its
@@ -7046,8 +7078,8 @@ static int tt__remesh_passes_through(const tt__remesh_graph *g, int v)
    pieces of fewer than 8 faces (pockets a pinch closed off) are dropped.
    Vertices lie on the input (tt__remesh_onto_input). */
 static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, const tt__remesh_graph *g,
-                                   int input_components, tt_mesh **out_mesh, tt_remesh_report *rep,
-                                   tt_error *error)
+                                   const unsigned char *creases, double edge_length, int input_components,
+                                   tt_mesh **out_mesh, tt_remesh_report *rep, tt_error *error)
 {
     int nc = g->nclusters, total = g->face_start[g->nfaces], f, k, q, nloops = 0, ncorners = 0, nhalf = 0;
     int nverts = nc, npieces = 0, nkept = 0, nindices = 0;
@@ -7129,8 +7161,9 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         if (keep[q])
             for (k = loop_start[q]; k < loop_start[q + 1]; k++) where[loop_vert[k]] = 1;
     for (k = 0; k < nc; k++)
-        if (where[k]) tt__remesh_onto_input(m, member_head, member_next, &k, 1, g->pos + 3 * (size_t)k,
-                                            surface + 3 * (size_t)k);
+        if (where[k])
+            rep->snapped_vertices += tt__remesh_onto_input(m, member_head, member_next, &k, 1, creases, 0.5 * edge_length,
+                                                           g->pos + 3 * (size_t)k, surface + 3 * (size_t)k);
     for (q = 0; q < nloops; q++)
         if (keep[q] && tt__face_has_zero_area(surface, loop_vert + loop_start[q], loop_start[q + 1] - loop_start[q])) {
             keep[q] = 0;
@@ -7275,8 +7308,9 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             around[0] = out_cluster[lattice->corner_vert[c]];
             around[1] = out_cluster[lattice->corner_vert[tt_mesh_next(lattice, c)]];
             for (j = 0; j < 3; j++) mid[j] = pos[3 * ((size_t)lattice->nverts + edge) + j];
-            tt__remesh_onto_input(m, member_head, member_next, around, 2, mid,
-                                  pos + 3 * ((size_t)lattice->nverts + edge));
+            rep->snapped_vertices += tt__remesh_onto_input(m, member_head, member_next, around, 2, creases,
+                                                           0.5 * edge_length, mid,
+                                                           pos + 3 * ((size_t)lattice->nverts + edge));
             edge++;
         }
         for (face = 0; face < lattice->nfaces; face++) {
@@ -7286,7 +7320,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             for (c = lattice->face_start[face]; c < lattice->face_start[face + 1] && count < 3 * 64; c++)
                 around[count++] = out_cluster[lattice->corner_vert[c]];
             for (j = 0; j < 3; j++) centre[j] = at[j];
-            tt__remesh_onto_input(m, member_head, member_next, around, count, centre, at);
+            tt__remesh_onto_input(m, member_head, member_next, around, count, NULL, 0.0, centre, at);
         }
     }
     goto done;
@@ -7326,6 +7360,8 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     const tt_mesh *work = mesh;
     tt_mesh *refined = NULL;
     int *face_source = NULL, *ancestor = NULL, nlevels = 0, finest = 0, f, i, l, sweeps, components = 1;
+    unsigned char *creases = NULL;
+    double crease_cos;
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, diag, rho;
     double *lengths = NULL, smoothed = 0.0, smoothed_total = 0.0;
     tt_result result = TT_OK;
@@ -7350,6 +7386,14 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "sweeps must be 0 (the default) or positive, got %d", opt.sweeps);
     sweeps = opt.sweeps ? opt.sweeps : TT_DEFAULT_REMESH_SWEEPS;
+    if (!(opt.crease_degrees >= 0.0f && opt.crease_degrees <= 180.0f))
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "crease_degrees must be in [0, 180] (0: the default, 180: no creases), got %g",
+                        (double)opt.crease_degrees);
+    crease_cos = opt.crease_degrees >= 180.0f
+                     ? -2.0
+                     : cos((opt.crease_degrees > 0.0f ? opt.crease_degrees : TT_DEFAULT_REMESH_CREASE) *
+                           3.14159265358979323846 / 180.0);
     for (f = 0; f < mesh->nfaces; f++) {
         int k;
         for (k = 0; k < 3; k++)
@@ -7550,7 +7594,21 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         tt__free(allocator, face_component);
         if (result != TT_OK) goto done;
     }
-    result = tt__remesh_output(allocator, work, &graph, components, out_mesh, &rep, error);
+    /* Creases: half-edges whose faces turn more than crease_degrees, and
+       the boundary. */
+    if (crease_cos > -1.0) {
+        creases = TT__ALLOC(allocator, unsigned char, (size_t)work->ncorners + 1);
+        if (!creases) goto oom;
+        for (i = 0; i < work->ncorners; i++) {
+            double a[3], b[3];
+            int t = work->twin[i];
+            creases[i] = t < 0;
+            if (t >= 0 && tt__face_normal_d(work, work->corner_face[i], a) &&
+                tt__face_normal_d(work, work->corner_face[t], b))
+                creases[i] = tt__dot3(a, b) < crease_cos;
+        }
+    }
+    result = tt__remesh_output(allocator, work, &graph, creases, 0.5 * rho, components, out_mesh, &rep, error);
     if (result == TT_OK && tt__remesh_cancelled(&opt, 1.0)) {
         tt_mesh_free(*out_mesh);
         *out_mesh = NULL;
@@ -7567,6 +7625,7 @@ done:
     tt__remesh_graph_free(allocator, &graph);
     tt__free(allocator, face_source);
     tt__free(allocator, ancestor);
+    tt__free(allocator, creases);
     tt__free(allocator, lengths);
     tt_mesh_free(refined);
     if (report) *report = rep;

@@ -2164,6 +2164,111 @@ static void test_remesh_topology(void)
     }
 }
 
+/* Sharp edges stay sharp: a cube (side 2, 12 x 12 cells a face, in
+   triangles) remeshed at 0.2 with up y. Measured: the mean distance from
+   points along the cube's 12 edges to the nearest edge of the output
+   (0 where a row of output edges runs on the crease). The control turns
+   creases off (crease_degrees 180): its edges cut the corners. */
+static double remesh_crease_gap(const tt_mesh *q)
+{
+    double sum = 0.0;
+    int axis, s, e, c, count = 0;
+    for (axis = 0; axis < 3; axis++)
+        for (e = 0; e < 4; e++)
+            for (s = 1; s < 40; s++) {
+                double p[3], best = 1e30;
+                p[axis] = -1.0 + 2.0 * s / 40.0;
+                p[(axis + 1) % 3] = (e & 1) ? 1.0 : -1.0;
+                p[(axis + 2) % 3] = (e & 2) ? 1.0 : -1.0;
+                for (c = 0; c < q->ncorners; c++) {
+                    const float *a = q->pos + 3 * q->corner_vert[c], *b = q->pos + 3 * q->corner_vert[tt_mesh_next(q, c)];
+                    double ab[3], ap[3], len2 = 0, along = 0, d2 = 0;
+                    int k;
+                    for (k = 0; k < 3; k++) {
+                        ab[k] = (double)b[k] - a[k];
+                        ap[k] = p[k] - a[k];
+                        len2 += ab[k] * ab[k];
+                        along += ap[k] * ab[k];
+                    }
+                    along = len2 > 0 ? along / len2 : 0;
+                    along = along < 0 ? 0 : along > 1 ? 1 : along;
+                    for (k = 0; k < 3; k++) d2 += (ap[k] - along * ab[k]) * (ap[k] - along * ab[k]);
+                    if (d2 < best) best = d2;
+                }
+                sum += sqrt(best);
+                count++;
+            }
+    return sum / count;
+}
+
+static void test_remesh_creases(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *q = NULL;
+    tt_error err;
+    tt_remesh_options o;
+    tt_remesh_report rep;
+    float *vec, *w;
+    double gap = 1, control = 0;
+    int side, i, j, n = 12;
+    memset(&m, 0, sizeof m);
+    for (side = 0; side < 6; side++) {
+        int axis = side / 2, row[13][13];
+        double sign = (side & 1) ? 1.0 : -1.0;
+        for (i = 0; i <= n; i++)
+            for (j = 0; j <= n; j++) {
+                double p[3];
+                p[axis] = sign;
+                p[(axis + 1) % 3] = -1.0 + 2.0 * i / n;
+                p[(axis + 2) % 3] = -1.0 + 2.0 * j / n;
+                row[i][j] = tm_vert(&m, p[0], p[1], p[2]);
+            }
+        for (i = 0; i < n; i++)
+            for (j = 0; j < n; j++) {
+                /* outward: (axis+1) x (axis+2) = axis, so the order flips with the sign */
+                if (sign > 0) {
+                    tm_tri(&m, row[i][j], row[i + 1][j], row[i + 1][j + 1]);
+                    tm_tri(&m, row[i][j], row[i + 1][j + 1], row[i][j + 1]);
+                } else {
+                    tm_tri(&m, row[i][j], row[i + 1][j + 1], row[i + 1][j]);
+                    tm_tri(&m, row[i][j], row[i][j + 1], row[i + 1][j + 1]);
+                }
+            }
+    }
+    CHECK(build_welded(&m, &mesh, &err) == TT_OK, "cube: %s", err.message);
+    tm_free(&m);
+    if (!mesh) return;
+    remesh_field_new(mesh, &vec, &w);
+    memset(&o, 0, sizeof o);
+    o.edge_length = 0.2f;
+    o.face_weights = w;
+    CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "cube: %s", err.message);
+    if (q) {
+        gap = remesh_crease_gap(q);
+        CHECK(rep.snapped_vertices > 0, "vertices onto the creases: %d", rep.snapped_vertices);
+    }
+    tt_mesh_free(q);
+    q = NULL;
+    o.crease_degrees = 180.0f;
+    CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "cube, no creases: %s", err.message);
+    if (q) {
+        control = remesh_crease_gap(q);
+        CHECK(rep.snapped_vertices == 0, "no creases, nothing snapped: %d", rep.snapped_vertices);
+    }
+    tt_mesh_free(q);
+    CHECK(gap < 0.004 && control > 0.008 && gap < control / 4, "the cube's edges: %.4f from the output's edges (without creases %.4f)",
+          gap, control);
+    o.crease_degrees = -1.0f;
+    q = (tt_mesh *)&q;
+    CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err) == TT_ERROR_INVALID_ARGUMENT && q == NULL,
+          "crease_degrees -1: %s", err.message);
+    o.crease_degrees = 181.0f;
+    CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err) == TT_ERROR_INVALID_ARGUMENT, "crease_degrees 181");
+    free(vec);
+    free(w);
+    tt_mesh_free(mesh);
+}
+
 /* Records the fractions; asks to stop at call `stop_at` (-1: never). */
 typedef struct remesh_progress {
     int calls, stop_at, decreasing;
@@ -2322,5 +2427,6 @@ void run_mesh_tests(void)
     RUN(test_mesh_query_allocators);
     RUN(test_remesh_sphere);
     RUN(test_remesh_topology);
+    RUN(test_remesh_creases);
     RUN(test_remesh_errors);
 }

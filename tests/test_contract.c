@@ -463,6 +463,13 @@ static void cases_mesh(const baseline *b)
         ro.sweeps = INT_MIN;
         OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
         ro.sweeps = 0;
+        ro.crease_degrees = -1.0f;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.crease_degrees = 180.5f;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.crease_degrees = b->nan_t;
+        OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
+        ro.crease_degrees = 0.0f;
         ro.face_weights = weights;
         weights[3] = -0.5f;
         OUT_CASE(rm, tt_mesh_free, tt_remesh_quads(t, vectors, &ro, AL, &rm, NULL, E));
