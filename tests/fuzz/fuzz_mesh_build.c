@@ -320,6 +320,48 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
     check_types_and_uvs(m, layout, seed, a);
 
     if (depth == 0) {
+        /* tt_remesh_quads, each face's first edge its direction, at the
+           largest edge allowed (an eighth of the diagonal: little
+           refinement): a strict mesh of quads, or a documented error. */
+        float *vectors = (float *)malloc(3 * (size_t)(m->nfaces > 0 ? m->nfaces : 1) * sizeof(float));
+        double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+        tt_remesh_options ro;
+        tt_mesh *rq = (tt_mesh *)&err;   /* must be set to NULL on failure */
+        int f, c, k;
+        CHECK(vectors != NULL, "out of memory");
+        for (f = 0; f < m->nfaces; f++) {
+            const float *p0 = m->pos + 3 * m->corner_vert[m->face_start[f]];
+            const float *p1 = m->pos + 3 * m->corner_vert[m->face_start[f] + 1];
+            for (k = 0; k < 3; k++) vectors[3 * f + k] = (float)((double)p1[k] - p0[k]);
+            for (k = 0; k < 3; k++)
+                if (!(fabsf(vectors[3 * f + k]) <= FLT_MAX)) vectors[3 * f + k] = 0.0f;
+        }
+        for (c = 0; c < m->ncorners; c++)
+            for (k = 0; k < 3; k++) {
+                lo[k] = fmin(lo[k], m->pos[3 * m->corner_vert[c] + k]);
+                hi[k] = fmax(hi[k], m->pos[3 * m->corner_vert[c] + k]);
+            }
+        memset(&ro, 0, sizeof ro);
+        ro.edge_length = (float)(0.124 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                              (hi[2] - lo[2]) * (hi[2] - lo[2])));
+        if (!(ro.edge_length > 0.0f && ro.edge_length <= FLT_MAX)) ro.edge_length = 0.0f;
+        memset(&err, 0x55, sizeof err);
+        r = tt_remesh_quads(m, vectors, &ro, &a->tt, &rq, NULL, &err);
+        if (r != TT_OK) {
+            fz_check_null("tt_remesh_quads", r, rq);
+            check_error(r, &err, m->nfaces, m->ncorners, a);
+            CHECK(r == TT_ERROR_OUT_OF_MEMORY || r == TT_ERROR_NON_FINITE || r == TT_ERROR_ZERO_AREA_FACE ||
+                      r == TT_ERROR_TOO_LARGE || r == TT_ERROR_NOT_CONVERGED || r == TT_ERROR_INVALID_ARGUMENT,
+                  "remeshing failed outside the documented codes: %d %s", r, err.message);
+        } else {
+            check_mesh(rq, NULL, 1);
+            CHECK(rq->min_face_size == 4 && rq->max_face_size == 4, "remeshed faces of %d..%d sides",
+                  rq->min_face_size, rq->max_face_size);
+            tt_mesh_free(rq);
+        }
+        free(vectors);
+    }
+    if (depth == 0) {
         int scheme;
         for (scheme = 0; scheme < 2; ++scheme) {
             tt_mesh *q = (tt_mesh *)&err;   /* must be set to NULL on failure */
