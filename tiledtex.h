@@ -6996,10 +6996,11 @@ done:
 /* The closest point to p on the faces around the members (level-0
    vertices, listed by head / next) of `count` clusters; or, with creases
    (per half-edge of m, NULL for none), the closest point on a crease edge
-   of those faces when one lies within `snap` of p. Returns whether it
-   snapped. */
+   of those faces when one lies within `snap` of p; p itself when the
+   closest point is farther than `reach`. Returns whether it snapped. */
 static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *next, const int *clusters, int count,
-                                 const unsigned char *creases, double snap, const double *p, float *out)
+                                 const unsigned char *creases, double snap, double reach, const double *p,
+                                 float *out)
 {
     double best[3], best_d = HUGE_VAL, on_crease[3], crease_d = HUGE_VAL;
     int i, j, n;
@@ -7049,29 +7050,13 @@ static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *n
         } while (c >= 0 && c != c0 && ++steps < m->ncorners);
     }
     if (crease_d <= snap * snap) memcpy(best, on_crease, sizeof best);
+    else if (best_d > reach * reach) memcpy(best, p, sizeof best);
     for (j = 0; j < 3; j++) out[j] = (float)best[j];
     return crease_d <= snap * snap;
 }
 
-/* A vertex with two edges only lies in the middle of a side of both its
-   faces (a quad there would have a straight corner, and its split a vertex
-   of valence 2): the faces skip it, unless its two neighbours are joined
-   already (the faces are then a triangle and its neighbour, and dropping
-   it would join them twice). */
-static int tt__remesh_passes_through(const tt__remesh_graph *g, int v)
-{
-    int a, b, q;
-    if (g->start[v + 1] - g->start[v] != 2) return 0;
-    a = g->nbr[g->start[v]];
-    b = g->nbr[g->start[v] + 1];
-    for (q = g->start[a]; q < g->start[a + 1]; q++)
-        if (g->nbr[q] == b) return 0;
-    return 1;
-}
-
-/* The output from the traced faces: vertices a face only passes through
-   are left out (tt__remesh_passes_through); a face that meets itself at a
-   vertex is split there into simple loops; a loop facing against the surface
+/* The output from the traced faces: a face that meets itself at a vertex
+   is split there into simple loops; a loop facing against the surface
    with most of its vertices on the input's boundary, or one entirely on
    it, spans a hole and is dropped; each vertex whose faces form several
    fans becomes one vertex per fan; with more pieces than the input,
@@ -7100,14 +7085,23 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     where = TT__ALLOC(al, int, (size_t)nc + 1);
     path = TT__ALLOC(al, int, (size_t)total + 1);
     keep = TT__ALLOC(al, unsigned char, (size_t)total + 1);
-    if (!loop_start || !loop_vert || !corner_loop || !where || !path || !keep) goto fail;
+    member_head = TT__ALLOC(al, int, (size_t)nc + 1);
+    member_next = TT__ALLOC(al, int, (size_t)m->nverts + 1);
+    surface = TT__ALLOC(al, float, 3 * (size_t)nc + 3);
+    if (!loop_start || !loop_vert || !corner_loop || !where || !path || !keep || !member_head || !member_next ||
+        !surface)
+        goto fail;
+    for (k = 0; k < nc; k++) member_head[k] = -1;
+    for (k = m->nverts - 1; k >= 0; k--) {
+        member_next[k] = member_head[g->member_cluster[k]];
+        member_head[g->member_cluster[k]] = k;
+    }
     for (k = 0; k < nc; k++) where[k] = -1;
     loop_start[0] = 0;
     for (f = 0; f < g->nfaces; f++) {
         int begin = g->face_start[f], size = g->face_start[f + 1] - begin, depth = 0, split = 0, first = nloops;
         for (k = 0; k <= size; k++) {
             int v = k < size ? g->face_vert[begin + k] : -1, from = k < size ? where[v] : 0;
-            if (k < size && tt__remesh_passes_through(g, v)) continue;
             if (k < size && from < 0) {
                 where[v] = depth;
                 path[depth++] = v;
@@ -7140,6 +7134,21 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             }
             turn = tt__dot3(newell, normal);
             keep[q] = !(on == s || (turn <= 0.0 && 2 * on >= s));
+            /* A loop round a hole need not pass only through clusters that
+               hold a boundary vertex (those can end nowhere and go): one
+               that touches the boundary and whose centre lies more than a
+               lattice step off the input spans a hole (half a step also
+               cut faces of small, curved parts: a teapot lid's knob). */
+            if (keep[q] && on > 0) {
+                double centre[3] = {0.0, 0.0, 0.0}, d[3];
+                float on_input[3];
+                for (k = 0; k < s; k++)
+                    for (j = 0; j < 3; j++) centre[j] += g->pos[3 * (size_t)loop_vert[b + k] + j] / s;
+                tt__remesh_onto_input(m, member_head, member_next, loop_vert + b, s, NULL, 0.0, HUGE_VAL, centre,
+                                      on_input);
+                for (j = 0; j < 3; j++) d[j] = on_input[j] - centre[j];
+                keep[q] = tt__dot3(d, d) <= 4.0 * edge_length * edge_length;
+            }
             if (!keep[q]) rep->dropped_faces++;
             else if (turn <= 0.0) rep->folded_faces++;
         }
@@ -7147,23 +7156,15 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     /* Each cluster a loop uses moves to the closest point of the input's
        faces around its members; a loop those points make flat (two
        clusters onto one point, or three onto a line) is dropped. */
-    member_head = TT__ALLOC(al, int, (size_t)nc + 1);
-    member_next = TT__ALLOC(al, int, (size_t)m->nverts + 1);
-    surface = TT__ALLOC(al, float, 3 * (size_t)nc + 3);
-    if (!member_head || !member_next || !surface) goto fail;
-    for (k = 0; k < nc; k++) member_head[k] = -1;
-    for (k = m->nverts - 1; k >= 0; k--) {
-        member_next[k] = member_head[g->member_cluster[k]];
-        member_head[g->member_cluster[k]] = k;
-    }
     for (k = 0; k < nc; k++) where[k] = 0;
     for (q = 0; q < nloops; q++)
         if (keep[q])
             for (k = loop_start[q]; k < loop_start[q + 1]; k++) where[loop_vert[k]] = 1;
     for (k = 0; k < nc; k++)
         if (where[k])
-            rep->snapped_vertices += tt__remesh_onto_input(m, member_head, member_next, &k, 1, creases, 0.5 * edge_length,
-                                                           g->pos + 3 * (size_t)k, surface + 3 * (size_t)k);
+            rep->snapped_vertices += tt__remesh_onto_input(m, member_head, member_next, &k, 1, creases,
+                                                           0.5 * edge_length, HUGE_VAL, g->pos + 3 * (size_t)k,
+                                                           surface + 3 * (size_t)k);
     for (q = 0; q < nloops; q++)
         if (keep[q] && tt__face_has_zero_area(surface, loop_vert + loop_start[q], loop_start[q + 1] - loop_start[q])) {
             keep[q] = 0;
@@ -7295,7 +7296,9 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     if (result != TT_OK) goto done;
     /* Every face split into quads (tt_mesh_quadrangulate: its vertices, its
        edges' points in order of their first half-edge, its faces' points),
-       the new points also moved onto the input, near their clusters. */
+       the new points also moved onto the input, near their clusters, when
+       the input lies within an edge (a face over a small part, a teapot's
+       knob, would otherwise reach for it in a spike). */
     result = tt_mesh_quadrangulate(lattice, TT_SUBDIVIDE_LINEAR, al, out_mesh, error);
     if (result != TT_OK) goto done;
     {
@@ -7309,7 +7312,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             around[1] = out_cluster[lattice->corner_vert[tt_mesh_next(lattice, c)]];
             for (j = 0; j < 3; j++) mid[j] = pos[3 * ((size_t)lattice->nverts + edge) + j];
             rep->snapped_vertices += tt__remesh_onto_input(m, member_head, member_next, around, 2, creases,
-                                                           0.5 * edge_length, mid,
+                                                           0.5 * edge_length, edge_length, mid,
                                                            pos + 3 * ((size_t)lattice->nverts + edge));
             edge++;
         }
@@ -7320,7 +7323,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             for (c = lattice->face_start[face]; c < lattice->face_start[face + 1] && count < 3 * 64; c++)
                 around[count++] = out_cluster[lattice->corner_vert[c]];
             for (j = 0; j < 3; j++) centre[j] = at[j];
-            tt__remesh_onto_input(m, member_head, member_next, around, count, NULL, 0.0, centre, at);
+            tt__remesh_onto_input(m, member_head, member_next, around, count, NULL, 0.0, edge_length, centre, at);
         }
     }
     goto done;
