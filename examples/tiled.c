@@ -509,9 +509,10 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
         if (tool_quiet()) return;
         tool_progress_clear();
         fprintf(stderr, "tiledtex: %s remeshed along the field into %d quads of side about %g (from a lattice of "
-                        "%d quads, %d triangles, %d pentagons and %d larger faces, each n-gon split into n quads",
-                obj_path, mesh->remeshed, mesh->remesh_edge, r->quads, r->triangles, r->pentagons,
-                r->larger_faces);
+                        "%d quad%s, %d triangle%s, %d pentagon%s and %d larger face%s, each n-gon split into n "
+                        "quads", obj_path, mesh->remeshed, mesh->remesh_edge, r->quads, r->quads == 1 ? "" : "s",
+                r->triangles, r->triangles == 1 ? "" : "s", r->pentagons, r->pentagons == 1 ? "" : "s",
+                r->larger_faces, r->larger_faces == 1 ? "" : "s");
         if (r->folded_faces) fprintf(stderr, "; %d folded", r->folded_faces);
         fprintf(stderr, ")\n");
         /* Where the surface is thinner than an edge, the new mesh closes a
