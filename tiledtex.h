@@ -6325,25 +6325,42 @@ static void tt__tangent_or_any(const double *d, const double *n, double *out)
     if (tt__normalize3(out) == 0.0) { out[0] = 1.0; out[1] = 0.0; out[2] = 0.0; }
 }
 
-/* Point p + rho (a o + b (n x o)). */
-static void tt__lattice_point(const double *p, const double *o, const double *n, double rho, int a, int b,
-                              double *out)
+/* sum += w d, d first turned by the quarter turn about n nearest sum
+   (none while sum is zero): a 4-fold mean, accumulated. */
+static void tt__rosy4_add(double *sum, const double *d, const double *n, double w)
 {
-    double t[3];
+    double turned[3];
     int k;
-    tt__cross3(n, o, t);
-    for (k = 0; k < 3; k++) out[k] = p[k] + rho * ((double)a * o[k] + (double)b * t[k]);
+    if (sum[0] != 0.0 || sum[1] != 0.0 || sum[2] != 0.0) tt__rosy4_nearest(sum, d, n, turned);
+    else memcpy(turned, d, sizeof turned);
+    for (k = 0; k < 3; k++) sum[k] += w * turned[k];
+}
+
+/* Each vertex's neighbours adj[start[i] .. start[i + 1]) sorted, repeats
+   removed, the array closed up (start rewritten). */
+static void tt__remesh_unique_neighbours(int *start, int *adj, int n)
+{
+    int w = 0, i, k;
+    for (i = 0; i < n; i++) {
+        int begin = start[i], end = start[i + 1];
+        qsort(adj + begin, (size_t)(end - begin), sizeof(int), tt__int_compare);
+        start[i] = w;
+        for (k = begin; k < end; k++)
+            if (k == begin || adj[k] != adj[k - 1]) adj[w++] = adj[k];
+    }
+    start[n] = w;
 }
 
 /* The points of lattices i and j (origins pi, pj, directions oi and oj
    already matched by tt__rosy4_nearest) closest to each other near the
    middle of xi and xj: their integer coordinates ci, cj in their own
-   lattices; returns the distance between the two points. Of the four
+   lattices, the first point less the second in apart; returns the
+   distance between the two points. Of the four
    lattice points around the middle on each side, the closest pair wins
    (the paper's compat_position, extrinsic form). */
 static double tt__lattice_pair(const double *xi, const double *ni, const double *oi, const double *pi,
                                const double *xj, const double *nj, const double *oj, const double *pj, double rho,
-                               int ci[2], int cj[2])
+                               int ci[2], int cj[2], double apart[3])
 {
     double ti[3], tj[3], mi[3], mj[3], base[3], best = HUGE_VAL;
     int k, fi[2], fj[2], q, r;
@@ -6371,6 +6388,7 @@ static double tt__lattice_pair(const double *xi, const double *ni, const double 
                 best = dd;
                 ci[0] = fi[0] + (q & 1); ci[1] = fi[1] + (q >> 1);
                 cj[0] = fj[0] + (r & 1); cj[1] = fj[1] + (r >> 1);
+                memcpy(apart, d, sizeof d);
             }
         }
     }
@@ -6424,14 +6442,13 @@ static void tt__remesh_position_sweep(tt__remesh_level *l, double rho, int backw
         for (k = 0; k < 3; k++) q[k] = l->lattice[3 * (size_t)i + k];
         for (e = l->adj_start[i]; e < l->adj_start[i + 1]; e++) {
             int j = l->adj[e], ci[2], cj[2];
-            double oj[3], li[3], lj[3];
+            double oj[3], apart[3];
             const double *nj = l->normal + 3 * (size_t)j;
             tt__rosy4_nearest(o, l->orient + 3 * (size_t)j, nj, oj);
-            tt__lattice_pair(x, n, o, q, l->x + 3 * (size_t)j, nj, oj, l->lattice + 3 * (size_t)j, rho, ci, cj);
-            tt__lattice_point(q, o, n, rho, ci[0], ci[1], li);
-            tt__lattice_point(l->lattice + 3 * (size_t)j, oj, nj, rho, cj[0], cj[1], lj);
+            tt__lattice_pair(x, n, o, q, l->x + 3 * (size_t)j, nj, oj, l->lattice + 3 * (size_t)j, rho, ci, cj,
+                             apart);
             w += 1.0;
-            for (k = 0; k < 3; k++) q[k] += (lj[k] - li[k]) / w;
+            for (k = 0; k < 3; k++) q[k] -= apart[k] / w;
         }
         for (k = 0; k < 3; k++) d[k] = q[k] - x[k];
         a = tt__dot3(d, n);
@@ -6506,19 +6523,10 @@ static int tt__remesh_coarsen(const tt_allocator *al, tt__remesh_level *f, tt__r
         for (k = 0; k < 3; k++) c->x[3 * (size_t)p + k] = f->x[3 * (size_t)i + k];
     }
     for (i = 0; i < n; i++) {
-        int p = f->parent[i], k;
-        double a[3], w = f->weight[i] * f->area[i];
-        double *ca = c->anchor + 3 * (size_t)p;
+        int p = f->parent[i];
+        double w = f->weight[i] * f->area[i];
         if (w <= 0.0) continue;
-        if (c->weight[p] > 0.0) {
-            double cur[3];
-            for (k = 0; k < 3; k++) cur[k] = ca[k];
-            tt__normalize3(cur);
-            tt__rosy4_nearest(cur, f->anchor + 3 * (size_t)i, f->normal + 3 * (size_t)i, a);
-        } else {
-            for (k = 0; k < 3; k++) a[k] = f->anchor[3 * (size_t)i + k];
-        }
-        for (k = 0; k < 3; k++) ca[k] += w * a[k];
+        tt__rosy4_add(c->anchor + 3 * (size_t)p, f->anchor + 3 * (size_t)i, f->normal + 3 * (size_t)i, w);
         c->weight[p] += w;
     }
     for (i = 0; i < cn; i++) {
@@ -6546,17 +6554,7 @@ static int tt__remesh_coarsen(const tt_allocator *al, tt__remesh_level *f, tt__r
             int p = f->parent[i], q = f->parent[f->adj[e]];
             if (q != p) c->adj[fill[p]++] = q;
         }
-    {
-        int w = 0, p;
-        for (p = 0; p < cn; p++) {
-            int begin = c->adj_start[p], end = c->adj_start[p + 1], k;
-            qsort(c->adj + begin, (size_t)(end - begin), sizeof(int), tt__int_compare);
-            c->adj_start[p] = w;
-            for (k = begin; k < end; k++)
-                if (k == begin || c->adj[k] != c->adj[k - 1]) c->adj[w++] = c->adj[k];
-        }
-        c->adj_start[cn] = w;
-    }
+    tt__remesh_unique_neighbours(c->adj_start, c->adj, cn);
     ok = 1;
 done:
     tt__free(al, order);
@@ -6604,17 +6602,10 @@ static int tt__remesh_base_level(const tt_allocator *al, const tt_mesh *m, const
         if (w <= 0.0 || share <= 0.0 || tt__length3(d) == 0.0) continue;
         for (c = begin; c < end; c++) {
             int v = m->corner_vert[c];
-            double *a = l->anchor + 3 * (size_t)v, t[3], turned[3], cur[3];
+            double t[3];
             tt__project3(d, l->normal + 3 * (size_t)v, t);
             if (tt__normalize3(t) == 0.0) continue;
-            if (l->weight[v] > 0.0) {
-                for (k = 0; k < 3; k++) cur[k] = a[k];
-                tt__normalize3(cur);
-                tt__rosy4_nearest(cur, t, l->normal + 3 * (size_t)v, turned);
-            } else {
-                for (k = 0; k < 3; k++) turned[k] = t[k];
-            }
-            for (k = 0; k < 3; k++) a[k] += share * w * turned[k];
+            tt__rosy4_add(l->anchor + 3 * (size_t)v, t, l->normal + 3 * (size_t)v, share * w);
             l->weight[v] += share * w;
         }
     }
@@ -6642,17 +6633,7 @@ static int tt__remesh_base_level(const tt_allocator *al, const tt_mesh *m, const
             for (b = begin; b < end; b++)
                 if (a != b) l->adj[fill[m->corner_vert[a]]++] = m->corner_vert[b];
     }
-    {
-        int w = 0;
-        for (i = 0; i < n; i++) {
-            int begin = l->adj_start[i], end = l->adj_start[i + 1], k;
-            qsort(l->adj + begin, (size_t)(end - begin), sizeof(int), tt__int_compare);
-            l->adj_start[i] = w;
-            for (k = begin; k < end; k++)
-                if (k == begin || l->adj[k] != l->adj[k - 1]) l->adj[w++] = l->adj[k];
-        }
-        l->adj_start[n] = w;
-    }
+    tt__remesh_unique_neighbours(l->adj_start, l->adj, n);
     ok = 1;
 done:
     tt__free(al, fill);
@@ -6730,7 +6711,7 @@ static void tt__remesh_graph_free(const tt_allocator *al, tt__remesh_graph *g)
 static int tt__remesh_clusters(const tt_allocator *al, const tt__remesh_level *l, const tt_mesh *m,
                                const int *ancestor, double rho, tt__remesh_graph *g)
 {
-    int n = l->n, i, e, nunit = 0, cap_unit = 0, ncollapse = 0, cap_collapse = 0, ok = 0, k;
+    int n = l->n, i, e, nunit = 0, cap_unit = 0, ncollapse = 0, cap_collapse = 0, cap_keys = 0, ok = 0, k;
     int *unit = NULL, *collapse = NULL, *parent = NULL, *head = NULL, *tail = NULL, *next = NULL, *root_id = NULL;
     uint64_t *keys = NULL;
     double *wsum = NULL;
@@ -6738,21 +6719,28 @@ static int tt__remesh_clusters(const tt_allocator *al, const tt__remesh_level *l
         const double *xi = l->x + 3 * (size_t)i, *ni = l->normal + 3 * (size_t)i, *oi = l->orient + 3 * (size_t)i;
         for (e = l->adj_start[i]; e < l->adj_start[i + 1]; e++) {
             int j = l->adj[e], ci[2], cj[2], da, db;
-            double oj[3], d;
+            double oj[3], apart[3], d;
             if (j <= i) continue;
             tt__rosy4_nearest(oi, l->orient + 3 * (size_t)j, l->normal + 3 * (size_t)j, oj);
             d = tt__lattice_pair(xi, ni, oi, l->lattice + 3 * (size_t)i, l->x + 3 * (size_t)j,
-                                 l->normal + 3 * (size_t)j, oj, l->lattice + 3 * (size_t)j, rho, ci, cj);
+                                 l->normal + 3 * (size_t)j, oj, l->lattice + 3 * (size_t)j, rho, ci, cj, apart);
             if (d > 0.5 * rho) continue;       /* the two lattices disagree here */
             da = abs(ci[0] - cj[0]);
             db = abs(ci[1] - cj[1]);
             if (da > 1 || db > 1 || (da == 1 && db == 1)) continue;   /* far or diagonal */
             if (da + db == 0) {
+                /* Ordered by the distance of the two lattice points (the
+                   most certain first), then by the pair's index. */
                 int *grown = (int *)tt__grow(al, collapse, &cap_collapse, 2 * ncollapse + 2, sizeof(int));
+                uint64_t *grown_keys;
                 if (!grown) goto done;
                 collapse = grown;
+                grown_keys = (uint64_t *)tt__grow(al, keys, &cap_keys, ncollapse + 1, sizeof(uint64_t));
+                if (!grown_keys) goto done;
+                keys = grown_keys;
                 collapse[2 * ncollapse] = i;
                 collapse[2 * ncollapse + 1] = j;
+                keys[ncollapse] = ((uint64_t)(uint32_t)fmin(4294967295.0, d / rho * 1e9) << 32) | (uint32_t)ncollapse;
                 ncollapse++;
             } else {
                 int *grown = (int *)tt__grow(al, unit, &cap_unit, 2 * nunit + 2, sizeof(int));
@@ -6764,23 +6752,12 @@ static int tt__remesh_clusters(const tt_allocator *al, const tt__remesh_level *l
             }
         }
     }
-    /* The collapses in order of their lattice points' distance. */
-    keys = TT__ALLOC(al, uint64_t, (size_t)ncollapse + 1);
     parent = TT__ALLOC(al, int, (size_t)n + 1);
     head = TT__ALLOC(al, int, (size_t)n + 1);
     tail = TT__ALLOC(al, int, (size_t)n + 1);
     next = TT__ALLOC(al, int, 2 * (size_t)nunit + 1);
-    if (!keys || !parent || !head || !tail || !next) goto done;
-    for (k = 0; k < ncollapse; k++) {
-        int a = collapse[2 * k], b = collapse[2 * k + 1], ci[2], cj[2];
-        double oj[3], d;
-        tt__rosy4_nearest(l->orient + 3 * (size_t)a, l->orient + 3 * (size_t)b, l->normal + 3 * (size_t)b, oj);
-        d = tt__lattice_pair(l->x + 3 * (size_t)a, l->normal + 3 * (size_t)a, l->orient + 3 * (size_t)a,
-                             l->lattice + 3 * (size_t)a, l->x + 3 * (size_t)b, l->normal + 3 * (size_t)b, oj,
-                             l->lattice + 3 * (size_t)b, rho, ci, cj);
-        keys[k] = ((uint64_t)(uint32_t)fmin(4294967295.0, d / rho * 1e9) << 32) | (uint32_t)k;
-    }
-    qsort(keys, (size_t)ncollapse, sizeof *keys, tt__u64_compare);
+    if (!parent || !head || !tail || !next) goto done;
+    if (keys) qsort(keys, (size_t)ncollapse, sizeof *keys, tt__u64_compare);
     /* Each root keeps a list of the lattice edges of its members (entry 2u
        at unit edge u's first end names its second, 2u + 1 the reverse). */
     for (i = 0; i < n; i++) { parent[i] = i; head[i] = tail[i] = -1; }
@@ -7542,14 +7519,9 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     for (l = finest + 1; l < nlevels; l++) {
         tt__remesh_level *fine = &levels[l - 1], *lv = &levels[l];
         memset(lv->orient, 0, 3 * (size_t)lv->n * sizeof(double));
-        for (i = 0; i < fine->n; i++) {
-            double *o = lv->orient + 3 * (size_t)fine->parent[i], t[3], cur[3];
-            int k;
-            for (k = 0; k < 3; k++) cur[k] = o[k];
-            if (tt__normalize3(cur) > 0.0) tt__rosy4_nearest(cur, fine->orient + 3 * (size_t)i, fine->normal + 3 * (size_t)i, t);
-            else for (k = 0; k < 3; k++) t[k] = fine->orient[3 * (size_t)i + k];
-            for (k = 0; k < 3; k++) o[k] += t[k];
-        }
+        for (i = 0; i < fine->n; i++)
+            tt__rosy4_add(lv->orient + 3 * (size_t)fine->parent[i], fine->orient + 3 * (size_t)i,
+                          fine->normal + 3 * (size_t)i, 1.0);
         for (i = 0; i < lv->n; i++) {
             double t[3];
             tt__tangent_or_any(lv->orient + 3 * (size_t)i, lv->normal + 3 * (size_t)i, t);
