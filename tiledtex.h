@@ -598,6 +598,7 @@ typedef struct tt_remesh_options {
 #define TT_MAX_REMESH_VERTICES (1 << 24) /* the refined input's vertices at most */
 
 typedef struct tt_remesh_report {
+    float edge_length;          /* the output quads' side asked for: options' or the default's */
     int refinements;            /* linear quadrangulations of the input before remeshing */
     int working_vertices;       /* vertices of that refined input */
     int levels;                 /* levels of the hierarchy */
@@ -4858,6 +4859,25 @@ static double tt__face_longest_edge(const tt_mesh *mesh, int face)
     return longest;
 }
 
+/* The diagonal of the bounding box of the vertices the faces use (the
+   scale the defaults of the field and of the remesher are relative to);
+   NaN when one of those vertices is not finite. */
+static double tt__mesh_diagonal(const tt_mesh *mesh)
+{
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, d[3];
+    int c, k;
+    for (c = 0; c < mesh->ncorners; c++)
+        for (k = 0; k < 3; k++) {
+            double x = mesh->pos[3 * (size_t)mesh->corner_vert[c] + k];
+            if (!tt__is_finite_d(x)) return tt__not_a_number();
+            if (x < lo[k]) lo[k] = x;
+            if (x > hi[k]) hi[k] = x;
+        }
+    if (mesh->ncorners == 0) return 0.0;
+    for (k = 0; k < 3; k++) d[k] = hi[k] - lo[k];
+    return tt__length3(d);
+}
+
 /* A tt_mesh of no faces can only be made by hand (tt_mesh_build refuses
    it): every function that takes a mesh refuses it too. */
 static tt_result tt__require_faces(const tt_mesh *mesh, tt_error *error)
@@ -7342,7 +7362,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     int *face_source = NULL, *ancestor = NULL, nlevels = 0, finest = 0, f, i, l, sweeps, components = 1;
     unsigned char *creases = NULL;
     double crease_cos;
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, diag, rho;
+    double diag, rho;
     double *lengths = NULL, smoothed = 0.0, smoothed_total = 0.0;
     tt_result result = TT_OK;
 
@@ -7384,15 +7404,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
             return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, f, -1, -1, -1,
                             "face %d's weight %g is not in [0, 1]", f, (double)opt.face_weights[f]);
     }
-    for (f = 0; f < mesh->ncorners; f++) {
-        int v = mesh->corner_vert[f], k;
-        for (k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], mesh->pos[3 * (size_t)v + k]);
-            hi[k] = fmax(hi[k], mesh->pos[3 * (size_t)v + k]);
-        }
-    }
-    diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    diag = tt__mesh_diagonal(mesh);
     if (!tt__is_finite_d(diag))
         return tt__fail(error, TT_ERROR_NON_FINITE, -1, -1, -1, -1,
                         "the mesh's bounding box is not finite (diagonal %g): a NaN or infinite position", diag);
@@ -7401,6 +7413,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
                         "the mesh's faces all lie at one point: nothing to remesh");
     /* The lattice is twice the output's edge: each of its faces is split. */
     rho = 2.0 * (opt.edge_length > 0.0f ? (double)opt.edge_length : TT_DEFAULT_REMESH_EDGE * diag);
+    rep.edge_length = (float)(0.5 * rho);
     if (rho > 0.25 * diag)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "edge_length %g is more than an eighth of the mesh's bounding-box diagonal %g",
@@ -7431,7 +7444,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         if ((long long)work->nverts + work->ncorners / 2 + work->nfaces > TT_MAX_REMESH_VERTICES) {
             result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                               "edge_length %g needs the mesh refined past %d vertices (its edges are up to %g "
-                              "long): choose a larger edge_length", rho, TT_MAX_REMESH_VERTICES, p90);
+                              "long): choose a larger edge_length", 0.5 * rho, TT_MAX_REMESH_VERTICES, p90);
             goto done;
         }
         result = tt_mesh_quadrangulate(work, TT_SUBDIVIDE_LINEAR, allocator, &next, &ignored);
@@ -13887,8 +13900,8 @@ static tt_result tt__field_setup(tt__field *F, const tt_mesh *mesh, const tt_fie
                                  const tt_allocator *allocator, tt_error *error)
 {
     tt_field_options *opt = &F->opt;
-    double diag, lo[3], hi[3];
-    int c, k;
+    double diag;
+    int k;
 
     memset(F, 0, sizeof *F);
     F->mesh = mesh;
@@ -13920,17 +13933,7 @@ static tt_result tt__field_setup(tt__field *F, const tt_mesh *mesh, const tt_fie
                         opt->constraints ? "given" : "NULL");
     if (F->nf <= 0) return TT_OK;   /* nothing to build: the driver stops here */
 
-    /* Bounding-box diagonal of the vertices the faces use. */
-    for (k = 0; k < 3; k++) { lo[k] = 1e300; hi[k] = -1e300; }
-    for (c = 0; c < mesh->ncorners; c++) {
-        const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
-        for (k = 0; k < 3; k++) {
-            if (p[k] < lo[k]) lo[k] = p[k];
-            if (p[k] > hi[k]) hi[k] = p[k];
-        }
-    }
-    for (k = 0; k < 3; k++) lo[k] = hi[k] - lo[k];
-    diag = tt__length3(lo);
+    diag = tt__mesh_diagonal(mesh);
     if (!(diag > 0.0)) diag = 1.0;
     F->scale = opt->scale > 0.0f ? (double)opt->scale : TT_DEFAULT_FIELD_SCALE * diag;
     F->sigma = opt->sigma > 0.0f ? (double)opt->sigma : TT_DEFAULT_FIELD_SIGMA * diag;

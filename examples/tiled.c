@@ -197,33 +197,21 @@ static int remesh_along_field(const char *obj_path, const tiled_options *options
     const int nfaces = out->mesh->nfaces;
     float *vectors = (float *)malloc((size_t)nfaces * 3 * sizeof(float));
     float *weights = (float *)malloc((size_t)nfaces * sizeof(float));
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     tt_field_options field;
     tt_remesh_options remesh;
     tt_mesh *remeshed = NULL;
     tt_error error;
-    int f, c, k, status = 0;
+    int f, status = 0;
     if (!vectors || !weights) {
         free(vectors);
         free(weights);
         return tool_fail("out of memory for the direction field of %d faces", nfaces);
     }
-    for (c = 0; c < out->mesh->ncorners; c++)
-        for (k = 0; k < 3; k++) {
-            double x = out->mesh->pos[3 * (size_t)out->mesh->corner_vert[c] + k];
-            lo[k] = x < lo[k] ? x : lo[k];
-            hi[k] = x > hi[k] ? x : hi[k];
-        }
     memset(&field, 0, sizeof field);
     memcpy(field.up, options->field.up, sizeof field.up);
     memset(&remesh, 0, sizeof remesh);
     remesh.edge_length = (float)options->remesh_size;
     remesh.face_weights = weights;
-    out->remesh_edge = remesh.edge_length > 0.0f
-                           ? remesh.edge_length
-                           : (float)(TT_DEFAULT_REMESH_EDGE * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-                                                                   (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                                                   (hi[2] - lo[2]) * (hi[2] - lo[2])));
     tool_stage("computing the direction field");
     if (tt_mesh_compute_stats(out->mesh, NULL, &out->input_stats, &error) != TT_OK ||
         tt_tangent_field(out->mesh, &field, NULL, vectors, &error) != TT_OK ||
@@ -237,7 +225,10 @@ static int remesh_along_field(const char *obj_path, const tiled_options *options
         remesh.progress_user_data = &progress;
         result = tt_remesh_quads(out->mesh, vectors, &remesh, NULL, &remeshed, &out->remesh, &error);
         tool_progress_end(&progress);
-        if (result != TT_OK) status = tool_fail("%s: --remesh %g: %s", obj_path, out->remesh_edge, error.message);
+        if (result != TT_OK && options->remesh_size > 0.0)
+            status = tool_fail("%s: --remesh %g: %s", obj_path, options->remesh_size, error.message);
+        else if (result != TT_OK)
+            status = tool_fail("%s: --remesh auto: %s", obj_path, error.message);
     }
     free(vectors);
     free(weights);
@@ -510,7 +501,7 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
         tool_progress_clear();
         fprintf(stderr, "tiledtex: %s remeshed along the field into %d quads of side about %g (from a lattice of "
                         "%d quad%s, %d triangle%s, %d pentagon%s and %d larger face%s, each n-gon split into n "
-                        "quads", obj_path, mesh->remeshed, mesh->remesh_edge, r->quads, r->quads == 1 ? "" : "s",
+                        "quads", obj_path, mesh->remeshed, r->edge_length, r->quads, r->quads == 1 ? "" : "s",
                 r->triangles, r->triangles == 1 ? "" : "s", r->pentagons, r->pentagons == 1 ? "" : "s",
                 r->larger_faces, r->larger_faces == 1 ? "" : "s");
         if (r->folded_faces) fprintf(stderr, "; %d folded", r->folded_faces);

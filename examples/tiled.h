@@ -99,8 +99,7 @@ typedef struct tiled_mesh {
     int input_min_face_size, input_max_face_size;
     int repaired_edges;          /* edges --permissive cut open */
     int remeshed;                /* --remesh: the quads tt_remesh_quads made */
-    tt_remesh_report remesh;     /* ...and its report */
-    float remesh_edge;           /* ...and the edge length it was asked for (mesh units) */
+    tt_remesh_report remesh;     /* ...and its report (the quads' side: remesh.edge_length) */
     tt_mesh_stats input_stats;   /* --remesh: the OBJ's topology, to say where the new mesh differs */
     /* With --up or --constraints (else NULL and 0): */
     uint8_t *face_turn;          /* per quad: the half-edge its tile's bottom side lies on (tt_orient_tiles) */
