@@ -1977,6 +1977,16 @@ static void remesh_field_new(const tt_mesh *mesh, float **vectors, float **weigh
     remesh_field(mesh, 0, *vectors, *weights);
 }
 
+/* Options with this edge length and these face weights, the rest defaults. */
+static tt_remesh_options remesh_options(float edge_length, const float *weights)
+{
+    tt_remesh_options o;
+    memset(&o, 0, sizeof o);
+    o.edge_length = edge_length;
+    o.face_weights = weights;
+    return o;
+}
+
 /* The welded icosphere of radius 1 at `level` (make_icosphere), or NULL
    after a failed CHECK. */
 static tt_mesh *remesh_icosphere(int level)
@@ -2036,9 +2046,7 @@ static void test_remesh_sphere(void)
     mesh = remesh_icosphere(5);
     if (!mesh) return;
     remesh_field_new(mesh, &vec, &w);
-    memset(&o, 0, sizeof o);
-    o.edge_length = 0.15f;
-    o.face_weights = w;
+    o = remesh_options(0.15f, w);
     CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "remesh: %s", err.message);
     if (q) {
         CHECK(tt_mesh_compute_stats(q, NULL, &st, &err) == TT_OK && st.genus == 0 && st.components == 1 &&
@@ -2113,9 +2121,7 @@ static void test_remesh_topology(void)
     tm_free(&m);
     if (mesh) {
         remesh_field_new(mesh, &vec, &w);
-        memset(&o, 0, sizeof o);
-        o.edge_length = 0.25f;
-        o.face_weights = w;
+        o = remesh_options(0.25f, w);
         CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err) == TT_OK, "torus: %s", err.message);
         if (q)
             CHECK(tt_mesh_compute_stats(q, NULL, &st, &err) == TT_OK && st.genus == 1 && st.components == 1 &&
@@ -2143,9 +2149,7 @@ static void test_remesh_topology(void)
     if (mesh) {
         tt_remesh_report rep;
         remesh_field_new(mesh, &vec, &w);
-        memset(&o, 0, sizeof o);
-        o.edge_length = 0.3f;
-        o.face_weights = w;
+        o = remesh_options(0.3f, w);
         CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "tube: %s", err.message);
         if (q) {
             double median, share = remesh_aligned_share(q, &median);
@@ -2239,9 +2243,7 @@ static void test_remesh_creases(void)
     tm_free(&m);
     if (!mesh) return;
     remesh_field_new(mesh, &vec, &w);
-    memset(&o, 0, sizeof o);
-    o.edge_length = 0.2f;
-    o.face_weights = w;
+    o = remesh_options(0.2f, w);
     CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, &rep, &err) == TT_OK, "cube: %s", err.message);
     if (q) {
         gap = remesh_crease_gap(q);
@@ -2352,9 +2354,7 @@ static void test_remesh_errors(void)
         counter cnt;
         tt_allocator al = make_allocator(&cnt, -1);
         int calls, k, bad = 0;
-        memset(&o, 0, sizeof o);
-        o.edge_length = 0.3f;
-        o.face_weights = w;
+        o = remesh_options(0.3f, w);
         o.progress = remesh_progress_fn;
         o.progress_user_data = &p;
         memset(&p, 0, sizeof p);
