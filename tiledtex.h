@@ -607,6 +607,10 @@ typedef struct tt_remesh_report {
                                    at most 1.4 edge_length (0.7 lattice steps) apart */
     int triangles, quads, pentagons, larger_faces;  /* the lattice's faces by sides, before the split:
                                                        each n-gon gave n quads */
+    int thin_triangles;         /* lattice triangles with a vertex within 0.3 lattice steps of their
+                                   longest edge, joined to the face beyond that edge */
+    int merged_triangles;       /* then, pairs of lattice triangles on one edge made one quad (the edge
+                                   was a square's diagonal); both before the counts above */
     int folded_faces;           /* lattice faces turned against the surface's normal (kept) */
     int split_faces;            /* traced faces that met themselves at a vertex, split there */
     int split_vertices;         /* vertices duplicated so that each has one fan of faces */
@@ -6883,6 +6887,9 @@ static int tt__remesh_trace(const tt_allocator *al, tt__remesh_graph *g)
 {
     int nc = g->nclusters, round, e, c, k, ok = 0, *degree = NULL, *fill = NULL, *stack = NULL;
     double *angle = NULL;
+    /* (Traced again after edges are removed: the lists are rebuilt.) */
+    tt__free(al, g->start); tt__free(al, g->nbr); tt__free(al, g->nbr_edge);
+    tt__free(al, g->face_of); tt__free(al, g->face_start); tt__free(al, g->face_vert);
     degree = TT__ALLOC(al, int, (size_t)nc + 1);
     fill = TT__ALLOC(al, int, (size_t)nc + 1);
     stack = TT__ALLOC(al, int, (size_t)nc + 1);
@@ -6988,6 +6995,85 @@ static int tt__remesh_trace(const tt_allocator *al, tt__remesh_graph *g)
 done:
     tt__free(al, degree); tt__free(al, fill); tt__free(al, stack); tt__free(al, angle);
     return ok;
+}
+
+/* Lattice triangles the field got wrong, mended as Instant Meshes'
+   extraction does (Sec. 5 leaves them to the implementation). With
+   `thin`, a triangle whose vertex lies within 0.3 lattice steps of its
+   longest edge is a vertex that belongs on that edge: the edge is
+   removed, so the face beyond it takes the vertex as a corner instead of
+   the triangle folding its three quads. Otherwise, two triangles sharing
+   an edge are one square whose diagonal the classification kept (the
+   position field put its ends one step apart): the diagonal is removed,
+   the one closest to the length a square of those four sides would have
+   first, and the pair becomes one quad instead of two stars of turned
+   tiles. Each face loses at most one edge. Returns the number of edges
+   removed (the faces need tracing again), or -1 on allocation failure. */
+static int tt__remesh_merge_triangles(const tt_allocator *al, tt__remesh_graph *g, double rho, int thin)
+{
+    int entries = g->start[g->nclusters], ncandidates = 0, removed = 0, c, k, q;
+    tt__scored_edge *candidates = TT__ALLOC(al, tt__scored_edge, (size_t)entries / 2 + 1);
+    unsigned char *merged = TT__ALLOC(al, unsigned char, (size_t)g->nfaces + 1);
+    if (!candidates || !merged) {
+        tt__free(al, candidates);
+        tt__free(al, merged);
+        return -1;
+    }
+    memset(merged, 0, (size_t)g->nfaces + 1);
+    for (c = 0; c < g->nclusters; c++)
+        for (k = g->start[c]; k < g->start[c + 1]; k++) {
+            const double *pc = g->pos + 3 * (size_t)c, *pv;
+            int v = g->nbr[k], face[2], side, j, triangles = 0;
+            double sides = 0.0, d[3], edge[3], along[2], score = HUGE_VAL;
+            if (v < c) continue;
+            pv = g->pos + 3 * (size_t)v;
+            face[0] = g->face_of[k];
+            face[1] = -1;
+            for (q = g->start[v]; q < g->start[v + 1]; q++)
+                if (g->nbr[q] == c) { face[1] = g->face_of[q]; break; }
+            if (face[1] < 0 || face[0] == face[1]) continue;
+            for (j = 0; j < 3; j++) edge[j] = pv[j] - pc[j];
+            for (side = 0; side < 2; side++) {
+                int f = face[side], apex = -1;
+                const double *pa;
+                double cross[3], length = tt__length3(edge);
+                if (g->face_start[f + 1] - g->face_start[f] != 3) continue;
+                triangles++;
+                for (j = g->face_start[f]; j < g->face_start[f + 1]; j++)
+                    if (g->face_vert[j] != c && g->face_vert[j] != v) apex = g->face_vert[j];
+                pa = g->pos + 3 * (size_t)apex;
+                for (j = 0; j < 3; j++) d[j] = pa[j] - pc[j];
+                along[0] = tt__length3(d);
+                tt__cross3(edge, d, cross);
+                for (j = 0; j < 3; j++) d[j] = pa[j] - pv[j];
+                along[1] = tt__length3(d);
+                sides += along[0] + along[1];
+                /* The apex's height over (c, v), the triangle's longest edge. */
+                if (thin && length > fmax(along[0], along[1]) && tt__length3(cross) / length < 0.3 * rho)
+                    score = fmin(score, tt__length3(cross) / length / rho);
+            }
+            if (!thin) {
+                double diagonal = tt__length3(edge), square = 0.25 * sides * sqrt(2.0);
+                if (triangles < 2) continue;
+                score = fabs(diagonal - square) / fmax(1e-300, fmin(diagonal, square));
+            } else if (score == HUGE_VAL) {
+                continue;
+            }
+            candidates[ncandidates].score = score;
+            candidates[ncandidates].a = k;
+            candidates[ncandidates++].b = q;
+        }
+    qsort(candidates, (size_t)ncandidates, sizeof *candidates, tt__scored_edge_compare);
+    for (k = 0; k < ncandidates; k++) {
+        int f1 = g->face_of[candidates[k].a], f2 = g->face_of[candidates[k].b];
+        if (merged[f1] || merged[f2]) continue;
+        merged[f1] = merged[f2] = 1;
+        g->dead[g->nbr_edge[candidates[k].a]] = 1;
+        removed++;
+    }
+    tt__free(al, candidates);
+    tt__free(al, merged);
+    return removed;
 }
 
 /* The closest point to p on the faces around the members (level-0
@@ -7574,6 +7660,12 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     if (!tt__remesh_clusters(allocator, &levels[finest], work, ancestor, rho, &graph)) goto oom;
     if (tt__remesh_cancelled(&opt, 0.9)) goto cancelled;
     if (!tt__remesh_trace(allocator, &graph)) goto oom;
+    for (l = 1; l >= 0; l--) {
+        i = tt__remesh_merge_triangles(allocator, &graph, rho, l);
+        if (i < 0) goto oom;
+        if (l) rep.thin_triangles = i; else rep.merged_triangles = i;
+        if (i > 0 && !tt__remesh_trace(allocator, &graph)) goto oom;
+    }
     if (tt__remesh_cancelled(&opt, 0.95)) goto cancelled;
     {
         int *face_component = TT__ALLOC(allocator, int, mesh->nfaces);
