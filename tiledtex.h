@@ -611,6 +611,8 @@ typedef struct tt_remesh_report {
                                    longest edge, joined to the face beyond that edge */
     int merged_triangles;       /* then, pairs of lattice triangles on one edge made one quad (the edge
                                    was a square's diagonal); both before the counts above */
+    int cut_edges;              /* edges added across lattice faces of 6 sides or more, each cutting a
+                                   quad off (also before the counts above) */
     int folded_faces;           /* lattice faces turned against the surface's normal (kept) */
     int split_faces;            /* traced faces that met themselves at a vertex, split there */
     int split_vertices;         /* vertices duplicated so that each has one fan of faces */
@@ -7076,6 +7078,118 @@ static int tt__remesh_merge_triangles(const tt_allocator *al, tt__remesh_graph *
     return removed;
 }
 
+/* The angle at b of the corner a, b, c, in degrees. */
+static double tt__remesh_corner_degrees(const double *a, const double *b, const double *c)
+{
+    double u[3], v[3], cross[3];
+    int k;
+    for (k = 0; k < 3; k++) { u[k] = a[k] - b[k]; v[k] = c[k] - b[k]; }
+    tt__cross3(u, v, cross);
+    return atan2(tt__length3(cross), tt__dot3(u, v)) * (180.0 / TT__PI);
+}
+
+/* Whether key is in the ascending array sorted[0 .. n). */
+static int tt__u64_in(const uint64_t *sorted, int n, uint64_t key)
+{
+    int lo = 0, hi = n;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (sorted[mid] < key) lo = mid + 1; else hi = mid;
+    }
+    return lo < n && sorted[lo] == key;
+}
+
+/* A lattice face of six sides or more becomes quads where it can, before
+   the split into quads around a centre (which turns its tiles into a star
+   and folds some where the face is not convex): the quad of four
+   consecutive corners closest to square is cut off along a new edge, and
+   again while six or more corners are left, as Instant Meshes fills its
+   larger faces. A cut never joins two clusters an edge already joins.
+   Returns the number of edges added (the faces need tracing again), or -1
+   on allocation failure. */
+static int tt__remesh_cut_large_faces(const tt_allocator *al, tt__remesh_graph *g)
+{
+    int f, k, j, largest = 0, nadded = 0, cap_added = 0, live = 0, total, ok = 0;
+    int *corner = NULL;
+    uint64_t *added = NULL, *edges = NULL;
+    unsigned char *dead = NULL;
+    for (f = 0; f < g->nfaces; f++) largest = tt__max_i(largest, g->face_start[f + 1] - g->face_start[f]);
+    if (largest < 6) return 0;
+    corner = TT__ALLOC(al, int, (size_t)largest);
+    if (!corner) return -1;
+    for (f = 0; f < g->nfaces; f++) {
+        int size = g->face_start[f + 1] - g->face_start[f], repeated = 0;
+        if (size < 6) continue;
+        memcpy(corner, g->face_vert + g->face_start[f], (size_t)size * sizeof(int));
+        for (k = 0; k < size && !repeated; k++)
+            for (j = k + 1; j < size; j++) repeated |= corner[k] == corner[j];
+        if (repeated) continue;     /* a face that meets itself: the output splits it */
+        while (size >= 6) {
+            int best = -1;
+            double best_score = HUGE_VAL;
+            for (k = 0; k < size; k++) {
+                const double *p[4];
+                double score = 0.0, worst = 0.0;
+                int a = corner[k], b = corner[(k + 3) % size];
+                uint64_t key = a < b ? ((uint64_t)(uint32_t)a << 32) | (uint32_t)b
+                                     : ((uint64_t)(uint32_t)b << 32) | (uint32_t)a;
+                if (tt__u64_in(g->edges, g->nedges, key)) continue;
+                for (j = 0; j < 4; j++) p[j] = g->pos + 3 * (size_t)corner[(k + j) % size];
+                for (j = 0; j < 4; j++) {
+                    double off = fabs(tt__remesh_corner_degrees(p[(j + 3) & 3], p[j], p[(j + 1) & 3]) - 90.0);
+                    score += off;
+                    worst = fmax(worst, off);
+                }
+                if (worst < 45.0 && score < best_score) { best_score = score; best = k; }
+            }
+            if (best < 0) break;
+            {
+                int a = corner[best], b = corner[(best + 3) % size];
+                uint64_t *grown = (uint64_t *)tt__grow(al, added, &cap_added, nadded + 1, sizeof(uint64_t));
+                if (!grown) goto done;
+                added = grown;
+                added[nadded++] = a < b ? ((uint64_t)(uint32_t)a << 32) | (uint32_t)b
+                                        : ((uint64_t)(uint32_t)b << 32) | (uint32_t)a;
+            }
+            /* Drop the quad's two inner corners from the face. */
+            for (j = 0; j < 2; j++) {
+                int at = (best + 1) % size;
+                memmove(corner + at, corner + at + 1, (size_t)(size - at - 1) * sizeof(int));
+                size--;
+                if (at < best) best--;
+            }
+        }
+    }
+    ok = 1;
+    if (nadded == 0) goto done;
+    /* The live edges and the new ones, sorted and unique, all live. */
+    for (k = 0; k < g->nedges; k++) live += !g->dead[k];
+    total = live + nadded;
+    edges = TT__ALLOC(al, uint64_t, (size_t)total + 1);
+    dead = TT__ALLOC(al, unsigned char, (size_t)total + 1);
+    if (!edges || !dead) { ok = 0; goto done; }
+    for (k = 0, j = 0; k < g->nedges; k++)
+        if (!g->dead[k]) edges[j++] = g->edges[k];
+    memcpy(edges + live, added, (size_t)nadded * sizeof(uint64_t));
+    qsort(edges, (size_t)total, sizeof *edges, tt__u64_compare);
+    for (k = 0, j = 0; k < total; k++)
+        if (j == 0 || edges[k] != edges[j - 1]) edges[j++] = edges[k];
+    memset(dead, 0, (size_t)total + 1);
+    tt__free(al, g->edges);
+    tt__free(al, g->dead);
+    g->edges = edges;
+    g->dead = dead;
+    g->nedges = j;
+    edges = NULL;
+    dead = NULL;
+done:
+    tt__free(al, corner);
+    tt__free(al, added);
+    tt__free(al, edges);
+    tt__free(al, dead);
+    return ok ? nadded : -1;
+}
+
 /* The closest point to p on the faces around the members (level-0
    vertices, listed by head / next) of `count` clusters; or, with creases
    (per half-edge of m, NULL for none), the closest point on a crease edge
@@ -7388,15 +7502,30 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         float *pos = (float *)(*out_mesh)->pos;
         int c, edge = 0, face, around[3 * 64];
         for (c = 0; c < lattice->ncorners; c++) {
-            int t = lattice->twin[c], j;
+            int t = lattice->twin[c], j, count = 0, side;
+            float *at = pos + 3 * ((size_t)lattice->nverts + edge);
             double mid[3];
             if (t >= 0 && t < c) continue;
-            around[0] = out_cluster[lattice->corner_vert[c]];
-            around[1] = out_cluster[lattice->corner_vert[tt_mesh_next(lattice, c)]];
-            for (j = 0; j < 3; j++) mid[j] = pos[3 * ((size_t)lattice->nverts + edge) + j];
-            rep->snapped_vertices += tt__remesh_onto_input(m, member_head, member_next, around, 2, creases,
-                                                           0.5 * edge_length, edge_length, mid,
-                                                           pos + 3 * ((size_t)lattice->nverts + edge));
+            around[count++] = out_cluster[lattice->corner_vert[c]];
+            around[count++] = out_cluster[lattice->corner_vert[tt_mesh_next(lattice, c)]];
+            for (j = 0; j < 3; j++) mid[j] = at[j];
+            if (tt__remesh_onto_input(m, member_head, member_next, around, count, creases, 0.5 * edge_length,
+                                      edge_length, mid, at)) {
+                rep->snapped_vertices++;
+            } else if (at[0] == (float)mid[0] && at[1] == (float)mid[1] && at[2] == (float)mid[2]) {
+                /* Nothing within an edge near its ends: the middle of a long
+                   edge (a cut across a face) is nearer its faces' other
+                   corners. */
+                for (side = 0; side < 2; side++) {
+                    int first = side ? t : c, d = first;
+                    if (first < 0) continue;
+                    do {
+                        around[count++] = out_cluster[lattice->corner_vert[d]];
+                        d = tt_mesh_next(lattice, d);
+                    } while (d != first && count < 3 * 64);
+                }
+                tt__remesh_onto_input(m, member_head, member_next, around, count, NULL, 0.0, edge_length, mid, at);
+            }
             edge++;
         }
         for (face = 0; face < lattice->nfaces; face++) {
@@ -7666,6 +7795,10 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         if (l) rep.thin_triangles = i; else rep.merged_triangles = i;
         if (i > 0 && !tt__remesh_trace(allocator, &graph)) goto oom;
     }
+    i = tt__remesh_cut_large_faces(allocator, &graph);
+    if (i < 0) goto oom;
+    rep.cut_edges = i;
+    if (i > 0 && !tt__remesh_trace(allocator, &graph)) goto oom;
     if (tt__remesh_cancelled(&opt, 0.95)) goto cancelled;
     {
         int *face_component = TT__ALLOC(allocator, int, mesh->nfaces);
