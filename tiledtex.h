@@ -6288,6 +6288,18 @@ static int tt__u64_compare(const void *a, const void *b)
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
+/* The first of n keys, each `stride` entries apart in a (ascending),
+   that is not below key: n when there is none. */
+static int tt__u64_lower_bound(const uint64_t *a, int n, size_t stride, uint64_t key)
+{
+    int lo = 0, hi = n;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (a[stride * (size_t)mid] < key) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+}
+
 /* A pair of vertices and its score, sorted by score, then by the pair
    (the order is total, so the result does not depend on qsort). */
 typedef struct tt__scored_edge {
@@ -7088,17 +7100,6 @@ static double tt__remesh_corner_degrees(const double *a, const double *b, const 
     return atan2(tt__length3(cross), tt__dot3(u, v)) * (180.0 / TT__PI);
 }
 
-/* Whether key is in the ascending array sorted[0 .. n). */
-static int tt__u64_in(const uint64_t *sorted, int n, uint64_t key)
-{
-    int lo = 0, hi = n;
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        if (sorted[mid] < key) lo = mid + 1; else hi = mid;
-    }
-    return lo < n && sorted[lo] == key;
-}
-
 /* A lattice face of six sides or more becomes quads where it can, before
    the split into quads around a centre (which turns its tiles into a star
    and folds some where the face is not convex): the quad of four
@@ -7133,7 +7134,8 @@ static int tt__remesh_cut_large_faces(const tt_allocator *al, tt__remesh_graph *
                 int a = corner[k], b = corner[(k + 3) % size];
                 uint64_t key = a < b ? ((uint64_t)(uint32_t)a << 32) | (uint32_t)b
                                      : ((uint64_t)(uint32_t)b << 32) | (uint32_t)a;
-                if (tt__u64_in(g->edges, g->nedges, key)) continue;
+                j = tt__u64_lower_bound(g->edges, g->nedges, 1, key);
+                if (j < g->nedges && g->edges[j] == key) continue;
                 for (j = 0; j < 4; j++) p[j] = g->pos + 3 * (size_t)corner[(k + j) % size];
                 for (j = 0; j < 4; j++) {
                     double off = fabs(tt__remesh_corner_degrees(p[(j + 3) & 3], p[j], p[(j + 1) & 3]) - 90.0);
@@ -7390,12 +7392,9 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         int b = loop_start[q], s = loop_start[q + 1] - b;
         if (!keep[q]) continue;
         for (k = 0; k < s; k++) {
-            int v = loop_vert[b + k], w = loop_vert[b + (k + 1) % s], lo = 0, hi = nhalf;
+            int v = loop_vert[b + k], w = loop_vert[b + (k + 1) % s], lo;
             uint64_t twin = ((uint64_t)(uint32_t)w << 32) | (uint32_t)v;
-            while (lo < hi) {
-                int mid = lo + (hi - lo) / 2;
-                if (half[2 * (size_t)mid] < twin) lo = mid + 1; else hi = mid;
-            }
+            lo = tt__u64_lower_bound(half, nhalf, 2, twin);
             if (lo < nhalf && half[2 * (size_t)lo] == twin) {
                 int other = (int)half[2 * (size_t)lo + 1], x, y;
                 x = tt__find_root(corner_root, b + k);
