@@ -7254,6 +7254,61 @@ static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *n
     return crease_d <= snap * snap;
 }
 
+/* Of the quads first .. first + count - 1 of q (one face's split), how
+   many are folded: two corners on one point, or the two triangles on
+   either diagonal facing apart. */
+static int tt__remesh_folded_quads(const tt_mesh *q, int first, int count)
+{
+    int f, folded = 0;
+    for (f = first; f < first + count; f++) {
+        const int *v = q->corner_vert + q->face_start[f];
+        double e[4][3], a[3], b[3];
+        int i, k, bad = 0;
+        for (i = 0; i < 4; i++) tt__sub3f(q->pos + 3 * (size_t)v[(i + 1) & 3], q->pos + 3 * (size_t)v[i], e[i]);
+        for (i = 0; i < 4; i++) bad |= e[i][0] == 0.0 && e[i][1] == 0.0 && e[i][2] == 0.0;
+        for (k = 0; k < 2; k++) {
+            tt__cross3(e[k], e[k + 1], a);
+            tt__cross3(e[k + 2], e[(k + 3) & 3], b);
+            bad |= tt__dot3(a, b) < 0.0;
+        }
+        folded += bad;
+    }
+    return folded;
+}
+
+/* The area centroid of the polygon around a split face (quads first ..
+   first + count - 1 of q): with ring 0 of its edge points, with 1 of its
+   corners; triangles fanned from the points' mean, signed along their
+   summed normal. The mean when the area is zero. */
+static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int ring, double out[3])
+{
+    double mean[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 0.0}, sum[3] = {0.0, 0.0, 0.0}, weight = 0.0;
+    int i, k, pass;
+    for (pass = 0; pass < 3; pass++)
+        for (i = 0; i < count; i++) {
+            /* Quad i is (corner, edge point of half-edge i, centre, edge point of i - 1). */
+            const int *v = q->corner_vert + q->face_start[first + i];
+            const int *w = q->corner_vert + q->face_start[first + (i + 1) % count];
+            const float *p = q->pos + 3 * (size_t)(ring ? v[0] : v[1]);
+            const float *r = q->pos + 3 * (size_t)(ring ? w[0] : w[1]);
+            double a[3], b[3], cross[3], area;
+            if (pass == 0) {
+                for (k = 0; k < 3; k++) mean[k] += p[k] / (double)count;
+                continue;
+            }
+            for (k = 0; k < 3; k++) { a[k] = p[k] - mean[k]; b[k] = r[k] - mean[k]; }
+            tt__cross3(a, b, cross);
+            if (pass == 1) {
+                for (k = 0; k < 3; k++) normal[k] += cross[k];
+                continue;
+            }
+            area = tt__dot3(cross, normal);
+            weight += area;
+            for (k = 0; k < 3; k++) sum[k] += area * (mean[k] + (a[k] + b[k]) / 3.0);
+        }
+    for (k = 0; k < 3; k++) out[k] = weight != 0.0 ? sum[k] / weight : mean[k];
+}
+
 /* The output from the traced faces: a face that meets itself at a vertex
    is split there into simple loops; a loop facing against the surface
    with most of its vertices on the input's boundary, or one entirely on
@@ -7528,13 +7583,31 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             edge++;
         }
         for (face = 0; face < lattice->nfaces; face++) {
-            int count = 0, j;
+            int count = 0, j, ring, folded, best_folded, first = lattice->face_start[face];
+            int size = lattice->face_start[face + 1] - first;
             double centre[3];
-            float *at = pos + 3 * ((size_t)lattice->nverts + edge + face);
-            for (c = lattice->face_start[face]; c < lattice->face_start[face + 1] && count < 3 * 64; c++)
+            float *at = pos + 3 * ((size_t)lattice->nverts + edge + face), best[3];
+            for (c = first; c < first + size && count < 3 * 64; c++)
                 around[count++] = out_cluster[lattice->corner_vert[c]];
             for (j = 0; j < 3; j++) centre[j] = at[j];
             tt__remesh_onto_input(m, member_head, member_next, around, count, NULL, 0.0, edge_length, centre, at);
+            /* A face that is not convex can fold some of its quads about
+               the mean of its corners: the area centroid of its edge points'
+               polygon, or of its corners', may fold fewer. */
+            best_folded = tt__remesh_folded_quads(*out_mesh, first, size);
+            memcpy(best, at, sizeof best);
+            for (ring = 0; ring < 2 && best_folded > 0; ring++) {
+                double candidate[3];
+                tt__remesh_ring_centroid(*out_mesh, first, size, ring, candidate);
+                tt__remesh_onto_input(m, member_head, member_next, around, count, NULL, 0.0, edge_length,
+                                      candidate, at);
+                folded = tt__remesh_folded_quads(*out_mesh, first, size);
+                if (folded < best_folded) {
+                    best_folded = folded;
+                    memcpy(best, at, sizeof best);
+                }
+            }
+            memcpy(at, best, sizeof best);
         }
     }
     goto done;
