@@ -327,19 +327,19 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
         double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
         tt_remesh_options ro;
         tt_mesh *rq = (tt_mesh *)&err;   /* must be set to NULL on failure */
-        int f, c, k;
+        int face, corner, k;
         CHECK(vectors != NULL, "out of memory");
-        for (f = 0; f < m->nfaces; f++) {
-            const float *p0 = m->pos + 3 * m->corner_vert[m->face_start[f]];
-            const float *p1 = m->pos + 3 * m->corner_vert[m->face_start[f] + 1];
-            for (k = 0; k < 3; k++) vectors[3 * f + k] = (float)((double)p1[k] - p0[k]);
+        for (face = 0; face < m->nfaces; face++) {
+            const float *p0 = m->pos + 3 * m->corner_vert[m->face_start[face]];
+            const float *p1 = m->pos + 3 * m->corner_vert[m->face_start[face] + 1];
+            for (k = 0; k < 3; k++) vectors[3 * face + k] = (float)((double)p1[k] - p0[k]);
             for (k = 0; k < 3; k++)
-                if (!(fabsf(vectors[3 * f + k]) <= FLT_MAX)) vectors[3 * f + k] = 0.0f;
+                if (!(fabsf(vectors[3 * face + k]) <= FLT_MAX)) vectors[3 * face + k] = 0.0f;
         }
-        for (c = 0; c < m->ncorners; c++)
+        for (corner = 0; corner < m->ncorners; corner++)
             for (k = 0; k < 3; k++) {
-                lo[k] = fmin(lo[k], m->pos[3 * m->corner_vert[c] + k]);
-                hi[k] = fmax(hi[k], m->pos[3 * m->corner_vert[c] + k]);
+                lo[k] = fmin(lo[k], m->pos[3 * m->corner_vert[corner] + k]);
+                hi[k] = fmax(hi[k], m->pos[3 * m->corner_vert[corner] + k]);
             }
         memset(&ro, 0, sizeof ro);
         ro.edge_length = (float)(0.124 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
