@@ -7572,11 +7572,11 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
                    corners. */
                 for (side = 0; side < 2; side++) {
                     int first = side ? t : c, d = first;
-                    if (first < 0) continue;
-                    do {
+                    while (first >= 0 && count < 3 * 64) {
                         around[count++] = out_cluster[lattice->corner_vert[d]];
                         d = tt_mesh_next(lattice, d);
-                    } while (d != first && count < 3 * 64);
+                        if (d == first) break;
+                    }
                 }
                 tt__remesh_onto_input(m, member_head, member_next, around, count, NULL, 0.0, edge_length, mid, at);
             }
