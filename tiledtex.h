@@ -627,7 +627,11 @@ typedef struct tt_remesh_report {
    it has the input's holes larger than about two edges. The quads come in
    rows along the field; where a row ends and at the field's singularities
    the lattice has a triangle or a pentagon, split into three or five quads
-   around its centre (vertices of valence 3 or 5).
+   around its centre (vertices of valence 3 or 5). Before that split, the
+   lattice is mended: a thin triangle gives its longest edge to the face
+   beyond, two triangles on one edge become one quad, and a face of six
+   sides or more loses quads to cuts where they can be near square (the
+   report counts each).
 
    The result is always a mesh tt_mesh_build accepts (strict): each vertex
    has one fan of faces (duplicated otherwise), no face repeats a vertex.
