@@ -613,6 +613,10 @@ typedef struct tt_remesh_report {
                                    was a square's diagonal); both before the counts above */
     int cut_edges;              /* edges added across lattice faces of 6 sides or more, each cutting a
                                    quad off (also before the counts above) */
+    int merged_doublets;        /* output vertices with two quads sharing both their edges, removed and
+                                   the two quads made one (not at a thin part's tip) */
+    int unmoved_points;         /* new points of the split left off the input, where moving them onto
+                                   it gave a quad of zero area */
     int folded_faces;           /* lattice faces turned against the surface's normal (kept) */
     int split_faces;            /* traced faces that met themselves at a vertex, split there */
     int split_vertices;         /* vertices duplicated so that each has one fan of faces */
@@ -655,7 +659,8 @@ typedef struct tt_remesh_report {
    TT_ERROR_NON_FINITE; a mesh without faces: TT_ERROR_EMPTY_MESH; a mesh
    with no extent: TT_ERROR_ZERO_AREA_FACE; an edge_length so small that
    the refined input would pass TT_MAX_REMESH_VERTICES: TT_ERROR_TOO_LARGE;
-   a field so inconsistent that no face could be traced:
+   a field so inconsistent that no face could be traced, or a quad whose
+   corners float cannot part (a tiny face far from the origin):
    TT_ERROR_NOT_CONVERGED; TT_CANCELLED by options->progress;
    TT_ERROR_OUT_OF_MEMORY. Deterministic; the result is built with
    `allocator` and freed with tt_mesh_free. */
@@ -7258,26 +7263,118 @@ static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *n
     return crease_d <= snap * snap;
 }
 
+/* Whether the quad of vertices v[0..3] is folded: an edge of zero length,
+   or the two triangles on either diagonal facing apart. */
+static int tt__quad_is_folded(const float *pos, const int v[4])
+{
+    double e[4][3], a[3], b[3];
+    int i, k, bad = 0;
+    for (i = 0; i < 4; i++) tt__sub3f(pos + 3 * (size_t)v[(i + 1) & 3], pos + 3 * (size_t)v[i], e[i]);
+    for (i = 0; i < 4; i++) bad |= e[i][0] == 0.0 && e[i][1] == 0.0 && e[i][2] == 0.0;
+    for (k = 0; k < 2; k++) {
+        tt__cross3(e[k], e[k + 1], a);
+        tt__cross3(e[k + 2], e[(k + 3) & 3], b);
+        bad |= tt__dot3(a, b) < 0.0;
+    }
+    return bad;
+}
+
 /* Of the quads first .. first + count - 1 of q (one face's split), how
-   many are folded: two corners on one point, or the two triangles on
-   either diagonal facing apart. */
+   many are folded. */
 static int tt__remesh_folded_quads(const tt_mesh *q, int first, int count)
 {
     int f, folded = 0;
-    for (f = first; f < first + count; f++) {
-        const int *v = q->corner_vert + q->face_start[f];
-        double e[4][3], a[3], b[3];
-        int i, k, bad = 0;
-        for (i = 0; i < 4; i++) tt__sub3f(q->pos + 3 * (size_t)v[(i + 1) & 3], q->pos + 3 * (size_t)v[i], e[i]);
-        for (i = 0; i < 4; i++) bad |= e[i][0] == 0.0 && e[i][1] == 0.0 && e[i][2] == 0.0;
-        for (k = 0; k < 2; k++) {
-            tt__cross3(e[k], e[k + 1], a);
-            tt__cross3(e[k + 2], e[(k + 3) & 3], b);
-            bad |= tt__dot3(a, b) < 0.0;
-        }
-        folded += bad;
-    }
+    for (f = first; f < first + count; f++) folded += tt__quad_is_folded(q->pos, q->corner_vert + q->face_start[f]);
     return folded;
+}
+
+/* A vertex inside the surface with two quads, which share both its edges
+   (a doublet: a lattice vertex with two edges), turns the tiles of both
+   into thin wedges. The two become one quad, the vertex gone, where that
+   quad is not folded and the vertex lies within a quarter edge of its
+   plane (a doublet at a thin part's tip, an ear's, keeps the tip). *mesh
+   is replaced; returns 0 on allocation failure (*mesh then unchanged). */
+static int tt__remesh_merge_doublets(const tt_allocator *al, tt_mesh **mesh, double edge_length, int *merged)
+{
+    tt_mesh *q = *mesh, *rebuilt = NULL;
+    int *gone_face = NULL, *new_id = NULL, *indices = NULL, *sizes = NULL, *extra = NULL;
+    float *positions = NULL;
+    int v, f, k, nextra = 0, nverts = 0, nfaces = 0, ncorners = 0, ok = 0;
+    tt_mesh_desc desc;
+    gone_face = TT__ALLOC(al, int, (size_t)q->nfaces + 1);
+    new_id = TT__ALLOC(al, int, (size_t)q->nverts + 1);
+    extra = TT__ALLOC(al, int, 4 * (size_t)q->nverts + 4);      /* a quad per vertex at most */
+    if (!gone_face || !new_id || !extra) goto done;
+    memset(gone_face, 0, ((size_t)q->nfaces + 1) * sizeof(int));
+    for (v = 0; v < q->nverts; v++) {
+        int c0 = q->vert_corner[v], c1, t0, t1, f1, f2, quad[4], a, b;
+        double d1[3], d2[3], normal[3], centre[3], away[3], length;
+        new_id[v] = 0;
+        if (c0 < 0 || (t0 = q->twin[tt_mesh_prev(q, c0)]) < 0) continue;
+        c1 = t0;    /* the corner at v of the next face around it */
+        if ((t1 = q->twin[tt_mesh_prev(q, c1)]) != c0) continue;     /* not two faces */
+        f1 = q->corner_face[c0];
+        f2 = q->corner_face[c1];
+        if (f1 == f2 || gone_face[f1] || gone_face[f2] || q->twin[c0] < 0 || q->twin[c1] < 0) continue;
+        a = q->corner_vert[tt_mesh_next(q, c0)];
+        b = q->corner_vert[tt_mesh_prev(q, c0)];
+        if (q->corner_vert[tt_mesh_next(q, c1)] != b || q->corner_vert[tt_mesh_prev(q, c1)] != a || a == b) continue;
+        quad[0] = a;
+        quad[1] = q->corner_vert[tt_mesh_next(q, tt_mesh_next(q, c0))];
+        quad[2] = b;
+        quad[3] = q->corner_vert[tt_mesh_next(q, tt_mesh_next(q, c1))];
+        if (quad[1] == quad[3] || tt__quad_is_folded(q->pos, quad)) continue;
+        tt__sub3f(q->pos + 3 * (size_t)quad[2], q->pos + 3 * (size_t)quad[0], d1);
+        tt__sub3f(q->pos + 3 * (size_t)quad[3], q->pos + 3 * (size_t)quad[1], d2);
+        tt__cross3(d1, d2, normal);
+        length = tt__length3(normal);
+        if (!(length > 0.0)) continue;
+        for (k = 0; k < 3; k++)
+            centre[k] = 0.25 * ((double)q->pos[3 * (size_t)quad[0] + k] + q->pos[3 * (size_t)quad[1] + k] +
+                                q->pos[3 * (size_t)quad[2] + k] + q->pos[3 * (size_t)quad[3] + k]);
+        for (k = 0; k < 3; k++) away[k] = q->pos[3 * (size_t)v + k] - centre[k];
+        if (fabs(tt__dot3(away, normal)) / length > 0.25 * edge_length) continue;
+        gone_face[f1] = gone_face[f2] = 1;
+        new_id[v] = -1;
+        memcpy(extra + 4 * (size_t)nextra, quad, sizeof quad);
+        nextra++;
+    }
+    *merged = nextra;
+    if (nextra == 0) { ok = 1; goto done; }
+    for (v = 0; v < q->nverts; v++) new_id[v] = new_id[v] < 0 ? -1 : nverts++;
+    positions = TT__ALLOC(al, float, 3 * (size_t)nverts + 3);
+    indices = TT__ALLOC(al, int, (size_t)q->ncorners + 1);
+    sizes = TT__ALLOC(al, int, (size_t)q->nfaces + 1);
+    if (!positions || !indices || !sizes) goto done;
+    for (v = 0; v < q->nverts; v++)
+        if (new_id[v] >= 0) memcpy(positions + 3 * (size_t)new_id[v], q->pos + 3 * (size_t)v, 3 * sizeof(float));
+    for (f = 0; f < q->nfaces; f++) {
+        if (gone_face[f]) continue;
+        for (k = q->face_start[f]; k < q->face_start[f + 1]; k++) indices[ncorners++] = new_id[q->corner_vert[k]];
+        sizes[nfaces++] = q->face_start[f + 1] - q->face_start[f];
+    }
+    for (f = 0; f < nextra; f++) {
+        for (k = 0; k < 4; k++) indices[ncorners++] = new_id[extra[4 * (size_t)f + k]];
+        sizes[nfaces++] = 4;
+    }
+    memset(&desc, 0, sizeof desc);
+    desc.positions = positions;
+    desc.nverts = nverts;
+    desc.indices = indices;
+    desc.face_sizes = sizes;
+    desc.nfaces = nfaces;
+    if (tt_mesh_build(&desc, al, &rebuilt, NULL) == TT_ERROR_OUT_OF_MEMORY) goto done;
+    ok = 1;
+    if (rebuilt) {
+        tt_mesh_free(q);
+        *mesh = rebuilt;
+    } else {
+        *merged = 0;    /* never expected: the doublets' quads keep the mesh valid */
+    }
+done:
+    tt__free(al, gone_face); tt__free(al, new_id); tt__free(al, extra); tt__free(al, positions);
+    tt__free(al, indices); tt__free(al, sizes);
+    return ok;
 }
 
 /* The area centroid of the polygon around a split face (quads first ..
@@ -7331,7 +7428,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     int *member_head = NULL, *member_next = NULL, *out_id = NULL, *indices = NULL, *sizes = NULL;
     unsigned char *keep = NULL;
     uint64_t *half = NULL;      /* pairs: (a << 32 | b, the corner at b of the loop running a -> b) */
-    float *positions = NULL, *surface = NULL;
+    float *positions = NULL, *surface = NULL, *straight = NULL;
     int *out_cluster = NULL;    /* per output vertex of the lattice mesh: its cluster */
     tt_mesh *lattice = NULL;    /* the traced faces, before the split */
     tt_mesh_desc desc;
@@ -7556,6 +7653,9 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
        knob, would otherwise reach for it in a spike). */
     result = tt_mesh_quadrangulate(lattice, TT_SUBDIVIDE_LINEAR, al, out_mesh, error);
     if (result != TT_OK) goto done;
+    straight = TT__ALLOC(al, float, 3 * (size_t)(*out_mesh)->nverts + 3);
+    if (!straight) goto fail;
+    memcpy(straight, (*out_mesh)->pos, 3 * (size_t)(*out_mesh)->nverts * sizeof(float));
     {
         float *pos = (float *)(*out_mesh)->pos;
         int c, edge = 0, face, around[3 * 64];
@@ -7613,7 +7713,35 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
             }
             memcpy(at, best, sizeof best);
         }
+        /* A quad two of whose corners those moves put on one point (two
+           edge points onto one point of a crease or a tip), or all on one
+           line, keeps its new points where the split put them: the result
+           stays a mesh tt_mesh_build accepts, of quads with four corners. */
+        for (face = 0; face < (*out_mesh)->nfaces; face++) {
+            const int *v = (*out_mesh)->corner_vert + (*out_mesh)->face_start[face];
+            int same = 0, other;
+            for (c = 0; c < 4; c++)
+                for (other = c + 1; other < 4; other++)
+                    same |= memcmp(pos + 3 * (size_t)v[c], pos + 3 * (size_t)v[other], 3 * sizeof(float)) == 0;
+            if (!same && !tt__face_has_zero_area(pos, v, 4)) continue;
+            for (c = 0; c < 4; c++)
+                if (v[c] >= lattice->nverts) {
+                    memcpy(pos + 3 * (size_t)v[c], straight + 3 * (size_t)v[c], 3 * sizeof(float));
+                    rep->unmoved_points++;
+                }
+        }
+        /* Where even the split's own points make a quad of zero area (float
+           cannot part them: a tiny lattice face far from the origin), there
+           is no valid result at this edge length. */
+        for (face = 0; face < (*out_mesh)->nfaces; face++)
+            if (tt__face_has_zero_area(pos, (*out_mesh)->corner_vert + (*out_mesh)->face_start[face], 4)) {
+                result = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
+                                  "remeshing made a quad of zero area (float cannot part its corners): try "
+                                  "another edge_length");
+                goto done;
+            }
     }
+    if (!tt__remesh_merge_doublets(al, out_mesh, edge_length, &rep->merged_doublets)) goto fail;
     goto done;
 fail:
     result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory");
@@ -7623,6 +7751,7 @@ done:
     tt__free(al, loop_root); tt__free(al, piece_size); tt__free(al, vertex_root); tt__free(al, vertex_of);
     tt__free(al, member_head); tt__free(al, member_next); tt__free(al, out_id); tt__free(al, positions);
     tt__free(al, indices); tt__free(al, sizes); tt__free(al, surface); tt__free(al, out_cluster);
+    tt__free(al, straight);
     tt_mesh_free(lattice);
     if (result != TT_OK && *out_mesh) {
         tt_mesh_free(*out_mesh);
