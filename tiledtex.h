@@ -627,15 +627,17 @@ typedef struct tt_remesh_report {
 /* A new mesh of quads of side about edge_length whose edges follow
    face_vectors (3 * mesh->nfaces floats, each in its face's plane, as
    tt_tangent_field makes them; only directions count, and a direction and
-   its quarter turns are the same). Every vertex lies on the input's faces;
+   its quarter turns are the same). Every vertex lies on the input's faces
+   (but the few points a quad would fold flat on, report->unmoved_points);
    it has the input's holes larger than about two edges. The quads come in
    rows along the field; where a row ends and at the field's singularities
    the lattice has a triangle or a pentagon, split into three or five quads
    around its centre (vertices of valence 3 or 5). Before that split, the
    lattice is mended: a thin triangle gives its longest edge to the face
    beyond, two triangles on one edge become one quad, and a face of six
-   sides or more loses quads to cuts where they can be near square (the
-   report counts each).
+   sides or more loses quads to cuts where they can be near square; after
+   it, a vertex whose two quads share both its edges goes, the two made
+   one (the report counts each).
 
    The result is always a mesh tt_mesh_build accepts (strict): each vertex
    has one fan of faces (duplicated otherwise), no face repeats a vertex.
