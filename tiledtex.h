@@ -7034,7 +7034,7 @@ done:
    first, and the pair becomes one quad instead of two stars of turned
    tiles. Each face loses at most one edge. Returns the number of edges
    removed (the faces need tracing again), or -1 on allocation failure. */
-static int tt__remesh_merge_triangles(const tt_allocator *al, tt__remesh_graph *g, double rho, int thin)
+static int tt__remesh_mend_triangles(const tt_allocator *al, tt__remesh_graph *g, double rho, int thin)
 {
     int entries = g->start[g->nclusters], ncandidates = 0, removed = 0, c, k, q;
     tt__scored_edge *candidates = TT__ALLOC(al, tt__scored_edge, (size_t)entries / 2 + 1);
@@ -7997,7 +7997,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     if (tt__remesh_cancelled(&opt, 0.9)) goto cancelled;
     if (!tt__remesh_trace(allocator, &graph)) goto oom;
     for (l = 1; l >= 0; l--) {
-        i = tt__remesh_merge_triangles(allocator, &graph, rho, l);
+        i = tt__remesh_mend_triangles(allocator, &graph, rho, l);
         if (i < 0) goto oom;
         if (l) rep.thin_triangles = i; else rep.merged_triangles = i;
         if (i > 0 && !tt__remesh_trace(allocator, &graph)) goto oom;
