@@ -4706,12 +4706,15 @@ TTDEF void tt_mesh_free(tt_mesh *mesh)
     tt__free(&allocator, mesh);
 }
 
+/* Two non-negative ints as one 64-bit sort key, high first. */
+static uint64_t tt__pair_key(int high, int low) { return ((uint64_t)(uint32_t)high << 32) | (uint32_t)low; }
+
 /* A half-edge in the bucket of its edge's smaller vertex, as one sort key:
    the larger vertex in the high 32 bits, corner_dir = 2 * corner + 1 when the
    half-edge runs from the larger vertex to the smaller in the low ones. Both
    halves of an edge share one bucket, so pairing never has to look into
    another vertex's bucket. */
-#define TT__EDGE_KEY(other, corner_dir) (((uint64_t)(uint32_t)(other) << 32) | (uint32_t)(corner_dir))
+#define TT__EDGE_KEY(other, corner_dir) tt__pair_key(other, corner_dir)
 #define TT__KEY_OTHER(key) ((int)((key) >> 32))
 #define TT__KEY_CORNER_DIR(key) ((int)((key) & 0xffffffffu))
 
@@ -4942,17 +4945,24 @@ TTDEF void tt_face_normal(const tt_mesh *mesh, int face, float normal[3])
 
 #define TT__NOT_WRITTEN 2.0f
 
+/* The angle between u and v in radians (0 when one is zero). */
+static double tt__angle3(const double *u, const double *v)
+{
+    double cross[3];
+    tt__cross3(u, v, cross);
+    return atan2(tt__length3(cross), tt__dot3(u, v));
+}
+
 /* The angle of face corner c between its two edges (0 for a degenerate one). */
 static double tt__corner_angle(const tt_mesh *mesh, int c)
 {
     const float *p = mesh->pos + 3 * (size_t)mesh->corner_vert[c];
     const float *a = mesh->pos + 3 * (size_t)mesh->corner_vert[tt__next(mesh, c)];
     const float *b = mesh->pos + 3 * (size_t)mesh->corner_vert[tt__prev(mesh, c)];
-    double u[3], v[3], cross[3];
+    double u[3], v[3];
     tt__sub3f(a, p, u);
     tt__sub3f(b, p, v);
-    tt__cross3(u, v, cross);
-    return atan2(tt__length3(cross), tt__dot3(u, v));
+    return tt__angle3(u, v);
 }
 
 TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, const tt_allocator *allocator,
@@ -6881,7 +6891,7 @@ static int tt__remesh_clusters(const tt_allocator *al, const tt__remesh_level *l
         int a = g->cluster[unit[2 * k]], b = g->cluster[unit[2 * k + 1]];
         if (a == b) continue;
         if (a > b) { int t = a; a = b; b = t; }
-        g->edges[g->nedges++] = ((uint64_t)(uint32_t)a << 32) | (uint32_t)b;
+        g->edges[g->nedges++] = tt__pair_key(a, b);
     }
     qsort(g->edges, (size_t)g->nedges, sizeof *g->edges, tt__u64_compare);
     {
@@ -7049,7 +7059,7 @@ static int tt__remesh_mend_triangles(const tt_allocator *al, tt__remesh_graph *g
         for (k = g->start[c]; k < g->start[c + 1]; k++) {
             const double *pc = g->pos + 3 * (size_t)c, *pv;
             int v = g->nbr[k], face[2], side, j, triangles = 0;
-            double sides = 0.0, d[3], edge[3], along[2], score = HUGE_VAL;
+            double sides = 0.0, d[3], edge[3], along[2], length, score = HUGE_VAL;
             if (v < c) continue;
             pv = g->pos + 3 * (size_t)v;
             face[0] = g->face_of[k];
@@ -7058,10 +7068,11 @@ static int tt__remesh_mend_triangles(const tt_allocator *al, tt__remesh_graph *g
                 if (g->nbr[q] == c) { face[1] = g->face_of[q]; break; }
             if (face[1] < 0 || face[0] == face[1]) continue;
             for (j = 0; j < 3; j++) edge[j] = pv[j] - pc[j];
+            length = tt__length3(edge);
             for (side = 0; side < 2; side++) {
                 int f = face[side], apex = -1;
                 const double *pa;
-                double cross[3], length = tt__length3(edge);
+                double cross[3], height;
                 if (g->face_start[f + 1] - g->face_start[f] != 3) continue;
                 triangles++;
                 for (j = g->face_start[f]; j < g->face_start[f + 1]; j++)
@@ -7074,13 +7085,14 @@ static int tt__remesh_mend_triangles(const tt_allocator *al, tt__remesh_graph *g
                 along[1] = tt__length3(d);
                 sides += along[0] + along[1];
                 /* The apex's height over (c, v), the triangle's longest edge. */
-                if (thin && length > fmax(along[0], along[1]) && tt__length3(cross) / length < 0.3 * rho)
-                    score = fmin(score, tt__length3(cross) / length / rho);
+                height = tt__length3(cross) / length;
+                if (thin && length > fmax(along[0], along[1]) && height < 0.3 * rho)
+                    score = fmin(score, height / rho);
             }
             if (!thin) {
-                double diagonal = tt__length3(edge), square = 0.25 * sides * sqrt(2.0);
+                double square = 0.25 * sides * sqrt(2.0);
                 if (triangles < 2) continue;
-                score = fabs(diagonal - square) / fmax(1e-300, fmin(diagonal, square));
+                score = fabs(length - square) / fmax(1e-300, fmin(length, square));
             } else if (score == HUGE_VAL) {
                 continue;
             }
@@ -7099,16 +7111,6 @@ static int tt__remesh_mend_triangles(const tt_allocator *al, tt__remesh_graph *g
     tt__free(al, candidates);
     tt__free(al, merged);
     return removed;
-}
-
-/* The angle at b of the corner a, b, c, in degrees. */
-static double tt__remesh_corner_degrees(const double *a, const double *b, const double *c)
-{
-    double u[3], v[3], cross[3];
-    int k;
-    for (k = 0; k < 3; k++) { u[k] = a[k] - b[k]; v[k] = c[k] - b[k]; }
-    tt__cross3(u, v, cross);
-    return atan2(tt__length3(cross), tt__dot3(u, v)) * (180.0 / TT__PI);
 }
 
 /* A lattice face of six sides or more becomes quads where it can, before
@@ -7143,17 +7145,22 @@ static int tt__remesh_cut_large_faces(const tt_allocator *al, tt__remesh_graph *
                 const double *p[4];
                 double score = 0.0, worst = 0.0;
                 int a = corner[k], b = corner[(k + 3) % size];
-                uint64_t key = a < b ? ((uint64_t)(uint32_t)a << 32) | (uint32_t)b
-                                     : ((uint64_t)(uint32_t)b << 32) | (uint32_t)a;
+                uint64_t key = tt__pair_key(tt__min_i(a, b), tt__max_i(a, b));
                 j = tt__u64_lower_bound(g->edges, g->nedges, 1, key);
                 if (j < g->nedges && g->edges[j] == key) continue;
                 for (j = 0; j < 4; j++) p[j] = g->pos + 3 * (size_t)corner[(k + j) % size];
                 for (j = 0; j < 4; j++) {
-                    double off = fabs(tt__remesh_corner_degrees(p[(j + 3) & 3], p[j], p[(j + 1) & 3]) - 90.0);
+                    double u[3], w[3], off;
+                    int i;
+                    for (i = 0; i < 3; i++) {
+                        u[i] = p[(j + 3) & 3][i] - p[j][i];
+                        w[i] = p[(j + 1) & 3][i] - p[j][i];
+                    }
+                    off = fabs(tt__angle3(u, w) - 0.5 * TT__PI);
                     score += off;
                     worst = fmax(worst, off);
                 }
-                if (worst < 45.0 && score < best_score) { best_score = score; best = k; }
+                if (worst < 0.25 * TT__PI && score < best_score) { best_score = score; best = k; }
             }
             if (best < 0) break;
             {
@@ -7161,8 +7168,7 @@ static int tt__remesh_cut_large_faces(const tt_allocator *al, tt__remesh_graph *
                 uint64_t *grown = (uint64_t *)tt__grow(al, added, &cap_added, nadded + 1, sizeof(uint64_t));
                 if (!grown) goto done;
                 added = grown;
-                added[nadded++] = a < b ? ((uint64_t)(uint32_t)a << 32) | (uint32_t)b
-                                        : ((uint64_t)(uint32_t)b << 32) | (uint32_t)a;
+                added[nadded++] = tt__pair_key(tt__min_i(a, b), tt__max_i(a, b));
             }
             /* Drop the quad's two inner corners from the face. */
             for (j = 0; j < 2; j++) {
@@ -7203,18 +7209,35 @@ done:
     return ok ? nadded : -1;
 }
 
+/* The traced lattice mended, each step traced again when it changed
+   something: thin triangles, then pairs of triangles, then faces of six
+   sides or more. Returns 0 on allocation failure. */
+static int tt__remesh_mend_lattice(const tt_allocator *al, tt__remesh_graph *g, double rho, tt_remesh_report *rep)
+{
+    int step;
+    for (step = 0; step < 3; step++) {
+        int changed = step < 2 ? tt__remesh_mend_triangles(al, g, rho, step == 0) : tt__remesh_cut_large_faces(al, g);
+        if (changed < 0) return 0;
+        if (step == 0) rep->thin_triangles = changed;
+        else if (step == 1) rep->merged_triangles = changed;
+        else rep->cut_edges = changed;
+        if (changed > 0 && !tt__remesh_trace(al, g)) return 0;
+    }
+    return 1;
+}
+
 /* The closest point to p on the faces around the members (level-0
    vertices, listed by head / next) of `count` clusters; or, with creases
    (per half-edge of m, NULL for none), the closest point on a crease edge
    of those faces when one lies within `snap` of p; p itself when the
-   closest point is farther than `reach`. Returns whether it snapped. */
+   closest point is farther than `reach`. Returns 2 when it snapped onto a
+   crease, 1 when it moved onto a face, 0 when it kept p. */
 static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *next, const int *clusters, int count,
                                  const unsigned char *creases, double snap, double reach, const double *p,
                                  float *out)
 {
-    double best[3], best_d = HUGE_VAL, on_crease[3], crease_d = HUGE_VAL;
-    int i, j, n;
-    memcpy(best, p, sizeof best);
+    double best[3] = {0.0, 0.0, 0.0}, best_d = HUGE_VAL, on_crease[3] = {0.0, 0.0, 0.0}, crease_d = HUGE_VAL;
+    int i, j, n, moved;
     for (n = 0; n < count; n++)
     for (i = head[clusters[n]]; i >= 0; i = next[i]) {
         int c0 = m->vert_corner[i], c = c0, steps = 0;
@@ -7259,10 +7282,13 @@ static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *n
             c = m->twin[tt_mesh_prev(m, c)];
         } while (c >= 0 && c != c0 && ++steps < m->ncorners);
     }
-    if (crease_d <= snap * snap) memcpy(best, on_crease, sizeof best);
-    else if (best_d > reach * reach) memcpy(best, p, sizeof best);
-    for (j = 0; j < 3; j++) out[j] = (float)best[j];
-    return crease_d <= snap * snap;
+    if (crease_d < HUGE_VAL && crease_d <= snap * snap) {
+        for (j = 0; j < 3; j++) out[j] = (float)on_crease[j];
+        return 2;
+    }
+    moved = best_d < HUGE_VAL && best_d <= reach * reach;
+    for (j = 0; j < 3; j++) out[j] = (float)(moved ? best[j] : p[j]);
+    return moved;
 }
 
 /* Whether the quad of vertices v[0..3] is folded: an edge of zero length,
@@ -7379,6 +7405,13 @@ done:
     return ok;
 }
 
+static const float *tt__remesh_ring_point(const tt_mesh *q, int first, int count, int ring, int i)
+{
+    /* Quad i is (corner, edge point of half-edge i, centre, edge point of
+       i - 1): its corner 0 or 1 is the ring's point i. */
+    return q->pos + 3 * (size_t)q->corner_vert[q->face_start[first + i % count] + (ring ? 0 : 1)];
+}
+
 /* The area centroid of the polygon around a split face (quads first ..
    first + count - 1 of q): with ring 0 of its edge points, with 1 of its
    corners; triangles fanned from the points' mean, signed along their
@@ -7386,22 +7419,19 @@ done:
 static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int ring, double out[3])
 {
     double mean[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 0.0}, sum[3] = {0.0, 0.0, 0.0}, weight = 0.0;
+    double a[3], b[3], cross[3];
     int i, k, pass;
-    for (pass = 0; pass < 3; pass++)
+    for (i = 0; i < count; i++)
+        for (k = 0; k < 3; k++) mean[k] += tt__remesh_ring_point(q, first, count, ring, i)[k] / (double)count;
+    /* The fan's summed normal first, then each triangle's area along it. */
+    for (pass = 0; pass < 2; pass++)
         for (i = 0; i < count; i++) {
-            /* Quad i is (corner, edge point of half-edge i, centre, edge point of i - 1). */
-            const int *v = q->corner_vert + q->face_start[first + i];
-            const int *w = q->corner_vert + q->face_start[first + (i + 1) % count];
-            const float *p = q->pos + 3 * (size_t)(ring ? v[0] : v[1]);
-            const float *r = q->pos + 3 * (size_t)(ring ? w[0] : w[1]);
-            double a[3], b[3], cross[3], area;
-            if (pass == 0) {
-                for (k = 0; k < 3; k++) mean[k] += p[k] / (double)count;
-                continue;
-            }
+            const float *p = tt__remesh_ring_point(q, first, count, ring, i);
+            const float *r = tt__remesh_ring_point(q, first, count, ring, i + 1);
+            double area;
             for (k = 0; k < 3; k++) { a[k] = p[k] - mean[k]; b[k] = r[k] - mean[k]; }
             tt__cross3(a, b, cross);
-            if (pass == 1) {
+            if (pass == 0) {
                 for (k = 0; k < 3; k++) normal[k] += cross[k];
                 continue;
             }
@@ -7521,7 +7551,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         if (where[k])
             rep->snapped_vertices += tt__remesh_onto_input(m, member_head, member_next, &k, 1, creases,
                                                            0.5 * edge_length, HUGE_VAL, g->pos + 3 * (size_t)k,
-                                                           surface + 3 * (size_t)k);
+                                                           surface + 3 * (size_t)k) == 2;
     for (q = 0; q < nloops; q++)
         if (keep[q] && tt__face_has_zero_area(surface, loop_vert + loop_start[q], loop_start[q + 1] - loop_start[q])) {
             keep[q] = 0;
@@ -7539,7 +7569,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         loop_root[q] = q;
         if (!keep[q]) continue;
         for (k = 0; k < s; k++) {
-            half[2 * (size_t)nhalf] = ((uint64_t)(uint32_t)loop_vert[b + k] << 32) | (uint32_t)loop_vert[b + (k + 1) % s];
+            half[2 * (size_t)nhalf] = tt__pair_key(loop_vert[b + k], loop_vert[b + (k + 1) % s]);
             half[2 * (size_t)nhalf + 1] = (uint64_t)(b + (k + 1) % s);
             nhalf++;
         }
@@ -7551,7 +7581,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         if (!keep[q]) continue;
         for (k = 0; k < s; k++) {
             int v = loop_vert[b + k], w = loop_vert[b + (k + 1) % s], lo;
-            uint64_t twin = ((uint64_t)(uint32_t)w << 32) | (uint32_t)v;
+            uint64_t twin = tt__pair_key(w, v);
             lo = tt__u64_lower_bound(half, nhalf, 2, twin);
             if (lo < nhalf && half[2 * (size_t)lo] == twin) {
                 int other = (int)half[2 * (size_t)lo + 1], x, y;
@@ -7662,17 +7692,17 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         float *pos = (float *)(*out_mesh)->pos;
         int c, edge = 0, face, around[3 * 64];
         for (c = 0; c < lattice->ncorners; c++) {
-            int t = lattice->twin[c], j, count = 0, side;
+            int t = lattice->twin[c], j, count = 0, side, moved;
             float *at = pos + 3 * ((size_t)lattice->nverts + edge);
             double mid[3];
             if (t >= 0 && t < c) continue;
             around[count++] = out_cluster[lattice->corner_vert[c]];
             around[count++] = out_cluster[lattice->corner_vert[tt_mesh_next(lattice, c)]];
             for (j = 0; j < 3; j++) mid[j] = at[j];
-            if (tt__remesh_onto_input(m, member_head, member_next, around, count, creases, 0.5 * edge_length,
-                                      edge_length, mid, at)) {
-                rep->snapped_vertices++;
-            } else if (at[0] == (float)mid[0] && at[1] == (float)mid[1] && at[2] == (float)mid[2]) {
+            moved = tt__remesh_onto_input(m, member_head, member_next, around, count, creases, 0.5 * edge_length,
+                                          edge_length, mid, at);
+            rep->snapped_vertices += moved == 2;
+            if (!moved) {
                 /* Nothing within an edge near its ends: the middle of a long
                    edge (a cut across a face) is nearer its faces' other
                    corners. */
@@ -7735,7 +7765,7 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
         /* Where even the split's own points make a quad of zero area (float
            cannot part them: a tiny lattice face far from the origin), there
            is no valid result at this edge length. */
-        for (face = 0; face < (*out_mesh)->nfaces; face++)
+        for (face = 0; rep->unmoved_points > 0 && face < (*out_mesh)->nfaces; face++)
             if (tt__face_has_zero_area(pos, (*out_mesh)->corner_vert + (*out_mesh)->face_start[face], 4)) {
                 result = tt__fail(error, TT_ERROR_NOT_CONVERGED, -1, -1, -1, -1,
                                   "remeshing made a quad of zero area (float cannot part its corners): try "
@@ -7996,16 +8026,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     if (!tt__remesh_clusters(allocator, &levels[finest], work, ancestor, rho, &graph)) goto oom;
     if (tt__remesh_cancelled(&opt, 0.9)) goto cancelled;
     if (!tt__remesh_trace(allocator, &graph)) goto oom;
-    for (l = 1; l >= 0; l--) {
-        i = tt__remesh_mend_triangles(allocator, &graph, rho, l);
-        if (i < 0) goto oom;
-        if (l) rep.thin_triangles = i; else rep.merged_triangles = i;
-        if (i > 0 && !tt__remesh_trace(allocator, &graph)) goto oom;
-    }
-    i = tt__remesh_cut_large_faces(allocator, &graph);
-    if (i < 0) goto oom;
-    rep.cut_edges = i;
-    if (i > 0 && !tt__remesh_trace(allocator, &graph)) goto oom;
+    if (!tt__remesh_mend_lattice(allocator, &graph, rho, &rep)) goto oom;
     if (tt__remesh_cancelled(&opt, 0.95)) goto cancelled;
     {
         int *face_component = TT__ALLOC(allocator, int, mesh->nfaces);
