@@ -2033,6 +2033,14 @@ static double remesh_aligned_share(const tt_mesh *q, double *median_edge)
     return counted ? (double)aligned / counted : 0.0;
 }
 
+/* The normal of triangle (o, o + e, o + e + f), for the fold test. */
+static void remesh_cross(const double e[3], const double f[3], double out[3])
+{
+    out[0] = e[1] * f[2] - e[2] * f[1];
+    out[1] = e[2] * f[0] - e[0] * f[2];
+    out[2] = e[0] * f[1] - e[1] * f[0];
+}
+
 /* Quads folded: two corners on one point, or the two triangles on either
    diagonal facing apart. */
 static int remesh_folded_quads(const tt_mesh *q)
@@ -2046,12 +2054,8 @@ static int remesh_folded_quads(const tt_mesh *q)
             for (k = 0; k < 3; k++) e[i][k] = (double)q->pos[3 * v[(i + 1) % 4] + k] - q->pos[3 * v[i] + k];
         for (i = 0; i < 4; i++) bad |= e[i][0] == 0.0 && e[i][1] == 0.0 && e[i][2] == 0.0;
         for (i = 0; i < 2; i++) {
-            a[0] = e[i][1] * e[i + 1][2] - e[i][2] * e[i + 1][1];
-            a[1] = e[i][2] * e[i + 1][0] - e[i][0] * e[i + 1][2];
-            a[2] = e[i][0] * e[i + 1][1] - e[i][1] * e[i + 1][0];
-            b[0] = e[i + 2][1] * e[(i + 3) % 4][2] - e[i + 2][2] * e[(i + 3) % 4][1];
-            b[1] = e[i + 2][2] * e[(i + 3) % 4][0] - e[i + 2][0] * e[(i + 3) % 4][2];
-            b[2] = e[i + 2][0] * e[(i + 3) % 4][1] - e[i + 2][1] * e[(i + 3) % 4][0];
+            remesh_cross(e[i], e[i + 1], a);
+            remesh_cross(e[i + 2], e[(i + 3) % 4], b);
             bad |= a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < 0.0;
         }
         folded += bad;
