@@ -19740,7 +19740,13 @@ static tt_result tt__atlas_too_small(int ncharts, int gutter, int size, tt_error
    the scale TT__PACK_REFINE times larger while it fits: packings differ
    by a step or two from chart set to chart set, none best on all, and
    what fits is kept, so the fill never falls below the first way's.
-   try_box holds 3 nf ints. */
+   Against a rival, the search first packs at the lowest scale from which
+   those steps could still pass it: where the charts do not fit there,
+   they cannot win, and *scale is left at tiny after that one packing
+   instead of a whole search. Where they fit, the search goes on from
+   tiny as without a rival: the packing's fit is not monotone in the
+   scale, and a search bracketed from elsewhere ends elsewhere (the flange
+   would lose a point of fill). try_box holds 3 nf ints. */
 static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart_order *order,
                                         const tt__chart_order *order_area, int ncharts, const int *members,
                                         const double *xy, int block_gutter, int side, tt__packing *pack, int *need,
@@ -19750,7 +19756,16 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
 {
     int packed = 0, tries = 0, failed = 0, fitted = 0, way, step;
     double s_lo = tiny, s_hi = surface > 0.0 ? 1.0001 * side / sqrt(surface) : tiny;
+    double floor_scale = rival / pow(TT__PACK_REFINE, 2 * TT__PACK_REFINE_STEPS);
     if (s_hi < s_lo) s_hi = s_lo;
+    if (floor_scale > s_lo && floor_scale < s_hi) {
+        tries++;
+        if (!tt__pack_bitmap(charts, order, ncharts, members, xy, floor_scale, block_gutter, side, pack, need,
+                             rows_order, box_x, box_y, box_turn)) {
+            *scale = tiny;
+            return TT_OK;
+        }
+    }
     {
         double mid = s_hi * sqrt(opt->fill_guess);
         while (tries < 100 && s_hi - s_lo > 5e-3 * s_hi) {
