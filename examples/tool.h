@@ -267,9 +267,10 @@ int tool_read_file(const char *path, unsigned char **data, size_t *size, char *e
 
 /* tool_read_file remembers every regular file it read (device and inode,
    which catches "./m.obj" for "m.obj" and hard links). An output path that
-   is a directory or is one of those inputs gives -1 and the reason in err;
-   a path that does not exist yet is fine, and so is "-" (the standard
-   output). output_commit checks every output; a command may check its
+   is a directory or is one of those inputs gives -1 and the reason in err,
+   and so does a path that does not exist yet in a folder that does not
+   exist or cannot be written; otherwise a new path is fine, and so is "-"
+   (the standard output). output_commit checks every output; a command may check its
    outputs earlier, before a long computation, with
    tool_refuse_input_overwrite (prints the error, returns
    TOOL_EXIT_FAILURE, or 0 when the path is fine). */

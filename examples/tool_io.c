@@ -240,12 +240,49 @@ static void remember_input(FILE *file, const char *path)
     tool_input_count++;
 }
 
+/* The directory part of `path` with its slash ("out/" for "out/m.obj"), or
+   "./" for a bare name: malloc'd, NULL when out of memory. */
+static char *directory_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    size_t length = slash ? (size_t)(slash - path) + 1 : 0;
+    char *directory = (char *)malloc(length + 3);
+    if (!directory) return NULL;
+    if (slash) {
+        memcpy(directory, path, length);
+        directory[length] = '\0';
+    } else {
+        strcpy(directory, "./");
+    }
+    return directory;
+}
+
+/* A path that does not exist yet can still not be written: its folder is
+   missing or closed to this user. Said before a long run rather than after
+   it. */
+static int check_output_directory(const char *path, char *err, size_t err_size)
+{
+    struct stat info;
+    char *directory = directory_of(path);
+    int status = 0;
+    if (!directory) return 0;                   /* the write itself will say */
+    if (stat(directory, &info) != 0 || !S_ISDIR(info.st_mode)) {
+        tool_set_error(err, err_size, "cannot write '%s': there is no folder '%s'", path, directory);
+        status = -1;
+    } else if (access(directory, W_OK | X_OK) != 0) {
+        tool_set_error(err, err_size, "cannot write '%s': the folder '%s': %s", path, directory, strerror(errno));
+        status = -1;
+    }
+    free(directory);
+    return status;
+}
+
 int tool_check_output_path(const char *path, char *err, size_t err_size)
 {
     struct stat info;
     int i;
     if (strcmp(path, "-") == 0) return 0;      /* standard output: never a file on disk */
-    if (stat(path, &info) != 0) return 0;      /* does not exist (yet): cannot be an input */
+    if (stat(path, &info) != 0) return check_output_directory(path, err, err_size); /* cannot be an input */
     if (S_ISDIR(info.st_mode)) {
         tool_set_error(err, err_size, "cannot write '%s': it is a directory", path);
         return -1;
@@ -645,16 +682,10 @@ static void remove_leftovers(const char *path)
 {
     const char *slash = strrchr(path, '/');
     size_t dir_length = slash ? (size_t)(slash - path) + 1 : 0;
-    char *directory = (char *)malloc(dir_length + 3);
+    char *directory = directory_of(path);
     DIR *dir;
     struct dirent *entry;
     if (!directory) return;
-    if (slash) {
-        memcpy(directory, path, dir_length);
-        directory[dir_length] = '\0';
-    } else {
-        strcpy(directory, "./");
-    }
     dir = opendir(directory);
     while (dir && (entry = readdir(dir)) != NULL) {
         struct stat info;

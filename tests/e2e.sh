@@ -1912,6 +1912,12 @@ check "tiledtex with no arguments" "exit 0 with help, or non-zero with one 'tile
     "$({ [ $RC -eq 0 ] && [ -n "$OUT" ]; } || { [ $RC -ne 0 ] && [ "$(wc -l <"$W/err")" -eq 1 ] && head -c 8 "$W/err" | grep -qx tiledtex; }; echo $?)"
 cd "$W" || exit 1
 
+# an output folder that does not exist: said at once, before the work
+for pipeline in tile hpm lapped polycube; do
+    expect_error "$pipeline into a missing folder" $pipeline ../in/torus.obj ../in/tex.png no_such_folder/out
+    err_mentions "$pipeline into a missing folder: names the folder" "no folder 'no_such_folder/'"
+done
+
 # all-or-nothing output: one output path is a directory -> nothing else written
 for blocked in obj mtl png; do
     newdir
