@@ -20166,6 +20166,7 @@ typedef struct tt__bake {
     /* Normal-map patches: per item, the turn (row-major 2 x 2, image axes)
        from its patch's frame to the atlas's; NULL for colour. */
     const float *turns;
+    const unsigned char *clear_border;  /* per patch: tt__image_border_clear */
     double x[3], y[3];          /* the face's atlas triangle, pixels */
     double area2, inverse_area2;    /* twice its signed area, and 1 over it */
     double gutter;              /* texels */
@@ -20191,10 +20192,32 @@ static float tt__paste_cut_at(const tt_lapped *lapped, int p, double u, double v
 /* Paste item k of the face sampled at barycentric weights w (weights outside
    [0, 1] extend the paste's linear map across the face's edges), and its
    cut there (1 without). */
+/* Whether every texel on the image's border is 0 in all four channels. */
+static int tt__image_border_clear(const tt_image *image)
+{
+    const int w = image->width, h = image->height;
+    int x, y, k;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x += (y == 0 || y == h - 1) ? 1 : (w > 1 ? w - 1 : 1))
+            for (k = 0; k < 4; k++)
+                if (image->pixels[4 * ((size_t)y * w + x) + k] != 0.0f) return 0;
+    return 1;
+}
+
+/* Whether clamped bilinear sampling at (x, y) (tt_image_sample_bilinear,
+   whose arithmetic this follows) reads only texels of the image's border:
+   outside the centres of its outer ring of texels. */
+static int tt__bilinear_reads_border_only(const tt_image *image, float x, float y)
+{
+    const float fx = x - 0.5f, fy = y - 0.5f;
+    return fx < 0.0f || fy < 0.0f || fx >= (float)(image->width - 1) || fy >= (float)(image->height - 1);
+}
+
 static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float sample[4], float *cut)
 {
     const float *uv = b->lapped->uv + 6 * (size_t)b->items[2 * k];
-    const tt_image *patch = b->patches[b->lapped->pastes[b->items[2 * k + 1]].patch];
+    const int patch_index = b->lapped->pastes[b->items[2 * k + 1]].patch;
+    const tt_image *patch = b->patches[patch_index];
     double u = 0.0, v = 0.0, px, py;
     int i;
     for (i = 0; i < 3; i++) {
@@ -20203,11 +20226,18 @@ static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float s
     }
     /* The sampler clamps; clamping here first keeps the float conversion
        defined for far extrapolations. */
-    *cut = b->lapped->cut ? tt__paste_cut_at(b->lapped, b->items[2 * k + 1], u, v) : 1.0f;
     px = u * patch->width;
     py = (1.0 - v) * patch->height;
     px = px < -1.0 ? -1.0 : (px > patch->width + 1.0 ? patch->width + 1.0 : px);
     py = py < -1.0 ? -1.0 : (py > patch->height + 1.0 ? patch->height + 1.0 : py);
+    if (b->clear_border[patch_index] && tt__bilinear_reads_border_only(patch, (float)px, (float)py)) {
+        /* 0, the sample the sampler would give: what a coarse face's many
+           pastes give over most of it, costing no cut and no sampling. */
+        sample[0] = sample[1] = sample[2] = sample[3] = 0.0f;
+        *cut = 1.0f;
+        return;
+    }
+    *cut = b->lapped->cut ? tt__paste_cut_at(b->lapped, b->items[2 * k + 1], u, v) : 1.0f;
     tt_image_sample_bilinear(patch, (float)px, (float)py, sample);
     if (b->turns) tt__turn_vector(b->turns + 4 * k, sample, sample);
     if (b->lapped->fade) {
@@ -20254,18 +20284,23 @@ static void tt__bake_over(float out[4], float sample[4], float cut, int narrow)
    the paste itself, exactly - so the walk goes down from the topmost paste
    and composites upward from the first opaque one: the same bits as
    drawing every paste, at the cost of the one or two on top instead of the
-   face's whole overdraw. */
+   face's whole overdraw. A sample of 0 in all four channels leaves what
+   lies beneath exactly as it is, cut or not (tt__bake_over), so the walk
+   keeps none: on a face much larger than a paste, most pastes of the face
+   give 0 at most of its texels. */
 static void tt__bake_composite(const tt__bake *b, const double w[3], float out[4])
 {
     float cache[TT__BAKE_CACHE][4], cuts[TT__BAKE_CACHE];
     int n = b->nitems, k, cached = 0, opaque = 0;
     out[0] = out[1] = out[2] = out[3] = 0.0f;
     for (k = n - 1; k >= 0 && cached < TT__BAKE_CACHE && !opaque; k--) {
+        const float *s = cache[cached];
         tt__bake_sample(b, k, w, cache[cached], &cuts[cached]);
-        opaque = cache[cached][3] == 1.0f && cuts[cached] == 1.0f;
+        if (s[0] == 0.0f && s[1] == 0.0f && s[2] == 0.0f && s[3] == 0.0f) continue;
+        opaque = s[3] == 1.0f && cuts[cached] == 1.0f;
         cached++;
     }
-    if (opaque || cached == n) {
+    if (opaque || k < 0) {
         while (cached > 0) {
             cached--;
             tt__bake_over(out, cache[cached], cuts[cached], b->lapped->cut != NULL);
@@ -20434,6 +20469,7 @@ typedef struct tt__bake_job {
     tt_image *atlas;
     double gutter;
     const int *band_start, *band_faces;   /* per band, the faces whose triangle or gutter reaches it */
+    const unsigned char *clear_border;    /* per patch: tt__image_border_clear */
     int first_band;             /* the batch running: bands first_band + task */
 } tt__bake_job;
 
@@ -20489,6 +20525,7 @@ static void tt__bake_band(void *context, int task)
     memset(&b, 0, sizeof b);
     b.lapped = job->lapped;
     b.patches = job->patches;
+    b.clear_border = job->clear_border;
     b.state = job->state;
     b.atlas = job->atlas;
     b.gutter = job->gutter;
@@ -20711,9 +20748,10 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     int *start = NULL, *fill = NULL, *items = NULL, *queue = NULL, *band_start = NULL, *band_fill = NULL;
     int *band_faces = NULL;
     float *state = NULL, *turns = NULL;
+    unsigned char *clear_border = NULL;
     size_t texels, t, total = 0;
     float empty = tt__infinity();
-    int width, height, normal = 0, nbands;
+    int width, height, normal = 0, nbands, p;
 
     tt__ok(error);
     if (!mesh || !lapped || !patches || !corner_uv || !atlas)
@@ -20738,12 +20776,15 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     nbands = (height + TT__BAKE_BAND_ROWS - 1) / TT__BAKE_BAND_ROWS;
     band_start = TT__ALLOC(al, int, (size_t)nbands + 1);
     band_fill = TT__ALLOC(al, int, nbands);
-    if (!start || !fill || !items || !state || !queue || (normal && !turns) || !band_start || !band_fill) {
+    clear_border = TT__ALLOC(al, unsigned char, npatches);
+    if (!start || !fill || !items || !state || !queue || (normal && !turns) || !band_start || !band_fill ||
+        !clear_border) {
         result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1,
                           "out of memory baking %d faces into a %d x %d atlas", mesh->nfaces, width, height);
         goto done;
     }
     tt__bake_entries_by_face(mesh, lapped, start, fill, items);
+    for (p = 0; p < npatches; p++) clear_border[p] = (unsigned char)tt__image_border_clear(patches[p]);
 
     for (t = 0; t < texels; t++) state[t] = empty;
     memset(&job, 0, sizeof job);
@@ -20754,6 +20795,7 @@ TTDEF tt_result tt_lapped_bake(const tt_mesh *mesh, const tt_lapped *lapped, tt_
     job.start = start;
     job.items = items;
     job.turns = turns;
+    job.clear_border = clear_border;
     job.state = state;
     job.atlas = atlas;
     /* A gutter wider than the image reaches every texel anyway. */
@@ -20794,6 +20836,7 @@ done:
     tt__free(al, band_start);
     tt__free(al, band_fill);
     tt__free(al, band_faces);
+    tt__free(al, clear_border);
     return result;
 }
 

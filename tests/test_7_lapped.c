@@ -5601,6 +5601,89 @@ static void test_lapped_bake_order(void)
     tt_mesh_free(mesh);
 }
 
+/* A face far larger than its pastes (a coarse mesh): 90 small pastes over
+   one square, most of them 0 at most texels, which the bake passes by. The
+   atlas must equal every paste composited with "over", bottom first, at
+   every texel (a naive reference). Every seventh paste is a patch whose
+   border is not clear: clamped sampling spreads its edge over the whole
+   square, so it must never be passed by. */
+static void test_lapped_bake_many_small_pastes(void)
+{
+    const int size = 64, npastes = 90;
+    tt_mesh *mesh = bake_grid(1, 1, 0.0, NULL);
+    tt_image *patches[2], *atlas = NULL;
+    float uv[12];
+    double maps[90][6];
+    lb_builder b;
+    tt_error err;
+    int k, x, y, i, worst_x = -1, worst_y = -1;
+    double worst = 0.0;
+    CHECK(tt_image_create(16, 16, NULL, &patches[0], NULL) == TT_OK, "patch 0");
+    for (y = 0; y < 16; y++)
+        for (x = 0; x < 16; x++) {
+            float *p = patches[0]->pixels + 4 * (y * 16 + x);
+            double r = sqrt((x + 0.5 - 8.0) * (x + 0.5 - 8.0) + (y + 0.5 - 8.0) * (y + 0.5 - 8.0));
+            float a = r < 5.0 ? 1.0f : (r < 7.0 ? (float)((7.0 - r) / 2.0) : 0.0f);
+            p[0] = a * (float)x / 16.0f;
+            p[1] = a * (float)y / 16.0f;
+            p[2] = a * 0.5f;
+            p[3] = a;
+        }
+    patches[1] = bake_constant(8, 8, 0.2f, 0.9f, 0.4f, 0.25f);
+    lcg_seed(7);
+    lb_init(&b);
+    for (k = 0; k < npastes; k++) {
+        double angle = 6.283185307179586 * lcg_unit(), scale = 1.0 / (0.1 + 0.1 * lcg_unit());
+        double cx = lcg_unit(), cy = lcg_unit(), *m = maps[k];
+        m[0] = scale * cos(angle);
+        m[1] = -scale * sin(angle);
+        m[2] = scale * sin(angle);
+        m[3] = scale * cos(angle);
+        m[4] = 0.5 - m[0] * cx - m[1] * cy;
+        m[5] = 0.5 - m[2] * cx - m[3] * cy;
+        lb_paste_all(&b, mesh, k % 7 == 3, m, m + 4);
+    }
+    bake_square_uvs(mesh, 0.0, 1.0, uv);
+    tt_image_create(size, size, NULL, &atlas, NULL);
+    CHECK(bake_gutter(mesh, &b.l, patches, 2, uv, 0, atlas, &err) == TT_OK, "bake: %s", err.message);
+    for (y = 0; y < size; y++)
+        for (x = 0; x < size; x++) {
+            /* the surface point of the texel's centre: atlas UV = position */
+            double px = (x + 0.5) / size, py = 1.0 - (y + 0.5) / size, d;
+            float out[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+            const float *got = atlas->pixels + 4 * (y * size + x);
+            for (k = 0; k < npastes; k++) {
+                const tt_image *patch = patches[k % 7 == 3];
+                double u = maps[k][0] * px + maps[k][1] * py + maps[k][4];
+                double v = maps[k][2] * px + maps[k][3] * py + maps[k][5];
+                double sx = u * patch->width, sy = (1.0 - v) * patch->height;
+                float sample[4];
+                sx = sx < -1.0 ? -1.0 : (sx > patch->width + 1.0 ? patch->width + 1.0 : sx);
+                sy = sy < -1.0 ? -1.0 : (sy > patch->height + 1.0 ? patch->height + 1.0 : sy);
+                tt_image_sample_bilinear(patch, (float)sx, (float)sy, sample);
+                for (i = 0; i < 4; i++) out[i] = sample[i] + (1.0f - sample[3]) * out[i];
+            }
+            /* the bake stores straight colour */
+            if (out[3] > 0.0f)
+                for (i = 0; i < 3; i++) out[i] /= out[3];
+            for (i = 0; i < 4; i++) {
+                d = fabs((double)got[i] - out[i]);
+                if (d > worst) {
+                    worst = d;
+                    worst_x = x;
+                    worst_y = y;
+                }
+            }
+        }
+    CHECK(worst < 1e-4, "90 pastes on one square: the bake differs from compositing every paste by %g at texel (%d, %d)",
+          worst, worst_x, worst_y);
+    lb_free(&b);
+    tt_image_free(atlas);
+    tt_image_free(patches[0]);
+    tt_image_free(patches[1]);
+    tt_mesh_free(mesh);
+}
+
 /* A tt_lapped_bake error: the code, err.result, a message without long
    digit runs, the item (-2: not compared) and the face (-2: not compared). */
 #define BAKE_EXPECT(call, code, item_, face_, what)                                                             \
@@ -5898,8 +5981,8 @@ static void test_lapped_bake_oom(void)
     c.uv = uv;
     c.atlas = atlas;
     oom_sweep("tt_lapped_bake", bake_oom_call, &c, TT_OK);
-    /* entries by face (2), items, state, fill queue, and the bands' lists (3) */
-    CHECK(g_oom_counter.calls == 8, "tt_lapped_bake: 8 allocations, got %ld", g_oom_counter.calls);
+    /* entries by face (2), items, state, fill queue, the bands' lists (3) and the patches' clear borders */
+    CHECK(g_oom_counter.calls == 9, "tt_lapped_bake: 9 allocations, got %ld", g_oom_counter.calls);
     tt_mesh_free(mesh);
     CHECK(g_oom_counter.live == 0 && g_oom_counter.bad_frees == 0, "all freed (%ld live, %ld bad frees)",
           g_oom_counter.live, g_oom_counter.bad_frees);
@@ -6003,6 +6086,7 @@ void run_lapped_tests(void)
     RUN(test_lapped_bake_gutter);
     RUN(test_lapped_bake_seams);
     RUN(test_lapped_bake_order);
+    RUN(test_lapped_bake_many_small_pastes);
     RUN(test_lapped_bake_errors);
     RUN(test_lapped_bake_progress);
     RUN(test_lapped_bake_executor);
