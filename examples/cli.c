@@ -491,6 +491,15 @@ int parse_up(const char *option, const char *text, double up[3])
     return 0;
 }
 
+void tool_note_courses_without_up(const tt_image *image, const char *image_path, const tt_courses *found,
+                                  const char *without)
+{
+    tt_courses courses;
+    if (found) courses = *found;
+    else if (tt_find_courses(image, NULL, &courses, NULL) != TT_OK) return;
+    if (courses.period > 0.0f) tool_note("%s has courses (bricks, blocks laid in rows): %s", image_path, without);
+}
+
 int parse_field_option(int argc, char **argv, int *index, tool_field *field)
 {
     const char *value;

@@ -133,6 +133,7 @@ typedef struct polycube_command_options {
     tiled_options tiles;            /* --colors --tile --gutter --seed, as `tile` takes them */
     tt_polycube_options build;      /* zero fields: the library's defaults */
     int plain;                      /* --no-upright */
+    int up_given;                   /* --up was given */
     int max_atlas;                  /* --max-atlas; 0 = the library's default */
     double texture_size;            /* --texture-size; 0 = the mesh's longest side / 16, or the cube size when
                                        --resolution or --cube-size chose it */
@@ -186,6 +187,7 @@ static int parse_command_line(int argc, char **argv, polycube_command_options *o
             options->build.flags |= TT_POLYCUBE_NO_CORRECT;
         } else if (tool_option(argc, argv, &i, "--up", &value)) {
             if (parse_up("--up", value, options->build.up) != 0) return TOOL_EXIT_USAGE;
+            options->up_given = 1;
         } else if (tool_is_option(argv[i])) {
             return tool_unknown_option(argv[i]);
         } else if (npositional < 3) {
@@ -877,6 +879,9 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0) status = build_polycube(&options, &job);
     if (status == 0 && !options.plain)
         status = tiled_find_courses(image, options.image_path, &options.tiles, &photo_courses);
+    if (status == 0 && !options.plain && !options.up_given)
+        tool_note_courses_without_up(image, options.image_path, &photo_courses,
+                                     "they run level where +y is up, the default (OBJ's and glTF's convention); give --up z for a mesh made z-up (CAD parts, many scans)");
     if (status == 0) status = scale_tiles(&options, &job, image, photo_courses.period);
     if (status == 0) status = tiled_check_atlas_size(&options.tiles);
     if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)

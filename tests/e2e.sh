@@ -1414,8 +1414,25 @@ check "tile --no-courses: no word of courses" "no 'courses' on stderr" "$ERR" \
 check "tile --up on bricks: --no-courses makes another atlas" "files differ" "identical" \
     "$(! cmp -s courses.png asis.png; echo $?)"
 expect_ok "tile (no --up) on bricks" tile ../in/torus.obj bricks.pgm plain --colors 2 --tile 32
-check "tile without --up: the photo as it is" "no 'courses' on stderr" "$ERR" \
-    "$(! printf '%s' "$ERR" | grep -q courses; echo $?)"
+check "tile without --up: the photo as it is" "no 'courses every' on stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q 'courses every'; echo $?)"
+err_mentions "tile without --up on bricks: one note that --up keeps the courses level" \
+    'bricks\.pgm has courses \(bricks, blocks laid in rows\): without --up each tile follows its quad.*--up y'
+for pipeline in lapped hpm polycube; do
+    case $pipeline in
+        polycube) extra=(--resolution 6 --tile 32) ;;
+        *) extra=() ;;
+    esac
+    expect_ok "$pipeline without --up on bricks" $pipeline ../in/spheretri.obj bricks.pgm noup "${extra[@]}"
+    check "$pipeline without --up on bricks: one note on the courses and --up" "one 'has courses (bricks' line" \
+        "$ERR" "$([ "$(printf '%s\n' "$ERR" | grep -c 'has courses (bricks')" -eq 1 ]; echo $?)"
+    expect_ok "$pipeline --up y on bricks" $pipeline ../in/spheretri.obj bricks.pgm up "${extra[@]}" --up y
+    check "$pipeline --up y on bricks: no note on --up" "no 'has courses (bricks' line" "$ERR" \
+        "$(! printf '%s' "$ERR" | grep -q 'has courses (bricks'; echo $?)"
+done
+expect_ok "hpm without --up on stones" hpm ../in/spheretri.obj ../in/lap256.png noup_stones
+check "hpm on a photo without courses: no note on --up" "no 'has courses (bricks' line" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q 'has courses (bricks'; echo $?)"
 expect_ok "tile --up y on stones" tile ../in/torus.obj ../in/lap256.png stones --colors 2 --tile 32 --up y
 check "tile --up on a photo without courses: none found" "no 'courses' on stderr" "$ERR" \
     "$(! printf '%s' "$ERR" | grep -q courses; echo $?)"
