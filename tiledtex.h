@@ -8414,7 +8414,8 @@ TTDEF void tt_image_sample_bilinear_wrap(const tt_image *image, float x, float y
         ty = tt__repeat_axis(fy, image->height, &y0, &y1);
     } else {
         /* Far outside is the same as just outside (clamping), and it keeps
-           the conversion to int defined; NaN samples the first texel. */
+           the conversion to int defined; NaN samples the first texel.
+           tt__bilinear_reads_border_only follows this arithmetic. */
         fx = fx != fx ? 0.0f : tt__clamp_f(fx, -1.0f, (float)image->width);
         fy = fy != fy ? 0.0f : tt__clamp_f(fy, -1.0f, (float)image->height);
         x0 = (int)floorf(fx);
@@ -8440,6 +8441,27 @@ TTDEF void tt_image_sample_bilinear_wrap(const tt_image *image, float x, float y
 TTDEF void tt_image_sample_bilinear(const tt_image *image, float x, float y, float rgba[4])
 {
     tt_image_sample_bilinear_wrap(image, x, y, TT_WRAP_CLAMP, rgba);
+}
+
+/* Whether every texel on the image's border is 0 in all four channels. */
+static int tt__image_border_clear(const tt_image *image)
+{
+    const int w = image->width, h = image->height;
+    int x, y, k;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x += (y == 0 || y == h - 1) ? 1 : (w > 1 ? w - 1 : 1))
+            for (k = 0; k < 4; k++)
+                if (image->pixels[4 * ((size_t)y * w + x) + k] != 0.0f) return 0;
+    return 1;
+}
+
+/* Whether clamped bilinear sampling at (x, y) (tt_image_sample_bilinear,
+   whose arithmetic this follows) reads only texels of the image's border:
+   outside the centres of its outer ring of texels. */
+static int tt__bilinear_reads_border_only(const tt_image *image, float x, float y)
+{
+    const float fx = x - 0.5f, fy = y - 0.5f;
+    return fx < 0.0f || fy < 0.0f || fx >= (float)(image->width - 1) || fy >= (float)(image->height - 1);
 }
 
 TTDEF void tt_rotate_coords(int quarter_turns, int width, int height, int x, int y, int *out_x, int *out_y)
@@ -20192,27 +20214,6 @@ static float tt__paste_cut_at(const tt_lapped *lapped, int p, double u, double v
 /* Paste item k of the face sampled at barycentric weights w (weights outside
    [0, 1] extend the paste's linear map across the face's edges), and its
    cut there (1 without). */
-/* Whether every texel on the image's border is 0 in all four channels. */
-static int tt__image_border_clear(const tt_image *image)
-{
-    const int w = image->width, h = image->height;
-    int x, y, k;
-    for (y = 0; y < h; y++)
-        for (x = 0; x < w; x += (y == 0 || y == h - 1) ? 1 : (w > 1 ? w - 1 : 1))
-            for (k = 0; k < 4; k++)
-                if (image->pixels[4 * ((size_t)y * w + x) + k] != 0.0f) return 0;
-    return 1;
-}
-
-/* Whether clamped bilinear sampling at (x, y) (tt_image_sample_bilinear,
-   whose arithmetic this follows) reads only texels of the image's border:
-   outside the centres of its outer ring of texels. */
-static int tt__bilinear_reads_border_only(const tt_image *image, float x, float y)
-{
-    const float fx = x - 0.5f, fy = y - 0.5f;
-    return fx < 0.0f || fy < 0.0f || fx >= (float)(image->width - 1) || fy >= (float)(image->height - 1);
-}
-
 static void tt__bake_sample(const tt__bake *b, int k, const double w[3], float sample[4], float *cut)
 {
     const float *uv = b->lapped->uv + 6 * (size_t)b->items[2 * k];
