@@ -41,6 +41,11 @@
    paper's 256 tiles at 64 texels. `atlas_charts_100k_faces` times
    tt_atlas_pack_charts on that torus at 2048 x 2048 (gutter 2, the tool's
    --bake), with the charts it made and the fraction of the atlas they fill.
+   `lapped_bake_coarse_over_fine` bakes the pastes of a 32-triangle torus
+   (about a hundred pastes per face) and of a 20k-triangle one (a few) into
+   1024 x 1024 atlases: the time per baked texel of the coarse over the
+   fine, which stays near 1 only while the bake passes by the pastes that
+   give a texel nothing (it was about 10 when it composited them all).
 
    Peers: bench/bench_build.c times the half-edge build on three 1M-face
    meshes beside a radix-sort pairing yardstick, and bench_build_cgal.cpp
@@ -514,6 +519,65 @@ static double bench_lapped(const char *name, int n, double thin, tt_image *patch
     return total - field;
 }
 
+typedef struct bake_ctx {
+    tt_mesh *mesh;
+    tt_lapped *lapped;
+    tt_image *patch, *atlas;
+    float *uv;
+} bake_ctx;
+
+static double run_bake(void *p)
+{
+    bake_ctx *c = (bake_ctx *)p;
+    tt_error err;
+    double t0 = bench_now_ms(), t1;
+    tt_result r = tt_lapped_bake(c->mesh, c->lapped, &c->patch, 1, c->uv, NULL, NULL, c->atlas, &err);
+    t1 = bench_now_ms();
+    if (r != TT_OK) fail("tt_lapped_bake", r, &err);
+    return t1 - t0;
+}
+
+/* The bake of a torus of n x n quads split in two, pasted with the default
+   field: its time per texel written (ms per million), and the pastes'
+   overdraw in *overdraw. */
+static double bench_bake(const char *name, int n, tt_image *patch, double *overdraw)
+{
+    bake_ctx c;
+    tt_lapped_options options;
+    tt_chart_atlas_report atlas_report;
+    float *field;
+    char label[64];
+    tt_error err;
+    tt_result r;
+    double ms;
+    c.mesh = make_triangle_torus(n, 0.0);
+    c.patch = patch;
+    field = (float *)xmalloc(sizeof(float) * 3 * (size_t)c.mesh->nfaces);
+    c.uv = (float *)xmalloc(sizeof(float) * 2 * (size_t)c.mesh->ncorners);
+    r = tt_tangent_field(c.mesh, NULL, NULL, field, &err);
+    if (r != TT_OK) fail("tt_tangent_field", r, &err);
+    memset(&options, 0, sizeof options);
+    options.seed = 1;
+    r = tt_lapped_paste(c.mesh, field, &c.patch, 1, &options, NULL, &c.lapped, &err);
+    if (r != TT_OK) fail("tt_lapped_paste", r, &err);
+    *overdraw = c.lapped->mean_overdraw;
+    r = tt_atlas_pack_charts(c.mesh, 1024, 2, NULL, NULL, c.uv, &atlas_report, &err);
+    if (r != TT_OK) fail("tt_atlas_pack_charts", r, &err);
+    r = tt_image_create(1024, 1024, NULL, &c.atlas, &err);
+    if (r != TT_OK) fail("tt_image_create", r, &err);
+    ms = median_ms(run_bake, &c, RUNS_FAST);
+    report(name, ms, "ms");
+    snprintf(label, sizeof label, "%s_overdraw", name);
+    report(label, *overdraw, "x");
+    tt_image_free(c.atlas);
+    tt_lapped_free(c.lapped);
+    free(c.uv);
+    free(field);
+    tt_mesh_free(c.mesh);
+    /* the atlas's texels inside its charts, which the bake composites */
+    return ms / (atlas_report.fill * 1024.0 * 1024.0 / 1e6);
+}
+
 typedef struct hpm_ctx {
     tt_mesh *mesh;
     tt_image *image;
@@ -778,6 +842,19 @@ int main(int argc, char **argv)
             double slivers = bench_lapped("lapped_100k_faces_slivers", 224, 0.04, patch);
             report("lapped_slivers_over_regular", slivers / regular, "x");
         }
+        tt_image_free(patch);
+        tt_image_free(source);
+    }
+    if (wanted("lapped_bake")) {
+        tt_image *source = make_source(256), *patch = NULL;
+        tt_error err;
+        tt_result r;
+        double coarse, fine, overdraw;
+        r = tt_make_texture_patch(source, NULL, NULL, NULL, &patch, &err);
+        if (r != TT_OK) fail("tt_make_texture_patch", r, &err);
+        coarse = bench_bake("lapped_bake_coarse_32_faces", 4, patch, &overdraw);
+        fine = bench_bake("lapped_bake_fine_20k_faces", 100, patch, &overdraw);
+        report("lapped_bake_coarse_over_fine", coarse / fine, "x");
         tt_image_free(patch);
         tt_image_free(source);
     }
