@@ -497,7 +497,10 @@ void tool_note_courses_without_up(const tt_image *image, const char *image_path,
     tt_courses courses;
     if (found) courses = *found;
     else if (tt_find_courses(image, NULL, &courses, NULL) != TT_OK) return;
-    if (courses.period > 0.0f) tool_note("%s has courses (bricks, blocks laid in rows): %s", image_path, without);
+    if (courses.period > 0.0f)
+        tool_note("%s has courses (bricks, blocks laid in rows): %s; --up gives the mesh's up (z for a mesh made "
+                  "z-up: CAD parts, many scans) and keeps them level on every wall",
+                  image_path, without);
 }
 
 int parse_field_option(int argc, char **argv, int *index, tool_field *field)

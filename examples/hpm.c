@@ -461,8 +461,7 @@ int cmd_hpm(int argc, char **argv)
         status = tool_fail("%s", message);
     if (status == 0 && !options.field.given)
         tool_note_courses_without_up(image, options.image_path, NULL,
-                                     "without --up each cluster takes its own direction, so they wander; --up y "
-                                     "(or z for a mesh made z-up) keeps them level on every wall");
+                                     "without --up each cluster takes its own direction, so they wander");
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again, but only after mapping). */

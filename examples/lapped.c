@@ -1402,8 +1402,7 @@ int cmd_lapped(int argc, char **argv)
     if (status == 0 && image_load(options.image_path, TT_COLOR_SRGB, &image, message, sizeof message) != 0)
         status = tool_fail("%s", message);
     if (status == 0 && !options.field.given && !options.isotropic)
-        tool_note_courses_without_up(image, options.image_path, NULL,
-                                     "they run level where +y is up, the default (OBJ's and glTF's convention); give --up z for a mesh made z-up (CAD parts, many scans)");
+        tool_note_courses_without_up(image, options.image_path, NULL, TOOL_COURSES_DEFAULT_UP);
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     if (status == 0) status = choose_windows(&options, image->width, image->height, &windows);
     if (status == 0) status = lapped_patches_name(options.prefix, &windows, &options.maps, &patches);

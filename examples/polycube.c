@@ -880,8 +880,7 @@ int cmd_polycube(int argc, char **argv)
     if (status == 0 && !options.plain)
         status = tiled_find_courses(image, options.image_path, &options.tiles, &photo_courses);
     if (status == 0 && !options.plain && !options.up_given)
-        tool_note_courses_without_up(image, options.image_path, &photo_courses,
-                                     "they run level where +y is up, the default (OBJ's and glTF's convention); give --up z for a mesh made z-up (CAD parts, many scans)");
+        tool_note_courses_without_up(image, options.image_path, &photo_courses, TOOL_COURSES_DEFAULT_UP);
     if (status == 0) status = scale_tiles(&options, &job, image, photo_courses.period);
     if (status == 0) status = tiled_check_atlas_size(&options.tiles);
     if (status == 0 && tt_tile_layout_resolve(&options.tiles.layout, &job.layout, &error) != TT_OK)

@@ -167,8 +167,7 @@ int cmd_tile(int argc, char **argv)
     status = tiled_pick_tile_size(positional[1], image->width, image->height, &options);
     if (status == 0 && !options.field.given && !options.no_courses)
         tool_note_courses_without_up(image, positional[1], NULL,
-                                     "without --up each tile follows its quad, so they turn with the quads; --up y "
-                                     "(or z for a mesh made z-up) keeps them level on every wall");
+                                     "without --up each tile follows its quad, so they turn with the quads");
     if (status == 0) status = material_load(&options.maps, positional[1], image->width, image->height);
     if (status != 0) {
         image_free(image);

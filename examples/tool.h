@@ -239,12 +239,15 @@ typedef struct tool_field {
    any other argument; -1 after printing a bad value. */
 int parse_field_option(int argc, char **argv, int *index, tool_field *field);
 /* A photo laid in courses (bricks, blocks: tt_find_courses), with no --up
-   given: one note, which says `without` (what the courses follow then, and
-   what --up would do), since a mesh made z-up shows them on end. found: the
+   given: one note, which says `without` (what the courses follow then) and
+   what --up does, since a mesh made z-up shows them on end. found: the
    courses already found, or NULL to look here (a failure to look notes
    nothing). */
 void tool_note_courses_without_up(const tt_image *image, const char *image_path, const tt_courses *found,
                                   const char *without);
+/* `without` for the commands whose up is +y unless told (lapped, polycube). */
+#define TOOL_COURSES_DEFAULT_UP "they run level where +y is up, the default (OBJ's and glTF's convention)"
+
 /* An integer in [min, max]: "tiledtex CMD: --seed wants an integer from 0 to 9, got 'x'". */
 int parse_int(const char *option, const char *text, int min, int max, int *out);
 /* An unsigned 64-bit integer (seeds), decimal or 0x hexadecimal. */

@@ -1417,7 +1417,7 @@ expect_ok "tile (no --up) on bricks" tile ../in/torus.obj bricks.pgm plain --col
 check "tile without --up: the photo as it is" "no 'courses every' on stderr" "$ERR" \
     "$(! printf '%s' "$ERR" | grep -q 'courses every'; echo $?)"
 err_mentions "tile without --up on bricks: one note that --up keeps the courses level" \
-    'bricks\.pgm has courses \(bricks, blocks laid in rows\): without --up each tile follows its quad.*--up y'
+    'bricks\.pgm has courses \(bricks, blocks laid in rows\): without --up each tile follows its quad.*--up gives'
 for pipeline in lapped hpm polycube; do
     case $pipeline in
         polycube) extra=(--resolution 6 --tile 32) ;;
