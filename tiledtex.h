@@ -2628,9 +2628,10 @@ typedef struct tt_chart_atlas_report {
    (with the faces of a chart in a bounded number of grid cells each); the
    packing, five to eight times over for the search of the scale (fewer
    with a good options->fill_guess) and two to four times more to refine it
-   for each of the two sets of charts (the second set's refinement skipped
-   when it cannot catch up with the first; progress reports the first
-   set's search up to 0.5), scans the bitmap
+   for each of the two sets of charts (the second set packs once at the
+   lowest scale from which it could still pass the first, and stops there
+   when it does not fit; its refinement is skipped when it cannot catch up;
+   progress reports the first set's search up to 0.5), scans the bitmap
    for each chart, skipping rows without a long enough free run. options may be NULL
    (defaults); TT_CANCELLED by options->progress. Deterministic; reentrant
    and thread-safe on distinct outputs. */
