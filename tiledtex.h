@@ -2603,6 +2603,11 @@ typedef struct tt_chart_pack_options {
        cancels with TT_CANCELLED. */
     tt_progress_fn progress;
     void *progress_user_data;
+    /* Tries each chart's four quarter turns at once; NULL: one after
+       another. The same atlas either way; at once, each turn searches the
+       whole bitmap (one after another, a turn stops where it cannot beat
+       the turns before), so the work grows by about a tenth. */
+    const tt_executor *executor;
 } tt_chart_pack_options;
 
 /* The fill tried first when the options give none. */
@@ -2623,7 +2628,7 @@ typedef struct tt_chart_atlas_report {
    not fit even when shrunk to nothing - each needs 2 * gutter + 1 texels a
    side (TT_ERROR_IMAGE_TOO_SMALL; the message gives the smallest size that
    holds them); TT_ERROR_OUT_OF_MEMORY. corner_uv is written only on
-   success. Temporary memory only: about 235 bytes per face and three bits
+   success. Temporary memory only: about 235 bytes per face and six bits
    per texel (per block above 2048 a side). Time O(faces) for the charts
    (with the faces of a chart in a bounded number of grid cells each); the
    packing, five to eight times over for the search of the scale (fewer
@@ -19066,13 +19071,27 @@ static void tt__chart_texel(const double *xy, int face, int k, double s, int gut
    (rows of `words` 64-bit words), the longest free run of each row, and
    the outline of the chart being placed and its mask in the turn tried
    (same layout). */
+/* One quarter turn tried for the chart being placed: its mask (the
+   outline turned, width x height cells), each mask row's longest run, the
+   order the search asks its rows in, and where it sits (found: at x, y,
+   scored key). */
+typedef struct tt__packing_turn {
+    uint64_t *mask;
+    int *need, *order;
+    int width, height, found, x, y;
+    double key;
+} tt__packing_turn;
+
 typedef struct tt__packing {
-    uint64_t *bits, *mask, *outline;
+    uint64_t *bits, *outline;
+    tt__packing_turn turn[4];
     int words;
     int *run;
     double reach;   /* cells: a cell whose centre lies this near a triangle is the chart's */
     const unsigned char *border;   /* per face, bit k: its edge from corner k borders another chart */
     int waste;   /* 0: each chart in the turn that sits lowest; 1: the one that leaves least room beneath */
+    const tt_executor *executor;   /* tries the four turns at once; NULL: one after another */
+    int size, cols, rows;          /* the atlas's side and the outline of the chart being placed */
 } tt__packing;
 
 /* Sets bits [a, b] of a row of words. */
@@ -19238,17 +19257,18 @@ static int tt__chart_outline(const tt__chart *chart, const int *members, const d
     return 1;
 }
 
-/* p->mask: the outline (cols x rows) turned by `turn` quarter turns as
+/* mask: the outline (cols x rows) turned by `turn` quarter turns as
    tt__chart_texel turns the chart (cell (i, j) goes where its square
    goes), `*width` x `*height` cells. Turning the cells, not the triangles,
    costs a pass over the outline's cells instead of three more outlines. */
-static void tt__mask_turn(tt__packing *p, int cols, int rows, int turn, int *width, int *height)
+static void tt__mask_turn(const tt__packing *p, int cols, int rows, int turn, uint64_t *mask, int *width,
+                          int *height)
 {
     int w = turn & 1 ? rows : cols, h = turn & 1 ? cols : rows, j, word;
     if (turn == 0) {
-        memcpy(p->mask, p->outline, sizeof *p->mask * (size_t)rows * p->words);
+        memcpy(mask, p->outline, sizeof *mask * (size_t)rows * p->words);
     } else {
-        memset(p->mask, 0, sizeof *p->mask * (size_t)h * p->words);
+        memset(mask, 0, sizeof *mask * (size_t)h * p->words);
         for (j = 0; j < rows; j++)
             for (word = 0; word < (cols + 63) / 64; word++) {
                 uint64_t bits = p->outline[(size_t)j * p->words + word];
@@ -19260,7 +19280,7 @@ static void tt__mask_turn(tt__packing *p, int cols, int rows, int turn, int *wid
                     case 2: x = cols - 1 - i; y = rows - 1 - j; break;
                     default: x = j; y = cols - 1 - i; break;
                     }
-                    p->mask[(size_t)y * p->words + (x >> 6)] |= (uint64_t)1 << (x & 63);
+                    mask[(size_t)y * p->words + (x >> 6)] |= (uint64_t)1 << (x & 63);
                 }
             }
     }
@@ -19336,9 +19356,10 @@ static uint64_t tt__bits_at(const uint64_t *line, int words, int at)
    highest, in a run of the mask row from column a to b; a shift that
    keeps the run over a taken texel clashes again, so the run must move
    onto the next free stretch of its length past the clash. */
-static int tt__packing_clash(const tt__packing *p, int r, int width, int row, int x, int size)
+static int tt__packing_clash(const tt__packing *p, const uint64_t *turned, int r, int width, int row, int x,
+                             int size)
 {
-    const uint64_t *mask = p->mask + (size_t)r * p->words, *line = p->bits + (size_t)row * p->words;
+    const uint64_t *mask = turned + (size_t)r * p->words, *line = p->bits + (size_t)row * p->words;
     int j, nw = (width + 63) / 64;
     for (j = nw - 1; j >= 0; j--) {
         uint64_t both = mask[j] & tt__bits_at(line, p->words, x + 64 * j), gap;
@@ -19366,18 +19387,18 @@ static int tt__packing_clash(const tt__packing *p, int r, int width, int row, in
     return -1;
 }
 
-/* Bottom-left placement of the chart mask (width x height cells; need[r]
-   the longest run of row r) at the lowest row below `below`, then
+/* Bottom-left placement of the chart's turn t (its mask, width x height
+   cells; need[r] the longest run of row r) at the lowest row below `below`, then
    leftmost, where none of its texels is taken. An atlas row whose longest
    free run is shorter than the mask row that would lie on it rules out
    the whole shift (the longest mask row is asked first). Rows far apart
    are tried first (every 16th, then the 8th between, ...: what is in the
    way is usually several rows tall), and the row that clashed last first
-   of all. 1 and (x, y) when it fits. */
-static int tt__packing_find(const tt__packing *p, int size, int width, int height, const int *need, int *order,
-                            int below, int *x, int *y)
+   of all. 1 and (t->x, t->y) when it fits. */
+static int tt__packing_find(const tt__packing *p, tt__packing_turn *t, int below)
 {
-    int at_y, at_x, r, widest = 0, hint = 0, stride, n = 0, i;
+    const int size = p->size, width = t->width, height = t->height, *need = t->need;
+    int *order = t->order, at_y, at_x, r, widest = 0, hint = 0, stride, n = 0, i;
     for (r = 1; r < height; r++)
         if (need[r] > need[widest]) widest = r;
     for (stride = 16; stride >= 1; stride /= 2)
@@ -19392,14 +19413,14 @@ static int tt__packing_find(const tt__packing *p, int size, int width, int heigh
             int next = -1;
             for (i = 0; i < height && next < 0; i++) {
                 r = i == 0 ? hint : order[i] == hint ? order[0] : order[i];
-                if ((next = tt__packing_clash(p, r, width, at_y + r, at_x, size)) >= 0) {
+                if ((next = tt__packing_clash(p, t->mask, r, width, at_y + r, at_x, size)) >= 0) {
                     at_x = next;
                     hint = r;
                 }
             }
             if (next < 0) {
-                *x = at_x;
-                *y = at_y;
+                t->x = at_x;
+                t->y = at_y;
                 return 1;
             }
         }
@@ -19407,19 +19428,20 @@ static int tt__packing_find(const tt__packing *p, int size, int width, int heigh
     return 0;
 }
 
-/* The free cells beneath the mask (p->mask, width x height) placed at (x,
-   y): in each of its columns, those between its lowest cell and the first
+/* The free cells beneath turn t's mask (width x height) placed at (x, y):
+   in each of its columns, those between its lowest cell and the first
    taken cell below (or the atlas's bottom), at most `height` deep. Room a
    chart leaves there is a hollow that only a smaller chart can still use. */
-static long tt__packing_waste(const tt__packing *p, int width, int height, int x, int y)
+static long tt__packing_waste(const tt__packing *p, const tt__packing_turn *t)
 {
+    const int width = t->width, height = t->height, x = t->x, y = t->y;
     long waste = 0;
     int nw = (width + 63) / 64, w, low;
     /* Row by row from the bottom, the columns whose lowest cell it holds. */
     for (w = 0; w < nw; w++) {
         uint64_t seen = 0, all = 64 * w + 64 <= width ? ~(uint64_t)0 : ((uint64_t)1 << (width - 64 * w)) - 1;
         for (low = 0; low < height && seen != all; low++) {
-            uint64_t fresh = p->mask[(size_t)low * p->words + w] & ~seen;
+            uint64_t fresh = t->mask[(size_t)low * p->words + w] & ~seen;
             seen |= fresh;
             while (fresh) {
                 int col = x + 64 * w + tt__lowest_bit(fresh), row, depth;
@@ -19433,6 +19455,31 @@ static long tt__packing_waste(const tt__packing *p, int width, int height, int x
     return waste;
 }
 
+/* Turn r of the chart whose outline (p->cols x p->rows) is in p->outline,
+   at its lowest place (then leftmost): found, x, y and key in p->turn[r].
+   The key is the row, or with p->waste the free cells beneath plus the
+   mask's width times the row. With `rival` (a turn tried before), it looks
+   only where it could still win: below the rival's row, or with p->waste
+   below the rival's key over its own width (the waste is never
+   negative). */
+static void tt__packing_try_turn(tt__packing *p, int r, const tt__packing_turn *rival)
+{
+    tt__packing_turn *t = &p->turn[r];
+    int j, below;
+    tt__mask_turn(p, p->cols, p->rows, r, t->mask, &t->width, &t->height);
+    for (j = 0; j < t->height; j++) t->need[j] = tt__longest_run(t->mask + (size_t)j * p->words, t->width, 1);
+    below = !rival ? p->size : p->waste ? (int)(rival->key / t->width) + 1 : rival->y;
+    t->found = tt__packing_find(p, t, below < p->size ? below : p->size);
+    if (t->found) t->key = p->waste ? (double)tt__packing_waste(p, t) + (double)t->width * t->y : t->y;
+}
+
+/* A turn tried as a task, over the whole atlas: the others are tried at
+   the same time. */
+static void tt__packing_turn_task(void *context, int r)
+{
+    tt__packing_try_turn((tt__packing *)context, r, NULL);
+}
+
 /* Packing of the charts' outlines in a bitmap: the charts in `order`, each
    in the turn that lets it sit lowest (then leftmost), at the lowest free
    place (then leftmost): small charts fill the room that larger ones left
@@ -19440,56 +19487,49 @@ static long tt__packing_waste(const tt__packing *p, int width, int height, int x
    With p->waste, each turn still goes to its lowest place, but the turn
    kept is the one whose free cells beneath plus its width times its row
    are fewest (a chart that sits a little higher but fits the ground below
-   it). 1 when all fit in size x size; then x, y, turn, if given, get each
-   chart's offset in texels from the bottom-left corner and its turn.
-   need and rows_order: size ints each. */
+   it). 1 when all fit in p->size x p->size; then x, y, turn, if given, get
+   each chart's offset in texels from the bottom-left corner and its turn.
+   Tried one after another, a turn looks only where it could still beat
+   the best so far (tt__packing_try_turn); tried at once (p->executor),
+   each looks everywhere, and the same rule in the same order picks the
+   same turn: a turn found only by looking further has a larger key, and
+   without p->waste a later turn wins only by a lower row. */
 static int tt__pack_bitmap(const tt__chart *charts, const tt__chart_order *order, int n, const int *members,
-                           const double *xy, double s, int gutter, int size, tt__packing *p, int *need,
-                           int *rows_order, int *x, int *y, int *turn)
+                           const double *xy, double s, int gutter, tt__packing *p, int *x, int *y, int *turn)
 {
+    const int size = p->size;
     int i, r, j;
     memset(p->bits, 0, sizeof *p->bits * (size_t)size * p->words);
     for (r = 0; r < size; r++) p->run[r] = size;
     for (i = 0; i < n; i++) {
         const tt__chart *chart = charts + order[i].chart;
-        int best_x = 0, best_y = size, best_turn = -1, at_x, at_y, width, height, cols, rows;
-        double best_key = 0.0;
-        if (!tt__chart_outline(chart, members, xy, s, gutter, size, p, &cols, &rows)) return 0;
+        const tt__packing_turn *best = NULL;
+        if (!tt__chart_outline(chart, members, xy, s, gutter, size, p, &p->cols, &p->rows)) return 0;
+        if (p->executor) tt__run_tasks(p->executor, 4, tt__packing_turn_task, p);
         for (r = 0; r < 4; r++) {
-            int below = best_y;
-            double key;
-            tt__mask_turn(p, cols, rows, r, &width, &height);
-            for (j = 0; j < height; j++) need[j] = tt__longest_run(p->mask + (size_t)j * p->words, width, 1);
-            /* The waste is never negative: rows from best_key / width up cannot win. */
-            if (p->waste) below = best_turn < 0 ? size : (int)(best_key / width) + 1;
-            if (below > size) below = size;
-            if (!tt__packing_find(p, size, width, height, need, rows_order, below, &at_x, &at_y)) continue;
-            key = p->waste ? (double)tt__packing_waste(p, width, height, at_x, at_y) + (double)width * at_y : at_y;
-            if (best_turn < 0 || key < best_key ||
-                (key == best_key && (at_y < best_y || (at_y == best_y && at_x < best_x)))) {
-                best_key = key;
-                best_x = at_x;
-                best_y = at_y;
-                best_turn = r;
-            }
+            const tt__packing_turn *t = &p->turn[r];
+            if (!p->executor) tt__packing_try_turn(p, r, best);
+            if (!t->found) continue;
+            if (!best || t->key < best->key ||
+                (p->waste && t->key == best->key && (t->y < best->y || (t->y == best->y && t->x < best->x))))
+                best = t;
         }
-        if (best_turn < 0) return 0;
-        tt__mask_turn(p, cols, rows, best_turn, &width, &height);
-        for (r = 0; r < height; r++) {
-            const uint64_t *mask = p->mask + (size_t)r * p->words;
-            uint64_t *line = p->bits + (size_t)(best_y + r) * p->words;
-            int shift = best_x & 63, w0 = best_x >> 6;
-            for (j = 0; j < (width + 63) / 64; j++) {
+        if (!best) return 0;
+        for (r = 0; r < best->height; r++) {
+            const uint64_t *mask = best->mask + (size_t)r * p->words;
+            uint64_t *line = p->bits + (size_t)(best->y + r) * p->words;
+            int shift = best->x & 63, w0 = best->x >> 6;
+            for (j = 0; j < (best->width + 63) / 64; j++) {
                 if (!mask[j]) continue;
                 line[w0 + j] |= mask[j] << shift;
                 if (shift && w0 + j + 1 < p->words) line[w0 + j + 1] |= mask[j] >> (64 - shift);
             }
-            p->run[best_y + r] = tt__longest_run(line, size, 0);
+            p->run[best->y + r] = tt__longest_run(line, size, 0);
         }
         if (x) {
-            x[order[i].chart] = best_x;
-            y[order[i].chart] = best_y;
-            turn[order[i].chart] = best_turn;
+            x[order[i].chart] = best->x;
+            y[order[i].chart] = best->y;
+            turn[order[i].chart] = (int)(best - p->turn);
         }
     }
     return 1;
@@ -19772,8 +19812,8 @@ static tt_result tt__atlas_too_small(int ncharts, int gutter, int size, tt_error
    would lose a point of fill). try_box holds 3 nf ints. */
 static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart_order *order,
                                         const tt__chart_order *order_area, int ncharts, const int *members,
-                                        const double *xy, int block_gutter, int side, tt__packing *pack, int *need,
-                                        int *rows_order, int *try_box, int nf, const tt_chart_pack_options *opt,
+                                        const double *xy, int block_gutter, int side, tt__packing *pack,
+                                        int *try_box, int nf, const tt_chart_pack_options *opt,
                                         float base, float span, double surface, double tiny, double rival, int *box_x,
                                         int *box_y, int *box_turn, double *scale, tt_error *error)
 {
@@ -19783,8 +19823,8 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
     if (s_hi < s_lo) s_hi = s_lo;
     if (floor_scale > s_lo && floor_scale < s_hi) {
         tries++;
-        if (!tt__pack_bitmap(charts, order, ncharts, members, xy, floor_scale, block_gutter, side, pack, need,
-                             rows_order, box_x, box_y, box_turn)) {
+        if (!tt__pack_bitmap(charts, order, ncharts, members, xy, floor_scale, block_gutter, pack, box_x, box_y,
+                             box_turn)) {
             *scale = tiny;
             return TT_OK;
         }
@@ -19794,8 +19834,8 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
         while (tries < 100 && s_hi - s_lo > 5e-3 * s_hi) {
             int fits;
             if (!(mid > s_lo && mid < s_hi)) mid = 0.5 * (s_lo + s_hi);
-            fits = tt__pack_bitmap(charts, order, ncharts, members, xy, mid, block_gutter, side, pack, need, rows_order,
-                                   try_box, try_box + nf, try_box + 2 * (size_t)nf);
+            fits = tt__pack_bitmap(charts, order, ncharts, members, xy, mid, block_gutter, pack, try_box, try_box + nf,
+                                   try_box + 2 * (size_t)nf);
             tries++;
             if (fits) {
                 s_lo = mid;
@@ -19817,16 +19857,14 @@ static tt_result tt__atlas_search_scale(const tt__chart *charts, const tt__chart
         }
     }
     if (!packed)
-        tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, side, pack, need, rows_order, box_x,
-                        box_y, box_turn);
+        tt__pack_bitmap(charts, order, ncharts, members, xy, s_lo, block_gutter, pack, box_x, box_y, box_turn);
     if (packed && s_lo * pow(TT__PACK_REFINE, 2 * TT__PACK_REFINE_STEPS) >= rival)
         for (way = 0; way < 2; way++) {
             pack->waste = 1;
             for (step = 0; step < TT__PACK_REFINE_STEPS; step++) {
                 double s = s_lo * TT__PACK_REFINE;
                 int fits = tt__pack_bitmap(charts, way ? order_area : order, ncharts, members, xy, s, block_gutter,
-                                           side, pack, need, rows_order, try_box, try_box + nf,
-                                           try_box + 2 * (size_t)nf);
+                                           pack, try_box, try_box + nf, try_box + 2 * (size_t)nf);
                 tries++;
                 if (opt->progress &&
                     opt->progress(base + span * (float)(1.0 - 1.0 / (1.0 + tries / 3.0)), opt->progress_user_data)) {
@@ -19950,7 +19988,8 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     int *try_box = NULL, *seed = NULL;
     unsigned char *border = NULL;
     tt_chart_pack_options opt;
-    int *need = NULL, *rows_order = NULL, block, side, block_gutter;
+    uint64_t *turn_masks = NULL;
+    int *turn_rows = NULL, block, side, block_gutter, r;
     tt__chart *charts = NULL;
     tt__chart_order *order = NULL, *order_area = NULL;
     tt__tri_grid grid;
@@ -19995,16 +20034,23 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
     block_gutter = (gutter + block - 1) / block;
     reach_cells = tt__atlas_reach_cells(gutter, block);
     pack.words = (side + 63) / 64;
+    pack.size = side;
+    pack.executor = opt.executor;
     pack.bits = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
-    pack.mask = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
     pack.outline = TT__ALLOC(al, uint64_t, (size_t)side * pack.words);
     pack.run = TT__ALLOC(al, int, side);
-    need = TT__ALLOC(al, int, side);
-    rows_order = TT__ALLOC(al, int, side);
+    /* each turn's mask, and its rows' runs and order */
+    turn_masks = TT__ALLOC(al, uint64_t, 4 * (size_t)side * pack.words);
+    turn_rows = TT__ALLOC(al, int, 8 * (size_t)side);
     if (!normal || !area || !xy || !chart || !tried || !members || !charts || !order || !order_area || !box_x ||
-        !box_y || !box_turn || !try_box || !seed || !border || !best_uv || !pack.bits || !pack.mask || !pack.outline ||
-        !pack.run || !need || !rows_order || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
+        !box_y || !box_turn || !try_box || !seed || !border || !best_uv || !pack.bits || !pack.outline ||
+        !pack.run || !turn_masks || !turn_rows || !tt__tri_grid_init(&grid, al, xy, nf, 1.0))
         goto out_of_memory;
+    for (r = 0; r < 4; r++) {
+        pack.turn[r].mask = turn_masks + (size_t)r * side * pack.words;
+        pack.turn[r].need = turn_rows + 2 * (size_t)r * side;
+        pack.turn[r].order = turn_rows + (2 * (size_t)r + 1) * side;
+    }
 
     tt__atlas_measure(mesh, normal, area, &surface, &diagonal, &cell);
     grid.cell = cell;
@@ -20031,15 +20077,14 @@ TTDEF tt_result tt_atlas_pack_charts(const tt_mesh *mesh, int size, int gutter, 
            within its frame. */
         tiny = largest > 0.0 ? 1e-6 / largest : 1.0;
         pack.reach = 2.0 * (block_gutter + 1);
-        fits = tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, block_gutter, side, &pack, need, rows_order,
-                               NULL, NULL, NULL);
+        fits = tt__pack_bitmap(charts, order, ncharts, members, xy, tiny, block_gutter, &pack, NULL, NULL, NULL);
         pack.reach = reach_cells;
         if (!fits) {
             if (fewest < 0 || ncharts < fewest) fewest = ncharts;
             continue;
         }
         result = tt__atlas_search_scale(charts, order, order_area, ncharts, members, xy, block_gutter, side, &pack,
-                                        need, rows_order, try_box, nf, &opt, 0.5f * attempt, 0.5f, surface, tiny,
+                                        try_box, nf, &opt, 0.5f * attempt, 0.5f, surface, tiny,
                                         best_charts ? best_scale : 0.0, box_x, box_y, box_turn, &s_lo, error);
         if (result != TT_OK) goto done;
         if (best_charts == 0 || s_lo > best_scale) {
@@ -20084,11 +20129,10 @@ done:
     tt__free(al, border);
     tt__free(al, best_uv);
     tt__free(al, pack.bits);
-    tt__free(al, pack.mask);
     tt__free(al, pack.outline);
     tt__free(al, pack.run);
-    tt__free(al, need);
-    tt__free(al, rows_order);
+    tt__free(al, turn_masks);
+    tt__free(al, turn_rows);
     return result;
 }
 

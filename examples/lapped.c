@@ -858,6 +858,7 @@ static int bake_uvs(lapped_options *options, const triangle_mesh *m, const float
         memset(&pack, 0, sizeof pack);
         pack.progress = tool_show_progress;
         pack.progress_user_data = &progress;
+        pack.executor = tool_executor();
         for (;;) {
             tt_result packed = tt_atlas_pack_charts(m->mesh, options->bake_size, LAPPED_BAKE_GUTTER, &pack, NULL,
                                                     *corner_uv, &report, &error);

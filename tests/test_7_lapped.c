@@ -4549,6 +4549,24 @@ static void test_atlas_pack_charts(void)
     CHECK(tt_atlas_pack_charts(mesh, 1024, 2, NULL, NULL, again, &report2, NULL) == TT_OK &&
               memcmp(uv, again, sizeof(float) * 2 * (size_t)mesh->ncorners) == 0,
           "deterministic");
+    {
+        /* The four turns tried at once pick what one after another picks. */
+        const tt_executor *executors[2];
+        tt_chart_pack_options po;
+        int e;
+        executors[0] = &g_reverse_executor;
+        executors[1] = &g_thread_executor;
+        for (e = 0; e < 2; e++) {
+            memset(&po, 0, sizeof po);
+            po.executor = executors[e];
+            memset(again, 0, sizeof(float) * 2 * (size_t)mesh->ncorners);
+            CHECK(tt_atlas_pack_charts(mesh, 1024, 2, &po, NULL, again, &report2, &err) == TT_OK &&
+                      memcmp(uv, again, sizeof(float) * 2 * (size_t)mesh->ncorners) == 0 &&
+                      report2.fill == report.fill,
+                  "the %s executor packs the same atlas (fill %.4f against %.4f)", e ? "threads'" : "reverse",
+                  report2.fill, report.fill);
+        }
+    }
     /* Gutter 0 and 4, a small size: still every promise. */
     CHECK(tt_atlas_pack_charts(mesh, 256, 4, NULL, NULL, uv, &report, &err) == TT_OK, "gutter 4 at 256: %s", err.message);
     chart_check_atlas("torus at 256, gutter 4", mesh, uv, &report, 256, 4, spread);
