@@ -680,12 +680,12 @@ static int left_by_dead_run(const char *path, const char *entry)
    Only regular files of exactly those names go. */
 static void remove_leftovers(const char *path)
 {
-    const char *slash = strrchr(path, '/');
-    size_t dir_length = slash ? (size_t)(slash - path) + 1 : 0;
     char *directory = directory_of(path);
+    size_t dir_length;
     DIR *dir;
     struct dirent *entry;
     if (!directory) return;
+    dir_length = strlen(directory);
     dir = opendir(directory);
     while (dir && (entry = readdir(dir)) != NULL) {
         struct stat info;
@@ -693,7 +693,7 @@ static void remove_leftovers(const char *path)
         if (!left_by_dead_run(path, entry->d_name)) continue;
         full = (char *)malloc(dir_length + strlen(entry->d_name) + 1);
         if (!full) break;
-        memcpy(full, path, dir_length);
+        memcpy(full, directory, dir_length);
         strcpy(full + dir_length, entry->d_name);
         if (lstat(full, &info) == 0 && S_ISREG(info.st_mode)) remove(full);
         free(full);

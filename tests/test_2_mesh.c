@@ -2063,32 +2063,35 @@ static int remesh_folded_quads(const tt_mesh *q)
     return folded;
 }
 
-/* What tt_remesh_quads promises of every result: tt_mesh_build accepts
-   it again (strict: no face of zero area), and no quad has two corners at
-   one point. Returns the interior vertices with two faces (doublets). */
+/* What tt_remesh_quads promises of every result: quads only, which
+   tt_mesh_build accepts again (strict: no face of zero area), none with
+   two corners at one point. Returns the interior vertices with two faces (doublets). */
 static int remesh_check_clean(const tt_mesh *q, const char *what)
 {
     tt_mesh_desc desc;
     tt_mesh *again = NULL;
     tt_error err;
-    int *sizes = (int *)malloc(sizeof(int) * (size_t)q->nfaces), f, v, c, k, same = 0, doublets = 0;
+    int f, v, c, k, same = 0, doublets = 0;
     int *count = (int *)calloc((size_t)q->nverts, sizeof(int));
     unsigned char *boundary = (unsigned char *)calloc((size_t)q->nverts, 1);
-    if (!sizes || !count || !boundary) {
+    if (!count || !boundary) {
         CHECK(0, "%s: out of memory", what);
-        free(sizes); free(count); free(boundary);
+        free(count); free(boundary);
         return -1;
     }
-    for (f = 0; f < q->nfaces; f++) sizes[f] = q->face_start[f + 1] - q->face_start[f];
-    memset(&desc, 0, sizeof desc);
-    desc.positions = q->pos;
-    desc.nverts = q->nverts;
-    desc.indices = q->corner_vert;
-    desc.face_sizes = sizes;
-    desc.nfaces = q->nfaces;
-    CHECK(tt_mesh_build(&desc, NULL, &again, &err) == TT_OK, "%s: the result builds again, strict: %s", what,
-          err.message);
-    tt_mesh_free(again);
+    CHECK(q->min_face_size == 4 && q->max_face_size == 4, "%s: faces of %d..%d sides", what, q->min_face_size,
+          q->max_face_size);
+    if (q->min_face_size == 4 && q->max_face_size == 4) {
+        memset(&desc, 0, sizeof desc);
+        desc.positions = q->pos;
+        desc.nverts = q->nverts;
+        desc.indices = q->corner_vert;
+        desc.fixed_face_size = 4;
+        desc.nfaces = q->nfaces;
+        CHECK(tt_mesh_build(&desc, NULL, &again, &err) == TT_OK, "%s: the result builds again, strict: %s", what,
+              err.message);
+        tt_mesh_free(again);
+    }
     for (f = 0; f < q->nfaces; f++)
         for (c = q->face_start[f]; c < q->face_start[f + 1]; c++)
             for (k = c + 1; k < q->face_start[f + 1]; k++)
@@ -2099,7 +2102,7 @@ static int remesh_check_clean(const tt_mesh *q, const char *what)
         if (q->twin[c] < 0) boundary[q->corner_vert[c]] = 1;
     }
     for (v = 0; v < q->nverts; v++) doublets += count[v] == 2 && !boundary[v];
-    free(sizes); free(count); free(boundary);
+    free(count); free(boundary);
     return doublets;
 }
 

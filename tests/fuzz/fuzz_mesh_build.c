@@ -356,24 +356,20 @@ static void exercise(const tt_mesh *m, const tt_tile_layout *layout, uint64_t se
         } else {
             tt_mesh_desc again_desc;
             tt_mesh *again = NULL;
-            int *sizes = (int *)malloc(sizeof(int) * (size_t)rq->nfaces);
             check_mesh(rq, NULL, 1);
             CHECK(rq->min_face_size == 4 && rq->max_face_size == 4, "remeshed faces of %d..%d sides",
                   rq->min_face_size, rq->max_face_size);
             /* The promise: tt_mesh_build accepts the result again, strict
                (no face of zero area). */
-            CHECK(sizes != NULL, "out of memory");
-            for (face = 0; face < rq->nfaces; face++) sizes[face] = 4;
             memset(&again_desc, 0, sizeof again_desc);
             again_desc.positions = rq->pos;
             again_desc.nverts = rq->nverts;
             again_desc.indices = rq->corner_vert;
-            again_desc.face_sizes = sizes;
+            again_desc.fixed_face_size = 4;
             again_desc.nfaces = rq->nfaces;
             r = tt_mesh_build(&again_desc, NULL, &again, &err);
             CHECK(r == TT_OK, "the remeshed mesh does not build again: %s", err.message);
             tt_mesh_free(again);
-            free(sizes);
             tt_mesh_free(rq);
         }
         free(vectors);
