@@ -7421,14 +7421,22 @@ static const float *tt__remesh_ring_point(const tt_mesh *q, int first, int count
 /* The area centroid of the polygon around a split face (quads first ..
    first + count - 1 of q): with ring 0 of its edge points, with 1 of its
    corners; triangles fanned from the points' mean, signed along their
-   summed normal. The mean when the area is zero. */
+   summed normal. The mean when the area is zero, or when the signed areas
+   so nearly cancel (a ring crossing itself) that the quotient leaves the
+   points' bounding box, where no average of the polygon's points lies:
+   it could even pass the float range. */
 static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int ring, double out[3])
 {
     double mean[3] = {0.0, 0.0, 0.0}, normal[3] = {0.0, 0.0, 0.0}, sum[3] = {0.0, 0.0, 0.0}, weight = 0.0;
-    double a[3], b[3], cross[3];
-    int i, k, pass;
+    double a[3], b[3], cross[3], lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    int i, k, pass, inside = 1;
     for (i = 0; i < count; i++)
-        for (k = 0; k < 3; k++) mean[k] += tt__remesh_ring_point(q, first, count, ring, i)[k] / (double)count;
+        for (k = 0; k < 3; k++) {
+            double x = tt__remesh_ring_point(q, first, count, ring, i)[k];
+            mean[k] += x / (double)count;
+            lo[k] = fmin(lo[k], x);
+            hi[k] = fmax(hi[k], x);
+        }
     /* The fan's summed normal first, then each triangle's area along it. */
     for (pass = 0; pass < 2; pass++)
         for (i = 0; i < count; i++) {
@@ -7445,7 +7453,11 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
             weight += area;
             for (k = 0; k < 3; k++) sum[k] += area * (mean[k] + (a[k] + b[k]) / 3.0);
         }
-    for (k = 0; k < 3; k++) out[k] = weight != 0.0 ? sum[k] / weight : mean[k];
+    for (k = 0; k < 3 && weight != 0.0; k++) {
+        out[k] = sum[k] / weight;
+        inside &= out[k] >= lo[k] && out[k] <= hi[k];
+    }
+    if (weight == 0.0 || !inside) memcpy(out, mean, sizeof mean);
 }
 
 /* The output from the traced faces: a face that meets itself at a vertex

@@ -2487,6 +2487,49 @@ static void test_remesh_errors(void)
     tt_mesh_free(mesh);
 }
 
+/* The centre the remesher tries for a split face that folds: the area
+   centroid of the ring of its corners, which for a ring crossing itself
+   (signed areas almost cancelling) is a quotient of two small numbers far
+   outside the ring, once past the float range (a remeshed vertex at
+   infinity); there it must fall back to the mean. */
+static void test_remesh_ring_centroid(void)
+{
+    static const float trapezoid[4 * 3] = {0, 0, 0, 3, 0, 0, 2, 1, 0, 0, 1, 0};
+    float bow_tie[4 * 3] = {0, 0, 0, 1, 1, 0, 1, 0, 0, 0, 1, 0};
+    const float *shapes[2];
+    double expected[2][3] = {{19.0 / 15.0, 7.0 / 15.0, 0.0}, {0.5, 0.5 + 0.25e-6, 0.0}};
+    int indices[4] = {0, 1, 2, 3}, s, k;
+    bow_tie[3 * 3 + 1] = 1.0f + 1e-6f;   /* the two lobes' areas differ by 5e-7 */
+    shapes[0] = trapezoid;
+    shapes[1] = bow_tie;
+    for (s = 0; s < 2; s++) {
+        tt_mesh_desc d;
+        tt_mesh *face = NULL, *q = NULL;
+        tt_error err;
+        double centre[3] = {0.0, 0.0, 0.0}, off = 0.0;
+        memset(&d, 0, sizeof d);
+        d.positions = shapes[s];
+        d.nverts = 4;
+        d.indices = indices;
+        d.fixed_face_size = 4;
+        d.nfaces = 1;
+        d.flags = TT_MESH_PERMISSIVE;
+        if (tt_mesh_build(&d, NULL, &face, &err) != TT_OK ||
+            tt_mesh_quadrangulate(face, TT_SUBDIVIDE_LINEAR, NULL, &q, &err) != TT_OK) {
+            CHECK(0, "building shape %d: %s", s, err.message);
+            tt_mesh_free(face);
+            continue;
+        }
+        internal_remesh_ring_centroid(q, 0, 4, 1, centre);
+        for (k = 0; k < 3; k++) off = fmax(off, fabs(centre[k] - expected[s][k]));
+        CHECK(off < 1e-6, "%s: centre (%g, %g, %g), expected (%g, %g, %g)", s ? "a bow tie (the mean)" :
+              "a trapezoid (its area centroid)", centre[0], centre[1], centre[2], expected[s][0], expected[s][1],
+              expected[s][2]);
+        tt_mesh_free(q);
+        tt_mesh_free(face);
+    }
+}
+
 /* Flag bits the builder does not know are refused, not ignored: a caller
    who sets one expects something of it. */
 static void test_builder_unknown_flags(void)
@@ -2528,4 +2571,5 @@ void run_mesh_tests(void)
     RUN(test_remesh_topology);
     RUN(test_remesh_creases);
     RUN(test_remesh_errors);
+    RUN(test_remesh_ring_centroid);
 }

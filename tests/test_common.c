@@ -446,6 +446,10 @@ void internal_untangle_descend(int n, const double (*ring)[2][2], const double (
     }
     tt__untangle_descend(&star, x, reach, delta2, density, strict, kept);
 }
+void internal_remesh_ring_centroid(const tt_mesh *q, int first, int count, int ring, double out[3])
+{
+    tt__remesh_ring_centroid(q, first, count, ring, out);
+}
 void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
                                 float weight_out[3])
 {

@@ -228,6 +228,10 @@ double internal_untangle_energy(int n, const double (*ring)[2][2], const double 
 /* Where a star's centre descends from x (tt__untangle_descend). */
 void internal_untangle_descend(int n, const double (*ring)[2][2], const double (*shape)[2][2], const double x[2],
                                double reach, double delta2, double density, int strict, double kept[2]);
+/* Section 2's area centroid of the ring around a split face of q
+   (tt__remesh_ring_centroid): quads first .. first + count - 1, ring 0 its
+   edge points, 1 its corners. */
+void internal_remesh_ring_centroid(const tt_mesh *q, int first, int count, int ring, double out[3]);
 /* The position and weights of a split vertex interpolating three of mesh's vertices (tt__split_vertex_data). */
 void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
                                 float weight_out[3]);
