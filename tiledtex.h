@@ -7298,7 +7298,8 @@ static int tt__remesh_onto_input(const tt_mesh *m, const int *head, const int *n
 }
 
 /* Whether the quad of vertices v[0..3] is folded: an edge of zero length,
-   or the two triangles on either diagonal facing apart. */
+   or the two triangles on either diagonal facing apart (or a corner not
+   finite, which no comparison of their normals could tell). */
 static int tt__quad_is_folded(const float *pos, const int v[4])
 {
     double e[4][3], a[3], b[3];
@@ -7308,7 +7309,7 @@ static int tt__quad_is_folded(const float *pos, const int v[4])
     for (k = 0; k < 2; k++) {
         tt__cross3(e[k], e[k + 1], a);
         tt__cross3(e[k + 2], e[(k + 3) & 3], b);
-        bad |= tt__dot3(a, b) < 0.0;
+        bad |= !(tt__dot3(a, b) >= 0.0);
     }
     return bad;
 }
