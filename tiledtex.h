@@ -3077,7 +3077,11 @@ TTDEF tt_result tt_flatten_cluster(const tt_mesh *mesh, const tt_cluster_hierarc
         no room in a bounded image, or fits worse
         than `threshold` - unless its children would be smaller than the
         floor (min_footprint texels^2 or min_faces faces), where the best
-        fit is taken whatever its error. A cluster smaller than the floor
+        fit is taken whatever its error. A fit taken gives way to the
+        textured neighbours' continuation (below) when that matches the
+        cluster's borders better at full resolution: the fit was judged on
+        the blurred copy, which cannot see a fine photo's grains (the
+        report's floor_continued and accepted_continued). A cluster smaller than the floor
         (reached only below a cluster that could not be flattened) is not
         fitted: it continues the map of the textured neighbour whose
         continuation matches its borders best (the one it shares most
@@ -3177,7 +3181,8 @@ typedef struct tt_hpm_report {
     int fits;                               /* fits that found a place: accepted + floor + rejected
                                                (each a masked correlation over every copy) */
     int copies;                             /* turned copies of the image each fit tries */
-    int accepted_fits;                      /* fits at or below the threshold */
+    int accepted_fits;                      /* fits at or below the threshold: their place, or
+                                               accepted_continued */
     int floor_fits;                         /* fits at the floor: above the threshold, accepted, or
                                                floor_continued */
     int rejected_fits;                      /* fits above it: the cluster was split */
@@ -3198,6 +3203,7 @@ typedef struct tt_hpm_report {
     int floor_continued;                    /* of floor_fits, those whose place gave way to a textured
                                                neighbour's continuation, which matched the cluster's
                                                borders better (at full resolution) */
+    int accepted_continued;                 /* of accepted_fits, those whose place gave way the same way */
 } tt_hpm_report;
 
 /* Texture `mesh` (triangles) from `image` (linear RGBA; alpha ignored).
@@ -25045,19 +25051,26 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
         fit = tt__hpm_fit(S, C, stamp, &pl, &eps, res, error);
         if (fit == -2) return 0;
     }
-    /* At the floor a fit is accepted whatever its error; there it competes
-       with the continuations, judged where the seam is seen. The fit
-       matches the band on the image box-filtered to match_size and may
-       not continue its main neighbour, so on a fine stochastic photo
-       (gravel: grains of a few texels) its borders are unrelated texel
-       for texel - its place only shares the band's blurred brightness - and
-       those borders made most of the seam score on a knot tube. A
-       continuation is exact along the neighbour it continues. */
-    if (fit == 1 && at_floor && tt__hpm_continue_place(S, C, &cont, &cont_cost) && cont_cost >= 0) {
+    /* A fit that will be accepted (under the threshold, or at the floor
+       whatever its error) competes with the continuations, judged where
+       the seam is seen. The fit matches the band on the image box-filtered
+       to match_size and may not continue its main neighbour, so on a fine
+       stochastic photo (gravel: grains of a few texels) its borders are
+       unrelated texel for texel - its place only shares the band's blurred
+       brightness - and those borders made most of the seam score on a knot
+       tube. A continuation is exact along the neighbour it continues. */
+    if (fit == 1 && (at_floor || eps <= S->threshold) && tt__hpm_continue_place(S, C, &cont, &cont_cost) &&
+        cont_cost >= 0) {
         double fit_cost = tt__hpm_border_cost(S, C, &pl);
         if (fit_cost >= 0 && cont_cost < fit_cost) {
-            S->rep.floor_fits++;
-            S->rep.floor_continued++;
+            if (eps <= S->threshold) {
+                S->rep.accepted_fits++;
+                S->rep.accepted_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
+                S->rep.accepted_continued++;
+            } else {
+                S->rep.floor_fits++;
+                S->rep.floor_continued++;
+            }
             S->error_sum += eps;
             if (eps > S->rep.max_error) S->rep.max_error = eps;
             return tt__hpm_accept(S, C, &cont) ? 1 : tt__hpm_out_of_memory(C, res, error);

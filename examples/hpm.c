@@ -358,10 +358,11 @@ static void print_summary(const hpm_command_options *options, const triangle_mes
     for (level = 0; level <= last; level++)
         printf("%s L%d %d", level == 0 ? "" : ",", level, report->mapped_per_level[level]);
     printf("\n");
-    printf("fits: %d accepted, %d at the floor, %d rejected (split); %d continued, %d in place of a floor fit, "
-           "%d starts; split before fitting: %d not flat, %d no room; %d faces changed sides at borders\n",
+    printf("fits: %d accepted, %d at the floor, %d rejected (split); %d continued, %d in place of a fit (%d at the "
+           "floor), %d starts; split before fitting: %d not flat, %d no room; %d faces changed sides at borders\n",
            report->accepted_fits, report->floor_fits, report->rejected_fits, report->continued,
-           report->floor_continued, report->starts, report->not_flat, report->no_room, report->faces_moved);
+           report->accepted_continued + report->floor_continued, report->floor_continued, report->starts,
+           report->not_flat, report->no_room, report->faces_moved);
     if (report->faces_unflattened > 0)
         printf("%d faces no cluster could flatten show a neighbour's map continued over their edge, or their own\n",
                report->faces_unflattened);
