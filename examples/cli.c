@@ -459,7 +459,8 @@ int parse_mesh_option(int argc, char **argv, int *index, tool_mesh_options *opti
 {
     const char *value;
     if (tool_option(argc, argv, index, "--subdivide", &value)) {
-        if (parse_int("--subdivide", value, 0, 8, &options->subdivide) != 0) return -1;
+        if (options->auto_allowed && value && strcmp(value, "auto") == 0) options->subdivide = TOOL_SUBDIVIDE_AUTO;
+        else if (parse_int("--subdivide", value, 0, 8, &options->subdivide) != 0) return -1;
     } else if (tool_flag(argv[*index], "--smooth")) {
         options->smooth = 1;
     } else if (tool_flag(argv[*index], "--permissive")) {

@@ -11,6 +11,8 @@
 
      tt_mesh_build       validate the OBJ's faces, split into triangle fans
                          first: the method works on triangles
+     tt_mesh_quadrangulate  --subdivide (by default as many times as the
+                         texture's scale asks: hpm_auto_steps)
      tt_tangent_field    with --up or --constraints, the direction the
                          image's up follows on each face
      tt_hpm_map          the whole pipeline: cluster hierarchy, flattening,
@@ -27,6 +29,21 @@
 #include <string.h>
 
 #include "tool.h"
+
+/* --subdivide auto (the default; hpm_auto_steps below). Clusters are made
+   of whole triangles, and the library stops splitting them at the floor:
+   TT_DEFAULT_HPM_MIN_FACES faces or TT_DEFAULT_HPM_MIN_FOOTPRINT texels^2,
+   whichever comes first. Where the median triangle alone covers more than
+   half that footprint, the faces decide: the clusters at the floor are
+   many footprints large, fitted whatever their error, with long straight
+   borders that show (the bunny's 3.7k triangles with gravel: border seams
+   0.37; subdivided once, 0.10). Each step of --subdivide makes a triangle
+   6, then 4 times as many; a mesh already finer gains nothing and pays
+   the time (a 14k-face knot tube: 0.10 either way, 3 times the CPU).
+   docs/hpm.md has the measures. */
+#define HPM_AUTO_TRIANGLE_TEXELS (0.5 * TT_DEFAULT_HPM_MIN_FOOTPRINT)
+#define HPM_AUTO_MAX_STEPS 3
+#define HPM_AUTO_MAX_TRIANGLES 1000000  /* no step past this many triangles */
 
 static void print_help(void)
 {
@@ -84,14 +101,14 @@ static void print_help(void)
            "                   gltf: the same as glTF text, OUT_PREFIX.gltf, with OUT_PREFIX.bin and\n"
            "                   OUT_PREFIX_baseColor.png (and a PNG per map) beside it\n"
            "  --triangles      accepted for the OBJ, whose faces are triangles already\n");
-    printf("  --subdivide L    make the triangles smaller first, L from 0 to 8 (default 0):\n"
-           "                   quadrangulate them L times, as 'tiledtex tile' does, and split every\n"
-           "                   quad into two triangles, so a triangle becomes 6, 24, 96, ... (the\n"
-           "                   outputs have these). Clusters are made of whole triangles, so on a\n"
-           "                   coarse mesh (edges spanning a hundred texels) their borders are few,\n"
-           "                   long and visible; on smaller triangles they may find better places\n"
-           "                   (try 1 or 2 and compare the renders; a mesh whose edges span 30 texels\n"
-           "                   or fewer gains nothing)\n"
+    printf("  --subdivide L    make the triangles smaller first, L from 0 to 8, or auto (the\n"
+           "                   default): quadrangulate them L times, as 'tiledtex tile' does, and\n"
+           "                   split every quad into two triangles, so a triangle becomes 6, 24, 96,\n"
+           "                   ... (the outputs have these). Clusters are made of whole triangles, so\n"
+           "                   on a coarse mesh their borders are few, long and visible. auto\n"
+           "                   subdivides (at most 3 times, and not past %d triangles) until the\n"
+           "                   median triangle covers at most %g texels^2 at --scale, half the\n"
+           "                   smallest patch, and says so; 0 keeps the mesh as it is\n"
            "  --smooth         Catmull-Clark positions when subdividing (rounder, a little smaller)\n"
            "  --permissive     accept non-manifold or mis-oriented edges (an edge shared by three\n"
            "                   faces, as some exports have): they are cut open into boundaries\n"
@@ -114,7 +131,8 @@ static void print_help(void)
            "example: tiledtex generate mesh torus.obj --shape torus\n"
            "         tiledtex generate texture stones.png --size 256\n"
            "         tiledtex hpm torus.obj stones.png torus_hpm --scale 3\n"
-           "         tiledtex render torus_hpm.obj stones.png view.png\n");
+           "         tiledtex render torus_hpm.obj stones.png view.png\n",
+           HPM_AUTO_MAX_TRIANGLES, HPM_AUTO_TRIANGLE_TEXELS);
 }
 
 typedef struct hpm_command_options {
@@ -147,6 +165,8 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
     const char *positional[3];
     int npositional = 0, i;
     memset(options, 0, sizeof *options);
+    options->mesh.subdivide = TOOL_SUBDIVIDE_AUTO;
+    options->mesh.auto_allowed = 1;
     for (i = 1; i < argc; i++) {
         const char *value;
         double number;
@@ -196,6 +216,87 @@ static int parse_command_line(int argc, char **argv, hpm_command_options *option
                                &options->output, options->prefix) != 0)
         return TOOL_EXIT_USAGE;
     return -1;
+}
+
+/* ======================================================================== */
+/* Subdividing a coarse mesh (--subdivide auto, the default)                */
+/* ======================================================================== */
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The steps --subdivide auto takes on m: the fewest (up to
+   HPM_AUTO_MAX_STEPS) after which the median triangle covers at most
+   HPM_AUTO_TRIANGLE_TEXELS at the mapping's scale (--scale, or the
+   library's default: the image's width over a quarter of the bounding
+   box's diagonal), none that would pass HPM_AUTO_MAX_TRIANGLES. The
+   median's area in texels^2 goes to *median_texels (0 when the mesh is
+   too small to tell). */
+static int hpm_auto_steps(const triangle_mesh *m, const tt_image *image, double scale, double *median_texels)
+{
+    const tt_mesh *mesh = m->mesh;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, diagonal = 0.0;
+    double *areas = (double *)malloc((size_t)mesh->nfaces * sizeof(double)), texels, triangles;
+    int f, k, steps = 0;
+    *median_texels = 0.0;
+    if (!areas) return 0;   /* out of memory: the mesh as it is */
+    for (f = 0; f < mesh->nfaces; f++) {
+        const float *p[3];
+        double e1[3], e2[3], cross[3];
+        for (k = 0; k < 3; k++) p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[mesh->face_start[f] + k];
+        for (k = 0; k < 3; k++) {
+            int j;
+            for (j = 0; j < 3; j++) {
+                lo[k] = fmin(lo[k], p[j][k]);
+                hi[k] = fmax(hi[k], p[j][k]);
+            }
+            e1[k] = (double)p[1][k] - p[0][k];
+            e2[k] = (double)p[2][k] - p[0][k];
+        }
+        cross[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        cross[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        cross[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        areas[f] = 0.5 * sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+    }
+    for (k = 0; k < 3; k++) diagonal += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    diagonal = sqrt(diagonal);
+    if (!(scale > 0.0)) scale = 0.25 * diagonal;
+    qsort(areas, (size_t)mesh->nfaces, sizeof(double), compare_doubles);
+    texels = areas[mesh->nfaces / 2] * ((double)image->width / scale) * ((double)image->width / scale);
+    free(areas);
+    if (!(texels > 0.0 && texels < HUGE_VAL)) return 0;
+    *median_texels = texels;
+    for (triangles = mesh->nfaces; steps < HPM_AUTO_MAX_STEPS && texels > HPM_AUTO_TRIANGLE_TEXELS; steps++) {
+        double factor = steps == 0 ? 6.0 : 4.0;
+        if (triangles * factor > HPM_AUTO_MAX_TRIANGLES) break;
+        triangles *= factor;
+        texels /= factor;
+    }
+    return steps;
+}
+
+/* --subdivide auto: m subdivided as hpm_auto_steps says, and said. */
+static int subdivide_coarse_mesh(const hpm_command_options *options, const tt_image *image, triangle_mesh *m)
+{
+    double median;
+    int before = m->ntriangles, steps = hpm_auto_steps(m, image, options->map.scale, &median), status;
+    if (steps == 0) {
+        if (median > HPM_AUTO_TRIANGLE_TEXELS)
+            tool_note("%s: its triangles cover %.0f texels^2 each (the median) at the texture's scale, more than "
+                      "half the smallest patch (%g), but subdividing them would pass %d triangles",
+                      options->mesh_path, median, TT_DEFAULT_HPM_MIN_FOOTPRINT, HPM_AUTO_MAX_TRIANGLES);
+        return 0;
+    }
+    if ((status = triangle_mesh_subdivide(options->mesh_path, steps, options->mesh.smooth, m)) != 0) return status;
+    tool_note("%s: its triangles cover %.0f texels^2 each (the median) at the texture's scale, more than half the "
+              "smallest patch (%g): subdivided %s (--subdivide %d), %d triangles into %d, so that clusters can "
+              "follow the texture (--subdivide 0 keeps them)",
+              options->mesh_path, median, TT_DEFAULT_HPM_MIN_FOOTPRINT,
+              steps == 1 ? "once" : steps == 2 ? "twice" : "three times", steps, before, m->ntriangles);
+    return 0;
 }
 
 /* ======================================================================== */
@@ -463,6 +564,8 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0 && !options.field.given)
         tool_note_courses_without_up(image, options.image_path, NULL,
                                      "without --up each cluster takes its own direction, so they wander");
+    if (status == 0 && options.mesh.subdivide == TOOL_SUBDIVIDE_AUTO)
+        status = subdivide_coarse_mesh(&options, image, &mesh);
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);
     /* Refuse, before the long part, outputs that would replace an input
        (the commit checks again, but only after mapping). */

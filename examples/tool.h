@@ -803,16 +803,22 @@ int triangle_texture_axes(const float *p0, const float *p1, const float *p2, con
 /* ---------------------------------------------------------------------- */
 
 /* The options of the commands that may refine or repair the mesh they read
-   (map, tile, lapped). */
+   (map, tile, lapped, hpm). */
 typedef struct tool_mesh_options {
-    int subdivide;          /* --subdivide L: quadrangulation steps */
+    int subdivide;          /* --subdivide L: quadrangulation steps, or TOOL_SUBDIVIDE_AUTO */
     int smooth;             /* --smooth: Catmull-Clark positions for those steps */
     int permissive;         /* --permissive: built with TT_MESH_PERMISSIVE, bad edges cut open */
+    int auto_allowed;       /* set by the command before parsing: --subdivide auto is accepted */
 } tool_mesh_options;
 
-/* If argv[*index] is --subdivide L (0 to 8), --smooth or --permissive,
-   consume it and return 1; 0 for any other argument; -1 after printing a
-   bad value. */
+/* --subdivide auto (hpm's default): the command chooses the steps once it
+   knows the texture's scale; triangle_mesh_read then leaves the mesh as
+   it is, for triangle_mesh_subdivide. */
+#define TOOL_SUBDIVIDE_AUTO (-1)
+
+/* If argv[*index] is --subdivide L (0 to 8, or auto where auto_allowed),
+   --smooth or --permissive, consume it and return 1; 0 for any other
+   argument; -1 after printing a bad value. */
 int parse_mesh_option(int argc, char **argv, int *index, tool_mesh_options *options);
 
 /* Subdividing past this many quads is refused (an OBJ of 16M quads is already
@@ -868,11 +874,17 @@ typedef struct triangle_mesh {
    (and a build error says when it would help), and --subdivide L
    quadrangulates the triangles L times (with Catmull-Clark positions under
    --smooth) and splits every quad into two triangles: a triangle becomes 6,
-   then 24, 96, ...; the file's texture coordinates and normals, when every
+   then 24, 96, ... (TOOL_SUBDIVIDE_AUTO leaves that to the command,
+   triangle_mesh_subdivide); the file's texture coordinates and normals, when every
    corner has them, go along (corner_uv, corner_normal). A build error is
    printed about the OBJ's own face and line. Returns 0, or the exit status after printing the error (*m is then
    empty). */
 int triangle_mesh_read(const char *path, const tool_mesh_options *options, triangle_mesh *m);
+/* The triangles of m (read without subdividing) quadrangulated `steps`
+   times (smooth: Catmull-Clark positions) and every quad split in two, as
+   --subdivide does; built again. Returns 0, or the exit status after
+   printing the error (m then holds no triangles: free it). */
+int triangle_mesh_subdivide(const char *path, int steps, int smooth, triangle_mesh *m);
 void triangle_mesh_free(triangle_mesh *m);
 /* Reverse every triangle's corners (an inside-out mesh turned outward) and
    build the mesh again; the file's normals, if any, are turned round too

@@ -211,7 +211,7 @@ static float *split_corner_values(const tt_mesh *quads, const float *values, int
    quad split into two triangles (quad_split). Every triangle keeps its OBJ
    face, and the OBJ's texture coordinates and normals are carried along.
    Replaces the triangles of m and builds them again. */
-static int triangle_mesh_subdivide(const char *path, const tool_mesh_options *options, triangle_mesh *m)
+int triangle_mesh_subdivide(const char *path, int steps, int smooth, triangle_mesh *m)
 {
     tt_mesh *mesh = m->mesh;
     int *face = m->face, *quad_face, *vert = NULL, step, q, k, status;
@@ -221,12 +221,12 @@ static int triangle_mesh_subdivide(const char *path, const tool_mesh_options *op
     m->face = NULL;
     m->corner_uv = NULL;
     m->corner_normal = NULL;
-    if ((status = tool_check_subdivide(path, mesh, options->subdivide)) != 0) goto done;
-    for (step = 0; step < options->subdivide; step++) {
+    if ((status = tool_check_subdivide(path, mesh, steps)) != 0) goto done;
+    for (step = 0; step < steps; step++) {
         if (!(quad_face = quad_faces(mesh, face))) goto out_of_memory;
         free(face);
         face = quad_face;
-        if ((status = tool_quadrangulate(path, &mesh, options->smooth, &uv, &normal)) != 0) goto done;
+        if ((status = tool_quadrangulate(path, &mesh, smooth, &uv, &normal)) != 0) goto done;
     }
 
     quad_face = (int *)malloc((size_t)mesh->nfaces * 2 * sizeof(int));
@@ -252,7 +252,7 @@ static int triangle_mesh_subdivide(const char *path, const tool_mesh_options *op
     m->pos = pos;
     m->nverts = mesh->nverts;
     m->ntriangles = 2 * mesh->nfaces;
-    m->subdivided = options->subdivide;
+    m->subdivided = steps;
     vert = NULL;
     pos = NULL;
     split_uv = split_normal = NULL;
@@ -300,7 +300,8 @@ int triangle_mesh_read(const char *path, const tool_mesh_options *options, trian
     find_first_triangles(m);
     status = triangle_mesh_build(path, m, options != NULL);
     if (status == 0) m->repaired_edges = m->mesh->repaired_edges;
-    if (status == 0 && options && options->subdivide > 0) status = triangle_mesh_subdivide(path, options, m);
+    if (status == 0 && options && options->subdivide > 0)
+        status = triangle_mesh_subdivide(path, options->subdivide, options->smooth, m);
     if (status == 0) tool_note_cut_edges(path, m->repaired_edges);
     else triangle_mesh_free(m);
     return status;

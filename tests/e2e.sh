@@ -1293,6 +1293,38 @@ check "hpm --subdivide 1: the summary counts 6 triangles for each" "'7680 triang
 check "hpm --subdivide 1: the OBJ has them" "7680 f lines" "$(grep -c '^f ' out.obj 2>&1) f lines" \
     "$([ "$(grep -c '^f ' out.obj 2>/dev/null)" = 7680 ]; echo $?)"
 cd "$W" || exit 1
+# --subdivide auto, the default: the 1280-triangle sphere at a 256-texel
+# image's default scale has triangles of about 860 texels^2, more than half
+# the library's smallest patch (576): subdivided once, and said; a 64-texel
+# image (54 texels^2) leaves it; --subdivide 0 keeps it; auto is hpm's own.
+newdir
+expect_ok "hpm on a coarse mesh (--subdivide auto)" hpm ../in/spheretri.obj ../in/lap256.png out --rotations 3
+err_mentions "hpm on a coarse mesh: says it subdivided, why and how to keep the mesh" \
+    'spheretri\.obj: its triangles cover [0-9]+ texels\^2 each \(the median\) at the texture.s scale, more than half the smallest patch \(576\): subdivided once \(--subdivide 1\), 1280 triangles into 7680, .*--subdivide 0 keeps them'
+check "hpm on a coarse mesh: the summary and the OBJ have the 7680 triangles" \
+    "'7680 triangles (1280 faces, --subdivide 1)', 7680 f lines" "$(grep -c '^f ' out.obj 2>&1) f lines" \
+    "$(printf '%s' "$OUT" | grep -q 'spheretri.obj: 7680 triangles (1280 faces, --subdivide 1)' &&
+       [ "$(grep -c '^f ' out.obj 2>/dev/null)" = 7680 ]; echo $?)"
+expect_ok "hpm --subdivide auto (given)" hpm ../in/spheretri.obj ../in/lap256.png given --rotations 3 --subdivide auto
+check "hpm --subdivide auto: the same vertices, coordinates and faces as the default" "equal v, vt and f lines" \
+    "$(diff <(grep -E '^(v|vt|f) ' out.obj) <(grep -E '^(v|vt|f) ' given.obj) 2>&1 | head -3)" \
+    "$(diff -q <(grep -E '^(v|vt|f) ' out.obj) <(grep -E '^(v|vt|f) ' given.obj) >/dev/null 2>&1; echo $?)"
+expect_ok "hpm --subdivide 0 on the coarse mesh" hpm ../in/spheretri.obj ../in/lap256.png kept --rotations 3 --subdivide 0
+check "hpm --subdivide 0: the mesh's 1280 triangles, no note" "1280 f lines, nothing on stderr about subdividing" \
+    "$(grep -c '^f ' kept.obj 2>&1) f lines; $ERR" \
+    "$([ "$(grep -c '^f ' kept.obj 2>/dev/null)" = 1280 ] && ! printf '%s' "$ERR" | grep -q subdivid; echo $?)"
+expect_ok "hpm on a 64-texel image (triangles small enough)" hpm ../in/spheretri.obj ../in/lap.png small --rotations 3
+check "hpm on a 64-texel image: not subdivided, no note" "1280 f lines, nothing on stderr about subdividing" \
+    "$(grep -c '^f ' small.obj 2>&1) f lines; $ERR" \
+    "$([ "$(grep -c '^f ' small.obj 2>/dev/null)" = 1280 ] && ! printf '%s' "$ERR" | grep -q subdivid; echo $?)"
+expect_ok "hpm --scale 8 (a coarser texture: triangles small enough)" hpm ../in/spheretri.obj ../in/lap256.png far \
+    --rotations 3 --scale 8
+check "hpm --scale 8: not subdivided" "1280 f lines" "$(grep -c '^f ' far.obj 2>&1) f lines" \
+    "$([ "$(grep -c '^f ' far.obj 2>/dev/null)" = 1280 ]; echo $?)"
+expect_error "lapped --subdivide auto (hpm's only)" lapped ../in/spheretri.obj ../in/lap.png out --subdivide auto
+check "lapped --subdivide auto: exit status 2 (usage)" "exit 2" "exit $RC" "$([ $RC -eq 2 ]; echo $?)"
+err_mentions "lapped --subdivide auto: names the option and what it wants" "subdivide wants an integer from 0 to 8, got 'auto'"
+cd "$W" || exit 1
 permissive_case hpm lap.png --rotations 3
 
 # --up: each cluster turned so that the image's up follows the direction field;
