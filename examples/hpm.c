@@ -39,10 +39,11 @@
    borders that show (the bunny's 3.7k triangles with gravel: border seams
    0.37; subdivided once, 0.10). Each step of --subdivide makes a triangle
    6, then 4 times as many; a mesh already finer gains nothing and pays
-   the time (a 14k-face knot tube: 0.10 either way, 3 times the CPU).
+   the time (a 14k-face knot tube: 0.10 either way, 3 times the CPU). A
+   12-triangle cube takes six steps (0.67 after three, 0.01 after six).
    docs/hpm.md has the measures. */
 #define HPM_AUTO_TRIANGLE_TEXELS (0.5 * TT_DEFAULT_HPM_MIN_FOOTPRINT)
-#define HPM_AUTO_MAX_STEPS 3
+#define HPM_AUTO_MAX_STEPS 8   /* --subdivide's own limit */
 #define HPM_AUTO_MAX_TRIANGLES 1000000  /* no step past this many triangles */
 
 static void print_help(void)
@@ -106,9 +107,9 @@ static void print_help(void)
            "                   split every quad into two triangles, so a triangle becomes 6, 24, 96,\n"
            "                   ... (the outputs have these). Clusters are made of whole triangles, so\n"
            "                   on a coarse mesh their borders are few, long and visible. auto\n"
-           "                   subdivides (at most 3 times, and not past %d triangles) until the\n"
-           "                   median triangle covers at most %g texels^2 at --scale, half the\n"
-           "                   smallest patch, and says so; 0 keeps the mesh as it is\n"
+           "                   subdivides (not past %d triangles) until the median triangle\n"
+           "                   covers at most %g texels^2 at --scale, half the smallest patch,\n"
+           "                   and says so; 0 keeps the mesh as it is\n"
            "  --smooth         Catmull-Clark positions when subdividing (rounder, a little smaller)\n"
            "  --permissive     accept non-manifold or mis-oriented edges (an edge shared by three\n"
            "                   faces, as some exports have): they are cut open into boundaries\n"
@@ -228,8 +229,8 @@ static int compare_doubles(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The steps --subdivide auto takes on m: the fewest (up to
-   HPM_AUTO_MAX_STEPS) after which the median triangle covers at most
+/* The steps --subdivide auto takes on m: the fewest after which the
+   median triangle covers at most
    HPM_AUTO_TRIANGLE_TEXELS at the mapping's scale (--scale, or the
    library's default: the image's width over a quarter of the bounding
    box's diagonal), none that would pass HPM_AUTO_MAX_TRIANGLES. The
@@ -281,6 +282,7 @@ static int hpm_auto_steps(const triangle_mesh *m, const tt_image *image, double 
 /* --subdivide auto: m subdivided as hpm_auto_steps says, and said. */
 static int subdivide_coarse_mesh(const hpm_command_options *options, const tt_image *image, triangle_mesh *m)
 {
+    char times[32];
     double median;
     int before = m->ntriangles, steps = hpm_auto_steps(m, image, options->map.scale, &median), status;
     if (steps == 0) {
@@ -291,11 +293,12 @@ static int subdivide_coarse_mesh(const hpm_command_options *options, const tt_im
         return 0;
     }
     if ((status = triangle_mesh_subdivide(options->mesh_path, steps, options->mesh.smooth, m)) != 0) return status;
+    if (steps <= 2) snprintf(times, sizeof times, "%s", steps == 1 ? "once" : "twice");
+    else snprintf(times, sizeof times, "%d times", steps);
     tool_note("%s: its triangles cover %.0f texels^2 each (the median) at the texture's scale, more than half the "
               "smallest patch (%g): subdivided %s (--subdivide %d), %d triangles into %d, so that clusters can "
               "follow the texture (--subdivide 0 keeps them)",
-              options->mesh_path, median, TT_DEFAULT_HPM_MIN_FOOTPRINT,
-              steps == 1 ? "once" : steps == 2 ? "twice" : "three times", steps, before, m->ntriangles);
+              options->mesh_path, median, TT_DEFAULT_HPM_MIN_FOOTPRINT, times, steps, before, m->ntriangles);
     return 0;
 }
 
