@@ -3226,6 +3226,9 @@ typedef struct tt_hpm_report {
                                 image whose kind is not a tt_image_kind, a bad
                                 allocator, options out of range, a face
                                 that is not a triangle (error->face), a
+                                bounded image (no TT_HPM_TOROIDAL) under 3
+                                texels on a side (every coordinate keeps
+                                a texel's margin), a
                                 scale at which a face does not fit the
                                 image without TT_HPM_TOROIDAL
                                 (error->face; the message says which
@@ -3241,14 +3244,14 @@ typedef struct tt_hpm_report {
      TT_CANCELLED               the progress callback stopped it;
      TT_ERROR_OUT_OF_MEMORY.
    Clusters are made of whole faces, so on a coarse mesh their borders
-   are few and long, and their seams show. Subdividing it first
+   are few and long, and their seams show. Subdivide it first
    (tt_mesh_quadrangulate with TT_SUBDIVIDE_LINEAR, each quad split into
-   two triangles) can help: an 891-triangle pig with a gravel photo,
-   edges of 100 texels, scores 0.50 on its borders and 0.04 subdivided
-   twice, the score times the borders' length 0.29 of what it was. It is
-   not a rule (a generated double torus with edges of 98 texels gains
-   nothing), and on a mesh whose edges span about 30 texels a step only
-   adds borders: the mean score falls, the mismatch does not.
+   two triangles) until the median triangle covers at most half of
+   min_footprint at the scale (288 texels^2 by default), as the tool
+   does: an 891-triangle pig with a gravel photo scores 0.50 on its
+   borders, 0.04 subdivided twice (the score times the borders' length
+   0.27 of what it was); a 12-triangle cube 0.67, 0.01 after six steps.
+   A mesh already that fine gains nothing (docs/hpm.md).
    On any error corner_uv and face_cluster are untouched. Time: the
    hierarchy and flattening (above) plus, per fit (report->fits), about
    10 ms at P = 256 by transforms or 0.3 ms summing a band of 30 pixels
@@ -25856,6 +25859,11 @@ TTDEF tt_result tt_hpm_map(const tt_mesh *mesh, const tt_image *image, const tt_
        default scale makes the longest edge span at most 3/4 of that, and a
        scale the caller chose is refused, saying which would work. */
     fit_texels = tt__min_i(image->width, image->height) - 2;
+    if (!S.toroidal && fit_texels < 1)
+        return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
+                        "hpm: the image is %d x %d texels: a bounded image needs at least 3 on each side (every "
+                        "texture coordinate stays a texel inside it); use a larger image, or TT_HPM_TOROIDAL for "
+                        "one that tiles", image->width, image->height);
     if (o.scale > 0)
         scale = o.scale;
     else {

@@ -323,9 +323,12 @@ static int map_mesh(const hpm_command_options *options, const triangle_mesh *m, 
     result = tt_hpm_map(m->mesh, image, &map, NULL, corner_uv, NULL, report, &error);
     tool_progress_end(&progress);
     if (result == TT_OK) return 0;
-    /* A texel error is about the image (an HDR file with infinities), the
-       rest about the mesh. */
-    if (result == TT_ERROR_NON_FINITE && error.face < 0)
+    /* A texel error is about the image (an HDR file with infinities), as
+       is a bounded image too small to keep a texel's margin; the rest is
+       about the mesh. */
+    if ((result == TT_ERROR_NON_FINITE && error.face < 0) ||
+        (result == TT_ERROR_INVALID_ARGUMENT && !(map.flags & TT_HPM_TOROIDAL) &&
+         (image->width < 3 || image->height < 3)))
         return tool_fail("%s: %s", options->image_path, error.message);
     return triangle_mesh_report_error(options->mesh_path, m, &error);
 }

@@ -1494,6 +1494,15 @@ expect_error "tile --up with an atlas too wide for four sets" tile ../in/torus.o
     --tile 72 --gutter 0 --up z
 err_mentions "tile --up atlas too wide: says why" 'plain and upright'
 expect_error "hpm --constraints missing file" hpm ../in/torus.obj ../in/lap.png out --constraints ../in/nope.txt
+# A bounded image keeps a texel's margin round every coordinate: 2 x 2 has
+# none to give (the error once blamed the mesh's "scale 0"); tiling, it maps.
+{ printf 'P5\n2 2\n255\n'; printf '\000\377\377\000'; } >"$W/in/tiny2.pgm"
+expect_error "hpm on a 2 x 2 image" hpm ../in/torus.obj ../in/tiny2.pgm out
+err_mentions "hpm on a 2 x 2 image: names the image, its size and the 3 texels it needs" \
+    'tiny2\.pgm: hpm: the image is 2 x 2 texels: a bounded image needs at least 3 on each side'
+newdir
+expect_ok "hpm on a 2 x 2 image --toroidal" hpm ../in/torus.obj ../in/tiny2.pgm tiny --toroidal
+cd "$W" || exit 1
 expect_error "hpm --up 0,0,0" hpm ../in/torus.obj ../in/lap.png out --up 0,0,0
 
 # the same seed twice: the same file; another seed: another result

@@ -2492,6 +2492,29 @@ static void test_hpm_map_errors(void)
               err.column == 3,
           "a NaN texel is named (row %d, column %d)", err.row, err.column);
     px(im, 3, 4)[1] = 0.5f;
+    /* A bounded image keeps a texel's margin: under 3 texels on a side it
+       has no room (the default scale divided by zero there, and the error
+       blamed "scale 0"); a tiling one has no margin to keep. */
+    {
+        tt_image *small = NULL;
+        int side;
+        for (side = 1; side <= 3; side++) {
+            tt_result r;
+            if (tt_image_create(side == 3 ? 3 : 2, side, NULL, &small, NULL) != TT_OK) break;
+            memset(&o, 0, sizeof o);
+            r = tt_hpm_map(mesh, small, &o, NULL, uv, NULL, NULL, &err);
+            if (side < 3)
+                CHECK(r == TT_ERROR_INVALID_ARGUMENT && strstr(err.message, "at least 3 on each side"),
+                      "a bounded %d x %d image: %d (%s)", small->width, side, r, err.message);
+            else
+                CHECK(r == TT_OK, "a bounded 3 x 3 image: %d (%s)", r, err.message);
+            o.flags = TT_HPM_TOROIDAL;
+            r = tt_hpm_map(mesh, small, &o, NULL, uv, NULL, NULL, &err);
+            CHECK(r == TT_OK, "a tiling %d x %d image: %d (%s)", small->width, side, r, err.message);
+            tt_image_free(small);
+            small = NULL;
+        }
+    }
     memset(&q, 0, sizeof q);
     make_grid(&q, 3, 3);
     if (build(&q, 0, &quads, &err) == TT_OK) {
