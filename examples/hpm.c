@@ -230,12 +230,12 @@ static int compare_doubles(const void *a, const void *b)
 }
 
 /* The steps --subdivide auto takes on m: the fewest after which the
-   median triangle covers at most
-   HPM_AUTO_TRIANGLE_TEXELS at the mapping's scale (--scale, or the
-   library's default: the image's width over a quarter of the bounding
-   box's diagonal), none that would pass HPM_AUTO_MAX_TRIANGLES. The
-   median's area in texels^2 goes to *median_texels (0 when the mesh is
-   too small to tell). */
+   median triangle covers at most HPM_AUTO_TRIANGLE_TEXELS at the
+   mapping's scale (--scale, or the library's default: the image's width
+   over a quarter of the bounding box's diagonal), and none that would
+   pass HPM_AUTO_MAX_TRIANGLES. The median's area in texels^2 goes to
+   *median_texels (0 when it has no finite area, or out of memory: then
+   no step). */
 static int hpm_auto_steps(const triangle_mesh *m, const tt_image *image, double scale, double *median_texels)
 {
     const tt_mesh *mesh = m->mesh;
