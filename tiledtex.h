@@ -25054,43 +25054,38 @@ static int tt__hpm_process(tt__hpm *S, int C, int has_neighbours, tt_result *res
         fit = tt__hpm_fit(S, C, stamp, &pl, &eps, res, error);
         if (fit == -2) return 0;
     }
-    /* A fit that will be accepted (under the threshold, or at the floor
-       whatever its error) competes with the continuations, judged where
-       the seam is seen. The fit matches the band on the image box-filtered
-       to match_size and may not continue its main neighbour, so on a fine
-       stochastic photo (gravel: grains of a few texels) its borders are
-       unrelated texel for texel - its place only shares the band's blurred
-       brightness - and those borders made most of the seam score on a knot
-       tube. A continuation is exact along the neighbour it continues. */
-    if (fit == 1 && (at_floor || eps <= S->threshold) && tt__hpm_continue_place(S, C, &cont, &cont_cost) &&
-        cont_cost >= 0) {
-        double fit_cost = tt__hpm_border_cost(S, C, &pl);
-        if (fit_cost >= 0 && cont_cost < fit_cost) {
-            if (eps <= S->threshold) {
-                S->rep.accepted_fits++;
-                S->rep.accepted_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
-                S->rep.accepted_continued++;
-            } else {
-                S->rep.floor_fits++;
-                S->rep.floor_continued++;
+    if (fit == 1 && (eps <= S->threshold || at_floor)) {
+        /* A fit taken (under the threshold, or at the floor whatever its
+           error) competes with the continuations, judged where the seam
+           is seen. The fit matches the band on the image box-filtered to
+           match_size and may not continue its main neighbour, so on a
+           fine stochastic photo (gravel: grains of a few texels) its
+           borders are unrelated texel for texel - its place only shares
+           the band's blurred brightness - and those borders made most of
+           the seam score on a knot tube. A continuation is exact along
+           the neighbour it continues. */
+        const tt__hpm_place *chosen = &pl;
+        int gave_way = 0;
+        if (tt__hpm_continue_place(S, C, &cont, &cont_cost) && cont_cost >= 0) {
+            double fit_cost = tt__hpm_border_cost(S, C, &pl);
+            if (fit_cost >= 0 && cont_cost < fit_cost) {
+                chosen = &cont;
+                gave_way = 1;
             }
-            S->error_sum += eps;
-            if (eps > S->rep.max_error) S->rep.max_error = eps;
-            return tt__hpm_accept(S, C, &cont) ? 1 : tt__hpm_out_of_memory(C, res, error);
         }
+        if (eps <= S->threshold) {
+            S->rep.accepted_fits++;
+            S->rep.accepted_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
+            S->rep.accepted_continued += gave_way;
+        } else {
+            S->rep.floor_fits++;
+            S->rep.floor_continued += gave_way;
+        }
+        S->error_sum += eps;
+        if (eps > S->rep.max_error) S->rep.max_error = eps;
+        return tt__hpm_accept(S, C, chosen) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }
     if (fit == 1) {
-        if (eps <= S->threshold || at_floor) {
-            if (eps <= S->threshold) {
-                S->rep.accepted_fits++;
-                S->rep.accepted_per_level[tt__min_i(cl->level, TT_HPM_MAX_LEVELS - 1)]++;
-            } else {
-                S->rep.floor_fits++;
-            }
-            S->error_sum += eps;
-            if (eps > S->rep.max_error) S->rep.max_error = eps;
-            return tt__hpm_accept(S, C, &pl) ? 1 : tt__hpm_out_of_memory(C, res, error);
-        }
         S->rep.rejected_fits++;
         return tt__hpm_split(S, C) ? 1 : tt__hpm_out_of_memory(C, res, error);
     }

@@ -229,16 +229,15 @@ static int compare_doubles(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The steps --subdivide auto takes on m: the fewest after which the
+/* The steps --subdivide auto takes on mesh: the fewest after which the
    median triangle covers at most HPM_AUTO_TRIANGLE_TEXELS at the
    mapping's scale (--scale, or the library's default: the image's width
    over a quarter of the bounding box's diagonal), and none that would
    pass HPM_AUTO_MAX_TRIANGLES. The median's area in texels^2 goes to
    *median_texels (0 when it has no finite area, or out of memory: then
    no step). */
-static int hpm_auto_steps(const triangle_mesh *m, const tt_image *image, double scale, double *median_texels)
+static int hpm_auto_steps(const tt_mesh *mesh, const tt_image *image, double scale, double *median_texels)
 {
-    const tt_mesh *mesh = m->mesh;
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, diagonal = 0.0;
     double *areas = (double *)malloc((size_t)mesh->nfaces * sizeof(double)), texels, triangles;
     int f, k, steps = 0;
@@ -284,7 +283,7 @@ static int subdivide_coarse_mesh(const hpm_command_options *options, const tt_im
 {
     char times[32];
     double median;
-    int before = m->ntriangles, steps = hpm_auto_steps(m, image, options->map.scale, &median), status;
+    int before = m->ntriangles, steps = hpm_auto_steps(m->mesh, image, options->map.scale, &median), status;
     if (steps == 0) {
         if (median > HPM_AUTO_TRIANGLE_TEXELS)
             tool_note("%s: its triangles cover %.0f texels^2 each (the median) at the texture's scale, more than "
