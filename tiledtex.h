@@ -3795,13 +3795,13 @@ typedef struct tt_polycube_map_options {
                                        non-zero cancels with TT_CANCELLED */
     void *progress_user_data;
     double max_map_error;   /* how far (in quads: a tile's side) merging the output's pieces may move the
-                               texture; 0 = TT_POLYCUBE_MAP_DEFAULT_ERROR; below 0: no merging (every piece of
-                               the split kept) */
+                               texture, within the shape bounds of step 7; 0 = TT_POLYCUBE_MAP_DEFAULT_ERROR;
+                               below 0: no merging (every piece of the split kept) */
 } tt_polycube_map_options;
 
 #define TT_POLYCUBE_MAP_DEFAULT_EDGE 1.0  /* cubes; see max_edge */
 #define TT_POLYCUBE_MAP_FINER_EDGE 0.5    /* cubes */
-#define TT_POLYCUBE_MAP_DEFAULT_ERROR (1.0 / 256)   /* quads: half a texel of a 128-texel tile */
+#define TT_POLYCUBE_MAP_DEFAULT_ERROR 1.0   /* quads: a tile's side; the shape bounds of step 7 decide first */
 
 /* The most triangles tt_polycube_map's refinement (max_edge) may make: a
    max_edge that needs more is refused with TT_ERROR_TOO_LARGE before the
@@ -3951,16 +3951,21 @@ typedef struct tt_polycube_mapping {
           from the quad): a local seam, counted in fallback_triangles,
           but no flipped piece;
      7. merging: an output vertex the split made is merged into a
-        neighbour (an edge collapse) where the texture moves by at most
-        max_map_error and every triangle around keeps its input face, its
-        quad, and some area turning the same way in both spaces; the move
-        is measured where it is largest (at the two ends and where the old
-        and new edges cross) and adds up within each triangle, so the
-        whole stays within max_map_error. Where the refinement put more
-        vertices than the map needs (a model coarser than the squares) the
-        output loses a sixth to a quarter of its triangles at half a texel,
-        and slivers of the split go too, no merge making a new one. Input
-        vertices and a fallback's vertices stay (report->merged).
+        neighbour (an edge collapse) where every triangle around keeps
+        its input face, its quad, some area turning the same way in both
+        spaces, and its shape: none ends more stretched than the star's
+        most stretched triangle before, or than 1.5, nor with a density
+        (area on S over area on the model) outside the star's range
+        unless within a factor 1.25 of the median; and where the texture
+        moves by at most max_map_error (a tile's side by default), the
+        move measured where it is largest (at the two ends and where the
+        old and new edges cross) and added up within each triangle. The
+        shape bounds decide, so the output keeps the split's stretch and
+        nearly its density; where the refinement put more vertices than
+        the map needs (a model coarser than the squares) it loses 40 to
+        75 % of its triangles, and slivers of the split go too, no merge
+        making a new one. Input vertices and a fallback's vertices stay
+        (report->merged).
    Every split point of an edge is one output vertex shared by the two
    triangles on the edge: a closed manifold model gives a closed manifold
    output. Pieces of zero area (an edge along a lattice line) are dropped,
@@ -32423,10 +32428,13 @@ static int tt__mapping_to_input(tt_polycube_mapping *mapping, const tt__refined 
    around. So the output covers the same surface and the same squares,
    closed and without T-junctions, as before. A merge is made when every
    triangle around keeps turning the same way, with some area, in both
-   spaces, and the texture moves by at most the tolerance at the two ends
-   (the map's value at each end's model point against its point on S); a
+   spaces, keeps the shape its star had (tt__merge_keeps_shape), and the
+   texture moves by at most the tolerance at the two ends (the map's
+   value at each end's model point against its point on S); a
    triangle's bound carries what merges before it moved (their sum), so
-   the whole stays within the tolerance. Vertices whose triangles put
+   the whole stays within the tolerance. The smoothing's map is no better
+   than another of the same stretch and density, so the default lets the
+   texture move by up to a tile: the shapes decide. Vertices whose triangles put
    them at more than one place of S (a fallback's local seam) and input
    vertices (they keep their index and place) stay. */
 
@@ -32434,6 +32442,8 @@ static int tt__mapping_to_input(tt_polycube_mapping *mapping, const tt__refined 
 #define TT__MERGE_PASSES 12     /* passes over the vertices, each merging an independent set */
 #define TT__MERGE_QUADS 8       /* quads around a vertex beyond which it is left (a corner of S has 3 to 6) */
 #define TT__MERGE_AREA 1e-10    /* twice a triangle's area on S, in quads, below which a merge may not take it */
+#define TT__MERGE_STRETCH 1.5   /* a merge may stretch a triangle this much, or as much as its star's worst */
+#define TT__MERGE_DENSITY 1.25  /* ...and give it a density within this factor of the median, or within its star's */
 
 enum { TT__MERGE_FREE, TT__MERGE_STAYS, TT__MERGE_TOUCHED, TT__MERGE_GONE };
 
@@ -32447,6 +32457,8 @@ typedef struct tt__merge {
     unsigned char *dirty;       /* per vertex: its star changed since it was last tried with the whole tolerance */
     double *position;           /* per vertex: its model point (3) */
     double *normal;             /* per input face: its unit normal (3), 0 when it has no area */
+    double median_density;      /* the triangles' median area on S over area on the model, before merging */
+    int keep_shape;             /* 1: tt__merge_keeps_shape bounds every merge (0 only for the tests' control) */
 } tt__merge;
 
 /* One candidate merge: a goes, b stays with the model point of `keep_model`
@@ -32796,6 +32808,62 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
 /* 1 when merge T is allowed with the texture moving by at most `tolerance`
    (T->moved gets the new bound of its triangles); without `crossings`,
    judged at the two ends only (a lower bound, and a quicker one). */
+/* A triangle's stretch (sigma_max / sigma_min of its map from S to the
+   model, infinite when it has no area on S) and density (its area on S
+   over its area on the model), from its corners in both spaces. */
+static void tt__merge_shape(const double q[3][3], const double st[3][2], double *stretch, double *density)
+{
+    const double e1[2] = {st[1][0] - st[0][0], st[1][1] - st[0][1]}, e2[2] = {st[2][0] - st[0][0], st[2][1] - st[0][1]};
+    const double det = e1[0] * e2[1] - e1[1] * e2[0];
+    double ds[3], dt[3], n[3], g11 = 0.0, g12 = 0.0, g22 = 0.0, big, small, area;
+    int k;
+    tt__merge_normal(q, n);
+    area = tt__length3(n);
+    *density = area > 0.0 ? fabs(det) / area : 0.0;
+    *stretch = tt__infinity();
+    if (det == 0.0) return;
+    for (k = 0; k < 3; k++) {
+        const double d1 = q[1][k] - q[0][k], d2 = q[2][k] - q[0][k];
+        ds[k] = (d1 * e2[1] - d2 * e1[1]) / det;    /* dP/ds */
+        dt[k] = (d2 * e1[0] - d1 * e2[0]) / det;    /* dP/dt */
+        g11 += ds[k] * ds[k];
+        g12 += ds[k] * dt[k];
+        g22 += dt[k] * dt[k];
+    }
+    tt__metric_eigenvalues(g11, g12, g22, &big, &small);
+    *stretch = tt__stretch_ratio(big, small);
+}
+
+/* 1 when merge T leaves every triangle around within the shape its star
+   had: no more stretched than the star's most stretched triangle, or
+   than TT__MERGE_STRETCH, and with a density within the star's range, or
+   within TT__MERGE_DENSITY of the median. So however far the texture is
+   let move, no triangle ends more stretched than the split's worst (or
+   1.5), nor denser or sparser than the split's extremes (or that band):
+   merging without these bounds, the stretch's 95th percentile more than doubles
+   on a coarse sphere (the unit test's control). */
+static int tt__merge_keeps_shape(const tt__merge *G, const tt__merge_try *T)
+{
+    double worst = TT__MERGE_STRETCH, low = HUGE_VAL, high = 0.0, stretch, density;
+    const double median = G->median_density;
+    int i;
+    for (i = 0; i < T->n; i++) {
+        tt__merge_shape((const double(*)[3])T->before[i], (const double(*)[2])T->st_before[i], &stretch, &density);
+        worst = fmax(worst, stretch);
+        low = fmin(low, density);
+        high = fmax(high, density);
+    }
+    for (i = 0; i < T->n; i++) {
+        if (T->gone[i]) continue;
+        tt__merge_shape((const double(*)[3])T->after[i], (const double(*)[2])T->st_after[i], &stretch, &density);
+        if (!(stretch <= worst)) return 0;
+        if ((density < low || density > high) &&
+            !(density * TT__MERGE_DENSITY >= median && density <= median * TT__MERGE_DENSITY))
+            return 0;
+    }
+    return 1;
+}
+
 static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double tolerance, int crossings)
 {
     double largest = 0.0, moved_before = 0.0, ma, mb, mc;
@@ -32852,7 +32920,7 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
         if (area[i] < 1e-6 * largest && area[i] < T->area_before[i]) return 0;
         slivers -= area[i] < 1e-4 * largest;
     }
-    if (slivers < 0) return 0;
+    if (slivers < 0 || (G->keep_shape && !tt__merge_keeps_shape(G, T))) return 0;
     mc = crossings ? tt__merge_moved_crossings(G, T) : 0.0;
     if (mc < 0.0) return 0;
     T->moved = moved_before + fmax(fmax(ma, mb), mc);
@@ -33053,10 +33121,34 @@ static void tt__merge_compact(tt__merge *G)
     m->ntriangles = nt;
 }
 
+/* G->median_density: the median over the triangles with some area in
+   both spaces (1 when none has). 0 when out of memory. */
+static int tt__merge_median_density(tt__merge *G, const tt_allocator *allocator)
+{
+    const tt_polycube_mapping *m = G->m;
+    double *values = TT__ALLOC(allocator, double, (size_t)m->ntriangles + 1), q[3][3], st[3][2], stretch;
+    int t, k, n = 0;
+    if (!values) return 0;
+    for (t = 0; t < m->ntriangles; t++) {
+        for (k = 0; k < 3; k++) {
+            const tt_surface_point *p = m->corner_points + 3 * (size_t)t + k;
+            tt__merge_position(G, m->triangles[3 * t + k], q[k]);
+            st[k][0] = p->s;
+            st[k][1] = p->t;
+        }
+        tt__merge_shape((const double(*)[3])q, (const double(*)[2])st, &stretch, &values[n]);
+        n += values[n] > 0.0 && values[n] < HUGE_VAL;
+    }
+    G->median_density = n > 0 ? tt__median(values, n) : 1.0;
+    tt__free(allocator, values);
+    return 1;
+}
+
 /* Merge the mapping's needless vertices (see above) with the texture
-   moving by at most `tolerance` quads; returns the triangles removed, -1
-   when out of memory (the mapping unchanged). */
-static int tt__mapping_merge(tt_polycube_mapping *m, const tt_mesh *mesh, double tolerance,
+   moving by at most `tolerance` quads, every merge keeping the shapes of
+   its star (tt__merge_keeps_shape) when keep_shape; returns the
+   triangles removed, -1 when out of memory (the mapping unchanged). */
+static int tt__mapping_merge(tt_polycube_mapping *m, const tt_mesh *mesh, double tolerance, int keep_shape,
                              const tt_allocator *allocator)
 {
     tt__merge G;
@@ -33065,6 +33157,7 @@ static int tt__mapping_merge(tt_polycube_mapping *m, const tt_mesh *mesh, double
     memset(&G, 0, sizeof G);
     G.m = m;
     G.mesh = mesh;
+    G.keep_shape = keep_shape;
     G.start = TT__ALLOC(allocator, int, (size_t)m->nverts + 1);
     G.items = TT__ALLOC(allocator, int, 3 * (size_t)m->ntriangles);
     G.state = TT__ALLOC(allocator, unsigned char, m->nverts);
@@ -33093,6 +33186,10 @@ static int tt__mapping_merge(tt_polycube_mapping *m, const tt_mesh *mesh, double
         }
     }
     for (a = 0; a < mesh->nfaces; a++) tt__face_normal_d(mesh, a, G.normal + 3 * (size_t)a);
+    if (!tt__merge_median_density(&G, allocator)) {
+        before = -1;
+        goto done;
+    }
     for (pass = 0; pass < TT__MERGE_PASSES; pass++) {
         /* A vertex is tried again only when its star changed. */
         int merged = 0;
@@ -33351,7 +33448,7 @@ TTDEF tt_result tt_polycube_map(const tt_polycube *polycube, const tt_mesh *mesh
     if (result == TT_OK && !(options && options->max_map_error < 0.0)) {
         const double tolerance =
             options && options->max_map_error > 0.0 ? options->max_map_error : TT_POLYCUBE_MAP_DEFAULT_ERROR;
-        if ((report->merged = tt__mapping_merge(mapping, mesh, tolerance, allocator)) < 0) {
+        if ((report->merged = tt__mapping_merge(mapping, mesh, tolerance, 1, allocator)) < 0) {
             report->merged = 0;
             result = tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory merging the mapping's pieces");
         }

@@ -498,8 +498,6 @@ static int map_mesh(const polycube_command_options *options, polycube_job *job)
     /* -j: the projection, the relaxation, the tracing and the split on the tool's threads (the same mapping). */
     memset(&map_options, 0, sizeof map_options);
     map_options.executor = tool_executor();
-    /* Pieces merge where the texture moves by less than half a texel. */
-    map_options.max_map_error = 0.5 / job->layout.tile_size;
     tool_progress_begin(&progress, "mapping", "of the steps done");
     map_options.progress = tool_show_progress;
     map_options.progress_user_data = &progress;
@@ -639,7 +637,7 @@ static void print_summary(const polycube_command_options *options, const polycub
     if (m->triangles != job->mesh.ntriangles) printf(" (of %d after refining long edges)", m->triangles);
     if (m->refined_again) printf(" (%d input faces refined further, where a first mapping fell short)", m->refined_again);
     if (m->unpinched) printf(" (%d edges split where a triangle wrapped a saddle of the polycube)", m->unpinched);
-    if (m->merged) printf(" (%d merged where the texture moves by less than half a texel)", m->merged);
+    if (m->merged) printf(" (%d merged away, the triangles around keeping their stretch and density)", m->merged);
     printf("; smoothing: %d moves, %d vertices left as projected", m->smoothed, m->held);
     printf("; vertices onto the polycube: %d by rays, %d nearest, %d fallback, mean distance %.2f cubes\n", p->rays,
            p->nearest, p->fallbacks, p->mean_distance);

@@ -2367,16 +2367,17 @@ static void test_map_unpinch(void)
    The control, one mapping at a cube, must fall short somewhere (a
    triangle put whole into a quad, or a piece of no area); the default
    must fall short less, and make far fewer triangles than half a cube
-   everywhere, with no more fallbacks than the sphere test allows. */
+   everywhere (both unmerged, so that the refinement is measured), with
+   no more fallbacks than the sphere test allows. */
 static void test_map_refine_where_needed(void)
 {
     const double centre[3] = {0.13, -0.21, 0.05};
     tmesh m;
     tt_mesh *mesh;
     tt_polycube *pc;
-    tt_polycube_map_report rep, coarse_rep, fine_rep;
+    tt_polycube_map_report rep, coarse_rep, fine_rep, unmerged_rep;
     tt_polycube_map_options mo;
-    tt_polycube_mapping *map, *coarse = NULL, *fine = NULL;
+    tt_polycube_mapping *map, *coarse = NULL, *fine = NULL, *unmerged = NULL;
     tt_error err;
     memset(&m, 0, sizeof m);
     memset(&mo, 0, sizeof mo);
@@ -2385,14 +2386,18 @@ static void test_map_refine_where_needed(void)
     if (map) {
         mo.max_edge = pc->h;
         CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &coarse, &coarse_rep, &err) == TT_OK, "coarse: %s", err.message);
+        mo.max_map_error = -1.0;
         mo.max_edge = 0.5 * pc->h;
         CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &fine, &fine_rep, &err) == TT_OK, "fine: %s", err.message);
+        mo.max_edge = 0.0;
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &unmerged, &unmerged_rep, &err) == TT_OK, "unmerged: %s",
+              err.message);
     }
-    if (map && coarse && fine) {
-        printf("     sphere at 32: one mapping at a cube %d triangles, %d fallbacks, %d empty; half a cube %d, %d, %d; "
-               "default %d, %d, %d (%d faces refined again)\n", coarse->ntriangles, coarse_rep.fallback_triangles,
-               coarse_rep.collapsed, fine->ntriangles, fine_rep.fallback_triangles, fine_rep.collapsed,
-               map->ntriangles, rep.fallback_triangles, rep.collapsed, rep.refined_again);
+    if (map && coarse && fine && unmerged) {
+        printf("     sphere at 32: one mapping at a cube %d triangles, %d fallbacks, %d empty; default %d, %d, %d (%d "
+               "faces refined again); unmerged, half a cube %d, the default %d\n", coarse->ntriangles,
+               coarse_rep.fallback_triangles, coarse_rep.collapsed, map->ntriangles, rep.fallback_triangles,
+               rep.collapsed, rep.refined_again, fine->ntriangles, unmerged->ntriangles);
         CHECK(coarse_rep.fallback_triangles + coarse_rep.collapsed > 0 && coarse_rep.refined_again == 0,
               "control: one mapping at a cube falls short (%d fallbacks, %d empty)", coarse_rep.fallback_triangles,
               coarse_rep.collapsed);
@@ -2401,13 +2406,16 @@ static void test_map_refine_where_needed(void)
               "the default refines again (%d faces) and falls short less (%d + %d against %d + %d)",
               rep.refined_again, rep.fallback_triangles, rep.collapsed, coarse_rep.fallback_triangles,
               coarse_rep.collapsed);
-        CHECK(map->ntriangles <= 0.7 * fine->ntriangles && rep.fallback_triangles <= rep.triangles / 1000,
-              "the default makes %d triangles (at most 70 %% of half a cube's %d) with %d fallbacks (at most 0.1 "
-              "%% of %d)", map->ntriangles, fine->ntriangles, rep.fallback_triangles, rep.triangles);
+        CHECK(unmerged->ntriangles <= 0.7 * fine->ntriangles && unmerged_rep.refined_again == rep.refined_again &&
+                  rep.fallback_triangles <= rep.triangles / 1000,
+              "the default refinement makes %d triangles unmerged (at most 70 %% of half a cube's %d), with %d "
+              "fallbacks (at most 0.1 %% of %d)", unmerged->ntriangles, fine->ntriangles, rep.fallback_triangles,
+              rep.triangles);
     }
     tt_polycube_mapping_free(map);
     tt_polycube_mapping_free(coarse);
     tt_polycube_mapping_free(fine);
+    tt_polycube_mapping_free(unmerged);
     tt_polycube_free(pc);
     tt_mesh_free(mesh);
     tm_free(&m);
@@ -2490,40 +2498,130 @@ static double merge_moved(const tt_polycube_mapping *ref, const tt_polycube_mapp
     return worst;
 }
 
-/* A mapping's triangles with less area on the model than `share` of the
-   mean (slivers). */
-static int mapping_slivers(const tt_polycube_mapping *map, double share)
+/* A mapping's triangles with less area on the model than `below`
+   (slivers). */
+static int mapping_slivers(const tt_polycube_mapping *map, double below)
 {
-    double mean = 0.0, *area = (double *)malloc(sizeof(double) * (size_t)map->ntriangles);
     int j, count = 0;
-    if (!area) return map->ntriangles;
     for (j = 0; j < map->ntriangles; j++) {
         const int *v = map->triangles + 3 * j;
-        area[j] = triangle_area3(map->positions + 3 * v[0], map->positions + 3 * v[1], map->positions + 3 * v[2]);
-        mean += area[j] / map->ntriangles;
+        count += triangle_area3(map->positions + 3 * v[0], map->positions + 3 * v[1], map->positions + 3 * v[2]) <
+                 below;
     }
-    for (j = 0; j < map->ntriangles; j++) count += area[j] < share * mean;
-    free(area);
     return count;
+}
+
+/* A mapping's mean triangle area on the model. */
+static double mapping_mean_area(const tt_polycube_mapping *map)
+{
+    double sum = 0.0;
+    int j;
+    for (j = 0; j < map->ntriangles; j++) {
+        const int *v = map->triangles + 3 * j;
+        sum += triangle_area3(map->positions + 3 * v[0], map->positions + 3 * v[1], map->positions + 3 * v[2]);
+    }
+    return map->ntriangles > 0 ? sum / map->ntriangles : 0.0;
+}
+
+/* The shape of a mapping's texture as the tool's summary reports it,
+   computed here from scratch: the stretch (sigma_max / sigma_min of each
+   triangle's map from S to the model) at the 95th percentile, and the
+   density (area on S over area on the model) at the 5th and 95th
+   against its median, all weighted by the triangles' area on the model. */
+typedef struct mapping_shapes {
+    double stretch95, density5, density95;
+} mapping_shapes;
+
+static mapping_shapes mapping_shape_stats(const tt_polycube_mapping *map)
+{
+    mapping_shapes out = {HUGE_VAL, 0.0, HUGE_VAL};
+    double *stretch = (double *)malloc(sizeof(double) * ((size_t)map->ntriangles + 1));
+    double *density = (double *)malloc(sizeof(double) * ((size_t)map->ntriangles + 1));
+    double *area = (double *)malloc(sizeof(double) * ((size_t)map->ntriangles + 1)), median;
+    int j, k, n = 0;
+    if (!stretch || !density || !area) {
+        free(stretch);
+        free(density);
+        free(area);
+        return out;
+    }
+    for (j = 0; j < map->ntriangles; j++) {
+        const float *p[3];
+        const tt_surface_point *q = map->corner_points + 3 * j;
+        double e1[3], e2[3], n3[3], x[3], y[3], len, P[2][2], S[2][2], detP, detS, J[2][2], a, b, c, root;
+        for (k = 0; k < 3; k++) p[k] = map->positions + 3 * map->triangles[3 * j + k];
+        for (k = 0; k < 3; k++) {
+            e1[k] = (double)p[1][k] - p[0][k];
+            e2[k] = (double)p[2][k] - p[0][k];
+        }
+        n3[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n3[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n3[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        len = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+        if (!(len > 0.0)) continue;
+        for (k = 0; k < 3; k++) x[k] = e1[k] / len;
+        y[0] = n3[1] * x[2] - n3[2] * x[1];
+        y[1] = n3[2] * x[0] - n3[0] * x[2];
+        y[2] = n3[0] * x[1] - n3[1] * x[0];
+        a = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+        if (!(a > 0.0)) continue;
+        for (k = 0; k < 3; k++) y[k] /= a;
+        /* columns: the two edges in the model triangle's frame, and on S */
+        P[0][0] = len; P[1][0] = 0.0;
+        P[0][1] = e2[0] * x[0] + e2[1] * x[1] + e2[2] * x[2];
+        P[1][1] = e2[0] * y[0] + e2[1] * y[1] + e2[2] * y[2];
+        S[0][0] = (double)q[1].s - q[0].s; S[1][0] = (double)q[1].t - q[0].t;
+        S[0][1] = (double)q[2].s - q[0].s; S[1][1] = (double)q[2].t - q[0].t;
+        detP = P[0][0] * P[1][1] - P[0][1] * P[1][0];
+        detS = S[0][0] * S[1][1] - S[0][1] * S[1][0];
+        if (!(fabs(detS) > 0.0)) continue;
+        /* J = P S^-1, the map from S to the model */
+        J[0][0] = (P[0][0] * S[1][1] - P[0][1] * S[1][0]) / detS;
+        J[0][1] = (P[0][1] * S[0][0] - P[0][0] * S[0][1]) / detS;
+        J[1][0] = (P[1][0] * S[1][1] - P[1][1] * S[1][0]) / detS;
+        J[1][1] = (P[1][1] * S[0][0] - P[1][0] * S[0][1]) / detS;
+        a = J[0][0] * J[0][0] + J[1][0] * J[1][0];
+        b = J[0][0] * J[0][1] + J[1][0] * J[1][1];
+        c = J[0][1] * J[0][1] + J[1][1] * J[1][1];
+        root = sqrt((a - c) * (a - c) + 4.0 * b * b);
+        stretch[n] = (a + c - root) > 0.0 ? sqrt((a + c + root) / (a + c - root)) : HUGE_VAL;
+        density[n] = fabs(detS) / fabs(detP);
+        area[n++] = 0.5 * fabs(detP);
+    }
+    if (n > 0) {
+        median = internal_weighted_percentile(density, area, n, 0.5);
+        out.stretch95 = internal_weighted_percentile(stretch, area, n, 0.95);
+        out.density5 = internal_weighted_percentile(density, area, n, 0.05) / median;
+        out.density95 = internal_weighted_percentile(density, area, n, 0.95) / median;
+    }
+    free(stretch);
+    free(density);
+    free(area);
+    return out;
 }
 
 /* Step 7, the pieces merged: on a coarse sphere (its triangles span
    several squares, so the split leaves many vertices inside them) the
-   default mapping has fewer triangles than with merging off
+   default mapping has far fewer triangles than with merging off
    (max_map_error below 0), is as sound (on the model, the area kept,
-   closed, each triangle in one quad, none flipped), and its texture stays
-   within max_map_error of the unmerged one; the split's slivers on the
-   model are mostly gone, and none is made. Control: merged with 0.05
-   quads, the same measure finds it moved past the default's bound. */
+   closed, each triangle in one quad, none flipped), and its texture keeps
+   close to the unmerged one's shape: the stretch percentile the summary
+   reports within 0.05, the density's within 0.05 below and 0.2 above (a
+   merge may give a triangle any density its star had). Control: merged
+   as far without the shape bounds, the stretch p95 grows by more than 1.
+   A tight max_map_error holds: the texture stays within
+   1/256 of a quad of the unmerged one (control: merged with 0.05 quads,
+   the same measure finds it moved past that); the split's slivers on the
+   model are mostly gone, and none is made. */
 static void test_map_merge(void)
 {
-    const double centre[3] = {0.02, -0.03, 0.01};
+    const double centre[3] = {0.02, -0.03, 0.01}, tight_error = 1.0 / 256;
     tmesh m;
     tt_mesh *mesh;
     tt_polycube *pc;
-    tt_polycube_map_report rep, ref_rep, loose_rep;
+    tt_polycube_map_report rep, ref_rep, tight_rep, loose_rep, free_rep;
     tt_polycube_map_options mo;
-    tt_polycube_mapping *map, *ref = NULL, *loose = NULL;
+    tt_polycube_mapping *map, *ref = NULL, *tight = NULL, *loose = NULL, *unbounded = NULL;
     tt_error err;
     memset(&m, 0, sizeof m);
     memset(&mo, 0, sizeof mo);
@@ -2532,45 +2630,74 @@ static void test_map_merge(void)
     if (map) {
         mo.max_map_error = -1.0;
         CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &ref, &ref_rep, &err) == TT_OK, "unmerged: %s", err.message);
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &unbounded, &free_rep, &err) == TT_OK, "unmerged: %s",
+              err.message);
         mo.max_map_error = NAN;
         CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &loose, &loose_rep, &err) == TT_ERROR_INVALID_ARGUMENT && !loose,
               "a NaN max_map_error is refused");
+        mo.max_map_error = tight_error;
+        CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &tight, &tight_rep, &err) == TT_OK, "tight: %s", err.message);
         mo.max_map_error = 0.05;
         CHECK(tt_polycube_map(pc, mesh, &mo, NULL, &loose, &loose_rep, &err) == TT_OK, "loose: %s", err.message);
     }
-    if (map && ref && loose) {
+    if (map && ref && tight && loose && unbounded) {
         const mapping_check c = check_mapping(pc, mesh, map);
-        int unfound, loose_unfound;
-        const double moved = merge_moved(ref, map, mesh->nfaces, &unfound);
-        const double loose_moved = merge_moved(ref, loose, mesh->nfaces, &loose_unfound);
-        const int slivers = mapping_slivers(map, 1e-4), ref_slivers = mapping_slivers(ref, 1e-4);
-        printf("     coarse sphere at 24: %d triangles unmerged, %d merged by default (texture moved %.2g quads, "
-               "%d centroids across a line), %d at 0.05 quads (moved %.2g); slivers %d unmerged, %d merged\n",
-               ref->ntriangles, map->ntriangles, moved, unfound, loose->ntriangles, loose_moved, ref_slivers, slivers);
+        const double ref_mean = mapping_mean_area(ref);
+        int unfound, loose_unfound, slivers, ref_slivers;
+        double moved, loose_moved;
+        mapping_shapes ref_shape, shape, free_shape;
+        CHECK(internal_mapping_merge(unbounded, mesh, TT_POLYCUBE_MAP_DEFAULT_ERROR, 0) > 0,
+              "the control merges");
+        moved = merge_moved(ref, tight, mesh->nfaces, &unfound);
+        loose_moved = merge_moved(ref, loose, mesh->nfaces, &loose_unfound);
+        slivers = mapping_slivers(map, 1e-4 * ref_mean);
+        ref_slivers = mapping_slivers(ref, 1e-4 * ref_mean);
+        ref_shape = mapping_shape_stats(ref);
+        shape = mapping_shape_stats(map);
+        free_shape = mapping_shape_stats(unbounded);
+        printf("     coarse sphere at 24: %d triangles unmerged, %d merged by default, %d within %.3g quads (texture "
+               "moved %.2g quads, %d centroids across a line), %d within 0.05 (moved %.2g), %d without the shape "
+               "bounds; slivers %d unmerged, %d merged\n", ref->ntriangles, map->ntriangles, tight->ntriangles,
+               tight_error, moved, unfound, loose->ntriangles, loose_moved, unbounded->ntriangles, ref_slivers,
+               slivers);
+        printf("     stretch p95 / density p5, p95: unmerged %.3f / %.3f, %.3f; default %.3f / %.3f, %.3f; "
+               "control %.3f / %.3f, %.3f\n", ref_shape.stretch95, ref_shape.density5, ref_shape.density95,
+               shape.stretch95, shape.density5, shape.density95, free_shape.stretch95, free_shape.density5,
+               free_shape.density95);
         CHECK(ref_rep.merged == 0 && rep.merged == ref->ntriangles - map->ntriangles &&
-                  map->ntriangles <= 0.95 * ref->ntriangles && loose->ntriangles < map->ntriangles,
-              "merging: %d triangles unmerged, %d by default (report %d), %d at 0.05", ref->ntriangles,
-              map->ntriangles, rep.merged, loose->ntriangles);
+                  map->ntriangles <= 0.5 * ref->ntriangles && map->ntriangles < loose->ntriangles &&
+                  loose->ntriangles < tight->ntriangles && tight->ntriangles <= 0.95 * ref->ntriangles,
+              "merging: %d triangles unmerged, %d by default (report %d), %d within 0.05 quads, %d within %.3g",
+              ref->ntriangles, map->ntriangles, rep.merged, loose->ntriangles, tight->ntriangles, tight_error);
         CHECK(mapping_sound(&c) && c.moved_inputs == 0 && rep.flipped == 0 &&
                   rep.fallback_triangles == ref_rep.fallback_triangles,
               "the merged mapping is sound (%d off the model, %d inputs moved, %d bad points, area error %.2g, "
               "strict build %s, %d open edges), %d flipped, %d fallbacks (unmerged %d)", c.off_surface,
               c.moved_inputs, c.bad_points, c.area_error, c.strict_fails ? "fails" : "holds", c.open_edges,
               rep.flipped, rep.fallback_triangles, ref_rep.fallback_triangles);
-        CHECK(moved <= TT_POLYCUBE_MAP_DEFAULT_ERROR + 1e-5 && unfound <= ref->ntriangles / 100,
-              "the texture moved %.3g quads (at most %.3g), %d of %d centroids not found", moved,
-              TT_POLYCUBE_MAP_DEFAULT_ERROR, unfound, ref->ntriangles);
-        CHECK(4 * slivers <= ref_slivers && mapping_slivers(map, 1e-6) == 0,
-              "merging takes the split's slivers away and makes none: %d under 1e-4 of the mean area (unmerged %d), "
-              "%d under 1e-6 (unmerged %d)", slivers, ref_slivers, mapping_slivers(map, 1e-6),
-              mapping_slivers(ref, 1e-6));
-        CHECK(loose_moved > TT_POLYCUBE_MAP_DEFAULT_ERROR + 1e-5 && loose_moved <= 0.05 + 1e-5,
-              "control: merged within 0.05 quads the texture moved %.3g (above the default's %.3g)", loose_moved,
-              TT_POLYCUBE_MAP_DEFAULT_ERROR);
+        CHECK(shape.stretch95 <= ref_shape.stretch95 + 0.05 && shape.density5 >= ref_shape.density5 - 0.05 &&
+                  shape.density95 <= ref_shape.density95 + 0.2,
+              "the default keeps the texture's shape: stretch p95 %.3f (unmerged %.3f), density p5 %.3f, p95 %.3f "
+              "(unmerged %.3f, %.3f)", shape.stretch95, ref_shape.stretch95, shape.density5, shape.density95,
+              ref_shape.density5, ref_shape.density95);
+        CHECK(free_shape.stretch95 > ref_shape.stretch95 + 1.0,
+              "control: merged as far without the shape bounds, the stretch p95 grows (%.3f, unmerged %.3f)",
+              free_shape.stretch95, ref_shape.stretch95);
+        CHECK(moved <= tight_error + 1e-5 && unfound <= ref->ntriangles / 100,
+              "within %.3g quads the texture moved %.3g quads, %d of %d centroids not found", tight_error, moved,
+              unfound, ref->ntriangles);
+        CHECK(loose_moved > tight_error + 1e-5 && loose_moved <= 0.05 + 1e-5,
+              "control: merged within 0.05 quads the texture moved %.3g (above %.3g)", loose_moved, tight_error);
+        CHECK(4 * slivers <= ref_slivers && mapping_slivers(map, 1e-6 * ref_mean) == 0,
+              "merging takes the split's slivers away and makes none: %d under 1e-4 of the unmerged mean area "
+              "(unmerged %d), %d under 1e-6 (unmerged %d)", slivers, ref_slivers,
+              mapping_slivers(map, 1e-6 * ref_mean), mapping_slivers(ref, 1e-6 * ref_mean));
     }
     tt_polycube_mapping_free(map);
     tt_polycube_mapping_free(ref);
+    tt_polycube_mapping_free(tight);
     tt_polycube_mapping_free(loose);
+    tt_polycube_mapping_free(unbounded);
     tt_polycube_free(pc);
     tt_mesh_free(mesh);
     tm_free(&m);
@@ -3970,7 +4097,7 @@ static void test_map_random(void)
             }
             fallbacks += rep.fallback_triangles;
             triangles += rep.triangles;
-            slivers += mapping_slivers(map, 1e-6);
+            slivers += mapping_slivers(map, 1e-6 * mapping_mean_area(map));
             flipped += rep.flipped;
             collapsed += rep.collapsed;
         } else {

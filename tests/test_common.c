@@ -450,6 +450,10 @@ void internal_remesh_ring_centroid(const tt_mesh *q, int first, int count, int r
 {
     tt__remesh_ring_centroid(q, first, count, ring, out);
 }
+int internal_mapping_merge(tt_polycube_mapping *mapping, const tt_mesh *mesh, double tolerance, int keep_shape)
+{
+    return tt__mapping_merge(mapping, mesh, tolerance, keep_shape, NULL);
+}
 void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
                                 float weight_out[3])
 {

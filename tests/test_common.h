@@ -233,6 +233,11 @@ void internal_untangle_descend(int n, const double (*ring)[2][2], const double (
    edge points, 1 its corners. */
 void internal_remesh_ring_centroid(const tt_mesh *q, int first, int count, int ring, double out[3]);
 /* The position and weights of a split vertex interpolating three of mesh's vertices (tt__split_vertex_data). */
+/* tt_polycube_map's step 7 on `mapping` (in place): merges moving the
+   texture up to `tolerance` quads, bounded by the shapes of their stars
+   when keep_shape (0: the control, bounded by the tolerance only);
+   returns the triangles removed. */
+int internal_mapping_merge(tt_polycube_mapping *mapping, const tt_mesh *mesh, double tolerance, int keep_shape);
 void internal_split_vertex_data(const tt_mesh *mesh, const int source[3], const double weight[3], float position[3],
                                 float weight_out[3]);
 /* Smooths the points (tt__polycube_smooth); returns its moves, -1 when out of memory; *held as it says. */
