@@ -2517,11 +2517,17 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
    courses of a wall do). A face whose UV map is singular or not finite
    counts as 90. A face of more corners (a tiling's quads) is measured as
    the fan of triangles from its first corner, phi(P_f(up)) their mean, its
-   normal theirs added up. No wall face: TT_ERROR_NOT_MEASURED (the
-   statistics NaN). Errors: NULL pointers, width or height below 1, a zero
-   or non-finite up, options out of range (TT_ERROR_INVALID_ARGUMENT);
-   TT_ERROR_OUT_OF_MEMORY. Temporary memory: 8 bytes a face. Only reads its
-   inputs. */
+   normal theirs added up. The rows_ statistics measure the texture's rows
+   instead (a brick course, a plank): the angle between the surface
+   gradient of v (area-weighted over the fan) and P_f(up). The two differ
+   where the map shears: a quad whose bottom and top lie level but whose
+   sides lean shows level courses and leaning head joints, which the
+   image's up counts as turned and the rows do not; a zero gradient counts
+   as 90. No wall face: TT_ERROR_NOT_MEASURED (the statistics NaN).
+   Errors: NULL pointers, width or height below 1, a zero or non-finite
+   up, options out of range (TT_ERROR_INVALID_ARGUMENT);
+   TT_ERROR_OUT_OF_MEMORY. Temporary memory: 16 bytes a face. Only reads
+   its inputs. */
 typedef struct tt_uv_direction_options {
     float up[3];            /* the world's up; 0,0,0 = (0,1,0), as tt_field_options */
     double min_projected;   /* wall faces: |P_f(up)| at least this; 0 = 0.7, about 45 degrees from level */
@@ -2533,6 +2539,7 @@ typedef struct tt_uv_direction_report {
     int singular;           /* of them, faces whose UV map is singular or not finite (counted at 90) */
     double mean, p90;       /* degrees from level over the wall faces: the mean, the 90th percentile */
     double within;          /* the share of wall faces within options->tolerance of level */
+    double rows_mean, rows_p90, rows_within;    /* the same for the texture's rows (v's gradient) */
 } tt_uv_direction_report;
 
 TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner_uv, int width, int height,
@@ -18543,17 +18550,47 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
     return TT_OK;
 }
 
+/* Adds twice the area of the fan triangle (first, first + i, first + i + 1)
+   times the surface gradient of v * height over it to gradient: the sum
+   over its corners of v_k (N x e_k), e_k the edge opposite corner k taken
+   counter-clockwise and N the triangle's unit normal. */
+static void tt__fan_gradient_add(const tt_mesh *mesh, int first, int i, const float *uv, int height,
+                                 double gradient[3])
+{
+    const int corners[3] = {0, i, i + 1};
+    double p[3][3], cross[3], e1[3], e2[3], length;
+    int k, j;
+    for (k = 0; k < 3; k++)
+        for (j = 0; j < 3; j++) p[k][j] = tt__corner_pos(mesh, first + corners[k])[j];
+    for (j = 0; j < 3; j++) {
+        e1[j] = p[1][j] - p[0][j];
+        e2[j] = p[2][j] - p[0][j];
+    }
+    tt__cross3(e1, e2, cross);
+    length = tt__length3(cross);
+    if (!(length > 0.0 && length < 1e300)) return;
+    for (k = 0; k < 3; k++) {
+        const double *from = p[(k + 1) % 3], *to = p[(k + 2) % 3], v = (double)uv[2 * corners[k] + 1] * height;
+        double edge[3], turned[3];
+        for (j = 0; j < 3; j++) edge[j] = to[j] - from[j];
+        tt__cross3(cross, edge, turned);
+        for (j = 0; j < 3; j++) gradient[j] += v * turned[j] / length;
+    }
+}
+
 TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner_uv, int width, int height,
                                         const tt_uv_direction_options *options, const tt_allocator *allocator,
                                         tt_uv_direction_report *report, tt_error *error)
 {
     double up[3] = {0.0, 1.0, 0.0}, min_projected = 0.7, tolerance = 10.0, length, sum = 0.0, *angles;
-    int f, k, n = 0, within = 0;
+    double rows_sum = 0.0, *rows;
+    int f, k, n = 0, within = 0, rows_within = 0;
 
     tt__ok(error);
     if (report) {
         memset(report, 0, sizeof *report);
         report->mean = report->p90 = report->within = tt__not_a_number();
+        report->rows_mean = report->rows_p90 = report->rows_within = tt__not_a_number();
     }
     if (!mesh || !corner_uv || !report || width < 1 || height < 1)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
@@ -18572,15 +18609,16 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
                         "tt_measure_uv_direction: up must be finite and not zero, min_projected in (0, 1], "
                         "tolerance in (0, 90] degrees (got %g, %g)", min_projected, tolerance);
     for (k = 0; k < 3; k++) up[k] /= length;
-    angles = TT__ALLOC(allocator, double, (size_t)mesh->nfaces + 1);
+    angles = TT__ALLOC(allocator, double, 2 * (size_t)mesh->nfaces + 1);
     if (!angles)
         return tt__fail(error, TT_ERROR_OUT_OF_MEMORY, -1, -1, -1, -1, "out of memory measuring %d faces",
                         mesh->nfaces);
+    rows = angles + mesh->nfaces;
     for (f = 0; f < mesh->nfaces; f++) {
         const int first = mesh->face_start[f], fan = mesh->face_start[f + 1] - first - 2;
         const float *uv = corner_uv + 2 * (size_t)first;
         double a[3], b[3], cross[3], normal[3] = {0.0, 0.0, 0.0}, projected[3], w[3], image[2] = {0.0, 0.0};
-        double angle, scale, along;
+        double gradient[3] = {0.0, 0.0, 0.0}, perpendicular[3], angle, scale, along, g;
         int i;
         for (i = 1; i <= fan; i++) {
             tt__sub3f(tt__corner_pos(mesh, first + i), tt__corner_pos(mesh, first), a);
@@ -18600,6 +18638,7 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
                 image[0] += w[k] * uv[2 * corners[k]] * width / fan;
                 image[1] += w[k] * uv[2 * corners[k] + 1] * height / fan;
             }
+            tt__fan_gradient_add(mesh, first, i, uv, height, gradient);
         }
         tt__alignment_error(image, &angle, &scale);
         if (!(scale > 0.0 && scale < 1e300)) {
@@ -18608,9 +18647,17 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
         } else if (angle > 90.0) {
             angle = 180.0 - angle;  /* between lines: upside down is level */
         }
-        angles[n++] = angle;
+        angles[n] = angle;
         sum += angle;
         within += angle <= tolerance;
+        tt__cross3(gradient, projected, perpendicular);
+        g = tt__length3(gradient);
+        angle = g > 0.0 && g < 1e300
+                    ? atan2(tt__length3(perpendicular), fabs(tt__dot3(gradient, projected))) * (180.0 / TT__PI)
+                    : 90.0;
+        rows[n++] = angle;
+        rows_sum += angle;
+        rows_within += angle <= tolerance;
     }
     report->faces = n;
     if (n == 0) {
@@ -18622,6 +18669,10 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
     report->mean = sum / n;
     report->p90 = angles[(int)ceil(0.9 * n) - 1];
     report->within = (double)within / n;
+    tt__sort_doubles(rows, n);
+    report->rows_mean = rows_sum / n;
+    report->rows_p90 = rows[(int)ceil(0.9 * n) - 1];
+    report->rows_within = (double)rows_within / n;
     tt__free(allocator, angles);
     return TT_OK;
 }

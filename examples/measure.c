@@ -90,7 +90,8 @@ void tool_print_level(const tool_level *level)
     const tt_uv_direction_report *r = &level->report;
     if (level->measured)
         printf("level: the image's up %.1f%% of %d wall faces within 10 degrees of --up, mean %.1f, p90 %.1f "
-               "degrees\n", 100.0 * r->within, r->faces, r->mean, r->p90);
+               "degrees; its rows (courses) %.1f%%, mean %.1f, p90 %.1f\n", 100.0 * r->within, r->faces, r->mean,
+               r->p90, 100.0 * r->rows_within, r->rows_mean, r->rows_p90);
     else
         printf("level: not measured (%s)\n", level->reason);
 }

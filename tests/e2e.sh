@@ -1333,7 +1333,7 @@ permissive_case hpm lap.png --rotations 3
 # 10 degrees, against about 1 in 9 for random turns)
 newdir
 expect_ok "hpm --up z" hpm ../in/torus.obj ../in/lap.png out --rotations 3 --seed 2 --up z
-LEVEL=$(printf '%s\n' "$OUT" | sed -nE "s/^level: the image's up ([0-9.]+)% of ([0-9]+) wall faces within 10 degrees of --up, mean [0-9.]+, p90 [0-9.]+ degrees$/\1 \2/p")
+LEVEL=$(printf '%s\n' "$OUT" | sed -nE "s/^level: the image's up ([0-9.]+)% of ([0-9]+) wall faces within 10 degrees of --up, mean [0-9.]+, p90 [0-9.]+ degrees; its rows \(courses\) [0-9.]+%, mean [0-9.]+, p90 [0-9.]+$/\1 \2/p")
 check "hpm --up z: summary 'level: the image's up P% of N wall faces ...', P >= 40, N > 0" "P >= 40, N > 0" \
     "${LEVEL:-no level line}: $OUT" "$(read -r p n <<<"$LEVEL"; awk -v p="${p:-0}" -v n="${n:-0}" 'BEGIN { exit !(p >= 40 && n > 0) }'; echo $?)"
 check "hpm --up z: other coordinates than without" "files differ" "identical" \
@@ -1395,6 +1395,9 @@ expect_ok "tile --up y on the icosphere's triangles, no remesh" tile ../in/spher
 LEVEL_KITES=$(printf '%s\n' "$OUT" | sed -nE 's/^level: the image.s up ([0-9.]+)% .*/\1/p')
 expect_ok "tile --up y --remesh auto" tile ../in/spheretri.obj ../in/lap256.png rm --tile 32 --up y --remesh auto
 LEVEL_REMESH=$(printf '%s\n' "$OUT" | sed -nE 's/^level: the image.s up ([0-9.]+)% .*/\1/p')
+ROWS_REMESH=$(printf '%s\n' "$OUT" | sed -nE 's/^level: .*; its rows \(courses\) ([0-9.]+)%, mean [0-9.]+, p90 [0-9.]+$/\1/p')
+check "tile --remesh: the rows (courses) level too (90 % within 10 degrees)" "rows >= 90" \
+    "rows ${ROWS_REMESH:-none}" "$(awk -v r="${ROWS_REMESH:-0}" 'BEGIN { exit !(r >= 90) }'; echo $?)"
 check "tile --remesh: walls level (90 % within 10 degrees), the kites far from it" \
     "remesh >= 90, kites < 60" "remesh ${LEVEL_REMESH:-none}, kites ${LEVEL_KITES:-none}" \
     "$(awk -v r="${LEVEL_REMESH:-0}" -v k="${LEVEL_KITES:-100}" 'BEGIN { exit !(r >= 90 && k < 60) }'; echo $?)"

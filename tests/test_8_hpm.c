@@ -1782,8 +1782,9 @@ static void hpm_bricks(tt_image *im)
 
 /* tt_measure_uv_direction against maps whose answer is known: a wall (the
    plane x-z, up z) mapped with v along z lies level, turned by 30 degrees
-   it does not, upside down it lies level again (between lines); a floor
-   has no wall face. */
+   it does not, upside down it lies level again (between lines), and the
+   rows read the same; sheared, the image's up and the rows part (each
+   case the other's control); a floor has no wall face. */
 static void test_uv_direction_measure(void)
 {
     tmesh m;
@@ -1825,6 +1826,25 @@ static void test_uv_direction_measure(void)
         CHECK(r.faces == wall->nfaces && near(r.mean, turns[k] == 30 ? 30 : 0, 1e-3) &&
                   near(r.p90, r.mean, 1e-3) && r.within == (turns[k] == 30 ? 0.0 : 1.0) && r.singular == 0,
               "turned %d degrees: %d faces, mean %g, p90 %g, within %g", turns[k], r.faces, r.mean, r.p90, r.within);
+        CHECK(near(r.rows_mean, r.mean, 1e-3) && near(r.rows_p90, r.p90, 1e-3) && r.rows_within == r.within,
+              "turned %d degrees, the rows read the same: mean %g, p90 %g, within %g", turns[k], r.rows_mean,
+              r.rows_p90, r.rows_within);
+    }
+    /* Sheared: rows level, head joints leaning 30 degrees (u = x + z tan 30,
+       v = z) read 30 by the image's up and 0 by the rows; the converse
+       (u = x, v = z + x tan 30, rows rising) 0 and 30. */
+    for (k = 0; k < 2; k++) {
+        const double lean = tan(30 * 3.14159265358979323846 / 180);
+        for (f = 0; f < wall->ncorners; f++) {
+            const float *p = wall->pos + 3 * wall->corner_vert[f];
+            uv[2 * f] = (float)(0.1 * (p[0] + (k ? 0.0 : lean * p[2])));
+            uv[2 * f + 1] = (float)(0.1 * (p[2] + (k ? lean * p[0] : 0.0)));
+        }
+        CHECK(tt_measure_uv_direction(wall, uv, 64, 64, &o, NULL, &r, &err) == TT_OK &&
+                  near(r.mean, k ? 0 : 30, 1e-3) && near(r.rows_mean, k ? 30 : 0, 1e-3) &&
+                  r.rows_within == (k ? 0.0 : 1.0),
+              "sheared %s: the image's up %g degrees, the rows %g (%d and %d expected)",
+              k ? "with the rows rising" : "with the rows level", r.mean, r.rows_mean, k ? 0 : 30, k ? 30 : 0);
     }
     /* Quads (a tiling's faces) are measured as their fans: the same wall in
        quads reads 30 degrees turned; each quad's corners' UVs passed on by
@@ -1869,10 +1889,10 @@ static void test_uv_direction_measure(void)
           "64 x 128 texels: %g degrees (26.57)", r.mean);
     for (f = 0; f < wall->ncorners; f++) uv[2 * f] = uv[2 * f + 1] = 0.5f;
     CHECK(tt_measure_uv_direction(wall, uv, 64, 64, &o, NULL, &r, NULL) == TT_OK && r.singular == wall->nfaces &&
-              r.mean == 90 && r.within == 0,
-          "a collapsed map counts as 90 degrees: %d singular, mean %g", r.singular, r.mean);
+              r.mean == 90 && r.within == 0 && r.rows_mean == 90 && r.rows_within == 0,
+          "a collapsed map counts as 90 degrees: %d singular, mean %g, rows %g", r.singular, r.mean, r.rows_mean);
     CHECK(tt_measure_uv_direction(floor_mesh, uv, 64, 64, &o, NULL, &r, &err) == TT_ERROR_NOT_MEASURED &&
-              r.faces == 0 && r.mean != r.mean,
+              r.faces == 0 && r.mean != r.mean && r.rows_mean != r.rows_mean,
           "a floor has no wall: %s", err.message);
     o.up[2] = 0;
     o.tolerance = -1;
