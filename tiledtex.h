@@ -3170,8 +3170,9 @@ typedef struct tt_hpm_options {
                                     direction per face, 3 floats each in the face's plane (from
                                     tt_tangent_field: --up, constraints): each cluster's flattening is
                                     combed along the field (each triangle turned toward it, the cluster
-                                    re-fitted by least squares), and its texture is turned so that its up
-                                    (+v) follows the field averaged over the cluster's faces, at starts and
+                                    re-fitted by least squares), and its texture is turned so that its
+                                    rows (constant v) lie across the field averaged over the cluster's
+                                    faces (+v along the field's gradient in the flattening), at starts and
                                     in the fits, whose max_turn then counts from the field's direction
                                     instead of the main neighbour's (default then
                                     TT_DEFAULT_HPM_FIELD_MAX_TURN); a continuation turned further from it
@@ -23125,11 +23126,15 @@ static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, const double *an
 }
 
 /* The angle of a placement (tt__hpm_place) that turns C's texture up -
-   texel -y, +v - along the direction field averaged over C's faces: each
-   face's vector carried into C's flattened frame by the face's linear map
-   (tt__face_vector_weights), as a unit direction weighted by the face's
-   flattened area. centre gets the mean of C's corners in that frame.
-   Returns 0 without a field, or where the directions cancel. */
+   texel -y, +v - so that its rows (the lines of constant v: a brick
+   course) lie across the direction field, averaged over C's faces: in
+   each face, the direction in C's flattened frame in which the field's
+   height t.p rises fastest (its gradient there, J^-T t for the face's
+   linear map J; the field's own image J t leans with it where the
+   flattening shears, and rows laid across that would lean by as much),
+   as a unit direction weighted by the face's flattened area. centre gets
+   the mean of C's corners in that frame. Returns 0 without a field, or
+   where the directions cancel. */
 static int tt__hpm_field_angle(const tt__hpm *S, int C, double *angle, double *centre)
 {
     const tt_cluster *cl = &S->H->clusters[C];
@@ -23139,21 +23144,24 @@ static int tt__hpm_field_angle(const tt__hpm *S, int C, double *angle, double *c
     centre[0] = centre[1] = 0;
     for (i = 0; i < cl->nfaces; i++) {
         int f = S->H->faces[cl->first_face + i];
-        double t[3], w[3], q[3][2], d[2] = {0, 0}, length, area;
+        double t[3], height[3], q[3][2], d[2], length, det;
         for (k = 0; k < 3; k++) t[k] = S->field[3 * (size_t)f + k];
-        tt__face_vector_weights(S->mesh, f, t, w);
         for (j = 0; j < 3; j++) {
+            const float *p = tt__corner_pos(S->mesh, 3 * f + j);
+            height[j] = t[0] * p[0] + t[1] * p[1] + t[2] * p[2];
             tt__hpm_q(S, 3 * f + j, q[j]);
-            d[0] += w[j] * q[j][0];
-            d[1] += w[j] * q[j][1];
             centre[0] += q[j][0] / (3.0 * cl->nfaces);
             centre[1] += q[j][1] / (3.0 * cl->nfaces);
         }
+        /* d . (q_j - q_0) = height_j - height_0 for j = 1, 2 */
+        det = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
+        if (!(fabs(det) > 0)) continue;
+        d[0] = ((height[1] - height[0]) * (q[2][1] - q[0][1]) - (height[2] - height[0]) * (q[1][1] - q[0][1])) / det;
+        d[1] = ((height[2] - height[0]) * (q[1][0] - q[0][0]) - (height[1] - height[0]) * (q[2][0] - q[0][0])) / det;
         length = sqrt(d[0] * d[0] + d[1] * d[1]);
-        area = 0.5 * fabs((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]));
-        if (!(length > 0)) continue;
-        sum[0] += area * d[0] / length;
-        sum[1] += area * d[1] / length;
+        if (!(length > 0 && length < 1e300)) continue;
+        sum[0] += 0.5 * fabs(det) * d[0] / length;
+        sum[1] += 0.5 * fabs(det) * d[1] / length;
     }
     if (!(sum[0] * sum[0] + sum[1] * sum[1] > 0)) return 0;
     /* s R(angle) sum points along -y: angle + atan2(sum) = -pi / 2 */

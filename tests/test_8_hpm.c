@@ -2054,15 +2054,16 @@ static void test_hpm_map_level_curved(void)
         if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) break;
         CHECK(tt_measure_uv_direction(mesh, uv, 64, 64, &mo, NULL, &r, NULL) == TT_OK, "measured");
         hpm_uv_checks(mesh, uv, 64, 64, 0, &flipped, &bad);
-        printf("     sphere, seed %d%s: %.0f%% of %d wall faces within 10 degrees of level (mean %.1f), "
-               "%d clusters\n", (int)o.seed, t < 2 ? "" : ", random field", 100 * r.within, r.faces, r.mean,
-               rep.clusters);
+        printf("     sphere, seed %d%s: %.0f%% of %d wall faces within 10 degrees of level (mean %.1f), rows %.0f%% "
+               "(mean %.1f), %d clusters\n", (int)o.seed, t < 2 ? "" : ", random field", 100 * r.within, r.faces,
+               r.mean, 100 * r.rows_within, r.rows_mean, rep.clusters);
         if (t < 2)
-            CHECK(r.within >= 0.9 && flipped == 0 && bad == 0,
-                  "seed %d: %g of the wall faces within 10 degrees of level (at least 0.9), %d flipped, %d bad",
-                  (int)o.seed, r.within, flipped, bad);
+            CHECK(r.within >= 0.9 && r.rows_within >= 0.9 && flipped == 0 && bad == 0,
+                  "seed %d: %g of the wall faces within 10 degrees of level, their rows %g (at least 0.9 each), "
+                  "%d flipped, %d bad", (int)o.seed, r.within, r.rows_within, flipped, bad);
         else
-            CHECK(r.within < 0.4, "a random field: %g within 10 degrees (the control: under 0.4)", r.within);
+            CHECK(r.within < 0.4 && r.rows_within < 0.4,
+                  "a random field: %g within 10 degrees, rows %g (the control: under 0.4)", r.within, r.rows_within);
         free(uv);
         free(cl);
         uv = NULL;
