@@ -2523,81 +2523,33 @@ static double mapping_mean_area(const tt_polycube_mapping *map)
     return map->ntriangles > 0 ? sum / map->ntriangles : 0.0;
 }
 
-/* The shape of a mapping's texture as the tool's summary reports it,
-   computed here from scratch: the stretch (sigma_max / sigma_min of each
-   triangle's map from S to the model) at the 95th percentile, and the
-   density (area on S over area on the model) at the 5th and 95th
-   against its median, all weighted by the triangles' area on the model. */
-typedef struct mapping_shapes {
-    double stretch95, density5, density95;
-} mapping_shapes;
-
-static mapping_shapes mapping_shape_stats(const tt_polycube_mapping *map)
+/* The per-face stretch of a mapping: each output triangle against its
+   points on S scaled to cube units (all three lie in one quad, whose frame
+   is a unit square of side h), through tt_measure_uv_distortion. */
+static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map)
 {
-    mapping_shapes out = {HUGE_VAL, 0.0, HUGE_VAL};
-    double *stretch = (double *)malloc(sizeof(double) * ((size_t)map->ntriangles + 1));
-    double *density = (double *)malloc(sizeof(double) * ((size_t)map->ntriangles + 1));
-    double *area = (double *)malloc(sizeof(double) * ((size_t)map->ntriangles + 1)), median;
-    int j, k, n = 0;
-    if (!stretch || !density || !area) {
-        free(stretch);
-        free(density);
-        free(area);
-        return out;
+    tt_uv_distortion_report d;
+    tt_mesh_desc desc;
+    tt_mesh *out = NULL;
+    float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
+    int i;
+    memset(&d, 0, sizeof d);
+    for (i = 0; i < 3 * map->ntriangles; i++) {
+        uv[2 * i] = map->corner_points[i].s;
+        uv[2 * i + 1] = map->corner_points[i].t;
     }
-    for (j = 0; j < map->ntriangles; j++) {
-        const float *p[3];
-        const tt_surface_point *q = map->corner_points + 3 * j;
-        double e1[3], e2[3], n3[3], x[3], y[3], len, P[2][2], S[2][2], detP, detS, J[2][2], a, b, c, root;
-        for (k = 0; k < 3; k++) p[k] = map->positions + 3 * map->triangles[3 * j + k];
-        for (k = 0; k < 3; k++) {
-            e1[k] = (double)p[1][k] - p[0][k];
-            e2[k] = (double)p[2][k] - p[0][k];
-        }
-        n3[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n3[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n3[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        len = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-        if (!(len > 0.0)) continue;
-        for (k = 0; k < 3; k++) x[k] = e1[k] / len;
-        y[0] = n3[1] * x[2] - n3[2] * x[1];
-        y[1] = n3[2] * x[0] - n3[0] * x[2];
-        y[2] = n3[0] * x[1] - n3[1] * x[0];
-        a = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
-        if (!(a > 0.0)) continue;
-        for (k = 0; k < 3; k++) y[k] /= a;
-        /* columns: the two edges in the model triangle's frame, and on S */
-        P[0][0] = len; P[1][0] = 0.0;
-        P[0][1] = e2[0] * x[0] + e2[1] * x[1] + e2[2] * x[2];
-        P[1][1] = e2[0] * y[0] + e2[1] * y[1] + e2[2] * y[2];
-        S[0][0] = (double)q[1].s - q[0].s; S[1][0] = (double)q[1].t - q[0].t;
-        S[0][1] = (double)q[2].s - q[0].s; S[1][1] = (double)q[2].t - q[0].t;
-        detP = P[0][0] * P[1][1] - P[0][1] * P[1][0];
-        detS = S[0][0] * S[1][1] - S[0][1] * S[1][0];
-        if (!(fabs(detS) > 0.0)) continue;
-        /* J = P S^-1, the map from S to the model */
-        J[0][0] = (P[0][0] * S[1][1] - P[0][1] * S[1][0]) / detS;
-        J[0][1] = (P[0][1] * S[0][0] - P[0][0] * S[0][1]) / detS;
-        J[1][0] = (P[1][0] * S[1][1] - P[1][1] * S[1][0]) / detS;
-        J[1][1] = (P[1][1] * S[0][0] - P[1][0] * S[0][1]) / detS;
-        a = J[0][0] * J[0][0] + J[1][0] * J[1][0];
-        b = J[0][0] * J[0][1] + J[1][0] * J[1][1];
-        c = J[0][1] * J[0][1] + J[1][1] * J[1][1];
-        root = sqrt((a - c) * (a - c) + 4.0 * b * b);
-        stretch[n] = (a + c - root) > 0.0 ? sqrt((a + c + root) / (a + c - root)) : HUGE_VAL;
-        density[n] = fabs(detS) / fabs(detP);
-        area[n++] = 0.5 * fabs(detP);
-    }
-    if (n > 0) {
-        median = internal_weighted_percentile(density, area, n, 0.5);
-        out.stretch95 = internal_weighted_percentile(stretch, area, n, 0.95);
-        out.density5 = internal_weighted_percentile(density, area, n, 0.05) / median;
-        out.density95 = internal_weighted_percentile(density, area, n, 0.95) / median;
-    }
-    free(stretch);
-    free(density);
-    free(area);
-    return out;
+    memset(&desc, 0, sizeof desc);
+    desc.positions = map->positions;
+    desc.nverts = map->nverts;
+    desc.indices = map->triangles;
+    desc.nfaces = map->ntriangles;
+    desc.fixed_face_size = 3;
+    desc.flags = TT_MESH_PERMISSIVE;
+    if (tt_mesh_build(&desc, NULL, &out, NULL) == TT_OK)
+        tt_measure_uv_distortion(out, uv, 256, 256, NULL, NULL, &d, NULL);
+    tt_mesh_free(out);
+    free(uv);
+    return d;
 }
 
 /* Step 7, the pieces merged: on a coarse sphere (its triangles span
@@ -2606,8 +2558,9 @@ static mapping_shapes mapping_shape_stats(const tt_polycube_mapping *map)
    (max_map_error below 0), is as sound (on the model, the area kept,
    closed, each triangle in one quad, none flipped), and its texture keeps
    close to the unmerged one's shape: the stretch percentile the summary
-   reports within 0.05, the density's within 0.05 below and 0.2 above (a
-   merge may give a triangle any density its star had). Control: merged
+   reports (tt_measure_uv_distortion) within 0.05, the texel density's
+   within 0.05 below and 0.1 above (a merge may give a triangle any
+   density its star had). Control: merged
    as far without the shape bounds, the stretch p95 grows by more than 1.
    A tight max_map_error holds: the texture stays within
    1/256 of a quad of the unmerged one (control: merged with 0.05 quads,
@@ -2645,25 +2598,25 @@ static void test_map_merge(void)
         const double ref_mean = mapping_mean_area(ref);
         int unfound, loose_unfound, slivers, ref_slivers;
         double moved, loose_moved;
-        mapping_shapes ref_shape, shape, free_shape;
+        tt_uv_distortion_report ref_shape, shape, free_shape;
         CHECK(internal_mapping_merge(unbounded, mesh, TT_POLYCUBE_MAP_DEFAULT_ERROR, 0) > 0,
               "the control merges");
         moved = merge_moved(ref, tight, mesh->nfaces, &unfound);
         loose_moved = merge_moved(ref, loose, mesh->nfaces, &loose_unfound);
         slivers = mapping_slivers(map, 1e-4 * ref_mean);
         ref_slivers = mapping_slivers(ref, 1e-4 * ref_mean);
-        ref_shape = mapping_shape_stats(ref);
-        shape = mapping_shape_stats(map);
-        free_shape = mapping_shape_stats(unbounded);
+        ref_shape = mapping_stretch(ref);
+        shape = mapping_stretch(map);
+        free_shape = mapping_stretch(unbounded);
         printf("     coarse sphere at 24: %d triangles unmerged, %d merged by default, %d within %.3g quads (texture "
                "moved %.2g quads, %d centroids across a line), %d within 0.05 (moved %.2g), %d without the shape "
                "bounds; slivers %d unmerged, %d merged\n", ref->ntriangles, map->ntriangles, tight->ntriangles,
                tight_error, moved, unfound, loose->ntriangles, loose_moved, unbounded->ntriangles, ref_slivers,
                slivers);
         printf("     stretch p95 / density p5, p95: unmerged %.3f / %.3f, %.3f; default %.3f / %.3f, %.3f; "
-               "control %.3f / %.3f, %.3f\n", ref_shape.stretch95, ref_shape.density5, ref_shape.density95,
-               shape.stretch95, shape.density5, shape.density95, free_shape.stretch95, free_shape.density5,
-               free_shape.density95);
+               "control %.3f / %.3f, %.3f\n", ref_shape.stretch_p95, ref_shape.density_p5_over_median, ref_shape.density_p95_over_median,
+               shape.stretch_p95, shape.density_p5_over_median, shape.density_p95_over_median, free_shape.stretch_p95, free_shape.density_p5_over_median,
+               free_shape.density_p95_over_median);
         CHECK(ref_rep.merged == 0 && rep.merged == ref->ntriangles - map->ntriangles &&
                   map->ntriangles <= 0.5 * ref->ntriangles && map->ntriangles < loose->ntriangles &&
                   loose->ntriangles < tight->ntriangles && tight->ntriangles <= 0.95 * ref->ntriangles,
@@ -2675,14 +2628,14 @@ static void test_map_merge(void)
               "strict build %s, %d open edges), %d flipped, %d fallbacks (unmerged %d)", c.off_surface,
               c.moved_inputs, c.bad_points, c.area_error, c.strict_fails ? "fails" : "holds", c.open_edges,
               rep.flipped, rep.fallback_triangles, ref_rep.fallback_triangles);
-        CHECK(shape.stretch95 <= ref_shape.stretch95 + 0.05 && shape.density5 >= ref_shape.density5 - 0.05 &&
-                  shape.density95 <= ref_shape.density95 + 0.2,
+        CHECK(shape.stretch_p95 <= ref_shape.stretch_p95 + 0.05 && shape.density_p5_over_median >= ref_shape.density_p5_over_median - 0.05 &&
+                  shape.density_p95_over_median <= ref_shape.density_p95_over_median + 0.1,
               "the default keeps the texture's shape: stretch p95 %.3f (unmerged %.3f), density p5 %.3f, p95 %.3f "
-              "(unmerged %.3f, %.3f)", shape.stretch95, ref_shape.stretch95, shape.density5, shape.density95,
-              ref_shape.density5, ref_shape.density95);
-        CHECK(free_shape.stretch95 > ref_shape.stretch95 + 1.0,
+              "(unmerged %.3f, %.3f)", shape.stretch_p95, ref_shape.stretch_p95, shape.density_p5_over_median, shape.density_p95_over_median,
+              ref_shape.density_p5_over_median, ref_shape.density_p95_over_median);
+        CHECK(free_shape.stretch_p95 > ref_shape.stretch_p95 + 1.0,
               "control: merged as far without the shape bounds, the stretch p95 grows (%.3f, unmerged %.3f)",
-              free_shape.stretch95, ref_shape.stretch95);
+              free_shape.stretch_p95, ref_shape.stretch_p95);
         CHECK(moved <= tight_error + 1e-5 && unfound <= ref->ntriangles / 100,
               "within %.3g quads the texture moved %.3g quads, %d of %d centroids not found", tight_error, moved,
               unfound, ref->ntriangles);
@@ -3267,35 +3220,6 @@ static void test_map_determinism_and_errors(void)
     tt_polycube_free(pc);
     tt_mesh_free(mesh);
     tm_free(&m);
-}
-
-/* The per-face stretch of a mapping: each output triangle against its
-   points on S scaled to cube units (all three lie in one quad, whose frame
-   is a unit square of side h), through tt_measure_uv_distortion. */
-static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map)
-{
-    tt_uv_distortion_report d;
-    tt_mesh_desc desc;
-    tt_mesh *out = NULL;
-    float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
-    int i;
-    memset(&d, 0, sizeof d);
-    for (i = 0; i < 3 * map->ntriangles; i++) {
-        uv[2 * i] = map->corner_points[i].s;
-        uv[2 * i + 1] = map->corner_points[i].t;
-    }
-    memset(&desc, 0, sizeof desc);
-    desc.positions = map->positions;
-    desc.nverts = map->nverts;
-    desc.indices = map->triangles;
-    desc.nfaces = map->ntriangles;
-    desc.fixed_face_size = 3;
-    desc.flags = TT_MESH_PERMISSIVE;
-    if (tt_mesh_build(&desc, NULL, &out, NULL) == TT_OK)
-        tt_measure_uv_distortion(out, uv, 256, 256, NULL, NULL, &d, NULL);
-    tt_mesh_free(out);
-    free(uv);
-    return d;
 }
 
 /* The stretch floor of a voxel polycube: a cube turned 45
