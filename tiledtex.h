@@ -2519,11 +2519,13 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
    the fan of triangles from its first corner, phi(P_f(up)) their mean, its
    normal theirs added up. The rows_ statistics measure the texture's rows
    instead (a brick course, a plank): the angle between the surface
-   gradient of v (area-weighted over the fan) and P_f(up). The two differ
-   where the map shears: a quad whose bottom and top lie level but whose
-   sides lean shows level courses and leaning head joints, which the
-   image's up counts as turned and the rows do not; a zero gradient counts
-   as 90. No wall face: TT_ERROR_NOT_MEASURED (the statistics NaN).
+   gradient of v and P_f(up), that is between the rows' direction dP/du
+   and level, at the face's centre (a quad's bilinear map there). The two
+   differ where the map shears: a quad whose bottom and top lie level but
+   whose sides lean shows level courses and leaning head joints, which
+   the image's up counts as turned and the rows do not; a map with no
+   area counts as 90. No wall face: TT_ERROR_NOT_MEASURED (the statistics
+   NaN).
    Errors: NULL pointers, width or height below 1, a zero or non-finite
    up, options out of range (TT_ERROR_INVALID_ARGUMENT);
    TT_ERROR_OUT_OF_MEMORY. Temporary memory: 16 bytes a face. Only reads
@@ -14148,19 +14150,41 @@ static void tt__metric_eigenvalues(double g11, double g12, double g22, double *b
     *small = 0.5 * (tr - disc);
 }
 
-/* The map from texture to surface of `face` at its centre, M (3x2, columns
-   dP/du and dP/dv), through the face's own parametrisation (s, t): for a
-   quad the bilinear patch's derivatives, otherwise the first triangle.
-   A = dP/d(s,t) (3x2), B = dUV/d(s,t) (2x2) with texture coordinates
-   (u * u_scale, v * v_scale) (1, 1: UV units; width, height: texels), and
-   M = A B^-1. Gives the eigenvalues big >= small of M^T M, the squares of
-   M's singular values; returns 0 when B is singular (|det B| < 1e-30). */
-static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
-                                       double v_scale, double *big, double *small)
+/* A linear map's texture axes M (m[0] = dP/du, m[1] = dP/dv), given
+   along two directions of any parametrisation: a[i] = dP/d(param i),
+   b[i] = d(u, v)/d(param i); M B = A. Returns 0 when B is singular
+   (|det B| < 1e-30). */
+static int tt__texture_axes(const double a[2][3], const double b[2][2], double m[2][3])
+{
+    const double det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
+    int k;
+    if (!(fabs(det) >= 1e-30)) return 0;
+    for (k = 0; k < 3; k++) {
+        m[0][k] = (a[0][k] * b[1][1] - a[1][k] * b[0][1]) / det;
+        m[1][k] = (a[1][k] * b[0][0] - a[0][k] * b[1][0]) / det;
+    }
+    return 1;
+}
+
+/* The eigenvalues big >= small of M^T M for texture axes m: the squares
+   of the map's singular values. */
+static void tt__texture_axes_metric(const double m[2][3], double *big, double *small)
+{
+    tt__metric_eigenvalues(tt__dot3(m[0], m[0]), tt__dot3(m[0], m[1]), tt__dot3(m[1], m[1]), big, small);
+}
+
+/* The map from texture to surface of `face` at its centre, M (columns
+   dP/du and dP/dv, tt__texture_axes), through the face's own
+   parametrisation (s, t): for a quad the bilinear patch's derivatives,
+   otherwise the first triangle, with texture coordinates (u * u_scale,
+   v * v_scale) (1, 1: UV units; width, height: texels). Returns 0 when
+   the texture coordinates have no area there. */
+static int tt__face_texture_axes(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
+                                 double v_scale, double m[2][3])
 {
     int first = mesh->face_start[face], size = mesh->face_start[face + 1] - first, k;
     const float *p[4], *q[4];
-    double a[2][3], b[2][3], det, m[2][3], g11 = 0, g12 = 0, g22 = 0;
+    double a[2][3], b[2][3], scaled[2][2];
     for (k = 0; k < 4; k++) {
         int corner = first + (size == 4 ? k : (k < 3 ? k : 2));
         p[k] = mesh->pos + 3 * (size_t)mesh->corner_vert[corner];
@@ -14169,21 +14193,20 @@ static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_
     tt__face_tangents(p, 3, size, a);
     tt__face_tangents(q, 2, size, b);
     for (k = 0; k < 2; k++) {
-        b[k][0] *= u_scale;
-        b[k][1] *= v_scale;
+        scaled[k][0] = b[k][0] * u_scale;
+        scaled[k][1] = b[k][1] * v_scale;
     }
-    /* b[i] is d(u,v)/d(param i); rows of A likewise. Solve M B = A for the
-       two texture axes: M's column for u and v. */
-    det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
-    if (fabs(det) < 1e-30) return 0;
-    for (k = 0; k < 3; k++) {
-        m[0][k] = (a[0][k] * b[1][1] - a[1][k] * b[0][1]) / det;   /* dP/du */
-        m[1][k] = (a[1][k] * b[0][0] - a[0][k] * b[1][0]) / det;   /* dP/dv */
-        g11 += m[0][k] * m[0][k];
-        g12 += m[0][k] * m[1][k];
-        g22 += m[1][k] * m[1][k];
-    }
-    tt__metric_eigenvalues(g11, g12, g22, big, small);
+    return tt__texture_axes((const double(*)[3])a, (const double(*)[2])scaled, m);
+}
+
+/* tt__face_texture_axes' metric: the eigenvalues big >= small of M^T M;
+   returns 0 when the texture coordinates have no area. */
+static int tt__face_texture_to_surface(const tt_mesh *mesh, const float *corner_uv, int face, double u_scale,
+                                       double v_scale, double *big, double *small)
+{
+    double m[2][3];
+    if (!tt__face_texture_axes(mesh, corner_uv, face, u_scale, v_scale, m)) return 0;
+    tt__texture_axes_metric((const double(*)[3])m, big, small);
     return 1;
 }
 
@@ -18551,34 +18574,6 @@ TTDEF tt_result tt_lapped_measure(const tt_mesh *mesh, const float *face_vectors
     return TT_OK;
 }
 
-/* Adds twice the area of the fan triangle (first, first + i, first + i + 1)
-   times the surface gradient of v * height over it to gradient: the sum
-   over its corners of v_k (N x e_k), e_k the edge opposite corner k taken
-   counter-clockwise and N the triangle's unit normal. */
-static void tt__fan_gradient_add(const tt_mesh *mesh, int first, int i, const float *uv, int height,
-                                 double gradient[3])
-{
-    const int corners[3] = {0, i, i + 1};
-    double p[3][3], cross[3], e1[3], e2[3], length;
-    int k, j;
-    for (k = 0; k < 3; k++)
-        for (j = 0; j < 3; j++) p[k][j] = tt__corner_pos(mesh, first + corners[k])[j];
-    for (j = 0; j < 3; j++) {
-        e1[j] = p[1][j] - p[0][j];
-        e2[j] = p[2][j] - p[0][j];
-    }
-    tt__cross3(e1, e2, cross);
-    length = tt__length3(cross);
-    if (!(length > 0.0 && length < 1e300)) return;
-    for (k = 0; k < 3; k++) {
-        const double *from = p[(k + 1) % 3], *to = p[(k + 2) % 3], v = (double)uv[2 * corners[k] + 1] * height;
-        double edge[3], turned[3];
-        for (j = 0; j < 3; j++) edge[j] = to[j] - from[j];
-        tt__cross3(cross, edge, turned);
-        for (j = 0; j < 3; j++) gradient[j] += v * turned[j] / length;
-    }
-}
-
 TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner_uv, int width, int height,
                                         const tt_uv_direction_options *options, const tt_allocator *allocator,
                                         tt_uv_direction_report *report, tt_error *error)
@@ -18619,7 +18614,7 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
         const int first = mesh->face_start[f], fan = mesh->face_start[f + 1] - first - 2;
         const float *uv = corner_uv + 2 * (size_t)first;
         double a[3], b[3], cross[3], normal[3] = {0.0, 0.0, 0.0}, projected[3], w[3], image[2] = {0.0, 0.0};
-        double gradient[3] = {0.0, 0.0, 0.0}, perpendicular[3], angle, scale, along, g;
+        double axes[2][3], perpendicular[3], angle, scale, along;
         int i;
         for (i = 1; i <= fan; i++) {
             tt__sub3f(tt__corner_pos(mesh, first + i), tt__corner_pos(mesh, first), a);
@@ -18639,7 +18634,6 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
                 image[0] += w[k] * uv[2 * corners[k]] * width / fan;
                 image[1] += w[k] * uv[2 * corners[k] + 1] * height / fan;
             }
-            tt__fan_gradient_add(mesh, first, i, uv, height, gradient);
         }
         tt__alignment_error(image, &angle, &scale);
         if (!(scale > 0.0 && scale < 1e300)) {
@@ -18651,11 +18645,14 @@ TTDEF tt_result tt_measure_uv_direction(const tt_mesh *mesh, const float *corner
         angles[n] = angle;
         sum += angle;
         within += angle <= tolerance;
-        tt__cross3(gradient, projected, perpendicular);
-        g = tt__length3(gradient);
-        angle = g > 0.0 && g < 1e300
-                    ? atan2(tt__length3(perpendicular), fabs(tt__dot3(gradient, projected))) * (180.0 / TT__PI)
-                    : 90.0;
+        /* The rows run along dP/du: level when it lies across P_f(up). */
+        if (tt__face_texture_axes(mesh, corner_uv, f, width, height, axes)) {
+            tt__cross3(axes[0], projected, perpendicular);
+            angle = atan2(fabs(tt__dot3(axes[0], projected)), tt__length3(perpendicular)) * (180.0 / TT__PI);
+        } else {
+            angle = 90.0;
+        }
+        if (!(angle == angle)) angle = 90.0;
         rows[n++] = angle;
         rows_sum += angle;
         rows_within += angle <= tolerance;
@@ -23129,9 +23126,10 @@ static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, const double *an
    texel -y, +v - so that its rows (the lines of constant v: a brick
    course) lie across the direction field, averaged over C's faces: in
    each face, the direction in C's flattened frame in which the field's
-   height t.p rises fastest (its gradient there, J^-T t for the face's
-   linear map J; the field's own image J t leans with it where the
-   flattening shears, and rows laid across that would lean by as much),
+   height t.p rises fastest (its gradient there, M^T t for the face's
+   texture axes M; the field's own image in the frame leans with the
+   flattening where it shears, and rows laid across that would lean by
+   as much),
    as a unit direction weighted by the face's flattened area. centre gets
    the mean of C's corners in that frame. Returns 0 without a field, or
    where the directions cancel. */
@@ -23144,24 +23142,28 @@ static int tt__hpm_field_angle(const tt__hpm *S, int C, double *angle, double *c
     centre[0] = centre[1] = 0;
     for (i = 0; i < cl->nfaces; i++) {
         int f = S->H->faces[cl->first_face + i];
-        double t[3], height[3], q[3][2], d[2], length, det;
+        double t[3], q[3][2], a[2][3], b[2][2], axes[2][3], d[2], length, area;
         for (k = 0; k < 3; k++) t[k] = S->field[3 * (size_t)f + k];
         for (j = 0; j < 3; j++) {
-            const float *p = tt__corner_pos(S->mesh, 3 * f + j);
-            height[j] = t[0] * p[0] + t[1] * p[1] + t[2] * p[2];
             tt__hpm_q(S, 3 * f + j, q[j]);
             centre[0] += q[j][0] / (3.0 * cl->nfaces);
             centre[1] += q[j][1] / (3.0 * cl->nfaces);
         }
-        /* d . (q_j - q_0) = height_j - height_0 for j = 1, 2 */
-        det = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
-        if (!(fabs(det) > 0)) continue;
-        d[0] = ((height[1] - height[0]) * (q[2][1] - q[0][1]) - (height[2] - height[0]) * (q[1][1] - q[0][1])) / det;
-        d[1] = ((height[2] - height[0]) * (q[1][0] - q[0][0]) - (height[1] - height[0]) * (q[2][0] - q[0][0])) / det;
+        for (j = 0; j < 2; j++) {
+            tt__sub3f(tt__corner_pos(S->mesh, 3 * f + j + 1), tt__corner_pos(S->mesh, 3 * f), a[j]);
+            b[j][0] = q[j + 1][0] - q[0][0];
+            b[j][1] = q[j + 1][1] - q[0][1];
+        }
+        /* the field's height t.p rises along M^T t in the frame (M: the
+           face's axes, dP/dq) */
+        if (!tt__texture_axes((const double(*)[3])a, (const double(*)[2])b, axes)) continue;
+        d[0] = tt__dot3(t, axes[0]);
+        d[1] = tt__dot3(t, axes[1]);
         length = sqrt(d[0] * d[0] + d[1] * d[1]);
         if (!(length > 0 && length < 1e300)) continue;
-        sum[0] += 0.5 * fabs(det) * d[0] / length;
-        sum[1] += 0.5 * fabs(det) * d[1] / length;
+        area = 0.5 * fabs(b[0][0] * b[1][1] - b[0][1] * b[1][0]);
+        sum[0] += area * d[0] / length;
+        sum[1] += area * d[1] / length;
     }
     if (!(sum[0] * sum[0] + sum[1] * sum[1] > 0)) return 0;
     /* s R(angle) sum points along -y: angle + atan2(sum) = -pi / 2 */
@@ -32516,6 +32518,7 @@ typedef struct tt__merge {
     unsigned char *dirty;       /* per vertex: its star changed since it was last tried with the whole tolerance */
     double *position;           /* per vertex: its model point (3) */
     double *normal;             /* per input face: its unit normal (3), 0 when it has no area */
+    double *shape;              /* per triangle: its stretch and density (tt__merge_shape), kept up to date */
     double median_density;      /* the triangles' median area on S over area on the model, before merging */
     int keep_shape;             /* 1: tt__merge_keeps_shape bounds every merge (0 only for the tests' control) */
 } tt__merge;
@@ -32864,32 +32867,24 @@ static double tt__merge_moved_crossings(const tt__merge *G, const tt__merge_try 
     return moved;
 }
 
-/* 1 when merge T is allowed with the texture moving by at most `tolerance`
-   (T->moved gets the new bound of its triangles); without `crossings`,
-   judged at the two ends only (a lower bound, and a quicker one). */
 /* A triangle's stretch (sigma_max / sigma_min of its map from S to the
    model, infinite when it has no area on S) and density (its area on S
    over its area on the model), from its corners in both spaces. */
 static void tt__merge_shape(const double q[3][3], const double st[3][2], double *stretch, double *density)
 {
-    const double e1[2] = {st[1][0] - st[0][0], st[1][1] - st[0][1]}, e2[2] = {st[2][0] - st[0][0], st[2][1] - st[0][1]};
-    const double det = e1[0] * e2[1] - e1[1] * e2[0];
-    double ds[3], dt[3], n[3], g11 = 0.0, g12 = 0.0, g22 = 0.0, big, small, area;
-    int k;
+    double a[2][3], b[2][2], axes[2][3], n[3], area, big, small;
+    int j, k;
+    for (j = 0; j < 2; j++) {
+        for (k = 0; k < 3; k++) a[j][k] = q[j + 1][k] - q[0][k];
+        b[j][0] = st[j + 1][0] - st[0][0];
+        b[j][1] = st[j + 1][1] - st[0][1];
+    }
     tt__merge_normal(q, n);
     area = tt__length3(n);
-    *density = area > 0.0 ? fabs(det) / area : 0.0;
+    *density = area > 0.0 ? fabs(b[0][0] * b[1][1] - b[0][1] * b[1][0]) / area : 0.0;
     *stretch = tt__infinity();
-    if (det == 0.0) return;
-    for (k = 0; k < 3; k++) {
-        const double d1 = q[1][k] - q[0][k], d2 = q[2][k] - q[0][k];
-        ds[k] = (d1 * e2[1] - d2 * e1[1]) / det;    /* dP/ds */
-        dt[k] = (d2 * e1[0] - d1 * e2[0]) / det;    /* dP/dt */
-        g11 += ds[k] * ds[k];
-        g12 += ds[k] * dt[k];
-        g22 += dt[k] * dt[k];
-    }
-    tt__metric_eigenvalues(g11, g12, g22, &big, &small);
+    if (!tt__texture_axes((const double(*)[3])a, (const double(*)[2])b, axes)) return;
+    tt__texture_axes_metric((const double(*)[3])axes, &big, &small);
     *stretch = tt__stretch_ratio(big, small);
 }
 
@@ -32907,10 +32902,10 @@ static int tt__merge_keeps_shape(const tt__merge *G, const tt__merge_try *T)
     const double median = G->median_density;
     int i;
     for (i = 0; i < T->n; i++) {
-        tt__merge_shape((const double(*)[3])T->before[i], (const double(*)[2])T->st_before[i], &stretch, &density);
-        worst = fmax(worst, stretch);
-        low = fmin(low, density);
-        high = fmax(high, density);
+        const double *before = G->shape + 2 * (size_t)T->tris[i];
+        worst = fmax(worst, before[0]);
+        low = fmin(low, before[1]);
+        high = fmax(high, before[1]);
     }
     for (i = 0; i < T->n; i++) {
         if (T->gone[i]) continue;
@@ -32923,6 +32918,9 @@ static int tt__merge_keeps_shape(const tt__merge *G, const tt__merge_try *T)
     return 1;
 }
 
+/* 1 when merge T is allowed with the texture moving by at most `tolerance`
+   (T->moved gets the new bound of its triangles); without `crossings`,
+   judged at the two ends only (a lower bound, and a quicker one). */
 static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double tolerance, int crossings)
 {
     double largest = 0.0, moved_before = 0.0, ma, mb, mc;
@@ -33006,6 +33004,8 @@ static void tt__merge_apply(tt__merge *G, const tt__merge_try *T)
             m->corner_points[3 * t + k].t = T->st[i][1];
         }
         G->moved[t] = (float)T->moved;
+        tt__merge_shape((const double(*)[3])T->after[i], (const double(*)[2])T->st_after[i], G->shape + 2 * (size_t)t,
+                        G->shape + 2 * (size_t)t + 1);
     }
     if (T->keep_model == T->a) {
         memcpy(G->position + 3 * (size_t)T->b, G->position + 3 * (size_t)T->a, 3 * sizeof(double));
@@ -33180,23 +33180,25 @@ static void tt__merge_compact(tt__merge *G)
     m->ntriangles = nt;
 }
 
-/* G->median_density: the median over the triangles with some area in
-   both spaces (1 when none has). 0 when out of memory. */
-static int tt__merge_median_density(tt__merge *G, const tt_allocator *allocator)
+/* Every triangle's shape (G->shape) and the median of the densities
+   with some area in both spaces (G->median_density; 1 when none has). 0
+   when out of memory. */
+static int tt__merge_shapes(tt__merge *G, const tt_allocator *allocator)
 {
     const tt_polycube_mapping *m = G->m;
-    double *values = TT__ALLOC(allocator, double, (size_t)m->ntriangles + 1), q[3][3], st[3][2], stretch;
+    double *values = TT__ALLOC(allocator, double, (size_t)m->ntriangles + 1), q[3][3], st[3][2];
     int t, k, n = 0;
     if (!values) return 0;
     for (t = 0; t < m->ntriangles; t++) {
+        double *shape = G->shape + 2 * (size_t)t;
         for (k = 0; k < 3; k++) {
             const tt_surface_point *p = m->corner_points + 3 * (size_t)t + k;
             tt__merge_position(G, m->triangles[3 * t + k], q[k]);
             st[k][0] = p->s;
             st[k][1] = p->t;
         }
-        tt__merge_shape((const double(*)[3])q, (const double(*)[2])st, &stretch, &values[n]);
-        n += values[n] > 0.0 && values[n] < HUGE_VAL;
+        tt__merge_shape((const double(*)[3])q, (const double(*)[2])st, &shape[0], &shape[1]);
+        if (shape[1] > 0.0 && shape[1] < HUGE_VAL) values[n++] = shape[1];
     }
     G->median_density = n > 0 ? tt__median(values, n) : 1.0;
     tt__free(allocator, values);
@@ -33224,9 +33226,11 @@ static int tt__mapping_merge(tt_polycube_mapping *m, const tt_mesh *mesh, double
     G.moved = TT__ALLOC(allocator, float, m->ntriangles);
     G.dirty = TT__ALLOC(allocator, unsigned char, m->nverts);
     G.position = TT__ALLOC(allocator, double, 3 * (size_t)m->nverts);
+    G.shape = TT__ALLOC(allocator, double, 2 * (size_t)m->ntriangles + 2);
     G.normal = TT__ALLOC(allocator, double, 3 * (size_t)mesh->nfaces);
     tries = TT__ALLOC(allocator, tt__merge_try, 2);
-    if (!G.start || !G.items || !G.state || !G.dead || !G.moved || !G.dirty || !G.position || !G.normal || !tries) {
+    if (!G.start || !G.items || !G.state || !G.dead || !G.moved || !G.dirty || !G.position || !G.shape || !G.normal ||
+        !tries) {
         before = -1;
         goto done;
     }
@@ -33245,7 +33249,7 @@ static int tt__mapping_merge(tt_polycube_mapping *m, const tt_mesh *mesh, double
         }
     }
     for (a = 0; a < mesh->nfaces; a++) tt__face_normal_d(mesh, a, G.normal + 3 * (size_t)a);
-    if (!tt__merge_median_density(&G, allocator)) {
+    if (!tt__merge_shapes(&G, allocator)) {
         before = -1;
         goto done;
     }
@@ -33274,6 +33278,7 @@ done:
     tt__free(allocator, G.moved);
     tt__free(allocator, G.dirty);
     tt__free(allocator, G.position);
+    tt__free(allocator, G.shape);
     tt__free(allocator, G.normal);
     tt__free(allocator, tries);
     return before;

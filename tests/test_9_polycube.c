@@ -2076,12 +2076,29 @@ static double triangle_area3(const float *a, const float *b, const float *c)
     return 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 
+/* A mapping's triangles as a tt_mesh built with `flags` (0: strict, as
+   the seam measure and the soundness check want it); NULL when they make
+   none. */
+static tt_mesh *mapping_mesh(const tt_polycube_mapping *map, unsigned flags)
+{
+    tt_mesh_desc d;
+    tt_mesh *out = NULL;
+    memset(&d, 0, sizeof d);
+    d.positions = map->positions;
+    d.nverts = map->nverts;
+    d.indices = map->triangles;
+    d.nfaces = map->ntriangles;
+    d.fixed_face_size = 3;
+    d.flags = flags;
+    if (tt_mesh_build(&d, NULL, &out, NULL) != TT_OK) return NULL;
+    return out;
+}
+
 static mapping_check check_mapping(const tt_polycube *pc, const tt_mesh *mesh, const tt_polycube_mapping *m)
 {
     mapping_check c;
     double in = 0.0, out = 0.0, scale = 0.0;
     int v, f, k, a;
-    tt_mesh_desc d;
     tt_mesh *built = NULL;
     memset(&c, 0, sizeof c);
     for (v = 0; v < 3 * mesh->nverts; v++) scale = fmax(scale, fabs(mesh->pos[v]));
@@ -2112,13 +2129,7 @@ static mapping_check check_mapping(const tt_polycube *pc, const tt_mesh *mesh, c
         }
     }
     c.area_error = fabs(out - in) / in;
-    memset(&d, 0, sizeof d);
-    d.positions = m->positions;
-    d.nverts = m->nverts;
-    d.indices = m->triangles;
-    d.nfaces = m->ntriangles;
-    d.fixed_face_size = 3;
-    if (tt_mesh_build(&d, NULL, &built, NULL) != TT_OK) {
+    if (!(built = mapping_mesh(m, 0))) {
         c.strict_fails = 1;
     } else {
         for (k = 0; k < built->ncorners; k++) c.open_edges += built->twin[k] < 0;
@@ -2529,8 +2540,7 @@ static double mapping_mean_area(const tt_polycube_mapping *map)
 static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map)
 {
     tt_uv_distortion_report d;
-    tt_mesh_desc desc;
-    tt_mesh *out = NULL;
+    tt_mesh *out = mapping_mesh(map, TT_MESH_PERMISSIVE);
     float *uv = (float *)malloc(sizeof(float) * 6 * (size_t)map->ntriangles);
     int i;
     memset(&d, 0, sizeof d);
@@ -2538,15 +2548,7 @@ static tt_uv_distortion_report mapping_stretch(const tt_polycube_mapping *map)
         uv[2 * i] = map->corner_points[i].s;
         uv[2 * i + 1] = map->corner_points[i].t;
     }
-    memset(&desc, 0, sizeof desc);
-    desc.positions = map->positions;
-    desc.nverts = map->nverts;
-    desc.indices = map->triangles;
-    desc.nfaces = map->ntriangles;
-    desc.fixed_face_size = 3;
-    desc.flags = TT_MESH_PERMISSIVE;
-    if (tt_mesh_build(&desc, NULL, &out, NULL) == TT_OK)
-        tt_measure_uv_distortion(out, uv, 256, 256, NULL, NULL, &d, NULL);
+    if (out) tt_measure_uv_distortion(out, uv, 256, 256, NULL, NULL, &d, NULL);
     tt_mesh_free(out);
     free(uv);
     return d;
@@ -2673,21 +2675,6 @@ static tt_tileset *seam_test_tiles(tt_synth_options *so, tt_image **photo)
     return tiles;
 }
 
-/* A mapping's triangles as a strict tt_mesh (for the seam measure); NULL when they make none. */
-static tt_mesh *mapping_mesh(const tt_polycube_mapping *map)
-{
-    tt_mesh_desc d;
-    tt_mesh *out = NULL;
-    memset(&d, 0, sizeof d);
-    d.positions = map->positions;
-    d.nverts = map->nverts;
-    d.indices = map->triangles;
-    d.nfaces = map->ntriangles;
-    d.fixed_face_size = 3;
-    if (tt_mesh_build(&d, NULL, &out, NULL) != TT_OK) return NULL;
-    return out;
-}
-
 /* The UVs of a mapping put each output
    triangle inside its quad's tile (the three UVs in one tile rectangle),
    the textured model is seamless on the tile borders and over all edges,
@@ -2747,7 +2734,7 @@ static void test_map_uvs_and_seams(void)
             }
             memset(&border, 0, sizeof border);
             border.flags = TT_SEAM_UV_DISCONTINUOUS;
-            if ((out = mapping_mesh(map)) != NULL &&
+            if ((out = mapping_mesh(map, 0)) != NULL &&
                 tt_measure_seams(out, uv, &tiles->levels[0], &border, NULL, &fit_border, &err) == TT_OK &&
                 tt_measure_seams(out, uv, &tiles->levels[0], NULL, NULL, &fit_all, &err) == TT_OK &&
                 tt_measure_seams(out, shuffled, &tiles->levels[0], &border, NULL, &control_border, &err) == TT_OK &&
@@ -3027,7 +3014,7 @@ static void test_map_uvs_upright(void)
               top_sets[0], top_sets[1], top_sets[2], top_sets[3]);
         memset(&border, 0, sizeof border);
         border.flags = TT_SEAM_UV_DISCONTINUOUS;
-        if ((out = mapping_mesh(map)) != NULL &&
+        if ((out = mapping_mesh(map, 0)) != NULL &&
             tt_measure_seams(out, uv, atlas, &border, NULL, &fit, &err) == TT_OK &&
             tt_measure_seams(out, everywhere, atlas, &border, NULL, &control, &err) == TT_OK) {
             printf("     sphere with upright tiles, plain sides beside the walls: seam %.3f on tile borders; "
