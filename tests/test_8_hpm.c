@@ -2011,10 +2011,14 @@ done:
    along the field and the border work keeps the triangles it moves level,
    so the courses lie within 10 degrees of level on at least 90 % of the
    wall faces (measured 95 to 96 %; 77 to 80 % before either), with no
-   flipped triangle. Control: a field pointing every which way leaves far
-   fewer level. (Shuffling the field over the faces is no control here:
-   on a sphere nearly every face's direction, projected on another face,
-   still points up.) */
+   flipped triangle. The same on the sphere with its vertices moved at
+   random by a third of an edge and back onto it, irregular triangles as a
+   scan has: there the border work sheared triangles whose image's up it
+   kept within its bound, and their rows leaned (88 % level); bounding both
+   keeps 97 %, so the rows must be at least 93 %. Control: a field pointing
+   every which way leaves far fewer level. (Shuffling the field over the
+   faces is no control here: on a sphere nearly every face's direction,
+   projected on another face, still points up.) */
 static void test_hpm_map_level_curved(void)
 {
     tmesh m;
@@ -2026,56 +2030,73 @@ static void test_hpm_map_level_curved(void)
     tt_uv_direction_options mo;
     tt_uv_direction_report r;
     float *field = NULL, *random_field = NULL, *uv = NULL;
-    int *cl = NULL, f, k, t, flipped, bad;
-    memset(&m, 0, sizeof m);
-    hpm_sphere(&m, 24, 48);
-    CHECK(build(&m, 0, &mesh, NULL) == TT_OK, "sphere");
-    tm_free(&m);
+    int *cl = NULL, f, k, t, v, jittered, flipped, bad;
     CHECK(tt_image_create(64, 64, NULL, &im, NULL) == TT_OK, "image");
-    if (!mesh || !im) goto done;
+    if (!im) return;
     hpm_bricks(im);
-    field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    random_field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
-    if (!field || !random_field) goto done;
-    memset(&fo, 0, sizeof fo);
-    fo.up[2] = 1;
-    CHECK(tt_tangent_field(mesh, &fo, NULL, field, NULL) == TT_OK, "field");
-    lcg_seed(5);
-    for (f = 0; f < mesh->nfaces; f++) /* only its projection on the face counts */
-        for (k = 0; k < 3; k++) random_field[3 * f + k] = (float)(2 * lcg_unit() - 1);
     memset(&mo, 0, sizeof mo);
     mo.up[2] = 1;
-    for (t = 0; t < 3; t++) {
-        memset(&o, 0, sizeof o);
-        o.scale = 4;
-        o.seed = (uint64_t)(1 + t % 2);
-        o.flags = TT_HPM_TOROIDAL;
-        o.face_vectors = t < 2 ? field : random_field;
-        if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) break;
-        CHECK(tt_measure_uv_direction(mesh, uv, 64, 64, &mo, NULL, &r, NULL) == TT_OK, "measured");
-        hpm_uv_checks(mesh, uv, 64, 64, 0, &flipped, &bad);
-        printf("     sphere, seed %d%s: %.0f%% of %d wall faces within 10 degrees of level (mean %.1f), rows %.0f%% "
-               "(mean %.1f), %d clusters\n", (int)o.seed, t < 2 ? "" : ", random field", 100 * r.within, r.faces,
-               r.mean, 100 * r.rows_within, r.rows_mean, rep.clusters);
-        if (t < 2)
-            CHECK(r.within >= 0.9 && r.rows_within >= 0.9 && flipped == 0 && bad == 0,
-                  "seed %d: %g of the wall faces within 10 degrees of level, their rows %g (at least 0.9 each), "
-                  "%d flipped, %d bad", (int)o.seed, r.within, r.rows_within, flipped, bad);
-        else
-            CHECK(r.within < 0.4 && r.rows_within < 0.4,
-                  "a random field: %g within 10 degrees, rows %g (the control: under 0.4)", r.within, r.rows_within);
-        free(uv);
-        free(cl);
-        uv = NULL;
-        cl = NULL;
+    for (jittered = 0; jittered < 2; jittered++) {
+        memset(&m, 0, sizeof m);
+        hpm_sphere(&m, 24, 48);
+        lcg_seed(11);
+        for (v = 0; jittered && v < m.nv; v++) {
+            float *p = m.pos + 3 * v;
+            double length = 0;
+            for (k = 0; k < 3; k++) p[k] += (float)(0.08 * (2 * lcg_unit() - 1));
+            for (k = 0; k < 3; k++) length += (double)p[k] * p[k];
+            for (k = 0; k < 3; k++) p[k] = (float)(2 * p[k] / sqrt(length));
+        }
+        CHECK(build(&m, 0, &mesh, NULL) == TT_OK, "sphere");
+        tm_free(&m);
+        if (!mesh) break;
+        field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+        random_field = (float *)malloc(sizeof(float) * 3 * (size_t)mesh->nfaces);
+        if (!field || !random_field) break;
+        memset(&fo, 0, sizeof fo);
+        fo.up[2] = 1;
+        CHECK(tt_tangent_field(mesh, &fo, NULL, field, NULL) == TT_OK, "field");
+        lcg_seed(5);
+        for (f = 0; f < mesh->nfaces; f++) /* only its projection on the face counts */
+            for (k = 0; k < 3; k++) random_field[3 * f + k] = (float)(2 * lcg_unit() - 1);
+        for (t = 0; t < 3; t++) {
+            const double rows = jittered ? 0.93 : 0.9;
+            memset(&o, 0, sizeof o);
+            o.scale = 4;
+            o.seed = (uint64_t)(1 + t % 2);
+            o.flags = TT_HPM_TOROIDAL;
+            o.face_vectors = t < 2 ? field : random_field;
+            if (hpm_run(mesh, im, &o, &uv, &cl, &rep) != TT_OK) break;
+            CHECK(tt_measure_uv_direction(mesh, uv, 64, 64, &mo, NULL, &r, NULL) == TT_OK, "measured");
+            hpm_uv_checks(mesh, uv, 64, 64, 0, &flipped, &bad);
+            printf("     sphere%s, seed %d%s: %.0f%% of %d wall faces within 10 degrees of level (mean %.1f), "
+                   "rows %.0f%% (mean %.1f), %d clusters\n", jittered ? " jittered" : "", (int)o.seed,
+                   t < 2 ? "" : ", random field", 100 * r.within, r.faces, r.mean, 100 * r.rows_within, r.rows_mean,
+                   rep.clusters);
+            if (t < 2)
+                CHECK(r.within >= 0.9 && r.rows_within >= rows && flipped == 0 && bad == 0,
+                      "%s seed %d: %g of the wall faces within 10 degrees of level, their rows %g (at least 0.9 and "
+                      "%g), %d flipped, %d bad", jittered ? "jittered," : "regular,", (int)o.seed, r.within,
+                      r.rows_within, rows, flipped, bad);
+            else
+                CHECK(r.within < 0.4 && r.rows_within < 0.4,
+                      "a random field: %g within 10 degrees, rows %g (the control: under 0.4)", r.within,
+                      r.rows_within);
+            free(uv);
+            free(cl);
+            uv = NULL;
+            cl = NULL;
+        }
+        free(field);
+        free(random_field);
+        field = random_field = NULL;
+        tt_mesh_free(mesh);
+        mesh = NULL;
     }
-done:
     free(field);
     free(random_field);
-    free(uv);
-    free(cl);
-    tt_image_free(im);
     tt_mesh_free(mesh);
+    tt_image_free(im);
 }
 
 /* The budget: a 6144-face torus at a scale where clusters of
