@@ -1621,7 +1621,12 @@ typedef struct tt_synth_options {
    alpha at (x, d) is tt_synth_plan_band_alpha: 1 on the edge row, then
    clamp((depth - d - 1/2) / feather + 1/2, 0, 1) times a 2-texel blend at
    the side's wedge (the triangle between the tile's diagonals), 0 in the
-   two corner columns x = 0 and x = S-1 and beyond depth + feather.
+   two corner columns x = 0 and x = S-1 and beyond depth + feather. Where
+   the band's depth and that of the side meeting it at the nearer corner
+   (side s-1 at x's start, s+1 at its end, column S-1-x) both reach the
+   wedge's edge d = min(x, S-1-x), the two meet on the diagonal with no
+   background between: the band of the higher side index (laid first) is 1
+   up to a row past the diagonal, the other 1 before it and 1/2 on it.
 
    Memory: one allocation of about sizeof(tt_synth_plan) + 16 * (n + (2n)^4)
    (2n for an upright plan) + 4 * S * (2n)^4 bytes (the last term doubles for S >= 1024, whose depths
@@ -12083,18 +12088,48 @@ static int tt__plan_depth_at(const tt_synth_plan *plan, size_t i)
    is the edge sample, exactly; below it the band fades out across the cut
    (`feather` texels) and, near the corners where two bands meet along the
    diagonal, across the side's wedge (a short 2-texel blend that keeps both
-   bands' rows next to their edges intact). Corner columns belong to the
-   neighbouring sides. */
-static float tt__band_alpha(int size, int feather, int depth, int x, int d)
+   bands' rows next to their edges intact). Where this band's cut and its
+   neighbour's (the side that meets it at the nearer corner, whose column
+   at the diagonal texel is S-1-x) both reach the diagonal, the two bands
+   meet there and nothing of the background may show between them: a
+   background window differs from the bands, and at a tile's corners, where
+   the wedge is narrow and the cuts reach it in most columns, faded bands
+   let it through as a thin line along each diagonal, a lattice over the
+   surface. There the lower band (laid first) covers the diagonal and a
+   texel past it, and the upper one blends over it on the diagonal alone.
+   neighbour_depth is -1 where the neighbour is not planned yet; upper
+   says whether this band is laid over the neighbour. Corner columns
+   belong to the neighbouring sides. */
+static float tt__band_alpha(int size, int feather, int depth, int neighbour_depth, int upper, int x, int d)
 {
     float a_cut, a_wedge;
     int wedge;
     if (x <= 0 || x >= size - 1 || d < 0 || d > tt__min_i(depth + feather, size - 1)) return 0.0f;
     if (d == 0) return 1.0f;
     wedge = tt__min_i(x, size - 1 - x);   /* rows strictly inside this side's wedge */
+    if (depth >= wedge && neighbour_depth >= wedge) {
+        if (upper) return d < wedge ? 1.0f : d == wedge ? 0.5f : 0.0f;
+        return d <= wedge + 1 ? 1.0f : 0.0f;
+    }
     a_cut = tt__clamp_f(((float)depth - (float)d - 0.5f) / (float)feather + 0.5f, 0.0f, 1.0f);
     a_wedge = tt__clamp_f(((float)wedge - (float)d - 0.5f) / 2.0f + 0.5f, 0.0f, 1.0f);
     return a_cut * a_wedge;
+}
+
+/* The alpha of band `side` of the tile whose depths start at tile_base, at
+   side-frame (x, d): tt__band_alpha with the neighbour at the nearer
+   corner (side - 1 at x's start, side + 1 at its end) and the order of the
+   composition, ABCD = A over B over C over D (the band of the lower index
+   on top). While planning, only the bands after `side` (laid before it)
+   are known. */
+static float tt__plan_band_alpha(const tt_synth_plan *plan, size_t tile_base, int side, int planning, int x, int d)
+{
+    const int S = plan->layout.tile_size;
+    int depth = tt__plan_depth_at(plan, tile_base + (size_t)side * (size_t)S + (size_t)x);
+    int neighbour = x < S - 1 - x ? (side + 3) % 4 : (side + 1) % 4, neighbour_depth = -1;
+    if (x > 0 && x < S - 1 && (!planning || neighbour > side))
+        neighbour_depth = tt__plan_depth_at(plan, tile_base + (size_t)neighbour * (size_t)S + (size_t)(S - 1 - x));
+    return tt__band_alpha(S, plan->feather, depth, neighbour_depth, side < neighbour, x, d);
 }
 
 /* XXXX: the tile's background window, opaque. */
@@ -12110,17 +12145,18 @@ static void tt__copy_background(const tt__synth *s, const tt_rect *bg)
 }
 
 /* Lay the band of side `side` (type `type`) over the tile composed so far:
-   AXXX over (what is there), with the depths of the plan's entries
-   depth_base .. depth_base + S-1. */
-static void tt__lay_band(const tt__synth *s, const tt_synth_plan *plan, size_t depth_base, int side, int type)
+   AXXX over (what is there), with the depths of the plan's tile whose
+   entries start at tile_base (planning: tt__plan_band_alpha). */
+static void tt__lay_band(const tt__synth *s, const tt_synth_plan *plan, size_t tile_base, int side, int type,
+                         int planning)
 {
     const int S = s->size;
     int x, d, k;
     for (x = 1; x < S - 1; x++) {
-        int depth = tt__plan_depth_at(plan, depth_base + (size_t)x);
+        int depth = tt__plan_depth_at(plan, tile_base + (size_t)side * (size_t)S + (size_t)x);
         int last = tt__min_i(depth + s->feather, S - 1);
         for (d = 0; d <= last; d++) {
-            float alpha = tt__band_alpha(S, s->feather, depth, x, d), premultiplied[4], band[3];
+            float alpha = tt__plan_band_alpha(plan, tile_base, side, planning, x, d), premultiplied[4], band[3];
             int tx, ty;
             if (alpha <= 0.0f) continue;
             tt__edge_value(s, side, type, x, d, band);
@@ -12187,7 +12223,7 @@ static void tt__compose_cell(const tt_synth_plan *plan, const tt_image *source, 
     tt__copy_background(&s, &plan->background_windows[tile]);
     /* ABCD = AXXX over XBXX over XXCX over XXXD over XXXX: lay D first. */
     for (side = 3; side >= 0; side--)
-        tt__lay_band(&s, plan, (4 * (size_t)tile + (size_t)side) * (size_t)S, side, types[side]);
+        tt__lay_band(&s, plan, 4 * (size_t)tile * (size_t)S, side, types[side], 0);
     /* A corner texel lies on two sides' edge rows, and whatever meets it
        around a mesh vertex differs from tile to tile: the mean of the two
        edge samples there matches each neighbour across an edge halfway. */
@@ -12819,7 +12855,7 @@ static void tt__plan_task(void *context, int index)
             if (plan->depth8) plan->depth8[depth_base + (size_t)x] = (uint8_t)cut[x];
             else plan->depth16[depth_base + (size_t)x] = (uint16_t)cut[x];
         }
-        if (side > 0) tt__lay_band(&s, plan, depth_base, side, types[side]);
+        if (side > 0) tt__lay_band(&s, plan, 4 * (size_t)t * (size_t)S, side, types[side], 1);
     }
 done:
     tt__free(job->allocator, scratch);
@@ -13101,7 +13137,10 @@ TTDEF float tt_synth_plan_band_alpha(const tt_synth_plan *plan, int tile, int si
 {
     TT_ASSERT(plan && d >= 0 && d < plan->layout.tile_size);
     if (!plan) return 0.0f;
-    return tt__band_alpha(plan->layout.tile_size, plan->feather, tt_synth_plan_depth(plan, tile, side, x), x, d);
+    if (tile < 0 || tile >= tt_tile_layout_tile_count(&plan->layout) || side < 0 || side > 3 || x < 0 ||
+        x >= plan->layout.tile_size)
+        return 0.0f;
+    return tt__plan_band_alpha(plan, 4 * (size_t)tile * (size_t)plan->layout.tile_size, side, 0, x, d);
 }
 
 /* A compose_tile whose cell came out non-finite: name the source texel that
