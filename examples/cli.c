@@ -504,6 +504,40 @@ void tool_note_courses_without_up(const tt_image *image, const char *image_path,
                   image_path, without);
 }
 
+/* Mean absolute RGB difference of texels a and b. */
+static double texel_difference(const float *a, const float *b)
+{
+    return (fabs((double)a[0] - b[0]) + fabs((double)a[1] - b[1]) + fabs((double)a[2] - b[2])) / 3.0;
+}
+
+/* One axis of tool_image_tiles: `lines` lines (columns, or rows) of
+   `length` texels, texel i of line k at pixels + 4 (k * line_step + i *
+   texel_step). */
+static int wraps_like_its_pairs(const float *pixels, int lines, int length, size_t line_step, size_t texel_step)
+{
+    double wrap = 0.0, *pair = (double *)calloc((size_t)lines, sizeof(double));
+    int k, i, as_large = 0;
+    if (!pair) return 0;
+    for (k = 0; k < lines; k++)
+        for (i = 0; i < length; i++) {
+            const float *p = pixels + 4 * ((size_t)k * line_step + (size_t)i * texel_step);
+            const float *next = pixels + 4 * ((size_t)((k + 1) % lines) * line_step + (size_t)i * texel_step);
+            if (k + 1 < lines) pair[k] += texel_difference(p, next);
+            else wrap += texel_difference(p, next);
+        }
+    for (k = 0; k + 1 < lines; k++) as_large += pair[k] >= wrap;
+    free(pair);
+    return as_large >= TOOL_TILES_RANK * (lines - 1);
+}
+
+int tool_image_tiles(const tt_image *image)
+{
+    const int w = image->width, h = image->height;
+    if (w < 3 || h < 3) return 0;
+    return wraps_like_its_pairs(image->pixels, w, h, 1, (size_t)w) &&
+           wraps_like_its_pairs(image->pixels, h, w, (size_t)w, 1);
+}
+
 int parse_field_option(int argc, char **argv, int *index, tool_field *field)
 {
     const char *value;

@@ -569,6 +569,15 @@ int cmd_hpm(int argc, char **argv)
     if (status == 0 && !options.field.given)
         tool_note_courses_without_up(image, options.image_path, NULL,
                                      "without --up each cluster takes its own direction, so they wander");
+    /* A seamless photo held inside its bounds leaves each cluster fewer
+       places, and more of them at the floor are fitted where a neighbour
+       could have been continued across the wrap (a knotted tube with
+       pebbles: cluster borders 0.18 to 0.23, 0.04 to 0.07 with
+       --toroidal). */
+    if (status == 0 && !(options.map.flags & TT_HPM_TOROIDAL) && tool_image_tiles(image))
+        tool_note("%s tiles (its opposite edges continue each other): --toroidal lets the clusters wrap round it, "
+                  "with lower seams (the texture coordinates then leave [0,1]; render with repeat)",
+                  options.image_path);
     if (status == 0 && options.mesh.subdivide == TOOL_SUBDIVIDE_AUTO)
         status = subdivide_coarse_mesh(&options, image, &mesh);
     if (status == 0) status = material_load(&options.maps, options.image_path, image->width, image->height);

@@ -245,6 +245,16 @@ int parse_field_option(int argc, char **argv, int *index, tool_field *field);
    nothing). */
 void tool_note_courses_without_up(const tt_image *image, const char *image_path, const tt_courses *found,
                                   const char *without);
+/* Whether an image tiles: along each axis, the colour difference across its
+   wrap (last column against the first, last row against the first) is no
+   larger than that between at least TOOL_TILES_RANK of its neighbouring
+   column (row) pairs. A photo that does not tile wraps onto unrelated
+   texels, a larger difference than nearly every neighbouring pair (none
+   of gravel_gray's, forest_floor's); a seamless one wraps like any pair
+   (pebbles: 27 to 75 % of its pairs differ as much). 0 when it does not
+   tile, is smaller than 3 x 3, or on a failed allocation. */
+#define TOOL_TILES_RANK 0.05
+int tool_image_tiles(const tt_image *image);
 /* `without` for the commands whose up is +y unless told (lapped, polycube). */
 #define TOOL_COURSES_DEFAULT_UP "they run level where +y is up, the default (OBJ's and glTF's convention)"
 

@@ -1324,6 +1324,20 @@ check "hpm --scale 8: not subdivided" "1280 f lines" "$(grep -c '^f ' far.obj 2>
 expect_error "lapped --subdivide auto (hpm's only)" lapped ../in/spheretri.obj ../in/lap.png out --subdivide auto
 check "lapped --subdivide auto: exit status 2 (usage)" "exit 2" "exit $RC" "$([ $RC -eq 2 ]; echo $?)"
 err_mentions "lapped --subdivide auto: names the option and what it wants" "subdivide wants an integer from 0 to 8, got 'auto'"
+# A seamless image (white noise wraps like any pair of its columns and rows)
+# gets one note suggesting --toroidal; a photo that does not tile (the
+# generated stones) gets none, nor does a command that gives --toroidal.
+newdir
+{ printf 'P6\n64 64\n255\n'; head -c 12288 /dev/urandom; } >noise.ppm
+expect_ok "hpm with an image that tiles" hpm ../in/spheretri.obj noise.ppm seamless --rotations 3
+check "hpm with an image that tiles: one note naming it and --toroidal" "1 line '... tiles ...: --toroidal'" "$ERR" \
+    "$(printf '%s' "$ERR" | grep -c "noise.ppm tiles (its opposite edges continue each other): --toroidal" | grep -qx 1; echo $?)"
+expect_ok "hpm --toroidal with an image that tiles" hpm ../in/spheretri.obj noise.ppm wrapped --rotations 3 --toroidal
+check "hpm --toroidal: no note about tiling" "no 'tiles (' in stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q "tiles (its opposite"; echo $?)"
+expect_ok "hpm with a photo that does not tile" hpm ../in/spheretri.obj ../in/lap256.png bounded --rotations 3
+check "hpm with a photo that does not tile: no note about tiling" "no 'tiles (' in stderr" "$ERR" \
+    "$(! printf '%s' "$ERR" | grep -q "tiles (its opposite"; echo $?)"
 cd "$W" || exit 1
 permissive_case hpm lap.png --rotations 3
 
