@@ -24974,8 +24974,9 @@ static int tt__hpm_accept(tt__hpm *S, int C, const tt__hpm_place *pl)
    turns the whole cluster by one angle, but over a curved cluster the
    field turns: on the bunny (up y) 300 of the 421 wall faces more than 10
    degrees from level lay in clusters whose mean direction was level. So
-   each flattened triangle is turned by the angle between the field there
-   and the field's area-weighted mean over C, and the positions that best
+   each flattened triangle is turned by the angle between the field's rise
+   there (tt__hpm_field_rise, as the cluster's turn reads it) and its
+   area-weighted mean over C, and the positions that best
    fit the turned triangles found by least squares (a triangle's edges
    weighted by its cotangents, floored as the harmonic map floors them; a
    slight pull to the old positions fixes the translation). The sizes stay
@@ -25013,7 +25014,7 @@ static int tt__hpm_comb(tt__hpm *S, int C)
             }
         }
     }
-    /* the field's direction per face, its area-weighted mean, the weights */
+    /* the field's rise per face, its area-weighted mean, the weights */
     for (i = 0; i < n; i++) {
         int f = S->H->faces[cl->first_face + i];
         const double *a = q + 2 * S->vlocal[m->corner_vert[3 * f]], *b = q + 2 * S->vlocal[m->corner_vert[3 * f + 1]],
