@@ -12116,20 +12116,28 @@ static float tt__band_alpha(int size, int feather, int depth, int neighbour_dept
     return a_cut * a_wedge;
 }
 
-/* The alpha of band `side` of the tile whose depths start at tile_base, at
-   side-frame (x, d): tt__band_alpha with the neighbour at the nearer
-   corner (side - 1 at x's start, side + 1 at its end) and the order of the
-   composition, ABCD = A over B over C over D (the band of the lower index
-   on top). While planning, only the bands after `side` (laid before it)
-   are known. */
-static float tt__plan_band_alpha(const tt_synth_plan *plan, size_t tile_base, int side, int planning, int x, int d)
+/* What tt__band_alpha needs of column x of band `side`, in the tile whose
+   depths start at tile_base: its depth, the depth of the neighbour at the
+   nearer corner (side - 1 at x's start, side + 1 at its end) in the
+   column that meets it on the diagonal, and whether this band lies over
+   that one (ABCD = A over B over C over D: the lower index on top). While
+   planning, only the bands after `side` (laid before it) are known. */
+typedef struct tt__band_column {
+    int depth, neighbour_depth, upper;
+} tt__band_column;
+
+static tt__band_column tt__plan_band_column(const tt_synth_plan *plan, size_t tile_base, int side, int planning,
+                                            int x)
 {
     const int S = plan->layout.tile_size;
-    int depth = tt__plan_depth_at(plan, tile_base + (size_t)side * (size_t)S + (size_t)x);
-    int neighbour = x < S - 1 - x ? (side + 3) % 4 : (side + 1) % 4, neighbour_depth = -1;
+    const int neighbour = x < S - 1 - x ? (side + 3) % 4 : (side + 1) % 4;
+    tt__band_column c;
+    c.depth = tt__plan_depth_at(plan, tile_base + (size_t)side * (size_t)S + (size_t)x);
+    c.neighbour_depth = -1;
+    c.upper = side < neighbour;
     if (x > 0 && x < S - 1 && (!planning || neighbour > side))
-        neighbour_depth = tt__plan_depth_at(plan, tile_base + (size_t)neighbour * (size_t)S + (size_t)(S - 1 - x));
-    return tt__band_alpha(S, plan->feather, depth, neighbour_depth, side < neighbour, x, d);
+        c.neighbour_depth = tt__plan_depth_at(plan, tile_base + (size_t)neighbour * (size_t)S + (size_t)(S - 1 - x));
+    return c;
 }
 
 /* XXXX: the tile's background window, opaque. */
@@ -12146,17 +12154,18 @@ static void tt__copy_background(const tt__synth *s, const tt_rect *bg)
 
 /* Lay the band of side `side` (type `type`) over the tile composed so far:
    AXXX over (what is there), with the depths of the plan's tile whose
-   entries start at tile_base (planning: tt__plan_band_alpha). */
+   entries start at tile_base (planning: tt__plan_band_column). */
 static void tt__lay_band(const tt__synth *s, const tt_synth_plan *plan, size_t tile_base, int side, int type,
                          int planning)
 {
     const int S = s->size;
     int x, d, k;
     for (x = 1; x < S - 1; x++) {
-        int depth = tt__plan_depth_at(plan, tile_base + (size_t)side * (size_t)S + (size_t)x);
-        int last = tt__min_i(depth + s->feather, S - 1);
+        const tt__band_column c = tt__plan_band_column(plan, tile_base, side, planning, x);
+        int last = tt__min_i(c.depth + s->feather, S - 1);
         for (d = 0; d <= last; d++) {
-            float alpha = tt__plan_band_alpha(plan, tile_base, side, planning, x, d), premultiplied[4], band[3];
+            float alpha = tt__band_alpha(S, s->feather, c.depth, c.neighbour_depth, c.upper, x, d), premultiplied[4],
+                  band[3];
             int tx, ty;
             if (alpha <= 0.0f) continue;
             tt__edge_value(s, side, type, x, d, band);
@@ -13137,10 +13146,12 @@ TTDEF float tt_synth_plan_band_alpha(const tt_synth_plan *plan, int tile, int si
 {
     TT_ASSERT(plan && d >= 0 && d < plan->layout.tile_size);
     if (!plan) return 0.0f;
+    tt__band_column c;
     if (tile < 0 || tile >= tt_tile_layout_tile_count(&plan->layout) || side < 0 || side > 3 || x < 0 ||
         x >= plan->layout.tile_size)
         return 0.0f;
-    return tt__plan_band_alpha(plan, 4 * (size_t)tile * (size_t)plan->layout.tile_size, side, 0, x, d);
+    c = tt__plan_band_column(plan, 4 * (size_t)tile * (size_t)plan->layout.tile_size, side, 0, x);
+    return tt__band_alpha(plan->layout.tile_size, plan->feather, c.depth, c.neighbour_depth, c.upper, x, d);
 }
 
 /* A compose_tile whose cell came out non-finite: name the source texel that
