@@ -23172,13 +23172,16 @@ static int tt__hpm_random_place(tt__hpm *S, tt_rng *rng, int C, const double *an
     return 0;
 }
 
-/* The unit direction in which the field's height t.p rises fastest over
-   face f flattened at corners q (in C's frame): its gradient there, M^T t
-   for the face's texture axes M. Rows (lines of constant v) laid across
-   it lie level; the field's own image in the frame leans with the
-   flattening where it shears, and rows laid across that would lean by as
-   much. Returns 0 where the face has no area or the field no height. */
-static int tt__hpm_field_rise(const tt__hpm *S, int f, const double q[3][2], double d[2])
+/* The field over face f flattened at corners q (in C's frame), read
+   through the face's texture axes M (dP/dq): `rise`, the unit direction
+   in which the field's height t.p rises fastest, its gradient M^T t; and,
+   when `image` is not NULL, the field's own image in the frame, the q-step
+   that M takes to t's part in the face's plane: (M^T M)^-1 M^T t. Rows
+   (lines of constant v) laid across the rise lie level; the image is where
+   the texture's up should point, and leans from the rise where the
+   flattening shears. Returns 0 where the face has no area or the field
+   no height. */
+static int tt__hpm_field_rise(const tt__hpm *S, int f, const double q[3][2], double rise[2], double image[2])
 {
     double a[2][3], b[2][2], axes[2][3], t[3], length;
     int j;
@@ -23189,12 +23192,19 @@ static int tt__hpm_field_rise(const tt__hpm *S, int f, const double q[3][2], dou
         b[j][1] = q[j + 1][1] - q[0][1];
     }
     if (!tt__texture_axes((const double(*)[3])a, (const double(*)[2])b, axes)) return 0;
-    d[0] = tt__dot3(t, axes[0]);
-    d[1] = tt__dot3(t, axes[1]);
-    length = sqrt(d[0] * d[0] + d[1] * d[1]);
+    rise[0] = tt__dot3(t, axes[0]);
+    rise[1] = tt__dot3(t, axes[1]);
+    length = sqrt(rise[0] * rise[0] + rise[1] * rise[1]);
     if (!(length > 0 && length < 1e300)) return 0;
-    d[0] /= length;
-    d[1] /= length;
+    if (image) {
+        const double g11 = tt__dot3(axes[0], axes[0]), g12 = tt__dot3(axes[0], axes[1]);
+        const double g22 = tt__dot3(axes[1], axes[1]), det = g11 * g22 - g12 * g12;
+        if (!(det > 0.0)) return 0;
+        image[0] = (g22 * rise[0] - g12 * rise[1]) / det;
+        image[1] = (g11 * rise[1] - g12 * rise[0]) / det;
+    }
+    rise[0] /= length;
+    rise[1] /= length;
     return 1;
 }
 
@@ -23219,7 +23229,7 @@ static int tt__hpm_field_angle(const tt__hpm *S, int C, double *angle, double *c
             centre[0] += q[j][0] / (3.0 * cl->nfaces);
             centre[1] += q[j][1] / (3.0 * cl->nfaces);
         }
-        if (!tt__hpm_field_rise(S, f, (const double(*)[2])q, d)) continue;
+        if (!tt__hpm_field_rise(S, f, (const double(*)[2])q, d, NULL)) continue;
         area = 0.5 * fabs((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]));
         sum[0] += area * d[0];
         sum[1] += area * d[1];
@@ -24369,10 +24379,10 @@ static double tt__hpm_tri_area(const tt__hpm *S, int c, double *stretch)
 
 /* With a direction field, how far corner c's triangle lays the texture
    off the field, in radians between lines (0 to pi / 2; 0 where the field
-   has no say), in texels: the larger of two angles, its rows' (the lines
-   of constant v) from level - the image's up against the direction in
-   which the field's height rises (tt__hpm_field_rise) - and the image's up
-   from the field's own image. Where the map shears the two differ, and a
+   has no say), in texels: the larger of two angles (both read by
+   tt__hpm_field_rise), its rows' (the lines of constant v) from level -
+   the image's up against the field's rise - and the image's up from the
+   field's own image. Where the map shears the two differ, and a
    brick wall wants both: level courses and upright joints. The border
    work may move a triangle only so that this stays within
    TT__HPM_FIELD_TURN or does not grow: seams pull the texture round. On
@@ -24388,18 +24398,12 @@ static double tt__hpm_tri_turn(const tt__hpm *S, int c)
     const tt_mesh *m = S->mesh;
     int f = m->corner_face[c], k;
     const double *uv = S->uv + 2 * (size_t)m->face_start[f];
-    double q[3][2], rise[2], t[3], w[3], image[2] = {0, 0}, rows, up;
+    double q[3][2], rise[2], image[2], rows, up;
     for (k = 0; k < 3; k++) {
         q[k][0] = uv[2 * k] * S->W;
         q[k][1] = uv[2 * k + 1] * S->Hh;
-        t[k] = S->field[3 * (size_t)f + k];
     }
-    if (!tt__hpm_field_rise(S, f, (const double(*)[2])q, rise)) return 0;
-    tt__face_vector_weights(m, f, t, w);
-    for (k = 0; k < 3; k++) {
-        image[0] += w[k] * q[k][0];
-        image[1] += w[k] * q[k][1];
-    }
+    if (!tt__hpm_field_rise(S, f, (const double(*)[2])q, rise, image)) return 0;
     rows = atan2(fabs(rise[0]), fabs(rise[1]));
     up = atan2(fabs(image[0]), fabs(image[1]));
     return rows > up ? rows : up;
@@ -25032,7 +25036,7 @@ static int tt__hpm_comb(tt__hpm *S, int C)
                      *c = q + 2 * S->vlocal[m->corner_vert[3 * f + 2]];
         double corners[3][2], d[2], area = 0.5 * fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
         for (k = 0; k < 2; k++) corners[0][k] = a[k], corners[1][k] = b[k], corners[2][k] = c[k];
-        if (!tt__hpm_field_rise(S, f, (const double(*)[2])corners, d)) d[0] = d[1] = 0;
+        if (!tt__hpm_field_rise(S, f, (const double(*)[2])corners, d, NULL)) d[0] = d[1] = 0;
         turn[2 * i] = d[0];
         turn[2 * i + 1] = d[1];
         mean[0] += area * turn[2 * i];
