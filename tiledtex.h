@@ -33052,7 +33052,8 @@ static int tt__merge_check(const tt__merge *G, tt__merge_try *T, double toleranc
         if (area[i] < 1e-6 * largest && area[i] < T->area_before[i]) return 0;
         slivers -= area[i] < 1e-4 * largest;
     }
-    if (slivers < 0 || (G->keep_shape && !tt__merge_keeps_shape(G, T))) return 0;
+    /* the shapes do not depend on the crossings: judged once, with the ends */
+    if (slivers < 0 || (G->keep_shape && !crossings && !tt__merge_keeps_shape(G, T))) return 0;
     mc = crossings ? tt__merge_moved_crossings(G, T) : 0.0;
     if (mc < 0.0) return 0;
     T->moved = moved_before + fmax(fmax(ma, mb), mc);
