@@ -4859,17 +4859,17 @@ static int tt__face_has_zero_area(const float *pos, const int *verts, int count)
     double n[3], scale;
     if (count == 4) {
         /* The builder's hot path: for a quad, Newell's vector is the cross
-           product of its diagonals, and their squared lengths a fair size. */
+           product of its diagonals, and their squared lengths a fair size.
+           The diagonals in double, as tt__polygon_newell takes its
+           differences: in float, FLT_MAX - -1e38 overflows to infinity, the
+           cross product to NaN, and a face whose normal is zero passed. */
         const float *o = pos + 3 * (size_t)verts[0], *p = pos + 3 * (size_t)verts[1];
         const float *q = pos + 3 * (size_t)verts[2], *r = pos + 3 * (size_t)verts[3];
-        float d[3], e[3];
-        d[0] = q[0] - o[0]; d[1] = q[1] - o[1]; d[2] = q[2] - o[2];
-        e[0] = r[0] - p[0]; e[1] = r[1] - p[1]; e[2] = r[2] - p[2];
-        n[0] = (double)d[1] * e[2] - (double)d[2] * e[1];
-        n[1] = (double)d[2] * e[0] - (double)d[0] * e[2];
-        n[2] = (double)d[0] * e[1] - (double)d[1] * e[0];
-        scale = (double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2] + (double)e[0] * e[0] +
-                (double)e[1] * e[1] + (double)e[2] * e[2];
+        double d[3], e[3];
+        tt__sub3f(q, o, d);
+        tt__sub3f(r, p, e);
+        tt__cross3(d, e, n);
+        scale = tt__dot3(d, d) + tt__dot3(e, e);
         return tt__newell_is_zero(n, scale);
     }
     tt__polygon_newell(pos, verts, count, n, &scale);
