@@ -567,9 +567,10 @@ TTDEF tt_result tt_corner_normals(const tt_mesh *mesh, float crease_degrees, con
    Beyond the paper: the input is first refined (linear quadrangulation)
    until its edges are short enough for extraction; the faces are traced
    from the edges' order around each vertex, so the result is always a
-   valid mesh (see below); the lattice is twice edge_length, and each of
-   its faces is split into quads (the paper's pure-quad output); every
-   vertex is moved onto the input's surface.
+   valid mesh (see below); the lattice's triangles and pentagons are
+   paired into quads (the paper's pure-quad output splits every face
+   instead, which makes a vertex of valence 3 or 5 of each); every vertex
+   is moved onto the input's surface.
 
    What it is for: tiles (section 6) follow a quad's edges, so on a triangle
    scan quadrangulated in place, where each triangle makes three kites, a
@@ -605,8 +606,7 @@ typedef struct tt_remesh_report {
     int extracted_vertices;     /* vertices of the hierarchy's level the lattice was smoothed to and
                                    extracted from: the coarsest whose neighbours are, nine pairs in ten,
                                    at most 1.4 edge_length (0.7 lattice steps) apart */
-    int triangles, quads, pentagons, larger_faces;  /* the lattice's faces by sides, before the split:
-                                                       each n-gon gave n quads */
+    int triangles, quads, pentagons, larger_faces;  /* the lattice's faces by sides, before the pairing */
     int thin_triangles;         /* lattice triangles with a vertex within 0.3 lattice steps of their
                                    longest edge, joined to the face beyond that edge */
     int merged_triangles;       /* then, pairs of lattice triangles on one edge made one quad (the edge
@@ -622,6 +622,11 @@ typedef struct tt_remesh_report {
     int split_vertices;         /* vertices duplicated so that each has one fan of faces */
     int dropped_faces;          /* traced faces across the input's holes, and stray pieces */
     int snapped_vertices;       /* output vertices moved onto a crease or the boundary */
+    int paired_faces;           /* lattice faces joined into groups (each face of an odd number of sides
+                                   with the nearest other, and the faces between) and cut into quads;
+                                   the lattice's other faces are the output's quads */
+    int split_all;              /* 1 when some face could not be paired: every lattice face was then split
+                                   into quads around its centre, quads of half edge_length */
 } tt_remesh_report;
 
 /* A new mesh of quads of side about edge_length whose edges follow
@@ -631,13 +636,19 @@ typedef struct tt_remesh_report {
    (but the few points a quad would fold flat on, report->unmoved_points);
    it has the input's holes larger than about two edges. The quads come in
    rows along the field; where a row ends and at the field's singularities
-   the lattice has a triangle or a pentagon, split into three or five quads
-   around its centre (vertices of valence 3 or 5). Before that split, the
-   lattice is mended: a thin triangle gives its longest edge to the face
-   beyond, two triangles on one edge become one quad, and a face of six
-   sides or more loses quads to cuts where they can be near square; after
-   it, a vertex whose two quads share both its edges goes, the two made
-   one (the report counts each).
+   the lattice has a triangle or a pentagon. The lattice is mended first: a
+   thin triangle gives its longest edge to the face beyond, two triangles
+   on one edge become one quad, and a face of six sides or more loses
+   quads to cuts where they can be near square. Then each face of an odd
+   number of sides is paired with the nearest other (neighbours first):
+   the two, with the quads between them, become one polygon, cut along
+   diagonals into the quads closest to square; where a piece beside a hole
+   has an odd number of them, one pairs with the boundary through the
+   middle of a boundary edge, and one with no partner near takes the
+   middle of each edge on its way as a corner. Where pairing fails, every
+   lattice face is split into quads around its centre instead, quads of
+   half edge_length (report->split_all). Last, a vertex whose two quads
+   share both its edges goes, the two made one (the report counts each).
 
    The result is always a mesh tt_mesh_build accepts (strict): each vertex
    has one fan of faces (duplicated otherwise), no face repeats a vertex.
@@ -650,8 +661,9 @@ typedef struct tt_remesh_report {
    Cost: O(V log V) in the refined input's vertices V, serial; the
    smoothing and extraction run on about area / (0.7 edge_length)^2
    vertices whatever V (a coarser level of the hierarchy when the input is
-   denser). At -O2: 0.4 s for the 48k-vertex horse at the default edge,
-   0.9 s for it split to 194k vertices, 2.9 s at 776k. Temporary memory
+   denser). At -O2, the whole of `tiledtex tile --remesh auto`: 1.3 s for
+   the 48k-vertex horse, 2 to 4 s for meshes of 1k to 26k vertices, which
+   are refined first. Temporary memory
    about 250 bytes per vertex of the (refined) input.
    Errors: NULL mesh, face_vectors or out_mesh, a negative, non-finite or
    too large edge_length (more than an eighth of the bounding-box
@@ -7490,6 +7502,537 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
     if (weight == 0.0 || !inside) memcpy(out, mean, sizeof mean);
 }
 
+/* Quads from a lattice with triangles and pentagons, without splitting its
+   quads: each face with an odd number of sides is paired with the nearest
+   other one (breadth-first searches over faces), and each group of faces
+   so joined (the pair and the quads between), and each even face of six
+   sides or more, becomes one polygon cut along diagonals into the quads
+   closest to square (tt__remesh_quadrangulate_polygon). The quads keep
+   the lattice's spacing, and a row of quads that ends costs a few quads
+   around a pair instead of the paper's split of every face, which puts a
+   star of quads around each triangle's and pentagon's centre. */
+#define TT__PAIR_MAX_CORNERS 32   /* a group's outline at most */
+#define TT__PAIR_SEARCH 4096      /* faces one search visits at most */
+#define TT__PAIR_ROUNDS 12        /* the faces a pair's path crosses, at most */
+
+/* How far quad v is from square: its corners' angles' distances from a
+   right angle, summed (at most 2 pi); a folded quad costs more than any
+   that is not, one of zero area (which no mesh takes) HUGE_VAL. */
+static double tt__remesh_quad_cost(const float *pos, const int v[4])
+{
+    double cost = 0.0;
+    int j, k;
+    if (tt__face_has_zero_area(pos, v, 4)) return HUGE_VAL;
+    if (tt__quad_is_folded(pos, v)) cost = 4.0 * TT__PI;
+    for (j = 0; j < 4; j++) {
+        double u[3], w[3];
+        for (k = 0; k < 3; k++) {
+            u[k] = pos[3 * (size_t)v[(j + 3) & 3] + k] - pos[3 * (size_t)v[j] + k];
+            w[k] = pos[3 * (size_t)v[(j + 1) & 3] + k] - pos[3 * (size_t)v[j] + k];
+        }
+        cost += fabs(tt__angle3(u, w) - 0.5 * TT__PI);
+    }
+    return cost;
+}
+
+/* The quads closest to square that cut polygon poly (n corners, n even,
+   4 <= n <= TT__PAIR_MAX_CORNERS) along its diagonals, by dynamic
+   programming over its chains: cost[i][j] is the best cut of the chain
+   i .. j closed by the diagonal j -> i into quads (i, a, b, j) and the
+   chains i .. a, a .. b, b .. j. No cut joins corners x and y where
+   joined[x * n + y] (an edge outside the polygon joins them already),
+   and a corner x with needy[x] is never left without a cut reaching it
+   (but corners 0 and n - 1, which the closing chain holds).
+   Writes n / 2 - 1 quads to out; returns 0 when every cut has a quad of
+   zero area or such a join. cost and choice hold n * n. */
+static int tt__remesh_quadrangulate_polygon(const float *pos, const int *poly, int n, const unsigned char *joined,
+                                            const unsigned char *needy, double *cost, int *choice, int *out)
+{
+    int span, i, a, b, top = 0, stack[6 * TT__PAIR_MAX_CORNERS];
+    for (i = 0; i + 1 < n; i++) cost[i * n + i + 1] = 0.0;
+    for (span = 3; span < n; span += 2)
+        for (i = 0; i + span < n; i++) {
+            int j = i + span;
+            double best = HUGE_VAL;
+            choice[i * n + j] = -1;
+            for (a = i + 1; a < j; a += 2)
+                for (b = a + 1; b < j; b += 2) {
+                    int quad[4];
+                    double c = cost[i * n + a] + cost[a * n + b] + cost[b * n + j];
+                    if (!(c < best)) continue;
+                    if ((a - i > 1 && joined[i * n + a]) || (b - a > 1 && joined[a * n + b]) ||
+                        (j - b > 1 && joined[b * n + j]))
+                        continue;
+                    if ((needy[a] && a - i == 1 && b - a == 1) || (needy[b] && b - a == 1 && j - b == 1)) continue;
+                    quad[0] = poly[i]; quad[1] = poly[a]; quad[2] = poly[b]; quad[3] = poly[j];
+                    c += tt__remesh_quad_cost(pos, quad);
+                    if (c < best) { best = c; choice[i * n + j] = a * n + b; }
+                }
+            cost[i * n + j] = best;
+        }
+    if (!(cost[n - 1] < HUGE_VAL)) return 0;
+    stack[top++] = 0; stack[top++] = n - 1;
+    while (top > 0) {
+        int j = stack[--top], at;
+        i = stack[--top];
+        if (j - i < 3) continue;
+        at = choice[i * n + j];
+        a = at / n; b = at % n;
+        *out++ = poly[i]; *out++ = poly[a]; *out++ = poly[b]; *out++ = poly[j];
+        stack[top++] = i; stack[top++] = a;
+        stack[top++] = a; stack[top++] = b;
+        stack[top++] = b; stack[top++] = j;
+    }
+    return 1;
+}
+
+/* The work of tt__remesh_pair_faces. */
+typedef struct tt__pairing {
+    const tt_mesh *lat;
+    const tt_allocator *al;
+    int out_of_memory;
+    int *stamp;             /* per face: in the group being cut when equal to `current` */
+    int current;
+    int *group;             /* per face: the group whose quads cover it, -1 while none does */
+    int *edge_point;        /* per half-edge: the point added at its middle, -1 for none */
+    int poly[TT__PAIR_MAX_CORNERS];
+    double cost[TT__PAIR_MAX_CORNERS * TT__PAIR_MAX_CORNERS];
+    int choice[TT__PAIR_MAX_CORNERS * TT__PAIR_MAX_CORNERS];
+    unsigned char joined[TT__PAIR_MAX_CORNERS * TT__PAIR_MAX_CORNERS];
+    unsigned char needy[TT__PAIR_MAX_CORNERS];
+    float *pos;             /* the lattice's vertices, then the points added */
+    int npos, pos_capacity;
+    int *quads;             /* 4 corners each */
+    int *quad_group;        /* per quad: its group, -1 once a later group has taken that group's faces */
+    int nquads, quad_capacity;
+    /* The cuts' new edges (chords), listed at their smaller end: two
+       groups that share two corners must not both join them. */
+    int *chord_head, head_capacity;
+    int *chord_next, *chord_other, *chord_group, nchords, chord_capacity;
+} tt__pairing;
+
+/* The group whose cut joins vertices u and v, or -1. */
+static int tt__pairing_chord(const tt__pairing *P, int u, int v)
+{
+    int a = tt__min_i(u, v), b = tt__max_i(u, v), e;
+    if (a >= P->head_capacity) return -1;
+    for (e = P->chord_head[a]; e >= 0; e = P->chord_next[e])
+        if (P->chord_other[e] == b && P->chord_group[e] >= 0) return P->chord_group[e];
+    return -1;
+}
+
+/* Lists the chord u v of group g; 0 when out of memory. */
+static int tt__pairing_add_chord(tt__pairing *P, int u, int v, int g)
+{
+    int a = tt__min_i(u, v), capacity, k, *grown;
+    if (a >= P->head_capacity) {
+        capacity = P->head_capacity;
+        grown = (int *)tt__grow(P->al, P->chord_head, &capacity, a + 1, sizeof(int));
+        if (!grown) return 0;
+        for (k = P->head_capacity; k < capacity; k++) grown[k] = -1;
+        P->chord_head = grown;
+        P->head_capacity = capacity;
+    }
+    if (P->nchords >= P->chord_capacity) {
+        int *arrays[3];
+        arrays[0] = P->chord_next; arrays[1] = P->chord_other; arrays[2] = P->chord_group;
+        for (k = 0; k < 3; k++) {
+            capacity = P->chord_capacity;
+            arrays[k] = (int *)tt__grow(P->al, arrays[k], &capacity, P->nchords + 1, sizeof(int));
+            if (!arrays[k]) return 0;
+            if (k == 0) P->chord_next = arrays[0];
+            if (k == 1) P->chord_other = arrays[1];
+            if (k == 2) P->chord_group = arrays[2];
+        }
+        P->chord_capacity = capacity;
+    }
+    P->chord_next[P->nchords] = P->chord_head[a];
+    P->chord_other[P->nchords] = tt__max_i(u, v);
+    P->chord_group[P->nchords] = g;
+    P->chord_head[a] = P->nchords++;
+    return 1;
+}
+
+/* A point at the middle of half-edge c (and its twin); -1 when out of
+   memory. */
+static int tt__pairing_add_point(tt__pairing *P, int c)
+{
+    const tt_mesh *lat = P->lat;
+    int a = lat->corner_vert[c], b = lat->corner_vert[tt_mesh_next(lat, c)], k, capacity = P->pos_capacity;
+    float *grown = (float *)tt__grow(P->al, P->pos, &capacity, 3 * (P->npos + 1), sizeof(float));
+    if (!grown) { P->out_of_memory = 1; return -1; }
+    P->pos = grown;
+    P->pos_capacity = capacity;
+    for (k = 0; k < 3; k++) P->pos[3 * (size_t)P->npos + k] = 0.5f * (P->pos[3 * (size_t)a + k] + P->pos[3 * (size_t)b + k]);
+    P->edge_point[c] = P->npos;
+    if (lat->twin[c] >= 0) P->edge_point[lat->twin[c]] = P->npos;
+    return P->npos++;
+}
+
+/* Cut the faces members[0 .. count - 1], stamped `current`, into quads:
+   their outline (with the points added on its edges) must be one loop
+   that meets no vertex twice, of an even number of corners, at most
+   TT__PAIR_MAX_CORNERS, and without allow_folded its cut must fold no
+   quad. With commit, the quads replace those of the groups the members
+   were in. Returns 1 when the cut exists. */
+static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int allow_folded, int commit)
+{
+    const tt_mesh *lat = P->lat;
+    int k, c, n = 0, nb = 0, start = -1, at, quads;
+    for (k = 0; k < count; k++)
+        for (c = lat->face_start[members[k]]; c < lat->face_start[members[k] + 1]; c++) {
+            int t = lat->twin[c];
+            if (t >= 0 && P->stamp[lat->corner_face[t]] == P->current) continue;
+            nb += 1 + (P->edge_point[c] >= 0);
+            if (start < 0) start = c;
+        }
+    if (nb > TT__PAIR_MAX_CORNERS || (nb & 1) || start < 0) return 0;
+    c = start;
+    do {
+        int t;
+        for (k = 0; k < n; k++)
+            if (P->poly[k] == lat->corner_vert[c]) return 0;    /* pinched */
+        if (n + 1 + (P->edge_point[c] >= 0) > nb) return 0;    /* more than one loop */
+        P->poly[n++] = lat->corner_vert[c];
+        if (P->edge_point[c] >= 0) P->poly[n++] = P->edge_point[c];
+        at = tt_mesh_next(lat, c);
+        for (t = lat->twin[at]; t >= 0 && P->stamp[lat->corner_face[t]] == P->current; t = lat->twin[at])
+            at = tt_mesh_next(lat, t);
+        c = at;
+    } while (c != start);
+    if (n != nb) return 0;
+    /* A corner inside the surface whose only edges are the outline's two
+       needs a cut to reach it, or it is left between two quads that share
+       both its edges. A point added on an edge has no others. The outline
+       starts past two corners that need none, where it can, as the cut of
+       the chain that closes it cannot reach them. */
+    for (k = 0; k < n; k++) {
+        int first, edges = 0, inside = 1;
+        P->needy[k] = 1;
+        if (P->poly[k] >= lat->nverts || (first = lat->vert_corner[P->poly[k]]) < 0) continue;
+        c = first;
+        do {
+            int t = lat->twin[c];
+            edges += t < 0 || P->stamp[lat->corner_face[c]] != P->current || P->stamp[lat->corner_face[t]] != P->current;
+            c = lat->twin[tt_mesh_prev(lat, c)];
+        } while (c >= 0 && c != first);
+        if (c < 0) inside = 0;
+        P->needy[k] = inside && edges <= 2;
+    }
+    for (k = 0; k < n; k++)
+        if (!P->needy[k] && !P->needy[(k + 1) % n]) {
+            int turned[TT__PAIR_MAX_CORNERS];
+            unsigned char flags[TT__PAIR_MAX_CORNERS];
+            for (at = 0; at < n; at++) {
+                turned[at] = P->poly[(k + 1 + at) % n];
+                flags[at] = P->needy[(k + 1 + at) % n];
+            }
+            memcpy(P->poly, turned, (size_t)n * sizeof(int));
+            memcpy(P->needy, flags, (size_t)n);
+            break;
+        }
+    /* Corners an edge outside the group joins already: a cut between
+       them would give that edge a third face. */
+    memset(P->joined, 0, (size_t)n * (size_t)n);
+    for (k = 0; k < n; k++) {
+        int first, t, y;
+        if (P->poly[k] >= lat->nverts || (first = lat->vert_corner[P->poly[k]]) < 0) continue;
+        c = first;
+        do {
+            int ends[2], e;
+            ends[0] = tt_mesh_next(lat, c);
+            ends[1] = tt_mesh_prev(lat, c);
+            for (e = 0; e < 2; e++) {
+                int edge = e ? ends[1] : c, other = lat->twin[edge];
+                if (P->stamp[lat->corner_face[edge]] == P->current && other >= 0 &&
+                    P->stamp[lat->corner_face[other]] == P->current)
+                    continue;
+                for (y = 0; y < n; y++)
+                    if (P->poly[y] == lat->corner_vert[ends[e]]) P->joined[k * n + y] = P->joined[y * n + k] = 1;
+            }
+            t = lat->twin[tt_mesh_prev(lat, c)];
+            c = t;
+        } while (c >= 0 && c != first);
+    }
+    for (k = 0; k < n; k++) {
+        int y;
+        for (y = k + 2; y < n; y++) {
+            int g = tt__pairing_chord(P, P->poly[k], P->poly[y]), m, own = 0;
+            if (g < 0 || (k == 0 && y == n - 1)) continue;
+            for (m = 0; m < count && !own; m++) own = P->group[members[m]] == g;
+            if (!own) P->joined[k * n + y] = P->joined[y * n + k] = 1;
+        }
+    }
+    quads = n / 2 - 1;
+    if (P->nquads + quads > P->quad_capacity) {
+        int groups = P->quad_capacity, corners = 4 * P->quad_capacity, *grown;
+        grown = (int *)tt__grow(P->al, P->quad_group, &groups, P->nquads + quads, sizeof(int));
+        if (!grown) { P->out_of_memory = 1; return 0; }
+        P->quad_group = grown;
+        grown = (int *)tt__grow(P->al, P->quads, &corners, 4 * (P->nquads + quads), sizeof(int));
+        if (!grown) { P->out_of_memory = 1; return 0; }
+        P->quads = grown;
+        P->quad_capacity = tt__min_i(groups, corners / 4);
+    }
+    if (n == 4) {
+        double shape = tt__remesh_quad_cost(P->pos, P->poly);
+        if (shape == HUGE_VAL || (!allow_folded && shape >= 4.0 * TT__PI)) return 0;
+        memcpy(P->quads + 4 * (size_t)P->nquads, P->poly, 4 * sizeof(int));
+    } else {
+        /* A cut that reaches every needy corner, or failing that any. */
+        if (!tt__remesh_quadrangulate_polygon(P->pos, P->poly, n, P->joined, P->needy, P->cost, P->choice,
+                                              P->quads + 4 * (size_t)P->nquads)) {
+            memset(P->needy, 0, (size_t)n);
+            if (!tt__remesh_quadrangulate_polygon(P->pos, P->poly, n, P->joined, P->needy, P->cost, P->choice,
+                                                  P->quads + 4 * (size_t)P->nquads))
+                return 0;
+        }
+        if (!allow_folded && P->cost[n - 1] >= 4.0 * TT__PI) return 0;
+    }
+    if (!commit) return 1;
+    for (k = 0; k < count; k++) {
+        int old = P->group[members[k]], q;
+        if (old < 0) continue;
+        for (q = 0; q < P->nquads; q++)
+            if (P->quad_group[q] == old) P->quad_group[q] = -1;
+        for (q = 0; q < P->nchords; q++)
+            if (P->chord_group[q] == old) P->chord_group[q] = -1;
+        for (q = 0; q < count; q++)
+            if (P->group[members[q]] == old) P->group[members[q]] = -1;
+    }
+    for (k = 0; k < quads; k++) {
+        const int *quad = P->quads + 4 * ((size_t)P->nquads + k);
+        int e;
+        P->quad_group[P->nquads + k] = P->current;
+        for (e = 0; e < 4; e++) {
+            int here = 0, to = 0, y, gap;
+            for (y = 0; y < n; y++) {
+                if (P->poly[y] == quad[e]) here = y;
+                if (P->poly[y] == quad[(e + 1) & 3]) to = y;
+            }
+            gap = abs(here - to);
+            if (gap != 1 && gap != n - 1 && here < to &&
+                !tt__pairing_add_chord(P, quad[e], quad[(e + 1) & 3], P->current)) {
+                P->out_of_memory = 1;
+                return 0;
+            }
+        }
+    }
+    P->nquads += quads;
+    for (k = 0; k < count; k++) P->group[members[k]] = P->current;
+    return 1;
+}
+
+/* The faces that a new group holding face f must take in: f's group's
+   faces, or f alone; stamped `current` and appended to members. */
+static int tt__pairing_take(tt__pairing *P, int f, int *members, int count)
+{
+    int k;
+    if (P->stamp[f] == P->current) return count;
+    P->stamp[f] = P->current;
+    members[count++] = f;
+    if (P->group[f] < 0) return count;
+    for (k = 0; k < P->lat->nfaces; k++)
+        if (P->group[k] == P->group[f] && P->stamp[k] != P->current) {
+            P->stamp[k] = P->current;
+            members[count++] = k;
+        }
+    return count;
+}
+
+/* The lattice's faces as quads (the rule above): *quads gets 4 * *nquads
+   corner vertices of *positions (the lattice's vertices, then the points
+   added: where a piece beside a hole has an odd number of odd faces, the
+   last one pairs with the boundary through the middle of a boundary edge,
+   and one that finds no partner near enough pairs with the nearest along
+   any path, the middle of each edge it crosses a new corner). *nquads is
+   -1 when some face could not be made quads, and the caller splits every
+   face instead. Returns 0 on allocation failure. */
+static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int **quads, int *nquads,
+                                 float **positions, int *npositions, int *paired)
+{
+    int nf = lat->nfaces, nv = lat->nverts, f, k, ok = 0, failed = 0, round, phase, mark = 0, lone = 0;
+    int *from = TT__ALLOC(al, int, (size_t)nf + 1), *queue = TT__ALLOC(al, int, (size_t)nf + 1);
+    int *seen = TT__ALLOC(al, int, (size_t)nf + 1), *members = TT__ALLOC(al, int, (size_t)nf + 1);
+    int *depth = TT__ALLOC(al, int, (size_t)nf + 1), *through = TT__ALLOC(al, int, (size_t)nf + 1);
+    tt__pairing *P = TT__ALLOC(al, tt__pairing, 1);
+    if (P) memset(P, 0, sizeof *P);
+    *quads = NULL;
+    *positions = NULL;
+    *nquads = -1;
+    *npositions = 0;
+    *paired = 0;
+    if (!from || !queue || !seen || !members || !depth || !through || !P) goto done;
+    P->lat = lat;
+    P->al = al;
+    P->quad_capacity = lat->ncorners / 4 + 16;
+    P->pos_capacity = 3 * (nv + 16);
+    P->stamp = TT__ALLOC(al, int, (size_t)nf + 1);
+    P->group = TT__ALLOC(al, int, (size_t)nf + 1);
+    P->edge_point = TT__ALLOC(al, int, (size_t)lat->ncorners + 1);
+    P->quads = TT__ALLOC(al, int, 4 * (size_t)P->quad_capacity);
+    P->quad_group = TT__ALLOC(al, int, (size_t)P->quad_capacity);
+    P->pos = TT__ALLOC(al, float, (size_t)P->pos_capacity);
+    if (!P->stamp || !P->group || !P->edge_point || !P->quads || !P->quad_group || !P->pos) goto done;
+    memcpy(P->pos, lat->pos, 3 * (size_t)nv * sizeof(float));
+    P->npos = nv;
+    for (f = 0; f < nf; f++) { P->stamp[f] = -1; P->group[f] = -1; seen[f] = -1; }
+    for (k = 0; k < lat->ncorners; k++) P->edge_point[k] = -1;
+#define TT__ODD(face) (((lat->face_start[(face) + 1] - lat->face_start[face]) & 1) != 0)
+    /* A vertex inside the surface with two faces (which share both its
+       edges) would leave two quads that do: the two faces become one
+       group without it, where that gives an even number of corners. */
+    for (k = 0; k < nv; k++) {
+        int c0 = lat->vert_corner[k], c1, t, two[2];
+        if (c0 < 0 || (c1 = lat->twin[tt_mesh_prev(lat, c0)]) < 0) continue;
+        if ((t = lat->twin[tt_mesh_prev(lat, c1)]) != c0 || lat->twin[c0] < 0 || lat->twin[c1] < 0) continue;
+        two[0] = lat->corner_face[c0];
+        two[1] = lat->corner_face[c1];
+        if (two[0] == two[1] || P->group[two[0]] >= 0 || P->group[two[1]] >= 0 || TT__ODD(two[0]) != TT__ODD(two[1]))
+            continue;
+        P->current++;
+        P->stamp[two[0]] = P->stamp[two[1]] = P->current;
+        tt__pairing_cut(P, two, 2, 0, 1);
+    }
+    /* Each odd face with another, the nearest pairs first: rounds of
+       searches reaching one face further each, across faces no group
+       holds, first for groups whose cut folds no quad, then for any. Then
+       what is left goes to the nearest boundary, through the middle of a
+       boundary edge; last, to the nearest odd face along any path,
+       through the middle of each edge it crosses (each group on the way
+       cut anew with those points as corners). */
+    for (phase = 0; phase < 4 && !P->out_of_memory; phase++)
+        for (round = 1; round <= (phase >= 2 ? 1 : TT__PAIR_ROUNDS); round++) {
+            const int reach = phase >= 2 ? nf : round, allow_folded = phase > 0;
+            for (f = 0; f < nf && !P->out_of_memory; f++) {
+                int head = 0, tail = 0, found = -1, found_edge = -1;
+                if (!TT__ODD(f) || P->group[f] >= 0) continue;
+                mark++;
+                queue[tail++] = f;
+                seen[f] = mark;
+                from[f] = -1;
+                depth[f] = 0;
+                while (head < tail && found < 0 && (tail < TT__PAIR_SEARCH || phase == 3)) {
+                    int x = queue[head++], c;
+                    if (depth[x] >= reach) continue;
+                    for (c = lat->face_start[x]; c < lat->face_start[x + 1] && found < 0; c++) {
+                        int t = lat->twin[c], g = t >= 0 ? lat->corner_face[t] : -1, count = 0, y;
+                        if (phase == 2 && t < 0) {
+                            /* x is on the boundary: one group from f to x,
+                               with the middle of this edge as a corner. */
+                            P->current++;
+                            for (y = x; y >= 0; y = from[y]) count = tt__pairing_take(P, y, members, count);
+                            if (tt__pairing_add_point(P, c) < 0) break;
+                            if (tt__pairing_cut(P, members, count, 1, 1)) { found = x; break; }
+                            P->edge_point[c] = -1;
+                            P->npos--;
+                            continue;
+                        }
+                        if (phase == 3 && t < 0 && P->edge_point[c] < 0) {
+                            found = x;      /* the boundary: its edge's middle pairs with f */
+                            found_edge = c;
+                            break;
+                        }
+                        if (g < 0 || seen[g] == mark || (P->group[g] >= 0 && phase < 3) || P->edge_point[c] >= 0)
+                            continue;
+                        seen[g] = mark;
+                        from[g] = x;
+                        through[g] = c;
+                        depth[g] = depth[x] + 1;
+                        if (!TT__ODD(g) || P->group[g] >= 0) {
+                            queue[tail++] = g;
+                            continue;
+                        }
+                        if (phase == 2) continue;
+                        if (phase < 3) {
+                            P->current++;
+                            for (y = g; y >= 0; y = from[y]) count = tt__pairing_take(P, y, members, count);
+                            if (tt__pairing_cut(P, members, count, allow_folded, 1)) found = g;
+                            continue;
+                        }
+                        found = g;
+                    }
+                }
+                if (phase < 3 || found < 0) continue;
+                /* The path's crossings between different groups (or
+                   faces no group holds) get their middles; then each
+                   group on it is cut with them, all or none. */
+                {
+                    int y, first_point = P->npos, pass, ok_all = 1;
+                    for (y = found; from[y] >= 0; y = from[y]) {
+                        int a = P->group[y], b = P->group[from[y]];
+                        if (a >= 0 && a == b) continue;
+                        if (tt__pairing_add_point(P, through[y]) < 0) break;
+                    }
+                    if (found_edge >= 0 && tt__pairing_add_point(P, found_edge) < 0) break;
+                    for (pass = 0; pass < 2 && ok_all && !P->out_of_memory; pass++)
+                        for (y = found; y >= 0 && ok_all; y = from[y]) {
+                            int count;
+                            P->current++;
+                            count = tt__pairing_take(P, y, members, 0);
+                            ok_all = tt__pairing_cut(P, members, count, 1, pass);
+                        }
+                    if (!ok_all) {
+                        for (y = found; from[y] >= 0; y = from[y]) {
+                            int t = lat->twin[through[y]];
+                            if (P->edge_point[through[y]] < first_point) continue;
+                            P->edge_point[through[y]] = -1;
+                            if (t >= 0) P->edge_point[t] = -1;
+                        }
+                        if (found_edge >= 0) P->edge_point[found_edge] = -1;
+                        P->npos = first_point;
+                    }
+                }
+            }
+        }
+    if (P->out_of_memory) goto done;
+    /* The rest: quads as they are, larger faces cut on their own. */
+    for (f = 0; f < nf && !failed; f++) {
+        if (P->group[f] >= 0) continue;
+        if (TT__ODD(f)) { failed = 1; break; }
+        P->current++;
+        P->stamp[f] = P->current;
+        failed = !tt__pairing_cut(P, &f, 1, 1, 1);
+        lone += lat->face_start[f + 1] - lat->face_start[f] == 4;
+    }
+#undef TT__ODD
+    if (P->out_of_memory) goto done;
+    if (!failed) {
+        /* The live quads, and the vertices they use (a vertex inside a
+           group is gone), renumbered in order. */
+        int live = 0, used = 0, *renumber = TT__ALLOC(al, int, (size_t)P->npos + 1);
+        if (!renumber) goto done;
+        for (k = 0; k < P->npos; k++) renumber[k] = -1;
+        for (k = 0; k < P->nquads; k++)
+            if (P->quad_group[k] >= 0) memmove(P->quads + 4 * (size_t)live++, P->quads + 4 * (size_t)k, 4 * sizeof(int));
+        for (k = 0; k < 4 * live; k++) renumber[P->quads[k]] = 0;
+        for (k = 0; k < P->npos; k++)
+            if (renumber[k] == 0) {
+                memmove(P->pos + 3 * (size_t)used, P->pos + 3 * (size_t)k, 3 * sizeof(float));
+                renumber[k] = used++;
+            }
+        for (k = 0; k < 4 * live; k++) P->quads[k] = renumber[P->quads[k]];
+        tt__free(al, renumber);
+        *quads = P->quads;
+        P->quads = NULL;
+        *positions = P->pos;
+        P->pos = NULL;
+        *nquads = live;
+        *npositions = used;
+        *paired = nf - lone;
+    }
+    ok = 1;
+done:
+    if (P) {
+        tt__free(al, P->stamp); tt__free(al, P->group); tt__free(al, P->edge_point); tt__free(al, P->quads);
+        tt__free(al, P->quad_group); tt__free(al, P->pos); tt__free(al, P->chord_head);
+        tt__free(al, P->chord_next); tt__free(al, P->chord_other); tt__free(al, P->chord_group);
+    }
+    tt__free(al, P); tt__free(al, from); tt__free(al, queue); tt__free(al, seen); tt__free(al, members);
+    tt__free(al, depth); tt__free(al, through);
+    return ok;
+}
+
 /* The output from the traced faces: a face that meets itself at a vertex
    is split there into simple loops; a loop facing against the surface
    with most of its vertices on the input's boundary, or one entirely on
@@ -7511,6 +8054,8 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     float *positions = NULL, *surface = NULL, *straight = NULL;
     int *out_cluster = NULL;    /* per output vertex of the lattice mesh: its cluster */
     tt_mesh *lattice = NULL;    /* the traced faces, before the split */
+    int *paired_quads = NULL, npaired = -1, npaired_pos = 0;
+    float *paired_pos = NULL;
     tt_mesh_desc desc;
     tt_result result = TT_ERROR_OUT_OF_MEMORY;
 
@@ -7726,6 +8271,25 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
                           "remeshing made an invalid mesh (%s): try another edge_length", why);
     }
     if (result != TT_OK) goto done;
+    if (!tt__remesh_pair_faces(al, lattice, &paired_quads, &npaired, &paired_pos, &npaired_pos,
+                               &rep->paired_faces))
+        goto fail;
+    if (npaired >= 0) {
+        memset(&desc, 0, sizeof desc);
+        desc.positions = paired_pos;
+        desc.nverts = npaired_pos;
+        desc.indices = paired_quads;
+        desc.nfaces = npaired;
+        desc.fixed_face_size = 4;
+        result = tt_mesh_build(&desc, al, out_mesh, NULL);
+        if (result == TT_ERROR_OUT_OF_MEMORY) goto fail;
+        if (result == TT_OK) {
+            if (!tt__remesh_merge_doublets(al, out_mesh, edge_length, &rep->merged_doublets)) goto fail;
+            goto done;
+        }
+        result = TT_OK;     /* the pairs made no valid mesh: split every face, below */
+    }
+    rep->split_all = 1;
     /* Every face split into quads (tt_mesh_quadrangulate: its vertices, its
        edges' points in order of their first half-edge, its faces' points),
        the new points also moved onto the input, near their clusters, when
@@ -7832,6 +8396,8 @@ done:
     tt__free(al, member_head); tt__free(al, member_next); tt__free(al, out_id); tt__free(al, positions);
     tt__free(al, indices); tt__free(al, sizes); tt__free(al, surface); tt__free(al, out_cluster);
     tt__free(al, straight);
+    tt__free(al, paired_quads);
+    tt__free(al, paired_pos);
     tt_mesh_free(lattice);
     if (result != TT_OK && *out_mesh) {
         tt_mesh_free(*out_mesh);
@@ -7911,13 +8477,12 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
     if (!(diag > 0.0))
         return tt__fail(error, TT_ERROR_ZERO_AREA_FACE, -1, -1, -1, -1,
                         "the mesh's faces all lie at one point: nothing to remesh");
-    /* The lattice is twice the output's edge: each of its faces is split. */
-    rho = 2.0 * (opt.edge_length > 0.0f ? (double)opt.edge_length : TT_DEFAULT_REMESH_EDGE * diag);
-    rep.edge_length = (float)(0.5 * rho);
-    if (rho > 0.25 * diag)
+    rho = opt.edge_length > 0.0f ? (double)opt.edge_length : TT_DEFAULT_REMESH_EDGE * diag;
+    rep.edge_length = (float)rho;
+    if (rho > 0.125 * diag)
         return tt__fail(error, TT_ERROR_INVALID_ARGUMENT, -1, -1, -1, -1,
                         "edge_length %g is more than an eighth of the mesh's bounding-box diagonal %g",
-                        0.5 * rho, diag);
+                        rho, diag);
 
     /* Refine until nine edges in ten are short enough (TT__REMESH_SPACING). */
     face_source = TT__ALLOC(allocator, int, mesh->nfaces);
@@ -7944,7 +8509,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         if ((long long)work->nverts + work->ncorners / 2 + work->nfaces > TT_MAX_REMESH_VERTICES) {
             result = tt__fail(error, TT_ERROR_TOO_LARGE, -1, -1, -1, -1,
                               "edge_length %g needs the mesh refined past %d vertices (its edges are up to %g "
-                              "long): choose a larger edge_length", 0.5 * rho, TT_MAX_REMESH_VERTICES, p90);
+                              "long): choose a larger edge_length", rho, TT_MAX_REMESH_VERTICES, p90);
             goto done;
         }
         result = tt_mesh_quadrangulate(work, TT_SUBDIVIDE_LINEAR, allocator, &next, &ignored);
@@ -8097,7 +8662,7 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
                 creases[i] = tt__dot3(a, b) < crease_cos;
         }
     }
-    result = tt__remesh_output(allocator, work, &graph, creases, 0.5 * rho, components, out_mesh, &rep, error);
+    result = tt__remesh_output(allocator, work, &graph, creases, rho, components, out_mesh, &rep, error);
     if (result == TT_OK && tt__remesh_cancelled(&opt, 1.0)) {
         tt_mesh_free(*out_mesh);
         *out_mesh = NULL;

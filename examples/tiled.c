@@ -500,10 +500,14 @@ void tiled_print_notes(const char *obj_path, const tiled_mesh *mesh)
         if (tool_quiet()) return;
         tool_progress_clear();
         fprintf(stderr, "tiledtex: %s remeshed along the field into %d quads of side about %g (from a lattice of "
-                        "%d quad%s, %d triangle%s, %d pentagon%s and %d larger face%s, each n-gon split into n "
-                        "quads", obj_path, mesh->remeshed, r->edge_length, r->quads, r->quads == 1 ? "" : "s",
+                        "%d quad%s, %d triangle%s, %d pentagon%s and %d larger face%s, ", obj_path, mesh->remeshed,
+                r->split_all ? 0.5 * r->edge_length : r->edge_length, r->quads, r->quads == 1 ? "" : "s",
                 r->triangles, r->triangles == 1 ? "" : "s", r->pentagons, r->pentagons == 1 ? "" : "s",
                 r->larger_faces, r->larger_faces == 1 ? "" : "s");
+        if (r->split_all)
+            fprintf(stderr, "each split into quads around its centre: some could not be paired");
+        else
+            fprintf(stderr, "%d joined into groups of quads", r->paired_faces);
         if (r->folded_faces) fprintf(stderr, "; %d folded", r->folded_faces);
         fprintf(stderr, ")\n");
         /* Where the surface is thinner than an edge, the new mesh closes a
