@@ -6483,19 +6483,21 @@ static double tt__lattice_pair(const double *xi, const double *ni, const double 
     /* The lower-left points' difference; each candidate adds whole steps. */
     for (k = 0; k < 3; k++)
         base[k] = pi[k] - pj[k] + rho * (fi[0] * oi[k] + fi[1] * ti[k] - fj[0] * oj[k] - fj[1] * tj[k]);
+    /* For each of i's four points, j's nearest of its four: oj and tj are
+       orthonormal, so |d - rho (r0 oj + r1 tj)|^2 parts into one term per
+       axis, and each step is worth taking when d runs more than half a
+       step along it. */
     for (q = 0; q < 4; q++) {
-        double dq[3];
+        double dq[3], d[3], dd;
         for (k = 0; k < 3; k++) dq[k] = base[k] + rho * ((q & 1) * oi[k] + (q >> 1) * ti[k]);
-        for (r = 0; r < 4; r++) {
-            double d[3], dd;
-            for (k = 0; k < 3; k++) d[k] = dq[k] - rho * ((r & 1) * oj[k] + (r >> 1) * tj[k]);
-            dd = tt__dot3(d, d);
-            if (dd < best) {
-                best = dd;
-                ci[0] = fi[0] + (q & 1); ci[1] = fi[1] + (q >> 1);
-                cj[0] = fj[0] + (r & 1); cj[1] = fj[1] + (r >> 1);
-                memcpy(apart, d, sizeof d);
-            }
+        r = (tt__dot3(dq, oj) > 0.5 * rho) + 2 * (tt__dot3(dq, tj) > 0.5 * rho);
+        for (k = 0; k < 3; k++) d[k] = dq[k] - rho * ((r & 1) * oj[k] + (r >> 1) * tj[k]);
+        dd = tt__dot3(d, d);
+        if (dd < best) {
+            best = dd;
+            ci[0] = fi[0] + (q & 1); ci[1] = fi[1] + (q >> 1);
+            cj[0] = fj[0] + (r & 1); cj[1] = fj[1] + (r >> 1);
+            memcpy(apart, d, sizeof d);
         }
     }
     return sqrt(best);
