@@ -7516,6 +7516,7 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
 #define TT__PAIR_MAX_CORNERS 32   /* a group's outline at most */
 #define TT__PAIR_SEARCH 4096      /* faces one search visits at most */
 #define TT__PAIR_ROUNDS 12        /* the faces a pair's path crosses, at most */
+#define TT__PAIR_LAST_RESORT 256  /* faces paired along any path, at most */
 
 /* How far quad v is from square: its corners' angles' distances from a
    right angle, summed (at most 2 pi); a folded quad costs more than any
@@ -7698,8 +7699,10 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
         P->poly[n++] = lat->corner_vert[c];
         if (P->edge_point[c] >= 0) P->poly[n++] = P->edge_point[c];
         at = tt_mesh_next(lat, c);
-        for (t = lat->twin[at]; t >= 0 && P->stamp[lat->corner_face[t]] == P->current; t = lat->twin[at])
+        for (t = lat->twin[at], k = 0; t >= 0 && P->stamp[lat->corner_face[t]] == P->current; t = lat->twin[at]) {
             at = tt_mesh_next(lat, t);
+            if (++k > lat->ncorners) return 0;     /* a vertex the group surrounds: not an outline */
+        }
         c = at;
     } while (c != start);
     if (n != nb) return 0;
@@ -7854,6 +7857,7 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
                                  float **positions, int *npositions, int *paired)
 {
     int nf = lat->nfaces, nv = lat->nverts, f, k, ok = 0, failed = 0, round, phase, mark = 0, lone = 0;
+    int last_resort = 0;
     int *from = TT__ALLOC(al, int, (size_t)nf + 1), *queue = TT__ALLOC(al, int, (size_t)nf + 1);
     int *seen = TT__ALLOC(al, int, (size_t)nf + 1), *members = TT__ALLOC(al, int, (size_t)nf + 1);
     int *depth = TT__ALLOC(al, int, (size_t)nf + 1), *through = TT__ALLOC(al, int, (size_t)nf + 1);
@@ -7956,6 +7960,12 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
                     }
                 }
                 if (phase < 3 || found < 0) continue;
+                /* The last resort re-cuts groups on the way; a lattice
+                   that needs it for many faces is split instead. */
+                if (++last_resort > TT__PAIR_LAST_RESORT) {
+                    failed = 1;
+                    break;
+                }
                 /* The path's crossings between different groups (or
                    faces no group holds) get their middles; then each
                    group on it is cut with them, all or none. */
