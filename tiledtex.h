@@ -661,9 +661,9 @@ typedef struct tt_remesh_report {
    Cost: O(V log V) in the refined input's vertices V, serial; the
    smoothing and extraction run on about area / (0.7 edge_length)^2
    vertices whatever V (a coarser level of the hierarchy when the input is
-   denser). At -O2, the whole of `tiledtex tile --remesh auto`: 1.3 s for
-   the 48k-vertex horse, 2 to 4 s for meshes of 1k to 26k vertices, which
-   are refined first. Temporary memory
+   denser). At -O2, the whole of `tiledtex tile --remesh auto`: 1.2 s for
+   the 48k-vertex horse, 1.7 to 3.3 s for meshes of 0.5k to 13k vertices,
+   which are refined first. Temporary memory
    about 250 bytes per vertex of the (refined) input.
    Errors: NULL mesh, face_vectors or out_mesh, a negative, non-finite or
    too large edge_length (more than an eighth of the bounding-box
