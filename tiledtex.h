@@ -7514,7 +7514,7 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
    around a pair instead of the paper's split of every face, which puts a
    star of quads around each triangle's and pentagon's centre. */
 #define TT__PAIR_MAX_CORNERS 32   /* a group's outline at most */
-#define TT__PAIR_SEARCH 4096      /* faces one search visits at most */
+#define TT__PAIR_SEARCH 4096      /* faces one search queues at most (the last resort: any) */
 #define TT__PAIR_ROUNDS 12        /* the faces a pair's path crosses, at most */
 #define TT__PAIR_LAST_RESORT 256  /* faces paired along any path, at most */
 
