@@ -7589,7 +7589,17 @@ static int tt__remesh_quadrangulate_polygon(const float *pos, const int *poly, i
     return 1;
 }
 
-/* The work of tt__remesh_pair_faces. */
+/* The work of tt__remesh_pair_faces. A group's quads lie together, in the
+   order the groups were cut; a group that a later one takes in is dead,
+   and its quads and chords with it. */
+typedef struct tt__pair_group {
+    int first_quad, quads, dead;
+} tt__pair_group;
+
+typedef struct tt__pair_chord {
+    int next, other, group;     /* the next chord at the same smaller end, the larger end, the group */
+} tt__pair_chord;
+
 typedef struct tt__pairing {
     const tt_mesh *lat;
     const tt_allocator *al;
@@ -7597,6 +7607,9 @@ typedef struct tt__pairing {
     int *stamp;             /* per face: in the group being cut when equal to `current` */
     int current;
     int *group;             /* per face: the group whose quads cover it, -1 while none does */
+    int *member_next;       /* per face in a group: the next of its faces, a ring */
+    tt__pair_group *groups; /* in the order they were cut */
+    int ngroups, group_capacity;
     int *edge_point;        /* per half-edge: the point added at its middle, -1 for none */
     int poly[TT__PAIR_MAX_CORNERS];
     double cost[TT__PAIR_MAX_CORNERS * TT__PAIR_MAX_CORNERS];
@@ -7605,13 +7618,13 @@ typedef struct tt__pairing {
     unsigned char needy[TT__PAIR_MAX_CORNERS];
     float *pos;             /* the lattice's vertices, then the points added */
     int npos, pos_capacity;
-    int *quads;             /* 4 corners each */
-    int *quad_group;        /* per quad: its group, -1 once a later group has taken that group's faces */
+    int *quads;             /* 4 corners each, each group's together */
     int nquads, quad_capacity;
     /* The cuts' new edges (chords), listed at their smaller end: two
        groups that share two corners must not both join them. */
     int *chord_head, head_capacity;
-    int *chord_next, *chord_other, *chord_group, nchords, chord_capacity;
+    tt__pair_chord *chords;
+    int nchords, chord_capacity;
 } tt__pairing;
 
 /* The group whose cut joins vertices u and v, or -1. */
@@ -7619,8 +7632,8 @@ static int tt__pairing_chord(const tt__pairing *P, int u, int v)
 {
     int a = tt__min_i(u, v), b = tt__max_i(u, v), e;
     if (a >= P->head_capacity) return -1;
-    for (e = P->chord_head[a]; e >= 0; e = P->chord_next[e])
-        if (P->chord_other[e] == b && P->chord_group[e] >= 0) return P->chord_group[e];
+    for (e = P->chord_head[a]; e >= 0; e = P->chords[e].next)
+        if (P->chords[e].other == b && !P->groups[P->chords[e].group].dead) return P->chords[e].group;
     return -1;
 }
 
@@ -7628,6 +7641,7 @@ static int tt__pairing_chord(const tt__pairing *P, int u, int v)
 static int tt__pairing_add_chord(tt__pairing *P, int u, int v, int g)
 {
     int a = tt__min_i(u, v), capacity, k, *grown;
+    tt__pair_chord *chords;
     if (a >= P->head_capacity) {
         capacity = P->head_capacity;
         grown = (int *)tt__grow(P->al, P->chord_head, &capacity, a + 1, sizeof(int));
@@ -7636,22 +7650,12 @@ static int tt__pairing_add_chord(tt__pairing *P, int u, int v, int g)
         P->chord_head = grown;
         P->head_capacity = capacity;
     }
-    if (P->nchords >= P->chord_capacity) {
-        int *arrays[3];
-        arrays[0] = P->chord_next; arrays[1] = P->chord_other; arrays[2] = P->chord_group;
-        for (k = 0; k < 3; k++) {
-            capacity = P->chord_capacity;
-            arrays[k] = (int *)tt__grow(P->al, arrays[k], &capacity, P->nchords + 1, sizeof(int));
-            if (!arrays[k]) return 0;
-            if (k == 0) P->chord_next = arrays[0];
-            if (k == 1) P->chord_other = arrays[1];
-            if (k == 2) P->chord_group = arrays[2];
-        }
-        P->chord_capacity = capacity;
-    }
-    P->chord_next[P->nchords] = P->chord_head[a];
-    P->chord_other[P->nchords] = tt__max_i(u, v);
-    P->chord_group[P->nchords] = g;
+    chords = (tt__pair_chord *)tt__grow(P->al, P->chords, &P->chord_capacity, P->nchords + 1, sizeof *chords);
+    if (!chords) return 0;
+    P->chords = chords;
+    chords[P->nchords].next = P->chord_head[a];
+    chords[P->nchords].other = tt__max_i(u, v);
+    chords[P->nchords].group = g;
     P->chord_head[a] = P->nchords++;
     return 1;
 }
@@ -7769,15 +7773,13 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
         }
     }
     quads = n / 2 - 1;
-    if (P->nquads + quads > P->quad_capacity) {
-        int groups = P->quad_capacity, corners = 4 * P->quad_capacity, *grown;
-        grown = (int *)tt__grow(P->al, P->quad_group, &groups, P->nquads + quads, sizeof(int));
-        if (!grown) { P->out_of_memory = 1; return 0; }
-        P->quad_group = grown;
-        grown = (int *)tt__grow(P->al, P->quads, &corners, 4 * (P->nquads + quads), sizeof(int));
-        if (!grown) { P->out_of_memory = 1; return 0; }
-        P->quads = grown;
-        P->quad_capacity = tt__min_i(groups, corners / 4);
+    {
+        int *grown = (int *)tt__grow(P->al, P->quads, &P->quad_capacity, 4 * (P->nquads + quads), sizeof(int));
+        tt__pair_group *more = (tt__pair_group *)tt__grow(P->al, P->groups, &P->group_capacity, P->ngroups + 1,
+                                                          sizeof *more);
+        if (grown) P->quads = grown;
+        if (more) P->groups = more;
+        if (!grown || !more) { P->out_of_memory = 1; return 0; }
     }
     if (n == 4) {
         double shape = tt__remesh_quad_cost(P->pos, P->poly);
@@ -7795,20 +7797,14 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
         if (!allow_folded && P->cost[n - 1] >= 4.0 * TT__PI) return 0;
     }
     if (!commit) return 1;
-    for (k = 0; k < count; k++) {
-        int old = P->group[members[k]], q;
-        if (old < 0) continue;
-        for (q = 0; q < P->nquads; q++)
-            if (P->quad_group[q] == old) P->quad_group[q] = -1;
-        for (q = 0; q < P->nchords; q++)
-            if (P->chord_group[q] == old) P->chord_group[q] = -1;
-        for (q = 0; q < count; q++)
-            if (P->group[members[q]] == old) P->group[members[q]] = -1;
-    }
+    for (k = 0; k < count; k++)
+        if (P->group[members[k]] >= 0) P->groups[P->group[members[k]]].dead = 1;
+    P->groups[P->ngroups].first_quad = P->nquads;
+    P->groups[P->ngroups].quads = quads;
+    P->groups[P->ngroups].dead = 0;
     for (k = 0; k < quads; k++) {
         const int *quad = P->quads + 4 * ((size_t)P->nquads + k);
         int e;
-        P->quad_group[P->nquads + k] = P->current;
         for (e = 0; e < 4; e++) {
             int here = 0, to = 0, y, gap;
             for (y = 0; y < n; y++) {
@@ -7817,14 +7813,18 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
             }
             gap = abs(here - to);
             if (gap != 1 && gap != n - 1 && here < to &&
-                !tt__pairing_add_chord(P, quad[e], quad[(e + 1) & 3], P->current)) {
+                !tt__pairing_add_chord(P, quad[e], quad[(e + 1) & 3], P->ngroups)) {
                 P->out_of_memory = 1;
                 return 0;
             }
         }
     }
     P->nquads += quads;
-    for (k = 0; k < count; k++) P->group[members[k]] = P->current;
+    for (k = 0; k < count; k++) {
+        P->group[members[k]] = P->ngroups;
+        P->member_next[members[k]] = members[(k + 1) % count];
+    }
+    P->ngroups++;
     return 1;
 }
 
@@ -7832,16 +7832,13 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
    faces, or f alone; stamped `current` and appended to members. */
 static int tt__pairing_take(tt__pairing *P, int f, int *members, int count)
 {
-    int k;
+    int k = f;
     if (P->stamp[f] == P->current) return count;
-    P->stamp[f] = P->current;
-    members[count++] = f;
-    if (P->group[f] < 0) return count;
-    for (k = 0; k < P->lat->nfaces; k++)
-        if (P->group[k] == P->group[f] && P->stamp[k] != P->current) {
-            P->stamp[k] = P->current;
-            members[count++] = k;
-        }
+    do {
+        P->stamp[k] = P->current;
+        members[count++] = k;
+        k = P->group[f] < 0 ? f : P->member_next[k];
+    } while (k != f);
     return count;
 }
 
@@ -7871,15 +7868,15 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
     if (!from || !queue || !seen || !members || !depth || !through || !P) goto done;
     P->lat = lat;
     P->al = al;
-    P->quad_capacity = lat->ncorners / 4 + 16;
+    P->quad_capacity = lat->ncorners + 64;
     P->pos_capacity = 3 * (nv + 16);
     P->stamp = TT__ALLOC(al, int, (size_t)nf + 1);
     P->group = TT__ALLOC(al, int, (size_t)nf + 1);
     P->edge_point = TT__ALLOC(al, int, (size_t)lat->ncorners + 1);
-    P->quads = TT__ALLOC(al, int, 4 * (size_t)P->quad_capacity);
-    P->quad_group = TT__ALLOC(al, int, (size_t)P->quad_capacity);
+    P->member_next = TT__ALLOC(al, int, (size_t)nf + 1);
+    P->quads = TT__ALLOC(al, int, (size_t)P->quad_capacity);
     P->pos = TT__ALLOC(al, float, (size_t)P->pos_capacity);
-    if (!P->stamp || !P->group || !P->edge_point || !P->quads || !P->quad_group || !P->pos) goto done;
+    if (!P->stamp || !P->group || !P->member_next || !P->edge_point || !P->quads || !P->pos) goto done;
     memcpy(P->pos, lat->pos, 3 * (size_t)nv * sizeof(float));
     P->npos = nv;
     for (f = 0; f < nf; f++) { P->stamp[f] = -1; P->group[f] = -1; seen[f] = -1; }
@@ -8015,8 +8012,12 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
         int live = 0, used = 0, *renumber = TT__ALLOC(al, int, (size_t)P->npos + 1);
         if (!renumber) goto done;
         for (k = 0; k < P->npos; k++) renumber[k] = -1;
-        for (k = 0; k < P->nquads; k++)
-            if (P->quad_group[k] >= 0) memmove(P->quads + 4 * (size_t)live++, P->quads + 4 * (size_t)k, 4 * sizeof(int));
+        for (k = 0; k < P->ngroups; k++) {
+            const tt__pair_group *g = P->groups + k;
+            if (g->dead) continue;
+            memmove(P->quads + 4 * (size_t)live, P->quads + 4 * (size_t)g->first_quad, 4 * (size_t)g->quads * sizeof(int));
+            live += g->quads;
+        }
         for (k = 0; k < 4 * live; k++) renumber[P->quads[k]] = 0;
         for (k = 0; k < P->npos; k++)
             if (renumber[k] == 0) {
@@ -8036,9 +8037,9 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
     ok = 1;
 done:
     if (P) {
-        tt__free(al, P->stamp); tt__free(al, P->group); tt__free(al, P->edge_point); tt__free(al, P->quads);
-        tt__free(al, P->quad_group); tt__free(al, P->pos); tt__free(al, P->chord_head);
-        tt__free(al, P->chord_next); tt__free(al, P->chord_other); tt__free(al, P->chord_group);
+        tt__free(al, P->stamp); tt__free(al, P->group); tt__free(al, P->member_next); tt__free(al, P->groups);
+        tt__free(al, P->edge_point); tt__free(al, P->quads); tt__free(al, P->pos); tt__free(al, P->chord_head);
+        tt__free(al, P->chords);
     }
     tt__free(al, P); tt__free(al, from); tt__free(al, queue); tt__free(al, seen); tt__free(al, members);
     tt__free(al, depth); tt__free(al, through);
