@@ -7162,6 +7162,26 @@ static int tt__remesh_mend_triangles(const tt_allocator *al, tt__remesh_graph *g
     return removed;
 }
 
+/* How far quad p[0..3] is from a rectangle: the sum of its corners'
+   angles' distances from a right angle; *worst gets the largest one. */
+static double tt__quad_squareness(const double *const p[4], double *worst)
+{
+    double sum = 0.0;
+    int j, i;
+    *worst = 0.0;
+    for (j = 0; j < 4; j++) {
+        double u[3], w[3], off;
+        for (i = 0; i < 3; i++) {
+            u[i] = p[(j + 3) & 3][i] - p[j][i];
+            w[i] = p[(j + 1) & 3][i] - p[j][i];
+        }
+        off = fabs(tt__angle3(u, w) - 0.5 * TT__PI);
+        sum += off;
+        *worst = fmax(*worst, off);
+    }
+    return sum;
+}
+
 /* A lattice face of six sides or more becomes quads where it can, before
    the split into quads around a centre (which turns its tiles into a star
    and folds some where the face is not convex): the quad of four
@@ -7192,23 +7212,13 @@ static int tt__remesh_cut_large_faces(const tt_allocator *al, tt__remesh_graph *
             double best_score = HUGE_VAL;
             for (k = 0; k < size; k++) {
                 const double *p[4];
-                double score = 0.0, worst = 0.0;
+                double score, worst;
                 int a = corner[k], b = corner[(k + 3) % size];
                 uint64_t key = tt__pair_key(tt__min_i(a, b), tt__max_i(a, b));
                 j = tt__u64_lower_bound(g->edges, g->nedges, 1, key);
                 if (j < g->nedges && g->edges[j] == key) continue;
                 for (j = 0; j < 4; j++) p[j] = g->pos + 3 * (size_t)corner[(k + j) % size];
-                for (j = 0; j < 4; j++) {
-                    double u[3], w[3], off;
-                    int i;
-                    for (i = 0; i < 3; i++) {
-                        u[i] = p[(j + 3) & 3][i] - p[j][i];
-                        w[i] = p[(j + 1) & 3][i] - p[j][i];
-                    }
-                    off = fabs(tt__angle3(u, w) - 0.5 * TT__PI);
-                    score += off;
-                    worst = fmax(worst, off);
-                }
+                score = tt__quad_squareness(p, &worst);
                 if (worst < 0.25 * TT__PI && score < best_score) { best_score = score; best = k; }
             }
             if (best < 0) break;
@@ -7523,19 +7533,15 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
    that is not, one of zero area (which no mesh takes) HUGE_VAL. */
 static double tt__remesh_quad_cost(const float *pos, const int v[4])
 {
-    double cost = 0.0;
+    double corners[4][3], worst;
+    const double *p[4];
     int j, k;
     if (tt__face_has_zero_area(pos, v, 4)) return HUGE_VAL;
-    if (tt__quad_is_folded(pos, v)) cost = 4.0 * TT__PI;
     for (j = 0; j < 4; j++) {
-        double u[3], w[3];
-        for (k = 0; k < 3; k++) {
-            u[k] = pos[3 * (size_t)v[(j + 3) & 3] + k] - pos[3 * (size_t)v[j] + k];
-            w[k] = pos[3 * (size_t)v[(j + 1) & 3] + k] - pos[3 * (size_t)v[j] + k];
-        }
-        cost += fabs(tt__angle3(u, w) - 0.5 * TT__PI);
+        for (k = 0; k < 3; k++) corners[j][k] = pos[3 * (size_t)v[j] + k];
+        p[j] = corners[j];
     }
-    return cost;
+    return (tt__quad_is_folded(pos, v) ? 4.0 * TT__PI : 0.0) + tt__quad_squareness(p, &worst);
 }
 
 /* The quads closest to square that cut polygon poly (n corners, n even,
