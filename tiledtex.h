@@ -640,9 +640,11 @@ typedef struct tt_remesh_report {
    thin triangle gives its longest edge to the face beyond, two triangles
    on one edge become one quad, and a face of six sides or more loses
    quads to cuts where they can be near square. Then each face of an odd
-   number of sides is paired with the nearest other (neighbours first):
-   the two, with the quads between them, become one polygon, cut along
-   diagonals into the quads closest to square; where a piece beside a hole
+   number of sides is paired with the nearest other (neighbours first,
+   along the field's rows first where face_weights let it decide): the
+   two, with the quads between them, become one polygon, cut along
+   diagonals into the quads closest to square with their rows (the sides
+   across face_vectors) nearest level; where a piece beside a hole
    has an odd number of them, one pairs with the boundary through the
    middle of a boundary edge, and one with no partner near takes the
    middle of each edge on its way as a corner. Where pairing fails, every
@@ -6795,6 +6797,7 @@ typedef struct tt__remesh_graph {
     int *cluster;           /* per vertex of the level extracted: its cluster */
     int *member_cluster;    /* per vertex of the refined input (level 0): its cluster */
     double *pos, *normal;   /* 3 per cluster */
+    double *up, *weight;    /* 3 and 1 per cluster: the caller's field there (tt__remesh_cluster_field) */
     unsigned char *on_boundary;     /* per cluster: holds a vertex of the input's boundary */
     uint64_t *edges;        /* (low << 32 | high) cluster pairs, sorted, unique */
     int nedges;
@@ -6807,6 +6810,7 @@ typedef struct tt__remesh_graph {
 static void tt__remesh_graph_free(const tt_allocator *al, tt__remesh_graph *g)
 {
     tt__free(al, g->cluster); tt__free(al, g->member_cluster); tt__free(al, g->pos); tt__free(al, g->normal); tt__free(al, g->on_boundary);
+    tt__free(al, g->up); tt__free(al, g->weight);
     tt__free(al, g->edges); tt__free(al, g->dead); tt__free(al, g->start); tt__free(al, g->nbr);
     tt__free(al, g->nbr_edge); tt__free(al, g->face_of); tt__free(al, g->face_start); tt__free(al, g->face_vert);
     memset(g, 0, sizeof *g);
@@ -7522,26 +7526,91 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
    closest to square (tt__remesh_quadrangulate_polygon). The quads keep
    the lattice's spacing, and a row of quads that ends costs a few quads
    around a pair instead of the paper's split of every face, which puts a
-   star of quads around each triangle's and pentagon's centre. */
+   star of quads around each triangle's and pentagon's centre.
+
+   Where the caller's field gives the texture's up, a group's quads also
+   keep their rows (the sides a tile's courses follow) level: the cut
+   weighs how far each quad's rows lean from the field's level, and pairs
+   are first sought along rows. A group that runs up a column has only
+   diagonals across it to cut along, and each of its quads' rows then
+   leans by about a step over a step: on the horse such groups held 70 %
+   of the wall quads whose rows leaned more than 10 degrees. */
 #define TT__PAIR_MAX_CORNERS 32   /* a group's outline at most */
 #define TT__PAIR_SEARCH 4096      /* faces one search queues at most (the last resort: any) */
 #define TT__PAIR_ROUNDS 12        /* the faces a pair's path crosses, at most */
 #define TT__PAIR_LAST_RESORT 256  /* faces paired along any path, at most */
+#define TT__PAIR_FOLDED 1e4       /* a folded quad's cost: above any cut of quads that fold none */
+#define TT__PAIR_SIDES 3.0        /* cost of a quad's sides per unit of log(one pair's length / the other's) */
+#define TT__PAIR_ROWS 12.0        /* cost per radian that a quad's rows lean from level, where up decides */
+#define TT__PAIR_COLUMNS 0.3      /* ...and per radian its columns lean from up, as a share of that */
 
-/* How far quad v is from square: its corners' angles' distances from a
-   right angle, summed (at most 2 pi); a folded quad costs more than any
-   that is not, one of zero area (which no mesh takes) HUGE_VAL. */
-static double tt__remesh_quad_cost(const float *pos, const int v[4])
+/* The caller's field at the lattice's vertices, for the pairing. */
+typedef struct tt__pair_field {
+    const double *up;       /* 3 per lattice vertex: the field's direction (the texture's up), a unit tangent */
+    const double *weight;   /* per lattice vertex: how much it counts, 0 (tops) to 1 (walls) */
+    int n;                  /* the lattice's vertices; the points the pairing adds have no field */
+} tt__pair_field;
+
+/* How far quad v is from the quad the lattice would have: its corners'
+   angles' distances from a right angle, summed (at most 2 pi), plus
+   TT__PAIR_SIDES times |log| of the ratio of its two pairs of opposite
+   sides' lengths (an angle measure alone takes a long thin rectangle for a
+   square: a tile drawn out into a streak), plus, with a field, the lean
+   of its rows and columns at the corners' mean weight. Rows are the pair
+   of opposite sides further from the field's up, as the tile's quarter
+   turn takes them; their mean direction's angle from level counts fully,
+   the columns' from up TT__PAIR_COLUMNS as much (a column leaning turns
+   the joints between bricks, a row leaning the whole course). A folded
+   quad costs TT__PAIR_FOLDED more, one of zero area (which no mesh
+   takes) HUGE_VAL. */
+static double tt__remesh_quad_cost(const float *pos, const int v[4], const tt__pair_field *field)
 {
-    double corners[4][3], worst;
+    double corners[4][3], worst, cost, side[4], rows[3], columns[3], normal[3], a[3], b[3];
+    double up[3] = {0.0, 0.0, 0.0}, level_up[3], weight = 0.0, along_rows, along_columns;
     const double *p[4];
-    int j, k;
+    int j, k, with_field = 0;
     if (tt__face_has_zero_area(pos, v, 4)) return HUGE_VAL;
     for (j = 0; j < 4; j++) {
         for (k = 0; k < 3; k++) corners[j][k] = pos[3 * (size_t)v[j] + k];
         p[j] = corners[j];
     }
-    return (tt__quad_is_folded(pos, v) ? 4.0 * TT__PI : 0.0) + tt__quad_squareness(p, &worst);
+    cost = (tt__quad_is_folded(pos, v) ? TT__PAIR_FOLDED : 0.0) + tt__quad_squareness(p, &worst);
+    for (j = 0; j < 4; j++) {
+        for (k = 0; k < 3; k++) a[k] = p[(j + 1) & 3][k] - p[j][k];
+        side[j] = tt__length3(a);
+    }
+    if (side[0] + side[2] > 0.0 && side[1] + side[3] > 0.0)
+        cost += TT__PAIR_SIDES * fabs(log((side[0] + side[2]) / (side[1] + side[3])));
+    if (!field) return cost;
+    /* The corners' up, each turned to agree with the sum so far (a field
+       may point either way along a line), and their weights. */
+    for (j = 0; j < 4; j++)
+        if (v[j] < field->n) {
+            const double *d = field->up + 3 * (size_t)v[j];
+            const double sign = tt__dot3(d, up) < 0.0 ? -1.0 : 1.0;
+            for (k = 0; k < 3; k++) up[k] += sign * d[k];
+            weight += field->weight[v[j]];
+            with_field++;
+        }
+    if (with_field == 0 || !(weight > 0.0)) return cost;
+    weight /= with_field;
+    for (k = 0; k < 3; k++) {
+        a[k] = p[2][k] - p[0][k];
+        b[k] = p[3][k] - p[1][k];
+        rows[k] = p[1][k] - p[0][k] + p[2][k] - p[3][k];
+        columns[k] = p[3][k] - p[0][k] + p[2][k] - p[1][k];
+    }
+    tt__cross3(a, b, normal);
+    tt__project3(up, normal, level_up);
+    if (tt__normalize3(level_up) == 0.0 || tt__length3(rows) == 0.0 || tt__length3(columns) == 0.0) return cost;
+    along_rows = fmin(1.0, fabs(tt__dot3(rows, level_up)) / tt__length3(rows));
+    along_columns = fmin(1.0, fabs(tt__dot3(columns, level_up)) / tt__length3(columns));
+    if (along_rows > along_columns) {
+        double t = along_rows;
+        along_rows = along_columns;
+        along_columns = t;
+    }
+    return cost + TT__PAIR_ROWS * weight * (asin(along_rows) + TT__PAIR_COLUMNS * acos(along_columns));
 }
 
 /* The quads closest to square that cut polygon poly (n corners, n even,
@@ -7554,8 +7623,9 @@ static double tt__remesh_quad_cost(const float *pos, const int v[4])
    (but corners 0 and n - 1, which the closing chain holds).
    Writes n / 2 - 1 quads to out; returns 0 when every cut has a quad of
    zero area or such a join. cost and choice hold n * n. */
-static int tt__remesh_quadrangulate_polygon(const float *pos, const int *poly, int n, const unsigned char *joined,
-                                            const unsigned char *needy, double *cost, int *choice, int *out)
+static int tt__remesh_quadrangulate_polygon(const float *pos, const tt__pair_field *field, const int *poly, int n,
+                                            const unsigned char *joined, const unsigned char *needy, double *cost,
+                                            int *choice, int *out)
 {
     int span, i, a, b, top = 0, stack[6 * TT__PAIR_MAX_CORNERS];
     for (i = 0; i + 1 < n; i++) cost[i * n + i + 1] = 0.0;
@@ -7574,7 +7644,7 @@ static int tt__remesh_quadrangulate_polygon(const float *pos, const int *poly, i
                         continue;
                     if ((needy[a] && a - i == 1 && b - a == 1) || (needy[b] && b - a == 1 && j - b == 1)) continue;
                     quad[0] = poly[i]; quad[1] = poly[a]; quad[2] = poly[b]; quad[3] = poly[j];
-                    c += tt__remesh_quad_cost(pos, quad);
+                    c += tt__remesh_quad_cost(pos, quad, field);
                     if (c < best) { best = c; choice[i * n + j] = a * n + b; }
                 }
             cost[i * n + j] = best;
@@ -7608,6 +7678,7 @@ typedef struct tt__pair_chord {
 
 typedef struct tt__pairing {
     const tt_mesh *lat;
+    const tt__pair_field *field;    /* NULL: cut by shape alone */
     const tt_allocator *al;
     int out_of_memory;
     int *stamp;             /* per face: in the group being cut when equal to `current` */
@@ -7788,19 +7859,19 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
         if (!grown || !more) { P->out_of_memory = 1; return 0; }
     }
     if (n == 4) {
-        double shape = tt__remesh_quad_cost(P->pos, P->poly);
-        if (shape == HUGE_VAL || (!allow_folded && shape >= 4.0 * TT__PI)) return 0;
+        double shape = tt__remesh_quad_cost(P->pos, P->poly, P->field);
+        if (shape == HUGE_VAL || (!allow_folded && shape >= TT__PAIR_FOLDED)) return 0;
         memcpy(P->quads + 4 * (size_t)P->nquads, P->poly, 4 * sizeof(int));
     } else {
         /* A cut that reaches every needy corner, or failing that any. */
-        if (!tt__remesh_quadrangulate_polygon(P->pos, P->poly, n, P->joined, P->needy, P->cost, P->choice,
+        if (!tt__remesh_quadrangulate_polygon(P->pos, P->field, P->poly, n, P->joined, P->needy, P->cost, P->choice,
                                               P->quads + 4 * (size_t)P->nquads)) {
             memset(P->needy, 0, (size_t)n);
-            if (!tt__remesh_quadrangulate_polygon(P->pos, P->poly, n, P->joined, P->needy, P->cost, P->choice,
+            if (!tt__remesh_quadrangulate_polygon(P->pos, P->field, P->poly, n, P->joined, P->needy, P->cost, P->choice,
                                                   P->quads + 4 * (size_t)P->nquads))
                 return 0;
         }
-        if (!allow_folded && P->cost[n - 1] >= 4.0 * TT__PI) return 0;
+        if (!allow_folded && P->cost[n - 1] >= TT__PAIR_FOLDED) return 0;
     }
     if (!commit) return 1;
     for (k = 0; k < count; k++)
@@ -7848,16 +7919,47 @@ static int tt__pairing_take(tt__pairing *P, int f, int *members, int count)
     return count;
 }
 
+/* The pairing's phases, in order. */
+enum {
+    TT__PAIR_ALONG_ROWS,    /* nearest pairs along rows, no quad folded (with a field only) */
+    TT__PAIR_NEAREST,       /* nearest pairs every way, no quad folded */
+    TT__PAIR_FOLDING,       /* nearest pairs, a quad folded allowed */
+    TT__PAIR_BOUNDARY,      /* an odd face with the nearest boundary edge's middle */
+    TT__PAIR_ANY_PATH       /* with the nearest odd face along any path */
+};
+
+/* 1 when crossing lattice edge c (from its face to the twin's) would move
+   along a column: the edge lies nearer level than up, where up decides
+   (its ends' mean weight at least 1/2). */
+static int tt__pairing_across_rows(const tt__pairing *P, int c)
+{
+    const tt_mesh *lat = P->lat;
+    const tt__pair_field *field = P->field;
+    const int a = lat->corner_vert[c], b = lat->corner_vert[tt_mesh_next(lat, c)];
+    double edge[3], up[3], sign, length, up_length;
+    int k;
+    if (!field || a >= field->n || b >= field->n || field->weight[a] + field->weight[b] < 1.0) return 0;
+    sign = tt__dot3(field->up + 3 * (size_t)a, field->up + 3 * (size_t)b) < 0.0 ? -1.0 : 1.0;
+    for (k = 0; k < 3; k++) {
+        edge[k] = (double)P->pos[3 * (size_t)b + k] - P->pos[3 * (size_t)a + k];
+        up[k] = field->up[3 * (size_t)a + k] + sign * field->up[3 * (size_t)b + k];
+    }
+    length = tt__length3(edge);
+    up_length = tt__length3(up);
+    return length > 0.0 && up_length > 0.0 && fabs(tt__dot3(edge, up)) < sqrt(0.5) * length * up_length;
+}
+
 /* The lattice's faces as quads (the rule above): *quads gets 4 * *nquads
    corner vertices of *positions (the lattice's vertices, then the points
    added: where a piece beside a hole has an odd number of odd faces, the
    last one pairs with the boundary through the middle of a boundary edge,
    and one that finds no partner near enough pairs with the nearest along
-   any path, the middle of each edge it crosses a new corner). *nquads is
-   -1 when some face could not be made quads, and the caller splits every
-   face instead. Returns 0 on allocation failure. */
-static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int **quads, int *nquads,
-                                 float **positions, int *npositions, int *paired)
+   any path, the middle of each edge it crosses a new corner). field may
+   be NULL (groups cut by shape alone). *nquads is -1 when some face could
+   not be made quads, and the caller splits every face instead. Returns 0
+   on allocation failure. */
+static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, const tt__pair_field *field,
+                                 int **quads, int *nquads, float **positions, int *npositions, int *paired)
 {
     int nf = lat->nfaces, nv = lat->nverts, f, k, ok = 0, failed = 0, round, phase, mark = 0, lone = 0;
     int last_resort = 0;
@@ -7873,6 +7975,7 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
     *paired = 0;
     if (!from || !queue || !seen || !members || !depth || !through || !P) goto done;
     P->lat = lat;
+    P->field = field;
     P->al = al;
     P->quad_capacity = lat->ncorners + 64;
     P->pos_capacity = 3 * (nv + 16);
@@ -7905,14 +8008,17 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
     }
     /* Each odd face with another, the nearest pairs first: rounds of
        searches reaching one face further each, across faces no group
-       holds, first for groups whose cut folds no quad, then for any. Then
-       what is left goes to the nearest boundary, through the middle of a
+       holds; with a field, first only along rows (where up decides, a
+       search crosses only edges nearer up than level), then every way;
+       first for groups whose cut folds no quad, then for any. Then what
+       is left goes to the nearest boundary, through the middle of a
        boundary edge; last, to the nearest odd face along any path,
        through the middle of each edge it crosses (each group on the way
        cut anew with those points as corners). */
-    for (phase = 0; phase < 4 && !P->out_of_memory; phase++)
-        for (round = 1; round <= (phase >= 2 ? 1 : TT__PAIR_ROUNDS); round++) {
-            const int reach = phase >= 2 ? nf : round, allow_folded = phase > 0;
+    for (phase = field ? TT__PAIR_ALONG_ROWS : TT__PAIR_NEAREST; phase <= TT__PAIR_ANY_PATH && !P->out_of_memory;
+         phase++)
+        for (round = 1; round <= (phase >= TT__PAIR_BOUNDARY ? 1 : TT__PAIR_ROUNDS); round++) {
+            const int reach = phase >= TT__PAIR_BOUNDARY ? nf : round, allow_folded = phase >= TT__PAIR_FOLDING;
             for (f = 0; f < nf && !P->out_of_memory; f++) {
                 int head = 0, tail = 0, found = -1, found_edge = -1;
                 if (!TT__ODD(f) || P->group[f] >= 0) continue;
@@ -7921,12 +8027,12 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
                 seen[f] = mark;
                 from[f] = -1;
                 depth[f] = 0;
-                while (head < tail && found < 0 && (tail < TT__PAIR_SEARCH || phase == 3)) {
+                while (head < tail && found < 0 && (tail < TT__PAIR_SEARCH || phase == TT__PAIR_ANY_PATH)) {
                     int x = queue[head++], c;
                     if (depth[x] >= reach) continue;
                     for (c = lat->face_start[x]; c < lat->face_start[x + 1] && found < 0; c++) {
                         int t = lat->twin[c], g = t >= 0 ? lat->corner_face[t] : -1, count = 0, y;
-                        if (phase == 2 && t < 0) {
+                        if (phase == TT__PAIR_BOUNDARY && t < 0) {
                             /* x is on the boundary: one group from f to x,
                                with the middle of this edge as a corner. */
                             P->current++;
@@ -7937,12 +8043,13 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
                             P->npos--;
                             continue;
                         }
-                        if (phase == 3 && t < 0 && P->edge_point[c] < 0) {
+                        if (phase == TT__PAIR_ANY_PATH && t < 0 && P->edge_point[c] < 0) {
                             found = x;      /* the boundary: its edge's middle pairs with f */
                             found_edge = c;
                             break;
                         }
-                        if (g < 0 || seen[g] == mark || (P->group[g] >= 0 && phase < 3) || P->edge_point[c] >= 0)
+                        if (g < 0 || seen[g] == mark || (P->group[g] >= 0 && phase < TT__PAIR_ANY_PATH) ||
+                            P->edge_point[c] >= 0 || (phase == TT__PAIR_ALONG_ROWS && tt__pairing_across_rows(P, c)))
                             continue;
                         seen[g] = mark;
                         from[g] = x;
@@ -7952,8 +8059,8 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
                             queue[tail++] = g;
                             continue;
                         }
-                        if (phase == 2) continue;
-                        if (phase < 3) {
+                        if (phase == TT__PAIR_BOUNDARY) continue;
+                        if (phase < TT__PAIR_ANY_PATH) {
                             P->current++;
                             for (y = g; y >= 0; y = from[y]) count = tt__pairing_take(P, y, members, count);
                             if (tt__pairing_cut(P, members, count, allow_folded, 1)) found = g;
@@ -7962,7 +8069,7 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, int
                         found = g;
                     }
                 }
-                if (phase < 3 || found < 0) continue;
+                if (phase < TT__PAIR_ANY_PATH || found < 0) continue;
                 /* The last resort re-cuts groups on the way; a lattice
                    that needs it for many faces is split instead. */
                 if (++last_resort > TT__PAIR_LAST_RESORT) {
@@ -8052,6 +8159,52 @@ done:
     return ok;
 }
 
+/* The caller's field at each cluster, from the refined input's faces
+   around its members: the direction (turned to agree with the sum so
+   far, as a field may point either way along a line) by area times
+   weight, and the weight by area. The pairing reads the texture's up from
+   it; the smoothed 4-fold field would not tell up from across. Returns 0
+   on allocation failure. */
+static int tt__remesh_cluster_field(const tt_allocator *al, const tt_mesh *m, const float *face_vectors,
+                                    const float *face_weights, const int *face_source, tt__remesh_graph *g)
+{
+    const int nc = g->nclusters;
+    double *area = TT__ALLOC(al, double, (size_t)nc + 1);
+    int f, c, i, k;
+    g->up = TT__ALLOC(al, double, 3 * (size_t)nc + 3);
+    g->weight = TT__ALLOC(al, double, (size_t)nc + 1);
+    if (!area || !g->up || !g->weight) {
+        tt__free(al, area);
+        return 0;
+    }
+    memset(area, 0, ((size_t)nc + 1) * sizeof(double));
+    memset(g->up, 0, (3 * (size_t)nc + 3) * sizeof(double));
+    memset(g->weight, 0, ((size_t)nc + 1) * sizeof(double));
+    for (f = 0; f < m->nfaces; f++) {
+        const int src = face_source[f], begin = m->face_start[f], end = m->face_start[f + 1];
+        const double w = face_weights ? face_weights[src] : 1.0, share = tt__face_area_d(m, f) / (end - begin);
+        double d[3];
+        for (k = 0; k < 3; k++) d[k] = face_vectors[3 * (size_t)src + k];
+        if (!(share > 0.0) || tt__normalize3(d) == 0.0) continue;
+        for (c = begin; c < end; c++) {
+            const int cl = g->member_cluster[m->corner_vert[c]];
+            double *up = g->up + 3 * (size_t)cl;
+            const double sign = tt__dot3(d, up) < 0.0 ? -1.0 : 1.0;
+            for (k = 0; k < 3; k++) up[k] += sign * share * w * d[k];
+            g->weight[cl] += share * w;
+            area[cl] += share;
+        }
+    }
+    for (i = 0; i < nc; i++) {
+        double t[3];
+        tt__tangent_or_any(g->up + 3 * (size_t)i, g->normal + 3 * (size_t)i, t);
+        memcpy(g->up + 3 * (size_t)i, t, sizeof t);
+        g->weight[i] = area[i] > 0.0 ? fmin(1.0, g->weight[i] / area[i]) : 0.0;
+    }
+    tt__free(al, area);
+    return 1;
+}
+
 /* The output from the traced faces: a face that meets itself at a vertex
    is split there into simple loops; a loop facing against the surface
    with most of its vertices on the input's boundary, or one entirely on
@@ -8075,6 +8228,8 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     tt_mesh *lattice = NULL;    /* the traced faces, before the split */
     int *paired_quads = NULL, npaired = -1, npaired_pos = 0;
     float *paired_pos = NULL;
+    double *field_up = NULL, *field_weight = NULL;  /* per vertex of the lattice mesh: the caller's field */
+    tt__pair_field field;
     tt_mesh_desc desc;
     tt_result result = TT_ERROR_OUT_OF_MEMORY;
 
@@ -8290,7 +8445,18 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
                           "remeshing made an invalid mesh (%s): try another edge_length", why);
     }
     if (result != TT_OK) goto done;
-    if (!tt__remesh_pair_faces(al, lattice, &paired_quads, &npaired, &paired_pos, &npaired_pos,
+    /* The caller's field at the lattice's vertices, from their clusters. */
+    field_up = TT__ALLOC(al, double, 3 * (size_t)nverts + 3);
+    field_weight = TT__ALLOC(al, double, (size_t)nverts + 1);
+    if (!field_up || !field_weight) goto fail;
+    for (k = 0; k < nverts; k++) {
+        memcpy(field_up + 3 * (size_t)k, g->up + 3 * (size_t)out_cluster[k], 3 * sizeof(double));
+        field_weight[k] = g->weight[out_cluster[k]];
+    }
+    field.up = field_up;
+    field.weight = field_weight;
+    field.n = nverts;
+    if (!tt__remesh_pair_faces(al, lattice, &field, &paired_quads, &npaired, &paired_pos, &npaired_pos,
                                &rep->paired_faces))
         goto fail;
     if (npaired >= 0) {
@@ -8417,6 +8583,8 @@ done:
     tt__free(al, straight);
     tt__free(al, paired_quads);
     tt__free(al, paired_pos);
+    tt__free(al, field_up);
+    tt__free(al, field_weight);
     tt_mesh_free(lattice);
     if (result != TT_OK && *out_mesh) {
         tt_mesh_free(*out_mesh);
@@ -8655,7 +8823,9 @@ TTDEF tt_result tt_remesh_quads(const tt_mesh *mesh, const float *face_vectors, 
         }
     }
     if (tt__remesh_cancelled(&opt, 0.85)) goto cancelled;
-    if (!tt__remesh_clusters(allocator, &levels[finest], work, ancestor, rho, &graph)) goto oom;
+    if (!tt__remesh_clusters(allocator, &levels[finest], work, ancestor, rho, &graph) ||
+        !tt__remesh_cluster_field(allocator, work, face_vectors, opt.face_weights, face_source, &graph))
+        goto oom;
     if (tt__remesh_cancelled(&opt, 0.9)) goto cancelled;
     if (!tt__remesh_trace(allocator, &graph)) goto oom;
     if (!tt__remesh_mend_lattice(allocator, &graph, rho, &rep)) goto oom;

@@ -2033,6 +2033,39 @@ static double remesh_aligned_share(const tt_mesh *q, double *median_edge)
     return counted ? (double)aligned / counted : 0.0;
 }
 
+/* The share of wall quads (facing 45 degrees or more from up, +y) whose
+   rows lie within 10 degrees of level, as the tile pipeline lays them:
+   the rows are the pair of opposite sides further from up, their mean
+   direction taken against the level direction in the quad's plane. */
+static double remesh_rows_level_share(const tt_mesh *q)
+{
+    int f, walls = 0, level = 0;
+    for (f = 0; f < q->nfaces; f++) {
+        const int *v = q->corner_vert + q->face_start[f];
+        double p[4][3], pair[2][3], along[2], up[3], ul;
+        float n[3];
+        int j, k;
+        if (q->face_start[f + 1] - q->face_start[f] != 4) continue;
+        tt_face_normal(q, f, n);
+        if (fabs(n[1]) > 0.7071) continue;
+        for (j = 0; j < 4; j++)
+            for (k = 0; k < 3; k++) p[j][k] = q->pos[3 * v[j] + k];
+        for (k = 0; k < 3; k++) {
+            pair[0][k] = p[1][k] - p[0][k] + p[2][k] - p[3][k];
+            pair[1][k] = p[3][k] - p[0][k] + p[2][k] - p[1][k];
+            up[k] = (k == 1) - n[1] * n[k];
+        }
+        ul = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+        for (j = 0; j < 2; j++) {
+            double l = sqrt(pair[j][0] * pair[j][0] + pair[j][1] * pair[j][1] + pair[j][2] * pair[j][2]);
+            along[j] = l > 0 ? fabs(pair[j][0] * up[0] + pair[j][1] * up[1] + pair[j][2] * up[2]) / (l * ul) : 1.0;
+        }
+        walls++;
+        level += asin(fmin(1.0, fmin(along[0], along[1]))) <= 10.0 / 57.29577951308232;
+    }
+    return walls ? (double)level / walls : 0.0;
+}
+
 /* The normal of triangle (o, o + e, o + e + f), for the fold test. */
 static void remesh_cross(const double e[3], const double f[3], double out[3])
 {
@@ -2165,6 +2198,11 @@ static void test_remesh_sphere(void)
         share = remesh_aligned_share(q, &median);
         CHECK(median > 0.11 && median < 0.19, "median edge %.3f, asked 0.15", median);
         CHECK(share >= 0.85, "wall edges along or across up: %.3f", share);
+        /* The rows of the pairing's quads kept level too: the field's
+           lean in the cut, pairs sought along rows first (0.957 cut by
+           shape alone, along the nearest path). */
+        share = remesh_rows_level_share(q);
+        CHECK(share >= 0.97, "wall quads with rows within 10 degrees of level: %.3f", share);
         /* On the input's faces: between the icosphere's flattest point and the sphere. */
         for (v = 0; v < q->nverts; v++) {
             const float *p = q->pos + 3 * v;
@@ -2527,10 +2565,58 @@ static void test_remesh_ring_centroid(void)
     }
 }
 
+/* A quad's cost in the pairing's cut: a square level with the field's up
+   (+y) costs nothing; turned 30 degrees it costs more, but not where the
+   field weighs nothing; rows leaning cost more than columns leaning by
+   the same angle (the same shape, mirrored); a 3:1 rectangle, right
+   angled, costs more than a square; a folded quad more than any other. */
+static void test_remesh_quad_cost(void)
+{
+    float pos[3 * 4];
+    const int quad[4] = {0, 1, 2, 3};
+    double up[3 * 4], weight[4], square, turned, turned_free, rows_lean, columns_lean, long_one, folded, t;
+    internal_pair_field field;
+    int k;
+    for (k = 0; k < 4; k++) {
+        up[3 * k] = 0.0; up[3 * k + 1] = k == 2 ? -1.0 : 1.0; up[3 * k + 2] = 0.0;
+        weight[k] = 1.0;
+    }
+    field.up = up;
+    field.weight = weight;
+    field.n = 4;
+#define QUAD(x0, y0, x1, y1, x2, y2, x3, y3)                                                            \
+    (pos[0] = x0, pos[1] = y0, pos[3] = x1, pos[4] = y1, pos[6] = x2, pos[7] = y2, pos[9] = x3, pos[10] = y3, \
+     pos[2] = pos[5] = pos[8] = pos[11] = 0.0f)
+    QUAD(0.0f, 0.0f, 1.0f, 0.0f, 1.0f, 1.0f, 0.0f, 1.0f);
+    square = internal_remesh_quad_cost(pos, &field, quad);
+    t = 30.0 / 57.29577951308232;
+    QUAD(0.0f, 0.0f, (float)cos(t), (float)sin(t), (float)(cos(t) - sin(t)), (float)(sin(t) + cos(t)),
+         (float)-sin(t), (float)cos(t));
+    turned = internal_remesh_quad_cost(pos, &field, quad);
+    for (k = 0; k < 4; k++) weight[k] = 0.0;
+    turned_free = internal_remesh_quad_cost(pos, &field, quad);
+    for (k = 0; k < 4; k++) weight[k] = 1.0;
+    CHECK(fabs(square) < 1e-6 && turned > square + 1.0 && fabs(turned_free - square) < 1e-6,
+          "a square level %g, turned 30 degrees %g, turned where up weighs nothing %g", square, turned, turned_free);
+    QUAD(0.0f, 0.0f, 1.0f, 0.0f, 1.4f, 1.0f, 0.4f, 1.0f);     /* columns lean, rows level */
+    columns_lean = internal_remesh_quad_cost(pos, &field, quad);
+    QUAD(0.0f, 0.0f, 1.0f, 0.4f, 1.0f, 1.4f, 0.0f, 1.0f);     /* rows lean, columns plumb */
+    rows_lean = internal_remesh_quad_cost(pos, &field, quad);
+    CHECK(columns_lean > square && rows_lean > 2.0 * columns_lean,
+          "columns leaning cost %g, rows leaning by as much %g", columns_lean, rows_lean);
+    QUAD(0.0f, 0.0f, 3.0f, 0.0f, 3.0f, 1.0f, 0.0f, 1.0f);
+    long_one = internal_remesh_quad_cost(pos, NULL, quad);
+    QUAD(0.0f, 0.0f, 2.0f, 0.0f, 0.5f, 0.5f, 0.0f, 2.0f);     /* a dart: the triangles on one diagonal face apart */
+    folded = internal_remesh_quad_cost(pos, NULL, quad);
+    CHECK(long_one > 3.0 && folded > 1000.0 && folded < HUGE_VAL, "a 3:1 rectangle %g, a folded quad %g", long_one,
+          folded);
+#undef QUAD
+}
+
 /* The naive reference for the cut of a polygon into quads: every
    quadrangulation by diagonals, by recursion on the quad that holds the
    edge from corner i to corner j; the least summed cost. */
-static double naive_polygon_cut(const float *pos, const int *poly, int i, int j)
+static double naive_polygon_cut(const float *pos, const internal_pair_field *field, const int *poly, int i, int j)
 {
     double best = HUGE_VAL;
     int a, b;
@@ -2540,45 +2626,56 @@ static double naive_polygon_cut(const float *pos, const int *poly, int i, int j)
             int quad[4];
             double c;
             quad[0] = poly[i]; quad[1] = poly[a]; quad[2] = poly[b]; quad[3] = poly[j];
-            c = internal_remesh_quad_cost(pos, quad);
+            c = internal_remesh_quad_cost(pos, field, quad);
             if (c == HUGE_VAL) continue;
-            c += naive_polygon_cut(pos, poly, i, a) + naive_polygon_cut(pos, poly, a, b) +
-                 naive_polygon_cut(pos, poly, b, j);
+            c += naive_polygon_cut(pos, field, poly, i, a) + naive_polygon_cut(pos, field, poly, a, b) +
+                 naive_polygon_cut(pos, field, poly, b, j);
             if (c < best) best = c;
         }
     return best;
 }
 
-/* The lattice's odd faces are paired, each group cut into the quads
-   closest to square: the dynamic programme finds the least cost that
-   trying every cut finds, on random star-shaped polygons (some with
-   corners that fold every cut: a cost, not a refusal); the quads it
+/* The lattice's odd faces are paired, each group cut into the cheapest
+   quads: the dynamic programme finds the least cost that trying every
+   cut finds, on random star-shaped polygons (some with corners that fold
+   every cut: a cost, not a refusal), half of them with a random field
+   (an up at each corner but the last, weights from 0 to 1); the quads it
    returns use each polygon corner and cover the polygon's area; a
    corner marked needy gets a diagonal; a pair marked joined gets none. */
 static void test_remesh_polygon_cut(void)
 {
     float pos[3 * 12];
+    double up[3 * 12], weight[12];
     int poly[12], out[4 * 5], n, trial, k, mismatches = 0, uncovered = 0, unreached = 0, joined_used = 0;
     unsigned char joined[12 * 12], needy[12];
+    internal_pair_field field;
     lcg_seed(7);
     for (trial = 0; trial < 300; trial++) {
         double cost, reference, area = 0.0, quads_area = 0.0;
+        const internal_pair_field *with = trial & 1 ? &field : NULL;
         n = 4 + 2 * lcg_below(5);     /* 4 .. 12 */
         for (k = 0; k < n; k++) {
             double angle = 2.0 * 3.14159265358979 * (k + 0.8 * (lcg_unit() - 0.5)) / n;
-            double radius = 0.4 + lcg_unit();
+            double radius = 0.4 + lcg_unit(), turn = 0.6 * (lcg_unit() - 0.5);
             pos[3 * k] = (float)(radius * cos(angle));
             pos[3 * k + 1] = (float)(radius * sin(angle));
             pos[3 * k + 2] = (float)(0.05 * lcg_unit());
             poly[k] = k;
+            up[3 * k] = sin(turn);
+            up[3 * k + 1] = (k & 2 ? -1.0 : 1.0) * cos(turn);    /* either way along the line */
+            up[3 * k + 2] = 0.0;
+            weight[k] = lcg_unit();
         }
+        field.up = up;
+        field.weight = weight;
+        field.n = n - 1;
         memset(joined, 0, sizeof joined);
         memset(needy, 0, sizeof needy);
-        if (!internal_remesh_quadrangulate_polygon(pos, poly, n, joined, needy, &cost, out)) {
+        if (!internal_remesh_quadrangulate_polygon(pos, with, poly, n, joined, needy, &cost, out)) {
             mismatches++;
             continue;
         }
-        reference = naive_polygon_cut(pos, poly, 0, n - 1);
+        reference = naive_polygon_cut(pos, with, poly, 0, n - 1);
         mismatches += fabs(cost - reference) > 1e-9 * (1.0 + reference);
         for (k = 0; k < n; k++) {
             const float *p = pos + 3 * k, *r = pos + 3 * ((k + 1) % n);
@@ -2597,7 +2694,7 @@ static void test_remesh_polygon_cut(void)
             int reached = 0;
             needy[3] = 1;
             joined[0 * n + 2] = joined[2 * n + 0] = 1;
-            if (internal_remesh_quadrangulate_polygon(pos, poly, n, joined, needy, &cost, out)) {
+            if (internal_remesh_quadrangulate_polygon(pos, with, poly, n, joined, needy, &cost, out)) {
                 for (k = 0; k < n / 2 - 1; k++) {
                     int j;
                     for (j = 0; j < 4; j++) {
@@ -2644,6 +2741,7 @@ void run_mesh_tests(void)
 {
     RUN(test_builder_unknown_flags);
     RUN(test_remesh_polygon_cut);
+    RUN(test_remesh_quad_cost);
     RUN(test_builder_valid);
     RUN(test_builder_errors);
     RUN(test_builder_oom);

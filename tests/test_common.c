@@ -450,18 +450,30 @@ void internal_remesh_ring_centroid(const tt_mesh *q, int first, int count, int r
 {
     tt__remesh_ring_centroid(q, first, count, ring, out);
 }
-int internal_remesh_quadrangulate_polygon(const float *pos, const int *poly, int n, const unsigned char *joined,
-                                          const unsigned char *needy, double *cost, int *out)
+static const tt__pair_field *internal_pair_field_to(const internal_pair_field *field, tt__pair_field *out)
+{
+    if (!field || !field->up) return NULL;
+    out->up = field->up;
+    out->weight = field->weight;
+    out->n = field->n;
+    return out;
+}
+int internal_remesh_quadrangulate_polygon(const float *pos, const internal_pair_field *field, const int *poly, int n,
+                                          const unsigned char *joined, const unsigned char *needy, double *cost,
+                                          int *out)
 {
     int choice[TT__PAIR_MAX_CORNERS * TT__PAIR_MAX_CORNERS];
     double table[TT__PAIR_MAX_CORNERS * TT__PAIR_MAX_CORNERS];
-    int found = tt__remesh_quadrangulate_polygon(pos, poly, n, joined, needy, table, choice, out);
+    tt__pair_field f;
+    int found = tt__remesh_quadrangulate_polygon(pos, internal_pair_field_to(field, &f), poly, n, joined, needy, table,
+                                                 choice, out);
     *cost = table[n - 1];
     return found;
 }
-double internal_remesh_quad_cost(const float *pos, const int quad[4])
+double internal_remesh_quad_cost(const float *pos, const internal_pair_field *field, const int quad[4])
 {
-    return tt__remesh_quad_cost(pos, quad);
+    tt__pair_field f;
+    return tt__remesh_quad_cost(pos, quad, internal_pair_field_to(field, &f));
 }
 int internal_mapping_merge(tt_polycube_mapping *mapping, const tt_mesh *mesh, double tolerance, int keep_shape)
 {

@@ -232,14 +232,21 @@ void internal_untangle_descend(int n, const double (*ring)[2][2], const double (
    (tt__remesh_ring_centroid): quads first .. first + count - 1, ring 0 its
    edge points, 1 its corners. */
 void internal_remesh_ring_centroid(const tt_mesh *q, int first, int count, int ring, double out[3]);
+/* Section 2's pairing field: up (3 per vertex, unit tangents) and weight
+   (1 per vertex) for the first n vertices of pos; up NULL for none. */
+typedef struct internal_pair_field {
+    const double *up, *weight;
+    int n;
+} internal_pair_field;
 /* Section 2's cut of polygon poly (n corners of pos, n even, at most 32)
-   into the quads closest to square (tt__remesh_quadrangulate_polygon):
-   n / 2 - 1 quads to out, their summed cost to *cost; 0 when none fits
-   joined and needy (n * n and n flags). */
-int internal_remesh_quadrangulate_polygon(const float *pos, const int *poly, int n, const unsigned char *joined,
-                                          const unsigned char *needy, double *cost, int *out);
-/* How far a quad is from square (tt__remesh_quad_cost). */
-double internal_remesh_quad_cost(const float *pos, const int quad[4]);
+   into the cheapest quads (tt__remesh_quadrangulate_polygon), with field
+   (NULL for none): n / 2 - 1 quads to out, their summed cost to *cost; 0
+   when none fits joined and needy (n * n and n flags). */
+int internal_remesh_quadrangulate_polygon(const float *pos, const internal_pair_field *field, const int *poly, int n,
+                                          const unsigned char *joined, const unsigned char *needy, double *cost,
+                                          int *out);
+/* A quad's cost in that cut (tt__remesh_quad_cost), with field (NULL for none). */
+double internal_remesh_quad_cost(const float *pos, const internal_pair_field *field, const int quad[4]);
 /* The position and weights of a split vertex interpolating three of mesh's vertices (tt__split_vertex_data). */
 /* tt_polycube_map's step 7 on `mapping` (in place): merges moving the
    texture up to `tolerance` quads, bounded by the shapes of their stars
