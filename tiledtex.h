@@ -33332,7 +33332,7 @@ static int tt__mapping_to_input(tt_polycube_mapping *mapping, const tt__refined 
 #define TT__MERGE_PASSES 12     /* passes over the vertices, each merging an independent set */
 #define TT__MERGE_QUADS 8       /* quads around a vertex beyond which it is left (a corner of S has 3 to 6) */
 #define TT__MERGE_AREA 1e-10    /* twice a triangle's area on S, in quads, below which a merge may not take it */
-#define TT__MERGE_STRETCH 1.5   /* a merge may stretch a triangle this much, or as much as its star's worst */
+#define TT__MERGE_STRETCH 2.0   /* a merge may stretch a triangle this much, or as much as its star's worst */
 #define TT__MERGE_DENSITY 1.25  /* ...and give it a density within this factor of the median, or within its star's */
 
 enum { TT__MERGE_FREE, TT__MERGE_STAYS, TT__MERGE_TOUCHED, TT__MERGE_GONE };
@@ -33722,7 +33722,7 @@ static void tt__merge_shape(const double q[3][3], const double st[3][2], double 
    than TT__MERGE_STRETCH, and with a density within the star's range, or
    within TT__MERGE_DENSITY of the median. So however far the texture is
    let move, no triangle ends more stretched than the split's worst (or
-   1.5), nor denser or sparser than the split's extremes (or that band):
+   2), nor denser or sparser than the split's extremes (or that band):
    merging without these bounds, the stretch's 95th percentile more than doubles
    on a coarse sphere (the unit test's control). */
 static int tt__merge_keeps_shape(const tt__merge *G, const tt__merge_try *T)
