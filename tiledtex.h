@@ -7541,6 +7541,7 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
 #define TT__PAIR_LAST_RESORT 256  /* faces paired along any path, at most */
 #define TT__PAIR_FOLDED 1e4       /* a folded quad's cost: above any cut of quads that fold none */
 #define TT__PAIR_SIDES 3.0        /* cost of a quad's sides per unit of log(one pair's length / the other's) */
+#define TT__PAIR_TAPER 1.0        /* ...and per unit of log(one side / the side opposite), each pair */
 #define TT__PAIR_ROWS 12.0        /* cost per radian that a quad's rows lean from level, where up decides */
 #define TT__PAIR_COLUMNS 0.3      /* ...and per radian its columns lean from up, as a share of that */
 
@@ -7555,14 +7556,15 @@ typedef struct tt__pair_field {
    angles' distances from a right angle, summed (at most 2 pi), plus
    TT__PAIR_SIDES times |log| of the ratio of its two pairs of opposite
    sides' lengths (an angle measure alone takes a long thin rectangle for a
-   square: a tile drawn out into a streak), plus, with a field, the lean
-   of its rows and columns at the corners' mean weight. Rows are the pair
-   of opposite sides further from the field's up, as the tile's quarter
-   turn takes them; their mean direction's angle from level counts fully,
-   the columns' from up TT__PAIR_COLUMNS as much (a column leaning turns
-   the joints between bricks, a row leaning the whole course). A folded
-   quad costs TT__PAIR_FOLDED more, one of zero area (which no mesh
-   takes) HUGE_VAL. */
+   square: a tile drawn out into a streak) and TT__PAIR_TAPER times that of
+   each side to the one opposite (a tile squeezed at one end), plus, with a
+   field, the lean of its rows and columns at the corners' mean weight.
+   Rows are the pair of opposite sides further from the field's up, as the
+   tile's quarter turn takes them; their mean direction's angle from level
+   counts fully, the columns' from up TT__PAIR_COLUMNS as much (a column
+   leaning turns the joints between bricks, a row leaning the whole
+   course). A folded quad costs TT__PAIR_FOLDED more, one of zero area
+   (which no mesh takes) HUGE_VAL. */
 static double tt__remesh_quad_cost(const float *pos, const int v[4], const tt__pair_field *field)
 {
     double corners[4][3], worst, cost, side[4], rows[3], columns[3], normal[3], a[3], b[3];
@@ -7581,6 +7583,8 @@ static double tt__remesh_quad_cost(const float *pos, const int v[4], const tt__p
     }
     if (side[0] + side[2] > 0.0 && side[1] + side[3] > 0.0)
         cost += TT__PAIR_SIDES * fabs(log((side[0] + side[2]) / (side[1] + side[3])));
+    if (side[0] > 0.0 && side[1] > 0.0 && side[2] > 0.0 && side[3] > 0.0)
+        cost += TT__PAIR_TAPER * (fabs(log(side[0] / side[2])) + fabs(log(side[1] / side[3])));
     if (!field) return cost;
     /* The corners' up, each turned to agree with the sum so far (a field
        may point either way along a line), and their weights. */

@@ -2569,12 +2569,14 @@ static void test_remesh_ring_centroid(void)
    (+y) costs nothing; turned 30 degrees it costs more, but not where the
    field weighs nothing; rows leaning cost more than columns leaning by
    the same angle (the same shape, mirrored); a 3:1 rectangle, right
-   angled, costs more than a square; a folded quad more than any other. */
+   angled, costs more than a square, a trapezoid more than the
+   parallelogram of its angles; a folded quad more than any other. */
 static void test_remesh_quad_cost(void)
 {
     float pos[3 * 4];
     const int quad[4] = {0, 1, 2, 3};
     double up[3 * 4], weight[4], square, turned, turned_free, rows_lean, columns_lean, long_one, folded, t;
+    double tapered, slanted;
     internal_pair_field field;
     int k;
     for (k = 0; k < 4; k++) {
@@ -2606,6 +2608,13 @@ static void test_remesh_quad_cost(void)
           "columns leaning cost %g, rows leaning by as much %g", columns_lean, rows_lean);
     QUAD(0.0f, 0.0f, 3.0f, 0.0f, 3.0f, 1.0f, 0.0f, 1.0f);
     long_one = internal_remesh_quad_cost(pos, NULL, quad);
+    /* corners of 60 and 120 degrees both, the same sums of opposite sides */
+    QUAD(0.0f, 0.0f, 3.0f, 0.0f, 2.42265f, 1.0f, 0.57735f, 1.0f);
+    tapered = internal_remesh_quad_cost(pos, NULL, quad);
+    QUAD(0.0f, 0.0f, 2.42265f, 0.0f, 3.0f, 1.0f, 0.57735f, 1.0f);
+    slanted = internal_remesh_quad_cost(pos, NULL, quad);
+    CHECK(tapered > slanted + 0.3, "a trapezoid %g, the parallelogram of its angles and sides' sums %g", tapered,
+          slanted);
     QUAD(0.0f, 0.0f, 2.0f, 0.0f, 0.5f, 0.5f, 0.0f, 2.0f);     /* a dart: the triangles on one diagonal face apart */
     folded = internal_remesh_quad_cost(pos, NULL, quad);
     CHECK(long_one > 3.0 && folded > 1000.0 && folded < HUGE_VAL, "a 3:1 rectangle %g, a folded quad %g", long_one,
