@@ -7540,6 +7540,7 @@ static void tt__remesh_ring_centroid(const tt_mesh *q, int first, int count, int
 #define TT__PAIR_ROUNDS 12        /* the faces a pair's path crosses, at most */
 #define TT__PAIR_LAST_RESORT 256  /* faces paired along any path, at most */
 #define TT__PAIR_FOLDED 1e4       /* a folded quad's cost: above any cut of quads that fold none */
+#define TT__PAIR_DRAWN_OUT 6.0    /* a quad with a side this many times another is refused until folds are allowed */
 #define TT__PAIR_SIDES 3.0        /* cost of a quad's sides per unit of log(one pair's length / the other's) */
 #define TT__PAIR_TAPER 1.0        /* ...and per unit of log(one side / the side opposite), each pair */
 #define TT__PAIR_ROWS 12.0        /* cost per radian that a quad's rows lean from level, where up decides */
@@ -7551,6 +7552,17 @@ typedef struct tt__pair_field {
     const double *weight;   /* per lattice vertex: how much it counts, 0 (tops) to 1 (walls) */
     int n;                  /* the lattice's vertices; the points the pairing adds have no field */
 } tt__pair_field;
+
+/* The lengths of quad v's sides, side j from corner j to corner j + 1. */
+static void tt__quad_sides(const float *pos, const int v[4], double side[4])
+{
+    int j, k;
+    for (j = 0; j < 4; j++) {
+        double e[3];
+        for (k = 0; k < 3; k++) e[k] = (double)pos[3 * (size_t)v[(j + 1) & 3] + k] - pos[3 * (size_t)v[j] + k];
+        side[j] = tt__length3(e);
+    }
+}
 
 /* How far quad v is from the quad the lattice would have: its corners'
    angles' distances from a right angle, summed (at most 2 pi), plus
@@ -7577,10 +7589,7 @@ static double tt__remesh_quad_cost(const float *pos, const int v[4], const tt__p
         p[j] = corners[j];
     }
     cost = (tt__quad_is_folded(pos, v) ? TT__PAIR_FOLDED : 0.0) + tt__quad_squareness(p, &worst);
-    for (j = 0; j < 4; j++) {
-        for (k = 0; k < 3; k++) a[k] = p[(j + 1) & 3][k] - p[j][k];
-        side[j] = tt__length3(a);
-    }
+    tt__quad_sides(pos, v, side);
     if (side[0] + side[2] > 0.0 && side[1] + side[3] > 0.0)
         cost += TT__PAIR_SIDES * fabs(log((side[0] + side[2]) / (side[1] + side[3])));
     if (side[0] > 0.0 && side[1] > 0.0 && side[2] > 0.0 && side[3] > 0.0)
@@ -7760,10 +7769,13 @@ static int tt__pairing_add_point(tt__pairing *P, int c)
 /* Cut the faces members[0 .. count - 1], stamped `current`, into quads:
    their outline (with the points added on its edges) must be one loop
    that meets no vertex twice, of an even number of corners, at most
-   TT__PAIR_MAX_CORNERS, and without allow_folded its cut must fold no
-   quad. With commit, the quads replace those of the groups the members
-   were in. Returns 1 when the cut exists. */
-static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int allow_folded, int commit)
+   TT__PAIR_MAX_CORNERS, and without allow_poor its cut must fold no quad
+   and draw none out (a side over TT__PAIR_DRAWN_OUT times another: a
+   streak of one tile, where the best cut of a group that runs along a
+   column can leave a quad several steps long). With commit, the quads
+   replace those of the groups the members were in. Returns 1 when the
+   cut exists. */
+static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int allow_poor, int commit)
 {
     const tt_mesh *lat = P->lat;
     int k, c, n = 0, nb = 0, start = -1, at, quads;
@@ -7864,7 +7876,7 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
     }
     if (n == 4) {
         double shape = tt__remesh_quad_cost(P->pos, P->poly, P->field);
-        if (shape == HUGE_VAL || (!allow_folded && shape >= TT__PAIR_FOLDED)) return 0;
+        if (shape == HUGE_VAL || (!allow_poor && shape >= TT__PAIR_FOLDED)) return 0;
         memcpy(P->quads + 4 * (size_t)P->nquads, P->poly, 4 * sizeof(int));
     } else {
         /* A cut that reaches every needy corner, or failing that any. */
@@ -7875,7 +7887,14 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
                                                   P->quads + 4 * (size_t)P->nquads))
                 return 0;
         }
-        if (!allow_folded && P->cost[n - 1] >= TT__PAIR_FOLDED) return 0;
+        if (!allow_poor && P->cost[n - 1] >= TT__PAIR_FOLDED) return 0;
+    }
+    for (k = 0; k < quads && !allow_poor; k++) {
+        double side[4];
+        tt__quad_sides(P->pos, P->quads + 4 * ((size_t)P->nquads + k), side);
+        if (fmax(fmax(side[0], side[1]), fmax(side[2], side[3])) >
+            TT__PAIR_DRAWN_OUT * fmin(fmin(side[0], side[1]), fmin(side[2], side[3])))
+            return 0;
     }
     if (!commit) return 1;
     for (k = 0; k < count; k++)
@@ -7925,9 +7944,9 @@ static int tt__pairing_take(tt__pairing *P, int f, int *members, int count)
 
 /* The pairing's phases, in order. */
 enum {
-    TT__PAIR_ALONG_ROWS,    /* nearest pairs along rows, no quad folded (with a field only) */
-    TT__PAIR_NEAREST,       /* nearest pairs every way, no quad folded */
-    TT__PAIR_FOLDING,       /* nearest pairs, a quad folded allowed */
+    TT__PAIR_ALONG_ROWS,    /* nearest pairs along rows, no quad folded or drawn out (with a field only) */
+    TT__PAIR_NEAREST,       /* nearest pairs every way, no quad folded or drawn out */
+    TT__PAIR_FOLDING,       /* nearest pairs, a quad folded or drawn out allowed */
     TT__PAIR_BOUNDARY,      /* an odd face with the nearest boundary edge's middle */
     TT__PAIR_ANY_PATH       /* with the nearest odd face along any path */
 };
@@ -8022,7 +8041,7 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, con
     for (phase = field ? TT__PAIR_ALONG_ROWS : TT__PAIR_NEAREST; phase <= TT__PAIR_ANY_PATH && !P->out_of_memory;
          phase++)
         for (round = 1; round <= (phase >= TT__PAIR_BOUNDARY ? 1 : TT__PAIR_ROUNDS); round++) {
-            const int reach = phase >= TT__PAIR_BOUNDARY ? nf : round, allow_folded = phase >= TT__PAIR_FOLDING;
+            const int reach = phase >= TT__PAIR_BOUNDARY ? nf : round, allow_poor = phase >= TT__PAIR_FOLDING;
             for (f = 0; f < nf && !P->out_of_memory; f++) {
                 int head = 0, tail = 0, found = -1, found_edge = -1;
                 if (!TT__ODD(f) || P->group[f] >= 0) continue;
@@ -8067,7 +8086,7 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, con
                         if (phase < TT__PAIR_ANY_PATH) {
                             P->current++;
                             for (y = g; y >= 0; y = from[y]) count = tt__pairing_take(P, y, members, count);
-                            if (tt__pairing_cut(P, members, count, allow_folded, 1)) found = g;
+                            if (tt__pairing_cut(P, members, count, allow_poor, 1)) found = g;
                             continue;
                         }
                         found = g;

@@ -2066,6 +2066,24 @@ static double remesh_rows_level_share(const tt_mesh *q)
     return walls ? (double)level / walls : 0.0;
 }
 
+/* Quads with a side more than `ratio` times another: a tile drawn into a streak. */
+static int remesh_drawn_out(const tt_mesh *q, double ratio)
+{
+    int f, j, count = 0;
+    for (f = 0; f < q->nfaces; f++) {
+        double lo = HUGE_VAL, hi = 0.0;
+        for (j = q->face_start[f]; j < q->face_start[f + 1]; j++) {
+            const float *a = q->pos + 3 * q->corner_vert[j], *b = q->pos + 3 * q->corner_vert[tt_mesh_next(q, j)];
+            double l = sqrt(((double)b[0] - a[0]) * (b[0] - a[0]) + ((double)b[1] - a[1]) * (b[1] - a[1]) +
+                            ((double)b[2] - a[2]) * (b[2] - a[2]));
+            lo = fmin(lo, l);
+            hi = fmax(hi, l);
+        }
+        count += hi > ratio * lo;
+    }
+    return count;
+}
+
 /* The normal of triangle (o, o + e, o + e + f), for the fold test. */
 static void remesh_cross(const double e[3], const double f[3], double out[3])
 {
@@ -2299,6 +2317,48 @@ static void test_remesh_topology(void)
         free(w);
         tt_mesh_free(mesh);
     }
+}
+
+/* A cone's walls: its circles shrink from radius 2 to 0.5 over a height
+   of 3, so a column of quads ends every few rows all the way up, and the
+   pairing's groups are on walls. Their rows stay level (the field's
+   lean in the cut, pairs sought along rows first), and few of their
+   quads are drawn out into streaks. */
+static void test_remesh_cone(void)
+{
+    tmesh m;
+    tt_mesh *mesh = NULL, *q = NULL;
+    tt_error err;
+    tt_remesh_options o;
+    float *vec, *w;
+    int i, j;
+    memset(&m, 0, sizeof m);
+    for (j = 0; j <= 30; j++)
+        for (i = 0; i < 60; i++) {
+            double a = 6.283185307179586 * i / 60, r = 2.0 - 1.5 * j / 30.0;
+            tm_vert(&m, r * cos(a), 0.1 * j, r * sin(a));
+        }
+    for (j = 0; j < 30; j++)
+        for (i = 0; i < 60; i++)
+            tm_quad(&m, j * 60 + i, (j + 1) * 60 + i, (j + 1) * 60 + (i + 1) % 60, j * 60 + (i + 1) % 60);
+    CHECK(build(&m, 0, &mesh, &err) == TT_OK, "cone: %s", err.message);
+    tm_free(&m);
+    if (!mesh) return;
+    remesh_field_new(mesh, &vec, &w);
+    o = remesh_options(0.15f, w);
+    CHECK(tt_remesh_quads(mesh, vec, &o, NULL, &q, NULL, &err) == TT_OK, "cone: %s", err.message);
+    if (q) {
+        const double level = remesh_rows_level_share(q);
+        const int drawn = remesh_drawn_out(q, 6.0);
+        /* 0.978; cut by shape alone along the nearest path, about 0.956 */
+        CHECK(level >= 0.97, "a cone's wall quads with rows within 10 degrees of level: %.3f", level);
+        CHECK(200 * drawn <= q->nfaces, "quads with a side over 6 times another: %d of %d", drawn, q->nfaces);
+        remesh_check_clean(q, "cone");
+    }
+    tt_mesh_free(q);
+    free(vec);
+    free(w);
+    tt_mesh_free(mesh);
 }
 
 /* Sharp edges stay sharp: a cube (side 2, 12 x 12 cells a face, in
@@ -2751,6 +2811,7 @@ void run_mesh_tests(void)
     RUN(test_builder_unknown_flags);
     RUN(test_remesh_polygon_cut);
     RUN(test_remesh_quad_cost);
+    RUN(test_remesh_cone);
     RUN(test_builder_valid);
     RUN(test_builder_errors);
     RUN(test_builder_oom);
