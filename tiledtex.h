@@ -8033,11 +8033,11 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, con
        searches reaching one face further each, across faces no group
        holds; with a field, first only along rows (where up decides, a
        search crosses only edges nearer up than level), then every way;
-       first for groups whose cut folds no quad, then for any. Then what
-       is left goes to the nearest boundary, through the middle of a
-       boundary edge; last, to the nearest odd face along any path,
-       through the middle of each edge it crosses (each group on the way
-       cut anew with those points as corners). */
+       first for groups whose cut folds no quad and draws none out, then
+       for any. Then what is left goes to the nearest boundary, through
+       the middle of a boundary edge; last, to the nearest odd face along
+       any path, through the middle of each edge it crosses (each group on
+       the way cut anew with those points as corners). */
     for (phase = field ? TT__PAIR_ALONG_ROWS : TT__PAIR_NEAREST; phase <= TT__PAIR_ANY_PATH && !P->out_of_memory;
          phase++)
         for (round = 1; round <= (phase >= TT__PAIR_BOUNDARY ? 1 : TT__PAIR_ROUNDS); round++) {
