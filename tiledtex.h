@@ -6444,6 +6444,16 @@ static void tt__rosy4_add(double *sum, const double *d, const double *n, double 
     for (k = 0; k < 3; k++) sum[k] += w * turned[k];
 }
 
+/* sum += w d, d first reversed when it points away from sum: a mean of
+   directions along lines (a field that may point either way along one),
+   accumulated; the 2-fold counterpart of tt__rosy4_add. */
+static void tt__line_add(double *sum, const double *d, double w)
+{
+    const double signed_w = tt__dot3(d, sum) < 0.0 ? -w : w;
+    int k;
+    for (k = 0; k < 3; k++) sum[k] += signed_w * d[k];
+}
+
 /* Each vertex's neighbours adj[start[i] .. start[i + 1]) sorted, repeats
    removed, the array closed up (start rewritten). */
 static void tt__remesh_unique_neighbours(int *start, int *adj, int n)
@@ -7595,13 +7605,10 @@ static double tt__remesh_quad_cost(const float *pos, const int v[4], const tt__p
     if (side[0] > 0.0 && side[1] > 0.0 && side[2] > 0.0 && side[3] > 0.0)
         cost += TT__PAIR_TAPER * (fabs(log(side[0] / side[2])) + fabs(log(side[1] / side[3])));
     if (!field) return cost;
-    /* The corners' up, each turned to agree with the sum so far (a field
-       may point either way along a line), and their weights. */
+    /* The corners' up and their weights. */
     for (j = 0; j < 4; j++)
         if (v[j] < field->n) {
-            const double *d = field->up + 3 * (size_t)v[j];
-            const double sign = tt__dot3(d, up) < 0.0 ? -1.0 : 1.0;
-            for (k = 0; k < 3; k++) up[k] += sign * d[k];
+            tt__line_add(up, field->up + 3 * (size_t)v[j], 1.0);
             weight += field->weight[v[j]];
             with_field++;
         }
@@ -7959,14 +7966,12 @@ static int tt__pairing_across_rows(const tt__pairing *P, int c)
     const tt_mesh *lat = P->lat;
     const tt__pair_field *field = P->field;
     const int a = lat->corner_vert[c], b = lat->corner_vert[tt_mesh_next(lat, c)];
-    double edge[3], up[3], sign, length, up_length;
+    double edge[3], up[3] = {0.0, 0.0, 0.0}, length, up_length;
     int k;
     if (!field || a >= field->n || b >= field->n || field->weight[a] + field->weight[b] < 1.0) return 0;
-    sign = tt__dot3(field->up + 3 * (size_t)a, field->up + 3 * (size_t)b) < 0.0 ? -1.0 : 1.0;
-    for (k = 0; k < 3; k++) {
-        edge[k] = (double)P->pos[3 * (size_t)b + k] - P->pos[3 * (size_t)a + k];
-        up[k] = field->up[3 * (size_t)a + k] + sign * field->up[3 * (size_t)b + k];
-    }
+    tt__line_add(up, field->up + 3 * (size_t)a, 1.0);
+    tt__line_add(up, field->up + 3 * (size_t)b, 1.0);
+    for (k = 0; k < 3; k++) edge[k] = (double)P->pos[3 * (size_t)b + k] - P->pos[3 * (size_t)a + k];
     length = tt__length3(edge);
     up_length = tt__length3(up);
     return length > 0.0 && up_length > 0.0 && fabs(tt__dot3(edge, up)) < sqrt(0.5) * length * up_length;
@@ -8183,9 +8188,8 @@ done:
 }
 
 /* The caller's field at each cluster, from the refined input's faces
-   around its members: the direction (turned to agree with the sum so
-   far, as a field may point either way along a line) by area times
-   weight, and the weight by area. The pairing reads the texture's up from
+   around its members: the direction (a mean along lines, tt__line_add)
+   by area times weight, and the weight by area. The pairing reads the texture's up from
    it; the smoothed 4-fold field would not tell up from across. Returns 0
    on allocation failure. */
 static int tt__remesh_cluster_field(const tt_allocator *al, const tt_mesh *m, const float *face_vectors,
@@ -8211,9 +8215,7 @@ static int tt__remesh_cluster_field(const tt_allocator *al, const tt_mesh *m, co
         if (!(share > 0.0) || tt__normalize3(d) == 0.0) continue;
         for (c = begin; c < end; c++) {
             const int cl = g->member_cluster[m->corner_vert[c]];
-            double *up = g->up + 3 * (size_t)cl;
-            const double sign = tt__dot3(d, up) < 0.0 ? -1.0 : 1.0;
-            for (k = 0; k < 3; k++) up[k] += sign * share * w * d[k];
+            tt__line_add(g->up + 3 * (size_t)cl, d, share * w);
             g->weight[cl] += share * w;
             area[cl] += share;
         }
