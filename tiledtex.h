@@ -7699,6 +7699,7 @@ typedef struct tt__pair_chord {
 typedef struct tt__pairing {
     const tt_mesh *lat;
     const tt__pair_field *field;    /* NULL: cut by shape alone */
+    int refuse_drawn_out;           /* 1: the phases that refuse folds refuse drawn-out quads too */
     const tt_allocator *al;
     int out_of_memory;
     int *stamp;             /* per face: in the group being cut when equal to `current` */
@@ -7777,9 +7778,10 @@ static int tt__pairing_add_point(tt__pairing *P, int c)
    their outline (with the points added on its edges) must be one loop
    that meets no vertex twice, of an even number of corners, at most
    TT__PAIR_MAX_CORNERS, and without allow_poor its cut must fold no quad
-   and draw none out (a side over TT__PAIR_DRAWN_OUT times another: a
-   streak of one tile, where the best cut of a group that runs along a
-   column can leave a quad several steps long). With commit, the quads
+   and, with P->refuse_drawn_out, draw none out (a side over
+   TT__PAIR_DRAWN_OUT times another: a streak of one tile, where the best
+   cut of a group that runs along a column can leave a quad several steps
+   long). With commit, the quads
    replace those of the groups the members were in. Returns 1 when the
    cut exists. */
 static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int allow_poor, int commit)
@@ -7896,7 +7898,7 @@ static int tt__pairing_cut(tt__pairing *P, const int *members, int count, int al
         }
         if (!allow_poor && P->cost[n - 1] >= TT__PAIR_FOLDED) return 0;
     }
-    for (k = 0; k < quads && !allow_poor; k++) {
+    for (k = 0; k < quads && !allow_poor && P->refuse_drawn_out; k++) {
         double side[4];
         tt__quad_sides(P->pos, P->quads + 4 * ((size_t)P->nquads + k), side);
         if (fmax(fmax(side[0], side[1]), fmax(side[2], side[3])) >
@@ -7983,11 +7985,13 @@ static int tt__pairing_across_rows(const tt__pairing *P, int c)
    last one pairs with the boundary through the middle of a boundary edge,
    and one that finds no partner near enough pairs with the nearest along
    any path, the middle of each edge it crosses a new corner). field may
-   be NULL (groups cut by shape alone). *nquads is -1 when some face could
+   be NULL (groups cut by shape alone); refuse_drawn_out as in
+   tt__pairing_cut. *nquads is -1 when some face could
    not be made quads, and the caller splits every face instead. Returns 0
    on allocation failure. */
 static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, const tt__pair_field *field,
-                                 int **quads, int *nquads, float **positions, int *npositions, int *paired)
+                                 int refuse_drawn_out, int **quads, int *nquads, float **positions, int *npositions,
+                                 int *paired)
 {
     int nf = lat->nfaces, nv = lat->nverts, f, k, ok = 0, failed = 0, round, phase, mark = 0, lone = 0;
     int last_resort = 0;
@@ -8004,6 +8008,7 @@ static int tt__remesh_pair_faces(const tt_allocator *al, const tt_mesh *lat, con
     if (!from || !queue || !seen || !members || !depth || !through || !P) goto done;
     P->lat = lat;
     P->field = field;
+    P->refuse_drawn_out = refuse_drawn_out;
     P->al = al;
     P->quad_capacity = lat->ncorners + 64;
     P->pos_capacity = 3 * (nv + 16);
@@ -8481,9 +8486,14 @@ static tt_result tt__remesh_output(const tt_allocator *al, const tt_mesh *m, con
     field.up = field_up;
     field.weight = field_weight;
     field.n = nverts;
-    if (!tt__remesh_pair_faces(al, lattice, &field, &paired_quads, &npaired, &paired_pos, &npaired_pos,
-                               &rep->paired_faces))
-        goto fail;
+    /* Refusing drawn-out quads early changes which faces pair, and can
+       strand one that the last resort cannot reach (the horse cut 1-to-4
+       into 388k triangles): the pairing then runs again without it,
+       before every face is split. */
+    for (k = 1; k >= 0 && npaired < 0; k--)
+        if (!tt__remesh_pair_faces(al, lattice, &field, k, &paired_quads, &npaired, &paired_pos, &npaired_pos,
+                                   &rep->paired_faces))
+            goto fail;
     if (npaired >= 0) {
         memset(&desc, 0, sizeof desc);
         desc.positions = paired_pos;
